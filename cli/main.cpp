@@ -1,0 +1,55 @@
+// `tessera`: the command-line front end. Dispatches to one subcommand per file.
+
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+
+#include "commands.hpp"
+#include "util/input_error.hpp"
+
+namespace {
+
+struct Command {
+  const char* name;
+  int (*run)(const tessera::cli::Args&);
+  const char* summary;
+};
+
+const Command kCommands[] = {
+    {"info", tessera::cli::run_info, "describe a pose graph (poses, edges, dimension, components)"},
+    {"generate", tessera::cli::run_generate, "write a synthetic multi-robot pose graph (g2o)"},
+    {"solve", tessera::cli::run_solve, "optimise a pose graph (centralized or distributed)"},
+    {"partition", tessera::cli::run_partition, "split a graph into balanced blocks"},
+};
+
+void print_usage() {
+  std::printf("usage: tessera <command> [options]   (tessera <command> --help for details)\n\n");
+  for (const auto& c : kCommands) std::printf("  %-10s %s\n", c.name, c.summary);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+    print_usage();
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string name = argv[1];
+  tessera::cli::Args args(argv + 2, argv + argc);
+  for (const auto& c : kCommands) {
+    if (name != c.name) continue;
+    try {
+      return c.run(args);
+    } catch (const tessera::InputError& e) {
+      std::fprintf(stderr, "tessera %s: error: %s\n", c.name, e.what());
+      return 2;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "tessera %s: internal error: %s\n", c.name, e.what());
+      return 3;
+    }
+  }
+  std::fprintf(stderr, "tessera: unknown command '%s'\n\n", name.c_str());
+  print_usage();
+  return 2;
+}

@@ -1,0 +1,45 @@
+#include "graph/connectivity.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace tessera {
+namespace {
+
+std::size_t find_root(std::vector<std::size_t>& parent, std::size_t v) {
+  while (parent[v] != v) {
+    parent[v] = parent[parent[v]];  // path halving keeps trees shallow
+    v = parent[v];
+  }
+  return v;
+}
+
+}  // namespace
+
+std::vector<std::size_t> connected_components(const PoseGraph& graph) {
+  const std::size_t n = graph.num_poses;
+  std::vector<std::size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& m : graph.measurements) {
+    if (m.i >= n || m.j >= n) continue;
+    std::size_t a = find_root(parent, m.i), b = find_root(parent, m.j);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+  std::vector<std::size_t> label(n), root_label(n, n);
+  std::size_t next = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    std::size_t r = find_root(parent, v);
+    if (root_label[r] == n) root_label[r] = next++;
+    label[v] = root_label[r];
+  }
+  return label;
+}
+
+std::size_t count_components(const PoseGraph& graph) {
+  auto labels = connected_components(graph);
+  std::size_t k = 0;
+  for (auto l : labels) k = std::max(k, l + 1);
+  return k;
+}
+
+}  // namespace tessera

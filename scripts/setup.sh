@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs every Debian package Tessera needs (skipped when already present), then
+# configures and builds into build/. Idempotent; a second run only rebuilds what changed.
+#   scripts/setup.sh            Release build
+#   TESSERA_WERROR=ON scripts/setup.sh   warnings as errors (CI)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(
+  build-essential cmake pkg-config
+  libeigen3-dev libsuitesparse-dev libspectra-dev
+  libgtest-dev
+  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
+  python3 python3-matplotlib
+  iproute2 nftables openssl
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+JOBS=$(nproc 2>/dev/null || echo 2)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTESSERA_WERROR="${TESSERA_WERROR:-OFF}" >/dev/null
+cmake --build build -j "$JOBS"

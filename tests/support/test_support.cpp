@@ -1,0 +1,52 @@
+#include "test_support.hpp"
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sys/wait.h>
+
+namespace tessera::test {
+
+std::string shared_dir() {
+  namespace fs = std::filesystem;
+  const char* env = std::getenv("TESSERA_SHARED_DIR");
+  fs::path p = env ? fs::path(env) : fs::path(TESSERA_SHARED_DIR);
+  if (fs::is_directory(p / "datasets")) return fs::weakly_canonical(p).string();
+  return "";
+}
+
+std::string temp_dir() {
+  namespace fs = std::filesystem;
+  std::random_device rd;
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string stem = info ? std::string(info->test_suite_name()) + "_" + info->name() : "tessera";
+  fs::path p = fs::temp_directory_path() / ("tessera_test_" + stem + "_" + std::to_string(rd()));
+  fs::create_directories(p);
+  return p.string();
+}
+
+std::string write_file(const std::string& dir, const std::string& name, const std::string& text) {
+  std::string path = dir + "/" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+int run_command(const std::string& command, std::string* output) {
+  std::string full = command + " 2>&1";
+  FILE* pipe = popen(full.c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 4096> buf{};
+  std::string out;
+  std::size_t got;
+  while ((got = fread(buf.data(), 1, buf.size(), pipe)) > 0) out.append(buf.data(), got);
+  int status = pclose(pipe);
+  if (output) *output = out;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string bin(const std::string& name) { return std::string(TESSERA_BIN_DIR) + "/" + name; }
+
+}  // namespace tessera::test

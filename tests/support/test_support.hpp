@@ -1,0 +1,34 @@
+#pragma once
+// Helpers shared by the tests: where ../shared lives, temporary files, running binaries.
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace tessera::test {
+
+/// The shared data folder (datasets/, reference/) configured at build time, or "" when it
+/// does not exist on this machine.
+std::string shared_dir();
+
+/// A fresh temporary directory for this test, removed by the OS eventually.
+std::string temp_dir();
+
+/// Writes `text` into `dir/name` and returns the path.
+std::string write_file(const std::string& dir, const std::string& name, const std::string& text);
+
+/// Runs a shell command, returns its exit code and captures stdout+stderr into `output`.
+int run_command(const std::string& command, std::string* output);
+
+/// Path of a built executable (build/bin/NAME).
+std::string bin(const std::string& name);
+
+}  // namespace tessera::test
+
+/// Skips the current test with a clear message when ../shared is not there.
+#define TESSERA_REQUIRE_SHARED()                                                          \
+  do {                                                                                    \
+    if (tessera::test::shared_dir().empty())                                              \
+      GTEST_SKIP() << "../shared (datasets and reference optima) is missing next to the " \
+                      "checkout: skipping this dataset test";                             \
+  } while (0)
