@@ -1,0 +1,500 @@
+#include "io/g2o_reader.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "graph/connectivity.hpp"
+#include "io/information_weights.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera {
+namespace {
+
+// The longest record (EDGE_SE3:QUAT) has 31 tokens; longer lines are only counted.
+constexpr std::size_t kMaxTokens = 32;
+// Ids are bounded so that pairs pack into 64 bits and n stays an int-sized count.
+constexpr std::uint64_t kMaxPoseId = 2147483646;
+// Quaternions shorter than this cannot be turned into a rotation meaningfully.
+constexpr double kMinQuaternionNorm = 1e-6;
+
+struct RecordSpec {
+  const char* tag;
+  int d;
+  bool edge;
+  std::size_t values;  // tokens after the tag
+  const char* layout;
+};
+
+const RecordSpec kSpecs[] = {
+    {"VERTEX_SE2", 2, false, 4, "id x y theta"},
+    {"EDGE_SE2", 2, true, 11, "i j dx dy dtheta and 6 information values"},
+    {"VERTEX_SE3:QUAT", 3, false, 8, "id x y z qx qy qz qw"},
+    {"EDGE_SE3:QUAT", 3, true, 30, "i j x y z qx qy qz qw and 21 information values"},
+};
+
+// Name of value k (0-based, after the tag) of a record, for error messages.
+std::string field_name(const RecordSpec& spec, std::size_t k) {
+  static const char* const kVertex2[] = {"id", "x", "y", "theta"};
+  static const char* const kVertex3[] = {"id", "x", "y", "z", "qx", "qy", "qz", "qw"};
+  static const char* const kEdge2[] = {"i", "j", "dx", "dy", "dtheta"};
+  static const char* const kEdge3[] = {"i", "j", "x", "y", "z", "qx", "qy", "qz", "qw"};
+  if (!spec.edge) return spec.d == 2 ? kVertex2[k] : kVertex3[k];
+  const std::size_t head = spec.d == 2 ? 5 : 9;
+  if (k < head) return spec.d == 2 ? kEdge2[k] : kEdge3[k];
+  // Information entry number k - head of the row-major upper triangle.
+  int size = spec.d == 2 ? 3 : 6, idx = static_cast<int>(k - head), r = 0;
+  while (idx >= size - r) idx -= size - r++;
+  return "I" + std::to_string(r + 1) + std::to_string(r + 1 + idx);
+}
+
+bool is_blank(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+// A token quoted for a message: at most 40 bytes, non-printable bytes as \xNN.
+std::string quoted(std::string_view s) {
+  std::string out = "'";
+  std::size_t k = 0;
+  for (; k < s.size() && k < 40; ++k) {
+    const auto c = static_cast<unsigned char>(s[k]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    }
+  }
+  if (k < s.size()) out += "...";
+  return out + "'";
+}
+
+std::string number_text(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+// Parses a whole token as a double. Returns false if it is not a number at all; the value
+// may be non-finite (the caller says so). A leading '+' is accepted, as strtod would.
+bool parse_number(std::string_view s, double& out) {
+  const char* b = s.data();
+  const char* e = b + s.size();
+  if (b != e && *b == '+') {
+    ++b;
+    if (b == e || *b == '-' || *b == '+') return false;
+  }
+  if (b == e) return false;
+  auto [ptr, ec] = std::from_chars(b, e, out, std::chars_format::general);
+  if (ec == std::errc() && ptr == e) return true;
+  if (ec != std::errc::result_out_of_range || ptr != e) return false;
+  // Out of range: overflow becomes inf (rejected by the caller), underflow a tiny value.
+  const std::string copy(b, e);
+  char* end = nullptr;
+  out = std::strtod(copy.c_str(), &end);
+  return end == copy.c_str() + copy.size();
+}
+
+struct VertexRecord {
+  std::uint64_t id;
+  std::size_t line;
+  std::array<double, 7> v;  // x y theta (2D) or x y z qx qy qz qw (3D, normalised)
+};
+
+// Rotation from a quaternion with the unit-quaternion formula (the one SE-Sync applies,
+// also to a quaternion that is not exactly unit).
+Eigen::MatrixXd rotation_from_quaternion(double x, double y, double z, double w) {
+  const double tx = 2 * x, ty = 2 * y, tz = 2 * z;
+  const double twx = tx * w, twy = ty * w, twz = tz * w;
+  const double txx = tx * x, txy = ty * x, txz = tz * x;
+  const double tyy = ty * y, tyz = tz * y, tzz = tz * z;
+  Eigen::MatrixXd R(3, 3);
+  R << 1 - (tyy + tzz), txy - twz, txz + twy,  //
+      txy + twz, 1 - (txx + tzz), tyz - twx,   //
+      txz - twy, tyz + twx, 1 - (txx + tyy);
+  return R;
+}
+
+class Parser {
+ public:
+  Parser(std::string_view text, const std::string& name, const G2oReadOptions& options)
+      : text_(text), name_(name), options_(options) {}
+
+  G2oReadResult run() {
+    options_.validate();
+    result_.graph.source = name_;
+    // A UTF-8 byte-order mark from some editors is not part of the first tag.
+    if (text_.size() >= 3 && text_.compare(0, 3, "\xEF\xBB\xBF") == 0) text_.remove_prefix(3);
+    const char* p = text_.data();
+    const char* const end = p + text_.size();
+    while (p < end) {
+      const auto* nl = static_cast<const char*>(std::memchr(p, '\n', end - p));
+      const char* eol = nl ? nl : end;
+      ++line_;
+      parse_line(p, eol);
+      p = nl ? nl + 1 : end;
+    }
+    stats().lines = line_;
+    finish();
+    return std::move(result_);
+  }
+
+ private:
+  G2oReadStats& stats() { return result_.stats; }
+
+  [[noreturn]] void fail(std::size_t line, const std::string& what) const {
+    throw InputError(name_, line, what);
+  }
+
+  void parse_line(const char* p, const char* eol) {
+    count_ = 0;
+    while (p < eol) {
+      while (p < eol && is_blank(*p)) ++p;
+      if (p == eol) break;
+      const char* s = p;
+      while (p < eol && !is_blank(*p)) ++p;
+      if (count_ < kMaxTokens) tok_[count_] = std::string_view(s, p - s);
+      ++count_;
+    }
+    if (count_ == 0) {
+      ++stats().blank_lines;
+      return;
+    }
+    const std::string_view tag = tok_[0];
+    if (tag[0] == '#') {
+      ++stats().comment_lines;
+      return;
+    }
+    if (tag == "FIX") {
+      // Fixing a pose only chooses the gauge, which the solvers choose themselves.
+      if (count_ < 2) fail(line_, "FIX needs at least one pose id");
+      for (std::size_t k = 1; k < count_ && k < kMaxTokens; ++k) parse_id(tok_[k], "FIX pose id");
+      if (count_ > kMaxTokens) fail(line_, "FIX line has too many fields");
+      ++stats().fix_lines;
+      return;
+    }
+    const RecordSpec* spec = nullptr;
+    for (const auto& s : kSpecs)
+      if (tag == s.tag) spec = &s;
+    if (!spec)
+      fail(line_, "unknown tag " + quoted(tag) +
+                      " (expected VERTEX_SE2, EDGE_SE2, VERTEX_SE3:QUAT, EDGE_SE3:QUAT or FIX)");
+    if (count_ - 1 != spec->values)
+      fail(line_, std::string(spec->tag) + " needs " + std::to_string(spec->values) + " values (" +
+                      spec->layout + "), found " + std::to_string(count_ - 1));
+    if (d_ == 0) {
+      d_ = spec->d;
+      d_line_ = line_;
+      d_tag_ = spec->tag;
+      result_.graph.d = d_;
+    } else if (d_ != spec->d) {
+      fail(line_, "mixed 2D and 3D records: " + std::string(spec->tag) + " here, but line " +
+                      std::to_string(d_line_) + " has " + d_tag_);
+    }
+    if (spec->edge)
+      parse_edge(*spec);
+    else
+      parse_vertex(*spec);
+  }
+
+  std::uint64_t parse_id(std::string_view s, const std::string& role) {
+    if (!s.empty() && s[0] == '-') {
+      double x;
+      if (parse_number(s, x)) fail(line_, role + " " + quoted(s) + " is negative");
+    }
+    std::uint64_t id = 0;
+    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), id);
+    if (ptr != s.data() + s.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
+      fail(line_, role + " " + quoted(s) + " is not a non-negative integer");
+    if (ec == std::errc::result_out_of_range || id > kMaxPoseId)
+      fail(line_,
+           role + " " + quoted(s) + " is too large (at most " + std::to_string(kMaxPoseId) + ")");
+    return id;
+  }
+
+  // Values first..spec.values-1 (after the tag) as finite doubles into vals_.
+  void parse_values(const RecordSpec& spec, std::size_t first) {
+    for (std::size_t k = first; k < spec.values; ++k) {
+      const std::string_view s = tok_[k + 1];
+      double x;
+      if (!parse_number(s, x))
+        fail(line_, std::string(spec.tag) + " " + field_name(spec, k) + " (column " +
+                        std::to_string(k + 2) + "): " + quoted(s) + " is not a number");
+      if (!std::isfinite(x))
+        fail(line_, std::string(spec.tag) + " " + field_name(spec, k) + " (column " +
+                        std::to_string(k + 2) + "): " + quoted(s) + " is not finite");
+      vals_[k] = x;
+    }
+  }
+
+  double quaternion_norm(const double* q) {
+    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!(norm >= kMinQuaternionNorm))
+      fail(line_, "zero quaternion (norm " + number_text(norm) + "): not a rotation");
+    if (!std::isfinite(norm)) fail(line_, "quaternion too large to normalise");
+    return norm;
+  }
+
+  void parse_vertex(const RecordSpec& spec) {
+    VertexRecord v{parse_id(tok_[1], "pose id"), line_, {}};
+    parse_values(spec, 1);
+    std::copy(vals_.begin() + 1, vals_.begin() + spec.values, v.v.begin());
+    if (spec.d == 3) {
+      // The initial guess must lie on SE(3), so vertex quaternions are always normalised.
+      const double norm = quaternion_norm(&v.v[3]);
+      for (int k = 3; k < 7; ++k) v.v[k] /= norm;
+    }
+    vertices_.push_back(v);
+    ++stats().vertex_lines;
+  }
+
+  void parse_edge(const RecordSpec& spec) {
+    const std::uint64_t i = parse_id(tok_[1], "pose id i");
+    const std::uint64_t j = parse_id(tok_[2], "pose id j");
+    if (i == j) fail(line_, "self-loop: edge from pose " + std::to_string(i) + " to itself");
+    parse_values(spec, 2);
+    Measurement m;
+    m.i = static_cast<std::size_t>(i);
+    m.j = static_cast<std::size_t>(j);
+    const double* info;
+    IsotropicWeights w;
+    if (spec.d == 2) {
+      const double c = std::cos(vals_[4]), s = std::sin(vals_[4]);
+      m.R.resize(2, 2);
+      m.R << c, -s, s, c;
+      m.t.resize(2);
+      m.t << vals_[2], vals_[3];
+      info = &vals_[5];
+      w = isotropic_weights_2d(info);
+    } else {
+      m.t.resize(3);
+      m.t << vals_[2], vals_[3], vals_[4];
+      double* q = &vals_[5];
+      const double norm = quaternion_norm(q);
+      stats().max_quaternion_norm_error =
+          std::max(stats().max_quaternion_norm_error, std::abs(norm - 1.0));
+      if (options_.normalize_quaternions)
+        for (int k = 0; k < 4; ++k) q[k] /= norm;
+      m.R = rotation_from_quaternion(q[0], q[1], q[2], q[3]);
+      info = &vals_[9];
+      w = isotropic_weights_3d(info);
+    }
+    if (!upper_triangle_is_positive_definite(info, spec.d == 2 ? 3 : 6)) {
+      if (stats().non_pd_information++ == 0) stats().first_non_pd_line = line_;
+    }
+    if (!(std::isfinite(w.tau) && w.tau > 0))
+      fail(line_, "the information matrix gives translation weight tau = " + number_text(w.tau) +
+                      " (must be finite and > 0): its translation block is singular or not "
+                      "positive definite");
+    if (!(std::isfinite(w.kappa) && w.kappa > 0))
+      fail(line_, "the information matrix gives rotation weight kappa = " + number_text(w.kappa) +
+                      " (must be finite and > 0): its rotation " +
+                      (spec.d == 2 ? "entry I33 is not positive"
+                                   : "block is singular or not positive definite"));
+    m.kappa = w.kappa;
+    m.tau = w.tau;
+    result_.graph.measurements.push_back(std::move(m));
+    edge_lines_.push_back(line_);
+    ++stats().edge_lines;
+  }
+
+  void finish() {
+    auto& g = result_.graph;
+    if (g.measurements.empty())
+      fail(0, line_ == 0 ? "empty file: no pose-graph edges"
+                         : "no edges (EDGE_SE2 or EDGE_SE3:QUAT lines): nothing to optimise");
+    std::uint64_t n = 0;
+    if (!vertices_.empty()) {
+      n = check_vertices();
+    } else {
+      n = check_edge_ids();
+    }
+    g.num_poses = static_cast<std::size_t>(n);
+    if (!vertices_.empty()) {
+      g.initial.resize(g.num_poses);
+      for (const auto& v : vertices_) {
+        Pose& pose = g.initial[v.id];
+        if (d_ == 2) {
+          const double c = std::cos(v.v[2]), s = std::sin(v.v[2]);
+          pose.R.resize(2, 2);
+          pose.R << c, -s, s, c;
+          pose.t.resize(2);
+          pose.t << v.v[0], v.v[1];
+        } else {
+          pose.R = rotation_from_quaternion(v.v[3], v.v[4], v.v[5], v.v[6]);
+          pose.t.resize(3);
+          pose.t << v.v[0], v.v[1], v.v[2];
+        }
+      }
+    }
+    count_pairs();
+    const auto labels = connected_components(g);
+    std::size_t k = 0, outside = 0;
+    for (std::size_t v = 0; v < labels.size(); ++v) {
+      if (labels[v] + 1 > k) k = labels[v] + 1;
+      if (labels[v] != 0 && outside == 0) outside = v;
+    }
+    stats().components = k;
+    if (k > 1 && !options_.allow_disconnected)
+      fail(0, "the graph is disconnected: " + std::to_string(k) +
+                  " connected components (no chain of edges links pose " + std::to_string(outside) +
+                  " to pose 0)");
+  }
+
+  // With VERTEX lines: ids unique, every edge endpoint a vertex, ids exactly 0..n-1.
+  std::uint64_t check_vertices() {
+    std::vector<std::pair<std::uint64_t, std::size_t>> ids;  // (id, line)
+    ids.reserve(vertices_.size());
+    for (const auto& v : vertices_) ids.emplace_back(v.id, v.line);
+    std::sort(ids.begin(), ids.end());
+    std::size_t dup_line = 0, dup_first = 0;
+    std::uint64_t dup_id = 0;
+    for (std::size_t k = 1; k < ids.size(); ++k) {
+      if (ids[k].first == ids[k - 1].first && (dup_line == 0 || ids[k].second < dup_line)) {
+        dup_line = ids[k].second;
+        dup_first = ids[k - 1].second;
+        dup_id = ids[k].first;
+      }
+    }
+    if (dup_line)
+      fail(dup_line, "duplicate VERTEX id " + std::to_string(dup_id) + " (first on line " +
+                         std::to_string(dup_first) + ")");
+    const std::uint64_t n = ids.back().first + 1;
+    const bool dense = n == ids.size();
+    auto has_vertex = [&](std::uint64_t id) {
+      if (dense) return id < n;
+      auto it = std::lower_bound(ids.begin(), ids.end(), std::make_pair(id, std::size_t{0}));
+      return it != ids.end() && it->first == id;
+    };
+    const auto& ms = result_.graph.measurements;
+    for (std::size_t e = 0; e < ms.size(); ++e) {
+      for (std::size_t id : {ms[e].i, ms[e].j})
+        if (!has_vertex(id))
+          fail(edge_lines_[e], "edge to missing pose " + std::to_string(id) +
+                                   " (the file has VERTEX lines, but none for this id)");
+    }
+    if (!dense) {
+      std::uint64_t missing = 0;
+      while (missing < ids.size() && ids[missing].first == missing) ++missing;
+      fail(0, "pose id " + std::to_string(missing) + " appears on no line, but ids must be 0.." +
+                  std::to_string(n - 1) + " (largest VERTEX id " + std::to_string(n - 1) +
+                  " on line " + std::to_string(ids.back().second) + ")");
+    }
+    return n;
+  }
+
+  // Without VERTEX lines: n = 1 + the largest edge id and every id 0..n-1 must be used.
+  std::uint64_t check_edge_ids() {
+    const auto& ms = result_.graph.measurements;
+    std::uint64_t max_id = 0;
+    std::size_t max_line = 0;
+    for (std::size_t e = 0; e < ms.size(); ++e) {
+      const std::uint64_t m = std::max(ms[e].i, ms[e].j);
+      if (m > max_id || max_line == 0) {
+        max_id = m;
+        max_line = edge_lines_[e];
+      }
+    }
+    const std::uint64_t n = max_id + 1;
+    // 2E endpoints cannot cover more than 2E ids, so a bitmap of 2E + 1 entries always finds
+    // the smallest unused id without allocating for a huge bogus id.
+    const std::uint64_t limit = std::min<std::uint64_t>(n, 2 * ms.size() + 1);
+    std::vector<char> seen(limit, 0);
+    for (const auto& m : ms) {
+      if (m.i < limit) seen[m.i] = 1;
+      if (m.j < limit) seen[m.j] = 1;
+    }
+    for (std::uint64_t id = 0; id < limit; ++id)
+      if (!seen[id])
+        fail(0, "pose id " + std::to_string(id) + " appears on no line, but ids must be 0.." +
+                    std::to_string(max_id) + " (largest id " + std::to_string(max_id) +
+                    " on line " + std::to_string(max_line) + ")");
+    return n;
+  }
+
+  void count_pairs() {
+    const auto& ms = result_.graph.measurements;
+    std::vector<std::uint64_t> keys;
+    keys.reserve(ms.size());
+    for (const auto& m : ms) {
+      if (m.i > m.j) ++stats().backward_edges;
+      const std::uint64_t a = std::min(m.i, m.j), b = std::max(m.i, m.j);
+      keys.push_back(a << 32 | b);
+    }
+    std::sort(keys.begin(), keys.end());
+    const std::size_t distinct = std::unique(keys.begin(), keys.end()) - keys.begin();
+    stats().distinct_pairs = distinct;
+    stats().parallel_edges = ms.size() - distinct;
+  }
+
+  std::string_view text_;
+  const std::string& name_;
+  const G2oReadOptions& options_;
+  G2oReadResult result_;
+  std::size_t line_ = 0;
+  std::array<std::string_view, kMaxTokens> tok_{};
+  std::size_t count_ = 0;
+  std::array<double, 30> vals_{};
+  int d_ = 0;
+  std::size_t d_line_ = 0;
+  std::string d_tag_;
+  std::vector<VertexRecord> vertices_;
+  std::vector<std::size_t> edge_lines_;
+};
+
+}  // namespace
+
+G2oReadResult read_g2o_text(std::string_view text, const std::string& name,
+                            const G2oReadOptions& options) {
+  return Parser(text, name, options).run();
+}
+
+G2oReadResult read_g2o_stream(std::istream& in, const std::string& name,
+                              const G2oReadOptions& options) {
+  if (!in) throw InputError(name, 0, "cannot read the input stream");
+  std::string data;
+  char buf[1 << 16];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) data.append(buf, in.gcount());
+  if (in.bad()) throw InputError(name, 0, "error while reading the input stream");
+  return read_g2o_text(data, name, options);
+}
+
+G2oReadResult read_g2o_file(const std::string& path, const G2oReadOptions& options) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw InputError(path, 0, std::string("cannot open the file: ") + std::strerror(errno));
+  std::string data;
+  // Read in one go when the size is known (regular files), then whatever follows.
+  if (std::fseek(f, 0, SEEK_END) == 0) {
+    const long size = std::ftell(f);
+    if (size > 0) data.resize(static_cast<std::size_t>(size));
+    std::rewind(f);
+  }
+  std::size_t have = std::fread(data.data(), 1, data.size(), f);
+  data.resize(have);
+  char buf[1 << 16];
+  std::size_t got;
+  while ((got = std::fread(buf, 1, sizeof buf, f)) > 0) data.append(buf, got);
+  const bool failed = std::ferror(f) != 0;
+  const int err = errno;
+  std::fclose(f);
+  if (failed) throw InputError(path, 0, std::string("cannot read the file: ") + std::strerror(err));
+  return read_g2o_text(data, path, options);
+}
+
+PoseGraph read_g2o(const std::string& path, const G2oReadOptions& options) {
+  return read_g2o_file(path, options).graph;
+}
+
+PoseGraph read_g2o(std::istream& in, const std::string& name, const G2oReadOptions& options) {
+  return read_g2o_stream(in, name, options).graph;
+}
+
+}  // namespace tessera
