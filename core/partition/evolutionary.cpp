@@ -1,0 +1,106 @@
+#include "partition/evolutionary.hpp"
+
+#include <algorithm>
+
+namespace tessera::partition_detail {
+namespace {
+
+struct Individual {
+  std::vector<int> part;
+  long long cut = 0;
+};
+
+std::vector<int> pair_label(const std::vector<int>& a, const std::vector<int>& b, int k) {
+  std::vector<int> label(a.size());
+  for (std::size_t v = 0; v < a.size(); ++v) label[v] = a[v] * k + b[v];
+  return label;
+}
+
+// Improves `p` by V-cycles that keep its blocks contractible.
+Individual vcycle(const WorkGraph& g, int k, const std::vector<long long>& ub, Individual ind,
+                  const CycleParams& cp, Rng& rng) {
+  std::vector<int> p = guided_cycle(g, k, ub, ind.part, ind.part, cp, rng);
+  const long long cut = edge_cut(g, p);
+  if (cut <= ind.cut) return {std::move(p), cut};
+  return ind;
+}
+
+Individual combine(const WorkGraph& g, int k, const std::vector<long long>& ub, const Individual& a,
+                   const Individual& b, const CycleParams& cp, Rng& rng) {
+  const Individual& better = a.cut <= b.cut ? a : b;
+  std::vector<int> p = guided_cycle(g, k, ub, pair_label(a.part, b.part, k), better.part, cp, rng);
+  const long long cut = edge_cut(g, p);
+  if (cut <= better.cut) return {std::move(p), cut};
+  return better;
+}
+
+int tournament(const std::vector<Individual>& pop, Rng& rng, int exclude) {
+  const int n = static_cast<int>(pop.size());
+  int a = rng.below(n), b = rng.below(n);
+  if (a == exclude) a = (a + 1) % n;
+  if (b == exclude) b = (b + 1) % n;
+  return pop[a].cut <= pop[b].cut ? a : b;
+}
+
+}  // namespace
+
+std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>& ub,
+                        const EvolutionParams& params, Rng& rng, const EvolutionTrace& trace) {
+  std::vector<Individual> pop;
+  auto best_cut = [&] {
+    long long b = pop.front().cut;
+    for (const auto& ind : pop) b = std::min(b, ind.cut);
+    return b;
+  };
+  for (int i = 0; i < std::max(1, params.population); ++i) {
+    Individual ind;
+    ind.part = multilevel_partition(g, k, ub, params.cycle, rng);
+    ind.cut = edge_cut(g, ind.part);
+    for (int c = 0; c < params.vcycles; ++c)
+      ind = vcycle(g, k, ub, std::move(ind), params.cycle, rng);
+    pop.push_back(std::move(ind));
+  }
+  if (trace)
+    trace("population",
+          std::to_string(pop.size()) + " multilevel runs + " + std::to_string(params.vcycles) +
+              " V-cycles each",
+          best_cut());
+  int improved = 0;
+  for (int gen = 0; gen < params.generations && pop.size() > 1; ++gen) {
+    Individual child;
+    if (rng.uniform() < params.mutation_rate) {
+      // Mutation: combine an individual with a fresh multilevel partition.
+      const int a = tournament(pop, rng, -1);
+      Individual fresh;
+      fresh.part = multilevel_partition(g, k, ub, params.cycle, rng);
+      fresh.cut = edge_cut(g, fresh.part);
+      child = combine(g, k, ub, pop[a], fresh, params.cycle, rng);
+    } else {
+      const int a = tournament(pop, rng, -1);
+      const int b = tournament(pop, rng, a);
+      child = combine(g, k, ub, pop[a], pop[b], params.cycle, rng);
+    }
+    // Replace the worst individual if the child is better and not already in the population.
+    int worst = 0;
+    for (int i = 1; i < static_cast<int>(pop.size()); ++i)
+      if (pop[i].cut > pop[worst].cut) worst = i;
+    bool duplicate = false;
+    for (const auto& ind : pop)
+      duplicate = duplicate || (ind.cut == child.cut && ind.part == child.part);
+    if (!duplicate && child.cut <= pop[worst].cut) {
+      if (child.cut < best_cut()) ++improved;
+      pop[worst] = std::move(child);
+    }
+  }
+  if (trace && params.generations > 0)
+    trace("evolution",
+          std::to_string(params.generations) + " combine/mutation steps, " +
+              std::to_string(improved) + " improved the best",
+          best_cut());
+  int best = 0;
+  for (int i = 1; i < static_cast<int>(pop.size()); ++i)
+    if (pop[i].cut < pop[best].cut) best = i;
+  return pop[best].part;
+}
+
+}  // namespace tessera::partition_detail

@@ -1,0 +1,31 @@
+#pragma once
+// Internal: a small memetic (evolutionary + multilevel) search in the style of KaHIP's KaFFPaE:
+// a population of multilevel partitions improved by combine operations (a guided V-cycle that
+// only contracts vertices the two parents put in the same blocks, started from the better
+// parent, so a child is never worse than it) and mutations (V-cycles and combines with fresh
+// partitions). Everything is counted in operations, not seconds, so a seed fixes the result.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "partition/multilevel.hpp"
+
+namespace tessera::partition_detail {
+
+struct EvolutionParams {
+  int population = 6;          ///< Individuals built by independent multilevel runs (+ V-cycles).
+  int vcycles = 1;             ///< Guided V-cycles applied to each new individual.
+  int generations = 20;        ///< Combine / mutation steps after the initial population.
+  double mutation_rate = 0.3;  ///< Share of steps that combine with a fresh partition instead.
+  CycleParams cycle;
+};
+
+/// Called after each phase with (phase name, detail, best cut so far).
+using EvolutionTrace = std::function<void(const std::string&, const std::string&, long long)>;
+
+/// Returns the best partition found.
+std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>& ub,
+                        const EvolutionParams& params, Rng& rng, const EvolutionTrace& trace);
+
+}  // namespace tessera::partition_detail

@@ -1,0 +1,185 @@
+#include "partition/kway_refinement.hpp"
+
+#include <algorithm>
+#include <climits>
+
+#include "partition/gain_queue.hpp"
+
+namespace tessera::partition_detail {
+namespace {
+
+// Connectivity of one vertex to the blocks around it, reused across calls.
+struct Connectivity {
+  std::vector<long long> conn;
+  std::vector<int> touched;
+  explicit Connectivity(int k) : conn(static_cast<std::size_t>(k), 0) {}
+
+  void compute(const WorkGraph& g, const std::vector<int>& part, int v) {
+    for (int b : touched) conn[b] = 0;
+    touched.clear();
+    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
+      const int b = part[g.adj[e]];
+      if (conn[b] == 0) touched.push_back(b);
+      conn[b] += g.ew[e];
+    }
+  }
+};
+
+struct Move {
+  int target = -1;
+  long long gain = LLONG_MIN;
+};
+
+// Best feasible move of v among the blocks it has neighbours in (ties: the lighter block).
+Move best_adjacent_move(const WorkGraph& g, const std::vector<int>& part,
+                        const std::vector<long long>& bw, const std::vector<long long>& ub,
+                        Connectivity& c, int v) {
+  c.compute(g, part, v);
+  const int own = part[v];
+  const long long internal = c.conn[own];
+  Move best;
+  for (int b : c.touched) {
+    if (b == own || bw[b] + g.vw[v] > ub[b]) continue;
+    const long long gain = c.conn[b] - internal;
+    if (gain > best.gain || (gain == best.gain && bw[b] < bw[best.target])) best = {b, gain};
+  }
+  return best;
+}
+
+// Heap key: the gain, with random low bits so equal gains are taken in random order.
+long long key_of(long long gain, Rng& rng) {
+  return gain * 1024 + static_cast<long long>(rng.next() & 1023);
+}
+
+}  // namespace
+
+long long kway_fm(const WorkGraph& g, int k, std::vector<int>& part,
+                  const std::vector<long long>& ub, const FmParams& params, Rng& rng) {
+  std::vector<long long> bw = block_weights(g, part, k);
+  long long cut = edge_cut(g, part);
+  if (k < 2) return cut;
+  Connectivity c(k);
+  GainQueue queue(g.n);
+  std::vector<char> locked(static_cast<std::size_t>(g.n), 0);
+  std::vector<std::pair<int, int>> moves;  // (vertex, block it came from)
+  for (int pass = 0; pass < params.max_passes; ++pass) {
+    queue.reset(g.n);
+    std::fill(locked.begin(), locked.end(), 0);
+    moves.clear();
+    for (int v : random_order(g.n, rng)) {
+      bool boundary = false;
+      for (int e = g.xadj[v]; e < g.xadj[v + 1] && !boundary; ++e)
+        boundary = part[g.adj[e]] != part[v];
+      if (!boundary) continue;
+      const Move m = best_adjacent_move(g, part, bw, ub, c, v);
+      if (m.target >= 0) queue.set(v, key_of(m.gain, rng));
+    }
+    long long delta = 0, best_delta = 0;
+    long long best_max = *std::max_element(bw.begin(), bw.end());  // tie breaker at equal cut
+    std::size_t best_len = 0;
+    int since_best = 0;
+    while (!queue.empty()) {
+      const long long key = queue.top_key();
+      const int v = queue.pop();
+      const Move m = best_adjacent_move(g, part, bw, ub, c, v);
+      if (m.target < 0) continue;
+      if (m.gain * 1024 + 1023 < key) {  // block weights changed since v was queued
+        queue.set(v, key_of(m.gain, rng));
+        continue;
+      }
+      const int from = part[v];
+      part[v] = m.target;
+      bw[from] -= g.vw[v];
+      bw[m.target] += g.vw[v];
+      locked[v] = 1;
+      moves.emplace_back(v, from);
+      delta -= m.gain;
+      bool better = delta < best_delta;
+      if (!better && delta == best_delta) {  // same cut: keep it if it is better balanced
+        const long long mx = *std::max_element(bw.begin(), bw.end());
+        better = mx < best_max;
+      }
+      if (better) {
+        best_delta = delta;
+        best_max = *std::max_element(bw.begin(), bw.end());
+        best_len = moves.size();
+        since_best = 0;
+      } else if (++since_best > params.stop_after) {
+        break;
+      }
+      for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
+        const int u = g.adj[e];
+        if (locked[u]) continue;
+        const Move mu = best_adjacent_move(g, part, bw, ub, c, u);
+        if (mu.target >= 0)
+          queue.set(u, key_of(mu.gain, rng));
+        else
+          queue.remove(u);
+      }
+    }
+    while (moves.size() > best_len) {
+      const auto [v, from] = moves.back();
+      moves.pop_back();
+      bw[part[v]] -= g.vw[v];
+      bw[from] += g.vw[v];
+      part[v] = from;
+    }
+    cut += best_delta;
+    if (best_delta == 0) break;
+  }
+  return cut;
+}
+
+bool rebalance(const WorkGraph& g, int k, std::vector<int>& part,
+               const std::vector<long long>& ub) {
+  std::vector<long long> bw = block_weights(g, part, k);
+  auto overloaded = [&](int b) { return bw[b] > ub[b]; };
+  bool any = false;
+  for (int b = 0; b < k; ++b) any = any || overloaded(b);
+  if (!any) return true;
+  Connectivity c(k);
+  // Best move of v anywhere: an adjacent block with room, or else the block with most room.
+  auto best_move = [&](int v) {
+    Move m = best_adjacent_move(g, part, bw, ub, c, v);
+    int roomiest = -1;
+    for (int b = 0; b < k; ++b)
+      if (b != part[v] && bw[b] + g.vw[v] <= ub[b] &&
+          (roomiest < 0 || ub[b] - bw[b] > ub[roomiest] - bw[roomiest]))
+        roomiest = b;
+    if (roomiest >= 0) {
+      const long long gain = c.conn[roomiest] - c.conn[part[v]];
+      if (gain > m.gain) m = {roomiest, gain};
+    }
+    return m;
+  };
+  GainQueue queue(g.n);
+  std::vector<char> moved(static_cast<std::size_t>(g.n), 0);
+  for (int v = 0; v < g.n; ++v) {
+    if (!overloaded(part[v])) continue;
+    const Move m = best_move(v);
+    // Lighter vertices first among equal gains: they overshoot less on coarse levels.
+    if (m.target >= 0) queue.set(v, m.gain * 4096 - std::min(g.vw[v], 4095));
+  }
+  while (!queue.empty()) {
+    const int v = queue.pop();
+    if (!overloaded(part[v])) continue;
+    const Move m = best_move(v);
+    if (m.target < 0) continue;
+    const int from = part[v];
+    part[v] = m.target;
+    bw[from] -= g.vw[v];
+    bw[m.target] += g.vw[v];
+    moved[v] = 1;
+    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
+      const int u = g.adj[e];
+      if (moved[u] || !overloaded(part[u])) continue;
+      const Move mu = best_move(u);
+      if (mu.target >= 0) queue.set(u, mu.gain * 4096 - std::min(g.vw[u], 4095));
+    }
+  }
+  for (int b = 0; b < k; ++b)
+    if (overloaded(b)) return false;
+  return true;
+}
+
+}  // namespace tessera::partition_detail

@@ -1,0 +1,27 @@
+#pragma once
+// Internal: local improvement of a k-way partition on one level of the hierarchy.
+
+#include <vector>
+
+#include "partition/work_graph.hpp"
+
+namespace tessera::partition_detail {
+
+struct FmParams {
+  int max_passes = 3;   ///< FM passes per call; stops early when a pass finds no improvement.
+  int stop_after = 60;  ///< A pass ends after this many moves without a new best cut.
+};
+
+/// Boundary k-way Fiduccia–Mattheyses: repeatedly moves the unlocked boundary vertex with the
+/// best gain to its best block whose weight stays within ub, accepting negative gains to climb
+/// out of local minima, then rolls back to the best cut seen in the pass. Never increases the cut
+/// and never puts a block above ub (blocks already above stay where they are or get lighter).
+/// Returns the new cut.
+long long kway_fm(const WorkGraph& g, int k, std::vector<int>& part,
+                  const std::vector<long long>& ub, const FmParams& params, Rng& rng);
+
+/// Moves vertices out of blocks heavier than ub[b], choosing the moves that cost the least cut.
+/// Returns true when every block ends within its bound (always possible with unit weights).
+bool rebalance(const WorkGraph& g, int k, std::vector<int>& part, const std::vector<long long>& ub);
+
+}  // namespace tessera::partition_detail

@@ -1,0 +1,63 @@
+#include "partition/multilevel.hpp"
+
+namespace tessera::partition_detail {
+namespace {
+
+// Projects the coarsest partition down level by level, rebalancing and refining on each.
+std::vector<int> uncoarsen(const WorkGraph& fine, const Hierarchy& h, std::vector<int> part, int k,
+                           const std::vector<long long>& ub, const CycleParams& params, Rng& rng,
+                           CycleStats* stats) {
+  for (int level = static_cast<int>(h.coarse.size()) - 1; level >= 0; --level) {
+    const WorkGraph& g = level > 0 ? h.coarse[level - 1] : fine;
+    const std::vector<int>& map = h.maps[level];
+    std::vector<int> finer(static_cast<std::size_t>(g.n));
+    for (int v = 0; v < g.n; ++v) finer[v] = part[map[v]];
+    part.swap(finer);
+    rebalance(g, k, part, ub);
+    const long long cut = kway_fm(g, k, part, ub, params.fm, rng);
+    if (stats && level == 0) stats->cut = cut;
+  }
+  if (stats && h.coarse.empty()) stats->cut = edge_cut(fine, part);
+  return part;
+}
+
+}  // namespace
+
+std::vector<int> multilevel_partition(const WorkGraph& g, int k, const std::vector<long long>& ub,
+                                      const CycleParams& params, Rng& rng, CycleStats* stats) {
+  const Hierarchy h = coarsen(g, nullptr, params.coarsening, rng);
+  const WorkGraph& top = h.top(g);
+  std::vector<int> part = initial_partition(top, k, ub, params.initial, rng);
+  if (stats) {
+    stats->levels = static_cast<int>(h.coarse.size());
+    stats->coarsest_vertices = top.n;
+    stats->coarsest_cut = edge_cut(top, part);
+  }
+  return uncoarsen(g, h, std::move(part), k, ub, params, rng, stats);
+}
+
+std::vector<int> guided_cycle(const WorkGraph& g, int k, const std::vector<long long>& ub,
+                              const std::vector<int>& label, const std::vector<int>& start,
+                              const CycleParams& params, Rng& rng, CycleStats* stats) {
+  const Hierarchy h = coarsen(g, &label, params.coarsening, rng);
+  const WorkGraph& top = h.top(g);
+  // Project `start` up to the coarsest level (constant on every cluster by construction).
+  std::vector<int> part = start;
+  for (const auto& map : h.maps) {
+    int cn = 0;
+    for (int c : map) cn = std::max(cn, c + 1);
+    std::vector<int> coarse(static_cast<std::size_t>(cn));
+    for (std::size_t v = 0; v < map.size(); ++v) coarse[map[v]] = part[v];
+    part.swap(coarse);
+  }
+  rebalance(top, k, part, ub);
+  kway_fm(top, k, part, ub, params.fm, rng);
+  if (stats) {
+    stats->levels = static_cast<int>(h.coarse.size());
+    stats->coarsest_vertices = top.n;
+    stats->coarsest_cut = edge_cut(top, part);
+  }
+  return uncoarsen(g, h, std::move(part), k, ub, params, rng, stats);
+}
+
+}  // namespace tessera::partition_detail

@@ -1,0 +1,40 @@
+#pragma once
+// Internal: one multilevel cycle (coarsen, partition the coarsest graph, project and refine back
+// up), used fresh, as a V-cycle on an existing partition, or to combine two partitions.
+
+#include <vector>
+
+#include "partition/coarsening.hpp"
+#include "partition/initial_partitioning.hpp"
+#include "partition/kway_refinement.hpp"
+#include "partition/work_graph.hpp"
+
+namespace tessera::partition_detail {
+
+struct CycleParams {
+  CoarseningParams coarsening;
+  InitialParams initial;
+  FmParams fm;
+};
+
+struct CycleStats {
+  int levels = 0;  ///< Coarse levels built.
+  int coarsest_vertices = 0;
+  long long coarsest_cut = 0;  ///< Cut right after initial partitioning (or projection).
+  long long cut = 0;           ///< Final cut.
+};
+
+/// A fresh multilevel partition of g into k blocks with block weights <= ub.
+std::vector<int> multilevel_partition(const WorkGraph& g, int k, const std::vector<long long>& ub,
+                                      const CycleParams& params, Rng& rng,
+                                      CycleStats* stats = nullptr);
+
+/// A V-cycle that keeps `start` representable on every level: coarsening only contracts
+/// vertices with the same `label` (e.g. the block of `start`, or a pair of blocks of two parents
+/// for combine), the coarsest graph starts from `start`, and FM refines on every level. The
+/// result is never worse than `start` (if `start` is balanced).
+std::vector<int> guided_cycle(const WorkGraph& g, int k, const std::vector<long long>& ub,
+                              const std::vector<int>& label, const std::vector<int>& start,
+                              const CycleParams& params, Rng& rng, CycleStats* stats = nullptr);
+
+}  // namespace tessera::partition_detail
