@@ -1,0 +1,129 @@
+#include "problem/block_problem.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace tessera {
+
+BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
+                           const std::vector<Measurement>& measurements)
+    : d_(d), owned_(std::move(owned)) {
+  std::unordered_map<std::size_t, std::size_t> owned_slot;
+  owned_slot.reserve(owned_.size() * 2);
+  for (std::size_t s = 0; s < owned_.size(); ++s) {
+    if (!owned_slot.emplace(owned_[s], s).second)
+      throw std::invalid_argument("BlockProblem: pose listed twice in block");
+  }
+  // First pass: which measurements touch the block, and which neighbours they bring.
+  std::vector<std::size_t> touching;
+  for (std::size_t k = 0; k < measurements.size(); ++k) {
+    const auto& m = measurements[k];
+    bool oi = owned_slot.count(m.i) > 0, oj = owned_slot.count(m.j) > 0;
+    if (!oi && !oj) continue;
+    touching.push_back(k);
+    if (!oi) neighbors_.push_back(m.i);
+    if (!oj) neighbors_.push_back(m.j);
+  }
+  std::sort(neighbors_.begin(), neighbors_.end());
+  neighbors_.erase(std::unique(neighbors_.begin(), neighbors_.end()), neighbors_.end());
+  auto slot_of = [&](std::size_t id) {
+    auto it = owned_slot.find(id);
+    if (it != owned_slot.end()) return it->second;
+    return owned_.size() + static_cast<std::size_t>(std::lower_bound(neighbors_.begin(),
+                                                                     neighbors_.end(), id) -
+                                                    neighbors_.begin());
+  };
+  edge_storage_.reserve(touching.size());
+  for (auto k : touching) edge_storage_.push_back(measurements[k]);
+  std::vector<const Measurement*> ptrs;
+  std::vector<std::size_t> si, sj;
+  for (std::size_t k = 0; k < edge_storage_.size(); ++k) {
+    const Measurement& m = edge_storage_[k];
+    ptrs.push_back(&m);
+    si.push_back(slot_of(m.i));
+    sj.push_back(slot_of(m.j));
+    edges_.push_back({k, si.back(), sj.back()});
+  }
+  const std::size_t total = owned_.size() + neighbors_.size();
+  SparseMatrix Q = build_data_matrix(ptrs, si, sj, d_, total);
+  const Eigen::Index nb = (d_ + 1) * static_cast<Eigen::Index>(owned_.size());
+  const Eigen::Index nn = (d_ + 1) * static_cast<Eigen::Index>(neighbors_.size());
+  Q_bb_ = Q.topLeftCorner(nb, nb);
+  Q_nb_ = Q.bottomLeftCorner(nn, nb);
+  Q_nn_ = Q.bottomRightCorner(nn, nn);
+  Q_bb_.makeCompressed();
+  Q_nb_.makeCompressed();
+}
+
+BlockProblem BlockProblem::whole_graph(int d, std::size_t num_poses,
+                                       const std::vector<Measurement>& measurements) {
+  std::vector<std::size_t> all(num_poses);
+  for (std::size_t i = 0; i < num_poses; ++i) all[i] = i;
+  return BlockProblem(d, std::move(all), measurements);
+}
+
+void BlockProblem::set_neighbor_poses(const Eigen::MatrixXd& X_neighbors) {
+  if (X_neighbors.cols() != Q_nn_.cols())
+    throw std::invalid_argument("BlockProblem: neighbour poses have the wrong size");
+  X_n_ = X_neighbors;
+  linear_ = X_n_ * Q_nb_;
+  constant_ = (X_n_ * Q_nn_).cwiseProduct(X_n_).sum();
+}
+
+double BlockProblem::cost(const Eigen::MatrixXd& X) const {
+  double f = (X * Q_bb_).cwiseProduct(X).sum();
+  if (!neighbors_.empty()) f += 2.0 * linear_.cwiseProduct(X).sum() + constant_;
+  return f;
+}
+
+Eigen::MatrixXd BlockProblem::euclidean_gradient(const Eigen::MatrixXd& X) const {
+  Eigen::MatrixXd G = 2.0 * (X * Q_bb_);
+  if (!neighbors_.empty()) G += 2.0 * linear_;
+  return G;
+}
+
+Eigen::MatrixXd BlockProblem::riemannian_gradient(const Eigen::MatrixXd& X,
+                                                  const Eigen::MatrixXd& egrad) const {
+  return manifold(static_cast<int>(X.rows())).tangent_project(X, egrad);
+}
+
+Eigen::MatrixXd BlockProblem::hessian_vector(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
+                                             const Eigen::MatrixXd& V) const {
+  const LiftedManifold M = manifold(static_cast<int>(X.rows()));
+  Eigen::MatrixXd H = 2.0 * (V * Q_bb_);
+  return M.tangent_project(X, H) - M.weingarten_term(X, egrad, V);
+}
+
+double BlockProblem::edge_cost(const Edge& e, const Eigen::MatrixXd& X) const {
+  const Eigen::Index w = d_ + 1;
+  const std::size_t m = owned_.size();
+  auto pose = [&](std::size_t slot) {
+    return slot < m ? X.middleCols(w * static_cast<Eigen::Index>(slot), w)
+                    : X_n_.middleCols(w * static_cast<Eigen::Index>(slot - m), w);
+  };
+  const auto Xi = pose(e.slot_i);
+  const auto Xj = pose(e.slot_j);
+  const Measurement& me = edge_storage_[e.measurement];
+  double rot = (Xj.leftCols(d_) - Xi.leftCols(d_) * me.R).squaredNorm();
+  double tr = (Xj.col(d_) - Xi.col(d_) - Xi.leftCols(d_) * me.t).squaredNorm();
+  return me.kappa * rot + me.tau * tr;
+}
+
+double BlockProblem::cost_share(const Eigen::MatrixXd& X) const {
+  const std::size_t m = owned_.size();
+  double share = 0.0;
+  for (const auto& e : edges_) {
+    double c = edge_cost(e, X);
+    share += (e.slot_i < m && e.slot_j < m) ? c : 0.5 * c;
+  }
+  return share;
+}
+
+long BlockProblem::owned_slot(std::size_t global_id) const {
+  for (std::size_t s = 0; s < owned_.size(); ++s)
+    if (owned_[s] == global_id) return static_cast<long>(s);
+  return -1;
+}
+
+}  // namespace tessera

@@ -1,0 +1,85 @@
+#pragma once
+// The lifted PGO objective restricted to a block of poses, with the poses of neighbouring
+// blocks held fixed. The centralized problem is the block that owns every pose (no
+// neighbours); a distributed agent's local problem is the block of its partition.
+//
+// With X the block's lifted poses (owned order) and X_N the neighbours' (neighbor order):
+//   f_B(X) = tr(X Q_BB X^T) + 2 tr(X Q_BN X_N^T) + tr(X_N Q_NN X_N^T),
+// i.e. the full reference objective summed over every measurement touching the block.
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "graph/measurement.hpp"
+#include "manifold/lifted_manifold.hpp"
+#include "problem/data_matrix.hpp"
+
+namespace tessera {
+
+class BlockProblem {
+ public:
+  /// `owned`: global ids of the block's poses (any order; kept as given). Measurements not
+  /// touching an owned pose are ignored; a measurement's other endpoint, when not owned,
+  /// becomes a neighbour pose. Neighbours are ordered by global id.
+  BlockProblem(int d, std::vector<std::size_t> owned, const std::vector<Measurement>& measurements);
+
+  /// The centralized problem: every pose 0..n-1 owned.
+  static BlockProblem whole_graph(int d, std::size_t num_poses,
+                                  const std::vector<Measurement>& measurements);
+
+  int dim() const { return d_; }
+  const std::vector<std::size_t>& owned() const { return owned_; }
+  const std::vector<std::size_t>& neighbors() const { return neighbors_; }
+  std::size_t num_owned() const { return owned_.size(); }
+  std::size_t num_neighbors() const { return neighbors_.size(); }
+  /// Measurements touching the block (internal and cut).
+  std::size_t num_measurements() const { return edges_.size(); }
+  /// Q_BB: the quadratic form on the block's own poses.
+  const SparseMatrix& data_matrix() const { return Q_bb_; }
+  LiftedManifold manifold(int r) const { return LiftedManifold(r, d_, owned_.size()); }
+
+  /// Fixes the neighbours' lifted poses (r x (d+1)k, neighbors() order). Must be called
+  /// before evaluating a block with neighbours, and again whenever they change.
+  void set_neighbor_poses(const Eigen::MatrixXd& X_neighbors);
+  const Eigen::MatrixXd& neighbor_poses() const { return X_n_; }
+
+  /// f_B(X) as above.
+  double cost(const Eigen::MatrixXd& X) const;
+  /// Euclidean gradient 2 (X Q_BB + X_N Q_NB).
+  Eigen::MatrixXd euclidean_gradient(const Eigen::MatrixXd& X) const;
+  /// Riemannian gradient on the block's manifold.
+  Eigen::MatrixXd riemannian_gradient(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad) const;
+  /// Riemannian Hessian applied to tangent V at X (egrad = Euclidean gradient at X).
+  Eigen::MatrixXd hessian_vector(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
+                                 const Eigen::MatrixXd& V) const;
+
+  /// This block's share of the global cost: internal measurements in full, cut measurements
+  /// half (the other half is counted by the neighbour's block), so shares sum to f exactly.
+  double cost_share(const Eigen::MatrixXd& X) const;
+
+  /// Local slot of an owned global id, or -1.
+  long owned_slot(std::size_t global_id) const;
+
+ private:
+  struct Edge {
+    std::size_t measurement;     // index into edge_storage_ (indices survive copies)
+    std::size_t slot_i, slot_j;  // local slots: owned first, then neighbours
+  };
+  double edge_cost(const Edge& e, const Eigen::MatrixXd& X) const;
+
+  int d_;
+  std::vector<std::size_t> owned_;
+  std::vector<std::size_t> neighbors_;
+  std::vector<Edge> edges_;
+  std::vector<Measurement> edge_storage_;  // copies, so the problem outlives its input
+  SparseMatrix Q_bb_;
+  SparseMatrix Q_nb_;  // (d+1)k x (d+1)m
+  SparseMatrix Q_nn_;
+  Eigen::MatrixXd X_n_;
+  Eigen::MatrixXd linear_;  // X_N Q_NB, r x (d+1)m
+  double constant_ = 0.0;   // tr(X_N Q_NN X_N^T)
+};
+
+}  // namespace tessera

@@ -1,0 +1,14 @@
+#pragma once
+// The PGO objective on SE(d) in the reference convention (../shared/reference/README.md):
+//   f = sum_e kappa ||R_j - R_i R_ij||_F^2 + tau ||t_j - t_i - R_i t_ij||^2   (the full sum).
+
+#include <vector>
+
+#include "graph/pose.hpp"
+#include "graph/pose_graph.hpp"
+
+namespace tessera {
+
+double evaluate_objective(const PoseGraph& graph, const std::vector<Pose>& poses);
+
+}  // namespace tessera

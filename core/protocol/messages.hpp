@@ -1,0 +1,50 @@
+#pragma once
+// The messages agents exchange during a distributed solve, independent of any transport.
+// An in-process driver hands them over directly; the DDS runtime maps each type 1:1 to an
+// IDL type (idl/) and back. Fields are plain values so that mapping is mechanical.
+//
+// Lifted poses travel as flat arrays: pose_ids[k] owns data[k*r*(d+1) .. (k+1)*r*(d+1)),
+// the r x (d+1) block [Y_i | p_i] stored column-major.
+
+#include <cstdint>
+#include <variant>
+#include <vector>
+
+namespace tessera {
+
+/// Which sequence of the accelerated methods a pose block belongs to.
+enum class BlockKind : std::uint8_t { kY = 0, kP = 1, kV = 2 };
+
+/// Public (boundary) poses of one agent's block, for the neighbours that need them.
+struct PoseBlockMessage {
+  std::uint32_t round = 0;
+  std::uint32_t sender = 0;
+  BlockKind kind = BlockKind::kY;
+  std::uint32_t rank = 0;  ///< r
+  std::uint32_t dim = 0;   ///< d
+  std::vector<std::uint32_t> pose_ids;
+  std::vector<double> data;
+};
+
+/// One agent's scalar contributions to the global reductions of a round, and its votes.
+struct RoundStatusMessage {
+  std::uint32_t round = 0;
+  std::uint32_t sender = 0;
+  std::uint32_t phase = 0;       ///< Protocol step within the round (algorithm specific).
+  double cost = 0.0;             ///< Contribution to f, every measurement counted once overall.
+  double grad_norm_sq = 0.0;     ///< Contribution to ||grad f||^2.
+  double block_grad_norm = 0.0;  ///< This block's own gradient norm (greedy selection).
+  bool restart_vote = false;
+  bool done_vote = false;
+};
+
+using ProtocolMessage = std::variant<PoseBlockMessage, RoundStatusMessage>;
+
+/// A message an agent wants sent: to every agent (broadcast) or to the listed agents.
+struct OutgoingMessage {
+  ProtocolMessage message;
+  bool broadcast = true;
+  std::vector<std::uint32_t> recipients;  ///< Used when broadcast is false.
+};
+
+}  // namespace tessera

@@ -1,0 +1,155 @@
+#include "solvers/centralized_solver.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "problem/block_problem.hpp"
+#include "problem/lifting.hpp"
+#include "problem/objective.hpp"
+#include "problem/rounding.hpp"
+#include "solvers/block_preconditioner.hpp"
+#include "solvers/chordal_initialization.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera {
+
+TrustRegionOptions CentralizedOptions::default_trust_region() {
+  TrustRegionOptions o;
+  o.max_iterations = 500;
+  o.max_inner_iterations = 2000;
+  o.grad_norm_tol = 1e-7;
+  o.rel_cost_decrease_tol = 1e-14;
+  return o;
+}
+
+void CentralizedOptions::validate() const {
+  if (initial_rank < 2) throw InputError("CentralizedOptions.initial_rank must be >= d (2 or 3)");
+  if (max_rank < initial_rank) throw InputError("CentralizedOptions.max_rank must be >= initial_rank");
+  if (!(preconditioner_shift > 0)) throw InputError("CentralizedOptions.preconditioner_shift must be > 0");
+  trust_region.validate();
+  certificate.validate();
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+std::vector<Pose> odometry_initialization(const PoseGraph& graph) {
+  // Compose consecutive-id measurements; poses not reachable that way start at identity.
+  std::vector<Pose> poses(graph.num_poses, Pose::identity(graph.d));
+  std::vector<const Measurement*> next(graph.num_poses, nullptr);
+  for (const auto& m : graph.measurements)
+    if (m.j == m.i + 1 && !next[m.i]) next[m.i] = &m;
+  for (std::size_t i = 0; i + 1 < graph.num_poses; ++i) {
+    if (!next[i]) continue;
+    poses[i + 1].R = poses[i].R * next[i]->R;
+    poses[i + 1].t = poses[i].t + poses[i].R * next[i]->t;
+  }
+  return poses;
+}
+
+// Escapes a saddle at rank r along the negative-curvature direction v (eigenvector of S).
+// Returns the new point at rank r+1.
+Eigen::MatrixXd escape_saddle(const BlockProblem& problem, const Eigen::MatrixXd& X,
+                              const Eigen::VectorXd& v, double grad_tol) {
+  Eigen::MatrixXd Xa = pad_rank(X, 1);
+  Eigen::MatrixXd dir = Eigen::MatrixXd::Zero(Xa.rows(), Xa.cols());
+  dir.row(Xa.rows() - 1) = v.transpose();  // tangent at Xa: Xa's last row is zero
+  const LiftedManifold M = problem.manifold(static_cast<int>(Xa.rows()));
+  const double f0 = problem.cost(Xa);
+  double alpha = 1e2 * std::sqrt(static_cast<double>(problem.num_owned()));
+  for (int k = 0; k < 80; ++k, alpha *= 0.5) {
+    Eigen::MatrixXd Xp = M.retract(Xa, alpha * dir);
+    if (problem.cost(Xp) >= f0) continue;
+    Eigen::MatrixXd g = M.tangent_project(Xp, problem.euclidean_gradient(Xp));
+    if (g.norm() > grad_tol) return Xp;
+  }
+  throw std::runtime_error("saddle escape: no descent step found along the eigenvector");
+}
+
+}  // namespace
+
+CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOptions& options) {
+  options.validate();
+  if (options.initial_rank < graph.d)
+    throw InputError("CentralizedOptions.initial_rank must be >= d = " + std::to_string(graph.d));
+  const auto start = Clock::now();
+  CentralizedResult res;
+
+  std::vector<Pose> init;
+  switch (options.initialization) {
+    case Initialization::kChordal: init = chordal_initialization(graph); break;
+    case Initialization::kOdometry: init = odometry_initialization(graph); break;
+    case Initialization::kFile:
+      if (!graph.has_initial()) throw InputError(graph.source, 0, "has no VERTEX lines to initialise from");
+      init = graph.initial;
+      break;
+  }
+  const BlockProblem problem = BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
+  const BlockPreconditioner precon(problem, options.preconditioner_shift);
+  Eigen::MatrixXd X = lift_poses(init, options.initial_rank);
+  res.init_s = seconds_since(start);
+
+  TrustRegionOptions tr = options.trust_region;
+  {
+    const LiftedManifold M = problem.manifold(options.initial_rank);
+    const double g0 = M.tangent_project(X, problem.euclidean_gradient(X)).norm();
+    tr.grad_norm_tol = options.trust_region.grad_norm_tol * std::max(1.0, g0);
+  }
+  for (int r = options.initial_rank;; ++r) {
+    const auto level_start = Clock::now();
+    TrustRegionResult level = solve_trust_region(problem, X, tr, &precon);
+    res.optimize_s += seconds_since(level_start);
+    X = level.X;
+    res.iterations += level.iterations;
+    for (const auto& it : level.trace) res.trace.push_back({r, it});
+    StaircaseLevel info{r, level.iterations, level.cost, level.grad_norm, std::nullopt, false,
+                        seconds_since(level_start)};
+    res.final_rank = r;
+    res.relaxation_cost = level.cost;
+    res.grad_norm = level.grad_norm;
+    if (!options.certify) {
+      res.levels.push_back(info);
+      break;
+    }
+    const auto cert_start = Clock::now();
+    CertificateResult cert = verify_certificate(problem, X, options.certificate);
+    res.certify_s += seconds_since(cert_start);
+    info.min_eigenvalue = cert.min_eigenvalue;
+    info.certified = cert.certified;
+    info.elapsed_s = seconds_since(level_start);
+    res.levels.push_back(info);
+    res.certified = cert.certified;
+    res.min_eigenvalue = cert.min_eigenvalue;
+    if (cert.certified || r >= options.max_rank) break;
+    X = escape_saddle(problem, X, cert.min_eigenvector, tr.grad_norm_tol);
+  }
+  res.X = X;
+  res.poses = round_solution(graph, X);
+  res.cost = evaluate_objective(graph, res.poses);
+  res.total_s = seconds_since(start);
+  return res;
+}
+
+std::string CentralizedResult::full_report() const {
+  std::ostringstream os;
+  os.precision(12);
+  os << "Centralized certifiable solve\n";
+  for (const auto& l : levels) {
+    os << "  rank " << l.rank << ": " << l.iterations << " iterations, f(X) = " << l.cost
+       << ", |grad| = " << l.grad_norm;
+    if (l.min_eigenvalue) os << ", lambda_min(S) = " << *l.min_eigenvalue << (l.certified ? " (certified)" : " (saddle)");
+    os << ", " << l.elapsed_s << " s\n";
+  }
+  os << "  rounded cost " << cost << " (relaxation " << relaxation_cost << ")\n";
+  os << "  certified: " << (certified ? (*certified ? "yes" : "no") : "not checked") << "\n";
+  os << "  time: init " << init_s << " s, optimize " << optimize_s << " s, certify " << certify_s
+     << " s, total " << total_s << " s\n";
+  return os.str();
+}
+
+}  // namespace tessera

@@ -1,0 +1,161 @@
+#include "solvers/trust_region.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "util/input_error.hpp"
+
+namespace tessera {
+
+void TrustRegionOptions::validate() const {
+  auto fail = [](const std::string& field, const std::string& why) {
+    throw InputError("TrustRegionOptions." + field + " " + why);
+  };
+  if (max_iterations < 1) fail("max_iterations", "must be >= 1");
+  if (max_inner_iterations < 1) fail("max_inner_iterations", "must be >= 1");
+  if (!(grad_norm_tol >= 0)) fail("grad_norm_tol", "must be >= 0");
+  if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
+  if (!(max_radius > 0)) fail("max_radius", "must be > 0");
+  if (!(tcg_kappa > 0 && tcg_kappa < 1)) fail("tcg_kappa", "must be in (0, 1)");
+  if (!(tcg_theta > 0 && tcg_theta <= 1)) fail("tcg_theta", "must be in (0, 1]");
+  if (!(acceptance_ratio >= 0 && acceptance_ratio < 0.25)) fail("acceptance_ratio", "must be in [0, 0.25)");
+  if (!(max_time_s > 0)) fail("max_time_s", "must be > 0");
+}
+
+namespace {
+
+double inner(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) { return A.cwiseProduct(B).sum(); }
+
+struct TcgOutcome {
+  Eigen::MatrixXd eta;
+  Eigen::MatrixXd Heta;
+  int iterations = 0;
+  bool hit_boundary = false;
+};
+
+// Steihaug–Toint truncated CG on the model m(eta) = <g, eta> + 1/2 <H eta, eta>, with the
+// trust region measured in the preconditioner's norm.
+TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M, const Eigen::MatrixXd& X,
+                        const Eigen::MatrixXd& egrad, const Eigen::MatrixXd& grad, double radius,
+                        const TrustRegionOptions& opt, const BlockPreconditioner* precon) {
+  auto precondition = [&](const Eigen::MatrixXd& v) {
+    return precon ? precon->apply(M, X, v) : v;
+  };
+  TcgOutcome out;
+  out.eta = Eigen::MatrixXd::Zero(X.rows(), X.cols());
+  out.Heta = out.eta;
+  Eigen::MatrixXd r = grad;
+  double r0_norm = std::sqrt(inner(r, r));
+  Eigen::MatrixXd z = precondition(r);
+  double z_r = inner(z, r);
+  double d_Pd = z_r, e_Pd = 0.0, e_Pe = 0.0;
+  Eigen::MatrixXd delta = -z;
+  const double radius_sq = radius * radius;
+  for (int j = 0; j < opt.max_inner_iterations; ++j) {
+    out.iterations = j + 1;
+    Eigen::MatrixXd Hdelta = problem.hessian_vector(X, egrad, delta);
+    const double d_Hd = inner(delta, Hdelta);
+    const double alpha = z_r / d_Hd;
+    const double e_Pe_new = e_Pe + 2.0 * alpha * e_Pd + alpha * alpha * d_Pd;
+    if (d_Hd <= 0 || e_Pe_new >= radius_sq) {
+      // Follow delta to the boundary of the trust region.
+      const double tau = (-e_Pd + std::sqrt(std::max(0.0, e_Pd * e_Pd + d_Pd * (radius_sq - e_Pe)))) / d_Pd;
+      out.eta += tau * delta;
+      out.Heta += tau * Hdelta;
+      out.hit_boundary = true;
+      return out;
+    }
+    e_Pe = e_Pe_new;
+    out.eta += alpha * delta;
+    out.Heta += alpha * Hdelta;
+    r += alpha * Hdelta;
+    r = M.tangent_project(X, r);  // keep rounding errors from leaving the tangent space
+    const double r_norm = std::sqrt(inner(r, r));
+    if (r_norm <= r0_norm * std::min(std::pow(r0_norm, opt.tcg_theta), opt.tcg_kappa)) return out;
+    z = precondition(r);
+    const double z_r_old = z_r;
+    z_r = inner(z, r);
+    const double beta = z_r / z_r_old;
+    delta = -z + beta * delta;
+    e_Pd = beta * (e_Pd + alpha * d_Pd);
+    d_Pd = z_r + beta * beta * d_Pd;
+  }
+  return out;
+}
+
+}  // namespace
+
+TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::MatrixXd& X0,
+                                     const TrustRegionOptions& options,
+                                     const BlockPreconditioner* preconditioner) {
+  options.validate();
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  const LiftedManifold M = problem.manifold(static_cast<int>(X0.rows()));
+  TrustRegionResult res;
+  res.X = X0;
+  double f = problem.cost(res.X);
+  Eigen::MatrixXd egrad = problem.euclidean_gradient(res.X);
+  Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
+  double grad_norm = std::sqrt(inner(grad, grad));
+  double radius = options.initial_radius;
+  if (radius <= 0) {
+    Eigen::MatrixXd z = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
+    radius = std::max(1e-10, std::sqrt(std::max(0.0, inner(z, grad))));
+  }
+  res.stop_reason = "max_iterations";
+  for (int it = 0; it < options.max_iterations; ++it) {
+    if (grad_norm <= options.grad_norm_tol) {
+      res.stop_reason = "grad_norm";
+      break;
+    }
+    if (elapsed() > options.max_time_s) {
+      res.stop_reason = "time";
+      break;
+    }
+    TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner);
+    res.total_inner_iterations += step.iterations;
+    Eigen::MatrixXd X_new = M.retract(res.X, step.eta);
+    const double f_new = problem.cost(X_new);
+    const double model_decrease = -(inner(grad, step.eta) + 0.5 * inner(step.Heta, step.eta));
+    double rho = (f - f_new) / std::max(model_decrease, std::numeric_limits<double>::min());
+    // When both decreases sit at round-off level, the ratio is noise: trust the model.
+    if (std::abs(f - f_new) <= 1e-14 * std::abs(f) && model_decrease <= 1e-14 * std::abs(f)) rho = 1.0;
+    if (rho < 0.25) {
+      radius *= 0.25;
+    } else if (rho > 0.75 && step.hit_boundary) {
+      radius = std::min(2.0 * radius, options.max_radius);
+    }
+    const bool accepted = rho > options.acceptance_ratio && f_new <= f;
+    double decrease = 0.0;
+    if (accepted) {
+      decrease = f - f_new;
+      res.X = std::move(X_new);
+      f = f_new;
+      egrad = problem.euclidean_gradient(res.X);
+      grad = M.tangent_project(res.X, egrad);
+      grad_norm = std::sqrt(inner(grad, grad));
+    }
+    res.iterations = it + 1;
+    if (options.record_trace)
+      res.trace.push_back({it + 1, f, grad_norm, radius, rho, step.iterations, accepted, elapsed()});
+    if (accepted && decrease <= options.rel_cost_decrease_tol * std::abs(f)) {
+      res.stop_reason = "relative_decrease";
+      break;
+    }
+    if (radius < 1e-14) {
+      res.stop_reason = "radius";
+      break;
+    }
+  }
+  if (grad_norm <= options.grad_norm_tol) res.stop_reason = "grad_norm";
+  res.cost = f;
+  res.grad_norm = grad_norm;
+  return res;
+}
+
+}  // namespace tessera

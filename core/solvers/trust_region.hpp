@@ -1,0 +1,61 @@
+#pragma once
+// Riemannian trust-region method (RTR) with truncated, preconditioned conjugate gradients
+// (Steihaug–Toint) for a BlockProblem on its lifted manifold. Used by the centralized
+// solver (many iterations) and by the distributed block updates (one or a few iterations).
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "problem/block_problem.hpp"
+#include "solvers/block_preconditioner.hpp"
+
+namespace tessera {
+
+struct TrustRegionOptions {
+  int max_iterations = 500;         ///< Outer iterations (>= 1).
+  int max_inner_iterations = 1000;  ///< tCG iterations per outer iteration (>= 1).
+  double grad_norm_tol = 1e-6;      ///< Stop when ||grad f|| <= this (absolute, >= 0).
+  /// Stop when an accepted step decreases f by less than this fraction of f (>= 0).
+  double rel_cost_decrease_tol = 1e-12;
+  double initial_radius = 0.0;      ///< <= 0: set from the first preconditioned gradient.
+  double max_radius = 1e12;         ///< > 0.
+  double tcg_kappa = 0.1;           ///< Linear convergence target of tCG, in (0, 1).
+  double tcg_theta = 1.0;           ///< Superlinear exponent of tCG, in (0, 1].
+  double acceptance_ratio = 1e-4;   ///< Minimum rho to accept a step, in [0, 0.25).
+  double max_time_s = 1e9;          ///< Wall-clock budget, seconds (> 0).
+  bool record_trace = true;
+
+  /// Throws InputError naming the first invalid field.
+  void validate() const;
+};
+
+struct TrustRegionIteration {
+  int iteration;
+  double cost;
+  double grad_norm;
+  double radius;
+  double rho;
+  int inner_iterations;
+  bool accepted;
+  double elapsed_s;
+};
+
+struct TrustRegionResult {
+  Eigen::MatrixXd X;
+  double cost = 0.0;
+  double grad_norm = 0.0;
+  int iterations = 0;
+  int total_inner_iterations = 0;
+  std::string stop_reason;
+  std::vector<TrustRegionIteration> trace;
+};
+
+/// Minimises problem.cost over the lifted manifold starting from X0 (on the manifold).
+/// `preconditioner` may be null (identity).
+TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::MatrixXd& X0,
+                                     const TrustRegionOptions& options,
+                                     const BlockPreconditioner* preconditioner = nullptr);
+
+}  // namespace tessera
