@@ -1,0 +1,25 @@
+#include "io/number_text.hpp"
+
+#include <charconv>
+#include <cmath>
+
+namespace tessera {
+
+void append_number(std::string& out, double x) {
+  if (!std::isfinite(x)) {
+    out += std::isnan(x) ? "nan" : (x > 0 ? "inf" : "-inf");
+    return;
+  }
+  if (x == 0.0) x = 0.0;  // "-0" would read back fine, but "0" keeps files tidy
+  char buf[32];
+  auto res = std::to_chars(buf, buf + sizeof buf, x);
+  out.append(buf, res.ptr);
+}
+
+void append_integer(std::string& out, unsigned long long x) {
+  char buf[24];
+  auto res = std::to_chars(buf, buf + sizeof buf, x);
+  out.append(buf, res.ptr);
+}
+
+}  // namespace tessera

@@ -1,0 +1,34 @@
+#include "io/tum_writer.hpp"
+
+#include "io/number_text.hpp"
+#include "io/rotation_text.hpp"
+#include "io/text_file_writer.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera {
+
+void write_tum(const std::vector<Pose>& poses, const std::string& path) {
+  for (const auto& p : poses)
+    if ((p.dim() != 2 && p.dim() != 3) || p.R.rows() != p.dim() || p.R.cols() != p.dim())
+      throw InputError(path, 0, "cannot write a pose of dimension " + std::to_string(p.dim()));
+
+  TextFileWriter file(path);
+  std::string& out = file.buffer();
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const Pose& p = poses[k];
+    append_integer(out, k);
+    for (int c = 0; c < 3; ++c) {
+      out += ' ';
+      append_number(out, c < p.dim() ? p.t(c) : 0.0);
+    }
+    for (double q : unit_quaternion(p.R)) {
+      out += ' ';
+      append_number(out, q);
+    }
+    out += '\n';
+    file.maybe_flush();
+  }
+  file.close();
+}
+
+}  // namespace tessera
