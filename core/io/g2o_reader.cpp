@@ -1,5 +1,7 @@
 #include "io/g2o_reader.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -24,6 +26,9 @@ constexpr std::size_t kMaxTokens = 32;
 constexpr std::uint64_t kMaxPoseId = 2147483646;
 // Quaternions shorter than this cannot be turned into a rotation meaningfully.
 constexpr double kMinQuaternionNorm = 1e-6;
+// Larger inputs are refused rather than read forever (e.g. /dev/zero); the biggest public
+// benchmark graphs are a few tens of MB.
+constexpr std::size_t kMaxInputBytes = std::size_t{2} << 30;
 
 struct RecordSpec {
   const char* tag;
@@ -462,7 +467,9 @@ G2oReadResult read_g2o_stream(std::istream& in, const std::string& name,
   if (!in) throw InputError(name, 0, "cannot read the input stream");
   std::string data;
   char buf[1 << 16];
-  while (in.read(buf, sizeof buf) || in.gcount() > 0) data.append(buf, in.gcount());
+  while ((in.read(buf, sizeof buf) || in.gcount() > 0) && data.size() <= kMaxInputBytes)
+    data.append(buf, in.gcount());
+  if (data.size() > kMaxInputBytes) throw InputError(name, 0, "input too large (over 2 GiB)");
   if (in.bad()) throw InputError(name, 0, "error while reading the input stream");
   return read_g2o_text(data, name, options);
 }
@@ -472,20 +479,25 @@ G2oReadResult read_g2o_file(const std::string& path, const G2oReadOptions& optio
   if (!f) throw InputError(path, 0, std::string("cannot open the file: ") + std::strerror(errno));
   std::string data;
   // Read in one go when the size is known (regular files), then whatever follows.
-  if (std::fseek(f, 0, SEEK_END) == 0) {
-    const long size = std::ftell(f);
-    if (size > 0) data.resize(static_cast<std::size_t>(size));
-    std::rewind(f);
+  struct stat st {};
+  if (fstat(fileno(f), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) {
+      std::fclose(f);
+      throw InputError(path, 0, "cannot read the file: it is a directory");
+    }
+    if (S_ISREG(st.st_mode) && st.st_size > 0) data.resize(static_cast<std::size_t>(st.st_size));
   }
   std::size_t have = std::fread(data.data(), 1, data.size(), f);
   data.resize(have);
   char buf[1 << 16];
   std::size_t got;
-  while ((got = std::fread(buf, 1, sizeof buf, f)) > 0) data.append(buf, got);
+  while ((got = std::fread(buf, 1, sizeof buf, f)) > 0 && data.size() <= kMaxInputBytes)
+    data.append(buf, got);
   const bool failed = std::ferror(f) != 0;
   const int err = errno;
   std::fclose(f);
   if (failed) throw InputError(path, 0, std::string("cannot read the file: ") + std::strerror(err));
+  if (data.size() > kMaxInputBytes) throw InputError(path, 0, "file too large (over 2 GiB)");
   return read_g2o_text(data, path, options);
 }
 
