@@ -1,0 +1,358 @@
+// tessera-agent: one robot's process in a distributed run. Thin over core/ (graph I/O,
+// the round protocol) and transport/ (DDS). See docs/dds-runtime.md.
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "agent/dds_channel.hpp"
+#include "agent/local_dump.hpp"
+#include "agent/local_share.hpp"
+#include "agent/round_loop.hpp"
+#include "arguments.hpp"
+#include "io/g2o_reader.hpp"
+#include "transport/message_mapping.hpp"
+#include "transport/run_failure.hpp"
+#include "transport/session.hpp"
+#include "transport/signal_watcher.hpp"
+#include "transport/transport_error.hpp"
+#include "util/input_error.hpp"
+
+using namespace tessera;
+using namespace tessera::transport;
+
+namespace {
+
+constexpr const char* kHelp = R"(usage: tessera-agent --graph FILE --robots N --id I [options]
+
+One agent (robot) of a distributed Tessera run. Reads robot I's share of a multi-robot
+g2o file (its contiguous poses [I n/N, (I+1) n/N) and the measurements starting there),
+announces its graph structure to the coordinator, hands measurements and initial poses
+to the agents that own them after the partition (peer to peer: the coordinator never sees
+measurement values), runs the round protocol and sends its final poses to the coordinator.
+
+options:
+  --graph FILE       g2o file of the whole multi-robot graph (required)
+  --robots N         number of robots = agents of the run (required)
+  --id I             this agent's id, 0..N-1 (required)
+  --run-id ID        run id shared by all processes of the run (default "default");
+                     [A-Za-z0-9_.-], at most 64 characters
+  --domain D         DDS domain id 0..232 (default: derived from the run id)
+  --timeout S        bound on each wait for peers during set-up, in seconds (default 30)
+  --round-timeout S  bound on each wait for a peer's message during the rounds (default 600)
+  --lease S          participant/liveliness lease in seconds: a dead peer is noticed after
+                     about this long (default 1, range 0.2..60)
+  --peers IP[,IP]    IPv4 addresses to contact by unicast (when multicast is not available)
+  --output FILE      write this agent's final poses as g2o VERTEX lines
+  --dump-local FILE  write the local problem after the hand-off (text; see docs/dds-runtime.md)
+  --verbose          print each phase
+  --help             this text
+
+exit codes: 0 done, 1 the run failed (lost peer, abort, timeout), 2 bad options or input,
+128+signal when interrupted (SIGINT 130, SIGTERM 143).
+)";
+
+struct AgentArgs {
+  std::string graph;
+  std::uint32_t robots = 0;
+  std::uint32_t id = 0;
+  std::string run_id = "default";
+  int domain = -1;
+  double timeout_s = 30;
+  double round_timeout_s = 600;
+  double lease_s = 1.0;
+  std::vector<std::string> peers;
+  std::string output;
+  std::string dump_local;
+  bool verbose = false;
+};
+
+std::vector<std::string> split_commas(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= s.size()) {
+    std::size_t comma = s.find(',', start);
+    if (comma == std::string::npos) comma = s.size();
+    if (comma > start) out.push_back(s.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return out;
+}
+
+AgentArgs parse(const std::vector<std::string>& argv) {
+  cli::Arguments args(argv,
+                      {"graph", "robots", "id", "run-id", "domain", "timeout", "round-timeout", "lease", "peers",
+                       "output", "dump-local"},
+                      {"verbose", "help"});
+  if (!args.positional().empty())
+    throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
+  AgentArgs a;
+  if (!args.has("graph")) throw InputError("option --graph is required (see --help)");
+  if (!args.has("robots")) throw InputError("option --robots is required (see --help)");
+  if (!args.has("id")) throw InputError("option --id is required (see --help)");
+  a.graph = *args.get("graph");
+  long robots = args.get_long("robots", 0), id = args.get_long("id", 0);
+  if (robots < 1 || robots > 1000) throw InputError("option --robots: must be 1..1000");
+  if (id < 0 || id >= robots) throw InputError("option --id: must be 0.." + std::to_string(robots - 1));
+  a.robots = static_cast<std::uint32_t>(robots);
+  a.id = static_cast<std::uint32_t>(id);
+  a.run_id = args.get_or("run-id", a.run_id);
+  validate_run_id(a.run_id);
+  long domain = args.get_long("domain", -1);
+  if (args.has("domain") && (domain < 0 || domain > kMaxDomain))
+    throw InputError("option --domain: must be 0.." + std::to_string(kMaxDomain));
+  a.domain = static_cast<int>(domain);
+  a.timeout_s = args.get_double("timeout", a.timeout_s);
+  if (!(a.timeout_s > 0)) throw InputError("option --timeout: must be positive");
+  a.round_timeout_s = args.get_double("round-timeout", a.round_timeout_s);
+  if (!(a.round_timeout_s > 0)) throw InputError("option --round-timeout: must be positive");
+  a.lease_s = args.get_double("lease", a.lease_s);
+  if (args.has("peers")) a.peers = split_commas(*args.get("peers"));
+  a.output = args.get_or("output", "");
+  a.dump_local = args.get_or("dump-local", "");
+  a.verbose = args.has("verbose");
+  return a;
+}
+
+class Agent {
+ public:
+  Agent(const AgentArgs& a, SignalWatcher& signals) : a_(a), signals_(signals) {
+    tag_ = "tessera-agent[" + std::to_string(a.id) + "]";
+  }
+
+  int run() {
+    SessionOptions so;
+    so.run_id = a_.run_id;
+    so.domain = a_.domain;
+    so.coordinator = false;
+    so.agent_id = a_.id;
+    so.num_agents = a_.robots;
+    so.lease_s = a_.lease_s;
+    so.initial_peers = a_.peers;
+    try {
+      session_ = std::make_unique<Session>(so);
+    } catch (const InputError& e) {
+      std::cerr << tag_ << ": error: " << e.what() << "\n";
+      return kExitBadInput;
+    } catch (const std::exception& e) {
+      std::cerr << tag_ << ": error: " << e.what() << "\n";
+      return kExitRunFailed;
+    }
+    Session& s = *session_;
+    signals_.start([&s](int signo) {
+      s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted by " + signal_name(signo));
+    });
+    int code = kExitOk;
+    try {
+      phases();
+    } catch (const RunFailure& f) {
+      code = leave(f.exit_code(), f.what(), f.tell_others());
+    } catch (const InputError& e) {
+      code = leave(kExitBadInput, e.what(), true);
+    } catch (const agent::RunStopped&) {
+      auto stop = s.mailroom().stop_info().value_or(StopInfo{kExitRunFailed, "stopped", false});
+      code = leave(stop.exit_code, stop.reason, !stop.remote);
+    } catch (const std::exception& e) {
+      // A RunStopped may hide behind another error raised while stopping: prefer the cause.
+      if (auto stop = s.mailroom().stop_info())
+        code = leave(stop->exit_code, stop->reason, !stop->remote);
+      else
+        code = leave(kExitRunFailed, e.what(), true);
+    }
+    signals_.stop();  // the callback refers to the session
+    s.close();
+    return code;
+  }
+
+ private:
+  void log(const std::string& what) {
+    if (a_.verbose) std::cerr << tag_ << ": " << what << "\n";
+  }
+
+  // Prints the error, tells the other processes (ABORT) when they may not know yet, and
+  // waits briefly so that the ABORT reaches them before this participant disappears.
+  int leave(int code, const std::string& why, bool tell_others) {
+    std::cerr << tag_ << ": error: " << why << "\n";
+    if (tell_others) {
+      try {
+        session_->send_control(wire::CONTROL_ABORT, "agent " + std::to_string(a_.id) + ": " + why);
+        session_->linger_for_control(Seconds(std::min(3.0, a_.timeout_s)));
+      } catch (const std::exception&) {
+        // Leaving anyway: the others notice this participant disappear.
+      }
+    }
+    return code;
+  }
+
+  void phases() {
+    Session& s = *session_;
+    Mailroom& room = s.mailroom();
+    const auto t0 = std::chrono::steady_clock::now();
+
+    // 1. Our share of the graph.
+    PoseGraph graph = read_g2o(a_.graph);
+    share_ = agent::robot_share(graph, a_.id, a_.robots);
+    graph = PoseGraph();  // keep only the share
+    log("read " + a_.graph + ": poses [" + std::to_string(share_.begin) + ", " + std::to_string(share_.end) +
+        ") of " + std::to_string(share_.num_poses) + ", " + std::to_string(share_.measurements.size()) +
+        " measurements");
+
+    // 2. Announce the structure (endpoints only).
+    wire::AgentAnnouncement ann;
+    ann.run_id(a_.run_id);
+    ann.agent_id(a_.id);
+    ann.num_agents(a_.robots);
+    ann.host(host_name());
+    ann.pid(static_cast<std::uint32_t>(getpid()));
+    ann.dim(static_cast<std::uint32_t>(share_.d));
+    ann.num_poses(static_cast<std::uint32_t>(share_.num_poses));
+    ann.pose_begin(share_.begin);
+    ann.pose_end(share_.end);
+    for (const Measurement& m : share_.measurements) {
+      ann.edge_i().push_back(static_cast<std::uint32_t>(m.i));
+      ann.edge_j().push_back(static_cast<std::uint32_t>(m.j));
+    }
+    s.publish(ann);
+    log("announced");
+
+    // 3. The assignment.
+    wire::PartitionAssignment asg;
+    expect_ready(s.assignments().take(Seconds(a_.timeout_s), &asg), room, a_.timeout_s,
+                 "the partition assignment from the coordinator",
+                 s.live_peers().empty() ? "no peer of run '" + a_.run_id + "' seen on domain " +
+                                              std::to_string(s.domain()) + " (is the coordinator running?)"
+                                        : "");
+    check_assignment(asg);
+    log("assignment received (" + std::to_string(std::count(asg.owner().begin(), asg.owner().end(), a_.id)) +
+        " poses owned)");
+
+    // 4. Everyone's endpoints matched before any volatile agent-to-agent message.
+    std::string missing;
+    expect_ready(s.ready_barrier(Seconds(a_.timeout_s), &missing), room, a_.timeout_s,
+                 "the other processes to be ready", missing);
+    log("all processes ready");
+
+    // 5. Hand-off, peer to peer: exactly one message to every other agent.
+    for (std::uint32_t b = 0; b < a_.robots; ++b) {
+      if (b == a_.id) continue;
+      agent::HandoffPlan plan = agent::plan_handoff(share_, asg.owner(), b);
+      s.publish(to_wire_handoff(a_.run_id, a_.id, b, share_.d, plan.measurements, plan.measurement_index,
+                                plan.poses));
+    }
+    const std::size_t others = a_.robots - 1;
+    auto senders_missing = [&](const std::deque<wire::MeasurementHandoff>& q) {
+      std::set<std::uint32_t> have;
+      for (const auto& h : q) have.insert(h.sender());
+      std::string out;
+      for (std::uint32_t b = 0; b < a_.robots; ++b)
+        if (b != a_.id && !have.count(b)) out += (out.empty() ? "agent " : ", agent ") + std::to_string(b);
+      return out;
+    };
+    std::string absent;
+    expect_ready(s.handoffs().wait_for(
+                     [&](const auto& q) {
+                       absent = senders_missing(q);
+                       return q.size() >= others && absent.empty();
+                     },
+                     Seconds(a_.timeout_s)),
+                 room, a_.timeout_s, "measurement hand-offs", "none yet from " + absent);
+    std::vector<agent::ReceivedHandoff> received;
+    for (auto& w : s.handoffs().take_all()) {
+      HandoffContent c = from_wire(w);
+      received.push_back({w.sender(), std::move(c.measurements), std::move(c.measurement_index), std::move(c.poses)});
+    }
+    agent::RunOptions ro;
+    ro.algorithm = asg.algorithm();
+    ro.initialization = asg.initialization();
+    ro.rank = asg.rank();
+    ro.max_rounds = asg.max_rounds();
+    ro.grad_norm_tolerance = asg.grad_norm_tolerance();
+    ro.relative_cost_tolerance = asg.relative_cost_tolerance();
+    ro.seed = asg.seed();
+    agent::AgentLocalData local = agent::assemble_local(share_, asg.owner(), a_.id, a_.robots, std::move(received), ro);
+    share_ = agent::RobotShare();
+    log("hand-off complete: " + std::to_string(local.owned.size()) + " poses, " +
+        std::to_string(local.measurements.size()) + " measurements");
+    if (!a_.dump_local.empty()) agent::write_local_dump(local, a_.dump_local);
+
+    // 6. THE SEAM: core's round protocol over DDS.
+    agent::DdsProtocolChannel channel(s);
+    agent::RoundLoopResult result = agent::run_round_loop(local, channel, a_.round_timeout_s);
+    if (result.poses.size() != local.owned.size())
+      throw RunFailure(kExitRunFailed, "the round loop returned " + std::to_string(result.poses.size()) +
+                                           " poses for " + std::to_string(local.owned.size()) + " owned poses");
+    log("round loop done after " + std::to_string(result.rounds) + " round(s)");
+    if (!a_.output.empty()) agent::write_vertices_g2o(local.owned, result.poses, local.d, a_.output);
+
+    // 7. Final estimate to the coordinator; leave when it has the merged result.
+    wire::FinalEstimate fin;
+    fin.run_id(a_.run_id);
+    fin.sender(a_.id);
+    fin.dim(static_cast<std::uint32_t>(local.d));
+    fin.rounds(result.rounds);
+    fin.pose_ids(local.owned);
+    for (const Pose& p : result.poses) append_pose(fin.pose_data(), p);
+    fin.bytes_sent(s.stats().bytes_sent + serialized_size(fin));
+    s.publish(fin);
+    expect_ready(s.wait_finished(Seconds(a_.timeout_s)), room, a_.timeout_s,
+                 "the coordinator to confirm the merged result");
+    s.set_peer_loss_fatal(false);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    char buf[256];
+    std::snprintf(buf, sizeof(buf), "%s: done: %zu poses, %zu measurements, %u round(s), %llu bytes sent, %.2f s\n",
+                  tag_.c_str(), local.owned.size(), local.measurements.size(), result.rounds,
+                  static_cast<unsigned long long>(s.stats().bytes_sent), secs);
+    std::cerr << buf;
+  }
+
+  void check_assignment(const wire::PartitionAssignment& asg) {
+    auto mismatch = [&](const std::string& what) {
+      throw RunFailure(kExitBadInput, "the coordinator's assignment does not fit this agent: " + what);
+    };
+    if (asg.num_agents() != a_.robots)
+      mismatch("it is for " + std::to_string(asg.num_agents()) + " agents, this agent was started with --robots " +
+               std::to_string(a_.robots));
+    if (asg.num_poses() != share_.num_poses || asg.owner().size() != share_.num_poses)
+      mismatch("it has " + std::to_string(asg.owner().size()) + " poses, " + a_.graph + " has " +
+               std::to_string(share_.num_poses));
+    if (asg.dim() != static_cast<std::uint32_t>(share_.d))
+      mismatch("dimension " + std::to_string(asg.dim()) + " vs " + std::to_string(share_.d));
+    for (std::uint32_t o : asg.owner())
+      if (o >= a_.robots) mismatch("owner " + std::to_string(o) + " is not an agent id");
+  }
+
+  AgentArgs a_;
+  SignalWatcher& signals_;
+  std::string tag_;
+  std::unique_ptr<Session> session_;
+  agent::RobotShare share_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  SignalWatcher signals;  // first: every thread created later inherits the blocked signals
+  std::vector<std::string> argv_list(argv + 1, argv + argc);
+  for (const auto& a : argv_list)
+    if (a == "--help" || a == "-h") {
+      std::cout << kHelp;
+      return kExitOk;
+    }
+  AgentArgs args;
+  try {
+    args = parse(argv_list);
+  } catch (const InputError& e) {
+    std::cerr << "tessera-agent: error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  Agent agent(args, signals);
+  return agent.run();
+}

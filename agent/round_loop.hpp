@@ -1,0 +1,85 @@
+#pragma once
+// THE SEAM between the DDS runtime and core's round protocol.
+//
+// After the hand-off, an agent holds its local problem (AgentLocalData) and a
+// ProtocolChannel that delivers core ProtocolMessages to and from the other agents. The
+// runtime calls run_round_loop() once and publishes the poses it returns as this agent's
+// final estimate. Nothing here knows about DDS: the same function can be driven by an
+// in-process channel in tests.
+//
+// Today run_round_loop() is a placeholder that exercises the channel (one exchange of
+// boundary pose blocks and one status broadcast) and returns the initial poses. The lead
+// replaces its body with core's agent state machine (issue 4).
+
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "graph/measurement.hpp"
+#include "graph/pose.hpp"
+#include "protocol/messages.hpp"
+
+namespace tessera::agent {
+
+/// Algorithm options of the run as published by the coordinator (simple fields).
+struct RunOptions {
+  std::string algorithm;           ///< Solver name ("" = core's default).
+  std::string initialization;      ///< e.g. "distributed" ("" = core's default).
+  std::uint32_t rank = 0;          ///< r (0 = d).
+  std::uint32_t max_rounds = 0;    ///< 0 = core's default.
+  double grad_norm_tolerance = 0;  ///< 0 = core's default.
+  double relative_cost_tolerance = 0;
+  std::uint64_t seed = 1;
+};
+
+/// Everything one agent knows after the hand-off.
+struct AgentLocalData {
+  std::uint32_t agent_id = 0;
+  std::uint32_t num_agents = 1;
+  int d = 0;
+  std::size_t num_poses = 0;             ///< n of the whole graph.
+  std::vector<std::uint32_t> owner;      ///< Owner agent of every pose 0..n-1.
+  std::vector<std::uint32_t> owned;      ///< Poses this agent optimizes, ascending.
+  /// Every measurement with at least one endpoint in `owned`, in the order of the original
+  /// file (measurement_index is the position in that file), so sums can follow the same
+  /// order as the in-process engine.
+  std::vector<Measurement> measurements;
+  std::vector<std::uint64_t> measurement_index;
+  /// Initial poses of `owned` (same order); empty when the input had no VERTEX lines.
+  std::vector<Pose> initial;
+  RunOptions options;
+};
+
+/// Raised by a channel when the run is stopping (lost peer, abort, signal): the round loop
+/// must unwind; the runtime reports the reason.
+class RunStopped : public std::runtime_error {
+ public:
+  explicit RunStopped(const std::string& why) : std::runtime_error(why) {}
+};
+
+/// How the round loop talks to the other agents.
+class ProtocolChannel {
+ public:
+  virtual ~ProtocolChannel() = default;
+  /// Sends to every agent (broadcast) or to the listed recipients. Never delivered back to
+  /// the sender. Throws RunStopped / std::runtime_error when it cannot be delivered.
+  virtual void send(const OutgoingMessage& message) = 0;
+  /// The next message for this agent in arrival order (FIFO per sender and message type;
+  /// a block and a status from one sender may arrive in either order), or nullopt when
+  /// none arrived within `timeout_s`. Throws RunStopped when the run is stopping.
+  virtual std::optional<ProtocolMessage> receive(double timeout_s) = 0;
+};
+
+struct RoundLoopResult {
+  std::vector<Pose> poses;  ///< Final (rounded) poses of `owned`, same order.
+  std::uint32_t rounds = 0;
+};
+
+/// Runs this agent's part of the distributed solve. `receive_timeout_s` bounds every wait
+/// for a peer's message (a throw names the missing sender).
+RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
+                               double receive_timeout_s);
+
+}  // namespace tessera::agent

@@ -1,0 +1,160 @@
+#pragma once
+// Inboxes: where a DDS listener thread drops received messages and where the application
+// thread waits for them. Every inbox of a session shares one Mailroom (one mutex and one
+// condition variable), so any wait wakes on a new message, on a stop request (signal,
+// abort from a peer, lost peer) or on its timeout, whichever comes first. No busy polling.
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace tessera::transport {
+
+using Seconds = std::chrono::duration<double>;
+
+enum class WaitStatus {
+  kReady,    ///< The condition holds (or a message was taken).
+  kTimeout,  ///< The timeout passed first.
+  kStopped,  ///< The run is stopping (see Mailroom::stop_info()); checked before the condition.
+};
+
+/// Why a run stops: the exit code the process should return and a message naming the cause.
+struct StopInfo {
+  int exit_code = 1;
+  std::string reason;
+  bool remote = false;  ///< Another process asked to stop (ABORT received): no need to tell the others.
+};
+
+class Mailroom {
+ public:
+  /// Records a stop request (the first one wins) and wakes every waiter.
+  void request_stop(int exit_code, const std::string& reason, bool remote = false) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!stop_) stop_ = StopInfo{exit_code, reason, remote};
+    }
+    cv_.notify_all();
+  }
+  std::optional<StopInfo> stop_info() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return stop_;
+  }
+  bool stopped() const { return stop_info().has_value(); }
+
+  /// Waits until `pred()` holds (evaluated with the mailroom locked, so it may read inbox
+  /// contents through the *_locked accessors), the run stops, or `timeout` passes.
+  WaitStatus wait_for(const std::function<bool()>& pred, Seconds timeout) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return wait_locked(lock, pred, timeout);
+  }
+
+  /// Runs `fn` with the mailroom locked (for listener threads that update shared state).
+  template <class Fn>
+  auto with_lock(Fn&& fn) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return fn();
+  }
+  /// Wakes every waiter so it re-evaluates its condition (call after with_lock updates).
+  void notify() { cv_.notify_all(); }
+
+  WaitStatus wait_locked(std::unique_lock<std::mutex>& lock, const std::function<bool()>& pred,
+                         Seconds timeout) {
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(timeout);
+    for (;;) {
+      if (stop_) return WaitStatus::kStopped;
+      if (pred()) return WaitStatus::kReady;
+      if (cv_.wait_until(lock, deadline) == std::cv_status::timeout) {
+        if (stop_) return WaitStatus::kStopped;
+        return pred() ? WaitStatus::kReady : WaitStatus::kTimeout;
+      }
+    }
+  }
+  std::mutex& mutex() { return mutex_; }
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::optional<StopInfo> stop_;
+};
+
+/// A FIFO of received messages of one type.
+template <class T>
+class Inbox {
+ public:
+  explicit Inbox(Mailroom& room) : room_(room) {}
+  Inbox(const Inbox&) = delete;
+  Inbox& operator=(const Inbox&) = delete;
+
+  /// Appends a message and wakes waiters (called from listener threads).
+  void push(T message) {
+    {
+      std::lock_guard<std::mutex> lock(room_.mutex());
+      queue_.push_back(std::move(message));
+    }
+    room_.notify();
+  }
+
+  /// Waits until `pred(queued messages)` holds, the run stops, or the timeout passes.
+  WaitStatus wait_for(const std::function<bool(const std::deque<T>&)>& pred, Seconds timeout) {
+    std::unique_lock<std::mutex> lock(room_.mutex());
+    return room_.wait_locked(lock, [&] { return pred(queue_); }, timeout);
+  }
+
+  /// Removes the first queued message satisfying `match` into `*out`, waiting for one to
+  /// arrive if needed. Returns kReady when a message was taken.
+  WaitStatus take(const std::function<bool(const T&)>& match, Seconds timeout, T* out) {
+    std::unique_lock<std::mutex> lock(room_.mutex());
+    typename std::deque<T>::iterator found;
+    auto pred = [&] {
+      for (found = queue_.begin(); found != queue_.end(); ++found)
+        if (match(*found)) return true;
+      return false;
+    };
+    WaitStatus status = room_.wait_locked(lock, pred, timeout);
+    if (status == WaitStatus::kReady) {
+      *out = std::move(*found);
+      queue_.erase(found);
+    }
+    return status;
+  }
+
+  /// Takes the first queued message, waiting up to `timeout`.
+  WaitStatus take(Seconds timeout, T* out) {
+    return take([](const T&) { return true; }, timeout, out);
+  }
+
+  /// Removes and returns every queued message satisfying `match` (no waiting).
+  std::vector<T> take_all(const std::function<bool(const T&)>& match = [](const T&) { return true; }) {
+    std::lock_guard<std::mutex> lock(room_.mutex());
+    std::vector<T> out;
+    for (auto it = queue_.begin(); it != queue_.end();) {
+      if (match(*it)) {
+        out.push_back(std::move(*it));
+        it = queue_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    return out;
+  }
+
+  std::size_t size() const {
+    std::lock_guard<std::mutex> lock(room_.mutex());
+    return queue_.size();
+  }
+  /// The queue itself; only while holding the mailroom lock (inside a wait predicate).
+  const std::deque<T>& queued_locked() const { return queue_; }
+
+ private:
+  Mailroom& room_;
+  std::deque<T> queue_;
+};
+
+}  // namespace tessera::transport

@@ -1,0 +1,62 @@
+#pragma once
+// Conversions between core's transport-independent types (protocol messages, measurements,
+// poses) and the generated DDS wire types (idl/tessera.idl). Mechanical, field by field;
+// pose data as flat column-major arrays. Decoding checks array lengths and throws
+// TransportError on a malformed message (never reads out of bounds).
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "graph/measurement.hpp"
+#include "graph/pose.hpp"
+#include "protocol/messages.hpp"
+#include "tessera.h"
+#include "transport/transport_error.hpp"
+
+namespace tessera::transport {
+
+// ---- round protocol -------------------------------------------------------------------
+
+/// Wire form of an outgoing protocol message (block or status) from `run_id`.
+wire::PoseBlock to_wire_block(const PoseBlockMessage& m, const std::string& run_id, bool broadcast,
+                              const std::vector<std::uint32_t>& recipients);
+wire::RoundStatus to_wire_status(const RoundStatusMessage& m, const std::string& run_id,
+                                 bool broadcast, const std::vector<std::uint32_t>& recipients);
+PoseBlockMessage from_wire(const wire::PoseBlock& w);
+RoundStatusMessage from_wire(const wire::RoundStatus& w);
+
+/// Whether a routed message is meant for agent `me` (broadcast, or `me` among the recipients).
+bool addressed_to(bool broadcast, const std::vector<std::uint32_t>& recipients, std::uint32_t me);
+
+// ---- poses and measurements ------------------------------------------------------------
+
+/// Appends [R | t] column-major (d*(d+1) doubles).
+void append_pose(std::vector<double>& flat, const Pose& pose);
+/// The k-th pose of a flat array of poses in SE(d).
+Pose pose_at(const std::vector<double>& flat, std::size_t k, int d);
+
+/// The content of a measurement hand-off, decoded.
+struct HandoffContent {
+  std::vector<Measurement> measurements;
+  std::vector<std::uint64_t> measurement_index;  ///< Position of each in the original input.
+  std::vector<std::pair<std::uint32_t, Pose>> poses;  ///< Initial poses (id, pose).
+};
+wire::MeasurementHandoff to_wire_handoff(const std::string& run_id, std::uint32_t sender,
+                                         std::uint32_t recipient, int d,
+                                         const std::vector<const Measurement*>& measurements,
+                                         const std::vector<std::uint64_t>& measurement_index,
+                                         const std::vector<std::pair<std::uint32_t, const Pose*>>& poses);
+HandoffContent from_wire(const wire::MeasurementHandoff& w);
+
+/// Poses (id, pose) of a final estimate.
+std::vector<std::pair<std::uint32_t, Pose>> final_poses(const wire::FinalEstimate& w);
+
+/// Serialized size in bytes of a wire message (what DDS puts on the wire, without headers).
+template <class T>
+std::size_t serialized_size(const T& sample) {
+  return T::getCdrSerializedSize(sample) + 4;  // + encapsulation
+}
+
+}  // namespace tessera::transport

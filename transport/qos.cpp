@@ -1,0 +1,97 @@
+#include "transport/qos.hpp"
+
+#include <algorithm>
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastrtps/utils/IPLocator.h>
+
+namespace tessera::transport {
+
+namespace dds = eprosima::fastdds::dds;
+using eprosima::fastrtps::Duration_t;
+
+dds::DomainParticipantQos participant_qos(const std::string& name, double lease_s,
+                                          const std::vector<std::string>& initial_peers, int domain,
+                                          std::uint32_t num_agents) {
+  dds::DomainParticipantQos q;
+  dds::DomainParticipantFactory::get_instance()->get_default_participant_qos(q);
+  q.name(name);
+  auto& discovery = q.wire_protocol().builtin.discovery_config;
+  // Default lease is 20 s (a killed peer noticed after ~18 s); 1 s with announcements every
+  // lease/5 notices it in ~0.9 s at negligible cost.
+  discovery.leaseDuration = Duration_t(lease_s);
+  discovery.leaseDuration_announcementperiod = Duration_t(lease_s / 5.0);
+  // Announce a few times quickly at start-up so a missed first announcement costs
+  // ~0.1 s instead of a full announcement period.
+  discovery.initial_announcements.count = 5;
+  discovery.initial_announcements.period = Duration_t(0, 100000000);
+  for (const std::string& ip : initial_peers) {
+    // Metatraffic unicast port of participant id p: 7400 + 250 * domain + 10 + 2 * p.
+    const std::uint32_t participants = num_agents + 3;
+    for (std::uint32_t p = 0; p < participants; ++p) {
+      eprosima::fastrtps::rtps::Locator_t loc;
+      eprosima::fastrtps::rtps::IPLocator::setIPv4(loc, ip);
+      loc.port = 7400 + 250 * static_cast<std::uint32_t>(domain) + 10 + 2 * p;
+      q.wire_protocol().builtin.initialPeersList.push_back(loc);
+    }
+  }
+  return q;
+}
+
+dds::PublisherQos publisher_qos(const std::string& run_id) {
+  dds::PublisherQos q = dds::PUBLISHER_QOS_DEFAULT;
+  q.partition().push_back(run_id.c_str());
+  return q;
+}
+
+dds::SubscriberQos subscriber_qos(const std::string& run_id) {
+  dds::SubscriberQos q = dds::SUBSCRIBER_QOS_DEFAULT;
+  q.partition().push_back(run_id.c_str());
+  return q;
+}
+
+dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_t num_agents) {
+  (void)num_agents;
+  dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  // write() never blocks long: when the bounded history is full it returns and we retry
+  // after waiting for acknowledgements (Session::Impl::write).
+  q.reliability().max_blocking_time = Duration_t(0, 10000000);
+  q.durability().kind = transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  // Bounded KEEP_ALL: unbounded limits let acknowledged samples pile up (hundreds of MB).
+  q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  q.resource_limits().max_samples = kWriterHistory;
+  q.resource_limits().max_instances = 1;
+  q.resource_limits().max_samples_per_instance = kWriterHistory;
+  q.resource_limits().allocated_samples = 4;
+  // The default 3 s heartbeat stalls request/reply exchanges for seconds after a loss.
+  q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(0, 50000000);
+  q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
+  q.liveliness().lease_duration = Duration_t(lease_s);
+  q.liveliness().announcement_period = Duration_t(lease_s / 4.0);
+  // Messages are variable-sized (unbounded sequences): size payloads per sample.
+  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  return q;
+}
+
+dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_t num_agents) {
+  dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+  // The listener takes every sample at once; room for a burst from every writer avoids
+  // rejections (and their heartbeat-period resend delay) when all agents send together.
+  const std::int32_t limit = std::max<std::int32_t>(kWriterHistory, 4 * static_cast<std::int32_t>(num_agents));
+  q.resource_limits().max_samples = limit;
+  q.resource_limits().max_instances = 1;
+  q.resource_limits().max_samples_per_instance = limit;
+  q.resource_limits().allocated_samples = 4;
+  q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
+  q.liveliness().lease_duration = Duration_t(lease_s);
+  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  return q;
+}
+
+}  // namespace tessera::transport

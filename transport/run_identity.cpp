@@ -1,0 +1,71 @@
+#include "transport/run_identity.hpp"
+
+#include <cerrno>
+#include <cstdlib>
+#include <unistd.h>
+
+#include "util/input_error.hpp"
+
+namespace tessera::transport {
+
+void validate_run_id(const std::string& run_id) {
+  if (run_id.empty() || run_id.size() > 64)
+    throw InputError("option --run-id: must be 1 to 64 characters, got '" + run_id + "'");
+  for (char c : run_id) {
+    bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+              c == '_' || c == '.' || c == '-';
+    if (!ok)
+      throw InputError("option --run-id: '" + run_id +
+                       "' may only contain letters, digits, '_', '.' and '-'");
+  }
+}
+
+int domain_for_run(const std::string& run_id) {
+  std::uint32_t h = 2166136261u;
+  for (unsigned char c : run_id) {
+    h ^= c;
+    h *= 16777619u;
+  }
+  return 1 + static_cast<int>(h % static_cast<std::uint32_t>(kMaxDomain));
+}
+
+std::string PeerIdentity::describe() const {
+  return coordinator ? std::string("the coordinator") : "agent " + std::to_string(agent_id);
+}
+
+std::string participant_name(const PeerIdentity& who) {
+  return "tessera:" + who.run_id +
+         (who.coordinator ? std::string(":coordinator") : ":agent:" + std::to_string(who.agent_id));
+}
+
+std::optional<PeerIdentity> parse_participant_name(const std::string& name) {
+  const std::string prefix = "tessera:";
+  if (name.compare(0, prefix.size(), prefix) != 0) return std::nullopt;
+  std::string rest = name.substr(prefix.size());
+  PeerIdentity who;
+  const std::string coord = ":coordinator";
+  if (rest.size() > coord.size() && rest.compare(rest.size() - coord.size(), coord.size(), coord) == 0) {
+    who.run_id = rest.substr(0, rest.size() - coord.size());
+    who.coordinator = true;
+    return who;
+  }
+  auto pos = rest.rfind(":agent:");
+  if (pos == std::string::npos) return std::nullopt;
+  std::string id = rest.substr(pos + 7);
+  if (id.empty()) return std::nullopt;
+  errno = 0;
+  char* end = nullptr;
+  unsigned long v = std::strtoul(id.c_str(), &end, 10);
+  if (*end != '\0' || errno != 0 || v > 0xFFFFFFFEul) return std::nullopt;
+  who.run_id = rest.substr(0, pos);
+  who.agent_id = static_cast<std::uint32_t>(v);
+  return who;
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  if (gethostname(buf, sizeof(buf) - 1) != 0) return "unknown";
+  return buf;
+}
+
+}  // namespace tessera::transport

@@ -1,0 +1,570 @@
+#include "transport/session.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <set>
+
+#include <fastdds/dds/core/status/StatusMask.hpp>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/common/InstanceHandle.h>
+#include <fastrtps/utils/IPLocator.h>
+
+#include "tesseraPubSubTypes.h"
+#include "transport/message_mapping.hpp"
+#include "transport/qos.hpp"
+#include "transport/transport_error.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera::transport {
+
+namespace dds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+void SessionOptions::validate() const {
+  validate_run_id(run_id);
+  if (domain > kMaxDomain)
+    throw InputError("option --domain: " + std::to_string(domain) + " is above the highest usable domain " +
+                     std::to_string(kMaxDomain));
+  if (num_agents < 1 || num_agents > 1000)
+    throw InputError("number of agents must be 1..1000, got " + std::to_string(num_agents));
+  if (!coordinator && agent_id >= num_agents)
+    throw InputError("option --id: " + std::to_string(agent_id) + " is not below the number of agents " +
+                     std::to_string(num_agents));
+  if (!(lease_s >= 0.2 && lease_s <= 60))
+    throw InputError("option --lease: " + std::to_string(lease_s) + " s is outside 0.2..60 s");
+  if (!(write_timeout_s > 0)) throw InputError("write timeout must be positive");
+  for (const auto& ip : initial_peers)
+    if (!eprosima::fastrtps::rtps::IPLocator::isIPv4(ip))
+      throw InputError("option --peers: '" + ip + "' is not an IPv4 address");
+}
+
+namespace {
+
+// Topic names (one topic per message type; Partition QoS = run id on top).
+constexpr const char* kAnnounceTopic = "tessera_announce";
+constexpr const char* kAssignmentTopic = "tessera_assignment";
+constexpr const char* kHandoffTopic = "tessera_handoff";
+constexpr const char* kBlockTopic = "tessera_pose_block";
+constexpr const char* kStatusTopic = "tessera_round_status";
+constexpr const char* kFinalTopic = "tessera_final";
+constexpr const char* kControlTopic = "tessera_control";
+
+using Prefix = rtps::GuidPrefix_t;
+
+Prefix prefix_of(const rtps::InstanceHandle_t& handle) { return rtps::iHandle2GUID(handle).guidPrefix; }
+
+// Which peers an endpoint must match before the readiness barrier can pass.
+enum class Expect { kNone, kOtherAgents, kOtherAgentsAndCoordinator, kCoordinator, kAllAgents };
+
+}  // namespace
+
+struct Session::Impl {
+  SessionOptions opt;
+  int domain = 0;
+  PeerIdentity me;
+  Mailroom room;
+  Inbox<wire::AgentAnnouncement> announce_in{room};
+  Inbox<wire::PartitionAssignment> assignment_in{room};
+  Inbox<wire::MeasurementHandoff> handoff_in{room};
+  Inbox<ProtocolMessage> protocol_in{room};
+  Inbox<wire::RoundStatus> status_in{room};
+  Inbox<wire::FinalEstimate> final_in{room};
+
+  // State below is guarded by room.mutex().
+  std::map<Prefix, PeerIdentity> peers;  // participants of this run, by GUID prefix
+  std::set<Prefix> lost;
+  std::map<std::string, std::multiset<Prefix>> matched;  // endpoint name -> matched remote participants
+  std::map<std::string, Expect> expect;
+  std::set<std::string> ready_from;  // describe() of peers that published READY
+  bool finished_flag = false;
+  bool loss_fatal = true;
+
+  std::atomic<std::uint64_t> bytes{0}, messages{0}, retries{0};
+
+  dds::DomainParticipant* participant = nullptr;
+  dds::Publisher* publisher = nullptr;
+  dds::Subscriber* subscriber = nullptr;
+  Prefix own_prefix;
+  std::map<std::string, dds::Topic*> topics;
+  std::map<std::string, dds::DataWriter*> writers;
+  std::vector<dds::DataReader*> readers;
+
+  // ---- listeners -------------------------------------------------------------------------
+  struct ParticipantListener : dds::DomainParticipantListener {
+    Impl* s;
+    explicit ParticipantListener(Impl* impl) : s(impl) {}
+    void on_participant_discovery(dds::DomainParticipant*, rtps::ParticipantDiscoveryInfo&& info) override {
+      s->on_participant(info.status, info.info.m_guid.guidPrefix, info.info.m_participantName.to_string());
+    }
+  };
+
+  struct WriterListener : dds::DataWriterListener {
+    Impl* s;
+    std::string name;
+    WriterListener(Impl* impl, std::string n) : s(impl), name(std::move(n)) {}
+    void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& st) override {
+      s->on_matched(name, prefix_of(st.last_subscription_handle), st.current_count_change);
+    }
+  };
+
+  struct ReaderListener : dds::DataReaderListener {
+    Impl* s;
+    std::string name;
+    std::function<void(dds::DataReader*)> drain;
+    ReaderListener(Impl* impl, std::string n, std::function<void(dds::DataReader*)> fn)
+        : s(impl), name(std::move(n)), drain(std::move(fn)) {}
+    void on_data_available(dds::DataReader* reader) override { drain(reader); }
+    void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& st) override {
+      s->on_matched(name, prefix_of(st.last_publication_handle), st.current_count_change);
+    }
+    void on_liveliness_changed(dds::DataReader*, const dds::LivelinessChangedStatus& st) override {
+      if (st.not_alive_count_change > 0) s->on_liveliness_lost(prefix_of(st.last_publication_handle));
+    }
+  };
+
+  std::unique_ptr<ParticipantListener> participant_listener;
+  std::vector<std::unique_ptr<WriterListener>> writer_listeners;
+  std::vector<std::unique_ptr<ReaderListener>> reader_listeners;
+  std::vector<std::unique_ptr<dds::TypeSupport>> types;
+
+  // ---- discovery and failure -------------------------------------------------------------
+  void on_participant(rtps::ParticipantDiscoveryInfo::DISCOVERY_STATUS status, const Prefix& prefix,
+                      const std::string& name) {
+    if (prefix == own_prefix) return;
+    auto who = parse_participant_name(name);
+    if (!who || who->run_id != opt.run_id) return;  // someone else's run on this domain
+    if (status == rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT) {
+      std::string clash;
+      room.with_lock([&] {
+        for (const auto& [p, id] : peers)
+          if (p != prefix && !lost.count(p) && id.coordinator == who->coordinator &&
+              id.agent_id == who->agent_id)
+            clash = who->describe();
+        if (!who->coordinator && who->agent_id == me.agent_id && !me.coordinator) clash = who->describe();
+        if (who->coordinator && me.coordinator) clash = who->describe();
+        peers[prefix] = *who;
+        return 0;
+      });
+      room.notify();
+      if (!clash.empty())
+        room.request_stop(2, "two processes claim to be " + clash + " of run '" + opt.run_id +
+                                 "' (check --id / --run-id)");
+    } else if (status == rtps::ParticipantDiscoveryInfo::REMOVED_PARTICIPANT) {
+      peer_gone(prefix, "left the run");
+    } else if (status == rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
+      char buf[96];
+      std::snprintf(buf, sizeof(buf), "stopped responding (participant lease of %.1f s expired)", opt.lease_s);
+      peer_gone(prefix, buf);
+    }
+  }
+
+  void on_liveliness_lost(const Prefix& prefix) {
+    char buf[96];
+    std::snprintf(buf, sizeof(buf), "stopped responding (writer liveliness of %.1f s lost)", opt.lease_s);
+    peer_gone(prefix, buf);
+  }
+
+  void peer_gone(const Prefix& prefix, const std::string& how) {
+    std::optional<PeerIdentity> who;
+    bool fatal = false;
+    room.with_lock([&] {
+      auto it = peers.find(prefix);
+      if (it != peers.end() && !lost.count(prefix)) {
+        lost.insert(prefix);
+        who = it->second;
+        fatal = loss_fatal;
+      }
+      return 0;
+    });
+    if (!who) return;
+    room.notify();
+    if (fatal) room.request_stop(1, "lost " + who->describe() + " of run '" + opt.run_id + "': it " + how);
+  }
+
+  void on_matched(const std::string& endpoint, const Prefix& prefix, int change) {
+    if (prefix == own_prefix) return;
+    room.with_lock([&] {
+      auto& set = matched[endpoint];
+      if (change > 0) {
+        set.insert(prefix);
+      } else if (change < 0) {
+        auto it = set.find(prefix);
+        if (it != set.end()) set.erase(it);
+      }
+      return 0;
+    });
+    room.notify();
+  }
+
+  // ---- readiness -------------------------------------------------------------------------
+  std::vector<PeerIdentity> expected_peers(Expect e) const {
+    std::vector<PeerIdentity> out;
+    auto agent = [&](std::uint32_t k) { return PeerIdentity{opt.run_id, false, k}; };
+    switch (e) {
+      case Expect::kNone:
+        break;
+      case Expect::kCoordinator:
+        out.push_back(PeerIdentity{opt.run_id, true, 0});
+        break;
+      case Expect::kOtherAgentsAndCoordinator:
+        out.push_back(PeerIdentity{opt.run_id, true, 0});
+        [[fallthrough]];
+      case Expect::kOtherAgents:
+        for (std::uint32_t k = 0; k < opt.num_agents; ++k)
+          if (me.coordinator || k != me.agent_id) out.push_back(agent(k));
+        break;
+      case Expect::kAllAgents:
+        for (std::uint32_t k = 0; k < opt.num_agents; ++k) out.push_back(agent(k));
+        break;
+    }
+    return out;
+  }
+
+  // Requires room.mutex() held.
+  bool matched_locked(std::string* missing) const {
+    std::set<std::string> absent;
+    for (const auto& [endpoint, e] : expect) {
+      std::set<std::string> have;
+      auto it = matched.find(endpoint);
+      if (it != matched.end())
+        for (const Prefix& p : it->second) {
+          auto peer = peers.find(p);
+          if (peer != peers.end() && !lost.count(p)) have.insert(peer->second.describe());
+        }
+      for (const auto& want : expected_peers(e))
+        if (!have.count(want.describe())) absent.insert(want.describe());
+    }
+    if (missing) {
+      missing->clear();
+      for (const auto& a : absent) *missing += (missing->empty() ? "" : ", ") + a;
+    }
+    return absent.empty();
+  }
+
+  // ---- entities --------------------------------------------------------------------------
+  template <class PubSubType>
+  dds::Topic* topic(const std::string& name) {
+    auto it = topics.find(name);
+    if (it != topics.end()) return it->second;
+    types.push_back(std::make_unique<dds::TypeSupport>(new PubSubType()));
+    dds::TypeSupport& type = *types.back();
+    if (participant->register_type(type) != ReturnCode_t::RETCODE_OK)
+      throw TransportError("cannot register DDS type " + type.get_type_name());
+    dds::Topic* t = participant->create_topic(name, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    if (!t) throw TransportError("cannot create DDS topic " + name);
+    topics[name] = t;
+    return t;
+  }
+
+  template <class PubSubType>
+  void make_writer(const std::string& name, bool transient_local, Expect e) {
+    dds::Topic* t = topic<PubSubType>(name);
+    writer_listeners.push_back(std::make_unique<WriterListener>(this, name + "/w"));
+    dds::DataWriter* w = publisher->create_datawriter(
+        t, writer_qos(transient_local, opt.lease_s, opt.num_agents), writer_listeners.back().get(),
+        dds::StatusMask::publication_matched());
+    if (!w) throw TransportError("cannot create DDS writer for " + name);
+    writers[name] = w;
+    if (e != Expect::kNone) expect[name + "/w"] = e;
+  }
+
+  template <class PubSubType, class T>
+  void make_reader(const std::string& name, bool transient_local, Expect e,
+                   std::function<void(T&&)> deliver) {
+    dds::Topic* t = topic<PubSubType>(name);
+    auto drain = [this, deliver](dds::DataReader* reader) {
+      T sample;
+      dds::SampleInfo info;
+      while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+        if (!info.valid_data) continue;
+        if (sample.run_id() != opt.run_id) continue;  // belt and braces: Partition already filters
+        try {
+          deliver(std::move(sample));
+        } catch (const std::exception& ex) {
+          room.request_stop(1, std::string("received a bad message on ") + reader->get_topicdescription()->get_name() +
+                                   ": " + ex.what());
+        }
+        sample = T();
+      }
+    };
+    reader_listeners.push_back(std::make_unique<ReaderListener>(this, name + "/r", drain));
+    dds::StatusMask mask = dds::StatusMask::data_available() << dds::StatusMask::subscription_matched()
+                                                           << dds::StatusMask::liveliness_changed();
+    dds::DataReader* r = subscriber->create_datareader(
+        t, reader_qos(transient_local, opt.lease_s, opt.num_agents), reader_listeners.back().get(), mask);
+    if (!r) throw TransportError("cannot create DDS reader for " + name);
+    readers.push_back(r);
+    if (e != Expect::kNone) expect[name + "/r"] = e;
+  }
+
+  template <class T>
+  void write(const std::string& name, const T& sample) {
+    auto it = writers.find(name);
+    if (it == writers.end())
+      throw TransportError("this " + std::string(me.coordinator ? "coordinator" : "agent") +
+                           " does not write " + name);
+    dds::DataWriter* w = it->second;
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(opt.write_timeout_s));
+    for (;;) {
+      ReturnCode_t rc = w->write(const_cast<T*>(&sample));
+      if (rc == ReturnCode_t::RETCODE_OK) {
+        bytes += serialized_size(sample);
+        ++messages;
+        return;
+      }
+      if (rc != ReturnCode_t::RETCODE_OUT_OF_RESOURCES && rc != ReturnCode_t::RETCODE_TIMEOUT)
+        throw TransportError("DDS write on " + name + " failed (code " + std::to_string(rc()) + ")");
+      // The bounded history is full of unacknowledged samples: wait for acknowledgements
+      // (not a busy loop), then try again, until the deadline.
+      ++retries;
+      if (std::chrono::steady_clock::now() > deadline)
+        throw TransportError("could not send on " + name + " within " + std::to_string(opt.write_timeout_s) +
+                             " s: the receivers do not acknowledge (history full)");
+      w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 20000000));
+    }
+  }
+
+  void close() {
+    if (!participant) return;
+    room.with_lock([&] {
+      loss_fatal = false;
+      return 0;
+    });
+    participant->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant);
+    participant = nullptr;
+    writers.clear();
+    readers.clear();
+    topics.clear();
+  }
+};
+
+Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()) {
+  options.validate();
+  Impl& s = *impl_;
+  s.opt = options;
+  s.domain = options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
+  s.me = PeerIdentity{options.run_id, options.coordinator, options.coordinator ? 0u : options.agent_id};
+
+  s.participant_listener = std::make_unique<Impl::ParticipantListener>(&s);
+  auto* factory = dds::DomainParticipantFactory::get_instance();
+  s.participant = factory->create_participant(
+      s.domain, participant_qos(participant_name(s.me), options.lease_s, options.initial_peers, s.domain,
+                                options.num_agents),
+      s.participant_listener.get(), dds::StatusMask::none());
+  if (!s.participant)
+    throw TransportError("cannot create a DDS participant on domain " + std::to_string(s.domain));
+  s.own_prefix = s.participant->guid().guidPrefix;
+  try {
+    s.publisher = s.participant->create_publisher(publisher_qos(options.run_id));
+    s.subscriber = s.participant->create_subscriber(subscriber_qos(options.run_id));
+    if (!s.publisher || !s.subscriber) throw TransportError("cannot create DDS publisher/subscriber");
+
+    const std::uint32_t me = s.me.agent_id;
+    if (options.coordinator) {
+      s.make_writer<wire::PartitionAssignmentPubSubType>(kAssignmentTopic, true, Expect::kNone);
+      s.make_writer<wire::ControlPubSubType>(kControlTopic, true, Expect::kNone);
+      s.make_reader<wire::AgentAnnouncementPubSubType, wire::AgentAnnouncement>(
+          kAnnounceTopic, true, Expect::kNone, [&s](wire::AgentAnnouncement&& m) { s.announce_in.push(std::move(m)); });
+      s.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
+          kStatusTopic, false, Expect::kAllAgents, [&s](wire::RoundStatus&& m) { s.status_in.push(std::move(m)); });
+      s.make_reader<wire::FinalEstimatePubSubType, wire::FinalEstimate>(
+          kFinalTopic, false, Expect::kAllAgents, [&s](wire::FinalEstimate&& m) { s.final_in.push(std::move(m)); });
+    } else {
+      s.make_writer<wire::AgentAnnouncementPubSubType>(kAnnounceTopic, true, Expect::kNone);
+      s.make_writer<wire::ControlPubSubType>(kControlTopic, true, Expect::kNone);
+      s.make_writer<wire::MeasurementHandoffPubSubType>(kHandoffTopic, false, Expect::kOtherAgents);
+      s.make_writer<wire::PoseBlockPubSubType>(kBlockTopic, false, Expect::kOtherAgents);
+      s.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false, Expect::kOtherAgentsAndCoordinator);
+      s.make_writer<wire::FinalEstimatePubSubType>(kFinalTopic, false, Expect::kCoordinator);
+      s.make_reader<wire::PartitionAssignmentPubSubType, wire::PartitionAssignment>(
+          kAssignmentTopic, true, Expect::kNone,
+          [&s](wire::PartitionAssignment&& m) { s.assignment_in.push(std::move(m)); });
+      s.make_reader<wire::MeasurementHandoffPubSubType, wire::MeasurementHandoff>(
+          kHandoffTopic, false, Expect::kOtherAgents, [&s, me](wire::MeasurementHandoff&& m) {
+            if (m.recipient() == me && m.sender() != me) s.handoff_in.push(std::move(m));
+          });
+      s.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(
+          kBlockTopic, false, Expect::kOtherAgents, [&s, me](wire::PoseBlock&& m) {
+            if (m.sender() != me && addressed_to(m.broadcast(), m.recipients(), me))
+              s.protocol_in.push(ProtocolMessage(from_wire(m)));
+          });
+      s.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
+          kStatusTopic, false, Expect::kOtherAgents, [&s, me](wire::RoundStatus&& m) {
+            if (m.sender() != me && addressed_to(m.broadcast(), m.recipients(), me))
+              s.protocol_in.push(ProtocolMessage(from_wire(m)));
+          });
+    }
+    // Control: everyone reads everyone (READY barrier, ABORT, FINISHED).
+    const std::uint32_t self_id = options.coordinator ? kCoordinatorId : me;
+    s.make_reader<wire::ControlPubSubType, wire::Control>(
+        kControlTopic, true, Expect::kNone, [&s, self_id](wire::Control&& m) {
+          if (m.sender() == self_id) return;
+          PeerIdentity from{s.opt.run_id, m.sender() == kCoordinatorId, m.sender() == kCoordinatorId ? 0u : m.sender()};
+          switch (m.kind()) {
+            case wire::CONTROL_READY:
+              s.room.with_lock([&] { return s.ready_from.insert(from.describe()).second; });
+              s.room.notify();
+              break;
+            case wire::CONTROL_FINISHED:
+              s.room.with_lock([&] { return s.finished_flag = true; });
+              s.room.notify();
+              break;
+            case wire::CONTROL_ABORT:
+              s.room.request_stop(1, from.describe() + " aborted run '" + s.opt.run_id + "': " + m.reason(), true);
+              break;
+          }
+        });
+  } catch (...) {
+    s.close();
+    throw;
+  }
+}
+
+Session::~Session() { close(); }
+
+const SessionOptions& Session::options() const { return impl_->opt; }
+int Session::domain() const { return impl_->domain; }
+PeerIdentity Session::self() const { return impl_->me; }
+Mailroom& Session::mailroom() { return impl_->room; }
+
+Inbox<wire::AgentAnnouncement>& Session::announcements() { return impl_->announce_in; }
+Inbox<wire::PartitionAssignment>& Session::assignments() { return impl_->assignment_in; }
+Inbox<wire::MeasurementHandoff>& Session::handoffs() { return impl_->handoff_in; }
+Inbox<ProtocolMessage>& Session::protocol() { return impl_->protocol_in; }
+Inbox<wire::RoundStatus>& Session::status_watch() { return impl_->status_in; }
+Inbox<wire::FinalEstimate>& Session::finals() { return impl_->final_in; }
+
+void Session::publish(const wire::AgentAnnouncement& m) { impl_->write(kAnnounceTopic, m); }
+void Session::publish(const wire::PartitionAssignment& m) { impl_->write(kAssignmentTopic, m); }
+void Session::publish(const wire::MeasurementHandoff& m) { impl_->write(kHandoffTopic, m); }
+void Session::publish(const wire::FinalEstimate& m) { impl_->write(kFinalTopic, m); }
+
+void Session::send(const OutgoingMessage& m) {
+  const std::string& run = impl_->opt.run_id;
+  if (const auto* block = std::get_if<PoseBlockMessage>(&m.message)) {
+    impl_->write(kBlockTopic, to_wire_block(*block, run, m.broadcast, m.recipients));
+  } else {
+    impl_->write(kStatusTopic,
+                 to_wire_status(std::get<RoundStatusMessage>(m.message), run, m.broadcast, m.recipients));
+  }
+}
+
+void Session::send_control(wire::ControlKind kind, const std::string& reason) {
+  wire::Control c;
+  c.run_id(impl_->opt.run_id);
+  c.sender(impl_->me.coordinator ? kCoordinatorId : impl_->me.agent_id);
+  c.kind(kind);
+  c.reason(reason);
+  impl_->write(kControlTopic, c);
+}
+
+bool Session::endpoints_matched(std::string* missing) const {
+  std::lock_guard<std::mutex> lock(impl_->room.mutex());
+  return impl_->matched_locked(missing);
+}
+
+WaitStatus Session::ready_barrier(Seconds timeout, std::string* missing) {
+  Impl& s = *impl_;
+  const auto start = std::chrono::steady_clock::now();
+  std::string absent;
+  WaitStatus st = s.room.wait_for([&] { return s.matched_locked(&absent); }, timeout);
+  if (st != WaitStatus::kReady) {
+    if (missing) *missing = "endpoints not matched with " + absent;
+    return st;
+  }
+  send_control(wire::CONTROL_READY);
+  std::vector<PeerIdentity> others = s.expected_peers(Expect::kOtherAgents);
+  if (!s.me.coordinator) others.push_back(PeerIdentity{s.opt.run_id, true, 0});
+  const Seconds left = timeout - (std::chrono::steady_clock::now() - start);
+  st = s.room.wait_for(
+      [&] {
+        absent.clear();
+        for (const auto& p : others)
+          if (!s.ready_from.count(p.describe())) absent += (absent.empty() ? "" : ", ") + p.describe();
+        return absent.empty();
+      },
+      left);
+  if (st == WaitStatus::kTimeout && missing) *missing = "no READY from " + absent;
+  return st;
+}
+
+bool Session::finished() const {
+  std::lock_guard<std::mutex> lock(impl_->room.mutex());
+  return impl_->finished_flag;
+}
+
+WaitStatus Session::wait_finished(Seconds timeout) {
+  return impl_->room.wait_for([&] { return impl_->finished_flag; }, timeout);
+}
+
+std::vector<PeerIdentity> Session::live_peers() const {
+  std::lock_guard<std::mutex> lock(impl_->room.mutex());
+  std::vector<PeerIdentity> out;
+  for (const auto& [p, who] : impl_->peers)
+    if (!impl_->lost.count(p)) out.push_back(who);
+  return out;
+}
+
+void Session::set_peer_loss_fatal(bool fatal) {
+  impl_->room.with_lock([&] { return impl_->loss_fatal = fatal; });
+}
+
+void Session::flush(Seconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(timeout);
+  for (auto& [name, w] : impl_->writers) {
+    (void)name;
+    double left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+    if (left <= 0) return;
+    w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(left));
+  }
+}
+
+void Session::linger_for_control(Seconds timeout) {
+  Impl& s = *impl_;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<PeerIdentity> others = s.expected_peers(Expect::kOtherAgents);
+  if (!s.me.coordinator) others.push_back(PeerIdentity{s.opt.run_id, true, 0});
+  const std::string endpoint = std::string(kControlTopic) + "/w";
+  s.room.wait_for(
+      [&] {
+        std::set<std::string> have;
+        auto it = s.matched.find(endpoint);
+        if (it != s.matched.end())
+          for (const Prefix& p : it->second) {
+            auto peer = s.peers.find(p);
+            if (peer != s.peers.end()) have.insert(peer->second.describe());
+          }
+        for (const auto& p : others)
+          if (!have.count(p.describe())) return false;
+        return true;
+      },
+      timeout);
+  flush(timeout - (std::chrono::steady_clock::now() - start));
+}
+
+SessionStats Session::stats() const {
+  return SessionStats{impl_->bytes.load(), impl_->messages.load(), impl_->retries.load()};
+}
+
+void Session::close() {
+  if (impl_) impl_->close();
+}
+
+}  // namespace tessera::transport

@@ -1,0 +1,122 @@
+#pragma once
+// One DDS participant per process and everything it needs for a Tessera run: the topics
+// with their QoS, typed writers that retry while the bounded history is full, inboxes fed
+// by listener threads, a readiness barrier, and peer-loss detection. DDS types stay inside
+// the implementation; callers see the generated wire structs (idl/) and core's
+// ProtocolMessage only.
+//
+// Isolation: domain id (derived from the run id unless given), Partition QoS = run id,
+// and the run id field of every message (messages of other runs are dropped).
+//
+// Failure: a peer of this run that disappears (participant lease or writer liveliness
+// expires, or it leaves) or that publishes ABORT stops the session: every wait returns
+// WaitStatus::kStopped and mailroom().stop_info() names the cause.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "protocol/messages.hpp"
+#include "tessera.h"
+#include "transport/inbox.hpp"
+#include "transport/run_identity.hpp"
+
+namespace tessera::transport {
+
+struct SessionOptions {
+  std::string run_id = "default";  ///< 1..64 of [A-Za-z0-9_.-]; Partition QoS and message field.
+  int domain = -1;                 ///< DDS domain 0..kMaxDomain; < 0: domain_for_run(run_id).
+  bool coordinator = false;        ///< Role: the coordinator, or agent `agent_id`.
+  std::uint32_t agent_id = 0;      ///< 0..num_agents-1 (agents only).
+  std::uint32_t num_agents = 1;    ///< N >= 1.
+  /// Participant lease and writer liveliness lease in seconds (0.2..60). A SIGKILLed peer is
+  /// noticed after about this long (participant announcements go out every lease/5).
+  double lease_s = 1.0;
+  /// IPv4 addresses of hosts to contact by unicast for discovery (when multicast is blocked).
+  std::vector<std::string> initial_peers;
+  /// How long a write may wait for room in the bounded history before failing (seconds).
+  double write_timeout_s = 30.0;
+
+  /// Throws InputError naming the bad field.
+  void validate() const;
+};
+
+/// Counters of one session (this process).
+struct SessionStats {
+  std::uint64_t bytes_sent = 0;     ///< Serialized payload bytes written (all topics).
+  std::uint64_t messages_sent = 0;
+  std::uint64_t write_retries = 0;  ///< Writes that found the history full and waited.
+};
+
+class Session {
+ public:
+  /// Creates the participant and this role's endpoints; throws TransportError on failure.
+  explicit Session(const SessionOptions& options);
+  /// Same as close().
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  const SessionOptions& options() const;
+  int domain() const;
+  PeerIdentity self() const;
+  /// Stop state shared by every inbox; request_stop() interrupts all waits.
+  Mailroom& mailroom();
+
+  // ---- inboxes: messages of this run meant for this process ------------------------------
+  Inbox<wire::AgentAnnouncement>& announcements();  ///< Coordinator.
+  Inbox<wire::PartitionAssignment>& assignments();  ///< Agents.
+  Inbox<wire::MeasurementHandoff>& handoffs();      ///< Agents: those addressed to this agent.
+  /// Agents: pose blocks and round statuses addressed to this agent (own messages excluded),
+  /// converted to core's types, in arrival order per topic.
+  Inbox<ProtocolMessage>& protocol();
+  Inbox<wire::RoundStatus>& status_watch();         ///< Coordinator: every round status (progress).
+  Inbox<wire::FinalEstimate>& finals();             ///< Coordinator.
+
+  // ---- sending (retries while the history is full; throws TransportError after write_timeout_s)
+  void publish(const wire::AgentAnnouncement& m);
+  void publish(const wire::PartitionAssignment& m);
+  void publish(const wire::MeasurementHandoff& m);
+  void publish(const wire::FinalEstimate& m);
+  /// A round-protocol message from this agent (run id and routing filled in here).
+  void send(const OutgoingMessage& m);
+  /// READY / ABORT / FINISHED from this process.
+  void send_control(wire::ControlKind kind, const std::string& reason = "");
+
+  // ---- run coordination ----------------------------------------------------------------
+  /// Whether every volatile endpoint of this process has matched every peer of a complete
+  /// run (the other agents, the coordinator). When false, `missing` (if given) lists them.
+  bool endpoints_matched(std::string* missing = nullptr) const;
+  /// Waits until endpoints_matched(), publishes READY, then waits for READY from every
+  /// other agent (and the coordinator, for agents). After kReady, volatile messages between
+  /// any two processes of the run cannot be lost to discovery races. On kTimeout `missing`
+  /// names who is not ready.
+  WaitStatus ready_barrier(Seconds timeout, std::string* missing);
+  /// Whether the coordinator has published FINISHED (agents).
+  bool finished() const;
+  /// Waits for FINISHED from the coordinator.
+  WaitStatus wait_finished(Seconds timeout);
+
+  /// Peers of this run discovered and not lost.
+  std::vector<PeerIdentity> live_peers() const;
+  /// When false, a lost peer is only logged (set it once the run's work is complete).
+  void set_peer_loss_fatal(bool fatal);
+  /// Waits until every reliable sample written so far is acknowledged (bounded).
+  void flush(Seconds timeout);
+  /// Before leaving on an error: waits (bounded) until the control topic has matched every
+  /// peer of the run and they acknowledged what this process wrote, so an ABORT written
+  /// just before reaches processes that are still starting up.
+  void linger_for_control(Seconds timeout);
+
+  SessionStats stats() const;
+  /// Deletes every DDS entity and the participant (idempotent). After this the process
+  /// leaves no shared-memory files behind.
+  void close();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tessera::transport
