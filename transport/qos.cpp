@@ -72,7 +72,7 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
   q.liveliness().lease_duration = Duration_t(lease_s);
   q.liveliness().announcement_period = Duration_t(lease_s / 4.0);
   // Messages are variable-sized (unbounded sequences): size payloads per sample.
-  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return q;
 }
 
@@ -90,7 +90,7 @@ dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_
   q.resource_limits().allocated_samples = 4;
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
   q.liveliness().lease_duration = Duration_t(lease_s);
-  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return q;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <map>
 #include <set>
@@ -11,6 +12,7 @@
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/log/Log.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -322,20 +324,26 @@ struct Session::Impl {
     const auto deadline = std::chrono::steady_clock::now() +
                           std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(opt.write_timeout_s));
     for (;;) {
-      ReturnCode_t rc = w->write(const_cast<T*>(&sample));
+      // The handle overload reports why a write failed (the plain one only returns a bool).
+      ReturnCode_t rc = w->write(const_cast<T*>(&sample), rtps::c_InstanceHandle_Unknown);
       if (rc == ReturnCode_t::RETCODE_OK) {
         bytes += serialized_size(sample);
         ++messages;
         return;
       }
-      if (rc != ReturnCode_t::RETCODE_OUT_OF_RESOURCES && rc != ReturnCode_t::RETCODE_TIMEOUT)
-        throw TransportError("DDS write on " + name + " failed (code " + std::to_string(rc()) + ")");
-      // The bounded history is full of unacknowledged samples: wait for acknowledgements
-      // (not a busy loop), then try again, until the deadline.
+      if (rc == ReturnCode_t::RETCODE_BAD_PARAMETER || rc == ReturnCode_t::RETCODE_NOT_ENABLED ||
+          rc == ReturnCode_t::RETCODE_PRECONDITION_NOT_MET || rc == ReturnCode_t::RETCODE_ILLEGAL_OPERATION)
+        throw TransportError("DDS write on " + name + " failed (return code " + std::to_string(rc()) + ")");
+      // Most likely the bounded history is full of unacknowledged samples (2.9 reports that
+      // as OUT_OF_RESOURCES, TIMEOUT or ERROR): wait for acknowledgements (not a busy loop),
+      // then try again, until the deadline.
       ++retries;
-      if (std::chrono::steady_clock::now() > deadline)
-        throw TransportError("could not send on " + name + " within " + std::to_string(opt.write_timeout_s) +
-                             " s: the receivers do not acknowledge (history full)");
+      if (std::chrono::steady_clock::now() > deadline) {
+        char buf[64];
+        std::snprintf(buf, sizeof(buf), "%g s (return code %u)", opt.write_timeout_s, rc());
+        throw TransportError("could not send on " + name + " within " + buf +
+                             ": the receivers do not acknowledge (history full)");
+      }
       w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 20000000));
     }
   }
@@ -362,6 +370,9 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   s.domain = options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
   s.me = PeerIdentity{options.run_id, options.coordinator, options.coordinator ? 0u : options.agent_id};
 
+  // TESSERA_DDS_LOG=1 shows Fast DDS's own warnings and errors (for diagnosing QoS trouble).
+  if (const char* env = std::getenv("TESSERA_DDS_LOG"); env && *env && *env != '0')
+    eprosima::fastdds::dds::Log::SetVerbosity(eprosima::fastdds::dds::Log::Kind::Warning);
   s.participant_listener = std::make_unique<Impl::ParticipantListener>(&s);
   auto* factory = dds::DomainParticipantFactory::get_instance();
   s.participant = factory->create_participant(

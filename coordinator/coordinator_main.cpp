@@ -1,0 +1,432 @@
+// tessera-coordinator: the lightweight process of a distributed run. It waits for the N
+// agents, partitions the graph structure they announce (never measurement values),
+// publishes the assignment and gathers the final estimate. See docs/dds-runtime.md.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "arguments.hpp"
+#include "coordinator/partition_step.hpp"
+#include "coordinator/run_structure.hpp"
+#include "graph/pose_graph.hpp"
+#include "io/g2o_writer.hpp"
+#include "io/tum_writer.hpp"
+#include "transport/message_mapping.hpp"
+#include "transport/run_failure.hpp"
+#include "transport/session.hpp"
+#include "transport/signal_watcher.hpp"
+#include "util/input_error.hpp"
+
+using namespace tessera;
+using namespace tessera::transport;
+
+namespace {
+
+constexpr const char* kHelp = R"(usage: tessera-coordinator --agents N [options]
+
+The coordinator of a distributed Tessera run. Waits for N tessera-agent processes of the
+same run id, receives their graph structure (edge endpoints only), partitions it, publishes
+the assignment and the algorithm options, then gathers every agent's final poses and writes
+the merged result. It never receives measurement values.
+
+options:
+  --agents N           number of agents of the run (required)
+  --run-id ID          run id shared by all processes of the run (default "default")
+  --domain D           DDS domain id 0..232 (default: derived from the run id)
+  --timeout S          bound on each wait during set-up and shutdown, seconds (default 30)
+  --run-timeout S      bound on the wait for the final estimates, seconds (default 3600)
+  --lease S            participant/liveliness lease in seconds (default 1, range 0.2..60)
+  --peers IP[,IP]      IPv4 addresses to contact by unicast (when multicast is not available)
+  --partition PRESET   sequential, fast, eco, strong or highest (default eco)
+  --partition-seed K   seed of the partitioner (default 1)
+  --rank R             rank r of the relaxation sent to the agents (default 0 = d)
+  --algorithm NAME     solver name sent to the agents (default: core's default)
+  --init NAME          initialisation sent to the agents (default: core's default)
+  --max-rounds K       round limit sent to the agents (default 0 = core's default)
+  --grad-tol X         gradient-norm tolerance sent to the agents (default 0 = core's default)
+  --rel-cost-tol X     relative cost tolerance sent to the agents (default 0 = core's default)
+  --seed K             solver seed sent to the agents (default 1)
+  --output FILE        write the merged poses as g2o (VERTEX lines only)
+  --tum FILE           write the merged poses in the TUM format
+  --summary FILE       write a JSON summary of the run
+  --progress           print round progress (sum of the agents' cost and gradient norm)
+  --verbose            print each phase
+  --help               this text
+
+exit codes: 0 done, 1 the run failed (lost agent, abort, timeout), 2 bad options or input,
+128+signal when interrupted (SIGINT 130, SIGTERM 143).
+)";
+
+struct CoordinatorArgs {
+  std::uint32_t agents = 0;
+  std::string run_id = "default";
+  int domain = -1;
+  double timeout_s = 30;
+  double run_timeout_s = 3600;
+  double lease_s = 1.0;
+  std::vector<std::string> peers;
+  std::string partition = "eco";
+  std::uint64_t partition_seed = 1;
+  std::uint32_t rank = 0;
+  std::string algorithm, init;
+  std::uint32_t max_rounds = 0;
+  double grad_tol = 0, rel_cost_tol = 0;
+  std::uint64_t seed = 1;
+  std::string output, tum, summary;
+  bool progress = false, verbose = false;
+};
+
+std::vector<std::string> split_commas(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= s.size()) {
+    std::size_t comma = s.find(',', start);
+    if (comma == std::string::npos) comma = s.size();
+    if (comma > start) out.push_back(s.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return out;
+}
+
+CoordinatorArgs parse(const std::vector<std::string>& argv) {
+  cli::Arguments args(argv,
+                      {"agents", "run-id", "domain", "timeout", "run-timeout", "lease", "peers", "partition",
+                       "partition-seed", "rank", "algorithm", "init", "max-rounds", "grad-tol", "rel-cost-tol",
+                       "seed", "output", "tum", "summary"},
+                      {"progress", "verbose", "help"});
+  if (!args.positional().empty())
+    throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
+  CoordinatorArgs a;
+  if (!args.has("agents")) throw InputError("option --agents is required (see --help)");
+  long agents = args.get_long("agents", 0);
+  if (agents < 1 || agents > 1000) throw InputError("option --agents: must be 1..1000");
+  a.agents = static_cast<std::uint32_t>(agents);
+  a.run_id = args.get_or("run-id", a.run_id);
+  validate_run_id(a.run_id);
+  long domain = args.get_long("domain", -1);
+  if (args.has("domain") && (domain < 0 || domain > kMaxDomain))
+    throw InputError("option --domain: must be 0.." + std::to_string(kMaxDomain));
+  a.domain = static_cast<int>(domain);
+  a.timeout_s = args.get_double("timeout", a.timeout_s);
+  if (!(a.timeout_s > 0)) throw InputError("option --timeout: must be positive");
+  a.run_timeout_s = args.get_double("run-timeout", a.run_timeout_s);
+  if (!(a.run_timeout_s > 0)) throw InputError("option --run-timeout: must be positive");
+  a.lease_s = args.get_double("lease", a.lease_s);
+  if (args.has("peers")) a.peers = split_commas(*args.get("peers"));
+  a.partition = args.get_or("partition", a.partition);
+  auto nonneg = [&](const char* name, long fallback) {
+    long v = args.get_long(name, fallback);
+    if (v < 0) throw InputError(std::string("option --") + name + ": must not be negative");
+    return v;
+  };
+  a.partition_seed = static_cast<std::uint64_t>(nonneg("partition-seed", 1));
+  a.rank = static_cast<std::uint32_t>(nonneg("rank", 0));
+  a.algorithm = args.get_or("algorithm", "");
+  a.init = args.get_or("init", "");
+  a.max_rounds = static_cast<std::uint32_t>(nonneg("max-rounds", 0));
+  a.grad_tol = args.get_double("grad-tol", 0);
+  a.rel_cost_tol = args.get_double("rel-cost-tol", 0);
+  if (a.grad_tol < 0) throw InputError("option --grad-tol: must not be negative");
+  if (a.rel_cost_tol < 0) throw InputError("option --rel-cost-tol: must not be negative");
+  a.seed = static_cast<std::uint64_t>(nonneg("seed", 1));
+  a.output = args.get_or("output", "");
+  a.tum = args.get_or("tum", "");
+  a.summary = args.get_or("summary", "");
+  a.progress = args.has("progress");
+  a.verbose = args.has("verbose");
+  return a;
+}
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.17g", x);
+  return buf;
+}
+
+class Coordinator {
+ public:
+  Coordinator(const CoordinatorArgs& a, SignalWatcher& signals) : a_(a), signals_(signals) {}
+
+  int run() {
+    SessionOptions so;
+    so.run_id = a_.run_id;
+    so.domain = a_.domain;
+    so.coordinator = true;
+    so.num_agents = a_.agents;
+    so.lease_s = a_.lease_s;
+    so.initial_peers = a_.peers;
+    try {
+      session_ = std::make_unique<Session>(so);
+    } catch (const InputError& e) {
+      std::cerr << "tessera-coordinator: error: " << e.what() << "\n";
+      return kExitBadInput;
+    } catch (const std::exception& e) {
+      std::cerr << "tessera-coordinator: error: " << e.what() << "\n";
+      return kExitRunFailed;
+    }
+    Session& s = *session_;
+    signals_.start([&s](int signo) {
+      s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted by " + signal_name(signo));
+    });
+    int code = kExitOk;
+    try {
+      phases();
+    } catch (const RunFailure& f) {
+      code = leave(f.exit_code(), f.what(), f.tell_others());
+    } catch (const InputError& e) {
+      code = leave(kExitBadInput, e.what(), true);
+    } catch (const std::exception& e) {
+      if (auto stop = s.mailroom().stop_info())
+        code = leave(stop->exit_code, stop->reason, !stop->remote);
+      else
+        code = leave(kExitRunFailed, e.what(), true);
+    }
+    signals_.stop();
+    s.close();
+    return code;
+  }
+
+ private:
+  void log(const std::string& what) {
+    if (a_.verbose) std::cerr << "tessera-coordinator: " << what << "\n";
+  }
+
+  int leave(int code, const std::string& why, bool tell_others) {
+    std::cerr << "tessera-coordinator: error: " << why << "\n";
+    if (tell_others) {
+      try {
+        session_->send_control(wire::CONTROL_ABORT, "coordinator: " + why);
+        session_->linger_for_control(Seconds(std::min(3.0, a_.timeout_s)));
+      } catch (const std::exception&) {
+        // Leaving anyway: the agents notice the coordinator disappear.
+      }
+    }
+    return code;
+  }
+
+  static double ms_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  }
+
+  void phases() {
+    Session& s = *session_;
+    Mailroom& room = s.mailroom();
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::uint32_t N = a_.agents;
+
+    // 1. Every agent's announcement (TRANSIENT_LOCAL: agents may have started first).
+    std::string missing;
+    auto all_announced = [&](const std::deque<wire::AgentAnnouncement>& q) {
+      std::set<std::uint32_t> have;
+      for (const auto& m : q) {
+        if (m.agent_id() >= N || m.num_agents() != N) return true;  // let merge_announcements explain
+        have.insert(m.agent_id());
+      }
+      missing.clear();
+      std::string present;
+      for (std::uint32_t k = 0; k < N; ++k) {
+        std::string& list = have.count(k) ? present : missing;
+        list += (list.empty() ? "" : ", ") + std::to_string(k);
+      }
+      if (!missing.empty()) missing = "missing agent " + missing + (present.empty() ? "" : " (have agent " + present + ")");
+      return have.size() == N;
+    };
+    expect_ready(s.announcements().wait_for(all_announced, Seconds(a_.timeout_s)), room, a_.timeout_s,
+                 std::to_string(N) + " agents of run '" + a_.run_id + "' on domain " + std::to_string(s.domain()),
+                 missing);
+    std::vector<wire::AgentAnnouncement> announcements = s.announcements().take_all();
+    discovery_ms_ = ms_since(t0);
+    coordinator::RunStructure rs = coordinator::merge_announcements(announcements, N, a_.run_id);
+    announcements.clear();
+    log("all " + std::to_string(N) + " agents announced (" + std::to_string(static_cast<long>(discovery_ms_)) + " ms): " +
+        std::to_string(rs.num_poses) + " poses, " + std::to_string(rs.num_measurements) + " measurements");
+
+    // 2. Partition and publish the assignment.
+    coordinator::PartitionStepResult part =
+        coordinator::partition_for_agents(rs.graph, N, a_.partition, a_.partition_seed);
+    log("partition (" + a_.partition + "): cut " + std::to_string(part.cut_edges) + " measurements in " +
+        std::to_string(part.ms) + " ms");
+    wire::PartitionAssignment asg;
+    asg.run_id(a_.run_id);
+    asg.num_agents(N);
+    asg.num_poses(static_cast<std::uint32_t>(rs.num_poses));
+    asg.dim(static_cast<std::uint32_t>(rs.d));
+    asg.rank(a_.rank);
+    asg.owner(part.owner);
+    asg.algorithm(a_.algorithm);
+    asg.initialization(a_.init);
+    asg.max_rounds(a_.max_rounds);
+    asg.grad_norm_tolerance(a_.grad_tol);
+    asg.relative_cost_tolerance(a_.rel_cost_tol);
+    asg.seed(a_.seed);
+    asg.partition_ms(part.ms);
+    s.publish(asg);
+    expect_ready(s.ready_barrier(Seconds(a_.timeout_s), &missing), room, a_.timeout_s,
+                 "the agents to be ready", missing);
+    log("all agents ready");
+
+    // 3. Final estimates (progress from round statuses meanwhile).
+    const auto t_run = std::chrono::steady_clock::now();
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::pair<std::uint32_t, std::pair<double, double>>> progress;
+    auto finals_missing = [&]() {
+      std::set<std::uint32_t> have;
+      for (const auto& f : s.finals().queued_locked()) have.insert(f.sender());
+      std::string out;
+      for (std::uint32_t k = 0; k < N; ++k)
+        if (!have.count(k)) out += (out.empty() ? "agent " : ", agent ") + std::to_string(k);
+      return out;
+    };
+    for (;;) {
+      const double left = a_.run_timeout_s - ms_since(t_run) / 1000.0;
+      std::string absent;
+      WaitStatus st = room.wait_for(
+          [&] {
+            absent = finals_missing();
+            return absent.empty() || !s.status_watch().queued_locked().empty();
+          },
+          Seconds(std::max(0.0, left)));
+      expect_ready(st, room, a_.run_timeout_s, "the final estimates", "none yet from " + absent);
+      for (const auto& m : s.status_watch().take_all()) {
+        auto& p = progress[{m.round(), m.phase()}];
+        p.first += 1;
+        p.second.first += m.cost();
+        p.second.second += m.grad_norm_sq();
+        if (p.first == N && a_.progress) {
+          char buf[160];
+          std::snprintf(buf, sizeof(buf), "round %u phase %u: cost %.10g, grad norm %.3e\n", m.round(), m.phase(),
+                        p.second.first, std::sqrt(p.second.second));
+          std::cout << buf << std::flush;
+        }
+        if (p.first == N) progress.erase({m.round(), m.phase()});
+      }
+      if (s.finals().size() >= N && room.wait_for([&] { return finals_missing().empty(); }, Seconds(0)) ==
+                                         WaitStatus::kReady)
+        break;
+    }
+    solve_ms_ = ms_since(t_run);
+
+    // 4. Merge.
+    std::vector<Pose> poses(rs.num_poses);
+    std::vector<bool> seen(rs.num_poses, false);
+    std::vector<std::uint64_t> bytes(N, 0);
+    std::uint32_t rounds = 0;
+    for (const auto& f : s.finals().take_all()) {
+      if (f.sender() >= N) continue;
+      bytes[f.sender()] = f.bytes_sent();
+      rounds = std::max(rounds, f.rounds());
+      auto list = final_poses(f);
+      for (auto& [id, pose] : list) {
+        if (id >= rs.num_poses || part.owner[id] != f.sender())
+          throw RunFailure(kExitRunFailed, "agent " + std::to_string(f.sender()) + " returned pose " +
+                                               std::to_string(id) + " which it does not own");
+        if (pose.dim() != rs.d) throw RunFailure(kExitRunFailed, "final pose of the wrong dimension");
+        poses[id] = std::move(pose);
+        seen[id] = true;
+      }
+    }
+    for (std::size_t id = 0; id < rs.num_poses; ++id)
+      if (!seen[id])
+        throw RunFailure(kExitRunFailed, "pose " + std::to_string(id) + " is missing from agent " +
+                                             std::to_string(part.owner[id]) + "'s final estimate");
+    if (!a_.output.empty()) {
+      PoseGraph g;
+      g.d = rs.d;
+      g.num_poses = rs.num_poses;
+      g.source = "tessera-coordinator run " + a_.run_id;
+      write_g2o(g, poses, a_.output);
+    }
+    if (!a_.tum.empty()) write_tum(poses, a_.tum);
+    if (!a_.summary.empty()) write_summary(rs, part, bytes, rounds, ms_since(t0));
+
+    // 5. Tell the agents they may leave.
+    s.send_control(wire::CONTROL_FINISHED);
+    s.flush(Seconds(std::min(3.0, a_.timeout_s)));
+    s.set_peer_loss_fatal(false);
+    std::uint64_t total_bytes = 0;
+    for (auto b : bytes) total_bytes += b;
+    char buf[256];
+    std::snprintf(buf, sizeof(buf),
+                  "tessera-coordinator: done: %u agents, %zu poses, %u round(s), discovery %.0f ms, partition %.1f ms, "
+                  "%llu bytes sent by agents, %.2f s\n",
+                  N, rs.num_poses, rounds, discovery_ms_, part.ms, static_cast<unsigned long long>(total_bytes),
+                  ms_since(t0) / 1000.0);
+    std::cerr << buf;
+  }
+
+  void write_summary(const coordinator::RunStructure& rs, const coordinator::PartitionStepResult& part,
+                     const std::vector<std::uint64_t>& bytes, std::uint32_t rounds, double total_ms) {
+    std::string j = "{\n";
+    j += "  \"run_id\": " + json_string(a_.run_id) + ",\n";
+    j += "  \"domain\": " + std::to_string(session_->domain()) + ",\n";
+    j += "  \"agents\": " + std::to_string(a_.agents) + ",\n";
+    j += "  \"dim\": " + std::to_string(rs.d) + ",\n";
+    j += "  \"num_poses\": " + std::to_string(rs.num_poses) + ",\n";
+    j += "  \"num_measurements\": " + std::to_string(rs.num_measurements) + ",\n";
+    j += "  \"partition\": " + json_string(a_.partition) + ",\n";
+    j += "  \"cut_edges\": " + std::to_string(part.cut_edges) + ",\n";
+    j += "  \"rounds\": " + std::to_string(rounds) + ",\n";
+    j += "  \"discovery_ms\": " + json_number(discovery_ms_) + ",\n";
+    j += "  \"partition_ms\": " + json_number(part.ms) + ",\n";
+    j += "  \"solve_ms\": " + json_number(solve_ms_) + ",\n";
+    j += "  \"total_ms\": " + json_number(total_ms) + ",\n";
+    j += "  \"bytes_sent\": [";
+    for (std::size_t k = 0; k < bytes.size(); ++k) j += (k ? ", " : "") + std::to_string(bytes[k]);
+    j += "],\n  \"hosts\": [";
+    for (std::size_t k = 0; k < rs.hosts.size(); ++k) j += (k ? ", " : "") + json_string(rs.hosts[k]);
+    j += "]\n}\n";
+    std::ofstream f(a_.summary, std::ios::binary);
+    if (!f || !(f << j)) throw InputError(a_.summary, 0, "cannot write the summary");
+  }
+
+  CoordinatorArgs a_;
+  SignalWatcher& signals_;
+  std::unique_ptr<Session> session_;
+  double discovery_ms_ = 0, solve_ms_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  SignalWatcher signals;  // first: every thread created later inherits the blocked signals
+  std::vector<std::string> argv_list(argv + 1, argv + argc);
+  for (const auto& a : argv_list)
+    if (a == "--help" || a == "-h") {
+      std::cout << kHelp;
+      return kExitOk;
+    }
+  CoordinatorArgs args;
+  try {
+    args = parse(argv_list);
+  } catch (const InputError& e) {
+    std::cerr << "tessera-coordinator: error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  Coordinator c(args, signals);
+  return c.run();
+}
