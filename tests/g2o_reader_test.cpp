@@ -7,11 +7,16 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "io/information_weights.hpp"
 #include "test_support.hpp"
@@ -162,6 +167,49 @@ TEST(G2oReader, SlightlyNonUnitQuaternionLikeRealFiles) {
   const auto r = read(edge3(0, 1, "0 0 0.0001 1.0000001"));
   const Eigen::MatrixXd& R = r.graph.measurements[0].R;
   EXPECT_TRUE((R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-15));
+}
+
+TEST(G2oReader, NumbersParsedExactlyLikeStrtod) {
+  // The reader has a fast path for plain decimals; it must round exactly like strtod.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> mag(-30, 30);
+  const char* const formats[] = {"%.6f", "%.7g", "%.17g", "%.3e", "%.15e", "%.0f", "%.20f"};
+  std::vector<std::string> tokens = {"0",
+                                     "-0",
+                                     "1.",
+                                     ".5",
+                                     "-.25",
+                                     "1e5",
+                                     "1E-5",
+                                     "+3.5",
+                                     "9007199254740993",
+                                     "0.1",
+                                     "123456789012345678",
+                                     "1.2345678901234567890123",
+                                     "4.9e-324",
+                                     "1e22",
+                                     "1e23",
+                                     "8.98846567431158e307",
+                                     "0.000000",
+                                     "100.000000"};
+  char buf[64];
+  for (int k = 0; k < 3000; ++k) {
+    const double x = (rng() % 2 ? 1 : -1) * std::pow(10.0, mag(rng)) * (1 + (rng() % 1000) / 7.0);
+    std::snprintf(buf, sizeof buf, formats[k % 7], x);
+    tokens.push_back(buf);
+  }
+  std::string text;
+  for (std::size_t k = 0; k < tokens.size(); ++k)
+    text += "EDGE_SE2 " + std::to_string(k) + " " + std::to_string(k + 1) + " " + tokens[k] +
+            " 0 0" + kInfo2 + "\n";
+  const auto r = read(text);
+  ASSERT_EQ(r.graph.num_measurements(), tokens.size());
+  for (std::size_t k = 0; k < tokens.size(); ++k) {
+    const double expected = std::strtod(tokens[k].c_str(), nullptr);
+    const double got = r.graph.measurements[k].t(0);
+    ASSERT_EQ(std::memcmp(&expected, &got, sizeof got), 0)
+        << tokens[k] << ": " << got << " vs strtod " << expected;
+  }
 }
 
 TEST(G2oReader, WeightsOfAKnownMatrix2d) {

@@ -45,10 +45,11 @@ IsotropicWeights isotropic_weights_3d(const double* upper21) {
 }
 
 bool upper_triangle_is_positive_definite(const double* upper, int size) {
-  // In-place Cholesky on a small dense copy; size is 3 or 6.
-  double l[6][6] = {};
-  for (int r = 0; r < size; ++r)
-    for (int c = 0; c < size; ++c) l[r][c] = upper_at(upper, size, r, c);
+  // Cholesky on the lower triangle of a small dense copy (size 3 or 6); stops at the first
+  // pivot that is not > 0. Runs once per edge, so it unpacks sequentially.
+  double l[6][6];
+  for (int r = 0, k = 0; r < size; ++r)
+    for (int c = r; c < size; ++c) l[c][r] = upper[k++];
   for (int k = 0; k < size; ++k) {
     double pivot = l[k][k];
     for (int m = 0; m < k; ++m) pivot -= l[k][m] * l[k][m];
