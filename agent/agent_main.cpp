@@ -137,6 +137,7 @@ class Agent {
     so.num_agents = a_.robots;
     so.lease_s = a_.lease_s;
     so.initial_peers = a_.peers;
+    so.verbose = a_.verbose;
     try {
       session_ = std::make_unique<Session>(so);
     } catch (const InputError& e) {
@@ -225,11 +226,11 @@ class Agent {
 
     // 3. The assignment.
     wire::PartitionAssignment asg;
-    expect_ready(s.assignments().take(Seconds(a_.timeout_s), &asg), room, a_.timeout_s,
-                 "the partition assignment from the coordinator",
-                 s.live_peers().empty() ? "no peer of run '" + a_.run_id + "' seen on domain " +
-                                              std::to_string(s.domain()) + " (is the coordinator running?)"
-                                        : "");
+    WaitStatus got = s.assignments().take(Seconds(a_.timeout_s), &asg);
+    expect_ready(got, room, a_.timeout_s, "the partition assignment from the coordinator",
+                 s.peers_ever_seen() == 0 ? "no process of run '" + a_.run_id + "' seen on domain " +
+                                                std::to_string(s.domain()) + " (is the coordinator running?)"
+                                          : "");
     check_assignment(asg);
     log("assignment received (" + std::to_string(std::count(asg.owner().begin(), asg.owner().end(), a_.id)) +
         " poses owned)");

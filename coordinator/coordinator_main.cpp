@@ -181,6 +181,7 @@ class Coordinator {
     so.num_agents = a_.agents;
     so.lease_s = a_.lease_s;
     so.initial_peers = a_.peers;
+    so.verbose = a_.verbose;
     try {
       session_ = std::make_unique<Session>(so);
     } catch (const InputError& e) {
@@ -198,12 +199,14 @@ class Coordinator {
     try {
       phases();
     } catch (const RunFailure& f) {
-      code = leave(f.exit_code(), f.what(), f.tell_others());
+      // Always tell the agents, even when an agent aborted: the coordinator's ABORT carries
+      // the original reason and reaches every agent before the coordinator disappears.
+      code = leave(f.exit_code(), f.what(), true);
     } catch (const InputError& e) {
       code = leave(kExitBadInput, e.what(), true);
     } catch (const std::exception& e) {
       if (auto stop = s.mailroom().stop_info())
-        code = leave(stop->exit_code, stop->reason, !stop->remote);
+        code = leave(stop->exit_code, stop->reason, true);
       else
         code = leave(kExitRunFailed, e.what(), true);
     }

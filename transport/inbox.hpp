@@ -49,9 +49,9 @@ class Mailroom {
 
   /// Waits until `pred()` holds (evaluated with the mailroom locked, so it may read inbox
   /// contents through the *_locked accessors), the run stops, or `timeout` passes.
-  WaitStatus wait_for(const std::function<bool()>& pred, Seconds timeout) {
+  WaitStatus wait_for(const std::function<bool()>& pred, Seconds timeout, bool interruptible = true) {
     std::unique_lock<std::mutex> lock(mutex_);
-    return wait_locked(lock, pred, timeout);
+    return wait_locked(lock, pred, timeout, interruptible);
   }
 
   /// Runs `fn` with the mailroom locked (for listener threads that update shared state).
@@ -63,15 +63,16 @@ class Mailroom {
   /// Wakes every waiter so it re-evaluates its condition (call after with_lock updates).
   void notify() { cv_.notify_all(); }
 
+  /// `interruptible` false: a stop request does not end the wait (for leaving cleanly).
   WaitStatus wait_locked(std::unique_lock<std::mutex>& lock, const std::function<bool()>& pred,
-                         Seconds timeout) {
+                         Seconds timeout, bool interruptible = true) {
     const auto deadline =
         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(timeout);
     for (;;) {
-      if (stop_) return WaitStatus::kStopped;
+      if (stop_ && interruptible) return WaitStatus::kStopped;
       if (pred()) return WaitStatus::kReady;
       if (cv_.wait_until(lock, deadline) == std::cv_status::timeout) {
-        if (stop_) return WaitStatus::kStopped;
+        if (stop_ && interruptible) return WaitStatus::kStopped;
         return pred() ? WaitStatus::kReady : WaitStatus::kTimeout;
       }
     }

@@ -162,6 +162,7 @@ struct Session::Impl {
         peers[prefix] = *who;
         return 0;
       });
+      if (opt.verbose) std::fprintf(stderr, "%s: discovered %s\n", participant_name(me).c_str(), who->describe().c_str());
       room.notify();
       if (!clash.empty())
         room.request_stop(2, "two processes claim to be " + clash + " of run '" + opt.run_id +
@@ -194,6 +195,8 @@ struct Session::Impl {
       return 0;
     });
     if (!who) return;
+    if (opt.verbose)
+      std::fprintf(stderr, "%s: lost %s: %s\n", participant_name(me).c_str(), who->describe().c_str(), how.c_str());
     room.notify();
     if (fatal) room.request_stop(1, "lost " + who->describe() + " of run '" + opt.run_id + "': it " + how);
   }
@@ -533,6 +536,11 @@ std::vector<PeerIdentity> Session::live_peers() const {
   return out;
 }
 
+std::size_t Session::peers_ever_seen() const {
+  std::lock_guard<std::mutex> lock(impl_->room.mutex());
+  return impl_->peers.size();
+}
+
 void Session::set_peer_loss_fatal(bool fatal) {
   impl_->room.with_lock([&] { return impl_->loss_fatal = fatal; });
 }
@@ -553,21 +561,31 @@ void Session::linger_for_control(Seconds timeout) {
   std::vector<PeerIdentity> others = s.expected_peers(Expect::kOtherAgents);
   if (!s.me.coordinator) others.push_back(PeerIdentity{s.opt.run_id, true, 0});
   const std::string endpoint = std::string(kControlTopic) + "/w";
-  s.room.wait_for(
-      [&] {
-        std::set<std::string> have;
-        auto it = s.matched.find(endpoint);
-        if (it != s.matched.end())
-          for (const Prefix& p : it->second) {
-            auto peer = s.peers.find(p);
-            if (peer != s.peers.end()) have.insert(peer->second.describe());
-          }
-        for (const auto& p : others)
-          if (!have.count(p.describe())) return false;
-        return true;
-      },
-      timeout);
-  flush(timeout - (std::chrono::steady_clock::now() - start));
+  // Every expected peer has matched our control writer or is gone; with `include_unseen`
+  // false, peers never discovered are not waited for.
+  auto reached = [&](bool include_unseen) {
+    std::set<std::string> have, seen;
+    auto it = s.matched.find(endpoint);
+    if (it != s.matched.end())
+      for (const Prefix& p : it->second) {
+        auto peer = s.peers.find(p);
+        if (peer != s.peers.end()) have.insert(peer->second.describe());
+      }
+    for (const auto& [p, who] : s.peers) {
+      seen.insert(who.describe());
+      if (s.lost.count(p)) have.insert(who.describe());  // no point waiting for a peer that is gone
+    }
+    for (const auto& p : others)
+      if (!have.count(p.describe()) && (include_unseen || seen.count(p.describe()))) return false;
+    return true;
+  };
+  // A peer never seen may still be starting: wait for it, but only about a second.
+  const Seconds first = std::min(timeout, Seconds(1.0));
+  if (s.room.wait_for([&] { return reached(true); }, first, /*interruptible=*/false) != WaitStatus::kReady)
+    s.room.wait_for([&] { return reached(false); }, timeout - first, /*interruptible=*/false);
+  const double left = (timeout - (std::chrono::steady_clock::now() - start)).count();
+  auto w = s.writers.find(kControlTopic);
+  if (left > 0 && w != s.writers.end()) w->second->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(left));
 }
 
 SessionStats Session::stats() const {

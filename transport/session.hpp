@@ -37,6 +37,8 @@ struct SessionOptions {
   std::vector<std::string> initial_peers;
   /// How long a write may wait for room in the bounded history before failing (seconds).
   double write_timeout_s = 30.0;
+  /// Print discovery events (peer found / lost) to stderr.
+  bool verbose = false;
 
   /// Throws InputError naming the bad field.
   void validate() const;
@@ -100,6 +102,8 @@ class Session {
 
   /// Peers of this run discovered and not lost.
   std::vector<PeerIdentity> live_peers() const;
+  /// Number of peers of this run ever discovered (lost ones included).
+  std::size_t peers_ever_seen() const;
   /// When false, a lost peer is only logged (set it once the run's work is complete).
   void set_peer_loss_fatal(bool fatal);
   /// Waits until every reliable sample written so far is acknowledged (bounded).
