@@ -41,8 +41,20 @@ class Mailroom {
     }
     cv_.notify_all();
   }
+  /// A stop that takes effect after `delay` unless another stop request comes first (used
+  /// when a peer leaves cleanly: the ABORT explaining why is usually still on its way).
+  void request_stop_after(int exit_code, const std::string& reason, Seconds delay) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!stop_ && !pending_)
+        pending_ = Pending{StopInfo{exit_code, reason, false},
+                           std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(delay)};
+    }
+    cv_.notify_all();
+  }
   std::optional<StopInfo> stop_info() const {
     std::lock_guard<std::mutex> lock(mutex_);
+    promote_pending();
     return stop_;
   }
   bool stopped() const { return stop_info().has_value(); }
@@ -69,9 +81,13 @@ class Mailroom {
     const auto deadline =
         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(timeout);
     for (;;) {
+      promote_pending();
       if (stop_ && interruptible) return WaitStatus::kStopped;
       if (pred()) return WaitStatus::kReady;
-      if (cv_.wait_until(lock, deadline) == std::cv_status::timeout) {
+      auto until = deadline;
+      if (pending_ && interruptible && pending_->at < until) until = pending_->at;
+      if (cv_.wait_until(lock, until) == std::cv_status::timeout && until == deadline) {
+        promote_pending();
         if (stop_ && interruptible) return WaitStatus::kStopped;
         return pred() ? WaitStatus::kReady : WaitStatus::kTimeout;
       }
@@ -80,9 +96,19 @@ class Mailroom {
   std::mutex& mutex() { return mutex_; }
 
  private:
+  struct Pending {
+    StopInfo info;
+    std::chrono::steady_clock::time_point at;
+  };
+  // Requires mutex_ held.
+  void promote_pending() const {
+    if (pending_ && !stop_ && std::chrono::steady_clock::now() >= pending_->at) stop_ = pending_->info;
+  }
+
   mutable std::mutex mutex_;
   std::condition_variable cv_;
-  std::optional<StopInfo> stop_;
+  mutable std::optional<StopInfo> stop_;
+  mutable std::optional<Pending> pending_;
 };
 
 /// A FIFO of received messages of one type.

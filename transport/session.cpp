@@ -168,7 +168,7 @@ struct Session::Impl {
         room.request_stop(2, "two processes claim to be " + clash + " of run '" + opt.run_id +
                                  "' (check --id / --run-id)");
     } else if (status == rtps::ParticipantDiscoveryInfo::REMOVED_PARTICIPANT) {
-      peer_gone(prefix, "left the run");
+      peer_gone(prefix, "left the run", /*graceful=*/true);
     } else if (status == rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
       char buf[96];
       std::snprintf(buf, sizeof(buf), "stopped responding (participant lease of %.1f s expired)", opt.lease_s);
@@ -182,7 +182,7 @@ struct Session::Impl {
     peer_gone(prefix, buf);
   }
 
-  void peer_gone(const Prefix& prefix, const std::string& how) {
+  void peer_gone(const Prefix& prefix, const std::string& how, bool graceful = false) {
     std::optional<PeerIdentity> who;
     bool fatal = false;
     room.with_lock([&] {
@@ -198,7 +198,14 @@ struct Session::Impl {
     if (opt.verbose)
       std::fprintf(stderr, "%s: lost %s: %s\n", participant_name(me).c_str(), who->describe().c_str(), how.c_str());
     room.notify();
-    if (fatal) room.request_stop(1, "lost " + who->describe() + " of run '" + opt.run_id + "': it " + how);
+    if (!fatal) return;
+    const std::string why = "lost " + who->describe() + " of run '" + opt.run_id + "': it " + how;
+    // A peer that left cleanly has (almost always) sent or seen an ABORT that says why;
+    // give it a moment to arrive so the message names the cause, not the symptom.
+    if (graceful)
+      room.request_stop_after(1, why, Seconds(1.0));
+    else
+      room.request_stop(1, why);
   }
 
   void on_matched(const std::string& endpoint, const Prefix& prefix, int change) {

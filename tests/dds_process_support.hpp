@@ -1,0 +1,201 @@
+#pragma once
+// Helpers for the DDS runtime tests (header-only; not a *_test.cpp so it is no test of its
+// own): start tessera-agent / tessera-coordinator processes in the background, wait for
+// them with a deadline (a test never hangs: stragglers are SIGKILLed), write the small
+// graphs the tests use, and find shared-memory files nobody uses any more.
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "test_support.hpp"
+
+namespace tessera::test::dds {
+
+using Clock = std::chrono::steady_clock;
+
+/// A background process whose stdout+stderr go to a file.
+struct Process {
+  pid_t pid = -1;
+  std::string log;
+  int exit_code = -1;       ///< After wait: exit status, or 128 + signal.
+  double exit_after_s = 0;  ///< Seconds from start() to exit, as seen by wait_all.
+  Clock::time_point started;
+  bool done = false;
+
+  std::string output() const {
+    std::ifstream f(log);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+  }
+};
+
+inline Process start(const std::vector<std::string>& argv, const std::string& log) {
+  Process p;
+  p.log = log;
+  p.started = Clock::now();
+  p.pid = fork();
+  if (p.pid == 0) {
+    int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(fd, 1);
+      dup2(fd, 2);
+      close(fd);
+    }
+    // A fresh process group so a signal sent to the test runner's group does not reach it twice.
+    setpgid(0, 0);
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
+    _exit(127);
+  }
+  return p;
+}
+
+/// Waits for every process up to `timeout_s` (polling every 10 ms: test code only), then
+/// SIGKILLs the rest and returns false.
+inline bool wait_all(std::vector<Process*> procs, double timeout_s) {
+  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    bool all = true;
+    for (Process* p : procs) {
+      if (p->done) continue;
+      int status = 0;
+      pid_t r = waitpid(p->pid, &status, WNOHANG);
+      if (r == p->pid) {
+        p->done = true;
+        p->exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        p->exit_after_s = std::chrono::duration<double>(Clock::now() - p->started).count();
+      } else {
+        all = false;
+      }
+    }
+    if (all) return true;
+    if (Clock::now() > deadline) {
+      for (Process* p : procs)
+        if (!p->done) {
+          kill(p->pid, SIGKILL);
+          waitpid(p->pid, nullptr, 0);
+          p->done = true;
+          p->exit_code = -2;  // hung
+        }
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+/// An 2D graph of `side` x `side` poses on a grid, joined by grid-neighbour odometry-like
+/// measurements (noise free), with ids shuffled (fixed seed) so that contiguous id ranges
+/// are a poor partition and the multilevel partitioner moves poses between agents.
+/// Returns the g2o text; `poses` receives (x, y, theta) per id.
+inline std::string grid_graph_g2o(int side, unsigned seed, std::vector<std::array<double, 3>>* poses_out = nullptr) {
+  const int n = side * side;
+  std::vector<int> id(n);
+  for (int k = 0; k < n; ++k) id[k] = k;
+  std::mt19937 rng(seed);
+  std::shuffle(id.begin(), id.end(), rng);
+  std::vector<std::array<double, 3>> pose(n);
+  for (int r = 0; r < side; ++r)
+    for (int c = 0; c < side; ++c) pose[id[r * side + c]] = {1.0 * c, 1.0 * r, 0.05 * (r + c)};
+  std::string out;
+  char buf[256];
+  for (int k = 0; k < n; ++k) {
+    std::snprintf(buf, sizeof(buf), "VERTEX_SE2 %d %.17g %.17g %.17g\n", k, pose[k][0], pose[k][1], pose[k][2]);
+    out += buf;
+  }
+  auto edge = [&](int a, int b) {
+    const auto& pa = pose[a];
+    const auto& pb = pose[b];
+    const double dx = pb[0] - pa[0], dy = pb[1] - pa[1];
+    const double c = std::cos(pa[2]), s = std::sin(pa[2]);
+    std::snprintf(buf, sizeof(buf), "EDGE_SE2 %d %d %.17g %.17g %.17g 100 0 0 100 0 400\n", a, b, c * dx + s * dy,
+                  -s * dx + c * dy, pb[2] - pa[2]);
+    out += buf;
+  };
+  for (int r = 0; r < side; ++r)
+    for (int c = 0; c < side; ++c) {
+      if (c + 1 < side) edge(id[r * side + c], id[r * side + c + 1]);
+      if (r + 1 < side) edge(id[r * side + c], id[(r + 1) * side + c]);
+    }
+  if (poses_out) *poses_out = pose;
+  return out;
+}
+
+/// Shared-memory files of Fast DDS in /dev/shm.
+inline std::set<std::string> shm_files() {
+  std::set<std::string> out;
+  if (DIR* d = opendir("/dev/shm")) {
+    while (dirent* e = readdir(d)) {
+      std::string name = e->d_name;
+      if (name.find("fastrtps") != std::string::npos) out.insert(name);
+    }
+    closedir(d);
+  }
+  return out;
+}
+
+/// Files of /dev/shm mapped by some live process (from /proc/*/maps).
+inline std::set<std::string> shm_files_in_use() {
+  std::set<std::string> out;
+  if (DIR* d = opendir("/proc")) {
+    while (dirent* e = readdir(d)) {
+      if (e->d_name[0] < '0' || e->d_name[0] > '9') continue;
+      std::ifstream maps(std::string("/proc/") + e->d_name + "/maps");
+      std::string line;
+      while (std::getline(maps, line)) {
+        auto pos = line.find("/dev/shm/");
+        if (pos != std::string::npos) out.insert(line.substr(pos + 9));
+      }
+    }
+    closedir(d);
+  }
+  return out;
+}
+
+/// Fast DDS files that appeared since `before` and no live process uses: what a run leaked.
+inline std::set<std::string> leaked_shm_files(const std::set<std::string>& before) {
+  std::set<std::string> in_use = shm_files_in_use();
+  std::set<std::string> out;
+  for (const auto& f : shm_files()) {
+    if (before.count(f)) continue;
+    const std::string& base = f;
+    if (in_use.count(base)) continue;
+    // Lock files ("_el") are held with flock, not mapped: they belong to a port in use.
+    if (base.size() > 3 && base.compare(base.size() - 3, 3, "_el") == 0 && in_use.count(base.substr(0, base.size() - 3)))
+      continue;
+    out.insert(f);
+  }
+  return out;
+}
+
+/// Removes leaked files (after a SIGKILL test, which leaks by nature).
+inline void remove_shm_files(const std::set<std::string>& files) {
+  for (const auto& f : files) unlink(("/dev/shm/" + f).c_str());
+}
+
+inline std::string join(const std::set<std::string>& s) {
+  std::string out;
+  for (const auto& x : s) out += (out.empty() ? "" : ", ") + x;
+  return out;
+}
+
+}  // namespace tessera::test::dds

@@ -1,0 +1,340 @@
+// The DDS runtime end to end on one host: tessera-coordinator and tessera-agent processes
+// on a graph the test writes. Every test uses its own DDS domain (and run id) so tests may
+// run in parallel, and finishes in seconds; no process outlives its test.
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "dds_process_support.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace tessera::test;
+using namespace tessera::test::dds;
+
+std::string agent_bin() { return bin("tessera-agent"); }
+std::string coordinator_bin() { return bin("tessera-coordinator"); }
+
+std::string unique_run(const std::string& stem) { return stem + "-" + std::to_string(getpid()); }
+
+std::vector<std::string> agent_args(const std::string& graph, int robots, int id, const std::string& run, int domain,
+                                    std::vector<std::string> extra = {}) {
+  std::vector<std::string> a = {agent_bin(), "--graph", graph, "--robots", std::to_string(robots),
+                                "--id", std::to_string(id), "--run-id", run, "--domain", std::to_string(domain)};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
+std::vector<std::string> coordinator_args(int agents, const std::string& run, int domain,
+                                          std::vector<std::string> extra = {}) {
+  std::vector<std::string> a = {coordinator_bin(), "--agents", std::to_string(agents), "--run-id", run,
+                                "--domain", std::to_string(domain)};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
+// Parsed agent dump (--dump-local).
+struct Dump {
+  std::set<int> owned;
+  std::map<long, std::vector<double>> meas;  // file index -> i j kappa tau R t
+  std::map<int, std::vector<double>> poses;
+};
+
+Dump read_dump(const std::string& path) {
+  Dump d;
+  std::ifstream f(path);
+  std::string line;
+  while (std::getline(f, line)) {
+    std::istringstream ss(line);
+    std::string tag;
+    ss >> tag;
+    if (tag == "OWNED") {
+      int id;
+      ss >> id;
+      d.owned.insert(id);
+    } else if (tag == "MEAS") {
+      long k;
+      ss >> k;
+      double x;
+      while (ss >> x) d.meas[k].push_back(x);
+    } else if (tag == "POSE") {
+      int id;
+      ss >> id;
+      double x;
+      while (ss >> x) d.poses[id].push_back(x);
+    }
+  }
+  return d;
+}
+
+// Measurements of the g2o text, in file order: (i, j, dx, dy, dtheta).
+std::vector<std::array<double, 5>> edges_of(const std::string& g2o) {
+  std::vector<std::array<double, 5>> out;
+  std::istringstream in(g2o);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    std::string tag;
+    ss >> tag;
+    if (tag != "EDGE_SE2") continue;
+    std::array<double, 5> e{};
+    for (double& x : e) ss >> x;
+    out.push_back(e);
+  }
+  return out;
+}
+
+// Merged g2o output of the coordinator: id -> (x, y, theta).
+std::map<int, std::array<double, 3>> vertices_of(const std::string& path) {
+  std::map<int, std::array<double, 3>> out;
+  std::ifstream f(path);
+  std::string tag;
+  while (f >> tag) {
+    if (tag != "VERTEX_SE2") {
+      std::string rest;
+      std::getline(f, rest);
+      continue;
+    }
+    int id;
+    std::array<double, 3> v{};
+    f >> id >> v[0] >> v[1] >> v[2];
+    out[id] = v;
+  }
+  return out;
+}
+
+TEST(DdsRuntime, OneHostRunHandsOffEveryMeasurementAndMergesEveryPose) {
+  const std::string dir = temp_dir();
+  const int domain = 141;
+  const std::string run = unique_run("onehost");
+  std::vector<std::array<double, 3>> truth;
+  const std::string text = grid_graph_g2o(7, 11, &truth);
+  const std::string graph = write_file(dir, "grid.g2o", text);
+  const auto before = shm_files();
+
+  Process coord = start(coordinator_args(3, run, domain,
+                                         {"--timeout", "20", "--output", dir + "/merged.g2o", "--summary",
+                                          dir + "/summary.json", "--verbose"}),
+                        dir + "/coordinator.log");
+  std::vector<Process> agents;
+  for (int k = 0; k < 3; ++k)
+    agents.push_back(start(agent_args(graph, 3, k, run, domain,
+                                      {"--timeout", "20", "--dump-local", dir + "/local" + std::to_string(k) + ".txt"}),
+                           dir + "/agent" + std::to_string(k) + ".log"));
+  std::vector<Process*> all = {&coord, &agents[0], &agents[1], &agents[2]};
+  ASSERT_TRUE(wait_all(all, 30)) << "a process hung";
+  for (Process* p : all) ASSERT_EQ(p->exit_code, 0) << p->output();
+
+  // Owners from the dumps: every pose owned by exactly one agent.
+  std::vector<Dump> dumps;
+  std::map<int, int> owner;
+  for (int k = 0; k < 3; ++k) {
+    dumps.push_back(read_dump(dir + "/local" + std::to_string(k) + ".txt"));
+    for (int id : dumps[k].owned) {
+      EXPECT_EQ(owner.count(id), 0u) << "pose " << id << " owned twice";
+      owner[id] = k;
+    }
+  }
+  ASSERT_EQ(owner.size(), truth.size());
+  // The partition moved some poses away from the robot that read them (ids are shuffled),
+  // so initial poses really travelled.
+  int moved = 0;
+  for (auto [id, k] : owner)
+    if (k != id * 3 / static_cast<int>(truth.size())) ++moved;
+  EXPECT_GT(moved, 0);
+
+  // Every measurement is at the owners of both endpoints, with its values, and nowhere else.
+  const auto edges = edges_of(text);
+  for (std::size_t k = 0; k < edges.size(); ++k) {
+    const int i = static_cast<int>(edges[k][0]), j = static_cast<int>(edges[k][1]);
+    for (int a = 0; a < 3; ++a) {
+      const bool should = owner[i] == a || owner[j] == a;
+      auto it = dumps[a].meas.find(static_cast<long>(k));
+      ASSERT_EQ(it != dumps[a].meas.end(), should) << "measurement #" << k << " (" << i << "," << j << ") at agent " << a;
+      if (!should) continue;
+      const auto& v = it->second;  // i j kappa tau R(4) t(2)
+      ASSERT_EQ(v.size(), 10u);
+      EXPECT_EQ(v[0], i);
+      EXPECT_EQ(v[1], j);
+      EXPECT_NEAR(v[8], edges[k][2], 1e-12);
+      EXPECT_NEAR(v[9], edges[k][3], 1e-12);
+      EXPECT_NEAR(std::atan2(v[5], v[4]), edges[k][4], 1e-12);
+    }
+  }
+  // Initial poses arrived at their owners.
+  for (int a = 0; a < 3; ++a)
+    for (int id : dumps[a].owned) {
+      ASSERT_EQ(dumps[a].poses.count(id), 1u);
+      EXPECT_NEAR(dumps[a].poses[id][4], truth[id][0], 1e-12);
+      EXPECT_NEAR(dumps[a].poses[id][5], truth[id][1], 1e-12);
+    }
+
+  // The merged result has every pose (the placeholder round loop returns the initial poses).
+  auto merged = vertices_of(dir + "/merged.g2o");
+  ASSERT_EQ(merged.size(), truth.size());
+  for (auto& [id, v] : merged) {
+    EXPECT_NEAR(v[0], truth[id][0], 1e-9);
+    EXPECT_NEAR(v[1], truth[id][1], 1e-9);
+    EXPECT_NEAR(std::remainder(v[2] - truth[id][2], 2 * M_PI), 0.0, 1e-9);
+  }
+  std::ifstream summary(dir + "/summary.json");
+  std::stringstream ss;
+  ss << summary.rdbuf();
+  EXPECT_NE(ss.str().find("\"discovery_ms\""), std::string::npos);
+  EXPECT_NE(ss.str().find("\"bytes_sent\""), std::string::npos);
+  EXPECT_TRUE(leaked_shm_files(before).empty()) << join(leaked_shm_files(before));
+}
+
+TEST(DdsRuntime, TwoConcurrentRunsOnOneDomainDoNotMix) {
+  // Same domain on purpose (the harder case): only Partition QoS and the run id keep them apart.
+  const std::string dir = temp_dir();
+  const int domain = 142;
+  const std::string graph_a = write_file(dir, "a.g2o", grid_graph_g2o(5, 1));
+  const std::string graph_b = write_file(dir, "b.g2o", grid_graph_g2o(6, 2));
+  std::vector<Process> procs;
+  for (const auto& [run, graph, n] : {std::make_tuple(unique_run("runA"), graph_a, 25),
+                                      std::make_tuple(unique_run("runB"), graph_b, 36)}) {
+    (void)n;
+    procs.push_back(start(coordinator_args(2, run, domain, {"--timeout", "20", "--output", dir + "/" + run + ".g2o"}),
+                          dir + "/" + run + "_coordinator.log"));
+    for (int k = 0; k < 2; ++k)
+      procs.push_back(start(agent_args(graph, 2, k, run, domain, {"--timeout", "20"}),
+                            dir + "/" + run + "_agent" + std::to_string(k) + ".log"));
+  }
+  std::vector<Process*> all;
+  for (auto& p : procs) all.push_back(&p);
+  ASSERT_TRUE(wait_all(all, 30));
+  for (Process* p : all) ASSERT_EQ(p->exit_code, 0) << p->output();
+  EXPECT_EQ(vertices_of(dir + "/" + unique_run("runA") + ".g2o").size(), 25u);
+  EXPECT_EQ(vertices_of(dir + "/" + unique_run("runB") + ".g2o").size(), 36u);
+}
+
+TEST(DdsRuntime, KilledAgentIsNamedAndEveryoneStopsNonZero) {
+  const std::string dir = temp_dir();
+  const int domain = 143;
+  const std::string run = unique_run("kill");
+  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 3));
+  const auto before = shm_files();
+  // The coordinator waits for a 4th agent that never comes, so the others are mid-run
+  // (waiting) when agent 1 is killed.
+  Process coord = start(coordinator_args(4, run, domain, {"--timeout", "30"}), dir + "/coordinator.log");
+  std::vector<Process> agents;
+  for (int k = 0; k < 3; ++k)
+    agents.push_back(start(agent_args(graph, 4, k, run, domain, {"--timeout", "30"}), dir + "/agent" + std::to_string(k) + ".log"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+  for (Process* p : {&coord, &agents[0], &agents[1], &agents[2]}) {
+    int status;
+    ASSERT_EQ(waitpid(p->pid, &status, WNOHANG), 0) << "exited early: " << p->output();
+  }
+  kill(agents[1].pid, SIGKILL);
+  const auto killed_at = Clock::now();
+  ASSERT_TRUE(wait_all({&agents[1]}, 5));
+  std::vector<Process*> survivors = {&coord, &agents[0], &agents[2]};
+  ASSERT_TRUE(wait_all(survivors, 10)) << "a survivor hung";
+  const double took = std::chrono::duration<double>(Clock::now() - killed_at).count();
+  EXPECT_LT(took, 5.0);
+  for (Process* p : survivors) {
+    EXPECT_NE(p->exit_code, 0) << p->output();
+    EXPECT_NE(p->output().find("lost agent 1"), std::string::npos) << p->output();
+  }
+  // A SIGKILLed participant leaks its shared memory by nature; remove what nobody uses.
+  remove_shm_files(leaked_shm_files(before));
+}
+
+// Signals go to one process only: with several, which process stops first (and so
+// whose reason the others report) is a race.
+void signal_one_process(int domain, const std::string& stem, int target, int signo) {
+  const std::string dir = temp_dir();
+  const std::string run = unique_run(stem);
+  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(5, 4));
+  const auto before = shm_files();
+  // Three agents of four: everybody is waiting (mid-run) when the signal comes.
+  std::vector<Process> procs;
+  procs.push_back(start(coordinator_args(4, run, domain, {"--timeout", "30"}), dir + "/coordinator.log"));
+  for (int k = 0; k < 3; ++k)
+    procs.push_back(start(agent_args(graph, 4, k, run, domain, {"--timeout", "30"}), dir + "/agent" + std::to_string(k) + ".log"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  kill(procs[target].pid, signo);
+  std::vector<Process*> all;
+  for (auto& p : procs) all.push_back(&p);
+  ASSERT_TRUE(wait_all(all, 10)) << "did not stop after the signal";
+  const std::string name = signo == SIGINT ? "SIGINT" : "SIGTERM";
+  const std::string who = target == 0 ? "coordinator" : "agent " + std::to_string(target - 1);
+  for (std::size_t k = 0; k < procs.size(); ++k) {
+    const std::string out = procs[k].output();
+    if (static_cast<int>(k) == target) {
+      EXPECT_EQ(procs[k].exit_code, 128 + signo) << out;
+    } else {
+      EXPECT_EQ(procs[k].exit_code, 1) << out;
+      EXPECT_NE(out.find(who), std::string::npos) << out;
+    }
+    EXPECT_NE(out.find("interrupted by " + name), std::string::npos) << out;
+    EXPECT_LT(procs[k].exit_after_s, 1.5 + 4.0) << out;
+  }
+  const auto leaked = leaked_shm_files(before);
+  EXPECT_TRUE(leaked.empty()) << "left in /dev/shm: " << join(leaked);
+}
+
+TEST(DdsRuntime, SigintToCoordinatorStopsTheRunCleanlyWithoutSharedMemoryLeft) {
+  signal_one_process(144, "sigint", 0, SIGINT);
+}
+
+TEST(DdsRuntime, SigtermToAgentStopsTheRunCleanlyWithoutSharedMemoryLeft) {
+  signal_one_process(147, "sigterm", 2, SIGTERM);
+}
+
+TEST(DdsRuntime, AgentWithBadFileFailsClearlyAndTheOthersStop) {
+  const std::string dir = temp_dir();
+  const int domain = 145;
+  const std::string run = unique_run("badfile");
+  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(5, 5));
+  const std::string bad = write_file(dir, "bad.g2o", "VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 oops\n");
+  const auto before = shm_files();
+  Process coord = start(coordinator_args(3, run, domain, {"--timeout", "30"}), dir + "/coordinator.log");
+  Process a0 = start(agent_args(graph, 3, 0, run, domain, {"--timeout", "30"}), dir + "/agent0.log");
+  Process a2 = start(agent_args(graph, 3, 2, run, domain, {"--timeout", "30"}), dir + "/agent2.log");
+  Process a1 = start(agent_args(bad, 3, 1, run, domain, {"--timeout", "30"}), dir + "/agent1.log");
+  ASSERT_TRUE(wait_all({&coord, &a0, &a1, &a2}, 10)) << "a process hung";
+  EXPECT_EQ(a1.exit_code, 2) << a1.output();
+  EXPECT_NE(a1.output().find("bad.g2o:2:"), std::string::npos) << a1.output();
+  for (Process* p : {&coord, &a0, &a2}) {
+    EXPECT_EQ(p->exit_code, 1) << p->output();
+    EXPECT_NE(p->output().find("agent 1"), std::string::npos) << p->output();
+  }
+  const auto leaked = leaked_shm_files(before);
+  EXPECT_TRUE(leaked.empty()) << "left in /dev/shm: " << join(leaked);
+}
+
+TEST(DdsRuntime, CoordinatorTimesOutNamingTheMissingAgents) {
+  const std::string dir = temp_dir();
+  const int domain = 146;
+  const std::string run = unique_run("missing");
+  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(5, 6));
+  Process coord = start(coordinator_args(3, run, domain, {"--timeout", "2"}), dir + "/coordinator.log");
+  Process a0 = start(agent_args(graph, 3, 0, run, domain, {"--timeout", "30"}), dir + "/agent0.log");
+  ASSERT_TRUE(wait_all({&coord, &a0}, 10));
+  EXPECT_EQ(coord.exit_code, 1);
+  EXPECT_NE(coord.output().find("timed out after 2 s waiting for 3 agents"), std::string::npos) << coord.output();
+  EXPECT_NE(coord.output().find("missing agent 1, 2 (have agent 0)"), std::string::npos) << coord.output();
+  EXPECT_EQ(a0.exit_code, 1) << a0.output();
+}
+
+TEST(DdsRuntime, ExecutablesExplainTheirOptions) {
+  std::string out;
+  EXPECT_EQ(run_command(agent_bin() + " --help", &out), 0);
+  EXPECT_NE(out.find("--run-id"), std::string::npos);
+  EXPECT_EQ(run_command(coordinator_bin() + " --help", &out), 0);
+  EXPECT_NE(out.find("--domain"), std::string::npos);
+  EXPECT_EQ(run_command(agent_bin() + " --graph x.g2o --robots 2", &out), 2);
+  EXPECT_NE(out.find("--id is required"), std::string::npos) << out;
+  EXPECT_EQ(run_command(coordinator_bin() + " --agents 2 --bogus 1", &out), 2);
+  EXPECT_NE(out.find("unknown option --bogus"), std::string::npos) << out;
+  EXPECT_EQ(run_command(coordinator_bin() + " --agents 2 --run-id 'a b'", &out), 2);
+  EXPECT_NE(out.find("--run-id"), std::string::npos) << out;
+}
+
+}  // namespace
