@@ -16,6 +16,11 @@ class GainQueue {
     pos_.assign(static_cast<std::size_t>(n), -1);
     heap_.clear();
   }
+  /// Empties the queue in time proportional to its size (the index keeps its length).
+  void clear() {
+    for (const auto& entry : heap_) pos_[entry.second] = -1;
+    heap_.clear();
+  }
   bool empty() const { return heap_.empty(); }
   bool contains(int v) const { return pos_[v] >= 0; }
   long long top_key() const { return heap_[0].first; }

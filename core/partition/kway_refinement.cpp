@@ -51,81 +51,133 @@ long long key_of(long long gain, Rng& rng) {
   return gain * 1024 + static_cast<long long>(rng.next() & 1023);
 }
 
+// FM searches on one partition: a search starts from a set of seed vertices, moves the best
+// unlocked vertex again and again (negative gains allowed), queues the neighbours of moved
+// vertices, stops after `stop_after` moves without a new best and rolls back to the best point.
+class FmEngine {
+ public:
+  FmEngine(const WorkGraph& g, int k, std::vector<int>& part, const std::vector<long long>& ub)
+      : g_(g),
+        part_(part),
+        ub_(ub),
+        bw_(block_weights(g, part, k)),
+        conn_(k),
+        queue_(g.n),
+        lock_(static_cast<std::size_t>(g.n), 0) {}
+
+  bool boundary(int v) const {
+    for (int e = g_.xadj[v]; e < g_.xadj[v + 1]; ++e)
+      if (part_[g_.adj[e]] != part_[v]) return true;
+    return false;
+  }
+
+  /// Returns the cut reduction (>= 0) kept after the rollback.
+  long long search(const std::vector<int>& seeds, int stop_after, Rng& rng) {
+    ++stamp_;
+    moves_.clear();
+    for (int v : seeds) {
+      if (lock_[v] == stamp_) continue;
+      const Move m = best_adjacent_move(g_, part_, bw_, ub_, conn_, v);
+      if (m.target >= 0) queue_.set(v, key_of(m.gain, rng));
+    }
+    long long delta = 0, best_delta = 0;
+    long long best_max = *std::max_element(bw_.begin(), bw_.end());  // tie breaker at equal cut
+    std::size_t best_len = 0;
+    int since_best = 0;
+    while (!queue_.empty()) {
+      const long long key = queue_.top_key();
+      const int v = queue_.pop();
+      const Move m = best_adjacent_move(g_, part_, bw_, ub_, conn_, v);
+      if (m.target < 0) continue;
+      if (m.gain * 1024 + 1023 < key) {  // block weights changed since v was queued
+        queue_.set(v, key_of(m.gain, rng));
+        continue;
+      }
+      const int from = part_[v];
+      part_[v] = m.target;
+      bw_[from] -= g_.vw[v];
+      bw_[m.target] += g_.vw[v];
+      lock_[v] = stamp_;
+      moves_.emplace_back(v, from);
+      delta -= m.gain;
+      bool better = delta < best_delta;
+      if (!better && delta == best_delta)  // same cut: keep it if it is better balanced
+        better = *std::max_element(bw_.begin(), bw_.end()) < best_max;
+      if (better) {
+        best_delta = delta;
+        best_max = *std::max_element(bw_.begin(), bw_.end());
+        best_len = moves_.size();
+        since_best = 0;
+      } else if (++since_best > stop_after) {
+        break;
+      }
+      for (int e = g_.xadj[v]; e < g_.xadj[v + 1]; ++e) {
+        const int u = g_.adj[e];
+        if (lock_[u] == stamp_) continue;
+        const Move mu = best_adjacent_move(g_, part_, bw_, ub_, conn_, u);
+        if (mu.target >= 0)
+          queue_.set(u, key_of(mu.gain, rng));
+        else
+          queue_.remove(u);
+      }
+    }
+    queue_.clear();
+    while (moves_.size() > best_len) {
+      const auto [v, from] = moves_.back();
+      moves_.pop_back();
+      bw_[part_[v]] -= g_.vw[v];
+      bw_[from] += g_.vw[v];
+      part_[v] = from;
+    }
+    return -best_delta;
+  }
+
+  /// Vertices moved (and kept) by the last search.
+  const std::vector<std::pair<int, int>>& kept_moves() const { return moves_; }
+
+ private:
+  const WorkGraph& g_;
+  std::vector<int>& part_;
+  const std::vector<long long>& ub_;
+  std::vector<long long> bw_;
+  Connectivity conn_;
+  GainQueue queue_;
+  std::vector<int> lock_;
+  int stamp_ = 0;
+  std::vector<std::pair<int, int>> moves_;  // (vertex, block it came from)
+};
+
 }  // namespace
 
 long long kway_fm(const WorkGraph& g, int k, std::vector<int>& part,
                   const std::vector<long long>& ub, const FmParams& params, Rng& rng) {
-  std::vector<long long> bw = block_weights(g, part, k);
   long long cut = edge_cut(g, part);
   if (k < 2) return cut;
-  Connectivity c(k);
-  GainQueue queue(g.n);
-  std::vector<char> locked(static_cast<std::size_t>(g.n), 0);
-  std::vector<std::pair<int, int>> moves;  // (vertex, block it came from)
+  FmEngine fm(g, k, part, ub);
   for (int pass = 0; pass < params.max_passes; ++pass) {
-    queue.reset(g.n);
-    std::fill(locked.begin(), locked.end(), 0);
-    moves.clear();
+    std::vector<int> seeds;
+    for (int v : random_order(g.n, rng))
+      if (fm.boundary(v)) seeds.push_back(v);
+    const long long gain = fm.search(seeds, params.stop_after, rng);
+    cut -= gain;
+    if (gain == 0) break;
+  }
+  for (int round = 0; round < params.local_rounds; ++round) {
+    // Localized searches from single boundary vertices find improvements a global pass misses
+    // because its queue is dominated by the best gains elsewhere.
+    long long round_gain = 0;
+    std::vector<char> used(static_cast<std::size_t>(g.n), 0);
+    std::vector<int> seed(1);
     for (int v : random_order(g.n, rng)) {
-      bool boundary = false;
-      for (int e = g.xadj[v]; e < g.xadj[v + 1] && !boundary; ++e)
-        boundary = part[g.adj[e]] != part[v];
-      if (!boundary) continue;
-      const Move m = best_adjacent_move(g, part, bw, ub, c, v);
-      if (m.target >= 0) queue.set(v, key_of(m.gain, rng));
+      if (used[v] || !fm.boundary(v)) continue;
+      seed[0] = v;
+      used[v] = 1;
+      const long long gain = fm.search(seed, params.local_stop_after, rng);
+      for (const auto& mv : fm.kept_moves()) used[mv.first] = 1;
+      round_gain += gain;
     }
-    long long delta = 0, best_delta = 0;
-    long long best_max = *std::max_element(bw.begin(), bw.end());  // tie breaker at equal cut
-    std::size_t best_len = 0;
-    int since_best = 0;
-    while (!queue.empty()) {
-      const long long key = queue.top_key();
-      const int v = queue.pop();
-      const Move m = best_adjacent_move(g, part, bw, ub, c, v);
-      if (m.target < 0) continue;
-      if (m.gain * 1024 + 1023 < key) {  // block weights changed since v was queued
-        queue.set(v, key_of(m.gain, rng));
-        continue;
-      }
-      const int from = part[v];
-      part[v] = m.target;
-      bw[from] -= g.vw[v];
-      bw[m.target] += g.vw[v];
-      locked[v] = 1;
-      moves.emplace_back(v, from);
-      delta -= m.gain;
-      bool better = delta < best_delta;
-      if (!better && delta == best_delta) {  // same cut: keep it if it is better balanced
-        const long long mx = *std::max_element(bw.begin(), bw.end());
-        better = mx < best_max;
-      }
-      if (better) {
-        best_delta = delta;
-        best_max = *std::max_element(bw.begin(), bw.end());
-        best_len = moves.size();
-        since_best = 0;
-      } else if (++since_best > params.stop_after) {
-        break;
-      }
-      for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
-        const int u = g.adj[e];
-        if (locked[u]) continue;
-        const Move mu = best_adjacent_move(g, part, bw, ub, c, u);
-        if (mu.target >= 0)
-          queue.set(u, key_of(mu.gain, rng));
-        else
-          queue.remove(u);
-      }
-    }
-    while (moves.size() > best_len) {
-      const auto [v, from] = moves.back();
-      moves.pop_back();
-      bw[part[v]] -= g.vw[v];
-      bw[from] += g.vw[v];
-      part[v] = from;
-    }
-    cut += best_delta;
-    if (best_delta == 0) break;
+    cut -= round_gain;
+    if (round_gain == 0) break;
   }
   return cut;
 }

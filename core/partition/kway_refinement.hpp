@@ -8,8 +8,10 @@
 namespace tessera::partition_detail {
 
 struct FmParams {
-  int max_passes = 3;   ///< FM passes per call; stops early when a pass finds no improvement.
-  int stop_after = 60;  ///< A pass ends after this many moves without a new best cut.
+  int max_passes = 3;         ///< FM passes per call; stops early when a pass finds no improvement.
+  int stop_after = 60;        ///< A pass ends after this many moves without a new best cut.
+  int local_rounds = 0;       ///< Rounds of localized FM (searches from single boundary vertices).
+  int local_stop_after = 20;  ///< Stopping rule of each localized search.
 };
 
 /// Boundary k-way Fiduccia–Mattheyses: repeatedly moves the unlocked boundary vertex with the

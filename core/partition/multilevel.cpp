@@ -1,6 +1,18 @@
 #include "partition/multilevel.hpp"
 
 namespace tessera::partition_detail {
+long long refine_level(const WorkGraph& g, int k, std::vector<int>& part,
+                       const std::vector<long long>& ub, const CycleParams& params, Rng& rng,
+                       bool flow) {
+  rebalance(g, k, part, ub);
+  long long cut = kway_fm(g, k, part, ub, params.fm, rng);
+  if (params.use_flow && flow) {
+    const long long after = flow_refine(g, k, part, ub, params.flow, rng);
+    if (after < cut) cut = kway_fm(g, k, part, ub, params.fm, rng);
+  }
+  return cut;
+}
+
 namespace {
 
 // Projects the coarsest partition down level by level, rebalancing and refining on each.
@@ -13,8 +25,7 @@ std::vector<int> uncoarsen(const WorkGraph& fine, const Hierarchy& h, std::vecto
     std::vector<int> finer(static_cast<std::size_t>(g.n));
     for (int v = 0; v < g.n; ++v) finer[v] = part[map[v]];
     part.swap(finer);
-    rebalance(g, k, part, ub);
-    const long long cut = kway_fm(g, k, part, ub, params.fm, rng);
+    const long long cut = refine_level(g, k, part, ub, params, rng, level <= params.flow_levels);
     if (stats && level == 0) stats->cut = cut;
   }
   if (stats && h.coarse.empty()) stats->cut = edge_cut(fine, part);
@@ -50,8 +61,8 @@ std::vector<int> guided_cycle(const WorkGraph& g, int k, const std::vector<long 
     for (std::size_t v = 0; v < map.size(); ++v) coarse[map[v]] = part[v];
     part.swap(coarse);
   }
-  rebalance(top, k, part, ub);
-  kway_fm(top, k, part, ub, params.fm, rng);
+  refine_level(top, k, part, ub, params, rng,
+               static_cast<int>(h.coarse.size()) <= params.flow_levels);
   if (stats) {
     stats->levels = static_cast<int>(h.coarse.size());
     stats->coarsest_vertices = top.n;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "partition/coarsening.hpp"
+#include "partition/flow_refinement.hpp"
 #include "partition/initial_partitioning.hpp"
 #include "partition/kway_refinement.hpp"
 #include "partition/work_graph.hpp"
@@ -15,7 +16,16 @@ struct CycleParams {
   CoarseningParams coarsening;
   InitialParams initial;
   FmParams fm;
+  bool use_flow = false;  ///< Add max-flow refinement between block pairs...
+  int flow_levels = 64;   ///< ...on this many of the finest levels (0 = the input graph only).
+  FlowParams flow;
 };
+
+/// The refinement applied on every level: rebalance, FM, then (optionally) flow refinement
+/// followed by another FM round when the flows found something. Returns the cut.
+long long refine_level(const WorkGraph& g, int k, std::vector<int>& part,
+                       const std::vector<long long>& ub, const CycleParams& params, Rng& rng,
+                       bool flow = true);
 
 struct CycleStats {
   int levels = 0;  ///< Coarse levels built.

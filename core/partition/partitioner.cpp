@@ -1,7 +1,9 @@
 #include "partition/partitioner.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 
 #include "partition/evolutionary.hpp"
 #include "partition/multilevel.hpp"
@@ -50,32 +52,89 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-// Per-preset effort. Coarse vertices stay light enough that the coarsest graph can still be
-// balanced well; the coarsest graph has a few dozen vertices per block.
-CycleParams cycle_params(PartitionPreset preset, const WorkGraph& g, int k, long long lmax) {
-  CycleParams cp;
+// Per-preset effort (see docs/partitioning.md). Shared by all presets: coarse vertices stay
+// below lmax/30 so the coarsest graph (a few dozen vertices per block) can still be balanced.
+struct PresetPlan {
+  CycleParams cycle;
+  int runs = 1;     ///< fast/eco: independent multilevel runs, best kept.
+  int vcycles = 0;  ///< fast/eco: V-cycles on the best run.
+  bool evolve = false;
+  EvolutionParams evolution;  ///< strong/highest.
+};
+
+PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long long lmax) {
+  PresetPlan plan;
+  CycleParams& cp = plan.cycle;
   cp.coarsening.stop_vertices = std::max(20 * k, 80);
-  cp.coarsening.max_vertex_weight = static_cast<int>(std::max<long long>(1, lmax / 10));
-  (void)g;
+  cp.coarsening.max_vertex_weight = static_cast<int>(std::max<long long>(1, lmax / 30));
+  cp.initial.repeats = 4;
+  cp.initial.bisection_tries = 4;
   switch (preset) {
     case PartitionPreset::kFast:
-      cp.initial.repeats = 2;
-      cp.initial.bisection_tries = 3;
-      cp.fm = {2, 40};
+      cp.fm.max_passes = 2;
+      cp.fm.stop_after = 40;
       break;
     case PartitionPreset::kEco:
-      cp.initial.repeats = 3;
-      cp.initial.bisection_tries = 4;
-      cp.fm = {3, 100};
+      cp.coarsening.label_propagation_rounds = 3;
+      cp.initial.repeats = 10;
+      cp.fm.max_passes = 6;
+      cp.fm.stop_after = 400;
+      cp.use_flow = true;
+      cp.flow_levels = 1;
+      cp.flow.rounds = 1;
+      cp.flow.alpha = 4;
+      plan.runs = 2;
+      plan.vcycles = 1;
+      break;
+    case PartitionPreset::kStrong:
+    case PartitionPreset::kHighest:
+      cp.coarsening.label_propagation_rounds = 3;
+      cp.initial.repeats = 10;
+      cp.fm.max_passes = 6;
+      cp.fm.stop_after = 400;
+      cp.use_flow = true;
+      plan.evolve = true;
+      {
+        // Effort in multilevel operations, scaled so that every graph gets about the same
+        // time: one operation costs roughly proportional to n + edges.
+        const double size = static_cast<double>(g.n) + static_cast<double>(g.adj.size()) / 2.0;
+        const double budget = preset == PartitionPreset::kStrong ? 4.0e5 : 1.8e6;
+        const int ops = static_cast<int>(std::clamp(budget / size, 12.0, 2000.0));
+        plan.evolution.population = preset == PartitionPreset::kStrong ? 4 : 6;
+        plan.evolution.vcycles = 1;
+        plan.evolution.generations = std::max(4, ops - 2 * plan.evolution.population);
+      }
       break;
     default:
-      cp.initial.repeats = 4;
-      cp.initial.bisection_tries = 6;
-      cp.fm = {4, 200};
       break;
   }
+#ifdef TESSERA_PARTITION_TUNING
+  // Developer hooks for parameter sweeps (never compiled into the normal build).
+  auto env = [](const char* name) { return std::getenv(name); };
+  if (env("T_FLOW")) cp.use_flow = std::atoi(env("T_FLOW")) > 0;
+  if (env("T_ALPHA")) cp.flow.alpha = std::atof(env("T_ALPHA"));
+  if (env("T_FLEV")) cp.flow_levels = std::atoi(env("T_FLEV"));
+  if (env("T_FROUNDS")) cp.flow.rounds = std::atoi(env("T_FROUNDS"));
+  if (env("T_LOC")) cp.fm.local_rounds = std::atoi(env("T_LOC"));
+  if (env("T_LOCSTOP")) cp.fm.local_stop_after = std::atoi(env("T_LOCSTOP"));
+  if (env("T_STOP")) cp.fm.stop_after = std::atoi(env("T_STOP"));
+  if (env("T_PASS")) cp.fm.max_passes = std::atoi(env("T_PASS"));
+  if (env("T_CSTOP")) cp.coarsening.stop_vertices = std::atoi(env("T_CSTOP")) * k;
+  if (env("T_MAXW"))
+    cp.coarsening.max_vertex_weight =
+        static_cast<int>(std::max<long long>(1, lmax / std::atoi(env("T_MAXW"))));
+  if (env("T_LP")) cp.coarsening.label_propagation_rounds = std::atoi(env("T_LP"));
+  if (env("T_REP")) cp.initial.repeats = std::atoi(env("T_REP"));
+  if (env("T_RUNS")) plan.runs = std::atoi(env("T_RUNS"));
+  if (env("T_VCYC")) plan.vcycles = std::atoi(env("T_VCYC"));
+  if (env("T_POP")) plan.evolution.population = std::atoi(env("T_POP"));
+  if (env("T_GEN")) plan.evolution.generations = std::atoi(env("T_GEN"));
+  if (env("T_VC")) plan.evolution.vcycles = std::atoi(env("T_VC"));
+  if (env("T_MUT")) plan.evolution.mutation_rate = std::atof(env("T_MUT"));
+#endif
   cp.initial.fm = cp.fm;
-  return cp;
+  plan.evolution.cycle = cp;
+  return plan;
 }
 
 }  // namespace
@@ -108,66 +167,44 @@ PartitionResult partition_graph(const GraphStructure& graph, const PartitionOpti
   const WorkGraph g = to_work_graph(graph);
   const long long lmax = static_cast<long long>(result.max_block_size);
   const std::vector<long long> ub(static_cast<std::size_t>(k), lmax);
-  const CycleParams cp = cycle_params(options.preset, g, k, lmax);
+  const PresetPlan plan = preset_plan(options.preset, g, k, lmax);
+  const CycleParams& cp = plan.cycle;
   Rng rng(options.seed);
   std::vector<int> part;
 
   auto describe = [](const CycleStats& s) {
     return std::to_string(s.levels) + " levels, coarsest " + std::to_string(s.coarsest_vertices) +
-           " vertices (cut " + std::to_string(s.coarsest_cut) + ")";
+           " vertices (cut there " + std::to_string(s.coarsest_cut) + ")";
   };
-  auto vcycles = [&](int count) {
-    for (int c = 0; c < count; ++c) {
+  if (!plan.evolve) {
+    long long best = -1;
+    for (int r = 0; r < plan.runs; ++r) {
+      const auto tr = Clock::now();
+      CycleStats s;
+      std::vector<int> p = multilevel_partition(g, k, ub, cp, rng, &s);
+      if (best < 0 || s.cut < best) {
+        best = s.cut;
+        part.swap(p);
+      }
+      phase("multilevel", describe(s), best, tr);
+    }
+    for (int c = 0; c < plan.vcycles; ++c) {
       const auto tc = Clock::now();
       CycleStats s;
       std::vector<int> p = guided_cycle(g, k, ub, part, part, cp, rng, &s);
-      if (s.cut <= edge_cut(g, part)) part.swap(p);
-      phase("v-cycle", describe(s), edge_cut(g, part), tc);
-    }
-  };
-
-  switch (options.preset) {
-    case PartitionPreset::kFast:
-    case PartitionPreset::kEco: {
-      const bool eco = options.preset == PartitionPreset::kEco;
-      const int runs = eco ? 3 : 1;
-      long long best = -1;
-      for (int r = 0; r < runs; ++r) {
-        const auto tr = Clock::now();
-        CycleStats s;
-        std::vector<int> p = multilevel_partition(g, k, ub, cp, rng, &s);
-        if (best < 0 || s.cut < best) {
-          best = s.cut;
-          part.swap(p);
-        }
-        phase("multilevel", describe(s), best, tr);
+      if (s.cut <= best) {
+        best = s.cut;
+        part.swap(p);
       }
-      vcycles(eco ? 3 : 1);
-      break;
+      phase("v-cycle", describe(s), best, tc);
     }
-    case PartitionPreset::kStrong:
-    case PartitionPreset::kHighest: {
-      EvolutionParams ep;
-      ep.cycle = cp;
-      if (options.preset == PartitionPreset::kStrong) {
-        ep.population = 4;
-        ep.vcycles = 1;
-        ep.generations = 12;
-      } else {
-        ep.population = 10;
-        ep.vcycles = 2;
-        ep.generations = 150;
-      }
-      auto tp = Clock::now();
-      part = evolve(g, k, ub, ep, rng,
-                    [&](const std::string& name, const std::string& detail, long long cut) {
-                      phase(name, detail, cut, tp);
-                      tp = Clock::now();
-                    });
-      break;
-    }
-    default:
-      break;
+  } else {
+    auto tp = Clock::now();
+    part = evolve(g, k, ub, plan.evolution, rng,
+                  [&](const std::string& name, const std::string& detail, long long cut) {
+                    phase(name, detail, cut, tp);
+                    tp = Clock::now();
+                  });
   }
   rebalance(g, k, part, ub);  // no-op for balanced results; a safety net for the promise above
   result.assignment = std::move(part);

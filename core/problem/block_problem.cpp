@@ -68,12 +68,13 @@ void BlockProblem::set_neighbor_poses(const Eigen::MatrixXd& X_neighbors) {
     throw std::invalid_argument("BlockProblem: neighbour poses have the wrong size");
   X_n_ = X_neighbors;
   linear_ = X_n_ * Q_nb_;
-  constant_ = (X_n_ * Q_nn_).cwiseProduct(X_n_).sum();
 }
 
 double BlockProblem::cost(const Eigen::MatrixXd& X) const {
-  double f = (X * Q_bb_).cwiseProduct(X).sum();
-  if (!neighbors_.empty()) f += 2.0 * linear_.cwiseProduct(X).sum() + constant_;
+  // Summed edge by edge rather than as tr(X Q X^T): the trace form cancels large terms and
+  // loses ~8 digits near the optimum, which would blind the trust-region ratio test.
+  double f = 0.0;
+  for (const auto& e : edges_) f += edge_cost(e, X);
   return f;
 }
 
@@ -98,15 +99,26 @@ Eigen::MatrixXd BlockProblem::hessian_vector(const Eigen::MatrixXd& X, const Eig
 double BlockProblem::edge_cost(const Edge& e, const Eigen::MatrixXd& X) const {
   const Eigen::Index w = d_ + 1;
   const std::size_t m = owned_.size();
-  auto pose = [&](std::size_t slot) {
-    return slot < m ? X.middleCols(w * static_cast<Eigen::Index>(slot), w)
-                    : X_n_.middleCols(w * static_cast<Eigen::Index>(slot - m), w);
+  const Eigen::Index r = X.rows();
+  auto column = [&](std::size_t slot) -> const double* {
+    return slot < m ? X.data() + r * w * static_cast<Eigen::Index>(slot)
+                    : X_n_.data() + r * w * static_cast<Eigen::Index>(slot - m);
   };
-  const auto Xi = pose(e.slot_i);
-  const auto Xj = pose(e.slot_j);
+  const double* Xi = column(e.slot_i);  // column-major r x (d+1) pose blocks
+  const double* Xj = column(e.slot_j);
   const Measurement& me = edge_storage_[e.measurement];
-  double rot = (Xj.leftCols(d_) - Xi.leftCols(d_) * me.R).squaredNorm();
-  double tr = (Xj.col(d_) - Xi.col(d_) - Xi.leftCols(d_) * me.t).squaredNorm();
+  // Plain loops: no temporaries on this hot path.
+  double rot = 0.0, tr = 0.0;
+  for (Eigen::Index a = 0; a < r; ++a) {
+    double ta = Xj[d_ * r + a] - Xi[d_ * r + a];
+    for (int c = 0; c < d_; ++c) ta -= Xi[c * r + a] * me.t(c);
+    tr += ta * ta;
+    for (int b = 0; b < d_; ++b) {
+      double v = Xj[b * r + a];
+      for (int c = 0; c < d_; ++c) v -= Xi[c * r + a] * me.R(c, b);
+      rot += v * v;
+    }
+  }
   return me.kappa * rot + me.tau * tr;
 }
 

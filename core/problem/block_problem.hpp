@@ -76,10 +76,9 @@ class BlockProblem {
   std::vector<Measurement> edge_storage_;  // copies, so the problem outlives its input
   SparseMatrix Q_bb_;
   SparseMatrix Q_nb_;  // (d+1)k x (d+1)m
-  SparseMatrix Q_nn_;
+  SparseMatrix Q_nn_;  // kept for its size: validates neighbour blocks
   Eigen::MatrixXd X_n_;
   Eigen::MatrixXd linear_;  // X_N Q_NB, r x (d+1)m
-  double constant_ = 0.0;   // tr(X_N Q_NN X_N^T)
 };
 
 }  // namespace tessera

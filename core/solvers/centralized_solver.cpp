@@ -18,7 +18,7 @@ TrustRegionOptions CentralizedOptions::default_trust_region() {
   TrustRegionOptions o;
   o.max_iterations = 500;
   o.max_inner_iterations = 2000;
-  o.grad_norm_tol = 1e-7;
+  o.grad_norm_tol = 1e-4;
   o.rel_cost_decrease_tol = 1e-14;
   return o;
 }
@@ -90,7 +90,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
       break;
   }
   const BlockProblem problem = BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
-  const BlockPreconditioner precon(problem, options.preconditioner_shift);
+  BlockPreconditioner precon(problem, options.preconditioner_shift);
   Eigen::MatrixXd X = lift_poses(init, options.initial_rank);
   res.init_s = seconds_since(start);
 

@@ -1,0 +1,345 @@
+#include "partition/flow_refinement.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <map>
+#include <utility>
+
+namespace tessera::partition_detail {
+namespace {
+
+// Dinic's max flow on a small network.
+class FlowNetwork {
+ public:
+  explicit FlowNetwork(int n) : head_(static_cast<std::size_t>(n), -1), level_(n), it_(n) {}
+  void add(int u, int v, long long c_uv, long long c_vu) {
+    arc(u, v, c_uv);
+    arc(v, u, c_vu);
+  }
+  long long max_flow(int s, int t) {
+    long long flow = 0;
+    while (bfs(s, t)) {
+      for (std::size_t v = 0; v < head_.size(); ++v) it_[v] = head_[v];
+      while (long long f = dfs(s, t, LLONG_MAX)) flow += f;
+    }
+    return flow;
+  }
+  /// Nodes reachable from s in the residual network.
+  std::vector<char> reachable_from(int s) const {
+    std::vector<char> seen(head_.size(), 0);
+    std::vector<int> stack = {s};
+    seen[s] = 1;
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      for (int a = head_[v]; a >= 0; a = next_[a])
+        if (cap_[a] > 0 && !seen[to_[a]]) {
+          seen[to_[a]] = 1;
+          stack.push_back(to_[a]);
+        }
+    }
+    return seen;
+  }
+  /// Strongly connected components of the residual network (Tarjan, iterative), numbered in
+  /// completion order, which is a reverse topological order: every residual arc goes from a
+  /// component to one with a smaller or equal number. Roots are tried in `order`.
+  std::vector<int> residual_components(const std::vector<int>& order, int* count) const {
+    const int n = static_cast<int>(head_.size());
+    std::vector<int> index(n, -1), low(n, 0), comp(n, -1), stack, call, arc_it(n);
+    std::vector<char> on_stack(n, 0);
+    int next_index = 0, next_comp = 0;
+    for (int root : order) {
+      if (index[root] >= 0) continue;
+      call.push_back(root);
+      index[root] = low[root] = next_index++;
+      stack.push_back(root);
+      on_stack[root] = 1;
+      arc_it[root] = head_[root];
+      while (!call.empty()) {
+        const int v = call.back();
+        int& a = arc_it[v];
+        bool descended = false;
+        for (; a >= 0; a = next_[a]) {
+          if (cap_[a] <= 0) continue;
+          const int u = to_[a];
+          if (index[u] < 0) {
+            index[u] = low[u] = next_index++;
+            stack.push_back(u);
+            on_stack[u] = 1;
+            arc_it[u] = head_[u];
+            call.push_back(u);
+            a = next_[a];
+            descended = true;
+            break;
+          }
+          if (on_stack[u]) low[v] = std::min(low[v], index[u]);
+        }
+        if (descended) continue;
+        if (low[v] == index[v]) {
+          for (;;) {
+            const int w = stack.back();
+            stack.pop_back();
+            on_stack[w] = 0;
+            comp[w] = next_comp;
+            if (w == v) break;
+          }
+          ++next_comp;
+        }
+        call.pop_back();
+        if (!call.empty()) low[call.back()] = std::min(low[call.back()], low[v]);
+      }
+    }
+    *count = next_comp;
+    return comp;
+  }
+
+  /// Nodes that can reach t in the residual network.
+  std::vector<char> reaching(int t) const {
+    std::vector<char> seen(head_.size(), 0);
+    std::vector<int> stack = {t};
+    seen[t] = 1;
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      for (int a = head_[v]; a >= 0; a = next_[a]) {
+        // The reverse arc a^1 goes to_[a] -> v; usable if it has residual capacity.
+        if (cap_[a ^ 1] > 0 && !seen[to_[a]]) {
+          seen[to_[a]] = 1;
+          stack.push_back(to_[a]);
+        }
+      }
+    }
+    return seen;
+  }
+
+ private:
+  void arc(int u, int v, long long c) {
+    to_.push_back(v);
+    cap_.push_back(c);
+    next_.push_back(head_[u]);
+    head_[u] = static_cast<int>(to_.size()) - 1;
+  }
+  bool bfs(int s, int t) {
+    std::fill(level_.begin(), level_.end(), -1);
+    std::vector<int> queue = {s};
+    level_[s] = 0;
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const int v = queue[q];
+      for (int a = head_[v]; a >= 0; a = next_[a])
+        if (cap_[a] > 0 && level_[to_[a]] < 0) {
+          level_[to_[a]] = level_[v] + 1;
+          queue.push_back(to_[a]);
+        }
+    }
+    return level_[t] >= 0;
+  }
+  long long dfs(int v, int t, long long pushed) {
+    if (v == t) return pushed;
+    for (int& a = it_[v]; a >= 0; a = next_[a]) {
+      const int u = to_[a];
+      if (cap_[a] <= 0 || level_[u] != level_[v] + 1) continue;
+      const long long f = dfs(u, t, std::min(pushed, cap_[a]));
+      if (f > 0) {
+        cap_[a] -= f;
+        cap_[a ^ 1] += f;
+        return f;
+      }
+    }
+    return 0;
+  }
+
+  std::vector<int> head_, next_, to_;
+  std::vector<long long> cap_;
+  std::vector<int> level_, it_;
+};
+
+// Grows a BFS corridor inside block `own` from its vertices adjacent to block `other`, up to
+// total weight `budget`.
+std::vector<int> corridor(const WorkGraph& g, const std::vector<int>& part, int own, int other,
+                          long long budget, const std::vector<int>& boundary, std::vector<char>& in,
+                          Rng& rng) {
+  std::vector<int> region;
+  if (budget <= 0) return region;
+  std::vector<int> seeds;
+  for (int v : boundary) {
+    if (part[v] != own) continue;
+    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e)
+      if (part[g.adj[e]] == other) {
+        seeds.push_back(v);
+        break;
+      }
+  }
+  for (int i = static_cast<int>(seeds.size()) - 1; i > 0; --i)
+    std::swap(seeds[i], seeds[rng.below(i + 1)]);
+  long long weight = 0;
+  for (int v : seeds) {
+    if (weight + g.vw[v] > budget) continue;
+    in[v] = 1;
+    region.push_back(v);
+    weight += g.vw[v];
+  }
+  for (std::size_t q = 0; q < region.size(); ++q) {
+    const int v = region[q];
+    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
+      const int u = g.adj[e];
+      if (in[u] || part[u] != own || weight + g.vw[u] > budget) continue;
+      in[u] = 1;
+      region.push_back(u);
+      weight += g.vw[u];
+    }
+  }
+  return region;
+}
+
+// One flow step on blocks a, b with corridors sized by `factor`. Returns the cut gain applied
+// (0 when nothing better and balanced was found); `feasible_found` tells whether a balanced
+// min cut existed at all (if not, a smaller corridor may help).
+long long refine_pair(const WorkGraph& g, std::vector<int>& part, std::vector<long long>& bw,
+                      const std::vector<long long>& ub, int a, int b,
+                      const std::vector<int>& boundary, long long slack, double factor,
+                      std::vector<char>& in, std::vector<int>& local, Rng& rng,
+                      bool* feasible_found) {
+  *feasible_found = false;
+  if (boundary.empty()) return 0;
+  const long long budget_a = std::max<long long>(0, ub[b] - bw[b]) +
+                             static_cast<long long>(factor * static_cast<double>(slack));
+  const long long budget_b = std::max<long long>(0, ub[a] - bw[a]) +
+                             static_cast<long long>(factor * static_cast<double>(slack));
+  std::vector<int> ra = corridor(g, part, a, b, budget_a, boundary, in, rng);
+  std::vector<int> rb = corridor(g, part, b, a, budget_b, boundary, in, rng);
+  std::vector<int> nodes = ra;
+  nodes.insert(nodes.end(), rb.begin(), rb.end());
+  const int m = static_cast<int>(nodes.size());
+  const int s = m, t = m + 1;
+  for (int i = 0; i < m; ++i) local[nodes[i]] = i;
+  FlowNetwork net(m + 2);
+  long long old_cut = 0;  // the current a-b cut as seen by this network
+  for (int i = 0; i < m; ++i) {
+    const int v = nodes[i];
+    long long to_s = 0, to_t = 0;
+    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
+      const int u = g.adj[e];
+      if (in[u]) {
+        if (local[u] > i) net.add(i, local[u], g.ew[e], g.ew[e]);
+        if (part[v] == a && part[u] == b) old_cut += g.ew[e];
+      } else if (part[u] == a) {
+        to_s += g.ew[e];
+      } else if (part[u] == b) {
+        to_t += g.ew[e];
+      }
+    }
+    old_cut += part[v] == a ? to_t : to_s;
+    if (to_s > 0) net.add(s, i, to_s, 0);
+    if (to_t > 0) net.add(i, t, to_t, 0);
+  }
+  const long long new_cut = net.max_flow(s, t);
+  long long gain = 0;
+  if (new_cut <= old_cut) {
+    // Every minimum cut is a source side closed under residual arcs: everything reachable from
+    // s, plus any prefix of the other residual components taken in reverse topological order
+    // (those that cannot reach t). Among these prefixes take the best balanced one.
+    const std::vector<char> from_s = net.reachable_from(s);
+    const std::vector<char> to_t = net.reaching(t);
+    std::vector<int> roots(static_cast<std::size_t>(m) + 2);
+    for (int i = 0; i < m + 2; ++i) roots[i] = i;
+    for (int i = m + 1; i > 0; --i) std::swap(roots[i], roots[rng.below(i + 1)]);
+    int num_comp = 0;
+    const std::vector<int> comp = net.residual_components(roots, &num_comp);
+    std::vector<long long> comp_weight(static_cast<std::size_t>(num_comp), 0);
+    std::vector<char> comp_free(static_cast<std::size_t>(num_comp), 1);
+    long long wa = bw[a];
+    for (int v : ra) wa -= g.vw[v];
+    for (int i = 0; i < m; ++i) {
+      if (from_s[i]) {
+        wa += g.vw[nodes[i]];
+        comp_free[comp[i]] = 0;
+      } else if (to_t[i]) {
+        comp_free[comp[i]] = 0;
+      } else {
+        comp_weight[comp[i]] += g.vw[nodes[i]];
+      }
+    }
+    comp_free[comp[s]] = comp_free[comp[t]] = 0;
+    const long long total = bw[a] + bw[b];
+    long long best_max = LLONG_MAX;
+    int best_prefix = -2;  // -1: no free component on the source side
+    for (int c = -1; c < num_comp; ++c) {
+      if (c >= 0) {
+        if (!comp_free[c]) continue;
+        wa += comp_weight[c];
+      }
+      const long long wb = total - wa;
+      if (wa > ub[a] || wb > ub[b]) continue;
+      const long long mx = std::max(wa, wb);
+      if (mx < best_max) {
+        best_max = mx;
+        best_prefix = c;
+      }
+    }
+    *feasible_found = best_prefix > -2;
+    const long long old_max = std::max(bw[a], bw[b]);
+    if (*feasible_found && (new_cut < old_cut || best_max < old_max)) {
+      long long new_wa = bw[a];
+      for (int v : ra) new_wa -= g.vw[v];
+      for (int i = 0; i < m; ++i) {
+        const bool side_a = from_s[i] || (!to_t[i] && comp[i] <= best_prefix && comp_free[comp[i]]);
+        part[nodes[i]] = side_a ? a : b;
+        if (side_a) new_wa += g.vw[nodes[i]];
+      }
+      bw[b] = total - new_wa;
+      bw[a] = new_wa;
+      gain = old_cut - new_cut;
+    }
+  }
+  for (int v : nodes) {
+    in[v] = 0;
+    local[v] = -1;
+  }
+  return gain;
+}
+
+}  // namespace
+
+long long flow_refine(const WorkGraph& g, int k, std::vector<int>& part,
+                      const std::vector<long long>& ub, const FlowParams& params, Rng& rng) {
+  std::vector<long long> bw = block_weights(g, part, k);
+  long long cut = edge_cut(g, part);
+  if (k < 2) return cut;
+  const long long avg = (g.total_vw + k - 1) / k;
+  long long slack = 1;
+  for (int b = 0; b < k; ++b) slack = std::max(slack, ub[b] - avg);
+  std::vector<char> in(static_cast<std::size_t>(g.n), 0);
+  std::vector<int> local(static_cast<std::size_t>(g.n), -1);
+  for (int round = 0; round < params.rounds; ++round) {
+    // Boundary vertices of every adjacent block pair (a < b), collected once per round; later
+    // pairs may see slightly stale lists, which only affects where their corridors start.
+    std::map<std::pair<int, int>, std::vector<int>> boundary;
+    std::vector<int> seen(static_cast<std::size_t>(k), -1);
+    for (int v = 0; v < g.n; ++v)
+      for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
+        const int pu = part[g.adj[e]];
+        if (pu == part[v] || seen[pu] == v) continue;
+        seen[pu] = v;
+        boundary[{std::min(pu, part[v]), std::max(pu, part[v])}].push_back(v);
+      }
+    std::vector<std::pair<int, int>> order;
+    for (const auto& entry : boundary) order.push_back(entry.first);
+    for (int i = static_cast<int>(order.size()) - 1; i > 0; --i)
+      std::swap(order[i], order[rng.below(i + 1)]);
+    long long round_gain = 0;
+    for (const auto& ab : order) {
+      for (double factor : {params.alpha, params.alpha / 4, 0.0}) {
+        bool feasible = false;
+        const long long gain = refine_pair(g, part, bw, ub, ab.first, ab.second, boundary[ab],
+                                           slack, factor, in, local, rng, &feasible);
+        round_gain += gain;
+        if (feasible) break;  // a balanced min cut was found (applied if it helped)
+      }
+    }
+    cut -= round_gain;
+    if (round_gain == 0) break;
+  }
+  return cut;  // exact: every applied step gained exactly old_cut - flow on its network
+}
+
+}  // namespace tessera::partition_detail
