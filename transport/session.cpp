@@ -226,6 +226,10 @@ struct Session::Impl {
   // ---- readiness -------------------------------------------------------------------------
   std::vector<PeerIdentity> expected_peers(Expect e) const {
     std::vector<PeerIdentity> out;
+    if (!opt.expect_coordinator) {
+      if (e == Expect::kCoordinator) e = Expect::kNone;
+      if (e == Expect::kOtherAgentsAndCoordinator) e = Expect::kOtherAgents;
+    }
     auto agent = [&](std::uint32_t k) { return PeerIdentity{opt.run_id, false, k}; };
     switch (e) {
       case Expect::kNone:
@@ -512,7 +516,7 @@ WaitStatus Session::ready_barrier(Seconds timeout, std::string* missing) {
   }
   send_control(wire::CONTROL_READY);
   std::vector<PeerIdentity> others = s.expected_peers(Expect::kOtherAgents);
-  if (!s.me.coordinator) others.push_back(PeerIdentity{s.opt.run_id, true, 0});
+  if (!s.me.coordinator && s.opt.expect_coordinator) others.push_back(PeerIdentity{s.opt.run_id, true, 0});
   const Seconds left = timeout - (std::chrono::steady_clock::now() - start);
   st = s.room.wait_for(
       [&] {
@@ -566,7 +570,7 @@ void Session::linger_for_control(Seconds timeout) {
   Impl& s = *impl_;
   const auto start = std::chrono::steady_clock::now();
   std::vector<PeerIdentity> others = s.expected_peers(Expect::kOtherAgents);
-  if (!s.me.coordinator) others.push_back(PeerIdentity{s.opt.run_id, true, 0});
+  if (!s.me.coordinator && s.opt.expect_coordinator) others.push_back(PeerIdentity{s.opt.run_id, true, 0});
   const std::string endpoint = std::string(kControlTopic) + "/w";
   // Every expected peer has matched our control writer or is gone; with `include_unseen`
   // false, peers never discovered are not waited for.

@@ -39,6 +39,9 @@ struct SessionOptions {
   double write_timeout_s = 30.0;
   /// Print discovery events (peer found / lost) to stderr.
   bool verbose = false;
+  /// Whether the run has a coordinator (agents wait for it in the readiness barrier). Off
+  /// only for agent-to-agent tools such as tessera-dds-ping.
+  bool expect_coordinator = true;
 
   /// Throws InputError naming the bad field.
   void validate() const;
