@@ -22,8 +22,7 @@ Eigen::MatrixXd frame_from_forward_up(const Eigen::Vector3d& forward, const Eige
   return R;
 }
 
-Eigen::MatrixXd rotation_exp(const Eigen::VectorXd& w) {
-  if (w.size() == 1) return planar_rotation(w(0));
+Eigen::Matrix3d so3_exp(const Eigen::Vector3d& w) {
   const double angle = w.norm();
   Eigen::Matrix3d K;
   K << 0, -w(2), w(1), w(2), 0, -w(0), -w(1), w(0), 0;
@@ -32,6 +31,11 @@ Eigen::MatrixXd rotation_exp(const Eigen::VectorXd& w) {
   const double b =
       angle < 1e-8 ? 0.5 - angle * angle / 24.0 : (1.0 - std::cos(angle)) / (angle * angle);
   return Eigen::Matrix3d::Identity() + a * K + b * K * K;
+}
+
+Eigen::MatrixXd rotation_exp(const Eigen::VectorXd& w) {
+  if (w.size() == 1) return planar_rotation(w(0));
+  return so3_exp(Eigen::Vector3d(w));
 }
 
 }  // namespace tessera
