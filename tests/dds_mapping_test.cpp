@@ -1,0 +1,227 @@
+// Unit tests of the DDS runtime's pure parts: message mapping (core types <-> wire types),
+// inboxes and stop requests, run identity, and the agents' hand-off bookkeeping. No
+// participant is created here.
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "agent/local_share.hpp"
+#include "transport/inbox.hpp"
+#include "transport/message_mapping.hpp"
+#include "transport/run_identity.hpp"
+#include "util/input_error.hpp"
+
+namespace {
+
+using namespace tessera;
+using namespace tessera::transport;
+
+Pose pose2(double x, double y, double th) {
+  Pose p = Pose::identity(2);
+  p.R << std::cos(th), -std::sin(th), std::sin(th), std::cos(th);
+  p.t << x, y;
+  return p;
+}
+
+TEST(DdsMapping, PoseBlockRoundTripsExactly) {
+  PoseBlockMessage m;
+  m.round = 7;
+  m.sender = 3;
+  m.kind = BlockKind::kV;
+  m.rank = 4;
+  m.dim = 3;
+  m.pose_ids = {5, 9};
+  for (int k = 0; k < 2 * 4 * 4; ++k) m.data.push_back(0.1 * k - 1.0 / 3.0);
+  wire::PoseBlock w = to_wire_block(m, "run", false, {1, 2});
+  EXPECT_EQ(w.run_id(), "run");
+  EXPECT_TRUE(addressed_to(w.broadcast(), w.recipients(), 2));
+  EXPECT_FALSE(addressed_to(w.broadcast(), w.recipients(), 0));
+  PoseBlockMessage back = from_wire(w);
+  EXPECT_EQ(back.round, 7u);
+  EXPECT_EQ(back.sender, 3u);
+  EXPECT_EQ(back.kind, BlockKind::kV);
+  EXPECT_EQ(back.pose_ids, m.pose_ids);
+  EXPECT_EQ(back.data, m.data);  // bit for bit
+}
+
+TEST(DdsMapping, MalformedPoseBlockIsRejected) {
+  PoseBlockMessage m;
+  m.rank = 3;
+  m.dim = 2;
+  m.pose_ids = {1};
+  m.data = {1, 2, 3};  // needs 9
+  EXPECT_THROW(from_wire(to_wire_block(m, "r", true, {})), TransportError);
+  wire::PoseBlock w = to_wire_block(PoseBlockMessage{}, "r", true, {});
+  w.kind(7);
+  EXPECT_THROW(from_wire(w), TransportError);
+}
+
+TEST(DdsMapping, RoundStatusRoundTrips) {
+  RoundStatusMessage m;
+  m.round = 2;
+  m.sender = 1;
+  m.phase = 3;
+  m.cost = 12.5;
+  m.grad_norm_sq = 1e-9;
+  m.block_grad_norm = 0.25;
+  m.restart_vote = true;
+  m.done_vote = false;
+  RoundStatusMessage back = from_wire(to_wire_status(m, "r", true, {}));
+  EXPECT_EQ(back.round, 2u);
+  EXPECT_EQ(back.phase, 3u);
+  EXPECT_EQ(back.cost, 12.5);
+  EXPECT_EQ(back.grad_norm_sq, 1e-9);
+  EXPECT_EQ(back.block_grad_norm, 0.25);
+  EXPECT_TRUE(back.restart_vote);
+  EXPECT_FALSE(back.done_vote);
+}
+
+TEST(DdsMapping, HandoffCarriesMeasurementsAndPosesExactly) {
+  Measurement e;
+  e.i = 4;
+  e.j = 1;
+  e.R = pose2(0, 0, 0.3).R;
+  e.t = Eigen::Vector2d(1.5, -2.0);
+  e.kappa = 10;
+  e.tau = 20;
+  Pose p = pose2(1, 2, -0.7);
+  wire::MeasurementHandoff w = to_wire_handoff("r", 0, 1, 2, {&e}, {42}, {{4u, &p}});
+  HandoffContent c = from_wire(w);
+  ASSERT_EQ(c.measurements.size(), 1u);
+  EXPECT_EQ(c.measurement_index, std::vector<std::uint64_t>{42});
+  EXPECT_EQ(c.measurements[0].i, 4u);
+  EXPECT_EQ(c.measurements[0].j, 1u);
+  EXPECT_EQ(c.measurements[0].R, e.R);
+  EXPECT_EQ(c.measurements[0].t, e.t);
+  EXPECT_EQ(c.measurements[0].kappa, 10);
+  EXPECT_EQ(c.measurements[0].tau, 20);
+  ASSERT_EQ(c.poses.size(), 1u);
+  EXPECT_EQ(c.poses[0].first, 4u);
+  EXPECT_EQ(c.poses[0].second.R, p.R);
+  EXPECT_EQ(c.poses[0].second.t, p.t);
+  w.meas_t().pop_back();
+  EXPECT_THROW(from_wire(w), TransportError);
+}
+
+TEST(DdsRunIdentity, RunIdsDomainsAndNames) {
+  EXPECT_NO_THROW(validate_run_id("run-1_a.b"));
+  EXPECT_THROW(validate_run_id(""), InputError);
+  EXPECT_THROW(validate_run_id("a b"), InputError);
+  EXPECT_THROW(validate_run_id(std::string(65, 'x')), InputError);
+  const int d = domain_for_run("abc");
+  EXPECT_EQ(d, domain_for_run("abc"));
+  EXPECT_GE(d, 1);
+  EXPECT_LE(d, kMaxDomain);
+  auto who = parse_participant_name(participant_name(PeerIdentity{"r-1", false, 12}));
+  ASSERT_TRUE(who.has_value());
+  EXPECT_EQ(who->run_id, "r-1");
+  EXPECT_FALSE(who->coordinator);
+  EXPECT_EQ(who->agent_id, 12u);
+  who = parse_participant_name(participant_name(PeerIdentity{"r", true, 0}));
+  ASSERT_TRUE(who.has_value());
+  EXPECT_TRUE(who->coordinator);
+  EXPECT_FALSE(parse_participant_name("ros2_node").has_value());
+  EXPECT_FALSE(parse_participant_name("tessera:r:agent:x").has_value());
+}
+
+TEST(DdsInbox, WaitsWakeOnMessagesStopsAndTimeouts) {
+  Mailroom room;
+  Inbox<int> inbox(room);
+  int got = 0;
+  auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(inbox.take(Seconds(0.05), &got), WaitStatus::kTimeout);
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(45));
+  std::thread producer([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    inbox.push(1);
+    inbox.push(2);
+  });
+  EXPECT_EQ(inbox.take([](int x) { return x == 2; }, Seconds(5), &got), WaitStatus::kReady);
+  EXPECT_EQ(got, 2);
+  producer.join();
+  EXPECT_EQ(inbox.size(), 1u);
+  EXPECT_EQ(inbox.wait_for([](const std::deque<int>& q) { return q.size() == 1; }, Seconds(1)), WaitStatus::kReady);
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    room.request_stop(3, "because");
+  });
+  EXPECT_EQ(inbox.take([](int x) { return x == 99; }, Seconds(5), &got), WaitStatus::kStopped);
+  stopper.join();
+  EXPECT_EQ(room.stop_info()->exit_code, 3);
+  room.request_stop(4, "later");  // first reason wins
+  EXPECT_EQ(room.stop_info()->reason, "because");
+}
+
+TEST(DdsInbox, DeferredStopTakesEffectUnlessAnotherComesFirst) {
+  Mailroom room;
+  room.request_stop_after(1, "peer left", Seconds(0.05));
+  EXPECT_FALSE(room.stopped());
+  EXPECT_EQ(room.wait_for([] { return false; }, Seconds(5)), WaitStatus::kStopped);
+  EXPECT_EQ(room.stop_info()->reason, "peer left");
+  Mailroom other;
+  other.request_stop_after(1, "peer left", Seconds(1));
+  other.request_stop(1, "the real cause", true);
+  EXPECT_EQ(other.stop_info()->reason, "the real cause");
+}
+
+// A 9-pose chain split among 3 robots, then owned by a different partition.
+TEST(DdsHandoff, EveryMeasurementReachesBothOwnersAndPosesTheirOwner) {
+  PoseGraph g;
+  g.d = 2;
+  g.num_poses = 9;
+  g.source = "test";
+  for (int k = 0; k < 9; ++k) g.initial.push_back(pose2(k, 0, 0));
+  auto add = [&](int i, int j) {
+    Measurement m;
+    m.i = i;
+    m.j = j;
+    m.R = Eigen::Matrix2d::Identity();
+    m.t = Eigen::Vector2d(j - i, 0);
+    g.measurements.push_back(m);
+  };
+  for (int k = 0; k + 1 < 9; ++k) add(k, k + 1);
+  add(8, 0);
+  add(2, 6);
+  const std::vector<std::uint32_t> owner = {1, 1, 1, 0, 0, 2, 2, 2, 0};
+  std::vector<agent::RobotShare> shares;
+  for (std::uint32_t r = 0; r < 3; ++r) shares.push_back(agent::robot_share(g, r, 3));
+  EXPECT_EQ(shares[1].begin, 3u);
+  EXPECT_EQ(shares[1].end, 6u);
+  std::size_t held = 0;
+  for (const auto& s : shares) held += s.measurements.size();
+  EXPECT_EQ(held, g.measurements.size());  // each measurement held by exactly one robot
+
+  for (std::uint32_t a = 0; a < 3; ++a) {
+    std::vector<agent::ReceivedHandoff> received;
+    for (std::uint32_t b = 0; b < 3; ++b) {
+      if (b == a) continue;
+      agent::HandoffPlan plan = agent::plan_handoff(shares[b], owner, a);
+      HandoffContent c = from_wire(
+          to_wire_handoff("r", b, a, 2, plan.measurements, plan.measurement_index, plan.poses));
+      received.push_back({b, c.measurements, c.measurement_index, c.poses});
+    }
+    agent::AgentLocalData local = agent::assemble_local(shares[a], owner, a, 3, received, {});
+    std::vector<std::uint64_t> expected;
+    for (std::size_t k = 0; k < g.measurements.size(); ++k)
+      if (owner[g.measurements[k].i] == a || owner[g.measurements[k].j] == a) expected.push_back(k);
+    EXPECT_EQ(local.measurement_index, expected) << "agent " << a;
+    ASSERT_EQ(local.initial.size(), local.owned.size());
+    for (std::size_t k = 0; k < local.owned.size(); ++k)
+      EXPECT_EQ(local.initial[k].t(0), static_cast<double>(local.owned[k]));
+  }
+}
+
+TEST(DdsHandoff, InconsistentHandoffsAreReported) {
+  PoseGraph g;
+  g.d = 2;
+  g.num_poses = 4;
+  for (int k = 0; k < 4; ++k) g.initial.push_back(pose2(k, 0, 0));
+  agent::RobotShare s = agent::robot_share(g, 0, 2);
+  const std::vector<std::uint32_t> owner = {0, 0, 1, 0};
+  // Pose 3 belongs to agent 0 but robot 1 never handed it over.
+  EXPECT_THROW(agent::assemble_local(s, owner, 0, 2, {}, {}), std::runtime_error);
+  EXPECT_THROW(agent::robot_share(g, 0, 5), InputError);
+}
+
+}  // namespace
