@@ -1,4 +1,5 @@
 // `tessera generate`: writes a synthetic multi-robot pose graph (see docs/generator.md).
+#include <chrono>
 #include <cstdio>
 #include <string>
 
@@ -92,8 +93,16 @@ std::string json_escape(const std::string& s) {
   return out;
 }
 
+struct Timing {
+  double generate_s = 0, write_s = 0;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 void write_json(const std::string& path, const GeneratorOptions& o, const GeneratorResult& r,
-                const std::string& graph_path) {
+                const std::string& graph_path, const Timing& timing) {
   TextFileWriter file(path);
   std::string& out = file.buffer();
   out += "{\n";
@@ -115,7 +124,9 @@ void write_json(const std::string& path, const GeneratorOptions& o, const Genera
   append_field(out, "inter_robot_closure_probability", o.inter_robot_closure_probability);
   append_field(out, "max_loop_closures", o.max_loop_closures);
   append_field(out, "kappa", r.graph.measurements.front().kappa);
-  append_field(out, "tau", r.graph.measurements.front().tau, true);
+  append_field(out, "tau", r.graph.measurements.front().tau);
+  append_field(out, "generate_s", timing.generate_s);
+  append_field(out, "write_s", timing.write_s, true);
   out += "}\n";
   file.close();
 }
@@ -138,10 +149,15 @@ int run_generate(const Args& argv) {
   if (!out) throw InputError("option --out FILE.g2o is required (see --help)");
 
   const GeneratorOptions options = parse_options(args);
+  Timing timing;
+  auto start = std::chrono::steady_clock::now();
   const GeneratorResult result = generate_pose_graph(options);
+  timing.generate_s = seconds_since(start);
+  start = std::chrono::steady_clock::now();
   write_g2o(result.graph, *out);
+  timing.write_s = seconds_since(start);  // the g2o file only
   if (auto truth = args.get("truth")) write_tum(result.ground_truth, *truth);
-  if (auto json = args.get("json")) write_json(*json, options, result, *out);
+  if (auto json = args.get("json")) write_json(*json, options, result, *out, timing);
 
   std::printf(
       "generated %s: %zu poses, %zu edges, %zu robots, %zu loop closures (%zu intra-robot, %zu "
