@@ -299,6 +299,27 @@ TEST(GenerateCommand, WritesGraphTruthAndJsonAndPrintsASummary) {
   EXPECT_NE(json.find("\"kind\": \"sphere\""), std::string::npos) << json;
 }
 
+// The centralized solver certifies what the generator writes (its own tests go further).
+TEST(GenerateCommand, GeneratedGraphsAreSolvedAndCertified) {
+  const std::string dir = test::temp_dir();
+  for (const char* kind : {"grid3d", "sphere", "torus", "city"}) {
+    SCOPED_TRACE(kind);
+    std::string out;
+    ASSERT_EQ(test::run_command(tessera() + " generate --kind " + kind +
+                                    " --poses 300 --robots 3 --seed 2 --out " + dir + "/g.g2o",
+                                &out),
+              0)
+        << out;
+    ASSERT_EQ(test::run_command(tessera() + " solve " + dir + "/g.g2o --algorithm centralized " +
+                                    "--json " + dir + "/s.json",
+                                &out),
+              0)
+        << out;
+    const std::string json = read_text(dir + "/s.json");
+    EXPECT_NE(json.find("\"certified\": true"), std::string::npos) << json;
+  }
+}
+
 TEST(GenerateCommand, SameCommandSameBytes) {
   const std::string dir = test::temp_dir();
   const std::string args = " generate --kind city --poses 300 --robots 2 --seed 4 --out ";
