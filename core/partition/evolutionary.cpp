@@ -65,8 +65,11 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
           std::to_string(pop.size()) + " multilevel runs + " + std::to_string(params.vcycles) +
               " V-cycles each",
           best_cut());
-  int improved = 0;
-  for (int gen = 0; gen < params.generations && pop.size() > 1; ++gen) {
+  int improved = 0, steps = 0, stalled = 0;
+  for (int gen = 0; gen < params.generations && pop.size() > 1 && stalled < params.stall_limit;
+       ++gen) {
+    ++steps;
+    ++stalled;
     Individual child;
     if (rng.uniform() < params.mutation_rate) {
       // Mutation: combine an individual with a fresh multilevel partition.
@@ -88,14 +91,17 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
     for (const auto& ind : pop)
       duplicate = duplicate || (ind.cut == child.cut && ind.part == child.part);
     if (!duplicate && child.cut <= pop[worst].cut) {
-      if (child.cut < best_cut()) ++improved;
+      if (child.cut < best_cut()) {
+        ++improved;
+        stalled = 0;
+      }
       pop[worst] = std::move(child);
     }
   }
   if (trace && params.generations > 0)
     trace("evolution",
-          std::to_string(params.generations) + " combine/mutation steps, " +
-              std::to_string(improved) + " improved the best",
+          std::to_string(steps) + " combine/mutation steps, " + std::to_string(improved) +
+              " improved the best",
           best_cut());
   int best = 0;
   for (int i = 1; i < static_cast<int>(pop.size()); ++i)

@@ -17,6 +17,7 @@ struct EvolutionParams {
   int population = 6;          ///< Individuals built by independent multilevel runs (+ V-cycles).
   int vcycles = 1;             ///< Guided V-cycles applied to each new individual.
   int generations = 20;        ///< Combine / mutation steps after the initial population.
+  int stall_limit = 1 << 30;   ///< Stop after this many steps without a new best cut.
   double mutation_rate = 0.3;  ///< Share of steps that combine with a fresh partition instead.
   CycleParams cycle;
 };

@@ -1,9 +1,19 @@
 #include "partition/multilevel.hpp"
 
+#include <algorithm>
+
 namespace tessera::partition_detail {
+std::vector<long long> level_bounds(const WorkGraph& g, const std::vector<long long>& ub) {
+  const int heaviest = g.vw.empty() ? 1 : *std::max_element(g.vw.begin(), g.vw.end());
+  std::vector<long long> relaxed = ub;
+  for (auto& b : relaxed) b += heaviest - 1;
+  return relaxed;
+}
+
 long long refine_level(const WorkGraph& g, int k, std::vector<int>& part,
-                       const std::vector<long long>& ub, const CycleParams& params, Rng& rng,
+                       const std::vector<long long>& ub_fine, const CycleParams& params, Rng& rng,
                        bool flow) {
+  const std::vector<long long> ub = level_bounds(g, ub_fine);
   rebalance(g, k, part, ub);
   long long cut = kway_fm(g, k, part, ub, params.fm, rng);
   if (params.use_flow && flow) {
@@ -38,7 +48,7 @@ std::vector<int> multilevel_partition(const WorkGraph& g, int k, const std::vect
                                       const CycleParams& params, Rng& rng, CycleStats* stats) {
   const Hierarchy h = coarsen(g, nullptr, params.coarsening, rng);
   const WorkGraph& top = h.top(g);
-  std::vector<int> part = initial_partition(top, k, ub, params.initial, rng);
+  std::vector<int> part = initial_partition(top, k, level_bounds(top, ub), params.initial, rng);
   if (stats) {
     stats->levels = static_cast<int>(h.coarse.size());
     stats->coarsest_vertices = top.n;

@@ -21,6 +21,11 @@ struct CycleParams {
   FlowParams flow;
 };
 
+/// The bounds used on a level whose heaviest vertex weighs w: ub + w - 1. Coarse levels may
+/// overshoot by less than one vertex (otherwise a tight bound may be unreachable with heavy
+/// vertices); on the input graph (unit weights) they are exactly ub.
+std::vector<long long> level_bounds(const WorkGraph& g, const std::vector<long long>& ub);
+
 /// The refinement applied on every level: rebalance, FM, then (optionally) flow refinement
 /// followed by another FM round when the flows found something. Returns the cut.
 long long refine_level(const WorkGraph& g, int k, std::vector<int>& part,

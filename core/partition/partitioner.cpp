@@ -66,7 +66,7 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   PresetPlan plan;
   CycleParams& cp = plan.cycle;
   cp.coarsening.stop_vertices = std::max(20 * k, 80);
-  cp.coarsening.max_vertex_weight = static_cast<int>(std::max<long long>(1, lmax / 30));
+  cp.coarsening.max_vertex_weight = static_cast<int>(std::max<long long>(2, lmax / 30));
   cp.initial.repeats = 4;
   cp.initial.bisection_tries = 4;
   switch (preset) {
@@ -98,11 +98,14 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // Effort in multilevel operations, scaled so that every graph gets about the same
         // time: one operation costs roughly proportional to n + edges.
         const double size = static_cast<double>(g.n) + static_cast<double>(g.adj.size()) / 2.0;
-        const double budget = preset == PartitionPreset::kStrong ? 4.0e5 : 1.8e6;
-        const int ops = static_cast<int>(std::clamp(budget / size, 12.0, 2000.0));
+        const bool strong = preset == PartitionPreset::kStrong;
+        const int ops = static_cast<int>(
+            std::clamp((strong ? 4.0e5 : 1.2e6) / size, 12.0, strong ? 150.0 : 600.0));
         plan.evolution.population = preset == PartitionPreset::kStrong ? 4 : 6;
         plan.evolution.vcycles = 1;
         plan.evolution.generations = std::max(4, ops - 2 * plan.evolution.population);
+        // Small graphs converge long before the budget is spent.
+        plan.evolution.stall_limit = std::max(40, plan.evolution.generations / 3);
       }
       break;
     default:
