@@ -1,6 +1,8 @@
 // tessera-agent: one robot's process in a distributed run. Thin over core/ (graph I/O,
 // the round protocol) and transport/ (DDS). See docs/dds-runtime.md.
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -10,8 +12,6 @@
 #include <set>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
 
 #include "agent/dds_channel.hpp"
 #include "agent/local_dump.hpp"
@@ -89,8 +89,8 @@ std::vector<std::string> split_commas(const std::string& s) {
 
 AgentArgs parse(const std::vector<std::string>& argv) {
   cli::Arguments args(argv,
-                      {"graph", "robots", "id", "run-id", "domain", "timeout", "round-timeout", "lease", "peers",
-                       "output", "dump-local"},
+                      {"graph", "robots", "id", "run-id", "domain", "timeout", "round-timeout",
+                       "lease", "peers", "output", "dump-local"},
                       {"verbose", "help"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
@@ -101,7 +101,8 @@ AgentArgs parse(const std::vector<std::string>& argv) {
   a.graph = *args.get("graph");
   long robots = args.get_long("robots", 0), id = args.get_long("id", 0);
   if (robots < 1 || robots > 1000) throw InputError("option --robots: must be 1..1000");
-  if (id < 0 || id >= robots) throw InputError("option --id: must be 0.." + std::to_string(robots - 1));
+  if (id < 0 || id >= robots)
+    throw InputError("option --id: must be 0.." + std::to_string(robots - 1));
   a.robots = static_cast<std::uint32_t>(robots);
   a.id = static_cast<std::uint32_t>(id);
   a.run_id = args.get_or("run-id", a.run_id);
@@ -149,7 +150,8 @@ class Agent {
     }
     Session& s = *session_;
     signals_.start([&s](int signo) {
-      s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted by " + signal_name(signo));
+      s.mailroom().request_stop(exit_code_for_signal(signo),
+                                "interrupted by " + signal_name(signo));
     });
     int code = kExitOk;
     try {
@@ -202,9 +204,9 @@ class Agent {
     PoseGraph graph = read_g2o(a_.graph);
     share_ = agent::robot_share(graph, a_.id, a_.robots);
     graph = PoseGraph();  // keep only the share
-    log("read " + a_.graph + ": poses [" + std::to_string(share_.begin) + ", " + std::to_string(share_.end) +
-        ") of " + std::to_string(share_.num_poses) + ", " + std::to_string(share_.measurements.size()) +
-        " measurements");
+    log("read " + a_.graph + ": poses [" + std::to_string(share_.begin) + ", " +
+        std::to_string(share_.end) + ") of " + std::to_string(share_.num_poses) + ", " +
+        std::to_string(share_.measurements.size()) + " measurements");
 
     // 2. Announce the structure (endpoints only).
     wire::AgentAnnouncement ann;
@@ -228,11 +230,13 @@ class Agent {
     wire::PartitionAssignment asg;
     WaitStatus got = s.assignments().take(Seconds(a_.timeout_s), &asg);
     expect_ready(got, room, a_.timeout_s, "the partition assignment from the coordinator",
-                 s.peers_ever_seen() == 0 ? "no process of run '" + a_.run_id + "' seen on domain " +
-                                                std::to_string(s.domain()) + " (is the coordinator running?)"
-                                          : "");
+                 s.peers_ever_seen() == 0
+                     ? "no process of run '" + a_.run_id + "' seen on domain " +
+                           std::to_string(s.domain()) + " (is the coordinator running?)"
+                     : "");
     check_assignment(asg);
-    log("assignment received (" + std::to_string(std::count(asg.owner().begin(), asg.owner().end(), a_.id)) +
+    log("assignment received (" +
+        std::to_string(std::count(asg.owner().begin(), asg.owner().end(), a_.id)) +
         " poses owned)");
 
     // 4. Everyone's endpoints matched before any volatile agent-to-agent message.
@@ -245,8 +249,8 @@ class Agent {
     for (std::uint32_t b = 0; b < a_.robots; ++b) {
       if (b == a_.id) continue;
       agent::HandoffPlan plan = agent::plan_handoff(share_, asg.owner(), b);
-      s.publish(to_wire_handoff(a_.run_id, a_.id, b, share_.d, plan.measurements, plan.measurement_index,
-                                plan.poses));
+      s.publish(to_wire_handoff(a_.run_id, a_.id, b, share_.d, plan.measurements,
+                                plan.measurement_index, plan.poses));
     }
     const std::size_t others = a_.robots - 1;
     auto senders_missing = [&](const std::deque<wire::MeasurementHandoff>& q) {
@@ -254,7 +258,8 @@ class Agent {
       for (const auto& h : q) have.insert(h.sender());
       std::string out;
       for (std::uint32_t b = 0; b < a_.robots; ++b)
-        if (b != a_.id && !have.count(b)) out += (out.empty() ? "agent " : ", agent ") + std::to_string(b);
+        if (b != a_.id && !have.count(b))
+          out += (out.empty() ? "agent " : ", agent ") + std::to_string(b);
       return out;
     };
     std::string absent;
@@ -268,7 +273,8 @@ class Agent {
     std::vector<agent::ReceivedHandoff> received;
     for (auto& w : s.handoffs().take_all()) {
       HandoffContent c = from_wire(w);
-      received.push_back({w.sender(), std::move(c.measurements), std::move(c.measurement_index), std::move(c.poses)});
+      received.push_back({w.sender(), std::move(c.measurements), std::move(c.measurement_index),
+                          std::move(c.poses)});
     }
     agent::RunOptions ro;
     ro.algorithm = asg.algorithm();
@@ -278,7 +284,8 @@ class Agent {
     ro.grad_norm_tolerance = asg.grad_norm_tolerance();
     ro.relative_cost_tolerance = asg.relative_cost_tolerance();
     ro.seed = asg.seed();
-    agent::AgentLocalData local = agent::assemble_local(share_, asg.owner(), a_.id, a_.robots, std::move(received), ro);
+    agent::AgentLocalData local =
+        agent::assemble_local(share_, asg.owner(), a_.id, a_.robots, std::move(received), ro);
     share_ = agent::RobotShare();
     log("hand-off complete: " + std::to_string(local.owned.size()) + " poses, " +
         std::to_string(local.measurements.size()) + " measurements");
@@ -288,10 +295,12 @@ class Agent {
     agent::DdsProtocolChannel channel(s);
     agent::RoundLoopResult result = agent::run_round_loop(local, channel, a_.round_timeout_s);
     if (result.poses.size() != local.owned.size())
-      throw RunFailure(kExitRunFailed, "the round loop returned " + std::to_string(result.poses.size()) +
-                                           " poses for " + std::to_string(local.owned.size()) + " owned poses");
+      throw RunFailure(kExitRunFailed, "the round loop returned " +
+                                           std::to_string(result.poses.size()) + " poses for " +
+                                           std::to_string(local.owned.size()) + " owned poses");
     log("round loop done after " + std::to_string(result.rounds) + " round(s)");
-    if (!a_.output.empty()) agent::write_vertices_g2o(local.owned, result.poses, local.d, a_.output);
+    if (!a_.output.empty())
+      agent::write_vertices_g2o(local.owned, result.poses, local.d, a_.output);
 
     // 7. Final estimate to the coordinator; leave when it has the merged result.
     wire::FinalEstimate fin;
@@ -306,9 +315,11 @@ class Agent {
     expect_ready(s.wait_finished(Seconds(a_.timeout_s)), room, a_.timeout_s,
                  "the coordinator to confirm the merged result");
     s.set_peer_loss_fatal(false);
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     char buf[256];
-    std::snprintf(buf, sizeof(buf), "%s: done: %zu poses, %zu measurements, %u round(s), %llu bytes sent, %.2f s\n",
+    std::snprintf(buf, sizeof(buf),
+                  "%s: done: %zu poses, %zu measurements, %u round(s), %llu bytes sent, %.2f s\n",
                   tag_.c_str(), local.owned.size(), local.measurements.size(), result.rounds,
                   static_cast<unsigned long long>(s.stats().bytes_sent), secs);
     std::cerr << buf;
@@ -316,11 +327,12 @@ class Agent {
 
   void check_assignment(const wire::PartitionAssignment& asg) {
     auto mismatch = [&](const std::string& what) {
-      throw RunFailure(kExitBadInput, "the coordinator's assignment does not fit this agent: " + what);
+      throw RunFailure(kExitBadInput,
+                       "the coordinator's assignment does not fit this agent: " + what);
     };
     if (asg.num_agents() != a_.robots)
-      mismatch("it is for " + std::to_string(asg.num_agents()) + " agents, this agent was started with --robots " +
-               std::to_string(a_.robots));
+      mismatch("it is for " + std::to_string(asg.num_agents()) +
+               " agents, this agent was started with --robots " + std::to_string(a_.robots));
     if (asg.num_poses() != share_.num_poses || asg.owner().size() != share_.num_poses)
       mismatch("it has " + std::to_string(asg.owner().size()) + " poses, " + a_.graph + " has " +
                std::to_string(share_.num_poses));

@@ -1,10 +1,9 @@
 #include "agent/local_dump.hpp"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-
-#include <Eigen/Geometry>
 
 #include "util/input_error.hpp"
 
@@ -28,8 +27,9 @@ void write_text(const std::string& path, const std::string& text) {
 }  // namespace
 
 void write_local_dump(const AgentLocalData& local, const std::string& path) {
-  std::string out = "AGENT " + std::to_string(local.agent_id) + " " + std::to_string(local.num_agents) + " " +
-                    std::to_string(local.d) + " " + std::to_string(local.num_poses) + "\n";
+  std::string out = "AGENT " + std::to_string(local.agent_id) + " " +
+                    std::to_string(local.num_agents) + " " + std::to_string(local.d) + " " +
+                    std::to_string(local.num_poses) + "\n";
   for (std::uint32_t id : local.owned) out += "OWNED " + std::to_string(id) + "\n";
   for (std::size_t k = 0; k < local.initial.size(); ++k) {
     out += "POSE " + std::to_string(local.owned[k]);
@@ -53,8 +53,8 @@ void write_local_dump(const AgentLocalData& local, const std::string& path) {
   write_text(path, out);
 }
 
-void write_vertices_g2o(const std::vector<std::uint32_t>& ids, const std::vector<Pose>& poses, int d,
-                        const std::string& path) {
+void write_vertices_g2o(const std::vector<std::uint32_t>& ids, const std::vector<Pose>& poses,
+                        int d, const std::string& path) {
   std::string out;
   for (std::size_t k = 0; k < ids.size(); ++k) {
     const Pose& p = poses[k];

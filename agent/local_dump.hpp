@@ -19,7 +19,7 @@ namespace tessera::agent {
 void write_local_dump(const AgentLocalData& local, const std::string& path);
 
 /// Writes VERTEX_SE2 ("id x y theta") or VERTEX_SE3:QUAT ("id x y z qx qy qz qw") lines.
-void write_vertices_g2o(const std::vector<std::uint32_t>& ids, const std::vector<Pose>& poses, int d,
-                        const std::string& path);
+void write_vertices_g2o(const std::vector<std::uint32_t>& ids, const std::vector<Pose>& poses,
+                        int d, const std::string& path);
 
 }  // namespace tessera::agent

@@ -76,11 +76,11 @@ AgentLocalData assemble_local(const RobotShare& share, const std::vector<std::ui
       all.emplace_back(h.measurement_index[k], &m);
     }
   }
-  std::sort(all.begin(), all.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   for (std::size_t k = 0; k < all.size(); ++k) {
     if (k > 0 && all[k].first == all[k - 1].first)
-      throw std::runtime_error("measurement #" + std::to_string(all[k].first) + " was received twice");
+      throw std::runtime_error("measurement #" + std::to_string(all[k].first) +
+                               " was received twice");
     local.measurements.push_back(*all[k].second);
     local.measurement_index.push_back(all[k].first);
   }
@@ -97,13 +97,14 @@ AgentLocalData assemble_local(const RobotShare& share, const std::vector<std::ui
           throw std::runtime_error("agent " + std::to_string(h.sender) + " handed over pose " +
                                    std::to_string(id) + " which agent " + std::to_string(self) +
                                    " does not own");
-        if (slot[id]) throw std::runtime_error("pose " + std::to_string(id) + " was handed over twice");
+        if (slot[id])
+          throw std::runtime_error("pose " + std::to_string(id) + " was handed over twice");
         slot[id] = &pose;
       }
     for (std::uint32_t id : local.owned) {
       if (!slot[id])
-        throw std::runtime_error("initial pose " + std::to_string(id) + " was never handed over to agent " +
-                                 std::to_string(self));
+        throw std::runtime_error("initial pose " + std::to_string(id) +
+                                 " was never handed over to agent " + std::to_string(self));
       local.initial.push_back(*slot[id]);
     }
   }

@@ -11,7 +11,8 @@ namespace {
 
 // For each neighbouring agent, the ids of our owned poses it needs (endpoints of shared
 // measurements), ascending.
-std::map<std::uint32_t, std::vector<std::uint32_t>> boundary_by_neighbour(const AgentLocalData& local) {
+std::map<std::uint32_t, std::vector<std::uint32_t>> boundary_by_neighbour(
+    const AgentLocalData& local) {
   std::map<std::uint32_t, std::set<std::uint32_t>> sets;
   for (const Measurement& m : local.measurements) {
     const auto i = static_cast<std::uint32_t>(m.i), j = static_cast<std::uint32_t>(m.j);
@@ -25,7 +26,8 @@ std::map<std::uint32_t, std::vector<std::uint32_t>> boundary_by_neighbour(const 
 }
 
 // The poses of a neighbour's block we should receive: its owned endpoints of our measurements.
-std::map<std::uint32_t, std::vector<std::uint32_t>> expected_from_neighbours(const AgentLocalData& local) {
+std::map<std::uint32_t, std::vector<std::uint32_t>> expected_from_neighbours(
+    const AgentLocalData& local) {
   std::map<std::uint32_t, std::set<std::uint32_t>> sets;
   for (const Measurement& m : local.measurements) {
     const auto i = static_cast<std::uint32_t>(m.i), j = static_cast<std::uint32_t>(m.j);
@@ -84,13 +86,14 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
       std::string who;
       for (auto& [b, ids] : expected) who += " block from agent " + std::to_string(b) + ";";
       for (auto a : statuses_missing) who += " status from agent " + std::to_string(a) + ";";
-      throw std::runtime_error("round 0: nothing received for " + std::to_string(receive_timeout_s) +
-                               " s; still waiting for:" + who);
+      throw std::runtime_error("round 0: nothing received for " +
+                               std::to_string(receive_timeout_s) + " s; still waiting for:" + who);
     }
     if (auto* block = std::get_if<PoseBlockMessage>(&*msg)) {
       auto it = expected.find(block->sender);
       if (it == expected.end())
-        throw std::runtime_error("round 0: unexpected pose block from agent " + std::to_string(block->sender));
+        throw std::runtime_error("round 0: unexpected pose block from agent " +
+                                 std::to_string(block->sender));
       if (block->pose_ids != it->second || block->rank != static_cast<std::uint32_t>(d))
         throw std::runtime_error("round 0: pose block from agent " + std::to_string(block->sender) +
                                  " does not hold the expected boundary poses");

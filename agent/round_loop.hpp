@@ -39,9 +39,9 @@ struct AgentLocalData {
   std::uint32_t agent_id = 0;
   std::uint32_t num_agents = 1;
   int d = 0;
-  std::size_t num_poses = 0;             ///< n of the whole graph.
-  std::vector<std::uint32_t> owner;      ///< Owner agent of every pose 0..n-1.
-  std::vector<std::uint32_t> owned;      ///< Poses this agent optimizes, ascending.
+  std::size_t num_poses = 0;         ///< n of the whole graph.
+  std::vector<std::uint32_t> owner;  ///< Owner agent of every pose 0..n-1.
+  std::vector<std::uint32_t> owned;  ///< Poses this agent optimizes, ascending.
   /// Every measurement with at least one endpoint in `owned`, in the order of the original
   /// file (measurement_index is the position in that file), so sums can follow the same
   /// order as the in-process engine.

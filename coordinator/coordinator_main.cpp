@@ -99,9 +99,9 @@ std::vector<std::string> split_commas(const std::string& s) {
 
 CoordinatorArgs parse(const std::vector<std::string>& argv) {
   cli::Arguments args(argv,
-                      {"agents", "run-id", "domain", "timeout", "run-timeout", "lease", "peers", "partition",
-                       "partition-seed", "rank", "algorithm", "init", "max-rounds", "grad-tol", "rel-cost-tol",
-                       "seed", "output", "tum", "summary"},
+                      {"agents", "run-id", "domain", "timeout", "run-timeout", "lease", "peers",
+                       "partition", "partition-seed", "rank", "algorithm", "init", "max-rounds",
+                       "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary"},
                       {"progress", "verbose", "help"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
@@ -193,7 +193,8 @@ class Coordinator {
     }
     Session& s = *session_;
     signals_.start([&s](int signo) {
-      s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted by " + signal_name(signo));
+      s.mailroom().request_stop(exit_code_for_signal(signo),
+                                "interrupted by " + signal_name(signo));
     });
     int code = kExitOk;
     try {
@@ -248,7 +249,8 @@ class Coordinator {
     auto all_announced = [&](const std::deque<wire::AgentAnnouncement>& q) {
       std::set<std::uint32_t> have;
       for (const auto& m : q) {
-        if (m.agent_id() >= N || m.num_agents() != N) return true;  // let merge_announcements explain
+        if (m.agent_id() >= N || m.num_agents() != N)
+          return true;  // let merge_announcements explain
         have.insert(m.agent_id());
       }
       missing.clear();
@@ -257,24 +259,29 @@ class Coordinator {
         std::string& list = have.count(k) ? present : missing;
         list += (list.empty() ? "" : ", ") + std::to_string(k);
       }
-      if (!missing.empty()) missing = "missing agent " + missing + (present.empty() ? "" : " (have agent " + present + ")");
+      if (!missing.empty())
+        missing =
+            "missing agent " + missing + (present.empty() ? "" : " (have agent " + present + ")");
       return have.size() == N;
     };
-    expect_ready(s.announcements().wait_for(all_announced, Seconds(a_.timeout_s)), room, a_.timeout_s,
-                 std::to_string(N) + " agents of run '" + a_.run_id + "' on domain " + std::to_string(s.domain()),
+    expect_ready(s.announcements().wait_for(all_announced, Seconds(a_.timeout_s)), room,
+                 a_.timeout_s,
+                 std::to_string(N) + " agents of run '" + a_.run_id + "' on domain " +
+                     std::to_string(s.domain()),
                  missing);
     std::vector<wire::AgentAnnouncement> announcements = s.announcements().take_all();
     discovery_ms_ = ms_since(t0);
     coordinator::RunStructure rs = coordinator::merge_announcements(announcements, N, a_.run_id);
     announcements.clear();
-    log("all " + std::to_string(N) + " agents announced (" + std::to_string(static_cast<long>(discovery_ms_)) + " ms): " +
-        std::to_string(rs.num_poses) + " poses, " + std::to_string(rs.num_measurements) + " measurements");
+    log("all " + std::to_string(N) + " agents announced (" +
+        std::to_string(static_cast<long>(discovery_ms_)) + " ms): " + std::to_string(rs.num_poses) +
+        " poses, " + std::to_string(rs.num_measurements) + " measurements");
 
     // 2. Partition and publish the assignment.
     coordinator::PartitionStepResult part =
         coordinator::partition_for_agents(rs.graph, N, a_.partition, a_.partition_seed);
-    log("partition (" + a_.partition + "): cut " + std::to_string(part.cut_edges) + " measurements in " +
-        std::to_string(part.ms) + " ms");
+    log("partition (" + a_.partition + "): cut " + std::to_string(part.cut_edges) +
+        " measurements in " + std::to_string(part.ms) + " ms");
     wire::PartitionAssignment asg;
     asg.run_id(a_.run_id);
     asg.num_agents(N);
@@ -296,7 +303,9 @@ class Coordinator {
 
     // 3. Final estimates (progress from round statuses meanwhile).
     const auto t_run = std::chrono::steady_clock::now();
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::pair<std::uint32_t, std::pair<double, double>>> progress;
+    std::map<std::pair<std::uint32_t, std::uint32_t>,
+             std::pair<std::uint32_t, std::pair<double, double>>>
+        progress;
     auto finals_missing = [&]() {
       std::set<std::uint32_t> have;
       for (const auto& f : s.finals().queued_locked()) have.insert(f.sender());
@@ -322,14 +331,14 @@ class Coordinator {
         p.second.second += m.grad_norm_sq();
         if (p.first == N && a_.progress) {
           char buf[160];
-          std::snprintf(buf, sizeof(buf), "round %u phase %u: cost %.10g, grad norm %.3e\n", m.round(), m.phase(),
-                        p.second.first, std::sqrt(p.second.second));
+          std::snprintf(buf, sizeof(buf), "round %u phase %u: cost %.10g, grad norm %.3e\n",
+                        m.round(), m.phase(), p.second.first, std::sqrt(p.second.second));
           std::cout << buf << std::flush;
         }
         if (p.first == N) progress.erase({m.round(), m.phase()});
       }
-      if (s.finals().size() >= N && room.wait_for([&] { return finals_missing().empty(); }, Seconds(0)) ==
-                                         WaitStatus::kReady)
+      if (s.finals().size() >= N &&
+          room.wait_for([&] { return finals_missing().empty(); }, Seconds(0)) == WaitStatus::kReady)
         break;
     }
     solve_ms_ = ms_since(t_run);
@@ -346,9 +355,11 @@ class Coordinator {
       auto list = final_poses(f);
       for (auto& [id, pose] : list) {
         if (id >= rs.num_poses || part.owner[id] != f.sender())
-          throw RunFailure(kExitRunFailed, "agent " + std::to_string(f.sender()) + " returned pose " +
-                                               std::to_string(id) + " which it does not own");
-        if (pose.dim() != rs.d) throw RunFailure(kExitRunFailed, "final pose of the wrong dimension");
+          throw RunFailure(kExitRunFailed, "agent " + std::to_string(f.sender()) +
+                                               " returned pose " + std::to_string(id) +
+                                               " which it does not own");
+        if (pose.dim() != rs.d)
+          throw RunFailure(kExitRunFailed, "final pose of the wrong dimension");
         poses[id] = std::move(pose);
         seen[id] = true;
       }
@@ -375,15 +386,18 @@ class Coordinator {
     for (auto b : bytes) total_bytes += b;
     char buf[256];
     std::snprintf(buf, sizeof(buf),
-                  "tessera-coordinator: done: %u agents, %zu poses, %u round(s), discovery %.0f ms, partition %.1f ms, "
+                  "tessera-coordinator: done: %u agents, %zu poses, %u round(s), discovery %.0f "
+                  "ms, partition %.1f ms, "
                   "%llu bytes sent by agents, %.2f s\n",
-                  N, rs.num_poses, rounds, discovery_ms_, part.ms, static_cast<unsigned long long>(total_bytes),
-                  ms_since(t0) / 1000.0);
+                  N, rs.num_poses, rounds, discovery_ms_, part.ms,
+                  static_cast<unsigned long long>(total_bytes), ms_since(t0) / 1000.0);
     std::cerr << buf;
   }
 
-  void write_summary(const coordinator::RunStructure& rs, const coordinator::PartitionStepResult& part,
-                     const std::vector<std::uint64_t>& bytes, std::uint32_t rounds, double total_ms) {
+  void write_summary(const coordinator::RunStructure& rs,
+                     const coordinator::PartitionStepResult& part,
+                     const std::vector<std::uint64_t>& bytes, std::uint32_t rounds,
+                     double total_ms) {
     std::string j = "{\n";
     j += "  \"run_id\": " + json_string(a_.run_id) + ",\n";
     j += "  \"domain\": " + std::to_string(session_->domain()) + ",\n";
@@ -401,7 +415,8 @@ class Coordinator {
     j += "  \"bytes_sent\": [";
     for (std::size_t k = 0; k < bytes.size(); ++k) j += (k ? ", " : "") + std::to_string(bytes[k]);
     j += "],\n  \"hosts\": [";
-    for (std::size_t k = 0; k < rs.hosts.size(); ++k) j += (k ? ", " : "") + json_string(rs.hosts[k]);
+    for (std::size_t k = 0; k < rs.hosts.size(); ++k)
+      j += (k ? ", " : "") + json_string(rs.hosts[k]);
     j += "]\n}\n";
     std::ofstream f(a_.summary, std::ios::binary);
     if (!f || !(f << j)) throw InputError(a_.summary, 0, "cannot write the summary");

@@ -10,15 +10,17 @@ RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& ann
                                  std::uint32_t num_agents, const std::string& run_id) {
   std::vector<const wire::AgentAnnouncement*> by_id(num_agents, nullptr);
   for (const auto& a : announcements) {
-    const std::string who = "agent " + std::to_string(a.agent_id()) + " (pid " + std::to_string(a.pid()) +
-                            " on " + a.host() + ")";
+    const std::string who = "agent " + std::to_string(a.agent_id()) + " (pid " +
+                            std::to_string(a.pid()) + " on " + a.host() + ")";
     if (a.num_agents() != num_agents)
       throw InputError(who + " was started for " + std::to_string(a.num_agents()) +
-                       " robots, the coordinator expects " + std::to_string(num_agents) + " agents");
-    if (a.agent_id() >= num_agents) throw InputError(who + ": id is not below " + std::to_string(num_agents));
+                       " robots, the coordinator expects " + std::to_string(num_agents) +
+                       " agents");
+    if (a.agent_id() >= num_agents)
+      throw InputError(who + ": id is not below " + std::to_string(num_agents));
     if (by_id[a.agent_id()])
-      throw InputError("two agents announced themselves as agent " + std::to_string(a.agent_id()) + " (hosts " +
-                       by_id[a.agent_id()]->host() + " and " + a.host() + ")");
+      throw InputError("two agents announced themselves as agent " + std::to_string(a.agent_id()) +
+                       " (hosts " + by_id[a.agent_id()]->host() + " and " + a.host() + ")");
     by_id[a.agent_id()] = &a;
   }
   RunStructure rs;
@@ -30,17 +32,20 @@ RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& ann
     if (k == 0) {
       rs.d = static_cast<int>(a.dim());
       rs.num_poses = a.num_poses();
-      if (rs.d != 2 && rs.d != 3) throw InputError(who + ": dimension " + std::to_string(a.dim()) + " is not 2 or 3");
+      if (rs.d != 2 && rs.d != 3)
+        throw InputError(who + ": dimension " + std::to_string(a.dim()) + " is not 2 or 3");
     } else if (static_cast<int>(a.dim()) != rs.d || a.num_poses() != rs.num_poses) {
-      throw InputError(who + " has a " + std::to_string(a.dim()) + "D graph of " + std::to_string(a.num_poses()) +
-                       " poses, agent 0 a " + std::to_string(rs.d) + "D graph of " + std::to_string(rs.num_poses) +
+      throw InputError(who + " has a " + std::to_string(a.dim()) + "D graph of " +
+                       std::to_string(a.num_poses()) + " poses, agent 0 a " + std::to_string(rs.d) +
+                       "D graph of " + std::to_string(rs.num_poses) +
                        " poses: were they given the same file?");
     }
     const std::size_t expected_begin = k == 0 ? 0 : by_id[k - 1]->pose_end();
     if (a.pose_begin() != expected_begin || a.pose_end() < a.pose_begin() ||
         (k + 1 == num_agents && a.pose_end() != rs.num_poses))
       throw InputError(who + " holds poses [" + std::to_string(a.pose_begin()) + ", " +
-                       std::to_string(a.pose_end()) + "), which does not continue the previous agents' ranges");
+                       std::to_string(a.pose_end()) +
+                       "), which does not continue the previous agents' ranges");
     if (a.edge_i().size() != a.edge_j().size())
       throw InputError(who + ": edge endpoint arrays differ in length");
     for (std::size_t e = 0; e < a.edge_i().size(); ++e) {

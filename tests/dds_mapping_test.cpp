@@ -141,7 +141,8 @@ TEST(DdsInbox, WaitsWakeOnMessagesStopsAndTimeouts) {
   EXPECT_EQ(got, 2);
   producer.join();
   EXPECT_EQ(inbox.size(), 1u);
-  EXPECT_EQ(inbox.wait_for([](const std::deque<int>& q) { return q.size() == 1; }, Seconds(1)), WaitStatus::kReady);
+  EXPECT_EQ(inbox.wait_for([](const std::deque<int>& q) { return q.size() == 1; }, Seconds(1)),
+            WaitStatus::kReady);
   std::thread stopper([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     room.request_stop(3, "because");

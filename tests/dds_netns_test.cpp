@@ -35,7 +35,8 @@ class Hosts {
     prefix_ = "tss" + std::to_string(tag);
     subnet_ = "10.77." + std::to_string(20 + tag % 200);
     std::string out;
-    ok_ = run_command(kScript + " up " + prefix_ + " 4 " + subnet_ + (block_multicast ? " --block-multicast" : ""),
+    ok_ = run_command(kScript + " up " + prefix_ + " 4 " + subnet_ +
+                          (block_multicast ? " --block-multicast" : ""),
                       &out) == 0;
     error_ = out;
   }
@@ -43,11 +44,14 @@ class Hosts {
   bool ok() const { return ok_; }
   const std::string& error() const { return error_; }
   std::vector<std::string> in(int host, std::vector<std::string> argv) const {
-    std::vector<std::string> a = {"/usr/bin/env", "ip", "netns", "exec", prefix_ + "-" + std::to_string(host)};
+    std::vector<std::string> a = {"/usr/bin/env", "ip", "netns", "exec",
+                                  prefix_ + "-" + std::to_string(host)};
     a.insert(a.end(), argv.begin(), argv.end());
     return a;
   }
-  std::string addresses() const { return subnet_ + ".1," + subnet_ + ".2," + subnet_ + ".3," + subnet_ + ".4"; }
+  std::string addresses() const {
+    return subnet_ + ".1," + subnet_ + ".2," + subnet_ + ".3," + subnet_ + ".4";
+  }
 
  private:
   std::string prefix_, subnet_, error_;
@@ -55,20 +59,40 @@ class Hosts {
 };
 
 // Coordinator on host 0, agent k on host k+1; returns the processes after they ended.
-std::vector<Process> run_across_hosts(const Hosts& hosts, const std::string& dir, const std::string& graph, int domain,
-                                      const std::string& run, double timeout_s, const std::vector<std::string>& extra) {
+std::vector<Process> run_across_hosts(const Hosts& hosts, const std::string& dir,
+                                      const std::string& graph, int domain, const std::string& run,
+                                      double timeout_s, const std::vector<std::string>& extra) {
   std::vector<Process> procs;
-  std::vector<std::string> c = {bin("tessera-coordinator"), "--agents", "3", "--run-id", run,
-                                "--domain", std::to_string(domain), "--timeout", std::to_string(timeout_s),
-                                "--output", dir + "/" + run + ".g2o"};
+  std::vector<std::string> c = {bin("tessera-coordinator"),
+                                "--agents",
+                                "3",
+                                "--run-id",
+                                run,
+                                "--domain",
+                                std::to_string(domain),
+                                "--timeout",
+                                std::to_string(timeout_s),
+                                "--output",
+                                dir + "/" + run + ".g2o"};
   c.insert(c.end(), extra.begin(), extra.end());
   procs.push_back(start(hosts.in(0, c), dir + "/" + run + "_coordinator.log"));
   for (int k = 0; k < 3; ++k) {
-    std::vector<std::string> a = {bin("tessera-agent"), "--graph", graph, "--robots", "3", "--id", std::to_string(k),
-                                  "--run-id", run, "--domain", std::to_string(domain), "--timeout",
+    std::vector<std::string> a = {bin("tessera-agent"),
+                                  "--graph",
+                                  graph,
+                                  "--robots",
+                                  "3",
+                                  "--id",
+                                  std::to_string(k),
+                                  "--run-id",
+                                  run,
+                                  "--domain",
+                                  std::to_string(domain),
+                                  "--timeout",
                                   std::to_string(timeout_s)};
     a.insert(a.end(), extra.begin(), extra.end());
-    procs.push_back(start(hosts.in(k + 1, a), dir + "/" + run + "_agent" + std::to_string(k) + ".log"));
+    procs.push_back(
+        start(hosts.in(k + 1, a), dir + "/" + run + "_agent" + std::to_string(k) + ".log"));
   }
   std::vector<Process*> all;
   for (auto& p : procs) all.push_back(&p);
@@ -78,12 +102,14 @@ std::vector<Process> run_across_hosts(const Hosts& hosts, const std::string& dir
 
 TEST(DdsNetns, RunAcrossNamespacesWithMulticastDiscovery) {
   std::string why;
-  if (!namespaces_available(&why)) GTEST_SKIP() << "network namespaces unavailable here, skipping: " << why;
+  if (!namespaces_available(&why))
+    GTEST_SKIP() << "network namespaces unavailable here, skipping: " << why;
   Hosts hosts(false);
   ASSERT_TRUE(hosts.ok()) << hosts.error();
   const std::string dir = temp_dir();
   const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 7));
-  auto procs = run_across_hosts(hosts, dir, graph, 151, "netns-mc-" + std::to_string(getpid()), 20, {});
+  auto procs =
+      run_across_hosts(hosts, dir, graph, 151, "netns-mc-" + std::to_string(getpid()), 20, {});
   for (auto& p : procs) EXPECT_EQ(p.exit_code, 0) << p.output();
   std::ifstream merged(dir + "/netns-mc-" + std::to_string(getpid()) + ".g2o");
   int lines = 0;
@@ -93,18 +119,21 @@ TEST(DdsNetns, RunAcrossNamespacesWithMulticastDiscovery) {
 
 TEST(DdsNetns, MulticastBlockedNeedsAndWorksWithInitialPeers) {
   std::string why;
-  if (!namespaces_available(&why)) GTEST_SKIP() << "network namespaces unavailable here, skipping: " << why;
+  if (!namespaces_available(&why))
+    GTEST_SKIP() << "network namespaces unavailable here, skipping: " << why;
   Hosts hosts(true);
   ASSERT_TRUE(hosts.ok()) << hosts.error();
   const std::string dir = temp_dir();
   const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 8));
   // Without peers nobody finds anybody: the coordinator times out naming every agent.
-  auto lonely = run_across_hosts(hosts, dir, graph, 152, "netns-nopeers-" + std::to_string(getpid()), 2, {});
+  auto lonely =
+      run_across_hosts(hosts, dir, graph, 152, "netns-nopeers-" + std::to_string(getpid()), 2, {});
   EXPECT_EQ(lonely[0].exit_code, 1);
-  EXPECT_NE(lonely[0].output().find("missing agent 0, 1, 2"), std::string::npos) << lonely[0].output();
+  EXPECT_NE(lonely[0].output().find("missing agent 0, 1, 2"), std::string::npos)
+      << lonely[0].output();
   // With the initial-peers list it works.
-  auto procs = run_across_hosts(hosts, dir, graph, 153, "netns-peers-" + std::to_string(getpid()), 20,
-                                {"--peers", hosts.addresses()});
+  auto procs = run_across_hosts(hosts, dir, graph, 153, "netns-peers-" + std::to_string(getpid()),
+                                20, {"--peers", hosts.addresses()});
   for (auto& p : procs) EXPECT_EQ(p.exit_code, 0) << p.output();
 }
 

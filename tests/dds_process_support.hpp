@@ -107,7 +107,8 @@ inline bool wait_all(std::vector<Process*> procs, double timeout_s) {
 /// measurements (noise free), with ids shuffled (fixed seed) so that contiguous id ranges
 /// are a poor partition and the multilevel partitioner moves poses between agents.
 /// Returns the g2o text; `poses` receives (x, y, theta) per id.
-inline std::string grid_graph_g2o(int side, unsigned seed, std::vector<std::array<double, 3>>* poses_out = nullptr) {
+inline std::string grid_graph_g2o(int side, unsigned seed,
+                                  std::vector<std::array<double, 3>>* poses_out = nullptr) {
   const int n = side * side;
   std::vector<int> id(n);
   for (int k = 0; k < n; ++k) id[k] = k;
@@ -119,7 +120,8 @@ inline std::string grid_graph_g2o(int side, unsigned seed, std::vector<std::arra
   std::string out;
   char buf[256];
   for (int k = 0; k < n; ++k) {
-    std::snprintf(buf, sizeof(buf), "VERTEX_SE2 %d %.17g %.17g %.17g\n", k, pose[k][0], pose[k][1], pose[k][2]);
+    std::snprintf(buf, sizeof(buf), "VERTEX_SE2 %d %.17g %.17g %.17g\n", k, pose[k][0], pose[k][1],
+                  pose[k][2]);
     out += buf;
   }
   auto edge = [&](int a, int b) {
@@ -127,8 +129,8 @@ inline std::string grid_graph_g2o(int side, unsigned seed, std::vector<std::arra
     const auto& pb = pose[b];
     const double dx = pb[0] - pa[0], dy = pb[1] - pa[1];
     const double c = std::cos(pa[2]), s = std::sin(pa[2]);
-    std::snprintf(buf, sizeof(buf), "EDGE_SE2 %d %d %.17g %.17g %.17g 100 0 0 100 0 400\n", a, b, c * dx + s * dy,
-                  -s * dx + c * dy, pb[2] - pa[2]);
+    std::snprintf(buf, sizeof(buf), "EDGE_SE2 %d %d %.17g %.17g %.17g 100 0 0 100 0 400\n", a, b,
+                  c * dx + s * dy, -s * dx + c * dy, pb[2] - pa[2]);
     out += buf;
   };
   for (int r = 0; r < side; ++r)
@@ -180,7 +182,8 @@ inline std::set<std::string> leaked_shm_files(const std::set<std::string>& befor
     const std::string& base = f;
     if (in_use.count(base)) continue;
     // Lock files ("_el") are held with flock, not mapped: they belong to a port in use.
-    if (base.size() > 3 && base.compare(base.size() - 3, 3, "_el") == 0 && in_use.count(base.substr(0, base.size() - 3)))
+    if (base.size() > 3 && base.compare(base.size() - 3, 3, "_el") == 0 &&
+        in_use.count(base.substr(0, base.size() - 3)))
       continue;
     out.insert(f);
   }

@@ -16,23 +16,32 @@ namespace {
 using namespace tessera::test;
 using namespace tessera::test::dds;
 
-std::string agent_bin() { return bin("tessera-agent"); }
-std::string coordinator_bin() { return bin("tessera-coordinator"); }
+std::string agent_bin() {
+  return bin("tessera-agent");
+}
+std::string coordinator_bin() {
+  return bin("tessera-coordinator");
+}
 
-std::string unique_run(const std::string& stem) { return stem + "-" + std::to_string(getpid()); }
+std::string unique_run(const std::string& stem) {
+  return stem + "-" + std::to_string(getpid());
+}
 
-std::vector<std::string> agent_args(const std::string& graph, int robots, int id, const std::string& run, int domain,
+std::vector<std::string> agent_args(const std::string& graph, int robots, int id,
+                                    const std::string& run, int domain,
                                     std::vector<std::string> extra = {}) {
-  std::vector<std::string> a = {agent_bin(), "--graph", graph, "--robots", std::to_string(robots),
-                                "--id", std::to_string(id), "--run-id", run, "--domain", std::to_string(domain)};
+  std::vector<std::string> a = {
+      agent_bin(),        "--graph",  graph, "--robots", std::to_string(robots), "--id",
+      std::to_string(id), "--run-id", run,   "--domain", std::to_string(domain)};
   a.insert(a.end(), extra.begin(), extra.end());
   return a;
 }
 
 std::vector<std::string> coordinator_args(int agents, const std::string& run, int domain,
                                           std::vector<std::string> extra = {}) {
-  std::vector<std::string> a = {coordinator_bin(), "--agents", std::to_string(agents), "--run-id", run,
-                                "--domain", std::to_string(domain)};
+  std::vector<std::string> a = {
+      coordinator_bin(),     "--agents", std::to_string(agents), "--run-id", run, "--domain",
+      std::to_string(domain)};
   a.insert(a.end(), extra.begin(), extra.end());
   return a;
 }
@@ -117,13 +126,14 @@ TEST(DdsRuntime, OneHostRunHandsOffEveryMeasurementAndMergesEveryPose) {
   const auto before = shm_files();
 
   Process coord = start(coordinator_args(3, run, domain,
-                                         {"--timeout", "20", "--output", dir + "/merged.g2o", "--summary",
-                                          dir + "/summary.json", "--verbose"}),
+                                         {"--timeout", "20", "--output", dir + "/merged.g2o",
+                                          "--summary", dir + "/summary.json", "--verbose"}),
                         dir + "/coordinator.log");
   std::vector<Process> agents;
   for (int k = 0; k < 3; ++k)
     agents.push_back(start(agent_args(graph, 3, k, run, domain,
-                                      {"--timeout", "20", "--dump-local", dir + "/local" + std::to_string(k) + ".txt"}),
+                                      {"--timeout", "20", "--dump-local",
+                                       dir + "/local" + std::to_string(k) + ".txt"}),
                            dir + "/agent" + std::to_string(k) + ".log"));
   std::vector<Process*> all = {&coord, &agents[0], &agents[1], &agents[2]};
   ASSERT_TRUE(wait_all(all, 30)) << "a process hung";
@@ -154,7 +164,8 @@ TEST(DdsRuntime, OneHostRunHandsOffEveryMeasurementAndMergesEveryPose) {
     for (int a = 0; a < 3; ++a) {
       const bool should = owner[i] == a || owner[j] == a;
       auto it = dumps[a].meas.find(static_cast<long>(k));
-      ASSERT_EQ(it != dumps[a].meas.end(), should) << "measurement #" << k << " (" << i << "," << j << ") at agent " << a;
+      ASSERT_EQ(it != dumps[a].meas.end(), should)
+          << "measurement #" << k << " (" << i << "," << j << ") at agent " << a;
       if (!should) continue;
       const auto& v = it->second;  // i j kappa tau R(4) t(2)
       ASSERT_EQ(v.size(), 10u);
@@ -199,8 +210,9 @@ TEST(DdsRuntime, TwoConcurrentRunsOnOneDomainDoNotMix) {
   for (const auto& [run, graph, n] : {std::make_tuple(unique_run("runA"), graph_a, 25),
                                       std::make_tuple(unique_run("runB"), graph_b, 36)}) {
     (void)n;
-    procs.push_back(start(coordinator_args(2, run, domain, {"--timeout", "20", "--output", dir + "/" + run + ".g2o"}),
-                          dir + "/" + run + "_coordinator.log"));
+    procs.push_back(start(
+        coordinator_args(2, run, domain, {"--timeout", "20", "--output", dir + "/" + run + ".g2o"}),
+        dir + "/" + run + "_coordinator.log"));
     for (int k = 0; k < 2; ++k)
       procs.push_back(start(agent_args(graph, 2, k, run, domain, {"--timeout", "20"}),
                             dir + "/" + run + "_agent" + std::to_string(k) + ".log"));
@@ -221,10 +233,12 @@ TEST(DdsRuntime, KilledAgentIsNamedAndEveryoneStopsNonZero) {
   const auto before = shm_files();
   // The coordinator waits for a 4th agent that never comes, so the others are mid-run
   // (waiting) when agent 1 is killed.
-  Process coord = start(coordinator_args(4, run, domain, {"--timeout", "30"}), dir + "/coordinator.log");
+  Process coord =
+      start(coordinator_args(4, run, domain, {"--timeout", "30"}), dir + "/coordinator.log");
   std::vector<Process> agents;
   for (int k = 0; k < 3; ++k)
-    agents.push_back(start(agent_args(graph, 4, k, run, domain, {"--timeout", "30"}), dir + "/agent" + std::to_string(k) + ".log"));
+    agents.push_back(start(agent_args(graph, 4, k, run, domain, {"--timeout", "30"}),
+                           dir + "/agent" + std::to_string(k) + ".log"));
   std::this_thread::sleep_for(std::chrono::milliseconds(2000));
   for (Process* p : {&coord, &agents[0], &agents[1], &agents[2]}) {
     int status;
@@ -254,9 +268,11 @@ void signal_one_process(int domain, const std::string& stem, int target, int sig
   const auto before = shm_files();
   // Three agents of four: everybody is waiting (mid-run) when the signal comes.
   std::vector<Process> procs;
-  procs.push_back(start(coordinator_args(4, run, domain, {"--timeout", "30"}), dir + "/coordinator.log"));
+  procs.push_back(
+      start(coordinator_args(4, run, domain, {"--timeout", "30"}), dir + "/coordinator.log"));
   for (int k = 0; k < 3; ++k)
-    procs.push_back(start(agent_args(graph, 4, k, run, domain, {"--timeout", "30"}), dir + "/agent" + std::to_string(k) + ".log"));
+    procs.push_back(start(agent_args(graph, 4, k, run, domain, {"--timeout", "30"}),
+                          dir + "/agent" + std::to_string(k) + ".log"));
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   kill(procs[target].pid, signo);
   std::vector<Process*> all;
@@ -294,9 +310,12 @@ TEST(DdsRuntime, AgentWithBadFileFailsClearlyAndTheOthersStop) {
   const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(5, 5));
   const std::string bad = write_file(dir, "bad.g2o", "VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 oops\n");
   const auto before = shm_files();
-  Process coord = start(coordinator_args(3, run, domain, {"--timeout", "30"}), dir + "/coordinator.log");
-  Process a0 = start(agent_args(graph, 3, 0, run, domain, {"--timeout", "30"}), dir + "/agent0.log");
-  Process a2 = start(agent_args(graph, 3, 2, run, domain, {"--timeout", "30"}), dir + "/agent2.log");
+  Process coord =
+      start(coordinator_args(3, run, domain, {"--timeout", "30"}), dir + "/coordinator.log");
+  Process a0 =
+      start(agent_args(graph, 3, 0, run, domain, {"--timeout", "30"}), dir + "/agent0.log");
+  Process a2 =
+      start(agent_args(graph, 3, 2, run, domain, {"--timeout", "30"}), dir + "/agent2.log");
   Process a1 = start(agent_args(bad, 3, 1, run, domain, {"--timeout", "30"}), dir + "/agent1.log");
   ASSERT_TRUE(wait_all({&coord, &a0, &a1, &a2}, 10)) << "a process hung";
   EXPECT_EQ(a1.exit_code, 2) << a1.output();
@@ -314,12 +333,16 @@ TEST(DdsRuntime, CoordinatorTimesOutNamingTheMissingAgents) {
   const int domain = 146;
   const std::string run = unique_run("missing");
   const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(5, 6));
-  Process coord = start(coordinator_args(3, run, domain, {"--timeout", "2"}), dir + "/coordinator.log");
-  Process a0 = start(agent_args(graph, 3, 0, run, domain, {"--timeout", "30"}), dir + "/agent0.log");
+  Process coord =
+      start(coordinator_args(3, run, domain, {"--timeout", "2"}), dir + "/coordinator.log");
+  Process a0 =
+      start(agent_args(graph, 3, 0, run, domain, {"--timeout", "30"}), dir + "/agent0.log");
   ASSERT_TRUE(wait_all({&coord, &a0}, 10));
   EXPECT_EQ(coord.exit_code, 1);
-  EXPECT_NE(coord.output().find("timed out after 2 s waiting for 3 agents"), std::string::npos) << coord.output();
-  EXPECT_NE(coord.output().find("missing agent 1, 2 (have agent 0)"), std::string::npos) << coord.output();
+  EXPECT_NE(coord.output().find("timed out after 2 s waiting for 3 agents"), std::string::npos)
+      << coord.output();
+  EXPECT_NE(coord.output().find("missing agent 1, 2 (have agent 0)"), std::string::npos)
+      << coord.output();
   EXPECT_EQ(a0.exit_code, 1) << a0.output();
 }
 

@@ -28,7 +28,8 @@ enum class WaitStatus {
 struct StopInfo {
   int exit_code = 1;
   std::string reason;
-  bool remote = false;  ///< Another process asked to stop (ABORT received): no need to tell the others.
+  bool remote =
+      false;  ///< Another process asked to stop (ABORT received): no need to tell the others.
 };
 
 class Mailroom {
@@ -48,7 +49,8 @@ class Mailroom {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!stop_ && !pending_)
         pending_ = Pending{StopInfo{exit_code, reason, false},
-                           std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(delay)};
+                           std::chrono::steady_clock::now() +
+                               std::chrono::duration_cast<std::chrono::nanoseconds>(delay)};
     }
     cv_.notify_all();
   }
@@ -61,7 +63,8 @@ class Mailroom {
 
   /// Waits until `pred()` holds (evaluated with the mailroom locked, so it may read inbox
   /// contents through the *_locked accessors), the run stops, or `timeout` passes.
-  WaitStatus wait_for(const std::function<bool()>& pred, Seconds timeout, bool interruptible = true) {
+  WaitStatus wait_for(const std::function<bool()>& pred, Seconds timeout,
+                      bool interruptible = true) {
     std::unique_lock<std::mutex> lock(mutex_);
     return wait_locked(lock, pred, timeout, interruptible);
   }
@@ -78,8 +81,8 @@ class Mailroom {
   /// `interruptible` false: a stop request does not end the wait (for leaving cleanly).
   WaitStatus wait_locked(std::unique_lock<std::mutex>& lock, const std::function<bool()>& pred,
                          Seconds timeout, bool interruptible = true) {
-    const auto deadline =
-        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(timeout);
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::nanoseconds>(timeout);
     for (;;) {
       promote_pending();
       if (stop_ && interruptible) return WaitStatus::kStopped;
@@ -102,7 +105,8 @@ class Mailroom {
   };
   // Requires mutex_ held.
   void promote_pending() const {
-    if (pending_ && !stop_ && std::chrono::steady_clock::now() >= pending_->at) stop_ = pending_->info;
+    if (pending_ && !stop_ && std::chrono::steady_clock::now() >= pending_->at)
+      stop_ = pending_->info;
   }
 
   mutable std::mutex mutex_;
@@ -131,7 +135,8 @@ class Inbox {
   /// Waits until `pred(queued messages)` holds, the run stops, or the timeout passes.
   WaitStatus wait_for(const std::function<bool(const std::deque<T>&)>& pred, Seconds timeout) {
     std::unique_lock<std::mutex> lock(room_.mutex());
-    return room_.wait_locked(lock, [&] { return pred(queue_); }, timeout);
+    return room_.wait_locked(
+        lock, [&] { return pred(queue_); }, timeout);
   }
 
   /// Removes the first queued message satisfying `match` into `*out`, waiting for one to
@@ -158,7 +163,9 @@ class Inbox {
   }
 
   /// Removes and returns every queued message satisfying `match` (no waiting).
-  std::vector<T> take_all(const std::function<bool(const T&)>& match = [](const T&) { return true; }) {
+  std::vector<T> take_all(const std::function<bool(const T&)>& match = [](const T&) {
+    return true;
+  }) {
     std::lock_guard<std::mutex> lock(room_.mutex());
     std::vector<T> out;
     for (auto it = queue_.begin(); it != queue_.end();) {

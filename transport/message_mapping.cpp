@@ -50,8 +50,9 @@ PoseBlockMessage from_wire(const wire::PoseBlock& w) {
   const std::size_t per = static_cast<std::size_t>(w.rank()) * (w.dim() + 1);
   require(w.data().size() == w.pose_ids().size() * per,
           "pose block from agent " + std::to_string(w.sender()) + " has " +
-              std::to_string(w.data().size()) + " values for " + std::to_string(w.pose_ids().size()) +
-              " poses of rank " + std::to_string(w.rank()) + " and dimension " + std::to_string(w.dim()));
+              std::to_string(w.data().size()) + " values for " +
+              std::to_string(w.pose_ids().size()) + " poses of rank " + std::to_string(w.rank()) +
+              " and dimension " + std::to_string(w.dim()));
   PoseBlockMessage m;
   m.round = w.round();
   m.sender = w.sender();
@@ -102,7 +103,8 @@ Pose pose_at(const std::vector<double>& flat, std::size_t k, int d) {
 
 wire::MeasurementHandoff to_wire_handoff(
     const std::string& run_id, std::uint32_t sender, std::uint32_t recipient, int d,
-    const std::vector<const Measurement*>& measurements, const std::vector<std::uint64_t>& measurement_index,
+    const std::vector<const Measurement*>& measurements,
+    const std::vector<std::uint64_t>& measurement_index,
     const std::vector<std::pair<std::uint32_t, const Pose*>>& poses) {
   wire::MeasurementHandoff w;
   w.run_id(run_id);
@@ -110,7 +112,8 @@ wire::MeasurementHandoff to_wire_handoff(
   w.recipient(recipient);
   w.dim(static_cast<std::uint32_t>(d));
   const std::size_t m = measurements.size();
-  if (measurement_index.size() != m) throw TransportError("hand-off: one index per measurement needed");
+  if (measurement_index.size() != m)
+    throw TransportError("hand-off: one index per measurement needed");
   w.meas_index(measurement_index);
   w.meas_i().reserve(m);
   w.meas_j().reserve(m);
@@ -140,9 +143,10 @@ HandoffContent from_wire(const wire::MeasurementHandoff& w) {
   const int d = static_cast<int>(w.dim());
   require(d == 2 || d == 3, "hand-off dimension " + std::to_string(w.dim()) + " is not 2 or 3");
   const std::size_t m = w.meas_i().size();
-  require(w.meas_index().size() == m && w.meas_j().size() == m && w.meas_R().size() == m * d * d && w.meas_t().size() == m * d &&
-              w.meas_kappa().size() == m && w.meas_tau().size() == m,
-          "hand-off from agent " + std::to_string(w.sender()) + ": measurement arrays differ in length");
+  require(w.meas_index().size() == m && w.meas_j().size() == m && w.meas_R().size() == m * d * d &&
+              w.meas_t().size() == m * d && w.meas_kappa().size() == m && w.meas_tau().size() == m,
+          "hand-off from agent " + std::to_string(w.sender()) +
+              ": measurement arrays differ in length");
   require(w.pose_data().size() == w.pose_ids().size() * d * (d + 1),
           "hand-off from agent " + std::to_string(w.sender()) + ": pose arrays differ in length");
   HandoffContent out;
@@ -168,9 +172,11 @@ HandoffContent from_wire(const wire::MeasurementHandoff& w) {
 
 std::vector<std::pair<std::uint32_t, Pose>> final_poses(const wire::FinalEstimate& w) {
   const int d = static_cast<int>(w.dim());
-  require(d == 2 || d == 3, "final estimate dimension " + std::to_string(w.dim()) + " is not 2 or 3");
-  require(w.pose_data().size() == w.pose_ids().size() * d * (d + 1),
-          "final estimate from agent " + std::to_string(w.sender()) + ": pose arrays differ in length");
+  require(d == 2 || d == 3,
+          "final estimate dimension " + std::to_string(w.dim()) + " is not 2 or 3");
+  require(
+      w.pose_data().size() == w.pose_ids().size() * d * (d + 1),
+      "final estimate from agent " + std::to_string(w.sender()) + ": pose arrays differ in length");
   std::vector<std::pair<std::uint32_t, Pose>> out;
   out.reserve(w.pose_ids().size());
   for (std::size_t k = 0; k < w.pose_ids().size(); ++k)

@@ -40,14 +40,14 @@ Pose pose_at(const std::vector<double>& flat, std::size_t k, int d);
 /// The content of a measurement hand-off, decoded.
 struct HandoffContent {
   std::vector<Measurement> measurements;
-  std::vector<std::uint64_t> measurement_index;  ///< Position of each in the original input.
+  std::vector<std::uint64_t> measurement_index;       ///< Position of each in the original input.
   std::vector<std::pair<std::uint32_t, Pose>> poses;  ///< Initial poses (id, pose).
 };
-wire::MeasurementHandoff to_wire_handoff(const std::string& run_id, std::uint32_t sender,
-                                         std::uint32_t recipient, int d,
-                                         const std::vector<const Measurement*>& measurements,
-                                         const std::vector<std::uint64_t>& measurement_index,
-                                         const std::vector<std::pair<std::uint32_t, const Pose*>>& poses);
+wire::MeasurementHandoff to_wire_handoff(
+    const std::string& run_id, std::uint32_t sender, std::uint32_t recipient, int d,
+    const std::vector<const Measurement*>& measurements,
+    const std::vector<std::uint64_t>& measurement_index,
+    const std::vector<std::pair<std::uint32_t, const Pose*>>& poses);
 HandoffContent from_wire(const wire::MeasurementHandoff& w);
 
 /// Poses (id, pose) of a final estimate.

@@ -1,11 +1,11 @@
 #include "transport/qos.hpp"
 
-#include <algorithm>
+#include <fastrtps/utils/IPLocator.h>
 
+#include <algorithm>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
-#include <fastrtps/utils/IPLocator.h>
 
 namespace tessera::transport {
 
@@ -59,7 +59,8 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
   // write() never blocks long: when the bounded history is full it returns and we retry
   // after waiting for acknowledgements (Session::Impl::write).
   q.reliability().max_blocking_time = Duration_t(0, 10000000);
-  q.durability().kind = transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  q.durability().kind =
+      transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
   // Bounded KEEP_ALL: unbounded limits let acknowledged samples pile up (hundreds of MB).
   q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
   q.resource_limits().max_samples = kWriterHistory;
@@ -72,25 +73,29 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
   q.liveliness().lease_duration = Duration_t(lease_s);
   q.liveliness().announcement_period = Duration_t(lease_s / 4.0);
   // Messages are variable-sized (unbounded sequences): size payloads per sample.
-  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+  q.endpoint().history_memory_policy =
+      eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return q;
 }
 
 dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_t num_agents) {
   dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  q.durability().kind =
+      transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
   q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
   // The listener takes every sample at once; room for a burst from every writer avoids
   // rejections (and their heartbeat-period resend delay) when all agents send together.
-  const std::int32_t limit = std::max<std::int32_t>(kWriterHistory, 4 * static_cast<std::int32_t>(num_agents));
+  const std::int32_t limit =
+      std::max<std::int32_t>(kWriterHistory, 4 * static_cast<std::int32_t>(num_agents));
   q.resource_limits().max_samples = limit;
   q.resource_limits().max_instances = 1;
   q.resource_limits().max_samples_per_instance = limit;
   q.resource_limits().allocated_samples = 4;
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
   q.liveliness().lease_duration = Duration_t(lease_s);
-  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+  q.endpoint().history_memory_policy =
+      eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return q;
 }
 

@@ -3,14 +3,13 @@
 // why each value). Internal to transport/: only session.cpp and tools include it.
 
 #include <cstdint>
-#include <string>
-#include <vector>
-
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
+#include <string>
+#include <vector>
 
 namespace tessera::transport {
 
@@ -19,15 +18,17 @@ constexpr std::int32_t kWriterHistory = 16;
 
 /// Participant: named, short lease so a dead peer is noticed within ~lease seconds,
 /// optional unicast initial peers (all participant ids up to num_agents + 2 on `domain`).
-eprosima::fastdds::dds::DomainParticipantQos participant_qos(const std::string& name, double lease_s,
-                                                             const std::vector<std::string>& initial_peers,
-                                                             int domain, std::uint32_t num_agents);
+eprosima::fastdds::dds::DomainParticipantQos participant_qos(
+    const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
+    int domain, std::uint32_t num_agents);
 /// Publisher / subscriber: Partition = run id.
 eprosima::fastdds::dds::PublisherQos publisher_qos(const std::string& run_id);
 eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);
 /// Reliable, bounded KEEP_ALL, 50 ms heartbeat, AUTOMATIC liveliness with `lease_s`.
 /// TRANSIENT_LOCAL for hand-shake topics (late joiners still get them), VOLATILE otherwise.
-eprosima::fastdds::dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_t num_agents);
-eprosima::fastdds::dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_t num_agents);
+eprosima::fastdds::dds::DataWriterQos writer_qos(bool transient_local, double lease_s,
+                                                 std::uint32_t num_agents);
+eprosima::fastdds::dds::DataReaderQos reader_qos(bool transient_local, double lease_s,
+                                                 std::uint32_t num_agents);
 
 }  // namespace tessera::transport

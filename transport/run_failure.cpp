@@ -5,8 +5,8 @@
 
 namespace tessera::transport {
 
-void expect_ready(WaitStatus status, const Mailroom& room, double timeout_s, const std::string& what,
-                  const std::string& detail) {
+void expect_ready(WaitStatus status, const Mailroom& room, double timeout_s,
+                  const std::string& what, const std::string& detail) {
   if (status == WaitStatus::kReady) return;
   if (status == WaitStatus::kStopped) {
     StopInfo stop = room.stop_info().value_or(StopInfo{kExitRunFailed, "stopped", false});

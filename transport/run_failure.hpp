@@ -29,8 +29,8 @@ class RunFailure : public std::runtime_error {
 
 /// Returns normally on kReady. Throws RunFailure with the stop reason on kStopped, and
 /// "timed out after <timeout> s waiting for <what>[: <detail>]" on kTimeout.
-void expect_ready(WaitStatus status, const Mailroom& room, double timeout_s, const std::string& what,
-                  const std::string& detail = "");
+void expect_ready(WaitStatus status, const Mailroom& room, double timeout_s,
+                  const std::string& what, const std::string& detail = "");
 
 /// "SIGINT", "SIGTERM" or "signal N".
 std::string signal_name(int signo);

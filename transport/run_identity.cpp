@@ -1,8 +1,9 @@
 #include "transport/run_identity.hpp"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstdlib>
-#include <unistd.h>
 
 #include "util/input_error.hpp"
 
@@ -44,7 +45,8 @@ std::optional<PeerIdentity> parse_participant_name(const std::string& name) {
   std::string rest = name.substr(prefix.size());
   PeerIdentity who;
   const std::string coord = ":coordinator";
-  if (rest.size() > coord.size() && rest.compare(rest.size() - coord.size(), coord.size(), coord) == 0) {
+  if (rest.size() > coord.size() &&
+      rest.compare(rest.size() - coord.size(), coord.size(), coord) == 0) {
     who.run_id = rest.substr(0, rest.size() - coord.size());
     who.coordinator = true;
     return who;

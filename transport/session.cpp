@@ -1,13 +1,12 @@
 #include "transport/session.hpp"
 
+#include <fastdds/rtps/common/InstanceHandle.h>
+#include <fastrtps/utils/IPLocator.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
-#include <map>
-#include <set>
-
 #include <fastdds/dds/core/status/StatusMask.hpp>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -22,8 +21,9 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
-#include <fastdds/rtps/common/InstanceHandle.h>
-#include <fastrtps/utils/IPLocator.h>
+#include <functional>
+#include <map>
+#include <set>
 
 #include "tesseraPubSubTypes.h"
 #include "transport/message_mapping.hpp"
@@ -40,13 +40,13 @@ using eprosima::fastrtps::types::ReturnCode_t;
 void SessionOptions::validate() const {
   validate_run_id(run_id);
   if (domain > kMaxDomain)
-    throw InputError("option --domain: " + std::to_string(domain) + " is above the highest usable domain " +
-                     std::to_string(kMaxDomain));
+    throw InputError("option --domain: " + std::to_string(domain) +
+                     " is above the highest usable domain " + std::to_string(kMaxDomain));
   if (num_agents < 1 || num_agents > 1000)
     throw InputError("number of agents must be 1..1000, got " + std::to_string(num_agents));
   if (!coordinator && agent_id >= num_agents)
-    throw InputError("option --id: " + std::to_string(agent_id) + " is not below the number of agents " +
-                     std::to_string(num_agents));
+    throw InputError("option --id: " + std::to_string(agent_id) +
+                     " is not below the number of agents " + std::to_string(num_agents));
   if (!(lease_s >= 0.2 && lease_s <= 60))
     throw InputError("option --lease: " + std::to_string(lease_s) + " s is outside 0.2..60 s");
   if (!(write_timeout_s > 0)) throw InputError("write timeout must be positive");
@@ -68,7 +68,9 @@ constexpr const char* kControlTopic = "tessera_control";
 
 using Prefix = rtps::GuidPrefix_t;
 
-Prefix prefix_of(const rtps::InstanceHandle_t& handle) { return rtps::iHandle2GUID(handle).guidPrefix; }
+Prefix prefix_of(const rtps::InstanceHandle_t& handle) {
+  return rtps::iHandle2GUID(handle).guidPrefix;
+}
 
 // Which peers an endpoint must match before the readiness barrier can pass.
 enum class Expect { kNone, kOtherAgents, kOtherAgentsAndCoordinator, kCoordinator, kAllAgents };
@@ -90,7 +92,8 @@ struct Session::Impl {
   // State below is guarded by room.mutex().
   std::map<Prefix, PeerIdentity> peers;  // participants of this run, by GUID prefix
   std::set<Prefix> lost;
-  std::map<std::string, std::multiset<Prefix>> matched;  // endpoint name -> matched remote participants
+  std::map<std::string, std::multiset<Prefix>>
+      matched;  // endpoint name -> matched remote participants
   std::map<std::string, Expect> expect;
   std::set<std::string> ready_from;  // describe() of peers that published READY
   bool finished_flag = false;
@@ -110,8 +113,10 @@ struct Session::Impl {
   struct ParticipantListener : dds::DomainParticipantListener {
     Impl* s;
     explicit ParticipantListener(Impl* impl) : s(impl) {}
-    void on_participant_discovery(dds::DomainParticipant*, rtps::ParticipantDiscoveryInfo&& info) override {
-      s->on_participant(info.status, info.info.m_guid.guidPrefix, info.info.m_participantName.to_string());
+    void on_participant_discovery(dds::DomainParticipant*,
+                                  rtps::ParticipantDiscoveryInfo&& info) override {
+      s->on_participant(info.status, info.info.m_guid.guidPrefix,
+                        info.info.m_participantName.to_string());
     }
   };
 
@@ -119,7 +124,8 @@ struct Session::Impl {
     Impl* s;
     std::string name;
     WriterListener(Impl* impl, std::string n) : s(impl), name(std::move(n)) {}
-    void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& st) override {
+    void on_publication_matched(dds::DataWriter*,
+                                const dds::PublicationMatchedStatus& st) override {
       s->on_matched(name, prefix_of(st.last_subscription_handle), st.current_count_change);
     }
   };
@@ -131,11 +137,13 @@ struct Session::Impl {
     ReaderListener(Impl* impl, std::string n, std::function<void(dds::DataReader*)> fn)
         : s(impl), name(std::move(n)), drain(std::move(fn)) {}
     void on_data_available(dds::DataReader* reader) override { drain(reader); }
-    void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& st) override {
+    void on_subscription_matched(dds::DataReader*,
+                                 const dds::SubscriptionMatchedStatus& st) override {
       s->on_matched(name, prefix_of(st.last_publication_handle), st.current_count_change);
     }
     void on_liveliness_changed(dds::DataReader*, const dds::LivelinessChangedStatus& st) override {
-      if (st.not_alive_count_change > 0) s->on_liveliness_lost(prefix_of(st.last_publication_handle));
+      if (st.not_alive_count_change > 0)
+        s->on_liveliness_lost(prefix_of(st.last_publication_handle));
     }
   };
 
@@ -157,12 +165,15 @@ struct Session::Impl {
           if (p != prefix && !lost.count(p) && id.coordinator == who->coordinator &&
               id.agent_id == who->agent_id)
             clash = who->describe();
-        if (!who->coordinator && who->agent_id == me.agent_id && !me.coordinator) clash = who->describe();
+        if (!who->coordinator && who->agent_id == me.agent_id && !me.coordinator)
+          clash = who->describe();
         if (who->coordinator && me.coordinator) clash = who->describe();
         peers[prefix] = *who;
         return 0;
       });
-      if (opt.verbose) std::fprintf(stderr, "%s: discovered %s\n", participant_name(me).c_str(), who->describe().c_str());
+      if (opt.verbose)
+        std::fprintf(stderr, "%s: discovered %s\n", participant_name(me).c_str(),
+                     who->describe().c_str());
       room.notify();
       if (!clash.empty())
         room.request_stop(2, "two processes claim to be " + clash + " of run '" + opt.run_id +
@@ -171,14 +182,16 @@ struct Session::Impl {
       peer_gone(prefix, "left the run", /*graceful=*/true);
     } else if (status == rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
       char buf[96];
-      std::snprintf(buf, sizeof(buf), "stopped responding (participant lease of %.1f s expired)", opt.lease_s);
+      std::snprintf(buf, sizeof(buf), "stopped responding (participant lease of %.1f s expired)",
+                    opt.lease_s);
       peer_gone(prefix, buf);
     }
   }
 
   void on_liveliness_lost(const Prefix& prefix) {
     char buf[96];
-    std::snprintf(buf, sizeof(buf), "stopped responding (writer liveliness of %.1f s lost)", opt.lease_s);
+    std::snprintf(buf, sizeof(buf), "stopped responding (writer liveliness of %.1f s lost)",
+                  opt.lease_s);
     peer_gone(prefix, buf);
   }
 
@@ -196,7 +209,8 @@ struct Session::Impl {
     });
     if (!who) return;
     if (opt.verbose)
-      std::fprintf(stderr, "%s: lost %s: %s\n", participant_name(me).c_str(), who->describe().c_str(), how.c_str());
+      std::fprintf(stderr, "%s: lost %s: %s\n", participant_name(me).c_str(),
+                   who->describe().c_str(), how.c_str());
     room.notify();
     if (!fatal) return;
     const std::string why = "lost " + who->describe() + " of run '" + opt.run_id + "': it " + how;
@@ -312,17 +326,19 @@ struct Session::Impl {
         try {
           deliver(std::move(sample));
         } catch (const std::exception& ex) {
-          room.request_stop(1, std::string("received a bad message on ") + reader->get_topicdescription()->get_name() +
-                                   ": " + ex.what());
+          room.request_stop(1, std::string("received a bad message on ") +
+                                   reader->get_topicdescription()->get_name() + ": " + ex.what());
         }
         sample = T();
       }
     };
     reader_listeners.push_back(std::make_unique<ReaderListener>(this, name + "/r", drain));
-    dds::StatusMask mask = dds::StatusMask::data_available() << dds::StatusMask::subscription_matched()
-                                                           << dds::StatusMask::liveliness_changed();
-    dds::DataReader* r = subscriber->create_datareader(
-        t, reader_qos(transient_local, opt.lease_s, opt.num_agents), reader_listeners.back().get(), mask);
+    dds::StatusMask mask = dds::StatusMask::data_available()
+                           << dds::StatusMask::subscription_matched()
+                           << dds::StatusMask::liveliness_changed();
+    dds::DataReader* r =
+        subscriber->create_datareader(t, reader_qos(transient_local, opt.lease_s, opt.num_agents),
+                                      reader_listeners.back().get(), mask);
     if (!r) throw TransportError("cannot create DDS reader for " + name);
     readers.push_back(r);
     if (e != Expect::kNone) expect[name + "/r"] = e;
@@ -335,8 +351,9 @@ struct Session::Impl {
       throw TransportError("this " + std::string(me.coordinator ? "coordinator" : "agent") +
                            " does not write " + name);
     dds::DataWriter* w = it->second;
-    const auto deadline = std::chrono::steady_clock::now() +
-                          std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(opt.write_timeout_s));
+    const auto deadline =
+        std::chrono::steady_clock::now() +
+        std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(opt.write_timeout_s));
     for (;;) {
       // The handle overload reports why a write failed (the plain one only returns a bool).
       ReturnCode_t rc = w->write(const_cast<T*>(&sample), rtps::c_InstanceHandle_Unknown);
@@ -346,8 +363,10 @@ struct Session::Impl {
         return;
       }
       if (rc == ReturnCode_t::RETCODE_BAD_PARAMETER || rc == ReturnCode_t::RETCODE_NOT_ENABLED ||
-          rc == ReturnCode_t::RETCODE_PRECONDITION_NOT_MET || rc == ReturnCode_t::RETCODE_ILLEGAL_OPERATION)
-        throw TransportError("DDS write on " + name + " failed (return code " + std::to_string(rc()) + ")");
+          rc == ReturnCode_t::RETCODE_PRECONDITION_NOT_MET ||
+          rc == ReturnCode_t::RETCODE_ILLEGAL_OPERATION)
+        throw TransportError("DDS write on " + name + " failed (return code " +
+                             std::to_string(rc()) + ")");
       // Most likely the bounded history is full of unacknowledged samples (2.9 reports that
       // as OUT_OF_RESOURCES, TIMEOUT or ERROR): wait for acknowledgements (not a busy loop),
       // then try again, until the deadline.
@@ -382,7 +401,8 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   Impl& s = *impl_;
   s.opt = options;
   s.domain = options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
-  s.me = PeerIdentity{options.run_id, options.coordinator, options.coordinator ? 0u : options.agent_id};
+  s.me = PeerIdentity{options.run_id, options.coordinator,
+                      options.coordinator ? 0u : options.agent_id};
 
   // TESSERA_DDS_LOG=1 shows Fast DDS's own warnings and errors (for diagnosing QoS trouble).
   if (const char* env = std::getenv("TESSERA_DDS_LOG"); env && *env && *env != '0')
@@ -390,8 +410,9 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   s.participant_listener = std::make_unique<Impl::ParticipantListener>(&s);
   auto* factory = dds::DomainParticipantFactory::get_instance();
   s.participant = factory->create_participant(
-      s.domain, participant_qos(participant_name(s.me), options.lease_s, options.initial_peers, s.domain,
-                                options.num_agents),
+      s.domain,
+      participant_qos(participant_name(s.me), options.lease_s, options.initial_peers, s.domain,
+                      options.num_agents),
       s.participant_listener.get(), dds::StatusMask::none());
   if (!s.participant)
     throw TransportError("cannot create a DDS participant on domain " + std::to_string(s.domain));
@@ -399,24 +420,29 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   try {
     s.publisher = s.participant->create_publisher(publisher_qos(options.run_id));
     s.subscriber = s.participant->create_subscriber(subscriber_qos(options.run_id));
-    if (!s.publisher || !s.subscriber) throw TransportError("cannot create DDS publisher/subscriber");
+    if (!s.publisher || !s.subscriber)
+      throw TransportError("cannot create DDS publisher/subscriber");
 
     const std::uint32_t me = s.me.agent_id;
     if (options.coordinator) {
       s.make_writer<wire::PartitionAssignmentPubSubType>(kAssignmentTopic, true, Expect::kNone);
       s.make_writer<wire::ControlPubSubType>(kControlTopic, true, Expect::kNone);
       s.make_reader<wire::AgentAnnouncementPubSubType, wire::AgentAnnouncement>(
-          kAnnounceTopic, true, Expect::kNone, [&s](wire::AgentAnnouncement&& m) { s.announce_in.push(std::move(m)); });
+          kAnnounceTopic, true, Expect::kNone,
+          [&s](wire::AgentAnnouncement&& m) { s.announce_in.push(std::move(m)); });
       s.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
-          kStatusTopic, false, Expect::kAllAgents, [&s](wire::RoundStatus&& m) { s.status_in.push(std::move(m)); });
+          kStatusTopic, false, Expect::kAllAgents,
+          [&s](wire::RoundStatus&& m) { s.status_in.push(std::move(m)); });
       s.make_reader<wire::FinalEstimatePubSubType, wire::FinalEstimate>(
-          kFinalTopic, false, Expect::kAllAgents, [&s](wire::FinalEstimate&& m) { s.final_in.push(std::move(m)); });
+          kFinalTopic, false, Expect::kAllAgents,
+          [&s](wire::FinalEstimate&& m) { s.final_in.push(std::move(m)); });
     } else {
       s.make_writer<wire::AgentAnnouncementPubSubType>(kAnnounceTopic, true, Expect::kNone);
       s.make_writer<wire::ControlPubSubType>(kControlTopic, true, Expect::kNone);
       s.make_writer<wire::MeasurementHandoffPubSubType>(kHandoffTopic, false, Expect::kOtherAgents);
       s.make_writer<wire::PoseBlockPubSubType>(kBlockTopic, false, Expect::kOtherAgents);
-      s.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false, Expect::kOtherAgentsAndCoordinator);
+      s.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false,
+                                                 Expect::kOtherAgentsAndCoordinator);
       s.make_writer<wire::FinalEstimatePubSubType>(kFinalTopic, false, Expect::kCoordinator);
       s.make_reader<wire::PartitionAssignmentPubSubType, wire::PartitionAssignment>(
           kAssignmentTopic, true, Expect::kNone,
@@ -441,7 +467,8 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
     s.make_reader<wire::ControlPubSubType, wire::Control>(
         kControlTopic, true, Expect::kNone, [&s, self_id](wire::Control&& m) {
           if (m.sender() == self_id) return;
-          PeerIdentity from{s.opt.run_id, m.sender() == kCoordinatorId, m.sender() == kCoordinatorId ? 0u : m.sender()};
+          PeerIdentity from{s.opt.run_id, m.sender() == kCoordinatorId,
+                            m.sender() == kCoordinatorId ? 0u : m.sender()};
           switch (m.kind()) {
             case wire::CONTROL_READY:
               s.room.with_lock([&] { return s.ready_from.insert(from.describe()).second; });
@@ -452,7 +479,8 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
               s.room.notify();
               break;
             case wire::CONTROL_ABORT:
-              s.room.request_stop(1, from.describe() + " aborted run '" + s.opt.run_id + "': " + m.reason(), true);
+              s.room.request_stop(
+                  1, from.describe() + " aborted run '" + s.opt.run_id + "': " + m.reason(), true);
               break;
           }
         });
@@ -462,32 +490,62 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   }
 }
 
-Session::~Session() { close(); }
+Session::~Session() {
+  close();
+}
 
-const SessionOptions& Session::options() const { return impl_->opt; }
-int Session::domain() const { return impl_->domain; }
-PeerIdentity Session::self() const { return impl_->me; }
-Mailroom& Session::mailroom() { return impl_->room; }
+const SessionOptions& Session::options() const {
+  return impl_->opt;
+}
+int Session::domain() const {
+  return impl_->domain;
+}
+PeerIdentity Session::self() const {
+  return impl_->me;
+}
+Mailroom& Session::mailroom() {
+  return impl_->room;
+}
 
-Inbox<wire::AgentAnnouncement>& Session::announcements() { return impl_->announce_in; }
-Inbox<wire::PartitionAssignment>& Session::assignments() { return impl_->assignment_in; }
-Inbox<wire::MeasurementHandoff>& Session::handoffs() { return impl_->handoff_in; }
-Inbox<ProtocolMessage>& Session::protocol() { return impl_->protocol_in; }
-Inbox<wire::RoundStatus>& Session::status_watch() { return impl_->status_in; }
-Inbox<wire::FinalEstimate>& Session::finals() { return impl_->final_in; }
+Inbox<wire::AgentAnnouncement>& Session::announcements() {
+  return impl_->announce_in;
+}
+Inbox<wire::PartitionAssignment>& Session::assignments() {
+  return impl_->assignment_in;
+}
+Inbox<wire::MeasurementHandoff>& Session::handoffs() {
+  return impl_->handoff_in;
+}
+Inbox<ProtocolMessage>& Session::protocol() {
+  return impl_->protocol_in;
+}
+Inbox<wire::RoundStatus>& Session::status_watch() {
+  return impl_->status_in;
+}
+Inbox<wire::FinalEstimate>& Session::finals() {
+  return impl_->final_in;
+}
 
-void Session::publish(const wire::AgentAnnouncement& m) { impl_->write(kAnnounceTopic, m); }
-void Session::publish(const wire::PartitionAssignment& m) { impl_->write(kAssignmentTopic, m); }
-void Session::publish(const wire::MeasurementHandoff& m) { impl_->write(kHandoffTopic, m); }
-void Session::publish(const wire::FinalEstimate& m) { impl_->write(kFinalTopic, m); }
+void Session::publish(const wire::AgentAnnouncement& m) {
+  impl_->write(kAnnounceTopic, m);
+}
+void Session::publish(const wire::PartitionAssignment& m) {
+  impl_->write(kAssignmentTopic, m);
+}
+void Session::publish(const wire::MeasurementHandoff& m) {
+  impl_->write(kHandoffTopic, m);
+}
+void Session::publish(const wire::FinalEstimate& m) {
+  impl_->write(kFinalTopic, m);
+}
 
 void Session::send(const OutgoingMessage& m) {
   const std::string& run = impl_->opt.run_id;
   if (const auto* block = std::get_if<PoseBlockMessage>(&m.message)) {
     impl_->write(kBlockTopic, to_wire_block(*block, run, m.broadcast, m.recipients));
   } else {
-    impl_->write(kStatusTopic,
-                 to_wire_status(std::get<RoundStatusMessage>(m.message), run, m.broadcast, m.recipients));
+    impl_->write(kStatusTopic, to_wire_status(std::get<RoundStatusMessage>(m.message), run,
+                                              m.broadcast, m.recipients));
   }
 }
 
@@ -516,13 +574,15 @@ WaitStatus Session::ready_barrier(Seconds timeout, std::string* missing) {
   }
   send_control(wire::CONTROL_READY);
   std::vector<PeerIdentity> others = s.expected_peers(Expect::kOtherAgents);
-  if (!s.me.coordinator && s.opt.expect_coordinator) others.push_back(PeerIdentity{s.opt.run_id, true, 0});
+  if (!s.me.coordinator && s.opt.expect_coordinator)
+    others.push_back(PeerIdentity{s.opt.run_id, true, 0});
   const Seconds left = timeout - (std::chrono::steady_clock::now() - start);
   st = s.room.wait_for(
       [&] {
         absent.clear();
         for (const auto& p : others)
-          if (!s.ready_from.count(p.describe())) absent += (absent.empty() ? "" : ", ") + p.describe();
+          if (!s.ready_from.count(p.describe()))
+            absent += (absent.empty() ? "" : ", ") + p.describe();
         return absent.empty();
       },
       left);
@@ -557,10 +617,12 @@ void Session::set_peer_loss_fatal(bool fatal) {
 }
 
 void Session::flush(Seconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(timeout);
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::nanoseconds>(timeout);
   for (auto& [name, w] : impl_->writers) {
     (void)name;
-    double left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+    double left =
+        std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
     if (left <= 0) return;
     w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(left));
   }
@@ -570,7 +632,8 @@ void Session::linger_for_control(Seconds timeout) {
   Impl& s = *impl_;
   const auto start = std::chrono::steady_clock::now();
   std::vector<PeerIdentity> others = s.expected_peers(Expect::kOtherAgents);
-  if (!s.me.coordinator && s.opt.expect_coordinator) others.push_back(PeerIdentity{s.opt.run_id, true, 0});
+  if (!s.me.coordinator && s.opt.expect_coordinator)
+    others.push_back(PeerIdentity{s.opt.run_id, true, 0});
   const std::string endpoint = std::string(kControlTopic) + "/w";
   // Every expected peer has matched our control writer or is gone; with `include_unseen`
   // false, peers never discovered are not waited for.
@@ -592,11 +655,13 @@ void Session::linger_for_control(Seconds timeout) {
   };
   // A peer never seen may still be starting: wait for it, but only about a second.
   const Seconds first = std::min(timeout, Seconds(1.0));
-  if (s.room.wait_for([&] { return reached(true); }, first, /*interruptible=*/false) != WaitStatus::kReady)
+  if (s.room.wait_for([&] { return reached(true); }, first, /*interruptible=*/false) !=
+      WaitStatus::kReady)
     s.room.wait_for([&] { return reached(false); }, timeout - first, /*interruptible=*/false);
   const double left = (timeout - (std::chrono::steady_clock::now() - start)).count();
   auto w = s.writers.find(kControlTopic);
-  if (left > 0 && w != s.writers.end()) w->second->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(left));
+  if (left > 0 && w != s.writers.end())
+    w->second->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(left));
 }
 
 SessionStats Session::stats() const {

@@ -49,7 +49,7 @@ struct SessionOptions {
 
 /// Counters of one session (this process).
 struct SessionStats {
-  std::uint64_t bytes_sent = 0;     ///< Serialized payload bytes written (all topics).
+  std::uint64_t bytes_sent = 0;  ///< Serialized payload bytes written (all topics).
   std::uint64_t messages_sent = 0;
   std::uint64_t write_retries = 0;  ///< Writes that found the history full and waited.
 };
@@ -76,8 +76,8 @@ class Session {
   /// Agents: pose blocks and round statuses addressed to this agent (own messages excluded),
   /// converted to core's types, in arrival order per topic.
   Inbox<ProtocolMessage>& protocol();
-  Inbox<wire::RoundStatus>& status_watch();         ///< Coordinator: every round status (progress).
-  Inbox<wire::FinalEstimate>& finals();             ///< Coordinator.
+  Inbox<wire::RoundStatus>& status_watch();  ///< Coordinator: every round status (progress).
+  Inbox<wire::FinalEstimate>& finals();      ///< Coordinator.
 
   // ---- sending (retries while the history is full; throws TransportError after write_timeout_s)
   void publish(const wire::AgentAnnouncement& m);

@@ -1,8 +1,9 @@
 #include "transport/signal_watcher.hpp"
 
+#include <pthread.h>
+
 #include <csignal>
 #include <cstdlib>
-#include <pthread.h>
 
 namespace tessera::transport {
 
@@ -40,7 +41,9 @@ void SignalWatcher::start(std::function<void(int)> on_signal) {
   });
 }
 
-SignalWatcher::~SignalWatcher() { stop(); }
+SignalWatcher::~SignalWatcher() {
+  stop();
+}
 
 void SignalWatcher::stop() {
   if (thread_.joinable()) {
@@ -49,6 +52,8 @@ void SignalWatcher::stop() {
   }
 }
 
-int exit_code_for_signal(int signo) { return 128 + signo; }
+int exit_code_for_signal(int signo) {
+  return 128 + signo;
+}
 
 }  // namespace tessera::transport

@@ -29,9 +29,12 @@ int main(int argc, char** argv) {
   std::string run = "ping";
   double timeout = 20;
   try {
-    cli::Arguments args(argv_list, {"role", "poses", "rank", "dim", "count", "domain", "run-id", "timeout"}, {"help"});
+    cli::Arguments args(argv_list,
+                        {"role", "poses", "rank", "dim", "count", "domain", "run-id", "timeout"},
+                        {"help"});
     if (args.has("help")) {
-      std::cout << "usage: tessera-dds-ping --role ping|echo [--poses 1000] [--rank 5] [--dim 3] [--count 100]\n"
+      std::cout << "usage: tessera-dds-ping --role ping|echo [--poses 1000] [--rank 5] [--dim 3] "
+                   "[--count 100]\n"
                    "                        [--domain 200] [--run-id ping] [--timeout 20]\n";
       return 0;
     }
@@ -59,7 +62,8 @@ int main(int argc, char** argv) {
   so.num_agents = 2;
   so.expect_coordinator = false;
   Session s(so);
-  signals.start([&s](int signo) { s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted"); });
+  signals.start(
+      [&s](int signo) { s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted"); });
   auto ms_since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
   };
@@ -99,11 +103,15 @@ int main(int argc, char** argv) {
     }
     if (pinger && code == 0) {
       std::sort(rtt.begin(), rtt.end());
-      auto q = [&](double f) { return rtt[std::min(rtt.size() - 1, static_cast<std::size_t>(f * rtt.size()))]; };
-      std::printf("discovery_ms=%.1f poses=%ld rank=%ld dim=%ld bytes=%zu count=%ld rtt_p50_ms=%.3f rtt_p90_ms=%.3f "
-                  "rtt_max_ms=%.3f\n",
-                  discovery_ms, poses, rank, dim, block.data.size() * 8 + block.pose_ids.size() * 4, count, q(0.5),
-                  q(0.9), rtt.back());
+      auto q = [&](double f) {
+        return rtt[std::min(rtt.size() - 1, static_cast<std::size_t>(f * rtt.size()))];
+      };
+      std::printf(
+          "discovery_ms=%.1f poses=%ld rank=%ld dim=%ld bytes=%zu count=%ld rtt_p50_ms=%.3f "
+          "rtt_p90_ms=%.3f "
+          "rtt_max_ms=%.3f\n",
+          discovery_ms, poses, rank, dim, block.data.size() * 8 + block.pose_ids.size() * 4, count,
+          q(0.5), q(0.9), rtt.back());
     } else if (!pinger) {
       std::printf("echo discovery_ms=%.1f\n", discovery_ms);
     }
