@@ -287,6 +287,56 @@ TEST(G2oReader, StreamAndFileVariants) {
   EXPECT_EQ(h.source, path);
 }
 
+TEST(G2oReader, StreamThroughSmallBuffersEqualsInMemory) {
+  // Lines straddle the read buffer's end, and one line is longer than the whole buffer.
+  std::string text = "\xEF\xBB\xBFVERTEX_SE2 0 0 0 0\n\n";
+  for (int k = 1; k < 60; ++k)
+    text += "VERTEX_SE2 " + std::to_string(k) + " " + std::to_string(k * 0.37) + " 0 0.1\n";
+  for (int k = 0; k + 1 < 60; ++k) text += edge2(k, k + 1) + "   \r\n";
+  text += "EDGE_SE2 0 59 " + std::string(300, '0') + "1.5 0 0" + kInfo2;  // no final newline
+  const auto expected = read(text);
+  EXPECT_EQ(expected.graph.num_measurements(), 60u);
+  EXPECT_DOUBLE_EQ(expected.graph.measurements.back().t(0), 1.5);
+  for (std::size_t chunk : {1, 2, 7, 64, 100, 4096, 65536}) {
+    G2oReadOptions options;
+    options.read_chunk_bytes = chunk;
+    std::istringstream in(text);
+    const auto r = tessera::read_g2o_stream(in, "t.g2o", options);
+    ASSERT_EQ(r.graph.num_measurements(), expected.graph.num_measurements()) << chunk;
+    EXPECT_EQ(r.graph.num_poses, 60u);
+    EXPECT_EQ(r.stats.lines, expected.stats.lines) << chunk;
+    EXPECT_EQ(r.stats.blank_lines, 60u) << chunk;  // one empty, 59 whitespace-only
+    for (std::size_t k = 0; k < r.graph.num_measurements(); ++k) {
+      EXPECT_EQ(r.graph.measurements[k].t, expected.graph.measurements[k].t) << chunk;
+      EXPECT_EQ(r.graph.measurements[k].i, expected.graph.measurements[k].i) << chunk;
+    }
+    for (std::size_t k = 0; k < 60; ++k)
+      EXPECT_EQ(r.graph.initial[k].t, expected.graph.initial[k].t) << chunk;
+  }
+  // Errors name the same line whatever the buffer size.
+  G2oReadOptions tiny;
+  tiny.read_chunk_bytes = 3;
+  std::istringstream bad(edge2(0, 1) + "\n" + edge2(1, 1));
+  try {
+    tessera::read_g2o_stream(bad, "t.g2o", tiny);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "t.g2o:3: self-loop: edge from pose 1 to itself");
+  }
+}
+
+TEST(G2oReader, OptionsValidated) {
+  G2oReadOptions options;
+  options.read_chunk_bytes = 0;
+  EXPECT_THROW(options.validate(), InputError);
+  try {
+    read(edge2(0, 1), options);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("read_chunk_bytes"), std::string::npos) << e.what();
+  }
+}
+
 TEST(G2oReader, DisconnectedAllowedOnRequest) {
   G2oReadOptions options;
   options.allow_disconnected = true;

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include "graph/connectivity.hpp"
@@ -175,22 +176,25 @@ Eigen::MatrixXd rotation_from_quaternion(double x, double y, double z, double w)
 
 class Parser {
  public:
-  Parser(std::string_view text, const std::string& name, const G2oReadOptions& options)
-      : text_(text), name_(name), options_(options) {}
-
-  G2oReadResult run() {
+  Parser(const std::string& name, const G2oReadOptions& options, std::size_t size_hint)
+      : name_(name), options_(options) {
     options_.validate();
     result_.graph.source = name_;
-    // A UTF-8 byte-order mark from some editors is not part of the first tag.
-    if (text_.size() >= 3 && text_.compare(0, 3, "\xEF\xBB\xBF") == 0) text_.remove_prefix(3);
-    const char* p = text_.data();
-    const char* const end = p + text_.size();
-    // One measurement per line at most: reserving avoids moving them while growing.
-    std::size_t lines = 1;
-    for (const char* q = p; (q = static_cast<const char*>(std::memchr(q, '\n', end - q))); ++q)
-      ++lines;
-    // (An EDGE line has at least 30 bytes, so a file of empty lines reserves little.)
-    result_.graph.measurements.reserve(std::min(lines, text_.size() / 30 + 1));
+    // An EDGE line has at least 30 bytes: reserving for that many measurements avoids moving
+    // them while the vector grows (untouched capacity costs no memory pages).
+    const std::size_t max_edges = std::min<std::size_t>(size_hint / 30 + 1, 1 << 22);
+    result_.graph.measurements.reserve(max_edges);
+    edge_lines_.reserve(max_edges);
+    vertices_.reserve(std::min<std::size_t>(size_hint / 18 + 1, 1 << 22));  // VERTEX_SE2 0 0 0 0
+  }
+
+  /// Parses whole lines [p, end): each ends with '\n', except a last line of the input.
+  void feed(const char* p, const char* end) {
+    if (!bom_checked_ && p < end) {  // (the first non-empty call holds a whole line)
+      bom_checked_ = true;
+      // A UTF-8 byte-order mark from some editors is not part of the first tag.
+      if (end - p >= 3 && std::memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;
+    }
     while (p < end) {
       const auto* nl = static_cast<const char*>(std::memchr(p, '\n', end - p));
       const char* eol = nl ? nl : end;
@@ -198,8 +202,11 @@ class Parser {
       parse_line(p, eol);
       p = nl ? nl + 1 : end;
     }
+  }
+
+  G2oReadResult finish() {
     stats().lines = line_;
-    finish();
+    check_graph();
     return std::move(result_);
   }
 
@@ -362,7 +369,7 @@ class Parser {
     ++stats().edge_lines;
   }
 
-  void finish() {
+  void check_graph() {
     auto& g = result_.graph;
     if (g.measurements.empty())
       fail(0, line_ == 0 ? "empty file: no pose-graph edges"
@@ -491,11 +498,11 @@ class Parser {
     stats().parallel_edges = ms.size() - distinct;
   }
 
-  std::string_view text_;
   const std::string& name_;
   const G2oReadOptions& options_;
   G2oReadResult result_;
   std::size_t line_ = 0;
+  bool bom_checked_ = false;
   std::array<std::string_view, kMaxTokens> tok_{};
   std::size_t count_ = 0;
   std::array<double, 30> vals_{};
@@ -506,50 +513,89 @@ class Parser {
   std::vector<std::size_t> edge_lines_;
 };
 
+// Parses what `read_some(buffer, capacity)` delivers (it returns the bytes read, 0 at the
+// end) through one reused buffer, whole lines at a time, so the input never sits in memory
+// as a whole: fresh memory pages are expensive on small VMs, and a few MB of file would
+// cost more in page faults than the parsing itself.
+template <class ReadSome>
+G2oReadResult parse_chunks(ReadSome&& read_some, std::size_t size_hint, const std::string& name,
+                           const G2oReadOptions& options) {
+  Parser parser(name, options, size_hint);
+  // Not zero-filled: only the pages the input reaches are ever touched.
+  std::size_t capacity = options.read_chunk_bytes;
+  std::unique_ptr<char[]> buffer(new char[capacity]);
+  std::size_t have = 0;  // bytes of an unfinished line kept at the start of the buffer
+  std::size_t total = 0;
+  for (;;) {
+    if (have == capacity) {  // a line longer than the buffer
+      std::unique_ptr<char[]> bigger(new char[2 * capacity]);
+      std::memcpy(bigger.get(), buffer.get(), have);
+      buffer = std::move(bigger);
+      capacity *= 2;
+    }
+    const std::size_t got = read_some(buffer.get() + have, capacity - have);
+    total += got;
+    if (total > kMaxInputBytes) throw InputError(name, 0, "input too large (over 2 GiB)");
+    const char* begin = buffer.get();
+    const char* end = begin + have + got;
+    if (got == 0) {  // the end: the rest is the last line
+      parser.feed(begin, end);
+      break;
+    }
+    const char* stop = end;
+    while (stop > begin && stop[-1] != '\n') --stop;
+    parser.feed(begin, stop);
+    have = static_cast<std::size_t>(end - stop);
+    std::memmove(buffer.get(), stop, have);
+  }
+  return parser.finish();
+}
+
 }  // namespace
+
+void G2oReadOptions::validate() const {
+  if (read_chunk_bytes < 1 || read_chunk_bytes > (std::size_t{1} << 30))
+    throw InputError("G2oReadOptions.read_chunk_bytes must be in 1..2^30, got " +
+                     std::to_string(read_chunk_bytes));
+}
 
 G2oReadResult read_g2o_text(std::string_view text, const std::string& name,
                             const G2oReadOptions& options) {
-  return Parser(text, name, options).run();
+  Parser parser(name, options, text.size());
+  parser.feed(text.data(), text.data() + text.size());
+  return parser.finish();
 }
 
 G2oReadResult read_g2o_stream(std::istream& in, const std::string& name,
                               const G2oReadOptions& options) {
   if (!in) throw InputError(name, 0, "cannot read the input stream");
-  std::string data;
-  char buf[1 << 16];
-  while ((in.read(buf, sizeof buf) || in.gcount() > 0) && data.size() <= kMaxInputBytes)
-    data.append(buf, in.gcount());
-  if (data.size() > kMaxInputBytes) throw InputError(name, 0, "input too large (over 2 GiB)");
-  if (in.bad()) throw InputError(name, 0, "error while reading the input stream");
-  return read_g2o_text(data, name, options);
+  auto read_some = [&](char* buf, std::size_t cap) {
+    in.read(buf, static_cast<std::streamsize>(cap));
+    if (in.bad()) throw InputError(name, 0, "error while reading the input stream");
+    return static_cast<std::size_t>(in.gcount());
+  };
+  return parse_chunks(read_some, 0, name, options);
 }
 
 G2oReadResult read_g2o_file(const std::string& path, const G2oReadOptions& options) {
+  options.validate();
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw InputError(path, 0, std::string("cannot open the file: ") + std::strerror(errno));
-  std::string data;
-  // Read in one go when the size is known (regular files), then whatever follows.
+  // Closes the file on every path out, errors included.
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> closer(f, &std::fclose);
+  std::size_t size_hint = 0;
   struct stat st {};
   if (fstat(fileno(f), &st) == 0) {
-    if (S_ISDIR(st.st_mode)) {
-      std::fclose(f);
-      throw InputError(path, 0, "cannot read the file: it is a directory");
-    }
-    if (S_ISREG(st.st_mode) && st.st_size > 0) data.resize(static_cast<std::size_t>(st.st_size));
+    if (S_ISDIR(st.st_mode)) throw InputError(path, 0, "cannot read the file: it is a directory");
+    if (S_ISREG(st.st_mode) && st.st_size > 0) size_hint = static_cast<std::size_t>(st.st_size);
   }
-  std::size_t have = std::fread(data.data(), 1, data.size(), f);
-  data.resize(have);
-  char buf[1 << 16];
-  std::size_t got;
-  while ((got = std::fread(buf, 1, sizeof buf, f)) > 0 && data.size() <= kMaxInputBytes)
-    data.append(buf, got);
-  const bool failed = std::ferror(f) != 0;
-  const int err = errno;
-  std::fclose(f);
-  if (failed) throw InputError(path, 0, std::string("cannot read the file: ") + std::strerror(err));
-  if (data.size() > kMaxInputBytes) throw InputError(path, 0, "file too large (over 2 GiB)");
-  return read_g2o_text(data, path, options);
+  auto read_some = [&](char* buf, std::size_t cap) {
+    const std::size_t got = std::fread(buf, 1, cap, f);
+    if (got < cap && std::ferror(f))
+      throw InputError(path, 0, std::string("cannot read the file: ") + std::strerror(errno));
+    return got;
+  };
+  return parse_chunks(read_some, size_hint, path, options);
 }
 
 PoseGraph read_g2o(const std::string& path, const G2oReadOptions& options) {

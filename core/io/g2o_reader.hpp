@@ -30,8 +30,12 @@ struct G2oReadOptions {
   /// Off by default: a disconnected graph has no unique optimum up to one global gauge.
   bool allow_disconnected = false;
 
-  /// Nothing can be out of range today; kept so all option structs can be checked alike.
-  void validate() const {}
+  /// Size of the one buffer files and streams are read through, in bytes (1..2^30; a line
+  /// longer than it grows it). Small values only serve tests and fuzzing.
+  std::size_t read_chunk_bytes = 64 * 1024;
+
+  /// Throws InputError naming the field when an option is out of range.
+  void validate() const;
 };
 
 /// What was seen while reading, beyond the graph itself.
