@@ -18,7 +18,8 @@ constexpr std::uint64_t kNoiseStream = 3;
 std::string describe(const GeneratorOptions& o) {
   return std::string("generated ") + trajectory_kind_name(o.kind) +
          " poses=" + std::to_string(o.num_poses) + " robots=" + std::to_string(o.num_robots) +
-         " seed=" + std::to_string(o.seed);
+         " seed=" + std::to_string(o.seed) + " rot_noise=" + std::to_string(o.rotation_noise) +
+         " trans_noise=" + std::to_string(o.translation_noise);
 }
 
 // Chain measurements (k, k+1) in id order, composed into the initial guess as they go.
