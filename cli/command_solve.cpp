@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <set>
+#include <string>
 
 #include "arguments.hpp"
 #include "commands.hpp"
@@ -12,6 +14,7 @@
 #include "io/g2o_writer.hpp"
 #include "io/tum_writer.hpp"
 #include "json_writer.hpp"
+#include "solve_distributed.hpp"
 #include "solvers/centralized_solver.hpp"
 #include "util/input_error.hpp"
 
@@ -19,7 +22,7 @@ namespace tessera::cli {
 namespace {
 
 const char* kHelp =
-    "usage: tessera solve GRAPH --algorithm centralized [options]\n"
+    "usage: tessera solve GRAPH --algorithm centralized|rbcd|rbcd++|irbcd [options]\n"
     "\n"
     "Optimises the pose graph GRAPH (g2o) and prints a summary.\n"
     "\n"
@@ -117,18 +120,23 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
 
 int run_solve(const Args& args) {
   const auto start = std::chrono::steady_clock::now();
-  Arguments a(args,
-              {"algorithm", "out", "tum", "json", "trace", "init", "rank", "max-rank", "grad-tol"},
-              {"help", "no-certify", "raw-quaternions"});
+  std::set<std::string> valued = {"algorithm", "out",  "tum",      "json",    "trace",
+                                   "init",      "rank", "max-rank", "grad-tol"};
+  std::set<std::string> switches = {"help", "no-certify", "raw-quaternions"};
+  for (const char* const* o = kDistributedValued; *o; ++o) valued.insert(*o);
+  for (const char* const* o = kDistributedSwitches; *o; ++o) switches.insert(*o);
+  Arguments a(args, valued, switches);
   if (a.has("help")) {
-    std::printf("%s", kHelp);
+    std::printf("%s%s", kHelp, kDistributedHelp);
     return 0;
   }
   if (a.positional().size() != 1)
     throw InputError("expected exactly one GRAPH argument (see tessera solve --help)");
   const std::string algorithm = a.get_or("algorithm", "centralized");
   if (algorithm == "centralized") return solve_centralized_command(a, a.positional()[0], start);
-  throw InputError("option --algorithm: '" + algorithm + "' is not one of centralized");
+  if (algorithm == "rbcd" || algorithm == "rbcd++" || algorithm == "irbcd")
+    return solve_distributed_command(a, a.positional()[0], start);
+  throw InputError("option --algorithm: '" + algorithm + "' is not one of centralized, rbcd, rbcd++, irbcd");
 }
 
 }  // namespace tessera::cli

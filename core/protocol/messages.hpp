@@ -19,6 +19,7 @@ enum class BlockKind : std::uint8_t { kY = 0, kP = 1, kV = 2 };
 struct PoseBlockMessage {
   std::uint32_t round = 0;
   std::uint32_t sender = 0;
+  std::uint32_t phase = 0;  ///< Protocol step within the round (see distributed/round_protocol.hpp).
   BlockKind kind = BlockKind::kY;
   std::uint32_t rank = 0;  ///< r
   std::uint32_t dim = 0;   ///< d

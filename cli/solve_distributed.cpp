@@ -1,0 +1,177 @@
+#include "solve_distributed.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <optional>
+
+#include "distributed/distributed_solver.hpp"
+#include "io/g2o_reader.hpp"
+#include "io/g2o_writer.hpp"
+#include "io/tum_writer.hpp"
+#include "json_writer.hpp"
+#include "partition/partitioner.hpp"
+#include "partition/sequential_partition.hpp"
+#include "solvers/centralized_solver.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera::cli {
+
+const char* const kDistributedValued[] = {"agents",         "partition", "max-rounds", "seed",
+                                          "reference-cost", "select",    "rel-tol",    "tr-steps",
+                                          "restart-c",      "sigma",     "unselected", nullptr};
+const char* const kDistributedSwitches[] = {"parallel", "reference", nullptr};
+
+const char* kDistributedHelp =
+    "\n"
+    "Distributed algorithms (N agents in one process, same messages as over DDS):\n"
+    "  --algorithm rbcd|rbcd++|irbcd   RBCD, Nesterov-accelerated RBCD++, or IRBCD (default "
+    "algorithm\n"
+    "                            of the reference paper; see docs/irbcd.md)\n"
+    "  --agents N                number of agents / blocks (default 5)\n"
+    "  --partition PRESET        sequential|fast|eco|strong|highest (default highest)\n"
+    "  --init chordal|distributed   initial guess (default chordal)\n"
+    "  --grad-tol T              stop at ||grad f|| <= T, full cost (default 0.01)\n"
+    "  --max-rounds K            round cap (default 10000)\n"
+    "  --rel-tol T               stop when a round decreases f by < T f (default 0: off)\n"
+    "  --select greedy|uniform|round_robin   block selection (default greedy)\n"
+    "  --parallel                update a whole colour class of blocks per round\n"
+    "  --seed S                  shared seed (uniform selection, partitioner)\n"
+    "  --rank R                  relaxation rank (default 5)\n"
+    "  --tr-steps K              trust-region steps per block update (default 1)\n"
+    "  --restart-c C             restart constant c1 of RBCD++/IRBCD (< 0: never restart)\n"
+    "  --sigma S                 IRBCD sigma (default 1e-3)\n"
+    "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
+    "  --reference               also run the centralized solver for f* and report rel_gap\n"
+    "  --reference-cost F        f* given: report rel_gap = (cost - F) / F\n"
+    "  --trace FILE              CSV per round: round,cost,grad_norm,selected,restart,bytes\n";
+
+namespace {
+
+void write_trace(const std::string& path, const DistributedResult& r) {
+  std::ofstream out(path);
+  if (!out) throw InputError(path, 0, "cannot open for writing");
+  out << "round,cost,grad_norm,selected,restart,bytes,elapsed_s\n";
+  char buf[256];
+  for (const auto& row : r.trace) {
+    std::string sel;
+    for (std::size_t k = 0; k < row.selected.size(); ++k)
+      sel += (k ? ";" : "") + std::to_string(row.selected[k]);
+    std::snprintf(buf, sizeof buf, "%d,%.17g,%.17g,%s,%d,%llu,%.6f\n", row.round, row.cost,
+                  row.grad_norm, sel.c_str(), row.restart ? 1 : 0,
+                  static_cast<unsigned long long>(row.bytes), row.elapsed_s);
+    out << buf;
+  }
+  if (!out) throw InputError(path, 0, "write failed");
+}
+
+}  // namespace
+
+int solve_distributed_command(const Arguments& a, const std::string& graph_path,
+                              std::chrono::steady_clock::time_point start) {
+  DistributedOptions opt;
+  opt.algorithm = parse_algorithm(a.get_or("algorithm", "irbcd"));
+  opt.initialization = parse_init(a.get_or("init", "chordal"));
+  opt.grad_norm_tol = a.get_double("grad-tol", opt.grad_norm_tol);
+  opt.max_rounds = static_cast<int>(a.get_long("max-rounds", opt.max_rounds));
+  opt.rel_cost_decrease_tol = a.get_double("rel-tol", opt.rel_cost_decrease_tol);
+  opt.selection = parse_selection(a.get_or("select", selection_name(opt.selection)));
+  opt.parallel = a.has("parallel");
+  const long seed = a.get_long("seed", 1);
+  if (seed < 0) throw InputError("option --seed: must be >= 0");
+  opt.seed = static_cast<std::uint64_t>(seed);
+  opt.rank = static_cast<int>(a.get_long("rank", opt.rank));
+  opt.block_update.trust_region_steps =
+      static_cast<int>(a.get_long("tr-steps", opt.block_update.trust_region_steps));
+  opt.block_update.max_attempts =
+      std::max(opt.block_update.max_attempts, opt.block_update.trust_region_steps);
+  if (a.has("restart-c")) {
+    opt.irbcd.restart_c = a.get_double("restart-c", 0);
+    opt.rbcd_plus_plus.restart_c = opt.irbcd.restart_c;
+  }
+  opt.irbcd.sigma = a.get_double("sigma", opt.irbcd.sigma);
+  const std::string unselected = a.get_or("unselected", "take");
+  if (unselected != "take" && unselected != "keep")
+    throw InputError("option --unselected: '" + unselected + "' is not one of take, keep");
+  opt.irbcd.unselected_take_extrapolation = unselected == "take";
+  const long agents = a.get_long("agents", 5);
+  if (agents < 1 || agents > 64) throw InputError("option --agents: must be in 1..64");
+  if (a.has("reference") && a.has("reference-cost"))
+    throw InputError("options --reference and --reference-cost exclude each other");
+  opt.validate();
+
+  G2oReadOptions read;
+  read.normalize_quaternions = !a.has("raw-quaternions");
+  const PoseGraph graph = read_g2o(graph_path, read);
+  if (static_cast<std::size_t>(agents) > graph.num_poses)
+    throw InputError("option --agents: more agents than the graph's " +
+                     std::to_string(graph.num_poses) + " poses");
+  PartitionOptions popt;
+  popt.parts = static_cast<int>(agents);
+  popt.preset = parse_preset(a.get_or("partition", "highest"));
+  popt.seed = opt.seed;
+  const PartitionResult part = partition_graph(graph_structure_from_pose_graph(graph), popt);
+  const DistributedResult r = solve_distributed(graph, part.assignment, opt);
+
+  std::optional<double> fstar;
+  if (a.has("reference")) fstar = solve_centralized(graph).cost;
+  if (a.has("reference-cost")) fstar = a.get_double("reference-cost", 0);
+  std::optional<double> rel_gap;
+  if (fstar) rel_gap = (r.cost - *fstar) / std::abs(*fstar);
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  std::printf("%s: %zu poses, %zu edges, d = %d; %s, %ld agents, %s partition (cut %lld)\n",
+              graph_path.c_str(), graph.num_poses, graph.num_measurements(), graph.d,
+              algorithm_name(opt.algorithm), agents, preset_name(popt.preset),
+              static_cast<long long>(part.metrics.cut_edges));
+  std::printf("  %d rounds (%d restarts), stop: %s, |grad f| = %.4g, relaxation f = %.10g\n",
+              r.rounds, r.restarts, r.stop_reason.c_str(), r.grad_norm, r.relaxation_cost);
+  std::printf("  rounded cost %.10g", r.cost);
+  if (rel_gap) std::printf(", f* %.10g, rel gap %.3g", *fstar, *rel_gap);
+  std::printf("\n  %.3f MB exchanged, %.2f ms per round, solve %.3f s, wall %.3f s\n",
+              r.bytes_exchanged / 1e6, r.rounds > 0 ? 1e3 * r.solve_s / r.rounds : 0.0, r.solve_s,
+              wall_s);
+  if (auto p = a.get("out")) {
+    const std::string& path = *p;
+    if (path.size() >= 4 && path.compare(path.size() - 4, 4, ".tum") == 0)
+      write_tum(r.poses, path);
+    else
+      write_g2o(graph, r.poses, path);
+  }
+  if (auto p = a.get("tum")) write_tum(r.poses, *p);
+  if (auto p = a.get("trace")) write_trace(*p, r);
+  if (auto p = a.get("json")) {
+    JsonObject j;
+    j.add("algorithm", algorithm_name(opt.algorithm))
+        .add("graph", graph_path)
+        .add("poses", graph.num_poses)
+        .add("edges", graph.num_measurements())
+        .add("d", graph.d)
+        .add("rank", opt.rank)
+        .add("iterations", r.rounds)
+        .add("grad_norm", r.grad_norm)
+        .add("cost", r.cost)
+        .add("relaxation_cost", r.relaxation_cost)
+        .add_null("certified")
+        .add("wall_s", wall_s)
+        .add("agents", static_cast<int>(agents))
+        .add("partition", preset_name(popt.preset))
+        .add("cut_edges", static_cast<long long>(part.metrics.cut_edges))
+        .add("init", init_name(opt.initialization))
+        .add("selection", selection_name(opt.selection))
+        .add("parallel", opt.parallel)
+        .add("rounds", r.rounds)
+        .add("restarts", r.restarts)
+        .add("stop_reason", r.stop_reason)
+        .add("bytes_exchanged", static_cast<long long>(r.bytes_exchanged))
+        .add("messages", static_cast<long long>(r.messages))
+        .add("solve_s", r.solve_s)
+        .add("ms_per_round", r.rounds > 0 ? 1e3 * r.solve_s / r.rounds : 0.0)
+        .add("rel_gap", rel_gap);
+    if (fstar) j.add("f_star", *fstar);
+    write_output(*p, j.str());
+  }
+  return 0;
+}
+
+}  // namespace tessera::cli

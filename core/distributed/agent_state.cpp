@@ -1,0 +1,106 @@
+#include "distributed/agent_state.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace tessera {
+
+AgentState::AgentState(int id, int d, const BlockLayout& layout,
+                       const std::vector<Measurement>& measurements, const Eigen::MatrixXd& Y0)
+    : id_(id),
+      d_(d),
+      layout_(layout),
+      problem_(d, layout.poses[static_cast<std::size_t>(id)], measurements) {
+  const Eigen::Index cols = (d + 1) * static_cast<Eigen::Index>(problem_.num_owned());
+  if (Y0.cols() != cols)
+    throw std::invalid_argument("AgentState: initial block has the wrong size");
+  Y = Y0;
+  P = Y0;
+  V = Y0;
+  Y_prev = Y0;
+  V_prev = Y0;
+  Yn = Eigen::MatrixXd::Zero(Y0.rows(),
+                             (d + 1) * static_cast<Eigen::Index>(problem_.num_neighbors()));
+  Pn = Yn;
+  Yn_prev = Yn;
+  precon_ = std::make_unique<BlockPreconditioner>(problem_);
+}
+
+PoseBlockMessage AgentState::publish(const Eigen::MatrixXd& X, BlockKind kind, int recipient,
+                                     std::uint32_t round, std::uint32_t phase) const {
+  const int k = layout_.adjacency_index(id_, recipient);
+  if (k < 0) throw std::logic_error("AgentState::publish: recipient is not a neighbour block");
+  const auto& ids = layout_.public_to[static_cast<std::size_t>(id_)][static_cast<std::size_t>(k)];
+  const auto& own = layout_.poses[static_cast<std::size_t>(id_)];
+  const Eigen::Index w = (d_ + 1) * X.rows();
+  PoseBlockMessage m;
+  m.round = round;
+  m.sender = static_cast<std::uint32_t>(id_);
+  m.phase = phase;
+  m.kind = kind;
+  m.rank = static_cast<std::uint32_t>(X.rows());
+  m.dim = static_cast<std::uint32_t>(d_);
+  m.pose_ids.reserve(ids.size());
+  m.data.resize(ids.size() * static_cast<std::size_t>(w));
+  double* out = m.data.data();
+  for (std::size_t id : ids) {
+    const auto slot = std::lower_bound(own.begin(), own.end(), id) - own.begin();
+    m.pose_ids.push_back(static_cast<std::uint32_t>(id));
+    std::memcpy(out, X.data() + w * slot, sizeof(double) * static_cast<std::size_t>(w));
+    out += w;
+  }
+  return m;
+}
+
+void AgentState::absorb(const PoseBlockMessage& m, Eigen::MatrixXd& copy) const {
+  const Eigen::Index r = copy.rows();
+  const Eigen::Index w = (d_ + 1) * r;
+  if (m.rank != static_cast<std::uint32_t>(r) || m.dim != static_cast<std::uint32_t>(d_) ||
+      m.data.size() != m.pose_ids.size() * static_cast<std::size_t>(w))
+    throw std::runtime_error("agent " + std::to_string(id_) + ": pose message from agent " +
+                             std::to_string(m.sender) + " has the wrong shape");
+  const auto& nb = problem_.neighbors();
+  const double* in = m.data.data();
+  for (std::uint32_t id : m.pose_ids) {
+    auto it = std::lower_bound(nb.begin(), nb.end(), static_cast<std::size_t>(id));
+    if (it == nb.end() || *it != id)
+      throw std::runtime_error("agent " + std::to_string(id_) + ": pose " + std::to_string(id) +
+                               " from agent " + std::to_string(m.sender) + " is not a neighbour");
+    std::memcpy(copy.data() + w * (it - nb.begin()), in,
+                sizeof(double) * static_cast<std::size_t>(w));
+    in += w;
+  }
+}
+
+void AgentState::set_neighbours(const Eigen::MatrixXd& neighbours) {
+  if (problem_.num_neighbors() == 0) return;
+  if (neighbours_set_.size() == neighbours.size() && neighbours_set_ == neighbours) return;
+  neighbours_set_ = neighbours;
+  problem_.set_neighbor_poses(neighbours);
+}
+
+LocalStatus AgentState::status() {
+  set_neighbours(Yn);
+  LocalStatus s;
+  s.cost_share = problem_.cost_share(Y);
+  const Eigen::MatrixXd g = problem_.riemannian_gradient(Y, problem_.euclidean_gradient(Y));
+  s.grad_norm_sq = g.squaredNorm();
+  s.block_grad_norm = std::sqrt(s.grad_norm_sq);
+  return s;
+}
+
+Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
+                                   const BlockUpdateOptions& options) {
+  set_neighbours(neighbours);
+  return block_update(problem_, X0, options, precon_.get());
+}
+
+double AgentState::local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours) {
+  set_neighbours(neighbours);
+  return problem_.cost(X);
+}
+
+}  // namespace tessera

@@ -1,0 +1,71 @@
+#pragma once
+// One agent's data: its block's local problem (own poses, every measurement touching them,
+// neighbours' poses held fixed), its blocks of the sequences Y (iterates), P (extrapolated
+// points) and V (momentum), and its copies of the neighbours' public poses. Pure data and
+// local math; the round protocol (round_protocol.hpp) decides when each piece is used.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "distributed/block_layout.hpp"
+#include "distributed/rbcd.hpp"
+#include "problem/block_problem.hpp"
+#include "protocol/messages.hpp"
+#include "solvers/block_preconditioner.hpp"
+
+namespace tessera {
+
+/// An agent's contributions to the global reductions at its current Y.
+struct LocalStatus {
+  double cost_share = 0.0;       ///< Internal edges in full, cut edges half.
+  double grad_norm_sq = 0.0;     ///< ||grad_B f||^2: the block's part of ||grad f||^2.
+  double block_grad_norm = 0.0;  ///< sqrt(grad_norm_sq).
+};
+
+class AgentState {
+ public:
+  /// `Y0`: the block's initial lifted poses, r x (d+1)m in layout.poses[id] order.
+  AgentState(int id, int d, const BlockLayout& layout, const std::vector<Measurement>& measurements,
+             const Eigen::MatrixXd& Y0);
+  AgentState(const AgentState&) = delete;
+  AgentState& operator=(const AgentState&) = delete;
+
+  int id() const { return id_; }
+  int rank() const { return static_cast<int>(Y.rows()); }
+  const BlockProblem& problem() const { return problem_; }
+  LiftedManifold manifold() const { return problem_.manifold(rank()); }
+
+  /// The public poses of `X` (own block, own order) that neighbour block `recipient` needs.
+  PoseBlockMessage publish(const Eigen::MatrixXd& X, BlockKind kind, int recipient,
+                           std::uint32_t round, std::uint32_t phase) const;
+  /// Writes a neighbour's poses into `copy` (neighbour order). Throws std::runtime_error when
+  /// the message names a pose that is not a neighbour of this block or has the wrong size.
+  void absorb(const PoseBlockMessage& message, Eigen::MatrixXd& copy) const;
+
+  /// Status at (Y, Yn).
+  LocalStatus status();
+  /// Block update from X0 with neighbours at `neighbours`.
+  Eigen::MatrixXd update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
+                         const BlockUpdateOptions& options);
+  /// Local objective f_B(X) with neighbours at `neighbours`.
+  double local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
+
+  // The sequences (own block) and neighbour copies; *_prev keep round k while k+1 is tried,
+  // so an adaptive restart can go back.
+  Eigen::MatrixXd Y, P, V, Y_prev, V_prev;
+  Eigen::MatrixXd Yn, Pn, Yn_prev;
+
+ private:
+  void set_neighbours(const Eigen::MatrixXd& neighbours);
+
+  int id_;
+  int d_;
+  const BlockLayout& layout_;
+  BlockProblem problem_;
+  std::unique_ptr<BlockPreconditioner> precon_;
+  Eigen::MatrixXd neighbours_set_;  // what problem_ holds, so X_N Q_NB is rebuilt only on change
+};
+
+}  // namespace tessera

@@ -1,0 +1,37 @@
+#pragma once
+// Which block(s) update in a round. Every agent evaluates the same rule on the same broadcast
+// statuses, so all agents agree without a coordinator.
+//
+//   uniform      a block drawn uniformly at random from a stream that depends only on
+//                (seed, round): stateless, so a restart or a late joiner cannot desynchronise it.
+//   greedy       the block with the largest block gradient norm (ties: lowest id).
+//   round_robin  block round mod N.
+// With `parallel`, the unit of choice is a colour class of the block adjacency graph: uniform
+// draws a class, greedy takes the class of the greedy block, round-robin cycles the classes.
+// All blocks of the class update in the round (they share no measurement).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "distributed/block_layout.hpp"
+
+namespace tessera {
+
+enum class SelectionRule { kUniform, kGreedy, kRoundRobin };
+
+/// "uniform", "greedy", "round_robin".
+const char* selection_name(SelectionRule rule);
+/// Inverse of selection_name; throws InputError listing the valid names.
+SelectionRule parse_selection(const std::string& name);
+
+/// The blocks updated in `round` (ascending ids). `block_grad_norms` has one entry per block,
+/// in block-id order.
+std::vector<int> select_blocks(SelectionRule rule, bool parallel, std::uint64_t seed,
+                               std::uint64_t round, const std::vector<double>& block_grad_norms,
+                               const BlockLayout& layout);
+
+/// Number of selectable units: N blocks, or the number of colour classes with `parallel`.
+int selection_units(bool parallel, const BlockLayout& layout);
+
+}  // namespace tessera

@@ -1,0 +1,143 @@
+#include "distributed/distributed_solver.hpp"
+
+#include <chrono>
+#include <memory>
+
+#include "distributed/agent_state.hpp"
+#include "distributed/block_layout.hpp"
+#include "distributed/round_protocol.hpp"
+#include "problem/lifting.hpp"
+#include "problem/objective.hpp"
+#include "problem/rounding.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera {
+
+const char* algorithm_name(DistributedAlgorithm a) {
+  switch (a) {
+    case DistributedAlgorithm::kRbcd:
+      return "rbcd";
+    case DistributedAlgorithm::kRbcdPlusPlus:
+      return "rbcd++";
+    case DistributedAlgorithm::kIrbcd:
+      return "irbcd";
+  }
+  return "?";
+}
+
+DistributedAlgorithm parse_algorithm(const std::string& name) {
+  if (name == "rbcd") return DistributedAlgorithm::kRbcd;
+  if (name == "rbcd++") return DistributedAlgorithm::kRbcdPlusPlus;
+  if (name == "irbcd") return DistributedAlgorithm::kIrbcd;
+  throw InputError("algorithm '" + name + "' is not one of rbcd, rbcd++, irbcd");
+}
+
+void DistributedOptions::validate() const {
+  auto fail = [](const char* field, const char* why) {
+    throw InputError(std::string("DistributedOptions.") + field + " " + why);
+  };
+  if (rank < 2) fail("rank", "must be >= d (2 or 3)");
+  if (robots < 0) fail("robots", "must be >= 0");
+  if (!(grad_norm_tol >= 0)) fail("grad_norm_tol", "must be >= 0");
+  if (max_rounds < 0) fail("max_rounds", "must be >= 0");
+  if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
+  block_update.validate();
+  rbcd_plus_plus.validate();
+  irbcd.validate();
+}
+
+DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<int>& assignment,
+                                    const DistributedOptions& options,
+                                    const std::vector<Pose>& initial) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  options.validate();
+  if (options.rank < graph.d)
+    throw InputError("DistributedOptions.rank must be >= d = " + std::to_string(graph.d));
+  const BlockLayout layout = make_block_layout(graph.num_poses, graph.measurements, assignment);
+  const int N = layout.num_blocks;
+  DistributedResult res;
+  res.agents = N;
+
+  std::vector<Pose> init = initial;
+  if (init.empty())
+    init = initial_poses(graph, options.initialization, options.robots > 0 ? options.robots : N);
+  if (init.size() != graph.num_poses)
+    throw InputError("distributed solve: initial guess has the wrong size");
+  const Eigen::MatrixXd X0 = lift_poses(init, options.rank);
+  const Eigen::Index w = graph.d + 1;
+
+  std::vector<std::unique_ptr<AgentState>> states;
+  for (int b = 0; b < N; ++b) {
+    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+    Eigen::MatrixXd Yb(options.rank, w * static_cast<Eigen::Index>(ids.size()));
+    for (std::size_t s = 0; s < ids.size(); ++s)
+      Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
+          X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
+    states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb));
+  }
+
+  std::unique_ptr<MomentumScheme> scheme;
+  const int units = selection_units(options.parallel, layout);
+  if (options.algorithm == DistributedAlgorithm::kRbcdPlusPlus) {
+    scheme = std::make_unique<RbcdPlusPlusScheme>(options.rbcd_plus_plus, units);
+  } else if (options.algorithm == DistributedAlgorithm::kIrbcd) {
+    const double n = options.irbcd.dimension == IrbcdDimension::kUnits
+                         ? static_cast<double>(units)
+                         : static_cast<double>(X0.size());
+    scheme = std::make_unique<IrbcdScheme>(options.irbcd, n);
+  }
+  RoundConfig config;
+  config.selection = options.selection;
+  config.parallel = options.parallel;
+  config.seed = options.seed;
+  config.grad_norm_tol = options.grad_norm_tol;
+  config.max_rounds = options.max_rounds;
+  config.rel_cost_decrease_tol = options.rel_cost_decrease_tol;
+  config.update = options.block_update;
+  config.scheme = scheme.get();
+  std::vector<std::unique_ptr<RoundProtocol>> protocols;
+  std::vector<RoundProtocol*> agents;
+  for (int b = 0; b < N; ++b) {
+    protocols.push_back(
+        std::make_unique<RoundProtocol>(*states[static_cast<std::size_t>(b)], layout, config));
+    agents.push_back(protocols.back().get());
+  }
+  res.init_s = since(start);
+
+  const auto solve_start = Clock::now();
+  const DeliveryStats stats = run_in_process(agents, options.delivery, options.delivery_seed);
+  res.solve_s = since(solve_start);
+
+  const RoundProtocol& lead = *protocols.front();
+  res.rounds = lead.rounds();
+  res.restarts = lead.restarts();
+  res.stop_reason = lead.stop_reason();
+  res.bytes_exchanged = stats.bytes;
+  res.messages = stats.messages;
+  for (const auto& r : lead.trace()) {
+    DistributedRound row{r.round, r.cost, r.grad_norm, r.selected, r.restart, 0, r.elapsed_s};
+    if (static_cast<std::size_t>(r.round) < stats.bytes_per_round.size())
+      row.bytes = stats.bytes_per_round[static_cast<std::size_t>(r.round)];
+    res.trace.push_back(std::move(row));
+  }
+  res.X.resize(options.rank, w * static_cast<Eigen::Index>(graph.num_poses));
+  for (int b = 0; b < N; ++b) {
+    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+    const Eigen::MatrixXd& Yb = states[static_cast<std::size_t>(b)]->Y;
+    for (std::size_t s = 0; s < ids.size(); ++s)
+      res.X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
+          Yb.middleCols(w * static_cast<Eigen::Index>(s), w);
+  }
+  res.relaxation_cost = res.trace.empty() ? 0.0 : res.trace.back().cost;
+  res.grad_norm = res.trace.empty() ? 0.0 : res.trace.back().grad_norm;
+  res.poses = round_solution(graph, res.X);
+  res.cost = evaluate_objective(graph, res.poses);
+  res.wall_s = since(start);
+  return res;
+}
+
+}  // namespace tessera

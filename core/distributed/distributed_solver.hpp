@@ -1,0 +1,83 @@
+#pragma once
+// Distributed PGO over a partition: N agents (one per block) run RBCD, RBCD++ or IRBCD through
+// the round protocol, here in one process (in_process_driver.hpp). Options in, result out.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "distributed/block_selection.hpp"
+#include "distributed/distributed_initialization.hpp"
+#include "distributed/in_process_driver.hpp"
+#include "distributed/irbcd.hpp"
+#include "distributed/rbcd.hpp"
+#include "distributed/rbcd_plus_plus.hpp"
+#include "graph/pose.hpp"
+#include "graph/pose_graph.hpp"
+
+namespace tessera {
+
+enum class DistributedAlgorithm { kRbcd, kRbcdPlusPlus, kIrbcd };
+
+/// "rbcd", "rbcd++", "irbcd".
+const char* algorithm_name(DistributedAlgorithm a);
+/// Throws InputError listing the valid names.
+DistributedAlgorithm parse_algorithm(const std::string& name);
+
+struct DistributedOptions {
+  DistributedAlgorithm algorithm = DistributedAlgorithm::kIrbcd;
+  int rank = 5;  ///< Relaxation rank r >= d (5: the reference optima's rank).
+  DistributedInit initialization = DistributedInit::kChordal;
+  int robots = 0;  ///< Robots of the distributed initialization; 0 = number of blocks.
+  SelectionRule selection = SelectionRule::kGreedy;
+  bool parallel = false;        ///< Update a whole colour class of blocks per round.
+  std::uint64_t seed = 1;       ///< Shared by all agents (uniform selection).
+  double grad_norm_tol = 0.01;  ///< Stop when ||grad f|| (full cost) <= this; >= 0.
+  int max_rounds = 10000;       ///< >= 0.
+  /// Stop when a round decreases f by less than this fraction of f (0 = off: with one block
+  /// per round a tiny decrease says little about the others).
+  double rel_cost_decrease_tol = 0.0;
+  BlockUpdateOptions block_update;
+  RbcdPlusPlusOptions rbcd_plus_plus;
+  IrbcdOptions irbcd;
+  DeliveryOrder delivery = DeliveryOrder::kFifo;  ///< In-process delivery order (tests).
+  std::uint64_t delivery_seed = 1;
+
+  /// Throws InputError naming the first invalid field.
+  void validate() const;
+};
+
+struct DistributedRound {
+  int round = 0;
+  double cost = 0.0;       ///< f(Y^k) of the lifted iterate, full sum.
+  double grad_norm = 0.0;  ///< ||grad f(Y^k)||.
+  std::vector<int> selected;
+  bool restart = false;
+  std::uint64_t bytes = 0;  ///< Bytes of the messages tagged with this round.
+  double elapsed_s = 0.0;
+};
+
+struct DistributedResult {
+  int agents = 0;
+  int rounds = 0;  ///< Block-update rounds done (restarts' redos are inside their round).
+  int restarts = 0;
+  std::string stop_reason;  ///< grad_norm, max_rounds or relative_decrease.
+  std::vector<DistributedRound> trace;
+  std::uint64_t bytes_exchanged = 0;
+  std::uint64_t messages = 0;
+  Eigen::MatrixXd X;             ///< Final lifted iterate (r x (d+1)n, global order).
+  double relaxation_cost = 0.0;  ///< f(X).
+  double grad_norm = 0.0;        ///< ||grad f(X)||.
+  std::vector<Pose> poses;       ///< X rounded to SE(d).
+  double cost = 0.0;             ///< Objective of `poses` (reference convention).
+  double init_s = 0.0, solve_s = 0.0, wall_s = 0.0;
+};
+
+/// Solves `graph` with the blocks of `assignment` (block id per pose, 0..N-1, none empty).
+/// `initial`: initial poses; empty = options.initialization.
+DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<int>& assignment,
+                                    const DistributedOptions& options,
+                                    const std::vector<Pose>& initial = {});
+
+}  // namespace tessera

@@ -1,0 +1,89 @@
+#include "distributed/in_process_driver.hpp"
+
+#include <deque>
+#include <stdexcept>
+
+namespace tessera {
+
+std::size_t message_bytes(const ProtocolMessage& message) {
+  if (const auto* p = std::get_if<PoseBlockMessage>(&message))
+    return 5 * sizeof(std::uint32_t) + 1 + p->pose_ids.size() * sizeof(std::uint32_t) +
+           p->data.size() * sizeof(double);
+  return 3 * sizeof(std::uint32_t) + 3 * sizeof(double) + 2;
+}
+
+namespace {
+
+struct Delivery {
+  std::size_t recipient;
+  ProtocolMessage message;
+};
+
+std::uint32_t round_of(const ProtocolMessage& m) {
+  if (const auto* p = std::get_if<PoseBlockMessage>(&m)) return p->round;
+  return std::get<RoundStatusMessage>(m).round;
+}
+
+}  // namespace
+
+DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+                             std::uint64_t delivery_seed) {
+  DeliveryStats stats;
+  std::deque<Delivery> queue;
+  const std::size_t n = agents.size();
+  auto post = [&](std::size_t sender, std::vector<OutgoingMessage>&& out) {
+    for (auto& o : out) {
+      const std::size_t bytes = message_bytes(o.message);
+      const std::uint32_t round = round_of(o.message);
+      auto count = [&](std::size_t recipient) {
+        ++stats.messages;
+        stats.bytes += bytes;
+        if (stats.bytes_per_round.size() <= round) stats.bytes_per_round.resize(round + 1, 0);
+        stats.bytes_per_round[round] += bytes;
+        queue.push_back({recipient, o.message});
+      };
+      if (o.broadcast) {
+        for (std::size_t r = 0; r < n; ++r)
+          if (r != sender) count(r);
+      } else {
+        for (auto r : o.recipients) count(r);
+      }
+    }
+  };
+  if (order == DeliveryOrder::kReversed) {
+    for (std::size_t i = n; i-- > 0;) post(i, agents[i]->start());
+  } else {
+    for (std::size_t i = 0; i < n; ++i) post(i, agents[i]->start());
+  }
+  std::uint64_t state = delivery_seed * 0x9E3779B97F4A7C15ull + 1;
+  auto next_random = [&] {  // xorshift64*: reproducible and cheap
+    state ^= state >> 12;
+    state ^= state << 25;
+    state ^= state >> 27;
+    return state * 0x2545F4914F6CDD1Dull;
+  };
+  while (!queue.empty()) {
+    Delivery d;
+    if (order == DeliveryOrder::kFifo) {
+      d = std::move(queue.front());
+      queue.pop_front();
+    } else if (order == DeliveryOrder::kReversed) {
+      d = std::move(queue.back());
+      queue.pop_back();
+    } else {
+      const std::size_t k = static_cast<std::size_t>(next_random() % queue.size());
+      std::swap(queue[k], queue.back());
+      d = std::move(queue.back());
+      queue.pop_back();
+    }
+    if (d.recipient >= n) throw std::logic_error("in-process driver: message to unknown agent");
+    if (agents[d.recipient]->done()) continue;
+    post(d.recipient, agents[d.recipient]->handle(d.message));
+  }
+  for (auto* a : agents)
+    if (!a->done())
+      throw std::logic_error("in-process driver: agents stalled with no message in flight");
+  return stats;
+}
+
+}  // namespace tessera

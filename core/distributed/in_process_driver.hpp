@@ -1,0 +1,35 @@
+#pragma once
+// Runs N agents' round protocols in one process by handing each emitted message to its
+// recipients. The DDS runtime delivers the same messages; because each agent buffers messages
+// by (round, phase) and reduces in agent-id order, the delivery order cannot change iterates.
+// The orders here exist to test exactly that.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "distributed/round_protocol.hpp"
+
+namespace tessera {
+
+enum class DeliveryOrder {
+  kFifo,      ///< Oldest message first (agents started in id order).
+  kReversed,  ///< Newest message first (agents started in reverse id order).
+  kShuffled   ///< A pseudo-random pending message each time (delivery_seed).
+};
+
+struct DeliveryStats {
+  std::uint64_t messages = 0;  ///< Deliveries (a broadcast to N-1 agents counts N-1).
+  std::uint64_t bytes = 0;     ///< Payload bytes over all deliveries.
+  std::vector<std::uint64_t> bytes_per_round;  ///< By the messages' round field.
+};
+
+/// Payload size of a message as it would travel (fixed fields + arrays), in bytes.
+std::size_t message_bytes(const ProtocolMessage& message);
+
+/// Delivers messages until every agent is done (or no message is left, which would be a
+/// protocol bug: then std::logic_error). `agents[i]` must be the agent with id i.
+DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+                             std::uint64_t delivery_seed = 1);
+
+}  // namespace tessera

@@ -1,0 +1,70 @@
+#include "distributed/irbcd.hpp"
+
+#include <cmath>
+
+#include "util/input_error.hpp"
+
+namespace tessera {
+
+void IrbcdOptions::validate() const {
+  if (!(sigma >= 0 && std::isfinite(sigma)))
+    throw InputError("IrbcdOptions.sigma must be finite and >= 0");
+  if (!std::isfinite(a0)) throw InputError("IrbcdOptions.a0 must be finite");
+  if (!(b0 > 0 && std::isfinite(b0))) throw InputError("IrbcdOptions.b0 must be finite and > 0");
+  if (!std::isfinite(restart_c)) throw InputError("IrbcdOptions.restart_c must be finite");
+}
+
+const char* dimension_name(IrbcdDimension d) {
+  return d == IrbcdDimension::kUnits ? "units" : "variables";
+}
+
+IrbcdDimension parse_dimension(const std::string& name) {
+  if (name == "units" || name == "blocks") return IrbcdDimension::kUnits;
+  if (name == "variables") return IrbcdDimension::kVariables;
+  throw InputError("IRBCD dimension '" + name + "' is not one of units, variables");
+}
+
+double irbcd_gamma(double n, double sigma, double a, double b) {
+  // gamma^2 + gamma (sigma q - 1)/n - q = 0; the product of the roots is -q < 0, so exactly one
+  // root is positive, and it exceeds 1/n because the left side is negative at 1/n when sigma < n^2.
+  const double q = (a * a) / (b * b);
+  const double p = (sigma * q - 1.0) / n;
+  return 0.5 * (-p + std::sqrt(p * p + 4.0 * q));
+}
+
+IrbcdScheme::IrbcdScheme(const IrbcdOptions& options, double n) : options_(options), n_(n) {
+  options_.validate();
+  if (!(n_ >= 1)) throw InputError("IRBCD: n must be >= 1");
+  if (!(options_.sigma < n_ * n_)) throw InputError("IrbcdOptions.sigma must be < n^2");
+  reset();
+}
+
+std::unique_ptr<MomentumScheme> IrbcdScheme::clone() const {
+  return std::make_unique<IrbcdScheme>(*this);
+}
+
+MomentumCoefficients IrbcdScheme::coefficients() const {
+  const double sigma = options_.sigma;
+  MomentumCoefficients c;
+  c.gamma = irbcd_gamma(n_, sigma, a_, b_);
+  c.alpha = (n_ - c.gamma * sigma) / (c.gamma * (n_ * n_ - sigma));
+  c.beta = 1.0 - c.gamma * sigma / n_;
+  return c;
+}
+
+void IrbcdScheme::advance() {
+  const MomentumCoefficients c = coefficients();
+  b_ = b_ / std::sqrt(c.beta);
+  a_ = c.gamma * b_;
+}
+
+void IrbcdScheme::restart() {
+  if (options_.reset_on_restart) reset();
+}
+
+void IrbcdScheme::reset() {
+  a_ = options_.a0 > 0 ? options_.a0 : 1.0 / n_;
+  b_ = options_.b0;
+}
+
+}  // namespace tessera

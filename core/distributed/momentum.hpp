@@ -1,0 +1,50 @@
+#pragma once
+// The shape shared by the accelerated methods (RBCD++ and IRBCD). Each round k, with global
+// scalars (alpha_k, beta_k, gamma_k) computed identically by every agent:
+//   P^k     = Proj_M(alpha_k V^k + (1 - alpha_k) Y^k)                     (extrapolated point)
+//   Y^{k+1} = block update of the selected block(s) from P^k, neighbours at P^k;
+//             unselected blocks keep Y^k or take P^k (scheme option)
+//   V^{k+1} = Proj_M(beta_k V^k + (1 - beta_k) P^k + gamma_k (Y^{k+1} - P^k))
+// and an adaptive restart: if f(Y^k) - f(Y^{k+1}) < c ||grad f(Y^k)||^2, the round is redone
+// from Y^k (plain block update, neighbours at Y^k) and V^{k+1} = Y^{k+1}.
+// Every operation above is pose-wise, so each agent applies it to its own block alone.
+
+#include <Eigen/Core>
+#include <memory>
+
+#include "manifold/lifted_manifold.hpp"
+
+namespace tessera {
+
+struct MomentumCoefficients {
+  double alpha = 1.0;
+  double beta = 1.0;
+  double gamma = 0.0;
+};
+
+class MomentumScheme {
+ public:
+  virtual ~MomentumScheme() = default;
+  virtual std::unique_ptr<MomentumScheme> clone() const = 0;
+  /// The coefficients of the current round.
+  virtual MomentumCoefficients coefficients() const = 0;
+  /// Moves the scalar recurrences to the next round.
+  virtual void advance() = 0;
+  /// Called after a restart.
+  virtual void restart() = 0;
+  /// Unselected blocks take P^k (true) or keep Y^k (false).
+  virtual bool unselected_take_extrapolation() const = 0;
+  /// Restart constant c (< 0: never restart).
+  virtual double restart_constant() const = 0;
+};
+
+/// Proj_M(alpha V + (1 - alpha) Y).
+Eigen::MatrixXd extrapolate(const LiftedManifold& M, const MomentumCoefficients& c,
+                            const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V);
+
+/// Proj_M(beta V + (1 - beta) P + gamma (Y_new - P)).
+Eigen::MatrixXd momentum_update(const LiftedManifold& M, const MomentumCoefficients& c,
+                                const Eigen::MatrixXd& V, const Eigen::MatrixXd& P,
+                                const Eigen::MatrixXd& Y_new);
+
+}  // namespace tessera

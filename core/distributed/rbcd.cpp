@@ -1,0 +1,50 @@
+#include "distributed/rbcd.hpp"
+
+#include "solvers/trust_region.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera {
+
+void BlockUpdateOptions::validate() const {
+  auto fail = [](const char* field, const char* why) {
+    throw InputError(std::string("BlockUpdateOptions.") + field + " " + why);
+  };
+  if (trust_region_steps < 1) fail("trust_region_steps", "must be >= 1");
+  if (max_attempts < trust_region_steps) fail("max_attempts", "must be >= trust_region_steps");
+  if (max_inner_iterations < 1) fail("max_inner_iterations", "must be >= 1");
+  if (!(tcg_kappa > 0 && tcg_kappa < 1)) fail("tcg_kappa", "must be in (0, 1)");
+}
+
+Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd& X0,
+                             const BlockUpdateOptions& options,
+                             BlockPreconditioner* preconditioner) {
+  TrustRegionOptions tr;
+  tr.max_iterations = 1;
+  tr.max_inner_iterations = options.max_inner_iterations;
+  tr.tcg_kappa = options.tcg_kappa;
+  tr.grad_norm_tol = 0.0;
+  tr.rel_cost_decrease_tol = 0.0;
+  tr.record_trace = true;
+  // Q_BB never changes for a block: the constant factor is reused by every update.
+  tr.adaptive_preconditioner = false;
+  BlockPreconditioner* precon = options.precondition ? preconditioner : nullptr;
+  Eigen::MatrixXd X = X0;
+  int accepted = 0;
+  double radius = 0.0;  // <= 0: set from the first preconditioned gradient
+  for (int attempt = 0; attempt < options.max_attempts && accepted < options.trust_region_steps;
+       ++attempt) {
+    tr.initial_radius = radius;
+    TrustRegionResult res = solve_trust_region(problem, X, tr, precon);
+    if (res.trace.empty()) break;  // zero gradient: nothing to do
+    const TrustRegionIteration& it = res.trace.back();
+    radius = it.radius;
+    if (it.accepted) {
+      X = std::move(res.X);
+      ++accepted;
+    }
+    if (radius < 1e-14) break;
+  }
+  return X;
+}
+
+}  // namespace tessera

@@ -1,0 +1,244 @@
+#include "distributed/round_protocol.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace tessera {
+namespace {
+
+std::uint64_t key(std::uint32_t round, ProtocolPhase phase) {
+  return (static_cast<std::uint64_t>(round) << 8) | static_cast<std::uint64_t>(phase);
+}
+
+std::uint32_t u32(int x) {
+  return static_cast<std::uint32_t>(x);
+}
+
+}  // namespace
+
+RoundProtocol::RoundProtocol(AgentState& state, const BlockLayout& layout,
+                             const RoundConfig& config)
+    : state_(state), layout_(layout), config_(config) {
+  config_.update.validate();
+  if (config_.scheme) scheme_ = config_.scheme->clone();
+  config_.scheme = nullptr;  // the clone is ours; the caller's object may go away
+}
+
+bool RoundProtocol::selected(int block) const {
+  return std::binary_search(selection_.begin(), selection_.end(), block);
+}
+
+std::vector<int> RoundProtocol::selected_neighbours() const {
+  std::vector<int> out;
+  for (int a : layout_.adjacent[static_cast<std::size_t>(state_.id())])
+    if (selected(a)) out.push_back(a);
+  return out;
+}
+
+std::vector<OutgoingMessage> RoundProtocol::start() {
+  start_time_ = std::chrono::steady_clock::now();
+  std::vector<OutgoingMessage> out;
+  const auto& adj = layout_.adjacent[static_cast<std::size_t>(state_.id())];
+  send_poses(state_.Y, BlockKind::kY, ProtocolPhase::kInit, adj, out);
+  expect(0, ProtocolPhase::kInit, adj);
+  pump(out);
+  return out;
+}
+
+std::vector<OutgoingMessage> RoundProtocol::handle(const ProtocolMessage& message) {
+  std::uint32_t round = 0, phase = 0, sender = 0;
+  if (const auto* p = std::get_if<PoseBlockMessage>(&message)) {
+    round = p->round, phase = p->phase, sender = p->sender;
+  } else {
+    const auto& s = std::get<RoundStatusMessage>(message);
+    round = s.round, phase = s.phase, sender = s.sender;
+  }
+  if (sender >= u32(layout_.num_blocks) ||
+      phase > static_cast<std::uint32_t>(ProtocolPhase::kRedoStatus))
+    throw std::runtime_error("agent " + std::to_string(state_.id()) +
+                             ": malformed message (sender " + std::to_string(sender) + ", phase " +
+                             std::to_string(phase) + ")");
+  Inbox& inbox = pending_[key(round, static_cast<ProtocolPhase>(phase))];
+  if (!inbox.emplace(static_cast<int>(sender), message).second)
+    throw std::runtime_error("agent " + std::to_string(state_.id()) +
+                             ": duplicate message from agent " + std::to_string(sender));
+  std::vector<OutgoingMessage> out;
+  pump(out);
+  return out;
+}
+
+void RoundProtocol::expect(std::uint32_t round, ProtocolPhase phase, std::vector<int> senders) {
+  wait_round_ = round;
+  phase_ = phase;
+  wait_senders_ = std::move(senders);
+}
+
+void RoundProtocol::pump(std::vector<OutgoingMessage>& out) {
+  while (!done_) {
+    Inbox& inbox = pending_[key(wait_round_, phase_)];
+    for (int s : wait_senders_)
+      if (!inbox.count(s)) return;
+    Inbox taken = std::move(inbox);
+    pending_.erase(key(wait_round_, phase_));
+    complete(taken, out);
+  }
+}
+
+void RoundProtocol::send_poses(const Eigen::MatrixXd& X, BlockKind kind, ProtocolPhase phase,
+                               const std::vector<int>& recipients,
+                               std::vector<OutgoingMessage>& out) {
+  for (int a : recipients) {
+    OutgoingMessage m;
+    m.message = state_.publish(X, kind, a, u32(round_), static_cast<std::uint32_t>(phase));
+    m.broadcast = false;
+    m.recipients = {u32(a)};
+    out.push_back(std::move(m));
+  }
+}
+
+void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
+  switch (phase_) {
+    case ProtocolPhase::kInit:
+      for (auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), state_.Yn);
+      begin_status(ProtocolPhase::kStatus, out);
+      return;
+    case ProtocolPhase::kStatus:
+    case ProtocolPhase::kRedoStatus:
+      after_status(phase_, inbox, out);
+      return;
+    case ProtocolPhase::kExtrapolate:
+      for (auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), state_.Pn);
+      begin_update(out);
+      return;
+    case ProtocolPhase::kUpdate:
+      // Unselected neighbours took P^k; selected ones overwrite it with their Y^{k+1}.
+      if (scheme_ && scheme_->unselected_take_extrapolation()) state_.Yn = state_.Pn;
+      for (auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), state_.Yn);
+      ++round_;
+      begin_status(ProtocolPhase::kStatus, out);
+      return;
+    case ProtocolPhase::kRedoUpdate:
+      for (auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), state_.Yn);
+      state_.V = state_.Y;
+      ++round_;
+      begin_status(ProtocolPhase::kRedoStatus, out);
+      return;
+  }
+}
+
+void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessage>& out) {
+  const LocalStatus s = state_.status();
+  RoundStatusMessage m;
+  m.round = u32(round_);
+  m.sender = u32(state_.id());
+  m.phase = static_cast<std::uint32_t>(phase);
+  m.cost = s.cost_share;
+  m.grad_norm_sq = s.grad_norm_sq;
+  m.block_grad_norm = s.block_grad_norm;
+  // Our own status goes straight into the inbox: the reduction then treats every agent alike.
+  pending_[key(u32(round_), phase)].emplace(state_.id(), m);
+  OutgoingMessage o;
+  o.message = m;
+  o.broadcast = true;
+  out.push_back(std::move(o));
+  std::vector<int> everyone(static_cast<std::size_t>(layout_.num_blocks));
+  for (int b = 0; b < layout_.num_blocks; ++b) everyone[static_cast<std::size_t>(b)] = b;
+  expect(u32(round_), phase, std::move(everyone));
+}
+
+void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
+                                 std::vector<OutgoingMessage>& out) {
+  // The reduction: summed in agent-id order (the map's order) by every agent.
+  double f = 0.0, gsq = 0.0;
+  std::vector<double> norms(static_cast<std::size_t>(layout_.num_blocks), 0.0);
+  for (const auto& [sender, m] : inbox) {
+    const auto& s = std::get<RoundStatusMessage>(m);
+    f += s.cost;
+    gsq += s.grad_norm_sq;
+    norms[static_cast<std::size_t>(sender)] = s.block_grad_norm;
+  }
+  const int me = state_.id();
+  const bool restart = phase == ProtocolPhase::kStatus && scheme_ && round_ > 0 &&
+                       scheme_->restart_constant() >= 0 &&
+                       f_prev_ - f < scheme_->restart_constant() * gsq_prev_;
+  if (restart) {
+    // Back to Y^{k-1}; the same blocks redo a plain update from there.
+    ++restarts_;
+    trace_.back().restart = true;
+    --round_;
+    state_.Y = state_.Y_prev;
+    state_.Yn = state_.Yn_prev;
+    scheme_->restart();
+    if (selected(me)) {
+      state_.Y = state_.update(state_.Y, state_.Yn, config_.update);
+      send_poses(state_.Y, BlockKind::kY, ProtocolPhase::kRedoUpdate,
+                 layout_.adjacent[static_cast<std::size_t>(me)], out);
+    }
+    expect(u32(round_), ProtocolPhase::kRedoUpdate, selected_neighbours());
+    return;
+  }
+  RoundRecord rec;
+  rec.round = round_;
+  rec.cost = f;
+  rec.grad_norm = std::sqrt(gsq);
+  rec.elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time_).count();
+  const bool small_decrease = config_.rel_cost_decrease_tol > 0 && round_ > 0 && f <= f_prev_ &&
+                              f_prev_ - f <= config_.rel_cost_decrease_tol * std::abs(f);
+  if (rec.grad_norm <= config_.grad_norm_tol)
+    stop_reason_ = "grad_norm";
+  else if (round_ >= config_.max_rounds)
+    stop_reason_ = "max_rounds";
+  else if (small_decrease)
+    stop_reason_ = "relative_decrease";
+  if (!stop_reason_.empty()) {
+    trace_.push_back(rec);
+    done_ = true;
+    return;
+  }
+  f_prev_ = f;
+  gsq_prev_ = gsq;
+  selection_ = select_blocks(config_.selection, config_.parallel, config_.seed,
+                             static_cast<std::uint64_t>(round_), norms, layout_);
+  rec.selected = selection_;
+  trace_.push_back(rec);
+  state_.Y_prev = state_.Y;
+  state_.Yn_prev = state_.Yn;
+  if (!scheme_) {
+    begin_update(out);
+    return;
+  }
+  coeff_ = scheme_->coefficients();
+  state_.P = extrapolate(state_.manifold(), coeff_, state_.Y, state_.V);
+  const bool everyone = scheme_->unselected_take_extrapolation();
+  std::vector<int> to;
+  for (int a : layout_.adjacent[static_cast<std::size_t>(me)])
+    if (everyone || selected(a)) to.push_back(a);
+  send_poses(state_.P, BlockKind::kP, ProtocolPhase::kExtrapolate, to, out);
+  std::vector<int> from;
+  if (everyone || selected(me)) from = layout_.adjacent[static_cast<std::size_t>(me)];
+  expect(u32(round_), ProtocolPhase::kExtrapolate, std::move(from));
+}
+
+void RoundProtocol::begin_update(std::vector<OutgoingMessage>& out) {
+  const int me = state_.id();
+  const bool accelerated = scheme_ != nullptr;
+  Eigen::MatrixXd Y_new;
+  if (selected(me)) {
+    Y_new = accelerated ? state_.update(state_.P, state_.Pn, config_.update)
+                        : state_.update(state_.Y, state_.Yn, config_.update);
+    send_poses(Y_new, BlockKind::kY, ProtocolPhase::kUpdate,
+               layout_.adjacent[static_cast<std::size_t>(me)], out);
+  } else {
+    Y_new = (accelerated && scheme_->unselected_take_extrapolation()) ? state_.P : state_.Y;
+  }
+  if (accelerated) {
+    state_.V = momentum_update(state_.manifold(), coeff_, state_.V, state_.P, Y_new);
+    scheme_->advance();
+  }
+  state_.Y = std::move(Y_new);
+  expect(u32(round_), ProtocolPhase::kUpdate, selected_neighbours());
+}
+
+}  // namespace tessera

@@ -1,0 +1,120 @@
+#pragma once
+// The round protocol of one agent: a state machine that consumes messages and emits messages.
+// It holds no transport and does no math of its own (that is AgentState, block_selection and
+// the momentum schemes); it decides which step comes next and what must be sent.
+//
+// Round k (Y^k known to the agent and, for its public poses, to its neighbours):
+//   STATUS      every agent broadcasts its cost share and squared block gradient norm at Y^k;
+//               once all N are in, each agent sums them in agent-id order (so every agent gets
+//               bit-identical f(Y^k) and ||grad f(Y^k)||), checks stopping, and for the
+//               accelerated methods the restart test of round k-1 (see below); then selects
+//               the block(s) S_k.
+//   EXTRAPOLATE (accelerated only) every agent forms P^k from its own Y, V and sends its public
+//               P poses to the neighbours that need them (the selected ones, or every neighbour
+//               when unselected blocks take P^k).
+//   UPDATE      the selected agents update their block and send their public Y^{k+1} poses.
+//   Restart:    if the STATUS of round k+1 shows f(Y^k) - f(Y^{k+1}) < c ||grad f(Y^k)||^2,
+//               every agent returns to Y^k, S_k redo a plain block update from Y^k (REDO_UPDATE),
+//               V := Y, and the status is taken again (REDO_STATUS).
+// Messages may arrive early or in any order; they are buffered by (round, phase) and used only
+// when the agent reaches that step, so any correct delivery gives identical iterates.
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "distributed/agent_state.hpp"
+#include "distributed/block_layout.hpp"
+#include "distributed/block_selection.hpp"
+#include "distributed/momentum.hpp"
+#include "distributed/rbcd.hpp"
+#include "protocol/messages.hpp"
+
+namespace tessera {
+
+/// Protocol steps, carried in the messages' `phase` field.
+enum class ProtocolPhase : std::uint32_t {
+  kInit = 0,         ///< Initial public Y poses.
+  kStatus = 1,       ///< Round status at Y^k.
+  kExtrapolate = 2,  ///< Public P^k poses.
+  kUpdate = 3,       ///< Public Y^{k+1} poses of the selected blocks.
+  kRedoUpdate = 4,   ///< Same after a restart.
+  kRedoStatus = 5    ///< Round status after a restart.
+};
+
+/// What the protocol needs to know; identical on every agent.
+struct RoundConfig {
+  SelectionRule selection = SelectionRule::kGreedy;
+  bool parallel = false;
+  std::uint64_t seed = 1;
+  double grad_norm_tol = 0.01;
+  int max_rounds = 10000;
+  double rel_cost_decrease_tol = 0.0;
+  BlockUpdateOptions update;
+  /// Null for plain RBCD; otherwise RBCD++ or IRBCD (each agent keeps its own clone).
+  const MomentumScheme* scheme = nullptr;
+};
+
+/// One round as every agent sees it (identical on all agents).
+struct RoundRecord {
+  int round = 0;
+  double cost = 0.0;       ///< f(Y^k), full sum.
+  double grad_norm = 0.0;  ///< ||grad f(Y^k)||.
+  std::vector<int> selected;
+  bool restart = false;    ///< The update of this round was redone from Y^k.
+  double elapsed_s = 0.0;  ///< Since start(), when the status completed (not part of the iterates).
+};
+
+class RoundProtocol {
+ public:
+  RoundProtocol(AgentState& state, const BlockLayout& layout, const RoundConfig& config);
+
+  std::vector<OutgoingMessage> start();
+  /// Consumes one message addressed to this agent. Throws std::runtime_error on a message
+  /// that cannot belong to this run (bad sender, wrong shape, unexpected pose).
+  std::vector<OutgoingMessage> handle(const ProtocolMessage& message);
+
+  bool done() const { return done_; }
+  int rounds() const { return round_; }
+  int restarts() const { return restarts_; }
+  const std::string& stop_reason() const { return stop_reason_; }
+  const std::vector<RoundRecord>& trace() const { return trace_; }
+  const AgentState& state() const { return state_; }
+
+ private:
+  using Inbox = std::map<int, ProtocolMessage>;  // by sender: processed in id order
+  void expect(std::uint32_t round, ProtocolPhase phase, std::vector<int> senders);
+  void pump(std::vector<OutgoingMessage>& out);
+  void complete(Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void begin_status(ProtocolPhase phase, std::vector<OutgoingMessage>& out);
+  void after_status(ProtocolPhase phase, const Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void begin_update(std::vector<OutgoingMessage>& out);
+  void send_poses(const Eigen::MatrixXd& X, BlockKind kind, ProtocolPhase phase,
+                  const std::vector<int>& recipients, std::vector<OutgoingMessage>& out);
+  bool selected(int block) const;
+  std::vector<int> selected_neighbours() const;
+
+  AgentState& state_;
+  const BlockLayout& layout_;
+  RoundConfig config_;
+  std::unique_ptr<MomentumScheme> scheme_;
+  MomentumCoefficients coeff_;
+
+  int round_ = 0;
+  ProtocolPhase phase_ = ProtocolPhase::kInit;
+  std::uint32_t wait_round_ = 0;
+  std::vector<int> wait_senders_;
+  std::map<std::uint64_t, Inbox> pending_;
+  std::vector<int> selection_;
+  double f_prev_ = 0.0, gsq_prev_ = 0.0;
+  bool done_ = false;
+  int restarts_ = 0;
+  std::string stop_reason_;
+  std::vector<RoundRecord> trace_;
+  std::chrono::steady_clock::time_point start_time_;
+};
+
+}  // namespace tessera

@@ -1,0 +1,234 @@
+// The distributed engine: N agents in one process reach the centralized optimum, the agents'
+// cost shares sum to the global cost, and iterates do not depend on message delivery order.
+
+#include "distributed/distributed_solver.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "distributed/agent_state.hpp"
+#include "distributed/block_layout.hpp"
+#include "partition/sequential_partition.hpp"
+#include "problem/block_problem.hpp"
+#include "problem/lifting.hpp"
+#include "random_graph.hpp"
+#include "solvers/centralized_solver.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera {
+namespace {
+
+PoseGraph small_graph(int d, std::size_t poses, std::uint64_t seed) {
+  test::RandomGraphSpec spec;
+  spec.d = d;
+  spec.poses = poses;
+  spec.loop_closures = poses / 2;
+  spec.seed = seed;
+  return test::random_pose_graph(spec);
+}
+
+double optimum(const PoseGraph& g) {
+  return solve_centralized(g).cost;
+}
+
+TEST(DistributedSolver, TwoBlocksConvergeToCentralizedOptimum) {
+  const PoseGraph g = small_graph(2, 40, 3);
+  DistributedOptions opt;
+  opt.algorithm = DistributedAlgorithm::kRbcd;
+  // 1e-4: far below the solvers' 0.01, yet above the level where one block step's decrease
+  // is lost in the cost's round-off (then the trust region rejects every step).
+  opt.grad_norm_tol = 1e-4;
+  opt.max_rounds = 2000;
+  const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 2), opt);
+  EXPECT_EQ(r.stop_reason, "grad_norm") << r.grad_norm << " " << r.rounds;
+  EXPECT_EQ(r.agents, 2);
+  const double fstar = optimum(g);
+  EXPECT_NEAR(r.cost, fstar, 1e-7 * fstar);
+}
+
+TEST(DistributedSolver, AgentCostSharesSumToGlobalCost) {
+  const PoseGraph g = small_graph(3, 50, 5);
+  const std::vector<int> assignment = {0, 1, 2, 0, 1, 2};  // interleaved: many cut edges
+  std::vector<int> a(g.num_poses);
+  for (std::size_t i = 0; i < g.num_poses; ++i) a[i] = assignment[i % assignment.size()];
+  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
+  const Eigen::MatrixXd X = lift_poses(g.initial, 5) + 0.0 * Eigen::MatrixXd::Zero(5, 4 * 50);
+  const BlockProblem whole = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  double sum = 0.0, gsq = 0.0;
+  for (int b = 0; b < 3; ++b) {
+    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+    BlockProblem p(3, ids, g.measurements);
+    auto gather = [&](const std::vector<std::size_t>& which) {
+      Eigen::MatrixXd out(5, 4 * static_cast<Eigen::Index>(which.size()));
+      for (std::size_t s = 0; s < which.size(); ++s)
+        out.middleCols(4 * static_cast<Eigen::Index>(s), 4) =
+            X.middleCols(4 * static_cast<Eigen::Index>(which[s]), 4);
+      return out;
+    };
+    p.set_neighbor_poses(gather(p.neighbors()));
+    const Eigen::MatrixXd Xb = gather(ids);
+    sum += p.cost_share(Xb);
+    gsq += p.riemannian_gradient(Xb, p.euclidean_gradient(Xb)).squaredNorm();
+  }
+  EXPECT_NEAR(sum, whole.cost(X), 1e-10 * whole.cost(X));
+  const double g_whole = whole.riemannian_gradient(X, whole.euclidean_gradient(X)).squaredNorm();
+  EXPECT_NEAR(gsq, g_whole, 1e-9 * g_whole);
+}
+
+TEST(DistributedSolver, DeterministicAcrossDeliveryOrdersAndReruns) {
+  const PoseGraph g = small_graph(3, 60, 7);
+  for (auto alg : {DistributedAlgorithm::kRbcd, DistributedAlgorithm::kRbcdPlusPlus,
+                   DistributedAlgorithm::kIrbcd}) {
+    DistributedOptions opt;
+    opt.algorithm = alg;
+    opt.selection = SelectionRule::kUniform;
+    opt.max_rounds = 60;
+    opt.grad_norm_tol = 0;
+    opt.irbcd.restart_c = 1e-3;  // make restarts part of the comparison
+    const auto part = sequential_partition(g.num_poses, 4);
+    const DistributedResult a = solve_distributed(g, part, opt);
+    const DistributedResult again = solve_distributed(g, part, opt);
+    opt.delivery = DeliveryOrder::kReversed;
+    const DistributedResult b = solve_distributed(g, part, opt);
+    opt.delivery = DeliveryOrder::kShuffled;
+    opt.delivery_seed = 99;
+    const DistributedResult c = solve_distributed(g, part, opt);
+    ASSERT_EQ(a.trace.size(), b.trace.size());
+    for (const auto* o : {&again, &b, &c}) {
+      EXPECT_TRUE(a.X == o->X) << algorithm_name(alg);  // bit-identical
+      EXPECT_EQ(a.rounds, o->rounds);
+      EXPECT_EQ(a.restarts, o->restarts);
+      EXPECT_EQ(a.bytes_exchanged, o->bytes_exchanged);
+      for (std::size_t k = 0; k < a.trace.size(); ++k) {
+        EXPECT_EQ(a.trace[k].cost, o->trace[k].cost);
+        EXPECT_EQ(a.trace[k].selected, o->trace[k].selected);
+      }
+    }
+  }
+}
+
+class EachAlgorithm : public ::testing::TestWithParam<DistributedAlgorithm> {};
+
+TEST_P(EachAlgorithm, ReachesToleranceAndOptimum) {
+  for (int d : {2, 3}) {
+    const PoseGraph g = small_graph(d, 80, 11);
+    const double fstar = optimum(g);
+    for (bool parallel : {false, true}) {
+      DistributedOptions opt;
+      opt.algorithm = GetParam();
+      opt.parallel = parallel;
+      opt.grad_norm_tol = 0.01;
+      opt.max_rounds = 5000;
+      const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 5), opt);
+      EXPECT_EQ(r.stop_reason, "grad_norm") << algorithm_name(GetParam()) << " d=" << d;
+      EXPECT_LE(r.grad_norm, 0.01);
+      EXPECT_NEAR(r.cost, fstar, 1e-5 * fstar) << algorithm_name(GetParam()) << " d=" << d;
+      EXPECT_GT(r.bytes_exchanged, 0u);
+      ASSERT_FALSE(r.trace.empty());
+      EXPECT_EQ(r.trace.back().round, r.rounds);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Distributed, EachAlgorithm,
+                         ::testing::Values(DistributedAlgorithm::kRbcd,
+                                           DistributedAlgorithm::kRbcdPlusPlus,
+                                           DistributedAlgorithm::kIrbcd));
+
+TEST(DistributedSolver, RestartPathConvergesAndIsRecorded) {
+  const PoseGraph g = small_graph(3, 60, 13);
+  DistributedOptions opt;
+  opt.algorithm = DistributedAlgorithm::kIrbcd;
+  opt.irbcd.restart_c = 1e3;  // absurdly demanding: nearly every round restarts
+  opt.max_rounds = 5000;
+  const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 3), opt);
+  EXPECT_GT(r.restarts, 0);
+  int flagged = 0;
+  for (const auto& row : r.trace) flagged += row.restart ? 1 : 0;
+  EXPECT_EQ(flagged, r.restarts);
+  EXPECT_EQ(r.stop_reason, "grad_norm");
+  // After a restart the redo is a plain block update: the cost never goes up.
+  for (std::size_t k = 1; k < r.trace.size(); ++k)
+    EXPECT_LE(r.trace[k].cost, r.trace[k - 1].cost * (1 + 1e-12));
+}
+
+TEST(DistributedSolver, MaxRoundsStops) {
+  const PoseGraph g = small_graph(2, 30, 2);
+  DistributedOptions opt;
+  opt.max_rounds = 3;
+  opt.grad_norm_tol = 0;
+  const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 3), opt);
+  EXPECT_EQ(r.rounds, 3);
+  EXPECT_EQ(r.stop_reason, "max_rounds");
+  EXPECT_EQ(r.trace.size(), 4u);
+}
+
+TEST(DistributedSolver, DistributedInitializationStartsCloseAndConverges) {
+  test::RandomGraphSpec spec;
+  spec.d = 3;
+  spec.poses = 60;
+  spec.loop_closures = 30;
+  spec.rotation_noise = 0;
+  spec.translation_noise = 0;
+  const PoseGraph exact = test::random_pose_graph(spec);
+  DistributedOptions opt;
+  opt.initialization = DistributedInit::kDistributed;
+  opt.max_rounds = 0;
+  const DistributedResult r0 = solve_distributed(exact, sequential_partition(60, 4), opt);
+  EXPECT_LT(r0.cost, 1e-8);  // noise-free: every robot's chordal solve and the alignment are exact
+  const PoseGraph g = small_graph(3, 60, 17);
+  opt.max_rounds = 5000;
+  const DistributedResult r = solve_distributed(g, sequential_partition(60, 4), opt);
+  EXPECT_EQ(r.stop_reason, "grad_norm");
+  EXPECT_NEAR(r.cost, optimum(g), 1e-5 * optimum(g));
+}
+
+TEST(DistributedSolver, ColourClassesAreIndependentSets) {
+  const PoseGraph g = small_graph(2, 60, 19);
+  std::vector<int> a(g.num_poses);
+  for (std::size_t i = 0; i < g.num_poses; ++i) a[i] = static_cast<int>(i % 6);
+  const BlockLayout L = make_block_layout(g.num_poses, g.measurements, a);
+  for (const auto& cls : L.colour_classes)
+    for (int x : cls)
+      for (int y : cls) EXPECT_LT(L.adjacency_index(x, y), 0);
+}
+
+TEST(DistributedSolver, BadOptionsNameTheField) {
+  auto message_of = [](auto&& f) {
+    try {
+      f();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  DistributedOptions o;
+  o.grad_norm_tol = -1;
+  EXPECT_NE(message_of([&] { o.validate(); }).find("grad_norm_tol"), std::string::npos);
+  o = {};
+  o.max_rounds = -2;
+  EXPECT_NE(message_of([&] { o.validate(); }).find("max_rounds"), std::string::npos);
+  o = {};
+  o.block_update.trust_region_steps = 0;
+  EXPECT_NE(message_of([&] { o.validate(); }).find("trust_region_steps"), std::string::npos);
+  o = {};
+  o.irbcd.b0 = 0;
+  EXPECT_NE(message_of([&] { o.validate(); }).find("b0"), std::string::npos);
+  o = {};
+  o.irbcd.sigma = -1;
+  EXPECT_NE(message_of([&] { o.validate(); }).find("sigma"), std::string::npos);
+  const PoseGraph g = small_graph(3, 20, 1);
+  o = {};
+  o.rank = 2;
+  EXPECT_NE(message_of([&] { solve_distributed(g, sequential_partition(20, 2), o); }).find("rank"),
+            std::string::npos);
+  std::vector<int> bad(20, 0);
+  bad[3] = 2;  // block 1 empty
+  EXPECT_NE(message_of([&] { solve_distributed(g, bad, DistributedOptions{}); }).find("empty"),
+            std::string::npos);
+  EXPECT_NE(message_of([] { parse_algorithm("sgd"); }).find("rbcd"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace tessera
