@@ -90,7 +90,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
       break;
   }
   const BlockProblem problem = BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
-  BlockPreconditioner precon(problem, options.preconditioner_shift);
+  const BlockPreconditioner precon(problem, options.preconditioner_shift);
   Eigen::MatrixXd X = lift_poses(init, options.initial_rank);
   res.init_s = seconds_since(start);
 

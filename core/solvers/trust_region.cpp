@@ -89,7 +89,7 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M, co
 
 TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::MatrixXd& X0,
                                      const TrustRegionOptions& options,
-                                     BlockPreconditioner* preconditioner) {
+                                     const BlockPreconditioner* preconditioner) {
   options.validate();
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] {
@@ -102,8 +102,6 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   Eigen::MatrixXd egrad = problem.euclidean_gradient(res.X);
   Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
   double grad_norm = std::sqrt(inner(grad, grad));
-  const bool adaptive = preconditioner && options.adaptive_preconditioner;
-  if (adaptive) preconditioner->update(res.X, egrad);
   double radius = options.initial_radius;
   if (radius <= 0) {
     Eigen::MatrixXd z = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
@@ -141,7 +139,6 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       egrad = problem.euclidean_gradient(res.X);
       grad = M.tangent_project(res.X, egrad);
       grad_norm = std::sqrt(inner(grad, grad));
-      if (adaptive) preconditioner->update(res.X, egrad);
     }
     res.iterations = it + 1;
     if (options.record_trace)

@@ -26,9 +26,6 @@ struct TrustRegionOptions {
   double acceptance_ratio = 1e-4;   ///< Minimum rho to accept a step, in [0, 0.25).
   double max_time_s = 1e9;          ///< Wall-clock budget, seconds (> 0).
   bool record_trace = true;
-  /// Re-base the preconditioner on the certificate matrix S(X) after each accepted step
-  /// (see BlockPreconditioner::update).
-  bool adaptive_preconditioner = true;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
@@ -59,6 +56,6 @@ struct TrustRegionResult {
 /// `preconditioner` may be null (identity).
 TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::MatrixXd& X0,
                                      const TrustRegionOptions& options,
-                                     BlockPreconditioner* preconditioner = nullptr);
+                                     const BlockPreconditioner* preconditioner = nullptr);
 
 }  // namespace tessera

@@ -1,0 +1,189 @@
+// The centralized certifiable solver: optimality, certificates, initialization, and the
+// reference optima of the public benchmark graphs.
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include "certification/certificate.hpp"
+#include "generate/generator.hpp"
+#include "io/g2o_reader.hpp"
+#include "problem/block_problem.hpp"
+#include "problem/lifting.hpp"
+#include "problem/objective.hpp"
+#include "solvers/centralized_solver.hpp"
+#include "solvers/chordal_initialization.hpp"
+#include "util/input_error.hpp"
+#include "random_graph.hpp"
+#include "test_support.hpp"
+
+namespace tessera {
+namespace {
+
+class CentralizedTest : public ::testing::TestWithParam<int> {};
+
+TEST_P(CentralizedTest, CertifiesAndAgreesAcrossInitializations) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 60, 40, 0.05, 0.1, 21});
+  CentralizedOptions opt;
+  const CentralizedResult a = solve_centralized(g, opt);
+  ASSERT_TRUE(a.certified.has_value());
+  EXPECT_TRUE(*a.certified);
+  EXPECT_LE(a.cost, evaluate_objective(g, chordal_initialization(g)) + 1e-9);
+  // A certified optimum is global: another start reaches the same value.
+  opt.initialization = Initialization::kOdometry;
+  const CentralizedResult b = solve_centralized(g, opt);
+  EXPECT_TRUE(*b.certified);
+  EXPECT_NEAR(a.cost, b.cost, 1e-6 * a.cost);
+  // The rounded estimate attains the relaxation's value (the relaxation is tight here).
+  EXPECT_NEAR(a.cost, a.relaxation_cost, 1e-6 * a.cost);
+  EXPECT_EQ(a.poses.size(), g.num_poses);
+}
+
+TEST_P(CentralizedTest, NoiseFreeGraphHasZeroCost) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 30, 20, 0.0, 0.0, 5});
+  const CentralizedResult r = solve_centralized(g);
+  EXPECT_TRUE(*r.certified);
+  EXPECT_LT(r.cost, 1e-10);
+}
+
+TEST_P(CentralizedTest, CertificateEigenvalueMatchesDenseComputation) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 15, 10, 0.1, 0.1, 9});
+  const BlockProblem P = BlockProblem::whole_graph(d, g.num_poses, g.measurements);
+  // At the optimum: certified, lambda_min close to 0 from above.
+  const CentralizedResult r = solve_centralized(g);
+  Eigen::MatrixXd S = Eigen::MatrixXd(certificate_matrix(P, r.X));
+  const double dense_min = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S).eigenvalues()(0);
+  const CertificateResult c = verify_certificate(P, r.X);
+  EXPECT_TRUE(c.certified);
+  EXPECT_NEAR(c.min_eigenvalue, dense_min, 1e-6 * S.norm());
+  // At an arbitrary point far from critical, S is indefinite: the certificate fails, and the
+  // returned direction has the most negative curvature.
+  Eigen::MatrixXd X = lift_poses(g.initial, d + 1);
+  std::vector<Pose> bad = g.initial;
+  for (auto& p : bad) p.R = project_to_rotation(Eigen::MatrixXd::Random(d, d));
+  X = lift_poses(bad, d + 1);
+  Eigen::MatrixXd S2 = Eigen::MatrixXd(certificate_matrix(P, X));
+  const double dense_min2 = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(S2).eigenvalues()(0);
+  const CertificateResult c2 = verify_certificate(P, X);
+  ASSERT_LT(dense_min2, -1e-3);
+  EXPECT_FALSE(c2.certified);
+  EXPECT_NEAR(c2.min_eigenvalue, dense_min2, 1e-6 * S2.norm());
+  EXPECT_NEAR(c2.min_eigenvector.dot(S2 * c2.min_eigenvector), dense_min2, 1e-6 * S2.norm());
+}
+
+TEST(CentralizedSolver, StaircaseEscapesFromRankDeficientSaddle) {
+  // At rank r = d, starting from a point with a large rotation error, the solver may stop
+  // at a non-certified critical point; it must then climb the staircase and certify.
+  auto g = test::random_pose_graph({2, 80, 60, 0.3, 0.2, 33});
+  CentralizedOptions opt;
+  opt.initial_rank = 2;
+  opt.initialization = Initialization::kOdometry;
+  const CentralizedResult r = solve_centralized(g, opt);
+  EXPECT_TRUE(*r.certified);
+  CentralizedOptions ref;
+  const CentralizedResult best = solve_centralized(g, ref);
+  EXPECT_NEAR(r.cost, best.cost, 1e-6 * best.cost);
+}
+
+TEST(CentralizedSolver, RejectsInvalidOptionsNamingTheField) {
+  auto g = test::random_pose_graph({3, 10, 5, 0.05, 0.1, 1});
+  CentralizedOptions opt;
+  opt.max_rank = 2;
+  try {
+    solve_centralized(g, opt);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("max_rank"), std::string::npos) << e.what();
+  }
+  CentralizedOptions opt2;
+  opt2.trust_region.max_iterations = 0;
+  EXPECT_THROW(solve_centralized(g, opt2), InputError);
+}
+
+struct GeneratedCase {
+  TrajectoryKind kind;
+  std::size_t poses;
+};
+
+class GeneratedGraphTest : public ::testing::TestWithParam<GeneratedCase> {};
+
+TEST_P(GeneratedGraphTest, GeneratorGraphsAreSolvedAndCertified) {
+  GeneratorOptions o;
+  o.kind = GetParam().kind;
+  o.num_poses = GetParam().poses;
+  o.num_robots = 4;
+  o.seed = 7;
+  const GeneratorResult gen = generate_pose_graph(o);
+  const CentralizedResult r = solve_centralized(gen.graph);
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_TRUE(*r.certified) << trajectory_kind_name(o.kind);
+  // Small noise: the optimum is no worse than the ground truth.
+  EXPECT_LE(r.cost, evaluate_objective(gen.graph, gen.ground_truth) * (1 + 1e-9));
+}
+
+INSTANTIATE_TEST_SUITE_P(Dimensions, CentralizedTest, ::testing::Values(2, 3));
+INSTANTIATE_TEST_SUITE_P(Kinds, GeneratedGraphTest,
+                         ::testing::Values(GeneratedCase{TrajectoryKind::kGrid3d, 500},
+                                           GeneratedCase{TrajectoryKind::kSphere, 400},
+                                           GeneratedCase{TrajectoryKind::kTorus, 400},
+                                           GeneratedCase{TrajectoryKind::kCity, 600}));
+
+// --- The public benchmark graphs against the reference optima ------------------------------
+
+std::map<std::string, double> read_optima(const std::string& path) {
+  std::map<std::string, double> f;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string name, poses, edges, d, fstar;
+    std::getline(ss, name, ',');
+    std::getline(ss, poses, ',');
+    std::getline(ss, edges, ',');
+    std::getline(ss, d, ',');
+    std::getline(ss, fstar, ',');
+    f[name] = std::stod(fstar);
+  }
+  return f;
+}
+
+class DatasetTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(DatasetTest, ReachesCertifiedReferenceOptimum) {
+  TESSERA_REQUIRE_SHARED();
+  const std::string shared = test::shared_dir();
+  const auto optima = read_optima(shared + "/reference/optima.csv");
+  const std::string name = GetParam();
+  // Quaternions are normalised on reading, so 3D graphs compare with the _qnorm rows.
+  auto it = optima.find(name + "_qnorm");
+  if (it == optima.end()) it = optima.find(name);
+  ASSERT_NE(it, optima.end()) << name << " missing from optima.csv";
+  const PoseGraph g = read_g2o(shared + "/datasets/" + name + ".g2o");
+  const CentralizedResult r = solve_centralized(g);
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_TRUE(*r.certified) << name;
+  EXPECT_NEAR(r.cost, it->second, 1e-6 * it->second) << name;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Reference, DatasetTest,
+    ::testing::Values("tinyGrid3D", "smallGrid3D", "MIT", "CSAIL", "intel", "kitti_05", "kitti_00",
+                      "kitti_02", "manhattan3500", "sphere2500", "parking-garage", "city10000",
+                      "sphere_bignoise_vertex3", "ais2klinik", "cubicle", "torus3D"),
+    [](const auto& info) {
+      std::string s = info.param;
+      for (auto& c : s)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+      return s;
+    });
+
+}  // namespace
+}  // namespace tessera
