@@ -16,9 +16,9 @@
 
 namespace tessera::cli {
 
-const char* const kDistributedValued[] = {"agents",         "partition", "max-rounds", "seed",
-                                          "reference-cost", "select",    "rel-tol",    "tr-steps",
-                                          "restart-c",      "sigma",     "unselected", nullptr};
+const char* const kDistributedValued[] = {
+    "agents",   "partition", "max-rounds", "seed",       "reference-cost", "select", "rel-tol",
+    "tr-steps", "restart-c", "sigma",      "unselected", "irbcd-n",        nullptr};
 const char* const kDistributedSwitches[] = {"parallel", "reference", nullptr};
 
 const char* kDistributedHelp =
@@ -41,6 +41,7 @@ const char* kDistributedHelp =
     "  --restart-c C             restart constant c1 of RBCD++/IRBCD (< 0: never restart)\n"
     "  --sigma S                 IRBCD sigma (default 1e-3)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
+    "  --irbcd-n units|variables IRBCD: n = selectable blocks (default) or scalar variables\n"
     "  --reference               also run the centralized solver for f* and report rel_gap\n"
     "  --reference-cost F        f* given: report rel_gap = (cost - F) / F\n"
     "  --trace FILE              CSV per round: round,cost,grad_norm,selected,restart,bytes\n";
@@ -93,6 +94,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   if (unselected != "take" && unselected != "keep")
     throw InputError("option --unselected: '" + unselected + "' is not one of take, keep");
   opt.irbcd.unselected_take_extrapolation = unselected == "take";
+  opt.irbcd.dimension = parse_dimension(a.get_or("irbcd-n", "units"));
   const long agents = a.get_long("agents", 5);
   if (agents < 1 || agents > 64) throw InputError("option --agents: must be in 1..64");
   if (a.has("reference") && a.has("reference-cost"))

@@ -25,8 +25,6 @@ Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd&
   tr.grad_norm_tol = 0.0;
   tr.rel_cost_decrease_tol = 0.0;
   tr.record_trace = true;
-  // Q_BB never changes for a block: the constant factor is reused by every update.
-  tr.adaptive_preconditioner = false;
   BlockPreconditioner* precon = options.precondition ? preconditioner : nullptr;
   Eigen::MatrixXd X = X0;
   int accepted = 0;
