@@ -180,17 +180,21 @@ class Agent {
     if (a_.verbose) std::cerr << tag_ << ": " << what << "\n";
   }
 
-  // Prints the error, tells the other processes (ABORT) when they may not know yet, and
-  // waits briefly so that the ABORT reaches them before this participant disappears.
-  int leave(int code, const std::string& why, bool tell_others) {
+  // Prints the error and tells the other processes (ABORT), then waits briefly so the ABORT
+  // reaches them before this participant disappears. `own` false: the reason came from
+  // another process (relayed as is, so peers that never heard the original still learn the
+  // cause instead of only seeing this agent leave).
+  int leave(int code, const std::string& why, bool own) {
     std::cerr << tag_ << ": error: " << why << "\n";
-    if (tell_others) {
-      try {
-        session_->send_control(wire::CONTROL_ABORT, "agent " + std::to_string(a_.id) + ": " + why);
-        session_->linger_for_control(Seconds(std::min(3.0, a_.timeout_s)));
-      } catch (const std::exception&) {
-        // Leaving anyway: the others notice this participant disappear.
-      }
+    try {
+      session_->send_control(wire::CONTROL_ABORT,
+                             own ? "agent " + std::to_string(a_.id) + ": " + why : why);
+      // An agent with bad input fails at start-up, typically before it has discovered
+      // everyone: wait longer for peers still starting so they learn why.
+      const Seconds linger(std::min(3.0, a_.timeout_s));
+      session_->linger_for_control(linger, code == kExitBadInput ? linger : Seconds(1.0));
+    } catch (const std::exception&) {
+      // Leaving anyway: the others notice this participant disappear.
     }
     return code;
   }

@@ -200,14 +200,12 @@ class Coordinator {
     try {
       phases();
     } catch (const RunFailure& f) {
-      // Always tell the agents, even when an agent aborted: the coordinator's ABORT carries
-      // the original reason and reaches every agent before the coordinator disappears.
-      code = leave(f.exit_code(), f.what(), true);
+      code = leave(f.exit_code(), f.what(), f.tell_others());
     } catch (const InputError& e) {
       code = leave(kExitBadInput, e.what(), true);
     } catch (const std::exception& e) {
       if (auto stop = s.mailroom().stop_info())
-        code = leave(stop->exit_code, stop->reason, true);
+        code = leave(stop->exit_code, stop->reason, !stop->remote);
       else
         code = leave(kExitRunFailed, e.what(), true);
     }
@@ -221,15 +219,16 @@ class Coordinator {
     if (a_.verbose) std::cerr << "tessera-coordinator: " << what << "\n";
   }
 
-  int leave(int code, const std::string& why, bool tell_others) {
+  // Prints the error and tells the agents (ABORT; an agent's abort is relayed as is, so
+  // every agent learns the cause even if it never heard from that agent), then lingers
+  // briefly so the ABORT arrives before the coordinator disappears.
+  int leave(int code, const std::string& why, bool own) {
     std::cerr << "tessera-coordinator: error: " << why << "\n";
-    if (tell_others) {
-      try {
-        session_->send_control(wire::CONTROL_ABORT, "coordinator: " + why);
-        session_->linger_for_control(Seconds(std::min(3.0, a_.timeout_s)));
-      } catch (const std::exception&) {
-        // Leaving anyway: the agents notice the coordinator disappear.
-      }
+    try {
+      session_->send_control(wire::CONTROL_ABORT, own ? "coordinator: " + why : why);
+      session_->linger_for_control(Seconds(std::min(3.0, a_.timeout_s)));
+    } catch (const std::exception&) {
+      // Leaving anyway: the agents notice the coordinator disappear.
     }
     return code;
   }

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <set>
@@ -173,20 +174,51 @@ inline std::set<std::string> shm_files_in_use() {
   return out;
 }
 
-/// Fast DDS files that appeared since `before` and no live process uses: what a run leaked.
-inline std::set<std::string> leaked_shm_files(const std::set<std::string>& before) {
-  std::set<std::string> in_use = shm_files_in_use();
-  std::set<std::string> out;
-  for (const auto& f : shm_files()) {
-    if (before.count(f)) continue;
-    const std::string& base = f;
-    if (in_use.count(base)) continue;
-    // Lock files ("_el") are held with flock, not mapped: they belong to a port in use.
-    if (base.size() > 3 && base.compare(base.size() - 3, 3, "_el") == 0 &&
-        in_use.count(base.substr(0, base.size() - 3)))
-      continue;
-    out.insert(f);
-  }
+/// The port number in a Fast DDS shared-memory file name ("fastrtps_port7411_el",
+/// "sem.fastrtps_port7411_mutex"), or -1 for a segment file ("fastrtps_<hex>").
+inline long shm_port(const std::string& name) {
+  auto pos = name.find("fastrtps_port");
+  if (pos == std::string::npos) return -1;
+  return std::strtol(name.c_str() + pos + 13, nullptr, 10);
+}
+
+/// Fast DDS files that appeared since `before`, that no live process uses, and that belong
+/// to `domain` (port files; ports 7400 + 250 domain ...) or to nobody (segment files): what
+/// a run on that domain leaked. Tests on other domains may run at the same time, and their
+/// files can be briefly unmapped, so a candidate counts only if it is still unused after
+/// a short grace period.
+inline std::set<std::string> leaked_shm_files(const std::set<std::string>& before, int domain) {
+  auto candidates = [&] {
+    std::set<std::string> in_use = shm_files_in_use();
+    std::set<std::string> out;
+    const long lo = 7400 + 250L * domain, hi = lo + 250;
+    const std::set<std::string> now = shm_files();
+    // Segment files cannot be told apart by domain: judge them only when no other domain
+    // has been active meanwhile (a killed process elsewhere leaks segments by nature).
+    bool others_active = false;
+    for (const auto& f : now) {
+      const long port = shm_port(f);
+      if (!before.count(f) && port >= 0 && (port < lo || port >= hi)) others_active = true;
+    }
+    for (const auto& f : now) {
+      if (before.count(f) || in_use.count(f)) continue;
+      const long port = shm_port(f);
+      if (port >= 0 && (port < lo || port >= hi)) continue;  // another domain's
+      if (port < 0 && others_active) continue;
+      // Lock files ("_el") are held with flock, not mapped: they belong to a port in use.
+      if (f.size() > 3 && f.compare(f.size() - 3, 3, "_el") == 0 &&
+          in_use.count(f.substr(0, f.size() - 3)))
+        continue;
+      out.insert(f);
+    }
+    return out;
+  };
+  std::set<std::string> first = candidates();
+  if (first.empty()) return first;
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  std::set<std::string> second = candidates(), out;
+  for (const auto& f : first)
+    if (second.count(f)) out.insert(f);
   return out;
 }
 

@@ -197,7 +197,7 @@ TEST(DdsRuntime, OneHostRunHandsOffEveryMeasurementAndMergesEveryPose) {
   ss << summary.rdbuf();
   EXPECT_NE(ss.str().find("\"discovery_ms\""), std::string::npos);
   EXPECT_NE(ss.str().find("\"bytes_sent\""), std::string::npos);
-  EXPECT_TRUE(leaked_shm_files(before).empty()) << join(leaked_shm_files(before));
+  EXPECT_TRUE(leaked_shm_files(before, domain).empty()) << join(leaked_shm_files(before, domain));
 }
 
 TEST(DdsRuntime, TwoConcurrentRunsOnOneDomainDoNotMix) {
@@ -256,7 +256,9 @@ TEST(DdsRuntime, KilledAgentIsNamedAndEveryoneStopsNonZero) {
     EXPECT_NE(p->output().find("lost agent 1"), std::string::npos) << p->output();
   }
   // A SIGKILLed participant leaks its shared memory by nature; remove what nobody uses.
-  remove_shm_files(leaked_shm_files(before));
+  remove_shm_files(leaked_shm_files(before, domain));
+  // Its segment files too (`fastdds shm clean` only removes segments nobody holds).
+  run_command("fastdds shm clean", nullptr);
 }
 
 // Signals go to one process only: with several, which process stops first (and so
@@ -291,7 +293,7 @@ void signal_one_process(int domain, const std::string& stem, int target, int sig
     EXPECT_NE(out.find("interrupted by " + name), std::string::npos) << out;
     EXPECT_LT(procs[k].exit_after_s, 1.5 + 4.0) << out;
   }
-  const auto leaked = leaked_shm_files(before);
+  const auto leaked = leaked_shm_files(before, domain);
   EXPECT_TRUE(leaked.empty()) << "left in /dev/shm: " << join(leaked);
 }
 
@@ -320,11 +322,16 @@ TEST(DdsRuntime, AgentWithBadFileFailsClearlyAndTheOthersStop) {
   ASSERT_TRUE(wait_all({&coord, &a0, &a1, &a2}, 10)) << "a process hung";
   EXPECT_EQ(a1.exit_code, 2) << a1.output();
   EXPECT_NE(a1.output().find("bad.g2o:2:"), std::string::npos) << a1.output();
+  // The coordinator names the cause. The other agents stop too; they usually relay the
+  // cause as well, but on a heavily loaded machine an agent may not have discovered agent 1
+  // (nor anyone relaying its abort) before they left, and then reports whom it lost.
+  EXPECT_NE(coord.output().find("agent 1"), std::string::npos) << coord.output();
   for (Process* p : {&coord, &a0, &a2}) {
     EXPECT_EQ(p->exit_code, 1) << p->output();
-    EXPECT_NE(p->output().find("agent 1"), std::string::npos) << p->output();
+    EXPECT_NE(p->output().find("error: "), std::string::npos) << p->output();
+    EXPECT_LT(p->exit_after_s, 8.0) << p->output();
   }
-  const auto leaked = leaked_shm_files(before);
+  const auto leaked = leaked_shm_files(before, domain);
   EXPECT_TRUE(leaked.empty()) << "left in /dev/shm: " << join(leaked);
 }
 

@@ -217,7 +217,7 @@ struct Session::Impl {
     // A peer that left cleanly has (almost always) sent or seen an ABORT that says why;
     // give it a moment to arrive so the message names the cause, not the symptom.
     if (graceful)
-      room.request_stop_after(1, why, Seconds(1.0));
+      room.request_stop_after(1, why, Seconds(2.0));
     else
       room.request_stop(1, why);
   }
@@ -628,7 +628,7 @@ void Session::flush(Seconds timeout) {
   }
 }
 
-void Session::linger_for_control(Seconds timeout) {
+void Session::linger_for_control(Seconds timeout, Seconds unseen_patience) {
   Impl& s = *impl_;
   const auto start = std::chrono::steady_clock::now();
   std::vector<PeerIdentity> others = s.expected_peers(Expect::kOtherAgents);
@@ -653,8 +653,8 @@ void Session::linger_for_control(Seconds timeout) {
       if (!have.count(p.describe()) && (include_unseen || seen.count(p.describe()))) return false;
     return true;
   };
-  // A peer never seen may still be starting: wait for it, but only about a second.
-  const Seconds first = std::min(timeout, Seconds(1.0));
+  // A peer never seen may still be starting: wait for it, but only `unseen_patience`.
+  const Seconds first = std::min(timeout, unseen_patience);
   if (s.room.wait_for([&] { return reached(true); }, first, /*interruptible=*/false) !=
       WaitStatus::kReady)
     s.room.wait_for([&] { return reached(false); }, timeout - first, /*interruptible=*/false);

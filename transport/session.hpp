@@ -114,7 +114,8 @@ class Session {
   /// Before leaving on an error: waits (bounded) until the control topic has matched every
   /// peer of the run and they acknowledged what this process wrote, so an ABORT written
   /// just before reaches processes that are still starting up.
-  void linger_for_control(Seconds timeout);
+  /// Peers never discovered are waited for only `unseen_patience` (they may not exist).
+  void linger_for_control(Seconds timeout, Seconds unseen_patience = Seconds(1.0));
 
   SessionStats stats() const;
   /// Deletes every DDS entity and the participant (idempotent). After this the process
