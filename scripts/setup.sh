@@ -9,6 +9,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
   build-essential cmake pkg-config
   libeigen3-dev libsuitesparse-dev libspectra-dev
+  libopenblas0-serial  # optimised single-threaded BLAS behind CHOLMOD's supernodal factorizations
   libgtest-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
   python3 python3-matplotlib

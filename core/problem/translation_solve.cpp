@@ -39,7 +39,9 @@ Eigen::MatrixXd solve_translations(const PoseGraph& graph, const Eigen::MatrixXd
   L.setFromTriplets(trip.begin(), trip.end());
   Eigen::MatrixXd t = Eigen::MatrixXd::Zero(d, static_cast<Eigen::Index>(n));
   if (n == 1) return t;
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> chol(L);
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> chol;
+  chol.setMode(Eigen::CholmodAuto);  // CHOLMOD chooses simplicial or supernodal
+  chol.compute(L);
   if (chol.info() != Eigen::Success)
     throw std::runtime_error("solve_translations: Laplacian factorization failed (disconnected graph?)");
   Eigen::MatrixXd sol = chol.solve(b);

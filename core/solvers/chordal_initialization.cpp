@@ -41,7 +41,9 @@ Eigen::MatrixXd chordal_rotations(const PoseGraph& graph) {
   if (n == 1) return R;
   Eigen::SparseMatrix<double> Hrr = H.bottomRightCorner(m, m);
   Eigen::MatrixXd rhs = -Eigen::MatrixXd(H.bottomLeftCorner(m, d));
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> chol(Hrr);
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> chol;
+  chol.setMode(Eigen::CholmodAuto);  // CHOLMOD chooses simplicial or supernodal
+  chol.compute(Hrr);
   if (chol.info() != Eigen::Success)
     throw std::runtime_error("chordal initialization: factorization failed (disconnected graph?)");
   Eigen::MatrixXd Z = chol.solve(rhs);  // rows: d(n-1) coordinates, cols: row index a
