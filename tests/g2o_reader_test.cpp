@@ -103,6 +103,16 @@ TEST(G2oReader, Reads3dVerticesAndEdges) {
   EXPECT_DOUBLE_EQ(g.measurements[0].kappa, 3.0);  // 3 / (2 trace(inv(6 I3)))
 }
 
+TEST(G2oReader, VerticesInAnyOrder) {
+  for (const std::string order : {"0123", "3210", "0132", "2031"}) {
+    std::string text = edge2(0, 1) + edge2(1, 2) + edge2(2, 3);
+    for (char c : order) text += std::string("VERTEX_SE2 ") + c + " " + c + ".5 0 0\n";
+    const auto r = read(text);
+    ASSERT_EQ(r.graph.initial.size(), 4u) << order;
+    for (int k = 0; k < 4; ++k) EXPECT_DOUBLE_EQ(r.graph.initial[k].t(0), k + 0.5) << order;
+  }
+}
+
 TEST(G2oReader, SkipsBlankWhitespaceCommentAndFixLines) {
   const std::string text =
       "\n   \n\t\r\nVERTEX_SE2 0 0 0 0\r\n# a comment\nFIX 0\n  VERTEX_SE2\t1 0 0 0 \n\n" +

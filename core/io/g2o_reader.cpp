@@ -154,10 +154,11 @@ bool parse_number(std::string_view s, double& out) {
   return end == copy.c_str() + copy.size();
 }
 
-struct VertexRecord {
+// A vertex that did not arrive in id order 0, 1, 2, ... (rare; see Parser::parse_vertex).
+struct LooseVertex {
   std::uint64_t id;
-  std::size_t line;
-  std::array<double, 7> v;  // x y theta (2D) or x y z qx qy qz qw (3D, normalised)
+  std::uint32_t line;
+  Pose pose;
 };
 
 // Rotation from a quaternion with the unit-quaternion formula (the one SE-Sync applies,
@@ -185,7 +186,9 @@ class Parser {
     const std::size_t max_edges = std::min<std::size_t>(size_hint / 30 + 1, 1 << 22);
     result_.graph.measurements.reserve(max_edges);
     edge_lines_.reserve(max_edges);
-    vertices_.reserve(std::min<std::size_t>(size_hint / 18 + 1, 1 << 22));  // VERTEX_SE2 0 0 0 0
+    const std::size_t max_vertices = std::min<std::size_t>(size_hint / 18 + 1, 1 << 22);
+    result_.graph.initial.reserve(max_vertices);  // (a VERTEX line has at least 18 bytes)
+    vertex_lines_.reserve(max_vertices);
   }
 
   /// Parses whole lines [p, end): each ends with '\n', except a last line of the input.
@@ -306,16 +309,41 @@ class Parser {
     return norm;
   }
 
+  // Vertices normally come as ids 0, 1, 2, ...: their poses go straight into graph.initial
+  // and only their line numbers are kept. The first vertex out of that order moves them all
+  // to a list that is sorted and checked at the end (so any order is still accepted).
   void parse_vertex(const RecordSpec& spec) {
-    VertexRecord v{parse_id(tok_[1], "pose id"), line_, {}};
+    const std::uint64_t id = parse_id(tok_[1], "pose id");
     parse_values(spec, 1);
-    std::copy(vals_.begin() + 1, vals_.begin() + spec.values, v.v.begin());
-    if (spec.d == 3) {
+    Pose pose;
+    if (spec.d == 2) {
+      const double c = std::cos(vals_[3]), s = std::sin(vals_[3]);
+      pose.R.resize(2, 2);
+      pose.R << c, -s, s, c;
+      pose.t.resize(2);
+      pose.t << vals_[1], vals_[2];
+    } else {
       // The initial guess must lie on SE(3), so vertex quaternions are always normalised.
-      const double norm = quaternion_norm(&v.v[3]);
-      for (int k = 3; k < 7; ++k) v.v[k] /= norm;
+      double* q = &vals_[4];
+      const double norm = quaternion_norm(q);
+      pose.R = rotation_from_quaternion(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
+      pose.t.resize(3);
+      pose.t << vals_[1], vals_[2], vals_[3];
     }
-    vertices_.push_back(v);
+    auto& initial = result_.graph.initial;
+    const auto line = static_cast<std::uint32_t>(line_);
+    if (loose_.empty() && id == initial.size()) {
+      initial.push_back(std::move(pose));
+      vertex_lines_.push_back(line);
+    } else {
+      if (loose_.empty()) {
+        loose_.reserve(initial.size() + 1);
+        for (std::size_t k = 0; k < initial.size(); ++k)
+          loose_.push_back({k, vertex_lines_[k], std::move(initial[k])});
+        initial.clear();
+      }
+      loose_.push_back({id, line, std::move(pose)});
+    }
     ++stats().vertex_lines;
   }
 
@@ -365,7 +393,7 @@ class Parser {
     m.kappa = w.kappa;
     m.tau = w.tau;
     result_.graph.measurements.push_back(std::move(m));
-    edge_lines_.push_back(line_);
+    edge_lines_.push_back(static_cast<std::uint32_t>(line_));
     ++stats().edge_lines;
   }
 
@@ -375,29 +403,19 @@ class Parser {
       fail(0, line_ == 0 ? "empty file: no pose-graph edges"
                          : "no edges (EDGE_SE2 or EDGE_SE3:QUAT lines): nothing to optimise");
     std::uint64_t n = 0;
-    if (!vertices_.empty()) {
-      n = check_vertices();
+    if (!loose_.empty()) {
+      n = check_loose_vertices();
+    } else if (stats().vertex_lines > 0) {
+      // Vertices 0..n-1 in order: unique and contiguous by construction.
+      n = g.initial.size();
+      const auto& ms = g.measurements;
+      for (std::size_t e = 0; e < ms.size(); ++e)
+        for (std::size_t id : {ms[e].i, ms[e].j})
+          if (id >= n) fail_missing_pose(e, id);
     } else {
       n = check_edge_ids();
     }
     g.num_poses = static_cast<std::size_t>(n);
-    if (!vertices_.empty()) {
-      g.initial.resize(g.num_poses);
-      for (const auto& v : vertices_) {
-        Pose& pose = g.initial[v.id];
-        if (d_ == 2) {
-          const double c = std::cos(v.v[2]), s = std::sin(v.v[2]);
-          pose.R.resize(2, 2);
-          pose.R << c, -s, s, c;
-          pose.t.resize(2);
-          pose.t << v.v[0], v.v[1];
-        } else {
-          pose.R = rotation_from_quaternion(v.v[3], v.v[4], v.v[5], v.v[6]);
-          pose.t.resize(3);
-          pose.t << v.v[0], v.v[1], v.v[2];
-        }
-      }
-    }
     count_pairs();
     const auto labels = connected_components(g);
     std::size_t k = 0, outside = 0;
@@ -412,11 +430,17 @@ class Parser {
                   " to pose 0)");
   }
 
-  // With VERTEX lines: ids unique, every edge endpoint a vertex, ids exactly 0..n-1.
-  std::uint64_t check_vertices() {
-    std::vector<std::pair<std::uint64_t, std::size_t>> ids;  // (id, line)
-    ids.reserve(vertices_.size());
-    for (const auto& v : vertices_) ids.emplace_back(v.id, v.line);
+  [[noreturn]] void fail_missing_pose(std::size_t edge, std::uint64_t id) const {
+    fail(edge_lines_[edge], "edge to missing pose " + std::to_string(id) +
+                                " (the file has VERTEX lines, but none for this id)");
+  }
+
+  // Vertices in any order: ids unique, every edge endpoint a vertex, ids exactly 0..n-1;
+  // then their poses go to graph.initial by id.
+  std::uint64_t check_loose_vertices() {
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> ids;  // (id, line)
+    ids.reserve(loose_.size());
+    for (const auto& v : loose_) ids.emplace_back(v.id, v.line);
     std::sort(ids.begin(), ids.end());
     std::size_t dup_line = 0, dup_first = 0;
     std::uint64_t dup_id = 0;
@@ -434,16 +458,13 @@ class Parser {
     const bool dense = n == ids.size();
     auto has_vertex = [&](std::uint64_t id) {
       if (dense) return id < n;
-      auto it = std::lower_bound(ids.begin(), ids.end(), std::make_pair(id, std::size_t{0}));
+      auto it = std::lower_bound(ids.begin(), ids.end(), std::make_pair(id, std::uint32_t{0}));
       return it != ids.end() && it->first == id;
     };
     const auto& ms = result_.graph.measurements;
-    for (std::size_t e = 0; e < ms.size(); ++e) {
+    for (std::size_t e = 0; e < ms.size(); ++e)
       for (std::size_t id : {ms[e].i, ms[e].j})
-        if (!has_vertex(id))
-          fail(edge_lines_[e], "edge to missing pose " + std::to_string(id) +
-                                   " (the file has VERTEX lines, but none for this id)");
-    }
+        if (!has_vertex(id)) fail_missing_pose(e, id);
     if (!dense) {
       std::uint64_t missing = 0;
       while (missing < ids.size() && ids[missing].first == missing) ++missing;
@@ -451,6 +472,9 @@ class Parser {
                   std::to_string(n - 1) + " (largest VERTEX id " + std::to_string(n - 1) +
                   " on line " + std::to_string(ids.back().second) + ")");
     }
+    auto& initial = result_.graph.initial;
+    initial.resize(static_cast<std::size_t>(n));
+    for (auto& v : loose_) initial[v.id] = std::move(v.pose);
     return n;
   }
 
@@ -509,8 +533,9 @@ class Parser {
   int d_ = 0;
   std::size_t d_line_ = 0;
   std::string d_tag_;
-  std::vector<VertexRecord> vertices_;
-  std::vector<std::size_t> edge_lines_;
+  std::vector<std::uint32_t> vertex_lines_;  // line of graph.initial[k] while in order
+  std::vector<LooseVertex> loose_;           // all vertices once one came out of order
+  std::vector<std::uint32_t> edge_lines_;    // line of each measurement (inputs < 2^32 lines)
 };
 
 // Parses what `read_some(buffer, capacity)` delivers (it returns the bytes read, 0 at the
