@@ -291,6 +291,14 @@ class Agent {
     agent::AgentLocalData local =
         agent::assemble_local(share_, asg.owner(), a_.id, a_.robots, std::move(received), ro);
     share_ = agent::RobotShare();
+    if (asg.edge_i().size() != asg.edge_j().size())
+      throw RunFailure(kExitRunFailed, "the assignment's structure arrays differ in length");
+    local.structure.reserve(asg.edge_i().size());
+    for (std::size_t e = 0; e < asg.edge_i().size(); ++e) {
+      if (asg.edge_i()[e] >= local.num_poses || asg.edge_j()[e] >= local.num_poses)
+        throw RunFailure(kExitRunFailed, "the assignment's structure names a pose out of range");
+      local.structure.emplace_back(asg.edge_i()[e], asg.edge_j()[e]);
+    }
     log("hand-off complete: " + std::to_string(local.owned.size()) + " poses, " +
         std::to_string(local.measurements.size()) + " measurements");
     if (!a_.dump_local.empty()) agent::write_local_dump(local, a_.dump_local);

@@ -30,6 +30,7 @@ void write_local_dump(const AgentLocalData& local, const std::string& path) {
   std::string out = "AGENT " + std::to_string(local.agent_id) + " " +
                     std::to_string(local.num_agents) + " " + std::to_string(local.d) + " " +
                     std::to_string(local.num_poses) + "\n";
+  out += "STRUCTURE " + std::to_string(local.structure.size()) + "\n";
   for (std::uint32_t id : local.owned) out += "OWNED " + std::to_string(id) + "\n";
   for (std::size_t k = 0; k < local.initial.size(); ++k) {
     out += "POSE " + std::to_string(local.owned[k]);

@@ -12,6 +12,7 @@ namespace tessera::agent {
 
 /// Writes `local` as text, one record per line, numbers in %.17g:
 ///   "AGENT id N d n"
+///   "STRUCTURE m"                                  edges of the whole graph's structure
 ///   "OWNED id"                                     per owned pose
 ///   "POSE id R(col-major, d*d) t(d)"               per owned pose with an initial value
 ///   "MEAS index i j kappa tau R(col-major) t"      per local measurement

@@ -15,6 +15,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "graph/measurement.hpp"
@@ -49,6 +50,10 @@ struct AgentLocalData {
   std::vector<std::uint64_t> measurement_index;
   /// Initial poses of `owned` (same order); empty when the input had no VERTEX lines.
   std::vector<Pose> initial;
+  /// Endpoints (i, j) of every measurement of the whole graph, no values: with `owner`
+  /// enough for core's make_block_layout (give it Measurements with only i and j set), so
+  /// every agent builds the same layout (neighbours, public poses, colouring).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;
   RunOptions options;
 };
 

@@ -288,6 +288,8 @@ class Coordinator {
     asg.dim(static_cast<std::uint32_t>(rs.d));
     asg.rank(a_.rank);
     asg.owner(part.owner);
+    asg.edge_i(rs.edge_i);
+    asg.edge_j(rs.edge_j);
     asg.algorithm(a_.algorithm);
     asg.initialization(a_.init);
     asg.max_rounds(a_.max_rounds);

@@ -52,6 +52,8 @@ RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& ann
       if (a.edge_i()[e] >= rs.num_poses || a.edge_j()[e] >= rs.num_poses)
         throw InputError(who + ": edge endpoint out of range");
       pairs.emplace_back(a.edge_i()[e], a.edge_j()[e]);
+      rs.edge_i.push_back(a.edge_i()[e]);
+      rs.edge_j.push_back(a.edge_j()[e]);
     }
     rs.hosts.push_back(a.host());
   }

@@ -16,7 +16,8 @@ struct RunStructure {
   std::size_t num_poses = 0;
   std::size_t num_measurements = 0;
   GraphStructure graph;
-  std::vector<std::string> hosts;  ///< Per agent.
+  std::vector<std::uint32_t> edge_i, edge_j;  ///< Every measurement's endpoints (agent order).
+  std::vector<std::string> hosts;             ///< Per agent.
 };
 
 /// Checks the N announcements (one per agent id 0..N-1, any order) against each other:

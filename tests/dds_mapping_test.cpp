@@ -28,6 +28,7 @@ TEST(DdsMapping, PoseBlockRoundTripsExactly) {
   PoseBlockMessage m;
   m.round = 7;
   m.sender = 3;
+  m.phase = 4;
   m.kind = BlockKind::kV;
   m.rank = 4;
   m.dim = 3;
@@ -40,6 +41,7 @@ TEST(DdsMapping, PoseBlockRoundTripsExactly) {
   PoseBlockMessage back = from_wire(w);
   EXPECT_EQ(back.round, 7u);
   EXPECT_EQ(back.sender, 3u);
+  EXPECT_EQ(back.phase, 4u);
   EXPECT_EQ(back.kind, BlockKind::kV);
   EXPECT_EQ(back.pose_ids, m.pose_ids);
   EXPECT_EQ(back.data, m.data);  // bit for bit

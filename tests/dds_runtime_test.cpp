@@ -48,6 +48,7 @@ std::vector<std::string> coordinator_args(int agents, const std::string& run, in
 
 // Parsed agent dump (--dump-local).
 struct Dump {
+  long structure = -1;
   std::set<int> owned;
   std::map<long, std::vector<double>> meas;  // file index -> i j kappa tau R t
   std::map<int, std::vector<double>> poses;
@@ -61,7 +62,9 @@ Dump read_dump(const std::string& path) {
     std::istringstream ss(line);
     std::string tag;
     ss >> tag;
-    if (tag == "OWNED") {
+    if (tag == "STRUCTURE") {
+      ss >> d.structure;
+    } else if (tag == "OWNED") {
       int id;
       ss >> id;
       d.owned.insert(id);
@@ -159,6 +162,7 @@ TEST(DdsRuntime, OneHostRunHandsOffEveryMeasurementAndMergesEveryPose) {
 
   // Every measurement is at the owners of both endpoints, with its values, and nowhere else.
   const auto edges = edges_of(text);
+  for (const Dump& d : dumps) EXPECT_EQ(d.structure, static_cast<long>(edges.size()));
   for (std::size_t k = 0; k < edges.size(); ++k) {
     const int i = static_cast<int>(edges[k][0]), j = static_cast<int>(edges[k][1]);
     for (int a = 0; a < 3; ++a) {

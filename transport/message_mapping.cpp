@@ -18,6 +18,7 @@ wire::PoseBlock to_wire_block(const PoseBlockMessage& m, const std::string& run_
   w.run_id(run_id);
   w.round(m.round);
   w.sender(m.sender);
+  w.phase(m.phase);
   w.broadcast(broadcast);
   w.recipients(recipients);
   w.kind(static_cast<std::uint8_t>(m.kind));
@@ -56,6 +57,7 @@ PoseBlockMessage from_wire(const wire::PoseBlock& w) {
   PoseBlockMessage m;
   m.round = w.round();
   m.sender = w.sender();
+  m.phase = w.phase();
   m.kind = static_cast<BlockKind>(w.kind());
   m.rank = w.rank();
   m.dim = w.dim();
