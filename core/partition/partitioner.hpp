@@ -54,6 +54,7 @@ struct PartitionResult {
   PartitionMetrics metrics;
   std::size_t max_block_size = 0;  ///< The balance bound used, floor((1+eps) ceil(n/N)).
   double time_ms = 0.0;            ///< Wall time of the partitioning (metrics excluded).
+  double cpu_ms = 0.0;  ///< Process CPU time of the same (tells contention apart on busy hosts).
   std::vector<PartitionPhase> trace;
 };
 

@@ -65,6 +65,7 @@ def measure(binary, path, parts, preset, seeds, eps):
         "ratio": max(r["max_block_ratio"] for r in runs),
         "cvolume": statistics.mean(r["cvolume"] for r in runs),
         "ms": statistics.median(r["time_ms"] for r in runs),
+        "cpu": statistics.median(r["cpu_ms"] for r in runs),
         "n": runs[0]["n"],
         "edges": runs[0]["edges"],
     }
@@ -93,10 +94,10 @@ def main():
     graphs = [g for g in GRAPHS if not a.only or g[0] in a.only.split(",")]
 
     print(f"N = 5, eps = {a.eps}, seeds 1..{a.seeds}; cut = sum of cut measurements"
-          + (" (mean/best)" if a.seeds > 1 else "") + "; ratio = max block / ceil(n/N); ms = partitioning time")
+          + (" (mean/best)" if a.seeds > 1 else "") + "; ratio = max block / ceil(n/N); ms = partitioning wall time, cpu_ms = its CPU time")
     head = f"{'graph':15s} {'n':>6s} {'paper s/e/f/h':>18s}"
     for p in presets:
-        head += f" | {p:>10s} {'ratio':>6s} {'Cvol':>6s} {'ms':>7s}"
+        head += f" | {p:>10s} {'ratio':>6s} {'Cvol':>6s} {'ms':>7s} {'cpu_ms':>7s}"
     print(head)
     rows, misses = [], []
     for name, rel, label, paper in graphs:
@@ -106,20 +107,20 @@ def main():
             m = measure(a.bin, path, 5, p, a.seeds, a.eps)
             if line is None:
                 line = f"{name:15s} {m['n']:6d} {'/'.join(map(str, paper[1:])):>18s}"
-            line += f" | {fmt_cut(m, a.seeds):>10s} {m['ratio']:6.4f} {m['cvolume']:6.4f} {m['ms']:7.1f}"
+            line += f" | {fmt_cut(m, a.seeds):>10s} {m['ratio']:6.4f} {m['cvolume']:6.4f} {m['ms']:7.1f} {m['cpu']:7.1f}"
             rows.append({"graph": name, "n": m["n"], "edges": m["edges"], "parts": 5, "preset": p,
                          "seeds": a.seeds, "cut_mean": m["cut"], "cut_best": m["best"],
                          "max_block_ratio": m["ratio"], "cvolume": round(m["cvolume"], 6),
-                         "time_ms": round(m["ms"], 2), "paper_highest": paper[4],
+                         "time_ms": round(m["ms"], 2), "cpu_ms": round(m["cpu"], 2), "paper_highest": paper[4],
                          "paper_strong": paper[1], "paper_eco": paper[2], "paper_fast": paper[3]})
             if p == "highest" and m["cut"] > paper[4]:
                 misses.append(f"{name}: highest {m['cut']:g} > paper {paper[4]}")
             if p == "strong" and m["cut"] > 1.05 * paper[4]:
                 misses.append(f"{name}: strong {m['cut']:g} > 1.05 x paper highest {paper[4]}")
             if p == "fast" and m["ms"] >= 50:
-                misses.append(f"{name}: fast {m['ms']:.1f} ms >= 50 ms")
+                misses.append(f"{name}: fast {m['ms']:.1f} ms (cpu {m['cpu']:.1f}) >= 50 ms")
             if p == "highest" and m["ms"] >= 5000:
-                misses.append(f"{name}: highest {m['ms']:.0f} ms >= 5 s")
+                misses.append(f"{name}: highest {m['ms']:.0f} ms (cpu {m['cpu']:.0f}) >= 5 s")
         print(line, flush=True)
     os.makedirs(os.path.dirname(a.csv), exist_ok=True)
     with open(a.csv, "w", newline="") as f:
@@ -135,7 +136,7 @@ def main():
         return
     print(f"\nN = 4, 9, 16, 25 on the larger graphs (eps = {a.eps})")
     rows_k = []
-    print(f"{'graph':15s} {'N':>3s}" + "".join(f" | {p:>10s} {'ratio':>6s} {'Cvol':>6s} {'ms':>7s}" for p in presets))
+    print(f"{'graph':15s} {'N':>3s}" + "".join(f" | {p:>10s} {'ratio':>6s} {'Cvol':>6s} {'ms':>7s} {'cpu_ms':>7s}" for p in presets))
     for name, rel, label, paper in graphs:
         if name not in LARGE:
             continue
@@ -144,10 +145,11 @@ def main():
             line = f"{name:15s} {parts:3d}"
             for p in presets:
                 m = measure(a.bin, path, parts, p, a.seeds, a.eps)
-                line += f" | {fmt_cut(m, a.seeds):>10s} {m['ratio']:6.4f} {m['cvolume']:6.4f} {m['ms']:7.1f}"
+                line += f" | {fmt_cut(m, a.seeds):>10s} {m['ratio']:6.4f} {m['cvolume']:6.4f} {m['ms']:7.1f} {m['cpu']:7.1f}"
                 rows_k.append({"graph": name, "n": m["n"], "parts": parts, "preset": p, "seeds": a.seeds,
                                "cut_mean": m["cut"], "cut_best": m["best"], "max_block_ratio": m["ratio"],
-                               "cvolume": round(m["cvolume"], 6), "time_ms": round(m["ms"], 2)})
+                               "cvolume": round(m["cvolume"], 6), "time_ms": round(m["ms"], 2),
+                               "cpu_ms": round(m["cpu"], 2)})
             print(line, flush=True)
     with open(a.csv_k, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows_k[0].keys()))
