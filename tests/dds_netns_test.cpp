@@ -43,15 +43,19 @@ class Hosts {
   ~Hosts() { run_command(kScript + " down " + prefix_, nullptr); }
   bool ok() const { return ok_; }
   const std::string& error() const { return error_; }
-  std::vector<std::string> in(int host, std::vector<std::string> argv) const {
-    std::vector<std::string> a = {"/usr/bin/env", "ip", "netns", "exec",
-                                  prefix_ + "-" + std::to_string(host)};
+  std::vector<std::string> in(int host, std::vector<std::string> argv,
+                              const std::string& env = "") const {
+    std::vector<std::string> a = {"/usr/bin/env"};
+    if (!env.empty()) a.push_back(env);
+    for (const char* w : {"ip", "netns", "exec"}) a.push_back(w);
+    a.push_back(prefix_ + "-" + std::to_string(host));
     a.insert(a.end(), argv.begin(), argv.end());
     return a;
   }
   std::string addresses() const {
     return subnet_ + ".1," + subnet_ + ".2," + subnet_ + ".3," + subnet_ + ".4";
   }
+  std::string address(int host) const { return subnet_ + "." + std::to_string(host + 1); }
 
  private:
   std::string prefix_, subnet_, error_;
@@ -61,7 +65,8 @@ class Hosts {
 // Coordinator on host 0, agent k on host k+1; returns the processes after they ended.
 std::vector<Process> run_across_hosts(const Hosts& hosts, const std::string& dir,
                                       const std::string& graph, int domain, const std::string& run,
-                                      double timeout_s, const std::vector<std::string>& extra) {
+                                      double timeout_s, const std::vector<std::string>& extra,
+                                      const std::string& env = "") {
   std::vector<Process> procs;
   std::vector<std::string> c = {bin("tessera-coordinator"),
                                 "--agents",
@@ -75,7 +80,7 @@ std::vector<Process> run_across_hosts(const Hosts& hosts, const std::string& dir
                                 "--output",
                                 dir + "/" + run + ".g2o"};
   c.insert(c.end(), extra.begin(), extra.end());
-  procs.push_back(start(hosts.in(0, c), dir + "/" + run + "_coordinator.log"));
+  procs.push_back(start(hosts.in(0, c, env), dir + "/" + run + "_coordinator.log"));
   for (int k = 0; k < 3; ++k) {
     std::vector<std::string> a = {bin("tessera-agent"),
                                   "--graph",
@@ -92,7 +97,7 @@ std::vector<Process> run_across_hosts(const Hosts& hosts, const std::string& dir
                                   std::to_string(timeout_s)};
     a.insert(a.end(), extra.begin(), extra.end());
     procs.push_back(
-        start(hosts.in(k + 1, a), dir + "/" + run + "_agent" + std::to_string(k) + ".log"));
+        start(hosts.in(k + 1, a, env), dir + "/" + run + "_agent" + std::to_string(k) + ".log"));
   }
   std::vector<Process*> all;
   for (auto& p : procs) all.push_back(&p);
@@ -135,6 +140,29 @@ TEST(DdsNetns, MulticastBlockedNeedsAndWorksWithInitialPeers) {
   auto procs = run_across_hosts(hosts, dir, graph, 153, "netns-peers-" + std::to_string(getpid()),
                                 20, {"--peers", hosts.addresses()});
   for (auto& p : procs) EXPECT_EQ(p.exit_code, 0) << p.output();
+}
+
+TEST(DdsNetns, MulticastBlockedWorksWithTheDiscoveryServer) {
+  std::string why;
+  if (!namespaces_available(&why))
+    GTEST_SKIP() << "network namespaces unavailable here, skipping: " << why;
+  if (access("/usr/bin/fast-discovery-server", X_OK) != 0)
+    GTEST_SKIP() << "fast-discovery-server (fastdds-tools) is not installed, skipping";
+  Hosts hosts(true);
+  ASSERT_TRUE(hosts.ok()) << hosts.error();
+  const std::string dir = temp_dir();
+  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 9));
+  // The server itself (not the `fastdds discovery` wrapper, which would outlive a kill).
+  Process server = start(hosts.in(0, {"/usr/bin/fast-discovery-server", "-i", "0", "-l",
+                                      hosts.address(0), "-p", "11811"}),
+                         dir + "/server.log");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  auto procs = run_across_hosts(hosts, dir, graph, 154, "netns-ds-" + std::to_string(getpid()), 20,
+                                {}, "ROS_DISCOVERY_SERVER=" + hosts.address(0) + ":11811");
+  for (auto& p : procs) EXPECT_EQ(p.exit_code, 0) << p.output();
+  kill(server.pid, SIGINT);  // it ignores SIGTERM
+  EXPECT_TRUE(wait_all({&server}, 5)) << server.output();
+  run_command("fastdds shm clean", nullptr);
 }
 
 }  // namespace
