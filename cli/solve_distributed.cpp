@@ -17,8 +17,8 @@
 namespace tessera::cli {
 
 const char* const kDistributedValued[] = {
-    "agents",   "partition", "max-rounds", "seed",       "reference-cost", "select", "rel-tol",
-    "tr-steps", "restart-c", "sigma",      "unselected", "irbcd-n",        nullptr};
+    "agents",   "partition", "max-rounds", "seed",       "reference-cost", "select",    "rel-tol",
+    "tr-steps", "restart-c", "sigma",      "unselected", "irbcd-n",        "tcg-iters", nullptr};
 const char* const kDistributedSwitches[] = {"parallel", "reference", nullptr};
 
 const char* kDistributedHelp =
@@ -38,6 +38,7 @@ const char* kDistributedHelp =
     "  --seed S                  shared seed (uniform selection, partitioner)\n"
     "  --rank R                  relaxation rank (default 5)\n"
     "  --tr-steps K              trust-region steps per block update (default 1)\n"
+    "  --tcg-iters K             truncated-CG iterations per trust-region step (default 50)\n"
     "  --restart-c C             restart constant c1 of RBCD++/IRBCD (< 0: never restart)\n"
     "  --sigma S                 IRBCD sigma (default 1e-3)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
@@ -83,6 +84,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   opt.rank = static_cast<int>(a.get_long("rank", opt.rank));
   opt.block_update.trust_region_steps =
       static_cast<int>(a.get_long("tr-steps", opt.block_update.trust_region_steps));
+  opt.block_update.max_inner_iterations =
+      static_cast<int>(a.get_long("tcg-iters", opt.block_update.max_inner_iterations));
   opt.block_update.max_attempts =
       std::max(opt.block_update.max_attempts, opt.block_update.trust_region_steps);
   if (a.has("restart-c")) {

@@ -1,0 +1,79 @@
+// `tessera solve --algorithm rbcd|rbcd++|irbcd`: JSON fields, trace rows, errors.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+#include "io/g2o_writer.hpp"
+#include "random_graph.hpp"
+#include "test_support.hpp"
+
+namespace tessera {
+namespace {
+
+std::string read_all(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string graph_file(const std::string& dir) {
+  test::RandomGraphSpec spec;
+  spec.d = 2;
+  spec.poses = 60;
+  spec.loop_closures = 30;
+  const PoseGraph g = test::random_pose_graph(spec);
+  const std::string path = dir + "/g.g2o";
+  write_g2o(g, path);
+  return path;
+}
+
+TEST(DistributedCli, JsonAndTrace) {
+  const std::string dir = test::temp_dir();
+  const std::string g = graph_file(dir);
+  for (const char* alg : {"rbcd", "rbcd++", "irbcd"}) {
+    std::string out;
+    const std::string cmd = test::bin("tessera") + " solve " + g + " --algorithm " + alg +
+                            " --agents 3 --partition fast --reference --json " + dir +
+                            "/r.json --trace " + dir + "/t.csv --out " + dir + "/o.g2o";
+    ASSERT_EQ(test::run_command(cmd, &out), 0) << out;
+    const std::string j = read_all(dir + "/r.json");
+    for (const char* key :
+         {"\"algorithm\"", "\"graph\"", "\"poses\"", "\"edges\"", "\"d\"", "\"rank\"",
+          "\"iterations\"", "\"grad_norm\"", "\"cost\"", "\"certified\": null", "\"wall_s\"",
+          "\"agents\": 3", "\"partition\": \"fast\"", "\"rounds\"", "\"restarts\"",
+          "\"bytes_exchanged\"", "\"rel_gap\"", "\"stop_reason\": \"grad_norm\""})
+      EXPECT_NE(j.find(key), std::string::npos) << key << " in\n" << j;
+    EXPECT_EQ(j.find("\"rel_gap\": null"), std::string::npos);
+    const std::string t = read_all(dir + "/t.csv");
+    EXPECT_EQ(t.rfind("round,cost,grad_norm,selected,restart,bytes", 0), 0u);
+    EXPECT_GT(std::count(t.begin(), t.end(), '\n'), 2);
+    EXPECT_FALSE(read_all(dir + "/o.g2o").empty());
+  }
+}
+
+TEST(DistributedCli, RejectsBadOptions) {
+  const std::string dir = test::temp_dir();
+  const std::string g = graph_file(dir);
+  std::string out;
+  EXPECT_EQ(test::run_command(
+                test::bin("tessera") + " solve " + g + " --algorithm irbcd --agents 0", &out),
+            2);
+  EXPECT_NE(out.find("--agents"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(
+                test::bin("tessera") + " solve " + g + " --algorithm irbcd --select best", &out),
+            2);
+  EXPECT_NE(out.find("uniform"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(
+                test::bin("tessera") + " solve " + g + " --algorithm irbcd --grad-tol -1", &out),
+            2);
+  EXPECT_NE(out.find("grad_norm_tol"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + g + " --algorithm sgd", &out), 2);
+  EXPECT_NE(out.find("irbcd"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace tessera
