@@ -4,11 +4,10 @@
 #include <string>
 
 #include "arguments.hpp"
+#include "json_writer.hpp"
 #include "commands.hpp"
 #include "generate/generator.hpp"
 #include "io/g2o_writer.hpp"
-#include "io/number_text.hpp"
-#include "io/text_file_writer.hpp"
 #include "io/tum_writer.hpp"
 #include "util/input_error.hpp"
 
@@ -63,36 +62,6 @@ GeneratorOptions parse_options(const Arguments& args) {
   return o;
 }
 
-void append_field(std::string& out, const char* name, double value, bool last = false) {
-  out += std::string("  \"") + name + "\": ";
-  append_number(out, value);
-  out += last ? "\n" : ",\n";
-}
-
-void append_field(std::string& out, const char* name, std::size_t value) {
-  out += std::string("  \"") + name + "\": ";
-  append_integer(out, value);
-  out += ",\n";
-}
-
-// JSON string contents: escape quotes, backslashes and control characters.
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
 struct Timing {
   double generate_s = 0, write_s = 0;
 };
@@ -103,32 +72,29 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 void write_json(const std::string& path, const GeneratorOptions& o, const GeneratorResult& r,
                 const std::string& graph_path, const Timing& timing) {
-  TextFileWriter file(path);
-  std::string& out = file.buffer();
-  out += "{\n";
-  out += std::string("  \"kind\": \"") + trajectory_kind_name(o.kind) + "\",\n";
-  out += "  \"graph\": \"" + json_escape(graph_path) + "\",\n";
-  append_field(out, "d", static_cast<std::size_t>(r.graph.d));
-  append_field(out, "poses", r.graph.num_poses);
-  append_field(out, "edges", r.graph.num_measurements());
-  append_field(out, "robots", o.num_robots);
-  append_field(out, "seed", static_cast<std::size_t>(o.seed));
-  append_field(out, "odometry_edges", r.odometry_edges);
-  append_field(out, "loop_closures", r.loop_closures());
-  append_field(out, "intra_robot_closures", r.intra_robot_closures);
-  append_field(out, "inter_robot_closures", r.inter_robot_closures);
-  append_field(out, "rendezvous_edges", r.rendezvous_edges);
-  append_field(out, "rotation_noise", o.rotation_noise);
-  append_field(out, "translation_noise", o.translation_noise);
-  append_field(out, "loop_closure_probability", o.loop_closure_probability);
-  append_field(out, "inter_robot_closure_probability", o.inter_robot_closure_probability);
-  append_field(out, "max_loop_closures", o.max_loop_closures);
-  append_field(out, "kappa", r.graph.measurements.front().kappa);
-  append_field(out, "tau", r.graph.measurements.front().tau);
-  append_field(out, "generate_s", timing.generate_s);
-  append_field(out, "write_s", timing.write_s, true);
-  out += "}\n";
-  file.close();
+  JsonObject j;
+  j.add("kind", trajectory_kind_name(o.kind))
+      .add("graph", graph_path)
+      .add("d", r.graph.d)
+      .add("poses", r.graph.num_poses)
+      .add("edges", r.graph.num_measurements())
+      .add("robots", o.num_robots)
+      .add("seed", static_cast<std::size_t>(o.seed))
+      .add("odometry_edges", r.odometry_edges)
+      .add("loop_closures", r.loop_closures())
+      .add("intra_robot_closures", r.intra_robot_closures)
+      .add("inter_robot_closures", r.inter_robot_closures)
+      .add("rendezvous_edges", r.rendezvous_edges)
+      .add("rotation_noise", o.rotation_noise)
+      .add("translation_noise", o.translation_noise)
+      .add("loop_closure_probability", o.loop_closure_probability)
+      .add("inter_robot_closure_probability", o.inter_robot_closure_probability)
+      .add("max_loop_closures", o.max_loop_closures)
+      .add("kappa", r.graph.measurements.front().kappa)
+      .add("tau", r.graph.measurements.front().tau)
+      .add("generate_s", timing.generate_s)
+      .add("write_s", timing.write_s);
+  write_output(path, j.str());
 }
 
 }  // namespace

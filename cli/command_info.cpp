@@ -8,6 +8,7 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "io/g2o_reader.hpp"
+#include "json_writer.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::cli {
@@ -27,53 +28,28 @@ const char* const kHelp =
     "\n"
     "exit status: 0 on success, 2 on bad input (the message names file, line and problem).\n";
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
-std::string json_number(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
-
-std::string info_json(const G2oReadResult& r, double load_s) {
+JsonObject info_json(const G2oReadResult& r, double load_s) {
   const auto& g = r.graph;
   const auto& s = r.stats;
-  auto count = [](std::size_t v) { return std::to_string(v); };
-  std::string j = "{\n";
-  j += "  \"graph\": " + json_string(g.source) + ",\n";
-  j += "  \"poses\": " + count(g.num_poses) + ",\n";
-  j += "  \"edges\": " + count(g.num_measurements()) + ",\n";
-  j += "  \"d\": " + std::to_string(g.d) + ",\n";
-  j += "  \"components\": " + count(s.components) + ",\n";
-  j += "  \"distinct_pairs\": " + count(s.distinct_pairs) + ",\n";
-  j += "  \"parallel_edges\": " + count(s.parallel_edges) + ",\n";
-  j += "  \"backward_edges\": " + count(s.backward_edges) + ",\n";
-  j += "  \"non_pd_information\": " + count(s.non_pd_information) + ",\n";
-  j += "  \"first_non_pd_line\": " + count(s.first_non_pd_line) + ",\n";
-  j += "  \"has_vertices\": " + std::string(s.vertex_lines > 0 ? "true" : "false") + ",\n";
-  j += "  \"vertex_lines\": " + count(s.vertex_lines) + ",\n";
-  j += "  \"fix_lines\": " + count(s.fix_lines) + ",\n";
-  j += "  \"blank_lines\": " + count(s.blank_lines) + ",\n";
-  j += "  \"comment_lines\": " + count(s.comment_lines) + ",\n";
-  j += "  \"max_quaternion_norm_error\": " + json_number(s.max_quaternion_norm_error) + ",\n";
-  j += "  \"load_s\": " + json_number(load_s) + "\n";
-  return j + "}\n";
+  JsonObject j;
+  j.add("graph", g.source)
+      .add("poses", g.num_poses)
+      .add("edges", g.num_measurements())
+      .add("d", g.d)
+      .add("components", s.components)
+      .add("distinct_pairs", s.distinct_pairs)
+      .add("parallel_edges", s.parallel_edges)
+      .add("backward_edges", s.backward_edges)
+      .add("non_pd_information", s.non_pd_information)
+      .add("first_non_pd_line", s.first_non_pd_line)
+      .add("has_vertices", s.vertex_lines > 0)
+      .add("vertex_lines", s.vertex_lines)
+      .add("fix_lines", s.fix_lines)
+      .add("blank_lines", s.blank_lines)
+      .add("comment_lines", s.comment_lines)
+      .add("max_quaternion_norm_error", s.max_quaternion_norm_error)
+      .add("load_s", load_s);
+  return j;
 }
 
 }  // namespace
@@ -120,17 +96,7 @@ int run_info(const Args& args) {
                 s.comment_lines, s.fix_lines);
   std::printf("load time:                  %.1f ms\n", load_s * 1e3);
 
-  if (auto path = a.get("json")) {
-    const std::string text = info_json(r, load_s);
-    if (*path == "-") {
-      std::fputs(text.c_str(), stdout);
-    } else {
-      std::FILE* f = std::fopen(path->c_str(), "w");
-      if (!f) throw InputError(*path, 0, "cannot write the JSON summary");
-      const bool ok = std::fputs(text.c_str(), f) >= 0;
-      if ((std::fclose(f) != 0) || !ok) throw InputError(*path, 0, "cannot write the JSON summary");
-    }
-  }
+  if (auto path = a.get("json")) write_output(*path, info_json(r, load_s).str());
   return 0;
 }
 
