@@ -72,6 +72,9 @@ struct DistributedResult {
   std::vector<Pose> poses;       ///< X rounded to SE(d).
   double cost = 0.0;             ///< Objective of `poses` (reference convention).
   double init_s = 0.0, solve_s = 0.0, wall_s = 0.0;
+  /// Process CPU time of the rounds (all agents, in one process): unlike solve_s it does not
+  /// grow when other jobs share the machine.
+  double solve_cpu_s = 0.0;
 };
 
 /// Solves `graph` with the blocks of `assignment` (block id per pose, 0..N-1, none empty).
