@@ -331,8 +331,10 @@ class Agent {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     char buf[256];
     std::snprintf(buf, sizeof(buf),
-                  "%s: done: %zu poses, %zu measurements, %u round(s), %llu bytes sent, %.2f s\n",
+                  "%s: done: %zu poses, %zu measurements, %u round(s), cost %.12g, %llu bytes "
+                  "sent, %.2f s\n",
                   tag_.c_str(), local.owned.size(), local.measurements.size(), result.rounds,
+                  result.cost,
                   static_cast<unsigned long long>(s.stats().bytes_sent), secs);
     std::cerr << buf;
   }

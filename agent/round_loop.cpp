@@ -1,112 +1,459 @@
 #include "agent/round_loop.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <map>
-#include <set>
+#include <memory>
+#include <tuple>
 #include <variant>
+
+#include "distributed/agent_factory.hpp"
+#include "distributed/agent_state.hpp"
+#include "distributed/block_layout.hpp"
+#include "distributed/distributed_solver.hpp"
+#include "distributed/round_protocol.hpp"
+#include "problem/lifting.hpp"
 
 namespace tessera::agent {
 
 namespace {
 
-// For each neighbouring agent, the ids of our owned poses it needs (endpoints of shared
-// measurements), ascending.
-std::map<std::uint32_t, std::vector<std::uint32_t>> boundary_by_neighbour(
-    const AgentLocalData& local) {
-  std::map<std::uint32_t, std::set<std::uint32_t>> sets;
-  for (const Measurement& m : local.measurements) {
-    const auto i = static_cast<std::uint32_t>(m.i), j = static_cast<std::uint32_t>(m.j);
-    const std::uint32_t oi = local.owner[i], oj = local.owner[j];
-    if (oi == local.agent_id && oj != local.agent_id) sets[oj].insert(i);
-    if (oj == local.agent_id && oi != local.agent_id) sets[oi].insert(j);
-  }
-  std::map<std::uint32_t, std::vector<std::uint32_t>> out;
-  for (auto& [b, s] : sets) out[b] = std::vector<std::uint32_t>(s.begin(), s.end());
-  return out;
+// Phases of the rounding messages (statuses and pose blocks), after core's protocol.
+enum RoundingPhase : std::uint32_t {
+  kGram = kRoundingPhaseBase,  // r x r Gram matrix of the block's rotation parts
+  kNegative,                   // number of rounded blocks with det < 0
+  kRotations,                  // rounded rotations of public poses
+  kInitialResidual,            // PCG: <r,z>, <r,r> at the start
+  kDirection,                  // PCG: public entries of the search direction
+  kCurvature,                  // PCG: <p, L p>
+  kResidual,                   // PCG: <r,z>, <r,r> after a step
+  kTranslations,               // final translations of public poses
+  kCost                        // cost share of the rounded poses
+};
+
+DistributedOptions options_of(const RunOptions& o) {
+  DistributedOptions opt;
+  if (!o.algorithm.empty()) opt.algorithm = parse_algorithm(o.algorithm);
+  if (o.rank > 0) opt.rank = static_cast<int>(o.rank);
+  if (o.max_rounds > 0) opt.max_rounds = static_cast<int>(o.max_rounds);
+  if (o.grad_norm_tolerance > 0) opt.grad_norm_tol = o.grad_norm_tolerance;
+  opt.rel_cost_decrease_tol = o.relative_cost_tolerance;
+  opt.seed = o.seed;
+  opt.validate();
+  return opt;
 }
 
-// The poses of a neighbour's block we should receive: its owned endpoints of our measurements.
-std::map<std::uint32_t, std::vector<std::uint32_t>> expected_from_neighbours(
-    const AgentLocalData& local) {
-  std::map<std::uint32_t, std::set<std::uint32_t>> sets;
-  for (const Measurement& m : local.measurements) {
-    const auto i = static_cast<std::uint32_t>(m.i), j = static_cast<std::uint32_t>(m.j);
-    const std::uint32_t oi = local.owner[i], oj = local.owner[j];
-    if (oi == local.agent_id && oj != local.agent_id) sets[oj].insert(j);
-    if (oj == local.agent_id && oi != local.agent_id) sets[oi].insert(i);
+// Delivers messages to core's protocol and keeps the rounding messages (which a faster agent
+// may send before this one has finished) until the rounding asks for them.
+class Mailbox {
+ public:
+  Mailbox(ProtocolChannel& channel, double timeout_s, std::uint32_t self)
+      : channel_(channel), timeout_s_(timeout_s), self_(self) {}
+
+  void send_all(const std::vector<OutgoingMessage>& out) {
+    for (const auto& m : out) channel_.send(m);
   }
-  std::map<std::uint32_t, std::vector<std::uint32_t>> out;
-  for (auto& [b, s] : sets) out[b] = std::vector<std::uint32_t>(s.begin(), s.end());
-  return out;
-}
+
+  void run_protocol(RoundProtocol& protocol) {
+    send_all(protocol.start());
+    while (!protocol.done()) {
+      std::optional<ProtocolMessage> msg = channel_.receive(timeout_s_);
+      if (!msg)
+        throw std::runtime_error("agent " + std::to_string(self_) + ": no message for " +
+                                 std::to_string(timeout_s_) + " s in round " +
+                                 std::to_string(protocol.rounds()) + " of the solve");
+      if (phase_of(*msg) >= kRoundingPhaseBase) {
+        keep(std::move(*msg));
+        continue;
+      }
+      send_all(protocol.handle(*msg));
+    }
+  }
+
+  // Waits for the messages of (phase, round) from every agent in `senders`; returns them by
+  // sender (ascending, so reductions sum in agent-id order).
+  std::map<std::uint32_t, ProtocolMessage> gather(std::uint32_t phase, std::uint32_t round,
+                                                  const std::vector<std::uint32_t>& senders) {
+    const auto key = std::make_pair(phase, round);
+    for (;;) {
+      auto& have = stash_[key];
+      bool all = true;
+      for (auto s : senders) all = all && have.count(s);
+      if (all) break;
+      std::optional<ProtocolMessage> msg = channel_.receive(timeout_s_);
+      if (!msg) {
+        std::string who;
+        for (auto s : senders)
+          if (!stash_[key].count(s)) who += " " + std::to_string(s);
+        throw std::runtime_error("agent " + std::to_string(self_) + ": rounding step " +
+                                 std::to_string(phase) + " (iteration " + std::to_string(round) +
+                                 "): nothing received for " + std::to_string(timeout_s_) +
+                                 " s; waiting for agent(s)" + who);
+      }
+      if (phase_of(*msg) < kRoundingPhaseBase) continue;  // late protocol traffic
+      keep(std::move(*msg));
+    }
+    auto out = std::move(stash_[key]);
+    stash_.erase(key);
+    return out;
+  }
+
+ private:
+  static std::uint32_t phase_of(const ProtocolMessage& m) {
+    return std::visit([](const auto& x) { return x.phase; }, m);
+  }
+  static std::uint32_t round_of(const ProtocolMessage& m) {
+    return std::visit([](const auto& x) { return x.round; }, m);
+  }
+  static std::uint32_t sender_of(const ProtocolMessage& m) {
+    return std::visit([](const auto& x) { return x.sender; }, m);
+  }
+  void keep(ProtocolMessage m) {
+    if (phase_of(m) >= kFinalReportPhase) return;  // for the coordinator
+    stash_[{phase_of(m), round_of(m)}][sender_of(m)] = std::move(m);
+  }
+
+  ProtocolChannel& channel_;
+  double timeout_s_;
+  std::uint32_t self_;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::map<std::uint32_t, ProtocolMessage>>
+      stash_;
+};
+
+// The distributed rounding: the same result as core's round_solution (rank-d truncation via
+// the r x r Gram matrix, reflection by majority, per-block projection to SO(d), translations
+// optimal for those rotations with pose 0 at the origin) up to floating-point summation order.
+class Rounding {
+ public:
+  Rounding(const AgentLocalData& local, const BlockLayout& layout, const AgentState& state,
+           Mailbox& mail)
+      : local_(local),
+        layout_(layout),
+        mail_(mail),
+        self_(local.agent_id),
+        d_(local.d),
+        own_(layout.poses[local.agent_id]),
+        Y_(state.Y) {
+    for (std::uint32_t a = 0; a < local.num_agents; ++a) everyone_.push_back(a);
+    for (int b : layout.adjacent[self_]) neighbours_.push_back(static_cast<std::uint32_t>(b));
+  }
+
+  RoundLoopResult run(RoundLoopResult res) {
+    rotations();
+    res.translation_iterations = translations();
+    res.poses.clear();
+    for (std::size_t s = 0; s < own_.size(); ++s) res.poses.push_back(poses_.at(own_[s]));
+    res.cost = cost();
+    return res;
+  }
+
+ private:
+  double reduce(std::uint32_t phase, std::uint32_t round, double a, double b, double* b_sum) {
+    RoundStatusMessage st;
+    st.round = round;
+    st.sender = self_;
+    st.phase = phase;
+    st.cost = a;
+    st.grad_norm_sq = b;
+    mail_.send_all({OutgoingMessage{st, true, {}}});
+    auto got = mail_.gather(phase, round, others());
+    double sa = 0.0, sb = 0.0;
+    for (std::uint32_t k : everyone_) {  // agent-id order: bit-identical sums everywhere
+      const RoundStatusMessage& m = k == self_ ? st : std::get<RoundStatusMessage>(got.at(k));
+      sa += m.cost;
+      sb += m.grad_norm_sq;
+    }
+    if (b_sum) *b_sum = sb;
+    return sa;
+  }
+
+  std::vector<std::uint32_t> others() const {
+    std::vector<std::uint32_t> o;
+    for (auto a : everyone_)
+      if (a != self_) o.push_back(a);
+    return o;
+  }
+
+  // Sends `values(id)` (width doubles per pose, as a block of the given rank) of the public
+  // poses to each neighbour and returns the neighbours' values by pose id.
+  template <class F>
+  std::map<std::size_t, std::vector<double>> exchange(std::uint32_t phase, std::uint32_t round,
+                                                      std::uint32_t rank, F values) {
+    const std::size_t width = static_cast<std::size_t>(rank) * static_cast<std::size_t>(d_ + 1);
+    const auto& adj = layout_.adjacent[self_];
+    for (std::size_t k = 0; k < adj.size(); ++k) {
+      PoseBlockMessage m;
+      m.round = round;
+      m.sender = self_;
+      m.phase = phase;
+      m.rank = rank;
+      m.dim = static_cast<std::uint32_t>(d_);
+      for (std::size_t id : layout_.public_to[self_][k]) {
+        m.pose_ids.push_back(static_cast<std::uint32_t>(id));
+        std::vector<double> v = values(id);
+        v.resize(width, 0.0);
+        m.data.insert(m.data.end(), v.begin(), v.end());
+      }
+      mail_.send_all({OutgoingMessage{m, false, {static_cast<std::uint32_t>(adj[k])}}});
+    }
+    std::map<std::size_t, std::vector<double>> out;
+    for (auto& [sender, msg] : mail_.gather(phase, round, neighbours_)) {
+      const auto& m = std::get<PoseBlockMessage>(msg);
+      if (m.data.size() != m.pose_ids.size() * width)
+        throw std::runtime_error("rounding: block of the wrong size from agent " +
+                                 std::to_string(sender));
+      for (std::size_t k = 0; k < m.pose_ids.size(); ++k)
+        out[m.pose_ids[k]] =
+            std::vector<double>(m.data.begin() + static_cast<long>(k * width),
+                                m.data.begin() + static_cast<long>((k + 1) * width));
+    }
+    return out;
+  }
+
+  void rotations() {
+    const Eigen::Index r = Y_.rows(), d = d_, m = static_cast<Eigen::Index>(own_.size());
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(r, r);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const auto B = Y_.middleCols((d + 1) * i, d);
+      G.noalias() += B * B.transpose();
+    }
+    // The Gram matrix travels as r "poses" of rank r whose first r entries are its columns.
+    PoseBlockMessage gm;
+    gm.sender = self_;
+    gm.phase = kGram;
+    gm.rank = static_cast<std::uint32_t>(r);
+    gm.dim = static_cast<std::uint32_t>(d);
+    for (Eigen::Index c = 0; c < r; ++c) {
+      gm.pose_ids.push_back(static_cast<std::uint32_t>(c));
+      for (Eigen::Index k = 0; k < r * (d + 1); ++k) gm.data.push_back(k < r ? G(k, c) : 0.0);
+    }
+    mail_.send_all({OutgoingMessage{gm, true, {}}});
+    auto got = mail_.gather(kGram, 0, others());
+    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(r, r);
+    for (std::uint32_t a : everyone_) {
+      if (a == self_) {
+        S += G;
+        continue;
+      }
+      const auto& msg = std::get<PoseBlockMessage>(got.at(a));
+      if (msg.data.size() != static_cast<std::size_t>(r * r * (d + 1)))
+        throw std::runtime_error("rounding: Gram matrix of the wrong size from agent " +
+                                 std::to_string(a));
+      for (Eigen::Index c = 0; c < r; ++c)
+        for (Eigen::Index k = 0; k < r; ++k)
+          S(k, c) += msg.data[static_cast<std::size_t>(c * r * (d + 1) + k)];
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
+    const Eigen::MatrixXd U = eig.eigenvectors().rightCols(d);
+    Eigen::MatrixXd R(d, d * m);
+    double negative = 0;
+    for (Eigen::Index i = 0; i < m; ++i) {
+      R.middleCols(d * i, d) = U.transpose() * Y_.middleCols((d + 1) * i, d);
+      if (R.middleCols(d * i, d).determinant() < 0) negative += 1;
+    }
+    const double total_negative = reduce(kNegative, 0, negative, 0.0, nullptr);
+    const double n = static_cast<double>(local_.num_poses);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      Eigen::MatrixXd Ri = R.middleCols(d * i, d);
+      if (2 * total_negative > n) Ri.row(d - 1) *= -1.0;
+      poses_[own_[static_cast<std::size_t>(i)]] =
+          Pose{project_to_rotation(Ri), Eigen::VectorXd::Zero(d)};
+    }
+    auto nb = exchange(kRotations, 0, static_cast<std::uint32_t>(d), [&](std::size_t id) {
+      const Pose& p = poses_.at(id);
+      return std::vector<double>(p.R.data(), p.R.data() + d * d);
+    });
+    for (auto& [id, v] : nb)
+      poses_[id] =
+          Pose{Eigen::Map<const Eigen::MatrixXd>(v.data(), d, d), Eigen::VectorXd::Zero(d)};
+  }
+
+  // Preconditioned CG on L t = b (the translation Laplacian without the anchor pose 0), with
+  // each agent's own Laplacian block as the preconditioner (solved exactly by Cholesky).
+  std::uint32_t translations() {
+    const Eigen::Index d = d_, m = static_cast<Eigen::Index>(own_.size());
+    std::map<std::size_t, Eigen::Index> slot;
+    for (Eigen::Index s = 0; s < m; ++s) slot[own_[static_cast<std::size_t>(s)]] = s;
+    auto free = [&](std::size_t id) { return id != 0; };
+    Eigen::MatrixXd b = Eigen::MatrixXd::Zero(m, d);
+    std::vector<Eigen::Triplet<double>> trip;
+    for (Eigen::Index s = 0; s < m; ++s)
+      if (!free(own_[static_cast<std::size_t>(s)])) trip.emplace_back(s, s, 1.0);  // fixed at 0
+    for (const Measurement& e : local_.measurements) {
+      const Eigen::VectorXd c = poses_.at(e.i).R * e.t;
+      auto si = slot.find(e.i), sj = slot.find(e.j);
+      const bool oi = si != slot.end() && free(e.i), oj = sj != slot.end() && free(e.j);
+      if (oi) {
+        b.row(si->second) -= e.tau * c.transpose();
+        trip.emplace_back(si->second, si->second, e.tau);
+      }
+      if (oj) {
+        b.row(sj->second) += e.tau * c.transpose();
+        trip.emplace_back(sj->second, sj->second, e.tau);
+      }
+      if (oi && oj) {
+        trip.emplace_back(si->second, sj->second, -e.tau);
+        trip.emplace_back(sj->second, si->second, -e.tau);
+      }
+    }
+    Eigen::SparseMatrix<double> Lbb(m, m);
+    Lbb.setFromTriplets(trip.begin(), trip.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> chol(Lbb);
+    if (chol.info() != Eigen::Success)
+      throw std::runtime_error("rounding: local translation Laplacian is singular");
+    auto precondition = [&](const Eigen::MatrixXd& r) {
+      Eigen::MatrixXd z = chol.solve(r);
+      for (Eigen::Index s = 0; s < m; ++s)
+        if (!free(own_[static_cast<std::size_t>(s)])) z.row(s).setZero();
+      return z;
+    };
+    // L p for owned rows, given p on owned poses and the neighbours' public entries.
+    auto apply = [&](const Eigen::MatrixXd& p,
+                     const std::map<std::size_t, std::vector<double>>& pn) {
+      auto value = [&](std::size_t id) -> Eigen::VectorXd {
+        if (!free(id)) return Eigen::VectorXd::Zero(d);
+        auto s = slot.find(id);
+        if (s != slot.end()) return p.row(s->second).transpose();
+        const auto& v = pn.at(id);
+        return Eigen::Map<const Eigen::VectorXd>(v.data(), d);
+      };
+      Eigen::MatrixXd out = Eigen::MatrixXd::Zero(m, d);
+      for (const Measurement& e : local_.measurements) {
+        const Eigen::VectorXd diff = e.tau * (value(e.j) - value(e.i));
+        auto si = slot.find(e.i), sj = slot.find(e.j);
+        if (si != slot.end() && free(e.i)) out.row(si->second) -= diff.transpose();
+        if (sj != slot.end() && free(e.j)) out.row(sj->second) += diff.transpose();
+      }
+      return out;
+    };
+    Eigen::MatrixXd x = Eigen::MatrixXd::Zero(m, d), r = b;
+    Eigen::MatrixXd z = precondition(r), p = z;
+    double rr0 = 0.0;
+    double rz = reduce(kInitialResidual, 0, (r.array() * z.array()).sum(), r.squaredNorm(), &rr0);
+    const double tol = 1e-24 * rr0;  // relative residual 1e-12
+    const std::uint32_t max_it = 5000;
+    std::uint32_t it = 0;
+    double rr = rr0;
+    while (rr > tol && it < max_it && rr0 > 0) {
+      auto pn = exchange(kDirection, it, 1, [&](std::size_t id) {
+        const Eigen::VectorXd v = p.row(slot.at(id)).transpose();
+        return std::vector<double>(v.data(), v.data() + d);
+      });
+      const Eigen::MatrixXd Ap = apply(p, pn);
+      const double pAp = reduce(kCurvature, it, (p.array() * Ap.array()).sum(), 0.0, nullptr);
+      if (!(pAp > 0)) break;
+      const double alpha = rz / pAp;
+      x += alpha * p;
+      r -= alpha * Ap;
+      z = precondition(r);
+      const double rz_new =
+          reduce(kResidual, it, (r.array() * z.array()).sum(), r.squaredNorm(), &rr);
+      p = z + (rz_new / rz) * p;
+      rz = rz_new;
+      ++it;
+    }
+    for (Eigen::Index s = 0; s < m; ++s)
+      poses_[own_[static_cast<std::size_t>(s)]].t = x.row(s).transpose();
+    auto nb = exchange(kTranslations, 0, 1, [&](std::size_t id) {
+      const Eigen::VectorXd& t = poses_.at(id).t;
+      return std::vector<double>(t.data(), t.data() + d);
+    });
+    for (auto& [id, v] : nb) poses_[id].t = Eigen::Map<const Eigen::VectorXd>(v.data(), d);
+    return it;
+  }
+
+  // Cost of the rounded poses: internal measurements in full, cut ones half (as core's status).
+  double cost() {
+    double share = 0.0;
+    for (const Measurement& e : local_.measurements) {
+      const Pose& a = poses_.at(e.i);
+      const Pose& b = poses_.at(e.j);
+      const double f =
+          e.kappa * (b.R - a.R * e.R).squaredNorm() + e.tau * (b.t - a.t - a.R * e.t).squaredNorm();
+      const bool both = local_.owner[e.i] == self_ && local_.owner[e.j] == self_;
+      share += both ? f : 0.5 * f;
+    }
+    return reduce(kCost, 0, share, 0.0, nullptr);
+  }
+
+  const AgentLocalData& local_;
+  const BlockLayout& layout_;
+  Mailbox& mail_;
+  std::uint32_t self_;
+  int d_;
+  const std::vector<std::size_t>& own_;
+  const Eigen::MatrixXd& Y_;
+  std::vector<std::uint32_t> everyone_, neighbours_;
+  std::map<std::size_t, Pose> poses_;  // own and neighbours' rounded poses
+};
 
 }  // namespace
 
-// PLACEHOLDER until core's agent state machine is plugged in: one round in which every
-// agent sends its boundary poses (rank r = d, i.e. the poses themselves) to each
-// neighbour and a status to everyone, and checks it received exactly what it expected.
 RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
                                double receive_timeout_s) {
-  const int d = local.d;
-  std::map<std::uint32_t, std::size_t> slot;  // owned pose id -> index in local.owned
-  for (std::size_t k = 0; k < local.owned.size(); ++k) slot[local.owned[k]] = k;
-  auto pose_of = [&](std::uint32_t id) {
-    return local.initial.empty() ? Pose::identity(d) : local.initial[slot.at(id)];
-  };
+  const DistributedOptions options = options_of(local.options);
+  const std::string& init = local.options.initialization;
+  if (!init.empty() && init != "file")
+    throw std::runtime_error("initialisation '" + init +
+                             "' is not available over DDS yet: use 'file' (the VERTEX poses of "
+                             "the input), the default");
+  if (local.initial.size() != local.owned.size())
+    throw std::runtime_error("agent " + std::to_string(local.agent_id) +
+                             ": the input has no VERTEX poses for the poses it owns; the DDS "
+                             "runtime initialises from the file's poses");
+  if (options.rank < local.d)
+    throw std::runtime_error("rank " + std::to_string(options.rank) +
+                             " is below d = " + std::to_string(local.d));
 
-  for (const auto& [neighbour, ids] : boundary_by_neighbour(local)) {
-    PoseBlockMessage block;
-    block.round = 0;
-    block.sender = local.agent_id;
-    block.kind = BlockKind::kY;
-    block.rank = static_cast<std::uint32_t>(d);
-    block.dim = static_cast<std::uint32_t>(d);
-    block.pose_ids = ids;
-    for (std::uint32_t id : ids) {
-      Pose p = pose_of(id);
-      for (int c = 0; c < d; ++c)
-        for (int r = 0; r < d; ++r) block.data.push_back(p.R(r, c));
-      for (int r = 0; r < d; ++r) block.data.push_back(p.t(r));
-    }
-    channel.send(OutgoingMessage{block, false, {neighbour}});
+  // Every agent builds the same layout from the structure (endpoints only).
+  std::vector<Measurement> skeleton(local.structure.size());
+  for (std::size_t k = 0; k < skeleton.size(); ++k) {
+    skeleton[k].i = local.structure[k].first;
+    skeleton[k].j = local.structure[k].second;
   }
-  RoundStatusMessage status;
-  status.round = 0;
-  status.sender = local.agent_id;
-  status.done_vote = true;
-  channel.send(OutgoingMessage{status, true, {}});
+  const std::vector<int> assignment(local.owner.begin(), local.owner.end());
+  const BlockLayout layout = make_block_layout(local.num_poses, skeleton, assignment);
+  const auto& own = layout.poses[local.agent_id];
+  if (own.size() != local.owned.size() || !std::equal(own.begin(), own.end(), local.owned.begin()))
+    throw std::runtime_error("agent " + std::to_string(local.agent_id) +
+                             ": owned poses do not match the assignment");
 
-  auto expected = expected_from_neighbours(local);
-  std::set<std::uint32_t> statuses_missing;
-  for (std::uint32_t a = 0; a < local.num_agents; ++a)
-    if (a != local.agent_id) statuses_missing.insert(a);
-  while (!expected.empty() || !statuses_missing.empty()) {
-    auto msg = channel.receive(receive_timeout_s);
-    if (!msg) {
-      std::string who;
-      for (auto& [b, ids] : expected) who += " block from agent " + std::to_string(b) + ";";
-      for (auto a : statuses_missing) who += " status from agent " + std::to_string(a) + ";";
-      throw std::runtime_error("round 0: nothing received for " +
-                               std::to_string(receive_timeout_s) + " s; still waiting for:" + who);
-    }
-    if (auto* block = std::get_if<PoseBlockMessage>(&*msg)) {
-      auto it = expected.find(block->sender);
-      if (it == expected.end())
-        throw std::runtime_error("round 0: unexpected pose block from agent " +
-                                 std::to_string(block->sender));
-      if (block->pose_ids != it->second || block->rank != static_cast<std::uint32_t>(d))
-        throw std::runtime_error("round 0: pose block from agent " + std::to_string(block->sender) +
-                                 " does not hold the expected boundary poses");
-      expected.erase(it);
-    } else {
-      statuses_missing.erase(std::get<RoundStatusMessage>(*msg).sender);
-    }
+  // Core's agent, configured as the in-process engine configures it.
+  AgentState state(static_cast<int>(local.agent_id), local.d, layout, local.measurements,
+                   lift_poses(local.initial, options.rank));
+  const double variables =
+      static_cast<double>(options.rank) * (local.d + 1) * static_cast<double>(local.num_poses);
+  const auto scheme = make_momentum_scheme(options, layout, variables);
+  const RoundConfig config = make_round_config(options, scheme.get());
+  RoundProtocol protocol(state, layout, config);
+
+  Mailbox mail(channel, receive_timeout_s, local.agent_id);
+  mail.run_protocol(protocol);
+
+  RoundLoopResult res;
+  res.rounds = static_cast<std::uint32_t>(protocol.rounds());
+  res.restarts = static_cast<std::uint32_t>(protocol.restarts());
+  res.stop_reason = protocol.stop_reason();
+  if (!protocol.trace().empty()) {
+    res.relaxation_cost = protocol.trace().back().cost;
+    res.grad_norm = protocol.trace().back().grad_norm;
   }
+  res = Rounding(local, layout, state, mail).run(std::move(res));
 
-  RoundLoopResult result;
-  result.rounds = 1;
-  for (std::uint32_t id : local.owned) result.poses.push_back(pose_of(id));
-  return result;
+  if (local.agent_id == 0) {  // one report for the coordinator's summary
+    RoundStatusMessage st;
+    st.round = res.rounds;
+    st.phase = kFinalReportPhase;
+    st.sender = 0;
+    st.cost = res.cost;
+    st.grad_norm_sq = res.grad_norm * res.grad_norm;
+    st.block_grad_norm = static_cast<double>(res.restarts);
+    channel.send(OutgoingMessage{st, true, {}});
+  }
+  return res;
 }
 
 }  // namespace tessera::agent

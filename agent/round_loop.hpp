@@ -7,9 +7,10 @@
 // final estimate. Nothing here knows about DDS: the same function can be driven by an
 // in-process channel in tests.
 //
-// Today run_round_loop() is a placeholder that exercises the channel (one exchange of
-// boundary pose blocks and one status broadcast) and returns the initial poses. The lead
-// replaces its body with core's agent state machine (issue 4).
+// run_round_loop() runs core's agent (AgentState + RoundProtocol, configured exactly as the
+// in-process engine configures it) and then rounds the final iterate to SE(d) without a
+// central step: the rotation rounding from a summed Gram matrix, the optimal translations
+// by a distributed preconditioned conjugate gradient on the translation Laplacian.
 
 #include <cstdint>
 #include <optional>
@@ -80,7 +81,19 @@ class ProtocolChannel {
 struct RoundLoopResult {
   std::vector<Pose> poses;  ///< Final (rounded) poses of `owned`, same order.
   std::uint32_t rounds = 0;
+  std::uint32_t restarts = 0;
+  std::string stop_reason;       ///< grad_norm, max_rounds or relative_decrease.
+  double relaxation_cost = 0.0;  ///< f of the final lifted iterate (as every agent summed it).
+  double grad_norm = 0.0;        ///< ||grad f|| there.
+  double cost = 0.0;             ///< Objective of the rounded poses (whole graph, summed).
+  std::uint32_t translation_iterations = 0;  ///< Distributed CG iterations of the rounding.
 };
+
+/// Status phases of the messages the round loop adds after core's protocol (distributed
+/// rounding), and the one agent 0 sends for the coordinator's summary: round = rounds,
+/// cost = rounded cost, grad_norm_sq = ||grad f||^2, block_grad_norm = restarts.
+constexpr std::uint32_t kRoundingPhaseBase = 100;
+constexpr std::uint32_t kFinalReportPhase = 200;
 
 /// Runs this agent's part of the distributed solve. `receive_timeout_s` bounds every wait
 /// for a peer's message (a throw names the missing sender).

@@ -29,6 +29,9 @@
 using namespace tessera;
 using namespace tessera::transport;
 
+// Status phase of agent 0's final report (agent/round_loop.hpp: kFinalReportPhase).
+constexpr std::uint32_t agent_final_report_phase = 200;
+
 namespace {
 
 constexpr const char* kHelp = R"(usage: tessera-coordinator --agents N [options]
@@ -48,9 +51,9 @@ options:
   --peers IP[,IP]      IPv4 addresses to contact by unicast (when multicast is not available)
   --partition PRESET   sequential, fast, eco, strong or highest (default eco)
   --partition-seed K   seed of the partitioner (default 1)
-  --rank R             rank r of the relaxation sent to the agents (default 0 = d)
+  --rank R             rank r of the relaxation sent to the agents (default 0 = core's, 5)
   --algorithm NAME     solver name sent to the agents (default: core's default)
-  --init NAME          initialisation sent to the agents (default: core's default)
+  --init NAME          initialisation sent to the agents: file (default: the VERTEX poses)
   --max-rounds K       round limit sent to the agents (default 0 = core's default)
   --grad-tol X         gradient-norm tolerance sent to the agents (default 0 = core's default)
   --rel-cost-tol X     relative cost tolerance sent to the agents (default 0 = core's default)
@@ -58,6 +61,7 @@ options:
   --output FILE        write the merged poses as g2o (VERTEX lines only)
   --tum FILE           write the merged poses in the TUM format
   --summary FILE       write a JSON summary of the run
+  --graph-name NAME    label of the graph in the summary (default "")
   --progress           print round progress (sum of the agents' cost and gradient norm)
   --verbose            print each phase
   --help               this text
@@ -81,7 +85,7 @@ struct CoordinatorArgs {
   std::uint32_t max_rounds = 0;
   double grad_tol = 0, rel_cost_tol = 0;
   std::uint64_t seed = 1;
-  std::string output, tum, summary;
+  std::string output, tum, summary, graph_name;
   bool progress = false, verbose = false;
 };
 
@@ -101,7 +105,7 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
   cli::Arguments args(argv,
                       {"agents", "run-id", "domain", "timeout", "run-timeout", "lease", "peers",
                        "partition", "partition-seed", "rank", "algorithm", "init", "max-rounds",
-                       "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary"},
+                       "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary", "graph-name"},
                       {"progress", "verbose", "help"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
@@ -141,6 +145,7 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
   a.output = args.get_or("output", "");
   a.tum = args.get_or("tum", "");
   a.summary = args.get_or("summary", "");
+  a.graph_name = args.get_or("graph-name", "");
   a.progress = args.has("progress");
   a.verbose = args.has("verbose");
   return a;
@@ -321,24 +326,35 @@ class Coordinator {
       WaitStatus st = room.wait_for(
           [&] {
             absent = finals_missing();
-            return absent.empty() || !s.status_watch().queued_locked().empty();
+            return (absent.empty() && have_final_report_) ||
+                   !s.status_watch().queued_locked().empty();
           },
           Seconds(std::max(0.0, left)));
       expect_ready(st, room, a_.run_timeout_s, "the final estimates", "none yet from " + absent);
       for (const auto& m : s.status_watch().take_all()) {
+        if (m.phase() == agent_final_report_phase) {  // agent 0's summary of the solve
+          final_cost_ = m.cost();
+          final_grad_norm_ = std::sqrt(m.grad_norm_sq());
+          final_restarts_ = static_cast<std::uint32_t>(m.block_grad_norm());
+          have_final_report_ = true;
+          continue;
+        }
+        // Only the round statuses (core's phases 1 and 5) make progress lines.
+        if (m.phase() != 1 && m.phase() != 5) continue;
         auto& p = progress[{m.round(), m.phase()}];
         p.first += 1;
         p.second.first += m.cost();
         p.second.second += m.grad_norm_sq();
         if (p.first == N && a_.progress) {
           char buf[160];
-          std::snprintf(buf, sizeof(buf), "round %u phase %u: cost %.10g, grad norm %.3e\n",
-                        m.round(), m.phase(), p.second.first, std::sqrt(p.second.second));
+          std::snprintf(buf, sizeof(buf), "round %u%s: cost %.10g, grad norm %.3e\n", m.round(),
+                        m.phase() == 5 ? " (restart)" : "", p.second.first,
+                        std::sqrt(p.second.second));
           std::cout << buf << std::flush;
         }
         if (p.first == N) progress.erase({m.round(), m.phase()});
       }
-      if (s.finals().size() >= N &&
+      if (have_final_report_ && s.finals().size() >= N &&
           room.wait_for([&] { return finals_missing().empty(); }, Seconds(0)) == WaitStatus::kReady)
         break;
     }
@@ -400,6 +416,21 @@ class Coordinator {
                      const std::vector<std::uint64_t>& bytes, std::uint32_t rounds,
                      double total_ms) {
     std::string j = "{\n";
+    std::uint64_t total_bytes = 0;
+    for (auto b : bytes) total_bytes += b;
+    j += "  \"algorithm\": " + json_string(a_.algorithm.empty() ? "irbcd" : a_.algorithm) + ",\n";
+    j += "  \"graph\": " + json_string(a_.graph_name) + ",\n";
+    j += "  \"poses\": " + std::to_string(rs.num_poses) + ",\n";
+    j += "  \"edges\": " + std::to_string(rs.num_measurements) + ",\n";
+    j += "  \"d\": " + std::to_string(rs.d) + ",\n";
+    j += "  \"rank\": " + std::to_string(a_.rank ? a_.rank : 5) + ",\n";
+    j += "  \"iterations\": " + std::to_string(rounds) + ",\n";
+    j += "  \"grad_norm\": " + (have_final_report_ ? json_number(final_grad_norm_) : "null") + ",\n";
+    j += "  \"cost\": " + (have_final_report_ ? json_number(final_cost_) : "null") + ",\n";
+    j += "  \"certified\": null,\n";
+    j += "  \"wall_s\": " + json_number(total_ms / 1000.0) + ",\n";
+    j += "  \"restarts\": " + std::to_string(final_restarts_) + ",\n";
+    j += "  \"bytes_exchanged\": " + std::to_string(total_bytes) + ",\n";
     j += "  \"run_id\": " + json_string(a_.run_id) + ",\n";
     j += "  \"domain\": " + std::to_string(session_->domain()) + ",\n";
     j += "  \"agents\": " + std::to_string(a_.agents) + ",\n";
@@ -427,6 +458,10 @@ class Coordinator {
   SignalWatcher& signals_;
   std::unique_ptr<Session> session_;
   double discovery_ms_ = 0, solve_ms_ = 0;
+  // From agent 0's final report (agent/round_loop.hpp kFinalReportPhase).
+  double final_cost_ = 0, final_grad_norm_ = 0;
+  std::uint32_t final_restarts_ = 0;
+  bool have_final_report_ = false;
 };
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <ctime>
 #include <memory>
 
+#include "distributed/agent_factory.hpp"
 #include "distributed/agent_state.hpp"
 #include "distributed/block_layout.hpp"
 #include "distributed/round_protocol.hpp"
@@ -81,25 +82,9 @@ DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<in
     states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb));
   }
 
-  std::unique_ptr<MomentumScheme> scheme;
-  const int units = selection_units(options.parallel, layout);
-  if (options.algorithm == DistributedAlgorithm::kRbcdPlusPlus) {
-    scheme = std::make_unique<RbcdPlusPlusScheme>(options.rbcd_plus_plus, units);
-  } else if (options.algorithm == DistributedAlgorithm::kIrbcd) {
-    const double n = options.irbcd.dimension == IrbcdDimension::kUnits
-                         ? static_cast<double>(units)
-                         : static_cast<double>(X0.size());
-    scheme = std::make_unique<IrbcdScheme>(options.irbcd, n);
-  }
-  RoundConfig config;
-  config.selection = options.selection;
-  config.parallel = options.parallel;
-  config.seed = options.seed;
-  config.grad_norm_tol = options.grad_norm_tol;
-  config.max_rounds = options.max_rounds;
-  config.rel_cost_decrease_tol = options.rel_cost_decrease_tol;
-  config.update = options.block_update;
-  config.scheme = scheme.get();
+  const std::unique_ptr<MomentumScheme> scheme =
+      make_momentum_scheme(options, layout, static_cast<double>(X0.size()));
+  const RoundConfig config = make_round_config(options, scheme.get());
   std::vector<std::unique_ptr<RoundProtocol>> protocols;
   std::vector<RoundProtocol*> agents;
   for (int b = 0; b < N; ++b) {

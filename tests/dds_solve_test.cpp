@@ -1,0 +1,150 @@
+// Real distributed solves over DDS: the agents run core's round protocol as processes and must
+// give the same iterates as the in-process engine; `tessera launch` end to end.
+// Domains used here: 161-164 (each test its own, so ctest -j is safe).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "dds_process_support.hpp"
+#include "distributed/distributed_solver.hpp"
+#include "io/g2o_reader.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// A number field of the (flat) JSON summary; NaN when absent.
+double json_field(const std::string& json, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
+  return std::stod(m[1]);
+}
+
+// Owned pose ids from an agent's --dump-local file.
+std::vector<int> owned_of(const std::string& path) {
+  std::ifstream f(path);
+  std::string line;
+  std::vector<int> out;
+  while (std::getline(f, line))
+    if (line.rfind("OWNED ", 0) == 0) out.push_back(std::stoi(line.substr(6)));
+  return out;
+}
+
+std::string generate(const std::string& dir, int poses, int robots, int seed) {
+  const std::string path = dir + "/graph.g2o";
+  std::string out;
+  const int rc = run_command(bin("tessera") + " generate --kind grid3d --poses " +
+                                 std::to_string(poses) + " --robots " + std::to_string(robots) +
+                                 " --seed " + std::to_string(seed) + " --out " + path,
+                             &out);
+  EXPECT_EQ(rc, 0) << out;
+  return path;
+}
+
+struct DdsRun {
+  std::string summary;
+  std::vector<int> assignment;
+};
+
+DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int domain,
+               const std::vector<std::string>& solver_args) {
+  const std::string run = "solve-" + std::to_string(getpid()) + "-" + std::to_string(domain);
+  std::vector<std::string> cargs = {bin("tessera-coordinator"),
+                                    "--agents",
+                                    std::to_string(agents),
+                                    "--run-id",
+                                    run,
+                                    "--domain",
+                                    std::to_string(domain),
+                                    "--timeout",
+                                    "20",
+                                    "--run-timeout",
+                                    "60",
+                                    "--summary",
+                                    dir + "/summary.json",
+                                    "--output",
+                                    dir + "/merged.g2o",
+                                    "--progress"};
+  cargs.insert(cargs.end(), solver_args.begin(), solver_args.end());
+  Process coord = start(cargs, dir + "/coordinator.log");
+  std::vector<Process> procs;
+  for (int k = 0; k < agents; ++k)
+    procs.push_back(
+        start({bin("tessera-agent"), "--graph", graph, "--robots", std::to_string(agents), "--id",
+               std::to_string(k), "--run-id", run, "--domain", std::to_string(domain), "--timeout",
+               "20", "--dump-local", dir + "/local" + std::to_string(k) + ".txt"},
+              dir + "/agent" + std::to_string(k) + ".log"));
+  std::vector<Process*> all = {&coord};
+  for (auto& p : procs) all.push_back(&p);
+  EXPECT_TRUE(wait_all(all, 60)) << "a process hung";
+  for (Process* p : all) EXPECT_EQ(p->exit_code, 0) << p->output();
+  DdsRun r;
+  r.summary = slurp(dir + "/summary.json");
+  std::map<int, int> owner;
+  for (int k = 0; k < agents; ++k)
+    for (int id : owned_of(dir + "/local" + std::to_string(k) + ".txt")) owner[id] = k;
+  for (auto& [id, k] : owner) r.assignment.push_back(k);
+  return r;
+}
+
+void expect_same_as_in_process(const std::string& algorithm, int domain) {
+  const std::string dir = temp_dir();
+  const std::string graph = generate(dir, 240, 3, 5);
+  const DdsRun dds = run_dds(dir, graph, 3, domain,
+                             {"--partition", "eco", "--algorithm", algorithm, "--seed", "7"});
+  const PoseGraph g = read_g2o(graph);
+  ASSERT_EQ(dds.assignment.size(), g.num_poses);
+
+  DistributedOptions opt;
+  opt.algorithm = parse_algorithm(algorithm);
+  opt.seed = 7;
+  const DistributedResult ref = solve_distributed(g, dds.assignment, opt, g.initial);
+  ASSERT_GT(ref.rounds, 1) << "the graph should need a few rounds";
+
+  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.rounds) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "restarts"), ref.restarts) << dds.summary;
+  const double cost = json_field(dds.summary, "cost");
+  EXPECT_NEAR(cost, ref.cost, 1e-9 * ref.cost) << dds.summary;
+  EXPECT_NEAR(json_field(dds.summary, "grad_norm"), ref.grad_norm, 1e-9 * ref.grad_norm);
+
+  // The merged poses have the same cost as the in-process engine's rounded poses.
+  // (The merged file holds VERTEX lines only; add the input's edges so the reader takes it.)
+  std::string text = slurp(dir + "/merged.g2o");
+  std::ifstream in(graph);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("EDGE", 0) == 0) text += line + "\n";
+  PoseGraph merged_graph = read_g2o_text(text, "merged").graph;
+  ASSERT_EQ(merged_graph.initial.size(), g.num_poses);
+  double f = 0.0;
+  for (const auto& m : g.measurements) {
+    const Pose& a = merged_graph.initial[m.i];
+    const Pose& b = merged_graph.initial[m.j];
+    f += m.kappa * (b.R - a.R * m.R).squaredNorm() + m.tau * (b.t - a.t - a.R * m.t).squaredNorm();
+  }
+  EXPECT_NEAR(f, ref.cost, 1e-8 * ref.cost);  // g2o text keeps ~17 digits per value
+}
+
+TEST(DdsSolve, IrbcdOverDdsGivesTheInProcessIterates) {
+  expect_same_as_in_process("irbcd", 161);
+}
+
+TEST(DdsSolve, RbcdPlusPlusOverDdsGivesTheInProcessIterates) {
+  expect_same_as_in_process("rbcd++", 162);
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
