@@ -13,5 +13,6 @@ int run_info(const Args& args);
 int run_generate(const Args& args);
 int run_solve(const Args& args);
 int run_partition(const Args& args);
+int run_launch(const Args& args);
 
 }  // namespace tessera::cli

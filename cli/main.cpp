@@ -21,6 +21,7 @@ const Command kCommands[] = {
     {"generate", tessera::cli::run_generate, "write a synthetic multi-robot pose graph (g2o)"},
     {"solve", tessera::cli::run_solve, "optimise a pose graph (centralized or distributed)"},
     {"partition", tessera::cli::run_partition, "split a graph into balanced blocks"},
+    {"launch", tessera::cli::run_launch, "run a distributed solve as DDS processes on this host"},
 };
 
 void print_usage() {

@@ -1,0 +1,359 @@
+// `tessera launch`: runs a whole distributed solve on this host as separate processes, the
+// coordinator and N agents talking over DDS (tessera-coordinator / tessera-agent, found next
+// to this executable). Streams the coordinator's progress, prints the summary, and takes
+// everything down on the first failure, on the time limit and on Ctrl-C.
+
+#include <fcntl.h>
+#include <limits.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "arguments.hpp"
+#include "commands.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera::cli {
+
+namespace {
+
+constexpr const char* kHelp = R"(usage: tessera launch [GRAPH.g2o] --agents N [options]
+
+Runs a distributed solve on this host as separate processes: one tessera-coordinator and N
+tessera-agent processes (robot k reads its sequential share of GRAPH) talking peer to peer
+over Fast DDS. Prints progress (round, cost, gradient norm) while it runs and the JSON
+summary at the end. Any failing process, the time limit or Ctrl-C stops every process; the
+exit code is then non-zero. Without GRAPH, a 3D grid is generated into a temporary folder
+(tessera generate --kind grid3d --poses P --robots N). Agents initialise from the file's
+VERTEX poses.
+
+options:
+  --agents N           number of agent processes, 1..64                     [3]
+  --algorithm NAME     rbcd | rbcd++ | irbcd                                 [irbcd]
+  --partition PRESET   sequential | fast | eco | strong | highest           [highest]
+  --grad-tol X         stop when the gradient norm is at most X (> 0)       [0.01]
+  --max-rounds K       round limit (0 = the solver's default, 10000)        [0]
+  --rank R             relaxation rank (0 = the solver's default, 5)        [0]
+  --seed S             solver seed                                           [1]
+  --json FILE          also write the summary to FILE
+  --out FILE           write the merged poses (g2o, VERTEX lines)
+  --tum FILE           write the merged poses (TUM)
+  --domain D           DDS domain 0..232 (default: derived from the run id)
+  --timeout S          time limit of the whole run, seconds                 [600]
+  --poses P            poses of the generated graph (without GRAPH)         [1000]
+  --quiet              no progress lines
+  --help               this text
+
+exit codes: 0 done, 1 the run failed (a process failed, or the time limit), 2 bad options,
+130 interrupted.
+)";
+
+volatile sig_atomic_t g_signal = 0;
+void on_signal(int signo) {
+  g_signal = signo;
+}
+
+std::string self_dir() {
+  char buf[PATH_MAX];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
+  if (n <= 0) return ".";
+  std::string p(buf, static_cast<std::size_t>(n));
+  return p.substr(0, p.find_last_of('/'));
+}
+
+struct Child {
+  std::string name;
+  pid_t pid = -1;
+  std::string log;
+  bool running = false;
+  int code = -1;  // exit code, or 128 + signal
+};
+
+// Starts argv with stdout going to `stdout_fd` (or the log) and stderr to the log, in its own
+// process group (so a terminal's Ctrl-C reaches only us, and we decide how to stop them).
+Child spawn(const std::string& name, const std::vector<std::string>& argv, const std::string& log,
+            int stdout_fd) {
+  Child c;
+  c.name = name;
+  c.log = log;
+  c.pid = fork();
+  if (c.pid < 0) throw std::runtime_error("fork failed: " + std::string(std::strerror(errno)));
+  if (c.pid == 0) {
+    setpgid(0, 0);
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(stdout_fd >= 0 ? stdout_fd : fd, 1);
+      dup2(fd, 2);
+      close(fd);
+    }
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
+    std::fprintf(stderr, "cannot run %s: %s\n", args[0], std::strerror(errno));
+    _exit(127);
+  }
+  c.running = true;
+  return c;
+}
+
+void reap(std::vector<Child>& children, bool block) {
+  for (auto& c : children) {
+    if (!c.running) continue;
+    int status = 0;
+    if (waitpid(c.pid, &status, block ? 0 : WNOHANG) == c.pid) {
+      c.running = false;
+      c.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+  }
+}
+
+bool any_running(const std::vector<Child>& children) {
+  for (const auto& c : children)
+    if (c.running) return true;
+  return false;
+}
+
+// Asks every process to stop (they shut down cleanly on SIGINT), SIGKILLs what is left after
+// `grace_s`.
+void stop_all(std::vector<Child>& children, double grace_s) {
+  for (auto& c : children)
+    if (c.running) kill(c.pid, SIGINT);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(grace_s);
+  while (any_running(children) && std::chrono::steady_clock::now() < until) {
+    reap(children, false);
+    usleep(20000);
+  }
+  for (auto& c : children)
+    if (c.running) kill(c.pid, SIGKILL);
+  reap(children, true);
+}
+
+std::string tail_of(const std::string& path, std::size_t max_lines) {
+  std::ifstream f(path);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(f, l);) lines.push_back(l);
+  std::string out;
+  for (std::size_t k = lines.size() > max_lines ? lines.size() - max_lines : 0; k < lines.size();
+       ++k)
+    out += "    " + lines[k] + "\n";
+  return out;
+}
+
+void remove_tree(const std::string& dir) {
+  if (dir.empty()) return;
+  std::string cmd = "rm -rf '" + dir + "'";
+  if (std::system(cmd.c_str()) != 0)
+    std::fprintf(stderr, "tessera launch: could not remove %s\n", dir.c_str());
+}
+
+}  // namespace
+
+int run_launch(const Args& argv) {
+  for (const auto& a : argv)
+    if (a == "--help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      return 0;
+    }
+  Arguments args(argv,
+                 {"agents", "algorithm", "partition", "grad-tol", "max-rounds", "rank", "seed",
+                  "json", "out", "tum", "domain", "timeout", "poses"},
+                 {"quiet"});
+  if (args.positional().size() > 1)
+    throw InputError("launch: at most one GRAPH argument, got " +
+                     std::to_string(args.positional().size()));
+  const long agents = args.get_long("agents", 3);
+  if (agents < 1 || agents > 64) throw InputError("launch: --agents must be in 1..64");
+  const std::string algorithm = args.get_or("algorithm", "irbcd");
+  if (algorithm != "rbcd" && algorithm != "rbcd++" && algorithm != "irbcd")
+    throw InputError("launch: --algorithm '" + algorithm + "' is not one of rbcd, rbcd++, irbcd");
+  const std::string partition = args.get_or("partition", "highest");
+  const double grad_tol = args.get_double("grad-tol", 0.01);
+  if (!(grad_tol > 0)) throw InputError("launch: --grad-tol must be > 0");
+  const long max_rounds = args.get_long("max-rounds", 0);
+  if (max_rounds < 0) throw InputError("launch: --max-rounds must be >= 0");
+  const long rank = args.get_long("rank", 0);
+  if (rank < 0) throw InputError("launch: --rank must be >= 0");
+  const long seed = args.get_long("seed", 1);
+  if (seed < 0) throw InputError("launch: --seed must be >= 0");
+  const long domain = args.get_long("domain", -1);
+  if (args.has("domain") && (domain < 0 || domain > 232))
+    throw InputError("launch: --domain must be in 0..232");
+  const double timeout_s = args.get_double("timeout", 600);
+  if (!(timeout_s > 0)) throw InputError("launch: --timeout must be > 0");
+  const long poses = args.get_long("poses", 1000);
+  if (poses < agents) throw InputError("launch: --poses must be at least --agents");
+  const bool quiet = args.has("quiet");
+
+  const std::string bin = self_dir();
+  for (const char* exe : {"tessera-agent", "tessera-coordinator"})
+    if (access((bin + "/" + exe).c_str(), X_OK) != 0)
+      throw InputError("launch: " + bin + "/" + exe + " not found (build it next to tessera)");
+
+  char tmpl[] = "/tmp/tessera-launch-XXXXXX";
+  if (!mkdtemp(tmpl)) throw std::runtime_error("launch: cannot create a temporary folder");
+  const std::string work = tmpl;
+  struct Cleanup {
+    std::string dir;
+    ~Cleanup() { remove_tree(dir); }
+  } cleanup{work};
+
+  std::string graph;
+  if (args.positional().empty()) {
+    graph = work + "/grid3d.g2o";
+    std::string cmd = "'" + bin + "/tessera' generate --kind grid3d --poses " +
+                      std::to_string(poses) + " --robots " + std::to_string(agents) + " --out '" +
+                      graph + "' > '" + work + "/generate.log' 2>&1";
+    if (std::system(cmd.c_str()) != 0)
+      throw std::runtime_error("launch: generating the graph failed:\n" +
+                               tail_of(work + "/generate.log", 10));
+    std::printf("generated %s (grid3d, %ld poses, %ld robots)\n", graph.c_str(), poses, agents);
+  } else {
+    graph = args.positional()[0];
+    std::ifstream probe(graph);
+    if (!probe) throw InputError(graph, 0, "cannot open the graph");
+  }
+  const std::string summary = args.get_or("json", work + "/summary.json");
+  const std::string run_id =
+      "launch-" + std::to_string(getpid()) + "-" +
+      std::to_string(std::chrono::steady_clock::now().time_since_epoch().count() % 1000000);
+  std::vector<std::string> common = {"--run-id", run_id};
+  if (domain >= 0) common.insert(common.end(), {"--domain", std::to_string(domain)});
+
+  // Our own handlers: a Ctrl-C stops the children cleanly instead of orphaning them.
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  struct sigaction old_int {
+  }, old_term{};
+  sigaction(SIGINT, &sa, &old_int);
+  sigaction(SIGTERM, &sa, &old_term);
+  g_signal = 0;
+
+  int pipefd[2];
+  if (pipe(pipefd) != 0) throw std::runtime_error("launch: pipe failed");
+  std::vector<std::string> cargs = {bin + "/tessera-coordinator",
+                                    "--agents",
+                                    std::to_string(agents),
+                                    "--partition",
+                                    partition,
+                                    "--algorithm",
+                                    algorithm,
+                                    "--grad-tol",
+                                    args.get_or("grad-tol", "0.01"),
+                                    "--max-rounds",
+                                    std::to_string(max_rounds),
+                                    "--rank",
+                                    std::to_string(rank),
+                                    "--seed",
+                                    std::to_string(seed),
+                                    "--summary",
+                                    summary,
+                                    "--graph-name",
+                                    graph.substr(graph.find_last_of('/') + 1),
+                                    "--run-timeout",
+                                    std::to_string(timeout_s),
+                                    "--progress"};
+  cargs.insert(cargs.end(), common.begin(), common.end());
+  if (args.has("out")) cargs.insert(cargs.end(), {"--output", args.get_or("out", "")});
+  if (args.has("tum")) cargs.insert(cargs.end(), {"--tum", args.get_or("tum", "")});
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Child> children;
+  children.push_back(spawn("coordinator", cargs, work + "/coordinator.log", pipefd[1]));
+  close(pipefd[1]);
+  for (long k = 0; k < agents; ++k) {
+    std::vector<std::string> a = {
+        bin + "/tessera-agent", "--graph", graph, "--robots", std::to_string(agents), "--id",
+        std::to_string(k)};
+    a.insert(a.end(), common.begin(), common.end());
+    children.push_back(
+        spawn("agent " + std::to_string(k), a, work + "/agent" + std::to_string(k) + ".log", -1));
+  }
+  std::printf("launched run %s: coordinator + %ld agents (logs in %s until the end)\n",
+              run_id.c_str(), agents, work.c_str());
+  std::fflush(stdout);
+
+  // Stream progress; watch for failures, the time limit and signals.
+  std::string pending;
+  std::string failure;
+  int exit_code = 0;
+  bool pipe_open = true;
+  for (;;) {
+    if (pipe_open) {
+      pollfd pfd{pipefd[0], POLLIN, 0};
+      if (poll(&pfd, 1, 50) > 0) {
+        char buf[4096];
+        const ssize_t n = read(pipefd[0], buf, sizeof(buf));
+        if (n <= 0) {
+          pipe_open = false;
+        } else {
+          pending.append(buf, static_cast<std::size_t>(n));
+          for (std::size_t nl; (nl = pending.find('\n')) != std::string::npos;) {
+            if (!quiet) std::printf("%s\n", pending.substr(0, nl).c_str());
+            pending.erase(0, nl + 1);
+          }
+          std::fflush(stdout);
+        }
+      }
+    } else {
+      usleep(50000);
+    }
+    reap(children, false);
+    if (g_signal) {
+      failure = std::string("interrupted (") + (g_signal == SIGINT ? "SIGINT" : "SIGTERM") +
+                "): stopping every process";
+      exit_code = 130;
+      break;
+    }
+    for (const auto& c : children)
+      if (!c.running && c.code != 0 && failure.empty()) {
+        failure = c.name + " failed (exit code " + std::to_string(c.code) + ")";
+        exit_code = 1;
+      }
+    if (!failure.empty()) break;
+    if (!any_running(children)) break;
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > timeout_s) {
+      failure = "time limit of " + std::to_string(timeout_s) + " s reached";
+      exit_code = 1;
+      break;
+    }
+  }
+  close(pipefd[0]);
+  if (!failure.empty()) {
+    std::fprintf(stderr, "tessera launch: %s\n", failure.c_str());
+    // The others notice a lost or aborting peer themselves; give them time to say why.
+    stop_all(children, exit_code == 130 ? 5.0 : 4.0);
+    for (const auto& c : children)
+      if (c.code != 0 && c.code != 130 && c.code != 143)
+        std::fprintf(stderr, "  %s (exit %d):\n%s", c.name.c_str(), c.code,
+                     tail_of(c.log, 6).c_str());
+  }
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+  if (!failure.empty()) return exit_code;
+
+  std::ifstream s(summary);
+  std::stringstream ss;
+  ss << s.rdbuf();
+  std::printf("summary:\n%s", ss.str().c_str());
+  std::printf("wall time %.2f s\n",
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  return 0;
+}
+
+}  // namespace tessera::cli
