@@ -1,6 +1,6 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-164 (each test its own, so ctest -j is safe).
+// Domains used here: 161-165 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -144,6 +144,63 @@ TEST(DdsSolve, IrbcdOverDdsGivesTheInProcessIterates) {
 
 TEST(DdsSolve, RbcdPlusPlusOverDdsGivesTheInProcessIterates) {
   expect_same_as_in_process("rbcd++", 162);
+}
+
+TEST(DdsLaunch, EndToEndOnAGeneratedGraphPrintsTheSummary) {
+  const std::string dir = temp_dir();
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch --agents 3 --poses 150 --domain 163 " +
+                                 "--partition eco --timeout 60 --json " + dir + "/s.json --out " +
+                                 dir + "/merged.g2o 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find("round 1:"), std::string::npos) << out;  // progress streamed
+  EXPECT_NE(out.find("summary:"), std::string::npos) << out;
+  const std::string json = slurp(dir + "/s.json");
+  for (const char* field :
+       {"algorithm", "graph", "poses", "edges", "d", "rank", "rounds", "iterations", "grad_norm",
+        "cost", "certified", "wall_s", "agents", "partition", "restarts", "bytes_exchanged",
+        "partition_ms", "bytes_sent", "discovery_ms"})
+    EXPECT_NE(json.find("\"" + std::string(field) + "\":"), std::string::npos) << field << json;
+  EXPECT_EQ(json_field(json, "poses"), 150);
+  EXPECT_LE(json_field(json, "grad_norm"), 0.01);
+  EXPECT_GT(json_field(json, "cost"), 0);
+  std::ifstream merged(dir + "/merged.g2o");
+  int vertices = 0;
+  for (std::string line; std::getline(merged, line);) vertices += line.rfind("VERTEX", 0) == 0;
+  EXPECT_EQ(vertices, 150);
+}
+
+TEST(DdsLaunch, BadGraphFailsWithTheAgentsReason) {
+  const std::string dir = temp_dir();
+  const std::string graph = write_file(dir, "bad.g2o", "VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 7 1 0\n");
+  std::string out;
+  const int rc = run_command(
+      bin("tessera") + " launch " + graph + " --agents 2 --domain 164 --timeout 30 2>&1", &out);
+  EXPECT_NE(rc, 0) << out;
+  EXPECT_NE(out.find("failed"), std::string::npos) << out;
+  EXPECT_NE(out.find("bad.g2o"), std::string::npos) << out;  // the agent's message names the file
+}
+
+TEST(DdsLaunch, SigintStopsEveryProcess) {
+  const std::string dir = temp_dir();
+  Process launch = start(
+      {bin("tessera"), "launch", "--agents", "3", "--poses", "600", "--domain", "165", "--grad-tol",
+       "1e-12", "--max-rounds", "100000", "--partition", "fast", "--timeout", "60"},
+      dir + "/launch.log");
+  // Wait until the rounds run, then interrupt.
+  const auto until = Clock::now() + std::chrono::seconds(20);
+  while (launch.output().find("round 2:") == std::string::npos && Clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_NE(launch.output().find("round 2:"), std::string::npos) << launch.output();
+  kill(launch.pid, SIGINT);
+  ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
+  EXPECT_EQ(launch.exit_code, 130) << launch.output();
+  EXPECT_NE(launch.output().find("interrupted"), std::string::npos) << launch.output();
+  // No agent or coordinator of that run is left.
+  std::string ps;
+  run_command("ps -eo args | grep -c '[t]essera-agent.*--domain 165'", &ps);
+  EXPECT_EQ(std::stoi(ps), 0) << ps;
 }
 
 }  // namespace
