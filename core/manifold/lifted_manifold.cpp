@@ -31,15 +31,49 @@ Eigen::MatrixXd LiftedManifold::project(const Eigen::MatrixXd& X) const {
   return out;
 }
 
+namespace {
+
+// sym(A_i^T B_i) for the d x d Stiefel block of pose i, on raw column-major data: with
+// dynamic sizes Eigen evaluates these tiny products coefficient by coefficient, and they were
+// the top entry of the solver's profile (38% on kitti_05).
+void block_sym_product(const double* A, const double* B, Eigen::Index r, int d, double* sym) {
+  double S[9];
+  for (int a = 0; a < d; ++a)
+    for (int b = 0; b < d; ++b) {
+      double acc = 0.0;
+      const double* Aa = A + a * r;
+      const double* Bb = B + b * r;
+      for (Eigen::Index k = 0; k < r; ++k) acc += Aa[k] * Bb[k];
+      S[a * d + b] = acc;
+    }
+  for (int a = 0; a < d; ++a)
+    for (int b = 0; b < d; ++b) sym[a * d + b] = 0.5 * (S[a * d + b] + S[b * d + a]);
+}
+
+// out_i (r x d) += sign * C_i * sym, C_i the d columns of pose i in C.
+void block_multiply_add(const double* C, const double* sym, Eigen::Index r, int d, double sign,
+                        double* out) {
+  for (int b = 0; b < d; ++b) {
+    double* o = out + b * r;
+    for (int a = 0; a < d; ++a) {
+      const double w = sign * sym[a * d + b];
+      const double* Ca = C + a * r;
+      for (Eigen::Index k = 0; k < r; ++k) o[k] += w * Ca[k];
+    }
+  }
+}
+
+}  // namespace
+
 Eigen::MatrixXd LiftedManifold::tangent_project(const Eigen::MatrixXd& X,
                                                 const Eigen::MatrixXd& V) const {
   Eigen::MatrixXd out = V;
-  SmallMatrix S(d_, d_);
+  const Eigen::Index r = X.rows();
+  double sym[9];
   for (std::size_t i = 0; i < n_; ++i) {
-    const Eigen::Index c = static_cast<Eigen::Index>((d_ + 1) * i);
-    S.noalias() = X.middleCols(c, d_).transpose() * V.middleCols(c, d_);
-    SmallMatrix sym = 0.5 * (S + S.transpose());
-    out.middleCols(c, d_).noalias() -= X.middleCols(c, d_) * sym;
+    const Eigen::Index offset = r * static_cast<Eigen::Index>((d_ + 1) * i);
+    block_sym_product(X.data() + offset, V.data() + offset, r, d_, sym);
+    block_multiply_add(X.data() + offset, sym, r, d_, -1.0, out.data() + offset);
   }
   return out;
 }
@@ -51,12 +85,12 @@ Eigen::MatrixXd LiftedManifold::retract(const Eigen::MatrixXd& X, const Eigen::M
 Eigen::MatrixXd LiftedManifold::weingarten_term(const Eigen::MatrixXd& X, const Eigen::MatrixXd& G,
                                                 const Eigen::MatrixXd& V) const {
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(X.rows(), X.cols());
-  SmallMatrix S(d_, d_);
+  const Eigen::Index r = X.rows();
+  double sym[9];
   for (std::size_t i = 0; i < n_; ++i) {
-    const Eigen::Index c = static_cast<Eigen::Index>((d_ + 1) * i);
-    S.noalias() = X.middleCols(c, d_).transpose() * G.middleCols(c, d_);
-    SmallMatrix sym = 0.5 * (S + S.transpose());
-    out.middleCols(c, d_).noalias() = V.middleCols(c, d_) * sym;
+    const Eigen::Index offset = r * static_cast<Eigen::Index>((d_ + 1) * i);
+    block_sym_product(X.data() + offset, G.data() + offset, r, d_, sym);
+    block_multiply_add(V.data() + offset, sym, r, d_, 1.0, out.data() + offset);
   }
   return out;
 }
