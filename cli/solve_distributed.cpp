@@ -16,9 +16,10 @@
 
 namespace tessera::cli {
 
-const char* const kDistributedValued[] = {
-    "agents",   "partition", "max-rounds", "seed",       "reference-cost", "select",    "rel-tol",
-    "tr-steps", "restart-c", "sigma",      "unselected", "irbcd-n",        "tcg-iters", nullptr};
+const char* const kDistributedValued[] = {"agents",         "partition", "max-rounds", "seed",
+                                          "reference-cost", "select",    "rel-tol",    "tr-steps",
+                                          "restart-c",      "sigma",     "unselected", "irbcd-n",
+                                          "tcg-iters",      "robots",    nullptr};
 const char* const kDistributedSwitches[] = {"parallel", "reference", nullptr};
 
 const char* kDistributedHelp =
@@ -30,6 +31,7 @@ const char* kDistributedHelp =
     "  --agents N                number of agents / blocks (default 5)\n"
     "  --partition PRESET        sequential|fast|eco|strong|highest (default highest)\n"
     "  --init chordal|distributed   initial guess (default chordal)\n"
+    "  --robots R                robots of --init distributed: R contiguous id ranges (default N)\n"
     "  --grad-tol T              stop at ||grad f|| <= T, full cost (default 0.01)\n"
     "  --max-rounds K            round cap (default 10000)\n"
     "  --rel-tol T               stop when a round decreases f by < T f (default 0: off)\n"
@@ -78,6 +80,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   opt.rel_cost_decrease_tol = a.get_double("rel-tol", opt.rel_cost_decrease_tol);
   opt.selection = parse_selection(a.get_or("select", selection_name(opt.selection)));
   opt.parallel = a.has("parallel");
+  opt.robots = static_cast<int>(a.get_long("robots", 0));
   const long seed = a.get_long("seed", 1);
   if (seed < 0) throw InputError("option --seed: must be >= 0");
   opt.seed = static_cast<std::uint64_t>(seed);
