@@ -9,13 +9,15 @@
 namespace tessera {
 
 const char* init_name(DistributedInit init) {
+  if (init == DistributedInit::kFile) return "file";
   return init == DistributedInit::kChordal ? "chordal" : "distributed";
 }
 
 DistributedInit parse_init(const std::string& name) {
   if (name == "chordal") return DistributedInit::kChordal;
   if (name == "distributed") return DistributedInit::kDistributed;
-  throw InputError("initialization '" + name + "' is not one of chordal, distributed");
+  if (name == "file") return DistributedInit::kFile;
+  throw InputError("initialization '" + name + "' is not one of chordal, distributed, file");
 }
 
 namespace {
@@ -114,6 +116,11 @@ std::vector<Pose> distributed_initialization(const PoseGraph& graph, int robots)
 
 std::vector<Pose> initial_poses(const PoseGraph& graph, DistributedInit init, int robots) {
   if (init == DistributedInit::kChordal) return chordal_initialization(graph);
+  if (init == DistributedInit::kFile) {
+    if (!graph.has_initial())
+      throw InputError(graph.source, 0, "initialization 'file' needs a VERTEX line for every pose");
+    return graph.initial;
+  }
   return distributed_initialization(graph, robots);
 }
 

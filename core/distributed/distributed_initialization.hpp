@@ -16,9 +16,10 @@
 
 namespace tessera {
 
-enum class DistributedInit { kChordal, kDistributed };
+/// kFile: the input's VERTEX poses (graph.initial), what the DDS runtime's agents start from.
+enum class DistributedInit { kChordal, kDistributed, kFile };
 
-/// "chordal", "distributed".
+/// "chordal", "distributed", "file".
 const char* init_name(DistributedInit init);
 /// Throws InputError listing the valid names.
 DistributedInit parse_init(const std::string& name);

@@ -1,0 +1,135 @@
+#!/usr/bin/env python3
+"""Overhead of the DDS runtime over the in-process engine, side by side, on the paper graphs.
+
+For each graph: N agents (default 5), `highest` partition, IRBCD, both runs starting from the
+same initial poses (`--init file`: the file's VERTEX poses; graphs without VERTEX lines get
+their rounded chordal initialisation written to a temporary copy first, by
+`tessera solve --max-rounds 0 --out`). Measured, as the user sees it (process start to exit):
+  in-process  `tessera solve G --algorithm irbcd --agents N --partition highest --init file`
+  DDS         `tessera launch G --agents N --partition highest` (coordinator + N agents)
+and printed: rounds of each (they differ only when the coordinator's partition differs: it
+partitions the structure in the agents' announcement order, not file order), relative cost
+difference, wall times and their ratio (target <= 1.5), median ms per round of the DDS run
+(from the arrival times of its progress lines), bytes per round (all agents' DDS bytes / rounds).
+
+usage: dds_overhead.py [--bin build/bin] [--graphs CSAIL,intel] [--agents 5] [--domain 210]
+                       [--out FILE.csv]
+"""
+import argparse
+import csv
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+SHARED = os.path.abspath(os.path.join(ROOT, "..", "shared"))
+
+
+def paper_graphs():
+    names = []
+    with open(os.path.join(SHARED, "reference", "optima.csv")) as f:
+        for row in csv.DictReader(f):
+            if not row["dataset"].endswith("_qnorm"):
+                names.append(row["dataset"])
+    return sorted(set(names))
+
+
+def has_vertices(path):
+    with open(path) as f:
+        for line in f:
+            if line.startswith("VERTEX"):
+                return True
+    return False
+
+
+def run_in_process(tessera, graph, agents, tmp):
+    js = os.path.join(tmp, "inprocess.json")
+    t0 = time.monotonic()
+    p = subprocess.run([tessera, "solve", graph, "--algorithm", "irbcd", "--agents", str(agents),
+                        "--partition", "highest", "--init", "file", "--json", js],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    wall = time.monotonic() - t0
+    if p.returncode != 0:
+        print(p.stdout, file=sys.stderr)
+        return None
+    with open(js) as f:
+        return json.load(f), wall
+
+
+def run_dds(tessera, graph, agents, domain, tmp):
+    js = os.path.join(tmp, "dds.json")
+    t0 = time.monotonic()
+    p = subprocess.Popen([tessera, "launch", graph, "--agents", str(agents), "--partition",
+                          "highest", "--domain", str(domain), "--json", js, "--timeout", "3600"],
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1)
+    stamps = []
+    log = []
+    for line in p.stdout:
+        log.append(line)
+        if line.startswith("round "):
+            stamps.append(time.monotonic())
+    p.wait()
+    wall = time.monotonic() - t0
+    if p.returncode != 0:
+        print("".join(log[-20:]), file=sys.stderr)
+        return None
+    with open(js) as f:
+        s = json.load(f)
+    gaps = [1000 * (b - a) for a, b in zip(stamps, stamps[1:])]
+    return s, wall, (statistics.median(gaps) if gaps else float("nan"))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--graphs", default="")
+    ap.add_argument("--agents", type=int, default=5)
+    ap.add_argument("--domain", type=int, default=210)
+    ap.add_argument("--out", default="")
+    a = ap.parse_args()
+    tessera = os.path.join(a.bin, "tessera")
+    names = a.graphs.split(",") if a.graphs else paper_graphs()
+    head = ("graph", "rounds ip", "rounds dds", "rel cost diff", "wall ip s", "wall dds s",
+            "ratio", "dds ms/round", "bytes/round")
+    print("%-18s %9s %10s %13s %9s %10s %6s %12s %11s" % head)
+    rows = []
+    for name in names:
+        src = os.path.join(SHARED, "datasets", name + ".g2o")
+        with tempfile.TemporaryDirectory() as tmp:
+            graph = src
+            if not has_vertices(src):
+                graph = os.path.join(tmp, name + ".g2o")
+                subprocess.run([tessera, "solve", src, "--algorithm", "irbcd", "--agents", "1",
+                                "--partition", "sequential", "--max-rounds", "0", "--out", graph],
+                               check=True, stdout=subprocess.DEVNULL)
+            ip = run_in_process(tessera, graph, a.agents, tmp)
+            dds = run_dds(tessera, graph, a.agents, a.domain, tmp)
+        if ip is None or dds is None:
+            print("%-18s failed (%s)" % (name, "in-process" if ip is None else "dds"))
+            continue
+        (si, wi), (sd, wd, med) = ip, dds
+        row = {"graph": name, "rounds_inprocess": si["rounds"], "rounds_dds": sd["rounds"],
+               "rel_cost_diff": abs(sd["cost"] - si["cost"]) / abs(si["cost"]),
+               "wall_inprocess_s": wi, "wall_dds_s": wd, "ratio": wd / wi,
+               "dds_median_ms_per_round": med,
+               "bytes_per_round": sd["bytes_exchanged"] / max(1, sd["rounds"])}
+        rows.append(row)
+        print("%-18s %9d %10d %13.2e %9.2f %10.2f %6.2f %12.2f %11.0f" % (
+            name, row["rounds_inprocess"], row["rounds_dds"], row["rel_cost_diff"],
+            wi, wd, row["ratio"], med, row["bytes_per_round"]), flush=True)
+    if rows:
+        print("median ratio %.2f over %d graphs" % (statistics.median(r["ratio"] for r in rows), len(rows)))
+    if a.out and rows:
+        with open(a.out, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+            w.writeheader()
+            w.writerows(rows)
+
+
+if __name__ == "__main__":
+    main()
