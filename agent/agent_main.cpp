@@ -310,7 +310,14 @@ class Agent {
       throw RunFailure(kExitRunFailed, "the round loop returned " +
                                            std::to_string(result.poses.size()) + " poses for " +
                                            std::to_string(local.owned.size()) + " owned poses");
-    log("round loop done after " + std::to_string(result.rounds) + " round(s)");
+    {
+      char line[200];
+      std::snprintf(line, sizeof(line),
+                    "round loop done: %u round(s) in %.3f s, rounding %.3f s (%u CG iterations)",
+                    result.rounds, result.solve_s, result.rounding_s,
+                    result.translation_iterations);
+      log(line);
+    }
     if (!a_.output.empty())
       agent::write_vertices_g2o(local.owned, result.poses, local.d, a_.output);
 

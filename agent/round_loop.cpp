@@ -5,6 +5,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <chrono>
 #include <map>
 #include <memory>
 #include <tuple>
@@ -431,7 +432,9 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   RoundProtocol protocol(state, layout, config);
 
   Mailbox mail(channel, receive_timeout_s, local.agent_id);
+  const auto t0 = std::chrono::steady_clock::now();
   mail.run_protocol(protocol);
+  const auto t1 = std::chrono::steady_clock::now();
 
   RoundLoopResult res;
   res.rounds = static_cast<std::uint32_t>(protocol.rounds());
@@ -442,6 +445,8 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     res.grad_norm = protocol.trace().back().grad_norm;
   }
   res = Rounding(local, layout, state, mail).run(std::move(res));
+  res.solve_s = std::chrono::duration<double>(t1 - t0).count();
+  res.rounding_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 
   if (local.agent_id == 0) {  // one report for the coordinator's summary
     RoundStatusMessage st;

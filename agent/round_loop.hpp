@@ -87,6 +87,8 @@ struct RoundLoopResult {
   double grad_norm = 0.0;        ///< ||grad f|| there.
   double cost = 0.0;             ///< Objective of the rounded poses (whole graph, summed).
   std::uint32_t translation_iterations = 0;  ///< Distributed CG iterations of the rounding.
+  double solve_s = 0.0;                      ///< Time in core's protocol.
+  double rounding_s = 0.0;                   ///< Time in the distributed rounding.
 };
 
 /// Status phases of the messages the round loop adds after core's protocol (distributed
