@@ -34,6 +34,14 @@ Individual combine(const WorkGraph& g, int k, const std::vector<long long>& ub, 
   return better;
 }
 
+// Every operation draws its flow corridor size from {alpha, 2 alpha}: neither size is better on
+// all benchmark graphs, and mixing them diversifies the population.
+CycleParams varied(const CycleParams& cp, Rng& rng) {
+  CycleParams c = cp;
+  if (rng.next() & 1) c.flow.alpha *= 2;
+  return c;
+}
+
 int tournament(const std::vector<Individual>& pop, Rng& rng, int exclude) {
   const int n = static_cast<int>(pop.size());
   int a = rng.below(n), b = rng.below(n);
@@ -75,13 +83,13 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
       // Mutation: combine an individual with a fresh multilevel partition.
       const int a = tournament(pop, rng, -1);
       Individual fresh;
-      fresh.part = multilevel_partition(g, k, ub, params.cycle, rng);
+      fresh.part = multilevel_partition(g, k, ub, varied(params.cycle, rng), rng);
       fresh.cut = edge_cut(g, fresh.part);
-      child = combine(g, k, ub, pop[a], fresh, params.cycle, rng);
+      child = combine(g, k, ub, pop[a], fresh, varied(params.cycle, rng), rng);
     } else {
       const int a = tournament(pop, rng, -1);
       const int b = tournament(pop, rng, a);
-      child = combine(g, k, ub, pop[a], pop[b], params.cycle, rng);
+      child = combine(g, k, ub, pop[a], pop[b], varied(params.cycle, rng), rng);
     }
     // Replace the worst individual if the child is better and not already in the population.
     int worst = 0;

@@ -109,7 +109,8 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         const bool strong = preset == PartitionPreset::kStrong;
         const int ops = static_cast<int>(
             std::clamp((strong ? 8.0e5 : 2.0e6) / per_op, 12.0, strong ? 200.0 : 800.0));
-        plan.evolution.population = preset == PartitionPreset::kStrong ? 4 : 6;
+        plan.evolution.population = strong ? 4 : 8;
+        plan.evolution.mutation_rate = strong ? 0.3 : 0.5;
         plan.evolution.vcycles = 1;
         plan.evolution.generations = std::max(4, ops - 2 * plan.evolution.population);
         // Small graphs converge long before the budget is spent.
