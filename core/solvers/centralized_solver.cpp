@@ -25,8 +25,10 @@ TrustRegionOptions CentralizedOptions::default_trust_region() {
 
 void CentralizedOptions::validate() const {
   if (initial_rank < 2) throw InputError("CentralizedOptions.initial_rank must be >= d (2 or 3)");
-  if (max_rank < initial_rank) throw InputError("CentralizedOptions.max_rank must be >= initial_rank");
-  if (!(preconditioner_shift > 0)) throw InputError("CentralizedOptions.preconditioner_shift must be > 0");
+  if (max_rank < initial_rank)
+    throw InputError("CentralizedOptions.max_rank must be >= initial_rank");
+  if (!(preconditioner_shift > 0))
+    throw InputError("CentralizedOptions.preconditioner_shift must be > 0");
   trust_region.validate();
   certificate.validate();
 }
@@ -82,14 +84,20 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
 
   std::vector<Pose> init;
   switch (options.initialization) {
-    case Initialization::kChordal: init = chordal_initialization(graph); break;
-    case Initialization::kOdometry: init = odometry_initialization(graph); break;
+    case Initialization::kChordal:
+      init = chordal_initialization(graph);
+      break;
+    case Initialization::kOdometry:
+      init = odometry_initialization(graph);
+      break;
     case Initialization::kFile:
-      if (!graph.has_initial()) throw InputError(graph.source, 0, "has no VERTEX lines to initialise from");
+      if (!graph.has_initial())
+        throw InputError(graph.source, 0, "has no VERTEX lines to initialise from");
       init = graph.initial;
       break;
   }
-  const BlockProblem problem = BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
+  const BlockProblem problem =
+      BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
   const BlockPreconditioner precon(problem, options.preconditioner_shift);
   Eigen::MatrixXd X = lift_poses(init, options.initial_rank);
   res.init_s = seconds_since(start);
@@ -107,8 +115,9 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     X = level.X;
     res.iterations += level.iterations;
     for (const auto& it : level.trace) res.trace.push_back({r, it});
-    StaircaseLevel info{r, level.iterations, level.cost, level.grad_norm, std::nullopt, false,
-                        seconds_since(level_start)};
+    StaircaseLevel info{
+        r,     level.iterations,           level.cost,       level.grad_norm, std::nullopt,
+        false, seconds_since(level_start), level.stop_reason};
     res.final_rank = r;
     res.relaxation_cost = level.cost;
     res.grad_norm = level.grad_norm;
@@ -120,10 +129,14 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     CertificateResult cert = verify_certificate(problem, X, options.certificate);
     res.certify_s += seconds_since(cert_start);
     info.min_eigenvalue = cert.min_eigenvalue;
-    info.certified = cert.certified;
+    // S(X) >= 0 proves optimality only at a first-order critical point: a level that ran out
+    // of iterations or time is not certified, whatever the eigenvalue says.
+    const bool converged =
+        level.stop_reason == "grad_norm" || level.stop_reason == "relative_decrease";
+    info.certified = cert.certified && converged;
     info.elapsed_s = seconds_since(level_start);
     res.levels.push_back(info);
-    res.certified = cert.certified;
+    res.certified = info.certified;
     res.min_eigenvalue = cert.min_eigenvalue;
     if (cert.certified || r >= options.max_rank) break;
     X = escape_saddle(problem, X, cert.min_eigenvector, tr.grad_norm_tol);
@@ -142,8 +155,10 @@ std::string CentralizedResult::full_report() const {
   for (const auto& l : levels) {
     os << "  rank " << l.rank << ": " << l.iterations << " iterations, f(X) = " << l.cost
        << ", |grad| = " << l.grad_norm;
-    if (l.min_eigenvalue) os << ", lambda_min(S) = " << *l.min_eigenvalue << (l.certified ? " (certified)" : " (saddle)");
-    os << ", " << l.elapsed_s << " s\n";
+    if (l.min_eigenvalue)
+      os << ", lambda_min(S) = " << *l.min_eigenvalue
+         << (l.certified ? " (certified)" : " (saddle)");
+    os << ", stop: " << l.stop_reason << ", " << l.elapsed_s << " s\n";
   }
   os << "  rounded cost " << cost << " (relaxation " << relaxation_cost << ")\n";
   os << "  certified: " << (certified ? (*certified ? "yes" : "no") : "not checked") << "\n";

@@ -4,11 +4,10 @@
 // up the Riemannian staircase when the certificate fails, and rounding to SE(d). It gives
 // the reference optimum f* that distributed runs are measured against.
 
+#include <Eigen/Core>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "certification/certificate.hpp"
 #include "graph/pose.hpp"
@@ -23,7 +22,7 @@ struct CentralizedOptions {
   int initial_rank = 5;  ///< r0 >= d. 5 matches the reference optima's runs.
   int max_rank = 10;     ///< Staircase ceiling, >= initial_rank.
   Initialization initialization = Initialization::kChordal;
-  bool certify = true;   ///< Run the certificate (and the staircase) after each rank.
+  bool certify = true;  ///< Run the certificate (and the staircase) after each rank.
   /// Trust-region settings for each staircase level; grad_norm_tol here is relative to
   /// max(1, ||grad f|| at the initial point), so it does not depend on the weights' scale.
   TrustRegionOptions trust_region = default_trust_region();
@@ -37,11 +36,12 @@ struct CentralizedOptions {
 struct StaircaseLevel {
   int rank;
   int iterations;
-  double cost;           ///< Relaxation cost f(X) at the end of the level.
+  double cost;  ///< Relaxation cost f(X) at the end of the level.
   double grad_norm;
   std::optional<double> min_eigenvalue;
   bool certified;
   double elapsed_s;
+  std::string stop_reason;  ///< Why the trust region stopped (grad_norm, relative_decrease, ...).
 };
 
 struct CentralizedIteration {
@@ -55,13 +55,13 @@ struct CentralizedResult {
   double relaxation_cost = 0.0;  ///< f(X) of the lifted solution (a lower bound when certified).
   double grad_norm = 0.0;        ///< Riemannian gradient norm of the final lifted X.
   int final_rank = 0;
-  int iterations = 0;            ///< Trust-region iterations over all levels.
-  std::optional<bool> certified; ///< Empty when certification was off.
+  int iterations = 0;             ///< Trust-region iterations over all levels.
+  std::optional<bool> certified;  ///< Empty when certification was off.
   std::optional<double> min_eigenvalue;
   std::vector<StaircaseLevel> levels;
   std::vector<CentralizedIteration> trace;
   double init_s = 0.0, optimize_s = 0.0, certify_s = 0.0, total_s = 0.0;
-  Eigen::MatrixXd X;             ///< Final lifted solution.
+  Eigen::MatrixXd X;  ///< Final lifted solution.
 
   /// Human-readable multi-line summary.
   std::string full_report() const;
