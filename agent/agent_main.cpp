@@ -313,9 +313,11 @@ class Agent {
     {
       char line[200];
       std::snprintf(line, sizeof(line),
-                    "round loop done: %u round(s) in %.3f s, rounding %.3f s (%u CG iterations)",
-                    result.rounds, result.solve_s, result.rounding_s,
-                    result.translation_iterations);
+                    "round loop done: %u round(s) in %.3f s, rounding %.3f s (%u CG iterations), "
+                    "%llu messages, %llu write retries",
+                    result.rounds, result.solve_s, result.rounding_s, result.translation_iterations,
+                    static_cast<unsigned long long>(s.stats().messages_sent),
+                    static_cast<unsigned long long>(s.stats().write_retries));
       log(line);
     }
     if (!a_.output.empty())
@@ -341,8 +343,7 @@ class Agent {
                   "%s: done: %zu poses, %zu measurements, %u round(s), cost %.12g, %llu bytes "
                   "sent, %.2f s\n",
                   tag_.c_str(), local.owned.size(), local.measurements.size(), result.rounds,
-                  result.cost,
-                  static_cast<unsigned long long>(s.stats().bytes_sent), secs);
+                  result.cost, static_cast<unsigned long long>(s.stats().bytes_sent), secs);
     std::cerr << buf;
   }
 
