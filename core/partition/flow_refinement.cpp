@@ -100,8 +100,12 @@ class FlowNetwork {
   std::vector<int> level_, it_;
 };
 
+// At most this many vertices per corridor side: keeps each max flow cheap on huge graphs and
+// bounds the depth of Dinic's recursive augmenting-path search (<= network size).
+constexpr std::size_t kMaxCorridorVertices = 4000;
+
 // Grows a BFS corridor inside block `own` from its vertices adjacent to block `other`, up to
-// total weight `budget`.
+// total weight `budget` and kMaxCorridorVertices vertices.
 std::vector<int> corridor(const WorkGraph& g, const std::vector<int>& part, int own, int other,
                           long long budget, const std::vector<int>& boundary, std::vector<char>& in,
                           Rng& rng) {
@@ -120,7 +124,7 @@ std::vector<int> corridor(const WorkGraph& g, const std::vector<int>& part, int 
     std::swap(seeds[i], seeds[rng.below(i + 1)]);
   long long weight = 0;
   for (int v : seeds) {
-    if (weight + g.vw[v] > budget) continue;
+    if (weight + g.vw[v] > budget || region.size() >= kMaxCorridorVertices) continue;
     in[v] = 1;
     region.push_back(v);
     weight += g.vw[v];
@@ -130,6 +134,7 @@ std::vector<int> corridor(const WorkGraph& g, const std::vector<int>& part, int 
     for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
       const int u = g.adj[e];
       if (in[u] || part[u] != own || weight + g.vw[u] > budget) continue;
+      if (region.size() >= kMaxCorridorVertices) break;
       in[u] = 1;
       region.push_back(u);
       weight += g.vw[u];
