@@ -21,14 +21,16 @@ namespace tessera {
 struct CertificateOptions {
   /// eta = relative_tolerance * max(1, max diagonal entry of Q). >= 0.
   double relative_tolerance = 1e-6;
-  int lanczos_max_iterations = 300;  ///< > 0
+  int lanczos_max_iterations = 1000;  ///< > 0
   double lanczos_tolerance = 1e-8;   ///< Relative accuracy of the eigenvalue, > 0.
   void validate() const;
 };
 
 struct CertificateResult {
   bool certified = false;
-  double min_eigenvalue = 0.0;  ///< lambda_min(S) (estimate).
+  /// lambda_min(S) (estimate); NaN if Lanczos did not converge (the factorization test still
+  /// decides `certified`).
+  double min_eigenvalue = 0.0;
   double tolerance = 0.0;       ///< The absolute eta used.
   /// Unit eigenvector of lambda_min, length (d+1)n, set when not certified.
   Eigen::VectorXd min_eigenvector;

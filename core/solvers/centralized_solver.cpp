@@ -138,7 +138,8 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     res.levels.push_back(info);
     res.certified = info.certified;
     res.min_eigenvalue = cert.min_eigenvalue;
-    if (cert.certified || r >= options.max_rank) break;
+    // No eigenvector (Lanczos did not converge): nothing to escape along.
+    if (cert.certified || r >= options.max_rank || cert.min_eigenvector.size() == 0) break;
     X = escape_saddle(problem, X, cert.min_eigenvector, tr.grad_norm_tol);
   }
   res.X = X;

@@ -27,7 +27,7 @@ struct CentralizedOptions {
   /// max(1, ||grad f|| at the initial point), so it does not depend on the weights' scale.
   TrustRegionOptions trust_region = default_trust_region();
   CertificateOptions certificate;
-  double preconditioner_shift = 1e-6;  ///< Relative diagonal shift of the preconditioner, > 0.
+  double preconditioner_shift = 1e-10;  ///< Relative diagonal shift of the preconditioner, > 0.
 
   static TrustRegionOptions default_trust_region();
   void validate() const;
