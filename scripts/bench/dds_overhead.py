@@ -13,7 +13,7 @@ difference, wall times and their ratio (target <= 1.5), median ms per round of t
 (from the arrival times of its progress lines), bytes per round (all agents' DDS bytes / rounds).
 
 usage: dds_overhead.py [--bin build/bin] [--graphs CSAIL,intel] [--agents 5] [--domain 210]
-                       [--out FILE.csv]
+                       [--out FILE.csv] [--limit S]
 """
 import argparse
 import csv
@@ -47,12 +47,16 @@ def has_vertices(path):
     return False
 
 
-def run_in_process(tessera, graph, agents, tmp):
+def run_in_process(tessera, graph, agents, tmp, limit):
     js = os.path.join(tmp, "inprocess.json")
     t0 = time.monotonic()
-    p = subprocess.run([tessera, "solve", graph, "--algorithm", "irbcd", "--agents", str(agents),
-                        "--partition", "highest", "--init", "file", "--json", js],
-                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        p = subprocess.run([tessera, "solve", graph, "--algorithm", "irbcd", "--agents", str(agents),
+                            "--partition", "highest", "--init", "file", "--json", js],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=limit)
+    except subprocess.TimeoutExpired:
+        print("in-process run over the %g s limit" % limit, file=sys.stderr)
+        return None
     wall = time.monotonic() - t0
     if p.returncode != 0:
         print(p.stdout, file=sys.stderr)
@@ -61,11 +65,11 @@ def run_in_process(tessera, graph, agents, tmp):
         return json.load(f), wall
 
 
-def run_dds(tessera, graph, agents, domain, tmp):
+def run_dds(tessera, graph, agents, domain, tmp, limit):
     js = os.path.join(tmp, "dds.json")
     t0 = time.monotonic()
     p = subprocess.Popen([tessera, "launch", graph, "--agents", str(agents), "--partition",
-                          "highest", "--domain", str(domain), "--json", js, "--timeout", "3600"],
+                          "highest", "--domain", str(domain), "--json", js, "--timeout", str(limit)],
                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1)
     stamps = []
     log = []
@@ -91,6 +95,7 @@ def main():
     ap.add_argument("--agents", type=int, default=5)
     ap.add_argument("--domain", type=int, default=210)
     ap.add_argument("--out", default="")
+    ap.add_argument("--limit", type=float, default=600, help="seconds per run (each side)")
     a = ap.parse_args()
     tessera = os.path.join(a.bin, "tessera")
     names = a.graphs.split(",") if a.graphs else paper_graphs()
@@ -107,8 +112,8 @@ def main():
                 subprocess.run([tessera, "solve", src, "--algorithm", "irbcd", "--agents", "1",
                                 "--partition", "sequential", "--max-rounds", "0", "--out", graph],
                                check=True, stdout=subprocess.DEVNULL)
-            ip = run_in_process(tessera, graph, a.agents, tmp)
-            dds = run_dds(tessera, graph, a.agents, a.domain, tmp)
+            ip = run_in_process(tessera, graph, a.agents, tmp, a.limit)
+            dds = run_dds(tessera, graph, a.agents, a.domain, tmp, a.limit) if ip else None
         if ip is None or dds is None:
             print("%-18s failed (%s)" % (name, "in-process" if ip is None else "dds"))
             continue
