@@ -336,8 +336,16 @@ int run_launch(const Args& argv) {
   close(pipefd[0]);
   if (!failure.empty()) {
     std::fprintf(stderr, "tessera launch: %s\n", failure.c_str());
-    // The others notice a lost or aborting peer themselves; give them time to say why.
-    stop_all(children, exit_code == 130 ? 5.0 : 4.0);
+    // The others notice a lost or aborting peer themselves (within ~2 s): give them time to
+    // stop on their own and say why, then ask (SIGINT) and finally force (SIGKILL).
+    if (exit_code != 130) {
+      const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+      while (any_running(children) && std::chrono::steady_clock::now() < until) {
+        reap(children, false);
+        usleep(20000);
+      }
+    }
+    stop_all(children, exit_code == 130 ? 5.0 : 3.0);
     for (const auto& c : children)
       if (c.code != 0 && c.code != 130 && c.code != 143)
         std::fprintf(stderr, "  %s (exit %d):\n%s", c.name.c_str(), c.code,
