@@ -1,6 +1,6 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-165 (each test its own, so ctest -j is safe).
+// Domains used here: 161-166 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -201,6 +201,32 @@ TEST(DdsLaunch, SigintStopsEveryProcess) {
   std::string ps;
   run_command("ps -eo args | grep -c '[t]essera-agent.*--domain 165'", &ps);
   EXPECT_EQ(std::stoi(ps), 0) << ps;
+}
+
+TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
+  const std::string dir = temp_dir();
+  const auto before = shm_files();
+  Process launch = start(
+      {bin("tessera"), "launch", "--agents", "3", "--poses", "600", "--domain", "166", "--grad-tol",
+       "1e-12", "--max-rounds", "100000", "--partition", "fast", "--timeout", "60"},
+      dir + "/launch.log");
+  const auto until = Clock::now() + std::chrono::seconds(20);
+  while (launch.output().find("round 2:") == std::string::npos && Clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_NE(launch.output().find("round 2:"), std::string::npos) << launch.output();
+  std::string pid;
+  run_command("pgrep -f 'tessera-agent.*--id 1 .*--domain 166' | head -1", &pid);
+  ASSERT_FALSE(pid.empty());
+  kill(std::stoi(pid), SIGKILL);
+  ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
+  EXPECT_EQ(launch.exit_code, 1) << launch.output();
+  const std::string out = launch.output();
+  EXPECT_NE(out.find("agent 1 failed"), std::string::npos) << out;
+  // Who hears it first varies (lease expiry or a relayed abort); the survivors' reasons are
+  // printed and name the lost agent.
+  EXPECT_NE(out.find("error: lost agent 1"), std::string::npos) << out;
+  EXPECT_NE(out.find("participant lease"), std::string::npos) << out;
+  remove_shm_files(leaked_shm_files(before, 166));  // what the killed process left
 }
 
 }  // namespace
