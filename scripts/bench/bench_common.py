@@ -108,7 +108,7 @@ def progress(msg):
 
 def run_tessera(ctx, args, trace=True, timeout=None):
     """Runs `tessera ARGS --json F [--trace T]`; returns (summary, trace rows, peak RSS MB of the
-    process, wall s). Raises RuntimeError with the output on failure."""
+    process (VmHWM, sampled every 50 ms), wall s). Raises RuntimeError with the output on failure."""
     fd, js = tempfile.mkstemp(suffix=".json", dir=ctx.work)
     os.close(fd)
     tr = js[:-5] + ".csv"
@@ -119,7 +119,17 @@ def run_tessera(ctx, args, trace=True, timeout=None):
         p = subprocess.Popen(cmd, stdout=logf, stderr=subprocess.STDOUT)
         deadline = None if timeout is None else t0 + timeout
         beat = t0
+        hwm_kb = 0
         while True:
+            # Peak RSS of the tessera process itself: VmHWM restarts at exec, whereas the child's ru_maxrss
+            # also counts the forked Python interpreter before the exec.
+            try:
+                with open(f"/proc/{p.pid}/status") as f:
+                    for line in f:
+                        if line.startswith("VmHWM:"):
+                            hwm_kb = max(hwm_kb, int(line.split()[1]))
+            except (OSError, ValueError):
+                pass
             pid, status, ru = os.wait4(p.pid, os.WNOHANG)
             if pid:
                 break
@@ -143,7 +153,7 @@ def run_tessera(ctx, args, trace=True, timeout=None):
     with open(js) as f:
         summary = json.load(f)
     rows = read_trace(tr) if trace else []
-    return summary, rows, ru.ru_maxrss / 1024.0, wall
+    return summary, rows, (hwm_kb or ru.ru_maxrss) / 1024.0, wall
 
 
 def read_trace(path):
