@@ -106,7 +106,11 @@ def progress(msg):
     print(f"[{time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
 
 
-def run_tessera(ctx, args, trace=True, timeout=None):
+class OverLimit(RuntimeError):
+    """The run was stopped by run_tessera's memory or time limit."""
+
+
+def run_tessera(ctx, args, trace=True, timeout=None, mem_limit_mb=None):
     """Runs `tessera ARGS --json F [--trace T]`; returns (summary, trace rows, peak RSS MB of the
     process (VmHWM, sampled every 50 ms), wall s). Raises RuntimeError with the output on failure."""
     fd, js = tempfile.mkstemp(suffix=".json", dir=ctx.work)
@@ -140,10 +144,17 @@ def run_tessera(ctx, args, trace=True, timeout=None):
                     with open(tr, "rb") as f:
                         done = max(0, sum(1 for _ in f) - 2)
                 progress(f"  ... {args[0]} running for {beat - t0:.0f} s" + (f", round {done}" if done else ""))
+            over = None
             if deadline and time.monotonic() > deadline:
+                over = f"stopped after the {timeout:.0f} s time limit"
+            if mem_limit_mb and hwm_kb / 1024.0 > mem_limit_mb:
+                # The machine is shared: stop before the process takes all of its memory.
+                over = (f"stopped at {hwm_kb / 1048576.0:.1f} GB peak RSS (limit {mem_limit_mb / 1024.0:.0f} GB) "
+                        f"after {time.monotonic() - t0:.0f} s")
+            if over:
                 p.kill()
-                pid, status, ru = os.wait4(p.pid, 0)
-                break
+                os.wait4(p.pid, 0)
+                raise OverLimit(over)
             time.sleep(0.05)
     wall = time.monotonic() - t0
     p.returncode = os.waitstatus_to_exitcode(status)

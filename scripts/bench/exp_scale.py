@@ -28,7 +28,7 @@ def plan(quick):
     return [(10000, 500), (100000, 50), (1000000, 5)]
 
 
-def run(ctx, preset="fast"):
+def run(ctx, preset="fast", mem_limit_gb=8):
     res = bc.Result("6. Scale")
     rows, table = [], []
     for poses, cap in plan(ctx.quick):
@@ -42,9 +42,18 @@ def run(ctx, preset="fast"):
             part = json.loads(p.stdout)
             part_wall = time.monotonic() - t0
             bc.progress(f"scale: {poses} poses, N = {n}: IRBCD, cap {cap} rounds")
-            s, tr, rss_mb, wall = bc.run_tessera(ctx, ["solve", path, "--algorithm", "irbcd", "--agents", str(n),
-                                                       "--partition", preset, "--grad-tol", "0.01", "--init", "file",
-                                                       "--max-rounds", str(cap)])
+            try:
+                s, tr, rss_mb, wall = bc.run_tessera(ctx, ["solve", path, "--algorithm", "irbcd", "--agents", str(n),
+                                                           "--partition", preset, "--grad-tol", "0.01", "--init",
+                                                           "file", "--max-rounds", str(cap)],
+                                                     mem_limit_mb=mem_limit_gb * 1024)
+            except bc.OverLimit as e:
+                bc.progress(f"  {e}")
+                rows.append({"poses": poses, "agents": n, "preset": preset, "cut_edges": part["cut_edges"],
+                             "partition_ms": part["time_ms"], "partition_process_s": part_wall, "round_cap": cap,
+                             "stop": str(e)})
+                table.append([poses, "-", n, part["cut_edges"], f"{part['time_ms']:.0f}", "-", str(e)] + ["-"] * 7)
+                continue
             row = {"poses": poses, "edges": s["edges"], "agents": n, "preset": preset, "cut_edges": part["cut_edges"],
                    "partition_ms": part["time_ms"], "partition_process_s": part_wall, "round_cap": cap,
                    "rounds": s["rounds"], "stop": s["stop_reason"], "final_grad_norm": s["grad_norm"],
@@ -65,7 +74,8 @@ def run(ctx, preset="fast"):
             f"dominate at this scale and is not what a distributed system runs), with a round cap per size ({', '.join(f'{p}: {c}' for p, c in plan(ctx.quick))}) so the run fits "
             f"its time budget: the rounds column shows the cap, not convergence, where stop = max_rounds. "
             f"In-process engine (all agents in one process): peak MB per agent = the process's peak RSS / N, "
-            f"an upper bound of one agent's share. Process wall time includes loading, partitioning and setting up "
+            f"an upper bound of one agent's share; a run is stopped (and said so in the stop column) when its peak RSS "
+            f"passes {mem_limit_gb} GB, as the machine is shared. Process wall time includes loading, partitioning and setting up "
             f"the agents." + (" `--quick`: 2k and 10k poses only." if ctx.quick else "") + "\n\n" + md)
     csv_path = os.path.join(ctx.out_dir, "exp6_scale.csv")
     bc.write_csv(csv_path, rows)
@@ -78,9 +88,11 @@ def plot(ctx, rows):
     plt = bc.pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(18, 4.5))
     for n, marker in ((5, "o-"), (25, "s--")):
-        rs = [r for r in rows if r["agents"] == n]
+        rs = [r for r in rows if r["agents"] == n and "solve_s" in r]
+        axes[0].plot([r["poses"] for r in rows if r["agents"] == n], [r["partition_ms"] for r in rows
+                                                                       if r["agents"] == n], marker,
+                     label=f"partition, N = {n}")
         xs = [r["poses"] for r in rs]
-        axes[0].plot(xs, [r["partition_ms"] for r in rs], marker, label=f"partition, N = {n}")
         axes[1].plot(xs, [r["ms_per_round"] for r in rs], marker, label=f"solver ms per round, N = {n}")
         axes[1].plot(xs, [1000 * r["process_wall_s"] / max(1, r["rounds"]) for r in rs], marker, alpha=0.5,
                      label=f"process wall ms / rounds, N = {n}")
@@ -107,8 +119,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     bc.add_common_args(ap)
     ap.add_argument("--preset", default="fast")
+    ap.add_argument("--mem-limit-gb", type=float, default=8, help="stop a solve whose peak RSS passes this")
     a = ap.parse_args()
-    run(bc.Ctx(a), a.preset)
+    run(bc.Ctx(a), a.preset, a.mem_limit_gb)
 
 
 if __name__ == "__main__":
