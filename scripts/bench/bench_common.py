@@ -221,8 +221,10 @@ def print_table(title, headers, rows):
     for r in cells:
         print("  ".join(c.rjust(w) for c, w in zip(r, widths)))
     sys.stdout.flush()
-    md = ["| " + " | ".join(headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
-    md += ["| " + " | ".join(r) + " |" for r in cells]
+    def esc(c):  # a "|" inside a cell (|grad|) would split the markdown column
+        return c.replace("|", "\\|")
+    md = ["| " + " | ".join(esc(h) for h in headers) + " |", "|" + "|".join("---" for _ in headers) + "|"]
+    md += ["| " + " | ".join(esc(c) for c in r) + " |" for r in cells]
     return "\n".join(md)
 
 
