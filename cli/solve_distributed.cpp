@@ -30,7 +30,7 @@ const char* kDistributedHelp =
     "                            of the reference paper; see docs/irbcd.md)\n"
     "  --agents N                number of agents / blocks (default 5)\n"
     "  --partition PRESET        sequential|fast|eco|strong|highest (default highest)\n"
-    "  --init chordal|distributed   initial guess (default chordal)\n"
+    "  --init chordal|distributed|file   initial guess (default chordal; file = VERTEX poses)\n"
     "  --robots R                robots of --init distributed: R contiguous id ranges (default N)\n"
     "  --grad-tol T              stop at ||grad f|| <= T, full cost (default 0.01)\n"
     "  --max-rounds K            round cap (default 10000)\n"
