@@ -255,6 +255,17 @@ def pyplot():
     return plt
 
 
+def save_figure(ctx, fig, name, dpi=100):
+    """Lays out `fig`, writes it as ctx.out_dir/name, closes it, and returns the path."""
+    plt = pyplot()
+    fig.tight_layout()
+    path = os.path.join(ctx.out_dir, name)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    print(f"wrote {os.path.relpath(path, ROOT)}")
+    return path
+
+
 def gap_series(trace, fstar):
     """(rounds, f - f*) with non-positive gaps (round-off at the optimum) clipped for log axes."""
     xs, ys = [], []

@@ -104,12 +104,7 @@ def plot(ctx, graphs, traces, rows):
             ax.set_title(f"{label}, N = 5, highest")
             ax.grid(True, alpha=0.3)
             ax.legend(fontsize=8)
-    fig.tight_layout()
-    path = os.path.join(ctx.out_dir, "exp3_algorithms.png")
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    print(f"wrote {os.path.relpath(path, bc.ROOT)}")
-    return path
+    return bc.save_figure(ctx, fig, "exp3_algorithms.png", dpi=90)
 
 
 def main():

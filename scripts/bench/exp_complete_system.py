@@ -195,12 +195,7 @@ def plot(ctx, graphs, traces, rows):
             ax.set_title(f"{label}, N = 5")
             ax.grid(True, alpha=0.3)
             ax.legend(fontsize=8)
-    fig.tight_layout()
-    path = os.path.join(ctx.out_dir, "exp4_complete_system.png")
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    print(f"wrote {os.path.relpath(path, bc.ROOT)}")
-    return path
+    return bc.save_figure(ctx, fig, "exp4_complete_system.png", dpi=90)
 
 
 def add_args(ap):

@@ -74,12 +74,7 @@ def plot(ctx, graphs, presets, traces, rows):
             ax.set_title(f"RBCD on {label}, N = 5")
             ax.grid(True, which="major", alpha=0.3)
             ax.legend(fontsize=8)
-    fig.tight_layout()
-    path = os.path.join(ctx.out_dir, "exp2_partition_convergence.png")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    print(f"wrote {os.path.relpath(path, bc.ROOT)}")
-    return path
+    return bc.save_figure(ctx, fig, "exp2_partition_convergence.png", dpi=100)
 
 
 def main():

@@ -124,12 +124,7 @@ def plot(ctx, rows, krows):
         ax.set_ylabel("cut measurements (count, log)")
         ax.set_title("cut against N")
         ax.legend(fontsize=6, ncol=2)
-    fig.tight_layout()
-    path = os.path.join(ctx.out_dir, "exp1_partition_quality.png")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    print(f"wrote {os.path.relpath(path, bc.ROOT)}")
-    return path
+    return bc.save_figure(ctx, fig, "exp1_partition_quality.png", dpi=110)
 
 
 def main():

@@ -90,12 +90,7 @@ def plot(ctx, label, traces, rows, fstar):
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
     ax.legend(h1 + h2, l1 + l2, fontsize=8, loc="upper left")
-    fig.tight_layout()
-    path = os.path.join(ctx.out_dir, "exp5_robots.png")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    print(f"wrote {os.path.relpath(path, bc.ROOT)}")
-    return path
+    return bc.save_figure(ctx, fig, "exp5_robots.png", dpi=100)
 
 
 def main():

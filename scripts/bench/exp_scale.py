@@ -107,12 +107,7 @@ def plot(ctx, rows):
         ax.set_title(title)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
-    fig.tight_layout()
-    path = os.path.join(ctx.out_dir, "exp6_scale.png")
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    print(f"wrote {os.path.relpath(path, bc.ROOT)}")
-    return path
+    return bc.save_figure(ctx, fig, "exp6_scale.png", dpi=100)
 
 
 def main():
