@@ -75,18 +75,6 @@ struct AgentArgs {
   bool verbose = false;
 };
 
-std::vector<std::string> split_commas(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= s.size()) {
-    std::size_t comma = s.find(',', start);
-    if (comma == std::string::npos) comma = s.size();
-    if (comma > start) out.push_back(s.substr(start, comma - start));
-    start = comma + 1;
-  }
-  return out;
-}
-
 AgentArgs parse(const std::vector<std::string>& argv) {
   cli::Arguments args(argv,
                       {"graph", "robots", "id", "run-id", "domain", "timeout", "round-timeout",
@@ -116,7 +104,7 @@ AgentArgs parse(const std::vector<std::string>& argv) {
   a.round_timeout_s = args.get_double("round-timeout", a.round_timeout_s);
   if (!(a.round_timeout_s > 0)) throw InputError("option --round-timeout: must be positive");
   a.lease_s = args.get_double("lease", a.lease_s);
-  if (args.has("peers")) a.peers = split_commas(*args.get("peers"));
+  a.peers = args.get_list("peers");
   a.output = args.get_or("output", "");
   a.dump_local = args.get_or("dump-local", "");
   a.verbose = args.has("verbose");

@@ -77,4 +77,17 @@ long Arguments::get_long(const std::string& name, long fallback) const {
   return x;
 }
 
+std::vector<std::string> Arguments::get_list(const std::string& name) const {
+  std::vector<std::string> out;
+  const std::string s = get_or(name, "");
+  std::size_t start = 0;
+  while (start < s.size()) {
+    std::size_t comma = s.find(',', start);
+    if (comma == std::string::npos) comma = s.size();
+    if (comma > start) out.push_back(s.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return out;
+}
+
 }  // namespace tessera::cli

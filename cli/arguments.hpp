@@ -24,6 +24,8 @@ class Arguments {
   /// Parses the option as a number; throws InputError naming the option if it is not one.
   double get_double(const std::string& name, double fallback) const;
   long get_long(const std::string& name, long fallback) const;
+  /// Comma-separated values of the option ("a,b,,c" -> a, b, c); empty when it is absent.
+  std::vector<std::string> get_list(const std::string& name) const;
 
  private:
   std::vector<std::string> positional_;

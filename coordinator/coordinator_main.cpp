@@ -89,18 +89,6 @@ struct CoordinatorArgs {
   bool progress = false, verbose = false;
 };
 
-std::vector<std::string> split_commas(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= s.size()) {
-    std::size_t comma = s.find(',', start);
-    if (comma == std::string::npos) comma = s.size();
-    if (comma > start) out.push_back(s.substr(start, comma - start));
-    start = comma + 1;
-  }
-  return out;
-}
-
 CoordinatorArgs parse(const std::vector<std::string>& argv) {
   cli::Arguments args(argv,
                       {"agents", "run-id", "domain", "timeout", "run-timeout", "lease", "peers",
@@ -125,7 +113,7 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
   a.run_timeout_s = args.get_double("run-timeout", a.run_timeout_s);
   if (!(a.run_timeout_s > 0)) throw InputError("option --run-timeout: must be positive");
   a.lease_s = args.get_double("lease", a.lease_s);
-  if (args.has("peers")) a.peers = split_commas(*args.get("peers"));
+  a.peers = args.get_list("peers");
   a.partition = args.get_or("partition", a.partition);
   auto nonneg = [&](const char* name, long fallback) {
     long v = args.get_long(name, fallback);
