@@ -30,9 +30,9 @@ BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
   auto slot_of = [&](std::size_t id) {
     auto it = owned_slot.find(id);
     if (it != owned_slot.end()) return it->second;
-    return owned_.size() + static_cast<std::size_t>(std::lower_bound(neighbors_.begin(),
-                                                                     neighbors_.end(), id) -
-                                                    neighbors_.begin());
+    return owned_.size() +
+           static_cast<std::size_t>(std::lower_bound(neighbors_.begin(), neighbors_.end(), id) -
+                                    neighbors_.begin());
   };
   edge_storage_.reserve(touching.size());
   for (auto k : touching) edge_storage_.push_back(measurements[k]);
@@ -51,7 +51,6 @@ BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
   const Eigen::Index nn = (d_ + 1) * static_cast<Eigen::Index>(neighbors_.size());
   Q_bb_ = Q.topLeftCorner(nb, nb);
   Q_nb_ = Q.bottomLeftCorner(nn, nb);
-  Q_nn_ = Q.bottomRightCorner(nn, nn);
   Q_bb_.makeCompressed();
   Q_nb_.makeCompressed();
 }
@@ -64,7 +63,7 @@ BlockProblem BlockProblem::whole_graph(int d, std::size_t num_poses,
 }
 
 void BlockProblem::set_neighbor_poses(const Eigen::MatrixXd& X_neighbors) {
-  if (X_neighbors.cols() != Q_nn_.cols())
+  if (X_neighbors.cols() != (d_ + 1) * static_cast<Eigen::Index>(neighbors_.size()))
     throw std::invalid_argument("BlockProblem: neighbour poses have the wrong size");
   X_n_ = X_neighbors;
   linear_ = X_n_ * Q_nb_;
@@ -130,12 +129,6 @@ double BlockProblem::cost_share(const Eigen::MatrixXd& X) const {
     share += (e.slot_i < m && e.slot_j < m) ? c : 0.5 * c;
   }
   return share;
-}
-
-long BlockProblem::owned_slot(std::size_t global_id) const {
-  for (std::size_t s = 0; s < owned_.size(); ++s)
-    if (owned_[s] == global_id) return static_cast<long>(s);
-  return -1;
 }
 
 }  // namespace tessera

@@ -7,10 +7,9 @@
 //   f_B(X) = tr(X Q_BB X^T) + 2 tr(X Q_BN X_N^T) + tr(X_N Q_NN X_N^T),
 // i.e. the full reference objective summed over every measurement touching the block.
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "graph/measurement.hpp"
 #include "manifold/lifted_manifold.hpp"
@@ -59,9 +58,6 @@ class BlockProblem {
   /// half (the other half is counted by the neighbour's block), so shares sum to f exactly.
   double cost_share(const Eigen::MatrixXd& X) const;
 
-  /// Local slot of an owned global id, or -1.
-  long owned_slot(std::size_t global_id) const;
-
  private:
   struct Edge {
     std::size_t measurement;     // index into edge_storage_ (indices survive copies)
@@ -76,7 +72,6 @@ class BlockProblem {
   std::vector<Measurement> edge_storage_;  // copies, so the problem outlives its input
   SparseMatrix Q_bb_;
   SparseMatrix Q_nb_;  // (d+1)k x (d+1)m
-  SparseMatrix Q_nn_;  // kept for its size: validates neighbour blocks
   Eigen::MatrixXd X_n_;
   Eigen::MatrixXd linear_;  // X_N Q_NB, r x (d+1)m
 };
