@@ -19,6 +19,7 @@
 #include "agent/round_loop.hpp"
 #include "arguments.hpp"
 #include "io/g2o_reader.hpp"
+#include "session_args.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/session.hpp"
@@ -31,6 +32,7 @@ using namespace tessera::transport;
 
 namespace {
 
+// %s: the shared DDS session options (cli/session_args.hpp).
 constexpr const char* kHelp = R"(usage: tessera-agent --graph FILE --robots N --id I [options]
 
 One agent (robot) of a distributed Tessera run. Reads robot I's share of a multi-robot
@@ -43,19 +45,14 @@ options:
   --graph FILE       g2o file of the whole multi-robot graph (required)
   --robots N         number of robots = agents of the run (required)
   --id I             this agent's id, 0..N-1 (required)
-  --run-id ID        run id shared by all processes of the run (default "default");
-                     [A-Za-z0-9_.-], at most 64 characters
-  --domain D         DDS domain id 0..232 (default: derived from the run id)
-  --timeout S        bound on each wait for peers during set-up, in seconds (default 30)
   --round-timeout S  bound on each wait for a peer's message during the rounds (default 600)
-  --lease S          participant/liveliness lease in seconds: a dead peer is noticed after
-                     about this long (default 1, range 0.2..60)
-  --peers IP[,IP]    IPv4 addresses to contact by unicast (when multicast is not available)
   --output FILE      write this agent's final poses as g2o VERTEX lines
   --dump-local FILE  write the local problem after the hand-off (text; see docs/dds-runtime.md)
   --verbose          print each phase
   --help             this text
 
+DDS session options (shared with tessera-coordinator and tessera launch):
+%s
 exit codes: 0 done, 1 the run failed (lost peer, abort, timeout), 2 bad options or input,
 128+signal when interrupted (SIGINT 130, SIGTERM 143).
 )";
@@ -64,22 +61,19 @@ struct AgentArgs {
   std::string graph;
   std::uint32_t robots = 0;
   std::uint32_t id = 0;
-  std::string run_id = "default";
-  int domain = -1;
-  double timeout_s = 30;
+  cli::SessionArgs net;  ///< run id, domain, lease, peers, --timeout (cli/session_args.hpp)
   double round_timeout_s = 600;
-  double lease_s = 1.0;
-  std::vector<std::string> peers;
   std::string output;
   std::string dump_local;
   bool verbose = false;
 };
 
 AgentArgs parse(const std::vector<std::string>& argv) {
-  cli::Arguments args(argv,
-                      {"graph", "robots", "id", "run-id", "domain", "timeout", "round-timeout",
-                       "lease", "peers", "output", "dump-local"},
-                      {"verbose", "help"});
+  cli::Arguments args(
+      argv,
+      cli::with_session_options({"graph", "robots", "id", "round-timeout", "output", "dump-local"},
+                                cli::SessionArgsFor::kProcess),
+      {"verbose", "help"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   AgentArgs a;
@@ -93,18 +87,9 @@ AgentArgs parse(const std::vector<std::string>& argv) {
     throw InputError("option --id: must be 0.." + std::to_string(robots - 1));
   a.robots = static_cast<std::uint32_t>(robots);
   a.id = static_cast<std::uint32_t>(id);
-  a.run_id = args.get_or("run-id", a.run_id);
-  validate_run_id(a.run_id);
-  long domain = args.get_long("domain", -1);
-  if (args.has("domain") && (domain < 0 || domain > kMaxDomain))
-    throw InputError("option --domain: must be 0.." + std::to_string(kMaxDomain));
-  a.domain = static_cast<int>(domain);
-  a.timeout_s = args.get_double("timeout", a.timeout_s);
-  if (!(a.timeout_s > 0)) throw InputError("option --timeout: must be positive");
+  a.net = cli::parse_session_args(args, cli::SessionArgsFor::kProcess);
   a.round_timeout_s = args.get_double("round-timeout", a.round_timeout_s);
   if (!(a.round_timeout_s > 0)) throw InputError("option --round-timeout: must be positive");
-  a.lease_s = args.get_double("lease", a.lease_s);
-  a.peers = args.get_list("peers");
   a.output = args.get_or("output", "");
   a.dump_local = args.get_or("dump-local", "");
   a.verbose = args.has("verbose");
@@ -118,14 +103,10 @@ class Agent {
   }
 
   int run() {
-    SessionOptions so;
-    so.run_id = a_.run_id;
-    so.domain = a_.domain;
+    SessionOptions so = a_.net.session;
     so.coordinator = false;
     so.agent_id = a_.id;
     so.num_agents = a_.robots;
-    so.lease_s = a_.lease_s;
-    so.initial_peers = a_.peers;
     so.verbose = a_.verbose;
     try {
       session_ = std::make_unique<Session>(so);
@@ -179,7 +160,7 @@ class Agent {
                              own ? "agent " + std::to_string(a_.id) + ": " + why : why);
       // An agent with bad input fails at start-up, typically before it has discovered
       // everyone: wait longer for peers still starting so they learn why.
-      const Seconds linger(std::min(3.0, a_.timeout_s));
+      const Seconds linger(std::min(3.0, a_.net.timeout_s));
       session_->linger_for_control(linger, code == kExitBadInput ? linger : Seconds(1.0));
     } catch (const std::exception&) {
       // Leaving anyway: the others notice this participant disappear.
@@ -202,7 +183,7 @@ class Agent {
 
     // 2. Announce the structure (endpoints only).
     wire::AgentAnnouncement ann;
-    ann.run_id(a_.run_id);
+    ann.run_id(a_.net.session.run_id);
     ann.agent_id(a_.id);
     ann.num_agents(a_.robots);
     ann.host(host_name());
@@ -220,10 +201,10 @@ class Agent {
 
     // 3. The assignment.
     wire::PartitionAssignment asg;
-    WaitStatus got = s.assignments().take(Seconds(a_.timeout_s), &asg);
-    expect_ready(got, room, a_.timeout_s, "the partition assignment from the coordinator",
+    WaitStatus got = s.assignments().take(Seconds(a_.net.timeout_s), &asg);
+    expect_ready(got, room, a_.net.timeout_s, "the partition assignment from the coordinator",
                  s.peers_ever_seen() == 0
-                     ? "no process of run '" + a_.run_id + "' seen on domain " +
+                     ? "no process of run '" + a_.net.session.run_id + "' seen on domain " +
                            std::to_string(s.domain()) + " (is the coordinator running?)"
                      : "");
     check_assignment(asg);
@@ -233,7 +214,7 @@ class Agent {
 
     // 4. Everyone's endpoints matched before any volatile agent-to-agent message.
     std::string missing;
-    expect_ready(s.ready_barrier(Seconds(a_.timeout_s), &missing), room, a_.timeout_s,
+    expect_ready(s.ready_barrier(Seconds(a_.net.timeout_s), &missing), room, a_.net.timeout_s,
                  "the other processes to be ready", missing);
     log("all processes ready");
 
@@ -241,7 +222,7 @@ class Agent {
     for (std::uint32_t b = 0; b < a_.robots; ++b) {
       if (b == a_.id) continue;
       agent::HandoffPlan plan = agent::plan_handoff(share_, asg.owner(), b);
-      s.publish(to_wire_handoff(a_.run_id, a_.id, b, share_.d, plan.measurements,
+      s.publish(to_wire_handoff(a_.net.session.run_id, a_.id, b, share_.d, plan.measurements,
                                 plan.measurement_index, plan.poses));
     }
     const std::size_t others = a_.robots - 1;
@@ -260,8 +241,8 @@ class Agent {
                        absent = senders_missing(q);
                        return q.size() >= others && absent.empty();
                      },
-                     Seconds(a_.timeout_s)),
-                 room, a_.timeout_s, "measurement hand-offs", "none yet from " + absent);
+                     Seconds(a_.net.timeout_s)),
+                 room, a_.net.timeout_s, "measurement hand-offs", "none yet from " + absent);
     std::vector<agent::ReceivedHandoff> received;
     for (auto& w : s.handoffs().take_all()) {
       HandoffContent c = from_wire(w);
@@ -313,7 +294,7 @@ class Agent {
 
     // 7. Final estimate to the coordinator; leave when it has the merged result.
     wire::FinalEstimate fin;
-    fin.run_id(a_.run_id);
+    fin.run_id(a_.net.session.run_id);
     fin.sender(a_.id);
     fin.dim(static_cast<std::uint32_t>(local.d));
     fin.rounds(result.rounds);
@@ -321,7 +302,7 @@ class Agent {
     for (const Pose& p : result.poses) append_pose(fin.pose_data(), p);
     fin.bytes_sent(s.stats().bytes_sent + serialized_size(fin));
     s.publish(fin);
-    expect_ready(s.wait_finished(Seconds(a_.timeout_s)), room, a_.timeout_s,
+    expect_ready(s.wait_finished(Seconds(a_.net.timeout_s)), room, a_.net.timeout_s,
                  "the coordinator to confirm the merged result");
     s.set_peer_loss_fatal(false);
     const double secs =
@@ -366,7 +347,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> argv_list(argv + 1, argv + argc);
   for (const auto& a : argv_list)
     if (a == "--help" || a == "-h") {
-      std::cout << kHelp;
+      std::printf(kHelp, cli::session_options_help(cli::SessionArgsFor::kProcess).c_str());
       return kExitOk;
     }
   AgentArgs args;

@@ -23,12 +23,14 @@
 
 #include "arguments.hpp"
 #include "commands.hpp"
+#include "session_args.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::cli {
 
 namespace {
 
+// %s: the shared DDS session options (session_args.hpp).
 constexpr const char* kHelp = R"(usage: tessera launch [GRAPH.g2o] --agents N [options]
 
 Runs a distributed solve on this host as separate processes: one tessera-coordinator and N
@@ -50,12 +52,13 @@ options:
   --json FILE          also write the summary to FILE
   --out FILE           write the merged poses (g2o, VERTEX lines)
   --tum FILE           write the merged poses (TUM)
-  --domain D           DDS domain 0..232 (default: derived from the run id)
   --timeout S          time limit of the whole run, seconds                 [600]
   --poses P            poses of the generated graph (without GRAPH)         [1000]
   --quiet              no progress lines
   --help               this text
 
+DDS session options (passed on to the coordinator and every agent):
+%s
 exit codes: 0 done, 1 the run failed (a process failed, or the time limit), 2 bad options,
 130 interrupted.
 )";
@@ -166,12 +169,13 @@ void remove_tree(const std::string& dir) {
 int run_launch(const Args& argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
+      std::printf(kHelp, session_options_help(SessionArgsFor::kLaunch).c_str());
       return 0;
     }
   Arguments args(argv,
-                 {"agents", "algorithm", "partition", "grad-tol", "max-rounds", "rank", "seed",
-                  "json", "out", "tum", "domain", "timeout", "poses"},
+                 with_session_options({"agents", "algorithm", "partition", "grad-tol", "max-rounds",
+                                       "rank", "seed", "json", "out", "tum", "timeout", "poses"},
+                                      SessionArgsFor::kLaunch),
                  {"quiet"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
@@ -190,9 +194,7 @@ int run_launch(const Args& argv) {
   if (rank < 0) throw InputError("launch: --rank must be >= 0");
   const long seed = args.get_long("seed", 1);
   if (seed < 0) throw InputError("launch: --seed must be >= 0");
-  const long domain = args.get_long("domain", -1);
-  if (args.has("domain") && (domain < 0 || domain > 232))
-    throw InputError("launch: --domain must be in 0..232");
+  SessionArgs net = parse_session_args(args, SessionArgsFor::kLaunch);
   const double timeout_s = args.get_double("timeout", 600);
   if (!(timeout_s > 0)) throw InputError("launch: --timeout must be > 0");
   const long poses = args.get_long("poses", 1000);
@@ -228,11 +230,12 @@ int run_launch(const Args& argv) {
     if (!probe) throw InputError(graph, 0, "cannot open the graph");
   }
   const std::string summary = args.get_or("json", work + "/summary.json");
-  const std::string run_id =
-      "launch-" + std::to_string(getpid()) + "-" +
-      std::to_string(std::chrono::steady_clock::now().time_since_epoch().count() % 1000000);
-  std::vector<std::string> common = {"--run-id", run_id};
-  if (domain >= 0) common.insert(common.end(), {"--domain", std::to_string(domain)});
+  if (!args.has("run-id"))
+    net.session.run_id =
+        "launch-" + std::to_string(getpid()) + "-" +
+        std::to_string(std::chrono::steady_clock::now().time_since_epoch().count() % 1000000);
+  const std::string& run_id = net.session.run_id;
+  const std::vector<std::string> common = session_argv(net.session);
 
   // Our own handlers: a Ctrl-C stops the children cleanly instead of orphaning them.
   struct sigaction sa {};

@@ -20,6 +20,7 @@
 #include "graph/pose_graph.hpp"
 #include "io/g2o_writer.hpp"
 #include "io/tum_writer.hpp"
+#include "session_args.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/session.hpp"
@@ -34,6 +35,7 @@ constexpr std::uint32_t agent_final_report_phase = 200;
 
 namespace {
 
+// %s: the shared DDS session options (cli/session_args.hpp).
 constexpr const char* kHelp = R"(usage: tessera-coordinator --agents N [options]
 
 The coordinator of a distributed Tessera run. Waits for N tessera-agent processes of the
@@ -43,12 +45,7 @@ the merged result. It never receives measurement values.
 
 options:
   --agents N           number of agents of the run (required)
-  --run-id ID          run id shared by all processes of the run (default "default")
-  --domain D           DDS domain id 0..232 (default: derived from the run id)
-  --timeout S          bound on each wait during set-up and shutdown, seconds (default 30)
   --run-timeout S      bound on the wait for the final estimates, seconds (default 3600)
-  --lease S            participant/liveliness lease in seconds (default 1, range 0.2..60)
-  --peers IP[,IP]      IPv4 addresses to contact by unicast (when multicast is not available)
   --partition PRESET   sequential, fast, eco, strong or highest (default eco)
   --partition-seed K   seed of the partitioner (default 1)
   --rank R             rank r of the relaxation sent to the agents (default 0 = core's, 5)
@@ -66,18 +63,16 @@ options:
   --verbose            print each phase
   --help               this text
 
+DDS session options (shared with tessera-agent and tessera launch):
+%s
 exit codes: 0 done, 1 the run failed (lost agent, abort, timeout), 2 bad options or input,
 128+signal when interrupted (SIGINT 130, SIGTERM 143).
 )";
 
 struct CoordinatorArgs {
   std::uint32_t agents = 0;
-  std::string run_id = "default";
-  int domain = -1;
-  double timeout_s = 30;
+  cli::SessionArgs net;  ///< run id, domain, lease, peers, --timeout (cli/session_args.hpp)
   double run_timeout_s = 3600;
-  double lease_s = 1.0;
-  std::vector<std::string> peers;
   std::string partition = "eco";
   std::uint64_t partition_seed = 1;
   std::uint32_t rank = 0;
@@ -90,11 +85,13 @@ struct CoordinatorArgs {
 };
 
 CoordinatorArgs parse(const std::vector<std::string>& argv) {
-  cli::Arguments args(argv,
-                      {"agents", "run-id", "domain", "timeout", "run-timeout", "lease", "peers",
-                       "partition", "partition-seed", "rank", "algorithm", "init", "max-rounds",
-                       "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary", "graph-name"},
-                      {"progress", "verbose", "help"});
+  cli::Arguments args(
+      argv,
+      cli::with_session_options({"agents", "run-timeout", "partition", "partition-seed", "rank",
+                                 "algorithm", "init", "max-rounds", "grad-tol", "rel-cost-tol",
+                                 "seed", "output", "tum", "summary", "graph-name"},
+                                cli::SessionArgsFor::kProcess),
+      {"progress", "verbose", "help"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   CoordinatorArgs a;
@@ -102,18 +99,9 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
   long agents = args.get_long("agents", 0);
   if (agents < 1 || agents > 1000) throw InputError("option --agents: must be 1..1000");
   a.agents = static_cast<std::uint32_t>(agents);
-  a.run_id = args.get_or("run-id", a.run_id);
-  validate_run_id(a.run_id);
-  long domain = args.get_long("domain", -1);
-  if (args.has("domain") && (domain < 0 || domain > kMaxDomain))
-    throw InputError("option --domain: must be 0.." + std::to_string(kMaxDomain));
-  a.domain = static_cast<int>(domain);
-  a.timeout_s = args.get_double("timeout", a.timeout_s);
-  if (!(a.timeout_s > 0)) throw InputError("option --timeout: must be positive");
+  a.net = cli::parse_session_args(args, cli::SessionArgsFor::kProcess);
   a.run_timeout_s = args.get_double("run-timeout", a.run_timeout_s);
   if (!(a.run_timeout_s > 0)) throw InputError("option --run-timeout: must be positive");
-  a.lease_s = args.get_double("lease", a.lease_s);
-  a.peers = args.get_list("peers");
   a.partition = args.get_or("partition", a.partition);
   auto nonneg = [&](const char* name, long fallback) {
     long v = args.get_long(name, fallback);
@@ -167,13 +155,9 @@ class Coordinator {
   Coordinator(const CoordinatorArgs& a, SignalWatcher& signals) : a_(a), signals_(signals) {}
 
   int run() {
-    SessionOptions so;
-    so.run_id = a_.run_id;
-    so.domain = a_.domain;
+    SessionOptions so = a_.net.session;
     so.coordinator = true;
     so.num_agents = a_.agents;
-    so.lease_s = a_.lease_s;
-    so.initial_peers = a_.peers;
     so.verbose = a_.verbose;
     try {
       session_ = std::make_unique<Session>(so);
@@ -219,7 +203,7 @@ class Coordinator {
     std::cerr << "tessera-coordinator: error: " << why << "\n";
     try {
       session_->send_control(wire::CONTROL_ABORT, own ? "coordinator: " + why : why);
-      session_->linger_for_control(Seconds(std::min(3.0, a_.timeout_s)));
+      session_->linger_for_control(Seconds(std::min(3.0, a_.net.timeout_s)));
     } catch (const std::exception&) {
       // Leaving anyway: the agents notice the coordinator disappear.
     }
@@ -256,14 +240,15 @@ class Coordinator {
             "missing agent " + missing + (present.empty() ? "" : " (have agent " + present + ")");
       return have.size() == N;
     };
-    expect_ready(s.announcements().wait_for(all_announced, Seconds(a_.timeout_s)), room,
-                 a_.timeout_s,
-                 std::to_string(N) + " agents of run '" + a_.run_id + "' on domain " +
+    expect_ready(s.announcements().wait_for(all_announced, Seconds(a_.net.timeout_s)), room,
+                 a_.net.timeout_s,
+                 std::to_string(N) + " agents of run '" + a_.net.session.run_id + "' on domain " +
                      std::to_string(s.domain()),
                  missing);
     std::vector<wire::AgentAnnouncement> announcements = s.announcements().take_all();
     discovery_ms_ = ms_since(t0);
-    coordinator::RunStructure rs = coordinator::merge_announcements(announcements, N, a_.run_id);
+    coordinator::RunStructure rs =
+        coordinator::merge_announcements(announcements, N, a_.net.session.run_id);
     announcements.clear();
     log("all " + std::to_string(N) + " agents announced (" +
         std::to_string(static_cast<long>(discovery_ms_)) + " ms): " + std::to_string(rs.num_poses) +
@@ -275,7 +260,7 @@ class Coordinator {
     log("partition (" + a_.partition + "): cut " + std::to_string(part.cut_edges) +
         " measurements in " + std::to_string(part.ms) + " ms");
     wire::PartitionAssignment asg;
-    asg.run_id(a_.run_id);
+    asg.run_id(a_.net.session.run_id);
     asg.num_agents(N);
     asg.num_poses(static_cast<std::uint32_t>(rs.num_poses));
     asg.dim(static_cast<std::uint32_t>(rs.d));
@@ -291,7 +276,7 @@ class Coordinator {
     asg.seed(a_.seed);
     asg.partition_ms(part.ms);
     s.publish(asg);
-    expect_ready(s.ready_barrier(Seconds(a_.timeout_s), &missing), room, a_.timeout_s,
+    expect_ready(s.ready_barrier(Seconds(a_.net.timeout_s), &missing), room, a_.net.timeout_s,
                  "the agents to be ready", missing);
     log("all agents ready");
 
@@ -377,7 +362,7 @@ class Coordinator {
       PoseGraph g;
       g.d = rs.d;
       g.num_poses = rs.num_poses;
-      g.source = "tessera-coordinator run " + a_.run_id;
+      g.source = "tessera-coordinator run " + a_.net.session.run_id;
       write_g2o(g, poses, a_.output);
     }
     if (!a_.tum.empty()) write_tum(poses, a_.tum);
@@ -385,7 +370,7 @@ class Coordinator {
 
     // 5. Tell the agents they may leave.
     s.send_control(wire::CONTROL_FINISHED);
-    s.flush(Seconds(std::min(3.0, a_.timeout_s)));
+    s.flush(Seconds(std::min(3.0, a_.net.timeout_s)));
     s.set_peer_loss_fatal(false);
     std::uint64_t total_bytes = 0;
     for (auto b : bytes) total_bytes += b;
@@ -413,13 +398,14 @@ class Coordinator {
     j += "  \"d\": " + std::to_string(rs.d) + ",\n";
     j += "  \"rank\": " + std::to_string(a_.rank ? a_.rank : 5) + ",\n";
     j += "  \"iterations\": " + std::to_string(rounds) + ",\n";
-    j += "  \"grad_norm\": " + (have_final_report_ ? json_number(final_grad_norm_) : "null") + ",\n";
+    j +=
+        "  \"grad_norm\": " + (have_final_report_ ? json_number(final_grad_norm_) : "null") + ",\n";
     j += "  \"cost\": " + (have_final_report_ ? json_number(final_cost_) : "null") + ",\n";
     j += "  \"certified\": null,\n";
     j += "  \"wall_s\": " + json_number(total_ms / 1000.0) + ",\n";
     j += "  \"restarts\": " + std::to_string(final_restarts_) + ",\n";
     j += "  \"bytes_exchanged\": " + std::to_string(total_bytes) + ",\n";
-    j += "  \"run_id\": " + json_string(a_.run_id) + ",\n";
+    j += "  \"run_id\": " + json_string(a_.net.session.run_id) + ",\n";
     j += "  \"domain\": " + std::to_string(session_->domain()) + ",\n";
     j += "  \"agents\": " + std::to_string(a_.agents) + ",\n";
     j += "  \"dim\": " + std::to_string(rs.d) + ",\n";
@@ -459,7 +445,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> argv_list(argv + 1, argv + argc);
   for (const auto& a : argv_list)
     if (a == "--help" || a == "-h") {
-      std::cout << kHelp;
+      std::printf(kHelp, cli::session_options_help(cli::SessionArgsFor::kProcess).c_str());
       return kExitOk;
     }
   CoordinatorArgs args;

@@ -1,7 +1,6 @@
 #include "transport/session.hpp"
 
 #include <fastdds/rtps/common/InstanceHandle.h>
-#include <fastrtps/utils/IPLocator.h>
 
 #include <algorithm>
 #include <atomic>
@@ -36,24 +35,6 @@ namespace tessera::transport {
 namespace dds = eprosima::fastdds::dds;
 namespace rtps = eprosima::fastrtps::rtps;
 using eprosima::fastrtps::types::ReturnCode_t;
-
-void SessionOptions::validate() const {
-  validate_run_id(run_id);
-  if (domain > kMaxDomain)
-    throw InputError("option --domain: " + std::to_string(domain) +
-                     " is above the highest usable domain " + std::to_string(kMaxDomain));
-  if (num_agents < 1 || num_agents > 1000)
-    throw InputError("number of agents must be 1..1000, got " + std::to_string(num_agents));
-  if (!coordinator && agent_id >= num_agents)
-    throw InputError("option --id: " + std::to_string(agent_id) +
-                     " is not below the number of agents " + std::to_string(num_agents));
-  if (!(lease_s >= 0.2 && lease_s <= 60))
-    throw InputError("option --lease: " + std::to_string(lease_s) + " s is outside 0.2..60 s");
-  if (!(write_timeout_s > 0)) throw InputError("write timeout must be positive");
-  for (const auto& ip : initial_peers)
-    if (!eprosima::fastrtps::rtps::IPLocator::isIPv4(ip))
-      throw InputError("option --peers: '" + ip + "' is not an IPv4 address");
-}
 
 namespace {
 

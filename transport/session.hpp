@@ -21,31 +21,9 @@
 #include "tessera.h"
 #include "transport/inbox.hpp"
 #include "transport/run_identity.hpp"
+#include "transport/session_options.hpp"
 
 namespace tessera::transport {
-
-struct SessionOptions {
-  std::string run_id = "default";  ///< 1..64 of [A-Za-z0-9_.-]; Partition QoS and message field.
-  int domain = -1;                 ///< DDS domain 0..kMaxDomain; < 0: domain_for_run(run_id).
-  bool coordinator = false;        ///< Role: the coordinator, or agent `agent_id`.
-  std::uint32_t agent_id = 0;      ///< 0..num_agents-1 (agents only).
-  std::uint32_t num_agents = 1;    ///< N >= 1.
-  /// Participant lease and writer liveliness lease in seconds (0.2..60). A SIGKILLed peer is
-  /// noticed after about this long (participant announcements go out every lease/5).
-  double lease_s = 1.0;
-  /// IPv4 addresses of hosts to contact by unicast for discovery (when multicast is blocked).
-  std::vector<std::string> initial_peers;
-  /// How long a write may wait for room in the bounded history before failing (seconds).
-  double write_timeout_s = 30.0;
-  /// Print discovery events (peer found / lost) to stderr.
-  bool verbose = false;
-  /// Whether the run has a coordinator (agents wait for it in the readiness barrier). Off
-  /// only for agent-to-agent tools such as tessera-dds-ping.
-  bool expect_coordinator = true;
-
-  /// Throws InputError naming the bad field.
-  void validate() const;
-};
 
 /// Counters of one session (this process).
 struct SessionStats {

@@ -1,0 +1,78 @@
+#include "session_args.hpp"
+
+#include <cstdio>
+
+#include "transport/run_identity.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera::cli {
+
+std::set<std::string> session_option_names(SessionArgsFor who) {
+  std::set<std::string> names = {"run-id", "domain", "lease", "peers"};
+  if (who == SessionArgsFor::kProcess) names.insert("timeout");
+  return names;
+}
+
+std::set<std::string> with_session_options(std::set<std::string> names, SessionArgsFor who) {
+  for (const auto& n : session_option_names(who)) names.insert(n);
+  return names;
+}
+
+SessionArgs parse_session_args(const Arguments& args, SessionArgsFor who) {
+  SessionArgs a;
+  transport::SessionOptions& o = a.session;
+  o.run_id = args.get_or("run-id", o.run_id);
+  transport::validate_run_id(o.run_id);
+  const long domain = args.get_long("domain", -1);
+  if (args.has("domain") && (domain < 0 || domain > transport::kMaxDomain))
+    throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));
+  o.domain = static_cast<int>(domain);
+  o.lease_s = args.get_double("lease", o.lease_s);
+  o.initial_peers = args.get_list("peers");
+  if (who == SessionArgsFor::kProcess) {
+    a.timeout_s = args.get_double("timeout", a.timeout_s);
+    if (!(a.timeout_s > 0)) throw InputError("option --timeout: must be positive");
+  }
+  // Role fields are still defaults (agent 0 of 1), which validate() accepts; it checks the
+  // lease range and the peer addresses here, before any participant exists.
+  o.validate();
+  return a;
+}
+
+std::vector<std::string> session_argv(const transport::SessionOptions& o) {
+  const transport::SessionOptions defaults;
+  std::vector<std::string> out = {"--run-id", o.run_id};
+  if (o.domain >= 0) out.insert(out.end(), {"--domain", std::to_string(o.domain)});
+  if (o.lease_s != defaults.lease_s) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%.17g", o.lease_s);
+    out.insert(out.end(), {"--lease", buf});
+  }
+  if (!o.initial_peers.empty()) {
+    std::string list;
+    for (const auto& ip : o.initial_peers) list += (list.empty() ? "" : ",") + ip;
+    out.insert(out.end(), {"--peers", list});
+  }
+  return out;
+}
+
+std::string session_options_help(SessionArgsFor who) {
+  std::string h;
+  if (who == SessionArgsFor::kProcess)
+    h += "  --run-id ID        run id shared by all processes of the run (default \"default\");\n"
+         "                     [A-Za-z0-9_.-], at most 64 characters\n";
+  else
+    h += "  --run-id ID        run id of every process (default: a fresh one per launch)\n";
+  h += "  --domain D         DDS domain id 0..232 (default: derived from the run id)\n";
+  if (who == SessionArgsFor::kProcess)
+    h += "  --timeout S        bound on each wait for peers during set-up, in seconds (default "
+         "30)\n";
+  h +=
+      "  --lease S          participant/liveliness lease in seconds: a dead peer is noticed after\n"
+      "                     about this long (default 1, range 0.2..60)\n"
+      "  --peers IP[,IP]    IPv4 addresses to contact by unicast (when multicast is not "
+      "available)\n";
+  return h;
+}
+
+}  // namespace tessera::cli

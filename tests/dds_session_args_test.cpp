@@ -1,0 +1,73 @@
+// The DDS session options shared by tessera-agent, tessera-coordinator and tessera launch
+// (cli/session_args.*): parsing, checks that name the option, and forwarding to the
+// processes of a launch. No participant is created here.
+
+#include <gtest/gtest.h>
+
+#include "session_args.hpp"
+#include "util/input_error.hpp"
+
+namespace {
+
+using namespace tessera;
+using namespace tessera::cli;
+
+SessionArgs parse(const std::vector<std::string>& argv, SessionArgsFor who) {
+  Arguments args(argv, session_option_names(who), {});
+  return parse_session_args(args, who);
+}
+
+std::string error_of(const std::vector<std::string>& argv, SessionArgsFor who) {
+  try {
+    parse(argv, who);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(DdsSessionArgs, DefaultsMatchTheSessionDefaults) {
+  SessionArgs a = parse({}, SessionArgsFor::kProcess);
+  const transport::SessionOptions defaults;
+  EXPECT_EQ(a.session.run_id, "default");
+  EXPECT_EQ(a.session.domain, -1);
+  EXPECT_EQ(a.session.lease_s, defaults.lease_s);
+  EXPECT_TRUE(a.session.initial_peers.empty());
+  EXPECT_EQ(a.timeout_s, 30);
+}
+
+TEST(DdsSessionArgs, ForwardedOptionsParseBackToTheSameSession) {
+  SessionArgs a = parse(
+      {"--run-id", "r-1.x", "--domain", "0", "--lease", "2.5", "--peers", "10.0.0.1,,10.0.0.2"},
+      SessionArgsFor::kLaunch);
+  EXPECT_EQ(a.session.initial_peers, (std::vector<std::string>{"10.0.0.1", "10.0.0.2"}));
+  SessionArgs b = parse(session_argv(a.session), SessionArgsFor::kProcess);
+  EXPECT_EQ(b.session.run_id, "r-1.x");
+  EXPECT_EQ(b.session.domain, 0);
+  EXPECT_EQ(b.session.lease_s, 2.5);
+  EXPECT_EQ(b.session.initial_peers, a.session.initial_peers);
+  // Defaults are not spelled out: only the run id is always passed on.
+  EXPECT_EQ(session_argv(transport::SessionOptions{}),
+            (std::vector<std::string>{"--run-id", "default"}));
+}
+
+TEST(DdsSessionArgs, BadValuesNameTheOption) {
+  const auto P = SessionArgsFor::kProcess;
+  EXPECT_NE(error_of({"--domain", "233"}, P).find("--domain"), std::string::npos);
+  EXPECT_NE(error_of({"--domain", "-1"}, P).find("--domain"), std::string::npos);
+  EXPECT_NE(error_of({"--lease", "0.1"}, P).find("--lease"), std::string::npos);
+  EXPECT_NE(error_of({"--lease", "x"}, P).find("--lease"), std::string::npos);
+  EXPECT_NE(error_of({"--peers", "10.0.0"}, P).find("--peers"), std::string::npos);
+  EXPECT_NE(error_of({"--run-id", "a b"}, P).find("--run-id"), std::string::npos);
+  EXPECT_NE(error_of({"--timeout", "0"}, P).find("--timeout"), std::string::npos);
+}
+
+TEST(DdsSessionArgs, LaunchKeepsItsOwnTimeout) {
+  // `tessera launch --timeout` is the whole run's limit, not the processes' set-up bound.
+  EXPECT_TRUE(session_option_names(SessionArgsFor::kProcess).count("timeout"));
+  EXPECT_FALSE(session_option_names(SessionArgsFor::kLaunch).count("timeout"));
+  EXPECT_NE(session_options_help(SessionArgsFor::kProcess).find("--timeout"), std::string::npos);
+  EXPECT_EQ(session_options_help(SessionArgsFor::kLaunch).find("--timeout"), std::string::npos);
+}
+
+}  // namespace
