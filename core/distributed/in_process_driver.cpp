@@ -1,6 +1,7 @@
 #include "distributed/in_process_driver.hpp"
 
 #include <deque>
+#include <functional>
 #include <stdexcept>
 
 namespace tessera {
@@ -24,10 +25,9 @@ std::uint32_t round_of(const ProtocolMessage& m) {
   return std::get<RoundStatusMessage>(m).round;
 }
 
-}  // namespace
-
-DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
-                             std::uint64_t delivery_seed) {
+DeliveryStats deliver(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+                      std::uint64_t delivery_seed,
+                      const std::function<std::vector<OutgoingMessage>(std::size_t)>& begin) {
   DeliveryStats stats;
   std::deque<Delivery> queue;
   const std::size_t n = agents.size();
@@ -51,9 +51,9 @@ DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, Delivery
     }
   };
   if (order == DeliveryOrder::kReversed) {
-    for (std::size_t i = n; i-- > 0;) post(i, agents[i]->start());
+    for (std::size_t i = n; i-- > 0;) post(i, begin(i));
   } else {
-    for (std::size_t i = 0; i < n; ++i) post(i, agents[i]->start());
+    for (std::size_t i = 0; i < n; ++i) post(i, begin(i));
   }
   std::uint64_t state = delivery_seed * 0x9E3779B97F4A7C15ull + 1;
   auto next_random = [&] {  // xorshift64*: reproducible and cheap
@@ -84,6 +84,25 @@ DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, Delivery
     if (!a->done())
       throw std::logic_error("in-process driver: agents stalled with no message in flight");
   return stats;
+}
+
+}  // namespace
+
+DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+                             std::uint64_t delivery_seed) {
+  return deliver(agents, order, delivery_seed, [&](std::size_t i) { return agents[i]->start(); });
+}
+
+DeliveryStats resume_in_process(const std::vector<RoundProtocol*>& agents,
+                                const std::vector<ProtocolSnapshot>& snapshots, DeliveryOrder order,
+                                std::uint64_t delivery_seed) {
+  if (snapshots.size() != agents.size())
+    throw std::invalid_argument("resume_in_process: one snapshot per agent needed");
+  for (const auto& s : snapshots)
+    if (s.round != snapshots.front().round)
+      throw std::invalid_argument("resume_in_process: snapshots of different rounds");
+  return deliver(agents, order, delivery_seed,
+                 [&](std::size_t i) { return agents[i]->resume(snapshots[i]); });
 }
 
 }  // namespace tessera

@@ -1,6 +1,8 @@
 #include "distributed/irbcd.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "util/input_error.hpp"
 
@@ -65,6 +67,18 @@ void IrbcdScheme::restart() {
 void IrbcdScheme::reset() {
   a_ = options_.a0 > 0 ? options_.a0 : 1.0 / n_;
   b_ = options_.b0;
+}
+
+std::vector<double> IrbcdScheme::save() const {
+  return {a_, b_};
+}
+
+void IrbcdScheme::load(const std::vector<double>& state) {
+  if (state.size() != 2)
+    throw std::runtime_error("IrbcdScheme: saved state has " + std::to_string(state.size()) +
+                             " values, expected 2");
+  a_ = state[0];
+  b_ = state[1];
 }
 
 }  // namespace tessera

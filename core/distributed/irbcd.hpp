@@ -52,6 +52,8 @@ class IrbcdScheme : public MomentumScheme {
     return options_.unselected_take_extrapolation;
   }
   double restart_constant() const override { return options_.restart_c; }
+  std::vector<double> save() const override;
+  void load(const std::vector<double>& state) override;
   double a() const { return a_; }
   double b() const { return b_; }
 

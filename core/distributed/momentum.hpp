@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <vector>
 
 #include "manifold/lifted_manifold.hpp"
 
@@ -36,6 +37,11 @@ class MomentumScheme {
   virtual bool unselected_take_extrapolation() const = 0;
   /// Restart constant c (< 0: never restart).
   virtual double restart_constant() const = 0;
+  /// The scalar recurrences' current values (for checkpoints), and restoring them: after
+  /// load(save()) the scheme produces the same coefficients as the one saved.
+  virtual std::vector<double> save() const = 0;
+  /// Throws std::runtime_error when `state` does not have this scheme's size.
+  virtual void load(const std::vector<double>& state) = 0;
 };
 
 /// Proj_M(alpha V + (1 - alpha) Y).

@@ -1,6 +1,8 @@
 #include "distributed/rbcd_plus_plus.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "util/input_error.hpp"
 
@@ -34,6 +36,17 @@ void RbcdPlusPlusScheme::advance() {
 
 void RbcdPlusPlusScheme::restart() {
   gamma_prev_ = 0.0;
+}
+
+std::vector<double> RbcdPlusPlusScheme::save() const {
+  return {gamma_prev_};
+}
+
+void RbcdPlusPlusScheme::load(const std::vector<double>& state) {
+  if (state.size() != 1)
+    throw std::runtime_error("RbcdPlusPlusScheme: saved state has " + std::to_string(state.size()) +
+                             " values, expected 1");
+  gamma_prev_ = state[0];
 }
 
 }  // namespace tessera

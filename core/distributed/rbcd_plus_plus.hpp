@@ -26,6 +26,8 @@ class RbcdPlusPlusScheme : public MomentumScheme {
   void restart() override;
   bool unselected_take_extrapolation() const override { return true; }
   double restart_constant() const override { return options_.restart_c; }
+  std::vector<double> save() const override;
+  void load(const std::vector<double>& state) override;
 
  private:
   RbcdPlusPlusOptions options_;

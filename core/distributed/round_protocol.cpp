@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "distributed/protocol_snapshot.hpp"
+
 namespace tessera {
 namespace {
 
@@ -42,6 +44,70 @@ std::vector<OutgoingMessage> RoundProtocol::start() {
   const auto& adj = layout_.adjacent[static_cast<std::size_t>(state_.id())];
   send_poses(state_.Y, BlockKind::kY, ProtocolPhase::kInit, adj, out);
   expect(0, ProtocolPhase::kInit, adj);
+  pump(out);
+  return out;
+}
+
+ProtocolSnapshot RoundProtocol::snapshot() const {
+  ProtocolSnapshot s;
+  s.agent = state_.id();
+  s.round = round_;
+  s.Y = state_.Y;
+  s.P = state_.P;
+  s.V = state_.V;
+  s.Y_prev = state_.Y_prev;
+  s.Yn = state_.Yn;
+  s.Pn = state_.Pn;
+  s.Yn_prev = state_.Yn_prev;
+  s.selection = selection_;
+  s.f_prev = f_prev_;
+  s.gsq_prev = gsq_prev_;
+  s.restarts = restarts_;
+  if (scheme_) s.scheme_state = scheme_->save();
+  s.trace = trace_;
+  return s;
+}
+
+std::vector<OutgoingMessage> RoundProtocol::resume(const ProtocolSnapshot& s) {
+  auto fail = [&](const std::string& why) {
+    throw std::runtime_error("agent " + std::to_string(state_.id()) +
+                             ": cannot resume from the snapshot of round " +
+                             std::to_string(s.round) + ": " + why);
+  };
+  if (s.agent != state_.id()) fail("it belongs to agent " + std::to_string(s.agent));
+  auto same = [](const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+    return a.rows() == b.rows() && a.cols() == b.cols();
+  };
+  for (const Eigen::MatrixXd* m : {&s.Y, &s.P, &s.V, &s.Y_prev})
+    if (!same(*m, state_.Y)) fail("own block of the wrong size");
+  for (const Eigen::MatrixXd* m : {&s.Yn, &s.Pn, &s.Yn_prev})
+    if (!same(*m, state_.Yn)) fail("neighbour copies of the wrong size");
+  if (scheme_)
+    scheme_->load(s.scheme_state);
+  else if (!s.scheme_state.empty())
+    fail("it has momentum state, this run has none");
+  state_.Y = s.Y;
+  state_.P = s.P;
+  state_.V = s.V;
+  state_.Y_prev = s.Y_prev;
+  state_.Yn = s.Yn;
+  state_.Pn = s.Pn;
+  state_.Yn_prev = s.Yn_prev;
+  round_ = s.round;
+  selection_ = s.selection;
+  f_prev_ = s.f_prev;
+  gsq_prev_ = s.gsq_prev;
+  restarts_ = s.restarts;
+  trace_ = s.trace;
+  done_ = false;
+  stop_reason_.clear();
+  pending_.clear();
+  const double elapsed = trace_.empty() ? 0.0 : trace_.back().elapsed_s;
+  start_time_ = std::chrono::steady_clock::now() -
+                std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                    std::chrono::duration<double>(elapsed));
+  std::vector<OutgoingMessage> out;
+  begin_status(ProtocolPhase::kStatus, out);
   pump(out);
   return out;
 }
@@ -128,6 +194,7 @@ void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
 }
 
 void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessage>& out) {
+  if (phase == ProtocolPhase::kStatus && observer_) observer_(snapshot());
   const LocalStatus s = state_.status();
   RoundStatusMessage m;
   m.round = u32(round_);

@@ -21,6 +21,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -34,6 +35,8 @@
 #include "protocol/messages.hpp"
 
 namespace tessera {
+
+struct ProtocolSnapshot;  // distributed/protocol_snapshot.hpp
 
 /// Protocol steps, carried in the messages' `phase` field.
 enum class ProtocolPhase : std::uint32_t {
@@ -77,6 +80,20 @@ class RoundProtocol {
   /// that cannot belong to this run (bad sender, wrong shape, unexpected pose).
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message);
 
+  /// Instead of start(): continues from `snapshot` (taken by this agent at round k, see
+  /// protocol_snapshot.hpp) and emits round k's status. When every agent resumes from its
+  /// snapshot of the same round, the iterates are bit-identical to the uninterrupted run.
+  /// Throws std::runtime_error when the snapshot does not fit this agent (id, sizes).
+  std::vector<OutgoingMessage> resume(const ProtocolSnapshot& snapshot);
+  /// Called with a snapshot each time a round's status is about to be sent (not for the
+  /// status retaken after an adaptive restart), i.e. at every consistent point.
+  void set_round_observer(std::function<void(const ProtocolSnapshot&)> observer) {
+    observer_ = std::move(observer);
+  }
+  /// The state at this moment as a snapshot (meaningful at a consistent point: inside the
+  /// round observer).
+  ProtocolSnapshot snapshot() const;
+
   bool done() const { return done_; }
   int rounds() const { return round_; }
   int restarts() const { return restarts_; }
@@ -115,6 +132,7 @@ class RoundProtocol {
   std::string stop_reason_;
   std::vector<RoundRecord> trace_;
   std::chrono::steady_clock::time_point start_time_;
+  std::function<void(const ProtocolSnapshot&)> observer_;
 };
 
 }  // namespace tessera
