@@ -325,7 +325,15 @@ class Coordinator {
                         std::sqrt(p.second.second));
           std::cout << buf << std::flush;
         }
-        if (p.first == N) progress.erase({m.round(), m.phase()});
+        if (p.first == N) {
+          progress.erase({m.round(), m.phase()});
+          // Round timing from the status completions the coordinator sees: excludes the
+          // fixed costs (hand-off, initialisation, rounding, shutdown) that solve_ms holds.
+          const double t = ms_since(t_run);
+          if (completed_statuses_ == 0) first_status_ms_ = t;
+          last_status_ms_ = t;
+          if (m.phase() == 1) ++completed_statuses_;
+        }
       }
       if (have_final_report_ && s.finals().size() >= N &&
           room.wait_for([&] { return finals_missing().empty(); }, Seconds(0)) == WaitStatus::kReady)
@@ -417,6 +425,12 @@ class Coordinator {
     j += "  \"discovery_ms\": " + json_number(discovery_ms_) + ",\n";
     j += "  \"partition_ms\": " + json_number(part.ms) + ",\n";
     j += "  \"solve_ms\": " + json_number(solve_ms_) + ",\n";
+    // Mean wall time of one round (status of round k to status of round k+1), or null.
+    const double rounds_ms = last_status_ms_ - first_status_ms_;
+    j += "  \"rounds_ms\": " + json_number(rounds_ms) + ",\n";
+    j += "  \"ms_per_round\": " +
+         (completed_statuses_ > 1 ? json_number(rounds_ms / (completed_statuses_ - 1)) : "null") +
+         ",\n";
     j += "  \"total_ms\": " + json_number(total_ms) + ",\n";
     j += "  \"bytes_sent\": [";
     for (std::size_t k = 0; k < bytes.size(); ++k) j += (k ? ", " : "") + std::to_string(bytes[k]);
@@ -432,6 +446,8 @@ class Coordinator {
   SignalWatcher& signals_;
   std::unique_ptr<Session> session_;
   double discovery_ms_ = 0, solve_ms_ = 0;
+  double first_status_ms_ = 0, last_status_ms_ = 0;  // completions of round statuses
+  std::uint32_t completed_statuses_ = 0;
   // From agent 0's final report (agent/round_loop.hpp kFinalReportPhase).
   double final_cost_ = 0, final_grad_norm_ = 0;
   std::uint32_t final_restarts_ = 0;
