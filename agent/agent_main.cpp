@@ -9,15 +9,21 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "agent/agent_checkpoint.hpp"
+#include "agent/checkpoint_keeper.hpp"
 #include "agent/dds_channel.hpp"
 #include "agent/local_dump.hpp"
 #include "agent/local_share.hpp"
+#include "agent/rejoin.hpp"
 #include "agent/round_loop.hpp"
 #include "arguments.hpp"
+#include "distributed/checkpoint_file.hpp"
 #include "io/g2o_reader.hpp"
 #include "session_args.hpp"
 #include "transport/message_mapping.hpp"
@@ -48,6 +54,11 @@ options:
   --round-timeout S  bound on each wait for a peer's message during the rounds (default 600)
   --output FILE      write this agent's final poses as g2o VERTEX lines
   --dump-local FILE  write the local problem after the hand-off (text; see docs/dds-runtime.md)
+  --checkpoint-dir DIR  keep this agent's checkpoint in DIR (one folder per run). Started
+                     again with the same options after a crash, the agent finds it there and
+                     rejoins the run (the coordinator needs --rejoin-timeout); removed when
+                     the run completes. A damaged checkpoint is an error naming the file.
+  --checkpoint-every K  write the checkpoint every K rounds (default 1)
   --verbose          print each phase
   --help             this text
 
@@ -65,13 +76,16 @@ struct AgentArgs {
   double round_timeout_s = 600;
   std::string output;
   std::string dump_local;
+  std::string checkpoint_dir;
+  int checkpoint_every = 1;
   bool verbose = false;
 };
 
 AgentArgs parse(const std::vector<std::string>& argv) {
   cli::Arguments args(
       argv,
-      cli::with_session_options({"graph", "robots", "id", "round-timeout", "output", "dump-local"},
+      cli::with_session_options({"graph", "robots", "id", "round-timeout", "output", "dump-local",
+                                 "checkpoint-dir", "checkpoint-every"},
                                 cli::SessionArgsFor::kProcess),
       {"verbose", "help"});
   if (!args.positional().empty())
@@ -92,6 +106,9 @@ AgentArgs parse(const std::vector<std::string>& argv) {
   if (!(a.round_timeout_s > 0)) throw InputError("option --round-timeout: must be positive");
   a.output = args.get_or("output", "");
   a.dump_local = args.get_or("dump-local", "");
+  a.checkpoint_dir = args.get_or("checkpoint-dir", "");
+  a.checkpoint_every = static_cast<int>(args.get_long("checkpoint-every", 1));
+  agent::CheckpointOptions{a.checkpoint_dir, a.checkpoint_every}.validate();
   a.verbose = args.has("verbose");
   return a;
 }
@@ -103,6 +120,24 @@ class Agent {
   }
 
   int run() {
+    // A checkpoint of this run in --checkpoint-dir means this process is a restart: rejoin.
+    if (!a_.checkpoint_dir.empty()) {
+      const std::string path = agent::checkpoint_path(a_.checkpoint_dir, a_.id);
+      if (access(path.c_str(), F_OK) == 0) {
+        try {
+          rejoin_ = agent::load_checkpoint(path, a_.net.session.run_id, a_.id, a_.robots);
+        } catch (const CheckpointError& e) {
+          std::cerr << tag_ << ": error: " << e.what() << "\n";
+          return kExitBadInput;
+        }
+        std::cerr << tag_ << ": rejoining run '" << a_.net.session.run_id << "' from checkpoint "
+                  << path << " (rounds " << rejoin_->snapshots.front().round << ".."
+                  << rejoin_->snapshots.back().round << ")\n";
+        // The others drop our previous incarnation after one lease; joining earlier would
+        // look like two processes claiming this id.
+        std::this_thread::sleep_for(Seconds(1.5 * a_.net.session.lease_s));
+      }
+    }
     SessionOptions so = a_.net.session;
     so.coordinator = false;
     so.agent_id = a_.id;
@@ -169,9 +204,19 @@ class Agent {
   }
 
   void phases() {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (rejoin_) {
+      solve(rejoin_->local, t0);
+    } else {
+      agent::AgentLocalData local = fresh_start();
+      solve(local, t0);
+    }
+  }
+
+  // Steps 1-5 of a run: share, announcement, assignment, readiness, hand-off.
+  agent::AgentLocalData fresh_start() {
     Session& s = *session_;
     Mailroom& room = s.mailroom();
-    const auto t0 = std::chrono::steady_clock::now();
 
     // 1. Our share of the graph.
     PoseGraph graph = read_g2o(a_.graph);
@@ -208,6 +253,7 @@ class Agent {
                            std::to_string(s.domain()) + " (is the coordinator running?)"
                      : "");
     check_assignment(asg);
+    rejoin_enabled_ = asg.rejoin_timeout_s() > 0;
     log("assignment received (" +
         std::to_string(std::count(asg.owner().begin(), asg.owner().end(), a_.id)) +
         " poses owned)");
@@ -271,10 +317,60 @@ class Agent {
     log("hand-off complete: " + std::to_string(local.owned.size()) + " poses, " +
         std::to_string(local.measurements.size()) + " measurements");
     if (!a_.dump_local.empty()) agent::write_local_dump(local, a_.dump_local);
+    return local;
+  }
 
+  // Steps 6-7: the rounds (resumed from a snapshot on every coordinated rollback), the final
+  // estimate, and the wait for the coordinator's FINISHED.
+  void solve(const agent::AgentLocalData& local, std::chrono::steady_clock::time_point t0) {
+    Session& s = *session_;
     // 6. THE SEAM: core's round protocol over DDS.
     agent::DdsProtocolChannel channel(s);
-    agent::RoundLoopResult result = agent::run_round_loop(local, channel, a_.round_timeout_s);
+    agent::CheckpointKeeper keeper(a_.net.session.run_id, local,
+                                   {a_.checkpoint_dir, a_.checkpoint_every});
+    std::optional<ProtocolSnapshot> from;  // a copy: the keeper replaces its entries
+    // With a rejoin window the coordinator arbitrates lost agents (it waits for a restart,
+    // then orders a rollback, or gives up and aborts the run): do not stop on one.
+    if (rejoin_enabled_ || rejoin_) s.set_agent_loss_tolerated(true);
+    if (rejoin_) {
+      keeper.adopt(rejoin_->snapshots);
+      const agent::RollbackRequested order =
+          agent::request_rejoin(s, a_.id, rejoin_->snapshots, a_.net.timeout_s);
+      from = agent::prepare_rollback(s, keeper, order, a_.net.timeout_s);
+      log("rejoined: resuming at round " + std::to_string(order.round) + ", epoch " +
+          std::to_string(order.epoch));
+    }
+    agent::RoundLoopHooks hooks;
+    hooks.on_round = [&keeper](const ProtocolSnapshot& snap) { keeper.on_round(snap); };
+    for (;;) {
+      try {
+        hooks.resume_from = from ? &*from : nullptr;
+        finish(local, agent::run_round_loop(local, channel, a_.round_timeout_s, hooks), t0);
+        break;
+      } catch (const agent::RollbackRequested& order) {
+        std::cerr << tag_ << ": " << order.what() << ": resuming from the snapshot of round "
+                  << order.round << "\n";
+        from = agent::prepare_rollback(s, keeper, order, a_.net.timeout_s);
+      }
+    }
+    if (!a_.checkpoint_dir.empty()) {
+      const auto& cs = keeper.stats();
+      char buf[200];
+      std::snprintf(buf, sizeof(buf),
+                    "%s: checkpoints: %llu written, %.1f ms in total (%.2f ms each), %llu bytes "
+                    "each\n",
+                    tag_.c_str(), static_cast<unsigned long long>(cs.writes), cs.write_s * 1e3,
+                    cs.writes ? cs.write_s * 1e3 / static_cast<double>(cs.writes) : 0.0,
+                    static_cast<unsigned long long>(cs.last_bytes));
+      std::cerr << buf;
+      std::remove(keeper.path().c_str());  // the run is complete: nothing to rejoin
+    }
+  }
+
+  void finish(const agent::AgentLocalData& local, const agent::RoundLoopResult& result,
+              std::chrono::steady_clock::time_point t0) {
+    Session& s = *session_;
+    Mailroom& room = s.mailroom();
     if (result.poses.size() != local.owned.size())
       throw RunFailure(kExitRunFailed, "the round loop returned " +
                                            std::to_string(result.poses.size()) + " poses for " +
@@ -302,8 +398,17 @@ class Agent {
     for (const Pose& p : result.poses) append_pose(fin.pose_data(), p);
     fin.bytes_sent(s.stats().bytes_sent + serialized_size(fin));
     s.publish(fin);
-    expect_ready(s.wait_finished(Seconds(a_.net.timeout_s)), room, a_.net.timeout_s,
-                 "the coordinator to confirm the merged result");
+    // Until FINISHED, a rollback (another agent rejoined) means doing the rounds again.
+    const auto wait_start = std::chrono::steady_clock::now();
+    for (;;) {
+      const WaitStatus st = s.wait_finished(Seconds(0.2));
+      if (st == WaitStatus::kReady) break;
+      if (auto order = agent::take_rollback(s)) throw *order;
+      const double waited =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - wait_start).count();
+      if (st == WaitStatus::kStopped || waited > a_.net.timeout_s)
+        expect_ready(st, room, a_.net.timeout_s, "the coordinator to confirm the merged result");
+    }
     s.set_peer_loss_fatal(false);
     const double secs =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -338,6 +443,8 @@ class Agent {
   std::string tag_;
   std::unique_ptr<Session> session_;
   agent::RobotShare share_;
+  std::optional<agent::AgentCheckpoint> rejoin_;  // set when restarted from a checkpoint
+  bool rejoin_enabled_ = false;                   // the coordinator waits for lost agents
 };
 
 }  // namespace

@@ -1,5 +1,9 @@
 #pragma once
 // The ProtocolChannel of the DDS runtime: core ProtocolMessages over a transport Session.
+// A ROLLBACK order of the coordinator (newer epoch than this process's) interrupts a wait
+// with RollbackRequested.
+
+#include <optional>
 
 #include "agent/round_loop.hpp"
 #include "transport/session.hpp"
@@ -15,5 +19,9 @@ class DdsProtocolChannel : public ProtocolChannel {
  private:
   transport::Session& session_;
 };
+
+/// Takes the coordinator's newest ROLLBACK order with an epoch above the session's (older
+/// ones are discarded), if any.
+std::optional<RollbackRequested> take_rollback(transport::Session& session);
 
 }  // namespace tessera::agent

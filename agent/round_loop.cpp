@@ -15,6 +15,7 @@
 #include "distributed/agent_state.hpp"
 #include "distributed/block_layout.hpp"
 #include "distributed/distributed_solver.hpp"
+#include "distributed/protocol_snapshot.hpp"
 #include "distributed/round_protocol.hpp"
 #include "problem/lifting.hpp"
 
@@ -58,8 +59,8 @@ class Mailbox {
     for (const auto& m : out) channel_.send(m);
   }
 
-  void run_protocol(RoundProtocol& protocol) {
-    send_all(protocol.start());
+  void run_protocol(RoundProtocol& protocol, const ProtocolSnapshot* resume_from) {
+    send_all(resume_from ? protocol.resume(*resume_from) : protocol.start());
     while (!protocol.done()) {
       std::optional<ProtocolMessage> msg = channel_.receive(timeout_s_);
       if (!msg)
@@ -394,7 +395,7 @@ class Rounding {
 }  // namespace
 
 RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
-                               double receive_timeout_s) {
+                               double receive_timeout_s, const RoundLoopHooks& hooks) {
   const DistributedOptions options = options_of(local.options);
   const std::string& init = local.options.initialization;
   if (!init.empty() && init != "file")
@@ -430,10 +431,11 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   const auto scheme = make_momentum_scheme(options, layout, variables);
   const RoundConfig config = make_round_config(options, scheme.get());
   RoundProtocol protocol(state, layout, config);
+  if (hooks.on_round) protocol.set_round_observer(hooks.on_round);
 
   Mailbox mail(channel, receive_timeout_s, local.agent_id);
   const auto t0 = std::chrono::steady_clock::now();
-  mail.run_protocol(protocol);
+  mail.run_protocol(protocol, hooks.resume_from);
   const auto t1 = std::chrono::steady_clock::now();
 
   RoundLoopResult res;

@@ -13,6 +13,7 @@
 // by a distributed preconditioned conjugate gradient on the translation Laplacian.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -22,6 +23,10 @@
 #include "graph/measurement.hpp"
 #include "graph/pose.hpp"
 #include "protocol/messages.hpp"
+
+namespace tessera {
+struct ProtocolSnapshot;  // distributed/protocol_snapshot.hpp
+}
 
 namespace tessera::agent {
 
@@ -65,6 +70,20 @@ class RunStopped : public std::runtime_error {
   explicit RunStopped(const std::string& why) : std::runtime_error(why) {}
 };
 
+/// Raised by a channel when the coordinator orders a coordinated rollback (an agent was
+/// restarted and rejoins): every agent abandons its current round and resumes from its
+/// snapshot of `round`; messages of earlier epochs are discarded from then on.
+class RollbackRequested : public std::runtime_error {
+ public:
+  RollbackRequested(std::uint32_t round, std::uint32_t epoch, std::uint32_t rejoined_agent)
+      : std::runtime_error("rollback to round " + std::to_string(round) + " (agent " +
+                           std::to_string(rejoined_agent) + " rejoined)"),
+        round(round),
+        epoch(epoch),
+        agent(rejoined_agent) {}
+  std::uint32_t round, epoch, agent;
+};
+
 /// How the round loop talks to the other agents.
 class ProtocolChannel {
  public:
@@ -97,9 +116,19 @@ struct RoundLoopResult {
 constexpr std::uint32_t kRoundingPhaseBase = 100;
 constexpr std::uint32_t kFinalReportPhase = 200;
 
+/// Optional recovery hooks of the round loop.
+struct RoundLoopHooks {
+  /// Called at every consistent point of the protocol (see RoundProtocol::set_round_observer).
+  std::function<void(const ProtocolSnapshot&)> on_round;
+  /// Continue from this snapshot (a coordinated rollback) instead of starting from the
+  /// initial poses; every other agent must resume from its snapshot of the same round.
+  const ProtocolSnapshot* resume_from = nullptr;
+};
+
 /// Runs this agent's part of the distributed solve. `receive_timeout_s` bounds every wait
-/// for a peer's message (a throw names the missing sender).
+/// for a peer's message (a throw names the missing sender). RollbackRequested from the
+/// channel propagates: the caller calls again with the snapshot of that round.
 RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
-                               double receive_timeout_s);
+                               double receive_timeout_s, const RoundLoopHooks& hooks = {});
 
 }  // namespace tessera::agent

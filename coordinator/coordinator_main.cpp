@@ -10,12 +10,15 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "arguments.hpp"
 #include "coordinator/partition_step.hpp"
+#include "coordinator/rejoin_arbiter.hpp"
+#include "coordinator/run_monitor.hpp"
 #include "coordinator/run_structure.hpp"
 #include "graph/pose_graph.hpp"
 #include "io/g2o_writer.hpp"
@@ -60,6 +63,11 @@ options:
   --summary FILE       write a JSON summary of the run
   --graph-name NAME    label of the graph in the summary (default "")
   --progress           print round progress (sum of the agents' cost and gradient norm)
+  --rejoin-timeout S   when an agent process dies, wait up to S seconds for it to be
+                       restarted (same id, --checkpoint-dir) and rejoin; every agent then rolls
+                       back to a common checkpoint round. 0 = stop the run at once (default 0)
+  --status-interval S  print a status line (agents alive, their rounds, lagging or lost
+                       agents) every S seconds and on changes; 0 = off (default 5)
   --verbose            print each phase
   --help               this text
 
@@ -82,15 +90,18 @@ struct CoordinatorArgs {
   std::uint64_t seed = 1;
   std::string output, tum, summary, graph_name;
   bool progress = false, verbose = false;
+  double rejoin_timeout_s = 0;
+  double status_interval_s = 5;
 };
 
 CoordinatorArgs parse(const std::vector<std::string>& argv) {
   cli::Arguments args(
       argv,
-      cli::with_session_options({"agents", "run-timeout", "partition", "partition-seed", "rank",
-                                 "algorithm", "init", "max-rounds", "grad-tol", "rel-cost-tol",
-                                 "seed", "output", "tum", "summary", "graph-name"},
-                                cli::SessionArgsFor::kProcess),
+      cli::with_session_options(
+          {"agents", "run-timeout", "partition", "partition-seed", "rank", "algorithm", "init",
+           "max-rounds", "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary",
+           "graph-name", "rejoin-timeout", "status-interval"},
+          cli::SessionArgsFor::kProcess),
       {"progress", "verbose", "help"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
@@ -123,6 +134,12 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
   a.summary = args.get_or("summary", "");
   a.graph_name = args.get_or("graph-name", "");
   a.progress = args.has("progress");
+  a.rejoin_timeout_s = args.get_double("rejoin-timeout", a.rejoin_timeout_s);
+  if (!(a.rejoin_timeout_s >= 0 && a.rejoin_timeout_s <= 86400))
+    throw InputError("option --rejoin-timeout: must be 0..86400 seconds");
+  a.status_interval_s = args.get_double("status-interval", a.status_interval_s);
+  if (!(a.status_interval_s >= 0 && a.status_interval_s <= 86400))
+    throw InputError("option --status-interval: must be 0..86400 seconds");
   a.verbose = args.has("verbose");
   return a;
 }
@@ -275,13 +292,22 @@ class Coordinator {
     asg.relative_cost_tolerance(a_.rel_cost_tol);
     asg.seed(a_.seed);
     asg.partition_ms(part.ms);
+    asg.rejoin_timeout_s(a_.rejoin_timeout_s);
     s.publish(asg);
     expect_ready(s.ready_barrier(Seconds(a_.net.timeout_s), &missing), room, a_.net.timeout_s,
                  "the agents to be ready", missing);
     log("all agents ready");
 
-    // 3. Final estimates (progress from round statuses meanwhile).
+    // 3. Final estimates (progress from round statuses meanwhile; lost agents go to the
+    // arbiter, which waits for them to rejoin).
     const auto t_run = std::chrono::steady_clock::now();
+    using Clock = std::chrono::steady_clock;
+    coordinator::RejoinArbiter arbiter(N, a_.rejoin_timeout_s);
+    if (a_.rejoin_timeout_s > 0) s.set_agent_loss_tolerated(true);
+    std::optional<coordinator::RunMonitor> monitor;
+    if (a_.status_interval_s > 0)
+      monitor.emplace(N, coordinator::MonitorOptions{a_.status_interval_s, 2, 3.0}, std::cout,
+                      t_run);
     std::map<std::pair<std::uint32_t, std::uint32_t>,
              std::pair<std::uint32_t, std::pair<double, double>>>
         progress;
@@ -293,18 +319,29 @@ class Coordinator {
         if (!have.count(k)) out += (out.empty() ? "agent " : ", agent ") + std::to_string(k);
       return out;
     };
+    const bool watch = monitor || a_.rejoin_timeout_s > 0;
     for (;;) {
       const double left = a_.run_timeout_s - ms_since(t_run) / 1000.0;
       std::string absent;
+      // Lost peers are noticed by polling the session (a few times a second) when watching.
+      const double nap = watch ? std::min(std::max(0.0, left), 0.25) : std::max(0.0, left);
       WaitStatus st = room.wait_for(
           [&] {
             absent = finals_missing();
             return (absent.empty() && have_final_report_) ||
-                   !s.status_watch().queued_locked().empty();
+                   !s.status_watch().queued_locked().empty() ||
+                   !s.rejoins().queued_locked().empty();
           },
-          Seconds(std::max(0.0, left)));
-      expect_ready(st, room, a_.run_timeout_s, "the final estimates", "none yet from " + absent);
+          Seconds(nap));
+      if (st == WaitStatus::kStopped || (st == WaitStatus::kTimeout && left <= 0))
+        expect_ready(st, room, a_.run_timeout_s, "the final estimates", "none yet from " + absent);
+      const auto now = Clock::now();
       for (const auto& m : s.status_watch().take_all()) {
+        if (m.epoch() < arbiter.epoch()) continue;  // sent before the last rollback
+        if ((m.phase() == 1 || m.phase() == 5) && m.sender() < N) {
+          arbiter.on_status(m.sender(), m.round());
+          if (monitor) monitor->on_status(m.sender(), m.round(), now);
+        }
         if (m.phase() == agent_final_report_phase) {  // agent 0's summary of the solve
           final_cost_ = m.cost();
           final_grad_norm_ = std::sqrt(m.grad_norm_sq());
@@ -334,6 +371,23 @@ class Coordinator {
           last_status_ms_ = t;
           if (m.phase() == 1) ++completed_statuses_;
         }
+      }
+      if (watch) {
+        const std::vector<std::uint32_t> lost = s.lost_agents();
+        if (a_.rejoin_timeout_s > 0)
+          for (auto k : lost) arbiter.on_lost(k, now);
+        if (monitor) monitor->set_lost(lost, now);
+        for (const auto& c : s.rejoins().take_all()) {
+          arbiter.on_rejoin({c.agent(), c.round(), c.round_prev(), c.nonce()}, now);
+          if (monitor)
+            monitor->event("agent " + std::to_string(c.agent()) +
+                               " restarted, asks to rejoin (checkpoint rounds " +
+                               std::to_string(c.round_prev()) + ", " + std::to_string(c.round()) +
+                               ")",
+                           now);
+        }
+        if (a_.rejoin_timeout_s > 0) decide_on_losses(arbiter, monitor, progress, now);
+        if (monitor) monitor->tick(now);
       }
       if (have_final_report_ && s.finals().size() >= N &&
           room.wait_for([&] { return finals_missing().empty(); }, Seconds(0)) == WaitStatus::kReady)
@@ -392,6 +446,39 @@ class Coordinator {
     std::cerr << buf;
   }
 
+  // Acts on the arbiter's decision (coordinator/rejoin_arbiter.hpp): a rollback order to
+  // every agent, or a clean stop naming the lost agent.
+  template <class Progress>
+  void decide_on_losses(coordinator::RejoinArbiter& arbiter,
+                        std::optional<coordinator::RunMonitor>& monitor, Progress& progress,
+                        std::chrono::steady_clock::time_point now) {
+    const coordinator::LossDecision d = arbiter.decide(now);
+    using Kind = coordinator::LossDecision::Kind;
+    if (d.kind == Kind::kGiveUp)
+      throw RunFailure(kExitRunFailed, "lost agent " + std::to_string(d.agent) + " of run '" +
+                                           a_.net.session.run_id + "': " + d.reason);
+    if (d.kind != Kind::kRollback) return;
+    for (const auto& r : d.rejoined) {
+      wire::Control c;
+      c.kind(wire::CONTROL_ROLLBACK);
+      c.round(d.round);
+      c.epoch(d.epoch);
+      c.agent(r.agent);
+      c.nonce(r.nonce);
+      c.reason("agent " + std::to_string(r.agent) + " rejoined");
+      session_->send_control(c);
+    }
+    progress.clear();  // partial sums of abandoned rounds
+    ++rollbacks_;
+    const std::string what = "agent " + std::to_string(d.agent) +
+                             " rejoined: every agent rolls back to round " +
+                             std::to_string(d.round) + " (epoch " + std::to_string(d.epoch) + ")";
+    if (monitor)
+      monitor->event(what, now);
+    else
+      std::cerr << "tessera-coordinator: " << what << "\n";
+  }
+
   void write_summary(const coordinator::RunStructure& rs,
                      const coordinator::PartitionStepResult& part,
                      const std::vector<std::uint64_t>& bytes, std::uint32_t rounds,
@@ -413,6 +500,7 @@ class Coordinator {
     j += "  \"wall_s\": " + json_number(total_ms / 1000.0) + ",\n";
     j += "  \"restarts\": " + std::to_string(final_restarts_) + ",\n";
     j += "  \"bytes_exchanged\": " + std::to_string(total_bytes) + ",\n";
+    j += "  \"rollbacks\": " + std::to_string(rollbacks_) + ",\n";
     j += "  \"run_id\": " + json_string(a_.net.session.run_id) + ",\n";
     j += "  \"domain\": " + std::to_string(session_->domain()) + ",\n";
     j += "  \"agents\": " + std::to_string(a_.agents) + ",\n";
@@ -452,6 +540,7 @@ class Coordinator {
   double final_cost_ = 0, final_grad_norm_ = 0;
   std::uint32_t final_restarts_ = 0;
   bool have_final_report_ = false;
+  std::uint32_t rollbacks_ = 0;  // coordinated rollbacks (agents that rejoined)
 };
 
 }  // namespace

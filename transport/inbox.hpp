@@ -132,6 +132,12 @@ class Inbox {
     room_.notify();
   }
 
+  /// Same as push() for a caller that already holds the mailroom lock (no wake-up: call
+  /// Mailroom::notify() after releasing it).
+  void push_locked(T message) { queue_.push_back(std::move(message)); }
+  /// Drops every queued message; requires the mailroom lock.
+  void clear_locked() { queue_.clear(); }
+
   /// Waits until `pred(queued messages)` holds, the run stops, or the timeout passes.
   WaitStatus wait_for(const std::function<bool(const std::deque<T>&)>& pred, Seconds timeout) {
     std::unique_lock<std::mutex> lock(room_.mutex());

@@ -69,6 +69,10 @@ struct Session::Impl {
   Inbox<ProtocolMessage> protocol_in{room};
   Inbox<wire::RoundStatus> status_in{room};
   Inbox<wire::FinalEstimate> final_in{room};
+  Inbox<wire::Control> rejoin_in{room};
+  Inbox<wire::Control> rollback_in{room};
+  std::uint32_t epoch = 0;                                        // guarded by room.mutex()
+  std::vector<std::pair<std::uint32_t, ProtocolMessage>> future;  // newer epochs, held
 
   // State below is guarded by room.mutex().
   std::map<Prefix, PeerIdentity> peers;  // participants of this run, by GUID prefix
@@ -79,6 +83,7 @@ struct Session::Impl {
   std::set<std::string> ready_from;  // describe() of peers that published READY
   bool finished_flag = false;
   bool loss_fatal = true;
+  bool tolerate_agent_loss = false;
 
   std::atomic<std::uint64_t> bytes{0}, messages{0}, retries{0};
 
@@ -184,7 +189,7 @@ struct Session::Impl {
       if (it != peers.end() && !lost.count(prefix)) {
         lost.insert(prefix);
         who = it->second;
-        fatal = loss_fatal;
+        fatal = loss_fatal && !(tolerate_agent_loss && !it->second.coordinator);
       }
       return 0;
     });
@@ -216,6 +221,21 @@ struct Session::Impl {
       return 0;
     });
     room.notify();
+  }
+
+  // A protocol message of `e`: delivered, held or dropped by epoch (see Session::set_epoch).
+  void deliver_protocol(std::uint32_t e, ProtocolMessage&& m) {
+    bool wake = false;
+    room.with_lock([&] {
+      if (e == epoch) {
+        protocol_in.push_locked(std::move(m));
+        wake = true;
+      } else if (e > epoch) {
+        future.emplace_back(e, std::move(m));
+      }
+      return 0;
+    });
+    if (wake) room.notify();
   }
 
   // ---- readiness -------------------------------------------------------------------------
@@ -381,6 +401,7 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   options.validate();
   Impl& s = *impl_;
   s.opt = options;
+  s.tolerate_agent_loss = options.tolerate_agent_loss;
   s.domain = options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
   s.me = PeerIdentity{options.run_id, options.coordinator,
                       options.coordinator ? 0u : options.agent_id};
@@ -435,12 +456,12 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
       s.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(
           kBlockTopic, false, Expect::kOtherAgents, [&s, me](wire::PoseBlock&& m) {
             if (m.sender() != me && addressed_to(m.broadcast(), m.recipients(), me))
-              s.protocol_in.push(ProtocolMessage(from_wire(m)));
+              s.deliver_protocol(m.epoch(), ProtocolMessage(from_wire(m)));
           });
       s.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
           kStatusTopic, false, Expect::kOtherAgents, [&s, me](wire::RoundStatus&& m) {
             if (m.sender() != me && addressed_to(m.broadcast(), m.recipients(), me))
-              s.protocol_in.push(ProtocolMessage(from_wire(m)));
+              s.deliver_protocol(m.epoch(), ProtocolMessage(from_wire(m)));
           });
     }
     // Control: everyone reads everyone (READY barrier, ABORT, FINISHED).
@@ -462,6 +483,13 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
             case wire::CONTROL_ABORT:
               s.room.request_stop(
                   1, from.describe() + " aborted run '" + s.opt.run_id + "': " + m.reason(), true);
+              break;
+            case wire::CONTROL_REJOIN:
+              if (s.opt.coordinator) s.rejoin_in.push(std::move(m));
+              break;
+            case wire::CONTROL_ROLLBACK:
+              if (!s.opt.coordinator && m.sender() == kCoordinatorId)
+                s.rollback_in.push(std::move(m));
               break;
           }
         });
@@ -506,6 +534,36 @@ Inbox<wire::RoundStatus>& Session::status_watch() {
 Inbox<wire::FinalEstimate>& Session::finals() {
   return impl_->final_in;
 }
+Inbox<wire::Control>& Session::rejoins() {
+  return impl_->rejoin_in;
+}
+Inbox<wire::Control>& Session::rollbacks() {
+  return impl_->rollback_in;
+}
+
+std::uint32_t Session::epoch() const {
+  std::lock_guard<std::mutex> lock(impl_->room.mutex());
+  return impl_->epoch;
+}
+
+void Session::set_epoch(std::uint32_t e) {
+  Impl& s = *impl_;
+  s.room.with_lock([&] {
+    if (e < s.epoch) return 0;
+    s.epoch = e;
+    s.protocol_in.clear_locked();  // everything queued is of an older epoch
+    std::vector<std::pair<std::uint32_t, ProtocolMessage>> later;
+    for (auto& [k, m] : s.future) {
+      if (k == e)
+        s.protocol_in.push_locked(std::move(m));
+      else if (k > e)
+        later.emplace_back(k, std::move(m));
+    }
+    s.future = std::move(later);
+    return 0;
+  });
+  s.room.notify();
+}
 
 void Session::publish(const wire::AgentAnnouncement& m) {
   impl_->write(kAnnounceTopic, m);
@@ -522,11 +580,16 @@ void Session::publish(const wire::FinalEstimate& m) {
 
 void Session::send(const OutgoingMessage& m) {
   const std::string& run = impl_->opt.run_id;
+  const std::uint32_t e = epoch();
   if (const auto* block = std::get_if<PoseBlockMessage>(&m.message)) {
-    impl_->write(kBlockTopic, to_wire_block(*block, run, m.broadcast, m.recipients));
+    wire::PoseBlock w = to_wire_block(*block, run, m.broadcast, m.recipients);
+    w.epoch(e);
+    impl_->write(kBlockTopic, w);
   } else {
-    impl_->write(kStatusTopic, to_wire_status(std::get<RoundStatusMessage>(m.message), run,
-                                              m.broadcast, m.recipients));
+    wire::RoundStatus w =
+        to_wire_status(std::get<RoundStatusMessage>(m.message), run, m.broadcast, m.recipients);
+    w.epoch(e);
+    impl_->write(kStatusTopic, w);
   }
 }
 
@@ -536,6 +599,12 @@ void Session::send_control(wire::ControlKind kind, const std::string& reason) {
   c.sender(impl_->me.coordinator ? kCoordinatorId : impl_->me.agent_id);
   c.kind(kind);
   c.reason(reason);
+  impl_->write(kControlTopic, c);
+}
+
+void Session::send_control(wire::Control c) {
+  c.run_id(impl_->opt.run_id);
+  c.sender(impl_->me.coordinator ? kCoordinatorId : impl_->me.agent_id);
   impl_->write(kControlTopic, c);
 }
 
@@ -595,6 +664,23 @@ std::size_t Session::peers_ever_seen() const {
 
 void Session::set_peer_loss_fatal(bool fatal) {
   impl_->room.with_lock([&] { return impl_->loss_fatal = fatal; });
+}
+
+void Session::set_agent_loss_tolerated(bool tolerated) {
+  impl_->room.with_lock([&] { return impl_->tolerate_agent_loss = tolerated; });
+}
+
+std::vector<std::uint32_t> Session::lost_agents() const {
+  std::lock_guard<std::mutex> lock(impl_->room.mutex());
+  std::set<std::uint32_t> lost, live;
+  for (const auto& [p, who] : impl_->peers) {
+    if (who.coordinator) continue;
+    (impl_->lost.count(p) ? lost : live).insert(who.agent_id);
+  }
+  std::vector<std::uint32_t> out;
+  for (auto k : lost)
+    if (!live.count(k)) out.push_back(k);
+  return out;
 }
 
 void Session::flush(Seconds timeout) {

@@ -56,6 +56,15 @@ class Session {
   Inbox<ProtocolMessage>& protocol();
   Inbox<wire::RoundStatus>& status_watch();  ///< Coordinator: every round status (progress).
   Inbox<wire::FinalEstimate>& finals();      ///< Coordinator.
+  Inbox<wire::Control>& rejoins();           ///< Coordinator: REJOIN requests of restarted agents.
+  Inbox<wire::Control>& rollbacks();         ///< Agents: ROLLBACK orders of the coordinator.
+
+  // ---- rollback epochs: protocol messages carry the sender's epoch; those of an older
+  // epoch are dropped, those of a newer one are held until this process reaches it.
+  std::uint32_t epoch() const;
+  /// Moves to `epoch` (>= the current one): drops queued protocol messages of older epochs
+  /// and releases the held ones of this epoch into protocol().
+  void set_epoch(std::uint32_t epoch);
 
   // ---- sending (retries while the history is full; throws TransportError after write_timeout_s)
   void publish(const wire::AgentAnnouncement& m);
@@ -66,6 +75,9 @@ class Session {
   void send(const OutgoingMessage& m);
   /// READY / ABORT / FINISHED from this process.
   void send_control(wire::ControlKind kind, const std::string& reason = "");
+  /// A control message with its REJOIN / ROLLBACK fields set by the caller (run id and
+  /// sender are filled in here).
+  void send_control(wire::Control message);
 
   // ---- run coordination ----------------------------------------------------------------
   /// Whether every volatile endpoint of this process has matched every peer of a complete
@@ -87,6 +99,10 @@ class Session {
   std::size_t peers_ever_seen() const;
   /// When false, a lost peer is only logged (set it once the run's work is complete).
   void set_peer_loss_fatal(bool fatal);
+  /// See SessionOptions::tolerate_agent_loss.
+  void set_agent_loss_tolerated(bool tolerated);
+  /// Agents that were discovered and lost, with no live process of the same id since.
+  std::vector<std::uint32_t> lost_agents() const;
   /// Waits until every reliable sample written so far is acknowledged (bounded).
   void flush(Seconds timeout);
   /// Before leaving on an error: waits (bounded) until the control topic has matched every

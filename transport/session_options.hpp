@@ -27,6 +27,10 @@ struct SessionOptions {
   /// Whether the run has a coordinator (agents wait for it in the readiness barrier). Off
   /// only for agent-to-agent tools such as tessera-dds-ping.
   bool expect_coordinator = true;
+  /// When true, losing an *agent* peer does not stop the session: it is recorded
+  /// (lost_agents()) so the coordinator can wait for the agent to rejoin. Losing the
+  /// coordinator always stops. Can be changed later with set_agent_loss_tolerated().
+  bool tolerate_agent_loss = false;
 
   /// Throws InputError naming the bad field (as its command-line option).
   void validate() const;

@@ -1,0 +1,111 @@
+#include "coordinator/run_monitor.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace tessera::coordinator {
+
+namespace {
+double secs(RunMonitor::Clock::duration d) {
+  return std::chrono::duration<double>(d).count();
+}
+std::string list(const std::vector<std::uint32_t>& v) {
+  std::string s;
+  for (auto k : v) s += (s.empty() ? "" : ",") + std::to_string(k);
+  return s;
+}
+}  // namespace
+
+RunMonitor::RunMonitor(std::uint32_t num_agents, MonitorOptions options, std::ostream& out,
+                       Clock::time_point start)
+    : n_(num_agents),
+      opt_(options),
+      out_(out),
+      start_(start),
+      last_print_(start),
+      round_(num_agents, -1),
+      last_seen_(num_agents, start),
+      lost_(num_agents, false) {}
+
+void RunMonitor::on_status(std::uint32_t agent, std::uint32_t round, Clock::time_point now) {
+  if (agent >= n_) return;
+  // After a rollback rounds go back: the newest report is the agent's round.
+  round_[agent] = round;
+  last_seen_[agent] = now;
+}
+
+void RunMonitor::set_lost(const std::vector<std::uint32_t>& lost, Clock::time_point now) {
+  std::vector<bool> now_lost(n_, false);
+  for (auto k : lost)
+    if (k < n_) now_lost[k] = true;
+  for (std::uint32_t k = 0; k < n_; ++k) {
+    if (now_lost[k] == lost_[k]) continue;
+    lost_[k] = now_lost[k];
+    if (!now_lost[k]) last_seen_[k] = now;  // back: lag counts from now
+    event(now_lost[k] ? "agent " + std::to_string(k) + " lost"
+                      : "agent " + std::to_string(k) + " is back",
+          now);
+  }
+}
+
+void RunMonitor::event(const std::string& what, Clock::time_point now) {
+  char buf[48];
+  std::snprintf(buf, sizeof(buf), "status %.1fs: ", secs(now - start_));
+  out_ << buf << what << "\n";
+  print(now);
+}
+
+std::vector<std::uint32_t> RunMonitor::lagging(Clock::time_point now) const {
+  std::int64_t lead = -1;
+  Clock::time_point newest = start_;
+  for (std::uint32_t k = 0; k < n_; ++k)
+    if (!lost_[k]) {
+      lead = std::max(lead, round_[k]);
+      newest = std::max(newest, last_seen_[k]);
+    }
+  std::vector<std::uint32_t> out;
+  if (lead < 0) return out;  // nothing reported yet: set-up, not lag
+  for (std::uint32_t k = 0; k < n_; ++k) {
+    if (lost_[k]) continue;
+    const bool behind = lead - round_[k] >= static_cast<std::int64_t>(opt_.lag_rounds);
+    const bool silent = secs(newest - last_seen_[k]) >= opt_.lag_s ||
+                        (secs(now - last_seen_[k]) >= opt_.lag_s && newest > last_seen_[k]);
+    if (behind || silent) out.push_back(k);
+  }
+  return out;
+}
+
+std::string RunMonitor::line(Clock::time_point now) const {
+  std::vector<std::uint32_t> lost;
+  std::uint32_t alive = 0;
+  for (std::uint32_t k = 0; k < n_; ++k) lost_[k] ? lost.push_back(k) : void(++alive);
+  char head[64];
+  std::snprintf(head, sizeof(head), "status %.1fs: %u/%u agents alive; rounds", secs(now - start_),
+                alive, n_);
+  std::string s = head;
+  for (std::uint32_t k = 0; k < n_; ++k)
+    s += " " + std::to_string(k) + ":" + (round_[k] < 0 ? "-" : std::to_string(round_[k]));
+  const auto lag = lagging(now);
+  if (!lag.empty()) s += "; lagging: " + list(lag);
+  if (!lost.empty()) s += "; lost: " + list(lost);
+  return s;
+}
+
+void RunMonitor::print(Clock::time_point now) {
+  out_ << line(now) << "\n" << std::flush;
+  last_print_ = now;
+  last_lagging_ = lagging(now);
+}
+
+void RunMonitor::tick(Clock::time_point now) {
+  if (lagging(now) != last_lagging_ ||
+      (opt_.interval_s > 0 && secs(now - last_print_) >= opt_.interval_s))
+    print(now);
+}
+
+double RunMonitor::seconds_to_next(Clock::time_point now) const {
+  if (opt_.interval_s <= 0) return 1.0;  // still re-check lag once a second
+  return std::max(0.0, std::min(1.0, opt_.interval_s - secs(now - last_print_)));
+}
+
+}  // namespace tessera::coordinator

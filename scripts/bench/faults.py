@@ -1,0 +1,255 @@
+#!/usr/bin/env python3
+"""Fault benchmark of the DDS runtime (issue 8) and assembler of docs/benchmarks/faults.md.
+
+COLUMN CONTRACT (every docs/benchmarks/faults_<name>.csv, one row per fault kind):
+    fault,trials,finished,cost_error,extra_time_s
+  fault         short description of the fault injected
+  trials        number of runs with that fault
+  finished      runs that completed (exit 0 of every process, summary written)
+  cost_error    worst relative cost error of the finished runs against the undisturbed run
+                (|cost - cost_undisturbed| / cost_undisturbed), or against f* where stated
+  extra_time_s  mean extra wall time of a faulty run over the undisturbed run, in seconds
+The `loss` and `net` helpers write faults_loss.csv and faults_lossy_link.csv with the same
+columns; `--assemble-only` rebuilds faults.md from whatever faults_*.csv exist.
+
+This script's own experiment (`restart`): a generated 3D grid, N = 5 agents with
+--checkpoint-dir, the coordinator with --rejoin-timeout. Each trial SIGKILLs a random agent
+when the coordinator reports a random round, starts it again with the same options after a
+random delay (0-1 s), and checks that the run finishes at the undisturbed run's cost.
+Per-trial details go to docs/benchmarks/faults/restart_trials.csv, the checkpoint write cost
+(undisturbed runs without / with checkpoints) to docs/benchmarks/faults/checkpoint_cost.csv.
+"""
+import argparse
+import csv
+import glob
+import json
+import os
+import random
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+OUT_DIR = os.path.join(ROOT, "docs", "benchmarks")
+COLUMNS = ["fault", "trials", "finished", "cost_error", "extra_time_s"]
+
+
+class Run:
+    """A coordinator and N agents started together; optional kill + restart of one agent."""
+
+    def __init__(self, args, work, name, checkpoints=True, rejoin_timeout=30):
+        self.args, self.work, self.name = args, work, name
+        self.dir = os.path.join(work, name)
+        os.makedirs(self.dir, exist_ok=True)
+        self.ckpt = os.path.join(self.dir, "ckpt")
+        os.makedirs(self.ckpt, exist_ok=True)
+        self.run_id = "faults-%d-%s" % (os.getpid(), name)
+        self.checkpoints = checkpoints
+        self.rejoin_timeout = rejoin_timeout
+        self.procs = []
+
+    def agent_cmd(self, k):
+        cmd = [os.path.join(self.args.bin_dir, "tessera-agent"), "--graph", self.args.graph_path,
+               "--robots", str(self.args.agents), "--id", str(k), "--run-id", self.run_id,
+               "--domain", str(self.args.domain), "--timeout", "60"]
+        if self.checkpoints:
+            cmd += ["--checkpoint-dir", self.ckpt, "--checkpoint-every", str(self.args.every)]
+        return cmd
+
+    def spawn(self, cmd, log):
+        f = open(os.path.join(self.dir, log), "w")
+        return subprocess.Popen(cmd, stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
+
+    def start(self):
+        self.t0 = time.time()
+        self.summary = os.path.join(self.dir, "summary.json")
+        ccmd = [os.path.join(self.args.bin_dir, "tessera-coordinator"), "--agents", str(self.args.agents),
+                "--run-id", self.run_id, "--domain", str(self.args.domain), "--timeout", "60",
+                "--run-timeout", str(self.args.limit), "--summary", self.summary, "--progress",
+                "--partition", "highest", "--grad-tol", str(self.args.grad_tol),
+                "--rejoin-timeout", str(self.rejoin_timeout), "--status-interval", "2"]
+        self.coord = self.spawn(ccmd, "coordinator.log")
+        self.agents = {k: self.spawn(self.agent_cmd(k), "agent%d.log" % k) for k in range(self.args.agents)}
+        self.procs = [self.coord] + list(self.agents.values())
+
+    def coordinator_output(self):
+        with open(os.path.join(self.dir, "coordinator.log")) as f:
+            return f.read()
+
+    def kill_and_restart(self, agent, at_round, delay):
+        deadline = time.time() + self.args.limit
+        pattern = "round %d:" % at_round
+        while pattern not in self.coordinator_output():
+            if time.time() > deadline or self.coord.poll() is not None:
+                return False
+            time.sleep(0.005)
+        os.kill(self.agents[agent].pid, signal.SIGKILL)
+        self.agents[agent].wait()
+        time.sleep(delay)
+        p = self.spawn(self.agent_cmd(agent), "agent%d-restarted.log" % agent)
+        self.procs.append(p)
+        return True
+
+    def wait(self):
+        deadline = time.time() + self.args.limit
+        codes = []
+        for p in self.procs:
+            try:
+                codes.append(p.wait(timeout=max(1, deadline - time.time())))
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                codes.append(-9)
+        wall = time.time() - self.t0
+        summary = None
+        if os.path.exists(self.summary):
+            with open(self.summary) as f:
+                summary = json.load(f)
+        return codes, wall, summary
+
+    def checkpoint_cost(self):
+        """Sum over agents of (writes, ms) from the agents' 'checkpoints:' lines."""
+        writes, ms, size = 0, 0.0, 0
+        for log in glob.glob(os.path.join(self.dir, "agent*.log")):
+            with open(log) as f:
+                m = re.search(r"checkpoints: (\d+) written, ([0-9.]+) ms in total .* (\d+) bytes each", f.read())
+            if m:
+                writes += int(m.group(1))
+                ms += float(m.group(2))
+                size = max(size, int(m.group(3)))
+        return writes, ms, size
+
+
+def write_contract_csv(path, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(COLUMNS)
+        for r in rows:
+            w.writerow([r[c] for c in COLUMNS])
+
+
+def assemble(out_dir):
+    rows, sources = [], []
+    for path in sorted(glob.glob(os.path.join(out_dir, "faults_*.csv"))):
+        with open(path) as f:
+            reader = csv.DictReader(f)
+            if reader.fieldnames != COLUMNS:
+                print("skipping %s: columns %s are not the contract %s" % (path, reader.fieldnames, COLUMNS))
+                continue
+            for r in reader:
+                rows.append(r)
+        sources.append(os.path.basename(path))
+    lines = ["# Fault table (issue 8)", "",
+             "Assembled by `scripts/bench/faults.py` from " + ", ".join("`%s`" % s for s in sources) +
+             " (columns: %s; see the script's header for their meaning)." % ", ".join(COLUMNS), "",
+             "| fault | trials | finished | cost error | extra time (s) |", "|---|---|---|---|---|"]
+    for r in rows:
+        lines.append("| %s | %s | %s | %s | %s |" % tuple(r[c] for c in COLUMNS))
+    extra = os.path.join(out_dir, "faults", "README.md")
+    if os.path.exists(extra):
+        with open(extra) as f:
+            lines += ["", f.read().strip()]
+    with open(os.path.join(out_dir, "faults.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    print("wrote %s (%d rows)" % (os.path.join(out_dir, "faults.md"), len(rows)))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--out-dir", default=OUT_DIR)
+    ap.add_argument("--trials", type=int, default=10)
+    ap.add_argument("--agents", type=int, default=5)
+    ap.add_argument("--poses", type=int, default=500)
+    ap.add_argument("--grad-tol", type=float, default=0.002)
+    ap.add_argument("--every", type=int, default=1, help="--checkpoint-every of the agents")
+    ap.add_argument("--domain", type=int, default=212)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--limit", type=float, default=300, help="time limit of one run, seconds")
+    ap.add_argument("--assemble-only", action="store_true")
+    args = ap.parse_args()
+    if args.assemble_only:
+        assemble(args.out_dir)
+        return 0
+    rng = random.Random(args.seed)
+    work = tempfile.mkdtemp(prefix="tessera_faults_")
+    args.graph_path = os.path.join(work, "graph.g2o")
+    subprocess.run([os.path.join(args.bin_dir, "tessera"), "generate", "--kind", "grid3d", "--poses",
+                    str(args.poses), "--robots", str(args.agents), "--seed", "3", "--out", args.graph_path],
+                   check=True, stdout=subprocess.DEVNULL)
+
+    # Undisturbed runs: without checkpoints, and with them (the reference of the trials).
+    base = {}
+    for name, ck in (("plain", False), ("checkpointed", True)):
+        r = Run(args, work, "undisturbed-" + name, checkpoints=ck)
+        r.start()
+        codes, wall, summary = r.wait()
+        if any(codes) or not summary:
+            print("undisturbed run (%s) failed: exit codes %s; logs in %s" % (name, codes, r.dir))
+            return 1
+        base[name] = (wall, summary, r.checkpoint_cost())
+        print("undisturbed %-12s: %d rounds, cost %.12g, wall %.2f s" %
+              (name, summary["rounds"], summary["cost"], wall))
+    ref_wall, ref, _ = base["checkpointed"]
+    rounds = int(ref["rounds"])
+    if rounds < 8:
+        print("the run is too short (%d rounds) to kill it in the middle" % rounds)
+        return 1
+
+    trials = []
+    for t in range(args.trials):
+        agent = rng.randrange(args.agents)
+        at = rng.randrange(2, max(3, rounds - 3))
+        delay = rng.uniform(0.0, 1.0)
+        r = Run(args, work, "trial%d" % t)
+        r.start()
+        killed = r.kill_and_restart(agent, at, delay)
+        codes, wall, summary = r.wait()
+        ok = killed and not any(codes) and summary is not None
+        err = abs(summary["cost"] - ref["cost"]) / ref["cost"] if ok else float("nan")
+        trials.append(dict(trial=t, agent=agent, kill_round=at, restart_delay_s=round(delay, 3),
+                           finished=int(ok), rounds=summary["rounds"] if summary else "",
+                           rollbacks=summary.get("rollbacks", "") if summary else "",
+                           cost=summary["cost"] if summary else "", rel_cost_error=err,
+                           wall_s=round(wall, 3), extra_s=round(wall - ref_wall, 3)))
+        print("trial %d: kill agent %d at round %d, restart after %.2f s -> %s, cost error %.2e, "
+              "wall %.2f s (+%.2f)" % (t, agent, at, delay, "finished" if ok else "FAILED %s" % codes,
+                                       err, wall, wall - ref_wall))
+        if not ok:
+            print("  logs kept in %s" % r.dir)
+    finished = [x for x in trials if x["finished"]]
+    row = dict(fault="agent SIGKILLed at a random round, restarted with the same id (N=%d, %d-pose grid3d)"
+               % (args.agents, args.poses),
+               trials=len(trials), finished=len(finished),
+               cost_error="%.1e" % max([x["rel_cost_error"] for x in finished], default=float("nan")),
+               extra_time_s="%.2f" % (sum(x["extra_s"] for x in finished) / max(1, len(finished))))
+    os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
+    write_contract_csv(os.path.join(args.out_dir, "faults_restart.csv"), [row])
+    with open(os.path.join(args.out_dir, "faults", "restart_trials.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(trials[0].keys()))
+        w.writeheader()
+        w.writerows(trials)
+    with open(os.path.join(args.out_dir, "faults", "checkpoint_cost.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["run", "wall_s", "rounds", "checkpoint_writes", "checkpoint_ms_total", "checkpoint_bytes"])
+        for name, (wall, s, (writes, ms, size)) in base.items():
+            w.writerow([name, "%.3f" % wall, s["rounds"], writes, "%.1f" % ms, size])
+    print("\nfault | trials | finished | cost_error | extra_time_s")
+    print("%s | %d | %d | %s | %s" % (row["fault"], row["trials"], row["finished"], row["cost_error"],
+                                     row["extra_time_s"]))
+    w_plain, w_ck = base["plain"][0], base["checkpointed"][0]
+    writes, ms, size = base["checkpointed"][2]
+    print("checkpoints (every %d rounds): %d writes by %d agents, %.1f ms in total (%.2f ms each, %d bytes); "
+          "undisturbed wall %.2f s without, %.2f s with" %
+          (args.every, writes, args.agents, ms, ms / max(1, writes), size, w_plain, w_ck))
+    assemble(args.out_dir)
+    shutil.rmtree(work, ignore_errors=True) if len(finished) == len(trials) else print("work dir kept: " + work)
+    return 0 if len(finished) == len(trials) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

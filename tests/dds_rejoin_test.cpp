@@ -1,0 +1,216 @@
+// Faults over DDS: an agent process SIGKILLed during the rounds and started again with the
+// same options rejoins from its checkpoint; every agent rolls back to a common round and the
+// run finishes with the in-process engine's result (same rounds, cost to 1e-9). Without a
+// restart the coordinator gives up after --rejoin-timeout with a message naming the agent.
+// A damaged checkpoint is refused with an error naming the file.
+// Domains used here: 181-183 (each test its own, so ctest -j is safe).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "dds_process_support.hpp"
+#include "distributed/distributed_solver.hpp"
+#include "io/g2o_reader.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+double json_field(const std::string& json, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
+  return std::stod(m[1]);
+}
+
+std::vector<int> owned_of(const std::string& path) {
+  std::ifstream f(path);
+  std::vector<int> out;
+  for (std::string line; std::getline(f, line);)
+    if (line.rfind("OWNED ", 0) == 0) out.push_back(std::stoi(line.substr(6)));
+  return out;
+}
+
+std::string generate(const std::string& dir, int poses, int robots) {
+  const std::string path = dir + "/graph.g2o";
+  std::string out;
+  EXPECT_EQ(
+      run_command(bin("tessera") + " generate --kind grid3d --poses " + std::to_string(poses) +
+                      " --robots " + std::to_string(robots) + " --seed 3 --out " + path,
+                  &out),
+      0)
+      << out;
+  return path;
+}
+
+// Waits until `p`'s log contains `text` (bounded); true when it does.
+bool wait_for_output(const Process& p, const std::string& text, double timeout_s) {
+  const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
+  while (Clock::now() < until) {
+    if (p.output().find(text) != std::string::npos) return true;
+    usleep(20000);
+  }
+  return false;
+}
+
+struct Fixture {
+  std::string dir, graph, run;
+  int agents, domain;
+  std::vector<std::string> agent_args(int k, const std::string& ckpt) const {
+    return {bin("tessera-agent"),
+            "--graph",
+            graph,
+            "--robots",
+            std::to_string(agents),
+            "--id",
+            std::to_string(k),
+            "--run-id",
+            run,
+            "--domain",
+            std::to_string(domain),
+            "--timeout",
+            "20",
+            "--checkpoint-dir",
+            ckpt,
+            "--dump-local",
+            dir + "/local" + std::to_string(k) + ".txt"};
+  }
+  Process coordinator(double rejoin_timeout) const {
+    return start({bin("tessera-coordinator"),
+                  "--agents",
+                  std::to_string(agents),
+                  "--run-id",
+                  run,
+                  "--domain",
+                  std::to_string(domain),
+                  "--timeout",
+                  "20",
+                  "--run-timeout",
+                  "50",
+                  "--summary",
+                  dir + "/summary.json",
+                  "--progress",
+                  "--partition",
+                  "eco",
+                  "--grad-tol",
+                  "0.002",
+                  "--rejoin-timeout",
+                  std::to_string(rejoin_timeout),
+                  "--status-interval",
+                  "1"},
+                 dir + "/coordinator.log");
+  }
+};
+
+TEST(DdsRejoin, KilledAgentRestartedWithSameIdFinishesAtTheUndisturbedCost) {
+  Fixture f;
+  f.dir = temp_dir();
+  f.agents = 5;
+  f.domain = 181;
+  f.run = "rejoin-" + std::to_string(getpid());
+  f.graph = generate(f.dir, 300, f.agents);
+  const std::string ckpt = f.dir + "/ckpt";
+  ASSERT_EQ(mkdir(ckpt.c_str(), 0755), 0);
+
+  Process coord = f.coordinator(20);
+  std::vector<Process> agents;
+  for (int k = 0; k < f.agents; ++k)
+    agents.push_back(start(f.agent_args(k, ckpt), f.dir + "/agent" + std::to_string(k) + ".log"));
+  // Kill agent 2 in the middle of the rounds.
+  const bool started = wait_for_output(coord, "round 4:", 30);
+  kill(agents[2].pid, SIGKILL);
+  ASSERT_TRUE(started) << coord.output();
+  ASSERT_TRUE(wait_all({&agents[2]}, 5));
+  EXPECT_EQ(agents[2].exit_code, 128 + SIGKILL);
+  Process again = start(f.agent_args(2, ckpt), f.dir + "/agent2-restarted.log");
+
+  std::vector<Process*> all = {&coord, &again};
+  for (int k = 0; k < f.agents; ++k)
+    if (k != 2) all.push_back(&agents[static_cast<std::size_t>(k)]);
+  EXPECT_TRUE(wait_all(all, 50)) << "a process hung";
+  for (Process* p : all) EXPECT_EQ(p->exit_code, 0) << p->log << ":\n" << p->output();
+  EXPECT_NE(again.output().find("rejoining run"), std::string::npos) << again.output();
+  const std::string co = coord.output();
+  EXPECT_NE(co.find("agent 2 lost"), std::string::npos) << co;
+  EXPECT_NE(co.find("agent 2 rejoined: every agent rolls back to round"), std::string::npos) << co;
+  EXPECT_NE(co.find("lost: 2"), std::string::npos) << "status line names the lost agent\n" << co;
+
+  // The undisturbed run, in process, with the same assignment and initial poses.
+  const std::string summary = slurp(f.dir + "/summary.json");
+  EXPECT_EQ(json_field(summary, "rollbacks"), 1) << summary;
+  const PoseGraph g = read_g2o(f.graph);
+  std::map<int, int> owner;
+  for (int k = 0; k < f.agents; ++k)
+    for (int id : owned_of(f.dir + "/local" + std::to_string(k) + ".txt")) owner[id] = k;
+  ASSERT_EQ(owner.size(), g.num_poses);
+  std::vector<int> assignment;
+  for (auto& [id, k] : owner) assignment.push_back(k);
+  DistributedOptions opt;
+  opt.grad_norm_tol = 0.002;
+  const DistributedResult ref = solve_distributed(g, assignment, opt, g.initial);
+  EXPECT_EQ(json_field(summary, "rounds"), ref.rounds) << summary;
+  EXPECT_NEAR(json_field(summary, "cost"), ref.cost, 1e-9 * ref.cost) << summary;
+  // Completed runs leave no checkpoint behind.
+  EXPECT_FALSE(std::ifstream(ckpt + "/agent-2.ckpt").good());
+}
+
+TEST(DdsRejoin, AgentThatDoesNotComeBackStopsTheRunAfterTheRejoinTimeout) {
+  Fixture f;
+  f.dir = temp_dir();
+  f.agents = 3;
+  f.domain = 182;
+  f.run = "norejoin-" + std::to_string(getpid());
+  f.graph = generate(f.dir, 300, f.agents);
+  const std::string ckpt = f.dir + "/ckpt";
+  ASSERT_EQ(mkdir(ckpt.c_str(), 0755), 0);
+  Process coord = f.coordinator(2);
+  std::vector<Process> agents;
+  for (int k = 0; k < f.agents; ++k)
+    agents.push_back(start(f.agent_args(k, ckpt), f.dir + "/agent" + std::to_string(k) + ".log"));
+  const bool started = wait_for_output(coord, "round 2:", 30);
+  kill(agents[1].pid, SIGKILL);
+  ASSERT_TRUE(started) << coord.output();
+  const auto killed = Clock::now();
+  std::vector<Process*> all = {&coord, &agents[0], &agents[1], &agents[2]};
+  EXPECT_TRUE(wait_all(all, 30)) << "a process hung";
+  const double took = std::chrono::duration<double>(Clock::now() - killed).count();
+  EXPECT_EQ(coord.exit_code, 1) << coord.output();
+  EXPECT_NE(coord.output().find("lost agent 1 of run"), std::string::npos) << coord.output();
+  EXPECT_NE(coord.output().find("did not rejoin within 2 s"), std::string::npos) << coord.output();
+  EXPECT_EQ(agents[0].exit_code, 1) << agents[0].output();
+  EXPECT_EQ(agents[2].exit_code, 1) << agents[2].output();
+  EXPECT_NE(agents[0].output().find("did not rejoin"), std::string::npos) << agents[0].output();
+  EXPECT_GT(took, 2.0) << "the coordinator waited for the agent";
+  EXPECT_LT(took, 15.0);
+}
+
+TEST(DdsRejoin, DamagedCheckpointIsRefusedNamingTheFile) {
+  const std::string dir = temp_dir();
+  const std::string graph = generate(dir, 60, 2);
+  const std::string ckpt = dir + "/agent-0.ckpt";
+  std::ofstream(ckpt) << "TSRCKPT\0 this is not a checkpoint";
+  Process p =
+      start({bin("tessera-agent"), "--graph", graph, "--robots", "2", "--id", "0", "--run-id",
+             "damaged", "--domain", "183", "--timeout", "5", "--checkpoint-dir", dir},
+            dir + "/agent.log");
+  ASSERT_TRUE(wait_all({&p}, 20));
+  EXPECT_EQ(p.exit_code, 2) << p.output();
+  EXPECT_NE(p.output().find(ckpt), std::string::npos) << p.output();
+  EXPECT_NE(p.output().find("not usable"), std::string::npos) << p.output();
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
