@@ -4,11 +4,13 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "io/g2o_reader.hpp"
 #include "io/metis_reader.hpp"
+#include "json_writer.hpp"
 #include "partition/graph_structure.hpp"
 #include "partition/partitioner.hpp"
 #include "util/input_error.hpp"
@@ -40,30 +42,6 @@ const char* const kHelp =
     "\n"
     "exit status: 0 on success, 2 on bad input (the message says what is wrong).\n";
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
-std::string json_number(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
-
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() &&
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -92,50 +70,35 @@ GraphStructure load_structure(const std::string& path, const std::string& format
 std::string result_json(const GraphStructure& g, const PartitionOptions& o,
                         const PartitionResult& r) {
   const auto& m = r.metrics;
-  auto count = [](std::size_t v) { return std::to_string(v); };
-  std::string sizes;
-  for (std::size_t b = 0; b < m.block_sizes.size(); ++b)
-    sizes += (b ? ", " : "") + count(m.block_sizes[b]);
-  std::string j = "{\n";
-  j += "  \"graph\": " + json_string(g.source) + ",\n";
-  j += "  \"n\": " + count(g.num_vertices) + ",\n";
-  j += "  \"edges\": " + count(g.total_edge_weight()) + ",\n";
-  j += "  \"pairs\": " + count(g.num_pairs()) + ",\n";
-  j += "  \"parts\": " + std::to_string(o.parts) + ",\n";
-  j += "  \"preset\": " + json_string(preset_name(o.preset)) + ",\n";
-  j += "  \"eps\": " + json_number(o.eps) + ",\n";
-  j += "  \"seed\": " + std::to_string(o.seed) + ",\n";
-  j += "  \"cut_edges\": " + count(m.cut_edges) + ",\n";
-  j += "  \"cut_pairs\": " + count(m.cut_pairs) + ",\n";
-  j += "  \"block_sizes\": [" + sizes + "],\n";
-  j += "  \"max_block\": " + count(m.max_block) + ",\n";
-  j += "  \"max_block_bound\": " + count(r.max_block_size) + ",\n";
-  j += "  \"max_block_ratio\": " + json_number(m.max_block_ratio) + ",\n";
-  j += "  \"imbalance\": " + json_number(m.imbalance) + ",\n";
-  j += "  \"cvolume\": " + json_number(m.cvolume) + ",\n";
-  j += "  \"boundary_vertices\": " + count(m.boundary_vertices) + ",\n";
-  j += "  \"time_ms\": " + json_number(r.time_ms) + ",\n";
-  j += "  \"cpu_ms\": " + json_number(r.cpu_ms) + ",\n";
-  j += "  \"trace\": [";
-  for (std::size_t k = 0; k < r.trace.size(); ++k) {
-    const auto& p = r.trace[k];
-    j += std::string(k ? "," : "") + "\n    {\"phase\": " + json_string(p.name) +
-         ", \"detail\": " + json_string(p.detail) + ", \"cut\": " + std::to_string(p.cut) +
-         ", \"ms\": " + json_number(p.ms) + "}";
-  }
-  j += r.trace.empty() ? "]\n" : "\n  ]\n";
-  return j + "}\n";
-}
-
-void write_text(const std::string& path, const std::string& text, const char* what) {
-  if (path == "-") {
-    std::fputs(text.c_str(), stdout);
-    return;
-  }
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw InputError(path, 0, std::string("cannot write the ") + what);
-  out << text;
-  if (!out) throw InputError(path, 0, std::string("error while writing the ") + what);
+  std::vector<JsonObject> trace;
+  for (const auto& p : r.trace)
+    trace.push_back(JsonObject()
+                        .add("phase", p.name)
+                        .add("detail", p.detail)
+                        .add("cut", static_cast<long long>(p.cut))
+                        .add("ms", p.ms));
+  return JsonObject()
+      .add("graph", g.source)
+      .add("n", g.num_vertices)
+      .add("edges", g.total_edge_weight())
+      .add("pairs", g.num_pairs())
+      .add("parts", o.parts)
+      .add("preset", preset_name(o.preset))
+      .add("eps", o.eps)
+      .add("seed", static_cast<long long>(o.seed))  // parsed from a non-negative long
+      .add("cut_edges", m.cut_edges)
+      .add("cut_pairs", m.cut_pairs)
+      .add("block_sizes", m.block_sizes)
+      .add("max_block", m.max_block)
+      .add("max_block_bound", r.max_block_size)
+      .add("max_block_ratio", m.max_block_ratio)
+      .add("imbalance", m.imbalance)
+      .add("cvolume", m.cvolume)
+      .add("boundary_vertices", m.boundary_vertices)
+      .add("time_ms", r.time_ms)
+      .add("cpu_ms", r.cpu_ms)
+      .add("trace", trace)
+      .str();
 }
 
 }  // namespace
@@ -172,10 +135,10 @@ int run_partition(const Args& args) {
     std::string text;
     text.reserve(r.assignment.size() * 3);
     for (int b : r.assignment) text += std::to_string(b) + "\n";
-    write_text(*out, text, "partition");
+    write_output(*out, text);
   }
   const bool json_stdout = a.get("json") && *a.get("json") == "-";
-  if (auto json = a.get("json")) write_text(*json, result_json(g, options, r), "JSON report");
+  if (auto json = a.get("json")) write_output(*json, result_json(g, options, r));
   if (json_stdout) return 0;  // keep stdout valid JSON
 
   std::printf("graph:        %s (%zu poses, %zu measurements, %zu distinct pairs)\n",

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 
@@ -13,11 +14,21 @@ std::string json_quote(const std::string& s) {
   std::string out = "\"";
   for (unsigned char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
       default:
         if (c < 0x20) {
           char buf[8];
@@ -33,8 +44,12 @@ std::string json_quote(const std::string& s) {
 
 std::string json_number(double x) {
   if (!std::isfinite(x)) return "null";
+  // The shortest of 15..17 significant digits that reads back as the same double.
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
   return buf;
 }
 
@@ -72,6 +87,23 @@ JsonObject& JsonObject::add(const std::string& key, const std::vector<std::size_
   fields_.emplace_back(key, s + "]");
   return *this;
 }
+JsonObject& JsonObject::add(const std::string& key, const std::vector<std::string>& values) {
+  std::string s = "[";
+  for (std::size_t k = 0; k < values.size(); ++k) s += (k ? ", " : "") + json_quote(values[k]);
+  fields_.emplace_back(key, s + "]");
+  return *this;
+}
+JsonObject& JsonObject::add(const std::string& key, const std::vector<JsonObject>& objects) {
+  if (objects.empty()) {
+    fields_.emplace_back(key, "[]");
+    return *this;
+  }
+  std::string s = "[";
+  for (std::size_t k = 0; k < objects.size(); ++k)
+    s += std::string(k ? "," : "") + "\n    " + objects[k].compact();
+  fields_.emplace_back(key, s + "\n  ]");
+  return *this;
+}
 JsonObject& JsonObject::add(const std::string& key, const JsonObject& nested) {
   std::string text = nested.str(1);
   text.pop_back();  // nested objects end without the newline
@@ -92,6 +124,13 @@ std::string JsonObject::str(int indent) const {
   }
   out += std::string(static_cast<std::size_t>(2 * indent), ' ') + "}\n";
   return out;
+}
+
+std::string JsonObject::compact() const {
+  std::string out = "{";
+  for (std::size_t k = 0; k < fields_.size(); ++k)
+    out += (k ? ", " : "") + json_quote(fields_[k].first) + ": " + fields_[k].second;
+  return out + "}";
 }
 
 void write_output(const std::string& path, const std::string& text) {

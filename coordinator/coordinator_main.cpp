@@ -23,6 +23,7 @@
 #include "graph/pose_graph.hpp"
 #include "io/g2o_writer.hpp"
 #include "io/tum_writer.hpp"
+#include "json_writer.hpp"
 #include "session_args.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
@@ -142,29 +143,6 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
     throw InputError("option --status-interval: must be 0..86400 seconds");
   a.verbose = args.has("verbose");
   return a;
-}
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
-std::string json_number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", x);
-  return buf;
 }
 
 class Coordinator {
@@ -483,51 +461,48 @@ class Coordinator {
                      const coordinator::PartitionStepResult& part,
                      const std::vector<std::uint64_t>& bytes, std::uint32_t rounds,
                      double total_ms) {
-    std::string j = "{\n";
     std::uint64_t total_bytes = 0;
     for (auto b : bytes) total_bytes += b;
-    j += "  \"algorithm\": " + json_string(a_.algorithm.empty() ? "irbcd" : a_.algorithm) + ",\n";
-    j += "  \"graph\": " + json_string(a_.graph_name) + ",\n";
-    j += "  \"poses\": " + std::to_string(rs.num_poses) + ",\n";
-    j += "  \"edges\": " + std::to_string(rs.num_measurements) + ",\n";
-    j += "  \"d\": " + std::to_string(rs.d) + ",\n";
-    j += "  \"rank\": " + std::to_string(a_.rank ? a_.rank : 5) + ",\n";
-    j += "  \"iterations\": " + std::to_string(rounds) + ",\n";
-    j +=
-        "  \"grad_norm\": " + (have_final_report_ ? json_number(final_grad_norm_) : "null") + ",\n";
-    j += "  \"cost\": " + (have_final_report_ ? json_number(final_cost_) : "null") + ",\n";
-    j += "  \"certified\": null,\n";
-    j += "  \"wall_s\": " + json_number(total_ms / 1000.0) + ",\n";
-    j += "  \"restarts\": " + std::to_string(final_restarts_) + ",\n";
-    j += "  \"bytes_exchanged\": " + std::to_string(total_bytes) + ",\n";
-    j += "  \"rollbacks\": " + std::to_string(rollbacks_) + ",\n";
-    j += "  \"run_id\": " + json_string(a_.net.session.run_id) + ",\n";
-    j += "  \"domain\": " + std::to_string(session_->domain()) + ",\n";
-    j += "  \"agents\": " + std::to_string(a_.agents) + ",\n";
-    j += "  \"dim\": " + std::to_string(rs.d) + ",\n";
-    j += "  \"num_poses\": " + std::to_string(rs.num_poses) + ",\n";
-    j += "  \"num_measurements\": " + std::to_string(rs.num_measurements) + ",\n";
-    j += "  \"partition\": " + json_string(a_.partition) + ",\n";
-    j += "  \"cut_edges\": " + std::to_string(part.cut_edges) + ",\n";
-    j += "  \"rounds\": " + std::to_string(rounds) + ",\n";
-    j += "  \"discovery_ms\": " + json_number(discovery_ms_) + ",\n";
-    j += "  \"partition_ms\": " + json_number(part.ms) + ",\n";
-    j += "  \"solve_ms\": " + json_number(solve_ms_) + ",\n";
+    const auto final_value = [&](double v) {
+      return have_final_report_ ? std::optional<double>(v) : std::nullopt;
+    };
     // Mean wall time of one round (status of round k to status of round k+1), or null.
     const double rounds_ms = last_status_ms_ - first_status_ms_;
-    j += "  \"rounds_ms\": " + json_number(rounds_ms) + ",\n";
-    j += "  \"ms_per_round\": " +
-         (completed_statuses_ > 1 ? json_number(rounds_ms / (completed_statuses_ - 1)) : "null") +
-         ",\n";
-    j += "  \"total_ms\": " + json_number(total_ms) + ",\n";
-    j += "  \"bytes_sent\": [";
-    for (std::size_t k = 0; k < bytes.size(); ++k) j += (k ? ", " : "") + std::to_string(bytes[k]);
-    j += "],\n  \"hosts\": [";
-    for (std::size_t k = 0; k < rs.hosts.size(); ++k)
-      j += (k ? ", " : "") + json_string(rs.hosts[k]);
-    j += "]\n}\n";
-    std::ofstream f(a_.summary, std::ios::binary);
-    if (!f || !(f << j)) throw InputError(a_.summary, 0, "cannot write the summary");
+    cli::JsonObject j;
+    j.add("algorithm", a_.algorithm.empty() ? "irbcd" : a_.algorithm)
+        .add("graph", a_.graph_name)
+        .add("poses", rs.num_poses)
+        .add("edges", rs.num_measurements)
+        .add("d", rs.d)
+        .add("rank", static_cast<long long>(a_.rank ? a_.rank : 5))
+        .add("iterations", static_cast<long long>(rounds))
+        .add("grad_norm", final_value(final_grad_norm_))
+        .add("cost", final_value(final_cost_))
+        .add_null("certified")
+        .add("wall_s", total_ms / 1000.0)
+        .add("restarts", static_cast<long long>(final_restarts_))
+        .add("bytes_exchanged", static_cast<long long>(total_bytes))
+        .add("rollbacks", static_cast<long long>(rollbacks_))
+        .add("run_id", a_.net.session.run_id)
+        .add("domain", static_cast<long long>(session_->domain()))
+        .add("agents", static_cast<long long>(a_.agents))
+        .add("dim", rs.d)
+        .add("num_poses", rs.num_poses)
+        .add("num_measurements", rs.num_measurements)
+        .add("partition", a_.partition)
+        .add("cut_edges", part.cut_edges)
+        .add("rounds", static_cast<long long>(rounds))
+        .add("discovery_ms", discovery_ms_)
+        .add("partition_ms", part.ms)
+        .add("solve_ms", solve_ms_)
+        .add("rounds_ms", rounds_ms)
+        .add("ms_per_round", completed_statuses_ > 1
+                                 ? std::optional<double>(rounds_ms / (completed_statuses_ - 1))
+                                 : std::nullopt)
+        .add("total_ms", total_ms)
+        .add("bytes_sent", std::vector<std::size_t>(bytes.begin(), bytes.end()))
+        .add("hosts", rs.hosts);
+    cli::write_output(a_.summary, j.str());
   }
 
   CoordinatorArgs a_;
