@@ -59,18 +59,43 @@ DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<in
   options.validate();
   if (options.rank < graph.d)
     throw InputError("DistributedOptions.rank must be >= d = " + std::to_string(graph.d));
-  const BlockLayout layout = make_block_layout(graph.num_poses, graph.measurements, assignment);
-  const int N = layout.num_blocks;
-  DistributedResult res;
-  res.agents = N;
-
+  // Checks the assignment before the (possibly costly) initial guess.
+  const int N = make_block_layout(graph.num_poses, graph.measurements, assignment).num_blocks;
   std::vector<Pose> init = initial;
   if (init.empty())
     init = initial_poses(graph, options.initialization, options.robots > 0 ? options.robots : N);
   if (init.size() != graph.num_poses)
     throw InputError("distributed solve: initial guess has the wrong size");
-  const Eigen::MatrixXd X0 = lift_poses(init, options.rank);
+  const double guess_s = since(start);
+  DistributedResult res =
+      solve_distributed_from_lifted(graph, assignment, options, lift_poses(init, options.rank));
+  res.init_s += guess_s;
+  res.wall_s = since(start);
+  return res;
+}
+
+DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
+                                                const std::vector<int>& assignment,
+                                                const DistributedOptions& options,
+                                                const Eigen::MatrixXd& X0) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  options.validate();
+  if (options.rank < graph.d)
+    throw InputError("DistributedOptions.rank must be >= d = " + std::to_string(graph.d));
   const Eigen::Index w = graph.d + 1;
+  if (X0.rows() != options.rank || X0.cols() != w * static_cast<Eigen::Index>(graph.num_poses))
+    throw InputError("distributed solve: lifted starting point is " + std::to_string(X0.rows()) +
+                     " x " + std::to_string(X0.cols()) +
+                     ", expected r x (d+1)n = " + std::to_string(options.rank) + " x " +
+                     std::to_string(w * static_cast<Eigen::Index>(graph.num_poses)));
+  const BlockLayout layout = make_block_layout(graph.num_poses, graph.measurements, assignment);
+  const int N = layout.num_blocks;
+  DistributedResult res;
+  res.agents = N;
 
   std::vector<std::unique_ptr<AgentState>> states;
   for (int b = 0; b < N; ++b) {

@@ -83,4 +83,13 @@ DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<in
                                     const DistributedOptions& options,
                                     const std::vector<Pose>& initial = {});
 
+/// The same from a lifted starting point X0 (r x (d+1)n, global pose order, each block [Y_i |
+/// p_i] with Y_i in St(d, r)): e.g. the iterate of an earlier run whose agents changed, so a run
+/// continues where it was instead of starting over. Throws InputError when X0 has the wrong
+/// shape.
+DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
+                                                const std::vector<int>& assignment,
+                                                const DistributedOptions& options,
+                                                const Eigen::MatrixXd& X0);
+
 }  // namespace tessera
