@@ -8,7 +8,7 @@
 namespace tessera::cli {
 
 std::set<std::string> session_option_names(SessionArgsFor who) {
-  std::set<std::string> names = {"run-id", "domain", "lease", "peers"};
+  std::set<std::string> names = {"run-id", "domain", "lease", "peers", "network"};
   if (who == SessionArgsFor::kProcess) names.insert("timeout");
   return names;
 }
@@ -29,6 +29,7 @@ SessionArgs parse_session_args(const Arguments& args, SessionArgsFor who) {
   o.domain = static_cast<int>(domain);
   o.lease_s = args.get_double("lease", o.lease_s);
   o.initial_peers = args.get_list("peers");
+  o.network = args.get_or("network", o.network);
   if (who == SessionArgsFor::kProcess) {
     a.timeout_s = args.get_double("timeout", a.timeout_s);
     if (!(a.timeout_s > 0)) throw InputError("option --timeout: must be positive");
@@ -53,6 +54,7 @@ std::vector<std::string> session_argv(const transport::SessionOptions& o) {
     for (const auto& ip : o.initial_peers) list += (list.empty() ? "" : ",") + ip;
     out.insert(out.end(), {"--peers", list});
   }
+  if (o.network != defaults.network) out.insert(out.end(), {"--network", o.network});
   return out;
 }
 

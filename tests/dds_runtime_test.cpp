@@ -201,10 +201,10 @@ TEST(DdsRuntime, OneHostRunHandsOffEveryMeasurementAndMergesEveryPose) {
   for (const auto& e : edges) {
     const int i = static_cast<int>(e[0]), j = static_cast<int>(e[1]);
     ASSERT_TRUE(merged.count(i) && merged.count(j));
-    const auto got = relative(merged[i][0], merged[i][1], merged[i][2], merged[j][0],
-                              merged[j][1], merged[j][2]);
-    const auto want = relative(truth[i][0], truth[i][1], truth[i][2], truth[j][0], truth[j][1],
-                               truth[j][2]);
+    const auto got = relative(merged[i][0], merged[i][1], merged[i][2], merged[j][0], merged[j][1],
+                              merged[j][2]);
+    const auto want =
+        relative(truth[i][0], truth[i][1], truth[i][2], truth[j][0], truth[j][1], truth[j][2]);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-6) << "edge " << i << "-" << j;
   }
   std::ifstream summary(dir + "/summary.json");

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "session_args.hpp"
 #include "util/input_error.hpp"
 
@@ -60,6 +62,18 @@ TEST(DdsSessionArgs, BadValuesNameTheOption) {
   EXPECT_NE(error_of({"--peers", "10.0.0"}, P).find("--peers"), std::string::npos);
   EXPECT_NE(error_of({"--run-id", "a b"}, P).find("--run-id"), std::string::npos);
   EXPECT_NE(error_of({"--timeout", "0"}, P).find("--timeout"), std::string::npos);
+  const std::string net = error_of({"--network", "wifi"}, P);
+  EXPECT_NE(net.find("--network"), std::string::npos) << net;
+  EXPECT_NE(net.find("lossy"), std::string::npos) << net;  // lists the valid names
+}
+
+TEST(DdsSessionArgs, NetworkProfileIsForwardedOnlyWhenNotDefault) {
+  SessionArgs a = parse({"--network", "lossy"}, SessionArgsFor::kLaunch);
+  EXPECT_EQ(a.session.network, "lossy");
+  EXPECT_EQ(parse(session_argv(a.session), SessionArgsFor::kProcess).session.network, "lossy");
+  a.session.network = "default";
+  const auto argv = session_argv(a.session);
+  EXPECT_EQ(std::find(argv.begin(), argv.end(), "--network"), argv.end());
 }
 
 TEST(DdsSessionArgs, LaunchKeepsItsOwnTimeout) {

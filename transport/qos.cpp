@@ -1,11 +1,14 @@
 #include "transport/qos.hpp"
 
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
 #include <algorithm>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <memory>
 
 namespace tessera::transport {
 
@@ -14,7 +17,7 @@ using eprosima::fastrtps::Duration_t;
 
 dds::DomainParticipantQos participant_qos(const std::string& name, double lease_s,
                                           const std::vector<std::string>& initial_peers, int domain,
-                                          std::uint32_t num_agents) {
+                                          std::uint32_t num_agents, const NetworkProfile& net) {
   dds::DomainParticipantQos q;
   dds::DomainParticipantFactory::get_instance()->get_default_participant_qos(q);
   q.name(name);
@@ -27,6 +30,21 @@ dds::DomainParticipantQos participant_qos(const std::string& name, double lease_
   // ~0.1 s instead of a full announcement period.
   discovery.initial_announcements.count = 5;
   discovery.initial_announcements.period = Duration_t(0, 100000000);
+  if (net.udp_max_message_size != 0 || net.socket_buffer_bytes != 0) {
+    // Our own UDPv4 transport instead of the built-in one, plus shared memory as built in
+    // (same-host peers keep using it). Fast DDS fragments every sample to the smallest
+    // maximum message size of the participant's transports.
+    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    if (net.udp_max_message_size != 0) udp->maxMessageSize = net.udp_max_message_size;
+    udp->sendBufferSize = net.socket_buffer_bytes;
+    udp->receiveBufferSize = net.socket_buffer_bytes;
+    q.transport().use_builtin_transports = false;
+    q.transport().user_transports.push_back(
+        std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+    q.transport().user_transports.push_back(udp);
+    q.transport().send_socket_buffer_size = net.socket_buffer_bytes;
+    q.transport().listen_socket_buffer_size = net.socket_buffer_bytes;
+  }
   for (const std::string& ip : initial_peers) {
     // Metatraffic unicast port of participant id p: 7400 + 250 * domain + 10 + 2 * p.
     const std::uint32_t participants = num_agents + 3;
@@ -52,7 +70,8 @@ dds::SubscriberQos subscriber_qos(const std::string& run_id) {
   return q;
 }
 
-dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_t num_agents) {
+dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_t num_agents,
+                              const NetworkProfile& net) {
   (void)num_agents;
   dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
@@ -68,7 +87,8 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
   q.resource_limits().max_samples_per_instance = kWriterHistory;
   q.resource_limits().allocated_samples = 4;
   // The default 3 s heartbeat stalls request/reply exchanges for seconds after a loss.
-  q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(0, 50000000);
+  q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(net.heartbeat_period_s);
+  q.reliable_writer_qos().times.nackResponseDelay = Duration_t(net.nack_response_delay_s);
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
   q.liveliness().lease_duration = Duration_t(lease_s);
   q.liveliness().announcement_period = Duration_t(lease_s / 4.0);
@@ -78,7 +98,8 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
   return q;
 }
 
-dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_t num_agents) {
+dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_t num_agents,
+                              const NetworkProfile& net) {
   dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
   q.durability().kind =
@@ -92,6 +113,7 @@ dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_
   q.resource_limits().max_instances = 1;
   q.resource_limits().max_samples_per_instance = limit;
   q.resource_limits().allocated_samples = 4;
+  q.reliable_reader_qos().times.heartbeatResponseDelay = Duration_t(net.heartbeat_response_delay_s);
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
   q.liveliness().lease_duration = Duration_t(lease_s);
   q.endpoint().history_memory_policy =

@@ -11,24 +11,30 @@
 #include <string>
 #include <vector>
 
+#include "transport/network_profile.hpp"
+
 namespace tessera::transport {
 
 /// Samples a writer may hold unacknowledged before write() has to wait (bounded KEEP_ALL).
 constexpr std::int32_t kWriterHistory = 16;
 
 /// Participant: named, short lease so a dead peer is noticed within ~lease seconds,
-/// optional unicast initial peers (all participant ids up to num_agents + 2 on `domain`).
+/// optional unicast initial peers (all participant ids up to num_agents + 2 on `domain`),
+/// the UDP datagram size and socket buffers of `net`.
 eprosima::fastdds::dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
-    int domain, std::uint32_t num_agents);
+    int domain, std::uint32_t num_agents, const NetworkProfile& net);
 /// Publisher / subscriber: Partition = run id.
 eprosima::fastdds::dds::PublisherQos publisher_qos(const std::string& run_id);
 eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);
-/// Reliable, bounded KEEP_ALL, 50 ms heartbeat, AUTOMATIC liveliness with `lease_s`.
+/// Reliable, bounded KEEP_ALL, heartbeat and repair delays of `net`, AUTOMATIC liveliness
+/// with `lease_s`.
 /// TRANSIENT_LOCAL for hand-shake topics (late joiners still get them), VOLATILE otherwise.
 eprosima::fastdds::dds::DataWriterQos writer_qos(bool transient_local, double lease_s,
-                                                 std::uint32_t num_agents);
+                                                 std::uint32_t num_agents,
+                                                 const NetworkProfile& net);
 eprosima::fastdds::dds::DataReaderQos reader_qos(bool transient_local, double lease_s,
-                                                 std::uint32_t num_agents);
+                                                 std::uint32_t num_agents,
+                                                 const NetworkProfile& net);
 
 }  // namespace tessera::transport

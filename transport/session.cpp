@@ -60,6 +60,7 @@ enum class Expect { kNone, kOtherAgents, kOtherAgentsAndCoordinator, kCoordinato
 
 struct Session::Impl {
   SessionOptions opt;
+  NetworkProfile net;  // network_profile(opt.network)
   int domain = 0;
   PeerIdentity me;
   Mailroom room;
@@ -307,8 +308,8 @@ struct Session::Impl {
     dds::Topic* t = topic<PubSubType>(name);
     writer_listeners.push_back(std::make_unique<WriterListener>(this, name + "/w"));
     dds::DataWriter* w = publisher->create_datawriter(
-        t, writer_qos(transient_local, opt.lease_s, opt.num_agents), writer_listeners.back().get(),
-        dds::StatusMask::publication_matched());
+        t, writer_qos(transient_local, opt.lease_s, opt.num_agents, net),
+        writer_listeners.back().get(), dds::StatusMask::publication_matched());
     if (!w) throw TransportError("cannot create DDS writer for " + name);
     writers[name] = w;
     if (e != Expect::kNone) expect[name + "/w"] = e;
@@ -337,9 +338,9 @@ struct Session::Impl {
     dds::StatusMask mask = dds::StatusMask::data_available()
                            << dds::StatusMask::subscription_matched()
                            << dds::StatusMask::liveliness_changed();
-    dds::DataReader* r =
-        subscriber->create_datareader(t, reader_qos(transient_local, opt.lease_s, opt.num_agents),
-                                      reader_listeners.back().get(), mask);
+    dds::DataReader* r = subscriber->create_datareader(
+        t, reader_qos(transient_local, opt.lease_s, opt.num_agents, net),
+        reader_listeners.back().get(), mask);
     if (!r) throw TransportError("cannot create DDS reader for " + name);
     readers.push_back(r);
     if (e != Expect::kNone) expect[name + "/r"] = e;
@@ -402,6 +403,7 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   Impl& s = *impl_;
   s.opt = options;
   s.tolerate_agent_loss = options.tolerate_agent_loss;
+  s.net = network_profile(options.network);
   s.domain = options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
   s.me = PeerIdentity{options.run_id, options.coordinator,
                       options.coordinator ? 0u : options.agent_id};
@@ -414,7 +416,7 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   s.participant = factory->create_participant(
       s.domain,
       participant_qos(participant_name(s.me), options.lease_s, options.initial_peers, s.domain,
-                      options.num_agents),
+                      options.num_agents, s.net),
       s.participant_listener.get(), dds::StatusMask::none());
   if (!s.participant)
     throw TransportError("cannot create a DDS participant on domain " + std::to_string(s.domain));

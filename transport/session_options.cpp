@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 
+#include "transport/network_profile.hpp"
 #include "transport/run_identity.hpp"
 #include "util/input_error.hpp"
 
@@ -19,6 +20,7 @@ void SessionOptions::validate() const {
                      " is not below the number of agents " + std::to_string(num_agents));
   if (!(lease_s >= 0.2 && lease_s <= 60))
     throw InputError("option --lease: " + std::to_string(lease_s) + " s is outside 0.2..60 s");
+  network_profile(network);  // throws for an unknown name
   if (!(write_timeout_s > 0)) throw InputError("write timeout must be positive");
   for (const auto& ip : initial_peers) {
     in_addr addr{};

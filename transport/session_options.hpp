@@ -20,6 +20,9 @@ struct SessionOptions {
   double lease_s = 1.0;
   /// IPv4 addresses of hosts to contact by unicast for discovery (when multicast is blocked).
   std::vector<std::string> initial_peers;
+  /// Transport profile (network_profile.hpp): "default", or "lossy" for links that drop
+  /// frames (small datagrams, big socket buffers).
+  std::string network = "default";
   /// How long a write may wait for room in the bounded history before failing (seconds).
   double write_timeout_s = 30.0;
   /// Print discovery events (peer found / lost) to stderr.

@@ -12,6 +12,10 @@
 #   scripts/netns/netns.sh addr PREFIX k [SUBNET]     prints host k's address
 #   scripts/netns/netns.sh down PREFIX                removes every namespace named PREFIX-*
 #   scripts/netns/netns.sh check                      exit 0 if namespaces can be created here
+#   scripts/netns/netns.sh loss PREFIX k PERCENT      drops PERCENT% of the Ethernet frames on
+#       host k's link, both ways (nftables `numgen random` on the netdev ingress hook of both
+#       ends of its veth pair: every frame, IP fragments included, is a separate draw).
+#       PERCENT 0 removes the rule. Only inside the namespaces made by `up`.
 #
 # Needs root (CAP_NET_ADMIN) and iproute2. `up` removes leftovers of the same PREFIX first.
 set -euo pipefail
@@ -67,6 +71,23 @@ NFT
   done
 }
 
+loss() {
+  local prefix=$1 h=$2 pct=$3
+  [[ $pct =~ ^[0-9]+$ && $pct -le 100 ]] || die "PERCENT must be 0..100"
+  ip netns list | awk '{print $1}' | grep -qx "$prefix-$h" || die "no host $prefix-$h (run up first)"
+  local ns dev
+  for end in "$prefix-$h eth0" "$prefix-br p$h"; do
+    read -r ns dev <<<"$end"
+    ip netns exec "$ns" nft delete table netdev tessera_loss 2>/dev/null || true
+    [[ $pct -eq 0 ]] && continue
+    ip netns exec "$ns" nft -f - <<NFT
+table netdev tessera_loss {
+  chain in { type filter hook ingress device $dev priority 0; numgen random mod 100 < $pct counter drop; }
+}
+NFT
+  done
+}
+
 cmd=${1:-}
 case $cmd in
   up) [[ $# -ge 3 ]] || die "usage: up PREFIX K [SUBNET] [--block-multicast]"; up "$2" "$3" "${4:-10.77.0}" "${5:-}" ;;
@@ -74,5 +95,6 @@ case $cmd in
   exec) [[ $# -ge 4 ]] || die "usage: exec PREFIX k COMMAND..."; ns="$2-$3"; shift 3; exec ip netns exec "$ns" "$@" ;;
   addr) [[ $# -ge 3 ]] || die "usage: addr PREFIX k [SUBNET]"; echo "${4:-10.77.0}.$(($3 + 1))" ;;
   check) check ;;
-  *) die "usage: netns.sh up|down|exec|addr|check ... (see the header of this script)" ;;
+  loss) [[ $# -eq 4 ]] || die "usage: loss PREFIX k PERCENT"; loss "$2" "$3" "$4" ;;
+  *) die "usage: netns.sh up|down|exec|addr|check|loss ... (see the header of this script)" ;;
 esac
