@@ -16,11 +16,12 @@
 
 namespace tessera::cli {
 
-const char* const kDistributedValued[] = {"agents",         "partition", "max-rounds", "seed",
-                                          "reference-cost", "select",    "rel-tol",    "tr-steps",
-                                          "restart-c",      "sigma",     "unselected", "irbcd-n",
-                                          "tcg-iters",      "robots",    nullptr};
-const char* const kDistributedSwitches[] = {"parallel", "reference", nullptr};
+const char* const kDistributedValued[] = {
+    "agents",        "partition",        "max-rounds",     "seed",      "reference-cost",
+    "select",        "rel-tol",          "tr-steps",       "restart-c", "sigma",
+    "unselected",    "irbcd-n",          "tcg-iters",      "robots",    "certify-grad-tol",
+    "certify-iters", "certify-residual", "certify-precon", nullptr};
+const char* const kDistributedSwitches[] = {"parallel", "reference", "certify", nullptr};
 
 const char* kDistributedHelp =
     "\n"
@@ -47,7 +48,18 @@ const char* kDistributedHelp =
     "  --irbcd-n units|variables IRBCD: n = selectable blocks (default) or scalar variables\n"
     "  --reference               also run the centralized solver for f* and report rel_gap\n"
     "  --reference-cost F        f* given: report rel_gap = (cost - F) / F\n"
-    "  --trace FILE              CSV per round: round,cost,grad_norm,selected,restart,bytes\n";
+    "  --trace FILE              CSV per round: round,cost,grad_norm,selected,restart,bytes\n"
+    "  --certify                 after the solve, certify global optimality distributedly\n"
+    "                            (lambda_min of S by LOBPCG over neighbour exchanges) and climb\n"
+    "                            the staircase on a saddle (off by default; see\n"
+    "                            docs/distributed-certification.md)\n"
+    "  --max-rank R              staircase ceiling with --certify (default 10)\n"
+    "  --certify-grad-tol T      gradient tolerance of the solve stages with --certify\n"
+    "                            (default 1e-4; 0 = --grad-tol)\n"
+    "  --certify-iters K         certificate iteration cap (default 300)\n"
+    "  --certify-residual T      certificate stops at Ritz residual <= T max(1, max diag Q)\n"
+    "                            (default 1e-6)\n"
+    "  --certify-precon block-jacobi|none   certificate preconditioner (default block-jacobi)\n";
 
 namespace {
 
@@ -101,6 +113,22 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     throw InputError("option --unselected: '" + unselected + "' is not one of take, keep");
   opt.irbcd.unselected_take_extrapolation = unselected == "take";
   opt.irbcd.dimension = parse_dimension(a.get_or("irbcd-n", "units"));
+  opt.certify = a.has("certify");
+  opt.staircase.max_rank = static_cast<int>(a.get_long("max-rank", opt.staircase.max_rank));
+  opt.staircase.grad_norm_tol = a.get_double("certify-grad-tol", opt.staircase.grad_norm_tol);
+  opt.staircase.certificate.residual_tolerance =
+      a.get_double("certify-residual", opt.staircase.certificate.residual_tolerance);
+  {
+    const std::string precon = a.get_or("certify-precon", "block-jacobi");
+    if (precon != "block-jacobi" && precon != "none")
+      throw InputError("option --certify-precon: '" + precon +
+                       "' is not one of block-jacobi, none");
+    opt.staircase.certificate.preconditioner = precon == "none"
+                                                   ? CertificatePreconditioner::kNone
+                                                   : CertificatePreconditioner::kBlockJacobi;
+  }
+  opt.staircase.certificate.max_iterations =
+      static_cast<int>(a.get_long("certify-iters", opt.staircase.certificate.max_iterations));
   const long agents = a.get_long("agents", 5);
   if (agents < 1 || agents > 64) throw InputError("option --agents: must be in 1..64");
   if (a.has("reference") && a.has("reference-cost"))
@@ -139,6 +167,14 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   std::printf("\n  %.3f MB exchanged, %.2f ms per round (%.2f CPU), solve %.3f s, wall %.3f s\n",
               r.bytes_exchanged / 1e6, r.rounds > 0 ? 1e3 * r.solve_s / r.rounds : 0.0,
               r.rounds > 0 ? 1e3 * r.solve_cpu_s / r.rounds : 0.0, r.solve_s, wall_s);
+  if (r.certified) {
+    std::printf(
+        "  %s: lambda_min(S) = %.4g (eta %.3g, residual %.3g), %d certificate rounds "
+        "(%.3f MB), %d escape rounds (%.3f MB), final rank %d\n",
+        *r.certified ? "certified optimal" : "NOT certified", r.min_eigenvalue,
+        r.certificate_tolerance, r.certificate_residual, r.certificate_rounds,
+        r.certificate_bytes / 1e6, r.escape_rounds, r.escape_bytes / 1e6, r.final_rank);
+  }
   if (auto p = a.get("out")) {
     const std::string& path = *p;
     if (path.size() >= 4 && path.compare(path.size() - 4, 4, ".tum") == 0)
@@ -160,7 +196,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         .add("grad_norm", r.grad_norm)
         .add("cost", r.cost)
         .add("relaxation_cost", r.relaxation_cost)
-        .add_null("certified")
+        .add("certified", r.certified)
         .add("wall_s", wall_s)
         .add("agents", static_cast<int>(agents))
         .add("partition", preset_name(popt.preset))
@@ -177,7 +213,20 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         .add("ms_per_round", r.rounds > 0 ? 1e3 * r.solve_s / r.rounds : 0.0)
         .add("solve_cpu_s", r.solve_cpu_s)
         .add("cpu_ms_per_round", r.rounds > 0 ? 1e3 * r.solve_cpu_s / r.rounds : 0.0)
-        .add("rel_gap", rel_gap);
+        .add("rel_gap", rel_gap)
+        .add("final_rank", r.final_rank);
+    if (r.certified) {
+      j.add("min_eigenvalue", r.min_eigenvalue)
+          .add("certificate_tolerance", r.certificate_tolerance)
+          .add("certificate_residual", r.certificate_residual)
+          .add("certificate_rounds", r.certificate_rounds)
+          .add("certificate_bytes", static_cast<long long>(r.certificate_bytes))
+          .add("escape_rounds", r.escape_rounds)
+          .add("escape_bytes", static_cast<long long>(r.escape_bytes))
+          .add("staircase_levels", static_cast<int>(r.certificates.size()));
+    } else {
+      j.add_null("min_eigenvalue").add_null("certificate_rounds");
+    }
     if (fstar) j.add("f_star", *fstar);
     write_output(*p, j.str());
   }

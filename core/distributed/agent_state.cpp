@@ -103,4 +103,12 @@ double AgentState::local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& n
   return problem_.cost(X);
 }
 
+void AgentState::reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd& Yn0) {
+  if (Y0.cols() != Y.cols() || Yn0.cols() != Yn.cols() || Yn0.rows() != Y0.rows())
+    throw std::invalid_argument("AgentState::reset_iterate: block of the wrong size");
+  Y = P = V = Y_prev = V_prev = Y0;
+  Yn = Pn = Yn_prev = Yn0;
+  neighbours_set_.resize(0, 0);  // the problem's neighbour poses are stale
+}
+
 }  // namespace tessera

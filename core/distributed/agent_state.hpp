@@ -51,6 +51,9 @@ class AgentState {
                          const BlockUpdateOptions& options);
   /// Local objective f_B(X) with neighbours at `neighbours`.
   double local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
+  /// Starts the sequences afresh at Y0 (any rank, e.g. r + 1 after a saddle escape) with
+  /// neighbours at Yn0 (same rank, neighbour order).
+  void reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd& Yn0);
 
   // The sequences (own block) and neighbour copies; *_prev keep round k while k+1 is tried,
   // so an adaptive restart can go back.

@@ -7,7 +7,9 @@
 #include "distributed/agent_factory.hpp"
 #include "distributed/agent_state.hpp"
 #include "distributed/block_layout.hpp"
+#include "distributed/certified_agent.hpp"
 #include "distributed/round_protocol.hpp"
+#include "distributed/stage_tag.hpp"
 #include "problem/lifting.hpp"
 #include "problem/objective.hpp"
 #include "problem/rounding.hpp"
@@ -46,6 +48,10 @@ void DistributedOptions::validate() const {
   block_update.validate();
   rbcd_plus_plus.validate();
   irbcd.validate();
+  if (certify) {
+    staircase.validate();
+    if (staircase.max_rank < rank) fail("staircase.max_rank", "must be >= rank");
+  }
 }
 
 DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<int>& assignment,
@@ -107,15 +113,13 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
     states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb));
   }
 
-  const std::unique_ptr<MomentumScheme> scheme =
-      make_momentum_scheme(options, layout, static_cast<double>(X0.size()));
-  const RoundConfig config = make_round_config(options, scheme.get());
-  std::vector<std::unique_ptr<RoundProtocol>> protocols;
-  std::vector<RoundProtocol*> agents;
+  // One certified sequence per agent (with certification off: exactly the round protocol).
+  std::vector<std::unique_ptr<CertifiedAgent>> sequences;
+  std::vector<AgentProcess*> agents;
   for (int b = 0; b < N; ++b) {
-    protocols.push_back(
-        std::make_unique<RoundProtocol>(*states[static_cast<std::size_t>(b)], layout, config));
-    agents.push_back(protocols.back().get());
+    sequences.push_back(
+        std::make_unique<CertifiedAgent>(*states[static_cast<std::size_t>(b)], layout, options));
+    agents.push_back(sequences.back().get());
   }
   res.init_s = since(start);
 
@@ -125,19 +129,41 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
   res.solve_s = since(solve_start);
   res.solve_cpu_s = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
 
-  const RoundProtocol& lead = *protocols.front();
-  res.rounds = lead.rounds();
-  res.restarts = lead.restarts();
-  res.stop_reason = lead.stop_reason();
+  const CertifiedAgent& lead = *sequences.front();
+  res.rounds = lead.total_rounds();
+  res.restarts = lead.total_restarts();
+  res.stop_reason = lead.solves().back().stop_reason;
   res.bytes_exchanged = stats.bytes;
   res.messages = stats.messages;
-  for (const auto& r : lead.trace()) {
-    DistributedRound row{r.round, r.cost, r.grad_norm, r.selected, r.restart, 0, r.elapsed_s};
-    if (static_cast<std::size_t>(r.round) < stats.bytes_per_round.size())
-      row.bytes = stats.bytes_per_round[static_cast<std::size_t>(r.round)];
-    res.trace.push_back(std::move(row));
+  int offset = 0;
+  for (const auto& stage : lead.solves()) {
+    for (const auto& r : stage.trace) {
+      DistributedRound row{offset + r.round, stage.rank, r.cost, r.grad_norm,
+                           r.selected,       r.restart,  0,      r.elapsed_s};
+      auto b = stats.bytes_per_stage_round.find({stage.stage, static_cast<std::uint32_t>(r.round)});
+      if (b != stats.bytes_per_stage_round.end()) row.bytes = b->second;
+      res.trace.push_back(std::move(row));
+    }
+    offset += stage.rounds;
   }
-  res.X.resize(options.rank, w * static_cast<Eigen::Index>(graph.num_poses));
+  for (std::size_t s = 0; s < stats.bytes_per_stage.size(); ++s) {
+    const StageKind kind = stage_kind(static_cast<std::uint32_t>(s));
+    if (kind == StageKind::kCertify) res.certificate_bytes += stats.bytes_per_stage[s];
+    if (kind == StageKind::kEscape) res.escape_bytes += stats.bytes_per_stage[s];
+  }
+  res.certified = lead.certified();
+  res.certificates = lead.certificates();
+  res.escapes = lead.escapes();
+  if (!res.certificates.empty()) {
+    const auto& c = res.certificates.back().result;
+    res.min_eigenvalue = c.min_eigenvalue;
+    res.certificate_tolerance = c.tolerance;
+    res.certificate_residual = c.residual;
+  }
+  res.certificate_rounds = lead.certificate_iterations();
+  res.escape_rounds = lead.escape_trials();
+  res.final_rank = lead.final_rank();
+  res.X.resize(res.final_rank, w * static_cast<Eigen::Index>(graph.num_poses));
   for (int b = 0; b < N; ++b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
     const Eigen::MatrixXd& Yb = states[static_cast<std::size_t>(b)]->Y;

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,8 @@
 #include "distributed/irbcd.hpp"
 #include "distributed/rbcd.hpp"
 #include "distributed/rbcd_plus_plus.hpp"
+#include "distributed/stage_records.hpp"
+#include "distributed/staircase_options.hpp"
 #include "graph/pose.hpp"
 #include "graph/pose_graph.hpp"
 
@@ -41,6 +44,10 @@ struct DistributedOptions {
   BlockUpdateOptions block_update;
   RbcdPlusPlusOptions rbcd_plus_plus;
   IrbcdOptions irbcd;
+  /// After the solve, certify global optimality distributedly and climb the staircase
+  /// (docs/distributed-certification.md). Off by default for `tessera solve`.
+  bool certify = false;
+  StaircaseOptions staircase;
   DeliveryOrder delivery = DeliveryOrder::kFifo;  ///< In-process delivery order (tests).
   std::uint64_t delivery_seed = 1;
 
@@ -49,7 +56,8 @@ struct DistributedOptions {
 };
 
 struct DistributedRound {
-  int round = 0;
+  int round = 0;           ///< Counted over every solve stage of the staircase.
+  int rank = 0;            ///< Rank of the solve stage.
   double cost = 0.0;       ///< f(Y^k) of the lifted iterate, full sum.
   double grad_norm = 0.0;  ///< ||grad f(Y^k)||.
   std::vector<int> selected;
@@ -60,12 +68,24 @@ struct DistributedRound {
 
 struct DistributedResult {
   int agents = 0;
-  int rounds = 0;  ///< Block-update rounds done (restarts' redos are inside their round).
+  int rounds = 0;  ///< Block-update rounds done, all solve stages (restarts' redos inside).
   int restarts = 0;
   std::string stop_reason;  ///< grad_norm, max_rounds or relative_decrease.
   std::vector<DistributedRound> trace;
-  std::uint64_t bytes_exchanged = 0;
+  std::uint64_t bytes_exchanged = 0;  ///< Every message (solve, certificate, escape).
   std::uint64_t messages = 0;
+  // Certification (options.certify): nullopt / zero when off.
+  std::optional<bool> certified;
+  double min_eigenvalue = 0.0;         ///< Last certificate's smallest Ritz value of S.
+  double certificate_tolerance = 0.0;  ///< Its eta.
+  double certificate_residual = 0.0;   ///< Its Ritz residual.
+  int certificate_rounds = 0;          ///< LOBPCG iterations, all certificates.
+  std::uint64_t certificate_bytes = 0;
+  int escape_rounds = 0;  ///< Line-search trials, all escapes.
+  std::uint64_t escape_bytes = 0;
+  int final_rank = 0;
+  std::vector<CertifyStageRecord> certificates;
+  std::vector<EscapeStageRecord> escapes;
   Eigen::MatrixXd X;             ///< Final lifted iterate (r x (d+1)n, global order).
   double relaxation_cost = 0.0;  ///< f(X).
   double grad_norm = 0.0;        ///< ||grad f(X)||.

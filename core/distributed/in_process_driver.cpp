@@ -4,6 +4,9 @@
 #include <functional>
 #include <stdexcept>
 
+#include "distributed/message_gate.hpp"
+#include "distributed/stage_tag.hpp"
+
 namespace tessera {
 
 std::size_t message_bytes(const ProtocolMessage& message) {
@@ -25,7 +28,7 @@ std::uint32_t round_of(const ProtocolMessage& m) {
   return std::get<RoundStatusMessage>(m).round;
 }
 
-DeliveryStats deliver(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder order,
                       std::uint64_t delivery_seed,
                       const std::function<std::vector<OutgoingMessage>(std::size_t)>& begin) {
   DeliveryStats stats;
@@ -35,11 +38,15 @@ DeliveryStats deliver(const std::vector<RoundProtocol*>& agents, DeliveryOrder o
     for (auto& o : out) {
       const std::size_t bytes = message_bytes(o.message);
       const std::uint32_t round = round_of(o.message);
+      const std::uint32_t stage = stage_of_phase(message_phase(o.message));
       auto count = [&](std::size_t recipient) {
         ++stats.messages;
         stats.bytes += bytes;
         if (stats.bytes_per_round.size() <= round) stats.bytes_per_round.resize(round + 1, 0);
         stats.bytes_per_round[round] += bytes;
+        if (stats.bytes_per_stage.size() <= stage) stats.bytes_per_stage.resize(stage + 1, 0);
+        stats.bytes_per_stage[stage] += bytes;
+        stats.bytes_per_stage_round[{stage, round}] += bytes;
         queue.push_back({recipient, o.message});
       };
       if (o.broadcast) {
@@ -88,7 +95,7 @@ DeliveryStats deliver(const std::vector<RoundProtocol*>& agents, DeliveryOrder o
 
 }  // namespace
 
-DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+DeliveryStats run_in_process(const std::vector<AgentProcess*>& agents, DeliveryOrder order,
                              std::uint64_t delivery_seed) {
   return deliver(agents, order, delivery_seed, [&](std::size_t i) { return agents[i]->start(); });
 }
@@ -101,7 +108,8 @@ DeliveryStats resume_in_process(const std::vector<RoundProtocol*>& agents,
   for (const auto& s : snapshots)
     if (s.round != snapshots.front().round)
       throw std::invalid_argument("resume_in_process: snapshots of different rounds");
-  return deliver(agents, order, delivery_seed,
+  const std::vector<AgentProcess*> processes(agents.begin(), agents.end());
+  return deliver(processes, order, delivery_seed,
                  [&](std::size_t i) { return agents[i]->resume(snapshots[i]); });
 }
 

@@ -6,8 +6,11 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
+#include <utility>
 #include <vector>
 
+#include "distributed/agent_process.hpp"
 #include "distributed/protocol_snapshot.hpp"
 #include "distributed/round_protocol.hpp"
 
@@ -23,6 +26,10 @@ struct DeliveryStats {
   std::uint64_t messages = 0;  ///< Deliveries (a broadcast to N-1 agents counts N-1).
   std::uint64_t bytes = 0;     ///< Payload bytes over all deliveries.
   std::vector<std::uint64_t> bytes_per_round;  ///< By the messages' round field.
+  /// By the stage of the certified sequence (stage_tag.hpp; stage 0 = the first solve).
+  std::vector<std::uint64_t> bytes_per_stage;
+  /// By (stage, round field).
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint64_t> bytes_per_stage_round;
 };
 
 /// Payload size of a message as it would travel (fixed fields + arrays), in bytes.
@@ -30,7 +37,7 @@ std::size_t message_bytes(const ProtocolMessage& message);
 
 /// Delivers messages until every agent is done (or no message is left, which would be a
 /// protocol bug: then std::logic_error). `agents[i]` must be the agent with id i.
-DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+DeliveryStats run_in_process(const std::vector<AgentProcess*>& agents, DeliveryOrder order,
                              std::uint64_t delivery_seed = 1);
 
 /// Same, but every agent continues from its snapshot (`snapshots[i]` for agent i, all of the

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "distributed/agent_process.hpp"
 #include "distributed/agent_state.hpp"
 #include "distributed/block_layout.hpp"
 #include "distributed/block_selection.hpp"
@@ -71,14 +72,14 @@ struct RoundRecord {
   double elapsed_s = 0.0;  ///< Since start(), when the status completed (not part of the iterates).
 };
 
-class RoundProtocol {
+class RoundProtocol : public AgentProcess {
  public:
   RoundProtocol(AgentState& state, const BlockLayout& layout, const RoundConfig& config);
 
-  std::vector<OutgoingMessage> start();
+  std::vector<OutgoingMessage> start() override;
   /// Consumes one message addressed to this agent. Throws std::runtime_error on a message
   /// that cannot belong to this run (bad sender, wrong shape, unexpected pose).
-  std::vector<OutgoingMessage> handle(const ProtocolMessage& message);
+  std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
 
   /// Instead of start(): continues from `snapshot` (taken by this agent at round k, see
   /// protocol_snapshot.hpp) and emits round k's status. When every agent resumes from its
@@ -94,7 +95,7 @@ class RoundProtocol {
   /// round observer).
   ProtocolSnapshot snapshot() const;
 
-  bool done() const { return done_; }
+  bool done() const override { return done_; }
   int rounds() const { return round_; }
   int restarts() const { return restarts_; }
   const std::string& stop_reason() const { return stop_reason_; }

@@ -1,0 +1,277 @@
+#include "certification/distributed_certificate.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "util/input_error.hpp"
+
+namespace tessera {
+
+void DistributedCertificateOptions::validate() const {
+  auto fail = [](const char* field, const char* why) {
+    throw InputError(std::string("DistributedCertificateOptions.") + field + " " + why);
+  };
+  if (!(relative_tolerance >= 0)) fail("relative_tolerance", "must be >= 0");
+  if (!(residual_tolerance > 0)) fail("residual_tolerance", "must be > 0");
+  if (max_iterations <= 0) fail("max_iterations", "must be > 0");
+}
+
+double certificate_start_entry(std::uint64_t seed, std::size_t pose, int coordinate, int d) {
+  // splitmix64 of (seed, global coordinate index): independent of the partition.
+  std::uint64_t z = seed * 0x9E3779B97F4A7C15ull +
+                    static_cast<std::uint64_t>(pose) * static_cast<std::uint64_t>(d + 1) +
+                    static_cast<std::uint64_t>(coordinate) + 0x632BE59BD9B4E019ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
+}
+
+// The agent's diagonal block of S, shifted until positive definite and factored once; applied
+// locally, it makes each LOBPCG step an inverse iteration on the agent's own poses.
+struct BlockJacobi {
+  Eigen::SimplicialLLT<SparseMatrix> factor;
+  double shift = 0.0;
+};
+
+CertificateProtocol::CertificateProtocol(const AgentState& state, const BlockLayout& layout,
+                                         const DistributedCertificateOptions& options)
+    : state_(state), layout_(layout), options_(options), problem_(state.problem()) {
+  options_.validate();
+}
+
+CertificateProtocol::~CertificateProtocol() = default;
+
+std::vector<int> CertificateProtocol::everyone() const {
+  std::vector<int> all(static_cast<std::size_t>(layout_.num_blocks));
+  for (int b = 0; b < layout_.num_blocks; ++b) all[static_cast<std::size_t>(b)] = b;
+  return all;
+}
+
+Eigen::MatrixXd CertificateProtocol::apply(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn) {
+  // (v S)_B = v_B Q_BB + v_N Q_NB - v_B Lambda_B; euclidean_gradient is 2 (X Q_BB + X_N Q_NB)
+  // and the halving is exact.
+  if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(vn);
+  Eigen::MatrixXd out = 0.5 * problem_.euclidean_gradient(v);
+  out -= v * lambda_;
+  return out;
+}
+
+std::vector<OutgoingMessage> CertificateProtocol::start() {
+  const int d = problem_.dim();
+  const Eigen::Index w = d + 1;
+  const Eigen::Index m = static_cast<Eigen::Index>(problem_.num_owned());
+  const Eigen::MatrixXd& Y = state_.Y;
+  if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(state_.Yn);
+  const Eigen::MatrixXd G = 0.5 * problem_.euclidean_gradient(Y);  // (X Q)_B
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(static_cast<std::size_t>(m * d * d));
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const Eigen::Index c = w * i;
+    Eigen::MatrixXd L = Y.middleCols(c, d).transpose() * G.middleCols(c, d);
+    L = (0.5 * (L + L.transpose())).eval();
+    for (int a = 0; a < d; ++a)
+      for (int b = 0; b < d; ++b) trip.emplace_back(c + a, c + b, L(a, b));
+  }
+  lambda_.resize(w * m, w * m);
+  lambda_.setFromTriplets(trip.begin(), trip.end());
+  const SparseMatrix& Q = problem_.data_matrix();
+  local_max_diag_ = Q.rows() > 0 ? Q.diagonal().maxCoeff() : 0.0;
+
+  if (options_.preconditioner == CertificatePreconditioner::kBlockJacobi && m > 0) {
+    const double local_scale = std::max(1.0, local_max_diag_);
+    precon_ = std::make_unique<BlockJacobi>();
+    SparseMatrix S = Q - lambda_;
+    SparseMatrix I(S.rows(), S.cols());
+    I.setIdentity();
+    double shift = std::max(options_.relative_tolerance, 1e-12) * local_scale;
+    for (;;) {
+      precon_->factor.compute(S + shift * I);
+      if (precon_->factor.info() == Eigen::Success) break;
+      shift *= 10.0;
+      if (shift > 1e4 * local_scale)
+        throw std::runtime_error("certificate: agent " + std::to_string(state_.id()) +
+                                 " found no positive definite shift of its block");
+    }
+    precon_->shift = shift;
+  }
+
+  x_.resize(1, w * m);
+  const auto& owned = problem_.owned();
+  for (Eigen::Index i = 0; i < m; ++i)
+    for (int c = 0; c < w; ++c)
+      x_(0, w * i + c) =
+          certificate_start_entry(options_.seed, owned[static_cast<std::size_t>(i)], c, d);
+  std::vector<OutgoingMessage> out;
+  iteration_ = 0;
+  send_boundary(x_, 0, out);
+  gate_.expect(0, kVector, layout_.adjacent[static_cast<std::size_t>(state_.id())]);
+  pump(out);
+  return out;
+}
+
+std::vector<OutgoingMessage> CertificateProtocol::handle(const ProtocolMessage& message) {
+  const std::uint32_t sender = message_sender(message);
+  const std::uint32_t step = message_phase(message);
+  if (sender >= static_cast<std::uint32_t>(layout_.num_blocks) ||
+      (step != kVector && step != kReduce))
+    throw std::runtime_error("certificate: agent " + std::to_string(state_.id()) +
+                             ": malformed message (sender " + std::to_string(sender) + ", step " +
+                             std::to_string(step) + ")");
+  if (!gate_.add(static_cast<int>(sender), message_round(message), step, message))
+    throw std::runtime_error("certificate: agent " + std::to_string(state_.id()) +
+                             ": duplicate message from agent " + std::to_string(sender));
+  std::vector<OutgoingMessage> out;
+  pump(out);
+  return out;
+}
+
+void CertificateProtocol::pump(std::vector<OutgoingMessage>& out) {
+  while (!done_) {
+    std::optional<MessageGate::Inbox> ready = gate_.take_ready();
+    if (!ready) return;
+    if (gate_.step() == kVector)
+      after_vector(*ready, out);
+    else
+      after_reduce(*ready, out);
+  }
+}
+
+void CertificateProtocol::send_boundary(const Eigen::MatrixXd& v, std::uint32_t round,
+                                        std::vector<OutgoingMessage>& out) {
+  for (int a : layout_.adjacent[static_cast<std::size_t>(state_.id())]) {
+    OutgoingMessage o;
+    o.message = state_.publish(v, BlockKind::kY, a, round, kVector);
+    o.broadcast = false;
+    o.recipients = {static_cast<std::uint32_t>(a)};
+    out.push_back(std::move(o));
+  }
+}
+
+void CertificateProtocol::broadcast(std::uint32_t round, const std::vector<double>& values,
+                                    std::vector<OutgoingMessage>& out) {
+  PoseBlockMessage m = make_reduction_message(state_.id(), round, kReduce, values);
+  gate_.add(state_.id(), round, kReduce, m);  // our own share joins the reduction like any other
+  OutgoingMessage o;
+  o.message = std::move(m);
+  o.broadcast = true;
+  out.push_back(std::move(o));
+  gate_.expect(round, kReduce, everyone());
+}
+
+namespace {
+double dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a.array() * b.array()).sum();
+}
+}  // namespace
+
+void CertificateProtocol::after_vector(const MessageGate::Inbox& inbox,
+                                       std::vector<OutgoingMessage>& out) {
+  Eigen::MatrixXd vn = Eigen::MatrixXd::Zero(
+      1, (problem_.dim() + 1) * static_cast<Eigen::Index>(problem_.num_neighbors()));
+  for (const auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), vn);
+  if (iteration_ == 0) {
+    Sx_ = apply(x_, vn);
+    broadcast(0, {dot(x_, x_), dot(x_, Sx_), local_max_diag_}, out);
+    return;
+  }
+  Sw_ = apply(w_, vn);
+  const Eigen::MatrixXd* V[3] = {&x_, &w_, &p_};
+  const Eigen::MatrixXd* SV[3] = {&Sx_, &Sw_, &Sp_};
+  const int k = has_p_ ? 3 : 2;
+  std::vector<double> values{rr_local_};
+  for (int i = 0; i < k; ++i)
+    for (int j = i; j < k; ++j) values.push_back(dot(*V[i], *V[j]));
+  for (int i = 0; i < k; ++i)
+    for (int j = i; j < k; ++j) values.push_back(dot(*V[i], *SV[j]));
+  broadcast(iteration_, values, out);
+}
+
+void CertificateProtocol::begin_iteration(std::vector<OutgoingMessage>& out) {
+  const Eigen::MatrixXd r = Sx_ - theta_ * x_;
+  rr_local_ = r.squaredNorm();
+  if (precon_)
+    w_ = precon_->factor.solve(r.transpose()).transpose();
+  else
+    w_ = r;
+  send_boundary(w_, iteration_, out);
+  gate_.expect(iteration_, kVector, layout_.adjacent[static_cast<std::size_t>(state_.id())]);
+}
+
+void CertificateProtocol::finish(bool converged) {
+  result_.converged = converged;
+  result_.min_eigenvalue = theta_;
+  result_.certified = converged && theta_ >= -result_.tolerance;
+  result_.eigenvector = x_;
+  done_ = true;
+}
+
+void CertificateProtocol::after_reduce(const MessageGate::Inbox& inbox,
+                                       std::vector<OutgoingMessage>& out) {
+  if (iteration_ == 0) {
+    const std::vector<double> t = reduce_in_id_order(inbox, 3, {2});
+    result_.scale = std::max(1.0, t[2]);
+    result_.tolerance = options_.relative_tolerance * result_.scale;
+    if (!(t[0] > 0)) throw std::runtime_error("certificate: zero start vector");
+    const double norm = std::sqrt(t[0]);
+    x_ /= norm;
+    Sx_ /= norm;
+    theta_ = t[1] / t[0];
+    iteration_ = 1;
+    begin_iteration(out);
+    return;
+  }
+  const int k = has_p_ ? 3 : 2;
+  const std::size_t count = 1 + static_cast<std::size_t>(k * (k + 1));
+  const std::vector<double> t = reduce_in_id_order(inbox, count);
+  result_.residual = std::sqrt(std::max(0.0, t[0]));
+  result_.iterations = static_cast<int>(iteration_);
+  if (result_.residual <= options_.residual_tolerance * result_.scale) return finish(true);
+  if (static_cast<int>(iteration_) >= options_.max_iterations) return finish(false);
+
+  // Rayleigh-Ritz on span{x, w, p}: the same 3x3 problem, bit for bit, on every agent.
+  Eigen::MatrixXd B(k, k), A(k, k);
+  std::size_t at = 1;
+  for (int i = 0; i < k; ++i)
+    for (int j = i; j < k; ++j) B(i, j) = B(j, i) = t[at++];
+  for (int i = 0; i < k; ++i)
+    for (int j = i; j < k; ++j) A(i, j) = A(j, i) = t[at++];
+  // Scale the basis to unit length (conditioning) and drop vanishing directions.
+  Eigen::VectorXd D = Eigen::VectorXd::Zero(k);
+  for (int i = 0; i < k; ++i)
+    if (B(i, i) > 1e-300) D(i) = 1.0 / std::sqrt(B(i, i));
+  const Eigen::MatrixXd Bs = D.asDiagonal() * B * D.asDiagonal();
+  const Eigen::MatrixXd As = D.asDiagonal() * A * D.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eb(Bs);
+  const double top = eb.eigenvalues().maxCoeff();
+  std::vector<int> keep;
+  for (int i = 0; i < k; ++i)
+    if (eb.eigenvalues()(i) > 1e-10 * top) keep.push_back(i);
+  Eigen::MatrixXd Z(k, static_cast<Eigen::Index>(keep.size()));
+  for (std::size_t c = 0; c < keep.size(); ++c)
+    Z.col(static_cast<Eigen::Index>(c)) =
+        eb.eigenvectors().col(keep[c]) / std::sqrt(eb.eigenvalues()(keep[c]));
+  Eigen::MatrixXd C = Z.transpose() * As * Z;
+  C = (0.5 * (C + C.transpose())).eval();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ec(C);
+  const Eigen::VectorXd c = D.asDiagonal() * (Z * ec.eigenvectors().col(0));
+  const double cp = has_p_ ? c(2) : 0.0;
+  Eigen::MatrixXd p_new = c(1) * w_, Sp_new = c(1) * Sw_;
+  if (has_p_) {
+    p_new += cp * p_;
+    Sp_new += cp * Sp_;
+  }
+  x_ = c(0) * x_ + p_new;
+  Sx_ = c(0) * Sx_ + Sp_new;
+  p_ = std::move(p_new);
+  Sp_ = std::move(Sp_new);
+  has_p_ = true;
+  theta_ = ec.eigenvalues()(0);
+  ++iteration_;
+  begin_iteration(out);
+}
+
+}  // namespace tessera

@@ -1,0 +1,23 @@
+#pragma once
+// What a driver (the in-process driver, the DDS round loop) needs from one agent: a state
+// machine that emits messages when started and consumes one message at a time. RoundProtocol
+// is one; the certified sequence (solve -> certify -> escape -> solve ...) is another.
+
+#include <vector>
+
+#include "protocol/messages.hpp"
+
+namespace tessera {
+
+class AgentProcess {
+ public:
+  virtual ~AgentProcess() = default;
+  /// The first messages; called once before any handle().
+  virtual std::vector<OutgoingMessage> start() = 0;
+  /// Consumes one message addressed to this agent and returns what it wants sent.
+  virtual std::vector<OutgoingMessage> handle(const ProtocolMessage& message) = 0;
+  /// True once the agent needs no further message.
+  virtual bool done() const = 0;
+};
+
+}  // namespace tessera

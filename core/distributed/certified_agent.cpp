@@ -1,0 +1,180 @@
+#include "distributed/certified_agent.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "distributed/agent_factory.hpp"
+#include "distributed/stage_tag.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera {
+
+void StaircaseOptions::validate() const {
+  if (max_rank < 2) throw InputError("StaircaseOptions.max_rank must be >= d (2 or 3)");
+  if (!(grad_norm_tol >= 0)) throw InputError("StaircaseOptions.grad_norm_tol must be >= 0");
+  certificate.validate();
+  escape.validate();
+}
+
+CertifiedAgent::CertifiedAgent(AgentState& state, const BlockLayout& layout,
+                               const DistributedOptions& options)
+    : state_(state), layout_(layout), options_(options) {}
+
+double CertifiedAgent::solve_tolerance() const {
+  if (options_.certify && options_.staircase.grad_norm_tol > 0)
+    return std::min(options_.grad_norm_tol, options_.staircase.grad_norm_tol);
+  return options_.grad_norm_tol;
+}
+
+std::optional<bool> CertifiedAgent::certified() const {
+  if (!options_.certify) return std::nullopt;
+  if (certificates_.empty() || solves_.empty()) return false;
+  const std::string& stop = solves_.back().stop_reason;
+  const bool converged = stop == "grad_norm" || stop == "relative_decrease";
+  // The last certificate must be of the last solve (an escape that failed leaves it so).
+  return converged && certificates_.back().rank == solves_.back().rank &&
+         certificates_.back().result.certified;
+}
+
+int CertifiedAgent::total_rounds() const {
+  int n = 0;
+  for (const auto& s : solves_) n += s.rounds;
+  return n;
+}
+int CertifiedAgent::total_restarts() const {
+  int n = 0;
+  for (const auto& s : solves_) n += s.restarts;
+  return n;
+}
+int CertifiedAgent::certificate_iterations() const {
+  int n = 0;
+  for (const auto& c : certificates_) n += c.result.iterations;
+  return n;
+}
+int CertifiedAgent::escape_trials() const {
+  int n = 0;
+  for (const auto& e : escapes_) n += e.trials;
+  return n;
+}
+
+void CertifiedAgent::emit(std::vector<OutgoingMessage>&& sub,
+                          std::vector<OutgoingMessage>& out) const {
+  for (auto& o : sub) {
+    std::visit([&](auto& m) { m.phase = tag_phase(stage_, m.phase); }, o.message);
+    out.push_back(std::move(o));
+  }
+}
+
+std::vector<OutgoingMessage> CertifiedAgent::start() {
+  std::vector<OutgoingMessage> out;
+  begin(0, out);
+  advance(out);
+  return out;
+}
+
+void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& out) {
+  stage_ = stage;
+  switch (stage_kind(stage)) {
+    case StageKind::kSolve: {
+      DistributedOptions o = options_;
+      o.rank = state_.rank();
+      o.grad_norm_tol = solve_tolerance();
+      const double variables = static_cast<double>(state_.rank()) * (state_.problem().dim() + 1) *
+                               static_cast<double>(layout_.owner.size());
+      const auto scheme = make_momentum_scheme(o, layout_, variables);
+      solve_ = std::make_unique<RoundProtocol>(state_, layout_, make_round_config(o, scheme.get()));
+      current_ = solve_.get();
+      break;
+    }
+    case StageKind::kCertify: {
+      DistributedCertificateOptions c = options_.staircase.certificate;
+      c.seed = options_.seed;
+      certify_ = std::make_unique<CertificateProtocol>(state_, layout_, c);
+      current_ = certify_.get();
+      break;
+    }
+    case StageKind::kEscape:
+      escape_ = std::make_unique<SaddleEscapeProtocol>(
+          state_, layout_, direction_, solves_.back().trace.back().cost, solve_tolerance(),
+          options_.staircase.escape);
+      current_ = escape_.get();
+      break;
+  }
+  emit(current_->start(), out);
+  // Messages of this stage that arrived while we were still in an earlier one.
+  auto it = later_.find(stage);
+  if (it == later_.end()) return;
+  std::vector<ProtocolMessage> kept = std::move(it->second);
+  later_.erase(it);
+  for (auto& m : kept) {
+    if (current_->done()) break;
+    std::visit([](auto& x) { x.phase = step_of_phase(x.phase); }, m);
+    emit(current_->handle(m), out);
+  }
+}
+
+std::vector<OutgoingMessage> CertifiedAgent::handle(const ProtocolMessage& message) {
+  std::vector<OutgoingMessage> out;
+  if (done_) return out;
+  const std::uint32_t stage = stage_of_phase(message_phase(message));
+  if (stage < stage_) return out;  // a finished stage needs nothing more
+  if (stage > stage_) {
+    if (stage > stage_ + 3 * 64)
+      throw std::runtime_error("agent " + std::to_string(state_.id()) +
+                               ": message of an impossible stage " + std::to_string(stage));
+    later_[stage].push_back(message);
+    return out;
+  }
+  ProtocolMessage m = message;
+  std::visit([](auto& x) { x.phase = step_of_phase(x.phase); }, m);
+  emit(current_->handle(m), out);
+  advance(out);
+  return out;
+}
+
+void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
+  while (!done_ && current_->done()) {
+    const int rank = state_.rank();
+    switch (stage_kind(stage_)) {
+      case StageKind::kSolve: {
+        solves_.push_back({stage_, rank, solve_->rounds(), solve_->restarts(),
+                           solve_->stop_reason(), solve_->trace()});
+        if (!options_.certify || solve_->trace().empty()) {
+          done_ = true;
+          break;
+        }
+        begin(stage_ + 1, out);
+        break;
+      }
+      case StageKind::kCertify: {
+        CertifyStageRecord rec{stage_, rank, certify_->result()};
+        direction_ = std::move(rec.result.eigenvector);
+        rec.result.eigenvector.resize(0, 0);
+        const bool negative = rec.result.min_eigenvalue < -rec.result.tolerance;
+        certificates_.push_back(std::move(rec));
+        certify_.reset();
+        if (certificates_.back().result.certified || !negative ||
+            rank >= options_.staircase.max_rank) {
+          done_ = true;
+          break;
+        }
+        begin(stage_ + 1, out);
+        break;
+      }
+      case StageKind::kEscape: {
+        const SaddleEscapeResult& r = escape_->result();
+        escapes_.push_back({stage_, rank, r.success, r.trials, r.alpha, r.cost});
+        if (!r.success) {
+          done_ = true;
+          break;
+        }
+        state_.reset_iterate(r.Y, r.Yn);
+        escape_.reset();
+        begin(stage_ + 1, out);
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace tessera

@@ -1,0 +1,89 @@
+#include "distributed/message_gate.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace tessera {
+
+void MessageGate::expect(std::uint32_t round, std::uint32_t step, std::vector<int> senders) {
+  round_ = round;
+  step_ = step;
+  senders_ = std::move(senders);
+}
+
+bool MessageGate::add(int sender, std::uint32_t round, std::uint32_t step,
+                      ProtocolMessage message) {
+  return pending_[key(round, step)].emplace(sender, std::move(message)).second;
+}
+
+std::optional<MessageGate::Inbox> MessageGate::take_ready() {
+  auto it = pending_.find(key(round_, step_));
+  if (senders_.empty()) {
+    Inbox none;
+    if (it != pending_.end()) {
+      none = std::move(it->second);
+      pending_.erase(it);
+    }
+    return none;
+  }
+  if (it == pending_.end()) return std::nullopt;
+  for (int s : senders_)
+    if (!it->second.count(s)) return std::nullopt;
+  Inbox ready = std::move(it->second);
+  pending_.erase(it);
+  return ready;
+}
+
+PoseBlockMessage make_reduction_message(int sender, std::uint32_t round, std::uint32_t phase,
+                                        const std::vector<double>& values) {
+  PoseBlockMessage m;
+  m.round = round;
+  m.sender = static_cast<std::uint32_t>(sender);
+  m.phase = phase;
+  m.kind = BlockKind::kY;
+  m.rank = 1;
+  m.dim = 0;
+  m.pose_ids.resize(values.size());
+  for (std::size_t k = 0; k < values.size(); ++k) m.pose_ids[k] = static_cast<std::uint32_t>(k);
+  m.data = values;
+  return m;
+}
+
+const std::vector<double>& reduction_values(const ProtocolMessage& message, std::size_t count) {
+  const auto* p = std::get_if<PoseBlockMessage>(&message);
+  if (!p || p->data.size() != count || p->rank != 1 || p->dim != 0)
+    throw std::runtime_error("reduction message from agent " +
+                             std::to_string(message_sender(message)) + " does not hold " +
+                             std::to_string(count) + " values");
+  return p->data;
+}
+
+std::vector<double> reduce_in_id_order(const MessageGate::Inbox& inbox, std::size_t count,
+                                       const std::vector<std::size_t>& max_entries) {
+  std::vector<double> total(count, 0.0);
+  bool first = true;
+  for (const auto& [sender, m] : inbox) {
+    const auto& v = reduction_values(m, count);
+    for (std::size_t k = 0; k < count; ++k) {
+      const bool is_max = std::find(max_entries.begin(), max_entries.end(), k) != max_entries.end();
+      if (is_max)
+        total[k] = first ? v[k] : std::max(total[k], v[k]);
+      else
+        total[k] += v[k];
+    }
+    first = false;
+  }
+  return total;
+}
+
+std::uint32_t message_round(const ProtocolMessage& m) {
+  return std::visit([](const auto& x) { return x.round; }, m);
+}
+std::uint32_t message_sender(const ProtocolMessage& m) {
+  return std::visit([](const auto& x) { return x.sender; }, m);
+}
+std::uint32_t message_phase(const ProtocolMessage& m) {
+  return std::visit([](const auto& x) { return x.phase; }, m);
+}
+
+}  // namespace tessera
