@@ -1,0 +1,188 @@
+// Distributed certification and the distributed staircase: the agents' lambda_min(S) agrees
+// with the centralized certificate, a well-behaved optimum is certified, a rank-d saddle of a
+// noisy graph is detected and escaped to the certified optimum, and none of it depends on the
+// message delivery order.
+
+#include "certification/distributed_certificate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "certification/certificate.hpp"
+#include "distributed/agent_state.hpp"
+#include "distributed/block_layout.hpp"
+#include "distributed/distributed_solver.hpp"
+#include "distributed/in_process_driver.hpp"
+#include "generate/generator.hpp"
+#include "partition/sequential_partition.hpp"
+#include "problem/block_problem.hpp"
+#include "problem/lifting.hpp"
+#include "random_graph.hpp"
+#include "solvers/centralized_solver.hpp"
+
+namespace tessera {
+namespace {
+
+// A noisy 2D city graph whose rank-2 (r = d) critical point reached from the odometry guess
+// is a saddle: the certificate fails there.
+PoseGraph saddle_graph() {
+  GeneratorOptions g;
+  g.kind = TrajectoryKind::kCity;
+  g.num_poses = 120;
+  g.rotation_noise = 0.5;
+  g.translation_noise = 0.3;
+  g.seed = 1;
+  return generate_pose_graph(g).graph;
+}
+
+// Runs only the certificate protocol of N agents on an arbitrary lifted point X.
+DistributedCertificateResult certify_in_process(const PoseGraph& g, const Eigen::MatrixXd& X,
+                                                const std::vector<int>& assignment,
+                                                DeliveryOrder order) {
+  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, assignment);
+  const Eigen::Index w = g.d + 1;
+  std::vector<std::unique_ptr<AgentState>> states;
+  std::vector<std::unique_ptr<CertificateProtocol>> protocols;
+  std::vector<AgentProcess*> agents;
+  for (int b = 0; b < layout.num_blocks; ++b) {
+    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+    Eigen::MatrixXd Yb(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
+    for (std::size_t s = 0; s < ids.size(); ++s)
+      Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
+          X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
+    states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements, Yb));
+    const auto& nb = states.back()->problem().neighbors();
+    for (std::size_t s = 0; s < nb.size(); ++s)
+      states.back()->Yn.middleCols(w * static_cast<Eigen::Index>(s), w) =
+          X.middleCols(w * static_cast<Eigen::Index>(nb[s]), w);
+    protocols.push_back(std::make_unique<CertificateProtocol>(*states.back(), layout,
+                                                              DistributedCertificateOptions{}));
+    agents.push_back(protocols.back().get());
+  }
+  run_in_process(agents, order, 7);
+  for (const auto& p : protocols) {  // every agent decided the same
+    EXPECT_EQ(p->result().min_eigenvalue, protocols.front()->result().min_eigenvalue);
+    EXPECT_EQ(p->result().iterations, protocols.front()->result().iterations);
+  }
+  return protocols.front()->result();
+}
+
+TEST(DistributedCertificate, MinimumEigenvalueMatchesCentralizedAtAnyPoint) {
+  test::RandomGraphSpec spec;
+  spec.d = 2;
+  spec.poses = 60;
+  spec.loop_closures = 30;
+  spec.seed = 4;
+  spec.rotation_noise = 0.3;
+  const PoseGraph g = test::random_pose_graph(spec);
+  // An arbitrary (non-critical) lifted point: S is well defined and indefinite there.
+  Eigen::MatrixXd X = lift_poses(g.initial, 3);
+  X.row(2) = 0.3 * X.row(0);
+  X = BlockProblem::whole_graph(2, g.num_poses, g.measurements).manifold(3).project(X);
+  const BlockProblem whole = BlockProblem::whole_graph(2, g.num_poses, g.measurements);
+  const CertificateResult central = verify_certificate(whole, X);
+  ASSERT_FALSE(central.certified);
+  const DistributedCertificateResult dist =
+      certify_in_process(g, X, sequential_partition(g.num_poses, 4), DeliveryOrder::kFifo);
+  EXPECT_TRUE(dist.converged);
+  EXPECT_FALSE(dist.certified);
+  EXPECT_EQ(dist.tolerance, central.tolerance);
+  EXPECT_NEAR(dist.min_eigenvalue, central.min_eigenvalue, 1e-3 * std::abs(central.min_eigenvalue));
+  // theta is a Rayleigh quotient: never below the true minimum (up to round-off).
+  EXPECT_GE(dist.min_eigenvalue, central.min_eigenvalue - 1e-9 * std::abs(central.min_eigenvalue));
+}
+
+TEST(DistributedCertificate, CertifiesTheOptimumOfAWellBehavedGraph) {
+  test::RandomGraphSpec spec;
+  spec.d = 3;
+  spec.poses = 50;
+  spec.loop_closures = 25;
+  spec.seed = 2;
+  const PoseGraph g = test::random_pose_graph(spec);
+  DistributedOptions opt;
+  opt.certify = true;
+  const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 3), opt);
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_TRUE(*r.certified);
+  EXPECT_EQ(r.final_rank, 5);
+  EXPECT_TRUE(r.escapes.empty());
+  EXPECT_GT(r.certificate_rounds, 0);
+  EXPECT_GT(r.certificate_bytes, 0u);
+  EXPECT_LE(r.grad_norm, opt.staircase.grad_norm_tol);
+  // Same verdict and eigenvalue (within eta) as the centralized certificate at the same point.
+  const BlockProblem whole = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  const CertificateResult central = verify_certificate(whole, r.X);
+  EXPECT_TRUE(central.certified);
+  EXPECT_NEAR(r.min_eigenvalue, central.min_eigenvalue, central.tolerance);
+}
+
+TEST(DistributedCertificate, OffByDefaultSendsOnlyTheSolversMessages) {
+  test::RandomGraphSpec spec;
+  spec.d = 2;
+  spec.poses = 40;
+  spec.seed = 3;
+  const PoseGraph g = test::random_pose_graph(spec);
+  const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 3), {});
+  EXPECT_FALSE(r.certified.has_value());
+  EXPECT_EQ(r.certificate_rounds, 0);
+  EXPECT_EQ(r.certificate_bytes, 0u);
+  EXPECT_EQ(r.final_rank, 5);
+}
+
+DistributedOptions saddle_options(DeliveryOrder order) {
+  DistributedOptions opt;
+  opt.rank = 2;  // r = d: the staircase must climb
+  opt.initialization = DistributedInit::kChordal;
+  opt.certify = true;
+  opt.delivery = order;
+  opt.delivery_seed = 11;
+  return opt;
+}
+
+TEST(DistributedStaircase, RankDSaddleEscapesToTheCertifiedOptimum) {
+  const PoseGraph g = saddle_graph();
+  const std::vector<Pose> start = g.initial;  // odometry: far from the optimum
+  const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 4),
+                                                saddle_options(DeliveryOrder::kFifo), start);
+  ASSERT_GE(r.certificates.size(), 2u);
+  const auto& first = r.certificates.front();
+  EXPECT_EQ(first.rank, 2);
+  EXPECT_FALSE(first.result.certified);
+  EXPECT_LT(first.result.min_eigenvalue, -first.result.tolerance);
+  ASSERT_FALSE(r.escapes.empty());
+  EXPECT_TRUE(r.escapes.front().success);
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_TRUE(*r.certified);
+  EXPECT_GT(r.final_rank, 2);
+  EXPECT_EQ(r.X.rows(), r.final_rank);
+  // The same optimum as the centralized certified solver (the SDP's optimum is unique in value).
+  const CentralizedResult ref = solve_centralized(g);
+  ASSERT_TRUE(ref.certified.value_or(false));
+  EXPECT_NEAR(r.relaxation_cost, ref.relaxation_cost, 1e-6 * ref.relaxation_cost);
+  EXPECT_NEAR(r.cost, ref.cost, 1e-5 * ref.cost);
+}
+
+TEST(DistributedStaircase, DeliveryOrderDoesNotChangeTheResult) {
+  const PoseGraph g = saddle_graph();
+  const auto assignment = sequential_partition(g.num_poses, 4);
+  const DistributedResult a =
+      solve_distributed(g, assignment, saddle_options(DeliveryOrder::kFifo), g.initial);
+  const DistributedResult b =
+      solve_distributed(g, assignment, saddle_options(DeliveryOrder::kShuffled), g.initial);
+  const DistributedResult c =
+      solve_distributed(g, assignment, saddle_options(DeliveryOrder::kReversed), g.initial);
+  for (const DistributedResult* o : {&b, &c}) {
+    EXPECT_EQ(o->cost, a.cost);
+    EXPECT_EQ(o->rounds, a.rounds);
+    EXPECT_EQ(o->min_eigenvalue, a.min_eigenvalue);
+    EXPECT_EQ(o->certificate_rounds, a.certificate_rounds);
+    EXPECT_EQ(o->escape_rounds, a.escape_rounds);
+    EXPECT_EQ(o->final_rank, a.final_rank);
+    EXPECT_EQ(o->certificate_bytes, a.certificate_bytes);
+  }
+}
+
+}  // namespace
+}  // namespace tessera
