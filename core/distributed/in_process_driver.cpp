@@ -100,6 +100,12 @@ DeliveryStats run_in_process(const std::vector<AgentProcess*>& agents, DeliveryO
   return deliver(agents, order, delivery_seed, [&](std::size_t i) { return agents[i]->start(); });
 }
 
+DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+                             std::uint64_t delivery_seed) {
+  return run_in_process(std::vector<AgentProcess*>(agents.begin(), agents.end()), order,
+                        delivery_seed);
+}
+
 DeliveryStats resume_in_process(const std::vector<RoundProtocol*>& agents,
                                 const std::vector<ProtocolSnapshot>& snapshots, DeliveryOrder order,
                                 std::uint64_t delivery_seed) {

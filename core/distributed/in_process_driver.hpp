@@ -39,6 +39,9 @@ std::size_t message_bytes(const ProtocolMessage& message);
 /// protocol bug: then std::logic_error). `agents[i]` must be the agent with id i.
 DeliveryStats run_in_process(const std::vector<AgentProcess*>& agents, DeliveryOrder order,
                              std::uint64_t delivery_seed = 1);
+/// Same for plain round protocols.
+DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+                             std::uint64_t delivery_seed = 1);
 
 /// Same, but every agent continues from its snapshot (`snapshots[i]` for agent i, all of the
 /// same round) instead of starting: a coordinated rollback in one process.
