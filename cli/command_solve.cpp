@@ -36,7 +36,7 @@ const char* kHelp =
     "  --init chordal|odometry|file   initial guess (default chordal; file = VERTEX lines)\n"
     "  --rank R                  initial relaxation rank r0 >= d (default 5)\n"
     "  --max-rank R              staircase ceiling (default 10)\n"
-    "  --grad-tol T              relative gradient-norm tolerance (default 1e-4)\n"
+    "  --grad-tol T              relative gradient-norm tolerance (default 1e-5)\n"
     "  --no-certify              skip the certificate (and the staircase)\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 

@@ -1,13 +1,15 @@
 // The centralized certifiable solver: optimality, certificates, initialization, and the
 // reference optima of the public benchmark graphs.
 
+#include "solvers/centralized_solver.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
-
-#include <Eigen/Eigenvalues>
-#include <gtest/gtest.h>
 
 #include "certification/certificate.hpp"
 #include "generate/generator.hpp"
@@ -15,11 +17,12 @@
 #include "problem/block_problem.hpp"
 #include "problem/lifting.hpp"
 #include "problem/objective.hpp"
-#include "solvers/centralized_solver.hpp"
-#include "solvers/chordal_initialization.hpp"
-#include "util/input_error.hpp"
+#include "problem/translation_solve.hpp"
 #include "random_graph.hpp"
+#include "solvers/chordal_initialization.hpp"
+#include "solvers/translation_elimination.hpp"
 #include "test_support.hpp"
+#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {
@@ -98,6 +101,71 @@ TEST(CentralizedSolver, StaircaseEscapesFromRankDeficientSaddle) {
   EXPECT_NEAR(r.cost, best.cost, 1e-6 * best.cost);
 }
 
+TEST_P(CentralizedTest, TranslationEliminationMinimisesOverTranslations) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 40, 25, 0.1, 0.2, 13});
+  const BlockProblem P = BlockProblem::whole_graph(d, g.num_poses, g.measurements);
+  const TranslationElimination elim(d, g.num_poses, g.measurements);
+  // A lifted point (rank d + 2) with random Stiefel blocks and random translations.
+  const int r = d + 2;
+  Eigen::MatrixXd X = Eigen::MatrixXd::Random(r, (d + 1) * static_cast<Eigen::Index>(g.num_poses));
+  const LiftedManifold M = P.manifold(r);
+  X = M.project(X);
+  const Eigen::MatrixXd before = X;
+  elim.optimize_translations(X);
+  // Stiefel blocks and pose 0's translation untouched; the cost went down.
+  for (std::size_t i = 0; i < g.num_poses; ++i)
+    EXPECT_EQ(X.middleCols((d + 1) * i, d), before.middleCols((d + 1) * i, d));
+  EXPECT_EQ(X.col(d), before.col(d));
+  EXPECT_LT(P.cost(X), P.cost(before));
+  // First-order optimality in the translations: their gradient columns vanish.
+  const Eigen::MatrixXd G = P.euclidean_gradient(X);
+  for (std::size_t i = 0; i < g.num_poses; ++i)
+    EXPECT_LT(G.col((d + 1) * i + d).norm(), 1e-8 * (1.0 + G.norm())) << "pose " << i;
+  // At rank d with rotation blocks, the same translations as the SE(d) translation solve.
+  Eigen::MatrixXd Xd = lift_poses(g.initial, d);
+  Eigen::MatrixXd R(d, d * static_cast<Eigen::Index>(g.num_poses));
+  for (std::size_t i = 0; i < g.num_poses; ++i) R.middleCols(d * i, d) = g.initial[i].R;
+  Xd.col(d).setZero();
+  elim.optimize_translations(Xd);
+  const Eigen::MatrixXd t = solve_translations(g, R);
+  for (std::size_t i = 0; i < g.num_poses; ++i)
+    EXPECT_LT((Xd.col((d + 1) * i + d) - t.col(i)).norm(), 1e-8) << "pose " << i;
+}
+
+TEST_P(CentralizedTest, ExplicitAndEliminatedTranslationsReachTheSameOptimum) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 80, 50, 0.1, 0.1, 17});
+  CentralizedOptions opt;
+  opt.trust_region.grad_norm_tol = 1e-8;
+  opt.eliminate_translations = true;
+  const CentralizedResult a = solve_centralized(g, opt);
+  opt.eliminate_translations = false;
+  const CentralizedResult b = solve_centralized(g, opt);
+  ASSERT_TRUE(a.certified && b.certified);
+  EXPECT_TRUE(*a.certified);
+  EXPECT_TRUE(*b.certified);
+  EXPECT_NEAR(a.cost, b.cost, 1e-9 * b.cost);
+  EXPECT_NEAR(a.relaxation_cost, b.relaxation_cost, 1e-9 * b.relaxation_cost);
+}
+
+TEST(CentralizedSolver, ReportsTheSolutionAtTheRelaxationRank) {
+  // The solver iterates on the active (non-zero) rows only; the result is still the rank-r0
+  // point, certified by the certificate computed on all r0 rows.
+  auto g = test::random_pose_graph({3, 50, 30, 0.05, 0.1, 3});
+  CentralizedOptions opt;
+  opt.initial_rank = 6;
+  const CentralizedResult r = solve_centralized(g, opt);
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_TRUE(*r.certified);
+  EXPECT_EQ(r.final_rank, 6);
+  ASSERT_EQ(r.X.rows(), 6);
+  const BlockProblem P = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  EXPECT_LT(P.manifold(6).distance_from_manifold(r.X), 1e-10);
+  EXPECT_NEAR(P.cost(r.X), r.relaxation_cost, 1e-9 * r.relaxation_cost);
+  EXPECT_TRUE(verify_certificate(P, r.X).certified);
+}
+
 TEST(CentralizedSolver, RejectsInvalidOptionsNamingTheField) {
   auto g = test::random_pose_graph({3, 10, 5, 0.05, 0.1, 1});
   CentralizedOptions opt;
@@ -111,6 +179,15 @@ TEST(CentralizedSolver, RejectsInvalidOptionsNamingTheField) {
   CentralizedOptions opt2;
   opt2.trust_region.max_iterations = 0;
   EXPECT_THROW(solve_centralized(g, opt2), InputError);
+  CentralizedOptions opt3;
+  opt3.certified_lanczos_tolerance = 0.0;
+  try {
+    solve_centralized(g, opt3);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("certified_lanczos_tolerance"), std::string::npos)
+        << e.what();
+  }
 }
 
 struct GeneratedCase {
@@ -179,17 +256,18 @@ TEST_P(DatasetTest, ReachesCertifiedReferenceOptimum) {
   EXPECT_NEAR(r.cost, it->second, 1e-6 * it->second) << name;
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Reference, DatasetTest,
-    ::testing::Values("tinyGrid3D", "smallGrid3D", "MIT", "CSAIL", "intel", "kitti_05", "kitti_00",
-                      "kitti_02", "manhattan3500", "sphere2500", "parking-garage", "city10000",
-                      "sphere_bignoise_vertex3", "ais2klinik", "cubicle", "torus3D"),
-    [](const auto& info) {
-      std::string s = info.param;
-      for (auto& c : s)
-        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-      return s;
-    });
+INSTANTIATE_TEST_SUITE_P(Reference, DatasetTest,
+                         ::testing::Values("tinyGrid3D", "smallGrid3D", "MIT", "CSAIL", "intel",
+                                           "kitti_05", "kitti_00", "kitti_02", "manhattan3500",
+                                           "sphere2500", "parking-garage", "city10000",
+                                           "sphere_bignoise_vertex3", "ais2klinik", "cubicle",
+                                           "torus3D"),
+                         [](const auto& info) {
+                           std::string s = info.param;
+                           for (auto& c : s)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return s;
+                         });
 
 }  // namespace
 }  // namespace tessera

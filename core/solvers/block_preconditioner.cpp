@@ -1,8 +1,7 @@
 #include "solvers/block_preconditioner.hpp"
 
-#include <stdexcept>
-
 #include <Eigen/CholmodSupport>
+#include <stdexcept>
 
 namespace tessera {
 

@@ -7,9 +7,8 @@
 // part near a critical point, was tried: no fewer tCG iterations on kitti_02 (1598 vs 1588)
 // for one extra factorization per step, so the fixed Q-based factor stays.)
 
-#include <memory>
-
 #include <Eigen/Core>
+#include <memory>
 
 #include "problem/block_problem.hpp"
 

@@ -1,9 +1,8 @@
 #include "solvers/chordal_initialization.hpp"
 
-#include <stdexcept>
-
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
+#include <stdexcept>
 
 #include "problem/lifting.hpp"
 #include "problem/rounding.hpp"

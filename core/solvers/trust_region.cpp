@@ -20,13 +20,16 @@ void TrustRegionOptions::validate() const {
   if (!(max_radius > 0)) fail("max_radius", "must be > 0");
   if (!(tcg_kappa > 0 && tcg_kappa < 1)) fail("tcg_kappa", "must be in (0, 1)");
   if (!(tcg_theta > 0 && tcg_theta <= 1)) fail("tcg_theta", "must be in (0, 1]");
-  if (!(acceptance_ratio >= 0 && acceptance_ratio < 0.25)) fail("acceptance_ratio", "must be in [0, 0.25)");
+  if (!(acceptance_ratio >= 0 && acceptance_ratio < 0.25))
+    fail("acceptance_ratio", "must be in [0, 0.25)");
   if (!(max_time_s > 0)) fail("max_time_s", "must be > 0");
 }
 
 namespace {
 
-double inner(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) { return A.cwiseProduct(B).sum(); }
+double inner(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+  return A.cwiseProduct(B).sum();
+}
 
 struct TcgOutcome {
   Eigen::MatrixXd eta;
@@ -37,12 +40,11 @@ struct TcgOutcome {
 
 // Steihaug–Toint truncated CG on the model m(eta) = <g, eta> + 1/2 <H eta, eta>, with the
 // trust region measured in the preconditioner's norm.
-TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M, const Eigen::MatrixXd& X,
-                        const Eigen::MatrixXd& egrad, const Eigen::MatrixXd& grad, double radius,
-                        const TrustRegionOptions& opt, const BlockPreconditioner* precon) {
-  auto precondition = [&](const Eigen::MatrixXd& v) {
-    return precon ? precon->apply(M, X, v) : v;
-  };
+TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
+                        const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
+                        const Eigen::MatrixXd& grad, double radius, const TrustRegionOptions& opt,
+                        const BlockPreconditioner* precon) {
+  auto precondition = [&](const Eigen::MatrixXd& v) { return precon ? precon->apply(M, X, v) : v; };
   TcgOutcome out;
   out.eta = Eigen::MatrixXd::Zero(X.rows(), X.cols());
   out.Heta = out.eta;
@@ -61,7 +63,8 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M, co
     const double e_Pe_new = e_Pe + 2.0 * alpha * e_Pd + alpha * alpha * d_Pd;
     if (d_Hd <= 0 || e_Pe_new >= radius_sq) {
       // Follow delta to the boundary of the trust region.
-      const double tau = (-e_Pd + std::sqrt(std::max(0.0, e_Pd * e_Pd + d_Pd * (radius_sq - e_Pe)))) / d_Pd;
+      const double tau =
+          (-e_Pd + std::sqrt(std::max(0.0, e_Pd * e_Pd + d_Pd * (radius_sq - e_Pe)))) / d_Pd;
       out.eta += tau * delta;
       out.Heta += tau * Hdelta;
       out.hit_boundary = true;
@@ -89,7 +92,8 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M, co
 
 TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::MatrixXd& X0,
                                      const TrustRegionOptions& options,
-                                     const BlockPreconditioner* preconditioner) {
+                                     const BlockPreconditioner* preconditioner,
+                                     const PointRefinement* refine) {
   options.validate();
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] {
@@ -98,6 +102,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   const LiftedManifold M = problem.manifold(static_cast<int>(X0.rows()));
   TrustRegionResult res;
   res.X = X0;
+  if (refine) (*refine)(res.X);
   double f = problem.cost(res.X);
   Eigen::MatrixXd egrad = problem.euclidean_gradient(res.X);
   Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
@@ -120,11 +125,13 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner);
     res.total_inner_iterations += step.iterations;
     Eigen::MatrixXd X_new = M.retract(res.X, step.eta);
+    if (refine) (*refine)(X_new);
     const double f_new = problem.cost(X_new);
     const double model_decrease = -(inner(grad, step.eta) + 0.5 * inner(step.Heta, step.eta));
     double rho = (f - f_new) / std::max(model_decrease, std::numeric_limits<double>::min());
     // When both decreases sit at round-off level, the ratio is noise: trust the model.
-    if (std::abs(f - f_new) <= 1e-14 * std::abs(f) && model_decrease <= 1e-14 * std::abs(f)) rho = 1.0;
+    if (std::abs(f - f_new) <= 1e-14 * std::abs(f) && model_decrease <= 1e-14 * std::abs(f))
+      rho = 1.0;
     if (rho < 0.25) {
       radius *= 0.25;
     } else if (rho > 0.75 && step.hit_boundary) {
@@ -142,7 +149,8 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     }
     res.iterations = it + 1;
     if (options.record_trace)
-      res.trace.push_back({it + 1, f, grad_norm, radius, rho, step.iterations, accepted, elapsed()});
+      res.trace.push_back(
+          {it + 1, f, grad_norm, radius, rho, step.iterations, accepted, elapsed()});
     if (accepted && decrease <= options.rel_cost_decrease_tol * std::abs(f)) {
       res.stop_reason = "relative_decrease";
       break;

@@ -3,10 +3,10 @@
 // (Steihaug–Toint) for a BlockProblem on its lifted manifold. Used by the centralized
 // solver (many iterations) and by the distributed block updates (one or a few iterations).
 
+#include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "problem/block_problem.hpp"
 #include "solvers/block_preconditioner.hpp"
@@ -19,12 +19,12 @@ struct TrustRegionOptions {
   double grad_norm_tol = 1e-6;      ///< Stop when ||grad f|| <= this (absolute, >= 0).
   /// Stop when an accepted step decreases f by less than this fraction of f (>= 0).
   double rel_cost_decrease_tol = 1e-12;
-  double initial_radius = 0.0;      ///< <= 0: set from the first preconditioned gradient.
-  double max_radius = 1e12;         ///< > 0.
-  double tcg_kappa = 0.1;           ///< Linear convergence target of tCG, in (0, 1).
-  double tcg_theta = 1.0;           ///< Superlinear exponent of tCG, in (0, 1].
-  double acceptance_ratio = 1e-4;   ///< Minimum rho to accept a step, in [0, 0.25).
-  double max_time_s = 1e9;          ///< Wall-clock budget, seconds (> 0).
+  double initial_radius = 0.0;     ///< <= 0: set from the first preconditioned gradient.
+  double max_radius = 1e12;        ///< > 0.
+  double tcg_kappa = 0.1;          ///< Linear convergence target of tCG, in (0, 1).
+  double tcg_theta = 1.0;          ///< Superlinear exponent of tCG, in (0, 1].
+  double acceptance_ratio = 1e-4;  ///< Minimum rho to accept a step, in [0, 0.25).
+  double max_time_s = 1e9;         ///< Wall-clock budget, seconds (> 0).
   bool record_trace = true;
 
   /// Throws InputError naming the first invalid field.
@@ -52,10 +52,16 @@ struct TrustRegionResult {
   std::vector<TrustRegionIteration> trace;
 };
 
+/// Optional map applied to X0 and to every trial point after the retraction; it must keep
+/// the point on the manifold and must not increase the cost. The centralized solver passes
+/// the exact translation solve (solvers/translation_elimination.hpp).
+using PointRefinement = std::function<void(Eigen::MatrixXd&)>;
+
 /// Minimises problem.cost over the lifted manifold starting from X0 (on the manifold).
-/// `preconditioner` may be null (identity).
+/// `preconditioner` may be null (identity); `refine` may be null (none).
 TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::MatrixXd& X0,
                                      const TrustRegionOptions& options,
-                                     const BlockPreconditioner* preconditioner = nullptr);
+                                     const BlockPreconditioner* preconditioner = nullptr,
+                                     const PointRefinement* refine = nullptr);
 
 }  // namespace tessera
