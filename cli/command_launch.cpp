@@ -24,6 +24,7 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "session_args.hpp"
+#include "transport/security.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::cli {
@@ -195,6 +196,10 @@ int run_launch(const Args& argv) {
   const long seed = args.get_long("seed", 1);
   if (seed < 0) throw InputError("launch: --seed must be >= 0");
   SessionArgs net = parse_session_args(args, SessionArgsFor::kLaunch);
+  if (!net.session.security_dir.empty())  // every identity is needed on this host
+    for (long k = -1; k < agents; ++k)
+      transport::security_files(net.session.security_dir,
+                                transport::security_identity(k < 0, static_cast<std::uint32_t>(k)));
   const double timeout_s = args.get_double("timeout", 600);
   if (!(timeout_s > 0)) throw InputError("launch: --timeout must be > 0");
   const long poses = args.get_long("poses", 1000);

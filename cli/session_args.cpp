@@ -8,7 +8,7 @@
 namespace tessera::cli {
 
 std::set<std::string> session_option_names(SessionArgsFor who) {
-  std::set<std::string> names = {"run-id", "domain", "lease", "peers", "network"};
+  std::set<std::string> names = {"run-id", "domain", "lease", "peers", "network", "security"};
   if (who == SessionArgsFor::kProcess) names.insert("timeout");
   return names;
 }
@@ -30,6 +30,9 @@ SessionArgs parse_session_args(const Arguments& args, SessionArgsFor who) {
   o.lease_s = args.get_double("lease", o.lease_s);
   o.initial_peers = args.get_list("peers");
   o.network = args.get_or("network", o.network);
+  o.security_dir = args.get_or("security", o.security_dir);
+  if (args.has("security") && o.security_dir.empty())
+    throw InputError("option --security: needs a folder (scripts/security/make_identities.sh)");
   if (who == SessionArgsFor::kProcess) {
     a.timeout_s = args.get_double("timeout", a.timeout_s);
     if (!(a.timeout_s > 0)) throw InputError("option --timeout: must be positive");
@@ -55,10 +58,12 @@ std::vector<std::string> session_argv(const transport::SessionOptions& o) {
     out.insert(out.end(), {"--peers", list});
   }
   if (o.network != defaults.network) out.insert(out.end(), {"--network", o.network});
+  if (!o.security_dir.empty()) out.insert(out.end(), {"--security", o.security_dir});
   return out;
 }
 
 std::string session_options_help(SessionArgsFor who) {
+  // clang-format off
   std::string h;
   if (who == SessionArgsFor::kProcess)
     h += "  --run-id ID        run id shared by all processes of the run (default \"default\");\n"
@@ -67,13 +72,16 @@ std::string session_options_help(SessionArgsFor who) {
     h += "  --run-id ID        run id of every process (default: a fresh one per launch)\n";
   h += "  --domain D         DDS domain id 0..232 (default: derived from the run id)\n";
   if (who == SessionArgsFor::kProcess)
-    h += "  --timeout S        bound on each wait for peers during set-up, in seconds (default "
-         "30)\n";
-  h +=
-      "  --lease S          participant/liveliness lease in seconds: a dead peer is noticed after\n"
-      "                     about this long (default 1, range 0.2..60)\n"
-      "  --peers IP[,IP]    IPv4 addresses to contact by unicast (when multicast is not "
-      "available)\n";
+    h += "  --timeout S        bound on each wait for peers during set-up, in seconds (default 30)\n";
+  h += "  --lease S          participant/liveliness lease in seconds: a dead peer is noticed after\n"
+       "                     about this long (default 1, range 0.2..60)\n"
+       "  --peers IP[,IP]    IPv4 addresses to contact by unicast (when multicast is not available)\n"
+       "  --network NAME     transport profile: default, or lossy for links that drop packets\n"
+       "                     (1400-byte datagrams, 4 MB socket buffers, 10 ms heartbeat)\n"
+       "  --security DIR     DDS Security: authentication, access control and encryption with\n"
+       "                     the CA, the signed governance and this process's identity in DIR\n"
+       "                     (DIR/coordinator, DIR/agent_<k>; scripts/security/make_identities.sh)\n";
+  // clang-format on
   return h;
 }
 

@@ -19,8 +19,8 @@ enum class SessionArgsFor { kProcess, kLaunch };
 
 /// The shared session options of one process.
 struct SessionArgs {
-  /// --run-id, --domain, --lease, --peers, --network (role fields left at their defaults: the
-  /// caller sets coordinator / agent_id / num_agents / verbose).
+  /// --run-id, --domain, --lease, --peers, --network, --security (role fields left at their
+  /// defaults: the caller sets coordinator / agent_id / num_agents / verbose).
   transport::SessionOptions session;
   /// --timeout S (kProcess only): bound on each wait for peers during set-up and shutdown,
   /// seconds, > 0. Default 30.
@@ -40,7 +40,8 @@ SessionArgs parse_session_args(const Arguments& args, SessionArgsFor who);
 
 /// The command-line arguments that make a tessera-agent / tessera-coordinator join the run
 /// described by `o`: --run-id always, the others only when they differ from the defaults.
-/// parse_session_args(session_argv(o)) gives back o's run id, domain, lease, peers and network.
+/// parse_session_args(session_argv(o)) gives back o's run id, domain, lease, peers, network and
+/// security folder.
 std::vector<std::string> session_argv(const transport::SessionOptions& o);
 
 /// --help lines describing the shared options (two-space indent, one option per entry).

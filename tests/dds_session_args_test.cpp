@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "session_args.hpp"
+#include "test_support.hpp"
 #include "util/input_error.hpp"
 
 namespace {
@@ -82,6 +83,21 @@ TEST(DdsSessionArgs, LaunchKeepsItsOwnTimeout) {
   EXPECT_FALSE(session_option_names(SessionArgsFor::kLaunch).count("timeout"));
   EXPECT_NE(session_options_help(SessionArgsFor::kProcess).find("--timeout"), std::string::npos);
   EXPECT_EQ(session_options_help(SessionArgsFor::kLaunch).find("--timeout"), std::string::npos);
+}
+
+TEST(DdsSessionArgs, SecurityFolderIsCheckedAndForwarded) {
+  const std::string missing =
+      error_of({"--security", "/nonexistent/tessera-sec"}, SessionArgsFor::kProcess);
+  EXPECT_NE(missing.find("--security"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("/nonexistent/tessera-sec"), std::string::npos) << missing;
+  // A folder with the shared files passes parsing (the role's own files are checked later).
+  const std::string dir = tessera::test::temp_dir();
+  const std::string no_governance = error_of({"--security", dir}, SessionArgsFor::kLaunch);
+  EXPECT_NE(no_governance.find("ca_cert.pem"), std::string::npos) << no_governance;
+  tessera::test::write_file(dir, "ca_cert.pem", "x");
+  tessera::test::write_file(dir, "governance.p7s", "x");
+  SessionArgs a = parse({"--security", dir}, SessionArgsFor::kLaunch);
+  EXPECT_EQ(parse(session_argv(a.session), SessionArgsFor::kProcess).session.security_dir, dir);
 }
 
 }  // namespace

@@ -15,9 +15,10 @@ namespace tessera::transport {
 namespace dds = eprosima::fastdds::dds;
 using eprosima::fastrtps::Duration_t;
 
-dds::DomainParticipantQos participant_qos(const std::string& name, double lease_s,
-                                          const std::vector<std::string>& initial_peers, int domain,
-                                          std::uint32_t num_agents, const NetworkProfile& net) {
+dds::DomainParticipantQos participant_qos(
+    const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
+    int domain, std::uint32_t num_agents, const NetworkProfile& net,
+    const std::vector<std::pair<std::string, std::string>>& properties) {
   dds::DomainParticipantQos q;
   dds::DomainParticipantFactory::get_instance()->get_default_participant_qos(q);
   q.name(name);
@@ -45,6 +46,7 @@ dds::DomainParticipantQos participant_qos(const std::string& name, double lease_
     q.transport().send_socket_buffer_size = net.socket_buffer_bytes;
     q.transport().listen_socket_buffer_size = net.socket_buffer_bytes;
   }
+  for (const auto& [key, value] : properties) q.properties().properties().emplace_back(key, value);
   for (const std::string& ip : initial_peers) {
     // Metatraffic unicast port of participant id p: 7400 + 250 * domain + 10 + 2 * p.
     const std::uint32_t participants = num_agents + 3;

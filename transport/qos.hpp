@@ -9,6 +9,7 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "transport/network_profile.hpp"
@@ -20,10 +21,12 @@ constexpr std::int32_t kWriterHistory = 16;
 
 /// Participant: named, short lease so a dead peer is noticed within ~lease seconds,
 /// optional unicast initial peers (all participant ids up to num_agents + 2 on `domain`),
-/// the UDP datagram size and socket buffers of `net`.
+/// the UDP datagram size and socket buffers of `net`, extra `properties` (DDS Security's,
+/// security.hpp).
 eprosima::fastdds::dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
-    int domain, std::uint32_t num_agents, const NetworkProfile& net);
+    int domain, std::uint32_t num_agents, const NetworkProfile& net,
+    const std::vector<std::pair<std::string, std::string>>& properties = {});
 /// Publisher / subscriber: Partition = run id.
 eprosima::fastdds::dds::PublisherQos publisher_qos(const std::string& run_id);
 eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);

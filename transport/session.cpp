@@ -27,6 +27,8 @@
 #include "tesseraPubSubTypes.h"
 #include "transport/message_mapping.hpp"
 #include "transport/qos.hpp"
+#include "transport/security.hpp"
+#include "transport/topic_names.hpp"
 #include "transport/transport_error.hpp"
 #include "util/input_error.hpp"
 
@@ -37,15 +39,6 @@ namespace rtps = eprosima::fastrtps::rtps;
 using eprosima::fastrtps::types::ReturnCode_t;
 
 namespace {
-
-// Topic names (one topic per message type; Partition QoS = run id on top).
-constexpr const char* kAnnounceTopic = "tessera_announce";
-constexpr const char* kAssignmentTopic = "tessera_assignment";
-constexpr const char* kHandoffTopic = "tessera_handoff";
-constexpr const char* kBlockTopic = "tessera_pose_block";
-constexpr const char* kStatusTopic = "tessera_round_status";
-constexpr const char* kFinalTopic = "tessera_final";
-constexpr const char* kControlTopic = "tessera_control";
 
 using Prefix = rtps::GuidPrefix_t;
 
@@ -404,6 +397,10 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   s.opt = options;
   s.tolerate_agent_loss = options.tolerate_agent_loss;
   s.net = network_profile(options.network);
+  std::vector<std::pair<std::string, std::string>> security;
+  if (!options.security_dir.empty())
+    security = security_properties(security_files(
+        options.security_dir, security_identity(options.coordinator, options.agent_id)));
   s.domain = options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
   s.me = PeerIdentity{options.run_id, options.coordinator,
                       options.coordinator ? 0u : options.agent_id};
@@ -416,10 +413,15 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   s.participant = factory->create_participant(
       s.domain,
       participant_qos(participant_name(s.me), options.lease_s, options.initial_peers, s.domain,
-                      options.num_agents, s.net),
+                      options.num_agents, s.net, security),
       s.participant_listener.get(), dds::StatusMask::none());
   if (!s.participant)
-    throw TransportError("cannot create a DDS participant on domain " + std::to_string(s.domain));
+    throw TransportError("cannot create a DDS participant on domain " + std::to_string(s.domain) +
+                         (security.empty()
+                              ? std::string()
+                              : " with DDS Security from " + options.security_dir +
+                                    " (certificate, key, permissions or governance rejected; "
+                                    "TESSERA_DDS_LOG=1 shows Fast DDS's reason)"));
   s.own_prefix = s.participant->guid().guidPrefix;
   try {
     s.publisher = s.participant->create_publisher(publisher_qos(options.run_id));

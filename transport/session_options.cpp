@@ -4,6 +4,7 @@
 
 #include "transport/network_profile.hpp"
 #include "transport/run_identity.hpp"
+#include "transport/security.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::transport {
@@ -21,6 +22,8 @@ void SessionOptions::validate() const {
   if (!(lease_s >= 0.2 && lease_s <= 60))
     throw InputError("option --lease: " + std::to_string(lease_s) + " s is outside 0.2..60 s");
   network_profile(network);  // throws for an unknown name
+  // The role's own files are checked when the session starts (security_files).
+  if (!security_dir.empty()) check_security_dir(security_dir);
   if (!(write_timeout_s > 0)) throw InputError("write timeout must be positive");
   for (const auto& ip : initial_peers) {
     in_addr addr{};

@@ -23,6 +23,10 @@ struct SessionOptions {
   /// Transport profile (network_profile.hpp): "default", or "lossy" for links that drop
   /// frames (small datagrams, big socket buffers).
   std::string network = "default";
+  /// DDS Security folder (security.hpp; scripts/security/make_identities.sh): empty = off.
+  /// On: authentication, access control and encryption with this process's identity
+  /// (DIR/coordinator or DIR/agent_<k>), the CA and the signed governance in DIR.
+  std::string security_dir;
   /// How long a write may wait for room in the bounded history before failing (seconds).
   double write_timeout_s = 30.0;
   /// Print discovery events (peer found / lost) to stderr.

@@ -1,0 +1,180 @@
+// DDS Security (`--security DIR`, scripts/security/make_identities.sh): a secured run works
+// end to end with the unsecured run's cost; outsiders -- a participant without identity, one
+// with an identity from another CA, one from the right CA without permission for Tessera's
+// topics -- read zero samples of a secured run while a permitted read-only identity reads
+// it (so "zero" is not the snoop failing); a bad DIR is a clear error naming the file.
+// Domains 193-198.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "dds_process_support.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace tessera::test;
+using namespace tessera::test::dds;
+
+const std::string kMakeIdentities =
+    std::string(TESSERA_SOURCE_DIR) + "/scripts/security/make_identities.sh";
+
+bool have_openssl() {
+  return run_command("command -v openssl", nullptr) == 0;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// One number field of a JSON summary (NaN when absent).
+double json_field(const std::string& text, const std::string& key) {
+  const auto at = text.find("\"" + key + "\": ");
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(text.c_str() + at + key.size() + 4, nullptr);
+}
+
+// "samples=K" etc. from tessera-dds-snoop's last line (-1 when absent).
+long snoop_field(const std::string& out, const std::string& key) {
+  const auto at = out.rfind(key + "=");
+  if (at == std::string::npos) return -1;
+  return std::strtol(out.c_str() + at + key.size() + 1, nullptr, 10);
+}
+
+TEST(DdsSecurity, SecuredLaunchGivesTheUnsecuredCost) {
+  if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
+  const std::string dir = temp_dir();
+  ASSERT_EQ(run_command(kMakeIdentities + " " + dir + "/sec 3", nullptr), 0);
+  std::string plain_out, secure_out;
+  const std::string common = " launch --agents 3 --poses 200 --partition eco --timeout 60 --quiet";
+  ASSERT_EQ(run_command(bin("tessera") + common + " --domain 193 --json " + dir + "/plain.json",
+                        &plain_out),
+            0)
+      << plain_out;
+  ASSERT_EQ(run_command(bin("tessera") + common + " --domain 194 --security " + dir +
+                            "/sec --json " + dir + "/secure.json",
+                        &secure_out),
+            0)
+      << secure_out;
+  const std::string plain = read_text(dir + "/plain.json"),
+                    secure = read_text(dir + "/secure.json");
+  const double c0 = json_field(plain, "cost"), c1 = json_field(secure, "cost");
+  ASSERT_TRUE(std::isfinite(c0) && c0 > 0) << plain;
+  EXPECT_NEAR(c1, c0, 1e-9 * c0) << secure;
+  EXPECT_EQ(json_field(secure, "rounds"), json_field(plain, "rounds"));
+}
+
+TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
+  if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
+  const std::string dir = temp_dir();
+  const std::string sec = dir + "/sec", other = dir + "/other";
+  ASSERT_EQ(run_command(kMakeIdentities + " " + sec + " 3 --observer monitor --no-permission nosy",
+                        nullptr),
+            0);
+  ASSERT_EQ(
+      run_command(kMakeIdentities + " " + other + " 3 --ca-name 'Another CA' --observer monitor",
+                  nullptr),
+      0);
+  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 5));
+  const std::string run = "secure-" + std::to_string(getpid());
+  const int domain = 195;
+
+  // The watchers first, so they are there for the whole run.
+  struct Watcher {
+    std::string name;
+    std::vector<std::string> extra;
+    Process p;
+  };
+  std::vector<Watcher> watchers = {
+      {"no identity", {}, {}},
+      {"another CA", {"--security", other, "--identity", "monitor"}, {}},
+      {"no permission", {"--security", sec, "--identity", "nosy"}, {}},
+      {"permitted monitor", {"--security", sec, "--identity", "monitor"}, {}},
+  };
+  for (auto& w : watchers) {
+    std::vector<std::string> argv = {bin("tessera-dds-snoop"),
+                                     "--domain",
+                                     std::to_string(domain),
+                                     "--run-id",
+                                     run,
+                                     "--duration",
+                                     "60"};
+    argv.insert(argv.end(), w.extra.begin(), w.extra.end());
+    w.p = start(argv, dir + "/snoop_" + std::to_string(&w - watchers.data()) + ".log");
+  }
+  for (auto& w : watchers) {  // each prints "listening" once its readers exist
+    for (int k = 0; k < 200 && w.p.output().find("listening") == std::string::npos; ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    ASSERT_NE(w.p.output().find("listening"), std::string::npos) << w.name << ": " << w.p.output();
+  }
+
+  std::vector<Process> procs;
+  const std::vector<std::string> session = {"--run-id",  run,  "--domain",   std::to_string(domain),
+                                            "--timeout", "30", "--security", sec};
+  std::vector<std::string> c = {bin("tessera-coordinator"), "--agents", "3"};
+  c.insert(c.end(), session.begin(), session.end());
+  procs.push_back(start(c, dir + "/coordinator.log"));
+  for (int k = 0; k < 3; ++k) {
+    std::vector<std::string> a = {bin("tessera-agent"), "--graph", graph, "--robots", "3", "--id",
+                                  std::to_string(k)};
+    a.insert(a.end(), session.begin(), session.end());
+    procs.push_back(start(a, dir + "/agent" + std::to_string(k) + ".log"));
+  }
+  std::vector<Process*> all;
+  for (auto& p : procs) all.push_back(&p);
+  ASSERT_TRUE(wait_all(all, 45)) << "a process hung";
+  for (auto& p : procs) EXPECT_EQ(p.exit_code, 0) << p.output();
+
+  for (auto& w : watchers) kill(w.p.pid, SIGINT);
+  std::vector<Process*> snoops;
+  for (auto& w : watchers) snoops.push_back(&w.p);
+  ASSERT_TRUE(wait_all(snoops, 15));
+  for (auto& w : watchers) {
+    const std::string out = w.p.output();
+    const long samples = snoop_field(out, "samples");
+    if (w.name == "permitted monitor") {
+      EXPECT_GT(samples, 0) << w.name << " (the control) should read the run: " << out;
+    } else {
+      EXPECT_EQ(samples, 0) << w.name << " read the secured run: " << out;
+    }
+    if (w.name == "no permission") {  // access control refuses its readers outright
+      EXPECT_EQ(snoop_field(out, "refused"), 7) << out;
+    }
+  }
+  run_command("fastdds shm clean", nullptr);
+}
+
+TEST(DdsSecurity, BadSecurityFolderNamesTheFile) {
+  if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
+  const std::string dir = temp_dir();
+  ASSERT_EQ(run_command(kMakeIdentities + " " + dir + "/sec 2", nullptr), 0);
+  ASSERT_EQ(std::remove((dir + "/sec/agent_1/key.pem").c_str()), 0);
+  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(4, 5));
+  std::string out;
+  EXPECT_EQ(
+      run_command(bin("tessera-agent") + " --graph " + graph +
+                      " --robots 2 --id 1 --domain 196 --timeout 2 --security " + dir + "/sec 2>&1",
+                  &out),
+      2);
+  EXPECT_NE(out.find("agent_1/key.pem"), std::string::npos) << out;
+  // A folder without the shared files: named at option parsing, by every executable.
+  EXPECT_EQ(run_command(bin("tessera-coordinator") + " --agents 2 --domain 196 --security " + dir +
+                            "/nowhere 2>&1",
+                        &out),
+            2);
+  EXPECT_NE(out.find(dir + "/nowhere"), std::string::npos) << out;
+  ASSERT_EQ(std::remove((dir + "/sec/governance.p7s").c_str()), 0);
+  EXPECT_EQ(
+      run_command(
+          bin("tessera") + " launch --agents 2 --domain 196 --security " + dir + "/sec 2>&1", &out),
+      2);
+  EXPECT_NE(out.find("governance.p7s"), std::string::npos) << out;
+}
+
+}  // namespace
