@@ -85,6 +85,22 @@ TEST(Momentum, StepsLandOnTheManifold) {
   EXPECT_LT((extrapolate(M, c, Y, V) - Y).norm(), 1e-12);
 }
 
+// Points near the manifold (the usual case: blends of nearby iterates) take the Newton-Schulz
+// path of Proj_M, far ones the eigen-decomposition: both must give the SVD's polar factor.
+TEST(Momentum, ProjectionMatchesThePolarFactorNearAndFar) {
+  for (int d : {2, 3}) {
+    const LiftedManifold M(5, d, 9);
+    const Eigen::MatrixXd Y = M.project(Eigen::MatrixXd::Random(5, 9 * (d + 1)));
+    for (double offset : {1e-9, 1e-3, 0.1, 3.0}) {
+      const Eigen::MatrixXd V = M.project(Y + offset * Eigen::MatrixXd::Random(5, 9 * (d + 1)));
+      const MomentumCoefficients c{0.4, 1.0, 0.0};
+      const Eigen::MatrixXd P = extrapolate(M, c, Y, V);
+      EXPECT_LT(M.distance_from_manifold(P), 1e-13) << d << " " << offset;
+      EXPECT_LT((P - M.project(0.4 * V + 0.6 * Y)).norm(), 1e-12) << d << " " << offset;
+    }
+  }
+}
+
 TEST(Irbcd, BadOptionsNameTheField) {
   IrbcdOptions o;
   o.b0 = -1;

@@ -76,6 +76,44 @@ TEST(DistributedSolver, AgentCostSharesSumToGlobalCost) {
   EXPECT_NEAR(gsq, g_whole, 1e-9 * g_whole);
 }
 
+// The status after a block update reuses the update's gradient only while the point and the
+// neighbours are those of the update; either way it must equal a fresh computation.
+TEST(DistributedSolver, StatusAfterUpdateMatchesFreshGradient) {
+  const PoseGraph g = small_graph(3, 40, 7);
+  const std::vector<int> a = [&] {
+    std::vector<int> out(g.num_poses);
+    for (std::size_t i = 0; i < g.num_poses; ++i) out[i] = i < g.num_poses / 2 ? 0 : 1;
+    return out;
+  }();
+  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
+  const Eigen::MatrixXd X = lift_poses(g.initial, 5);
+  auto gather = [&](const std::vector<std::size_t>& which) {
+    Eigen::MatrixXd out(5, 4 * static_cast<Eigen::Index>(which.size()));
+    for (std::size_t s = 0; s < which.size(); ++s)
+      out.middleCols(4 * static_cast<Eigen::Index>(s), 4) =
+          X.middleCols(4 * static_cast<Eigen::Index>(which[s]), 4);
+    return out;
+  };
+  const auto& ids = layout.poses[0];
+  AgentState agent(0, 3, layout, g.measurements, gather(ids));
+  BlockProblem fresh(3, ids, g.measurements);
+  agent.Yn = gather(fresh.neighbors());
+  auto fresh_gsq = [&] {
+    fresh.set_neighbor_poses(agent.Yn);
+    return fresh.riemannian_gradient(agent.Y, fresh.euclidean_gradient(agent.Y)).squaredNorm();
+  };
+  const double before = agent.status().grad_norm_sq;
+  EXPECT_NEAR(before, fresh_gsq(), 1e-12 * before);
+  agent.Y = agent.update(agent.Y, agent.Yn, BlockUpdateOptions{});
+  const double reused = agent.status().grad_norm_sq;
+  EXPECT_LT(reused, before);  // the update made progress, and the status sees the new point
+  EXPECT_NEAR(reused, fresh_gsq(), 1e-10 * reused);
+  agent.Yn.col(0) *= 1.5;  // a neighbour moved: the stored gradient no longer applies
+  const double moved = agent.status().grad_norm_sq;
+  EXPECT_NEAR(moved, fresh_gsq(), 1e-12 * moved);
+  EXPECT_GT(std::abs(moved - reused), 1e-6 * reused);
+}
+
 TEST(DistributedSolver, DeterministicAcrossDeliveryOrdersAndReruns) {
   const PoseGraph g = small_graph(3, 60, 7);
   for (auto alg : {DistributedAlgorithm::kRbcd, DistributedAlgorithm::kRbcdPlusPlus,

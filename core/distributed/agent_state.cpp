@@ -80,14 +80,19 @@ void AgentState::set_neighbours(const Eigen::MatrixXd& neighbours) {
   if (neighbours_set_.size() == neighbours.size() && neighbours_set_ == neighbours) return;
   neighbours_set_ = neighbours;
   problem_.set_neighbor_poses(neighbours);
+  ++neighbours_version_;
 }
 
 LocalStatus AgentState::status() {
   set_neighbours(Yn);
   LocalStatus s;
   s.cost_share = problem_.cost_share(Y);
-  const Eigen::MatrixXd g = problem_.riemannian_gradient(Y, problem_.euclidean_gradient(Y));
-  s.grad_norm_sq = g.squaredNorm();
+  if (updated_grad_norm_sq_ >= 0 && updated_version_ == neighbours_version_ && Y == updated_X_) {
+    s.grad_norm_sq = updated_grad_norm_sq_;  // same point, same neighbours: same gradient
+  } else {
+    const Eigen::MatrixXd g = problem_.riemannian_gradient(Y, problem_.euclidean_gradient(Y));
+    s.grad_norm_sq = g.squaredNorm();
+  }
   s.block_grad_norm = std::sqrt(s.grad_norm_sq);
   return s;
 }
@@ -95,7 +100,9 @@ LocalStatus AgentState::status() {
 Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
                                    const BlockUpdateOptions& options) {
   set_neighbours(neighbours);
-  return block_update(problem_, X0, options, precon_.get());
+  updated_X_ = block_update(problem_, X0, options, precon_.get(), &updated_grad_norm_sq_);
+  updated_version_ = neighbours_version_;
+  return updated_X_;
 }
 
 double AgentState::local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours) {

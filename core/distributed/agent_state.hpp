@@ -69,6 +69,12 @@ class AgentState {
   BlockProblem problem_;
   std::unique_ptr<BlockPreconditioner> precon_;
   Eigen::MatrixXd neighbours_set_;  // what problem_ holds, so X_N Q_NB is rebuilt only on change
+  std::uint64_t neighbours_version_ = 0;  // bumped whenever problem_'s neighbour poses change
+  // The last update's result and ||grad f_B||^2 there: with one block per round the selected
+  // block's neighbours do not move before the next status, whose gradient is then this one.
+  Eigen::MatrixXd updated_X_;
+  double updated_grad_norm_sq_ = -1.0;  // < 0: nothing to reuse
+  std::uint64_t updated_version_ = 0;
 };
 
 }  // namespace tessera

@@ -16,8 +16,8 @@ void BlockUpdateOptions::validate() const {
 }
 
 Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd& X0,
-                             const BlockUpdateOptions& options,
-                             BlockPreconditioner* preconditioner) {
+                             const BlockUpdateOptions& options, BlockPreconditioner* preconditioner,
+                             double* grad_norm_sq) {
   TrustRegionOptions tr;
   tr.max_iterations = 1;
   tr.max_inner_iterations = options.max_inner_iterations;
@@ -33,6 +33,8 @@ Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd&
        ++attempt) {
     tr.initial_radius = radius;
     TrustRegionResult res = solve_trust_region(problem, X, tr, precon);
+    // res.grad_norm is at res.X, which is X after this attempt whether or not it is accepted.
+    if (grad_norm_sq) *grad_norm_sq = res.grad_norm * res.grad_norm;
     if (res.trace.empty()) break;  // zero gradient: nothing to do
     const TrustRegionIteration& it = res.trace.back();
     radius = it.radius;

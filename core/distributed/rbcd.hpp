@@ -26,9 +26,11 @@ struct BlockUpdateOptions {
 };
 
 /// One block update from X0 (on the block's manifold) with the neighbour poses currently set
-/// in `problem`. Never increases the local cost: returns X0 when no step is accepted.
+/// in `problem`. Never increases the local cost: returns X0 when no step is accepted. When
+/// `grad_norm_sq` is not null it receives ||grad f_B||^2 at the returned point (the trust-region
+/// step computes that gradient anyway; the next status can reuse it).
 Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd& X0,
-                             const BlockUpdateOptions& options,
-                             BlockPreconditioner* preconditioner);
+                             const BlockUpdateOptions& options, BlockPreconditioner* preconditioner,
+                             double* grad_norm_sq = nullptr);
 
 }  // namespace tessera
