@@ -34,11 +34,19 @@ Individual combine(const WorkGraph& g, int k, const std::vector<long long>& ub, 
   return better;
 }
 
-// Every operation draws its flow corridor size from {alpha, 2 alpha}: neither size is better on
-// all benchmark graphs, and mixing them diversifies the population.
-CycleParams varied(const CycleParams& cp, Rng& rng) {
-  CycleParams c = cp;
+// Every operation draws its flow corridor size from {alpha, 2 alpha} and its coarsening (label
+// propagation or, with probability matching_share, heavy-edge matching): no single choice is
+// best on all benchmark graphs (matching finds the best cuts on rim and parking-garage, label
+// propagation on city10000), and mixing them diversifies the population.
+CycleParams varied(const EvolutionParams& params, Rng& rng) {
+  CycleParams c = params.cycle;
   if (rng.next() & 1) c.flow.alpha *= 2;
+  if (params.matching_share > 0.0 && rng.uniform() < params.matching_share) {
+    c.coarsening.label_propagation_rounds = 0;
+    // Matching only halves each level, so its finer levels are much larger than label
+    // propagation's: flows there would cost several times more for little gain.
+    c.flow_levels = std::min(c.flow_levels, params.matching_flow_levels);
+  }
   return c;
 }
 
@@ -60,14 +68,15 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
     for (const auto& ind : pop) b = std::min(b, ind.cut);
     return b;
   };
-  for (int i = 0; i < std::max(1, params.population); ++i) {
+  auto fresh_individual = [&] {
     Individual ind;
-    ind.part = multilevel_partition(g, k, ub, params.cycle, rng);
+    ind.part = multilevel_partition(g, k, ub, varied(params, rng), rng);
     ind.cut = edge_cut(g, ind.part);
     for (int c = 0; c < params.vcycles; ++c)
-      ind = vcycle(g, k, ub, std::move(ind), params.cycle, rng);
-    pop.push_back(std::move(ind));
-  }
+      ind = vcycle(g, k, ub, std::move(ind), varied(params, rng), rng);
+    return ind;
+  };
+  for (int i = 0; i < std::max(1, params.population); ++i) pop.push_back(fresh_individual());
   if (trace)
     trace("population",
           std::to_string(pop.size()) + " multilevel runs + " + std::to_string(params.vcycles) +
@@ -83,13 +92,13 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
       // Mutation: combine an individual with a fresh multilevel partition.
       const int a = tournament(pop, rng, -1);
       Individual fresh;
-      fresh.part = multilevel_partition(g, k, ub, varied(params.cycle, rng), rng);
+      fresh.part = multilevel_partition(g, k, ub, varied(params, rng), rng);
       fresh.cut = edge_cut(g, fresh.part);
-      child = combine(g, k, ub, pop[a], fresh, varied(params.cycle, rng), rng);
+      child = combine(g, k, ub, pop[a], fresh, varied(params, rng), rng);
     } else {
       const int a = tournament(pop, rng, -1);
       const int b = tournament(pop, rng, a);
-      child = combine(g, k, ub, pop[a], pop[b], varied(params.cycle, rng), rng);
+      child = combine(g, k, ub, pop[a], pop[b], varied(params, rng), rng);
     }
     // Replace the worst individual if the child is better and not already in the population.
     int worst = 0;

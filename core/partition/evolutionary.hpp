@@ -19,6 +19,11 @@ struct EvolutionParams {
   int generations = 20;        ///< Combine / mutation steps after the initial population.
   int stall_limit = 1 << 30;   ///< Stop after this many steps without a new best cut.
   double mutation_rate = 0.3;  ///< Share of steps that combine with a fresh partition instead.
+  /// Share of operations (fresh runs, V-cycles, combines) that coarsen by heavy-edge matching
+  /// instead of the label propagation of `cycle`: the two give differently shaped hierarchies,
+  /// and mixing them keeps the population diverse (0 = always `cycle`'s coarsening).
+  double matching_share = 0.0;
+  int matching_flow_levels = 1;  ///< flow_levels of the operations that coarsen by matching.
   CycleParams cycle;
 };
 

@@ -115,6 +115,10 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         plan.evolution.generations = std::max(4, ops - 2 * plan.evolution.population);
         // Small graphs converge long before the budget is spent.
         plan.evolution.stall_limit = std::max(40, plan.evolution.generations / 3);
+        // highest: half of its operations coarsen by heavy-edge matching instead of label
+        // propagation (flows then only on the input graph, see EvolutionParams).
+        plan.evolution.matching_share = strong ? 0.0 : 0.5;
+        plan.evolution.matching_flow_levels = 0;
       }
       break;
     default:
@@ -143,6 +147,12 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_GEN")) plan.evolution.generations = std::atoi(env("T_GEN"));
   if (env("T_VC")) plan.evolution.vcycles = std::atoi(env("T_VC"));
   if (env("T_MUT")) plan.evolution.mutation_rate = std::atof(env("T_MUT"));
+  if (env("T_MATCH")) plan.evolution.matching_share = std::atof(env("T_MATCH"));
+  if (env("T_STALL")) plan.evolution.stall_limit = std::atoi(env("T_STALL"));
+  if (env("T_MFLEV")) plan.evolution.matching_flow_levels = std::atoi(env("T_MFLEV"));
+  if (env("T_OPS"))
+    plan.evolution.generations =
+        static_cast<int>(plan.evolution.generations * std::atof(env("T_OPS")));
 #endif
   cp.initial.fm = cp.fm;
   plan.evolution.cycle = cp;
