@@ -1,6 +1,7 @@
 #include "distributed/momentum.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <utility>
 
 namespace tessera {
 namespace {
@@ -62,7 +63,9 @@ void project_poses(Eigen::MatrixXd& X, int d) {
   }
 }
 
-Eigen::MatrixXd project(const LiftedManifold& M, Eigen::MatrixXd X) {
+}  // namespace
+
+Eigen::MatrixXd project_to_manifold(const LiftedManifold& M, Eigen::MatrixXd X) {
   if (M.dim() == 2)
     project_poses<2>(X, 2);
   else
@@ -70,6 +73,10 @@ Eigen::MatrixXd project(const LiftedManifold& M, Eigen::MatrixXd X) {
   return X;
 }
 
+namespace {
+Eigen::MatrixXd project(const LiftedManifold& M, Eigen::MatrixXd X) {
+  return project_to_manifold(M, std::move(X));
+}
 }  // namespace
 
 Eigen::MatrixXd extrapolate(const LiftedManifold& M, const MomentumCoefficients& c,

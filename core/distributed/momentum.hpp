@@ -44,6 +44,10 @@ class MomentumScheme {
   virtual void load(const std::vector<double>& state) = 0;
 };
 
+/// Proj_M(X): each pose's Stiefel part replaced by its polar factor (equal to
+/// LiftedManifold::project to round-off, several times cheaper near the manifold).
+Eigen::MatrixXd project_to_manifold(const LiftedManifold& M, Eigen::MatrixXd X);
+
 /// Proj_M(alpha V + (1 - alpha) Y).
 Eigen::MatrixXd extrapolate(const LiftedManifold& M, const MomentumCoefficients& c,
                             const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V);

@@ -1,5 +1,6 @@
 #include "distributed/rbcd.hpp"
 
+#include "distributed/momentum.hpp"
 #include "solvers/trust_region.hpp"
 #include "util/input_error.hpp"
 
@@ -25,6 +26,10 @@ Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd&
   tr.grad_norm_tol = 0.0;
   tr.rel_cost_decrease_tol = 0.0;
   tr.record_trace = true;
+  const LiftedManifold M = problem.manifold(static_cast<int>(X0.rows()));
+  tr.retraction = [&M](const Eigen::MatrixXd& X, const Eigen::MatrixXd& V) {
+    return project_to_manifold(M, X + V);
+  };
   BlockPreconditioner* precon = options.precondition ? preconditioner : nullptr;
   Eigen::MatrixXd X = X0;
   int accepted = 0;

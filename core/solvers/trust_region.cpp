@@ -124,7 +124,8 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     }
     TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner);
     res.total_inner_iterations += step.iterations;
-    Eigen::MatrixXd X_new = M.retract(res.X, step.eta);
+    Eigen::MatrixXd X_new =
+        options.retraction ? options.retraction(res.X, step.eta) : M.retract(res.X, step.eta);
     if (refine) (*refine)(X_new);
     const double f_new = problem.cost(X_new);
     const double model_decrease = -(inner(grad, step.eta) + 0.5 * inner(step.Heta, step.eta));

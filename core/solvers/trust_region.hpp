@@ -26,6 +26,9 @@ struct TrustRegionOptions {
   double acceptance_ratio = 1e-4;  ///< Minimum rho to accept a step, in [0, 0.25).
   double max_time_s = 1e9;         ///< Wall-clock budget, seconds (> 0).
   bool record_trace = true;
+  /// Retraction R_X(V) to use instead of the manifold's (its SVD polar factor per pose); empty:
+  /// the manifold's. The distributed block updates pass a cheaper, equally exact projection.
+  std::function<Eigen::MatrixXd(const Eigen::MatrixXd& X, const Eigen::MatrixXd& V)> retraction;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
