@@ -28,6 +28,10 @@ TrustRegionOptions CentralizedOptions::default_trust_region() {
   // final steps' CG from solving to |g|^2 accuracy (1299 -> 451 iterations for the last step
   // on ais2klinik) while staying superlinear.
   o.tcg_theta = 0.5;
+  // Linear forcing 0.3 instead of 0.1: shorter early steps that land inside the region. On
+  // ais2klinik 6 outer / 1623 tCG iterations, no rejected step (vs 11 / 3262, 4 rejected);
+  // on the easy graphs it costs 10-40% more CPU, all far below the reference there.
+  o.tcg_kappa = 0.3;
   return o;
 }
 

@@ -131,14 +131,23 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     const double model_decrease = -(inner(grad, step.eta) + 0.5 * inner(step.Heta, step.eta));
     double rho = (f - f_new) / std::max(model_decrease, std::numeric_limits<double>::min());
     // When both decreases sit at round-off level, the ratio is noise: trust the model.
-    if (std::abs(f - f_new) <= 1e-14 * std::abs(f) && model_decrease <= 1e-14 * std::abs(f))
-      rho = 1.0;
+    const bool round_off =
+        std::abs(f - f_new) <= 1e-14 * std::abs(f) && model_decrease <= 1e-14 * std::abs(f);
+    if (round_off) rho = 1.0;
     if (rho < 0.25) {
       radius *= 0.25;
     } else if (rho > 0.75 && step.hit_boundary) {
       radius = std::min(2.0 * radius, options.max_radius);
     }
     const bool accepted = rho > options.acceptance_ratio && f_new <= f;
+    // A step that changes f only at round-off level but happens to raise it: nothing measurable
+    // is left to gain, and retrying would repeat the same step with the same radius forever.
+    if (!accepted && round_off) {
+      res.iterations = it + 1;
+      res.stop_reason = "relative_decrease";
+      break;
+    }
+    if (!accepted && rho >= 0.25) radius *= 0.25;  // every rejection shrinks the region
     double decrease = 0.0;
     if (accepted) {
       decrease = f - f_new;
