@@ -55,6 +55,8 @@ options:
   --tum FILE           write the merged poses (TUM)
   --timeout S          time limit of the whole run, seconds                 [600]
   --poses P            poses of the generated graph (without GRAPH)         [1000]
+  --status-interval S  coordinator status line (agents alive, rounds, lagging or lost
+                       agents) every S seconds and on changes; 0 = off          [5]
   --quiet              no progress lines
   --help               this text
 
@@ -173,16 +175,20 @@ int run_launch(const Args& argv) {
       std::printf(kHelp, session_options_help(SessionArgsFor::kLaunch).c_str());
       return 0;
     }
-  Arguments args(argv,
-                 with_session_options({"agents", "algorithm", "partition", "grad-tol", "max-rounds",
-                                       "rank", "seed", "json", "out", "tum", "timeout", "poses"},
-                                      SessionArgsFor::kLaunch),
-                 {"quiet"});
+  Arguments args(
+      argv,
+      with_session_options({"agents", "algorithm", "partition", "grad-tol", "max-rounds", "rank",
+                            "seed", "json", "out", "tum", "timeout", "poses", "status-interval"},
+                           SessionArgsFor::kLaunch),
+      {"quiet"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
                      std::to_string(args.positional().size()));
   const long agents = args.get_long("agents", 3);
   if (agents < 1 || agents > 64) throw InputError("launch: --agents must be in 1..64");
+  const double status_interval = args.get_double("status-interval", 5);
+  if (!(status_interval >= 0 && status_interval <= 86400))
+    throw InputError("launch: --status-interval must be in 0..86400 seconds");
   const std::string algorithm = args.get_or("algorithm", "irbcd");
   if (algorithm != "rbcd" && algorithm != "rbcd++" && algorithm != "irbcd")
     throw InputError("launch: --algorithm '" + algorithm + "' is not one of rbcd, rbcd++, irbcd");
@@ -279,6 +285,8 @@ int run_launch(const Args& argv) {
   cargs.insert(cargs.end(), common.begin(), common.end());
   if (args.has("out")) cargs.insert(cargs.end(), {"--output", args.get_or("out", "")});
   if (args.has("tum")) cargs.insert(cargs.end(), {"--tum", args.get_or("tum", "")});
+  if (args.has("status-interval"))
+    cargs.insert(cargs.end(), {"--status-interval", std::to_string(status_interval)});
 
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<Child> children;

@@ -88,8 +88,10 @@ class Run:
             if time.time() > deadline or self.coord.poll() is not None:
                 return False
             time.sleep(0.005)
-        os.kill(self.agents[agent].pid, signal.SIGKILL)
-        self.agents[agent].wait()
+        victim = self.agents[agent]
+        os.kill(victim.pid, signal.SIGKILL)
+        victim.wait()
+        self.procs.remove(victim)  # its exit code is the kill, not a failure
         time.sleep(delay)
         p = self.spawn(self.agent_cmd(agent), "agent%d-restarted.log" % agent)
         self.procs.append(p)
