@@ -139,6 +139,8 @@ class Agent {
       }
     }
     SessionOptions so = a_.net.session;
+    // An agent meant to survive a SIGKILL talks UDP only (see transport/qos.hpp).
+    so.shared_memory = a_.checkpoint_dir.empty();
     so.coordinator = false;
     so.agent_id = a_.id;
     so.num_agents = a_.robots;

@@ -154,6 +154,8 @@ class Coordinator {
     so.coordinator = true;
     so.num_agents = a_.agents;
     so.verbose = a_.verbose;
+    // A run that survives killed agents talks UDP only (see transport/qos.hpp).
+    so.shared_memory = a_.rejoin_timeout_s <= 0;
     try {
       session_ = std::make_unique<Session>(so);
     } catch (const InputError& e) {

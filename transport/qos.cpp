@@ -18,7 +18,7 @@ using eprosima::fastrtps::Duration_t;
 dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
     int domain, std::uint32_t num_agents, const NetworkProfile& net,
-    const std::vector<std::pair<std::string, std::string>>& properties) {
+    const std::vector<std::pair<std::string, std::string>>& properties, bool shared_memory) {
   dds::DomainParticipantQos q;
   dds::DomainParticipantFactory::get_instance()->get_default_participant_qos(q);
   q.name(name);
@@ -31,17 +31,18 @@ dds::DomainParticipantQos participant_qos(
   // ~0.1 s instead of a full announcement period.
   discovery.initial_announcements.count = 5;
   discovery.initial_announcements.period = Duration_t(0, 100000000);
-  if (net.udp_max_message_size != 0 || net.socket_buffer_bytes != 0) {
+  if (net.udp_max_message_size != 0 || net.socket_buffer_bytes != 0 || !shared_memory) {
     // Our own UDPv4 transport instead of the built-in one, plus shared memory as built in
-    // (same-host peers keep using it). Fast DDS fragments every sample to the smallest
-    // maximum message size of the participant's transports.
+    // (same-host peers keep using it) unless `shared_memory` is off. Fast DDS fragments every
+    // sample to the smallest maximum message size of the participant's transports.
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
     if (net.udp_max_message_size != 0) udp->maxMessageSize = net.udp_max_message_size;
     udp->sendBufferSize = net.socket_buffer_bytes;
     udp->receiveBufferSize = net.socket_buffer_bytes;
     q.transport().use_builtin_transports = false;
-    q.transport().user_transports.push_back(
-        std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+    if (shared_memory)
+      q.transport().user_transports.push_back(
+          std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
     q.transport().user_transports.push_back(udp);
     q.transport().send_socket_buffer_size = net.socket_buffer_bytes;
     q.transport().listen_socket_buffer_size = net.socket_buffer_bytes;

@@ -23,10 +23,15 @@ constexpr std::int32_t kWriterHistory = 16;
 /// optional unicast initial peers (all participant ids up to num_agents + 2 on `domain`),
 /// the UDP datagram size and socket buffers of `net`, extra `properties` (DDS Security's,
 /// security.hpp).
+/// `shared_memory` false: UDPv4 only (also between processes of one host). Used by runs that
+/// survive SIGKILLed processes: a process killed while writing into a peer's shared-memory
+/// port leaves that port locked, and the peer then hears nothing more (seen as every agent
+/// "lost" at once, or a restarted agent that never gets its messages).
 eprosima::fastdds::dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
     int domain, std::uint32_t num_agents, const NetworkProfile& net,
-    const std::vector<std::pair<std::string, std::string>>& properties = {});
+    const std::vector<std::pair<std::string, std::string>>& properties = {},
+    bool shared_memory = true);
 /// Publisher / subscriber: Partition = run id.
 eprosima::fastdds::dds::PublisherQos publisher_qos(const std::string& run_id);
 eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);

@@ -413,7 +413,7 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   s.participant = factory->create_participant(
       s.domain,
       participant_qos(participant_name(s.me), options.lease_s, options.initial_peers, s.domain,
-                      options.num_agents, s.net, security),
+                      options.num_agents, s.net, security, options.shared_memory),
       s.participant_listener.get(), dds::StatusMask::none());
   if (!s.participant)
     throw TransportError("cannot create a DDS participant on domain " + std::to_string(s.domain) +

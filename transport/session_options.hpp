@@ -38,6 +38,9 @@ struct SessionOptions {
   /// (lost_agents()) so the coordinator can wait for the agent to rejoin. Losing the
   /// coordinator always stops. Can be changed later with set_agent_loss_tolerated().
   bool tolerate_agent_loss = false;
+  /// Use the shared-memory transport between processes of one host (faster). Off for runs
+  /// that survive killed processes (see transport/qos.hpp participant_qos): UDP only.
+  bool shared_memory = true;
 
   /// Throws InputError naming the bad field (as its command-line option).
   void validate() const;

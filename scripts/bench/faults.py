@@ -10,7 +10,8 @@ COLUMN CONTRACT (every docs/benchmarks/faults_<name>.csv, one row per fault kind
                 (|cost - cost_undisturbed| / cost_undisturbed), or against f* where stated
   extra_time_s  mean extra wall time of a faulty run over the undisturbed run, in seconds
 The `loss` and `net` helpers write faults_loss.csv and faults_lossy_link.csv with the same
-columns; `--assemble-only` rebuilds faults.md from whatever faults_*.csv exist.
+columns; `--assemble-only` rebuilds faults.md from whatever faults_*.csv exist, followed by
+every docs/benchmarks/faults/*.md (each experiment's notes: command, machine, details).
 
 This script's own experiment (`restart`): a generated 3D grid, N = 5 agents with
 --checkpoint-dir, the coordinator with --rejoin-timeout. Each trial SIGKILLs a random agent
@@ -32,6 +33,9 @@ import subprocess
 import sys
 import tempfile
 import time
+import functools
+
+print = functools.partial(print, flush=True)  # progress shows up in logs as it happens
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
@@ -61,9 +65,13 @@ class Run:
             cmd += ["--checkpoint-dir", self.ckpt, "--checkpoint-every", str(self.args.every)]
         return cmd
 
-    def spawn(self, cmd, log):
+    def spawn(self, cmd, log, env=None):
         f = open(os.path.join(self.dir, log), "w")
-        return subprocess.Popen(cmd, stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
+        full = dict(os.environ)
+        for kv in env or []:
+            k, _, v = kv.partition("=")
+            full[k] = v
+        return subprocess.Popen(cmd, stdout=f, stderr=subprocess.STDOUT, start_new_session=True, env=full)
 
     def start(self):
         self.t0 = time.time()
@@ -93,7 +101,7 @@ class Run:
         victim.wait()
         self.procs.remove(victim)  # its exit code is the kill, not a failure
         time.sleep(delay)
-        p = self.spawn(self.agent_cmd(agent), "agent%d-restarted.log" % agent)
+        p = self.spawn(self.agent_cmd(agent), "agent%d-restarted.log" % agent, self.args.restart_env)
         self.procs.append(p)
         return True
 
@@ -151,8 +159,7 @@ def assemble(out_dir):
              "| fault | trials | finished | cost error | extra time (s) |", "|---|---|---|---|---|"]
     for r in rows:
         lines.append("| %s | %s | %s | %s | %s |" % tuple(r[c] for c in COLUMNS))
-    extra = os.path.join(out_dir, "faults", "README.md")
-    if os.path.exists(extra):
+    for extra in sorted(glob.glob(os.path.join(out_dir, "faults", "*.md"))):
         with open(extra) as f:
             lines += ["", f.read().strip()]
     with open(os.path.join(out_dir, "faults.md"), "w") as f:
@@ -173,6 +180,7 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--limit", type=float, default=300, help="time limit of one run, seconds")
     ap.add_argument("--assemble-only", action="store_true")
+    ap.add_argument("--restart-env", action="append", default=[], help="KEY=VALUE for the restarted agent (diagnostics)")
     args = ap.parse_args()
     if args.assemble_only:
         assemble(args.out_dir)
@@ -248,6 +256,29 @@ def main():
     print("checkpoints (every %d rounds): %d writes by %d agents, %.1f ms in total (%.2f ms each, %d bytes); "
           "undisturbed wall %.2f s without, %.2f s with" %
           (args.every, writes, args.agents, ms, ms / max(1, writes), size, w_plain, w_ck))
+    notes = ["## Agent killed and restarted (`faults_restart.csv`)", "",
+             "Command: `scripts/bench/faults.py %s`" % " ".join(sys.argv[1:]), "",
+             "%d-pose generated grid3d, N = %d, IRBCD, `highest`, grad tol %g; every agent with "
+             "`--checkpoint-dir` (`--checkpoint-every %d`), the coordinator with `--rejoin-timeout 30`. "
+             "Each trial SIGKILLs a random agent when the coordinator reports a random round and starts "
+             "it again with the same options after a random 0-1 s delay. cost_error is against the "
+             "undisturbed run with checkpoints; extra_time_s is the mean wall-time difference (it "
+             "includes the restart delay, the 1.5-lease wait of the restarted agent before it joins, "
+             "discovery, and the repeated rounds)." % (args.poses, args.agents, args.grad_tol, args.every), "",
+             "| trial | agent | kill round | restart delay s | finished | rounds | rollbacks | rel. cost error | wall s | extra s |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for x in trials:
+        notes.append("| %d | %d | %d | %.2f | %s | %s | %s | %.1e | %.2f | %+.2f |" % (
+            x["trial"], x["agent"], x["kill_round"], x["restart_delay_s"], "yes" if x["finished"] else "NO",
+            x["rounds"], x["rollbacks"], x["rel_cost_error"], x["wall_s"], x["extra_s"]))
+    notes += ["", "Checkpoint cost (undisturbed runs): %d rounds; wall %.2f s without checkpoints, %.2f s "
+              "with (one run each); %d checkpoint writes by the %d agents took %.1f ms in total "
+              "(%.2f ms per write: encode, write, fsync, rename, folder fsync; %d bytes each)." %
+              (ref["rounds"], w_plain, w_ck, writes, args.agents, ms, ms / max(1, writes), size),
+              "", "Machine: %s, %d cores, shared with other builds and benchmarks while measured "
+              "(wall times are inflated and noisy)." % (os.uname().machine, os.cpu_count())]
+    with open(os.path.join(args.out_dir, "faults", "restart.md"), "w") as f:
+        f.write("\n".join(notes) + "\n")
     assemble(args.out_dir)
     shutil.rmtree(work, ignore_errors=True) if len(finished) == len(trials) else print("work dir kept: " + work)
     return 0 if len(finished) == len(trials) else 1
