@@ -1,7 +1,10 @@
 #include "solvers/block_preconditioner.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
+#include <algorithm>
 #include <stdexcept>
+#include <vector>
 
 namespace tessera {
 
@@ -11,27 +14,88 @@ struct BlockPreconditioner::Factor {
   // supernodes cost more than they save: measured CPU per solve, simplicial LDL^T vs CHOLMOD's
   // automatic choice (supernodal on these graphs): city10000 2.6 vs 4.8 ms, sphere2500 1.2 vs
   // 2.0 ms, cubicle 5.0 vs 5.9 ms, ais2klinik 0.78 vs 0.72 ms (docs/centralized-solver.md).
-  Eigen::CholmodDecomposition<SparseMatrix> llt;
+  std::unique_ptr<Eigen::CholmodDecomposition<SparseMatrix>> llt =
+      std::make_unique<Eigen::CholmodDecomposition<SparseMatrix>>();
+  // Fallback: inverses of the (d+1) x (d+1) diagonal blocks, one after the other (column-major).
+  int w = 0;
+  std::vector<double> block_inverses;
 };
 
-BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double relative_shift)
+namespace {
+
+// Inverses of the diagonal (w x w) blocks of A (symmetric positive definite blocks).
+std::vector<double> diagonal_block_inverses(const SparseMatrix& A, int w) {
+  const Eigen::Index blocks = A.rows() / w;
+  std::vector<double> out(static_cast<std::size_t>(blocks * w * w));
+  Eigen::MatrixXd B(w, w);
+  for (Eigen::Index b = 0; b < blocks; ++b) {
+    B.setZero();
+    for (int c = 0; c < w; ++c)
+      for (SparseMatrix::InnerIterator it(A, b * w + c); it; ++it)
+        if (it.row() >= b * w && it.row() < (b + 1) * w) B(it.row() - b * w, c) = it.value();
+    Eigen::LLT<Eigen::MatrixXd> llt(B);
+    if (llt.info() != Eigen::Success)
+      throw std::runtime_error("BlockPreconditioner: a diagonal block is not positive definite");
+    Eigen::Map<Eigen::MatrixXd>(out.data() + b * w * w, w, w) =
+        llt.solve(Eigen::MatrixXd::Identity(w, w));
+  }
+  return out;
+}
+
+}  // namespace
+
+BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double relative_shift,
+                                         std::size_t max_factor_entries)
     : factor_(std::make_unique<Factor>()) {
   const SparseMatrix& Q = problem.data_matrix();
   const double lambda = relative_shift * std::max(1e-12, Q.diagonal().maxCoeff());
   SparseMatrix A = Q;
   for (Eigen::Index k = 0; k < A.rows(); ++k) A.coeffRef(k, k) += lambda;
-  factor_->llt.setMode(Eigen::CholmodLDLt);
-  factor_->llt.compute(A);
-  if (factor_->llt.info() != Eigen::Success)
+  // The factor holds at least the lower triangle of A; beyond that, CHOLMOD's symbolic
+  // analysis predicts its entries (lnz) before any numeric work.
+  const auto too_large = [&](double entries) {
+    return max_factor_entries > 0 && entries > static_cast<double>(max_factor_entries);
+  };
+  bool fallback = too_large(0.5 * static_cast<double>(A.nonZeros() + A.rows()));
+  if (!fallback) {
+    factor_->llt->setMode(Eigen::CholmodLDLt);
+    factor_->llt->analyzePattern(A);
+    if (factor_->llt->info() != Eigen::Success)
+      throw std::runtime_error("BlockPreconditioner: symbolic analysis failed");
+    fallback = too_large(factor_->llt->cholmod().lnz);
+  }
+  if (fallback) {
+    factor_->llt.reset();  // release the symbolic factor
+    factor_->w =
+        A.rows() / static_cast<Eigen::Index>(std::max<std::size_t>(1, problem.num_owned()));
+    factor_->block_inverses = diagonal_block_inverses(A, factor_->w);
+    return;
+  }
+  factor_->llt->factorize(A);
+  if (factor_->llt->info() != Eigen::Success)
     throw std::runtime_error("BlockPreconditioner: Cholesky factorization failed");
+}
+
+bool BlockPreconditioner::block_diagonal() const {
+  return factor_->w > 0;
 }
 
 BlockPreconditioner::~BlockPreconditioner() = default;
 
 Eigen::MatrixXd BlockPreconditioner::apply(const LiftedManifold& manifold, const Eigen::MatrixXd& X,
                                            const Eigen::MatrixXd& V) const {
+  if (factor_->w > 0) {
+    // Rows of V times the symmetric block inverses, pose by pose.
+    const Eigen::Index w = factor_->w, blocks = V.cols() / w;
+    Eigen::MatrixXd Z(V.rows(), V.cols());
+    for (Eigen::Index b = 0; b < blocks; ++b)
+      Z.middleCols(b * w, w).noalias() =
+          V.middleCols(b * w, w) *
+          Eigen::Map<const Eigen::MatrixXd>(factor_->block_inverses.data() + b * w * w, w, w);
+    return manifold.tangent_project(X, 0.5 * Z);
+  }
   Eigen::MatrixXd Vt = V.transpose();
-  Eigen::MatrixXd Z = factor_->llt.solve(Vt).transpose();
+  Eigen::MatrixXd Z = factor_->llt->solve(Vt).transpose();
   return manifold.tangent_project(X, 0.5 * Z);
 }
 

@@ -112,7 +112,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   }
   const BlockProblem problem =
       BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
-  const BlockPreconditioner precon(problem, options.preconditioner_shift);
+  const BlockPreconditioner precon(problem, options.preconditioner_shift, 0);  // always exact
   std::unique_ptr<TranslationElimination> elimination;
   PointRefinement refine;
   if (options.eliminate_translations) {
