@@ -22,9 +22,13 @@
 #include "agent/local_share.hpp"
 #include "agent/rejoin.hpp"
 #include "agent/round_loop.hpp"
+#include "agent/survivor_exchange.hpp"
 #include "arguments.hpp"
 #include "distributed/checkpoint_file.hpp"
+#include "distributed/distributed_solver.hpp"
+#include "distributed/replica_plan.hpp"
 #include "io/g2o_reader.hpp"
+#include "problem/lifting.hpp"
 #include "session_args.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
@@ -256,6 +260,8 @@ class Agent {
                      : "");
     check_assignment(asg);
     rejoin_enabled_ = asg.rejoin_timeout_s() > 0;
+    loss_.replicas = asg.replicas();
+    loss_.replica_every = std::max<std::uint32_t>(1, asg.replica_every());
     log("assignment received (" +
         std::to_string(std::count(asg.owner().begin(), asg.owner().end(), a_.id)) +
         " poses owned)");
@@ -333,7 +339,9 @@ class Agent {
     std::optional<ProtocolSnapshot> from;  // a copy: the keeper replaces its entries
     // With a rejoin window the coordinator arbitrates lost agents (it waits for a restart,
     // then orders a rollback, or gives up and aborts the run): do not stop on one.
-    if (rejoin_enabled_ || rejoin_) s.set_agent_loss_tolerated(true);
+    if (rejoin_enabled_ || rejoin_ || loss_.replicas > 0) s.set_agent_loss_tolerated(true);
+    const agent::AgentLocalData* cur = &local;  // the survivors' new block after a re-partition
+    if (loss_.replicas > 0 && !rejoin_) start_replication(local, channel);
     if (rejoin_) {
       keeper.adopt(rejoin_->snapshots);
       const agent::RollbackRequested order =
@@ -343,12 +351,22 @@ class Agent {
           std::to_string(order.epoch));
     }
     agent::RoundLoopHooks hooks;
-    hooks.on_round = [&keeper](const ProtocolSnapshot& snap) { keeper.on_round(snap); };
+    hooks.on_round = [&](const ProtocolSnapshot& snap) {
+      if (cur == &local) keeper.on_round(snap);
+      if (loss_.replicas > 0) on_round_replicate(*cur, snap);
+    };
     for (;;) {
       try {
         hooks.resume_from = from ? &*from : nullptr;
-        finish(local, agent::run_round_loop(local, channel, a_.round_timeout_s, hooks), t0);
+        finish(*cur, agent::run_round_loop(*cur, channel, a_.round_timeout_s, hooks), t0);
         break;
+      } catch (const agent::RepartitionRequested& order) {
+        if (loss_.replicas == 0 || cur != &local)
+          throw RunFailure(kExitRunFailed, std::string(order.what()) +
+                                               ": this run does not replicate for a second loss");
+        loss_.taken = take_over(local, order.assignment);
+        cur = &*loss_.taken;
+        from.reset();
       } catch (const agent::RollbackRequested& order) {
         std::cerr << tag_ << ": " << order.what() << ": resuming from the snapshot of round "
                   << order.round << "\n";
@@ -399,6 +417,7 @@ class Agent {
     fin.pose_ids(local.owned);
     for (const Pose& p : result.poses) append_pose(fin.pose_data(), p);
     fin.bytes_sent(s.stats().bytes_sent + serialized_size(fin));
+    fin.epoch(s.epoch());
     s.publish(fin);
     // Until FINISHED, a rollback (another agent rejoined) means doing the rounds again.
     const auto wait_start = std::chrono::steady_clock::now();
@@ -406,6 +425,7 @@ class Agent {
       const WaitStatus st = s.wait_finished(Seconds(0.2));
       if (st == WaitStatus::kReady) break;
       if (auto order = agent::take_rollback(s)) throw *order;
+      if (auto a = agent::take_reassignment(s)) throw agent::RepartitionRequested(std::move(*a));
       const double waited =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - wait_start).count();
       if (st == WaitStatus::kStopped || waited > a_.net.timeout_s)
@@ -445,6 +465,73 @@ class Agent {
   std::string tag_;
   std::unique_ptr<Session> session_;
   agent::RobotShare share_;
+  // Permanent loss (agent/survivor_takeover.hpp): replication and take-over state.
+  struct LossState {
+    std::uint32_t replicas = 0, replica_every = 10;
+    std::vector<std::uint32_t> holders;  // who keeps this agent's replica
+    agent::ReplicaStore store;           // replicas this agent keeps
+    Eigen::MatrixXd Y;                   // latest lifted poses (consistent point)
+    std::uint32_t round = 0;
+    std::optional<agent::AgentLocalData> taken;  // the new block after a re-partition
+  } loss_;
+
+  void start_replication(const agent::AgentLocalData& local, agent::DdsProtocolChannel& channel) {
+    std::vector<std::uint32_t> owner = local.owner;
+    loss_.holders =
+        replica_holders(local.structure, owner, local.num_agents, loss_.replicas)[local.agent_id];
+    const DistributedOptions dummy;
+    loss_.Y = lift_poses(local.initial,
+                         static_cast<int>(local.options.rank ? local.options.rank : dummy.rank));
+    agent::send_problem_replicas(*session_, local, a_.id, loss_.Y, loss_.holders);
+    channel.set_intercept([this](const ProtocolMessage& m) {
+      const auto* b = std::get_if<PoseBlockMessage>(&m);
+      if (!b || b->phase != agent::kReplicaPhase) return false;
+      loss_.store.absorb_poses(*b);
+      return true;
+    });
+    log("replicating to agent(s) " + join_ids(loss_.holders) + " every " +
+        std::to_string(loss_.replica_every) + " rounds");
+  }
+
+  void on_round_replicate(const agent::AgentLocalData& local, const ProtocolSnapshot& snap) {
+    loss_.Y = snap.Y;
+    loss_.round = static_cast<std::uint32_t>(snap.round);
+    // Replicas only in the first epoch: a second loss is not covered (see the docs).
+    if (!loss_.taken && !loss_.holders.empty() &&
+        static_cast<std::uint32_t>(snap.round) % loss_.replica_every == 0) {
+      PoseBlockMessage m =
+          agent::replica_block(local.agent_id, loss_.round, local.d, local.owned, snap.Y);
+      session_->send(OutgoingMessage{m, false, loss_.holders});
+    }
+  }
+
+  agent::AgentLocalData take_over(const agent::AgentLocalData& local,
+                                  const wire::PartitionAssignment& asg) {
+    Session& s = *session_;
+    agent::absorb_problem_replicas(s, loss_.store);
+    const agent::Reassignment r = agent::reassignment_of(asg, local.owner);
+    std::cerr << tag_ << ": agent(s) " << join_ids(r.lost)
+              << " lost for good: taking over the re-partition (epoch " << r.epoch << ", "
+              << r.survivors.size() << " survivors)\n";
+    agent::TakeoverSource src;
+    src.self = a_.id;
+    src.local = &local;
+    src.Y = loss_.Y;
+    src.round = loss_.round;
+    src.replicas = &loss_.store;
+    agent::AgentLocalData next = agent::exchange_takeover(s, src, r, a_.net.timeout_s);
+    s.set_epoch(r.epoch, next.agent_id);
+    log("take-over complete: " + std::to_string(next.owned.size()) + " poses, " +
+        std::to_string(next.measurements.size()) + " measurements, protocol id " +
+        std::to_string(next.agent_id) + " of " + std::to_string(next.num_agents));
+    return next;
+  }
+
+  static std::string join_ids(const std::vector<std::uint32_t>& ids) {
+    std::string out;
+    for (auto k : ids) out += (out.empty() ? "" : ", ") + std::to_string(k);
+    return out;
+  }
   std::optional<agent::AgentCheckpoint> rejoin_;  // set when restarted from a checkpoint
   bool rejoin_enabled_ = false;                   // the coordinator waits for lost agents
 };

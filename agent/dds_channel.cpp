@@ -1,5 +1,8 @@
 #include "agent/dds_channel.hpp"
 
+#include <algorithm>
+#include <chrono>
+
 namespace tessera::agent {
 
 void DdsProtocolChannel::send(const OutgoingMessage& message) {
@@ -16,24 +19,45 @@ std::optional<RollbackRequested> take_rollback(transport::Session& session) {
   return newest;
 }
 
+std::optional<wire::PartitionAssignment> take_reassignment(transport::Session& session) {
+  const std::uint32_t current = session.epoch();
+  std::optional<wire::PartitionAssignment> newest;
+  for (auto& a : session.assignments().take_all())
+    if (a.epoch() > current && (!newest || a.epoch() > newest->epoch())) newest = std::move(a);
+  return newest;
+}
+
 std::optional<ProtocolMessage> DdsProtocolChannel::receive(double timeout_s) {
-  const std::uint32_t current = session_.epoch();
-  auto& rollbacks = session_.rollbacks();
-  auto& protocol = session_.protocol();
-  const transport::WaitStatus st = session_.mailroom().wait_for(
-      [&] {
-        for (const auto& c : rollbacks.queued_locked())
-          if (c.epoch() > current) return true;
-        return !protocol.queued_locked().empty();
-      },
-      transport::Seconds(timeout_s));
-  if (st == transport::WaitStatus::kStopped)
-    throw RunStopped(session_.mailroom().stop_info()->reason);
-  if (st == transport::WaitStatus::kTimeout) return std::nullopt;
-  if (auto r = take_rollback(session_)) throw *r;
-  ProtocolMessage out;
-  if (protocol.take(transport::Seconds(0), &out) == transport::WaitStatus::kReady) return out;
-  return std::nullopt;  // only stale rollbacks were queued; the caller waits again
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                             std::chrono::duration<double>(timeout_s));
+  for (;;) {
+    const std::uint32_t current = session_.epoch();
+    auto& rollbacks = session_.rollbacks();
+    auto& assignments = session_.assignments();
+    auto& protocol = session_.protocol();
+    const double left =
+        std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+    const transport::WaitStatus st = session_.mailroom().wait_for(
+        [&] {
+          for (const auto& c : rollbacks.queued_locked())
+            if (c.epoch() > current) return true;
+          for (const auto& a : assignments.queued_locked())
+            if (a.epoch() > current) return true;
+          return !protocol.queued_locked().empty();
+        },
+        transport::Seconds(std::max(0.0, left)));
+    if (st == transport::WaitStatus::kStopped)
+      throw RunStopped(session_.mailroom().stop_info()->reason);
+    if (st == transport::WaitStatus::kTimeout) return std::nullopt;
+    if (auto a = take_reassignment(session_)) throw RepartitionRequested(std::move(*a));
+    if (auto r = take_rollback(session_)) throw *r;
+    ProtocolMessage out;
+    if (protocol.take(transport::Seconds(0), &out) != transport::WaitStatus::kReady)
+      return std::nullopt;  // only stale rollbacks were queued; the caller waits again
+    if (intercept_ && intercept_(out)) continue;  // e.g. a replica, not for the protocol
+    return out;
+  }
 }
 
 }  // namespace tessera::agent

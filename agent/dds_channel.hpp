@@ -3,7 +3,9 @@
 // A ROLLBACK order of the coordinator (newer epoch than this process's) interrupts a wait
 // with RollbackRequested.
 
+#include <functional>
 #include <optional>
+#include <stdexcept>
 
 #include "agent/round_loop.hpp"
 #include "transport/session.hpp"
@@ -15,10 +17,29 @@ class DdsProtocolChannel : public ProtocolChannel {
   explicit DdsProtocolChannel(transport::Session& session) : session_(session) {}
   void send(const OutgoingMessage& message) override;
   std::optional<ProtocolMessage> receive(double timeout_s) override;
+  /// Messages for which `f` returns true are consumed by it instead of being returned
+  /// (lifted-pose replicas of other agents).
+  void set_intercept(std::function<bool(const ProtocolMessage&)> f) { intercept_ = std::move(f); }
 
  private:
   transport::Session& session_;
+  std::function<bool(const ProtocolMessage&)> intercept_;
 };
+
+/// Raised by the channel when the coordinator publishes a re-partition for the survivors (an
+/// assignment of a newer epoch): every survivor abandons its round and takes over its new
+/// block (agent/survivor_takeover.hpp).
+class RepartitionRequested : public std::runtime_error {
+ public:
+  explicit RepartitionRequested(wire::PartitionAssignment a)
+      : std::runtime_error("re-partition for the survivors (epoch " + std::to_string(a.epoch()) +
+                           ")"),
+        assignment(std::move(a)) {}
+  wire::PartitionAssignment assignment;
+};
+
+/// Takes the coordinator's newest assignment with an epoch above the session's, if any.
+std::optional<wire::PartitionAssignment> take_reassignment(transport::Session& session);
 
 /// Takes the coordinator's newest ROLLBACK order with an epoch above the session's (older
 /// ones are discarded), if any.

@@ -402,7 +402,13 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     throw std::runtime_error("initialisation '" + init +
                              "' is not available over DDS yet: use 'file' (the VERTEX poses of "
                              "the input), the default");
-  if (local.initial.size() != local.owned.size())
+  const bool lifted = local.lifted_start.size() > 0;
+  if (lifted &&
+      (local.lifted_start.cols() != (local.d + 1) * static_cast<Eigen::Index>(local.owned.size()) ||
+       local.lifted_start.rows() != options.rank))
+    throw std::runtime_error("agent " + std::to_string(local.agent_id) +
+                             ": lifted starting point of the wrong shape");
+  if (!lifted && local.initial.size() != local.owned.size())
     throw std::runtime_error("agent " + std::to_string(local.agent_id) +
                              ": the input has no VERTEX poses for the poses it owns; the DDS "
                              "runtime initialises from the file's poses");
@@ -425,7 +431,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
 
   // Core's agent, configured as the in-process engine configures it.
   AgentState state(static_cast<int>(local.agent_id), local.d, layout, local.measurements,
-                   lift_poses(local.initial, options.rank));
+                   lifted ? local.lifted_start : lift_poses(local.initial, options.rank));
   const double variables =
       static_cast<double>(options.rank) * (local.d + 1) * static_cast<double>(local.num_poses);
   const auto scheme = make_momentum_scheme(options, layout, variables);

@@ -12,6 +12,7 @@
 // central step: the rotation rounding from a summed Gram matrix, the optimal translations
 // by a distributed preconditioned conjugate gradient on the translation Laplacian.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -56,6 +57,9 @@ struct AgentLocalData {
   std::vector<std::uint64_t> measurement_index;
   /// Initial poses of `owned` (same order); empty when the input had no VERTEX lines.
   std::vector<Pose> initial;
+  /// When not empty: the lifted starting point of `owned` (r x (d+1)m, same order), used
+  /// instead of lifting `initial` (a run continued by survivors after a permanent loss).
+  Eigen::MatrixXd lifted_start;
   /// Endpoints (i, j) of every measurement of the whole graph, no values: with `owner`
   /// enough for core's make_block_layout (give it Measurements with only i and j set), so
   /// every agent builds the same layout (neighbours, public poses, colouring).

@@ -20,6 +20,7 @@
 #include "coordinator/rejoin_arbiter.hpp"
 #include "coordinator/run_monitor.hpp"
 #include "coordinator/run_structure.hpp"
+#include "coordinator/survivor_step.hpp"
 #include "graph/pose_graph.hpp"
 #include "io/g2o_writer.hpp"
 #include "io/tum_writer.hpp"
@@ -67,6 +68,11 @@ options:
   --rejoin-timeout S   when an agent process dies, wait up to S seconds for it to be
                        restarted (same id, --checkpoint-dir) and rejoin; every agent then rolls
                        back to a common checkpoint round. 0 = stop the run at once (default 0)
+  --replicas K         replicate every agent's measurements and lifted poses to K other
+                       agents; an agent lost for good (not back within --rejoin-timeout) then
+                       has its block re-partitioned among the survivors, and the run goes on
+                       with N-1 agents. 0 = off: the run stops (default 0)
+  --replica-every K    rounds between lifted-pose replicas (default 10)
   --status-interval S  print a status line (agents alive, their rounds, lagging or lost
                        agents) every S seconds and on changes; 0 = off (default 5)
   --verbose            print each phase
@@ -93,6 +99,7 @@ struct CoordinatorArgs {
   bool progress = false, verbose = false;
   double rejoin_timeout_s = 0;
   double status_interval_s = 5;
+  std::uint32_t replicas = 0, replica_every = 10;
 };
 
 CoordinatorArgs parse(const std::vector<std::string>& argv) {
@@ -101,7 +108,7 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
       cli::with_session_options(
           {"agents", "run-timeout", "partition", "partition-seed", "rank", "algorithm", "init",
            "max-rounds", "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary",
-           "graph-name", "rejoin-timeout", "status-interval"},
+           "graph-name", "rejoin-timeout", "status-interval", "replicas", "replica-every"},
           cli::SessionArgsFor::kProcess),
       {"progress", "verbose", "help"});
   if (!args.positional().empty())
@@ -141,6 +148,10 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
   a.status_interval_s = args.get_double("status-interval", a.status_interval_s);
   if (!(a.status_interval_s >= 0 && a.status_interval_s <= 86400))
     throw InputError("option --status-interval: must be 0..86400 seconds");
+  a.replicas = static_cast<std::uint32_t>(nonneg("replicas", 0));
+  if (a.replicas > 8) throw InputError("option --replicas: must be 0..8");
+  a.replica_every = static_cast<std::uint32_t>(nonneg("replica-every", 10));
+  if (a.replica_every < 1) throw InputError("option --replica-every: must be >= 1");
   a.verbose = args.has("verbose");
   return a;
 }
@@ -273,6 +284,11 @@ class Coordinator {
     asg.seed(a_.seed);
     asg.partition_ms(part.ms);
     asg.rejoin_timeout_s(a_.rejoin_timeout_s);
+    asg.replicas(a_.replicas);
+    asg.replica_every(a_.replica_every);
+    loss_.owner = part.owner;
+    for (std::uint32_t k = 0; k < N; ++k) loss_.expected.push_back(k);
+    base_assignment_ = asg;
     s.publish(asg);
     expect_ready(s.ready_barrier(Seconds(a_.net.timeout_s), &missing), room, a_.net.timeout_s,
                  "the agents to be ready", missing);
@@ -281,9 +297,11 @@ class Coordinator {
     // 3. Final estimates (progress from round statuses meanwhile; lost agents go to the
     // arbiter, which waits for them to rejoin).
     const auto t_run = std::chrono::steady_clock::now();
+    loss_.t_run = t_run;
     using Clock = std::chrono::steady_clock;
     coordinator::RejoinArbiter arbiter(N, a_.rejoin_timeout_s);
-    if (a_.rejoin_timeout_s > 0) s.set_agent_loss_tolerated(true);
+    const bool arbitrate = a_.rejoin_timeout_s > 0 || a_.replicas > 0;
+    if (arbitrate) s.set_agent_loss_tolerated(true);
     std::optional<coordinator::RunMonitor> monitor;
     if (a_.status_interval_s > 0)
       monitor.emplace(N, coordinator::MonitorOptions{a_.status_interval_s, 2, 3.0}, std::cout,
@@ -293,13 +311,14 @@ class Coordinator {
         progress;
     auto finals_missing = [&]() {
       std::set<std::uint32_t> have;
-      for (const auto& f : s.finals().queued_locked()) have.insert(f.sender());
+      for (const auto& f : s.finals().queued_locked())
+        if (f.epoch() >= loss_.epoch) have.insert(f.sender());
       std::string out;
-      for (std::uint32_t k = 0; k < N; ++k)
+      for (std::uint32_t k : loss_.expected)
         if (!have.count(k)) out += (out.empty() ? "agent " : ", agent ") + std::to_string(k);
       return out;
     };
-    const bool watch = monitor || a_.rejoin_timeout_s > 0;
+    const bool watch = monitor || arbitrate;
     for (;;) {
       const double left = a_.run_timeout_s - ms_since(t_run) / 1000.0;
       std::string absent;
@@ -317,10 +336,12 @@ class Coordinator {
         expect_ready(st, room, a_.run_timeout_s, "the final estimates", "none yet from " + absent);
       const auto now = Clock::now();
       for (const auto& m : s.status_watch().take_all()) {
-        if (m.epoch() < arbiter.epoch()) continue;  // sent before the last rollback
-        if ((m.phase() == 1 || m.phase() == 5) && m.sender() < N) {
-          arbiter.on_status(m.sender(), m.round());
-          if (monitor) monitor->on_status(m.sender(), m.round(), now);
+        if (m.epoch() < std::max(arbiter.epoch(), loss_.epoch)) continue;  // before a rollback
+        if ((m.phase() == 1 || m.phase() == 5) && m.sender() < loss_.expected.size()) {
+          // After a re-partition senders are protocol ids: positions among the survivors.
+          const std::uint32_t agent = loss_.expected[m.sender()];
+          if (loss_.epoch == 0) arbiter.on_status(agent, m.round());
+          if (monitor) monitor->on_status(agent, m.round(), now);
         }
         if (m.phase() == agent_final_report_phase) {  // agent 0's summary of the solve
           final_cost_ = m.cost();
@@ -335,14 +356,16 @@ class Coordinator {
         p.first += 1;
         p.second.first += m.cost();
         p.second.second += m.grad_norm_sq();
-        if (p.first == N && a_.progress) {
+        const std::uint32_t active = static_cast<std::uint32_t>(loss_.expected.size());
+        if ((m.phase() == 1 || m.phase() == 5) && loss_.epoch == 0) loss_.last_round = m.round();
+        if (p.first == active && a_.progress) {
           char buf[160];
           std::snprintf(buf, sizeof(buf), "round %u%s: cost %.10g, grad norm %.3e\n", m.round(),
                         m.phase() == 5 ? " (restart)" : "", p.second.first,
                         std::sqrt(p.second.second));
           std::cout << buf << std::flush;
         }
-        if (p.first == N) {
+        if (p.first == active) {
           progress.erase({m.round(), m.phase()});
           // Round timing from the status completions the coordinator sees: excludes the
           // fixed costs (hand-off, initialisation, rounding, shutdown) that solve_ms holds.
@@ -354,8 +377,22 @@ class Coordinator {
       }
       if (watch) {
         const std::vector<std::uint32_t> lost = s.lost_agents();
-        if (a_.rejoin_timeout_s > 0)
+        if (arbitrate && loss_.epoch == 0)
           for (auto k : lost) arbiter.on_lost(k, now);
+        if (loss_.epoch > 0) {
+          // A survivor lost too (for longer than the rejoin window: a loaded host can drop
+          // and rediscover a live peer) is a second loss, which the replicas do not cover.
+          std::map<std::uint32_t, Clock::time_point> still;
+          for (auto k : lost)
+            if (std::find(loss_.lost.begin(), loss_.lost.end(), k) == loss_.lost.end())
+              still[k] = loss_.second.count(k) ? loss_.second[k] : now;
+          loss_.second = still;
+          for (const auto& [k, since] : still)
+            if (std::chrono::duration<double>(now - since).count() > a_.rejoin_timeout_s)
+              throw RunFailure(kExitRunFailed, "lost agent " + std::to_string(k) +
+                                                   " after a re-partition: a second loss is "
+                                                   "not covered by the replicas");
+        }
         if (monitor) monitor->set_lost(lost, now);
         for (const auto& c : s.rejoins().take_all()) {
           arbiter.on_rejoin({c.agent(), c.round(), c.round_prev(), c.nonce()}, now);
@@ -366,10 +403,10 @@ class Coordinator {
                                ")",
                            now);
         }
-        if (a_.rejoin_timeout_s > 0) decide_on_losses(arbiter, monitor, progress, now);
+        if (arbitrate && loss_.epoch == 0) decide_on_losses(arbiter, monitor, progress, now, rs);
         if (monitor) monitor->tick(now);
       }
-      if (have_final_report_ && s.finals().size() >= N &&
+      if (have_final_report_ && s.finals().size() >= loss_.expected.size() &&
           room.wait_for([&] { return finals_missing().empty(); }, Seconds(0)) == WaitStatus::kReady)
         break;
     }
@@ -381,12 +418,12 @@ class Coordinator {
     std::vector<std::uint64_t> bytes(N, 0);
     std::uint32_t rounds = 0;
     for (const auto& f : s.finals().take_all()) {
-      if (f.sender() >= N) continue;
+      if (f.sender() >= N || f.epoch() < loss_.epoch) continue;
       bytes[f.sender()] = f.bytes_sent();
       rounds = std::max(rounds, f.rounds());
       auto list = final_poses(f);
       for (auto& [id, pose] : list) {
-        if (id >= rs.num_poses || part.owner[id] != f.sender())
+        if (id >= rs.num_poses || loss_.owner[id] != f.sender())
           throw RunFailure(kExitRunFailed, "agent " + std::to_string(f.sender()) +
                                                " returned pose " + std::to_string(id) +
                                                " which it does not own");
@@ -399,7 +436,7 @@ class Coordinator {
     for (std::size_t id = 0; id < rs.num_poses; ++id)
       if (!seen[id])
         throw RunFailure(kExitRunFailed, "pose " + std::to_string(id) + " is missing from agent " +
-                                             std::to_string(part.owner[id]) + "'s final estimate");
+                                             std::to_string(loss_.owner[id]) + "'s final estimate");
     if (!a_.output.empty()) {
       PoseGraph g;
       g.d = rs.d;
@@ -421,8 +458,9 @@ class Coordinator {
                   "tessera-coordinator: done: %u agents, %zu poses, %u round(s), discovery %.0f "
                   "ms, partition %.1f ms, "
                   "%llu bytes sent by agents, %.2f s\n",
-                  N, rs.num_poses, rounds, discovery_ms_, part.ms,
-                  static_cast<unsigned long long>(total_bytes), ms_since(t0) / 1000.0);
+                  static_cast<std::uint32_t>(loss_.expected.size()), rs.num_poses, rounds,
+                  discovery_ms_, part.ms, static_cast<unsigned long long>(total_bytes),
+                  ms_since(t0) / 1000.0);
     std::cerr << buf;
   }
 
@@ -431,9 +469,40 @@ class Coordinator {
   template <class Progress>
   void decide_on_losses(coordinator::RejoinArbiter& arbiter,
                         std::optional<coordinator::RunMonitor>& monitor, Progress& progress,
-                        std::chrono::steady_clock::time_point now) {
+                        std::chrono::steady_clock::time_point now,
+                        const coordinator::RunStructure& rs) {
     const coordinator::LossDecision d = arbiter.decide(now);
     using Kind = coordinator::LossDecision::Kind;
+    // Lost for good: re-partition. Only the agent whose rejoin window closed leaves: a peer
+    // dropped at the same moment may be a false alarm of a loaded host (it reappears).
+    if (d.kind == Kind::kGiveUp && a_.replicas > 0) {
+      const coordinator::SurvivorAssignment sa = coordinator::reassign_for_survivors(
+          rs.graph, loss_.owner, a_.agents, {d.agent}, arbiter.epoch() + 1);
+      wire::PartitionAssignment asg = base_assignment_;
+      asg.epoch(sa.epoch);
+      asg.owner(sa.owner);
+      asg.survivors(sa.survivors);
+      asg.lost(sa.lost);
+      session_->publish(asg);
+      loss_.epoch = sa.epoch;
+      loss_.owner = sa.owner;
+      loss_.expected = sa.survivors;
+      loss_.lost = sa.lost;
+      loss_.moved_poses = sa.moved_poses;
+      loss_.cut_edges = sa.cut_edges;
+      loss_.at_ms = ms_since(loss_.t_run);
+      have_final_report_ = false;  // the survivors' run reports again
+      progress.clear();
+      const std::string what = "agent(s) lost for good; re-partitioned " +
+                               std::to_string(sa.moved_poses) + " poses among " +
+                               std::to_string(sa.survivors.size()) + " survivors (epoch " +
+                               std::to_string(sa.epoch) + ", " + d.reason + ")";
+      if (monitor)
+        monitor->event(what, now);
+      else
+        std::cerr << "tessera-coordinator: " << what << "\n";
+      return;
+    }
     if (d.kind == Kind::kGiveUp)
       throw RunFailure(kExitRunFailed, "lost agent " + std::to_string(d.agent) + " of run '" +
                                            a_.net.session.run_id + "': " + d.reason);
@@ -504,6 +573,22 @@ class Coordinator {
         .add("total_ms", total_ms)
         .add("bytes_sent", std::vector<std::size_t>(bytes.begin(), bytes.end()))
         .add("hosts", rs.hosts);
+    if (loss_.epoch > 0) {  // the permanent-loss record (docs/fault-tolerance.md)
+      cli::JsonObject f;
+      std::vector<std::size_t> lost(loss_.lost.begin(), loss_.lost.end());
+      std::vector<std::size_t> survivors(loss_.expected.begin(), loss_.expected.end());
+      f.add("kind", "lost_for_good")
+          .add("lost_agents", lost)
+          .add("round", static_cast<long long>(loss_.last_round))
+          .add("survivors", survivors)
+          .add("moved_poses", loss_.moved_poses)
+          .add("cut_edges_after", loss_.cut_edges)
+          .add("repartition_at_s", loss_.at_ms / 1000.0)
+          .add("epoch", static_cast<long long>(loss_.epoch));
+      j.add("fault", f);
+    } else {
+      j.add_null("fault");
+    }
     cli::write_output(a_.summary, j.str());
   }
 
@@ -518,6 +603,19 @@ class Coordinator {
   std::uint32_t final_restarts_ = 0;
   bool have_final_report_ = false;
   std::uint32_t rollbacks_ = 0;  // coordinated rollbacks (agents that rejoined)
+  // Permanent loss: the assignment in force and what the re-partition did (for the summary).
+  wire::PartitionAssignment base_assignment_;
+  struct {
+    std::uint32_t epoch = 0;              // > 0 after a re-partition for the survivors
+    std::vector<std::uint32_t> owner;     // agent of every pose, as now assigned
+    std::vector<std::uint32_t> expected;  // agents whose final estimates count
+    std::vector<std::uint32_t> lost;
+    std::uint32_t last_round = 0;  // last round status seen before the loss
+    std::size_t moved_poses = 0, cut_edges = 0;
+    double at_ms = 0;  // since the rounds started
+    std::map<std::uint32_t, std::chrono::steady_clock::time_point> second;  // survivors lost
+    std::chrono::steady_clock::time_point t_run;
+  } loss_;
 };
 
 }  // namespace

@@ -60,13 +60,25 @@ struct Session::Impl {
   Inbox<wire::AgentAnnouncement> announce_in{room};
   Inbox<wire::PartitionAssignment> assignment_in{room};
   Inbox<wire::MeasurementHandoff> handoff_in{room};
+  Inbox<wire::MeasurementHandoff> replica_in{room};  // purpose 1: replicas of peers' data
   Inbox<ProtocolMessage> protocol_in{room};
   Inbox<wire::RoundStatus> status_in{room};
   Inbox<wire::FinalEstimate> final_in{room};
   Inbox<wire::Control> rejoin_in{room};
   Inbox<wire::Control> rollback_in{room};
-  std::uint32_t epoch = 0;                                        // guarded by room.mutex()
-  std::vector<std::pair<std::uint32_t, ProtocolMessage>> future;  // newer epochs, held
+  std::uint32_t epoch = 0;  // guarded by room.mutex()
+  // Protocol id of this agent in the current epoch (its agent id until a re-partition for
+  // survivors renumbers them), guarded by room.mutex().
+  std::uint32_t protocol_id = 0;
+  // Newer epochs' messages, held with their routing: whether one is for this agent is only
+  // known once this agent has its protocol id of that epoch.
+  struct Held {
+    std::uint32_t epoch, sender;
+    bool broadcast;
+    std::vector<std::uint32_t> recipients;
+    ProtocolMessage message;
+  };
+  std::vector<Held> future;
 
   // State below is guarded by room.mutex().
   std::map<Prefix, PeerIdentity> peers;  // participants of this run, by GUID prefix
@@ -218,14 +230,17 @@ struct Session::Impl {
   }
 
   // A protocol message of `e`: delivered, held or dropped by epoch (see Session::set_epoch).
-  void deliver_protocol(std::uint32_t e, ProtocolMessage&& m) {
+  void deliver_protocol(std::uint32_t e, std::uint32_t sender, bool broadcast,
+                        const std::vector<std::uint32_t>& recipients, ProtocolMessage&& m) {
     bool wake = false;
     room.with_lock([&] {
       if (e == epoch) {
-        protocol_in.push_locked(std::move(m));
-        wake = true;
+        if (sender != protocol_id && addressed_to(broadcast, recipients, protocol_id)) {
+          protocol_in.push_locked(std::move(m));
+          wake = true;
+        }
       } else if (e > epoch) {
-        future.emplace_back(e, std::move(m));
+        future.push_back(Held{e, sender, broadcast, recipients, std::move(m)});
       }
       return 0;
     });
@@ -404,6 +419,7 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   s.domain = options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
   s.me = PeerIdentity{options.run_id, options.coordinator,
                       options.coordinator ? 0u : options.agent_id};
+  s.protocol_id = s.me.agent_id;
 
   // TESSERA_DDS_LOG=1 shows Fast DDS's own warnings and errors (for diagnosing QoS trouble).
   if (const char* env = std::getenv("TESSERA_DDS_LOG"); env && *env && *env != '0')
@@ -455,17 +471,21 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
           [&s](wire::PartitionAssignment&& m) { s.assignment_in.push(std::move(m)); });
       s.make_reader<wire::MeasurementHandoffPubSubType, wire::MeasurementHandoff>(
           kHandoffTopic, false, Expect::kOtherAgents, [&s, me](wire::MeasurementHandoff&& m) {
-            if (m.recipient() == me && m.sender() != me) s.handoff_in.push(std::move(m));
+            if (m.recipient() != me || m.sender() == me) return;
+            if (m.purpose() == 1)
+              s.replica_in.push(std::move(m));
+            else
+              s.handoff_in.push(std::move(m));
           });
       s.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(
-          kBlockTopic, false, Expect::kOtherAgents, [&s, me](wire::PoseBlock&& m) {
-            if (m.sender() != me && addressed_to(m.broadcast(), m.recipients(), me))
-              s.deliver_protocol(m.epoch(), ProtocolMessage(from_wire(m)));
+          kBlockTopic, false, Expect::kOtherAgents, [&s](wire::PoseBlock&& m) {
+            s.deliver_protocol(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
+                               ProtocolMessage(from_wire(m)));
           });
       s.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
-          kStatusTopic, false, Expect::kOtherAgents, [&s, me](wire::RoundStatus&& m) {
-            if (m.sender() != me && addressed_to(m.broadcast(), m.recipients(), me))
-              s.deliver_protocol(m.epoch(), ProtocolMessage(from_wire(m)));
+          kStatusTopic, false, Expect::kOtherAgents, [&s](wire::RoundStatus&& m) {
+            s.deliver_protocol(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
+                               ProtocolMessage(from_wire(m)));
           });
     }
     // Control: everyone reads everyone (READY barrier, ABORT, FINISHED).
@@ -529,6 +549,9 @@ Inbox<wire::PartitionAssignment>& Session::assignments() {
 Inbox<wire::MeasurementHandoff>& Session::handoffs() {
   return impl_->handoff_in;
 }
+Inbox<wire::MeasurementHandoff>& Session::replicas() {
+  return impl_->replica_in;
+}
 Inbox<ProtocolMessage>& Session::protocol() {
   return impl_->protocol_in;
 }
@@ -551,17 +574,29 @@ std::uint32_t Session::epoch() const {
 }
 
 void Session::set_epoch(std::uint32_t e) {
+  set_epoch(e, protocol_id());
+}
+
+std::uint32_t Session::protocol_id() const {
+  std::lock_guard<std::mutex> lock(impl_->room.mutex());
+  return impl_->protocol_id;
+}
+
+void Session::set_epoch(std::uint32_t e, std::uint32_t protocol_id) {
   Impl& s = *impl_;
   s.room.with_lock([&] {
     if (e < s.epoch) return 0;
     s.epoch = e;
+    s.protocol_id = protocol_id;
     s.protocol_in.clear_locked();  // everything queued is of an older epoch
-    std::vector<std::pair<std::uint32_t, ProtocolMessage>> later;
-    for (auto& [k, m] : s.future) {
-      if (k == e)
-        s.protocol_in.push_locked(std::move(m));
-      else if (k > e)
-        later.emplace_back(k, std::move(m));
+    std::vector<Impl::Held> later;
+    for (auto& h : s.future) {
+      if (h.epoch == e) {
+        if (h.sender != protocol_id && addressed_to(h.broadcast, h.recipients, protocol_id))
+          s.protocol_in.push_locked(std::move(h.message));
+      } else if (h.epoch > e) {
+        later.push_back(std::move(h));
+      }
     }
     s.future = std::move(later);
     return 0;

@@ -50,7 +50,10 @@ class Session {
   // ---- inboxes: messages of this run meant for this process ------------------------------
   Inbox<wire::AgentAnnouncement>& announcements();  ///< Coordinator.
   Inbox<wire::PartitionAssignment>& assignments();  ///< Agents.
-  Inbox<wire::MeasurementHandoff>& handoffs();      ///< Agents: those addressed to this agent.
+  Inbox<wire::MeasurementHandoff>& handoffs();
+  /// Agents: replicas of other agents' local problems (hand-offs with purpose 1) addressed to
+  /// this agent; kept apart so they never count as hand-offs.
+  Inbox<wire::MeasurementHandoff>& replicas();  ///< Agents: those addressed to this agent.
   /// Agents: pose blocks and round statuses addressed to this agent (own messages excluded),
   /// converted to core's types, in arrival order per topic.
   Inbox<ProtocolMessage>& protocol();
@@ -65,6 +68,12 @@ class Session {
   /// Moves to `epoch` (>= the current one): drops queued protocol messages of older epochs
   /// and releases the held ones of this epoch into protocol().
   void set_epoch(std::uint32_t epoch);
+  /// Same, and from then on this agent is `protocol_id` in the round protocol (a re-partition
+  /// for survivors renumbers them 0..S-1): incoming messages are routed by it. Held messages
+  /// of `epoch` are routed by it when released.
+  void set_epoch(std::uint32_t epoch, std::uint32_t protocol_id);
+  /// This agent's id in the round protocol of the current epoch (its agent id at first).
+  std::uint32_t protocol_id() const;
 
   // ---- sending (retries while the history is full; throws TransportError after write_timeout_s)
   void publish(const wire::AgentAnnouncement& m);
