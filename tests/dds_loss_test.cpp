@@ -1,0 +1,182 @@
+// Permanent loss over DDS: an agent SIGKILLed for good during the rounds (not restarted) has
+// its block re-partitioned among the survivors, which take over its measurements from the
+// replicas and finish with N-1 agents: every pose in the merged estimate, cost within 1e-6 of
+// the centralized optimum, and a fault record in the summary.
+// Domains used here: 186-187 (each test its own, so ctest -j is safe).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "dds_process_support.hpp"
+#include "io/g2o_reader.hpp"
+#include "solvers/centralized_solver.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+double json_field(const std::string& json, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
+  return std::stod(m[1]);
+}
+
+bool wait_for_output(const Process& p, const std::string& text, double timeout_s) {
+  const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
+  while (Clock::now() < until) {
+    if (p.output().find(text) != std::string::npos) return true;
+    usleep(20000);
+  }
+  return false;
+}
+
+struct LossRun {
+  std::string dir, graph, run;
+  int agents = 5, domain = 0;
+  std::vector<std::string> agent(int k) const {
+    return {bin("tessera-agent"),
+            "--graph",
+            graph,
+            "--robots",
+            std::to_string(agents),
+            "--id",
+            std::to_string(k),
+            "--run-id",
+            run,
+            "--domain",
+            std::to_string(domain),
+            "--timeout",
+            "20"};
+  }
+  Process coordinator(int replicas) const {
+    return start({bin("tessera-coordinator"),
+                  "--agents",
+                  std::to_string(agents),
+                  "--run-id",
+                  run,
+                  "--domain",
+                  std::to_string(domain),
+                  "--timeout",
+                  "20",
+                  "--run-timeout",
+                  "50",
+                  "--summary",
+                  dir + "/summary.json",
+                  "--output",
+                  dir + "/merged.g2o",
+                  "--progress",
+                  "--partition",
+                  "eco",
+                  "--grad-tol",
+                  "0.0005",
+                  "--replicas",
+                  std::to_string(replicas),
+                  "--replica-every",
+                  "5",
+                  "--rejoin-timeout",
+                  "1",
+                  "--status-interval",
+                  "1"},
+                 dir + "/coordinator.log");
+  }
+};
+
+LossRun make_run(int domain, const std::string& name) {
+  LossRun r;
+  r.dir = temp_dir();
+  r.domain = domain;
+  r.run = name + "-" + std::to_string(getpid());
+  r.graph = r.dir + "/graph.g2o";
+  std::string out;
+  EXPECT_EQ(run_command(bin("tessera") +
+                            " generate --kind grid3d --poses 300 --robots 5 "
+                            "--seed 3 --out " +
+                            r.graph,
+                        &out),
+            0)
+      << out;
+  return r;
+}
+
+TEST(DdsLoss, AgentKilledForGoodSurvivorsFinishAtTheOptimumWithEveryPose) {
+  LossRun r = make_run(186, "loss");
+  Process coord = r.coordinator(1);
+  std::vector<Process> agents;
+  for (int k = 0; k < r.agents; ++k)
+    agents.push_back(start(r.agent(k), r.dir + "/agent" + std::to_string(k) + ".log"));
+  const bool started = wait_for_output(coord, "round 10:", 30);
+  kill(agents[2].pid, SIGKILL);  // for good: never restarted
+  ASSERT_TRUE(started) << coord.output();
+  std::vector<Process*> all = {&coord};
+  for (auto& a : agents) all.push_back(&a);
+  EXPECT_TRUE(wait_all(all, 50)) << "a process hung";
+  EXPECT_EQ(agents[2].exit_code, 128 + SIGKILL);
+  EXPECT_EQ(coord.exit_code, 0) << coord.output();
+  for (int k : {0, 1, 3, 4})
+    EXPECT_EQ(agents[static_cast<std::size_t>(k)].exit_code, 0)
+        << agents[static_cast<std::size_t>(k)].output();
+  const std::string co = coord.output();
+  EXPECT_NE(co.find("re-partitioned"), std::string::npos) << co;
+
+  // Every pose is in the merged estimate, and its cost is the centralized optimum's.
+  const PoseGraph g = read_g2o(r.graph);
+  std::set<long> ids;  // the merged output holds VERTEX lines only
+  {
+    std::ifstream f(r.dir + "/merged.g2o");
+    for (std::string line; std::getline(f, line);)
+      if (line.rfind("VERTEX", 0) == 0) ids.insert(std::stol(line.substr(line.find(' ') + 1)));
+  }
+  EXPECT_EQ(ids.size(), g.num_poses);
+  EXPECT_EQ(ids.empty() ? -1L : *ids.rbegin(), static_cast<long>(g.num_poses) - 1);
+  const double fstar = solve_centralized(g).cost;
+  const std::string summary = slurp(r.dir + "/summary.json");
+  const double cost = json_field(summary, "cost");
+  EXPECT_LE(std::abs(cost - fstar), 1e-6 * fstar) << summary << "\nf* = " << fstar;
+  // The fault record: who was lost, who survived, what moved.
+  EXPECT_NE(summary.find("\"lost_agents\": [2]"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"survivors\": [0, 1, 3, 4]"), std::string::npos) << summary;
+  EXPECT_EQ(json_field(summary, "moved_poses"), 60) << summary;  // exactly agent 2's block
+}
+
+TEST(DdsLoss, WithoutReplicasALostAgentStillStopsTheRun) {
+  LossRun r = make_run(187, "noreplica");
+  r.agents = 3;
+  std::string out;
+  ASSERT_EQ(run_command(bin("tessera") +
+                            " generate --kind grid3d --poses 300 --robots 3 "
+                            "--seed 3 --out " +
+                            r.graph,
+                        &out),
+            0);
+  Process coord = r.coordinator(0);
+  std::vector<Process> agents;
+  for (int k = 0; k < r.agents; ++k)
+    agents.push_back(start(r.agent(k), r.dir + "/agent" + std::to_string(k) + ".log"));
+  const bool started = wait_for_output(coord, "round 3:", 30);
+  kill(agents[1].pid, SIGKILL);
+  ASSERT_TRUE(started) << coord.output();
+  std::vector<Process*> all = {&coord};
+  for (auto& a : agents) all.push_back(&a);
+  EXPECT_TRUE(wait_all(all, 30)) << "a process hung";
+  EXPECT_EQ(coord.exit_code, 1) << coord.output();
+  // (On a loaded host another agent may be reported lost first; either way the run stops.)
+  EXPECT_NE(coord.output().find("lost agent"), std::string::npos) << coord.output();
+  EXPECT_EQ(coord.output().find("re-partitioned"), std::string::npos) << coord.output();
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
