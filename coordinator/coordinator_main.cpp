@@ -476,6 +476,14 @@ class Coordinator {
     // Lost for good: re-partition. Only the agent whose rejoin window closed leaves: a peer
     // dropped at the same moment may be a false alarm of a loaded host (it reappears).
     if (d.kind == Kind::kGiveUp && a_.replicas > 0) {
+      const std::vector<std::uint32_t> lost = session_->lost_agents();
+      if (std::find(lost.begin(), lost.end(), d.agent) == lost.end()) {
+        // Alive again: a false alarm of the lease on a busy host, not a loss.
+        arbiter.forget(d.agent);
+        std::cerr << "tessera-coordinator: agent " << d.agent
+                  << " is back (false alarm): no re-partition\n";
+        return;
+      }
       const coordinator::SurvivorAssignment sa = coordinator::reassign_for_survivors(
           rs.graph, loss_.owner, a_.agents, {d.agent}, arbiter.epoch() + 1);
       wire::PartitionAssignment asg = base_assignment_;

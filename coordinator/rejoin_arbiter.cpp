@@ -31,6 +31,10 @@ std::optional<double> RejoinArbiter::seconds_to_deadline(Clock::time_point now) 
   return out;
 }
 
+void RejoinArbiter::forget(std::uint32_t agent) {
+  if (!requests_.count(agent)) lost_since_.erase(agent);
+}
+
 LossDecision RejoinArbiter::decide(Clock::time_point now) {
   LossDecision d;
   if (lost_since_.empty()) return d;

@@ -56,6 +56,10 @@ class RejoinArbiter {
   /// A restarted process asks to rejoin (counts as lost if the loss was not seen yet).
   void on_rejoin(const RejoinRequest& request, Clock::time_point now);
 
+  /// Drops a lost agent that turned out to be alive (the lease of a busy host expired and the
+  /// same process was discovered again) and never asked to rejoin; no rollback follows.
+  void forget(std::uint32_t agent);
+
   /// The decision point: a rollback once every lost agent asked to rejoin and a common round
   /// exists; give up when a lost agent's window expired; otherwise wait. After kRollback the
   /// epoch has advanced and the agents are no longer lost.

@@ -1,0 +1,200 @@
+#!/usr/bin/env python3
+"""Permanent-loss fault benchmark of the DDS runtime (issue 8, item 2).
+
+A generated 3D grid, N = 5 agents, the coordinator with --replicas 1 (every agent's
+measurements and lifted poses replicated to one neighbour) and a short --rejoin-timeout.
+Each trial SIGKILLs a random agent when the coordinator reports a random round and never
+restarts it: the coordinator re-partitions its block among the survivors, which take over
+from the replicas and finish with N - 1 agents. A trial counts as finished when every
+surviving process exits 0, the merged estimate holds every pose, and the summary names the
+loss; its cost error is measured against f* (the centralized solver's optimum).
+
+Writes docs/benchmarks/faults_loss.csv with the column contract of scripts/bench/faults.py
+(fault,trials,finished,cost_error,extra_time_s; extra time = mean wall time over the
+undisturbed replicated run), per-trial rows in docs/benchmarks/faults/loss_trials.csv, and
+re-assembles docs/benchmarks/faults.md.
+"""
+import argparse
+import csv
+import json
+import os
+import random
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from faults import COLUMNS, OUT_DIR, ROOT, assemble, write_contract_csv  # noqa: E402
+
+
+class LossRun:
+    def __init__(self, args, work, name, replicas):
+        self.args, self.name, self.replicas = args, name, replicas
+        self.dir = os.path.join(work, name)
+        os.makedirs(self.dir, exist_ok=True)
+        self.run_id = "loss-%d-%s" % (os.getpid(), name)
+        self.summary = os.path.join(self.dir, "summary.json")
+        self.merged = os.path.join(self.dir, "merged.g2o")
+
+    def spawn(self, cmd, log):
+        f = open(os.path.join(self.dir, log), "w")
+        return subprocess.Popen(cmd, stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
+
+    def start(self):
+        a = self.args
+        self.t0 = time.time()
+        self.coord = self.spawn([os.path.join(a.bin_dir, "tessera-coordinator"), "--agents", str(a.agents),
+                                 "--run-id", self.run_id, "--domain", str(a.domain), "--timeout", "60",
+                                 "--run-timeout", str(a.limit), "--summary", self.summary,
+                                 "--output", self.merged, "--progress", "--partition", "eco",
+                                 "--grad-tol", str(a.grad_tol), "--replicas", str(self.replicas),
+                                 "--replica-every", str(a.replica_every),
+                                 "--rejoin-timeout", str(a.rejoin_timeout), "--status-interval", "2"],
+                                "coordinator.log")
+        self.agents = {k: self.spawn([os.path.join(a.bin_dir, "tessera-agent"), "--graph", a.graph_path,
+                                      "--robots", str(a.agents), "--id", str(k), "--run-id", self.run_id,
+                                      "--domain", str(a.domain), "--timeout", "60"], "agent%d.log" % k)
+                       for k in range(a.agents)}
+
+    def coordinator_output(self):
+        with open(os.path.join(self.dir, "coordinator.log")) as f:
+            return f.read()
+
+    def kill_at(self, agent, at_round):
+        deadline = time.time() + self.args.limit
+        pattern = "round %d:" % at_round
+        while pattern not in self.coordinator_output():
+            if time.time() > deadline or self.coord.poll() is not None:
+                return False
+            time.sleep(0.005)
+        os.kill(self.agents[agent].pid, signal.SIGKILL)
+        return True
+
+    def wait(self, victim=None):
+        deadline = time.time() + self.args.limit
+        codes = {}
+        for name, p in [("coordinator", self.coord)] + [(k, p) for k, p in self.agents.items()]:
+            try:
+                codes[name] = p.wait(timeout=max(1, deadline - time.time()))
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                codes[name] = -9
+        wall = time.time() - self.t0
+        summary = None
+        if os.path.exists(self.summary):
+            with open(self.summary) as f:
+                summary = json.load(f)
+        ok = all(c == 0 for n, c in codes.items() if n != victim) and summary is not None
+        return ok, codes, wall, summary
+
+    def merged_poses(self):
+        ids = set()
+        if os.path.exists(self.merged):
+            with open(self.merged) as f:
+                for line in f:
+                    if line.startswith("VERTEX"):
+                        ids.add(int(line.split()[1]))
+        return ids
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--out-dir", default=OUT_DIR)
+    ap.add_argument("--trials", type=int, default=10)
+    ap.add_argument("--agents", type=int, default=5)
+    ap.add_argument("--poses", type=int, default=500)
+    ap.add_argument("--grad-tol", type=float, default=0.0005)
+    ap.add_argument("--replica-every", type=int, default=5)
+    ap.add_argument("--rejoin-timeout", type=float, default=1.0)
+    ap.add_argument("--domain", type=int, default=213)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--limit", type=float, default=300, help="time limit of one run, seconds")
+    args = ap.parse_args()
+    rng = random.Random(args.seed)
+    work = tempfile.mkdtemp(prefix="tessera_faults_loss_")
+    args.graph_path = os.path.join(work, "graph.g2o")
+    tessera = os.path.join(args.bin_dir, "tessera")
+    subprocess.run([tessera, "generate", "--kind", "grid3d", "--poses", str(args.poses), "--robots",
+                    str(args.agents), "--seed", "3", "--out", args.graph_path], check=True,
+                   stdout=subprocess.DEVNULL)
+    cjson = os.path.join(work, "centralized.json")
+    subprocess.run([tessera, "solve", args.graph_path, "--algorithm", "centralized", "--json", cjson],
+                   check=True, stdout=subprocess.DEVNULL)
+    with open(cjson) as f:
+        fstar = json.load(f)["cost"]
+    print("f* = %.12g (centralized)" % fstar)
+
+    base = {}
+    for name, replicas in (("plain", 0), ("replicated", 1)):
+        r = LossRun(args, work, "undisturbed-" + name, replicas)
+        r.start()
+        ok, codes, wall, summary = r.wait()
+        if not ok:
+            print("undisturbed run (%s) failed: %s; logs in %s" % (name, codes, r.dir))
+            return 1
+        base[name] = (wall, summary)
+        print("undisturbed %-10s: %d rounds, cost %.12g (error %.1e vs f*), wall %.2f s, %d bytes" %
+              (name, summary["rounds"], summary["cost"], abs(summary["cost"] - fstar) / fstar, wall,
+               summary["bytes_exchanged"]))
+    ref_wall, ref = base["replicated"]
+    rounds = int(ref["rounds"])
+
+    trials = []
+    for t in range(args.trials):
+        agent = rng.randrange(args.agents)
+        at = rng.randrange(2, max(3, rounds - 5))
+        r = LossRun(args, work, "trial%d" % t, 1)
+        r.start()
+        killed = r.kill_at(agent, at)
+        ok, codes, wall, summary = r.wait(victim=agent)
+        poses = len(r.merged_poses())
+        fault = (summary or {}).get("fault") or {}
+        ok = ok and killed and poses == args.poses and fault.get("lost_agents") == [agent]
+        err = abs(summary["cost"] - fstar) / fstar if ok else float("nan")
+        trials.append(dict(trial=t, agent=agent, kill_round=at, finished=int(ok),
+                           survivors=len(fault.get("survivors", [])), poses_in_estimate=poses,
+                           moved_poses=fault.get("moved_poses", ""),
+                           repartition_at_s=fault.get("repartition_at_s", ""),
+                           rounds_after=summary["rounds"] if summary else "",
+                           cost=summary["cost"] if summary else "", rel_cost_error=err,
+                           wall_s=round(wall, 3), extra_s=round(wall - ref_wall, 3)))
+        print("trial %d: kill agent %d at round %d for good -> %s, %d poses, cost error %.2e vs f*, "
+              "wall %.2f s (+%.2f)" % (t, agent, at, "finished with %d agents" % len(fault.get("survivors", []))
+                                       if ok else "FAILED %s" % codes, poses, err, wall, wall - ref_wall))
+        if not ok:
+            print("  logs kept in %s" % r.dir)
+    finished = [x for x in trials if x["finished"]]
+    row = dict(fault="agent SIGKILLed for good at a random round, block re-partitioned to the survivors "
+                     "(N=%d, %d-pose grid3d, --replicas 1; cost error vs f*)" % (args.agents, args.poses),
+               trials=len(trials), finished=len(finished),
+               cost_error="%.1e" % max([x["rel_cost_error"] for x in finished], default=float("nan")),
+               extra_time_s="%.2f" % (sum(x["extra_s"] for x in finished) / max(1, len(finished))))
+    os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
+    write_contract_csv(os.path.join(args.out_dir, "faults_loss.csv"), [row])
+    with open(os.path.join(args.out_dir, "faults", "loss_trials.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(trials[0].keys()))
+        w.writeheader()
+        w.writerows(trials)
+    with open(os.path.join(args.out_dir, "faults", "loss_replication_cost.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["run", "replicas", "wall_s", "rounds", "bytes_exchanged", "cost"])
+        for name, (wall, s) in base.items():
+            w.writerow([name, 0 if name == "plain" else 1, "%.3f" % wall, s["rounds"], s["bytes_exchanged"],
+                        "%.12g" % s["cost"]])
+    print("\n" + " | ".join(COLUMNS))
+    print(" | ".join(str(row[c]) for c in COLUMNS))
+    assemble(args.out_dir)
+    if len(finished) == len(trials):
+        shutil.rmtree(work, ignore_errors=True)
+    else:
+        print("work dir kept: " + work)
+    return 0 if len(finished) == len(trials) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
