@@ -116,6 +116,7 @@ void AgentState::reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd&
   Y = P = V = Y_prev = V_prev = Y0;
   Yn = Pn = Yn_prev = Yn0;
   neighbours_set_.resize(0, 0);  // the problem's neighbour poses are stale
+  updated_grad_norm_sq_ = -1.0;  // nothing to reuse (and updated_X_ may have another rank)
 }
 
 }  // namespace tessera
