@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""Distributed certification on every graph of ../shared/datasets (issue #7).
+
+For each graph: `tessera solve G --algorithm irbcd --agents 5 --partition highest --certify`
+(the in-process engine: same messages and rounds as over DDS) and the centralized certifiable
+solver `tessera solve G --algorithm centralized`. Prints, and writes to
+docs/benchmarks/distributed_certificate.{csv,md}: whether the distributed certificate holds,
+its lambda_min beside the centralized one, the certificate's rounds and bytes beside the
+solver's rounds and bytes, the staircase's final rank, and wall/CPU times. Each run has a time
+limit; graphs that did not finish are listed as such (the machine may be loaded).
+
+usage: scripts/bench/distributed_certificate.py [--bin build/bin/tessera] [--limit 600]
+       [--only NAME,NAME] [--datasets ../shared/datasets]
+"""
+import argparse
+import csv
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+
+def run(cmd, limit):
+    """(json dict or None, wall s, cpu s of the child, status text)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.monotonic()
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=limit)
+        status = "ok" if p.returncode == 0 else f"exit {p.returncode}: {p.stderr.strip()[-200:]}"
+    except subprocess.TimeoutExpired:
+        status = f"timeout ({limit:.0f} s)"
+    wall = time.monotonic() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return status, wall, cpu
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin", "tessera"))
+    ap.add_argument("--datasets", default=os.path.join(ROOT, "..", "shared", "datasets"))
+    ap.add_argument("--limit", type=float, default=600.0, help="seconds per run")
+    ap.add_argument("--only", default="", help="comma-separated graph names")
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "benchmarks", "distributed_certificate"))
+    a = ap.parse_args()
+    if not os.path.isdir(a.datasets):
+        print(f"no datasets at {a.datasets}: nothing to do", file=sys.stderr)
+        return 0
+    graphs = sorted((f for f in os.listdir(a.datasets) if f.endswith(".g2o")),
+                    key=lambda f: os.path.getsize(os.path.join(a.datasets, f)))
+    if a.only:
+        keep = set(a.only.split(","))
+        graphs = [g for g in graphs if g[:-4] in keep]
+    rows = []
+    tmp = tempfile.mkdtemp(prefix="tessera-cert-")
+    for g in graphs:
+        name, path = g[:-4], os.path.join(a.datasets, g)
+        dj, cj = os.path.join(tmp, name + ".dist.json"), os.path.join(tmp, name + ".central.json")
+        print(f"{name}: distributed ...", file=sys.stderr, flush=True)
+        ds, dwall, dcpu = run([a.bin, "solve", path, "--algorithm", "irbcd", "--agents", "5",
+                               "--partition", "highest", "--certify", "--json", dj], a.limit)
+        print(f"{name}: {ds}, {dwall:.1f} s; centralized ...", file=sys.stderr, flush=True)
+        cs, cwall, ccpu = run([a.bin, "solve", path, "--algorithm", "centralized", "--json", cj], a.limit)
+        d = json.load(open(dj)) if ds == "ok" else {}
+        c = json.load(open(cj)) if cs == "ok" else {}
+        total = d.get("bytes_exchanged")
+        cert_b, esc_b = d.get("certificate_bytes"), d.get("escape_bytes")
+        solver_b = total - cert_b - esc_b if None not in (total, cert_b, esc_b) else None
+        rows.append({
+            "graph": name, "poses": d.get("poses", c.get("poses")),
+            "status": ds if ds == cs else f"distributed {ds}; centralized {cs}",
+            "certified": d.get("certified"), "central_certified": c.get("certified"),
+            "min_eigenvalue": d.get("min_eigenvalue"), "central_min_eigenvalue": c.get("min_eigenvalue"),
+            "eta": d.get("certificate_tolerance"), "residual": d.get("certificate_residual"),
+            "final_rank": d.get("final_rank"), "central_final_rank": c.get("final_rank"),
+            "solver_rounds": d.get("rounds"), "solver_bytes": solver_b,
+            "certificate_rounds": d.get("certificate_rounds"), "certificate_bytes": cert_b,
+            "escape_rounds": d.get("escape_rounds"), "escape_bytes": esc_b,
+            "grad_norm": d.get("grad_norm"), "cost": d.get("cost"), "central_cost": c.get("cost"),
+            "rel_gap": (d["cost"] - c["cost"]) / abs(c["cost"]) if d.get("cost") and c.get("cost") else None,
+            "wall_s": round(dwall, 2), "cpu_s": round(dcpu, 2), "central_wall_s": round(cwall, 2),
+        })
+        print(rows[-1], file=sys.stderr, flush=True)
+        write(a.out, rows, a)
+    return 0
+
+
+def fmt(x, spec="{:.3g}"):
+    if x is None:
+        return "-"
+    if isinstance(x, bool):
+        return "yes" if x else "NO"
+    return spec.format(x) if isinstance(x, float) else str(x)
+
+
+def write(out, rows, a):
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    with open(out + ".csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+    head = ["graph", "poses", "certified (dist / central)", "lambda_min dist", "lambda_min central",
+            "eta", "final rank", "solver rounds", "solver MB", "cert rounds", "cert MB",
+            "escape rounds", "rel gap", "wall s (CPU s)", "status"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    mb = lambda b: None if b is None else b / 1e6
+    for r in rows:
+        lines.append("| " + " | ".join([
+            r["graph"], fmt(r["poses"]), f"{fmt(r['certified'])} / {fmt(r['central_certified'])}",
+            fmt(r["min_eigenvalue"]), fmt(r["central_min_eigenvalue"]), fmt(r["eta"]),
+            f"{fmt(r['final_rank'])} / {fmt(r['central_final_rank'])}", fmt(r["solver_rounds"]),
+            fmt(mb(r["solver_bytes"])), fmt(r["certificate_rounds"]), fmt(mb(r["certificate_bytes"])),
+            fmt(r["escape_rounds"]), fmt(r["rel_gap"]), f"{r['wall_s']} ({r['cpu_s']})", r["status"]]) + " |")
+    text = ("Distributed certification, N = 5, highest partition, IRBCD, chordal init; "
+            f"limit {a.limit:.0f} s per run (`scripts/bench/distributed_certificate.py`).\n\n"
+            + "\n".join(lines) + "\n")
+    with open(out + ".md", "w") as f:
+        f.write(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
