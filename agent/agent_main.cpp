@@ -18,6 +18,7 @@
 #include "agent/agent_checkpoint.hpp"
 #include "agent/checkpoint_keeper.hpp"
 #include "agent/dds_channel.hpp"
+#include "agent/initialization_stage.hpp"
 #include "agent/local_dump.hpp"
 #include "agent/local_share.hpp"
 #include "agent/rejoin.hpp"
@@ -219,7 +220,7 @@ class Agent {
     }
   }
 
-  // Steps 1-5 of a run: share, announcement, assignment, readiness, hand-off.
+  // Steps 1-6 of a run: share, announcement, assignment, readiness, initialisation, hand-off.
   agent::AgentLocalData fresh_start() {
     Session& s = *session_;
     Mailroom& room = s.mailroom();
@@ -247,6 +248,7 @@ class Agent {
       ann.edge_i().push_back(static_cast<std::uint32_t>(m.i));
       ann.edge_j().push_back(static_cast<std::uint32_t>(m.j));
     }
+    ann.edge_index(share_.measurement_index);
     s.publish(ann);
     log("announced");
 
@@ -272,7 +274,27 @@ class Agent {
                  "the other processes to be ready", missing);
     log("all processes ready");
 
-    // 5. Hand-off, peer to peer: exactly one message to every other agent.
+    // 5. Initial poses of our share (agent/initialization_stage.hpp), before they move.
+    if (asg.edge_i().size() != asg.edge_j().size())
+      throw RunFailure(kExitRunFailed, "the assignment's structure arrays differ in length");
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;
+    structure.reserve(asg.edge_i().size());
+    for (std::size_t e = 0; e < asg.edge_i().size(); ++e) {
+      if (asg.edge_i()[e] >= share_.num_poses || asg.edge_j()[e] >= share_.num_poses)
+        throw RunFailure(kExitRunFailed, "the assignment's structure names a pose out of range");
+      structure.emplace_back(asg.edge_i()[e], asg.edge_j()[e]);
+    }
+    agent::DdsProtocolChannel channel(s);
+    {
+      agent::InitializationResult init =
+          agent::run_initialization_stage(share_, a_.id, a_.robots, structure, asg.initialization(),
+                                          a_.graph, channel, a_.round_timeout_s);
+      share_.initial = std::move(init.poses);
+      log("initialisation '" + init.method + "' done in " +
+          std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
+    }
+
+    // 6. Hand-off, peer to peer: exactly one message to every other agent.
     for (std::uint32_t b = 0; b < a_.robots; ++b) {
       if (b == a_.id) continue;
       agent::HandoffPlan plan = agent::plan_handoff(share_, asg.owner(), b);
@@ -314,25 +336,18 @@ class Agent {
     agent::AgentLocalData local =
         agent::assemble_local(share_, asg.owner(), a_.id, a_.robots, std::move(received), ro);
     share_ = agent::RobotShare();
-    if (asg.edge_i().size() != asg.edge_j().size())
-      throw RunFailure(kExitRunFailed, "the assignment's structure arrays differ in length");
-    local.structure.reserve(asg.edge_i().size());
-    for (std::size_t e = 0; e < asg.edge_i().size(); ++e) {
-      if (asg.edge_i()[e] >= local.num_poses || asg.edge_j()[e] >= local.num_poses)
-        throw RunFailure(kExitRunFailed, "the assignment's structure names a pose out of range");
-      local.structure.emplace_back(asg.edge_i()[e], asg.edge_j()[e]);
-    }
+    local.structure = std::move(structure);
     log("hand-off complete: " + std::to_string(local.owned.size()) + " poses, " +
         std::to_string(local.measurements.size()) + " measurements");
     if (!a_.dump_local.empty()) agent::write_local_dump(local, a_.dump_local);
     return local;
   }
 
-  // Steps 6-7: the rounds (resumed from a snapshot on every coordinated rollback), the final
+  // Steps 7-8: the rounds (resumed from a snapshot on every coordinated rollback), the final
   // estimate, and the wait for the coordinator's FINISHED.
   void solve(const agent::AgentLocalData& local, std::chrono::steady_clock::time_point t0) {
     Session& s = *session_;
-    // 6. THE SEAM: core's round protocol over DDS.
+    // 7. THE SEAM: core's round protocol over DDS.
     agent::DdsProtocolChannel channel(s);
     agent::CheckpointKeeper keeper(a_.net.session.run_id, local,
                                    {a_.checkpoint_dir, a_.checkpoint_every});
@@ -408,7 +423,7 @@ class Agent {
     if (!a_.output.empty())
       agent::write_vertices_g2o(local.owned, result.poses, local.d, a_.output);
 
-    // 7. Final estimate to the coordinator; leave when it has the merged result.
+    // 8. Final estimate to the coordinator; leave when it has the merged result.
     wire::FinalEstimate fin;
     fin.run_id(a_.net.session.run_id);
     fin.sender(a_.id);

@@ -397,11 +397,6 @@ class Rounding {
 RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
                                double receive_timeout_s, const RoundLoopHooks& hooks) {
   const DistributedOptions options = options_of(local.options);
-  const std::string& init = local.options.initialization;
-  if (!init.empty() && init != "file")
-    throw std::runtime_error("initialisation '" + init +
-                             "' is not available over DDS yet: use 'file' (the VERTEX poses of "
-                             "the input), the default");
   const bool lifted = local.lifted_start.size() > 0;
   if (lifted &&
       (local.lifted_start.cols() != (local.d + 1) * static_cast<Eigen::Index>(local.owned.size()) ||
@@ -409,9 +404,10 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     throw std::runtime_error("agent " + std::to_string(local.agent_id) +
                              ": lifted starting point of the wrong shape");
   if (!lifted && local.initial.size() != local.owned.size())
-    throw std::runtime_error("agent " + std::to_string(local.agent_id) +
-                             ": the input has no VERTEX poses for the poses it owns; the DDS "
-                             "runtime initialises from the file's poses");
+    throw std::runtime_error("agent " + std::to_string(local.agent_id) + ": " +
+                             std::to_string(local.initial.size()) + " initial poses for " +
+                             std::to_string(local.owned.size()) +
+                             " owned poses (run the initialisation stage first)");
   if (options.rank < local.d)
     throw std::runtime_error("rank " + std::to_string(options.rank) +
                              " is below d = " + std::to_string(local.d));

@@ -55,7 +55,7 @@ struct AgentLocalData {
   /// order as the in-process engine.
   std::vector<Measurement> measurements;
   std::vector<std::uint64_t> measurement_index;
-  /// Initial poses of `owned` (same order); empty when the input had no VERTEX lines.
+  /// Initial poses of `owned` (same order), from the initialisation stage.
   std::vector<Pose> initial;
   /// When not empty: the lifted starting point of `owned` (r x (d+1)m, same order), used
   /// instead of lifting `initial` (a run continued by survivors after a permanent loss).

@@ -23,6 +23,7 @@
 
 #include "arguments.hpp"
 #include "commands.hpp"
+#include "distributed/distributed_solver.hpp"
 #include "session_args.hpp"
 #include "transport/security.hpp"
 #include "util/input_error.hpp"
@@ -39,13 +40,14 @@ tessera-agent processes (robot k reads its sequential share of GRAPH) talking pe
 over Fast DDS. Prints progress (round, cost, gradient norm) while it runs and the JSON
 summary at the end. Any failing process, the time limit or Ctrl-C stops every process; the
 exit code is then non-zero. Without GRAPH, a 3D grid is generated into a temporary folder
-(tessera generate --kind grid3d --poses P --robots N). Agents initialise from the file's
-VERTEX poses.
+(tessera generate --kind grid3d --poses P --robots N). The agents initialise like
+`tessera solve` (--init, default chordal), so both give the same iterates.
 
 options:
   --agents N           number of agent processes, 1..64                     [3]
   --algorithm NAME     rbcd | rbcd++ | irbcd                                 [irbcd]
   --partition PRESET   sequential | fast | eco | strong | highest           [highest]
+  --init NAME          chordal | distributed | file (VERTEX poses)           [chordal]
   --grad-tol X         stop when the gradient norm is at most X (> 0)       [0.01]
   --max-rounds K       round limit (0 = the solver's default, 10000)        [0]
   --rank R             relaxation rank (0 = the solver's default, 5)        [0]
@@ -175,12 +177,12 @@ int run_launch(const Args& argv) {
       std::printf(kHelp, session_options_help(SessionArgsFor::kLaunch).c_str());
       return 0;
     }
-  Arguments args(
-      argv,
-      with_session_options({"agents", "algorithm", "partition", "grad-tol", "max-rounds", "rank",
-                            "seed", "json", "out", "tum", "timeout", "poses", "status-interval"},
-                           SessionArgsFor::kLaunch),
-      {"quiet"});
+  Arguments args(argv,
+                 with_session_options({"agents", "algorithm", "partition", "init", "grad-tol",
+                                       "max-rounds", "rank", "seed", "json", "out", "tum",
+                                       "timeout", "poses", "status-interval"},
+                                      SessionArgsFor::kLaunch),
+                 {"quiet"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
                      std::to_string(args.positional().size()));
@@ -193,6 +195,8 @@ int run_launch(const Args& argv) {
   if (algorithm != "rbcd" && algorithm != "rbcd++" && algorithm != "irbcd")
     throw InputError("launch: --algorithm '" + algorithm + "' is not one of rbcd, rbcd++, irbcd");
   const std::string partition = args.get_or("partition", "highest");
+  const std::string init = args.get_or("init", init_name(DistributedOptions{}.initialization));
+  parse_init(init);  // InputError naming the valid ones
   const double grad_tol = args.get_double("grad-tol", 0.01);
   if (!(grad_tol > 0)) throw InputError("launch: --grad-tol must be > 0");
   const long max_rounds = args.get_long("max-rounds", 0);
@@ -267,6 +271,8 @@ int run_launch(const Args& argv) {
                                     partition,
                                     "--algorithm",
                                     algorithm,
+                                    "--init",
+                                    init,
                                     "--grad-tol",
                                     args.get_or("grad-tol", "0.01"),
                                     "--max-rounds",
@@ -274,6 +280,8 @@ int run_launch(const Args& argv) {
                                     "--rank",
                                     std::to_string(rank),
                                     "--seed",
+                                    std::to_string(seed),
+                                    "--partition-seed",  // `tessera solve` partitions with --seed
                                     std::to_string(seed),
                                     "--summary",
                                     summary,

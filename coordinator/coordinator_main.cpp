@@ -21,6 +21,7 @@
 #include "coordinator/run_monitor.hpp"
 #include "coordinator/run_structure.hpp"
 #include "coordinator/survivor_step.hpp"
+#include "distributed/distributed_solver.hpp"
 #include "graph/pose_graph.hpp"
 #include "io/g2o_writer.hpp"
 #include "io/tum_writer.hpp"
@@ -55,7 +56,8 @@ options:
   --partition-seed K   seed of the partitioner (default 1)
   --rank R             rank r of the relaxation sent to the agents (default 0 = core's, 5)
   --algorithm NAME     solver name sent to the agents (default: core's default)
-  --init NAME          initialisation sent to the agents: file (default: the VERTEX poses)
+  --init NAME          initialisation the agents run: chordal | distributed | file (the
+                       VERTEX poses) (default: the in-process engine's, chordal)
   --max-rounds K       round limit sent to the agents (default 0 = core's default)
   --grad-tol X         gradient-norm tolerance sent to the agents (default 0 = core's default)
   --rel-cost-tol X     relative cost tolerance sent to the agents (default 0 = core's default)
@@ -130,7 +132,8 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
   a.partition_seed = static_cast<std::uint64_t>(nonneg("partition-seed", 1));
   a.rank = static_cast<std::uint32_t>(nonneg("rank", 0));
   a.algorithm = args.get_or("algorithm", "");
-  a.init = args.get_or("init", "");
+  a.init = args.get_or("init", init_name(DistributedOptions{}.initialization));
+  parse_init(a.init);  // throws InputError naming the valid ones
   a.max_rounds = static_cast<std::uint32_t>(nonneg("max-rounds", 0));
   a.grad_tol = args.get_double("grad-tol", 0);
   a.rel_cost_tol = args.get_double("rel-cost-tol", 0);
@@ -549,6 +552,7 @@ class Coordinator {
     const double rounds_ms = last_status_ms_ - first_status_ms_;
     cli::JsonObject j;
     j.add("algorithm", a_.algorithm.empty() ? "irbcd" : a_.algorithm)
+        .add("init", a_.init)
         .add("graph", a_.graph_name)
         .add("poses", rs.num_poses)
         .add("edges", rs.num_measurements)

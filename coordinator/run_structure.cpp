@@ -24,7 +24,11 @@ RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& ann
     by_id[a.agent_id()] = &a;
   }
   RunStructure rs;
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  struct Edge {
+    std::uint64_t index;
+    std::uint32_t agent, i, j;
+  };
+  std::vector<Edge> edges;
   for (std::uint32_t k = 0; k < num_agents; ++k) {
     if (!by_id[k]) throw InputError("no announcement from agent " + std::to_string(k));
     const auto& a = *by_id[k];
@@ -46,16 +50,29 @@ RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& ann
       throw InputError(who + " holds poses [" + std::to_string(a.pose_begin()) + ", " +
                        std::to_string(a.pose_end()) +
                        "), which does not continue the previous agents' ranges");
-    if (a.edge_i().size() != a.edge_j().size())
-      throw InputError(who + ": edge endpoint arrays differ in length");
+    if (a.edge_i().size() != a.edge_j().size() || a.edge_index().size() != a.edge_i().size())
+      throw InputError(who + ": edge endpoint and index arrays differ in length");
     for (std::size_t e = 0; e < a.edge_i().size(); ++e) {
       if (a.edge_i()[e] >= rs.num_poses || a.edge_j()[e] >= rs.num_poses)
         throw InputError(who + ": edge endpoint out of range");
-      pairs.emplace_back(a.edge_i()[e], a.edge_j()[e]);
-      rs.edge_i.push_back(a.edge_i()[e]);
-      rs.edge_j.push_back(a.edge_j()[e]);
+      edges.push_back({a.edge_index()[e], k, a.edge_i()[e], a.edge_j()[e]});
     }
     rs.hosts.push_back(a.host());
+  }
+  // Canonical order: the measurements' positions in the input, whatever the agents' order,
+  // so the coordinator partitions (and every agent lays out) the graph as `tessera solve` does.
+  std::stable_sort(edges.begin(), edges.end(),
+                   [](const Edge& x, const Edge& y) { return x.index < y.index; });
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  pairs.reserve(edges.size());
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    if (e > 0 && edges[e].index == edges[e - 1].index)
+      throw InputError("agents " + std::to_string(edges[e - 1].agent) + " and " +
+                       std::to_string(edges[e].agent) + " both announced measurement #" +
+                       std::to_string(edges[e].index) + ": were they given overlapping files?");
+    pairs.emplace_back(edges[e].i, edges[e].j);
+    rs.edge_i.push_back(edges[e].i);
+    rs.edge_j.push_back(edges[e].j);
   }
   rs.num_measurements = pairs.size();
   rs.graph = make_graph_structure(rs.num_poses, pairs, "run '" + run_id + "'");

@@ -16,13 +16,15 @@ struct RunStructure {
   std::size_t num_poses = 0;
   std::size_t num_measurements = 0;
   GraphStructure graph;
-  std::vector<std::uint32_t> edge_i, edge_j;  ///< Every measurement's endpoints (agent order).
+  std::vector<std::uint32_t> edge_i, edge_j;  ///< Every measurement's endpoints (input order).
   std::vector<std::string> hosts;             ///< Per agent.
 };
 
 /// Checks the N announcements (one per agent id 0..N-1, any order) against each other:
 /// same N, dimension and number of poses, pose ranges that tile 0..n-1 in agent order,
-/// endpoints in range. Throws InputError naming the offending agent.
+/// endpoints in range, no measurement index announced twice. The structure comes out in the
+/// measurements' input order (edge_index), independent of the announcements' order. Throws
+/// InputError naming the offending agent.
 RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& announcements,
                                  std::uint32_t num_agents, const std::string& run_id);
 

@@ -105,6 +105,8 @@ struct Fixture {
                   "--progress",
                   "--partition",
                   "eco",
+                  "--init",  // compared with the file's poses in process
+                  "file",
                   "--grad-tol",
                   "0.002",
                   "--rejoin-timeout",

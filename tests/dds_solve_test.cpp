@@ -104,8 +104,9 @@ DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int
 void expect_same_as_in_process(const std::string& algorithm, int domain) {
   const std::string dir = temp_dir();
   const std::string graph = generate(dir, 240, 3, 5);
-  const DdsRun dds = run_dds(dir, graph, 3, domain,
-                             {"--partition", "eco", "--algorithm", algorithm, "--seed", "7"});
+  const DdsRun dds =
+      run_dds(dir, graph, 3, domain,
+              {"--partition", "eco", "--algorithm", algorithm, "--seed", "7", "--init", "file"});
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(dds.assignment.size(), g.num_poses);
 

@@ -1,0 +1,333 @@
+// The agents' initialisation stage (agent/initialization_stage.hpp), over DDS and in process.
+//  - In process (threads and an in-memory channel, no DDS): every agent's poses equal core's
+//    chordal / distributed initialisation of the whole graph bit for bit.
+//  - Over DDS (processes): a graph without VERTEX lines, `--init distributed` and the default
+//    (chordal), gives the in-process engine's rounds and cost; the coordinator's `highest`
+//    partition is the one `tessera solve` computes from the file.
+// Domains used here: 201-203 (each test its own, so ctest -j is safe).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include "agent/initialization_stage.hpp"
+#include "dds_process_support.hpp"
+#include "distributed/distributed_solver.hpp"
+#include "generate/generator.hpp"
+#include "io/g2o_reader.hpp"
+#include "partition/graph_structure.hpp"
+#include "partition/partitioner.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+// ---------------------------------------------------------------- in process
+
+// N mailboxes; send() copies into the recipients' queues (never back to the sender).
+class Exchange {
+ public:
+  explicit Exchange(std::uint32_t n) : queues_(n) {}
+  void post(std::uint32_t from, const OutgoingMessage& m) {
+    std::lock_guard<std::mutex> lock(mu_);
+    for (std::uint32_t a = 0; a < queues_.size(); ++a) {
+      if (a == from) continue;
+      if (!m.broadcast &&
+          std::find(m.recipients.begin(), m.recipients.end(), a) == m.recipients.end())
+        continue;
+      queues_[a].push_back(m.message);
+      ++posted_;
+    }
+    cv_.notify_all();
+  }
+  std::optional<ProtocolMessage> take(std::uint32_t self, double timeout_s) {
+    std::unique_lock<std::mutex> lock(mu_);
+    if (!cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                      [&] { return !queues_[self].empty(); }))
+      return std::nullopt;
+    ProtocolMessage m = std::move(queues_[self].front());
+    queues_[self].pop_front();
+    return m;
+  }
+  std::size_t left_over() {
+    std::lock_guard<std::mutex> lock(mu_);
+    std::size_t n = 0;
+    for (auto& q : queues_) n += q.size();
+    return n;
+  }
+
+ private:
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::vector<std::deque<ProtocolMessage>> queues_;
+  std::size_t posted_ = 0;
+};
+
+class ThreadChannel : public agent::ProtocolChannel {
+ public:
+  ThreadChannel(Exchange& ex, std::uint32_t self) : ex_(ex), self_(self) {}
+  void send(const OutgoingMessage& m) override { ex_.post(self_, m); }
+  std::optional<ProtocolMessage> receive(double timeout_s) override {
+    return ex_.take(self_, timeout_s);
+  }
+
+ private:
+  Exchange& ex_;
+  std::uint32_t self_;
+};
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_of(const PoseGraph& g) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> s;
+  for (const auto& m : g.measurements)
+    s.emplace_back(static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j));
+  return s;
+}
+
+// Runs the stage for every agent in its own thread; returns the poses in global order.
+std::vector<Pose> run_stage(const PoseGraph& g, std::uint32_t N, const std::string& method,
+                            std::size_t* leftover = nullptr) {
+  Exchange ex(N);
+  std::vector<agent::RobotShare> shares;
+  for (std::uint32_t k = 0; k < N; ++k) shares.push_back(agent::robot_share(g, k, N));
+  std::vector<agent::InitializationResult> out(N);
+  std::vector<std::string> errors(N);
+  const auto structure = structure_of(g);
+  std::vector<std::thread> threads;
+  for (std::uint32_t k = 0; k < N; ++k)
+    threads.emplace_back([&, k] {
+      ThreadChannel ch(ex, k);
+      try {
+        out[k] =
+            agent::run_initialization_stage(shares[k], k, N, structure, method, "test", ch, 20.0);
+      } catch (const std::exception& e) {
+        errors[k] = e.what();
+      }
+    });
+  for (auto& t : threads) t.join();
+  std::vector<Pose> poses;
+  for (std::uint32_t k = 0; k < N; ++k) {
+    EXPECT_EQ(errors[k], "") << "agent " << k;
+    EXPECT_EQ(out[k].poses.size(), shares[k].end - shares[k].begin);
+    poses.insert(poses.end(), out[k].poses.begin(), out[k].poses.end());
+  }
+  if (leftover) *leftover = ex.left_over();
+  return poses;
+}
+
+PoseGraph generated(TrajectoryKind kind, std::size_t poses, std::size_t robots,
+                    std::uint64_t seed) {
+  GeneratorOptions o;
+  o.kind = kind;
+  o.num_poses = poses;
+  o.num_robots = robots;
+  o.seed = seed;
+  return generate_pose_graph(o).graph;
+}
+
+void expect_identical(const std::vector<Pose>& a, const std::vector<Pose>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_TRUE(a[i].R == b[i].R) << "rotation of pose " << i;
+    ASSERT_TRUE(a[i].t == b[i].t) << "translation of pose " << i;
+  }
+}
+
+TEST(DdsInitializationStage, DistributedGivesCoresPosesBitForBit) {
+  // 250 poses among 4 robots: uneven ranges; 2D and 3D.
+  for (auto kind : {TrajectoryKind::kCity, TrajectoryKind::kGrid3d}) {
+    const PoseGraph g = generated(kind, 250, 4, 11);
+    std::size_t leftover = 1;
+    const std::vector<Pose> dds = run_stage(g, 4, "distributed", &leftover);
+    expect_identical(dds, initial_poses(g, DistributedInit::kDistributed, 4));
+    EXPECT_EQ(leftover, 0u) << "every message of the stage is consumed inside it";
+  }
+}
+
+TEST(DdsInitializationStage, ChordalGivesCoresPosesBitForBit) {
+  const PoseGraph g = generated(TrajectoryKind::kGrid3d, 200, 3, 4);
+  std::size_t leftover = 1;
+  expect_identical(run_stage(g, 3, "chordal", &leftover),
+                   initial_poses(g, DistributedInit::kChordal, 3));
+  EXPECT_EQ(leftover, 0u);
+  // The default is the in-process engine's default.
+  EXPECT_EQ(agent::default_initialization(), init_name(DistributedOptions{}.initialization));
+  expect_identical(run_stage(g, 3, ""), initial_poses(g, DistributedOptions{}.initialization, 3));
+}
+
+TEST(DdsInitializationStage, OneAgentNeedsNoMessages) {
+  const PoseGraph g = generated(TrajectoryKind::kCity, 80, 1, 2);
+  expect_identical(run_stage(g, 1, "distributed"),
+                   initial_poses(g, DistributedInit::kDistributed, 1));
+  expect_identical(run_stage(g, 1, "chordal"), initial_poses(g, DistributedInit::kChordal, 1));
+}
+
+TEST(DdsInitializationStage, FileWithoutVertexLinesAndUnknownNamesAreInputErrors) {
+  PoseGraph g = generated(TrajectoryKind::kCity, 60, 2, 3);
+  g.initial.clear();
+  const agent::RobotShare share = agent::robot_share(g, 1, 2);
+  Exchange ex(2);
+  ThreadChannel ch(ex, 1);
+  try {
+    agent::run_initialization_stage(share, 1, 2, structure_of(g), "file", "robot1.g2o", ch, 1.0);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("robot1.g2o"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("VERTEX"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(
+      agent::run_initialization_stage(share, 1, 2, structure_of(g), "odometry", "x", ch, 1.0),
+      InputError);
+}
+
+TEST(DdsInitializationStage, AMissingPeerTimesOutNamingIt) {
+  const PoseGraph g = generated(TrajectoryKind::kCity, 60, 3, 3);
+  const agent::RobotShare share = agent::robot_share(g, 0, 3);
+  Exchange ex(3);
+  ThreadChannel ch(ex, 0);
+  try {
+    agent::run_initialization_stage(share, 0, 3, structure_of(g), "distributed", "x", ch, 0.2);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("waiting for agent(s) 1 2"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(DdsInitializationStage, PhasesCannotCollideWithTheRoundLoops) {
+  EXPECT_GT(agent::kInitPhaseBase, agent::kFinalReportPhase);
+  EXPECT_GT(agent::kInitPhaseBase, agent::kRoundingPhaseBase + 50);
+  EXPECT_GT(agent::kInitPhaseBase, static_cast<std::uint32_t>(ProtocolPhase::kRedoStatus));
+}
+
+// ---------------------------------------------------------------- over DDS
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+double json_field(const std::string& json, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
+  return std::stod(m[1]);
+}
+
+std::vector<int> assignment_of(const std::string& dir, int agents) {
+  std::map<int, int> owner;
+  for (int k = 0; k < agents; ++k) {
+    std::ifstream f(dir + "/local" + std::to_string(k) + ".txt");
+    for (std::string line; std::getline(f, line);)
+      if (line.rfind("OWNED ", 0) == 0) owner[std::stoi(line.substr(6))] = k;
+  }
+  std::vector<int> out;
+  for (auto& [id, k] : owner) out.push_back(k);
+  return out;
+}
+
+// Coordinator + agents (started in reverse id order) on `graph`; returns the summary JSON.
+std::string run_dds(const std::string& dir, const std::string& graph, int agents, int domain,
+                    const std::vector<std::string>& solver_args) {
+  const std::string run = "init-" + std::to_string(getpid()) + "-" + std::to_string(domain);
+  std::vector<std::string> cargs = {bin("tessera-coordinator"),
+                                    "--agents",
+                                    std::to_string(agents),
+                                    "--run-id",
+                                    run,
+                                    "--domain",
+                                    std::to_string(domain),
+                                    "--timeout",
+                                    "20",
+                                    "--run-timeout",
+                                    "60",
+                                    "--summary",
+                                    dir + "/summary.json"};
+  cargs.insert(cargs.end(), solver_args.begin(), solver_args.end());
+  std::vector<Process> procs;
+  procs.reserve(static_cast<std::size_t>(agents) + 1);
+  for (int k = agents - 1; k >= 0; --k)
+    procs.push_back(
+        start({bin("tessera-agent"), "--graph", graph, "--robots", std::to_string(agents), "--id",
+               std::to_string(k), "--run-id", run, "--domain", std::to_string(domain), "--timeout",
+               "20", "--dump-local", dir + "/local" + std::to_string(k) + ".txt"},
+              dir + "/agent" + std::to_string(k) + ".log"));
+  procs.push_back(start(cargs, dir + "/coordinator.log"));
+  std::vector<Process*> all;
+  for (auto& p : procs) all.push_back(&p);
+  EXPECT_TRUE(wait_all(all, 90)) << "a process hung";
+  for (Process* p : all) EXPECT_EQ(p->exit_code, 0) << p->output();
+  return slurp(dir + "/summary.json");
+}
+
+// A generated graph with its VERTEX lines removed (like CSAIL: edges only).
+std::string graph_without_vertices(const std::string& dir, const std::string& kind, int poses,
+                                   int robots) {
+  const std::string full = dir + "/full.g2o", path = dir + "/edges_only.g2o";
+  std::string out;
+  EXPECT_EQ(run_command(bin("tessera") + " generate --kind " + kind + " --poses " +
+                            std::to_string(poses) + " --robots " + std::to_string(robots) +
+                            " --seed 9 --out " + full,
+                        &out),
+            0)
+      << out;
+  std::ifstream in(full);
+  std::ofstream o(path);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("VERTEX", 0) != 0) o << line << "\n";
+  return path;
+}
+
+void expect_same_as_solve(const std::string& init, int domain) {
+  const std::string dir = temp_dir();
+  const int N = 3;
+  const std::string graph = graph_without_vertices(dir, "grid3d", 250, N);
+  std::vector<std::string> args = {"--partition", "highest",          "--seed",
+                                   "3",           "--partition-seed", "3"};
+  if (!init.empty()) args.insert(args.end(), {"--init", init});
+  const std::string summary = run_dds(dir, graph, N, domain, args);
+  const PoseGraph g = read_g2o(graph);
+  ASSERT_FALSE(g.has_initial());
+
+  // What `tessera solve --agents 3 --partition highest --seed 3 [--init X]` does.
+  PartitionOptions popt;
+  popt.parts = N;
+  popt.preset = parse_preset("highest");
+  popt.seed = 3;
+  const std::vector<int> part =
+      partition_graph(graph_structure_from_pose_graph(g), popt).assignment;
+  EXPECT_EQ(assignment_of(dir, N), part) << "the coordinator's partition is not solve's";
+  DistributedOptions opt;
+  opt.seed = 3;
+  if (!init.empty()) opt.initialization = parse_init(init);
+  const DistributedResult ref = solve_distributed(g, part, opt);
+  ASSERT_GT(ref.rounds, 1);
+  EXPECT_EQ(json_field(summary, "rounds"), ref.rounds) << summary;
+  EXPECT_EQ(json_field(summary, "restarts"), ref.restarts) << summary;
+  EXPECT_NEAR(json_field(summary, "cost"), ref.cost, 1e-9 * ref.cost) << summary;
+  EXPECT_NEAR(json_field(summary, "grad_norm"), ref.grad_norm, 1e-9 * ref.grad_norm) << summary;
+  const std::string expect_init =
+      init.empty() ? init_name(DistributedOptions{}.initialization) : init;
+  EXPECT_NE(summary.find("\"init\": \"" + expect_init + "\""), std::string::npos) << summary;
+}
+
+TEST(DdsInitialization, DistributedOverDdsGivesTheInProcessIterates) {
+  expect_same_as_solve("distributed", 201);
+}
+
+TEST(DdsInitialization, DefaultOverDdsIsSolvesDefaultWithTheSameIterates) {
+  expect_same_as_solve("", 202);
+}
+
+}  // namespace
+}  // namespace tessera::test::dds

@@ -1,0 +1,91 @@
+// The coordinator's structure (coordinator/run_structure.hpp) comes out in the measurements'
+// input order whatever order the announcements arrive in, so it partitions and every agent
+// lays out the graph exactly as `tessera solve` does. No participant, no domain.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "agent/local_share.hpp"
+#include "coordinator/run_structure.hpp"
+#include "generate/generator.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera {
+namespace {
+
+std::vector<wire::AgentAnnouncement> announcements_of(const PoseGraph& g, std::uint32_t N) {
+  std::vector<wire::AgentAnnouncement> out;
+  for (std::uint32_t k = 0; k < N; ++k) {
+    const agent::RobotShare s = agent::robot_share(g, k, N);
+    wire::AgentAnnouncement a;
+    a.run_id("r");
+    a.agent_id(k);
+    a.num_agents(N);
+    a.host("h");
+    a.dim(static_cast<std::uint32_t>(g.d));
+    a.num_poses(static_cast<std::uint32_t>(g.num_poses));
+    a.pose_begin(s.begin);
+    a.pose_end(s.end);
+    for (const auto& m : s.measurements) {
+      a.edge_i().push_back(static_cast<std::uint32_t>(m.i));
+      a.edge_j().push_back(static_cast<std::uint32_t>(m.j));
+    }
+    a.edge_index(s.measurement_index);
+    out.push_back(a);
+  }
+  return out;
+}
+
+PoseGraph graph() {
+  GeneratorOptions o;
+  o.kind = TrajectoryKind::kGrid3d;
+  o.num_poses = 300;
+  o.num_robots = 4;
+  o.seed = 6;
+  return generate_pose_graph(o).graph;
+}
+
+TEST(DdsStructureOrder, StructureIsInInputOrderWhateverTheArrivalOrder) {
+  const PoseGraph g = graph();
+  std::vector<wire::AgentAnnouncement> anns = announcements_of(g, 4);
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::shuffle(anns.begin(), anns.end(), rng);
+    const coordinator::RunStructure rs = coordinator::merge_announcements(anns, 4, "r");
+    ASSERT_EQ(rs.edge_i.size(), g.measurements.size());
+    for (std::size_t k = 0; k < g.measurements.size(); ++k) {
+      ASSERT_EQ(rs.edge_i[k], g.measurements[k].i) << "measurement " << k;
+      ASSERT_EQ(rs.edge_j[k], g.measurements[k].j) << "measurement " << k;
+    }
+  }
+  // The measurements of one robot are not contiguous in the file: agent order would differ.
+  const coordinator::RunStructure rs = coordinator::merge_announcements(anns, 4, "r");
+  std::vector<std::uint32_t> agent_order;
+  for (std::uint32_t k = 0; k < 4; ++k)
+    for (const auto& a : anns)
+      if (a.agent_id() == k)
+        agent_order.insert(agent_order.end(), a.edge_i().begin(), a.edge_i().end());
+  EXPECT_NE(agent_order, rs.edge_i);
+}
+
+TEST(DdsStructureOrder, AMeasurementAnnouncedTwiceOrWithoutIndexIsAnError) {
+  const PoseGraph g = graph();
+  std::vector<wire::AgentAnnouncement> anns = announcements_of(g, 4);
+  anns[2].edge_index()[0] = anns[1].edge_index()[0];
+  try {
+    coordinator::merge_announcements(anns, 4, "r");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("agents 1 and 2 both announced measurement #"),
+              std::string::npos)
+        << e.what();
+  }
+  anns = announcements_of(g, 4);
+  anns[3].edge_index().pop_back();
+  EXPECT_THROW(coordinator::merge_announcements(anns, 4, "r"), InputError);
+}
+
+}  // namespace
+}  // namespace tessera
