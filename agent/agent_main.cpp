@@ -21,6 +21,7 @@
 #include "agent/initialization_stage.hpp"
 #include "agent/local_dump.hpp"
 #include "agent/local_share.hpp"
+#include "agent/robot_file.hpp"
 #include "agent/rejoin.hpp"
 #include "agent/round_loop.hpp"
 #include "agent/survivor_exchange.hpp"
@@ -53,7 +54,9 @@ to the agents that own them after the partition (peer to peer: the coordinator n
 measurement values), runs the round protocol and sends its final poses to the coordinator.
 
 options:
-  --graph FILE       g2o file of the whole multi-robot graph (required)
+  --graph FILE       g2o file of the whole multi-robot graph (required), or a file with only
+                     this robot's data (it starts with '# tessera-robot poses BEGIN END';
+                     written by tessera generate --split; see docs/dds-runtime.md)
   --robots N         number of robots = agents of the run (required)
   --id I             this agent's id, 0..N-1 (required)
   --round-timeout S  bound on each wait for a peer's message during the rounds (default 600)
@@ -225,10 +228,13 @@ class Agent {
     Session& s = *session_;
     Mailroom& room = s.mailroom();
 
-    // 1. Our share of the graph.
-    PoseGraph graph = read_g2o(a_.graph);
-    share_ = agent::robot_share(graph, a_.id, a_.robots);
-    graph = PoseGraph();  // keep only the share
+    // 1. Our share of the graph: robot I's part of the whole file, or the robot's own file.
+    if (agent::is_robot_file(a_.graph)) {
+      share_ = agent::read_robot_file(a_.graph, a_.id);  // n comes with the assignment
+    } else {
+      PoseGraph graph = read_g2o(a_.graph);
+      share_ = agent::robot_share(graph, a_.id, a_.robots);
+    }
     log("read " + a_.graph + ": poses [" + std::to_string(share_.begin) + ", " +
         std::to_string(share_.end) + ") of " + std::to_string(share_.num_poses) + ", " +
         std::to_string(share_.measurements.size()) + " measurements");
@@ -459,6 +465,7 @@ class Agent {
   }
 
   void check_assignment(const wire::PartitionAssignment& asg) {
+    if (share_.num_poses == 0) agent::adopt_num_poses(share_, asg.num_poses(), a_.graph);
     auto mismatch = [&](const std::string& what) {
       throw RunFailure(kExitBadInput,
                        "the coordinator's assignment does not fit this agent: " + what);

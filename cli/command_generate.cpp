@@ -5,6 +5,7 @@
 
 #include "arguments.hpp"
 #include "json_writer.hpp"
+#include "robot_files.hpp"
 #include "commands.hpp"
 #include "generate/generator.hpp"
 #include "io/g2o_writer.hpp"
@@ -36,6 +37,9 @@ const char* const kHelp =
     "  --out FILE.g2o           where to write the graph (required)\n"
     "  --truth FILE.tum         also write the ground-truth trajectory (TUM format)\n"
     "  --json FILE              also write a JSON summary\n"
+    "  --split DIR              also write one file per robot, DIR/robot<r>.g2o: its poses'\n"
+    "                           VERTEX lines and the measurements it recorded, global ids\n"
+    "                           (for tessera launch DIR / tessera-agent --graph FILE)\n"
     "  --help                   this text\n"
     "\n"
     "Weights: kappa = 1/(2 rot_noise^2), tau = 1/trans_noise^2 (noise floored at 1e-3).\n";
@@ -103,7 +107,7 @@ int run_generate(const Args& argv) {
   const Arguments args(
       argv,
       {"kind", "poses", "robots", "seed", "rot-noise", "trans-noise", "loop-closures",
-       "inter-robot-closures", "max-loop-closures", "out", "truth", "json"},
+       "inter-robot-closures", "max-loop-closures", "out", "truth", "json", "split"},
       {"help"});
   if (args.has("help")) {
     std::fputs(kHelp, stdout);
@@ -124,6 +128,11 @@ int run_generate(const Args& argv) {
   timing.write_s = seconds_since(start);  // the g2o file only
   if (auto truth = args.get("truth")) write_tum(result.ground_truth, *truth);
   if (auto json = args.get("json")) write_json(*json, options, result, *out, timing);
+  if (auto split = args.get("split")) {
+    const auto files =
+        write_robot_files(*out, result.graph.num_poses, options.num_robots, *split);
+    std::printf("wrote %zu robot files into %s\n", files.size(), split->c_str());
+  }
 
   std::printf(
       "generated %s: %zu poses, %zu edges, %zu robots, %zu loop closures (%zu intra-robot, %zu "

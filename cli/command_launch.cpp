@@ -24,6 +24,7 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "distributed/distributed_solver.hpp"
+#include "robot_files.hpp"
 #include "session_args.hpp"
 #include "transport/security.hpp"
 #include "util/input_error.hpp"
@@ -33,10 +34,11 @@ namespace tessera::cli {
 namespace {
 
 // %s: the shared DDS session options (session_args.hpp).
-constexpr const char* kHelp = R"(usage: tessera launch [GRAPH.g2o] --agents N [options]
+constexpr const char* kHelp = R"(usage: tessera launch [GRAPH.g2o | ROBOT_FILES_DIR | R0.g2o,R1.g2o,...] --agents N [options]
 
 Runs a distributed solve on this host as separate processes: one tessera-coordinator and N
-tessera-agent processes (robot k reads its sequential share of GRAPH) talking peer to peer
+tessera-agent processes (robot k reads its sequential share of GRAPH, or the k-th robot file
+of a folder or list, as written by tessera generate --split) talking peer to peer
 over Fast DDS. Prints progress (round, cost, gradient norm) while it runs and the JSON
 summary at the end. Any failing process, the time limit or Ctrl-C stops every process; the
 exit code is then non-zero. Without GRAPH, a 3D grid is generated into a temporary folder
@@ -186,7 +188,14 @@ int run_launch(const Args& argv) {
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
                      std::to_string(args.positional().size()));
-  const long agents = args.get_long("agents", 3);
+  // GRAPH may be one robot's own file per agent: a folder of *.g2o or a comma-separated list.
+  const std::vector<std::string> robot_files =
+      args.positional().empty() ? std::vector<std::string>{} : robot_files_of(args.positional()[0]);
+  const long agents =
+      args.get_long("agents", robot_files.empty() ? 3 : static_cast<long>(robot_files.size()));
+  if (!robot_files.empty() && static_cast<std::size_t>(agents) != robot_files.size())
+    throw InputError("launch: " + std::to_string(robot_files.size()) + " robot files in " +
+                     args.positional()[0] + " but --agents " + std::to_string(agents));
   if (agents < 1 || agents > 64) throw InputError("launch: --agents must be in 1..64");
   const double status_interval = args.get_double("status-interval", 5);
   if (!(status_interval >= 0 && status_interval <= 86400))
@@ -241,8 +250,8 @@ int run_launch(const Args& argv) {
     std::printf("generated %s (grid3d, %ld poses, %ld robots)\n", graph.c_str(), poses, agents);
   } else {
     graph = args.positional()[0];
-    std::ifstream probe(graph);
-    if (!probe) throw InputError(graph, 0, "cannot open the graph");
+    for (const std::string& f : robot_files.empty() ? std::vector<std::string>{graph} : robot_files)
+      if (!std::ifstream(f)) throw InputError(f, 0, "cannot open the graph");
   }
   const std::string summary = args.get_or("json", work + "/summary.json");
   if (!args.has("run-id"))
@@ -302,8 +311,9 @@ int run_launch(const Args& argv) {
   close(pipefd[1]);
   for (long k = 0; k < agents; ++k) {
     std::vector<std::string> a = {
-        bin + "/tessera-agent", "--graph", graph, "--robots", std::to_string(agents), "--id",
-        std::to_string(k)};
+        bin + "/tessera-agent", "--graph",
+        robot_files.empty() ? graph : robot_files[static_cast<std::size_t>(k)], "--robots",
+        std::to_string(agents), "--id", std::to_string(k)};
     a.insert(a.end(), common.begin(), common.end());
     children.push_back(
         spawn("agent " + std::to_string(k), a, work + "/agent" + std::to_string(k) + ".log", -1));

@@ -29,18 +29,25 @@ RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& ann
     std::uint32_t agent, i, j;
   };
   std::vector<Edge> edges;
-  for (std::uint32_t k = 0; k < num_agents; ++k) {
+  for (std::uint32_t k = 0; k < num_agents; ++k)
     if (!by_id[k]) throw InputError("no announcement from agent " + std::to_string(k));
+  // n: an agent reading the whole file announces it; one reading only its robot's own file
+  // announces 0 (it cannot know n), and n is then the end of the last agent's range.
+  for (std::uint32_t k = 0; k < num_agents && rs.num_poses == 0; ++k)
+    rs.num_poses = by_id[k]->num_poses();
+  if (rs.num_poses == 0) rs.num_poses = by_id[num_agents - 1]->pose_end();
+  for (std::uint32_t k = 0; k < num_agents; ++k) {
     const auto& a = *by_id[k];
     const std::string who = "agent " + std::to_string(k) + " (on " + a.host() + ")";
     if (k == 0) {
       rs.d = static_cast<int>(a.dim());
-      rs.num_poses = a.num_poses();
       if (rs.d != 2 && rs.d != 3)
         throw InputError(who + ": dimension " + std::to_string(a.dim()) + " is not 2 or 3");
-    } else if (static_cast<int>(a.dim()) != rs.d || a.num_poses() != rs.num_poses) {
+    }
+    if (static_cast<int>(a.dim()) != rs.d ||
+        (a.num_poses() != 0 && a.num_poses() != rs.num_poses)) {
       throw InputError(who + " has a " + std::to_string(a.dim()) + "D graph of " +
-                       std::to_string(a.num_poses()) + " poses, agent 0 a " + std::to_string(rs.d) +
+                       std::to_string(a.num_poses()) + " poses, the run a " + std::to_string(rs.d) +
                        "D graph of " + std::to_string(rs.num_poses) +
                        " poses: were they given the same file?");
     }
