@@ -339,6 +339,7 @@ class Agent {
     ro.grad_norm_tolerance = asg.grad_norm_tolerance();
     ro.relative_cost_tolerance = asg.relative_cost_tolerance();
     ro.seed = asg.seed();
+    ro.certify = asg.certify();
     agent::AgentLocalData local =
         agent::assemble_local(share_, asg.owner(), a_.id, a_.robots, std::move(received), ro);
     share_ = agent::RobotShare();

@@ -14,9 +14,12 @@
 #include "distributed/agent_factory.hpp"
 #include "distributed/agent_state.hpp"
 #include "distributed/block_layout.hpp"
+#include "distributed/certified_agent.hpp"
 #include "distributed/distributed_solver.hpp"
+#include "distributed/in_process_driver.hpp"
 #include "distributed/protocol_snapshot.hpp"
 #include "distributed/round_protocol.hpp"
+#include "distributed/stage_tag.hpp"
 #include "problem/lifting.hpp"
 
 namespace tessera::agent {
@@ -33,7 +36,8 @@ enum RoundingPhase : std::uint32_t {
   kCurvature,                  // PCG: <p, L p>
   kResidual,                   // PCG: <r,z>, <r,r> after a step
   kTranslations,               // final translations of public poses
-  kCost                        // cost share of the rounded poses
+  kCost,                       // cost share of the rounded poses
+  kTraffic                     // certificate and escape bytes sent (certification only)
 };
 
 DistributedOptions options_of(const RunOptions& o) {
@@ -44,6 +48,7 @@ DistributedOptions options_of(const RunOptions& o) {
   if (o.grad_norm_tolerance > 0) opt.grad_norm_tol = o.grad_norm_tolerance;
   opt.rel_cost_decrease_tol = o.relative_cost_tolerance;
   opt.seed = o.seed;
+  opt.certify = o.certify;
   opt.validate();
   return opt;
 }
@@ -56,18 +61,31 @@ class Mailbox {
       : channel_(channel), timeout_s_(timeout_s), self_(self) {}
 
   void send_all(const std::vector<OutgoingMessage>& out) {
-    for (const auto& m : out) channel_.send(m);
+    for (const auto& m : out) {
+      channel_.send(m);
+      // Certificate and escape traffic, as the in-process driver counts it (per delivery).
+      const std::uint32_t phase = phase_of(m.message);
+      if (is_auxiliary_phase(phase)) continue;
+      const StageKind kind = stage_kind(stage_of_phase(phase));
+      if (kind == StageKind::kSolve) continue;
+      const std::uint64_t copies = m.broadcast ? num_agents_ - 1 : m.recipients.size();
+      (kind == StageKind::kCertify ? certificate_bytes : escape_bytes) +=
+          copies * message_bytes(m.message);
+    }
   }
 
-  void run_protocol(RoundProtocol& protocol, const ProtocolSnapshot* resume_from) {
-    send_all(resume_from ? protocol.resume(*resume_from) : protocol.start());
+  void set_num_agents(std::uint32_t n) { num_agents_ = n; }
+
+  // `describe` names where the agent is, for the timeout message.
+  template <class Describe>
+  void run_protocol(AgentProcess& protocol, std::vector<OutgoingMessage> first, Describe describe) {
+    send_all(first);
     while (!protocol.done()) {
       std::optional<ProtocolMessage> msg = channel_.receive(timeout_s_);
       if (!msg)
         throw std::runtime_error("agent " + std::to_string(self_) + ": no message for " +
-                                 std::to_string(timeout_s_) + " s in round " +
-                                 std::to_string(protocol.rounds()) + " of the solve");
-      if (phase_of(*msg) >= kRoundingPhaseBase) {
+                                 std::to_string(timeout_s_) + " s in " + describe());
+      if (is_auxiliary_phase(phase_of(*msg))) {
         keep(std::move(*msg));
         continue;
       }
@@ -95,7 +113,7 @@ class Mailbox {
                                  "): nothing received for " + std::to_string(timeout_s_) +
                                  " s; waiting for agent(s)" + who);
       }
-      if (phase_of(*msg) < kRoundingPhaseBase) continue;  // late protocol traffic
+      if (!is_auxiliary_phase(phase_of(*msg))) continue;  // late protocol traffic
       keep(std::move(*msg));
     }
     auto out = std::move(stash_[key]);
@@ -121,6 +139,12 @@ class Mailbox {
   ProtocolChannel& channel_;
   double timeout_s_;
   std::uint32_t self_;
+  std::uint32_t num_agents_ = 1;
+
+ public:
+  std::uint64_t certificate_bytes = 0, escape_bytes = 0;  // sent by this agent
+
+ private:
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::map<std::uint32_t, ProtocolMessage>>
       stash_;
 };
@@ -141,6 +165,11 @@ class Rounding {
         Y_(state.Y) {
     for (std::uint32_t a = 0; a < local.num_agents; ++a) everyone_.push_back(a);
     for (int b : layout.adjacent[self_]) neighbours_.push_back(static_cast<std::uint32_t>(b));
+  }
+
+  /// A global sum of (a, b) over the agents, in agent-id order.
+  double sum_over_agents(std::uint32_t phase, double a, double b, double* b_sum) {
+    return reduce(phase, 0, a, b, b_sum);
   }
 
   RoundLoopResult run(RoundLoopResult res) {
@@ -432,26 +461,80 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
       static_cast<double>(options.rank) * (local.d + 1) * static_cast<double>(local.num_poses);
   const auto scheme = make_momentum_scheme(options, layout, variables);
   const RoundConfig config = make_round_config(options, scheme.get());
-  RoundProtocol protocol(state, layout, config);
-  if (hooks.on_round) protocol.set_round_observer(hooks.on_round);
-
   Mailbox mail(channel, receive_timeout_s, local.agent_id);
+  mail.set_num_agents(local.num_agents);
+  RoundLoopResult res;
   const auto t0 = std::chrono::steady_clock::now();
-  mail.run_protocol(protocol, hooks.resume_from);
+  std::unique_ptr<CertifiedAgent> sequence;
+  if (!options.certify) {
+    RoundProtocol protocol(state, layout, config);
+    if (hooks.on_round) protocol.set_round_observer(hooks.on_round);
+    mail.run_protocol(
+        protocol, hooks.resume_from ? protocol.resume(*hooks.resume_from) : protocol.start(),
+        [&] { return "round " + std::to_string(protocol.rounds()) + " of the solve"; });
+    res.rounds = static_cast<std::uint32_t>(protocol.rounds());
+    res.restarts = static_cast<std::uint32_t>(protocol.restarts());
+    res.stop_reason = protocol.stop_reason();
+    if (!protocol.trace().empty()) {
+      res.relaxation_cost = protocol.trace().back().cost;
+      res.grad_norm = protocol.trace().back().grad_norm;
+    }
+  } else {
+    // The certified sequence. Checkpoints and rollbacks cover its first solve stage.
+    sequence = std::make_unique<CertifiedAgent>(state, layout, options);
+    if (hooks.on_round) sequence->set_round_observer(hooks.on_round);
+    mail.run_protocol(
+        *sequence, hooks.resume_from ? sequence->resume(*hooks.resume_from) : sequence->start(),
+        [&] { return "stage " + std::to_string(sequence->stage()) + " of the certified solve"; });
+    const SolveStageRecord& last = sequence->solves().back();
+    res.rounds = static_cast<std::uint32_t>(sequence->total_rounds());
+    res.restarts = static_cast<std::uint32_t>(sequence->total_restarts());
+    res.stop_reason = last.stop_reason;
+    if (!last.trace.empty()) {
+      res.relaxation_cost = last.trace.back().cost;
+      res.grad_norm = last.trace.back().grad_norm;
+    }
+    res.certified = sequence->certified();
+    if (!sequence->certificates().empty())
+      res.min_eigenvalue = sequence->certificates().back().result.min_eigenvalue;
+    res.certificate_rounds = static_cast<std::uint32_t>(sequence->certificate_iterations());
+    res.escape_rounds = static_cast<std::uint32_t>(sequence->escape_trials());
+  }
+  res.final_rank = static_cast<std::uint32_t>(state.rank());
   const auto t1 = std::chrono::steady_clock::now();
 
-  RoundLoopResult res;
-  res.rounds = static_cast<std::uint32_t>(protocol.rounds());
-  res.restarts = static_cast<std::uint32_t>(protocol.restarts());
-  res.stop_reason = protocol.stop_reason();
-  if (!protocol.trace().empty()) {
-    res.relaxation_cost = protocol.trace().back().cost;
-    res.grad_norm = protocol.trace().back().grad_norm;
+  Rounding rounding(local, layout, state, mail);
+  res = rounding.run(std::move(res));
+  if (sequence) {
+    double escape_bytes = 0.0;
+    res.certificate_bytes = static_cast<std::uint64_t>(
+        rounding.sum_over_agents(kTraffic, static_cast<double>(mail.certificate_bytes),
+                                 static_cast<double>(mail.escape_bytes), &escape_bytes));
+    res.escape_bytes = static_cast<std::uint64_t>(escape_bytes);
   }
-  res = Rounding(local, layout, state, mail).run(std::move(res));
   res.solve_s = std::chrono::duration<double>(t1 - t0).count();
   res.rounding_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 
+  if (local.agent_id == 0 && res.certified) {  // before the final report, which ends the wait
+    RoundStatusMessage c;
+    c.round = res.rounds;
+    c.phase = kCertificateReportPhase;
+    c.sender = 0;
+    c.cost = res.min_eigenvalue;
+    c.grad_norm_sq = res.certificate_rounds;
+    c.block_grad_norm = res.final_rank;
+    c.restart_vote = *res.certified;
+    c.done_vote = true;
+    channel.send(OutgoingMessage{c, true, {}});
+    RoundStatusMessage b;
+    b.round = res.rounds;
+    b.phase = kCertificateBytesPhase;
+    b.sender = 0;
+    b.cost = static_cast<double>(res.certificate_bytes);
+    b.grad_norm_sq = static_cast<double>(res.escape_bytes);
+    b.block_grad_norm = res.escape_rounds;
+    channel.send(OutgoingMessage{b, true, {}});
+  }
   if (local.agent_id == 0) {  // one report for the coordinator's summary
     RoundStatusMessage st;
     st.round = res.rounds;

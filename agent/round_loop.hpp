@@ -40,6 +40,7 @@ struct RunOptions {
   double grad_norm_tolerance = 0;  ///< 0 = core's default.
   double relative_cost_tolerance = 0;
   std::uint64_t seed = 1;
+  bool certify = false;  ///< Certified sequence (solve -> certify -> escape ...), core's defaults.
 };
 
 /// Everything one agent knows after the hand-off.
@@ -112,6 +113,12 @@ struct RoundLoopResult {
   std::uint32_t translation_iterations = 0;  ///< Distributed CG iterations of the rounding.
   double solve_s = 0.0;                      ///< Time in core's protocol.
   double rounding_s = 0.0;                   ///< Time in the distributed rounding.
+  // Certification (RunOptions::certify), identical on every agent; bytes summed over agents.
+  std::optional<bool> certified;
+  double min_eigenvalue = 0.0;
+  std::uint32_t certificate_rounds = 0, escape_rounds = 0;
+  std::uint64_t certificate_bytes = 0, escape_bytes = 0;
+  std::uint32_t final_rank = 0;
 };
 
 /// Status phases of the messages the round loop adds after core's protocol (distributed
@@ -119,6 +126,13 @@ struct RoundLoopResult {
 /// cost = rounded cost, grad_norm_sq = ||grad f||^2, block_grad_norm = restarts.
 constexpr std::uint32_t kRoundingPhaseBase = 100;
 constexpr std::uint32_t kFinalReportPhase = 200;
+/// Agent 0's certificate report, sent just before the final report when certification ran:
+/// cost = lambda_min estimate, grad_norm_sq = certificate rounds, block_grad_norm = final rank,
+/// restart_vote = certified.
+constexpr std::uint32_t kCertificateReportPhase = 201;
+/// And its traffic: cost = certificate bytes, grad_norm_sq = escape bytes (all agents),
+/// block_grad_norm = escape rounds.
+constexpr std::uint32_t kCertificateBytesPhase = 202;
 
 /// Optional recovery hooks of the round loop.
 struct RoundLoopHooks {

@@ -54,6 +54,9 @@ options:
   --max-rounds K       round limit (0 = the solver's default, 10000)        [0]
   --rank R             relaxation rank (0 = the solver's default, 5)        [0]
   --seed S             solver seed                                           [1]
+  --certify            after the solve, the agents certify global optimality distributedly
+                       and escape saddles up the staircase (default: on)
+  --no-certify         skip the certificate
   --json FILE          also write the summary to FILE
   --out FILE           write the merged poses (g2o, VERTEX lines)
   --tum FILE           write the merged poses (TUM)
@@ -184,7 +187,7 @@ int run_launch(const Args& argv) {
                                        "max-rounds", "rank", "seed", "json", "out", "tum",
                                        "timeout", "poses", "status-interval"},
                                       SessionArgsFor::kLaunch),
-                 {"quiet"});
+                 {"quiet", "certify", "no-certify"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
                      std::to_string(args.positional().size()));
@@ -299,6 +302,9 @@ int run_launch(const Args& argv) {
                                     "--run-timeout",
                                     std::to_string(timeout_s),
                                     "--progress"};
+  if (args.has("certify") && args.has("no-certify"))
+    throw InputError("launch: --certify and --no-certify exclude each other");
+  if (!args.has("no-certify")) cargs.push_back("--certify");
   cargs.insert(cargs.end(), common.begin(), common.end());
   if (args.has("out")) cargs.insert(cargs.end(), {"--output", args.get_or("out", "")});
   if (args.has("tum")) cargs.insert(cargs.end(), {"--tum", args.get_or("tum", "")});

@@ -38,6 +38,9 @@ using namespace tessera::transport;
 
 // Status phase of agent 0's final report (agent/round_loop.hpp: kFinalReportPhase).
 constexpr std::uint32_t agent_final_report_phase = 200;
+// Agent 0's certificate reports (kCertificateReportPhase, kCertificateBytesPhase).
+constexpr std::uint32_t agent_certificate_report_phase = 201;
+constexpr std::uint32_t agent_certificate_bytes_phase = 202;
 
 namespace {
 
@@ -62,6 +65,8 @@ options:
   --grad-tol X         gradient-norm tolerance sent to the agents (default 0 = core's default)
   --rel-cost-tol X     relative cost tolerance sent to the agents (default 0 = core's default)
   --seed K             solver seed sent to the agents (default 1)
+  --certify            agents certify the optimum distributedly and climb the staircase
+                       after the solve (docs/distributed-certification.md; default off)
   --output FILE        write the merged poses as g2o (VERTEX lines only)
   --tum FILE           write the merged poses in the TUM format
   --summary FILE       write a JSON summary of the run
@@ -102,6 +107,7 @@ struct CoordinatorArgs {
   double rejoin_timeout_s = 0;
   double status_interval_s = 5;
   std::uint32_t replicas = 0, replica_every = 10;
+  bool certify = false;
 };
 
 CoordinatorArgs parse(const std::vector<std::string>& argv) {
@@ -112,7 +118,7 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
            "max-rounds", "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary",
            "graph-name", "rejoin-timeout", "status-interval", "replicas", "replica-every"},
           cli::SessionArgsFor::kProcess),
-      {"progress", "verbose", "help"});
+      {"progress", "verbose", "help", "certify"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   CoordinatorArgs a;
@@ -156,6 +162,7 @@ CoordinatorArgs parse(const std::vector<std::string>& argv) {
   a.replica_every = static_cast<std::uint32_t>(nonneg("replica-every", 10));
   if (a.replica_every < 1) throw InputError("option --replica-every: must be >= 1");
   a.verbose = args.has("verbose");
+  a.certify = args.has("certify");
   return a;
 }
 
@@ -292,6 +299,7 @@ class Coordinator {
     loss_.owner = part.owner;
     for (std::uint32_t k = 0; k < N; ++k) loss_.expected.push_back(k);
     base_assignment_ = asg;
+    asg.certify(a_.certify);
     s.publish(asg);
     expect_ready(s.ready_barrier(Seconds(a_.net.timeout_s), &missing), room, a_.net.timeout_s,
                  "the agents to be ready", missing);
@@ -345,6 +353,14 @@ class Coordinator {
           const std::uint32_t agent = loss_.expected[m.sender()];
           if (loss_.epoch == 0) arbiter.on_status(agent, m.round());
           if (monitor) monitor->on_status(agent, m.round(), now);
+        }
+        if (m.phase() == agent_certificate_report_phase) {
+          certificate_ = {m.restart_vote(), m.cost(), m.grad_norm_sq(), m.block_grad_norm()};
+          continue;
+        }
+        if (m.phase() == agent_certificate_bytes_phase) {
+          certificate_bytes_ = {m.cost(), m.grad_norm_sq(), m.block_grad_norm()};
+          continue;
         }
         if (m.phase() == agent_final_report_phase) {  // agent 0's summary of the solve
           final_cost_ = m.cost();
@@ -561,7 +577,8 @@ class Coordinator {
         .add("iterations", static_cast<long long>(rounds))
         .add("grad_norm", final_value(final_grad_norm_))
         .add("cost", final_value(final_cost_))
-        .add_null("certified")
+        .add("certified",
+             certificate_ ? std::optional<bool>(certificate_->certified) : std::nullopt)
         .add("wall_s", total_ms / 1000.0)
         .add("restarts", static_cast<long long>(final_restarts_))
         .add("bytes_exchanged", static_cast<long long>(total_bytes))
@@ -601,6 +618,18 @@ class Coordinator {
     } else {
       j.add_null("fault");
     }
+    if (certificate_) {
+      j.add("min_eigenvalue", certificate_->min_eigenvalue)
+          .add("certificate_rounds", static_cast<long long>(certificate_->rounds))
+          .add("final_rank", static_cast<long long>(certificate_->final_rank));
+      if (certificate_bytes_)
+        j.add("certificate_bytes", static_cast<long long>(certificate_bytes_->certificate))
+            .add("escape_bytes", static_cast<long long>(certificate_bytes_->escape))
+            .add("escape_rounds", static_cast<long long>(certificate_bytes_->escape_rounds));
+    } else {
+      j.add_null("min_eigenvalue").add_null("certificate_rounds");
+      j.add("final_rank", static_cast<long long>(a_.rank ? a_.rank : 5));
+    }
     cli::write_output(a_.summary, j.str());
   }
 
@@ -614,6 +643,16 @@ class Coordinator {
   double final_cost_ = 0, final_grad_norm_ = 0;
   std::uint32_t final_restarts_ = 0;
   bool have_final_report_ = false;
+  // From agent 0's certificate reports (certification only).
+  struct CertificateReport {
+    bool certified;
+    double min_eigenvalue, rounds, final_rank;
+  };
+  struct CertificateTraffic {
+    double certificate, escape, escape_rounds;
+  };
+  std::optional<CertificateReport> certificate_;
+  std::optional<CertificateTraffic> certificate_bytes_;
   std::uint32_t rollbacks_ = 0;  // coordinated rollbacks (agents that rejoined)
   // Permanent loss: the assignment in force and what the re-partition did (for the summary).
   wire::PartitionAssignment base_assignment_;

@@ -72,7 +72,15 @@ std::vector<OutgoingMessage> CertifiedAgent::start() {
   return out;
 }
 
-void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& out) {
+std::vector<OutgoingMessage> CertifiedAgent::resume(const ProtocolSnapshot& snapshot) {
+  std::vector<OutgoingMessage> out;
+  begin(0, out, &snapshot);
+  advance(out);
+  return out;
+}
+
+void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& out,
+                           const ProtocolSnapshot* resume_from) {
   stage_ = stage;
   switch (stage_kind(stage)) {
     case StageKind::kSolve: {
@@ -83,7 +91,12 @@ void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& ou
                                static_cast<double>(layout_.owner.size());
       const auto scheme = make_momentum_scheme(o, layout_, variables);
       solve_ = std::make_unique<RoundProtocol>(state_, layout_, make_round_config(o, scheme.get()));
+      if (stage == 0 && observer_) solve_->set_round_observer(observer_);
       current_ = solve_.get();
+      if (resume_from) {
+        emit(solve_->resume(*resume_from), out);
+        return;  // nothing of a later stage can be pending yet
+      }
       break;
     }
     case StageKind::kCertify: {

@@ -11,6 +11,7 @@
 // RoundProtocol's messages.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -22,6 +23,7 @@
 #include "distributed/agent_state.hpp"
 #include "distributed/block_layout.hpp"
 #include "distributed/distributed_solver.hpp"
+#include "distributed/protocol_snapshot.hpp"
 #include "distributed/round_protocol.hpp"
 #include "distributed/saddle_escape.hpp"
 #include "distributed/stage_records.hpp"
@@ -35,6 +37,14 @@ class CertifiedAgent : public AgentProcess {
   CertifiedAgent(AgentState& state, const BlockLayout& layout, const DistributedOptions& options);
 
   std::vector<OutgoingMessage> start() override;
+  /// Instead of start(): the first solve stage continues from `snapshot` (a coordinated
+  /// rollback, see RoundProtocol::resume); the later stages follow as usual.
+  std::vector<OutgoingMessage> resume(const ProtocolSnapshot& snapshot);
+  /// Observer of the FIRST solve stage's consistent points (RoundProtocol::set_round_observer):
+  /// snapshots of later stages would not be resumable from stage 0.
+  void set_round_observer(std::function<void(const ProtocolSnapshot&)> observer) {
+    observer_ = std::move(observer);
+  }
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
   bool done() const override { return done_; }
 
@@ -54,7 +64,8 @@ class CertifiedAgent : public AgentProcess {
   std::uint32_t stage() const { return stage_; }
 
  private:
-  void begin(std::uint32_t stage, std::vector<OutgoingMessage>& out);
+  void begin(std::uint32_t stage, std::vector<OutgoingMessage>& out,
+             const ProtocolSnapshot* resume_from = nullptr);
   void advance(std::vector<OutgoingMessage>& out);
   void emit(std::vector<OutgoingMessage>&& sub, std::vector<OutgoingMessage>& out) const;
   double solve_tolerance() const;
@@ -72,6 +83,7 @@ class CertifiedAgent : public AgentProcess {
   std::vector<SolveStageRecord> solves_;
   std::vector<CertifyStageRecord> certificates_;
   std::vector<EscapeStageRecord> escapes_;
+  std::function<void(const ProtocolSnapshot&)> observer_;
   bool done_ = false;
 };
 

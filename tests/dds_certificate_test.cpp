@@ -1,0 +1,132 @@
+// Distributed certification over DDS: the agents' certified sequence (solve -> certify ->
+// escape -> solve ...) gives the in-process engine's results, and `tessera launch` certifies by
+// default and reports the certificate in its JSON summary.
+// Domains used here: 171-173 (each test its own, so ctest -j is safe).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "dds_process_support.hpp"
+#include "distributed/distributed_solver.hpp"
+#include "io/g2o_reader.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// A field of the (flat) JSON summary as text ("" when absent).
+std::string json_text(const std::string& json, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eEa-z]+)"))) return "";
+  return m[1];
+}
+double json_number(const std::string& json, const std::string& name) {
+  const std::string t = json_text(json, name);
+  return t.empty() ? NAN : std::stod(t);
+}
+
+std::vector<int> owned_of(const std::string& path) {
+  std::ifstream f(path);
+  std::vector<int> out;
+  for (std::string line; std::getline(f, line);)
+    if (line.rfind("OWNED ", 0) == 0) out.push_back(std::stoi(line.substr(6)));
+  return out;
+}
+
+TEST(DdsCertificate, StaircaseOverDdsGivesTheInProcessResult) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/city.g2o";
+  std::string out;
+  // Large rotation noise and rank 2 = d: the first certificate fails, the staircase climbs.
+  ASSERT_EQ(run_command(bin("tessera") +
+                            " generate --kind city --poses 120 --robots 3 --rot-noise 0.5 "
+                            "--trans-noise 0.3 --seed 1 --out " +
+                            graph,
+                        &out),
+            0)
+      << out;
+  const int agents = 3, domain = 171;
+  const std::string run = "cert-" + std::to_string(getpid());
+  Process coord =
+      start({bin("tessera-coordinator"), "--agents", std::to_string(agents), "--run-id", run,
+             "--domain", std::to_string(domain), "--timeout", "20", "--run-timeout", "90",
+             "--summary", dir + "/summary.json", "--partition", "eco", "--rank", "2", "--certify"},
+            dir + "/coordinator.log");
+  std::vector<Process> procs;
+  for (int k = 0; k < agents; ++k)
+    procs.push_back(
+        start({bin("tessera-agent"), "--graph", graph, "--robots", std::to_string(agents), "--id",
+               std::to_string(k), "--run-id", run, "--domain", std::to_string(domain), "--timeout",
+               "20", "--dump-local", dir + "/local" + std::to_string(k) + ".txt"},
+              dir + "/agent" + std::to_string(k) + ".log"));
+  std::vector<Process*> all = {&coord};
+  for (auto& p : procs) all.push_back(&p);
+  ASSERT_TRUE(wait_all(all, 90)) << "a process hung";
+  for (Process* p : all) ASSERT_EQ(p->exit_code, 0) << p->output();
+  const std::string summary = slurp(dir + "/summary.json");
+
+  std::map<int, int> owner;
+  for (int k = 0; k < agents; ++k)
+    for (int id : owned_of(dir + "/local" + std::to_string(k) + ".txt")) owner[id] = k;
+  std::vector<int> assignment;
+  for (auto& [id, k] : owner) assignment.push_back(k);
+  const PoseGraph g = read_g2o(graph);
+  ASSERT_EQ(assignment.size(), g.num_poses);
+  DistributedOptions opt;
+  opt.rank = 2;
+  opt.certify = true;
+  const DistributedResult ref = solve_distributed(g, assignment, opt, g.initial);
+  ASSERT_TRUE(ref.certified.value_or(false));
+  ASSERT_FALSE(ref.escapes.empty()) << "the graph should need the staircase";
+
+  EXPECT_EQ(json_text(summary, "certified"), "true") << summary;
+  EXPECT_EQ(json_number(summary, "final_rank"), ref.final_rank) << summary;
+  EXPECT_EQ(json_number(summary, "certificate_rounds"), ref.certificate_rounds) << summary;
+  EXPECT_EQ(json_number(summary, "escape_rounds"), ref.escape_rounds) << summary;
+  EXPECT_EQ(json_number(summary, "certificate_bytes"), static_cast<double>(ref.certificate_bytes));
+  EXPECT_EQ(json_number(summary, "rounds"), ref.rounds) << summary;
+  EXPECT_NEAR(json_number(summary, "min_eigenvalue"), ref.min_eigenvalue,
+              1e-9 * std::abs(ref.min_eigenvalue) + 1e-15);
+  EXPECT_NEAR(json_number(summary, "cost"), ref.cost, 1e-9 * ref.cost) << summary;
+}
+
+TEST(DdsCertificate, LaunchCertifiesByDefaultAndReportsIt) {
+  const std::string dir = temp_dir();
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch --agents 3 --poses 150 --domain 172 " +
+                                 "--partition eco --timeout 60 --json " + dir + "/s.json 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  const std::string json = slurp(dir + "/s.json");
+  EXPECT_EQ(json_text(json, "certified"), "true") << json;
+  for (const char* field :
+       {"min_eigenvalue", "certificate_rounds", "final_rank", "certificate_bytes"})
+    EXPECT_FALSE(std::isnan(json_number(json, field))) << field << json;
+  EXPECT_GT(json_number(json, "certificate_rounds"), 0);
+  EXPECT_GT(json_number(json, "certificate_bytes"), 0);
+  EXPECT_EQ(json_number(json, "final_rank"), 5);
+
+  const int rc2 = run_command(bin("tessera") + " launch --agents 2 --poses 100 --domain 173 " +
+                                  "--no-certify --timeout 60 --json " + dir + "/n.json 2>&1",
+                              &out);
+  ASSERT_EQ(rc2, 0) << out;
+  const std::string plain = slurp(dir + "/n.json");
+  EXPECT_EQ(json_text(plain, "certified"), "null") << plain;
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
