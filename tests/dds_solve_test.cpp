@@ -207,16 +207,25 @@ TEST(DdsLaunch, SigintStopsEveryProcess) {
 TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
   const std::string dir = temp_dir();
   const auto before = shm_files();
-  Process launch = start(
-      {bin("tessera"), "launch", "--agents", "3", "--poses", "600", "--domain", "166", "--grad-tol",
-       "1e-12", "--max-rounds", "100000", "--partition", "fast", "--timeout", "60"},
-      dir + "/launch.log");
+  // A run id of its own: the agent to kill is found by it, and whatever this test leaves
+  // running when an assertion fails is removed by it (a leftover in the same domain would
+  // otherwise be what the next run's pgrep finds).
+  const std::string run_id = "killed-" + std::to_string(getpid());
+  struct Cleanup {
+    std::string run_id;
+    ~Cleanup() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
+  } cleanup{run_id};
+  Process launch = start({bin("tessera"), "launch", "--agents", "3", "--poses", "600", "--domain",
+                          "166", "--run-id", run_id, "--grad-tol", "1e-12", "--max-rounds",
+                          "100000", "--partition", "fast", "--timeout", "60"},
+                         dir + "/launch.log");
   const auto until = Clock::now() + std::chrono::seconds(20);
   while (launch.output().find("round 2:") == std::string::npos && Clock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   ASSERT_NE(launch.output().find("round 2:"), std::string::npos) << launch.output();
   std::string pid;
-  run_command("pgrep -f 'tessera-agent.*--id 1 .*--domain 166' | head -1", &pid);
+  // "[t]" keeps the pattern from matching the shell that runs pgrep.
+  run_command("pgrep -f '[t]essera-agent.*--id 1 --run-id " + run_id + " ' | head -1", &pid);
   ASSERT_FALSE(pid.empty());
   kill(std::stoi(pid), SIGKILL);
   ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
