@@ -61,11 +61,27 @@ TEST(DdsCertificate, StaircaseOverDdsGivesTheInProcessResult) {
       << out;
   const int agents = 3, domain = 171;
   const std::string run = "cert-" + std::to_string(getpid());
-  Process coord =
-      start({bin("tessera-coordinator"), "--agents", std::to_string(agents), "--run-id", run,
-             "--domain", std::to_string(domain), "--timeout", "20", "--run-timeout", "90",
-             "--summary", dir + "/summary.json", "--partition", "eco", "--rank", "2", "--certify"},
-            dir + "/coordinator.log");
+  Process coord = start({bin("tessera-coordinator"),
+                         "--agents",
+                         std::to_string(agents),
+                         "--run-id",
+                         run,
+                         "--domain",
+                         std::to_string(domain),
+                         "--timeout",
+                         "20",
+                         "--run-timeout",
+                         "90",
+                         "--summary",
+                         dir + "/summary.json",
+                         "--partition",
+                         "eco",
+                         "--rank",
+                         "2",
+                         "--certify",
+                         "--init",
+                         "file"},  // the in-process reference starts from the file's poses too
+                        dir + "/coordinator.log");
   std::vector<Process> procs;
   for (int k = 0; k < agents; ++k)
     procs.push_back(

@@ -196,7 +196,8 @@ TEST(DdsRobotFiles, LaunchOnAFolderOfRobotFilesAgreesWithSolve) {
             0)
       << out;
   ASSERT_EQ(run_command(bin("tessera") + " solve " + whole +
-                            " --algorithm irbcd --agents 3 --json " + dir + "/solve.json",
+                            " --algorithm irbcd --agents 3 --certify --json " + dir +
+                            "/solve.json",  // launch certifies by default
                         &out),
             0)
       << out;
