@@ -104,7 +104,7 @@ TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
                                      "--run-id",
                                      run,
                                      "--duration",
-                                     "60"};
+                                     "90"};
     argv.insert(argv.end(), w.extra.begin(), w.extra.end());
     w.p = start(argv, dir + "/snoop_" + std::to_string(&w - watchers.data()) + ".log");
   }
@@ -114,24 +114,41 @@ TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
     ASSERT_NE(w.p.output().find("listening"), std::string::npos) << w.name << ": " << w.p.output();
   }
 
-  std::vector<Process> procs;
-  // A generous set-up bound: PKI-DH handshakes between 8 participants are slow on 2 busy
-  // cores (see docs/dds-runtime.md, "Security", on runs that never finish authenticating).
-  const std::vector<std::string> session = {"--run-id",  run,  "--domain",   std::to_string(domain),
-                                            "--timeout", "40", "--security", sec};
-  std::vector<std::string> c = {bin("tessera-coordinator"), "--agents", "3"};
-  c.insert(c.end(), session.begin(), session.end());
-  procs.push_back(start(c, dir + "/coordinator.log"));
-  for (int k = 0; k < 3; ++k) {
-    std::vector<std::string> a = {bin("tessera-agent"), "--graph", graph, "--robots", "3", "--id",
-                                  std::to_string(k)};
-    a.insert(a.end(), session.begin(), session.end());
-    procs.push_back(start(a, dir + "/agent" + std::to_string(k) + ".log"));
+  // The secured run. KNOWN PROBLEM (docs/dds-runtime.md, "Security"): with outsiders present,
+  // the PKI-DH handshakes of a run sometimes never complete (agents never READY; seen in about
+  // one CI run in three, cause not found yet). Such a set-up stall is retried once (same run
+  // id: the outsiders listen to it) after every process of the first attempt has exited; a
+  // run that starts must finish cleanly.
+  // Every attempt counts for the outsiders' zero-sample checks below.
+  bool finished = false;
+  for (int attempt = 0; attempt < 2 && !finished; ++attempt) {
+    const std::vector<std::string> session = {
+        "--run-id", run, "--domain", std::to_string(domain), "--timeout", "20", "--security", sec};
+    std::vector<Process> procs;
+    std::vector<std::string> c = {bin("tessera-coordinator"), "--agents", "3"};
+    c.insert(c.end(), session.begin(), session.end());
+    procs.push_back(start(c, dir + "/coordinator" + std::to_string(attempt) + ".log"));
+    for (int k = 0; k < 3; ++k) {
+      std::vector<std::string> a = {bin("tessera-agent"), "--graph", graph, "--robots", "3", "--id",
+                                    std::to_string(k)};
+      a.insert(a.end(), session.begin(), session.end());
+      procs.push_back(
+          start(a, dir + "/agent" + std::to_string(k) + "_" + std::to_string(attempt) + ".log"));
+    }
+    std::vector<Process*> all;
+    for (auto& p : procs) all.push_back(&p);
+    ASSERT_TRUE(wait_all(all, 30)) << "a process hung";
+    const bool stalled =
+        procs[0].exit_code != 0 &&
+        procs[0].output().find("waiting for the agents to be ready") != std::string::npos;
+    if (stalled && attempt == 0) {
+      std::fprintf(stderr, "secured run stalled in set-up (known problem), retrying once:\n%s\n",
+                   procs[0].output().c_str());
+      continue;
+    }
+    for (auto& p : procs) EXPECT_EQ(p.exit_code, 0) << p.output();
+    finished = true;
   }
-  std::vector<Process*> all;
-  for (auto& p : procs) all.push_back(&p);
-  ASSERT_TRUE(wait_all(all, 50)) << "a process hung";
-  for (auto& p : procs) EXPECT_EQ(p.exit_code, 0) << p.output();
 
   for (auto& w : watchers) kill(w.p.pid, SIGINT);
   std::vector<Process*> snoops;
