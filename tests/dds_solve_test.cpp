@@ -215,10 +215,11 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
     std::string run_id;
     ~Cleanup() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
   } cleanup{run_id};
-  Process launch = start({bin("tessera"), "launch", "--agents", "3", "--poses", "600", "--domain",
-                          "166", "--run-id", run_id, "--grad-tol", "1e-12", "--max-rounds",
-                          "100000", "--partition", "fast", "--timeout", "60"},
-                         dir + "/launch.log");
+  Process launch = start(
+      {bin("tessera"), "launch",   "--agents",    "3",      "--poses",   "600",        "--domain",
+       "166",          "--run-id", run_id,        "--init", "file",      "--grad-tol", "1e-12",
+       "--max-rounds", "100000",   "--partition", "fast",   "--timeout", "60"},
+      dir + "/launch.log");
   const auto until = Clock::now() + std::chrono::seconds(20);
   while (launch.output().find("round 2:") == std::string::npos && Clock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
