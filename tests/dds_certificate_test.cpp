@@ -21,13 +21,6 @@
 namespace tessera::test::dds {
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
 // A field of the (flat) JSON summary as text ("" when absent).
 std::string json_text(const std::string& json, const std::string& name) {
   std::smatch m;
@@ -37,14 +30,6 @@ std::string json_text(const std::string& json, const std::string& name) {
 double json_number(const std::string& json, const std::string& name) {
   const std::string t = json_text(json, name);
   return t.empty() ? NAN : std::stod(t);
-}
-
-std::vector<int> owned_of(const std::string& path) {
-  std::ifstream f(path);
-  std::vector<int> out;
-  for (std::string line; std::getline(f, line);)
-    if (line.rfind("OWNED ", 0) == 0) out.push_back(std::stoi(line.substr(6)));
-  return out;
 }
 
 TEST(DdsCertificate, StaircaseOverDdsGivesTheInProcessResult) {

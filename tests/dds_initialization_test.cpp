@@ -211,19 +211,6 @@ TEST(DdsInitializationStage, PhasesCannotCollideWithTheRoundLoops) {
 
 // ---------------------------------------------------------------- over DDS
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
-double json_field(const std::string& json, const std::string& name) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
-  return std::stod(m[1]);
-}
-
 std::vector<int> assignment_of(const std::string& dir, int agents) {
   std::map<int, int> owner;
   for (int k = 0; k < agents; ++k) {

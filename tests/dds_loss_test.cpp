@@ -22,19 +22,6 @@
 namespace tessera::test::dds {
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
-double json_field(const std::string& json, const std::string& name) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
-  return std::stod(m[1]);
-}
-
 bool wait_for_output(const Process& p, const std::string& text, double timeout_s) {
   const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
   while (Clock::now() < until) {

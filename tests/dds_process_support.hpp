@@ -19,6 +19,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <random>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -230,6 +231,31 @@ inline void remove_shm_files(const std::set<std::string>& files) {
 inline std::string join(const std::set<std::string>& s) {
   std::string out;
   for (const auto& x : s) out += (out.empty() ? "" : ", ") + x;
+  return out;
+}
+
+/// The whole text of a file ("" when it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+/// A number field of a flat JSON summary; NaN when absent.
+inline double json_field(const std::string& json, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
+  return std::stod(m[1]);
+}
+
+/// Owned pose ids listed in an agent's --dump-local file.
+inline std::vector<int> owned_of(const std::string& path) {
+  std::ifstream f(path);
+  std::string line;
+  std::vector<int> out;
+  while (std::getline(f, line))
+    if (line.rfind("OWNED ", 0) == 0) out.push_back(std::stoi(line.substr(6)));
   return out;
 }
 

@@ -23,27 +23,6 @@
 namespace tessera::test::dds {
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
-double json_field(const std::string& json, const std::string& name) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
-  return std::stod(m[1]);
-}
-
-std::vector<int> owned_of(const std::string& path) {
-  std::ifstream f(path);
-  std::vector<int> out;
-  for (std::string line; std::getline(f, line);)
-    if (line.rfind("OWNED ", 0) == 0) out.push_back(std::stoi(line.substr(6)));
-  return out;
-}
-
 std::string generate(const std::string& dir, int poses, int robots) {
   const std::string path = dir + "/graph.g2o";
   std::string out;

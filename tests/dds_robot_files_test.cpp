@@ -23,19 +23,6 @@
 namespace tessera::test::dds {
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
-double json_field(const std::string& json, const std::string& name) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
-  return std::stod(m[1]);
-}
-
 // Generates a graph and its per-robot split; returns the whole file's path.
 std::string generate_split(const std::string& dir, const std::string& kind, int poses, int robots,
                            bool strip_vertices = false) {

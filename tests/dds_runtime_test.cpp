@@ -130,8 +130,8 @@ TEST(DdsRuntime, OneHostRunHandsOffEveryMeasurementAndMergesEveryPose) {
 
   Process coord = start(coordinator_args(3, run, domain,
                                          {"--timeout", "20", "--output", dir + "/merged.g2o",
-                                          "--summary", dir + "/summary.json", "--verbose",
-                                          "--init", "file"}),  // the file's poses travel
+                                          "--summary", dir + "/summary.json", "--verbose", "--init",
+                                          "file"}),  // the file's poses travel
                         dir + "/coordinator.log");
   std::vector<Process> agents;
   for (int k = 0; k < 3; ++k)

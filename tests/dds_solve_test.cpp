@@ -20,30 +20,6 @@
 namespace tessera::test::dds {
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
-// A number field of the (flat) JSON summary; NaN when absent.
-double json_field(const std::string& json, const std::string& name) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eE]+)"))) return NAN;
-  return std::stod(m[1]);
-}
-
-// Owned pose ids from an agent's --dump-local file.
-std::vector<int> owned_of(const std::string& path) {
-  std::ifstream f(path);
-  std::string line;
-  std::vector<int> out;
-  while (std::getline(f, line))
-    if (line.rfind("OWNED ", 0) == 0) out.push_back(std::stoi(line.substr(6)));
-  return out;
-}
-
 std::string generate(const std::string& dir, int poses, int robots, int seed) {
   const std::string path = dir + "/graph.g2o";
   std::string out;
