@@ -75,23 +75,42 @@ void AgentState::absorb(const PoseBlockMessage& m, Eigen::MatrixXd& copy) const 
   }
 }
 
-void AgentState::set_neighbours(const Eigen::MatrixXd& neighbours) {
+void AgentState::set_point(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours) {
+  // Active rows: non-zero somewhere in the block or in the neighbours' poses.
+  const Eigen::Index r = X.rows();
+  Eigen::Array<bool, Eigen::Dynamic, 1> nonzero = (X.array() != 0.0).rowwise().any();
+  if (neighbours.size() > 0) nonzero = nonzero || (neighbours.array() != 0.0).rowwise().any();
+  std::vector<Eigen::Index> rows;
+  rows.reserve(static_cast<std::size_t>(r));
+  for (Eigen::Index k = 0; k < r; ++k)
+    if (nonzero(k)) rows.push_back(k);
+  if (rows.empty()) rows.push_back(0);  // all zero (not a manifold point): keep one row
+  const bool same_rows = rows == rows_;
+  rows_ = std::move(rows);
   if (problem_.num_neighbors() == 0) return;
-  if (neighbours_set_.size() == neighbours.size() && neighbours_set_ == neighbours) return;
+  if (same_rows && neighbours_set_.size() == neighbours.size() && neighbours_set_ == neighbours)
+    return;
   neighbours_set_ = neighbours;
-  problem_.set_neighbor_poses(neighbours);
+  problem_.set_neighbor_poses(active_part(neighbours));
   ++neighbours_version_;
 }
 
+Eigen::MatrixXd AgentState::active_part(const Eigen::MatrixXd& X) const {
+  if (static_cast<Eigen::Index>(rows_.size()) == X.rows()) return X;
+  return X(rows_, Eigen::all);
+}
+
 LocalStatus AgentState::status() {
-  set_neighbours(Yn);
+  set_point(Y, Yn);
   LocalStatus s;
-  s.cost_share = problem_.cost_share(Y);
   if (updated_grad_norm_sq_ >= 0 && updated_version_ == neighbours_version_ && Y == updated_X_) {
+    s.cost_share = problem_.cost_share(active_part(Y));
     s.grad_norm_sq = updated_grad_norm_sq_;  // same point, same neighbours: same gradient
   } else {
-    const Eigen::MatrixXd g = problem_.riemannian_gradient(Y, problem_.euclidean_gradient(Y));
-    s.grad_norm_sq = g.squaredNorm();
+    const Eigen::MatrixXd Ya = active_part(Y);
+    s.cost_share = problem_.cost_share(Ya);
+    s.grad_norm_sq =
+        problem_.riemannian_gradient(Ya, problem_.euclidean_gradient(Ya)).squaredNorm();
   }
   s.block_grad_norm = std::sqrt(s.grad_norm_sq);
   return s;
@@ -99,15 +118,22 @@ LocalStatus AgentState::status() {
 
 Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
                                    const BlockUpdateOptions& options) {
-  set_neighbours(neighbours);
-  updated_X_ = block_update(problem_, X0, options, precon_.get(), &updated_grad_norm_sq_);
+  set_point(X0, neighbours);
+  if (static_cast<Eigen::Index>(rows_.size()) == X0.rows()) {
+    updated_X_ = block_update(problem_, X0, options, precon_.get(), &updated_grad_norm_sq_);
+  } else {
+    const Eigen::MatrixXd Xa =
+        block_update(problem_, active_part(X0), options, precon_.get(), &updated_grad_norm_sq_);
+    updated_X_ = Eigen::MatrixXd::Zero(X0.rows(), X0.cols());
+    updated_X_(rows_, Eigen::all) = Xa;
+  }
   updated_version_ = neighbours_version_;
   return updated_X_;
 }
 
 double AgentState::local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours) {
-  set_neighbours(neighbours);
-  return problem_.cost(X);
+  set_point(X, neighbours);
+  return problem_.cost(active_part(X));
 }
 
 void AgentState::reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd& Yn0) {
@@ -116,6 +142,7 @@ void AgentState::reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd&
   Y = P = V = Y_prev = V_prev = Y0;
   Yn = Pn = Yn_prev = Yn0;
   neighbours_set_.resize(0, 0);  // the problem's neighbour poses are stale
+  rows_.clear();
   updated_grad_norm_sq_ = -1.0;  // nothing to reuse (and updated_X_ may have another rank)
 }
 

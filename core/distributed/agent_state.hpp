@@ -61,7 +61,11 @@ class AgentState {
   Eigen::MatrixXd Yn, Pn, Yn_prev;
 
  private:
-  void set_neighbours(const Eigen::MatrixXd& neighbours);
+  /// Selects the rows to compute on for the point (X, neighbours) and sets problem_'s
+  /// neighbour poses to those rows.
+  void set_point(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
+  /// X restricted to rows_ (X itself when every row is active).
+  Eigen::MatrixXd active_part(const Eigen::MatrixXd& X) const;
 
   int id_;
   int d_;
@@ -69,6 +73,13 @@ class AgentState {
   BlockProblem problem_;
   std::unique_ptr<BlockPreconditioner> precon_;
   Eigen::MatrixXd neighbours_set_;  // what problem_ holds, so X_N Q_NB is rebuilt only on change
+  // Rows of the current point that are not identically zero, in increasing order. A lifted
+  // point [I_d; 0] R (chordal or distributed initialisation) has r - d zero rows, and every
+  // step of the algorithms (gradient, tangent projection, Hessian, Q_BB solve, Proj_M) maps
+  // zero rows to zero rows, so the local math runs on the active rows only: the same iterates
+  // (up to the order of floating-point additions) at d/r of the cost. A saddle escape fills the
+  // new row, after which every row is active.
+  std::vector<Eigen::Index> rows_;
   std::uint64_t neighbours_version_ = 0;  // bumped whenever problem_'s neighbour poses change
   // The last update's result and ||grad f_B||^2 there: with one block per round the selected
   // block's neighbours do not move before the next status, whose gradient is then this one.

@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "problem/pose_kernels.hpp"
+
 namespace tessera {
 
 BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
@@ -66,7 +68,7 @@ void BlockProblem::set_neighbor_poses(const Eigen::MatrixXd& X_neighbors) {
   if (X_neighbors.cols() != (d_ + 1) * static_cast<Eigen::Index>(neighbors_.size()))
     throw std::invalid_argument("BlockProblem: neighbour poses have the wrong size");
   X_n_ = X_neighbors;
-  linear_ = X_n_ * Q_nb_;
+  scaled_dense_times_sparse(X_n_, Q_nb_, 1.0, linear_);
 }
 
 double BlockProblem::cost(const Eigen::MatrixXd& X) const {
@@ -78,7 +80,8 @@ double BlockProblem::cost(const Eigen::MatrixXd& X) const {
 }
 
 Eigen::MatrixXd BlockProblem::euclidean_gradient(const Eigen::MatrixXd& X) const {
-  Eigen::MatrixXd G = 2.0 * (X * Q_bb_);
+  Eigen::MatrixXd G;
+  scaled_dense_times_sparse(X, Q_bb_, 2.0, G);
   if (!neighbors_.empty()) G += 2.0 * linear_;
   return G;
 }
@@ -90,9 +93,11 @@ Eigen::MatrixXd BlockProblem::riemannian_gradient(const Eigen::MatrixXd& X,
 
 Eigen::MatrixXd BlockProblem::hessian_vector(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
                                              const Eigen::MatrixXd& V) const {
-  const LiftedManifold M = manifold(static_cast<int>(X.rows()));
-  Eigen::MatrixXd H = 2.0 * (V * Q_bb_);
-  return M.tangent_project(X, H) - M.weingarten_term(X, egrad, V);
+  // Proj_X(2 V Q_BB) - Weingarten(X, egrad, V), fused (problem/pose_kernels.hpp).
+  Eigen::MatrixXd H;
+  scaled_dense_times_sparse(V, Q_bb_, 2.0, H);
+  apply_hessian_projection(X, egrad, V, d_, H);
+  return H;
 }
 
 double BlockProblem::edge_cost(const Edge& e, const Eigen::MatrixXd& X) const {

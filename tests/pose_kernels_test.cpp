@@ -1,0 +1,79 @@
+// The hand-written derivative kernels (problem/pose_kernels.hpp) against the plain Eigen /
+// LiftedManifold expressions they replace, for every rank with a fixed-size path and one without.
+
+#include "problem/pose_kernels.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "manifold/lifted_manifold.hpp"
+#include "problem/block_problem.hpp"
+#include "random_graph.hpp"
+
+namespace tessera {
+namespace {
+
+Eigen::MatrixXd random_point(const LiftedManifold& M, unsigned seed) {
+  std::srand(seed);
+  return M.project(Eigen::MatrixXd::Random(M.rank(), M.cols()));
+}
+
+double max_abs(const Eigen::MatrixXd& A) {
+  return A.cwiseAbs().maxCoeff();
+}
+
+class PoseKernels : public ::testing::TestWithParam<std::tuple<int, int>> {};
+
+TEST_P(PoseKernels, DenseTimesSparseMatchesEigen) {
+  const auto [d, r] = GetParam();
+  auto g = test::random_pose_graph({d, 30, 20, 0.05, 0.1, 9});
+  const BlockProblem P = BlockProblem::whole_graph(d, g.num_poses, g.measurements);
+  const SparseMatrix& Q = P.data_matrix();
+  std::srand(3);
+  const Eigen::MatrixXd X = Eigen::MatrixXd::Random(r, Q.rows());
+  Eigen::MatrixXd out;
+  scaled_dense_times_sparse(X, Q, 2.0, out);
+  const Eigen::MatrixXd ref = 2.0 * (X * Q);
+  ASSERT_EQ(out.rows(), ref.rows());
+  ASSERT_EQ(out.cols(), ref.cols());
+  EXPECT_LE(max_abs(out - ref), 1e-12 * max_abs(ref));
+  // A rectangular, uncompressed right factor (the cut-edge block Q_NB has this shape).
+  SparseMatrix R = Q.leftCols(Q.cols() / 2);
+  R.uncompress();
+  R.coeffRef(0, 0) += 1.0;
+  scaled_dense_times_sparse(X, R, -0.5, out);
+  const Eigen::MatrixXd ref2 = -0.5 * (X * R);
+  ASSERT_EQ(out.cols(), ref2.cols());
+  EXPECT_LE(max_abs(out - ref2), 1e-12 * max_abs(ref2));
+}
+
+TEST_P(PoseKernels, HessianProjectionMatchesManifoldOperations) {
+  const auto [d, r] = GetParam();
+  const LiftedManifold M(r, d, 17);
+  const Eigen::MatrixXd X = random_point(M, 5);
+  std::srand(6);
+  const Eigen::MatrixXd G = Eigen::MatrixXd::Random(r, M.cols());
+  const Eigen::MatrixXd V = M.tangent_project(X, Eigen::MatrixXd::Random(r, M.cols()));
+  const Eigen::MatrixXd H0 = Eigen::MatrixXd::Random(r, M.cols());
+  Eigen::MatrixXd H = H0;
+  apply_hessian_projection(X, G, V, d, H);
+  const Eigen::MatrixXd ref = M.tangent_project(X, H0) - M.weingarten_term(X, G, V);
+  EXPECT_LE(max_abs(H - ref), 1e-12 * max_abs(ref));
+}
+
+TEST(PoseKernelsShapes, RejectMismatchedOperands) {
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(3, 8), out;
+  SparseMatrix Q(9, 9);
+  EXPECT_THROW(scaled_dense_times_sparse(X, Q, 1.0, out), std::invalid_argument);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3, 6);
+  EXPECT_THROW(apply_hessian_projection(X, X, X, 2, H), std::invalid_argument);
+  EXPECT_THROW(apply_hessian_projection(X, X, X, 4, X), std::invalid_argument);
+}
+
+INSTANTIATE_TEST_SUITE_P(RanksAndDimensions, PoseKernels,
+                         ::testing::Combine(::testing::Values(2, 3), ::testing::Values(3, 5, 7)));
+
+}  // namespace
+}  // namespace tessera
