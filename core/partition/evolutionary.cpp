@@ -10,9 +10,10 @@ struct Individual {
   long long cut = 0;
 };
 
-std::vector<int> pair_label(const std::vector<int>& a, const std::vector<int>& b, int k) {
+// One label per (block in a, block in b); b has kb blocks.
+std::vector<int> pair_label(const std::vector<int>& a, const std::vector<int>& b, int kb) {
   std::vector<int> label(a.size());
-  for (std::size_t v = 0; v < a.size(); ++v) label[v] = a[v] * k + b[v];
+  for (std::size_t v = 0; v < a.size(); ++v) label[v] = a[v] * kb + b[v];
   return label;
 }
 
@@ -32,6 +33,35 @@ Individual combine(const WorkGraph& g, int k, const std::vector<long long>& ub, 
   const long long cut = edge_cut(g, p);
   if (cut <= better.cut) return {std::move(p), cut};
   return better;
+}
+
+// KaFFPaE's cross combine: a fresh partition into a different number of blocks kx (drawn from
+// [k/2, 4k]) with a looser balance has its boundaries in other places than any k-way partition;
+// contracting only vertices that `a` and it put together lets the V-cycle on `a` move whole
+// regions along those boundaries. The result is never worse than `a`.
+Individual cross_combine(const WorkGraph& g, int k, const std::vector<long long>& ub,
+                         const Individual& a, const CycleParams& cp, Rng& rng) {
+  const int kx = std::max(2, k / 2 + rng.below(4 * k - k / 2 + 1));
+  const double eps = 0.03 + 0.2 * rng.uniform();
+  const long long avg = (g.total_vw + kx - 1) / kx;
+  const std::vector<long long> ubx(static_cast<std::size_t>(kx),
+                                   static_cast<long long>((1.0 + eps) * static_cast<double>(avg)));
+  CycleParams fresh_cp = cp;
+  // Only its boundaries matter, not their last few edges: a cheap run (no flows, short FM)
+  // keeps the many-block partitions from dominating the search's cost.
+  fresh_cp.use_flow = false;
+  fresh_cp.fm.max_passes = 2;
+  fresh_cp.fm.stop_after = 60;
+  fresh_cp.initial.repeats = 2;
+  fresh_cp.initial.fm = fresh_cp.fm;
+  fresh_cp.coarsening.stop_vertices = std::max(cp.coarsening.stop_vertices, 20 * kx);
+  fresh_cp.coarsening.max_vertex_weight =
+      std::max(2, static_cast<int>(std::min<long long>(cp.coarsening.max_vertex_weight, avg / 30)));
+  const std::vector<int> other = multilevel_partition(g, kx, ubx, fresh_cp, rng);
+  std::vector<int> p = guided_cycle(g, k, ub, pair_label(a.part, other, kx), a.part, cp, rng);
+  const long long cut = edge_cut(g, p);
+  if (cut <= a.cut) return {std::move(p), cut};
+  return a;
 }
 
 // Every operation draws its flow corridor size from {alpha, 2 alpha} and its coarsening (label
@@ -88,7 +118,9 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
     ++steps;
     ++stalled;
     Individual child;
-    if (rng.uniform() < params.mutation_rate) {
+    if (params.cross_share > 0.0 && rng.uniform() < params.cross_share) {
+      child = cross_combine(g, k, ub, pop[tournament(pop, rng, -1)], varied(params, rng), rng);
+    } else if (rng.uniform() < params.mutation_rate) {
       // Mutation: combine an individual with a fresh multilevel partition.
       const int a = tournament(pop, rng, -1);
       Individual fresh;

@@ -23,7 +23,10 @@ struct EvolutionParams {
   /// instead of the label propagation of `cycle`: the two give differently shaped hierarchies,
   /// and mixing them keeps the population diverse (0 = always `cycle`'s coarsening).
   double matching_share = 0.0;
-  int matching_flow_levels = 1;  ///< flow_levels of the operations that coarsen by matching.
+  int matching_flow_levels = 1;
+  /// Share of steps that cross-combine a tournament winner with a fresh partition into another
+  /// number of blocks (KaFFPaE's cross combine) instead of a combine or mutation.
+  double cross_share = 0.0;  ///< flow_levels of the operations that coarsen by matching.
   CycleParams cycle;
 };
 
