@@ -52,6 +52,59 @@ TEST(BlockPreconditioner, ExactFactorInvertsTheShiftedDataMatrix) {
   EXPECT_LT((precon.apply(M, X, V) - expected).norm(), 1e-8 * expected.norm());
 }
 
+// The exact factor against a dense solve of a well-conditioned shifted matrix, to round-off, for
+// every rank the solvers use (and beyond).
+TEST(BlockPreconditioner, ExactFactorMatchesADenseSolveForEveryRank) {
+  for (int d : {2, 3}) {
+    test::RandomGraphSpec spec;
+    spec.d = d;
+    spec.poses = 40;
+    spec.loop_closures = 30;
+    spec.seed = 11;
+    Block b;
+    b.graph = test::random_pose_graph(spec);
+    for (std::size_t i = 0; i < spec.poses / 2; ++i) b.owned.push_back(i);
+    const BlockProblem problem(d, b.owned, b.graph.measurements);
+    const double shift = 1e-2;
+    const BlockPreconditioner precon(problem, shift, 0);
+    Eigen::MatrixXd A = Eigen::MatrixXd(problem.data_matrix());
+    A.diagonal().array() += shift * A.diagonal().maxCoeff();
+    const Eigen::LLT<Eigen::MatrixXd> dense(A);
+    for (int r = d; r <= 7; ++r) {
+      const Eigen::MatrixXd X =
+          lift_poses(b.graph.initial, r).leftCols(problem.data_matrix().rows());
+      const LiftedManifold M = problem.manifold(r);
+      const Eigen::MatrixXd V = M.tangent_project(X, Eigen::MatrixXd::Random(r, X.cols()));
+      const Eigen::MatrixXd expected =
+          M.tangent_project(X, 0.5 * dense.solve(V.transpose()).transpose());
+      EXPECT_LT((precon.apply(M, X, V) - expected).cwiseAbs().maxCoeff(),
+                1e-12 * expected.cwiseAbs().maxCoeff())
+          << "d = " << d << ", r = " << r;
+    }
+  }
+}
+
+// tCG needs a symmetric positive definite preconditioner on the tangent space.
+TEST(BlockPreconditioner, IsSymmetricPositiveDefiniteOnTheTangentSpace) {
+  const Block b = half_block(13);
+  const BlockProblem problem(b.graph.d, b.owned, b.measurements);
+  for (std::size_t max_entries : {std::size_t{0}, std::size_t{10}}) {  // exact, block diagonal
+    const BlockPreconditioner precon(problem, 1e-6, max_entries);
+    const int r = 5;
+    const LiftedManifold M = problem.manifold(r);
+    const Eigen::MatrixXd X = M.project(Eigen::MatrixXd::Random(r, problem.data_matrix().rows()));
+    for (int trial = 0; trial < 5; ++trial) {
+      const Eigen::MatrixXd u = M.tangent_project(X, Eigen::MatrixXd::Random(r, X.cols()));
+      const Eigen::MatrixXd v = M.tangent_project(X, Eigen::MatrixXd::Random(r, X.cols()));
+      const Eigen::MatrixXd Pu = precon.apply(M, X, u), Pv = precon.apply(M, X, v);
+      const double uPv = u.cwiseProduct(Pv).sum(), vPu = v.cwiseProduct(Pu).sum();
+      EXPECT_NEAR(uPv, vPu, 1e-10 * (std::abs(uPv) + std::abs(vPu)));
+      EXPECT_GT(u.cwiseProduct(Pu).sum(), 0.0);
+      EXPECT_GT(v.cwiseProduct(Pv).sum(), 0.0);
+    }
+  }
+}
+
 TEST(BlockPreconditioner, FallsBackToTheBlockDiagonalWhenTheFactorWouldBeTooLarge) {
   const Block b = half_block(5);
   const BlockProblem problem(b.graph.d, b.owned, b.measurements);

@@ -5,29 +5,25 @@
 namespace tessera {
 namespace {
 
-// R > 0: the row count is R (fixed-size loops the compiler unrolls); R == 0: rows at run time.
+// R: the row count, or Eigen::Dynamic. The accumulator is a fixed-size Eigen vector so that it
+// lives in registers (through a pointer it would chain every update through memory).
 template <int R>
-void dense_times_sparse(const double* X, Eigen::Index rows, const SparseMatrix& Q, double scale,
+void dense_times_sparse(const double* X, Eigen::Index r, const SparseMatrix& Q, double scale,
                         double* out) {
-  const Eigen::Index r = R > 0 ? R : rows;
+  using Vec = Eigen::Matrix<double, R, 1>;
+  using ConstMap = Eigen::Map<const Vec>;
   const auto* outer = Q.outerIndexPtr();
   const auto* nnz = Q.innerNonZeroPtr();  // null when compressed
   const auto* inner = Q.innerIndexPtr();
   const double* value = Q.valuePtr();
-  double acc_fixed[R > 0 ? R : 1];
-  Eigen::VectorXd acc_dynamic(R > 0 ? 0 : r);
-  double* acc = R > 0 ? acc_fixed : acc_dynamic.data();
+  Vec acc(r);
   for (Eigen::Index j = 0; j < Q.outerSize(); ++j) {
-    for (Eigen::Index a = 0; a < r; ++a) acc[a] = 0.0;
+    acc.setZero();
     const Eigen::Index begin = outer[j];
     const Eigen::Index end = nnz ? begin + nnz[j] : outer[j + 1];
-    for (Eigen::Index p = begin; p < end; ++p) {
-      const double v = value[p];
-      const double* x = X + r * static_cast<Eigen::Index>(inner[p]);
-      for (Eigen::Index a = 0; a < r; ++a) acc[a] += v * x[a];
-    }
-    double* o = out + r * j;
-    for (Eigen::Index a = 0; a < r; ++a) o[a] = scale * acc[a];
+    for (Eigen::Index p = begin; p < end; ++p)
+      acc += value[p] * ConstMap(X + r * static_cast<Eigen::Index>(inner[p]), r);
+    Eigen::Map<Vec>(out + r * j, r) = scale * acc;
   }
 }
 
@@ -109,7 +105,7 @@ void scaled_dense_times_sparse(const Eigen::MatrixXd& X, const SparseMatrix& Q, 
     case 6:
       return dense_times_sparse<6>(X.data(), r, Q, scale, out.data());
     default:
-      return dense_times_sparse<0>(X.data(), r, Q, scale, out.data());
+      return dense_times_sparse<Eigen::Dynamic>(X.data(), r, Q, scale, out.data());
   }
 }
 

@@ -43,14 +43,15 @@ struct TcgOutcome {
 TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
                         const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
                         const Eigen::MatrixXd& grad, double radius, const TrustRegionOptions& opt,
-                        const BlockPreconditioner* precon) {
+                        const BlockPreconditioner* precon, const Eigen::MatrixXd* precon_grad) {
   auto precondition = [&](const Eigen::MatrixXd& v) { return precon ? precon->apply(M, X, v) : v; };
   TcgOutcome out;
   out.eta = Eigen::MatrixXd::Zero(X.rows(), X.cols());
   out.Heta = out.eta;
   Eigen::MatrixXd r = grad;
   double r0_norm = std::sqrt(inner(r, r));
-  Eigen::MatrixXd z = precondition(r);
+  // The caller may already hold the preconditioned gradient (it sets the initial radius).
+  Eigen::MatrixXd z = precon_grad ? *precon_grad : precondition(r);
   double z_r = inner(z, r);
   double d_Pd = z_r, e_Pd = 0.0, e_Pe = 0.0;
   Eigen::MatrixXd delta = -z;
@@ -108,9 +109,14 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
   double grad_norm = std::sqrt(inner(grad, grad));
   double radius = options.initial_radius;
+  // The preconditioned gradient at the current point, when computed for the initial radius:
+  // the first tCG iteration starts from the same vector (one solve fewer per block update).
+  Eigen::MatrixXd precon_grad;
+  bool have_precon_grad = false;
   if (radius <= 0) {
-    Eigen::MatrixXd z = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
-    radius = std::max(1e-10, std::sqrt(std::max(0.0, inner(z, grad))));
+    precon_grad = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
+    have_precon_grad = true;
+    radius = std::max(1e-10, std::sqrt(std::max(0.0, inner(precon_grad, grad))));
   }
   res.stop_reason = "max_iterations";
   for (int it = 0; it < options.max_iterations; ++it) {
@@ -122,7 +128,8 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       res.stop_reason = "time";
       break;
     }
-    TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner);
+    TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner,
+                                   have_precon_grad ? &precon_grad : nullptr);
     res.total_inner_iterations += step.iterations;
     Eigen::MatrixXd X_new =
         options.retraction ? options.retraction(res.X, step.eta) : M.retract(res.X, step.eta);
@@ -150,6 +157,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     if (!accepted && rho >= 0.25) radius *= 0.25;  // every rejection shrinks the region
     double decrease = 0.0;
     if (accepted) {
+      have_precon_grad = false;  // the gradient changes
       decrease = f - f_new;
       res.X = std::move(X_new);
       f = f_new;
