@@ -67,6 +67,8 @@ options:
                      rejoins the run (the coordinator needs --rejoin-timeout); removed when
                      the run completes. A damaged checkpoint is an error naming the file.
   --checkpoint-every K  write the checkpoint every K rounds (default 1)
+  --udp-only         talk UDP only, no shared memory (implied by --checkpoint-dir): for runs
+                     that survive a SIGKILLed peer (tessera launch --on-agent-loss continue)
   --verbose          print each phase
   --help             this text
 
@@ -86,6 +88,7 @@ struct AgentArgs {
   std::string dump_local;
   std::string checkpoint_dir;
   int checkpoint_every = 1;
+  bool udp_only = false;
   bool verbose = false;
 };
 
@@ -95,7 +98,7 @@ AgentArgs parse(const std::vector<std::string>& argv) {
       cli::with_session_options({"graph", "robots", "id", "round-timeout", "output", "dump-local",
                                  "checkpoint-dir", "checkpoint-every"},
                                 cli::SessionArgsFor::kProcess),
-      {"verbose", "help"});
+      {"verbose", "help", "udp-only"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   AgentArgs a;
@@ -115,6 +118,7 @@ AgentArgs parse(const std::vector<std::string>& argv) {
   a.output = args.get_or("output", "");
   a.dump_local = args.get_or("dump-local", "");
   a.checkpoint_dir = args.get_or("checkpoint-dir", "");
+  a.udp_only = args.has("udp-only");
   a.checkpoint_every = static_cast<int>(args.get_long("checkpoint-every", 1));
   agent::CheckpointOptions{a.checkpoint_dir, a.checkpoint_every}.validate();
   a.verbose = args.has("verbose");
@@ -148,7 +152,7 @@ class Agent {
     }
     SessionOptions so = a_.net.session;
     // An agent meant to survive a SIGKILL talks UDP only (see transport/qos.hpp).
-    so.shared_memory = a_.checkpoint_dir.empty();
+    so.shared_memory = a_.checkpoint_dir.empty() && !a_.udp_only;
     so.coordinator = false;
     so.agent_id = a_.id;
     so.num_agents = a_.robots;

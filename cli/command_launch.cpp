@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -24,6 +25,7 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "distributed/distributed_solver.hpp"
+#include "launch_loss_policy.hpp"
 #include "robot_files.hpp"
 #include "session_args.hpp"
 #include "transport/security.hpp"
@@ -33,15 +35,18 @@ namespace tessera::cli {
 
 namespace {
 
-// %s: the shared DDS session options (session_args.hpp).
-constexpr const char* kHelp = R"(usage: tessera launch [GRAPH.g2o | ROBOT_FILES_DIR | R0.g2o,R1.g2o,...] --agents N [options]
+// %s: the loss options (launch_loss_policy.hpp), then the shared DDS session options
+// (session_args.hpp).
+constexpr const char* kHelp =
+    R"(usage: tessera launch [GRAPH.g2o | ROBOT_FILES_DIR | R0.g2o,R1.g2o,...] --agents N [options]
 
 Runs a distributed solve on this host as separate processes: one tessera-coordinator and N
 tessera-agent processes (robot k reads its sequential share of GRAPH, or the k-th robot file
 of a folder or list, as written by tessera generate --split) talking peer to peer
 over Fast DDS. Prints progress (round, cost, gradient norm) while it runs and the JSON
-summary at the end. Any failing process, the time limit or Ctrl-C stops every process; the
-exit code is then non-zero. Without GRAPH, a 3D grid is generated into a temporary folder
+summary at the end. Any failing process (a dead agent only with --on-agent-loss stop, the
+default), the time limit or Ctrl-C stops every process; the exit code is then non-zero.
+Without GRAPH, a 3D grid is generated into a temporary folder
 (tessera generate --kind grid3d --poses P --robots N). The agents initialise like
 `tessera solve` (--init, default chordal), so both give the same iterates.
 
@@ -64,7 +69,7 @@ options:
   --poses P            poses of the generated graph (without GRAPH)         [1000]
   --status-interval S  coordinator status line (agents alive, rounds, lagging or lost
                        agents) every S seconds and on changes; 0 = off          [5]
-  --quiet              no progress lines
+%s  --quiet              no progress lines
   --help               this text
 
 DDS session options (passed on to the coordinator and every agent):
@@ -91,7 +96,10 @@ struct Child {
   pid_t pid = -1;
   std::string log;
   bool running = false;
-  int code = -1;  // exit code, or 128 + signal
+  int code = -1;        // exit code, or 128 + signal
+  long agent = -1;      // agent id; -1 for the coordinator
+  bool judged = false;  // its end has been judged (launch_loss_policy.hpp)
+  bool lost = false;    // it died and the run went on without it
 };
 
 // Starts argv with stdout going to `stdout_fd` (or the log) and stderr to the log, in its own
@@ -179,14 +187,15 @@ void remove_tree(const std::string& dir) {
 int run_launch(const Args& argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
-      std::printf(kHelp, session_options_help(SessionArgsFor::kLaunch).c_str());
+      std::printf(kHelp, launch_loss_help().c_str(),
+                  session_options_help(SessionArgsFor::kLaunch).c_str());
       return 0;
     }
-  Arguments args(argv,
-                 with_session_options({"agents", "algorithm", "partition", "init", "grad-tol",
-                                       "max-rounds", "rank", "seed", "json", "out", "tum",
-                                       "timeout", "poses", "status-interval"},
-                                      SessionArgsFor::kLaunch),
+  std::set<std::string> valued = {
+      "agents", "algorithm", "partition", "init", "grad-tol", "max-rounds", "rank",
+      "seed",   "json",      "out",       "tum",  "timeout",  "poses",      "status-interval"};
+  for (const auto& n : launch_loss_option_names()) valued.insert(n);
+  Arguments args(argv, with_session_options(valued, SessionArgsFor::kLaunch),
                  {"quiet", "certify", "no-certify"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
@@ -227,6 +236,7 @@ int run_launch(const Args& argv) {
   const long poses = args.get_long("poses", 1000);
   if (poses < agents) throw InputError("launch: --poses must be at least --agents");
   const bool quiet = args.has("quiet");
+  const LaunchLossOptions loss = parse_launch_loss_options(args);
 
   const std::string bin = self_dir();
   for (const char* exe : {"tessera-agent", "tessera-coordinator"})
@@ -306,6 +316,7 @@ int run_launch(const Args& argv) {
     throw InputError("launch: --certify and --no-certify exclude each other");
   if (!args.has("no-certify")) cargs.push_back("--certify");
   cargs.insert(cargs.end(), common.begin(), common.end());
+  for (const auto& a : coordinator_loss_argv(loss)) cargs.push_back(a);
   if (args.has("out")) cargs.insert(cargs.end(), {"--output", args.get_or("out", "")});
   if (args.has("tum")) cargs.insert(cargs.end(), {"--tum", args.get_or("tum", "")});
   if (args.has("status-interval"))
@@ -317,12 +328,18 @@ int run_launch(const Args& argv) {
   close(pipefd[1]);
   for (long k = 0; k < agents; ++k) {
     std::vector<std::string> a = {
-        bin + "/tessera-agent", "--graph",
-        robot_files.empty() ? graph : robot_files[static_cast<std::size_t>(k)], "--robots",
-        std::to_string(agents), "--id", std::to_string(k)};
+        bin + "/tessera-agent",
+        "--graph",
+        robot_files.empty() ? graph : robot_files[static_cast<std::size_t>(k)],
+        "--robots",
+        std::to_string(agents),
+        "--id",
+        std::to_string(k)};
     a.insert(a.end(), common.begin(), common.end());
+    for (const auto& x : agent_loss_argv(loss)) a.push_back(x);
     children.push_back(
         spawn("agent " + std::to_string(k), a, work + "/agent" + std::to_string(k) + ".log", -1));
+    children.back().agent = k;
   }
   std::printf("launched run %s: coordinator + %ld agents (logs in %s until the end)\n",
               run_id.c_str(), agents, work.c_str());
@@ -360,11 +377,18 @@ int run_launch(const Args& argv) {
       exit_code = 130;
       break;
     }
-    for (const auto& c : children)
-      if (!c.running && c.code != 0 && failure.empty()) {
-        failure = c.name + " failed (exit code " + std::to_string(c.code) + ")";
+    const bool coordinator_done = !children[0].running && children[0].code == 0;
+    for (auto& c : children) {
+      if (c.running || c.judged) continue;
+      c.judged = true;
+      const ExitVerdict v = judge_exit(loss, c.agent, c.code, coordinator_done);
+      c.lost = v.lost;
+      if (!v.notice.empty()) std::fprintf(stderr, "tessera launch: %s\n", v.notice.c_str());
+      if (!v.failure.empty() && failure.empty()) {
+        failure = v.failure;
         exit_code = 1;
       }
+    }
     if (!failure.empty()) break;
     if (!any_running(children)) break;
     if (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > timeout_s) {
@@ -399,6 +423,14 @@ int run_launch(const Args& argv) {
   std::stringstream ss;
   ss << s.rdbuf();
   std::printf("summary:\n%s", ss.str().c_str());
+  std::string lost;
+  for (const auto& c : children)
+    if (c.lost) lost += (lost.empty() ? "" : ", ") + c.name;
+  if (!lost.empty())
+    std::printf(
+        "finished without %s (lost during the run; its block was re-partitioned among "
+        "the survivors: see \"fault\" in the summary)\n",
+        lost.c_str());
   std::printf("wall time %.2f s\n",
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return 0;

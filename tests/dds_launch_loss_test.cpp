@@ -1,0 +1,166 @@
+// `tessera launch --on-agent-loss continue`: an agent process SIGKILLed during the rounds no
+// longer stops the run; the coordinator re-partitions its block among the survivors, which
+// finish with N-1 agents, every pose and the centralized optimum. A second loss in the same
+// run stops it with a message naming the agent. The default (stop) is covered by
+// DdsLaunch.AgentKilledDuringTheRoundsIsNamedByEveryone (dds_solve_test.cpp).
+// Domains used here: 221-222 (each test its own, so ctest -j is safe).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "dds_process_support.hpp"
+#include "io/g2o_reader.hpp"
+#include "solvers/centralized_solver.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+bool wait_for_output(const Process& p, const std::string& text, double timeout_s) {
+  const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
+  while (Clock::now() < until) {
+    if (p.output().find(text) != std::string::npos) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+// One launch of its own run id on a 300-pose grid3d with 5 agents; its processes are found
+// (and, if an assertion fails, removed) by that run id.
+struct LaunchRun {
+  std::string dir, graph, run_id;
+  int domain = 0;
+  ~LaunchRun() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + " '", nullptr); }
+
+  Process launch(const std::vector<std::string>& extra) const {
+    std::vector<std::string> argv = {bin("tessera"),
+                                     "launch",
+                                     graph,
+                                     "--agents",
+                                     "5",
+                                     "--domain",
+                                     std::to_string(domain),
+                                     "--run-id",
+                                     run_id,
+                                     "--init",
+                                     "file",
+                                     "--partition",
+                                     "eco",
+                                     "--on-agent-loss",
+                                     "continue",
+                                     "--rejoin-timeout",
+                                     "1",
+                                     "--replica-every",
+                                     "5",
+                                     "--status-interval",
+                                     "1",
+                                     "--out",
+                                     dir + "/merged.g2o",
+                                     "--json",
+                                     dir + "/summary.json",
+                                     "--timeout",
+                                     "60"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return start(argv, dir + "/launch.log");
+  }
+
+  // SIGKILLs agent k of this run (for good: launch never restarts it).
+  bool kill_agent(int k) const {
+    std::string pid;
+    // "[t]" keeps the pattern from matching the shell that runs pgrep.
+    run_command("pgrep -f '[t]essera-agent.*--id " + std::to_string(k) + " --run-id " + run_id +
+                    " ' | head -1",
+                &pid);
+    if (pid.empty()) return false;
+    return kill(std::stoi(pid), SIGKILL) == 0;
+  }
+};
+
+LaunchRun make_run(int domain, const std::string& name) {
+  LaunchRun r;
+  r.dir = temp_dir();
+  r.domain = domain;
+  r.run_id = name + "-" + std::to_string(getpid());
+  r.graph = r.dir + "/graph.g2o";
+  std::string out;
+  EXPECT_EQ(
+      run_command(bin("tessera") +
+                      " generate --kind grid3d --poses 300 --robots 5 --seed 3 --out " + r.graph,
+                  &out),
+      0)
+      << out;
+  return r;
+}
+
+TEST(DdsLaunchLoss, KilledAgentLeavesFourAgentsThatFinishAtTheOptimumWithEveryPose) {
+  LaunchRun r = make_run(221, "launchloss");
+  Process launch = r.launch({"--grad-tol", "0.0005"});
+  ASSERT_TRUE(wait_for_output(launch, "round 10:", 40)) << launch.output();
+  ASSERT_TRUE(r.kill_agent(2)) << launch.output();
+  ASSERT_TRUE(wait_all({&launch}, 60)) << launch.output();
+  const std::string out = launch.output();
+  EXPECT_EQ(launch.exit_code, 0) << out;
+  EXPECT_NE(out.find("agent 2 ended during the run"), std::string::npos) << out;
+  EXPECT_NE(out.find("re-partitioned"), std::string::npos) << out;
+  EXPECT_NE(out.find("finished without agent 2"), std::string::npos) << out;
+
+  // Every pose is in the merged estimate (VERTEX lines only), at the centralized optimum.
+  const PoseGraph g = read_g2o(r.graph);
+  std::set<long> ids;
+  {
+    std::ifstream f(r.dir + "/merged.g2o");
+    for (std::string line; std::getline(f, line);)
+      if (line.rfind("VERTEX", 0) == 0) ids.insert(std::stol(line.substr(line.find(' ') + 1)));
+  }
+  EXPECT_EQ(ids.size(), g.num_poses);
+  EXPECT_EQ(ids.empty() ? -1L : *ids.rbegin(), static_cast<long>(g.num_poses) - 1);
+  const double fstar = solve_centralized(g).cost;
+  const std::string summary = slurp(r.dir + "/summary.json");
+  const double cost = json_field(summary, "cost");
+  EXPECT_LE(std::abs(cost - fstar), 1e-6 * fstar) << summary << "\nf* = " << fstar;
+  EXPECT_NE(summary.find("\"lost_agents\": [2]"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"survivors\": [0, 1, 3, 4]"), std::string::npos) << summary;
+}
+
+TEST(DdsLaunchLoss, SecondLossInTheSameRunStopsItNamingTheAgent) {
+  LaunchRun r = make_run(222, "launchloss2");
+  // A tolerance the run never reaches: it is still in its rounds at the second kill.
+  Process launch = r.launch({"--grad-tol", "1e-12", "--max-rounds", "100000", "--no-certify"});
+  ASSERT_TRUE(wait_for_output(launch, "round 10:", 40)) << launch.output();
+  ASSERT_TRUE(r.kill_agent(2)) << launch.output();
+  ASSERT_TRUE(wait_for_output(launch, "re-partitioned", 30)) << launch.output();
+  ASSERT_TRUE(r.kill_agent(3)) << launch.output();
+  ASSERT_TRUE(wait_all({&launch}, 40)) << launch.output();
+  const std::string out = launch.output();
+  EXPECT_EQ(launch.exit_code, 1) << out;
+  EXPECT_NE(out.find("agent 3 ended during the run"), std::string::npos) << out;
+  EXPECT_NE(out.find("coordinator failed"), std::string::npos) << out;
+  EXPECT_NE(out.find("lost agent 3 after a re-partition: a second loss is not covered"),
+            std::string::npos)
+      << out;
+}
+
+TEST(DdsLaunchLoss, LossOptionsAreCheckedNamingTheOption) {
+  std::string out;
+  EXPECT_EQ(run_command(bin("tessera") + " launch --on-agent-loss maybe", &out), 2) << out;
+  EXPECT_NE(out.find("--on-agent-loss 'maybe' is not one of stop, continue"), std::string::npos)
+      << out;
+  EXPECT_EQ(run_command(bin("tessera") + " launch --replicas 2", &out), 2) << out;
+  EXPECT_NE(out.find("--replicas needs --on-agent-loss continue"), std::string::npos) << out;
+  EXPECT_EQ(run_command(bin("tessera") + " launch --on-agent-loss continue --replicas 0", &out), 2)
+      << out;
+  EXPECT_NE(out.find("--replicas must be 1..8"), std::string::npos) << out;
+  EXPECT_EQ(
+      run_command(bin("tessera") + " launch --on-agent-loss continue --rejoin-timeout -1", &out), 2)
+      << out;
+  EXPECT_NE(out.find("--rejoin-timeout must be in (0, 3600]"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
