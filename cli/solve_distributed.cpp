@@ -36,7 +36,7 @@ const char* kDistributedHelp =
     "  --grad-tol T              stop at ||grad f|| <= T, full cost (default 0.01)\n"
     "  --max-rounds K            round cap (default 10000)\n"
     "  --rel-tol T               stop when a round decreases f by < T f (default 0: off)\n"
-    "  --select greedy|uniform|round_robin   block selection (default greedy)\n"
+    "  --select greedy|greedy_newton|uniform|round_robin   block selection (default greedy)\n"
     "  --parallel                update a whole colour class of blocks per round\n"
     "  --seed S                  shared seed (uniform selection, partitioner)\n"
     "  --rank R                  relaxation rank (default 5)\n"
@@ -164,9 +164,12 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
               r.rounds, r.restarts, r.stop_reason.c_str(), r.grad_norm, r.relaxation_cost);
   std::printf("  rounded cost %.10g", r.cost);
   if (rel_gap) std::printf(", f* %.10g, rel gap %.3g", *fstar, *rel_gap);
-  std::printf("\n  %.3f MB exchanged, %.2f ms per round (%.2f CPU), solve %.3f s, wall %.3f s\n",
-              r.bytes_exchanged / 1e6, r.rounds > 0 ? 1e3 * r.solve_s / r.rounds : 0.0,
-              r.rounds > 0 ? 1e3 * r.solve_cpu_s / r.rounds : 0.0, r.solve_s, wall_s);
+  std::printf(
+      "\n  %.3f MB exchanged, %.2f ms per round (%.2f CPU, %.2f on the slowest agent), solve %.3f "
+      "s, wall %.3f s\n",
+      r.bytes_exchanged / 1e6, r.rounds > 0 ? 1e3 * r.solve_s / r.rounds : 0.0,
+      r.rounds > 0 ? 1e3 * r.solve_cpu_s / r.rounds : 0.0,
+      r.rounds > 0 ? 1e3 * r.critical_path_cpu_s / r.rounds : 0.0, r.solve_s, wall_s);
   if (r.certified) {
     std::printf(
         "  %s: lambda_min(S) = %.4g (eta %.3g, residual %.3g), %d certificate rounds "
@@ -213,6 +216,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         .add("ms_per_round", r.rounds > 0 ? 1e3 * r.solve_s / r.rounds : 0.0)
         .add("solve_cpu_s", r.solve_cpu_s)
         .add("cpu_ms_per_round", r.rounds > 0 ? 1e3 * r.solve_cpu_s / r.rounds : 0.0)
+        .add("critical_path_cpu_s", r.critical_path_cpu_s)
         .add("rel_gap", rel_gap)
         .add("final_rank", r.final_rank);
     if (r.certified) {

@@ -100,9 +100,19 @@ Eigen::MatrixXd AgentState::active_part(const Eigen::MatrixXd& X) const {
   return X(rows_, Eigen::all);
 }
 
-LocalStatus AgentState::status() {
+LocalStatus AgentState::status(bool newton_score) {
   set_point(Y, Yn);
   LocalStatus s;
+  if (newton_score) {
+    // The score needs the gradient itself, not only its norm: no reuse here.
+    const Eigen::MatrixXd Ya = active_part(Y);
+    s.cost_share = problem_.cost_share(Ya);
+    const Eigen::MatrixXd g = problem_.riemannian_gradient(Ya, problem_.euclidean_gradient(Ya));
+    s.grad_norm_sq = g.squaredNorm();
+    const Eigen::MatrixXd z = precon_->apply(problem_.manifold(static_cast<int>(Ya.rows())), Ya, g);
+    s.block_grad_norm = std::sqrt(std::max(0.0, (z.array() * g.array()).sum()));
+    return s;
+  }
   if (updated_grad_norm_sq_ >= 0 && updated_version_ == neighbours_version_ && Y == updated_X_) {
     s.cost_share = problem_.cost_share(active_part(Y));
     s.grad_norm_sq = updated_grad_norm_sq_;  // same point, same neighbours: same gradient

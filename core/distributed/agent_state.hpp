@@ -19,9 +19,10 @@ namespace tessera {
 
 /// An agent's contributions to the global reductions at its current Y.
 struct LocalStatus {
-  double cost_share = 0.0;       ///< Internal edges in full, cut edges half.
-  double grad_norm_sq = 0.0;     ///< ||grad_B f||^2: the block's part of ||grad f||^2.
-  double block_grad_norm = 0.0;  ///< sqrt(grad_norm_sq).
+  double cost_share = 0.0;    ///< Internal edges in full, cut edges half.
+  double grad_norm_sq = 0.0;  ///< ||grad_B f||^2: the block's part of ||grad f||^2.
+  /// Selection score: sqrt(grad_norm_sq), or with `newton_score` sqrt(<(2Q_BB)^-1 g, g>).
+  double block_grad_norm = 0.0;
 };
 
 class AgentState {
@@ -44,8 +45,9 @@ class AgentState {
   /// the message names a pose that is not a neighbour of this block or has the wrong size.
   void absorb(const PoseBlockMessage& message, Eigen::MatrixXd& copy) const;
 
-  /// Status at (Y, Yn).
-  LocalStatus status();
+  /// Status at (Y, Yn). `newton_score`: the selection score is the preconditioned gradient
+  /// norm (greedy_newton selection) instead of the gradient norm.
+  LocalStatus status(bool newton_score = false);
   /// Block update from X0 with neighbours at `neighbours`.
   Eigen::MatrixXd update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
                          const BlockUpdateOptions& options);

@@ -12,6 +12,8 @@ const char* selection_name(SelectionRule rule) {
       return "greedy";
     case SelectionRule::kRoundRobin:
       return "round_robin";
+    case SelectionRule::kGreedyNewton:
+      return "greedy_newton";
   }
   return "?";
 }
@@ -20,7 +22,9 @@ SelectionRule parse_selection(const std::string& name) {
   if (name == "uniform") return SelectionRule::kUniform;
   if (name == "greedy") return SelectionRule::kGreedy;
   if (name == "round_robin" || name == "round-robin") return SelectionRule::kRoundRobin;
-  throw InputError("selection rule '" + name + "' is not one of uniform, greedy, round_robin");
+  if (name == "greedy_newton" || name == "greedy-newton") return SelectionRule::kGreedyNewton;
+  throw InputError("selection rule '" + name +
+                   "' is not one of uniform, greedy, round_robin, greedy_newton");
 }
 
 namespace {
@@ -53,7 +57,8 @@ std::vector<int> select_blocks(SelectionRule rule, bool parallel, std::uint64_t 
     case SelectionRule::kRoundRobin:
       unit = static_cast<int>(round % static_cast<std::uint64_t>(units));
       break;
-    case SelectionRule::kGreedy: {
+    case SelectionRule::kGreedy:
+    case SelectionRule::kGreedyNewton: {
       int best = 0;
       for (int b = 1; b < layout.num_blocks; ++b)
         if (block_grad_norms[static_cast<std::size_t>(b)] >

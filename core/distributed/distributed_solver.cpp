@@ -128,6 +128,7 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
   const DeliveryStats stats = run_in_process(agents, options.delivery, options.delivery_seed);
   res.solve_s = since(solve_start);
   res.solve_cpu_s = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  res.critical_path_cpu_s = stats.critical_path_cpu_s;
 
   const CertifiedAgent& lead = *sequences.front();
   res.rounds = lead.total_rounds();

@@ -95,6 +95,10 @@ struct DistributedResult {
   /// Process CPU time of the rounds (all agents, in one process): unlike solve_s it does not
   /// grow when other jobs share the machine.
   double solve_cpu_s = 0.0;
+  /// Estimated compute time of the same rounds with each agent on its own machine: per
+  /// message (stage, round), the slowest agent's CPU time, summed (DeliveryStats). With
+  /// `parallel` several agents compute in one round; this is the time that then matters.
+  double critical_path_cpu_s = 0.0;
 };
 
 /// Solves `graph` with the blocks of `assignment` (block id per pose, 0..N-1, none empty).

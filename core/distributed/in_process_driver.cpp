@@ -1,5 +1,7 @@
 #include "distributed/in_process_driver.hpp"
 
+#include <algorithm>
+#include <ctime>
 #include <deque>
 #include <functional>
 #include <stdexcept>
@@ -23,6 +25,12 @@ struct Delivery {
   ProtocolMessage message;
 };
 
+double thread_cpu_s() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 std::uint32_t round_of(const ProtocolMessage& m) {
   if (const auto* p = std::get_if<PoseBlockMessage>(&m)) return p->round;
   return std::get<RoundStatusMessage>(m).round;
@@ -33,6 +41,7 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
                       const std::function<std::vector<OutgoingMessage>(std::size_t)>& begin) {
   DeliveryStats stats;
   std::deque<Delivery> queue;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<double>> cpu;
   const std::size_t n = agents.size();
   auto post = [&](std::size_t sender, std::vector<OutgoingMessage>&& out) {
     for (auto& o : out) {
@@ -85,8 +94,16 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
     }
     if (d.recipient >= n) throw std::logic_error("in-process driver: message to unknown agent");
     if (agents[d.recipient]->done()) continue;
-    post(d.recipient, agents[d.recipient]->handle(d.message));
+    const auto slot = std::make_pair(stage_of_phase(message_phase(d.message)), round_of(d.message));
+    const double t0 = thread_cpu_s();
+    std::vector<OutgoingMessage> out = agents[d.recipient]->handle(d.message);
+    auto& per_agent = cpu[slot];
+    if (per_agent.empty()) per_agent.assign(n, 0.0);
+    per_agent[d.recipient] += thread_cpu_s() - t0;
+    post(d.recipient, std::move(out));
   }
+  for (const auto& [slot, per_agent] : cpu)
+    stats.critical_path_cpu_s += *std::max_element(per_agent.begin(), per_agent.end());
   for (auto* a : agents)
     if (!a->done())
       throw std::logic_error("in-process driver: agents stalled with no message in flight");

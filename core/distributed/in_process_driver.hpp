@@ -30,6 +30,12 @@ struct DeliveryStats {
   std::vector<std::uint64_t> bytes_per_stage;
   /// By (stage, round field).
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint64_t> bytes_per_stage_round;
+  /// CPU time of each agent's message handling, by the handled message's (stage, round) and
+  /// agent. Agents run one after another here but concurrently over the network, where a round
+  /// lasts as long as its slowest agent: `critical_path_cpu_s` = sum over (stage, round) of the
+  /// largest agent's CPU time, an estimate of the distributed run's compute time (no latency)
+  /// that does not depend on how many agents share this process or the machine's load.
+  double critical_path_cpu_s = 0.0;
 };
 
 /// Payload size of a message as it would travel (fixed fields + arrays), in bytes.

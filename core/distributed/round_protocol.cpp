@@ -195,7 +195,7 @@ void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
 
 void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessage>& out) {
   if (phase == ProtocolPhase::kStatus && observer_) observer_(snapshot());
-  const LocalStatus s = state_.status();
+  const LocalStatus s = state_.status(config_.selection == SelectionRule::kGreedyNewton);
   RoundStatusMessage m;
   m.round = u32(round_);
   m.sender = u32(state_.id());
