@@ -1,0 +1,119 @@
+#include "agent/agent_run.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <thread>
+
+#include "agent/agent_log.hpp"
+#include "agent/block_replication.hpp"
+#include "agent/checkpoint_keeper.hpp"
+#include "agent/dds_channel.hpp"
+#include "agent/final_report.hpp"
+#include "agent/rejoin.hpp"
+#include "agent/round_loop.hpp"
+#include "agent/run_setup.hpp"
+#include "transport/run_failure.hpp"
+
+namespace tessera::agent {
+
+using namespace tessera::transport;
+
+namespace {
+
+// Step 7: THE SEAM, core's round protocol over DDS, until the coordinator confirms the
+// merged result (step 8, inside the loop: an order while waiting for it repeats the rounds).
+// `local` is the block of the first epoch (fresh or from the checkpoint).
+void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLocalData& local,
+           const std::optional<AgentCheckpoint>& restart, const RunSetup* setup,
+           std::chrono::steady_clock::time_point t0) {
+  const bool rejoin_enabled = setup && setup->rejoin_enabled;
+  BlockReplication replication(s, o.id, setup ? setup->replicas : 0,
+                               setup ? setup->replica_every : 10, log);
+  DdsProtocolChannel channel(s);
+  CheckpointKeeper keeper(o.net.session.run_id, local, {o.checkpoint_dir, o.checkpoint_every});
+  std::optional<ProtocolSnapshot> from;  // a copy: the keeper replaces its entries
+  // With a rejoin window the coordinator arbitrates lost agents (it waits for a restart,
+  // then orders a rollback, or gives up and aborts the run): do not stop on one.
+  if (rejoin_enabled || restart || replication.enabled()) s.set_agent_loss_tolerated(true);
+  const AgentLocalData* cur = &local;  // the survivors' new block after a re-partition
+  if (replication.enabled() && !restart) replication.start(local, channel);
+  if (restart) {
+    keeper.adopt(restart->snapshots);
+    const RollbackRequested order = request_rejoin(s, o.id, restart->snapshots, o.net.timeout_s);
+    from = prepare_rollback(s, keeper, order, o.net.timeout_s);
+    log("rejoined: resuming at round " + std::to_string(order.round) + ", epoch " +
+        std::to_string(order.epoch));
+  }
+  RoundLoopHooks hooks;
+  hooks.on_round = [&](const ProtocolSnapshot& snap) {
+    if (cur == &local) keeper.on_round(snap);
+    if (replication.enabled()) replication.on_round(*cur, snap);
+  };
+  for (;;) {
+    try {
+      hooks.resume_from = from ? &*from : nullptr;
+      deliver_final_estimate(s, *cur, run_round_loop(*cur, channel, o.round_timeout_s, hooks), o,
+                             log, t0);
+      break;
+    } catch (const RepartitionRequested& order) {
+      if (!replication.enabled() || cur != &local)
+        throw RunFailure(kExitRunFailed, std::string(order.what()) +
+                                             ": this run does not replicate for a second loss");
+      cur = &replication.take_over(local, order.assignment, o.net.timeout_s);
+      from.reset();
+    } catch (const RollbackRequested& order) {
+      std::cerr << log.tag << ": " << order.what() << ": resuming from the snapshot of round "
+                << order.round << "\n";
+      from = prepare_rollback(s, keeper, order, o.net.timeout_s);
+    }
+  }
+  if (!o.checkpoint_dir.empty()) {
+    const auto& cs = keeper.stats();
+    char buf[200];
+    std::snprintf(buf, sizeof(buf),
+                  "%s: checkpoints: %llu written, %.1f ms in total (%.2f ms each), %llu bytes "
+                  "each\n",
+                  log.tag.c_str(), static_cast<unsigned long long>(cs.writes), cs.write_s * 1e3,
+                  cs.writes ? cs.write_s * 1e3 / static_cast<double>(cs.writes) : 0.0,
+                  static_cast<unsigned long long>(cs.last_bytes));
+    std::cerr << buf;
+    std::remove(keeper.path().c_str());  // the run is complete: nothing to rejoin
+  }
+}
+
+}  // namespace
+
+std::optional<AgentCheckpoint> find_restart_checkpoint(const AgentOptions& o) {
+  if (o.checkpoint_dir.empty()) return std::nullopt;
+  const std::string path = checkpoint_path(o.checkpoint_dir, o.id);
+  if (access(path.c_str(), F_OK) != 0) return std::nullopt;
+  AgentCheckpoint restart = load_checkpoint(path, o.net.session.run_id, o.id, o.robots);
+  std::cerr << agent_tag(o.id) << ": rejoining run '" << o.net.session.run_id
+            << "' from checkpoint " << path << " (rounds " << restart.snapshots.front().round
+            << ".." << restart.snapshots.back().round << ")\n";
+  std::this_thread::sleep_for(Seconds(1.5 * o.net.session.lease_s));
+  return restart;
+}
+
+void run_agent(const AgentOptions& o, Session& s, std::optional<AgentCheckpoint> restart) {
+  const AgentLog log{agent_tag(o.id), o.verbose};
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    if (restart) {
+      solve(s, o, log, restart->local, restart, nullptr, t0);
+    } else {
+      const RunSetup setup = set_up_fresh_run(s, o, log);
+      solve(s, o, log, setup.local, restart, &setup, t0);
+    }
+  } catch (const RunStopped&) {
+    // The stop's own cause (a lost peer, an ABORT, a signal), not the unwinding's.
+    const StopInfo stop =
+        s.mailroom().stop_info().value_or(StopInfo{kExitRunFailed, "stopped", false});
+    throw RunFailure(stop.exit_code, stop.reason, !stop.remote);
+  }
+}
+
+}  // namespace tessera::agent

@@ -1,0 +1,69 @@
+#include "agent/final_report.hpp"
+
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include "agent/dds_channel.hpp"
+#include "agent/local_dump.hpp"
+#include "transport/message_mapping.hpp"
+#include "transport/run_failure.hpp"
+
+namespace tessera::agent {
+
+using namespace tessera::transport;
+
+void deliver_final_estimate(Session& s, const AgentLocalData& local, const RoundLoopResult& result,
+                            const AgentOptions& o, const AgentLog& log,
+                            std::chrono::steady_clock::time_point t0) {
+  Mailroom& room = s.mailroom();
+  if (result.poses.size() != local.owned.size())
+    throw RunFailure(kExitRunFailed, "the round loop returned " +
+                                         std::to_string(result.poses.size()) + " poses for " +
+                                         std::to_string(local.owned.size()) + " owned poses");
+  {
+    char line[200];
+    std::snprintf(line, sizeof(line),
+                  "round loop done: %u round(s) in %.3f s, rounding %.3f s (%u CG iterations), "
+                  "%llu messages, %llu write retries",
+                  result.rounds, result.solve_s, result.rounding_s, result.translation_iterations,
+                  static_cast<unsigned long long>(s.stats().messages_sent),
+                  static_cast<unsigned long long>(s.stats().write_retries));
+    log(line);
+  }
+  if (!o.output.empty()) write_vertices_g2o(local.owned, result.poses, local.d, o.output);
+
+  wire::FinalEstimate fin;
+  fin.run_id(o.net.session.run_id);
+  fin.sender(o.id);
+  fin.dim(static_cast<std::uint32_t>(local.d));
+  fin.rounds(result.rounds);
+  fin.pose_ids(local.owned);
+  for (const Pose& p : result.poses) append_pose(fin.pose_data(), p);
+  fin.bytes_sent(s.stats().bytes_sent + serialized_size(fin));
+  fin.epoch(s.epoch());
+  s.publish(fin);
+  // Until FINISHED, a rollback (another agent rejoined) means doing the rounds again.
+  const auto wait_start = std::chrono::steady_clock::now();
+  for (;;) {
+    const WaitStatus st = s.wait_finished(Seconds(0.2));
+    if (st == WaitStatus::kReady) break;
+    if (auto order = take_rollback(s)) throw *order;
+    if (auto a = take_reassignment(s)) throw RepartitionRequested(std::move(*a));
+    const double waited =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wait_start).count();
+    if (st == WaitStatus::kStopped || waited > o.net.timeout_s)
+      expect_ready(st, room, o.net.timeout_s, "the coordinator to confirm the merged result");
+  }
+  s.set_peer_loss_fatal(false);
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  char buf[256];
+  std::snprintf(buf, sizeof(buf),
+                "%s: done: %zu poses, %zu measurements, %u round(s), cost %.12g, %llu bytes "
+                "sent, %.2f s\n",
+                log.tag.c_str(), local.owned.size(), local.measurements.size(), result.rounds,
+                result.cost, static_cast<unsigned long long>(s.stats().bytes_sent), secs);
+  std::cerr << buf;
+}
+
+}  // namespace tessera::agent

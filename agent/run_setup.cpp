@@ -1,0 +1,134 @@
+#include "agent/run_setup.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "agent/dds_channel.hpp"
+#include "agent/handoff_exchange.hpp"
+#include "agent/initialization_stage.hpp"
+#include "agent/local_dump.hpp"
+#include "agent/robot_data.hpp"
+#include "transport/run_failure.hpp"
+#include "transport/run_identity.hpp"
+
+namespace tessera::agent {
+
+using namespace tessera::transport;
+
+namespace {
+
+wire::AgentAnnouncement announcement_of(const RobotShare& share, const AgentOptions& o) {
+  wire::AgentAnnouncement ann;
+  ann.run_id(o.net.session.run_id);
+  ann.agent_id(o.id);
+  ann.num_agents(o.robots);
+  ann.host(host_name());
+  ann.pid(static_cast<std::uint32_t>(getpid()));
+  ann.dim(static_cast<std::uint32_t>(share.d));
+  ann.num_poses(static_cast<std::uint32_t>(share.num_poses));
+  ann.pose_begin(share.begin);
+  ann.pose_end(share.end);
+  for (const Measurement& m : share.measurements) {
+    ann.edge_i().push_back(static_cast<std::uint32_t>(m.i));
+    ann.edge_j().push_back(static_cast<std::uint32_t>(m.j));
+  }
+  ann.edge_index(share.measurement_index);
+  return ann;
+}
+
+// The whole graph's endpoints from the assignment, checked: the agents build their block
+// layout from them, so a pose out of range must stop the run here.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_of(
+    const wire::PartitionAssignment& asg, std::size_t num_poses) {
+  if (asg.edge_i().size() != asg.edge_j().size())
+    throw RunFailure(kExitRunFailed, "the assignment's structure arrays differ in length");
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;
+  structure.reserve(asg.edge_i().size());
+  for (std::size_t e = 0; e < asg.edge_i().size(); ++e) {
+    if (asg.edge_i()[e] >= num_poses || asg.edge_j()[e] >= num_poses)
+      throw RunFailure(kExitRunFailed, "the assignment's structure names a pose out of range");
+    structure.emplace_back(asg.edge_i()[e], asg.edge_j()[e]);
+  }
+  return structure;
+}
+
+RunOptions run_options_of(const wire::PartitionAssignment& asg) {
+  RunOptions ro;
+  ro.algorithm = asg.algorithm();
+  ro.initialization = asg.initialization();
+  ro.rank = asg.rank();
+  ro.max_rounds = asg.max_rounds();
+  ro.grad_norm_tolerance = asg.grad_norm_tolerance();
+  ro.relative_cost_tolerance = asg.relative_cost_tolerance();
+  ro.seed = asg.seed();
+  ro.certify = asg.certify();
+  return ro;
+}
+
+}  // namespace
+
+RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log) {
+  Mailroom& room = s.mailroom();
+  RunSetup out;
+
+  // 1. Our share of the graph: robot I's part of the whole file, or the robot's own file.
+  RobotShare share = load_robot_share(o.graph, o.id, o.robots);
+  log("read " + o.graph + ": poses [" + std::to_string(share.begin) + ", " +
+      std::to_string(share.end) + ") of " + std::to_string(share.num_poses) + ", " +
+      std::to_string(share.measurements.size()) + " measurements");
+
+  // 2. Announce the structure (endpoints only).
+  s.publish(announcement_of(share, o));
+  log("announced");
+
+  // 3. The assignment.
+  wire::PartitionAssignment asg;
+  WaitStatus got = s.assignments().take(Seconds(o.net.timeout_s), &asg);
+  expect_ready(got, room, o.net.timeout_s, "the partition assignment from the coordinator",
+               s.peers_ever_seen() == 0
+                   ? "no process of run '" + o.net.session.run_id + "' seen on domain " +
+                         std::to_string(s.domain()) + " (is the coordinator running?)"
+                   : "");
+  check_assignment(share, asg, o.robots, o.graph);
+  out.rejoin_enabled = asg.rejoin_timeout_s() > 0;
+  out.replicas = asg.replicas();
+  out.replica_every = std::max<std::uint32_t>(1, asg.replica_every());
+  log("assignment received (" +
+      std::to_string(std::count(asg.owner().begin(), asg.owner().end(), o.id)) + " poses owned)");
+
+  // 4. Everyone's endpoints matched before any volatile agent-to-agent message.
+  std::string missing;
+  expect_ready(s.ready_barrier(Seconds(o.net.timeout_s), &missing), room, o.net.timeout_s,
+               "the other processes to be ready", missing);
+  log("all processes ready");
+
+  // 5. Initial poses of our share (agent/initialization_stage.hpp), before they move.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> structure =
+      structure_of(asg, share.num_poses);
+  DdsProtocolChannel channel(s);
+  {
+    InitializationResult init =
+        run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(), o.graph,
+                                 channel, o.round_timeout_s);
+    share.initial = std::move(init.poses);
+    log("initialisation '" + init.method + "' done in " +
+        std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
+  }
+
+  // 6. Hand-off, peer to peer: exactly one message to every other agent.
+  std::vector<ReceivedHandoff> received = exchange_handoffs(s, share, asg.owner(), o.id, o.robots,
+                                                            o.net.session.run_id, o.net.timeout_s);
+  out.local =
+      assemble_local(share, asg.owner(), o.id, o.robots, std::move(received), run_options_of(asg));
+  out.local.structure = std::move(structure);
+  log("hand-off complete: " + std::to_string(out.local.owned.size()) + " poses, " +
+      std::to_string(out.local.measurements.size()) + " measurements");
+  if (!o.dump_local.empty()) write_local_dump(out.local, o.dump_local);
+  return out;
+}
+
+}  // namespace tessera::agent

@@ -1,0 +1,90 @@
+#include "session_process.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "session_args.hpp"
+
+namespace tessera::cli {
+
+using namespace tessera::transport;
+
+std::string process_help(const std::string& usage) {
+  std::string help = usage;
+  const std::size_t at = help.find("%s");
+  if (at != std::string::npos) help.replace(at, 2, session_options_help(SessionArgsFor::kProcess));
+  return help;
+}
+
+bool asks_for_help(const std::vector<std::string>& argv) {
+  return std::any_of(argv.begin(), argv.end(),
+                     [](const std::string& a) { return a == "--help" || a == "-h"; });
+}
+
+void print_help(const std::string& help) {
+  std::fputs(help.c_str(), stdout);
+}
+
+void print_option_error(const std::string& program, const std::string& why) {
+  std::cerr << program << ": error: " << why << "\n";
+}
+
+namespace {
+
+// Prints the error and tells the other processes (ABORT), then lingers briefly so the ABORT
+// reaches them before this participant disappears. `own` false: the reason came from
+// another process and is relayed as is, so peers that never heard the original still learn
+// the cause instead of only seeing this process leave.
+int leave(Session& session, const ProcessRole& role, int code, const std::string& why, bool own) {
+  std::cerr << role.tag << ": error: " << why << "\n";
+  try {
+    session.send_control(wire::CONTROL_ABORT, own ? role.abort_prefix + why : why);
+    const Seconds linger(std::min(3.0, role.timeout_s));
+    session.linger_for_control(
+        linger, code == kExitBadInput && role.patient_on_bad_input ? linger : Seconds(1.0));
+  } catch (const std::exception&) {
+    // Leaving anyway: the others notice this participant disappear.
+  }
+  return code;
+}
+
+}  // namespace
+
+int run_session_process(const SessionOptions& options, const ProcessRole& role,
+                        SignalWatcher& signals, const std::function<void(Session&)>& body) {
+  std::unique_ptr<Session> session;
+  try {
+    session = std::make_unique<Session>(options);
+  } catch (const InputError& e) {
+    std::cerr << role.tag << ": error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << role.tag << ": error: " << e.what() << "\n";
+    return kExitRunFailed;
+  }
+  Session& s = *session;
+  signals.start([&s](int signo) {
+    s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted by " + signal_name(signo));
+  });
+  int code = kExitOk;
+  try {
+    body(s);
+  } catch (const RunFailure& f) {
+    code = leave(s, role, f.exit_code(), f.what(), f.tell_others());
+  } catch (const InputError& e) {
+    code = leave(s, role, kExitBadInput, e.what(), true);
+  } catch (const std::exception& e) {
+    // A stop may hide behind another error raised while stopping: prefer the cause.
+    if (auto stop = s.mailroom().stop_info())
+      code = leave(s, role, stop->exit_code, stop->reason, !stop->remote);
+    else
+      code = leave(s, role, kExitRunFailed, e.what(), true);
+  }
+  signals.stop();  // the callback refers to the session
+  s.close();
+  return code;
+}
+
+}  // namespace tessera::cli

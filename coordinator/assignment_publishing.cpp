@@ -1,0 +1,45 @@
+#include "coordinator/assignment_publishing.hpp"
+
+#include <string>
+
+#include "transport/run_failure.hpp"
+
+namespace tessera::coordinator {
+
+using namespace tessera::transport;
+
+wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
+                                          const RunStructure& structure,
+                                          const PartitionStepResult& part) {
+  wire::PartitionAssignment asg;
+  asg.run_id(options.net.session.run_id);
+  asg.num_agents(options.agents);
+  asg.num_poses(static_cast<std::uint32_t>(structure.num_poses));
+  asg.dim(static_cast<std::uint32_t>(structure.d));
+  asg.rank(options.rank);
+  asg.owner(part.owner);
+  asg.edge_i(structure.edge_i);
+  asg.edge_j(structure.edge_j);
+  asg.algorithm(options.algorithm);
+  asg.initialization(options.init);
+  asg.max_rounds(options.max_rounds);
+  asg.grad_norm_tolerance(options.grad_tol);
+  asg.relative_cost_tolerance(options.rel_cost_tol);
+  asg.seed(options.seed);
+  asg.partition_ms(part.ms);
+  asg.rejoin_timeout_s(options.rejoin_timeout_s);
+  asg.replicas(options.replicas);
+  asg.replica_every(options.replica_every);
+  return asg;
+}
+
+void publish_assignment(Session& session, wire::PartitionAssignment base, bool certify,
+                        double timeout_s) {
+  base.certify(certify);
+  session.publish(base);
+  std::string missing;
+  expect_ready(session.ready_barrier(Seconds(timeout_s), &missing), session.mailroom(), timeout_s,
+               "the agents to be ready", missing);
+}
+
+}  // namespace tessera::coordinator

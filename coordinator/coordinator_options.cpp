@@ -1,0 +1,122 @@
+#include "coordinator/coordinator_options.hpp"
+
+#include "arguments.hpp"
+#include "distributed/distributed_solver.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera::coordinator {
+
+// %s: the shared DDS session options (cli/session_args.hpp).
+const char* const kCoordinatorUsage = R"(usage: tessera-coordinator --agents N [options]
+
+The coordinator of a distributed Tessera run. Waits for N tessera-agent processes of the
+same run id, receives their graph structure (edge endpoints only), partitions it, publishes
+the assignment and the algorithm options, then gathers every agent's final poses and writes
+the merged result. It never receives measurement values.
+
+options:
+  --agents N           number of agents of the run (required)
+  --run-timeout S      bound on the wait for the final estimates, seconds (default 3600)
+  --partition PRESET   sequential, fast, eco, strong or highest (default eco)
+  --partition-seed K   seed of the partitioner (default 1)
+  --rank R             rank r of the relaxation sent to the agents (default 0 = core's, 5)
+  --algorithm NAME     solver name sent to the agents (default: core's default)
+  --init NAME          initialisation the agents run: chordal | distributed | file (the
+                       VERTEX poses) (default: the in-process engine's, chordal)
+  --max-rounds K       round limit sent to the agents (default 0 = core's default)
+  --grad-tol X         gradient-norm tolerance sent to the agents (default 0 = core's default)
+  --rel-cost-tol X     relative cost tolerance sent to the agents (default 0 = core's default)
+  --seed K             solver seed sent to the agents (default 1)
+  --certify            agents certify the optimum distributedly and climb the staircase
+                       after the solve (docs/distributed-certification.md; default off)
+  --output FILE        write the merged poses as g2o (VERTEX lines only)
+  --tum FILE           write the merged poses in the TUM format
+  --summary FILE       write a JSON summary of the run
+  --graph-name NAME    label of the graph in the summary (default "")
+  --progress           print round progress (sum of the agents' cost and gradient norm)
+  --rejoin-timeout S   when an agent process dies, wait up to S seconds for it to be
+                       restarted (same id, --checkpoint-dir) and rejoin; every agent then rolls
+                       back to a common checkpoint round. 0 = stop the run at once (default 0)
+  --replicas K         replicate every agent's measurements and lifted poses to K other
+                       agents; an agent lost for good (not back within --rejoin-timeout) then
+                       has its block re-partitioned among the survivors, and the run goes on
+                       with N-1 agents. 0 = off: the run stops (default 0)
+  --replica-every K    rounds between lifted-pose replicas (default 10)
+  --status-interval S  print a status line (agents alive, their rounds, lagging or lost
+                       agents) every S seconds and on changes; 0 = off (default 5)
+  --verbose            print each phase
+  --help               this text
+
+DDS session options (shared with tessera-agent and tessera launch):
+%s
+exit codes: 0 done, 1 the run failed (lost agent, abort, timeout), 2 bad options or input,
+128+signal when interrupted (SIGINT 130, SIGTERM 143).
+)";
+
+CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& argv) {
+  cli::Arguments args(
+      argv,
+      cli::with_session_options(
+          {"agents", "run-timeout", "partition", "partition-seed", "rank", "algorithm", "init",
+           "max-rounds", "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary",
+           "graph-name", "rejoin-timeout", "status-interval", "replicas", "replica-every"},
+          cli::SessionArgsFor::kProcess),
+      {"progress", "verbose", "help", "certify"});
+  if (!args.positional().empty())
+    throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
+  CoordinatorOptions a;
+  if (!args.has("agents")) throw InputError("option --agents is required (see --help)");
+  long agents = args.get_long("agents", 0);
+  if (agents < 1 || agents > 1000) throw InputError("option --agents: must be 1..1000");
+  a.agents = static_cast<std::uint32_t>(agents);
+  a.net = cli::parse_session_args(args, cli::SessionArgsFor::kProcess);
+  a.run_timeout_s = args.get_double("run-timeout", a.run_timeout_s);
+  if (!(a.run_timeout_s > 0)) throw InputError("option --run-timeout: must be positive");
+  a.partition = args.get_or("partition", a.partition);
+  auto nonneg = [&](const char* name, long fallback) {
+    long v = args.get_long(name, fallback);
+    if (v < 0) throw InputError(std::string("option --") + name + ": must not be negative");
+    return v;
+  };
+  a.partition_seed = static_cast<std::uint64_t>(nonneg("partition-seed", 1));
+  a.rank = static_cast<std::uint32_t>(nonneg("rank", 0));
+  a.algorithm = args.get_or("algorithm", "");
+  a.init = args.get_or("init", init_name(DistributedOptions{}.initialization));
+  parse_init(a.init);  // throws InputError naming the valid ones
+  a.max_rounds = static_cast<std::uint32_t>(nonneg("max-rounds", 0));
+  a.grad_tol = args.get_double("grad-tol", 0);
+  a.rel_cost_tol = args.get_double("rel-cost-tol", 0);
+  if (a.grad_tol < 0) throw InputError("option --grad-tol: must not be negative");
+  if (a.rel_cost_tol < 0) throw InputError("option --rel-cost-tol: must not be negative");
+  a.seed = static_cast<std::uint64_t>(nonneg("seed", 1));
+  a.output = args.get_or("output", "");
+  a.tum = args.get_or("tum", "");
+  a.summary = args.get_or("summary", "");
+  a.graph_name = args.get_or("graph-name", "");
+  a.progress = args.has("progress");
+  a.rejoin_timeout_s = args.get_double("rejoin-timeout", a.rejoin_timeout_s);
+  if (!(a.rejoin_timeout_s >= 0 && a.rejoin_timeout_s <= 86400))
+    throw InputError("option --rejoin-timeout: must be 0..86400 seconds");
+  a.status_interval_s = args.get_double("status-interval", a.status_interval_s);
+  if (!(a.status_interval_s >= 0 && a.status_interval_s <= 86400))
+    throw InputError("option --status-interval: must be 0..86400 seconds");
+  a.replicas = static_cast<std::uint32_t>(nonneg("replicas", 0));
+  if (a.replicas > 8) throw InputError("option --replicas: must be 0..8");
+  a.replica_every = static_cast<std::uint32_t>(nonneg("replica-every", 10));
+  if (a.replica_every < 1) throw InputError("option --replica-every: must be >= 1");
+  a.verbose = args.has("verbose");
+  a.certify = args.has("certify");
+  return a;
+}
+
+transport::SessionOptions coordinator_session_options(const CoordinatorOptions& options) {
+  transport::SessionOptions so = options.net.session;
+  so.coordinator = true;
+  so.num_agents = options.agents;
+  so.verbose = options.verbose;
+  // A run that survives killed agents talks UDP only (see transport/qos.hpp).
+  so.shared_memory = options.rejoin_timeout_s <= 0;
+  return so;
+}
+
+}  // namespace tessera::coordinator

@@ -1,0 +1,44 @@
+#pragma once
+// tessera-coordinator's command line: the options of one run (what the agents are told to
+// solve, where the merged result goes, how lost agents are handled) and their parser.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "session_args.hpp"
+#include "transport/session_options.hpp"
+
+namespace tessera::coordinator {
+
+/// Every field is an option of `tessera-coordinator --help` (defaults as documented there).
+struct CoordinatorOptions {
+  std::uint32_t agents = 0;     ///< --agents, 1..1000 (required).
+  cli::SessionArgs net;         ///< run id, domain, lease, peers, --timeout (cli/session_args.hpp)
+  double run_timeout_s = 3600;  ///< Bound on the wait for the final estimates, > 0 s.
+  std::string partition = "eco";
+  std::uint64_t partition_seed = 1;
+  std::uint32_t rank = 0;                 ///< 0 = core's default (5).
+  std::string algorithm, init;            ///< Empty algorithm = core's default (irbcd).
+  std::uint32_t max_rounds = 0;           ///< 0 = core's default.
+  double grad_tol = 0, rel_cost_tol = 0;  ///< 0 = core's defaults.
+  std::uint64_t seed = 1;
+  std::string output, tum, summary, graph_name;  ///< Empty: not written.
+  bool progress = false, verbose = false;
+  double rejoin_timeout_s = 0;       ///< 0..86400 s; 0 = a lost agent stops the run.
+  double status_interval_s = 5;      ///< 0..86400 s; 0 = no status lines.
+  std::uint32_t replicas = 0;        ///< 0..8; 0 = no re-partition after a permanent loss.
+  std::uint32_t replica_every = 10;  ///< Rounds between lifted-pose replicas, >= 1.
+  bool certify = false;
+};
+
+/// The --help text; its "%s" stands for the shared session options (cli::process_help).
+extern const char* const kCoordinatorUsage;
+
+/// Parses the arguments after the program name. Throws InputError naming the bad option.
+CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& argv);
+
+/// The DDS session the coordinator opens for these options.
+transport::SessionOptions coordinator_session_options(const CoordinatorOptions& options);
+
+}  // namespace tessera::coordinator

@@ -1,0 +1,90 @@
+#include "coordinator/coordinator_run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "coordinator/announcement_gathering.hpp"
+#include "coordinator/assignment_publishing.hpp"
+#include "coordinator/elapsed.hpp"
+#include "coordinator/final_merge.hpp"
+#include "coordinator/loss_handling.hpp"
+#include "coordinator/partition_step.hpp"
+#include "coordinator/result_gathering.hpp"
+#include "coordinator/round_reports.hpp"
+#include "coordinator/run_monitor.hpp"
+#include "coordinator/run_structure.hpp"
+#include "coordinator/run_summary.hpp"
+#include "json_writer.hpp"
+
+namespace tessera::coordinator {
+
+using namespace tessera::transport;
+
+void run_coordinator(const CoordinatorOptions& o, Session& s) {
+  const auto log = [&](const std::string& what) {
+    if (o.verbose) std::cerr << "tessera-coordinator: " << what << "\n";
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::uint32_t N = o.agents;
+
+  // 1. Every agent's announcement.
+  std::vector<wire::AgentAnnouncement> announcements =
+      await_announcements(s, N, o.net.session.run_id, o.net.timeout_s);
+  const double discovery_ms = ms_since(t0);
+  const RunStructure rs = merge_announcements(announcements, N, o.net.session.run_id);
+  announcements.clear();
+  log("all " + std::to_string(N) + " agents announced (" +
+      std::to_string(static_cast<long>(discovery_ms)) + " ms): " + std::to_string(rs.num_poses) +
+      " poses, " + std::to_string(rs.num_measurements) + " measurements");
+
+  // 2. Partition and publish the assignment.
+  const PartitionStepResult part = partition_for_agents(rs.graph, N, o.partition, o.partition_seed);
+  log("partition (" + o.partition + "): cut " + std::to_string(part.cut_edges) +
+      " measurements in " + std::to_string(part.ms) + " ms");
+  const wire::PartitionAssignment base = make_assignment(o, rs, part);
+  publish_assignment(s, base, o.certify, o.net.timeout_s);
+  log("all agents ready");
+
+  // 3. Final estimates (progress from round statuses meanwhile; lost agents go to the
+  // arbiter, which waits for them to rejoin).
+  const auto t_run = std::chrono::steady_clock::now();
+  std::optional<RunMonitor> monitor;
+  if (o.status_interval_s > 0)
+    monitor.emplace(N, MonitorOptions{o.status_interval_s, 2, 3.0}, std::cout, t_run);
+  RunMonitor* const shown = monitor ? &*monitor : nullptr;
+  LossHandling losses(o, s, rs.graph, base, shown, t_run);
+  RoundReports reports(o.progress, std::cout);
+  await_final_estimates(s, o, reports, losses, shown, t_run);
+  const double solve_ms = ms_since(t_run);
+
+  // 4. Merge and write.
+  const MergedEstimate merged = merge_final_estimates(
+      s.finals().take_all(), N, losses.record().epoch, losses.record().owner, rs);
+  write_merged_poses(rs, merged.poses, o.net.session.run_id, o.output, o.tum);
+  if (!o.summary.empty())
+    cli::write_output(o.summary,
+                      run_summary_json({o, rs, part, merged, reports.results(), losses.record(),
+                                        s.domain(), discovery_ms, solve_ms, ms_since(t0)}));
+
+  // 5. Tell the agents they may leave.
+  s.send_control(wire::CONTROL_FINISHED);
+  s.flush(Seconds(std::min(3.0, o.net.timeout_s)));
+  s.set_peer_loss_fatal(false);
+  std::uint64_t total_bytes = 0;
+  for (auto b : merged.bytes) total_bytes += b;
+  char buf[256];
+  std::snprintf(buf, sizeof(buf),
+                "tessera-coordinator: done: %u agents, %zu poses, %u round(s), discovery %.0f ms, "
+                "partition %.1f ms, %llu bytes sent by agents, %.2f s\n",
+                static_cast<std::uint32_t>(losses.record().expected.size()), rs.num_poses,
+                merged.rounds, discovery_ms, part.ms, static_cast<unsigned long long>(total_bytes),
+                ms_since(t0) / 1000.0);
+  std::cerr << buf;
+}
+
+}  // namespace tessera::coordinator

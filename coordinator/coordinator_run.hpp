@@ -1,0 +1,17 @@
+#pragma once
+// The steps of a distributed run on the coordinator's side, in order: gather the agents'
+// announcements, partition and publish the assignment, wait for the final estimates
+// (handling lost agents meanwhile), merge and write the result, tell the agents to leave.
+// Each step is its own file in coordinator/; this one only sequences them.
+
+#include "coordinator/coordinator_options.hpp"
+#include "transport/session.hpp"
+
+namespace tessera::coordinator {
+
+/// Runs the whole run on an open session. Throws RunFailure (or InputError for bad
+/// announcements) when the run fails; cli::run_session_process turns that into the ABORT
+/// and the exit code.
+void run_coordinator(const CoordinatorOptions& options, transport::Session& session);
+
+}  // namespace tessera::coordinator

@@ -1,0 +1,88 @@
+#include "coordinator/run_summary.hpp"
+
+#include <optional>
+#include <vector>
+
+#include "json_writer.hpp"
+
+namespace tessera::coordinator {
+
+std::string run_summary_json(const RunSummaryInputs& in) {
+  const CoordinatorOptions& o = in.options;
+  const ReportedResults& r = in.reports;
+  const LossRecord& L = in.losses;
+  std::uint64_t total_bytes = 0;
+  for (auto b : in.merged.bytes) total_bytes += b;
+  const auto final_value = [&](double v) {
+    return r.have_final_report ? std::optional<double>(v) : std::nullopt;
+  };
+  // Mean wall time of one round (status of round k to status of round k+1), or null.
+  const double rounds_ms = r.last_status_ms - r.first_status_ms;
+  cli::JsonObject j;
+  j.add("algorithm", o.algorithm.empty() ? "irbcd" : o.algorithm)
+      .add("init", o.init)
+      .add("graph", o.graph_name)
+      .add("poses", in.structure.num_poses)
+      .add("edges", in.structure.num_measurements)
+      .add("d", in.structure.d)
+      .add("rank", static_cast<long long>(o.rank ? o.rank : 5))
+      .add("iterations", static_cast<long long>(in.merged.rounds))
+      .add("grad_norm", final_value(r.final_grad_norm))
+      .add("cost", final_value(r.final_cost))
+      .add("certified",
+           r.certificate ? std::optional<bool>(r.certificate->certified) : std::nullopt)
+      .add("wall_s", in.total_ms / 1000.0)
+      .add("restarts", static_cast<long long>(r.final_restarts))
+      .add("bytes_exchanged", static_cast<long long>(total_bytes))
+      .add("rollbacks", static_cast<long long>(L.rollbacks))
+      .add("run_id", o.net.session.run_id)
+      .add("domain", static_cast<long long>(in.domain))
+      .add("agents", static_cast<long long>(o.agents))
+      .add("dim", in.structure.d)
+      .add("num_poses", in.structure.num_poses)
+      .add("num_measurements", in.structure.num_measurements)
+      .add("partition", o.partition)
+      .add("cut_edges", in.partition.cut_edges)
+      .add("rounds", static_cast<long long>(in.merged.rounds))
+      .add("discovery_ms", in.discovery_ms)
+      .add("partition_ms", in.partition.ms)
+      .add("solve_ms", in.solve_ms)
+      .add("rounds_ms", rounds_ms)
+      .add("ms_per_round", r.completed_statuses > 1
+                               ? std::optional<double>(rounds_ms / (r.completed_statuses - 1))
+                               : std::nullopt)
+      .add("total_ms", in.total_ms)
+      .add("bytes_sent", std::vector<std::size_t>(in.merged.bytes.begin(), in.merged.bytes.end()))
+      .add("hosts", in.structure.hosts);
+  if (L.epoch > 0) {  // the permanent-loss record (docs/fault-tolerance.md)
+    cli::JsonObject f;
+    std::vector<std::size_t> lost(L.lost.begin(), L.lost.end());
+    std::vector<std::size_t> survivors(L.expected.begin(), L.expected.end());
+    f.add("kind", "lost_for_good")
+        .add("lost_agents", lost)
+        .add("round", static_cast<long long>(L.last_round))
+        .add("survivors", survivors)
+        .add("moved_poses", L.moved_poses)
+        .add("cut_edges_after", L.cut_edges)
+        .add("repartition_at_s", L.at_ms / 1000.0)
+        .add("epoch", static_cast<long long>(L.epoch));
+    j.add("fault", f);
+  } else {
+    j.add_null("fault");
+  }
+  if (r.certificate) {
+    j.add("min_eigenvalue", r.certificate->min_eigenvalue)
+        .add("certificate_rounds", static_cast<long long>(r.certificate->rounds))
+        .add("final_rank", static_cast<long long>(r.certificate->final_rank));
+    if (r.certificate_bytes)
+      j.add("certificate_bytes", static_cast<long long>(r.certificate_bytes->certificate))
+          .add("escape_bytes", static_cast<long long>(r.certificate_bytes->escape))
+          .add("escape_rounds", static_cast<long long>(r.certificate_bytes->escape_rounds));
+  } else {
+    j.add_null("min_eigenvalue").add_null("certificate_rounds");
+    j.add("final_rank", static_cast<long long>(o.rank ? o.rank : 5));
+  }
+  return j.str();
+}
+
+}  // namespace tessera::coordinator
