@@ -35,56 +35,21 @@ double json_number(const std::string& json, const std::string& name) {
 TEST(DdsCertificate, StaircaseOverDdsGivesTheInProcessResult) {
   const std::string dir = temp_dir();
   const std::string graph = dir + "/city.g2o";
-  std::string out;
   // Large rotation noise and rank 2 = d: the first certificate fails, the staircase climbs.
-  ASSERT_EQ(run_command(bin("tessera") +
-                            " generate --kind city --poses 120 --robots 3 --rot-noise 0.5 "
-                            "--trans-noise 0.3 --seed 1 --out " +
-                            graph,
-                        &out),
-            0)
-      << out;
+  generate_graph(graph,
+                 "--kind city --poses 120 --robots 3 --rot-noise 0.5 --trans-noise 0.3 --seed 1");
+  ASSERT_FALSE(::testing::Test::HasFailure());
   const int agents = 3, domain = 171;
   const std::string run = "cert-" + std::to_string(getpid());
-  Process coord = start({bin("tessera-coordinator"),
-                         "--agents",
-                         std::to_string(agents),
-                         "--run-id",
-                         run,
-                         "--domain",
-                         std::to_string(domain),
-                         "--timeout",
-                         "20",
-                         "--run-timeout",
-                         "90",
-                         "--summary",
-                         dir + "/summary.json",
-                         "--partition",
-                         "eco",
-                         "--rank",
-                         "2",
-                         "--certify",
-                         "--init",
-                         "file"},  // the in-process reference starts from the file's poses too
-                        dir + "/coordinator.log");
-  std::vector<Process> procs;
-  for (int k = 0; k < agents; ++k)
-    procs.push_back(
-        start({bin("tessera-agent"), "--graph", graph, "--robots", std::to_string(agents), "--id",
-               std::to_string(k), "--run-id", run, "--domain", std::to_string(domain), "--timeout",
-               "20", "--dump-local", dir + "/local" + std::to_string(k) + ".txt"},
-              dir + "/agent" + std::to_string(k) + ".log"));
-  std::vector<Process*> all = {&coord};
-  for (auto& p : procs) all.push_back(&p);
-  ASSERT_TRUE(wait_all(all, 90)) << "a process hung";
-  for (Process* p : all) ASSERT_EQ(p->exit_code, 0) << p->output();
+  run_to_the_end(dir, graph, agents, run, domain,
+                 {"--timeout", "20", "--run-timeout", "90", "--summary", dir + "/summary.json",
+                  "--partition", "eco", "--rank", "2", "--certify", "--init",
+                  "file"},  // the in-process reference starts from the file's poses too
+                 90);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   const std::string summary = slurp(dir + "/summary.json");
 
-  std::map<int, int> owner;
-  for (int k = 0; k < agents; ++k)
-    for (int id : owned_of(dir + "/local" + std::to_string(k) + ".txt")) owner[id] = k;
-  std::vector<int> assignment;
-  for (auto& [id, k] : owner) assignment.push_back(k);
+  const std::vector<int> assignment = assignment_of(dir, agents);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(assignment.size(), g.num_poses);
   DistributedOptions opt;

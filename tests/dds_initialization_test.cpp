@@ -211,49 +211,14 @@ TEST(DdsInitializationStage, PhasesCannotCollideWithTheRoundLoops) {
 
 // ---------------------------------------------------------------- over DDS
 
-std::vector<int> assignment_of(const std::string& dir, int agents) {
-  std::map<int, int> owner;
-  for (int k = 0; k < agents; ++k) {
-    std::ifstream f(dir + "/local" + std::to_string(k) + ".txt");
-    for (std::string line; std::getline(f, line);)
-      if (line.rfind("OWNED ", 0) == 0) owner[std::stoi(line.substr(6))] = k;
-  }
-  std::vector<int> out;
-  for (auto& [id, k] : owner) out.push_back(k);
-  return out;
-}
-
 // Coordinator + agents (started in reverse id order) on `graph`; returns the summary JSON.
 std::string run_dds(const std::string& dir, const std::string& graph, int agents, int domain,
                     const std::vector<std::string>& solver_args) {
   const std::string run = "init-" + std::to_string(getpid()) + "-" + std::to_string(domain);
-  std::vector<std::string> cargs = {bin("tessera-coordinator"),
-                                    "--agents",
-                                    std::to_string(agents),
-                                    "--run-id",
-                                    run,
-                                    "--domain",
-                                    std::to_string(domain),
-                                    "--timeout",
-                                    "20",
-                                    "--run-timeout",
-                                    "60",
-                                    "--summary",
-                                    dir + "/summary.json"};
+  std::vector<std::string> cargs = {"--timeout", "20",        "--run-timeout",
+                                    "60",        "--summary", dir + "/summary.json"};
   cargs.insert(cargs.end(), solver_args.begin(), solver_args.end());
-  std::vector<Process> procs;
-  procs.reserve(static_cast<std::size_t>(agents) + 1);
-  for (int k = agents - 1; k >= 0; --k)
-    procs.push_back(
-        start({bin("tessera-agent"), "--graph", graph, "--robots", std::to_string(agents), "--id",
-               std::to_string(k), "--run-id", run, "--domain", std::to_string(domain), "--timeout",
-               "20", "--dump-local", dir + "/local" + std::to_string(k) + ".txt"},
-              dir + "/agent" + std::to_string(k) + ".log"));
-  procs.push_back(start(cargs, dir + "/coordinator.log"));
-  std::vector<Process*> all;
-  for (auto& p : procs) all.push_back(&p);
-  EXPECT_TRUE(wait_all(all, 90)) << "a process hung";
-  for (Process* p : all) EXPECT_EQ(p->exit_code, 0) << p->output();
+  run_to_the_end(dir, graph, agents, run, domain, cargs, 90, true);
   return slurp(dir + "/summary.json");
 }
 
@@ -261,13 +226,8 @@ std::string run_dds(const std::string& dir, const std::string& graph, int agents
 std::string graph_without_vertices(const std::string& dir, const std::string& kind, int poses,
                                    int robots) {
   const std::string full = dir + "/full.g2o", path = dir + "/edges_only.g2o";
-  std::string out;
-  EXPECT_EQ(run_command(bin("tessera") + " generate --kind " + kind + " --poses " +
-                            std::to_string(poses) + " --robots " + std::to_string(robots) +
-                            " --seed 9 --out " + full,
-                        &out),
-            0)
-      << out;
+  generate_graph(full, "--kind " + kind + " --poses " + std::to_string(poses) + " --robots " +
+                           std::to_string(robots) + " --seed 9");
   std::ifstream in(full);
   std::ofstream o(path);
   for (std::string line; std::getline(in, line);)

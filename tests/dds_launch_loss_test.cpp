@@ -22,15 +22,6 @@
 namespace tessera::test::dds {
 namespace {
 
-bool wait_for_output(const Process& p, const std::string& text, double timeout_s) {
-  const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
-  while (Clock::now() < until) {
-    if (p.output().find(text) != std::string::npos) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return false;
-}
-
 // One launch of its own run id on a 300-pose grid3d with 5 agents; its processes are found
 // (and, if an assertion fails, removed) by that run id.
 struct LaunchRun {
@@ -87,14 +78,7 @@ LaunchRun make_run(int domain, const std::string& name) {
   r.dir = temp_dir();
   r.domain = domain;
   r.run_id = name + "-" + std::to_string(getpid());
-  r.graph = r.dir + "/graph.g2o";
-  std::string out;
-  EXPECT_EQ(
-      run_command(bin("tessera") +
-                      " generate --kind grid3d --poses 300 --robots 5 --seed 3 --out " + r.graph,
-                  &out),
-      0)
-      << out;
+  r.graph = generate_graph(r.dir + "/graph.g2o", "--kind grid3d --poses 300 --robots 5 --seed 3");
   return r;
 }
 
@@ -112,12 +96,7 @@ TEST(DdsLaunchLoss, KilledAgentLeavesFourAgentsThatFinishAtTheOptimumWithEveryPo
 
   // Every pose is in the merged estimate (VERTEX lines only), at the centralized optimum.
   const PoseGraph g = read_g2o(r.graph);
-  std::set<long> ids;
-  {
-    std::ifstream f(r.dir + "/merged.g2o");
-    for (std::string line; std::getline(f, line);)
-      if (line.rfind("VERTEX", 0) == 0) ids.insert(std::stol(line.substr(line.find(' ') + 1)));
-  }
+  const std::set<long> ids = vertex_ids(r.dir + "/merged.g2o");
   EXPECT_EQ(ids.size(), g.num_poses);
   EXPECT_EQ(ids.empty() ? -1L : *ids.rbegin(), static_cast<long>(g.num_poses) - 1);
   const double fstar = solve_centralized(g).cost;

@@ -22,62 +22,32 @@
 namespace tessera::test::dds {
 namespace {
 
-bool wait_for_output(const Process& p, const std::string& text, double timeout_s) {
-  const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
-  while (Clock::now() < until) {
-    if (p.output().find(text) != std::string::npos) return true;
-    usleep(20000);
-  }
-  return false;
-}
-
 struct LossRun {
   std::string dir, graph, run;
   int agents = 5, domain = 0;
-  std::vector<std::string> agent(int k) const {
-    return {bin("tessera-agent"),
-            "--graph",
-            graph,
-            "--robots",
-            std::to_string(agents),
-            "--id",
-            std::to_string(k),
-            "--run-id",
-            run,
-            "--domain",
-            std::to_string(domain),
-            "--timeout",
-            "20"};
-  }
   Process coordinator(int replicas) const {
-    return start({bin("tessera-coordinator"),
-                  "--agents",
-                  std::to_string(agents),
-                  "--run-id",
-                  run,
-                  "--domain",
-                  std::to_string(domain),
-                  "--timeout",
-                  "20",
-                  "--run-timeout",
-                  "50",
-                  "--summary",
-                  dir + "/summary.json",
-                  "--output",
-                  dir + "/merged.g2o",
-                  "--progress",
-                  "--partition",
-                  "eco",
-                  "--grad-tol",
-                  "0.0005",
-                  "--replicas",
-                  std::to_string(replicas),
-                  "--replica-every",
-                  "5",
-                  "--rejoin-timeout",
-                  "1",
-                  "--status-interval",
-                  "1"},
+    return start(coordinator_args(agents, run, domain,
+                                  {"--timeout",
+                                   "20",
+                                   "--run-timeout",
+                                   "50",
+                                   "--summary",
+                                   dir + "/summary.json",
+                                   "--output",
+                                   dir + "/merged.g2o",
+                                   "--progress",
+                                   "--partition",
+                                   "eco",
+                                   "--grad-tol",
+                                   "0.0005",
+                                   "--replicas",
+                                   std::to_string(replicas),
+                                   "--replica-every",
+                                   "5",
+                                   "--rejoin-timeout",
+                                   "1",
+                                   "--status-interval",
+                                   "1"}),
                  dir + "/coordinator.log");
   }
 };
@@ -87,29 +57,19 @@ LossRun make_run(int domain, const std::string& name) {
   r.dir = temp_dir();
   r.domain = domain;
   r.run = name + "-" + std::to_string(getpid());
-  r.graph = r.dir + "/graph.g2o";
-  std::string out;
-  EXPECT_EQ(run_command(bin("tessera") +
-                            " generate --kind grid3d --poses 300 --robots 5 "
-                            "--seed 3 --out " +
-                            r.graph,
-                        &out),
-            0)
-      << out;
+  r.graph = generate_graph(r.dir + "/graph.g2o", "--kind grid3d --poses 300 --robots 5 --seed 3");
   return r;
 }
 
 TEST(DdsLoss, AgentKilledForGoodSurvivorsFinishAtTheOptimumWithEveryPose) {
   LossRun r = make_run(186, "loss");
   Process coord = r.coordinator(1);
-  std::vector<Process> agents;
-  for (int k = 0; k < r.agents; ++k)
-    agents.push_back(start(r.agent(k), r.dir + "/agent" + std::to_string(k) + ".log"));
+  std::vector<Process> agents =
+      start_agents(r.dir, r.graph, r.agents, r.run, r.domain, {"--timeout", "20"}, false);
   const bool started = wait_for_output(coord, "round 10:", 30);
   kill(agents[2].pid, SIGKILL);  // for good: never restarted
   ASSERT_TRUE(started) << coord.output();
-  std::vector<Process*> all = {&coord};
-  for (auto& a : agents) all.push_back(&a);
+  std::vector<Process*> all = all_of(coord, agents);
   EXPECT_TRUE(wait_all(all, 50)) << "a process hung";
   EXPECT_EQ(agents[2].exit_code, 128 + SIGKILL);
   EXPECT_EQ(coord.exit_code, 0) << coord.output();
@@ -121,12 +81,7 @@ TEST(DdsLoss, AgentKilledForGoodSurvivorsFinishAtTheOptimumWithEveryPose) {
 
   // Every pose is in the merged estimate, and its cost is the centralized optimum's.
   const PoseGraph g = read_g2o(r.graph);
-  std::set<long> ids;  // the merged output holds VERTEX lines only
-  {
-    std::ifstream f(r.dir + "/merged.g2o");
-    for (std::string line; std::getline(f, line);)
-      if (line.rfind("VERTEX", 0) == 0) ids.insert(std::stol(line.substr(line.find(' ') + 1)));
-  }
+  const std::set<long> ids = vertex_ids(r.dir + "/merged.g2o");
   EXPECT_EQ(ids.size(), g.num_poses);
   EXPECT_EQ(ids.empty() ? -1L : *ids.rbegin(), static_cast<long>(g.num_poses) - 1);
   const double fstar = solve_centralized(g).cost;
@@ -142,22 +97,15 @@ TEST(DdsLoss, AgentKilledForGoodSurvivorsFinishAtTheOptimumWithEveryPose) {
 TEST(DdsLoss, WithoutReplicasALostAgentStillStopsTheRun) {
   LossRun r = make_run(187, "noreplica");
   r.agents = 3;
-  std::string out;
-  ASSERT_EQ(run_command(bin("tessera") +
-                            " generate --kind grid3d --poses 300 --robots 3 "
-                            "--seed 3 --out " +
-                            r.graph,
-                        &out),
-            0);
+  generate_graph(r.graph, "--kind grid3d --poses 300 --robots 3 --seed 3");
+  ASSERT_FALSE(::testing::Test::HasFailure());
   Process coord = r.coordinator(0);
-  std::vector<Process> agents;
-  for (int k = 0; k < r.agents; ++k)
-    agents.push_back(start(r.agent(k), r.dir + "/agent" + std::to_string(k) + ".log"));
+  std::vector<Process> agents =
+      start_agents(r.dir, r.graph, r.agents, r.run, r.domain, {"--timeout", "20"}, false);
   const bool started = wait_for_output(coord, "round 3:", 30);
   kill(agents[1].pid, SIGKILL);
   ASSERT_TRUE(started) << coord.output();
-  std::vector<Process*> all = {&coord};
-  for (auto& a : agents) all.push_back(&a);
+  std::vector<Process*> all = all_of(coord, agents);
   EXPECT_TRUE(wait_all(all, 30)) << "a process hung";
   EXPECT_EQ(coord.exit_code, 1) << coord.output();
   // (On a loaded host another agent may be reported lost first; either way the run stops.)

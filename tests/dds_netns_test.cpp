@@ -68,33 +68,14 @@ std::vector<Process> run_across_hosts(const Hosts& hosts, const std::string& dir
                                       double timeout_s, const std::vector<std::string>& extra,
                                       const std::string& env = "") {
   std::vector<Process> procs;
-  std::vector<std::string> c = {bin("tessera-coordinator"),
-                                "--agents",
-                                "3",
-                                "--run-id",
-                                run,
-                                "--domain",
-                                std::to_string(domain),
-                                "--timeout",
-                                std::to_string(timeout_s),
-                                "--output",
-                                dir + "/" + run + ".g2o"};
+  std::vector<std::string> c = coordinator_args(
+      3, run, domain,
+      {"--timeout", std::to_string(timeout_s), "--output", dir + "/" + run + ".g2o"});
   c.insert(c.end(), extra.begin(), extra.end());
   procs.push_back(start(hosts.in(0, c, env), dir + "/" + run + "_coordinator.log"));
   for (int k = 0; k < 3; ++k) {
-    std::vector<std::string> a = {bin("tessera-agent"),
-                                  "--graph",
-                                  graph,
-                                  "--robots",
-                                  "3",
-                                  "--id",
-                                  std::to_string(k),
-                                  "--run-id",
-                                  run,
-                                  "--domain",
-                                  std::to_string(domain),
-                                  "--timeout",
-                                  std::to_string(timeout_s)};
+    std::vector<std::string> a =
+        agent_args(graph, 3, k, run, domain, {"--timeout", std::to_string(timeout_s)});
     a.insert(a.end(), extra.begin(), extra.end());
     procs.push_back(
         start(hosts.in(k + 1, a, env), dir + "/" + run + "_agent" + std::to_string(k) + ".log"));

@@ -1,11 +1,13 @@
 #pragma once
 // Helpers for the DDS runtime tests (header-only; not a *_test.cpp so it is no test of its
-// own): start tessera-agent / tessera-coordinator processes in the background, wait for
-// them with a deadline (a test never hangs: stragglers are SIGKILLed), write the small
-// graphs the tests use, and find shared-memory files nobody uses any more.
+// own): the command lines of tessera-agent / tessera-coordinator, start them in the
+// background, wait for them or for a line of their output with a deadline (a test never
+// hangs: stragglers are SIGKILLed), write the small graphs the tests use, read what the
+// agents dumped, and find shared-memory files nobody uses any more.
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -18,6 +20,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <random>
 #include <regex>
 #include <set>
@@ -103,6 +106,91 @@ inline bool wait_all(std::vector<Process*> procs, double timeout_s) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
+}
+
+/// tessera-agent for robot `id` of `robots` on `graph`, run `run` on `domain`, then `extra`.
+inline std::vector<std::string> agent_args(const std::string& graph, int robots, int id,
+                                           const std::string& run, int domain,
+                                           const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> a = {
+      bin("tessera-agent"), "--graph",  graph, "--robots", std::to_string(robots), "--id",
+      std::to_string(id),   "--run-id", run,   "--domain", std::to_string(domain)};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
+/// tessera-coordinator for `agents` agents, run `run` on `domain`, then `extra`.
+inline std::vector<std::string> coordinator_args(int agents, const std::string& run, int domain,
+                                                 const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> a = {
+      bin("tessera-coordinator"), "--agents", std::to_string(agents), "--run-id", run, "--domain",
+      std::to_string(domain)};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
+/// Starts agents 0..agents-1 (`reverse`: highest id first), each with `extra` and
+/// `--dump-local DIR/local<k>.txt` when `dump_local`, logging to DIR/agent<k>.log.
+inline std::vector<Process> start_agents(const std::string& dir, const std::string& graph,
+                                         int agents, const std::string& run, int domain,
+                                         const std::vector<std::string>& extra, bool dump_local,
+                                         bool reverse = false) {
+  std::vector<Process> procs;
+  procs.reserve(static_cast<std::size_t>(agents) + 1);  // room for a coordinator after them
+  for (int i = 0; i < agents; ++i) {
+    const int k = reverse ? agents - 1 - i : i;
+    std::vector<std::string> a = agent_args(graph, agents, k, run, domain, extra);
+    if (dump_local)
+      a.insert(a.end(), {"--dump-local", dir + "/local" + std::to_string(k) + ".txt"});
+    procs.push_back(start(a, dir + "/agent" + std::to_string(k) + ".log"));
+  }
+  return procs;
+}
+
+/// Pointers to `first` and every process of `rest` (for wait_all).
+inline std::vector<Process*> all_of(Process& first, std::vector<Process>& rest) {
+  std::vector<Process*> all = {&first};
+  for (auto& p : rest) all.push_back(&p);
+  return all;
+}
+
+/// One run on `domain` in `dir`: a coordinator with `coordinator_extra` and `agents` agents on
+/// `graph` (--timeout 20, --dump-local DIR/local<k>.txt). `agents_first`: the agents start
+/// first, highest id first (the coordinator then finds announcements already published).
+/// Every process must end within `wait_s` with exit code 0 (test failures otherwise).
+inline void run_to_the_end(const std::string& dir, const std::string& graph, int agents,
+                           const std::string& run, int domain,
+                           const std::vector<std::string>& coordinator_extra, double wait_s,
+                           bool agents_first = false) {
+  const auto coordinator = [&] {
+    return start(coordinator_args(agents, run, domain, coordinator_extra),
+                 dir + "/coordinator.log");
+  };
+  Process coord;
+  if (!agents_first) coord = coordinator();
+  std::vector<Process> procs =
+      start_agents(dir, graph, agents, run, domain, {"--timeout", "20"}, true, agents_first);
+  if (agents_first) coord = coordinator();
+  std::vector<Process*> all = all_of(coord, procs);
+  EXPECT_TRUE(wait_all(all, wait_s)) << "a process hung";
+  for (Process* p : all) EXPECT_EQ(p->exit_code, 0) << p->output();
+}
+
+/// Waits until `text` appears in `p`'s output (polling every 20 ms); false after `timeout_s`.
+inline bool wait_for_output(const Process& p, const std::string& text, double timeout_s) {
+  const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
+  while (Clock::now() < until) {
+    if (p.output().find(text) != std::string::npos) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+/// `tessera generate <args> --out <path>`; a failure is a test failure (with the output).
+inline std::string generate_graph(const std::string& path, const std::string& args) {
+  std::string out;
+  EXPECT_EQ(run_command(bin("tessera") + " generate " + args + " --out " + path, &out), 0) << out;
+  return path;
 }
 
 /// An 2D graph of `side` x `side` poses on a grid, joined by grid-neighbour odometry-like
@@ -256,6 +344,26 @@ inline std::vector<int> owned_of(const std::string& path) {
   std::vector<int> out;
   while (std::getline(f, line))
     if (line.rfind("OWNED ", 0) == 0) out.push_back(std::stoi(line.substr(6)));
+  return out;
+}
+
+/// Pose ids of the VERTEX lines of a g2o file (a merged estimate holds VERTEX lines only).
+inline std::set<long> vertex_ids(const std::string& path) {
+  std::set<long> ids;
+  std::ifstream f(path);
+  for (std::string line; std::getline(f, line);)
+    if (line.rfind("VERTEX", 0) == 0) ids.insert(std::stol(line.substr(line.find(' ') + 1)));
+  return ids;
+}
+
+/// The partition the coordinator chose: the agent of every pose (by id, ascending), read from
+/// the agents' --dump-local files DIR/local<k>.txt.
+inline std::vector<int> assignment_of(const std::string& dir, int agents) {
+  std::map<int, int> owner;
+  for (int k = 0; k < agents; ++k)
+    for (int id : owned_of(dir + "/local" + std::to_string(k) + ".txt")) owner[id] = k;
+  std::vector<int> out;
+  for (auto& [id, k] : owner) out.push_back(k);
   return out;
 }
 

@@ -24,99 +24,61 @@ namespace tessera::test::dds {
 namespace {
 
 std::string generate(const std::string& dir, int poses, int robots) {
-  const std::string path = dir + "/graph.g2o";
-  std::string out;
-  EXPECT_EQ(
-      run_command(bin("tessera") + " generate --kind grid3d --poses " + std::to_string(poses) +
-                      " --robots " + std::to_string(robots) + " --seed 3 --out " + path,
-                  &out),
-      0)
-      << out;
-  return path;
-}
-
-// Waits until `p`'s log contains `text` (bounded); true when it does.
-bool wait_for_output(const Process& p, const std::string& text, double timeout_s) {
-  const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
-  while (Clock::now() < until) {
-    if (p.output().find(text) != std::string::npos) return true;
-    usleep(20000);
-  }
-  return false;
+  return generate_graph(dir + "/graph.g2o", "--kind grid3d --poses " + std::to_string(poses) +
+                                                " --robots " + std::to_string(robots) +
+                                                " --seed 3");
 }
 
 struct Fixture {
-  std::string dir, graph, run;
+  std::string dir, graph, run, ckpt;
   int agents, domain;
-  std::vector<std::string> agent_args(int k, const std::string& ckpt) const {
-    return {bin("tessera-agent"),
-            "--graph",
-            graph,
-            "--robots",
-            std::to_string(agents),
-            "--id",
-            std::to_string(k),
-            "--run-id",
-            run,
-            "--domain",
-            std::to_string(domain),
-            "--timeout",
-            "20",
-            "--checkpoint-dir",
-            ckpt,
-            "--dump-local",
-            dir + "/local" + std::to_string(k) + ".txt"};
+  std::vector<std::string> agent_extra() const {
+    return {"--timeout", "20", "--checkpoint-dir", ckpt};
+  }
+  std::vector<std::string> agent_args(int k) const {
+    std::vector<std::string> a = dds::agent_args(graph, agents, k, run, domain, agent_extra());
+    a.insert(a.end(), {"--dump-local", dir + "/local" + std::to_string(k) + ".txt"});
+    return a;
   }
   Process coordinator(double rejoin_timeout) const {
-    return start({bin("tessera-coordinator"),
-                  "--agents",
-                  std::to_string(agents),
-                  "--run-id",
-                  run,
-                  "--domain",
-                  std::to_string(domain),
-                  "--timeout",
-                  "20",
-                  "--run-timeout",
-                  "50",
-                  "--summary",
-                  dir + "/summary.json",
-                  "--progress",
-                  "--partition",
-                  "eco",
-                  "--init",  // compared with the file's poses in process
-                  "file",
-                  "--grad-tol",
-                  "0.002",
-                  "--rejoin-timeout",
-                  std::to_string(rejoin_timeout),
-                  "--status-interval",
-                  "1"},
+    return start(coordinator_args(agents, run, domain,
+                                  {"--timeout", "20", "--run-timeout", "50", "--summary",
+                                   dir + "/summary.json", "--progress", "--partition", "eco",
+                                   "--init",  // compared with the file's poses in process
+                                   "file", "--grad-tol", "0.002", "--rejoin-timeout",
+                                   std::to_string(rejoin_timeout), "--status-interval", "1"}),
                  dir + "/coordinator.log");
   }
 };
 
-TEST(DdsRejoin, KilledAgentRestartedWithSameIdFinishesAtTheUndisturbedCost) {
+// Agents with checkpoints in DIR/ckpt, on a generated 300-pose graph.
+Fixture make_fixture(int agents, int domain, const std::string& name) {
   Fixture f;
   f.dir = temp_dir();
-  f.agents = 5;
-  f.domain = 181;
-  f.run = "rejoin-" + std::to_string(getpid());
+  f.agents = agents;
+  f.domain = domain;
+  f.run = name + "-" + std::to_string(getpid());
   f.graph = generate(f.dir, 300, f.agents);
-  const std::string ckpt = f.dir + "/ckpt";
-  ASSERT_EQ(mkdir(ckpt.c_str(), 0755), 0);
+  f.ckpt = f.dir + "/ckpt";
+  EXPECT_EQ(mkdir(f.ckpt.c_str(), 0755), 0);
+  return f;
+}
+
+TEST(DdsRejoin, KilledAgentRestartedWithSameIdFinishesAtTheUndisturbedCost) {
+  const Fixture f = make_fixture(5, 181, "rejoin");
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const std::string& ckpt = f.ckpt;
 
   Process coord = f.coordinator(20);
-  std::vector<Process> agents;
-  for (int k = 0; k < f.agents; ++k)
-    agents.push_back(start(f.agent_args(k, ckpt), f.dir + "/agent" + std::to_string(k) + ".log"));
+  std::vector<Process> agents =
+      start_agents(f.dir, f.graph, f.agents, f.run, f.domain, f.agent_extra(), true);
   // Kill agent 2 in the middle of the rounds.
   const bool started = wait_for_output(coord, "round 4:", 30);
   kill(agents[2].pid, SIGKILL);
   ASSERT_TRUE(started) << coord.output();
   ASSERT_TRUE(wait_all({&agents[2]}, 5));
   EXPECT_EQ(agents[2].exit_code, 128 + SIGKILL);
-  Process again = start(f.agent_args(2, ckpt), f.dir + "/agent2-restarted.log");
+  Process again = start(f.agent_args(2), f.dir + "/agent2-restarted.log");
 
   std::vector<Process*> all = {&coord, &again};
   for (int k = 0; k < f.agents; ++k)
@@ -133,12 +95,8 @@ TEST(DdsRejoin, KilledAgentRestartedWithSameIdFinishesAtTheUndisturbedCost) {
   const std::string summary = slurp(f.dir + "/summary.json");
   EXPECT_EQ(json_field(summary, "rollbacks"), 1) << summary;
   const PoseGraph g = read_g2o(f.graph);
-  std::map<int, int> owner;
-  for (int k = 0; k < f.agents; ++k)
-    for (int id : owned_of(f.dir + "/local" + std::to_string(k) + ".txt")) owner[id] = k;
-  ASSERT_EQ(owner.size(), g.num_poses);
-  std::vector<int> assignment;
-  for (auto& [id, k] : owner) assignment.push_back(k);
+  const std::vector<int> assignment = assignment_of(f.dir, f.agents);
+  ASSERT_EQ(assignment.size(), g.num_poses);
   DistributedOptions opt;
   opt.grad_norm_tol = 0.002;
   const DistributedResult ref = solve_distributed(g, assignment, opt, g.initial);
@@ -149,18 +107,11 @@ TEST(DdsRejoin, KilledAgentRestartedWithSameIdFinishesAtTheUndisturbedCost) {
 }
 
 TEST(DdsRejoin, AgentThatDoesNotComeBackStopsTheRunAfterTheRejoinTimeout) {
-  Fixture f;
-  f.dir = temp_dir();
-  f.agents = 3;
-  f.domain = 182;
-  f.run = "norejoin-" + std::to_string(getpid());
-  f.graph = generate(f.dir, 300, f.agents);
-  const std::string ckpt = f.dir + "/ckpt";
-  ASSERT_EQ(mkdir(ckpt.c_str(), 0755), 0);
+  const Fixture f = make_fixture(3, 182, "norejoin");
+  ASSERT_FALSE(::testing::Test::HasFailure());
   Process coord = f.coordinator(2);
-  std::vector<Process> agents;
-  for (int k = 0; k < f.agents; ++k)
-    agents.push_back(start(f.agent_args(k, ckpt), f.dir + "/agent" + std::to_string(k) + ".log"));
+  std::vector<Process> agents =
+      start_agents(f.dir, f.graph, f.agents, f.run, f.domain, f.agent_extra(), true);
   const bool started = wait_for_output(coord, "round 2:", 30);
   kill(agents[1].pid, SIGKILL);
   ASSERT_TRUE(started) << coord.output();
@@ -184,8 +135,7 @@ TEST(DdsRejoin, DamagedCheckpointIsRefusedNamingTheFile) {
   const std::string ckpt = dir + "/agent-0.ckpt";
   std::ofstream(ckpt) << "TSRCKPT\0 this is not a checkpoint";
   Process p =
-      start({bin("tessera-agent"), "--graph", graph, "--robots", "2", "--id", "0", "--run-id",
-             "damaged", "--domain", "183", "--timeout", "5", "--checkpoint-dir", dir},
+      start(agent_args(graph, 2, 0, "damaged", 183, {"--timeout", "5", "--checkpoint-dir", dir}),
             dir + "/agent.log");
   ASSERT_TRUE(wait_all({&p}, 20));
   EXPECT_EQ(p.exit_code, 2) << p.output();

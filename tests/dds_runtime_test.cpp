@@ -27,25 +27,6 @@ std::string unique_run(const std::string& stem) {
   return stem + "-" + std::to_string(getpid());
 }
 
-std::vector<std::string> agent_args(const std::string& graph, int robots, int id,
-                                    const std::string& run, int domain,
-                                    std::vector<std::string> extra = {}) {
-  std::vector<std::string> a = {
-      agent_bin(),        "--graph",  graph, "--robots", std::to_string(robots), "--id",
-      std::to_string(id), "--run-id", run,   "--domain", std::to_string(domain)};
-  a.insert(a.end(), extra.begin(), extra.end());
-  return a;
-}
-
-std::vector<std::string> coordinator_args(int agents, const std::string& run, int domain,
-                                          std::vector<std::string> extra = {}) {
-  std::vector<std::string> a = {
-      coordinator_bin(),     "--agents", std::to_string(agents), "--run-id", run, "--domain",
-      std::to_string(domain)};
-  a.insert(a.end(), extra.begin(), extra.end());
-  return a;
-}
-
 // Parsed agent dump (--dump-local).
 struct Dump {
   long structure = -1;

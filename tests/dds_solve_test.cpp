@@ -21,14 +21,9 @@ namespace tessera::test::dds {
 namespace {
 
 std::string generate(const std::string& dir, int poses, int robots, int seed) {
-  const std::string path = dir + "/graph.g2o";
-  std::string out;
-  const int rc = run_command(bin("tessera") + " generate --kind grid3d --poses " +
-                                 std::to_string(poses) + " --robots " + std::to_string(robots) +
-                                 " --seed " + std::to_string(seed) + " --out " + path,
-                             &out);
-  EXPECT_EQ(rc, 0) << out;
-  return path;
+  return generate_graph(dir + "/graph.g2o", "--kind grid3d --poses " + std::to_string(poses) +
+                                                " --robots " + std::to_string(robots) + " --seed " +
+                                                std::to_string(seed));
 }
 
 struct DdsRun {
@@ -39,41 +34,14 @@ struct DdsRun {
 DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int domain,
                const std::vector<std::string>& solver_args) {
   const std::string run = "solve-" + std::to_string(getpid()) + "-" + std::to_string(domain);
-  std::vector<std::string> cargs = {bin("tessera-coordinator"),
-                                    "--agents",
-                                    std::to_string(agents),
-                                    "--run-id",
-                                    run,
-                                    "--domain",
-                                    std::to_string(domain),
-                                    "--timeout",
-                                    "20",
-                                    "--run-timeout",
-                                    "60",
-                                    "--summary",
-                                    dir + "/summary.json",
-                                    "--output",
-                                    dir + "/merged.g2o",
-                                    "--progress"};
+  std::vector<std::string> cargs = {
+      "--timeout",           "20",       "--run-timeout",     "60",        "--summary",
+      dir + "/summary.json", "--output", dir + "/merged.g2o", "--progress"};
   cargs.insert(cargs.end(), solver_args.begin(), solver_args.end());
-  Process coord = start(cargs, dir + "/coordinator.log");
-  std::vector<Process> procs;
-  for (int k = 0; k < agents; ++k)
-    procs.push_back(
-        start({bin("tessera-agent"), "--graph", graph, "--robots", std::to_string(agents), "--id",
-               std::to_string(k), "--run-id", run, "--domain", std::to_string(domain), "--timeout",
-               "20", "--dump-local", dir + "/local" + std::to_string(k) + ".txt"},
-              dir + "/agent" + std::to_string(k) + ".log"));
-  std::vector<Process*> all = {&coord};
-  for (auto& p : procs) all.push_back(&p);
-  EXPECT_TRUE(wait_all(all, 60)) << "a process hung";
-  for (Process* p : all) EXPECT_EQ(p->exit_code, 0) << p->output();
+  run_to_the_end(dir, graph, agents, run, domain, cargs, 60);
   DdsRun r;
   r.summary = slurp(dir + "/summary.json");
-  std::map<int, int> owner;
-  for (int k = 0; k < agents; ++k)
-    for (int id : owned_of(dir + "/local" + std::to_string(k) + ".txt")) owner[id] = k;
-  for (auto& [id, k] : owner) r.assignment.push_back(k);
+  r.assignment = assignment_of(dir, agents);
   return r;
 }
 
