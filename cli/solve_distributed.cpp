@@ -21,7 +21,8 @@ const char* const kDistributedValued[] = {
     "select",        "rel-tol",          "tr-steps",       "restart-c", "sigma",
     "unselected",    "irbcd-n",          "tcg-iters",      "robots",    "certify-grad-tol",
     "certify-iters", "certify-residual", "certify-precon", nullptr};
-const char* const kDistributedSwitches[] = {"parallel", "reference", "certify", nullptr};
+const char* const kDistributedSwitches[] = {"parallel", "sequential", "reference", "certify",
+                                            nullptr};
 
 const char* kDistributedHelp =
     "\n"
@@ -37,7 +38,9 @@ const char* kDistributedHelp =
     "  --max-rounds K            round cap (default 10000)\n"
     "  --rel-tol T               stop when a round decreases f by < T f (default 0: off)\n"
     "  --select greedy|greedy_newton|uniform|round_robin   block selection (default greedy)\n"
-    "  --parallel                update a whole colour class of blocks per round\n"
+    "  --parallel                update a whole colour class of blocks (an independent set)\n"
+    "                            per round (the default)\n"
+    "  --sequential              one block per round (RBCD's and the baseline's rounds)\n"
     "  --seed S                  shared seed (uniform selection, partitioner)\n"
     "  --rank R                  relaxation rank (default 5)\n"
     "  --tr-steps K              trust-region steps per block update (default 1)\n"
@@ -91,7 +94,10 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   opt.max_rounds = static_cast<int>(a.get_long("max-rounds", opt.max_rounds));
   opt.rel_cost_decrease_tol = a.get_double("rel-tol", opt.rel_cost_decrease_tol);
   opt.selection = parse_selection(a.get_or("select", selection_name(opt.selection)));
-  opt.parallel = a.has("parallel");
+  if (a.has("parallel") && a.has("sequential"))
+    throw InputError("options --parallel and --sequential exclude each other");
+  if (a.has("parallel")) opt.parallel = true;
+  if (a.has("sequential")) opt.parallel = false;
   opt.robots = static_cast<int>(a.get_long("robots", 0));
   const long seed = a.get_long("seed", 1);
   if (seed < 0) throw InputError("option --seed: must be >= 0");

@@ -55,6 +55,52 @@ TEST(DistributedCli, JsonAndTrace) {
   }
 }
 
+// Parallel rounds (a colour class per round) are the default; --sequential restores one block
+// per round; the two switches exclude each other.
+TEST(DistributedCli, ParallelByDefaultSequentialOnRequest) {
+  const std::string dir = test::temp_dir();
+  // A chain: 4 sequential blocks form a path 0-1-2-3. Started from the ground truth (the file's
+  // poses), not the chordal solution, which is exact on a tree.
+  test::RandomGraphSpec spec;
+  spec.d = 2;
+  spec.poses = 60;
+  spec.loop_closures = 0;
+  const std::string g = dir + "/chain.g2o";
+  write_g2o(test::random_pose_graph(spec), g);
+  auto run = [&](const std::string& flags, std::string* out) {
+    return test::run_command(
+        test::bin("tessera") + " solve " + g +
+            " --algorithm irbcd --agents 4 --partition sequential --init file --json " + dir +
+            "/p.json --trace " + dir + "/p.csv " + flags,
+        out);
+  };
+  // Selected blocks per round, from the trace's `selected` column ("0;2" = two blocks).
+  auto most_selected = [&] {
+    std::istringstream t(read_all(dir + "/p.csv"));
+    std::string line;
+    std::getline(t, line);
+    std::size_t most = 0;
+    while (std::getline(t, line)) {
+      std::vector<std::string> cols;
+      std::stringstream ls(line);
+      for (std::string c; std::getline(ls, c, ',');) cols.push_back(c);
+      if (cols.size() < 4 || cols[3].empty()) continue;
+      most = std::max<std::size_t>(
+          most, 1 + static_cast<std::size_t>(std::count(cols[3].begin(), cols[3].end(), ';')));
+    }
+    return most;
+  };
+  std::string out;
+  ASSERT_EQ(run("", &out), 0) << out;
+  EXPECT_NE(read_all(dir + "/p.json").find("\"parallel\": true"), std::string::npos);
+  EXPECT_EQ(most_selected(), 2u);  // a chain of 4 blocks: classes {0,2} and {1,3}
+  ASSERT_EQ(run("--sequential", &out), 0) << out;
+  EXPECT_NE(read_all(dir + "/p.json").find("\"parallel\": false"), std::string::npos);
+  EXPECT_EQ(most_selected(), 1u);
+  EXPECT_EQ(run("--parallel --sequential", &out), 2);
+  EXPECT_NE(out.find("--sequential"), std::string::npos) << out;
+}
+
 TEST(DistributedCli, RejectsBadOptions) {
   const std::string dir = test::temp_dir();
   const std::string g = graph_file(dir);
