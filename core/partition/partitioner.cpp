@@ -108,7 +108,7 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         const double per_op = size * std::pow(std::max(1.0, k / 5.0), 0.8);
         const bool strong = preset == PartitionPreset::kStrong;
         const int ops = static_cast<int>(
-            std::clamp((strong ? 8.0e5 : 2.0e6) / per_op, 12.0, strong ? 200.0 : 800.0));
+            std::clamp((strong ? 1.6e6 : 2.8e6) / per_op, 12.0, strong ? 400.0 : 800.0));
         plan.evolution.population = strong ? 4 : 8;
         plan.evolution.mutation_rate = strong ? 0.3 : 0.5;
         plan.evolution.vcycles = 1;
