@@ -118,7 +118,8 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
     ++steps;
     ++stalled;
     Individual child;
-    if (params.cross_share > 0.0 && rng.uniform() < params.cross_share) {
+    if (params.cross_share > 0.0 && stalled > params.cross_after_stall &&
+        rng.uniform() < params.cross_share) {
       child = cross_combine(g, k, ub, pop[tournament(pop, rng, -1)], varied(params, rng), rng);
     } else if (rng.uniform() < params.mutation_rate) {
       // Mutation: combine an individual with a fresh multilevel partition.

@@ -26,7 +26,9 @@ struct EvolutionParams {
   int matching_flow_levels = 1;
   /// Share of steps that cross-combine a tournament winner with a fresh partition into another
   /// number of blocks (KaFFPaE's cross combine) instead of a combine or mutation.
-  double cross_share = 0.0;  ///< flow_levels of the operations that coarsen by matching.
+  double cross_share = 0.0;
+  /// Cross combines only start once this many steps in a row found no new best cut.
+  int cross_after_stall = 0;  ///< flow_levels of the operations that coarsen by matching.
   CycleParams cycle;
 };
 

@@ -105,7 +105,8 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // time: one operation costs roughly proportional to n + edges.
         const double size = static_cast<double>(g.n) + static_cast<double>(g.adj.size()) / 2.0;
         // More blocks make every operation dearer (more block pairs for the flows).
-        const double per_op = size * std::pow(std::max(1.0, k / 5.0), 0.8);
+        // (Exponent 1: with 0.8, highest on grid3D took 4.8 s CPU at N = 16.)
+        const double per_op = size * std::max(1.0, k / 5.0);
         const bool strong = preset == PartitionPreset::kStrong;
         const int ops = static_cast<int>(
             std::clamp((strong ? 1.6e6 : 2.8e6) / per_op, 12.0, strong ? 400.0 : 800.0));
@@ -119,9 +120,12 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // propagation (flows then only on the input graph, see EvolutionParams).
         plan.evolution.matching_share = strong ? 0.0 : 0.5;
         plan.evolution.matching_flow_levels = 0;
-        // highest: 30 % of its steps cross-combine with a cheap partition into another number
-        // of blocks (KaFFPaE); measured on 4 seeds it helps most on the 2D trajectory graphs.
+        // highest: once 8 steps in a row found no new best, 30 % of its steps cross-combine
+        // with a cheap partition into another number of blocks (KaFFPaE). From the start it
+        // helped rim/grid3D but cost parking-garage its 28 (32) and intel 1; as a diversification
+        // after a stall it keeps both (docs/partitioning.md).
         plan.evolution.cross_share = strong ? 0.0 : 0.3;
+        plan.evolution.cross_after_stall = 8;
       }
       break;
     default:
@@ -152,6 +156,7 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_MUT")) plan.evolution.mutation_rate = std::atof(env("T_MUT"));
   if (env("T_MATCH")) plan.evolution.matching_share = std::atof(env("T_MATCH"));
   if (env("T_STALL")) plan.evolution.stall_limit = std::atoi(env("T_STALL"));
+  if (env("T_XSTALL")) plan.evolution.cross_after_stall = std::atoi(env("T_XSTALL"));
   if (env("T_CROSS")) plan.evolution.cross_share = std::atof(env("T_CROSS"));
   if (env("T_MFLEV")) plan.evolution.matching_flow_levels = std::atoi(env("T_MFLEV"));
   if (env("T_OPS"))
