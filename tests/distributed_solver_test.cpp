@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/QR>
 #include <cmath>
 
 #include "distributed/agent_state.hpp"
@@ -114,6 +115,56 @@ TEST(DistributedSolver, StatusAfterUpdateMatchesFreshGradient) {
   const double moved = agent.status().grad_norm_sq;
   EXPECT_NEAR(moved, fresh_gsq(), 1e-12 * moved);
   EXPECT_GT(std::abs(moved - reused), 1e-6 * reused);
+}
+
+// The agents compute on the rows that are not identically zero (a lifted [I_d; 0] R start has
+// r - d zero rows). The update must be the full-rank update: the same result as the block update
+// on all r rows, zero rows exactly zero, and, for a lifting without zero rows (rotated in R^r),
+// the rotated result.
+TEST(DistributedSolver, ActiveRowUpdateEqualsTheFullRankUpdate) {
+  const PoseGraph g = small_graph(3, 40, 17);
+  std::vector<int> a(g.num_poses);
+  for (std::size_t i = 0; i < g.num_poses; ++i) a[i] = i < g.num_poses / 2 ? 0 : 1;
+  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
+  const int r = 5;
+  const Eigen::MatrixXd X = lift_poses(g.initial, r);
+  auto gather = [&](const Eigen::MatrixXd& from, const std::vector<std::size_t>& which) {
+    Eigen::MatrixXd out(r, 4 * static_cast<Eigen::Index>(which.size()));
+    for (std::size_t s = 0; s < which.size(); ++s)
+      out.middleCols(4 * static_cast<Eigen::Index>(s), 4) =
+          from.middleCols(4 * static_cast<Eigen::Index>(which[s]), 4);
+    return out;
+  };
+  const auto& ids = layout.poses[0];
+  BlockProblem full(3, ids, g.measurements);
+  BlockPreconditioner precon(full);
+  const LiftedManifold M = full.manifold(r);
+  // Start away from the optimum of the block so that the update moves.
+  std::srand(4);
+  const Eigen::MatrixXd Y0 = gather(X, ids);
+  const Eigen::MatrixXd tangent = M.tangent_project(Y0, Eigen::MatrixXd::Random(r, Y0.cols()));
+  Eigen::MatrixXd start = M.retract(Y0, 0.2 * tangent);
+  start.bottomRows(r - 3).setZero();  // keep the zero rows of the lifting
+  start = M.project(start);
+  const Eigen::MatrixXd Yn = gather(X, full.neighbors());
+
+  AgentState agent(0, 3, layout, g.measurements, start);
+  const Eigen::MatrixXd got = agent.update(start, Yn, BlockUpdateOptions{});
+  full.set_neighbor_poses(Yn);
+  const Eigen::MatrixXd want = block_update(full, start, BlockUpdateOptions{}, nullptr);
+  const Eigen::MatrixXd want_pre = block_update(full, start, BlockUpdateOptions{}, &precon);
+  EXPECT_GT((got - start).norm(), 1e-6);  // it moved
+  EXPECT_EQ(got.bottomRows(r - 3).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LT((got - want_pre).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_GT((want - want_pre).norm(),
+            0.0);  // (the preconditioner matters: the check is not vacuous)
+
+  // A random rotation of R^r: no zero rows left, every row active; the result rotates along.
+  const Eigen::MatrixXd R =
+      Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(r, r)).householderQ();
+  AgentState rotated(0, 3, layout, g.measurements, R * start);
+  const Eigen::MatrixXd got_rot = rotated.update(R * start, R * Yn, BlockUpdateOptions{});
+  EXPECT_LT((got_rot - R * got).cwiseAbs().maxCoeff(), 1e-8);
 }
 
 // greedy_newton scores each block by its preconditioned gradient norm sqrt(<(2Q_BB)^-1 g, g>)
