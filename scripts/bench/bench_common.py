@@ -31,6 +31,14 @@ def add_common_args(ap):
     ap.add_argument("--quick", action="store_true", help="small graphs, fewer rounds (CI smoke test)")
 
 
+def experiment_main(doc, run):
+    """main() of an exp_*.py experiment with only the common options: run(Ctx)."""
+    import argparse
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_common_args(ap)
+    run(Ctx(ap.parse_args()))
+
+
 class Ctx:
     """What every experiment needs: binary, folders, quick flag, a scratch dir and a command log."""
 
@@ -228,7 +236,8 @@ def print_table(title, headers, rows):
     return "\n".join(md)
 
 
-def write_csv(path, rows):
+def write_csv(path, rows, announce=True):
+    """Writes dict rows (columns: every key, in first-seen order); `announce` prints the path."""
     if not rows:
         return
     keys = []
@@ -240,7 +249,8 @@ def write_csv(path, rows):
         w = csv.DictWriter(f, fieldnames=keys)
         w.writeheader()
         w.writerows(rows)
-    print(f"wrote {os.path.relpath(path, ROOT)}")
+    if announce:
+        print(f"wrote {os.path.relpath(path, ROOT)}")
 
 
 def pyplot():
@@ -296,3 +306,24 @@ class Result:
             parts.append("CSV: " + ", ".join(f"[{os.path.basename(c)}]({os.path.relpath(c, out_dir)})"
                                               for c in self.csvs) + "\n")
         return "\n".join(parts)
+
+
+# ---- fault benchmarks (faults.py, faults_loss.py): processes of one run and the fault table row
+
+def wait_for_output(read, text, deadline, alive):
+    """Polls read() (every 5 ms) until it contains `text`; False at `deadline` (time.time()) or
+    when alive() turns false (the process that writes it ended)."""
+    while text not in read():
+        if time.time() > deadline or not alive():
+            return False
+        time.sleep(0.005)
+    return True
+
+
+def fault_row(fault, trials):
+    """The fault table's contract row from the trials (dicts with finished, rel_cost_error,
+    extra_s): worst cost error and mean extra time over the finished trials."""
+    finished = [x for x in trials if x["finished"]]
+    return dict(fault=fault, trials=len(trials), finished=len(finished),
+                cost_error="%.1e" % max([x["rel_cost_error"] for x in finished], default=float("nan")),
+                extra_time_s="%.2f" % (sum(x["extra_s"] for x in finished) / max(1, len(finished))))

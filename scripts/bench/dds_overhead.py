@@ -28,6 +28,8 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 SHARED = os.path.abspath(os.path.join(ROOT, "..", "shared"))
+sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
 
 
 def paper_graphs():
@@ -130,11 +132,8 @@ def main():
             wi, wd, row["ratio"], med, row["bytes_per_round"]), flush=True)
     if rows:
         print("median ratio %.2f over %d graphs" % (statistics.median(r["ratio"] for r in rows), len(rows)))
-    if a.out and rows:
-        with open(a.out, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-            w.writeheader()
-            w.writerows(rows)
+    if a.out:
+        bc.write_csv(a.out, rows, announce=False)
 
 
 if __name__ == "__main__":

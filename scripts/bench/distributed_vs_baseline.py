@@ -32,6 +32,8 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 SHARED = os.path.abspath(os.path.join(ROOT, "..", "shared"))
+sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
 
 
 def optima():
@@ -132,10 +134,7 @@ def main():
                 fmt(row["baseline_rounds_to_0.2"]), fmt(row["baseline_ms_per_round"]),
                 fmt(row["cpu_over_baseline"], "{:.3f}")), flush=True)
     if a.out:
-        with open(a.out, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-            w.writeheader()
-            w.writerows(rows)
+        bc.write_csv(a.out, rows, announce=False)
 
 
 if __name__ == "__main__":

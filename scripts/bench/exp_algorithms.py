@@ -7,7 +7,6 @@ solver's wall time (the trace's elapsed_s), one figure.
 
   scripts/bench/exp_algorithms.py [--quick] [--bin B] [--shared S] [--out-dir D]
 """
-import argparse
 import csv
 import os
 import sys
@@ -108,10 +107,7 @@ def plot(ctx, graphs, traces, rows):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    bc.add_common_args(ap)
-    ctx = bc.Ctx(ap.parse_args())
-    run(ctx)
+    bc.experiment_main(__doc__, run)
 
 
 if __name__ == "__main__":

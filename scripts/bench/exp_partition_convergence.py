@@ -7,7 +7,6 @@ preset: grad norm and f - f* against rounds, one row of plots per graph, one fig
 
   scripts/bench/exp_partition_convergence.py [--quick] [--bin B] [--shared S] [--out-dir D]
 """
-import argparse
 import os
 import sys
 
@@ -78,10 +77,7 @@ def plot(ctx, graphs, presets, traces, rows):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    bc.add_common_args(ap)
-    ctx = bc.Ctx(ap.parse_args())
-    run(ctx)
+    bc.experiment_main(__doc__, run)
 
 
 if __name__ == "__main__":

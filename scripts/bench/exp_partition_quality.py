@@ -8,7 +8,6 @@ cuts (../shared/datasets/PAPER_PARTITIONS.md; labelled "paper"). Full mode also 
 
   scripts/bench/exp_partition_quality.py [--quick] [--bin B] [--shared S] [--out-dir D]
 """
-import argparse
 import os
 import sys
 
@@ -128,10 +127,7 @@ def plot(ctx, rows, krows):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    bc.add_common_args(ap)
-    ctx = bc.Ctx(ap.parse_args())
-    run(ctx)
+    bc.experiment_main(__doc__, run)
 
 
 if __name__ == "__main__":

@@ -7,7 +7,6 @@ convergence (grad norm against rounds) in one figure.
 
   scripts/bench/exp_robots.py [--quick] [--bin B] [--shared S] [--out-dir D]
 """
-import argparse
 import os
 import sys
 
@@ -94,9 +93,7 @@ def plot(ctx, label, traces, rows, fstar):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    bc.add_common_args(ap)
-    run(bc.Ctx(ap.parse_args()))
+    bc.experiment_main(__doc__, run)
 
 
 if __name__ == "__main__":

@@ -39,6 +39,8 @@ print = functools.partial(print, flush=True)  # progress shows up in logs as it 
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
 OUT_DIR = os.path.join(ROOT, "docs", "benchmarks")
 COLUMNS = ["fault", "trials", "finished", "cost_error", "extra_time_s"]
 
@@ -90,12 +92,9 @@ class Run:
             return f.read()
 
     def kill_and_restart(self, agent, at_round, delay):
-        deadline = time.time() + self.args.limit
-        pattern = "round %d:" % at_round
-        while pattern not in self.coordinator_output():
-            if time.time() > deadline or self.coord.poll() is not None:
-                return False
-            time.sleep(0.005)
+        if not bc.wait_for_output(self.coordinator_output, "round %d:" % at_round,
+                                  time.time() + self.args.limit, lambda: self.coord.poll() is None):
+            return False
         victim = self.agents[agent]
         os.kill(victim.pid, signal.SIGKILL)
         victim.wait()
@@ -232,17 +231,11 @@ def main():
         if not ok:
             print("  logs kept in %s" % r.dir)
     finished = [x for x in trials if x["finished"]]
-    row = dict(fault="agent SIGKILLed at a random round, restarted with the same id (N=%d, %d-pose grid3d)"
-               % (args.agents, args.poses),
-               trials=len(trials), finished=len(finished),
-               cost_error="%.1e" % max([x["rel_cost_error"] for x in finished], default=float("nan")),
-               extra_time_s="%.2f" % (sum(x["extra_s"] for x in finished) / max(1, len(finished))))
+    row = bc.fault_row("agent SIGKILLed at a random round, restarted with the same id (N=%d, %d-pose grid3d)"
+                       % (args.agents, args.poses), trials)
     os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
     write_contract_csv(os.path.join(args.out_dir, "faults_restart.csv"), [row])
-    with open(os.path.join(args.out_dir, "faults", "restart_trials.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(trials[0].keys()))
-        w.writeheader()
-        w.writerows(trials)
+    bc.write_csv(os.path.join(args.out_dir, "faults", "restart_trials.csv"), trials, announce=False)
     with open(os.path.join(args.out_dir, "faults", "checkpoint_cost.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", "wall_s", "rounds", "checkpoint_writes", "checkpoint_ms_total", "checkpoint_bytes"])

@@ -28,6 +28,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
 from faults import COLUMNS, OUT_DIR, ROOT, assemble, write_contract_csv  # noqa: E402
 
 
@@ -65,12 +66,9 @@ class LossRun:
             return f.read()
 
     def kill_at(self, agent, at_round):
-        deadline = time.time() + self.args.limit
-        pattern = "round %d:" % at_round
-        while pattern not in self.coordinator_output():
-            if time.time() > deadline or self.coord.poll() is not None:
-                return False
-            time.sleep(0.005)
+        if not bc.wait_for_output(self.coordinator_output, "round %d:" % at_round,
+                                  time.time() + self.args.limit, lambda: self.coord.poll() is None):
+            return False
         os.kill(self.agents[agent].pid, signal.SIGKILL)
         return True
 
@@ -169,17 +167,12 @@ def main():
         if not ok:
             print("  logs kept in %s" % r.dir)
     finished = [x for x in trials if x["finished"]]
-    row = dict(fault="agent SIGKILLed for good at a random round, block re-partitioned to the survivors "
-                     "(N=%d, %d-pose grid3d, --replicas 1; cost error vs f*)" % (args.agents, args.poses),
-               trials=len(trials), finished=len(finished),
-               cost_error="%.1e" % max([x["rel_cost_error"] for x in finished], default=float("nan")),
-               extra_time_s="%.2f" % (sum(x["extra_s"] for x in finished) / max(1, len(finished))))
+    row = bc.fault_row("agent SIGKILLed for good at a random round, block re-partitioned to the survivors "
+                       "(N=%d, %d-pose grid3d, --replicas 1; cost error vs f*)" % (args.agents, args.poses),
+                       trials)
     os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
     write_contract_csv(os.path.join(args.out_dir, "faults_loss.csv"), [row])
-    with open(os.path.join(args.out_dir, "faults", "loss_trials.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(trials[0].keys()))
-        w.writeheader()
-        w.writerows(trials)
+    bc.write_csv(os.path.join(args.out_dir, "faults", "loss_trials.csv"), trials, announce=False)
     with open(os.path.join(args.out_dir, "faults", "loss_replication_cost.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", "replicas", "wall_s", "rounds", "bytes_exchanged", "cost"])
