@@ -20,6 +20,7 @@ contract of scripts/bench/faults.py) and docs/benchmarks/faults/lossy_link_trial
 Needs root (namespaces). usage:
   scripts/bench/lossy_link.py [--bin build/bin] [--poses 1000] [--agents 3] [--trials 3]
                               [--loss 10] [--limit 120] [--domain 199] [--out-dir docs/benchmarks]
+                              [--prefix tlb] [--subnet 10.77.39]
 """
 import argparse
 import csv
@@ -99,6 +100,7 @@ def run(bindir, graph, agents, domain, run_id, network, limit, work):
 
 
 def main():
+    global PREFIX, SUBNET  # --prefix / --subnet; dropped_frames() reads them
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
     ap.add_argument("--poses", type=int, default=1000)
@@ -108,7 +110,10 @@ def main():
     ap.add_argument("--limit", type=float, default=120, help="seconds before a run is stopped")
     ap.add_argument("--domain", type=int, default=199)
     ap.add_argument("--out-dir", default=os.path.join(ROOT, "docs", "benchmarks"))
+    ap.add_argument("--prefix", default=PREFIX, help="namespace name prefix (unique per user)")
+    ap.add_argument("--subnet", default=SUBNET, help="10.77.X of the namespaces (unique per user)")
     args = ap.parse_args()
+    PREFIX, SUBNET = args.prefix, args.subnet
     if os.geteuid() != 0 or subprocess.run([NETNS, "check"]).returncode != 0:
         print("lossy_link.py: network namespaces cannot be created here (need root); nothing measured")
         return 1

@@ -1,0 +1,218 @@
+#!/usr/bin/env python3
+"""Permanent loss under `tessera launch --on-agent-loss continue` (issue 8, item 2 via launch).
+
+The same experiment as faults_loss.py, but through the user-facing command: one
+`tessera launch GRAPH --agents 5 --on-agent-loss continue` per trial, a random agent
+SIGKILLed (for good) when launch prints a random round, and launch alone decides what
+happens (it passes --replicas/--replica-every/--rejoin-timeout to the coordinator and
+--udp-only to the agents). A trial counts as finished when launch exits 0, the merged
+estimate (--out) holds every pose and the summary's fault record names the killed agent;
+its cost error is against f* (centralized solver). Extra time is against an undisturbed
+launch with the same options (replicas on).
+
+Writes docs/benchmarks/faults_launch_loss.csv (column contract of scripts/bench/faults.py),
+per-trial rows in docs/benchmarks/faults/launch_loss_trials.csv, and re-assembles faults.md.
+CPU time = user + sys of launch and every process it started (they are all waited for).
+
+usage: scripts/bench/faults_launch_loss.py [--bin-dir build/bin] [--out-dir docs/benchmarks]
+           [--trials 10] [--agents 5] [--poses 500] [--domain 223] [--seed 1] [--limit 300]
+"""
+import argparse
+import csv
+import json
+import os
+import random
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from faults import COLUMNS, OUT_DIR, ROOT, assemble, write_contract_csv  # noqa: E402
+
+
+class LaunchRun:
+    """One `tessera launch` with its own run id and folder."""
+
+    def __init__(self, args, work, name):
+        self.args, self.name = args, name
+        self.dir = os.path.join(work, name)
+        os.makedirs(self.dir, exist_ok=True)
+        self.run_id = "launchloss-%d-%s" % (os.getpid(), name)
+        self.summary = os.path.join(self.dir, "summary.json")
+        self.merged = os.path.join(self.dir, "merged.g2o")
+        self.log_path = os.path.join(self.dir, "launch.log")
+
+    def start(self):
+        a = self.args
+        cmd = [os.path.join(a.bin_dir, "tessera"), "launch", a.graph_path, "--agents", str(a.agents),
+               "--run-id", self.run_id, "--domain", str(a.domain), "--partition", "eco",
+               "--grad-tol", str(a.grad_tol), "--on-agent-loss", "continue",
+               "--rejoin-timeout", str(a.rejoin_timeout), "--replica-every", str(a.replica_every),
+               "--out", self.merged, "--json", self.summary, "--timeout", str(a.limit),
+               "--status-interval", "2"]
+        self.cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        self.t0 = time.time()
+        self.log = open(self.log_path, "w")
+        self.proc = subprocess.Popen(cmd, stdout=self.log, stderr=subprocess.STDOUT, start_new_session=True)
+
+    def output(self):
+        with open(self.log_path) as f:
+            return f.read()
+
+    def agent_pid(self, agent):
+        # launch starts each agent with "--id K --run-id RUN ..." (its own run id: only ours match).
+        out = subprocess.run(["pgrep", "-f", "tessera-agent .*--id %d --run-id %s " % (agent, self.run_id)],
+                             stdout=subprocess.PIPE, text=True).stdout.split()
+        return int(out[0]) if out else None
+
+    def kill_at(self, agent, at_round):
+        deadline = time.time() + self.args.limit
+        pattern = "round %d:" % at_round
+        while pattern not in self.output():
+            if time.time() > deadline or self.proc.poll() is not None:
+                return False
+            time.sleep(0.005)
+        pid = self.agent_pid(agent)
+        if pid is None:
+            return False
+        os.kill(pid, signal.SIGKILL)
+        return True
+
+    def wait(self):
+        try:
+            code = self.proc.wait(timeout=self.args.limit + 30)
+        except subprocess.TimeoutExpired:
+            os.killpg(self.proc.pid, signal.SIGKILL)  # launch's own group; its children have theirs
+            subprocess.run(["pkill", "-9", "-f", "tessera-.*--run-id %s " % self.run_id])
+            code = -9
+            self.proc.wait()
+        wall = time.time() - self.t0
+        self.log.close()
+        cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = (cpu1.ru_utime - self.cpu0.ru_utime) + (cpu1.ru_stime - self.cpu0.ru_stime)
+        summary = None
+        if code == 0 and os.path.exists(self.summary):
+            with open(self.summary) as f:
+                summary = json.load(f)
+        return code, wall, cpu, summary
+
+    def merged_poses(self):
+        ids = set()
+        if os.path.exists(self.merged):
+            with open(self.merged) as f:
+                for line in f:
+                    if line.startswith("VERTEX"):
+                        ids.add(int(line.split()[1]))
+        return ids
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--out-dir", default=OUT_DIR)
+    ap.add_argument("--trials", type=int, default=10)
+    ap.add_argument("--agents", type=int, default=5)
+    ap.add_argument("--poses", type=int, default=500)
+    ap.add_argument("--grad-tol", type=float, default=0.0005)
+    ap.add_argument("--replica-every", type=int, default=5)
+    ap.add_argument("--rejoin-timeout", type=float, default=1.0)
+    ap.add_argument("--domain", type=int, default=223)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--limit", type=float, default=300, help="time limit of one run, seconds")
+    args = ap.parse_args()
+    rng = random.Random(args.seed)
+    work = tempfile.mkdtemp(prefix="tessera_faults_launch_loss_")
+    args.graph_path = os.path.join(work, "graph.g2o")
+    tessera = os.path.join(args.bin_dir, "tessera")
+    subprocess.run([tessera, "generate", "--kind", "grid3d", "--poses", str(args.poses), "--robots",
+                    str(args.agents), "--seed", "3", "--out", args.graph_path], check=True,
+                   stdout=subprocess.DEVNULL)
+    cjson = os.path.join(work, "centralized.json")
+    subprocess.run([tessera, "solve", args.graph_path, "--algorithm", "centralized", "--json", cjson],
+                   check=True, stdout=subprocess.DEVNULL)
+    with open(cjson) as f:
+        fstar = json.load(f)["cost"]
+    print("f* = %.12g (centralized)" % fstar, flush=True)
+
+    ref = LaunchRun(args, work, "undisturbed")
+    ref.start()
+    code, ref_wall, ref_cpu, ref_summary = ref.wait()
+    if code != 0 or ref_summary is None:
+        print("undisturbed launch failed (exit %d); log in %s" % (code, ref.log_path))
+        return 1
+    rounds = int(ref_summary["rounds"])
+    print("undisturbed launch: %d rounds, cost %.12g (error %.1e vs f*), wall %.2f s, cpu %.2f s" %
+          (rounds, ref_summary["cost"], abs(ref_summary["cost"] - fstar) / fstar, ref_wall, ref_cpu),
+          flush=True)
+
+    trials = []
+    for t in range(args.trials):
+        agent = rng.randrange(args.agents)
+        at = rng.randrange(2, max(3, rounds - 5))
+        r = LaunchRun(args, work, "trial%d" % t)
+        r.start()
+        killed = r.kill_at(agent, at)
+        code, wall, cpu, summary = r.wait()
+        poses = len(r.merged_poses())
+        fault = (summary or {}).get("fault") or {}
+        ok = code == 0 and killed and poses == args.poses and fault.get("lost_agents") == [agent]
+        err = abs(summary["cost"] - fstar) / fstar if ok else float("nan")
+        trials.append(dict(trial=t, agent=agent, kill_round=at, finished=int(ok), launch_exit=code,
+                           survivors=len(fault.get("survivors", [])), poses_in_estimate=poses,
+                           moved_poses=fault.get("moved_poses", ""),
+                           repartition_at_s=fault.get("repartition_at_s", ""),
+                           cost=summary["cost"] if summary else "", rel_cost_error=err,
+                           wall_s=round(wall, 3), cpu_s=round(cpu, 3), extra_s=round(wall - ref_wall, 3)))
+        print("trial %d: kill agent %d at round %d -> %s, %d poses, cost error %.2e vs f*, wall %.2f s "
+              "(+%.2f), cpu %.2f s" % (t, agent, at, "launch exit 0 with %d agents" % len(fault.get("survivors", []))
+                                       if ok else "FAILED (exit %d, killed %s)" % (code, killed), poses, err,
+                                       wall, wall - ref_wall, cpu), flush=True)
+        if not ok:
+            print("  log kept in %s" % r.log_path, flush=True)
+    finished = [x for x in trials if x["finished"]]
+    row = dict(fault="agent SIGKILLed for good under `tessera launch --on-agent-loss continue` "
+                     "(N=%d, %d-pose grid3d; cost error vs f*)" % (args.agents, args.poses),
+               trials=len(trials), finished=len(finished),
+               cost_error="%.1e" % max([x["rel_cost_error"] for x in finished], default=float("nan")),
+               extra_time_s="%.2f" % (sum(x["extra_s"] for x in finished) / max(1, len(finished))))
+    os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
+    write_contract_csv(os.path.join(args.out_dir, "faults_launch_loss.csv"), [row])
+    with open(os.path.join(args.out_dir, "faults", "launch_loss_trials.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(trials[0].keys()))
+        w.writeheader()
+        w.writerows(trials)
+    notes = ["## Agent lost for good under `tessera launch` (`faults_launch_loss.csv`)", "",
+             "Command: `scripts/bench/faults_launch_loss.py %s`" % " ".join(sys.argv[1:]), "",
+             "`tessera launch GRAPH --agents %d --partition eco --grad-tol %g --on-agent-loss continue "
+             "--rejoin-timeout %g --replica-every %d` on a %d-pose generated grid3d (seed 3); each trial "
+             "SIGKILLs a random agent when launch prints a random round and never restarts it. "
+             "f* = %.12g (centralized). Undisturbed launch with the same options: %d rounds, cost error "
+             "%.1e, wall %.2f s, CPU %.2f s (all processes)." %
+             (args.agents, args.grad_tol, args.rejoin_timeout, args.replica_every, args.poses, fstar, rounds,
+              abs(ref_summary["cost"] - fstar) / fstar, ref_wall, ref_cpu), "",
+             "| trial | agent | kill round | finished | survivors | poses | moved | rel. cost error vs f* "
+             "| wall s | CPU s | extra s |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for x in trials:
+        notes.append("| %d | %d | %d | %s | %s | %d | %s | %.1e | %.2f | %.2f | %+.2f |" %
+                     (x["trial"], x["agent"], x["kill_round"], "yes" if x["finished"] else "NO (exit %d)" %
+                      x["launch_exit"], x["survivors"], x["poses_in_estimate"], x["moved_poses"],
+                      x["rel_cost_error"], x["wall_s"], x["cpu_s"], x["extra_s"]))
+    with open(os.path.join(args.out_dir, "faults", "launch_loss.md"), "w") as f:
+        f.write("\n".join(notes) + "\n")
+    print("\n" + " | ".join(COLUMNS))
+    print(" | ".join(str(row[c]) for c in COLUMNS))
+    assemble(args.out_dir)
+    if len(finished) == len(trials):
+        shutil.rmtree(work, ignore_errors=True)
+    else:
+        print("work dir kept: " + work)
+    return 0 if len(finished) == len(trials) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""Secured run (issue 8, item 4) for the fault table: `tessera launch --security DIR` against
+the same launch without security, with an unauthenticated outsider watching the secured run.
+
+Per trial, on one generated grid3d (fresh run ids, one domain):
+  unsecured   tessera launch GRAPH --agents N --partition eco --no-certify
+  secured     the same with --security DIR (scripts/security/make_identities.sh DIR N), while
+              tessera-dds-snoop (no identity) subscribes to every Tessera topic of that run
+A secured trial counts as finished when launch exits 0 with the unsecured run's rounds; its
+cost error is against that trial's unsecured run; extra time is the secured wall time minus
+the unsecured one (handshakes, encryption). The outsider's sample count must be 0 (and the same
+outsider must read > 0 samples of the unsecured run: the control that it works).
+
+Writes docs/benchmarks/faults_secured.csv (column contract of scripts/bench/faults.py),
+docs/benchmarks/faults/secured.md (per-trial table) and re-assembles faults.md.
+CPU time = user + sys of launch and every process it started.
+
+usage: scripts/bench/faults_secured.py [--bin-dir build/bin] [--out-dir docs/benchmarks]
+           [--trials 5] [--agents 3] [--poses 500] [--domain 224] [--limit 120]
+"""
+import argparse
+import json
+import os
+import re
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from faults import COLUMNS, OUT_DIR, ROOT, assemble, write_contract_csv  # noqa: E402
+
+MAKE_IDENTITIES = os.path.join(ROOT, "scripts", "security", "make_identities.sh")
+
+
+def launch(args, work, name, extra):
+    """One launch; returns (exit code, wall s, cpu s, summary or None)."""
+    summary = os.path.join(work, name + ".json")
+    cmd = [os.path.join(args.bin_dir, "tessera"), "launch", args.graph, "--agents", str(args.agents),
+           "--partition", "eco", "--no-certify", "--quiet", "--domain", str(args.domain), "--run-id", name,
+           "--json", summary, "--timeout", str(args.limit)] + extra
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.time()
+    with open(os.path.join(work, name + ".log"), "w") as log:
+        try:
+            code = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, timeout=args.limit + 30).returncode
+        except subprocess.TimeoutExpired:
+            code = -9
+    wall = time.time() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    data = None
+    if code == 0 and os.path.exists(summary):
+        with open(summary) as f:
+            data = json.load(f)
+    return code, wall, cpu, data
+
+
+def watched_launch(args, work, name, extra):
+    """launch() while tessera-dds-snoop (no identity) subscribes to the run; adds its sample count."""
+    snoop_log = os.path.join(work, name + "-snoop.log")
+    with open(snoop_log, "w") as log:
+        snoop = subprocess.Popen([os.path.join(args.bin_dir, "tessera-dds-snoop"), "--domain", str(args.domain),
+                                  "--run-id", name, "--duration", str(args.limit + 10)],
+                                 stdout=log, stderr=subprocess.STDOUT)
+        for _ in range(200):  # its readers exist before the run starts
+            with open(snoop_log) as f:
+                if "listening" in f.read():
+                    break
+            time.sleep(0.05)
+        result = launch(args, work, name, extra)
+        snoop.send_signal(2)
+        try:
+            snoop.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            snoop.kill()
+            snoop.wait()
+    with open(snoop_log) as f:
+        m = re.search(r"samples=(\d+)", f.read())
+    return result + (int(m.group(1)) if m else -1,)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--out-dir", default=OUT_DIR)
+    ap.add_argument("--trials", type=int, default=5)
+    ap.add_argument("--agents", type=int, default=3)
+    ap.add_argument("--poses", type=int, default=500)
+    ap.add_argument("--domain", type=int, default=224)
+    ap.add_argument("--limit", type=float, default=120, help="time limit of one launch, seconds")
+    args = ap.parse_args()
+    work = tempfile.mkdtemp(prefix="tessera_faults_secured_")
+    args.graph = os.path.join(work, "graph.g2o")
+    subprocess.run([os.path.join(args.bin_dir, "tessera"), "generate", "--kind", "grid3d", "--poses",
+                    str(args.poses), "--robots", str(args.agents), "--seed", "3", "--out", args.graph],
+                   check=True, stdout=subprocess.DEVNULL)
+    sec = os.path.join(work, "sec")
+    subprocess.run([MAKE_IDENTITIES, sec, str(args.agents)], check=True, stdout=subprocess.DEVNULL)
+
+    rows = []
+    for t in range(args.trials):
+        base = "sec-%d-%d" % (os.getpid(), t)
+        # The same outsider reads the unsecured run (control: > 0 shows the snoop works).
+        pc, pwall, pcpu, plain, control = watched_launch(args, work, base + "-plain", [])
+        sc, swall, scpu, secured, samples = watched_launch(args, work, base + "-secured", ["--security", sec])
+        ok = sc == 0 and secured is not None and plain is not None and \
+            secured["rounds"] == plain["rounds"] and samples == 0 and control > 0
+        err = abs(secured["cost"] - plain["cost"]) / plain["cost"] if ok else float("nan")
+        rows.append(dict(trial=t, plain_exit=pc, secured_exit=sc, finished=int(ok),
+                         rounds=secured["rounds"] if secured else "", rel_cost_error=err,
+                         plain_wall_s=pwall, secured_wall_s=swall, plain_cpu_s=pcpu, secured_cpu_s=scpu,
+                         outsider_samples=samples, outsider_samples_unsecured=control))
+        print("trial %d: unsecured exit %d wall %.2f s cpu %.2f s | secured exit %d wall %.2f s cpu %.2f s | "
+              "rel. cost error %.1e | outsider samples %d (unsecured run: %d)" % (t, pc, pwall, pcpu, sc, swall, scpu,
+                                                                                err, samples, control),
+              flush=True)
+    fin = [r for r in rows if r["finished"]]
+    row = dict(fault="secured run (--security, %d agents, %d-pose grid3d; cost error vs the unsecured run; "
+                     "an unauthenticated outsider read 0 samples)" % (args.agents, args.poses),
+               trials=len(rows), finished=len(fin),
+               cost_error="%.1e" % max([r["rel_cost_error"] for r in fin], default=float("nan")),
+               extra_time_s="%.2f" % (sum(r["secured_wall_s"] - r["plain_wall_s"] for r in fin) / max(1, len(fin))))
+    os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
+    write_contract_csv(os.path.join(args.out_dir, "faults_secured.csv"), [row])
+    notes = ["## Secured run (`faults_secured.csv`)", "",
+             "Command: `scripts/bench/faults_secured.py %s`" % " ".join(sys.argv[1:]), "",
+             "`tessera launch GRAPH --agents %d --partition eco --no-certify` without and with `--security DIR` "
+             "(identities from `scripts/security/make_identities.sh`) on a %d-pose generated grid3d; during "
+             "each secured run `tessera-dds-snoop` without an identity subscribes to every Tessera topic "
+             "of that run." % (args.agents, args.poses), "",
+             "| trial | finished | rounds | rel. cost error | unsecured wall s | secured wall s | "
+             "unsecured CPU s | secured CPU s | outsider samples (secured / unsecured) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        notes.append("| %d | %s | %s | %.1e | %.2f | %.2f | %.2f | %.2f | %d / %d |" %
+                     (r["trial"], "yes" if r["finished"] else "NO (exit %d/%d)" % (r["plain_exit"], r["secured_exit"]),
+                      r["rounds"], r["rel_cost_error"], r["plain_wall_s"], r["secured_wall_s"], r["plain_cpu_s"],
+                      r["secured_cpu_s"], r["outsider_samples"], r["outsider_samples_unsecured"]))
+    with open(os.path.join(args.out_dir, "faults", "secured.md"), "w") as f:
+        f.write("\n".join(notes) + "\n")
+    print("\n" + " | ".join(COLUMNS))
+    print(" | ".join(str(row[c]) for c in COLUMNS))
+    assemble(args.out_dir)
+    if len(fin) == len(rows):
+        shutil.rmtree(work, ignore_errors=True)
+    else:
+        print("work dir kept: " + work)
+    return 0 if len(fin) == len(rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
