@@ -12,6 +12,7 @@
 #include "agent/checkpoint_keeper.hpp"
 #include "agent/dds_channel.hpp"
 #include "agent/final_report.hpp"
+#include "agent/lost_for_good.hpp"
 #include "agent/rejoin.hpp"
 #include "agent/round_loop.hpp"
 #include "agent/run_setup.hpp"
@@ -59,6 +60,7 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
                              log, t0);
       break;
     } catch (const RepartitionRequested& order) {
+      refuse_if_lost(order.assignment, o.id, o.net.session.run_id);
       if (!replication.enabled() || cur != &local)
         throw RunFailure(kExitRunFailed, std::string(order.what()) +
                                              ": this run does not replicate for a second loss");
@@ -108,6 +110,9 @@ void run_agent(const AgentOptions& o, Session& s, std::optional<AgentCheckpoint>
       const RunSetup setup = set_up_fresh_run(s, o, log);
       solve(s, o, log, setup.local, restart, &setup, t0);
     }
+  } catch (const RepartitionRequested& r) {  // outside the round loop (during set-up)
+    refuse_if_lost(r.assignment, o.id, o.net.session.run_id);
+    throw;
   } catch (const RunStopped&) {
     // The stop's own cause (a lost peer, an ABORT, a signal), not the unwinding's.
     const StopInfo stop =

@@ -11,6 +11,7 @@
 #include "agent/handoff_exchange.hpp"
 #include "agent/initialization_stage.hpp"
 #include "agent/local_dump.hpp"
+#include "agent/lost_for_good.hpp"
 #include "agent/robot_data.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
@@ -93,6 +94,9 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
                    ? "no process of run '" + o.net.session.run_id + "' seen on domain " +
                          std::to_string(s.domain()) + " (is the coordinator running?)"
                    : "");
+  // A process started again after the run gave its block to the survivors.
+  refuse_if_lost(asg, o.id, o.net.session.run_id);
+  refuse_if_lost(s, o.id);
   check_assignment(share, asg, o.robots, o.graph);
   out.rejoin_enabled = asg.rejoin_timeout_s() > 0;
   out.replicas = asg.replicas();
@@ -101,9 +105,19 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
       std::to_string(std::count(asg.owner().begin(), asg.owner().end(), o.id)) + " poses owned)");
 
   // 4. Everyone's endpoints matched before any volatile agent-to-agent message.
+  // With replicas a process restarted after the run gave its block away may have taken the
+  // first epoch's assignment before the one naming it lost arrived; the survivors will never
+  // be READY for it, so it looks again between short waits.
   std::string missing;
-  expect_ready(s.ready_barrier(Seconds(o.net.timeout_s), &missing), room, o.net.timeout_s,
-               "the other processes to be ready", missing);
+  const auto ready_until = std::chrono::steady_clock::now() + Seconds(o.net.timeout_s);
+  WaitStatus ready = WaitStatus::kTimeout;
+  for (;;) {
+    const Seconds left = ready_until - std::chrono::steady_clock::now();
+    ready = s.ready_barrier(out.replicas > 0 ? std::min(left, Seconds(0.5)) : left, &missing);
+    if (ready != WaitStatus::kTimeout || std::chrono::steady_clock::now() >= ready_until) break;
+    refuse_if_lost(s, o.id);
+  }
+  expect_ready(ready, room, o.net.timeout_s, "the other processes to be ready", missing);
   log("all processes ready");
 
   // 5. Initial poses of our share (agent/initialization_stage.hpp), before they move.

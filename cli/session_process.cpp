@@ -71,6 +71,9 @@ int run_session_process(const SessionOptions& options, const ProcessRole& role,
   int code = kExitOk;
   try {
     body(s);
+  } catch (const LeaveAlone& e) {  // the run goes on without this process: no ABORT
+    std::cerr << role.tag << ": error: " << e.what() << "\n";
+    code = e.exit_code();
   } catch (const RunFailure& f) {
     code = leave(s, role, f.exit_code(), f.what(), f.tell_others());
   } catch (const InputError& e) {

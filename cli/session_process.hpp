@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,19 @@
 #include "util/input_error.hpp"
 
 namespace tessera::cli {
+
+/// Thrown by a process body that must leave on its own while the run goes on without it (an
+/// agent refused after its block was re-partitioned): printed as "<tag>: error: <why>",
+/// mapped to `exit_code`, and NO ABORT is sent to the others.
+class LeaveAlone : public std::runtime_error {
+ public:
+  LeaveAlone(int exit_code, const std::string& why)
+      : std::runtime_error(why), exit_code_(exit_code) {}
+  int exit_code() const { return exit_code_; }
+
+ private:
+  int exit_code_;
+};
 
 /// Who is running, for the error lines and the ABORT reasons the others receive.
 struct ProcessRole {

@@ -2,9 +2,12 @@
 // its block re-partitioned among the survivors, which take over its measurements from the
 // replicas and finish with N-1 agents: every pose in the merged estimate, cost within 1e-6 of
 // the centralized optimum, and a fault record in the summary.
-// Domains used here: 186-187 (each test its own, so ctest -j is safe).
+// A process started again (same id) after its block was re-partitioned is refused with a
+// message naming why, and the survivors' run is not disturbed.
+// Domains used here: 186-187, 223-224 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -25,30 +28,17 @@ namespace {
 struct LossRun {
   std::string dir, graph, run;
   int agents = 5, domain = 0;
-  Process coordinator(int replicas) const {
-    return start(coordinator_args(agents, run, domain,
-                                  {"--timeout",
-                                   "20",
-                                   "--run-timeout",
-                                   "50",
-                                   "--summary",
-                                   dir + "/summary.json",
-                                   "--output",
-                                   dir + "/merged.g2o",
-                                   "--progress",
-                                   "--partition",
-                                   "eco",
-                                   "--grad-tol",
-                                   "0.0005",
-                                   "--replicas",
-                                   std::to_string(replicas),
-                                   "--replica-every",
-                                   "5",
-                                   "--rejoin-timeout",
-                                   "1",
-                                   "--status-interval",
-                                   "1"}),
-                 dir + "/coordinator.log");
+  std::string grad_tol = "0.0005";  // --grad-tol of the coordinator
+  Process coordinator(int replicas, const std::vector<std::string>& extra = {}) const {
+    std::vector<std::string> args = {
+        "--timeout", "20", "--run-timeout", "50", "--summary", dir + "/summary.json", "--output",
+        dir + "/merged.g2o", "--progress", "--partition", "eco", "--grad-tol", grad_tol,
+        "--replicas", std::to_string(replicas), "--replica-every", "5", "--rejoin-timeout",
+        "2",  // the false-alarm window: a live peer dropped by the
+              // lease on a loaded host comes back within it
+        "--status-interval", "1"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return start(coordinator_args(agents, run, domain, args), dir + "/coordinator.log");
   }
 };
 
@@ -111,6 +101,60 @@ TEST(DdsLoss, WithoutReplicasALostAgentStillStopsTheRun) {
   // (On a loaded host another agent may be reported lost first; either way the run stops.)
   EXPECT_NE(coord.output().find("lost agent"), std::string::npos) << coord.output();
   EXPECT_EQ(coord.output().find("re-partitioned"), std::string::npos) << coord.output();
+}
+
+// Agent 2 is killed for good, its block re-partitioned; then a process with id 2 is started
+// again (`checkpoint`: from its checkpoint, asking to rejoin; otherwise fresh). It must leave
+// at once saying it was lost for good, without aborting the survivors, who finish at f*.
+void restarted_after_repartition_is_refused(int domain, bool checkpoint) {
+  LossRun r = make_run(domain, checkpoint ? "refused-ckpt" : "refused-fresh");
+  r.grad_tol = "1e-12";
+  // A round limit instead of a reachable tolerance: the survivors are still in their rounds
+  // when the restarted process arrives (~1-3 s), and the run still ends by itself.
+  Process coord = r.coordinator(1, {"--max-rounds", "600"});
+  auto agent_argv = [&](int k) {
+    std::vector<std::string> a =
+        agent_args(r.graph, r.agents, k, r.run, r.domain, {"--timeout", "20"});
+    if (checkpoint) a.insert(a.end(), {"--checkpoint-dir", r.dir + "/ckpt" + std::to_string(k)});
+    return a;
+  };
+  std::vector<Process> agents;
+  for (int k = 0; k < r.agents; ++k) {
+    if (checkpoint) mkdir((r.dir + "/ckpt" + std::to_string(k)).c_str(), 0755);
+    agents.push_back(start(agent_argv(k), r.dir + "/agent" + std::to_string(k) + ".log"));
+  }
+  const bool started = wait_for_output(coord, "round 10:", 30);
+  kill(agents[2].pid, SIGKILL);
+  ASSERT_TRUE(started) << coord.output();
+  ASSERT_TRUE(wait_for_output(coord, "re-partitioned", 30)) << coord.output();
+  Process again = start(agent_argv(2), r.dir + "/agent2-again.log");
+  ASSERT_TRUE(wait_all({&again}, 15)) << again.output();
+  EXPECT_EQ(again.exit_code, 1) << again.output();
+  EXPECT_NE(again.output().find("agent 2 was lost for good in run '" + r.run +
+                                "': its block was re-partitioned among the survivors (epoch 1), "
+                                "so it cannot rejoin"),
+            std::string::npos)
+      << again.output();
+  std::vector<Process*> all = {&coord};
+  for (auto& a : agents) all.push_back(&a);
+  EXPECT_TRUE(wait_all(all, 50)) << "a process hung";
+  EXPECT_EQ(coord.exit_code, 0) << coord.output();  // not aborted by the refused process
+  for (int k : {0, 1, 3, 4})
+    EXPECT_EQ(agents[static_cast<std::size_t>(k)].exit_code, 0)
+        << agents[static_cast<std::size_t>(k)].output();
+  const PoseGraph g = read_g2o(r.graph);
+  const std::string summary = slurp(r.dir + "/summary.json");
+  EXPECT_NE(summary.find("\"survivors\": [0, 1, 3, 4]"), std::string::npos) << summary;
+  const double fstar = solve_centralized(g).cost;
+  EXPECT_LE(std::abs(json_field(summary, "cost") - fstar), 1e-6 * fstar) << summary;
+}
+
+TEST(DdsLoss, FreshProcessOfALostAgentIsRefusedAndTheSurvivorsFinish) {
+  restarted_after_repartition_is_refused(223, false);
+}
+
+TEST(DdsLoss, AgentRestartedFromItsCheckpointAfterTheRepartitionIsRefused) {
+  restarted_after_repartition_is_refused(224, true);
 }
 
 }  // namespace

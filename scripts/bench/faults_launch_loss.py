@@ -71,16 +71,24 @@ class LaunchRun:
         return int(out[0]) if out else None
 
     def kill_at(self, agent, at_round):
+        # The pid is looked up before the rounds start: pgrep on a loaded host can take longer
+        # than the rest of the run.
         deadline = time.time() + self.args.limit
+        pid = None
+        while pid is None:
+            if time.time() > deadline or self.proc.poll() is not None:
+                return False
+            pid = self.agent_pid(agent)
+            time.sleep(0.05)
         pattern = "round %d:" % at_round
         while pattern not in self.output():
             if time.time() > deadline or self.proc.poll() is not None:
                 return False
             time.sleep(0.005)
-        pid = self.agent_pid(agent)
-        if pid is None:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
             return False
-        os.kill(pid, signal.SIGKILL)
         return True
 
     def wait(self):
@@ -207,7 +215,7 @@ def main():
     print("\n" + " | ".join(COLUMNS))
     print(" | ".join(str(row[c]) for c in COLUMNS))
     assemble(args.out_dir)
-    if len(finished) == len(trials):
+    if len(finished) == len(trials) and not os.environ.get("TESSERA_BENCH_KEEP"):
         shutil.rmtree(work, ignore_errors=True)
     else:
         print("work dir kept: " + work)
