@@ -25,6 +25,7 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
   Yn = Eigen::MatrixXd::Zero(Y0.rows(),
                              (d + 1) * static_cast<Eigen::Index>(problem_.num_neighbors()));
   Pn = Yn;
+  Vn = Yn;
   Yn_prev = Yn;
   precon_ = std::make_unique<BlockPreconditioner>(problem_);
 }
@@ -150,7 +151,7 @@ void AgentState::reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd&
   if (Y0.cols() != Y.cols() || Yn0.cols() != Yn.cols() || Yn0.rows() != Y0.rows())
     throw std::invalid_argument("AgentState::reset_iterate: block of the wrong size");
   Y = P = V = Y_prev = V_prev = Y0;
-  Yn = Pn = Yn_prev = Yn0;
+  Yn = Pn = Vn = Yn_prev = Yn0;
   neighbours_set_.resize(0, 0);  // the problem's neighbour poses are stale
   rows_.clear();
   updated_grad_norm_sq_ = -1.0;  // nothing to reuse (and updated_X_ may have another rank)

@@ -58,9 +58,11 @@ class AgentState {
   void reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd& Yn0);
 
   // The sequences (own block) and neighbour copies; *_prev keep round k while k+1 is tried,
-  // so an adaptive restart can go back.
+  // so an adaptive restart can go back. Vn mirrors the neighbours' V on their public poses:
+  // every momentum operation is pose-wise and driven by global scalars, so each agent can
+  // evolve its neighbours' V (and form their P^k) itself instead of receiving P^k.
   Eigen::MatrixXd Y, P, V, Y_prev, V_prev;
-  Eigen::MatrixXd Yn, Pn, Yn_prev;
+  Eigen::MatrixXd Yn, Pn, Vn, Yn_prev;
 
  private:
   /// Selects the rows to compute on for the point (X, neighbours) and sets problem_'s

@@ -5,7 +5,7 @@ namespace tessera {
 void encode(ByteWriter& out, const ProtocolSnapshot& s) {
   out.i64(s.agent);
   out.i64(s.round);
-  for (const Eigen::MatrixXd* m : {&s.Y, &s.P, &s.V, &s.Y_prev, &s.Yn, &s.Pn, &s.Yn_prev})
+  for (const Eigen::MatrixXd* m : {&s.Y, &s.P, &s.V, &s.Y_prev, &s.Yn, &s.Pn, &s.Vn, &s.Yn_prev})
     out.matrix(*m);
   out.ints(s.selection);
   out.f64(s.f_prev);
@@ -33,6 +33,7 @@ ProtocolSnapshot decode_snapshot(ByteReader& in) {
   s.Y_prev = in.matrix("Y_prev");
   s.Yn = in.matrix("Yn");
   s.Pn = in.matrix("Pn");
+  s.Vn = in.matrix("Vn");
   s.Yn_prev = in.matrix("Yn_prev");
   s.selection = in.ints("selection");
   s.f_prev = in.f64("f_prev");

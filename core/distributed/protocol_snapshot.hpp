@@ -22,7 +22,7 @@ namespace tessera {
 struct ProtocolSnapshot {
   int agent = 0;
   int round = 0;
-  Eigen::MatrixXd Y, P, V, Y_prev, Yn, Pn, Yn_prev;
+  Eigen::MatrixXd Y, P, V, Y_prev, Yn, Pn, Vn, Yn_prev;
   std::vector<int> selection;
   double f_prev = 0.0, gsq_prev = 0.0;
   int restarts = 0;

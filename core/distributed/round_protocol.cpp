@@ -58,6 +58,7 @@ ProtocolSnapshot RoundProtocol::snapshot() const {
   s.Y_prev = state_.Y_prev;
   s.Yn = state_.Yn;
   s.Pn = state_.Pn;
+  s.Vn = state_.Vn;
   s.Yn_prev = state_.Yn_prev;
   s.selection = selection_;
   s.f_prev = f_prev_;
@@ -80,7 +81,7 @@ std::vector<OutgoingMessage> RoundProtocol::resume(const ProtocolSnapshot& s) {
   };
   for (const Eigen::MatrixXd* m : {&s.Y, &s.P, &s.V, &s.Y_prev})
     if (!same(*m, state_.Y)) fail("own block of the wrong size");
-  for (const Eigen::MatrixXd* m : {&s.Yn, &s.Pn, &s.Yn_prev})
+  for (const Eigen::MatrixXd* m : {&s.Yn, &s.Pn, &s.Vn, &s.Yn_prev})
     if (!same(*m, state_.Yn)) fail("neighbour copies of the wrong size");
   if (scheme_)
     scheme_->load(s.scheme_state);
@@ -92,6 +93,7 @@ std::vector<OutgoingMessage> RoundProtocol::resume(const ProtocolSnapshot& s) {
   state_.Y_prev = s.Y_prev;
   state_.Yn = s.Yn;
   state_.Pn = s.Pn;
+  state_.Vn = s.Vn;
   state_.Yn_prev = s.Yn_prev;
   round_ = s.round;
   selection_ = s.selection;
@@ -167,6 +169,7 @@ void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
   switch (phase_) {
     case ProtocolPhase::kInit:
       for (auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), state_.Yn);
+      state_.Vn = state_.Yn;  // V^0 = Y^0 everywhere
       begin_status(ProtocolPhase::kStatus, out);
       return;
     case ProtocolPhase::kStatus:
@@ -174,19 +177,22 @@ void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
       after_status(phase_, inbox, out);
       return;
     case ProtocolPhase::kExtrapolate:
-      for (auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), state_.Pn);
-      begin_update(out);
-      return;
+      throw std::logic_error("RoundProtocol: no step waits for extrapolated poses");
     case ProtocolPhase::kUpdate:
       // Unselected neighbours took P^k; selected ones overwrite it with their Y^{k+1}.
       if (scheme_ && scheme_->unselected_take_extrapolation()) state_.Yn = state_.Pn;
       for (auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), state_.Yn);
+      // The neighbours' V^{k+1}, exactly as each of them forms its own (same scalars, same
+      // pose-wise arithmetic), from the coefficients of the round just finished.
+      if (scheme_)
+        state_.Vn = momentum_update(state_.manifold(), coeff_, state_.Vn, state_.Pn, state_.Yn);
       ++round_;
       begin_status(ProtocolPhase::kStatus, out);
       return;
     case ProtocolPhase::kRedoUpdate:
       for (auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), state_.Yn);
       state_.V = state_.Y;
+      state_.Vn = state_.Yn;
       ++round_;
       begin_status(ProtocolPhase::kRedoStatus, out);
       return;
@@ -277,15 +283,10 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
     return;
   }
   coeff_ = scheme_->coefficients();
+  // P^k needs no exchange: the neighbours' public P^k is formed from their mirrored V^k.
   state_.P = extrapolate(state_.manifold(), coeff_, state_.Y, state_.V);
-  const bool everyone = scheme_->unselected_take_extrapolation();
-  std::vector<int> to;
-  for (int a : layout_.adjacent[static_cast<std::size_t>(me)])
-    if (everyone || selected(a)) to.push_back(a);
-  send_poses(state_.P, BlockKind::kP, ProtocolPhase::kExtrapolate, to, out);
-  std::vector<int> from;
-  if (everyone || selected(me)) from = layout_.adjacent[static_cast<std::size_t>(me)];
-  expect(u32(round_), ProtocolPhase::kExtrapolate, std::move(from));
+  state_.Pn = extrapolate(state_.manifold(), coeff_, state_.Yn, state_.Vn);
+  begin_update(out);
 }
 
 void RoundProtocol::begin_update(std::vector<OutgoingMessage>& out) {

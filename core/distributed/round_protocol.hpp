@@ -9,10 +9,13 @@
 //               bit-identical f(Y^k) and ||grad f(Y^k)||), checks stopping, and for the
 //               accelerated methods the restart test of round k-1 (see below); then selects
 //               the block(s) S_k.
-//   EXTRAPOLATE (accelerated only) every agent forms P^k from its own Y, V and sends its public
-//               P poses to the neighbours that need them (the selected ones, or every neighbour
-//               when unselected blocks take P^k).
-//   UPDATE      the selected agents update their block and send their public Y^{k+1} poses.
+//   EXTRAPOLATE (accelerated only, no message) every agent forms P^k from its own Y, V, and
+//               its neighbours' public P^k from its copies of their Y and V: V never travels,
+//               each agent evolves its copy of the neighbours' V (Vn) with the same pose-wise
+//               formulas and global scalars the owners use. So an accelerated round costs the
+//               same two message steps as a plain RBCD round.
+//   UPDATE      the selected agents update their block and send their public Y^{k+1} poses;
+//               every agent then advances its own V and its copy of the neighbours' V.
 //   Restart:    if the STATUS of round k+1 shows f(Y^k) - f(Y^{k+1}) < c ||grad f(Y^k)||^2,
 //               every agent returns to Y^k, S_k redo a plain block update from Y^k (REDO_UPDATE),
 //               V := Y, and the status is taken again (REDO_STATUS).
@@ -43,7 +46,7 @@ struct ProtocolSnapshot;  // distributed/protocol_snapshot.hpp
 enum class ProtocolPhase : std::uint32_t {
   kInit = 0,         ///< Initial public Y poses.
   kStatus = 1,       ///< Round status at Y^k.
-  kExtrapolate = 2,  ///< Public P^k poses.
+  kExtrapolate = 2,  ///< Retired (P^k is formed locally); the number stays reserved.
   kUpdate = 3,       ///< Public Y^{k+1} poses of the selected blocks.
   kRedoUpdate = 4,   ///< Same after a restart.
   kRedoStatus = 5    ///< Round status after a restart.
