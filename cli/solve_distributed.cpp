@@ -46,7 +46,7 @@ const char* kDistributedHelp =
     "  --tr-steps K              trust-region steps per block update (default 1)\n"
     "  --tcg-iters K             truncated-CG iterations per trust-region step (default 50)\n"
     "  --restart-c C             restart constant c1 of RBCD++/IRBCD (< 0: never restart)\n"
-    "  --sigma S                 IRBCD sigma (default 1e-3)\n"
+    "  --sigma S                 IRBCD sigma (default 1e-4; the paper: 1e-3)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
     "  --irbcd-n units|variables IRBCD: n = selectable blocks (default) or scalar variables\n"
     "  --reference               also run the centralized solver for f* and report rel_gap\n"

@@ -27,7 +27,7 @@ TEST(Irbcd, GammaSolvesItsQuadraticAndIsAtLeastOneOverN) {
 }
 
 TEST(Irbcd, RecurrencesFollowThePaper) {
-  IrbcdOptions o;  // sigma 1e-3, a0 = 1/n, b0 = 1
+  IrbcdOptions o;  // sigma 1e-4, a0 = 1/n, b0 = 1
   const double n = 5;
   IrbcdScheme s(o, n);
   EXPECT_DOUBLE_EQ(s.a(), 1.0 / n);
