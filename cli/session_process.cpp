@@ -86,7 +86,7 @@ int run_session_process(const SessionOptions& options, const ProcessRole& role,
       code = leave(s, role, kExitRunFailed, e.what(), true);
   }
   signals.stop();  // the callback refers to the session
-  s.close();
+  s.close(code);  // a Fast DDS abort or hang while deleting still exits with `code`
   return code;
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <fastdds/dds/core/status/StatusMask.hpp>
@@ -23,11 +24,14 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "tesseraPubSubTypes.h"
 #include "transport/message_mapping.hpp"
 #include "transport/qos.hpp"
+#include "transport/run_failure.hpp"
 #include "transport/security.hpp"
+#include "transport/teardown_guard.hpp"
 #include "transport/topic_names.hpp"
 #include "transport/transport_error.hpp"
 #include "util/input_error.hpp"
@@ -45,6 +49,9 @@ using Prefix = rtps::GuidPrefix_t;
 Prefix prefix_of(const rtps::InstanceHandle_t& handle) {
   return rtps::iHandle2GUID(handle).guidPrefix;
 }
+
+// Bound on deleting the participant at exit (normally well under a second).
+constexpr double kTeardownTimeoutS = 10.0;
 
 // Which peers an endpoint must match before the readiness barrier can pass.
 enum class Expect { kNone, kOtherAgents, kOtherAgentsAndCoordinator, kCoordinator, kAllAgents };
@@ -93,6 +100,30 @@ struct Session::Impl {
 
   std::atomic<std::uint64_t> bytes{0}, messages{0}, retries{0};
 
+  // ---- tracing: TESSERA_DDS_TRACE=1 (or --verbose) prints every discovery, match and
+  // barrier event with the time since the session started, to see where a process waits.
+  bool trace_on = false;
+  std::chrono::steady_clock::time_point t_start = std::chrono::steady_clock::now();
+  void trace(const char* fmt, ...) const __attribute__((format(printf, 2, 3))) {
+    if (!trace_on) return;
+    char text[512];
+    va_list args;
+    va_start(args, fmt);
+    std::vsnprintf(text, sizeof(text), fmt, args);
+    va_end(args);
+    const double t =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    std::fprintf(stderr, "[dds %8.3f %s] %s\n", t, participant_name(me).c_str(), text);
+  }
+  // Who a GUID prefix is (for traces; requires room.mutex() unless tracing is off).
+  std::string describe_locked(const Prefix& p) const {
+    auto it = peers.find(p);
+    if (it != peers.end()) return it->second.describe() + (lost.count(p) ? " (lost)" : "");
+    std::ostringstream os;
+    os << "unknown " << p;
+    return os.str();
+  }
+
   dds::DomainParticipant* participant = nullptr;
   dds::Publisher* publisher = nullptr;
   dds::Subscriber* subscriber = nullptr;
@@ -100,6 +131,7 @@ struct Session::Impl {
   std::map<std::string, dds::Topic*> topics;
   std::map<std::string, dds::DataWriter*> writers;
   std::vector<dds::DataReader*> readers;
+  std::map<std::string, dds::DataReader*> reader_by_name;
 
   // ---- listeners -------------------------------------------------------------------------
   struct ParticipantListener : dds::DomainParticipantListener {
@@ -110,6 +142,20 @@ struct Session::Impl {
       s->on_participant(info.status, info.info.m_guid.guidPrefix,
                         info.info.m_participantName.to_string());
     }
+#if HAVE_SECURITY
+    // Only traced: with DDS Security a peer's endpoints match only after this.
+    void onParticipantAuthentication(dds::DomainParticipant*,
+                                     rtps::ParticipantAuthenticationInfo&& info) override {
+      if (!s->trace_on) return;
+      s->room.with_lock([&] {
+        s->trace("authentication of %s: %s", s->describe_locked(info.guid.guidPrefix).c_str(),
+                 info.status == rtps::ParticipantAuthenticationInfo::AUTHORIZED_PARTICIPANT
+                     ? "authorized"
+                     : "UNAUTHORIZED");
+        return 0;
+      });
+    }
+#endif
   };
 
   struct WriterListener : dds::DataWriterListener {
@@ -148,6 +194,17 @@ struct Session::Impl {
   void on_participant(rtps::ParticipantDiscoveryInfo::DISCOVERY_STATUS status, const Prefix& prefix,
                       const std::string& name) {
     if (prefix == own_prefix) return;
+    if (trace_on) {
+      std::ostringstream os;
+      os << prefix;
+      trace("participant %s: '%s' %s",
+            status == rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT    ? "discovered"
+            : status == rtps::ParticipantDiscoveryInfo::REMOVED_PARTICIPANT     ? "removed"
+            : status == rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT     ? "dropped"
+            : status == rtps::ParticipantDiscoveryInfo::CHANGED_QOS_PARTICIPANT ? "changed"
+                                                                                : "ignored",
+            name.c_str(), os.str().c_str());
+    }
     auto who = parse_participant_name(name);
     if (!who || who->run_id != opt.run_id) return;  // someone else's run on this domain
     if (status == rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT) {
@@ -224,6 +281,11 @@ struct Session::Impl {
         auto it = set.find(prefix);
         if (it != set.end()) set.erase(it);
       }
+      trace("%s %s %s (change %+d, now %zu)", endpoint.c_str(),
+            change > 0   ? "matched"
+            : change < 0 ? "unmatched"
+                         : "match event without change from",
+            describe_locked(prefix).c_str(), change, set.size());
       return 0;
     });
     room.notify();
@@ -296,6 +358,40 @@ struct Session::Impl {
     return absent.empty();
   }
 
+  // What Fast DDS itself reports as matched on each endpoint next to what the listeners
+  // told us (for the trace when a barrier times out).
+  void trace_match_state(const char* why) {
+    if (!trace_on) return;
+    for (const auto& [name, w] : writers) {
+      std::vector<rtps::InstanceHandle_t> handles;
+      ReturnCode_t rc = w->get_matched_subscriptions(handles);
+      std::string who;
+      room.with_lock([&] {
+        for (const auto& h : handles) who += " " + describe_locked(prefix_of(h));
+        auto it = matched.find(name + "/w");
+        who += " | listener:";
+        if (it != matched.end())
+          for (const auto& p : it->second) who += " " + describe_locked(p);
+        return 0;
+      });
+      trace("%s: %s/w rc %d fastdds:%s", why, name.c_str(), static_cast<int>(rc()), who.c_str());
+    }
+    for (const auto& [name, r] : reader_by_name) {
+      std::vector<rtps::InstanceHandle_t> handles;
+      ReturnCode_t rc = r->get_matched_publications(handles);
+      std::string who;
+      room.with_lock([&] {
+        for (const auto& h : handles) who += " " + describe_locked(prefix_of(h));
+        auto it = matched.find(name + "/r");
+        who += " | listener:";
+        if (it != matched.end())
+          for (const auto& p : it->second) who += " " + describe_locked(p);
+        return 0;
+      });
+      trace("%s: %s/r rc %d fastdds:%s", why, name.c_str(), static_cast<int>(rc()), who.c_str());
+    }
+  }
+
   // ---- entities --------------------------------------------------------------------------
   template <class PubSubType>
   dds::Topic* topic(const std::string& name) {
@@ -327,12 +423,19 @@ struct Session::Impl {
   void make_reader(const std::string& name, bool transient_local, Expect e,
                    std::function<void(T&&)> deliver) {
     dds::Topic* t = topic<PubSubType>(name);
-    auto drain = [this, deliver](dds::DataReader* reader) {
+    const bool set_up_topic = name != kBlockTopic && name != kStatusTopic;
+    auto drain = [this, deliver, set_up_topic, name](dds::DataReader* reader) {
       T sample;
       dds::SampleInfo info;
       while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
         if (!info.valid_data) continue;
         if (sample.run_id() != opt.run_id) continue;  // belt and braces: Partition already filters
+        if (trace_on && set_up_topic)
+          room.with_lock([&] {
+            trace("received on %s from %s", name.c_str(),
+                  describe_locked(info.sample_identity.writer_guid().guidPrefix).c_str());
+            return 0;
+          });
         try {
           deliver(std::move(sample));
         } catch (const std::exception& ex) {
@@ -351,6 +454,7 @@ struct Session::Impl {
         reader_listeners.back().get(), mask);
     if (!r) throw TransportError("cannot create DDS reader for " + name);
     readers.push_back(r);
+    reader_by_name[name] = r;
     if (e != Expect::kNone) expect[name + "/r"] = e;
   }
 
@@ -381,6 +485,8 @@ struct Session::Impl {
       // as OUT_OF_RESOURCES, TIMEOUT or ERROR): wait for acknowledgements (not a busy loop),
       // then try again, until the deadline.
       ++retries;
+      trace("write on %s: history full (return code %u), waiting for acknowledgements",
+            name.c_str(), rc());
       if (std::chrono::steady_clock::now() > deadline) {
         char buf[64];
         std::snprintf(buf, sizeof(buf), "%g s (return code %u)", opt.write_timeout_s, rc());
@@ -391,17 +497,23 @@ struct Session::Impl {
     }
   }
 
-  void close() {
+  void close(int exit_code) {
     if (!participant) return;
     room.with_lock([&] {
       loss_fatal = false;
       return 0;
     });
-    participant->delete_contained_entities();
-    dds::DomainParticipantFactory::get_instance()->delete_participant(participant);
+    trace("closing: deleting the DDS entities and the participant");
+    {
+      // Fast DDS 2.9 may abort or deadlock in here (transport/teardown_guard.hpp).
+      TeardownGuard guard(exit_code, participant_name(me), Seconds(kTeardownTimeoutS));
+      participant->delete_contained_entities();
+      dds::DomainParticipantFactory::get_instance()->delete_participant(participant);
+    }
     participant = nullptr;
     writers.clear();
     readers.clear();
+    reader_by_name.clear();
     topics.clear();
   }
 };
@@ -412,6 +524,8 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
   s.opt = options;
   s.tolerate_agent_loss = options.tolerate_agent_loss;
   s.net = network_profile(options.network);
+  if (const char* env = std::getenv("TESSERA_DDS_TRACE"); env && *env && *env != '0')
+    s.trace_on = true;
   std::vector<std::pair<std::string, std::string>> security;
   if (!options.security_dir.empty())
     security = security_properties(security_files(
@@ -498,6 +612,7 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
           switch (m.kind()) {
             case wire::CONTROL_READY:
               s.room.with_lock([&] { return s.ready_from.insert(from.describe()).second; });
+              s.trace("READY from %s", from.describe().c_str());
               s.room.notify();
               break;
             case wire::CONTROL_FINISHED:
@@ -518,7 +633,7 @@ Session::Session(const SessionOptions& options) : impl_(std::make_unique<Impl>()
           }
         });
   } catch (...) {
-    s.close();
+    s.close(kExitRunFailed);
     throw;
   }
 }
@@ -656,11 +771,15 @@ WaitStatus Session::ready_barrier(Seconds timeout, std::string* missing) {
   Impl& s = *impl_;
   const auto start = std::chrono::steady_clock::now();
   std::string absent;
+  s.trace("barrier: waiting for endpoints to match");
   WaitStatus st = s.room.wait_for([&] { return s.matched_locked(&absent); }, timeout);
   if (st != WaitStatus::kReady) {
     if (missing) *missing = "endpoints not matched with " + absent;
+    s.trace("barrier: endpoints not matched with %s", absent.c_str());
+    s.trace_match_state("barrier timeout");
     return st;
   }
+  s.trace("barrier: endpoints matched, sending READY");
   send_control(wire::CONTROL_READY);
   std::vector<PeerIdentity> others = s.expected_peers(Expect::kOtherAgents);
   if (!s.me.coordinator && s.opt.expect_coordinator)
@@ -676,6 +795,12 @@ WaitStatus Session::ready_barrier(Seconds timeout, std::string* missing) {
       },
       left);
   if (st == WaitStatus::kTimeout && missing) *missing = "no READY from " + absent;
+  if (st == WaitStatus::kTimeout) {
+    s.trace("barrier: no READY from %s", absent.c_str());
+    s.trace_match_state("barrier timeout");
+  } else if (st == WaitStatus::kReady) {
+    s.trace("barrier: passed");
+  }
   return st;
 }
 
@@ -775,7 +900,11 @@ SessionStats Session::stats() const {
 }
 
 void Session::close() {
-  if (impl_) impl_->close();
+  close(kExitRunFailed);
+}
+
+void Session::close(int exit_code) {
+  if (impl_) impl_->close(exit_code);
 }
 
 }  // namespace tessera::transport

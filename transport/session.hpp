@@ -122,8 +122,12 @@ class Session {
 
   SessionStats stats() const;
   /// Deletes every DDS entity and the participant (idempotent). After this the process
-  /// leaves no shared-memory files behind.
+  /// leaves no shared-memory files behind. Same as close(1).
   void close();
+  /// Same, for a process about to exit with `exit_code`: if Fast DDS aborts or hangs while
+  /// the participant is deleted (known Fast DDS 2.9 teardown bugs, transport/teardown_guard.hpp),
+  /// the process exits at once with `exit_code` instead of crashing or hanging.
+  void close(int exit_code);
 
  private:
   struct Impl;

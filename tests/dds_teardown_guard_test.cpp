@@ -1,0 +1,73 @@
+// The guard around deleting a DDS participant at exit (transport/teardown_guard.hpp): Fast DDS
+// 2.9 was seen to abort (assertion in PDP.cpp) or deadlock (DDS Security) in there after the
+// run's work was done. While armed, an abort or a teardown that overruns its bound ends the
+// process with the exit code it was about to return; disarmed, nothing changes. Each case
+// runs in a forked child (no participant needed: the failures are simulated).
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <functional>
+#include <thread>
+
+#include "transport/teardown_guard.hpp"
+
+namespace {
+
+using tessera::transport::TeardownGuard;
+
+// Runs `body` in a child; returns its exit status as `exit code` or 128 + signal.
+int in_child(const std::function<void()>& body) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    body();
+    _exit(0);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+TEST(DdsTeardownGuard, AnAbortDuringTeardownExitsWithTheIntendedCode) {
+  EXPECT_EQ(in_child([] {
+              TeardownGuard guard(3, "test", std::chrono::seconds(10));
+              std::abort();  // what Fast DDS's failed assertion does
+            }),
+            3);
+  // An abort from another thread (Fast DDS's event thread in the real case).
+  EXPECT_EQ(in_child([] {
+              TeardownGuard guard(0, "test", std::chrono::seconds(10));
+              std::thread([] { std::abort(); }).join();
+            }),
+            0);
+}
+
+TEST(DdsTeardownGuard, ATeardownThatHangsEndsAfterTheBound) {
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(in_child([] {
+              TeardownGuard guard(4, "test", std::chrono::milliseconds(200));
+              std::this_thread::sleep_for(std::chrono::seconds(30));  // a deadlocked teardown
+            }),
+            4);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+}
+
+TEST(DdsTeardownGuard, ATeardownThatFinishesChangesNothing) {
+  EXPECT_EQ(in_child([] {
+              { TeardownGuard guard(5, "test", std::chrono::seconds(10)); }
+              _exit(7);  // the process's own exit code stands
+            }),
+            7);
+  // Disarmed: an abort afterwards is an abort again (the previous handler is back).
+  EXPECT_EQ(in_child([] {
+              { TeardownGuard guard(5, "test", std::chrono::seconds(10)); }
+              std::abort();
+            }),
+            128 + SIGABRT);
+}
+
+}  // namespace
