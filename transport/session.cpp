@@ -51,7 +51,7 @@ Prefix prefix_of(const rtps::InstanceHandle_t& handle) {
 }
 
 // Bound on deleting the participant at exit (normally well under a second).
-constexpr double kTeardownTimeoutS = 10.0;
+constexpr double kTeardownTimeoutS = 5.0;
 
 // Which peers an endpoint must match before the readiness barrier can pass.
 enum class Expect { kNone, kOtherAgents, kOtherAgentsAndCoordinator, kCoordinator, kAllAgents };
