@@ -57,8 +57,10 @@ const char* kDistributedHelp =
     "                            the staircase on a saddle (off by default; see\n"
     "                            docs/distributed-certification.md)\n"
     "  --max-rank R              staircase ceiling with --certify (default 10)\n"
-    "  --certify-grad-tol T      gradient tolerance of the solve stages with --certify\n"
-    "                            (default 1e-4; 0 = --grad-tol)\n"
+    "  --certify-grad-tol T      with --certify, each rank is solved to --grad-tol and\n"
+    "                            certified; if that certificate does not hold, the rank is\n"
+    "                            refined to this tolerance and certified again before a\n"
+    "                            saddle escape (default 1e-4; 0 = escape without refining)\n"
     "  --certify-iters K         certificate iteration cap (default 300)\n"
     "  --certify-residual T      certificate stops at Ritz residual <= T max(1, max diag Q)\n"
     "                            (default 1e-6)\n"
@@ -231,6 +233,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
           .add("certificate_residual", r.certificate_residual)
           .add("certificate_rounds", r.certificate_rounds)
           .add("certificate_bytes", static_cast<long long>(r.certificate_bytes))
+          .add("refine_rounds", r.refine_rounds)
           .add("escape_rounds", r.escape_rounds)
           .add("escape_bytes", static_cast<long long>(r.escape_bytes))
           .add("staircase_levels", static_cast<int>(r.certificates.size()));

@@ -21,6 +21,10 @@ CertifiedAgent::CertifiedAgent(AgentState& state, const BlockLayout& layout,
     : state_(state), layout_(layout), options_(options) {}
 
 double CertifiedAgent::solve_tolerance() const {
+  return refining_ ? refine_tolerance() : options_.grad_norm_tol;
+}
+
+double CertifiedAgent::refine_tolerance() const {
   if (options_.certify && options_.staircase.grad_norm_tol > 0)
     return std::min(options_.grad_norm_tol, options_.staircase.grad_norm_tol);
   return options_.grad_norm_tol;
@@ -108,7 +112,8 @@ void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& ou
     }
     case StageKind::kEscape:
       escape_ = std::make_unique<SaddleEscapeProtocol>(
-          state_, layout_, direction_, solves_.back().trace.back().cost, solve_tolerance(),
+          state_, layout_, direction_, solves_.back().trace.back().cost,
+          options_.grad_norm_tol,  // the next rank's solve starts at the solver's tolerance
           options_.staircase.escape);
       current_ = escape_.get();
       break;
@@ -151,7 +156,7 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
     switch (stage_kind(stage_)) {
       case StageKind::kSolve: {
         solves_.push_back({stage_, rank, solve_->rounds(), solve_->restarts(),
-                           solve_->stop_reason(), solve_->trace()});
+                           solve_->stop_reason(), solve_->trace(), solve_tolerance(), refining_});
         if (!options_.certify || solve_->trace().empty()) {
           done_ = true;
           break;
@@ -166,8 +171,19 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
         const bool negative = rec.result.min_eigenvalue < -rec.result.tolerance;
         certificates_.push_back(std::move(rec));
         certify_.reset();
-        if (certificates_.back().result.certified || !negative ||
-            rank >= options_.staircase.max_rank) {
+        if (certificates_.back().result.certified) {
+          done_ = true;
+          break;
+        }
+        // Not certified at the solver's tolerance: Lambda(X) may be off by the residual
+        // gradient, so the verdict is inconclusive. Refine the same rank to the tighter
+        // tolerance (the next solve stage, skipping the escape) and certify again.
+        if (!refining_ && refine_tolerance() < options_.grad_norm_tol) {
+          refining_ = true;
+          begin(stage_ + 2, out);
+          break;
+        }
+        if (!negative || rank >= options_.staircase.max_rank) {
           done_ = true;
           break;
         }
@@ -183,6 +199,7 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
         }
         state_.reset_iterate(r.Y, r.Yn);
         escape_.reset();
+        refining_ = false;  // the new rank starts at the solver's tolerance again
         begin(stage_ + 1, out);
         break;
       }

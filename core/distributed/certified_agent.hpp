@@ -3,6 +3,11 @@
 //   stage 0: solve at rank r (RoundProtocol)      stage 3: solve at rank r + 1
 //   stage 1: certify (CertificateProtocol)        stage 4: certify
 //   stage 2: escape  (SaddleEscapeProtocol)       ...
+// Each rank is first solved to the solver's own gradient tolerance. A certificate that holds
+// there ends the sequence. One that does not is inconclusive (Lambda(X) is off by the
+// residual gradient): the same rank is refined to StaircaseOptions::grad_norm_tol (the solve
+// stage after the certify stage, the escape stage number is skipped) and certified again; only
+// a failure at the refined point leads to the escape.
 // It stops after a solve when certification is off, after a certificate that holds, at the
 // staircase's rank cap, or when no escape direction / step exists. Every message carries its
 // stage in the phase field (stage_tag.hpp); messages of a later stage from faster agents are
@@ -68,7 +73,10 @@ class CertifiedAgent : public AgentProcess {
              const ProtocolSnapshot* resume_from = nullptr);
   void advance(std::vector<OutgoingMessage>& out);
   void emit(std::vector<OutgoingMessage>&& sub, std::vector<OutgoingMessage>& out) const;
+  /// The current solve stage's gradient tolerance: the solver's own, or refine_tolerance()
+  /// while refining an inconclusive certificate.
   double solve_tolerance() const;
+  double refine_tolerance() const;
 
   AgentState& state_;
   const BlockLayout& layout_;
@@ -84,6 +92,7 @@ class CertifiedAgent : public AgentProcess {
   std::vector<CertifyStageRecord> certificates_;
   std::vector<EscapeStageRecord> escapes_;
   std::function<void(const ProtocolSnapshot&)> observer_;
+  bool refining_ = false;  // the current rank's solve continues at refine_tolerance()
   bool done_ = false;
 };
 

@@ -146,6 +146,7 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
       res.trace.push_back(std::move(row));
     }
     offset += stage.rounds;
+    if (stage.refine) res.refine_rounds += stage.rounds;
   }
   for (std::size_t s = 0; s < stats.bytes_per_stage.size(); ++s) {
     const StageKind kind = stage_kind(static_cast<std::uint32_t>(s));

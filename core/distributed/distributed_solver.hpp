@@ -85,6 +85,9 @@ struct DistributedResult {
   double certificate_residual = 0.0;   ///< Its Ritz residual.
   int certificate_rounds = 0;          ///< LOBPCG iterations, all certificates.
   std::uint64_t certificate_bytes = 0;
+  /// Solver rounds (included in `rounds`) spent refining ranks whose certificate at the
+  /// solver's tolerance was inconclusive (StaircaseOptions::grad_norm_tol).
+  int refine_rounds = 0;
   int escape_rounds = 0;  ///< Line-search trials, all escapes.
   std::uint64_t escape_bytes = 0;
   int final_rank = 0;

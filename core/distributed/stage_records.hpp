@@ -18,6 +18,10 @@ struct SolveStageRecord {
   int restarts = 0;
   std::string stop_reason;
   std::vector<RoundRecord> trace;
+  double grad_tol = 0.0;  ///< The stage's gradient-norm tolerance.
+  /// A refinement: the same rank continued to StaircaseOptions::grad_norm_tol after an
+  /// inconclusive certificate at the solver's tolerance.
+  bool refine = false;
 };
 
 struct CertifyStageRecord {

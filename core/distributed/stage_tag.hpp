@@ -15,7 +15,8 @@ namespace tessera {
 constexpr std::uint32_t kStagePhaseStride = 1000;
 constexpr std::uint32_t kAuxiliaryStepBase = 100;
 
-/// What a stage does: stage s is kind s % 3 at rank r0 + s / 3.
+/// What a stage does: stage s is kind s % 3. A refinement skips the escape stage's number
+/// (certify s -> solve s + 2), so the rank is r0 + the number of escapes so far.
 enum class StageKind : std::uint32_t { kSolve = 0, kCertify = 1, kEscape = 2 };
 
 inline std::uint32_t stage_of_phase(std::uint32_t phase) {
