@@ -72,7 +72,9 @@ def run_dds(tessera, graph, agents, domain, tmp, limit):
     t0 = time.monotonic()
     p = subprocess.Popen([tessera, "launch", graph, "--agents", str(agents), "--partition",
                           "highest", "--domain", str(domain), "--json", js, "--timeout", str(limit),
-                          "--no-certify"],  # the in-process run it is compared with does not certify
+                          # the same start as the in-process run (launch's own default is the
+                          # distributed chordal stage), and no certificate (the in-process run has none)
+                          "--init", "file", "--no-certify"],
                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1)
     stamps = []
     log = []
