@@ -55,7 +55,8 @@ TEST(DdsLoss, AgentKilledForGoodSurvivorsFinishAtTheOptimumWithEveryPose) {
   LossRun r = make_run(186, "loss");
   Process coord = r.coordinator(1);
   std::vector<Process> agents =
-      start_agents(r.dir, r.graph, r.agents, r.run, r.domain, {"--timeout", "20"}, false);
+      start_agents(r.dir, r.graph, r.agents, r.run, r.domain, {"--timeout", "20", "--udp-only"},
+                   false);  // --udp-only: the loss-tolerant configuration (docs/fault-tolerance.md)
   const bool started = wait_for_output(coord, "round 10:", 30);
   kill(agents[2].pid, SIGKILL);  // for good: never restarted
   ASSERT_TRUE(started) << coord.output();

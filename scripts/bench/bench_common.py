@@ -327,3 +327,45 @@ def fault_row(fault, trials):
     return dict(fault=fault, trials=len(trials), finished=len(finished),
                 cost_error="%.1e" % max([x["rel_cost_error"] for x in finished], default=float("nan")),
                 extra_time_s="%.2f" % (sum(x["extra_s"] for x in finished) / max(1, len(finished))))
+
+
+# ---- permanent-loss benchmarks (faults_loss.py, faults_launch_loss.py) ----------------------
+
+def add_loss_args(ap, domain):
+    """The options both permanent-loss benchmarks take (same names, same defaults)."""
+    ap.add_argument("--trials", type=int, default=10)
+    ap.add_argument("--agents", type=int, default=5)
+    ap.add_argument("--poses", type=int, default=500)
+    ap.add_argument("--grad-tol", type=float, default=0.0005)
+    ap.add_argument("--replica-every", type=int, default=5)
+    ap.add_argument("--rejoin-timeout", type=float, default=1.0)
+    ap.add_argument("--domain", type=int, default=domain)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--limit", type=float, default=300, help="time limit of one run, seconds")
+
+
+def loss_graph_and_fstar(tessera, args, work):
+    """Generates the benchmark's 3D grid into work/graph.g2o (args.graph_path) and returns f*
+    from the centralized solver, which every trial's final cost is compared with."""
+    args.graph_path = os.path.join(work, "graph.g2o")
+    subprocess.run([tessera, "generate", "--kind", "grid3d", "--poses", str(args.poses), "--robots",
+                    str(args.agents), "--seed", "3", "--out", args.graph_path], check=True,
+                   stdout=subprocess.DEVNULL)
+    cjson = os.path.join(work, "centralized.json")
+    subprocess.run([tessera, "solve", args.graph_path, "--algorithm", "centralized", "--json", cjson],
+                   check=True, stdout=subprocess.DEVNULL)
+    with open(cjson) as f:
+        fstar = json.load(f)["cost"]
+    print("f* = %.12g (centralized)" % fstar, flush=True)
+    return fstar
+
+
+def g2o_vertex_ids(path):
+    """The pose ids of a g2o file's VERTEX lines (empty when the file does not exist)."""
+    ids = set()
+    if os.path.exists(path):
+        with open(path) as f:
+            for line in f:
+                if line.startswith("VERTEX"):
+                    ids.add(int(line.split()[1]))
+    return ids

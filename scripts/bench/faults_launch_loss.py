@@ -32,6 +32,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
 from faults import COLUMNS, OUT_DIR, ROOT, assemble, write_contract_csv  # noqa: E402
 
 
@@ -110,42 +111,19 @@ class LaunchRun:
         return code, wall, cpu, summary
 
     def merged_poses(self):
-        ids = set()
-        if os.path.exists(self.merged):
-            with open(self.merged) as f:
-                for line in f:
-                    if line.startswith("VERTEX"):
-                        ids.add(int(line.split()[1]))
-        return ids
+        return bc.g2o_vertex_ids(self.merged)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
     ap.add_argument("--out-dir", default=OUT_DIR)
-    ap.add_argument("--trials", type=int, default=10)
-    ap.add_argument("--agents", type=int, default=5)
-    ap.add_argument("--poses", type=int, default=500)
-    ap.add_argument("--grad-tol", type=float, default=0.0005)
-    ap.add_argument("--replica-every", type=int, default=5)
-    ap.add_argument("--rejoin-timeout", type=float, default=1.0)
-    ap.add_argument("--domain", type=int, default=223)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--limit", type=float, default=300, help="time limit of one run, seconds")
+    bc.add_loss_args(ap, domain=223)
     args = ap.parse_args()
     rng = random.Random(args.seed)
     work = tempfile.mkdtemp(prefix="tessera_faults_launch_loss_")
-    args.graph_path = os.path.join(work, "graph.g2o")
     tessera = os.path.join(args.bin_dir, "tessera")
-    subprocess.run([tessera, "generate", "--kind", "grid3d", "--poses", str(args.poses), "--robots",
-                    str(args.agents), "--seed", "3", "--out", args.graph_path], check=True,
-                   stdout=subprocess.DEVNULL)
-    cjson = os.path.join(work, "centralized.json")
-    subprocess.run([tessera, "solve", args.graph_path, "--algorithm", "centralized", "--json", cjson],
-                   check=True, stdout=subprocess.DEVNULL)
-    with open(cjson) as f:
-        fstar = json.load(f)["cost"]
-    print("f* = %.12g (centralized)" % fstar, flush=True)
+    fstar = bc.loss_graph_and_fstar(tessera, args, work)
 
     ref = LaunchRun(args, work, "undisturbed")
     ref.start()

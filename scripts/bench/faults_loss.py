@@ -58,7 +58,11 @@ class LossRun:
                                 "coordinator.log")
         self.agents = {k: self.spawn([os.path.join(a.bin_dir, "tessera-agent"), "--graph", a.graph_path,
                                       "--robots", str(a.agents), "--id", str(k), "--run-id", self.run_id,
-                                      "--domain", str(a.domain), "--timeout", "60"], "agent%d.log" % k)
+                                      "--domain", str(a.domain), "--timeout", "60",
+                                      # the loss-tolerant configuration (as `launch --on-agent-loss
+                                      # continue`): with shared memory a SIGKILLed peer can leave the
+                                      # survivors' ports unusable and every peer looks lost at once
+                                      "--udp-only"], "agent%d.log" % k)
                        for k in range(a.agents)}
 
     def coordinator_output(self):
@@ -90,42 +94,19 @@ class LossRun:
         return ok, codes, wall, summary
 
     def merged_poses(self):
-        ids = set()
-        if os.path.exists(self.merged):
-            with open(self.merged) as f:
-                for line in f:
-                    if line.startswith("VERTEX"):
-                        ids.add(int(line.split()[1]))
-        return ids
+        return bc.g2o_vertex_ids(self.merged)
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
     ap.add_argument("--out-dir", default=OUT_DIR)
-    ap.add_argument("--trials", type=int, default=10)
-    ap.add_argument("--agents", type=int, default=5)
-    ap.add_argument("--poses", type=int, default=500)
-    ap.add_argument("--grad-tol", type=float, default=0.0005)
-    ap.add_argument("--replica-every", type=int, default=5)
-    ap.add_argument("--rejoin-timeout", type=float, default=1.0)
-    ap.add_argument("--domain", type=int, default=213)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--limit", type=float, default=300, help="time limit of one run, seconds")
+    bc.add_loss_args(ap, domain=213)
     args = ap.parse_args()
     rng = random.Random(args.seed)
     work = tempfile.mkdtemp(prefix="tessera_faults_loss_")
-    args.graph_path = os.path.join(work, "graph.g2o")
     tessera = os.path.join(args.bin_dir, "tessera")
-    subprocess.run([tessera, "generate", "--kind", "grid3d", "--poses", str(args.poses), "--robots",
-                    str(args.agents), "--seed", "3", "--out", args.graph_path], check=True,
-                   stdout=subprocess.DEVNULL)
-    cjson = os.path.join(work, "centralized.json")
-    subprocess.run([tessera, "solve", args.graph_path, "--algorithm", "centralized", "--json", cjson],
-                   check=True, stdout=subprocess.DEVNULL)
-    with open(cjson) as f:
-        fstar = json.load(f)["cost"]
-    print("f* = %.12g (centralized)" % fstar)
+    fstar = bc.loss_graph_and_fstar(tessera, args, work)
 
     base = {}
     for name, replicas in (("plain", 0), ("replicated", 1)):
