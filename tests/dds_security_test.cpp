@@ -57,11 +57,19 @@ TEST(DdsSecurity, SecuredLaunchGivesTheUnsecuredCost) {
                         &plain_out),
             0)
       << plain_out;
-  ASSERT_EQ(run_command(bin("tessera") + common + " --domain 194 --security " + dir +
-                            "/sec --json " + dir + "/secure.json",
-                        &secure_out),
-            0)
-      << secure_out;
+  // A secured set-up can stall in Fast DDS 2.9: one pair of participants never authenticates
+  // (one side's handshake writer never sends to that peer; docs/dds-runtime.md, "secured set-up
+  // stall"). The launch then fails with the coordinator's set-up timeout; that case, and only
+  // that one, is retried once, as in OutsidersReadNothingOfASecuredRun.
+  const std::string secured = bin("tessera") + common + " --domain 194 --security " + dir +
+                              "/sec --json " + dir + "/secure.json";
+  int rc = run_command(secured, &secure_out);
+  if (rc != 0 && secure_out.find("timed out after") != std::string::npos) {
+    std::fprintf(stderr, "secured launch stalled in set-up (known problem), retrying once:\n%s\n",
+                 secure_out.c_str());
+    rc = run_command(secured, &secure_out);
+  }
+  ASSERT_EQ(rc, 0) << secure_out;
   const std::string plain = read_text(dir + "/plain.json"),
                     secure = read_text(dir + "/secure.json");
   const double c0 = json_field(plain, "cost"), c1 = json_field(secure, "cost");
