@@ -1,6 +1,6 @@
 #pragma once
 // The QoS of every DDS entity of the runtime, in one place (see docs/dds-runtime.md for
-// why each value). Internal to transport/: only session.cpp and tools include it.
+// why each value). Internal to transport/ (dds_entities.hpp).
 
 #include <cstdint>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>

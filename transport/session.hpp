@@ -5,6 +5,14 @@
 // the implementation; callers see the generated wire structs (idl/) and core's
 // ProtocolMessage only.
 //
+// Implementation, one concept a file (all internal to transport/): session_parts.hpp (what a
+// session is made of), dds_entities (participant, topics, readers, writers, teardown),
+// dds_listeners (Fast DDS callbacks -> the trackers), peer_tracking (discovered / lost
+// peers, what a loss does), readiness (endpoint matches, READY/FINISHED, barrier),
+// epoch_routing (protocol messages by rollback epoch), sample_writing (writes with retry,
+// counters), role_endpoints.cpp (which topics each role uses, where samples go),
+// dds_trace (TESSERA_DDS_TRACE).
+//
 // Isolation: domain id (derived from the run id unless given), Partition QoS = run id,
 // and the run id field of every message (messages of other runs are dropped).
 //
@@ -24,6 +32,8 @@
 #include "transport/session_options.hpp"
 
 namespace tessera::transport {
+
+struct SessionParts;
 
 /// Counters of one session (this process).
 struct SessionStats {
@@ -130,8 +140,7 @@ class Session {
   void close(int exit_code);
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<SessionParts> impl_;  // session_parts.hpp
 };
 
 }  // namespace tessera::transport

@@ -1,0 +1,100 @@
+#include "transport/dds_entities.hpp"
+
+#include <fastdds/rtps/common/InstanceHandle.h>
+
+#include <cstdlib>
+#include <fastdds/dds/core/status/StatusMask.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/log/Log.hpp>
+
+#include "transport/teardown_guard.hpp"
+
+namespace tessera::transport {
+
+namespace dds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+namespace {
+// Bound on deleting the participant at exit (normally well under a second).
+constexpr double kTeardownTimeoutS = 5.0;
+}  // namespace
+
+DdsEntities::DdsEntities(const SessionOptions& options, const NetworkProfile& net, Mailroom& room,
+                         PeerTracker& peers, Readiness& readiness, const DdsTrace& trace)
+    : opt_(options), net_(net), room_(room), peers_(peers), readiness_(readiness), trace_(trace) {}
+
+void DdsEntities::open(int domain, const PeerIdentity& me,
+                       const std::vector<std::pair<std::string, std::string>>& security) {
+  // TESSERA_DDS_LOG=1 shows Fast DDS's own warnings and errors (for diagnosing QoS trouble).
+  if (const char* env = std::getenv("TESSERA_DDS_LOG"); env && *env && *env != '0')
+    eprosima::fastdds::dds::Log::SetVerbosity(eprosima::fastdds::dds::Log::Kind::Warning);
+  participant_listener_ =
+      std::make_unique<ParticipantDiscoveryListener>(peers_, opt_.run_id, room_, trace_);
+  auto* factory = dds::DomainParticipantFactory::get_instance();
+  participant_ = factory->create_participant(
+      domain,
+      participant_qos(participant_name(me), opt_.lease_s, opt_.initial_peers, domain,
+                      opt_.num_agents, net_, security, opt_.shared_memory),
+      participant_listener_.get(), dds::StatusMask::none());
+  if (!participant_)
+    throw TransportError("cannot create a DDS participant on domain " + std::to_string(domain) +
+                         (security.empty()
+                              ? std::string()
+                              : " with DDS Security from " + opt_.security_dir +
+                                    " (certificate, key, permissions or governance rejected; "
+                                    "TESSERA_DDS_LOG=1 shows Fast DDS's reason)"));
+  peers_.set_own_prefix(participant_->guid().guidPrefix);
+  publisher_ = participant_->create_publisher(publisher_qos(opt_.run_id));
+  subscriber_ = participant_->create_subscriber(subscriber_qos(opt_.run_id));
+  if (!publisher_ || !subscriber_) throw TransportError("cannot create DDS publisher/subscriber");
+}
+
+dds::DataWriter* DdsEntities::writer(const std::string& name) const {
+  auto it = writers_.find(name);
+  return it == writers_.end() ? nullptr : it->second;
+}
+
+void DdsEntities::trace_match_state(const char* why) {
+  if (!trace_.on()) return;
+  // One line per endpoint: Fast DDS's view (`handles`, `rc`) | the listeners' view.
+  auto line = [&](const std::string& endpoint, ReturnCode_t rc,
+                  const std::vector<rtps::InstanceHandle_t>& handles) {
+    std::string who;
+    room_.with_lock([&] {
+      for (const auto& h : handles) who += " " + peers_.describe_locked(prefix_of(h));
+      who += " | listener:" + readiness_.describe_matched_locked(endpoint);
+      return 0;
+    });
+    trace_("%s: %s rc %d fastdds:%s", why, endpoint.c_str(), static_cast<int>(rc()), who.c_str());
+  };
+  for (const auto& [name, w] : writers_) {
+    std::vector<rtps::InstanceHandle_t> handles;
+    ReturnCode_t rc = w->get_matched_subscriptions(handles);
+    line(name + "/w", rc, handles);
+  }
+  for (const auto& [name, r] : reader_by_name_) {
+    std::vector<rtps::InstanceHandle_t> handles;
+    ReturnCode_t rc = r->get_matched_publications(handles);
+    line(name + "/r", rc, handles);
+  }
+}
+
+void DdsEntities::close(int exit_code, const std::string& who) {
+  if (!participant_) return;
+  peers_.set_loss_fatal(false);
+  trace_("closing: deleting the DDS entities and the participant");
+  {
+    // Fast DDS 2.9 may abort or deadlock in here (transport/teardown_guard.hpp).
+    TeardownGuard guard(exit_code, who, Seconds(kTeardownTimeoutS));
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+  participant_ = nullptr;
+  writers_.clear();
+  readers_.clear();
+  reader_by_name_.clear();
+  topics_.clear();
+}
+
+}  // namespace tessera::transport

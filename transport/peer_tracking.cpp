@@ -1,0 +1,133 @@
+#include "transport/peer_tracking.hpp"
+
+#include <cstdio>
+#include <optional>
+#include <sstream>
+
+namespace tessera::transport {
+
+PeerTracker::PeerTracker(Mailroom& room, const SessionOptions& options, PeerIdentity me)
+    : room_(room),
+      opt_(options),
+      me_(std::move(me)),
+      tolerate_agent_loss_(options.tolerate_agent_loss) {}
+
+void PeerTracker::discovered(const GuidPrefix& prefix, const PeerIdentity& who) {
+  std::string clash;
+  room_.with_lock([&] {
+    for (const auto& [p, id] : peers_)
+      if (p != prefix && !lost_.count(p) && id.coordinator == who.coordinator &&
+          id.agent_id == who.agent_id)
+        clash = who.describe();
+    if (!who.coordinator && who.agent_id == me_.agent_id && !me_.coordinator)
+      clash = who.describe();
+    if (who.coordinator && me_.coordinator) clash = who.describe();
+    peers_[prefix] = who;
+    return 0;
+  });
+  if (opt_.verbose)
+    std::fprintf(stderr, "%s: discovered %s\n", participant_name(me_).c_str(),
+                 who.describe().c_str());
+  room_.notify();
+  if (!clash.empty())
+    room_.request_stop(2, "two processes claim to be " + clash + " of run '" + opt_.run_id +
+                              "' (check --id / --run-id)");
+}
+
+void PeerTracker::left(const GuidPrefix& prefix) {
+  gone(prefix, "left the run", /*graceful=*/true);
+}
+
+void PeerTracker::dropped(const GuidPrefix& prefix) {
+  char buf[96];
+  std::snprintf(buf, sizeof(buf), "stopped responding (participant lease of %.1f s expired)",
+                opt_.lease_s);
+  gone(prefix, buf, /*graceful=*/false);
+}
+
+void PeerTracker::liveliness_lost(const GuidPrefix& prefix) {
+  char buf[96];
+  std::snprintf(buf, sizeof(buf), "stopped responding (writer liveliness of %.1f s lost)",
+                opt_.lease_s);
+  gone(prefix, buf, /*graceful=*/false);
+}
+
+void PeerTracker::gone(const GuidPrefix& prefix, const std::string& how, bool graceful) {
+  std::optional<PeerIdentity> who;
+  bool fatal = false;
+  room_.with_lock([&] {
+    auto it = peers_.find(prefix);
+    if (it != peers_.end() && !lost_.count(prefix)) {
+      lost_.insert(prefix);
+      who = it->second;
+      fatal = loss_fatal_ && !(tolerate_agent_loss_ && !it->second.coordinator);
+    }
+    return 0;
+  });
+  if (!who) return;
+  if (opt_.verbose)
+    std::fprintf(stderr, "%s: lost %s: %s\n", participant_name(me_).c_str(),
+                 who->describe().c_str(), how.c_str());
+  room_.notify();
+  if (!fatal) return;
+  const std::string why = "lost " + who->describe() + " of run '" + opt_.run_id + "': it " + how;
+  // A peer that left cleanly has (almost always) sent or seen an ABORT that says why;
+  // give it a moment to arrive so the message names the cause, not the symptom.
+  if (graceful)
+    room_.request_stop_after(1, why, Seconds(2.0));
+  else
+    room_.request_stop(1, why);
+}
+
+void PeerTracker::set_loss_fatal(bool fatal) {
+  room_.with_lock([&] { return loss_fatal_ = fatal; });
+}
+
+void PeerTracker::set_agent_loss_tolerated(bool tolerated) {
+  room_.with_lock([&] { return tolerate_agent_loss_ = tolerated; });
+}
+
+std::vector<PeerIdentity> PeerTracker::live_peers() const {
+  std::lock_guard<std::mutex> lock(room_.mutex());
+  std::vector<PeerIdentity> out;
+  for (const auto& [p, who] : peers_)
+    if (!lost_.count(p)) out.push_back(who);
+  return out;
+}
+
+std::size_t PeerTracker::peers_ever_seen() const {
+  std::lock_guard<std::mutex> lock(room_.mutex());
+  return peers_.size();
+}
+
+std::vector<std::uint32_t> PeerTracker::lost_agents() const {
+  std::lock_guard<std::mutex> lock(room_.mutex());
+  std::set<std::uint32_t> lost, live;
+  for (const auto& [p, who] : peers_) {
+    if (who.coordinator) continue;
+    (lost_.count(p) ? lost : live).insert(who.agent_id);
+  }
+  std::vector<std::uint32_t> out;
+  for (auto k : lost)
+    if (!live.count(k)) out.push_back(k);
+  return out;
+}
+
+const PeerIdentity* PeerTracker::known_locked(const GuidPrefix& prefix) const {
+  auto it = peers_.find(prefix);
+  return it == peers_.end() ? nullptr : &it->second;
+}
+
+const PeerIdentity* PeerTracker::live_locked(const GuidPrefix& prefix) const {
+  return lost_.count(prefix) ? nullptr : known_locked(prefix);
+}
+
+std::string PeerTracker::describe_locked(const GuidPrefix& prefix) const {
+  auto it = peers_.find(prefix);
+  if (it != peers_.end()) return it->second.describe() + (lost_.count(prefix) ? " (lost)" : "");
+  std::ostringstream os;
+  os << "unknown " << prefix;
+  return os.str();
+}
+
+}  // namespace tessera::transport

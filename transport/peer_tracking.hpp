@@ -1,0 +1,78 @@
+#pragma once
+// Which participants of this run a process has discovered and lost, and what a loss does:
+// a lost peer stops the session (Mailroom::request_stop) unless losses are not fatal (the
+// run's work is done) or it is an agent and agent losses are tolerated. Also detects two
+// processes claiming the same role. Internal to transport/; state is guarded by the
+// mailroom's mutex (the *_locked members require it held).
+
+#include <fastdds/rtps/common/GuidPrefix_t.hpp>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "transport/dds_trace.hpp"
+#include "transport/inbox.hpp"
+#include "transport/run_identity.hpp"
+#include "transport/session_options.hpp"
+
+namespace tessera::transport {
+
+/// A DDS participant's GUID prefix: how listeners name the remote side of an event.
+using GuidPrefix = eprosima::fastrtps::rtps::GuidPrefix_t;
+
+class PeerTracker {
+ public:
+  PeerTracker(Mailroom& room, const SessionOptions& options, PeerIdentity me);
+
+  /// This process's own participant (set once it exists): events about it are ignored.
+  void set_own_prefix(const GuidPrefix& prefix) { own_prefix_ = prefix; }
+  bool is_own(const GuidPrefix& prefix) const { return prefix == own_prefix_; }
+
+  /// A participant of this run appeared as `who`. Stops the session with exit code 2 when
+  /// another live process already claims the same role (or this process's own role).
+  void discovered(const GuidPrefix& prefix, const PeerIdentity& who);
+  /// The peer left cleanly: the stop (if fatal) waits 2 s so an ABORT that says why can
+  /// arrive first and name the cause.
+  void left(const GuidPrefix& prefix);
+  /// The peer's participant lease expired.
+  void dropped(const GuidPrefix& prefix);
+  /// One of the peer's writers lost its liveliness.
+  void liveliness_lost(const GuidPrefix& prefix);
+
+  /// When false, a lost peer is only logged.
+  void set_loss_fatal(bool fatal);
+  /// See SessionOptions::tolerate_agent_loss.
+  void set_agent_loss_tolerated(bool tolerated);
+
+  std::vector<PeerIdentity> live_peers() const;
+  std::size_t peers_ever_seen() const;
+  /// Agents discovered and lost, with no live process of the same id since.
+  std::vector<std::uint32_t> lost_agents() const;
+
+  // ---- with the mailroom's mutex held ------------------------------------------------------
+  /// The peer of `prefix` if discovered (lost or not), else nullptr.
+  const PeerIdentity* known_locked(const GuidPrefix& prefix) const;
+  /// The peer of `prefix` if discovered and not lost, else nullptr.
+  const PeerIdentity* live_locked(const GuidPrefix& prefix) const;
+  /// Every peer ever discovered, by prefix.
+  const std::map<GuidPrefix, PeerIdentity>& all_locked() const { return peers_; }
+  bool lost_locked(const GuidPrefix& prefix) const { return lost_.count(prefix) > 0; }
+  /// "agent 2", "agent 2 (lost)" or "unknown <prefix>" (for traces; the lock is not needed
+  /// while tracing is off, as then nothing is printed).
+  std::string describe_locked(const GuidPrefix& prefix) const;
+
+ private:
+  void gone(const GuidPrefix& prefix, const std::string& how, bool graceful);
+
+  Mailroom& room_;
+  const SessionOptions& opt_;
+  PeerIdentity me_;
+  GuidPrefix own_prefix_;
+  std::map<GuidPrefix, PeerIdentity> peers_;  // participants of this run, by GUID prefix
+  std::set<GuidPrefix> lost_;
+  bool loss_fatal_ = true;
+  bool tolerate_agent_loss_ = false;
+};
+
+}  // namespace tessera::transport

@@ -1,0 +1,80 @@
+#pragma once
+// Whether the processes of a run can reach each other: which peers each endpoint must match,
+// which remote participants each endpoint has matched (from the listeners), READY and
+// FINISHED from the other processes, and the waits built on them (the readiness barrier,
+// the linger before leaving on an error). Internal to transport/; state is guarded by the
+// mailroom's mutex.
+
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "transport/dds_trace.hpp"
+#include "transport/inbox.hpp"
+#include "transport/peer_tracking.hpp"
+#include "transport/session_options.hpp"
+
+namespace tessera::transport {
+
+/// Which peers an endpoint must match before the readiness barrier can pass.
+enum class Expect { kNone, kOtherAgents, kOtherAgentsAndCoordinator, kCoordinator, kAllAgents };
+
+class Readiness {
+ public:
+  Readiness(Mailroom& room, const SessionOptions& options, PeerIdentity me,
+            const PeerTracker& peers, const DdsTrace& trace);
+
+  /// Endpoint `endpoint` ("<topic>/w" or "<topic>/r") must match the peers of `e` (kNone:
+  /// no requirement). Called while the endpoints are created.
+  void expect(const std::string& endpoint, Expect e);
+  /// Listener event: `endpoint` matched (change > 0) or unmatched (< 0) an endpoint of the
+  /// participant `prefix` (own participant ignored). Wakes waiters.
+  void on_matched(const std::string& endpoint, const GuidPrefix& prefix, int change);
+  /// READY received from `from`. Wakes waiters.
+  void on_ready(const PeerIdentity& from);
+  /// FINISHED received from the coordinator. Wakes waiters.
+  void on_finished();
+
+  /// The peers of a complete run that `e` names (without a coordinator when the run has none).
+  std::vector<PeerIdentity> expected_peers(Expect e) const;
+  /// Whether every expected endpoint matched every live expected peer; else `missing` (if
+  /// given) lists the absent peers. Locks the mailroom.
+  bool endpoints_matched(std::string* missing) const;
+  bool finished() const;
+  WaitStatus wait_finished(Seconds timeout);
+
+  /// The readiness barrier: waits until endpoints_matched(), calls `send_ready`, then waits
+  /// for READY from every other agent (and the coordinator, for agents), all within
+  /// `timeout`. On kTimeout `missing` names who is not ready and `dump_match_state` is
+  /// called (trace of what each endpoint matched).
+  WaitStatus barrier(Seconds timeout, std::string* missing, const std::function<void()>& send_ready,
+                     const std::function<void()>& dump_match_state);
+  /// Waits (not interrupted by a stop, bounded by `timeout`) until `endpoint` has matched
+  /// every other process of the run or that process is gone; processes never discovered are
+  /// waited for only `unseen_patience`. Returns when done, whatever the outcome.
+  void wait_matched_or_gone(const std::string& endpoint, Seconds timeout, Seconds unseen_patience);
+
+  // ---- with the mailroom's mutex held ------------------------------------------------------
+  bool endpoints_matched_locked(std::string* missing) const;
+  /// " <peer> <peer> ..." the listeners report as matched on `endpoint` (for traces).
+  std::string describe_matched_locked(const std::string& endpoint) const;
+
+ private:
+  /// The other agents, and the coordinator for an agent of a run that has one.
+  std::vector<PeerIdentity> other_processes() const;
+
+  Mailroom& room_;
+  const SessionOptions& opt_;
+  PeerIdentity me_;
+  const PeerTracker& peers_;
+  const DdsTrace& trace_;
+  std::map<std::string, std::multiset<GuidPrefix>>
+      matched_;  // endpoint name -> matched remote participants
+  std::map<std::string, Expect> expect_;
+  std::set<std::string> ready_from_;  // describe() of peers that published READY
+  bool finished_ = false;
+};
+
+}  // namespace tessera::transport

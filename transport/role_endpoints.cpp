@@ -1,0 +1,101 @@
+// create_role_endpoints (session_parts.hpp): which topics the coordinator and the agents
+// write and read, with what durability, which peers each must match before the readiness
+// barrier, and where each received sample goes.
+
+#include "tesseraPubSubTypes.h"
+#include "transport/message_mapping.hpp"
+#include "transport/session_parts.hpp"
+#include "transport/topic_names.hpp"
+
+namespace tessera::transport {
+
+namespace {
+
+// Control: everyone reads everyone (READY barrier, ABORT, FINISHED, REJOIN, ROLLBACK).
+void dispatch_control(SessionParts& s, wire::Control&& m) {
+  PeerIdentity from{s.opt.run_id, m.sender() == kCoordinatorId,
+                    m.sender() == kCoordinatorId ? 0u : m.sender()};
+  switch (m.kind()) {
+    case wire::CONTROL_READY:
+      s.readiness.on_ready(from);
+      break;
+    case wire::CONTROL_FINISHED:
+      s.readiness.on_finished();
+      break;
+    case wire::CONTROL_ABORT:
+      s.room.request_stop(1, from.describe() + " aborted run '" + s.opt.run_id + "': " + m.reason(),
+                          true);
+      break;
+    case wire::CONTROL_REJOIN:
+      if (s.opt.coordinator) s.rejoin_in.push(std::move(m));
+      break;
+    case wire::CONTROL_ROLLBACK:
+      if (!s.opt.coordinator && m.sender() == kCoordinatorId) s.rollback_in.push(std::move(m));
+      break;
+  }
+}
+
+void create_coordinator_endpoints(SessionParts& s) {
+  DdsEntities& e = s.entities;
+  e.make_writer<wire::PartitionAssignmentPubSubType>(kAssignmentTopic, true, Expect::kNone);
+  e.make_writer<wire::ControlPubSubType>(kControlTopic, true, Expect::kNone);
+  e.make_reader<wire::AgentAnnouncementPubSubType, wire::AgentAnnouncement>(
+      kAnnounceTopic, true, Expect::kNone,
+      [&s](wire::AgentAnnouncement&& m) { s.announce_in.push(std::move(m)); });
+  e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
+      kStatusTopic, false, Expect::kAllAgents,
+      [&s](wire::RoundStatus&& m) { s.status_in.push(std::move(m)); });
+  e.make_reader<wire::FinalEstimatePubSubType, wire::FinalEstimate>(
+      kFinalTopic, false, Expect::kAllAgents,
+      [&s](wire::FinalEstimate&& m) { s.final_in.push(std::move(m)); });
+}
+
+void create_agent_endpoints(SessionParts& s) {
+  DdsEntities& e = s.entities;
+  const std::uint32_t me = s.me.agent_id;
+  e.make_writer<wire::AgentAnnouncementPubSubType>(kAnnounceTopic, true, Expect::kNone);
+  e.make_writer<wire::ControlPubSubType>(kControlTopic, true, Expect::kNone);
+  e.make_writer<wire::MeasurementHandoffPubSubType>(kHandoffTopic, false, Expect::kOtherAgents);
+  e.make_writer<wire::PoseBlockPubSubType>(kBlockTopic, false, Expect::kOtherAgents);
+  e.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false,
+                                             Expect::kOtherAgentsAndCoordinator);
+  e.make_writer<wire::FinalEstimatePubSubType>(kFinalTopic, false, Expect::kCoordinator);
+  e.make_reader<wire::PartitionAssignmentPubSubType, wire::PartitionAssignment>(
+      kAssignmentTopic, true, Expect::kNone,
+      [&s](wire::PartitionAssignment&& m) { s.assignment_in.push(std::move(m)); });
+  e.make_reader<wire::MeasurementHandoffPubSubType, wire::MeasurementHandoff>(
+      kHandoffTopic, false, Expect::kOtherAgents, [&s, me](wire::MeasurementHandoff&& m) {
+        if (m.recipient() != me || m.sender() == me) return;
+        if (m.purpose() == 1)
+          s.replica_in.push(std::move(m));
+        else
+          s.handoff_in.push(std::move(m));
+      });
+  e.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(
+      kBlockTopic, false, Expect::kOtherAgents, [&s](wire::PoseBlock&& m) {
+        s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
+                         ProtocolMessage(from_wire(m)));
+      });
+  e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
+      kStatusTopic, false, Expect::kOtherAgents, [&s](wire::RoundStatus&& m) {
+        s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
+                         ProtocolMessage(from_wire(m)));
+      });
+}
+
+}  // namespace
+
+void create_role_endpoints(SessionParts& s) {
+  if (s.opt.coordinator)
+    create_coordinator_endpoints(s);
+  else
+    create_agent_endpoints(s);
+  const std::uint32_t self_id = s.opt.coordinator ? kCoordinatorId : s.me.agent_id;
+  s.entities.make_reader<wire::ControlPubSubType, wire::Control>(
+      kControlTopic, true, Expect::kNone, [&s, self_id](wire::Control&& m) {
+        if (m.sender() == self_id) return;
+        dispatch_control(s, std::move(m));
+      });
+}
+
+}  // namespace tessera::transport

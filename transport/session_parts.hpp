@@ -1,0 +1,56 @@
+#pragma once
+// What a Session is made of (transport/session.hpp is the public view): its inboxes and the
+// pieces that fill and guard them, each in the file named for its concept. Members are
+// declared in dependency order (later ones refer to earlier ones). Internal to transport/.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "protocol/messages.hpp"
+#include "tessera.h"
+#include "transport/dds_entities.hpp"
+#include "transport/dds_trace.hpp"
+#include "transport/epoch_routing.hpp"
+#include "transport/inbox.hpp"
+#include "transport/network_profile.hpp"
+#include "transport/peer_tracking.hpp"
+#include "transport/readiness.hpp"
+#include "transport/run_identity.hpp"
+#include "transport/sample_writing.hpp"
+#include "transport/session_options.hpp"
+
+namespace tessera::transport {
+
+struct SessionParts {
+  /// `options` must be valid; `domain` is the resolved domain id.
+  SessionParts(const SessionOptions& options, int domain);
+
+  const SessionOptions opt;
+  const NetworkProfile net;  // network_profile(opt.network)
+  const int domain;
+  const PeerIdentity me;
+  const DdsTrace trace;
+  Mailroom room;
+  Inbox<wire::AgentAnnouncement> announce_in{room};
+  Inbox<wire::PartitionAssignment> assignment_in{room};
+  Inbox<wire::MeasurementHandoff> handoff_in{room};
+  Inbox<wire::MeasurementHandoff> replica_in{room};  // purpose 1: replicas of peers' data
+  Inbox<ProtocolMessage> protocol_in{room};
+  Inbox<wire::RoundStatus> status_in{room};
+  Inbox<wire::FinalEstimate> final_in{room};
+  Inbox<wire::Control> rejoin_in{room};
+  Inbox<wire::Control> rollback_in{room};
+  PeerTracker peers;
+  Readiness readiness;
+  EpochRouter router;
+  DdsEntities entities;
+  SampleWriter writer;
+};
+
+/// The topics the process of `parts.opt`'s role writes and reads, and where each received
+/// sample goes (inboxes, epoch routing, READY/FINISHED/ABORT handling). Requires
+/// parts.entities to be open. Throws TransportError.
+void create_role_endpoints(SessionParts& parts);
+
+}  // namespace tessera::transport
