@@ -9,6 +9,7 @@
 #include <random>
 
 #include "partition/graph_structure.hpp"
+#include "partition/multilevel.hpp"
 #include "partition/partition_metrics.hpp"
 #include "partition/partitioner.hpp"
 #include "util/input_error.hpp"
@@ -241,3 +242,87 @@ TEST(Partitioner, BadOptionsAreClearErrors) {
 }
 
 }  // namespace
+
+namespace {
+
+using namespace tessera::partition_detail;
+
+CycleParams relaxed_cycle(long long ub, double coarse_relax) {
+  CycleParams cp;
+  cp.coarsening.stop_vertices = 100;
+  cp.coarsening.max_vertex_weight = static_cast<int>(std::max<long long>(2, ub / 30));
+  cp.coarsening.label_propagation_rounds = 3;
+  cp.initial.repeats = 4;
+  cp.initial.fm = cp.fm;
+  cp.use_flow = true;
+  cp.flow_levels = 2;
+  cp.coarse_relax = coarse_relax;
+  return cp;
+}
+
+void expect_within(const WorkGraph& g, const std::vector<int>& part, int k,
+                   const std::vector<long long>& ub) {
+  ASSERT_EQ(part.size(), static_cast<std::size_t>(g.n));
+  for (int b : part) {
+    ASSERT_GE(b, 0);
+    ASSERT_LT(b, k);
+  }
+  const std::vector<long long> w = block_weights(g, part, k);
+  for (int b = 0; b < k; ++b) EXPECT_LE(w[b], ub[b]) << "block " << b;
+}
+
+}  // namespace
+
+// coarse_relax loosens the bound on the coarse levels only: whatever the coarse levels did, the
+// result on the input graph obeys the exact bound, and a fixed RNG seed gives the same
+// partition. Without relaxation a V-cycle from a balanced partition is never worse than it
+// (with it, the repair on the input graph may cost cut: the evolutionary search compares).
+TEST(MultilevelCycle, RelaxedCoarseLevelsKeepTheExactBoundOnTheInputGraph) {
+  const GraphStructure structure = pose_like_graph(3000, 17);
+  const WorkGraph g = to_work_graph(structure);
+  const int k = 5;
+  const std::vector<long long> ub(
+      k, static_cast<long long>(max_block_size(structure.num_vertices, k, 0.03)));
+  for (double relax : {0.0, 0.05, 0.2}) {
+    const CycleParams cp = relaxed_cycle(ub[0], relax);
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      Rng rng(seed);
+      CycleStats fresh_stats;
+      const std::vector<int> fresh = multilevel_partition(g, k, ub, cp, rng, &fresh_stats);
+      expect_within(g, fresh, k, ub);
+      EXPECT_GT(fresh_stats.levels, 0) << "the test graph should be coarsened";
+      const long long fresh_cut = edge_cut(g, fresh);
+      EXPECT_EQ(fresh_stats.cut, fresh_cut);
+
+      const std::vector<int> cycled = guided_cycle(g, k, ub, fresh, fresh, cp, rng);
+      expect_within(g, cycled, k, ub);
+      if (relax == 0.0) {
+        EXPECT_LE(edge_cut(g, cycled), fresh_cut) << "seed " << seed;
+      }
+
+      Rng again(seed);
+      EXPECT_EQ(multilevel_partition(g, k, ub, cp, again), fresh);
+    }
+  }
+}
+
+// Even a large coarse relaxation is repaired under the tightest bound (eps = 0, every block at
+// most ceil(n/k)) on the input graph, and the relaxation does change the search (otherwise the
+// parameter would be ignored).
+TEST(MultilevelCycle, LargeCoarseRelaxationIsRepairedUnderATightBound) {
+  const GraphStructure structure = grid_graph(60, 50);
+  const WorkGraph g = to_work_graph(structure);
+  const int k = 7;
+  const std::vector<long long> ub(
+      k, static_cast<long long>(max_block_size(structure.num_vertices, k, 0.0)));
+  int differing = 0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    Rng r1(seed), r2(seed);
+    const std::vector<int> tight = multilevel_partition(g, k, ub, relaxed_cycle(ub[0], 0.0), r1);
+    const std::vector<int> relaxed = multilevel_partition(g, k, ub, relaxed_cycle(ub[0], 0.3), r2);
+    expect_within(g, tight, k, ub);
+    expect_within(g, relaxed, k, ub);
+    differing += tight != relaxed ? 1 : 0;
+  }
+  EXPECT_GT(differing, 0);
+}

@@ -29,17 +29,27 @@ long long refine_level(const WorkGraph& g, int k, std::vector<int>& part,
 
 namespace {
 
+std::vector<long long> coarse_bounds(const std::vector<long long>& ub, const CycleParams& params) {
+  if (params.coarse_relax <= 0.0) return ub;
+  std::vector<long long> relaxed = ub;
+  for (auto& b : relaxed)
+    b = static_cast<long long>(static_cast<double>(b) * (1.0 + params.coarse_relax));
+  return relaxed;
+}
+
 // Projects the coarsest partition down level by level, rebalancing and refining on each.
 std::vector<int> uncoarsen(const WorkGraph& fine, const Hierarchy& h, std::vector<int> part, int k,
                            const std::vector<long long>& ub, const CycleParams& params, Rng& rng,
                            CycleStats* stats) {
+  const std::vector<long long> ub_coarse = coarse_bounds(ub, params);
   for (int level = static_cast<int>(h.coarse.size()) - 1; level >= 0; --level) {
     const WorkGraph& g = level > 0 ? h.coarse[level - 1] : fine;
     const std::vector<int>& map = h.maps[level];
     std::vector<int> finer(static_cast<std::size_t>(g.n));
     for (int v = 0; v < g.n; ++v) finer[v] = part[map[v]];
     part.swap(finer);
-    const long long cut = refine_level(g, k, part, ub, params, rng, level <= params.flow_levels);
+    const long long cut = refine_level(g, k, part, level > 0 ? ub_coarse : ub, params, rng,
+                                       level <= params.flow_levels);
     if (stats && level == 0) stats->cut = cut;
   }
   if (stats && h.coarse.empty()) stats->cut = edge_cut(fine, part);
@@ -52,7 +62,8 @@ std::vector<int> multilevel_partition(const WorkGraph& g, int k, const std::vect
                                       const CycleParams& params, Rng& rng, CycleStats* stats) {
   const Hierarchy h = coarsen(g, nullptr, params.coarsening, rng);
   const WorkGraph& top = h.top(g);
-  std::vector<int> part = initial_partition(top, k, level_bounds(top, ub), params.initial, rng);
+  const std::vector<long long> ub_top = h.coarse.empty() ? ub : coarse_bounds(ub, params);
+  std::vector<int> part = initial_partition(top, k, level_bounds(top, ub_top), params.initial, rng);
   if (stats) {
     stats->levels = static_cast<int>(h.coarse.size());
     stats->coarsest_vertices = top.n;
@@ -75,7 +86,7 @@ std::vector<int> guided_cycle(const WorkGraph& g, int k, const std::vector<long 
     for (std::size_t v = 0; v < map.size(); ++v) coarse[map[v]] = part[v];
     part.swap(coarse);
   }
-  refine_level(top, k, part, ub, params, rng,
+  refine_level(top, k, part, h.coarse.empty() ? ub : coarse_bounds(ub, params), params, rng,
                static_cast<int>(h.coarse.size()) <= params.flow_levels);
   if (stats) {
     stats->levels = static_cast<int>(h.coarse.size());

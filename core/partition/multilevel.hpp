@@ -19,6 +19,11 @@ struct CycleParams {
   bool use_flow = false;  ///< Add max-flow refinement between block pairs...
   int flow_levels = 64;   ///< ...on this many of the finest levels (0 = the input graph only).
   FlowParams flow;
+  /// Coarse levels (all but the input graph) use bounds (1 + coarse_relax) x ub: a looser
+  /// balance there lets the search pass through partitions the tight bound forbids (e.g. one
+  /// light block and the others at the bound); the input graph is rebalanced and refined under
+  /// the exact ub. 0 = the same bound everywhere.
+  double coarse_relax = 0.0;
 };
 
 /// The bounds used on a level whose heaviest vertex weighs w: ub + w - 1. Coarse levels may
@@ -47,7 +52,8 @@ std::vector<int> multilevel_partition(const WorkGraph& g, int k, const std::vect
 /// A V-cycle that keeps `start` representable on every level: coarsening only contracts
 /// vertices with the same `label` (e.g. the block of `start`, or a pair of blocks of two parents
 /// for combine), the coarsest graph starts from `start`, and FM refines on every level. The
-/// result is never worse than `start` (if `start` is balanced).
+/// result is never worse than `start` if `start` is balanced and params.coarse_relax is 0 (with
+/// a relaxed coarse bound the input graph's repair may cost cut: callers compare).
 std::vector<int> guided_cycle(const WorkGraph& g, int k, const std::vector<long long>& ub,
                               const std::vector<int>& label, const std::vector<int>& start,
                               const CycleParams& params, Rng& rng, CycleStats* stats = nullptr);
