@@ -1,11 +1,13 @@
 // The lifted problem: data matrix, block objective, derivatives, manifold operations.
 
-#include <random>
-
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
 
 #include "manifold/lifted_manifold.hpp"
 #include "problem/block_problem.hpp"
+#include "problem/data_matrix.hpp"
 #include "problem/lifting.hpp"
 #include "problem/objective.hpp"
 #include "problem/rounding.hpp"
@@ -91,8 +93,7 @@ TEST_P(ProblemTest, ProjectionAndRetractionLandOnManifold) {
   }
   // Projection is idempotent and the nearest point: translations untouched.
   EXPECT_LT((M.project(X) - X).norm(), 1e-12);
-  for (std::size_t i = 0; i < 40; ++i)
-    EXPECT_EQ(X.col((d + 1) * i + d), A.col((d + 1) * i + d));
+  for (std::size_t i = 0; i < 40; ++i) EXPECT_EQ(X.col((d + 1) * i + d), A.col((d + 1) * i + d));
 }
 
 TEST_P(ProblemTest, BlockCostSharesSumToGlobalCost) {
@@ -120,8 +121,9 @@ TEST_P(ProblemTest, BlockCostSharesSumToGlobalCost) {
     Eigen::MatrixXd G = whole.euclidean_gradient(X);
     Eigen::MatrixXd Gb = P.euclidean_gradient(Xb);
     for (std::size_t k = 0; k < owned.size(); ++k)
-      EXPECT_LT((Gb.middleCols((d + 1) * k, d + 1) - G.middleCols((d + 1) * owned[k], d + 1)).norm(),
-                1e-9 * (1.0 + G.norm()));
+      EXPECT_LT(
+          (Gb.middleCols((d + 1) * k, d + 1) - G.middleCols((d + 1) * owned[k], d + 1)).norm(),
+          1e-9 * (1.0 + G.norm()));
     // Block cost with neighbours fixed changes exactly like the global cost when only the
     // block moves.
     Eigen::MatrixXd D = Eigen::MatrixXd::Random(Xb.rows(), Xb.cols()) * 0.1;
@@ -144,6 +146,115 @@ TEST_P(ProblemTest, RoundingRecoversPosesFromARotatedLift) {
   Eigen::MatrixXd O = project_to_rotation(Eigen::MatrixXd::Random(r, r));
   auto poses = round_solution(g, O * X);
   EXPECT_LT(evaluate_objective(g, poses), 1e-16 * g.num_measurements() + 1e-18);
+}
+
+// The triplet assembly build_data_matrix replaced (duplicates summed in list order by
+// setFromTriplets): the new pose-block assembly must give the same pattern (explicit zeros
+// included, which the preconditioner's ordering sees) and the same values to the last bit.
+SparseMatrix triplet_data_matrix(const std::vector<Measurement>& ms, int d, std::size_t n) {
+  using Index = Eigen::Index;
+  const Index w = d + 1;
+  std::vector<Eigen::Triplet<double>> t;
+  auto add = [&](Index r, Index c, double v) { t.emplace_back(r, c, v); };
+  for (const Measurement& m : ms) {
+    const Index ri = w * static_cast<Index>(m.i), rj = w * static_cast<Index>(m.j);
+    const Index ti = ri + d, tj = rj + d;
+    for (Index a = 0; a < d; ++a) {
+      add(ri + a, ri + a, m.kappa);
+      add(rj + a, rj + a, m.kappa);
+      for (Index b = 0; b < d; ++b) {
+        add(ri + a, rj + b, -m.kappa * m.R(a, b));
+        add(rj + b, ri + a, -m.kappa * m.R(a, b));
+      }
+    }
+    for (Index a = 0; a < d; ++a) {
+      for (Index b = 0; b < d; ++b) add(ri + a, ri + b, m.tau * m.t(a) * m.t(b));
+      add(ri + a, ti, m.tau * m.t(a));
+      add(ti, ri + a, m.tau * m.t(a));
+      add(ri + a, tj, -m.tau * m.t(a));
+      add(tj, ri + a, -m.tau * m.t(a));
+    }
+    add(ti, ti, m.tau);
+    add(tj, tj, m.tau);
+    add(ti, tj, -m.tau);
+    add(tj, ti, -m.tau);
+  }
+  SparseMatrix Q(w * static_cast<Index>(n), w * static_cast<Index>(n));
+  Q.setFromTriplets(t.begin(), t.end());
+  Q.makeCompressed();
+  return Q;
+}
+
+void expect_identical(const SparseMatrix& A, const SparseMatrix& B) {
+  ASSERT_EQ(A.rows(), B.rows());
+  ASSERT_EQ(A.cols(), B.cols());
+  ASSERT_EQ(A.nonZeros(), B.nonZeros());
+  for (Eigen::Index c = 0; c < A.cols(); ++c) {
+    SparseMatrix::InnerIterator a(A, c), b(B, c);
+    for (; a && b; ++a, ++b) {
+      ASSERT_EQ(a.row(), b.row()) << "column " << c;
+      ASSERT_EQ(a.value(), b.value()) << "entry (" << a.row() << ", " << c << ")";  // bitwise
+    }
+    ASSERT_EQ(bool(a), bool(b)) << "column " << c;
+  }
+}
+
+TEST_P(ProblemTest, DataMatrixEqualsTheTripletAssemblyExactly) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 30, 25, 0.05, 0.1, 9});
+  // Repeated pairs, in both directions, and a measurement with exact zeros in R and t.
+  auto ms = g.measurements;
+  for (std::size_t k = 0; k < 6; ++k) {
+    Measurement m = ms[3 * k + 1];
+    if (k % 2) std::swap(m.i, m.j);
+    m.kappa *= 1.7;
+    ms.push_back(m);
+  }
+  Measurement z = ms.front();
+  z.R = Eigen::MatrixXd::Identity(d, d);
+  z.t = Eigen::VectorXd::Zero(d);
+  ms.push_back(z);
+  const SparseMatrix ref = triplet_data_matrix(ms, d, g.num_poses);
+  expect_identical(build_data_matrix(ms, d, g.num_poses), ref);
+
+  // A block's Q_BB and Q_NB: the owned slots (in a scrambled order) first, then neighbours.
+  std::vector<std::size_t> owned;
+  for (std::size_t i = 0; i < g.num_poses; i += 3) owned.push_back(i);
+  std::reverse(owned.begin() + 2, owned.end());
+  std::vector<std::size_t> slot(g.num_poses, g.num_poses), neighbours;
+  for (std::size_t s = 0; s < owned.size(); ++s) slot[owned[s]] = s;
+  std::vector<const Measurement*> touching;
+  for (const auto& m : ms) {
+    const bool oi = slot[m.i] < g.num_poses, oj = slot[m.j] < g.num_poses;
+    if (!oi && !oj) continue;
+    touching.push_back(&m);
+    if (!oi) neighbours.push_back(m.i);
+    if (!oj) neighbours.push_back(m.j);
+  }
+  std::sort(neighbours.begin(), neighbours.end());
+  neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
+  ASSERT_FALSE(neighbours.empty());
+  for (std::size_t k = 0; k < neighbours.size(); ++k) slot[neighbours[k]] = owned.size() + k;
+  std::vector<std::size_t> si, sj;
+  std::vector<Measurement> relabelled;
+  for (const Measurement* m : touching) {
+    si.push_back(slot[m->i]);
+    sj.push_back(slot[m->j]);
+    relabelled.push_back(*m);
+    relabelled.back().i = si.back();
+    relabelled.back().j = sj.back();
+  }
+  const std::size_t slots = owned.size() + neighbours.size();
+  const SparseMatrix full = triplet_data_matrix(relabelled, d, slots);
+  const auto blocks = build_data_matrix_blocks(touching, si, sj, d, slots, owned.size());
+  const Eigen::Index nb = (d + 1) * static_cast<Eigen::Index>(owned.size());
+  const Eigen::Index nn = (d + 1) * static_cast<Eigen::Index>(neighbours.size());
+  SparseMatrix Qbb = full.topLeftCorner(nb, nb), Qnb = full.bottomLeftCorner(nn, nb);
+  Qbb.makeCompressed();
+  Qnb.makeCompressed();
+  expect_identical(blocks.own, Qbb);
+  expect_identical(blocks.neighbour, Qnb);
+  expect_identical(BlockProblem(d, owned, ms).data_matrix(), Qbb);
 }
 
 INSTANTIATE_TEST_SUITE_P(Dimensions, ProblemTest, ::testing::Values(2, 3));

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <stdexcept>
-#include <unordered_map>
 
 #include "problem/pose_kernels.hpp"
 
@@ -11,17 +10,23 @@ namespace tessera {
 BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
                            const std::vector<Measurement>& measurements)
     : d_(d), owned_(std::move(owned)) {
-  std::unordered_map<std::size_t, std::size_t> owned_slot;
-  owned_slot.reserve(owned_.size() * 2);
+  // Slot of every pose id (a flat table: every agent scans all measurements it is given, and
+  // a hash lookup per endpoint was most of that scan at 10^6 poses).
+  std::size_t max_id = 0;
+  for (std::size_t id : owned_) max_id = std::max(max_id, id);
+  for (const auto& m : measurements) max_id = std::max({max_id, m.i, m.j});
+  constexpr std::size_t kNotOwned = static_cast<std::size_t>(-1);
+  std::vector<std::size_t> slot(owned_.empty() && measurements.empty() ? 0 : max_id + 1, kNotOwned);
   for (std::size_t s = 0; s < owned_.size(); ++s) {
-    if (!owned_slot.emplace(owned_[s], s).second)
+    if (slot[owned_[s]] != kNotOwned)
       throw std::invalid_argument("BlockProblem: pose listed twice in block");
+    slot[owned_[s]] = s;
   }
   // First pass: which measurements touch the block, and which neighbours they bring.
   std::vector<std::size_t> touching;
   for (std::size_t k = 0; k < measurements.size(); ++k) {
     const auto& m = measurements[k];
-    bool oi = owned_slot.count(m.i) > 0, oj = owned_slot.count(m.j) > 0;
+    const bool oi = slot[m.i] != kNotOwned, oj = slot[m.j] != kNotOwned;
     if (!oi && !oj) continue;
     touching.push_back(k);
     if (!oi) neighbors_.push_back(m.i);
@@ -29,32 +34,26 @@ BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
   }
   std::sort(neighbors_.begin(), neighbors_.end());
   neighbors_.erase(std::unique(neighbors_.begin(), neighbors_.end()), neighbors_.end());
-  auto slot_of = [&](std::size_t id) {
-    auto it = owned_slot.find(id);
-    if (it != owned_slot.end()) return it->second;
-    return owned_.size() +
-           static_cast<std::size_t>(std::lower_bound(neighbors_.begin(), neighbors_.end(), id) -
-                                    neighbors_.begin());
-  };
+  for (std::size_t k = 0; k < neighbors_.size(); ++k) slot[neighbors_[k]] = owned_.size() + k;
   edge_storage_.reserve(touching.size());
   for (auto k : touching) edge_storage_.push_back(measurements[k]);
   std::vector<const Measurement*> ptrs;
   std::vector<std::size_t> si, sj;
+  ptrs.reserve(touching.size());
+  si.reserve(touching.size());
+  sj.reserve(touching.size());
+  edges_.reserve(touching.size());
   for (std::size_t k = 0; k < edge_storage_.size(); ++k) {
     const Measurement& m = edge_storage_[k];
     ptrs.push_back(&m);
-    si.push_back(slot_of(m.i));
-    sj.push_back(slot_of(m.j));
+    si.push_back(slot[m.i]);
+    sj.push_back(slot[m.j]);
     edges_.push_back({k, si.back(), sj.back()});
   }
-  const std::size_t total = owned_.size() + neighbors_.size();
-  SparseMatrix Q = build_data_matrix(ptrs, si, sj, d_, total);
-  const Eigen::Index nb = (d_ + 1) * static_cast<Eigen::Index>(owned_.size());
-  const Eigen::Index nn = (d_ + 1) * static_cast<Eigen::Index>(neighbors_.size());
-  Q_bb_ = Q.topLeftCorner(nb, nb);
-  Q_nb_ = Q.bottomLeftCorner(nn, nb);
-  Q_bb_.makeCompressed();
-  Q_nb_.makeCompressed();
+  DataMatrixBlocks Q =
+      build_data_matrix_blocks(ptrs, si, sj, d_, owned_.size() + neighbors_.size(), owned_.size());
+  Q_bb_ = std::move(Q.own);
+  Q_nb_ = std::move(Q.neighbour);
 }
 
 BlockProblem BlockProblem::whole_graph(int d, std::size_t num_poses,

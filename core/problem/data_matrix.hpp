@@ -3,10 +3,9 @@
 // manifold/lifted_manifold.hpp), f(X) = tr(X Q X^T) equals the reference objective
 //   sum_e kappa ||Y_j - Y_i R_ij||_F^2 + tau ||p_j - p_i - Y_i t_ij||^2   (the full sum).
 
+#include <Eigen/SparseCore>
 #include <cstddef>
 #include <vector>
-
-#include <Eigen/SparseCore>
 
 #include "graph/measurement.hpp"
 
@@ -24,5 +23,19 @@ SparseMatrix build_data_matrix(const std::vector<const Measurement*>& measuremen
 /// Q for a whole graph whose poses are slots 0..n-1.
 SparseMatrix build_data_matrix(const std::vector<Measurement>& measurements, int d,
                                std::size_t num_poses);
+
+/// The two parts of Q a block problem needs, with slots 0..num_owned-1 the block's own poses
+/// and num_owned..num_slots-1 its neighbours: Q_BB (own rows and columns) and Q_NB
+/// (neighbour rows, own columns). Exactly the corresponding blocks of build_data_matrix's Q
+/// (same entries, explicit zeros included, same floating-point sums), built without the
+/// neighbour columns.
+struct DataMatrixBlocks {
+  SparseMatrix own;        ///< Q_BB, (d+1)num_owned square.
+  SparseMatrix neighbour;  ///< Q_NB, (d+1)(num_slots - num_owned) x (d+1)num_owned.
+};
+DataMatrixBlocks build_data_matrix_blocks(const std::vector<const Measurement*>& measurements,
+                                          const std::vector<std::size_t>& slot_of_i,
+                                          const std::vector<std::size_t>& slot_of_j, int d,
+                                          std::size_t num_slots, std::size_t num_owned);
 
 }  // namespace tessera
