@@ -6,6 +6,7 @@
 
 #include "agent/dds_channel.hpp"
 #include "agent/local_dump.hpp"
+#include "graph/flat_pose.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
 
@@ -39,7 +40,7 @@ void deliver_final_estimate(Session& s, const AgentLocalData& local, const Round
   fin.dim(static_cast<std::uint32_t>(local.d));
   fin.rounds(result.rounds);
   fin.pose_ids(local.owned);
-  for (const Pose& p : result.poses) append_pose(fin.pose_data(), p);
+  for (const Pose& p : result.poses) append_flat_pose(fin.pose_data(), p);
   fin.bytes_sent(s.stats().bytes_sent + serialized_size(fin));
   fin.epoch(s.epoch());
   s.publish(fin);

@@ -9,6 +9,7 @@
 
 #include "distributed/distributed_initialization.hpp"
 #include "distributed/distributed_solver.hpp"
+#include "graph/flat_pose.hpp"
 #include "solvers/chordal_initialization.hpp"
 #include "util/input_error.hpp"
 
@@ -75,21 +76,6 @@ class StageMailbox {
   std::uint32_t self_;
   std::map<std::uint32_t, std::map<std::uint32_t, ProtocolMessage>> stash_;
 };
-
-void append_pose(std::vector<double>& out, const Pose& p, std::size_t width) {
-  const std::size_t start = out.size();
-  out.insert(out.end(), p.R.data(), p.R.data() + p.R.size());
-  out.insert(out.end(), p.t.data(), p.t.data() + p.t.size());
-  out.resize(start + width, 0.0);
-}
-
-Pose pose_at(const std::vector<double>& data, std::size_t offset, int d) {
-  const std::size_t dd = static_cast<std::size_t>(d);
-  Pose p;
-  p.R = Eigen::Map<const Eigen::MatrixXd>(data.data() + offset, d, d);
-  p.t = Eigen::Map<const Eigen::VectorXd>(data.data() + offset + dd * dd, d);
-  return p;
-}
 
 PoseBlockMessage block(std::uint32_t self, std::uint32_t phase, std::uint32_t rank, int d) {
   PoseBlockMessage m;
@@ -174,7 +160,7 @@ std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std
                                 const std::string& source, ProtocolChannel& channel,
                                 StageMailbox& mail) {
   const int d = share.d;
-  const std::size_t width = static_cast<std::size_t>(d) * static_cast<std::size_t>(d + 1);
+  const std::size_t width = flat_pose_size(d);
   std::vector<const Measurement*> mine;
   for (const auto& m : share.measurements) mine.push_back(&m);
   if (self != 0) {
@@ -191,7 +177,7 @@ std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std
     for (std::size_t k = 0; k < m.pose_ids.size(); ++k) {
       const std::uint32_t id = m.pose_ids[k];
       if (id < share.begin || id >= share.end) continue;
-      out[id - share.begin] = pose_at(m.data, k * width, d);
+      out[id - share.begin] = read_flat_pose(m.data, k * width, d);
       seen[id - share.begin] = true;
     }
     if (std::find(seen.begin(), seen.end(), false) != seen.end())
@@ -214,7 +200,7 @@ std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std
     PoseBlockMessage out = block(self, kChordalPoses, static_cast<std::uint32_t>(d), d);
     for (std::size_t id = 0; id < poses.size(); ++id) {
       out.pose_ids.push_back(static_cast<std::uint32_t>(id));
-      append_pose(out.data, poses[id], width);
+      append_flat_pose(out.data, poses[id], width);
     }
     channel.send(OutgoingMessage{std::move(out), true, {}});
   }
@@ -245,9 +231,8 @@ std::vector<Pose> distributed_stage(
   for (std::size_t id : boundary) {
     const auto [u, k] = slot[id - share.begin];
     ends.pose_ids.push_back(static_cast<std::uint32_t>(id));
-    append_pose(ends.data, units.poses[u][k], unit_width);
-    ends.data[ends.data.size() - unit_width + static_cast<std::size_t>(d * (d + 1))] =
-        static_cast<double>(u);
+    append_flat_pose(ends.data, units.poses[u][k], unit_width);
+    ends.data[ends.data.size() - unit_width + flat_pose_size(d)] = static_cast<double>(u);
   }
   std::vector<const Measurement*> crossing_mine;
   std::vector<std::uint64_t> crossing_index;
@@ -289,12 +274,12 @@ std::vector<Pose> distributed_stage(
       throw std::runtime_error("initialisation: malformed unit poses from agent " +
                                std::to_string(a));
     for (std::size_t k = 0; k < m.pose_ids.size(); ++k) {
-      const double u = m.data[k * w + static_cast<std::size_t>(d * (d + 1))];
+      const double u = m.data[k * w + flat_pose_size(d)];
       if (!(u >= 0 && u < static_cast<double>(offset[a + 1] - offset[a])))
         throw std::runtime_error("initialisation: agent " + std::to_string(a) +
                                  " named a unit it does not have");
       endpoint[m.pose_ids[k]] = {offset[a] + static_cast<std::size_t>(u),
-                                 pose_at(m.data, k * w, d)};
+                                 read_flat_pose(m.data, k * w, d)};
     }
   }
   std::vector<std::pair<std::uint64_t, Measurement>> all;

@@ -2,12 +2,20 @@
 
 #include <algorithm>
 
+#include "graph/flat_pose.hpp"
+
 namespace tessera::transport {
 
 namespace {
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw TransportError("malformed message: " + what);
+}
+
+// The k-th pose of a flat array of poses in SE(d) (graph/flat_pose.hpp).
+Pose pose_at(const std::vector<double>& flat, std::size_t k, int d) {
+  require((k + 1) * flat_pose_size(d) <= flat.size(), "pose array too short");
+  return read_flat_pose(flat, k * flat_pose_size(d), d);
 }
 
 }  // namespace
@@ -83,26 +91,6 @@ bool addressed_to(bool broadcast, const std::vector<std::uint32_t>& recipients, 
   return broadcast || std::find(recipients.begin(), recipients.end(), me) != recipients.end();
 }
 
-void append_pose(std::vector<double>& flat, const Pose& pose) {
-  const int d = pose.dim();
-  for (int c = 0; c < d; ++c)
-    for (int r = 0; r < d; ++r) flat.push_back(pose.R(r, c));
-  for (int r = 0; r < d; ++r) flat.push_back(pose.t(r));
-}
-
-Pose pose_at(const std::vector<double>& flat, std::size_t k, int d) {
-  const std::size_t per = static_cast<std::size_t>(d) * (d + 1);
-  require((k + 1) * per <= flat.size(), "pose array too short");
-  const double* p = flat.data() + k * per;
-  Pose pose;
-  pose.R.resize(d, d);
-  pose.t.resize(d);
-  for (int c = 0; c < d; ++c)
-    for (int r = 0; r < d; ++r) pose.R(r, c) = *p++;
-  for (int r = 0; r < d; ++r) pose.t(r) = *p++;
-  return pose;
-}
-
 wire::MeasurementHandoff to_wire_handoff(
     const std::string& run_id, std::uint32_t sender, std::uint32_t recipient, int d,
     const std::vector<const Measurement*>& measurements,
@@ -133,10 +121,10 @@ wire::MeasurementHandoff to_wire_handoff(
     w.meas_tau().push_back(e->tau);
   }
   w.pose_ids().reserve(poses.size());
-  w.pose_data().reserve(poses.size() * d * (d + 1));
+  w.pose_data().reserve(poses.size() * flat_pose_size(d));
   for (const auto& [id, pose] : poses) {
     w.pose_ids().push_back(id);
-    append_pose(w.pose_data(), *pose);
+    append_flat_pose(w.pose_data(), *pose);
   }
   return w;
 }
@@ -149,7 +137,7 @@ HandoffContent from_wire(const wire::MeasurementHandoff& w) {
               w.meas_t().size() == m * d && w.meas_kappa().size() == m && w.meas_tau().size() == m,
           "hand-off from agent " + std::to_string(w.sender()) +
               ": measurement arrays differ in length");
-  require(w.pose_data().size() == w.pose_ids().size() * d * (d + 1),
+  require(w.pose_data().size() == w.pose_ids().size() * flat_pose_size(d),
           "hand-off from agent " + std::to_string(w.sender()) + ": pose arrays differ in length");
   HandoffContent out;
   out.measurement_index = w.meas_index();
@@ -177,7 +165,7 @@ std::vector<std::pair<std::uint32_t, Pose>> final_poses(const wire::FinalEstimat
   require(d == 2 || d == 3,
           "final estimate dimension " + std::to_string(w.dim()) + " is not 2 or 3");
   require(
-      w.pose_data().size() == w.pose_ids().size() * d * (d + 1),
+      w.pose_data().size() == w.pose_ids().size() * flat_pose_size(d),
       "final estimate from agent " + std::to_string(w.sender()) + ": pose arrays differ in length");
   std::vector<std::pair<std::uint32_t, Pose>> out;
   out.reserve(w.pose_ids().size());

@@ -32,11 +32,6 @@ bool addressed_to(bool broadcast, const std::vector<std::uint32_t>& recipients, 
 
 // ---- poses and measurements ------------------------------------------------------------
 
-/// Appends [R | t] column-major (d*(d+1) doubles).
-void append_pose(std::vector<double>& flat, const Pose& pose);
-/// The k-th pose of a flat array of poses in SE(d).
-Pose pose_at(const std::vector<double>& flat, std::size_t k, int d);
-
 /// The content of a measurement hand-off, decoded.
 struct HandoffContent {
   std::vector<Measurement> measurements;
