@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
   }
   const cli::ProcessRole role{tag, "agent " + std::to_string(options.id) + ": ",
                               options.net.timeout_s, true};
-  return cli::run_session_process(
-      agent::agent_session_options(options), role, signals,
-      [&](transport::Session& session) { agent::run_agent(options, session, std::move(restart)); });
+  cli::exit_process(cli::run_session_process(
+      agent::agent_session_options(options), role, signals, [&](transport::Session& session) {
+        agent::run_agent(options, session, std::move(restart));
+      }));
 }

@@ -26,6 +26,10 @@ namespace tessera::agent {
 
 namespace {
 
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 // Phases of the rounding messages (statuses and pose blocks), after core's protocol.
 enum RoundingPhase : std::uint32_t {
   kGram = kRoundingPhaseBase,  // r x r Gram matrix of the block's rotation parts
@@ -61,6 +65,7 @@ class Mailbox {
       : channel_(channel), timeout_s_(timeout_s), self_(self) {}
 
   void send_all(const std::vector<OutgoingMessage>& out) {
+    const auto t0 = std::chrono::steady_clock::now();
     for (const auto& m : out) {
       channel_.send(m);
       // Certificate and escape traffic, as the in-process driver counts it (per delivery).
@@ -72,6 +77,15 @@ class Mailbox {
       (kind == StageKind::kCertify ? certificate_bytes : escape_bytes) +=
           copies * message_bytes(m.message);
     }
+    send_s += seconds_since(t0);
+  }
+
+  // A message from the channel, its wait timed.
+  std::optional<ProtocolMessage> receive() {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::optional<ProtocolMessage> msg = channel_.receive(timeout_s_);
+    wait_s += seconds_since(t0);
+    return msg;
   }
 
   void set_num_agents(std::uint32_t n) { num_agents_ = n; }
@@ -81,7 +95,7 @@ class Mailbox {
   void run_protocol(AgentProcess& protocol, std::vector<OutgoingMessage> first, Describe describe) {
     send_all(first);
     while (!protocol.done()) {
-      std::optional<ProtocolMessage> msg = channel_.receive(timeout_s_);
+      std::optional<ProtocolMessage> msg = receive();
       if (!msg)
         throw std::runtime_error("agent " + std::to_string(self_) + ": no message for " +
                                  std::to_string(timeout_s_) + " s in " + describe());
@@ -103,7 +117,7 @@ class Mailbox {
       bool all = true;
       for (auto s : senders) all = all && have.count(s);
       if (all) break;
-      std::optional<ProtocolMessage> msg = channel_.receive(timeout_s_);
+      std::optional<ProtocolMessage> msg = receive();
       if (!msg) {
         std::string who;
         for (auto s : senders)
@@ -118,6 +132,7 @@ class Mailbox {
     }
     auto out = std::move(stash_[key]);
     stash_.erase(key);
+    ++gathers;
     return out;
   }
 
@@ -143,6 +158,8 @@ class Mailbox {
 
  public:
   std::uint64_t certificate_bytes = 0, escape_bytes = 0;  // sent by this agent
+  double wait_s = 0.0, send_s = 0.0;                      // time in receive() and in send_all()
+  std::uint32_t gathers = 0;  // completed gather() steps (the rounding's message steps)
 
  private:
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::map<std::uint32_t, ProtocolMessage>>
@@ -514,6 +531,9 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   }
   res.solve_s = std::chrono::duration<double>(t1 - t0).count();
   res.rounding_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  res.wait_s = mail.wait_s;
+  res.send_s = mail.send_s;
+  res.rounding_steps = mail.gathers;
 
   if (local.agent_id == 0 && res.certified) {  // before the final report, which ends the wait
     RoundStatusMessage c;

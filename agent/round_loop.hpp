@@ -113,6 +113,11 @@ struct RoundLoopResult {
   std::uint32_t translation_iterations = 0;  ///< Distributed CG iterations of the rounding.
   double solve_s = 0.0;                      ///< Time in core's protocol.
   double rounding_s = 0.0;                   ///< Time in the distributed rounding.
+  /// Where the solve and rounding time went (seconds): waiting for messages, handing
+  /// messages to the channel (serialising and writing), and the rest (this agent's math).
+  double wait_s = 0.0, send_s = 0.0;
+  /// Message steps of the rounding (every one waits for peers: rotations, CG, cost).
+  std::uint32_t rounding_steps = 0;
   // Certification (RunOptions::certify), identical on every agent; bytes summed over agents.
   std::optional<bool> certified;
   double min_eigenvalue = 0.0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 
@@ -25,6 +26,13 @@ bool asks_for_help(const std::vector<std::string>& argv) {
 
 void print_help(const std::string& help) {
   std::fputs(help.c_str(), stdout);
+}
+
+void exit_process(int code) {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  std::_Exit(code);
 }
 
 void print_option_error(const std::string& program, const std::string& why) {
@@ -86,7 +94,7 @@ int run_session_process(const SessionOptions& options, const ProcessRole& role,
       code = leave(s, role, kExitRunFailed, e.what(), true);
   }
   signals.stop();  // the callback refers to the session
-  s.close(code);  // a Fast DDS abort or hang while deleting still exits with `code`
+  s.close(code);   // a Fast DDS abort or hang while deleting still exits with `code`
   return code;
 }
 

@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
                                              coordinator::parse_coordinator_options, options))
     return *code;
   const cli::ProcessRole role{"tessera-coordinator", "coordinator: ", options.net.timeout_s};
-  return cli::run_session_process(
+  cli::exit_process(cli::run_session_process(
       coordinator::coordinator_session_options(options), role, signals,
-      [&](transport::Session& session) { coordinator::run_coordinator(options, session); });
+      [&](transport::Session& session) { coordinator::run_coordinator(options, session); }));
 }

@@ -85,12 +85,15 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
       transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
   // Bounded KEEP_ALL: unbounded limits let acknowledged samples pile up (hundreds of MB).
   q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
-  q.resource_limits().max_samples = kWriterHistory;
+  const std::int32_t history = transient_local ? kWriterHistory : kVolatileWriterHistory;
+  q.resource_limits().max_samples = history;
   q.resource_limits().max_instances = 1;
-  q.resource_limits().max_samples_per_instance = kWriterHistory;
+  q.resource_limits().max_samples_per_instance = history;
   q.resource_limits().allocated_samples = 4;
   // The default 3 s heartbeat stalls request/reply exchanges for seconds after a loss.
-  q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(net.heartbeat_period_s);
+  q.reliable_writer_qos().times.heartbeatPeriod =
+      Duration_t(transient_local ? std::min(net.heartbeat_period_s, kHandshakeHeartbeatS)
+                                 : net.heartbeat_period_s);
   q.reliable_writer_qos().times.nackResponseDelay = Duration_t(net.nack_response_delay_s);
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
   q.liveliness().lease_duration = Duration_t(lease_s);
