@@ -39,7 +39,7 @@ enum RoundingPhase : std::uint32_t {
   kDirection,                  // PCG: public entries of the search direction
   kCurvature,                  // PCG: <p, L p>
   kResidual,                   // PCG: <r,z>, <r,r> after a step
-  kTranslations,               // final translations of public poses
+  kTranslations,               // retired: the final translations ride on the last CG step
   kCost,                       // cost share of the rounded poses
   kTraffic                     // certificate and escape bytes sent (certification only)
 };
@@ -78,6 +78,7 @@ class Mailbox {
           copies * message_bytes(m.message);
     }
     send_s += seconds_since(t0);
+    sent_since_gather_ = true;
   }
 
   // A message from the channel, its wait timed.
@@ -132,7 +133,8 @@ class Mailbox {
     }
     auto out = std::move(stash_[key]);
     stash_.erase(key);
-    ++gathers;
+    if (sent_since_gather_) ++gathers;  // the first wait after sending: one message step
+    sent_since_gather_ = false;
     return out;
   }
 
@@ -155,6 +157,7 @@ class Mailbox {
   double timeout_s_;
   std::uint32_t self_;
   std::uint32_t num_agents_ = 1;
+  bool sent_since_gather_ = false;
 
  public:
   std::uint64_t certificate_bytes = 0, escape_bytes = 0;  // sent by this agent
@@ -230,7 +233,15 @@ class Rounding {
   template <class F>
   std::map<std::size_t, std::vector<double>> exchange(std::uint32_t phase, std::uint32_t round,
                                                       std::uint32_t rank, F values) {
-    const std::size_t width = static_cast<std::size_t>(rank) * static_cast<std::size_t>(d_ + 1);
+    send_publics(phase, round, rank, values);
+    return gather_publics(phase, round, rank);
+  }
+
+  // The two halves of exchange(), for steps that also carry a reduction: send, reduce,
+  // then gather (one message step instead of two).
+  template <class F>
+  void send_publics(std::uint32_t phase, std::uint32_t round, std::uint32_t rank, F values) {
+    const std::size_t width = width_of(rank);
     const auto& adj = layout_.adjacent[self_];
     for (std::size_t k = 0; k < adj.size(); ++k) {
       PoseBlockMessage m;
@@ -247,6 +258,12 @@ class Rounding {
       }
       mail_.send_all({OutgoingMessage{m, false, {static_cast<std::uint32_t>(adj[k])}}});
     }
+  }
+
+  std::map<std::size_t, std::vector<double>> gather_publics(std::uint32_t phase,
+                                                            std::uint32_t round,
+                                                            std::uint32_t rank) {
+    const std::size_t width = width_of(rank);
     std::map<std::size_t, std::vector<double>> out;
     for (auto& [sender, msg] : mail_.gather(phase, round, neighbours_)) {
       const auto& m = std::get<PoseBlockMessage>(msg);
@@ -259,6 +276,10 @@ class Rounding {
                                 m.data.begin() + static_cast<long>((k + 1) * width));
     }
     return out;
+  }
+
+  std::size_t width_of(std::uint32_t rank) const {
+    return static_cast<std::size_t>(rank) * static_cast<std::size_t>(d_ + 1);
   }
 
   void rotations() {
@@ -379,17 +400,34 @@ class Rounding {
     };
     Eigen::MatrixXd x = Eigen::MatrixXd::Zero(m, d), r = b;
     Eigen::MatrixXd z = precondition(r), p = z;
+    // Each residual step also carries the public entries of z and x to the neighbours (as a
+    // rank-2 block: z, then x). With z and the new beta every agent forms its neighbours'
+    // public search direction itself (p = z + beta p, the owner's formula), so the direction
+    // needs no step of its own, and the x of the last step are the final translations: an
+    // iteration costs two message steps (curvature, residual) instead of three.
+    auto send_zx = [&](std::uint32_t round) {
+      send_publics(kDirection, round, 2, [&](std::size_t id) {
+        const Eigen::Index s = slot.at(id);
+        std::vector<double> v(2 * static_cast<std::size_t>(d));
+        for (Eigen::Index k = 0; k < d; ++k) {
+          v[static_cast<std::size_t>(k)] = z(s, k);
+          v[static_cast<std::size_t>(d + k)] = x(s, k);
+        }
+        return v;
+      });
+    };
+    std::map<std::size_t, std::vector<double>> zx;  // neighbours' public z and x
+    std::map<std::size_t, std::vector<double>> pn;  // neighbours' public p (first d entries)
+    send_zx(0);
     double rr0 = 0.0;
     double rz = reduce(kInitialResidual, 0, (r.array() * z.array()).sum(), r.squaredNorm(), &rr0);
+    zx = gather_publics(kDirection, 0, 2);
+    for (const auto& [id, v] : zx) pn[id] = std::vector<double>(v.begin(), v.begin() + d);
     const double tol = 1e-24 * rr0;  // relative residual 1e-12
     const std::uint32_t max_it = 5000;
     std::uint32_t it = 0;
     double rr = rr0;
     while (rr > tol && it < max_it && rr0 > 0) {
-      auto pn = exchange(kDirection, it, 1, [&](std::size_t id) {
-        const Eigen::VectorXd v = p.row(slot.at(id)).transpose();
-        return std::vector<double>(v.data(), v.data() + d);
-      });
       const Eigen::MatrixXd Ap = apply(p, pn);
       const double pAp = reduce(kCurvature, it, (p.array() * Ap.array()).sum(), 0.0, nullptr);
       if (!(pAp > 0)) break;
@@ -397,19 +435,25 @@ class Rounding {
       x += alpha * p;
       r -= alpha * Ap;
       z = precondition(r);
+      send_zx(it + 1);
       const double rz_new =
           reduce(kResidual, it, (r.array() * z.array()).sum(), r.squaredNorm(), &rr);
-      p = z + (rz_new / rz) * p;
+      zx = gather_publics(kDirection, it + 1, 2);
+      const double beta = rz_new / rz;
+      p = z + beta * p;
+      for (const auto& [id, v] : zx) {
+        std::vector<double>& q = pn.at(id);
+        for (Eigen::Index k = 0; k < d; ++k)
+          q[static_cast<std::size_t>(k)] =
+              v[static_cast<std::size_t>(k)] + beta * q[static_cast<std::size_t>(k)];
+      }
       rz = rz_new;
       ++it;
     }
     for (Eigen::Index s = 0; s < m; ++s)
       poses_[own_[static_cast<std::size_t>(s)]].t = x.row(s).transpose();
-    auto nb = exchange(kTranslations, 0, 1, [&](std::size_t id) {
-      const Eigen::VectorXd& t = poses_.at(id).t;
-      return std::vector<double>(t.data(), t.data() + d);
-    });
-    for (auto& [id, v] : nb) poses_[id].t = Eigen::Map<const Eigen::VectorXd>(v.data(), d);
+    for (const auto& [id, v] : zx)  // the x sent with the last residual (or initial) step
+      poses_[id].t = Eigen::Map<const Eigen::VectorXd>(v.data() + d, d);
     return it;
   }
 
