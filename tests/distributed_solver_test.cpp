@@ -50,6 +50,31 @@ TEST(DistributedSolver, TwoBlocksConvergeToCentralizedOptimum) {
   EXPECT_NEAR(r.cost, fstar, 1e-7 * fstar);
 }
 
+// Below that level no block step is accepted any more and the iterate stops moving: the run
+// stops as "stalled" after a few rounds per block instead of spinning to max_rounds (seen as
+// 10000 rounds, ~100 s, after a re-partition for survivors over DDS).
+TEST(DistributedSolver, AnUnreachableToleranceStopsWhenTheIterateStallsNotAtMaxRounds) {
+  const PoseGraph g = small_graph(2, 40, 3);
+  const double fstar = optimum(g);
+  for (auto alg : {DistributedAlgorithm::kRbcd, DistributedAlgorithm::kIrbcd}) {
+    DistributedOptions opt;
+    opt.algorithm = alg;
+    opt.grad_norm_tol = 1e-15;
+    opt.max_rounds = 20000;
+    const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 2), opt);
+    EXPECT_EQ(r.stop_reason, "stalled")
+        << algorithm_name(alg) << ": " << r.grad_norm << " after " << r.rounds << " rounds";
+    EXPECT_LT(r.rounds, 20000) << algorithm_name(alg);
+    EXPECT_NEAR(r.cost, fstar, 1e-9 * fstar) << algorithm_name(alg);
+    // The rounds that decided it repeat the final cost and gradient norm exactly.
+    ASSERT_GE(r.trace.size(), 21u) << algorithm_name(alg);
+    for (std::size_t i = r.trace.size() - 21; i < r.trace.size(); ++i) {
+      EXPECT_EQ(r.trace[i].cost, r.trace.back().cost) << algorithm_name(alg) << " round " << i;
+      EXPECT_EQ(r.trace[i].grad_norm, r.trace.back().grad_norm) << algorithm_name(alg);
+    }
+  }
+}
+
 TEST(DistributedSolver, AgentCostSharesSumToGlobalCost) {
   const PoseGraph g = small_graph(3, 50, 5);
   const std::vector<int> assignment = {0, 1, 2, 0, 1, 2};  // interleaved: many cut edges

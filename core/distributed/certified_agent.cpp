@@ -34,7 +34,8 @@ std::optional<bool> CertifiedAgent::certified() const {
   if (!options_.certify) return std::nullopt;
   if (certificates_.empty() || solves_.empty()) return false;
   const std::string& stop = solves_.back().stop_reason;
-  const bool converged = stop == "grad_norm" || stop == "relative_decrease";
+  // "stalled": as close to a critical point as the block updates can resolve.
+  const bool converged = stop == "grad_norm" || stop == "relative_decrease" || stop == "stalled";
   // The last certificate must be of the last solve (an escape that failed leaves it so).
   return converged && certificates_.back().rank == solves_.back().rank &&
          certificates_.back().result.certified;

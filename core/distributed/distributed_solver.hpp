@@ -74,7 +74,9 @@ struct DistributedResult {
   int agents = 0;
   int rounds = 0;  ///< Block-update rounds done, all solve stages (restarts' redos inside).
   int restarts = 0;
-  std::string stop_reason;  ///< grad_norm, max_rounds or relative_decrease.
+  /// grad_norm, max_rounds, relative_decrease or stalled (the iterate stopped moving above
+  /// the tolerance: RoundProtocol::stop_reason()).
+  std::string stop_reason;
   std::vector<DistributedRound> trace;
   std::uint64_t bytes_exchanged = 0;  ///< Every message (solve, certificate, escape).
   std::uint64_t messages = 0;

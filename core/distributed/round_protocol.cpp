@@ -263,6 +263,8 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
     stop_reason_ = "grad_norm";
   else if (round_ >= config_.max_rounds)
     stop_reason_ = "max_rounds";
+  else if (stalled(rec))
+    stop_reason_ = "stalled";
   else if (small_decrease)
     stop_reason_ = "relative_decrease";
   if (!stop_reason_.empty()) {
@@ -287,6 +289,22 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   state_.P = extrapolate(state_.manifold(), coeff_, state_.Y, state_.V);
   state_.Pn = extrapolate(state_.manifold(), coeff_, state_.Yn, state_.Vn);
   begin_update(out);
+}
+
+bool RoundProtocol::stalled(const RoundRecord& rec) const {
+  // Near the optimum every block update can be rejected: the trust region cannot measure a
+  // decrease of the block's cost below its round-off (solvers/trust_region.cpp), so no block
+  // moves and the cost and gradient norm repeat bit for bit, round after round (seen at
+  // ||grad f|| ~ 1e-5 on a 500-pose grid, ~1e-4 after a re-partition for survivors). A
+  // tolerance below that floor would otherwise spin to max_rounds (10000 rounds, minutes).
+  // Enough rounds that every block had its turn many times (parallel colour classes, uniform
+  // selection). Computed from the trace, which snapshots restore, so a resumed run stops at
+  // the same round as an uninterrupted one.
+  const std::size_t window = static_cast<std::size_t>(std::max(20, 10 * layout_.num_blocks));
+  if (trace_.size() < window) return false;
+  for (std::size_t i = trace_.size() - window; i < trace_.size(); ++i)
+    if (trace_[i].cost != rec.cost || trace_[i].grad_norm != rec.grad_norm) return false;
+  return true;
 }
 
 void RoundProtocol::begin_update(std::vector<OutgoingMessage>& out) {

@@ -101,6 +101,8 @@ class RoundProtocol : public AgentProcess {
   bool done() const override { return done_; }
   int rounds() const { return round_; }
   int restarts() const { return restarts_; }
+  /// grad_norm, max_rounds, relative_decrease, or stalled (the cost and gradient norm
+  /// repeated bit for bit for 10 rounds per block: no update is accepted any more).
   const std::string& stop_reason() const { return stop_reason_; }
   const std::vector<RoundRecord>& trace() const { return trace_; }
   const AgentState& state() const { return state_; }
@@ -131,6 +133,8 @@ class RoundProtocol : public AgentProcess {
   std::map<std::uint64_t, Inbox> pending_;
   std::vector<int> selection_;
   double f_prev_ = 0.0, gsq_prev_ = 0.0;
+  // Whether `rec` and the recent rounds show an iterate that no longer moves.
+  bool stalled(const RoundRecord& rec) const;
   bool done_ = false;
   int restarts_ = 0;
   std::string stop_reason_;
