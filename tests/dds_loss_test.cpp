@@ -43,12 +43,13 @@ struct LossRun {
   }
 };
 
-LossRun make_run(int domain, const std::string& name) {
+LossRun make_run(int domain, const std::string& name, int poses = 300) {
   LossRun r;
   r.dir = temp_dir();
   r.domain = domain;
   r.run = name + "-" + std::to_string(getpid());
-  r.graph = generate_graph(r.dir + "/graph.g2o", "--kind grid3d --poses 300 --robots 5 --seed 3");
+  r.graph = generate_graph(r.dir + "/graph.g2o", "--kind grid3d --poses " + std::to_string(poses) +
+                                                     " --robots 5 --seed 3");
   return r;
 }
 
@@ -102,10 +103,12 @@ TEST(DdsLoss, WithoutReplicasALostAgentStillStopsTheRun) {
 // again (`checkpoint`: from its checkpoint, asking to rejoin; otherwise fresh). It must leave
 // at once saying it was lost for good, without aborting the survivors, who finish at f*.
 void restarted_after_repartition_is_refused(int domain, bool checkpoint) {
-  LossRun r = make_run(domain, checkpoint ? "refused-ckpt" : "refused-fresh");
+  // The survivors must still be in their rounds when the restarted process arrives (~1-3 s):
+  // a tolerance below the round-off floor, so they run until the iterate stalls (a few hundred
+  // rounds, core's "stalled" stop) on a graph large enough that this takes several seconds
+  // (4000 poses: ~5 s after the re-partition), and a round limit as a bound.
+  LossRun r = make_run(domain, checkpoint ? "refused-ckpt" : "refused-fresh", 4000);
   r.grad_tol = "1e-12";
-  // A round limit instead of a reachable tolerance: the survivors are still in their rounds
-  // when the restarted process arrives (~1-3 s), and the run still ends by itself.
   Process coord = r.coordinator(1, {"--max-rounds", "600"});
   auto agent_argv = [&](int k) {
     std::vector<std::string> a =
