@@ -146,6 +146,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   G2oReadOptions read;
   read.normalize_quaternions = !a.has("raw-quaternions");
   const PoseGraph graph = read_g2o(graph_path, read);
+  const double load_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (static_cast<std::size_t>(agents) > graph.num_poses)
     throw InputError("option --agents: more agents than the graph's " +
                      std::to_string(graph.num_poses) + " poses");
@@ -178,6 +180,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       r.bytes_exchanged / 1e6, r.rounds > 0 ? 1e3 * r.solve_s / r.rounds : 0.0,
       r.rounds > 0 ? 1e3 * r.solve_cpu_s / r.rounds : 0.0,
       r.rounds > 0 ? 1e3 * r.critical_path_cpu_s / r.rounds : 0.0, r.solve_s, wall_s);
+  std::printf("  load %.3f s, partition %.3f s, set-up %.3f s, rounds %.3f s, rounding %.3f s\n",
+              load_s, part.time_ms / 1e3, r.init_s, r.solve_s, r.rounding_s);
   if (r.certified) {
     std::printf(
         "  %s: lambda_min(S) = %.4g (eta %.3g, residual %.3g), %d certificate rounds "
@@ -220,7 +224,11 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         .add("stop_reason", r.stop_reason)
         .add("bytes_exchanged", static_cast<long long>(r.bytes_exchanged))
         .add("messages", static_cast<long long>(r.messages))
+        .add("load_s", load_s)
+        .add("partition_ms", part.time_ms)
+        .add("init_s", r.init_s)
         .add("solve_s", r.solve_s)
+        .add("rounding_s", r.rounding_s)
         .add("ms_per_round", r.rounds > 0 ? 1e3 * r.solve_s / r.rounds : 0.0)
         .add("solve_cpu_s", r.solve_cpu_s)
         .add("cpu_ms_per_round", r.rounds > 0 ? 1e3 * r.solve_cpu_s / r.rounds : 0.0)

@@ -53,35 +53,38 @@ TEST(BlockPreconditioner, ExactFactorInvertsTheShiftedDataMatrix) {
 }
 
 // The exact factor against a dense solve of a well-conditioned shifted matrix, to round-off, for
-// every rank the solvers use (and beyond).
+// every rank the solvers use (and beyond), simplicial LDL^T and supernodal LL^T alike.
 TEST(BlockPreconditioner, ExactFactorMatchesADenseSolveForEveryRank) {
-  for (int d : {2, 3}) {
-    test::RandomGraphSpec spec;
-    spec.d = d;
-    spec.poses = 40;
-    spec.loop_closures = 30;
-    spec.seed = 11;
-    Block b;
-    b.graph = test::random_pose_graph(spec);
-    for (std::size_t i = 0; i < spec.poses / 2; ++i) b.owned.push_back(i);
-    const BlockProblem problem(d, b.owned, b.graph.measurements);
-    const double shift = 1e-2;
-    const BlockPreconditioner precon(problem, shift, 0);
-    Eigen::MatrixXd A = Eigen::MatrixXd(problem.data_matrix());
-    A.diagonal().array() += shift * A.diagonal().maxCoeff();
-    const Eigen::LLT<Eigen::MatrixXd> dense(A);
-    for (int r = d; r <= 7; ++r) {
-      const Eigen::MatrixXd X =
-          lift_poses(b.graph.initial, r).leftCols(problem.data_matrix().rows());
-      const LiftedManifold M = problem.manifold(r);
-      const Eigen::MatrixXd V = M.tangent_project(X, Eigen::MatrixXd::Random(r, X.cols()));
-      const Eigen::MatrixXd expected =
-          M.tangent_project(X, 0.5 * dense.solve(V.transpose()).transpose());
-      EXPECT_LT((precon.apply(M, X, V) - expected).cwiseAbs().maxCoeff(),
-                1e-12 * expected.cwiseAbs().maxCoeff())
-          << "d = " << d << ", r = " << r;
+  for (int d : {2, 3})
+    for (std::size_t supernodal_from : {std::size_t{0}, std::size_t{1}}) {
+      test::RandomGraphSpec spec;
+      spec.d = d;
+      spec.poses = 40;
+      spec.loop_closures = 30;
+      spec.seed = 11;
+      Block b;
+      b.graph = test::random_pose_graph(spec);
+      for (std::size_t i = 0; i < spec.poses / 2; ++i) b.owned.push_back(i);
+      const BlockProblem problem(d, b.owned, b.graph.measurements);
+      const double shift = 1e-2;
+      const BlockPreconditioner precon(problem, shift, 0, supernodal_from);
+      EXPECT_FALSE(precon.block_diagonal());
+      EXPECT_EQ(precon.supernodal(), supernodal_from == 1);
+      Eigen::MatrixXd A = Eigen::MatrixXd(problem.data_matrix());
+      A.diagonal().array() += shift * A.diagonal().maxCoeff();
+      const Eigen::LLT<Eigen::MatrixXd> dense(A);
+      for (int r = d; r <= 7; ++r) {
+        const Eigen::MatrixXd X =
+            lift_poses(b.graph.initial, r).leftCols(problem.data_matrix().rows());
+        const LiftedManifold M = problem.manifold(r);
+        const Eigen::MatrixXd V = M.tangent_project(X, Eigen::MatrixXd::Random(r, X.cols()));
+        const Eigen::MatrixXd expected =
+            M.tangent_project(X, 0.5 * dense.solve(V.transpose()).transpose());
+        EXPECT_LT((precon.apply(M, X, V) - expected).cwiseAbs().maxCoeff(),
+                  1e-12 * expected.cwiseAbs().maxCoeff())
+            << "d = " << d << ", r = " << r << ", supernodal " << precon.supernodal();
+      }
     }
-  }
 }
 
 // tCG needs a symmetric positive definite preconditioner on the tangent space.

@@ -100,7 +100,9 @@ struct DistributedResult {
   double grad_norm = 0.0;        ///< ||grad f(X)||.
   std::vector<Pose> poses;       ///< X rounded to SE(d).
   double cost = 0.0;             ///< Objective of `poses` (reference convention).
-  double init_s = 0.0, solve_s = 0.0, wall_s = 0.0;
+  /// Seconds: initial guess + agents' set-up (block problems, preconditioners), the rounds,
+  /// the final rounding (rotations and the translation solve), the whole call.
+  double init_s = 0.0, solve_s = 0.0, rounding_s = 0.0, wall_s = 0.0;
   /// Process CPU time of the rounds (all agents, in one process): unlike solve_s it does not
   /// grow when other jobs share the machine.
   double solve_cpu_s = 0.0;

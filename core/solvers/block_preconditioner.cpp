@@ -9,11 +9,12 @@
 namespace tessera {
 
 struct BlockPreconditioner::Factor {
-  // Simplicial LDL^T. The factor is computed once and solved against thousands of times with
-  // only r (= d, mostly) right-hand sides, where the supernodal solve's BLAS calls on small
-  // supernodes cost more than they save: measured CPU per solve, simplicial LDL^T vs CHOLMOD's
-  // automatic choice (supernodal on these graphs): city10000 2.6 vs 4.8 ms, sphere2500 1.2 vs
-  // 2.0 ms, cubicle 5.0 vs 5.9 ms, ais2klinik 0.78 vs 0.72 ms (docs/centralized-solver.md).
+  // Simplicial LDL^T for small factors. The factor is computed once and solved against
+  // thousands of times with only r (= d, mostly) right-hand sides, where the supernodal solve's
+  // BLAS calls on small supernodes cost more than they save: measured CPU per solve, simplicial
+  // LDL^T vs CHOLMOD's automatic choice (supernodal on these graphs): city10000 2.6 vs 4.8 ms,
+  // sphere2500 1.2 vs 2.0 ms, cubicle 5.0 vs 5.9 ms, ais2klinik 0.78 vs 0.72 ms
+  // (docs/centralized-solver.md). Supernodal LL^T for large ones (see the constructor).
   std::unique_ptr<Eigen::CholmodDecomposition<SparseMatrix>> llt =
       std::make_unique<Eigen::CholmodDecomposition<SparseMatrix>>();
   // Fallback: inverses of the (d+1) x (d+1) diagonal blocks, one after the other (column-major).
@@ -45,7 +46,8 @@ std::vector<double> diagonal_block_inverses(const SparseMatrix& A, int w) {
 }  // namespace
 
 BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double relative_shift,
-                                         std::size_t max_factor_entries)
+                                         std::size_t max_factor_entries,
+                                         std::size_t supernodal_min_entries)
     : factor_(std::make_unique<Factor>()) {
   const SparseMatrix& Q = problem.data_matrix();
   const double lambda = relative_shift * std::max(1e-12, Q.diagonal().maxCoeff());
@@ -57,8 +59,9 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
     return max_factor_entries > 0 && entries > static_cast<double>(max_factor_entries);
   };
   bool fallback = too_large(0.5 * static_cast<double>(A.nonZeros() + A.rows()));
-  if (!fallback) {
-    factor_->llt->setMode(Eigen::CholmodLDLt);
+  const auto analyze = [&](Eigen::CholmodMode mode) {
+    factor_->llt = std::make_unique<Eigen::CholmodDecomposition<SparseMatrix>>();
+    factor_->llt->setMode(mode);
     // AMD only. CHOLMOD's default also tries METIS when AMD's fill looks high (it does on 3D
     // grids) and keeps the better one: METIS never won on any block measured (more fill than
     // AMD everywhere, docs/irbcd.md section 8), but its trial was ~2/3 of the set-up time of
@@ -70,7 +73,19 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
     factor_->llt->analyzePattern(A);
     if (factor_->llt->info() != Eigen::Success)
       throw std::runtime_error("BlockPreconditioner: symbolic analysis failed");
-    fallback = too_large(factor_->llt->cholmod().lnz);
+    return static_cast<double>(factor_->llt->cholmod().lnz);
+  };
+  if (!fallback) {
+    const double entries = analyze(Eigen::CholmodLDLt);
+    fallback = too_large(entries);
+    // A large factor is computed supernodally (dense BLAS-3 kernels on its supernodes): on the
+    // 4,000-pose blocks of a 100k-pose 3D grid (1.2-2.0 M entries) set-up CPU drops ~7x and
+    // the solves are no slower; at ~0.6 M entries both are equal. The re-analysis repeats the
+    // AMD ordering (same permutation), a small part of the factorization. Blocks of all the
+    // public benchmark graphs stay below the switch, so their iterates are unchanged.
+    if (!fallback && supernodal_min_entries > 0 &&
+        entries > static_cast<double>(supernodal_min_entries))
+      analyze(Eigen::CholmodSupernodalLLt);
   }
   if (fallback) {
     factor_->llt.reset();  // release the symbolic factor
@@ -86,6 +101,10 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
 
 bool BlockPreconditioner::block_diagonal() const {
   return factor_->w > 0;
+}
+
+bool BlockPreconditioner::supernodal() const {
+  return factor_->w == 0 && factor_->llt->cholmod().supernodal == CHOLMOD_SUPERNODAL;
 }
 
 BlockPreconditioner::~BlockPreconditioner() = default;

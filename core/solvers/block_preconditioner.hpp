@@ -25,11 +25,18 @@ class BlockPreconditioner {
   /// (16 M entries = 128 MB of factor; no benchmark graph's block comes near it).
   static constexpr std::size_t kDefaultMaxFactorEntries = 16'000'000;
 
+  /// Factor entries above which the exact factor is supernodal LL^T rather than simplicial
+  /// LDL^T (1 M entries = 8 MB; measured crossover ~0.6 M, see the .cpp).
+  static constexpr std::size_t kDefaultSupernodalMinEntries = 1'000'000;
+
   /// `relative_shift`: lambda = relative_shift * max diagonal entry of Q_BB.
   /// `max_factor_entries`: when CHOLMOD's symbolic analysis predicts a larger Cholesky factor,
   /// use the block-diagonal fallback instead; 0 = always the exact factor.
+  /// `supernodal_min_entries`: exact factors with more entries are supernodal (same operator
+  /// up to round-off); 0 = always simplicial.
   explicit BlockPreconditioner(const BlockProblem& problem, double relative_shift = 1e-6,
-                               std::size_t max_factor_entries = kDefaultMaxFactorEntries);
+                               std::size_t max_factor_entries = kDefaultMaxFactorEntries,
+                               std::size_t supernodal_min_entries = kDefaultSupernodalMinEntries);
   ~BlockPreconditioner();
   BlockPreconditioner(const BlockPreconditioner&) = delete;
   BlockPreconditioner& operator=(const BlockPreconditioner&) = delete;
@@ -40,6 +47,8 @@ class BlockPreconditioner {
 
   /// True when the exact factor was too large and the block diagonal is used.
   bool block_diagonal() const;
+  /// True when the exact factor is supernodal.
+  bool supernodal() const;
 
  private:
   struct Factor;

@@ -19,6 +19,7 @@ Each prints its table, writes CSV and one PNG figure under --out-dir; this comma
 """
 import argparse
 import os
+import resource
 import sys
 import time
 
@@ -58,10 +59,12 @@ def main():
         if num not in only:
             continue
         bc.progress(f"=== experiment {num} ({time.monotonic() - t0:.0f} s elapsed) ===")
-        t = time.monotonic()
+        t, cpu = time.monotonic(), cpu_seconds()
         try:
             r = fn()
             r.seconds = time.monotonic() - t
+            r.cpu_seconds = cpu_seconds() - cpu
+            bc.progress(f"=== experiment {num} done: {r.seconds:.0f} s wall, {r.cpu_seconds:.0f} s CPU ===")
             results.append(r)
         except Exception as e:  # one failing experiment must not hide the others' results
             failures.append(f"experiment {num}: {e}")
@@ -71,6 +74,14 @@ def main():
         write_readme(a, ctx, results, failures, machine_before, started, time.monotonic() - t0, pending)
     if failures:
         sys.exit(1)
+
+
+def cpu_seconds():
+    """User + system CPU of this script and of every child it waited for (tessera processes,
+    and the agents a `tessera launch` waited for): on a busy machine wall time grows with the
+    load, CPU time much less, so both are reported."""
+    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 def write_readme(a, ctx, results, failures, machine_before, started, total, pending):
@@ -99,9 +110,17 @@ def write_readme(a, ctx, results, failures, machine_before, started, total, pend
         out += ["**Failed experiments:**", ""] + [f"- {f}" for f in failures] + [""]
     if pending:
         out += [f"**Incomplete run: experiments {', '.join(map(str, pending))} not run yet.**", ""]
+    if results:
+        out += ["Duration of each experiment in this run (CPU = user + system time of the script and "
+                "the processes it ran; on an idle 2-core machine wall time is about CPU time, less where "
+                "agent processes run in parallel):", "",
+                "| experiment | wall s | CPU s |", "|---|---|---|"]
+        out += [f"| {r.title} | {r.seconds:.0f} | {r.cpu_seconds:.0f} |" for r in results]
+        out += [f"| total | {sum(r.seconds for r in results):.0f} | {sum(r.cpu_seconds for r in results):.0f} |",
+                ""]
     for r in results:
         out.append(r.markdown(ctx.out_dir))
-        out.append(f"_({r.seconds:.0f} s)_\n")
+        out.append(f"_({r.seconds:.0f} s wall, {r.cpu_seconds:.0f} s CPU)_\n")
     out += ["## Exact commands", "", "Every tessera command this invocation ran, in order "
             "(`$WORK` = its scratch folder, `OUT.json`/`TRACE.csv` = temporary outputs):", "", "```"]
     out += ctx.commands
