@@ -176,10 +176,17 @@ def run_tessera(ctx, args, trace=True, timeout=None, mem_limit_mb=None):
 
 
 def read_trace(path):
+    """Trace rows as floats; a non-numeric cell (`selected` of a parallel round, e.g. "1;3")
+    stays a string."""
+    def value(v):
+        try:
+            return float(v)
+        except ValueError:
+            return v
     rows = []
     with open(path) as f:
         for r in csv.DictReader(f):
-            rows.append({k: float(v) for k, v in r.items() if v not in ("", None)})
+            rows.append({k: value(v) for k, v in r.items() if v not in ("", None)})
     return rows
 
 
