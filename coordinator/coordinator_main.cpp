@@ -10,12 +10,14 @@
 
 #include "coordinator/coordinator_options.hpp"
 #include "coordinator/coordinator_run.hpp"
+#include "coordinator/run_timeline.hpp"
 #include "session_process.hpp"
 #include "transport/signal_watcher.hpp"
 
 using namespace tessera;
 
 int main(int argc, char** argv) {
+  coordinator::RunTimeline timeline;  // first: the summary's timeline counts from here
   transport::SignalWatcher
       signals;  // first: every thread created later inherits the blocked signals
   const std::vector<std::string> argv_list(argv + 1, argv + argc);
@@ -25,7 +27,9 @@ int main(int argc, char** argv) {
                                              coordinator::parse_coordinator_options, options))
     return *code;
   const cli::ProcessRole role{"tessera-coordinator", "coordinator: ", options.net.timeout_s};
-  cli::exit_process(cli::run_session_process(
-      coordinator::coordinator_session_options(options), role, signals,
-      [&](transport::Session& session) { coordinator::run_coordinator(options, session); }));
+  cli::exit_process(cli::run_session_process(coordinator::coordinator_session_options(options),
+                                             role, signals, [&](transport::Session& session) {
+                                               coordinator::run_coordinator(options, session,
+                                                                            timeline);
+                                             }));
 }

@@ -25,17 +25,19 @@ namespace tessera::coordinator {
 
 using namespace tessera::transport;
 
-void run_coordinator(const CoordinatorOptions& o, Session& s) {
+void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timeline) {
   const auto log = [&](const std::string& what) {
     if (o.verbose) std::cerr << "tessera-coordinator: " << what << "\n";
   };
   const auto t0 = std::chrono::steady_clock::now();
+  timeline.mark_at("session", t0);
   const std::uint32_t N = o.agents;
 
   // 1. Every agent's announcement.
   std::vector<wire::AgentAnnouncement> announcements =
       await_announcements(s, N, o.net.session.run_id, o.net.timeout_s);
   const double discovery_ms = ms_since(t0);
+  timeline.mark("announced");
   const RunStructure rs = merge_announcements(announcements, N, o.net.session.run_id);
   announcements.clear();
   log("all " + std::to_string(N) + " agents announced (" +
@@ -44,11 +46,13 @@ void run_coordinator(const CoordinatorOptions& o, Session& s) {
 
   // 2. Partition and publish the assignment.
   const PartitionStepResult part = partition_for_agents(rs.graph, N, o.partition, o.partition_seed);
+  timeline.mark("partitioned");
   log("partition (" + o.partition + "): cut " + std::to_string(part.cut_edges) +
       " measurements in " + std::to_string(part.ms) + " ms");
   const wire::PartitionAssignment base = make_assignment(o, rs, part);
   publish_assignment(s, base, o.certify, o.net.timeout_s);
   log("all agents ready");
+  timeline.mark("ready");
 
   // 3. Final estimates (progress from round statuses meanwhile; lost agents go to the
   // arbiter, which waits for them to rejoin).
@@ -61,15 +65,25 @@ void run_coordinator(const CoordinatorOptions& o, Session& s) {
   RoundReports reports(o.progress, std::cout);
   await_final_estimates(s, o, reports, losses, shown, t_run);
   const double solve_ms = ms_since(t_run);
+  timeline.mark("finals");
+  if (reports.results().completed_statuses > 0) {  // the rounds, as their statuses came in
+    const auto at = [&](double ms) {
+      return t_run + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                         std::chrono::duration<double, std::milli>(ms));
+    };
+    timeline.mark_at("first_status", at(reports.results().first_status_ms));
+    timeline.mark_at("last_status", at(reports.results().last_status_ms));
+  }
 
   // 4. Merge and write.
   const MergedEstimate merged = merge_final_estimates(
       s.finals().take_all(), N, losses.record().epoch, losses.record().owner, rs);
   write_merged_poses(rs, merged.poses, o.net.session.run_id, o.output, o.tum);
+  timeline.mark("merged");
   if (!o.summary.empty())
-    cli::write_output(o.summary,
-                      run_summary_json({o, rs, part, merged, reports.results(), losses.record(),
-                                        s.domain(), discovery_ms, solve_ms, ms_since(t0)}));
+    cli::write_output(
+        o.summary, run_summary_json({o, rs, part, merged, reports.results(), losses.record(),
+                                     s.domain(), discovery_ms, solve_ms, ms_since(t0), &timeline}));
 
   // 5. Tell the agents they may leave.
   s.send_control(wire::CONTROL_FINISHED);

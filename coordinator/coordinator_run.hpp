@@ -5,13 +5,15 @@
 // Each step is its own file in coordinator/; this one only sequences them.
 
 #include "coordinator/coordinator_options.hpp"
+#include "coordinator/run_timeline.hpp"
 #include "transport/session.hpp"
 
 namespace tessera::coordinator {
 
 /// Runs the whole run on an open session. Throws RunFailure (or InputError for bad
 /// announcements) when the run fails; cli::run_session_process turns that into the ABORT
-/// and the exit code.
-void run_coordinator(const CoordinatorOptions& options, transport::Session& session);
+/// and the exit code. Marks the end of each step on `timeline` (reported in the summary).
+void run_coordinator(const CoordinatorOptions& options, transport::Session& session,
+                     RunTimeline& timeline);
 
 }  // namespace tessera::coordinator

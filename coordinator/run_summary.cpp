@@ -54,6 +54,9 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("total_ms", in.total_ms)
       .add("bytes_sent", std::vector<std::size_t>(in.merged.bytes.begin(), in.merged.bytes.end()))
       .add("hosts", in.structure.hosts);
+  if (in.timeline)
+    j.add("timeline_ms", in.timeline->json())
+        .add("started_monotonic_ms", in.timeline->started_monotonic_ms());
   if (L.epoch > 0) {  // the permanent-loss record (docs/fault-tolerance.md)
     cli::JsonObject f;
     std::vector<std::size_t> lost(L.lost.begin(), L.lost.end());

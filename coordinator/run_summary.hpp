@@ -10,6 +10,7 @@
 #include "coordinator/partition_step.hpp"
 #include "coordinator/round_reports.hpp"
 #include "coordinator/run_structure.hpp"
+#include "coordinator/run_timeline.hpp"
 
 namespace tessera::coordinator {
 
@@ -23,6 +24,7 @@ struct RunSummaryInputs {
   const LossRecord& losses;
   int domain = 0;
   double discovery_ms = 0, solve_ms = 0, total_ms = 0;
+  const RunTimeline* timeline = nullptr;  ///< "timeline_ms" / "started_monotonic_ms" when set.
 };
 
 /// The summary as one JSON object. Values the run did not produce (no final report, no

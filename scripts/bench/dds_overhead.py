@@ -10,7 +10,10 @@ their rounded chordal initialisation written to a temporary copy first, by
 and printed: rounds of each (they differ only when the coordinator's partition differs: it
 partitions the structure in the agents' announcement order, not file order), relative cost
 difference, wall times and their ratio (target <= 1.5), median ms per round of the DDS run
-(from the arrival times of its progress lines), bytes per round (all agents' DDS bytes / rounds).
+(from the arrival times of its progress lines), bytes per round (all agents' DDS bytes / rounds),
+and where the DDS run's wall time went (the coordinator's timeline: start = launch to the
+coordinator's session, discovery, partition, ready = assignment + barrier, handoff = to the first
+round status, rounds, rounding = to the final estimates, merge, exit = summary to launch's exit).
 
 usage: dds_overhead.py [--bin build/bin] [--graphs CSAIL,intel] [--agents 5] [--domain 210]
                        [--out FILE.csv] [--limit S]
@@ -70,6 +73,7 @@ def run_in_process(tessera, graph, agents, tmp, limit):
 def run_dds(tessera, graph, agents, domain, tmp, limit):
     js = os.path.join(tmp, "dds.json")
     t0 = time.monotonic()
+    t0_ms = time.monotonic_ns() / 1e6
     p = subprocess.Popen([tessera, "launch", graph, "--agents", str(agents), "--partition",
                           "highest", "--domain", str(domain), "--json", js, "--timeout", str(limit),
                           # the same start as the in-process run (launch's own default is the
@@ -90,7 +94,30 @@ def run_dds(tessera, graph, agents, domain, tmp, limit):
     with open(js) as f:
         s = json.load(f)
     gaps = [1000 * (b - a) for a, b in zip(stamps, stamps[1:])]
+    s["phases_s"] = phases(s, t0_ms, wall)
     return s, wall, (statistics.median(gaps) if gaps else float("nan"))
+
+
+# Phases of the DDS run from the coordinator's timeline (milliseconds since its start, and
+# that start on CLOCK_MONOTONIC, which time.monotonic() also reads): seconds per phase.
+PHASES = [("start", "session"), ("discovery", "announced"), ("partition", "partitioned"),
+          ("ready", "ready"), ("handoff", "first_status"), ("rounds", "last_status"),
+          ("rounding", "finals"), ("merge", "merged")]
+
+
+def phases(summary, t0_ms, wall):
+    tl = summary.get("timeline_ms")
+    if not tl or "started_monotonic_ms" not in summary:
+        return {}
+    base = summary["started_monotonic_ms"] - t0_ms  # coordinator start after launch, ms
+    out, prev = {}, 0.0
+    for name, mark in PHASES:
+        if mark in tl:
+            at = base + tl[mark]
+            out[name] = (at - prev) / 1000
+            prev = at
+    out["exit"] = wall - prev / 1000  # FINISHED, flush, participant deletion, process exits
+    return out
 
 
 def main():
@@ -128,10 +155,15 @@ def main():
                "wall_inprocess_s": wi, "wall_dds_s": wd, "ratio": wd / wi,
                "dds_median_ms_per_round": med,
                "bytes_per_round": sd["bytes_exchanged"] / max(1, sd["rounds"])}
+        for k, v in sd.get("phases_s", {}).items():
+            row["dds_" + k + "_s"] = v
         rows.append(row)
         print("%-18s %9d %10d %13.2e %9.2f %10.2f %6.2f %12.2f %11.0f" % (
             name, row["rounds_inprocess"], row["rounds_dds"], row["rel_cost_diff"],
             wi, wd, row["ratio"], med, row["bytes_per_round"]), flush=True)
+        if sd.get("phases_s"):
+            print("    dds phases s: " + ", ".join("%s %.3f" % kv for kv in sd["phases_s"].items()) +
+                  "; in-process solve %.3f" % si.get("solve_s", float("nan")), flush=True)
     if rows:
         print("median ratio %.2f over %d graphs" % (statistics.median(r["ratio"] for r in rows), len(rows)))
     if a.out:
