@@ -78,22 +78,14 @@ TEST(DdsSecurity, SecuredLaunchGivesTheUnsecuredCost) {
   EXPECT_EQ(json_field(secure, "rounds"), json_field(plain, "rounds"));
 }
 
-TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
-  if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
-  const std::string dir = temp_dir();
-  const std::string sec = dir + "/sec", other = dir + "/other";
-  ASSERT_EQ(run_command(kMakeIdentities + " " + sec + " 3 --observer monitor --no-permission nosy",
-                        nullptr),
-            0);
-  ASSERT_EQ(
-      run_command(kMakeIdentities + " " + other + " 3 --ca-name 'Another CA' --observer monitor",
-                  nullptr),
-      0);
-  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 5));
-  const std::string run = "secure-" + std::to_string(getpid());
-  const int domain = 195;
-
-  // The watchers first, so they are there for the whole run.
+// One secured run of 3 agents on `domain`, watched from its start by four outsiders and a
+// permitted monitor. Returns true when the run stalled in set-up (a set-up wait timed out: the
+// known Fast DDS 2.9 handshake stall, docs/dds-runtime.md "Security"); every other outcome is
+// checked here: the run finishes cleanly and, stalled or not, no outsider reads a sample.
+bool secured_run_is_watched_safely(const std::string& dir, const std::string& sec,
+                                   const std::string& other, const std::string& graph, int domain) {
+  const std::string run = "secure-" + std::to_string(getpid()) + "-" + std::to_string(domain);
+  const std::string tag = std::to_string(domain);
   struct Watcher {
     std::string name;
     std::vector<std::string> extra;
@@ -106,66 +98,59 @@ TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
       {"permitted monitor", {"--security", sec, "--identity", "monitor"}, {}},
   };
   for (auto& w : watchers) {
-    std::vector<std::string> argv = {bin("tessera-dds-snoop"),
-                                     "--domain",
-                                     std::to_string(domain),
-                                     "--run-id",
-                                     run,
-                                     "--duration",
-                                     "90"};
+    std::vector<std::string> argv = {
+        bin("tessera-dds-snoop"), "--domain", tag, "--run-id", run, "--duration", "90"};
     argv.insert(argv.end(), w.extra.begin(), w.extra.end());
-    w.p = start(argv, dir + "/snoop_" + std::to_string(&w - watchers.data()) + ".log");
+    w.p = start(argv, dir + "/snoop_" + tag + "_" + std::to_string(&w - watchers.data()) + ".log");
   }
-  for (auto& w : watchers) {  // each prints "listening" once its readers exist
+  bool listening = true;  // each prints "listening" once its readers exist
+  for (auto& w : watchers) {
     for (int k = 0; k < 200 && w.p.output().find("listening") == std::string::npos; ++k)
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    ASSERT_NE(w.p.output().find("listening"), std::string::npos) << w.name << ": " << w.p.output();
+    if (w.p.output().find("listening") == std::string::npos) {
+      ADD_FAILURE() << w.name << " never listened: " << w.p.output();
+      listening = false;
+    }
   }
 
-  // The secured run. KNOWN PROBLEM (docs/dds-runtime.md, "Security"): with outsiders present,
-  // the PKI-DH handshakes of a run sometimes never complete (a set-up wait times out; seen in about
-  // one CI run in three, cause not found yet). Such a set-up stall is retried once (same run
-  // id: the outsiders listen to it) after every process of the first attempt has exited; a
-  // run that starts must finish cleanly.
-  // Every attempt counts for the outsiders' zero-sample checks below.
-  bool finished = false;
-  for (int attempt = 0; attempt < 2 && !finished; ++attempt) {
-    const std::vector<std::string> session = {
-        "--run-id", run, "--domain", std::to_string(domain), "--timeout", "20", "--security", sec};
+  bool stalled = false;
+  if (listening) {
+    const std::vector<std::string> session = {"--run-id",  run,  "--domain",   tag,
+                                              "--timeout", "20", "--security", sec};
     std::vector<Process> procs;
     std::vector<std::string> c = {bin("tessera-coordinator"), "--agents", "3"};
     c.insert(c.end(), session.begin(), session.end());
-    procs.push_back(start(c, dir + "/coordinator" + std::to_string(attempt) + ".log"));
+    procs.push_back(start(c, dir + "/coordinator_" + tag + ".log"));
     for (int k = 0; k < 3; ++k) {
       std::vector<std::string> a = {bin("tessera-agent"), "--graph", graph, "--robots", "3", "--id",
                                     std::to_string(k)};
       a.insert(a.end(), session.begin(), session.end());
-      procs.push_back(
-          start(a, dir + "/agent" + std::to_string(k) + "_" + std::to_string(attempt) + ".log"));
+      procs.push_back(start(a, dir + "/agent" + std::to_string(k) + "_" + tag + ".log"));
     }
     std::vector<Process*> all;
     for (auto& p : procs) all.push_back(&p);
-    ASSERT_TRUE(wait_all(all, 30)) << "a process hung";
-    const bool stalled =  // any set-up wait that timed out (READY, assignment, hand-off)
+    EXPECT_TRUE(wait_all(all, 30)) << "a process hung";
+    stalled =  // any set-up wait that timed out (READY, assignment, hand-off)
         procs[0].exit_code != 0 && procs[0].output().find("timed out after") != std::string::npos;
-    if (stalled && attempt == 0) {
-      std::fprintf(stderr, "secured run stalled in set-up (known problem), retrying once:\n%s\n",
-                   procs[0].output().c_str());
-      continue;
+    if (stalled) {
+      std::fprintf(stderr, "secured run on domain %d stalled in set-up (known problem):\n%s\n",
+                   domain, procs[0].output().c_str());
+    } else {
+      for (auto& p : procs) EXPECT_EQ(p.exit_code, 0) << p.output();
     }
-    for (auto& p : procs) EXPECT_EQ(p.exit_code, 0) << p.output();
-    finished = true;
   }
 
   for (auto& w : watchers) kill(w.p.pid, SIGINT);
   std::vector<Process*> snoops;
   for (auto& w : watchers) snoops.push_back(&w.p);
-  ASSERT_TRUE(wait_all(snoops, 15));
+  EXPECT_TRUE(wait_all(snoops, 15)) << "a watcher hung";
   for (auto& w : watchers) {
     const std::string out = w.p.output();
     const long samples = snoop_field(out, "samples");
     if (w.name == "permitted monitor") {
-      EXPECT_GT(samples, 0) << w.name << " (the control) should read the run: " << out;
+      if (listening && !stalled) {
+        EXPECT_GT(samples, 0) << w.name << " (the control) should read the run: " << out;
+      }
     } else {
       EXPECT_EQ(samples, 0) << w.name << " read the secured run: " << out;
     }
@@ -173,6 +158,34 @@ TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
       EXPECT_EQ(snoop_field(out, "refused"), 7) << out;
     }
   }
+  return stalled;
+}
+
+TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
+  if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
+  const std::string dir = temp_dir();
+  const std::string sec = dir + "/sec", other = dir + "/other";
+  ASSERT_EQ(run_command(kMakeIdentities + " " + sec + " 3 --observer monitor --no-permission nosy",
+                        nullptr),
+            0);
+  ASSERT_EQ(
+      run_command(kMakeIdentities + " " + other + " 3 --ca-name 'Another CA' --observer monitor",
+                  nullptr),
+      0);
+  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 5));
+  // KNOWN PROBLEM (docs/dds-runtime.md, "Security"): with outsiders present, the PKI-DH
+  // handshakes of a run sometimes never complete (about one run in three under load; twice in a
+  // row on one fresh-clone CI run when the retry reused the domain). A stalled attempt is
+  // repeated from scratch, watchers included, on a fresh domain, up to three attempts; every
+  // attempt is checked for outsiders reading nothing.
+  bool finished = false;
+  for (const int domain : {195, 197, 198}) {
+    if (!secured_run_is_watched_safely(dir, sec, other, graph, domain)) {
+      finished = true;
+      break;
+    }
+  }
+  EXPECT_TRUE(finished) << "every attempt stalled in secured set-up";
   run_command("fastdds shm clean", nullptr);
 }
 
