@@ -152,8 +152,9 @@ def run(ctx, launch_bin=None):
                 why = ""
                 if k == "ms_per_round_per_agent":
                     why = (f" ({hi[k]:.2f} vs {seq[k]:.2f} ms: an IRBCD round has more work and message phases -- "
-                           f"every agent extrapolates P^k and sends its public P poses, updates its momentum V, "
-                           f"and a restart redoes the update (docs/irbcd.md, section 2) -- but it needs "
+                           f"every agent forms the extrapolated point P^k (one projection per pose, its own and its "
+                           f"neighbours' mirrored public poses), updates its momentum V (another projection per "
+                           f"pose), and a restart redoes the update (docs/irbcd.md, section 2) -- but it needs "
                            f"{hi['rounds']} rounds instead of {seq['rounds']}, so the whole solve takes "
                            f"{hi[k] * hi['rounds'] / 1000:.2f} s instead of {seq[k] * seq['rounds'] / 1000:.2f} s)")
                 bad.append(k + why)
