@@ -260,6 +260,12 @@ CycleParams relaxed_cycle(long long ub, double coarse_relax) {
   return cp;
 }
 
+// The same balance bound for each of the k blocks: (1 + eps) ceil(n / k) poses.
+std::vector<long long> uniform_bounds(const GraphStructure& structure, int k, double eps) {
+  return std::vector<long long>(
+      k, static_cast<long long>(max_block_size(structure.num_vertices, k, eps)));
+}
+
 void expect_within(const WorkGraph& g, const std::vector<int>& part, int k,
                    const std::vector<long long>& ub) {
   ASSERT_EQ(part.size(), static_cast<std::size_t>(g.n));
@@ -281,8 +287,7 @@ TEST(MultilevelCycle, RelaxedCoarseLevelsKeepTheExactBoundOnTheInputGraph) {
   const GraphStructure structure = pose_like_graph(3000, 17);
   const WorkGraph g = to_work_graph(structure);
   const int k = 5;
-  const std::vector<long long> ub(
-      k, static_cast<long long>(max_block_size(structure.num_vertices, k, 0.03)));
+  const std::vector<long long> ub = uniform_bounds(structure, k, 0.03);
   for (double relax : {0.0, 0.05, 0.2}) {
     const CycleParams cp = relaxed_cycle(ub[0], relax);
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
@@ -313,8 +318,7 @@ TEST(MultilevelCycle, LargeCoarseRelaxationIsRepairedUnderATightBound) {
   const GraphStructure structure = grid_graph(60, 50);
   const WorkGraph g = to_work_graph(structure);
   const int k = 7;
-  const std::vector<long long> ub(
-      k, static_cast<long long>(max_block_size(structure.num_vertices, k, 0.0)));
+  const std::vector<long long> ub = uniform_bounds(structure, k, 0.0);
   int differing = 0;
   for (std::uint64_t seed = 1; seed <= 4; ++seed) {
     Rng r1(seed), r2(seed);
