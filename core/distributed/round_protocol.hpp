@@ -102,7 +102,7 @@ class RoundProtocol : public AgentProcess {
   int rounds() const { return round_; }
   int restarts() const { return restarts_; }
   /// grad_norm, max_rounds, relative_decrease, or stalled (the cost and gradient norm
-  /// repeated bit for bit for 10 rounds per block: no update is accepted any more).
+  /// repeated bit for bit for max(20, 10 x blocks) rounds: no update is accepted any more).
   const std::string& stop_reason() const { return stop_reason_; }
   const std::vector<RoundRecord>& trace() const { return trace_; }
   const AgentState& state() const { return state_; }
