@@ -26,11 +26,12 @@ void deliver_final_estimate(Session& s, const AgentLocalData& local, const Round
     char line[320];
     std::snprintf(line, sizeof(line),
                   "round loop done: %u round(s) in %.3f s, rounding %.3f s (%u CG iterations, "
-                  "%u message steps); of both: waiting %.3f s, sending %.3f s; %llu messages, "
-                  "%llu write retries",
+                  "%u message steps); of both: waiting %.3f s, sending %.3f s; %llu messages "
+                  "sent, %llu protocol messages received, %llu write retries",
                   result.rounds, result.solve_s, result.rounding_s, result.translation_iterations,
                   result.rounding_steps, result.wait_s, result.send_s,
                   static_cast<unsigned long long>(s.stats().messages_sent),
+                  static_cast<unsigned long long>(s.stats().protocol_samples_received),
                   static_cast<unsigned long long>(s.stats().write_retries));
     log(line);
   }

@@ -48,9 +48,11 @@ class DdsEntities {
             const std::vector<std::pair<std::string, std::string>>& security);
 
   /// A writer on topic `name` (transient-local for set-up topics, volatile otherwise) that
-  /// must match the peers of `e` before the readiness barrier passes. Throws TransportError.
+  /// must match the peers of `e` (kAgent: agent `agent`) before the readiness barrier passes.
+  /// Throws TransportError.
   template <class PubSubType>
-  void make_writer(const std::string& name, bool transient_local, Expect e);
+  void make_writer(const std::string& name, bool transient_local, Expect e,
+                   std::uint32_t agent = 0);
   /// A reader on topic `name` whose samples of this run go to `deliver` (on a listener
   /// thread, in arrival order); a sample `deliver` rejects by throwing stops the session.
   /// Must match the peers of `e` before the readiness barrier passes. Throws TransportError.
@@ -116,7 +118,8 @@ eprosima::fastdds::dds::Topic* DdsEntities::topic(const std::string& name) {
 }
 
 template <class PubSubType>
-void DdsEntities::make_writer(const std::string& name, bool transient_local, Expect e) {
+void DdsEntities::make_writer(const std::string& name, bool transient_local, Expect e,
+                              std::uint32_t agent) {
   namespace dds = eprosima::fastdds::dds;
   dds::Topic* t = topic<PubSubType>(name);
   writer_listeners_.push_back(std::make_unique<WriterMatchListener>(readiness_, name + "/w"));
@@ -125,7 +128,7 @@ void DdsEntities::make_writer(const std::string& name, bool transient_local, Exp
       writer_listeners_.back().get(), dds::StatusMask::publication_matched());
   if (!w) throw TransportError("cannot create DDS writer for " + name);
   writers_[name] = w;
-  readiness_.expect(name + "/w", e);
+  readiness_.expect(name + "/w", e, agent);
 }
 
 template <class PubSubType, class T>
@@ -133,7 +136,9 @@ void DdsEntities::make_reader(const std::string& name, bool transient_local, Exp
                               std::function<void(T&&)> deliver) {
   namespace dds = eprosima::fastdds::dds;
   dds::Topic* t = topic<PubSubType>(name);
-  const bool set_up_topic = name != kBlockTopic && name != kStatusTopic;
+  // Per-round traffic is not traced sample by sample (kBlockTopic and block_topic_for(k)).
+  const bool set_up_topic =
+      name.rfind(kBlockTopic, 0) != 0 && name != kStatusTopic && name != kAgentStatusTopic;
   auto drain = [this, deliver, set_up_topic, name](dds::DataReader* reader) {
     T sample;
     dds::SampleInfo info;

@@ -9,8 +9,8 @@ Readiness::Readiness(Mailroom& room, const SessionOptions& options, PeerIdentity
                      const PeerTracker& peers, const DdsTrace& trace)
     : room_(room), opt_(options), me_(std::move(me)), peers_(peers), trace_(trace) {}
 
-void Readiness::expect(const std::string& endpoint, Expect e) {
-  if (e != Expect::kNone) expect_[endpoint] = e;
+void Readiness::expect(const std::string& endpoint, Expect e, std::uint32_t agent) {
+  if (e != Expect::kNone) expect_[endpoint] = {e, agent};
 }
 
 void Readiness::on_matched(const std::string& endpoint, const GuidPrefix& prefix, int change) {
@@ -44,7 +44,7 @@ void Readiness::on_finished() {
   room_.notify();
 }
 
-std::vector<PeerIdentity> Readiness::expected_peers(Expect e) const {
+std::vector<PeerIdentity> Readiness::expected_peers(Expect e, std::uint32_t one) const {
   std::vector<PeerIdentity> out;
   if (!opt_.expect_coordinator) {
     if (e == Expect::kCoordinator) e = Expect::kNone;
@@ -66,6 +66,9 @@ std::vector<PeerIdentity> Readiness::expected_peers(Expect e) const {
       break;
     case Expect::kAllAgents:
       for (std::uint32_t k = 0; k < opt_.num_agents; ++k) out.push_back(agent(k));
+      break;
+    case Expect::kAgent:
+      out.push_back(agent(one));
       break;
   }
   return out;
@@ -91,7 +94,7 @@ bool Readiness::endpoints_matched_locked(std::string* missing) const {
     if (it != matched_.end())
       for (const GuidPrefix& p : it->second)
         if (const PeerIdentity* peer = peers_.live_locked(p)) have.insert(peer->describe());
-    for (const auto& want : expected_peers(e))
+    for (const auto& want : expected_peers(e.first, e.second))
       if (!have.count(want.describe())) absent.insert(want.describe());
   }
   if (missing) {

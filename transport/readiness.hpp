@@ -5,10 +5,12 @@
 // the linger before leaving on an error). Internal to transport/; state is guarded by the
 // mailroom's mutex.
 
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "transport/dds_trace.hpp"
@@ -19,7 +21,15 @@
 namespace tessera::transport {
 
 /// Which peers an endpoint must match before the readiness barrier can pass.
-enum class Expect { kNone, kOtherAgents, kOtherAgentsAndCoordinator, kCoordinator, kAllAgents };
+/// kAgent: one agent, named when the expectation is registered (Readiness::expect).
+enum class Expect {
+  kNone,
+  kOtherAgents,
+  kOtherAgentsAndCoordinator,
+  kCoordinator,
+  kAllAgents,
+  kAgent
+};
 
 class Readiness {
  public:
@@ -27,8 +37,8 @@ class Readiness {
             const PeerTracker& peers, const DdsTrace& trace);
 
   /// Endpoint `endpoint` ("<topic>/w" or "<topic>/r") must match the peers of `e` (kNone:
-  /// no requirement). Called while the endpoints are created.
-  void expect(const std::string& endpoint, Expect e);
+  /// no requirement; kAgent: agent `agent`). Called while the endpoints are created.
+  void expect(const std::string& endpoint, Expect e, std::uint32_t agent = 0);
   /// Listener event: `endpoint` matched (change > 0) or unmatched (< 0) an endpoint of the
   /// participant `prefix` (own participant ignored). Wakes waiters.
   void on_matched(const std::string& endpoint, const GuidPrefix& prefix, int change);
@@ -37,8 +47,9 @@ class Readiness {
   /// FINISHED received from the coordinator. Wakes waiters.
   void on_finished();
 
-  /// The peers of a complete run that `e` names (without a coordinator when the run has none).
-  std::vector<PeerIdentity> expected_peers(Expect e) const;
+  /// The peers of a complete run that `e` names (without a coordinator when the run has none;
+  /// kAgent: agent `one`).
+  std::vector<PeerIdentity> expected_peers(Expect e, std::uint32_t one = 0) const;
   /// Whether every expected endpoint matched every live expected peer; else `missing` (if
   /// given) lists the absent peers. Locks the mailroom.
   bool endpoints_matched(std::string* missing) const;
@@ -72,7 +83,7 @@ class Readiness {
   const DdsTrace& trace_;
   std::map<std::string, std::multiset<GuidPrefix>>
       matched_;  // endpoint name -> matched remote participants
-  std::map<std::string, Expect> expect_;
+  std::map<std::string, std::pair<Expect, std::uint32_t>> expect_;  // with kAgent's agent
   std::set<std::string> ready_from_;  // describe() of peers that published READY
   bool finished_ = false;
 };

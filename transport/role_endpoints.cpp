@@ -56,9 +56,16 @@ void create_agent_endpoints(SessionParts& s) {
   e.make_writer<wire::AgentAnnouncementPubSubType>(kAnnounceTopic, true, Expect::kNone);
   e.make_writer<wire::ControlPubSubType>(kControlTopic, true, Expect::kNone);
   e.make_writer<wire::MeasurementHandoffPubSubType>(kHandoffTopic, false, Expect::kOtherAgents);
+  // Broadcast pose blocks on kBlockTopic, addressed ones on the recipient's own topic.
   e.make_writer<wire::PoseBlockPubSubType>(kBlockTopic, false, Expect::kOtherAgents);
+  for (std::uint32_t k = 0; k < s.opt.num_agents; ++k)
+    if (k != me)
+      e.make_writer<wire::PoseBlockPubSubType>(block_topic_for(k), false, Expect::kAgent, k);
+  // Statuses the coordinator reads (coordinator_reads_status) on kStatusTopic, the others on
+  // kAgentStatusTopic.
   e.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false,
                                              Expect::kOtherAgentsAndCoordinator);
+  e.make_writer<wire::RoundStatusPubSubType>(kAgentStatusTopic, false, Expect::kOtherAgents);
   e.make_writer<wire::FinalEstimatePubSubType>(kFinalTopic, false, Expect::kCoordinator);
   e.make_reader<wire::PartitionAssignmentPubSubType, wire::PartitionAssignment>(
       kAssignmentTopic, true, Expect::kNone,
@@ -71,16 +78,20 @@ void create_agent_endpoints(SessionParts& s) {
         else
           s.handoff_in.push(std::move(m));
       });
-  e.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(
-      kBlockTopic, false, Expect::kOtherAgents, [&s](wire::PoseBlock&& m) {
-        s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
-                         ProtocolMessage(from_wire(m)));
-      });
-  e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
-      kStatusTopic, false, Expect::kOtherAgents, [&s](wire::RoundStatus&& m) {
-        s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
-                         ProtocolMessage(from_wire(m)));
-      });
+  for (const std::string& topic : {std::string(kBlockTopic), block_topic_for(me)})
+    e.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(
+        topic, false, Expect::kOtherAgents, [&s](wire::PoseBlock&& m) {
+          ++s.protocol_samples;
+          s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
+                           ProtocolMessage(from_wire(m)));
+        });
+  for (const char* topic : {kStatusTopic, kAgentStatusTopic})
+    e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
+        topic, false, Expect::kOtherAgents, [&s](wire::RoundStatus&& m) {
+          ++s.protocol_samples;
+          s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
+                           ProtocolMessage(from_wire(m)));
+        });
 }
 
 }  // namespace

@@ -41,8 +41,11 @@ Session::Session(const SessionOptions& options)
     security = security_properties(security_files(
         options.security_dir, security_identity(options.coordinator, options.agent_id)));
   try {
+    s.trace("creating the participant on domain %d", s.domain);
     s.entities.open(s.domain, s.me, security);
+    s.trace("participant created");
     create_role_endpoints(s);
+    s.trace("endpoints created");
   } catch (...) {
     s.entities.close(kExitRunFailed, participant_name(s.me));
     throw;
@@ -99,7 +102,7 @@ std::uint32_t Session::epoch() const {
 }
 
 void Session::set_epoch(std::uint32_t e) {
-  set_epoch(e, protocol_id());
+  impl_->router.set_epoch(e, protocol_id());
 }
 
 std::uint32_t Session::protocol_id() const {
@@ -107,6 +110,7 @@ std::uint32_t Session::protocol_id() const {
 }
 
 void Session::set_epoch(std::uint32_t e, std::uint32_t protocol_id) {
+  impl_->renumbered = true;
   impl_->router.set_epoch(e, protocol_id);
 }
 
@@ -129,12 +133,20 @@ void Session::send(const OutgoingMessage& m) {
   if (const auto* block = std::get_if<PoseBlockMessage>(&m.message)) {
     wire::PoseBlock w = to_wire_block(*block, run, m.broadcast, m.recipients);
     w.epoch(e);
-    impl_->writer.write(kBlockTopic, w);
+    // Addressed blocks reach only their recipients (one sample on each one's own topic);
+    // broadcasts, and everything after a renumbering re-partition, use the shared topic.
+    if (m.broadcast || impl_->renumbered) {
+      impl_->writer.write(kBlockTopic, w);
+    } else {
+      for (std::uint32_t k : m.recipients)
+        if (k != impl_->me.agent_id) impl_->writer.write(block_topic_for(k), w);
+    }
   } else {
-    wire::RoundStatus w =
-        to_wire_status(std::get<RoundStatusMessage>(m.message), run, m.broadcast, m.recipients);
+    const auto& status = std::get<RoundStatusMessage>(m.message);
+    wire::RoundStatus w = to_wire_status(status, run, m.broadcast, m.recipients);
     w.epoch(e);
-    impl_->writer.write(kStatusTopic, w);
+    impl_->writer.write(coordinator_reads_status(status.phase) ? kStatusTopic : kAgentStatusTopic,
+                        w);
   }
 }
 
@@ -205,7 +217,7 @@ void Session::linger_for_control(Seconds timeout, Seconds unseen_patience) {
 
 SessionStats Session::stats() const {
   return SessionStats{impl_->writer.bytes_sent(), impl_->writer.messages_sent(),
-                      impl_->writer.write_retries()};
+                      impl_->writer.write_retries(), impl_->protocol_samples.load()};
 }
 
 void Session::close() {

@@ -40,6 +40,9 @@ struct SessionStats {
   std::uint64_t bytes_sent = 0;  ///< Serialized payload bytes written (all topics).
   std::uint64_t messages_sent = 0;
   std::uint64_t write_retries = 0;  ///< Writes that found the history full and waited.
+  /// Agents: round-protocol samples (pose blocks, round statuses) that reached this process,
+  /// counted before routing, i.e. including any not addressed to it.
+  std::uint64_t protocol_samples_received = 0;
 };
 
 class Session {

@@ -3,6 +3,8 @@
 // pieces that fill and guard them, each in the file named for its concept. Members are
 // declared in dependency order (later ones refer to earlier ones). Internal to transport/.
 
+#include <atomic>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -46,6 +48,12 @@ struct SessionParts {
   EpochRouter router;
   DdsEntities entities;
   SampleWriter writer;
+  // Set once a re-partition renumbered the protocol ids (Session::set_epoch with an id):
+  // recipients are then no longer agent ids, so addressed pose blocks go on the shared
+  // kBlockTopic (every agent's router picks its own) instead of block_topic_for(recipient).
+  bool renumbered = false;
+  // Protocol samples taken by the listeners (SessionStats::protocol_samples_received).
+  std::atomic<std::uint64_t> protocol_samples{0};
 };
 
 /// The topics the process of `parts.opt`'s role writes and reads, and where each received

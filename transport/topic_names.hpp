@@ -1,7 +1,12 @@
 #pragma once
-// The DDS topic of every message type (one topic per type; Partition QoS = run id on top).
-// All start with "tessera_": the permissions of scripts/security/make_identities.sh grant
-// "tessera_*". Shared by the session and the tools that watch a run (tessera-dds-snoop).
+// The DDS topics of the message types (Partition QoS = run id on top). Round statuses and
+// pose blocks use several topics each, so that a message reaches only the processes that
+// need it (docs/dds-runtime.md, "Who receives what"). All start with "tessera_": the
+// permissions of scripts/security/make_identities.sh grant "tessera_*". Shared by the session
+// and the tools that watch a run (tessera-dds-snoop).
+
+#include <cstdint>
+#include <string>
 
 namespace tessera::transport {
 
@@ -12,5 +17,22 @@ inline constexpr const char* kBlockTopic = "tessera_pose_block";
 inline constexpr const char* kStatusTopic = "tessera_round_status";
 inline constexpr const char* kFinalTopic = "tessera_final";
 inline constexpr const char* kControlTopic = "tessera_control";
+/// Round statuses only agents need (rounding reductions, the initialisation stage,
+/// certification): kept off kStatusTopic so the coordinator is not woken by each of them.
+inline constexpr const char* kAgentStatusTopic = "tessera_agent_status";
+
+/// Whether the coordinator reads round statuses of this phase (they go on kStatusTopic, the
+/// others on kAgentStatusTopic): core's round statuses of the solve (phase 1, and 5 after a
+/// restart; coordinator/round_reports.hpp's is_round_status) for progress and loss handling,
+/// and agent 0's reports (200..299: final report, certificate; agent/round_loop.hpp).
+inline bool coordinator_reads_status(std::uint32_t phase) {
+  return phase == 1 || phase == 5 || (phase >= 200 && phase < 300);
+}
+
+/// Pose blocks addressed to agent `k` alone (kBlockTopic carries the broadcast ones): only
+/// the recipient's process receives them, instead of every agent receiving and dropping them.
+inline std::string block_topic_for(std::uint32_t k) {
+  return std::string(kBlockTopic) + "_to_" + std::to_string(k);
+}
 
 }  // namespace tessera::transport

@@ -1,0 +1,145 @@
+// Who receives what (docs/dds-runtime.md, "Who receives what"): a pose block addressed to
+// one agent reaches only that agent's process, a broadcast reaches every other agent, and
+// only the round statuses the coordinator reads (coordinator_reads_status) reach the
+// coordinator. A coordinator and three agents, each a Session of its own in this process,
+// on DDS domain 60.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <future>
+#include <memory>
+#include <string>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include "transport/session.hpp"
+#include "transport/topic_names.hpp"
+
+namespace {
+
+using namespace tessera;
+using namespace tessera::transport;
+
+constexpr int kDomain = 60;
+constexpr std::uint32_t kAgents = 3;
+
+SessionOptions options_for(bool coordinator, std::uint32_t agent) {
+  SessionOptions o;
+  o.run_id = "delivery-test";
+  o.domain = kDomain;
+  o.coordinator = coordinator;
+  o.agent_id = agent;
+  o.num_agents = kAgents;
+  o.lease_s = 3.0;  // no false peer loss on a loaded machine
+  return o;
+}
+
+OutgoingMessage block_to(std::vector<std::uint32_t> recipients, std::uint32_t phase) {
+  PoseBlockMessage b;
+  b.round = 7;
+  b.sender = 0;
+  b.phase = phase;
+  b.rank = 2;
+  b.dim = 1;
+  b.pose_ids = {3};
+  b.data = {1.0, 2.0, 3.0, 4.0};
+  OutgoingMessage m;
+  m.message = b;
+  m.broadcast = recipients.empty();
+  m.recipients = std::move(recipients);
+  return m;
+}
+
+OutgoingMessage status(std::uint32_t phase) {
+  RoundStatusMessage s;
+  s.round = 7;
+  s.sender = 0;
+  s.phase = phase;
+  s.cost = 1.5;
+  OutgoingMessage m;
+  m.message = s;
+  return m;
+}
+
+// The phases of the protocol messages `s` has received, in arrival order per type.
+std::vector<std::uint32_t> received_phases(Session& s, std::size_t expected) {
+  std::vector<std::uint32_t> out;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (out.size() < expected && std::chrono::steady_clock::now() < until) {
+    ProtocolMessage m;
+    if (s.protocol().take(Seconds(0.2), &m) == WaitStatus::kReady)
+      out.push_back(std::visit([](const auto& x) { return x.phase; }, m));
+  }
+  return out;
+}
+
+TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyItsStatuses) {
+  ASSERT_TRUE(coordinator_reads_status(1));
+  ASSERT_TRUE(coordinator_reads_status(200));
+  ASSERT_FALSE(coordinator_reads_status(101));  // a rounding reduction
+  ASSERT_FALSE(coordinator_reads_status(300));  // the initialisation stage
+
+  std::vector<std::unique_ptr<Session>> sessions;
+  sessions.push_back(std::make_unique<Session>(options_for(true, 0)));
+  for (std::uint32_t k = 0; k < kAgents; ++k)
+    sessions.push_back(std::make_unique<Session>(options_for(false, k)));
+  Session& coordinator = *sessions[0];
+  Session& a0 = *sessions[1];
+  Session& a1 = *sessions[2];
+  Session& a2 = *sessions[3];
+
+  // Every process passes the readiness barrier (every endpoint matched, READY from all).
+  std::vector<std::future<WaitStatus>> barriers;
+  for (auto& s : sessions)
+    barriers.push_back(std::async(std::launch::async, [&s] {
+      std::string missing;
+      return s->ready_barrier(Seconds(30), &missing);
+    }));
+  for (auto& b : barriers) ASSERT_EQ(b.get(), WaitStatus::kReady);
+
+  a0.send(block_to({1}, 2));  // addressed to agent 1 only
+  a0.send(block_to({}, 3));   // broadcast
+  a0.send(block_to({2}, 4));  // addressed to agent 2 only
+  a0.send(status(1));         // a round status: agents and coordinator
+  a0.send(status(101));       // a rounding reduction: agents only
+  a0.flush(Seconds(10));      // acknowledged = delivered to every matched reader
+
+  const std::vector<std::uint32_t> at1 = received_phases(a1, 4);
+  const std::vector<std::uint32_t> at2 = received_phases(a2, 4);
+  EXPECT_EQ(at1.size(), 4u);
+  EXPECT_EQ(at2.size(), 4u);
+  EXPECT_EQ(std::count(at1.begin(), at1.end(), 2u), 1);
+  EXPECT_EQ(std::count(at1.begin(), at1.end(), 4u), 0);
+  EXPECT_EQ(std::count(at2.begin(), at2.end(), 4u), 1);
+  EXPECT_EQ(std::count(at2.begin(), at2.end(), 2u), 0);
+  for (const auto* at : {&at1, &at2})
+    for (std::uint32_t phase : {3u, 1u, 101u})
+      EXPECT_EQ(std::count(at->begin(), at->end(), phase), 1);
+  // Nothing more was delivered to either agent's process: the addressed block of the other
+  // agent never reached it, not even to be dropped.
+  EXPECT_EQ(a1.stats().protocol_samples_received, 4u);
+  EXPECT_EQ(a2.stats().protocol_samples_received, 4u);
+  // The sender's own readers see its broadcasts (same topic, same participant) but never
+  // pass them on.
+  EXPECT_EQ(a0.protocol().size(), 0u);
+
+  // The coordinator got the round status only.
+  std::vector<wire::RoundStatus> watched;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+  while (std::chrono::steady_clock::now() < until) {
+    for (auto& m : coordinator.status_watch().take_all()) watched.push_back(std::move(m));
+    if (!watched.empty()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // room for a wrong extra one
+  for (auto& m : coordinator.status_watch().take_all()) watched.push_back(std::move(m));
+  ASSERT_EQ(watched.size(), 1u);
+  EXPECT_EQ(watched[0].phase(), 1u);
+
+  for (auto it = sessions.rbegin(); it != sessions.rend(); ++it) (*it)->close();
+}
+
+}  // namespace
