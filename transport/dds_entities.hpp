@@ -124,7 +124,7 @@ void DdsEntities::make_writer(const std::string& name, bool transient_local, Exp
   dds::Topic* t = topic<PubSubType>(name);
   writer_listeners_.push_back(std::make_unique<WriterMatchListener>(readiness_, name + "/w"));
   dds::DataWriter* w = publisher_->create_datawriter(
-      t, writer_qos(transient_local, opt_.lease_s, opt_.num_agents, net_),
+      t, writer_qos(transient_local, opt_.lease_s, opt_.num_agents, net_, !is_round_topic(name)),
       writer_listeners_.back().get(), dds::StatusMask::publication_matched());
   if (!w) throw TransportError("cannot create DDS writer for " + name);
   writers_[name] = w;
@@ -167,7 +167,7 @@ void DdsEntities::make_reader(const std::string& name, bool transient_local, Exp
                          << dds::StatusMask::subscription_matched()
                          << dds::StatusMask::liveliness_changed();
   dds::DataReader* r = subscriber_->create_datareader(
-      t, reader_qos(transient_local, opt_.lease_s, opt_.num_agents, net_),
+      t, reader_qos(transient_local, opt_.lease_s, opt_.num_agents, net_, set_up_topic),
       reader_listeners_.back().get(), mask);
   if (!r) throw TransportError("cannot create DDS reader for " + name);
   readers_.push_back(r);

@@ -74,7 +74,7 @@ dds::SubscriberQos subscriber_qos(const std::string& run_id) {
 }
 
 dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_t num_agents,
-                              const NetworkProfile& net) {
+                              const NetworkProfile& net, bool liveliness) {
   (void)num_agents;
   dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
@@ -96,8 +96,10 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
                                  : net.heartbeat_period_s);
   q.reliable_writer_qos().times.nackResponseDelay = Duration_t(net.nack_response_delay_s);
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
-  q.liveliness().lease_duration = Duration_t(lease_s);
-  q.liveliness().announcement_period = Duration_t(lease_s / 4.0);
+  q.liveliness().lease_duration =
+      liveliness ? Duration_t(lease_s) : eprosima::fastrtps::c_TimeInfinite;
+  q.liveliness().announcement_period =
+      liveliness ? Duration_t(lease_s / 4.0) : eprosima::fastrtps::c_TimeInfinite;
   // Messages are variable-sized (unbounded sequences): size payloads per sample.
   q.endpoint().history_memory_policy =
       eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
@@ -105,7 +107,7 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
 }
 
 dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_t num_agents,
-                              const NetworkProfile& net) {
+                              const NetworkProfile& net, bool liveliness) {
   dds::DataReaderQos q = dds::DATAREADER_QOS_DEFAULT;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
   q.durability().kind =
@@ -121,7 +123,8 @@ dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_
   q.resource_limits().allocated_samples = 4;
   q.reliable_reader_qos().times.heartbeatResponseDelay = Duration_t(net.heartbeat_response_delay_s);
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
-  q.liveliness().lease_duration = Duration_t(lease_s);
+  q.liveliness().lease_duration =
+      liveliness ? Duration_t(lease_s) : eprosima::fastrtps::c_TimeInfinite;
   q.endpoint().history_memory_policy =
       eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return q;

@@ -51,13 +51,21 @@ eprosima::fastdds::dds::DomainParticipantQos participant_qos(
 eprosima::fastdds::dds::PublisherQos publisher_qos(const std::string& run_id);
 eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);
 /// Reliable, bounded KEEP_ALL, heartbeat and repair delays of `net`, AUTOMATIC liveliness
-/// with `lease_s`.
+/// with `lease_s` (`liveliness` false: no liveliness lease at all).
 /// TRANSIENT_LOCAL for hand-shake topics (late joiners still get them), VOLATILE otherwise.
+///
+/// The per-round topics (pose blocks, round statuses) use `liveliness` false: with a lease,
+/// Fast DDS 2.9 asserts the writer's liveliness on every write and the reader's on every
+/// sample received, and each assertion restarts a timer of the participant's event thread,
+/// i.e. wakes that thread (measured: about a third of all context switches of a run, ~50 per
+/// round over 6 processes). A dead peer is still noticed by the participant lease and by the
+/// liveliness of its set-up topics' writers (control, announcement, ...), which stay AUTOMATIC
+/// and are asserted by the participant's periodic liveliness messages.
 eprosima::fastdds::dds::DataWriterQos writer_qos(bool transient_local, double lease_s,
                                                  std::uint32_t num_agents,
-                                                 const NetworkProfile& net);
+                                                 const NetworkProfile& net, bool liveliness = true);
 eprosima::fastdds::dds::DataReaderQos reader_qos(bool transient_local, double lease_s,
                                                  std::uint32_t num_agents,
-                                                 const NetworkProfile& net);
+                                                 const NetworkProfile& net, bool liveliness = true);
 
 }  // namespace tessera::transport

@@ -35,4 +35,10 @@ inline std::string block_topic_for(std::uint32_t k) {
   return std::string(kBlockTopic) + "_to_" + std::to_string(k);
 }
 
+/// The topics of the per-round traffic (pose blocks and round statuses, every kind): many
+/// small samples a second, so their endpoints carry no liveliness lease (qos.hpp).
+inline bool is_round_topic(const std::string& name) {
+  return name.rfind(kBlockTopic, 0) == 0 || name == kStatusTopic || name == kAgentStatusTopic;
+}
+
 }  // namespace tessera::transport
