@@ -17,10 +17,11 @@
 namespace tessera::cli {
 
 const char* const kDistributedValued[] = {
-    "agents",        "partition",        "max-rounds",     "seed",      "reference-cost",
-    "select",        "rel-tol",          "tr-steps",       "restart-c", "sigma",
-    "unselected",    "irbcd-n",          "tcg-iters",      "robots",    "certify-grad-tol",
-    "certify-iters", "certify-residual", "certify-precon", nullptr};
+    "agents",        "partition",        "max-rounds",     "seed",         "reference-cost",
+    "select",        "rel-tol",          "tr-steps",       "restart-c",    "sigma",
+    "unselected",    "irbcd-n",          "tcg-iters",      "robots",       "certify-grad-tol",
+    "certify-iters", "certify-residual", "certify-precon", "block-precon", "tangent-refresh",
+    nullptr};
 const char* const kDistributedSwitches[] = {"parallel", "sequential", "reference", "certify",
                                             nullptr};
 
@@ -45,6 +46,11 @@ const char* kDistributedHelp =
     "  --rank R                  relaxation rank (default 5)\n"
     "  --tr-steps K              trust-region steps per block update (default 1)\n"
     "  --tcg-iters K             truncated-CG iterations per trust-region step (default 50)\n"
+    "  --block-precon tangent|euclidean   block updates' tCG preconditioner: the tangent-\n"
+    "                            coordinate factor J A^-1 J^T at rank-d points (default), or\n"
+    "                            the Q_BB factor (docs/irbcd.md section 12)\n"
+    "  --tangent-refresh K       refactor the tangent factor at the current point every K\n"
+    "                            updates of an agent (default 0: once, at its first update)\n"
     "  --restart-c C             restart constant c1 of RBCD++/IRBCD (< 0: never restart)\n"
     "  --sigma S                 IRBCD sigma (default 1e-4; the paper: 1e-3)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
@@ -109,6 +115,14 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       static_cast<int>(a.get_long("tr-steps", opt.block_update.trust_region_steps));
   opt.block_update.max_inner_iterations =
       static_cast<int>(a.get_long("tcg-iters", opt.block_update.max_inner_iterations));
+  {
+    const std::string precon = a.get_or("block-precon", "tangent");
+    if (precon != "tangent" && precon != "euclidean")
+      throw InputError("option --block-precon: '" + precon + "' is not one of tangent, euclidean");
+    opt.block_update.tangent_preconditioner = precon == "tangent";
+  }
+  opt.block_update.tangent_refresh_interval =
+      static_cast<int>(a.get_long("tangent-refresh", opt.block_update.tangent_refresh_interval));
   opt.block_update.max_attempts =
       std::max(opt.block_update.max_attempts, opt.block_update.trust_region_steps);
   if (a.has("restart-c")) {
@@ -234,7 +248,14 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         .add("cpu_ms_per_round", r.rounds > 0 ? 1e3 * r.solve_cpu_s / r.rounds : 0.0)
         .add("critical_path_cpu_s", r.critical_path_cpu_s)
         .add("rel_gap", rel_gap)
-        .add("final_rank", r.final_rank);
+        .add("final_rank", r.final_rank)
+        .add("block_updates", r.block_updates)
+        .add("tcg_iterations", r.tcg_iterations)
+        .add("tcg_per_update", r.block_updates > 0 ? static_cast<double>(r.tcg_iterations) /
+                                                         static_cast<double>(r.block_updates)
+                                                   : 0.0)
+        .add("tangent_updates", r.tangent_updates)
+        .add("tangent_factorizations", r.tangent_factorizations);
     if (r.certified) {
       j.add("min_eigenvalue", r.min_eigenvalue)
           .add("certificate_tolerance", r.certificate_tolerance)

@@ -173,11 +173,14 @@ TEST(DistributedSolver, ActiveRowUpdateEqualsTheFullRankUpdate) {
   start = M.project(start);
   const Eigen::MatrixXd Yn = gather(X, full.neighbors());
 
-  AgentState agent(0, 3, layout, g.measurements, start);
-  const Eigen::MatrixXd got = agent.update(start, Yn, BlockUpdateOptions{});
+  // The Q_BB preconditioner on both sides (the tangent one exists at rank d only).
+  BlockUpdateOptions euclidean;
+  euclidean.tangent_preconditioner = false;
+  AgentState agent(0, 3, layout, g.measurements, start, euclidean);
+  const Eigen::MatrixXd got = agent.update(start, Yn, euclidean);
   full.set_neighbor_poses(Yn);
-  const Eigen::MatrixXd want = block_update(full, start, BlockUpdateOptions{}, nullptr);
-  const Eigen::MatrixXd want_pre = block_update(full, start, BlockUpdateOptions{}, &precon);
+  const Eigen::MatrixXd want = block_update(full, start, euclidean, nullptr);
+  const Eigen::MatrixXd want_pre = block_update(full, start, euclidean, &precon);
   EXPECT_GT((got - start).norm(), 1e-6);  // it moved
   EXPECT_EQ(got.bottomRows(r - 3).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_LT((got - want_pre).cwiseAbs().maxCoeff(), 1e-10);
@@ -187,8 +190,8 @@ TEST(DistributedSolver, ActiveRowUpdateEqualsTheFullRankUpdate) {
   // A random rotation of R^r: no zero rows left, every row active; the result rotates along.
   const Eigen::MatrixXd R =
       Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(r, r)).householderQ();
-  AgentState rotated(0, 3, layout, g.measurements, R * start);
-  const Eigen::MatrixXd got_rot = rotated.update(R * start, R * Yn, BlockUpdateOptions{});
+  AgentState rotated(0, 3, layout, g.measurements, R * start, euclidean);
+  const Eigen::MatrixXd got_rot = rotated.update(R * start, R * Yn, euclidean);
   EXPECT_LT((got_rot - R * got).cwiseAbs().maxCoeff(), 1e-8);
 }
 

@@ -9,7 +9,8 @@
 namespace tessera {
 
 AgentState::AgentState(int id, int d, const BlockLayout& layout,
-                       const std::vector<Measurement>& measurements, const Eigen::MatrixXd& Y0)
+                       const std::vector<Measurement>& measurements, const Eigen::MatrixXd& Y0,
+                       const BlockUpdateOptions& options)
     : id_(id),
       d_(d),
       layout_(layout),
@@ -27,7 +28,31 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
   Pn = Yn;
   Vn = Yn;
   Yn_prev = Yn;
-  precon_ = std::make_unique<BlockPreconditioner>(problem_);
+  // The factor the updates will use is computed with the rest of the set-up, not in a round.
+  bool tangent = false;
+  if (options.precondition && options.tangent_preconditioner) {
+    const Eigen::Array<bool, Eigen::Dynamic, 1> nonzero = (Y0.array() != 0.0).rowwise().any();
+    if (nonzero.count() == d) {
+      std::vector<Eigen::Index> rows;
+      for (Eigen::Index k = 0; k < Y0.rows(); ++k)
+        if (nonzero(k)) rows.push_back(k);
+      tangent = build_tangent(Y0(rows, Eigen::all), options);
+    }
+  }
+  if (!tangent) euclidean();
+}
+
+BlockPreconditioner& AgentState::euclidean() {
+  if (!precon_) precon_ = std::make_unique<BlockPreconditioner>(problem_);
+  return *precon_;
+}
+
+bool AgentState::build_tangent(const Eigen::MatrixXd& X, const BlockUpdateOptions& options) {
+  if (tangent_tried_) return tangent_ && tangent_->usable();
+  tangent_tried_ = true;
+  tangent_ = std::make_unique<TangentPreconditioner>(problem_, options.tangent_relative_shift);
+  if (!tangent_->usable() || !tangent_->factorize(X)) tangent_.reset();
+  return tangent_ != nullptr;
 }
 
 PoseBlockMessage AgentState::publish(const Eigen::MatrixXd& X, BlockKind kind, int recipient,
@@ -110,7 +135,8 @@ LocalStatus AgentState::status(bool newton_score) {
     s.cost_share = problem_.cost_share(Ya);
     const Eigen::MatrixXd g = problem_.riemannian_gradient(Ya, problem_.euclidean_gradient(Ya));
     s.grad_norm_sq = g.squaredNorm();
-    const Eigen::MatrixXd z = precon_->apply(problem_.manifold(static_cast<int>(Ya.rows())), Ya, g);
+    const Eigen::MatrixXd z =
+        euclidean().apply(problem_.manifold(static_cast<int>(Ya.rows())), Ya, g);
     s.block_grad_norm = std::sqrt(std::max(0.0, (z.array() * g.array()).sum()));
     return s;
   }
@@ -130,14 +156,32 @@ LocalStatus AgentState::status(bool newton_score) {
 Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
                                    const BlockUpdateOptions& options) {
   set_point(X0, neighbours);
-  if (static_cast<Eigen::Index>(rows_.size()) == X0.rows()) {
-    updated_X_ = block_update(problem_, X0, options, precon_.get(), &updated_grad_norm_sq_);
-  } else {
-    const Eigen::MatrixXd Xa =
-        block_update(problem_, active_part(X0), options, precon_.get(), &updated_grad_norm_sq_);
-    updated_X_ = Eigen::MatrixXd::Zero(X0.rows(), X0.cols());
-    updated_X_(rows_, Eigen::all) = Xa;
+  // The tangent factor needs rank-d points (docs/irbcd.md section 12): the active rows of a
+  // lifted start. After a saddle escape (every row active), when its factor would be too large
+  // or fails, the Q_BB factor is used.
+  const Eigen::MatrixXd Xa = active_part(X0);
+  BlockPreconditioner* euclid = nullptr;
+  const TangentPreconditioner* tangent = nullptr;
+  if (options.precondition) {
+    if (options.tangent_preconditioner && Xa.rows() == d_ && build_tangent(Xa, options) &&
+        tangent_->prepare(Xa, options.tangent_refresh_interval))
+      tangent = tangent_.get();
+    else
+      euclid = &euclidean();
   }
+  BlockUpdateStats stats;
+  if (static_cast<Eigen::Index>(rows_.size()) == X0.rows()) {
+    updated_X_ =
+        block_update(problem_, X0, options, euclid, &updated_grad_norm_sq_, tangent, &stats);
+  } else {
+    const Eigen::MatrixXd Xn =
+        block_update(problem_, Xa, options, euclid, &updated_grad_norm_sq_, tangent, &stats);
+    updated_X_ = Eigen::MatrixXd::Zero(X0.rows(), X0.cols());
+    updated_X_(rows_, Eigen::all) = Xn;
+  }
+  ++block_updates_;
+  tcg_iterations_ += stats.tcg_iterations;
+  if (stats.tangent) ++tangent_updates_;
   updated_version_ = neighbours_version_;
   return updated_X_;
 }

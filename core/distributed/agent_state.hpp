@@ -27,9 +27,11 @@ struct LocalStatus {
 
 class AgentState {
  public:
-  /// `Y0`: the block's initial lifted poses, r x (d+1)m in layout.poses[id] order.
+  /// `Y0`: the block's initial lifted poses, r x (d+1)m in layout.poses[id] order. The
+  /// preconditioner `options` ask for is factored here (set-up): the tangent one at Y0 when Y0
+  /// has d active rows, else the Q_BB one; the other is built when first needed.
   AgentState(int id, int d, const BlockLayout& layout, const std::vector<Measurement>& measurements,
-             const Eigen::MatrixXd& Y0);
+             const Eigen::MatrixXd& Y0, const BlockUpdateOptions& options = {});
   AgentState(const AgentState&) = delete;
   AgentState& operator=(const AgentState&) = delete;
 
@@ -53,6 +55,13 @@ class AgentState {
                          const BlockUpdateOptions& options);
   /// Local objective f_B(X) with neighbours at `neighbours`.
   double local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
+  /// Totals over this agent's block updates so far (BlockUpdateStats summed): updates,
+  /// truncated-CG iterations, updates preconditioned with the tangent factor, and that
+  /// factor's numeric factorizations.
+  long long block_updates() const { return block_updates_; }
+  long long tcg_iterations() const { return tcg_iterations_; }
+  long long tangent_updates() const { return tangent_updates_; }
+  int tangent_factorizations() const { return tangent_ ? tangent_->factorizations() : 0; }
   /// Starts the sequences afresh at Y0 (any rank, e.g. r + 1 after a saddle escape) with
   /// neighbours at Yn0 (same rank, neighbour order).
   void reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd& Yn0);
@@ -75,7 +84,15 @@ class AgentState {
   int d_;
   const BlockLayout& layout_;
   BlockProblem problem_;
+  /// The Q_BB preconditioner, built on first use.
+  BlockPreconditioner& euclidean();
+  /// Builds and factors the tangent preconditioner at X (rank d) once; false when unusable.
+  bool build_tangent(const Eigen::MatrixXd& X, const BlockUpdateOptions& options);
+
   std::unique_ptr<BlockPreconditioner> precon_;
+  std::unique_ptr<TangentPreconditioner> tangent_;
+  bool tangent_tried_ = false;
+  long long block_updates_ = 0, tcg_iterations_ = 0, tangent_updates_ = 0;
   Eigen::MatrixXd neighbours_set_;  // what problem_ holds, so X_N Q_NB is rebuilt only on change
   // Rows of the current point that are not identically zero, in increasing order. A lifted
   // point [I_d; 0] R (chordal or distributed initialisation) has r - d zero rows, and every

@@ -110,7 +110,8 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
     for (std::size_t s = 0; s < ids.size(); ++s)
       Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
           X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-    states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb));
+    states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb,
+                                                  options.block_update));
   }
 
   // One certified sequence per agent (with certification off: exactly the round protocol).
@@ -172,6 +173,12 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
     for (std::size_t s = 0; s < ids.size(); ++s)
       res.X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
           Yb.middleCols(w * static_cast<Eigen::Index>(s), w);
+  }
+  for (const auto& s : states) {
+    res.block_updates += s->block_updates();
+    res.tcg_iterations += s->tcg_iterations();
+    res.tangent_updates += s->tangent_updates();
+    res.tangent_factorizations += s->tangent_factorizations();
   }
   res.relaxation_cost = res.trace.empty() ? 0.0 : res.trace.back().cost;
   res.grad_norm = res.trace.empty() ? 0.0 : res.trace.back().grad_norm;

@@ -95,6 +95,12 @@ struct DistributedResult {
   int final_rank = 0;
   std::vector<CertifyStageRecord> certificates;
   std::vector<EscapeStageRecord> escapes;
+  /// Block updates of all agents (restarts' redos included), their truncated-CG iterations,
+  /// the updates preconditioned with the tangent factor, and that factor's factorizations.
+  long long block_updates = 0;
+  long long tcg_iterations = 0;
+  long long tangent_updates = 0;
+  long long tangent_factorizations = 0;
   Eigen::MatrixXd X;             ///< Final lifted iterate (r x (d+1)n, global order).
   double relaxation_cost = 0.0;  ///< f(X).
   double grad_norm = 0.0;        ///< ||grad f(X)||.

@@ -2,12 +2,14 @@
 // RBCD's round math (Tian et al., Riemannian block coordinate descent): the block update.
 // The selected block minimises its local objective over (St(r,d) x R^r)^m with the
 // neighbours' poses held fixed, by a few Riemannian trust-region steps (truncated CG,
-// preconditioned by the block's constant Q_BB, factored once per agent).
+// preconditioned by a factor computed once per agent: the tangent-coordinate one at rank d,
+// else the block's constant Q_BB; docs/irbcd.md section 12).
 
 #include <Eigen/Core>
 
 #include "problem/block_problem.hpp"
 #include "solvers/block_preconditioner.hpp"
+#include "solvers/tangent_preconditioner.hpp"
 
 namespace tessera {
 
@@ -19,18 +21,41 @@ struct BlockUpdateOptions {
   int max_attempts = 10;
   int max_inner_iterations = 50;  ///< tCG iterations per step (>= 1).
   double tcg_kappa = 0.1;         ///< tCG linear convergence target, in (0, 1).
-  bool precondition = true;       ///< Use the block's Q_BB factor (else the identity).
+  bool precondition = true;       ///< Use a preconditioner (else the identity).
+  /// Precondition with the tangent-coordinate factor (solvers/tangent_preconditioner.hpp,
+  /// docs/irbcd.md section 12) when the point has rank d (the agents' active rows) and the
+  /// factor is not too large or failing; otherwise, and when false, with the Euclidean Q_BB
+  /// factor (solvers/block_preconditioner.hpp).
+  bool tangent_preconditioner = true;
+  /// Updates of an agent between refactorizations of its tangent factor at the current point
+  /// (>= 0; 0 = factored once, at the agent's first update, and kept: the basis J(X) is still
+  /// taken at every update's point, only A = J^T 2Q_BB J is from the first one).
+  int tangent_refresh_interval = 0;
+  /// lambda of the tangent factor, relative to the largest diagonal entry of J^T 2Q_BB J (>= 0).
+  double tangent_relative_shift = 1e-9;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
 };
 
+/// What a block update did (for the solver's totals).
+struct BlockUpdateStats {
+  int trust_region_iterations = 0;  ///< Attempts made (accepted or not).
+  int tcg_iterations = 0;           ///< Truncated-CG iterations, all attempts.
+  bool tangent = false;             ///< Preconditioned with the tangent factor.
+};
+
 /// One block update from X0 (on the block's manifold) with the neighbour poses currently set
 /// in `problem`. Never increases the local cost: returns X0 when no step is accepted. When
 /// `grad_norm_sq` is not null it receives ||grad f_B||^2 at the returned point (the trust-region
-/// step computes that gradient anyway; the next status can reuse it).
+/// step computes that gradient anyway; the next status can reuse it). With
+/// options.precondition, tCG is preconditioned with `tangent` when it is not null (it must be
+/// factored and X0 of rank d: TangentPreconditioner::prepare), else with `preconditioner` (null:
+/// the identity). `stats`, when not null, receives what the update did.
 Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd& X0,
                              const BlockUpdateOptions& options, BlockPreconditioner* preconditioner,
-                             double* grad_norm_sq = nullptr);
+                             double* grad_norm_sq = nullptr,
+                             const TangentPreconditioner* tangent = nullptr,
+                             BlockUpdateStats* stats = nullptr);
 
 }  // namespace tessera

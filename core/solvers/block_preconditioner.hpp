@@ -16,10 +16,11 @@
 #include <memory>
 
 #include "problem/block_problem.hpp"
+#include "solvers/riemannian_preconditioner.hpp"
 
 namespace tessera {
 
-class BlockPreconditioner {
+class BlockPreconditioner : public RiemannianPreconditioner {
  public:
   /// Factor entries above which the distributed agents use the block-diagonal fallback
   /// (16 M entries = 128 MB of factor; no benchmark graph's block comes near it).
@@ -37,13 +38,13 @@ class BlockPreconditioner {
   explicit BlockPreconditioner(const BlockProblem& problem, double relative_shift = 1e-6,
                                std::size_t max_factor_entries = kDefaultMaxFactorEntries,
                                std::size_t supernodal_min_entries = kDefaultSupernodalMinEntries);
-  ~BlockPreconditioner();
+  ~BlockPreconditioner() override;
   BlockPreconditioner(const BlockPreconditioner&) = delete;
   BlockPreconditioner& operator=(const BlockPreconditioner&) = delete;
 
   /// Tangent projection at X of (2(Q_BB + lambda I))^{-1} applied to the rows of V.
   Eigen::MatrixXd apply(const LiftedManifold& manifold, const Eigen::MatrixXd& X,
-                        const Eigen::MatrixXd& V) const;
+                        const Eigen::MatrixXd& V) const override;
 
   /// True when the exact factor was too large and the block diagonal is used.
   bool block_diagonal() const;

@@ -43,7 +43,8 @@ struct TcgOutcome {
 TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
                         const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
                         const Eigen::MatrixXd& grad, double radius, const TrustRegionOptions& opt,
-                        const BlockPreconditioner* precon, const Eigen::MatrixXd* precon_grad) {
+                        const RiemannianPreconditioner* precon,
+                        const Eigen::MatrixXd* precon_grad) {
   auto precondition = [&](const Eigen::MatrixXd& v) { return precon ? precon->apply(M, X, v) : v; };
   TcgOutcome out;
   out.eta = Eigen::MatrixXd::Zero(X.rows(), X.cols());
@@ -93,7 +94,7 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
 
 TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::MatrixXd& X0,
                                      const TrustRegionOptions& options,
-                                     const BlockPreconditioner* preconditioner,
+                                     const RiemannianPreconditioner* preconditioner,
                                      const PointRefinement* refine) {
   options.validate();
   const auto start = std::chrono::steady_clock::now();

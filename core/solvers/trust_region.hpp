@@ -64,7 +64,7 @@ using PointRefinement = std::function<void(Eigen::MatrixXd&)>;
 /// `preconditioner` may be null (identity); `refine` may be null (none).
 TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::MatrixXd& X0,
                                      const TrustRegionOptions& options,
-                                     const BlockPreconditioner* preconditioner = nullptr,
+                                     const RiemannianPreconditioner* preconditioner = nullptr,
                                      const PointRefinement* refine = nullptr);
 
 }  // namespace tessera

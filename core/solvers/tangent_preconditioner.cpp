@@ -1,0 +1,272 @@
+#include "solvers/tangent_preconditioner.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
+#include <algorithm>
+#include <stdexcept>
+#include <vector>
+
+namespace tessera {
+
+struct TangentPreconditioner::Factor {
+  int d = 0;
+  int p = 0;  // coordinates per pose
+  Eigen::Index m = 0;
+  double relative_shift = 0.0;
+  // Pose-block pattern of Q_BB by block columns: the row blocks of block column j are
+  // block_row[block_start[j] .. block_start[j+1]), increasing, the diagonal always included.
+  std::vector<Eigen::Index> block_start, block_row, diagonal_slot;
+  // Q_BB's (d+1) x (d+1) block of each pose-block pair, column-major, in block_row order.
+  std::vector<double> q_blocks;
+  // A with its full pattern (every pose-block pair p x p dense; CHOLMOD reads the lower half).
+  SparseMatrix A;
+  Eigen::CholmodDecomposition<SparseMatrix> llt;
+  std::size_t entries = 0;
+  bool usable = false;
+  bool factored = false;
+  int factorizations = 0;
+  int calls_since_factor = 0;
+
+  // Offset in A's value array of entry (0, c) of the block in slot s of block column j.
+  Eigen::Index value_offset(Eigen::Index j, Eigen::Index s, int c) const {
+    return A.outerIndexPtr()[j * p + c] + (s - block_start[static_cast<std::size_t>(j)]) * p;
+  }
+};
+
+namespace {
+
+// The rotation-coordinate index pairs (a < b) of the skew basis E_ab = e_b e_a^T - e_a e_b^T.
+std::vector<std::pair<int, int>> skew_pairs(int d) {
+  std::vector<std::pair<int, int>> out;
+  for (int a = 0; a < d; ++a)
+    for (int b = a + 1; b < d; ++b) out.emplace_back(a, b);
+  return out;
+}
+
+// G (d(d+1) x p): the pose's tangent basis vectors, each the column-major vec of a d x (d+1)
+// pose block, at rotation Y (d x d).
+Eigen::MatrixXd pose_basis(const Eigen::Ref<const Eigen::MatrixXd>& Y,
+                           const std::vector<std::pair<int, int>>& pairs) {
+  const Eigen::Index d = Y.rows();
+  const Eigen::Index nr = static_cast<Eigen::Index>(pairs.size());
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(d * (d + 1), nr + d);
+  for (Eigen::Index k = 0; k < nr; ++k) {
+    const auto [a, b] = pairs[static_cast<std::size_t>(k)];
+    // Y E_ab: column a is Y e_b, column b is -Y e_a.
+    G.block(a * d, k, d, 1) = Y.col(b);
+    G.block(b * d, k, d, 1) = -Y.col(a);
+  }
+  G.block(d * d, nr, d, d) = Y;
+  return G;
+}
+
+}  // namespace
+
+TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double relative_shift,
+                                             std::size_t max_factor_entries)
+    : factor_(std::make_unique<Factor>()) {
+  if (!(relative_shift >= 0))
+    throw std::invalid_argument("TangentPreconditioner: relative_shift must be >= 0");
+  Factor& f = *factor_;
+  f.d = problem.dim();
+  f.p = f.d * (f.d + 1) / 2;
+  f.m = static_cast<Eigen::Index>(problem.num_owned());
+  f.relative_shift = relative_shift;
+  const int w = f.d + 1;
+  SparseMatrix Q = problem.data_matrix();
+  Q.makeCompressed();
+
+  // Pose-block pattern of Q (row blocks per block column).
+  std::vector<std::vector<Eigen::Index>> rows(static_cast<std::size_t>(f.m));
+  for (Eigen::Index j = 0; j < f.m; ++j) {
+    auto& r = rows[static_cast<std::size_t>(j)];
+    r.push_back(j);
+    for (int s = 0; s < w; ++s)
+      for (SparseMatrix::InnerIterator it(Q, j * w + s); it; ++it) r.push_back(it.row() / w);
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+  }
+  f.block_start.assign(1, 0);
+  for (Eigen::Index j = 0; j < f.m; ++j) {
+    const auto& r = rows[static_cast<std::size_t>(j)];
+    f.diagonal_slot.push_back(f.block_start.back() +
+                              (std::lower_bound(r.begin(), r.end(), j) - r.begin()));
+    f.block_row.insert(f.block_row.end(), r.begin(), r.end());
+    f.block_start.push_back(static_cast<Eigen::Index>(f.block_row.size()));
+  }
+  // Q's pose blocks, densely.
+  f.q_blocks.assign(f.block_row.size() * static_cast<std::size_t>(w * w), 0.0);
+  for (Eigen::Index j = 0; j < f.m; ++j) {
+    const auto begin = f.block_row.begin() + f.block_start[static_cast<std::size_t>(j)];
+    const auto end = f.block_row.begin() + f.block_start[static_cast<std::size_t>(j) + 1];
+    for (int s = 0; s < w; ++s)
+      for (SparseMatrix::InnerIterator it(Q, j * w + s); it; ++it) {
+        const Eigen::Index slot = std::lower_bound(begin, end, it.row() / w) - f.block_row.begin();
+        f.q_blocks[static_cast<std::size_t>(slot * w * w + s * w + it.row() % w)] = it.value();
+      }
+  }
+  // A's pattern: block column j's columns each hold p rows per row block.
+  const Eigen::Index n = f.m * f.p;
+  const Eigen::Index nnz = static_cast<Eigen::Index>(f.block_row.size()) * f.p * f.p;
+  f.A.resize(n, n);
+  f.A.resizeNonZeros(nnz);
+  Eigen::Index pos = 0;
+  for (Eigen::Index j = 0; j < f.m; ++j)
+    for (int c = 0; c < f.p; ++c) {
+      f.A.outerIndexPtr()[j * f.p + c] = static_cast<int>(pos);
+      for (Eigen::Index s = f.block_start[static_cast<std::size_t>(j)];
+           s < f.block_start[static_cast<std::size_t>(j) + 1]; ++s)
+        for (int r = 0; r < f.p; ++r) {
+          f.A.innerIndexPtr()[pos] =
+              static_cast<int>(f.block_row[static_cast<std::size_t>(s)] * f.p + r);
+          f.A.valuePtr()[pos] = 0.0;
+          ++pos;
+        }
+    }
+  f.A.outerIndexPtr()[n] = static_cast<int>(pos);
+
+  // Symbolic analysis once (AMD only, as the Euclidean preconditioner; simplicial LDL^T).
+  f.llt.setMode(Eigen::CholmodLDLt);
+  cholmod_common& c = f.llt.cholmod();
+  c.nmethods = 1;
+  c.method[0].ordering = CHOLMOD_AMD;
+  c.postorder = 1;
+  f.llt.analyzePattern(f.A);
+  if (f.llt.info() != Eigen::Success) return;  // not usable
+  f.entries = static_cast<std::size_t>(f.llt.cholmod().lnz);
+  f.usable = max_factor_entries == 0 || f.entries <= max_factor_entries;
+}
+
+TangentPreconditioner::~TangentPreconditioner() = default;
+
+bool TangentPreconditioner::usable() const {
+  return factor_->usable;
+}
+
+bool TangentPreconditioner::factored() const {
+  return factor_->usable && factor_->factored;
+}
+
+int TangentPreconditioner::factorizations() const {
+  return factor_->factorizations;
+}
+
+std::size_t TangentPreconditioner::factor_entries() const {
+  return factor_->entries;
+}
+
+int TangentPreconditioner::coordinates_per_pose() const {
+  return factor_->p;
+}
+
+bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
+  Factor& f = *factor_;
+  const int d = f.d, w = d + 1, p = f.p;
+  if (!f.usable || X.rows() != d || X.cols() != w * f.m) return false;
+  const auto pairs = skew_pairs(d);
+  std::vector<Eigen::MatrixXd> G(static_cast<std::size_t>(f.m));
+  for (Eigen::Index i = 0; i < f.m; ++i)
+    G[static_cast<std::size_t>(i)] = pose_basis(X.block(0, i * w, d, d), pairs);
+  // Block (i, j) of A = 2 G_i^T (Q_ij kron I_d) G_j.
+  Eigen::MatrixXd T(d * w, p), B(p, p);
+  double max_diagonal = 0.0;
+  for (Eigen::Index j = 0; j < f.m; ++j) {
+    const Eigen::MatrixXd& Gj = G[static_cast<std::size_t>(j)];
+    for (Eigen::Index s = f.block_start[static_cast<std::size_t>(j)];
+         s < f.block_start[static_cast<std::size_t>(j) + 1]; ++s) {
+      const Eigen::Index i = f.block_row[static_cast<std::size_t>(s)];
+      const Eigen::Map<const Eigen::MatrixXd> Qij(f.q_blocks.data() + s * w * w, w, w);
+      for (int t = 0; t < w; ++t) {
+        auto row = T.middleRows(t * d, d);
+        row.setZero();
+        for (int u = 0; u < w; ++u)
+          if (Qij(t, u) != 0.0) row.noalias() += Qij(t, u) * Gj.middleRows(u * d, d);
+      }
+      B.noalias() = 2.0 * G[static_cast<std::size_t>(i)].transpose() * T;
+      if (i == j) {
+        B = 0.5 * (B + B.transpose()).eval();  // exactly symmetric
+        max_diagonal = std::max(max_diagonal, B.diagonal().maxCoeff());
+      }
+      for (int c = 0; c < p; ++c)
+        std::copy(B.col(c).data(), B.col(c).data() + p, f.A.valuePtr() + f.value_offset(j, s, c));
+    }
+  }
+  const double lambda = f.relative_shift * std::max(1e-12, max_diagonal);
+  for (Eigen::Index j = 0; j < f.m; ++j)
+    for (int c = 0; c < p; ++c)
+      f.A.valuePtr()[f.value_offset(j, f.diagonal_slot[static_cast<std::size_t>(j)], c) + c] +=
+          lambda;
+  f.llt.factorize(f.A);
+  ++f.factorizations;
+  f.calls_since_factor = 0;
+  if (f.llt.info() != Eigen::Success) {
+    f.usable = false;  // keep the caller on its Euclidean preconditioner from now on
+    f.factored = false;
+    return false;
+  }
+  f.factored = true;
+  return true;
+}
+
+bool TangentPreconditioner::prepare(const Eigen::MatrixXd& X, int refresh_interval) {
+  Factor& f = *factor_;
+  if (!f.usable || X.rows() != f.d) return false;
+  if (!f.factored || (refresh_interval > 0 && f.calls_since_factor >= refresh_interval)) {
+    if (!factorize(X)) return false;
+  }
+  ++f.calls_since_factor;
+  return true;
+}
+
+Eigen::MatrixXd TangentPreconditioner::apply(const LiftedManifold&, const Eigen::MatrixXd& X,
+                                             const Eigen::MatrixXd& V) const {
+  const Factor& f = *factor_;
+  const int d = f.d, w = d + 1, p = f.p;
+  if (!factored() || X.rows() != d || V.rows() != d || X.cols() != w * f.m || V.cols() != X.cols())
+    throw std::logic_error("TangentPreconditioner::apply: not factored, or not a rank-d point");
+  const auto pairs = skew_pairs(d);
+  const int nr = static_cast<int>(pairs.size());
+  // b = J^T V, pose by pose: omega_ab = <Y E_ab, V_R> = (Y^T V_R)(b, a) - (Y^T V_R)(a, b),
+  // u = Y^T v.
+  Eigen::VectorXd b(f.m * p);
+  Eigen::MatrixXd W(d, w);
+  for (Eigen::Index i = 0; i < f.m; ++i) {
+    const auto Y = X.block(0, i * w, d, d);
+    W.noalias() = Y.transpose() * V.middleCols(i * w, w);
+    for (int k = 0; k < nr; ++k) {
+      const auto [a, bb] = pairs[static_cast<std::size_t>(k)];
+      b(i * p + k) = W(bb, a) - W(a, bb);
+    }
+    b.segment(i * p + nr, d) = W.col(d);
+  }
+  const Eigen::VectorXd c = f.llt.solve(b);
+  // Z = J c: rotation Y Omega(omega), translation Y u.
+  Eigen::MatrixXd Z(d, V.cols());
+  Eigen::MatrixXd S(d, w);
+  for (Eigen::Index i = 0; i < f.m; ++i) {
+    S.setZero();
+    for (int k = 0; k < nr; ++k) {
+      const auto [a, bb] = pairs[static_cast<std::size_t>(k)];
+      const double omega = c(i * p + k);
+      S(bb, a) += omega;
+      S(a, bb) -= omega;
+    }
+    S.col(d) = c.segment(i * p + nr, d);
+    Z.middleCols(i * w, w).noalias() = X.block(0, i * w, d, d) * S;
+  }
+  return Z;
+}
+
+Eigen::MatrixXd TangentPreconditioner::basis(const Eigen::MatrixXd& X) const {
+  const Factor& f = *factor_;
+  const int d = f.d, w = d + 1, p = f.p;
+  if (X.rows() != d || X.cols() != w * f.m)
+    throw std::invalid_argument("TangentPreconditioner::basis: not a rank-d point of the block");
+  const auto pairs = skew_pairs(d);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(X.size(), f.m * p);
+  for (Eigen::Index i = 0; i < f.m; ++i)
+    J.block(i * d * w, i * p, d * w, p) = pose_basis(X.block(0, i * w, d, d), pairs);
+  return J;
+}
+
+}  // namespace tessera
