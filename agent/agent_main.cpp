@@ -37,8 +37,7 @@ int main(int argc, char** argv) {
     std::cerr << tag << ": error: " << e.what() << "\n";
     return transport::kExitBadInput;
   }
-  const cli::ProcessRole role{tag, "agent " + std::to_string(options.id) + ": ",
-                              options.net.timeout_s, true};
+  const cli::ProcessRole role{tag, options.net.timeout_s, true};
   cli::exit_process(cli::run_session_process(
       agent::agent_session_options(options), role, signals, [&](transport::Session& session) {
         agent::run_agent(options, session, std::move(restart));

@@ -115,8 +115,8 @@ void run_agent(const AgentOptions& o, Session& s, std::optional<AgentCheckpoint>
     throw;
   } catch (const RunStopped&) {
     // The stop's own cause (a lost peer, an ABORT, a signal), not the unwinding's.
-    const StopInfo stop =
-        s.mailroom().stop_info().value_or(StopInfo{kExitRunFailed, "stopped", false});
+    const StopInfo stop = s.mailroom().stop_info().value_or(
+        StopInfo{kExitRunFailed, "stopped", false, std::nullopt, ""});
     throw RunFailure(stop.exit_code, stop.reason, !stop.remote);
   }
 }

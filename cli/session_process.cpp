@@ -43,12 +43,17 @@ namespace {
 
 // Prints the error and tells the other processes (ABORT), then lingers briefly so the ABORT
 // reaches them before this participant disappears. `own` false: the reason came from
-// another process and is relayed as is, so peers that never heard the original still learn
-// the cause instead of only seeing this process leave.
+// another process (an ABORT received) and its origin and cause are relayed unchanged, so
+// peers that never heard the original still learn the first cause and who had it instead
+// of only seeing this process leave.
 int leave(Session& session, const ProcessRole& role, int code, const std::string& why, bool own) {
   std::cerr << role.tag << ": error: " << why << "\n";
   try {
-    session.send_control(wire::CONTROL_ABORT, own ? role.abort_prefix + why : why);
+    const std::optional<StopInfo> stop = session.mailroom().stop_info();
+    if (!own && stop && stop->origin)
+      session.send_abort(stop->cause, stop->origin);
+    else
+      session.send_abort(why);
     const Seconds linger(std::min(3.0, role.timeout_s));
     session.linger_for_control(
         linger, code == kExitBadInput && role.patient_on_bad_input ? linger : Seconds(1.0));

@@ -34,9 +34,8 @@ class LeaveAlone : public std::runtime_error {
 
 /// Who is running, for the error lines and the ABORT reasons the others receive.
 struct ProcessRole {
-  std::string tag;           ///< Prefix of every error line, e.g. "tessera-agent[2]".
-  std::string abort_prefix;  ///< Prefix of this process's own ABORT reasons, e.g. "agent 2: ".
-  double timeout_s = 10;     ///< --timeout; the linger for the ABORT is min(3 s, this).
+  std::string tag;        ///< Prefix of every error line, e.g. "tessera-agent[2]".
+  double timeout_s = 10;  ///< --timeout; the linger for the ABORT is min(3 s, this).
   /// On bad input, also wait the whole linger for peers not seen yet (an agent fails at
   /// start-up, typically before it has discovered everyone, and they should learn why).
   bool patient_on_bad_input = false;

@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
                                              cli::process_help(coordinator::kCoordinatorUsage),
                                              coordinator::parse_coordinator_options, options))
     return *code;
-  const cli::ProcessRole role{"tessera-coordinator", "coordinator: ", options.net.timeout_s};
+  const cli::ProcessRole role{"tessera-coordinator", options.net.timeout_s};
   cli::exit_process(cli::run_session_process(coordinator::coordinator_session_options(options),
                                              role, signals, [&](transport::Session& session) {
                                                coordinator::run_coordinator(options, session,

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <mutex>
@@ -30,15 +31,23 @@ struct StopInfo {
   std::string reason;
   bool remote =
       false;  ///< Another process asked to stop (ABORT received): no need to tell the others.
+  /// ABORT received: the process whose failure started it (agent id, or the coordinator's
+  /// id), whoever relayed it, and its cause as that process gave it. Relayed unchanged, so
+  /// every process names the first cause and the process that had it.
+  std::optional<std::uint32_t> origin;
+  std::string cause;
 };
 
 class Mailroom {
  public:
   /// Records a stop request (the first one wins) and wakes every waiter.
   void request_stop(int exit_code, const std::string& reason, bool remote = false) {
+    request_stop(StopInfo{exit_code, reason, remote, std::nullopt, ""});
+  }
+  void request_stop(StopInfo info) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (!stop_) stop_ = StopInfo{exit_code, reason, remote};
+      if (!stop_) stop_ = std::move(info);
     }
     cv_.notify_all();
   }
@@ -48,7 +57,7 @@ class Mailroom {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!stop_ && !pending_)
-        pending_ = Pending{StopInfo{exit_code, reason, false},
+        pending_ = Pending{StopInfo{exit_code, reason, false, std::nullopt, ""},
                            std::chrono::steady_clock::now() +
                                std::chrono::duration_cast<std::chrono::nanoseconds>(delay)};
     }

@@ -44,6 +44,12 @@ void Readiness::on_finished() {
   room_.notify();
 }
 
+void Readiness::on_abort(const PeerIdentity& from) {
+  if (!from.coordinator) return;
+  room_.with_lock([&] { return coordinator_aborted_ = true; });
+  room_.notify();
+}
+
 std::vector<PeerIdentity> Readiness::expected_peers(Expect e, std::uint32_t one) const {
   std::vector<PeerIdentity> out;
   if (!opt_.expect_coordinator) {
@@ -182,6 +188,21 @@ void Readiness::wait_matched_or_gone(const std::string& endpoint, Seconds timeou
   if (room_.wait_for([&] { return reached(true); }, first, /*interruptible=*/false) !=
       WaitStatus::kReady)
     room_.wait_for([&] { return reached(false); }, timeout - first, /*interruptible=*/false);
+}
+
+bool Readiness::wait_coordinator_acknowledged(Seconds timeout) {
+  if (me_.coordinator || !opt_.expect_coordinator) return true;
+  auto acknowledged_or_gone = [&] {
+    if (coordinator_aborted_) return true;
+    for (const auto& [p, who] : peers_.all_locked())
+      if (who.coordinator && peers_.lost_locked(p)) return true;
+    return false;
+  };
+  const bool done =
+      room_.wait_for(acknowledged_or_gone, timeout, /*interruptible=*/false) == WaitStatus::kReady;
+  trace_("linger: the coordinator %s",
+         done ? "acknowledged the abort (or is gone)" : "did not acknowledge the abort in time");
+  return done;
 }
 
 }  // namespace tessera::transport

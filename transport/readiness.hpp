@@ -46,6 +46,8 @@ class Readiness {
   void on_ready(const PeerIdentity& from);
   /// FINISHED received from the coordinator. Wakes waiters.
   void on_finished();
+  /// ABORT received from `from` (its own or relayed). Wakes waiters.
+  void on_abort(const PeerIdentity& from);
 
   /// The peers of a complete run that `e` names (without a coordinator when the run has none;
   /// kAgent: agent `one`).
@@ -66,6 +68,13 @@ class Readiness {
   /// every other process of the run or that process is gone; processes never discovered are
   /// waited for only `unseen_patience`. Returns when done, whatever the outcome.
   void wait_matched_or_gone(const std::string& endpoint, Seconds timeout, Seconds unseen_patience);
+  /// Agents of a run with a coordinator, leaving on an error: waits (not interrupted by a
+  /// stop, bounded by `timeout`) until the coordinator has acknowledged the abort, i.e. sent
+  /// an ABORT of its own (it relays the cause that stopped it, which is ours when ours
+  /// reached it first), or is gone. A coordinator not discovered yet is waited for too: it
+  /// is the process that must name the cause. Returns at once for the coordinator itself
+  /// and in runs without one; true when acknowledged or gone.
+  bool wait_coordinator_acknowledged(Seconds timeout);
 
   // ---- with the mailroom's mutex held ------------------------------------------------------
   bool endpoints_matched_locked(std::string* missing) const;
@@ -86,6 +95,7 @@ class Readiness {
   std::map<std::string, std::pair<Expect, std::uint32_t>> expect_;  // with kAgent's agent
   std::set<std::string> ready_from_;  // describe() of peers that published READY
   bool finished_ = false;
+  bool coordinator_aborted_ = false;  // an ABORT came from the coordinator
 };
 
 }  // namespace tessera::transport

@@ -22,10 +22,17 @@ void dispatch_control(SessionParts& s, wire::Control&& m) {
     case wire::CONTROL_FINISHED:
       s.readiness.on_finished();
       break;
-    case wire::CONTROL_ABORT:
-      s.room.request_stop(1, from.describe() + " aborted run '" + s.opt.run_id + "': " + m.reason(),
-                          true);
+    case wire::CONTROL_ABORT: {
+      // `agent` names the process whose failure started the abort, whoever relays it, so
+      // the first ABORT to arrive (own or relayed) gives the true cause.
+      const PeerIdentity origin{s.opt.run_id, m.agent() == kCoordinatorId,
+                                m.agent() == kCoordinatorId ? 0u : m.agent()};
+      std::string why = origin.describe() + " aborted run '" + s.opt.run_id + "': " + m.reason();
+      if (origin.describe() != from.describe()) why += " (relayed by " + from.describe() + ")";
+      s.readiness.on_abort(from);
+      s.room.request_stop(StopInfo{1, why, true, m.agent(), m.reason()});
       break;
+    }
     case wire::CONTROL_REJOIN:
       if (s.opt.coordinator) s.rejoin_in.push(std::move(m));
       break;

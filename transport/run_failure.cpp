@@ -9,7 +9,8 @@ void expect_ready(WaitStatus status, const Mailroom& room, double timeout_s,
                   const std::string& what, const std::string& detail) {
   if (status == WaitStatus::kReady) return;
   if (status == WaitStatus::kStopped) {
-    StopInfo stop = room.stop_info().value_or(StopInfo{kExitRunFailed, "stopped", false});
+    StopInfo stop =
+        room.stop_info().value_or(StopInfo{kExitRunFailed, "stopped", false, std::nullopt, ""});
     throw RunFailure(stop.exit_code, stop.reason, !stop.remote);
   }
   char buf[64];

@@ -3,6 +3,7 @@
 
 #include "transport/session.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <variant>
 
@@ -165,6 +166,14 @@ void Session::send_control(wire::Control c) {
   impl_->writer.write(kControlTopic, c);
 }
 
+void Session::send_abort(const std::string& cause, std::optional<std::uint32_t> origin) {
+  wire::Control c;
+  c.kind(wire::CONTROL_ABORT);
+  c.reason(cause);
+  c.agent(origin.value_or(impl_->me.coordinator ? kCoordinatorId : impl_->me.agent_id));
+  send_control(std::move(c));
+}
+
 bool Session::endpoints_matched(std::string* missing) const {
   return impl_->readiness.endpoints_matched(missing);
 }
@@ -209,10 +218,14 @@ void Session::flush(Seconds timeout) {
 
 void Session::linger_for_control(Seconds timeout, Seconds unseen_patience) {
   const auto start = std::chrono::steady_clock::now();
-  impl_->readiness.wait_matched_or_gone(std::string(kControlTopic) + "/w", timeout,
-                                        unseen_patience);
-  impl_->writer.wait_acknowledged(kControlTopic,
-                                  timeout - (std::chrono::steady_clock::now() - start));
+  auto left = [&] {
+    const Seconds rest = timeout - (std::chrono::steady_clock::now() - start);
+    return rest > Seconds(0) ? rest : Seconds(0);
+  };
+  impl_->readiness.wait_coordinator_acknowledged(timeout);
+  impl_->readiness.wait_matched_or_gone(std::string(kControlTopic) + "/w", left(),
+                                        std::min(unseen_patience, left()));
+  impl_->writer.wait_acknowledged(kControlTopic, left());
 }
 
 SessionStats Session::stats() const {

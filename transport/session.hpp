@@ -22,6 +22,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -95,8 +96,12 @@ class Session {
   void publish(const wire::FinalEstimate& m);
   /// A round-protocol message from this agent (run id and routing filled in here).
   void send(const OutgoingMessage& m);
-  /// READY / ABORT / FINISHED from this process.
+  /// READY / FINISHED from this process (ABORT: send_abort).
   void send_control(wire::ControlKind kind, const std::string& reason = "");
+  /// ABORT: the run stops because of `cause`, a failure of process `origin` (agent id, or
+  /// kCoordinatorId; nullopt: this process). A process relaying an ABORT it received passes
+  /// the received StopInfo's origin and cause, so the receivers name the first cause.
+  void send_abort(const std::string& cause, std::optional<std::uint32_t> origin = std::nullopt);
   /// A control message with its REJOIN / ROLLBACK fields set by the caller (run id and
   /// sender are filled in here).
   void send_control(wire::Control message);
@@ -127,9 +132,12 @@ class Session {
   std::vector<std::uint32_t> lost_agents() const;
   /// Waits until every reliable sample written so far is acknowledged (bounded).
   void flush(Seconds timeout);
-  /// Before leaving on an error: waits (bounded) until the control topic has matched every
-  /// peer of the run and they acknowledged what this process wrote, so an ABORT written
-  /// just before reaches processes that are still starting up.
+  /// Before leaving on an error, all within `timeout`: an agent first waits until the
+  /// coordinator acknowledged the abort (sent its own ABORT) or is gone, discovered or not
+  /// (the coordinator must name the cause; matching our writer to its reader is not enough,
+  /// since its reader may not have matched our writer yet); then every process waits until
+  /// the control topic has matched every peer of the run and they acknowledged what this
+  /// process wrote, so an ABORT written just before reaches processes still starting up.
   /// Peers never discovered are waited for only `unseen_patience` (they may not exist).
   void linger_for_control(Seconds timeout, Seconds unseen_patience = Seconds(1.0));
 
