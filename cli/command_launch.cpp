@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -175,11 +176,14 @@ std::string tail_of(const std::string& path, std::size_t max_lines) {
   return out;
 }
 
+// In process (no `sh -c rm -rf`: two more process starts at the end of every run).
 void remove_tree(const std::string& dir) {
   if (dir.empty()) return;
-  std::string cmd = "rm -rf '" + dir + "'";
-  if (std::system(cmd.c_str()) != 0)
-    std::fprintf(stderr, "tessera launch: could not remove %s\n", dir.c_str());
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  if (ec)
+    std::fprintf(stderr, "tessera launch: could not remove %s: %s\n", dir.c_str(),
+                 ec.message().c_str());
 }
 
 }  // namespace
