@@ -14,6 +14,9 @@ difference, wall times and their ratio (target <= 1.5), median ms per round of t
 and where the DDS run's wall time went (the coordinator's timeline: start = launch to the
 coordinator's session, discovery, partition, ready = assignment + barrier, handoff = to the first
 round status, rounds, rounding = to the final estimates, merge, exit = summary to launch's exit).
+Also printed (and in the CSV): CPU seconds (user + system over all processes of each run) and the
+DDS run's voluntary context switches, which stay meaningful on a loaded machine where wall times
+do not.
 
 usage: dds_overhead.py [--bin build/bin] [--graphs CSAIL,intel] [--agents 5] [--domain 210]
                        [--out FILE.csv] [--limit S]
@@ -22,6 +25,7 @@ import argparse
 import csv
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -52,8 +56,22 @@ def has_vertices(path):
     return False
 
 
+# CPU seconds (user + system) and voluntary context switches of every finished child process
+# and its waited-for descendants (launch waits for the coordinator and the agents), so a
+# difference around one run counts all of its processes.
+def children_usage():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime, r.ru_nvcsw
+
+
+def usage_since(before):
+    cpu, csw = children_usage()
+    return cpu - before[0], csw - before[1]
+
+
 def run_in_process(tessera, graph, agents, tmp, limit):
     js = os.path.join(tmp, "inprocess.json")
+    u0 = children_usage()
     t0 = time.monotonic()
     try:
         p = subprocess.run([tessera, "solve", graph, "--algorithm", "irbcd", "--agents", str(agents),
@@ -67,11 +85,14 @@ def run_in_process(tessera, graph, agents, tmp, limit):
         print(p.stdout, file=sys.stderr)
         return None
     with open(js) as f:
-        return json.load(f), wall
+        s = json.load(f)
+    s["cpu_s"], s["csw"] = usage_since(u0)
+    return s, wall
 
 
 def run_dds(tessera, graph, agents, domain, tmp, limit):
     js = os.path.join(tmp, "dds.json")
+    u0 = children_usage()
     t0 = time.monotonic()
     t0_ms = time.monotonic_ns() / 1e6
     p = subprocess.Popen([tessera, "launch", graph, "--agents", str(agents), "--partition",
@@ -93,6 +114,7 @@ def run_dds(tessera, graph, agents, domain, tmp, limit):
         return None
     with open(js) as f:
         s = json.load(f)
+    s["cpu_s"], s["csw"] = usage_since(u0)
     gaps = [1000 * (b - a) for a, b in zip(stamps, stamps[1:])]
     s["phases_s"] = phases(s, t0_ms, wall)
     return s, wall, (statistics.median(gaps) if gaps else float("nan"))
@@ -161,6 +183,11 @@ def main():
         print("%-18s %9d %10d %13.2e %9.2f %10.2f %6.2f %12.2f %11.0f" % (
             name, row["rounds_inprocess"], row["rounds_dds"], row["rel_cost_diff"],
             wi, wd, row["ratio"], med, row["bytes_per_round"]), flush=True)
+        row.update({"cpu_inprocess_s": si["cpu_s"], "cpu_dds_s": sd["cpu_s"],
+                    "dds_voluntary_csw": sd["csw"]})
+        print("    cpu s (user+sys, all processes): in-process %.2f, dds %.2f; dds voluntary context "
+              "switches %d (%.0f per round)" % (si["cpu_s"], sd["cpu_s"], sd["csw"],
+                                                 sd["csw"] / max(1, sd["rounds"])), flush=True)
         if sd.get("phases_s"):
             print("    dds phases s: " + ", ".join("%s %.3f" % kv for kv in sd["phases_s"].items()) +
                   "; in-process solve %.3f" % si.get("solve_s", float("nan")), flush=True)
