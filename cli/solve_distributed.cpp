@@ -17,11 +17,12 @@
 namespace tessera::cli {
 
 const char* const kDistributedValued[] = {
-    "agents",        "partition",        "max-rounds",     "seed",         "reference-cost",
-    "select",        "rel-tol",          "tr-steps",       "restart-c",    "sigma",
-    "unselected",    "irbcd-n",          "tcg-iters",      "robots",       "certify-grad-tol",
-    "certify-iters", "certify-residual", "certify-precon", "block-precon", "tangent-refresh",
-    nullptr};
+    "agents",           "partition",      "max-rounds",       "seed",
+    "reference-cost",   "select",         "rel-tol",          "tr-steps",
+    "restart-c",        "sigma",          "unselected",       "irbcd-n",
+    "tcg-iters",        "robots",         "certify-grad-tol", "certify-iters",
+    "certify-residual", "certify-precon", "block-precon",     "tangent-refresh",
+    "tcg-kappa",        nullptr};
 const char* const kDistributedSwitches[] = {"parallel", "sequential", "reference", "certify",
                                             nullptr};
 
@@ -46,6 +47,7 @@ const char* kDistributedHelp =
     "  --rank R                  relaxation rank (default 5)\n"
     "  --tr-steps K              trust-region steps per block update (default 1)\n"
     "  --tcg-iters K             truncated-CG iterations per trust-region step (default 50)\n"
+    "  --tcg-kappa K             tCG's relative residual target per step, in (0, 1) (default 0.1)\n"
     "  --block-precon tangent|euclidean   block updates' tCG preconditioner: the tangent-\n"
     "                            coordinate factor J A^-1 J^T at rank-d points (default), or\n"
     "                            the Q_BB factor (docs/irbcd.md section 12)\n"

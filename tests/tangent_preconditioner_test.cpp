@@ -245,6 +245,15 @@ TEST(TangentPreconditioner, OptionsAreValidated) {
   o = BlockUpdateOptions{};
   o.tangent_relative_shift = -1e-9;
   EXPECT_THROW(o.validate(), InputError);
+  o.tangent_relative_shift = 1e-9;
+  o.tangent_radius_scale = 0.0;
+  try {
+    o.validate();
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tangent_radius_scale"), std::string::npos);
+  }
+  o = BlockUpdateOptions{};
   o.tangent_relative_shift = std::nan("");
   try {
     o.validate();

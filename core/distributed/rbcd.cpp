@@ -19,6 +19,8 @@ void BlockUpdateOptions::validate() const {
   if (tangent_refresh_interval < 0) fail("tangent_refresh_interval", "must be >= 0");
   if (!(tangent_relative_shift >= 0 && std::isfinite(tangent_relative_shift)))
     fail("tangent_relative_shift", "must be finite and >= 0");
+  if (!(tangent_radius_scale > 0 && std::isfinite(tangent_radius_scale)))
+    fail("tangent_radius_scale", "must be finite and > 0");
 }
 
 Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd& X0,
@@ -41,6 +43,7 @@ Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd&
   if (options.precondition && tangent) {
     precon = tangent;
     local.tangent = true;
+    tr.initial_radius_scale = options.tangent_radius_scale;
   }
   Eigen::MatrixXd X = X0;
   int accepted = 0;

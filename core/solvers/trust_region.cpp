@@ -18,6 +18,8 @@ void TrustRegionOptions::validate() const {
   if (!(grad_norm_tol >= 0)) fail("grad_norm_tol", "must be >= 0");
   if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
   if (!(max_radius > 0)) fail("max_radius", "must be > 0");
+  if (!(initial_radius_scale > 0 && std::isfinite(initial_radius_scale)))
+    fail("initial_radius_scale", "must be finite and > 0");
   if (!(tcg_kappa > 0 && tcg_kappa < 1)) fail("tcg_kappa", "must be in (0, 1)");
   if (!(tcg_theta > 0 && tcg_theta <= 1)) fail("tcg_theta", "must be in (0, 1]");
   if (!(acceptance_ratio >= 0 && acceptance_ratio < 0.25))
@@ -117,7 +119,8 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   if (radius <= 0) {
     precon_grad = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
     have_precon_grad = true;
-    radius = std::max(1e-10, std::sqrt(std::max(0.0, inner(precon_grad, grad))));
+    radius = std::max(
+        1e-10, options.initial_radius_scale * std::sqrt(std::max(0.0, inner(precon_grad, grad))));
   }
   res.stop_reason = "max_iterations";
   for (int it = 0; it < options.max_iterations; ++it) {

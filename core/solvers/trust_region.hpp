@@ -19,7 +19,10 @@ struct TrustRegionOptions {
   double grad_norm_tol = 1e-6;      ///< Stop when ||grad f|| <= this (absolute, >= 0).
   /// Stop when an accepted step decreases f by less than this fraction of f (>= 0).
   double rel_cost_decrease_tol = 1e-12;
-  double initial_radius = 0.0;     ///< <= 0: set from the first preconditioned gradient.
+  double initial_radius = 0.0;  ///< <= 0: set from the first preconditioned gradient.
+  /// With initial_radius <= 0 the radius is this times sqrt(<P g, g>) (the preconditioned
+  /// gradient norm: the length of the Newton step when P is the exact inverse Hessian); > 0.
+  double initial_radius_scale = 1.0;
   double max_radius = 1e12;        ///< > 0.
   double tcg_kappa = 0.1;          ///< Linear convergence target of tCG, in (0, 1).
   double tcg_theta = 1.0;          ///< Superlinear exponent of tCG, in (0, 1].
