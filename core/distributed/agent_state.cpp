@@ -28,18 +28,22 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
   Pn = Yn;
   Vn = Yn;
   Yn_prev = Yn;
-  // The factor the updates will use is computed with the rest of the set-up, not in a round.
-  bool tangent = false;
-  if (options.precondition && options.tangent_preconditioner) {
+  // The factors the updates will use are computed with the rest of the set-up, not in a round.
+  // The Q_BB factor comes first: when it is too large (block-diagonal fallback, e.g. 20k-pose
+  // 3D blocks), the tangent one (p x p pose blocks instead of (d+1) x (d+1): 2.25x the entries
+  // in 3D, as many in 2D) is too large as well, and its analysis is skipped (a 100k-pose grid
+  // with N = 5 spent 2 s more CPU in set-up analysing tangent factors it could not use).
+  const BlockPreconditioner& q = euclidean();
+  if (options.precondition && options.tangent_preconditioner && !q.block_diagonal()) {
     const Eigen::Array<bool, Eigen::Dynamic, 1> nonzero = (Y0.array() != 0.0).rowwise().any();
     if (nonzero.count() == d) {
       std::vector<Eigen::Index> rows;
       for (Eigen::Index k = 0; k < Y0.rows(); ++k)
         if (nonzero(k)) rows.push_back(k);
-      tangent = build_tangent(Y0(rows, Eigen::all), options);
+      build_tangent(Y0(rows, Eigen::all), options);
     }
   }
-  if (!tangent) euclidean();
+  if (q.block_diagonal()) tangent_tried_ = true;  // never build it later either
 }
 
 BlockPreconditioner& AgentState::euclidean() {

@@ -28,8 +28,8 @@ struct LocalStatus {
 class AgentState {
  public:
   /// `Y0`: the block's initial lifted poses, r x (d+1)m in layout.poses[id] order. The
-  /// preconditioner `options` ask for is factored here (set-up): the tangent one at Y0 when Y0
-  /// has d active rows, else the Q_BB one; the other is built when first needed.
+  /// preconditioners are factored here (set-up): the Q_BB one, and the tangent one at Y0 when
+  /// `options` ask for it, Y0 has d active rows and the Q_BB factor is not too large.
   AgentState(int id, int d, const BlockLayout& layout, const std::vector<Measurement>& measurements,
              const Eigen::MatrixXd& Y0, const BlockUpdateOptions& options = {});
   AgentState(const AgentState&) = delete;
@@ -84,7 +84,7 @@ class AgentState {
   int d_;
   const BlockLayout& layout_;
   BlockProblem problem_;
-  /// The Q_BB preconditioner, built on first use.
+  /// The Q_BB preconditioner (built in the constructor).
   BlockPreconditioner& euclidean();
   /// Builds and factors the tangent preconditioner at X (rank d) once; false when unusable.
   bool build_tangent(const Eigen::MatrixXd& X, const BlockUpdateOptions& options);
