@@ -9,6 +9,7 @@
 
 #include "distributed/distributed_initialization.hpp"
 #include "distributed/distributed_solver.hpp"
+#include "graph/flat_measurement.hpp"
 #include "graph/flat_pose.hpp"
 #include "solvers/chordal_initialization.hpp"
 #include "util/input_error.hpp"
@@ -104,8 +105,7 @@ PoseBlockMessage encode_measurements(std::uint32_t self, std::uint32_t phase, in
     const std::size_t start = m.data.size();
     m.data.insert(m.data.end(),
                   {static_cast<double>(e.i), static_cast<double>(e.j), e.kappa, e.tau});
-    m.data.insert(m.data.end(), e.R.data(), e.R.data() + e.R.size());
-    m.data.insert(m.data.end(), e.t.data(), e.t.data() + e.t.size());
+    append_measurement_rt(m.data, m.data, e);  // R then t
     m.data.resize(start + width, 0.0);
   }
   return m;
@@ -129,8 +129,7 @@ void decode_measurements(const PoseBlockMessage& m, int d, std::size_t num_poses
     e.j = static_cast<std::size_t>(v[1]);
     e.kappa = v[2];
     e.tau = v[3];
-    e.R = Eigen::Map<const Eigen::MatrixXd>(v + 4, d, d);
-    e.t = Eigen::Map<const Eigen::VectorXd>(v + 4 + dd * dd, d);
+    read_measurement_rt(m.data, k * width + 4, m.data, k * width + 4 + dd * dd, d, e);
     out.emplace_back(m.pose_ids[k], std::move(e));
   }
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "graph/flat_measurement.hpp"
 #include "graph/flat_pose.hpp"
 
 namespace tessera::transport {
@@ -114,9 +115,7 @@ wire::MeasurementHandoff to_wire_handoff(
   for (const Measurement* e : measurements) {
     w.meas_i().push_back(static_cast<std::uint32_t>(e->i));
     w.meas_j().push_back(static_cast<std::uint32_t>(e->j));
-    for (int c = 0; c < d; ++c)
-      for (int r = 0; r < d; ++r) w.meas_R().push_back(e->R(r, c));
-    for (int r = 0; r < d; ++r) w.meas_t().push_back(e->t(r));
+    append_measurement_rt(w.meas_R(), w.meas_t(), *e);
     w.meas_kappa().push_back(e->kappa);
     w.meas_tau().push_back(e->tau);
   }
@@ -146,11 +145,7 @@ HandoffContent from_wire(const wire::MeasurementHandoff& w) {
     Measurement& e = out.measurements[k];
     e.i = w.meas_i()[k];
     e.j = w.meas_j()[k];
-    e.R.resize(d, d);
-    e.t.resize(d);
-    for (int c = 0; c < d; ++c)
-      for (int r = 0; r < d; ++r) e.R(r, c) = w.meas_R()[k * d * d + c * d + r];
-    for (int r = 0; r < d; ++r) e.t(r) = w.meas_t()[k * d + r];
+    read_measurement_rt(w.meas_R(), k * d * d, w.meas_t(), k * d, d, e);
     e.kappa = w.meas_kappa()[k];
     e.tau = w.meas_tau()[k];
   }
