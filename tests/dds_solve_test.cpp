@@ -159,8 +159,10 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
     std::string run_id;
     ~Cleanup() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
   } cleanup{run_id};
+  // 2000 poses: enough rounds (until the stalled rule stops it) that the run is still going
+  // when the agent is looked up after round 2 (with 600 poses it could already have finished).
   Process launch = start(
-      {bin("tessera"), "launch",   "--agents",    "3",      "--poses",   "600",        "--domain",
+      {bin("tessera"), "launch",   "--agents",    "3",      "--poses",   "2000",       "--domain",
        "166",          "--run-id", run_id,        "--init", "file",      "--grad-tol", "1e-12",
        "--max-rounds", "100000",   "--partition", "fast",   "--timeout", "60"},
       dir + "/launch.log");

@@ -46,10 +46,27 @@ void PeerTracker::dropped(const GuidPrefix& prefix) {
 }
 
 void PeerTracker::liveliness_lost(const GuidPrefix& prefix) {
+  std::optional<PeerIdentity> who;
+  bool fatal = false;
+  room_.with_lock([&] {
+    auto it = peers_.find(prefix);
+    if (it != peers_.end() && !lost_.count(prefix)) {
+      who = it->second;
+      fatal = loss_fatal_ && !(tolerate_agent_loss_ && !it->second.coordinator);
+    }
+    return 0;
+  });
+  if (!who) return;
   char buf[96];
   std::snprintf(buf, sizeof(buf), "stopped responding (writer liveliness of %.1f s lost)",
                 opt_.lease_s);
-  gone(prefix, buf, /*graceful=*/false);
+  if (opt_.verbose)
+    std::fprintf(stderr, "%s: %s: %s\n", participant_name(me_).c_str(), who->describe().c_str(),
+                 buf);
+  if (fatal)
+    room_.request_stop_after(1,
+                             "lost " + who->describe() + " of run '" + opt_.run_id + "': it " + buf,
+                             Seconds(kLivelinessStopDelayS));
 }
 
 void PeerTracker::gone(const GuidPrefix& prefix, const std::string& how, bool graceful) {

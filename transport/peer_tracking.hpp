@@ -37,8 +37,15 @@ class PeerTracker {
   void left(const GuidPrefix& prefix);
   /// The peer's participant lease expired.
   void dropped(const GuidPrefix& prefix);
-  /// One of the peer's writers lost its liveliness.
+  /// One of the peer's writers lost its liveliness. Not proof that the peer died: a process
+  /// SIGKILLed while writing into a shared-memory port leaves that port locked, and the
+  /// receiver then stops hearing *every* peer through it, so the first writer whose
+  /// liveliness lapses may belong to a live peer. The peer is therefore not marked lost; a
+  /// fatal stop naming it only takes effect after kLivelinessStopDelayS, so the participant
+  /// lease of the process that really died (announced over UDP, not through the locked port)
+  /// names it first.
   void liveliness_lost(const GuidPrefix& prefix);
+  static constexpr double kLivelinessStopDelayS = 0.5;
 
   /// When false, a lost peer is only logged.
   void set_loss_fatal(bool fatal);
