@@ -65,9 +65,11 @@ void create_agent_endpoints(SessionParts& s) {
   e.make_writer<wire::MeasurementHandoffPubSubType>(kHandoffTopic, false, Expect::kOtherAgents);
   // Broadcast pose blocks on kBlockTopic, addressed ones on the recipient's own topic.
   e.make_writer<wire::PoseBlockPubSubType>(kBlockTopic, false, Expect::kOtherAgents);
-  for (std::uint32_t k = 0; k < s.opt.num_agents; ++k)
-    if (k != me)
-      e.make_writer<wire::PoseBlockPubSubType>(block_topic_for(k), false, Expect::kAgent, k);
+  const bool recipient_topics = s.opt.num_agents <= kMaxAgentsWithRecipientTopics;
+  if (recipient_topics)
+    for (std::uint32_t k = 0; k < s.opt.num_agents; ++k)
+      if (k != me)
+        e.make_writer<wire::PoseBlockPubSubType>(block_topic_for(k), false, Expect::kAgent, k);
   // Statuses the coordinator reads (coordinator_reads_status) on kStatusTopic, the others on
   // kAgentStatusTopic.
   e.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false,
@@ -85,7 +87,9 @@ void create_agent_endpoints(SessionParts& s) {
         else
           s.handoff_in.push(std::move(m));
       });
-  for (const std::string& topic : {std::string(kBlockTopic), block_topic_for(me)})
+  std::vector<std::string> block_topics{kBlockTopic};
+  if (recipient_topics) block_topics.push_back(block_topic_for(me));
+  for (const std::string& topic : block_topics)
     e.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(
         topic, false, Expect::kOtherAgents, [&s](wire::PoseBlock&& m) {
           ++s.protocol_samples;

@@ -136,7 +136,7 @@ void Session::send(const OutgoingMessage& m) {
     w.epoch(e);
     // Addressed blocks reach only their recipients (one sample on each one's own topic);
     // broadcasts, and everything after a renumbering re-partition, use the shared topic.
-    if (m.broadcast || impl_->renumbered) {
+    if (m.broadcast || impl_->renumbered || impl_->opt.num_agents > kMaxAgentsWithRecipientTopics) {
       impl_->writer.write(kBlockTopic, w);
     } else {
       for (std::uint32_t k : m.recipients)

@@ -29,6 +29,12 @@ inline bool coordinator_reads_status(std::uint32_t phase) {
   return phase == 1 || phase == 5 || (phase >= 200 && phase < 300);
 }
 
+/// Runs of at most this many agents use block_topic_for(k); larger ones send addressed blocks on
+/// kBlockTopic as well. Each agent writes every other agent's topic, so endpoints grow as N^2:
+/// at N = 25 (600 more writers) the discovery burst on 2 cores delayed participant
+/// announcements until a participant lease expired during set-up.
+inline constexpr std::uint32_t kMaxAgentsWithRecipientTopics = 8;
+
 /// Pose blocks addressed to agent `k` alone (kBlockTopic carries the broadcast ones): only
 /// the recipient's process receives them, instead of every agent receiving and dropping them.
 inline std::string block_topic_for(std::uint32_t k) {
