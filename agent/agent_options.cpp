@@ -31,6 +31,10 @@ options:
   --checkpoint-every K  write the checkpoint every K rounds (default 1)
   --udp-only         talk UDP only, no shared memory (implied by --checkpoint-dir): for runs
                      that survive a SIGKILLed peer (tessera launch --on-agent-loss continue)
+  --handshake-stall S  with --security: a peer still unauthenticated S seconds after it was
+                     discovered (a stalled Fast DDS 2.9 handshake) makes this agent re-create
+                     its participant before it announces itself (default 4)
+  --handshake-retries K  at most K such re-creations, 0..10 (default 3)
   --verbose          print each phase
   --help             this text
 
@@ -41,12 +45,12 @@ exit codes: 0 done, 1 the run failed (lost peer, abort, timeout), 2 bad options 
 )";
 
 AgentOptions parse_agent_options(const std::vector<std::string>& argv) {
-  cli::Arguments args(
-      argv,
-      cli::with_session_options({"graph", "robots", "id", "round-timeout", "output", "dump-local",
-                                 "checkpoint-dir", "checkpoint-every"},
-                                cli::SessionArgsFor::kProcess),
-      {"verbose", "help", "udp-only"});
+  cli::Arguments args(argv,
+                      cli::with_session_options({"graph", "robots", "id", "round-timeout", "output",
+                                                 "dump-local", "checkpoint-dir", "checkpoint-every",
+                                                 "handshake-stall", "handshake-retries"},
+                                                cli::SessionArgsFor::kProcess),
+                      {"verbose", "help", "udp-only"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   AgentOptions a;
@@ -69,6 +73,12 @@ AgentOptions parse_agent_options(const std::vector<std::string>& argv) {
   a.udp_only = args.has("udp-only");
   a.checkpoint_every = static_cast<int>(args.get_long("checkpoint-every", 1));
   CheckpointOptions{a.checkpoint_dir, a.checkpoint_every}.validate();
+  a.handshake_stall_s = args.get_double("handshake-stall", a.handshake_stall_s);
+  if (!(a.handshake_stall_s > 0) || a.handshake_stall_s > 3600)
+    throw InputError("option --handshake-stall: must be in (0, 3600] seconds");
+  const long retries = args.get_long("handshake-retries", a.handshake_retries);
+  if (retries < 0 || retries > 10) throw InputError("option --handshake-retries: must be 0..10");
+  a.handshake_retries = static_cast<int>(retries);
   a.verbose = args.has("verbose");
   return a;
 }

@@ -23,6 +23,11 @@ struct AgentOptions {
   std::string checkpoint_dir;    ///< Empty: no checkpoints (and no rejoin).
   int checkpoint_every = 1;      ///< Rounds between checkpoints, >= 1.
   bool udp_only = false;         ///< No shared memory (implied by checkpoint_dir).
+  /// --handshake-stall S: with --security, a peer discovered but not authenticated for this
+  /// long before the agent announces itself makes it re-create its participant
+  /// (transport/peer_gate.hpp), > 0 s.
+  double handshake_stall_s = 4;
+  int handshake_retries = 3;  ///< --handshake-retries: at most this many re-creations, 0..10.
   bool verbose = false;
 };
 

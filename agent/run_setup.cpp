@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <iostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "agent/local_dump.hpp"
 #include "agent/lost_for_good.hpp"
 #include "agent/robot_data.hpp"
+#include "transport/peer_gate.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
 
@@ -82,11 +84,32 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
       std::to_string(share.end) + ") of " + std::to_string(share.num_poses) + ", " +
       std::to_string(share.measurements.size()) + " measurements");
 
-  // 2. Announce the structure (endpoints only).
+  // 2. Before announcing: know the coordinator and, in a secured run, have authenticated every
+  // other process. On the way the participant may be re-created (UDP only when the
+  // coordinator's run survives killed agents; a stalled DDS Security handshake): nothing is
+  // announced yet, so that is invisible to the run (transport/peer_gate.hpp).
+  PeerGateOptions gate;
+  gate.timeout_s = o.net.timeout_s;
+  gate.stall_after_s = o.handshake_stall_s;
+  gate.max_reopens = o.handshake_retries;
+  const PeerGateResult gated = pass_peer_gate(s, gate);
+  for (const std::string& event : gated.events)
+    std::cerr << agent_tag(o.id) << ": " << event << "\n";
+  expect_ready(gated.status, room, o.net.timeout_s,
+               s.options().security_dir.empty()
+                   ? "the coordinator"
+                   : "the DDS Security handshakes with the other processes",
+               s.peers_ever_seen() == 0
+                   ? "no process of run '" + o.net.session.run_id + "' seen on domain " +
+                         std::to_string(s.domain()) + " (is the coordinator running?)"
+                   : gated.missing);
+  log("peers known" + std::string(s.options().shared_memory ? "" : " (UDP only)"));
+
+  // 3. Announce the structure (endpoints only).
   s.publish(announcement_of(share, o));
   log("announced");
 
-  // 3. The assignment.
+  // 4. The assignment.
   wire::PartitionAssignment asg;
   WaitStatus got = s.assignments().take(Seconds(o.net.timeout_s), &asg);
   expect_ready(got, room, o.net.timeout_s, "the partition assignment from the coordinator",
@@ -104,7 +127,7 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
   log("assignment received (" +
       std::to_string(std::count(asg.owner().begin(), asg.owner().end(), o.id)) + " poses owned)");
 
-  // 4. Everyone's endpoints matched before any volatile agent-to-agent message.
+  // 5. Everyone's endpoints matched before any volatile agent-to-agent message.
   // With replicas a process restarted after the run gave its block away may have taken the
   // first epoch's assignment before the one naming it lost arrived; the survivors will never
   // be READY for it, so it looks again between short waits.
@@ -120,7 +143,7 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
   expect_ready(ready, room, o.net.timeout_s, "the other processes to be ready", missing);
   log("all processes ready");
 
-  // 5. Initial poses of our share (agent/initialization_stage.hpp), before they move.
+  // 6. Initial poses of our share (agent/initialization_stage.hpp), before they move.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> structure =
       structure_of(asg, share.num_poses);
   DdsProtocolChannel channel(s);
@@ -133,7 +156,7 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
         std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
   }
 
-  // 6. Hand-off, peer to peer: exactly one message to every other agent.
+  // 7. Hand-off, peer to peer: exactly one message to every other agent.
   std::vector<ReceivedHandoff> received = exchange_handoffs(s, share, asg.owner(), o.id, o.robots,
                                                             o.net.session.run_id, o.net.timeout_s);
   out.local =

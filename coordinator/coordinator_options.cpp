@@ -114,8 +114,10 @@ transport::SessionOptions coordinator_session_options(const CoordinatorOptions& 
   so.coordinator = true;
   so.num_agents = options.agents;
   so.verbose = options.verbose;
-  // A run that survives killed agents talks UDP only (see transport/qos.hpp).
-  so.shared_memory = options.rejoin_timeout_s <= 0;
+  // A run that survives killed agents talks UDP only (see transport/qos.hpp). The
+  // coordinator's participant says so (transport/participant_tags.hpp), and agents started
+  // without --udp-only move to UDP only before they announce themselves.
+  so.shared_memory = options.rejoin_timeout_s <= 0 && options.replicas == 0;
   return so;
 }
 

@@ -25,18 +25,20 @@ DdsEntities::DdsEntities(const SessionOptions& options, const NetworkProfile& ne
     : opt_(options), net_(net), room_(room), peers_(peers), readiness_(readiness), trace_(trace) {}
 
 void DdsEntities::open(int domain, const PeerIdentity& me,
-                       const std::vector<std::pair<std::string, std::string>>& security) {
+                       const std::vector<std::pair<std::string, std::string>>& security,
+                       const std::vector<std::uint8_t>& user_data, const GuidPrefix* prefix) {
   // TESSERA_DDS_LOG=1 shows Fast DDS's own warnings and errors (for diagnosing QoS trouble).
   if (const char* env = std::getenv("TESSERA_DDS_LOG"); env && *env && *env != '0')
     eprosima::fastdds::dds::Log::SetVerbosity(eprosima::fastdds::dds::Log::Kind::Warning);
   participant_listener_ =
-      std::make_unique<ParticipantDiscoveryListener>(peers_, opt_.run_id, room_, trace_);
+      std::make_unique<ParticipantDiscoveryListener>(peers_, opt_.run_id, room_, trace_, muted_);
   auto* factory = dds::DomainParticipantFactory::get_instance();
-  participant_ = factory->create_participant(
-      domain,
+  dds::DomainParticipantQos qos =
       participant_qos(participant_name(me), opt_.lease_s, opt_.initial_peers, domain,
-                      opt_.num_agents, net_, security, opt_.shared_memory),
-      participant_listener_.get(), dds::StatusMask::none());
+                      opt_.num_agents, net_, security, opt_.shared_memory, user_data);
+  if (prefix) qos.wire_protocol().prefix = *prefix;
+  participant_ = factory->create_participant(domain, qos, participant_listener_.get(),
+                                             dds::StatusMask::none());
   if (!participant_)
     throw TransportError("cannot create a DDS participant on domain " + std::to_string(domain) +
                          (security.empty()
@@ -44,10 +46,56 @@ void DdsEntities::open(int domain, const PeerIdentity& me,
                               : " with DDS Security from " + opt_.security_dir +
                                     " (certificate, key, permissions or governance rejected; "
                                     "TESSERA_DDS_LOG=1 shows Fast DDS's reason)"));
-  peers_.set_own_prefix(participant_->guid().guidPrefix);
+  peers_.add_own_prefix(participant_->guid().guidPrefix);
   publisher_ = participant_->create_publisher(publisher_qos(opt_.run_id));
   subscriber_ = participant_->create_subscriber(subscriber_qos(opt_.run_id));
   if (!publisher_ || !subscriber_) throw TransportError("cannot create DDS publisher/subscriber");
+}
+
+GuidPrefix DdsEntities::prefix() const {
+  return participant_->guid().guidPrefix;
+}
+
+void DdsEntities::set_user_data(const std::vector<std::uint8_t>& user_data) {
+  dds::DomainParticipantQos q = participant_->get_qos();
+  q.user_data().data_vec(user_data);
+  if (participant_->set_qos(q) != ReturnCode_t::RETCODE_OK)
+    throw TransportError("cannot change the DDS participant's user data");
+}
+
+GuidPrefix DdsEntities::retire() {
+  const GuidPrefix old = participant_->guid().guidPrefix;
+  muted_->store(true);
+  Retired r;
+  r.participant = participant_;
+  r.muted = muted_;
+  r.participant_listener = std::move(participant_listener_);
+  r.writer_listeners = std::move(writer_listeners_);
+  r.reader_listeners = std::move(reader_listeners_);
+  r.types = std::move(types_);
+  retired_.push_back(std::move(r));
+  muted_ = std::make_shared<std::atomic<bool>>(false);
+  participant_ = nullptr;
+  publisher_ = nullptr;
+  subscriber_ = nullptr;
+  writer_listeners_.clear();
+  reader_listeners_.clear();
+  types_.clear();
+  writers_.clear();
+  readers_.clear();
+  reader_by_name_.clear();
+  topics_.clear();
+  return old;
+}
+
+void DdsEntities::close_retired(int exit_code, const std::string& who) {
+  for (Retired& r : retired_) {
+    trace_("deleting a replaced participant");
+    TeardownGuard guard(exit_code, who, Seconds(kTeardownTimeoutS));
+    r.participant->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(r.participant);
+  }
+  retired_.clear();
 }
 
 dds::DataWriter* DdsEntities::writer(const std::string& name) const {
@@ -81,8 +129,10 @@ void DdsEntities::trace_match_state(const char* why) {
 }
 
 void DdsEntities::close(int exit_code, const std::string& who) {
-  if (!participant_) return;
+  if (!participant_ && retired_.empty()) return;
   peers_.set_loss_fatal(false);
+  close_retired(exit_code, who);
+  if (!participant_) return;
   trace_("closing: deleting the DDS entities and the participant");
   {
     // Fast DDS 2.9 may abort or deadlock in here (transport/teardown_guard.hpp).

@@ -5,6 +5,8 @@
 // endpoint must match with Readiness; teardown is bounded (teardown_guard.hpp). Internal to
 // transport/.
 
+#include <atomic>
+#include <cstdint>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -44,8 +46,25 @@ class DdsEntities {
   /// its properties), tells the PeerTracker its own GUID prefix, then the publisher and the
   /// subscriber. Throws TransportError naming what failed (call close() afterwards: a
   /// participant may already exist).
+  /// `user_data`: the participant's USER_DATA (ParticipantTags::encode()). `prefix`: the
+  /// GUID prefix to use instead of Fast DDS's own choice (nullptr: Fast DDS's).
   void open(int domain, const PeerIdentity& me,
-            const std::vector<std::pair<std::string, std::string>>& security);
+            const std::vector<std::pair<std::string, std::string>>& security,
+            const std::vector<std::uint8_t>& user_data = {}, const GuidPrefix* prefix = nullptr);
+
+  /// Sets the current participant aside for a replacement (Session::replace_participant):
+  /// its listeners fall silent at once (no discovery, match or sample of it counts any more)
+  /// and the entities are forgotten here, so open() can create the next participant; the
+  /// retired one exists until close_retired(). Returns its GUID prefix. Requires an open
+  /// participant.
+  GuidPrefix retire();
+  /// Deletes the retired participants (bounded like close()). Idempotent.
+  void close_retired(int exit_code, const std::string& who);
+  /// Replaces the current participant's USER_DATA (peers see the change with its next
+  /// announcement). Throws TransportError.
+  void set_user_data(const std::vector<std::uint8_t>& user_data);
+  /// The GUID prefix of the current participant (requires one).
+  GuidPrefix prefix() const;
 
   /// A writer on topic `name` (transient-local for set-up topics, volatile otherwise) that
   /// must match the peers of `e` (kAgent: agent `agent`) before the readiness barrier passes.
@@ -71,8 +90,9 @@ class DdsEntities {
   /// listeners reported (when a barrier times out). Nothing when tracing is off.
   void trace_match_state(const char* why);
 
-  /// Deletes every entity and the participant (idempotent); first makes peer losses
-  /// non-fatal. A Fast DDS abort or hang in here ends the process with `exit_code`.
+  /// Deletes every entity and the participant, retired ones included (idempotent); first
+  /// makes peer losses non-fatal. A Fast DDS abort or hang in here ends the process with
+  /// `exit_code`.
   void close(int exit_code, const std::string& who);
 
  private:
@@ -86,6 +106,18 @@ class DdsEntities {
   Readiness& readiness_;
   const DdsTrace& trace_;
 
+  // A participant set aside by retire(), with what its listeners need to stay valid.
+  struct Retired {
+    eprosima::fastdds::dds::DomainParticipant* participant = nullptr;
+    std::shared_ptr<std::atomic<bool>> muted;
+    std::unique_ptr<ParticipantDiscoveryListener> participant_listener;
+    std::vector<std::unique_ptr<WriterMatchListener>> writer_listeners;
+    std::vector<std::unique_ptr<ReaderListener>> reader_listeners;
+    std::vector<std::unique_ptr<eprosima::fastdds::dds::TypeSupport>> types;
+  };
+  std::vector<Retired> retired_;
+
+  std::shared_ptr<std::atomic<bool>> muted_ = std::make_shared<std::atomic<bool>>(false);
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
@@ -122,7 +154,8 @@ void DdsEntities::make_writer(const std::string& name, bool transient_local, Exp
                               std::uint32_t agent) {
   namespace dds = eprosima::fastdds::dds;
   dds::Topic* t = topic<PubSubType>(name);
-  writer_listeners_.push_back(std::make_unique<WriterMatchListener>(readiness_, name + "/w"));
+  writer_listeners_.push_back(
+      std::make_unique<WriterMatchListener>(readiness_, name + "/w", muted_));
   dds::DataWriter* w = publisher_->create_datawriter(
       t, writer_qos(transient_local, opt_.lease_s, opt_.num_agents, net_, !is_round_topic(name)),
       writer_listeners_.back().get(), dds::StatusMask::publication_matched());
@@ -162,7 +195,7 @@ void DdsEntities::make_reader(const std::string& name, bool transient_local, Exp
     }
   };
   reader_listeners_.push_back(
-      std::make_unique<ReaderListener>(readiness_, peers_, name + "/r", drain));
+      std::make_unique<ReaderListener>(readiness_, peers_, name + "/r", drain, muted_));
   dds::StatusMask mask = dds::StatusMask::data_available()
                          << dds::StatusMask::subscription_matched()
                          << dds::StatusMask::liveliness_changed();

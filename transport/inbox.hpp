@@ -63,6 +63,16 @@ class Mailroom {
     }
     cv_.notify_all();
   }
+  /// Withdraws the pending stop of request_stop_after() if its reason is `reason` and it has
+  /// not taken effect yet (a peer that "left" turned out to be replaced by a new participant of
+  /// the same process; see Session::replace_participant). Returns whether one was withdrawn.
+  bool cancel_pending_stop(const std::string& reason) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    promote_pending();
+    if (stop_ || !pending_ || pending_->info.reason != reason) return false;
+    pending_.reset();
+    return true;
+  }
   std::optional<StopInfo> stop_info() const {
     std::lock_guard<std::mutex> lock(mutex_);
     promote_pending();

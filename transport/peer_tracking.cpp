@@ -12,9 +12,43 @@ PeerTracker::PeerTracker(Mailroom& room, const SessionOptions& options, PeerIden
       me_(std::move(me)),
       tolerate_agent_loss_(options.tolerate_agent_loss) {}
 
-void PeerTracker::discovered(const GuidPrefix& prefix, const PeerIdentity& who) {
-  std::string clash;
+std::string prefix_text(const GuidPrefix& prefix) {
+  std::ostringstream os;
+  os << prefix;
+  return os.str();
+}
+
+void PeerTracker::add_own_prefix(const GuidPrefix& prefix) {
+  std::lock_guard<std::mutex> lock(own_mutex_);
+  own_prefixes_.insert(prefix);
+}
+
+bool PeerTracker::is_own(const GuidPrefix& prefix) const {
+  std::lock_guard<std::mutex> lock(own_mutex_);
+  return own_prefixes_.count(prefix) > 0;
+}
+
+void PeerTracker::discovered(const GuidPrefix& prefix, const PeerIdentity& who,
+                             const ParticipantTags& tags) {
+  std::string clash, forgotten;
   room_.with_lock([&] {
+    if (replaced_.count(prefix_text(prefix))) return 0;  // a replaced participant seen late
+    // Forget the participants this one replaces (same role only: a tag cannot make another
+    // process's participant disappear), whether or not they were discovered here yet.
+    for (const std::string& old : tags.replaces) {
+      replaced_.insert(old);
+      for (auto it = peers_.begin(); it != peers_.end(); ++it)
+        if (it->first != prefix && prefix_text(it->first) == old &&
+            it->second.coordinator == who.coordinator && it->second.agent_id == who.agent_id) {
+          forgotten = left_reason(it->second);
+          lost_.erase(it->first);
+          authenticated_.erase(it->first);
+          discovered_at_.erase(it->first);
+          tags_.erase(it->first);
+          peers_.erase(it);
+          break;
+        }
+    }
     for (const auto& [p, id] : peers_)
       if (p != prefix && !lost_.count(p) && id.coordinator == who.coordinator &&
           id.agent_id == who.agent_id)
@@ -23,15 +57,57 @@ void PeerTracker::discovered(const GuidPrefix& prefix, const PeerIdentity& who) 
       clash = who.describe();
     if (who.coordinator && me_.coordinator) clash = who.describe();
     peers_[prefix] = who;
+    discovered_at_.emplace(prefix, std::chrono::steady_clock::now());
+    tags_[prefix] = tags;
     return 0;
   });
   if (opt_.verbose)
-    std::fprintf(stderr, "%s: discovered %s\n", participant_name(me_).c_str(),
-                 who.describe().c_str());
+    std::fprintf(stderr, "%s: discovered %s%s\n", participant_name(me_).c_str(),
+                 who.describe().c_str(),
+                 tags.replaces.empty() ? "" : " (a new participant of that process)");
+  // Its old participant may have left already (it is deleted once the new one is known).
+  if (!forgotten.empty()) room_.cancel_pending_stop(forgotten);
   room_.notify();
   if (!clash.empty())
     room_.request_stop(2, "two processes claim to be " + clash + " of run '" + opt_.run_id +
                               "' (check --id / --run-id)");
+}
+
+void PeerTracker::changed(const GuidPrefix& prefix, const ParticipantTags& tags) {
+  if (!tags.retiring) return;
+  std::string forgotten;
+  room_.with_lock([&] {
+    replaced_.insert(prefix_text(prefix));
+    auto it = peers_.find(prefix);
+    if (it == peers_.end()) return 0;
+    forgotten = left_reason(it->second);
+    lost_.erase(prefix);
+    authenticated_.erase(prefix);
+    discovered_at_.erase(prefix);
+    tags_.erase(prefix);
+    peers_.erase(it);
+    return 0;
+  });
+  if (!forgotten.empty()) room_.cancel_pending_stop(forgotten);
+  room_.notify();
+}
+
+void PeerTracker::authenticated(const GuidPrefix& prefix) {
+  room_.with_lock([&] { return authenticated_.insert(prefix).second; });
+  room_.notify();
+}
+
+void PeerTracker::restart_handshakes() {
+  room_.with_lock([&] {
+    authenticated_.clear();
+    const auto now = std::chrono::steady_clock::now();
+    for (auto& [p, at] : discovered_at_) at = now;
+    return 0;
+  });
+}
+
+std::string PeerTracker::left_reason(const PeerIdentity& who) const {
+  return "lost " + who.describe() + " of run '" + opt_.run_id + "': it left the run";
 }
 
 void PeerTracker::left(const GuidPrefix& prefix) {
@@ -73,6 +149,7 @@ void PeerTracker::gone(const GuidPrefix& prefix, const std::string& how, bool gr
   std::optional<PeerIdentity> who;
   bool fatal = false;
   room_.with_lock([&] {
+    if (replaced_.count(prefix_text(prefix))) return 0;  // forgotten: its successor is live
     auto it = peers_.find(prefix);
     if (it != peers_.end() && !lost_.count(prefix)) {
       lost_.insert(prefix);
@@ -87,7 +164,9 @@ void PeerTracker::gone(const GuidPrefix& prefix, const std::string& how, bool gr
                  who->describe().c_str(), how.c_str());
   room_.notify();
   if (!fatal) return;
-  const std::string why = "lost " + who->describe() + " of run '" + opt_.run_id + "': it " + how;
+  const std::string why =
+      graceful ? left_reason(*who)
+               : "lost " + who->describe() + " of run '" + opt_.run_id + "': it " + how;
   // A peer that left cleanly has (almost always) sent or seen an ABORT that says why;
   // give it a moment to arrive so the message names the cause, not the symptom.
   if (graceful)
@@ -109,6 +188,25 @@ std::vector<PeerIdentity> PeerTracker::live_peers() const {
   std::vector<PeerIdentity> out;
   for (const auto& [p, who] : peers_)
     if (!lost_.count(p)) out.push_back(who);
+  return out;
+}
+
+std::vector<PeerView> PeerTracker::peer_views(bool secured) const {
+  std::lock_guard<std::mutex> lock(room_.mutex());
+  const auto now = std::chrono::steady_clock::now();
+  std::vector<PeerView> out;
+  for (const auto& [p, who] : peers_) {
+    if (lost_.count(p)) continue;
+    PeerView v;
+    v.who = who;
+    auto at = discovered_at_.find(p);
+    if (at != discovered_at_.end())
+      v.known_for_s = std::chrono::duration<double>(now - at->second).count();
+    v.authenticated = !secured || authenticated_.count(p) > 0;
+    auto t = tags_.find(p);
+    if (t != tags_.end()) v.tags = t->second;
+    out.push_back(v);
+  }
   return out;
 }
 

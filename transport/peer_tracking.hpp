@@ -5,14 +5,18 @@
 // processes claiming the same role. Internal to transport/; state is guarded by the
 // mailroom's mutex (the *_locked members require it held).
 
+#include <chrono>
 #include <fastdds/rtps/common/GuidPrefix_t.hpp>
 #include <map>
+#include <mutex>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "transport/dds_trace.hpp"
 #include "transport/inbox.hpp"
+#include "transport/participant_tags.hpp"
+#include "transport/peer_view.hpp"
 #include "transport/run_identity.hpp"
 #include "transport/session_options.hpp"
 
@@ -21,17 +25,36 @@ namespace tessera::transport {
 /// A DDS participant's GUID prefix: how listeners name the remote side of an event.
 using GuidPrefix = eprosima::fastrtps::rtps::GuidPrefix_t;
 
+/// "01.0f.78.fd..." (Fast DDS's own text form; what ParticipantTags::replaces carries).
+std::string prefix_text(const GuidPrefix& prefix);
+
 class PeerTracker {
  public:
   PeerTracker(Mailroom& room, const SessionOptions& options, PeerIdentity me);
 
-  /// This process's own participant (set once it exists): events about it are ignored.
-  void set_own_prefix(const GuidPrefix& prefix) { own_prefix_ = prefix; }
-  bool is_own(const GuidPrefix& prefix) const { return prefix == own_prefix_; }
+  /// This process's participant (set once it exists): events about it are ignored. A
+  /// process that re-creates its participant (Session::replace_participant) adds each new
+  /// one; events about its earlier ones stay ignored too (they briefly coexist). Set before
+  /// the participant's listener can fire (it is set from the listener's own thread at the
+  /// latest), read by listener threads afterwards.
+  void add_own_prefix(const GuidPrefix& prefix);
+  bool is_own(const GuidPrefix& prefix) const;
 
-  /// A participant of this run appeared as `who`. Stops the session with exit code 2 when
-  /// another live process already claims the same role (or this process's own role).
-  void discovered(const GuidPrefix& prefix, const PeerIdentity& who);
+  /// A participant of this run appeared as `who` with `tags` (its USER_DATA). When the tags
+  /// say it replaces participant P of the same role, P is forgotten silently (no loss, no
+  /// clash; a pending stop for P's clean leave is withdrawn). Otherwise stops the session with
+  /// exit code 2 when another live process already claims the same role (or this process's
+  /// own role).
+  void discovered(const GuidPrefix& prefix, const PeerIdentity& who,
+                  const ParticipantTags& tags = {});
+  /// The participant `prefix` changed its QoS; with `tags.retiring` it is forgotten silently
+  /// (its process is about to replace it: no loss, no stop when it leaves).
+  void changed(const GuidPrefix& prefix, const ParticipantTags& tags);
+  /// DDS Security: the handshake with `prefix` completed (authorized).
+  void authenticated(const GuidPrefix& prefix);
+  /// This process's participant was replaced: handshakes start afresh (none counts as
+  /// authenticated, every peer's age restarts now).
+  void restart_handshakes();
   /// The peer left cleanly: the stop (if fatal) waits 2 s so an ABORT that says why can
   /// arrive first and name the cause.
   void left(const GuidPrefix& prefix);
@@ -53,6 +76,9 @@ class PeerTracker {
   void set_agent_loss_tolerated(bool tolerated);
 
   std::vector<PeerIdentity> live_peers() const;
+  /// Every live peer with its age, authentication state (`secured` false: always true) and
+  /// tags.
+  std::vector<PeerView> peer_views(bool secured) const;
   std::size_t peers_ever_seen() const;
   /// Agents discovered and lost, with no live process of the same id since.
   std::vector<std::uint32_t> lost_agents() const;
@@ -71,13 +97,19 @@ class PeerTracker {
 
  private:
   void gone(const GuidPrefix& prefix, const std::string& how, bool graceful);
+  std::string left_reason(const PeerIdentity& who) const;
 
   Mailroom& room_;
   const SessionOptions& opt_;
   PeerIdentity me_;
-  GuidPrefix own_prefix_;
+  mutable std::mutex own_mutex_;
+  std::set<GuidPrefix> own_prefixes_;
   std::map<GuidPrefix, PeerIdentity> peers_;  // participants of this run, by GUID prefix
   std::set<GuidPrefix> lost_;
+  std::set<std::string> replaced_;  // prefix_text() of participants replaced by a new one
+  std::set<GuidPrefix> authenticated_;
+  std::map<GuidPrefix, std::chrono::steady_clock::time_point> discovered_at_;
+  std::map<GuidPrefix, ParticipantTags> tags_;
   bool loss_fatal_ = true;
   bool tolerate_agent_loss_ = false;
 };

@@ -18,10 +18,12 @@ using eprosima::fastrtps::Duration_t;
 dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
     int domain, std::uint32_t num_agents, const NetworkProfile& net,
-    const std::vector<std::pair<std::string, std::string>>& properties, bool shared_memory) {
+    const std::vector<std::pair<std::string, std::string>>& properties, bool shared_memory,
+    const std::vector<std::uint8_t>& user_data) {
   dds::DomainParticipantQos q;
   dds::DomainParticipantFactory::get_instance()->get_default_participant_qos(q);
   q.name(name);
+  if (!user_data.empty()) q.user_data().data_vec(user_data);
   auto& discovery = q.wire_protocol().builtin.discovery_config;
   // Default lease is 20 s (a killed peer noticed after ~18 s); 1 s with announcements every
   // lease/5 notices it in ~0.9 s at negligible cost.
@@ -50,7 +52,9 @@ dds::DomainParticipantQos participant_qos(
   for (const auto& [key, value] : properties) q.properties().properties().emplace_back(key, value);
   for (const std::string& ip : initial_peers) {
     // Metatraffic unicast port of participant id p: 7400 + 250 * domain + 10 + 2 * p.
-    const std::uint32_t participants = num_agents + 3;
+    // + 3: the coordinator and tools; + 3 more: participants re-created by
+    // Session::replace_participant, which briefly overlap the ones they replace.
+    const std::uint32_t participants = num_agents + 6;
     for (std::uint32_t p = 0; p < participants; ++p) {
       eprosima::fastrtps::rtps::Locator_t loc;
       eprosima::fastrtps::rtps::IPLocator::setIPv4(loc, ip);

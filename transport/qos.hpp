@@ -42,11 +42,12 @@ constexpr double kHandshakeHeartbeatS = 0.005;
 /// survive SIGKILLed processes: a process killed while writing into a peer's shared-memory
 /// port leaves that port locked, and the peer then hears nothing more (seen as every agent
 /// "lost" at once, or a restarted agent that never gets its messages).
+/// `user_data`: the participant's USER_DATA (ParticipantTags::encode(), participant_tags.hpp).
 eprosima::fastdds::dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
     int domain, std::uint32_t num_agents, const NetworkProfile& net,
     const std::vector<std::pair<std::string, std::string>>& properties = {},
-    bool shared_memory = true);
+    bool shared_memory = true, const std::vector<std::uint8_t>& user_data = {});
 /// Publisher / subscriber: Partition = run id.
 eprosima::fastdds::dds::PublisherQos publisher_qos(const std::string& run_id);
 eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);

@@ -50,6 +50,22 @@ void Readiness::on_abort(const PeerIdentity& from) {
   room_.notify();
 }
 
+void Readiness::forget_matches() {
+  room_.with_lock([&] {
+    matched_.clear();
+    return 0;
+  });
+}
+
+bool Readiness::has_matched_locked(const std::string& endpoint, const PeerIdentity& who) const {
+  auto it = matched_.find(endpoint);
+  if (it == matched_.end()) return false;
+  for (const GuidPrefix& p : it->second)
+    if (const PeerIdentity* peer = peers_.live_locked(p))
+      if (peer->describe() == who.describe()) return true;
+  return false;
+}
+
 std::vector<PeerIdentity> Readiness::expected_peers(Expect e, std::uint32_t one) const {
   std::vector<PeerIdentity> out;
   if (!opt_.expect_coordinator) {

@@ -49,6 +49,10 @@ class Readiness {
   /// ABORT received from `from` (its own or relayed). Wakes waiters.
   void on_abort(const PeerIdentity& from);
 
+  /// Forgets every endpoint match (the participant they belonged to was replaced:
+  /// Session::replace_participant); READY/FINISHED received are kept.
+  void forget_matches();
+
   /// The peers of a complete run that `e` names (without a coordinator when the run has none;
   /// kAgent: agent `one`).
   std::vector<PeerIdentity> expected_peers(Expect e, std::uint32_t one = 0) const;
@@ -78,6 +82,8 @@ class Readiness {
 
   // ---- with the mailroom's mutex held ------------------------------------------------------
   bool endpoints_matched_locked(std::string* missing) const;
+  /// Whether `endpoint` has matched a live participant of `who`.
+  bool has_matched_locked(const std::string& endpoint, const PeerIdentity& who) const;
   /// " <peer> <peer> ..." the listeners report as matched on `endpoint` (for traces).
   std::string describe_matched_locked(const std::string& endpoint) const;
 

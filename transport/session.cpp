@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <random>
 #include <variant>
 
 #include "transport/message_mapping.hpp"
@@ -32,18 +33,37 @@ int resolved_domain(const SessionOptions& options) {
   options.validate();
   return options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
 }
+// The GUID prefix of a re-created participant. Fast DDS would derive the same one as before
+// (host, process, lowest free participant number; with DDS Security a hash of that and the
+// identity), and peers that still hold state of the deleted participant then mistake the new
+// one for it (seen: its endpoints never match, "Cannot find remote writer"). Unsecured: same
+// vendor, host and process bytes (Fast DDS's locality checks read them), a participant
+// number no first participant has. Secured: the prefix is only a seed that Fast DDS hashes,
+// so any unused value does.
+GuidPrefix successor_prefix(const GuidPrefix& old, bool secured, std::size_t generation) {
+  static std::mt19937 random(std::random_device{}());
+  GuidPrefix p = old;
+  p.value[0] = 0x01;  // eProsima's vendor id
+  p.value[1] = 0x0f;
+  if (secured)
+    for (int k = 2; k < 8; ++k) p.value[k] = static_cast<std::uint8_t>(random());
+  p.value[8] = static_cast<std::uint8_t>(0xf0 | (generation & 0x0f));
+  for (int k = 9; k < 12; ++k) p.value[k] = static_cast<std::uint8_t>(random());
+  return p;
+}
 }  // namespace
 
 Session::Session(const SessionOptions& options)
     : impl_(std::make_unique<SessionParts>(options, resolved_domain(options))) {
   SessionParts& s = *impl_;
-  std::vector<std::pair<std::string, std::string>> security;
   if (!options.security_dir.empty())
-    security = security_properties(security_files(
+    s.security = security_properties(security_files(
         options.security_dir, security_identity(options.coordinator, options.agent_id)));
+  ParticipantTags tags;
+  tags.udp_only = !options.shared_memory;
   try {
     s.trace("creating the participant on domain %d", s.domain);
-    s.entities.open(s.domain, s.me, security);
+    s.entities.open(s.domain, s.me, s.security, tags.encode());
     s.trace("participant created");
     create_role_endpoints(s);
     s.trace("endpoints created");
@@ -194,6 +214,57 @@ WaitStatus Session::wait_finished(Seconds timeout) {
 
 std::vector<PeerIdentity> Session::live_peers() const {
   return impl_->peers.live_peers();
+}
+
+std::vector<PeerView> Session::peer_views() const {
+  const SessionParts& s = *impl_;
+  const bool secured = !s.opt.security_dir.empty();
+  std::vector<PeerView> views = s.peers.peer_views(secured);
+  if (!secured) return views;
+  // A handshake can finish on one side only (its last message lost): count a peer as
+  // authenticated when both directions work, i.e. this process's control writer and reader
+  // have matched the peer's (secure endpoint discovery needs both sides authenticated).
+  const std::string w = std::string(kControlTopic) + "/w", r = std::string(kControlTopic) + "/r";
+  std::lock_guard<std::mutex> lock(impl_->room.mutex());
+  for (PeerView& v : views)
+    v.authenticated = v.authenticated && s.readiness.has_matched_locked(w, v.who) &&
+                      s.readiness.has_matched_locked(r, v.who);
+  return views;
+}
+
+void Session::replace_participant(bool shared_memory, Seconds notice, const std::string& why) {
+  SessionParts& s = *impl_;
+  s.trace("replacing the participant: %s", why.c_str());
+  const std::string name = participant_name(s.me);
+  // 1. Tell the peers the old participant retires, so its leaving is no loss; give the news
+  //    `notice` (a few announcement periods) to arrive. Peers that miss it still forget it
+  //    when the new one appears (ParticipantTags::replaces).
+  ParticipantTags tags;
+  tags.udp_only = !s.opt.shared_memory;
+  tags.replaces = s.former_prefixes;
+  tags.retiring = true;
+  s.entities.set_user_data(tags.encode());
+  s.room.wait_for([] { return false; }, notice, /*interruptible=*/false);
+  // 2. Delete it before the new one exists (see ParticipantTags::retiring for why they never
+  //    coexist), and forget what it had matched and authenticated.
+  const GuidPrefix old = s.entities.retire();
+  s.entities.close_retired(kExitRunFailed, name);
+  s.readiness.forget_matches();
+  s.peers.restart_handshakes();
+  // 3. The new participant, naming every participant it replaces.
+  s.opt.shared_memory = shared_memory;
+  s.former_prefixes.push_back(prefix_text(old));
+  tags.udp_only = !shared_memory;
+  tags.retiring = false;
+  tags.replaces = s.former_prefixes;
+  const GuidPrefix next = successor_prefix(old, !s.security.empty(), s.former_prefixes.size());
+  try {
+    s.entities.open(s.domain, s.me, s.security, tags.encode(), &next);
+    create_role_endpoints(s);
+  } catch (...) {
+    s.entities.close(kExitRunFailed, name);
+    throw;
+  }
 }
 
 std::size_t Session::peers_ever_seen() const {

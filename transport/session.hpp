@@ -29,6 +29,7 @@
 #include "protocol/messages.hpp"
 #include "tessera.h"
 #include "transport/inbox.hpp"
+#include "transport/peer_view.hpp"
 #include "transport/run_identity.hpp"
 #include "transport/session_options.hpp"
 
@@ -122,6 +123,17 @@ class Session {
 
   /// Peers of this run discovered and not lost.
   std::vector<PeerIdentity> live_peers() const;
+  /// Live peers with what is known of them before any message (age, DDS Security handshake
+  /// done, participant tags).
+  std::vector<PeerView> peer_views() const;
+  /// Re-creates this process's participant (new GUID, same role and identity; UDP only when
+  /// `shared_memory` is false) and its endpoints. The old participant first announces that it
+  /// retires and is deleted `notice` later; the new one names every participant it replaces.
+  /// Peers forget the old one silently (ParticipantTags) instead of treating it as lost or as
+  /// a second process of the same role. Only before this process has written anything (e.g. a
+  /// stalled DDS Security handshake before an agent announces itself, transport/peer_gate.hpp):
+  /// samples and matches of the old participant are dropped. Throws TransportError.
+  void replace_participant(bool shared_memory, Seconds notice, const std::string& why);
   /// Number of peers of this run ever discovered (lost ones included).
   std::size_t peers_ever_seen() const;
   /// When false, a lost peer is only logged (set it once the run's work is complete).

@@ -28,8 +28,10 @@ struct SessionParts {
   /// `options` must be valid; `domain` is the resolved domain id.
   SessionParts(const SessionOptions& options, int domain);
 
-  const SessionOptions opt;
-  const NetworkProfile net;  // network_profile(opt.network)
+  SessionOptions opt;  // only shared_memory changes (Session::replace_participant)
+  std::vector<std::pair<std::string, std::string>> security;  // participant properties
+  std::vector<std::string> former_prefixes;  // replaced participants (ParticipantTags::replaces)
+  const NetworkProfile net;                  // network_profile(opt.network)
   const int domain;
   const PeerIdentity me;
   const DdsTrace trace;

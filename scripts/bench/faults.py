@@ -1,17 +1,10 @@
 #!/usr/bin/env python3
 """Fault benchmark of the DDS runtime (issue 8) and assembler of docs/benchmarks/faults.md.
 
-COLUMN CONTRACT (every docs/benchmarks/faults_<name>.csv, one row per fault kind):
-    fault,trials,finished,cost_error,extra_time_s
-  fault         short description of the fault injected
-  trials        number of runs with that fault
-  finished      runs that completed (exit 0 of every process, summary written)
-  cost_error    worst relative cost error of the finished runs against the undisturbed run
-                (|cost - cost_undisturbed| / cost_undisturbed), or against f* where stated
-  extra_time_s  mean extra wall time of a faulty run over the undisturbed run, in seconds
-The `loss` and `net` helpers write faults_loss.csv and faults_lossy_link.csv with the same
-columns; `--assemble-only` rebuilds faults.md from whatever faults_*.csv exist, followed by
-every docs/benchmarks/faults/*.md (each experiment's notes: command, machine, details).
+Every fault benchmark writes one docs/benchmarks/faults_<name>.csv row with the column
+contract of scripts/bench/faults_common.py (fault,trials,finished,cost_error,extra_time_s);
+`--assemble-only` rebuilds faults.md from whatever faults_*.csv exist, followed by every
+docs/benchmarks/faults/*.md (each experiment's notes: command, machine, details).
 
 This script's own experiment (`restart`): a generated 3D grid, N = 5 agents with
 --checkpoint-dir, the coordinator with --rejoin-timeout. Each trial SIGKILLs a random agent
@@ -20,18 +13,15 @@ random delay (0-1 s), and checks that the run finishes at the undisturbed run's 
 Per-trial details go to docs/benchmarks/faults/restart_trials.csv, the checkpoint write cost
 (undisturbed runs without / with checkpoints) to docs/benchmarks/faults/checkpoint_cost.csv.
 """
-import argparse
 import csv
 import glob
 import json
 import os
 import random
 import re
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 import functools
 
@@ -41,8 +31,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, HERE)
 import bench_common as bc  # noqa: E402
-OUT_DIR = os.path.join(ROOT, "docs", "benchmarks")
-COLUMNS = ["fault", "trials", "finished", "cost_error", "extra_time_s"]
+import faults_common as fc  # noqa: E402
+from faults_common import COLUMNS, OUT_DIR, assemble, write_contract_csv  # noqa: E402,F401 (used by older callers)
 
 
 class Run:
@@ -133,63 +123,21 @@ class Run:
         return writes, ms, size
 
 
-def write_contract_csv(path, rows):
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(COLUMNS)
-        for r in rows:
-            w.writerow([r[c] for c in COLUMNS])
-
-
-def assemble(out_dir):
-    rows, sources = [], []
-    for path in sorted(glob.glob(os.path.join(out_dir, "faults_*.csv"))):
-        with open(path) as f:
-            reader = csv.DictReader(f)
-            if reader.fieldnames != COLUMNS:
-                print("skipping %s: columns %s are not the contract %s" % (path, reader.fieldnames, COLUMNS))
-                continue
-            for r in reader:
-                rows.append(r)
-        sources.append(os.path.basename(path))
-    lines = ["# Fault table (issue 8)", "",
-             "Assembled by `scripts/bench/faults.py` from " + ", ".join("`%s`" % s for s in sources) +
-             " (columns: %s; see the script's header for their meaning)." % ", ".join(COLUMNS), "",
-             "| fault | trials | finished | cost error | extra time (s) |", "|---|---|---|---|---|"]
-    for r in rows:
-        lines.append("| %s | %s | %s | %s | %s |" % tuple(r[c] for c in COLUMNS))
-    for extra in sorted(glob.glob(os.path.join(out_dir, "faults", "*.md"))):
-        with open(extra) as f:
-            lines += ["", f.read().strip()]
-    with open(os.path.join(out_dir, "faults.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("wrote %s (%d rows)" % (os.path.join(out_dir, "faults.md"), len(rows)))
-
-
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
-    ap.add_argument("--out-dir", default=OUT_DIR)
-    ap.add_argument("--trials", type=int, default=10)
-    ap.add_argument("--agents", type=int, default=5)
-    ap.add_argument("--poses", type=int, default=500)
+    ap = fc.parser(__doc__, trials=10, agents=5, poses=500, domain=212, limit=300)
     ap.add_argument("--grad-tol", type=float, default=0.002)
     ap.add_argument("--every", type=int, default=1, help="--checkpoint-every of the agents")
-    ap.add_argument("--domain", type=int, default=212)
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--limit", type=float, default=300, help="time limit of one run, seconds")
     ap.add_argument("--assemble-only", action="store_true")
     ap.add_argument("--restart-env", action="append", default=[], help="KEY=VALUE for the restarted agent (diagnostics)")
     args = ap.parse_args()
     if args.assemble_only:
         assemble(args.out_dir)
         return 0
+    if args.every < 1:
+        sys.exit("option --every: must be at least 1")
     rng = random.Random(args.seed)
-    work = tempfile.mkdtemp(prefix="tessera_faults_")
-    args.graph_path = os.path.join(work, "graph.g2o")
-    subprocess.run([os.path.join(args.bin_dir, "tessera"), "generate", "--kind", "grid3d", "--poses",
-                    str(args.poses), "--robots", str(args.agents), "--seed", "3", "--out", args.graph_path],
-                   check=True, stdout=subprocess.DEVNULL)
+    work = fc.start(args, "tessera_faults_")
 
     # Undisturbed runs: without checkpoints, and with them (the reference of the trials).
     base = {}
@@ -230,27 +178,20 @@ def main():
                                        err, wall, wall - ref_wall))
         if not ok:
             print("  logs kept in %s" % r.dir)
-    finished = [x for x in trials if x["finished"]]
     row = bc.fault_row("agent SIGKILLed at a random round, restarted with the same id (N=%d, %d-pose grid3d)"
                        % (args.agents, args.poses), trials)
     os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
-    write_contract_csv(os.path.join(args.out_dir, "faults_restart.csv"), [row])
-    bc.write_csv(os.path.join(args.out_dir, "faults", "restart_trials.csv"), trials, announce=False)
     with open(os.path.join(args.out_dir, "faults", "checkpoint_cost.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", "wall_s", "rounds", "checkpoint_writes", "checkpoint_ms_total", "checkpoint_bytes"])
         for name, (wall, s, (writes, ms, size)) in base.items():
             w.writerow([name, "%.3f" % wall, s["rounds"], writes, "%.1f" % ms, size])
-    print("\nfault | trials | finished | cost_error | extra_time_s")
-    print("%s | %d | %d | %s | %s" % (row["fault"], row["trials"], row["finished"], row["cost_error"],
-                                     row["extra_time_s"]))
     w_plain, w_ck = base["plain"][0], base["checkpointed"][0]
     writes, ms, size = base["checkpointed"][2]
     print("checkpoints (every %d rounds): %d writes by %d agents, %.1f ms in total (%.2f ms each, %d bytes); "
           "undisturbed wall %.2f s without, %.2f s with" %
           (args.every, writes, args.agents, ms, ms / max(1, writes), size, w_plain, w_ck))
-    notes = ["## Agent killed and restarted (`faults_restart.csv`)", "",
-             "Command: `scripts/bench/faults.py %s`" % " ".join(sys.argv[1:]), "",
+    notes = fc.notes_head("Agent killed and restarted", "restart") + [
              "%d-pose generated grid3d, N = %d, IRBCD, `highest`, grad tol %g; every agent with "
              "`--checkpoint-dir` (`--checkpoint-every %d`), the coordinator with `--rejoin-timeout 30`. "
              "Each trial SIGKILLs a random agent when the coordinator reports a random round and starts "
@@ -270,11 +211,7 @@ def main():
               (ref["rounds"], w_plain, w_ck, writes, args.agents, ms, ms / max(1, writes), size),
               "", "Machine: %s, %d cores, shared with other builds and benchmarks while measured "
               "(wall times are inflated and noisy)." % (os.uname().machine, os.cpu_count())]
-    with open(os.path.join(args.out_dir, "faults", "restart.md"), "w") as f:
-        f.write("\n".join(notes) + "\n")
-    assemble(args.out_dir)
-    shutil.rmtree(work, ignore_errors=True) if len(finished) == len(trials) else print("work dir kept: " + work)
-    return 0 if len(finished) == len(trials) else 1
+    return fc.finish(args, "restart", row, trials, work, notes)
 
 
 if __name__ == "__main__":

@@ -17,23 +17,19 @@ CPU time = user + sys of launch and every process it started (they are all waite
 usage: scripts/bench/faults_launch_loss.py [--bin-dir build/bin] [--out-dir docs/benchmarks]
            [--trials 10] [--agents 5] [--poses 500] [--domain 223] [--seed 1] [--limit 300]
 """
-import argparse
-import csv
 import json
 import os
-import random
 import resource
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import bench_common as bc  # noqa: E402
-from faults import COLUMNS, OUT_DIR, ROOT, assemble, write_contract_csv  # noqa: E402
+import faults_common as fc  # noqa: E402
+from faults_loss import loss_benchmark_start  # noqa: E402
 
 
 class LaunchRun:
@@ -115,15 +111,7 @@ class LaunchRun:
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
-    ap.add_argument("--out-dir", default=OUT_DIR)
-    bc.add_loss_args(ap, domain=223)
-    args = ap.parse_args()
-    rng = random.Random(args.seed)
-    work = tempfile.mkdtemp(prefix="tessera_faults_launch_loss_")
-    tessera = os.path.join(args.bin_dir, "tessera")
-    fstar = bc.loss_graph_and_fstar(tessera, args, work)
+    args, rng, work, fstar = loss_benchmark_start(__doc__, 223, "tessera_faults_launch_loss_")
 
     ref = LaunchRun(args, work, "undisturbed")
     ref.start()
@@ -160,20 +148,9 @@ def main():
                                        wall, wall - ref_wall, cpu), flush=True)
         if not ok:
             print("  log kept in %s" % r.log_path, flush=True)
-    finished = [x for x in trials if x["finished"]]
-    row = dict(fault="agent SIGKILLed for good under `tessera launch --on-agent-loss continue` "
-                     "(N=%d, %d-pose grid3d; cost error vs f*)" % (args.agents, args.poses),
-               trials=len(trials), finished=len(finished),
-               cost_error="%.1e" % max([x["rel_cost_error"] for x in finished], default=float("nan")),
-               extra_time_s="%.2f" % (sum(x["extra_s"] for x in finished) / max(1, len(finished))))
-    os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
-    write_contract_csv(os.path.join(args.out_dir, "faults_launch_loss.csv"), [row])
-    with open(os.path.join(args.out_dir, "faults", "launch_loss_trials.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(trials[0].keys()))
-        w.writeheader()
-        w.writerows(trials)
-    notes = ["## Agent lost for good under `tessera launch` (`faults_launch_loss.csv`)", "",
-             "Command: `scripts/bench/faults_launch_loss.py %s`" % " ".join(sys.argv[1:]), "",
+    row = bc.fault_row("agent SIGKILLed for good under `tessera launch --on-agent-loss continue` "
+                       "(N=%d, %d-pose grid3d; cost error vs f*)" % (args.agents, args.poses), trials)
+    notes = fc.notes_head("Agent lost for good under `tessera launch`", "launch_loss") + [
              "`tessera launch GRAPH --agents %d --partition eco --grad-tol %g --on-agent-loss continue "
              "--rejoin-timeout %g --replica-every %d` on a %d-pose generated grid3d (seed 3); each trial "
              "SIGKILLs a random agent when launch prints a random round and never restarts it. "
@@ -188,16 +165,7 @@ def main():
                      (x["trial"], x["agent"], x["kill_round"], "yes" if x["finished"] else "NO (exit %d)" %
                       x["launch_exit"], x["survivors"], x["poses_in_estimate"], x["moved_poses"],
                       x["rel_cost_error"], x["wall_s"], x["cpu_s"], x["extra_s"]))
-    with open(os.path.join(args.out_dir, "faults", "launch_loss.md"), "w") as f:
-        f.write("\n".join(notes) + "\n")
-    print("\n" + " | ".join(COLUMNS))
-    print(" | ".join(str(row[c]) for c in COLUMNS))
-    assemble(args.out_dir)
-    if len(finished) == len(trials) and not os.environ.get("TESSERA_BENCH_KEEP"):
-        shutil.rmtree(work, ignore_errors=True)
-    else:
-        print("work dir kept: " + work)
-    return 0 if len(finished) == len(trials) else 1
+    return fc.finish(args, "launch_loss", row, trials, work, notes)
 
 
 if __name__ == "__main__":

@@ -14,22 +14,19 @@ Writes docs/benchmarks/faults_loss.csv with the column contract of scripts/bench
 undisturbed replicated run), per-trial rows in docs/benchmarks/faults/loss_trials.csv, and
 re-assembles docs/benchmarks/faults.md.
 """
-import argparse
 import csv
 import json
 import os
 import random
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import bench_common as bc  # noqa: E402
-from faults import COLUMNS, OUT_DIR, ROOT, assemble, write_contract_csv  # noqa: E402
+import faults_common as fc  # noqa: E402
 
 
 class LossRun:
@@ -97,16 +94,19 @@ class LossRun:
         return bc.g2o_vertex_ids(self.merged)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
-    ap.add_argument("--out-dir", default=OUT_DIR)
-    bc.add_loss_args(ap, domain=213)
+def loss_benchmark_start(doc, domain, prefix):
+    """The start both permanent-loss benchmarks share (this one and faults_launch_loss.py):
+    options (bench_common.add_loss_args), random generator, scratch folder with the graph, f*."""
+    ap = fc.parser(doc)
+    bc.add_loss_args(ap, domain=domain)
     args = ap.parse_args()
-    rng = random.Random(args.seed)
-    work = tempfile.mkdtemp(prefix="tessera_faults_loss_")
-    tessera = os.path.join(args.bin_dir, "tessera")
-    fstar = bc.loss_graph_and_fstar(tessera, args, work)
+    work = fc.start(args, prefix, graph=False)
+    fstar = bc.loss_graph_and_fstar(os.path.join(args.bin_dir, "tessera"), args, work)
+    return args, random.Random(args.seed), work, fstar
+
+
+def main():
+    args, rng, work, fstar = loss_benchmark_start(__doc__, 213, "tessera_faults_loss_")
 
     base = {}
     for name, replicas in (("plain", 0), ("replicated", 1)):
@@ -147,27 +147,17 @@ def main():
                                        if ok else "FAILED %s" % codes, poses, err, wall, wall - ref_wall))
         if not ok:
             print("  logs kept in %s" % r.dir)
-    finished = [x for x in trials if x["finished"]]
     row = bc.fault_row("agent SIGKILLed for good at a random round, block re-partitioned to the survivors "
                        "(N=%d, %d-pose grid3d, --replicas 1; cost error vs f*)" % (args.agents, args.poses),
                        trials)
     os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
-    write_contract_csv(os.path.join(args.out_dir, "faults_loss.csv"), [row])
-    bc.write_csv(os.path.join(args.out_dir, "faults", "loss_trials.csv"), trials, announce=False)
     with open(os.path.join(args.out_dir, "faults", "loss_replication_cost.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["run", "replicas", "wall_s", "rounds", "bytes_exchanged", "cost"])
         for name, (wall, s) in base.items():
             w.writerow([name, 0 if name == "plain" else 1, "%.3f" % wall, s["rounds"], s["bytes_exchanged"],
                         "%.12g" % s["cost"]])
-    print("\n" + " | ".join(COLUMNS))
-    print(" | ".join(str(row[c]) for c in COLUMNS))
-    assemble(args.out_dir)
-    if len(finished) == len(trials):
-        shutil.rmtree(work, ignore_errors=True)
-    else:
-        print("work dir kept: " + work)
-    return 0 if len(finished) == len(trials) else 1
+    return fc.finish(args, "loss", row, trials, work)
 
 
 if __name__ == "__main__":

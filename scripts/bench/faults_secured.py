@@ -18,22 +18,20 @@ CPU time = user + sys of launch and every process it started.
 usage: scripts/bench/faults_secured.py [--bin-dir build/bin] [--out-dir docs/benchmarks]
            [--trials 5] [--agents 3] [--poses 500] [--domain 224] [--limit 120]
 """
-import argparse
 import json
 import os
 import re
 import resource
-import shutil
 import subprocess
 import sys
-import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from faults import COLUMNS, OUT_DIR, ROOT, assemble, write_contract_csv  # noqa: E402
+import bench_common as bc  # noqa: E402
+import faults_common as fc  # noqa: E402
 
-MAKE_IDENTITIES = os.path.join(ROOT, "scripts", "security", "make_identities.sh")
+MAKE_IDENTITIES = os.path.join(fc.ROOT, "scripts", "security", "make_identities.sh")
 
 
 def launch(args, work, name, extra):
@@ -84,20 +82,9 @@ def watched_launch(args, work, name, extra):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin-dir", default=os.path.join(ROOT, "build", "bin"))
-    ap.add_argument("--out-dir", default=OUT_DIR)
-    ap.add_argument("--trials", type=int, default=5)
-    ap.add_argument("--agents", type=int, default=3)
-    ap.add_argument("--poses", type=int, default=500)
-    ap.add_argument("--domain", type=int, default=224)
-    ap.add_argument("--limit", type=float, default=120, help="time limit of one launch, seconds")
-    args = ap.parse_args()
-    work = tempfile.mkdtemp(prefix="tessera_faults_secured_")
-    args.graph = os.path.join(work, "graph.g2o")
-    subprocess.run([os.path.join(args.bin_dir, "tessera"), "generate", "--kind", "grid3d", "--poses",
-                    str(args.poses), "--robots", str(args.agents), "--seed", "3", "--out", args.graph],
-                   check=True, stdout=subprocess.DEVNULL)
+    args = fc.parser(__doc__, trials=5, agents=3, poses=500, domain=224, limit=120).parse_args()
+    work = fc.start(args, "tessera_faults_secured_")
+    args.graph = args.graph_path
     sec = os.path.join(work, "sec")
     subprocess.run([MAKE_IDENTITIES, sec, str(args.agents)], check=True, stdout=subprocess.DEVNULL)
 
@@ -112,22 +99,16 @@ def main():
         err = abs(secured["cost"] - plain["cost"]) / plain["cost"] if ok else float("nan")
         rows.append(dict(trial=t, plain_exit=pc, secured_exit=sc, finished=int(ok),
                          rounds=secured["rounds"] if secured else "", rel_cost_error=err,
-                         plain_wall_s=pwall, secured_wall_s=swall, plain_cpu_s=pcpu, secured_cpu_s=scpu,
+                         plain_wall_s=pwall, secured_wall_s=swall, extra_s=swall - pwall,
+                         plain_cpu_s=pcpu, secured_cpu_s=scpu,
                          outsider_samples=samples, outsider_samples_unsecured=control))
         print("trial %d: unsecured exit %d wall %.2f s cpu %.2f s | secured exit %d wall %.2f s cpu %.2f s | "
               "rel. cost error %.1e | outsider samples %d (unsecured run: %d)" % (t, pc, pwall, pcpu, sc, swall, scpu,
                                                                                 err, samples, control),
               flush=True)
-    fin = [r for r in rows if r["finished"]]
-    row = dict(fault="secured run (--security, %d agents, %d-pose grid3d; cost error vs the unsecured run; "
-                     "an unauthenticated outsider read 0 samples)" % (args.agents, args.poses),
-               trials=len(rows), finished=len(fin),
-               cost_error="%.1e" % max([r["rel_cost_error"] for r in fin], default=float("nan")),
-               extra_time_s="%.2f" % (sum(r["secured_wall_s"] - r["plain_wall_s"] for r in fin) / max(1, len(fin))))
-    os.makedirs(os.path.join(args.out_dir, "faults"), exist_ok=True)
-    write_contract_csv(os.path.join(args.out_dir, "faults_secured.csv"), [row])
-    notes = ["## Secured run (`faults_secured.csv`)", "",
-             "Command: `scripts/bench/faults_secured.py %s`" % " ".join(sys.argv[1:]), "",
+    row = bc.fault_row("secured run (--security, %d agents, %d-pose grid3d; cost error vs the unsecured run; "
+                       "an unauthenticated outsider read 0 samples)" % (args.agents, args.poses), rows)
+    notes = fc.notes_head("Secured run", "secured") + [
              "`tessera launch GRAPH --agents %d --partition eco --no-certify` without and with `--security DIR` "
              "(identities from `scripts/security/make_identities.sh`) on a %d-pose generated grid3d; during "
              "each secured run `tessera-dds-snoop` without an identity subscribes to every Tessera topic "
@@ -140,16 +121,7 @@ def main():
                      (r["trial"], "yes" if r["finished"] else "NO (exit %d/%d)" % (r["plain_exit"], r["secured_exit"]),
                       r["rounds"], r["rel_cost_error"], r["plain_wall_s"], r["secured_wall_s"], r["plain_cpu_s"],
                       r["secured_cpu_s"], r["outsider_samples"], r["outsider_samples_unsecured"]))
-    with open(os.path.join(args.out_dir, "faults", "secured.md"), "w") as f:
-        f.write("\n".join(notes) + "\n")
-    print("\n" + " | ".join(COLUMNS))
-    print(" | ".join(str(row[c]) for c in COLUMNS))
-    assemble(args.out_dir)
-    if len(fin) == len(rows):
-        shutil.rmtree(work, ignore_errors=True)
-    else:
-        print("work dir kept: " + work)
-    return 0 if len(fin) == len(rows) else 1
+    return fc.finish(args, "secured", row, rows, work, notes)
 
 
 if __name__ == "__main__":
