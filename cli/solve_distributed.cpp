@@ -16,15 +16,17 @@
 
 namespace tessera::cli {
 
-const char* const kDistributedValued[] = {
-    "agents",           "partition",      "max-rounds",       "seed",
-    "reference-cost",   "select",         "rel-tol",          "tr-steps",
-    "restart-c",        "sigma",          "unselected",       "irbcd-n",
-    "tcg-iters",        "robots",         "certify-grad-tol", "certify-iters",
-    "certify-residual", "certify-precon", "block-precon",     "tangent-refresh",
-    "tcg-kappa",        nullptr};
-const char* const kDistributedSwitches[] = {"parallel", "sequential", "reference", "certify",
-                                            nullptr};
+const char* const kDistributedValued[] = {"agents",        "partition",        "max-rounds",
+                                          "seed",          "reference-cost",   "select",
+                                          "rel-tol",       "tr-steps",         "restart-c",
+                                          "sigma",         "unselected",       "irbcd-n",
+                                          "tcg-iters",     "robots",           "certify-grad-tol",
+                                          "certify-iters", "certify-residual", "certify-precon",
+                                          "block-precon",  "tangent-refresh",  "tcg-kappa",
+                                          "sigma-shrink",  "sigma-saturation", "sigma-theta",
+                                          "sigma-min",     "sigma-max",        nullptr};
+const char* const kDistributedSwitches[] = {"parallel",    "sequential",  "reference", "certify",
+                                            "sigma-adapt", "sigma-fixed", nullptr};
 
 const char* kDistributedHelp =
     "\n"
@@ -55,6 +57,10 @@ const char* kDistributedHelp =
     "                            updates of an agent (default 0: once, at its first update)\n"
     "  --restart-c C             restart constant c1 of RBCD++/IRBCD (< 0: never restart)\n"
     "  --sigma S                 IRBCD sigma (default 1e-4; the paper: 1e-3)\n"
+    "  --sigma-adapt, --sigma-fixed   IRBCD: adapt sigma at restarts / when gamma saturates\n"
+    "                            (docs/irbcd.md section 12), or keep it fixed\n"
+    "  --sigma-shrink F, --sigma-saturation S, --sigma-theta T, --sigma-min A, --sigma-max B\n"
+    "                            adaptive sigma's constants (IrbcdOptions)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
     "  --irbcd-n units|variables IRBCD: n = selectable blocks (default) or scalar variables\n"
     "  --reference               also run the centralized solver for f* and report rel_gap\n"
@@ -132,6 +138,13 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     opt.rbcd_plus_plus.restart_c = opt.irbcd.restart_c;
   }
   opt.irbcd.sigma = a.get_double("sigma", opt.irbcd.sigma);
+  if (a.has("sigma-adapt")) opt.irbcd.adaptive_sigma = true;
+  if (a.has("sigma-fixed")) opt.irbcd.adaptive_sigma = false;
+  opt.irbcd.sigma_shrink = a.get_double("sigma-shrink", opt.irbcd.sigma_shrink);
+  opt.irbcd.sigma_saturation = a.get_double("sigma-saturation", opt.irbcd.sigma_saturation);
+  opt.irbcd.sigma_restart_theta = a.get_double("sigma-theta", opt.irbcd.sigma_restart_theta);
+  opt.irbcd.sigma_min = a.get_double("sigma-min", opt.irbcd.sigma_min);
+  opt.irbcd.sigma_max = a.get_double("sigma-max", opt.irbcd.sigma_max);
   const std::string unselected = a.get_or("unselected", "take");
   if (unselected != "take" && unselected != "keep")
     throw InputError("option --unselected: '" + unselected + "' is not one of take, keep");

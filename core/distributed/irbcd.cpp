@@ -1,5 +1,6 @@
 #include "distributed/irbcd.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -14,6 +15,16 @@ void IrbcdOptions::validate() const {
   if (!std::isfinite(a0)) throw InputError("IrbcdOptions.a0 must be finite");
   if (!(b0 > 0 && std::isfinite(b0))) throw InputError("IrbcdOptions.b0 must be finite and > 0");
   if (!std::isfinite(restart_c)) throw InputError("IrbcdOptions.restart_c must be finite");
+  if (!(sigma_shrink > 0 && sigma_shrink <= 1))
+    throw InputError("IrbcdOptions.sigma_shrink must be in (0, 1]");
+  if (!(sigma_saturation > 0 && sigma_saturation <= 1))
+    throw InputError("IrbcdOptions.sigma_saturation must be in (0, 1]");
+  if (!(sigma_restart_theta > 0 && std::isfinite(sigma_restart_theta)))
+    throw InputError("IrbcdOptions.sigma_restart_theta must be finite and > 0");
+  if (!(sigma_min >= 0 && std::isfinite(sigma_min)))
+    throw InputError("IrbcdOptions.sigma_min must be finite and >= 0");
+  if (!(sigma_max >= sigma_min && std::isfinite(sigma_max)))
+    throw InputError("IrbcdOptions.sigma_max must be finite and >= sigma_min");
 }
 
 const char* dimension_name(IrbcdDimension d) {
@@ -34,7 +45,8 @@ double irbcd_gamma(double n, double sigma, double a, double b) {
   return 0.5 * (-p + std::sqrt(p * p + 4.0 * q));
 }
 
-IrbcdScheme::IrbcdScheme(const IrbcdOptions& options, double n) : options_(options), n_(n) {
+IrbcdScheme::IrbcdScheme(const IrbcdOptions& options, double n)
+    : options_(options), n_(n), sigma_(options.sigma) {
   options_.validate();
   if (!(n_ >= 1)) throw InputError("IRBCD: n must be >= 1");
   if (!(options_.sigma < n_ * n_)) throw InputError("IrbcdOptions.sigma must be < n^2");
@@ -46,7 +58,7 @@ std::unique_ptr<MomentumScheme> IrbcdScheme::clone() const {
 }
 
 MomentumCoefficients IrbcdScheme::coefficients() const {
-  const double sigma = options_.sigma;
+  const double sigma = sigma_;
   MomentumCoefficients c;
   c.gamma = irbcd_gamma(n_, sigma, a_, b_);
   c.alpha = (n_ - c.gamma * sigma) / (c.gamma * (n_ * n_ - sigma));
@@ -58,10 +70,29 @@ void IrbcdScheme::advance() {
   const MomentumCoefficients c = coefficients();
   b_ = b_ / std::sqrt(c.beta);
   a_ = c.gamma * b_;
+  // gamma's fixed point is 1/sqrt(sigma); near it the damping (beta < 1) holds the momentum.
+  // Reaching it without a restart means f still decreased every round: allow more momentum.
+  if (options_.adaptive_sigma && sigma_ > 0 &&
+      c.gamma * std::sqrt(sigma_) >= options_.sigma_saturation)
+    set_sigma(sigma_ * options_.sigma_shrink);
 }
 
 void IrbcdScheme::restart() {
+  if (options_.adaptive_sigma) {
+    // advance() ran for the rejected round, so a/b is that round's gamma: momentum of that
+    // size increased f. Damp so that gamma settles at theta times it.
+    const double gamma_r = a_ / b_;
+    const double g = options_.sigma_restart_theta * gamma_r;
+    set_sigma(1.0 / (g * g));
+  }
   if (options_.reset_on_restart) reset();
+}
+
+void IrbcdScheme::set_sigma(double s) {
+  // Also below n^2 (the recurrences' domain); NaN-safe: a non-finite value keeps the old one.
+  s = std::min(std::max(s, options_.sigma_min), options_.sigma_max);
+  s = std::min(s, 0.5 * n_ * n_);
+  if (std::isfinite(s)) sigma_ = s;
 }
 
 void IrbcdScheme::reset() {
@@ -70,15 +101,17 @@ void IrbcdScheme::reset() {
 }
 
 std::vector<double> IrbcdScheme::save() const {
-  return {a_, b_};
+  return {a_, b_, sigma_};
 }
 
 void IrbcdScheme::load(const std::vector<double>& state) {
-  if (state.size() != 2)
+  // 2 values: a snapshot from before adaptive sigma existed (sigma was the option's).
+  if (state.size() != 2 && state.size() != 3)
     throw std::runtime_error("IrbcdScheme: saved state has " + std::to_string(state.size()) +
-                             " values, expected 2");
+                             " values, expected 3");
   a_ = state[0];
   b_ = state[1];
+  sigma_ = state.size() == 3 ? state[2] : options_.sigma;
 }
 
 }  // namespace tessera
