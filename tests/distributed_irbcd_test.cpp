@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <vector>
 
 #include "distributed/irbcd.hpp"
 #include "distributed/momentum.hpp"
@@ -28,6 +31,7 @@ TEST(Irbcd, GammaSolvesItsQuadraticAndIsAtLeastOneOverN) {
 
 TEST(Irbcd, RecurrencesFollowThePaper) {
   IrbcdOptions o;  // sigma 1e-4, a0 = 1/n, b0 = 1
+  o.adaptive_sigma = false;
   const double n = 5;
   IrbcdScheme s(o, n);
   EXPECT_DOUBLE_EQ(s.a(), 1.0 / n);
@@ -53,6 +57,107 @@ TEST(Irbcd, RecurrencesFollowThePaper) {
   const double a1 = keep.a();
   keep.restart();
   EXPECT_DOUBLE_EQ(keep.a(), a1);
+}
+
+// Adaptive sigma (docs/irbcd.md section 12). sigma 1e-2 with n = 2 puts gamma's fixed point
+// 1/sqrt(sigma) = 10 within a few dozen rounds.
+IrbcdOptions adaptive_options() {
+  IrbcdOptions o;
+  o.sigma = 1e-2;
+  o.adaptive_sigma = true;
+  o.sigma_max = 1e-1;
+  return o;
+}
+
+TEST(IrbcdAdaptiveSigma, DisabledIsTheFixedRecurrenceAndEnabledMatchesItUntilSaturation) {
+  const double n = 2;
+  IrbcdOptions fixed_o = adaptive_options();
+  fixed_o.adaptive_sigma = false;
+  IrbcdScheme fixed(fixed_o, n), adaptive(adaptive_options(), n);
+  bool shrunk = false;
+  for (int k = 0; k < 300; ++k) {
+    const MomentumCoefficients f = fixed.coefficients(), a = adaptive.coefficients();
+    EXPECT_EQ(fixed.sigma(), 1e-2);  // never moves when disabled
+    if (!shrunk) {                   // bit-identical until the first adjustment
+      EXPECT_EQ(f.gamma, a.gamma);
+      EXPECT_EQ(f.alpha, a.alpha);
+      EXPECT_EQ(f.beta, a.beta);
+    }
+    fixed.advance();
+    adaptive.advance();
+    if (adaptive.sigma() != 1e-2 && !shrunk) {
+      shrunk = true;
+      // Shrunk exactly when gamma reached the saturation fraction of 1/sqrt(sigma).
+      EXPECT_GE(a.gamma * std::sqrt(1e-2), adaptive_options().sigma_saturation);
+      EXPECT_DOUBLE_EQ(adaptive.sigma(), 1e-2 * adaptive_options().sigma_shrink);
+    }
+  }
+  EXPECT_TRUE(shrunk);
+  // The fixed scheme's gamma settles at 1/sqrt(sigma); the adaptive one grows past it.
+  EXPECT_NEAR(fixed.coefficients().gamma, 10.0, 0.5);
+  EXPECT_GT(adaptive.coefficients().gamma, 12.0);
+  EXPECT_LT(adaptive.sigma(), 1e-2 * adaptive_options().sigma_shrink);
+}
+
+TEST(IrbcdAdaptiveSigma, ShrinksNoFurtherThanSigmaMin) {
+  IrbcdOptions o = adaptive_options();
+  o.sigma_min = 1e-3;
+  IrbcdScheme s(o, 2);
+  for (int k = 0; k < 2000; ++k) {
+    s.advance();
+    EXPECT_GE(s.sigma(), 1e-3);
+  }
+  EXPECT_DOUBLE_EQ(s.sigma(), 1e-3);
+}
+
+TEST(IrbcdAdaptiveSigma, RestartRaisesSigmaToDampTheRejectedMomentum) {
+  IrbcdOptions o = adaptive_options();
+  o.sigma = 1e-4;
+  const double n = 2;
+  IrbcdScheme s(o, n);
+  for (int k = 0; k < 40; ++k) s.advance();
+  const double gamma_r = s.a() / s.b();                      // the gamma of the round just taken
+  ASSERT_LT(gamma_r * std::sqrt(1e-4), o.sigma_saturation);  // no shrink happened
+  s.restart();
+  const double expected = 1.0 / std::pow(o.sigma_restart_theta * gamma_r, 2);
+  EXPECT_GT(expected, 1e-4);
+  EXPECT_DOUBLE_EQ(s.sigma(), std::min(expected, o.sigma_max));
+  EXPECT_DOUBLE_EQ(s.a(), 1.0 / n);  // a, b reset as before
+  EXPECT_DOUBLE_EQ(s.b(), 1.0);
+  // Clamped to sigma_max: a restart right after the reset (gamma ~ 1.6 / n) asks for ~1.
+  s.restart();
+  EXPECT_DOUBLE_EQ(s.sigma(), o.sigma_max);
+  // Disabled: a restart leaves sigma alone.
+  o.adaptive_sigma = false;
+  IrbcdScheme off(o, n);
+  for (int k = 0; k < 40; ++k) off.advance();
+  off.restart();
+  EXPECT_EQ(off.sigma(), 1e-4);
+}
+
+TEST(IrbcdAdaptiveSigma, SaveLoadRoundTripKeepsSigma) {
+  const double n = 2;
+  IrbcdScheme s(adaptive_options(), n);
+  for (int k = 0; k < 120; ++k) s.advance();
+  ASSERT_NE(s.sigma(), 1e-2);
+  const std::vector<double> saved = s.save();
+  ASSERT_EQ(saved.size(), 3u);
+  IrbcdScheme t(adaptive_options(), n);
+  t.load(saved);
+  EXPECT_EQ(t.sigma(), s.sigma());
+  for (int k = 0; k < 100; ++k) {
+    const MomentumCoefficients a = s.coefficients(), b = t.coefficients();
+    EXPECT_EQ(a.gamma, b.gamma);
+    EXPECT_EQ(a.alpha, b.alpha);
+    EXPECT_EQ(a.beta, b.beta);
+    s.advance();
+    t.advance();
+    EXPECT_EQ(s.sigma(), t.sigma());
+  }
+  // A two-value state (before adaptive sigma) takes the option's sigma; other sizes fail.
+  t.load({0.5, 1.0});
+  EXPECT_EQ(t.sigma(), 1e-2);
+  EXPECT_THROW(t.load({1.0}), std::runtime_error);
 }
 
 TEST(RbcdPlusPlus, NesterovSequence) {
@@ -113,6 +218,29 @@ TEST(Irbcd, BadOptionsNameTheField) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("sigma"), std::string::npos);
   }
+  const auto names = [](IrbcdOptions bad, const char* field) {
+    try {
+      bad.validate();
+      ADD_FAILURE() << field;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  IrbcdOptions bad;
+  bad.sigma_shrink = 0;
+  names(bad, "sigma_shrink");
+  bad = {};
+  bad.sigma_saturation = 1.5;
+  names(bad, "sigma_saturation");
+  bad = {};
+  bad.sigma_restart_theta = -1;
+  names(bad, "sigma_restart_theta");
+  bad = {};
+  bad.sigma_min = -1;
+  names(bad, "sigma_min");
+  bad = {};
+  bad.sigma_max = 1e-9;  // below sigma_min
+  names(bad, "sigma_max");
 }
 
 }  // namespace

@@ -50,6 +50,8 @@ IrbcdScheme::IrbcdScheme(const IrbcdOptions& options, double n)
   options_.validate();
   if (!(n_ >= 1)) throw InputError("IRBCD: n must be >= 1");
   if (!(options_.sigma < n_ * n_)) throw InputError("IrbcdOptions.sigma must be < n^2");
+  // A start value above the cap raises the cap: --sigma 1e-3 alone keeps meaning 1e-3.
+  options_.sigma_max = std::max(options_.sigma_max, options_.sigma);
   reset();
 }
 

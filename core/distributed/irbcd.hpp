@@ -54,7 +54,7 @@ struct IrbcdOptions {
   double sigma_saturation = 0.9;     ///< In (0, 1].
   double sigma_restart_theta = 0.5;  ///< > 0.
   double sigma_min = 1e-8;           ///< >= 0.
-  double sigma_max = 1e-4;           ///< >= sigma_min.
+  double sigma_max = 1e-4;           ///< >= sigma_min; raised to `sigma` if below it.
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
