@@ -16,17 +16,17 @@
 
 namespace tessera::cli {
 
-const char* const kDistributedValued[] = {"agents",        "partition",        "max-rounds",
-                                          "seed",          "reference-cost",   "select",
-                                          "rel-tol",       "tr-steps",         "restart-c",
-                                          "sigma",         "unselected",       "irbcd-n",
-                                          "tcg-iters",     "robots",           "certify-grad-tol",
-                                          "certify-iters", "certify-residual", "certify-precon",
-                                          "block-precon",  "tangent-refresh",  "tcg-kappa",
-                                          "sigma-shrink",  "sigma-saturation", "sigma-theta",
-                                          "sigma-min",     "sigma-max",        nullptr};
-const char* const kDistributedSwitches[] = {"parallel",    "sequential",  "reference", "certify",
-                                            "sigma-adapt", "sigma-fixed", nullptr};
+const char* const kDistributedValued[] = {
+    "agents",           "partition",      "max-rounds",       "seed",
+    "reference-cost",   "select",         "rel-tol",          "tr-steps",
+    "restart-c",        "sigma",          "unselected",       "irbcd-n",
+    "tcg-iters",        "robots",         "certify-grad-tol", "certify-iters",
+    "certify-residual", "certify-precon", "block-precon",     "tangent-refresh",
+    "tcg-kappa",        "sigma-shrink",   "sigma-saturation", "sigma-theta",
+    "sigma-min",        "sigma-max",      "irbcd-a0",         nullptr};
+const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
+                                            "certify",       "sigma-adapt", "sigma-fixed",
+                                            "irbcd-keep-ab", nullptr};
 
 const char* kDistributedHelp =
     "\n"
@@ -58,7 +58,7 @@ const char* kDistributedHelp =
     "  --restart-c C             restart constant c1 of RBCD++/IRBCD (< 0: never restart)\n"
     "  --sigma S                 IRBCD sigma (default 1e-4; the paper: 1e-3)\n"
     "  --sigma-adapt, --sigma-fixed   IRBCD: adapt sigma at restarts / when gamma saturates\n"
-    "                            (docs/irbcd.md section 12), or keep it fixed\n"
+    "                            (docs/irbcd.md section 13), or keep it fixed\n"
     "  --sigma-shrink F, --sigma-saturation S, --sigma-theta T, --sigma-min A, --sigma-max B\n"
     "                            adaptive sigma's constants (IrbcdOptions)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
@@ -138,6 +138,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     opt.rbcd_plus_plus.restart_c = opt.irbcd.restart_c;
   }
   opt.irbcd.sigma = a.get_double("sigma", opt.irbcd.sigma);
+  opt.irbcd.a0 = a.get_double("irbcd-a0", opt.irbcd.a0);
+  if (a.has("irbcd-keep-ab")) opt.irbcd.reset_on_restart = false;
   if (a.has("sigma-adapt")) opt.irbcd.adaptive_sigma = true;
   if (a.has("sigma-fixed")) opt.irbcd.adaptive_sigma = false;
   opt.irbcd.sigma_shrink = a.get_double("sigma-shrink", opt.irbcd.sigma_shrink);
