@@ -61,6 +61,8 @@ const char* kDistributedHelp =
     "                            (docs/irbcd.md section 13), or keep it fixed\n"
     "  --sigma-shrink F, --sigma-saturation S, --sigma-theta T, --sigma-min A, --sigma-max B\n"
     "                            adaptive sigma's constants (IrbcdOptions)\n"
+    "  --irbcd-a0 A              IRBCD: initial a (default 1/n, the paper's)\n"
+    "  --irbcd-keep-ab           IRBCD: keep a, b running after a restart (default: reset)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
     "  --irbcd-n units|variables IRBCD: n = selectable blocks (default) or scalar variables\n"
     "  --reference               also run the centralized solver for f* and report rel_gap\n"
