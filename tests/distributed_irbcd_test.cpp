@@ -32,6 +32,7 @@ TEST(Irbcd, GammaSolvesItsQuadraticAndIsAtLeastOneOverN) {
 TEST(Irbcd, RecurrencesFollowThePaper) {
   IrbcdOptions o;  // sigma 1e-4, a0 = 1/n, b0 = 1
   o.adaptive_sigma = false;
+  o.reset_on_restart = true;
   const double n = 5;
   IrbcdScheme s(o, n);
   EXPECT_DOUBLE_EQ(s.a(), 1.0 / n);
@@ -57,6 +58,34 @@ TEST(Irbcd, RecurrencesFollowThePaper) {
   const double a1 = keep.a();
   keep.restart();
   EXPECT_DOUBLE_EQ(keep.a(), a1);
+}
+
+// Keeping a, b across restarts (the default) relies on gamma staying below its fixed point
+// 1/sqrt(sigma): the momentum a restart keeps is bounded, unlike RBCD++'s growing gamma.
+TEST(Irbcd, KeptGammaIsBoundedByItsFixedPointAndSurvivesARestart) {
+  IrbcdOptions o;
+  o.adaptive_sigma = false;
+  EXPECT_FALSE(o.reset_on_restart);  // the default
+  const double n = 3;
+  IrbcdScheme s(o, n);
+  double prev = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const double g = s.coefficients().gamma;
+    EXPECT_LE(g, 1.0 / std::sqrt(o.sigma) * (1 + 1e-12));
+    EXPECT_GE(g, prev * (1 - 1e-12));  // monotone towards the fixed point (to round-off)
+    prev = g;
+    s.advance();
+  }
+  EXPECT_NEAR(prev, 1.0 / std::sqrt(o.sigma), 1e-3);
+  const MomentumCoefficients before = s.coefficients();
+  s.restart();
+  EXPECT_EQ(s.coefficients().gamma, before.gamma);
+  o.reset_on_restart = true;
+  IrbcdScheme r(o, n);
+  const double gamma0 = r.coefficients().gamma;
+  for (int k = 0; k < 100; ++k) r.advance();
+  r.restart();
+  EXPECT_EQ(r.coefficients().gamma, gamma0);
 }
 
 // Adaptive sigma (docs/irbcd.md section 12). sigma 1e-2 with n = 2 puts gamma's fixed point

@@ -30,8 +30,15 @@ struct IrbcdOptions {
   bool unselected_take_extrapolation = true;
   /// c1 of the restart rule; < 0 disables restarts.
   double restart_c = 0.0;
-  /// After a restart, reset a and b to a0, b0 (else keep the recurrences running).
-  bool reset_on_restart = true;
+  /// After a restart, reset a and b to a0, b0 (true: as RBCD++ resets its gamma), or keep the
+  /// recurrences running (false, the default since session 5). Keeping is safe only because
+  /// sigma > 0 bounds gamma by 1/sqrt(sigma) (RBCD++'s gamma would grow without bound): the
+  /// restart still discards the round and sets V := Y, but the momentum schedule is not thrown
+  /// away. Rounds to 0.01 at main 098acb3, keep / reset: CSAIL 100/114, intel 74/87,
+  /// sphere2500 107/131, city10000 111/134, torus3D 91/103, grid 8000 66/75, kitti_02
+  /// 1424/1578, ais2klinik 842/919, manhattan3500 172/181, garage 25/25, cubicle 173/166
+  /// (docs/irbcd.md section 12).
+  bool reset_on_restart = false;
 
   /// Adaptive sigma (ours, not the paper's; docs/irbcd.md section 13). sigma is the
   /// strong-convexity estimate of Nesterov's ACDM, whose gamma settles at 1/sqrt(sigma). Two
