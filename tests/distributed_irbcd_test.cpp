@@ -95,6 +95,7 @@ IrbcdOptions adaptive_options() {
   o.sigma = 1e-2;
   o.adaptive_sigma = true;
   o.sigma_max = 1e-1;
+  o.reset_on_restart = true;  // the restart test checks the reset too
   return o;
 }
 
