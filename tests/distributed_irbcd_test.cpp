@@ -88,7 +88,7 @@ TEST(Irbcd, KeptGammaIsBoundedByItsFixedPointAndSurvivesARestart) {
   EXPECT_EQ(r.coefficients().gamma, gamma0);
 }
 
-// Adaptive sigma (docs/irbcd.md section 12). sigma 1e-2 with n = 2 puts gamma's fixed point
+// Adaptive sigma (docs/irbcd.md section 13). sigma 1e-2 with n = 2 puts gamma's fixed point
 // 1/sqrt(sigma) = 10 within a few dozen rounds.
 IrbcdOptions adaptive_options() {
   IrbcdOptions o;

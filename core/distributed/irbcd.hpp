@@ -37,7 +37,7 @@ struct IrbcdOptions {
   /// away. Rounds to 0.01 at main 098acb3, keep / reset: CSAIL 100/114, intel 74/87,
   /// sphere2500 107/131, city10000 111/134, torus3D 91/103, grid 8000 66/75, kitti_02
   /// 1424/1578, ais2klinik 842/919, manhattan3500 172/181, garage 25/25, cubicle 173/166
-  /// (docs/irbcd.md section 12).
+  /// (docs/irbcd.md section 13).
   bool reset_on_restart = false;
 
   /// Adaptive sigma (ours, not the paper's; docs/irbcd.md section 13). sigma is the
