@@ -9,6 +9,7 @@
 #include <random>
 
 #include "partition/graph_structure.hpp"
+#include "partition/light_block.hpp"
 #include "partition/multilevel.hpp"
 #include "partition/partition_metrics.hpp"
 #include "partition/partitioner.hpp"
@@ -329,4 +330,52 @@ TEST(MultilevelCycle, LargeCoarseRelaxationIsRepairedUnderATightBound) {
     differing += tight != relaxed ? 1 : 0;
   }
   EXPECT_GT(differing, 0);
+}
+
+// light_block_bounds lowers exactly one block's bound to the requested share of the average,
+// raises it where the other blocks could not hold the rest, and never exceeds the input bound.
+TEST(LightBlock, BoundsForceOneBlockLightAndStayFeasible) {
+  const std::vector<long long> ub(5, 2100);  // rim: n = 10195, eps 0.03
+  const long long total = 10195;
+  const std::vector<long long> lub = light_block_bounds(ub, total, 2, 0.92);
+  for (int b = 0; b < 5; ++b) {
+    if (b != 2) {
+      EXPECT_EQ(lub[b], 2100) << "block " << b;
+    }
+  }
+  EXPECT_EQ(lub[2], static_cast<long long>(std::floor(0.92 * 2039.0)));  // 1875
+  // 0.5 x the average would leave 10195 - 4 x 2100 = 1795 poses for block 2 plus a margin of
+  // 1 % of the average (20): raised to 1815.
+  EXPECT_EQ(light_block_bounds(ub, total, 2, 0.5)[2], 1815);
+  // Never above the input bound.
+  EXPECT_EQ(light_block_bounds(ub, total, 0, 1.2)[0], 2100);
+}
+
+// A multilevel partition and a V-cycle under light-block bounds respect them (so they respect
+// the uniform bound too), the light block really is lighter than the uniform bound allows, and
+// a V-cycle of that partition under the uniform bound is never worse than it.
+TEST(LightBlock, MultilevelRunsRespectTheLightBound) {
+  const GraphStructure structure = pose_like_graph(3000, 23);
+  const WorkGraph g = to_work_graph(structure);
+  const int k = 5;
+  const std::vector<long long> ub = uniform_bounds(structure, k, 0.03);
+  const CycleParams cp = relaxed_cycle(ub[0], 0.0);
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    Rng rng(seed);
+    const std::vector<int> start = multilevel_partition(g, k, ub, cp, rng);
+    const std::vector<long long> lub = random_light_bounds(g, start, ub, 0.88, 0.9, rng);
+    int light = -1;
+    for (int b = 0; b < k; ++b)
+      if (lub[b] < ub[b]) light = b;
+    ASSERT_GE(light, 0) << "one block must get a lower bound";
+    EXPECT_LE(lub[light], static_cast<long long>(0.9 * 3000 / k) + 1);
+
+    const std::vector<int> fresh = multilevel_partition(g, k, lub, cp, rng);
+    expect_within(g, fresh, k, lub);
+    const std::vector<int> pushed = guided_cycle(g, k, lub, start, start, cp, rng);
+    expect_within(g, pushed, k, lub);
+    const std::vector<int> back = guided_cycle(g, k, ub, pushed, pushed, cp, rng);
+    expect_within(g, back, k, ub);
+    EXPECT_LE(edge_cut(g, back), edge_cut(g, pushed)) << "seed " << seed;
+  }
 }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "partition/light_block.hpp"
+
 namespace tessera::partition_detail {
 namespace {
 
@@ -98,9 +100,20 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
     for (const auto& ind : pop) b = std::min(b, ind.cut);
     return b;
   };
+  // A fresh partition, with probability light_share under bounds that keep one block light
+  // (which one and how light is drawn relative to `like`, e.g. the parent it will combine with).
+  auto fresh_partition = [&](const std::vector<int>* like) {
+    if (params.light_share > 0.0 && rng.uniform() < params.light_share) {
+      const std::vector<int> none(static_cast<std::size_t>(g.n), 0);
+      const std::vector<long long> lub =
+          random_light_bounds(g, like ? *like : none, ub, params.light_min, params.light_max, rng);
+      return multilevel_partition(g, k, lub, varied(params, rng), rng);
+    }
+    return multilevel_partition(g, k, ub, varied(params, rng), rng);
+  };
   auto fresh_individual = [&] {
     Individual ind;
-    ind.part = multilevel_partition(g, k, ub, varied(params, rng), rng);
+    ind.part = fresh_partition(nullptr);
     ind.cut = edge_cut(g, ind.part);
     for (int c = 0; c < params.vcycles; ++c)
       ind = vcycle(g, k, ub, std::move(ind), varied(params, rng), rng);
@@ -118,14 +131,22 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
     ++steps;
     ++stalled;
     Individual child;
-    if (params.cross_share > 0.0 && stalled > params.cross_after_stall &&
-        rng.uniform() < params.cross_share) {
+    if (params.light_cycle_share > 0.0 && rng.uniform() < params.light_cycle_share) {
+      const Individual& a = pop[tournament(pop, rng, -1)];
+      const std::vector<long long> lub =
+          random_light_bounds(g, a.part, ub, params.light_min, params.light_max, rng);
+      Individual pushed;
+      pushed.part = guided_cycle(g, k, lub, a.part, a.part, varied(params, rng), rng);
+      pushed.cut = edge_cut(g, pushed.part);
+      child = vcycle(g, k, ub, std::move(pushed), varied(params, rng), rng);
+    } else if (params.cross_share > 0.0 && stalled > params.cross_after_stall &&
+               rng.uniform() < params.cross_share) {
       child = cross_combine(g, k, ub, pop[tournament(pop, rng, -1)], varied(params, rng), rng);
     } else if (rng.uniform() < params.mutation_rate) {
       // Mutation: combine an individual with a fresh multilevel partition.
       const int a = tournament(pop, rng, -1);
       Individual fresh;
-      fresh.part = multilevel_partition(g, k, ub, varied(params, rng), rng);
+      fresh.part = fresh_partition(&pop[a].part);
       fresh.cut = edge_cut(g, fresh.part);
       child = combine(g, k, ub, pop[a], fresh, varied(params, rng), rng);
     } else {

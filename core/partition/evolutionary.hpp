@@ -23,12 +23,21 @@ struct EvolutionParams {
   /// instead of the label propagation of `cycle`: the two give differently shaped hierarchies,
   /// and mixing them keeps the population diverse (0 = always `cycle`'s coarsening).
   double matching_share = 0.0;
-  int matching_flow_levels = 1;
+  int matching_flow_levels = 1;  ///< flow_levels of the operations that coarsen by matching.
   /// Share of steps that cross-combine a tournament winner with a fresh partition into another
   /// number of blocks (KaFFPaE's cross combine) instead of a combine or mutation.
   double cross_share = 0.0;
   /// Cross combines only start once this many steps in a row found no new best cut.
-  int cross_after_stall = 0;  ///< flow_levels of the operations that coarsen by matching.
+  int cross_after_stall = 0;
+  /// Share of fresh partitions (initial population and mutations) built under bounds that force
+  /// one block to be light (light_block.hpp); the search then also starts from shapes with one
+  /// light block and the others at the bound, which the uniform bound rarely reaches.
+  double light_share = 0.0;
+  /// Share of steps that instead V-cycle a tournament winner under such bounds and then once
+  /// more under the real bounds (a perturbation towards a light block).
+  double light_cycle_share = 0.0;
+  double light_min = 0.88;  ///< Range of the light block's bound, as a fraction of the
+  double light_max = 0.98;  ///< average block weight (raised where infeasible).
   CycleParams cycle;
 };
 

@@ -165,6 +165,10 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_STALL")) plan.evolution.stall_limit = std::atoi(env("T_STALL"));
   if (env("T_XSTALL")) plan.evolution.cross_after_stall = std::atoi(env("T_XSTALL"));
   if (env("T_CROSS")) plan.evolution.cross_share = std::atof(env("T_CROSS"));
+  if (env("T_LIGHT")) plan.evolution.light_share = std::atof(env("T_LIGHT"));
+  if (env("T_LCYC")) plan.evolution.light_cycle_share = std::atof(env("T_LCYC"));
+  if (env("T_LMIN")) plan.evolution.light_min = std::atof(env("T_LMIN"));
+  if (env("T_LMAX")) plan.evolution.light_max = std::atof(env("T_LMAX"));
   if (env("T_MFLEV")) plan.evolution.matching_flow_levels = std::atoi(env("T_MFLEV"));
   if (env("T_OPS"))
     plan.evolution.generations =
