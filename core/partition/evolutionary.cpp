@@ -125,13 +125,18 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
           std::to_string(pop.size()) + " multilevel runs + " + std::to_string(params.vcycles) +
               " V-cycles each",
           best_cut());
-  int improved = 0, steps = 0, stalled = 0;
-  for (int gen = 0; gen < params.generations && pop.size() > 1 && stalled < params.stall_limit;
-       ++gen) {
+  int improved = 0, steps = 0, stalled = 0, tail = -1;  // tail: light-only steps left (-1: off)
+  for (int gen = 0; gen < params.generations && pop.size() > 1 && tail != 0; ++gen) {
+    if (tail < 0 && stalled >= params.stall_limit) {
+      if (params.light_tail <= 0) break;
+      tail = params.light_tail;
+    }
+    if (tail > 0) --tail;
     ++steps;
     ++stalled;
     Individual child;
-    if (params.light_cycle_share > 0.0 && rng.uniform() < params.light_cycle_share) {
+    if (tail >= 0 || (params.light_cycle_share > 0.0 && stalled > params.light_after_stall &&
+                      rng.uniform() < params.light_cycle_share)) {
       const Individual& a = pop[tournament(pop, rng, -1)];
       const std::vector<long long> lub =
           random_light_bounds(g, a.part, ub, params.light_min, params.light_max, rng);

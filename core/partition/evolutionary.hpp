@@ -36,6 +36,12 @@ struct EvolutionParams {
   /// Share of steps that instead V-cycle a tournament winner under such bounds and then once
   /// more under the real bounds (a perturbation towards a light block).
   double light_cycle_share = 0.0;
+  int light_after_stall = 0;  ///< Light-block V-cycles only start after this many stalled steps.
+  /// When the search stops on the stall limit before its step budget is spent, up to this many
+  /// more steps (within the budget) are light-block V-cycles only: the unused budget goes into
+  /// pushing the converged population towards one-light-block shapes. Until then the search
+  /// runs exactly as without it, and the best cut can only get better.
+  int light_tail = 0;
   double light_min = 0.88;  ///< Range of the light block's bound, as a fraction of the
   double light_max = 0.98;  ///< average block weight (raised where infeasible).
   CycleParams cycle;

@@ -126,6 +126,15 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // after a stall it keeps both (docs/partitioning.md).
         plan.evolution.cross_share = strong ? 0.0 : 0.3;
         plan.evolution.cross_after_stall = 8;
+        // highest: when the search stalls before its budget is spent, up to 40 more steps push
+        // tournament winners towards one light block (a V-cycle under bounds that keep that
+        // block at 0.88-0.98 of the average, then one under the real bounds). The best known
+        // cuts mostly have one light block and the others at the bound (rim 2100 2096 1867 2032
+        // 2100). Light steps mixed into the whole search (20 %) found sphere2500 179 but lost
+        // city10000/grid3D at seed 1; as a tail the search before it is unchanged (session 5,
+        // seeds 1-3: torus3D 242/240/242 instead of 242/241/243, rim 258/266/243 instead of
+        // 260/266/243; docs/partitioning.md).
+        plan.evolution.light_tail = strong ? 0 : 40;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
         // bound on every level the coarse searches rarely reach such shapes (session 4, seeds
@@ -167,6 +176,8 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_CROSS")) plan.evolution.cross_share = std::atof(env("T_CROSS"));
   if (env("T_LIGHT")) plan.evolution.light_share = std::atof(env("T_LIGHT"));
   if (env("T_LCYC")) plan.evolution.light_cycle_share = std::atof(env("T_LCYC"));
+  if (env("T_LSTALL")) plan.evolution.light_after_stall = std::atoi(env("T_LSTALL"));
+  if (env("T_LTAIL")) plan.evolution.light_tail = std::atoi(env("T_LTAIL"));
   if (env("T_LMIN")) plan.evolution.light_min = std::atof(env("T_LMIN"));
   if (env("T_LMAX")) plan.evolution.light_max = std::atof(env("T_LMAX"));
   if (env("T_MFLEV")) plan.evolution.matching_flow_levels = std::atoi(env("T_MFLEV"));
