@@ -171,17 +171,20 @@ WatchedRun secured_run_is_watched_safely(const std::string& dir, const std::stri
   return result;
 }
 
+// The run's CA with 3 agents, an observer "monitor" and a participant "nosy" without
+// permission in `sec`; a second CA ("Another CA") with its own 3 agents and observer in `other`.
+bool make_run_and_foreign_identities(const std::string& sec, const std::string& other) {
+  return run_command(kMakeIdentities + " " + sec + " 3 --observer monitor --no-permission nosy",
+                     nullptr) == 0 &&
+         run_command(kMakeIdentities + " " + other + " 3 --ca-name 'Another CA' --observer monitor",
+                     nullptr) == 0;
+}
+
 TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
   if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
   const std::string dir = temp_dir();
   const std::string sec = dir + "/sec", other = dir + "/other";
-  ASSERT_EQ(run_command(kMakeIdentities + " " + sec + " 3 --observer monitor --no-permission nosy",
-                        nullptr),
-            0);
-  ASSERT_EQ(
-      run_command(kMakeIdentities + " " + other + " 3 --ca-name 'Another CA' --observer monitor",
-                  nullptr),
-      0);
+  ASSERT_TRUE(make_run_and_foreign_identities(sec, other));
   const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 5));
   // Fast DDS 2.9 sometimes never completes one pair's PKI-DH handshake (about one secured
   // run in ten with 3 agents, one in two with 5, more under load; docs/dds-runtime.md,
@@ -201,13 +204,7 @@ TEST(DdsSecurity, AgentsThatRecreateTheirParticipantFinishUnreadByOutsiders) {
   if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
   const std::string dir = temp_dir();
   const std::string sec = dir + "/sec", other = dir + "/other";
-  ASSERT_EQ(run_command(kMakeIdentities + " " + sec + " 3 --observer monitor --no-permission nosy",
-                        nullptr),
-            0);
-  ASSERT_EQ(
-      run_command(kMakeIdentities + " " + other + " 3 --ca-name 'Another CA' --observer monitor",
-                  nullptr),
-      0);
+  ASSERT_TRUE(make_run_and_foreign_identities(sec, other));
   const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 5));
   const WatchedRun run =
       secured_run_is_watched_safely(dir, sec, other, graph, 72, {}, /*forced_agent=*/2,
