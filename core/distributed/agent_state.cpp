@@ -5,8 +5,25 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace tessera {
+
+namespace {
+
+// The rows of X (and of `also`, when it has entries) that are non-zero somewhere: the rows a
+// lifted point actually uses.
+std::vector<Eigen::Index> nonzero_rows(const Eigen::MatrixXd& X, const Eigen::MatrixXd& also) {
+  Eigen::Array<bool, Eigen::Dynamic, 1> nonzero = (X.array() != 0.0).rowwise().any();
+  if (also.size() > 0) nonzero = nonzero || (also.array() != 0.0).rowwise().any();
+  std::vector<Eigen::Index> rows;
+  rows.reserve(static_cast<std::size_t>(X.rows()));
+  for (Eigen::Index k = 0; k < X.rows(); ++k)
+    if (nonzero(k)) rows.push_back(k);
+  return rows;
+}
+
+}  // namespace
 
 AgentState::AgentState(int id, int d, const BlockLayout& layout,
                        const std::vector<Measurement>& measurements, const Eigen::MatrixXd& Y0,
@@ -35,13 +52,8 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
   // with N = 5 spent 2 s more CPU in set-up analysing tangent factors it could not use).
   const BlockPreconditioner& q = euclidean();
   if (options.precondition && options.tangent_preconditioner && !q.block_diagonal()) {
-    const Eigen::Array<bool, Eigen::Dynamic, 1> nonzero = (Y0.array() != 0.0).rowwise().any();
-    if (nonzero.count() == d) {
-      std::vector<Eigen::Index> rows;
-      for (Eigen::Index k = 0; k < Y0.rows(); ++k)
-        if (nonzero(k)) rows.push_back(k);
-      build_tangent(Y0(rows, Eigen::all), options);
-    }
+    const std::vector<Eigen::Index> rows = nonzero_rows(Y0, Eigen::MatrixXd());
+    if (static_cast<int>(rows.size()) == d) build_tangent(Y0(rows, Eigen::all), options);
   }
   if (q.block_diagonal()) tangent_tried_ = true;  // never build it later either
 }
@@ -107,13 +119,7 @@ void AgentState::absorb(const PoseBlockMessage& m, Eigen::MatrixXd& copy) const 
 
 void AgentState::set_point(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours) {
   // Active rows: non-zero somewhere in the block or in the neighbours' poses.
-  const Eigen::Index r = X.rows();
-  Eigen::Array<bool, Eigen::Dynamic, 1> nonzero = (X.array() != 0.0).rowwise().any();
-  if (neighbours.size() > 0) nonzero = nonzero || (neighbours.array() != 0.0).rowwise().any();
-  std::vector<Eigen::Index> rows;
-  rows.reserve(static_cast<std::size_t>(r));
-  for (Eigen::Index k = 0; k < r; ++k)
-    if (nonzero(k)) rows.push_back(k);
+  std::vector<Eigen::Index> rows = nonzero_rows(X, neighbours);
   if (rows.empty()) rows.push_back(0);  // all zero (not a manifold point): keep one row
   const bool same_rows = rows == rows_;
   rows_ = std::move(rows);
@@ -163,7 +169,10 @@ Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::Matri
   // The tangent factor needs rank-d points (docs/irbcd.md section 12): the active rows of a
   // lifted start. After a saddle escape (every row active), when its factor would be too large
   // or fails, the Q_BB factor is used.
-  const Eigen::MatrixXd Xa = active_part(X0);
+  // Every row active (r = d, or after a saddle escape): work on X0 itself, no copy of it.
+  const bool all_rows = static_cast<Eigen::Index>(rows_.size()) == X0.rows();
+  const Eigen::MatrixXd active_copy = all_rows ? Eigen::MatrixXd() : active_part(X0);
+  const Eigen::MatrixXd& Xa = all_rows ? X0 : active_copy;
   BlockPreconditioner* euclid = nullptr;
   const TangentPreconditioner* tangent = nullptr;
   if (options.precondition) {
@@ -174,12 +183,11 @@ Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::Matri
       euclid = &euclidean();
   }
   BlockUpdateStats stats;
-  if (static_cast<Eigen::Index>(rows_.size()) == X0.rows()) {
-    updated_X_ =
-        block_update(problem_, X0, options, euclid, &updated_grad_norm_sq_, tangent, &stats);
+  Eigen::MatrixXd Xn =
+      block_update(problem_, Xa, options, euclid, &updated_grad_norm_sq_, tangent, &stats);
+  if (all_rows) {
+    updated_X_ = std::move(Xn);
   } else {
-    const Eigen::MatrixXd Xn =
-        block_update(problem_, Xa, options, euclid, &updated_grad_norm_sq_, tangent, &stats);
     updated_X_ = Eigen::MatrixXd::Zero(X0.rows(), X0.cols());
     updated_X_(rows_, Eigen::all) = Xn;
   }

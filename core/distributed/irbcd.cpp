@@ -110,7 +110,7 @@ void IrbcdScheme::load(const std::vector<double>& state) {
   // 2 values: a snapshot from before adaptive sigma existed (sigma was the option's).
   if (state.size() != 2 && state.size() != 3)
     throw std::runtime_error("IrbcdScheme: saved state has " + std::to_string(state.size()) +
-                             " values, expected 3");
+                             " values, expected 3 (or 2 from an older snapshot)");
   a_ = state[0];
   b_ = state[1];
   sigma_ = state.size() == 3 ? state[2] : options_.sigma;
