@@ -6,7 +6,9 @@
 // - over DDS: agents started WITHOUT --udp-only for a coordinator that keeps replicas
 //   re-create their participant UDP-only before announcing, the coordinator and the other
 //   agents take the new participant for the old one (no "lost", no "two processes claim"),
-//   and the run finishes; with a plain coordinator nothing is re-created.
+//   and the run finishes; with a plain coordinator nothing is re-created;
+// - secured runs count a participant's name and tags only once its handshake is authorized
+//   (peer tracking and the gate), so an outsider advertising a member's name decides nothing.
 // Domains 74-75.
 
 #include <gtest/gtest.h>
@@ -18,6 +20,7 @@
 #include "dds_process_support.hpp"
 #include "transport/participant_tags.hpp"
 #include "transport/peer_gate.hpp"
+#include "transport/peer_tracking.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::test::dds {
@@ -140,6 +143,130 @@ TEST(PeerGate, SecuredRunsWaitForEveryHandshakeAndOneSideOfAStalledPairReopens) 
                   stall)
           .kind,
       GateStep::kWait);
+}
+
+// Impostors (unauthenticated participants advertising a member's name, as anyone can in
+// plaintext SPDP data) next to the real, authenticated members: they neither hold the gate
+// nor move the agent to UDP only.
+TEST(PeerGate, SecuredRunsIgnoreUnauthenticatedClaimantsOfAnAuthenticatedRole) {
+  using transport::judge_peers;
+  const double stall = 4;
+  const std::vector<PeerView> real = {view(true, 0, 1, true), view(false, 0, 1, true),
+                                      view(false, 2, 1, true)};
+  std::vector<PeerView> with_impostors = {view(true, 0, 60, false, /*udp_only=*/true),
+                                          view(false, 0, 60, false), view(false, 2, 60, false)};
+  with_impostors.insert(with_impostors.end(), real.begin(), real.end());
+  EXPECT_EQ(judge_peers(agent_options(1), true, with_impostors, stall).kind, GateStep::kPass);
+  // Only an unauthenticated coordinator that says "UDP only": no re-creation for its tag; its
+  // handshake is judged like any other (stalled after 60 s).
+  GateStep s = judge_peers(
+      agent_options(1), true,
+      {view(true, 0, 60, false, true), view(false, 0, 1, true), view(false, 2, 1, true)}, stall);
+  EXPECT_EQ(s.kind, GateStep::kReopenStalled);
+  EXPECT_EQ(s.why, "the coordinator");
+  // Two unauthenticated claimants: stalled only when the most recent one is (a real peer
+  // discovered 1 s ago may still finish its handshake).
+  s = judge_peers(agent_options(1), true,
+                  {view(true, 0, 1, true), view(false, 0, 60, false), view(false, 0, 1, false),
+                   view(false, 2, 1, true)},
+                  stall);
+  EXPECT_EQ(s.kind, GateStep::kWait);
+  EXPECT_NE(s.why.find("agent 0 (not authenticated yet)"), std::string::npos) << s.why;
+}
+
+transport::GuidPrefix prefix_of_byte(unsigned char b) {
+  transport::GuidPrefix p;
+  p.value[0] = b;
+  return p;
+}
+
+// What a secured process counts from discovery: a participant's name, tags and leaving only
+// once Fast DDS reported its handshake authorized (either order); a second *authenticated*
+// claimant of a role is still a clash.
+TEST(PeerTracking, SecuredRunsCountANameOnlyFromAnAuthenticatedParticipant) {
+  transport::Mailroom room;
+  transport::SessionOptions o = agent_options(1);
+  o.security_dir = "/unused";  // only whether it is set matters to the tracker
+  transport::PeerTracker t(room, o, PeerIdentity{"gate", false, 1});
+  const PeerIdentity agent0{"gate", false, 0}, coord{"gate", true, 0}, me{"gate", false, 1};
+  t.discovered(prefix_of_byte(1), agent0);
+  EXPECT_TRUE(t.live_peers().empty()) << "counted before its handshake";
+  t.authenticated(prefix_of_byte(1));
+  ASSERT_EQ(t.live_peers().size(), 1u);
+  // Impostors: agent 0's name with tags that would replace it and say "UDP only", this
+  // process's own name, the coordinator's name; then they change their tags and leave.
+  ParticipantTags evil;
+  evil.udp_only = true;
+  evil.replaces = {transport::prefix_text(prefix_of_byte(1))};
+  t.discovered(prefix_of_byte(2), agent0, evil);
+  t.discovered(prefix_of_byte(3), me);
+  t.discovered(prefix_of_byte(4), coord, evil);
+  ParticipantTags retiring;
+  retiring.retiring = true;
+  t.changed(prefix_of_byte(2), retiring);
+  t.left(prefix_of_byte(2));
+  t.dropped(prefix_of_byte(3));
+  EXPECT_FALSE(room.stopped()) << room.stop_info()->reason;
+  ASSERT_EQ(t.live_peers().size(), 1u);
+  EXPECT_EQ(t.live_peers()[0].describe(), agent0.describe());
+  EXPECT_TRUE(t.lost_agents().empty());
+  // The gate still sees the remaining candidate, unauthenticated, behind the members.
+  std::vector<PeerView> views = t.peer_views(true);
+  ASSERT_EQ(views.size(), 2u);
+  EXPECT_TRUE(views[0].authenticated);
+  EXPECT_FALSE(views[1].authenticated);
+  EXPECT_TRUE(views[1].who.coordinator);
+  // The real coordinator, authorized before its discovery is reported: counted at discovery.
+  t.authenticated(prefix_of_byte(5));
+  t.discovered(prefix_of_byte(5), coord);
+  EXPECT_EQ(t.live_peers().size(), 2u);
+  EXPECT_FALSE(room.stopped());
+  // A second participant that authenticates with agent 0's name: a real clash.
+  t.discovered(prefix_of_byte(6), agent0);
+  EXPECT_FALSE(room.stopped());
+  t.authenticated(prefix_of_byte(6));
+  ASSERT_TRUE(room.stopped());
+  EXPECT_EQ(room.stop_info()->exit_code, 2);
+  EXPECT_NE(room.stop_info()->reason.find("two processes claim to be agent 0"), std::string::npos)
+      << room.stop_info()->reason;
+}
+
+TEST(PeerTracking, AnAuthenticatedMemberThatLeavesIsLostAndItsSuccessorReplacesIt) {
+  transport::Mailroom room;
+  transport::SessionOptions o = agent_options(1);
+  o.security_dir = "/unused";
+  transport::PeerTracker t(room, o, PeerIdentity{"gate", false, 1});
+  const PeerIdentity agent0{"gate", false, 0};
+  t.discovered(prefix_of_byte(1), agent0);
+  t.authenticated(prefix_of_byte(1));
+  // It re-creates its participant: retiring, then the successor (counted once authenticated).
+  ParticipantTags retiring;
+  retiring.retiring = true;
+  t.changed(prefix_of_byte(1), retiring);
+  t.left(prefix_of_byte(1));
+  ParticipantTags next;
+  next.replaces = {transport::prefix_text(prefix_of_byte(1))};
+  t.discovered(prefix_of_byte(2), agent0, next);
+  t.authenticated(prefix_of_byte(2));
+  EXPECT_FALSE(room.stopped()) << room.stop_info()->reason;
+  ASSERT_EQ(t.live_peers().size(), 1u);
+  // The successor's lease expires: that is a loss.
+  t.dropped(prefix_of_byte(2));
+  ASSERT_TRUE(room.stopped());
+  EXPECT_NE(room.stop_info()->reason.find("lost agent 0"), std::string::npos)
+      << room.stop_info()->reason;
+}
+
+TEST(PeerTracking, UnsecuredRunsCountANameAtDiscovery) {
+  transport::Mailroom room;
+  transport::PeerTracker t(room, agent_options(1), PeerIdentity{"gate", false, 1});
+  const PeerIdentity agent0{"gate", false, 0};
+  t.discovered(prefix_of_byte(1), agent0);
+  EXPECT_EQ(t.live_peers().size(), 1u);
+  EXPECT_TRUE(t.peer_views(false)[0].authenticated);
+  t.discovered(prefix_of_byte(2), agent0);
+  ASSERT_TRUE(room.stopped());
+  EXPECT_EQ(room.stop_info()->exit_code, 2);
 }
 
 TEST(PeerGate, OptionsAreChecked) {

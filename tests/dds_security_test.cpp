@@ -4,8 +4,9 @@
 // topics -- read zero samples of a secured run while a permitted read-only identity reads
 // it (so "zero" is not the snoop failing); agents that re-create their participant (the cure
 // for a stalled handshake, forced here) still finish unread; a bad DIR is a clear error
-// naming the file.
-// Domains 193-196 and 72.
+// naming the file; outsiders without identity that advertise a member's name and tags in
+// plaintext discovery data neither stop nor steer a secured run.
+// Domains 193-196, 72 and 42.
 
 #include <gtest/gtest.h>
 
@@ -88,7 +89,8 @@ WatchedRun secured_run_is_watched_safely(const std::string& dir, const std::stri
                                          int domain,
                                          const std::vector<std::string>& agent_extra = {},
                                          int forced_agent = -1,
-                                         const std::vector<std::string>& forced_extra = {}) {
+                                         const std::vector<std::string>& forced_extra = {},
+                                         bool impostors = false) {
   const std::string run = "secure-" + std::to_string(getpid()) + "-" + std::to_string(domain);
   const std::string tag = std::to_string(domain);
   struct Watcher {
@@ -102,6 +104,17 @@ WatchedRun secured_run_is_watched_safely(const std::string& dir, const std::stri
       {"no permission", {"--security", sec, "--identity", "nosy"}, {}},
       {"permitted monitor", {"--security", sec, "--identity", "monitor"}, {}},
   };
+  if (impostors) {
+    // Without identity, under run members' names (plaintext SPDP data), with tags that would
+    // move the agents to UDP only if they counted (tests/dds_peer_gate_test.cpp covers a
+    // "replaces" tag naming a member's real participant).
+    const std::string udp = "tessera-tags;udp_only=1";
+    watchers.push_back(
+        {"impostor of agent 1", {"--name", "tessera:" + run + ":agent:1", "--user-data", udp}, {}});
+    watchers.push_back({"impostor of the coordinator",
+                        {"--name", "tessera:" + run + ":coordinator", "--user-data", udp},
+                        {}});
+  }
   for (auto& w : watchers) {
     std::vector<std::string> argv = {
         bin("tessera-dds-snoop"), "--domain", tag, "--run-id", run, "--duration", "90"};
@@ -228,6 +241,38 @@ TEST(DdsSecurity, AgentsThatRecreateTheirParticipantFinishUnreadByOutsiders) {
   EXPECT_NE(run.agents[2].find("re-creating this participant"), std::string::npos);
   EXPECT_EQ(run.coordinator.find("claim"), std::string::npos) << run.coordinator;
   EXPECT_EQ(run.coordinator.find("lost"), std::string::npos) << run.coordinator;
+  run_command("fastdds shm clean", nullptr);
+}
+
+// Outsiders without identity advertise agent 1's and the coordinator's participant names
+// (and a tag saying "UDP only") from before the run starts to after it ends.
+// Their discovery data is plaintext, so every process sees the names; a secured run counts a
+// name only from an authenticated participant, so the run finishes as usual: no "two
+// processes claim", no "lost", no UDP-only re-creation, one cost, and the impostors (like the
+// other outsiders) read nothing.
+TEST(DdsSecurity, ImpostorsOfMemberNamesNeitherStopNorSteerASecuredRun) {
+  if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
+  const std::string dir = temp_dir();
+  const std::string sec = dir + "/sec", other = dir + "/other";
+  ASSERT_TRUE(make_run_and_foreign_identities(sec, other));
+  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 5));
+  const WatchedRun run =
+      secured_run_is_watched_safely(dir, sec, other, graph, 42, {}, -1, {}, /*impostors=*/true);
+  ASSERT_FALSE(run.stalled) << run.coordinator;
+  ASSERT_EQ(run.agents.size(), 3u);
+  EXPECT_EQ(run.coordinator.find("claim"), std::string::npos) << run.coordinator;
+  EXPECT_EQ(run.coordinator.find("lost"), std::string::npos) << run.coordinator;
+  std::string cost;
+  for (const std::string& out : run.agents) {
+    EXPECT_EQ(out.find("claim"), std::string::npos) << out;
+    EXPECT_EQ(out.find("lost"), std::string::npos) << out;
+    EXPECT_EQ(out.find("UDP only"), std::string::npos) << out;
+    const auto c = out.find(" cost ");
+    ASSERT_NE(c, std::string::npos) << out;
+    const std::string mine = out.substr(c, out.find(',', c) - c);
+    if (cost.empty()) cost = mine;
+    EXPECT_EQ(mine, cost) << out;
+  }
   run_command("fastdds shm clean", nullptr);
 }
 

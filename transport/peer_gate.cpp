@@ -18,15 +18,24 @@ void PeerGateOptions::validate() const {
 
 GateStep judge_peers(const SessionOptions& self, bool secured, const std::vector<PeerView>& peers,
                      double stall_after_s) {
+  // Several participants may carry one role's name (in a secured run anyone can advertise
+  // it): an authenticated one stands for the role; else the most recently discovered one, so
+  // a handshake counts as stalled only when no claimant of the role can still finish it.
   auto find = [&](bool coordinator, std::uint32_t id) -> const PeerView* {
-    for (const PeerView& v : peers)
-      if (v.who.coordinator == coordinator && (coordinator || v.who.agent_id == id)) return &v;
-    return nullptr;
+    const PeerView* best = nullptr;
+    for (const PeerView& v : peers) {
+      if (v.who.coordinator != coordinator || (!coordinator && v.who.agent_id != id)) continue;
+      if (v.authenticated) return &v;
+      if (!best || v.known_for_s < best->known_for_s) best = &v;
+    }
+    return best;
   };
   const PeerView* coordinator = find(true, 0);
   if (!coordinator) return {GateStep::kWait, "the coordinator (not discovered yet)"};
   // Before the handshake check: a UDP-only re-creation starts every handshake afresh anyway.
-  if (coordinator->tags.udp_only && self.shared_memory)
+  // Secured, the tag counts only from the authenticated coordinator (an unauthenticated
+  // participant's name and tags are anyone's to claim).
+  if (coordinator->tags.udp_only && self.shared_memory && (!secured || coordinator->authenticated))
     return {GateStep::kReopenUdpOnly, "the coordinator talks UDP only"};
   if (!secured) return {GateStep::kPass, ""};
   std::vector<PeerIdentity> expected{PeerIdentity{self.run_id, true, 0}};

@@ -10,7 +10,8 @@ PeerTracker::PeerTracker(Mailroom& room, const SessionOptions& options, PeerIden
     : room_(room),
       opt_(options),
       me_(std::move(me)),
-      tolerate_agent_loss_(options.tolerate_agent_loss) {}
+      tolerate_agent_loss_(options.tolerate_agent_loss),
+      secured_(!options.security_dir.empty()) {}
 
 std::string prefix_text(const GuidPrefix& prefix) {
   std::ostringstream os;
@@ -30,6 +31,34 @@ bool PeerTracker::is_own(const GuidPrefix& prefix) const {
 
 void PeerTracker::discovered(const GuidPrefix& prefix, const PeerIdentity& who,
                              const ParticipantTags& tags) {
+  const Clock::time_point now = Clock::now();
+  if (secured_) {
+    // The name and tags are plaintext SPDP data that anyone can send: they count only from a
+    // participant whose handshake completed (authenticated() admits it).
+    const bool admitted = room_.with_lock([&] {
+      if (admitted_.count(prefix)) return true;
+      auto it = candidates_.find(prefix);
+      if (it == candidates_.end())
+        candidates_.emplace(prefix, Candidate{who, tags, now});
+      else {
+        it->second.who = who;
+        it->second.tags = tags;
+      }
+      return false;
+    });
+    if (!admitted) {
+      if (opt_.verbose)
+        std::fprintf(stderr, "%s: discovered a participant named %s (counted once authenticated)\n",
+                     participant_name(me_).c_str(), who.describe().c_str());
+      room_.notify();
+      return;
+    }
+  }
+  admit(prefix, who, tags, now);
+}
+
+void PeerTracker::admit(const GuidPrefix& prefix, const PeerIdentity& who,
+                        const ParticipantTags& tags, Clock::time_point discovered_at) {
   std::string clash, forgotten;
   room_.with_lock([&] {
     if (replaced_.count(prefix_text(prefix))) return 0;  // a replaced participant seen late
@@ -57,7 +86,7 @@ void PeerTracker::discovered(const GuidPrefix& prefix, const PeerIdentity& who,
       clash = who.describe();
     if (who.coordinator && me_.coordinator) clash = who.describe();
     peers_[prefix] = who;
-    discovered_at_.emplace(prefix, std::chrono::steady_clock::now());
+    discovered_at_.emplace(prefix, discovered_at);
     tags_[prefix] = tags;
     return 0;
   });
@@ -74,9 +103,14 @@ void PeerTracker::discovered(const GuidPrefix& prefix, const PeerIdentity& who,
 }
 
 void PeerTracker::changed(const GuidPrefix& prefix, const ParticipantTags& tags) {
-  if (!tags.retiring) return;
   std::string forgotten;
   room_.with_lock([&] {
+    if (secured_ && !admitted_.count(prefix)) {  // a candidate's tags decide nothing yet
+      auto it = candidates_.find(prefix);
+      if (it != candidates_.end()) it->second.tags = tags;
+      return 0;
+    }
+    if (!tags.retiring) return 0;
     replaced_.insert(prefix_text(prefix));
     auto it = peers_.find(prefix);
     if (it == peers_.end()) return 0;
@@ -93,15 +127,29 @@ void PeerTracker::changed(const GuidPrefix& prefix, const ParticipantTags& tags)
 }
 
 void PeerTracker::authenticated(const GuidPrefix& prefix) {
-  room_.with_lock([&] { return authenticated_.insert(prefix).second; });
-  room_.notify();
+  std::optional<Candidate> candidate;
+  room_.with_lock([&] {
+    authenticated_.insert(prefix);
+    if (!admitted_.insert(prefix).second) return 0;
+    auto it = candidates_.find(prefix);
+    if (it != candidates_.end()) {
+      candidate = it->second;
+      candidates_.erase(it);
+    }
+    return 0;
+  });
+  if (candidate)
+    admit(prefix, candidate->who, candidate->tags, candidate->discovered_at);
+  else
+    room_.notify();
 }
 
 void PeerTracker::restart_handshakes() {
   room_.with_lock([&] {
     authenticated_.clear();
-    const auto now = std::chrono::steady_clock::now();
+    const auto now = Clock::now();
     for (auto& [p, at] : discovered_at_) at = now;
+    for (auto& [p, c] : candidates_) c.discovered_at = now;
     return 0;
   });
 }
@@ -149,6 +197,7 @@ void PeerTracker::gone(const GuidPrefix& prefix, const std::string& how, bool gr
   std::optional<PeerIdentity> who;
   bool fatal = false;
   room_.with_lock([&] {
+    candidates_.erase(prefix);  // never authenticated: its leaving means nothing
     if (replaced_.count(prefix_text(prefix))) return 0;  // forgotten: its successor is live
     auto it = peers_.find(prefix);
     if (it != peers_.end() && !lost_.count(prefix)) {
@@ -205,6 +254,14 @@ std::vector<PeerView> PeerTracker::peer_views(bool secured) const {
     v.authenticated = !secured || authenticated_.count(p) > 0;
     auto t = tags_.find(p);
     if (t != tags_.end()) v.tags = t->second;
+    out.push_back(v);
+  }
+  for (const auto& [p, c] : candidates_) {
+    PeerView v;
+    v.who = c.who;
+    v.known_for_s = std::chrono::duration<double>(now - c.discovered_at).count();
+    v.authenticated = false;
+    v.tags = c.tags;
     out.push_back(v);
   }
   return out;

@@ -4,6 +4,14 @@
 // run's work is done) or it is an agent and agent losses are tolerated. Also detects two
 // processes claiming the same role. Internal to transport/; state is guarded by the
 // mailroom's mutex (the *_locked members require it held).
+//
+// In a secured run (SessionOptions::security_dir set) a participant's name and USER_DATA
+// arrive in plaintext SPDP before any handshake, so anyone on the network can advertise a
+// run member's name. Such a participant is only a *candidate* until Fast DDS reports its
+// DDS Security handshake authorized: until then it claims no role (no "two processes
+// claim"), its tags decide nothing (replaces, retiring, udp_only), and its leaving is no
+// loss. The peer gate still sees candidates (unauthenticated PeerViews) to detect a stalled
+// handshake.
 
 #include <chrono>
 #include <fastdds/rtps/common/GuidPrefix_t.hpp>
@@ -40,17 +48,20 @@ class PeerTracker {
   void add_own_prefix(const GuidPrefix& prefix);
   bool is_own(const GuidPrefix& prefix) const;
 
-  /// A participant of this run appeared as `who` with `tags` (its USER_DATA). When the tags
-  /// say it replaces participant P of the same role, P is forgotten silently (no loss, no
-  /// clash; a pending stop for P's clean leave is withdrawn). Otherwise stops the session with
-  /// exit code 2 when another live process already claims the same role (or this process's
-  /// own role).
+  /// A participant of this run appeared as `who` with `tags` (its USER_DATA). In a secured
+  /// run it stays a candidate (see above) until authenticated() admits it; unsecured, or
+  /// once admitted: when the tags say it replaces participant P of the same role, P is
+  /// forgotten silently (no loss, no clash; a pending stop for P's clean leave is withdrawn).
+  /// Otherwise stops the session with exit code 2 when another live process already claims
+  /// the same role (or this process's own role).
   void discovered(const GuidPrefix& prefix, const PeerIdentity& who,
                   const ParticipantTags& tags = {});
   /// The participant `prefix` changed its QoS; with `tags.retiring` it is forgotten silently
   /// (its process is about to replace it: no loss, no stop when it leaves).
   void changed(const GuidPrefix& prefix, const ParticipantTags& tags);
-  /// DDS Security: the handshake with `prefix` completed (authorized).
+  /// DDS Security: the handshake with `prefix` completed (authorized). The first time, a
+  /// candidate of that prefix is admitted as discovered() describes (the report may also
+  /// come before the discovery; then discovered() admits it at once).
   void authenticated(const GuidPrefix& prefix);
   /// This process's participant was replaced: handshakes start afresh (none counts as
   /// authenticated, every peer's age restarts now).
@@ -77,7 +88,8 @@ class PeerTracker {
 
   std::vector<PeerIdentity> live_peers() const;
   /// Every live peer with its age, authentication state (`secured` false: always true) and
-  /// tags.
+  /// tags; in a secured run followed by every candidate (unauthenticated, possibly an
+  /// impostor of a member's name).
   std::vector<PeerView> peer_views(bool secured) const;
   std::size_t peers_ever_seen() const;
   /// Agents discovered and lost, with no live process of the same id since.
@@ -96,6 +108,10 @@ class PeerTracker {
   std::string describe_locked(const GuidPrefix& prefix) const;
 
  private:
+  using Clock = std::chrono::steady_clock;
+  /// The role claim and its consequences (see discovered()), for an admitted participant.
+  void admit(const GuidPrefix& prefix, const PeerIdentity& who, const ParticipantTags& tags,
+             Clock::time_point discovered_at);
   void gone(const GuidPrefix& prefix, const std::string& how, bool graceful);
   std::string left_reason(const PeerIdentity& who) const;
 
@@ -106,12 +122,22 @@ class PeerTracker {
   std::set<GuidPrefix> own_prefixes_;
   std::map<GuidPrefix, PeerIdentity> peers_;  // participants of this run, by GUID prefix
   std::set<GuidPrefix> lost_;
-  std::set<std::string> replaced_;  // prefix_text() of participants replaced by a new one
-  std::set<GuidPrefix> authenticated_;
-  std::map<GuidPrefix, std::chrono::steady_clock::time_point> discovered_at_;
+  std::set<std::string> replaced_;      // prefix_text() of participants replaced by a new one
+  std::set<GuidPrefix> authenticated_;  // handshake done with this process's current participant
+  std::map<GuidPrefix, Clock::time_point> discovered_at_;
+  // Secured runs only: participants seen in discovery but never authenticated, and those
+  // authenticated at least once (by any of this process's participants).
+  struct Candidate {
+    PeerIdentity who;
+    ParticipantTags tags;
+    Clock::time_point discovered_at;
+  };
+  std::map<GuidPrefix, Candidate> candidates_;
+  std::set<GuidPrefix> admitted_;
   std::map<GuidPrefix, ParticipantTags> tags_;
   bool loss_fatal_ = true;
   bool tolerate_agent_loss_ = false;
+  const bool secured_;  // SessionOptions::security_dir set
 };
 
 }  // namespace tessera::transport

@@ -5,7 +5,9 @@
 // With --security DIR --identity NAME it authenticates with DIR/NAME (layout of
 // scripts/security/make_identities.sh); without, it is an unauthenticated participant. Used
 // by tests/dds_security_test.cpp to show that outsiders read nothing from a secured run
-// (and, with a permitted identity, that the same tool does read a run).
+// (and, with a permitted identity, that the same tool does read a run). --name and
+// --user-data set its participant's name and USER_DATA: an impostor advertising a run
+// member's name ("tessera:RUN:agent:1") and tags, as anyone on the network can.
 
 #include <atomic>
 #include <chrono>
@@ -45,6 +47,7 @@ namespace {
 constexpr const char* kHelp =
     "usage: tessera-dds-snoop --domain D [--run-id ID] [--duration S]\n"
     "                         [--security DIR --identity NAME]\n"
+    "                         [--name PARTICIPANT_NAME] [--user-data TEXT]\n"
     "Reads every Tessera topic of run ID (Partition QoS) on domain D and prints how many\n"
     "samples arrived: participants=P readers=R refused=T samples=S topic=count...\n";
 
@@ -119,11 +122,12 @@ int main(int argc, char** argv) {
   SignalWatcher signals;
   std::vector<std::string> argv_list(argv + 1, argv + argc);
   long domain = -1;
-  std::string run = "default", security, identity;
+  std::string run = "default", security, identity, name = "tessera-dds-snoop", user_data;
   double duration = 30;
   try {
-    cli::Arguments args(argv_list, {"domain", "run-id", "duration", "security", "identity"},
-                        {"help"});
+    cli::Arguments args(
+        argv_list, {"domain", "run-id", "duration", "security", "identity", "name", "user-data"},
+        {"help"});
     if (args.has("help")) {
       std::cout << kHelp;
       return 0;
@@ -135,6 +139,9 @@ int main(int argc, char** argv) {
     if (!(duration > 0)) throw InputError("option --duration: must be positive");
     security = args.get_or("security", "");
     identity = args.get_or("identity", "");
+    name = args.get_or("name", name);
+    if (name.empty()) throw InputError("option --name: must not be empty");
+    user_data = args.get_or("user-data", "");
     if (security.empty() != identity.empty())
       throw InputError("options --security and --identity go together");
   } catch (const InputError& e) {
@@ -147,7 +154,9 @@ int main(int argc, char** argv) {
   fdds::DomainParticipantQos pq;
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   factory->get_default_participant_qos(pq);
-  pq.name("tessera-dds-snoop");
+  pq.name(name.c_str());
+  pq.user_data().data_vec(
+      std::vector<eprosima::fastrtps::rtps::octet>(user_data.begin(), user_data.end()));
   try {
     if (!security.empty())
       for (const auto& [k, v] : security_properties(security_files(security, identity)))
