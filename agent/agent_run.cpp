@@ -7,6 +7,7 @@
 #include <iostream>
 #include <thread>
 
+#include "agent/agent_gate.hpp"
 #include "agent/agent_log.hpp"
 #include "agent/block_replication.hpp"
 #include "agent/checkpoint_keeper.hpp"
@@ -43,6 +44,13 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
   if (replication.enabled() && !restart) replication.start(local, channel);
   if (restart) {
     keeper.adopt(restart->snapshots);
+    // Secured: the restarted process's handshakes may stall like a fresh one's; the gate
+    // re-creates its participant if so (nothing was sent yet, so peers just forget the old
+    // one), and meanwhile looks for the assignment that says the run went on without it.
+    if (!s.options().security_dir.empty()) {
+      pass_agent_gate(s, o, [&] { refuse_if_lost(s, o.id); });
+      log("peers known" + std::string(s.options().shared_memory ? "" : " (UDP only)"));
+    }
     const RollbackRequested order = request_rejoin(s, o.id, restart->snapshots, o.net.timeout_s);
     from = prepare_rollback(s, keeper, order, o.net.timeout_s);
     log("rejoined: resuming at round " + std::to_string(order.round) + ", epoch " +

@@ -8,13 +8,13 @@
 #include <utility>
 #include <vector>
 
+#include "agent/agent_gate.hpp"
 #include "agent/dds_channel.hpp"
 #include "agent/handoff_exchange.hpp"
 #include "agent/initialization_stage.hpp"
 #include "agent/local_dump.hpp"
 #include "agent/lost_for_good.hpp"
 #include "agent/robot_data.hpp"
-#include "transport/peer_gate.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
 
@@ -88,21 +88,7 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
   // other process. On the way the participant may be re-created (UDP only when the
   // coordinator's run survives killed agents; a stalled DDS Security handshake): nothing is
   // announced yet, so that is invisible to the run (transport/peer_gate.hpp).
-  PeerGateOptions gate;
-  gate.timeout_s = o.net.timeout_s;
-  gate.stall_after_s = o.handshake_stall_s;
-  gate.max_reopens = o.handshake_retries;
-  const PeerGateResult gated = pass_peer_gate(s, gate);
-  for (const std::string& event : gated.events)
-    std::cerr << agent_tag(o.id) << ": " << event << "\n";
-  expect_ready(gated.status, room, o.net.timeout_s,
-               s.options().security_dir.empty()
-                   ? "the coordinator"
-                   : "the DDS Security handshakes with the other processes",
-               s.peers_ever_seen() == 0
-                   ? "no process of run '" + o.net.session.run_id + "' seen on domain " +
-                         std::to_string(s.domain()) + " (is the coordinator running?)"
-                   : gated.missing);
+  pass_agent_gate(s, o);
   log("peers known" + std::string(s.options().shared_memory ? "" : " (UDP only)"));
 
   // 3. Announce the structure (endpoints only).

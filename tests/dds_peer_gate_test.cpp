@@ -216,6 +216,10 @@ TEST(PeerTracking, SecuredRunsCountANameOnlyFromAnAuthenticatedParticipant) {
   EXPECT_TRUE(views[0].authenticated);
   EXPECT_FALSE(views[1].authenticated);
   EXPECT_TRUE(views[1].who.coordinator);
+  // A candidate that says it retires is no longer waited for (it speaks only for itself).
+  t.changed(prefix_of_byte(4), retiring);
+  EXPECT_EQ(t.peer_views(true).size(), 1u);
+  EXPECT_FALSE(room.stopped());
   // The real coordinator, authorized before its discovery is reported: counted at discovery.
   t.authenticated(prefix_of_byte(5));
   t.discovered(prefix_of_byte(5), coord);

@@ -2,8 +2,10 @@
 // same options rejoins from its checkpoint; every agent rolls back to a common round and the
 // run finishes with the in-process engine's result (same rounds, cost to 1e-9). Without a
 // restart the coordinator gives up after --rejoin-timeout with a message naming the agent.
-// A damaged checkpoint is refused with an error naming the file.
-// Domains used here: 181-183 (each test its own, so ctest -j is safe).
+// A damaged checkpoint is refused with an error naming the file. In a secured run the
+// restarted agent passes the peer gate before it asks to rejoin (a stalled handshake makes it
+// re-create its participant, forced here) and the run still ends at the undisturbed result.
+// Domains used here: 181-183 and 43 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -32,8 +34,13 @@ std::string generate(const std::string& dir, int poses, int robots) {
 struct Fixture {
   std::string dir, graph, run, ckpt;
   int agents, domain;
+  std::vector<std::string> session;       // extra options of every process (--security DIR)
+  std::vector<std::string> agent_extras;  // extra options of every agent
   std::vector<std::string> agent_extra() const {
-    return {"--timeout", "20", "--checkpoint-dir", ckpt};
+    std::vector<std::string> a = {"--timeout", "20", "--checkpoint-dir", ckpt};
+    a.insert(a.end(), session.begin(), session.end());
+    a.insert(a.end(), agent_extras.begin(), agent_extras.end());
+    return a;
   }
   std::vector<std::string> agent_args(int k) const {
     std::vector<std::string> a = dds::agent_args(graph, agents, k, run, domain, agent_extra());
@@ -41,13 +48,25 @@ struct Fixture {
     return a;
   }
   Process coordinator(double rejoin_timeout) const {
-    return start(coordinator_args(agents, run, domain,
-                                  {"--timeout", "20", "--run-timeout", "50", "--summary",
-                                   dir + "/summary.json", "--progress", "--partition", "eco",
-                                   "--init",  // compared with the file's poses in process
-                                   "file", "--grad-tol", "0.002", "--rejoin-timeout",
-                                   std::to_string(rejoin_timeout), "--status-interval", "1"}),
-                 dir + "/coordinator.log");
+    std::vector<std::string> c = {"--timeout",
+                                  "20",
+                                  "--run-timeout",
+                                  "50",
+                                  "--summary",
+                                  dir + "/summary.json",
+                                  "--progress",
+                                  "--partition",
+                                  "eco",
+                                  "--init",  // compared with the file's poses in process
+                                  "file",
+                                  "--grad-tol",
+                                  "0.002",
+                                  "--rejoin-timeout",
+                                  std::to_string(rejoin_timeout),
+                                  "--status-interval",
+                                  "1"};
+    c.insert(c.end(), session.begin(), session.end());
+    return start(coordinator_args(agents, run, domain, c), dir + "/coordinator.log");
   }
 };
 
@@ -104,6 +123,62 @@ TEST(DdsRejoin, KilledAgentRestartedWithSameIdFinishesAtTheUndisturbedCost) {
   EXPECT_NEAR(json_field(summary, "cost"), ref.cost, 1e-9 * ref.cost) << summary;
   // Completed runs leave no checkpoint behind.
   EXPECT_FALSE(std::ifstream(ckpt + "/agent-2.ckpt").good());
+}
+
+TEST(DdsRejoin, SecuredRestartedAgentPassesThePeerGateThenRejoins) {
+  if (run_command("command -v openssl", nullptr) != 0)
+    GTEST_SKIP() << "openssl is not installed, skipping";
+  Fixture f = make_fixture(3, 43, "secrejoin");
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const std::string sec = f.dir + "/sec";
+  ASSERT_EQ(run_command(std::string(TESSERA_SOURCE_DIR) + "/scripts/security/make_identities.sh " +
+                            sec + " 3",
+                        nullptr),
+            0);
+  // UDP only from the start (the coordinator of a rejoin run talks UDP only): the gate's one
+  // re-creation below is then the forced handshake one. Lease 2 s: secured handshakes next to
+  // a loaded machine's other work made 1 s liveliness leases lapse falsely.
+  f.session = {"--security", sec, "--lease", "2"};
+  f.agent_extras = {"--udp-only"};
+
+  Process coord = f.coordinator(20);
+  std::vector<Process> agents =
+      start_agents(f.dir, f.graph, f.agents, f.run, f.domain, f.agent_extra(), true);
+  const bool started = wait_for_output(coord, "round 4:", 40);
+  kill(agents[1].pid, SIGKILL);
+  ASSERT_TRUE(started) << coord.output();
+  ASSERT_TRUE(wait_all({&agents[1]}, 5));
+  // The restarted process judges every handshake unfinished after 1 ms stalled and
+  // re-creates its participant once before asking to rejoin.
+  std::vector<std::string> again_args = f.agent_args(1);
+  again_args.insert(again_args.end(),
+                    {"--handshake-stall", "0.001", "--handshake-retries", "1", "--verbose"});
+  Process again = start(again_args, f.dir + "/agent1-restarted.log");
+
+  std::vector<Process*> all = {&coord, &agents[0], &agents[2], &again};
+  EXPECT_TRUE(wait_all(all, 55)) << "a process hung";
+  for (Process* p : all) EXPECT_EQ(p->exit_code, 0) << p->log << ":\n" << p->output();
+  const std::string out = again.output();
+  EXPECT_NE(out.find("rejoining run"), std::string::npos) << out;
+  EXPECT_NE(out.find("re-creating this participant (1 of at most 1)"), std::string::npos) << out;
+  EXPECT_LT(out.find("re-creating this participant"), out.find("rejoined: resuming at round"))
+      << "the gate comes before the rejoin request\n"
+      << out;
+  const std::string co = coord.output();
+  EXPECT_NE(co.find("agent 1 rejoined: every agent rolls back to round"), std::string::npos) << co;
+  EXPECT_EQ(co.find("claim"), std::string::npos) << co;
+
+  const std::string summary = slurp(f.dir + "/summary.json");
+  EXPECT_EQ(json_field(summary, "rollbacks"), 1) << summary;
+  const PoseGraph g = read_g2o(f.graph);
+  const std::vector<int> assignment = assignment_of(f.dir, f.agents);
+  ASSERT_EQ(assignment.size(), g.num_poses);
+  DistributedOptions opt;
+  opt.grad_norm_tol = 0.002;
+  const DistributedResult ref = solve_distributed(g, assignment, opt, g.initial);
+  EXPECT_EQ(json_field(summary, "rounds"), ref.rounds) << summary;
+  EXPECT_NEAR(json_field(summary, "cost"), ref.cost, 1e-9 * ref.cost) << summary;
+  run_command("fastdds shm clean", nullptr);
 }
 
 TEST(DdsRejoin, AgentThatDoesNotComeBackStopsTheRunAfterTheRejoinTimeout) {

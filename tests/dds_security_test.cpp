@@ -134,8 +134,10 @@ WatchedRun secured_run_is_watched_safely(const std::string& dir, const std::stri
   WatchedRun result;
   bool& stalled = result.stalled;
   if (listening) {
-    const std::vector<std::string> session = {"--run-id",  run,  "--domain",   tag,
-                                              "--timeout", "20", "--security", sec};
+    // Lease 3 s: with the handshakes of 8 secured participants on 2 busy cores a 1 s writer
+    // liveliness lapsed falsely ("lost the coordinator", 1 of 7 looped runs at load 12).
+    const std::vector<std::string> session = {"--run-id",   run, "--domain", tag, "--timeout", "20",
+                                              "--security", sec, "--lease",  "3"};
     std::vector<Process> procs;
     std::vector<std::string> c = {bin("tessera-coordinator"), "--agents", "3"};
     c.insert(c.end(), session.begin(), session.end());
@@ -210,9 +212,10 @@ TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
 
 // The cure for the stalled handshake, forced: with --handshake-stall 0.001 s agent 2 judges
 // every handshake that is not done within a millisecond of discovery stalled and re-creates
-// its participant (once: --handshake-retries 1). The new participant replaces the old one for
-// every peer (no "lost", no "two processes claim"), the run finishes, every agent reports the
-// same cost, and the outsiders still read nothing.
+// its participant (once: --handshake-retries 1; other agents only re-create to cure a real
+// stall). The new participant replaces the old one for every peer (no "lost", no "two
+// processes claim"), the run finishes, every agent reports the same cost, and the outsiders
+// still read nothing.
 TEST(DdsSecurity, AgentsThatRecreateTheirParticipantFinishUnreadByOutsiders) {
   if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
   const std::string dir = temp_dir();
@@ -224,12 +227,22 @@ TEST(DdsSecurity, AgentsThatRecreateTheirParticipantFinishUnreadByOutsiders) {
                                     {"--handshake-stall", "0.001", "--handshake-retries", "1"});
   ASSERT_FALSE(run.stalled) << run.coordinator;
   ASSERT_EQ(run.agents.size(), 3u);
-  std::size_t recreated = 0;
+  auto count = [](const std::string& out, const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = out.find(what); at != std::string::npos; at = out.find(what, at + 1)) ++n;
+    return n;
+  };
   std::string cost;
-  for (const std::string& out : run.agents) {
-    for (auto at = out.find("re-creating this participant"); at != std::string::npos;
-         at = out.find("re-creating this participant", at + 1))
-      ++recreated;
+  for (std::size_t k = 0; k < run.agents.size(); ++k) {
+    const std::string& out = run.agents[k];
+    // Agent 2 is forced exactly once (its retries are 1). The others re-create only as the
+    // cure of a handshake really unfinished after the default 4 s (seen at load 12: agent 0
+    // with the coordinator), never for another reason.
+    const std::size_t recreated = count(out, "re-creating this participant");
+    if (k == 2)
+      EXPECT_EQ(recreated, 1u) << "agent 2 re-creates its participant exactly once\n" << out;
+    else
+      EXPECT_EQ(recreated, count(out, "unfinished after 4 s")) << out;
     EXPECT_EQ(out.find("lost"), std::string::npos) << out;
     const auto c = out.find(" cost ");
     ASSERT_NE(c, std::string::npos) << out;
@@ -237,8 +250,6 @@ TEST(DdsSecurity, AgentsThatRecreateTheirParticipantFinishUnreadByOutsiders) {
     if (cost.empty()) cost = mine;
     EXPECT_EQ(mine, cost) << out;
   }
-  EXPECT_EQ(recreated, 1u) << "agent 2 re-creates its participant exactly once";
-  EXPECT_NE(run.agents[2].find("re-creating this participant"), std::string::npos);
   EXPECT_EQ(run.coordinator.find("claim"), std::string::npos) << run.coordinator;
   EXPECT_EQ(run.coordinator.find("lost"), std::string::npos) << run.coordinator;
   run_command("fastdds shm clean", nullptr);

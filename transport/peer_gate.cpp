@@ -61,7 +61,8 @@ GateStep judge_peers(const SessionOptions& self, bool secured, const std::vector
   return {GateStep::kWait, missing};
 }
 
-PeerGateResult pass_peer_gate(Session& s, const PeerGateOptions& o) {
+PeerGateResult pass_peer_gate(Session& s, const PeerGateOptions& o,
+                              const std::function<void()>& on_poll) {
   o.validate();
   PeerGateResult r;
   const auto deadline = std::chrono::steady_clock::now() + Seconds(o.timeout_s);
@@ -69,6 +70,7 @@ PeerGateResult pass_peer_gate(Session& s, const PeerGateOptions& o) {
   // Looks again every 0.2 s, or more often for a short stall bound (a stall is a duration).
   const Seconds poll(std::clamp(o.stall_after_s / 2, 0.001, 0.2));
   for (;;) {
+    if (on_poll) on_poll();
     const GateStep step = judge_peers(s.options(), secured, s.peer_views(), o.stall_after_s);
     if (step.kind == GateStep::kPass) {
       r.status = WaitStatus::kReady;

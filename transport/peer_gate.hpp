@@ -14,6 +14,7 @@
 // Nothing was announced yet, so a re-created participant is invisible to the run except that
 // peers forget the old one (ParticipantTags::replaces) instead of treating it as lost.
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -61,9 +62,11 @@ struct PeerGateResult {
   std::vector<std::string> events;  ///< One line per re-creation (for the agent's log).
 };
 
-/// Runs the gate on `session` (an agent's, before its announcement). Polls every 0.2 s, or
-/// every stall_after_s / 2 when that is shorter (at least 1 ms; the
-/// stall bound is a duration, not an event); a stop of the run ends it at once.
-PeerGateResult pass_peer_gate(Session& session, const PeerGateOptions& options);
+/// Runs the gate on `session` (an agent's, before its announcement or its rejoin request).
+/// Polls every 0.2 s, or every stall_after_s / 2 when that is shorter (at least 1 ms; the
+/// stall bound is a duration, not an event); a stop of the run ends it at once. `on_poll`
+/// (optional) runs before every look; what it throws ends the gate.
+PeerGateResult pass_peer_gate(Session& session, const PeerGateOptions& options,
+                              const std::function<void()>& on_poll = {});
 
 }  // namespace tessera::transport

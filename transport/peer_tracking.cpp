@@ -107,7 +107,13 @@ void PeerTracker::changed(const GuidPrefix& prefix, const ParticipantTags& tags)
   room_.with_lock([&] {
     if (secured_ && !admitted_.count(prefix)) {  // a candidate's tags decide nothing yet
       auto it = candidates_.find(prefix);
-      if (it != candidates_.end()) it->second.tags = tags;
+      if (it != candidates_.end()) {
+        // Retiring speaks only for itself: the gate stops waiting for this participant.
+        if (tags.retiring)
+          candidates_.erase(it);
+        else
+          it->second.tags = tags;
+      }
       return 0;
     }
     if (!tags.retiring) return 0;
