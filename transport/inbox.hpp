@@ -96,6 +96,24 @@ class Mailroom {
   }
   /// Wakes every waiter so it re-evaluates its condition (call after with_lock updates).
   void notify() { cv_.notify_all(); }
+  /// notify() for a change of what is known about the peers (discovered, lost, authenticated,
+  /// endpoint matched, READY ...): also counts it, so a wait whose condition is not a predicate
+  /// over locked state ("has anything changed since I looked?", transport/peer_gate.cpp) can
+  /// wait for state_changes_locked() to move instead of polling.
+  void notify_state_changed() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++state_changes_;
+    }
+    cv_.notify_all();
+  }
+  /// Number of notify_state_changed() calls so far; requires the lock (e.g. inside a
+  /// wait_for predicate).
+  std::uint64_t state_changes_locked() const { return state_changes_; }
+  std::uint64_t state_changes() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return state_changes_;
+  }
 
   /// `interruptible` false: a stop request does not end the wait (for leaving cleanly).
   WaitStatus wait_locked(std::unique_lock<std::mutex>& lock, const std::function<bool()>& pred,
@@ -132,6 +150,7 @@ class Mailroom {
   std::condition_variable cv_;
   mutable std::optional<StopInfo> stop_;
   mutable std::optional<Pending> pending_;
+  std::uint64_t state_changes_ = 0;
 };
 
 /// A FIFO of received messages of one type.

@@ -71,6 +71,9 @@ PeerGateResult pass_peer_gate(Session& s, const PeerGateOptions& o,
   const Seconds poll(std::clamp(o.stall_after_s / 2, 0.001, 0.2));
   for (;;) {
     if (on_poll) on_poll();
+    // Counted before judging: any discovery, loss, handshake or match after this wakes the
+    // wait below at once (only a stall, which is a duration, needs the poll).
+    const std::uint64_t seen = s.mailroom().state_changes();
     const GateStep step = judge_peers(s.options(), secured, s.peer_views(), o.stall_after_s);
     if (step.kind == GateStep::kPass) {
       r.status = WaitStatus::kReady;
@@ -104,7 +107,9 @@ PeerGateResult pass_peer_gate(Session& s, const PeerGateOptions& o,
       r.status = WaitStatus::kTimeout;
       return r;
     }
-    if (s.mailroom().wait_for([] { return false; }, std::min(left, poll)) == WaitStatus::kStopped) {
+    Mailroom& room = s.mailroom();
+    if (room.wait_for([&] { return room.state_changes_locked() != seen; }, std::min(left, poll)) ==
+        WaitStatus::kStopped) {
       r.status = WaitStatus::kStopped;
       return r;
     }

@@ -63,9 +63,11 @@ struct PeerGateResult {
 };
 
 /// Runs the gate on `session` (an agent's, before its announcement or its rejoin request).
-/// Polls every 0.2 s, or every stall_after_s / 2 when that is shorter (at least 1 ms; the
-/// stall bound is a duration, not an event); a stop of the run ends it at once. `on_poll`
-/// (optional) runs before every look; what it throws ends the gate.
+/// Judges again as soon as anything about the peers changes (discovery, loss, authentication,
+/// endpoint match: Mailroom::notify_state_changed) and at least every 0.2 s, or every
+/// stall_after_s / 2 when that is shorter (at least 1 ms; the stall bound is a duration, not an
+/// event); a stop of the run ends it at once. `on_poll` (optional) runs before every look; what
+/// it throws ends the gate.
 PeerGateResult pass_peer_gate(Session& session, const PeerGateOptions& options,
                               const std::function<void()>& on_poll = {});
 

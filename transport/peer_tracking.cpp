@@ -50,7 +50,7 @@ void PeerTracker::discovered(const GuidPrefix& prefix, const PeerIdentity& who,
       if (opt_.verbose)
         std::fprintf(stderr, "%s: discovered a participant named %s (counted once authenticated)\n",
                      participant_name(me_).c_str(), who.describe().c_str());
-      room_.notify();
+      room_.notify_state_changed();
       return;
     }
   }
@@ -96,7 +96,7 @@ void PeerTracker::admit(const GuidPrefix& prefix, const PeerIdentity& who,
                  tags.replaces.empty() ? "" : " (a new participant of that process)");
   // Its old participant may have left already (it is deleted once the new one is known).
   if (!forgotten.empty()) room_.cancel_pending_stop(forgotten);
-  room_.notify();
+  room_.notify_state_changed();
   if (!clash.empty())
     room_.request_stop(2, "two processes claim to be " + clash + " of run '" + opt_.run_id +
                               "' (check --id / --run-id)");
@@ -129,7 +129,7 @@ void PeerTracker::changed(const GuidPrefix& prefix, const ParticipantTags& tags)
     return 0;
   });
   if (!forgotten.empty()) room_.cancel_pending_stop(forgotten);
-  room_.notify();
+  room_.notify_state_changed();
 }
 
 void PeerTracker::authenticated(const GuidPrefix& prefix) {
@@ -147,7 +147,7 @@ void PeerTracker::authenticated(const GuidPrefix& prefix) {
   if (candidate)
     admit(prefix, candidate->who, candidate->tags, candidate->discovered_at);
   else
-    room_.notify();
+    room_.notify_state_changed();
 }
 
 void PeerTracker::restart_handshakes() {
@@ -217,7 +217,7 @@ void PeerTracker::gone(const GuidPrefix& prefix, const std::string& how, bool gr
   if (opt_.verbose)
     std::fprintf(stderr, "%s: lost %s: %s\n", participant_name(me_).c_str(),
                  who->describe().c_str(), how.c_str());
-  room_.notify();
+  room_.notify_state_changed();
   if (!fatal) return;
   const std::string why =
       graceful ? left_reason(*who)

@@ -30,24 +30,24 @@ void Readiness::on_matched(const std::string& endpoint, const GuidPrefix& prefix
            peers_.describe_locked(prefix).c_str(), change, set.size());
     return 0;
   });
-  room_.notify();
+  room_.notify_state_changed();
 }
 
 void Readiness::on_ready(const PeerIdentity& from) {
   room_.with_lock([&] { return ready_from_.insert(from.describe()).second; });
   trace_("READY from %s", from.describe().c_str());
-  room_.notify();
+  room_.notify_state_changed();
 }
 
 void Readiness::on_finished() {
   room_.with_lock([&] { return finished_ = true; });
-  room_.notify();
+  room_.notify_state_changed();
 }
 
 void Readiness::on_abort(const PeerIdentity& from) {
   if (!from.coordinator) return;
   room_.with_lock([&] { return coordinator_aborted_ = true; });
-  room_.notify();
+  room_.notify_state_changed();
 }
 
 void Readiness::forget_matches() {
