@@ -25,6 +25,7 @@
 
 #include "arguments.hpp"
 #include "commands.hpp"
+#include "coordinator/progress_lines.hpp"
 #include "distributed/distributed_solver.hpp"
 #include "launch_loss_policy.hpp"
 #include "robot_files.hpp"
@@ -184,6 +185,17 @@ void remove_tree(const std::string& dir) {
   if (ec)
     std::fprintf(stderr, "tessera launch: could not remove %s: %s\n", dir.c_str(),
                  ec.message().c_str());
+}
+
+// Prints the coordinator's JSON summary (launch's main output). Returns whether it was read.
+bool print_summary(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return false;
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::printf("summary:\n%s", ss.str().c_str());
+  std::fflush(stdout);
+  return true;
 }
 
 }  // namespace
@@ -351,6 +363,7 @@ int run_launch(const Args& argv) {
 
   // Stream progress; watch for failures, the time limit and signals.
   std::string pending;
+  bool summary_printed = false;
   std::string failure;
   int exit_code = 0;
   bool pipe_open = true;
@@ -365,8 +378,14 @@ int run_launch(const Args& argv) {
         } else {
           pending.append(buf, static_cast<std::size_t>(n));
           for (std::size_t nl; (nl = pending.find('\n')) != std::string::npos;) {
-            if (!quiet) std::printf("%s\n", pending.substr(0, nl).c_str());
+            const std::string line = pending.substr(0, nl);
             pending.erase(0, nl + 1);
+            if (line == coordinator::kSummaryWrittenLine) {
+              // The result is known: show it now, not after every process has left.
+              summary_printed = print_summary(summary);
+              continue;
+            }
+            if (!quiet) std::printf("%s\n", line.c_str());
           }
           std::fflush(stdout);
         }
@@ -423,10 +442,7 @@ int run_launch(const Args& argv) {
   sigaction(SIGTERM, &old_term, nullptr);
   if (!failure.empty()) return exit_code;
 
-  std::ifstream s(summary);
-  std::stringstream ss;
-  ss << s.rdbuf();
-  std::printf("summary:\n%s", ss.str().c_str());
+  if (!summary_printed) print_summary(summary);
   std::string lost;
   for (const auto& c : children)
     if (c.lost) lost += (lost.empty() ? "" : ", ") + c.name;
