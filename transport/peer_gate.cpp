@@ -67,7 +67,8 @@ PeerGateResult pass_peer_gate(Session& s, const PeerGateOptions& o,
   PeerGateResult r;
   const auto deadline = std::chrono::steady_clock::now() + Seconds(o.timeout_s);
   const bool secured = !s.options().security_dir.empty();
-  // Looks again every 0.2 s, or more often for a short stall bound (a stall is a duration).
+  // Looks again on every change, and every 0.2 s or more often for a short stall bound (a stall
+  // is a duration).
   const Seconds poll(std::clamp(o.stall_after_s / 2, 0.001, 0.2));
   for (;;) {
     if (on_poll) on_poll();
