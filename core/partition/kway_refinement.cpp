@@ -63,9 +63,12 @@ class FmEngine {
         bw_(block_weights(g, part, k)),
         conn_(k),
         queue_(g.n),
-        lock_(static_cast<std::size_t>(g.n), 0) {}
+        lock_(static_cast<std::size_t>(g.n), 0) {
+    if (k == 2) init_two_way();
+  }
 
   bool boundary(int v) const {
+    if (two_way_) return external_[v] > 0;
     for (int e = g_.xadj[v]; e < g_.xadj[v + 1]; ++e)
       if (part_[g_.adj[e]] != part_[v]) return true;
     return false;
@@ -77,7 +80,7 @@ class FmEngine {
     moves_.clear();
     for (int v : seeds) {
       if (lock_[v] == stamp_) continue;
-      const Move m = best_adjacent_move(g_, part_, bw_, ub_, conn_, v);
+      const Move m = best_move(v);
       if (m.target >= 0) queue_.set(v, key_of(m.gain, rng));
     }
     long long delta = 0, best_delta = 0;
@@ -87,16 +90,14 @@ class FmEngine {
     while (!queue_.empty()) {
       const long long key = queue_.top_key();
       const int v = queue_.pop();
-      const Move m = best_adjacent_move(g_, part_, bw_, ub_, conn_, v);
+      const Move m = best_move(v);
       if (m.target < 0) continue;
       if (m.gain * 1024 + 1023 < key) {  // block weights changed since v was queued
         queue_.set(v, key_of(m.gain, rng));
         continue;
       }
       const int from = part_[v];
-      part_[v] = m.target;
-      bw_[from] -= g_.vw[v];
-      bw_[m.target] += g_.vw[v];
+      apply_move(v, m.target);
       lock_[v] = stamp_;
       moves_.emplace_back(v, from);
       delta -= m.gain;
@@ -114,7 +115,7 @@ class FmEngine {
       for (int e = g_.xadj[v]; e < g_.xadj[v + 1]; ++e) {
         const int u = g_.adj[e];
         if (lock_[u] == stamp_) continue;
-        const Move mu = best_adjacent_move(g_, part_, bw_, ub_, conn_, u);
+        const Move mu = best_move(u);
         if (mu.target >= 0)
           queue_.set(u, key_of(mu.gain, rng));
         else
@@ -125,9 +126,7 @@ class FmEngine {
     while (moves_.size() > best_len) {
       const auto [v, from] = moves_.back();
       moves_.pop_back();
-      bw_[part_[v]] -= g_.vw[v];
-      bw_[from] += g_.vw[v];
-      part_[v] = from;
+      apply_move(v, from);
     }
     return -best_delta;
   }
@@ -136,6 +135,39 @@ class FmEngine {
   const std::vector<std::pair<int, int>>& kept_moves() const { return moves_; }
 
  private:
+  // Bisections (k = 2) run FM thousands of times per initial partitioning. There each vertex's
+  // weight towards the other block is kept up to date as vertices move, so a move's gain costs
+  // O(1) instead of a scan of the neighbours. Same moves, same order, same result as the scan.
+  void init_two_way() {
+    weighted_degree_.assign(static_cast<std::size_t>(g_.n), 0);
+    external_.assign(static_cast<std::size_t>(g_.n), 0);
+    for (int v = 0; v < g_.n; ++v)
+      for (int e = g_.xadj[v]; e < g_.xadj[v + 1]; ++e) {
+        if (g_.ew[e] <= 0) return;  // the scan treats zero weights differently: keep it
+        weighted_degree_[v] += g_.ew[e];
+        if (part_[g_.adj[e]] != part_[v]) external_[v] += g_.ew[e];
+      }
+    two_way_ = true;
+  }
+
+  Move best_move(int v) {
+    if (!two_way_) return best_adjacent_move(g_, part_, bw_, ub_, conn_, v);
+    const int other = 1 - part_[v];
+    if (external_[v] == 0 || bw_[other] + g_.vw[v] > ub_[other]) return {};
+    return {other, 2 * external_[v] - weighted_degree_[v]};
+  }
+
+  void apply_move(int v, int to) {
+    const int from = part_[v];
+    part_[v] = to;
+    bw_[from] -= g_.vw[v];
+    bw_[to] += g_.vw[v];
+    if (!two_way_) return;
+    external_[v] = weighted_degree_[v] - external_[v];
+    for (int e = g_.xadj[v]; e < g_.xadj[v + 1]; ++e)
+      external_[g_.adj[e]] += part_[g_.adj[e]] == to ? -g_.ew[e] : g_.ew[e];
+  }
+
   const WorkGraph& g_;
   std::vector<int>& part_;
   const std::vector<long long>& ub_;
@@ -145,6 +177,8 @@ class FmEngine {
   std::vector<int> lock_;
   int stamp_ = 0;
   std::vector<std::pair<int, int>> moves_;  // (vertex, block it came from)
+  bool two_way_ = false;
+  std::vector<long long> weighted_degree_, external_;  // k = 2 only
 };
 
 }  // namespace
