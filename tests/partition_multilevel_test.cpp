@@ -449,3 +449,30 @@ TEST(KwayFm, TwoWayGainCacheMakesTheMovesOfTheScan) {
   }
   EXPECT_GT(checked, 12) << "FM moved nothing: the comparison would be empty";
 }
+
+// InitialParams::repeat_budget scales the number of recursive-bisection runs with the graph:
+// clamp(round(budget / n), min_repeats, repeats) runs, the same partition as asking for that
+// many runs directly. Without a budget the repeats are used as given.
+TEST(InitialPartition, RepeatBudgetScalesTheRunsWithTheGraphSize) {
+  const WorkGraph g = to_work_graph(pose_like_graph(800, 5));
+  const int k = 9;
+  const std::vector<long long> ub(k, static_cast<long long>(max_block_size(800, k, 0.03)));
+  auto run = [&](int repeats, int budget, int min_repeats) {
+    InitialParams ip;
+    ip.repeats = repeats;
+    ip.repeat_budget = budget;
+    ip.min_repeats = min_repeats;
+    Rng rng(3);
+    std::vector<int> part = initial_partition(g, k, ub, ip, rng);
+    return std::make_pair(part, rng.next());  // the next draw tells how much was drawn
+  };
+  const auto r1 = run(1, 0, 1), r2 = run(2, 0, 1), r3 = run(3, 0, 1), r4 = run(4, 0, 1);
+  ASSERT_NE(r1.second, r2.second);
+  ASSERT_NE(r2.second, r3.second);
+  EXPECT_EQ(run(4, 2400, 1), r3);    // 2400 / 800 = 3 runs
+  EXPECT_EQ(run(4, 1000, 1), r1);    // round(1.25) = 1
+  EXPECT_EQ(run(4, 1000, 2), r2);    // raised to min_repeats
+  EXPECT_EQ(run(4, 100000, 2), r4);  // capped at repeats
+  EXPECT_EQ(run(3, 100000, 5), r3);  // repeats wins over a larger minimum
+  expect_within(g, r3.first, k, ub);
+}

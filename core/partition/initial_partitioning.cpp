@@ -113,7 +113,13 @@ std::vector<int> initial_partition(const WorkGraph& g, int k, const std::vector<
   std::vector<int> best;
   long long best_cut = -1;
   bool best_ok = false;
-  for (int r = 0; r < std::max(1, params.repeats); ++r) {
+  int repeats = std::max(1, params.repeats);
+  if (params.repeat_budget > 0 && g.n > 0) {
+    const int scaled =
+        static_cast<int>(std::lround(static_cast<double>(params.repeat_budget) / g.n));
+    repeats = std::clamp(scaled, std::min(std::max(1, params.min_repeats), repeats), repeats);
+  }
+  for (int r = 0; r < repeats; ++r) {
     std::vector<int> part(static_cast<std::size_t>(g.n), 0);
     recursive_bisection(g, all, k, 0, params, rng, part, local);
     const bool ok = rebalance(g, k, part, ub);

@@ -76,8 +76,15 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   cp.initial.bisection_tries = 4;
   switch (preset) {
     case PartitionPreset::kFast:
-      cp.fm.max_passes = 2;
+      cp.fm.max_passes = 3;
       cp.fm.stop_after = 40;
+      // Initial partitioning dominated fast at many blocks (73 % of grid3D N = 25: its
+      // coarsest graph has ~1100 vertices). Runs now shrink with the coarsest graph: 4 up to
+      // ~400 vertices (N <= 9), 3 around 600 (N = 16), 2 from ~900 (N = 25); the third FM pass
+      // (was 2) wins back what the fewer runs lose (session 6: grid3D N = 25 CPU 45 -> 32 ms,
+      // 12 graphs x N = 4..25 x seeds 1-5: cut sum 114317 instead of 114721; docs/partitioning.md).
+      cp.initial.repeat_budget = 1600;
+      cp.initial.min_repeats = 2;
       break;
     case PartitionPreset::kEco:
       cp.coarsening.label_propagation_rounds = 3;
@@ -164,6 +171,9 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         static_cast<int>(std::max<long long>(1, lmax / std::atoi(env("T_MAXW"))));
   if (env("T_LP")) cp.coarsening.label_propagation_rounds = std::atoi(env("T_LP"));
   if (env("T_REP")) cp.initial.repeats = std::atoi(env("T_REP"));
+  if (env("T_BUDGET")) cp.initial.repeat_budget = std::atoi(env("T_BUDGET"));
+  if (env("T_MINREP")) cp.initial.min_repeats = std::atoi(env("T_MINREP"));
+  if (env("T_BTRY")) cp.initial.bisection_tries = std::atoi(env("T_BTRY"));
   if (env("T_RUNS")) plan.runs = std::atoi(env("T_RUNS"));
   if (env("T_VCYC")) plan.vcycles = std::atoi(env("T_VCYC"));
   if (env("T_POP")) plan.evolution.population = std::atoi(env("T_POP"));
