@@ -30,7 +30,8 @@ TEST(Irbcd, GammaSolvesItsQuadraticAndIsAtLeastOneOverN) {
 }
 
 TEST(Irbcd, RecurrencesFollowThePaper) {
-  IrbcdOptions o;  // sigma 1e-4, a0 = 1/n, b0 = 1
+  IrbcdOptions o;  // sigma 1e-4, b0 = 1
+  o.a0 = 0.0;      // the paper's a_0 = 1/n (the default is 1, see StartsWithTheMomentumOfA0)
   o.adaptive_sigma = false;
   o.reset_on_restart = true;
   const double n = 5;
@@ -58,6 +59,32 @@ TEST(Irbcd, RecurrencesFollowThePaper) {
   const double a1 = keep.a();
   keep.restart();
   EXPECT_DOUBLE_EQ(keep.a(), a1);
+}
+
+// The default a_0 = 1 (not the paper's 1/n): the first gamma solves the recurrence's quadratic
+// with a = b = 1, exceeds the paper's start, and a reset (reset_on_restart) returns to it.
+TEST(Irbcd, StartsWithTheMomentumOfA0) {
+  IrbcdOptions o;
+  EXPECT_EQ(o.a0, 1.0);
+  EXPECT_FALSE(o.adaptive_sigma);  // the default since session 6 (docs/irbcd.md section 15)
+  o.reset_on_restart = true;
+  const double n = 3;
+  IrbcdScheme s(o, n);
+  EXPECT_DOUBLE_EQ(s.a(), 1.0);
+  const double g0 = s.coefficients().gamma;
+  EXPECT_DOUBLE_EQ(g0, irbcd_gamma(n, o.sigma, 1.0, 1.0));
+  EXPECT_NEAR(g0 * g0 - g0 / n, 1 - g0 * o.sigma / n, 1e-12);
+  IrbcdOptions paper = o;
+  paper.a0 = 0.0;
+  const double g_paper = IrbcdScheme(paper, n).coefficients().gamma;
+  EXPECT_NEAR(g_paper, (1 + std::sqrt(5.0)) / (2 * n), 1e-4);
+  EXPECT_GT(g0, 2 * g_paper);
+  for (int k = 0; k < 30; ++k) s.advance();
+  EXPECT_GT(s.coefficients().gamma, g0);
+  s.restart();
+  EXPECT_DOUBLE_EQ(s.a(), 1.0);
+  EXPECT_DOUBLE_EQ(s.b(), 1.0);
+  EXPECT_EQ(s.coefficients().gamma, g0);
 }
 
 // Keeping a, b across restarts (the default) relies on gamma staying below its fixed point
@@ -96,6 +123,7 @@ IrbcdOptions adaptive_options() {
   o.adaptive_sigma = true;
   o.sigma_max = 1e-1;
   o.reset_on_restart = true;  // the restart test checks the reset too
+  o.a0 = 0.0;                 // ... to the paper's a_0 = 1/n
   return o;
 }
 

@@ -23,7 +23,16 @@ struct IrbcdOptions {
   /// paper's 1e-3: with parallel rounds fewer rounds on 10 of 13 benchmark graphs (kitti_00
   /// 936 vs 2170), more on intel and MIT (+8%, +12%); docs/irbcd.md section 9.
   double sigma = 1e-4;
-  double a0 = 0.0;  ///< Initial a; <= 0 means 1/n (the paper).
+  /// Initial a; <= 0 means 1/n (the paper's a_0). With b_0 = 1 the first gamma solves
+  /// gamma^2 - gamma/n = (1 - gamma sigma/n) a_0^2: a_0 = 1 starts gamma at ~1.2 (n = 3) instead
+  /// of the paper's (1 + sqrt 5)/(2n) ~ 0.54, i.e. the momentum starts where the paper's reaches
+  /// after ~2n rounds (RBCD++ starts at 1/n). Default 1 since session 6, by measurement at main
+  /// be9349e (rounds to 0.01, N = 5, highest, chordal; a_0 = 1 / 1/n / RBCD++): parking-garage
+  /// 20/23/23, cubicle 172/223/201, CSAIL 111/110/126, intel 68/76/90, city10000 107/109/137,
+  /// manhattan3500 183/182/218, sphere2500 115/113/134, torus3D 91/95/106, ais2klinik
+  /// 1070/1070/1152, kitti_02 1259/1362/1239, grid 8000 66/66/77, with adaptive sigma on (fixed
+  /// sigma, the default now: kitti_02 1206, ais2klinik 1069, the rest equal; section 15).
+  double a0 = 1.0;
   double b0 = 1.0;  ///< Initial b, > 0.
   IrbcdDimension dimension = IrbcdDimension::kUnits;
   /// Unselected blocks take P^k (as in accelerated coordinate descent) instead of keeping Y^k.
@@ -51,14 +60,15 @@ struct IrbcdOptions {
   /// - a restart after a round with gamma_r: momentum of that size increased f, so
   ///   sigma := 1 / (sigma_restart_theta gamma_r)^2 (gamma's new fixed point theta gamma_r;
   ///   always an increase, since gamma_r <= 1/sqrt(sigma)).
-  /// sigma stays in [sigma_min, sigma_max]; `sigma` is the start value. Default on with
-  /// sigma_max = 1e-4 (= the start), so a restart can only undo earlier shrinks. Measured
-  /// (docs/irbcd.md section 13): before the tangent preconditioner (main b2418ed) kitti_02 4455
-  /// -> 2810 rounds (RBCD++ 2959); with it (main 098acb3) the rule rarely acts: runs under
-  /// ~180 n rounds cannot saturate, kitti_02 1579 -> 1578, ais2klinik 919 = 919. A larger sigma_max
-  /// (1e-1, 1e-3: restarts raise sigma above the start) measured worse. `adaptive_sigma = false`
-  /// restores the fixed sigma.
-  bool adaptive_sigma = true;
+  /// sigma stays in [sigma_min, sigma_max]; `sigma` is the start value; sigma_max = 1e-4 (= the
+  /// start) by default, so a restart can only undo earlier shrinks. Measured (docs/irbcd.md
+  /// section 13): before the tangent preconditioner (main b2418ed) kitti_02 4455 -> 2810 rounds
+  /// (RBCD++ 2959); with it (main 098acb3) the rule rarely acts: runs under ~180 n rounds cannot
+  /// saturate, kitti_02 1579 -> 1578, ais2klinik 919 = 919. A larger sigma_max (1e-1, 1e-3)
+  /// measured worse. Default OFF since session 6 (docs/irbcd.md section 15): with a0 = 1 it acts
+  /// only on the two long runs and costs rounds there (main be9349e, fixed / adaptive: kitti_02
+  /// 1206 / 1259, RBCD++ 1239; ais2klinik 1069 / 1070); every other paper graph: same rounds.
+  bool adaptive_sigma = false;
   double sigma_shrink = 0.25;        ///< In (0, 1].
   double sigma_saturation = 0.9;     ///< In (0, 1].
   double sigma_restart_theta = 0.5;  ///< > 0.
