@@ -118,7 +118,10 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         const int ops = static_cast<int>(
             std::clamp((strong ? 1.6e6 : 2.8e6) / per_op, 12.0, strong ? 400.0 : 800.0));
         plan.evolution.population = strong ? 4 : 8;
-        plan.evolution.mutation_rate = strong ? 0.3 : 0.5;
+        // Half of the steps are mutations (a fresh multilevel partition combined with a
+        // tournament winner) in both; with 0.3 strong's 4 individuals converged early on rim
+        // (271/271/243 on seeds 1-3, 275/275 on 4-5; with 0.5: 247/267/243, 259/252).
+        plan.evolution.mutation_rate = 0.5;
         plan.evolution.vcycles = 1;
         plan.evolution.generations = std::max(4, ops - 2 * plan.evolution.population);
         // Small graphs converge long before the budget is spent.
@@ -133,15 +136,16 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // after a stall it keeps both (docs/partitioning.md).
         plan.evolution.cross_share = strong ? 0.0 : 0.3;
         plan.evolution.cross_after_stall = 8;
-        // highest: when the search stalls before its budget is spent, up to 40 more steps push
+        // When the search stalls before its budget is spent, up to 40 more steps push
         // tournament winners towards one light block (a V-cycle under bounds that keep that
         // block at 0.88-0.98 of the average, then one under the real bounds). The best known
         // cuts mostly have one light block and the others at the bound (rim 2100 2096 1867 2032
         // 2100). Light steps mixed into the whole search (20 %) found sphere2500 179 but lost
         // city10000/grid3D at seed 1; as a tail the search before it is unchanged (session 5,
         // seeds 1-3: torus3D 242/240/242 instead of 242/241/243, rim 258/266/243 instead of
-        // 260/266/243; docs/partitioning.md).
-        plan.evolution.light_tail = strong ? 0 : 40;
+        // 260/266/243; docs/partitioning.md). strong too since session 6 (with mutation rate
+        // 0.5, seeds 1-3: parking-garage 28/28/28 instead of 32/28/28, the rest unchanged).
+        plan.evolution.light_tail = 40;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
         // bound on every level the coarse searches rarely reach such shapes (session 4, seeds
