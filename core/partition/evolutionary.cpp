@@ -182,6 +182,32 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
   int best = 0;
   for (int i = 1; i < static_cast<int>(pop.size()); ++i)
     if (pop[i].cut < pop[best].cut) best = i;
+  if (params.spectral_seeds > 0) {
+    // Global layouts after the search (spectral_layouts.hpp): the search itself is exactly the
+    // one without them, and they only replace its best when they are better, so the result can
+    // only improve. They draw from a copy of the generator for the same reason.
+    Rng srng = rng;
+    srng.next();
+    Individual top = pop[best];
+    std::string cuts;
+    // Layouts far above the search's best after FM are not worth V-cycles and combines.
+    const long long useful =
+        static_cast<long long>(static_cast<double>(top.cut) * (1.0 + params.spectral_gap));
+    for (auto& p : refined_spectral_layouts(g, k, ub, params.spectral, varied(params, srng),
+                                            params.spectral_seeds, srng, useful)) {
+      Individual seed{std::move(p), 0};
+      seed.cut = edge_cut(g, seed.part);
+      cuts += (cuts.empty() ? "" : " ") + std::to_string(seed.cut);
+      // Combining keeps what both share: a layout with the right global arrangement can pick
+      // up the search's better local boundaries (never worse than the better of the two).
+      Individual child = combine(g, k, ub, top, seed, varied(params, srng), srng);
+      if (child.cut < top.cut) top = std::move(child);
+    }
+    if (trace)
+      trace("spectral", "global layouts after V-cycles: " + (cuts.empty() ? "none" : cuts),
+            top.cut);
+    return top.part;
+  }
   return pop[best].part;
 }
 

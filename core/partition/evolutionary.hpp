@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "partition/multilevel.hpp"
+#include "partition/spectral_layouts.hpp"
 
 namespace tessera::partition_detail {
 
@@ -44,6 +45,13 @@ struct EvolutionParams {
   int light_tail = 0;
   double light_min = 0.88;  ///< Range of the light block's bound, as a fraction of the
   double light_max = 0.98;  ///< average block weight (raised where infeasible).
+  /// Spectral layouts (spectral_layouts.hpp): after the search, the best this many refined
+  /// global layouts read off the Laplacian embedding are each combined with the search's best
+  /// partition, which they replace when better (the search before is unchanged). 0 = off.
+  int spectral_seeds = 0;
+  /// ...only those whose cut after FM is within this fraction above the search's best.
+  double spectral_gap = 0.0;
+  SpectralLayoutOptions spectral;
   CycleParams cycle;
 };
 

@@ -146,6 +146,12 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // 260/266/243; docs/partitioning.md). strong too since session 6 (with mutation rate
         // 0.5, seeds 1-3: parking-garage 28/28/28 instead of 32/28/28, the rest unchanged).
         plan.evolution.light_tail = 40;
+        // highest: after the search, the 2 best global layouts read off the Laplacian
+        // embedding (bands, a + b layouts, arcs around rings; spectral_layouts.hpp) are
+        // combined with its best and replace it when better. The search before is unchanged,
+        // so no cut gets worse; sphere2500 (a twisted cylinder) gets the seam-aligned 3 + 2
+        // layout (179) that the search never reaches (180 on every seed, session 6).
+        plan.evolution.spectral_seeds = strong ? 0 : 2;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
         // bound on every level the coarse searches rarely reach such shapes (session 4, seeds
@@ -194,6 +200,12 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_LTAIL")) plan.evolution.light_tail = std::atoi(env("T_LTAIL"));
   if (env("T_LMIN")) plan.evolution.light_min = std::atof(env("T_LMIN"));
   if (env("T_LMAX")) plan.evolution.light_max = std::atof(env("T_LMAX"));
+  if (env("T_SPEC")) plan.evolution.spectral_seeds = std::atoi(env("T_SPEC"));
+  if (env("T_SPECEV")) plan.evolution.spectral.eigenvectors = std::atoi(env("T_SPECEV"));
+  if (env("T_SPECROT")) plan.evolution.spectral.rotations = std::atoi(env("T_SPECROT"));
+  if (env("T_SPECGAP")) plan.evolution.spectral_gap = std::atof(env("T_SPECGAP"));
+  if (env("T_SPECPOL")) plan.evolution.spectral.polish = std::atoi(env("T_SPECPOL"));
+  if (env("T_SPECTOL")) plan.evolution.spectral.lanczos_tolerance = std::atof(env("T_SPECTOL"));
   if (env("T_MFLEV")) plan.evolution.matching_flow_levels = std::atoi(env("T_MFLEV"));
   if (env("T_OPS"))
     plan.evolution.generations =
