@@ -42,7 +42,7 @@ struct SpectralLayoutOptions {
   /// factorization and the Lanczos iteration grow with n), >= 2.
   int max_vertices = 50000;
   /// ...and for at most this many blocks (the number of "a + b" layouts grows with k), 2..64.
-  int max_parts = 16;
+  int max_parts = 8;
   /// Lanczos (Spectra) iteration limit and relative tolerance of the eigenpairs. The layouts
   /// only need the coordinates roughly, so a loose tolerance is enough.
   int lanczos_max_iterations = 300;
