@@ -76,15 +76,20 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   cp.initial.bisection_tries = 4;
   switch (preset) {
     case PartitionPreset::kFast:
-      cp.fm.max_passes = 3;
+      cp.fm.max_passes = 2;
       cp.fm.stop_after = 40;
-      // Initial partitioning dominated fast at many blocks (73 % of grid3D N = 25: its
-      // coarsest graph has ~1100 vertices). Runs now shrink with the coarsest graph: 4 up to
-      // ~400 vertices (N <= 9), 3 around 600 (N = 16), 2 from ~900 (N = 25); the third FM pass
-      // (was 2) wins back what the fewer runs lose (session 6: grid3D N = 25 CPU 45 -> 32 ms,
-      // 12 graphs x N = 4..25 x seeds 1-5: cut sum 114317 instead of 114721; docs/partitioning.md).
-      cp.initial.repeat_budget = 1600;
-      cp.initial.min_repeats = 2;
+      // Initial partitioning dominated fast at many blocks (73 % of grid3D N = 25: coarse
+      // vertices stay below lmax/30, so its coarsest graph has ~1100 vertices). From 12 blocks
+      // on, the runs shrink with the coarsest graph (3 around 600 vertices, i.e. N = 16; 2 from
+      // ~900, N = 25) and a third FM pass per level wins back what the fewer runs lose
+      // (session 6, 12 graphs x N = 16, 25 x seeds 1-5: cut geomean ratio 1.007, sum 71340
+      // instead of 71406; grid3D N = 25 CPU 45 -> 32 ms; docs/partitioning.md). Below 12
+      // blocks fast is cheap (<= 24 ms) and unchanged.
+      if (k >= 12) {
+        cp.fm.max_passes = 3;
+        cp.initial.repeat_budget = 1600;
+        cp.initial.min_repeats = 2;
+      }
       break;
     case PartitionPreset::kEco:
       cp.coarsening.label_propagation_rounds = 3;
