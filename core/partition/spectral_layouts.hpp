@@ -36,7 +36,7 @@ struct SpectralLayoutOptions {
   /// keeping the best. Equal arcs cost the same at any rotation except where their borders
   /// meet a ring's seam (e.g. where a spiral steps to its next turn), which is worth an edge
   /// per side and which FM cannot reach (it would move a whole column). 0..8 and 1..64.
-  int polish = 3;
+  int polish = 6;
   int rotation_steps = 24;
   /// Layouts are only built for graphs with at most this many vertices (the sparse Cholesky
   /// factorization and the Lanczos iteration grow with n), >= 2.
