@@ -13,6 +13,8 @@
 #include <sstream>
 #include <vector>
 
+#include "util/byte_codec.hpp"
+
 namespace tessera {
 namespace {
 
@@ -78,12 +80,11 @@ std::uint64_t checkpoint_checksum(const std::string& bytes) {
 
 void write_checkpoint_file(const std::string& path, const std::string& payload) {
   remove_stale_temporaries(path);
-  std::string header(kMagic, sizeof kMagic);
-  const std::uint32_t version = kCheckpointFormatVersion;
-  const std::uint64_t length = payload.size(), sum = checkpoint_checksum(payload);
-  header.append(reinterpret_cast<const char*>(&version), sizeof version);
-  header.append(reinterpret_cast<const char*>(&length), sizeof length);
-  header.append(reinterpret_cast<const char*>(&sum), sizeof sum);
+  ByteWriter fields;
+  fields.u32(kCheckpointFormatVersion);
+  fields.u64(payload.size());
+  fields.u64(checkpoint_checksum(payload));
+  const std::string header = std::string(kMagic, sizeof kMagic) + fields.bytes();
 
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -128,11 +129,11 @@ std::string read_checkpoint_file(const std::string& path) {
               " bytes, shorter than the header (torn write?)");
   if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
     throw bad("not a Tessera checkpoint (bad magic)");
-  std::uint32_t version;
-  std::uint64_t length, sum;
-  std::memcpy(&version, bytes.data() + 8, sizeof version);
-  std::memcpy(&length, bytes.data() + 12, sizeof length);
-  std::memcpy(&sum, bytes.data() + 20, sizeof sum);
+  // The size check above guarantees these reads succeed.
+  const std::string fields = bytes.substr(sizeof kMagic, kHeaderSize - sizeof kMagic);
+  ByteReader header(fields, path);
+  const std::uint32_t version = header.u32("format version");
+  const std::uint64_t length = header.u64("payload length"), sum = header.u64("checksum");
   if (version != kCheckpointFormatVersion)
     throw bad("format version " + std::to_string(version) + ", this build reads version " +
               std::to_string(kCheckpointFormatVersion));
