@@ -283,6 +283,17 @@ def save_figure(ctx, fig, name, dpi=100):
     return path
 
 
+def style_log_axes(ax, xlabel, title, ylabel=None, grid="major"):
+    """The look every convergence plot shares: log y axis, labels, light grid, small legend."""
+    ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    if ylabel is not None:
+        ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which=grid, alpha=0.3)
+    ax.legend(fontsize=8)
+
+
 def gap_series(trace, fstar):
     """(rounds, f - f*) with non-positive gaps (round-off at the optimum) clipped for log axes."""
     xs, ys = [], []
@@ -303,6 +314,13 @@ class Result:
 
     def add(self, text):
         self.sections.append(text)
+
+    def add_csv(self, ctx, name, rows):
+        """Writes `rows` (see write_csv) as ctx.out_dir/name and lists the file in the section."""
+        path = os.path.join(ctx.out_dir, name)
+        write_csv(path, rows)
+        self.csvs.append(path)
+        return path
 
     def markdown(self, out_dir):
         parts = [f"## {self.title}", ""]

@@ -66,9 +66,7 @@ def run(ctx):
                                   "baseline rounds run"], btable)
             res.add(("Tessera beside the **public baseline** (`reference/dpgo_baseline.csv`, not measured here; "
                    "its gradient is of half the cost, so its 0.1 is Tessera's 0.2):\n\n" + md2))
-    csv_path = os.path.join(ctx.out_dir, "exp3_algorithms.csv")
-    bc.write_csv(csv_path, rows)
-    res.csvs.append(csv_path)
+    res.add_csv(ctx, "exp3_algorithms.csv", rows)
     res.images.append(plot(ctx, graphs, traces, rows))
     return res
 
@@ -97,12 +95,8 @@ def plot(ctx, graphs, traces, rows):
             axes[gi][2].plot(secs, grads, label=alg)
             axes[gi][3].plot(secs, gaps, label=alg)
         for k, ax in enumerate(axes[gi]):
-            ax.set_yscale("log")
-            ax.set_xlabel("round" if k < 2 else "solver wall time (s)")
-            ax.set_ylabel("gradient norm (cost units, log)" if k % 2 == 0 else "f - f* (cost units, log)")
-            ax.set_title(f"{label}, N = 5, highest")
-            ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=8)
+            bc.style_log_axes(ax, "round" if k < 2 else "solver wall time (s)", f"{label}, N = 5, highest",
+                              "gradient norm (cost units, log)" if k % 2 == 0 else "f - f* (cost units, log)")
     return bc.save_figure(ctx, fig, "exp3_algorithms.png", dpi=90)
 
 

@@ -175,9 +175,7 @@ def run(ctx, launch_bin=None):
             f"centralized solver in this run. {bc.GRID_NOTE} (P = {ctx.grid_poses()}); rim has no measurements."
             + (" `--quick`: parking-garage and the grid only." if ctx.quick else "") + "\n\n" + md
             + "\n\nChecks (highest+IRBCD vs sequential+RBCD):\n\n" + "\n".join(checks))
-    csv_path = os.path.join(ctx.out_dir, "exp4_complete_system.csv")
-    bc.write_csv(csv_path, rows)
-    res.csvs.append(csv_path)
+    res.add_csv(ctx, "exp4_complete_system.csv", rows)
     res.images.append(plot(ctx, graphs, traces, rows))
     return res
 
@@ -196,11 +194,7 @@ def plot(ctx, graphs, traces, rows):
         axes[0][k].set_ylabel("gradient norm (cost units, log)")
         axes[1][k].set_ylabel("f - f* (cost units, log)")
         for ax in (axes[0][k], axes[1][k]):
-            ax.set_yscale("log")
-            ax.set_xlabel("round")
-            ax.set_title(f"{label}, N = 5")
-            ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=8)
+            bc.style_log_axes(ax, "round", f"{label}, N = 5")
     return bc.save_figure(ctx, fig, "exp4_complete_system.png", dpi=90)
 
 

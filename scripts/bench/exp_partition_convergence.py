@@ -47,9 +47,7 @@ def run(ctx):
             f"grad norm 0.01 or {max_rounds} rounds. f* of parking-garage from `reference/optima.csv` "
             f"(quaternion-normalised row); f* of the generated grid from the centralized certifiable solver in "
             f"this run. {bc.GRID_NOTE} (P = {ctx.grid_poses()}).\n\n" + md)
-    csv_path = os.path.join(ctx.out_dir, "exp2_partition_convergence.csv")
-    bc.write_csv(csv_path, rows)
-    res.csvs.append(csv_path)
+    res.add_csv(ctx, "exp2_partition_convergence.csv", rows)
     res.images.append(plot(ctx, graphs, presets, traces, rows))
     return res
 
@@ -68,11 +66,7 @@ def plot(ctx, graphs, presets, traces, rows):
         axes[gi][0].set_ylabel("Riemannian gradient norm (cost units, log)")
         axes[gi][1].set_ylabel("f - f* (cost units, log)")
         for ax in axes[gi]:
-            ax.set_yscale("log")
-            ax.set_xlabel("round (one block update each)")
-            ax.set_title(f"RBCD on {label}, N = 5")
-            ax.grid(True, which="major", alpha=0.3)
-            ax.legend(fontsize=8)
+            bc.style_log_axes(ax, "round (one block update each)", f"RBCD on {label}, N = 5")
     return bc.save_figure(ctx, fig, "exp2_partition_convergence.png", dpi=100)
 
 

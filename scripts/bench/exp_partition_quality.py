@@ -55,9 +55,7 @@ def run(ctx):
             "**paper's** Table I cuts (`PAPER_PARTITIONS.md`, printed labels), not measured here. "
             "Balance = largest block / ceil(n/N); Cvolume as defined by the paper; ms = partitioning wall time.\n\n"
             + md)
-    csv1 = os.path.join(ctx.out_dir, "exp1_partition_quality.csv")
-    bc.write_csv(csv1, rows)
-    res.csvs.append(csv1)
+    res.add_csv(ctx, "exp1_partition_quality.csv", rows)
 
     krows = []
     if not ctx.quick:
@@ -80,9 +78,7 @@ def run(ctx):
                 table.append(line)
         md = bc.print_table("Cut for N = 4, 9, 16, 25", ["graph", "N"] + PRESETS + ["ms highest"], table)
         res.add("Cut for N = 4, 9, 16, 25 on the larger graphs:\n\n" + md)
-        csv2 = os.path.join(ctx.out_dir, "exp1_partition_quality_k.csv")
-        bc.write_csv(csv2, krows)
-        res.csvs.append(csv2)
+        res.add_csv(ctx, "exp1_partition_quality_k.csv", krows)
     else:
         res.add("(`--quick`: N = 4, 9, 16, 25 skipped.)")
 

@@ -53,9 +53,7 @@ def run(ctx):
             f"{max_rounds} rounds. Solver seconds from the solver's clock (trace `elapsed_s`); process wall time "
             f"includes loading, partitioning and the chordal initialisation. f* from the centralized solver in "
             f"this run ({fsrc}). {bc.GRID_NOTE} (P = {ctx.grid_poses()}).\n\n" + md)
-    csv_path = os.path.join(ctx.out_dir, "exp5_robots.csv")
-    bc.write_csv(csv_path, rows)
-    res.csvs.append(csv_path)
+    res.add_csv(ctx, "exp5_robots.csv", rows)
     res.images.append(plot(ctx, label, traces, rows, fstar))
     return res
 
@@ -69,12 +67,7 @@ def plot(ctx, label, traces, rows, fstar):
         xs, ys = bc.gap_series(tr, fstar)
         axes[1].plot(xs, ys, label=f"N = {n}")
     for ax, yl in ((axes[0], "gradient norm (cost units, log)"), (axes[1], "f - f* (cost units, log)")):
-        ax.set_yscale("log")
-        ax.set_xlabel("round")
-        ax.set_ylabel(yl)
-        ax.set_title(f"IRBCD on {label}")
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
+        bc.style_log_axes(ax, "round", f"IRBCD on {label}", yl)
     ax = axes[2]
     ns = [r["agents"] for r in rows]
     ax.plot(ns, [r["rounds_to_grad_0.01"] or r["rounds"] for r in rows], "o-", color="C0",

@@ -77,9 +77,7 @@ def run(ctx, preset="fast", mem_limit_gb=8):
             f"an upper bound of one agent's share; a run is stopped (and said so in the stop column) when its peak RSS "
             f"passes {mem_limit_gb} GB, as the machine is shared. Process wall time includes loading, partitioning and setting up "
             f"the agents." + (" `--quick`: 2k and 10k poses only." if ctx.quick else "") + "\n\n" + md)
-    csv_path = os.path.join(ctx.out_dir, "exp6_scale.csv")
-    bc.write_csv(csv_path, rows)
-    res.csvs.append(csv_path)
+    res.add_csv(ctx, "exp6_scale.csv", rows)
     res.images.append(plot(ctx, rows))
     return res
 
@@ -101,12 +99,7 @@ def plot(ctx, rows):
               ("memory (MB, log)", "peak memory per agent")]
     for ax, (yl, title) in zip(axes, labels):
         ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("poses (log)")
-        ax.set_ylabel(yl)
-        ax.set_title(title)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
+        bc.style_log_axes(ax, "poses (log)", title, yl, grid="both")
     return bc.save_figure(ctx, fig, "exp6_scale.png", dpi=100)
 
 
