@@ -35,6 +35,18 @@ double optimum(const PoseGraph& g) {
   return solve_centralized(g).cost;
 }
 
+// The columns of the poses `which` of the lifted iterate X, in that order: what an agent holding
+// those poses (its block, or its copies of neighbours) starts from. Each pose has d + 1 columns.
+Eigen::MatrixXd pose_columns(const Eigen::MatrixXd& X, int d,
+                             const std::vector<std::size_t>& which) {
+  const Eigen::Index w = d + 1;
+  Eigen::MatrixXd out(X.rows(), w * static_cast<Eigen::Index>(which.size()));
+  for (std::size_t s = 0; s < which.size(); ++s)
+    out.middleCols(w * static_cast<Eigen::Index>(s), w) =
+        X.middleCols(w * static_cast<Eigen::Index>(which[s]), w);
+  return out;
+}
+
 TEST(DistributedSolver, TwoBlocksConvergeToCentralizedOptimum) {
   const PoseGraph g = small_graph(2, 40, 3);
   DistributedOptions opt;
@@ -87,15 +99,8 @@ TEST(DistributedSolver, AgentCostSharesSumToGlobalCost) {
   for (int b = 0; b < 3; ++b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
     BlockProblem p(3, ids, g.measurements);
-    auto gather = [&](const std::vector<std::size_t>& which) {
-      Eigen::MatrixXd out(5, 4 * static_cast<Eigen::Index>(which.size()));
-      for (std::size_t s = 0; s < which.size(); ++s)
-        out.middleCols(4 * static_cast<Eigen::Index>(s), 4) =
-            X.middleCols(4 * static_cast<Eigen::Index>(which[s]), 4);
-      return out;
-    };
-    p.set_neighbor_poses(gather(p.neighbors()));
-    const Eigen::MatrixXd Xb = gather(ids);
+    p.set_neighbor_poses(pose_columns(X, 3, p.neighbors()));
+    const Eigen::MatrixXd Xb = pose_columns(X, 3, ids);
     sum += p.cost_share(Xb);
     gsq += p.riemannian_gradient(Xb, p.euclidean_gradient(Xb)).squaredNorm();
   }
@@ -115,17 +120,10 @@ TEST(DistributedSolver, StatusAfterUpdateMatchesFreshGradient) {
   }();
   const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
   const Eigen::MatrixXd X = lift_poses(g.initial, 5);
-  auto gather = [&](const std::vector<std::size_t>& which) {
-    Eigen::MatrixXd out(5, 4 * static_cast<Eigen::Index>(which.size()));
-    for (std::size_t s = 0; s < which.size(); ++s)
-      out.middleCols(4 * static_cast<Eigen::Index>(s), 4) =
-          X.middleCols(4 * static_cast<Eigen::Index>(which[s]), 4);
-    return out;
-  };
   const auto& ids = layout.poses[0];
-  AgentState agent(0, 3, layout, g.measurements, gather(ids));
+  AgentState agent(0, 3, layout, g.measurements, pose_columns(X, 3, ids));
   BlockProblem fresh(3, ids, g.measurements);
-  agent.Yn = gather(fresh.neighbors());
+  agent.Yn = pose_columns(X, 3, fresh.neighbors());
   auto fresh_gsq = [&] {
     fresh.set_neighbor_poses(agent.Yn);
     return fresh.riemannian_gradient(agent.Y, fresh.euclidean_gradient(agent.Y)).squaredNorm();
@@ -153,25 +151,18 @@ TEST(DistributedSolver, ActiveRowUpdateEqualsTheFullRankUpdate) {
   const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
   const int r = 5;
   const Eigen::MatrixXd X = lift_poses(g.initial, r);
-  auto gather = [&](const Eigen::MatrixXd& from, const std::vector<std::size_t>& which) {
-    Eigen::MatrixXd out(r, 4 * static_cast<Eigen::Index>(which.size()));
-    for (std::size_t s = 0; s < which.size(); ++s)
-      out.middleCols(4 * static_cast<Eigen::Index>(s), 4) =
-          from.middleCols(4 * static_cast<Eigen::Index>(which[s]), 4);
-    return out;
-  };
   const auto& ids = layout.poses[0];
   BlockProblem full(3, ids, g.measurements);
   BlockPreconditioner precon(full);
   const LiftedManifold M = full.manifold(r);
   // Start away from the optimum of the block so that the update moves.
   std::srand(4);
-  const Eigen::MatrixXd Y0 = gather(X, ids);
+  const Eigen::MatrixXd Y0 = pose_columns(X, 3, ids);
   const Eigen::MatrixXd tangent = M.tangent_project(Y0, Eigen::MatrixXd::Random(r, Y0.cols()));
   Eigen::MatrixXd start = M.retract(Y0, 0.2 * tangent);
   start.bottomRows(r - 3).setZero();  // keep the zero rows of the lifting
   start = M.project(start);
-  const Eigen::MatrixXd Yn = gather(X, full.neighbors());
+  const Eigen::MatrixXd Yn = pose_columns(X, 3, full.neighbors());
 
   // The Q_BB preconditioner on both sides (the tangent one exists at rank d only).
   BlockUpdateOptions euclidean;
@@ -203,16 +194,9 @@ TEST(DistributedSolver, GreedyNewtonScoreIsThePreconditionedGradientNorm) {
   for (std::size_t i = 0; i < g.num_poses; ++i) a[i] = i < 15 ? 0 : 1;
   const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
   const Eigen::MatrixXd X = lift_poses(g.initial, 5);
-  auto gather = [&](const std::vector<std::size_t>& which) {
-    Eigen::MatrixXd out(5, 3 * static_cast<Eigen::Index>(which.size()));
-    for (std::size_t s = 0; s < which.size(); ++s)
-      out.middleCols(3 * static_cast<Eigen::Index>(s), 3) =
-          X.middleCols(3 * static_cast<Eigen::Index>(which[s]), 3);
-    return out;
-  };
-  AgentState agent(0, 2, layout, g.measurements, gather(layout.poses[0]));
+  AgentState agent(0, 2, layout, g.measurements, pose_columns(X, 2, layout.poses[0]));
   BlockProblem fresh(2, layout.poses[0], g.measurements);
-  agent.Yn = gather(fresh.neighbors());
+  agent.Yn = pose_columns(X, 2, fresh.neighbors());
   fresh.set_neighbor_poses(agent.Yn);
   const Eigen::MatrixXd grad =
       fresh.riemannian_gradient(agent.Y, fresh.euclidean_gradient(agent.Y));

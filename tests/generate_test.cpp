@@ -37,6 +37,22 @@ double edge_residual(const Measurement& m, const std::vector<Pose>& x) {
   return m.kappa * (b.R - a.R * m.R).squaredNorm() + m.tau * (b.t - a.t - a.R * m.t).squaredNorm();
 }
 
+// A graph with the given noise (rotation rad, translation m); every other option as options_for.
+GeneratorResult generate_with_noise(TrajectoryKind kind, std::size_t n, std::size_t robots,
+                                    double rotation_noise, double translation_noise) {
+  GeneratorOptions o = options_for(kind, n, robots);
+  o.rotation_noise = rotation_noise;
+  o.translation_noise = translation_noise;
+  return generate_pose_graph(o);
+}
+
+// The cost of the generated graph at its ground truth (sum of edge_residual).
+double residual_at_truth(const GeneratorResult& r) {
+  double f = 0;
+  for (const auto& m : r.graph.measurements) f += edge_residual(m, r.ground_truth);
+  return f;
+}
+
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream s;
@@ -141,18 +157,14 @@ TEST(Generator, ClosureProbabilityAndCap) {
 TEST(Generator, NoiseFreeGraphHasZeroResidualAtTheTruthAndExactInitialGuess) {
   for (TrajectoryKind kind : kAllKinds) {
     SCOPED_TRACE(trajectory_kind_name(kind));
-    GeneratorOptions o = options_for(kind, 400, 3);
-    o.rotation_noise = 0;
-    o.translation_noise = 0;
-    const GeneratorResult r = generate_pose_graph(o);
-    double f = 0;
+    const std::size_t n = 400;
+    const GeneratorResult r = generate_with_noise(kind, n, 3, 0, 0);
     for (const auto& m : r.graph.measurements) {
       EXPECT_TRUE(std::isfinite(m.kappa) && m.kappa > 0);
       EXPECT_TRUE(std::isfinite(m.tau) && m.tau > 0);
-      f += edge_residual(m, r.ground_truth);
     }
-    EXPECT_LT(f, 1e-18);
-    for (std::size_t k = 0; k < o.num_poses; ++k) {
+    EXPECT_LT(residual_at_truth(r), 1e-18);
+    for (std::size_t k = 0; k < n; ++k) {
       EXPECT_LT((r.graph.initial[k].t - r.ground_truth[k].t).norm(), 1e-9);
       EXPECT_LT((r.graph.initial[k].R - r.ground_truth[k].R).norm(), 1e-9);
     }
@@ -182,14 +194,10 @@ TEST(Generator, GroundTruthIsRigidAndStepsAreAboutOneMetre) {
 TEST(Generator, WeightsAreConsistentWithTheNoise) {
   for (TrajectoryKind kind : kAllKinds) {
     SCOPED_TRACE(trajectory_kind_name(kind));
-    GeneratorOptions o = options_for(kind, 4000, 2);
-    o.rotation_noise = 0.02;
-    o.translation_noise = 0.1;
-    const GeneratorResult r = generate_pose_graph(o);
-    double f = 0;
-    for (const auto& m : r.graph.measurements) f += edge_residual(m, r.ground_truth);
+    const GeneratorResult r = generate_with_noise(kind, 4000, 2, 0.02, 0.1);
     const double expected = r.graph.d == 2 ? 3.0 : 6.0;
-    EXPECT_NEAR(f / double(r.graph.num_measurements()), expected, 0.05 * expected);
+    EXPECT_NEAR(residual_at_truth(r) / double(r.graph.num_measurements()), expected,
+                0.05 * expected);
     EXPECT_DOUBLE_EQ(r.graph.measurements[0].kappa, 1.0 / (2 * 0.02 * 0.02));
     EXPECT_DOUBLE_EQ(r.graph.measurements[0].tau, 1.0 / (0.1 * 0.1));
   }
