@@ -195,17 +195,42 @@ bool make_run_and_foreign_identities(const std::string& sec, const std::string& 
                      nullptr) == 0;
 }
 
+// A test folder for a watched secured run: the run's identities go to sec, foreign ones
+// (the outsiders') to other; graph is a 6 x 5 grid.
+struct WatchedFolder {
+  std::string dir, sec, other, graph;
+};
+
+WatchedFolder watched_folder() {
+  WatchedFolder f;
+  f.dir = temp_dir();
+  f.sec = f.dir + "/sec";
+  f.other = f.dir + "/other";
+  f.graph = write_file(f.dir, "g.g2o", grid_graph_g2o(6, 5));
+  return f;
+}
+
+// Every agent's closing line names a cost, and all name the same one (to the printed digits).
+void expect_one_cost(const std::vector<std::string>& agent_outputs) {
+  std::string cost;
+  for (const std::string& out : agent_outputs) {
+    const auto c = out.find(" cost ");
+    ASSERT_NE(c, std::string::npos) << out;
+    const std::string mine = out.substr(c, out.find(',', c) - c);
+    if (cost.empty()) cost = mine;
+    EXPECT_EQ(mine, cost) << out;
+  }
+}
+
 TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
   if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
-  const std::string dir = temp_dir();
-  const std::string sec = dir + "/sec", other = dir + "/other";
-  ASSERT_TRUE(make_run_and_foreign_identities(sec, other));
-  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 5));
+  const WatchedFolder f = watched_folder();
+  ASSERT_TRUE(make_run_and_foreign_identities(f.sec, f.other));
   // Fast DDS 2.9 sometimes never completes one pair's PKI-DH handshake (about one secured
   // run in ten with 3 agents, one in two with 5, more under load; docs/dds-runtime.md,
   // "Security"). Agents now re-create their participant when that happens
   // (transport/peer_gate.hpp), so the run must finish on the first attempt: no retry.
-  const WatchedRun run = secured_run_is_watched_safely(dir, sec, other, graph, 195);
+  const WatchedRun run = secured_run_is_watched_safely(f.dir, f.sec, f.other, f.graph, 195);
   EXPECT_FALSE(run.stalled) << "the secured run stalled in set-up:\n" << run.coordinator;
   run_command("fastdds shm clean", nullptr);
 }
@@ -218,12 +243,10 @@ TEST(DdsSecurity, OutsidersReadNothingOfASecuredRun) {
 // still read nothing.
 TEST(DdsSecurity, AgentsThatRecreateTheirParticipantFinishUnreadByOutsiders) {
   if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
-  const std::string dir = temp_dir();
-  const std::string sec = dir + "/sec", other = dir + "/other";
-  ASSERT_TRUE(make_run_and_foreign_identities(sec, other));
-  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 5));
+  const WatchedFolder f = watched_folder();
+  ASSERT_TRUE(make_run_and_foreign_identities(f.sec, f.other));
   const WatchedRun run =
-      secured_run_is_watched_safely(dir, sec, other, graph, 72, {}, /*forced_agent=*/2,
+      secured_run_is_watched_safely(f.dir, f.sec, f.other, f.graph, 72, {}, /*forced_agent=*/2,
                                     {"--handshake-stall", "0.001", "--handshake-retries", "1"});
   ASSERT_FALSE(run.stalled) << run.coordinator;
   ASSERT_EQ(run.agents.size(), 3u);
@@ -232,7 +255,6 @@ TEST(DdsSecurity, AgentsThatRecreateTheirParticipantFinishUnreadByOutsiders) {
     for (auto at = out.find(what); at != std::string::npos; at = out.find(what, at + 1)) ++n;
     return n;
   };
-  std::string cost;
   for (std::size_t k = 0; k < run.agents.size(); ++k) {
     const std::string& out = run.agents[k];
     // Agent 2 is forced exactly once (its retries are 1). The others re-create only as the
@@ -244,12 +266,8 @@ TEST(DdsSecurity, AgentsThatRecreateTheirParticipantFinishUnreadByOutsiders) {
     else
       EXPECT_EQ(recreated, count(out, "unfinished after 4 s")) << out;
     EXPECT_EQ(out.find("lost"), std::string::npos) << out;
-    const auto c = out.find(" cost ");
-    ASSERT_NE(c, std::string::npos) << out;
-    const std::string mine = out.substr(c, out.find(',', c) - c);
-    if (cost.empty()) cost = mine;
-    EXPECT_EQ(mine, cost) << out;
   }
+  expect_one_cost(run.agents);
   EXPECT_EQ(run.coordinator.find("claim"), std::string::npos) << run.coordinator;
   EXPECT_EQ(run.coordinator.find("lost"), std::string::npos) << run.coordinator;
   run_command("fastdds shm clean", nullptr);
@@ -263,27 +281,20 @@ TEST(DdsSecurity, AgentsThatRecreateTheirParticipantFinishUnreadByOutsiders) {
 // other outsiders) read nothing.
 TEST(DdsSecurity, ImpostorsOfMemberNamesNeitherStopNorSteerASecuredRun) {
   if (!have_openssl()) GTEST_SKIP() << "openssl is not installed, skipping";
-  const std::string dir = temp_dir();
-  const std::string sec = dir + "/sec", other = dir + "/other";
-  ASSERT_TRUE(make_run_and_foreign_identities(sec, other));
-  const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 5));
-  const WatchedRun run =
-      secured_run_is_watched_safely(dir, sec, other, graph, 42, {}, -1, {}, /*impostors=*/true);
+  const WatchedFolder f = watched_folder();
+  ASSERT_TRUE(make_run_and_foreign_identities(f.sec, f.other));
+  const WatchedRun run = secured_run_is_watched_safely(f.dir, f.sec, f.other, f.graph, 42, {}, -1,
+                                                       {}, /*impostors=*/true);
   ASSERT_FALSE(run.stalled) << run.coordinator;
   ASSERT_EQ(run.agents.size(), 3u);
   EXPECT_EQ(run.coordinator.find("claim"), std::string::npos) << run.coordinator;
   EXPECT_EQ(run.coordinator.find("lost"), std::string::npos) << run.coordinator;
-  std::string cost;
   for (const std::string& out : run.agents) {
     EXPECT_EQ(out.find("claim"), std::string::npos) << out;
     EXPECT_EQ(out.find("lost"), std::string::npos) << out;
     EXPECT_EQ(out.find("UDP only"), std::string::npos) << out;
-    const auto c = out.find(" cost ");
-    ASSERT_NE(c, std::string::npos) << out;
-    const std::string mine = out.substr(c, out.find(',', c) - c);
-    if (cost.empty()) cost = mine;
-    EXPECT_EQ(mine, cost) << out;
   }
+  expect_one_cost(run.agents);
   run_command("fastdds shm clean", nullptr);
 }
 
