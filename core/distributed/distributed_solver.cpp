@@ -54,17 +54,29 @@ void DistributedOptions::validate() const {
   }
 }
 
-DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<int>& assignment,
-                                    const DistributedOptions& options,
-                                    const std::vector<Pose>& initial) {
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  auto since = [](Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-  };
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// Both entry points refuse bad options before any work; the rank check needs the graph's d,
+// which DistributedOptions::validate() cannot know.
+void check_options(const PoseGraph& graph, const DistributedOptions& options) {
   options.validate();
   if (options.rank < graph.d)
     throw InputError("DistributedOptions.rank must be >= d = " + std::to_string(graph.d));
+}
+
+}  // namespace
+
+DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<int>& assignment,
+                                    const DistributedOptions& options,
+                                    const std::vector<Pose>& initial) {
+  const auto start = Clock::now();
+  check_options(graph, options);
   // Checks the assignment before the (possibly costly) initial guess.
   const int N = make_block_layout(graph.num_poses, graph.measurements, assignment).num_blocks;
   std::vector<Pose> init = initial;
@@ -84,14 +96,8 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
                                                 const std::vector<int>& assignment,
                                                 const DistributedOptions& options,
                                                 const Eigen::MatrixXd& X0) {
-  using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  auto since = [](Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-  };
-  options.validate();
-  if (options.rank < graph.d)
-    throw InputError("DistributedOptions.rank must be >= d = " + std::to_string(graph.d));
+  check_options(graph, options);
   const Eigen::Index w = graph.d + 1;
   if (X0.rows() != options.rank || X0.cols() != w * static_cast<Eigen::Index>(graph.num_poses))
     throw InputError("distributed solve: lifted starting point is " + std::to_string(X0.rows()) +
