@@ -47,6 +47,10 @@ struct Fixture {
     a.insert(a.end(), {"--dump-local", dir + "/local" + std::to_string(k) + ".txt"});
     return a;
   }
+  // Every agent with agent_extra() (checkpoints in ckpt) and --dump-local DIR/local<k>.txt.
+  std::vector<Process> launch_agents() const {
+    return start_agents(dir, graph, agents, run, domain, agent_extra(), true);
+  }
   Process coordinator(double rejoin_timeout) const {
     std::vector<std::string> c = {"--timeout",
                                   "20",
@@ -69,6 +73,15 @@ struct Fixture {
     return start(coordinator_args(agents, run, domain, c), dir + "/coordinator.log");
   }
 };
+
+// Waits up to wait_s for `line` in p's output, then SIGKILLs `victim` either way (so a failed
+// wait leaves no agent running on); true when the line came.
+bool kill_once_it_prints(const Process& p, const std::string& line, double wait_s,
+                         Process& victim) {
+  const bool seen = wait_for_output(p, line, wait_s);
+  kill(victim.pid, SIGKILL);
+  return seen;
+}
 
 // Agents with checkpoints in DIR/ckpt, on a generated 300-pose graph.
 Fixture make_fixture(int agents, int domain, const std::string& name) {
@@ -105,12 +118,9 @@ TEST(DdsRejoin, KilledAgentRestartedWithSameIdFinishesAtTheUndisturbedCost) {
   const std::string& ckpt = f.ckpt;
 
   Process coord = f.coordinator(20);
-  std::vector<Process> agents =
-      start_agents(f.dir, f.graph, f.agents, f.run, f.domain, f.agent_extra(), true);
+  std::vector<Process> agents = f.launch_agents();
   // Kill agent 2 in the middle of the rounds.
-  const bool started = wait_for_output(coord, "round 4:", 30);
-  kill(agents[2].pid, SIGKILL);
-  ASSERT_TRUE(started) << coord.output();
+  ASSERT_TRUE(kill_once_it_prints(coord, "round 4:", 30, agents[2])) << coord.output();
   ASSERT_TRUE(wait_all({&agents[2]}, 5));
   EXPECT_EQ(agents[2].exit_code, 128 + SIGKILL);
   Process again = start(f.agent_args(2), f.dir + "/agent2-restarted.log");
@@ -148,11 +158,8 @@ TEST(DdsRejoin, SecuredRestartedAgentPassesThePeerGateThenRejoins) {
   f.agent_extras = {"--udp-only"};
 
   Process coord = f.coordinator(20);
-  std::vector<Process> agents =
-      start_agents(f.dir, f.graph, f.agents, f.run, f.domain, f.agent_extra(), true);
-  const bool started = wait_for_output(coord, "round 4:", 40);
-  kill(agents[1].pid, SIGKILL);
-  ASSERT_TRUE(started) << coord.output();
+  std::vector<Process> agents = f.launch_agents();
+  ASSERT_TRUE(kill_once_it_prints(coord, "round 4:", 40, agents[1])) << coord.output();
   ASSERT_TRUE(wait_all({&agents[1]}, 5));
   // The restarted process judges every handshake unfinished after 1 ms stalled and
   // re-creates its participant once before asking to rejoin.
@@ -182,11 +189,8 @@ TEST(DdsRejoin, AgentThatDoesNotComeBackStopsTheRunAfterTheRejoinTimeout) {
   const Fixture f = make_fixture(3, 182, "norejoin");
   ASSERT_FALSE(::testing::Test::HasFailure());
   Process coord = f.coordinator(2);
-  std::vector<Process> agents =
-      start_agents(f.dir, f.graph, f.agents, f.run, f.domain, f.agent_extra(), true);
-  const bool started = wait_for_output(coord, "round 2:", 30);
-  kill(agents[1].pid, SIGKILL);
-  ASSERT_TRUE(started) << coord.output();
+  std::vector<Process> agents = f.launch_agents();
+  ASSERT_TRUE(kill_once_it_prints(coord, "round 2:", 30, agents[1])) << coord.output();
   const auto killed = Clock::now();
   std::vector<Process*> all = {&coord, &agents[0], &agents[1], &agents[2]};
   EXPECT_TRUE(wait_all(all, 30)) << "a process hung";
