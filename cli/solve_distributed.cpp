@@ -17,13 +17,12 @@
 namespace tessera::cli {
 
 const char* const kDistributedValued[] = {
-    "agents",           "partition",      "max-rounds",       "seed",
-    "reference-cost",   "select",         "rel-tol",          "tr-steps",
-    "restart-c",        "sigma",          "unselected",       "irbcd-n",
-    "tcg-iters",        "robots",         "certify-grad-tol", "certify-iters",
-    "certify-residual", "certify-precon", "block-precon",     "tangent-refresh",
-    "tcg-kappa",        "sigma-shrink",   "sigma-saturation", "sigma-theta",
-    "sigma-min",        "sigma-max",      "irbcd-a0",         nullptr};
+    "agents",        "partition",        "max-rounds",       "seed",         "reference-cost",
+    "select",        "rel-tol",          "tr-steps",         "restart-c",    "sigma",
+    "unselected",    "irbcd-n",          "tcg-iters",        "robots",       "certify-grad-tol",
+    "certify-iters", "certify-residual", "certify-precon",   "block-precon", "tangent-refresh",
+    "tcg-kappa",     "sigma-shrink",     "sigma-saturation", "sigma-theta",  "sigma-min",
+    "sigma-max",     "irbcd-a0",         "tangent-radius",   nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
                                             "irbcd-keep-ab", nullptr};
@@ -55,6 +54,8 @@ const char* kDistributedHelp =
     "                            the Q_BB factor (docs/irbcd.md section 12)\n"
     "  --tangent-refresh K       refactor the tangent factor at the current point every K\n"
     "                            updates of an agent (default 0: once, at its first update)\n"
+    "  --tangent-radius S        first trust-region radius of a tangent-preconditioned update,\n"
+    "                            in units of its preconditioned gradient norm (default 3)\n"
     "  --restart-c C             restart constant c1 of RBCD++/IRBCD (< 0: never restart)\n"
     "  --sigma S                 IRBCD sigma (default 1e-4; the paper: 1e-3)\n"
     "  --sigma-adapt, --sigma-fixed   IRBCD: adapt sigma at restarts / when gamma saturates\n"
@@ -133,6 +134,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   }
   opt.block_update.tangent_refresh_interval =
       static_cast<int>(a.get_long("tangent-refresh", opt.block_update.tangent_refresh_interval));
+  opt.block_update.tangent_radius_scale =
+      a.get_double("tangent-radius", opt.block_update.tangent_radius_scale);
   opt.block_update.max_attempts =
       std::max(opt.block_update.max_attempts, opt.block_update.trust_region_steps);
   if (a.has("restart-c")) {

@@ -117,6 +117,11 @@ TEST(DistributedCli, RejectsBadOptions) {
                 test::bin("tessera") + " solve " + g + " --algorithm irbcd --grad-tol -1", &out),
             2);
   EXPECT_NE(out.find("grad_norm_tol"), std::string::npos) << out;
+  EXPECT_EQ(
+      test::run_command(
+          test::bin("tessera") + " solve " + g + " --algorithm irbcd --tangent-radius 0", &out),
+      2);
+  EXPECT_NE(out.find("tangent_radius_scale"), std::string::npos) << out;
   EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + g + " --algorithm sgd", &out), 2);
   EXPECT_NE(out.find("irbcd"), std::string::npos) << out;
 }
