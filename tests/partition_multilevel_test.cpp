@@ -14,6 +14,7 @@
 #include "partition/multilevel.hpp"
 #include "partition/partition_metrics.hpp"
 #include "partition/partitioner.hpp"
+#include "structure_graphs.hpp"
 #include "util/input_error.hpp"
 
 namespace {
@@ -31,13 +32,7 @@ GraphStructure path_graph(std::size_t n) {
 }
 
 GraphStructure grid_graph(std::size_t w, std::size_t h) {
-  Pairs p;
-  for (std::size_t y = 0; y < h; ++y)
-    for (std::size_t x = 0; x < w; ++x) {
-      if (x + 1 < w) p.emplace_back(y * w + x, y * w + x + 1);
-      if (y + 1 < h) p.emplace_back(y * w + x, (y + 1) * w + x);
-    }
-  return make_graph_structure(w * h, p, "grid");
+  return test::grid_structure(w, h);
 }
 
 // Two cliques of size s joined by one edge (between vertex 0 and vertex s).

@@ -12,6 +12,7 @@
 #include "partition/partition_metrics.hpp"
 #include "partition/partitioner.hpp"
 #include "partition/spectral_layouts.hpp"
+#include "structure_graphs.hpp"
 #include "util/input_error.hpp"
 
 namespace {
@@ -21,13 +22,7 @@ using namespace tessera::partition_detail;
 using Pairs = std::vector<std::pair<std::size_t, std::size_t>>;
 
 GraphStructure grid_graph(std::size_t w, std::size_t h) {
-  Pairs p;
-  for (std::size_t y = 0; y < h; ++y)
-    for (std::size_t x = 0; x < w; ++x) {
-      if (x + 1 < w) p.emplace_back(y * w + x, y * w + x + 1);
-      if (y + 1 < h) p.emplace_back(y * w + x, (y + 1) * w + x);
-    }
-  return make_graph_structure(w * h, p, "grid");
+  return test::grid_structure(w, h);
 }
 
 // A spiral on a cylinder: pose i follows pose i - 1 and lies above pose i - turn (the pose
