@@ -245,23 +245,13 @@ namespace {
 using namespace tessera::partition_detail;
 
 CycleParams relaxed_cycle(long long ub, double coarse_relax) {
-  CycleParams cp;
-  cp.coarsening.stop_vertices = 100;
-  cp.coarsening.max_vertex_weight = static_cast<int>(std::max<long long>(2, ub / 30));
-  cp.coarsening.label_propagation_rounds = 3;
-  cp.initial.repeats = 4;
-  cp.initial.fm = cp.fm;
-  cp.use_flow = true;
-  cp.flow_levels = 2;
+  CycleParams cp = test::small_graph_cycle(ub);
   cp.coarse_relax = coarse_relax;
   return cp;
 }
 
 // The same balance bound for each of the k blocks: (1 + eps) ceil(n / k) poses.
-std::vector<long long> uniform_bounds(const GraphStructure& structure, int k, double eps) {
-  return std::vector<long long>(
-      k, static_cast<long long>(max_block_size(structure.num_vertices, k, eps)));
-}
+using test::uniform_bounds;
 
 void expect_within(const WorkGraph& g, const std::vector<int>& part, int k,
                    const std::vector<long long>& ub) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <string>
 
 #include "partition/evolutionary.hpp"
@@ -35,22 +36,14 @@ GraphStructure twisted_cylinder(std::size_t turn, std::size_t rings) {
   return make_graph_structure(n, p, "twisted cylinder");
 }
 
-std::vector<long long> bounds(const GraphStructure& s, int k, double eps) {
-  return std::vector<long long>(static_cast<std::size_t>(k),
-                                static_cast<long long>(max_block_size(s.num_vertices, k, eps)));
-}
+using test::uniform_bounds;
 
+// The small-graph cycle with more thorough FM (also in the initial partitioning).
 CycleParams cycle_for(long long ub) {
-  CycleParams cp;
-  cp.coarsening.stop_vertices = 100;
-  cp.coarsening.max_vertex_weight = static_cast<int>(std::max<long long>(2, ub / 30));
-  cp.coarsening.label_propagation_rounds = 3;
-  cp.initial.repeats = 4;
+  CycleParams cp = test::small_graph_cycle(ub);
   cp.fm.max_passes = 6;
   cp.fm.stop_after = 400;
   cp.initial.fm = cp.fm;
-  cp.use_flow = true;
-  cp.flow_levels = 2;
   return cp;
 }
 
@@ -72,7 +65,7 @@ TEST(SpectralLayouts, BandsOfALongGridAreOptimal) {
   const GraphStructure s = grid_graph(120, 8);
   const WorkGraph g = to_work_graph(s);
   const int k = 5;
-  const long long lmax = bounds(s, k, 0.03)[0];
+  const long long lmax = uniform_bounds(s, k, 0.03)[0];
   const std::vector<SpectralLayout> layouts = spectral_layouts(g, k, lmax, {});
   ASSERT_FALSE(layouts.empty());
   for (const auto& l : layouts) {
@@ -96,7 +89,7 @@ TEST(SpectralLayouts, BandsOfALongGridAreOptimal) {
 TEST(SpectralLayouts, DeterministicForTheSameGraphAndSeed) {
   const GraphStructure s = twisted_cylinder(30, 24);
   const WorkGraph g = to_work_graph(s);
-  const std::vector<long long> ub = bounds(s, 5, 0.03);
+  const std::vector<long long> ub = uniform_bounds(s, 5, 0.03);
   const auto a = spectral_layouts(g, 5, ub[0], {});
   const auto b = spectral_layouts(g, 5, ub[0], {});
   ASSERT_EQ(a.size(), b.size());
@@ -120,7 +113,7 @@ TEST(SpectralLayouts, RotationPolishFindsTheSeamAlignedCylinderLayout) {
   const GraphStructure s = twisted_cylinder(50, 50);
   const WorkGraph g = to_work_graph(s);
   const int k = 5;
-  const std::vector<long long> ub = bounds(s, k, 0.03);
+  const std::vector<long long> ub = uniform_bounds(s, k, 0.03);
   std::vector<int> known(2500);
   for (int i = 0; i < 2500; ++i) {
     const int ring = i / 50, col = i % 50;
@@ -156,7 +149,7 @@ TEST(SpectralLayouts, AfterTheSearchTheyNeverLoseTheBestCut) {
   const GraphStructure s = twisted_cylinder(50, 50);
   const WorkGraph g = to_work_graph(s);
   const int k = 5;
-  const std::vector<long long> ub = bounds(s, k, 0.03);
+  const std::vector<long long> ub = uniform_bounds(s, k, 0.03);
   EvolutionParams params;
   params.population = 3;
   params.generations = 6;
@@ -223,30 +216,21 @@ TEST(SpectralLayouts, BadOptionsNameTheField) {
   SpectralLayoutOptions o;
   o.eigenvectors = 0;
   EXPECT_NE(message(o).find("SpectralLayoutOptions.eigenvectors = 0"), std::string::npos);
-  o = {};
-  o.max_layouts = 0;
-  EXPECT_NE(message(o).find("max_layouts"), std::string::npos);
-  o = {};
-  o.rotations = 9;
-  EXPECT_NE(message(o).find("rotations"), std::string::npos);
-  o = {};
-  o.polish = -1;
-  EXPECT_NE(message(o).find("polish"), std::string::npos);
-  o = {};
-  o.rotation_steps = 0;
-  EXPECT_NE(message(o).find("rotation_steps"), std::string::npos);
-  o = {};
-  o.max_parts = 1;
-  EXPECT_NE(message(o).find("max_parts"), std::string::npos);
-  o = {};
-  o.max_vertices = 1;
-  EXPECT_NE(message(o).find("max_vertices"), std::string::npos);
-  o = {};
-  o.lanczos_tolerance = 0.0;
-  EXPECT_NE(message(o).find("lanczos_tolerance"), std::string::npos);
-  o = {};
-  o.lanczos_max_iterations = 0;
-  EXPECT_NE(message(o).find("lanczos_max_iterations"), std::string::npos);
+  // Each out-of-range field is named in the error.
+  const std::vector<std::pair<std::string, std::function<void(SpectralLayoutOptions&)>>> bad = {
+      {"max_layouts", [](SpectralLayoutOptions& x) { x.max_layouts = 0; }},
+      {"rotations", [](SpectralLayoutOptions& x) { x.rotations = 9; }},
+      {"polish", [](SpectralLayoutOptions& x) { x.polish = -1; }},
+      {"rotation_steps", [](SpectralLayoutOptions& x) { x.rotation_steps = 0; }},
+      {"max_parts", [](SpectralLayoutOptions& x) { x.max_parts = 1; }},
+      {"max_vertices", [](SpectralLayoutOptions& x) { x.max_vertices = 1; }},
+      {"lanczos_tolerance", [](SpectralLayoutOptions& x) { x.lanczos_tolerance = 0.0; }},
+      {"lanczos_max_iterations", [](SpectralLayoutOptions& x) { x.lanczos_max_iterations = 0; }}};
+  for (const auto& [field, spoil] : bad) {
+    o = {};
+    spoil(o);
+    EXPECT_NE(message(o).find(field), std::string::npos) << field;
+  }
   const GraphStructure grid = grid_graph(10, 10);
   o = {};
   o.eigenvectors = 7;

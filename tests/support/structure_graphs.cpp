@@ -1,7 +1,9 @@
 #include "structure_graphs.hpp"
 
+#include <algorithm>
 #include <utility>
-#include <vector>
+
+#include "partition/partition_metrics.hpp"
 
 namespace tessera::test {
 
@@ -13,6 +15,23 @@ GraphStructure grid_structure(std::size_t w, std::size_t h) {
       if (y + 1 < h) pairs.emplace_back(y * w + x, (y + 1) * w + x);
     }
   return make_graph_structure(w * h, pairs, "grid");
+}
+
+std::vector<long long> uniform_bounds(const GraphStructure& structure, int k, double eps) {
+  return std::vector<long long>(static_cast<std::size_t>(k), static_cast<long long>(max_block_size(
+                                                                 structure.num_vertices, k, eps)));
+}
+
+partition_detail::CycleParams small_graph_cycle(long long ub) {
+  partition_detail::CycleParams cp;
+  cp.coarsening.stop_vertices = 100;
+  cp.coarsening.max_vertex_weight = static_cast<int>(std::max<long long>(2, ub / 30));
+  cp.coarsening.label_propagation_rounds = 3;
+  cp.initial.repeats = 4;
+  cp.initial.fm = cp.fm;
+  cp.use_flow = true;
+  cp.flow_levels = 2;
+  return cp;
 }
 
 }  // namespace tessera::test

@@ -1,13 +1,24 @@
 #pragma once
-// Graph structures with known optimal cuts, shared by the partitioner's tests.
+// Graph structures with known optimal cuts, and the balance bounds and V-cycle set-up of small
+// graphs, shared by the partitioner's tests.
 
 #include <cstddef>
+#include <vector>
 
 #include "partition/graph_structure.hpp"
+#include "partition/multilevel.hpp"
 
 namespace tessera::test {
 
 /// A w x h 4-neighbour grid: vertex y * w + x is joined to its right and upper neighbours.
 GraphStructure grid_structure(std::size_t w, std::size_t h);
+
+/// The same balance bound for each of the k blocks: (1 + eps) ceil(n / k) vertices.
+std::vector<long long> uniform_bounds(const GraphStructure& structure, int k, double eps);
+
+/// A V-cycle for graphs of a few thousand vertices with block bound `ub`: coarsen to 100
+/// vertices (coarse vertices below ub / 30), 3 label-propagation rounds, 4 initial runs, flow
+/// refinement on the 2 finest levels, default FM everywhere.
+partition_detail::CycleParams small_graph_cycle(long long ub);
 
 }  // namespace tessera::test
