@@ -264,6 +264,32 @@ TEST(Momentum, ProjectionMatchesThePolarFactorNearAndFar) {
   }
 }
 
+// The round protocol forms P, V (and the neighbours' copies) in place in the agent's buffers:
+// writing into an existing matrix, or into one of the inputs, must give exactly what the
+// returning forms give, for every rank (the Gram entries of Proj_M are summed in an order that
+// depends on r) and for rank-deficient rows (the zero rows of a lifted start).
+TEST(Momentum, InPlaceFormsAreBitIdenticalToTheReturningForms) {
+  for (int d : {2, 3})
+    for (int r : {d, 4, 5, 7, 9}) {
+      const LiftedManifold M(r, d, 6);
+      const Eigen::MatrixXd Y = M.project(Eigen::MatrixXd::Random(r, 6 * (d + 1)));
+      const Eigen::MatrixXd V = M.project(Y + 0.05 * Eigen::MatrixXd::Random(r, 6 * (d + 1)));
+      const Eigen::MatrixXd Yn = M.project(Y + 0.05 * Eigen::MatrixXd::Random(r, 6 * (d + 1)));
+      const MomentumCoefficients c{0.4, 0.93, 1.7};
+      const Eigen::MatrixXd P = extrapolate(M, c, Y, V);
+      Eigen::MatrixXd P2 = Eigen::MatrixXd::Constant(r, 6 * (d + 1), 7.0);  // old contents
+      extrapolate_into(M, c, Y, V, P2);
+      EXPECT_TRUE(P2 == P) << d << " " << r;
+      const Eigen::MatrixXd Vn = momentum_update(M, c, V, P, Yn);
+      Eigen::MatrixXd V2 = V;
+      momentum_update_into(M, c, V2, P, Yn, V2);  // out aliases V, as in the protocol
+      EXPECT_TRUE(V2 == Vn) << d << " " << r;
+      EXPECT_LT(M.distance_from_manifold(V2), 1e-12);
+      Eigen::MatrixXd wrong(r, 3);
+      EXPECT_THROW(extrapolate_into(M, c, Y, wrong, P2), std::invalid_argument);
+    }
+}
+
 TEST(Irbcd, BadOptionsNameTheField) {
   IrbcdOptions o;
   o.b0 = -1;

@@ -1,6 +1,8 @@
 #include "distributed/momentum.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace tessera {
@@ -32,62 +34,143 @@ bool newton_schulz_inv_sqrt(const Eigen::Matrix<double, D, D>& B, Eigen::Matrix<
   return false;
 }
 
-template <int D>
-void project_poses(Eigen::MatrixXd& X, int d) {
-  using Small = Eigen::Matrix<double, D, D>;
-  const Eigen::Index n = X.cols() / (d + 1);
-  const Eigen::Index r = X.rows();
-  double tmp[D * 64];
-  for (Eigen::Index i = 0; i < n; ++i) {
-    auto A = X.middleCols((d + 1) * i, d);
-    const Small B = A.transpose() * A;
-    Small inv_sqrt;
-    if (!newton_schulz_inv_sqrt<D>(B, inv_sqrt)) {
-      Eigen::SelfAdjointEigenSolver<Small> es(B);
-      const auto& l = es.eigenvalues();
-      if (!(l(0) > 1e-12 * l(D - 1))) {  // (nearly) rank deficient: take the SVD's choice
-        A = polar_factor(Eigen::MatrixXd(A));
-        continue;
-      }
-      inv_sqrt = es.eigenvectors() * l.cwiseSqrt().cwiseInverse().asDiagonal() *
-                 es.eigenvectors().transpose();
+// sum_k x[k] y[k] for k < n, added in the order of Eigen 3.4's vectorised reduction of a
+// dynamic-length product with two-double packets (lanes of even and odd k, two packets per step,
+// then the lanes, then the odd tail), which is how `A.transpose() * A` formed each entry of
+// A^T A in the previous version. Keeping that order keeps Proj_M bit-identical to it (and so
+// every iterate of a run) while the hand-written loop skips Eigen's per-coefficient dispatch.
+inline double gram_entry(const double* x, const double* y, Eigen::Index n) {
+  if (n < 2) return n == 1 ? x[0] * y[0] : 0.0;
+  const Eigen::Index n2 = n / 2 * 2, n4 = n / 4 * 4;
+  double l0 = x[0] * y[0], l1 = x[1] * y[1];
+  if (n2 > 2) {
+    double h0 = x[2] * y[2], h1 = x[3] * y[3];
+    for (Eigen::Index k = 4; k < n4; k += 4) {
+      l0 += x[k] * y[k];
+      l1 += x[k + 1] * y[k + 1];
+      h0 += x[k + 2] * y[k + 2];
+      h1 += x[k + 3] * y[k + 3];
     }
-    if (r <= 64) {
-      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, D>> out(tmp, r, D);
-      out.noalias() = A * inv_sqrt;
-      A = out;
-    } else {
-      Eigen::Matrix<double, Eigen::Dynamic, D> out = A * inv_sqrt;
-      A = out;
+    l0 += h0;
+    l1 += h1;
+    if (n2 > n4) {
+      l0 += x[n4] * y[n4];
+      l1 += x[n4 + 1] * y[n4 + 1];
     }
   }
+  double s = l0 + l1;
+  for (Eigen::Index k = n2; k < n; ++k) s += x[k] * y[k];
+  return s;
+}
+
+// Replaces the r x D column-major Stiefel block at A by its polar factor.
+template <int D>
+void project_pose(double* A, Eigen::Index r) {
+  using Small = Eigen::Matrix<double, D, D>;
+  Small B;
+  for (int a = 0; a < D; ++a)
+    for (int b = a; b < D; ++b) B(a, b) = B(b, a) = gram_entry(A + a * r, A + b * r, r);
+  Small inv_sqrt;
+  if (!newton_schulz_inv_sqrt<D>(B, inv_sqrt)) {
+    Eigen::SelfAdjointEigenSolver<Small> es(B);
+    const auto& l = es.eigenvalues();
+    Eigen::Map<Eigen::MatrixXd> block(A, r, D);
+    if (!(l(0) > 1e-12 * l(D - 1))) {  // (nearly) rank deficient: take the SVD's choice
+      block = polar_factor(Eigen::MatrixXd(block));
+      return;
+    }
+    inv_sqrt = es.eigenvectors() * l.cwiseSqrt().cwiseInverse().asDiagonal() *
+               es.eigenvectors().transpose();
+  }
+  // Row by row, each entry summed over k in order (as the lazy product A * inv_sqrt did).
+  for (Eigen::Index i = 0; i < r; ++i) {
+    double row[D];
+    for (int j = 0; j < D; ++j) {
+      double s = A[i] * inv_sqrt(0, j);
+      for (int k = 1; k < D; ++k) s += A[k * r + i] * inv_sqrt(k, j);
+      row[j] = s;
+    }
+    for (int j = 0; j < D; ++j) A[j * r + i] = row[j];
+  }
+}
+
+// Proj_M applied pose by pose to out, after `blend` has written each pose's unprojected value
+// (r x (D+1), column-major) into out's storage for that pose. Pose i's output depends on pose
+// i's inputs only, so `out` may be one of the inputs.
+template <int D, typename Blend>
+void blend_and_project(Eigen::MatrixXd& out, Eigen::Index poses, const Blend& blend) {
+  const Eigen::Index r = out.rows(), w = (D + 1) * r;
+  double* base = out.data();
+  for (Eigen::Index i = 0; i < poses; ++i) {
+    blend(i * w, w, base + i * w);
+    project_pose<D>(base + i * w, r);
+  }
+}
+
+template <typename Blend>
+void blend_and_project(const LiftedManifold& M, Eigen::MatrixXd& out, const Blend& blend) {
+  const Eigen::Index poses = out.cols() / (M.dim() + 1);
+  if (M.dim() == 2)
+    blend_and_project<2>(out, poses, blend);
+  else
+    blend_and_project<3>(out, poses, blend);
+}
+
+void check_same_shape(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const char* what) {
+  if (a.rows() != b.rows() || a.cols() != b.cols())
+    throw std::invalid_argument(std::string(what) + ": operands of different shapes");
 }
 
 }  // namespace
 
 Eigen::MatrixXd project_to_manifold(const LiftedManifold& M, Eigen::MatrixXd X) {
-  if (M.dim() == 2)
-    project_poses<2>(X, 2);
-  else
-    project_poses<3>(X, 3);
+  blend_and_project(M, X, [](Eigen::Index, Eigen::Index, double*) {});
   return X;
 }
 
-namespace {
-Eigen::MatrixXd project(const LiftedManifold& M, Eigen::MatrixXd X) {
-  return project_to_manifold(M, std::move(X));
+void extrapolate_into(const LiftedManifold& M, const MomentumCoefficients& c,
+                      const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V, Eigen::MatrixXd& out) {
+  check_same_shape(Y, V, "extrapolate");
+  out.resize(Y.rows(), Y.cols());  // no reallocation when the shape is already right
+  const double a = c.alpha, one_minus_a = 1.0 - c.alpha;
+  const double* y = Y.data();
+  const double* v = V.data();
+  blend_and_project(M, out, [&](Eigen::Index at, Eigen::Index n, double* dst) {
+    // Element by element the expression alpha V + (1 - alpha) Y of the previous version.
+    for (Eigen::Index k = 0; k < n; ++k) dst[k] = a * v[at + k] + one_minus_a * y[at + k];
+  });
 }
-}  // namespace
+
+void momentum_update_into(const LiftedManifold& M, const MomentumCoefficients& c,
+                          const Eigen::MatrixXd& V, const Eigen::MatrixXd& P,
+                          const Eigen::MatrixXd& Y_new, Eigen::MatrixXd& out) {
+  check_same_shape(V, P, "momentum_update");
+  check_same_shape(V, Y_new, "momentum_update");
+  if (&out != &V && &out != &P && &out != &Y_new) out.resize(V.rows(), V.cols());
+  const double b = c.beta, one_minus_b = 1.0 - c.beta, g = c.gamma;
+  const double* v = V.data();
+  const double* p = P.data();
+  const double* y = Y_new.data();
+  blend_and_project(M, out, [&](Eigen::Index at, Eigen::Index n, double* dst) {
+    // (beta V + (1 - beta) P) + gamma (Y_new - P), element by element, as before.
+    for (Eigen::Index k = 0; k < n; ++k)
+      dst[k] = (b * v[at + k] + one_minus_b * p[at + k]) + g * (y[at + k] - p[at + k]);
+  });
+}
 
 Eigen::MatrixXd extrapolate(const LiftedManifold& M, const MomentumCoefficients& c,
                             const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V) {
-  return project(M, c.alpha * V + (1.0 - c.alpha) * Y);
+  Eigen::MatrixXd out;
+  extrapolate_into(M, c, Y, V, out);
+  return out;
 }
 
 Eigen::MatrixXd momentum_update(const LiftedManifold& M, const MomentumCoefficients& c,
                                 const Eigen::MatrixXd& V, const Eigen::MatrixXd& P,
                                 const Eigen::MatrixXd& Y_new) {
-  return project(M, c.beta * V + (1.0 - c.beta) * P + c.gamma * (Y_new - P));
+  Eigen::MatrixXd out;
+  momentum_update_into(M, c, V, P, Y_new, out);
+  return out;
 }
 
 }  // namespace tessera

@@ -57,4 +57,14 @@ Eigen::MatrixXd momentum_update(const LiftedManifold& M, const MomentumCoefficie
                                 const Eigen::MatrixXd& V, const Eigen::MatrixXd& P,
                                 const Eigen::MatrixXd& Y_new);
 
+/// The same two into `out`, bit-identical to the functions above, computed pose by pose in
+/// out's storage (no allocation when out already has the shape). `out` may be one of the
+/// inputs (the round protocol updates V in place). Throws std::invalid_argument when the
+/// inputs' shapes differ.
+void extrapolate_into(const LiftedManifold& M, const MomentumCoefficients& c,
+                      const Eigen::MatrixXd& Y, const Eigen::MatrixXd& V, Eigen::MatrixXd& out);
+void momentum_update_into(const LiftedManifold& M, const MomentumCoefficients& c,
+                          const Eigen::MatrixXd& V, const Eigen::MatrixXd& P,
+                          const Eigen::MatrixXd& Y_new, Eigen::MatrixXd& out);
+
 }  // namespace tessera

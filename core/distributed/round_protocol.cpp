@@ -185,7 +185,7 @@ void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
       // The neighbours' V^{k+1}, exactly as each of them forms its own (same scalars, same
       // pose-wise arithmetic), from the coefficients of the round just finished.
       if (scheme_)
-        state_.Vn = momentum_update(state_.manifold(), coeff_, state_.Vn, state_.Pn, state_.Yn);
+        momentum_update_into(state_.manifold(), coeff_, state_.Vn, state_.Pn, state_.Yn, state_.Vn);
       ++round_;
       begin_status(ProtocolPhase::kStatus, out);
       return;
@@ -286,8 +286,8 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   }
   coeff_ = scheme_->coefficients();
   // P^k needs no exchange: the neighbours' public P^k is formed from their mirrored V^k.
-  state_.P = extrapolate(state_.manifold(), coeff_, state_.Y, state_.V);
-  state_.Pn = extrapolate(state_.manifold(), coeff_, state_.Yn, state_.Vn);
+  extrapolate_into(state_.manifold(), coeff_, state_.Y, state_.V, state_.P);
+  extrapolate_into(state_.manifold(), coeff_, state_.Yn, state_.Vn, state_.Pn);
   begin_update(out);
 }
 
@@ -320,7 +320,7 @@ void RoundProtocol::begin_update(std::vector<OutgoingMessage>& out) {
     Y_new = (accelerated && scheme_->unselected_take_extrapolation()) ? state_.P : state_.Y;
   }
   if (accelerated) {
-    state_.V = momentum_update(state_.manifold(), coeff_, state_.V, state_.P, Y_new);
+    momentum_update_into(state_.manifold(), coeff_, state_.V, state_.P, Y_new, state_.V);
     scheme_->advance();
   }
   state_.Y = std::move(Y_new);

@@ -8,7 +8,44 @@
 
 namespace tessera {
 
+namespace {
+
+// Eigen's CHOLMOD wrapper with access to the factor, so that solves can go through
+// cholmod_solve2 with workspace kept across calls (Eigen's solve allocates and frees the result
+// and two work arrays on every call: three heap blocks per tCG iteration, first-touched each time).
+class CholmodLdlt : public Eigen::CholmodDecomposition<SparseMatrix> {
+ public:
+  cholmod_factor* factor() const { return m_cholmodFactor; }
+};
+
+}  // namespace
+
 struct TangentPreconditioner::Factor {
+  ~Factor() {
+    cholmod_common& c = llt.cholmod();
+    for (cholmod_dense** x : {&solve_x, &solve_y, &solve_e})
+      if (*x) cholmod_free_dense(x, &c);
+  }
+  // A^{-1} b for the right-hand side in `b`; the result lives in solve_x (valid until the next
+  // call). The same numeric solve as CholmodDecomposition::solve (cholmod_solve calls
+  // cholmod_solve2 with fresh workspace), hence the same result.
+  const double* solve() {
+    cholmod_dense rhs;
+    rhs.nrow = static_cast<std::size_t>(b.size());
+    rhs.ncol = 1;
+    rhs.nzmax = rhs.nrow;
+    rhs.d = rhs.nrow;
+    rhs.x = b.data();
+    rhs.z = nullptr;
+    rhs.xtype = CHOLMOD_REAL;
+    rhs.dtype = CHOLMOD_DOUBLE;
+    cholmod_common& c = llt.cholmod();
+    if (!cholmod_solve2(CHOLMOD_A, llt.factor(), &rhs, nullptr, &solve_x, nullptr, &solve_y,
+                        &solve_e, &c))
+      throw std::runtime_error("TangentPreconditioner: CHOLMOD solve failed");
+    return static_cast<const double*>(solve_x->x);
+  }
+
   int d = 0;
   int p = 0;  // coordinates per pose
   Eigen::Index m = 0;
@@ -20,7 +57,10 @@ struct TangentPreconditioner::Factor {
   std::vector<double> q_blocks;
   // A with its full pattern (every pose-block pair p x p dense; CHOLMOD reads the lower half).
   SparseMatrix A;
-  Eigen::CholmodDecomposition<SparseMatrix> llt;
+  CholmodLdlt llt;
+  // Solve workspace, reused by every apply (agents apply their own preconditioner only).
+  Eigen::VectorXd b;
+  cholmod_dense *solve_x = nullptr, *solve_y = nullptr, *solve_e = nullptr;
   std::size_t entries = 0;
   bool usable = false;
   bool factored = false;
@@ -218,42 +258,80 @@ bool TangentPreconditioner::prepare(const Eigen::MatrixXd& X, int refresh_interv
   return true;
 }
 
+namespace {
+
+// J^T V and J c pose by pose for a fixed d (2 or 3): fixed-size arrays instead of dynamic d x d
+// products (whose per-coefficient dispatch was ~40% of an apply on parking-garage). Every dot
+// product is summed over k = 0..d-1 in order, as Eigen's lazy products of the previous
+// version did, so the result is bit-identical to it.
+template <int D>
+void tangent_coordinates(const Eigen::MatrixXd& X, const Eigen::MatrixXd& V, Eigen::Index m,
+                         double* b) {
+  constexpr int W = D + 1, P = D * (D + 1) / 2, NR = P - D;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const double* Y = X.data() + i * W * D;   // d x d rotation block, column-major
+    const double* Vi = V.data() + i * W * D;  // d x (d+1) pose block
+    double Wm[D][W];                          // Wm[a][c] = (Y^T V_i)(a, c)
+    for (int c = 0; c < W; ++c)
+      for (int a = 0; a < D; ++a) {
+        double s = Y[a * D] * Vi[c * D];
+        for (int k = 1; k < D; ++k) s += Y[a * D + k] * Vi[c * D + k];
+        Wm[a][c] = s;
+      }
+    double* bi = b + i * P;
+    int k = 0;
+    for (int a = 0; a < D; ++a)
+      for (int bb = a + 1; bb < D; ++bb, ++k) bi[k] = Wm[bb][a] - Wm[a][bb];
+    for (int a = 0; a < D; ++a) bi[NR + a] = Wm[a][D];
+  }
+}
+
+template <int D>
+void tangent_vector(const Eigen::MatrixXd& X, const double* c, Eigen::Index m, Eigen::MatrixXd& Z) {
+  constexpr int W = D + 1, P = D * (D + 1) / 2, NR = P - D;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const double* Y = X.data() + i * W * D;
+    const double* ci = c + i * P;
+    double S[W][D] = {};  // S[col][row]: Omega(omega) and u
+    int k = 0;
+    for (int a = 0; a < D; ++a)
+      for (int bb = a + 1; bb < D; ++bb, ++k) {
+        S[a][bb] += ci[k];
+        S[bb][a] -= ci[k];
+      }
+    for (int a = 0; a < D; ++a) S[D][a] = ci[NR + a];
+    double* Zi = Z.data() + i * W * D;
+    for (int col = 0; col < W; ++col)
+      for (int row = 0; row < D; ++row) {
+        double s = Y[row] * S[col][0];
+        for (int kk = 1; kk < D; ++kk) s += Y[kk * D + row] * S[col][kk];
+        Zi[col * D + row] = s;
+      }
+  }
+}
+
+}  // namespace
+
 Eigen::MatrixXd TangentPreconditioner::apply(const LiftedManifold&, const Eigen::MatrixXd& X,
                                              const Eigen::MatrixXd& V) const {
-  const Factor& f = *factor_;
+  Factor& f = *factor_;
   const int d = f.d, w = d + 1, p = f.p;
   if (!factored() || X.rows() != d || V.rows() != d || X.cols() != w * f.m || V.cols() != X.cols())
     throw std::logic_error("TangentPreconditioner::apply: not factored, or not a rank-d point");
-  const auto pairs = skew_pairs(d);
-  const int nr = static_cast<int>(pairs.size());
   // b = J^T V, pose by pose: omega_ab = <Y E_ab, V_R> = (Y^T V_R)(b, a) - (Y^T V_R)(a, b),
   // u = Y^T v.
-  Eigen::VectorXd b(f.m * p);
-  Eigen::MatrixXd W(d, w);
-  for (Eigen::Index i = 0; i < f.m; ++i) {
-    const auto Y = X.block(0, i * w, d, d);
-    W.noalias() = Y.transpose() * V.middleCols(i * w, w);
-    for (int k = 0; k < nr; ++k) {
-      const auto [a, bb] = pairs[static_cast<std::size_t>(k)];
-      b(i * p + k) = W(bb, a) - W(a, bb);
-    }
-    b.segment(i * p + nr, d) = W.col(d);
-  }
-  const Eigen::VectorXd c = f.llt.solve(b);
+  f.b.resize(f.m * p);
+  if (d == 2)
+    tangent_coordinates<2>(X, V, f.m, f.b.data());
+  else
+    tangent_coordinates<3>(X, V, f.m, f.b.data());
+  const double* c = f.solve();
   // Z = J c: rotation Y Omega(omega), translation Y u.
   Eigen::MatrixXd Z(d, V.cols());
-  Eigen::MatrixXd S(d, w);
-  for (Eigen::Index i = 0; i < f.m; ++i) {
-    S.setZero();
-    for (int k = 0; k < nr; ++k) {
-      const auto [a, bb] = pairs[static_cast<std::size_t>(k)];
-      const double omega = c(i * p + k);
-      S(bb, a) += omega;
-      S(a, bb) -= omega;
-    }
-    S.col(d) = c.segment(i * p + nr, d);
-    Z.middleCols(i * w, w).noalias() = X.block(0, i * w, d, d) * S;
-  }
+  if (d == 2)
+    tangent_vector<2>(X, c, f.m, Z);
+  else
+    tangent_vector<3>(X, c, f.m, Z);
   return Z;
 }
 
