@@ -1,10 +1,38 @@
 #include "partition/evolutionary.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <string>
 
 #include "partition/light_block.hpp"
+#include "util/input_error.hpp"
 
 namespace tessera::partition_detail {
+
+void EvolutionParams::validate() const {
+  auto bad = [](const std::string& field, const std::string& value, const std::string& rule) {
+    throw InputError("EvolutionParams." + field + " = " + value + ": " + rule);
+  };
+  auto share = [&](const char* field, double v) {
+    if (!std::isfinite(v) || v < 0.0 || v > 1.0) bad(field, std::to_string(v), "must be in 0..1");
+  };
+  if (population < 1) bad("population", std::to_string(population), "must be >= 1");
+  if (vcycles < 0) bad("vcycles", std::to_string(vcycles), "must be >= 0");
+  if (generations < 0) bad("generations", std::to_string(generations), "must be >= 0");
+  if (stall_limit < 1) bad("stall_limit", std::to_string(stall_limit), "must be >= 1");
+  share("mutation_rate", mutation_rate);
+  share("matching_share", matching_share);
+  share("cross_share", cross_share);
+  share("light_share", light_share);
+  share("light_cycle_share", light_cycle_share);
+  if (light_tail < 0) bad("light_tail", std::to_string(light_tail), "must be >= 0");
+  if (spectral_seeds < 0) bad("spectral_seeds", std::to_string(spectral_seeds), "must be >= 0");
+  if (!std::isfinite(spectral_gap) || spectral_gap < 0.0)
+    bad("spectral_gap", std::to_string(spectral_gap), "must be >= 0");
+  polish.validate();
+  spectral.validate();
+}
+
 namespace {
 
 struct Individual {
@@ -94,6 +122,7 @@ int tournament(const std::vector<Individual>& pop, Rng& rng, int exclude) {
 
 std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>& ub,
                         const EvolutionParams& params, Rng& rng, const EvolutionTrace& trace) {
+  params.validate();
   std::vector<Individual> pop;
   auto best_cut = [&] {
     long long b = pop.front().cut;
@@ -182,6 +211,19 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
   int best = 0;
   for (int i = 1; i < static_cast<int>(pop.size()); ++i)
     if (pop[i].cut < pop[best].cut) best = i;
+  if (params.polish.rounds > 0) {
+    // Its own generator (seeded from a copy of the search's): the spectral layouts below draw
+    // exactly what they drew without the polish.
+    Rng copy = rng;
+    Rng prng(copy.next() ^ 0x5DEECE66DULL);
+    const long long before = pop[best].cut;
+    pop[best].cut = relaxed_polish(g, k, ub, pop[best].part, params.polish, params.cycle, prng);
+    if (trace)
+      trace("polish",
+            std::to_string(params.polish.rounds) + " relax/repair rounds from " +
+                std::to_string(before),
+            pop[best].cut);
+  }
   if (params.spectral_seeds > 0) {
     // Global layouts after the search (spectral_layouts.hpp): the search itself is exactly the
     // one without them, and they only replace its best when they are better, so the result can

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "partition/multilevel.hpp"
+#include "partition/relaxed_polish.hpp"
 #include "partition/spectral_layouts.hpp"
 
 namespace tessera::partition_detail {
@@ -45,6 +46,11 @@ struct EvolutionParams {
   int light_tail = 0;
   double light_min = 0.88;  ///< Range of the light block's bound, as a fraction of the
   double light_max = 0.98;  ///< average block weight (raised where infeasible).
+  /// After the search, its best partition gets this relax / repair refinement
+  /// (relaxed_polish.hpp; never worse; rounds = 0: off). It draws from its own generator,
+  /// seeded from a copy of the search's, so the spectral layouts after it see the same random
+  /// stream as without it.
+  RelaxedPolishOptions polish;
   /// Spectral layouts (spectral_layouts.hpp): after the search, the best this many refined
   /// global layouts read off the Laplacian embedding are each combined with the search's best
   /// partition, which they replace when better (the search before is unchanged). 0 = off.
@@ -53,6 +59,10 @@ struct EvolutionParams {
   double spectral_gap = 0.0;
   SpectralLayoutOptions spectral;
   CycleParams cycle;
+
+  /// Throws InputError naming the first field out of range (the polish and spectral options
+  /// included; the cycle's parameters are the presets' own).
+  void validate() const;
 };
 
 /// Called after each phase with (phase name, detail, best cut so far).

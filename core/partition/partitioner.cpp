@@ -157,6 +157,14 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // so no cut gets worse; sphere2500 (a twisted cylinder) gets the seam-aligned 3 + 2
         // layout (179) that the search never reaches (180 on every seed, session 6).
         plan.evolution.spectral_seeds = strong ? 0 : 2;
+        // highest: the search's best then gets 4 relax / repair rounds (relaxed_polish.hpp):
+        // FM and flows under bounds raised by 0.2-3 %, rebalance, FM and flows under the real
+        // bound. With several blocks at the bound a better cut can need a chain of moves that
+        // no bounded move starts (rim seed 4: 247 -> 243, 10 vertices). After the search, so
+        // the search is unchanged and no cut gets worse; it helps most at large N, where the
+        // search has few steps (session 7: rim/grid3D/city10000 N = 25 1167/2427/519 ->
+        // 1155/2403/502).
+        plan.evolution.polish.rounds = strong ? 0 : 4;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
         // bound on every level the coarse searches rarely reach such shapes (session 4, seeds
@@ -211,6 +219,9 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_SPECGAP")) plan.evolution.spectral_gap = std::atof(env("T_SPECGAP"));
   if (env("T_SPECPOL")) plan.evolution.spectral.polish = std::atoi(env("T_SPECPOL"));
   if (env("T_SPECTOL")) plan.evolution.spectral.lanczos_tolerance = std::atof(env("T_SPECTOL"));
+  if (env("T_POL")) plan.evolution.polish.rounds = std::atoi(env("T_POL"));
+  if (env("T_POLMIN")) plan.evolution.polish.min_relax = std::atof(env("T_POLMIN"));
+  if (env("T_POLMAX")) plan.evolution.polish.max_relax = std::atof(env("T_POLMAX"));
   if (env("T_MFLEV")) plan.evolution.matching_flow_levels = std::atoi(env("T_MFLEV"));
   if (env("T_OPS"))
     plan.evolution.generations =

@@ -1,0 +1,173 @@
+// Relax / repair refinement of a finished partition (relaxed_polish.hpp) and its place after the
+// memetic search: a chain of moves that no move under the exact bound can start is found, the cut
+// never gets worse, the bound holds, the result is deterministic, and bad options name the field.
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "partition/evolutionary.hpp"
+#include "partition/graph_structure.hpp"
+#include "partition/relaxed_polish.hpp"
+#include "structure_graphs.hpp"
+#include "util/input_error.hpp"
+
+namespace {
+
+using namespace tessera;
+using namespace tessera::partition_detail;
+
+void expect_within(const WorkGraph& g, const std::vector<int>& part, int k,
+                   const std::vector<long long>& ub) {
+  ASSERT_EQ(static_cast<int>(part.size()), g.n);
+  const std::vector<long long> w = block_weights(g, part, k);
+  for (int b = 0; b < k; ++b) EXPECT_LE(w[b], ub[b]) << "block " << b;
+}
+
+// A 10 x 10 grid in two halves of exactly 50 vertices (bound 50, no slack), except that one
+// vertex of each half sits on the other side: cut 14 instead of the straight 10. Each tooth
+// moves home with gain 2, but only after the other one: a single move overfills a block, so FM
+// under the bound cannot start, and flow corridors are empty without slack. One relaxed round
+// moves both.
+TEST(RelaxedPolish, MovesAChainThatNoBoundedMoveCanStart) {
+  const WorkGraph g = to_work_graph(test::grid_structure(10, 10));
+  const int k = 2;
+  const std::vector<long long> ub(2, 50);
+  std::vector<int> part(100);
+  for (int y = 0; y < 10; ++y)
+    for (int x = 0; x < 10; ++x) part[y * 10 + x] = x < 5 ? 0 : 1;
+  part[2 * 10 + 5] = 0;
+  part[7 * 10 + 4] = 1;
+  ASSERT_EQ(edge_cut(g, part), 14);
+  const CycleParams cycle = test::small_graph_cycle(50);
+
+  std::vector<int> fm_only = part;
+  Rng r0(1);
+  EXPECT_EQ(kway_fm(g, k, fm_only, ub, cycle.fm, r0), 14) << "FM alone must be stuck here";
+
+  RelaxedPolishOptions options;
+  options.rounds = 1;
+  std::vector<int> polished = part;
+  Rng r1(1);
+  EXPECT_EQ(relaxed_polish(g, k, ub, polished, options, cycle, r1), 10);
+  EXPECT_EQ(edge_cut(g, polished), 10);
+  expect_within(g, polished, k, ub);
+
+  options.rounds = 0;  // off: unchanged
+  std::vector<int> off = part;
+  Rng r2(1);
+  EXPECT_EQ(relaxed_polish(g, k, ub, off, options, cycle, r2), 14);
+  EXPECT_EQ(off, part);
+}
+
+// On irregular graphs with a few blocks at the bound: never worse than its start, within the
+// bound, and the same for the same seed; better than the start on some seeds.
+TEST(RelaxedPolish, NeverWorseWithinTheBoundAndDeterministic) {
+  int better = 0;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    // A 40 x 30 grid plus random short-range chords (loop closures).
+    const std::size_t w = 40, h = 30;
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t y = 0; y < h; ++y)
+      for (std::size_t x = 0; x < w; ++x) {
+        if (x + 1 < w) pairs.emplace_back(y * w + x, y * w + x + 1);
+        if (y + 1 < h) pairs.emplace_back(y * w + x, (y + 1) * w + x);
+      }
+    std::mt19937 gen(seed);
+    for (int e = 0; e < 300; ++e) {
+      const std::size_t v = gen() % (w * h);
+      const std::size_t u = (v + 1 + gen() % 3 + (gen() % 3) * w) % (w * h);
+      if (u != v) pairs.emplace_back(v, u);
+    }
+    const GraphStructure structure = make_graph_structure(w * h, pairs, "grid+chords");
+    const WorkGraph g = to_work_graph(structure);
+    const int k = 5;
+    const std::vector<long long> ub = test::uniform_bounds(structure, k, 0.03);
+    CycleParams cycle = test::small_graph_cycle(ub[0]);
+    cycle.use_flow = true;
+    Rng rng(seed);
+    const std::vector<int> start = multilevel_partition(g, k, ub, cycle, rng);
+    const long long start_cut = edge_cut(g, start);
+    RelaxedPolishOptions options;
+    options.rounds = 4;
+    std::vector<int> a = start, b = start;
+    Rng ra(seed), rb(seed);
+    const long long cut = relaxed_polish(g, k, ub, a, options, cycle, ra);
+    EXPECT_EQ(cut, edge_cut(g, a));
+    EXPECT_LE(cut, start_cut) << "seed " << seed;
+    expect_within(g, a, k, ub);
+    relaxed_polish(g, k, ub, b, options, cycle, rb);
+    EXPECT_EQ(a, b) << "seed " << seed;
+    better += cut < start_cut ? 1 : 0;
+  }
+  RecordProperty("seeds_improved", better);
+  EXPECT_GT(better, 0) << "the polish never improved a fresh multilevel partition";
+}
+
+// After the memetic search: the search runs exactly as without the polish (its own generator),
+// so the result is never worse than without it, and it is deterministic.
+TEST(RelaxedPolish, AfterTheSearchItNeverLosesTheBestCut) {
+  const GraphStructure structure = test::grid_structure(60, 25);
+  const WorkGraph g = to_work_graph(structure);
+  const int k = 5;
+  const std::vector<long long> ub = test::uniform_bounds(structure, k, 0.03);
+  EvolutionParams params;
+  params.population = 3;
+  params.generations = 6;
+  params.cycle = test::small_graph_cycle(ub[0]);
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    Rng r0(seed);
+    const std::vector<int> plain = evolve(g, k, ub, params, r0, nullptr);
+    EvolutionParams with = params;
+    with.polish.rounds = 3;
+    Rng r1(seed), r2(seed);
+    const std::vector<int> polished = evolve(g, k, ub, with, r1, nullptr);
+    expect_within(g, polished, k, ub);
+    EXPECT_LE(edge_cut(g, polished), edge_cut(g, plain)) << "seed " << seed;
+    EXPECT_EQ(evolve(g, k, ub, with, r2, nullptr), polished);
+  }
+}
+
+TEST(RelaxedPolish, BadOptionsNameTheField) {
+  auto message = [](const RelaxedPolishOptions& o) {
+    try {
+      o.validate();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  RelaxedPolishOptions o;
+  o.rounds = -1;
+  EXPECT_NE(message(o).find("RelaxedPolishOptions.rounds"), std::string::npos);
+  o = {};
+  o.min_relax = 0.0;
+  EXPECT_NE(message(o).find("RelaxedPolishOptions.min_relax"), std::string::npos);
+  o = {};
+  o.max_relax = 0.001;  // below min_relax
+  EXPECT_NE(message(o).find("RelaxedPolishOptions.max_relax"), std::string::npos);
+  EXPECT_EQ(message(RelaxedPolishOptions{}), "");
+}
+
+TEST(EvolutionParams, BadOptionsNameTheField) {
+  auto message = [](const EvolutionParams& p) {
+    try {
+      p.validate();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EvolutionParams p;
+  EXPECT_EQ(message(p), "");
+  p.population = 0;
+  EXPECT_NE(message(p).find("EvolutionParams.population"), std::string::npos);
+  p = {};
+  p.mutation_rate = 1.5;
+  EXPECT_NE(message(p).find("EvolutionParams.mutation_rate"), std::string::npos);
+  p = {};
+  p.polish.max_relax = 0.9;
+  EXPECT_NE(message(p).find("RelaxedPolishOptions.max_relax"), std::string::npos);
+}
+
+}  // namespace
