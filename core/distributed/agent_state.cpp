@@ -151,8 +151,10 @@ LocalStatus AgentState::status(bool newton_score) {
     return s;
   }
   if (updated_grad_norm_sq_ >= 0 && updated_version_ == neighbours_version_ && Y == updated_X_) {
-    s.cost_share = problem_.cost_share(active_part(Y));
-    s.grad_norm_sq = updated_grad_norm_sq_;  // same point, same neighbours: same gradient
+    // Same point, same neighbours (and active rows): the update's gradient norm and cost share
+    // are what this status would compute, bit for bit.
+    s.cost_share = updated_cost_share_;
+    s.grad_norm_sq = updated_grad_norm_sq_;
   } else {
     const Eigen::MatrixXd Ya = active_part(Y);
     s.cost_share = problem_.cost_share(Ya);
@@ -193,6 +195,7 @@ Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::Matri
   }
   ++block_updates_;
   tcg_iterations_ += stats.tcg_iterations;
+  updated_cost_share_ = stats.cost_share;
   if (stats.tangent) ++tangent_updates_;
   updated_version_ = neighbours_version_;
   return updated_X_;

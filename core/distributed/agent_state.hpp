@@ -106,6 +106,7 @@ class AgentState {
   // block's neighbours do not move before the next status, whose gradient is then this one.
   Eigen::MatrixXd updated_X_;
   double updated_grad_norm_sq_ = -1.0;  // < 0: nothing to reuse
+  double updated_cost_share_ = 0.0;     // cost share there
   std::uint64_t updated_version_ = 0;
 };
 

@@ -56,6 +56,7 @@ Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd&
     local.tcg_iterations += res.total_inner_iterations;
     // res.grad_norm is at res.X, which is X after this attempt whether or not it is accepted.
     if (grad_norm_sq) *grad_norm_sq = res.grad_norm * res.grad_norm;
+    local.cost_share = res.cost_share;
     if (res.trace.empty()) break;  // zero gradient: nothing to do
     const TrustRegionIteration& it = res.trace.back();
     radius = it.radius;

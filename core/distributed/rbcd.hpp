@@ -50,6 +50,8 @@ struct BlockUpdateStats {
   int trust_region_iterations = 0;  ///< Attempts made (accepted or not).
   int tcg_iterations = 0;           ///< Truncated-CG iterations, all attempts.
   bool tangent = false;             ///< Preconditioned with the tangent factor.
+  /// problem.cost_share at the returned point (computed with the trust region's cost there).
+  double cost_share = 0.0;
 };
 
 /// One block update from X0 (on the block's manifold) with the neighbour poses currently set

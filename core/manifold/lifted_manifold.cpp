@@ -1,10 +1,9 @@
 #include "manifold/lifted_manifold.hpp"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <stdexcept>
 #include <string>
-
-#include <Eigen/SVD>
 
 namespace tessera {
 namespace {
@@ -65,15 +64,57 @@ void block_multiply_add(const double* C, const double* sym, Eigen::Index r, int 
 
 }  // namespace
 
+namespace {
+
+// tangent_project's loop for a fixed d and (R > 0) a fixed number of rows: the operations of
+// block_sym_product and block_multiply_add in the same order (bit-identical), unrolled. The
+// agents' updates run at r = d (their active rows), where this is most of a tCG iteration's
+// projections.
+template <int D, int R>
+void tangent_project_poses(const double* X, const double* V, Eigen::Index r_runtime, std::size_t n,
+                           double* out) {
+  const Eigen::Index r = R > 0 ? R : r_runtime;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Index offset = r * static_cast<Eigen::Index>((D + 1) * i);
+    const double* A = X + offset;
+    const double* B = V + offset;
+    double S[D * D], sym[D * D];
+    for (int a = 0; a < D; ++a)
+      for (int b = 0; b < D; ++b) {
+        double acc = 0.0;
+        for (Eigen::Index k = 0; k < r; ++k) acc += A[a * r + k] * B[b * r + k];
+        S[a * D + b] = acc;
+      }
+    for (int a = 0; a < D; ++a)
+      for (int b = 0; b < D; ++b) sym[a * D + b] = 0.5 * (S[a * D + b] + S[b * D + a]);
+    double* o0 = out + offset;
+    for (int b = 0; b < D; ++b) {
+      double* o = o0 + b * r;
+      for (int a = 0; a < D; ++a) {
+        const double w = -1.0 * sym[a * D + b];
+        const double* Ca = A + a * r;
+        for (Eigen::Index k = 0; k < r; ++k) o[k] += w * Ca[k];
+      }
+    }
+  }
+}
+
+}  // namespace
+
 Eigen::MatrixXd LiftedManifold::tangent_project(const Eigen::MatrixXd& X,
                                                 const Eigen::MatrixXd& V) const {
   Eigen::MatrixXd out = V;
   const Eigen::Index r = X.rows();
-  double sym[9];
-  for (std::size_t i = 0; i < n_; ++i) {
-    const Eigen::Index offset = r * static_cast<Eigen::Index>((d_ + 1) * i);
-    block_sym_product(X.data() + offset, V.data() + offset, r, d_, sym);
-    block_multiply_add(X.data() + offset, sym, r, d_, -1.0, out.data() + offset);
+  if (d_ == 2) {
+    if (r == 2)
+      tangent_project_poses<2, 2>(X.data(), V.data(), r, n_, out.data());
+    else
+      tangent_project_poses<2, 0>(X.data(), V.data(), r, n_, out.data());
+  } else {
+    if (r == 3)
+      tangent_project_poses<3, 3>(X.data(), V.data(), r, n_, out.data());
+    else
+      tangent_project_poses<3, 0>(X.data(), V.data(), r, n_, out.data());
   }
   return out;
 }

@@ -10,6 +10,7 @@ namespace tessera {
 BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
                            const std::vector<Measurement>& measurements)
     : d_(d), owned_(std::move(owned)) {
+  if (d_ != 2 && d_ != 3) throw std::invalid_argument("BlockProblem: d must be 2 or 3");
   // Slot of every pose id (a flat table: every agent scans all measurements it is given, and
   // a hash lookup per endpoint was most of that scan at 10^6 poses).
   std::size_t max_id = 0;
@@ -50,6 +51,20 @@ BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
     sj.push_back(slot[m.j]);
     edges_.push_back({k, si.back(), sj.back()});
   }
+  // The measurements packed contiguously for the cost loops (edge_term).
+  const std::size_t stride = static_cast<std::size_t>(d_ * d_ + d_ + 2);
+  packed_.resize(edge_storage_.size() * stride);
+  for (std::size_t k = 0; k < edge_storage_.size(); ++k) {
+    const Measurement& me = edge_storage_[k];
+    if (me.R.rows() != d_ || me.R.cols() != d_ || me.t.size() != d_)
+      throw std::invalid_argument("BlockProblem: measurement of the wrong dimension");
+    double* out = packed_.data() + k * stride;
+    for (int b = 0; b < d_; ++b)
+      for (int c = 0; c < d_; ++c) out[b * d_ + c] = me.R(c, b);
+    for (int c = 0; c < d_; ++c) out[d_ * d_ + c] = me.t(c);
+    out[d_ * d_ + d_] = me.kappa;
+    out[d_ * d_ + d_ + 1] = me.tau;
+  }
   DataMatrixBlocks Q =
       build_data_matrix_blocks(ptrs, si, sj, d_, owned_.size() + neighbors_.size(), owned_.size());
   Q_bb_ = std::move(Q.own);
@@ -70,12 +85,10 @@ void BlockProblem::set_neighbor_poses(const Eigen::MatrixXd& X_neighbors) {
   scaled_dense_times_sparse(X_n_, Q_nb_, 1.0, linear_);
 }
 
-double BlockProblem::cost(const Eigen::MatrixXd& X) const {
+double BlockProblem::cost(const Eigen::MatrixXd& X, double* share) const {
   // Summed edge by edge rather than as tr(X Q X^T): the trace form cancels large terms and
   // loses ~8 digits near the optimum, which would blind the trust-region ratio test.
-  double f = 0.0;
-  for (const auto& e : edges_) f += edge_cost(e, X);
-  return f;
+  return edge_sum(X, share);
 }
 
 Eigen::MatrixXd BlockProblem::euclidean_gradient(const Eigen::MatrixXd& X) const {
@@ -99,39 +112,64 @@ Eigen::MatrixXd BlockProblem::hessian_vector(const Eigen::MatrixXd& X, const Eig
   return H;
 }
 
-double BlockProblem::edge_cost(const Edge& e, const Eigen::MatrixXd& X) const {
-  const Eigen::Index w = d_ + 1;
+namespace {
+
+// One measurement's term, kappa ||X_j^R - X_i^R R||^2 + tau ||t_j - t_i - X_i^R t||^2, for a fixed
+// d (and, when R > 0, a fixed number of rows): the same operations in the same order as the
+// runtime-d loops it replaces (bit-identical), unrolled by the compiler. `m` is the edge's
+// packed measurement: R (d x d, column-major), t (d), kappa, tau.
+template <int D, int R>
+double edge_term(const double* Xi, const double* Xj, const double* m, Eigen::Index r_runtime) {
+  const Eigen::Index r = R > 0 ? R : r_runtime;
+  const double* Rm = m;
+  const double* t = m + D * D;
+  double rot = 0.0, tr = 0.0;
+  for (Eigen::Index a = 0; a < r; ++a) {
+    double ta = Xj[D * r + a] - Xi[D * r + a];
+    for (int c = 0; c < D; ++c) ta -= Xi[c * r + a] * t[c];
+    tr += ta * ta;
+    for (int b = 0; b < D; ++b) {
+      double v = Xj[b * r + a];
+      for (int c = 0; c < D; ++c) v -= Xi[c * r + a] * Rm[b * D + c];
+      rot += v * v;
+    }
+  }
+  return m[D * D + D] * rot + m[D * D + D + 1] * tr;
+}
+
+}  // namespace
+
+template <int D, int R>
+double BlockProblem::sum_edges(const Eigen::MatrixXd& X, double* share) const {
+  const Eigen::Index w = D + 1;
   const std::size_t m = owned_.size();
   const Eigen::Index r = X.rows();
   auto column = [&](std::size_t slot) -> const double* {
     return slot < m ? X.data() + r * w * static_cast<Eigen::Index>(slot)
                     : X_n_.data() + r * w * static_cast<Eigen::Index>(slot - m);
   };
-  const double* Xi = column(e.slot_i);  // column-major r x (d+1) pose blocks
-  const double* Xj = column(e.slot_j);
-  const Measurement& me = edge_storage_[e.measurement];
-  // Plain loops: no temporaries on this hot path.
-  double rot = 0.0, tr = 0.0;
-  for (Eigen::Index a = 0; a < r; ++a) {
-    double ta = Xj[d_ * r + a] - Xi[d_ * r + a];
-    for (int c = 0; c < d_; ++c) ta -= Xi[c * r + a] * me.t(c);
-    tr += ta * ta;
-    for (int b = 0; b < d_; ++b) {
-      double v = Xj[b * r + a];
-      for (int c = 0; c < d_; ++c) v -= Xi[c * r + a] * me.R(c, b);
-      rot += v * v;
-    }
+  constexpr std::size_t stride = D * D + D + 2;
+  const double* packed = packed_.data();
+  double f = 0.0, s = 0.0;
+  for (std::size_t k = 0; k < edges_.size(); ++k) {
+    const Edge& e = edges_[k];
+    const double c = edge_term<D, R>(column(e.slot_i), column(e.slot_j), packed + k * stride, r);
+    f += c;
+    s += (e.slot_i < m && e.slot_j < m) ? c : 0.5 * c;
   }
-  return me.kappa * rot + me.tau * tr;
+  if (share) *share = s;
+  return f;
+}
+
+double BlockProblem::edge_sum(const Eigen::MatrixXd& X, double* share) const {
+  // The agents' active rows are d (lifted starts), the centralized solver's r = d + 1 or more.
+  if (d_ == 2) return X.rows() == 2 ? sum_edges<2, 2>(X, share) : sum_edges<2, 0>(X, share);
+  return X.rows() == 3 ? sum_edges<3, 3>(X, share) : sum_edges<3, 0>(X, share);
 }
 
 double BlockProblem::cost_share(const Eigen::MatrixXd& X) const {
-  const std::size_t m = owned_.size();
   double share = 0.0;
-  for (const auto& e : edges_) {
-    double c = edge_cost(e, X);
-    share += (e.slot_i < m && e.slot_j < m) ? c : 0.5 * c;
-  }
+  edge_sum(X, &share);
   return share;
 }
 

@@ -44,8 +44,9 @@ class BlockProblem {
   void set_neighbor_poses(const Eigen::MatrixXd& X_neighbors);
   const Eigen::MatrixXd& neighbor_poses() const { return X_n_; }
 
-  /// f_B(X) as above.
-  double cost(const Eigen::MatrixXd& X) const;
+  /// f_B(X) as above. With `share` not null, also cost_share(X) (the same edge terms summed
+  /// in the same order, so bit-identical to calling it).
+  double cost(const Eigen::MatrixXd& X, double* share = nullptr) const;
   /// Euclidean gradient 2 (X Q_BB + X_N Q_NB).
   Eigen::MatrixXd euclidean_gradient(const Eigen::MatrixXd& X) const;
   /// Riemannian gradient on the block's manifold.
@@ -63,13 +64,18 @@ class BlockProblem {
     std::size_t measurement;     // index into edge_storage_ (indices survive copies)
     std::size_t slot_i, slot_j;  // local slots: owned first, then neighbours
   };
-  double edge_cost(const Edge& e, const Eigen::MatrixXd& X) const;
+  // Sum over the block's measurements of their terms at X; `share` (if not null) receives the
+  // same sum with the cut ones halved.
+  double edge_sum(const Eigen::MatrixXd& X, double* share) const;
+  template <int D, int R>
+  double sum_edges(const Eigen::MatrixXd& X, double* share) const;
 
   int d_;
   std::vector<std::size_t> owned_;
   std::vector<std::size_t> neighbors_;
   std::vector<Edge> edges_;
   std::vector<Measurement> edge_storage_;  // copies, so the problem outlives its input
+  std::vector<double> packed_;             // per edge: R (column-major), t, kappa, tau
   SparseMatrix Q_bb_;
   SparseMatrix Q_nb_;  // (d+1)k x (d+1)m
   Eigen::MatrixXd X_n_;

@@ -107,7 +107,8 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   TrustRegionResult res;
   res.X = X0;
   if (refine) (*refine)(res.X);
-  double f = problem.cost(res.X);
+  double f_share = 0.0;
+  double f = problem.cost(res.X, &f_share);
   Eigen::MatrixXd egrad = problem.euclidean_gradient(res.X);
   Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
   double grad_norm = std::sqrt(inner(grad, grad));
@@ -138,7 +139,8 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     Eigen::MatrixXd X_new =
         options.retraction ? options.retraction(res.X, step.eta) : M.retract(res.X, step.eta);
     if (refine) (*refine)(X_new);
-    const double f_new = problem.cost(X_new);
+    double f_new_share = 0.0;
+    const double f_new = problem.cost(X_new, &f_new_share);
     const double model_decrease = -(inner(grad, step.eta) + 0.5 * inner(step.Heta, step.eta));
     double rho = (f - f_new) / std::max(model_decrease, std::numeric_limits<double>::min());
     // When both decreases sit at round-off level, the ratio is noise: trust the model.
@@ -165,6 +167,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       decrease = f - f_new;
       res.X = std::move(X_new);
       f = f_new;
+      f_share = f_new_share;
       egrad = problem.euclidean_gradient(res.X);
       grad = M.tangent_project(res.X, egrad);
       grad_norm = std::sqrt(inner(grad, grad));
@@ -184,6 +187,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   }
   if (grad_norm <= options.grad_norm_tol) res.stop_reason = "grad_norm";
   res.cost = f;
+  res.cost_share = f_share;
   res.grad_norm = grad_norm;
   return res;
 }

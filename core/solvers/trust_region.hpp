@@ -51,6 +51,8 @@ struct TrustRegionIteration {
 struct TrustRegionResult {
   Eigen::MatrixXd X;
   double cost = 0.0;
+  /// problem.cost_share(X), evaluated with the cost (the next round's status reuses it).
+  double cost_share = 0.0;
   double grad_norm = 0.0;
   int iterations = 0;
   int total_inner_iterations = 0;
