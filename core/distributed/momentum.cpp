@@ -21,15 +21,21 @@ bool newton_schulz_inv_sqrt(const Eigen::Matrix<double, D, D>& B, Eigen::Matrix<
   using Small = Eigen::Matrix<double, D, D>;
   const Small I = Small::Identity();
   if (!((B - I).norm() < 0.5)) return false;
-  Small Y = B;
-  Z = I;
-  for (int it = 0; it < 12; ++it) {
-    const Small E = I - Z * Y;
-    const double e = E.norm();
-    const Small T = I + 0.5 * E;
-    Y = (Y * T).eval();
+  // The first step has Z = I: E = I - B and Z = T without the two products by I (equal to them
+  // up to the sign of exact zeros). The last step's Y update is not used: skipped.
+  Small E = I - B;
+  double e = E.norm();
+  Small T = I + 0.5 * E;
+  Z = T;
+  if (e < 1e-9) return true;
+  Small Y = B * T;
+  for (int it = 1; it < 12; ++it) {
+    E = I - Z * Y;
+    e = E.norm();
+    T = I + 0.5 * E;
     Z = (T * Z).eval();
     if (e < 1e-9) return true;  // quadratic convergence: this last step took it to ~1e-17
+    Y = (Y * T).eval();
   }
   return false;
 }
@@ -39,7 +45,10 @@ bool newton_schulz_inv_sqrt(const Eigen::Matrix<double, D, D>& B, Eigen::Matrix<
 // then the lanes, then the odd tail), which is how `A.transpose() * A` formed each entry of
 // A^T A in the previous version. Keeping that order keeps Proj_M bit-identical to it (and so
 // every iterate of a run) while the hand-written loop skips Eigen's per-coefficient dispatch.
-inline double gram_entry(const double* x, const double* y, Eigen::Index n) {
+// N > 0: n is N (the loop then unrolls for the common ranks).
+template <int N>
+inline double gram_entry(const double* x, const double* y, Eigen::Index n_runtime) {
+  const Eigen::Index n = N > 0 ? N : n_runtime;
   if (n < 2) return n == 1 ? x[0] * y[0] : 0.0;
   const Eigen::Index n2 = n / 2 * 2, n4 = n / 4 * 4;
   double l0 = x[0] * y[0], l1 = x[1] * y[1];
@@ -63,13 +72,14 @@ inline double gram_entry(const double* x, const double* y, Eigen::Index n) {
   return s;
 }
 
-// Replaces the r x D column-major Stiefel block at A by its polar factor.
-template <int D>
-void project_pose(double* A, Eigen::Index r) {
+// Replaces the r x D column-major Stiefel block at A by its polar factor (R > 0: r is R).
+template <int D, int R>
+void project_pose(double* A, Eigen::Index r_runtime) {
+  const Eigen::Index r = R > 0 ? R : r_runtime;
   using Small = Eigen::Matrix<double, D, D>;
   Small B;
   for (int a = 0; a < D; ++a)
-    for (int b = a; b < D; ++b) B(a, b) = B(b, a) = gram_entry(A + a * r, A + b * r, r);
+    for (int b = a; b < D; ++b) B(a, b) = B(b, a) = gram_entry<R>(A + a * r, A + b * r, r);
   Small inv_sqrt;
   if (!newton_schulz_inv_sqrt<D>(B, inv_sqrt)) {
     Eigen::SelfAdjointEigenSolver<Small> es(B);
@@ -97,14 +107,26 @@ void project_pose(double* A, Eigen::Index r) {
 // Proj_M applied pose by pose to out, after `blend` has written each pose's unprojected value
 // (r x (D+1), column-major) into out's storage for that pose. Pose i's output depends on pose
 // i's inputs only, so `out` may be one of the inputs.
-template <int D, typename Blend>
+template <int D, int R, typename Blend>
 void blend_and_project(Eigen::MatrixXd& out, Eigen::Index poses, const Blend& blend) {
   const Eigen::Index r = out.rows(), w = (D + 1) * r;
   double* base = out.data();
   for (Eigen::Index i = 0; i < poses; ++i) {
     blend(i * w, w, base + i * w);
-    project_pose<D>(base + i * w, r);
+    project_pose<D, R>(base + i * w, r);
   }
+}
+
+// The ranks that occur every round: r = d (the block update's retraction on the active rows)
+// and the default relaxation rank 5 (P and V keep all rows).
+template <int D, typename Blend>
+void blend_and_project(Eigen::MatrixXd& out, Eigen::Index poses, const Blend& blend) {
+  if (out.rows() == D)
+    blend_and_project<D, D>(out, poses, blend);
+  else if (out.rows() == 5)
+    blend_and_project<D, 5>(out, poses, blend);
+  else
+    blend_and_project<D, 0>(out, poses, blend);
 }
 
 template <typename Blend>
