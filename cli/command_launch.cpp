@@ -27,6 +27,7 @@
 #include "commands.hpp"
 #include "coordinator/progress_lines.hpp"
 #include "distributed/distributed_solver.hpp"
+#include "launch_children.hpp"
 #include "launch_loss_policy.hpp"
 #include "robot_files.hpp"
 #include "session_args.hpp"
@@ -71,6 +72,9 @@ options:
   --poses P            poses of the generated graph (without GRAPH)         [1000]
   --status-interval S  coordinator status line (agents alive, rounds, lagging or lost
                        agents) every S seconds and on changes; 0 = off          [5]
+  --no-fork-server     start tessera-coordinator and tessera-agent with exec, each
+                       loading Fast DDS itself (default: one tessera-fork-server loads it
+                       once and forks them; see docs/dds-runtime.md, "Fork server")
 %s  --quiet              no progress lines
   --help               this text
 
@@ -91,90 +95,6 @@ std::string self_dir() {
   if (n <= 0) return ".";
   std::string p(buf, static_cast<std::size_t>(n));
   return p.substr(0, p.find_last_of('/'));
-}
-
-struct Child {
-  std::string name;
-  pid_t pid = -1;
-  std::string log;
-  bool running = false;
-  int code = -1;        // exit code, or 128 + signal
-  long agent = -1;      // agent id; -1 for the coordinator
-  bool judged = false;  // its end has been judged (launch_loss_policy.hpp)
-  bool lost = false;    // it died and the run went on without it
-};
-
-// Starts argv with stdout going to `stdout_fd` (or the log) and stderr to the log, in its own
-// process group (so a terminal's Ctrl-C reaches only us, and we decide how to stop them).
-Child spawn(const std::string& name, const std::vector<std::string>& argv, const std::string& log,
-            int stdout_fd) {
-  Child c;
-  c.name = name;
-  c.log = log;
-  c.pid = fork();
-  if (c.pid < 0) throw std::runtime_error("fork failed: " + std::string(std::strerror(errno)));
-  if (c.pid == 0) {
-    setpgid(0, 0);
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      dup2(stdout_fd >= 0 ? stdout_fd : fd, 1);
-      dup2(fd, 2);
-      close(fd);
-    }
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    execv(args[0], args.data());
-    std::fprintf(stderr, "cannot run %s: %s\n", args[0], std::strerror(errno));
-    _exit(127);
-  }
-  c.running = true;
-  return c;
-}
-
-void reap(std::vector<Child>& children, bool block) {
-  for (auto& c : children) {
-    if (!c.running) continue;
-    int status = 0;
-    if (waitpid(c.pid, &status, block ? 0 : WNOHANG) == c.pid) {
-      c.running = false;
-      c.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    }
-  }
-}
-
-bool any_running(const std::vector<Child>& children) {
-  for (const auto& c : children)
-    if (c.running) return true;
-  return false;
-}
-
-// Asks every process to stop (they shut down cleanly on SIGINT), SIGKILLs what is left after
-// `grace_s`.
-void stop_all(std::vector<Child>& children, double grace_s) {
-  for (auto& c : children)
-    if (c.running) kill(c.pid, SIGINT);
-  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(grace_s);
-  while (any_running(children) && std::chrono::steady_clock::now() < until) {
-    reap(children, false);
-    usleep(20000);
-  }
-  for (auto& c : children)
-    if (c.running) kill(c.pid, SIGKILL);
-  reap(children, true);
-}
-
-std::string tail_of(const std::string& path, std::size_t max_lines) {
-  std::ifstream f(path);
-  std::vector<std::string> lines;
-  for (std::string l; std::getline(f, l);) lines.push_back(l);
-  std::string out;
-  for (std::size_t k = lines.size() > max_lines ? lines.size() - max_lines : 0; k < lines.size();
-       ++k)
-    out += "    " + lines[k] + "\n";
-  return out;
 }
 
 // In process (no `sh -c rm -rf`: two more process starts at the end of every run).
@@ -212,7 +132,7 @@ int run_launch(const Args& argv) {
       "seed",   "json",      "out",       "tum",  "timeout",  "poses",      "status-interval"};
   for (const auto& n : launch_loss_option_names()) valued.insert(n);
   Arguments args(argv, with_session_options(valued, SessionArgsFor::kLaunch),
-                 {"quiet", "certify", "no-certify"});
+                 {"quiet", "certify", "no-certify", "no-fork-server"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
                      std::to_string(args.positional().size()));
@@ -258,6 +178,13 @@ int run_launch(const Args& argv) {
   for (const char* exe : {"tessera-agent", "tessera-coordinator"})
     if (access((bin + "/" + exe).c_str(), X_OK) != 0)
       throw InputError("launch: " + bin + "/" + exe + " not found (build it next to tessera)");
+  const std::string fork_server = bin + "/tessera-fork-server";
+  bool use_fork_server = !args.has("no-fork-server");
+  if (use_fork_server && access(fork_server.c_str(), X_OK) != 0) {
+    std::fprintf(stderr, "tessera launch: %s not found: starting the processes with exec\n",
+                 fork_server.c_str());
+    use_fork_server = false;
+  }
 
   char tmpl[] = "/tmp/tessera-launch-XXXXXX";
   if (!mkdtemp(tmpl)) throw std::runtime_error("launch: cannot create a temporary folder");
@@ -302,6 +229,7 @@ int run_launch(const Args& argv) {
 
   int pipefd[2];
   if (pipe(pipefd) != 0) throw std::runtime_error("launch: pipe failed");
+  fcntl(pipefd[0], F_SETFD, FD_CLOEXEC);  // the read end is ours alone
   std::vector<std::string> cargs = {bin + "/tessera-coordinator",
                                     "--agents",
                                     std::to_string(agents),
@@ -338,10 +266,13 @@ int run_launch(const Args& argv) {
   if (args.has("status-interval"))
     cargs.insert(cargs.end(), {"--status-interval", std::to_string(status_interval)});
 
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<Child> children;
-  children.push_back(spawn("coordinator", cargs, work + "/coordinator.log", pipefd[1]));
-  close(pipefd[1]);
+  // The processes to start, in order: the coordinator (stdout = our progress pipe), then
+  // agents 0..N-1.
+  ForkSpec spec;
+  std::vector<std::string> names = {"coordinator"};
+  std::vector<long> agent_ids = {-1};
+  spec.children.push_back(
+      {ForkRole::kCoordinator, work + "/coordinator.log", pipefd[1], std::move(cargs)});
   for (long k = 0; k < agents; ++k) {
     std::vector<std::string> a = {
         bin + "/tessera-agent",
@@ -353,12 +284,21 @@ int run_launch(const Args& argv) {
         std::to_string(k)};
     a.insert(a.end(), common.begin(), common.end());
     for (const auto& x : agent_loss_argv(loss)) a.push_back(x);
-    children.push_back(
-        spawn("agent " + std::to_string(k), a, work + "/agent" + std::to_string(k) + ".log", -1));
-    children.back().agent = k;
+    spec.children.push_back(
+        {ForkRole::kAgent, work + "/agent" + std::to_string(k) + ".log", -1, std::move(a)});
+    names.push_back("agent " + std::to_string(k));
+    agent_ids.push_back(k);
   }
-  std::printf("launched run %s: coordinator + %ld agents (logs in %s until the end)\n",
-              run_id.c_str(), agents, work.c_str());
+
+  const auto t0 = std::chrono::steady_clock::now();
+  // Both close our copy of the progress pipe's write end once the coordinator has its own.
+  std::vector<Child> children =
+      use_fork_server ? spawn_forked(fork_server, spec, names, agent_ids, work + "/fork-server.log",
+                                     std::min(timeout_s, 60.0))
+                      : spawn_exec(spec, names, agent_ids);
+  std::printf("launched run %s: coordinator + %ld agents, %s (logs in %s until the end)\n",
+              run_id.c_str(), agents,
+              use_fork_server ? "forked by tessera-fork-server" : "each exec'ed", work.c_str());
   std::fflush(stdout);
 
   // Stream progress; watch for failures, the time limit and signals.

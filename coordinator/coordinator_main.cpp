@@ -2,34 +2,12 @@
 // agents, partitions the graph structure they announce (never measurement values),
 // publishes the assignment and gathers the final estimate. See docs/dds-runtime.md.
 //
-// main() only parses the options and wires the pieces: the run's steps are sequenced in
-// coordinator_run.cpp, the process life around the DDS session in cli/session_process.hpp.
+// The body is coordinator_main() (coordinator_entry.cpp), which `tessera launch`'s fork
+// server also runs in its forked child.
 
-#include <string>
-#include <vector>
-
-#include "coordinator/coordinator_options.hpp"
-#include "coordinator/coordinator_run.hpp"
-#include "coordinator/run_timeline.hpp"
+#include "coordinator/coordinator_entry.hpp"
 #include "session_process.hpp"
-#include "transport/signal_watcher.hpp"
-
-using namespace tessera;
 
 int main(int argc, char** argv) {
-  coordinator::RunTimeline timeline;  // first: the summary's timeline counts from here
-  transport::SignalWatcher
-      signals;  // first: every thread created later inherits the blocked signals
-  const std::vector<std::string> argv_list(argv + 1, argv + argc);
-  coordinator::CoordinatorOptions options;
-  if (auto code = cli::parse_process_options(argv_list, "tessera-coordinator",
-                                             cli::process_help(coordinator::kCoordinatorUsage),
-                                             coordinator::parse_coordinator_options, options))
-    return *code;
-  const cli::ProcessRole role{"tessera-coordinator", options.net.timeout_s};
-  cli::exit_process(cli::run_session_process(coordinator::coordinator_session_options(options),
-                                             role, signals, [&](transport::Session& session) {
-                                               coordinator::run_coordinator(options, session,
-                                                                            timeline);
-                                             }));
+  tessera::cli::exit_process(tessera::coordinator::coordinator_main(argc, argv));
 }

@@ -103,7 +103,7 @@ def run_in_process(tessera, graph, agents, tmp, limit):
     return s, wall
 
 
-def run_dds(tessera, graph, agents, domain, tmp, limit):
+def run_dds(tessera, graph, agents, domain, tmp, limit, extra=()):
     js = os.path.join(tmp, "dds.json")
     u0 = children_usage()
     t0 = time.monotonic()
@@ -112,7 +112,7 @@ def run_dds(tessera, graph, agents, domain, tmp, limit):
                           "highest", "--domain", str(domain), "--json", js, "--timeout", str(limit),
                           # the same start as the in-process run (launch's own default is the
                           # distributed chordal stage), and no certificate (the in-process run has none)
-                          "--init", "file", "--no-certify"],
+                          "--init", "file", "--no-certify"] + list(extra),
                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1)
     stamps = []
     log = []
@@ -171,6 +171,8 @@ def main():
     ap.add_argument("--domain", type=int, default=210)
     ap.add_argument("--out", default="")
     ap.add_argument("--limit", type=float, default=600, help="seconds per run (each side)")
+    ap.add_argument("--launch-args", default="",
+                    help="extra options of the DDS run, e.g. --no-fork-server (exec each process)")
     a = ap.parse_args()
     tessera = os.path.join(a.bin, "tessera")
     names = a.graphs.split(",") if a.graphs else paper_graphs()
@@ -188,7 +190,8 @@ def main():
                                 "--partition", "sequential", "--max-rounds", "0", "--out", graph],
                                check=True, stdout=subprocess.DEVNULL)
             ip = run_in_process(tessera, graph, a.agents, tmp, a.limit)
-            dds = run_dds(tessera, graph, a.agents, a.domain, tmp, a.limit) if ip else None
+            dds = (run_dds(tessera, graph, a.agents, a.domain, tmp, a.limit, a.launch_args.split())
+                   if ip else None)
         if ip is None or dds is None:
             print("%-18s failed (%s)" % (name, "in-process" if ip is None else "dds"))
             continue

@@ -1,0 +1,146 @@
+// tessera-fork-server: `tessera launch`'s way to start the coordinator and the N agents of a
+// run on this host without each of them paying the dynamic loading of Fast DDS (and
+// libcrypto, libsqlite3: BIND_NOW, ~40 ms of CPU per process; docs/dds-runtime.md, "Fork
+// server"). This process is linked with the agent and coordinator code, so the loader
+// relocates everything once here; then it forks one child per process of the run, and each
+// child runs the entry function that tessera-agent's or tessera-coordinator's main() runs,
+// with the argv launch would have exec'ed. It writes each child's pid to launch and exits, so
+// the children are re-parented to launch (a child subreaper), which waits for them, signals
+// them and judges their exit codes exactly as it does for exec'ed processes.
+//
+// Nothing of Fast DDS may exist before a fork (its threads would not survive it, its shared
+// memory segments would be shared): this process only parses its argv and forks; the first
+// Fast DDS object of each process is created by the entry function in the child. Each fork is
+// refused unless this process is still single-threaded.
+//
+// usage (written by launch, cli/fork_spec.hpp):
+//   tessera-fork-server --pid-fd FD --child ROLE LOG STDOUT_FD ARGC ARGV... [--child ...]
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "agent/agent_entry.hpp"
+#include "coordinator/coordinator_entry.hpp"
+#include "fork_spec.hpp"
+#include "session_process.hpp"
+#include "util/input_error.hpp"
+
+using namespace tessera;
+
+namespace {
+
+// Threads of this process (the "Threads:" line of /proc/self/status), -1 if unreadable.
+int thread_count() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("Threads:", 0) == 0) return std::atoi(line.c_str() + 8);
+  return -1;
+}
+
+// The memory holding this process's argv strings (contiguous on Linux): what ps and pgrep -f
+// read as the command line.
+struct ArgvArea {
+  char* begin = nullptr;
+  std::size_t size = 0;
+};
+
+// Shows `argv` as this process's command line and its program name as the thread name, so a
+// forked child looks like the executable it stands for ("tessera-agent --graph ... --id 1
+// ..."): operators and the tests find processes with pgrep -f. The area is the fork server's
+// own argv, which holds every child's argv, so one child's always fits; it is padded with
+// NULs (ps shows trailing blanks).
+void show_as(const ArgvArea& area, const std::vector<std::string>& argv) {
+  std::size_t at = 0;
+  for (const std::string& a : argv) {
+    const std::size_t n = std::min(a.size() + 1, area.size - at);
+    std::memcpy(area.begin + at, a.c_str(), n);
+    at += n;
+    if (at == area.size) break;
+  }
+  if (area.size > 0) {
+    std::memset(area.begin + at, 0, area.size - at);
+    area.begin[area.size - 1] = '\0';
+  }
+  const std::string& exe = argv.front();
+  const std::string name = exe.substr(exe.find_last_of('/') + 1);
+  prctl(PR_SET_NAME, name.c_str(), 0, 0, 0);  // kernel keeps 15 characters
+}
+
+// The child's side of a fork: the same process set-up as launch's exec path (own process
+// group, default SIGINT/SIGTERM, stdout/stderr to its log or launch's pipe), then the entry.
+[[noreturn]] void run_child(const cli::ForkSpec& spec, std::size_t k, const ArgvArea& area) {
+  const cli::ForkChild& c = spec.children[k];
+  setpgid(0, 0);
+  signal(SIGINT, SIG_DFL);
+  signal(SIGTERM, SIG_DFL);
+  const int fd = open(c.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd >= 0) {
+    dup2(c.stdout_fd >= 0 ? c.stdout_fd : fd, 1);
+    dup2(fd, 2);
+    close(fd);
+  }
+  // Descriptors meant for launch or for another child: an agent holding launch's progress
+  // pipe would keep it open after the coordinator has left.
+  close(spec.pid_fd);
+  for (const cli::ForkChild& other : spec.children)
+    if (other.stdout_fd > 2) close(other.stdout_fd);
+  std::vector<std::string> strings = c.argv;  // copies: the argv area is overwritten next
+  show_as(area, strings);
+  std::vector<char*> argv;
+  for (auto& s : strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  const int argc = static_cast<int>(strings.size());
+  const int code = c.role == cli::ForkRole::kCoordinator
+                       ? coordinator::coordinator_main(argc, argv.data())
+                       : agent::agent_main(argc, argv.data());
+  cli::exit_process(code);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::ForkSpec spec;
+  try {
+    spec = cli::decode_fork_spec(std::vector<std::string>(argv + 1, argv + argc));
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "tessera-fork-server: error: %s\n", e.what());
+    return 2;
+  }
+  const ArgvArea area{argv[0], static_cast<std::size_t>(argv[argc - 1] +
+                                                        std::strlen(argv[argc - 1]) + 1 - argv[0])};
+  for (std::size_t k = 0; k < spec.children.size(); ++k) {
+    const int threads = thread_count();
+    if (threads != 1) {
+      std::fprintf(stderr,
+                   "tessera-fork-server: error: %d threads before forking child %zu (must be 1: "
+                   "nothing of Fast DDS may run before a fork)\n",
+                   threads, k);
+      return 1;
+    }
+    std::fflush(nullptr);  // nothing buffered may be written twice
+    const pid_t pid = fork();
+    if (pid < 0) {
+      std::fprintf(stderr, "tessera-fork-server: error: fork failed: %s\n", std::strerror(errno));
+      return 1;
+    }
+    if (pid == 0) run_child(spec, k, area);
+    const std::string line = std::to_string(pid) + "\n";
+    if (write(spec.pid_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) {
+      std::fprintf(stderr, "tessera-fork-server: error: cannot report pid %d to launch\n",
+                   static_cast<int>(pid));
+      return 1;
+    }
+  }
+  close(spec.pid_fd);
+  cli::exit_process(0);
+}

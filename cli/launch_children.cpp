@@ -1,0 +1,200 @@
+#include "launch_children.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+
+namespace tessera::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+Child labelled(const ForkSpec& spec, std::size_t k, const std::vector<std::string>& names,
+               const std::vector<long>& agents) {
+  Child c;
+  c.name = names.at(k);
+  c.agent = agents.at(k);
+  c.log = spec.children[k].log;
+  return c;
+}
+
+// Starts argv with stdout going to `stdout_fd` (or the log) and stderr to the log, in its own
+// process group (so a terminal's Ctrl-C reaches only us, and we decide how to stop them).
+pid_t spawn_one(const std::vector<std::string>& argv, const std::string& log, int stdout_fd) {
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed: " + std::string(std::strerror(errno)));
+  if (pid == 0) {
+    setpgid(0, 0);
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(stdout_fd >= 0 ? stdout_fd : fd, 1);
+      dup2(fd, 2);
+      close(fd);
+    }
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
+    std::fprintf(stderr, "cannot run %s: %s\n", args[0], std::strerror(errno));
+    _exit(127);
+  }
+  return pid;
+}
+
+int exit_code_of(int status) {
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+}  // namespace
+
+std::vector<Child> spawn_exec(const ForkSpec& spec, const std::vector<std::string>& names,
+                              const std::vector<long>& agents) {
+  std::vector<Child> children;
+  for (std::size_t k = 0; k < spec.children.size(); ++k) {
+    const ForkChild& f = spec.children[k];
+    Child c = labelled(spec, k, names, agents);
+    c.pid = spawn_one(f.argv, f.log, f.stdout_fd);
+    c.running = true;
+    children.push_back(c);
+    // The coordinator's progress pipe must not stay open in the agents (exec'ed later).
+    if (f.stdout_fd > 2) close(f.stdout_fd);
+  }
+  return children;
+}
+
+std::vector<Child> spawn_forked(const std::string& fork_server, ForkSpec spec,
+                                const std::vector<std::string>& names,
+                                const std::vector<long>& agents, const std::string& server_log,
+                                double timeout_s) {
+  int pids[2];
+  if (pipe(pids) != 0) throw std::runtime_error("launch: pipe failed");
+  fcntl(pids[0], F_SETFD, FD_CLOEXEC);  // only the write end goes to the server
+  spec.pid_fd = pids[1];
+  std::vector<std::string> argv = {fork_server};
+  for (std::string& a : encode_fork_spec(spec)) argv.push_back(std::move(a));
+  // Orphans of our descendants (the server's children once it exits) become our children.
+  prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0);
+  const pid_t server = spawn_one(argv, server_log, -1);
+  close(pids[1]);
+  for (const ForkChild& f : spec.children)
+    if (f.stdout_fd > 2) close(f.stdout_fd);  // the server has its own copy
+
+  std::vector<Child> children;
+  std::string pending;
+  std::string failure;
+  const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    const int left_ms = static_cast<int>(
+        std::chrono::duration_cast<std::chrono::milliseconds>(until - Clock::now()).count());
+    if (left_ms <= 0) {
+      failure = "no pid reported within " + std::to_string(timeout_s) + " s";
+      break;
+    }
+    pollfd pfd{pids[0], POLLIN, 0};
+    const int ready = poll(&pfd, 1, left_ms);
+    if (ready < 0 && errno == EINTR) continue;  // launch's SIGINT handler: judged afterwards
+    if (ready <= 0) continue;
+    char buf[256];
+    const ssize_t n = read(pids[0], buf, sizeof(buf));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;  // the server closed its end: all reported, or it failed
+    pending.append(buf, static_cast<std::size_t>(n));
+    for (std::size_t nl; (nl = pending.find('\n')) != std::string::npos;) {
+      Child c = labelled(spec, children.size(), names, agents);
+      c.pid = static_cast<pid_t>(std::atol(pending.substr(0, nl).c_str()));
+      c.running = true;
+      pending.erase(0, nl + 1);
+      children.push_back(c);
+    }
+  }
+  close(pids[0]);
+  // The server exits right after its last report; once it is reaped, every child it forked has
+  // been re-parented to us.
+  int status = 0;
+  int server_code = -1;
+  const auto reap_until = Clock::now() + std::chrono::seconds(5);
+  while (Clock::now() < reap_until) {
+    const pid_t r = waitpid(server, &status, WNOHANG);
+    if (r == server) {
+      server_code = exit_code_of(status);
+      break;
+    }
+    if (r < 0 && errno != EINTR) break;
+    usleep(1000);
+  }
+  if (server_code < 0) {
+    kill(server, SIGKILL);
+    waitpid(server, &status, 0);
+    if (failure.empty()) failure = "it did not exit after starting the processes";
+  }
+  prctl(PR_SET_CHILD_SUBREAPER, 0, 0, 0, 0);
+  if (failure.empty() && server_code != 0)
+    failure = "it exited with code " + std::to_string(server_code);
+  if (failure.empty() && children.size() != spec.children.size())
+    failure = "it reported " + std::to_string(children.size()) + " of " +
+              std::to_string(spec.children.size()) + " processes";
+  if (!failure.empty()) {
+    for (Child& c : children) kill(c.pid, SIGKILL);
+    reap(children, true);
+    throw std::runtime_error("launch: the fork server (" + fork_server + ") failed: " + failure +
+                             "\n" + tail_of(server_log, 10));
+  }
+  return children;
+}
+
+void reap(std::vector<Child>& children, bool block) {
+  for (auto& c : children) {
+    if (!c.running) continue;
+    int status = 0;
+    if (waitpid(c.pid, &status, block ? 0 : WNOHANG) == c.pid) {
+      c.running = false;
+      c.code = exit_code_of(status);
+    }
+  }
+}
+
+bool any_running(const std::vector<Child>& children) {
+  for (const auto& c : children)
+    if (c.running) return true;
+  return false;
+}
+
+void stop_all(std::vector<Child>& children, double grace_s) {
+  for (auto& c : children)
+    if (c.running) kill(c.pid, SIGINT);
+  const auto until = Clock::now() + std::chrono::duration<double>(grace_s);
+  while (any_running(children) && Clock::now() < until) {
+    reap(children, false);
+    usleep(20000);
+  }
+  for (auto& c : children)
+    if (c.running) kill(c.pid, SIGKILL);
+  reap(children, true);
+}
+
+std::string tail_of(const std::string& path, std::size_t max_lines) {
+  std::ifstream f(path);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(f, l);) lines.push_back(l);
+  std::string out;
+  for (std::size_t k = lines.size() > max_lines ? lines.size() - max_lines : 0; k < lines.size();
+       ++k)
+    out += "    " + lines[k] + "\n";
+  return out;
+}
+
+}  // namespace tessera::cli

@@ -1,0 +1,34 @@
+// tessera-coordinator's body: parses the options and wires the pieces: the run's steps are
+// sequenced in coordinator_run.cpp, the process life around the DDS session in
+// cli/session_process.hpp.
+
+#include "coordinator/coordinator_entry.hpp"
+
+#include <string>
+#include <vector>
+
+#include "coordinator/coordinator_options.hpp"
+#include "coordinator/coordinator_run.hpp"
+#include "coordinator/run_timeline.hpp"
+#include "session_process.hpp"
+#include "transport/signal_watcher.hpp"
+
+namespace tessera::coordinator {
+
+int coordinator_main(int argc, char** argv) {
+  RunTimeline timeline;  // first: the summary's timeline counts from here
+  transport::SignalWatcher
+      signals;  // first: every thread created later inherits the blocked signals
+  const std::vector<std::string> argv_list(argv + 1, argv + argc);
+  CoordinatorOptions options;
+  if (auto code = cli::parse_process_options(argv_list, "tessera-coordinator",
+                                             cli::process_help(kCoordinatorUsage),
+                                             parse_coordinator_options, options))
+    return *code;
+  const cli::ProcessRole role{"tessera-coordinator", options.net.timeout_s};
+  return cli::run_session_process(
+      coordinator_session_options(options), role, signals,
+      [&](transport::Session& session) { run_coordinator(options, session, timeline); });
+}
+
+}  // namespace tessera::coordinator

@@ -1,0 +1,165 @@
+// `tessera launch` through its fork server (cli/fork_server/: Fast DDS loaded once, the
+// coordinator and the agents forked from it) and through the exec fallback
+// (--no-fork-server): the same iterates as the in-process engine, forked processes that look
+// like the executables they stand for and are launch's own children, a clean SIGINT, and the
+// fork server's argv encoding.
+// Domains used here: 50-53 (each test its own, so ctest -j is safe).
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "dds_process_support.hpp"
+#include "fork_spec.hpp"
+#include "util/input_error.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+// The same solve in process (`tessera solve`) and with `tessera launch extra...` on `domain`:
+// same rounds, cost equal to 1e-9 relative, and no shared-memory file left behind.
+void expect_launch_gives_the_in_process_iterates(const std::string& extra, int domain,
+                                                 const std::string& expected_mode) {
+  const std::string dir = temp_dir();
+  const std::string graph =
+      generate_graph(dir + "/graph.g2o", "--kind grid3d --poses 240 --robots 3 --seed 5");
+  const std::string solver = " --agents 3 --algorithm irbcd --partition eco --seed 7 --init file";
+  std::string out;
+  ASSERT_EQ(
+      run_command(bin("tessera") + " solve " + graph + solver + " --json " + dir + "/ip.json 2>&1",
+                  &out),
+      0)
+      << out;
+  const std::string ip = slurp(dir + "/ip.json");
+  ASSERT_GT(json_field(ip, "rounds"), 1) << "the graph should need a few rounds";
+
+  const auto before = shm_files();
+  const int rc = run_command(bin("tessera") + " launch " + graph + solver + " --no-certify" +
+                                 " --domain " + std::to_string(domain) + " --timeout 60 --json " +
+                                 dir + "/dds.json " + extra + " 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find(expected_mode), std::string::npos) << out;
+  EXPECT_NE(out.find("summary:"), std::string::npos) << out;
+  const std::string dds = slurp(dir + "/dds.json");
+  EXPECT_EQ(json_field(dds, "rounds"), json_field(ip, "rounds")) << dds << ip;
+  const double cost = json_field(ip, "cost");
+  EXPECT_NEAR(json_field(dds, "cost"), cost, 1e-9 * cost) << dds << ip;
+  const auto leaked = leaked_shm_files(before, domain);
+  EXPECT_TRUE(leaked.empty()) << join(leaked);
+}
+
+TEST(DdsForkServer, LaunchThroughTheForkServerGivesTheInProcessIterates) {
+  expect_launch_gives_the_in_process_iterates("", 50, "forked by tessera-fork-server");
+}
+
+TEST(DdsForkServer, ExecFallbackGivesTheInProcessIterates) {
+  expect_launch_gives_the_in_process_iterates("--no-fork-server", 51, "each exec'ed");
+}
+
+// The parent pid and command line of a process, from /proc.
+long parent_of(long pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("PPid:", 0) == 0) return std::stol(line.substr(5));
+  return -1;
+}
+
+TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndStopOnSigint) {
+  const std::string dir = temp_dir();
+  const std::string run_id = "forked-" + std::to_string(getpid());
+  struct Cleanup {  // whatever an assertion leaves running
+    std::string run_id;
+    ~Cleanup() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
+  } cleanup{run_id};
+  const auto before = shm_files();
+  // 3000 poses from their file poses: enough rounds that the run is still going when its
+  // processes are looked up and interrupted after round 2.
+  Process launch = start(
+      {bin("tessera"), "launch",   "--agents",    "2",      "--poses",   "3000",       "--domain",
+       "52",           "--run-id", run_id,        "--init", "file",      "--grad-tol", "1e-12",
+       "--max-rounds", "100000",   "--partition", "fast",   "--timeout", "60"},
+      dir + "/launch.log");
+  ASSERT_TRUE(wait_for_output(launch, "round 2:", 30)) << launch.output();
+  EXPECT_NE(launch.output().find("forked by tessera-fork-server"), std::string::npos);
+  // pgrep -f reads the command line each forked child shows: its executable's argv.
+  for (const std::string& pattern : {"[t]essera-coordinator --agents 2 .*--run-id " + run_id + " ",
+                                     "[t]essera-agent.*--id 0 --run-id " + run_id + " ",
+                                     "[t]essera-agent.*--id 1 --run-id " + run_id + " "}) {
+    std::string pids;
+    run_command("pgrep -f '" + pattern + "'", &pids);
+    ASSERT_FALSE(pids.empty()) << pattern;
+    const long pid = std::stol(pids);
+    EXPECT_EQ(pids.find('\n'), pids.size() - 1) << "one process for " << pattern << ": " << pids;
+    EXPECT_EQ(parent_of(pid), launch.pid) << pattern;  // re-parented: launch waits for it
+    std::ifstream comm("/proc/" + std::to_string(pid) + "/comm");
+    std::string name;
+    std::getline(comm, name);
+    EXPECT_EQ(name.rfind("tessera-", 0), 0u) << name;
+  }
+  kill(launch.pid, SIGINT);
+  ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
+  EXPECT_EQ(launch.exit_code, 130) << launch.output();
+  EXPECT_NE(launch.output().find("interrupted"), std::string::npos) << launch.output();
+  std::string ps;
+  run_command("pgrep -fc '[t]essera-.*--run-id " + run_id + "'", &ps);
+  EXPECT_EQ(std::stoi(ps), 0) << ps;
+  const auto leaked = leaked_shm_files(before, 52);
+  EXPECT_TRUE(leaked.empty()) << join(leaked);
+}
+
+TEST(DdsForkServer, BadFileStopsTheForkedRunWithTheAgentsReason) {
+  const std::string dir = temp_dir();
+  const std::string graph = write_file(dir, "bad.g2o", "VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 7 1 0\n");
+  std::string out;
+  const int rc = run_command(
+      bin("tessera") + " launch " + graph + " --agents 2 --domain 53 --timeout 30 2>&1", &out);
+  EXPECT_NE(rc, 0) << out;
+  EXPECT_NE(out.find("forked by tessera-fork-server"), std::string::npos) << out;
+  EXPECT_NE(out.find("bad.g2o"), std::string::npos) << out;  // the agent's message names the file
+  EXPECT_NE(out.find("exit 2"), std::string::npos) << out;   // its exit code, as when exec'ed
+}
+
+TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
+  cli::ForkSpec spec;
+  spec.pid_fd = 7;
+  spec.children.push_back({cli::ForkRole::kCoordinator, "/tmp/c.log", 4, {"/b/c", "--x", ""}});
+  spec.children.push_back({cli::ForkRole::kAgent, "/tmp/a 0.log", -1, {"/b/a", "--child"}});
+  const std::vector<std::string> args = cli::encode_fork_spec(spec);
+  const cli::ForkSpec back = cli::decode_fork_spec(args);
+  EXPECT_EQ(back.pid_fd, 7);
+  ASSERT_EQ(back.children.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(back.children[k].role, spec.children[k].role);
+    EXPECT_EQ(back.children[k].log, spec.children[k].log);
+    EXPECT_EQ(back.children[k].stdout_fd, spec.children[k].stdout_fd);
+    EXPECT_EQ(back.children[k].argv, spec.children[k].argv);  // "--child" as an argument too
+  }
+  auto broken = [&](std::size_t at, const std::string& value) {
+    std::vector<std::string> a = args;
+    a[at] = value;
+    return a;
+  };
+  EXPECT_THROW(cli::decode_fork_spec({}), InputError);
+  EXPECT_THROW(cli::decode_fork_spec({"--pid-fd", "3"}), InputError);  // no child
+  EXPECT_THROW(cli::decode_fork_spec(broken(1, "x")), InputError);
+  EXPECT_THROW(cli::decode_fork_spec(broken(3, "worker")), InputError);
+  EXPECT_THROW(cli::decode_fork_spec(broken(6, "99")), InputError);  // argc past the end
+  EXPECT_THROW(cli::decode_fork_spec(broken(6, "0")), InputError);
+  cli::ForkSpec no_log = spec;
+  no_log.children[1].log.clear();
+  EXPECT_THROW(cli::encode_fork_spec(no_log), InputError);
+  // The executable says what is wrong and exits 2 (as the other executables on bad options).
+  std::string out;
+  EXPECT_EQ(run_command(bin("tessera-fork-server") + " --pid-fd 1 --child worker 2>&1", &out), 2)
+      << out;
+  EXPECT_NE(out.find("tessera-fork-server: error: "), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
