@@ -1,5 +1,6 @@
 #include "fork_spec.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 
@@ -79,6 +80,39 @@ ForkSpec decode_fork_spec(const std::vector<std::string>& args) {
   }
   spec.validate();
   return spec;
+}
+
+std::string serialize_fork_spec(const ForkSpec& spec) {
+  std::string out;
+  for (const std::string& item : encode_fork_spec(spec)) {
+    if (item.find('\0') != std::string::npos)
+      throw InputError("fork server: an argument contains a NUL byte");
+    out += item;
+    out += '\0';
+  }
+  return out;
+}
+
+ForkSpec parse_fork_spec(const std::string& text) {
+  if (text.empty() || text.back() != '\0')
+    throw InputError("fork server: the spec is empty or cut short (no final NUL)");
+  std::vector<std::string> items;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = text.find('\0', at);
+    items.push_back(text.substr(at, end - at));
+    at = end + 1;
+  }
+  return decode_fork_spec(items);
+}
+
+std::size_t longest_command_line(const ForkSpec& spec) {
+  std::size_t longest = 0;
+  for (const ForkChild& c : spec.children) {
+    std::size_t n = 0;
+    for (const std::string& a : c.argv) n += a.size() + 1;
+    longest = std::max(longest, n);
+  }
+  return longest;
 }
 
 }  // namespace tessera::cli

@@ -1,10 +1,10 @@
 #pragma once
 // What `tessera launch` asks its fork server (tessera-fork-server, cli/fork_server/) to start:
 // the coordinator and the agents, each with the argv its standalone executable would get.
-// Plain data and a flat argv encoding, free of Fast DDS, so that `tessera` (which never links
-// Fast DDS) can write it and the fork server read it back. Passing it on the fork server's
-// own command line also gives the server an argv area large enough to show each child's
-// command line in place of its own (ps / pgrep -f see "tessera-agent ... --id 1 ...").
+// Plain data and a flat encoding, free of Fast DDS, so that `tessera` (which never links
+// Fast DDS) can write it and the fork server read it back. It goes through a pipe, not the
+// server's command line: while the server loads, its command line must not look like an
+// agent's to `pgrep -f 'tessera-agent.*--id 1 ...'` (tests and operators find processes so).
 
 #include <string>
 #include <vector>
@@ -36,12 +36,24 @@ struct ForkSpec {
   void validate() const;
 };
 
-/// The fork server's argv after its program name: "--pid-fd FD" then, per child,
+/// The spec as a list of strings: "--pid-fd FD" then, per child,
 /// "--child ROLE LOG STDOUT_FD ARGC ARGV...". Validates `spec` first.
 std::vector<std::string> encode_fork_spec(const ForkSpec& spec);
 
 /// Inverse of encode_fork_spec(); throws InputError naming the bad item on malformed input.
 ForkSpec decode_fork_spec(const std::vector<std::string>& args);
+
+/// encode_fork_spec() as one byte string, each item NUL-terminated (what goes down the pipe).
+/// Throws InputError when an item contains a NUL byte.
+std::string serialize_fork_spec(const ForkSpec& spec);
+
+/// Inverse of serialize_fork_spec(); throws InputError on malformed input (also when the
+/// text does not end with a NUL, i.e. was cut short).
+ForkSpec parse_fork_spec(const std::string& text);
+
+/// Bytes of the longest child's command line (its argv, each NUL-terminated): the room the
+/// fork server's own argv must offer for a child to show its command line in place of it.
+std::size_t longest_command_line(const ForkSpec& spec);
 
 const char* fork_role_name(ForkRole role);
 

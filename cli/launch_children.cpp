@@ -80,16 +80,37 @@ std::vector<Child> spawn_forked(const std::string& fork_server, ForkSpec spec,
                                 const std::vector<std::string>& names,
                                 const std::vector<long>& agents, const std::string& server_log,
                                 double timeout_s) {
-  int pids[2];
-  if (pipe(pids) != 0) throw std::runtime_error("launch: pipe failed");
-  fcntl(pids[0], F_SETFD, FD_CLOEXEC);  // only the write end goes to the server
+  int pids[2], specs[2];
+  if (pipe(pids) != 0 || pipe(specs) != 0) throw std::runtime_error("launch: pipe failed");
+  // Only the pids' write end and the spec's read end go to the server.
+  fcntl(pids[0], F_SETFD, FD_CLOEXEC);
+  fcntl(specs[1], F_SETFD, FD_CLOEXEC);
   spec.pid_fd = pids[1];
-  std::vector<std::string> argv = {fork_server};
-  for (std::string& a : encode_fork_spec(spec)) argv.push_back(std::move(a));
+  const std::string text = serialize_fork_spec(spec);
+  const std::vector<std::string> argv = {fork_server, "--spec-fd", std::to_string(specs[0]),
+                                         "--title-room",
+                                         std::string(longest_command_line(spec), ' ')};
   // Orphans of our descendants (the server's children once it exits) become our children.
   prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0);
   const pid_t server = spawn_one(argv, server_log, -1);
   close(pids[1]);
+  close(specs[0]);
+  {
+    // A server that died early must not kill launch with SIGPIPE (the server has already
+    // been forked, so it keeps the default disposition): it is judged below.
+    struct sigaction ignore {};
+    struct sigaction previous {};
+    ignore.sa_handler = SIG_IGN;
+    sigaction(SIGPIPE, &ignore, &previous);
+    for (std::size_t at = 0; at < text.size();) {
+      const ssize_t n = write(specs[1], text.data() + at, text.size() - at);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      at += static_cast<std::size_t>(n);
+    }
+    sigaction(SIGPIPE, &previous, nullptr);
+    close(specs[1]);
+  }
   for (const ForkChild& f : spec.children)
     if (f.stdout_fd > 2) close(f.stdout_fd);  // the server has its own copy
 

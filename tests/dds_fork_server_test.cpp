@@ -154,11 +154,23 @@ TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
   cli::ForkSpec no_log = spec;
   no_log.children[1].log.clear();
   EXPECT_THROW(cli::encode_fork_spec(no_log), InputError);
+  // The bytes that go down the pipe.
+  const std::string text = cli::serialize_fork_spec(spec);
+  EXPECT_EQ(cli::parse_fork_spec(text).children[0].argv, spec.children[0].argv);
+  EXPECT_THROW(cli::parse_fork_spec(text.substr(0, text.size() - 1)), InputError);  // cut short
+  EXPECT_THROW(cli::parse_fork_spec(""), InputError);
+  EXPECT_EQ(cli::longest_command_line(spec), std::string("/b/a --child ").size());  // the agent
   // The executable says what is wrong and exits 2 (as the other executables on bad options).
   std::string out;
   EXPECT_EQ(run_command(bin("tessera-fork-server") + " --pid-fd 1 --child worker 2>&1", &out), 2)
       << out;
-  EXPECT_NE(out.find("tessera-fork-server: error: "), std::string::npos) << out;
+  EXPECT_NE(out.find("tessera-fork-server: error: usage"), std::string::npos) << out;
+  EXPECT_EQ(run_command("printf 'bad' | " + bin("tessera-fork-server") +
+                            " --spec-fd 0 --title-room '    ' 2>&1",
+                        &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("cut short"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -13,8 +13,10 @@
 // Fast DDS object of each process is created by the entry function in the child. Each fork is
 // refused unless this process is still single-threaded.
 //
-// usage (written by launch, cli/fork_spec.hpp):
-//   tessera-fork-server --pid-fd FD --child ROLE LOG STDOUT_FD ARGC ARGV... [--child ...]
+// usage (by launch): tessera-fork-server --spec-fd FD --title-room BLANKS
+//   FD: a pipe from which the spec is read to its end (cli/fork_spec.hpp: serialize_fork_spec);
+//   BLANKS: as many spaces as the longest child's command line, so that the argv area where
+//   each child writes its own command line (ps, pgrep -f) is large enough.
 
 #include <fcntl.h>
 #include <signal.h>
@@ -24,6 +26,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <string>
@@ -47,6 +50,20 @@ int thread_count() {
   return -1;
 }
 
+// The whole of descriptor `fd` (read to its end), or throws InputError.
+std::string read_all(int fd) {
+  std::string text;
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = read(fd, buf, sizeof(buf));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0)
+      throw InputError("fork server: cannot read the spec: " + std::string(std::strerror(errno)));
+    if (n == 0) return text;
+    text.append(buf, static_cast<std::size_t>(n));
+  }
+}
+
 // The memory holding this process's argv strings (contiguous on Linux): what ps and pgrep -f
 // read as the command line.
 struct ArgvArea {
@@ -57,8 +74,8 @@ struct ArgvArea {
 // Shows `argv` as this process's command line and its program name as the thread name, so a
 // forked child looks like the executable it stands for ("tessera-agent --graph ... --id 1
 // ..."): operators and the tests find processes with pgrep -f. The area is the fork server's
-// own argv, which holds every child's argv, so one child's always fits; it is padded with
-// NULs (ps shows trailing blanks).
+// own argv, made large enough by launch (--title-room); it is padded with NULs (ps shows
+// trailing blanks).
 void show_as(const ArgvArea& area, const std::vector<std::string>& argv) {
   std::size_t at = 0;
   for (const std::string& a : argv) {
@@ -111,7 +128,18 @@ void show_as(const ArgvArea& area, const std::vector<std::string>& argv) {
 int main(int argc, char** argv) {
   cli::ForkSpec spec;
   try {
-    spec = cli::decode_fork_spec(std::vector<std::string>(argv + 1, argv + argc));
+    if (argc != 5 || std::strcmp(argv[1], "--spec-fd") != 0 ||
+        std::strcmp(argv[3], "--title-room") != 0)
+      throw InputError(
+          "usage: tessera-fork-server --spec-fd FD --title-room BLANKS (run by tessera launch)");
+    char* end = nullptr;
+    const long fd = std::strtol(argv[2], &end, 10);
+    if (*argv[2] == '\0' || *end != '\0' || fd < 0)
+      throw InputError(std::string("--spec-fd '") + argv[2] + "' is not a descriptor");
+    spec = cli::parse_fork_spec(read_all(static_cast<int>(fd)));
+    close(static_cast<int>(fd));
+    if (std::strlen(argv[4]) < cli::longest_command_line(spec))
+      throw InputError("--title-room is shorter than the longest child's command line");
   } catch (const InputError& e) {
     std::fprintf(stderr, "tessera-fork-server: error: %s\n", e.what());
     return 2;
