@@ -23,8 +23,12 @@ Also printed (and in the CSV): CPU seconds (user + system over all processes of 
 DDS run's voluntary context switches, which stay meaningful on a loaded machine where wall times
 do not.
 
+launch starts its processes through tessera-fork-server by default (Fast DDS loaded once, the
+coordinator and the agents forked from it); `--launch-args=--no-fork-server` execs each one, for
+an A/B of the start-up cost (docs/dds-runtime.md, "Fork server").
+
 usage: dds_overhead.py [--bin build/bin] [--graphs CSAIL,intel] [--agents 5] [--domain 210]
-                       [--out FILE.csv] [--limit S]
+                       [--out FILE.csv] [--limit S] [--launch-args="--no-fork-server"]
 """
 import argparse
 import csv
@@ -178,6 +182,7 @@ def main():
     names = a.graphs.split(",") if a.graphs else paper_graphs()
     head = ("graph", "rounds ip", "rounds dds", "rel cost diff", "wall ip s", "wall dds s",
             "ratio", "dds ms/round", "bytes/round")
+    print("DDS runs: tessera launch ... %s" % (a.launch_args or "(fork server)"))
     print("%-18s %9s %10s %13s %9s %10s %6s %12s %11s" % head)
     rows = []
     for name in names:
