@@ -4,12 +4,12 @@
 #include <string>
 
 #include "arguments.hpp"
-#include "json_writer.hpp"
-#include "robot_files.hpp"
 #include "commands.hpp"
 #include "generate/generator.hpp"
 #include "io/g2o_writer.hpp"
 #include "io/tum_writer.hpp"
+#include "json_writer.hpp"
+#include "robot_files.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::cli {
@@ -129,8 +129,7 @@ int run_generate(const Args& argv) {
   if (auto truth = args.get("truth")) write_tum(result.ground_truth, *truth);
   if (auto json = args.get("json")) write_json(*json, options, result, *out, timing);
   if (auto split = args.get("split")) {
-    const auto files =
-        write_robot_files(*out, result.graph.num_poses, options.num_robots, *split);
+    const auto files = write_robot_files(*out, result.graph.num_poses, options.num_robots, *split);
     std::printf("wrote %zu robot files into %s\n", files.size(), split->c_str());
   }
 

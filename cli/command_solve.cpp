@@ -29,7 +29,8 @@ const char* kHelp =
     "  --algorithm centralized   certifiable centralized solver (SE-Sync family): chordal\n"
     "                            initialization, Riemannian trust region, Riemannian staircase\n"
     "                            and a minimum-eigenvalue certificate of global optimality\n"
-    "  --out FILE                write the optimised poses (g2o; a name ending in .tum writes TUM)\n"
+    "  --out FILE                write the optimised poses (g2o; a name ending in "
+    ".tum writes TUM)\n"
     "  --tum FILE                also write the trajectory as TUM text\n"
     "  --json FILE               write a JSON summary ('-' for stdout)\n"
     "  --trace FILE              write one CSV row per solver iteration\n"
@@ -86,7 +87,8 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   std::printf("%s", r.full_report().c_str());
   std::printf("%s: %zu poses, %zu edges, d = %d: cost %.10g, %s, %.3f s\n", graph_path.c_str(),
               graph.num_poses, graph.num_measurements(), graph.d, r.cost,
-              r.certified ? (*r.certified ? "certified optimal" : "NOT certified") : "not certified (skipped)",
+              r.certified ? (*r.certified ? "certified optimal" : "NOT certified")
+                          : "not certified (skipped)",
               wall_s);
   if (auto p = a.get("out")) write_poses(*p, graph, r.poses);
   if (auto p = a.get("tum")) write_tum(r.poses, *p);
@@ -121,7 +123,7 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
 int run_solve(const Args& args) {
   const auto start = std::chrono::steady_clock::now();
   std::set<std::string> valued = {"algorithm", "out",  "tum",      "json",    "trace",
-                                   "init",      "rank", "max-rank", "grad-tol"};
+                                  "init",      "rank", "max-rank", "grad-tol"};
   std::set<std::string> switches = {"help", "no-certify", "raw-quaternions"};
   for (const char* const* o = kDistributedValued; *o; ++o) valued.insert(*o);
   for (const char* const* o = kDistributedSwitches; *o; ++o) switches.insert(*o);
@@ -136,7 +138,8 @@ int run_solve(const Args& args) {
   if (algorithm == "centralized") return solve_centralized_command(a, a.positional()[0], start);
   if (algorithm == "rbcd" || algorithm == "rbcd++" || algorithm == "irbcd")
     return solve_distributed_command(a, a.positional()[0], start);
-  throw InputError("option --algorithm: '" + algorithm + "' is not one of centralized, rbcd, rbcd++, irbcd");
+  throw InputError("option --algorithm: '" + algorithm +
+                   "' is not one of centralized, rbcd, rbcd++, irbcd");
 }
 
 }  // namespace tessera::cli

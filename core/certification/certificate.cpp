@@ -1,21 +1,24 @@
 #include "certification/certificate.hpp"
 
+#include <Spectra/SymEigsSolver.h>
+
+#include <Eigen/CholmodSupport>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-
-#include <Eigen/CholmodSupport>
-#include <Spectra/SymEigsSolver.h>
 
 #include "util/input_error.hpp"
 
 namespace tessera {
 
 void CertificateOptions::validate() const {
-  if (!(relative_tolerance >= 0)) throw InputError("CertificateOptions.relative_tolerance must be >= 0");
-  if (lanczos_max_iterations <= 0) throw InputError("CertificateOptions.lanczos_max_iterations must be > 0");
-  if (!(lanczos_tolerance > 0)) throw InputError("CertificateOptions.lanczos_tolerance must be > 0");
+  if (!(relative_tolerance >= 0))
+    throw InputError("CertificateOptions.relative_tolerance must be >= 0");
+  if (lanczos_max_iterations <= 0)
+    throw InputError("CertificateOptions.lanczos_max_iterations must be > 0");
+  if (!(lanczos_tolerance > 0))
+    throw InputError("CertificateOptions.lanczos_tolerance must be > 0");
 }
 
 SparseMatrix certificate_matrix(const BlockProblem& problem, const Eigen::MatrixXd& X) {
@@ -65,7 +68,9 @@ class ShiftInvertOp {
 
 // A failed factorization is an expected outcome here (it is the test), so CHOLMOD must not
 // print its "not positive definite" warning.
-void quiet(Factor& f) { f.cholmod().print = 0; }
+void quiet(Factor& f) {
+  f.cholmod().print = 0;
+}
 
 SparseMatrix shifted(const SparseMatrix& S, double shift) {
   SparseMatrix A = S;
@@ -119,8 +124,8 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
     ++res.factorizations;
   }
   Eigen::VectorXd v;
-  res.min_eigenvalue = min_eigen_by_shift_invert(factor, n, shift, options,
-                                                 res.certified ? nullptr : &v, &res.lanczos_iterations);
+  res.min_eigenvalue = min_eigen_by_shift_invert(
+      factor, n, shift, options, res.certified ? nullptr : &v, &res.lanczos_iterations);
   if (!res.certified) {
     // The search shift can be far above -lambda_min, leaving lambda_min poorly separated in
     // the inverted spectrum (an inaccurate eigenvector). Move the shift just past the
@@ -132,8 +137,8 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
       refined.compute(shifted(S, tight));
       ++res.factorizations;
       if (refined.info() == Eigen::Success)
-        res.min_eigenvalue = min_eigen_by_shift_invert(refined, n, tight, options, &v,
-                                                       &res.lanczos_iterations);
+        res.min_eigenvalue =
+            min_eigen_by_shift_invert(refined, n, tight, options, &v, &res.lanczos_iterations);
     }
   }
   if (!res.certified && v.size() > 0) res.min_eigenvector = v.normalized();

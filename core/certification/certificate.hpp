@@ -10,9 +10,8 @@
 // pushed down until the factorization exists and the same operator yields the most negative
 // eigenvalue and its eigenvector (the saddle-escape direction).
 
-#include <string>
-
 #include <Eigen/Core>
+#include <string>
 
 #include "problem/block_problem.hpp"
 
@@ -22,7 +21,7 @@ struct CertificateOptions {
   /// eta = relative_tolerance * max(1, max diagonal entry of Q). >= 0.
   double relative_tolerance = 1e-6;
   int lanczos_max_iterations = 1000;  ///< > 0
-  double lanczos_tolerance = 1e-8;   ///< Relative accuracy of the eigenvalue, > 0.
+  double lanczos_tolerance = 1e-8;    ///< Relative accuracy of the eigenvalue, > 0.
   void validate() const;
 };
 
@@ -31,7 +30,7 @@ struct CertificateResult {
   /// lambda_min(S) (estimate); NaN if Lanczos did not converge (the factorization test still
   /// decides `certified`).
   double min_eigenvalue = 0.0;
-  double tolerance = 0.0;       ///< The absolute eta used.
+  double tolerance = 0.0;  ///< The absolute eta used.
   /// Unit eigenvector of lambda_min, length (d+1)n, set when not certified.
   Eigen::VectorXd min_eigenvector;
   int factorizations = 0;

@@ -9,7 +9,9 @@ struct Pose {
   Eigen::MatrixXd R;  ///< d x d rotation (orthonormal, det +1).
   Eigen::VectorXd t;  ///< d translation.
 
-  static Pose identity(int d) { return {Eigen::MatrixXd::Identity(d, d), Eigen::VectorXd::Zero(d)}; }
+  static Pose identity(int d) {
+    return {Eigen::MatrixXd::Identity(d, d), Eigen::VectorXd::Zero(d)};
+  }
   int dim() const { return static_cast<int>(t.size()); }
 };
 

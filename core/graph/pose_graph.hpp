@@ -11,9 +11,9 @@
 namespace tessera {
 
 struct PoseGraph {
-  int d = 0;                             ///< 2 or 3.
-  std::size_t num_poses = 0;             ///< n: ids are 0..n-1.
-  std::vector<Measurement> measurements; ///< In file order.
+  int d = 0;                              ///< 2 or 3.
+  std::size_t num_poses = 0;              ///< n: ids are 0..n-1.
+  std::vector<Measurement> measurements;  ///< In file order.
   /// Initial guess read from VERTEX lines; empty when the file had none (then
   /// initialisation comes from the measurements, e.g. chordal).
   std::vector<Pose> initial;

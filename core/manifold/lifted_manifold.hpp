@@ -4,9 +4,8 @@
 // pose i occupies columns (d+1)i .. (d+1)i+d, first the d Stiefel columns Y_i (Y_i^T Y_i = I),
 // then the translation p_i. Tangent vectors have the same shape.
 
-#include <cstddef>
-
 #include <Eigen/Core>
+#include <cstddef>
 
 namespace tessera {
 

@@ -2,9 +2,8 @@
 // Moving between poses in SE(d) and lifted poses in (St(r,d) x R^r)^n, and projections
 // of matrices onto SO(d).
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "graph/pose.hpp"
 

@@ -21,11 +21,13 @@ Eigen::MatrixXd round_rotations(const Eigen::MatrixXd& X, int d) {
   for (Eigen::Index i = 0; i < n; ++i)
     if (R.middleCols(d * i, d).determinant() < 0) ++negative;
   if (2 * negative > n) R.row(d - 1) *= -1.0;  // reflect so most blocks are rotations
-  for (Eigen::Index i = 0; i < n; ++i) R.middleCols(d * i, d) = project_to_rotation(R.middleCols(d * i, d));
+  for (Eigen::Index i = 0; i < n; ++i)
+    R.middleCols(d * i, d) = project_to_rotation(R.middleCols(d * i, d));
   return R;
 }
 
-std::vector<Pose> assemble_poses(const Eigen::MatrixXd& rotations, const Eigen::MatrixXd& translations) {
+std::vector<Pose> assemble_poses(const Eigen::MatrixXd& rotations,
+                                 const Eigen::MatrixXd& translations) {
   const Eigen::Index d = translations.rows();
   const Eigen::Index n = translations.cols();
   std::vector<Pose> poses(static_cast<std::size_t>(n));

@@ -4,9 +4,8 @@
 // (with the reflection chosen so most blocks have det +1), then the translations that are
 // optimal for those rotations.
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "graph/pose.hpp"
 #include "graph/pose_graph.hpp"
@@ -20,6 +19,7 @@ Eigen::MatrixXd round_rotations(const Eigen::MatrixXd& X, int d);
 std::vector<Pose> round_solution(const PoseGraph& graph, const Eigen::MatrixXd& X);
 
 /// Assembles poses from d x dn rotations and d x n translations.
-std::vector<Pose> assemble_poses(const Eigen::MatrixXd& rotations, const Eigen::MatrixXd& translations);
+std::vector<Pose> assemble_poses(const Eigen::MatrixXd& rotations,
+                                 const Eigen::MatrixXd& translations);
 
 }  // namespace tessera

@@ -1,9 +1,8 @@
 #include "problem/translation_solve.hpp"
 
-#include <stdexcept>
-
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
+#include <stdexcept>
 
 namespace tessera {
 
@@ -43,7 +42,8 @@ Eigen::MatrixXd solve_translations(const PoseGraph& graph, const Eigen::MatrixXd
   chol.setMode(Eigen::CholmodAuto);  // CHOLMOD chooses simplicial or supernodal
   chol.compute(L);
   if (chol.info() != Eigen::Success)
-    throw std::runtime_error("solve_translations: Laplacian factorization failed (disconnected graph?)");
+    throw std::runtime_error(
+        "solve_translations: Laplacian factorization failed (disconnected graph?)");
   Eigen::MatrixXd sol = chol.solve(b);
   for (std::size_t id = 0; id < n; ++id) {
     long v = var(id);

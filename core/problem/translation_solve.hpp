@@ -3,10 +3,9 @@
 // problem, solved with a sparse Cholesky factorization (CHOLMOD). Pose `anchor` is fixed
 // at the origin; the objective is invariant to a global translation, so this loses nothing.
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "graph/pose_graph.hpp"
 

@@ -19,7 +19,8 @@ enum class BlockKind : std::uint8_t { kY = 0, kP = 1, kV = 2 };
 struct PoseBlockMessage {
   std::uint32_t round = 0;
   std::uint32_t sender = 0;
-  std::uint32_t phase = 0;  ///< Protocol step within the round (see distributed/round_protocol.hpp).
+  /// Protocol step within the round (see distributed/round_protocol.hpp).
+  std::uint32_t phase = 0;
   BlockKind kind = BlockKind::kY;
   std::uint32_t rank = 0;  ///< r
   std::uint32_t dim = 0;   ///< d

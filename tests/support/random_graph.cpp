@@ -1,9 +1,8 @@
 #include "random_graph.hpp"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
-
-#include <Eigen/Geometry>
 
 namespace tessera::test {
 namespace {

@@ -1,12 +1,13 @@
 #include "test_support.hpp"
 
+#include <sys/wait.h>
+
 #include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <sys/wait.h>
 
 namespace tessera::test {
 
@@ -47,6 +48,8 @@ int run_command(const std::string& command, std::string* output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-std::string bin(const std::string& name) { return std::string(TESSERA_BIN_DIR) + "/" + name; }
+std::string bin(const std::string& name) {
+  return std::string(TESSERA_BIN_DIR) + "/" + name;
+}
 
 }  // namespace tessera::test

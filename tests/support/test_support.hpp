@@ -1,9 +1,9 @@
 #pragma once
 // Helpers shared by the tests: where ../shared lives, temporary files, running binaries.
 
-#include <string>
-
 #include <gtest/gtest.h>
+
+#include <string>
 
 namespace tessera::test {
 
