@@ -11,10 +11,10 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "io/g2o_reader.hpp"
-#include "io/g2o_writer.hpp"
 #include "io/tum_writer.hpp"
 #include "json_writer.hpp"
 #include "solve_distributed.hpp"
+#include "solve_output.hpp"
 #include "solvers/centralized_solver.hpp"
 #include "util/input_error.hpp"
 
@@ -61,14 +61,6 @@ void write_trace(const std::string& path, const CentralizedResult& r) {
   }
 }
 
-void write_poses(const std::string& path, const PoseGraph& graph, const std::vector<Pose>& poses) {
-  const bool tum = path.size() >= 4 && path.compare(path.size() - 4, 4, ".tum") == 0;
-  if (tum)
-    write_tum(poses, path);
-  else
-    write_g2o(graph, poses, path);
-}
-
 int solve_centralized_command(const Arguments& a, const std::string& graph_path,
                               std::chrono::steady_clock::time_point start) {
   G2oReadOptions read;
@@ -94,19 +86,16 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   if (auto p = a.get("tum")) write_tum(r.poses, *p);
   if (auto p = a.get("trace")) write_trace(*p, r);
   if (auto p = a.get("json")) {
-    JsonObject j;
-    j.add("algorithm", "centralized")
-        .add("graph", graph_path)
-        .add("poses", graph.num_poses)
-        .add("edges", graph.num_measurements())
-        .add("d", graph.d)
-        .add("rank", r.final_rank)
-        .add("iterations", r.iterations)
-        .add("grad_norm", r.grad_norm)
-        .add("cost", r.cost)
-        .add("relaxation_cost", r.relaxation_cost)
-        .add("certified", r.certified)
-        .add("min_eigenvalue", r.min_eigenvalue)
+    SolveSummary summary;
+    summary.algorithm = "centralized";
+    summary.rank = r.final_rank;
+    summary.iterations = r.iterations;
+    summary.grad_norm = r.grad_norm;
+    summary.cost = r.cost;
+    summary.relaxation_cost = r.relaxation_cost;
+    summary.certified = r.certified;
+    JsonObject j = solve_json(graph_path, graph, summary);
+    j.add("min_eigenvalue", r.min_eigenvalue)
         .add("final_rank", r.final_rank)
         .add("init_s", r.init_s)
         .add("optimize_s", r.optimize_s)

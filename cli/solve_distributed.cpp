@@ -6,11 +6,11 @@
 
 #include "distributed/distributed_solver.hpp"
 #include "io/g2o_reader.hpp"
-#include "io/g2o_writer.hpp"
 #include "io/tum_writer.hpp"
 #include "json_writer.hpp"
 #include "partition/partitioner.hpp"
 #include "partition/sequential_partition.hpp"
+#include "solve_output.hpp"
 #include "solvers/centralized_solver.hpp"
 #include "util/input_error.hpp"
 
@@ -226,29 +226,20 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         r.certificate_tolerance, r.certificate_residual, r.certificate_rounds,
         r.certificate_bytes / 1e6, r.escape_rounds, r.escape_bytes / 1e6, r.final_rank);
   }
-  if (auto p = a.get("out")) {
-    const std::string& path = *p;
-    if (path.size() >= 4 && path.compare(path.size() - 4, 4, ".tum") == 0)
-      write_tum(r.poses, path);
-    else
-      write_g2o(graph, r.poses, path);
-  }
+  if (auto p = a.get("out")) write_poses(*p, graph, r.poses);
   if (auto p = a.get("tum")) write_tum(r.poses, *p);
   if (auto p = a.get("trace")) write_trace(*p, r);
   if (auto p = a.get("json")) {
-    JsonObject j;
-    j.add("algorithm", algorithm_name(opt.algorithm))
-        .add("graph", graph_path)
-        .add("poses", graph.num_poses)
-        .add("edges", graph.num_measurements())
-        .add("d", graph.d)
-        .add("rank", opt.rank)
-        .add("iterations", r.rounds)
-        .add("grad_norm", r.grad_norm)
-        .add("cost", r.cost)
-        .add("relaxation_cost", r.relaxation_cost)
-        .add("certified", r.certified)
-        .add("wall_s", wall_s)
+    SolveSummary summary;
+    summary.algorithm = algorithm_name(opt.algorithm);
+    summary.rank = opt.rank;
+    summary.iterations = r.rounds;
+    summary.grad_norm = r.grad_norm;
+    summary.cost = r.cost;
+    summary.relaxation_cost = r.relaxation_cost;
+    summary.certified = r.certified;
+    JsonObject j = solve_json(graph_path, graph, summary);
+    j.add("wall_s", wall_s)
         .add("agents", static_cast<int>(agents))
         .add("partition", preset_name(popt.preset))
         .add("cut_edges", static_cast<long long>(part.metrics.cut_edges))
