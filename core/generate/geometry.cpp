@@ -5,13 +5,6 @@
 
 namespace tessera {
 
-Eigen::MatrixXd planar_rotation(double theta) {
-  Eigen::MatrixXd R(2, 2);
-  const double c = std::cos(theta), s = std::sin(theta);
-  R << c, -s, s, c;
-  return R;
-}
-
 Eigen::MatrixXd frame_from_forward_up(const Eigen::Vector3d& forward, const Eigen::Vector3d& up) {
   const Eigen::Vector3d x = forward.normalized();
   const Eigen::Vector3d z = (up - up.dot(x) * x).normalized();

@@ -3,12 +3,12 @@
 
 #include <Eigen/Core>
 
+// planar_rotation(theta), the 2x2 rotation by theta, lives beside its inverse planar_angle.
+#include "io/rotation_text.hpp"
+
 namespace tessera {
 
 constexpr double kPi = 3.14159265358979323846;
-
-/// The 2x2 rotation by `theta` radians.
-Eigen::MatrixXd planar_rotation(double theta);
 
 /// The right-handed frame whose x axis is `forward` and whose z axis is the part of `up`
 /// orthogonal to it (both normalised). `up` must not be parallel to `forward`.

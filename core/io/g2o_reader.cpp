@@ -16,6 +16,7 @@
 
 #include "graph/connectivity.hpp"
 #include "io/information_weights.hpp"
+#include "io/rotation_text.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera {
@@ -161,20 +162,6 @@ struct LooseVertex {
   Pose pose;
 };
 
-// Rotation from a quaternion with the unit-quaternion formula (the one SE-Sync applies,
-// also to a quaternion that is not exactly unit).
-Eigen::MatrixXd rotation_from_quaternion(double x, double y, double z, double w) {
-  const double tx = 2 * x, ty = 2 * y, tz = 2 * z;
-  const double twx = tx * w, twy = ty * w, twz = tz * w;
-  const double txx = tx * x, txy = ty * x, txz = tz * x;
-  const double tyy = ty * y, tyz = tz * y, tzz = tz * z;
-  Eigen::MatrixXd R(3, 3);
-  R << 1 - (tyy + tzz), txy - twz, txz + twy,  //
-      txy + twz, 1 - (txx + tzz), tyz - twx,   //
-      txz - twy, tyz + twx, 1 - (txx + tyy);
-  return R;
-}
-
 class Parser {
  public:
   Parser(const std::string& name, const G2oReadOptions& options, std::size_t size_hint)
@@ -317,9 +304,7 @@ class Parser {
     parse_values(spec, 1);
     Pose pose;
     if (spec.d == 2) {
-      const double c = std::cos(vals_[3]), s = std::sin(vals_[3]);
-      pose.R.resize(2, 2);
-      pose.R << c, -s, s, c;
+      pose.R = planar_rotation(vals_[3]);
       pose.t.resize(2);
       pose.t << vals_[1], vals_[2];
     } else {
@@ -358,9 +343,7 @@ class Parser {
     const double* info;
     IsotropicWeights w;
     if (spec.d == 2) {
-      const double c = std::cos(vals_[4]), s = std::sin(vals_[4]);
-      m.R.resize(2, 2);
-      m.R << c, -s, s, c;
+      m.R = planar_rotation(vals_[4]);
       m.t.resize(2);
       m.t << vals_[2], vals_[3];
       info = &vals_[5];
