@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <utility>
 
 #include "distributed/rbcd.hpp"
+#include "lifted_blocks.hpp"
 #include "problem/block_problem.hpp"
 #include "problem/lifting.hpp"
 #include "random_graph.hpp"
@@ -23,15 +25,13 @@ struct Block {
 
 // The first half of a random graph's poses as a block; its neighbours are the others.
 Block half_block(std::uint64_t seed) {
-  test::RandomGraphSpec spec;
-  spec.poses = 40;
-  spec.loop_closures = 30;
-  spec.seed = seed;
+  test::HalfBlock h = test::half_block(3, seed);
   Block b;
-  b.graph = test::random_pose_graph(spec);
-  for (std::size_t i = 0; i < spec.poses / 2; ++i) b.owned.push_back(i);
+  b.graph = std::move(h.graph);
+  b.owned = std::move(h.owned);
+  const std::size_t half = b.owned.size();  // the block is poses 0 .. half-1
   for (const auto& m : b.graph.measurements)
-    if (m.i < spec.poses / 2 || m.j < spec.poses / 2) b.measurements.push_back(m);
+    if (m.i < half || m.j < half) b.measurements.push_back(m);
   return b;
 }
 
@@ -135,12 +135,7 @@ TEST(BlockPreconditioner, BlockUpdateWithTheFallbackStillDecreasesTheLocalCost) 
   // Perturbed start: lifted ground truth moved away along a random tangent direction.
   const Eigen::MatrixXd all = lift_poses(b.graph.initial, r);
   const Eigen::Index cols = problem.data_matrix().rows();
-  const Eigen::Index w = b.graph.d + 1;
-  Eigen::MatrixXd neighbours(r, w * static_cast<Eigen::Index>(problem.neighbors().size()));
-  for (std::size_t k = 0; k < problem.neighbors().size(); ++k)
-    neighbours.middleCols(w * static_cast<Eigen::Index>(k), w) =
-        all.middleCols(w * static_cast<Eigen::Index>(problem.neighbors()[k]), w);
-  problem.set_neighbor_poses(neighbours);
+  problem.set_neighbor_poses(test::pose_columns(all, b.graph.d, problem.neighbors()));
   const LiftedManifold M = problem.manifold(r);
   Eigen::MatrixXd X0 = all.leftCols(cols);
   X0 = M.retract(X0, 0.3 * M.tangent_project(X0, Eigen::MatrixXd::Random(r, cols)));

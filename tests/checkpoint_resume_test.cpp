@@ -18,6 +18,7 @@
 #include "distributed/checkpoint_file.hpp"
 #include "distributed/in_process_driver.hpp"
 #include "distributed/protocol_snapshot.hpp"
+#include "lifted_blocks.hpp"
 #include "problem/lifting.hpp"
 #include "random_graph.hpp"
 
@@ -42,16 +43,12 @@ struct AgentsOfRun {
       assignment[i] = static_cast<int>(i * static_cast<std::size_t>(N) / g.num_poses);
     layout = make_block_layout(g.num_poses, g.measurements, assignment);
     const Eigen::MatrixXd X0 = lift_poses(g.initial, opt.rank);
-    const Eigen::Index w = g.d + 1;
     scheme = make_momentum_scheme(opt, layout, static_cast<double>(X0.size()));
     const RoundConfig config = make_round_config(opt, scheme.get());
     for (int b = 0; b < N; ++b) {
       const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-      Eigen::MatrixXd Yb(opt.rank, w * static_cast<Eigen::Index>(ids.size()));
-      for (std::size_t s = 0; s < ids.size(); ++s)
-        Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
-            X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-      states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements, Yb));
+      states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
+                                                    test::pose_columns(X0, g.d, ids)));
       protocols.push_back(std::make_unique<RoundProtocol>(*states.back(), layout, config));
       agents.push_back(protocols.back().get());
     }

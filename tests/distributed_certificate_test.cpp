@@ -18,6 +18,7 @@
 #include "distributed/distributed_solver.hpp"
 #include "distributed/in_process_driver.hpp"
 #include "generate/generator.hpp"
+#include "lifted_blocks.hpp"
 #include "partition/sequential_partition.hpp"
 #include "problem/block_problem.hpp"
 #include "problem/lifting.hpp"
@@ -44,21 +45,14 @@ DistributedCertificateResult certify_in_process(const PoseGraph& g, const Eigen:
                                                 const std::vector<int>& assignment,
                                                 DeliveryOrder order) {
   const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, assignment);
-  const Eigen::Index w = g.d + 1;
   std::vector<std::unique_ptr<AgentState>> states;
   std::vector<std::unique_ptr<CertificateProtocol>> protocols;
   std::vector<AgentProcess*> agents;
   for (int b = 0; b < layout.num_blocks; ++b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    Eigen::MatrixXd Yb(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
-          X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-    states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements, Yb));
-    const auto& nb = states.back()->problem().neighbors();
-    for (std::size_t s = 0; s < nb.size(); ++s)
-      states.back()->Yn.middleCols(w * static_cast<Eigen::Index>(s), w) =
-          X.middleCols(w * static_cast<Eigen::Index>(nb[s]), w);
+    states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
+                                                  test::pose_columns(X, g.d, ids)));
+    states.back()->Yn = test::pose_columns(X, g.d, states.back()->problem().neighbors());
     protocols.push_back(std::make_unique<CertificateProtocol>(*states.back(), layout,
                                                               DistributedCertificateOptions{}));
     agents.push_back(protocols.back().get());

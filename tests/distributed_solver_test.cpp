@@ -11,6 +11,7 @@
 #include "distributed/agent_state.hpp"
 #include "distributed/block_layout.hpp"
 #include "distributed/block_selection.hpp"
+#include "lifted_blocks.hpp"
 #include "partition/sequential_partition.hpp"
 #include "problem/block_problem.hpp"
 #include "problem/lifting.hpp"
@@ -35,17 +36,7 @@ double optimum(const PoseGraph& g) {
   return solve_centralized(g).cost;
 }
 
-// The columns of the poses `which` of the lifted iterate X, in that order: what an agent holding
-// those poses (its block, or its copies of neighbours) starts from. Each pose has d + 1 columns.
-Eigen::MatrixXd pose_columns(const Eigen::MatrixXd& X, int d,
-                             const std::vector<std::size_t>& which) {
-  const Eigen::Index w = d + 1;
-  Eigen::MatrixXd out(X.rows(), w * static_cast<Eigen::Index>(which.size()));
-  for (std::size_t s = 0; s < which.size(); ++s)
-    out.middleCols(w * static_cast<Eigen::Index>(s), w) =
-        X.middleCols(w * static_cast<Eigen::Index>(which[s]), w);
-  return out;
-}
+using test::pose_columns;
 
 TEST(DistributedSolver, TwoBlocksConvergeToCentralizedOptimum) {
   const PoseGraph g = small_graph(2, 40, 3);

@@ -10,11 +10,13 @@
 #include <Eigen/Dense>
 #include <Eigen/QR>
 #include <cstdlib>
+#include <utility>
 
 #include "distributed/agent_state.hpp"
 #include "distributed/block_layout.hpp"
 #include "distributed/momentum.hpp"
 #include "distributed/rbcd.hpp"
+#include "lifted_blocks.hpp"
 #include "problem/block_problem.hpp"
 #include "problem/lifting.hpp"
 #include "random_graph.hpp"
@@ -31,25 +33,16 @@ struct Block {
 };
 
 Block half_block(int d, std::uint64_t seed, int r) {
-  test::RandomGraphSpec spec;
-  spec.d = d;
-  spec.poses = 40;
-  spec.loop_closures = 30;
-  spec.seed = seed;
+  test::HalfBlock h = test::half_block(d, seed);
   Block b;
-  b.graph = test::random_pose_graph(spec);
-  for (std::size_t i = 0; i < spec.poses / 2; ++i) b.owned.push_back(i);
+  b.graph = std::move(h.graph);
+  b.owned = std::move(h.owned);
   b.all = lift_poses(b.graph.initial, r);
   return b;
 }
 
 Eigen::MatrixXd gather(const Eigen::MatrixXd& from, const std::vector<std::size_t>& which, int d) {
-  const Eigen::Index w = d + 1;
-  Eigen::MatrixXd out(from.rows(), w * static_cast<Eigen::Index>(which.size()));
-  for (std::size_t s = 0; s < which.size(); ++s)
-    out.middleCols(w * static_cast<Eigen::Index>(s), w) =
-        from.middleCols(w * static_cast<Eigen::Index>(which[s]), w);
-  return out;
+  return test::pose_columns(from, d, which);
 }
 
 // 2 V Q as a matrix acting on the column-major vec of a d-row V: 2 (Q kron I_d).
