@@ -79,7 +79,10 @@ struct IrbcdOptions {
   void validate() const;
 };
 
+/// "units" or "variables"; parse_dimension(dimension_name(d)) == d.
 const char* dimension_name(IrbcdDimension d);
+/// The dimension named "units" (or its alias "blocks") or "variables"; throws InputError
+/// naming any other value.
 IrbcdDimension parse_dimension(const std::string& name);
 
 /// gamma >= 1/n solving gamma^2 - gamma/n = (1 - gamma sigma/n) q, q = a^2/b^2 (the larger root).

@@ -30,6 +30,7 @@ struct ProtocolSnapshot {
   std::vector<RoundRecord> trace;
 };
 
+/// Appends every field of `s` to `out`; decode_snapshot reads them back bit-identical.
 void encode(ByteWriter& out, const ProtocolSnapshot& s);
 /// Throws CodecError when the bytes do not hold a snapshot.
 ProtocolSnapshot decode_snapshot(ByteReader& in);

@@ -9,6 +9,8 @@
 
 namespace tessera {
 
+/// f of `poses` (one per graph pose, in id order) summed over every measurement of the graph,
+/// in measurement order. Throws std::invalid_argument when poses.size() != graph.num_poses.
 double evaluate_objective(const PoseGraph& graph, const std::vector<Pose>& poses);
 
 }  // namespace tessera

@@ -40,7 +40,9 @@ struct CentralizedOptions {
   /// escape needs an accurate eigenvector.
   double certified_lanczos_tolerance = 1e-3;
 
+  /// The trust-region settings the centralized solver starts from (trust_region's default).
   static TrustRegionOptions default_trust_region();
+  /// Throws InputError naming the first field out of range.
   void validate() const;
 };
 
@@ -78,6 +80,12 @@ struct CentralizedResult {
   std::string full_report() const;
 };
 
+/// Solves the graph from options.initialization up the staircase: a trust-region solve per
+/// rank, then (when certify is on) the certificate, escaping a saddle one rank up until the
+/// certificate holds, max_rank is reached or no escape direction was found. Rounds the last
+/// lifted solution to SE(d) and fills every field of the result (trace and timings included;
+/// `certified` stays empty when certify is off). Throws InputError when the options are
+/// invalid, initial_rank < d, or kFile is asked of a graph without VERTEX lines.
 CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOptions& options = {});
 
 }  // namespace tessera

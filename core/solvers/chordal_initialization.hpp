@@ -10,9 +10,12 @@
 
 namespace tessera {
 
+/// One pose per graph pose: the rotations of chordal_rotations (pose 0 = identity) and the
+/// translations that are optimal for them. Throws std::runtime_error when the rotation system
+/// cannot be factored (a measurement graph that is not connected).
 std::vector<Pose> chordal_initialization(const PoseGraph& graph);
 
-/// Only the rotations, d x dn.
+/// Only the rotations, d x dn (the same ones chordal_initialization uses).
 Eigen::MatrixXd chordal_rotations(const PoseGraph& graph);
 
 }  // namespace tessera

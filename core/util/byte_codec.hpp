@@ -13,11 +13,14 @@
 
 namespace tessera {
 
+/// A buffer that does not hold what was to be read from it (short, inconsistent, trailing bytes).
 class CodecError : public std::runtime_error {
  public:
   explicit CodecError(const std::string& what) : std::runtime_error(what) {}
 };
 
+/// Appends values to a byte string; each ByteReader call of the same name and order reads
+/// back exactly what the writer call wrote (doubles bit-identical, NUL bytes kept).
 class ByteWriter {
  public:
   void u32(std::uint32_t v) { raw(&v, sizeof v); }
@@ -31,6 +34,7 @@ class ByteWriter {
   void u64s(const std::vector<std::uint64_t>& v);
   void ints(const std::vector<int>& v);
   void matrix(const Eigen::MatrixXd& m);
+  /// Everything written so far.
   const std::string& bytes() const { return bytes_; }
 
  private:
@@ -42,6 +46,8 @@ class ByteReader {
  public:
   /// `what` names the buffer in errors (e.g. the checkpoint file).
   ByteReader(const std::string& bytes, std::string what) : bytes_(bytes), what_(std::move(what)) {}
+  /// Each reads the next value of its kind. `field` names it in the CodecError thrown when
+  /// the bytes left are too few, a count exceeds them, or a boolean is not 0 or 1.
   std::uint32_t u32(const char* field);
   std::uint64_t u64(const char* field);
   std::int64_t i64(const char* field);
@@ -53,6 +59,7 @@ class ByteReader {
   std::vector<std::uint64_t> u64s(const char* field);
   std::vector<int> ints(const char* field);
   Eigen::MatrixXd matrix(const char* field);
+  /// True once every byte was read.
   bool at_end() const { return pos_ == bytes_.size(); }
   /// Throws CodecError unless every byte was read (trailing garbage means a format mismatch).
   void expect_end() const;
