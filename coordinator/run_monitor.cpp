@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "util/input_error.hpp"
+
 namespace tessera::coordinator {
 
 namespace {
@@ -16,6 +18,16 @@ std::string list(const std::vector<std::uint32_t>& v) {
 }
 }  // namespace
 
+void MonitorOptions::validate() const {
+  if (!(interval_s >= 0 && interval_s <= 86400))
+    throw InputError("MonitorOptions.interval_s must be 0..86400 seconds, got " +
+                     std::to_string(interval_s));
+  if (lag_rounds < 1) throw InputError("MonitorOptions.lag_rounds must be >= 1, got 0");
+  if (!(lag_s > 0 && lag_s <= 86400))
+    throw InputError("MonitorOptions.lag_s must be in (0, 86400] seconds, got " +
+                     std::to_string(lag_s));
+}
+
 RunMonitor::RunMonitor(std::uint32_t num_agents, MonitorOptions options, std::ostream& out,
                        Clock::time_point start)
     : n_(num_agents),
@@ -25,7 +37,9 @@ RunMonitor::RunMonitor(std::uint32_t num_agents, MonitorOptions options, std::os
       last_print_(start),
       round_(num_agents, -1),
       last_seen_(num_agents, start),
-      lost_(num_agents, false) {}
+      lost_(num_agents, false) {
+  opt_.validate();
+}
 
 void RunMonitor::on_status(std::uint32_t agent, std::uint32_t round, Clock::time_point now) {
   if (agent >= n_) return;

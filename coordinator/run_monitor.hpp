@@ -17,14 +17,21 @@
 namespace tessera::coordinator {
 
 struct MonitorOptions {
-  double interval_s = 5.0;  ///< Seconds between periodic status lines; 0 = only on changes.
+  /// Seconds between periodic status lines, 0..86400; 0 = only on changes.
+  double interval_s = 5.0;
+  /// Rounds behind the most advanced agent that make an agent lagging, >= 1.
   std::uint32_t lag_rounds = 2;
+  /// Seconds of silence (while another agent reported) that make an agent lagging, > 0.
   double lag_s = 3.0;
+
+  /// Throws InputError naming the first field out of range.
+  void validate() const;
 };
 
 class RunMonitor {
  public:
   using Clock = std::chrono::steady_clock;
+  /// Throws InputError when `options` are invalid (MonitorOptions::validate).
   RunMonitor(std::uint32_t num_agents, MonitorOptions options, std::ostream& out,
              Clock::time_point start);
 

@@ -4,10 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
+#include <string>
 
 #include "coordinator/rejoin_arbiter.hpp"
 #include "coordinator/run_monitor.hpp"
+#include "util/input_error.hpp"
 
 namespace tessera::coordinator {
 namespace {
@@ -66,6 +69,32 @@ TEST(RejoinArbiter, GivesUpWhenNobodyComesBackOrNoRoundIsCommon) {
   RejoinArbiter off(2, 0.0);
   off.on_lost(1, at(0));
   EXPECT_EQ(off.decide(at(0)).kind, Kind::kGiveUp);
+}
+
+TEST(RunMonitor, OptionsOutOfRangeAreErrorsNamingTheField) {
+  EXPECT_NO_THROW(MonitorOptions{}.validate());
+  EXPECT_NO_THROW((MonitorOptions{0.0, 1, 0.5}.validate()));  // 0 = only on changes
+  const struct {
+    MonitorOptions options;
+    const char* field;
+  } bad[] = {{{-1.0, 2, 3.0}, "interval_s"},
+             {{1e9, 2, 3.0}, "interval_s"},
+             {{std::nan(""), 2, 3.0}, "interval_s"},
+             {{5.0, 0, 3.0}, "lag_rounds"},
+             {{5.0, 2, 0.0}, "lag_s"},
+             {{5.0, 2, std::nan("")}, "lag_s"}};
+  for (const auto& b : bad) {
+    try {
+      b.options.validate();
+      ADD_FAILURE() << "accepted a bad " << b.field;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("MonitorOptions.") + b.field),
+                std::string::npos)
+          << e.what();
+    }
+    std::ostringstream out;
+    EXPECT_THROW(RunMonitor(3, b.options, out, t0), InputError) << b.field;
+  }
 }
 
 TEST(RunMonitor, ReportsAliveRoundsLaggingAndLostAgents) {
