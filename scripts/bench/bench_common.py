@@ -8,6 +8,7 @@ import csv
 import json
 import os
 import platform
+import resource
 import subprocess
 import sys
 import tempfile
@@ -90,11 +91,8 @@ class Ctx:
         if name_or_path in self._fstar:
             return self._fstar[name_or_path]
         if not os.path.sep in name_or_path:
-            table = {}
-            with open(os.path.join(self.shared, "reference", "optima.csv")) as f:
-                for row in csv.DictReader(f):
-                    table[row["dataset"]] = float(row["f_star"])
-            v = table.get(name_or_path + "_qnorm", table[name_or_path])
+            table = read_reference(self.shared, "optima.csv", "dataset")
+            v = float(table.get(name_or_path + "_qnorm", table[name_or_path])["f_star"])
             src = "reference/optima.csv"
         else:
             progress(f"computing f* of {os.path.basename(name_or_path)} with the centralized solver")
@@ -108,6 +106,35 @@ class Ctx:
             src = "centralized solver, this run" + ("" if s.get("certified") else " (NOT certified)")
         self._fstar[name_or_path] = (v, src)
         return self._fstar[name_or_path]
+
+
+def read_reference(shared, name, *key):
+    """Rows of ../shared/reference/NAME (csv) as dicts of strings, by the value of the column
+    `key` names, or by the tuple of values when it names several columns."""
+    with open(os.path.join(shared, "reference", name)) as f:
+        rows = csv.DictReader(f)
+        if len(key) == 1:
+            return {r[key[0]]: r for r in rows}
+        return {tuple(r[k] for k in key): r for r in rows}
+
+
+def children_usage():
+    """(CPU seconds user + system, voluntary context switches) of every finished child process
+    and its waited-for descendants (launch waits for the coordinator and the agents), so a
+    difference around one run counts all of its processes."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime, r.ru_nvcsw
+
+
+def usage_since(before):
+    """(CPU seconds, context switches) of the children finished since `before` = children_usage()."""
+    cpu, csw = children_usage()
+    return cpu - before[0], csw - before[1]
+
+
+def cpu_since(before):
+    """CPU seconds (user + system) of the children finished since `before` = children_usage()."""
+    return usage_since(before)[0]
 
 
 def progress(msg):

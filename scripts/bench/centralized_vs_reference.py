@@ -10,10 +10,8 @@ certificate. Writes docs/benchmarks/centralized.csv.
       [--only NAME,...] [--repeat K] [extra solver flags after --]
 """
 import argparse
-import csv
 import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
@@ -21,14 +19,8 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
-
-
-def load_optima(shared):
-    rows = {}
-    with open(os.path.join(shared, "reference", "optima.csv")) as f:
-        for r in csv.DictReader(f):
-            rows[r["dataset"]] = r
-    return rows
+sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
 
 
 def main():
@@ -43,7 +35,7 @@ def main():
     datasets = os.path.join(a.shared, "datasets")
     if not os.path.isdir(datasets):
         sys.exit(f"datasets folder not found: {datasets} (pass --shared)")
-    optima = load_optima(a.shared)
+    optima = bc.read_reference(a.shared, "optima.csv", "dataset")
     names = sorted(f[:-4] for f in os.listdir(datasets) if f.endswith(".g2o"))
     if a.only:
         names = [n for n in names if n in a.only.split(",")]
@@ -55,12 +47,11 @@ def main():
         for _ in range(a.repeat):
             with tempfile.NamedTemporaryFile(suffix=".json") as js:
                 t0 = time.perf_counter()
-                c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+                c0 = bc.children_usage()
                 p = subprocess.run([a.bin, "solve", os.path.join(datasets, name + ".g2o"), "--algorithm",
                                     "centralized", "--json", js.name] + a.extra, capture_output=True, text=True)
                 times.append(time.perf_counter() - t0)
-                c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-                cpus.append(c1.ru_utime + c1.ru_stime - c0.ru_utime - c0.ru_stime)
+                cpus.append(bc.cpu_since(c0))
                 if p.returncode != 0:
                     print(f"{name}: failed: {p.stderr.strip()}")
                     break
@@ -84,10 +75,7 @@ def main():
                   f"{str(row['certified']):>5s} {row['min_eigenvalue']:10.2e} {row['rank']:4d}", flush=True)
     if rows:
         os.makedirs(os.path.dirname(a.csv), exist_ok=True)
-        with open(a.csv, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-            w.writeheader()
-            w.writerows(rows)
+        bc.write_csv(a.csv, rows, announce=False)
         worst = max(r["ratio"] for r in rows if r["ratio"] != "")
         worst_cpu = max(r["cpu_ratio"] for r in rows if r["cpu_ratio"] != "")
         print(f"\nworst time ratio (ours / reference): wall {worst:.2f}, cpu {worst_cpu:.2f}; all certified: "

@@ -16,10 +16,8 @@ usage: scripts/bench/distributed_certificate.py [--bin build/bin/tessera] [--lim
        [--max-rounds 30000] [--extra "--certify-grad-tol 1e-4"]
 """
 import argparse
-import csv
 import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
@@ -27,11 +25,13 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
 
 
 def run(cmd, limit):
     """(json dict or None, wall s, cpu s of the child, status text)."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    before = bc.children_usage()
     t0 = time.monotonic()
     try:
         p = subprocess.run(cmd, capture_output=True, text=True, timeout=limit)
@@ -39,8 +39,7 @@ def run(cmd, limit):
     except subprocess.TimeoutExpired:
         status = f"timeout ({limit:.0f} s)"
     wall = time.monotonic() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    cpu = bc.cpu_since(before)
     return status, wall, cpu
 
 
@@ -113,10 +112,7 @@ def fmt(x, spec="{:.3g}"):
 
 def write(out, rows, a):
     os.makedirs(os.path.dirname(out), exist_ok=True)
-    with open(out + ".csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        w.writeheader()
-        w.writerows(rows)
+    bc.write_csv(out + ".csv", rows, announce=False)
     head = ["graph", "poses", "certified (dist / central)", "lambda_min dist", "lambda_min central",
             "eta", "final rank", "solver rounds", "solver MB", "of which refine rounds",
             "cert rounds", "cert MB", "escape rounds", "rel gap", "wall s (CPU s)", "status"]

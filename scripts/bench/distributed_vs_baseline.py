@@ -36,30 +36,6 @@ sys.path.insert(0, HERE)
 import bench_common as bc  # noqa: E402
 
 
-def optima():
-    out = {}
-    with open(os.path.join(SHARED, "reference", "optima.csv")) as f:
-        for row in csv.DictReader(f):
-            out[row["dataset"]] = float(row["f_star"])
-    return out
-
-
-def baseline():
-    out = {}
-    path = os.path.join(SHARED, "reference", "dpgo_baseline.csv")
-    with open(path) as f:
-        for row in csv.DictReader(f):
-            out[(row["dataset"], row["partition"], row["algorithm"])] = row
-    return out
-
-
-def first_round(trace, tol):
-    for row in trace:
-        if row["grad_norm"] <= tol:
-            return row["round"]
-    return None
-
-
 def run(binary, graph, algorithm, fstar, max_rounds, extra, timeout):
     with tempfile.TemporaryDirectory() as tmp:
         js, tr = os.path.join(tmp, "r.json"), os.path.join(tmp, "t.csv")
@@ -95,8 +71,8 @@ def main():
     ap.add_argument("--out", default="")
     ap.add_argument("--timeout", type=float, default=None, help="wall seconds per run")
     a = ap.parse_args()
-    fs = optima()
-    base = baseline()
+    fs = {k: float(r["f_star"]) for k, r in bc.read_reference(SHARED, "optima.csv", "dataset").items()}
+    base = bc.read_reference(SHARED, "dpgo_baseline.csv", "dataset", "partition", "algorithm")
     names = a.graphs.split(",") if a.graphs else sorted(
         k for k in fs if not k.endswith("_qnorm"))
     rows = []
@@ -114,8 +90,8 @@ def main():
                 continue
             s, trace = res
             b = base.get((name, "highest", {"rbcd": "RBCD", "rbcd++": "RBCD++"}.get(alg, "RBCD++")), {})
-            row = {"graph": name, "algorithm": alg, "rounds_to_0.2": first_round(trace, 0.2),
-                   "rounds_to_0.1": first_round(trace, 0.1), "rounds_to_0.01": first_round(trace, 0.01),
+            row = {"graph": name, "algorithm": alg, "rounds_to_0.2": bc.first_round(trace, 0.2),
+                   "rounds_to_0.1": bc.first_round(trace, 0.1), "rounds_to_0.01": bc.first_round(trace, 0.01),
                    "rounds": s["rounds"], "restarts": s["restarts"], "rel_gap": s["rel_gap"],
                    "ms_per_round": s["ms_per_round"], "cpu_ms_per_round": s.get("cpu_ms_per_round"),
                    "critical_ms_per_round": (1e3 * s["critical_path_cpu_s"] / s["rounds"]

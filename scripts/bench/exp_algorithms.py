@@ -7,7 +7,6 @@ solver's wall time (the trace's elapsed_s), one figure.
 
   scripts/bench/exp_algorithms.py [--quick] [--bin B] [--shared S] [--out-dir D]
 """
-import csv
 import os
 import sys
 
@@ -72,11 +71,9 @@ def run(ctx):
 
 
 def baseline(ctx):
-    path = os.path.join(ctx.shared, "reference", "dpgo_baseline.csv")
-    if not os.path.exists(path):
+    if not os.path.exists(os.path.join(ctx.shared, "reference", "dpgo_baseline.csv")):
         return {}
-    with open(path) as f:
-        return {(r["dataset"], r["partition"], r["algorithm"]): r for r in csv.DictReader(f)}
+    return bc.read_reference(ctx.shared, "dpgo_baseline.csv", "dataset", "partition", "algorithm")
 
 
 def plot(ctx, graphs, traces, rows):

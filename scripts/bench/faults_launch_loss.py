@@ -19,7 +19,6 @@ usage: scripts/bench/faults_launch_loss.py [--bin-dir build/bin] [--out-dir docs
 """
 import json
 import os
-import resource
 import signal
 import subprocess
 import sys
@@ -52,7 +51,7 @@ class LaunchRun:
                "--rejoin-timeout", str(a.rejoin_timeout), "--replica-every", str(a.replica_every),
                "--out", self.merged, "--json", self.summary, "--timeout", str(a.limit),
                "--status-interval", "2"]
-        self.cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        self.cpu0 = bc.children_usage()
         self.t0 = time.time()
         self.log = open(self.log_path, "w")
         self.proc = subprocess.Popen(cmd, stdout=self.log, stderr=subprocess.STDOUT, start_new_session=True)
@@ -98,8 +97,7 @@ class LaunchRun:
             self.proc.wait()
         wall = time.time() - self.t0
         self.log.close()
-        cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = (cpu1.ru_utime - self.cpu0.ru_utime) + (cpu1.ru_stime - self.cpu0.ru_stime)
+        cpu = bc.cpu_since(self.cpu0)
         summary = None
         if code == 0 and os.path.exists(self.summary):
             with open(self.summary) as f:

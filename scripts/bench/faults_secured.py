@@ -23,7 +23,6 @@ usage: scripts/bench/faults_secured.py [--bin-dir build/bin] [--out-dir docs/ben
 import json
 import os
 import re
-import resource
 import subprocess
 import sys
 import time
@@ -42,7 +41,7 @@ def launch(args, work, name, extra):
     cmd = [os.path.join(args.bin_dir, "tessera"), "launch", args.graph, "--agents", str(args.agents),
            "--partition", "eco", "--no-certify", "--quiet", "--domain", str(args.domain), "--run-id", name,
            "--json", summary, "--timeout", str(args.limit)] + extra
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    before = bc.children_usage()
     t0 = time.time()
     with open(os.path.join(work, name + ".log"), "w") as log:
         try:
@@ -50,8 +49,7 @@ def launch(args, work, name, extra):
         except subprocess.TimeoutExpired:
             code = -9
     wall = time.time() - t0
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    cpu = bc.cpu_since(before)
     data = None
     if code == 0 and os.path.exists(summary):
         with open(summary) as f:

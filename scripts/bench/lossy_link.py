@@ -26,7 +26,6 @@ import argparse
 import csv
 import json
 import os
-import resource
 import statistics
 import subprocess
 import sys
@@ -35,6 +34,8 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
 NETNS = os.path.join(ROOT, "scripts", "netns", "netns.sh")
 PREFIX, SUBNET = "tlb", "10.77.39"
 
@@ -66,7 +67,7 @@ def run(bindir, graph, agents, domain, run_id, network, limit, work):
         cmds.append(["ip", "netns", "exec", "%s-%d" % (PREFIX, k + 1),
                      os.path.join(bindir, "tessera-agent"), "--graph", graph, "--robots", str(agents),
                      "--id", str(k)] + session)
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    before = bc.children_usage()
     t0 = time.monotonic()
     logs = [open(os.path.join(work, "%s_%d.log" % (run_id, i)), "w") for i in range(len(cmds))]
     procs = [subprocess.Popen(c, stdout=l, stderr=subprocess.STDOUT) for c, l in zip(cmds, logs)]
@@ -90,8 +91,7 @@ def run(bindir, graph, agents, domain, run_id, network, limit, work):
     wall = time.monotonic() - t0
     for l in logs:
         l.close()
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    cpu = bc.cpu_since(before)
     data = None
     if ok and os.path.exists(summary):
         with open(summary) as f:
@@ -178,10 +178,7 @@ def main():
         w = csv.DictWriter(f, fieldnames=["fault", "trials", "finished", "cost_error", "extra_time_s"])
         w.writeheader()
         w.writerows(contract)
-    with open(os.path.join(args.out_dir, "faults", "lossy_link_trials.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        w.writeheader()
-        w.writerows(rows)
+    bc.write_csv(os.path.join(args.out_dir, "faults", "lossy_link_trials.csv"), rows, announce=False)
     print("\nwrote %s (grid3d %d poses, %d agents, %d%% loss on agent 0's link, limit %.0f s)"
           % (path, args.poses, args.agents, args.loss, args.limit))
     return 0

@@ -20,7 +20,6 @@ With --seeds S > 1 every run is repeated with seeds 1..S and the mean cut, the b
 the median time are reported.
 """
 import argparse
-import csv
 import json
 import os
 import statistics
@@ -30,6 +29,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
 
 # name, file (under datasets/), paper label, paper cuts as printed in Table I:
 # (baseline, strong, eco, fast, highest) -- baseline as printed (mostly 2x the true cut).
@@ -141,10 +142,7 @@ def main():
                 misses.append(f"{name}: highest {m['ms']:.0f} ms (cpu {m['cpu']:.0f}) >= 5 s")
         print(line, flush=True)
     os.makedirs(os.path.dirname(a.csv), exist_ok=True)
-    with open(a.csv, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        w.writeheader()
-        w.writerows(rows)
+    bc.write_csv(a.csv, rows, announce=False)
     print(f"\ntargets: {'all met' if not misses else str(len(misses)) + ' missed'}")
     for m in misses:
         print("  missed:", m)
@@ -168,10 +166,7 @@ def main():
                                "cvolume": round(m["cvolume"], 6), "time_ms": round(m["ms"], 2),
                                "cpu_ms": round(m["cpu"], 2)})
             print(line, flush=True)
-    with open(a.csv_k, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows_k[0].keys()))
-        w.writeheader()
-        w.writerows(rows_k)
+    bc.write_csv(a.csv_k, rows_k, announce=False)
     print(f"wrote {a.csv_k}")
 
 
