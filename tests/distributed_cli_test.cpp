@@ -20,6 +20,12 @@ std::string read_all(const std::string& path) {
   return ss.str();
 }
 
+std::size_t occurrences(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
 std::string graph_file(const std::string& dir) {
   test::RandomGraphSpec spec;
   spec.d = 2;
@@ -52,6 +58,44 @@ TEST(DistributedCli, JsonAndTrace) {
     EXPECT_EQ(t.rfind("round,cost,grad_norm,selected,restart,bytes", 0), 0u);
     EXPECT_GT(std::count(t.begin(), t.end(), '\n'), 2);
     EXPECT_FALSE(read_all(dir + "/o.g2o").empty());
+  }
+}
+
+// Every algorithm's summary starts with the same fields in the same order (cli/solve_output),
+// and --out picks the format by the file name: TUM for ".tum", g2o otherwise.
+TEST(DistributedCli, EveryAlgorithmSharesTheSummaryHeadAndThePoseFileFormats) {
+  const std::string dir = test::temp_dir();
+  const std::string g = graph_file(dir);
+  for (const char* alg : {"centralized", "irbcd"}) {
+    std::string out;
+    const std::string cmd = test::bin("tessera") + " solve " + g + " --algorithm " + alg +
+                            " --json " + dir + "/r.json --out " + dir + "/o.tum --tum " + dir +
+                            "/t.tum";
+    ASSERT_EQ(test::run_command(cmd, &out), 0) << out;
+    const std::string j = read_all(dir + "/r.json");
+    EXPECT_EQ(j.find(std::string("\"algorithm\": \"") + alg + "\""), 4u) << j;
+    std::size_t at = 0;
+    for (const char* key :
+         {"\"algorithm\"", "\"graph\"", "\"poses\": 60", "\"edges\"", "\"d\": 2", "\"rank\"",
+          "\"iterations\"", "\"grad_norm\"", "\"cost\"", "\"relaxation_cost\"", "\"certified\""}) {
+      const std::size_t found = j.find(key);
+      ASSERT_NE(found, std::string::npos) << key << " in\n" << j;
+      EXPECT_GE(found, at) << key << " out of order in\n" << j;
+      at = found;
+    }
+    // --out with ".tum" writes the same TUM text as --tum; a ".g2o" name writes vertices and
+    // the graph's edges.
+    EXPECT_EQ(read_all(dir + "/o.tum"), read_all(dir + "/t.tum")) << alg;
+    EXPECT_EQ(read_all(dir + "/o.tum").find("VERTEX"), std::string::npos) << alg;
+    ASSERT_EQ(test::run_command(test::bin("tessera") + " solve " + g + " --algorithm " + alg +
+                                    " --out " + dir + "/o.g2o",
+                                &out),
+              0)
+        << out;
+    const std::string written = read_all(dir + "/o.g2o");
+    EXPECT_EQ(written.rfind("VERTEX_SE2 0 ", 0), 0u) << alg;
+    EXPECT_EQ(occurrences(written, "VERTEX_SE2 "), 60u) << alg;
+    EXPECT_EQ(occurrences(written, "EDGE_SE2 "), occurrences(read_all(g), "EDGE_SE2 ")) << alg;
   }
 }
 
