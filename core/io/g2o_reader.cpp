@@ -9,13 +9,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <vector>
 
-#include "graph/connectivity.hpp"
+#include "io/g2o_graph_checks.hpp"
 #include "io/information_weights.hpp"
+#include "io/number_token.hpp"
 #include "io/rotation_text.hpp"
 #include "util/input_error.hpp"
 
@@ -74,93 +74,12 @@ inline bool is_blank(char c) {
   return kBlanks.blank[static_cast<unsigned char>(c)];
 }
 
-// Clinger's fast path: a plain decimal with at most 19 digits whose digit string is below
-// 2^53 and whose decimal exponent is within +-22 is one exact integer times or divided by
-// one exact power of ten, so a single IEEE operation rounds it correctly. Returns false
-// for anything else (then the general parser decides). Most numbers in g2o files qualify.
-bool parse_simple_decimal(const char* b, const char* e, double& out) {
-  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                      1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                      1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-  const bool negative = b != e && *b == '-';
-  if (negative) ++b;
-  std::uint64_t mantissa = 0;
-  int digits = 0, exponent = 0;
-  for (; b != e && static_cast<unsigned>(*b - '0') < 10; ++b, ++digits)
-    mantissa = mantissa * 10 + static_cast<unsigned>(*b - '0');
-  if (b != e && *b == '.')
-    for (++b; b != e && static_cast<unsigned>(*b - '0') < 10; ++b, ++digits, --exponent)
-      mantissa = mantissa * 10 + static_cast<unsigned>(*b - '0');
-  if (digits == 0 || digits > 19) return false;  // (more digits may have wrapped around)
-  if (b != e && (*b == 'e' || *b == 'E')) {
-    ++b;
-    const bool exp_negative = b != e && *b == '-';
-    if (b != e && (*b == '-' || *b == '+')) ++b;
-    if (b == e) return false;
-    int value = 0;
-    for (; b != e && static_cast<unsigned>(*b - '0') < 10; ++b)
-      if (value < 10000) value = value * 10 + (*b - '0');
-    exponent += exp_negative ? -value : value;
-  }
-  if (b != e || mantissa > (std::uint64_t{1} << 53) || exponent < -22 || exponent > 22)
-    return false;
-  double v = static_cast<double>(mantissa);
-  v = exponent < 0 ? v / kPow10[-exponent] : v * kPow10[exponent];
-  out = negative ? -v : v;
-  return true;
-}
-
-// A token quoted for a message: at most 40 bytes, non-printable bytes as \xNN.
-std::string quoted(std::string_view s) {
-  std::string out = "'";
-  std::size_t k = 0;
-  for (; k < s.size() && k < 40; ++k) {
-    const auto c = static_cast<unsigned char>(s[k]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    }
-  }
-  if (k < s.size()) out += "...";
-  return out + "'";
-}
-
+// A number in a message (not for reading back).
 std::string number_text(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6g", x);
   return buf;
 }
-
-// Parses a whole token as a double. Returns false if it is not a number at all; the value
-// may be non-finite (the caller says so). A leading '+' is accepted, as strtod would.
-bool parse_number(std::string_view s, double& out) {
-  const char* b = s.data();
-  const char* e = b + s.size();
-  if (b != e && *b == '+') {
-    ++b;
-    if (b == e || *b == '-' || *b == '+') return false;
-  }
-  if (b == e) return false;
-  if (parse_simple_decimal(b, e, out)) return true;
-  auto [ptr, ec] = std::from_chars(b, e, out, std::chars_format::general);
-  if (ec == std::errc() && ptr == e) return true;
-  if (ec != std::errc::result_out_of_range || ptr != e) return false;
-  // Out of range: overflow becomes inf (rejected by the caller), underflow a tiny value.
-  const std::string copy(b, e);
-  char* end = nullptr;
-  out = std::strtod(copy.c_str(), &end);
-  return end == copy.c_str() + copy.size();
-}
-
-// A vertex that did not arrive in id order 0, 1, 2, ... (rare; see Parser::parse_vertex).
-struct LooseVertex {
-  std::uint64_t id;
-  std::uint32_t line;
-  Pose pose;
-};
 
 class Parser {
  public:
@@ -196,7 +115,7 @@ class Parser {
 
   G2oReadResult finish() {
     stats().lines = line_;
-    check_graph();
+    check_g2o_graph(name_, options_.allow_disconnected, line_, edge_lines_, loose_, result_);
     return std::move(result_);
   }
 
@@ -238,7 +157,7 @@ class Parser {
     for (const auto& s : kSpecs)
       if (tag == s.tag) spec = &s;
     if (!spec)
-      fail(line_, "unknown tag " + quoted(tag) +
+      fail(line_, "unknown tag " + quoted_token(tag) +
                       " (expected VERTEX_SE2, EDGE_SE2, VERTEX_SE3:QUAT, EDGE_SE3:QUAT or FIX)");
     if (count_ - 1 != spec->values)
       fail(line_, std::string(spec->tag) + " needs " + std::to_string(spec->values) + " values (" +
@@ -261,15 +180,15 @@ class Parser {
   std::uint64_t parse_id(std::string_view s, const std::string& role) {
     if (!s.empty() && s[0] == '-') {
       double x;
-      if (parse_number(s, x)) fail(line_, role + " " + quoted(s) + " is negative");
+      if (parse_number(s, x)) fail(line_, role + " " + quoted_token(s) + " is negative");
     }
     std::uint64_t id = 0;
     auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), id);
     if (ptr != s.data() + s.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
-      fail(line_, role + " " + quoted(s) + " is not a non-negative integer");
+      fail(line_, role + " " + quoted_token(s) + " is not a non-negative integer");
     if (ec == std::errc::result_out_of_range || id > kMaxPoseId)
-      fail(line_,
-           role + " " + quoted(s) + " is too large (at most " + std::to_string(kMaxPoseId) + ")");
+      fail(line_, role + " " + quoted_token(s) + " is too large (at most " +
+                      std::to_string(kMaxPoseId) + ")");
     return id;
   }
 
@@ -280,10 +199,10 @@ class Parser {
       double x;
       if (!parse_number(s, x))
         fail(line_, std::string(spec.tag) + " " + field_name(spec, k) + " (column " +
-                        std::to_string(k + 2) + "): " + quoted(s) + " is not a number");
+                        std::to_string(k + 2) + "): " + quoted_token(s) + " is not a number");
       if (!std::isfinite(x))
         fail(line_, std::string(spec.tag) + " " + field_name(spec, k) + " (column " +
-                        std::to_string(k + 2) + "): " + quoted(s) + " is not finite");
+                        std::to_string(k + 2) + "): " + quoted_token(s) + " is not finite");
       vals_[k] = x;
     }
   }
@@ -380,131 +299,6 @@ class Parser {
     ++stats().edge_lines;
   }
 
-  void check_graph() {
-    auto& g = result_.graph;
-    if (g.measurements.empty())
-      fail(0, line_ == 0 ? "empty file: no pose-graph edges"
-                         : "no edges (EDGE_SE2 or EDGE_SE3:QUAT lines): nothing to optimise");
-    std::uint64_t n = 0;
-    if (!loose_.empty()) {
-      n = check_loose_vertices();
-    } else if (stats().vertex_lines > 0) {
-      // Vertices 0..n-1 in order: unique and contiguous by construction.
-      n = g.initial.size();
-      const auto& ms = g.measurements;
-      for (std::size_t e = 0; e < ms.size(); ++e)
-        for (std::size_t id : {ms[e].i, ms[e].j})
-          if (id >= n) fail_missing_pose(e, id);
-    } else {
-      n = check_edge_ids();
-    }
-    g.num_poses = static_cast<std::size_t>(n);
-    count_pairs();
-    const auto labels = connected_components(g);
-    std::size_t k = 0, outside = 0;
-    for (std::size_t v = 0; v < labels.size(); ++v) {
-      if (labels[v] + 1 > k) k = labels[v] + 1;
-      if (labels[v] != 0 && outside == 0) outside = v;
-    }
-    stats().components = k;
-    if (k > 1 && !options_.allow_disconnected)
-      fail(0, "the graph is disconnected: " + std::to_string(k) +
-                  " connected components (no chain of edges links pose " + std::to_string(outside) +
-                  " to pose 0)");
-  }
-
-  [[noreturn]] void fail_missing_pose(std::size_t edge, std::uint64_t id) const {
-    fail(edge_lines_[edge], "edge to missing pose " + std::to_string(id) +
-                                " (the file has VERTEX lines, but none for this id)");
-  }
-
-  // Vertices in any order: ids unique, every edge endpoint a vertex, ids exactly 0..n-1;
-  // then their poses go to graph.initial by id.
-  std::uint64_t check_loose_vertices() {
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> ids;  // (id, line)
-    ids.reserve(loose_.size());
-    for (const auto& v : loose_) ids.emplace_back(v.id, v.line);
-    std::sort(ids.begin(), ids.end());
-    std::size_t dup_line = 0, dup_first = 0;
-    std::uint64_t dup_id = 0;
-    for (std::size_t k = 1; k < ids.size(); ++k) {
-      if (ids[k].first == ids[k - 1].first && (dup_line == 0 || ids[k].second < dup_line)) {
-        dup_line = ids[k].second;
-        dup_first = ids[k - 1].second;
-        dup_id = ids[k].first;
-      }
-    }
-    if (dup_line)
-      fail(dup_line, "duplicate VERTEX id " + std::to_string(dup_id) + " (first on line " +
-                         std::to_string(dup_first) + ")");
-    const std::uint64_t n = ids.back().first + 1;
-    const bool dense = n == ids.size();
-    auto has_vertex = [&](std::uint64_t id) {
-      if (dense) return id < n;
-      auto it = std::lower_bound(ids.begin(), ids.end(), std::make_pair(id, std::uint32_t{0}));
-      return it != ids.end() && it->first == id;
-    };
-    const auto& ms = result_.graph.measurements;
-    for (std::size_t e = 0; e < ms.size(); ++e)
-      for (std::size_t id : {ms[e].i, ms[e].j})
-        if (!has_vertex(id)) fail_missing_pose(e, id);
-    if (!dense) {
-      std::uint64_t missing = 0;
-      while (missing < ids.size() && ids[missing].first == missing) ++missing;
-      fail(0, "pose id " + std::to_string(missing) + " appears on no line, but ids must be 0.." +
-                  std::to_string(n - 1) + " (largest VERTEX id " + std::to_string(n - 1) +
-                  " on line " + std::to_string(ids.back().second) + ")");
-    }
-    auto& initial = result_.graph.initial;
-    initial.resize(static_cast<std::size_t>(n));
-    for (auto& v : loose_) initial[v.id] = std::move(v.pose);
-    return n;
-  }
-
-  // Without VERTEX lines: n = 1 + the largest edge id and every id 0..n-1 must be used.
-  std::uint64_t check_edge_ids() {
-    const auto& ms = result_.graph.measurements;
-    std::uint64_t max_id = 0;
-    std::size_t max_line = 0;
-    for (std::size_t e = 0; e < ms.size(); ++e) {
-      const std::uint64_t m = std::max(ms[e].i, ms[e].j);
-      if (m > max_id || max_line == 0) {
-        max_id = m;
-        max_line = edge_lines_[e];
-      }
-    }
-    const std::uint64_t n = max_id + 1;
-    // 2E endpoints cannot cover more than 2E ids, so a bitmap of 2E + 1 entries always finds
-    // the smallest unused id without allocating for a huge bogus id.
-    const std::uint64_t limit = std::min<std::uint64_t>(n, 2 * ms.size() + 1);
-    std::vector<char> seen(limit, 0);
-    for (const auto& m : ms) {
-      if (m.i < limit) seen[m.i] = 1;
-      if (m.j < limit) seen[m.j] = 1;
-    }
-    for (std::uint64_t id = 0; id < limit; ++id)
-      if (!seen[id])
-        fail(0, "pose id " + std::to_string(id) + " appears on no line, but ids must be 0.." +
-                    std::to_string(max_id) + " (largest id " + std::to_string(max_id) +
-                    " on line " + std::to_string(max_line) + ")");
-    return n;
-  }
-
-  void count_pairs() {
-    const auto& ms = result_.graph.measurements;
-    std::vector<std::uint64_t> keys;
-    keys.reserve(ms.size());
-    for (const auto& m : ms) {
-      if (m.i > m.j) ++stats().backward_edges;
-      const std::uint64_t a = std::min(m.i, m.j), b = std::max(m.i, m.j);
-      keys.push_back(a << 32 | b);
-    }
-    std::sort(keys.begin(), keys.end());
-    const std::size_t distinct = std::unique(keys.begin(), keys.end()) - keys.begin();
-    stats().distinct_pairs = distinct;
-    stats().parallel_edges = ms.size() - distinct;
-  }
-
   const std::string& name_;
   const G2oReadOptions& options_;
   G2oReadResult result_;
@@ -517,7 +311,7 @@ class Parser {
   std::size_t d_line_ = 0;
   std::string d_tag_;
   std::vector<std::uint32_t> vertex_lines_;  // line of graph.initial[k] while in order
-  std::vector<LooseVertex> loose_;           // all vertices once one came out of order
+  std::vector<G2oLooseVertex> loose_;        // all vertices once one came out of order
   std::vector<std::uint32_t> edge_lines_;    // line of each measurement (inputs < 2^32 lines)
 };
 
