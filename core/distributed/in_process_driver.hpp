@@ -34,7 +34,9 @@ struct DeliveryStats {
   /// agent. Agents run one after another here but concurrently over the network, where a round
   /// lasts as long as its slowest agent: `critical_path_cpu_s` = sum over (stage, round) of the
   /// largest agent's CPU time, an estimate of the distributed run's compute time (no latency)
-  /// that does not depend on how many agents share this process or the machine's load.
+  /// that does not depend on how many agents share this process or the machine's load. A
+  /// message's time includes the driver's queueing just before it (the receiving side's share
+  /// of a transport).
   double critical_path_cpu_s = 0.0;
 };
 
