@@ -57,10 +57,18 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
         std::to_string(order.epoch));
   }
   RoundLoopHooks hooks;
-  hooks.on_round = [&](const ProtocolSnapshot& snap) {
-    if (cur == &local) keeper.on_round(snap);
-    if (replication.enabled()) replication.on_round(*cur, snap);
-  };
+  SnapshotReaders readers;
+  readers.rejoin = rejoin_enabled;
+  readers.restarted = restart.has_value();
+  readers.checkpoint_files = !o.checkpoint_dir.empty();
+  readers.replicas = replication.enabled();
+  if (snapshots_needed(readers))
+    hooks.on_round = [&](const ProtocolSnapshot& snap) {
+      if (cur == &local) keeper.on_round(snap);
+      if (replication.enabled()) replication.on_round(*cur, snap);
+    };
+  log(std::string("round snapshots: ") +
+      (hooks.on_round ? "kept (rejoin, checkpoints or replicas)" : "none (nothing reads them)"));
   for (;;) {
     try {
       hooks.resume_from = from ? &*from : nullptr;

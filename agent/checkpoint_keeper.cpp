@@ -13,6 +13,10 @@ void CheckpointOptions::validate() const {
     throw InputError("option --checkpoint-every: must be 1..1000000, got " + std::to_string(every));
 }
 
+bool snapshots_needed(const SnapshotReaders& r) {
+  return r.rejoin || r.restarted || r.checkpoint_files || r.replicas;
+}
+
 CheckpointKeeper::CheckpointKeeper(std::string run_id, const AgentLocalData& local,
                                    CheckpointOptions options)
     : run_id_(std::move(run_id)), local_(local), opt_(std::move(options)) {

@@ -29,6 +29,21 @@ struct CheckpointStats {
   int last_round = -1;           ///< Round of the newest snapshot in the file.
 };
 
+/// What may read an agent's round snapshots in this run.
+struct SnapshotReaders {
+  bool rejoin = false;            ///< The coordinator may order a rollback (rejoin window).
+  bool restarted = false;         ///< This agent resumed from its checkpoint file.
+  bool checkpoint_files = false;  ///< --checkpoint-dir: the file is rewritten from them.
+  bool replicas = false;          ///< Block replication sends the block of snapshot rounds.
+};
+
+/// True when some reader above is present. A snapshot copies every block matrix of the
+/// protocol and its whole round trace, every round (kitti_02, N = 5: about a third of an
+/// agent's CPU per round, none of which the in-process engine pays), so the round loop takes
+/// none when nothing reads them; a rollback order then cannot arrive (only the coordinator's
+/// rejoin arbiter sends one).
+bool snapshots_needed(const SnapshotReaders& r);
+
 class CheckpointKeeper {
  public:
   /// `local` must outlive the keeper (its data goes into every file).
