@@ -31,10 +31,8 @@ usage: dds_overhead.py [--bin build/bin] [--graphs CSAIL,intel] [--agents 5] [--
                        [--out FILE.csv] [--limit S] [--launch-args="--no-fork-server"]
 """
 import argparse
-import csv
 import json
 import os
-import resource
 import statistics
 import subprocess
 import sys
@@ -73,22 +71,9 @@ def has_vertices(path):
     return False
 
 
-# CPU seconds (user + system) and voluntary context switches of every finished child process
-# and its waited-for descendants (launch waits for the coordinator and the agents), so a
-# difference around one run counts all of its processes.
-def children_usage():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime, r.ru_nvcsw
-
-
-def usage_since(before):
-    cpu, csw = children_usage()
-    return cpu - before[0], csw - before[1]
-
-
 def run_in_process(tessera, graph, agents, tmp, limit):
     js = os.path.join(tmp, "inprocess.json")
-    u0 = children_usage()
+    u0 = bc.children_usage()
     t0 = time.monotonic()
     try:
         p = subprocess.run([tessera, "solve", graph, "--algorithm", "irbcd", "--agents", str(agents),
@@ -103,13 +88,13 @@ def run_in_process(tessera, graph, agents, tmp, limit):
         return None
     with open(js) as f:
         s = json.load(f)
-    s["cpu_s"], s["csw"] = usage_since(u0)
+    s["cpu_s"], s["csw"] = bc.usage_since(u0)
     return s, wall
 
 
 def run_dds(tessera, graph, agents, domain, tmp, limit, extra=()):
     js = os.path.join(tmp, "dds.json")
-    u0 = children_usage()
+    u0 = bc.children_usage()
     t0 = time.monotonic()
     t0_ms = time.monotonic_ns() / 1e6
     p = subprocess.Popen([tessera, "launch", graph, "--agents", str(agents), "--partition",
@@ -137,7 +122,7 @@ def run_dds(tessera, graph, agents, domain, tmp, limit, extra=()):
         return None
     with open(js) as f:
         s = json.load(f)
-    s["cpu_s"], s["csw"] = usage_since(u0)
+    s["cpu_s"], s["csw"] = bc.usage_since(u0)
     gaps = [1000 * (b - a) for a, b in zip(stamps, stamps[1:])]
     s["phases_s"] = phases(s, t0_ms, wall)
     s["phases_s"]["teardown"] = exit_wall - wall
