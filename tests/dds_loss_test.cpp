@@ -105,9 +105,12 @@ TEST(DdsLoss, WithoutReplicasALostAgentStillStopsTheRun) {
 void restarted_after_repartition_is_refused(int domain, bool checkpoint) {
   // The survivors must still be in their rounds when the restarted process arrives (~1-3 s):
   // a tolerance below the round-off floor, so they run until the iterate stalls (a few hundred
-  // rounds, core's "stalled" stop) on a graph large enough that this takes several seconds
-  // (4000 poses: ~5 s after the re-partition), and a round limit as a bound.
-  LossRun r = make_run(domain, checkpoint ? "refused-ckpt" : "refused-fresh", 4000);
+  // rounds, core's "stalled" stop) on a graph large enough that this takes several seconds,
+  // and a round limit as a bound. 8000 poses: the refused process leaves 2.8-5.2 s before the
+  // survivors finish on a quiet machine; 4000 poses left no margin once rounds got cheaper
+  // (session 7: the survivors stalled ~2 s after the re-partition, before a restarted process
+  // had read the assignment naming it lost).
+  LossRun r = make_run(domain, checkpoint ? "refused-ckpt" : "refused-fresh", 8000);
   r.grad_tol = "1e-12";
   Process coord = r.coordinator(1, {"--max-rounds", "600"});
   auto agent_argv = [&](int k) {
