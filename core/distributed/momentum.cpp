@@ -168,7 +168,7 @@ void momentum_update_into(const LiftedManifold& M, const MomentumCoefficients& c
                           const Eigen::MatrixXd& Y_new, Eigen::MatrixXd& out) {
   check_same_shape(V, P, "momentum_update");
   check_same_shape(V, Y_new, "momentum_update");
-  if (&out != &V && &out != &P && &out != &Y_new) out.resize(V.rows(), V.cols());
+  out.resize(V.rows(), V.cols());  // a no-op when out is one of the (same-shape) inputs
   const double b = c.beta, one_minus_b = 1.0 - c.beta, g = c.gamma;
   const double* v = V.data();
   const double* p = P.data();
