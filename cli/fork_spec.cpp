@@ -1,5 +1,9 @@
 #include "fork_spec.hpp"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
@@ -113,6 +117,18 @@ std::size_t longest_command_line(const ForkSpec& spec) {
     longest = std::max(longest, n);
   }
   return longest;
+}
+
+void enter_child_process(const ForkChild& child) {
+  setpgid(0, 0);
+  signal(SIGINT, SIG_DFL);
+  signal(SIGTERM, SIG_DFL);
+  const int fd = open(child.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd >= 0) {
+    dup2(child.stdout_fd >= 0 ? child.stdout_fd : fd, 1);
+    dup2(fd, 2);
+    close(fd);
+  }
 }
 
 }  // namespace tessera::cli

@@ -57,4 +57,10 @@ std::size_t longest_command_line(const ForkSpec& spec);
 
 const char* fork_role_name(ForkRole role);
 
+/// Called in a freshly forked child (exec'ed by launch or forked by the fork server, so both
+/// paths give a child the same process): its own process group (a terminal's Ctrl-C reaches
+/// launch only, which decides how to stop the run), default SIGINT / SIGTERM, stdout to
+/// `child.stdout_fd` (or the log) and stderr to `child.log`, created or truncated.
+void enter_child_process(const ForkChild& child);
+
 }  // namespace tessera::cli

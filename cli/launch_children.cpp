@@ -30,23 +30,14 @@ Child labelled(const ForkSpec& spec, std::size_t k, const std::vector<std::strin
   return c;
 }
 
-// Starts argv with stdout going to `stdout_fd` (or the log) and stderr to the log, in its own
-// process group (so a terminal's Ctrl-C reaches only us, and we decide how to stop them).
-pid_t spawn_one(const std::vector<std::string>& argv, const std::string& log, int stdout_fd) {
+// Starts `child` (fork + exec of its argv) with the process set-up of enter_child_process().
+pid_t spawn_one(const ForkChild& child) {
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed: " + std::string(std::strerror(errno)));
   if (pid == 0) {
-    setpgid(0, 0);
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      dup2(stdout_fd >= 0 ? stdout_fd : fd, 1);
-      dup2(fd, 2);
-      close(fd);
-    }
+    enter_child_process(child);
     std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    for (const auto& a : child.argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
     execv(args[0], args.data());
     std::fprintf(stderr, "cannot run %s: %s\n", args[0], std::strerror(errno));
@@ -67,7 +58,7 @@ std::vector<Child> spawn_exec(const ForkSpec& spec, const std::vector<std::strin
   for (std::size_t k = 0; k < spec.children.size(); ++k) {
     const ForkChild& f = spec.children[k];
     Child c = labelled(spec, k, names, agents);
-    c.pid = spawn_one(f.argv, f.log, f.stdout_fd);
+    c.pid = spawn_one(f);
     c.running = true;
     children.push_back(c);
     // The coordinator's progress pipe must not stay open in the agents (exec'ed later).
@@ -87,12 +78,13 @@ std::vector<Child> spawn_forked(const std::string& fork_server, ForkSpec spec,
   fcntl(specs[1], F_SETFD, FD_CLOEXEC);
   spec.pid_fd = pids[1];
   const std::string text = serialize_fork_spec(spec);
-  const std::vector<std::string> argv = {fork_server, "--spec-fd", std::to_string(specs[0]),
-                                         "--title-room",
-                                         std::string(longest_command_line(spec), ' ')};
+  ForkChild server_process;
+  server_process.log = server_log;
+  server_process.argv = {fork_server, "--spec-fd", std::to_string(specs[0]), "--title-room",
+                         std::string(longest_command_line(spec), ' ')};
   // Orphans of our descendants (the server's children once it exits) become our children.
   prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0);
-  const pid_t server = spawn_one(argv, server_log, -1);
+  const pid_t server = spawn_one(server_process);
   close(pids[1]);
   close(specs[0]);
   {

@@ -18,8 +18,6 @@
 //   BLANKS: as many spaces as the longest child's command line, so that the argv area where
 //   each child writes its own command line (ps, pgrep -f) is large enough.
 
-#include <fcntl.h>
-#include <signal.h>
 #include <sys/prctl.h>
 #include <sys/types.h>
 #include <unistd.h>
@@ -93,19 +91,11 @@ void show_as(const ArgvArea& area, const std::vector<std::string>& argv) {
   prctl(PR_SET_NAME, name.c_str(), 0, 0, 0);  // kernel keeps 15 characters
 }
 
-// The child's side of a fork: the same process set-up as launch's exec path (own process
-// group, default SIGINT/SIGTERM, stdout/stderr to its log or launch's pipe), then the entry.
+// The child's side of a fork: the same process set-up as launch's exec path
+// (cli::enter_child_process), then the entry.
 [[noreturn]] void run_child(const cli::ForkSpec& spec, std::size_t k, const ArgvArea& area) {
   const cli::ForkChild& c = spec.children[k];
-  setpgid(0, 0);
-  signal(SIGINT, SIG_DFL);
-  signal(SIGTERM, SIG_DFL);
-  const int fd = open(c.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd >= 0) {
-    dup2(c.stdout_fd >= 0 ? c.stdout_fd : fd, 1);
-    dup2(fd, 2);
-    close(fd);
-  }
+  cli::enter_child_process(c);
   // Descriptors meant for launch or for another child: an agent holding launch's progress
   // pipe would keep it open after the coordinator has left.
   close(spec.pid_fd);
