@@ -259,6 +259,10 @@ int run_launch(const Args& argv) {
   if (args.has("certify") && args.has("no-certify"))
     throw InputError("launch: --certify and --no-certify exclude each other");
   if (!args.has("no-certify")) cargs.push_back("--certify");
+  // Every process runs here and the coordinator can read the whole file: it partitions the
+  // file's structure while the agents start up (coordinator/file_partition.hpp). Robot files
+  // are each robot's own: there the announcements are the only whole structure.
+  if (robot_files.empty()) cargs.insert(cargs.end(), {"--graph", graph});
   cargs.insert(cargs.end(), common.begin(), common.end());
   for (const auto& a : coordinator_loss_argv(loss)) cargs.push_back(a);
   if (args.has("out")) cargs.insert(cargs.end(), {"--output", args.get_or("out", "")});

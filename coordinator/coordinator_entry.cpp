@@ -4,11 +4,13 @@
 
 #include "coordinator/coordinator_entry.hpp"
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "coordinator/coordinator_options.hpp"
 #include "coordinator/coordinator_run.hpp"
+#include "coordinator/file_partition.hpp"
 #include "coordinator/run_timeline.hpp"
 #include "session_process.hpp"
 #include "transport/signal_watcher.hpp"
@@ -25,10 +27,18 @@ int coordinator_main(int argc, char** argv) {
                                              cli::process_help(kCoordinatorUsage),
                                              parse_coordinator_options, options))
     return *code;
+  // The graph file's partition starts now, before the participant (after SignalWatcher: its
+  // thread keeps SIGINT / SIGTERM blocked), so the participant's creation and the agents'
+  // start-up happen while it runs (coordinator/file_partition.hpp).
+  std::unique_ptr<FilePartitionJob> file_job;
+  if (!options.graph.empty())
+    file_job = std::make_unique<FilePartitionJob>(options.graph, options.agents, options.partition,
+                                                  options.partition_seed);
   const cli::ProcessRole role{"tessera-coordinator", options.net.timeout_s};
-  return cli::run_session_process(
-      coordinator_session_options(options), role, signals,
-      [&](transport::Session& session) { run_coordinator(options, session, timeline); });
+  return cli::run_session_process(coordinator_session_options(options), role, signals,
+                                  [&](transport::Session& session) {
+                                    run_coordinator(options, session, timeline, file_job.get());
+                                  });
 }
 
 }  // namespace tessera::coordinator

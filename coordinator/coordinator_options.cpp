@@ -1,5 +1,8 @@
 #include "coordinator/coordinator_options.hpp"
 
+#include <set>
+#include <string>
+
 #include "arguments.hpp"
 #include "distributed/distributed_solver.hpp"
 #include "util/input_error.hpp"
@@ -33,6 +36,11 @@ options:
   --tum FILE           write the merged poses in the TUM format
   --summary FILE       write a JSON summary of the run
   --graph-name NAME    label of the graph in the summary (default "")
+  --graph FILE         the whole g2o file the agents read, if this host has it (tessera launch
+                       passes it): its structure is partitioned while the agents start up, and
+                       that partition is used if their announced structure is exactly the
+                       file's (otherwise, or if FILE cannot be read, the announced structure is
+                       partitioned as without it). Only endpoints are kept (default: none)
   --progress           print round progress (sum of the agents' cost and gradient norm)
   --rejoin-timeout S   when an agent process dies, wait up to S seconds for it to be
                        restarted (same id, --checkpoint-dir) and rejoin; every agent then rolls
@@ -54,14 +62,13 @@ exit codes: 0 done, 1 the run failed (lost agent, abort, timeout), 2 bad options
 )";
 
 CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& argv) {
-  cli::Arguments args(
-      argv,
-      cli::with_session_options(
-          {"agents", "run-timeout", "partition", "partition-seed", "rank", "algorithm", "init",
-           "max-rounds", "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary",
-           "graph-name", "rejoin-timeout", "status-interval", "replicas", "replica-every"},
-          cli::SessionArgsFor::kProcess),
-      {"progress", "verbose", "help", "certify"});
+  std::set<std::string> valued = cli::with_session_options(
+      {"agents", "run-timeout", "partition", "partition-seed", "rank", "algorithm", "init",
+       "max-rounds", "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary", "graph-name",
+       "rejoin-timeout", "status-interval", "replicas", "replica-every"},
+      cli::SessionArgsFor::kProcess);
+  valued.insert("graph");
+  cli::Arguments args(argv, valued, {"progress", "verbose", "help", "certify"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   CoordinatorOptions a;
@@ -93,6 +100,7 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   a.tum = args.get_or("tum", "");
   a.summary = args.get_or("summary", "");
   a.graph_name = args.get_or("graph-name", "");
+  a.graph = args.get_or("graph", "");
   a.progress = args.has("progress");
   a.rejoin_timeout_s = args.get_double("rejoin-timeout", a.rejoin_timeout_s);
   if (!(a.rejoin_timeout_s >= 0 && a.rejoin_timeout_s <= 86400))

@@ -24,6 +24,7 @@ struct CoordinatorOptions {
   double grad_tol = 0, rel_cost_tol = 0;  ///< 0 = core's defaults.
   std::uint64_t seed = 1;
   std::string output, tum, summary, graph_name;  ///< Empty: not written.
+  std::string graph;  ///< --graph: the agents' whole g2o file, partitioned early; empty = none.
   bool progress = false, verbose = false;
   double rejoin_timeout_s = 0;       ///< 0..86400 s; 0 = a lost agent stops the run.
   double status_interval_s = 5;      ///< 0..86400 s; 0 = no status lines.

@@ -11,6 +11,7 @@
 #include "coordinator/announcement_gathering.hpp"
 #include "coordinator/assignment_publishing.hpp"
 #include "coordinator/elapsed.hpp"
+#include "coordinator/file_partition.hpp"
 #include "coordinator/final_merge.hpp"
 #include "coordinator/loss_handling.hpp"
 #include "coordinator/partition_step.hpp"
@@ -26,13 +27,35 @@ namespace tessera::coordinator {
 
 using namespace tessera::transport;
 
-void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timeline) {
+void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timeline,
+                     FilePartitionJob* file_job) {
   const auto log = [&](const std::string& what) {
     if (o.verbose) std::cerr << "tessera-coordinator: " << what << "\n";
   };
   const auto t0 = std::chrono::steady_clock::now();
   timeline.mark_at("session", t0);
   const std::uint32_t N = o.agents;
+
+  // 0. With the whole file on this host (--graph, as tessera launch runs): its partition has
+  // been computed on a thread since before the session, while the participant was created and
+  // the agents started and discovered us (coordinator/file_partition.hpp). Their announcements
+  // queue in the session's inbox meanwhile; the wait for them below keeps its own timeout.
+  std::optional<FilePartition> early;
+  if (file_job) {
+    std::string why;
+    std::chrono::steady_clock::time_point started, ended;
+    early = file_job->take(&why, &started, &ended);
+    timeline.mark_at("partition_start", started);
+    if (early) {
+      timeline.mark_at("partitioned", ended);
+      log("partition of " + o.graph + " (" + o.partition + ") while the agents start: cut " +
+          std::to_string(early->part.cut_edges) + " measurements in " +
+          std::to_string(early->part.ms) + " ms");
+    } else {
+      log("cannot partition " + o.graph + " early (" + why +
+          "): partitioning the announced structure");
+    }
+  }
 
   // 1. Every agent's announcement.
   std::vector<wire::AgentAnnouncement> announcements =
@@ -45,11 +68,20 @@ void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timel
       std::to_string(static_cast<long>(discovery_ms)) + " ms): " + std::to_string(rs.num_poses) +
       " poses, " + std::to_string(rs.num_measurements) + " measurements");
 
-  // 2. Partition and publish the assignment.
-  const PartitionStepResult part = partition_for_agents(rs.graph, N, o.partition, o.partition_seed);
-  timeline.mark("partitioned");
-  log("partition (" + o.partition + "): cut " + std::to_string(part.cut_edges) +
-      " measurements in " + std::to_string(part.ms) + " ms");
+  // 2. Partition (unless the file's, computed above, is this very structure) and publish the
+  // assignment.
+  const bool use_early = early && early->fits(rs);
+  if (early && !use_early)
+    log("the announced structure is not " + o.graph + "'s: partitioning the announced one");
+  const PartitionStepResult part =
+      use_early ? std::move(early->part)
+                : partition_for_agents(rs.graph, N, o.partition, o.partition_seed);
+  early.reset();
+  if (!use_early) {
+    timeline.mark("partitioned");
+    log("partition (" + o.partition + "): cut " + std::to_string(part.cut_edges) +
+        " measurements in " + std::to_string(part.ms) + " ms");
+  }
   const wire::PartitionAssignment base = make_assignment(o, rs, part);
   publish_assignment(s, base, o.certify, o.net.timeout_s);
   log("all agents ready");

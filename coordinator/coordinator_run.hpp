@@ -5,6 +5,7 @@
 // Each step is its own file in coordinator/; this one only sequences them.
 
 #include "coordinator/coordinator_options.hpp"
+#include "coordinator/file_partition.hpp"
 #include "coordinator/run_timeline.hpp"
 #include "transport/session.hpp"
 
@@ -13,7 +14,8 @@ namespace tessera::coordinator {
 /// Runs the whole run on an open session. Throws RunFailure (or InputError for bad
 /// announcements) when the run fails; cli::run_session_process turns that into the ABORT
 /// and the exit code. Marks the end of each step on `timeline` (reported in the summary).
+/// `file_job`: the partition of --graph, started before the session (null without --graph).
 void run_coordinator(const CoordinatorOptions& options, transport::Session& session,
-                     RunTimeline& timeline);
+                     RunTimeline& timeline, FilePartitionJob* file_job);
 
 }  // namespace tessera::coordinator

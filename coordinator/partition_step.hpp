@@ -14,6 +14,7 @@ struct PartitionStepResult {
   std::vector<std::uint32_t> owner;  ///< Agent of every pose.
   double ms = 0;                     ///< Wall time of the partitioning.
   std::size_t cut_edges = 0;         ///< Measurements between different agents.
+  bool early = false;  ///< Of the graph file, while the agents started (file_partition.hpp).
 };
 
 /// Splits the structure among `num_agents` agents with core's partitioner (`preset` as

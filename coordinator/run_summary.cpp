@@ -46,6 +46,7 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("rounds", static_cast<long long>(in.merged.rounds))
       .add("discovery_ms", in.discovery_ms)
       .add("partition_ms", in.partition.ms)
+      .add("partition_early", in.partition.early)
       .add("solve_ms", in.solve_ms)
       .add("rounds_ms", rounds_ms)
       .add("ms_per_round", r.completed_statuses > 1

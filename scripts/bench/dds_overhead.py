@@ -132,9 +132,13 @@ def run_dds(tessera, graph, agents, domain, tmp, limit, extra=()):
 
 # Phases of the DDS run from the coordinator's timeline (milliseconds since its start, and
 # that start on CLOCK_MONOTONIC, which time.monotonic() also reads): seconds per phase.
-PHASES = [("start", "session"), ("discovery", "announced"), ("partition", "partitioned"),
-          ("ready", "ready"), ("handoff", "first_status"), ("rounds", "last_status"),
-          ("rounding", "finals"), ("merge", "merged")]
+# Each phase ends at its mark; phases are taken in the order of their marks' times. With the
+# graph file (launch's default) the coordinator partitions while the agents start:
+# session -> partition_start ("read" the file) -> partitioned -> announced ("discovery" is
+# then only what the agents' announcements took beyond the partition).
+PHASES = [("start", "session"), ("read", "partition_start"), ("discovery", "announced"),
+          ("partition", "partitioned"), ("ready", "ready"), ("handoff", "first_status"),
+          ("rounds", "last_status"), ("rounding", "finals"), ("merge", "merged")]
 
 
 def phases(summary, t0_ms, wall):
@@ -143,11 +147,9 @@ def phases(summary, t0_ms, wall):
         return {}
     base = summary["started_monotonic_ms"] - t0_ms  # coordinator start after launch, ms
     out, prev = {}, 0.0
-    for name, mark in PHASES:
-        if mark in tl:
-            at = base + tl[mark]
-            out[name] = (at - prev) / 1000
-            prev = at
+    for at, name in sorted((base + tl[mark], name) for name, mark in PHASES if mark in tl):
+        out[name] = (at - prev) / 1000
+        prev = at
     out["summary"] = wall - prev / 1000  # summary file written and printed by launch
     return out
 

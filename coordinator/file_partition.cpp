@@ -1,0 +1,84 @@
+#include "coordinator/file_partition.hpp"
+
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <utility>
+
+#include "io/g2o_reader.hpp"
+
+namespace tessera::coordinator {
+
+bool FilePartition::fits(const RunStructure& rs) const {
+  return rs.num_poses == num_poses && rs.edge_i == edge_i && rs.edge_j == edge_j;
+}
+
+std::optional<FilePartition> partition_graph_file(const std::string& path, std::uint32_t num_agents,
+                                                  const std::string& preset, std::uint64_t seed,
+                                                  std::string* why) {
+  try {
+    FilePartition fp;
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    {
+      const PoseGraph graph = read_g2o(path);  // values dropped at the end of this scope
+      fp.num_poses = graph.num_poses;
+      pairs.reserve(graph.measurements.size());
+      fp.edge_i.reserve(graph.measurements.size());
+      fp.edge_j.reserve(graph.measurements.size());
+      for (const Measurement& m : graph.measurements) {
+        pairs.emplace_back(m.i, m.j);
+        fp.edge_i.push_back(static_cast<std::uint32_t>(m.i));
+        fp.edge_j.push_back(static_cast<std::uint32_t>(m.j));
+      }
+    }
+    // The same call, on the same structure, as the partition of the announcements.
+    const GraphStructure structure = make_graph_structure(fp.num_poses, pairs, path);
+    fp.part = partition_for_agents(structure, num_agents, preset, seed);
+    fp.part.early = true;
+    return fp;
+  } catch (const std::exception& e) {
+    if (why) *why = e.what();
+    return std::nullopt;
+  }
+}
+
+struct FilePartitionJob::State {
+  std::mutex mutex;
+  std::condition_variable done_cv;
+  bool done = false;
+  std::optional<FilePartition> result;
+  std::string why;
+  std::chrono::steady_clock::time_point started, ended;
+};
+
+FilePartitionJob::FilePartitionJob(std::string path, std::uint32_t num_agents, std::string preset,
+                                   std::uint64_t seed)
+    : state_(std::make_shared<State>()) {
+  std::thread([st = state_, path = std::move(path), num_agents, preset = std::move(preset), seed] {
+    const auto started = std::chrono::steady_clock::now();
+    std::string why;
+    std::optional<FilePartition> r = partition_graph_file(path, num_agents, preset, seed, &why);
+    const auto ended = std::chrono::steady_clock::now();
+    std::lock_guard<std::mutex> lock(st->mutex);
+    st->result = std::move(r);
+    st->why = std::move(why);
+    st->started = started;
+    st->ended = ended;
+    st->done = true;
+    st->done_cv.notify_all();
+  }).detach();
+}
+
+std::optional<FilePartition> FilePartitionJob::take(std::string* why,
+                                                    std::chrono::steady_clock::time_point* started,
+                                                    std::chrono::steady_clock::time_point* ended) {
+  std::unique_lock<std::mutex> lock(state_->mutex);
+  state_->done_cv.wait(lock, [&] { return state_->done; });
+  if (why) *why = state_->why;
+  if (started) *started = state_->started;
+  if (ended) *ended = state_->ended;
+  return std::move(state_->result);
+}
+
+}  // namespace tessera::coordinator

@@ -1,0 +1,145 @@
+// The coordinator's early partition of the graph file (coordinator/file_partition.hpp: what
+// `tessera launch` uses to partition while the agents start up): it is the partition of the
+// structure the agents announce, it is used only when that structure is the file's, and a
+// coordinator given another file (or none it can read) partitions the announcements instead.
+// Domains used here: 54, 55 (each test its own, so ctest -j is safe).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <string>
+#include <vector>
+
+#include "agent/local_share.hpp"
+#include "coordinator/file_partition.hpp"
+#include "coordinator/run_structure.hpp"
+#include "dds_process_support.hpp"
+#include "io/g2o_reader.hpp"
+#include "partition/graph_structure.hpp"
+#include "partition/partitioner.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+// What the agents of a run on `g` announce (agent/run_setup.cpp: robot k's share).
+std::vector<wire::AgentAnnouncement> announcements_of(const PoseGraph& g, std::uint32_t N) {
+  std::vector<wire::AgentAnnouncement> out;
+  for (std::uint32_t k = 0; k < N; ++k) {
+    const agent::RobotShare s = agent::robot_share(g, k, N);
+    wire::AgentAnnouncement a;
+    a.run_id("r");
+    a.agent_id(k);
+    a.num_agents(N);
+    a.host("h");
+    a.dim(static_cast<std::uint32_t>(g.d));
+    a.num_poses(static_cast<std::uint32_t>(g.num_poses));
+    a.pose_begin(s.begin);
+    a.pose_end(s.end);
+    for (const auto& m : s.measurements) {
+      a.edge_i().push_back(static_cast<std::uint32_t>(m.i));
+      a.edge_j().push_back(static_cast<std::uint32_t>(m.j));
+    }
+    a.edge_index(s.measurement_index);
+    out.push_back(a);
+  }
+  return out;
+}
+
+TEST(DdsFilePartition, IsThePartitionOfTheAnnouncedStructure) {
+  const std::string dir = temp_dir();
+  // Robots' measurements interleave in a generated file, so file order != agent order.
+  const std::string path =
+      generate_graph(dir + "/g.g2o", "--kind grid3d --poses 300 --robots 4 --seed 6");
+  const PoseGraph g = read_g2o(path);
+  const coordinator::RunStructure rs =
+      coordinator::merge_announcements(announcements_of(g, 4), 4, "r");
+  const coordinator::PartitionStepResult announced =
+      coordinator::partition_for_agents(rs.graph, 4, "highest", 3);
+  EXPECT_FALSE(announced.early);
+
+  std::string why;
+  const auto fp = coordinator::partition_graph_file(path, 4, "highest", 3, &why);
+  ASSERT_TRUE(fp) << why;
+  EXPECT_TRUE(fp->fits(rs));
+  EXPECT_TRUE(fp->part.early);
+  EXPECT_EQ(fp->part.owner, announced.owner);
+  EXPECT_EQ(fp->part.cut_edges, announced.cut_edges);
+
+  // The same on its own thread, which reports when it ran.
+  coordinator::FilePartitionJob job(path, 4, "highest", 3);
+  std::chrono::steady_clock::time_point started, ended;
+  const auto threaded = job.take(&why, &started, &ended);
+  ASSERT_TRUE(threaded) << why;
+  EXPECT_EQ(threaded->part.owner, announced.owner);
+  EXPECT_LE(started, ended);
+}
+
+TEST(DdsFilePartition, AnotherStructureDoesNotFitAndAnUnreadableFileIsNoPartition) {
+  const std::string dir = temp_dir();
+  const std::string path =
+      generate_graph(dir + "/g.g2o", "--kind grid3d --poses 300 --robots 4 --seed 6");
+  // Same poses, other loop closures.
+  const std::string other =
+      generate_graph(dir + "/other.g2o", "--kind grid3d --poses 300 --robots 4 --seed 7");
+  const coordinator::RunStructure rs =
+      coordinator::merge_announcements(announcements_of(read_g2o(path), 4), 4, "r");
+  std::string why;
+  const auto fp = coordinator::partition_graph_file(other, 4, "eco", 1, &why);
+  ASSERT_TRUE(fp) << why;
+  EXPECT_FALSE(fp->fits(rs));
+  // One measurement's endpoints changed is enough.
+  auto same = coordinator::partition_graph_file(path, 4, "eco", 1, &why);
+  ASSERT_TRUE(same) << why;
+  EXPECT_TRUE(same->fits(rs));
+  std::swap(same->edge_i[5], same->edge_j[5]);
+  EXPECT_FALSE(same->fits(rs));
+
+  EXPECT_FALSE(coordinator::partition_graph_file(dir + "/missing.g2o", 4, "eco", 1, &why));
+  EXPECT_NE(why.find("missing.g2o"), std::string::npos) << why;
+  coordinator::FilePartitionJob job(dir + "/missing.g2o", 4, "eco", 1);
+  EXPECT_FALSE(job.take(nullptr, nullptr, nullptr));
+}
+
+// Coordinator `--graph coordinator_file` + 3 agents on `graph` (coordinator first, so the
+// agents start while it partitions); the agents' owners must be `partition_graph` of `graph`.
+void expect_partition_of_the_agents_graph(const std::string& coordinator_file, int domain,
+                                          bool expect_early) {
+  const std::string dir = temp_dir();
+  const std::string graph =
+      generate_graph(dir + "/graph.g2o", "--kind grid3d --poses 250 --robots 3 --seed 4");
+  generate_graph(dir + "/other.g2o", "--kind grid3d --poses 250 --robots 3 --seed 8");
+  const std::string run = "filepart-" + std::to_string(getpid()) + "-" + std::to_string(domain);
+  const std::vector<std::string> cargs = {"--timeout",        "20",
+                                          "--run-timeout",    "60",
+                                          "--summary",        dir + "/summary.json",
+                                          "--init",           "file",
+                                          "--partition",      "highest",
+                                          "--partition-seed", "2",
+                                          "--graph",          dir + "/" + coordinator_file,
+                                          "--verbose"};
+  run_to_the_end(dir, graph, 3, run, domain, cargs, 90);
+  PartitionOptions popt;
+  popt.parts = 3;
+  popt.preset = parse_preset("highest");
+  popt.seed = 2;
+  const std::vector<int> part =
+      partition_graph(graph_structure_from_pose_graph(read_g2o(graph)), popt).assignment;
+  EXPECT_EQ(assignment_of(dir, 3), part) << "not the partition of the agents' graph";
+  const std::string summary = slurp(dir + "/summary.json");
+  EXPECT_NE(summary.find(std::string("\"partition_early\": ") + (expect_early ? "true" : "false")),
+            std::string::npos)
+      << summary;
+  const std::string log = slurp(dir + "/coordinator.log");
+  EXPECT_EQ(log.find("partitioning the announced") != std::string::npos, !expect_early) << log;
+}
+
+TEST(DdsFilePartition, CoordinatorWithTheAgentsFileUsesItsEarlyPartition) {
+  expect_partition_of_the_agents_graph("graph.g2o", 54, true);
+}
+
+TEST(DdsFilePartition, CoordinatorWithAnotherFilePartitionsTheAnnouncements) {
+  expect_partition_of_the_agents_graph("other.g2o", 55, false);
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
