@@ -59,7 +59,8 @@ const char* fork_role_name(ForkRole role);
 
 /// Called in a freshly forked child (exec'ed by launch or forked by the fork server, so both
 /// paths give a child the same process): its own process group (a terminal's Ctrl-C reaches
-/// launch only, which decides how to stop the run), default SIGINT / SIGTERM, stdout to
+/// launch only, which decides how to stop the run; the coordinator's is in a session of its
+/// own, i.e. its own autogroup for the scheduler), default SIGINT / SIGTERM, stdout to
 /// `child.stdout_fd` (or the log) and stderr to `child.log`, created or truncated.
 void enter_child_process(const ForkChild& child);
 

@@ -16,7 +16,10 @@ difference, wall times and their ratio (target <= 1.5), median ms per round of t
 and where the DDS run's wall time went (the coordinator's timeline: start = launch to the
 coordinator's session, discovery, partition, ready = assignment + barrier, handoff = to the first
 round status, rounds, rounding = to the final estimates, merge, summary = to launch printing the
-summary; then teardown = summary to launch's exit, not in the ratio). The DDS wall time is the
+summary; then teardown = summary to launch's exit, not in the ratio; phases in the order their
+ends came: when the coordinator partitions launch's file while the agents start, fork = launch
+to the partition's start comes first and discovery, after the partition, is only the wait the
+partition did not hide). The DDS wall time is the
 issue's "from launch to summary": launch prints the summary as soon as the coordinator has written
 it, and the processes leave after that (FINISHED, participant deletion; CSV: wall_dds_to_exit_s).
 Also printed (and in the CSV): CPU seconds (user + system over all processes of each run) and the
@@ -134,9 +137,10 @@ def run_dds(tessera, graph, agents, domain, tmp, limit, extra=()):
 # that start on CLOCK_MONOTONIC, which time.monotonic() also reads): seconds per phase.
 # Each phase ends at its mark; phases are taken in the order of their marks' times. With the
 # graph file (launch's default) the coordinator partitions while the agents start:
-# session -> partition_start ("read" the file) -> partitioned -> announced ("discovery" is
-# then only what the agents' announcements took beyond the partition).
-PHASES = [("start", "session"), ("read", "partition_start"), ("discovery", "announced"),
+# fork = launch to the coordinator's partition start (fork server, coordinator's main), start =
+# to its participant, partition = to the partition's end, discovery = what the agents'
+# announcements took beyond the partition (0 when they were all in by then).
+PHASES = [("start", "session"), ("fork", "partition_start"), ("discovery", "announced"),
           ("partition", "partitioned"), ("ready", "ready"), ("handoff", "first_status"),
           ("rounds", "last_status"), ("rounding", "finals"), ("merge", "merged")]
 
