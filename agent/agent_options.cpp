@@ -35,6 +35,8 @@ options:
                      discovered (a stalled Fast DDS 2.9 handshake) makes this agent re-create
                      its participant before it announces itself (default 4)
   --handshake-retries K  at most K such re-creations, 0..10 (default 3)
+  --handshake-force-once  (a test hook) with --security: re-create the participant once at
+                     the first handshake not finished yet, without using up a retry
   --verbose          print each phase
   --help             this text
 
@@ -50,7 +52,7 @@ AgentOptions parse_agent_options(const std::vector<std::string>& argv) {
                                                  "dump-local", "checkpoint-dir", "checkpoint-every",
                                                  "handshake-stall", "handshake-retries"},
                                                 cli::SessionArgsFor::kProcess),
-                      {"verbose", "help", "udp-only"});
+                      {"verbose", "help", "udp-only", "handshake-force-once"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   AgentOptions a;
@@ -79,6 +81,7 @@ AgentOptions parse_agent_options(const std::vector<std::string>& argv) {
   const long retries = args.get_long("handshake-retries", a.handshake_retries);
   if (retries < 0 || retries > 10) throw InputError("option --handshake-retries: must be 0..10");
   a.handshake_retries = static_cast<int>(retries);
+  a.handshake_force_once = args.has("handshake-force-once");
   a.verbose = args.has("verbose");
   return a;
 }

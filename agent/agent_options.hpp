@@ -28,6 +28,9 @@ struct AgentOptions {
   /// (transport/peer_gate.hpp), > 0 s.
   double handshake_stall_s = 4;
   int handshake_retries = 3;  ///< --handshake-retries: at most this many re-creations, 0..10.
+  /// --handshake-force-once (a test hook): re-create once at the first unfinished handshake,
+  /// outside the handshake_retries budget (PeerGateOptions::force_one_reopen).
+  bool handshake_force_once = false;
   bool verbose = false;
 };
 

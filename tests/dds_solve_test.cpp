@@ -161,11 +161,14 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
   } cleanup{run_id};
   // 2000 poses: enough rounds (until the stalled rule stops it) that the run is still going
   // when the agent is looked up after round 2 (with 600 poses it could already have finished).
-  Process launch = start(
-      {bin("tessera"), "launch",   "--agents",    "3",      "--poses",   "2000",       "--domain",
-       "166",          "--run-id", run_id,        "--init", "file",      "--grad-tol", "1e-12",
-       "--max-rounds", "100000",   "--partition", "fast",   "--timeout", "60"},
-      dir + "/launch.log");
+  // Lease 3 s: under ctest -j2 (load ~20) the survivors' 1 s leases of each other lapsed
+  // falsely before agent 1's expired ("lost agent 2", "lost the coordinator"), so nobody named
+  // agent 1; only the killed agent's 3 s lease expires.
+  Process launch = start({bin("tessera"), "launch", "--agents",     "3",      "--poses",     "2000",
+                          "--domain",     "166",    "--run-id",     run_id,   "--init",      "file",
+                          "--grad-tol",   "1e-12",  "--max-rounds", "100000", "--partition", "fast",
+                          "--timeout",    "60",     "--lease",      "3"},
+                         dir + "/launch.log");
   const auto until = Clock::now() + std::chrono::seconds(20);
   while (launch.output().find("round 2:") == std::string::npos && Clock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));

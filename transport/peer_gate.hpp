@@ -28,10 +28,15 @@ namespace tessera::transport {
 class Session;
 
 struct PeerGateOptions {
-  double timeout_s = 10;         ///< Bound on the whole gate (the agent's --timeout), > 0.
-  double stall_after_s = 4;      ///< A handshake unfinished this long is stalled, > 0. Normal
-                                 ///< handshakes take < 1 s (a few under heavy load).
-  int max_reopens = 3;           ///< Re-creations for stalled handshakes, >= 0.
+  double timeout_s = 10;     ///< Bound on the whole gate (the agent's --timeout), > 0.
+  double stall_after_s = 4;  ///< A handshake unfinished this long is stalled, > 0. Normal
+                             ///< handshakes take < 1 s (a few under heavy load).
+  int max_reopens = 3;       ///< Re-creations for stalled handshakes, >= 0.
+  /// Test hook: re-create once as soon as a peer whose handshake this agent would cure is
+  /// discovered but not authenticated (as if that handshake had stalled at once). Not counted
+  /// in max_reopens, so a real stall after it is still cured (a stall bound of 1 ms used to
+  /// force this left a real stall that followed nothing to cure it with).
+  bool force_one_reopen = false;
   double retire_notice_s = 0.5;  ///< How long a participant announces that it retires before
                                  ///< it is deleted (Session::replace_participant), >= 0.
   /// Throws InputError naming the bad field.
@@ -58,6 +63,7 @@ struct PeerGateResult {
   WaitStatus status = WaitStatus::kTimeout;  ///< kReady: passed; kStopped: the run stops.
   int udp_reopens = 0;                       ///< 0 or 1.
   int stall_reopens = 0;
+  int forced_reopens = 0;           ///< 0 or 1 (PeerGateOptions::force_one_reopen).
   std::string missing;              ///< On kTimeout: what was still missing.
   std::vector<std::string> events;  ///< One line per re-creation (for the agent's log).
 };
@@ -66,7 +72,9 @@ struct PeerGateResult {
 /// Judges again as soon as anything about the peers changes (discovery, loss, authentication,
 /// endpoint match: Mailroom::notify_state_changed) and at least every 0.2 s, or every
 /// stall_after_s / 2 when that is shorter (at least 1 ms; the stall bound is a duration, not an
-/// event); a stop of the run ends it at once. `on_poll` (optional) runs before every look; what
+/// event); a stop of the run ends it at once. With force_one_reopen (secured runs only) the
+/// first look at an unauthenticated peer it would cure re-creates once, then stalls are judged
+/// with stall_after_s and max_reopens as usual. `on_poll` (optional) runs before every look; what
 /// it throws ends the gate.
 PeerGateResult pass_peer_gate(Session& session, const PeerGateOptions& options,
                               const std::function<void()>& on_poll = {});
