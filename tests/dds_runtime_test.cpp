@@ -229,12 +229,14 @@ TEST(DdsRuntime, KilledAgentIsNamedAndEveryoneStopsNonZero) {
   const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 3));
   const auto before = shm_files();
   // The coordinator waits for a 4th agent that never comes, so the others are mid-run
-  // (waiting) when agent 1 is killed.
-  Process coord =
-      start(coordinator_args(4, run, domain, {"--timeout", "30"}), dir + "/coordinator.log");
+  // (waiting) when agent 1 is killed. Lease 2 s: under ctest -j2 a survivor's 1 s lease can
+  // lapse falsely first, and then the others name it instead of agent 1 (seen in CI in the
+  // launch version of this test, DdsLaunch.AgentKilledDuringTheRoundsIsNamedByEveryone).
+  const std::vector<std::string> session = {"--timeout", "30", "--lease", "2"};
+  Process coord = start(coordinator_args(4, run, domain, session), dir + "/coordinator.log");
   std::vector<Process> agents;
   for (int k = 0; k < 3; ++k)
-    agents.push_back(start(agent_args(graph, 4, k, run, domain, {"--timeout", "30"}),
+    agents.push_back(start(agent_args(graph, 4, k, run, domain, session),
                            dir + "/agent" + std::to_string(k) + ".log"));
   std::this_thread::sleep_for(std::chrono::milliseconds(2000));
   for (Process* p : {&coord, &agents[0], &agents[1], &agents[2]}) {
