@@ -22,6 +22,7 @@
 #include "coordinator/run_structure.hpp"
 #include "coordinator/run_summary.hpp"
 #include "json_writer.hpp"
+#include "transport/run_failure.hpp"
 
 namespace tessera::coordinator {
 
@@ -44,6 +45,11 @@ void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timel
   if (file_job) {
     std::string why;
     std::chrono::steady_clock::time_point started, ended;
+    // A stop meanwhile (signal, an agent's ABORT) ends the run now, not after the partition.
+    while (!file_job->ready(std::chrono::milliseconds(50)))
+      if (s.mailroom().stopped())
+        expect_ready(WaitStatus::kStopped, s.mailroom(), o.net.timeout_s,
+                     "the partition of " + o.graph);
     early = file_job->take(&why, &started, &ended);
     timeline.mark_at("partition_start", started);
     if (early) {

@@ -70,6 +70,11 @@ FilePartitionJob::FilePartitionJob(std::string path, std::uint32_t num_agents, s
   }).detach();
 }
 
+bool FilePartitionJob::ready(std::chrono::milliseconds wait) const {
+  std::unique_lock<std::mutex> lock(state_->mutex);
+  return state_->done_cv.wait_for(lock, wait, [&] { return state_->done; });
+}
+
 std::optional<FilePartition> FilePartitionJob::take(std::string* why,
                                                     std::chrono::steady_clock::time_point* started,
                                                     std::chrono::steady_clock::time_point* ended) {

@@ -50,6 +50,8 @@ class FilePartitionJob {
  public:
   FilePartitionJob(std::string path, std::uint32_t num_agents, std::string preset,
                    std::uint64_t seed);
+  /// True once the result is there; waits at most `wait` for it.
+  bool ready(std::chrono::milliseconds wait) const;
   /// Waits for the result (local work with no timeout, like the partition of the
   /// announcements) and hands it over; call once. `started` / `ended`: when the thread began
   /// and finished (for the run's timeline).
