@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "partition/island_search.hpp"
 #include "partition/multilevel.hpp"
 #include "partition/relaxed_polish.hpp"
 #include "partition/spectral_layouts.hpp"
@@ -51,6 +52,10 @@ struct EvolutionParams {
   /// seeded from a copy of the search's, so the spectral layouts after it see the same random
   /// stream as without it.
   RelaxedPolishOptions polish;
+  /// Populations searched concurrently (island_search.hpp), each with all of the above budget;
+  /// the polish and the spectral layouts then start from the best island's best. The default
+  /// (1 island) is the single search on the calling thread.
+  IslandOptions islands;
   /// Spectral layouts (spectral_layouts.hpp): after the search, the best this many refined
   /// global layouts read off the Laplacian embedding are each combined with the search's best
   /// partition, which they replace when better (the search before is unchanged). 0 = off.
@@ -68,7 +73,8 @@ struct EvolutionParams {
 /// Called after each phase with (phase name, detail, best cut so far).
 using EvolutionTrace = std::function<void(const std::string&, const std::string&, long long)>;
 
-/// Returns the best partition found.
+/// Returns the best partition found. With params.islands.islands > 1 the islands run on their
+/// own threads; the result still depends only on the inputs and the generator's state.
 std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>& ub,
                         const EvolutionParams& params, Rng& rng, const EvolutionTrace& trace);
 

@@ -165,6 +165,16 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // search has few steps (session 7: rim/grid3D/city10000 N = 25 1167/2427/519 ->
         // 1155/2403/502).
         plan.evolution.polish.rounds = strong ? 0 : 4;
+        // highest: two islands (island_search.hpp), each with all of the budget above on its
+        // own thread. One search settles into one global arrangement (rim: 258 or 243 by
+        // seed); two independent ones reach the better one more often for the same wall time
+        // on two cores. A fixed count, not the machine's core count, so that a seed gives the
+        // same partition everywhere. No exchanges: with the best individuals exchanged every
+        // quarter of the budget the islands fell into one arrangement early (session 8, rim
+        // seeds 1-4 258/264/243/262, torus3D 242/240/244/245 instead of 258/266/243/243 and
+        // 242/240/242/246 for one island; docs/partitioning.md).
+        plan.evolution.islands.islands = strong ? 1 : 2;
+        plan.evolution.islands.exchange_every = 0;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
         // bound on every level the coarse searches rarely reach such shapes (session 4, seeds
@@ -223,6 +233,8 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_POLMIN")) plan.evolution.polish.min_relax = std::atof(env("T_POLMIN"));
   if (env("T_POLMAX")) plan.evolution.polish.max_relax = std::atof(env("T_POLMAX"));
   if (env("T_MFLEV")) plan.evolution.matching_flow_levels = std::atoi(env("T_MFLEV"));
+  if (env("T_ISL")) plan.evolution.islands.islands = std::atoi(env("T_ISL"));
+  if (env("T_XCH")) plan.evolution.islands.exchange_every = std::atoi(env("T_XCH"));
   if (env("T_OPS"))
     plan.evolution.generations =
         static_cast<int>(plan.evolution.generations * std::atof(env("T_OPS")));
