@@ -110,6 +110,27 @@ TEST(IslandSearch, HighestPresetIsDeterministicAndTracesBothIslands) {
   EXPECT_TRUE(traced) << "highest must run two islands";
 }
 
+// PartitionOptions::islands overrides the preset's count (one island: the single search, no
+// island in the trace); out of range it is refused naming the field.
+TEST(IslandSearch, PartitionOptionsChooseTheIslandCount) {
+  const GraphStructure structure = grid_with_chords(24, 16, 7);
+  PartitionOptions o;
+  o.parts = 4;
+  o.preset = PartitionPreset::kHighest;
+  o.seed = 3;
+  o.islands = 1;
+  const PartitionResult one = partition_graph(structure, o);
+  for (const auto& t : one.trace)
+    EXPECT_EQ(t.detail.find("island"), std::string::npos) << t.name << ": " << t.detail;
+  o.islands = 9;
+  try {
+    partition_graph(structure, o);
+    ADD_FAILURE() << "islands = 9 must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("PartitionOptions.islands"), std::string::npos);
+  }
+}
+
 TEST(IslandSearch, BadOptionsNameTheField) {
   auto message = [](const EvolutionParams& p) {
     try {

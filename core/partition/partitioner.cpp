@@ -43,6 +43,9 @@ void PartitionOptions::validate() const {
     throw InputError("PartitionOptions.parts = " + std::to_string(parts) + ": must be in 1..64");
   if (!std::isfinite(eps) || eps < 0.0 || eps > 1.0)
     throw InputError("PartitionOptions.eps = " + std::to_string(eps) + ": must be in 0..1");
+  if (islands < 0 || islands > 8)
+    throw InputError("PartitionOptions.islands = " + std::to_string(islands) +
+                     ": must be in 0..8 (0 = the preset's own)");
 }
 
 namespace {
@@ -276,7 +279,8 @@ PartitionResult partition_graph(const GraphStructure& graph, const PartitionOpti
   const WorkGraph g = to_work_graph(graph);
   const long long lmax = static_cast<long long>(result.max_block_size);
   const std::vector<long long> ub(static_cast<std::size_t>(k), lmax);
-  const PresetPlan plan = preset_plan(options.preset, g, k, lmax);
+  PresetPlan plan = preset_plan(options.preset, g, k, lmax);
+  if (options.islands > 0) plan.evolution.islands.islands = options.islands;
   const CycleParams& cp = plan.cycle;
   Rng rng(options.seed);
   std::vector<int> part;

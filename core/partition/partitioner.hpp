@@ -35,9 +35,15 @@ struct PartitionOptions {
   /// Range 0..1; default 0.03 (KaHIP's default and the reference paper's setting).
   double eps = 0.03;
   std::uint64_t seed = 1;  ///< Same seed, same graph, same preset => same partition.
+  /// Search islands of strong / highest, each a whole search on its own thread
+  /// (docs/partitioning.md item 10): 0 = the preset's own (highest 2, strong 1); else 1..8.
+  /// Each island costs a full search's CPU time, so a caller that shares the cores with other
+  /// work (e.g. agents starting up) may want 1. The partition depends on this value and the
+  /// seed, never on the machine's core count.
+  int islands = 0;
 
   /// Throws InputError naming the bad field (parts outside 1..64, eps negative, above 1 or not
-  /// finite).
+  /// finite, islands outside 0..8).
   void validate() const;
 };
 
