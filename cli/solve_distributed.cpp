@@ -16,13 +16,36 @@
 
 namespace tessera::cli {
 
-const char* const kDistributedValued[] = {
-    "agents",        "partition",        "max-rounds",       "seed",         "reference-cost",
-    "select",        "rel-tol",          "tr-steps",         "restart-c",    "sigma",
-    "unselected",    "irbcd-n",          "tcg-iters",        "robots",       "certify-grad-tol",
-    "certify-iters", "certify-residual", "certify-precon",   "block-precon", "tangent-refresh",
-    "tcg-kappa",     "sigma-shrink",     "sigma-saturation", "sigma-theta",  "sigma-min",
-    "sigma-max",     "irbcd-a0",         "tangent-radius",   nullptr};
+const char* const kDistributedValued[] = {"agents",
+                                          "partition",
+                                          "max-rounds",
+                                          "seed",
+                                          "reference-cost",
+                                          "select",
+                                          "rel-tol",
+                                          "tr-steps",
+                                          "restart-c",
+                                          "sigma",
+                                          "unselected",
+                                          "irbcd-n",
+                                          "tcg-iters",
+                                          "robots",
+                                          "certify-grad-tol",
+                                          "certify-iters",
+                                          "certify-residual",
+                                          "certify-precon",
+                                          "block-precon",
+                                          "tangent-refresh",
+                                          "tcg-kappa",
+                                          "sigma-shrink",
+                                          "sigma-saturation",
+                                          "sigma-theta",
+                                          "sigma-min",
+                                          "sigma-max",
+                                          "irbcd-a0",
+                                          "tangent-radius",
+                                          "irbcd-class-score",
+                                          nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
                                             "irbcd-keep-ab", nullptr};
@@ -63,6 +86,9 @@ const char* kDistributedHelp =
     "  --sigma-shrink F, --sigma-saturation S, --sigma-theta T, --sigma-min A, --sigma-max B\n"
     "                            adaptive sigma's constants (IrbcdOptions)\n"
     "  --irbcd-a0 A              IRBCD: initial a (default 1; <= 0: 1/n, the paper's)\n"
+    "  --irbcd-class-score norm|max   IRBCD, parallel greedy rounds: the colour class with the\n"
+    "                            largest class gradient norm, or the class of the largest\n"
+    "                            block gradient (RBCD++'s rule) (default: max)\n"
     "  --irbcd-keep-ab           IRBCD: keep a, b running after a restart (the default)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
     "  --irbcd-n units|variables IRBCD: n = selectable blocks (default) or scalar variables\n"
@@ -144,6 +170,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   }
   opt.irbcd.sigma = a.get_double("sigma", opt.irbcd.sigma);
   opt.irbcd.a0 = a.get_double("irbcd-a0", opt.irbcd.a0);
+  if (a.has("irbcd-class-score"))
+    opt.irbcd.class_score = parse_class_score(a.get_or("irbcd-class-score", ""));
   if (a.has("irbcd-keep-ab")) opt.irbcd.reset_on_restart = false;
   if (a.has("sigma-adapt")) opt.irbcd.adaptive_sigma = true;
   if (a.has("sigma-fixed")) opt.irbcd.adaptive_sigma = false;

@@ -325,6 +325,9 @@ TEST(Irbcd, BadOptionsNameTheField) {
   bad = {};
   bad.sigma_max = 1e-9;  // below sigma_min
   names(bad, "sigma_max");
+  bad = {};
+  bad.class_score = static_cast<ClassScore>(7);  // not an enumerator
+  names(bad, "class_score");
 }
 
 }  // namespace

@@ -211,6 +211,47 @@ TEST(DistributedSolver, GreedyNewtonScoreIsThePreconditionedGradientNorm) {
             std::vector<int>{0});
 }
 
+TEST(DistributedSolver, ClassNormScoresAColourClassByItsOwnGradientNorm) {
+  BlockLayout layout;
+  layout.num_blocks = 5;
+  layout.colour = {0, 1, 0, 1, 2};
+  layout.colour_classes = {{0, 2}, {1, 3}, {4}};
+  // Block 1 has the largest norm (class {1, 3}: 4 + 0.25 = 4.25 squared); class {0, 2} has
+  // the largest class norm (1 + 3.61 = 4.61 squared).
+  const std::vector<double> norms = {1.0, 2.0, 1.9, 0.5, 1.5};
+  EXPECT_EQ(select_blocks(SelectionRule::kGreedy, true, 1, 0, norms, layout),
+            (std::vector<int>{1, 3}));
+  EXPECT_EQ(
+      select_blocks(SelectionRule::kGreedy, true, 1, 0, norms, layout, ClassScore::kLargestBlock),
+      (std::vector<int>{1, 3}));
+  EXPECT_EQ(
+      select_blocks(SelectionRule::kGreedy, true, 1, 0, norms, layout, ClassScore::kClassNorm),
+      (std::vector<int>{0, 2}));
+  EXPECT_EQ(select_blocks(SelectionRule::kGreedyNewton, true, 1, 0, norms, layout,
+                          ClassScore::kClassNorm),
+            (std::vector<int>{0, 2}));
+  // The largest block (4: 1.96) loses to a class of two smaller ones (2).
+  EXPECT_EQ(select_blocks(SelectionRule::kGreedy, true, 1, 0, {1.0, 0.1, 1.0, 0.1, 1.4}, layout,
+                          ClassScore::kClassNorm),
+            (std::vector<int>{0, 2}));
+  EXPECT_EQ(select_blocks(SelectionRule::kGreedy, true, 1, 0, {1.0, 0.1, 1.0, 0.1, 1.4}, layout,
+                          ClassScore::kLargestBlock),
+            (std::vector<int>{4}));
+  // One block per round, and the non-greedy rules: the class score plays no part.
+  EXPECT_EQ(
+      select_blocks(SelectionRule::kGreedy, false, 1, 0, norms, layout, ClassScore::kClassNorm),
+      std::vector<int>{1});
+  EXPECT_EQ(
+      select_blocks(SelectionRule::kRoundRobin, true, 1, 4, norms, layout, ClassScore::kClassNorm),
+      layout.colour_classes[1]);
+  EXPECT_EQ(parse_class_score(class_score_name(ClassScore::kClassNorm)), ClassScore::kClassNorm);
+  EXPECT_EQ(parse_class_score(class_score_name(ClassScore::kLargestBlock)),
+            ClassScore::kLargestBlock);
+  EXPECT_EQ(parse_class_score("norm"), ClassScore::kClassNorm);
+  EXPECT_EQ(parse_class_score("max"), ClassScore::kLargestBlock);
+  EXPECT_THROW(parse_class_score("sum"), InputError);
+}
+
 TEST(DistributedSolver, GreedyNewtonSelectionReachesTheOptimum) {
   const PoseGraph g = small_graph(3, 60, 29);
   DistributedOptions opt;

@@ -27,6 +27,16 @@ SelectionRule parse_selection(const std::string& name) {
                    "' is not one of uniform, greedy, round_robin, greedy_newton");
 }
 
+const char* class_score_name(ClassScore score) {
+  return score == ClassScore::kClassNorm ? "class_norm" : "largest_block";
+}
+
+ClassScore parse_class_score(const std::string& name) {
+  if (name == "class_norm" || name == "norm") return ClassScore::kClassNorm;
+  if (name == "largest_block" || name == "max") return ClassScore::kLargestBlock;
+  throw InputError("class score '" + name + "' is not one of class_norm, largest_block");
+}
+
 namespace {
 
 // splitmix64: a well-mixed hash of (seed, round), the same on every platform.
@@ -45,7 +55,7 @@ int selection_units(bool parallel, const BlockLayout& layout) {
 
 std::vector<int> select_blocks(SelectionRule rule, bool parallel, std::uint64_t seed,
                                std::uint64_t round, const std::vector<double>& block_grad_norms,
-                               const BlockLayout& layout) {
+                               const BlockLayout& layout, ClassScore class_score) {
   const int units = selection_units(parallel, layout);
   int unit = 0;
   switch (rule) {
@@ -59,6 +69,20 @@ std::vector<int> select_blocks(SelectionRule rule, bool parallel, std::uint64_t 
       break;
     case SelectionRule::kGreedy:
     case SelectionRule::kGreedyNewton: {
+      if (parallel && class_score == ClassScore::kClassNorm) {
+        // A parallel round's unit is the colour class, so its Gauss-Southwell score is the
+        // class's own gradient norm (squared: the sum over its blocks), not its largest block.
+        double best_sq = -1.0;
+        for (std::size_t c = 0; c < layout.colour_classes.size(); ++c) {
+          double sq = 0.0;
+          for (int b : layout.colour_classes[c]) {
+            const double g = block_grad_norms[static_cast<std::size_t>(b)];
+            sq += g * g;
+          }
+          if (sq > best_sq) best_sq = sq, unit = static_cast<int>(c);
+        }
+        break;
+      }
       int best = 0;
       for (int b = 1; b < layout.num_blocks; ++b)
         if (block_grad_norms[static_cast<std::size_t>(b)] >

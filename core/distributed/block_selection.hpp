@@ -29,12 +29,26 @@ const char* selection_name(SelectionRule rule);
 /// Inverse of selection_name; throws InputError listing the valid names.
 SelectionRule parse_selection(const std::string& name);
 
+/// How greedy selection scores a colour class (parallel rounds; one block per round is the same
+/// either way).
+enum class ClassScore {
+  kLargestBlock,  ///< The class of the block with the largest score (RBCD's and RBCD++'s greedy).
+  kClassNorm      ///< The class with the largest sqrt(sum of its blocks' squared scores).
+};
+
+/// "largest_block", "class_norm".
+const char* class_score_name(ClassScore score);
+/// Inverse of class_score_name (also "max" and "norm"); throws InputError listing the valid names.
+ClassScore parse_class_score(const std::string& name);
+
 /// The blocks updated in `round` (ascending ids). `block_grad_norms` has one entry per block,
 /// in block-id order: each block's selection score (its gradient norm, or for greedy_newton its
-/// preconditioned gradient norm).
+/// preconditioned gradient norm). `class_score` matters only for greedy rules with `parallel`;
+/// ties go to the lowest block id / class index.
 std::vector<int> select_blocks(SelectionRule rule, bool parallel, std::uint64_t seed,
                                std::uint64_t round, const std::vector<double>& block_grad_norms,
-                               const BlockLayout& layout);
+                               const BlockLayout& layout,
+                               ClassScore class_score = ClassScore::kLargestBlock);
 
 /// Number of selectable units: N blocks, or the number of colour classes with `parallel`.
 int selection_units(bool parallel, const BlockLayout& layout);

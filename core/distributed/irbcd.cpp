@@ -25,6 +25,8 @@ void IrbcdOptions::validate() const {
     throw InputError("IrbcdOptions.sigma_min must be finite and >= 0");
   if (!(sigma_max >= sigma_min && std::isfinite(sigma_max)))
     throw InputError("IrbcdOptions.sigma_max must be finite and >= sigma_min");
+  if (class_score != ClassScore::kLargestBlock && class_score != ClassScore::kClassNorm)
+    throw InputError("IrbcdOptions.class_score must be largest_block or class_norm");
 }
 
 const char* dimension_name(IrbcdDimension d) {

@@ -48,6 +48,13 @@ struct IrbcdOptions {
   /// 1424/1578, ais2klinik 842/919, manhattan3500 172/181, garage 25/25, cubicle 173/166
   /// (docs/irbcd.md section 13).
   bool reset_on_restart = false;
+  /// Greedy selection with parallel rounds: the colour class with the largest class gradient
+  /// norm sqrt(sum_{B in class} ||grad_B f||^2) (kClassNorm), or the class of the block with the
+  /// largest ||grad_B f|| (kLargestBlock, RBCD's and RBCD++'s rule). n counts colour classes,
+  /// so the class is the coordinate unit of the recurrences and its own gradient norm is its
+  /// Gauss-Southwell score. No message change: every agent already has every block's norm.
+  /// One block per round: both are the same rule. docs/irbcd.md section 20.
+  ClassScore class_score = ClassScore::kLargestBlock;
 
   /// Adaptive sigma (ours, not the paper's; docs/irbcd.md section 13). sigma is the
   /// strong-convexity estimate of Nesterov's ACDM, whose gamma settles at 1/sqrt(sigma). Two
@@ -100,6 +107,7 @@ class IrbcdScheme : public MomentumScheme {
     return options_.unselected_take_extrapolation;
   }
   double restart_constant() const override { return options_.restart_c; }
+  ClassScore class_score() const override { return options_.class_score; }
   std::vector<double> save() const override;
   void load(const std::vector<double>& state) override;
   double a() const { return a_; }

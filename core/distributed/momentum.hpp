@@ -13,6 +13,7 @@
 #include <memory>
 #include <vector>
 
+#include "distributed/block_selection.hpp"
 #include "manifold/lifted_manifold.hpp"
 
 namespace tessera {
@@ -37,6 +38,9 @@ class MomentumScheme {
   virtual bool unselected_take_extrapolation() const = 0;
   /// Restart constant c (< 0: never restart).
   virtual double restart_constant() const = 0;
+  /// How greedy selection scores a colour class in parallel rounds (block_selection.hpp).
+  /// RBCD++ keeps the shared rule; IRBCD makes it an option (IrbcdOptions::class_score).
+  virtual ClassScore class_score() const { return ClassScore::kLargestBlock; }
   /// The scalar recurrences' current values (for checkpoints), and restoring them: after
   /// load(save()) the scheme produces the same coefficients as the one saved.
   virtual std::vector<double> save() const = 0;

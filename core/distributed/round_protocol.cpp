@@ -275,7 +275,8 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   f_prev_ = f;
   gsq_prev_ = gsq;
   selection_ = select_blocks(config_.selection, config_.parallel, config_.seed,
-                             static_cast<std::uint64_t>(round_), norms, layout_);
+                             static_cast<std::uint64_t>(round_), norms, layout_,
+                             scheme_ ? scheme_->class_score() : ClassScore::kLargestBlock);
   rec.selected = selection_;
   trace_.push_back(rec);
   state_.Y_prev = state_.Y;
