@@ -28,6 +28,20 @@ std::optional<wire::PartitionAssignment> take_reassignment(transport::Session& s
 }
 
 std::optional<ProtocolMessage> DdsProtocolChannel::receive(double timeout_s) {
+  return receive_after(timeout_s, 1);
+}
+
+std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_s,
+                                                                 std::size_t wake_after) {
+  // Back to a wake-up per message however this wait ends: the threshold is this step's only.
+  struct ThresholdGuard {
+    transport::Session& session;
+    bool set;
+    ~ThresholdGuard() {
+      if (set) session.set_protocol_wake_threshold(1);
+    }
+  } guard{session_, wake_after > 1};
+  if (guard.set) session_.set_protocol_wake_threshold(wake_after);
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(
                                              std::chrono::duration<double>(timeout_s));

@@ -17,6 +17,9 @@ class DdsProtocolChannel : public ProtocolChannel {
   explicit DdsProtocolChannel(transport::Session& session) : session_(session) {}
   void send(const OutgoingMessage& message) override;
   std::optional<ProtocolMessage> receive(double timeout_s) override;
+  /// The listener wakes this thread only once `wake_after` protocol messages are queued
+  /// (Session::set_protocol_wake_threshold); rollbacks, re-partitions and stops as receive().
+  std::optional<ProtocolMessage> receive_after(double timeout_s, std::size_t wake_after) override;
   /// Messages for which `f` returns true are consumed by it instead of being returned
   /// (lifted-pose replicas of other agents).
   void set_intercept(std::function<bool(const ProtocolMessage&)> f) { intercept_ = std::move(f); }

@@ -34,6 +34,11 @@ DistributedOptions options_of(const RunOptions& o) {
 
 }  // namespace
 
+std::optional<ProtocolMessage> ProtocolChannel::receive_after(double timeout_s,
+                                                              std::size_t /*wake_after*/) {
+  return receive(timeout_s);
+}
+
 RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
                                double receive_timeout_s, const RoundLoopHooks& hooks) {
   const DistributedOptions options = options_of(local.options);

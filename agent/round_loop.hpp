@@ -100,6 +100,12 @@ class ProtocolChannel {
   /// a block and a status from one sender may arrive in either order), or nullopt when
   /// none arrived within `timeout_s`. Throws RunStopped when the run is stopping.
   virtual std::optional<ProtocolMessage> receive(double timeout_s) = 0;
+  /// receive() for a caller whose protocol step still needs `wake_after` messages (a lower
+  /// bound, AgentProcess::messages_needed()): the channel may sleep until that many have
+  /// arrived instead of waking for each one. Anything else that needs the caller (a stop, a
+  /// rollback, a re-partition) and the timeout still end the wait at once.
+  /// The default is receive(timeout_s).
+  virtual std::optional<ProtocolMessage> receive_after(double timeout_s, std::size_t wake_after);
 };
 
 struct RoundLoopResult {

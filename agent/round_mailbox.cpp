@@ -31,9 +31,11 @@ void Mailbox::send_all(const std::vector<OutgoingMessage>& out) {
   sent_since_gather_ = true;
 }
 
-std::optional<ProtocolMessage> Mailbox::receive() {
+std::optional<ProtocolMessage> Mailbox::receive(std::size_t wake_after) {
   const auto t0 = std::chrono::steady_clock::now();
-  std::optional<ProtocolMessage> msg = channel_.receive(timeout_s_);
+  std::optional<ProtocolMessage> msg = wake_after > 1
+                                           ? channel_.receive_after(timeout_s_, wake_after)
+                                           : channel_.receive(timeout_s_);
   wait_s += seconds_since(t0);
   return msg;
 }

@@ -30,8 +30,8 @@ class Mailbox {
   void send_all(const std::vector<OutgoingMessage>& out);
 
   /// The next message from the channel, or nullopt after the receive timeout; the wait is
-  /// added to wait_s.
-  std::optional<ProtocolMessage> receive();
+  /// added to wait_s. `wake_after`: see ProtocolChannel::receive_after.
+  std::optional<ProtocolMessage> receive(std::size_t wake_after = 1);
 
   /// Agents in the run (for counting a broadcast's deliveries); 1 until set.
   void set_num_agents(std::uint32_t n) { num_agents_ = n; }
@@ -44,7 +44,10 @@ class Mailbox {
   void run_protocol(AgentProcess& protocol, std::vector<OutgoingMessage> first, Describe describe) {
     send_all(first);
     while (!protocol.done()) {
-      std::optional<ProtocolMessage> msg = receive();
+      // Sleep until the current step can move on, not once per arriving message: a status
+      // step needs every other agent's status, and each wake-up of this thread costs more
+      // than handling a small message (docs/dds-runtime.md, session 8).
+      std::optional<ProtocolMessage> msg = receive(protocol.messages_needed());
       if (!msg)
         throw std::runtime_error("agent " + std::to_string(self_) + ": no message for " +
                                  std::to_string(timeout_s_) + " s in " + describe());

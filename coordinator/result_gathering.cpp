@@ -26,7 +26,16 @@ void await_final_estimates(Session& s, const CoordinatorOptions& options, RoundR
     return out;
   };
   const bool watch = monitor || losses.arbitrates();
+  // Statuses come in rounds of one per active agent: wake once a round's worth is queued, not
+  // for each of them (a wake-up costs more than reading a status). Progress lines, lag and
+  // loss checks then see each round at most one round late; a silent agent still lets the
+  // nap below end the wait, and finals, rejoins and stops wake it as before.
+  struct ThresholdGuard {
+    Inbox<wire::RoundStatus>& inbox;
+    ~ThresholdGuard() { inbox.set_wake_threshold(1); }
+  } guard{s.status_watch()};
   for (;;) {
+    if (watch) s.status_watch().set_wake_threshold(losses.record().expected.size());
     const double left = options.run_timeout_s - ms_since(t_run) / 1000.0;
     std::string absent;
     // Lost peers are noticed by polling the session (a few times a second) when watching.

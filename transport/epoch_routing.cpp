@@ -38,6 +38,11 @@ void EpochRouter::set_epoch(std::uint32_t e, std::uint32_t protocol_id) {
   room_.notify();
 }
 
+void EpochRouter::set_wake_threshold(std::size_t n) {
+  std::lock_guard<std::mutex> lock(room_.mutex());
+  wake_threshold_ = n > 0 ? n : 1;
+}
+
 void EpochRouter::deliver(std::uint32_t e, std::uint32_t sender, bool broadcast,
                           const std::vector<std::uint32_t>& recipients, ProtocolMessage&& m) {
   bool wake = false;
@@ -45,7 +50,7 @@ void EpochRouter::deliver(std::uint32_t e, std::uint32_t sender, bool broadcast,
     if (e == epoch_) {
       if (sender != protocol_id_ && addressed_to(broadcast, recipients, protocol_id_)) {
         inbox_.push_locked(std::move(m));
-        wake = true;
+        wake = inbox_.queued_locked().size() >= wake_threshold_;
       }
     } else if (e > epoch_) {
       future_.push_back(Held{e, sender, broadcast, recipients, std::move(m)});

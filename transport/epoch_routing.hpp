@@ -6,6 +6,7 @@
 // (only then is it known whether it is for this agent: a re-partition for survivors
 // renumbers the protocol ids). Internal to transport/ (Session::set_epoch is the public view).
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -29,6 +30,9 @@ class EpochRouter {
   /// everyone when `broadcast`): delivered, held or dropped as above.
   void deliver(std::uint32_t epoch, std::uint32_t sender, bool broadcast,
                const std::vector<std::uint32_t>& recipients, ProtocolMessage&& message);
+  /// deliver() wakes the waiters only once the inbox holds at least `n` messages (0 counts
+  /// as 1). set_epoch() always wakes them.
+  void set_wake_threshold(std::size_t n);
 
  private:
   struct Held {
@@ -43,6 +47,7 @@ class EpochRouter {
   // Guarded by room_.mutex().
   std::uint32_t epoch_ = 0;
   std::uint32_t protocol_id_ = 0;
+  std::size_t wake_threshold_ = 1;
   std::vector<Held> future_;  // newer epochs' messages, with their routing
 };
 

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -161,13 +162,24 @@ class Inbox {
   Inbox(const Inbox&) = delete;
   Inbox& operator=(const Inbox&) = delete;
 
-  /// Appends a message and wakes waiters (called from listener threads).
+  /// Appends a message and wakes waiters (called from listener threads) once at least the
+  /// wake threshold's count is queued.
   void push(T message) {
+    bool wake;
     {
       std::lock_guard<std::mutex> lock(room_.mutex());
       queue_.push_back(std::move(message));
+      wake = queue_.size() >= wake_threshold_;
     }
-    room_.notify();
+    if (wake) room_.notify();
+  }
+  /// push() wakes the waiters only once `n` messages are queued (0 counts as 1; 1, the
+  /// default, wakes them for every message). For a reader that handles messages in batches
+  /// (the coordinator: one round's statuses) and bounds its wait by a timeout anyway; stop
+  /// requests and every other inbox still wake it at once.
+  void set_wake_threshold(std::size_t n) {
+    std::lock_guard<std::mutex> lock(room_.mutex());
+    wake_threshold_ = n > 0 ? n : 1;
   }
 
   /// Same as push() for a caller that already holds the mailroom lock (no wake-up: call
@@ -233,6 +245,7 @@ class Inbox {
  private:
   Mailroom& room_;
   std::deque<T> queue_;
+  std::size_t wake_threshold_ = 1;  // guarded by the mailroom's mutex
 };
 
 }  // namespace tessera::transport

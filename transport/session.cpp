@@ -105,6 +105,10 @@ Inbox<wire::MeasurementHandoff>& Session::replicas() {
 Inbox<ProtocolMessage>& Session::protocol() {
   return impl_->protocol_in;
 }
+
+void Session::set_protocol_wake_threshold(std::size_t n) {
+  impl_->router.set_wake_threshold(n);
+}
 Inbox<wire::RoundStatus>& Session::status_watch() {
   return impl_->status_in;
 }

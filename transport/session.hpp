@@ -72,6 +72,11 @@ class Session {
   /// Agents: pose blocks and round statuses addressed to this agent (own messages excluded),
   /// converted to core's types, in arrival order per topic.
   Inbox<ProtocolMessage>& protocol();
+  /// Agents: the listeners wake the mailroom's waiters for a protocol message only once
+  /// `n` (>= 1; 1 is the default: every message) are queued in protocol(). For a receiver that
+  /// knows how many messages its current step needs; every other wake-up (stop, rollback,
+  /// re-partition, new epoch) is unchanged. Set it back to 1 after the wait.
+  void set_protocol_wake_threshold(std::size_t n);
   Inbox<wire::RoundStatus>& status_watch();  ///< Coordinator: every round status (progress).
   Inbox<wire::FinalEstimate>& finals();      ///< Coordinator.
   Inbox<wire::Control>& rejoins();           ///< Coordinator: REJOIN requests of restarted agents.

@@ -3,6 +3,7 @@
 // machine that emits messages when started and consumes one message at a time. RoundProtocol
 // is one; the certified sequence (solve -> certify -> escape -> solve ...) is another.
 
+#include <cstddef>
 #include <vector>
 
 #include "protocol/messages.hpp"
@@ -18,6 +19,10 @@ class AgentProcess {
   virtual std::vector<OutgoingMessage> handle(const ProtocolMessage& message) = 0;
   /// True once the agent needs no further message.
   virtual bool done() const = 0;
+  /// How many more messages must arrive before handle() can move the current step on: a
+  /// lower bound (1 when the agent cannot tell, 0 once done). A driver may sleep until that
+  /// many have arrived instead of waking for each one; a wait for fewer is never wrong.
+  virtual std::size_t messages_needed() const { return done() ? 0 : 1; }
 };
 
 }  // namespace tessera

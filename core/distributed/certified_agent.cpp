@@ -132,6 +132,11 @@ void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& ou
   }
 }
 
+std::size_t CertifiedAgent::messages_needed() const {
+  if (done_) return 0;
+  return current_ ? std::max<std::size_t>(current_->messages_needed(), 1) : 1;
+}
+
 std::vector<OutgoingMessage> CertifiedAgent::handle(const ProtocolMessage& message) {
   std::vector<OutgoingMessage> out;
   if (done_) return out;

@@ -52,6 +52,8 @@ class CertifiedAgent : public AgentProcess {
   }
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
   bool done() const override { return done_; }
+  /// The running stage's count (messages of later stages are kept aside, not counted).
+  std::size_t messages_needed() const override;
 
   const std::vector<SolveStageRecord>& solves() const { return solves_; }
   const std::vector<CertifyStageRecord>& certificates() const { return certificates_; }

@@ -142,6 +142,16 @@ void RoundProtocol::expect(std::uint32_t round, ProtocolPhase phase, std::vector
   wait_senders_ = std::move(senders);
 }
 
+std::size_t RoundProtocol::messages_needed() const {
+  if (done_) return 0;
+  const auto it = pending_.find(key(wait_round_, phase_));
+  std::size_t missing = 0;
+  for (int s : wait_senders_)
+    if (it == pending_.end() || !it->second.count(s)) ++missing;
+  // pump() leaves no complete step behind, so a running protocol always waits for one.
+  return std::max<std::size_t>(missing, 1);
+}
+
 void RoundProtocol::pump(std::vector<OutgoingMessage>& out) {
   while (!done_) {
     Inbox& inbox = pending_[key(wait_round_, phase_)];
