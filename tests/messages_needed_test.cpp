@@ -1,0 +1,106 @@
+// AgentProcess::messages_needed (no DDS): the DDS agent sleeps until that many protocol
+// messages have arrived, so the count must be a lower bound -- handing an agent fewer messages
+// than it said it needs never lets it move on (no output, not done) -- and it must not be a
+// useless 1 everywhere: a status step of N agents waits for N - 1 statuses.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include "distributed/agent_factory.hpp"
+#include "distributed/agent_state.hpp"
+#include "distributed/block_layout.hpp"
+#include "distributed/round_protocol.hpp"
+#include "lifted_blocks.hpp"
+#include "problem/lifting.hpp"
+#include "random_graph.hpp"
+
+namespace tessera {
+namespace {
+
+TEST(MessagesNeeded, IsALowerBoundOnWhatEachStepWaitsFor) {
+  test::RandomGraphSpec spec;
+  spec.d = 2;
+  spec.poses = 80;
+  spec.loop_closures = 40;
+  spec.seed = 5;
+  const PoseGraph g = test::random_pose_graph(spec);
+  const int N = 4;
+  DistributedOptions opt;
+  opt.max_rounds = 30;
+  std::vector<int> assignment(g.num_poses);
+  for (std::size_t i = 0; i < g.num_poses; ++i)
+    assignment[i] = static_cast<int>(i * static_cast<std::size_t>(N) / g.num_poses);
+  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, assignment);
+  const Eigen::MatrixXd X0 = lift_poses(g.initial, opt.rank);
+  const auto scheme = make_momentum_scheme(opt, layout, static_cast<double>(X0.size()));
+  const RoundConfig config = make_round_config(opt, scheme.get());
+  std::vector<std::unique_ptr<AgentState>> states;
+  std::vector<std::unique_ptr<RoundProtocol>> agents;
+  for (int b = 0; b < N; ++b) {
+    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+    states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
+                                                  test::pose_columns(X0, g.d, ids)));
+    agents.push_back(std::make_unique<RoundProtocol>(*states.back(), layout, config));
+  }
+
+  std::vector<std::deque<ProtocolMessage>> queue(N);
+  auto post = [&](int from, const std::vector<OutgoingMessage>& out) {
+    for (const auto& m : out)
+      for (int a = 0; a < N; ++a) {
+        if (a == from) continue;
+        bool to_a = m.broadcast;
+        for (auto r : m.recipients) to_a = to_a || static_cast<int>(r) == a;
+        if (to_a) queue[static_cast<std::size_t>(a)].push_back(m.message);
+      }
+  };
+  for (int a = 0; a < N; ++a) post(a, agents[static_cast<std::size_t>(a)]->start());
+
+  // Each agent in turn takes exactly messages_needed() messages when that many are queued
+  // (as the DDS agent wakes then): the first needed - 1 of them must leave it where it was.
+  std::size_t max_needed = 0, steps = 0;
+  for (int sweep = 0; sweep < 100000; ++sweep) {
+    bool all_done = true, moved = false;
+    for (int a = 0; a < N; ++a) {
+      RoundProtocol& p = *agents[static_cast<std::size_t>(a)];
+      auto& q = queue[static_cast<std::size_t>(a)];
+      if (p.done()) continue;
+      all_done = false;
+      const std::size_t needed = p.messages_needed();
+      ASSERT_GE(needed, 1u) << "agent " << a << " runs but says it needs nothing";
+      if (q.size() < needed) continue;
+      max_needed = std::max(max_needed, needed);
+      ++steps;
+      for (std::size_t k = 0; k < needed; ++k) {
+        const ProtocolMessage m = std::move(q.front());
+        q.pop_front();
+        const int round = p.rounds();
+        const auto out = p.handle(m);
+        if (k + 1 < needed) {
+          ASSERT_TRUE(out.empty())
+              << "agent " << a << " moved on after " << k + 1 << " of " << needed << " messages";
+          ASSERT_FALSE(p.done());
+          ASSERT_EQ(p.rounds(), round);
+        }
+        post(a, out);
+      }
+      moved = true;
+    }
+    if (all_done) break;
+    ASSERT_TRUE(moved) << "no agent had the messages it said it needs: the count is too high";
+  }
+  for (int a = 0; a < N; ++a) {
+    EXPECT_TRUE(agents[static_cast<std::size_t>(a)]->done());
+    EXPECT_EQ(agents[static_cast<std::size_t>(a)]->messages_needed(), 0u);
+    EXPECT_EQ(agents[static_cast<std::size_t>(a)]->rounds(), agents[0]->rounds());
+  }
+  EXPECT_GT(agents[0]->rounds(), 2);
+  EXPECT_EQ(max_needed, static_cast<std::size_t>(N - 1));  // a status step: every other agent
+  EXPECT_GT(steps, static_cast<std::size_t>(agents[0]->rounds()));
+}
+
+}  // namespace
+}  // namespace tessera
