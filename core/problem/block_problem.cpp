@@ -36,26 +36,26 @@ BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
   std::sort(neighbors_.begin(), neighbors_.end());
   neighbors_.erase(std::unique(neighbors_.begin(), neighbors_.end()), neighbors_.end());
   for (std::size_t k = 0; k < neighbors_.size(); ++k) slot[neighbors_[k]] = owned_.size() + k;
-  edge_storage_.reserve(touching.size());
-  for (auto k : touching) edge_storage_.push_back(measurements[k]);
+  // The only copy of the measurements kept is packed_ (the cost loops read it); the data
+  // matrices are built from the caller's, which outlive this constructor.
   std::vector<const Measurement*> ptrs;
   std::vector<std::size_t> si, sj;
   ptrs.reserve(touching.size());
   si.reserve(touching.size());
   sj.reserve(touching.size());
   edges_.reserve(touching.size());
-  for (std::size_t k = 0; k < edge_storage_.size(); ++k) {
-    const Measurement& m = edge_storage_[k];
+  for (auto k : touching) {
+    const Measurement& m = measurements[k];
     ptrs.push_back(&m);
     si.push_back(slot[m.i]);
     sj.push_back(slot[m.j]);
-    edges_.push_back({k, si.back(), sj.back()});
+    edges_.push_back({si.back(), sj.back()});
   }
   // The measurements packed contiguously for the cost loops (edge_term).
   const std::size_t stride = static_cast<std::size_t>(d_ * d_ + d_ + 2);
-  packed_.resize(edge_storage_.size() * stride);
-  for (std::size_t k = 0; k < edge_storage_.size(); ++k) {
-    const Measurement& me = edge_storage_[k];
+  packed_.resize(ptrs.size() * stride);
+  for (std::size_t k = 0; k < ptrs.size(); ++k) {
+    const Measurement& me = *ptrs[k];
     if (me.R.rows() != d_ || me.R.cols() != d_ || me.t.size() != d_)
       throw std::invalid_argument("BlockProblem: measurement of the wrong dimension");
     double* out = packed_.data() + k * stride;

@@ -61,7 +61,6 @@ class BlockProblem {
 
  private:
   struct Edge {
-    std::size_t measurement;     // index into edge_storage_ (indices survive copies)
     std::size_t slot_i, slot_j;  // local slots: owned first, then neighbours
   };
   // Sum over the block's measurements of their terms at X; `share` (if not null) receives the
@@ -74,8 +73,9 @@ class BlockProblem {
   std::vector<std::size_t> owned_;
   std::vector<std::size_t> neighbors_;
   std::vector<Edge> edges_;
-  std::vector<Measurement> edge_storage_;  // copies, so the problem outlives its input
-  std::vector<double> packed_;             // per edge: R (column-major), t, kappa, tau
+  // Per edge, in edges_ order: R (column-major), t, kappa, tau. The problem's only copy of
+  // its measurements (so it outlives its input): the cost loops read them contiguously.
+  std::vector<double> packed_;
   SparseMatrix Q_bb_;
   SparseMatrix Q_nb_;  // (d+1)k x (d+1)m
   Eigen::MatrixXd X_n_;
