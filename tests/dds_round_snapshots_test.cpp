@@ -1,7 +1,7 @@
 // When an agent takes round snapshots (agent/checkpoint_keeper.hpp, snapshots_needed): a
-// snapshot copies every block matrix and the whole trace each round, so only runs where
-// something reads them (rollback for a rejoin, a restart, checkpoint files, replicas) take
-// them. That the iterates are unchanged either way is DdsSolve.*'s job; that rejoin,
+// snapshot copies every block matrix each round (the trace shares its older records,
+// distributed/round_history.hpp), so only runs where something reads them (rollback for a
+// rejoin, a restart, checkpoint files, replicas) take them. That the iterates are unchanged either way is DdsSolve.*'s job; that rejoin,
 // checkpoints and replicas still work is DdsRejoin.* / DdsLoss.*'s.
 
 #include <gtest/gtest.h>

@@ -162,7 +162,8 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
     switch (stage_kind(stage_)) {
       case StageKind::kSolve: {
         solves_.push_back({stage_, rank, solve_->rounds(), solve_->restarts(),
-                           solve_->stop_reason(), solve_->trace(), solve_tolerance(), refining_});
+                           solve_->stop_reason(), solve_->trace().to_vector(), solve_tolerance(),
+                           refining_});
         if (!options_.certify || solve_->trace().empty()) {
           done_ = true;
           break;

@@ -13,7 +13,8 @@ void encode(ByteWriter& out, const ProtocolSnapshot& s) {
   out.i64(s.restarts);
   out.doubles(s.scheme_state);
   out.u64(s.trace.size());
-  for (const RoundRecord& r : s.trace) {
+  for (std::size_t k = 0; k < s.trace.size(); ++k) {
+    const RoundRecord& r = s.trace[k];
     out.i64(r.round);
     out.f64(r.cost);
     out.f64(r.grad_norm);

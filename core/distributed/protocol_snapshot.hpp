@@ -27,7 +27,7 @@ struct ProtocolSnapshot {
   double f_prev = 0.0, gsq_prev = 0.0;
   int restarts = 0;
   std::vector<double> scheme_state;  ///< MomentumScheme::save(); empty for RBCD.
-  std::vector<RoundRecord> trace;
+  RoundHistory trace;  ///< Shares its older records with the protocol's and other snapshots'.
 };
 
 /// Appends every field of `s` to `out`; decode_snapshot reads them back bit-identical.

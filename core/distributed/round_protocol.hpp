@@ -36,6 +36,7 @@
 #include "distributed/block_selection.hpp"
 #include "distributed/momentum.hpp"
 #include "distributed/rbcd.hpp"
+#include "distributed/round_history.hpp"
 #include "protocol/messages.hpp"
 
 namespace tessera {
@@ -63,16 +64,6 @@ struct RoundConfig {
   BlockUpdateOptions update;
   /// Null for plain RBCD; otherwise RBCD++ or IRBCD (each agent keeps its own clone).
   const MomentumScheme* scheme = nullptr;
-};
-
-/// One round as every agent sees it (identical on all agents).
-struct RoundRecord {
-  int round = 0;
-  double cost = 0.0;       ///< f(Y^k), full sum.
-  double grad_norm = 0.0;  ///< ||grad f(Y^k)||.
-  std::vector<int> selected;
-  bool restart = false;    ///< The update of this round was redone from Y^k.
-  double elapsed_s = 0.0;  ///< Since start(), when the status completed (not part of the iterates).
 };
 
 class RoundProtocol : public AgentProcess {
@@ -106,7 +97,7 @@ class RoundProtocol : public AgentProcess {
   /// grad_norm, max_rounds, relative_decrease, or stalled (the cost and gradient norm
   /// repeated bit for bit for max(20, 10 x blocks) rounds: no update is accepted any more).
   const std::string& stop_reason() const { return stop_reason_; }
-  const std::vector<RoundRecord>& trace() const { return trace_; }
+  const RoundHistory& trace() const { return trace_; }
   const AgentState& state() const { return state_; }
 
  private:
@@ -140,7 +131,7 @@ class RoundProtocol : public AgentProcess {
   bool done_ = false;
   int restarts_ = 0;
   std::string stop_reason_;
-  std::vector<RoundRecord> trace_;
+  RoundHistory trace_;  // snapshots copy it every round: cheap copies
   std::chrono::steady_clock::time_point start_time_;
   std::function<void(const ProtocolSnapshot&)> observer_;
 };
