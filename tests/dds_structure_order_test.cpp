@@ -8,6 +8,7 @@
 #include <random>
 
 #include "agent/local_share.hpp"
+#include "announcement_support.hpp"
 #include "coordinator/run_structure.hpp"
 #include "generate/generator.hpp"
 #include "util/input_error.hpp"
@@ -15,28 +16,7 @@
 namespace tessera {
 namespace {
 
-std::vector<wire::AgentAnnouncement> announcements_of(const PoseGraph& g, std::uint32_t N) {
-  std::vector<wire::AgentAnnouncement> out;
-  for (std::uint32_t k = 0; k < N; ++k) {
-    const agent::RobotShare s = agent::robot_share(g, k, N);
-    wire::AgentAnnouncement a;
-    a.run_id("r");
-    a.agent_id(k);
-    a.num_agents(N);
-    a.host("h");
-    a.dim(static_cast<std::uint32_t>(g.d));
-    a.num_poses(static_cast<std::uint32_t>(g.num_poses));
-    a.pose_begin(s.begin);
-    a.pose_end(s.end);
-    for (const auto& m : s.measurements) {
-      a.edge_i().push_back(static_cast<std::uint32_t>(m.i));
-      a.edge_j().push_back(static_cast<std::uint32_t>(m.j));
-    }
-    a.edge_index(s.measurement_index);
-    out.push_back(a);
-  }
-  return out;
-}
+using test::announcements_of;
 
 PoseGraph graph() {
   GeneratorOptions o;
