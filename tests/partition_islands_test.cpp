@@ -13,12 +13,14 @@
 #include "partition/island_search.hpp"
 #include "partition/partitioner.hpp"
 #include "structure_graphs.hpp"
+#include "test_support.hpp"
 #include "util/input_error.hpp"
 
 namespace {
 
 using namespace tessera;
 using namespace tessera::partition_detail;
+using tessera::test::validation_message;
 
 // A w x h grid plus random short-range chords (loop closures): irregular enough that seeds and
 // islands find different cuts.
@@ -132,27 +134,19 @@ TEST(IslandSearch, PartitionOptionsChooseTheIslandCount) {
 }
 
 TEST(IslandSearch, BadOptionsNameTheField) {
-  auto message = [](const EvolutionParams& p) {
-    try {
-      p.validate();
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
   EvolutionParams p;
-  EXPECT_EQ(message(p), "");
+  EXPECT_EQ(validation_message(p), "");
   p.islands.islands = 0;
-  EXPECT_NE(message(p).find("IslandOptions.islands"), std::string::npos);
+  EXPECT_NE(validation_message(p).find("IslandOptions.islands"), std::string::npos);
   p.islands.islands = 9;
-  EXPECT_NE(message(p).find("IslandOptions.islands"), std::string::npos);
+  EXPECT_NE(validation_message(p).find("IslandOptions.islands"), std::string::npos);
   p = {};
   p.islands.exchange_every = -1;
-  EXPECT_NE(message(p).find("IslandOptions.exchange_every"), std::string::npos);
+  EXPECT_NE(validation_message(p).find("IslandOptions.exchange_every"), std::string::npos);
   p = {};
   p.islands.islands = 8;
   p.islands.exchange_every = 5;
-  EXPECT_EQ(message(p), "");
+  EXPECT_EQ(validation_message(p), "");
 }
 
 }  // namespace

@@ -10,12 +10,14 @@
 #include "partition/graph_structure.hpp"
 #include "partition/relaxed_polish.hpp"
 #include "structure_graphs.hpp"
+#include "test_support.hpp"
 #include "util/input_error.hpp"
 
 namespace {
 
 using namespace tessera;
 using namespace tessera::partition_detail;
+using tessera::test::validation_message;
 
 void expect_within(const WorkGraph& g, const std::vector<int>& part, int k,
                    const std::vector<long long>& ub) {
@@ -129,45 +131,29 @@ TEST(RelaxedPolish, AfterTheSearchItNeverLosesTheBestCut) {
 }
 
 TEST(RelaxedPolish, BadOptionsNameTheField) {
-  auto message = [](const RelaxedPolishOptions& o) {
-    try {
-      o.validate();
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
   RelaxedPolishOptions o;
   o.rounds = -1;
-  EXPECT_NE(message(o).find("RelaxedPolishOptions.rounds"), std::string::npos);
+  EXPECT_NE(validation_message(o).find("RelaxedPolishOptions.rounds"), std::string::npos);
   o = {};
   o.min_relax = 0.0;
-  EXPECT_NE(message(o).find("RelaxedPolishOptions.min_relax"), std::string::npos);
+  EXPECT_NE(validation_message(o).find("RelaxedPolishOptions.min_relax"), std::string::npos);
   o = {};
   o.max_relax = 0.001;  // below min_relax
-  EXPECT_NE(message(o).find("RelaxedPolishOptions.max_relax"), std::string::npos);
-  EXPECT_EQ(message(RelaxedPolishOptions{}), "");
+  EXPECT_NE(validation_message(o).find("RelaxedPolishOptions.max_relax"), std::string::npos);
+  EXPECT_EQ(validation_message(RelaxedPolishOptions{}), "");
 }
 
 TEST(EvolutionParams, BadOptionsNameTheField) {
-  auto message = [](const EvolutionParams& p) {
-    try {
-      p.validate();
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
   EvolutionParams p;
-  EXPECT_EQ(message(p), "");
+  EXPECT_EQ(validation_message(p), "");
   p.population = 0;
-  EXPECT_NE(message(p).find("EvolutionParams.population"), std::string::npos);
+  EXPECT_NE(validation_message(p).find("EvolutionParams.population"), std::string::npos);
   p = {};
   p.mutation_rate = 1.5;
-  EXPECT_NE(message(p).find("EvolutionParams.mutation_rate"), std::string::npos);
+  EXPECT_NE(validation_message(p).find("EvolutionParams.mutation_rate"), std::string::npos);
   p = {};
   p.polish.max_relax = 0.9;
-  EXPECT_NE(message(p).find("RelaxedPolishOptions.max_relax"), std::string::npos);
+  EXPECT_NE(validation_message(p).find("RelaxedPolishOptions.max_relax"), std::string::npos);
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "util/input_error.hpp"
+
 namespace tessera::test {
 
 /// The shared data folder (datasets/, reference/) configured at build time, or "" when it
@@ -22,6 +24,18 @@ int run_command(const std::string& command, std::string* output);
 
 /// Path of a built executable (build/bin/NAME).
 std::string bin(const std::string& name);
+
+/// What `options.validate()` throws as InputError, or "" when the options are valid: for the
+/// "bad options name the field" tests.
+template <class Options>
+std::string validation_message(const Options& options) {
+  try {
+    options.validate();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
 
 }  // namespace tessera::test
 
