@@ -15,6 +15,7 @@
 #include "agent/local_dump.hpp"
 #include "agent/lost_for_good.hpp"
 #include "agent/robot_data.hpp"
+#include "agent/share_announcement.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
 
@@ -23,25 +24,6 @@ namespace tessera::agent {
 using namespace tessera::transport;
 
 namespace {
-
-wire::AgentAnnouncement announcement_of(const RobotShare& share, const AgentOptions& o) {
-  wire::AgentAnnouncement ann;
-  ann.run_id(o.net.session.run_id);
-  ann.agent_id(o.id);
-  ann.num_agents(o.robots);
-  ann.host(host_name());
-  ann.pid(static_cast<std::uint32_t>(getpid()));
-  ann.dim(static_cast<std::uint32_t>(share.d));
-  ann.num_poses(static_cast<std::uint32_t>(share.num_poses));
-  ann.pose_begin(share.begin);
-  ann.pose_end(share.end);
-  for (const Measurement& m : share.measurements) {
-    ann.edge_i().push_back(static_cast<std::uint32_t>(m.i));
-    ann.edge_j().push_back(static_cast<std::uint32_t>(m.j));
-  }
-  ann.edge_index(share.measurement_index);
-  return ann;
-}
 
 // The whole graph's endpoints from the assignment, checked: the agents build their block
 // layout from them, so a pose out of range must stop the run here.
@@ -92,7 +74,7 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
   log("peers known" + std::string(s.options().shared_memory ? "" : " (UDP only)"));
 
   // 3. Announce the structure (endpoints only).
-  s.publish(announcement_of(share, o));
+  s.publish(announcement_of(share, o.net.session.run_id, o.id, o.robots));
   log("announced");
 
   // 4. The assignment.
