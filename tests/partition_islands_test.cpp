@@ -49,13 +49,6 @@ EvolutionParams small_search(long long bound) {
   return p;
 }
 
-void expect_within(const WorkGraph& g, const std::vector<int>& part, int k,
-                   const std::vector<long long>& ub) {
-  ASSERT_EQ(static_cast<int>(part.size()), g.n);
-  const std::vector<long long> w = block_weights(g, part, k);
-  for (int b = 0; b < k; ++b) EXPECT_LE(w[b], ub[b]) << "block " << b;
-}
-
 TEST(IslandSearch, SameSeedSamePartitionWithThreads) {
   const GraphStructure structure = grid_with_chords(30, 20, 3);
   const WorkGraph g = to_work_graph(structure);
@@ -69,7 +62,7 @@ TEST(IslandSearch, SameSeedSamePartitionWithThreads) {
       Rng r1(seed), r2(seed);
       const std::vector<int> a = evolve(g, k, ub, p, r1, nullptr);
       const std::vector<int> b = evolve(g, k, ub, p, r2, nullptr);
-      expect_within(g, a, k, ub);
+      test::expect_blocks_within(g, a, k, ub);
       EXPECT_EQ(a, b) << "exchange " << exchange << " seed " << seed;
       EXPECT_EQ(r1.next(), r2.next()) << "the caller's generator must end in the same state";
     }

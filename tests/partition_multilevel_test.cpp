@@ -253,17 +253,6 @@ CycleParams relaxed_cycle(long long ub, double coarse_relax) {
 // The same balance bound for each of the k blocks: (1 + eps) ceil(n / k) poses.
 using test::uniform_bounds;
 
-void expect_within(const WorkGraph& g, const std::vector<int>& part, int k,
-                   const std::vector<long long>& ub) {
-  ASSERT_EQ(part.size(), static_cast<std::size_t>(g.n));
-  for (int b : part) {
-    ASSERT_GE(b, 0);
-    ASSERT_LT(b, k);
-  }
-  const std::vector<long long> w = block_weights(g, part, k);
-  for (int b = 0; b < k; ++b) EXPECT_LE(w[b], ub[b]) << "block " << b;
-}
-
 }  // namespace
 
 // coarse_relax loosens the bound on the coarse levels only: whatever the coarse levels did, the
@@ -281,13 +270,13 @@ TEST(MultilevelCycle, RelaxedCoarseLevelsKeepTheExactBoundOnTheInputGraph) {
       Rng rng(seed);
       CycleStats fresh_stats;
       const std::vector<int> fresh = multilevel_partition(g, k, ub, cp, rng, &fresh_stats);
-      expect_within(g, fresh, k, ub);
+      test::expect_blocks_within(g, fresh, k, ub);
       EXPECT_GT(fresh_stats.levels, 0) << "the test graph should be coarsened";
       const long long fresh_cut = edge_cut(g, fresh);
       EXPECT_EQ(fresh_stats.cut, fresh_cut);
 
       const std::vector<int> cycled = guided_cycle(g, k, ub, fresh, fresh, cp, rng);
-      expect_within(g, cycled, k, ub);
+      test::expect_blocks_within(g, cycled, k, ub);
       if (relax == 0.0) {
         EXPECT_LE(edge_cut(g, cycled), fresh_cut) << "seed " << seed;
       }
@@ -311,8 +300,8 @@ TEST(MultilevelCycle, LargeCoarseRelaxationIsRepairedUnderATightBound) {
     Rng r1(seed), r2(seed);
     const std::vector<int> tight = multilevel_partition(g, k, ub, relaxed_cycle(ub[0], 0.0), r1);
     const std::vector<int> relaxed = multilevel_partition(g, k, ub, relaxed_cycle(ub[0], 0.3), r2);
-    expect_within(g, tight, k, ub);
-    expect_within(g, relaxed, k, ub);
+    test::expect_blocks_within(g, tight, k, ub);
+    test::expect_blocks_within(g, relaxed, k, ub);
     differing += tight != relaxed ? 1 : 0;
   }
   EXPECT_GT(differing, 0);
@@ -357,11 +346,11 @@ TEST(LightBlock, MultilevelRunsRespectTheLightBound) {
     EXPECT_LE(lub[light], static_cast<long long>(0.9 * 3000 / k) + 1);
 
     const std::vector<int> fresh = multilevel_partition(g, k, lub, cp, rng);
-    expect_within(g, fresh, k, lub);
+    test::expect_blocks_within(g, fresh, k, lub);
     const std::vector<int> pushed = guided_cycle(g, k, lub, start, start, cp, rng);
-    expect_within(g, pushed, k, lub);
+    test::expect_blocks_within(g, pushed, k, lub);
     const std::vector<int> back = guided_cycle(g, k, ub, pushed, pushed, cp, rng);
-    expect_within(g, back, k, ub);
+    test::expect_blocks_within(g, back, k, ub);
     EXPECT_LE(edge_cut(g, back), edge_cut(g, pushed)) << "seed " << seed;
   }
 }
@@ -387,7 +376,7 @@ TEST(LightBlock, TailAfterAStallNeverLosesTheBestCut) {
     with_tail.light_tail = 12;
     Rng r1(seed), r2(seed);
     const std::vector<int> tailed = evolve(g, k, ub, with_tail, r1, nullptr);
-    expect_within(g, tailed, k, ub);
+    test::expect_blocks_within(g, tailed, k, ub);
     EXPECT_LE(edge_cut(g, tailed), edge_cut(g, plain)) << "seed " << seed;
     better += edge_cut(g, tailed) < edge_cut(g, plain) ? 1 : 0;
     EXPECT_EQ(evolve(g, k, ub, with_tail, r2, nullptr), tailed);
@@ -459,5 +448,5 @@ TEST(InitialPartition, RepeatBudgetScalesTheRunsWithTheGraphSize) {
   EXPECT_EQ(run(4, 1000, 2), r2);    // raised to min_repeats
   EXPECT_EQ(run(4, 100000, 2), r4);  // capped at repeats
   EXPECT_EQ(run(3, 100000, 5), r3);  // repeats wins over a larger minimum
-  expect_within(g, r3.first, k, ub);
+  test::expect_blocks_within(g, r3.first, k, ub);
 }

@@ -19,13 +19,6 @@ using namespace tessera;
 using namespace tessera::partition_detail;
 using tessera::test::validation_message;
 
-void expect_within(const WorkGraph& g, const std::vector<int>& part, int k,
-                   const std::vector<long long>& ub) {
-  ASSERT_EQ(static_cast<int>(part.size()), g.n);
-  const std::vector<long long> w = block_weights(g, part, k);
-  for (int b = 0; b < k; ++b) EXPECT_LE(w[b], ub[b]) << "block " << b;
-}
-
 // A 10 x 10 grid in two halves of exactly 50 vertices (bound 50, no slack), except that one
 // vertex of each half sits on the other side: cut 14 instead of the straight 10. Each tooth
 // moves home with gain 2, but only after the other one: a single move overfills a block, so FM
@@ -53,7 +46,7 @@ TEST(RelaxedPolish, MovesAChainThatNoBoundedMoveCanStart) {
   Rng r1(1);
   EXPECT_EQ(relaxed_polish(g, k, ub, polished, options, cycle, r1), 10);
   EXPECT_EQ(edge_cut(g, polished), 10);
-  expect_within(g, polished, k, ub);
+  test::expect_blocks_within(g, polished, k, ub);
 
   options.rounds = 0;  // off: unchanged
   std::vector<int> off = part;
@@ -97,7 +90,7 @@ TEST(RelaxedPolish, NeverWorseWithinTheBoundAndDeterministic) {
     const long long cut = relaxed_polish(g, k, ub, a, options, cycle, ra);
     EXPECT_EQ(cut, edge_cut(g, a));
     EXPECT_LE(cut, start_cut) << "seed " << seed;
-    expect_within(g, a, k, ub);
+    test::expect_blocks_within(g, a, k, ub);
     relaxed_polish(g, k, ub, b, options, cycle, rb);
     EXPECT_EQ(a, b) << "seed " << seed;
     better += cut < start_cut ? 1 : 0;
@@ -124,7 +117,7 @@ TEST(RelaxedPolish, AfterTheSearchItNeverLosesTheBestCut) {
     with.polish.rounds = 3;
     Rng r1(seed), r2(seed);
     const std::vector<int> polished = evolve(g, k, ub, with, r1, nullptr);
-    expect_within(g, polished, k, ub);
+    test::expect_blocks_within(g, polished, k, ub);
     EXPECT_LE(edge_cut(g, polished), edge_cut(g, plain)) << "seed " << seed;
     EXPECT_EQ(evolve(g, k, ub, with, r2, nullptr), polished);
   }

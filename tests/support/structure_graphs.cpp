@@ -1,5 +1,7 @@
 #include "structure_graphs.hpp"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <utility>
 
@@ -32,6 +34,17 @@ partition_detail::CycleParams small_graph_cycle(long long ub) {
   cp.use_flow = true;
   cp.flow_levels = 2;
   return cp;
+}
+
+void expect_blocks_within(const partition_detail::WorkGraph& g, const std::vector<int>& part, int k,
+                          const std::vector<long long>& ub) {
+  ASSERT_EQ(part.size(), static_cast<std::size_t>(g.n));
+  for (int b : part) {
+    ASSERT_GE(b, 0);
+    ASSERT_LT(b, k);
+  }
+  const std::vector<long long> w = partition_detail::block_weights(g, part, k);
+  for (int b = 0; b < k; ++b) EXPECT_LE(w[b], ub[b]) << "block " << b;
 }
 
 }  // namespace tessera::test

@@ -7,6 +7,7 @@
 
 #include "partition/graph_structure.hpp"
 #include "partition/multilevel.hpp"
+#include "partition/work_graph.hpp"
 
 namespace tessera::test {
 
@@ -20,5 +21,10 @@ std::vector<long long> uniform_bounds(const GraphStructure& structure, int k, do
 /// vertices (coarse vertices below ub / 30), 3 label-propagation rounds, 4 initial runs, flow
 /// refinement on the 2 finest levels, default FM everywhere.
 partition_detail::CycleParams small_graph_cycle(long long ub);
+
+/// Test assertions: `part` gives every vertex of `g` a block in [0, k), and no block outweighs
+/// its bound `ub[b]`.
+void expect_blocks_within(const partition_detail::WorkGraph& g, const std::vector<int>& part, int k,
+                          const std::vector<long long>& ub);
 
 }  // namespace tessera::test
