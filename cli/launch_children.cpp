@@ -195,7 +195,13 @@ void stop_all(std::vector<Child>& children, double grace_s) {
     usleep(20000);
   }
   for (auto& c : children)
-    if (c.running) kill(c.pid, SIGKILL);
+    if (c.running) {
+      kill(c.pid, SIGKILL);
+      std::fprintf(stderr,
+                   "tessera launch: %s did not stop within %.0f s of SIGINT: killed (SIGKILL); "
+                   "its shared-memory files may remain in /dev/shm (`fastdds shm clean`)\n",
+                   c.name.c_str(), grace_s);
+    }
   reap(children, true);
 }
 

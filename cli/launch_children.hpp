@@ -47,7 +47,8 @@ void reap(std::vector<Child>& children, bool block);
 bool any_running(const std::vector<Child>& children);
 
 /// Asks every process to stop (they shut down cleanly on SIGINT), SIGKILLs what is left after
-/// `grace_s`.
+/// `grace_s` and says so on stderr, naming each one: a SIGKILLed process cannot remove its Fast
+/// DDS shared-memory files, so the message tells the user where leftovers come from.
 void stop_all(std::vector<Child>& children, double grace_s);
 
 /// The last `max_lines` lines of a log, indented, for error messages.

@@ -16,6 +16,7 @@
 
 #include "dds_process_support.hpp"
 #include "fork_spec.hpp"
+#include "launch_children.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::test::dds {
@@ -125,6 +126,28 @@ TEST(DdsForkServer, BadFileStopsTheForkedRunWithTheAgentsReason) {
   EXPECT_NE(out.find("forked by tessera-fork-server"), std::string::npos) << out;
   EXPECT_NE(out.find("bad.g2o"), std::string::npos) << out;  // the agent's message names the file
   EXPECT_NE(out.find("exit 2"), std::string::npos) << out;   // its exit code, as when exec'ed
+}
+
+// A child that ignores SIGINT is SIGKILLed after the grace period, and launch names it (its
+// shared-memory files cannot be removed by it: the message says where leftovers come from).
+TEST(DdsForkServer, StopAllKillsAndNamesAChildThatIgnoresSigint) {
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    signal(SIGINT, SIG_IGN);
+    for (;;) pause();
+  }
+  std::vector<cli::Child> children(1);
+  children[0].name = "agent 7";
+  children[0].pid = pid;
+  children[0].running = true;
+  testing::internal::CaptureStderr();
+  cli::stop_all(children, 0.3);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_FALSE(children[0].running);
+  EXPECT_EQ(children[0].code, 128 + SIGKILL);
+  EXPECT_NE(err.find("agent 7 did not stop within"), std::string::npos) << err;
+  EXPECT_NE(err.find("SIGKILL"), std::string::npos) << err;
 }
 
 TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
