@@ -8,49 +8,73 @@
 namespace tessera::partition_detail {
 namespace {
 
-// Dinic's max flow on a small network.
+// Dinic's max flow on a small network. Arcs are collected first and then laid out per node
+// (CSR: a node's arcs are contiguous, each with the index of its reverse arc), and the level BFS
+// stops as soon as it reaches t. The flows are ~60 % of a strong / highest run (perf, rim), most
+// of it in the BFS and the augmenting DFS, which scan the whole network once per phase; the two
+// changes made strong on rim ~12 % faster (session 9). Which maximum flow is found does not
+// matter: the residual sets used below (what s reaches, what reaches t) are the same for every
+// maximum flow, so every partition is bit-identical to the linked-list version's.
 class FlowNetwork {
  public:
-  explicit FlowNetwork(int n) : head_(static_cast<std::size_t>(n), -1), level_(n), it_(n) {}
+  explicit FlowNetwork(int n) : first_(static_cast<std::size_t>(n) + 1, 0), level_(n), it_(n) {}
+  /// Adds the arc pair u -> v (capacity c_uv) and v -> u (c_vu). Only before max_flow().
   void add(int u, int v, long long c_uv, long long c_vu) {
-    arc(u, v, c_uv);
-    arc(v, u, c_vu);
+    pending_.push_back({u, v, c_uv, c_vu});
+    ++first_[u + 1];
+    ++first_[v + 1];
   }
   long long max_flow(int s, int t) {
+    build();
     long long flow = 0;
     while (bfs(s, t)) {
-      for (std::size_t v = 0; v < head_.size(); ++v) it_[v] = head_[v];
+      std::copy(first_.begin(), first_.end() - 1, it_.begin());
       while (long long f = dfs(s, t, LLONG_MAX)) flow += f;
     }
     return flow;
   }
   /// Nodes reachable from s in the residual network.
-  std::vector<char> reachable_from(int s) const {
-    std::vector<char> seen(head_.size(), 0);
-    std::vector<int> stack = {s};
-    seen[s] = 1;
-    while (!stack.empty()) {
-      const int v = stack.back();
-      stack.pop_back();
-      for (int a = head_[v]; a >= 0; a = next_[a])
-        if (cap_[a] > 0 && !seen[to_[a]]) {
-          seen[to_[a]] = 1;
-          stack.push_back(to_[a]);
-        }
-    }
-    return seen;
-  }
+  std::vector<char> reachable_from(int s) const { return residual_search(s, false); }
   /// Nodes that can reach t in the residual network.
-  std::vector<char> reaching(int t) const {
-    std::vector<char> seen(head_.size(), 0);
-    std::vector<int> stack = {t};
-    seen[t] = 1;
+  std::vector<char> reaching(int t) const { return residual_search(t, true); }
+
+ private:
+  struct Pending {
+    int u, v;
+    long long c_uv, c_vu;
+  };
+
+  void build() {
+    const std::size_t n = first_.size() - 1;
+    for (std::size_t v = 0; v < n; ++v) first_[v + 1] += first_[v];
+    to_.resize(2 * pending_.size());
+    cap_.resize(2 * pending_.size());
+    rev_.resize(2 * pending_.size());
+    std::vector<int> fill(first_.begin(), first_.end() - 1);
+    for (const Pending& p : pending_) {
+      const int a = fill[p.u]++, b = fill[p.v]++;
+      to_[a] = p.v;
+      cap_[a] = p.c_uv;
+      rev_[a] = b;
+      to_[b] = p.u;
+      cap_[b] = p.c_vu;
+      rev_[b] = a;
+    }
+    pending_.clear();
+  }
+  // Depth-first search over arcs with residual capacity, forwards from `from` or (reverse)
+  // backwards into it.
+  std::vector<char> residual_search(int from, bool reverse) const {
+    std::vector<char> seen(first_.size() - 1, 0);
+    std::vector<int> stack = {from};
+    seen[from] = 1;
     while (!stack.empty()) {
       const int v = stack.back();
       stack.pop_back();
-      for (int a = head_[v]; a >= 0; a = next_[a]) {
-        // The reverse arc a^1 goes to_[a] -> v; usable if it has residual capacity.
-        if (cap_[a ^ 1] > 0 && !seen[to_[a]]) {
+      for (int a = first_[v]; a < first_[v + 1]; ++a) {
+        // Backwards, the arc to_[a] -> v is the reverse of a; usable if it has capacity.
+        const long long c = reverse ? cap_[rev_[a]] : cap_[a];
+        if (c > 0 && !seen[to_[a]]) {
           seen[to_[a]] = 1;
           stack.push_back(to_[a]);
         }
@@ -58,46 +82,44 @@ class FlowNetwork {
     }
     return seen;
   }
-
- private:
-  void arc(int u, int v, long long c) {
-    to_.push_back(v);
-    cap_.push_back(c);
-    next_.push_back(head_[u]);
-    head_[u] = static_cast<int>(to_.size()) - 1;
-  }
   bool bfs(int s, int t) {
     std::fill(level_.begin(), level_.end(), -1);
-    std::vector<int> queue = {s};
+    queue_.clear();
+    queue_.push_back(s);
     level_[s] = 0;
-    for (std::size_t q = 0; q < queue.size(); ++q) {
-      const int v = queue[q];
-      for (int a = head_[v]; a >= 0; a = next_[a])
+    for (std::size_t q = 0; q < queue_.size(); ++q) {
+      const int v = queue_[q];
+      const int next = level_[v] + 1;
+      for (int a = first_[v]; a < first_[v + 1]; ++a)
         if (cap_[a] > 0 && level_[to_[a]] < 0) {
-          level_[to_[a]] = level_[v] + 1;
-          queue.push_back(to_[a]);
+          level_[to_[a]] = next;
+          // Every node on a shortest s-t path is labelled by now: the augmenting search only
+          // follows arcs into the next level, so nodes found later are never on its paths.
+          if (to_[a] == t) return true;
+          queue_.push_back(to_[a]);
         }
     }
-    return level_[t] >= 0;
+    return false;
   }
   long long dfs(int v, int t, long long pushed) {
     if (v == t) return pushed;
-    for (int& a = it_[v]; a >= 0; a = next_[a]) {
+    for (int& a = it_[v]; a < first_[v + 1]; ++a) {
       const int u = to_[a];
       if (cap_[a] <= 0 || level_[u] != level_[v] + 1) continue;
       const long long f = dfs(u, t, std::min(pushed, cap_[a]));
       if (f > 0) {
         cap_[a] -= f;
-        cap_[a ^ 1] += f;
+        cap_[rev_[a]] += f;
         return f;
       }
     }
     return 0;
   }
 
-  std::vector<int> head_, next_, to_;
+  std::vector<Pending> pending_;
+  std::vector<int> first_, to_, rev_;
   std::vector<long long> cap_;
-  std::vector<int> level_, it_;
+  std::vector<int> level_, it_, queue_;
 };
 
 // At most this many vertices per corridor side: keeps each max flow cheap on huge graphs and
