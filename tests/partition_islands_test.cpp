@@ -1,7 +1,8 @@
 // The island model of the memetic search (island_search.hpp): two islands on their own threads
 // give the same partition for the same seed (with and without exchanges, through evolve() and
 // through the `highest` preset), two islands that never exchange are never worse than the single
-// search (island 0 is that search step for step), and bad options name the field.
+// search (island 0 is that search step for step), `highest` runs four islands on small graphs
+// and two on larger ones, and bad options name the field.
 
 #include <gtest/gtest.h>
 
@@ -90,7 +91,15 @@ TEST(IslandSearch, TwoIslandsWithoutExchangeNeverLoseToOne) {
   RecordProperty("seeds_improved_by_second_island", better);
 }
 
-TEST(IslandSearch, HighestPresetIsDeterministicAndTracesBothIslands) {
+// Whether the `evolution` trace phase names island `i`.
+bool traces_island(const PartitionResult& r, int i) {
+  const std::string name = "island " + std::to_string(i) + ":";
+  for (const auto& t : r.trace)
+    if (t.name == "evolution" && t.detail.find(name) != std::string::npos) return true;
+  return false;
+}
+
+TEST(IslandSearch, HighestPresetIsDeterministicAndTracesTheIslands) {
   const GraphStructure structure = grid_with_chords(24, 16, 7);
   PartitionOptions o;
   o.parts = 5;
@@ -99,10 +108,26 @@ TEST(IslandSearch, HighestPresetIsDeterministicAndTracesBothIslands) {
   const PartitionResult a = partition_graph(structure, o);
   const PartitionResult b = partition_graph(structure, o);
   EXPECT_EQ(a.assignment, b.assignment);
-  bool traced = false;
-  for (const auto& t : a.trace)
-    traced = traced || (t.name == "evolution" && t.detail.find("island 1:") != std::string::npos);
-  EXPECT_TRUE(traced) << "highest must run two islands";
+  EXPECT_TRUE(traces_island(a, 1)) << "highest must run several islands";
+}
+
+// highest's island count follows the graph's size in its budget unit, (n + edges) x max(1, N/5):
+// four islands up to 16000 (a 384-pose grid, N = 5), two above (an 8000-pose path, N = 10:
+// 15999 x 2). The path's optimal cut (9) is found either way.
+TEST(IslandSearch, HighestRunsFourIslandsOnSmallGraphsAndTwoOnLargerOnes) {
+  PartitionOptions o;
+  o.preset = PartitionPreset::kHighest;
+  o.parts = 5;
+  o.seed = 2;
+  const PartitionResult small = partition_graph(grid_with_chords(24, 16, 7), o);
+  EXPECT_TRUE(traces_island(small, 3));
+  EXPECT_FALSE(traces_island(small, 4));
+  o.parts = 10;
+  const PartitionResult path = partition_graph(test::grid_structure(8000, 1), o);
+  EXPECT_TRUE(traces_island(path, 1));
+  EXPECT_FALSE(traces_island(path, 2));
+  EXPECT_EQ(path.metrics.cut_edges, 9u);
+  EXPECT_LE(path.metrics.max_block_ratio, 1.03 + 1e-12);
 }
 
 // PartitionOptions::islands overrides the preset's count (one island: the single search, no
