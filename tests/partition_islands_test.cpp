@@ -70,25 +70,57 @@ TEST(IslandSearch, SameSeedSamePartitionWithThreads) {
   }
 }
 
+// The comparisons of one search against islands: a 30 x 20 grid with chords, 5 blocks.
+struct IslandCase {
+  GraphStructure structure = grid_with_chords(30, 20, 5);
+  WorkGraph g = to_work_graph(structure);
+  int k = 5;
+  std::vector<long long> ub = test::uniform_bounds(structure, k, 0.03);
+  EvolutionParams one = small_search(ub[0]);
+  EvolutionParams two() const {
+    EvolutionParams p = one;
+    p.islands.islands = 2;
+    return p;
+  }
+};
+
 // Island 0 draws the single search's random stream, so without exchanges the best of two islands
 // can only be at least as good as the single search; on some seeds island 1 is better.
 TEST(IslandSearch, TwoIslandsWithoutExchangeNeverLoseToOne) {
-  const GraphStructure structure = grid_with_chords(30, 20, 5);
-  const WorkGraph g = to_work_graph(structure);
-  const int k = 5;
-  const std::vector<long long> ub = test::uniform_bounds(structure, k, 0.03);
-  const EvolutionParams one = small_search(ub[0]);
-  EvolutionParams two = one;
-  two.islands.islands = 2;
+  const IslandCase c;
   int better = 0;
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     Rng r1(seed), r2(seed);
-    const long long single = edge_cut(g, evolve(g, k, ub, one, r1, nullptr));
-    const long long islands = edge_cut(g, evolve(g, k, ub, two, r2, nullptr));
+    const long long single = edge_cut(c.g, evolve(c.g, c.k, c.ub, c.one, r1, nullptr));
+    const long long islands = edge_cut(c.g, evolve(c.g, c.k, c.ub, c.two(), r2, nullptr));
     EXPECT_LE(islands, single) << "seed " << seed;
     better += islands < single ? 1 : 0;
   }
   RecordProperty("seeds_improved_by_second_island", better);
+}
+
+// IslandOptions::second_matching_share changes island 1's coarsening only: island 0 is still the
+// single search (never worse than it), a share equal to EvolutionParams::matching_share gives
+// exactly the default two islands, and the result is deterministic.
+TEST(IslandSearch, SecondIslandOwnMatchingShareLeavesIslandZero) {
+  const IslandCase c;
+  EvolutionParams same = c.two();
+  same.islands.second_matching_share = c.one.matching_share;
+  EvolutionParams other = c.two();
+  other.islands.second_matching_share = 1.0;
+  int differs = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    Rng r1(seed), r2(seed), r3(seed), r4(seed), r5(seed);
+    const long long single = edge_cut(c.g, evolve(c.g, c.k, c.ub, c.one, r1, nullptr));
+    const std::vector<int> plain = evolve(c.g, c.k, c.ub, c.two(), r2, nullptr);
+    EXPECT_EQ(evolve(c.g, c.k, c.ub, same, r3, nullptr), plain) << "seed " << seed;
+    const std::vector<int> a = evolve(c.g, c.k, c.ub, other, r4, nullptr);
+    EXPECT_EQ(evolve(c.g, c.k, c.ub, other, r5, nullptr), a) << "seed " << seed;
+    test::expect_blocks_within(c.g, a, c.k, c.ub);
+    EXPECT_LE(edge_cut(c.g, a), single) << "seed " << seed;
+    differs += a != plain ? 1 : 0;
+  }
+  EXPECT_GT(differs, 0) << "island 1 with matching coarsening must search differently";
 }
 
 // Whether the `evolution` trace phase names island `i`.
@@ -161,6 +193,11 @@ TEST(IslandSearch, BadOptionsNameTheField) {
   p = {};
   p.islands.exchange_every = -1;
   EXPECT_NE(validation_message(p).find("IslandOptions.exchange_every"), std::string::npos);
+  p = {};
+  p.islands.second_matching_share = 1.5;
+  EXPECT_NE(validation_message(p).find("IslandOptions.second_matching_share"), std::string::npos);
+  p.islands.second_matching_share = -0.5;
+  EXPECT_NE(validation_message(p).find("IslandOptions.second_matching_share"), std::string::npos);
   p = {};
   p.islands.islands = 8;
   p.islands.exchange_every = 5;

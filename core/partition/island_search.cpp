@@ -16,6 +16,10 @@ namespace tessera::partition_detail {
 void IslandOptions::validate() const {
   if (islands < 1 || islands > 8)
     throw InputError("IslandOptions.islands = " + std::to_string(islands) + ": must be in 1..8");
+  if (!(second_matching_share == -1.0 ||
+        (second_matching_share >= 0.0 && second_matching_share <= 1.0)))
+    throw InputError("IslandOptions.second_matching_share = " +
+                     std::to_string(second_matching_share) + ": must be -1 or in 0..1");
   if (exchange_every < 0)
     throw InputError("IslandOptions.exchange_every = " + std::to_string(exchange_every) +
                      ": must be >= 0");
@@ -49,12 +53,16 @@ IslandSearchResult island_search(
   // the caller's stream (and island 0's search) is the one a single search would draw.
   Rng seeder = rng;
   const std::uint64_t base = seeder.next();
+  EvolutionParams second = params;
+  if (params.islands.second_matching_share >= 0.0)
+    second.matching_share = params.islands.second_matching_share;
   std::vector<Island> islands;
   islands.reserve(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) {
     islands.push_back(
         Island{i == 0 ? rng : Rng(base ^ (0xA24BAED4963EE407ULL * i)), nullptr, 0.0, 0, nullptr});
-    islands.back().search = std::make_unique<EvolutionSearch>(g, k, ub, params, islands.back().rng);
+    islands.back().search =
+        std::make_unique<EvolutionSearch>(g, k, ub, i == 1 ? second : params, islands.back().rng);
   }
 
   // One epoch: every island runs `job` on its own thread (island 0 on the caller's); joining

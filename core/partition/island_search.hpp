@@ -36,6 +36,10 @@ struct IslandOptions {
   /// Steps (combine / mutation operations of one island) between two exchanges; 0 = the
   /// islands never exchange and only their best results are compared at the end. Range >= 0.
   int exchange_every = 0;
+  /// When >= 0, island 1 coarsens by heavy-edge matching in this share of its operations
+  /// instead of EvolutionParams::matching_share (a differently configured second search);
+  /// -1 = every island uses the same parameters. Range -1 or 0..1.
+  double second_matching_share = -1.0;
 
   /// Throws InputError naming the first field out of range.
   void validate() const;

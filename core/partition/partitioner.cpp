@@ -249,6 +249,7 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_POLMAX")) plan.evolution.polish.max_relax = std::atof(env("T_POLMAX"));
   if (env("T_MFLEV")) plan.evolution.matching_flow_levels = std::atoi(env("T_MFLEV"));
   if (env("T_ISL")) plan.evolution.islands.islands = std::atoi(env("T_ISL"));
+  if (env("T_I1MATCH")) plan.evolution.islands.second_matching_share = std::atof(env("T_I1MATCH"));
   if (env("T_XCH")) plan.evolution.islands.exchange_every = std::atoi(env("T_XCH"));
   if (env("T_OPS"))
     plan.evolution.generations =
