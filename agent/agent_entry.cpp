@@ -12,6 +12,7 @@
 #include "agent/agent_log.hpp"
 #include "agent/agent_options.hpp"
 #include "agent/agent_run.hpp"
+#include "agent/startup_priority.hpp"
 #include "distributed/checkpoint_file.hpp"
 #include "session_process.hpp"
 #include "transport/signal_watcher.hpp"
@@ -21,6 +22,9 @@ namespace tessera::agent {
 int agent_main(int argc, char** argv) {
   transport::SignalWatcher
       signals;  // first: every thread created later inherits the blocked signals
+  // Started lowered by launch's fork server: back to nice 0 at the latest after the bound
+  // (with the assignment, normally: run_setup.cpp).
+  const StartupPriorityBound startup_bound(StartupPriorityOptions{}.bound_s);
   const std::vector<std::string> argv_list(argv + 1, argv + argc);
   AgentOptions options;
   if (auto code = cli::parse_process_options(

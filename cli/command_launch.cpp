@@ -75,6 +75,10 @@ options:
   --no-fork-server     start tessera-coordinator and tessera-agent with exec, each
                        loading Fast DDS itself (default: one tessera-fork-server loads it
                        once and forks them; see docs/dds-runtime.md, "Fork server")
+  --agents-yield       the agents start at nice 19 (threads, or their own autogroup)
+                       until their assignment, so that the coordinator's partition of
+                       GRAPH gets the CPU first (fork server and a whole file only; off:
+                       measured no gain on a loaded host, docs/dds-runtime.md, start9)
 %s  --quiet              no progress lines
   --help               this text
 
@@ -132,7 +136,7 @@ int run_launch(const Args& argv) {
       "seed",   "json",      "out",       "tum",  "timeout",  "poses",      "status-interval"};
   for (const auto& n : launch_loss_option_names()) valued.insert(n);
   Arguments args(argv, with_session_options(valued, SessionArgsFor::kLaunch),
-                 {"quiet", "certify", "no-certify", "no-fork-server"});
+                 {"quiet", "certify", "no-certify", "no-fork-server", "agents-yield"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
                      std::to_string(args.positional().size()));
@@ -273,6 +277,7 @@ int run_launch(const Args& argv) {
   // The processes to start, in order: the coordinator (stdout = our progress pipe), then
   // agents 0..N-1.
   ForkSpec spec;
+  if (args.has("agents-yield")) spec.agents_nice = 19;  // agent/startup_priority.hpp
   std::vector<std::string> names = {"coordinator"};
   std::vector<long> agent_ids = {-1};
   spec.children.push_back(

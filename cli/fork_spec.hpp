@@ -23,6 +23,9 @@ struct ForkChild {
   int stdout_fd = -1;
   /// Its argv, argv[0] first (the standalone executable's path: what ps shows).
   std::vector<std::string> argv;
+  /// A session of its own (setsid) besides its own process group; the coordinator always has
+  /// one. launch's own use (the fork server), not part of the spec the server reads.
+  bool own_session = false;
 };
 
 /// Everything the fork server needs.
@@ -30,14 +33,18 @@ struct ForkSpec {
   /// Inherited descriptor on which the server writes one line "<pid>\n" per child, in order.
   int pid_fd = -1;
   std::vector<ForkChild> children;
+  /// Nice value at which the agents start when the coordinator partitions launch's file while
+  /// they start (its argv has --graph), until their assignment (agent/startup_priority.hpp;
+  /// launch --agents-yield). 0 = off (default); range 0..19.
+  int agents_nice = 0;
 
   /// Throws InputError naming the bad field: pid_fd < 0, no children, a child without argv
-  /// or log, or a stdout_fd < -1.
+  /// or log, a stdout_fd < -1, or agents_nice outside 0..19.
   void validate() const;
 };
 
-/// The spec as a list of strings: "--pid-fd FD" then, per child,
-/// "--child ROLE LOG STDOUT_FD ARGC ARGV...". Validates `spec` first.
+/// The spec as a list of strings: "--pid-fd FD", "--agents-nice N" when N > 0, then, per
+/// child, "--child ROLE LOG STDOUT_FD ARGC ARGV...". Validates `spec` first.
 std::vector<std::string> encode_fork_spec(const ForkSpec& spec);
 
 /// Inverse of encode_fork_spec(); throws InputError naming the bad item on malformed input.

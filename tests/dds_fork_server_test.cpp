@@ -2,18 +2,28 @@
 // coordinator and the agents forked from it) and through the exec fallback
 // (--no-fork-server): the same iterates as the in-process engine, forked processes that look
 // like the executables they stand for and are launch's own children, a clean SIGINT, and the
-// fork server's argv encoding.
-// Domains used here: 50-53 (each test its own, so ctest -j is safe).
+// fork server's argv encoding; --agents-yield (agents below the coordinator's priority until
+// their assignment, agent/startup_priority.hpp).
+// Domains used here: 50-53, 211-212 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstdlib>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "agent/startup_priority.hpp"
 #include "dds_process_support.hpp"
 #include "fork_spec.hpp"
 #include "launch_children.hpp"
@@ -65,12 +75,170 @@ TEST(DdsForkServer, ExecFallbackGivesTheInProcessIterates) {
   expect_launch_gives_the_in_process_iterates("--no-fork-server", 51, "each exec'ed");
 }
 
+TEST(DdsForkServer, AgentsYieldingAtStartGiveTheInProcessIterates) {
+  expect_launch_gives_the_in_process_iterates("--agents-yield", 211,
+                                              "forked by tessera-fork-server");
+}
+
 // The parent pid and command line of a process, from /proc.
 long parent_of(long pid) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
   for (std::string line; std::getline(status, line);)
     if (line.rfind("PPid:", 0) == 0) return std::stol(line.substr(5));
   return -1;
+}
+
+// Field `index` (1-based, as in proc(5)) of /proc/<pid>/stat or of a task's stat file.
+long stat_field(const std::string& path, int index) {
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t close = text.rfind(')');
+  if (close == std::string::npos) return -1000;
+  std::istringstream rest(text.substr(close + 2));  // field 3 onwards
+  std::string field;
+  for (int k = 3; rest >> field; ++k)
+    if (k == index) return std::stol(field);
+  return -1000;
+}
+
+// The nice of the autogroup of `pid` ("/autogroup-42 nice 19"), -1000 if unknown.
+int autogroup_nice_of(long pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/autogroup");
+  std::string name, word;
+  int nice = -1000;
+  if (in >> name >> word >> nice && word == "nice") return nice;
+  return -1000;
+}
+
+// The pids of the processes whose command line matches `pattern` (pgrep -f).
+std::vector<long> pids_of(const std::string& pattern) {
+  std::string out;
+  run_command("pgrep -f '" + pattern + "'", &out);
+  std::vector<long> pids;
+  std::istringstream in(out);
+  for (long pid; in >> pid;) pids.push_back(pid);
+  return pids;
+}
+
+TEST(DdsForkServer, YieldingAgentsShareASessionAndRunTheirRoundsAtNiceZero) {
+  const std::string dir = temp_dir();
+  const std::string run_id = "yield-" + std::to_string(getpid());
+  struct Cleanup {  // whatever an assertion leaves running
+    std::string run_id;
+    ~Cleanup() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
+  } cleanup{run_id};
+  const auto before = shm_files();
+  Process launch =
+      start({bin("tessera"), "launch", "--agents",      "2",      "--poses",     "3000",
+             "--domain",     "212",    "--run-id",      run_id,   "--init",      "file",
+             "--grad-tol",   "1e-12",  "--max-rounds",  "100000", "--partition", "fast",
+             "--timeout",    "60",     "--agents-yield"},
+            dir + "/launch.log");
+  ASSERT_TRUE(wait_for_output(launch, "round 2:", 30)) << launch.output();
+  // Every agent has its assignment: all its threads and its group are back at nice 0.
+  const std::vector<long> agents = pids_of("[t]essera-agent.*--run-id " + run_id + " ");
+  ASSERT_EQ(agents.size(), 2u);
+  const std::vector<long> coordinator = pids_of("[t]essera-coordinator .*--run-id " + run_id + " ");
+  ASSERT_EQ(coordinator.size(), 1u);
+  const long launch_session = stat_field("/proc/" + std::to_string(launch.pid) + "/stat", 6);
+  const long agents_session = stat_field("/proc/" + std::to_string(agents[0]) + "/stat", 6);
+  EXPECT_EQ(stat_field("/proc/" + std::to_string(agents[1]) + "/stat", 6), agents_session);
+  EXPECT_NE(agents_session, launch_session);  // the fork server's session, not launch's
+  EXPECT_NE(stat_field("/proc/" + std::to_string(coordinator[0]) + "/stat", 6), agents_session);
+  for (long pid : agents) {
+    const int group = autogroup_nice_of(pid);
+    if (group != -1000) {
+      EXPECT_EQ(group, 0) << pid;
+    }
+    run_command("ls /proc/" + std::to_string(pid) + "/task > " + dir + "/tasks", nullptr);
+    std::ifstream tasks(dir + "/tasks");
+    int seen = 0;
+    for (std::string tid; tasks >> tid; ++seen)
+      EXPECT_EQ(stat_field("/proc/" + std::to_string(pid) + "/task/" + tid + "/stat", 19), 0)
+          << "agent " << pid << " thread " << tid;
+    EXPECT_GT(seen, 1);
+  }
+  kill(launch.pid, SIGINT);
+  ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
+  EXPECT_EQ(launch.exit_code, 130) << launch.output();
+  std::string ps;
+  run_command("pgrep -fc '[t]essera-.*--run-id " + run_id + "'", &ps);
+  EXPECT_EQ(std::stoi(ps), 0) << ps;
+  const auto leaked = leaked_shm_files(before, 212);
+  EXPECT_TRUE(leaked.empty()) << join(leaked);
+}
+
+// In a forked child (so neither the test's session nor its threads change): what
+// enter_startup_priority / lower_autogroup_nice lower and restore_startup_priority and the
+// bound put back. Each failed check is one bit of the child's exit code.
+int lower_and_restore_in_child() {
+  int failed = 0;
+  if (setsid() < 0) return 1 << 0;  // a group of our own: never the test runner's
+  // Without CAP_SYS_ADMIN the kernel takes one group nice change per 100 ms machine-wide.
+  bool group = false;
+  for (int attempt = 0; attempt < 5 && !group; ++attempt) {
+    group = agent::lower_autogroup_nice(7);
+    if (!group) std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  }
+  std::ifstream probe("/proc/self/autogroup");
+  if (probe.good() && !group) failed |= 1 << 1;  // an autogroup kernel: lowered
+  if (group && autogroup_nice_of(getpid()) != 7) failed |= 1 << 2;
+  agent::StartupPriorityOptions o;
+  o.nice = 9;
+  const bool lowered = agent::enter_startup_priority(o, group);
+  const bool threads = getpriority(PRIO_PROCESS, 0) == 9;
+  if (lowered != (threads || group)) failed |= 1 << 3;
+  int thread_nice = 0;
+  std::thread([&] { thread_nice = getpriority(PRIO_PROCESS, 0); }).join();
+  if (threads && thread_nice != 9) failed |= 1 << 4;  // inherited by new threads
+  std::thread sleeper;                                // a thread alive while restoring
+  std::atomic<int> sleeper_nice{-100};
+  std::atomic<bool> restored{false};
+  sleeper = std::thread([&] {
+    while (!restored) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    sleeper_nice = getpriority(PRIO_PROCESS, 0);
+  });
+  const std::string what = agent::restore_startup_priority();
+  restored = true;
+  sleeper.join();
+  if (what.empty() == lowered) failed |= 1 << 5;
+  if (getpriority(PRIO_PROCESS, 0) != 0 || sleeper_nice != 0) failed |= 1 << 6;
+  if (group && autogroup_nice_of(getpid()) != 0) failed |= 1 << 7;
+  if (agent::startup_priority_lowered() || !agent::restore_startup_priority().empty())
+    failed |= 1 << 8;  // idempotent
+  // The bound: back at nice 0 without an assignment.
+  agent::enter_startup_priority(o, false);
+  {
+    const agent::StartupPriorityBound bound(0.05);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    if (getpriority(PRIO_PROCESS, 0) != 0 || agent::startup_priority_lowered()) failed |= 1 << 9;
+  }
+  return failed;
+}
+
+TEST(StartupPriority, LowersTheAgentsAndPutsThemBackAtNiceZero) {
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) _exit(lower_and_restore_in_child());
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "failed checks (bits): " << WEXITSTATUS(status);
+}
+
+TEST(StartupPriority, OptionsNameTheBadField) {
+  agent::StartupPriorityOptions o;
+  EXPECT_NO_THROW(o.validate());
+  o.nice = 0;
+  EXPECT_THROW(o.validate(), InputError);
+  o.nice = 19;
+  o.bound_s = 0.0;
+  try {
+    o.validate();
+    ADD_FAILURE() << "bound_s = 0 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bound_s"), std::string::npos) << e.what();
+  }
 }
 
 TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndStopOnSigint) {
@@ -158,6 +326,7 @@ TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
   const std::vector<std::string> args = cli::encode_fork_spec(spec);
   const cli::ForkSpec back = cli::decode_fork_spec(args);
   EXPECT_EQ(back.pid_fd, 7);
+  EXPECT_EQ(back.agents_nice, 0);
   ASSERT_EQ(back.children.size(), 2u);
   for (std::size_t k = 0; k < 2; ++k) {
     EXPECT_EQ(back.children[k].role, spec.children[k].role);
@@ -176,6 +345,11 @@ TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
   EXPECT_THROW(cli::decode_fork_spec(broken(3, "worker")), InputError);
   EXPECT_THROW(cli::decode_fork_spec(broken(6, "99")), InputError);  // argc past the end
   EXPECT_THROW(cli::decode_fork_spec(broken(6, "0")), InputError);
+  cli::ForkSpec yielding = spec;  // launch --agents-yield
+  yielding.agents_nice = 19;
+  EXPECT_EQ(cli::decode_fork_spec(cli::encode_fork_spec(yielding)).agents_nice, 19);
+  yielding.agents_nice = 20;
+  EXPECT_THROW(cli::encode_fork_spec(yielding), InputError);
   cli::ForkSpec no_log = spec;
   no_log.children[1].log.clear();
   EXPECT_THROW(cli::encode_fork_spec(no_log), InputError);

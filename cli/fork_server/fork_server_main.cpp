@@ -22,6 +22,7 @@
 #include <sys/types.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -31,6 +32,7 @@
 #include <vector>
 
 #include "agent/agent_entry.hpp"
+#include "agent/startup_priority.hpp"
 #include "coordinator/coordinator_entry.hpp"
 #include "fork_spec.hpp"
 #include "session_process.hpp"
@@ -91,11 +93,30 @@ void show_as(const ArgvArea& area, const std::vector<std::string>& argv) {
   prctl(PR_SET_NAME, name.c_str(), 0, 0, 0);  // kernel keeps 15 characters
 }
 
+// Whether the agents start below the coordinator's priority (agent/startup_priority.hpp):
+// when launch asks (--agents-yield) and the coordinator partitions launch's file while they
+// start (--graph), the only time it has work that their start-up slows down.
+bool agents_yield_at_start(const cli::ForkSpec& spec) {
+  if (spec.agents_nice <= 0) return false;
+  for (const cli::ForkChild& c : spec.children)
+    if (c.role == cli::ForkRole::kCoordinator)
+      return std::find(c.argv.begin(), c.argv.end(), "--graph") != c.argv.end();
+  return false;
+}
+
 // The child's side of a fork: the same process set-up as launch's exec path
-// (cli::enter_child_process), then the entry.
-[[noreturn]] void run_child(const cli::ForkSpec& spec, std::size_t k, const ArgvArea& area) {
+// (cli::enter_child_process), then the entry. `yield`: an agent starts lowered (its threads
+// here; its autogroup, this server's, once the server has forked every agent).
+[[noreturn]] void run_child(const cli::ForkSpec& spec, std::size_t k, const ArgvArea& area,
+                            bool yield) {
   const cli::ForkChild& c = spec.children[k];
   cli::enter_child_process(c);
+  // Before the entry creates any thread: every thread inherits this one's nice.
+  if (yield && c.role == cli::ForkRole::kAgent) {
+    agent::StartupPriorityOptions priority;
+    priority.nice = spec.agents_nice;
+    agent::enter_startup_priority(priority, true);
+  }
   // Descriptors meant for launch or for another child: an agent holding launch's progress
   // pipe would keep it open after the coordinator has left.
   close(spec.pid_fd);
@@ -136,6 +157,7 @@ int main(int argc, char** argv) {
   }
   const ArgvArea area{argv[0], static_cast<std::size_t>(argv[argc - 1] +
                                                         std::strlen(argv[argc - 1]) + 1 - argv[0])};
+  const bool yield = agents_yield_at_start(spec);
   for (std::size_t k = 0; k < spec.children.size(); ++k) {
     const int threads = thread_count();
     if (threads != 1) {
@@ -151,7 +173,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "tessera-fork-server: error: fork failed: %s\n", std::strerror(errno));
       return 1;
     }
-    if (pid == 0) run_child(spec, k, area);
+    if (pid == 0) run_child(spec, k, area, yield);
     const std::string line = std::to_string(pid) + "\n";
     if (write(spec.pid_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) {
       std::fprintf(stderr, "tessera-fork-server: error: cannot report pid %d to launch\n",
@@ -159,6 +181,10 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  // launch started this server in a session of its own, so its autogroup now holds only the
+  // agents (the coordinator made a session of its own): lowered only now, so that the forks
+  // themselves were not slowed. Each agent sets it back to 0 with its assignment.
+  if (yield) agent::lower_autogroup_nice(spec.agents_nice);
   close(spec.pid_fd);
   cli::exit_process(0);
 }

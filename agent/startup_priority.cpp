@@ -1,0 +1,178 @@
+#include "agent/startup_priority.hpp"
+
+#include <dirent.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <condition_variable>
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "util/input_error.hpp"
+
+namespace tessera::agent {
+
+void StartupPriorityOptions::validate() const {
+  if (nice < 1 || nice > 19)
+    throw InputError("StartupPriorityOptions.nice = " + std::to_string(nice) +
+                     ": must be in 1..19");
+  if (!(bound_s > 0.0 && bound_s <= 60.0))
+    throw InputError("StartupPriorityOptions.bound_s = " + std::to_string(bound_s) +
+                     ": must be in (0, 60]");
+}
+
+namespace {
+
+// Scheduling priority is a property of the process (its threads and its group), so what was
+// lowered is process state too.
+struct Lowered {
+  std::mutex mutex;
+  bool threads = false;
+  bool group = false;
+};
+
+Lowered& lowered() {
+  static Lowered state;
+  return state;
+}
+
+// The nice of this process's autogroup ("/autogroup-42 nice 19"), or nullopt-like -1000 when
+// the kernel has no autogroup support.
+int autogroup_nice() {
+  std::ifstream in("/proc/self/autogroup");
+  std::string name, word;
+  int nice = -1000;
+  if (in >> name >> word >> nice && word == "nice") return nice;
+  return -1000;
+}
+
+// Writes `nice` to /proc/self/autogroup; errno of the failure (EAGAIN: the kernel lets a
+// process without CAP_SYS_ADMIN change a group's nice once per 100 ms, machine-wide), 0 if done.
+int write_autogroup_nice(int nice) {
+  FILE* f = std::fopen("/proc/self/autogroup", "w");
+  if (!f) return errno;
+  const bool put = std::fprintf(f, "%d", nice) > 0;
+  int err = put ? 0 : errno;
+  if (std::fclose(f) != 0 && err == 0) err = errno;  // the write reaches the kernel here
+  return err;
+}
+
+// Whether a thread of this process may go back from a raised nice to 0: CAP_SYS_NICE in the
+// effective set (bit 23 of CapEff), or RLIMIT_NICE >= 20 (the limit is 20 - the lowest nice).
+bool can_restore_thread_nice() {
+  rlimit rl{};
+  if (getrlimit(RLIMIT_NICE, &rl) == 0 && (rl.rlim_cur == RLIM_INFINITY || rl.rlim_cur >= 20))
+    return true;
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("CapEff:", 0) == 0) {
+      const unsigned long long caps = std::strtoull(line.c_str() + 7, nullptr, 16);
+      return (caps >> 23) & 1ULL;
+    }
+  return false;
+}
+
+// Every thread of this process to nice 0; two passes, since a thread created during the first
+// by a thread still lowered inherits the lowered nice. Returns the threads changed.
+int restore_threads() {
+  int changed = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    DIR* dir = opendir("/proc/self/task");
+    if (!dir) return changed;
+    while (dirent* e = readdir(dir)) {
+      if (e->d_name[0] == '.') continue;
+      const id_t tid = static_cast<id_t>(std::atol(e->d_name));
+      errno = 0;
+      const int now = getpriority(PRIO_PROCESS, tid);
+      if (errno == 0 && now != 0 && setpriority(PRIO_PROCESS, tid, 0) == 0) ++changed;
+    }
+    closedir(dir);
+  }
+  return changed;
+}
+
+// The group back to nice 0, unless another agent of the group did it already; retried while
+// the kernel's rate limit refuses (EAGAIN), at most ~0.3 s.
+bool restore_group() {
+  for (int attempt = 0; attempt < 15; ++attempt) {
+    const int nice = autogroup_nice();
+    if (nice == 0 || nice == -1000) return true;
+    const int err = write_autogroup_nice(0);
+    if (err == 0) return true;
+    if (err != EAGAIN) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+}  // namespace
+
+bool lower_autogroup_nice(int nice) {
+  if (autogroup_nice() == -1000) return false;
+  return write_autogroup_nice(nice) == 0 && autogroup_nice() == nice;
+}
+
+bool enter_startup_priority(const StartupPriorityOptions& o, bool autogroup) {
+  o.validate();
+  Lowered& l = lowered();
+  std::lock_guard<std::mutex> lock(l.mutex);
+  l.group = autogroup;
+  l.threads = can_restore_thread_nice() && setpriority(PRIO_PROCESS, 0, o.nice) == 0;
+  return l.threads || l.group;
+}
+
+bool startup_priority_lowered() {
+  Lowered& l = lowered();
+  std::lock_guard<std::mutex> lock(l.mutex);
+  return l.threads || l.group;
+}
+
+std::string restore_startup_priority() {
+  Lowered& l = lowered();
+  std::lock_guard<std::mutex> lock(l.mutex);
+  std::ostringstream what;
+  if (l.threads) what << restore_threads() << " thread(s) back to nice 0";
+  if (l.group) {
+    if (l.threads) what << ", ";
+    what << (restore_group() ? "autogroup back to nice 0"
+                             : "autogroup NOT restored (" + std::to_string(autogroup_nice()) + ")");
+  }
+  l.threads = l.group = false;
+  return what.str();
+}
+
+struct StartupPriorityBound::State {
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool stop = false;
+  std::thread thread;
+};
+
+StartupPriorityBound::StartupPriorityBound(double bound_s) {
+  if (!startup_priority_lowered()) return;
+  state_ = new State;
+  State* st = state_;
+  st->thread = std::thread([st, bound_s] {
+    std::unique_lock<std::mutex> lock(st->mutex);
+    if (!st->cv.wait_for(lock, std::chrono::duration<double>(bound_s), [st] { return st->stop; }))
+      restore_startup_priority();
+  });
+}
+
+StartupPriorityBound::~StartupPriorityBound() {
+  if (!state_) return;
+  {
+    std::lock_guard<std::mutex> lock(state_->mutex);
+    state_->stop = true;
+  }
+  state_->cv.notify_all();
+  state_->thread.join();
+  delete state_;
+}
+
+}  // namespace tessera::agent
