@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -120,20 +121,49 @@ std::vector<long> pids_of(const std::string& pattern) {
   return pids;
 }
 
+// A 2-agent launch through the fork server on `domain` with enough rounds (3000 poses from
+// their file poses) that it is still going when its processes are looked at after round 2;
+// end() interrupts it and checks that everything stopped cleanly. Whatever an assertion leaves
+// running is killed by the destructor.
+struct LongForkedRun {
+  std::string dir = temp_dir();
+  std::string run_id;
+  int domain;
+  std::set<std::string> shm_before = shm_files();
+  Process launch;
+
+  LongForkedRun(const std::string& name, int domain_, const std::vector<std::string>& extra)
+      : run_id(name + "-" + std::to_string(getpid())), domain(domain_) {
+    std::vector<std::string> argv = {
+        bin("tessera"), "launch", "--agents",     "2",
+        "--poses",      "3000",   "--domain",     std::to_string(domain),
+        "--run-id",     run_id,   "--init",       "file",
+        "--grad-tol",   "1e-12",  "--max-rounds", "100000",
+        "--partition",  "fast",   "--timeout",    "60"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    launch = start(argv, dir + "/launch.log");
+  }
+  ~LongForkedRun() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
+
+  // SIGINT to launch: exit 130 naming the interruption, no process and no shared-memory file
+  // of the run left.
+  void end() {
+    kill(launch.pid, SIGINT);
+    ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
+    EXPECT_EQ(launch.exit_code, 130) << launch.output();
+    EXPECT_NE(launch.output().find("interrupted"), std::string::npos) << launch.output();
+    std::string ps;
+    run_command("pgrep -fc '[t]essera-.*--run-id " + run_id + "'", &ps);
+    EXPECT_EQ(std::stoi(ps), 0) << ps;
+    const auto leaked = leaked_shm_files(shm_before, domain);
+    EXPECT_TRUE(leaked.empty()) << join(leaked);
+  }
+};
+
 TEST(DdsForkServer, YieldingAgentsShareASessionAndRunTheirRoundsAtNiceZero) {
-  const std::string dir = temp_dir();
-  const std::string run_id = "yield-" + std::to_string(getpid());
-  struct Cleanup {  // whatever an assertion leaves running
-    std::string run_id;
-    ~Cleanup() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
-  } cleanup{run_id};
-  const auto before = shm_files();
-  Process launch =
-      start({bin("tessera"), "launch", "--agents",      "2",      "--poses",     "3000",
-             "--domain",     "212",    "--run-id",      run_id,   "--init",      "file",
-             "--grad-tol",   "1e-12",  "--max-rounds",  "100000", "--partition", "fast",
-             "--timeout",    "60",     "--agents-yield"},
-            dir + "/launch.log");
+  LongForkedRun run("yield", 212, {"--agents-yield"});
+  const std::string& run_id = run.run_id;
+  const Process& launch = run.launch;
   ASSERT_TRUE(wait_for_output(launch, "round 2:", 30)) << launch.output();
   // Every agent has its assignment: all its threads and its group are back at nice 0.
   const std::vector<long> agents = pids_of("[t]essera-agent.*--run-id " + run_id + " ");
@@ -150,22 +180,15 @@ TEST(DdsForkServer, YieldingAgentsShareASessionAndRunTheirRoundsAtNiceZero) {
     if (group != -1000) {
       EXPECT_EQ(group, 0) << pid;
     }
-    run_command("ls /proc/" + std::to_string(pid) + "/task > " + dir + "/tasks", nullptr);
-    std::ifstream tasks(dir + "/tasks");
+    run_command("ls /proc/" + std::to_string(pid) + "/task > " + run.dir + "/tasks", nullptr);
+    std::ifstream tasks(run.dir + "/tasks");
     int seen = 0;
     for (std::string tid; tasks >> tid; ++seen)
       EXPECT_EQ(stat_field("/proc/" + std::to_string(pid) + "/task/" + tid + "/stat", 19), 0)
           << "agent " << pid << " thread " << tid;
     EXPECT_GT(seen, 1);
   }
-  kill(launch.pid, SIGINT);
-  ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
-  EXPECT_EQ(launch.exit_code, 130) << launch.output();
-  std::string ps;
-  run_command("pgrep -fc '[t]essera-.*--run-id " + run_id + "'", &ps);
-  EXPECT_EQ(std::stoi(ps), 0) << ps;
-  const auto leaked = leaked_shm_files(before, 212);
-  EXPECT_TRUE(leaked.empty()) << join(leaked);
+  run.end();
 }
 
 // In a forked child (so neither the test's session nor its threads change): what
@@ -242,20 +265,9 @@ TEST(StartupPriority, OptionsNameTheBadField) {
 }
 
 TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndStopOnSigint) {
-  const std::string dir = temp_dir();
-  const std::string run_id = "forked-" + std::to_string(getpid());
-  struct Cleanup {  // whatever an assertion leaves running
-    std::string run_id;
-    ~Cleanup() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
-  } cleanup{run_id};
-  const auto before = shm_files();
-  // 3000 poses from their file poses: enough rounds that the run is still going when its
-  // processes are looked up and interrupted after round 2.
-  Process launch = start(
-      {bin("tessera"), "launch",   "--agents",    "2",      "--poses",   "3000",       "--domain",
-       "52",           "--run-id", run_id,        "--init", "file",      "--grad-tol", "1e-12",
-       "--max-rounds", "100000",   "--partition", "fast",   "--timeout", "60"},
-      dir + "/launch.log");
+  LongForkedRun run("forked", 52, {});
+  const std::string& run_id = run.run_id;
+  const Process& launch = run.launch;
   ASSERT_TRUE(wait_for_output(launch, "round 2:", 30)) << launch.output();
   EXPECT_NE(launch.output().find("forked by tessera-fork-server"), std::string::npos);
   // pgrep -f reads the command line each forked child shows: its executable's argv.
@@ -273,15 +285,7 @@ TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndS
     std::getline(comm, name);
     EXPECT_EQ(name.rfind("tessera-", 0), 0u) << name;
   }
-  kill(launch.pid, SIGINT);
-  ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
-  EXPECT_EQ(launch.exit_code, 130) << launch.output();
-  EXPECT_NE(launch.output().find("interrupted"), std::string::npos) << launch.output();
-  std::string ps;
-  run_command("pgrep -fc '[t]essera-.*--run-id " + run_id + "'", &ps);
-  EXPECT_EQ(std::stoi(ps), 0) << ps;
-  const auto leaked = leaked_shm_files(before, 52);
-  EXPECT_TRUE(leaked.empty()) << join(leaked);
+  run.end();
 }
 
 TEST(DdsForkServer, BadFileStopsTheForkedRunWithTheAgentsReason) {
@@ -299,12 +303,21 @@ TEST(DdsForkServer, BadFileStopsTheForkedRunWithTheAgentsReason) {
 // A child that ignores SIGINT is SIGKILLed after the grace period, and launch names it (its
 // shared-memory files cannot be removed by it: the message says where leftovers come from).
 TEST(DdsForkServer, StopAllKillsAndNamesAChildThatIgnoresSigint) {
+  // The child says when it ignores SIGINT: stop_all's SIGINT must not come before that (on a
+  // loaded host the child may not have run yet, and then SIGINT ends it with 130).
+  int ready[2];
+  ASSERT_EQ(pipe(ready), 0);
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     signal(SIGINT, SIG_IGN);
+    if (write(ready[1], "r", 1) != 1) _exit(1);
     for (;;) pause();
   }
+  close(ready[1]);
+  char byte = 0;
+  ASSERT_EQ(read(ready[0], &byte, 1), 1);
+  close(ready[0]);
   std::vector<cli::Child> children(1);
   children[0].name = "agent 7";
   children[0].pid = pid;
