@@ -1,4 +1,5 @@
-// `tessera partition GRAPH --parts N [--preset P] [--eps E] [--seed S] [--out FILE] [--json FILE]`:
+// `tessera partition GRAPH --parts N [--preset P] [--eps E] [--seed S] [--islands K] [--out FILE]
+// [--json FILE]`:
 // splits a pose graph (g2o) or a METIS graph into N balanced blocks and reports the quality.
 
 #include <cstdio>
@@ -20,7 +21,7 @@ namespace {
 
 const char* const kHelp =
     "usage: tessera partition GRAPH --parts N [--preset P] [--eps E] [--seed S]\n"
-    "                         [--out FILE] [--json FILE] [--format F]\n"
+    "                         [--islands K] [--out FILE] [--json FILE] [--format F]\n"
     "\n"
     "Splits the poses of GRAPH into N balanced blocks (one per agent) with few cut edges,\n"
     "using only the graph's structure. Every block holds at most floor((1+eps)*ceil(n/N))\n"
@@ -35,6 +36,10 @@ const char* const kHelp =
     "                 (see docs/partitioning.md)\n"
     "  --eps E        balance slack, 0..1 (default 0.03)\n"
     "  --seed S       non-negative integer; same seed, same partition (default 1)\n"
+    "  --islands K    strong/highest: independent searches, each on its own thread and each\n"
+    "                 with the preset's whole budget (K x the CPU); 0 = the preset's own\n"
+    "                 (strong 1, highest 2), else 1..8. The partition depends on K and the\n"
+    "                 seed, never on the machine (default 0)\n"
     "  --out FILE     write the block id of pose i on line i (0-based, one per line)\n"
     "  --json FILE    write the figures as one JSON object to FILE ('-' for stdout)\n"
     "  --format F     g2o | metis: override the format detection\n"
@@ -86,6 +91,7 @@ std::string result_json(const GraphStructure& g, const PartitionOptions& o,
       .add("preset", preset_name(o.preset))
       .add("eps", o.eps)
       .add("seed", static_cast<long long>(o.seed))  // parsed from a non-negative long
+      .add("islands", o.islands)
       .add("cut_edges", m.cut_edges)
       .add("cut_pairs", m.cut_pairs)
       .add("block_sizes", m.block_sizes)
@@ -104,7 +110,8 @@ std::string result_json(const GraphStructure& g, const PartitionOptions& o,
 }  // namespace
 
 int run_partition(const Args& args) {
-  Arguments a(args, {"parts", "preset", "eps", "seed", "out", "json", "format"}, {"help"});
+  Arguments a(args, {"parts", "preset", "eps", "seed", "islands", "out", "json", "format"},
+              {"help"});
   if (a.has("help")) {
     std::fputs(kHelp, stdout);
     return 0;
@@ -125,6 +132,10 @@ int run_partition(const Args& args) {
   const long seed = a.get_long("seed", 1);
   if (seed < 0) throw InputError("option --seed: must be a non-negative integer");
   options.seed = static_cast<std::uint64_t>(seed);
+  const long islands = a.get_long("islands", 0);
+  if (islands < 0 || islands > 8)
+    throw InputError("option --islands: " + std::to_string(islands) + " is outside 0..8");
+  options.islands = static_cast<int>(islands);
   options.validate();
 
   const GraphStructure g = load_structure(a.positional()[0], a.get_or("format", ""));

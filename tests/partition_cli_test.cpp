@@ -58,6 +58,21 @@ TEST(PartitionCli, G2oInputWritesAssignmentAndJson) {
     EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
 }
 
+// --islands reaches PartitionOptions::islands: highest with four islands traces island 3, and
+// the JSON says how many were asked for.
+TEST(PartitionCli, IslandsOptionSetsTheSearchCount) {
+  const std::string dir = tessera::test::temp_dir();
+  const std::string g = write_file(dir, "chain.g2o", chain_g2o(120));
+  std::string out;
+  ASSERT_EQ(
+      partition(g + " --parts 3 --preset highest --islands 4 --json " + dir + "/p.json", &out), 0)
+      << out;
+  const std::string json = read_all(dir + "/p.json");
+  EXPECT_NE(json.find("\"islands\": 4"), std::string::npos) << json;
+  EXPECT_NE(json.find("island 3:"), std::string::npos) << json;
+  EXPECT_EQ(json.find("island 4:"), std::string::npos) << json;
+}
+
 TEST(PartitionCli, SequentialPresetIsContiguous) {
   const std::string dir = tessera::test::temp_dir();
   const std::string g = write_file(dir, "chain.g2o", chain_g2o(10));
@@ -87,6 +102,7 @@ TEST(PartitionCli, BadInputIsAClearError) {
       {g + " --parts 0", "--parts: 0 is outside 1..64"},
       {g + " --parts 65", "--parts: 65 is outside 1..64"},
       {g + " --parts 2 --eps -0.5", "--eps: -0.5 is outside 0..1"},
+      {g + " --parts 2 --islands 9", "--islands: 9 is outside 0..8"},
       {g + " --parts 2 --preset best", "unknown preset 'best'"},
       {g, "--parts N is required"},
       {g + " --parts 2 --colour red", "unknown option --colour"},

@@ -1,8 +1,8 @@
 // The island model of the memetic search (island_search.hpp): two islands on their own threads
 // give the same partition for the same seed (with and without exchanges, through evolve() and
 // through the `highest` preset), two islands that never exchange are never worse than the single
-// search (island 0 is that search step for step), `highest` runs four islands on small graphs
-// and two on larger ones, and bad options name the field.
+// search (island 0 is that search step for step), `highest` runs two islands unless asked for four,
+// and bad options name the field.
 
 #include <gtest/gtest.h>
 
@@ -143,17 +143,21 @@ TEST(IslandSearch, HighestPresetIsDeterministicAndTracesTheIslands) {
   EXPECT_TRUE(traces_island(a, 1)) << "highest must run several islands";
 }
 
-// highest's island count follows the graph's size in its budget unit, (n + edges) x max(1, N/5):
-// four islands up to 16000 (a 384-pose grid, N = 5), two above (an 8000-pose path, N = 10:
-// 15999 x 2). The path's optimal cut (9) is found either way.
-TEST(IslandSearch, HighestRunsFourIslandsOnSmallGraphsAndTwoOnLargerOnes) {
+// highest runs two islands on every graph unless PartitionOptions::islands asks for more (four:
+// islands 0-3 traced, no fifth). The path's optimal cut (9) is found either way.
+TEST(IslandSearch, HighestRunsTwoIslandsUnlessAskedForFour) {
   PartitionOptions o;
   o.preset = PartitionPreset::kHighest;
   o.parts = 5;
   o.seed = 2;
-  const PartitionResult small = partition_graph(grid_with_chords(24, 16, 7), o);
-  EXPECT_TRUE(traces_island(small, 3));
-  EXPECT_FALSE(traces_island(small, 4));
+  const PartitionResult two = partition_graph(grid_with_chords(24, 16, 7), o);
+  EXPECT_TRUE(traces_island(two, 1));
+  EXPECT_FALSE(traces_island(two, 2));
+  o.islands = 4;
+  const PartitionResult four = partition_graph(grid_with_chords(24, 16, 7), o);
+  EXPECT_TRUE(traces_island(four, 3));
+  EXPECT_FALSE(traces_island(four, 4));
+  o.islands = 0;
   o.parts = 10;
   const PartitionResult path = partition_graph(test::grid_structure(8000, 1), o);
   EXPECT_TRUE(traces_island(path, 1));

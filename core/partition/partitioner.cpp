@@ -60,10 +60,6 @@ double cpu_ms_since(std::clock_t c0) {
   return 1000.0 * static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
 }
 
-// `highest` runs four islands instead of two up to this graph size ((n + edges) x max(1, N/5),
-// the unit of its operation budget): torus3D (14048) gets four, cubicle (18236) two.
-constexpr double kFourIslandSize = 16000.0;
-
 // Per-preset effort (see docs/partitioning.md). Shared by all presets: coarse vertices stay
 // below lmax/30 so the coarsest graph (a few dozen vertices per block) can still be balanced.
 struct PresetPlan {
@@ -180,15 +176,12 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // quarter of the budget the islands fell into one arrangement early (session 8, rim
         // seeds 1-4 258/264/243/262, torus3D 242/240/244/245 instead of 258/266/243/243 and
         // 242/240/242/246 for one island; docs/partitioning.md).
-        // Small graphs (per_op <= kFourIslandSize, i.e. n + edges <= 16000 at N <= 5) get four
-        // islands, i.e. twice the CPU: their search stops on its stall limit in 1-2 s, so
-        // there is room under 5 s, and more independent searches reach more arrangements
-        // (session 9, torus3D seeds 1-4: 240/240/242/243 instead of 242/240/242/246; the six
-        // other small benchmark graphs identical on every seed). Larger graphs spend their
-        // whole budget already (rim, city10000, grid3D ~4-4.7 s wall idle) and keep two.
-        // Islands 0 and 1 are the same searches as with two islands, so the best before the
-        // polish is never worse. Depends on the graph only, never on the machine.
-        plan.evolution.islands.islands = strong ? 1 : (per_op <= kFourIslandSize ? 4 : 2);
+        // Four islands (PartitionOptions::islands = 4, `--islands 4`) reach torus3D's 240 at
+        // seed 1 (242 with two) and change no other small benchmark graph's partition, for
+        // twice the CPU; the distributed solve on torus3D's 240 split needs 162 IRBCD rounds
+        // against 91 on the 242 split. So two stay the default (session 9,
+        // docs/partitioning.md "Four islands as an option, not the default").
+        plan.evolution.islands.islands = strong ? 1 : 2;
         plan.evolution.islands.exchange_every = 0;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
