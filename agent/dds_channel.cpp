@@ -63,6 +63,9 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_
         transport::Seconds(std::max(0.0, left)));
     if (st == transport::WaitStatus::kStopped)
       throw RunStopped(session_.mailroom().stop_info()->reason);
+    // On the relay agent: the statuses that just woke us may complete a step the others
+    // wait for; send its bundle before handling them (status_relay.hpp).
+    session_.relay_statuses();
     if (st == transport::WaitStatus::kTimeout) return std::nullopt;
     if (auto a = take_reassignment(session_)) throw RepartitionRequested(std::move(*a));
     if (auto r = take_rollback(session_)) throw *r;

@@ -1,8 +1,8 @@
 // Who receives what (docs/dds-runtime.md, "Who receives what"): a pose block addressed to
-// one agent reaches only that agent's process, a broadcast reaches every other agent, and
-// only the round statuses the coordinator reads (coordinator_reads_status) reach the
-// coordinator. A coordinator and three agents, each a Session of its own in this process,
-// on DDS domain 60.
+// one agent reaches only that agent's process, a broadcast reaches every other agent, only
+// the round statuses the coordinator reads (coordinator_reads_status) reach the coordinator,
+// and round statuses go through the relay agent (one bundle per step). A coordinator and three
+// agents, each a Session of its own in this process, on DDS domain 60.
 
 #include <gtest/gtest.h>
 
@@ -53,10 +53,10 @@ OutgoingMessage block_to(std::vector<std::uint32_t> recipients, std::uint32_t ph
   return m;
 }
 
-OutgoingMessage status(std::uint32_t phase) {
+OutgoingMessage status(std::uint32_t phase, std::uint32_t sender = 0) {
   RoundStatusMessage s;
   s.round = 7;
-  s.sender = 0;
+  s.sender = sender;
   s.phase = phase;
   s.cost = 1.5;
   OutgoingMessage m;
@@ -103,30 +103,41 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   a0.send(block_to({1}, 2));  // addressed to agent 1 only
   a0.send(block_to({}, 3));   // broadcast
   a0.send(block_to({2}, 4));  // addressed to agent 2 only
-  a0.send(status(1));         // a round status: agents and coordinator
-  a0.send(status(101));       // a rounding reduction: agents only
-  a0.flush(Seconds(10));      // acknowledged = delivered to every matched reader
+  a0.send(status(101));       // a rounding reduction: agents only, all to all
+  // Round statuses of the solve go through the relay, agent 0 (transport/status_relay.hpp),
+  // when the agents turn it on (as tessera-agent does unless lost agents are arbitrated):
+  // agents 1 and 2 send theirs to it alone ...
+  for (Session* a : {&a0, &a1, &a2}) a->set_status_relay(true);
+  a1.send(status(1, 1));
+  a2.send(status(1, 2));
+  const std::vector<std::uint32_t> at0 = received_phases(a0, 2);
+  EXPECT_EQ(at0, (std::vector<std::uint32_t>{1u, 1u}));
+  // ... and its own completes the step: one bundle of all three to every agent and the
+  // coordinator.
+  a0.send(status(1, 0));
+  a0.flush(Seconds(10));  // acknowledged = delivered to every matched reader
 
-  const std::vector<std::uint32_t> at1 = received_phases(a1, 4);
-  const std::vector<std::uint32_t> at2 = received_phases(a2, 4);
-  EXPECT_EQ(at1.size(), 4u);
-  EXPECT_EQ(at2.size(), 4u);
+  const std::vector<std::uint32_t> at1 = received_phases(a1, 5);
+  const std::vector<std::uint32_t> at2 = received_phases(a2, 5);
+  EXPECT_EQ(at1.size(), 5u);
+  EXPECT_EQ(at2.size(), 5u);
   EXPECT_EQ(std::count(at1.begin(), at1.end(), 2u), 1);
   EXPECT_EQ(std::count(at1.begin(), at1.end(), 4u), 0);
   EXPECT_EQ(std::count(at2.begin(), at2.end(), 4u), 1);
   EXPECT_EQ(std::count(at2.begin(), at2.end(), 2u), 0);
-  for (const auto* at : {&at1, &at2})
-    for (std::uint32_t phase : {3u, 1u, 101u})
-      EXPECT_EQ(std::count(at->begin(), at->end(), phase), 1);
+  for (const auto* at : {&at1, &at2}) {
+    for (std::uint32_t phase : {3u, 101u}) EXPECT_EQ(std::count(at->begin(), at->end(), phase), 1);
+    EXPECT_EQ(std::count(at->begin(), at->end(), 1u), 2);  // the other two agents' statuses
+  }
   // Nothing more was delivered to either agent's process: the addressed block of the other
-  // agent never reached it, not even to be dropped.
+  // agent never reached it, not even to be dropped, and the two statuses came as one sample.
   EXPECT_EQ(a1.stats().protocol_samples_received, 4u);
   EXPECT_EQ(a2.stats().protocol_samples_received, 4u);
-  // The sender's own readers see its broadcasts (same topic, same participant) but never
-  // pass them on.
+  // The sender's own readers see its broadcasts and its bundle (same topic, same
+  // participant) but never pass them on.
   EXPECT_EQ(a0.protocol().size(), 0u);
 
-  // The coordinator got the round status only.
+  // The coordinator got the round statuses only, every agent's, from the one bundle.
   std::vector<wire::RoundStatus> watched;
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
   while (std::chrono::steady_clock::now() < until) {
@@ -136,8 +147,12 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // room for a wrong extra one
   for (auto& m : coordinator.status_watch().take_all()) watched.push_back(std::move(m));
-  ASSERT_EQ(watched.size(), 1u);
-  EXPECT_EQ(watched[0].phase(), 1u);
+  ASSERT_EQ(watched.size(), 3u);
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(watched[k].phase(), 1u);
+    EXPECT_EQ(watched[k].sender(), k);
+    EXPECT_EQ(watched[k].round(), 7u);
+  }
 
   for (auto it = sessions.rbegin(); it != sessions.rend(); ++it) (*it)->close();
 }

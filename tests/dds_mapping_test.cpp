@@ -10,6 +10,8 @@
 #include "transport/inbox.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_identity.hpp"
+#include "transport/status_relay.hpp"
+#include "transport/transport_error.hpp"
 #include "util/input_error.hpp"
 
 namespace {
@@ -77,6 +79,68 @@ TEST(DdsMapping, RoundStatusRoundTrips) {
   EXPECT_EQ(back.block_grad_norm, 0.25);
   EXPECT_TRUE(back.restart_vote);
   EXPECT_FALSE(back.done_vote);
+}
+
+// The relay's bundles (transport/status_relay.hpp): every status of a step, exactly, and only
+// once the relay's own is in; steps of an epoch abandoned by a rollback are dropped.
+TEST(DdsStatusRelay, BundlesCarryEveryStatusOfAStepExactly) {
+  auto status = [](std::uint32_t sender, std::uint32_t epoch, double cost) {
+    RoundStatusMessage m;
+    m.round = 4;
+    m.sender = sender;
+    m.phase = 1;
+    m.cost = cost;
+    m.grad_norm_sq = cost / 3.0;
+    m.block_grad_norm = 1.0 / (sender + 7.0);
+    m.done_vote = sender == 2;
+    wire::RoundStatus w = to_wire_status(m, "r", true, {});
+    w.epoch(epoch);
+    return w;
+  };
+  ASSERT_TRUE(relayed_phase(1));
+  ASSERT_TRUE(relayed_phase(5));
+  ASSERT_FALSE(relayed_phase(101));
+  ASSERT_FALSE(relayed_phase(200));
+  StatusRelay relay(3);
+  EXPECT_FALSE(relay.add(status(2, 0, 0.1), 0));
+  EXPECT_FALSE(relay.add(status(1, 0, 0.2), 0));
+  EXPECT_FALSE(relay.add(status(1, 1, 0.3), 0));              // the next epoch: another step
+  EXPECT_TRUE(relay.take_bundles("r", kRelayAgent).empty());  // the relay's own is missing
+  EXPECT_TRUE(relay.add(status(kRelayAgent, 0, 1e-300), 0));
+  const std::vector<wire::RoundStatus> bundles = relay.take_bundles("r", kRelayAgent);
+  ASSERT_EQ(bundles.size(), 1u);
+  EXPECT_EQ(bundles[0].sender(), kRelayAgent);
+  EXPECT_EQ(bundles[0].round(), 4u);
+  EXPECT_EQ(bundles[0].epoch(), 0u);
+  const std::vector<wire::RoundStatus> back = StatusRelay::unpack(bundles[0]);
+  ASSERT_EQ(back.size(), 3u);
+  const double costs[] = {1e-300, 0.2, 0.1};
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(back[k].sender(), k);  // in sender order
+    EXPECT_EQ(back[k].run_id(), "r");
+    EXPECT_EQ(back[k].round(), 4u);
+    EXPECT_EQ(back[k].phase(), 1u);
+    EXPECT_EQ(back[k].cost(), costs[k]);
+    EXPECT_EQ(back[k].grad_norm_sq(), costs[k] / 3.0);
+    EXPECT_EQ(back[k].block_grad_norm(), 1.0 / (k + 7.0));
+    EXPECT_EQ(back[k].done_vote(), k == 2);
+    EXPECT_FALSE(back[k].restart_vote());
+  }
+  EXPECT_TRUE(relay.take_bundles("r", kRelayAgent).empty());
+  // A rollback to epoch 2: what epoch 1 collected is void, statuses of it are ignored.
+  EXPECT_FALSE(relay.add(status(2, 1, 0.4), 2));
+  EXPECT_FALSE(relay.add(status(kRelayAgent, 1, 0.4), 2));
+  EXPECT_FALSE(relay.add(status(2, 2, 0.5), 2));
+  EXPECT_FALSE(relay.add(status(1, 2, 0.5), 2));
+  EXPECT_TRUE(relay.add(status(kRelayAgent, 2, 0.5), 2));
+  ASSERT_EQ(relay.take_bundles("r", kRelayAgent).size(), 1u);
+
+  wire::RoundStatus bad = bundles[0];
+  bad.bundle().pop_back();
+  EXPECT_THROW(StatusRelay::unpack(bad), TransportError);
+  bad = bundles[0];
+  bad.bundle()[0] = -1.0;
+  EXPECT_THROW(StatusRelay::unpack(bad), TransportError);
 }
 
 TEST(DdsMapping, HandoffCarriesMeasurementsAndPosesExactly) {

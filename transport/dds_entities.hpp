@@ -169,9 +169,8 @@ void DdsEntities::make_reader(const std::string& name, bool transient_local, Exp
                               std::function<void(T&&)> deliver) {
   namespace dds = eprosima::fastdds::dds;
   dds::Topic* t = topic<PubSubType>(name);
-  // Per-round traffic is not traced sample by sample (kBlockTopic and block_topic_for(k)).
-  const bool set_up_topic =
-      name.rfind(kBlockTopic, 0) != 0 && name != kStatusTopic && name != kAgentStatusTopic;
+  // Per-round traffic is not traced sample by sample, and has no liveliness lease.
+  const bool set_up_topic = !is_round_topic(name);
   auto drain = [this, deliver, set_up_topic, name](dds::DataReader* reader) {
     T sample;
     dds::SampleInfo info;

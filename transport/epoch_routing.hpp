@@ -21,6 +21,8 @@ class EpochRouter {
   EpochRouter(Mailroom& room, Inbox<ProtocolMessage>& inbox, std::uint32_t protocol_id);
 
   std::uint32_t epoch() const;
+  /// epoch() for a caller that holds the mailroom lock.
+  std::uint32_t epoch_locked() const { return epoch_; }
   std::uint32_t protocol_id() const;
   /// Moves to `epoch` with `protocol_id` (ignored if `epoch` is older than the current one):
   /// drops every queued protocol message (all of older epochs) and releases the held ones of

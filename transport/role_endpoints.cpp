@@ -5,6 +5,7 @@
 #include "tesseraPubSubTypes.h"
 #include "transport/message_mapping.hpp"
 #include "transport/session_parts.hpp"
+#include "transport/status_relay.hpp"
 #include "transport/topic_names.hpp"
 
 namespace tessera::transport {
@@ -50,8 +51,13 @@ void create_coordinator_endpoints(SessionParts& s) {
       kAnnounceTopic, true, Expect::kNone,
       [&s](wire::AgentAnnouncement&& m) { s.announce_in.push(std::move(m)); });
   e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
-      kStatusTopic, false, Expect::kAllAgents,
-      [&s](wire::RoundStatus&& m) { s.status_in.push(std::move(m)); });
+      kStatusTopic, false, Expect::kAllAgents, [&s](wire::RoundStatus&& m) {
+        if (m.bundle().empty()) {
+          s.status_in.push(std::move(m));
+          return;
+        }
+        for (auto& one : StatusRelay::unpack(m)) s.status_in.push(std::move(one));  // relayed
+      });
   e.make_reader<wire::FinalEstimatePubSubType, wire::FinalEstimate>(
       kFinalTopic, false, Expect::kAllAgents,
       [&s](wire::FinalEstimate&& m) { s.final_in.push(std::move(m)); });
@@ -75,6 +81,11 @@ void create_agent_endpoints(SessionParts& s) {
   e.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false,
                                              Expect::kOtherAgentsAndCoordinator);
   e.make_writer<wire::RoundStatusPubSubType>(kAgentStatusTopic, false, Expect::kOtherAgents);
+  // Round statuses through the relay (status_relay.hpp): the others write to it, it reads.
+  const bool relayed = s.opt.num_agents >= kMinAgentsForRelay;
+  if (relayed && me != kRelayAgent)
+    e.make_writer<wire::RoundStatusPubSubType>(kRelayStatusTopic, false, Expect::kAgent,
+                                               kRelayAgent);
   e.make_writer<wire::FinalEstimatePubSubType>(kFinalTopic, false, Expect::kCoordinator);
   e.make_reader<wire::PartitionAssignmentPubSubType, wire::PartitionAssignment>(
       kAssignmentTopic, true, Expect::kNone,
@@ -100,6 +111,23 @@ void create_agent_endpoints(SessionParts& s) {
     e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
         topic, false, Expect::kOtherAgents, [&s](wire::RoundStatus&& m) {
           ++s.protocol_samples;
+          if (!m.bundle().empty()) {
+            // A relay's bundle: every agent's status of one step (ours is dropped by the
+            // router); the relay's own copy of its bundle is not for it.
+            if (m.sender() == s.router.protocol_id()) return;
+            for (const auto& one : StatusRelay::unpack(m))
+              s.router.deliver(one.epoch(), one.sender(), true, {},
+                               ProtocolMessage(from_wire(one)));
+            return;
+          }
+          s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
+                           ProtocolMessage(from_wire(m)));
+        });
+  if (relayed && me == kRelayAgent)
+    e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
+        kRelayStatusTopic, false, Expect::kOtherAgents, [&s](wire::RoundStatus&& m) {
+          ++s.protocol_samples;
+          s.room.with_lock([&] { return s.relay.add(m, s.router.epoch_locked()); });
           s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
                            ProtocolMessage(from_wire(m)));
         });

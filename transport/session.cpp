@@ -170,9 +170,31 @@ void Session::send(const OutgoingMessage& m) {
     const auto& status = std::get<RoundStatusMessage>(m.message);
     wire::RoundStatus w = to_wire_status(status, run, m.broadcast, m.recipients);
     w.epoch(e);
+    if (relayed_phase(status.phase) && impl_->relays_statuses()) {
+      if (impl_->me.agent_id != kRelayAgent) {
+        impl_->writer.write(kRelayStatusTopic, w);
+        return;
+      }
+      // The relay's own status completes a step when the others' came first.
+      impl_->room.with_lock([&] { return impl_->relay.add(w, impl_->router.epoch_locked()); });
+      relay_statuses();
+      return;
+    }
     impl_->writer.write(coordinator_reads_status(status.phase) ? kStatusTopic : kAgentStatusTopic,
                         w);
   }
+}
+
+void Session::set_status_relay(bool on) {
+  impl_->relay_enabled = on;
+}
+
+void Session::relay_statuses() {
+  SessionParts& s = *impl_;
+  if (!s.relays_statuses() || s.me.agent_id != kRelayAgent) return;
+  std::vector<wire::RoundStatus> bundles =
+      s.room.with_lock([&] { return s.relay.take_bundles(s.opt.run_id, kRelayAgent); });
+  for (const auto& b : bundles) s.writer.write(kStatusTopic, b);
 }
 
 void Session::send_control(wire::ControlKind kind, const std::string& reason) {

@@ -100,8 +100,18 @@ class Session {
   void publish(const wire::PartitionAssignment& m);
   void publish(const wire::MeasurementHandoff& m);
   void publish(const wire::FinalEstimate& m);
-  /// A round-protocol message from this agent (run id and routing filled in here).
+  /// A round-protocol message from this agent (run id and routing filled in here). Round
+  /// statuses of the solve go through the relay agent in runs of at least 3 agents
+  /// (transport/status_relay.hpp): to it alone, and from it to everyone as one bundle per step.
   void send(const OutgoingMessage& m);
+  /// On the relay agent: sends the status bundles of the steps completed since the last call
+  /// (their last status came in on a listener thread, which must not write). Call whenever a
+  /// wait for protocol messages ends; nothing to do on any other process.
+  void relay_statuses();
+  /// Round statuses through the relay (see send()) or, off (the default), all to all. Every
+  /// agent of a run must choose the same before its first round status. Off where the
+  /// coordinator arbitrates lost agents: it then reads each agent's round from its own status.
+  void set_status_relay(bool on);
   /// READY / FINISHED from this process (ABORT: send_abort).
   void send_control(wire::ControlKind kind, const std::string& reason = "");
   /// ABORT: the run stops because of `cause`, a failure of process `origin` (agent id, or

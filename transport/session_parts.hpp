@@ -21,6 +21,7 @@
 #include "transport/run_identity.hpp"
 #include "transport/sample_writing.hpp"
 #include "transport/session_options.hpp"
+#include "transport/status_relay.hpp"
 
 namespace tessera::transport {
 
@@ -54,6 +55,15 @@ struct SessionParts {
   // recipients are then no longer agent ids, so addressed pose blocks go on the shared
   // kBlockTopic (every agent's router picks its own) instead of block_topic_for(recipient).
   bool renumbered = false;
+  // The relay agent's collection of round statuses (guarded by room's mutex).
+  StatusRelay relay{opt.num_agents};
+  bool relay_enabled = false;  // Session::set_status_relay
+  /// Whether this agent's round statuses go through the relay (status_relay.hpp): agents of
+  /// runs of at least kMinAgentsForRelay that enabled it, until a re-partition renumbers the
+  /// protocol ids (the relay is agent kRelayAgent, whose id that changes).
+  bool relays_statuses() const {
+    return relay_enabled && !opt.coordinator && !renumbered && opt.num_agents >= kMinAgentsForRelay;
+  }
   // Protocol samples taken by the listeners (SessionStats::protocol_samples_received).
   std::atomic<std::uint64_t> protocol_samples{0};
 };

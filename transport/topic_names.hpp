@@ -20,6 +20,9 @@ inline constexpr const char* kControlTopic = "tessera_control";
 /// Round statuses only agents need (rounding reductions, the initialisation stage,
 /// certification): kept off kStatusTopic so the coordinator is not woken by each of them.
 inline constexpr const char* kAgentStatusTopic = "tessera_agent_status";
+/// Round statuses on their way to the relay agent, the topic's only reader
+/// (transport/status_relay.hpp); the relay sends them on as bundles on kStatusTopic.
+inline constexpr const char* kRelayStatusTopic = "tessera_status_relay";
 
 /// Whether the coordinator reads round statuses of this phase (they go on kStatusTopic, the
 /// others on kAgentStatusTopic): core's round statuses of the solve (phase 1, and 5 after a
@@ -44,7 +47,8 @@ inline std::string block_topic_for(std::uint32_t k) {
 /// The topics of the per-round traffic (pose blocks and round statuses, every kind): many
 /// small samples a second, so their endpoints carry no liveliness lease (qos.hpp).
 inline bool is_round_topic(const std::string& name) {
-  return name.rfind(kBlockTopic, 0) == 0 || name == kStatusTopic || name == kAgentStatusTopic;
+  return name.rfind(kBlockTopic, 0) == 0 || name == kStatusTopic || name == kAgentStatusTopic ||
+         name == kRelayStatusTopic;
 }
 
 }  // namespace tessera::transport
