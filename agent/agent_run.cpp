@@ -40,11 +40,13 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
   // With a rejoin window the coordinator arbitrates lost agents (it waits for a restart,
   // then orders a rollback, or gives up and aborts the run): do not stop on one.
   if (rejoin_enabled || restart || replication.enabled()) s.set_agent_loss_tolerated(true);
-  // Round statuses through the relay agent (transport/status_relay.hpp: N + 1 deliveries a
-  // step instead of N^2) unless lost agents are arbitrated: the rejoin arbiter picks the
-  // rollback round from each agent's own last status, which a relay waiting for a dead
-  // agent (or dead itself) would hold back. Every agent reads the same assignment.
-  s.set_status_relay(!(rejoin_enabled || restart || replication.enabled()));
+  // Round statuses through the relay agent when the coordinator asks for it
+  // (transport/status_relay.hpp: 2N - 1 deliveries a step instead of N^2), but never while
+  // lost agents are arbitrated: the rejoin arbiter picks the rollback round from each agent's
+  // own last status, which a relay waiting for a dead agent (or dead itself) would hold back.
+  // Every agent reads the same assignment, so all choose alike.
+  s.set_status_relay(setup && setup->status_relay &&
+                     !(rejoin_enabled || restart || replication.enabled()));
   const AgentLocalData* cur = &local;  // the survivors' new block after a re-partition
   if (replication.enabled() && !restart) replication.start(local, channel);
   if (restart) {

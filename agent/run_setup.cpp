@@ -97,6 +97,7 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
   out.rejoin_enabled = asg.rejoin_timeout_s() > 0;
   out.replicas = asg.replicas();
   out.replica_every = std::max<std::uint32_t>(1, asg.replica_every());
+  out.status_relay = asg.status_relay();
   log("assignment received (" +
       std::to_string(std::count(asg.owner().begin(), asg.owner().end(), o.id)) + " poses owned)");
 

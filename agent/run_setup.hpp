@@ -19,6 +19,7 @@ struct RunSetup {
   bool rejoin_enabled = false;       ///< The coordinator waits for lost agents to rejoin.
   std::uint32_t replicas = 0;        ///< Replicas of this agent's block (0: no re-partition).
   std::uint32_t replica_every = 10;  ///< Rounds between lifted-pose replicas, >= 1.
+  bool status_relay = false;         ///< Round statuses through agent 0 (coordinator's choice).
 };
 
 /// Runs steps 1-6 (and writes --dump-local). Throws InputError on bad input files,

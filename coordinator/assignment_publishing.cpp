@@ -29,6 +29,7 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   asg.partition_ms(part.ms);
   asg.rejoin_timeout_s(options.rejoin_timeout_s);
   asg.replicas(options.replicas);
+  asg.status_relay(options.status_relay);
   asg.replica_every(options.replica_every);
   return asg;
 }

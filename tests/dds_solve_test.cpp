@@ -1,6 +1,6 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-166 (each test its own, so ctest -j is safe).
+// Domains used here: 161-168 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -45,12 +45,14 @@ DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int
   return r;
 }
 
-void expect_same_as_in_process(const std::string& algorithm, int domain) {
+void expect_same_as_in_process(const std::string& algorithm, int domain,
+                               bool status_relay = false) {
   const std::string dir = temp_dir();
   const std::string graph = generate(dir, 240, 3, 5);
-  const DdsRun dds =
-      run_dds(dir, graph, 3, domain,
-              {"--partition", "eco", "--algorithm", algorithm, "--seed", "7", "--init", "file"});
+  std::vector<std::string> coordinator_args = {"--partition", "eco", "--algorithm", algorithm,
+                                               "--seed",      "7",   "--init",      "file"};
+  if (status_relay) coordinator_args.push_back("--status-relay");
+  const DdsRun dds = run_dds(dir, graph, 3, domain, coordinator_args);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(dds.assignment.size(), g.num_poses);
 
@@ -89,6 +91,13 @@ TEST(DdsSolve, IrbcdOverDdsGivesTheInProcessIterates) {
 
 TEST(DdsSolve, RbcdPlusPlusOverDdsGivesTheInProcessIterates) {
   expect_same_as_in_process("rbcd++", 162);
+}
+
+// Round statuses through the relay agent (transport/status_relay.hpp): the same statuses
+// reach every agent, so the same iterates (restarts included).
+TEST(DdsSolve, StatusRelayGivesTheInProcessIterates) {
+  expect_same_as_in_process("irbcd", 167, true);
+  expect_same_as_in_process("rbcd++", 168, true);
 }
 
 TEST(DdsLaunch, EndToEndOnAGeneratedGraphPrintsTheSummary) {
