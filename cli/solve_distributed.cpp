@@ -24,6 +24,9 @@ const char* const kDistributedValued[] = {"agents",
                                           "select",
                                           "rel-tol",
                                           "tr-steps",
+                                          "tr-grad-reduction",
+                                          "irbcd-tr-steps",
+                                          "irbcd-grad-reduction",
                                           "restart-c",
                                           "sigma",
                                           "unselected",
@@ -69,7 +72,14 @@ const char* kDistributedHelp =
     "  --sequential              one block per round (RBCD's and the baseline's rounds)\n"
     "  --seed S                  shared seed (uniform selection, partitioner)\n"
     "  --rank R                  relaxation rank (default 5)\n"
-    "  --tr-steps K              trust-region steps per block update (default 1)\n"
+    "  --tr-steps K              trust-region steps per block update, every algorithm\n"
+    "                            (default 1; IRBCD: see --irbcd-tr-steps)\n"
+    "  --tr-grad-reduction F     with --tr-steps K > 1: stop a block update early once its\n"
+    "                            block gradient fell to F times its start value (default 0:\n"
+    "                            always K steps)\n"
+    "  --irbcd-tr-steps K, --irbcd-grad-reduction F   the same for IRBCD only (RBCD and\n"
+    "                            RBCD++ keep --tr-steps, --tr-grad-reduction) (defaults 2,\n"
+    "                            0.2; K = 0, F < 0: take --tr-steps, --tr-grad-reduction)\n"
     "  --tcg-iters K             truncated-CG iterations per trust-region step (default 50)\n"
     "  --tcg-kappa K             tCG's relative residual target per step, in (0, 1) (default 0.1)\n"
     "  --block-precon tangent|euclidean   block updates' tCG preconditioner: the tangent-\n"
@@ -150,6 +160,15 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   opt.rank = static_cast<int>(a.get_long("rank", opt.rank));
   opt.block_update.trust_region_steps =
       static_cast<int>(a.get_long("tr-steps", opt.block_update.trust_region_steps));
+  opt.block_update.grad_reduction =
+      a.get_double("tr-grad-reduction", opt.block_update.grad_reduction);
+  // --tr-steps / --tr-grad-reduction set every algorithm's update, IRBCD's included, unless
+  // its own flag is given too.
+  if (a.has("tr-steps")) opt.irbcd_trust_region_steps = 0;
+  if (a.has("tr-grad-reduction")) opt.irbcd_grad_reduction = -1.0;
+  opt.irbcd_trust_region_steps =
+      static_cast<int>(a.get_long("irbcd-tr-steps", opt.irbcd_trust_region_steps));
+  opt.irbcd_grad_reduction = a.get_double("irbcd-grad-reduction", opt.irbcd_grad_reduction);
   opt.block_update.max_inner_iterations =
       static_cast<int>(a.get_long("tcg-iters", opt.block_update.max_inner_iterations));
   {

@@ -166,6 +166,16 @@ TEST(DistributedCli, RejectsBadOptions) {
           test::bin("tessera") + " solve " + g + " --algorithm irbcd --tangent-radius 0", &out),
       2);
   EXPECT_NE(out.find("tangent_radius_scale"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + g +
+                                  " --algorithm irbcd --irbcd-grad-reduction 1",
+                              &out),
+            2);
+  EXPECT_NE(out.find("irbcd_grad_reduction"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(
+                test::bin("tessera") + " solve " + g + " --algorithm rbcd++ --tr-grad-reduction -1",
+                &out),
+            2);
+  EXPECT_NE(out.find("grad_reduction"), std::string::npos) << out;
   EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + g + " --algorithm sgd", &out), 2);
   EXPECT_NE(out.find("irbcd"), std::string::npos) << out;
 }

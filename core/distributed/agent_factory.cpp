@@ -27,7 +27,7 @@ RoundConfig make_round_config(const DistributedOptions& options, const MomentumS
   config.grad_norm_tol = options.grad_norm_tol;
   config.max_rounds = options.max_rounds;
   config.rel_cost_decrease_tol = options.rel_cost_decrease_tol;
-  config.update = options.block_update;
+  config.update = options.algorithm_block_update();
   config.scheme = scheme;
   return config;
 }

@@ -1,5 +1,6 @@
 #include "distributed/distributed_solver.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <memory>
@@ -46,12 +47,26 @@ void DistributedOptions::validate() const {
   if (max_rounds < 0) fail("max_rounds", "must be >= 0");
   if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
   block_update.validate();
+  if (irbcd_trust_region_steps < 0) fail("irbcd_trust_region_steps", "must be >= 0");
+  if (!(irbcd_grad_reduction < 1)) fail("irbcd_grad_reduction", "must be < 1");
+  algorithm_block_update().validate();
   rbcd_plus_plus.validate();
   irbcd.validate();
   if (certify) {
     staircase.validate();
     if (staircase.max_rank < rank) fail("staircase.max_rank", "must be >= rank");
   }
+}
+
+BlockUpdateOptions DistributedOptions::algorithm_block_update() const {
+  BlockUpdateOptions o = block_update;
+  if (algorithm != DistributedAlgorithm::kIrbcd) return o;
+  if (irbcd_trust_region_steps > 0) {
+    o.trust_region_steps = irbcd_trust_region_steps;
+    o.max_attempts = std::max(o.max_attempts, o.trust_region_steps);
+  }
+  if (irbcd_grad_reduction >= 0) o.grad_reduction = irbcd_grad_reduction;
+  return o;
 }
 
 namespace {

@@ -19,6 +19,7 @@ void BlockUpdateOptions::validate() const {
   if (tangent_refresh_interval < 0) fail("tangent_refresh_interval", "must be >= 0");
   if (!(tangent_relative_shift >= 0 && std::isfinite(tangent_relative_shift)))
     fail("tangent_relative_shift", "must be finite and >= 0");
+  if (!(grad_reduction >= 0 && grad_reduction < 1)) fail("grad_reduction", "must be in [0, 1)");
   if (!(tangent_radius_scale > 0 && std::isfinite(tangent_radius_scale)))
     fail("tangent_radius_scale", "must be finite and > 0");
 }
@@ -27,13 +28,17 @@ Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd&
                              const BlockUpdateOptions& options, BlockPreconditioner* preconditioner,
                              double* grad_norm_sq, const TangentPreconditioner* tangent,
                              BlockUpdateStats* stats) {
+  // One trust-region run: `trust_region_steps` accepted steps within `max_attempts` attempts
+  // (a rejected step shrinks the radius and retries from the same point and gradient).
   TrustRegionOptions tr;
-  tr.max_iterations = 1;
+  tr.max_iterations = options.max_attempts;
+  tr.max_accepted_steps = options.trust_region_steps;
+  tr.relative_grad_tol = options.grad_reduction;
   tr.max_inner_iterations = options.max_inner_iterations;
   tr.tcg_kappa = options.tcg_kappa;
   tr.grad_norm_tol = 0.0;
   tr.rel_cost_decrease_tol = 0.0;
-  tr.record_trace = true;
+  tr.record_trace = false;
   const LiftedManifold M = problem.manifold(static_cast<int>(X0.rows()));
   tr.retraction = [&M](const Eigen::MatrixXd& X, const Eigen::MatrixXd& V) {
     return project_to_manifold(M, X + V);
@@ -45,29 +50,14 @@ Eigen::MatrixXd block_update(const BlockProblem& problem, const Eigen::MatrixXd&
     local.tangent = true;
     tr.initial_radius_scale = options.tangent_radius_scale;
   }
-  Eigen::MatrixXd X = X0;
-  int accepted = 0;
-  double radius = 0.0;  // <= 0: set from the first preconditioned gradient
-  for (int attempt = 0; attempt < options.max_attempts && accepted < options.trust_region_steps;
-       ++attempt) {
-    tr.initial_radius = radius;
-    TrustRegionResult res = solve_trust_region(problem, X, tr, precon);
-    ++local.trust_region_iterations;
-    local.tcg_iterations += res.total_inner_iterations;
-    // res.grad_norm is at res.X, which is X after this attempt whether or not it is accepted.
-    if (grad_norm_sq) *grad_norm_sq = res.grad_norm * res.grad_norm;
-    local.cost_share = res.cost_share;
-    if (res.trace.empty()) break;  // zero gradient: nothing to do
-    const TrustRegionIteration& it = res.trace.back();
-    radius = it.radius;
-    if (it.accepted) {
-      X = std::move(res.X);
-      ++accepted;
-    }
-    if (radius < 1e-14) break;
-  }
+  TrustRegionResult res = solve_trust_region(problem, X0, tr, precon);
+  local.trust_region_iterations = res.iterations;
+  local.tcg_iterations = res.total_inner_iterations;
+  // res.grad_norm and res.cost_share are at res.X (X0 when no step was accepted).
+  if (grad_norm_sq) *grad_norm_sq = res.grad_norm * res.grad_norm;
+  local.cost_share = res.cost_share;
   if (stats) *stats = local;
-  return X;
+  return std::move(res.X);
 }
 
 }  // namespace tessera

@@ -14,8 +14,13 @@
 namespace tessera {
 
 struct BlockUpdateOptions {
-  /// Accepted trust-region steps per update (>= 1). RBCD uses 1.
+  /// Accepted trust-region steps per update (>= 1). RBCD uses 1. With grad_reduction > 0 it
+  /// is the most steps an update takes.
   int trust_region_steps = 1;
+  /// Adaptive stop of a multi-step update: no further step once the block's Riemannian gradient
+  /// norm is at most this fraction of its value at the update's start point (in [0, 1); 0 = off:
+  /// always trust_region_steps steps). Only acts with trust_region_steps > 1.
+  double grad_reduction = 0.0;
   /// Trust-region iterations tried in total to obtain them; a rejected step shrinks the
   /// radius and retries (>= trust_region_steps).
   int max_attempts = 10;

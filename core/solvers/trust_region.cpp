@@ -16,6 +16,9 @@ void TrustRegionOptions::validate() const {
   if (max_iterations < 1) fail("max_iterations", "must be >= 1");
   if (max_inner_iterations < 1) fail("max_inner_iterations", "must be >= 1");
   if (!(grad_norm_tol >= 0)) fail("grad_norm_tol", "must be >= 0");
+  if (!(relative_grad_tol >= 0 && relative_grad_tol < 1))
+    fail("relative_grad_tol", "must be in [0, 1)");
+  if (max_accepted_steps < 0) fail("max_accepted_steps", "must be >= 0");
   if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
   if (!(max_radius > 0)) fail("max_radius", "must be > 0");
   if (!(initial_radius_scale > 0 && std::isfinite(initial_radius_scale)))
@@ -112,6 +115,9 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   Eigen::MatrixXd egrad = problem.euclidean_gradient(res.X);
   Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
   double grad_norm = std::sqrt(inner(grad, grad));
+  res.initial_grad_norm = grad_norm;
+  const double grad_tol = std::max(options.grad_norm_tol, options.relative_grad_tol * grad_norm);
+  int accepted_steps = 0;
   double radius = options.initial_radius;
   // The preconditioned gradient at the current point, when computed for the initial radius:
   // the first tCG iteration starts from the same vector (one solve fewer per block update).
@@ -125,7 +131,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   }
   res.stop_reason = "max_iterations";
   for (int it = 0; it < options.max_iterations; ++it) {
-    if (grad_norm <= options.grad_norm_tol) {
+    if (grad_norm <= grad_tol) {
       res.stop_reason = "grad_norm";
       break;
     }
@@ -171,6 +177,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       egrad = problem.euclidean_gradient(res.X);
       grad = M.tangent_project(res.X, egrad);
       grad_norm = std::sqrt(inner(grad, grad));
+      ++accepted_steps;
     }
     res.iterations = it + 1;
     if (options.record_trace)
@@ -184,8 +191,12 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       res.stop_reason = "radius";
       break;
     }
+    if (options.max_accepted_steps > 0 && accepted_steps >= options.max_accepted_steps) {
+      res.stop_reason = "steps";
+      break;
+    }
   }
-  if (grad_norm <= options.grad_norm_tol) res.stop_reason = "grad_norm";
+  if (grad_norm <= grad_tol) res.stop_reason = "grad_norm";
   res.cost = f;
   res.cost_share = f_share;
   res.grad_norm = grad_norm;

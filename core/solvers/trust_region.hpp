@@ -17,6 +17,12 @@ struct TrustRegionOptions {
   int max_iterations = 500;         ///< Outer iterations (>= 1).
   int max_inner_iterations = 1000;  ///< tCG iterations per outer iteration (>= 1).
   double grad_norm_tol = 1e-6;      ///< Stop when ||grad f|| <= this (absolute, >= 0).
+  /// Also stop when ||grad f|| <= this times its value at X0 (relative, in [0, 1); 0 = off).
+  double relative_grad_tol = 0.0;
+  /// Stop after this many accepted steps (>= 0; 0 = no limit). Rejected steps do not count,
+  /// only max_iterations bounds them: the distributed block updates ask for a number of
+  /// accepted steps within a budget of attempts.
+  int max_accepted_steps = 0;
   /// Stop when an accepted step decreases f by less than this fraction of f (>= 0).
   double rel_cost_decrease_tol = 1e-12;
   double initial_radius = 0.0;  ///< <= 0: set from the first preconditioned gradient.
@@ -54,6 +60,7 @@ struct TrustRegionResult {
   /// problem.cost_share(X), evaluated with the cost (the next round's status reuses it).
   double cost_share = 0.0;
   double grad_norm = 0.0;
+  double initial_grad_norm = 0.0;  ///< ||grad f|| at X0 (after `refine`).
   int iterations = 0;
   int total_inner_iterations = 0;
   std::string stop_reason;
