@@ -6,7 +6,6 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
 #include <string>
 
 #include "partition/evolutionary.hpp"
@@ -23,23 +22,7 @@ using namespace tessera;
 using namespace tessera::partition_detail;
 using tessera::test::validation_message;
 
-// A w x h grid plus random short-range chords (loop closures): irregular enough that seeds and
-// islands find different cuts.
-GraphStructure grid_with_chords(std::size_t w, std::size_t h, unsigned seed) {
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (std::size_t y = 0; y < h; ++y)
-    for (std::size_t x = 0; x < w; ++x) {
-      if (x + 1 < w) pairs.emplace_back(y * w + x, y * w + x + 1);
-      if (y + 1 < h) pairs.emplace_back(y * w + x, (y + 1) * w + x);
-    }
-  std::mt19937 gen(seed);
-  for (std::size_t e = 0; e < w * h / 4; ++e) {
-    const std::size_t v = gen() % (w * h);
-    const std::size_t u = (v + 1 + gen() % 3 + (gen() % 3) * w) % (w * h);
-    if (u != v) pairs.emplace_back(v, u);
-  }
-  return make_graph_structure(w * h, pairs, "grid+chords");
-}
+using test::grid_with_chords;
 
 EvolutionParams small_search(long long bound) {
   EvolutionParams p;

@@ -4,8 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
-
 #include "partition/evolutionary.hpp"
 #include "partition/graph_structure.hpp"
 #include "partition/relaxed_polish.hpp"
@@ -60,21 +58,8 @@ TEST(RelaxedPolish, MovesAChainThatNoBoundedMoveCanStart) {
 TEST(RelaxedPolish, NeverWorseWithinTheBoundAndDeterministic) {
   int better = 0;
   for (unsigned seed = 1; seed <= 6; ++seed) {
-    // A 40 x 30 grid plus random short-range chords (loop closures).
-    const std::size_t w = 40, h = 30;
-    std::vector<std::pair<std::size_t, std::size_t>> pairs;
-    for (std::size_t y = 0; y < h; ++y)
-      for (std::size_t x = 0; x < w; ++x) {
-        if (x + 1 < w) pairs.emplace_back(y * w + x, y * w + x + 1);
-        if (y + 1 < h) pairs.emplace_back(y * w + x, (y + 1) * w + x);
-      }
-    std::mt19937 gen(seed);
-    for (int e = 0; e < 300; ++e) {
-      const std::size_t v = gen() % (w * h);
-      const std::size_t u = (v + 1 + gen() % 3 + (gen() % 3) * w) % (w * h);
-      if (u != v) pairs.emplace_back(v, u);
-    }
-    const GraphStructure structure = make_graph_structure(w * h, pairs, "grid+chords");
+    // A 40 x 30 grid plus 300 random short-range chords (loop closures).
+    const GraphStructure structure = test::grid_with_chords(40, 30, seed);
     const WorkGraph g = to_work_graph(structure);
     const int k = 5;
     const std::vector<long long> ub = test::uniform_bounds(structure, k, 0.03);

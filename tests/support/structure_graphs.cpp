@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <random>
 #include <utility>
 
 #include "partition/partition_metrics.hpp"
@@ -17,6 +18,22 @@ GraphStructure grid_structure(std::size_t w, std::size_t h) {
       if (y + 1 < h) pairs.emplace_back(y * w + x, (y + 1) * w + x);
     }
   return make_graph_structure(w * h, pairs, "grid");
+}
+
+GraphStructure grid_with_chords(std::size_t w, std::size_t h, unsigned seed) {
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t y = 0; y < h; ++y)
+    for (std::size_t x = 0; x < w; ++x) {
+      if (x + 1 < w) pairs.emplace_back(y * w + x, y * w + x + 1);
+      if (y + 1 < h) pairs.emplace_back(y * w + x, (y + 1) * w + x);
+    }
+  std::mt19937 gen(seed);
+  for (std::size_t e = 0; e < w * h / 4; ++e) {
+    const std::size_t v = gen() % (w * h);
+    const std::size_t u = (v + 1 + gen() % 3 + (gen() % 3) * w) % (w * h);
+    if (u != v) pairs.emplace_back(v, u);
+  }
+  return make_graph_structure(w * h, pairs, "grid+chords");
 }
 
 std::vector<long long> uniform_bounds(const GraphStructure& structure, int k, double eps) {

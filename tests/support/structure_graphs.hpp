@@ -14,6 +14,10 @@ namespace tessera::test {
 /// A w x h 4-neighbour grid: vertex y * w + x is joined to its right and upper neighbours.
 GraphStructure grid_structure(std::size_t w, std::size_t h);
 
+/// A w x h grid plus w h / 4 random short-range chords (loop closures) drawn with std::mt19937
+/// from `seed`: irregular enough that seeds and islands find different cuts.
+GraphStructure grid_with_chords(std::size_t w, std::size_t h, unsigned seed);
+
 /// The same balance bound for each of the k blocks: (1 + eps) ceil(n / k) vertices.
 std::vector<long long> uniform_bounds(const GraphStructure& structure, int k, double eps);
 
