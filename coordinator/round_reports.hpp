@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "tessera.h"
+#include "transport/topic_names.hpp"
 
 namespace tessera::coordinator {
 
@@ -23,7 +24,7 @@ constexpr std::uint32_t kAgentCertificateBytesPhase = 202;
 
 /// Core's round statuses (phase 1: a round; phase 5: a restart of the momentum).
 inline bool is_round_status(const wire::RoundStatus& m) {
-  return m.phase() == 1 || m.phase() == 5;
+  return transport::is_solve_status_phase(m.phase());
 }
 
 struct CertificateReport {

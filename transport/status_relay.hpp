@@ -18,6 +18,7 @@
 
 #include "protocol/messages.hpp"
 #include "tessera.h"
+#include "transport/topic_names.hpp"
 
 namespace tessera::transport {
 
@@ -26,10 +27,10 @@ inline constexpr std::uint32_t kRelayAgent = 0;
 /// Runs of fewer agents broadcast their statuses (with 2 agents relaying saves nothing).
 inline constexpr std::uint32_t kMinAgentsForRelay = 3;
 
-/// Whether statuses of this phase are relayed: core's round statuses of the solve (phase 1, and
-/// 5 after a momentum restart), the ones the coordinator reads for progress and loss handling.
+/// Whether statuses of this phase are relayed: core's round statuses of the solve
+/// (is_solve_status_phase), the ones the coordinator reads for progress and loss handling.
 inline bool relayed_phase(std::uint32_t phase) {
-  return phase == 1 || phase == 5;
+  return is_solve_status_phase(phase);
 }
 
 /// The relay's collection of one process. Not thread-safe: the session guards it with its

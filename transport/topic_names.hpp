@@ -24,12 +24,20 @@ inline constexpr const char* kAgentStatusTopic = "tessera_agent_status";
 /// (transport/status_relay.hpp); the relay sends them on as bundles on kStatusTopic.
 inline constexpr const char* kRelayStatusTopic = "tessera_status_relay";
 
+/// Whether a round status of this phase is one of core's round statuses of the solve
+/// (ProtocolPhase::kStatus = 1, and kRedoStatus = 5 after a momentum restart;
+/// core/distributed/round_protocol.hpp): the ones the coordinator follows for progress and loss
+/// handling, and the ones the status relay bundles.
+inline bool is_solve_status_phase(std::uint32_t phase) {
+  return phase == 1 || phase == 5;
+}
+
 /// Whether the coordinator reads round statuses of this phase (they go on kStatusTopic, the
 /// others on kAgentStatusTopic): core's round statuses of the solve (phase 1, and 5 after a
 /// restart; coordinator/round_reports.hpp's is_round_status) for progress and loss handling,
 /// and agent 0's reports (200..299: final report, certificate; agent/round_loop.hpp).
 inline bool coordinator_reads_status(std::uint32_t phase) {
-  return phase == 1 || phase == 5 || (phase >= 200 && phase < 300);
+  return is_solve_status_phase(phase) || (phase >= 200 && phase < 300);
 }
 
 /// Runs of at most this many agents use block_topic_for(k); larger ones send addressed blocks on

@@ -115,7 +115,6 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   Eigen::MatrixXd egrad = problem.euclidean_gradient(res.X);
   Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
   double grad_norm = std::sqrt(inner(grad, grad));
-  res.initial_grad_norm = grad_norm;
   const double grad_tol = std::max(options.grad_norm_tol, options.relative_grad_tol * grad_norm);
   int accepted_steps = 0;
   double radius = options.initial_radius;

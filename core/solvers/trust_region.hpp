@@ -60,7 +60,6 @@ struct TrustRegionResult {
   /// problem.cost_share(X), evaluated with the cost (the next round's status reuses it).
   double cost_share = 0.0;
   double grad_norm = 0.0;
-  double initial_grad_norm = 0.0;  ///< ||grad f|| at X0 (after `refine`).
   int iterations = 0;
   int total_inner_iterations = 0;
   std::string stop_reason;
