@@ -22,14 +22,15 @@ namespace tessera::agent {
 int agent_main(int argc, char** argv) {
   transport::SignalWatcher
       signals;  // first: every thread created later inherits the blocked signals
-  // Started lowered by launch's fork server: back to nice 0 at the latest after the bound
-  // (with the assignment, normally: run_setup.cpp).
-  const StartupPriorityBound startup_bound(StartupPriorityOptions{}.bound_s);
   const std::vector<std::string> argv_list(argv + 1, argv + argc);
   AgentOptions options;
   if (auto code = cli::parse_process_options(
           argv_list, "tessera-agent", cli::process_help(kAgentUsage), parse_agent_options, options))
     return *code;
+  // Started lowered by launch's fork server: back to nice 0 at the latest after the bound
+  // (with the assignment, normally: run_setup.cpp), which stays well inside the lease.
+  const StartupPriorityBound startup_bound(
+      StartupPriorityOptions{}.bound_for_lease(options.net.session.lease_s));
   const std::string tag = agent_tag(options.id);
   // A checkpoint of this run in --checkpoint-dir means this process is a restart: rejoin.
   std::optional<AgentCheckpoint> restart;

@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <condition_variable>
@@ -24,6 +25,10 @@ void StartupPriorityOptions::validate() const {
   if (!(bound_s > 0.0 && bound_s <= 60.0))
     throw InputError("StartupPriorityOptions.bound_s = " + std::to_string(bound_s) +
                      ": must be in (0, 60]");
+}
+
+double StartupPriorityOptions::bound_for_lease(double lease_s) const {
+  return std::min(bound_s, 0.4 * lease_s);
 }
 
 namespace {

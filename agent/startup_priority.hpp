@@ -37,6 +37,13 @@ struct StartupPriorityOptions {
   /// assignment of a CSAIL run comes after ~0.6 s idle).
   double bound_s = 1.0;
 
+  /// The bound an agent with participant lease `lease_s` uses: min(bound_s, 0.4 x lease_s).
+  /// A lowered agent may get almost no CPU while the partition fills both cores, and its
+  /// participant announcements (every lease/5) must not lapse for a whole lease, or the
+  /// coordinator reports it lost (seen idle on intel with bound 1.0 s = lease 1.0 s: "lost
+  /// agent 3 ... participant lease of 1.0 s expired").
+  double bound_for_lease(double lease_s) const;
+
   /// Throws InputError naming the first field out of range.
   void validate() const;
 };

@@ -264,6 +264,13 @@ TEST(StartupPriority, OptionsNameTheBadField) {
   }
 }
 
+TEST(StartupPriority, BoundStaysWellInsideTheParticipantLease) {
+  const agent::StartupPriorityOptions o;          // bound_s 1.0
+  EXPECT_DOUBLE_EQ(o.bound_for_lease(1.0), 0.4);  // launch's default lease
+  EXPECT_DOUBLE_EQ(o.bound_for_lease(0.2), 0.2 * 0.4);
+  EXPECT_DOUBLE_EQ(o.bound_for_lease(10.0), 1.0);  // a long lease keeps the bound
+}
+
 TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndStopOnSigint) {
   LongForkedRun run("forked", 52, {});
   const std::string& run_id = run.run_id;
