@@ -45,10 +45,14 @@ std::map<std::uint32_t, ProtocolMessage> Mailbox::gather(
   const auto key = std::make_pair(phase, round);
   for (;;) {
     auto& have = stash_[key];
-    bool all = true;
-    for (auto s : senders) all = all && have.count(s);
-    if (all) break;
-    std::optional<ProtocolMessage> msg = receive();
+    std::size_t missing = 0;
+    for (auto s : senders) missing += have.count(s) ? 0 : 1;
+    if (missing == 0) break;
+    // Sleep until as many messages as are still missing have come (a lower bound: others may
+    // be for a later step, which only wakes us early), not once per message: a reduction
+    // waits for every other agent's status, and each wake-up of this thread costs more than
+    // handling a small message (as run_protocol's steps; docs/dds-runtime.md, stall10).
+    std::optional<ProtocolMessage> msg = receive(missing);
     if (!msg) {
       std::string who;
       for (auto s : senders)

@@ -61,8 +61,9 @@ class Mailbox {
 
   /// Waits for the rounding messages of (phase, round) from every agent in `senders` and
   /// returns them by sender (ascending, so reductions sum in agent-id order); late protocol
-  /// messages are dropped. Throws std::runtime_error naming the missing senders after the
-  /// receive timeout.
+  /// messages are dropped. Each wait asks the channel to sleep until as many messages as are
+  /// still missing have come (ProtocolChannel::receive_after). Throws std::runtime_error naming the
+  /// missing senders after the receive timeout.
   std::map<std::uint32_t, ProtocolMessage> gather(std::uint32_t phase, std::uint32_t round,
                                                   const std::vector<std::uint32_t>& senders);
 
