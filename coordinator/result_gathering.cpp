@@ -26,20 +26,21 @@ void await_final_estimates(Session& s, const CoordinatorOptions& options, RoundR
     return out;
   };
   const bool watch = monitor || losses.arbitrates();
-  // Statuses come in rounds of one per active agent: wake once a round's worth is queued, not
-  // for each of them (a wake-up costs more than reading a status). Progress lines and lag
-  // checks then see each round at most one round late; a silent agent still lets the nap
-  // below end the wait, and finals, rejoins and stops wake it as before. Not when lost agents
-  // are arbitrated: while one is missing the survivors' statuses never make a full round, so
-  // every decision of the rejoin / re-partition arbiter waited for the nap (restart fault
-  // benchmark, idle: +3.09 s with the batch wake-up, +2.23 s without).
+  // Statuses come in rounds of one per active agent: wake once a round can complete
+  // (RoundReports::statuses_to_complete), not for each status (a wake-up costs more than reading a
+  // status). A silent agent still lets the nap below end the wait, and finals, rejoins and stops
+  // wake it as before. Not when lost agents are arbitrated: while one is missing the survivors'
+  // statuses never make a full round, so every decision of the rejoin / re-partition arbiter waited
+  // for the nap (restart fault benchmark, idle: +3.09 s with the batch wake-up, +2.23 s without).
   const bool batch_wake = monitor && !losses.arbitrates();
   struct ThresholdGuard {
     Inbox<wire::RoundStatus>& inbox;
     ~ThresholdGuard() { inbox.set_wake_threshold(1); }
   } guard{s.status_watch()};
   for (;;) {
-    if (batch_wake) s.status_watch().set_wake_threshold(losses.record().expected.size());
+    if (batch_wake)
+      s.status_watch().set_wake_threshold(reports.statuses_to_complete(
+          static_cast<std::uint32_t>(losses.record().expected.size())));
     const double left = options.run_timeout_s - ms_since(t_run) / 1000.0;
     std::string absent;
     // Lost peers are noticed by polling the session (a few times a second) when watching.

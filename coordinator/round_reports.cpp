@@ -1,5 +1,6 @@
 #include "coordinator/round_reports.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -22,6 +23,14 @@ void RoundReports::on_round_status(const wire::RoundStatus& m, std::uint32_t act
   if (results_.completed_statuses == 0) results_.first_status_ms = ms;
   results_.last_status_ms = ms;
   if (m.phase() == 1) ++results_.completed_statuses;
+}
+
+std::size_t RoundReports::statuses_to_complete(std::uint32_t active_agents) const {
+  std::size_t fewest = active_agents;
+  for (const auto& [key, p] : partial_)
+    if (p.reported < active_agents)
+      fewest = std::min<std::size_t>(fewest, active_agents - p.reported);
+  return std::max<std::size_t>(fewest, 1);
 }
 
 bool RoundReports::on_report(const wire::RoundStatus& m) {

@@ -5,6 +5,7 @@
 // gradient, certificate, certificate traffic). No new traffic: these are the statuses the
 // agents exchange anyway, or a few extra ones from agent 0 on the same topic.
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -70,6 +71,14 @@ class RoundReports {
   }
 
   const ReportedResults& results() const { return results_; }
+
+  /// The fewest statuses that can complete a round of `active_agents`: what the partial round
+  /// closest to complete still lacks, or `active_agents` when none is partial. A lower bound for
+  /// the coordinator's wake-up threshold: a round whose first statuses were taken by the
+  /// previous wake-up completes with the rest, not only with the next round's worth (which
+  /// the last round never gets: its completion, and the timeline's last_status, then waited
+  /// for the final estimates).
+  std::size_t statuses_to_complete(std::uint32_t active_agents) const;
 
  private:
   struct Partial {
