@@ -1,8 +1,9 @@
 // The island model of the memetic search (island_search.hpp): two islands on their own threads
 // give the same partition for the same seed (with and without exchanges, through evolve() and
 // through the `highest` preset), two islands that never exchange are never worse than the single
-// search (island 0 is that search step for step), `highest` runs two islands unless asked for four,
-// and bad options name the field.
+// search (island 0 is that search step for step), a short island is the start of the full one,
+// `highest` runs two islands and a short one unless asked otherwise, and bad options name the
+// field.
 
 #include <gtest/gtest.h>
 
@@ -106,9 +107,45 @@ TEST(IslandSearch, SecondIslandOwnMatchingShareLeavesIslandZero) {
   EXPECT_GT(differs, 0) << "island 1 with matching coarsening must search differently";
 }
 
-// Whether the `evolution` trace phase names island `i`.
-bool traces_island(const PartitionResult& r, int i) {
-  const std::string name = "island " + std::to_string(i) + ":";
+// A short island is the first steps of the full island with the same index: with the whole
+// budget it is exactly a third full island, with a quarter it runs at most a quarter of the
+// steps, islands 0 and 1 are unchanged (never worse than two islands), and the result does not
+// depend on which thread ran it (same partition twice).
+TEST(IslandSearch, ShortIslandIsTheStartOfTheFullOne) {
+  const IslandCase c;
+  EvolutionParams three = c.two();
+  three.islands.islands = 3;
+  EvolutionParams whole = c.two();
+  whole.islands.short_islands = 1;
+  whole.islands.short_budget = 1.0;
+  EvolutionParams quarter = c.two();
+  quarter.islands.short_islands = 1;
+  quarter.islands.short_budget = 0.25;
+  int differs = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    Rng r1(seed), r2(seed), r3(seed), r4(seed), r5(seed);
+    const std::vector<int> full = evolve(c.g, c.k, c.ub, three, r1, nullptr);
+    EXPECT_EQ(evolve(c.g, c.k, c.ub, whole, r2, nullptr), full) << "seed " << seed;
+    const long long two = edge_cut(c.g, evolve(c.g, c.k, c.ub, c.two(), r3, nullptr));
+    std::string detail;
+    const std::vector<int> a = evolve(
+        c.g, c.k, c.ub, quarter, r4, [&](const std::string& name, const std::string& d, long long) {
+          if (name == "evolution") detail = d;
+        });
+    EXPECT_EQ(evolve(c.g, c.k, c.ub, quarter, r5, nullptr), a) << "seed " << seed;
+    test::expect_blocks_within(c.g, a, c.k, c.ub);
+    EXPECT_LE(edge_cut(c.g, a), two) << "seed " << seed;
+    // small_search has 12 steps: the short island gets 3.
+    EXPECT_NE(detail.find("island 2: short, 3 combine/mutation steps"), std::string::npos)
+        << detail;
+    differs += edge_cut(c.g, a) < two ? 1 : 0;
+  }
+  RecordProperty("seeds_improved_by_short_island", differs);
+}
+
+// Whether the `evolution` trace phase names island `i` (followed by `kind`, e.g. "short").
+bool traces_island(const PartitionResult& r, int i, const std::string& kind = "") {
+  const std::string name = "island " + std::to_string(i) + ":" + (kind.empty() ? "" : " " + kind);
   for (const auto& t : r.trace)
     if (t.name == "evolution" && t.detail.find(name) != std::string::npos) return true;
   return false;
@@ -126,8 +163,9 @@ TEST(IslandSearch, HighestPresetIsDeterministicAndTracesTheIslands) {
   EXPECT_TRUE(traces_island(a, 1)) << "highest must run several islands";
 }
 
-// highest runs two islands on every graph unless PartitionOptions::islands asks for more (four:
-// islands 0-3 traced, no fifth). The path's optimal cut (9) is found either way.
+// highest runs two islands and a short one on every graph unless PartitionOptions::islands asks
+// for more (four: islands 0-3 traced, then the short island 4, no sixth). The path's optimal cut
+// (9) is found either way.
 TEST(IslandSearch, HighestRunsTwoIslandsUnlessAskedForFour) {
   PartitionOptions o;
   o.preset = PartitionPreset::kHighest;
@@ -135,16 +173,19 @@ TEST(IslandSearch, HighestRunsTwoIslandsUnlessAskedForFour) {
   o.seed = 2;
   const PartitionResult two = partition_graph(grid_with_chords(24, 16, 7), o);
   EXPECT_TRUE(traces_island(two, 1));
-  EXPECT_FALSE(traces_island(two, 2));
+  EXPECT_TRUE(traces_island(two, 2, "short"));
+  EXPECT_FALSE(traces_island(two, 3));
   o.islands = 4;
   const PartitionResult four = partition_graph(grid_with_chords(24, 16, 7), o);
   EXPECT_TRUE(traces_island(four, 3));
-  EXPECT_FALSE(traces_island(four, 4));
+  EXPECT_FALSE(traces_island(four, 3, "short"));
+  EXPECT_TRUE(traces_island(four, 4, "short"));
+  EXPECT_FALSE(traces_island(four, 5));
   o.islands = 0;
   o.parts = 10;
   const PartitionResult path = partition_graph(test::grid_structure(8000, 1), o);
   EXPECT_TRUE(traces_island(path, 1));
-  EXPECT_FALSE(traces_island(path, 2));
+  EXPECT_FALSE(traces_island(path, 3));
   EXPECT_EQ(path.metrics.cut_edges, 9u);
   EXPECT_LE(path.metrics.max_block_ratio, 1.03 + 1e-12);
 }
@@ -185,6 +226,14 @@ TEST(IslandSearch, BadOptionsNameTheField) {
   EXPECT_NE(validation_message(p).find("IslandOptions.second_matching_share"), std::string::npos);
   p.islands.second_matching_share = -0.5;
   EXPECT_NE(validation_message(p).find("IslandOptions.second_matching_share"), std::string::npos);
+  p = {};
+  p.islands.short_islands = 9;
+  EXPECT_NE(validation_message(p).find("IslandOptions.short_islands"), std::string::npos);
+  p = {};
+  p.islands.short_budget = 0.0;
+  EXPECT_NE(validation_message(p).find("IslandOptions.short_budget"), std::string::npos);
+  p.islands.short_budget = 1.5;
+  EXPECT_NE(validation_message(p).find("IslandOptions.short_budget"), std::string::npos);
   p = {};
   p.islands.islands = 8;
   p.islands.exchange_every = 5;

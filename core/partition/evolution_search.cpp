@@ -168,7 +168,10 @@ bool EvolutionSearch::step() {
   }
   bool new_best = false;
   insert(std::move(child), &new_best);
-  if (new_best) ++improved_;
+  if (new_best) {
+    ++improved_;
+    last_improved_step_ = steps_;
+  }
   return true;
 }
 

@@ -44,6 +44,8 @@ class EvolutionSearch {
   const Individual& best() const;
   int steps() const { return steps_; }
   int improved() const { return improved_; }
+  /// The step (1-based) that found the current best; 0 = the initial population's.
+  int last_improved_step() const { return last_improved_step_; }
   int population_size() const { return static_cast<int>(pop_.size()); }
 
  private:
@@ -58,7 +60,7 @@ class EvolutionSearch {
   const EvolutionParams& params_;
   Rng& rng_;
   std::vector<Individual> pop_;
-  int gen_ = 0, steps_ = 0, improved_ = 0, stalled_ = 0;
+  int gen_ = 0, steps_ = 0, improved_ = 0, stalled_ = 0, last_improved_step_ = 0;
   int tail_ = -1;  ///< light-only steps left (-1: not started)
   bool ended_ = false;
 };

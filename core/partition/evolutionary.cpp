@@ -38,11 +38,23 @@ void EvolutionParams::validate() const {
 std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>& ub,
                         const EvolutionParams& params, Rng& rng, const EvolutionTrace& trace) {
   params.validate();
-  IslandSearchResult found = island_search(g, k, ub, params, rng, trace);
+  // Spectral layouts (spectral_layouts.hpp) come after the search and only replace its best
+  // when better, so the search is exactly the one without them and no cut can get worse. Their
+  // first half (embedding, layouts, FM) needs nothing from the search, so it runs as a side job
+  // of the islands in whichever thread is free first; its generator is seeded from the state
+  // before the search, so thread timing changes nothing.
+  const bool spectral = params.spectral_seeds > 0;
+  Rng srng(Rng(rng).next() ^ 0x9E3779B97F4A7C15ULL);
+  const CycleParams scycle = spectral ? varied(params, srng) : params.cycle;
+  std::vector<RefinedLayout> layouts;
+  std::vector<std::function<void()>> side_jobs;
+  if (spectral)
+    side_jobs.emplace_back(
+        [&] { layouts = fm_refined_layouts(g, k, ub, params.spectral, scycle, srng); });
+  IslandSearchResult found = island_search(g, k, ub, params, rng, trace, side_jobs);
   Individual top{std::move(found.part), found.cut};
   if (params.polish.rounds > 0) {
-    // Its own generator (seeded from a copy of the search's): the spectral layouts below draw
-    // exactly what they drew without the polish.
+    // Its own generator (seeded from a copy of the search's).
     Rng copy = rng;
     Rng prng(copy.next() ^ 0x5DEECE66DULL);
     const long long before = top.cut;
@@ -53,18 +65,13 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
                 std::to_string(before),
             top.cut);
   }
-  if (params.spectral_seeds > 0) {
-    // Global layouts after the search (spectral_layouts.hpp): the search itself is exactly the
-    // one without them, and they only replace its best when they are better, so the result can
-    // only improve. They draw from a copy of the generator for the same reason.
-    Rng srng = rng;
-    srng.next();
+  if (spectral) {
     std::string cuts;
     // Layouts far above the search's best after FM are not worth V-cycles and combines.
     const long long useful =
         static_cast<long long>(static_cast<double>(top.cut) * (1.0 + params.spectral_gap));
-    for (auto& p : refined_spectral_layouts(g, k, ub, params.spectral, varied(params, srng),
-                                            params.spectral_seeds, srng, useful)) {
+    for (auto& p : finished_layouts(g, k, ub, params.spectral, scycle, std::move(layouts),
+                                    params.spectral_seeds, srng, useful)) {
       Individual seed{std::move(p), 0};
       seed.cut = edge_cut(g, seed.part);
       cuts += (cuts.empty() ? "" : " ") + std::to_string(seed.cut);

@@ -49,8 +49,7 @@ struct EvolutionParams {
   double light_max = 0.98;  ///< average block weight (raised where infeasible).
   /// After the search, its best partition gets this relax / repair refinement
   /// (relaxed_polish.hpp; never worse; rounds = 0: off). It draws from its own generator,
-  /// seeded from a copy of the search's, so the spectral layouts after it see the same random
-  /// stream as without it.
+  /// seeded from a copy of the search's.
   RelaxedPolishOptions polish;
   /// Populations searched concurrently (island_search.hpp), each with all of the above budget;
   /// the polish and the spectral layouts then start from the best island's best. The default
@@ -58,7 +57,9 @@ struct EvolutionParams {
   IslandOptions islands;
   /// Spectral layouts (spectral_layouts.hpp): after the search, the best this many refined
   /// global layouts read off the Laplacian embedding are each combined with the search's best
-  /// partition, which they replace when better (the search before is unchanged). 0 = off.
+  /// partition, which they replace when better (the search before is unchanged). Their first
+  /// half (embedding, layouts, FM) runs beside the islands, on a generator seeded from the
+  /// caller's before the search. 0 = off.
   int spectral_seeds = 0;
   /// ...only those whose cut after FM is within this fraction above the search's best.
   double spectral_gap = 0.0;

@@ -3,7 +3,9 @@
 #include <time.h>
 
 #include <algorithm>
+#include <atomic>
 #include <climits>
+#include <cmath>
 #include <exception>
 #include <memory>
 #include <thread>
@@ -20,6 +22,12 @@ void IslandOptions::validate() const {
         (second_matching_share >= 0.0 && second_matching_share <= 1.0)))
     throw InputError("IslandOptions.second_matching_share = " +
                      std::to_string(second_matching_share) + ": must be -1 or in 0..1");
+  if (short_islands < 0 || short_islands > 8)
+    throw InputError("IslandOptions.short_islands = " + std::to_string(short_islands) +
+                     ": must be in 0..8");
+  if (!(short_budget > 0.0 && short_budget <= 1.0))
+    throw InputError("IslandOptions.short_budget = " + std::to_string(short_budget) +
+                     ": must be in (0, 1]");
   if (exchange_every < 0)
     throw InputError("IslandOptions.exchange_every = " + std::to_string(exchange_every) +
                      ": must be >= 0");
@@ -34,21 +42,54 @@ double thread_cpu_ms() {
   return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
+// Runs jobs[0..] on `workers` threads (the caller's one of them): each thread takes the next job
+// not yet started, so a thread whose job ends early takes on the queue's later ones. Exceptions
+// are rethrown (the lowest job's) after every thread has been joined. Returns each thread's CPU
+// time in ms (the caller's first): the largest plus the serial rest is what the wall time is on
+// an idle machine with as many cores as threads.
+std::vector<double> run_jobs(const std::vector<std::function<void()>>& jobs, int workers) {
+  std::vector<std::exception_ptr> errors(jobs.size());
+  std::atomic<std::size_t> next{0};
+  const int count = std::max(1, std::min(workers, static_cast<int>(jobs.size())));
+  std::vector<double> cpu(static_cast<std::size_t>(count), 0.0);
+  auto work = [&](int t) {
+    const double c0 = thread_cpu_ms();
+    for (std::size_t j = next++; j < jobs.size(); j = next++) {
+      try {
+        jobs[j]();
+      } catch (...) {
+        errors[j] = std::current_exception();
+      }
+    }
+    cpu[static_cast<std::size_t>(t)] = thread_cpu_ms() - c0;
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < count; ++t) threads.emplace_back(work, t);
+  work(0);
+  for (auto& t : threads) t.join();
+  for (auto& e : errors)
+    if (e) std::rethrow_exception(e);
+  return cpu;
+}
+
 struct Island {
   Rng rng;
+  EvolutionParams params;
   std::unique_ptr<EvolutionSearch> search;
   double cpu_ms = 0.0;
-  int taken = 0;  ///< Individuals from other islands that entered this population.
-  std::exception_ptr error;
+  int taken = 0;                 ///< Individuals from other islands that entered this population.
+  long long population_cut = 0;  ///< Best of the initial population.
 };
 
 }  // namespace
 
 IslandSearchResult island_search(
     const WorkGraph& g, int k, const std::vector<long long>& ub, const EvolutionParams& params,
-    Rng& rng, const std::function<void(const std::string&, const std::string&, long long)>& trace) {
+    Rng& rng, const std::function<void(const std::string&, const std::string&, long long)>& trace,
+    const std::vector<std::function<void()>>& side_jobs) {
   params.islands.validate();
-  const int count = params.islands.islands;
+  const int full = params.islands.islands;
+  const int count = full + params.islands.short_islands;
   // Island 0 runs on the caller's generator; the others get seeds drawn from a copy of it, so
   // the caller's stream (and island 0's search) is the one a single search would draw.
   Rng seeder = rng;
@@ -56,55 +97,72 @@ IslandSearchResult island_search(
   EvolutionParams second = params;
   if (params.islands.second_matching_share >= 0.0)
     second.matching_share = params.islands.second_matching_share;
+  // Reserved: each search keeps references to its island's generator and parameters.
   std::vector<Island> islands;
   islands.reserve(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) {
-    islands.push_back(
-        Island{i == 0 ? rng : Rng(base ^ (0xA24BAED4963EE407ULL * i)), nullptr, 0.0, 0, nullptr});
-    islands.back().search =
-        std::make_unique<EvolutionSearch>(g, k, ub, i == 1 ? second : params, islands.back().rng);
+    islands.push_back(Island{i == 0 ? rng : Rng(base ^ (0xA24BAED4963EE407ULL * i)),
+                             i == 1 ? second : params, nullptr, 0.0, 0, 0});
+    Island& isl = islands.back();
+    if (i >= full)
+      isl.params.generations = std::max(
+          1, static_cast<int>(std::lround(params.generations * params.islands.short_budget)));
+    isl.search = std::make_unique<EvolutionSearch>(g, k, ub, isl.params, isl.rng);
   }
 
-  // One epoch: every island runs `job` on its own thread (island 0 on the caller's); joining
-  // them all is the barrier after which individuals are exchanged.
-  auto epoch = [&](auto job) {
-    auto run_one = [&](Island& isl) {
-      try {
-        const double c0 = thread_cpu_ms();
-        job(*isl.search);
-        isl.cpu_ms += thread_cpu_ms() - c0;
-      } catch (...) {
-        isl.error = std::current_exception();
-      }
-    };
-    std::vector<std::thread> threads;
-    for (int i = 1; i < count; ++i) threads.emplace_back(run_one, std::ref(islands[i]));
-    run_one(islands[0]);
-    for (auto& t : threads) t.join();
+  // One epoch: every island runs `job` on its own thread (island 0 on the caller's), `extra` in
+  // whichever thread is free first; joining them all is the barrier after which individuals
+  // are exchanged. A short island on its own thread rather than queued behind a full one: on
+  // two cores the system then shares both cores among the three threads, which ends sooner
+  // than a short island started only when the first full island ends (rim, loaded host: the
+  // larger thread's CPU time was the smaller full island plus the short one, ~1 s above half
+  // of the total).
+  std::vector<double> thread_cpu;  // per worker thread, summed over the epochs
+  auto epoch = [&](auto job, const std::vector<std::function<void()>>& extra) {
+    std::vector<std::function<void()>> jobs;
     for (auto& isl : islands)
-      if (isl.error) std::rethrow_exception(isl.error);
+      jobs.emplace_back([&isl, &job] {
+        const double c0 = thread_cpu_ms();
+        job(isl);
+        isl.cpu_ms += thread_cpu_ms() - c0;
+      });
+    jobs.insert(jobs.end(), extra.begin(), extra.end());
+    const std::vector<double> cpu = run_jobs(jobs, count);
+    thread_cpu.resize(std::max(thread_cpu.size(), cpu.size()), 0.0);
+    for (std::size_t t = 0; t < cpu.size(); ++t) thread_cpu[t] += cpu[t];
   };
 
-  epoch([](EvolutionSearch& s) { s.build_population(); });
+  const int chunk = params.islands.exchange_every > 0 ? params.islands.exchange_every : INT_MAX;
+  const bool exchanges = params.islands.exchange_every > 0 && count > 1;
+  // Without exchanges an island builds its population and searches in one job, so a thread
+  // never waits for the others between the two.
+  epoch(
+      [&](Island& isl) {
+        isl.search->build_population();
+        isl.population_cut = isl.search->best().cut;
+        if (!exchanges) isl.search->run(INT_MAX);
+      },
+      side_jobs);
   if (trace) {
     long long cut = LLONG_MAX;
-    for (auto& isl : islands) cut = std::min(cut, isl.search->best().cut);
+    for (auto& isl : islands) cut = std::min(cut, isl.population_cut);
     trace("population",
           (count > 1 ? std::to_string(count) + " islands x " : std::string()) +
               std::to_string(params.population) + " multilevel runs + " +
-              std::to_string(params.vcycles) + " V-cycles each",
+              std::to_string(params.vcycles) + " V-cycles each" +
+              (exchanges || count == 1
+                   ? ""
+                   : " (each island searched on in the same job: this time is the search's)"),
           cut);
   }
 
-  const int chunk = params.islands.exchange_every > 0 ? params.islands.exchange_every : INT_MAX;
   auto running = [&] {
     for (auto& isl : islands)
       if (!isl.search->ended()) return true;
     return false;
   };
-  while (running()) {
-    epoch([chunk](EvolutionSearch& s) { s.run(chunk); });
-    if (params.islands.exchange_every <= 0 || count < 2) continue;
+  while (exchanges && running()) {
+    epoch([chunk](Island& isl) { isl.search->run(chunk); }, {});
     // Snapshot every island's best first, so the order of the offers changes nothing.
     std::vector<Individual> bests;
     for (auto& isl : islands) bests.push_back(isl.search->best());
@@ -126,18 +184,24 @@ IslandSearchResult island_search(
     std::string detail;
     for (int i = 0; i < count; ++i) {
       const auto& s = *islands[i].search;
-      const std::string steps = std::to_string(s.steps()) + " combine/mutation steps, " +
-                                std::to_string(s.improved()) + " improved the best";
+      std::string steps = std::to_string(s.steps()) + " combine/mutation steps, " +
+                          std::to_string(s.improved()) + " improved the best";
+      if (s.improved() > 0)
+        steps += " (last at step " + std::to_string(s.last_improved_step()) + ")";
       if (count == 1) {
         detail = steps;  // the single search's trace, as before the islands
         break;
       }
-      detail += (i > 0 ? "; " : "") + ("island " + std::to_string(i) + ": ") + steps + ", " +
-                std::to_string(islands[i].taken) + " migrants taken, best " +
-                std::to_string(s.best().cut) + ", thread cpu " +
+      detail += (i > 0 ? "; " : "") + ("island " + std::to_string(i) + ": ") +
+                (i >= full ? "short, " : "") + steps + ", " + std::to_string(islands[i].taken) +
+                " migrants taken, best " + std::to_string(s.best().cut) + ", thread cpu " +
                 std::to_string(static_cast<long long>(islands[i].cpu_ms)) + " ms";
     }
-    if (count > 1) detail += "; winner island " + std::to_string(winner);
+    if (count > 1) {
+      detail += "; winner island " + std::to_string(winner) + "; worker threads cpu";
+      for (double c : thread_cpu) detail += " " + std::to_string(static_cast<long long>(c));
+      detail += " ms";
+    }
     trace("evolution", detail, result.cut);
   }
   // The caller's generator continues from island 0's state (the single search's stream).

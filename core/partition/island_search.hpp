@@ -40,6 +40,13 @@ struct IslandOptions {
   /// instead of EvolutionParams::matching_share (a differently configured second search);
   /// -1 = every island uses the same parameters. Range -1 or 0..1.
   double second_matching_share = -1.0;
+  /// Further islands after the `islands` full ones, each with only `short_budget` of the step
+  /// budget (EvolutionParams::generations; the same population), each on its own thread. Island
+  /// i keeps its generator whatever the count, so a short island is the first steps of the full
+  /// island i would be. A cheap further draw of the arrangement lottery. Range 0..8.
+  int short_islands = 0;
+  /// Share of the step budget of each short island. Range (0, 1].
+  double short_budget = 0.5;
 
   /// Throws InputError naming the first field out of range.
   void validate() const;
@@ -50,14 +57,19 @@ struct IslandSearchResult {
   long long cut = 0;
 };
 
-/// Runs params.islands.islands populations of the memetic search (evolution_search.hpp) under
-/// `ub` and returns the best partition found. Island 0 uses `rng` (which it advances); island
-/// i > 0 a generator derived from rng's state and i. Exceptions thrown in an island are
-/// rethrown here after all threads have been joined. `trace` (may be empty) is called on the
-/// calling thread after the initial populations ("population") and after the search
-/// ("evolution"; per island: steps, improvements, migrants taken, best cut, thread CPU time).
+/// Runs params.islands.islands (+ short_islands) populations of the memetic search
+/// (evolution_search.hpp) under `ub` and returns the best partition found. Island 0 uses `rng`
+/// (which it advances); island i > 0 a generator derived from rng's state and i. Exceptions thrown
+/// in an island are rethrown here after all threads have been joined. `trace` (may be empty) is
+/// called on the calling thread after the initial populations ("population") and after the search
+/// ("evolution"; per island: steps, improvements and the step of the last one, migrants taken,
+/// best cut, thread CPU time; and each thread's CPU time). Every island runs on its own thread
+/// (island 0 on the caller's); `side_jobs` (may be empty; work independent of the search that
+/// the caller needs afterwards anyway) run after them in whichever thread is free first. Which
+/// thread runs what never changes a result.
 IslandSearchResult island_search(
     const WorkGraph& g, int k, const std::vector<long long>& ub, const EvolutionParams& params,
-    Rng& rng, const std::function<void(const std::string&, const std::string&, long long)>& trace);
+    Rng& rng, const std::function<void(const std::string&, const std::string&, long long)>& trace,
+    const std::vector<std::function<void()>>& side_jobs = {});
 
 }  // namespace tessera::partition_detail

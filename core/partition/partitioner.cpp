@@ -183,6 +183,15 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // docs/partitioning.md "Four islands as an option, not the default").
         plan.evolution.islands.islands = strong ? 1 : 2;
         plan.evolution.islands.exchange_every = 0;
+        // highest: and a third, short island (a fifth of the step budget, its own thread):
+        // the first steps of what a full third island would search, a cheap further draw of
+        // the arrangement lottery. The full third island reached its better arrangement early
+        // on rim seed 1 (246 instead of 258, at step 11 of 70), torus3D seed 4 (243 instead of
+        // 246, step 8) and city10000 seed 3 (131 instead of 134, step 8); a fifth (rim 14
+        // steps) keeps all three for ~1.1 s CPU on rim, about half of it wall time on two
+        // cores (session 10, docs/partitioning.md).
+        plan.evolution.islands.short_islands = strong ? 0 : 1;
+        plan.evolution.islands.short_budget = 0.2;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
         // bound on every level the coarse searches rarely reach such shapes (session 4, seeds
@@ -243,6 +252,8 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_MFLEV")) plan.evolution.matching_flow_levels = std::atoi(env("T_MFLEV"));
   if (env("T_ISL")) plan.evolution.islands.islands = std::atoi(env("T_ISL"));
   if (env("T_I1MATCH")) plan.evolution.islands.second_matching_share = std::atof(env("T_I1MATCH"));
+  if (env("T_SHORT")) plan.evolution.islands.short_islands = std::atoi(env("T_SHORT"));
+  if (env("T_SHORTF")) plan.evolution.islands.short_budget = std::atof(env("T_SHORTF"));
   if (env("T_XCH")) plan.evolution.islands.exchange_every = std::atoi(env("T_XCH"));
   if (env("T_OPS"))
     plan.evolution.generations =
@@ -286,7 +297,12 @@ PartitionResult partition_graph(const GraphStructure& graph, const PartitionOpti
   const long long lmax = static_cast<long long>(result.max_block_size);
   const std::vector<long long> ub(static_cast<std::size_t>(k), lmax);
   PresetPlan plan = preset_plan(options.preset, g, k, lmax);
-  if (options.islands > 0) plan.evolution.islands.islands = options.islands;
+  if (options.islands > 0) {
+    plan.evolution.islands.islands = options.islands;
+    // One island is the single search on the calling thread, without the short one: a caller
+    // asking for one wants the cheapest search (e.g. one that shares the cores).
+    if (options.islands == 1) plan.evolution.islands.short_islands = 0;
+  }
   const CycleParams& cp = plan.cycle;
   Rng rng(options.seed);
   std::vector<int> part;

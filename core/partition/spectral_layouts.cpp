@@ -474,36 +474,47 @@ std::vector<SpectralLayout> spectral_layouts(const WorkGraph& g, int k, long lon
   return out;
 }
 
-std::vector<std::vector<int>> refined_spectral_layouts(const WorkGraph& g, int k,
-                                                       const std::vector<long long>& ub,
-                                                       const SpectralLayoutOptions& options,
-                                                       const CycleParams& cycle, int keep, Rng& rng,
-                                                       long long worst_useful) {
-  std::vector<std::vector<int>> out;
-  if (keep <= 0) return out;
-  auto polished = [&](std::vector<int> p, long long* cut) {
-    rebalance(g, k, p, ub);
-    *cut = kway_fm(g, k, p, ub, cycle.fm, rng);
-    return p;
-  };
-  struct Candidate {
-    long long cut;
-    std::vector<int> part;
-    SpectralLayout layout;
-  };
-  std::vector<Candidate> cands;
+namespace {
+
+// Rebalanced and FM-refined under ub (cheap), as both halves below refine their layouts.
+std::vector<int> fm_polished(const WorkGraph& g, int k, const std::vector<long long>& ub,
+                             const CycleParams& cycle, std::vector<int> p, long long* cut,
+                             Rng& rng) {
+  rebalance(g, k, p, ub);
+  *cut = kway_fm(g, k, p, ub, cycle.fm, rng);
+  return p;
+}
+
+}  // namespace
+
+std::vector<RefinedLayout> fm_refined_layouts(const WorkGraph& g, int k,
+                                              const std::vector<long long>& ub,
+                                              const SpectralLayoutOptions& options,
+                                              const CycleParams& cycle, Rng& rng) {
+  std::vector<RefinedLayout> cands;
   for (auto& layout : spectral_layouts(g, k, *std::min_element(ub.begin(), ub.end()), options)) {
     long long cut = 0;
-    std::vector<int> p = polished(layout.part, &cut);
+    std::vector<int> p = fm_polished(g, k, ub, cycle, layout.part, &cut, rng);
     cands.push_back({cut, std::move(p), std::move(layout)});
   }
   std::stable_sort(cands.begin(), cands.end(),
                    [](const auto& a, const auto& b) { return a.cut < b.cut; });
+  return cands;
+}
+
+std::vector<std::vector<int>> finished_layouts(const WorkGraph& g, int k,
+                                               const std::vector<long long>& ub,
+                                               const SpectralLayoutOptions& options,
+                                               const CycleParams& cycle,
+                                               std::vector<RefinedLayout> cands, int keep, Rng& rng,
+                                               long long worst_useful) {
+  std::vector<std::vector<int>> out;
+  if (keep <= 0) return out;
   if (worst_useful >= 0)
     while (!cands.empty() && cands.back().cut > worst_useful) cands.pop_back();
   // Rotation polish (see SpectralLayoutOptions::polish), one set of arcs after the other.
   int polished_count = 0;
-  for (Candidate& cand : cands) {
+  for (RefinedLayout& cand : cands) {
     if (polished_count >= options.polish) break;
     if (cand.layout.sides.empty()) continue;  // slabs only: nothing to rotate
     ++polished_count;
@@ -520,7 +531,7 @@ std::vector<std::vector<int>> refined_spectral_layouts(const WorkGraph& g, int k
           trial[side.order[(q + shift) % ns]] =
               side.first + static_cast<int>(static_cast<long long>(q) * side.count / ns);
         long long cut = 0;
-        std::vector<int> p = polished(trial, &cut);
+        std::vector<int> p = fm_polished(g, k, ub, cycle, trial, &cut, rng);
         if (cut < cand.cut) {
           cand.cut = cut;
           cand.part = std::move(p);
@@ -544,6 +555,17 @@ std::vector<std::vector<int>> refined_spectral_layouts(const WorkGraph& g, int k
     out.push_back(edge_cut(g, p) <= c.cut ? std::move(p) : std::move(c.part));
   }
   return out;
+}
+
+std::vector<std::vector<int>> refined_spectral_layouts(const WorkGraph& g, int k,
+                                                       const std::vector<long long>& ub,
+                                                       const SpectralLayoutOptions& options,
+                                                       const CycleParams& cycle, int keep, Rng& rng,
+                                                       long long worst_useful) {
+  if (keep <= 0) return {};
+  return finished_layouts(g, k, ub, options, cycle,
+                          fm_refined_layouts(g, k, ub, options, cycle, rng), keep, rng,
+                          worst_useful);
 }
 
 }  // namespace tessera::partition_detail

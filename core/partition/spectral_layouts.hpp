@@ -77,6 +77,29 @@ struct SpectralLayout {
 std::vector<SpectralLayout> spectral_layouts(const WorkGraph& g, int k, long long max_block,
                                              const SpectralLayoutOptions& options);
 
+/// A layout after rebalancing and FM under the search's bounds.
+struct RefinedLayout {
+  long long cut = 0;
+  std::vector<int> part;
+  SpectralLayout layout;  ///< As built (its arcs drive the rotation polish).
+};
+
+/// The first half of refined_spectral_layouts: every layout rebalanced and FM-refined under ub,
+/// best first. It needs nothing from a search, so `highest` runs it beside the search's islands.
+std::vector<RefinedLayout> fm_refined_layouts(const WorkGraph& g, int k,
+                                              const std::vector<long long>& ub,
+                                              const SpectralLayoutOptions& options,
+                                              const CycleParams& cycle, Rng& rng);
+
+/// The second half: drops the refined layouts above `worst_useful` (if >= 0), rotation-polishes
+/// the rest and V-cycles the `keep` best distinct ones (see refined_spectral_layouts).
+std::vector<std::vector<int>> finished_layouts(const WorkGraph& g, int k,
+                                               const std::vector<long long>& ub,
+                                               const SpectralLayoutOptions& options,
+                                               const CycleParams& cycle,
+                                               std::vector<RefinedLayout> cands, int keep, Rng& rng,
+                                               long long worst_useful = -1);
+
 /// The layouts refined into partitions under ub: each is rebalanced and FM-refined on g (cheap);
 /// those whose cut then exceeds `worst_useful` (if >= 0) are dropped; the rest are polished (see
 /// SpectralLayoutOptions::polish) and the `keep` best distinct ones are then improved by a V-cycle
