@@ -110,7 +110,7 @@ IslandSearchResult island_search(
     isl.search = std::make_unique<EvolutionSearch>(g, k, ub, isl.params, isl.rng);
   }
 
-  // One epoch: every island runs `job` on its own thread (island 0 on the caller's), `extra` in
+  // One epoch: every island runs `job` on its own thread (the caller's is one), `extra` in
   // whichever thread is free first; joining them all is the barrier after which individuals
   // are exchanged. A short island on its own thread rather than queued behind a full one: on
   // two cores the system then shares both cores among the three threads, which ends sooner

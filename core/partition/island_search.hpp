@@ -64,7 +64,7 @@ struct IslandSearchResult {
 /// called on the calling thread after the initial populations ("population") and after the search
 /// ("evolution"; per island: steps, improvements and the step of the last one, migrants taken,
 /// best cut, thread CPU time; and each thread's CPU time). Every island runs on its own thread
-/// (island 0 on the caller's); `side_jobs` (may be empty; work independent of the search that
+/// (the caller's is one of them); `side_jobs` (may be empty; work independent of the search that
 /// the caller needs afterwards anyway) run after them in whichever thread is free first. Which
 /// thread runs what never changes a result.
 IslandSearchResult island_search(
