@@ -163,9 +163,9 @@ TEST(IslandSearch, HighestPresetIsDeterministicAndTracesTheIslands) {
   EXPECT_TRUE(traces_island(a, 1)) << "highest must run several islands";
 }
 
-// highest runs two islands and a short one on every graph unless PartitionOptions::islands asks
-// for more (four: islands 0-3 traced, then the short island 4, no sixth). The path's optimal cut
-// (9) is found either way.
+// highest runs two islands and a short one unless PartitionOptions::islands asks for more (four:
+// islands 0-3 traced, then the short island 4, no sixth) or its step budget is small. The
+// path's optimal cuts (9, 19) are found either way.
 TEST(IslandSearch, HighestRunsTwoIslandsUnlessAskedForFour) {
   PartitionOptions o;
   o.preset = PartitionPreset::kHighest;
@@ -188,6 +188,13 @@ TEST(IslandSearch, HighestRunsTwoIslandsUnlessAskedForFour) {
   EXPECT_FALSE(traces_island(path, 3));
   EXPECT_EQ(path.metrics.cut_edges, 9u);
   EXPECT_LE(path.metrics.max_block_ratio, 1.03 + 1e-12);
+  // 20 blocks of the path leave 27 steps: a fifth (5) is fewer than the population (8), so
+  // there is no short island (it would be mostly a population build).
+  o.parts = 20;
+  const PartitionResult many = partition_graph(test::grid_structure(8000, 1), o);
+  EXPECT_TRUE(traces_island(many, 1));
+  EXPECT_FALSE(traces_island(many, 2));
+  EXPECT_EQ(many.metrics.cut_edges, 19u);
 }
 
 // PartitionOptions::islands overrides the preset's count (one island: the single search, no

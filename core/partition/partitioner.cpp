@@ -190,8 +190,15 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // 246, step 8) and city10000 seed 3 (131 instead of 134, step 8); a fifth (rim 14
         // steps) keeps all three for ~1.1 s CPU on rim, about half of it wall time on two
         // cores (session 10, docs/partitioning.md).
-        plan.evolution.islands.short_islands = strong ? 0 : 1;
+        // Only where its steps are at least as many as its population: a short island costs
+        // its population (2 x population operations) plus its steps, so with a small step
+        // budget (many blocks: rim/grid3D N = 25 get 4 steps) it would cost ~75 % of a full
+        // island for one step of search (grid3D N = 25: +2.4 s thread CPU).
         plan.evolution.islands.short_budget = 0.2;
+        const int short_steps = static_cast<int>(
+            std::lround(plan.evolution.generations * plan.evolution.islands.short_budget));
+        plan.evolution.islands.short_islands =
+            !strong && short_steps >= plan.evolution.population ? 1 : 0;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
         // bound on every level the coarse searches rarely reach such shapes (session 4, seeds
