@@ -45,8 +45,13 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
   // lost agents are arbitrated: the rejoin arbiter picks the rollback round from each agent's
   // own last status, which a relay waiting for a dead agent (or dead itself) would hold back.
   // Every agent reads the same assignment, so all choose alike.
-  s.set_status_relay(setup && setup->status_relay &&
-                     !(rejoin_enabled || restart || replication.enabled()));
+  const bool arbitrated = rejoin_enabled || restart || replication.enabled();
+  s.set_status_relay(setup && setup->status_relay && !arbitrated);
+  // The coordinator reads each round's statuses only while it arbitrates lost agents (the
+  // rollback round is the newest every agent has sent its status for); otherwise it follows
+  // the agents' progress digests, a few a second (agent/progress_digest.hpp).
+  s.set_coordinator_follows_rounds(arbitrated);
+  if (!arbitrated) channel.report_progress(o.id, local.num_agents);
   const AgentLocalData* cur = &local;  // the survivors' new block after a re-partition
   if (replication.enabled() && !restart) replication.start(local, channel);
   if (restart) {
@@ -79,8 +84,9 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
   for (;;) {
     try {
       hooks.resume_from = from ? &*from : nullptr;
-      deliver_final_estimate(s, *cur, run_round_loop(*cur, channel, o.round_timeout_s, hooks), o,
-                             log, t0);
+      RoundLoopResult result = run_round_loop(*cur, channel, o.round_timeout_s, hooks);
+      channel.publish_final_progress();
+      deliver_final_estimate(s, *cur, std::move(result), o, log, t0);
       break;
     } catch (const RepartitionRequested& order) {
       refuse_if_lost(order.assignment, o.id, o.net.session.run_id);

@@ -8,6 +8,35 @@ namespace tessera::agent {
 void DdsProtocolChannel::send(const OutgoingMessage& message) {
   if (auto stop = session_.mailroom().stop_info()) throw RunStopped(stop->reason);
   session_.send(message);
+  note_status(message.message, true);
+}
+
+void DdsProtocolChannel::report_progress(std::uint32_t agent, std::uint32_t num_agents,
+                                         ProgressDigestOptions options) {
+  progress_.emplace(agent, num_agents, agent == 0, options, std::chrono::steady_clock::now());
+}
+
+void DdsProtocolChannel::publish_final_progress() {
+  if (!progress_) return;
+  wire::AgentProgress d = progress_->take(std::chrono::steady_clock::now(), true);
+  d.epoch(session_.epoch());
+  session_.publish(std::move(d));
+}
+
+void DdsProtocolChannel::note_status(const ProtocolMessage& m, bool own) {
+  if (!progress_) return;
+  if (const auto* status = std::get_if<RoundStatusMessage>(&m))
+    progress_->on_status(*status, own, std::chrono::steady_clock::now());
+  publish_progress_if_due();
+}
+
+void DdsProtocolChannel::publish_progress_if_due() {
+  if (!progress_) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (!progress_->due(now)) return;
+  wire::AgentProgress d = progress_->take(now);
+  d.epoch(session_.epoch());
+  session_.publish(std::move(d));
 }
 
 std::optional<RollbackRequested> take_rollback(transport::Session& session) {
@@ -50,8 +79,10 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_
     auto& rollbacks = session_.rollbacks();
     auto& assignments = session_.assignments();
     auto& protocol = session_.protocol();
+    // A digest falls due while we wait (a slow peer): wake for it, then wait on.
+    const auto until = progress_ ? std::min(deadline, progress_->next_due()) : deadline;
     const double left =
-        std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+        std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
     const transport::WaitStatus st = session_.mailroom().wait_for(
         [&] {
           for (const auto& c : rollbacks.queued_locked())
@@ -66,13 +97,18 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_
     // On the relay agent: the statuses that just woke us may complete a step the others
     // wait for; send its bundle before handling them (status_relay.hpp).
     session_.relay_statuses();
-    if (st == transport::WaitStatus::kTimeout) return std::nullopt;
+    if (st == transport::WaitStatus::kTimeout) {
+      if (until == deadline) return std::nullopt;
+      publish_progress_if_due();
+      continue;
+    }
     if (auto a = take_reassignment(session_)) throw RepartitionRequested(std::move(*a));
     if (auto r = take_rollback(session_)) throw *r;
     ProtocolMessage out;
     if (protocol.take(transport::Seconds(0), &out) != transport::WaitStatus::kReady)
       return std::nullopt;  // only stale rollbacks were queued; the caller waits again
     if (intercept_ && intercept_(out)) continue;  // e.g. a replica, not for the protocol
+    note_status(out, false);
     return out;
   }
 }

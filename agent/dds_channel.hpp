@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "agent/progress_digest.hpp"
 #include "agent/round_loop.hpp"
 #include "transport/session.hpp"
 
@@ -24,9 +25,22 @@ class DdsProtocolChannel : public ProtocolChannel {
   /// (lifted-pose replicas of other agents).
   void set_intercept(std::function<bool(const ProtocolMessage&)> f) { intercept_ = std::move(f); }
 
+  /// From now on, publishes this agent's progress digests (agent/progress_digest.hpp) from
+  /// its sends and waits: every `options.period_s` while it runs rounds (waits end early to
+  /// send them), at once on agent 0 when the first and each restart step complete. For runs
+  /// whose coordinator does not read the round statuses themselves.
+  void report_progress(std::uint32_t agent, std::uint32_t num_agents,
+                       ProgressDigestOptions options = {});
+  /// The solve is over: the last digest (nothing when report_progress was not called).
+  void publish_final_progress();
+
  private:
+  void note_status(const ProtocolMessage& m, bool own);
+  void publish_progress_if_due();
+
   transport::Session& session_;
   std::function<bool(const ProtocolMessage&)> intercept_;
+  std::optional<ProgressDigest> progress_;
 };
 
 /// Raised by the channel when the coordinator publishes a re-partition for the survivors (an

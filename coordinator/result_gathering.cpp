@@ -1,6 +1,7 @@
 #include "coordinator/result_gathering.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -26,21 +27,10 @@ void await_final_estimates(Session& s, const CoordinatorOptions& options, RoundR
     return out;
   };
   const bool watch = monitor || losses.arbitrates();
-  // Statuses come in rounds of one per active agent: wake once a round can complete
-  // (RoundReports::statuses_to_complete), not for each status (a wake-up costs more than reading a
-  // status). A silent agent still lets the nap below end the wait, and finals, rejoins and stops
-  // wake it as before. Not when lost agents are arbitrated: while one is missing the survivors'
-  // statuses never make a full round, so every decision of the rejoin / re-partition arbiter waited
-  // for the nap (restart fault benchmark, idle: +3.09 s with the batch wake-up, +2.23 s without).
-  const bool batch_wake = monitor && !losses.arbitrates();
-  struct ThresholdGuard {
-    Inbox<wire::RoundStatus>& inbox;
-    ~ThresholdGuard() { inbox.set_wake_threshold(1); }
-  } guard{s.status_watch()};
+  // Progress digests (a few a second from each agent) unless lost agents are arbitrated: the
+  // arbiter then needs each agent's own latest round, and reads every round status.
+  const bool digests = !losses.arbitrates();
   for (;;) {
-    if (batch_wake)
-      s.status_watch().set_wake_threshold(reports.statuses_to_complete(
-          static_cast<std::uint32_t>(losses.record().expected.size())));
     const double left = options.run_timeout_s - ms_since(t_run) / 1000.0;
     std::string absent;
     // Lost peers are noticed by polling the session (a few times a second) when watching.
@@ -48,14 +38,26 @@ void await_final_estimates(Session& s, const CoordinatorOptions& options, RoundR
     WaitStatus st = room.wait_for(
         [&] {
           absent = finals_missing();
-          return (absent.empty() && reports.results().have_final_report) ||
-                 !s.status_watch().queued_locked().empty() || !s.rejoins().queued_locked().empty();
+          return (absent.empty() && reports.results().have_final_report &&
+                  (!digests || reports.results().have_final_digest)) ||
+                 !s.status_watch().queued_locked().empty() ||
+                 !s.progress().queued_locked().empty() || !s.rejoins().queued_locked().empty();
         },
         Seconds(nap));
+    if (absent.empty() && digests && !reports.results().have_final_digest)
+      absent = "agent 0 (its last progress digest)";
     if (st == WaitStatus::kStopped || (st == WaitStatus::kTimeout && left <= 0))
       expect_ready(st, room, options.run_timeout_s, "the final estimates",
                    "none yet from " + absent);
     const auto now = std::chrono::steady_clock::now();
+    for (const auto& d : s.progress().take_all()) {
+      if (!digests) continue;
+      reports.on_digest(d, ms_since(t_run));
+      if (!monitor) continue;
+      std::optional<std::uint32_t> round;
+      if (d.phase() != 0) round = d.round();
+      monitor->on_digest(d.sender(), round, d.waiting_for(), d.waiting_s(), now);
+    }
     for (const auto& m : s.status_watch().take_all()) {
       if (m.epoch() < losses.status_epoch()) continue;  // from before a rollback
       if (is_round_status(m)) {
@@ -79,10 +81,12 @@ void await_final_estimates(Session& s, const CoordinatorOptions& options, RoundR
       }
       if (monitor) monitor->tick(now);
     }
-    if (reports.results().have_final_report &&
+    if (reports.results().have_final_report && (!digests || reports.results().have_final_digest) &&
         s.finals().size() >= losses.record().expected.size() &&
-        room.wait_for([&] { return finals_missing().empty(); }, Seconds(0)) == WaitStatus::kReady)
+        room.wait_for([&] { return finals_missing().empty(); }, Seconds(0)) == WaitStatus::kReady) {
+      reports.finish();  // the last round's line, if the rate limit held it back
       return;
+    }
   }
 }
 

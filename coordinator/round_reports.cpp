@@ -1,8 +1,6 @@
 #include "coordinator/round_reports.hpp"
 
-#include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 namespace tessera::coordinator {
 
@@ -13,24 +11,32 @@ void RoundReports::on_round_status(const wire::RoundStatus& m, std::uint32_t act
   p.cost += m.cost();
   p.grad_norm_sq += m.grad_norm_sq();
   if (p.reported != active_agents) return;
-  if (progress_) {
-    char buf[160];
-    std::snprintf(buf, sizeof(buf), "round %u%s: cost %.10g, grad norm %.3e\n", m.round(),
-                  m.phase() == 5 ? " (restart)" : "", p.cost, std::sqrt(p.grad_norm_sq));
-    out_ << buf << std::flush;
-  }
+  const CompletedStep step{m.round(), m.phase(), p.cost, p.grad_norm_sq};
   partial_.erase({m.round(), m.phase()});
-  if (results_.completed_statuses == 0) results_.first_status_ms = ms;
-  results_.last_status_ms = ms;
-  if (m.phase() == 1) ++results_.completed_statuses;
+  on_completed(step, ms);
 }
 
-std::size_t RoundReports::statuses_to_complete(std::uint32_t active_agents) const {
-  std::size_t fewest = active_agents;
-  for (const auto& [key, p] : partial_)
-    if (p.reported < active_agents)
-      fewest = std::min<std::size_t>(fewest, active_agents - p.reported);
-  return std::max<std::size_t>(fewest, 1);
+void RoundReports::on_digest(const wire::AgentProgress& m, double ms) {
+  if (m.sender() != 0) return;  // the reporter's digests (the others only feed the monitor)
+  const std::pair<std::uint32_t, std::uint32_t> at{m.round(), m.phase()};
+  if (m.phase() != 0 && (!newest_ || *newest_ < at)) {
+    if (!newest_) results_.first_status_ms = ms;  // sent as soon as agent 0 saw it complete
+    newest_ = at;
+    lines_.on_step({m.round(), m.phase(), m.cost(), m.grad_norm_sq()}, ms);
+  }
+  if (!m.final()) return;
+  // Exact figures from the agent's own clock: the digests themselves come only a few a second.
+  results_.completed_statuses = m.completed_rounds();
+  results_.last_status_ms = results_.first_status_ms + m.first_to_last_ms();
+  results_.have_final_digest = true;
+  lines_.finish();
+}
+
+void RoundReports::on_completed(const CompletedStep& step, double ms) {
+  lines_.on_step(step, ms);
+  if (results_.completed_statuses == 0) results_.first_status_ms = ms;
+  results_.last_status_ms = ms;
+  if (step.phase == 1) ++results_.completed_statuses;
 }
 
 bool RoundReports::on_report(const wire::RoundStatus& m) {

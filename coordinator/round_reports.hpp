@@ -1,17 +1,18 @@
 #pragma once
-// What the coordinator reads from the agents' round statuses: the progress of the rounds
-// (sums of the agents' cost and squared gradient norm once every active agent reported a
-// round, and when rounds completed) and agent 0's reports after the solve (final cost and
-// gradient, certificate, certificate traffic). No new traffic: these are the statuses the
-// agents exchange anyway, or a few extra ones from agent 0 on the same topic.
+// What the coordinator reads about the rounds: their progress (the sums of the agents' cost
+// and squared gradient norm of each completed status step, and when steps completed) and
+// agent 0's reports after the solve (final cost and gradient, certificate, certificate
+// traffic). The progress comes from agent 0's progress digests (agent/progress_digest.hpp: a
+// few a second, and its last one with the exact round timing), or, while the coordinator
+// arbitrates lost agents, from every agent's round statuses themselves. No traffic of its own.
 
-#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <optional>
 #include <ostream>
 #include <utility>
 
+#include "coordinator/progress_printer.hpp"
 #include "tessera.h"
 #include "transport/topic_names.hpp"
 
@@ -44,20 +45,28 @@ struct ReportedResults {
   bool have_final_report = false;
   std::optional<CertificateReport> certificate;
   std::optional<CertificateTraffic> certificate_bytes;
-  // Round timing from the status completions the coordinator sees: excludes the fixed
-  // costs (hand-off, initialisation, rounding, shutdown) that the solve time holds.
+  // Round timing from the status completions: excludes the fixed costs (hand-off,
+  // initialisation, rounding, shutdown) that the solve time holds. From digests: the first is
+  // when agent 0's first completion reached the coordinator, the last that plus agent 0's own
+  // first-to-last time, and the count agent 0's.
   double first_status_ms = 0, last_status_ms = 0;
   std::uint32_t completed_statuses = 0;  ///< Rounds (phase 1) every active agent reported.
+  bool have_final_digest = false;        ///< Agent 0's last progress digest arrived.
 };
 
 class RoundReports {
  public:
-  /// `progress`: print "round K: cost C, grad norm G" to `out` for every completed round.
-  RoundReports(bool progress, std::ostream& out) : progress_(progress), out_(out) {}
+  /// `progress`: print "round K: cost C, grad norm G" to `out` for completed rounds
+  /// (ProgressPrinter: the first, restarts, the last, at most ten a second in between).
+  RoundReports(bool progress, std::ostream& out) : lines_(progress, out) {}
 
   /// A round status (is_round_status) of one of `active_agents` agents, `ms` after the
   /// rounds started. Completes the round when every active agent has reported it.
   void on_round_status(const wire::RoundStatus& m, std::uint32_t active_agents, double ms);
+  /// A progress digest, `ms` after the rounds started; only agent 0's (the reporter's) count.
+  void on_digest(const wire::AgentProgress& m, double ms);
+  /// The rounds are over: prints the last completed round if its line was held back.
+  void finish() { lines_.finish(); }
   /// One of agent 0's reports (phases kAgent*Phase); false for any other phase.
   bool on_report(const wire::RoundStatus& m);
 
@@ -72,21 +81,14 @@ class RoundReports {
 
   const ReportedResults& results() const { return results_; }
 
-  /// The fewest statuses that can complete a round of `active_agents`: what the partial round
-  /// closest to complete still lacks, or `active_agents` when none is partial. A lower bound for
-  /// the coordinator's wake-up threshold: a round whose first statuses were taken by the
-  /// previous wake-up completes with the rest, not only with the next round's worth (which
-  /// the last round never gets: its completion, and the timeline's last_status, then waited
-  /// for the final estimates).
-  std::size_t statuses_to_complete(std::uint32_t active_agents) const;
-
  private:
   struct Partial {
     std::uint32_t reported = 0;
     double cost = 0, grad_norm_sq = 0;
   };
-  bool progress_;
-  std::ostream& out_;
+  void on_completed(const CompletedStep& step, double ms);
+  ProgressPrinter lines_;
+  std::optional<std::pair<std::uint32_t, std::uint32_t>> newest_;  // from digests: round, phase
   std::map<std::pair<std::uint32_t, std::uint32_t>, Partial> partial_;  // (round, phase)
   ReportedResults results_;
 };

@@ -37,7 +37,8 @@ RunMonitor::RunMonitor(std::uint32_t num_agents, MonitorOptions options, std::os
       last_print_(start),
       round_(num_agents, -1),
       last_seen_(num_agents, start),
-      lost_(num_agents, false) {
+      lost_(num_agents, false),
+      wait_(num_agents) {
   opt_.validate();
 }
 
@@ -46,6 +47,16 @@ void RunMonitor::on_status(std::uint32_t agent, std::uint32_t round, Clock::time
   // After a rollback rounds go back: the newest report is the agent's round.
   round_[agent] = round;
   last_seen_[agent] = now;
+}
+
+void RunMonitor::on_digest(std::uint32_t agent, std::optional<std::uint32_t> round,
+                           const std::vector<std::uint32_t>& waiting_for, double waiting_s,
+                           Clock::time_point now) {
+  if (agent >= n_) return;
+  digests_ = true;
+  if (round) round_[agent] = *round;
+  last_seen_[agent] = now;
+  wait_[agent] = Wait{waiting_for, waiting_s};
 }
 
 void RunMonitor::set_lost(const std::vector<std::uint32_t>& lost, Clock::time_point now) {
@@ -69,6 +80,11 @@ void RunMonitor::event(const std::string& what, Clock::time_point now) {
   print(now);
 }
 
+bool RunMonitor::silent(std::uint32_t k, Clock::time_point newest, Clock::time_point now) const {
+  return secs(newest - last_seen_[k]) >= opt_.lag_s ||
+         (secs(now - last_seen_[k]) >= opt_.lag_s && newest > last_seen_[k]);
+}
+
 std::vector<std::uint32_t> RunMonitor::lagging(Clock::time_point now) const {
   std::int64_t lead = -1;
   Clock::time_point newest = start_;
@@ -79,13 +95,38 @@ std::vector<std::uint32_t> RunMonitor::lagging(Clock::time_point now) const {
     }
   std::vector<std::uint32_t> out;
   if (lead < 0) return out;  // nothing reported yet: set-up, not lag
+  const std::vector<std::uint32_t> waited = waited_for(now).first;
   for (std::uint32_t k = 0; k < n_; ++k) {
     if (lost_[k]) continue;
-    const bool behind = lead - round_[k] >= static_cast<std::int64_t>(opt_.lag_rounds);
-    const bool silent = secs(newest - last_seen_[k]) >= opt_.lag_s ||
-                        (secs(now - last_seen_[k]) >= opt_.lag_s && newest > last_seen_[k]);
-    if (behind || silent) out.push_back(k);
+    const bool behind = !digests_ && lead - round_[k] >= static_cast<std::int64_t>(opt_.lag_rounds);
+    const bool waited_long = std::find(waited.begin(), waited.end(), k) != waited.end();
+    if (behind || waited_long || silent(k, newest, now)) out.push_back(k);
   }
+  return out;
+}
+
+std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> RunMonitor::waited_for(
+    Clock::time_point now) const {
+  std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> out;
+  if (!digests_) return out;
+  Clock::time_point newest = start_;
+  for (std::uint32_t k = 0; k < n_; ++k)
+    if (!lost_[k]) newest = std::max(newest, last_seen_[k]);
+  std::vector<bool> all(n_, true);
+  for (std::uint32_t k = 0; k < n_; ++k) {
+    // A silent agent's last wait is stale (it is named as silent instead).
+    if (lost_[k] || wait_[k].senders.empty() || wait_[k].waiting_s < opt_.lag_s ||
+        silent(k, newest, now))
+      continue;
+    out.second.push_back(k);
+    std::vector<bool> named(n_, false);
+    for (auto j : wait_[k].senders)
+      if (j < n_) named[j] = true;
+    for (std::uint32_t j = 0; j < n_; ++j) all[j] = all[j] && named[j];
+  }
+  if (out.second.empty()) return out;
+  for (std::uint32_t j = 0; j < n_; ++j)
+    if (all[j] && !lost_[j]) out.first.push_back(j);
   return out;
 }
 
@@ -101,6 +142,8 @@ std::string RunMonitor::line(Clock::time_point now) const {
     s += " " + std::to_string(k) + ":" + (round_[k] < 0 ? "-" : std::to_string(round_[k]));
   const auto lag = lagging(now);
   if (!lag.empty()) s += "; lagging: " + list(lag);
+  const auto [waited, waiters] = waited_for(now);
+  if (!waited.empty()) s += "; agents " + list(waiters) + " wait for " + list(waited);
   if (!lost.empty()) s += "; lost: " + list(lost);
   return s;
 }

@@ -1,17 +1,25 @@
 #pragma once
 // What an operator sees while a distributed run goes on (issue 8 item 5): which agents are
 // alive, the round each one has reported, and which are lagging or lost. Fed with the agents'
-// round statuses (which the coordinator reads anyway) and the session's peer events; prints a
+// progress digests (agent/progress_digest.hpp; a few a second) or, while the coordinator
+// arbitrates lost agents, their round statuses, and with the session's peer events; prints a
 // status line every `interval_s` seconds and at once when something changes (an agent lost,
 // rejoined, starts or stops lagging).
 //
-// Lagging: an agent whose last reported round is at least `lag_rounds` behind the most
-// advanced agent, or that has reported nothing for `lag_s` seconds while another agent has.
+// Lagging: an agent that has reported nothing for `lag_s` seconds while another agent has
+// (a hung process: its digests stop too); with round statuses, one whose last reported round
+// is at least `lag_rounds` behind the most advanced agent; with digests, one that every agent
+// waiting for at least `lag_s` in its current step waits for (digests are samples taken at
+// different moments, so their rounds are not compared; a waiting agent names the senders it
+// misses, and with the status relay the agents other than the relay miss everyone, hence the
+// intersection). The line then adds "agents A,B wait for K".
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tessera::coordinator {
@@ -36,6 +44,11 @@ class RunMonitor {
              Clock::time_point start);
 
   void on_status(std::uint32_t agent, std::uint32_t round, Clock::time_point now);
+  /// A progress digest from `agent`: `round` (nullopt: no step completed yet), and whom it
+  /// waits for in its current step (agent ids) since `waiting_s` seconds.
+  void on_digest(std::uint32_t agent, std::optional<std::uint32_t> round,
+                 const std::vector<std::uint32_t>& waiting_for, double waiting_s,
+                 Clock::time_point now);
   /// The set of agents currently lost (from the session); reports changes.
   void set_lost(const std::vector<std::uint32_t>& lost, Clock::time_point now);
   /// A one-off event line ("agent 2 rejoined: rollback to round 14").
@@ -49,6 +62,14 @@ class RunMonitor {
 
  private:
   std::vector<std::uint32_t> lagging(Clock::time_point now) const;
+  bool silent(std::uint32_t k, Clock::time_point newest, Clock::time_point now) const;
+  /// With digests: the agents every long waiter waits for, and those waiters.
+  std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> waited_for(
+      Clock::time_point now) const;
+  struct Wait {
+    std::vector<std::uint32_t> senders;
+    double waiting_s = 0;
+  };
   void print(Clock::time_point now);
   std::uint32_t n_;
   MonitorOptions opt_;
@@ -58,6 +79,8 @@ class RunMonitor {
   std::vector<Clock::time_point> last_seen_;
   std::vector<bool> lost_;
   std::vector<std::uint32_t> last_lagging_;
+  bool digests_ = false;    // fed by on_digest: rounds are samples, compare waits instead
+  std::vector<Wait> wait_;  // the newest digest's wait, per agent
 };
 
 }  // namespace tessera::coordinator

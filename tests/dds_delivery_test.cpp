@@ -1,7 +1,8 @@
 // Who receives what (docs/dds-runtime.md, "Who receives what"): a pose block addressed to
 // one agent reaches only that agent's process, a broadcast reaches every other agent, only
-// the round statuses the coordinator reads (coordinator_reads_status) reach the coordinator,
-// and round statuses go through the relay agent (one bundle per step). A coordinator and three
+// the round statuses the coordinator reads (coordinator_reads_status) reach the coordinator
+// (the solve's only while it follows the rounds; otherwise the agents' progress digests), and
+// round statuses go through the relay agent (one bundle per step). A coordinator and three
 // agents, each a Session of its own in this process, on DDS domain 60.
 
 #include <gtest/gtest.h>
@@ -53,9 +54,9 @@ OutgoingMessage block_to(std::vector<std::uint32_t> recipients, std::uint32_t ph
   return m;
 }
 
-OutgoingMessage status(std::uint32_t phase, std::uint32_t sender = 0) {
+OutgoingMessage status(std::uint32_t phase, std::uint32_t sender = 0, std::uint32_t round = 7) {
   RoundStatusMessage s;
-  s.round = 7;
+  s.round = round;
   s.sender = sender;
   s.phase = phase;
   s.cost = 1.5;
@@ -77,10 +78,11 @@ std::vector<std::uint32_t> received_phases(Session& s, std::size_t expected) {
 }
 
 TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyItsStatuses) {
-  ASSERT_TRUE(coordinator_reads_status(1));
-  ASSERT_TRUE(coordinator_reads_status(200));
-  ASSERT_FALSE(coordinator_reads_status(101));  // a rounding reduction
-  ASSERT_FALSE(coordinator_reads_status(300));  // the initialisation stage
+  ASSERT_TRUE(coordinator_reads_status(1, true));
+  ASSERT_FALSE(coordinator_reads_status(1, false));  // the digests tell the coordinator
+  ASSERT_TRUE(coordinator_reads_status(200, false));
+  ASSERT_FALSE(coordinator_reads_status(101, true));  // a rounding reduction
+  ASSERT_FALSE(coordinator_reads_status(300, true));  // the initialisation stage
 
   std::vector<std::unique_ptr<Session>> sessions;
   sessions.push_back(std::make_unique<Session>(options_for(true, 0)));
@@ -106,8 +108,12 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   a0.send(status(101));       // a rounding reduction: agents only, all to all
   // Round statuses of the solve go through the relay, agent 0 (transport/status_relay.hpp),
   // when the agents turn it on (as tessera-agent does unless lost agents are arbitrated):
-  // agents 1 and 2 send theirs to it alone ...
-  for (Session* a : {&a0, &a1, &a2}) a->set_status_relay(true);
+  // agents 1 and 2 send theirs to it alone ... (the coordinator follows the rounds here, as
+  // while it arbitrates lost agents)
+  for (Session* a : {&a0, &a1, &a2}) {
+    a->set_status_relay(true);
+    a->set_coordinator_follows_rounds(true);
+  }
   a1.send(status(1, 1));
   a2.send(status(1, 2));
   const std::vector<std::uint32_t> at0 = received_phases(a0, 2);
@@ -153,6 +159,44 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
     EXPECT_EQ(watched[k].sender(), k);
     EXPECT_EQ(watched[k].round(), 7u);
   }
+
+  // By default the coordinator follows the agents' progress digests: the statuses of the
+  // solve and their bundle stay among the agents; the coordinator gets the digest and agent
+  // 0's report, nothing else.
+  for (Session* a : {&a0, &a1, &a2}) a->set_coordinator_follows_rounds(false);
+  a1.send(status(1, 1, 8));
+  a2.send(status(1, 2, 8));
+  EXPECT_EQ(received_phases(a0, 2), (std::vector<std::uint32_t>{1u, 1u}));
+  a0.send(status(1, 0, 8));
+  wire::AgentProgress digest;
+  digest.sender(1);
+  digest.round(8);
+  digest.phase(1);
+  digest.cost(4.5);
+  a1.publish(digest);
+  a0.send(status(200, 0, 8));  // agent 0's final report
+  for (Session* a : {&a0, &a1, &a2}) a->flush(Seconds(10));
+  for (Session* a : {&a1, &a2}) {
+    const std::vector<std::uint32_t> at = received_phases(*a, 3);
+    EXPECT_EQ(std::count(at.begin(), at.end(), 1u), 2);
+    EXPECT_EQ(std::count(at.begin(), at.end(), 200u), 1);
+  }
+  std::vector<wire::AgentProgress> digests;
+  const auto digest_until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (digests.empty() && std::chrono::steady_clock::now() < digest_until) {
+    for (auto& m : coordinator.progress().take_all()) digests.push_back(std::move(m));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // room for a wrong extra one
+  for (auto& m : coordinator.progress().take_all()) digests.push_back(std::move(m));
+  ASSERT_EQ(digests.size(), 1u);
+  EXPECT_EQ(digests[0].sender(), 1u);
+  EXPECT_EQ(digests[0].round(), 8u);
+  EXPECT_EQ(digests[0].cost(), 4.5);
+  EXPECT_EQ(digests[0].run_id(), "delivery-test");
+  const std::vector<wire::RoundStatus> reports = coordinator.status_watch().take_all();
+  ASSERT_EQ(reports.size(), 1u);
+  EXPECT_EQ(reports[0].phase(), 200u);
 
   for (auto it = sessions.rbegin(); it != sessions.rend(); ++it) (*it)->close();
 }

@@ -164,7 +164,7 @@ TEST(DdsForkServer, YieldingAgentsShareASessionAndRunTheirRoundsAtNiceZero) {
   LongForkedRun run("yield", 212, {"--agents-yield"});
   const std::string& run_id = run.run_id;
   const Process& launch = run.launch;
-  ASSERT_TRUE(wait_for_output(launch, "round 2:", 30)) << launch.output();
+  ASSERT_TRUE(wait_for_round(launch, 2, 30)) << launch.output();
   // Every agent has its assignment: all its threads and its group are back at nice 0.
   const std::vector<long> agents = pids_of("[t]essera-agent.*--run-id " + run_id + " ");
   ASSERT_EQ(agents.size(), 2u);
@@ -275,7 +275,7 @@ TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndS
   LongForkedRun run("forked", 52, {});
   const std::string& run_id = run.run_id;
   const Process& launch = run.launch;
-  ASSERT_TRUE(wait_for_output(launch, "round 2:", 30)) << launch.output();
+  ASSERT_TRUE(wait_for_round(launch, 2, 30)) << launch.output();
   EXPECT_NE(launch.output().find("forked by tessera-fork-server"), std::string::npos);
   // pgrep -f reads the command line each forked child shows: its executable's argv.
   for (const std::string& pattern : {"[t]essera-coordinator --agents 2 .*--run-id " + run_id + " ",

@@ -95,7 +95,7 @@ TEST(DdsLaunchLoss, KilledAgentLeavesFourAgentsThatFinishAtTheOptimumWithEveryPo
   Process launch = r.launch({"--grad-tol", "0.0005"});
   const pid_t victim = r.agent_pid(2);
   ASSERT_GT(victim, 0) << launch.output();
-  ASSERT_TRUE(wait_for_output(launch, "round 10:", 40)) << launch.output();
+  ASSERT_TRUE(wait_for_round(launch, 10, 40)) << launch.output();
   ASSERT_EQ(kill(victim, SIGKILL), 0) << launch.output();
   ASSERT_TRUE(wait_all({&launch}, 60)) << launch.output();
   const std::string out = launch.output();
@@ -117,7 +117,7 @@ TEST(DdsLaunchLoss, SecondLossInTheSameRunStopsItNamingTheAgent) {
   const pid_t first = r.agent_pid(2), second = r.agent_pid(3);
   ASSERT_GT(first, 0) << launch.output();
   ASSERT_GT(second, 0) << launch.output();
-  ASSERT_TRUE(wait_for_output(launch, "round 10:", 40)) << launch.output();
+  ASSERT_TRUE(wait_for_round(launch, 10, 40)) << launch.output();
   ASSERT_EQ(kill(first, SIGKILL), 0) << launch.output();
   ASSERT_TRUE(wait_for_output(launch, "re-partitioned", 30)) << launch.output();
   ASSERT_EQ(kill(second, SIGKILL), 0) << launch.output();

@@ -59,7 +59,7 @@ TEST(DdsLoss, AgentKilledForGoodSurvivorsFinishAtTheOptimumWithEveryPose) {
   std::vector<Process> agents =
       start_agents(r.dir, r.graph, r.agents, r.run, r.domain, {"--timeout", "20", "--udp-only"},
                    false);  // --udp-only: the loss-tolerant configuration (docs/fault-tolerance.md)
-  const bool started = wait_for_output(coord, "round 10:", 30);
+  const bool started = wait_for_round(coord, 10, 30);
   kill(agents[2].pid, SIGKILL);  // for good: never restarted
   ASSERT_TRUE(started) << coord.output();
   std::vector<Process*> all = all_of(coord, agents);
@@ -88,7 +88,7 @@ TEST(DdsLoss, WithoutReplicasALostAgentStillStopsTheRun) {
   Process coord = r.coordinator(0);
   std::vector<Process> agents =
       start_agents(r.dir, r.graph, r.agents, r.run, r.domain, {"--timeout", "20"}, false);
-  const bool started = wait_for_output(coord, "round 3:", 30);
+  const bool started = wait_for_round(coord, 3, 30);
   kill(agents[1].pid, SIGKILL);
   ASSERT_TRUE(started) << coord.output();
   std::vector<Process*> all = all_of(coord, agents);
@@ -124,7 +124,7 @@ void restarted_after_repartition_is_refused(int domain, bool checkpoint) {
     if (checkpoint) mkdir((r.dir + "/ckpt" + std::to_string(k)).c_str(), 0755);
     agents.push_back(start(agent_argv(k), r.dir + "/agent" + std::to_string(k) + ".log"));
   }
-  const bool started = wait_for_output(coord, "round 10:", 30);
+  const bool started = wait_for_round(coord, 10, 30);
   kill(agents[2].pid, SIGKILL);
   ASSERT_TRUE(started) << coord.output();
   ASSERT_TRUE(wait_for_output(coord, "re-partitioned", 30)) << coord.output();

@@ -186,6 +186,28 @@ inline bool wait_for_output(const Process& p, const std::string& text, double ti
   return false;
 }
 
+/// The highest K of the progress lines ("round K: ..." and "round K (restart): ...") in
+/// `text`, or -1 when there is none.
+inline long last_progress_round(const std::string& text) {
+  static const std::regex line(R"((^|\n)round (\d+)( \(restart\))?:)");
+  long last = -1;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), line); it != std::sregex_iterator();
+       ++it)
+    last = std::max(last, std::stol((*it)[2].str()));
+  return last;
+}
+
+/// Waits until `p` printed a progress line of round `round` or later (the coordinator prints
+/// at most ~10 a second, so a given round may have no line); false after `timeout_s`.
+inline bool wait_for_round(const Process& p, long round, double timeout_s) {
+  const auto until = Clock::now() + std::chrono::duration<double>(timeout_s);
+  while (Clock::now() < until) {
+    if (last_progress_round(p.output()) >= round) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
 /// `tessera generate <args> --out <path>`; a failure is a test failure (with the output).
 inline std::string generate_graph(const std::string& path, const std::string& args) {
   std::string out;

@@ -74,11 +74,11 @@ struct Fixture {
   }
 };
 
-// Waits up to wait_s for `line` in p's output, then SIGKILLs `victim` either way (so a failed
-// wait leaves no agent running on); true when the line came.
-bool kill_once_it_prints(const Process& p, const std::string& line, double wait_s,
-                         Process& victim) {
-  const bool seen = wait_for_output(p, line, wait_s);
+// Waits up to wait_s for a progress line of round `round` or later in p's output, then
+// SIGKILLs `victim` either way (so a failed wait leaves no agent running on); true when the
+// line came.
+bool kill_once_it_prints(const Process& p, long round, double wait_s, Process& victim) {
+  const bool seen = wait_for_round(p, round, wait_s);
   kill(victim.pid, SIGKILL);
   return seen;
 }
@@ -120,7 +120,7 @@ TEST(DdsRejoin, KilledAgentRestartedWithSameIdFinishesAtTheUndisturbedCost) {
   Process coord = f.coordinator(20);
   std::vector<Process> agents = f.launch_agents();
   // Kill agent 2 in the middle of the rounds.
-  ASSERT_TRUE(kill_once_it_prints(coord, "round 4:", 30, agents[2])) << coord.output();
+  ASSERT_TRUE(kill_once_it_prints(coord, 4, 30, agents[2])) << coord.output();
   ASSERT_TRUE(wait_all({&agents[2]}, 5));
   EXPECT_EQ(agents[2].exit_code, 128 + SIGKILL);
   Process again = start(f.agent_args(2), f.dir + "/agent2-restarted.log");
@@ -159,7 +159,7 @@ TEST(DdsRejoin, SecuredRestartedAgentPassesThePeerGateThenRejoins) {
 
   Process coord = f.coordinator(20);
   std::vector<Process> agents = f.launch_agents();
-  ASSERT_TRUE(kill_once_it_prints(coord, "round 4:", 40, agents[1])) << coord.output();
+  ASSERT_TRUE(kill_once_it_prints(coord, 4, 40, agents[1])) << coord.output();
   ASSERT_TRUE(wait_all({&agents[1]}, 5));
   // The restarted process judges the first handshake it finds unfinished stalled and
   // re-creates its participant once before asking to rejoin (a test hook outside its budget
@@ -191,7 +191,7 @@ TEST(DdsRejoin, AgentThatDoesNotComeBackStopsTheRunAfterTheRejoinTimeout) {
   ASSERT_FALSE(::testing::Test::HasFailure());
   Process coord = f.coordinator(2);
   std::vector<Process> agents = f.launch_agents();
-  ASSERT_TRUE(kill_once_it_prints(coord, "round 2:", 30, agents[1])) << coord.output();
+  ASSERT_TRUE(kill_once_it_prints(coord, 2, 30, agents[1])) << coord.output();
   const auto killed = Clock::now();
   std::vector<Process*> all = {&coord, &agents[0], &agents[1], &agents[2]};
   EXPECT_TRUE(wait_all(all, 30)) << "a process hung";

@@ -1,7 +1,8 @@
-// The coordinator's round reports (RoundReports), without processes: a round completes when
-// every active agent reported it, and the wake-up threshold it gives the status inbox never
-// asks for more statuses than can complete a round (the last round's completion used to wait
-// for the final estimates, docs/dds-runtime.md, "Session 10 (stall10)").
+// The coordinator's round reports (RoundReports), without processes: from round statuses (read
+// while lost agents are arbitrated) a round completes when every active agent reported it, at
+// the time its last status was read; from progress digests, the round timing and the last line
+// come from agent 0's last digest (docs/dds-runtime.md, "Session 10 (relay10)"). (stall10's
+// status wake-up threshold, statuses_to_complete, went with the status reading it served.)
 
 #include <gtest/gtest.h>
 
@@ -21,28 +22,53 @@ wire::RoundStatus status(std::uint32_t sender, std::uint32_t round) {
   return m;
 }
 
-TEST(RoundReports, WakeThresholdIsWhatTheRoundClosestToCompleteLacks) {
+TEST(RoundReports, ARoundCompletesWithItsLastStatus) {
   std::ostringstream out;
   RoundReports r(true, out);
-  EXPECT_EQ(r.statuses_to_complete(5), 5u) << "nothing partial: a whole round";
-  // A wake-up took the first two statuses of round 0: three more complete it.
   r.on_round_status(status(0, 0), 5, 1.0);
   r.on_round_status(status(1, 0), 5, 1.0);
-  EXPECT_EQ(r.statuses_to_complete(5), 3u);
-  // A fast agent is already in round 1: round 0 still needs the fewest.
+  // A fast agent is already in round 1.
   r.on_round_status(status(0, 1), 5, 2.0);
   r.on_round_status(status(2, 0), 5, 2.0);
   r.on_round_status(status(3, 0), 5, 2.0);
-  EXPECT_EQ(r.statuses_to_complete(5), 1u);
   EXPECT_EQ(r.results().completed_statuses, 0u);
   r.on_round_status(status(4, 0), 5, 3.0);
   EXPECT_EQ(r.results().completed_statuses, 1u);
+  EXPECT_EQ(r.results().first_status_ms, 3.0);
   EXPECT_EQ(r.results().last_status_ms, 3.0) << "completed when its last status was read";
-  EXPECT_EQ(r.statuses_to_complete(5), 4u) << "round 1 has one of five";
   EXPECT_NE(out.str().find("round 0: cost 5"), std::string::npos) << out.str();
-  r.drop_partial_rounds();
-  EXPECT_EQ(r.statuses_to_complete(5), 5u);
-  EXPECT_EQ(r.statuses_to_complete(0), 1u) << "never 0 (a threshold of 0 would never wake)";
+}
+
+TEST(RoundReports, RoundTimingAndTheLastLineComeFromAgentZerosFinalDigest) {
+  std::ostringstream out;
+  RoundReports reports(true, out);
+  wire::AgentProgress d;
+  d.sender(1);  // not the reporter: ignored
+  d.round(3);
+  d.phase(1);
+  reports.on_digest(d, 10.0);
+  EXPECT_TRUE(out.str().empty());
+  d.sender(0);
+  d.round(0);
+  d.cost(9.0);
+  reports.on_digest(d, 40.0);
+  d.round(7);
+  d.cost(4.0);
+  reports.on_digest(d, 60.0);  // within 100 ms of the first line: held back
+  d.round(9);
+  d.cost(1.0);
+  d.grad_norm_sq(0.01);
+  d.completed_rounds(10);
+  d.first_to_last_ms(90.0);
+  d.final(true);
+  reports.on_digest(d, 130.0);  // the last: always printed
+  EXPECT_EQ(out.str(),
+            "round 0: cost 9, grad norm 0.000e+00\nround 9: cost 1, grad norm 1.000e-01\n");
+  const ReportedResults& r = reports.results();
+  EXPECT_TRUE(r.have_final_digest);
+  EXPECT_EQ(r.completed_statuses, 10u);
+  EXPECT_EQ(r.first_status_ms, 40.0);
+  EXPECT_EQ(r.last_status_ms, 130.0);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-168 (each test its own, so ctest -j is safe).
+// Domains used here: 161-168 and 9 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -100,6 +100,13 @@ TEST(DdsSolve, StatusRelayGivesTheInProcessIterates) {
   expect_same_as_in_process("rbcd++", 168, true);
 }
 
+// Kills whatever processes of run `run_id` a test leaves running when an assertion fails (a
+// leftover in the same domain would otherwise be what the next run's pgrep finds).
+struct RunCleanup {
+  std::string run_id;
+  ~RunCleanup() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
+};
+
 TEST(DdsLaunch, EndToEndOnAGeneratedGraphPrintsTheSummary) {
   const std::string dir = temp_dir();
   std::string out;
@@ -108,7 +115,7 @@ TEST(DdsLaunch, EndToEndOnAGeneratedGraphPrintsTheSummary) {
                                  dir + "/merged.g2o 2>&1",
                              &out);
   ASSERT_EQ(rc, 0) << out;
-  EXPECT_NE(out.find("round 1:"), std::string::npos) << out;  // progress streamed
+  EXPECT_GE(last_progress_round(out), 1) << out;  // progress streamed
   EXPECT_NE(out.find("summary:"), std::string::npos) << out;
   const std::string json = slurp(dir + "/s.json");
   for (const char* field :
@@ -143,10 +150,7 @@ TEST(DdsLaunch, SigintStopsEveryProcess) {
        "1e-12", "--max-rounds", "100000", "--partition", "fast", "--timeout", "60"},
       dir + "/launch.log");
   // Wait until the rounds run, then interrupt.
-  const auto until = Clock::now() + std::chrono::seconds(20);
-  while (launch.output().find("round 2:") == std::string::npos && Clock::now() < until)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  ASSERT_NE(launch.output().find("round 2:"), std::string::npos) << launch.output();
+  ASSERT_TRUE(wait_for_round(launch, 2, 20)) << launch.output();
   kill(launch.pid, SIGINT);
   ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
   EXPECT_EQ(launch.exit_code, 130) << launch.output();
@@ -164,10 +168,7 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
   // running when an assertion fails is removed by it (a leftover in the same domain would
   // otherwise be what the next run's pgrep finds).
   const std::string run_id = "killed-" + std::to_string(getpid());
-  struct Cleanup {
-    std::string run_id;
-    ~Cleanup() { run_command("pkill -9 -f '[t]essera-.*--run-id " + run_id + "'", nullptr); }
-  } cleanup{run_id};
+  const RunCleanup cleanup{run_id};
   // 2000 poses: enough rounds (until the stalled rule stops it) that the run is still going
   // when the agent is looked up after round 2 (with 600 poses it could already have finished).
   // Lease 3 s: under ctest -j2 (load ~20) the survivors' 1 s leases of each other lapsed
@@ -178,10 +179,7 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
                           "--grad-tol",   "1e-12",  "--max-rounds", "100000", "--partition", "fast",
                           "--timeout",    "60",     "--lease",      "3"},
                          dir + "/launch.log");
-  const auto until = Clock::now() + std::chrono::seconds(20);
-  while (launch.output().find("round 2:") == std::string::npos && Clock::now() < until)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  ASSERT_NE(launch.output().find("round 2:"), std::string::npos) << launch.output();
+  ASSERT_TRUE(wait_for_round(launch, 2, 20)) << launch.output();
   std::string pid;
   // "[t]" keeps the pattern from matching the shell that runs pgrep.
   run_command("pgrep -f '[t]essera-agent.*--id 1 --run-id " + run_id + " ' | head -1", &pid);
@@ -196,6 +194,60 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
   EXPECT_NE(out.find("error: lost agent 1"), std::string::npos) << out;
   EXPECT_NE(out.find("participant lease"), std::string::npos) << out;
   remove_shm_files(leaked_shm_files(before, 166));  // what the killed process left
+}
+
+// A hung agent (SIGSTOP: its DDS threads stop too, so a lease longer than the stop keeps it
+// from being declared lost) is named by the coordinator's status line, with the status relay
+// on and the coordinator following the agents' progress digests, not their
+// round statuses: its digests stop while the others' go on from their waits
+// (docs/dds-runtime.md, "Session 10"). Once it goes on, so does the run.
+TEST(DdsLaunch, HungAgentIsNamedAsLaggingAndTheRunGoesOn) {
+  const std::string dir = temp_dir();
+  const std::string run_id = "hung-" + std::to_string(getpid());
+  const RunCleanup cleanup{run_id};
+  Process launch = start({bin("tessera"),
+                          "launch",
+                          "--agents",
+                          "3",
+                          "--poses",
+                          "2000",
+                          "--domain",
+                          "9",
+                          "--run-id",
+                          run_id,
+                          "--init",
+                          "file",
+                          "--grad-tol",
+                          "1e-12",
+                          "--max-rounds",
+                          "100000",
+                          "--partition",
+                          "fast",
+                          "--timeout",
+                          "90",
+                          "--lease",
+                          "30",
+                          "--status-relay",
+                          "--status-interval",
+                          "1"},
+                         dir + "/launch.log");
+  ASSERT_TRUE(wait_for_round(launch, 2, 30)) << launch.output();
+  std::string pid;
+  run_command("pgrep -f '[t]essera-agent.*--id 1 --run-id " + run_id + " ' | head -1", &pid);
+  ASSERT_FALSE(pid.empty());
+  kill(std::stoi(pid), SIGSTOP);
+  // Silent for the monitor's lag_s (3 s) while the others report: named within a few seconds.
+  const bool named = wait_for_output(launch, "lagging: 1", 20);
+  const long stopped_at = last_progress_round(launch.output());
+  kill(std::stoi(pid), SIGCONT);
+  ASSERT_TRUE(named) << launch.output();
+  const std::string lag_line = launch.output().substr(launch.output().find("lagging: 1"));
+  EXPECT_EQ(lag_line.find("lagging: 1,"), std::string::npos) << lag_line;  // agent 1 only
+  // It goes on from where it stopped.
+  EXPECT_TRUE(wait_for_round(launch, stopped_at + 1, 30)) << launch.output();
+  kill(launch.pid, SIGINT);
+  ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
+  EXPECT_EQ(launch.exit_code, 130) << launch.output();
 }
 
 }  // namespace

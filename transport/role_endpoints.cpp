@@ -61,6 +61,9 @@ void create_coordinator_endpoints(SessionParts& s) {
   e.make_reader<wire::FinalEstimatePubSubType, wire::FinalEstimate>(
       kFinalTopic, false, Expect::kAllAgents,
       [&s](wire::FinalEstimate&& m) { s.final_in.push(std::move(m)); });
+  e.make_reader<wire::AgentProgressPubSubType, wire::AgentProgress>(
+      kProgressTopic, false, Expect::kAllAgents,
+      [&s](wire::AgentProgress&& m) { s.progress_in.push(std::move(m)); });
 }
 
 void create_agent_endpoints(SessionParts& s) {
@@ -77,10 +80,11 @@ void create_agent_endpoints(SessionParts& s) {
       if (k != me)
         e.make_writer<wire::PoseBlockPubSubType>(block_topic_for(k), false, Expect::kAgent, k);
   // Statuses the coordinator reads (coordinator_reads_status) on kStatusTopic, the others on
-  // kAgentStatusTopic.
+  // kAgentStatusTopic; its progress digests on kProgressTopic.
   e.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false,
                                              Expect::kOtherAgentsAndCoordinator);
   e.make_writer<wire::RoundStatusPubSubType>(kAgentStatusTopic, false, Expect::kOtherAgents);
+  e.make_writer<wire::AgentProgressPubSubType>(kProgressTopic, false, Expect::kCoordinator);
   // Round statuses through the relay (status_relay.hpp): the others write to it, it reads.
   const bool relayed = s.opt.num_agents >= kMinAgentsForRelay;
   if (relayed && me != kRelayAgent)

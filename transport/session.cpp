@@ -112,6 +112,9 @@ void Session::set_protocol_wake_threshold(std::size_t n) {
 Inbox<wire::RoundStatus>& Session::status_watch() {
   return impl_->status_in;
 }
+Inbox<wire::AgentProgress>& Session::progress() {
+  return impl_->progress_in;
+}
 Inbox<wire::FinalEstimate>& Session::finals() {
   return impl_->final_in;
 }
@@ -151,6 +154,10 @@ void Session::publish(const wire::MeasurementHandoff& m) {
 void Session::publish(const wire::FinalEstimate& m) {
   impl_->writer.write(kFinalTopic, m);
 }
+void Session::publish(wire::AgentProgress m) {
+  m.run_id(impl_->opt.run_id);
+  impl_->writer.write(kProgressTopic, m);
+}
 
 void Session::send(const OutgoingMessage& m) {
   const std::string& run = impl_->opt.run_id;
@@ -180,7 +187,9 @@ void Session::send(const OutgoingMessage& m) {
       relay_statuses();
       return;
     }
-    impl_->writer.write(coordinator_reads_status(status.phase) ? kStatusTopic : kAgentStatusTopic,
+    impl_->writer.write(coordinator_reads_status(status.phase, impl_->rounds_followed)
+                            ? kStatusTopic
+                            : kAgentStatusTopic,
                         w);
   }
 }
@@ -189,12 +198,18 @@ void Session::set_status_relay(bool on) {
   impl_->relay_enabled = on;
 }
 
+void Session::set_coordinator_follows_rounds(bool on) {
+  impl_->rounds_followed = on;
+}
+
 void Session::relay_statuses() {
   SessionParts& s = *impl_;
   if (!s.relays_statuses() || s.me.agent_id != kRelayAgent) return;
   std::vector<wire::RoundStatus> bundles =
       s.room.with_lock([&] { return s.relay.take_bundles(s.opt.run_id, kRelayAgent); });
-  for (const auto& b : bundles) s.writer.write(kStatusTopic, b);
+  // Bundles carry solve statuses: the coordinator's topic only when it follows them.
+  const char* topic = s.rounds_followed ? kStatusTopic : kAgentStatusTopic;
+  for (const auto& b : bundles) s.writer.write(topic, b);
 }
 
 void Session::send_control(wire::ControlKind kind, const std::string& reason) {

@@ -77,10 +77,13 @@ class Session {
   /// knows how many messages its current step needs; every other wake-up (stop, rollback,
   /// re-partition, new epoch) is unchanged. Set it back to 1 after the wait.
   void set_protocol_wake_threshold(std::size_t n);
-  Inbox<wire::RoundStatus>& status_watch();  ///< Coordinator: every round status (progress).
-  Inbox<wire::FinalEstimate>& finals();      ///< Coordinator.
-  Inbox<wire::Control>& rejoins();           ///< Coordinator: REJOIN requests of restarted agents.
-  Inbox<wire::Control>& rollbacks();         ///< Agents: ROLLBACK orders of the coordinator.
+  /// Coordinator: the round statuses it reads (topic_names.hpp, coordinator_reads_status).
+  Inbox<wire::RoundStatus>& status_watch();
+  /// Coordinator: the agents' progress digests (agent/progress_digest.hpp).
+  Inbox<wire::AgentProgress>& progress();
+  Inbox<wire::FinalEstimate>& finals();  ///< Coordinator.
+  Inbox<wire::Control>& rejoins();       ///< Coordinator: REJOIN requests of restarted agents.
+  Inbox<wire::Control>& rollbacks();     ///< Agents: ROLLBACK orders of the coordinator.
 
   // ---- rollback epochs: protocol messages carry the sender's epoch; those of an older
   // epoch are dropped, those of a newer one are held until this process reaches it.
@@ -100,6 +103,8 @@ class Session {
   void publish(const wire::PartitionAssignment& m);
   void publish(const wire::MeasurementHandoff& m);
   void publish(const wire::FinalEstimate& m);
+  /// Agents: a progress digest for the coordinator (run id filled in here).
+  void publish(wire::AgentProgress m);
   /// A round-protocol message from this agent (run id and routing filled in here). Round
   /// statuses of the solve go through the relay agent in runs of at least 3 agents
   /// (transport/status_relay.hpp): to it alone, and from it to everyone as one bundle per step.
@@ -112,6 +117,11 @@ class Session {
   /// agent of a run must choose the same before its first round status. Off where the
   /// coordinator arbitrates lost agents: it then reads each agent's round from its own status.
   void set_status_relay(bool on);
+  /// Whether core's round statuses of the solve (and the relay's bundles) also go to the
+  /// coordinator (topic_names.hpp, coordinator_reads_status): on while it arbitrates lost
+  /// agents (rejoin, replicas); off (the default) it follows the agents' progress digests.
+  /// Every agent of a run must choose the same before its first round status.
+  void set_coordinator_follows_rounds(bool on);
   /// READY / FINISHED from this process (ABORT: send_abort).
   void send_control(wire::ControlKind kind, const std::string& reason = "");
   /// ABORT: the run stops because of `cause`, a failure of process `origin` (agent id, or

@@ -43,6 +43,7 @@ struct SessionParts {
   Inbox<wire::MeasurementHandoff> replica_in{room};  // purpose 1: replicas of peers' data
   Inbox<ProtocolMessage> protocol_in{room};
   Inbox<wire::RoundStatus> status_in{room};
+  Inbox<wire::AgentProgress> progress_in{room};
   Inbox<wire::FinalEstimate> final_in{room};
   Inbox<wire::Control> rejoin_in{room};
   Inbox<wire::Control> rollback_in{room};
@@ -57,7 +58,8 @@ struct SessionParts {
   bool renumbered = false;
   // The relay agent's collection of round statuses (guarded by room's mutex).
   StatusRelay relay{opt.num_agents};
-  bool relay_enabled = false;  // Session::set_status_relay
+  bool relay_enabled = false;    // Session::set_status_relay
+  bool rounds_followed = false;  // Session::set_coordinator_follows_rounds
   /// Whether this agent's round statuses go through the relay (status_relay.hpp): agents of
   /// runs of at least kMinAgentsForRelay that enabled it, until a re-partition renumbers the
   /// protocol ids (the relay is agent kRelayAgent, whose id that changes).

@@ -1,0 +1,153 @@
+// The agents' progress digests and what the coordinator makes of them (docs/dds-runtime.md,
+// "Session 10 (relay10)"), without processes: the digest an agent builds from the statuses it
+// sends and receives (agent/progress_digest.hpp), the rate-limited progress lines
+// (coordinator/progress_printer.hpp) and the lag lines from digests (coordinator/run_monitor.hpp);
+// the round timing from agent 0's last digest: dds_round_reports_test.cpp.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "agent/progress_digest.hpp"
+#include "coordinator/progress_printer.hpp"
+#include "coordinator/run_monitor.hpp"
+#include "util/input_error.hpp"
+
+namespace {
+
+using namespace tessera;
+using Clock = std::chrono::steady_clock;
+
+const Clock::time_point t0{};
+Clock::time_point at(double s) {
+  return t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
+
+RoundStatusMessage status(std::uint32_t round, std::uint32_t phase, std::uint32_t sender,
+                          double cost, double grad_norm_sq) {
+  RoundStatusMessage m;
+  m.round = round;
+  m.phase = phase;
+  m.sender = sender;
+  m.cost = cost;
+  m.grad_norm_sq = grad_norm_sq;
+  return m;
+}
+
+TEST(ProgressDigest, PeriodOutOfRangeIsAnErrorNamingTheField) {
+  for (double bad : {0.0, -1.0, 61.0}) {
+    try {
+      agent::ProgressDigest d(0, 3, true, agent::ProgressDigestOptions{bad}, t0);
+      FAIL() << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("ProgressDigestOptions.period_s"), std::string::npos);
+    }
+  }
+}
+
+TEST(ProgressDigest, SumsCompletedStepsNamesMissingSendersAndTimesTheRounds) {
+  agent::ProgressDigest d(1, 3, /*reporter=*/false, agent::ProgressDigestOptions{0.1}, t0);
+  EXPECT_FALSE(d.due(at(0.05)));
+  EXPECT_TRUE(d.due(at(0.1)));
+  // Nothing completed yet: phase 0; waits in round 0 for agents 0 and 2 since it sent.
+  d.on_status(status(0, 1, 1, 2.0, 0.25), true, at(0.1));
+  d.on_status(status(0, 1, 0, 1.0, 0.5), false, at(0.12));
+  d.on_status(status(0, 101, 2, 99.0, 99.0), false, at(0.12));  // a rounding status: ignored
+  wire::AgentProgress p = d.take(at(0.3));
+  EXPECT_EQ(p.sender(), 1u);
+  EXPECT_EQ(p.phase(), 0u);
+  EXPECT_EQ(p.waiting_for(), (std::vector<std::uint32_t>{2u}));
+  EXPECT_EQ(p.waiting_round(), 0u);
+  EXPECT_NEAR(p.waiting_s(), 0.2, 1e-9);
+  EXPECT_EQ(p.completed_rounds(), 0u);
+  EXPECT_FALSE(p.final());
+  EXPECT_FALSE(d.due(at(0.35)));  // the period restarts with each digest
+  // Agent 2's status completes round 0 (sums in agent-id order); a status of round 1 from a
+  // faster agent may come before this agent sends its own.
+  d.on_status(status(1, 1, 2, 0.5, 0.0), false, at(0.4));
+  d.on_status(status(0, 1, 2, 4.0, 1.0), false, at(0.5));
+  d.on_status(status(1, 1, 1, 0.25, 0.0), true, at(0.6));
+  d.on_status(status(1, 1, 0, 0.125, 0.0), false, at(0.7));
+  d.on_status(status(1, 5, 1, 0.0625, 0.0), true, at(0.8));  // a restart step
+  d.on_status(status(1, 5, 0, 0.0625, 0.0), false, at(0.8));
+  p = d.take(at(0.9), /*final=*/true);
+  EXPECT_EQ(p.round(), 1u);
+  EXPECT_EQ(p.phase(), 1u);
+  EXPECT_EQ(p.cost(), 0.125 + 0.25 + 0.5);
+  EXPECT_EQ(p.waiting_for(), (std::vector<std::uint32_t>{2u}));  // the restart step
+  EXPECT_EQ(p.waiting_round(), 1u);
+  EXPECT_EQ(p.completed_rounds(), 2u);
+  EXPECT_NEAR(p.first_to_last_ms(), 200.0, 1e-6);  // round 0 at 0.5 s, round 1 at 0.7 s
+  EXPECT_TRUE(p.final());
+}
+
+TEST(ProgressDigest, TheReporterSendsTheFirstStepAndRestartsAtOnce) {
+  agent::ProgressDigest d(0, 2, /*reporter=*/true, agent::ProgressDigestOptions{10.0}, t0);
+  d.on_status(status(0, 1, 0, 1.0, 0.0), true, at(0.01));
+  EXPECT_FALSE(d.due(at(0.01)));
+  d.on_status(status(0, 1, 1, 1.0, 0.0), false, at(0.02));
+  EXPECT_TRUE(d.due(at(0.02)));  // the first completed step
+  EXPECT_EQ(d.take(at(0.02)).phase(), 1u);
+  d.on_status(status(1, 1, 0, 1.0, 0.0), true, at(0.03));
+  d.on_status(status(1, 1, 1, 1.0, 0.0), false, at(0.03));
+  EXPECT_FALSE(d.due(at(0.03)));  // an ordinary round waits for the period
+  d.on_status(status(1, 5, 0, 1.0, 0.0), true, at(0.04));
+  d.on_status(status(1, 5, 1, 1.0, 0.0), false, at(0.04));
+  EXPECT_TRUE(d.due(at(0.04)));  // a restart
+  const wire::AgentProgress p = d.take(at(0.04));
+  EXPECT_EQ(p.round(), 1u);
+  EXPECT_EQ(p.phase(), 5u);
+  EXPECT_TRUE(p.waiting_for().empty());
+}
+
+TEST(ProgressPrinter, PrintsTheFirstRestartsAndTheLastAndAtMostOneLinePerInterval) {
+  std::ostringstream out;
+  coordinator::ProgressPrinter lines(true, out, 100.0);
+  for (std::uint32_t k = 0; k < 50; ++k) lines.on_step({k, 1, 10.0 - k * 0.1, 4.0}, k * 5.0);
+  lines.on_step({50, 5, 5.0, 4.0}, 250.0);  // a restart: printed whatever the interval
+  lines.on_step({51, 1, 4.0, 1.0}, 255.0);
+  lines.finish();
+  const std::string s = out.str();
+  EXPECT_EQ(s,
+            "round 0: cost 10, grad norm 2.000e+00\n"
+            "round 20: cost 8, grad norm 2.000e+00\n"
+            "round 40: cost 6, grad norm 2.000e+00\n"
+            "round 50 (restart): cost 5, grad norm 2.000e+00\n"
+            "round 51: cost 4, grad norm 1.000e+00\n");
+  std::ostringstream quiet;
+  coordinator::ProgressPrinter off(false, quiet);
+  off.on_step({0, 1, 1.0, 1.0}, 0.0);
+  off.finish();
+  EXPECT_TRUE(quiet.str().empty());
+}
+
+TEST(RunMonitor, FromDigestsNamesSilentAgentsAndTheAgentEveryLongWaiterWaitsFor) {
+  std::ostringstream out;
+  coordinator::RunMonitor m(4, coordinator::MonitorOptions{5.0, 2, 3.0}, out, t0);
+  // Digests are samples: rounds far apart are no lag.
+  m.on_digest(0, 100u, {}, 0.0, at(1));
+  m.on_digest(1, 40u, {}, 0.0, at(1));
+  m.on_digest(2, 70u, {2u}, 0.01, at(1));
+  m.on_digest(3, 90u, {}, 0.0, at(1));
+  EXPECT_EQ(m.line(at(1)), "status 1.0s: 4/4 agents alive; rounds 0:100 1:40 2:70 3:90");
+  // Agent 3 hangs: its digests stop; the relay (0) waits for it alone, the others (no bundle
+  // yet) for everyone but themselves.
+  m.on_digest(0, 120u, {3u}, 3.5, at(4.5));
+  m.on_digest(1, 119u, {0u, 2u, 3u}, 3.4, at(4.5));
+  m.on_digest(2, 119u, {0u, 1u, 3u}, 3.4, at(4.5));
+  EXPECT_EQ(m.line(at(4.5)),
+            "status 4.5s: 4/4 agents alive; rounds 0:120 1:119 2:119 3:90; lagging: 3; agents "
+            "0,1,2 wait for 3");
+  m.tick(at(4.5));  // the lagging set changed: printed at once
+  EXPECT_NE(out.str().find("lagging: 3"), std::string::npos) << out.str();
+  // A short wait names nobody.
+  coordinator::RunMonitor brief(2, coordinator::MonitorOptions{5.0, 2, 3.0}, out, t0);
+  brief.on_digest(0, 5u, {1u}, 0.2, at(1));
+  brief.on_digest(1, 5u, {}, 0.0, at(1));
+  EXPECT_EQ(brief.line(at(1)), "status 1.0s: 2/2 agents alive; rounds 0:5 1:5");
+}
+
+}  // namespace
