@@ -67,7 +67,9 @@ options:
   --no-certify         skip the certificate
   --status-relay       round statuses through agent 0, one bundle per step instead of
                        all to all (fewer DDS deliveries, one more hop; not with
-                       --on-agent-loss continue; docs/dds-runtime.md, "Session 9")
+                       --on-agent-loss continue; docs/dds-runtime.md, "Session 9";
+                       the default)
+  --no-status-relay    round statuses all to all (every agent to every agent)
   --json FILE          also write the summary to FILE
   --out FILE           write the merged poses (g2o, VERTEX lines)
   --tum FILE           write the merged poses (TUM)
@@ -138,9 +140,9 @@ int run_launch(const Args& argv) {
       "agents", "algorithm", "partition", "init", "grad-tol", "max-rounds", "rank",
       "seed",   "json",      "out",       "tum",  "timeout",  "poses",      "status-interval"};
   for (const auto& n : launch_loss_option_names()) valued.insert(n);
-  Arguments args(
-      argv, with_session_options(valued, SessionArgsFor::kLaunch),
-      {"quiet", "certify", "no-certify", "no-fork-server", "agents-yield", "status-relay"});
+  Arguments args(argv, with_session_options(valued, SessionArgsFor::kLaunch),
+                 {"quiet", "certify", "no-certify", "no-fork-server", "agents-yield",
+                  "status-relay", "no-status-relay"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
                      std::to_string(args.positional().size()));
@@ -267,7 +269,10 @@ int run_launch(const Args& argv) {
   if (args.has("certify") && args.has("no-certify"))
     throw InputError("launch: --certify and --no-certify exclude each other");
   if (!args.has("no-certify")) cargs.push_back("--certify");
-  if (args.has("status-relay")) cargs.push_back("--status-relay");
+  if (args.has("status-relay") && args.has("no-status-relay"))
+    throw InputError("launch: --status-relay and --no-status-relay exclude each other");
+  // The coordinator relays by default (docs/dds-runtime.md, "Session 10").
+  if (args.has("no-status-relay")) cargs.push_back("--no-status-relay");
   // Every process runs here and the coordinator can read the whole file: it partitions the
   // file's structure while the agents start up (coordinator/file_partition.hpp). Robot files
   // are each robot's own: there the announcements are the only whole structure.

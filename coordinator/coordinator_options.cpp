@@ -35,7 +35,8 @@ options:
   --status-relay       agents send their round statuses to agent 0 alone, which forwards
                        each step's as one bundle to everyone (2N - 1 deliveries a round
                        instead of N^2; same iterates; ignored with --rejoin-timeout or
-                       --replicas; docs/dds-runtime.md, "Session 9"; default off)
+                       --replicas; docs/dds-runtime.md, "Session 9"; default on)
+  --no-status-relay    round statuses all to all instead (N^2 deliveries a round)
   --output FILE        write the merged poses as g2o (VERTEX lines only)
   --tum FILE           write the merged poses in the TUM format
   --summary FILE       write a JSON summary of the run
@@ -72,7 +73,8 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
        "rejoin-timeout", "status-interval", "replicas", "replica-every"},
       cli::SessionArgsFor::kProcess);
   valued.insert("graph");
-  cli::Arguments args(argv, valued, {"progress", "verbose", "help", "certify", "status-relay"});
+  cli::Arguments args(
+      argv, valued, {"progress", "verbose", "help", "certify", "status-relay", "no-status-relay"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   CoordinatorOptions a;
@@ -118,7 +120,9 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   if (a.replica_every < 1) throw InputError("option --replica-every: must be >= 1");
   a.verbose = args.has("verbose");
   a.certify = args.has("certify");
-  a.status_relay = args.has("status-relay");
+  if (args.has("status-relay") && args.has("no-status-relay"))
+    throw InputError("options --status-relay and --no-status-relay exclude each other");
+  a.status_relay = !args.has("no-status-relay");
   return a;
 }
 

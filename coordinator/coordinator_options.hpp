@@ -31,9 +31,10 @@ struct CoordinatorOptions {
   std::uint32_t replicas = 0;        ///< 0..8; 0 = no re-partition after a permanent loss.
   std::uint32_t replica_every = 10;  ///< Rounds between lifted-pose replicas, >= 1.
   bool certify = false;
-  /// --status-relay: the agents send their round statuses through agent 0, which forwards
-  /// each step's as one bundle (transport/status_relay.hpp); not with rejoin or replicas.
-  bool status_relay = false;
+  /// The agents send their round statuses through agent 0, which forwards each step's as one
+  /// bundle (transport/status_relay.hpp); on by default (--status-relay, still accepted),
+  /// --no-status-relay: all to all. Agents ignore it with rejoin or replicas.
+  bool status_relay = true;
 };
 
 /// The --help text; its "%s" stands for the shared session options (cli::process_help).

@@ -45,13 +45,12 @@ DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int
   return r;
 }
 
-void expect_same_as_in_process(const std::string& algorithm, int domain,
-                               bool status_relay = false) {
+void expect_same_as_in_process(const std::string& algorithm, int domain, bool status_relay = true) {
   const std::string dir = temp_dir();
   const std::string graph = generate(dir, 240, 3, 5);
   std::vector<std::string> coordinator_args = {"--partition", "eco", "--algorithm", algorithm,
                                                "--seed",      "7",   "--init",      "file"};
-  if (status_relay) coordinator_args.push_back("--status-relay");
+  if (!status_relay) coordinator_args.push_back("--no-status-relay");
   const DdsRun dds = run_dds(dir, graph, 3, domain, coordinator_args);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(dds.assignment.size(), g.num_poses);
@@ -93,11 +92,12 @@ TEST(DdsSolve, RbcdPlusPlusOverDdsGivesTheInProcessIterates) {
   expect_same_as_in_process("rbcd++", 162);
 }
 
-// Round statuses through the relay agent (transport/status_relay.hpp): the same statuses
-// reach every agent, so the same iterates (restarts included).
-TEST(DdsSolve, StatusRelayGivesTheInProcessIterates) {
-  expect_same_as_in_process("irbcd", 167, true);
-  expect_same_as_in_process("rbcd++", 168, true);
+// Round statuses all to all (--no-status-relay) instead of through the relay agent (the
+// default, transport/status_relay.hpp): the same statuses reach every agent, so the same
+// iterates (restarts included) either way.
+TEST(DdsSolve, StatusesAllToAllGiveTheInProcessIterates) {
+  expect_same_as_in_process("irbcd", 167, false);
+  expect_same_as_in_process("rbcd++", 168, false);
 }
 
 // Kills whatever processes of run `run_id` a test leaves running when an assertion fails (a
@@ -130,6 +130,21 @@ TEST(DdsLaunch, EndToEndOnAGeneratedGraphPrintsTheSummary) {
   int vertices = 0;
   for (std::string line; std::getline(merged, line);) vertices += line.rfind("VERTEX", 0) == 0;
   EXPECT_EQ(vertices, 150);
+}
+
+// The status relay is the default; --no-status-relay turns it off, and both at once are an
+// error naming them (launch and the coordinator).
+TEST(DdsLaunch, StatusRelayFlagsExcludeEachOther) {
+  std::string out;
+  EXPECT_EQ(
+      run_command(bin("tessera") + " launch --agents 3 --status-relay --no-status-relay", &out), 2)
+      << out;
+  EXPECT_NE(out.find("--status-relay and --no-status-relay"), std::string::npos) << out;
+  EXPECT_EQ(run_command(bin("tessera-coordinator") + " --agents 3 --status-relay --no-status-relay",
+                        &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("--status-relay and --no-status-relay"), std::string::npos) << out;
 }
 
 TEST(DdsLaunch, BadGraphFailsWithTheAgentsReason) {
@@ -198,7 +213,7 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
 
 // A hung agent (SIGSTOP: its DDS threads stop too, so a lease longer than the stop keeps it
 // from being declared lost) is named by the coordinator's status line, with the status relay
-// on and the coordinator following the agents' progress digests, not their
+// on (the default) and the coordinator following the agents' progress digests, not their
 // round statuses: its digests stop while the others' go on from their waits
 // (docs/dds-runtime.md, "Session 10"). Once it goes on, so does the run.
 TEST(DdsLaunch, HungAgentIsNamedAsLaggingAndTheRunGoesOn) {
@@ -227,7 +242,6 @@ TEST(DdsLaunch, HungAgentIsNamedAsLaggingAndTheRunGoesOn) {
                           "90",
                           "--lease",
                           "30",
-                          "--status-relay",
                           "--status-interval",
                           "1"},
                          dir + "/launch.log");
