@@ -12,7 +12,8 @@ their rounded chordal initialisation written to a temporary copy first, by
 and printed: rounds of each (they differ only when the coordinator's partition differs: it
 partitions the structure in the agents' announcement order, not file order), relative cost
 difference, wall times and their ratio (target <= 1.5), median ms per round of the DDS run
-(from the arrival times of its progress lines), bytes per round (all agents' DDS bytes / rounds),
+(from the arrival times of its progress lines and their round numbers: the coordinator
+prints at most ~10 lines a second, so each gap is divided by the rounds it spans), bytes per round (all agents' DDS bytes / rounds),
 and where the DDS run's wall time went (the coordinator's timeline: start = launch to the
 coordinator's session, discovery, partition, ready = assignment + barrier, handoff = to the first
 round status, rounds, rounding = to the final estimates, merge, summary = to launch printing the
@@ -36,6 +37,7 @@ usage: dds_overhead.py [--bin build/bin] [--graphs CSAIL,intel] [--agents 5] [--
 import argparse
 import json
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -95,6 +97,9 @@ def run_in_process(tessera, graph, agents, tmp, limit):
     return s, wall
 
 
+ROUND_LINE = re.compile(r"round (\d+)( \(restart\))?:")
+
+
 def run_dds(tessera, graph, agents, domain, tmp, limit, extra=()):
     js = os.path.join(tmp, "dds.json")
     u0 = bc.children_usage()
@@ -111,8 +116,9 @@ def run_dds(tessera, graph, agents, domain, tmp, limit, extra=()):
     summary_at = None
     for line in p.stdout:
         log.append(line)
-        if line.startswith("round "):
-            stamps.append(time.monotonic())
+        m = ROUND_LINE.match(line)
+        if m:
+            stamps.append((time.monotonic(), int(m.group(1))))
         elif line.startswith("summary:") and summary_at is None:
             summary_at = time.monotonic()
     p.wait()
@@ -126,7 +132,9 @@ def run_dds(tessera, graph, agents, domain, tmp, limit, extra=()):
     with open(js) as f:
         s = json.load(f)
     s["cpu_s"], s["csw"] = bc.usage_since(u0)
-    gaps = [1000 * (b - a) for a, b in zip(stamps, stamps[1:])]
+    # ms per round between consecutive progress lines (rate-limited: a line spans many rounds)
+    gaps = [1000 * (tb - ta) / (kb - ka) for (ta, ka), (tb, kb) in zip(stamps, stamps[1:])
+            if kb > ka]
     s["phases_s"] = phases(s, t0_ms, wall)
     s["phases_s"]["teardown"] = exit_wall - wall
     s["exit_wall_s"] = exit_wall
