@@ -56,7 +56,7 @@ void await_final_estimates(Session& s, const CoordinatorOptions& options, RoundR
       if (!monitor) continue;
       std::optional<std::uint32_t> round;
       if (d.phase() != 0) round = d.round();
-      monitor->on_digest(d.sender(), round, d.waiting_for(), d.waiting_s(), now);
+      monitor->on_digest(d.sender(), round, d.waiting_for(), d.waiting_s(), now, d.final());
     }
     for (const auto& m : s.status_watch().take_all()) {
       if (m.epoch() < losses.status_epoch()) continue;  // from before a rollback

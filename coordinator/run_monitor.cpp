@@ -38,7 +38,8 @@ RunMonitor::RunMonitor(std::uint32_t num_agents, MonitorOptions options, std::os
       round_(num_agents, -1),
       last_seen_(num_agents, start),
       lost_(num_agents, false),
-      wait_(num_agents) {
+      wait_(num_agents),
+      done_(num_agents, false) {
   opt_.validate();
 }
 
@@ -51,12 +52,13 @@ void RunMonitor::on_status(std::uint32_t agent, std::uint32_t round, Clock::time
 
 void RunMonitor::on_digest(std::uint32_t agent, std::optional<std::uint32_t> round,
                            const std::vector<std::uint32_t>& waiting_for, double waiting_s,
-                           Clock::time_point now) {
+                           Clock::time_point now, bool final) {
   if (agent >= n_) return;
   digests_ = true;
   if (round) round_[agent] = *round;
   last_seen_[agent] = now;
-  wait_[agent] = Wait{waiting_for, waiting_s};
+  wait_[agent] = final ? Wait{} : Wait{waiting_for, waiting_s};
+  done_[agent] = final;
 }
 
 void RunMonitor::set_lost(const std::vector<std::uint32_t>& lost, Clock::time_point now) {
@@ -97,7 +99,7 @@ std::vector<std::uint32_t> RunMonitor::lagging(Clock::time_point now) const {
   if (lead < 0) return out;  // nothing reported yet: set-up, not lag
   const std::vector<std::uint32_t> waited = waited_for(now).first;
   for (std::uint32_t k = 0; k < n_; ++k) {
-    if (lost_[k]) continue;
+    if (lost_[k] || done_[k]) continue;
     const bool behind = !digests_ && lead - round_[k] >= static_cast<std::int64_t>(opt_.lag_rounds);
     const bool waited_long = std::find(waited.begin(), waited.end(), k) != waited.end();
     if (behind || waited_long || silent(k, newest, now)) out.push_back(k);
@@ -126,7 +128,7 @@ std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> RunMonitor::wa
   }
   if (out.second.empty()) return out;
   for (std::uint32_t j = 0; j < n_; ++j)
-    if (all[j] && !lost_[j]) out.first.push_back(j);
+    if (all[j] && !lost_[j] && !done_[j]) out.first.push_back(j);
   return out;
 }
 

@@ -45,10 +45,11 @@ class RunMonitor {
 
   void on_status(std::uint32_t agent, std::uint32_t round, Clock::time_point now);
   /// A progress digest from `agent`: `round` (nullopt: no step completed yet), and whom it
-  /// waits for in its current step (agent ids) since `waiting_s` seconds.
+  /// waits for in its current step (agent ids) since `waiting_s` seconds. After its `final`
+  /// digest an agent sends none (it is done with the rounds): never lagging from then on.
   void on_digest(std::uint32_t agent, std::optional<std::uint32_t> round,
                  const std::vector<std::uint32_t>& waiting_for, double waiting_s,
-                 Clock::time_point now);
+                 Clock::time_point now, bool final = false);
   /// The set of agents currently lost (from the session); reports changes.
   void set_lost(const std::vector<std::uint32_t>& lost, Clock::time_point now);
   /// A one-off event line ("agent 2 rejoined: rollback to round 14").
@@ -81,6 +82,7 @@ class RunMonitor {
   std::vector<std::uint32_t> last_lagging_;
   bool digests_ = false;    // fed by on_digest: rounds are samples, compare waits instead
   std::vector<Wait> wait_;  // the newest digest's wait, per agent
+  std::vector<bool> done_;  // sent its final digest
 };
 
 }  // namespace tessera::coordinator

@@ -143,6 +143,11 @@ TEST(RunMonitor, FromDigestsNamesSilentAgentsAndTheAgentEveryLongWaiterWaitsFor)
             "0,1,2 wait for 3");
   m.tick(at(4.5));  // the lagging set changed: printed at once
   EXPECT_NE(out.str().find("lagging: 3"), std::string::npos) << out.str();
+  // An agent done with the rounds (its final digest) sends no more: never lagging.
+  coordinator::RunMonitor done(2, coordinator::MonitorOptions{5.0, 2, 3.0}, out, t0);
+  done.on_digest(0, 9u, {}, 0.0, at(1), /*final=*/true);
+  done.on_digest(1, 8u, {0u}, 4.0, at(5));
+  EXPECT_EQ(done.line(at(5)), "status 5.0s: 2/2 agents alive; rounds 0:9 1:8");
   // A short wait names nobody.
   coordinator::RunMonitor brief(2, coordinator::MonitorOptions{5.0, 2, 3.0}, out, t0);
   brief.on_digest(0, 5u, {1u}, 0.2, at(1));
