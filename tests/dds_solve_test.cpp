@@ -1,6 +1,6 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-168 and 9 (each test its own, so ctest -j is safe).
+// Domains used here: 161-169 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -227,7 +227,7 @@ TEST(DdsLaunch, HungAgentIsNamedAsLaggingAndTheRunGoesOn) {
                           "--poses",
                           "2000",
                           "--domain",
-                          "9",
+                          "169",
                           "--run-id",
                           run_id,
                           "--init",
