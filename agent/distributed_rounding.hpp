@@ -25,10 +25,10 @@ enum RoundingPhase : std::uint32_t {
   kGram = kRoundingPhaseBase,  // r x r Gram matrix of the block's rotation parts
   kNegative,                   // number of rounded blocks with det < 0
   kRotations,                  // rounded rotations of public poses
-  kInitialResidual,            // PCG: <r,z>, <r,r> at the start
-  kDirection,                  // PCG: public entries of the search direction
-  kCurvature,                  // PCG: <p, L p>
-  kResidual,                   // PCG: <r,z>, <r,r> after a step
+  kInitialResidual,            // retired: plain PCG's first <r,z>, <r,r>
+  kDirection,                  // PCG: public entries of u (first step), then of M w and x
+  kCurvature,                  // retired: plain PCG's <p, L p>
+  kResidual,                   // pipelined PCG: <r,u>, <w,u>, <r,r> of an iteration
   kTranslations,               // retired: the final translations ride on the last CG step
   kCost,                       // cost share of the rounded poses
   kTraffic                     // certificate and escape bytes sent (certification only)
@@ -65,7 +65,10 @@ class DistributedRounding {
   RoundLoopResult run(RoundLoopResult res);
 
  private:
-  double reduce(std::uint32_t phase, std::uint32_t round, double a, double b, double* b_sum);
+  // Sums (a, b, c) over the agents in agent-id order: returns a's sum, b's and c's in *b_sum
+  // and *c_sum when given.
+  double reduce(std::uint32_t phase, std::uint32_t round, double a, double b, double* b_sum,
+                double c = 0.0, double* c_sum = nullptr);
 
   std::vector<std::uint32_t> others() const;
 
@@ -84,6 +87,9 @@ class DistributedRounding {
                                                             std::uint32_t round,
                                                             std::uint32_t rank);
 
+  // Restarts of the pipelined CG from its x when only the recurrence's residual converged.
+  static constexpr std::uint32_t kMaxRestarts = 4;
+
   std::size_t width_of(std::uint32_t rank) const {
     return static_cast<std::size_t>(rank) * static_cast<std::size_t>(d_ + 1);
   }
@@ -91,7 +97,8 @@ class DistributedRounding {
   void rotations();
 
   // Preconditioned CG on L t = b (the translation Laplacian without the anchor pose 0), with
-  // each agent's own Laplacian block as the preconditioner (solved exactly by Cholesky).
+  // each agent's own Laplacian block as the preconditioner (solved exactly by Cholesky), in
+  // its pipelined form: one message step per iteration.
   std::uint32_t translations();
 
   // Cost of the rounded poses: internal measurements in full, cut ones half (as core's status).
