@@ -1,6 +1,7 @@
 #include "session_process.hpp"
 
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -67,6 +68,10 @@ int leave(Session& session, const ProcessRole& role, int code, const std::string
 
 int run_session_process(const SessionOptions& options, const ProcessRole& role,
                         SignalWatcher& signals, const std::function<void(Session&)>& body) {
+  // stdout may be a pipe its reader closes first (launch leaves on the first failure while the
+  // coordinator still prints lag or progress lines): a failed write must not kill the process
+  // (exit 141) before it has told the others and written why it stops.
+  std::signal(SIGPIPE, SIG_IGN);
   std::unique_ptr<Session> session;
   try {
     session = std::make_unique<Session>(options);
