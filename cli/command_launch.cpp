@@ -77,6 +77,9 @@ options:
   --poses P            poses of the generated graph (without GRAPH)         [1000]
   --status-interval S  coordinator status line (agents alive, rounds, lagging or lost
                        agents) every S seconds and on changes; 0 = off          [5]
+  --progress-interval S  at most one progress line per S seconds besides the first,
+                       the restarts and the last; 0 = every round the coordinator
+                       sees (every round with replicas or rejoin)             [0.1]
   --no-fork-server     start tessera-coordinator and tessera-agent with exec, each
                        loading Fast DDS itself (default: one tessera-fork-server loads it
                        once and forks them; see docs/dds-runtime.md, "Fork server")
@@ -136,9 +139,21 @@ int run_launch(const Args& argv) {
                   session_options_help(SessionArgsFor::kLaunch).c_str());
       return 0;
     }
-  std::set<std::string> valued = {
-      "agents", "algorithm", "partition", "init", "grad-tol", "max-rounds", "rank",
-      "seed",   "json",      "out",       "tum",  "timeout",  "poses",      "status-interval"};
+  std::set<std::string> valued = {"agents",
+                                  "algorithm",
+                                  "partition",
+                                  "init",
+                                  "grad-tol",
+                                  "max-rounds",
+                                  "rank",
+                                  "seed",
+                                  "json",
+                                  "out",
+                                  "tum",
+                                  "timeout",
+                                  "poses",
+                                  "status-interval",
+                                  "progress-interval"};
   for (const auto& n : launch_loss_option_names()) valued.insert(n);
   Arguments args(argv, with_session_options(valued, SessionArgsFor::kLaunch),
                  {"quiet", "certify", "no-certify", "no-fork-server", "agents-yield",
@@ -158,6 +173,9 @@ int run_launch(const Args& argv) {
   const double status_interval = args.get_double("status-interval", 5);
   if (!(status_interval >= 0 && status_interval <= 86400))
     throw InputError("launch: --status-interval must be in 0..86400 seconds");
+  const double progress_interval = args.get_double("progress-interval", 0.1);
+  if (!(progress_interval >= 0 && progress_interval <= 3600))
+    throw InputError("launch: --progress-interval must be in 0..3600 seconds");
   const std::string algorithm = args.get_or("algorithm", "irbcd");
   if (algorithm != "rbcd" && algorithm != "rbcd++" && algorithm != "irbcd")
     throw InputError("launch: --algorithm '" + algorithm + "' is not one of rbcd, rbcd++, irbcd");
@@ -283,6 +301,8 @@ int run_launch(const Args& argv) {
   if (args.has("tum")) cargs.insert(cargs.end(), {"--tum", args.get_or("tum", "")});
   if (args.has("status-interval"))
     cargs.insert(cargs.end(), {"--status-interval", std::to_string(status_interval)});
+  if (args.has("progress-interval"))
+    cargs.insert(cargs.end(), {"--progress-interval", std::to_string(progress_interval)});
 
   // The processes to start, in order: the coordinator (stdout = our progress pipe), then
   // agents 0..N-1.

@@ -47,6 +47,10 @@ options:
                        file's (otherwise, or if FILE cannot be read, the announced structure is
                        partitioned as without it). Only endpoints are kept (default: none)
   --progress           print round progress (sum of the agents' cost and gradient norm)
+  --progress-interval S  at most one progress line per S seconds besides the first, the
+                       restarts and the last; 0 = every round the coordinator sees (every
+                       round with --rejoin-timeout or --replicas, else one per progress
+                       digest, ~10 a second) (default 0.1)
   --rejoin-timeout S   when an agent process dies, wait up to S seconds for it to be
                        restarted (same id, --checkpoint-dir) and rejoin; every agent then rolls
                        back to a common checkpoint round. 0 = stop the run at once (default 0)
@@ -67,11 +71,27 @@ exit codes: 0 done, 1 the run failed (lost agent, abort, timeout), 2 bad options
 )";
 
 CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& argv) {
-  std::set<std::string> valued = cli::with_session_options(
-      {"agents", "run-timeout", "partition", "partition-seed", "rank", "algorithm", "init",
-       "max-rounds", "grad-tol", "rel-cost-tol", "seed", "output", "tum", "summary", "graph-name",
-       "rejoin-timeout", "status-interval", "replicas", "replica-every"},
-      cli::SessionArgsFor::kProcess);
+  std::set<std::string> valued = cli::with_session_options({"agents",
+                                                            "run-timeout",
+                                                            "partition",
+                                                            "partition-seed",
+                                                            "rank",
+                                                            "algorithm",
+                                                            "init",
+                                                            "max-rounds",
+                                                            "grad-tol",
+                                                            "rel-cost-tol",
+                                                            "seed",
+                                                            "output",
+                                                            "tum",
+                                                            "summary",
+                                                            "graph-name",
+                                                            "rejoin-timeout",
+                                                            "status-interval",
+                                                            "progress-interval",
+                                                            "replicas",
+                                                            "replica-every"},
+                                                           cli::SessionArgsFor::kProcess);
   valued.insert("graph");
   cli::Arguments args(
       argv, valued, {"progress", "verbose", "help", "certify", "status-relay", "no-status-relay"});
@@ -112,6 +132,9 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   if (!(a.rejoin_timeout_s >= 0 && a.rejoin_timeout_s <= 86400))
     throw InputError("option --rejoin-timeout: must be 0..86400 seconds");
   a.status_interval_s = args.get_double("status-interval", a.status_interval_s);
+  a.progress_interval_s = args.get_double("progress-interval", a.progress_interval_s);
+  if (!(a.progress_interval_s >= 0 && a.progress_interval_s <= 3600))
+    throw InputError("option --progress-interval: must be 0..3600 seconds");
   if (!(a.status_interval_s >= 0 && a.status_interval_s <= 86400))
     throw InputError("option --status-interval: must be 0..86400 seconds");
   a.replicas = static_cast<std::uint32_t>(nonneg("replicas", 0));

@@ -26,8 +26,12 @@ struct CoordinatorOptions {
   std::string output, tum, summary, graph_name;  ///< Empty: not written.
   std::string graph;  ///< --graph: the agents' whole g2o file, partitioned early; empty = none.
   bool progress = false, verbose = false;
-  double rejoin_timeout_s = 0;       ///< 0..86400 s; 0 = a lost agent stops the run.
-  double status_interval_s = 5;      ///< 0..86400 s; 0 = no status lines.
+  double rejoin_timeout_s = 0;   ///< 0..86400 s; 0 = a lost agent stops the run.
+  double status_interval_s = 5;  ///< 0..86400 s; 0 = no status lines.
+  /// Seconds between progress lines, 0..3600 (coordinator/progress_printer.hpp; the first, the
+  /// restarts and the last always print). 0 = every completed step the coordinator sees: every
+  /// round while it reads the round statuses (rejoin, replicas), else one per progress digest.
+  double progress_interval_s = 0.1;
   std::uint32_t replicas = 0;        ///< 0..8; 0 = no re-partition after a permanent loss.
   std::uint32_t replica_every = 10;  ///< Rounds between lifted-pose replicas, >= 1.
   bool certify = false;

@@ -101,7 +101,7 @@ void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timel
     monitor.emplace(N, MonitorOptions{o.status_interval_s, 2, 3.0}, std::cout, t_run);
   RunMonitor* const shown = monitor ? &*monitor : nullptr;
   LossHandling losses(o, s, rs.graph, base, shown, t_run);
-  RoundReports reports(o.progress, std::cout);
+  RoundReports reports(o.progress, std::cout, 1000.0 * o.progress_interval_s);
   await_final_estimates(s, o, reports, losses, shown, t_run);
   const double solve_ms = ms_since(t_run);
   timeline.mark("finals");

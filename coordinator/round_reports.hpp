@@ -58,7 +58,9 @@ class RoundReports {
  public:
   /// `progress`: print "round K: cost C, grad norm G" to `out` for completed rounds
   /// (ProgressPrinter: the first, restarts, the last, at most ten a second in between).
-  RoundReports(bool progress, std::ostream& out) : lines_(progress, out) {}
+  /// `min_interval_ms`: ProgressPrinter's (0: every completed step).
+  RoundReports(bool progress, std::ostream& out, double min_interval_ms = 100.0)
+      : lines_(progress, out, min_interval_ms) {}
 
   /// A round status (is_round_status) of one of `active_agents` agents, `ms` after the
   /// rounds started. Completes the round when every active agent has reported it.

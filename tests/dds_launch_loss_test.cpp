@@ -11,6 +11,7 @@
 #include <cmath>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -129,6 +130,27 @@ TEST(DdsLaunchLoss, SecondLossInTheSameRunStopsItNamingTheAgent) {
   EXPECT_NE(out.find("lost agent 3 after a re-partition: a second loss is not covered"),
             std::string::npos)
       << out;
+}
+
+// The fault benchmarks kill an agent when a given round's line appears: with
+// --progress-interval 0 and replicas on (the coordinator reads every round status), every
+// round of the solve has its line, in order; a bad interval is an error naming the option.
+TEST(DdsLaunchLoss, ProgressIntervalZeroPrintsEveryRound) {
+  const LaunchRun run = make_run(174, "every-round");
+  Process launch = run.launch({"--no-certify", "--progress-interval", "0"});
+  ASSERT_TRUE(wait_all({&launch}, 60)) << launch.output();
+  ASSERT_EQ(launch.exit_code, 0) << launch.output();
+  std::vector<long> rounds;
+  std::istringstream lines(launch.output());
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("round ", 0) == 0 && line.find(" (restart)") == std::string::npos)
+      rounds.push_back(std::stol(line.substr(6)));
+  ASSERT_GE(rounds.size(), 5u) << launch.output();
+  for (std::size_t i = 1; i < rounds.size(); ++i)
+    EXPECT_EQ(rounds[i], rounds[i - 1] + 1) << "round lines skip after " << rounds[i - 1];
+  std::string out;
+  EXPECT_EQ(run_command(bin("tessera") + " launch --progress-interval -1", &out), 2) << out;
+  EXPECT_NE(out.find("--progress-interval must be in 0..3600"), std::string::npos) << out;
 }
 
 TEST(DdsLaunchLoss, LossOptionsAreCheckedNamingTheOption) {

@@ -72,7 +72,8 @@ class Run:
                 "--run-id", self.run_id, "--domain", str(self.args.domain), "--timeout", "60",
                 "--run-timeout", str(self.args.limit), "--summary", self.summary, "--progress",
                 "--partition", "highest", "--grad-tol", str(self.args.grad_tol),
-                "--rejoin-timeout", str(self.rejoin_timeout), "--status-interval", "2"]
+                "--rejoin-timeout", str(self.rejoin_timeout), "--status-interval", "2",
+                "--progress-interval", "0"]
         self.coord = self.spawn(ccmd, "coordinator.log")
         self.agents = {k: self.spawn(self.agent_cmd(k), "agent%d.log" % k) for k in range(self.args.agents)}
         self.procs = [self.coord] + list(self.agents.values())

@@ -50,7 +50,7 @@ class LaunchRun:
                "--grad-tol", str(a.grad_tol), "--on-agent-loss", "continue",
                "--rejoin-timeout", str(a.rejoin_timeout), "--replica-every", str(a.replica_every),
                "--out", self.merged, "--json", self.summary, "--timeout", str(a.limit),
-               "--status-interval", "2"]
+               "--status-interval", "2", "--progress-interval", "0"]
         self.cpu0 = bc.children_usage()
         self.t0 = time.time()
         self.log = open(self.log_path, "w")

@@ -51,7 +51,8 @@ class LossRun:
                                  "--output", self.merged, "--progress", "--partition", "eco",
                                  "--grad-tol", str(a.grad_tol), "--replicas", str(self.replicas),
                                  "--replica-every", str(a.replica_every),
-                                 "--rejoin-timeout", str(a.rejoin_timeout), "--status-interval", "2"],
+                                 "--rejoin-timeout", str(a.rejoin_timeout), "--status-interval", "2",
+                                 "--progress-interval", "0"],
                                 "coordinator.log")
         self.agents = {k: self.spawn([os.path.join(a.bin_dir, "tessera-agent"), "--graph", a.graph_path,
                                       "--robots", str(a.agents), "--id", str(k), "--run-id", self.run_id,
