@@ -37,15 +37,16 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
   DdsProtocolChannel channel(s);
   CheckpointKeeper keeper(o.net.session.run_id, local, {o.checkpoint_dir, o.checkpoint_every});
   std::optional<ProtocolSnapshot> from;  // a copy: the keeper replaces its entries
-  // With a rejoin window the coordinator arbitrates lost agents (it waits for a restart,
-  // then orders a rollback, or gives up and aborts the run): do not stop on one.
-  if (rejoin_enabled || restart || replication.enabled()) s.set_agent_loss_tolerated(true);
+  // With a rejoin window (or replicas) the coordinator arbitrates lost agents (it waits for a
+  // restart, then orders a rollback or a re-partition, or gives up and aborts the run): do not
+  // stop on one.
+  const bool arbitrated = rejoin_enabled || restart || replication.enabled();
+  if (arbitrated) s.set_agent_loss_tolerated(true);
   // Round statuses through the relay agent when the coordinator asks for it
   // (transport/status_relay.hpp: 2N - 1 deliveries a step instead of N^2), but never while
   // lost agents are arbitrated: the rejoin arbiter picks the rollback round from each agent's
   // own last status, which a relay waiting for a dead agent (or dead itself) would hold back.
   // Every agent reads the same assignment, so all choose alike.
-  const bool arbitrated = rejoin_enabled || restart || replication.enabled();
   s.set_status_relay(setup && setup->status_relay && !arbitrated);
   // The coordinator reads each round's statuses only while it arbitrates lost agents (the
   // rollback round is the newest every agent has sent its status for); otherwise it follows

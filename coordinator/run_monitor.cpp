@@ -87,14 +87,18 @@ bool RunMonitor::silent(std::uint32_t k, Clock::time_point newest, Clock::time_p
          (secs(now - last_seen_[k]) >= opt_.lag_s && newest > last_seen_[k]);
 }
 
-std::vector<std::uint32_t> RunMonitor::lagging(Clock::time_point now) const {
-  std::int64_t lead = -1;
+RunMonitor::Clock::time_point RunMonitor::newest_report() const {
   Clock::time_point newest = start_;
   for (std::uint32_t k = 0; k < n_; ++k)
-    if (!lost_[k]) {
-      lead = std::max(lead, round_[k]);
-      newest = std::max(newest, last_seen_[k]);
-    }
+    if (!lost_[k]) newest = std::max(newest, last_seen_[k]);
+  return newest;
+}
+
+std::vector<std::uint32_t> RunMonitor::lagging(Clock::time_point now) const {
+  std::int64_t lead = -1;
+  for (std::uint32_t k = 0; k < n_; ++k)
+    if (!lost_[k]) lead = std::max(lead, round_[k]);
+  const Clock::time_point newest = newest_report();
   std::vector<std::uint32_t> out;
   if (lead < 0) return out;  // nothing reported yet: set-up, not lag
   const std::vector<std::uint32_t> waited = waited_for(now).first;
@@ -111,9 +115,7 @@ std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> RunMonitor::wa
     Clock::time_point now) const {
   std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> out;
   if (!digests_) return out;
-  Clock::time_point newest = start_;
-  for (std::uint32_t k = 0; k < n_; ++k)
-    if (!lost_[k]) newest = std::max(newest, last_seen_[k]);
+  const Clock::time_point newest = newest_report();
   std::vector<bool> all(n_, true);
   for (std::uint32_t k = 0; k < n_; ++k) {
     // A silent agent's last wait is stale (it is named as silent instead).

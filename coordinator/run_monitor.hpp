@@ -63,6 +63,8 @@ class RunMonitor {
 
  private:
   std::vector<std::uint32_t> lagging(Clock::time_point now) const;
+  /// When the most recent report of an agent not lost came (start if none).
+  Clock::time_point newest_report() const;
   bool silent(std::uint32_t k, Clock::time_point newest, Clock::time_point now) const;
   /// With digests: the agents every long waiter waits for, and those waiters.
   std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> waited_for(

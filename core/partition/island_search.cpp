@@ -83,6 +83,10 @@ struct Island {
 
 }  // namespace
 
+int short_island_generations(int generations, double short_budget) {
+  return std::max(1, static_cast<int>(std::lround(generations * short_budget)));
+}
+
 IslandSearchResult island_search(
     const WorkGraph& g, int k, const std::vector<long long>& ub, const EvolutionParams& params,
     Rng& rng, const std::function<void(const std::string&, const std::string&, long long)>& trace,
@@ -105,8 +109,8 @@ IslandSearchResult island_search(
                              i == 1 ? second : params, nullptr, 0.0, 0, 0});
     Island& isl = islands.back();
     if (i >= full)
-      isl.params.generations = std::max(
-          1, static_cast<int>(std::lround(params.generations * params.islands.short_budget)));
+      isl.params.generations =
+          short_island_generations(params.generations, params.islands.short_budget);
     isl.search = std::make_unique<EvolutionSearch>(g, k, ub, isl.params, isl.rng);
   }
 

@@ -57,6 +57,10 @@ struct IslandSearchResult {
   long long cut = 0;
 };
 
+/// The step budget (EvolutionParams::generations) of each short island: short_budget of the
+/// full islands' `generations`, at least 1.
+int short_island_generations(int generations, double short_budget);
+
 /// Runs params.islands.islands (+ short_islands) populations of the memetic search
 /// (evolution_search.hpp) under `ub` and returns the best partition found. Island 0 uses `rng`
 /// (which it advances); island i > 0 a generator derived from rng's state and i. Exceptions thrown

@@ -195,8 +195,8 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // budget (many blocks: rim/grid3D N = 25 get 4 steps) it would cost ~75 % of a full
         // island for one step of search (grid3D N = 25: +2.4 s thread CPU).
         plan.evolution.islands.short_budget = 0.2;
-        const int short_steps = static_cast<int>(
-            std::lround(plan.evolution.generations * plan.evolution.islands.short_budget));
+        const int short_steps = short_island_generations(plan.evolution.generations,
+                                                         plan.evolution.islands.short_budget);
         plan.evolution.islands.short_islands =
             !strong && short_steps >= plan.evolution.population ? 1 : 0;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
