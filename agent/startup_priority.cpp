@@ -10,7 +10,9 @@
 #include <condition_variable>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -46,14 +48,14 @@ Lowered& lowered() {
   return state;
 }
 
-// The nice of this process's autogroup ("/autogroup-42 nice 19"), or nullopt-like -1000 when
-// the kernel has no autogroup support.
-int autogroup_nice() {
+// The nice of this process's autogroup ("/autogroup-42 nice 19"); nullopt when the kernel has
+// no autogroup support.
+std::optional<int> autogroup_nice() {
   std::ifstream in("/proc/self/autogroup");
   std::string name, word;
-  int nice = -1000;
+  int nice = 0;
   if (in >> name >> word >> nice && word == "nice") return nice;
-  return -1000;
+  return std::nullopt;
 }
 
 // Writes `nice` to /proc/self/autogroup; errno of the failure (EAGAIN: the kernel lets a
@@ -105,8 +107,8 @@ int restore_threads() {
 // the kernel's rate limit refuses (EAGAIN), at most ~0.3 s.
 bool restore_group() {
   for (int attempt = 0; attempt < 15; ++attempt) {
-    const int nice = autogroup_nice();
-    if (nice == 0 || nice == -1000) return true;
+    const std::optional<int> nice = autogroup_nice();
+    if (!nice || *nice == 0) return true;
     const int err = write_autogroup_nice(0);
     if (err == 0) return true;
     if (err != EAGAIN) return false;
@@ -118,7 +120,7 @@ bool restore_group() {
 }  // namespace
 
 bool lower_autogroup_nice(int nice) {
-  if (autogroup_nice() == -1000) return false;
+  if (!autogroup_nice()) return false;
   return write_autogroup_nice(nice) == 0 && autogroup_nice() == nice;
 }
 
@@ -144,8 +146,9 @@ std::string restore_startup_priority() {
   if (l.threads) what << restore_threads() << " thread(s) back to nice 0";
   if (l.group) {
     if (l.threads) what << ", ";
-    what << (restore_group() ? "autogroup back to nice 0"
-                             : "autogroup NOT restored (" + std::to_string(autogroup_nice()) + ")");
+    what << (restore_group()
+                 ? "autogroup back to nice 0"
+                 : "autogroup NOT restored (" + std::to_string(autogroup_nice().value_or(0)) + ")");
   }
   l.threads = l.group = false;
   return what.str();
@@ -160,8 +163,8 @@ struct StartupPriorityBound::State {
 
 StartupPriorityBound::StartupPriorityBound(double bound_s) {
   if (!startup_priority_lowered()) return;
-  state_ = new State;
-  State* st = state_;
+  state_ = std::make_unique<State>();
+  State* st = state_.get();
   st->thread = std::thread([st, bound_s] {
     std::unique_lock<std::mutex> lock(st->mutex);
     if (!st->cv.wait_for(lock, std::chrono::duration<double>(bound_s), [st] { return st->stop; }))
@@ -177,7 +180,6 @@ StartupPriorityBound::~StartupPriorityBound() {
   }
   state_->cv.notify_all();
   state_->thread.join();
-  delete state_;
 }
 
 }  // namespace tessera::agent

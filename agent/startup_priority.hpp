@@ -21,6 +21,7 @@
 //   than one never lowered.
 // Standalone tessera-agent processes (other hosts, by hand) are never lowered.
 
+#include <memory>
 #include <string>
 
 namespace tessera::agent {
@@ -80,7 +81,7 @@ class StartupPriorityBound {
 
  private:
   struct State;
-  State* state_ = nullptr;
+  std::unique_ptr<State> state_;  // null when nothing was lowered
 };
 
 }  // namespace tessera::agent
