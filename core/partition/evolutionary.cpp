@@ -32,6 +32,7 @@ void EvolutionParams::validate() const {
     bad("spectral_gap", std::to_string(spectral_gap), "must be >= 0");
   polish.validate();
   islands.validate();
+  resplit.validate();
   spectral.validate();
 }
 
@@ -83,7 +84,17 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
     if (trace)
       trace("spectral", "global layouts after V-cycles: " + (cuts.empty() ? "none" : cuts),
             top.cut);
-    return top.part;
+  }
+  if (params.resplit.searches > 0 && k <= params.resplit.max_parts) {
+    const long long before = top.cut;
+    const BlockResplitResult r = block_resplit(g, k, ub, top.part, params, rng);
+    if (r.improved) top.cut = edge_cut(g, top.part);
+    if (trace) {
+      std::string detail =
+          "from " + std::to_string(before) + "; " + r.detail + "; worker threads cpu";
+      for (double c : r.thread_cpu_ms) detail += " " + std::to_string(static_cast<long long>(c));
+      trace("resplit", detail + " ms", top.cut);
+    }
   }
   return top.part;
 }

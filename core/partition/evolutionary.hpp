@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "partition/block_resplit.hpp"
 #include "partition/island_search.hpp"
 #include "partition/multilevel.hpp"
 #include "partition/relaxed_polish.hpp"
@@ -64,6 +65,10 @@ struct EvolutionParams {
   /// ...only those whose cut after FM is within this fraction above the search's best.
   double spectral_gap = 0.0;
   SpectralLayoutOptions spectral;
+  /// Last (after the polish and the spectral layouts): sub-searches that keep the best
+  /// partition's most separable blocks and search the rest again (block_resplit.hpp); the
+  /// result replaces the best only when strictly better. searches = 0: off.
+  BlockResplitOptions resplit;
   CycleParams cycle;
 
   /// Throws InputError naming the first field out of range (the polish and spectral options

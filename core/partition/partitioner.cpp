@@ -70,6 +70,11 @@ struct PresetPlan {
   EvolutionParams evolution;  ///< strong/highest.
 };
 
+// Size ((n + edges) x max(1, N/5), the unit of the search's operation budget) up to which
+// `highest` re-splits its best partition (block_resplit.hpp): torus3D (14048) and the smaller
+// benchmark graphs at N <= 5; cubicle (18236) and the larger ones spend ~3-4.4 s already.
+constexpr double kResplitSize = 16000.0;
+
 PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long long lmax) {
   PresetPlan plan;
   CycleParams& cp = plan.cycle;
@@ -199,6 +204,19 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
                                                          plan.evolution.islands.short_budget);
         plan.evolution.islands.short_islands =
             !strong && short_steps >= plan.evolution.population ? 1 : 0;
+        // highest, small problems only: last, two sub-searches (one thread each) keep the best
+        // partition's 1 and 2 most separable blocks and search the rest again from scratch
+        // (block_resplit.hpp), each with a population of 4 and the full step budget; the result
+        // replaces the best only when strictly better, so no cut gets worse. The search settles
+        // into one arrangement of the blocks; this is a new draw for the blocks that are not yet
+        // right (torus3D seed 1: 242 -> 240 = the paper's, keeping its two strip blocks). Only
+        // where (n + edges) x max(1, N/5) <= 16000 (torus3D and smaller at N = 4, 5): there the
+        // whole run costs <= ~2.2 s idle and the sub-searches add ~0.3-1 s; on rim / city10000 /
+        // grid3D (~4.2-4.4 s idle) they would pass 5 s, and on rim they did not find the 243
+        // (session 11, docs/partitioning.md).
+        if (!strong && per_op <= kResplitSize) plan.evolution.resplit.searches = 2;
+        plan.evolution.resplit.population = 4;
+        plan.evolution.resplit.budget = 1.0;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
         // bound on every level the coarse searches rarely reach such shapes (session 4, seeds
@@ -262,6 +280,9 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_SHORT")) plan.evolution.islands.short_islands = std::atoi(env("T_SHORT"));
   if (env("T_SHORTF")) plan.evolution.islands.short_budget = std::atof(env("T_SHORTF"));
   if (env("T_XCH")) plan.evolution.islands.exchange_every = std::atoi(env("T_XCH"));
+  if (env("T_RS")) plan.evolution.resplit.searches = std::atoi(env("T_RS"));
+  if (env("T_RSPOP")) plan.evolution.resplit.population = std::atoi(env("T_RSPOP"));
+  if (env("T_RSB")) plan.evolution.resplit.budget = std::atof(env("T_RSB"));
   if (env("T_OPS"))
     plan.evolution.generations =
         static_cast<int>(plan.evolution.generations * std::atof(env("T_OPS")));
@@ -306,9 +327,13 @@ PartitionResult partition_graph(const GraphStructure& graph, const PartitionOpti
   PresetPlan plan = preset_plan(options.preset, g, k, lmax);
   if (options.islands > 0) {
     plan.evolution.islands.islands = options.islands;
-    // One island is the single search on the calling thread, without the short one: a caller
-    // asking for one wants the cheapest search (e.g. one that shares the cores).
-    if (options.islands == 1) plan.evolution.islands.short_islands = 0;
+    // One island is the single search on the calling thread, without the short one or the
+    // re-split's sub-searches: a caller asking for one wants the cheapest search (e.g. one that
+    // shares the cores).
+    if (options.islands == 1) {
+      plan.evolution.islands.short_islands = 0;
+      plan.evolution.resplit.searches = 0;
+    }
   }
   const CycleParams& cp = plan.cycle;
   Rng rng(options.seed);
