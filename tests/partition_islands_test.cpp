@@ -25,14 +25,7 @@ using tessera::test::validation_message;
 
 using test::grid_with_chords;
 
-EvolutionParams small_search(long long bound) {
-  EvolutionParams p;
-  p.population = 3;
-  p.generations = 12;
-  p.mutation_rate = 0.5;
-  p.cycle = test::small_graph_cycle(bound);
-  return p;
-}
+using test::small_search;
 
 TEST(IslandSearch, SameSeedSamePartitionWithThreads) {
   const GraphStructure structure = grid_with_chords(30, 20, 3);

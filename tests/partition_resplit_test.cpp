@@ -23,16 +23,21 @@ using namespace tessera;
 using namespace tessera::partition_detail;
 using tessera::test::validation_message;
 
-EvolutionParams small_search(long long bound) {
-  EvolutionParams p;
-  p.population = 3;
-  p.generations = 12;
-  p.mutation_rate = 0.5;
-  p.cycle = test::small_graph_cycle(bound);
+// test::small_search with small re-split sub-searches (population 3, its 12 steps).
+EvolutionParams resplit_search(long long bound) {
+  EvolutionParams p = test::small_search(bound);
   p.resplit.population = 3;
   p.resplit.budget = 1.0;
   return p;
 }
+
+// A 30 x 20 grid with chords in 5 blocks.
+struct ChordsCase {
+  GraphStructure structure = test::grid_with_chords(30, 20, 5);
+  WorkGraph g = to_work_graph(structure);
+  int k = 5;
+  std::vector<long long> ub = test::uniform_bounds(structure, k, 0.03);
+};
 
 // A 40 x 9 grid in 4 blocks of 90 (bound 92): columns 0-9 are block 0 (9 cut edges, the most
 // separable block), the other 30 columns are cut into three horizontal strips of 3 rows (cut
@@ -57,7 +62,7 @@ TEST(BlockResplit, TurnsStripsIntoBandsKeepingTheSeparableBlock) {
   const StripsCase c;
   ASSERT_EQ(c.ub[0], 92);
   ASSERT_EQ(edge_cut(c.g, c.strips()), 69);
-  EvolutionParams p = small_search(c.ub[0]);
+  EvolutionParams p = resplit_search(c.ub[0]);
   p.resplit.searches = 1;  // keep 1 block (block 0, 9 cut edges)
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     // A V-cycle of the whole partition (FM and flows on every level) does not get there.
@@ -74,11 +79,11 @@ TEST(BlockResplit, TurnsStripsIntoBandsKeepingTheSeparableBlock) {
 }
 
 TEST(BlockResplit, NeverWorseWithinBoundsAndDeterministic) {
-  const GraphStructure structure = test::grid_with_chords(30, 20, 5);
-  const WorkGraph g = to_work_graph(structure);
-  const int k = 5;
-  const std::vector<long long> ub = test::uniform_bounds(structure, k, 0.03);
-  EvolutionParams p = small_search(ub[0]);
+  const ChordsCase c;
+  const WorkGraph& g = c.g;
+  const int k = c.k;
+  const std::vector<long long>& ub = c.ub;
+  EvolutionParams p = resplit_search(ub[0]);
   p.resplit.searches = 2;
   int improved = 0;
   for (std::uint64_t seed = 1; seed <= 4; ++seed) {
@@ -106,11 +111,11 @@ TEST(BlockResplit, NeverWorseWithinBoundsAndDeterministic) {
 // Through evolve(): the result is never worse than the search without the re-split (it runs
 // last and only replaces a strictly better partition), and the trace names it.
 TEST(BlockResplit, AfterTheSearchNeverWorseAndTraced) {
-  const GraphStructure structure = test::grid_with_chords(30, 20, 5);
-  const WorkGraph g = to_work_graph(structure);
-  const int k = 5;
-  const std::vector<long long> ub = test::uniform_bounds(structure, k, 0.03);
-  EvolutionParams with = small_search(ub[0]);
+  const ChordsCase c;
+  const WorkGraph& g = c.g;
+  const int k = c.k;
+  const std::vector<long long>& ub = c.ub;
+  EvolutionParams with = resplit_search(ub[0]);
   with.resplit.searches = 2;
   EvolutionParams without = with;
   without.resplit.searches = 0;
@@ -133,7 +138,7 @@ TEST(BlockResplit, AfterTheSearchNeverWorseAndTraced) {
 
 TEST(BlockResplit, OffOrTooManyBlocksLeavesThePartition) {
   const StripsCase c;
-  EvolutionParams p = small_search(c.ub[0]);
+  EvolutionParams p = resplit_search(c.ub[0]);
   std::vector<int> part = c.strips();
   EXPECT_FALSE(block_resplit(c.g, c.k, c.ub, part, p, Rng(1)).improved);  // searches = 0
   p.resplit.searches = 2;

@@ -53,6 +53,15 @@ partition_detail::CycleParams small_graph_cycle(long long ub) {
   return cp;
 }
 
+partition_detail::EvolutionParams small_search(long long ub) {
+  partition_detail::EvolutionParams p;
+  p.population = 3;
+  p.generations = 12;
+  p.mutation_rate = 0.5;
+  p.cycle = small_graph_cycle(ub);
+  return p;
+}
+
 void expect_blocks_within(const partition_detail::WorkGraph& g, const std::vector<int>& part, int k,
                           const std::vector<long long>& ub) {
   ASSERT_EQ(part.size(), static_cast<std::size_t>(g.n));

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "partition/evolutionary.hpp"
 #include "partition/graph_structure.hpp"
 #include "partition/multilevel.hpp"
 #include "partition/work_graph.hpp"
@@ -25,6 +26,10 @@ std::vector<long long> uniform_bounds(const GraphStructure& structure, int k, do
 /// vertices (coarse vertices below ub / 30), 3 label-propagation rounds, 4 initial runs, flow
 /// refinement on the 2 finest levels, default FM everywhere.
 partition_detail::CycleParams small_graph_cycle(long long ub);
+
+/// A small memetic search for such graphs: population 3, 12 steps, half of them mutations, the
+/// cycle above; nothing else (one island, no polish, no layouts, no re-split).
+partition_detail::EvolutionParams small_search(long long ub);
 
 /// Test assertions: `part` gives every vertex of `g` a block in [0, k), and no block outweighs
 /// its bound `ub[b]`.
