@@ -28,6 +28,8 @@ NetworkProfile network_profile(const std::string& name) {
     p.heartbeat_period_s = 0.01;
     p.nack_response_delay_s = 0.0;
     p.heartbeat_response_delay_s = 0.0;
+    // Repair first: a negative acknowledgement is answered whenever it comes.
+    p.nack_suppression_s = 0.0;
     return p;
   }
   std::string valid;

@@ -23,6 +23,15 @@ struct NetworkProfile {
   double nack_response_delay_s = 0.005;
   /// Delay before a reader answers a heartbeat with its acknowledgement, seconds.
   double heartbeat_response_delay_s = 0.005;
+  /// How long after sending a sample to a reader the writer ignores that reader's negative
+  /// acknowledgements of it, seconds (Fast DDS's nackSupressionDuration, whose default is 0).
+  /// Fast DDS 2.9 re-arms this per-reader timer on every send, and re-arming a timer that has
+  /// already fired wakes the participant's event thread, which then also fights the writing
+  /// thread for the writer's mutex: with 0 that is ~2 wake-ups per write. While the timer still
+  /// runs a send does not touch the event thread, so it should outlast the time between two
+  /// writes to one reader (a kitti_02 round is ~1.5 ms). Cost: a sample lost on the wire is
+  /// repaired up to this much later (shared memory loses none). Range >= 0.
+  double nack_suppression_s = 0.05;
 };
 
 /// The names --network accepts, in the order --help lists them ("default", "lossy").

@@ -99,6 +99,10 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
       Duration_t(transient_local ? std::min(net.heartbeat_period_s, kHandshakeHeartbeatS)
                                  : net.heartbeat_period_s);
   q.reliable_writer_qos().times.nackResponseDelay = Duration_t(net.nack_response_delay_s);
+  // Not Fast DDS's 0 on the volatile (per-round) topics: NetworkProfile::nack_suppression_s.
+  // The hand-shake topics are written a few times a run and keep answering at once.
+  q.reliable_writer_qos().times.nackSupressionDuration =
+      Duration_t(transient_local ? 0.0 : net.nack_suppression_s);
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
   q.liveliness().lease_duration =
       liveliness ? Duration_t(lease_s) : eprosima::fastrtps::c_TimeInfinite;
