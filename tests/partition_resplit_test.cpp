@@ -63,7 +63,8 @@ TEST(BlockResplit, TurnsStripsIntoBandsKeepingTheSeparableBlock) {
   ASSERT_EQ(c.ub[0], 92);
   ASSERT_EQ(edge_cut(c.g, c.strips()), 69);
   EvolutionParams p = resplit_search(c.ub[0]);
-  p.resplit.searches = 1;  // keep 1 block (block 0, 9 cut edges)
+  p.resplit.searches = 1;
+  p.resplit.kept = 1;  // block 0 (9 cut edges)
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     // A V-cycle of the whole partition (FM and flows on every level) does not get there.
     Rng vrng(seed);
@@ -131,8 +132,10 @@ TEST(BlockResplit, AfterTheSearchNeverWorseAndTraced) {
     if (edge_cut(g, a) == edge_cut(g, b)) {
       EXPECT_EQ(a, b) << "seed " << seed;
     }
-    EXPECT_NE(detail.find("keep 1: "), std::string::npos) << detail;
-    EXPECT_NE(detail.find("keep 2: "), std::string::npos) << detail;
+    // Two sub-searches, each keeping the 2 most separable blocks.
+    const std::size_t first = detail.find("keep 2: ");
+    ASSERT_NE(first, std::string::npos) << detail;
+    EXPECT_NE(detail.find("keep 2: ", first + 1), std::string::npos) << detail;
   }
 }
 
@@ -145,6 +148,14 @@ TEST(BlockResplit, OffOrTooManyBlocksLeavesThePartition) {
   p.resplit.max_parts = 3;
   EXPECT_FALSE(block_resplit(c.g, c.k, c.ub, part, p, Rng(1)).improved);
   EXPECT_EQ(part, c.strips());
+  // Two blocks: nothing to keep while splitting two again.
+  const std::vector<long long> two = test::uniform_bounds(c.structure, 2, 0.03);
+  std::vector<int> halves(static_cast<std::size_t>(c.g.n));
+  for (int v = 0; v < c.g.n; ++v) halves[v] = v % 40 < 20 ? 0 : 1;
+  p.resplit.max_parts = 8;
+  const std::vector<int> before = halves;
+  EXPECT_FALSE(block_resplit(c.g, 2, two, halves, p, Rng(1)).improved);
+  EXPECT_EQ(halves, before);
 }
 
 // Whether a trace phase of that name was recorded.
@@ -192,6 +203,11 @@ TEST(BlockResplit, BadOptionsNameTheField) {
   EXPECT_TRUE(names(o, "budget"));
   o.budget = 1.5;
   EXPECT_TRUE(names(o, "budget"));
+  o = {};
+  o.kept = 0;
+  EXPECT_TRUE(names(o, "kept"));
+  o.kept = 63;
+  EXPECT_TRUE(names(o, "kept"));
   o = {};
   o.max_parts = 1;
   EXPECT_TRUE(names(o, "max_parts"));

@@ -20,6 +20,7 @@ void BlockResplitOptions::validate() const {
   if (population < 2 || population > 64)
     bad("population", std::to_string(population), "must be in 2..64");
   if (!(budget > 0.0 && budget <= 1.0)) bad("budget", std::to_string(budget), "must be in (0, 1]");
+  if (kept < 1 || kept > 62) bad("kept", std::to_string(kept), "must be in 1..62");
   if (max_parts < 2 || max_parts > 64)
     bad("max_parts", std::to_string(max_parts), "must be in 2..64");
 }
@@ -100,10 +101,9 @@ BlockResplitResult block_resplit(const WorkGraph& g, int k, const std::vector<lo
     double cpu_ms = 0.0;
   };
   std::vector<Job> jobs;
-  // Keep 1, 2, 1, 2, ... blocks (at most k - 2, so that at least two are split again).
-  for (int j = 0; j < opt.searches && k >= 3; ++j)
-    jobs.push_back(Job{1 + j % std::min(2, k - 2), {}, 0.0});
-  if (jobs.empty()) return result;
+  // At most k - 2 blocks kept, so that at least two are split again.
+  if (k < 3) return result;
+  for (int j = 0; j < opt.searches; ++j) jobs.push_back(Job{std::min(opt.kept, k - 2), {}, 0.0});
 
   std::vector<std::function<void()>> work;
   for (std::size_t j = 0; j < jobs.size(); ++j)

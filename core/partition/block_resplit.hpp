@@ -14,6 +14,8 @@
 // edges inside it. A fresh search there (a small population of its own) is not tied to the old
 // arrangement of those blocks (rim: holding the light block and searching the rest with
 // `strong`'s effort gave 243 on 2 of 4 seeds; torus3D: holding its two strips, 240 on 2 of 4).
+// Keeping the two most separable blocks did better than keeping one on the small benchmark
+// graphs (torus3D seeds 1-8: keep 1 never improved, keep 2 on seeds 1, 7, 8).
 
 #include <string>
 #include <vector>
@@ -25,10 +27,12 @@ namespace tessera::partition_detail {
 struct EvolutionParams;
 
 struct BlockResplitOptions {
-  /// Sub-searches, each on its own thread; sub-search j keeps the j + 1 blocks with the fewest
-  /// cut edges (ties: lower block id) and searches the others again. 0 = off. Range 0..8; a
-  /// sub-search that would leave fewer than 2 blocks to split is skipped.
+  /// Sub-searches, each with its own generator and thread (at most 2 threads). 0 = off.
+  /// Range 0..8.
   int searches = 0;
+  /// Blocks each sub-search keeps: those with the fewest cut edges (ties: lower block id), at
+  /// most k - 2 (at least two blocks are split again; nothing happens for k < 3). Range 1..62.
+  int kept = 2;
   /// Individuals of each sub-search's population. Range 2..64.
   int population = 4;
   /// Combine / mutation steps of each sub-search, as a share of the full search's

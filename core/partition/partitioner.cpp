@@ -205,16 +205,17 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         plan.evolution.islands.short_islands =
             !strong && short_steps >= plan.evolution.population ? 1 : 0;
         // highest, small problems only: last, two sub-searches (one thread each) keep the best
-        // partition's 1 and 2 most separable blocks and search the rest again from scratch
+        // partition's 2 most separable blocks and search the rest again from scratch
         // (block_resplit.hpp), each with a population of 4 and the full step budget; the result
         // replaces the best only when strictly better, so no cut gets worse. The search settles
         // into one arrangement of the blocks; this is a new draw for the blocks that are not yet
-        // right (torus3D seed 1: 242 -> 240 = the paper's, keeping its two strip blocks). Only
+        // right (torus3D seeds 1, 7, 8: 242/241/245 -> 240/240/243, keeping its two strips). Only
         // where (n + edges) x max(1, N/5) <= 16000 (torus3D and smaller at N = 4, 5): there the
         // whole run costs <= ~2.2 s idle and the sub-searches add ~0.3-1 s; on rim / city10000 /
         // grid3D (~4.2-4.4 s idle) they would pass 5 s, and on rim they did not find the 243
         // (session 11, docs/partitioning.md).
         if (!strong && per_op <= kResplitSize) plan.evolution.resplit.searches = 2;
+        plan.evolution.resplit.kept = 2;
         plan.evolution.resplit.population = 4;
         plan.evolution.resplit.budget = 1.0;
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
@@ -281,6 +282,7 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
   if (env("T_SHORTF")) plan.evolution.islands.short_budget = std::atof(env("T_SHORTF"));
   if (env("T_XCH")) plan.evolution.islands.exchange_every = std::atoi(env("T_XCH"));
   if (env("T_RS")) plan.evolution.resplit.searches = std::atoi(env("T_RS"));
+  if (env("T_RSKEEP")) plan.evolution.resplit.kept = std::atoi(env("T_RSKEEP"));
   if (env("T_RSPOP")) plan.evolution.resplit.population = std::atoi(env("T_RSPOP"));
   if (env("T_RSB")) plan.evolution.resplit.budget = std::atof(env("T_RSB"));
   if (env("T_OPS"))
