@@ -1,5 +1,6 @@
 #include "agent/robot_data.hpp"
 
+#include "agent/preloaded_graph.hpp"
 #include "agent/robot_file.hpp"
 #include "io/g2o_reader.hpp"
 #include "transport/run_failure.hpp"
@@ -9,6 +10,9 @@ namespace tessera::agent {
 using namespace tessera::transport;
 
 RobotShare load_robot_share(const std::string& path, std::uint32_t id, std::uint32_t robots) {
+  // Parsed by the fork server before it forked this agent (launch): the same graph, read once.
+  if (const PoseGraph* preloaded = preloaded_graph(path))
+    return robot_share(*preloaded, id, robots);
   if (is_robot_file(path)) return read_robot_file(path, id);  // n comes with the assignment
   PoseGraph graph = read_g2o(path);
   return robot_share(graph, id, robots);

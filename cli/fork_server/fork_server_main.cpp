@@ -11,13 +11,18 @@
 // Nothing of Fast DDS may exist before a fork (its threads would not survive it, its shared
 // memory segments would be shared): this process only parses its argv and forks; the first
 // Fast DDS object of each process is created by the entry function in the child. Each fork is
-// refused unless this process is still single-threaded.
+// refused unless this process is still single-threaded. Between the coordinator's fork and the
+// first agent's, this process prepares plain data that every agent would otherwise build on
+// its own while the coordinator partitions on both cores (prepare_agents): the agents' graph
+// file, parsed once, and Fast DDS's TypeObjectFactory tables (no thread, no descriptor, no
+// shared memory).
 //
 // usage (by launch): tessera-fork-server --spec-fd FD --title-room BLANKS
 //   FD: a pipe from which the spec is read to its end (cli/fork_spec.hpp: serialize_fork_spec);
 //   BLANKS: as many spaces as the longest child's command line, so that the argv area where
 //   each child writes its own command line (ps, pgrep -f) is large enough.
 
+#include <fastrtps/types/TypeObjectFactory.h>
 #include <sys/prctl.h>
 #include <sys/types.h>
 #include <unistd.h>
@@ -32,6 +37,7 @@
 #include <vector>
 
 #include "agent/agent_entry.hpp"
+#include "agent/preloaded_graph.hpp"
 #include "agent/startup_priority.hpp"
 #include "coordinator/coordinator_entry.hpp"
 #include "fork_spec.hpp"
@@ -62,6 +68,35 @@ std::string read_all(int fd) {
     if (n == 0) return text;
     text.append(buf, static_cast<std::size_t>(n));
   }
+}
+
+// The --graph every agent of `spec` reads, or "" when they read different files (robot files).
+std::string shared_agent_graph(const cli::ForkSpec& spec) {
+  std::string shared;
+  for (const cli::ForkChild& c : spec.children) {
+    if (c.role != cli::ForkRole::kAgent) continue;
+    const auto at = std::find(c.argv.begin(), c.argv.end(), "--graph");
+    if (at == c.argv.end() || at + 1 == c.argv.end()) return "";
+    if (!shared.empty() && shared != *(at + 1)) return "";
+    shared = *(at + 1);
+  }
+  return shared;
+}
+
+// What every agent would otherwise do on its own at start-up, done once here so that the
+// agents inherit it (copy-on-write pages they only read); measured ~3 ms of CPU per agent
+// each, spent while the coordinator partitions on both cores (docs/dds-runtime.md, start11):
+// - the shared graph file, parsed (agent/preloaded_graph.hpp; a file that does not parse is
+//   left to each agent, which reports it);
+// - Fast DDS's TypeObjectFactory singleton (builtin types and annotations), which each
+//   process otherwise builds when it announces its first endpoint. It is a table of type
+//   descriptions: it starts no thread and opens nothing (checked with strace; the thread
+//   count is checked again before every fork).
+// Called after the coordinator's fork: that one is on the run's critical path.
+void prepare_agents(const cli::ForkSpec& spec) {
+  if (const std::string graph = shared_agent_graph(spec); !graph.empty())
+    agent::preload_graph(graph);
+  eprosima::fastrtps::types::TypeObjectFactory::get_instance();
 }
 
 // The memory holding this process's argv strings (contiguous on Linux): what ps and pgrep -f
@@ -158,7 +193,12 @@ int main(int argc, char** argv) {
   const ArgvArea area{argv[0], static_cast<std::size_t>(argv[argc - 1] +
                                                         std::strlen(argv[argc - 1]) + 1 - argv[0])};
   const bool yield = agents_yield_at_start(spec);
+  bool prepared = false;
   for (std::size_t k = 0; k < spec.children.size(); ++k) {
+    if (!prepared && spec.children[k].role == cli::ForkRole::kAgent) {
+      prepare_agents(spec);
+      prepared = true;
+    }
     const int threads = thread_count();
     if (threads != 1) {
       std::fprintf(stderr,
