@@ -25,6 +25,7 @@ std::unique_ptr<Preloaded>& slot() {
 }  // namespace
 
 void preload_graph(const std::string& path) noexcept {
+  slot().reset();
   try {
     if (is_robot_file(path)) return;
     auto p = std::make_unique<Preloaded>();

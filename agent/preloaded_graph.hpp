@@ -12,8 +12,9 @@
 namespace tessera::agent {
 
 /// Parses `path` (a whole multi-robot g2o file; not a robot file) and keeps it for
-/// preloaded_graph(). Keeps nothing when the file is a robot file or cannot be read or parsed:
-/// never throws, the agent then meets the error itself, with the file and line.
+/// preloaded_graph(), in place of any graph kept before. Keeps nothing when the file is a robot
+/// file or cannot be read or parsed: never throws, the agent then meets the error itself, with the
+/// file and line.
 void preload_graph(const std::string& path) noexcept;
 
 /// The graph preload_graph() parsed from exactly `path`, or nullptr.

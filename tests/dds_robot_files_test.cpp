@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "agent/local_share.hpp"
+#include "agent/preloaded_graph.hpp"
 #include "agent/robot_file.hpp"
 #include "dds_process_support.hpp"
 #include "distributed/distributed_solver.hpp"
@@ -100,6 +101,33 @@ TEST(DdsRobotFiles, WithoutIndexOrVerticesTheConventionStillHolds) {
     EXPECT_EQ(own.measurements[k].i, ref.measurements[k].i);
   }
   EXPECT_THROW(agent::adopt_num_poses(own, 60, path), InputError);  // poses beyond n
+}
+
+// The fork server's graph cache (agent/preloaded_graph.hpp): the same graph as reading the
+// file, only for that exact path, and nothing kept (no throw) for a robot file or a file
+// that does not parse, which each agent then reads itself and reports.
+TEST(DdsRobotFiles, PreloadedGraphIsTheFilesGraphForThatPathOnly) {
+  const std::string dir = temp_dir();
+  const std::string whole = generate_split(dir, "city", 120, 3);
+  agent::preload_graph(whole);
+  const PoseGraph* pre = agent::preloaded_graph(whole);
+  ASSERT_NE(pre, nullptr);
+  const PoseGraph g = read_g2o(whole);
+  for (std::uint32_t r = 0; r < 3; ++r)
+    expect_same_share(agent::robot_share(*pre, r, 3), agent::robot_share(g, r, 3));
+  EXPECT_EQ(agent::preloaded_graph(dir + "/robots/robot0.g2o"), nullptr);
+  EXPECT_EQ(agent::preloaded_graph(dir + "/./whole.g2o"), nullptr) << "exact path only";
+
+  const std::string bad = dir + "/bad.g2o";
+  std::ofstream(bad) << "VERTEX_SE2 0 0 0 0\nEDGE_SE2 0 7 1 0 0 1 0 0 1 0 1\nnonsense\n";
+  EXPECT_NO_THROW(agent::preload_graph(bad));
+  EXPECT_EQ(agent::preloaded_graph(bad), nullptr);
+  EXPECT_EQ(agent::preloaded_graph(whole), nullptr) << "a failed preload keeps nothing";
+  EXPECT_THROW(read_g2o(bad), InputError) << "the agent's own read still reports it";
+
+  agent::preload_graph(dir + "/robots/robot1.g2o");
+  EXPECT_EQ(agent::preloaded_graph(dir + "/robots/robot1.g2o"), nullptr)
+      << "robot files are not cached";
 }
 
 TEST(DdsRobotFiles, BadRobotFilesNameTheFileAndLine) {
