@@ -27,6 +27,7 @@
 #include "commands.hpp"
 #include "coordinator/progress_lines.hpp"
 #include "distributed/distributed_solver.hpp"
+#include "huge_page_heaps.hpp"
 #include "launch_children.hpp"
 #include "launch_loss_policy.hpp"
 #include "robot_files.hpp"
@@ -329,6 +330,7 @@ int run_launch(const Args& argv) {
     agent_ids.push_back(k);
   }
 
+  request_huge_page_heaps();  // for the processes started next (huge_page_heaps.hpp)
   const auto t0 = std::chrono::steady_clock::now();
   // Both close our copy of the progress pipe's write end once the coordinator has its own.
   std::vector<Child> children =
