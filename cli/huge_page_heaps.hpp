@@ -5,7 +5,7 @@
 // agent touches ~1000 new 4 KB pages before the coordinator's partition ends, and on the
 // virtual machines measured a page fault costs ~10 us of CPU, spent while the partition wants
 // both cores (docs/dds-runtime.md, "Session 11 (start11)"). With huge pages the agents fault
-// ~25-30 % less up to the assignment and ~40 % less over a CSAIL run.
+// ~20-25 % less up to the assignment and ~35 % less over a CSAIL run.
 //
 // A tunable is read when a program starts, so it goes into launch's own environment before
 // it starts any process; launch itself (already running) is unaffected. A user who set
