@@ -12,6 +12,7 @@
 #include "agent/agent_log.hpp"
 #include "agent/agent_options.hpp"
 #include "agent/agent_run.hpp"
+#include "agent/heap_retention.hpp"
 #include "agent/startup_priority.hpp"
 #include "distributed/checkpoint_file.hpp"
 #include "session_process.hpp"
@@ -21,7 +22,8 @@ namespace tessera::agent {
 
 int agent_main(int argc, char** argv) {
   transport::SignalWatcher
-      signals;  // first: every thread created later inherits the blocked signals
+      signals;          // first: every thread created later inherits the blocked signals
+  retain_freed_heap();  // rounds re-use their temporaries' pages (heap_retention.hpp)
   const std::vector<std::string> argv_list(argv + 1, argv + argc);
   AgentOptions options;
   if (auto code = cli::parse_process_options(

@@ -1,0 +1,15 @@
+#include "agent/heap_retention.hpp"
+
+#include <malloc.h>
+
+namespace tessera::agent {
+
+bool retain_freed_heap() {
+  // The mapping threshold first: either call turns off glibc's dynamic adjustment, which would
+  // otherwise have raised it towards the sizes actually freed.
+  const bool mapping = mallopt(M_MMAP_THRESHOLD, static_cast<int>(kOwnMappingBytes)) == 1;
+  const bool trim = mallopt(M_TRIM_THRESHOLD, static_cast<int>(kRetainedHeapBytes)) == 1;
+  return mapping && trim;
+}
+
+}  // namespace tessera::agent
