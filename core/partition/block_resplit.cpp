@@ -76,7 +76,9 @@ BlockResplitResult block_resplit(const WorkGraph& g, int k, const std::vector<lo
   const BlockResplitOptions& opt = params.resplit;
   opt.validate();
   BlockResplitResult result;
-  if (opt.searches == 0 || k > opt.max_parts) return result;
+  result.cut = edge_cut(g, part);
+  // At most k - 2 blocks kept, so that at least two are split again.
+  if (opt.searches == 0 || k > opt.max_parts || k < 3) return result;
 
   const std::vector<long long> cuts = block_cuts(g, part, k);
   std::vector<int> order(static_cast<std::size_t>(k));
@@ -101,8 +103,6 @@ BlockResplitResult block_resplit(const WorkGraph& g, int k, const std::vector<lo
     double cpu_ms = 0.0;
   };
   std::vector<Job> jobs;
-  // At most k - 2 blocks kept, so that at least two are split again.
-  if (k < 3) return result;
   for (int j = 0; j < opt.searches; ++j) jobs.push_back(Job{std::min(opt.kept, k - 2), {}, 0.0});
 
   std::vector<std::function<void()>> work;
@@ -136,14 +136,13 @@ BlockResplitResult block_resplit(const WorkGraph& g, int k, const std::vector<lo
     });
   result.thread_cpu_ms = run_jobs(work, std::min(2, static_cast<int>(work.size())));
 
-  long long cut = edge_cut(g, part);
   int winner = -1;
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     result.detail += (j > 0 ? "; " : "") + std::string("keep ") + std::to_string(jobs[j].kept) +
                      ": " + std::to_string(jobs[j].best.cut) + ", thread cpu " +
                      std::to_string(static_cast<long long>(jobs[j].cpu_ms)) + " ms";
-    if (jobs[j].best.cut < cut) {
-      cut = jobs[j].best.cut;
+    if (jobs[j].best.cut < result.cut) {
+      result.cut = jobs[j].best.cut;
       winner = static_cast<int>(j);
     }
   }

@@ -48,6 +48,7 @@ struct BlockResplitOptions {
 
 struct BlockResplitResult {
   bool improved = false;  ///< Whether `part` was replaced.
+  long long cut = 0;      ///< The cut of `part` on return.
   std::string detail;     ///< Per sub-search: blocks kept, its best total cut, thread CPU.
   std::vector<double> thread_cpu_ms;  ///< Per worker thread.
 };

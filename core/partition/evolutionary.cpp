@@ -88,7 +88,7 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
   if (params.resplit.searches > 0 && k <= params.resplit.max_parts) {
     const long long before = top.cut;
     const BlockResplitResult r = block_resplit(g, k, ub, top.part, params, rng);
-    if (r.improved) top.cut = edge_cut(g, top.part);
+    top.cut = r.cut;
     if (trace) {
       std::string detail =
           "from " + std::to_string(before) + "; " + r.detail + "; worker threads cpu";
