@@ -53,7 +53,7 @@ class FlowNetwork {
     long long c_uv, c_vu;
   };
   // One arc with everything the level search and the augmenting search read together: one
-  // 16-byte record instead of three parallel arrays (fewer cache lines per scanned arc).
+  // 24-byte record instead of parallel arrays (fewer cache lines per scanned arc).
   //
   // `back` mirrors the reverse arc's capacity so that searches against the arc direction (the
   // distance labels towards t, the set reaching t) stay within the record.
