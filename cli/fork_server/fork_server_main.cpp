@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "agent/agent_entry.hpp"
+#include "agent/agent_options.hpp"
 #include "agent/preloaded_graph.hpp"
 #include "agent/startup_priority.hpp"
 #include "coordinator/coordinator_entry.hpp"
@@ -70,15 +71,21 @@ std::string read_all(int fd) {
   }
 }
 
-// The --graph every agent of `spec` reads, or "" when they read different files (robot files).
+// The --graph every agent of `spec` reads (as the agent's own option parser reads it), or ""
+// when they read different files (robot files) or an agent's options do not parse (that agent
+// reports them itself).
 std::string shared_agent_graph(const cli::ForkSpec& spec) {
   std::string shared;
   for (const cli::ForkChild& c : spec.children) {
     if (c.role != cli::ForkRole::kAgent) continue;
-    const auto at = std::find(c.argv.begin(), c.argv.end(), "--graph");
-    if (at == c.argv.end() || at + 1 == c.argv.end()) return "";
-    if (!shared.empty() && shared != *(at + 1)) return "";
-    shared = *(at + 1);
+    std::string graph;
+    try {
+      graph = agent::parse_agent_options({c.argv.begin() + 1, c.argv.end()}).graph;
+    } catch (const InputError&) {
+      return "";
+    }
+    if (!shared.empty() && shared != graph) return "";
+    shared = graph;
   }
   return shared;
 }
