@@ -79,6 +79,38 @@ TEST(BlockResplit, TurnsStripsIntoBandsKeepingTheSeparableBlock) {
   }
 }
 
+// max_cut_ratio: the sub-searches run only when every kept block's cut edges are at most that
+// share of the mean block cut. The strips' block 0 has 9 of a mean 34.5 (0.26): kept at 0.6,
+// not at 0.2; a band layout (every block in a chain; the end blocks 0.67 of the mean at 4
+// blocks) has no clearly separable block at 0.6.
+TEST(BlockResplit, OnlyKeepsAClearlySeparableBlockWhenAsked) {
+  const StripsCase c;
+  EvolutionParams p = resplit_search(c.ub[0]);
+  p.resplit.searches = 1;
+  p.resplit.kept = 1;
+  p.resplit.max_cut_ratio = 0.6;
+  std::vector<int> part = c.strips();
+  BlockResplitResult r = block_resplit(c.g, c.k, c.ub, part, p, Rng(1));
+  EXPECT_TRUE(r.improved) << r.detail;
+  EXPECT_EQ(edge_cut(c.g, part), 27);
+  p.resplit.max_cut_ratio = 0.2;
+  part = c.strips();
+  r = block_resplit(c.g, c.k, c.ub, part, p, Rng(1));
+  EXPECT_FALSE(r.improved);
+  EXPECT_EQ(part, c.strips());
+  EXPECT_EQ(r.cut, 69);
+  EXPECT_NE(r.detail.find("no block clearly separable (9 cut edges, mean 35)"), std::string::npos)
+      << r.detail;
+  std::vector<int> bands(static_cast<std::size_t>(c.g.n));
+  for (int v = 0; v < c.g.n; ++v) bands[v] = (v % 40) / 10;
+  p.resplit.max_cut_ratio = 0.6;
+  r = block_resplit(c.g, c.k, c.ub, bands, p, Rng(1));
+  EXPECT_FALSE(r.improved);
+  EXPECT_NE(r.detail.find("no block clearly separable (9 cut edges, mean 14)"), std::string::npos)
+      << r.detail;
+  EXPECT_TRUE(r.thread_cpu_ms.empty());
+}
+
 TEST(BlockResplit, NeverWorseWithinBoundsAndDeterministic) {
   const ChordsCase c;
   const WorkGraph& g = c.g;
@@ -158,6 +190,13 @@ TEST(BlockResplit, OffOrTooManyBlocksLeavesThePartition) {
   EXPECT_EQ(halves, before);
 }
 
+// The detail of the trace phase "resplit" ("" if there is none).
+std::string resplit_detail(const PartitionResult& r) {
+  for (const auto& t : r.trace)
+    if (t.name == "resplit") return t.detail;
+  return "";
+}
+
 // Whether a trace phase of that name was recorded.
 bool traced(const PartitionResult& r, const std::string& phase) {
   for (const auto& t : r.trace)
@@ -165,9 +204,10 @@ bool traced(const PartitionResult& r, const std::string& phase) {
   return false;
 }
 
-// highest re-splits on small problems ((n + edges) x max(1, N/5) <= 16000), never with
-// --islands 1 (the cheapest search) and not on larger ones; strong never.
-TEST(BlockResplit, HighestResplitsSmallProblemsOnly) {
+// highest re-splits small problems ((n + edges) x max(1, N/5) <= 16000) keeping 2 blocks,
+// larger ones keeping 1 block only when it is clearly separable, never with --islands 1 (the
+// cheapest search); strong never.
+TEST(BlockResplit, HighestResplitsSmallProblemsAndClearlySeparableBlocks) {
   PartitionOptions o;
   o.preset = PartitionPreset::kHighest;
   o.parts = 5;
@@ -179,10 +219,31 @@ TEST(BlockResplit, HighestResplitsSmallProblemsOnly) {
   o.preset = PartitionPreset::kStrong;
   EXPECT_FALSE(traced(partition_graph(small, o), "resplit"));
   o.preset = PartitionPreset::kHighest;
-  // A path of 9000 poses: 17999 > 16000.
-  const PartitionResult large = partition_graph(test::grid_structure(9000, 1), o);
-  EXPECT_FALSE(traced(large, "resplit"));
-  EXPECT_EQ(large.metrics.cut_edges, 4u);
+  // A path of 9000 poses: 17999 > 16000. Its 5 blocks form a chain: the end blocks have 1 of
+  // a mean 1.6 cut edges (0.625), none is clearly separable.
+  const PartitionResult path = partition_graph(test::grid_structure(9000, 1), o);
+  EXPECT_NE(resplit_detail(path).find("no block clearly separable (1 cut edges, mean 2)"),
+            std::string::npos)
+      << resplit_detail(path);
+  EXPECT_EQ(path.metrics.cut_edges, 4u);
+  // A ring of 7200 poses joined by 2 measurements each, with a path of 1800 hanging from it
+  // (18000 > 16000): the best cut (9) splits the ring into 4 arcs (4 cut edges each, 5 where
+  // the path hangs) and cuts the path off (1 cut edge, 0.28 of the mean block cut): that block
+  // is kept and the ring searched again. (5 arcs with the path inside one would cut 10.)
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  std::vector<std::size_t> weights;
+  for (std::size_t v = 0; v < 7200; ++v) {
+    pairs.emplace_back(v, (v + 1) % 7200);
+    weights.push_back(2);
+  }
+  for (std::size_t v = 7200; v < 9000; ++v) {
+    pairs.emplace_back(v == 7200 ? 0 : v - 1, v);
+    weights.push_back(1);
+  }
+  const PartitionResult ring =
+      partition_graph(make_graph_structure(9000, pairs, weights, "ring"), o);
+  EXPECT_EQ(ring.metrics.cut_edges, 9u);
+  EXPECT_NE(resplit_detail(ring).find("keep 1: 9"), std::string::npos) << resplit_detail(ring);
 }
 
 TEST(BlockResplit, BadOptionsNameTheField) {

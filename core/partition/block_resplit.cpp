@@ -20,6 +20,8 @@ void BlockResplitOptions::validate() const {
   if (population < 2 || population > 64)
     bad("population", std::to_string(population), "must be in 2..64");
   if (!(budget > 0.0 && budget <= 1.0)) bad("budget", std::to_string(budget), "must be in (0, 1]");
+  if (!(max_cut_ratio >= 0.0 && max_cut_ratio <= 1.0))
+    bad("max_cut_ratio", std::to_string(max_cut_ratio), "must be in 0..1 (0 = no condition)");
   if (kept < 1 || kept > 62) bad("kept", std::to_string(kept), "must be in 1..62");
   if (max_parts < 2 || max_parts > 64)
     bad("max_parts", std::to_string(max_parts), "must be in 2..64");
@@ -84,6 +86,17 @@ BlockResplitResult block_resplit(const WorkGraph& g, int k, const std::vector<lo
   std::vector<int> order(static_cast<std::size_t>(k));
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return cuts[a] < cuts[b]; });
+  const int kept = std::min(opt.kept, k - 2);
+  if (opt.max_cut_ratio > 0.0) {
+    // Every kept block's cut against the mean block cut: 2 x cut / k, each cut edge counted
+    // by both of its blocks. The blocks are sorted by cut, so the last kept one decides.
+    const double mean = 2.0 * static_cast<double>(result.cut) / k;
+    if (static_cast<double>(cuts[order[kept - 1]]) > opt.max_cut_ratio * mean) {
+      result.detail = "no block clearly separable (" + std::to_string(cuts[order[kept - 1]]) +
+                      " cut edges, mean " + std::to_string(std::lround(mean)) + ")";
+      return result;
+    }
+  }
 
   // The sub-searches' own parameters: the full search's operators with a smaller population
   // and budget, one island, and nothing after the search.
@@ -103,7 +116,7 @@ BlockResplitResult block_resplit(const WorkGraph& g, int k, const std::vector<lo
     double cpu_ms = 0.0;
   };
   std::vector<Job> jobs;
-  for (int j = 0; j < opt.searches; ++j) jobs.push_back(Job{std::min(opt.kept, k - 2), {}, 0.0});
+  for (int j = 0; j < opt.searches; ++j) jobs.push_back(Job{kept, {}, 0.0});
 
   std::vector<std::function<void()>> work;
   for (std::size_t j = 0; j < jobs.size(); ++j)
