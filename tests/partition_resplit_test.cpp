@@ -1,8 +1,10 @@
 // The block re-split (block_resplit.hpp): keeping a partition's most separable blocks and
 // searching the rest again finds a better arrangement of the other blocks that no local move
 // reaches (horizontal strips -> vertical bands), is never worse, stays within the bounds, keeps
-// the kept blocks' vertices where they were when nothing else improves, is deterministic, and
-// runs in `highest` only on small problems and not with one island. Bad options name the field.
+// the kept blocks' vertices where they were when nothing else improves, is deterministic, keeps
+// a block only when asked if it is clearly separable, and runs in `highest` on small problems
+// and on larger ones with a clearly separable block, not with one island. Bad options name the
+// field.
 
 #include <gtest/gtest.h>
 
@@ -272,6 +274,11 @@ TEST(BlockResplit, BadOptionsNameTheField) {
   o = {};
   o.max_parts = 1;
   EXPECT_TRUE(names(o, "max_parts"));
+  o = {};
+  o.max_cut_ratio = -0.1;
+  EXPECT_TRUE(names(o, "max_cut_ratio"));
+  o.max_cut_ratio = 1.5;
+  EXPECT_TRUE(names(o, "max_cut_ratio"));
   EvolutionParams p;
   p.resplit.budget = -1.0;
   EXPECT_NE(validation_message(p).find("BlockResplitOptions.budget"), std::string::npos);
