@@ -62,7 +62,7 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
     // one), and meanwhile looks for the assignment that says the run went on without it.
     if (!s.options().security_dir.empty()) {
       pass_agent_gate(s, o, [&] { refuse_if_lost(s, o.id); });
-      log("peers known" + std::string(s.options().shared_memory ? "" : " (UDP only)"));
+      log(std::string("peers known") + s.options().transports_note());
     }
     const RollbackRequested order = request_rejoin(s, o.id, restart->snapshots, o.net.timeout_s);
     from = prepare_rollback(s, keeper, order, o.net.timeout_s);

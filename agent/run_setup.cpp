@@ -72,7 +72,7 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
   // coordinator's run survives killed agents; a stalled DDS Security handshake): nothing is
   // announced yet, so that is invisible to the run (transport/peer_gate.hpp).
   pass_agent_gate(s, o);
-  log("peers known" + std::string(s.options().shared_memory ? "" : " (UDP only)"));
+  log(std::string("peers known") + s.options().transports_note());
 
   // 3. Announce the structure (endpoints only).
   s.publish(announcement_of(share, o.net.session.run_id, o.id, o.robots));

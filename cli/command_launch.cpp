@@ -30,6 +30,7 @@
 #include "huge_page_heaps.hpp"
 #include "launch_children.hpp"
 #include "launch_loss_policy.hpp"
+#include "launch_transport.hpp"
 #include "robot_files.hpp"
 #include "session_args.hpp"
 #include "transport/security.hpp"
@@ -202,6 +203,7 @@ int run_launch(const Args& argv) {
   if (poses < agents) throw InputError("launch: --poses must be at least --agents");
   const bool quiet = args.has("quiet");
   const LaunchLossOptions loss = parse_launch_loss_options(args);
+  if (!args.has("transport")) net.session.transport = launch_transport(net.session, loss);
 
   const std::string bin = self_dir();
   for (const char* exe : {"tessera-agent", "tessera-coordinator"})

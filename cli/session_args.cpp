@@ -8,7 +8,8 @@
 namespace tessera::cli {
 
 std::set<std::string> session_option_names(SessionArgsFor who) {
-  std::set<std::string> names = {"run-id", "domain", "lease", "peers", "network", "security"};
+  std::set<std::string> names = {"run-id",  "domain",    "lease",   "peers",
+                                 "network", "transport", "security"};
   if (who == SessionArgsFor::kProcess) names.insert("timeout");
   return names;
 }
@@ -30,6 +31,7 @@ SessionArgs parse_session_args(const Arguments& args, SessionArgsFor who) {
   o.lease_s = args.get_double("lease", o.lease_s);
   o.initial_peers = args.get_list("peers");
   o.network = args.get_or("network", o.network);
+  o.transport = args.get_or("transport", o.transport);
   o.security_dir = args.get_or("security", o.security_dir);
   if (args.has("security") && o.security_dir.empty())
     throw InputError("option --security: needs a folder (scripts/security/make_identities.sh)");
@@ -58,6 +60,7 @@ std::vector<std::string> session_argv(const transport::SessionOptions& o) {
     out.insert(out.end(), {"--peers", list});
   }
   if (o.network != defaults.network) out.insert(out.end(), {"--network", o.network});
+  if (o.transport != defaults.transport) out.insert(out.end(), {"--transport", o.transport});
   if (!o.security_dir.empty()) out.insert(out.end(), {"--security", o.security_dir});
   return out;
 }
@@ -77,7 +80,17 @@ std::string session_options_help(SessionArgsFor who) {
        "                     about this long (default 1, range 0.2..60)\n"
        "  --peers IP[,IP]    IPv4 addresses to contact by unicast (when multicast is not available)\n"
        "  --network NAME     transport profile: default, or lossy for links that drop packets\n"
-       "                     (1400-byte datagrams, 4 MB socket buffers, 10 ms heartbeat)\n"
+       "                     (1400-byte datagrams, 4 MB socket buffers, 10 ms heartbeat)\n";
+  if (who == SessionArgsFor::kProcess)
+    h += "  --transport T      DDS transports: default (shared memory + UDPv4), shm (shared\n"
+         "                     memory only: every process on this host; not with --peers) or udp\n"
+         "                     (UDPv4 only); runs that survive killed processes use UDP only\n";
+  else
+    h += "  --transport T      DDS transports of every process: default (shared memory + UDPv4),\n"
+         "                     shm (shared memory only) or udp (UDPv4 only). Default here: shm,\n"
+         "                     unless --peers, --network lossy, --security or --on-agent-loss\n"
+         "                     continue (then default)\n";
+  h +=
        "  --security DIR     DDS Security: authentication, access control and encryption with\n"
        "                     the CA, the signed governance and this process's identity in DIR\n"
        "                     (DIR/coordinator, DIR/agent_<k>; scripts/security/make_identities.sh)\n";

@@ -197,21 +197,23 @@ TEST(DdsRuntime, OneHostRunHandsOffEveryMeasurementAndMergesEveryPose) {
   EXPECT_TRUE(leaked_shm_files(before, domain).empty()) << join(leaked_shm_files(before, domain));
 }
 
-TEST(DdsRuntime, TwoConcurrentRunsOnOneDomainDoNotMix) {
+// `transport`: extra session options of every process (e.g. --transport shm).
+void two_concurrent_runs_on_one_domain(int domain, const std::vector<std::string>& transport) {
   // Same domain on purpose (the harder case): only Partition QoS and the run id keep them apart.
   const std::string dir = temp_dir();
-  const int domain = 142;
   const std::string graph_a = write_file(dir, "a.g2o", grid_graph_g2o(5, 1));
   const std::string graph_b = write_file(dir, "b.g2o", grid_graph_g2o(6, 2));
+  std::vector<std::string> session = {"--timeout", "20"};
+  session.insert(session.end(), transport.begin(), transport.end());
   std::vector<Process> procs;
-  for (const auto& [run, graph, n] : {std::make_tuple(unique_run("runA"), graph_a, 25),
-                                      std::make_tuple(unique_run("runB"), graph_b, 36)}) {
-    (void)n;
-    procs.push_back(start(
-        coordinator_args(2, run, domain, {"--timeout", "20", "--output", dir + "/" + run + ".g2o"}),
-        dir + "/" + run + "_coordinator.log"));
+  for (const auto& [run, graph] :
+       {std::make_pair(unique_run("runA"), graph_a), std::make_pair(unique_run("runB"), graph_b)}) {
+    std::vector<std::string> coordinator = session;
+    coordinator.insert(coordinator.end(), {"--output", dir + "/" + run + ".g2o"});
+    procs.push_back(
+        start(coordinator_args(2, run, domain, coordinator), dir + "/" + run + "_coordinator.log"));
     for (int k = 0; k < 2; ++k)
-      procs.push_back(start(agent_args(graph, 2, k, run, domain, {"--timeout", "20"}),
+      procs.push_back(start(agent_args(graph, 2, k, run, domain, session),
                             dir + "/" + run + "_agent" + std::to_string(k) + ".log"));
   }
   std::vector<Process*> all;
@@ -222,9 +224,17 @@ TEST(DdsRuntime, TwoConcurrentRunsOnOneDomainDoNotMix) {
   EXPECT_EQ(vertices_of(dir + "/" + unique_run("runB") + ".g2o").size(), 36u);
 }
 
-TEST(DdsRuntime, KilledAgentIsNamedAndEveryoneStopsNonZero) {
+TEST(DdsRuntime, TwoConcurrentRunsOnOneDomainDoNotMix) {
+  two_concurrent_runs_on_one_domain(142, {});
+}
+
+TEST(DdsRuntime, TwoConcurrentRunsOnOneDomainDoNotMixOverSharedMemoryOnly) {
+  // Discovery too goes over shared-memory ports then (tessera launch's default).
+  two_concurrent_runs_on_one_domain(148, {"--transport", "shm"});
+}
+
+void killed_agent_is_named(int domain, const std::vector<std::string>& transport) {
   const std::string dir = temp_dir();
-  const int domain = 143;
   const std::string run = unique_run("kill");
   const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(6, 3));
   const auto before = shm_files();
@@ -232,7 +242,8 @@ TEST(DdsRuntime, KilledAgentIsNamedAndEveryoneStopsNonZero) {
   // (waiting) when agent 1 is killed. Lease 2 s: under ctest -j2 a survivor's 1 s lease can
   // lapse falsely first, and then the others name it instead of agent 1 (seen in CI in the
   // launch version of this test, DdsLaunch.AgentKilledDuringTheRoundsIsNamedByEveryone).
-  const std::vector<std::string> session = {"--timeout", "30", "--lease", "2"};
+  std::vector<std::string> session = {"--timeout", "30", "--lease", "2"};
+  session.insert(session.end(), transport.begin(), transport.end());
   Process coord = start(coordinator_args(4, run, domain, session), dir + "/coordinator.log");
   std::vector<Process> agents;
   for (int k = 0; k < 3; ++k)
@@ -258,6 +269,15 @@ TEST(DdsRuntime, KilledAgentIsNamedAndEveryoneStopsNonZero) {
   remove_shm_files(leaked_shm_files(before, domain));
   // Its segment files too (`fastdds shm clean` only removes segments nobody holds).
   run_command("fastdds shm clean", nullptr);
+}
+
+TEST(DdsRuntime, KilledAgentIsNamedAndEveryoneStopsNonZero) {
+  killed_agent_is_named(143, {});
+}
+
+TEST(DdsRuntime, KilledAgentIsNamedOverSharedMemoryOnly) {
+  // Nothing but the lease tells the survivors: no UDP, and the dead agent's ports stay.
+  killed_agent_is_named(149, {"--transport", "shm"});
 }
 
 // Signals go to one process only: with several, which process stops first (and so

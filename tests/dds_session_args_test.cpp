@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "launch_transport.hpp"
 #include "session_args.hpp"
 #include "test_support.hpp"
 #include "util/input_error.hpp"
@@ -75,6 +76,56 @@ TEST(DdsSessionArgs, NetworkProfileIsForwardedOnlyWhenNotDefault) {
   a.session.network = "default";
   const auto argv = session_argv(a.session);
   EXPECT_EQ(std::find(argv.begin(), argv.end(), "--network"), argv.end());
+}
+
+TEST(DdsSessionArgs, TransportIsForwardedOnlyWhenNotDefaultAndShmExcludesPeers) {
+  const auto P = SessionArgsFor::kProcess;
+  for (const std::string t : {"shm", "udp"}) {
+    SessionArgs a = parse({"--transport", t}, SessionArgsFor::kLaunch);
+    EXPECT_EQ(a.session.transport, t);
+    EXPECT_EQ(parse(session_argv(a.session), P).session.transport, t);
+  }
+  const auto argv = session_argv(transport::SessionOptions{});
+  EXPECT_EQ(std::find(argv.begin(), argv.end(), "--transport"), argv.end());
+  const std::string bad = error_of({"--transport", "tcp"}, P);
+  EXPECT_NE(bad.find("--transport"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("shm"), std::string::npos) << bad;  // lists the valid names
+  const std::string peers = error_of({"--transport", "shm", "--peers", "10.0.0.1"}, P);
+  EXPECT_NE(peers.find("--transport"), std::string::npos) << peers;
+  EXPECT_NE(peers.find("--peers"), std::string::npos) << peers;
+  EXPECT_EQ(error_of({"--transport", "udp", "--peers", "10.0.0.1"}, P), "");
+}
+
+TEST(DdsSessionArgs, TransportsFollowTheRoleAndTheChoice) {
+  transport::SessionOptions o;
+  EXPECT_TRUE(o.uses_shared_memory() && o.uses_udp());
+  o.transport = "shm";
+  EXPECT_TRUE(o.uses_shared_memory());
+  EXPECT_FALSE(o.uses_udp());
+  o.transport = "udp";
+  EXPECT_FALSE(o.uses_shared_memory());
+  EXPECT_TRUE(o.uses_udp());
+  // A role that survives killed processes talks UDP only, whatever --transport says.
+  o.transport = "shm";
+  o.shared_memory = false;
+  EXPECT_FALSE(o.uses_shared_memory());
+  EXPECT_TRUE(o.uses_udp());
+}
+
+TEST(DdsSessionArgs, LaunchUsesSharedMemoryOnlyWhenEveryPeerIsOnThisHost) {
+  const LaunchLossOptions stop;
+  EXPECT_EQ(launch_transport(parse({}, SessionArgsFor::kLaunch).session, stop), "shm");
+  for (const std::vector<std::string>& argv : {std::vector<std::string>{"--peers", "10.0.0.1"},
+                                               std::vector<std::string>{"--network", "lossy"}}) {
+    EXPECT_EQ(launch_transport(parse(argv, SessionArgsFor::kLaunch).session, stop), "default")
+        << argv[0];
+  }
+  transport::SessionOptions secured;
+  secured.security_dir = "/some/dir";  // not validated here: only the choice is
+  EXPECT_EQ(launch_transport(secured, stop), "default");
+  LaunchLossOptions carry_on;
+  carry_on.action = AgentLossAction::kContinue;
+  EXPECT_EQ(launch_transport(transport::SessionOptions{}, carry_on), "default");
 }
 
 TEST(DdsSessionArgs, LaunchKeepsItsOwnTimeout) {

@@ -33,9 +33,9 @@ void DdsEntities::open(int domain, const PeerIdentity& me,
   participant_listener_ =
       std::make_unique<ParticipantDiscoveryListener>(peers_, opt_.run_id, room_, trace_, muted_);
   auto* factory = dds::DomainParticipantFactory::get_instance();
-  dds::DomainParticipantQos qos =
-      participant_qos(participant_name(me), opt_.lease_s, opt_.initial_peers, domain,
-                      opt_.num_agents, net_, security, opt_.shared_memory, user_data);
+  dds::DomainParticipantQos qos = participant_qos(
+      participant_name(me), opt_.lease_s, opt_.initial_peers, domain, opt_.num_agents, net_,
+      security, opt_.uses_shared_memory(), user_data, opt_.uses_udp());
   if (prefix) qos.wire_protocol().prefix = *prefix;
   participant_ = factory->create_participant(domain, qos, participant_listener_.get(),
                                              dds::StatusMask::none());

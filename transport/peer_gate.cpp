@@ -35,7 +35,8 @@ GateStep judge_peers(const SessionOptions& self, bool secured, const std::vector
   // Before the handshake check: a UDP-only re-creation starts every handshake afresh anyway.
   // Secured, the tag counts only from the authenticated coordinator (an unauthenticated
   // participant's name and tags are anyone's to claim).
-  if (coordinator->tags.udp_only && self.shared_memory && (!secured || coordinator->authenticated))
+  if (coordinator->tags.udp_only && self.uses_shared_memory() &&
+      (!secured || coordinator->authenticated))
     return {GateStep::kReopenUdpOnly, "the coordinator talks UDP only"};
   if (!secured) return {GateStep::kPass, ""};
   std::vector<PeerIdentity> expected{PeerIdentity{self.run_id, true, 0}};

@@ -19,7 +19,7 @@ dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
     int domain, std::uint32_t num_agents, const NetworkProfile& net,
     const std::vector<std::pair<std::string, std::string>>& properties, bool shared_memory,
-    const std::vector<std::uint8_t>& user_data) {
+    const std::vector<std::uint8_t>& user_data, bool udp) {
   dds::DomainParticipantQos q;
   dds::DomainParticipantFactory::get_instance()->get_default_participant_qos(q);
   q.name(name);
@@ -33,7 +33,15 @@ dds::DomainParticipantQos participant_qos(
   // ~0.1 s instead of a full announcement period.
   discovery.initial_announcements.count = 5;
   discovery.initial_announcements.period = Duration_t(0, 100000000);
-  if (net.udp_max_message_size != 0 || net.socket_buffer_bytes != 0 || !shared_memory) {
+  if (shared_memory && !udp) {
+    // Shared memory only: every peer is on this host. Fast DDS then also announces and
+    // discovers over shared-memory ports (its SHM transport has multicast-like ports that
+    // every participant of the domain opens), and creates no UDP socket, receive thread or
+    // interface list. Peers at --peers addresses are unreachable (SessionOptions::validate).
+    q.transport().use_builtin_transports = false;
+    q.transport().user_transports.push_back(
+        std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  } else if (net.udp_max_message_size != 0 || net.socket_buffer_bytes != 0 || !shared_memory) {
     // Our own UDPv4 transport instead of the built-in one, plus shared memory as built in
     // (same-host peers keep using it) unless `shared_memory` is off. Fast DDS fragments every
     // sample to the smallest maximum message size of the participant's transports.

@@ -46,11 +46,13 @@ constexpr double kHandshakeHeartbeatS = 0.005;
 /// port leaves that port locked, and the peer then hears nothing more (seen as every agent
 /// "lost" at once, or a restarted agent that never gets its messages).
 /// `user_data`: the participant's USER_DATA (ParticipantTags::encode(), participant_tags.hpp).
+/// `udp` false (with `shared_memory`): shared memory only (SessionOptions::transport "shm"):
+/// discovery and data over shared-memory ports, no UDP sockets or their receive threads.
 eprosima::fastdds::dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
     int domain, std::uint32_t num_agents, const NetworkProfile& net,
     const std::vector<std::pair<std::string, std::string>>& properties = {},
-    bool shared_memory = true, const std::vector<std::uint8_t>& user_data = {});
+    bool shared_memory = true, const std::vector<std::uint8_t>& user_data = {}, bool udp = true);
 /// Publisher / subscriber: Partition = run id.
 eprosima::fastdds::dds::PublisherQos publisher_qos(const std::string& run_id);
 eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);

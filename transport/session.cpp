@@ -60,7 +60,7 @@ Session::Session(const SessionOptions& options)
     s.security = security_properties(security_files(
         options.security_dir, security_identity(options.coordinator, options.agent_id)));
   ParticipantTags tags;
-  tags.udp_only = !options.shared_memory;
+  tags.udp_only = !options.uses_shared_memory();
   try {
     s.trace("creating the participant on domain %d", s.domain);
     s.entities.open(s.domain, s.me, s.security, tags.encode());
@@ -281,7 +281,7 @@ void Session::replace_participant(bool shared_memory, Seconds notice, const std:
   //    `notice` (a few announcement periods) to arrive. Peers that miss it still forget it
   //    when the new one appears (ParticipantTags::replaces).
   ParticipantTags tags;
-  tags.udp_only = !s.opt.shared_memory;
+  tags.udp_only = !s.opt.uses_shared_memory();
   tags.replaces = s.former_prefixes;
   tags.retiring = true;
   s.entities.set_user_data(tags.encode());
@@ -295,7 +295,7 @@ void Session::replace_participant(bool shared_memory, Seconds notice, const std:
   // 3. The new participant, naming every participant it replaces.
   s.opt.shared_memory = shared_memory;
   s.former_prefixes.push_back(prefix_text(old));
-  tags.udp_only = !shared_memory;
+  tags.udp_only = !s.opt.uses_shared_memory();
   tags.retiring = false;
   tags.replaces = s.former_prefixes;
   const GuidPrefix next = successor_prefix(old, !s.security.empty(), s.former_prefixes.size());

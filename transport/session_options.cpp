@@ -2,12 +2,18 @@
 
 #include <arpa/inet.h>
 
+#include <algorithm>
+
 #include "transport/network_profile.hpp"
 #include "transport/run_identity.hpp"
 #include "transport/security.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::transport {
+
+std::vector<std::string> transport_names() {
+  return {"default", "shm", "udp"};
+}
 
 void SessionOptions::validate() const {
   validate_run_id(run_id);
@@ -22,6 +28,13 @@ void SessionOptions::validate() const {
   if (!(lease_s >= 0.2 && lease_s <= 60))
     throw InputError("option --lease: " + std::to_string(lease_s) + " s is outside 0.2..60 s");
   network_profile(network);  // throws for an unknown name
+  const std::vector<std::string> transports = transport_names();
+  if (std::find(transports.begin(), transports.end(), transport) == transports.end())
+    throw InputError("option --transport: '" + transport + "' is not one of default, shm, udp");
+  if (transport == "shm" && !initial_peers.empty())
+    throw InputError(
+        "option --transport: shm reaches processes of this host only, but --peers names hosts "
+        "to contact (use --transport default or udp)");
   // The role's own files are checked when the session starts (security_files).
   if (!security_dir.empty()) check_security_dir(security_dir);
   if (!(write_timeout_s > 0)) throw InputError("write timeout must be positive");

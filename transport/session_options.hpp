@@ -40,10 +40,30 @@ struct SessionOptions {
   bool tolerate_agent_loss = false;
   /// Use the shared-memory transport between processes of one host (faster). Off for runs
   /// that survive killed processes (see transport/qos.hpp participant_qos): UDP only.
+  /// Set by the role (agent/coordinator options), not by --transport.
   bool shared_memory = true;
+  /// --transport: which Fast DDS transports the participant opens. "default": shared memory
+  /// (to processes of this host) and UDPv4; "shm": shared memory only, for runs whose every
+  /// process is on this host (`tessera launch`): no UDP sockets, receive threads or interface
+  /// scans at start-up; "udp": UDPv4 only. A role that must survive killed processes
+  /// (`shared_memory` false) talks UDP whatever this says. "shm" excludes --peers.
+  std::string transport = "default";
+
+  /// Whether the participant opens the shared-memory transport (`shared_memory` and not
+  /// --transport udp).
+  bool uses_shared_memory() const { return shared_memory && transport != "udp"; }
+  /// Whether the participant opens UDPv4 (always unless it uses shared memory only).
+  bool uses_udp() const { return transport != "shm" || !uses_shared_memory(); }
+  /// For log lines: "" with both transports, else " (UDP only)" / " (shared memory only)".
+  const char* transports_note() const {
+    return !uses_shared_memory() ? " (UDP only)" : !uses_udp() ? " (shared memory only)" : "";
+  }
 
   /// Throws InputError naming the bad field (as its command-line option).
   void validate() const;
 };
+
+/// The names --transport accepts, in the order --help lists them ("default", "shm", "udp").
+std::vector<std::string> transport_names();
 
 }  // namespace tessera::transport
