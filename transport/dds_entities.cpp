@@ -2,6 +2,7 @@
 
 #include <fastdds/rtps/common/InstanceHandle.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <fastdds/dds/core/status/StatusMask.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -37,8 +38,24 @@ void DdsEntities::open(int domain, const PeerIdentity& me,
       participant_name(me), opt_.lease_s, opt_.initial_peers, domain, opt_.num_agents, net_,
       security, opt_.uses_shared_memory(), user_data, opt_.uses_udp());
   if (prefix) qos.wire_protocol().prefix = *prefix;
+  // Participant id (where Fast DDS starts looking for free ports of this host): the role's
+  // own, 0 for the coordinator and k + 1 for agent k, instead of Fast DDS's per-process
+  // counter. Every process of a run starts that counter at 0, so agent k probed (opened and
+  // closed) the ports of k + 1 participants already there before finding free ones. A taken
+  // id still works: Fast DDS then moves on to the next ports as before (another run on the
+  // domain). Only for a process's first participant: another one in the same process with
+  // the same id is refused by Fast DDS (tests hold several sessions), hence also the retry.
+  static std::atomic<bool> first_in_process{true};
+  const bool own_id = !prefix && first_in_process.exchange(false);
+  if (own_id)
+    qos.wire_protocol().participant_id = me.coordinator ? 0 : static_cast<int>(me.agent_id) + 1;
   participant_ = factory->create_participant(domain, qos, participant_listener_.get(),
                                              dds::StatusMask::none());
+  if (!participant_ && own_id) {
+    qos.wire_protocol().participant_id = -1;
+    participant_ = factory->create_participant(domain, qos, participant_listener_.get(),
+                                               dds::StatusMask::none());
+  }
   if (!participant_)
     throw TransportError("cannot create a DDS participant on domain " + std::to_string(domain) +
                          (security.empty()
