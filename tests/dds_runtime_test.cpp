@@ -282,17 +282,19 @@ TEST(DdsRuntime, KilledAgentIsNamedOverSharedMemoryOnly) {
 
 // Signals go to one process only: with several, which process stops first (and so
 // whose reason the others report) is a race.
-void signal_one_process(int domain, const std::string& stem, int target, int signo) {
+void signal_one_process(int domain, const std::string& stem, int target, int signo,
+                        const std::vector<std::string>& transport = {}) {
   const std::string dir = temp_dir();
   const std::string run = unique_run(stem);
   const std::string graph = write_file(dir, "g.g2o", grid_graph_g2o(5, 4));
   const auto before = shm_files();
   // Three agents of four: everybody is waiting (mid-run) when the signal comes.
+  std::vector<std::string> session = {"--timeout", "30"};
+  session.insert(session.end(), transport.begin(), transport.end());
   std::vector<Process> procs;
-  procs.push_back(
-      start(coordinator_args(4, run, domain, {"--timeout", "30"}), dir + "/coordinator.log"));
+  procs.push_back(start(coordinator_args(4, run, domain, session), dir + "/coordinator.log"));
   for (int k = 0; k < 3; ++k)
-    procs.push_back(start(agent_args(graph, 4, k, run, domain, {"--timeout", "30"}),
+    procs.push_back(start(agent_args(graph, 4, k, run, domain, session),
                           dir + "/agent" + std::to_string(k) + ".log"));
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   kill(procs[target].pid, signo);
@@ -322,6 +324,10 @@ TEST(DdsRuntime, SigintToCoordinatorStopsTheRunCleanlyWithoutSharedMemoryLeft) {
 
 TEST(DdsRuntime, SigtermToAgentStopsTheRunCleanlyWithoutSharedMemoryLeft) {
   signal_one_process(147, "sigterm", 2, SIGTERM);
+}
+
+TEST(DdsRuntime, SigtermToAgentOverSharedMemoryOnlyStopsTheRunWithoutSharedMemoryLeft) {
+  signal_one_process(155, "sigterm-shm", 2, SIGTERM, {"--transport", "shm"});
 }
 
 TEST(DdsRuntime, AgentWithBadFileFailsClearlyAndTheOthersStop) {
