@@ -283,9 +283,10 @@ long long refine_pair(const WorkGraph& g, std::vector<int>& part, std::vector<lo
 }  // namespace
 
 long long flow_refine(const WorkGraph& g, int k, std::vector<int>& part,
-                      const std::vector<long long>& ub, const FlowParams& params, Rng& rng) {
+                      const std::vector<long long>& ub, const FlowParams& params, Rng& rng,
+                      long long known_cut) {
   std::vector<long long> bw = block_weights(g, part, k);
-  long long cut = edge_cut(g, part);
+  long long cut = known_cut >= 0 ? known_cut : edge_cut(g, part);
   if (k < 2) return cut;
   const long long avg = (g.total_vw + k - 1) / k;
   long long slack = 1;

@@ -17,7 +17,9 @@ struct FlowParams {
 };
 
 /// Improves `part` in place; never increases the cut or breaks a bound. Returns the new cut.
+/// `known_cut`: the cut of `part` when the caller has it, -1 = not known.
 long long flow_refine(const WorkGraph& g, int k, std::vector<int>& part,
-                      const std::vector<long long>& ub, const FlowParams& params, Rng& rng);
+                      const std::vector<long long>& ub, const FlowParams& params, Rng& rng,
+                      long long known_cut = -1);
 
 }  // namespace tessera::partition_detail

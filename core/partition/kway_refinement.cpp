@@ -184,8 +184,9 @@ class FmEngine {
 }  // namespace
 
 long long kway_fm(const WorkGraph& g, int k, std::vector<int>& part,
-                  const std::vector<long long>& ub, const FmParams& params, Rng& rng) {
-  long long cut = edge_cut(g, part);
+                  const std::vector<long long>& ub, const FmParams& params, Rng& rng,
+                  long long known_cut) {
+  long long cut = known_cut >= 0 ? known_cut : edge_cut(g, part);
   if (k < 2) return cut;
   FmEngine fm(g, k, part, ub);
   for (int pass = 0; pass < params.max_passes; ++pass) {

@@ -19,8 +19,11 @@ struct FmParams {
 /// out of local minima, then rolls back to the best cut seen in the pass. Never increases the cut
 /// and never puts a block above ub (blocks already above stay where they are or get lighter).
 /// Returns the new cut.
+/// `known_cut`: the cut of `part` when the caller has it (saves a scan of the graph), -1 = not
+/// known.
 long long kway_fm(const WorkGraph& g, int k, std::vector<int>& part,
-                  const std::vector<long long>& ub, const FmParams& params, Rng& rng);
+                  const std::vector<long long>& ub, const FmParams& params, Rng& rng,
+                  long long known_cut = -1);
 
 /// Moves vertices out of blocks heavier than ub[b], choosing the moves that cost the least cut.
 /// Returns true when every block ends within its bound (always possible with unit weights).

@@ -21,8 +21,9 @@ long long refine_level(const WorkGraph& g, int k, std::vector<int>& part,
   rebalance(g, k, part, ub);
   long long cut = kway_fm(g, k, part, ub, params.fm, rng);
   if (params.use_flow && flow) {
-    const long long after = flow_refine(g, k, part, ub, params.flow, rng);
-    if (after < cut) cut = kway_fm(g, k, part, ub, params.fm, rng);
+    // Both return the exact cut, so the next step need not scan the graph for it again.
+    const long long after = flow_refine(g, k, part, ub, params.flow, rng, cut);
+    if (after < cut) cut = kway_fm(g, k, part, ub, params.fm, rng, after);
   }
   return cut;
 }
