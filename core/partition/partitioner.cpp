@@ -74,8 +74,9 @@ struct PresetPlan {
 // `highest` re-splits its best partition (block_resplit.hpp): torus3D (14048) and the smaller
 // benchmark graphs at N <= 5; cubicle (18236) and the larger ones spend ~3-4.4 s already.
 constexpr double kResplitSize = 16000.0;
-// Larger problems: a sub-search's share of the step budget, and how separable the kept block
-// must be (BlockResplitOptions::max_cut_ratio).
+// Larger problems: sub-searches (0 = none, session 11's behaviour), a sub-search's share of the
+// step budget, and how separable the kept block must be (BlockResplitOptions::max_cut_ratio).
+constexpr int kResplitLargeSearches = 2;
 constexpr double kResplitLargeBudget = 0.5;
 constexpr double kResplitCutRatio = 0.6;
 
@@ -230,7 +231,7 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // tries. Meshes (grid3D 0.92) and city10000 (0.81) have no such block and keep their
         // ~3.3-4.2 s (session 12, docs/partitioning.md).
         if (!strong && per_op > kResplitSize) {
-          plan.evolution.resplit.searches = 2;
+          plan.evolution.resplit.searches = kResplitLargeSearches;
           plan.evolution.resplit.kept = 1;
           plan.evolution.resplit.budget = kResplitLargeBudget;
           plan.evolution.resplit.max_cut_ratio = kResplitCutRatio;
