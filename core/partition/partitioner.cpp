@@ -227,7 +227,7 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // most separable block, and only when it is clearly separable (its cut edges at most
         // kResplitCutRatio x the mean block cut). rim's light block (49 cut edges, mean 98) is
         // shared by its 246 and 243 partitions, which arrange the other four blocks
-        // differently; a fresh search of those four found the 243 arrangement in ~40 % of the
+        // differently; a fresh search of those four found the 243 arrangement in 1/5-1/3 of the
         // tries. Meshes (grid3D 0.92) and city10000 (0.81) have no such block and keep their
         // ~3.3-4.2 s (session 12, docs/partitioning.md).
         if (!strong && per_op > kResplitSize) {
