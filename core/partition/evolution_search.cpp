@@ -39,8 +39,9 @@ Individual cross_combine(const WorkGraph& g, int k, const std::vector<long long>
   fresh_cp.coarsening.max_vertex_weight =
       std::max(2, static_cast<int>(std::min<long long>(cp.coarsening.max_vertex_weight, avg / 30)));
   const std::vector<int> other = multilevel_partition(g, kx, ubx, fresh_cp, rng);
-  std::vector<int> p = guided_cycle(g, k, ub, pair_label(a.part, other, kx), a.part, cp, rng);
-  const long long cut = edge_cut(g, p);
+  CycleStats s;  // its cut is the exact final one: no rescan of the graph
+  std::vector<int> p = guided_cycle(g, k, ub, pair_label(a.part, other, kx), a.part, cp, rng, &s);
+  const long long cut = s.cut;
   if (cut <= a.cut) return {std::move(p), cut};
   return a;
 }
@@ -57,8 +58,9 @@ int tournament(const std::vector<Individual>& pop, Rng& rng, int exclude) {
 
 Individual vcycle(const WorkGraph& g, int k, const std::vector<long long>& ub, Individual ind,
                   const CycleParams& cp, Rng& rng) {
-  std::vector<int> p = guided_cycle(g, k, ub, ind.part, ind.part, cp, rng);
-  const long long cut = edge_cut(g, p);
+  CycleStats s;
+  std::vector<int> p = guided_cycle(g, k, ub, ind.part, ind.part, cp, rng, &s);
+  const long long cut = s.cut;
   if (cut <= ind.cut) return {std::move(p), cut};
   return ind;
 }
@@ -66,8 +68,10 @@ Individual vcycle(const WorkGraph& g, int k, const std::vector<long long>& ub, I
 Individual combine(const WorkGraph& g, int k, const std::vector<long long>& ub, const Individual& a,
                    const Individual& b, const CycleParams& cp, Rng& rng) {
   const Individual& better = a.cut <= b.cut ? a : b;
-  std::vector<int> p = guided_cycle(g, k, ub, pair_label(a.part, b.part, k), better.part, cp, rng);
-  const long long cut = edge_cut(g, p);
+  CycleStats s;
+  std::vector<int> p =
+      guided_cycle(g, k, ub, pair_label(a.part, b.part, k), better.part, cp, rng, &s);
+  const long long cut = s.cut;
   if (cut <= better.cut) return {std::move(p), cut};
   return better;
 }
