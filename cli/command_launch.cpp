@@ -74,7 +74,7 @@ options:
   --no-status-relay    round statuses all to all (every agent to every agent)
   --listener-steps     the agents run each round-protocol step on the DDS listener thread
                        that received its last message (tessera-agent --listener-steps;
-                       off: measured no CPU gain on a loaded host, docs/dds-runtime.md,
+                       off: measured slower at load 3-4, docs/dds-runtime.md,
                        "Session 12")
   --json FILE          also write the summary to FILE
   --out FILE           write the merged poses (g2o, VERTEX lines)
