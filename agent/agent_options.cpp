@@ -31,9 +31,6 @@ options:
   --checkpoint-every K  write the checkpoint every K rounds (default 1)
   --udp-only         talk UDP only, no shared memory (implied by --checkpoint-dir): for runs
                      that survive a SIGKILLed peer (tessera launch --on-agent-loss continue)
-  --listener-steps   run each round-protocol step on the DDS listener thread that received
-                     its last message instead of waking the main thread (same iterates; not
-                     with checkpoints, replicas or rejoin; docs/dds-runtime.md, "Session 12")
   --handshake-stall S  with --security: a peer still unauthenticated S seconds after it was
                      discovered (a stalled Fast DDS 2.9 handshake) makes this agent re-create
                      its participant before it announces itself (default 4)
@@ -55,7 +52,7 @@ AgentOptions parse_agent_options(const std::vector<std::string>& argv) {
                                                  "dump-local", "checkpoint-dir", "checkpoint-every",
                                                  "handshake-stall", "handshake-retries"},
                                                 cli::SessionArgsFor::kProcess),
-                      {"verbose", "help", "udp-only", "listener-steps", "handshake-force-once"});
+                      {"verbose", "help", "udp-only", "handshake-force-once"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   AgentOptions a;
@@ -76,7 +73,6 @@ AgentOptions parse_agent_options(const std::vector<std::string>& argv) {
   a.dump_local = args.get_or("dump-local", "");
   a.checkpoint_dir = args.get_or("checkpoint-dir", "");
   a.udp_only = args.has("udp-only");
-  a.listener_steps = args.has("listener-steps");
   a.checkpoint_every = static_cast<int>(args.get_long("checkpoint-every", 1));
   CheckpointOptions{a.checkpoint_dir, a.checkpoint_every}.validate();
   a.handshake_stall_s = args.get_double("handshake-stall", a.handshake_stall_s);

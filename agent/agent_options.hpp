@@ -23,9 +23,6 @@ struct AgentOptions {
   std::string checkpoint_dir;    ///< Empty: no checkpoints (and no rejoin).
   int checkpoint_every = 1;      ///< Rounds between checkpoints, >= 1.
   bool udp_only = false;         ///< No shared memory (implied by checkpoint_dir).
-  /// --listener-steps: the round protocol's steps run on the DDS listener thread that
-  /// receives their last message (docs/dds-runtime.md, "Session 12"); off by default.
-  bool listener_steps = false;
   /// --handshake-stall S: with --security, a peer discovered but not authenticated for this
   /// long before the agent announces itself makes it re-create its participant
   /// (transport/peer_gate.hpp), > 0 s.

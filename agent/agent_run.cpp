@@ -70,7 +70,6 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
         std::to_string(order.epoch));
   }
   RoundLoopHooks hooks;
-  hooks.listener_steps = o.listener_steps;
   SnapshotReaders readers;
   readers.rejoin = rejoin_enabled;
   readers.restarted = restart.has_value();

@@ -56,96 +56,6 @@ std::optional<wire::PartitionAssignment> take_reassignment(transport::Session& s
   return newest;
 }
 
-bool DdsProtocolChannel::interrupted_locked(std::uint32_t current) {
-  for (const auto& c : session_.rollbacks().queued_locked())
-    if (c.epoch() > current) return true;
-  for (const auto& a : session_.assignments().queued_locked())
-    if (a.epoch() > current) return true;
-  return false;
-}
-
-void DdsProtocolChannel::consume(Driving& d) {
-  transport::Mailroom& room = session_.mailroom();
-  if (room.with_lock([&] { return d.finished; })) return;
-  try {
-    const std::uint32_t current = session_.epoch();
-    // On the relay agent: the statuses just received may complete a step the others wait
-    // for; send its bundle before handling them (status_relay.hpp).
-    session_.relay_statuses();
-    bool finished = false;
-    while (!finished) {
-      // Rollbacks, re-partitions and stops are for the waiting thread (they woke it).
-      if (room.with_lock([&] { return interrupted_locked(current); })) break;
-      ProtocolMessage m;
-      if (session_.protocol().take(transport::Seconds(0), &m) != transport::WaitStatus::kReady)
-        break;
-      ++d.handled;
-      if (intercept_ && intercept_(m)) continue;  // e.g. a replica, not for the protocol
-      note_status(m, false);
-      finished = d.step(std::move(m));
-    }
-    publish_progress_if_due();
-    if (!finished) return;
-  } catch (...) {
-    d.error = std::current_exception();
-  }
-  room.with_lock([&] { return d.finished = true; });
-  room.notify();
-}
-
-ProtocolChannel::Drive DdsProtocolChannel::drive(const std::function<bool(ProtocolMessage&&)>& step,
-                                                 double timeout_s) {
-  Driving d(step);
-  session_.set_protocol_consumer([this, &d] { consume(d); });
-  // Cleared before `d` goes: no listener thread is inside consume() after this returns.
-  struct Clear {
-    transport::Session& session;
-    ~Clear() { session.set_protocol_consumer(nullptr); }
-  } clear{session_};
-  session_.consume_protocol();  // what came before
-  transport::Mailroom& room = session_.mailroom();
-  const std::uint32_t current = session_.epoch();
-  using Clock = std::chrono::steady_clock;
-  const auto timeout =
-      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
-  // Digests fall due while nothing arrives (a slow peer): wake once a period to let
-  // consume() publish them.
-  const auto slice =
-      progress_
-          ? std::min(timeout, std::chrono::duration_cast<Clock::duration>(progress_->period()))
-          : timeout;
-  auto last_progress = Clock::now();
-  std::uint64_t seen = 0;
-  for (;;) {
-    const auto until = std::min(last_progress + timeout, Clock::now() + slice);
-    const transport::WaitStatus st = room.wait_for(
-        [&] { return d.finished || session_.writes_backlogged() || interrupted_locked(current); },
-        std::chrono::duration<double>(until - Clock::now()));
-    if (st == transport::WaitStatus::kStopped) throw RunStopped(room.stop_info()->reason);
-    // Writes the listener threads could not make without waiting: this thread makes them.
-    session_.flush_writes();
-    if (room.with_lock([&] { return d.finished; })) {
-      session_.set_protocol_consumer(nullptr);
-      if (d.error) std::rethrow_exception(d.error);
-      session_.flush_writes();  // the last step's, if deferred after the flush above
-      return Drive::kDone;
-    }
-    if (st == transport::WaitStatus::kReady) {
-      if (auto a = take_reassignment(session_)) throw RepartitionRequested(std::move(*a));
-      if (auto r = take_rollback(session_)) throw *r;
-      continue;  // only stale ones
-    }
-    const std::uint64_t handled = d.handled.load();
-    if (handled != seen) {
-      seen = handled;
-      last_progress = Clock::now();
-    } else if (Clock::now() >= last_progress + timeout) {
-      return Drive::kTimeout;
-    }
-    session_.consume_protocol();  // a digest may be due
-  }
-}
-
 std::optional<ProtocolMessage> DdsProtocolChannel::receive(double timeout_s) {
   return receive_after(timeout_s, 1);
 }
@@ -166,13 +76,21 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_
                                              std::chrono::duration<double>(timeout_s));
   for (;;) {
     const std::uint32_t current = session_.epoch();
+    auto& rollbacks = session_.rollbacks();
+    auto& assignments = session_.assignments();
     auto& protocol = session_.protocol();
     // A digest falls due while we wait (a slow peer): wake for it, then wait on.
     const auto until = progress_ ? std::min(deadline, progress_->next_due()) : deadline;
     const double left =
         std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
     const transport::WaitStatus st = session_.mailroom().wait_for(
-        [&] { return interrupted_locked(current) || !protocol.queued_locked().empty(); },
+        [&] {
+          for (const auto& c : rollbacks.queued_locked())
+            if (c.epoch() > current) return true;
+          for (const auto& a : assignments.queued_locked())
+            if (a.epoch() > current) return true;
+          return !protocol.queued_locked().empty();
+        },
         transport::Seconds(std::max(0.0, left)));
     if (st == transport::WaitStatus::kStopped)
       throw RunStopped(session_.mailroom().stop_info()->reason);

@@ -3,8 +3,6 @@
 // A ROLLBACK order of the coordinator (newer epoch than this process's) interrupts a wait
 // with RollbackRequested.
 
-#include <atomic>
-#include <exception>
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -23,10 +21,6 @@ class DdsProtocolChannel : public ProtocolChannel {
   /// The listener wakes this thread only once `wake_after` protocol messages are queued
   /// (Session::set_protocol_wake_threshold); rollbacks, re-partitions and stops as receive().
   std::optional<ProtocolMessage> receive_after(double timeout_s, std::size_t wake_after) override;
-  /// The steps run on the listener threads (Session::set_protocol_consumer); this thread
-  /// wakes for the end, an error, a stop, a rollback, a re-partition, a due progress digest
-  /// or the timeout only.
-  Drive drive(const std::function<bool(ProtocolMessage&&)>& step, double timeout_s) override;
   /// Messages for which `f` returns true are consumed by it instead of being returned
   /// (lifted-pose replicas of other agents).
   void set_intercept(std::function<bool(const ProtocolMessage&)> f) { intercept_ = std::move(f); }
@@ -41,20 +35,6 @@ class DdsProtocolChannel : public ProtocolChannel {
   void publish_final_progress();
 
  private:
-  /// drive()'s state, shared with consume(): `finished` is guarded by the mailroom's lock;
-  /// the rest is touched by consume() only (one call at a time) and read by drive() after
-  /// the consumer was cleared.
-  struct Driving {
-    explicit Driving(const std::function<bool(ProtocolMessage&&)>& f) : step(f) {}
-    const std::function<bool(ProtocolMessage&&)>& step;
-    bool finished = false;
-    std::exception_ptr error;
-    std::atomic<std::uint64_t> handled{0};
-  };
-  /// The protocol consumer while drive() runs: handles the queued messages.
-  void consume(Driving& d);
-  /// Whether a rollback or re-partition of a newer epoch is queued; requires the mailroom lock.
-  bool interrupted_locked(std::uint32_t current);
   void note_status(const ProtocolMessage& m, bool own);
   void publish_progress_if_due();
 

@@ -54,7 +54,6 @@ class ProgressDigest {
   bool due(Clock::time_point now) const;
   /// When the next periodic digest is due (for bounded waits).
   Clock::time_point next_due() const { return last_sent_ + period_; }
-  Clock::duration period() const { return period_; }
   /// The digest as of `now` (run id left to the session); restarts the period. `final`: the
   /// solve is over, this is the agent's last.
   wire::AgentProgress take(Clock::time_point now, bool final = false);

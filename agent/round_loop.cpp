@@ -39,11 +39,6 @@ std::optional<ProtocolMessage> ProtocolChannel::receive_after(double timeout_s,
   return receive(timeout_s);
 }
 
-ProtocolChannel::Drive ProtocolChannel::drive(const std::function<bool(ProtocolMessage&&)>&,
-                                              double) {
-  return Drive::kUnsupported;
-}
-
 RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
                                double receive_timeout_s, const RoundLoopHooks& hooks) {
   const DistributedOptions options = options_of(local.options);
@@ -84,7 +79,6 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   const RoundConfig config = make_round_config(options, scheme.get());
   Mailbox mail(channel, receive_timeout_s, local.agent_id);
   mail.set_num_agents(local.num_agents);
-  mail.allow_listener_steps(hooks.listener_steps && !hooks.on_round);
   RoundLoopResult res;
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<CertifiedAgent> sequence;

@@ -106,21 +106,6 @@ class ProtocolChannel {
   /// rollback, a re-partition) and the timeout still end the wait at once.
   /// The default is receive(timeout_s).
   virtual std::optional<ProtocolMessage> receive_after(double timeout_s, std::size_t wake_after);
-
-  /// How drive() ended.
-  enum class Drive {
-    kUnsupported,  ///< The channel cannot: use receive() instead.
-    kDone,         ///< `step` returned true.
-    kTimeout,      ///< No message for the timeout.
-  };
-  /// Hands every protocol message, as it arrives, to `step` on the thread that received it
-  /// (docs/dds-runtime.md, "Session 12": no wake-up of the caller per message); `step` sends
-  /// its replies through send() and returns whether the caller is finished. One `step` at a
-  /// time, never after drive() returned. The caller's thread waits until then; exceptions of
-  /// `step` and everything receive() throws (stop, rollback ...) are thrown from drive() on
-  /// the caller's thread. Messages left queued after the end are for receive(). The default
-  /// is kUnsupported.
-  virtual Drive drive(const std::function<bool(ProtocolMessage&&)>& step, double timeout_s);
 };
 
 struct RoundLoopResult {
@@ -167,10 +152,6 @@ struct RoundLoopHooks {
   /// Continue from this snapshot (a coordinated rollback) instead of starting from the
   /// initial poses; every other agent must resume from its snapshot of the same round.
   const ProtocolSnapshot* resume_from = nullptr;
-  /// Let the channel run the protocol's steps on its receiving threads (ProtocolChannel::drive;
-  /// docs/dds-runtime.md, "Session 12"). Ignored while `on_round` is set: the observers
-  /// (checkpoint files, replica sends) stay on the calling thread.
-  bool listener_steps = false;
 };
 
 /// Runs this agent's part of the distributed solve. `receive_timeout_s` bounds every wait

@@ -72,21 +72,6 @@ std::map<std::uint32_t, ProtocolMessage> Mailbox::gather(
   return out;
 }
 
-ProtocolChannel::Drive Mailbox::drive(const std::function<bool(ProtocolMessage&&)>& step) {
-  const auto t0 = std::chrono::steady_clock::now();
-  double stepping_s = 0.0;  // only one step at a time, and none after drive() returned
-  const ProtocolChannel::Drive driven = channel_.drive(
-      [&](ProtocolMessage&& m) {
-        const auto s0 = std::chrono::steady_clock::now();
-        const bool finished = step(std::move(m));
-        stepping_s += seconds_since(s0);
-        return finished;
-      },
-      timeout_s_);
-  if (driven != ProtocolChannel::Drive::kUnsupported) wait_s += seconds_since(t0) - stepping_s;
-  return driven;
-}
-
 void Mailbox::keep(ProtocolMessage m) {
   if (phase_of(m) >= kFinalReportPhase) return;  // for the coordinator
   stash_[{phase_of(m), round_of(m)}][sender_of(m)] = std::move(m);

@@ -5,7 +5,6 @@
 // the waits and the sends and counts the certificate and escape traffic this agent sends.
 
 #include <cstdint>
-#include <functional>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -36,9 +35,6 @@ class Mailbox {
 
   /// Agents in the run (for counting a broadcast's deliveries); 1 until set.
   void set_num_agents(std::uint32_t n) { num_agents_ = n; }
-  /// Whether run_protocol may hand the steps to the channel's receiving threads
-  /// (ProtocolChannel::drive; default true; RoundLoopHooks::listener_steps).
-  void allow_listener_steps(bool on) { listener_steps_ = on; }
 
   /// Sends `first`, then feeds every protocol message to `protocol` and sends its replies
   /// until it is done; rounding messages that arrive meanwhile are kept for gather().
@@ -47,22 +43,6 @@ class Mailbox {
   template <class Describe>
   void run_protocol(AgentProcess& protocol, std::vector<OutgoingMessage> first, Describe describe) {
     send_all(first);
-    if (protocol.done()) return;
-    // Each step on the thread that receives its last message, when the channel can (saves
-    // a wake-up of this thread per step; docs/dds-runtime.md, "Session 12").
-    const ProtocolChannel::Drive driven =
-        !listener_steps_ ? ProtocolChannel::Drive::kUnsupported : drive([&](ProtocolMessage&& m) {
-          if (is_auxiliary_phase(phase_of(m))) {
-            keep(std::move(m));
-            return false;
-          }
-          send_all(protocol.handle(m));
-          return protocol.done();
-        });
-    if (driven == ProtocolChannel::Drive::kDone) return;
-    if (driven == ProtocolChannel::Drive::kTimeout)
-      throw std::runtime_error("agent " + std::to_string(self_) + ": no message for " +
-                               std::to_string(timeout_s_) + " s in " + describe());
     while (!protocol.done()) {
       // Sleep until the current step can move on, not once per arriving message: a status
       // step needs every other agent's status, and each wake-up of this thread costs more
@@ -98,15 +78,12 @@ class Mailbox {
     return std::visit([](const auto& x) { return x.sender; }, m);
   }
   void keep(ProtocolMessage m);
-  /// channel_.drive(step) with the time outside `step` added to wait_s.
-  ProtocolChannel::Drive drive(const std::function<bool(ProtocolMessage&&)>& step);
 
   ProtocolChannel& channel_;
   double timeout_s_;
   std::uint32_t self_;
   std::uint32_t num_agents_ = 1;
   bool sent_since_gather_ = false;
-  bool listener_steps_ = true;
 
  public:
   std::uint64_t certificate_bytes = 0, escape_bytes = 0;  // sent by this agent

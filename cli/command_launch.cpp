@@ -72,10 +72,6 @@ options:
                        --on-agent-loss continue; docs/dds-runtime.md, "Session 9";
                        the default)
   --no-status-relay    round statuses all to all (every agent to every agent)
-  --listener-steps     the agents run each round-protocol step on the DDS listener thread
-                       that received its last message (tessera-agent --listener-steps;
-                       off: measured slower at load 3-4, docs/dds-runtime.md,
-                       "Session 12")
   --json FILE          also write the summary to FILE
   --out FILE           write the merged poses (g2o, VERTEX lines)
   --tum FILE           write the merged poses (TUM)
@@ -163,7 +159,7 @@ int run_launch(const Args& argv) {
   for (const auto& n : launch_loss_option_names()) valued.insert(n);
   Arguments args(argv, with_session_options(valued, SessionArgsFor::kLaunch),
                  {"quiet", "certify", "no-certify", "no-fork-server", "agents-yield",
-                  "status-relay", "no-status-relay", "listener-steps"});
+                  "status-relay", "no-status-relay"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
                      std::to_string(args.positional().size()));
@@ -330,7 +326,6 @@ int run_launch(const Args& argv) {
         std::to_string(k)};
     a.insert(a.end(), common.begin(), common.end());
     for (const auto& x : agent_loss_argv(loss)) a.push_back(x);
-    if (args.has("listener-steps")) a.push_back("--listener-steps");
     spec.children.push_back(
         {ForkRole::kAgent, work + "/agent" + std::to_string(k) + ".log", -1, std::move(a)});
     names.push_back("agent " + std::to_string(k));

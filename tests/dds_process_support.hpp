@@ -155,24 +155,21 @@ inline std::vector<Process*> all_of(Process& first, std::vector<Process>& rest) 
 }
 
 /// One run on `domain` in `dir`: a coordinator with `coordinator_extra` and `agents` agents on
-/// `graph` (--timeout 20, --dump-local DIR/local<k>.txt, then `agent_extra`). `agents_first`: the
-/// agents start first, highest id first (the coordinator then finds announcements already
-/// published). Every process must end within `wait_s` with exit code 0 (test failures otherwise).
+/// `graph` (--timeout 20, --dump-local DIR/local<k>.txt). `agents_first`: the agents start
+/// first, highest id first (the coordinator then finds announcements already published).
+/// Every process must end within `wait_s` with exit code 0 (test failures otherwise).
 inline void run_to_the_end(const std::string& dir, const std::string& graph, int agents,
                            const std::string& run, int domain,
                            const std::vector<std::string>& coordinator_extra, double wait_s,
-                           bool agents_first = false,
-                           const std::vector<std::string>& agent_extra = {}) {
+                           bool agents_first = false) {
   const auto coordinator = [&] {
     return start(coordinator_args(agents, run, domain, coordinator_extra),
                  dir + "/coordinator.log");
   };
   Process coord;
   if (!agents_first) coord = coordinator();
-  std::vector<std::string> agent_args = {"--timeout", "20"};
-  agent_args.insert(agent_args.end(), agent_extra.begin(), agent_extra.end());
   std::vector<Process> procs =
-      start_agents(dir, graph, agents, run, domain, agent_args, true, agents_first);
+      start_agents(dir, graph, agents, run, domain, {"--timeout", "20"}, true, agents_first);
   if (agents_first) coord = coordinator();
   std::vector<Process*> all = all_of(coord, procs);
   EXPECT_TRUE(wait_all(all, wait_s)) << "a process hung";

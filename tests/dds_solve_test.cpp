@@ -38,28 +38,26 @@ struct DdsRun {
 };
 
 DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int domain,
-               const std::vector<std::string>& solver_args,
-               const std::vector<std::string>& agent_args = {}) {
+               const std::vector<std::string>& solver_args) {
   const std::string run = "solve-" + std::to_string(getpid()) + "-" + std::to_string(domain);
   std::vector<std::string> cargs = {
       "--timeout",           "20",       "--run-timeout",     "60",        "--summary",
       dir + "/summary.json", "--output", dir + "/merged.g2o", "--progress"};
   cargs.insert(cargs.end(), solver_args.begin(), solver_args.end());
-  run_to_the_end(dir, graph, agents, run, domain, cargs, 60, false, agent_args);
+  run_to_the_end(dir, graph, agents, run, domain, cargs, 60);
   DdsRun r;
   r.summary = slurp(dir + "/summary.json");
   r.assignment = assignment_of(dir, agents);
   return r;
 }
 
-void expect_same_as_in_process(const std::string& algorithm, int domain, bool status_relay = true,
-                               const std::vector<std::string>& agent_args = {}) {
+void expect_same_as_in_process(const std::string& algorithm, int domain, bool status_relay = true) {
   const std::string dir = temp_dir();
   const std::string graph = generate(dir, 240, 3, 5);
   std::vector<std::string> coordinator_args = {"--partition", "eco", "--algorithm", algorithm,
                                                "--seed",      "7",   "--init",      "file"};
   if (!status_relay) coordinator_args.push_back("--no-status-relay");
-  const DdsRun dds = run_dds(dir, graph, 3, domain, coordinator_args, agent_args);
+  const DdsRun dds = run_dds(dir, graph, 3, domain, coordinator_args);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(dds.assignment.size(), g.num_poses);
 
@@ -115,13 +113,6 @@ TEST(DdsSolve, RbcdPlusPlusOverDdsGivesTheInProcessIterates) {
 TEST(DdsSolve, StatusesAllToAllGiveTheInProcessIterates) {
   expect_same_as_in_process("irbcd", 167, false);
   expect_same_as_in_process("rbcd++", 168, false);
-}
-
-// The protocol's steps on the DDS listener threads (--listener-steps, docs/dds-runtime.md,
-// "Session 12"): the same messages reach the same protocol, so the same iterates.
-TEST(DdsSolve, ListenerStepsGiveTheInProcessIterates) {
-  expect_same_as_in_process("irbcd", 9, true, {"--listener-steps"});
-  expect_same_as_in_process("rbcd++", 9, false, {"--listener-steps"});
 }
 
 // Kills whatever processes of run `run_id` a test leaves running when an assertion fails (a
