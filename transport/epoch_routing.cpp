@@ -50,7 +50,7 @@ void EpochRouter::deliver(std::uint32_t e, std::uint32_t sender, bool broadcast,
     if (e == epoch_) {
       if (sender != protocol_id_ && addressed_to(broadcast, recipients, protocol_id_)) {
         inbox_.push_locked(std::move(m));
-        wake = !consumed_ && inbox_.queued_locked().size() >= wake_threshold_;
+        wake = inbox_.queued_locked().size() >= wake_threshold_;
       }
     } else if (e > epoch_) {
       future_.push_back(Held{e, sender, broadcast, recipients, std::move(m)});
@@ -58,25 +58,6 @@ void EpochRouter::deliver(std::uint32_t e, std::uint32_t sender, bool broadcast,
     return 0;
   });
   if (wake) room_.notify();
-}
-
-void EpochRouter::set_consumer(std::function<void()> consumer) {
-  std::lock_guard<std::mutex> calls(consumer_mutex_);
-  room_.with_lock([&] { return consumed_ = static_cast<bool>(consumer); });
-  consumer_ = std::move(consumer);
-}
-
-void EpochRouter::hand_over() {
-  consume_again_.store(true);
-  for (;;) {
-    std::unique_lock<std::mutex> calls(consumer_mutex_, std::try_to_lock);
-    if (!calls.owns_lock()) return;  // the holder sees consume_again_ before letting go
-    while (consume_again_.exchange(false))
-      if (consumer_) consumer_();
-    calls.unlock();
-    // A caller may have set the flag after our last look and found the mutex still taken.
-    if (!consume_again_.load()) return;
-  }
 }
 
 }  // namespace tessera::transport

@@ -6,11 +6,8 @@
 // (only then is it known whether it is for this agent: a re-partition for survivors
 // renumbers the protocol ids). Internal to transport/ (Session::set_epoch is the public view).
 
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <functional>
-#include <mutex>
 #include <vector>
 
 #include "protocol/messages.hpp"
@@ -39,18 +36,6 @@ class EpochRouter {
   /// as 1). set_epoch() always wakes them.
   void set_wake_threshold(std::size_t n);
 
-  /// While set, deliver() wakes no waiter for a protocol message: the listener thread calls
-  /// `consumer` instead (hand_over()), which takes the queued messages itself (docs/dds-runtime.md,
-  /// "Session 12"). Setting or clearing waits for a running call to return, so after clearing
-  /// no thread is inside the old consumer. Never call it from inside the consumer.
-  void set_consumer(std::function<void()> consumer);
-  /// Runs the consumer, if any, one call at a time across every thread, and never blocks: when
-  /// another thread is inside it, that thread runs it once more before it lets go (a listener
-  /// thread must not wait here: it may be the one that would deliver what the other waits
-  /// for, e.g. the acknowledgements a full writer history needs). Listener threads call it
-  /// after the deliver() calls of one sample.
-  void hand_over();
-
  private:
   struct Held {
     std::uint32_t epoch, sender;
@@ -66,11 +51,6 @@ class EpochRouter {
   std::uint32_t protocol_id_ = 0;
   std::size_t wake_threshold_ = 1;
   std::vector<Held> future_;  // newer epochs' messages, with their routing
-  bool consumed_ = false;     // a consumer is set (guarded by room_.mutex(), read in deliver())
-  // Serialises the consumer's calls; taken before room_.mutex() by the consumer's callers.
-  std::mutex consumer_mutex_;
-  std::atomic<bool> consume_again_{false};  // hand_over() found the consumer busy
-  std::function<void()> consumer_;          // guarded by consumer_mutex_
 };
 
 }  // namespace tessera::transport

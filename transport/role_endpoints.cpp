@@ -110,7 +110,6 @@ void create_agent_endpoints(SessionParts& s) {
           ++s.protocol_samples;
           s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
                            ProtocolMessage(from_wire(m)));
-          s.router.hand_over();
         });
   for (const char* topic : {kStatusTopic, kAgentStatusTopic})
     e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
@@ -123,12 +122,10 @@ void create_agent_endpoints(SessionParts& s) {
             for (const auto& one : StatusRelay::unpack(m))
               s.router.deliver(one.epoch(), one.sender(), true, {},
                                ProtocolMessage(from_wire(one)));
-            s.router.hand_over();
             return;
           }
           s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
                            ProtocolMessage(from_wire(m)));
-          s.router.hand_over();
         });
   if (relayed && me == kRelayAgent)
     e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
@@ -137,7 +134,6 @@ void create_agent_endpoints(SessionParts& s) {
           s.room.with_lock([&] { return s.relay.add(m, s.router.epoch_locked()); });
           s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
                            ProtocolMessage(from_wire(m)));
-          s.router.hand_over();
         });
 }
 

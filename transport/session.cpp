@@ -26,7 +26,7 @@ SessionParts::SessionParts(const SessionOptions& options, int domain_id)
       readiness(room, opt, me, peers, trace),
       router(room, protocol_in, me.agent_id),
       entities(opt, net, room, peers, readiness, trace),
-      writer(entities, opt, me.coordinator, trace, room) {}
+      writer(entities, opt, me.coordinator, trace) {}
 
 namespace {
 int resolved_domain(const SessionOptions& options) {
@@ -108,27 +108,6 @@ Inbox<ProtocolMessage>& Session::protocol() {
 
 void Session::set_protocol_wake_threshold(std::size_t n) {
   impl_->router.set_wake_threshold(n);
-}
-void Session::set_protocol_consumer(std::function<void()> consumer) {
-  if (!consumer) {
-    impl_->router.set_consumer(nullptr);
-    return;
-  }
-  // Its writes never wait for acknowledgements: they may have to come through this very
-  // listener thread (sample_writing.hpp).
-  impl_->router.set_consumer([f = std::move(consumer)] {
-    SampleWriter::NoWait scope;
-    f();
-  });
-}
-bool Session::writes_backlogged() const {
-  return impl_->writer.backlogged();
-}
-void Session::flush_writes() {
-  impl_->writer.flush_backlog();
-}
-void Session::consume_protocol() {
-  impl_->router.hand_over();
 }
 Inbox<wire::RoundStatus>& Session::status_watch() {
   return impl_->status_in;

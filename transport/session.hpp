@@ -21,7 +21,6 @@
 // WaitStatus::kStopped and mailroom().stop_info() names the cause.
 
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -78,23 +77,6 @@ class Session {
   /// knows how many messages its current step needs; every other wake-up (stop, rollback,
   /// re-partition, new epoch) is unchanged. Set it back to 1 after the wait.
   void set_protocol_wake_threshold(std::size_t n);
-  /// Agents: while `consumer` is set (empty: cleared), a protocol message wakes no waiter; the
-  /// listener thread that received it runs `consumer` instead, which takes the queued messages
-  /// itself (docs/dds-runtime.md, "Session 12"). One call at a time across all threads; a
-  /// listener thread never waits for another's call (the running call repeats instead).
-  /// Setting or clearing waits for a running call to end; never call it from the consumer.
-  void set_protocol_consumer(std::function<void()> consumer);
-  /// Runs the protocol consumer now on this thread, as a listener thread would (nothing when
-  /// none is set, or when another thread is inside it: that one runs it again).
-  void consume_protocol();
-  /// The consumer's writes never wait for acknowledgements (those may have to come through
-  /// the listener thread that runs it): one that finds a writer's history full, and every
-  /// later one, wait in a backlog instead, and the mailroom's waiters are woken. Whether
-  /// that backlog holds writes (also inside a mailroom wait predicate):
-  bool writes_backlogged() const;
-  /// Writes the backlog in order, waiting for acknowledgements as any other write (every
-  /// write outside the consumer does this first). Throws TransportError as a write does.
-  void flush_writes();
   /// Coordinator: the round statuses it reads (topic_names.hpp, coordinator_reads_status).
   Inbox<wire::RoundStatus>& status_watch();
   /// Coordinator: the agents' progress digests (agent/progress_digest.hpp).
