@@ -3,7 +3,8 @@
 the same launch without security, with an unauthenticated outsider watching the secured run.
 
 Per trial, on one generated grid3d (fresh run ids, one domain):
-  unsecured   tessera launch GRAPH --agents N --partition eco --no-certify
+  unsecured   tessera launch GRAPH --agents N --partition eco --no-certify --transport default
+              (UDP + shared memory as the secured run; launch alone would use shared memory only)
   secured     the same with --security DIR (scripts/security/make_identities.sh DIR N), while
               tessera-dds-snoop (no identity) subscribes to every Tessera topic of that run, and
               a second one (no identity) advertises agent 1's participant name ("impostor")
@@ -110,7 +111,10 @@ def main():
     for t in range(args.trials):
         base = "sec-%d-%d" % (os.getpid(), t)
         # The same outsider reads the unsecured run (control: > 0 shows the snoop works).
-        pc, pwall, pcpu, plain, control, _ = watched_launch(args, work, base + "-plain", [])
+        # Over UDP + shared memory like the secured run (launch's own default for an unsecured
+        # run is shared memory only, which an outsider on the default transports never hears).
+        pc, pwall, pcpu, plain, control, _ = watched_launch(args, work, base + "-plain",
+                                                            ["--transport", "default"])
         # The secured run also has an impostor of agent 1 (it must change nothing, read nothing).
         sc, swall, scpu, secured, samples, fake = watched_launch(args, work, base + "-secured",
                                                                  ["--security", sec], impostor=True)
