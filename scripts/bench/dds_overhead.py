@@ -31,8 +31,13 @@ launch starts its processes through tessera-fork-server by default (Fast DDS loa
 coordinator and the agents forked from it); `--launch-args=--no-fork-server` execs each one, for
 an A/B of the start-up cost (docs/dds-runtime.md, "Fork server").
 
+`--repeat K` runs K alternated pairs (in process, then DDS) per graph and adds a line with the
+median ratio and its range: on a shared or virtual machine one pair's in-process wall alone can
+move by 20-40 % between passes (docs/dds-runtime.md, sessions 7-12), so a single pair of a short
+graph says little. The final median is then over the graphs' medians; the CSV has a row per pair.
+
 usage: dds_overhead.py [--bin build/bin] [--graphs CSAIL,intel] [--agents 5] [--domain 210]
-                       [--out FILE.csv] [--limit S] [--launch-args="--no-fork-server"]
+                       [--out FILE.csv] [--limit S] [--launch-args="--no-fork-server"] [--repeat 1]
 """
 import argparse
 import json
@@ -176,7 +181,11 @@ def main():
     ap.add_argument("--limit", type=float, default=600, help="seconds per run (each side)")
     ap.add_argument("--launch-args", default="",
                     help="extra options of the DDS run, e.g. --no-fork-server (exec each process)")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="alternated pairs (in process, DDS) per graph; K > 1 adds the median ratio")
     a = ap.parse_args()
+    if a.repeat < 1:
+        ap.error("--repeat must be at least 1")
     tessera = os.path.join(a.bin, "tessera")
     names = a.graphs.split(",") if a.graphs else paper_graphs()
     head = ("graph", "rounds ip", "rounds dds", "rel cost diff", "wall ip s", "wall dds s",
@@ -184,46 +193,65 @@ def main():
     print("DDS runs: tessera launch ... %s" % (a.launch_args or "(fork server)"))
     print("%-18s %9s %10s %13s %9s %10s %6s %12s %11s" % head)
     rows = []
+    medians = []
     for name in names:
-        src = os.path.join(SHARED, "datasets", name + ".g2o")
-        with tempfile.TemporaryDirectory() as tmp:
-            graph = src
-            if not has_vertices(src):
-                graph = os.path.join(tmp, name + ".g2o")
-                subprocess.run([tessera, "solve", src, "--algorithm", "irbcd", "--agents", "1",
-                                "--partition", "sequential", "--max-rounds", "0", "--out", graph],
-                               check=True, stdout=subprocess.DEVNULL)
-            ip = run_in_process(tessera, graph, a.agents, tmp, a.limit)
-            dds = (run_dds(tessera, graph, a.agents, a.domain, tmp, a.limit, a.launch_args.split())
-                   if ip else None)
-        if ip is None or dds is None:
-            print("%-18s failed (%s)" % (name, "in-process" if ip is None else "dds"))
-            continue
-        (si, wi), (sd, wd, med) = ip, dds
-        row = {"graph": name, "rounds_inprocess": si["rounds"], "rounds_dds": sd["rounds"],
-               "rel_cost_diff": abs(sd["cost"] - si["cost"]) / abs(si["cost"]),
-               "wall_inprocess_s": wi, "wall_dds_s": wd, "ratio": wd / wi,
-               "wall_dds_to_exit_s": sd["exit_wall_s"],
-               "dds_median_ms_per_round": med,
-               "bytes_per_round": sd["bytes_exchanged"] / max(1, sd["rounds"])}
-        for k, v in sd.get("phases_s", {}).items():
-            row["dds_" + k + "_s"] = v
-        rows.append(row)
-        print("%-18s %9d %10d %13.2e %9.2f %10.2f %6.2f %12.2f %11.0f" % (
-            name, row["rounds_inprocess"], row["rounds_dds"], row["rel_cost_diff"],
-            wi, wd, row["ratio"], med, row["bytes_per_round"]), flush=True)
-        row.update({"cpu_inprocess_s": si["cpu_s"], "cpu_dds_s": sd["cpu_s"],
-                    "dds_voluntary_csw": sd["csw"]})
-        print("    cpu s (user+sys, all processes): in-process %.2f, dds %.2f; dds voluntary context "
-              "switches %d (%.0f per round)" % (si["cpu_s"], sd["cpu_s"], sd["csw"],
-                                                 sd["csw"] / max(1, sd["rounds"])), flush=True)
-        if sd.get("phases_s"):
-            print("    dds phases s: " + ", ".join("%s %.3f" % kv for kv in sd["phases_s"].items()) +
-                  "; in-process solve %.3f" % si.get("solve_s", float("nan")), flush=True)
-    if rows:
-        print("median ratio %.2f over %d graphs" % (statistics.median(r["ratio"] for r in rows), len(rows)))
+        graph_rows = []
+        for pair in range(a.repeat):
+            row = measure_pair(a, tessera, name, pair)
+            if row:
+                graph_rows.append(row)
+        rows += graph_rows
+        if graph_rows:
+            ratios = [r["ratio"] for r in graph_rows]
+            medians.append(statistics.median(ratios))
+            if a.repeat > 1:
+                print("    %s ratio over %d pairs: median %.2f, range %.2f..%.2f" % (
+                    name, len(ratios), medians[-1], min(ratios), max(ratios)), flush=True)
+    if medians:
+        print("median ratio %.2f over %d graphs" % (statistics.median(medians), len(medians)))
     if a.out:
         bc.write_csv(a.out, rows, announce=False)
+
+
+def measure_pair(a, tessera, name, pair):
+    """One in-process run and one DDS run of graph `name`; prints them and returns the CSV row
+    (None when either failed)."""
+    src = os.path.join(SHARED, "datasets", name + ".g2o")
+    with tempfile.TemporaryDirectory() as tmp:
+        graph = src
+        if not has_vertices(src):
+            graph = os.path.join(tmp, name + ".g2o")
+            subprocess.run([tessera, "solve", src, "--algorithm", "irbcd", "--agents", "1",
+                            "--partition", "sequential", "--max-rounds", "0", "--out", graph],
+                           check=True, stdout=subprocess.DEVNULL)
+        ip = run_in_process(tessera, graph, a.agents, tmp, a.limit)
+        dds = (run_dds(tessera, graph, a.agents, a.domain, tmp, a.limit, a.launch_args.split())
+               if ip else None)
+    if ip is None or dds is None:
+        print("%-18s failed (%s)" % (name, "in-process" if ip is None else "dds"))
+        return None
+    (si, wi), (sd, wd, med) = ip, dds
+    row = {"graph": name, "pair": pair + 1, "rounds_inprocess": si["rounds"],
+           "rounds_dds": sd["rounds"],
+           "rel_cost_diff": abs(sd["cost"] - si["cost"]) / abs(si["cost"]),
+           "wall_inprocess_s": wi, "wall_dds_s": wd, "ratio": wd / wi,
+           "wall_dds_to_exit_s": sd["exit_wall_s"],
+           "dds_median_ms_per_round": med,
+           "bytes_per_round": sd["bytes_exchanged"] / max(1, sd["rounds"])}
+    for k, v in sd.get("phases_s", {}).items():
+        row["dds_" + k + "_s"] = v
+    print("%-18s %9d %10d %13.2e %9.2f %10.2f %6.2f %12.2f %11.0f" % (
+        name, row["rounds_inprocess"], row["rounds_dds"], row["rel_cost_diff"],
+        wi, wd, row["ratio"], med, row["bytes_per_round"]), flush=True)
+    row.update({"cpu_inprocess_s": si["cpu_s"], "cpu_dds_s": sd["cpu_s"],
+                "dds_voluntary_csw": sd["csw"]})
+    print("    cpu s (user+sys, all processes): in-process %.2f, dds %.2f; dds voluntary context "
+          "switches %d (%.0f per round)" % (si["cpu_s"], sd["cpu_s"], sd["csw"],
+                                             sd["csw"] / max(1, sd["rounds"])), flush=True)
+    if sd.get("phases_s"):
+        print("    dds phases s: " + ", ".join("%s %.3f" % kv for kv in sd["phases_s"].items()) +
+              "; in-process solve %.3f" % si.get("solve_s", float("nan")), flush=True)
+    return row
 
 
 if __name__ == "__main__":
