@@ -196,10 +196,12 @@ def main():
     medians = []
     for name in names:
         graph_rows = []
-        for pair in range(a.repeat):
-            row = measure_pair(a, tessera, name, pair)
-            if row:
-                graph_rows.append(row)
+        with tempfile.TemporaryDirectory() as tmp:
+            graph = prepared_graph(tessera, name, tmp)  # once: every pair starts from it
+            for pair in range(a.repeat):
+                row = measure_pair(a, tessera, name, graph, tmp, pair)
+                if row:
+                    graph_rows.append(row)
         rows += graph_rows
         if graph_rows:
             ratios = [r["ratio"] for r in graph_rows]
@@ -213,20 +215,25 @@ def main():
         bc.write_csv(a.out, rows, announce=False)
 
 
-def measure_pair(a, tessera, name, pair):
-    """One in-process run and one DDS run of graph `name`; prints them and returns the CSV row
-    (None when either failed)."""
+def prepared_graph(tessera, name, tmp):
+    """The paper graph `name` with VERTEX poses: the file itself, or (no VERTEX lines) a copy in
+    `tmp` with its rounded chordal initialisation, which both runs then start from."""
     src = os.path.join(SHARED, "datasets", name + ".g2o")
-    with tempfile.TemporaryDirectory() as tmp:
-        graph = src
-        if not has_vertices(src):
-            graph = os.path.join(tmp, name + ".g2o")
-            subprocess.run([tessera, "solve", src, "--algorithm", "irbcd", "--agents", "1",
-                            "--partition", "sequential", "--max-rounds", "0", "--out", graph],
-                           check=True, stdout=subprocess.DEVNULL)
-        ip = run_in_process(tessera, graph, a.agents, tmp, a.limit)
-        dds = (run_dds(tessera, graph, a.agents, a.domain, tmp, a.limit, a.launch_args.split())
-               if ip else None)
+    if has_vertices(src):
+        return src
+    graph = os.path.join(tmp, name + ".g2o")
+    subprocess.run([tessera, "solve", src, "--algorithm", "irbcd", "--agents", "1",
+                    "--partition", "sequential", "--max-rounds", "0", "--out", graph],
+                   check=True, stdout=subprocess.DEVNULL)
+    return graph
+
+
+def measure_pair(a, tessera, name, graph, tmp, pair):
+    """One in-process run and one DDS run of `graph` (paper graph `name`, summaries written in
+    `tmp`); prints them and returns the CSV row (None when either failed)."""
+    ip = run_in_process(tessera, graph, a.agents, tmp, a.limit)
+    dds = (run_dds(tessera, graph, a.agents, a.domain, tmp, a.limit, a.launch_args.split())
+           if ip else None)
     if ip is None or dds is None:
         print("%-18s failed (%s)" % (name, "in-process" if ip is None else "dds"))
         return None
