@@ -23,10 +23,17 @@
 #include "coordinator/run_summary.hpp"
 #include "json_writer.hpp"
 #include "transport/run_failure.hpp"
+#include "transport/teardown_guard.hpp"
 
 namespace tessera::coordinator {
 
 using namespace tessera::transport;
+
+namespace {
+// How long the FINISHED step may run beyond its flush before the guard ends the process with
+// the finished run's exit code (a Fast DDS hang there is the teardown deadlock's cousin).
+constexpr double kFinishedMarginS = 5.0;
+}  // namespace
 
 void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timeline,
                      FilePartitionJob* file_job) {
@@ -128,9 +135,13 @@ void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timel
   // idle, several tenths under load).
   if (o.progress && !o.summary.empty()) std::cout << kSummaryWrittenLine << "\n" << std::flush;
 
-  // 5. Tell the agents they may leave.
+  // 5. Tell the agents they may leave. The result is written: while the agents' participants
+  // leave, Fast DDS 2.9's lease check may abort this process (transport/teardown_guard.hpp;
+  // seen once here in an idle launch), which must not turn a finished run into a crash.
+  const double flush_s = std::min(3.0, o.net.timeout_s);
+  const TeardownGuard finished(kExitOk, "tessera-coordinator", Seconds(flush_s + kFinishedMarginS));
   s.send_control(wire::CONTROL_FINISHED);
-  s.flush(Seconds(std::min(3.0, o.net.timeout_s)));
+  s.flush(Seconds(flush_s));
   s.set_peer_loss_fatal(false);
   std::uint64_t total_bytes = 0;
   for (auto b : merged.bytes) total_bytes += b;

@@ -29,8 +29,8 @@ TeardownGuard::TeardownGuard(int exit_code, const std::string& who,
                              std::chrono::duration<double> timeout) {
   g_exit_code = exit_code;
   std::snprintf(g_abort_note, sizeof(g_abort_note),
-                "%s: note: Fast DDS aborted while deleting the DDS participant (a known Fast DDS "
-                "2.9 teardown race); exiting with code %d as intended\n",
+                "%s: note: Fast DDS aborted after the run's work was done (a known Fast DDS 2.9 "
+                "race in its participant lease check); exiting with code %d as intended\n",
                 who.c_str(), exit_code);
   g_abort_note_length = std::strlen(g_abort_note);
   struct sigaction sa;
@@ -43,8 +43,8 @@ TeardownGuard::TeardownGuard(int exit_code, const std::string& who,
     std::unique_lock<std::mutex> lock(mutex_);
     if (cv_.wait_for(lock, timeout, [this] { return done_; })) return;
     std::fprintf(stderr,
-                 "%s: note: deleting the DDS participant did not finish within %.0f s (a known "
-                 "Fast DDS 2.9 teardown deadlock); exiting with code %d as intended\n",
+                 "%s: note: the DDS teardown did not finish within %.0f s of the run's end (a "
+                 "known Fast DDS 2.9 teardown deadlock); exiting with code %d as intended\n",
                  who.c_str(), timeout.count(), exit_code);
     std::fflush(stderr);
     _exit(exit_code);

@@ -8,7 +8,9 @@
 //  - with DDS Security, removing a remote participant deadlocks against the same lease-check
 //    timer (SecurityManager::remove_participant destroys its handshake timer while the event
 //    thread waits for the PDP mutex): the process never exits.
-// Both are inside Fast DDS and cannot be avoided from the API. While a TeardownGuard lives, a
+// The abort also struck a coordinator once after its summary, while the agents' participants
+// left (coordinator_run.cpp guards that step too). Both are inside Fast DDS and cannot be
+// avoided from the API. While a TeardownGuard lives, a
 // SIGABRT or a teardown longer than `timeout` ends the process at once with `exit_code` (the
 // code the process was about to return) and a one-line note on stderr, so a finished run is
 // never reported as crashed or hung.
