@@ -11,6 +11,12 @@ void DdsProtocolChannel::send(const OutgoingMessage& message) {
   note_status(message.message, true);
 }
 
+void DdsProtocolChannel::send_all(const std::vector<OutgoingMessage>& messages) {
+  if (auto stop = session_.mailroom().stop_info()) throw RunStopped(stop->reason);
+  session_.send_all(messages);
+  for (const auto& m : messages) note_status(m.message, true);
+}
+
 void DdsProtocolChannel::report_progress(std::uint32_t agent, std::uint32_t num_agents,
                                          ProgressDigestOptions options) {
   progress_.emplace(agent, num_agents, agent == 0, options, std::chrono::steady_clock::now());

@@ -17,6 +17,8 @@ class DdsProtocolChannel : public ProtocolChannel {
  public:
   explicit DdsProtocolChannel(transport::Session& session) : session_(session) {}
   void send(const OutgoingMessage& message) override;
+  /// Session::send_all: blocks to the status relay ride in the step's status sample.
+  void send_all(const std::vector<OutgoingMessage>& messages) override;
   std::optional<ProtocolMessage> receive(double timeout_s) override;
   /// The listener wakes this thread only once `wake_after` protocol messages are queued
   /// (Session::set_protocol_wake_threshold); rollbacks, re-partitions and stops as receive().

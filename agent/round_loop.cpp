@@ -34,6 +34,10 @@ DistributedOptions options_of(const RunOptions& o) {
 
 }  // namespace
 
+void ProtocolChannel::send_all(const std::vector<OutgoingMessage>& messages) {
+  for (const auto& m : messages) send(m);
+}
+
 std::optional<ProtocolMessage> ProtocolChannel::receive_after(double timeout_s,
                                                               std::size_t /*wake_after*/) {
   return receive(timeout_s);

@@ -96,6 +96,10 @@ class ProtocolChannel {
   /// Sends to every agent (broadcast) or to the listed recipients. Never delivered back to
   /// the sender. Throws RunStopped / std::runtime_error when it cannot be delivered.
   virtual void send(const OutgoingMessage& message) = 0;
+  /// The messages one protocol step emits, in order. A channel may pack messages for the same
+  /// recipient into one delivery (the DDS channel: blocks to the status relay ride with the
+  /// status); the default sends them one by one.
+  virtual void send_all(const std::vector<OutgoingMessage>& messages);
   /// The next message for this agent in arrival order (FIFO per sender and message type;
   /// a block and a status from one sender may arrive in either order), or nullopt when
   /// none arrived within `timeout_s`. Throws RunStopped when the run is stopping.

@@ -201,4 +201,76 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   for (auto it = sessions.rbegin(); it != sessions.rend(); ++it) (*it)->close();
 }
 
+// Blocks to the relay ride in the sender's relayed status (Session::send_all,
+// transport/riding_blocks.hpp): one sample reaches the relay for both, the block's other
+// recipients get it as before, and a step without a relayed status sends its blocks alone.
+TEST(DdsDelivery, BlocksToTheRelayRideInTheSendersStatusSample) {
+  constexpr int kRidingDomain = 226;
+  std::vector<std::unique_ptr<Session>> sessions;
+  for (std::uint32_t k = 0; k <= kAgents; ++k) {
+    SessionOptions o = options_for(k == 0, k == 0 ? 0 : k - 1);
+    o.run_id = "riding-test";
+    o.domain = kRidingDomain;
+    sessions.push_back(std::make_unique<Session>(o));
+  }
+  Session& a0 = *sessions[1];
+  Session& a1 = *sessions[2];
+  Session& a2 = *sessions[3];
+  std::vector<std::future<WaitStatus>> barriers;
+  for (auto& s : sessions)
+    barriers.push_back(std::async(std::launch::async, [&s] {
+      std::string missing;
+      return s->ready_barrier(Seconds(30), &missing);
+    }));
+  for (auto& b : barriers) ASSERT_EQ(b.get(), WaitStatus::kReady);
+  for (Session* a : {&a0, &a1, &a2}) a->set_status_relay(true);
+
+  auto block_from_1 = [](std::vector<std::uint32_t> to, std::uint32_t pose) {
+    OutgoingMessage m = block_to(std::move(to), 3);  // an update step's Y poses
+    std::get<PoseBlockMessage>(m.message).sender = 1;
+    std::get<PoseBlockMessage>(m.message).pose_ids = {pose};
+    return m;
+  };
+  // Agent 1's step: its new poses for agents 0 (the relay) and 2, then its status.
+  a1.send_all({block_from_1({0}, 10), block_from_1({2}, 11), status(1, 1)});
+  a1.flush(Seconds(10));
+  std::vector<ProtocolMessage> at0;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (at0.size() < 2 && std::chrono::steady_clock::now() < until) {
+    ProtocolMessage m;
+    if (a0.protocol().take(Seconds(0.2), &m) == WaitStatus::kReady) at0.push_back(std::move(m));
+  }
+  ASSERT_EQ(at0.size(), 2u);
+  const auto* block = std::get_if<PoseBlockMessage>(&at0[0]);  // the riding block comes first
+  ASSERT_NE(block, nullptr);
+  EXPECT_EQ(block->sender, 1u);
+  EXPECT_EQ(block->phase, 3u);
+  EXPECT_EQ(block->pose_ids, (std::vector<std::uint32_t>{10}));
+  EXPECT_EQ(block->data, (std::vector<double>{1.0, 2.0, 3.0, 4.0}));
+  const auto* st = std::get_if<RoundStatusMessage>(&at0[1]);
+  ASSERT_NE(st, nullptr);
+  EXPECT_EQ(st->sender, 1u);
+  EXPECT_EQ(st->phase, 1u);
+  EXPECT_EQ(a0.stats().protocol_samples_received, 1u);  // both in one sample
+  const std::vector<std::uint32_t> at2 = received_phases(a2, 1);
+  EXPECT_EQ(at2, (std::vector<std::uint32_t>{3u}));
+  EXPECT_EQ(a2.stats().protocol_samples_received, 1u);
+
+  // The relay kept the status (without the block): with agent 2's and its own the step
+  // completes, and agent 1 gets the bundle of the other two.
+  a2.send_all({status(1, 2)});
+  EXPECT_EQ(received_phases(a0, 1), (std::vector<std::uint32_t>{1u}));
+  a0.send_all({status(1, 0)});
+  EXPECT_EQ(received_phases(a1, 2), (std::vector<std::uint32_t>{1u, 1u}));
+
+  // A step whose status is not relayed (a rounding reduction): the block travels alone.
+  a1.send_all({block_from_1({0}, 12), status(101, 1)});
+  EXPECT_EQ(received_phases(a0, 2).size(), 2u);
+  // 1 + agent 2's status + its own bundle (seen by its own reader, dropped) + these 2
+  EXPECT_EQ(a0.stats().protocol_samples_received, 5u);
+  EXPECT_EQ(a0.protocol().size(), 0u);
+
+  for (auto it = sessions.rbegin(); it != sessions.rend(); ++it) (*it)->close();
+}
+
 }  // namespace

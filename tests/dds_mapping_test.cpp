@@ -9,6 +9,7 @@
 #include "agent/local_share.hpp"
 #include "transport/inbox.hpp"
 #include "transport/message_mapping.hpp"
+#include "transport/riding_blocks.hpp"
 #include "transport/run_identity.hpp"
 #include "transport/status_relay.hpp"
 #include "transport/transport_error.hpp"
@@ -83,6 +84,66 @@ TEST(DdsMapping, RoundStatusRoundTrips) {
 
 // The relay's bundles (transport/status_relay.hpp): every status of a step, exactly, and only
 // once the relay's own is in; steps of an epoch abandoned by a rollback are dropped.
+// Blocks riding in a status sample (transport/riding_blocks.hpp) come out as they went in,
+// with the status's sender, in order; fields that do not describe whole blocks are refused.
+TEST(DdsRidingBlocks, BlocksComeOutOfTheStatusExactlyAndInOrder) {
+  auto block = [](std::uint32_t round, std::uint32_t phase, BlockKind kind,
+                  std::vector<std::uint32_t> ids, double base) {
+    PoseBlockMessage b;
+    b.round = round;
+    b.sender = 9;  // ignored: a riding block is the status sender's
+    b.phase = phase;
+    b.kind = kind;
+    b.rank = 3;
+    b.dim = 2;
+    b.pose_ids = std::move(ids);
+    for (std::size_t k = 0; k < b.pose_ids.size() * 9; ++k)
+      b.data.push_back(base + 0.1 * static_cast<double>(k) + 1e-17 * static_cast<double>(k));
+    return b;
+  };
+  const std::vector<PoseBlockMessage> in{block(12, 3, BlockKind::kY, {4, 7}, -1.5),
+                                         block(12, 4, BlockKind::kV, {}, 0.0),
+                                         block(13, 0, BlockKind::kP, {1}, 2.25)};
+  wire::RoundStatus w;
+  w.sender(2);
+  w.round(12);
+  w.phase(1);
+  for (const auto& b : in) attach_block(w, b);
+  EXPECT_EQ(w.block_header().size(), 18u);
+  const std::vector<PoseBlockMessage> out = detach_blocks(w);
+  ASSERT_EQ(out.size(), in.size());
+  for (std::size_t k = 0; k < in.size(); ++k) {
+    EXPECT_EQ(out[k].sender, 2u);
+    EXPECT_EQ(out[k].round, in[k].round);
+    EXPECT_EQ(out[k].phase, in[k].phase);
+    EXPECT_EQ(out[k].kind, in[k].kind);
+    EXPECT_EQ(out[k].rank, 3u);
+    EXPECT_EQ(out[k].dim, 2u);
+    EXPECT_EQ(out[k].pose_ids, in[k].pose_ids);
+    EXPECT_EQ(out[k].data, in[k].data);  // bit for bit
+  }
+  // Detached means gone: the relay keeps the status without them.
+  EXPECT_TRUE(w.block_header().empty() && w.block_pose_ids().empty() && w.block_data().empty());
+  EXPECT_TRUE(detach_blocks(w).empty());
+
+  wire::RoundStatus short_data;
+  attach_block(short_data, in[0]);
+  short_data.block_data().pop_back();
+  EXPECT_THROW(detach_blocks(short_data), TransportError);
+  wire::RoundStatus extra_id;
+  attach_block(extra_id, in[2]);
+  extra_id.block_pose_ids().push_back(5);
+  EXPECT_THROW(detach_blocks(extra_id), TransportError);
+  wire::RoundStatus cut_header;
+  attach_block(cut_header, in[1]);
+  cut_header.block_header().pop_back();
+  EXPECT_THROW(detach_blocks(cut_header), TransportError);
+  wire::RoundStatus bad_kind;
+  attach_block(bad_kind, in[1]);
+  bad_kind.block_header()[2] = 3;
+  EXPECT_THROW(detach_blocks(bad_kind), TransportError);
+}
+
 TEST(DdsStatusRelay, BundlesCarryEveryStatusOfAStepExactly) {
   auto status = [](std::uint32_t sender, std::uint32_t epoch, double cost) {
     RoundStatusMessage m;

@@ -4,6 +4,7 @@
 
 #include "tesseraPubSubTypes.h"
 #include "transport/message_mapping.hpp"
+#include "transport/riding_blocks.hpp"
 #include "transport/session_parts.hpp"
 #include "transport/status_relay.hpp"
 #include "transport/topic_names.hpp"
@@ -131,6 +132,11 @@ void create_agent_endpoints(SessionParts& s) {
     e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
         kRelayStatusTopic, false, Expect::kOtherAgents, [&s](wire::RoundStatus&& m) {
           ++s.protocol_samples;
+          // The sender's blocks for us that rode with its status (Session::send_all): as if
+          // they had come on our block topic, and not kept by the relay with the status.
+          for (auto& b : detach_blocks(m))
+            s.router.deliver(m.epoch(), m.sender(), false, {kRelayAgent},
+                             ProtocolMessage(std::move(b)));
           s.room.with_lock([&] { return s.relay.add(m, s.router.epoch_locked()); });
           s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
                            ProtocolMessage(from_wire(m)));

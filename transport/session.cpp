@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "transport/message_mapping.hpp"
+#include "transport/riding_blocks.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/security.hpp"
 #include "transport/session_parts.hpp"
@@ -191,6 +192,49 @@ void Session::send(const OutgoingMessage& m) {
                             ? kStatusTopic
                             : kAgentStatusTopic,
                         w);
+  }
+}
+
+void Session::send_all(const std::vector<OutgoingMessage>& messages) {
+  SessionParts& s = *impl_;
+  const std::uint32_t me = s.me.agent_id;
+  const bool to_relay = s.relays_statuses() && me != kRelayAgent && !s.renumbered &&
+                        s.opt.num_agents <= kMaxAgentsWithRecipientTopics;
+  // This step's status for the relay (a step has at most one; the first counts).
+  const OutgoingMessage* status = nullptr;
+  if (to_relay)
+    for (const auto& m : messages)
+      if (const auto* st = std::get_if<RoundStatusMessage>(&m.message);
+          st && relayed_phase(st->phase)) {
+        status = &m;
+        break;
+      }
+  const auto rides = [&](const OutgoingMessage& m) {
+    const auto* b = std::get_if<PoseBlockMessage>(&m.message);
+    return status && b && !m.broadcast && rides_with_status(b->phase) &&
+           std::find(m.recipients.begin(), m.recipients.end(), kRelayAgent) != m.recipients.end();
+  };
+  if (!status || std::none_of(messages.begin(), messages.end(), rides)) {
+    for (const auto& m : messages) send(m);
+    return;
+  }
+  for (const auto& m : messages) {
+    if (&m == status) {
+      wire::RoundStatus w = to_wire_status(std::get<RoundStatusMessage>(m.message), s.opt.run_id,
+                                           m.broadcast, m.recipients);
+      w.epoch(epoch());
+      for (const auto& b : messages)
+        if (rides(b)) attach_block(w, std::get<PoseBlockMessage>(b.message));
+      s.writer.write(kRelayStatusTopic, w);
+    } else if (rides(m)) {
+      OutgoingMessage others = m;  // its other recipients get it as usual
+      others.recipients.erase(
+          std::remove(others.recipients.begin(), others.recipients.end(), kRelayAgent),
+          others.recipients.end());
+      if (!others.recipients.empty()) send(others);
+    } else {
+      send(m);
+    }
   }
 }
 

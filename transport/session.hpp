@@ -109,6 +109,13 @@ class Session {
   /// statuses of the solve go through the relay agent in runs of at least 3 agents
   /// (transport/status_relay.hpp): to it alone, and from it to everyone as one bundle per step.
   void send(const OutgoingMessage& m);
+  /// The messages of one protocol step, as send() each, except that on an agent whose status
+  /// goes to the relay, pose blocks of the solve addressed to the relay ride in that status's
+  /// sample (wire RoundStatus::blocks) instead of one sample each: one delivery (one wake-up
+  /// of the relay's receive thread) less per block. The relay routes them as if they had come
+  /// on its block topic; core buffers solve messages by (round, phase, sender), so their
+  /// order relative to other blocks does not matter.
+  void send_all(const std::vector<OutgoingMessage>& messages);
   /// On the relay agent: sends the status bundles of the steps completed since the last call
   /// (their last status came in on a listener thread, which must not write). Call whenever a
   /// wait for protocol messages ends; nothing to do on any other process.

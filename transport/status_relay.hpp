@@ -33,6 +33,14 @@ inline bool relayed_phase(std::uint32_t phase) {
   return is_solve_status_phase(phase);
 }
 
+/// Whether a pose block of this phase to the relay may ride in the sender's relayed status
+/// sample (Session::send_all): the solve's blocks (core's ProtocolPhase kInit, kUpdate,
+/// kRedoUpdate), which core buffers by (round, phase, sender), so that they may arrive on
+/// another topic than the sender's other blocks.
+inline bool rides_with_status(std::uint32_t phase) {
+  return phase == 0 || phase == 3 || phase == 4;
+}
+
 /// The relay's collection of one process. Not thread-safe: the session guards it with its
 /// mailroom lock (statuses arrive on a listener thread, the bundle leaves on the main thread).
 class StatusRelay {
