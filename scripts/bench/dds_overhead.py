@@ -20,7 +20,9 @@ round status, rounds, rounding = to the final estimates, merge, summary = to lau
 summary; then teardown = summary to launch's exit, not in the ratio; phases in the order their
 ends came: when the coordinator partitions launch's file while the agents start, fork = launch
 to the partition's start comes first and discovery, after the partition, is only the wait the
-partition did not hide). The DDS wall time is the
+partition did not hide), and the partition's own duration on both sides (`partition_ms`: in the
+DDS run it shares the 2 cores with the agents' start-up; CSV partition_inprocess_ms,
+partition_dds_ms). The DDS wall time is the
 issue's "from launch to summary": launch prints the summary as soon as the coordinator has written
 it, and the processes leave after that (FINISHED, participant deletion; CSV: wall_dds_to_exit_s).
 Also printed (and in the CSV): CPU seconds (user + system over all processes of each run) and the
@@ -258,6 +260,14 @@ def measure_pair(a, tessera, name, graph, tmp, pair):
     if sd.get("phases_s"):
         print("    dds phases s: " + ", ".join("%s %.3f" % kv for kv in sd["phases_s"].items()) +
               "; in-process solve %.3f" % si.get("solve_s", float("nan")), flush=True)
+    # The partition on both sides (the same call on the same structure): in the DDS run it
+    # shares the cores with the agents' start-up, so its excess is what that start-up cost
+    # the wall. In process, everything else (start, reading, set-up, output, exit) as "other".
+    pi, pd = si.get("partition_ms"), sd.get("partition_ms")
+    if pi is not None and pd is not None:
+        row.update({"partition_inprocess_ms": pi, "partition_dds_ms": pd})
+        print("    partition ms: in-process %.0f, dds %.0f (%+.0f); in-process other %.3f s"
+              % (pi, pd, pd - pi, wi - pi / 1000 - si.get("solve_s", 0.0)), flush=True)
     return row
 
 
