@@ -16,6 +16,7 @@
 #include "agent/lost_for_good.hpp"
 #include "agent/robot_data.hpp"
 #include "agent/share_announcement.hpp"
+#include "agent/startup_batch.hpp"
 #include "agent/startup_priority.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
@@ -94,6 +95,10 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
   // (agent/startup_priority.hpp; a no-op unless launch's fork server lowered this process).
   const std::string restored = restore_startup_priority();
   if (!restored.empty()) log("start-up priority: " + restored);
+  // Likewise the start-up's SCHED_BATCH (agent/startup_batch.hpp): the rounds need wake-ups
+  // to run at once again.
+  const std::string unbatched = restore_startup_batch();
+  if (!unbatched.empty()) log("start-up batch: " + unbatched);
   out.rejoin_enabled = asg.rejoin_timeout_s() > 0;
   out.replicas = asg.replicas();
   out.replica_every = std::max<std::uint32_t>(1, asg.replica_every());

@@ -89,6 +89,10 @@ options:
                        until their assignment, so that the coordinator's partition of
                        GRAPH gets the CPU first (fork server and a whole file only; off:
                        measured no gain on a loaded host, docs/dds-runtime.md, start9)
+  --no-agents-batch    the agents start as normal threads (default: SCHED_BATCH until
+                       their assignment, so that their start-up's wake-ups do not preempt
+                       the coordinator's partition of GRAPH; fork server and a whole file
+                       only; docs/dds-runtime.md, start13)
 %s  --quiet              no progress lines
   --help               this text
 
@@ -159,7 +163,7 @@ int run_launch(const Args& argv) {
   for (const auto& n : launch_loss_option_names()) valued.insert(n);
   Arguments args(argv, with_session_options(valued, SessionArgsFor::kLaunch),
                  {"quiet", "certify", "no-certify", "no-fork-server", "agents-yield",
-                  "status-relay", "no-status-relay"});
+                  "no-agents-batch", "status-relay", "no-status-relay"});
   if (args.positional().size() > 1)
     throw InputError("launch: at most one GRAPH argument, got " +
                      std::to_string(args.positional().size()));
@@ -311,6 +315,7 @@ int run_launch(const Args& argv) {
   // agents 0..N-1.
   ForkSpec spec;
   if (args.has("agents-yield")) spec.agents_nice = 19;  // agent/startup_priority.hpp
+  spec.agents_batch = !args.has("no-agents-batch");     // agent/startup_batch.hpp
   std::vector<std::string> names = {"coordinator"};
   std::vector<long> agent_ids = {-1};
   spec.children.push_back(

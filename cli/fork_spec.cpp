@@ -49,6 +49,7 @@ std::vector<std::string> encode_fork_spec(const ForkSpec& spec) {
   std::vector<std::string> out = {"--pid-fd", std::to_string(spec.pid_fd)};
   if (spec.agents_nice > 0)
     out.insert(out.end(), {"--agents-nice", std::to_string(spec.agents_nice)});
+  if (spec.agents_batch) out.push_back("--agents-batch");
   for (const ForkChild& c : spec.children) {
     out.insert(out.end(), {"--child", fork_role_name(c.role), c.log, std::to_string(c.stdout_fd),
                            std::to_string(c.argv.size())});
@@ -69,6 +70,10 @@ ForkSpec decode_fork_spec(const std::vector<std::string>& args) {
   if (i < args.size() && args[i] == "--agents-nice") {
     ++i;
     spec.agents_nice = static_cast<int>(to_long(next("the agents' nice"), "--agents-nice"));
+  }
+  if (i < args.size() && args[i] == "--agents-batch") {
+    ++i;
+    spec.agents_batch = true;
   }
   while (i < args.size()) {
     const std::string& tag = next("--child");

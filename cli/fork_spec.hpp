@@ -37,13 +37,18 @@ struct ForkSpec {
   /// they start (its argv has --graph), until their assignment (agent/startup_priority.hpp;
   /// launch --agents-yield). 0 = off (default); range 0..19.
   int agents_nice = 0;
+  /// The agents start with every thread in SCHED_BATCH when the coordinator partitions
+  /// launch's file while they start, until their assignment (agent/startup_batch.hpp; launch's
+  /// default, --no-agents-batch turns it off).
+  bool agents_batch = false;
 
   /// Throws InputError naming the bad field: pid_fd < 0, no children, a child without argv
   /// or log, a stdout_fd < -1, or agents_nice outside 0..19.
   void validate() const;
 };
 
-/// The spec as a list of strings: "--pid-fd FD", "--agents-nice N" when N > 0, then, per
+/// The spec as a list of strings: "--pid-fd FD", "--agents-nice N" when N > 0, "--agents-batch"
+/// when set, then, per
 /// child, "--child ROLE LOG STDOUT_FD ARGC ARGV...". Validates `spec` first.
 std::vector<std::string> encode_fork_spec(const ForkSpec& spec);
 

@@ -3,10 +3,12 @@
 // (--no-fork-server): the same iterates as the in-process engine, forked processes that look
 // like the executables they stand for and are launch's own children, a clean SIGINT, and the
 // fork server's argv encoding; --agents-yield (agents below the coordinator's priority until
-// their assignment, agent/startup_priority.hpp).
-// Domains used here: 50-53, 211-212 (each test its own, so ctest -j is safe).
+// their assignment, agent/startup_priority.hpp); agents in SCHED_BATCH until their assignment
+// (launch's default, agent/startup_batch.hpp).
+// Domains used here: 50-53, 211-212, 217 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -24,6 +26,7 @@
 #include <thread>
 #include <vector>
 
+#include "agent/startup_batch.hpp"
 #include "agent/startup_priority.hpp"
 #include "dds_process_support.hpp"
 #include "fork_spec.hpp"
@@ -190,6 +193,64 @@ TEST(DdsForkServer, YieldingAgentsShareASessionAndRunTheirRoundsAtNiceZero) {
     EXPECT_GT(seen, 1);
   }
   run.end();
+}
+
+// Launch's default: agents start in SCHED_BATCH (agent/startup_batch.hpp) and leave it with
+// their assignment, so every thread of theirs runs the rounds as a normal thread.
+TEST(DdsForkServer, BatchStartedAgentsRunTheirRoundsAsNormalThreads) {
+  LongForkedRun run("batch", 217, {});
+  const std::string& run_id = run.run_id;
+  const Process& launch = run.launch;
+  ASSERT_TRUE(wait_for_round(launch, 2, 30)) << launch.output();
+  const std::vector<long> agents = pids_of("[t]essera-agent.*--run-id " + run_id + " ");
+  ASSERT_EQ(agents.size(), 2u);
+  for (long pid : agents) {
+    run_command("ls /proc/" + std::to_string(pid) + "/task > " + run.dir + "/tasks", nullptr);
+    std::ifstream tasks(run.dir + "/tasks");
+    int seen = 0;
+    for (std::string tid; tasks >> tid; ++seen)  // field 41: the scheduling policy
+      EXPECT_EQ(stat_field("/proc/" + std::to_string(pid) + "/task/" + tid + "/stat", 41),
+                SCHED_OTHER)
+          << "agent " << pid << " thread " << tid;
+    EXPECT_GT(seen, 1);
+  }
+  run.end();
+}
+
+// In a forked child (so the test's threads keep their policy): enter_startup_batch puts the
+// calling thread and every thread it creates in SCHED_BATCH; restore_startup_batch puts every
+// thread back, once. Each failed check is one bit of the child's exit code.
+int batch_and_restore_in_child() {
+  int failed = 0;
+  if (!agent::restore_startup_batch().empty()) failed |= 1 << 0;  // nothing entered yet
+  if (!agent::enter_startup_batch()) failed |= 1 << 1;
+  if (sched_getscheduler(0) != SCHED_BATCH) failed |= 1 << 2;
+  std::atomic<int> sleeper_policy{-1};
+  std::atomic<bool> restored{false};
+  std::thread sleeper([&] {  // created batch, alive while restoring
+    if (sched_getscheduler(0) != SCHED_BATCH) sleeper_policy = -2;
+    while (!restored) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    if (sleeper_policy != -2) sleeper_policy = sched_getscheduler(0);
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::string what = agent::restore_startup_batch();
+  restored = true;
+  sleeper.join();
+  if (what.find("2 thread(s)") == std::string::npos) failed |= 1 << 3;
+  if (sched_getscheduler(0) != SCHED_OTHER) failed |= 1 << 4;
+  if (sleeper_policy != SCHED_OTHER) failed |= 1 << 5;
+  if (!agent::restore_startup_batch().empty()) failed |= 1 << 6;  // idempotent
+  return failed;
+}
+
+TEST(StartupBatch, NewThreadsInheritItAndRestoreBringsEveryThreadBack) {
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) _exit(batch_and_restore_in_child());
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "failed checks (bits): " << WEXITSTATUS(status);
 }
 
 // In a forked child (so neither the test's session nor its threads change): what
@@ -366,6 +427,7 @@ TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
   const cli::ForkSpec back = cli::decode_fork_spec(args);
   EXPECT_EQ(back.pid_fd, 7);
   EXPECT_EQ(back.agents_nice, 0);
+  EXPECT_FALSE(back.agents_batch);
   ASSERT_EQ(back.children.size(), 2u);
   for (std::size_t k = 0; k < 2; ++k) {
     EXPECT_EQ(back.children[k].role, spec.children[k].role);
@@ -387,6 +449,14 @@ TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
   cli::ForkSpec yielding = spec;  // launch --agents-yield
   yielding.agents_nice = 19;
   EXPECT_EQ(cli::decode_fork_spec(cli::encode_fork_spec(yielding)).agents_nice, 19);
+  cli::ForkSpec batch = yielding;  // launch's default, with and without --agents-yield
+  batch.agents_batch = true;
+  const cli::ForkSpec batch_back = cli::decode_fork_spec(cli::encode_fork_spec(batch));
+  EXPECT_TRUE(batch_back.agents_batch);
+  EXPECT_EQ(batch_back.agents_nice, 19);
+  EXPECT_EQ(batch_back.children.size(), 2u);
+  batch.agents_nice = 0;
+  EXPECT_TRUE(cli::decode_fork_spec(cli::encode_fork_spec(batch)).agents_batch);
   yielding.agents_nice = 20;
   EXPECT_THROW(cli::encode_fork_spec(yielding), InputError);
   cli::ForkSpec no_log = spec;

@@ -39,6 +39,7 @@
 #include "agent/agent_entry.hpp"
 #include "agent/agent_options.hpp"
 #include "agent/preloaded_graph.hpp"
+#include "agent/startup_batch.hpp"
 #include "agent/startup_priority.hpp"
 #include "coordinator/coordinator_entry.hpp"
 #include "fork_spec.hpp"
@@ -138,19 +139,29 @@ void show_as(const ArgvArea& area, const std::vector<std::string>& argv) {
 // Whether the agents start below the coordinator's priority (agent/startup_priority.hpp):
 // when launch asks (--agents-yield) and the coordinator partitions launch's file while they
 // start (--graph), the only time it has work that their start-up slows down.
-bool agents_yield_at_start(const cli::ForkSpec& spec) {
-  if (spec.agents_nice <= 0) return false;
+bool coordinator_partitions_file(const cli::ForkSpec& spec) {
   for (const cli::ForkChild& c : spec.children)
     if (c.role == cli::ForkRole::kCoordinator)
       return std::find(c.argv.begin(), c.argv.end(), "--graph") != c.argv.end();
   return false;
 }
 
+bool agents_yield_at_start(const cli::ForkSpec& spec) {
+  return spec.agents_nice > 0 && coordinator_partitions_file(spec);
+}
+
+// Whether the agents start in SCHED_BATCH (agent/startup_batch.hpp): the same moment, when
+// launch asks (its default).
+bool agents_batch_at_start(const cli::ForkSpec& spec) {
+  return spec.agents_batch && coordinator_partitions_file(spec);
+}
+
 // The child's side of a fork: the same process set-up as launch's exec path
 // (cli::enter_child_process), then the entry. `yield`: an agent starts lowered (its threads
-// here; its autogroup, this server's, once the server has forked every agent).
+// here; its autogroup, this server's, once the server has forked every agent). `batch`: an
+// agent starts in SCHED_BATCH.
 [[noreturn]] void run_child(const cli::ForkSpec& spec, std::size_t k, const ArgvArea& area,
-                            bool yield) {
+                            bool yield, bool batch) {
   const cli::ForkChild& c = spec.children[k];
   cli::enter_child_process(c);
   // Before the entry creates any thread: every thread inherits this one's nice.
@@ -159,6 +170,8 @@ bool agents_yield_at_start(const cli::ForkSpec& spec) {
     priority.nice = spec.agents_nice;
     agent::enter_startup_priority(priority, true);
   }
+  // Likewise every thread inherits this one's policy.
+  if (batch && c.role == cli::ForkRole::kAgent) agent::enter_startup_batch();
   // Descriptors meant for launch or for another child: an agent holding launch's progress
   // pipe would keep it open after the coordinator has left.
   close(spec.pid_fd);
@@ -200,6 +213,7 @@ int main(int argc, char** argv) {
   const ArgvArea area{argv[0], static_cast<std::size_t>(argv[argc - 1] +
                                                         std::strlen(argv[argc - 1]) + 1 - argv[0])};
   const bool yield = agents_yield_at_start(spec);
+  const bool batch = agents_batch_at_start(spec);
   bool prepared = false;
   for (std::size_t k = 0; k < spec.children.size(); ++k) {
     if (!prepared && spec.children[k].role == cli::ForkRole::kAgent) {
@@ -220,7 +234,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "tessera-fork-server: error: fork failed: %s\n", std::strerror(errno));
       return 1;
     }
-    if (pid == 0) run_child(spec, k, area, yield);
+    if (pid == 0) run_child(spec, k, area, yield, batch);
     const std::string line = std::to_string(pid) + "\n";
     if (write(spec.pid_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) {
       std::fprintf(stderr, "tessera-fork-server: error: cannot report pid %d to launch\n",
