@@ -8,23 +8,22 @@
 namespace tessera::partition_detail {
 namespace {
 
-// Dinic's max flow on a small network. Arcs are collected first and then laid out per node
-// (CSR: a node's arcs are contiguous, each with the index of its reverse arc), and the level BFS
-// stops as soon as it reaches t. The flows are ~60 % of a strong / highest run (perf, rim), most
-// of it in the BFS and the augmenting DFS, which scan the whole network once per phase; the two
-// changes made strong on rim ~12 % faster (session 9). Which maximum flow is found does not
+// Max flow on a small network, by Boykov and Kolmogorov's search-tree algorithm ("An
+// experimental comparison of min-cut/max-flow algorithms for energy minimization in vision",
+// 2004). Arcs are collected first and then laid out per node (CSR: a node's arcs are
+// contiguous, each with the index of its reverse arc). Which maximum flow is found does not
 // matter: the residual sets used below (what s reaches, what reaches t) are the same for every
-// maximum flow, so every partition is bit-identical to the linked-list version's. Session 11
-// (speed11) labels levels by the distance to t instead of from s (see label_distances_to), which
-// took the augmenting search from ~22 % of a highest run on rim to ~3 %.
+// maximum flow, so every partition is bit-identical to the earlier Dinic versions' (session 9:
+// CSR; session 11: levels towards t). Dinic rebuilt its level graph with one scan of the
+// network per phase, ~22 % of a highest run on rim even after session 11; the two search trees
+// here (one from s, one into t) are kept between augmentations and only repaired where an
+// augmentation saturated a tree arc (session 13, part13).
 class FlowNetwork {
  public:
   /// Empties the network and gives it n nodes; keeps the buffers' memory, since one network
   /// is rebuilt for every block pair and corridor size of a round (session 11, speed11).
   void reset(int n) {
     first_.assign(static_cast<std::size_t>(n) + 1, 0);
-    level_.resize(static_cast<std::size_t>(n));
-    it_.resize(static_cast<std::size_t>(n));
     pending_.clear();
   }
   /// Adds the arc pair u -> v (capacity c_uv) and v -> u (c_vu). Only before max_flow().
@@ -33,127 +32,270 @@ class FlowNetwork {
     ++first_[u + 1];
     ++first_[v + 1];
   }
-  long long max_flow(int s, int t) {
-    build();
-    long long flow = 0;
-    while (label_distances_to(t, s)) {
-      std::copy(first_.begin(), first_.end() - 1, it_.begin());
-      while (long long f = dfs(s, t, LLONG_MAX)) flow += f;
-    }
-    return flow;
-  }
-  /// Nodes reachable from s in the residual network.
-  std::vector<char> reachable_from(int s) const { return residual_search(s, false); }
-  /// Nodes that can reach t in the residual network.
-  std::vector<char> reaching(int t) const { return residual_search(t, true); }
+  long long max_flow(int s, int t);
+  /// Nodes reachable from s in the residual network, after max_flow(): the source tree. When
+  /// no tree can grow, no residual arc leaves the source tree (its nodes scanned every arc out,
+  /// and an augmentation only adds residual capacity within a tree or from the sink tree into
+  /// the source tree), and every tree node is joined to its root by residual arcs.
+  std::vector<char> reachable_from() const { return in_tree(kSource); }
+  /// Nodes that can reach t in the residual network, after max_flow(): the sink tree.
+  std::vector<char> reaching() const { return in_tree(kSink); }
 
  private:
   struct Pending {
     int u, v;
     long long c_uv, c_vu;
   };
-  // One arc with everything the level search and the augmenting search read together: one
-  // 24-byte record instead of parallel arrays (fewer cache lines per scanned arc).
+  // One arc with everything the searches read together: one 24-byte record instead of parallel
+  // arrays (fewer cache lines per scanned arc).
   //
   // `back` mirrors the reverse arc's capacity so that searches against the arc direction (the
-  // distance labels towards t, the set reaching t) stay within the record.
+  // tree into t, the set reaching t) stay within the record.
   struct Arc {
     int to, rev;
     long long cap, back;
   };
+  enum : char { kFree = 0, kSource = 1, kSink = 2 };
+  // parent_ markers besides an arc index (the arc from the node to its parent).
+  static constexpr int kRoot = -1, kOrphan = -2;
 
   void build() {
     const std::size_t n = first_.size() - 1;
     for (std::size_t v = 0; v < n; ++v) first_[v + 1] += first_[v];
     arcs_.resize(2 * pending_.size());
-    it_.assign(first_.begin(), first_.end() - 1);  // fill positions while building
+    fill_.assign(first_.begin(), first_.end() - 1);
     for (const Pending& p : pending_) {
-      const int a = it_[p.u]++, b = it_[p.v]++;
+      const int a = fill_[p.u]++, b = fill_[p.v]++;
       arcs_[a] = {p.v, b, p.c_uv, p.c_vu};
       arcs_[b] = {p.u, a, p.c_vu, p.c_uv};
     }
     pending_.clear();
   }
-  // Depth-first search over arcs with residual capacity, forwards from `from` or (reverse)
-  // backwards into it.
-  std::vector<char> residual_search(int from, bool reverse) const {
-    std::vector<char> seen(first_.size() - 1, 0);
-    std::vector<int> stack = {from};
-    seen[from] = 1;
-    while (!stack.empty()) {
-      const int v = stack.back();
-      stack.pop_back();
-      for (int a = first_[v]; a < first_[v + 1]; ++a) {
-        const Arc& arc = arcs_[a];
-        // Backwards, the arc arc.to -> v is the reverse of a; usable if it has capacity.
-        const long long c = reverse ? arc.back : arc.cap;
-        if (c > 0 && !seen[arc.to]) {
-          seen[arc.to] = 1;
-          stack.push_back(arc.to);
-        }
-      }
-    }
-    return seen;
+  void push(int a, long long f) {
+    Arc& arc = arcs_[a];
+    arc.cap -= f;
+    arc.back += f;
+    Arc& reverse = arcs_[arc.rev];
+    reverse.cap += f;
+    reverse.back -= f;
   }
-  // Level search backwards from t: level_[v] = residual distance from v to t, for every node
-  // closer to t than s (and s itself). Returns whether s can reach t. Labelling by the distance
-  // to t (not from s) means that every node the augmenting search enters still has a shortest
-  // path on to t, so it no longer wanders into the many corridor nodes that lead nowhere
-  // (session 11, speed11: the forward labels made it scan about as many arcs as the search).
-  bool label_distances_to(int t, int s) {
-    std::fill(level_.begin(), level_.end(), -1);
-    queue_.clear();
-    queue_.push_back(t);
-    level_[t] = 0;
-    for (std::size_t q = 0; q < queue_.size(); ++q) {
-      const int v = queue_[q];
-      const int next = level_[v] + 1;
-      for (int a = first_[v]; a < first_[v + 1]; ++a) {
-        const Arc& arc = arcs_[a];
-        // arc.back > 0: the arc arc.to -> v has residual capacity.
-        if (arc.back > 0 && level_[arc.to] < 0) {
-          level_[arc.to] = next;
-          // Every node on a shortest s-t path is labelled by now: the augmenting search only
-          // follows arcs one level down, so nodes found later are never on its paths.
-          if (arc.to == s) return true;
-          queue_.push_back(arc.to);
-        }
-      }
+  void activate(int v) {
+    if (!active_[v]) {
+      active_[v] = 1;
+      queue_.push_back(v);
     }
-    return false;
   }
-  // Pushes up to `limit` from v towards t along arcs one level down and returns what it pushed.
-  // A node keeps sending down its next arcs until its limit is used up, so one call from s finds
-  // a whole blocking flow instead of re-descending from s for every path (session 11, speed11).
-  long long dfs(int v, int t, long long limit) {
-    if (v == t) return limit;
-    long long pushed = 0;
-    for (int& a = it_[v]; a < first_[v + 1]; ++a) {
-      Arc& arc = arcs_[a];
-      if (arc.cap <= 0 || level_[arc.to] != level_[v] - 1) continue;
-      const long long f = dfs(arc.to, t, std::min(limit - pushed, arc.cap));
-      if (f > 0) {
-        arc.cap -= f;
-        arc.back += f;
-        Arc& reverse = arcs_[arc.rev];
-        reverse.cap += f;
-        reverse.back -= f;
-        pushed += f;
-        // Keep the arc current: it (or what lies behind it) may still carry more.
-        if (pushed == limit) return pushed;
-      }
-    }
-    return pushed;
+  bool grow(int* meet);
+  long long augment(int meet);
+  void adopt(int v);
+  std::vector<char> in_tree(char tree) const {
+    std::vector<char> in(tree_.size());
+    for (std::size_t v = 0; v < tree_.size(); ++v) in[v] = tree_[v] == tree;
+    return in;
   }
 
   std::vector<Pending> pending_;
-  std::vector<int> first_;
+  std::vector<int> first_, fill_;
   std::vector<Arc> arcs_;
-  std::vector<int> level_, it_, queue_;
+  // Search trees: which tree a node is in, the arc to its parent, and for the origin checks of
+  // adoption the distance to the root and the augmentation (stamp) at which that was last known.
+  std::vector<char> tree_, active_;
+  std::vector<int> parent_, dist_, stamp_;
+  std::vector<int> up_;  // the parent node (arcs_[parent_[v]].to), for the walks to the root
+  std::vector<int> queue_, orphans_;
+  std::size_t head_ = 0;
+  int time_ = 0;
 };
 
-// At most this many vertices per corridor side: keeps each max flow cheap on huge graphs and
-// bounds the depth of Dinic's recursive augmenting-path search (<= network size).
+long long FlowNetwork::max_flow(int s, int t) {
+  build();
+  const std::size_t n = first_.size() - 1;
+  tree_.assign(n, kFree);
+  active_.assign(n, 0);
+  parent_.assign(n, kOrphan);
+  up_.assign(n, -1);
+  dist_.assign(n, 0);
+  stamp_.assign(n, 0);
+  queue_.clear();
+  orphans_.clear();
+  head_ = 0;
+  time_ = 0;
+  tree_[s] = kSource;
+  tree_[t] = kSink;
+  parent_[s] = parent_[t] = kRoot;
+  dist_[s] = dist_[t] = 1;  // as the origin checks count them
+  activate(s);
+  activate(t);
+  long long flow = 0;
+  int meet = -1;
+  while (grow(&meet)) {
+    ++time_;
+    flow += augment(meet);
+    // Adopt in FIFO order; adopt() may append more orphans.
+    for (std::size_t i = 0; i < orphans_.size(); ++i) adopt(orphans_[i]);
+    orphans_.clear();
+  }
+  return flow;
+}
+
+// Grows both trees from the active nodes until they touch. Returns true with *meet = an arc
+// from a source-tree node to a sink-tree node with residual capacity, false when no s-t path is
+// left (the flow is maximum).
+bool FlowNetwork::grow(int* meet) {
+  // Raw pointers in locals: stores through the char arrays may alias any member, so the
+  // compiler would reload every vector's data pointer per arc otherwise (~1/3 of this loop).
+  const int* first = first_.data();
+  const Arc* arcs = arcs_.data();
+  char* tree = tree_.data();
+  char* active = active_.data();
+  int* parent = parent_.data();
+  int* up = up_.data();
+  int* dist = dist_.data();
+  int* stamp = stamp_.data();
+  while (head_ < queue_.size()) {
+    const int p = queue_[head_];
+    const char tp = tree[p];
+    if (tp == kFree) {  // freed by an adoption since it was queued
+      active[p] = 0;
+      ++head_;
+      continue;
+    }
+    const bool source = tp == kSource;
+    for (int a = first[p], end = first[p + 1]; a < end; ++a) {
+      const Arc& arc = arcs[a];
+      // Residual capacity outwards from the source tree, inwards into the sink tree.
+      if ((source ? arc.cap : arc.back) <= 0) continue;
+      const int q = arc.to;
+      if (tree[q] == kFree) {
+        tree[q] = tp;
+        parent[q] = arc.rev;
+        up[q] = p;
+        dist[q] = dist[p] + 1;
+        stamp[q] = stamp[p];
+        if (!active[q]) {
+          active[q] = 1;
+          queue_.push_back(q);
+        }
+      } else if (tree[q] != tp) {
+        *meet = source ? a : arc.rev;  // p stays active: it may have more to give
+        return true;
+      } else if (stamp[q] <= stamp[p] && dist[q] > dist[p]) {
+        // Shorter way to the root (the BK heuristic that keeps the trees shallow).
+        parent[q] = arc.rev;
+        up[q] = p;
+        dist[q] = dist[p] + 1;
+        stamp[q] = stamp[p];
+      }
+    }
+    active[p] = 0;
+    ++head_;
+  }
+  return false;
+}
+
+// Pushes the bottleneck along root -> ... -> meet -> ... -> root and turns nodes whose tree arc
+// it saturated into orphans.
+long long FlowNetwork::augment(int meet) {
+  long long f = arcs_[meet].cap;
+  const int u = arcs_[arcs_[meet].rev].to, w = arcs_[meet].to;
+  for (int v = u; parent_[v] != kRoot; v = arcs_[parent_[v]].to)
+    f = std::min(f, arcs_[parent_[v]].back);
+  for (int v = w; parent_[v] != kRoot; v = arcs_[parent_[v]].to)
+    f = std::min(f, arcs_[parent_[v]].cap);
+  push(meet, f);
+  for (int v = u; parent_[v] != kRoot;) {
+    const int a = parent_[v], up = arcs_[a].to;
+    push(arcs_[a].rev, f);
+    if (arcs_[a].back == 0) {
+      parent_[v] = kOrphan;
+      orphans_.push_back(v);
+    }
+    v = up;
+  }
+  for (int v = w; parent_[v] != kRoot;) {
+    const int a = parent_[v], up = arcs_[a].to;
+    push(a, f);
+    if (arcs_[a].cap == 0) {
+      parent_[v] = kOrphan;
+      orphans_.push_back(v);
+    }
+    v = up;
+  }
+  return f;
+}
+
+// Finds an orphan a new parent in its tree whose path leads to the root (the one nearest the
+// root), or else frees it: its children become orphans and its tree neighbours that could grow
+// into it again become active.
+void FlowNetwork::adopt(int v) {
+  // Raw pointers in locals, as in grow().
+  const int* first = first_.data();
+  const Arc* arcs = arcs_.data();
+  char* tree_of = tree_.data();
+  int* parent = parent_.data();
+  int* up = up_.data();
+  int* dist = dist_.data();
+  int* stamp = stamp_.data();
+  const int now = time_;
+  const char tree = tree_of[v];
+  int best = -1, best_dist = INT_MAX;
+  for (int a = first[v]; a < first[v + 1]; ++a) {
+    const Arc& arc = arcs[a];
+    const int q = arc.to;
+    if (tree_of[q] != tree || (tree == kSource ? arc.back : arc.cap) <= 0) continue;
+    // Origin check: walk up from q until the root, a node already checked in this
+    // augmentation, or an orphan.
+    int d = 0, j = q;
+    bool rooted = false;
+    while (true) {
+      if (stamp[j] == now) {
+        d += dist[j];
+        rooted = true;
+        break;
+      }
+      const int pa = parent[j];
+      ++d;
+      if (pa == kRoot) {
+        stamp[j] = now;
+        dist[j] = 1;
+        rooted = true;
+        break;
+      }
+      if (pa == kOrphan) break;
+      j = up[j];
+    }
+    if (!rooted) continue;
+    if (d < best_dist) {
+      best = a;
+      best_dist = d;
+    }
+    // Remember the distances on the path for the next checks.
+    for (j = q; stamp[j] != now; j = up[j]) {
+      stamp[j] = now;
+      dist[j] = d--;
+    }
+  }
+  if (best >= 0) {
+    parent[v] = best;
+    up[v] = arcs[best].to;
+    stamp[v] = now;
+    dist[v] = best_dist + 1;
+    return;
+  }
+  for (int a = first[v]; a < first[v + 1]; ++a) {
+    const Arc& arc = arcs[a];
+    const int q = arc.to;
+    if (tree_of[q] != tree) continue;
+    if ((tree == kSource ? arc.back : arc.cap) > 0) activate(q);
+    if (parent[q] >= 0 && up[q] == v) {
+      parent[q] = kOrphan;
+      orphans_.push_back(q);
+    }
+  }
+  tree_of[v] = kFree;
+}
+
+// At most this many vertices per corridor side: keeps each max flow cheap on huge graphs.
 constexpr std::size_t kMaxCorridorVertices = 4000;
 
 // Grows a BFS corridor inside block `own` from its vertices adjacent to block `other`, up to
@@ -181,15 +323,22 @@ std::vector<int> corridor(const WorkGraph& g, const std::vector<int>& part, int 
     region.push_back(v);
     weight += g.vw[v];
   }
+  // Raw pointers in locals: the stores into `in` (chars) may alias anything, so the vectors'
+  // data pointers would be reloaded per scanned edge otherwise.
+  const int* xadj = g.xadj.data();
+  const int* adj = g.adj.data();
+  const int* vw = g.vw.data();
+  const int* block = part.data();
+  char* inside = in.data();
   for (std::size_t q = 0; q < region.size(); ++q) {
     const int v = region[q];
-    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
-      const int u = g.adj[e];
-      if (in[u] || part[u] != own || weight + g.vw[u] > budget) continue;
+    for (int e = xadj[v], end = xadj[v + 1]; e < end; ++e) {
+      const int u = adj[e];
+      if (inside[u] || block[u] != own || weight + vw[u] > budget) continue;
       if (region.size() >= kMaxCorridorVertices) break;
-      in[u] = 1;
+      inside[u] = 1;
       region.push_back(u);
-      weight += g.vw[u];
+      weight += vw[u];
     }
   }
   return region;
@@ -218,21 +367,28 @@ long long refine_pair(const WorkGraph& g, std::vector<int>& part, std::vector<lo
   for (int i = 0; i < m; ++i) local[nodes[i]] = i;
   net.reset(m + 2);
   long long old_cut = 0;  // the current a-b cut as seen by this network
+  const int* xadj = g.xadj.data();
+  const int* adj = g.adj.data();
+  const int* ew = g.ew.data();
+  const int* block = part.data();
+  const int* index = local.data();  // >= 0 exactly for the corridor nodes (`in` set)
   for (int i = 0; i < m; ++i) {
     const int v = nodes[i];
+    const bool side_a = block[v] == a;
     long long to_s = 0, to_t = 0;
-    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
-      const int u = g.adj[e];
-      if (in[u]) {
-        if (local[u] > i) net.add(i, local[u], g.ew[e], g.ew[e]);
-        if (part[v] == a && part[u] == b) old_cut += g.ew[e];
-      } else if (part[u] == a) {
-        to_s += g.ew[e];
-      } else if (part[u] == b) {
-        to_t += g.ew[e];
+    for (int e = xadj[v], end = xadj[v + 1]; e < end; ++e) {
+      const int u = adj[e];
+      const int j = index[u];
+      if (j >= 0) {
+        if (j > i) net.add(i, j, ew[e], ew[e]);
+        if (side_a && block[u] == b) old_cut += ew[e];
+      } else if (block[u] == a) {
+        to_s += ew[e];
+      } else if (block[u] == b) {
+        to_t += ew[e];
       }
     }
-    old_cut += part[v] == a ? to_t : to_s;
+    old_cut += side_a ? to_t : to_s;
     if (to_s > 0) net.add(s, i, to_s, 0);
     if (to_t > 0) net.add(i, t, to_t, 0);
   }
@@ -243,8 +399,8 @@ long long refine_pair(const WorkGraph& g, std::vector<int>& part, std::vector<lo
     // network) and the largest (everything that cannot reach t). Of the balanced ones take the
     // better balanced. (Choosing the most balanced among all minimum cuts, via the residual
     // components, was tried and gave worse partitions on the benchmarks.)
-    const std::vector<char> from_s = net.reachable_from(s);
-    const std::vector<char> to_t = net.reaching(t);
+    const std::vector<char> from_s = net.reachable_from();
+    const std::vector<char> to_t = net.reaching();
     long long base_a = bw[a];
     for (int v : ra) base_a -= g.vw[v];
     const long long total = bw[a] + bw[b];
