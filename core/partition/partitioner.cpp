@@ -74,9 +74,10 @@ struct PresetPlan {
 // `highest` re-splits its best partition (block_resplit.hpp): torus3D (14048) and the smaller
 // benchmark graphs at N <= 5; cubicle (18236) and the larger ones spend ~3-4.4 s already.
 constexpr double kResplitSize = 16000.0;
-// Larger problems: sub-searches (0 = none, session 11's behaviour), a sub-search's share of the
-// step budget, and how separable the kept block must be (BlockResplitOptions::max_cut_ratio).
-constexpr int kResplitLargeSearches = 2;
+// Larger problems: sub-searches (0 = none, session 11's behaviour; 2 in session 12), a
+// sub-search's share of the step budget, and how separable the kept block must be
+// (BlockResplitOptions::max_cut_ratio).
+constexpr int kResplitLargeSearches = 4;
 constexpr double kResplitLargeBudget = 0.5;
 constexpr double kResplitCutRatio = 0.6;
 
@@ -223,13 +224,16 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         plan.evolution.resplit.kept = 2;
         plan.evolution.resplit.population = 4;
         plan.evolution.resplit.budget = 1.0;
-        // highest, larger problems (session 12): two cheaper sub-searches that keep only the
-        // most separable block, and only when it is clearly separable (its cut edges at most
-        // kResplitCutRatio x the mean block cut). rim's light block (49 cut edges, mean 98) is
-        // shared by its 246 and 243 partitions, which arrange the other four blocks
-        // differently; a fresh search of those four found the 243 arrangement in 1/5-1/3 of the
-        // tries. Meshes (grid3D 0.92) and city10000 (0.81) have no such block and keep their
-        // ~3.3-4.2 s (session 12, docs/partitioning.md).
+        // highest, larger problems (session 12): cheaper sub-searches (half the budget) that
+        // keep only the most separable block, and only when it is clearly separable (its cut
+        // edges at most kResplitCutRatio x the mean block cut). rim's light block (49 cut
+        // edges, mean 98) is shared by its 246 and 243 partitions, which arrange the other four
+        // blocks differently; a fresh search of those four found the 243 arrangement in 1/5-1/3
+        // of the tries. Meshes (grid3D 0.92) and city10000 (0.81) have no such block and keep
+        // their ~3.3-4.2 s (session 12, docs/partitioning.md). Four sub-searches instead of two
+        // since session 13, paid for by the cheaper max flows (flow_refinement.cpp): rim seeds
+        // 1, 10, 15 reach 243 (mean over seeds 1-16 249.7 -> 248.1); the first two are the same
+        // as before, so no cut gets worse.
         if (!strong && per_op > kResplitSize) {
           plan.evolution.resplit.searches = kResplitLargeSearches;
           plan.evolution.resplit.kept = 1;
