@@ -77,6 +77,21 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_
     }
   } guard{session_, wake_after > 1};
   if (guard.set) session_.set_protocol_wake_threshold(wake_after);
+  return wait_and_take(timeout_s);
+}
+
+std::optional<ProtocolMessage> DdsProtocolChannel::receive_awaiting(
+    double timeout_s, const AwaitedMessages& awaited) {
+  // Back to a wake-up per message however this wait ends: the awaited set is this step's only.
+  struct AwaitedGuard {
+    transport::Session& session;
+    ~AwaitedGuard() { session.set_protocol_awaited(std::nullopt); }
+  } guard{session_};
+  session_.set_protocol_awaited(awaited);
+  return wait_and_take(timeout_s);
+}
+
+std::optional<ProtocolMessage> DdsProtocolChannel::wait_and_take(double timeout_s) {
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(
                                              std::chrono::duration<double>(timeout_s));
@@ -84,7 +99,6 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_
     const std::uint32_t current = session_.epoch();
     auto& rollbacks = session_.rollbacks();
     auto& assignments = session_.assignments();
-    auto& protocol = session_.protocol();
     // A digest falls due while we wait (a slow peer): wake for it, then wait on.
     const auto until = progress_ ? std::min(deadline, progress_->next_due()) : deadline;
     const double left =
@@ -95,7 +109,7 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_
             if (c.epoch() > current) return true;
           for (const auto& a : assignments.queued_locked())
             if (a.epoch() > current) return true;
-          return !protocol.queued_locked().empty();
+          return session_.protocol_ready_locked();
         },
         transport::Seconds(std::max(0.0, left)));
     if (st == transport::WaitStatus::kStopped)
@@ -111,7 +125,7 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_
     if (auto a = take_reassignment(session_)) throw RepartitionRequested(std::move(*a));
     if (auto r = take_rollback(session_)) throw *r;
     ProtocolMessage out;
-    if (protocol.take(transport::Seconds(0), &out) != transport::WaitStatus::kReady)
+    if (session_.protocol().take(transport::Seconds(0), &out) != transport::WaitStatus::kReady)
       return std::nullopt;  // only stale rollbacks were queued; the caller waits again
     if (intercept_ && intercept_(out)) continue;  // e.g. a replica, not for the protocol
     note_status(out, false);

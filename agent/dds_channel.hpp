@@ -23,6 +23,10 @@ class DdsProtocolChannel : public ProtocolChannel {
   /// The listener wakes this thread only once `wake_after` protocol messages are queued
   /// (Session::set_protocol_wake_threshold); rollbacks, re-partitions and stops as receive().
   std::optional<ProtocolMessage> receive_after(double timeout_s, std::size_t wake_after) override;
+  /// The listener wakes this thread only once every awaited message is queued
+  /// (Session::set_protocol_awaited); rollbacks, re-partitions and stops as receive().
+  std::optional<ProtocolMessage> receive_awaiting(double timeout_s,
+                                                  const AwaitedMessages& awaited) override;
   /// Messages for which `f` returns true are consumed by it instead of being returned
   /// (lifted-pose replicas of other agents).
   void set_intercept(std::function<bool(const ProtocolMessage&)> f) { intercept_ = std::move(f); }
@@ -39,6 +43,8 @@ class DdsProtocolChannel : public ProtocolChannel {
  private:
   void note_status(const ProtocolMessage& m, bool own);
   void publish_progress_if_due();
+  // The wait of receive_after and receive_awaiting, once the session knows what wakes it.
+  std::optional<ProtocolMessage> wait_and_take(double timeout_s);
 
   transport::Session& session_;
   std::function<bool(const ProtocolMessage&)> intercept_;

@@ -43,6 +43,11 @@ std::optional<ProtocolMessage> ProtocolChannel::receive_after(double timeout_s,
   return receive(timeout_s);
 }
 
+std::optional<ProtocolMessage> ProtocolChannel::receive_awaiting(double timeout_s,
+                                                                 const AwaitedMessages& awaited) {
+  return receive_after(timeout_s, awaited.senders.size());
+}
+
 RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
                                double receive_timeout_s, const RoundLoopHooks& hooks) {
   const DistributedOptions options = options_of(local.options);

@@ -23,6 +23,7 @@
 
 #include "graph/measurement.hpp"
 #include "graph/pose.hpp"
+#include "protocol/awaited_messages.hpp"
 #include "protocol/messages.hpp"
 
 namespace tessera {
@@ -110,6 +111,12 @@ class ProtocolChannel {
   /// rollback, a re-partition) and the timeout still end the wait at once.
   /// The default is receive(timeout_s).
   virtual std::optional<ProtocolMessage> receive_after(double timeout_s, std::size_t wake_after);
+  /// receive() for a caller whose protocol step waits for exactly `awaited`
+  /// (AgentProcess::awaited()): the channel may sleep until all of them have arrived; the
+  /// message returned may be any queued one. Ends early as receive_after() does.
+  /// The default is receive_after(timeout_s, awaited.senders.size()).
+  virtual std::optional<ProtocolMessage> receive_awaiting(double timeout_s,
+                                                          const AwaitedMessages& awaited);
 };
 
 struct RoundLoopResult {

@@ -1,5 +1,6 @@
 #include "agent/round_mailbox.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "distributed/in_process_driver.hpp"
@@ -40,19 +41,27 @@ std::optional<ProtocolMessage> Mailbox::receive(std::size_t wake_after) {
   return msg;
 }
 
+std::optional<ProtocolMessage> Mailbox::receive(const AwaitedMessages& awaited) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::optional<ProtocolMessage> msg = channel_.receive_awaiting(timeout_s_, awaited);
+  wait_s += seconds_since(t0);
+  return msg;
+}
+
 std::map<std::uint32_t, ProtocolMessage> Mailbox::gather(
     std::uint32_t phase, std::uint32_t round, const std::vector<std::uint32_t>& senders) {
   const auto key = std::make_pair(phase, round);
   for (;;) {
     auto& have = stash_[key];
-    std::size_t missing = 0;
-    for (auto s : senders) missing += have.count(s) ? 0 : 1;
-    if (missing == 0) break;
-    // Sleep until as many messages as are still missing have come (a lower bound: others may
-    // be for a later step, which only wakes us early), not once per message: a reduction
+    AwaitedMessages awaited{round, phase, {}};
+    for (auto s : senders)
+      if (!have.count(s)) awaited.senders.push_back(s);
+    if (awaited.senders.empty()) break;
+    std::sort(awaited.senders.begin(), awaited.senders.end());
+    // Sleep until the missing senders' messages have come, not once per message: a reduction
     // waits for every other agent's status, and each wake-up of this thread costs more than
     // handling a small message (as run_protocol's steps; docs/dds-runtime.md, stall10).
-    std::optional<ProtocolMessage> msg = receive(missing);
+    std::optional<ProtocolMessage> msg = receive(awaited);
     if (!msg) {
       std::string who;
       for (auto s : senders)

@@ -32,6 +32,8 @@ class Mailbox {
   /// The next message from the channel, or nullopt after the receive timeout; the wait is
   /// added to wait_s. `wake_after`: see ProtocolChannel::receive_after.
   std::optional<ProtocolMessage> receive(std::size_t wake_after = 1);
+  /// Same, sleeping until every awaited message has come (ProtocolChannel::receive_awaiting).
+  std::optional<ProtocolMessage> receive(const AwaitedMessages& awaited);
 
   /// Agents in the run (for counting a broadcast's deliveries); 1 until set.
   void set_num_agents(std::uint32_t n) { num_agents_ = n; }
@@ -46,8 +48,11 @@ class Mailbox {
     while (!protocol.done()) {
       // Sleep until the current step can move on, not once per arriving message: a status
       // step needs every other agent's status, and each wake-up of this thread costs more
-      // than handling a small message (docs/dds-runtime.md, session 8).
-      std::optional<ProtocolMessage> msg = receive(protocol.messages_needed());
+      // than handling a small message (docs/dds-runtime.md, session 8). By name when the
+      // protocol can tell: a count also counts messages of later steps (session 13, wake13).
+      const std::optional<AwaitedMessages> awaited = protocol.awaited();
+      std::optional<ProtocolMessage> msg =
+          awaited ? receive(*awaited) : receive(protocol.messages_needed());
       if (!msg)
         throw std::runtime_error("agent " + std::to_string(self_) + ": no message for " +
                                  std::to_string(timeout_s_) + " s in " + describe());

@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "agent/local_share.hpp"
+#include "transport/epoch_routing.hpp"
 #include "transport/inbox.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/riding_blocks.hpp"
@@ -350,6 +351,50 @@ TEST(DdsHandoff, InconsistentHandoffsAreReported) {
   // Pose 3 belongs to agent 0 but robot 1 never handed it over.
   EXPECT_THROW(agent::assemble_local(s, owner, 0, 2, {}, {}), std::runtime_error);
   EXPECT_THROW(agent::robot_share(g, 0, 5), InputError);
+}
+
+// The relay waiting in round 3's update step for the blocks of agents 1 and 4: agent 1's block
+// rides in its status sample, so its block and its next status arrive together. A count of 2
+// wakes the waiter there; the awaited set wakes it only with agent 4's block (session 13, wake13).
+TEST(DdsEpochRouting, AwaitedSendersWakeTheWaiterOnlyWhenTheStepIsComplete) {
+  auto block = [](std::uint32_t round, std::uint32_t sender) {
+    PoseBlockMessage b;
+    b.round = round, b.sender = sender, b.phase = 3;
+    return ProtocolMessage(b);
+  };
+  auto status = [](std::uint32_t round, std::uint32_t sender) {
+    RoundStatusMessage m;
+    m.round = round, m.sender = sender, m.phase = 1;
+    return ProtocolMessage(m);
+  };
+  Mailroom room;
+  Inbox<ProtocolMessage> inbox(room), counted_inbox(room);
+  EpochRouter router(room, inbox, 0), counted(room, counted_inbox, 0);
+  router.set_awaited(AwaitedMessages{3, 3, {1, 4}});
+  counted.set_wake_threshold(2);
+  auto both = [&](ProtocolMessage m) {
+    const bool a = router.deliver(0, 1, false, {0}, ProtocolMessage(m));
+    const bool c = counted.deliver(0, 1, false, {0}, std::move(m));
+    return std::make_pair(a, c);
+  };
+  auto ready = [&] { return room.with_lock([&] { return router.ready_locked(); }); };
+  EXPECT_EQ(both(block(3, 1)), std::make_pair(false, false));
+  EXPECT_EQ(both(status(4, 1)), std::make_pair(false, true));  // the count wakes too early
+  EXPECT_FALSE(ready());
+  EXPECT_EQ(both(block(2, 4)).first, false);  // agent 4, but an older round
+  EXPECT_EQ(both(status(4, 2)).first, false);
+  EXPECT_FALSE(ready());
+  EXPECT_EQ(both(block(3, 4)).first, true);  // the step is complete
+  EXPECT_TRUE(ready());
+
+  // Set while the messages are already queued: ready at once; nullopt: any message again.
+  router.set_awaited(AwaitedMessages{4, 1, {1, 2}});
+  EXPECT_TRUE(ready());
+  router.set_awaited(AwaitedMessages{4, 1, {3}});
+  EXPECT_FALSE(ready());
+  router.set_awaited(std::nullopt);
+  EXPECT_TRUE(ready());
+  EXPECT_TRUE(router.deliver(0, 3, false, {0}, status(4, 3)));
 }
 
 }  // namespace

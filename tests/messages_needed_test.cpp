@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "distributed/agent_factory.hpp"
@@ -100,6 +101,102 @@ TEST(MessagesNeeded, IsALowerBoundOnWhatEachStepWaitsFor) {
   EXPECT_GT(agents[0]->rounds(), 2);
   EXPECT_EQ(max_needed, static_cast<std::size_t>(N - 1));  // a status step: every other agent
   EXPECT_GT(steps, static_cast<std::size_t>(agents[0]->rounds()));
+}
+
+// AgentProcess::awaited names the messages the step lacks (the DDS agent sleeps until all of
+// them are queued, session 13): handing the agent everything else queued never moves it on,
+// the named ones do, with the last of them -- and the agents still run the same rounds.
+TEST(MessagesNeeded, AwaitedNamesExactlyTheMessagesThatCompleteTheStep) {
+  test::RandomGraphSpec spec;
+  spec.d = 2;
+  spec.poses = 80;
+  spec.loop_closures = 40;
+  spec.seed = 5;
+  const PoseGraph g = test::random_pose_graph(spec);
+  const int N = 4;
+  DistributedOptions opt;
+  opt.max_rounds = 30;
+  std::vector<int> assignment(g.num_poses);
+  for (std::size_t i = 0; i < g.num_poses; ++i)
+    assignment[i] = static_cast<int>(i * static_cast<std::size_t>(N) / g.num_poses);
+  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, assignment);
+  const Eigen::MatrixXd X0 = lift_poses(g.initial, opt.rank);
+  const auto scheme = make_momentum_scheme(opt, layout, static_cast<double>(X0.size()));
+  const RoundConfig config = make_round_config(opt, scheme.get());
+  std::vector<std::unique_ptr<AgentState>> states;
+  std::vector<std::unique_ptr<RoundProtocol>> agents;
+  for (int b = 0; b < N; ++b) {
+    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+    states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
+                                                  test::pose_columns(X0, g.d, ids)));
+    agents.push_back(std::make_unique<RoundProtocol>(*states.back(), layout, config));
+  }
+
+  std::vector<std::deque<ProtocolMessage>> queue(N);
+  auto post = [&](int from, const std::vector<OutgoingMessage>& out) {
+    for (const auto& m : out)
+      for (int a = 0; a < N; ++a) {
+        if (a == from) continue;
+        bool to_a = m.broadcast;
+        for (auto r : m.recipients) to_a = to_a || static_cast<int>(r) == a;
+        if (to_a) queue[static_cast<std::size_t>(a)].push_back(m.message);
+      }
+  };
+  for (int a = 0; a < N; ++a) post(a, agents[static_cast<std::size_t>(a)]->start());
+
+  std::size_t steps = 0, held_back = 0;
+  for (int sweep = 0; sweep < 100000; ++sweep) {
+    bool all_done = true, moved = false;
+    for (int a = 0; a < N; ++a) {
+      RoundProtocol& p = *agents[static_cast<std::size_t>(a)];
+      auto& q = queue[static_cast<std::size_t>(a)];
+      if (p.done()) {
+        EXPECT_FALSE(p.awaited().has_value());
+        continue;
+      }
+      all_done = false;
+      const std::optional<AwaitedMessages> awaited = p.awaited();
+      ASSERT_TRUE(awaited.has_value()) << "agent " << a << " runs but names nothing";
+      ASSERT_EQ(awaited->senders.size(), p.messages_needed());
+      if (!all_awaited_in(*awaited, q)) continue;  // the DDS agent sleeps on
+      ++steps;
+      // Everything else first (messages of later steps): none of it may move the step on.
+      std::deque<ProtocolMessage> named;
+      const int round = p.rounds();
+      for (auto& m : q) {
+        if (is_awaited(*awaited, m)) {
+          named.push_back(std::move(m));
+          continue;
+        }
+        ++held_back;
+        const auto out = p.handle(m);
+        ASSERT_TRUE(out.empty()) << "agent " << a << " moved on without an awaited message";
+        ASSERT_EQ(p.rounds(), round);
+      }
+      q.clear();
+      ASSERT_EQ(named.size(), awaited->senders.size());
+      for (std::size_t k = 0; k < named.size(); ++k) {
+        const auto out = p.handle(named[k]);
+        if (k + 1 < named.size()) {
+          ASSERT_TRUE(out.empty()) << "agent " << a << " moved on before its last awaited message";
+        }
+        post(a, out);
+      }
+      const std::optional<AwaitedMessages> next = p.awaited();
+      ASSERT_TRUE(p.done() || next->round != awaited->round || next->phase != awaited->phase)
+          << "agent " << a << " did not move on with every awaited message";
+      moved = true;
+    }
+    if (all_done) break;
+    ASSERT_TRUE(moved) << "no agent had every message it named";
+  }
+  for (int a = 0; a < N; ++a) {
+    EXPECT_TRUE(agents[static_cast<std::size_t>(a)]->done());
+    EXPECT_EQ(agents[static_cast<std::size_t>(a)]->rounds(), agents[0]->rounds());
+  }
+  EXPECT_GT(agents[0]->rounds(), 2);
+  EXPECT_GT(steps, static_cast<std::size_t>(agents[0]->rounds()));
+  EXPECT_GT(held_back, 0u);  // some agent did have later steps' messages queued
 }
 
 }  // namespace

@@ -43,14 +43,30 @@ void EpochRouter::set_wake_threshold(std::size_t n) {
   wake_threshold_ = n > 0 ? n : 1;
 }
 
-void EpochRouter::deliver(std::uint32_t e, std::uint32_t sender, bool broadcast,
+void EpochRouter::set_awaited(std::optional<AwaitedMessages> awaited) {
+  const bool ready = room_.with_lock([&] {
+    awaited_ = std::move(awaited);
+    return awaited_ && ready_locked();
+  });
+  if (ready) room_.notify();
+}
+
+bool EpochRouter::ready_locked() const {
+  const auto& queued = inbox_.queued_locked();
+  return awaited_ ? all_awaited_in(*awaited_, queued) : !queued.empty();
+}
+
+bool EpochRouter::deliver(std::uint32_t e, std::uint32_t sender, bool broadcast,
                           const std::vector<std::uint32_t>& recipients, ProtocolMessage&& m) {
   bool wake = false;
   room_.with_lock([&] {
     if (e == epoch_) {
       if (sender != protocol_id_ && addressed_to(broadcast, recipients, protocol_id_)) {
+        // Only a message the waiter awaits can complete its step; any other only queues.
+        const bool counts = !awaited_ || is_awaited(*awaited_, m);
         inbox_.push_locked(std::move(m));
-        wake = inbox_.queued_locked().size() >= wake_threshold_;
+        wake = counts &&
+               (awaited_ ? ready_locked() : inbox_.queued_locked().size() >= wake_threshold_);
       }
     } else if (e > epoch_) {
       future_.push_back(Held{e, sender, broadcast, recipients, std::move(m)});
@@ -58,6 +74,7 @@ void EpochRouter::deliver(std::uint32_t e, std::uint32_t sender, bool broadcast,
     return 0;
   });
   if (wake) room_.notify();
+  return wake;
 }
 
 }  // namespace tessera::transport

@@ -8,8 +8,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
+#include "protocol/awaited_messages.hpp"
 #include "protocol/messages.hpp"
 #include "transport/inbox.hpp"
 
@@ -30,11 +32,19 @@ class EpochRouter {
   void set_epoch(std::uint32_t epoch, std::uint32_t protocol_id);
   /// A received message sent in epoch `epoch` by protocol id `sender` to `recipients` (or
   /// everyone when `broadcast`): delivered, held or dropped as above.
-  void deliver(std::uint32_t epoch, std::uint32_t sender, bool broadcast,
+  /// Returns whether it woke the waiters.
+  bool deliver(std::uint32_t epoch, std::uint32_t sender, bool broadcast,
                const std::vector<std::uint32_t>& recipients, ProtocolMessage&& message);
   /// deliver() wakes the waiters only once the inbox holds at least `n` messages (0 counts
   /// as 1). set_epoch() always wakes them.
   void set_wake_threshold(std::size_t n);
+  /// While set, deliver() wakes the waiters only once the inbox holds a message of every
+  /// awaited sender (the threshold is then ignored); nullopt goes back to the threshold.
+  /// Wakes the waiters when the awaited messages are already queued.
+  void set_awaited(std::optional<AwaitedMessages> awaited);
+  /// Whether the inbox holds what the waiter needs: every awaited message when set, else any
+  /// message. Requires the mailroom lock.
+  bool ready_locked() const;
 
  private:
   struct Held {
@@ -50,6 +60,7 @@ class EpochRouter {
   std::uint32_t epoch_ = 0;
   std::uint32_t protocol_id_ = 0;
   std::size_t wake_threshold_ = 1;
+  std::optional<AwaitedMessages> awaited_;
   std::vector<Held> future_;  // newer epochs' messages, with their routing
 };
 

@@ -110,6 +110,12 @@ Inbox<ProtocolMessage>& Session::protocol() {
 void Session::set_protocol_wake_threshold(std::size_t n) {
   impl_->router.set_wake_threshold(n);
 }
+void Session::set_protocol_awaited(std::optional<AwaitedMessages> awaited) {
+  impl_->router.set_awaited(std::move(awaited));
+}
+bool Session::protocol_ready_locked() const {
+  return impl_->router.ready_locked();
+}
 Inbox<wire::RoundStatus>& Session::status_watch() {
   return impl_->status_in;
 }

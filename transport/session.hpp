@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "protocol/awaited_messages.hpp"
 #include "protocol/messages.hpp"
 #include "tessera.h"
 #include "transport/inbox.hpp"
@@ -77,6 +78,14 @@ class Session {
   /// knows how many messages its current step needs; every other wake-up (stop, rollback,
   /// re-partition, new epoch) is unchanged. Set it back to 1 after the wait.
   void set_protocol_wake_threshold(std::size_t n);
+  /// Agents: instead of a count, the listeners wake the waiters for a protocol message only
+  /// once a message of every awaited sender is queued (nullopt: back to the count). For a
+  /// receiver whose step names what it lacks (AgentProcess::awaited); a count would also
+  /// count messages of later steps. Other wake-ups are unchanged. Reset it after the wait.
+  void set_protocol_awaited(std::optional<AwaitedMessages> awaited);
+  /// Whether protocol() holds what the current wait needs: every awaited message when
+  /// set_protocol_awaited named some, else any message. Requires the mailroom lock.
+  bool protocol_ready_locked() const;
   /// Coordinator: the round statuses it reads (topic_names.hpp, coordinator_reads_status).
   Inbox<wire::RoundStatus>& status_watch();
   /// Coordinator: the agents' progress digests (agent/progress_digest.hpp).

@@ -4,8 +4,10 @@
 // is one; the certified sequence (solve -> certify -> escape -> solve ...) is another.
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
+#include "protocol/awaited_messages.hpp"
 #include "protocol/messages.hpp"
 
 namespace tessera {
@@ -23,6 +25,10 @@ class AgentProcess {
   /// lower bound (1 when the agent cannot tell, 0 once done). A driver may sleep until that
   /// many have arrived instead of waking for each one; a wait for fewer is never wrong.
   virtual std::size_t messages_needed() const { return done() ? 0 : 1; }
+  /// The messages the current step still lacks, by (round, phase, sender), when the agent can
+  /// name them (messages_needed() of them); nullopt when it cannot or is done. A driver may
+  /// sleep until exactly these have arrived: handle() cannot move the step on before.
+  virtual std::optional<AwaitedMessages> awaited() const { return std::nullopt; }
 };
 
 }  // namespace tessera

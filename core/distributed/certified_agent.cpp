@@ -137,6 +137,13 @@ std::size_t CertifiedAgent::messages_needed() const {
   return current_ ? std::max<std::size_t>(current_->messages_needed(), 1) : 1;
 }
 
+std::optional<AwaitedMessages> CertifiedAgent::awaited() const {
+  if (done_ || !current_) return std::nullopt;
+  std::optional<AwaitedMessages> a = current_->awaited();
+  if (a) a->phase = tag_phase(stage_, a->phase);
+  return a;
+}
+
 std::vector<OutgoingMessage> CertifiedAgent::handle(const ProtocolMessage& message) {
   std::vector<OutgoingMessage> out;
   if (done_) return out;

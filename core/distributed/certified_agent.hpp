@@ -54,6 +54,8 @@ class CertifiedAgent : public AgentProcess {
   bool done() const override { return done_; }
   /// The running stage's count (messages of later stages are kept aside, not counted).
   std::size_t messages_needed() const override;
+  /// The current stage's awaited messages, with the stage-tagged phase they carry on the wire.
+  std::optional<AwaitedMessages> awaited() const override;
 
   const std::vector<SolveStageRecord>& solves() const { return solves_; }
   const std::vector<CertifyStageRecord>& certificates() const { return certificates_; }

@@ -152,6 +152,19 @@ std::size_t RoundProtocol::messages_needed() const {
   return std::max<std::size_t>(missing, 1);
 }
 
+std::optional<AwaitedMessages> RoundProtocol::awaited() const {
+  if (done_) return std::nullopt;
+  AwaitedMessages a;
+  a.round = wait_round_;
+  a.phase = static_cast<std::uint32_t>(phase_);
+  const auto it = pending_.find(key(wait_round_, phase_));
+  for (int s : wait_senders_)
+    if (it == pending_.end() || !it->second.count(s)) a.senders.push_back(u32(s));
+  std::sort(a.senders.begin(), a.senders.end());
+  if (a.senders.empty()) return std::nullopt;  // not after pump(); never a wait for nothing
+  return a;
+}
+
 void RoundProtocol::pump(std::vector<OutgoingMessage>& out) {
   while (!done_) {
     Inbox& inbox = pending_[key(wait_round_, phase_)];

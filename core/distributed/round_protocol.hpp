@@ -92,6 +92,8 @@ class RoundProtocol : public AgentProcess {
   bool done() const override { return done_; }
   /// The senders of the step it waits for whose message has not been handled yet.
   std::size_t messages_needed() const override;
+  /// The senders counted by messages_needed(), with the step's round and phase.
+  std::optional<AwaitedMessages> awaited() const override;
   int rounds() const { return round_; }
   int restarts() const { return restarts_; }
   /// grad_norm, max_rounds, relative_decrease, or stalled (the cost and gradient norm
