@@ -33,6 +33,8 @@
 #include "launch_transport.hpp"
 #include "robot_files.hpp"
 #include "session_args.hpp"
+#include "shm_leftovers.hpp"
+#include "transport/run_identity.hpp"
 #include "transport/security.hpp"
 #include "util/input_error.hpp"
 
@@ -349,6 +351,17 @@ int run_launch(const Args& argv) {
               use_fork_server ? "forked by tessera-fork-server" : "each exec'ed", work.c_str());
   std::fflush(stdout);
 
+  // Data segments the run's processes mapped when one of them had failed: a killed process
+  // cannot remove its own, and only its peers' maps tell its segment apart (shm_leftovers.hpp).
+  std::set<std::string> run_segments;
+  auto note_segments = [&] {
+    std::vector<pid_t> pids;
+    for (const auto& c : children)
+      if (c.running) pids.push_back(c.pid);
+    const auto mapped = mapped_segments(pids);
+    run_segments.insert(mapped.begin(), mapped.end());
+  };
+
   // Stream progress; watch for failures, the time limit and signals.
   std::string pending;
   bool summary_printed = false;
@@ -392,6 +405,7 @@ int run_launch(const Args& argv) {
     for (auto& c : children) {
       if (c.running || c.judged) continue;
       c.judged = true;
+      if (c.code != 0) note_segments();
       const ExitVerdict v = judge_exit(loss, c.agent, c.code, coordinator_done);
       c.lost = v.lost;
       if (!v.notice.empty()) std::fprintf(stderr, "tessera launch: %s\n", v.notice.c_str());
@@ -420,6 +434,7 @@ int run_launch(const Args& argv) {
         usleep(20000);
       }
     }
+    note_segments();  // stop_all may have to SIGKILL some of them
     stop_all(children, exit_code == 130 ? 5.0 : 3.0);
     for (const auto& c : children)
       if (c.code != 0 && c.code != 130 && c.code != 143)
@@ -428,6 +443,21 @@ int run_launch(const Args& argv) {
   }
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
+  // Every process has ended. One that failed may have been killed (SIGKILL, an abort) and left
+  // its shared-memory files: remove what of this run's domain no live process holds.
+  bool any_failed = false;
+  for (const auto& c : children) any_failed = any_failed || c.code != 0;
+  if (any_failed) {
+    ShmCleanupOptions shm;
+    shm.domain = net.session.domain >= 0 ? net.session.domain : transport::domain_for_run(run_id);
+    shm.segments = std::move(run_segments);
+    const ShmCleanupResult r = remove_dead_shm_files(shm);
+    if (!r.removed.empty())
+      std::fprintf(stderr,
+                   "tessera launch: removed %zu shared-memory files of dead processes of domain "
+                   "%d from /dev/shm\n",
+                   r.removed.size(), shm.domain);
+  }
   if (!failure.empty()) return exit_code;
 
   if (!summary_printed) print_summary(summary);

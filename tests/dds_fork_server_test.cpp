@@ -7,13 +7,17 @@
 // (launch's default, agent/startup_batch.hpp).
 // Domains used here: 50-53, 211-212, 217 (each test its own, so ctest -j is safe).
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sched.h>
 #include <signal.h>
+#include <sys/file.h>
+#include <sys/mman.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -32,6 +36,7 @@
 #include "fork_spec.hpp"
 #include "huge_page_heaps.hpp"
 #include "launch_children.hpp"
+#include "shm_leftovers.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::test::dds {
@@ -416,6 +421,83 @@ TEST(DdsForkServer, StopAllKillsAndNamesAChildThatIgnoresSigint) {
   EXPECT_EQ(children[0].code, 128 + SIGKILL);
   EXPECT_NE(err.find("agent 7 did not stop within"), std::string::npos) << err;
   EXPECT_NE(err.find("SIGKILL"), std::string::npos) << err;
+}
+
+// After a run that lost a process, launch removes the shared-memory files its dead processes
+// left (shm_leftovers.hpp): ports of its domain and segments its processes mapped, each only
+// when no live process holds its lock. Here in a directory of its own, with locks held by this
+// test (flock locks of two open() calls conflict, even in one process).
+TEST(DdsShmLeftovers, OnlyDeadPortsOfTheDomainAndDeadSegmentsOfTheRunAreRemoved) {
+  const std::string dir = temp_dir();
+  auto touch = [&](const std::string& name) { std::ofstream(dir + "/" + name) << "x"; };
+  auto exists = [&](const std::string& name) {
+    return access((dir + "/" + name).c_str(), F_OK) == 0;
+  };
+  auto hold = [&](const std::string& name) {
+    const int fd = open((dir + "/" + name).c_str(), O_RDWR);
+    EXPECT_GE(fd, 0);
+    EXPECT_EQ(flock(fd, LOCK_EX | LOCK_NB), 0);
+    return fd;
+  };
+  // Domain 3: ports 8150 ... 8399.
+  const std::vector<std::string> dead_port = {"fastrtps_port8160", "fastrtps_port8160_el",
+                                              "sem.fastrtps_port8160_mutex"};
+  const std::vector<std::string> dead_shared_port = {"fastrtps_port8150", "fastrtps_port8150_sl"};
+  const std::vector<std::string> live_port = {"fastrtps_port8161", "fastrtps_port8161_el",
+                                              "sem.fastrtps_port8161_mutex"};
+  const std::vector<std::string> other_domain = {"fastrtps_port8400", "fastrtps_port8400_el",
+                                                 "fastrtps_port7411", "fastrtps_port7411_el"};
+  const std::vector<std::string> lock_gone = {"fastrtps_port8170", "sem.fastrtps_port8170_mutex"};
+  const std::vector<std::string> lock_gone_mapped = {"fastrtps_port8180"};
+  const std::vector<std::string> dead_segment = {"fastrtps_0123456789abcdef",
+                                                 "fastrtps_0123456789abcdef_el"};
+  const std::vector<std::string> unlisted_segment = {"fastrtps_fedcba9876543210",
+                                                     "fastrtps_fedcba9876543210_el"};
+  const std::vector<std::string> live_segment = {"fastrtps_aaaaaaaaaaaaaaaa",
+                                                 "fastrtps_aaaaaaaaaaaaaaaa_el"};
+  for (const auto* group : {&dead_port, &dead_shared_port, &live_port, &other_domain, &lock_gone,
+                            &lock_gone_mapped, &dead_segment, &unlisted_segment, &live_segment})
+    for (const auto& f : *group) touch(f);
+  const int mapped_fd = open((dir + "/fastrtps_port8180").c_str(), O_RDONLY);
+  ASSERT_GE(mapped_fd, 0);
+  void* mapped = mmap(nullptr, 1, PROT_READ, MAP_SHARED, mapped_fd, 0);
+  ASSERT_NE(mapped, MAP_FAILED);
+  const int port_lock = hold("fastrtps_port8161_el");
+  const int segment_lock = hold("fastrtps_aaaaaaaaaaaaaaaa_el");
+
+  cli::ShmCleanupOptions o;
+  o.domain = 3;
+  o.dir = dir;
+  o.segments = {"fastrtps_0123456789abcdef", "fastrtps_aaaaaaaaaaaaaaaa"};
+  const cli::ShmCleanupResult r = cli::remove_dead_shm_files(o);
+  std::vector<std::string> expected = dead_port;
+  expected.insert(expected.end(), dead_shared_port.begin(), dead_shared_port.end());
+  expected.insert(expected.end(), lock_gone.begin(), lock_gone.end());
+  expected.insert(expected.end(), dead_segment.begin(), dead_segment.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(r.removed, expected);
+  EXPECT_EQ(r.in_use, 3u);  // the held port, the mapped port and the held segment
+  for (const auto& f : expected) EXPECT_FALSE(exists(f)) << f;
+  for (const auto* group :
+       {&live_port, &other_domain, &lock_gone_mapped, &unlisted_segment, &live_segment})
+    for (const auto& f : *group) EXPECT_TRUE(exists(f)) << f << " was removed";
+  munmap(mapped, 1);
+  close(mapped_fd);
+  close(port_lock);
+  close(segment_lock);
+
+  // A live process's own segment is found through its maps (here: this test maps one).
+  const std::string shm = dir + "/fastrtps_5a5a5a5a5a5a5a5a";
+  { std::ofstream(shm) << std::string(4096, '\0'); }
+  const int fd = open(shm.c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  void* map = mmap(nullptr, 4096, PROT_READ, MAP_SHARED, fd, 0);
+  ASSERT_NE(map, MAP_FAILED);
+  EXPECT_EQ(cli::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 1u);
+  munmap(map, 4096);
+  close(fd);
+  unlink(shm.c_str());
+  EXPECT_EQ(cli::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 0u);
 }
 
 TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
