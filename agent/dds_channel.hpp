@@ -24,7 +24,8 @@ class DdsProtocolChannel : public ProtocolChannel {
   /// (Session::set_protocol_wake_threshold); rollbacks, re-partitions and stops as receive().
   std::optional<ProtocolMessage> receive_after(double timeout_s, std::size_t wake_after) override;
   /// The listener wakes this thread only once every awaited message is queued
-  /// (Session::set_protocol_awaited); rollbacks, re-partitions and stops as receive().
+  /// (Session::set_protocol_awaited); rollbacks, re-partitions and stops as receive(). With an
+  /// intercept set (replicas): receive_after(timeout_s, awaited.senders.size()) instead.
   std::optional<ProtocolMessage> receive_awaiting(double timeout_s,
                                                   const AwaitedMessages& awaited) override;
   /// Messages for which `f` returns true are consumed by it instead of being returned
