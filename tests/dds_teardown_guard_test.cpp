@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -65,6 +66,68 @@ TEST(DdsTeardownGuard, ATeardownThatFinishesChangesNothing) {
   // Disarmed: an abort afterwards is an abort again (the previous handler is back).
   EXPECT_EQ(in_child([] {
               { TeardownGuard guard(5, "test", std::chrono::seconds(10)); }
+              std::abort();
+            }),
+            128 + SIGABRT);
+}
+
+// The agent's cover from the coordinator's FINISHED on (cli/session_process.cpp): an abort
+// counts as the end of a finished run only once the flag is set; before, it is an abort.
+TEST(DdsTeardownGuard, ACoverOnAFlagHoldsOnlyOnceTheFlagIsSet) {
+  EXPECT_EQ(in_child([] {
+              std::atomic<bool> finished{false};
+              TeardownGuard cover(0, "test", std::chrono::seconds(0), &finished);
+              std::thread([] { std::abort(); }).join();
+            }),
+            128 + SIGABRT);
+  EXPECT_EQ(in_child([] {
+              std::atomic<bool> finished{false};
+              TeardownGuard cover(0, "test", std::chrono::seconds(0), &finished);
+              std::thread([&] { finished = true; }).join();  // the listener, on FINISHED
+              std::thread([] { std::abort(); }).join();
+            }),
+            0);
+  // Without a time bound the cover never ends the process on its own.
+  EXPECT_EQ(in_child([] {
+              std::atomic<bool> finished{true};
+              TeardownGuard cover(0, "test", std::chrono::seconds(0), &finished);
+              std::this_thread::sleep_for(std::chrono::milliseconds(300));
+              _exit(6);
+            }),
+            6);
+}
+
+// The participant's deletion is guarded inside the agent's cover: the inner guard takes over
+// (its exit code, unconditionally), and the outer one holds again after it.
+TEST(DdsTeardownGuard, GuardsNestAndTheOuterOneHoldsAgainAfterTheInner) {
+  EXPECT_EQ(in_child([] {
+              std::atomic<bool> finished{false};
+              TeardownGuard cover(0, "test", std::chrono::seconds(0), &finished);
+              TeardownGuard deletion(1, "test", std::chrono::seconds(10));
+              std::abort();
+            }),
+            1);
+  EXPECT_EQ(in_child([] {
+              std::atomic<bool> finished{false};
+              TeardownGuard cover(0, "test", std::chrono::seconds(0), &finished);
+              { TeardownGuard deletion(1, "test", std::chrono::seconds(10)); }
+              std::abort();  // the cover again, its flag not set: an abort
+            }),
+            128 + SIGABRT);
+  EXPECT_EQ(in_child([] {
+              std::atomic<bool> finished{true};
+              TeardownGuard cover(0, "test", std::chrono::seconds(0), &finished);
+              { TeardownGuard deletion(1, "test", std::chrono::seconds(10)); }
+              std::abort();
+            }),
+            0);
+  // Both gone: the previous handler (the default) is back.
+  EXPECT_EQ(in_child([] {
+              std::atomic<bool> finished{true};
+              {
+                TeardownGuard cover(0, "test", std::chrono::seconds(0), &finished);
+                TeardownGuard deletion(1, "test", std::chrono::seconds(10));
+              }
               std::abort();
             }),
             128 + SIGABRT);

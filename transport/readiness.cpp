@@ -136,11 +136,11 @@ std::string Readiness::describe_matched_locked(const std::string& endpoint) cons
 
 bool Readiness::finished() const {
   std::lock_guard<std::mutex> lock(room_.mutex());
-  return finished_;
+  return finished_.load();
 }
 
 WaitStatus Readiness::wait_finished(Seconds timeout) {
-  return room_.wait_for([&] { return finished_; }, timeout);
+  return room_.wait_for([&] { return finished_.load(); }, timeout);
 }
 
 WaitStatus Readiness::barrier(Seconds timeout, std::string* missing,

@@ -5,6 +5,7 @@
 // the linger before leaving on an error). Internal to transport/; state is guarded by the
 // mailroom's mutex.
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -60,6 +61,9 @@ class Readiness {
   /// given) lists the absent peers. Locks the mailroom.
   bool endpoints_matched(std::string* missing) const;
   bool finished() const;
+  /// FINISHED received, readable without the mutex (from a signal handler: the agent's
+  /// end-of-run cover, transport/teardown_guard.hpp). Lives as long as this object.
+  const std::atomic<bool>& finished_flag() const { return finished_; }
   WaitStatus wait_finished(Seconds timeout);
 
   /// The readiness barrier: waits until endpoints_matched(), calls `send_ready`, then waits
@@ -99,9 +103,9 @@ class Readiness {
   std::map<std::string, std::multiset<GuidPrefix>>
       matched_;  // endpoint name -> matched remote participants
   std::map<std::string, std::pair<Expect, std::uint32_t>> expect_;  // with kAgent's agent
-  std::set<std::string> ready_from_;  // describe() of peers that published READY
-  bool finished_ = false;
-  bool coordinator_aborted_ = false;  // an ABORT came from the coordinator
+  std::set<std::string> ready_from_;   // describe() of peers that published READY
+  std::atomic<bool> finished_{false};  // set under the mutex; atomic for finished_flag()
+  bool coordinator_aborted_ = false;   // an ABORT came from the coordinator
 };
 
 }  // namespace tessera::transport

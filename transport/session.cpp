@@ -299,6 +299,10 @@ bool Session::finished() const {
   return impl_->readiness.finished();
 }
 
+const std::atomic<bool>& Session::finished_flag() const {
+  return impl_->readiness.finished_flag();
+}
+
 WaitStatus Session::wait_finished(Seconds timeout) {
   return impl_->readiness.wait_finished(timeout);
 }

@@ -20,6 +20,7 @@
 // expires, or it leaves) or that publishes ABORT stops the session: every wait returns
 // WaitStatus::kStopped and mailroom().stop_info() names the cause.
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -159,6 +160,8 @@ class Session {
   WaitStatus ready_barrier(Seconds timeout, std::string* missing);
   /// Whether the coordinator has published FINISHED (agents).
   bool finished() const;
+  /// The same, readable without a lock (from a signal handler); valid while the session lives.
+  const std::atomic<bool>& finished_flag() const;
   /// Waits for FINISHED from the coordinator.
   WaitStatus wait_finished(Seconds timeout);
 

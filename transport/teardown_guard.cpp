@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -10,35 +11,66 @@ namespace tessera::transport {
 
 namespace {
 
-// State the signal handler reads: written before the handler is installed, so the handler
-// only reads plain memory and calls async-signal-safe functions (write, _exit).
+// State the signal handler reads: written before the handler is installed (or, nested, by
+// the guard's own thread while the outer guard's handler stays in place), so the handler only
+// reads plain memory and lock-free atomics and calls async-signal-safe functions.
 volatile std::sig_atomic_t g_exit_code = 1;
 char g_abort_note[256];
 std::size_t g_abort_note_length = 0;
-struct sigaction g_previous_abort;
+const std::atomic<bool>* volatile g_only_once = nullptr;
+int g_depth = 0;                    // guards alive (nesting)
+struct sigaction g_previous_abort;  // the handler before the outermost guard
 
 extern "C" void on_teardown_abort(int) {
+  const std::atomic<bool>* once = g_only_once;
+  if (once && !once->load()) {
+    // Not covered yet: an abort as without the guard. SIGABRT is blocked inside this handler,
+    // so the raised one is delivered, with the previous action, when the handler returns.
+    sigaction(SIGABRT, &g_previous_abort, nullptr);
+    raise(SIGABRT);
+    return;
+  }
   ssize_t ignored = write(STDERR_FILENO, g_abort_note, g_abort_note_length);
   (void)ignored;
   _exit(g_exit_code);
 }
 
+void set_note(const std::string& note) {
+  const std::size_t n = std::min(note.size(), sizeof(g_abort_note) - 1);
+  std::memcpy(g_abort_note, note.data(), n);
+  g_abort_note[n] = '\0';
+  g_abort_note_length = n;
+}
+
 }  // namespace
 
 TeardownGuard::TeardownGuard(int exit_code, const std::string& who,
-                             std::chrono::duration<double> timeout) {
-  g_exit_code = exit_code;
-  std::snprintf(g_abort_note, sizeof(g_abort_note),
+                             std::chrono::duration<double> timeout,
+                             const std::atomic<bool>* only_once) {
+  previous_was_guard_ = g_depth > 0;
+  if (previous_was_guard_) {
+    previous_exit_code_ = g_exit_code;
+    previous_note_.assign(g_abort_note, g_abort_note_length);
+    previous_only_once_ = g_only_once;
+  }
+  char note[256];
+  std::snprintf(note, sizeof(note),
                 "%s: note: Fast DDS aborted after the run's work was done (a known Fast DDS 2.9 "
                 "race in its participant lease check); exiting with code %d as intended\n",
                 who.c_str(), exit_code);
-  g_abort_note_length = std::strlen(g_abort_note);
-  struct sigaction sa;
-  std::memset(&sa, 0, sizeof(sa));
-  sa.sa_handler = on_teardown_abort;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGABRT, &sa, &g_previous_abort);
+  g_only_once = only_once;
+  g_exit_code = exit_code;
+  set_note(note);
+  if (!previous_was_guard_) {
+    struct sigaction sa;
+    std::memset(&sa, 0, sizeof(sa));
+    sa.sa_handler = on_teardown_abort;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGABRT, &sa, &g_previous_abort);
+  }
+  ++g_depth;
 
+  if (timeout.count() <= 0) return;  // aborts only
   watchdog_ = std::thread([this, exit_code, who, timeout] {
     std::unique_lock<std::mutex> lock(mutex_);
     if (cv_.wait_for(lock, timeout, [this] { return done_; })) return;
@@ -57,8 +89,16 @@ TeardownGuard::~TeardownGuard() {
     done_ = true;
   }
   cv_.notify_all();
-  watchdog_.join();
-  sigaction(SIGABRT, &g_previous_abort, nullptr);
+  if (watchdog_.joinable()) watchdog_.join();
+  --g_depth;
+  if (previous_was_guard_) {
+    g_only_once = previous_only_once_;
+    g_exit_code = previous_exit_code_;
+    set_note(previous_note_);
+  } else {
+    sigaction(SIGABRT, &g_previous_abort, nullptr);
+    g_only_once = nullptr;
+  }
 }
 
 }  // namespace tessera::transport
