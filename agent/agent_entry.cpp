@@ -42,7 +42,7 @@ int agent_main(int argc, char** argv) {
     std::cerr << tag << ": error: " << e.what() << "\n";
     return transport::kExitBadInput;
   }
-  const cli::ProcessRole role{tag, options.net.timeout_s, true};
+  const cli::ProcessRole role{tag, options.net.timeout_s, true, true};
   return cli::run_session_process(
       agent_session_options(options), role, signals,
       [&](transport::Session& session) { run_agent(options, session, std::move(restart)); });

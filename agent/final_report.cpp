@@ -6,6 +6,7 @@
 
 #include "agent/dds_channel.hpp"
 #include "agent/local_dump.hpp"
+#include "agent/test_abort_hook.hpp"
 #include "graph/flat_pose.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
@@ -37,6 +38,7 @@ void deliver_final_estimate(Session& s, const AgentLocalData& local, const Round
   }
   if (!o.output.empty()) write_vertices_g2o(local.owned, result.poses, local.d, o.output);
 
+  test_abort_point(TestAbortPoint::kBeforeResult, o.id);
   wire::FinalEstimate fin;
   fin.run_id(o.net.session.run_id);
   fin.sender(o.id);
@@ -68,6 +70,9 @@ void deliver_final_estimate(Session& s, const AgentLocalData& local, const Round
                 log.tag.c_str(), local.owned.size(), local.measurements.size(), result.rounds,
                 result.cost, static_cast<unsigned long long>(s.stats().bytes_sent), secs);
   std::cerr << buf;
+  // From here on the run is complete (cli/session_process.cpp covers an abort, e.g. Fast DDS's
+  // lease check while the others' participants leave).
+  test_abort_point(TestAbortPoint::kAfterFinished, o.id);
 }
 
 }  // namespace tessera::agent

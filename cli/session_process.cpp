@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "session_args.hpp"
+#include "transport/teardown_guard.hpp"
 
 namespace tessera::cli {
 
@@ -83,6 +84,11 @@ int run_session_process(const SessionOptions& options, const ProcessRole& role,
     return kExitRunFailed;
   }
   Session& s = *session;
+  // After the session (destroyed first: it reads the session's flag) and around everything
+  // up to the participant's deletion, whose own guard takes over inside it.
+  std::optional<TeardownGuard> finished_cover;
+  if (role.cover_after_finished)
+    finished_cover.emplace(kExitOk, role.tag, Seconds(0), &s.finished_flag());
   signals.start([&s](int signo) {
     s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted by " + signal_name(signo));
   });

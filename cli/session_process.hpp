@@ -39,6 +39,12 @@ struct ProcessRole {
   /// On bad input, also wait the whole linger for peers not seen yet (an agent fails at
   /// start-up, typically before it has discovered everyone, and they should learn why).
   bool patient_on_bad_input = false;
+  /// Agents: once the coordinator's FINISHED has arrived (the merged result is written, the
+  /// run is complete), an abort in what is left (the last steps, the others' participants
+  /// leaving, the deletion of ours) ends the process with exit code 0 and a note instead of
+  /// SIGABRT (Fast DDS 2.9's lease-check race, transport/teardown_guard.hpp). An abort before
+  /// FINISHED stays an abort: the run fails.
+  bool cover_after_finished = false;
 };
 
 /// `usage` with its one "%s" replaced by the shared DDS session options' help.

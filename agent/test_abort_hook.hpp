@@ -1,0 +1,22 @@
+#pragma once
+// TEST-ONLY: makes an agent abort (SIGABRT from another thread, as Fast DDS's failed
+// assertion does in its event thread) at a chosen point of the end of its run, so the tests
+// can check how that ends the agent and what launch reports (tests/dds_agent_end_abort_test.cpp).
+// Set by the environment variable TESSERA_TEST_AGENT_ABORT=WHEN[:ID] (every agent without
+// :ID), WHEN one of
+//   before-result   after its round loop, before its final estimate is published: the run
+//                   is not complete and must fail (exit 134, launch exit 1);
+//   after-finished  after the coordinator's FINISHED (the merged result is written): the
+//                   cover of cli/session_process.cpp ends the agent with exit 0 and a note.
+// Never set it outside tests: it crashes the agent on purpose.
+
+#include <cstdint>
+
+namespace tessera::agent {
+
+enum class TestAbortPoint { kBeforeResult, kAfterFinished };
+
+/// Aborts the process if TESSERA_TEST_AGENT_ABORT names `at` for agent `id`; else nothing.
+void test_abort_point(TestAbortPoint at, std::uint32_t id);
+
+}  // namespace tessera::agent
