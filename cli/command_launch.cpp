@@ -461,6 +461,9 @@ int run_launch(const Args& argv) {
   if (!failure.empty()) return exit_code;
 
   if (!summary_printed) print_summary(summary);
+  for (const auto& c : children)
+    for (const auto& note : notes_of(c.log))
+      std::fprintf(stderr, "tessera launch: %s: %s\n", c.name.c_str(), note.c_str());
   std::string lost;
   for (const auto& c : children)
     if (c.lost) lost += (lost.empty() ? "" : ", ") + c.name;

@@ -219,4 +219,12 @@ std::string tail_of(const std::string& path, std::size_t max_lines) {
   return out;
 }
 
+std::vector<std::string> notes_of(const std::string& path) {
+  std::ifstream f(path);
+  std::vector<std::string> notes;
+  for (std::string l; std::getline(f, l);)
+    if (l.find(": note: ") != std::string::npos) notes.push_back(l);
+  return notes;
+}
+
 }  // namespace tessera::cli

@@ -54,4 +54,9 @@ void stop_all(std::vector<Child>& children, double grace_s);
 /// The last `max_lines` lines of a log, indented, for error messages.
 std::string tail_of(const std::string& path, std::size_t max_lines);
 
+/// The lines of the log at `path` that are notes ("<tag>: note: ..."), each as one line: a
+/// finished run's logs are removed, and a note (e.g. a Fast DDS abort covered at the end of the
+/// run, transport/teardown_guard.hpp) should still be seen.
+std::vector<std::string> notes_of(const std::string& path);
+
 }  // namespace tessera::cli
