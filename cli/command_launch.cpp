@@ -365,6 +365,7 @@ int run_launch(const Args& argv) {
   // Stream progress; watch for failures, the time limit and signals.
   std::string pending;
   bool summary_printed = false;
+  bool guard_ended = false;  // a process ended through a teardown guard (its note)
   std::string failure;
   int exit_code = 0;
   bool pipe_open = true;
@@ -405,7 +406,10 @@ int run_launch(const Args& argv) {
     for (auto& c : children) {
       if (c.running || c.judged) continue;
       c.judged = true;
-      if (c.code != 0) note_segments();
+      // A note means a teardown guard ended it (transport/teardown_guard.hpp): with its code,
+      // but from inside Fast DDS, so its files stay like a failed process's.
+      if (!notes_of(c.log).empty()) guard_ended = true;
+      if (c.code != 0 || guard_ended) note_segments();
       const ExitVerdict v = judge_exit(loss, c.agent, c.code, coordinator_done);
       c.lost = v.lost;
       if (!v.notice.empty()) std::fprintf(stderr, "tessera launch: %s\n", v.notice.c_str());
@@ -445,7 +449,7 @@ int run_launch(const Args& argv) {
   sigaction(SIGTERM, &old_term, nullptr);
   // Every process has ended. One that failed may have been killed (SIGKILL, an abort) and left
   // its shared-memory files: remove what of this run's domain no live process holds.
-  bool any_failed = false;
+  bool any_failed = guard_ended;
   for (const auto& c : children) any_failed = any_failed || c.code != 0;
   if (any_failed) {
     ShmCleanupOptions shm;

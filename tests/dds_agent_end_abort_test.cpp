@@ -43,6 +43,7 @@ TEST(DdsAgentEndAbort, AnAbortAfterFinishedEndsTheAgentWithExitZeroAndANote) {
   const int domain = 106;
   const Cleanup cleanup{"endabort-" + std::to_string(getpid())};
   const std::string& run = cleanup.run_id;
+  const auto before = shm_files();
   Process coord =
       start(coordinator_args(2, run, domain, {"--timeout", "30"}), dir + "/coordinator.log");
   Process a0 = start(
@@ -58,6 +59,7 @@ TEST(DdsAgentEndAbort, AnAbortAfterFinishedEndsTheAgentWithExitZeroAndANote) {
   EXPECT_EQ(a0.exit_code, 0) << out0;
   EXPECT_EQ(a1.exit_code, 0) << a1.output();
   EXPECT_EQ(coord.exit_code, 0) << coord.output();
+  remove_shm_files(leaked_shm_files(before, domain));  // the aborted agent's (no launch here)
 }
 
 TEST(DdsAgentEndAbort, LaunchReportsARunWhoseAgentAbortsAfterFinishedAsFinished) {
@@ -67,6 +69,7 @@ TEST(DdsAgentEndAbort, LaunchReportsARunWhoseAgentAbortsAfterFinishedAsFinished)
   const Cleanup cleanup{"endabort2-" + std::to_string(getpid())};
   std::vector<std::string> argv = launch_args(graph, 107, cleanup.run_id);
   argv.insert(argv.end(), {"--json", dir + "/summary.json"});
+  const auto before = shm_files();
   Process launch = start(with_abort("after-finished:0", argv), dir + "/launch.log");
   ASSERT_TRUE(wait_all({&launch}, 90)) << launch.output();
   const std::string out = launch.output();
@@ -78,6 +81,13 @@ TEST(DdsAgentEndAbort, LaunchReportsARunWhoseAgentAbortsAfterFinishedAsFinished)
             std::string::npos)
       << out;
   EXPECT_GT(json_field(slurp(dir + "/summary.json"), "rounds"), 0) << out;
+  // The aborted agent could not remove its shared-memory files: launch does, as after a
+  // failed run (a dead port can keep later runs of the domain from discovering each other).
+  EXPECT_NE(out.find("shared-memory files of dead processes of domain 107"), std::string::npos)
+      << out;
+  const auto leaked = leaked_shm_files(before, 107);
+  EXPECT_TRUE(leaked.empty()) << "left in /dev/shm: " << join(leaked);
+  remove_shm_files(leaked);
 }
 
 TEST(DdsAgentEndAbort, AnAbortBeforeTheResultIsDeliveredStillFailsTheRun) {
