@@ -138,6 +138,20 @@ bool print_summary(const std::string& path) {
   return true;
 }
 
+// Removes the shared-memory files of dead processes of `domain` (and the listed dead segments)
+// and says so on stderr; `when` completes the sentence ("before the run", ...).
+void remove_dead_files_of(int domain, std::set<std::string> segments, const char* when) {
+  ShmCleanupOptions shm;
+  shm.domain = domain;
+  shm.segments = std::move(segments);
+  const ShmCleanupResult r = remove_dead_shm_files(shm);
+  if (!r.removed.empty())
+    std::fprintf(stderr,
+                 "tessera launch: removed %zu shared-memory files of dead processes of domain %d "
+                 "from /dev/shm %s\n",
+                 r.removed.size(), domain, when);
+}
+
 }  // namespace
 
 int run_launch(const Args& argv) {
@@ -339,6 +353,14 @@ int run_launch(const Args& argv) {
     agent_ids.push_back(k);
   }
 
+  // Ports of this domain that dead processes of an earlier run left (a SIGKILLed agent started by
+  // hand, an abort inside Fast DDS) can keep this run's participants from discovering each other
+  // (seen in session 13: every later launch on that domain failed until they were removed). Only
+  // files no live process holds or maps go (shm_leftovers.hpp).
+  const int run_domain =
+      net.session.domain >= 0 ? net.session.domain : transport::domain_for_run(run_id);
+  remove_dead_files_of(run_domain, {}, "before the run");
+
   request_huge_page_heaps();  // for the processes started next (huge_page_heaps.hpp)
   const auto t0 = std::chrono::steady_clock::now();
   // Both close our copy of the progress pipe's write end once the coordinator has its own.
@@ -451,17 +473,7 @@ int run_launch(const Args& argv) {
   // its shared-memory files: remove what of this run's domain no live process holds.
   bool any_failed = guard_ended;
   for (const auto& c : children) any_failed = any_failed || c.code != 0;
-  if (any_failed) {
-    ShmCleanupOptions shm;
-    shm.domain = net.session.domain >= 0 ? net.session.domain : transport::domain_for_run(run_id);
-    shm.segments = std::move(run_segments);
-    const ShmCleanupResult r = remove_dead_shm_files(shm);
-    if (!r.removed.empty())
-      std::fprintf(stderr,
-                   "tessera launch: removed %zu shared-memory files of dead processes of domain "
-                   "%d from /dev/shm\n",
-                   r.removed.size(), shm.domain);
-  }
+  if (any_failed) remove_dead_files_of(run_domain, std::move(run_segments), "after the run");
   if (!failure.empty()) return exit_code;
 
   if (!summary_printed) print_summary(summary);

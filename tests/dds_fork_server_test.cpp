@@ -5,7 +5,7 @@
 // fork server's argv encoding; --agents-yield (agents below the coordinator's priority until
 // their assignment, agent/startup_priority.hpp); agents in SCHED_BATCH until their assignment
 // (launch's default, agent/startup_batch.hpp).
-// Domains used here: 50-53, 211-212, 217 (each test its own, so ctest -j is safe).
+// Domains used here: 50-53, 211-212, 217-218 (each test its own, so ctest -j is safe).
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -498,6 +498,36 @@ TEST(DdsShmLeftovers, OnlyDeadPortsOfTheDomainAndDeadSegmentsOfTheRunAreRemoved)
   close(fd);
   unlink(shm.c_str());
   EXPECT_EQ(cli::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 0u);
+}
+
+// Dead ports of the run's domain that an earlier run's processes left (an abort, a SIGKILLed agent
+// started by hand) are removed before launch starts its processes: left there, they kept every
+// later launch on that domain from discovering its peers (session 13). A run that ends normally
+// removes nothing afterwards, so without the removal before the run the planted files stay.
+TEST(DdsShmLeftovers, LaunchRemovesTheDomainsDeadPortsBeforeTheRun) {
+  const int domain = 218;
+  const std::string port = std::to_string(7400 + 250 * domain + 200);  // no participant's port
+  const std::vector<std::string> planted = {"/dev/shm/fastrtps_port" + port,
+                                            "/dev/shm/fastrtps_port" + port + "_el",
+                                            "/dev/shm/sem.fastrtps_port" + port + "_mutex"};
+  for (const auto& f : planted) std::ofstream(f) << "x";
+  const std::string dir = temp_dir();
+  const std::string graph =
+      generate_graph(dir + "/graph.g2o", "--kind grid3d --poses 120 --robots 2 --seed 3");
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch " + graph +
+                                 " --agents 2 --no-certify --timeout 60 --domain " +
+                                 std::to_string(domain) + " 2>&1",
+                             &out);
+  for (const auto& f : planted) {
+    EXPECT_NE(access(f.c_str(), F_OK), 0) << f << " is still there\n" << out;
+    unlink(f.c_str());
+  }
+  ASSERT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find("removed 3 shared-memory files of dead processes of domain 218 from "
+                     "/dev/shm before the run"),
+            std::string::npos)
+      << out;
 }
 
 TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
