@@ -54,7 +54,7 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
   s.set_coordinator_follows_rounds(arbitrated);
   if (!arbitrated) channel.report_progress(o.id, local.num_agents);
   const AgentLocalData* cur = &local;  // the survivors' new block after a re-partition
-  if (replication.enabled() && !restart) replication.start(local, channel);
+  if (replication.enabled() && !restart) replication.start(local, channel, o.net.timeout_s);
   if (restart) {
     keeper.adopt(restart->snapshots);
     // Secured: the restarted process's handshakes may stall like a fresh one's; the gate

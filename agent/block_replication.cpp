@@ -1,5 +1,6 @@
 #include "agent/block_replication.hpp"
 
+#include <chrono>
 #include <iostream>
 #include <string>
 
@@ -20,13 +21,28 @@ std::string join_ids(const std::vector<std::uint32_t>& ids) {
 
 }  // namespace
 
-void BlockReplication::start(const AgentLocalData& local, DdsProtocolChannel& channel) {
+void BlockReplication::start(const AgentLocalData& local, DdsProtocolChannel& channel,
+                             double timeout_s) {
   std::vector<std::uint32_t> owner = local.owner;
   holders_ = replica_holders(local.structure, owner, local.num_agents, replicas_)[local.agent_id];
   const DistributedOptions defaults;
   Y_ = lift_poses(local.initial,
                   static_cast<int>(local.options.rank ? local.options.rank : defaults.rank));
   send_problem_replicas(session_, local, self_, Y_, holders_);
+  // The hand-off topic is volatile: a sample a holder has not received yet (a datagram lost
+  // under load waits for the next heartbeat's repair) is gone if this process dies, and with
+  // it the measurements only this agent had. So no round before the holders acknowledged it.
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool held = session_.handoffs_acknowledged(transport::Seconds(timeout_s));
+  const long ms = static_cast<long>(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  if (held)
+    log_("replica held by agent(s) " + join_ids(holders_) + " (acknowledged after " +
+         std::to_string(ms) + " ms)");
+  else
+    std::cerr << log_.tag << ": warning: replica not acknowledged by agent(s) "
+              << join_ids(holders_) << " within " << timeout_s
+              << " s: a loss of this agent may not be covered\n";
   channel.set_intercept([this](const ProtocolMessage& m) {
     const auto* b = std::get_if<PoseBlockMessage>(&m);
     if (!b || b->phase != kReplicaPhase) return false;

@@ -32,9 +32,11 @@ class BlockReplication {
         log_(log) {}
 
   bool enabled() const { return replicas_ > 0; }
-  /// Sends `local`'s problem and lifted start to its holders, and makes `channel` keep the
-  /// lifted-pose replicas of other agents instead of handing them to the round protocol.
-  void start(const AgentLocalData& local, DdsProtocolChannel& channel);
+  /// Sends `local`'s problem and lifted start to its holders and waits (at most `timeout_s`)
+  /// until they acknowledged it, so that from this agent's first round on a loss of it is
+  /// covered; makes `channel` keep the lifted-pose replicas of other agents instead of
+  /// handing them to the round protocol.
+  void start(const AgentLocalData& local, DdsProtocolChannel& channel, double timeout_s);
   /// After each round of `local` (the block in force): remembers the lifted poses (the
   /// take-over starts from them); every replica_every rounds, before any take-over, sends
   /// them to the holders.

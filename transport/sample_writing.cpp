@@ -65,10 +65,11 @@ void SampleWriter::flush(Seconds timeout) {
   }
 }
 
-void SampleWriter::wait_acknowledged(const std::string& topic, Seconds timeout) {
+bool SampleWriter::wait_acknowledged(const std::string& topic, Seconds timeout) {
   eprosima::fastdds::dds::DataWriter* w = entities_.writer(topic);
-  if (timeout.count() > 0 && w)
-    w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(timeout.count()));
+  if (timeout.count() <= 0 || !w) return false;
+  return w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(timeout.count())) ==
+         ReturnCode_t::RETCODE_OK;
 }
 
 }  // namespace tessera::transport

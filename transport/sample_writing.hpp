@@ -34,8 +34,8 @@ class SampleWriter {
   /// Waits until every writer's samples are acknowledged, for at most `timeout` in total.
   void flush(Seconds timeout);
   /// Waits until the writer of `topic` (if any) has its samples acknowledged, at most
-  /// `timeout` (nothing when <= 0).
-  void wait_acknowledged(const std::string& topic, Seconds timeout);
+  /// `timeout` (nothing when <= 0). True when every matched reader acknowledged them.
+  bool wait_acknowledged(const std::string& topic, Seconds timeout);
 
   std::uint64_t bytes_sent() const { return bytes_.load(); }
   std::uint64_t messages_sent() const { return messages_.load(); }

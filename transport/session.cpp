@@ -382,6 +382,10 @@ void Session::flush(Seconds timeout) {
   impl_->writer.flush(timeout);
 }
 
+bool Session::handoffs_acknowledged(Seconds timeout) {
+  return impl_->writer.wait_acknowledged(kHandoffTopic, timeout);
+}
+
 void Session::linger_for_control(Seconds timeout, Seconds unseen_patience) {
   const auto start = std::chrono::steady_clock::now();
   auto left = [&] {

@@ -188,6 +188,10 @@ class Session {
   std::vector<std::uint32_t> lost_agents() const;
   /// Waits until every reliable sample written so far is acknowledged (bounded).
   void flush(Seconds timeout);
+  /// Waits at most `timeout` until every hand-off this process published is acknowledged by
+  /// every matched reader, i.e. held in the recipients' queues even if this process dies
+  /// now (volatile samples are not repaired once their writer is gone). True if so.
+  bool handoffs_acknowledged(Seconds timeout);
   /// Before leaving on an error, all within `timeout`: an agent first waits until the
   /// coordinator acknowledged the abort (sent its own ABORT) or is gone, discovered or not
   /// (the coordinator must name the cause; matching our writer to its reader is not enough,
