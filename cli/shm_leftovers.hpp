@@ -5,11 +5,11 @@
 // data segment (fastrtps_<hex>, lock fastrtps_<hex>_el) stay. A live owner holds the lock file
 // (flock), so a lock nobody holds marks a dead owner's files; a port whose lock file is gone
 // (seen: the port and its mutex only) is dead when no process maps it. `fastdds shm clean`
-// looks at lock files only, and at every domain. `tessera launch` removes after a run that
-// lost a process the dead ports of its own domain (RTPS's default ports: 7400 + 250 domain, up
-// to the next domain's) and the dead segments its own processes had mapped -- never a file whose
-// lock is held or that a process maps, never another domain's port, never a segment no process
-// of the run used. (A process that has just created a port but not yet locked or mapped it
+// looks at lock files only, and at every domain. `tessera launch` removes before each run, and
+// after a run that lost a process, the dead ports of its own domain (RTPS's default ports: 7400 +
+// 250 domain, up to the next domain's) and the dead segments its own processes had mapped -- never
+// a file whose lock is held or that a process maps, never another domain's port, never a segment no
+// process of the run used. (A process that has just created a port but not yet locked or mapped it
 // could lose it: a run of its own domain starting in that instant; launch's domain is its
 // run's.)
 
