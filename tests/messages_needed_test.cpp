@@ -22,34 +22,45 @@
 namespace tessera {
 namespace {
 
-TEST(MessagesNeeded, IsALowerBoundOnWhatEachStepWaitsFor) {
-  test::RandomGraphSpec spec;
-  spec.d = 2;
-  spec.poses = 80;
-  spec.loop_closures = 40;
-  spec.seed = 5;
-  const PoseGraph g = test::random_pose_graph(spec);
-  const int N = 4;
-  DistributedOptions opt;
-  opt.max_rounds = 30;
-  std::vector<int> assignment(g.num_poses);
-  for (std::size_t i = 0; i < g.num_poses; ++i)
-    assignment[i] = static_cast<int>(i * static_cast<std::size_t>(N) / g.num_poses);
-  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, assignment);
-  const Eigen::MatrixXd X0 = lift_poses(g.initial, opt.rank);
-  const auto scheme = make_momentum_scheme(opt, layout, static_cast<double>(X0.size()));
-  const RoundConfig config = make_round_config(opt, scheme.get());
+// Four round protocols on an 80-pose random graph cut into contiguous blocks, started, and
+// their queues: post() hands a step's output to every recipient but the sender, as a transport.
+struct FourAgents {
+  static constexpr int N = 4;
+  PoseGraph g;
+  BlockLayout layout;
+  std::unique_ptr<MomentumScheme> scheme;
   std::vector<std::unique_ptr<AgentState>> states;
   std::vector<std::unique_ptr<RoundProtocol>> agents;
-  for (int b = 0; b < N; ++b) {
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
-                                                  test::pose_columns(X0, g.d, ids)));
-    agents.push_back(std::make_unique<RoundProtocol>(*states.back(), layout, config));
+  std::vector<std::deque<ProtocolMessage>> queue = std::vector<std::deque<ProtocolMessage>>(N);
+
+  FourAgents(const FourAgents&) = delete;  // the agents hold references into it
+  FourAgents& operator=(const FourAgents&) = delete;
+  FourAgents() {
+    test::RandomGraphSpec spec;
+    spec.d = 2;
+    spec.poses = 80;
+    spec.loop_closures = 40;
+    spec.seed = 5;
+    g = test::random_pose_graph(spec);
+    DistributedOptions opt;
+    opt.max_rounds = 30;
+    std::vector<int> assignment(g.num_poses);
+    for (std::size_t i = 0; i < g.num_poses; ++i)
+      assignment[i] = static_cast<int>(i * static_cast<std::size_t>(N) / g.num_poses);
+    layout = make_block_layout(g.num_poses, g.measurements, assignment);
+    const Eigen::MatrixXd X0 = lift_poses(g.initial, opt.rank);
+    scheme = make_momentum_scheme(opt, layout, static_cast<double>(X0.size()));
+    const RoundConfig config = make_round_config(opt, scheme.get());
+    for (int b = 0; b < N; ++b) {
+      const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+      states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
+                                                    test::pose_columns(X0, g.d, ids)));
+      agents.push_back(std::make_unique<RoundProtocol>(*states.back(), layout, config));
+    }
+    for (int a = 0; a < N; ++a) post(a, agents[static_cast<std::size_t>(a)]->start());
   }
 
-  std::vector<std::deque<ProtocolMessage>> queue(N);
-  auto post = [&](int from, const std::vector<OutgoingMessage>& out) {
+  void post(int from, const std::vector<OutgoingMessage>& out) {
     for (const auto& m : out)
       for (int a = 0; a < N; ++a) {
         if (a == from) continue;
@@ -57,8 +68,15 @@ TEST(MessagesNeeded, IsALowerBoundOnWhatEachStepWaitsFor) {
         for (auto r : m.recipients) to_a = to_a || static_cast<int>(r) == a;
         if (to_a) queue[static_cast<std::size_t>(a)].push_back(m.message);
       }
-  };
-  for (int a = 0; a < N; ++a) post(a, agents[static_cast<std::size_t>(a)]->start());
+  }
+};
+
+TEST(MessagesNeeded, IsALowerBoundOnWhatEachStepWaitsFor) {
+  FourAgents run;
+  const int N = FourAgents::N;
+  auto& agents = run.agents;
+  auto& queue = run.queue;
+  auto post = [&](int from, const std::vector<OutgoingMessage>& out) { run.post(from, out); };
 
   // Each agent in turn takes exactly messages_needed() messages when that many are queued
   // (as the DDS agent wakes then): the first needed - 1 of them must leave it where it was.
@@ -107,42 +125,11 @@ TEST(MessagesNeeded, IsALowerBoundOnWhatEachStepWaitsFor) {
 // them are queued, session 13): handing the agent everything else queued never moves it on,
 // the named ones do, with the last of them -- and the agents still run the same rounds.
 TEST(MessagesNeeded, AwaitedNamesExactlyTheMessagesThatCompleteTheStep) {
-  test::RandomGraphSpec spec;
-  spec.d = 2;
-  spec.poses = 80;
-  spec.loop_closures = 40;
-  spec.seed = 5;
-  const PoseGraph g = test::random_pose_graph(spec);
-  const int N = 4;
-  DistributedOptions opt;
-  opt.max_rounds = 30;
-  std::vector<int> assignment(g.num_poses);
-  for (std::size_t i = 0; i < g.num_poses; ++i)
-    assignment[i] = static_cast<int>(i * static_cast<std::size_t>(N) / g.num_poses);
-  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, assignment);
-  const Eigen::MatrixXd X0 = lift_poses(g.initial, opt.rank);
-  const auto scheme = make_momentum_scheme(opt, layout, static_cast<double>(X0.size()));
-  const RoundConfig config = make_round_config(opt, scheme.get());
-  std::vector<std::unique_ptr<AgentState>> states;
-  std::vector<std::unique_ptr<RoundProtocol>> agents;
-  for (int b = 0; b < N; ++b) {
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
-                                                  test::pose_columns(X0, g.d, ids)));
-    agents.push_back(std::make_unique<RoundProtocol>(*states.back(), layout, config));
-  }
-
-  std::vector<std::deque<ProtocolMessage>> queue(N);
-  auto post = [&](int from, const std::vector<OutgoingMessage>& out) {
-    for (const auto& m : out)
-      for (int a = 0; a < N; ++a) {
-        if (a == from) continue;
-        bool to_a = m.broadcast;
-        for (auto r : m.recipients) to_a = to_a || static_cast<int>(r) == a;
-        if (to_a) queue[static_cast<std::size_t>(a)].push_back(m.message);
-      }
-  };
-  for (int a = 0; a < N; ++a) post(a, agents[static_cast<std::size_t>(a)]->start());
+  FourAgents run;
+  const int N = FourAgents::N;
+  auto& agents = run.agents;
+  auto& queue = run.queue;
+  auto post = [&](int from, const std::vector<OutgoingMessage>& out) { run.post(from, out); };
 
   std::size_t steps = 0, held_back = 0;
   for (int sweep = 0; sweep < 100000; ++sweep) {
