@@ -65,6 +65,18 @@ OutgoingMessage status(std::uint32_t phase, std::uint32_t sender = 0, std::uint3
   return m;
 }
 
+// Every session passes the readiness barrier (every endpoint matched, READY from all), all at
+// once as separate processes would.
+void pass_readiness_barriers(std::vector<std::unique_ptr<Session>>& sessions) {
+  std::vector<std::future<WaitStatus>> barriers;
+  for (auto& s : sessions)
+    barriers.push_back(std::async(std::launch::async, [&s] {
+      std::string missing;
+      return s->ready_barrier(Seconds(30), &missing);
+    }));
+  for (auto& b : barriers) ASSERT_EQ(b.get(), WaitStatus::kReady);
+}
+
 // The phases of the protocol messages `s` has received, in arrival order per type.
 std::vector<std::uint32_t> received_phases(Session& s, std::size_t expected) {
   std::vector<std::uint32_t> out;
@@ -94,13 +106,7 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   Session& a2 = *sessions[3];
 
   // Every process passes the readiness barrier (every endpoint matched, READY from all).
-  std::vector<std::future<WaitStatus>> barriers;
-  for (auto& s : sessions)
-    barriers.push_back(std::async(std::launch::async, [&s] {
-      std::string missing;
-      return s->ready_barrier(Seconds(30), &missing);
-    }));
-  for (auto& b : barriers) ASSERT_EQ(b.get(), WaitStatus::kReady);
+  ASSERT_NO_FATAL_FAILURE(pass_readiness_barriers(sessions));
 
   a0.send(block_to({1}, 2));  // addressed to agent 1 only
   a0.send(block_to({}, 3));   // broadcast
@@ -216,13 +222,7 @@ TEST(DdsDelivery, BlocksToTheRelayRideInTheSendersStatusSample) {
   Session& a0 = *sessions[1];
   Session& a1 = *sessions[2];
   Session& a2 = *sessions[3];
-  std::vector<std::future<WaitStatus>> barriers;
-  for (auto& s : sessions)
-    barriers.push_back(std::async(std::launch::async, [&s] {
-      std::string missing;
-      return s->ready_barrier(Seconds(30), &missing);
-    }));
-  for (auto& b : barriers) ASSERT_EQ(b.get(), WaitStatus::kReady);
+  ASSERT_NO_FATAL_FAILURE(pass_readiness_barriers(sessions));
   for (Session* a : {&a0, &a1, &a2}) a->set_status_relay(true);
 
   auto block_from_1 = [](std::vector<std::uint32_t> to, std::uint32_t pose) {
