@@ -12,15 +12,11 @@
 #include <map>
 #include <memory>
 
-#include "distributed/agent_factory.hpp"
-#include "distributed/agent_state.hpp"
-#include "distributed/block_layout.hpp"
 #include "distributed/checkpoint_file.hpp"
 #include "distributed/in_process_driver.hpp"
 #include "distributed/protocol_snapshot.hpp"
-#include "lifted_blocks.hpp"
-#include "problem/lifting.hpp"
 #include "random_graph.hpp"
+#include "round_agents.hpp"
 
 namespace tessera {
 namespace {
@@ -35,31 +31,7 @@ fs::path fresh_dir(const std::string& name) {
   return dir;
 }
 
-// N agents of one run, built as the in-process engine builds them.
-struct AgentsOfRun {
-  AgentsOfRun(const PoseGraph& g, int N, const DistributedOptions& opt) : graph(g) {
-    std::vector<int> assignment(g.num_poses);
-    for (std::size_t i = 0; i < g.num_poses; ++i)
-      assignment[i] = static_cast<int>(i * static_cast<std::size_t>(N) / g.num_poses);
-    layout = make_block_layout(g.num_poses, g.measurements, assignment);
-    const Eigen::MatrixXd X0 = lift_poses(g.initial, opt.rank);
-    scheme = make_momentum_scheme(opt, layout, static_cast<double>(X0.size()));
-    const RoundConfig config = make_round_config(opt, scheme.get());
-    for (int b = 0; b < N; ++b) {
-      const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-      states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
-                                                    test::pose_columns(X0, g.d, ids)));
-      protocols.push_back(std::make_unique<RoundProtocol>(*states.back(), layout, config));
-      agents.push_back(protocols.back().get());
-    }
-  }
-  const PoseGraph& graph;
-  BlockLayout layout;
-  std::unique_ptr<MomentumScheme> scheme;
-  std::vector<std::unique_ptr<AgentState>> states;
-  std::vector<std::unique_ptr<RoundProtocol>> protocols;
-  std::vector<RoundProtocol*> agents;
-};
+using test::AgentsOfRun;
 
 PoseGraph test_graph() {
   test::RandomGraphSpec spec;

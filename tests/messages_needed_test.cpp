@@ -11,13 +11,9 @@
 #include <optional>
 #include <vector>
 
-#include "distributed/agent_factory.hpp"
-#include "distributed/agent_state.hpp"
-#include "distributed/block_layout.hpp"
 #include "distributed/round_protocol.hpp"
-#include "lifted_blocks.hpp"
-#include "problem/lifting.hpp"
 #include "random_graph.hpp"
+#include "round_agents.hpp"
 
 namespace tessera {
 namespace {
@@ -26,38 +22,29 @@ namespace {
 // their queues: post() hands a step's output to every recipient but the sender, as a transport.
 struct FourAgents {
   static constexpr int N = 4;
-  PoseGraph g;
-  BlockLayout layout;
-  std::unique_ptr<MomentumScheme> scheme;
-  std::vector<std::unique_ptr<AgentState>> states;
-  std::vector<std::unique_ptr<RoundProtocol>> agents;
+  PoseGraph g = graph();
+  test::AgentsOfRun built{g, N, options()};
+  std::vector<std::unique_ptr<RoundProtocol>>& agents = built.protocols;
   std::vector<std::deque<ProtocolMessage>> queue = std::vector<std::deque<ProtocolMessage>>(N);
 
   FourAgents(const FourAgents&) = delete;  // the agents hold references into it
   FourAgents& operator=(const FourAgents&) = delete;
   FourAgents() {
+    for (int a = 0; a < N; ++a) post(a, agents[static_cast<std::size_t>(a)]->start());
+  }
+
+  static PoseGraph graph() {
     test::RandomGraphSpec spec;
     spec.d = 2;
     spec.poses = 80;
     spec.loop_closures = 40;
     spec.seed = 5;
-    g = test::random_pose_graph(spec);
+    return test::random_pose_graph(spec);
+  }
+  static DistributedOptions options() {
     DistributedOptions opt;
     opt.max_rounds = 30;
-    std::vector<int> assignment(g.num_poses);
-    for (std::size_t i = 0; i < g.num_poses; ++i)
-      assignment[i] = static_cast<int>(i * static_cast<std::size_t>(N) / g.num_poses);
-    layout = make_block_layout(g.num_poses, g.measurements, assignment);
-    const Eigen::MatrixXd X0 = lift_poses(g.initial, opt.rank);
-    scheme = make_momentum_scheme(opt, layout, static_cast<double>(X0.size()));
-    const RoundConfig config = make_round_config(opt, scheme.get());
-    for (int b = 0; b < N; ++b) {
-      const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-      states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
-                                                    test::pose_columns(X0, g.d, ids)));
-      agents.push_back(std::make_unique<RoundProtocol>(*states.back(), layout, config));
-    }
-    for (int a = 0; a < N; ++a) post(a, agents[static_cast<std::size_t>(a)]->start());
+    return opt;
   }
 
   void post(int from, const std::vector<OutgoingMessage>& out) {

@@ -1,0 +1,32 @@
+#pragma once
+// N round protocols of one run over a graph cut into contiguous blocks, built as the in-process
+// engine builds them (layout, lifted start, momentum scheme, one AgentState each), for the
+// tests that drive core's protocol by hand.
+
+#include <memory>
+#include <vector>
+
+#include "distributed/agent_factory.hpp"
+#include "distributed/agent_state.hpp"
+#include "distributed/block_layout.hpp"
+#include "distributed/round_protocol.hpp"
+#include "graph/pose_graph.hpp"
+
+namespace tessera::test {
+
+struct AgentsOfRun {
+  /// Agent b owns poses [b n / N, (b + 1) n / N). `g` must outlive this object, which must not
+  /// move (the agents hold references into it).
+  AgentsOfRun(const PoseGraph& g, int N, const DistributedOptions& opt);
+  AgentsOfRun(const AgentsOfRun&) = delete;
+  AgentsOfRun& operator=(const AgentsOfRun&) = delete;
+
+  const PoseGraph& graph;
+  BlockLayout layout;
+  std::unique_ptr<MomentumScheme> scheme;
+  std::vector<std::unique_ptr<AgentState>> states;
+  std::vector<std::unique_ptr<RoundProtocol>> protocols;
+  std::vector<RoundProtocol*> agents;  ///< protocols, as the driver takes them
+};
+
+}  // namespace tessera::test
