@@ -1,10 +1,10 @@
 #include "agent/startup_batch.hpp"
 
-#include <dirent.h>
 #include <sched.h>
 
-#include <cstdlib>
 #include <mutex>
+
+#include "agent/process_threads.hpp"
 
 namespace tessera::agent {
 
@@ -23,21 +23,11 @@ BatchState& batch_state() {
 
 // Every thread of this process in SCHED_BATCH to SCHED_OTHER; returns the threads changed.
 int restore_threads() {
-  int changed = 0;
   const sched_param normal{};
-  for (int pass = 0; pass < 2; ++pass) {
-    DIR* dir = opendir("/proc/self/task");
-    if (!dir) return changed;
-    while (dirent* e = readdir(dir)) {
-      if (e->d_name[0] == '.') continue;
-      const pid_t tid = static_cast<pid_t>(std::atol(e->d_name));
-      if (sched_getscheduler(tid) == SCHED_BATCH &&
-          sched_setscheduler(tid, SCHED_OTHER, &normal) == 0)
-        ++changed;
-    }
-    closedir(dir);
-  }
-  return changed;
+  return change_every_thread([&normal](pid_t tid) {
+    return sched_getscheduler(tid) == SCHED_BATCH &&
+           sched_setscheduler(tid, SCHED_OTHER, &normal) == 0;
+  });
 }
 
 }  // namespace

@@ -1,6 +1,5 @@
 #include "agent/startup_priority.hpp"
 
-#include <dirent.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -16,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "agent/process_threads.hpp"
 #include "util/input_error.hpp"
 
 namespace tessera::agent {
@@ -84,23 +84,14 @@ bool can_restore_thread_nice() {
   return false;
 }
 
-// Every thread of this process to nice 0; two passes, since a thread created during the first
-// by a thread still lowered inherits the lowered nice. Returns the threads changed.
+// Every thread of this process to nice 0 (change_every_thread's two passes: a thread created
+// meanwhile by a lowered one inherits the lowered nice). Returns the threads changed.
 int restore_threads() {
-  int changed = 0;
-  for (int pass = 0; pass < 2; ++pass) {
-    DIR* dir = opendir("/proc/self/task");
-    if (!dir) return changed;
-    while (dirent* e = readdir(dir)) {
-      if (e->d_name[0] == '.') continue;
-      const id_t tid = static_cast<id_t>(std::atol(e->d_name));
-      errno = 0;
-      const int now = getpriority(PRIO_PROCESS, tid);
-      if (errno == 0 && now != 0 && setpriority(PRIO_PROCESS, tid, 0) == 0) ++changed;
-    }
-    closedir(dir);
-  }
-  return changed;
+  return change_every_thread([](pid_t tid) {
+    errno = 0;
+    const int now = getpriority(PRIO_PROCESS, static_cast<id_t>(tid));
+    return errno == 0 && now != 0 && setpriority(PRIO_PROCESS, static_cast<id_t>(tid), 0) == 0;
+  });
 }
 
 // The group back to nice 0, unless another agent of the group did it already; retried while
