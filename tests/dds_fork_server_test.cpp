@@ -222,6 +222,18 @@ TEST(DdsForkServer, BatchStartedAgentsRunTheirRoundsAsNormalThreads) {
   run.end();
 }
 
+// Runs `checks` in a forked child (scheduling settings are per process and per thread, so the
+// test process stays untouched) and expects it to report no failed check (a bit per check).
+void expect_checks_pass_in_child(int (*checks)()) {
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) _exit(checks());
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "failed checks (bits): " << WEXITSTATUS(status);
+}
+
 // In a forked child (so the test's threads keep their policy): enter_startup_batch puts the
 // calling thread and every thread it creates in SCHED_BATCH; restore_startup_batch puts every
 // thread back, once. Each failed check is one bit of the child's exit code.
@@ -249,13 +261,7 @@ int batch_and_restore_in_child() {
 }
 
 TEST(StartupBatch, NewThreadsInheritItAndRestoreBringsEveryThreadBack) {
-  const pid_t child = fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) _exit(batch_and_restore_in_child());
-  int status = 0;
-  ASSERT_EQ(waitpid(child, &status, 0), child);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0) << "failed checks (bits): " << WEXITSTATUS(status);
+  expect_checks_pass_in_child(batch_and_restore_in_child);
 }
 
 // In a forked child (so neither the test's session nor its threads change): what
@@ -307,13 +313,7 @@ int lower_and_restore_in_child() {
 }
 
 TEST(StartupPriority, LowersTheAgentsAndPutsThemBackAtNiceZero) {
-  const pid_t child = fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) _exit(lower_and_restore_in_child());
-  int status = 0;
-  ASSERT_EQ(waitpid(child, &status, 0), child);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0) << "failed checks (bits): " << WEXITSTATUS(status);
+  expect_checks_pass_in_child(lower_and_restore_in_child);
 }
 
 TEST(StartupPriority, OptionsNameTheBadField) {

@@ -344,6 +344,19 @@ inline std::string join(const std::set<std::string>& s) {
   return out;
 }
 
+/// After a launch in which a process died inside Fast DDS (SIGKILL, an abort): launch's output
+/// `out` says it removed the dead shared-memory files of `domain` (cli/shm_leftovers.hpp) and
+/// none of them is left since `before` (whatever is, is removed here after the check).
+inline void expect_launch_removed_dead_shm_files(const std::string& out,
+                                                 const std::set<std::string>& before, int domain) {
+  EXPECT_NE(out.find("shared-memory files of dead processes of domain " + std::to_string(domain)),
+            std::string::npos)
+      << out;
+  const auto leaked = leaked_shm_files(before, domain);
+  EXPECT_TRUE(leaked.empty()) << "left in /dev/shm: " << join(leaked);
+  remove_shm_files(leaked);
+}
+
 /// The whole text of a file ("" when it cannot be read).
 inline std::string slurp(const std::string& path) {
   std::ifstream f(path);

@@ -262,11 +262,7 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
   EXPECT_NE(out.find("participant lease"), std::string::npos) << out;
   // The killed agent could not remove its shared-memory files; launch removed them after the
   // run (cli/shm_leftovers.hpp): no file of this domain that no process uses is left.
-  EXPECT_NE(out.find("shared-memory files of dead processes of domain 166"), std::string::npos)
-      << out;
-  const auto leaked = leaked_shm_files(before, 166);
-  EXPECT_TRUE(leaked.empty()) << "left in /dev/shm: " << join(leaked);
-  remove_shm_files(leaked);
+  expect_launch_removed_dead_shm_files(out, before, 166);
 }
 
 // A hung agent (SIGSTOP: its DDS threads stop too, so a lease longer than the stop keeps it
