@@ -52,6 +52,21 @@ GuidPrefix successor_prefix(const GuidPrefix& old, bool secured, std::size_t gen
   for (int k = 9; k < 12; ++k) p.value[k] = static_cast<std::uint8_t>(random());
   return p;
 }
+
+// A pose block as Session::send writes it, to `recipients` (or everyone when `broadcast`).
+void write_block(SessionParts& s, std::uint32_t epoch, const PoseBlockMessage& block,
+                 bool broadcast, const std::vector<std::uint32_t>& recipients) {
+  wire::PoseBlock w = to_wire_block(block, s.opt.run_id, broadcast, recipients);
+  w.epoch(epoch);
+  // Addressed blocks reach only their recipients (one sample on each one's own topic);
+  // broadcasts, and everything after a renumbering re-partition, use the shared topic.
+  if (broadcast || s.renumbered || s.opt.num_agents > kMaxAgentsWithRecipientTopics) {
+    s.writer.write(kBlockTopic, w);
+  } else {
+    for (std::uint32_t k : recipients)
+      if (k != s.me.agent_id) s.writer.write(block_topic_for(k), w);
+  }
+}
 }  // namespace
 
 Session::Session(const SessionOptions& options)
@@ -170,16 +185,7 @@ void Session::send(const OutgoingMessage& m) {
   const std::string& run = impl_->opt.run_id;
   const std::uint32_t e = epoch();
   if (const auto* block = std::get_if<PoseBlockMessage>(&m.message)) {
-    wire::PoseBlock w = to_wire_block(*block, run, m.broadcast, m.recipients);
-    w.epoch(e);
-    // Addressed blocks reach only their recipients (one sample on each one's own topic);
-    // broadcasts, and everything after a renumbering re-partition, use the shared topic.
-    if (m.broadcast || impl_->renumbered || impl_->opt.num_agents > kMaxAgentsWithRecipientTopics) {
-      impl_->writer.write(kBlockTopic, w);
-    } else {
-      for (std::uint32_t k : m.recipients)
-        if (k != impl_->me.agent_id) impl_->writer.write(block_topic_for(k), w);
-    }
+    write_block(*impl_, e, *block, m.broadcast, m.recipients);
   } else {
     const auto& status = std::get<RoundStatusMessage>(m.message);
     wire::RoundStatus w = to_wire_status(status, run, m.broadcast, m.recipients);
@@ -233,11 +239,11 @@ void Session::send_all(const std::vector<OutgoingMessage>& messages) {
         if (rides(b)) attach_block(w, std::get<PoseBlockMessage>(b.message));
       s.writer.write(kRelayStatusTopic, w);
     } else if (rides(m)) {
-      OutgoingMessage others = m;  // its other recipients get it as usual
-      others.recipients.erase(
-          std::remove(others.recipients.begin(), others.recipients.end(), kRelayAgent),
-          others.recipients.end());
-      if (!others.recipients.empty()) send(others);
+      std::vector<std::uint32_t> others;  // its other recipients get it as usual
+      for (std::uint32_t k : m.recipients)
+        if (k != kRelayAgent) others.push_back(k);
+      if (!others.empty())
+        write_block(s, epoch(), std::get<PoseBlockMessage>(m.message), false, others);
     } else {
       send(m);
     }
