@@ -7,14 +7,14 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <tessera/distributed/checkpoint_file.hpp>
 #include <vector>
 
-#include "agent/agent_log.hpp"
 #include "agent/agent_options.hpp"
 #include "agent/agent_run.hpp"
 #include "agent/heap_retention.hpp"
 #include "agent/startup_priority.hpp"
-#include "distributed/checkpoint_file.hpp"
+#include "runtime/agent_log.hpp"
 #include "session_process.hpp"
 #include "transport/signal_watcher.hpp"
 

@@ -3,7 +3,7 @@
 #include <iostream>
 #include <string>
 
-#include "agent/agent_log.hpp"
+#include "runtime/agent_log.hpp"
 #include "transport/peer_gate.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"

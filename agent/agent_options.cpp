@@ -1,8 +1,9 @@
 #include "agent/agent_options.hpp"
 
-#include "agent/checkpoint_keeper.hpp"
+#include <tessera/util/input_error.hpp>
+
 #include "arguments.hpp"
-#include "util/input_error.hpp"
+#include "runtime/checkpoint_keeper.hpp"
 
 namespace tessera::agent {
 

@@ -8,15 +8,15 @@
 #include <thread>
 
 #include "agent/agent_gate.hpp"
-#include "agent/agent_log.hpp"
 #include "agent/block_replication.hpp"
-#include "agent/checkpoint_keeper.hpp"
 #include "agent/dds_channel.hpp"
 #include "agent/final_report.hpp"
 #include "agent/lost_for_good.hpp"
 #include "agent/rejoin.hpp"
-#include "agent/round_loop.hpp"
 #include "agent/run_setup.hpp"
+#include "runtime/agent_log.hpp"
+#include "runtime/checkpoint_keeper.hpp"
+#include "runtime/round_loop.hpp"
 #include "transport/run_failure.hpp"
 
 namespace tessera::agent {

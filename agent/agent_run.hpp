@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
-#include "agent/agent_checkpoint.hpp"
 #include "agent/agent_options.hpp"
+#include "runtime/agent_checkpoint.hpp"
 #include "transport/session.hpp"
 
 namespace tessera::agent {

@@ -3,11 +3,11 @@
 #include <chrono>
 #include <iostream>
 #include <string>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/replica_plan.hpp>
+#include <tessera/problem/lifting.hpp>
 
 #include "agent/survivor_exchange.hpp"
-#include "distributed/distributed_solver.hpp"
-#include "distributed/replica_plan.hpp"
-#include "problem/lifting.hpp"
 
 namespace tessera::agent {
 

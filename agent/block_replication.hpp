@@ -7,13 +7,13 @@
 
 #include <cstdint>
 #include <optional>
+#include <tessera/distributed/protocol_snapshot.hpp>
 #include <vector>
 
-#include "agent/agent_log.hpp"
 #include "agent/dds_channel.hpp"
-#include "agent/round_loop.hpp"
-#include "agent/survivor_takeover.hpp"
-#include "distributed/protocol_snapshot.hpp"
+#include "runtime/agent_log.hpp"
+#include "runtime/round_loop.hpp"
+#include "runtime/survivor_takeover.hpp"
 #include "tessera.h"
 #include "transport/session.hpp"
 

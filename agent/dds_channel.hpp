@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "agent/progress_digest.hpp"
-#include "agent/round_loop.hpp"
+#include "runtime/round_loop.hpp"
 #include "transport/session.hpp"
 
 namespace tessera::agent {

@@ -3,11 +3,11 @@
 #include <cstdio>
 #include <iostream>
 #include <string>
+#include <tessera/graph/flat_pose.hpp>
 
 #include "agent/dds_channel.hpp"
-#include "agent/local_dump.hpp"
 #include "agent/test_abort_hook.hpp"
-#include "graph/flat_pose.hpp"
+#include "runtime/local_dump.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
 

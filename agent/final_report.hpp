@@ -6,9 +6,9 @@
 
 #include <chrono>
 
-#include "agent/agent_log.hpp"
 #include "agent/agent_options.hpp"
-#include "agent/round_loop.hpp"
+#include "runtime/agent_log.hpp"
+#include "runtime/round_loop.hpp"
 #include "transport/session.hpp"
 
 namespace tessera::agent {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "agent/local_share.hpp"
+#include "runtime/local_share.hpp"
 #include "transport/session.hpp"
 
 namespace tessera::agent {

@@ -1,9 +1,9 @@
 #include "agent/progress_digest.hpp"
 
 #include <string>
+#include <tessera/util/input_error.hpp>
 
 #include "transport/topic_names.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::agent {
 

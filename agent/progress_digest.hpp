@@ -17,10 +17,10 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <tessera/protocol/messages.hpp>
 #include <utility>
 #include <vector>
 
-#include "protocol/messages.hpp"
 #include "tessera.h"
 
 namespace tessera::agent {

@@ -9,11 +9,11 @@
 // be lost), moves to the new epoch and resumes from its in-memory snapshot of that round.
 
 #include <cstdint>
+#include <tessera/distributed/protocol_snapshot.hpp>
 #include <vector>
 
-#include "agent/checkpoint_keeper.hpp"
-#include "agent/round_loop.hpp"
-#include "distributed/protocol_snapshot.hpp"
+#include "runtime/checkpoint_keeper.hpp"
+#include "runtime/round_loop.hpp"
 #include "transport/session.hpp"
 
 namespace tessera::agent {

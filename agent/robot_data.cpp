@@ -1,8 +1,9 @@
 #include "agent/robot_data.hpp"
 
-#include "agent/preloaded_graph.hpp"
-#include "agent/robot_file.hpp"
-#include "io/g2o_reader.hpp"
+#include <tessera/io/g2o_reader.hpp>
+
+#include "runtime/preloaded_graph.hpp"
+#include "runtime/robot_file.hpp"
 #include "transport/run_failure.hpp"
 
 namespace tessera::agent {

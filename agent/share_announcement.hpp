@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "agent/local_share.hpp"
+#include "runtime/local_share.hpp"
 #include "tessera.h"
 
 namespace tessera::agent {

@@ -13,10 +13,10 @@
 #include <mutex>
 #include <optional>
 #include <sstream>
+#include <tessera/util/input_error.hpp>
 #include <thread>
 
 #include "agent/process_threads.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::agent {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "agent/survivor_takeover.hpp"
+#include "runtime/survivor_takeover.hpp"
 #include "tessera.h"
 #include "transport/session.hpp"
 

@@ -3,8 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
-
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::cli {
 

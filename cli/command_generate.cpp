@@ -2,15 +2,15 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <tessera/generate/generator.hpp>
+#include <tessera/io/g2o_writer.hpp>
+#include <tessera/io/tum_writer.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "arguments.hpp"
 #include "commands.hpp"
-#include "generate/generator.hpp"
-#include "io/g2o_writer.hpp"
-#include "io/tum_writer.hpp"
 #include "json_writer.hpp"
 #include "robot_files.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::cli {
 namespace {

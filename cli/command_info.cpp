@@ -4,12 +4,12 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "arguments.hpp"
 #include "commands.hpp"
-#include "io/g2o_reader.hpp"
 #include "json_writer.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::cli {
 namespace {

@@ -21,22 +21,22 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "arguments.hpp"
 #include "commands.hpp"
-#include "coordinator/progress_lines.hpp"
-#include "distributed/distributed_solver.hpp"
 #include "huge_page_heaps.hpp"
 #include "launch_children.hpp"
 #include "launch_loss_policy.hpp"
 #include "launch_transport.hpp"
 #include "robot_files.hpp"
+#include "runtime/progress_lines.hpp"
 #include "session_args.hpp"
 #include "shm_leftovers.hpp"
 #include "transport/run_identity.hpp"
 #include "transport/security.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::cli {
 

@@ -5,16 +5,16 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/io/metis_reader.hpp>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "arguments.hpp"
 #include "commands.hpp"
-#include "io/g2o_reader.hpp"
-#include "io/metis_reader.hpp"
 #include "json_writer.hpp"
-#include "partition/graph_structure.hpp"
-#include "partition/partitioner.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::cli {
 namespace {

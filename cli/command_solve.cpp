@@ -7,16 +7,16 @@
 #include <fstream>
 #include <set>
 #include <string>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/io/tum_writer.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "arguments.hpp"
 #include "commands.hpp"
-#include "io/g2o_reader.hpp"
-#include "io/tum_writer.hpp"
 #include "json_writer.hpp"
 #include "solve_distributed.hpp"
 #include "solve_output.hpp"
-#include "solvers/centralized_solver.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::cli {
 namespace {

@@ -7,8 +7,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
-
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::cli {
 

@@ -5,8 +5,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
-
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::cli {
 

@@ -3,8 +3,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
-
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::cli {
 

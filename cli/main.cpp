@@ -4,9 +4,9 @@
 #include <cstring>
 #include <exception>
 #include <string>
+#include <tessera/util/input_error.hpp>
 
 #include "commands.hpp"
-#include "util/input_error.hpp"
 
 namespace {
 

@@ -9,9 +9,9 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <tessera/util/input_error.hpp>
 
 #include "generate/robot_ranges.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::cli {
 

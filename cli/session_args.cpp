@@ -1,9 +1,9 @@
 #include "session_args.hpp"
 
 #include <cstdio>
+#include <tessera/util/input_error.hpp>
 
 #include "transport/run_identity.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::cli {
 

@@ -9,13 +9,13 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "transport/run_failure.hpp"
 #include "transport/session.hpp"
 #include "transport/session_options.hpp"
 #include "transport/signal_watcher.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::cli {
 

@@ -3,16 +3,16 @@
 #include <cstdio>
 #include <fstream>
 #include <optional>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/io/tum_writer.hpp>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/partition/sequential_partition.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/util/input_error.hpp>
 
-#include "distributed/distributed_solver.hpp"
-#include "io/g2o_reader.hpp"
-#include "io/tum_writer.hpp"
 #include "json_writer.hpp"
-#include "partition/partitioner.hpp"
-#include "partition/sequential_partition.hpp"
 #include "solve_output.hpp"
-#include "solvers/centralized_solver.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::cli {
 

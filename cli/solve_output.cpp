@@ -1,7 +1,7 @@
 #include "solve_output.hpp"
 
-#include "io/g2o_writer.hpp"
-#include "io/tum_writer.hpp"
+#include <tessera/io/g2o_writer.hpp>
+#include <tessera/io/tum_writer.hpp>
 
 namespace tessera::cli {
 

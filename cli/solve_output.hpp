@@ -6,10 +6,10 @@
 
 #include <optional>
 #include <string>
+#include <tessera/graph/pose.hpp>
+#include <tessera/graph/pose_graph.hpp>
 #include <vector>
 
-#include "graph/pose.hpp"
-#include "graph/pose_graph.hpp"
 #include "json_writer.hpp"
 
 namespace tessera::cli {

@@ -5,8 +5,8 @@
 #include <cstdint>
 
 #include "coordinator/coordinator_options.hpp"
-#include "coordinator/partition_step.hpp"
 #include "coordinator/run_structure.hpp"
+#include "runtime/partition_step.hpp"
 #include "tessera.h"
 #include "transport/session.hpp"
 

@@ -2,10 +2,10 @@
 
 #include <set>
 #include <string>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "arguments.hpp"
-#include "distributed/distributed_solver.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::coordinator {
 

@@ -3,10 +3,9 @@
 #include <condition_variable>
 #include <exception>
 #include <mutex>
+#include <tessera/io/g2o_reader.hpp>
 #include <thread>
 #include <utility>
-
-#include "io/g2o_reader.hpp"
 
 namespace tessera::coordinator {
 

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "coordinator/partition_step.hpp"
 #include "coordinator/run_structure.hpp"
+#include "runtime/partition_step.hpp"
 
 namespace tessera::coordinator {
 

@@ -1,10 +1,10 @@
 #include "coordinator/final_merge.hpp"
 
 #include <algorithm>
+#include <tessera/graph/pose_graph.hpp>
+#include <tessera/io/g2o_writer.hpp>
+#include <tessera/io/tum_writer.hpp>
 
-#include "graph/pose_graph.hpp"
-#include "io/g2o_writer.hpp"
-#include "io/tum_writer.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
 

@@ -5,10 +5,10 @@
 
 #include <cstdint>
 #include <string>
+#include <tessera/graph/pose.hpp>
 #include <vector>
 
 #include "coordinator/run_structure.hpp"
-#include "graph/pose.hpp"
 #include "tessera.h"
 
 namespace tessera::coordinator {

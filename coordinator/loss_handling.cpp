@@ -4,8 +4,8 @@
 #include <iostream>
 #include <string>
 
-#include "coordinator/elapsed.hpp"
-#include "coordinator/survivor_step.hpp"
+#include "runtime/elapsed.hpp"
+#include "runtime/survivor_step.hpp"
 #include "transport/run_failure.hpp"
 
 namespace tessera::coordinator {

@@ -10,12 +10,12 @@
 #include <chrono>
 #include <cstdint>
 #include <map>
+#include <tessera/partition/graph_structure.hpp>
 #include <vector>
 
 #include "coordinator/coordinator_options.hpp"
-#include "coordinator/rejoin_arbiter.hpp"
-#include "coordinator/run_monitor.hpp"
-#include "partition/graph_structure.hpp"
+#include "runtime/rejoin_arbiter.hpp"
+#include "runtime/run_monitor.hpp"
 #include "tessera.h"
 #include "transport/session.hpp"
 

@@ -5,7 +5,7 @@
 #include <set>
 #include <string>
 
-#include "coordinator/elapsed.hpp"
+#include "runtime/elapsed.hpp"
 #include "transport/run_failure.hpp"
 
 namespace tessera::coordinator {

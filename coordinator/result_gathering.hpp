@@ -8,7 +8,7 @@
 #include "coordinator/coordinator_options.hpp"
 #include "coordinator/loss_handling.hpp"
 #include "coordinator/round_reports.hpp"
-#include "coordinator/run_monitor.hpp"
+#include "runtime/run_monitor.hpp"
 #include "transport/session.hpp"
 
 namespace tessera::coordinator {

@@ -12,7 +12,7 @@
 #include <ostream>
 #include <utility>
 
-#include "coordinator/progress_printer.hpp"
+#include "runtime/progress_printer.hpp"
 #include "tessera.h"
 #include "transport/topic_names.hpp"
 

@@ -1,8 +1,7 @@
 #include "coordinator/run_structure.hpp"
 
 #include <algorithm>
-
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::coordinator {
 

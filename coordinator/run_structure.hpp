@@ -4,9 +4,9 @@
 
 #include <cstdint>
 #include <string>
+#include <tessera/partition/graph_structure.hpp>
 #include <vector>
 
-#include "partition/graph_structure.hpp"
 #include "tessera.h"
 
 namespace tessera::coordinator {

@@ -7,10 +7,10 @@
 #include "coordinator/coordinator_options.hpp"
 #include "coordinator/final_merge.hpp"
 #include "coordinator/loss_handling.hpp"
-#include "coordinator/partition_step.hpp"
 #include "coordinator/round_reports.hpp"
 #include "coordinator/run_structure.hpp"
 #include "coordinator/run_timeline.hpp"
+#include "runtime/partition_step.hpp"
 
 namespace tessera::coordinator {
 

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "agent/local_share.hpp"
 #include "agent/share_announcement.hpp"
+#include "runtime/local_share.hpp"
 
 namespace tessera::test {
 

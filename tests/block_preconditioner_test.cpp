@@ -1,17 +1,16 @@
 // The block preconditioner: the exact Cholesky factor of Q_BB + lambda I, and the
 // block-diagonal fallback used when that factor would be too large.
 
-#include "solvers/block_preconditioner.hpp"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <tessera/distributed/rbcd.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/solvers/block_preconditioner.hpp>
 #include <utility>
 
-#include "distributed/rbcd.hpp"
 #include "lifted_blocks.hpp"
-#include "problem/block_problem.hpp"
-#include "problem/lifting.hpp"
 #include "random_graph.hpp"
 
 namespace tessera {

@@ -9,13 +9,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <string>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/rbcd.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/solvers/block_preconditioner.hpp>
 
-#include "distributed/distributed_solver.hpp"
-#include "distributed/rbcd.hpp"
 #include "lifted_blocks.hpp"
-#include "problem/block_problem.hpp"
-#include "problem/lifting.hpp"
-#include "solvers/block_preconditioner.hpp"
 #include "test_support.hpp"
 
 namespace tessera {

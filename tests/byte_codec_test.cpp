@@ -2,11 +2,10 @@
 // exactly, and a short or inconsistent buffer is a CodecError naming the buffer and the field
 // that could not be read, never a crash or a huge allocation.
 
-#include "util/byte_codec.hpp"
-
 #include <gtest/gtest.h>
 
 #include <string>
+#include <tessera/util/byte_codec.hpp>
 #include <vector>
 
 namespace tessera {

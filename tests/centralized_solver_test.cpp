@@ -1,8 +1,6 @@
 // The centralized certifiable solver: optimality, certificates, initialization, and the
 // reference optima of the public benchmark graphs.
 
-#include "solvers/centralized_solver.hpp"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -10,19 +8,20 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <tessera/certification/certificate.hpp>
+#include <tessera/generate/generator.hpp>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/problem/objective.hpp>
+#include <tessera/problem/translation_solve.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/solvers/chordal_initialization.hpp>
+#include <tessera/solvers/translation_elimination.hpp>
+#include <tessera/util/input_error.hpp>
 
-#include "certification/certificate.hpp"
-#include "generate/generator.hpp"
-#include "io/g2o_reader.hpp"
-#include "problem/block_problem.hpp"
-#include "problem/lifting.hpp"
-#include "problem/objective.hpp"
-#include "problem/translation_solve.hpp"
 #include "random_graph.hpp"
-#include "solvers/chordal_initialization.hpp"
-#include "solvers/translation_elimination.hpp"
 #include "test_support.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

@@ -11,10 +11,10 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <tessera/distributed/checkpoint_file.hpp>
+#include <tessera/distributed/in_process_driver.hpp>
+#include <tessera/distributed/protocol_snapshot.hpp>
 
-#include "distributed/checkpoint_file.hpp"
-#include "distributed/in_process_driver.hpp"
-#include "distributed/protocol_snapshot.hpp"
 #include "random_graph.hpp"
 #include "round_agents.hpp"
 

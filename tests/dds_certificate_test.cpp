@@ -12,11 +12,11 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/io/g2o_reader.hpp>
 #include <vector>
 
 #include "dds_process_support.hpp"
-#include "distributed/distributed_solver.hpp"
-#include "io/g2o_reader.hpp"
 
 namespace tessera::test::dds {
 namespace {

@@ -8,16 +8,16 @@
 #include <unistd.h>
 
 #include <string>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partitioner.hpp>
 #include <vector>
 
-#include "agent/local_share.hpp"
 #include "announcement_support.hpp"
 #include "coordinator/file_partition.hpp"
 #include "coordinator/run_structure.hpp"
 #include "dds_process_support.hpp"
-#include "io/g2o_reader.hpp"
-#include "partition/graph_structure.hpp"
-#include "partition/partitioner.hpp"
+#include "runtime/local_share.hpp"
 
 namespace tessera::test::dds {
 namespace {

@@ -27,6 +27,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tessera/util/input_error.hpp>
 #include <thread>
 #include <vector>
 
@@ -37,7 +38,6 @@
 #include "huge_page_heaps.hpp"
 #include "launch_children.hpp"
 #include "shm_leftovers.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::test::dds {
 namespace {

@@ -18,16 +18,16 @@
 #include <mutex>
 #include <regex>
 #include <sstream>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/generate/generator.hpp>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/util/input_error.hpp>
 #include <thread>
 
-#include "agent/initialization_stage.hpp"
 #include "dds_process_support.hpp"
-#include "distributed/distributed_solver.hpp"
-#include "generate/generator.hpp"
-#include "io/g2o_reader.hpp"
-#include "partition/graph_structure.hpp"
-#include "partition/partitioner.hpp"
-#include "util/input_error.hpp"
+#include "runtime/initialization_stage.hpp"
 
 namespace tessera::test::dds {
 namespace {

@@ -17,12 +17,12 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
 #include <vector>
 
 #include "dds_process_support.hpp"
-#include "io/g2o_reader.hpp"
 #include "merged_estimate_checks.hpp"
-#include "solvers/centralized_solver.hpp"
 
 namespace tessera::test::dds {
 namespace {

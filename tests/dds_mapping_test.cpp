@@ -4,9 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <tessera/util/input_error.hpp>
 #include <thread>
 
-#include "agent/local_share.hpp"
+#include "runtime/local_share.hpp"
 #include "transport/epoch_routing.hpp"
 #include "transport/inbox.hpp"
 #include "transport/message_mapping.hpp"
@@ -14,7 +15,6 @@
 #include "transport/run_identity.hpp"
 #include "transport/status_relay.hpp"
 #include "transport/transport_error.hpp"
-#include "util/input_error.hpp"
 
 namespace {
 

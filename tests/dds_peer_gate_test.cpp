@@ -15,13 +15,13 @@
 #include <unistd.h>
 
 #include <string>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "dds_process_support.hpp"
 #include "transport/participant_tags.hpp"
 #include "transport/peer_gate.hpp"
 #include "transport/peer_tracking.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::test::dds {
 namespace {

@@ -9,12 +9,12 @@
 #include <chrono>
 #include <sstream>
 #include <string>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "agent/progress_digest.hpp"
-#include "coordinator/progress_printer.hpp"
-#include "coordinator/run_monitor.hpp"
-#include "util/input_error.hpp"
+#include "runtime/progress_printer.hpp"
+#include "runtime/run_monitor.hpp"
 
 namespace {
 

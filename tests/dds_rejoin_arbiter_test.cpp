@@ -7,10 +7,10 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <tessera/util/input_error.hpp>
 
-#include "coordinator/rejoin_arbiter.hpp"
-#include "coordinator/run_monitor.hpp"
-#include "util/input_error.hpp"
+#include "runtime/rejoin_arbiter.hpp"
+#include "runtime/run_monitor.hpp"
 
 namespace tessera::coordinator {
 namespace {

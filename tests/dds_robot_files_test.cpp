@@ -10,16 +10,16 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/util/input_error.hpp>
 
-#include "agent/local_share.hpp"
-#include "agent/preloaded_graph.hpp"
-#include "agent/robot_file.hpp"
 #include "dds_process_support.hpp"
-#include "distributed/distributed_solver.hpp"
-#include "io/g2o_reader.hpp"
-#include "partition/graph_structure.hpp"
-#include "partition/partitioner.hpp"
-#include "util/input_error.hpp"
+#include "runtime/local_share.hpp"
+#include "runtime/preloaded_graph.hpp"
+#include "runtime/robot_file.hpp"
 
 namespace tessera::test::dds {
 namespace {

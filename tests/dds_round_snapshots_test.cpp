@@ -1,12 +1,13 @@
 // When an agent takes round snapshots (agent/checkpoint_keeper.hpp, snapshots_needed): a
 // snapshot copies every block matrix each round (the trace shares its older records,
 // distributed/round_history.hpp), so only runs where something reads them (rollback for a
-// rejoin, a restart, checkpoint files, replicas) take them. That the iterates are unchanged either way is DdsSolve.*'s job; that rejoin,
-// checkpoints and replicas still work is DdsRejoin.* / DdsLoss.*'s.
+// rejoin, a restart, checkpoint files, replicas) take them. That the iterates are unchanged either
+// way is DdsSolve.*'s job; that rejoin, checkpoints and replicas still work is DdsRejoin.* /
+// DdsLoss.*'s.
 
 #include <gtest/gtest.h>
 
-#include "agent/checkpoint_keeper.hpp"
+#include "runtime/checkpoint_keeper.hpp"
 
 namespace tessera::agent {
 namespace {

@@ -7,8 +7,8 @@
 #include <deque>
 #include <vector>
 
-#include "agent/distributed_rounding.hpp"
-#include "agent/round_mailbox.hpp"
+#include "runtime/distributed_rounding.hpp"
+#include "runtime/round_mailbox.hpp"
 
 namespace tessera::agent {
 namespace {

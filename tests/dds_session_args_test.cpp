@@ -5,11 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <tessera/util/input_error.hpp>
 
 #include "launch_transport.hpp"
 #include "session_args.hpp"
 #include "test_support.hpp"
-#include "util/input_error.hpp"
 
 namespace {
 

@@ -6,12 +6,12 @@
 
 #include <algorithm>
 #include <random>
+#include <tessera/generate/generator.hpp>
+#include <tessera/util/input_error.hpp>
 
-#include "agent/local_share.hpp"
 #include "announcement_support.hpp"
 #include "coordinator/run_structure.hpp"
-#include "generate/generator.hpp"
-#include "util/input_error.hpp"
+#include "runtime/local_share.hpp"
 
 namespace tessera {
 namespace {

@@ -3,27 +3,26 @@
 // noisy graph is detected and escaped to the certified optimum, and none of it depends on the
 // message delivery order.
 
-#include "certification/distributed_certificate.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <tessera/certification/certificate.hpp>
+#include <tessera/certification/distributed_certificate.hpp>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/in_process_driver.hpp>
+#include <tessera/generate/generator.hpp>
+#include <tessera/partition/sequential_partition.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
 
-#include "certification/certificate.hpp"
-#include "distributed/agent_state.hpp"
-#include "distributed/block_layout.hpp"
-#include "distributed/distributed_solver.hpp"
-#include "distributed/in_process_driver.hpp"
-#include "generate/generator.hpp"
 #include "lifted_blocks.hpp"
-#include "partition/sequential_partition.hpp"
-#include "problem/block_problem.hpp"
-#include "problem/lifting.hpp"
 #include "random_graph.hpp"
-#include "solvers/centralized_solver.hpp"
 
 namespace tessera {
 namespace {

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <fstream>
 #include <sstream>
+#include <tessera/io/g2o_writer.hpp>
 
-#include "io/g2o_writer.hpp"
 #include "random_graph.hpp"
 #include "test_support.hpp"
 

@@ -5,13 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <tessera/distributed/irbcd.hpp>
+#include <tessera/distributed/momentum.hpp>
+#include <tessera/distributed/rbcd_plus_plus.hpp>
+#include <tessera/manifold/lifted_manifold.hpp>
+#include <tessera/util/input_error.hpp>
 #include <vector>
-
-#include "distributed/irbcd.hpp"
-#include "distributed/momentum.hpp"
-#include "distributed/rbcd_plus_plus.hpp"
-#include "manifold/lifted_manifold.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

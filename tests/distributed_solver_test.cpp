@@ -1,24 +1,23 @@
 // The distributed engine: N agents in one process reach the centralized optimum, the agents'
 // cost shares sum to the global cost, and iterates do not depend on message delivery order.
 
-#include "distributed/distributed_solver.hpp"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/QR>
 #include <cmath>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/block_selection.hpp>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/partition/sequential_partition.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/solvers/block_preconditioner.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/util/input_error.hpp>
 
-#include "distributed/agent_state.hpp"
-#include "distributed/block_layout.hpp"
-#include "distributed/block_selection.hpp"
 #include "lifted_blocks.hpp"
-#include "partition/sequential_partition.hpp"
-#include "problem/block_problem.hpp"
-#include "problem/lifting.hpp"
 #include "random_graph.hpp"
-#include "solvers/block_preconditioner.hpp"
-#include "solvers/centralized_solver.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

@@ -2,13 +2,11 @@
 // column-major and t, into separate arrays (the hand-off) or one array (the initialisation
 // stage), read back at offsets, short arrays refused.
 
-#include "graph/flat_measurement.hpp"
-
 #include <gtest/gtest.h>
 
 #include <stdexcept>
-
-#include "graph/flat_pose.hpp"
+#include <tessera/graph/flat_measurement.hpp>
+#include <tessera/graph/flat_pose.hpp>
 
 namespace tessera {
 namespace {

@@ -1,11 +1,10 @@
 // The flat pose layout (core/graph/flat_pose.hpp): R column-major then t, padding, reading
 // at an offset, and refusing arrays that are too short.
 
-#include "graph/flat_pose.hpp"
-
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <tessera/graph/flat_pose.hpp>
 
 namespace tessera {
 namespace {

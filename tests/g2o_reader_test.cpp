@@ -1,8 +1,6 @@
 // The g2o reader: accepted quirks, every kind of bad input (message names file, line and
 // problem), weights from information matrices, and the shared benchmark datasets.
 
-#include "io/g2o_reader.hpp"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -16,11 +14,12 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/io/information_weights.hpp>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
-#include "io/information_weights.hpp"
 #include "test_support.hpp"
-#include "util/input_error.hpp"
 
 namespace {
 

@@ -5,14 +5,14 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tessera/generate/generator.hpp>
+#include <tessera/graph/connectivity.hpp>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/io/g2o_writer.hpp>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
-#include "generate/generator.hpp"
-#include "graph/connectivity.hpp"
-#include "io/g2o_reader.hpp"
-#include "io/g2o_writer.hpp"
 #include "test_support.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

@@ -2,17 +2,16 @@
 // survivors, from their current iterate and the lost agent's (stale) replica, reaches the
 // centralized optimum, and its final estimate holds every pose.
 
-#include "distributed/loss_recovery.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tessera/distributed/loss_recovery.hpp>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/util/input_error.hpp>
 
-#include "partition/graph_structure.hpp"
-#include "partition/partitioner.hpp"
 #include "random_graph.hpp"
-#include "solvers/centralized_solver.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <set>
 #include <string>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
 
 #include "dds_process_support.hpp"
-#include "io/g2o_reader.hpp"
-#include "solvers/centralized_solver.hpp"
 
 namespace tessera::test::dds {
 

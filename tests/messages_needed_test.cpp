@@ -9,9 +9,9 @@
 #include <deque>
 #include <memory>
 #include <optional>
+#include <tessera/distributed/round_protocol.hpp>
 #include <vector>
 
-#include "distributed/round_protocol.hpp"
 #include "random_graph.hpp"
 #include "round_agents.hpp"
 

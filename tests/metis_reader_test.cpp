@@ -1,13 +1,12 @@
 // The METIS reader: the format as the benchmark files use it, and every malformed-input error.
 
-#include "io/metis_reader.hpp"
-
 #include <gtest/gtest.h>
 
 #include <string>
+#include <tessera/io/metis_reader.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "test_support.hpp"
-#include "util/input_error.hpp"
 
 namespace {
 

@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <random>
+#include <tessera/partition/graph_structure.hpp>
 
 #include "partition/flow_refinement.hpp"
-#include "partition/graph_structure.hpp"
 #include "structure_graphs.hpp"
 
 namespace {

@@ -1,15 +1,13 @@
 // Graph structure construction, partition metrics, the balance bound and the sequential split.
 
-#include "partition/partition_metrics.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "graph/pose_graph.hpp"
-#include "partition/graph_structure.hpp"
-#include "partition/sequential_partition.hpp"
-#include "util/input_error.hpp"
+#include <tessera/graph/pose_graph.hpp>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partition_metrics.hpp>
+#include <tessera/partition/sequential_partition.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace {
 

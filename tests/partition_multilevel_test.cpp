@@ -7,15 +7,15 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partition_metrics.hpp>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "partition/evolutionary.hpp"
-#include "partition/graph_structure.hpp"
 #include "partition/light_block.hpp"
 #include "partition/multilevel.hpp"
-#include "partition/partition_metrics.hpp"
-#include "partition/partitioner.hpp"
 #include "structure_graphs.hpp"
-#include "util/input_error.hpp"
 
 namespace {
 

@@ -4,12 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/util/input_error.hpp>
+
 #include "partition/evolutionary.hpp"
-#include "partition/graph_structure.hpp"
 #include "partition/relaxed_polish.hpp"
 #include "structure_graphs.hpp"
 #include "test_support.hpp"
-#include "util/input_error.hpp"
 
 namespace {
 

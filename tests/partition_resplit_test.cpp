@@ -9,15 +9,15 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "partition/block_resplit.hpp"
 #include "partition/evolution_search.hpp"
 #include "partition/evolutionary.hpp"
-#include "partition/graph_structure.hpp"
-#include "partition/partitioner.hpp"
 #include "structure_graphs.hpp"
 #include "test_support.hpp"
-#include "util/input_error.hpp"
 
 namespace {
 

@@ -7,14 +7,14 @@
 #include <algorithm>
 #include <functional>
 #include <string>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partition_metrics.hpp>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "partition/evolutionary.hpp"
-#include "partition/graph_structure.hpp"
-#include "partition/partition_metrics.hpp"
-#include "partition/partitioner.hpp"
 #include "partition/spectral_layouts.hpp"
 #include "structure_graphs.hpp"
-#include "util/input_error.hpp"
 
 namespace {
 

@@ -1,15 +1,14 @@
 // The hand-written derivative kernels (problem/pose_kernels.hpp) against the plain Eigen /
 // LiftedManifold expressions they replace, for every rank with a fixed-size path and one without.
 
-#include "problem/pose_kernels.hpp"
-
 #include <gtest/gtest.h>
 
 #include <random>
+#include <tessera/manifold/lifted_manifold.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/pose_kernels.hpp>
 #include <vector>
 
-#include "manifold/lifted_manifold.hpp"
-#include "problem/block_problem.hpp"
 #include "random_graph.hpp"
 
 namespace tessera {

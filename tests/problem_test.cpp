@@ -4,13 +4,13 @@
 
 #include <algorithm>
 #include <random>
+#include <tessera/manifold/lifted_manifold.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/data_matrix.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/problem/objective.hpp>
+#include <tessera/problem/rounding.hpp>
 
-#include "manifold/lifted_manifold.hpp"
-#include "problem/block_problem.hpp"
-#include "problem/data_matrix.hpp"
-#include "problem/lifting.hpp"
-#include "problem/objective.hpp"
-#include "problem/rounding.hpp"
 #include "random_graph.hpp"
 
 namespace tessera {

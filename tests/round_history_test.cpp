@@ -3,9 +3,9 @@
 // back in order across chunk boundaries, and changing or growing one copy never shows in
 // another (a snapshot keeps the restart flag and length it was taken with).
 
-#include "distributed/round_history.hpp"
-
 #include <gtest/gtest.h>
+
+#include <tessera/distributed/round_history.hpp>
 
 namespace tessera {
 namespace {

@@ -2,18 +2,17 @@
 // keep their own poses (grow), balance holds over the survivors, results are deterministic,
 // and the replica plan picks the right holders.
 
-#include "partition/survivor_repartition.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <set>
+#include <tessera/distributed/replica_plan.hpp>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/partition/survivor_repartition.hpp>
+#include <tessera/util/input_error.hpp>
 
-#include "distributed/replica_plan.hpp"
-#include "partition/graph_structure.hpp"
-#include "partition/partitioner.hpp"
 #include "random_graph.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

@@ -3,25 +3,24 @@
 // tangent output, symmetric positive definite also when stale, the fallback to the Q_BB factor
 // at rank r > d, and block solves reaching the same minimiser as with the Q_BB factor.
 
-#include "solvers/tangent_preconditioner.hpp"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <Eigen/QR>
 #include <cstdlib>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/momentum.hpp>
+#include <tessera/distributed/rbcd.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/solvers/block_preconditioner.hpp>
+#include <tessera/solvers/tangent_preconditioner.hpp>
+#include <tessera/util/input_error.hpp>
 #include <utility>
 
-#include "distributed/agent_state.hpp"
-#include "distributed/block_layout.hpp"
-#include "distributed/momentum.hpp"
-#include "distributed/rbcd.hpp"
 #include "lifted_blocks.hpp"
-#include "problem/block_problem.hpp"
-#include "problem/lifting.hpp"
 #include "random_graph.hpp"
-#include "solvers/block_preconditioner.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

@@ -6,14 +6,14 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/io/g2o_writer.hpp>
+#include <tessera/io/tum_writer.hpp>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
-#include "io/g2o_reader.hpp"
-#include "io/g2o_writer.hpp"
 #include "io/number_text.hpp"
-#include "io/tum_writer.hpp"
 #include "test_support.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

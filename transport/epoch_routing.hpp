@@ -9,10 +9,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <tessera/protocol/awaited_messages.hpp>
+#include <tessera/protocol/messages.hpp>
 #include <vector>
 
-#include "protocol/awaited_messages.hpp"
-#include "protocol/messages.hpp"
 #include "transport/inbox.hpp"
 
 namespace tessera::transport {

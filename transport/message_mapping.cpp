@@ -1,9 +1,8 @@
 #include "transport/message_mapping.hpp"
 
 #include <algorithm>
-
-#include "graph/flat_measurement.hpp"
-#include "graph/flat_pose.hpp"
+#include <tessera/graph/flat_measurement.hpp>
+#include <tessera/graph/flat_pose.hpp>
 
 namespace tessera::transport {
 

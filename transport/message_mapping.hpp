@@ -6,12 +6,12 @@
 
 #include <cstdint>
 #include <string>
+#include <tessera/graph/measurement.hpp>
+#include <tessera/graph/pose.hpp>
+#include <tessera/protocol/messages.hpp>
 #include <utility>
 #include <vector>
 
-#include "graph/measurement.hpp"
-#include "graph/pose.hpp"
-#include "protocol/messages.hpp"
 #include "tessera.h"
 #include "transport/transport_error.hpp"
 

@@ -1,6 +1,6 @@
 #include "transport/network_profile.hpp"
 
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::transport {
 

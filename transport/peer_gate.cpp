@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <tessera/util/input_error.hpp>
 
 #include "transport/session.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::transport {
 

@@ -8,9 +8,9 @@
 // sender and epoch; the relay routes them as if they had come on its block topic. Internal
 // to transport/.
 
+#include <tessera/protocol/messages.hpp>
 #include <vector>
 
-#include "protocol/messages.hpp"
 #include "tessera.h"
 
 namespace tessera::transport {

@@ -4,8 +4,7 @@
 
 #include <cerrno>
 #include <cstdlib>
-
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::transport {
 

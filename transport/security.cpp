@@ -5,8 +5,7 @@
 
 #include <climits>
 #include <cstdlib>
-
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::transport {
 

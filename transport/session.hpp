@@ -25,10 +25,10 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tessera/protocol/awaited_messages.hpp>
+#include <tessera/protocol/messages.hpp>
 #include <vector>
 
-#include "protocol/awaited_messages.hpp"
-#include "protocol/messages.hpp"
 #include "tessera.h"
 #include "transport/inbox.hpp"
 #include "transport/peer_view.hpp"

@@ -3,11 +3,11 @@
 #include <arpa/inet.h>
 
 #include <algorithm>
+#include <tessera/util/input_error.hpp>
 
 #include "transport/network_profile.hpp"
 #include "transport/run_identity.hpp"
 #include "transport/security.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::transport {
 

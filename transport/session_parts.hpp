@@ -6,10 +6,10 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <tessera/protocol/messages.hpp>
 #include <utility>
 #include <vector>
 
-#include "protocol/messages.hpp"
 #include "tessera.h"
 #include "transport/dds_entities.hpp"
 #include "transport/dds_trace.hpp"

@@ -13,10 +13,10 @@
 
 #include <cstdint>
 #include <map>
+#include <tessera/protocol/messages.hpp>
 #include <tuple>
 #include <vector>
 
-#include "protocol/messages.hpp"
 #include "tessera.h"
 #include "transport/topic_names.hpp"
 

@@ -34,17 +34,17 @@
 #include <cstring>
 #include <fstream>
 #include <string>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "agent/agent_entry.hpp"
 #include "agent/agent_options.hpp"
-#include "agent/preloaded_graph.hpp"
 #include "agent/startup_batch.hpp"
 #include "agent/startup_priority.hpp"
 #include "coordinator/coordinator_entry.hpp"
 #include "fork_spec.hpp"
+#include "runtime/preloaded_graph.hpp"
 #include "session_process.hpp"
-#include "util/input_error.hpp"
 
 using namespace tessera;
 

@@ -1,5 +1,3 @@
-#include "certification/certificate.hpp"
-
 #include <Spectra/SymEigsSolver.h>
 
 #include <Eigen/CholmodSupport>
@@ -7,8 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-
-#include "util/input_error.hpp"
+#include <tessera/certification/certificate.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

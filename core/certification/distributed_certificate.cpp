@@ -1,12 +1,10 @@
-#include "certification/distributed_certificate.hpp"
-
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include "util/input_error.hpp"
+#include <tessera/certification/distributed_certificate.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

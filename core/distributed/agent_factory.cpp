@@ -1,8 +1,7 @@
-#include "distributed/agent_factory.hpp"
-
-#include "distributed/block_selection.hpp"
-#include "distributed/irbcd.hpp"
-#include "distributed/rbcd_plus_plus.hpp"
+#include <tessera/distributed/agent_factory.hpp>
+#include <tessera/distributed/block_selection.hpp>
+#include <tessera/distributed/irbcd.hpp>
+#include <tessera/distributed/rbcd_plus_plus.hpp>
 
 namespace tessera {
 

@@ -1,10 +1,9 @@
-#include "distributed/agent_state.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <tessera/distributed/agent_state.hpp>
 #include <utility>
 
 namespace tessera {

@@ -1,10 +1,8 @@
-#include "distributed/block_layout.hpp"
-
 #include <algorithm>
 #include <set>
 #include <string>
-
-#include "util/input_error.hpp"
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

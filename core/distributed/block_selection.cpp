@@ -1,6 +1,5 @@
-#include "distributed/block_selection.hpp"
-
-#include "util/input_error.hpp"
+#include <tessera/distributed/block_selection.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

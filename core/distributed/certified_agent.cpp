@@ -1,11 +1,9 @@
-#include "distributed/certified_agent.hpp"
-
 #include <algorithm>
 #include <stdexcept>
-
-#include "distributed/agent_factory.hpp"
-#include "distributed/stage_tag.hpp"
-#include "util/input_error.hpp"
+#include <tessera/distributed/agent_factory.hpp>
+#include <tessera/distributed/certified_agent.hpp>
+#include <tessera/distributed/stage_tag.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

@@ -1,5 +1,3 @@
-#include "distributed/checkpoint_file.hpp"
-
 #include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -11,9 +9,9 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <tessera/distributed/checkpoint_file.hpp>
+#include <tessera/util/byte_codec.hpp>
 #include <vector>
-
-#include "util/byte_codec.hpp"
 
 namespace tessera {
 namespace {

@@ -1,10 +1,9 @@
-#include "distributed/distributed_initialization.hpp"
-
 #include <deque>
+#include <tessera/distributed/distributed_initialization.hpp>
+#include <tessera/solvers/chordal_initialization.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "generate/robot_ranges.hpp"
-#include "solvers/chordal_initialization.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 

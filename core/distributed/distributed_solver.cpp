@@ -1,20 +1,18 @@
-#include "distributed/distributed_solver.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <memory>
-
-#include "distributed/agent_factory.hpp"
-#include "distributed/agent_state.hpp"
-#include "distributed/block_layout.hpp"
-#include "distributed/certified_agent.hpp"
-#include "distributed/round_protocol.hpp"
-#include "distributed/stage_tag.hpp"
-#include "problem/lifting.hpp"
-#include "problem/objective.hpp"
-#include "problem/rounding.hpp"
-#include "util/input_error.hpp"
+#include <tessera/distributed/agent_factory.hpp>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/certified_agent.hpp>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/round_protocol.hpp>
+#include <tessera/distributed/stage_tag.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/problem/objective.hpp>
+#include <tessera/problem/rounding.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

@@ -1,13 +1,11 @@
-#include "distributed/in_process_driver.hpp"
-
 #include <algorithm>
 #include <ctime>
 #include <deque>
 #include <functional>
 #include <stdexcept>
-
-#include "distributed/message_gate.hpp"
-#include "distributed/stage_tag.hpp"
+#include <tessera/distributed/in_process_driver.hpp>
+#include <tessera/distributed/message_gate.hpp>
+#include <tessera/distributed/stage_tag.hpp>
 
 namespace tessera {
 

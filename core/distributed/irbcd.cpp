@@ -1,11 +1,9 @@
-#include "distributed/irbcd.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
-
-#include "util/input_error.hpp"
+#include <tessera/distributed/irbcd.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

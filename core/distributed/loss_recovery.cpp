@@ -1,10 +1,8 @@
-#include "distributed/loss_recovery.hpp"
-
 #include <algorithm>
 #include <string>
-
-#include "partition/graph_structure.hpp"
-#include "util/input_error.hpp"
+#include <tessera/distributed/loss_recovery.hpp>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

@@ -1,7 +1,6 @@
-#include "distributed/message_gate.hpp"
-
 #include <algorithm>
 #include <stdexcept>
+#include <tessera/distributed/message_gate.hpp>
 
 namespace tessera {
 

@@ -1,8 +1,7 @@
-#include "distributed/momentum.hpp"
-
 #include <Eigen/Eigenvalues>
 #include <stdexcept>
 #include <string>
+#include <tessera/distributed/momentum.hpp>
 #include <utility>
 
 namespace tessera {

@@ -1,4 +1,4 @@
-#include "distributed/protocol_snapshot.hpp"
+#include <tessera/distributed/protocol_snapshot.hpp>
 
 namespace tessera {
 

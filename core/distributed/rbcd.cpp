@@ -1,10 +1,8 @@
-#include "distributed/rbcd.hpp"
-
 #include <cmath>
-
-#include "distributed/momentum.hpp"
-#include "solvers/trust_region.hpp"
-#include "util/input_error.hpp"
+#include <tessera/distributed/momentum.hpp>
+#include <tessera/distributed/rbcd.hpp>
+#include <tessera/solvers/trust_region.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

@@ -1,10 +1,8 @@
-#include "distributed/rbcd_plus_plus.hpp"
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
-
-#include "util/input_error.hpp"
+#include <tessera/distributed/rbcd_plus_plus.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

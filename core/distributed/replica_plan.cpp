@@ -1,9 +1,7 @@
-#include "distributed/replica_plan.hpp"
-
 #include <algorithm>
 #include <string>
-
-#include "util/input_error.hpp"
+#include <tessera/distributed/replica_plan.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

@@ -1,5 +1,4 @@
-#include "distributed/round_history.hpp"
-
+#include <tessera/distributed/round_history.hpp>
 #include <utility>
 
 namespace tessera {

@@ -1,10 +1,8 @@
-#include "distributed/round_protocol.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include "distributed/protocol_snapshot.hpp"
+#include <tessera/distributed/protocol_snapshot.hpp>
+#include <tessera/distributed/round_protocol.hpp>
 
 namespace tessera {
 namespace {

@@ -1,10 +1,8 @@
-#include "distributed/saddle_escape.hpp"
-
 #include <cmath>
 #include <stdexcept>
-
-#include "problem/lifting.hpp"
-#include "util/input_error.hpp"
+#include <tessera/distributed/saddle_escape.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

@@ -1,6 +1,5 @@
-#include "generate/generator.hpp"
-
 #include <string>
+#include <tessera/generate/generator.hpp>
 
 #include "generate/closure_sampling.hpp"
 #include "generate/noise_model.hpp"

@@ -1,9 +1,7 @@
-#include "generate/generator_options.hpp"
-
 #include <cmath>
 #include <cstdio>
-
-#include "util/input_error.hpp"
+#include <tessera/generate/generator_options.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 namespace {

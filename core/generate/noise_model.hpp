@@ -2,10 +2,10 @@
 // Measurement noise of the generator and the weights that match it.
 
 #include <cstddef>
+#include <tessera/graph/measurement.hpp>
+#include <tessera/graph/pose.hpp>
 
 #include "generate/random_stream.hpp"
-#include "graph/measurement.hpp"
-#include "graph/pose.hpp"
 
 namespace tessera {
 

@@ -3,12 +3,12 @@
 // sphere_trajectory.cpp, torus_trajectory.cpp, city_trajectory.cpp).
 
 #include <cstddef>
+#include <tessera/generate/generator_options.hpp>
+#include <tessera/graph/pose.hpp>
 #include <utility>
 #include <vector>
 
-#include "generate/generator_options.hpp"
 #include "generate/random_stream.hpp"
-#include "graph/pose.hpp"
 
 namespace tessera {
 

@@ -1,7 +1,6 @@
-#include "graph/connectivity.hpp"
-
 #include <algorithm>
 #include <numeric>
+#include <tessera/graph/connectivity.hpp>
 
 namespace tessera {
 namespace {

@@ -1,7 +1,6 @@
-#include "graph/flat_measurement.hpp"
-
 #include <stdexcept>
 #include <string>
+#include <tessera/graph/flat_measurement.hpp>
 
 namespace tessera {
 

@@ -1,7 +1,6 @@
-#include "graph/flat_pose.hpp"
-
 #include <stdexcept>
 #include <string>
+#include <tessera/graph/flat_pose.hpp>
 
 namespace tessera {
 

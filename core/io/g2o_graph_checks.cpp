@@ -1,10 +1,9 @@
 #include "io/g2o_graph_checks.hpp"
 
 #include <algorithm>
+#include <tessera/graph/connectivity.hpp>
+#include <tessera/util/input_error.hpp>
 #include <utility>
-
-#include "graph/connectivity.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

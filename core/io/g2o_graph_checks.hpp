@@ -5,10 +5,9 @@
 
 #include <cstdint>
 #include <string>
+#include <tessera/graph/pose.hpp>
+#include <tessera/io/g2o_reader.hpp>
 #include <vector>
-
-#include "graph/pose.hpp"
-#include "io/g2o_reader.hpp"
 
 namespace tessera {
 

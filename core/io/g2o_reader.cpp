@@ -1,5 +1,3 @@
-#include "io/g2o_reader.hpp"
-
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -11,13 +9,14 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/io/information_weights.hpp>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "io/g2o_graph_checks.hpp"
-#include "io/information_weights.hpp"
 #include "io/number_token.hpp"
 #include "io/rotation_text.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

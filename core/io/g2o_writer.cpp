@@ -1,10 +1,10 @@
-#include "io/g2o_writer.hpp"
+#include <tessera/io/g2o_writer.hpp>
+#include <tessera/io/information_weights.hpp>
+#include <tessera/io/text_file_writer.hpp>
+#include <tessera/util/input_error.hpp>
 
-#include "io/information_weights.hpp"
 #include "io/number_text.hpp"
 #include "io/rotation_text.hpp"
-#include "io/text_file_writer.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

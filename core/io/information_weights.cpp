@@ -1,6 +1,5 @@
-#include "io/information_weights.hpp"
-
 #include <cmath>
+#include <tessera/io/information_weights.hpp>
 #include <utility>
 
 namespace tessera {

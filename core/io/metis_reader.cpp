@@ -1,14 +1,12 @@
-#include "io/metis_reader.hpp"
-
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <tessera/io/metis_reader.hpp>
+#include <tessera/util/input_error.hpp>
 #include <tuple>
 #include <vector>
-
-#include "util/input_error.hpp"
 
 namespace tessera {
 namespace {

@@ -1,9 +1,7 @@
-#include "io/text_file_writer.hpp"
-
 #include <cerrno>
 #include <cstring>
-
-#include "util/input_error.hpp"
+#include <tessera/io/text_file_writer.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 namespace {

@@ -1,9 +1,9 @@
-#include "io/tum_writer.hpp"
+#include <tessera/io/text_file_writer.hpp>
+#include <tessera/io/tum_writer.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "io/number_text.hpp"
 #include "io/rotation_text.hpp"
-#include "io/text_file_writer.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 

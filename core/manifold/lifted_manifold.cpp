@@ -1,9 +1,8 @@
-#include "manifold/lifted_manifold.hpp"
-
 #include <Eigen/SVD>
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <tessera/manifold/lifted_manifold.hpp>
 
 namespace tessera {
 namespace {

@@ -4,11 +4,11 @@
 #include <climits>
 #include <cmath>
 #include <numeric>
+#include <tessera/util/input_error.hpp>
 
 #include "partition/evolution_search.hpp"
 #include "partition/evolutionary.hpp"
 #include "partition/job_runner.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::partition_detail {
 

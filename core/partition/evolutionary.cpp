@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tessera/util/input_error.hpp>
 
 #include "partition/evolution_search.hpp"
 #include "partition/island_search.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::partition_detail {
 

@@ -1,9 +1,7 @@
-#include "partition/graph_structure.hpp"
-
 #include <algorithm>
 #include <numeric>
-
-#include "util/input_error.hpp"
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

@@ -4,10 +4,10 @@
 #include <climits>
 #include <cmath>
 #include <memory>
+#include <tessera/util/input_error.hpp>
 
 #include "partition/evolution_search.hpp"
 #include "partition/job_runner.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::partition_detail {
 

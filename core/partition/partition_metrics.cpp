@@ -1,10 +1,8 @@
-#include "partition/partition_metrics.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <string>
-
-#include "util/input_error.hpp"
+#include <tessera/partition/partition_metrics.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

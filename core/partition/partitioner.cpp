@@ -1,15 +1,14 @@
-#include "partition/partitioner.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <ctime>
+#include <tessera/partition/partitioner.hpp>
+#include <tessera/partition/sequential_partition.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "partition/evolutionary.hpp"
 #include "partition/multilevel.hpp"
-#include "partition/sequential_partition.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera {
 

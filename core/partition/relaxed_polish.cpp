@@ -2,8 +2,7 @@
 
 #include <cmath>
 #include <string>
-
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::partition_detail {
 

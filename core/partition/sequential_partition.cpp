@@ -1,4 +1,4 @@
-#include "partition/sequential_partition.hpp"
+#include <tessera/partition/sequential_partition.hpp>
 
 namespace tessera {
 

@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <tessera/util/input_error.hpp>
 #include <tuple>
 
 #include "partition/kway_refinement.hpp"
-#include "util/input_error.hpp"
 
 namespace tessera::partition_detail {
 

@@ -1,12 +1,10 @@
-#include "partition/survivor_repartition.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <queue>
+#include <tessera/partition/survivor_repartition.hpp>
+#include <tessera/util/input_error.hpp>
 #include <tuple>
-
-#include "util/input_error.hpp"
 
 namespace tessera {
 

@@ -4,9 +4,8 @@
 // whose sequence is the same on every platform (so a seed gives the same partition anywhere).
 
 #include <cstdint>
+#include <tessera/partition/graph_structure.hpp>
 #include <vector>
-
-#include "partition/graph_structure.hpp"
 
 namespace tessera::partition_detail {
 

@@ -1,9 +1,7 @@
-#include "problem/block_problem.hpp"
-
 #include <algorithm>
 #include <stdexcept>
-
-#include "problem/pose_kernels.hpp"
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/pose_kernels.hpp>
 
 namespace tessera {
 

@@ -1,9 +1,8 @@
-#include "problem/data_matrix.hpp"
-
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdint>
 #include <stdexcept>
+#include <tessera/problem/data_matrix.hpp>
 
 namespace tessera {
 

@@ -1,7 +1,6 @@
-#include "problem/lifting.hpp"
-
 #include <Eigen/LU>
 #include <Eigen/SVD>
+#include <tessera/problem/lifting.hpp>
 
 namespace tessera {
 

@@ -1,6 +1,5 @@
-#include "problem/objective.hpp"
-
 #include <stdexcept>
+#include <tessera/problem/objective.hpp>
 
 namespace tessera {
 

@@ -1,6 +1,5 @@
-#include "problem/pose_kernels.hpp"
-
 #include <stdexcept>
+#include <tessera/problem/pose_kernels.hpp>
 
 namespace tessera {
 namespace {

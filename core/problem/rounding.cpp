@@ -1,10 +1,8 @@
-#include "problem/rounding.hpp"
-
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
-
-#include "problem/lifting.hpp"
-#include "problem/translation_solve.hpp"
+#include <tessera/problem/lifting.hpp>
+#include <tessera/problem/rounding.hpp>
+#include <tessera/problem/translation_solve.hpp>
 
 namespace tessera {
 

@@ -1,8 +1,7 @@
-#include "problem/translation_solve.hpp"
-
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 #include <stdexcept>
+#include <tessera/problem/translation_solve.hpp>
 
 namespace tessera {
 

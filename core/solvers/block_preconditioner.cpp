@@ -1,9 +1,8 @@
-#include "solvers/block_preconditioner.hpp"
-
 #include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <stdexcept>
+#include <tessera/solvers/block_preconditioner.hpp>
 #include <vector>
 
 namespace tessera {

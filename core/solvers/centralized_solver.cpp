@@ -1,18 +1,16 @@
-#include "solvers/centralized_solver.hpp"
-
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <sstream>
-
-#include "problem/block_problem.hpp"
-#include "problem/lifting.hpp"
-#include "problem/objective.hpp"
-#include "problem/rounding.hpp"
-#include "solvers/block_preconditioner.hpp"
-#include "solvers/chordal_initialization.hpp"
-#include "solvers/translation_elimination.hpp"
-#include "util/input_error.hpp"
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/problem/objective.hpp>
+#include <tessera/problem/rounding.hpp>
+#include <tessera/solvers/block_preconditioner.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/solvers/chordal_initialization.hpp>
+#include <tessera/solvers/translation_elimination.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

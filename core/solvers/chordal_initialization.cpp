@@ -1,12 +1,10 @@
-#include "solvers/chordal_initialization.hpp"
-
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 #include <stdexcept>
-
-#include "problem/lifting.hpp"
-#include "problem/rounding.hpp"
-#include "problem/translation_solve.hpp"
+#include <tessera/problem/lifting.hpp>
+#include <tessera/problem/rounding.hpp>
+#include <tessera/problem/translation_solve.hpp>
+#include <tessera/solvers/chordal_initialization.hpp>
 
 namespace tessera {
 

@@ -1,9 +1,8 @@
-#include "solvers/tangent_preconditioner.hpp"
-
 #include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
 #include <algorithm>
 #include <stdexcept>
+#include <tessera/solvers/tangent_preconditioner.hpp>
 #include <vector>
 
 namespace tessera {

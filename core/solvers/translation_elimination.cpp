@@ -1,8 +1,7 @@
-#include "solvers/translation_elimination.hpp"
-
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 #include <stdexcept>
+#include <tessera/solvers/translation_elimination.hpp>
 
 namespace tessera {
 

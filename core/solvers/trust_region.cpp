@@ -1,11 +1,9 @@
-#include "solvers/trust_region.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
-
-#include "util/input_error.hpp"
+#include <tessera/solvers/trust_region.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 

@@ -1,6 +1,5 @@
-#include "util/byte_codec.hpp"
-
 #include <cstring>
+#include <tessera/util/byte_codec.hpp>
 
 namespace tessera {
 

@@ -11,9 +11,8 @@
 #include <cstring>
 #include <sstream>
 #include <string>
-
-#include "io/g2o_reader.hpp"
-#include "util/input_error.hpp"
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace {
 

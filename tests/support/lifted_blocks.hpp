@@ -5,9 +5,8 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <tessera/graph/pose_graph.hpp>
 #include <vector>
-
-#include "graph/pose_graph.hpp"
 
 namespace tessera::test {
 

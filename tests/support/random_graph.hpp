@@ -4,9 +4,8 @@
 // random loop closures, and measurements perturbed by noise.
 
 #include <cstdint>
+#include <tessera/graph/pose_graph.hpp>
 #include <vector>
-
-#include "graph/pose_graph.hpp"
 
 namespace tessera::test {
 

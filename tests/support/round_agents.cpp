@@ -1,9 +1,9 @@
 #include "round_agents.hpp"
 
 #include <Eigen/Core>
+#include <tessera/problem/lifting.hpp>
 
 #include "lifted_blocks.hpp"
-#include "problem/lifting.hpp"
 
 namespace tessera::test {
 

@@ -4,13 +4,12 @@
 // tests that drive core's protocol by hand.
 
 #include <memory>
+#include <tessera/distributed/agent_factory.hpp>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/round_protocol.hpp>
+#include <tessera/graph/pose_graph.hpp>
 #include <vector>
-
-#include "distributed/agent_factory.hpp"
-#include "distributed/agent_state.hpp"
-#include "distributed/block_layout.hpp"
-#include "distributed/round_protocol.hpp"
-#include "graph/pose_graph.hpp"
 
 namespace tessera::test {
 

@@ -4,9 +4,8 @@
 
 #include <algorithm>
 #include <random>
+#include <tessera/partition/partition_metrics.hpp>
 #include <utility>
-
-#include "partition/partition_metrics.hpp"
 
 namespace tessera::test {
 

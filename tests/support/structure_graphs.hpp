@@ -3,10 +3,10 @@
 // graphs, shared by the partitioner's tests.
 
 #include <cstddef>
+#include <tessera/partition/graph_structure.hpp>
 #include <vector>
 
 #include "partition/evolutionary.hpp"
-#include "partition/graph_structure.hpp"
 #include "partition/multilevel.hpp"
 #include "partition/work_graph.hpp"
 

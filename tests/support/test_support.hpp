@@ -4,8 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
-
-#include "util/input_error.hpp"
+#include <tessera/util/input_error.hpp>
 
 namespace tessera::test {
 

@@ -11,12 +11,12 @@
 #include <cstdio>
 #include <iostream>
 #include <string>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "arguments.hpp"
 #include "transport/session.hpp"
 #include "transport/signal_watcher.hpp"
-#include "util/input_error.hpp"
 
 using namespace tessera;
 using namespace tessera::transport;

@@ -27,6 +27,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "arguments.hpp"
@@ -35,7 +36,6 @@
 #include "transport/security.hpp"
 #include "transport/signal_watcher.hpp"
 #include "transport/topic_names.hpp"
-#include "util/input_error.hpp"
 
 namespace fdds = ::eprosima::fastdds::dds;  // (Fast DDS declares a global ::dds)
 namespace rtps = ::eprosima::fastrtps::rtps;

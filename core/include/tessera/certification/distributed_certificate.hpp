@@ -1,0 +1,112 @@
+#pragma once
+// Distributed verification of the global-optimality certificate (the distributed counterpart
+// of certificate.hpp): the agents jointly estimate lambda_min(S) of S = Q - Lambda(X) without
+// gathering the measurements. One agent's state machine (messages in -> messages out, no
+// transport), driven like RoundProtocol.
+//
+// Each agent builds its own diagonal blocks Lambda_i = sym(Y_i^T (XQ)_i) from its own data and
+// its neighbours' boundary poses. The eigen-solver is LOBPCG with one vector (locally optimal
+// block preconditioned conjugate gradient, Knyazev 2001) on the vector [x, w, p]:
+//   * S v needs, besides the agent's own entries, only the neighbours' boundary entries of v:
+//     one neighbour exchange per iteration (of the preconditioned residual w; S x and S p are
+//     carried along as the same combinations of S w).
+//   * every inner product is a global reduction summed in agent-id order, so each agent solves
+//     the same 3x3 Rayleigh-Ritz problem bit for bit and takes the same decisions.
+//   * the preconditioner is block Jacobi: each agent factors its own diagonal block of S
+//     (shifted until positive definite) once and applies it locally, no communication.
+// The start vector is a hash of the GLOBAL pose ids, so it does not depend on the partition.
+// It stops when the Ritz residual ||S x - theta x|| (||x|| = 1) is small, or at a cap.
+// Certified iff converged and theta >= -eta, eta = relative_tolerance * max(1, max diag Q)
+// (the centralized certificate's eta). theta is a Rayleigh quotient, so theta < -eta PROVES
+// that S is not PSD; the Ritz vector (each agent its block) is then the escape direction.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <tessera/distributed/agent_process.hpp>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/message_gate.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <vector>
+
+namespace tessera {
+
+enum class CertificatePreconditioner {
+  kNone,        ///< Plain LOBPCG (identity preconditioner).
+  kBlockJacobi  ///< Each agent's diagonal block of S, factored locally (default).
+};
+
+struct DistributedCertificateOptions {
+  /// eta = relative_tolerance * max(1, max diagonal entry of Q), as the centralized one. >= 0.
+  double relative_tolerance = 1e-6;
+  /// Stop when ||S x - theta x|| <= residual_tolerance * max(1, max diag Q). > 0.
+  double residual_tolerance = 1e-6;
+  int max_iterations = 300;  ///< LOBPCG iteration cap (one exchange + one reduction each). > 0
+  CertificatePreconditioner preconditioner = CertificatePreconditioner::kBlockJacobi;
+  std::uint64_t seed = 1;  ///< Start vector (hash of the global pose ids and this seed).
+  /// Throws InputError naming the bad field.
+  void validate() const;
+};
+
+/// Identical on every agent except `eigenvector`.
+struct DistributedCertificateResult {
+  bool certified = false;
+  bool converged = false;       ///< Ritz residual reached the tolerance.
+  double min_eigenvalue = 0.0;  ///< Smallest Ritz value theta (>= lambda_min(S)).
+  double residual = 0.0;        ///< ||S x - theta x|| at the end.
+  double tolerance = 0.0;       ///< eta.
+  double scale = 1.0;           ///< max(1, max diag Q).
+  int iterations = 0;           ///< LOBPCG iterations (each: one exchange, one reduction).
+  Eigen::MatrixXd eigenvector;  ///< 1 x (d+1)m: this agent's block of the unit Ritz vector.
+};
+
+/// Deterministic start-vector entry for coordinate c of global pose `pose` (in [-1, 1)).
+double certificate_start_entry(std::uint64_t seed, std::size_t pose, int coordinate, int d);
+
+struct BlockJacobi;
+
+class CertificateProtocol : public AgentProcess {
+ public:
+  /// `state`: the agent at the point to certify (Y, and Yn = the neighbours' boundary poses
+  /// of the same point). It must outlive the protocol and not change while it runs.
+  CertificateProtocol(const AgentState& state, const BlockLayout& layout,
+                      const DistributedCertificateOptions& options);
+  ~CertificateProtocol() override;
+
+  std::vector<OutgoingMessage> start() override;
+  std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
+  bool done() const override { return done_; }
+  const DistributedCertificateResult& result() const { return result_; }
+
+ private:
+  enum Step : std::uint32_t { kVector = 1, kReduce = 2 };
+  Eigen::MatrixXd apply(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
+  void pump(std::vector<OutgoingMessage>& out);
+  void send_boundary(const Eigen::MatrixXd& v, std::uint32_t round,
+                     std::vector<OutgoingMessage>& out);
+  void broadcast(std::uint32_t round, const std::vector<double>& values,
+                 std::vector<OutgoingMessage>& out);
+  void begin_iteration(std::vector<OutgoingMessage>& out);
+  void after_vector(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void after_reduce(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void finish(bool converged);
+  std::vector<int> everyone() const;
+
+  const AgentState& state_;
+  const BlockLayout& layout_;
+  DistributedCertificateOptions options_;
+  BlockProblem problem_;  // own copy: its neighbour poses are set to vectors, not to Yn
+  SparseMatrix lambda_;   // Lambda_B on the block's coordinates
+  std::unique_ptr<BlockJacobi> precon_;
+  double local_max_diag_ = 0.0;
+  MessageGate gate_;
+  std::uint32_t iteration_ = 0;
+  Eigen::MatrixXd x_, Sx_, w_, Sw_, p_, Sp_;
+  double theta_ = 0.0, rr_local_ = 0.0;
+  bool has_p_ = false;
+  bool done_ = false;
+  DistributedCertificateResult result_;
+};
+
+}  // namespace tessera

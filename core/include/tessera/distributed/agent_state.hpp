@@ -1,0 +1,112 @@
+#pragma once
+// One agent's data: its block's local problem (own poses, every measurement touching them,
+// neighbours' poses held fixed), its blocks of the sequences Y (iterates), P (extrapolated
+// points) and V (momentum), and its copies of the neighbours' public poses. Pure data and
+// local math; the round protocol (round_protocol.hpp) decides when each piece is used.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/rbcd.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/protocol/messages.hpp>
+#include <tessera/solvers/block_preconditioner.hpp>
+#include <vector>
+
+namespace tessera {
+
+/// An agent's contributions to the global reductions at its current Y.
+struct LocalStatus {
+  double cost_share = 0.0;    ///< Internal edges in full, cut edges half.
+  double grad_norm_sq = 0.0;  ///< ||grad_B f||^2: the block's part of ||grad f||^2.
+  /// Selection score: sqrt(grad_norm_sq), or with `newton_score` sqrt(<(2Q_BB)^-1 g, g>).
+  double block_grad_norm = 0.0;
+};
+
+class AgentState {
+ public:
+  /// `Y0`: the block's initial lifted poses, r x (d+1)m in layout.poses[id] order. The
+  /// preconditioners are factored here (set-up): the Q_BB one, and the tangent one at Y0 when
+  /// `options` ask for it, Y0 has d active rows and the Q_BB factor is not too large.
+  AgentState(int id, int d, const BlockLayout& layout, const std::vector<Measurement>& measurements,
+             const Eigen::MatrixXd& Y0, const BlockUpdateOptions& options = {});
+  AgentState(const AgentState&) = delete;
+  AgentState& operator=(const AgentState&) = delete;
+
+  int id() const { return id_; }
+  int rank() const { return static_cast<int>(Y.rows()); }
+  const BlockProblem& problem() const { return problem_; }
+  LiftedManifold manifold() const { return problem_.manifold(rank()); }
+
+  /// The public poses of `X` (own block, own order) that neighbour block `recipient` needs.
+  PoseBlockMessage publish(const Eigen::MatrixXd& X, BlockKind kind, int recipient,
+                           std::uint32_t round, std::uint32_t phase) const;
+  /// Writes a neighbour's poses into `copy` (neighbour order). Throws std::runtime_error when
+  /// the message names a pose that is not a neighbour of this block or has the wrong size.
+  void absorb(const PoseBlockMessage& message, Eigen::MatrixXd& copy) const;
+
+  /// Status at (Y, Yn). `newton_score`: the selection score is the preconditioned gradient
+  /// norm (greedy_newton selection) instead of the gradient norm.
+  LocalStatus status(bool newton_score = false);
+  /// Block update from X0 with neighbours at `neighbours`.
+  Eigen::MatrixXd update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
+                         const BlockUpdateOptions& options);
+  /// Local objective f_B(X) with neighbours at `neighbours`.
+  double local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
+  /// Totals over this agent's block updates so far (BlockUpdateStats summed): updates,
+  /// truncated-CG iterations, updates preconditioned with the tangent factor, and that
+  /// factor's numeric factorizations.
+  long long block_updates() const { return block_updates_; }
+  long long tcg_iterations() const { return tcg_iterations_; }
+  long long tangent_updates() const { return tangent_updates_; }
+  int tangent_factorizations() const { return tangent_ ? tangent_->factorizations() : 0; }
+  /// Starts the sequences afresh at Y0 (any rank, e.g. r + 1 after a saddle escape) with
+  /// neighbours at Yn0 (same rank, neighbour order).
+  void reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd& Yn0);
+
+  // The sequences (own block) and neighbour copies; *_prev keep round k while k+1 is tried,
+  // so an adaptive restart can go back. Vn mirrors the neighbours' V on their public poses:
+  // every momentum operation is pose-wise and driven by global scalars, so each agent can
+  // evolve its neighbours' V (and form their P^k) itself instead of receiving P^k.
+  Eigen::MatrixXd Y, P, V, Y_prev, V_prev;
+  Eigen::MatrixXd Yn, Pn, Vn, Yn_prev;
+
+ private:
+  /// Selects the rows to compute on for the point (X, neighbours) and sets problem_'s
+  /// neighbour poses to those rows.
+  void set_point(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
+  /// X restricted to rows_ (X itself when every row is active).
+  Eigen::MatrixXd active_part(const Eigen::MatrixXd& X) const;
+
+  int id_;
+  int d_;
+  const BlockLayout& layout_;
+  BlockProblem problem_;
+  /// The Q_BB preconditioner (built in the constructor).
+  BlockPreconditioner& euclidean();
+  /// Builds and factors the tangent preconditioner at X (rank d) once; false when unusable.
+  bool build_tangent(const Eigen::MatrixXd& X, const BlockUpdateOptions& options);
+
+  std::unique_ptr<BlockPreconditioner> precon_;
+  std::unique_ptr<TangentPreconditioner> tangent_;
+  bool tangent_tried_ = false;
+  long long block_updates_ = 0, tcg_iterations_ = 0, tangent_updates_ = 0;
+  Eigen::MatrixXd neighbours_set_;  // what problem_ holds, so X_N Q_NB is rebuilt only on change
+  // Rows of the current point that are not identically zero, in increasing order. A lifted
+  // point [I_d; 0] R (chordal or distributed initialisation) has r - d zero rows, and every
+  // step of the algorithms (gradient, tangent projection, Hessian, Q_BB solve, Proj_M) maps
+  // zero rows to zero rows, so the local math runs on the active rows only: the same iterates
+  // (up to the order of floating-point additions) at d/r of the cost. A saddle escape fills the
+  // new row, after which every row is active.
+  std::vector<Eigen::Index> rows_;
+  std::uint64_t neighbours_version_ = 0;  // bumped whenever problem_'s neighbour poses change
+  // The last update's result and ||grad f_B||^2 there: with one block per round the selected
+  // block's neighbours do not move before the next status, whose gradient is then this one.
+  Eigen::MatrixXd updated_X_;
+  double updated_grad_norm_sq_ = -1.0;  // < 0: nothing to reuse
+  double updated_cost_share_ = 0.0;     // cost share there
+  std::uint64_t updated_version_ = 0;
+};
+
+}  // namespace tessera

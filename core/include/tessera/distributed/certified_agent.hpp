@@ -1,0 +1,102 @@
+#pragma once
+// One agent's whole certified sequence, as a single state machine for any driver:
+//   stage 0: solve at rank r (RoundProtocol)      stage 3: solve at rank r + 1
+//   stage 1: certify (CertificateProtocol)        stage 4: certify
+//   stage 2: escape  (SaddleEscapeProtocol)       ...
+// Each rank is first solved to the solver's own gradient tolerance. A certificate that holds
+// there ends the sequence. One that does not is inconclusive (Lambda(X) is off by the
+// residual gradient): the same rank is refined to StaircaseOptions::grad_norm_tol (the solve
+// stage after the certify stage, the escape stage number is skipped) and certified again; only
+// a failure at the refined point leads to the escape.
+// It stops after a solve when certification is off, after a certificate that holds, at the
+// staircase's rank cap, or when no escape direction / step exists. Every message carries its
+// stage in the phase field (stage_tag.hpp); messages of a later stage from faster agents are
+// kept until this agent gets there. Every agent takes the same stage decisions because they
+// follow from reductions summed in agent-id order. With certification off, it sends exactly
+// RoundProtocol's messages.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <tessera/certification/distributed_certificate.hpp>
+#include <tessera/distributed/agent_process.hpp>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/protocol_snapshot.hpp>
+#include <tessera/distributed/round_protocol.hpp>
+#include <tessera/distributed/saddle_escape.hpp>
+#include <tessera/distributed/stage_records.hpp>
+#include <vector>
+
+namespace tessera {
+
+class CertifiedAgent : public AgentProcess {
+ public:
+  /// `state`, `layout` and `options` must outlive the agent. options.certify switches the
+  /// certificate (and staircase) on.
+  CertifiedAgent(AgentState& state, const BlockLayout& layout, const DistributedOptions& options);
+
+  std::vector<OutgoingMessage> start() override;
+  /// Instead of start(): the first solve stage continues from `snapshot` (a coordinated
+  /// rollback, see RoundProtocol::resume); the later stages follow as usual.
+  std::vector<OutgoingMessage> resume(const ProtocolSnapshot& snapshot);
+  /// Observer of the FIRST solve stage's consistent points (RoundProtocol::set_round_observer):
+  /// snapshots of later stages would not be resumable from stage 0.
+  void set_round_observer(std::function<void(const ProtocolSnapshot&)> observer) {
+    observer_ = std::move(observer);
+  }
+  std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
+  bool done() const override { return done_; }
+  /// The running stage's count (messages of later stages are kept aside, not counted).
+  std::size_t messages_needed() const override;
+  /// The current stage's awaited messages, with the stage-tagged phase they carry on the wire.
+  std::optional<AwaitedMessages> awaited() const override;
+
+  const std::vector<SolveStageRecord>& solves() const { return solves_; }
+  const std::vector<CertifyStageRecord>& certificates() const { return certificates_; }
+  const std::vector<EscapeStageRecord>& escapes() const { return escapes_; }
+  /// nullopt when certification is off; otherwise the last certificate held at a point where
+  /// the solve converged (stopped on its gradient or relative-decrease test).
+  std::optional<bool> certified() const;
+  int final_rank() const { return state_.rank(); }
+  /// Sums over the solve stages.
+  int total_rounds() const;
+  int total_restarts() const;
+  /// Sums of the certificate's LOBPCG iterations and of the escapes' line-search trials.
+  int certificate_iterations() const;
+  int escape_trials() const;
+  std::uint32_t stage() const { return stage_; }
+
+ private:
+  void begin(std::uint32_t stage, std::vector<OutgoingMessage>& out,
+             const ProtocolSnapshot* resume_from = nullptr);
+  void advance(std::vector<OutgoingMessage>& out);
+  void emit(std::vector<OutgoingMessage>&& sub, std::vector<OutgoingMessage>& out) const;
+  /// The current solve stage's gradient tolerance: the solver's own, or refine_tolerance()
+  /// while refining an inconclusive certificate.
+  double solve_tolerance() const;
+  double refine_tolerance() const;
+
+  AgentState& state_;
+  const BlockLayout& layout_;
+  const DistributedOptions& options_;
+  std::uint32_t stage_ = 0;
+  std::unique_ptr<RoundProtocol> solve_;
+  std::unique_ptr<CertificateProtocol> certify_;
+  std::unique_ptr<SaddleEscapeProtocol> escape_;
+  AgentProcess* current_ = nullptr;
+  Eigen::MatrixXd direction_;  // the last certificate's Ritz vector (own block)
+  std::map<std::uint32_t, std::vector<ProtocolMessage>> later_;  // by stage
+  std::vector<SolveStageRecord> solves_;
+  std::vector<CertifyStageRecord> certificates_;
+  std::vector<EscapeStageRecord> escapes_;
+  std::function<void(const ProtocolSnapshot&)> observer_;
+  bool refining_ = false;  // the current rank's solve continues at refine_tolerance()
+  bool done_ = false;
+};
+
+}  // namespace tessera

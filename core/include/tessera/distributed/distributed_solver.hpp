@@ -1,0 +1,152 @@
+#pragma once
+// Distributed PGO over a partition: N agents (one per block) run RBCD, RBCD++ or IRBCD through
+// the round protocol, here in one process (in_process_driver.hpp). Options in, result out.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <tessera/distributed/block_selection.hpp>
+#include <tessera/distributed/distributed_initialization.hpp>
+#include <tessera/distributed/in_process_driver.hpp>
+#include <tessera/distributed/irbcd.hpp>
+#include <tessera/distributed/rbcd.hpp>
+#include <tessera/distributed/rbcd_plus_plus.hpp>
+#include <tessera/distributed/stage_records.hpp>
+#include <tessera/distributed/staircase_options.hpp>
+#include <tessera/graph/pose.hpp>
+#include <tessera/graph/pose_graph.hpp>
+#include <vector>
+
+namespace tessera {
+
+enum class DistributedAlgorithm { kRbcd, kRbcdPlusPlus, kIrbcd };
+
+/// "rbcd", "rbcd++", "irbcd".
+const char* algorithm_name(DistributedAlgorithm a);
+/// Throws InputError listing the valid names.
+DistributedAlgorithm parse_algorithm(const std::string& name);
+
+struct DistributedOptions {
+  DistributedAlgorithm algorithm = DistributedAlgorithm::kIrbcd;
+  int rank = 5;  ///< Relaxation rank r >= d (5: the reference optima's rank).
+  DistributedInit initialization = DistributedInit::kChordal;
+  int robots = 0;  ///< Robots of the distributed initialization; 0 = number of blocks.
+  SelectionRule selection = SelectionRule::kGreedy;
+  /// Update a whole colour class of blocks per round (an independent set of the block
+  /// adjacency graph: those agents compute at the same time), the default since it needs fewer
+  /// rounds and less time on every benchmark graph (docs/irbcd.md section 4); false = one block
+  /// per round, as RBCD and the public baseline count rounds.
+  bool parallel = true;
+  std::uint64_t seed = 1;       ///< Shared by all agents (uniform selection).
+  double grad_norm_tol = 0.01;  ///< Stop when ||grad f|| (full cost) <= this; >= 0.
+  int max_rounds = 10000;       ///< >= 0.
+  /// Stop when a round decreases f by less than this fraction of f (0 = off: with one block
+  /// per round a tiny decrease says little about the others).
+  double rel_cost_decrease_tol = 0.0;
+  BlockUpdateOptions block_update;
+  /// IRBCD's block minimisation where it differs from `block_update` (RBCD and RBCD++ always
+  /// use block_update): the most trust-region steps of an update (>= 0; 0 = block_update's
+  /// trust_region_steps) and the block-gradient reduction that ends it early (< 1; negative =
+  /// block_update's grad_reduction). Default: a second step only when the first left the
+  /// block's gradient above 0.2 of its start value (the paper's "minimise the block" done a
+  /// little more exactly where one step is not enough). Measured (docs/irbcd.md section 22;
+  /// rounds to 0.01, N = 5, highest, chordal, partition seeds 1-3): IRBCD beats RBCD++ on 27 of
+  /// 30 paper-graph cells instead of 25 (parking-garage 22/22/21 instead of 23/22/23 against
+  /// RBCD++'s 23/25/23); every other cell within -21..+18 rounds of one step (ais2klinik seed 1
+  /// 1087 vs 1069, kitti_02 1314 vs 1335), most of them bit-identical (the second step never
+  /// fires); CPU per round unchanged. RBCD++ with the same rule: same or more rounds (kitti_02
+  /// 1526 vs 1478), so it keeps one step.
+  int irbcd_trust_region_steps = 2;
+  double irbcd_grad_reduction = 0.2;
+  RbcdPlusPlusOptions rbcd_plus_plus;
+  IrbcdOptions irbcd;
+  /// After the solve, certify global optimality distributedly and climb the staircase
+  /// (docs/distributed-certification.md). Off by default for `tessera solve`.
+  bool certify = false;
+  StaircaseOptions staircase;
+  DeliveryOrder delivery = DeliveryOrder::kFifo;  ///< In-process delivery order (tests).
+  std::uint64_t delivery_seed = 1;
+
+  /// Throws InputError naming the first invalid field.
+  void validate() const;
+  /// The block update options of `algorithm`: block_update with the IRBCD overrides applied
+  /// when the algorithm is IRBCD.
+  BlockUpdateOptions algorithm_block_update() const;
+};
+
+struct DistributedRound {
+  int round = 0;           ///< Counted over every solve stage of the staircase.
+  int rank = 0;            ///< Rank of the solve stage.
+  double cost = 0.0;       ///< f(Y^k) of the lifted iterate, full sum.
+  double grad_norm = 0.0;  ///< ||grad f(Y^k)||.
+  std::vector<int> selected;
+  bool restart = false;
+  std::uint64_t bytes = 0;  ///< Bytes of the messages tagged with this round.
+  double elapsed_s = 0.0;
+};
+
+struct DistributedResult {
+  int agents = 0;
+  int rounds = 0;  ///< Block-update rounds done, all solve stages (restarts' redos inside).
+  int restarts = 0;
+  /// grad_norm, max_rounds, relative_decrease or stalled (the iterate stopped moving above
+  /// the tolerance: RoundProtocol::stop_reason()).
+  std::string stop_reason;
+  std::vector<DistributedRound> trace;
+  std::uint64_t bytes_exchanged = 0;  ///< Every message (solve, certificate, escape).
+  std::uint64_t messages = 0;
+  // Certification (options.certify): nullopt / zero when off.
+  std::optional<bool> certified;
+  double min_eigenvalue = 0.0;         ///< Last certificate's smallest Ritz value of S.
+  double certificate_tolerance = 0.0;  ///< Its eta.
+  double certificate_residual = 0.0;   ///< Its Ritz residual.
+  int certificate_rounds = 0;          ///< LOBPCG iterations, all certificates.
+  std::uint64_t certificate_bytes = 0;
+  /// Solver rounds (included in `rounds`) spent refining ranks whose certificate at the
+  /// solver's tolerance was inconclusive (StaircaseOptions::grad_norm_tol).
+  int refine_rounds = 0;
+  int escape_rounds = 0;  ///< Line-search trials, all escapes.
+  std::uint64_t escape_bytes = 0;
+  int final_rank = 0;
+  std::vector<CertifyStageRecord> certificates;
+  std::vector<EscapeStageRecord> escapes;
+  /// Block updates of all agents (restarts' redos included), their truncated-CG iterations,
+  /// the updates preconditioned with the tangent factor, and that factor's factorizations.
+  long long block_updates = 0;
+  long long tcg_iterations = 0;
+  long long tangent_updates = 0;
+  long long tangent_factorizations = 0;
+  Eigen::MatrixXd X;             ///< Final lifted iterate (r x (d+1)n, global order).
+  double relaxation_cost = 0.0;  ///< f(X).
+  double grad_norm = 0.0;        ///< ||grad f(X)||.
+  std::vector<Pose> poses;       ///< X rounded to SE(d).
+  double cost = 0.0;             ///< Objective of `poses` (reference convention).
+  /// Seconds: initial guess + agents' set-up (block problems, preconditioners), the rounds,
+  /// the final rounding (rotations and the translation solve), the whole call.
+  double init_s = 0.0, solve_s = 0.0, rounding_s = 0.0, wall_s = 0.0;
+  /// Process CPU time of the rounds (all agents, in one process): unlike solve_s it does not
+  /// grow when other jobs share the machine.
+  double solve_cpu_s = 0.0;
+  /// Estimated compute time of the same rounds with each agent on its own machine: per
+  /// message (stage, round), the slowest agent's CPU time, summed (DeliveryStats). With
+  /// `parallel` several agents compute in one round; this is the time that then matters.
+  double critical_path_cpu_s = 0.0;
+};
+
+/// Solves `graph` with the blocks of `assignment` (block id per pose, 0..N-1, none empty).
+/// `initial`: initial poses; empty = options.initialization.
+DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<int>& assignment,
+                                    const DistributedOptions& options,
+                                    const std::vector<Pose>& initial = {});
+
+/// The same from a lifted starting point X0 (r x (d+1)n, global pose order, each block [Y_i |
+/// p_i] with Y_i in St(d, r)): e.g. the iterate of an earlier run whose agents changed, so a run
+/// continues where it was instead of starting over. Throws InputError when X0 has the wrong
+/// shape.
+DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
+                                                const std::vector<int>& assignment,
+                                                const DistributedOptions& options,
+                                                const Eigen::MatrixXd& X0);
+
+}  // namespace tessera

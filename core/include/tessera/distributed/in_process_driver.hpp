@@ -1,0 +1,59 @@
+#pragma once
+// Runs N agents' round protocols in one process by handing each emitted message to its
+// recipients. The DDS runtime delivers the same messages; because each agent buffers messages
+// by (round, phase) and reduces in agent-id order, the delivery order cannot change iterates.
+// The orders here exist to test exactly that.
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <tessera/distributed/agent_process.hpp>
+#include <tessera/distributed/protocol_snapshot.hpp>
+#include <tessera/distributed/round_protocol.hpp>
+#include <utility>
+#include <vector>
+
+namespace tessera {
+
+enum class DeliveryOrder {
+  kFifo,      ///< Oldest message first (agents started in id order).
+  kReversed,  ///< Newest message first (agents started in reverse id order).
+  kShuffled   ///< A pseudo-random pending message each time (delivery_seed).
+};
+
+struct DeliveryStats {
+  std::uint64_t messages = 0;  ///< Deliveries (a broadcast to N-1 agents counts N-1).
+  std::uint64_t bytes = 0;     ///< Payload bytes over all deliveries.
+  std::vector<std::uint64_t> bytes_per_round;  ///< By the messages' round field.
+  /// By the stage of the certified sequence (stage_tag.hpp; stage 0 = the first solve).
+  std::vector<std::uint64_t> bytes_per_stage;
+  /// By (stage, round field).
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint64_t> bytes_per_stage_round;
+  /// CPU time of each agent's message handling, by the handled message's (stage, round) and
+  /// agent. Agents run one after another here but concurrently over the network, where a round
+  /// lasts as long as its slowest agent: `critical_path_cpu_s` = sum over (stage, round) of the
+  /// largest agent's CPU time, an estimate of the distributed run's compute time (no latency)
+  /// that does not depend on how many agents share this process or the machine's load. A
+  /// message's time includes the driver's queueing just before it (the receiving side's share
+  /// of a transport).
+  double critical_path_cpu_s = 0.0;
+};
+
+/// Payload size of a message as it would travel (fixed fields + arrays), in bytes.
+std::size_t message_bytes(const ProtocolMessage& message);
+
+/// Delivers messages until every agent is done (or no message is left, which would be a
+/// protocol bug: then std::logic_error). `agents[i]` must be the agent with id i.
+DeliveryStats run_in_process(const std::vector<AgentProcess*>& agents, DeliveryOrder order,
+                             std::uint64_t delivery_seed = 1);
+/// Same for plain round protocols.
+DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
+                             std::uint64_t delivery_seed = 1);
+
+/// Same, but every agent continues from its snapshot (`snapshots[i]` for agent i, all of the
+/// same round) instead of starting: a coordinated rollback in one process.
+DeliveryStats resume_in_process(const std::vector<RoundProtocol*>& agents,
+                                const std::vector<ProtocolSnapshot>& snapshots, DeliveryOrder order,
+                                std::uint64_t delivery_seed = 1);
+
+}  // namespace tessera

@@ -1,0 +1,56 @@
+#pragma once
+// Buffers one agent's incoming messages by (round, step) until the step it waits for has a
+// message from every expected sender; the step then gets them ordered by sender id, so
+// reductions sum in agent-id order and every agent takes bit-identical decisions. Messages of
+// later steps (from faster agents) wait in the gate.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <tessera/protocol/messages.hpp>
+#include <vector>
+
+namespace tessera {
+
+class MessageGate {
+ public:
+  using Inbox = std::map<int, ProtocolMessage>;  // by sender
+
+  /// From now on wait for step (round, step) from `senders`.
+  void expect(std::uint32_t round, std::uint32_t step, std::vector<int> senders);
+  /// Stores a message; false when the same (round, step, sender) was already stored.
+  bool add(int sender, std::uint32_t round, std::uint32_t step, ProtocolMessage message);
+  /// The expected step's messages once all are in (removed from the gate), else nullopt.
+  std::optional<Inbox> take_ready();
+  std::uint32_t round() const { return round_; }
+  std::uint32_t step() const { return step_; }
+
+ private:
+  static std::uint64_t key(std::uint32_t round, std::uint32_t step) {
+    return (static_cast<std::uint64_t>(round) << 16) | step;
+  }
+  std::map<std::uint64_t, Inbox> pending_;
+  std::uint32_t round_ = 0, step_ = 0;
+  std::vector<int> senders_;
+};
+
+/// A global reduction's contribution travels as a PoseBlockMessage broadcast whose "poses"
+/// 0..k-1 are k scalars (rank 1, dim 0), so every transport that carries pose blocks carries it.
+PoseBlockMessage make_reduction_message(int sender, std::uint32_t round, std::uint32_t phase,
+                                        const std::vector<double>& values);
+/// The values of a reduction message; throws std::runtime_error naming the sender when the
+/// message does not hold exactly `count` values.
+const std::vector<double>& reduction_values(const ProtocolMessage& message, std::size_t count);
+
+/// Sums the contributions of every sender in id order (the inbox's order): entry k summed,
+/// except entries listed in `max_entries`, which take the maximum.
+std::vector<double> reduce_in_id_order(const MessageGate::Inbox& inbox, std::size_t count,
+                                       const std::vector<std::size_t>& max_entries = {});
+
+/// round, sender and phase of any protocol message.
+std::uint32_t message_round(const ProtocolMessage& m);
+std::uint32_t message_sender(const ProtocolMessage& m);
+std::uint32_t message_phase(const ProtocolMessage& m);
+
+}  // namespace tessera

@@ -1,0 +1,16 @@
+#pragma once
+// Connectivity of a pose graph's measurement structure.
+
+#include <cstddef>
+#include <tessera/graph/pose_graph.hpp>
+#include <vector>
+
+namespace tessera {
+
+/// Component label (0..k-1, in order of the smallest pose id) for each of the graph's poses.
+std::vector<std::size_t> connected_components(const PoseGraph& graph);
+
+/// Number of connected components (1 for a connected graph; n for a graph with no edges).
+std::size_t count_components(const PoseGraph& graph);
+
+}  // namespace tessera

@@ -1,0 +1,90 @@
+#pragma once
+// The centralized certifiable solver (SE-Sync family): chordal initialization, Riemannian
+// trust-region on the rank-r relaxation, the minimum-eigenvalue certificate, saddle escape
+// up the Riemannian staircase when the certificate fails, and rounding to SE(d). It gives
+// the reference optimum f* that distributed runs are measured against.
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <tessera/certification/certificate.hpp>
+#include <tessera/graph/pose.hpp>
+#include <tessera/graph/pose_graph.hpp>
+#include <tessera/solvers/trust_region.hpp>
+#include <vector>
+
+namespace tessera {
+
+enum class Initialization { kChordal, kOdometry, kFile };
+
+struct CentralizedOptions {
+  int initial_rank = 5;  ///< r0 >= d. 5 matches the reference optima's runs.
+  int max_rank = 10;     ///< Staircase ceiling, >= initial_rank.
+  Initialization initialization = Initialization::kChordal;
+  bool certify = true;  ///< Run the certificate (and the staircase) after each rank.
+  /// Trust-region settings for each staircase level; grad_norm_tol here is relative to
+  /// max(1, ||grad f|| at the initial point), so it does not depend on the weights' scale.
+  TrustRegionOptions trust_region = default_trust_region();
+  CertificateOptions certificate;
+  double preconditioner_shift = 1e-10;  ///< Relative diagonal shift of the preconditioner, > 0.
+  /// Re-solve the translations exactly for the rotations of every trial point (SE-Sync's
+  /// translation elimination; see solvers/translation_elimination.hpp). false: plain
+  /// explicit-translation trust region.
+  bool eliminate_translations = true;
+  /// Lanczos tolerance for lambda_min(S) when the factorization test certifies, in (0, 1).
+  /// lambda_min is then only reported (the factorization is the proof), and near a certified
+  /// optimum the top of the shift-inverted spectrum is a tight cluster that a 1e-8 tolerance
+  /// resolves slowly (13 s on ais2klinik vs 0.5 s at 1e-3, which still gives lambda_min to
+  /// ~1e-3 eta). A failed test is rerun at certificate.lanczos_tolerance, since the saddle
+  /// escape needs an accurate eigenvector.
+  double certified_lanczos_tolerance = 1e-3;
+
+  /// The trust-region settings the centralized solver starts from (trust_region's default).
+  static TrustRegionOptions default_trust_region();
+  /// Throws InputError naming the first field out of range.
+  void validate() const;
+};
+
+struct StaircaseLevel {
+  int rank;
+  int iterations;
+  double cost;  ///< Relaxation cost f(X) at the end of the level.
+  double grad_norm;
+  std::optional<double> min_eigenvalue;
+  bool certified;
+  double elapsed_s;
+  std::string stop_reason;  ///< Why the trust region stopped (grad_norm, relative_decrease, ...).
+};
+
+struct CentralizedIteration {
+  int rank;
+  TrustRegionIteration tr;
+};
+
+struct CentralizedResult {
+  std::vector<Pose> poses;       ///< Rounded estimate in SE(d).
+  double cost = 0.0;             ///< Objective of `poses` (reference convention).
+  double relaxation_cost = 0.0;  ///< f(X) of the lifted solution (a lower bound when certified).
+  double grad_norm = 0.0;        ///< Riemannian gradient norm of the final lifted X.
+  int final_rank = 0;
+  int iterations = 0;             ///< Trust-region iterations over all levels.
+  std::optional<bool> certified;  ///< Empty when certification was off.
+  std::optional<double> min_eigenvalue;
+  std::vector<StaircaseLevel> levels;
+  std::vector<CentralizedIteration> trace;
+  double init_s = 0.0, optimize_s = 0.0, certify_s = 0.0, total_s = 0.0;
+  Eigen::MatrixXd X;  ///< Final lifted solution.
+
+  /// Human-readable multi-line summary.
+  std::string full_report() const;
+};
+
+/// Solves the graph from options.initialization up the staircase: a trust-region solve per
+/// rank, then (when certify is on) the certificate, escaping a saddle one rank up until the
+/// certificate holds, max_rank is reached or no escape direction was found. Rounds the last
+/// lifted solution to SE(d) and fills every field of the result (trace and timings included;
+/// `certified` stays empty when certify is off). Throws InputError when the options are
+/// invalid, initial_rank < d, or kFile is asked of a graph without VERTEX lines.
+CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOptions& options = {});
+
+}  // namespace tessera

@@ -1,0 +1,18 @@
+#pragma once
+// What the truncated-CG trust region needs from a preconditioner: a symmetric positive definite
+// map of the tangent space at X to itself, approximating the inverse Riemannian Hessian there.
+
+#include <Eigen/Core>
+#include <tessera/manifold/lifted_manifold.hpp>
+
+namespace tessera {
+
+class RiemannianPreconditioner {
+ public:
+  virtual ~RiemannianPreconditioner() = default;
+  /// The preconditioned tangent vector at X of the tangent vector V (both r x (d+1)m).
+  virtual Eigen::MatrixXd apply(const LiftedManifold& manifold, const Eigen::MatrixXd& X,
+                                const Eigen::MatrixXd& V) const = 0;
+};
+
+}  // namespace tessera

@@ -1,0 +1,80 @@
+#pragma once
+// Tangent-coordinate preconditioner for a block's trust-region steps at rank r = d (the agents'
+// active rows after a chordal or distributed lift; docs/irbcd.md section 12).
+//
+// Why: the Euclidean preconditioner (2 (Q_BB + lambda I))^{-1} followed by the tangent projection
+// (block_preconditioner.hpp) is far from the inverse of the Hessian on the tangent space when a
+// block is held by few cut edges: Q_BB is then nearly singular along the lifted gauge X -> M X,
+// whose normal components Q_BB^{-1} amplifies and the projection throws away (parking-garage: ~44
+// tCG iterations per update, docs/irbcd.md section 7). Working in tangent coordinates avoids it.
+//
+// What: each pose i = [Y_i | t_i] (Y_i in O(d)) gets p = d(d+1)/2 coordinates c_i = (omega, u):
+// rotation part Y_i Omega(omega) (Omega: the skew basis E_ab = e_b e_a^T - e_a e_b^T, a < b) and
+// translation Y_i u, both in the pose's own frame, so that A below depends on the rotations only
+// through the relative rotations Y_i^T Y_j. These columns form a basis J(X) of the tangent space.
+// With A = J^T (2 Q_BB) J + lambda I (the tangent restriction of the block's Euclidean Hessian,
+// pdm x pdm, the pattern of Q_BB in p x p pose blocks) the preconditioner is
+//     P(X) V = J(X) A^{-1} J(X)^T V,
+// which is exactly (Proj_X 2 Q_BB restricted to the tangent space)^{-1} when A was computed at X
+// (and lambda = 0), and is a symmetric positive definite map of the tangent space at X onto
+// itself for any X whose rotations are orthogonal, also when A is from an earlier point (A is
+// then "stale": still a valid preconditioner, merely less exact).
+//
+// A's pattern is analysed once (CHOLMOD, AMD); factorize() recomputes the values at a new point
+// and refactors numerically with the same symbolic factor.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <memory>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/solvers/riemannian_preconditioner.hpp>
+
+namespace tessera {
+
+class TangentPreconditioner : public RiemannianPreconditioner {
+ public:
+  /// `relative_shift`: lambda = relative_shift * max diagonal entry of J^T 2 Q_BB J (>= 0; keeps
+  /// A positive definite for a block whose tangent Hessian is singular, e.g. one without cut
+  /// edges). `max_factor_entries`: when CHOLMOD's symbolic analysis predicts a larger factor,
+  /// usable() is false (the caller keeps its Euclidean preconditioner); 0 = no limit.
+  explicit TangentPreconditioner(const BlockProblem& problem, double relative_shift = 1e-9,
+                                 std::size_t max_factor_entries = 16'000'000);
+  ~TangentPreconditioner() override;
+  TangentPreconditioner(const TangentPreconditioner&) = delete;
+  TangentPreconditioner& operator=(const TangentPreconditioner&) = delete;
+
+  /// False when the factor would be too large or a factorization failed: never usable then.
+  bool usable() const;
+  /// True when a factor is held (factorize() succeeded at least once and usable()).
+  bool factored() const;
+
+  /// Computes A at X (d x (d+1)m, each rotation block orthogonal) and factors it. Returns false
+  /// when X does not have d rows, or when the factorization fails (then usable() becomes false).
+  bool factorize(const Eigen::MatrixXd& X);
+
+  /// Readies the factor for an update at X: factors A at X on the first call and, when
+  /// `refresh_interval` > 0, again on every refresh_interval-th call after it (0: built once).
+  /// Returns true when apply() may be used at X (X has d rows and a factor is held).
+  bool prepare(const Eigen::MatrixXd& X, int refresh_interval);
+
+  /// J(X) A^{-1} J(X)^T V for a tangent vector V at X (d rows): a tangent vector at X.
+  Eigen::MatrixXd apply(const LiftedManifold& manifold, const Eigen::MatrixXd& X,
+                        const Eigen::MatrixXd& V) const override;
+
+  /// Numeric factorizations done so far.
+  int factorizations() const;
+  /// Entries of the Cholesky factor predicted by the symbolic analysis.
+  std::size_t factor_entries() const;
+  /// Coordinates per pose, d(d+1)/2.
+  int coordinates_per_pose() const;
+
+  /// The basis J(X) of the tangent space at X, one column per coordinate (pose after pose,
+  /// rotation then translation coordinates): for tests and diagnostics.
+  Eigen::MatrixXd basis(const Eigen::MatrixXd& X) const;
+
+ private:
+  struct Factor;
+  std::unique_ptr<Factor> factor_;
+};
+
+}  // namespace tessera

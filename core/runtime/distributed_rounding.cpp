@@ -1,0 +1,320 @@
+#include "runtime/distributed_rounding.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <stdexcept>
+#include <string>
+#include <tessera/problem/lifting.hpp>
+#include <variant>
+
+namespace tessera::agent {
+
+RoundLoopResult DistributedRounding::run(RoundLoopResult res) {
+  rotations();
+  res.translation_iterations = translations();
+  res.poses.clear();
+  for (std::size_t s = 0; s < own_.size(); ++s) res.poses.push_back(poses_.at(own_[s]));
+  res.cost = cost();
+  return res;
+}
+
+double DistributedRounding::reduce(std::uint32_t phase, std::uint32_t round, double a, double b,
+                                   double* b_sum, double c, double* c_sum) {
+  RoundStatusMessage st;
+  st.round = round;
+  st.sender = self_;
+  st.phase = phase;
+  st.cost = a;
+  st.grad_norm_sq = b;
+  st.block_grad_norm = c;
+  mail_.send_all({OutgoingMessage{st, true, {}}});
+  auto got = mail_.gather(phase, round, others());
+  double sa = 0.0, sb = 0.0, sc = 0.0;
+  for (std::uint32_t k : everyone_) {  // agent-id order: bit-identical sums everywhere
+    const RoundStatusMessage& m = k == self_ ? st : std::get<RoundStatusMessage>(got.at(k));
+    sa += m.cost;
+    sb += m.grad_norm_sq;
+    sc += m.block_grad_norm;
+  }
+  if (b_sum) *b_sum = sb;
+  if (c_sum) *c_sum = sc;
+  return sa;
+}
+
+std::vector<std::uint32_t> DistributedRounding::others() const {
+  std::vector<std::uint32_t> o;
+  for (auto a : everyone_)
+    if (a != self_) o.push_back(a);
+  return o;
+}
+
+template <class F>
+std::map<std::size_t, std::vector<double>> DistributedRounding::exchange(std::uint32_t phase,
+                                                                         std::uint32_t round,
+                                                                         std::uint32_t rank,
+                                                                         F values) {
+  send_publics(phase, round, rank, values);
+  return gather_publics(phase, round, rank);
+}
+
+template <class F>
+void DistributedRounding::send_publics(std::uint32_t phase, std::uint32_t round, std::uint32_t rank,
+                                       F values) {
+  const std::size_t width = width_of(rank);
+  const auto& adj = layout_.adjacent[self_];
+  for (std::size_t k = 0; k < adj.size(); ++k) {
+    PoseBlockMessage m;
+    m.round = round;
+    m.sender = self_;
+    m.phase = phase;
+    m.rank = rank;
+    m.dim = static_cast<std::uint32_t>(d_);
+    for (std::size_t id : layout_.public_to[self_][k]) {
+      m.pose_ids.push_back(static_cast<std::uint32_t>(id));
+      std::vector<double> v = values(id);
+      v.resize(width, 0.0);
+      m.data.insert(m.data.end(), v.begin(), v.end());
+    }
+    mail_.send_all({OutgoingMessage{m, false, {static_cast<std::uint32_t>(adj[k])}}});
+  }
+}
+
+std::map<std::size_t, std::vector<double>> DistributedRounding::gather_publics(std::uint32_t phase,
+                                                                               std::uint32_t round,
+                                                                               std::uint32_t rank) {
+  const std::size_t width = width_of(rank);
+  std::map<std::size_t, std::vector<double>> out;
+  for (auto& [sender, msg] : mail_.gather(phase, round, neighbours_)) {
+    const auto& m = std::get<PoseBlockMessage>(msg);
+    if (m.data.size() != m.pose_ids.size() * width)
+      throw std::runtime_error("rounding: block of the wrong size from agent " +
+                               std::to_string(sender));
+    for (std::size_t k = 0; k < m.pose_ids.size(); ++k)
+      out[m.pose_ids[k]] = std::vector<double>(m.data.begin() + static_cast<long>(k * width),
+                                               m.data.begin() + static_cast<long>((k + 1) * width));
+  }
+  return out;
+}
+
+void DistributedRounding::rotations() {
+  const Eigen::Index r = Y_.rows(), d = d_, m = static_cast<Eigen::Index>(own_.size());
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(r, r);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const auto B = Y_.middleCols((d + 1) * i, d);
+    G.noalias() += B * B.transpose();
+  }
+  // The Gram matrix travels as r "poses" of rank r whose first r entries are its columns.
+  PoseBlockMessage gm;
+  gm.sender = self_;
+  gm.phase = kGram;
+  gm.rank = static_cast<std::uint32_t>(r);
+  gm.dim = static_cast<std::uint32_t>(d);
+  for (Eigen::Index c = 0; c < r; ++c) {
+    gm.pose_ids.push_back(static_cast<std::uint32_t>(c));
+    for (Eigen::Index k = 0; k < r * (d + 1); ++k) gm.data.push_back(k < r ? G(k, c) : 0.0);
+  }
+  mail_.send_all({OutgoingMessage{gm, true, {}}});
+  auto got = mail_.gather(kGram, 0, others());
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(r, r);
+  for (std::uint32_t a : everyone_) {
+    if (a == self_) {
+      S += G;
+      continue;
+    }
+    const auto& msg = std::get<PoseBlockMessage>(got.at(a));
+    if (msg.data.size() != static_cast<std::size_t>(r * r * (d + 1)))
+      throw std::runtime_error("rounding: Gram matrix of the wrong size from agent " +
+                               std::to_string(a));
+    for (Eigen::Index c = 0; c < r; ++c)
+      for (Eigen::Index k = 0; k < r; ++k)
+        S(k, c) += msg.data[static_cast<std::size_t>(c * r * (d + 1) + k)];
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
+  const Eigen::MatrixXd U = eig.eigenvectors().rightCols(d);
+  Eigen::MatrixXd R(d, d * m);
+  double negative = 0;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    R.middleCols(d * i, d) = U.transpose() * Y_.middleCols((d + 1) * i, d);
+    if (R.middleCols(d * i, d).determinant() < 0) negative += 1;
+  }
+  const double total_negative = reduce(kNegative, 0, negative, 0.0, nullptr);
+  const double n = static_cast<double>(local_.num_poses);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    Eigen::MatrixXd Ri = R.middleCols(d * i, d);
+    if (2 * total_negative > n) Ri.row(d - 1) *= -1.0;
+    poses_[own_[static_cast<std::size_t>(i)]] =
+        Pose{project_to_rotation(Ri), Eigen::VectorXd::Zero(d)};
+  }
+  auto nb = exchange(kRotations, 0, static_cast<std::uint32_t>(d), [&](std::size_t id) {
+    const Pose& p = poses_.at(id);
+    return std::vector<double>(p.R.data(), p.R.data() + d * d);
+  });
+  for (auto& [id, v] : nb)
+    poses_[id] = Pose{Eigen::Map<const Eigen::MatrixXd>(v.data(), d, d), Eigen::VectorXd::Zero(d)};
+}
+
+std::uint32_t DistributedRounding::translations() {
+  const Eigen::Index d = d_, m = static_cast<Eigen::Index>(own_.size());
+  std::map<std::size_t, Eigen::Index> slot;
+  for (Eigen::Index s = 0; s < m; ++s) slot[own_[static_cast<std::size_t>(s)]] = s;
+  auto free = [&](std::size_t id) { return id != 0; };
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(m, d);
+  std::vector<Eigen::Triplet<double>> trip;
+  for (Eigen::Index s = 0; s < m; ++s)
+    if (!free(own_[static_cast<std::size_t>(s)])) trip.emplace_back(s, s, 1.0);  // fixed at 0
+  for (const Measurement& e : local_.measurements) {
+    const Eigen::VectorXd c = poses_.at(e.i).R * e.t;
+    auto si = slot.find(e.i), sj = slot.find(e.j);
+    const bool oi = si != slot.end() && free(e.i), oj = sj != slot.end() && free(e.j);
+    if (oi) {
+      b.row(si->second) -= e.tau * c.transpose();
+      trip.emplace_back(si->second, si->second, e.tau);
+    }
+    if (oj) {
+      b.row(sj->second) += e.tau * c.transpose();
+      trip.emplace_back(sj->second, sj->second, e.tau);
+    }
+    if (oi && oj) {
+      trip.emplace_back(si->second, sj->second, -e.tau);
+      trip.emplace_back(sj->second, si->second, -e.tau);
+    }
+  }
+  Eigen::SparseMatrix<double> Lbb(m, m);
+  Lbb.setFromTriplets(trip.begin(), trip.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> chol(Lbb);
+  if (chol.info() != Eigen::Success)
+    throw std::runtime_error("rounding: local translation Laplacian is singular");
+  auto precondition = [&](const Eigen::MatrixXd& r) {
+    Eigen::MatrixXd z = chol.solve(r);
+    for (Eigen::Index s = 0; s < m; ++s)
+      if (!free(own_[static_cast<std::size_t>(s)])) z.row(s).setZero();
+    return z;
+  };
+  // L p for owned rows, given p on owned poses and the neighbours' public entries.
+  auto apply = [&](const Eigen::MatrixXd& p, const std::map<std::size_t, std::vector<double>>& pn) {
+    auto value = [&](std::size_t id) -> Eigen::VectorXd {
+      if (!free(id)) return Eigen::VectorXd::Zero(d);
+      auto s = slot.find(id);
+      if (s != slot.end()) return p.row(s->second).transpose();
+      const auto& v = pn.at(id);
+      return Eigen::Map<const Eigen::VectorXd>(v.data(), d);
+    };
+    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(m, d);
+    for (const Measurement& e : local_.measurements) {
+      const Eigen::VectorXd diff = e.tau * (value(e.j) - value(e.i));
+      auto si = slot.find(e.i), sj = slot.find(e.j);
+      if (si != slot.end() && free(e.i)) out.row(si->second) -= diff.transpose();
+      if (sj != slot.end() && free(e.j)) out.row(sj->second) += diff.transpose();
+    }
+    return out;
+  };
+  // The public rows of `a` (and of `b2` after them) for send_publics.
+  auto rows_of = [&slot, d](const Eigen::MatrixXd* a, const Eigen::MatrixXd* b2) {
+    return [a, b2, &slot, d](std::size_t id) {
+      const Eigen::Index row = slot.at(id);
+      std::vector<double> v(static_cast<std::size_t>(b2 ? 2 * d : d));
+      for (Eigen::Index k = 0; k < d; ++k) {
+        v[static_cast<std::size_t>(k)] = (*a)(row, k);
+        if (b2) v[static_cast<std::size_t>(d + k)] = (*b2)(row, k);
+      }
+      return v;
+    };
+  };
+  // Pipelined PCG (Ghysels & Vanroose, "Hiding global synchronization latency in the
+  // preconditioned conjugate gradient algorithm", 2014): PCG's iterates in exact arithmetic,
+  // with w = L u, s = L p, q = M s and n = L q carried by recurrences, so that an iteration's
+  // two inner products (and |r|^2 for the stop) and the one product with L it needs,
+  // n = L M w, are independent: the reduction and the neighbours' public entries of M w
+  // travel in ONE message step per iteration. Plain PCG needs two (<p, L p>, then <r, z>
+  // with the new z's public entries): intel's rounding took 105 message steps, ~0.85 ms each
+  // on 2 cores, 62 this way (docs/dds-runtime.md, stall10). Each step also carries x's public
+  // entries, so the last one gives the neighbours' final translations.
+  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(m, d), r = b;
+  Eigen::MatrixXd u, w, p, s, q, n_rec;
+  const std::uint32_t max_it = 5000;
+  std::uint32_t it = 0, step = 0, restarts = 0;
+  double rr0 = -1.0, tol = 0.0, gamma_old = 0.0, alpha_old = 0.0;
+  // Whether r is b - L x as computed (a start), not as the recurrences carried it.
+  bool fresh = true;
+  std::map<std::size_t, std::vector<double>> mx;  // neighbours' public M w and x
+  // (Re)starts from x with r = b - L x: one message step for w = L u.
+  auto start = [&] {
+    u = precondition(r);
+    send_publics(kDirection, step, 1, rows_of(&u, nullptr));
+    w = apply(u, gather_publics(kDirection, step, 1));
+    ++step;
+    p = Eigen::MatrixXd::Zero(m, d);
+    s = p;
+    q = p;
+    n_rec = p;
+    fresh = true;
+  };
+  start();
+  for (;;) {
+    const Eigen::MatrixXd mw = precondition(w);
+    send_publics(kDirection, step, 2, rows_of(&mw, &x));
+    double delta = 0.0, rr = 0.0;
+    const double gamma = reduce(kResidual, step, (r.array() * u.array()).sum(),
+                                (w.array() * u.array()).sum(), &delta, r.squaredNorm(), &rr);
+    mx = gather_publics(kDirection, step, 2);
+    ++step;
+    if (rr0 < 0) {  // the first reduction: b's residual
+      rr0 = rr;
+      tol = 1e-24 * rr0;  // relative residual 1e-12
+    }
+    const double beta = fresh ? 0.0 : gamma / gamma_old;
+    const double pAp = fresh ? delta : delta - beta * gamma / alpha_old;  // <p, L p>
+    if (!(rr > tol) || !(pAp > 0)) {
+      // The recurrences drift from b - L x (more than plain PCG's), and <p, L p> from them
+      // may lose its sign: the stop counts only for a residual computed from x. Otherwise
+      // start again from x with that residual (the neighbours' x came with this step).
+      // kitti_02 stopped on the recurrence's residual: 5.7e-9 of b's instead of 1e-12, 3e-6 m
+      // off the direct solve; restarted (twice, on every graph measured): 1e-12, 1.3e-8 m as
+      // plain PCG. A start whose <p, L p> is not positive ends the solve, as plain PCG's did.
+      if (fresh || restarts >= kMaxRestarts) break;
+      std::map<std::size_t, std::vector<double>> xn;
+      for (const auto& [id, v] : mx) xn[id] = std::vector<double>(v.begin() + d, v.begin() + 2 * d);
+      r = b - apply(x, xn);
+      ++restarts;
+      start();
+      continue;
+    }
+    if (it >= max_it) break;
+    const double alpha = gamma / pAp;
+    const Eigen::MatrixXd n = apply(mw, mx);  // L M w
+    n_rec = n + beta * n_rec;
+    q = mw + beta * q;
+    s = w + beta * s;
+    p = u + beta * p;
+    x += alpha * p;
+    r -= alpha * s;
+    u -= alpha * q;
+    w -= alpha * n_rec;
+    gamma_old = gamma;
+    alpha_old = alpha;
+    fresh = false;
+    ++it;
+  }
+  for (Eigen::Index k = 0; k < m; ++k)
+    poses_[own_[static_cast<std::size_t>(k)]].t = x.row(k).transpose();
+  for (const auto& [id, v] : mx)  // the x sent with the last step
+    poses_[id].t = Eigen::Map<const Eigen::VectorXd>(v.data() + d, d);
+  return it;
+}
+
+double DistributedRounding::cost() {
+  double share = 0.0;
+  for (const Measurement& e : local_.measurements) {
+    const Pose& a = poses_.at(e.i);
+    const Pose& b = poses_.at(e.j);
+    const double f =
+        e.kappa * (b.R - a.R * e.R).squaredNorm() + e.tau * (b.t - a.t - a.R * e.t).squaredNorm();
+    const bool both = local_.owner[e.i] == self_ && local_.owner[e.j] == self_;
+    share += both ? f : 0.5 * f;
+  }
+  return reduce(kCost, 0, share, 0.0, nullptr);
+}
+
+}  // namespace tessera::agent

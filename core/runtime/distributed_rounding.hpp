@@ -1,0 +1,118 @@
+#pragma once
+// The distributed rounding of the final lifted iterate to SE(d), with no central step: the
+// same result as core's round_solution (rank-d truncation via the r x r Gram matrix summed
+// over the agents, reflection by majority, per-block projection to SO(d), translations
+// optimal for those rotations with pose 0 at the origin, by a distributed preconditioned
+// conjugate gradient) up to floating-point summation order. Runs after core's protocol in
+// run_round_loop, over the same Mailbox.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/graph/pose.hpp>
+#include <vector>
+
+#include "runtime/round_loop.hpp"
+#include "runtime/round_mailbox.hpp"
+
+namespace tessera::agent {
+
+// Phases of the rounding messages (statuses and pose blocks), after core's protocol.
+enum RoundingPhase : std::uint32_t {
+  kGram = kRoundingPhaseBase,  // r x r Gram matrix of the block's rotation parts
+  kNegative,                   // number of rounded blocks with det < 0
+  kRotations,                  // rounded rotations of public poses
+  kInitialResidual,            // retired: plain PCG's first <r,z>, <r,r>
+  kDirection,                  // PCG: public entries of u (first step), then of M w and x
+  kCurvature,                  // retired: plain PCG's <p, L p>
+  kResidual,                   // pipelined PCG: <r,u>, <w,u>, <r,r> of an iteration
+  kTranslations,               // retired: the final translations ride on the last CG step
+  kCost,                       // cost share of the rounded poses
+  kTraffic                     // certificate and escape bytes sent (certification only)
+};
+
+/// One agent's side of the rounding. It keeps references to its arguments (they must outlive
+/// it) and rounds the iterate `state.Y` as it is when run() is called.
+class DistributedRounding {
+ public:
+  DistributedRounding(const AgentLocalData& local, const BlockLayout& layout,
+                      const AgentState& state, Mailbox& mail)
+      : local_(local),
+        layout_(layout),
+        mail_(mail),
+        self_(local.agent_id),
+        d_(local.d),
+        own_(layout.poses[local.agent_id]),
+        Y_(state.Y) {
+    for (std::uint32_t a = 0; a < local.num_agents; ++a) everyone_.push_back(a);
+    for (int b : layout.adjacent[self_]) neighbours_.push_back(static_cast<std::uint32_t>(b));
+  }
+
+  /// A global sum of (a, b) over the agents, in agent-id order (bit-identical on every
+  /// agent): returns the sum of a and stores the sum of b in *b_sum when given. Every agent
+  /// must call it with the same `phase`, once per phase.
+  double sum_over_agents(std::uint32_t phase, double a, double b, double* b_sum) {
+    return reduce(phase, 0, a, b, b_sum);
+  }
+
+  /// Rounds this agent's block of the final lifted iterate (every agent calls it together)
+  /// and returns `res` with poses (of `owned`, in order), cost (of the rounded poses, whole
+  /// graph) and translation_iterations set. Throws std::runtime_error when a peer's message
+  /// is missing after the timeout or malformed.
+  RoundLoopResult run(RoundLoopResult res);
+
+ private:
+  // Sums (a, b, c) over the agents in agent-id order: returns a's sum, b's and c's in *b_sum
+  // and *c_sum when given.
+  double reduce(std::uint32_t phase, std::uint32_t round, double a, double b, double* b_sum,
+                double c = 0.0, double* c_sum = nullptr);
+
+  std::vector<std::uint32_t> others() const;
+
+  // Sends `values(id)` (width doubles per pose, as a block of the given rank) of the public
+  // poses to each neighbour and returns the neighbours' values by pose id.
+  template <class F>
+  std::map<std::size_t, std::vector<double>> exchange(std::uint32_t phase, std::uint32_t round,
+                                                      std::uint32_t rank, F values);
+
+  // The two halves of exchange(), for steps that also carry a reduction: send, reduce,
+  // then gather (one message step instead of two).
+  template <class F>
+  void send_publics(std::uint32_t phase, std::uint32_t round, std::uint32_t rank, F values);
+
+  std::map<std::size_t, std::vector<double>> gather_publics(std::uint32_t phase,
+                                                            std::uint32_t round,
+                                                            std::uint32_t rank);
+
+  // Restarts of the pipelined CG from its x when only the recurrence's residual converged.
+  static constexpr std::uint32_t kMaxRestarts = 4;
+
+  std::size_t width_of(std::uint32_t rank) const {
+    return static_cast<std::size_t>(rank) * static_cast<std::size_t>(d_ + 1);
+  }
+
+  void rotations();
+
+  // Preconditioned CG on L t = b (the translation Laplacian without the anchor pose 0), with
+  // each agent's own Laplacian block as the preconditioner (solved exactly by Cholesky), in
+  // its pipelined form: one message step per iteration.
+  std::uint32_t translations();
+
+  // Cost of the rounded poses: internal measurements in full, cut ones half (as core's status).
+  double cost();
+
+  const AgentLocalData& local_;
+  const BlockLayout& layout_;
+  Mailbox& mail_;
+  std::uint32_t self_;
+  int d_;
+  const std::vector<std::size_t>& own_;
+  const Eigen::MatrixXd& Y_;
+  std::vector<std::uint32_t> everyone_, neighbours_;
+  std::map<std::size_t, Pose> poses_;  // own and neighbours' rounded poses
+};
+
+}  // namespace tessera::agent

@@ -1,0 +1,22 @@
+#include "runtime/partition_step.hpp"
+
+#include <tessera/partition/partitioner.hpp>
+
+namespace tessera::coordinator {
+
+PartitionStepResult partition_for_agents(const GraphStructure& graph, std::uint32_t num_agents,
+                                         const std::string& preset, std::uint64_t seed) {
+  PartitionOptions opt;
+  opt.parts = static_cast<int>(num_agents);
+  opt.preset = parse_preset(preset);
+  opt.seed = seed;
+  opt.validate();
+  PartitionResult r = partition_graph(graph, opt);
+  PartitionStepResult out;
+  out.owner.assign(r.assignment.begin(), r.assignment.end());
+  out.ms = r.time_ms;
+  out.cut_edges = r.metrics.cut_edges;
+  return out;
+}
+
+}  // namespace tessera::coordinator

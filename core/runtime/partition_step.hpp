@@ -1,0 +1,25 @@
+#pragma once
+// The coordinator's one-shot partition, behind one function so the partitioner can be
+// swapped without touching the runtime.
+
+#include <cstdint>
+#include <string>
+#include <tessera/partition/graph_structure.hpp>
+#include <vector>
+
+namespace tessera::coordinator {
+
+struct PartitionStepResult {
+  std::vector<std::uint32_t> owner;  ///< Agent of every pose.
+  double ms = 0;                     ///< Wall time of the partitioning.
+  std::size_t cut_edges = 0;         ///< Measurements between different agents.
+  bool early = false;  ///< Of the graph file, while the agents started (file_partition.hpp).
+};
+
+/// Splits the structure among `num_agents` agents with core's partitioner (`preset` as
+/// parse_preset accepts: sequential, fast, eco, strong, highest). Throws InputError on a bad
+/// preset or more agents than poses.
+PartitionStepResult partition_for_agents(const GraphStructure& graph, std::uint32_t num_agents,
+                                         const std::string& preset, std::uint64_t seed);
+
+}  // namespace tessera::coordinator

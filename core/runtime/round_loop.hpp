@@ -1,0 +1,173 @@
+#pragma once
+// THE SEAM between the DDS runtime and core's round protocol.
+//
+// After the hand-off, an agent holds its local problem (AgentLocalData) and a
+// ProtocolChannel that delivers core ProtocolMessages to and from the other agents. The
+// runtime calls run_round_loop() once and publishes the poses it returns as this agent's
+// final estimate. Nothing here knows about DDS: the same function can be driven by an
+// in-process channel in tests.
+//
+// run_round_loop() runs core's agent (AgentState + RoundProtocol, configured exactly as the
+// in-process engine configures it) and then rounds the final iterate to SE(d) without a
+// central step: the rotation rounding from a summed Gram matrix, the optimal translations
+// by a distributed preconditioned conjugate gradient on the translation Laplacian.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <tessera/graph/measurement.hpp>
+#include <tessera/graph/pose.hpp>
+#include <tessera/protocol/awaited_messages.hpp>
+#include <tessera/protocol/messages.hpp>
+#include <utility>
+#include <vector>
+
+namespace tessera {
+struct ProtocolSnapshot;  // distributed/protocol_snapshot.hpp
+}
+
+namespace tessera::agent {
+
+/// Algorithm options of the run as published by the coordinator (simple fields).
+struct RunOptions {
+  std::string algorithm;           ///< Solver name ("" = core's default).
+  std::string initialization;      ///< e.g. "distributed" ("" = core's default).
+  std::uint32_t rank = 0;          ///< r (0 = d).
+  std::uint32_t max_rounds = 0;    ///< 0 = core's default.
+  double grad_norm_tolerance = 0;  ///< 0 = core's default.
+  double relative_cost_tolerance = 0;
+  std::uint64_t seed = 1;
+  bool certify = false;  ///< Certified sequence (solve -> certify -> escape ...), core's defaults.
+};
+
+/// Everything one agent knows after the hand-off.
+struct AgentLocalData {
+  std::uint32_t agent_id = 0;
+  std::uint32_t num_agents = 1;
+  int d = 0;
+  std::size_t num_poses = 0;         ///< n of the whole graph.
+  std::vector<std::uint32_t> owner;  ///< Owner agent of every pose 0..n-1.
+  std::vector<std::uint32_t> owned;  ///< Poses this agent optimizes, ascending.
+  /// Every measurement with at least one endpoint in `owned`, in the order of the original
+  /// file (measurement_index is the position in that file), so sums can follow the same
+  /// order as the in-process engine.
+  std::vector<Measurement> measurements;
+  std::vector<std::uint64_t> measurement_index;
+  /// Initial poses of `owned` (same order), from the initialisation stage.
+  std::vector<Pose> initial;
+  /// When not empty: the lifted starting point of `owned` (r x (d+1)m, same order), used
+  /// instead of lifting `initial` (a run continued by survivors after a permanent loss).
+  Eigen::MatrixXd lifted_start;
+  /// Endpoints (i, j) of every measurement of the whole graph, no values: with `owner`
+  /// enough for core's make_block_layout (give it Measurements with only i and j set), so
+  /// every agent builds the same layout (neighbours, public poses, colouring).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;
+  RunOptions options;
+};
+
+/// Raised by a channel when the run is stopping (lost peer, abort, signal): the round loop
+/// must unwind; the runtime reports the reason.
+class RunStopped : public std::runtime_error {
+ public:
+  explicit RunStopped(const std::string& why) : std::runtime_error(why) {}
+};
+
+/// Raised by a channel when the coordinator orders a coordinated rollback (an agent was
+/// restarted and rejoins): every agent abandons its current round and resumes from its
+/// snapshot of `round`; messages of earlier epochs are discarded from then on.
+class RollbackRequested : public std::runtime_error {
+ public:
+  RollbackRequested(std::uint32_t round, std::uint32_t epoch, std::uint32_t rejoined_agent)
+      : std::runtime_error("rollback to round " + std::to_string(round) + " (agent " +
+                           std::to_string(rejoined_agent) + " rejoined)"),
+        round(round),
+        epoch(epoch),
+        agent(rejoined_agent) {}
+  std::uint32_t round, epoch, agent;
+};
+
+/// How the round loop talks to the other agents.
+class ProtocolChannel {
+ public:
+  virtual ~ProtocolChannel() = default;
+  /// Sends to every agent (broadcast) or to the listed recipients. Never delivered back to
+  /// the sender. Throws RunStopped / std::runtime_error when it cannot be delivered.
+  virtual void send(const OutgoingMessage& message) = 0;
+  /// The messages one protocol step emits, in order. A channel may pack messages for the same
+  /// recipient into one delivery (the DDS channel: blocks to the status relay ride with the
+  /// status); the default sends them one by one.
+  virtual void send_all(const std::vector<OutgoingMessage>& messages);
+  /// The next message for this agent in arrival order (FIFO per sender and message type;
+  /// a block and a status from one sender may arrive in either order), or nullopt when
+  /// none arrived within `timeout_s`. Throws RunStopped when the run is stopping.
+  virtual std::optional<ProtocolMessage> receive(double timeout_s) = 0;
+  /// receive() for a caller whose protocol step still needs `wake_after` messages (a lower
+  /// bound, AgentProcess::messages_needed()): the channel may sleep until that many have
+  /// arrived instead of waking for each one. Anything else that needs the caller (a stop, a
+  /// rollback, a re-partition) and the timeout still end the wait at once.
+  /// The default is receive(timeout_s).
+  virtual std::optional<ProtocolMessage> receive_after(double timeout_s, std::size_t wake_after);
+  /// receive() for a caller whose protocol step waits for exactly `awaited`
+  /// (AgentProcess::awaited()): the channel may sleep until all of them have arrived; the
+  /// message returned may be any queued one. Ends early as receive_after() does.
+  /// The default is receive_after(timeout_s, awaited.senders.size()).
+  virtual std::optional<ProtocolMessage> receive_awaiting(double timeout_s,
+                                                          const AwaitedMessages& awaited);
+};
+
+struct RoundLoopResult {
+  std::vector<Pose> poses;  ///< Final (rounded) poses of `owned`, same order.
+  std::uint32_t rounds = 0;
+  std::uint32_t restarts = 0;
+  std::string stop_reason;       ///< grad_norm, max_rounds or relative_decrease.
+  double relaxation_cost = 0.0;  ///< f of the final lifted iterate (as every agent summed it).
+  double grad_norm = 0.0;        ///< ||grad f|| there.
+  double cost = 0.0;             ///< Objective of the rounded poses (whole graph, summed).
+  std::uint32_t translation_iterations = 0;  ///< Distributed CG iterations of the rounding.
+  double solve_s = 0.0;                      ///< Time in core's protocol.
+  double rounding_s = 0.0;                   ///< Time in the distributed rounding.
+  /// Where the solve and rounding time went (seconds): waiting for messages, handing
+  /// messages to the channel (serialising and writing), and the rest (this agent's math).
+  double wait_s = 0.0, send_s = 0.0;
+  /// Message steps of the rounding (every one waits for peers: rotations, CG, cost).
+  std::uint32_t rounding_steps = 0;
+  // Certification (RunOptions::certify), identical on every agent; bytes summed over agents.
+  std::optional<bool> certified;
+  double min_eigenvalue = 0.0;
+  std::uint32_t certificate_rounds = 0, escape_rounds = 0;
+  std::uint64_t certificate_bytes = 0, escape_bytes = 0;
+  std::uint32_t final_rank = 0;
+};
+
+/// Status phases of the messages the round loop adds after core's protocol (distributed
+/// rounding), and the one agent 0 sends for the coordinator's summary: round = rounds,
+/// cost = rounded cost, grad_norm_sq = ||grad f||^2, block_grad_norm = restarts.
+constexpr std::uint32_t kRoundingPhaseBase = 100;
+constexpr std::uint32_t kFinalReportPhase = 200;
+/// Agent 0's certificate report, sent just before the final report when certification ran:
+/// cost = lambda_min estimate, grad_norm_sq = certificate rounds, block_grad_norm = final rank,
+/// restart_vote = certified.
+constexpr std::uint32_t kCertificateReportPhase = 201;
+/// And its traffic: cost = certificate bytes, grad_norm_sq = escape bytes (all agents),
+/// block_grad_norm = escape rounds.
+constexpr std::uint32_t kCertificateBytesPhase = 202;
+
+/// Optional recovery hooks of the round loop.
+struct RoundLoopHooks {
+  /// Called at every consistent point of the protocol (see RoundProtocol::set_round_observer).
+  std::function<void(const ProtocolSnapshot&)> on_round;
+  /// Continue from this snapshot (a coordinated rollback) instead of starting from the
+  /// initial poses; every other agent must resume from its snapshot of the same round.
+  const ProtocolSnapshot* resume_from = nullptr;
+};
+
+/// Runs this agent's part of the distributed solve. `receive_timeout_s` bounds every wait
+/// for a peer's message (a throw names the missing sender). RollbackRequested from the
+/// channel propagates: the caller calls again with the snapshot of that round.
+RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
+                               double receive_timeout_s, const RoundLoopHooks& hooks = {});
+
+}  // namespace tessera::agent
