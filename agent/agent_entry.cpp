@@ -12,27 +12,22 @@
 
 #include "agent/agent_options.hpp"
 #include "agent/agent_run.hpp"
-#include "agent/heap_retention.hpp"
-#include "agent/startup_priority.hpp"
+#include "cli/session_process.hpp"
+#include "launch/process_tuning.hpp"
 #include "runtime/agent_log.hpp"
-#include "session_process.hpp"
 #include "transport/signal_watcher.hpp"
 
 namespace tessera::agent {
 
 int agent_main(int argc, char** argv) {
   transport::SignalWatcher
-      signals;          // first: every thread created later inherits the blocked signals
-  retain_freed_heap();  // rounds re-use their temporaries' pages (heap_retention.hpp)
+      signals;                    // first: every thread created later inherits the blocked signals
+  launch::begin_agent_process();  // process-level tuning (launch/process_tuning.hpp)
   const std::vector<std::string> argv_list(argv + 1, argv + argc);
   AgentOptions options;
   if (auto code = cli::parse_process_options(
           argv_list, "tessera-agent", cli::process_help(kAgentUsage), parse_agent_options, options))
     return *code;
-  // Started lowered by launch's fork server: back to nice 0 at the latest after the bound
-  // (with the assignment, normally: run_setup.cpp), which stays well inside the lease.
-  const StartupPriorityBound startup_bound(
-      StartupPriorityOptions{}.bound_for_lease(options.net.session.lease_s));
   const std::string tag = agent_tag(options.id);
   // A checkpoint of this run in --checkpoint-dir means this process is a restart: rejoin.
   std::optional<AgentCheckpoint> restart;

@@ -1,6 +1,6 @@
 #pragma once
 // The whole of tessera-agent behind one function, so that the standalone executable
-// (agent_main.cpp) and `tessera launch`'s fork server (cli/fork_server/) run the very same
+// (agent_main.cpp) and `tessera launch`'s fork server (launch/fork_server/) run the very same
 // code with the same argv.
 
 namespace tessera::agent {

@@ -14,8 +14,7 @@
 #include "agent/lost_for_good.hpp"
 #include "agent/robot_data.hpp"
 #include "agent/share_announcement.hpp"
-#include "agent/startup_batch.hpp"
-#include "agent/startup_priority.hpp"
+#include "launch/process_tuning.hpp"
 #include "runtime/initialization_stage.hpp"
 #include "runtime/local_dump.hpp"
 #include "transport/run_failure.hpp"
@@ -91,14 +90,10 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
   refuse_if_lost(asg, o.id, o.net.session.run_id);
   refuse_if_lost(s, o.id);
   check_assignment(share, asg, o.robots, o.graph);
-  // The coordinator's partition is done: no reason left to yield the CPU to it
-  // (agent/startup_priority.hpp; a no-op unless launch's fork server lowered this process).
-  const std::string restored = restore_startup_priority();
-  if (!restored.empty()) log("start-up priority: " + restored);
-  // Likewise the start-up's SCHED_BATCH (agent/startup_batch.hpp): the rounds need wake-ups
-  // to run at once again.
-  const std::string unbatched = restore_startup_batch();
-  if (!unbatched.empty()) log("start-up batch: " + unbatched);
+  // The coordinator's partition is done: the rounds need wake-ups to run at once again
+  // (launch/process_tuning.hpp).
+  const std::string unbatched = launch::end_agent_startup();
+  if (!unbatched.empty()) log(unbatched);
   out.rejoin_enabled = asg.rejoin_timeout_s() > 0;
   out.replicas = asg.replicas();
   out.replica_every = std::max<std::uint32_t>(1, asg.replica_every());

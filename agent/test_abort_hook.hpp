@@ -2,13 +2,14 @@
 // TEST-ONLY: makes an agent abort (SIGABRT from another thread, as Fast DDS's failed
 // assertion does in its event thread) at a chosen point of the end of its run, so the tests
 // can check how that ends the agent and what launch reports (tests/dds_agent_end_abort_test.cpp).
+// Compiled in only when the build has TESSERA_TEST_HOOKS (CMake option, on with the test suite);
+// elsewhere test_abort_point() is an empty inline function.
 // Set by the environment variable TESSERA_TEST_AGENT_ABORT=WHEN[:ID] (every agent without
 // :ID), WHEN one of
 //   before-result   after its round loop, before its final estimate is published: the run
 //                   is not complete and must fail (exit 134, launch exit 1);
 //   after-finished  after the coordinator's FINISHED (the merged result is written): the
 //                   cover of cli/session_process.cpp ends the agent with exit 0 and a note.
-// Never set it outside tests: it crashes the agent on purpose.
 
 #include <cstdint>
 
@@ -16,7 +17,11 @@ namespace tessera::agent {
 
 enum class TestAbortPoint { kBeforeResult, kAfterFinished };
 
+#ifdef TESSERA_TEST_HOOKS
 /// Aborts the process if TESSERA_TEST_AGENT_ABORT names `at` for agent `id`; else nothing.
 void test_abort_point(TestAbortPoint at, std::uint32_t id);
+#else
+inline void test_abort_point(TestAbortPoint, std::uint32_t) {}
+#endif
 
 }  // namespace tessera::agent

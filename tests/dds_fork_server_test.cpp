@@ -1,11 +1,10 @@
-// `tessera launch` through its fork server (cli/fork_server/: Fast DDS loaded once, the
+// `tessera launch` through its fork server (launch/fork_server/: Fast DDS loaded once, the
 // coordinator and the agents forked from it) and through the exec fallback
 // (--no-fork-server): the same iterates as the in-process engine, forked processes that look
 // like the executables they stand for and are launch's own children, a clean SIGINT, and the
-// fork server's argv encoding; --agents-yield (agents below the coordinator's priority until
-// their assignment, agent/startup_priority.hpp); agents in SCHED_BATCH until their assignment
-// (launch's default, agent/startup_batch.hpp).
-// Domains used here: 50-53, 211-212, 217-218 (each test its own, so ctest -j is safe).
+// fork server's argv encoding; agents in SCHED_BATCH until their assignment (launch's
+// default, launch/startup_batch.hpp).
+// Domains used here: 50-53, 217-218 (each test its own, so ctest -j is safe).
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -13,7 +12,6 @@
 #include <signal.h>
 #include <sys/file.h>
 #include <sys/mman.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -31,13 +29,12 @@
 #include <thread>
 #include <vector>
 
-#include "agent/startup_batch.hpp"
-#include "agent/startup_priority.hpp"
 #include "dds_process_support.hpp"
-#include "fork_spec.hpp"
-#include "huge_page_heaps.hpp"
-#include "launch_children.hpp"
-#include "shm_leftovers.hpp"
+#include "launch/fork_spec.hpp"
+#include "launch/huge_page_heaps.hpp"
+#include "launch/launch_children.hpp"
+#include "launch/shm_leftovers.hpp"
+#include "launch/startup_batch.hpp"
 
 namespace tessera::test::dds {
 namespace {
@@ -85,11 +82,6 @@ TEST(DdsForkServer, ExecFallbackGivesTheInProcessIterates) {
   expect_launch_gives_the_in_process_iterates("--no-fork-server", 51, "each exec'ed");
 }
 
-TEST(DdsForkServer, AgentsYieldingAtStartGiveTheInProcessIterates) {
-  expect_launch_gives_the_in_process_iterates("--agents-yield", 211,
-                                              "forked by tessera-fork-server");
-}
-
 // The parent pid and command line of a process, from /proc.
 long parent_of(long pid) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
@@ -108,15 +100,6 @@ long stat_field(const std::string& path, int index) {
   std::string field;
   for (int k = 3; rest >> field; ++k)
     if (k == index) return std::stol(field);
-  return -1000;
-}
-
-// The nice of the autogroup of `pid` ("/autogroup-42 nice 19"), -1000 if unknown.
-int autogroup_nice_of(long pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/autogroup");
-  std::string name, word;
-  int nice = -1000;
-  if (in >> name >> word >> nice && word == "nice") return nice;
   return -1000;
 }
 
@@ -169,38 +152,7 @@ struct LongForkedRun {
   }
 };
 
-TEST(DdsForkServer, YieldingAgentsShareASessionAndRunTheirRoundsAtNiceZero) {
-  LongForkedRun run("yield", 212, {"--agents-yield"});
-  const std::string& run_id = run.run_id;
-  const Process& launch = run.launch;
-  ASSERT_TRUE(wait_for_round(launch, 2, 30)) << launch.output();
-  // Every agent has its assignment: all its threads and its group are back at nice 0.
-  const std::vector<long> agents = pids_of("[t]essera-agent.*--run-id " + run_id + " ");
-  ASSERT_EQ(agents.size(), 2u);
-  const std::vector<long> coordinator = pids_of("[t]essera-coordinator .*--run-id " + run_id + " ");
-  ASSERT_EQ(coordinator.size(), 1u);
-  const long launch_session = stat_field("/proc/" + std::to_string(launch.pid) + "/stat", 6);
-  const long agents_session = stat_field("/proc/" + std::to_string(agents[0]) + "/stat", 6);
-  EXPECT_EQ(stat_field("/proc/" + std::to_string(agents[1]) + "/stat", 6), agents_session);
-  EXPECT_NE(agents_session, launch_session);  // the fork server's session, not launch's
-  EXPECT_NE(stat_field("/proc/" + std::to_string(coordinator[0]) + "/stat", 6), agents_session);
-  for (long pid : agents) {
-    const int group = autogroup_nice_of(pid);
-    if (group != -1000) {
-      EXPECT_EQ(group, 0) << pid;
-    }
-    run_command("ls /proc/" + std::to_string(pid) + "/task > " + run.dir + "/tasks", nullptr);
-    std::ifstream tasks(run.dir + "/tasks");
-    int seen = 0;
-    for (std::string tid; tasks >> tid; ++seen)
-      EXPECT_EQ(stat_field("/proc/" + std::to_string(pid) + "/task/" + tid + "/stat", 19), 0)
-          << "agent " << pid << " thread " << tid;
-    EXPECT_GT(seen, 1);
-  }
-  run.end();
-}
-
-// Launch's default: agents start in SCHED_BATCH (agent/startup_batch.hpp) and leave it with
+// Launch's default: agents start in SCHED_BATCH (launch/startup_batch.hpp) and leave it with
 // their assignment, so every thread of theirs runs the rounds as a normal thread.
 TEST(DdsForkServer, BatchStartedAgentsRunTheirRoundsAsNormalThreads) {
   LongForkedRun run("batch", 217, {});
@@ -239,8 +191,8 @@ void expect_checks_pass_in_child(int (*checks)()) {
 // thread back, once. Each failed check is one bit of the child's exit code.
 int batch_and_restore_in_child() {
   int failed = 0;
-  if (!agent::restore_startup_batch().empty()) failed |= 1 << 0;  // nothing entered yet
-  if (!agent::enter_startup_batch()) failed |= 1 << 1;
+  if (!launch::restore_startup_batch().empty()) failed |= 1 << 0;  // nothing entered yet
+  if (!launch::enter_startup_batch()) failed |= 1 << 1;
   if (sched_getscheduler(0) != SCHED_BATCH) failed |= 1 << 2;
   std::atomic<int> sleeper_policy{-1};
   std::atomic<bool> restored{false};
@@ -250,92 +202,18 @@ int batch_and_restore_in_child() {
     if (sleeper_policy != -2) sleeper_policy = sched_getscheduler(0);
   });
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  const std::string what = agent::restore_startup_batch();
+  const std::string what = launch::restore_startup_batch();
   restored = true;
   sleeper.join();
   if (what.find("2 thread(s)") == std::string::npos) failed |= 1 << 3;
   if (sched_getscheduler(0) != SCHED_OTHER) failed |= 1 << 4;
   if (sleeper_policy != SCHED_OTHER) failed |= 1 << 5;
-  if (!agent::restore_startup_batch().empty()) failed |= 1 << 6;  // idempotent
+  if (!launch::restore_startup_batch().empty()) failed |= 1 << 6;  // idempotent
   return failed;
 }
 
 TEST(StartupBatch, NewThreadsInheritItAndRestoreBringsEveryThreadBack) {
   expect_checks_pass_in_child(batch_and_restore_in_child);
-}
-
-// In a forked child (so neither the test's session nor its threads change): what
-// enter_startup_priority / lower_autogroup_nice lower and restore_startup_priority and the
-// bound put back. Each failed check is one bit of the child's exit code.
-int lower_and_restore_in_child() {
-  int failed = 0;
-  if (setsid() < 0) return 1 << 0;  // a group of our own: never the test runner's
-  // Without CAP_SYS_ADMIN the kernel takes one group nice change per 100 ms machine-wide.
-  bool group = false;
-  for (int attempt = 0; attempt < 5 && !group; ++attempt) {
-    group = agent::lower_autogroup_nice(7);
-    if (!group) std::this_thread::sleep_for(std::chrono::milliseconds(150));
-  }
-  std::ifstream probe("/proc/self/autogroup");
-  if (probe.good() && !group) failed |= 1 << 1;  // an autogroup kernel: lowered
-  if (group && autogroup_nice_of(getpid()) != 7) failed |= 1 << 2;
-  agent::StartupPriorityOptions o;
-  o.nice = 9;
-  const bool lowered = agent::enter_startup_priority(o, group);
-  const bool threads = getpriority(PRIO_PROCESS, 0) == 9;
-  if (lowered != (threads || group)) failed |= 1 << 3;
-  int thread_nice = 0;
-  std::thread([&] { thread_nice = getpriority(PRIO_PROCESS, 0); }).join();
-  if (threads && thread_nice != 9) failed |= 1 << 4;  // inherited by new threads
-  std::thread sleeper;                                // a thread alive while restoring
-  std::atomic<int> sleeper_nice{-100};
-  std::atomic<bool> restored{false};
-  sleeper = std::thread([&] {
-    while (!restored) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    sleeper_nice = getpriority(PRIO_PROCESS, 0);
-  });
-  const std::string what = agent::restore_startup_priority();
-  restored = true;
-  sleeper.join();
-  if (what.empty() == lowered) failed |= 1 << 5;
-  if (getpriority(PRIO_PROCESS, 0) != 0 || sleeper_nice != 0) failed |= 1 << 6;
-  if (group && autogroup_nice_of(getpid()) != 0) failed |= 1 << 7;
-  if (agent::startup_priority_lowered() || !agent::restore_startup_priority().empty())
-    failed |= 1 << 8;  // idempotent
-  // The bound: back at nice 0 without an assignment.
-  agent::enter_startup_priority(o, false);
-  {
-    const agent::StartupPriorityBound bound(0.05);
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    if (getpriority(PRIO_PROCESS, 0) != 0 || agent::startup_priority_lowered()) failed |= 1 << 9;
-  }
-  return failed;
-}
-
-TEST(StartupPriority, LowersTheAgentsAndPutsThemBackAtNiceZero) {
-  expect_checks_pass_in_child(lower_and_restore_in_child);
-}
-
-TEST(StartupPriority, OptionsNameTheBadField) {
-  agent::StartupPriorityOptions o;
-  EXPECT_NO_THROW(o.validate());
-  o.nice = 0;
-  EXPECT_THROW(o.validate(), InputError);
-  o.nice = 19;
-  o.bound_s = 0.0;
-  try {
-    o.validate();
-    ADD_FAILURE() << "bound_s = 0 accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("bound_s"), std::string::npos) << e.what();
-  }
-}
-
-TEST(StartupPriority, BoundStaysWellInsideTheParticipantLease) {
-  const agent::StartupPriorityOptions o;          // bound_s 1.0
-  EXPECT_DOUBLE_EQ(o.bound_for_lease(1.0), 0.4);  // launch's default lease
-  EXPECT_DOUBLE_EQ(o.bound_for_lease(0.2), 0.2 * 0.4);
-  EXPECT_DOUBLE_EQ(o.bound_for_lease(10.0), 1.0);  // a long lease keeps the bound
 }
 
 TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndStopOnSigint) {
@@ -358,7 +236,7 @@ TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndS
     std::string name;
     std::getline(comm, name);
     EXPECT_EQ(name.rfind("tessera-", 0), 0u) << name;
-    // launch asked for huge-page heaps (cli/huge_page_heaps.hpp) before starting the server.
+    // launch asked for huge-page heaps (launch/huge_page_heaps.hpp) before starting the server.
     std::ifstream env("/proc/" + std::to_string(pid) + "/environ");
     const std::string environ_text((std::istreambuf_iterator<char>(env)),
                                    std::istreambuf_iterator<char>());
@@ -368,15 +246,15 @@ TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndS
 }
 
 TEST(HugePageHeaps, AddsTheTunableAndKeepsTheUsersOwn) {
-  EXPECT_EQ(cli::with_huge_page_heaps(""), "glibc.malloc.hugetlb=1");
-  EXPECT_EQ(cli::with_huge_page_heaps("glibc.malloc.arena_max=2"),
+  EXPECT_EQ(launch::with_huge_page_heaps(""), "glibc.malloc.hugetlb=1");
+  EXPECT_EQ(launch::with_huge_page_heaps("glibc.malloc.arena_max=2"),
             "glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1");
   // The user's own choice (here: off) stays, wherever it stands in the list.
-  EXPECT_EQ(cli::with_huge_page_heaps("glibc.malloc.hugetlb=0"), "glibc.malloc.hugetlb=0");
-  EXPECT_EQ(cli::with_huge_page_heaps("glibc.malloc.arena_max=2:glibc.malloc.hugetlb=2"),
+  EXPECT_EQ(launch::with_huge_page_heaps("glibc.malloc.hugetlb=0"), "glibc.malloc.hugetlb=0");
+  EXPECT_EQ(launch::with_huge_page_heaps("glibc.malloc.arena_max=2:glibc.malloc.hugetlb=2"),
             "glibc.malloc.arena_max=2:glibc.malloc.hugetlb=2");
   // A longer name that merely starts like it is another tunable.
-  EXPECT_EQ(cli::with_huge_page_heaps("glibc.malloc.hugetlbx=1"),
+  EXPECT_EQ(launch::with_huge_page_heaps("glibc.malloc.hugetlbx=1"),
             "glibc.malloc.hugetlbx=1:glibc.malloc.hugetlb=1");
 }
 
@@ -410,12 +288,12 @@ TEST(DdsForkServer, StopAllKillsAndNamesAChildThatIgnoresSigint) {
   char byte = 0;
   ASSERT_EQ(read(ready[0], &byte, 1), 1);
   close(ready[0]);
-  std::vector<cli::Child> children(1);
+  std::vector<launch::Child> children(1);
   children[0].name = "agent 7";
   children[0].pid = pid;
   children[0].running = true;
   testing::internal::CaptureStderr();
-  cli::stop_all(children, 0.3);
+  launch::stop_all(children, 0.3);
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_FALSE(children[0].running);
   EXPECT_EQ(children[0].code, 128 + SIGKILL);
@@ -465,11 +343,11 @@ TEST(DdsShmLeftovers, OnlyDeadPortsOfTheDomainAndDeadSegmentsOfTheRunAreRemoved)
   const int port_lock = hold("fastrtps_port8161_el");
   const int segment_lock = hold("fastrtps_aaaaaaaaaaaaaaaa_el");
 
-  cli::ShmCleanupOptions o;
+  launch::ShmCleanupOptions o;
   o.domain = 3;
   o.dir = dir;
   o.segments = {"fastrtps_0123456789abcdef", "fastrtps_aaaaaaaaaaaaaaaa"};
-  const cli::ShmCleanupResult r = cli::remove_dead_shm_files(o);
+  const launch::ShmCleanupResult r = launch::remove_dead_shm_files(o);
   std::vector<std::string> expected = dead_port;
   expected.insert(expected.end(), dead_shared_port.begin(), dead_shared_port.end());
   expected.insert(expected.end(), lock_gone.begin(), lock_gone.end());
@@ -493,11 +371,11 @@ TEST(DdsShmLeftovers, OnlyDeadPortsOfTheDomainAndDeadSegmentsOfTheRunAreRemoved)
   ASSERT_GE(fd, 0);
   void* map = mmap(nullptr, 4096, PROT_READ, MAP_SHARED, fd, 0);
   ASSERT_NE(map, MAP_FAILED);
-  EXPECT_EQ(cli::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 1u);
+  EXPECT_EQ(launch::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 1u);
   munmap(map, 4096);
   close(fd);
   unlink(shm.c_str());
-  EXPECT_EQ(cli::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 0u);
+  EXPECT_EQ(launch::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 0u);
 }
 
 // Dead ports of the run's domain that an earlier run's processes left (an abort, a SIGKILLed agent
@@ -531,14 +409,13 @@ TEST(DdsShmLeftovers, LaunchRemovesTheDomainsDeadPortsBeforeTheRun) {
 }
 
 TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
-  cli::ForkSpec spec;
+  launch::ForkSpec spec;
   spec.pid_fd = 7;
-  spec.children.push_back({cli::ForkRole::kCoordinator, "/tmp/c.log", 4, {"/b/c", "--x", ""}});
-  spec.children.push_back({cli::ForkRole::kAgent, "/tmp/a 0.log", -1, {"/b/a", "--child"}});
-  const std::vector<std::string> args = cli::encode_fork_spec(spec);
-  const cli::ForkSpec back = cli::decode_fork_spec(args);
+  spec.children.push_back({launch::ForkRole::kCoordinator, "/tmp/c.log", 4, {"/b/c", "--x", ""}});
+  spec.children.push_back({launch::ForkRole::kAgent, "/tmp/a 0.log", -1, {"/b/a", "--child"}});
+  const std::vector<std::string> args = launch::encode_fork_spec(spec);
+  const launch::ForkSpec back = launch::decode_fork_spec(args);
   EXPECT_EQ(back.pid_fd, 7);
-  EXPECT_EQ(back.agents_nice, 0);
   EXPECT_FALSE(back.agents_batch);
   ASSERT_EQ(back.children.size(), 2u);
   for (std::size_t k = 0; k < 2; ++k) {
@@ -552,34 +429,26 @@ TEST(DdsForkServer, ArgvEncodingRoundTripsAndRejectsMalformedInput) {
     a[at] = value;
     return a;
   };
-  EXPECT_THROW(cli::decode_fork_spec({}), InputError);
-  EXPECT_THROW(cli::decode_fork_spec({"--pid-fd", "3"}), InputError);  // no child
-  EXPECT_THROW(cli::decode_fork_spec(broken(1, "x")), InputError);
-  EXPECT_THROW(cli::decode_fork_spec(broken(3, "worker")), InputError);
-  EXPECT_THROW(cli::decode_fork_spec(broken(6, "99")), InputError);  // argc past the end
-  EXPECT_THROW(cli::decode_fork_spec(broken(6, "0")), InputError);
-  cli::ForkSpec yielding = spec;  // launch --agents-yield
-  yielding.agents_nice = 19;
-  EXPECT_EQ(cli::decode_fork_spec(cli::encode_fork_spec(yielding)).agents_nice, 19);
-  cli::ForkSpec batch = yielding;  // launch's default, with and without --agents-yield
+  EXPECT_THROW(launch::decode_fork_spec({}), InputError);
+  EXPECT_THROW(launch::decode_fork_spec({"--pid-fd", "3"}), InputError);  // no child
+  EXPECT_THROW(launch::decode_fork_spec(broken(1, "x")), InputError);
+  EXPECT_THROW(launch::decode_fork_spec(broken(3, "worker")), InputError);
+  EXPECT_THROW(launch::decode_fork_spec(broken(6, "99")), InputError);  // argc past the end
+  EXPECT_THROW(launch::decode_fork_spec(broken(6, "0")), InputError);
+  launch::ForkSpec batch = spec;  // launch's default
   batch.agents_batch = true;
-  const cli::ForkSpec batch_back = cli::decode_fork_spec(cli::encode_fork_spec(batch));
+  const launch::ForkSpec batch_back = launch::decode_fork_spec(launch::encode_fork_spec(batch));
   EXPECT_TRUE(batch_back.agents_batch);
-  EXPECT_EQ(batch_back.agents_nice, 19);
   EXPECT_EQ(batch_back.children.size(), 2u);
-  batch.agents_nice = 0;
-  EXPECT_TRUE(cli::decode_fork_spec(cli::encode_fork_spec(batch)).agents_batch);
-  yielding.agents_nice = 20;
-  EXPECT_THROW(cli::encode_fork_spec(yielding), InputError);
-  cli::ForkSpec no_log = spec;
+  launch::ForkSpec no_log = spec;
   no_log.children[1].log.clear();
-  EXPECT_THROW(cli::encode_fork_spec(no_log), InputError);
+  EXPECT_THROW(launch::encode_fork_spec(no_log), InputError);
   // The bytes that go down the pipe.
-  const std::string text = cli::serialize_fork_spec(spec);
-  EXPECT_EQ(cli::parse_fork_spec(text).children[0].argv, spec.children[0].argv);
-  EXPECT_THROW(cli::parse_fork_spec(text.substr(0, text.size() - 1)), InputError);  // cut short
-  EXPECT_THROW(cli::parse_fork_spec(""), InputError);
-  EXPECT_EQ(cli::longest_command_line(spec), std::string("/b/a --child ").size());  // the agent
+  const std::string text = launch::serialize_fork_spec(spec);
+  EXPECT_EQ(launch::parse_fork_spec(text).children[0].argv, spec.children[0].argv);
+  EXPECT_THROW(launch::parse_fork_spec(text.substr(0, text.size() - 1)), InputError);  // cut short
+  EXPECT_THROW(launch::parse_fork_spec(""), InputError);
+  EXPECT_EQ(launch::longest_command_line(spec), std::string("/b/a --child ").size());  // the agent
   // The executable says what is wrong and exits 2 (as the other executables on bad options).
   std::string out;
   EXPECT_EQ(run_command(bin("tessera-fork-server") + " --pid-fd 1 --child worker 2>&1", &out), 2)

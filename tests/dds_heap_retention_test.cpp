@@ -1,4 +1,4 @@
-// The agent's malloc settings (agent/heap_retention.hpp): freed memory at the top of the heap
+// The agent's malloc settings (launch/heap_retention.hpp): freed memory at the top of the heap
 // stays in the process instead of being trimmed and faulted back in by the next round. Each
 // case runs in a forked child, since the settings are process-wide.
 #include <gtest/gtest.h>
@@ -10,7 +10,7 @@
 #include <cstring>
 #include <vector>
 
-#include "agent/heap_retention.hpp"
+#include "launch/heap_retention.hpp"
 
 namespace {
 
@@ -22,7 +22,7 @@ constexpr int kBlocks = 40;                // ~3.8 MB, far above the default tri
 int freed_top_kept_in_child(bool retain) {
   const pid_t pid = fork();
   if (pid == 0) {
-    if (retain && !tessera::agent::retain_freed_heap()) _exit(3);
+    if (retain && !tessera::launch::retain_freed_heap()) _exit(3);
     std::vector<void*> blocks;
     blocks.reserve(kBlocks);
     for (int i = 0; i < kBlocks; ++i) {

@@ -345,7 +345,7 @@ inline std::string join(const std::set<std::string>& s) {
 }
 
 /// After a launch in which a process died inside Fast DDS (SIGKILL, an abort): launch's output
-/// `out` says it removed the dead shared-memory files of `domain` (cli/shm_leftovers.hpp) and
+/// `out` says it removed the dead shared-memory files of `domain` (launch/shm_leftovers.hpp) and
 /// none of them is left since `before` (whatever is, is removed here after the check).
 inline void expect_launch_removed_dead_shm_files(const std::string& out,
                                                  const std::set<std::string>& before, int domain) {

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <tessera/util/input_error.hpp>
 
-#include "launch_transport.hpp"
+#include "launch/launch_transport.hpp"
 #include "session_args.hpp"
 #include "test_support.hpp"
 
@@ -15,6 +15,7 @@ namespace {
 
 using namespace tessera;
 using namespace tessera::cli;
+using namespace tessera::launch;
 
 SessionArgs parse(const std::vector<std::string>& argv, SessionArgsFor who) {
   Arguments args(argv, session_option_names(who), {});

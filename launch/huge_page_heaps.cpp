@@ -1,9 +1,9 @@
-#include "huge_page_heaps.hpp"
+#include "launch/huge_page_heaps.hpp"
 
 #include <algorithm>
 #include <cstdlib>
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 namespace {
 constexpr const char* kHugeTlb = "glibc.malloc.hugetlb";
@@ -26,4 +26,4 @@ void request_huge_page_heaps() {
   setenv("GLIBC_TUNABLES", with_huge_page_heaps(now ? now : "").c_str(), 1);
 }
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

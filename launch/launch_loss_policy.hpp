@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "arguments.hpp"
+#include "cli/arguments.hpp"
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 enum class AgentLossAction {
   kStop,      ///< a dead agent stops every process (exit 1, naming the agent)
@@ -50,7 +50,7 @@ std::set<std::string> launch_loss_option_names();
 
 /// Reads and validates the options above. --rejoin-timeout, --replicas and --replica-every
 /// given without `--on-agent-loss continue` are an InputError (they would have no effect).
-LaunchLossOptions parse_launch_loss_options(const Arguments& args);
+LaunchLossOptions parse_launch_loss_options(const cli::Arguments& args);
 
 /// --help lines for the options above (two-space indent, as the rest of launch's help).
 std::string launch_loss_help();
@@ -81,4 +81,4 @@ struct ExitVerdict {
 /// loss). Bad input (exit 2) or an agent that could not start (127) always stops the run.
 ExitVerdict judge_exit(const LaunchLossOptions& o, long agent, int code, bool coordinator_done);
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

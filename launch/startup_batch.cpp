@@ -1,12 +1,12 @@
-#include "agent/startup_batch.hpp"
+#include "launch/startup_batch.hpp"
 
 #include <sched.h>
 
 #include <mutex>
 
-#include "agent/process_threads.hpp"
+#include "launch/process_threads.hpp"
 
-namespace tessera::agent {
+namespace tessera::launch {
 
 namespace {
 
@@ -48,4 +48,4 @@ std::string restore_startup_batch() {
   return std::to_string(restore_threads()) + " thread(s) back from SCHED_BATCH";
 }
 
-}  // namespace tessera::agent
+}  // namespace tessera::launch

@@ -1,11 +1,11 @@
-#include "launch_loss_policy.hpp"
+#include "launch/launch_loss_policy.hpp"
 
 #include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <tessera/util/input_error.hpp>
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 namespace {
 
@@ -37,7 +37,7 @@ std::set<std::string> launch_loss_option_names() {
   return {"on-agent-loss", "rejoin-timeout", "replicas", "replica-every"};
 }
 
-LaunchLossOptions parse_launch_loss_options(const Arguments& args) {
+LaunchLossOptions parse_launch_loss_options(const cli::Arguments& args) {
   LaunchLossOptions o;
   const std::string action = args.get_or("on-agent-loss", "stop");
   if (action == "continue") {
@@ -115,4 +115,4 @@ ExitVerdict judge_exit(const LaunchLossOptions& o, long agent, int code, bool co
   return v;
 }
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

@@ -5,11 +5,11 @@
 
 #include <functional>
 
-namespace tessera::agent {
+namespace tessera::launch {
 
 /// Calls `change(tid)` for every thread of this process (/proc/self/task), in two passes: a
 /// thread created during the first by a thread not yet changed inherits the old setting.
 /// Returns how many calls returned true.
 int change_every_thread(const std::function<bool(pid_t)>& change);
 
-}  // namespace tessera::agent
+}  // namespace tessera::launch

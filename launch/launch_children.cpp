@@ -1,4 +1,4 @@
-#include "launch_children.hpp"
+#include "launch/launch_children.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -15,7 +15,7 @@
 #include <fstream>
 #include <stdexcept>
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 namespace {
 
@@ -82,9 +82,6 @@ std::vector<Child> spawn_forked(const std::string& fork_server, ForkSpec spec,
   server_process.log = server_log;
   server_process.argv = {fork_server, "--spec-fd", std::to_string(specs[0]), "--title-room",
                          std::string(longest_command_line(spec), ' ')};
-  // With --agents-yield its session's autogroup becomes the agents' (agent/startup_priority.hpp),
-  // apart from launch's, which may hold the user's shell.
-  server_process.own_session = spec.agents_nice > 0;
   // Orphans of our descendants (the server's children once it exits) become our children.
   prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0);
   const pid_t server = spawn_one(server_process);
@@ -227,4 +224,4 @@ std::vector<std::string> notes_of(const std::string& path) {
   return notes;
 }
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

@@ -1,4 +1,4 @@
-#include "shm_leftovers.hpp"
+#include "launch/shm_leftovers.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -11,7 +11,7 @@
 #include <fstream>
 #include <map>
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 namespace {
 
@@ -160,4 +160,4 @@ ShmCleanupResult remove_dead_shm_files(const ShmCleanupOptions& options) {
   return result;
 }
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

@@ -1,6 +1,6 @@
-#include "launch_transport.hpp"
+#include "launch/launch_transport.hpp"
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 std::string launch_transport(const transport::SessionOptions& session,
                              const LaunchLossOptions& loss) {
@@ -9,4 +9,4 @@ std::string launch_transport(const transport::SessionOptions& session,
   return this_host_only ? "shm" : "default";
 }
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

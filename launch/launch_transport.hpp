@@ -4,19 +4,19 @@
 
 #include <string>
 
-#include "launch_loss_policy.hpp"
+#include "launch/launch_loss_policy.hpp"
 #include "transport/session_options.hpp"
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 /// "shm" (shared memory only) when every process of the run talks to the others on this host
 /// alone, else "default" (shared memory + UDPv4, Fast DDS's own choice). Shared memory only
 /// spares each process its UDP sockets, their receive threads and the interface scans at
-/// start-up (docs/dds-runtime.md, "Session 12 (start12)"). "default" when `session` names
+/// start-up (docs/dds-runtime.md, "Transports"). "default" when `session` names
 /// --peers (other hosts), the lossy profile (its settings are UDP's), DDS Security (not
 /// checked over shared memory only), or `loss` continues after a lost agent (those runs talk
 /// UDP only anyway: a process SIGKILLed inside a shared-memory port can lock it).
 std::string launch_transport(const transport::SessionOptions& session,
                              const LaunchLossOptions& loss);
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

@@ -5,13 +5,13 @@
 // work matrices); with glibc's default, dynamic thresholds, freeing them often shrank the heap
 // (trim) and the next round faulted the same pages back in: ~100k minor faults in a kitti_02
 // run of 5 agents against ~6k in the in-process engine, ~10 us of CPU each on the virtual
-// machines measured, i.e. ~1 CPU-s of a 5-6 CPU-s run (docs/dds-runtime.md, "Session 11
-// (lead): the agents' heap"). Launch's huge-page heaps (cli/huge_page_heaps.hpp) make those
+// machines measured, i.e. ~1 CPU-s of a 5-6 CPU-s run (docs/dds-runtime.md, "Fork
+// server"). Launch's huge-page heaps (launch/huge_page_heaps.hpp) make those
 // faults cheaper; this removes them, for agents started by hand too.
 
 #include <cstddef>
 
-namespace tessera::agent {
+namespace tessera::launch {
 
 /// Freed memory at the top of the heap is returned to the kernel only beyond this many bytes.
 inline constexpr std::size_t kRetainedHeapBytes = std::size_t{64} << 20;
@@ -25,4 +25,4 @@ inline constexpr std::size_t kOwnMappingBytes = std::size_t{32} << 20;
 /// changes nothing that matters for correctness) when the C library refuses a setting.
 bool retain_freed_heap();
 
-}  // namespace tessera::agent
+}  // namespace tessera::launch

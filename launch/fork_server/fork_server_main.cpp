@@ -18,7 +18,7 @@
 // shared memory).
 //
 // usage (by launch): tessera-fork-server --spec-fd FD --title-room BLANKS
-//   FD: a pipe from which the spec is read to its end (cli/fork_spec.hpp: serialize_fork_spec);
+//   FD: a pipe from which the spec is read to its end (launch/fork_spec.hpp: serialize_fork_spec);
 //   BLANKS: as many spaces as the longest child's command line, so that the argv area where
 //   each child writes its own command line (ps, pgrep -f) is large enough.
 
@@ -39,12 +39,11 @@
 
 #include "agent/agent_entry.hpp"
 #include "agent/agent_options.hpp"
-#include "agent/startup_batch.hpp"
-#include "agent/startup_priority.hpp"
+#include "cli/session_process.hpp"
 #include "coordinator/coordinator_entry.hpp"
-#include "fork_spec.hpp"
+#include "launch/fork_spec.hpp"
+#include "launch/startup_batch.hpp"
 #include "runtime/preloaded_graph.hpp"
-#include "session_process.hpp"
 
 using namespace tessera;
 
@@ -75,10 +74,10 @@ std::string read_all(int fd) {
 // The --graph every agent of `spec` reads (as the agent's own option parser reads it), or ""
 // when they read different files (robot files) or an agent's options do not parse (that agent
 // reports them itself).
-std::string shared_agent_graph(const cli::ForkSpec& spec) {
+std::string shared_agent_graph(const launch::ForkSpec& spec) {
   std::string shared;
-  for (const cli::ForkChild& c : spec.children) {
-    if (c.role != cli::ForkRole::kAgent) continue;
+  for (const launch::ForkChild& c : spec.children) {
+    if (c.role != launch::ForkRole::kAgent) continue;
     std::string graph;
     try {
       graph = agent::parse_agent_options({c.argv.begin() + 1, c.argv.end()}).graph;
@@ -93,7 +92,7 @@ std::string shared_agent_graph(const cli::ForkSpec& spec) {
 
 // What every agent would otherwise do on its own at start-up, done once here so that the
 // agents inherit it (copy-on-write pages they only read); measured ~3 ms of CPU per agent
-// each, spent while the coordinator partitions on both cores (docs/dds-runtime.md, start11):
+// each, spent while the coordinator partitions on both cores (docs/dds-runtime.md, "Fork server"):
 // - the shared graph file, parsed (agent/preloaded_graph.hpp; a file that does not parse is
 //   left to each agent, which reports it);
 // - Fast DDS's TypeObjectFactory singleton (builtin types and annotations), which each
@@ -101,7 +100,7 @@ std::string shared_agent_graph(const cli::ForkSpec& spec) {
 //   descriptions: it starts no thread and opens nothing (checked with strace; the thread
 //   count is checked again before every fork).
 // Called after the coordinator's fork: that one is on the run's critical path.
-void prepare_agents(const cli::ForkSpec& spec) {
+void prepare_agents(const launch::ForkSpec& spec) {
   if (const std::string graph = shared_agent_graph(spec); !graph.empty())
     agent::preload_graph(graph);
   eprosima::fastrtps::types::TypeObjectFactory::get_instance();
@@ -136,46 +135,33 @@ void show_as(const ArgvArea& area, const std::vector<std::string>& argv) {
   prctl(PR_SET_NAME, name.c_str(), 0, 0, 0);  // kernel keeps 15 characters
 }
 
-// Whether the agents start below the coordinator's priority (agent/startup_priority.hpp):
-// when launch asks (--agents-yield) and the coordinator partitions launch's file while they
-// start (--graph), the only time it has work that their start-up slows down.
-bool coordinator_partitions_file(const cli::ForkSpec& spec) {
-  for (const cli::ForkChild& c : spec.children)
-    if (c.role == cli::ForkRole::kCoordinator)
+// Whether the coordinator partitions launch's file while the agents start (--graph), the only
+// time it has work that their start-up slows down.
+bool coordinator_partitions_file(const launch::ForkSpec& spec) {
+  for (const launch::ForkChild& c : spec.children)
+    if (c.role == launch::ForkRole::kCoordinator)
       return std::find(c.argv.begin(), c.argv.end(), "--graph") != c.argv.end();
   return false;
 }
 
-bool agents_yield_at_start(const cli::ForkSpec& spec) {
-  return spec.agents_nice > 0 && coordinator_partitions_file(spec);
-}
-
-// Whether the agents start in SCHED_BATCH (agent/startup_batch.hpp): the same moment, when
-// launch asks (its default).
-bool agents_batch_at_start(const cli::ForkSpec& spec) {
+// Whether the agents start in SCHED_BATCH (launch/startup_batch.hpp): when launch asks (its
+// default) and the coordinator partitions launch's file.
+bool agents_batch_at_start(const launch::ForkSpec& spec) {
   return spec.agents_batch && coordinator_partitions_file(spec);
 }
 
 // The child's side of a fork: the same process set-up as launch's exec path
-// (cli::enter_child_process), then the entry. `yield`: an agent starts lowered (its threads
-// here; its autogroup, this server's, once the server has forked every agent). `batch`: an
-// agent starts in SCHED_BATCH.
-[[noreturn]] void run_child(const cli::ForkSpec& spec, std::size_t k, const ArgvArea& area,
-                            bool yield, bool batch) {
-  const cli::ForkChild& c = spec.children[k];
-  cli::enter_child_process(c);
-  // Before the entry creates any thread: every thread inherits this one's nice.
-  if (yield && c.role == cli::ForkRole::kAgent) {
-    agent::StartupPriorityOptions priority;
-    priority.nice = spec.agents_nice;
-    agent::enter_startup_priority(priority, true);
-  }
-  // Likewise every thread inherits this one's policy.
-  if (batch && c.role == cli::ForkRole::kAgent) agent::enter_startup_batch();
+// (launch::enter_child_process), then the entry. `batch`: an agent starts in SCHED_BATCH.
+[[noreturn]] void run_child(const launch::ForkSpec& spec, std::size_t k, const ArgvArea& area,
+                            bool batch) {
+  const launch::ForkChild& c = spec.children[k];
+  launch::enter_child_process(c);
+  // Before the entry creates any thread: every thread inherits this one's policy.
+  if (batch && c.role == launch::ForkRole::kAgent) launch::enter_startup_batch();
   // Descriptors meant for launch or for another child: an agent holding launch's progress
   // pipe would keep it open after the coordinator has left.
   close(spec.pid_fd);
-  for (const cli::ForkChild& other : spec.children)
+  for (const launch::ForkChild& other : spec.children)
     if (other.stdout_fd > 2) close(other.stdout_fd);
   std::vector<std::string> strings = c.argv;  // copies: the argv area is overwritten next
   show_as(area, strings);
@@ -183,7 +169,7 @@ bool agents_batch_at_start(const cli::ForkSpec& spec) {
   for (auto& s : strings) argv.push_back(s.data());
   argv.push_back(nullptr);
   const int argc = static_cast<int>(strings.size());
-  const int code = c.role == cli::ForkRole::kCoordinator
+  const int code = c.role == launch::ForkRole::kCoordinator
                        ? coordinator::coordinator_main(argc, argv.data())
                        : agent::agent_main(argc, argv.data());
   cli::exit_process(code);
@@ -192,7 +178,7 @@ bool agents_batch_at_start(const cli::ForkSpec& spec) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  cli::ForkSpec spec;
+  launch::ForkSpec spec;
   try {
     if (argc != 5 || std::strcmp(argv[1], "--spec-fd") != 0 ||
         std::strcmp(argv[3], "--title-room") != 0)
@@ -202,9 +188,9 @@ int main(int argc, char** argv) {
     const long fd = std::strtol(argv[2], &end, 10);
     if (*argv[2] == '\0' || *end != '\0' || fd < 0)
       throw InputError(std::string("--spec-fd '") + argv[2] + "' is not a descriptor");
-    spec = cli::parse_fork_spec(read_all(static_cast<int>(fd)));
+    spec = launch::parse_fork_spec(read_all(static_cast<int>(fd)));
     close(static_cast<int>(fd));
-    if (std::strlen(argv[4]) < cli::longest_command_line(spec))
+    if (std::strlen(argv[4]) < launch::longest_command_line(spec))
       throw InputError("--title-room is shorter than the longest child's command line");
   } catch (const InputError& e) {
     std::fprintf(stderr, "tessera-fork-server: error: %s\n", e.what());
@@ -212,11 +198,10 @@ int main(int argc, char** argv) {
   }
   const ArgvArea area{argv[0], static_cast<std::size_t>(argv[argc - 1] +
                                                         std::strlen(argv[argc - 1]) + 1 - argv[0])};
-  const bool yield = agents_yield_at_start(spec);
   const bool batch = agents_batch_at_start(spec);
   bool prepared = false;
   for (std::size_t k = 0; k < spec.children.size(); ++k) {
-    if (!prepared && spec.children[k].role == cli::ForkRole::kAgent) {
+    if (!prepared && spec.children[k].role == launch::ForkRole::kAgent) {
       prepare_agents(spec);
       prepared = true;
     }
@@ -234,7 +219,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "tessera-fork-server: error: fork failed: %s\n", std::strerror(errno));
       return 1;
     }
-    if (pid == 0) run_child(spec, k, area, yield, batch);
+    if (pid == 0) run_child(spec, k, area, batch);
     const std::string line = std::to_string(pid) + "\n";
     if (write(spec.pid_fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) {
       std::fprintf(stderr, "tessera-fork-server: error: cannot report pid %d to launch\n",
@@ -242,10 +227,6 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  // launch started this server in a session of its own, so its autogroup now holds only the
-  // agents (the coordinator made a session of its own): lowered only now, so that the forks
-  // themselves were not slowed. Each agent sets it back to 0 with its assignment.
-  if (yield) agent::lower_autogroup_nice(spec.agents_nice);
   close(spec.pid_fd);
   cli::exit_process(0);
 }

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 struct ShmCleanupOptions {
   int domain = 0;
@@ -39,4 +39,4 @@ std::set<std::string> mapped_segments(const std::vector<pid_t>& pids);
 /// Removes the domain's dead ports and the listed segments whose lock no process holds.
 ShmCleanupResult remove_dead_shm_files(const ShmCleanupOptions& options);
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

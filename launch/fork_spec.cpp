@@ -1,4 +1,4 @@
-#include "fork_spec.hpp"
+#include "launch/fork_spec.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <tessera/util/input_error.hpp>
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 namespace {
 
@@ -38,16 +38,11 @@ void ForkSpec::validate() const {
     if (c.log.empty()) throw InputError(at + "log must not be empty");
     if (c.stdout_fd < -1) throw InputError(at + "stdout_fd must be -1 or a descriptor");
   }
-  if (agents_nice < 0 || agents_nice > 19)
-    throw InputError("fork server: agents_nice = " + std::to_string(agents_nice) +
-                     ": must be in 0..19");
 }
 
 std::vector<std::string> encode_fork_spec(const ForkSpec& spec) {
   spec.validate();
   std::vector<std::string> out = {"--pid-fd", std::to_string(spec.pid_fd)};
-  if (spec.agents_nice > 0)
-    out.insert(out.end(), {"--agents-nice", std::to_string(spec.agents_nice)});
   if (spec.agents_batch) out.push_back("--agents-batch");
   for (const ForkChild& c : spec.children) {
     out.insert(out.end(), {"--child", fork_role_name(c.role), c.log, std::to_string(c.stdout_fd),
@@ -66,10 +61,6 @@ ForkSpec decode_fork_spec(const std::vector<std::string>& args) {
   };
   if (next("--pid-fd") != "--pid-fd") throw InputError("fork server: expected --pid-fd first");
   spec.pid_fd = static_cast<int>(to_long(next("the pid descriptor"), "--pid-fd"));
-  if (i < args.size() && args[i] == "--agents-nice") {
-    ++i;
-    spec.agents_nice = static_cast<int>(to_long(next("the agents' nice"), "--agents-nice"));
-  }
   if (i < args.size() && args[i] == "--agents-batch") {
     ++i;
     spec.agents_batch = true;
@@ -140,9 +131,7 @@ void enter_child_process(const ForkChild& child) {
   // instead of a seventh of it (coordinator/file_partition.hpp). Without autogroup nothing
   // changes. setsid cannot fail in a fresh child (not yet a group leader); if it did,
   // setpgid still gives the own process group that launch signals.
-  // The fork server also gets one (own_session), so that its autogroup holds only the agents
-  // it forks (agent/startup_priority.hpp).
-  if ((child.role != ForkRole::kCoordinator && !child.own_session) || setsid() < 0) setpgid(0, 0);
+  if (child.role != ForkRole::kCoordinator || setsid() < 0) setpgid(0, 0);
   signal(SIGINT, SIG_DFL);
   signal(SIGTERM, SIG_DFL);
   const int fd = open(child.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -153,4 +142,4 @@ void enter_child_process(const ForkChild& child) {
   }
 }
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

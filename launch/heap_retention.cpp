@@ -1,8 +1,8 @@
-#include "agent/heap_retention.hpp"
+#include "launch/heap_retention.hpp"
 
 #include <malloc.h>
 
-namespace tessera::agent {
+namespace tessera::launch {
 
 bool retain_freed_heap() {
   // The mapping threshold first: either call turns off glibc's dynamic adjustment, which would
@@ -12,4 +12,4 @@ bool retain_freed_heap() {
   return mapping && trim;
 }
 
-}  // namespace tessera::agent
+}  // namespace tessera::launch

@@ -1,16 +1,16 @@
 #pragma once
 // The processes of a `tessera launch` run (the coordinator and the agents) as launch sees
 // them: started either by exec'ing tessera-coordinator / tessera-agent, or through the fork
-// server (cli/fork_server/: the libraries are loaded once and each process is a fork of it),
+// server (launch/fork_server/: the libraries are loaded once and each process is a fork of it),
 // and in both cases direct children of launch afterwards, so waiting, signalling and the exit
 // codes are the same.
 
 #include <string>
 #include <vector>
 
-#include "fork_spec.hpp"
+#include "launch/fork_spec.hpp"
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 /// One process of the run.
 struct Child {
@@ -59,4 +59,4 @@ std::string tail_of(const std::string& path, std::size_t max_lines);
 /// run, transport/teardown_guard.hpp) should still be seen.
 std::vector<std::string> notes_of(const std::string& path);
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

@@ -1,10 +1,10 @@
-#include "agent/process_threads.hpp"
+#include "launch/process_threads.hpp"
 
 #include <dirent.h>
 
 #include <cstdlib>
 
-namespace tessera::agent {
+namespace tessera::launch {
 
 int change_every_thread(const std::function<bool(pid_t)>& change) {
   int changed = 0;
@@ -20,4 +20,4 @@ int change_every_thread(const std::function<bool(pid_t)>& change) {
   return changed;
 }
 
-}  // namespace tessera::agent
+}  // namespace tessera::launch

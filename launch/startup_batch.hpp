@@ -8,12 +8,12 @@
 // 5 agents of a CSAIL run up to the partition's end), and under the kernel's wake-up
 // preemption each wake-up of a normal thread may stop a partition thread on the spot; a
 // stopped island then holds up the barrier for the other. Measured (docs/dds-runtime.md,
-// "Session 13 (start13)"): the coordinator's threads were scheduled ~3x as often as the
+// "Fork server"): the coordinator's threads were scheduled ~3x as often as the
 // in-process run's for the same partition. A SCHED_BATCH thread gets the same fair share of
 // the CPU (its nice is unchanged) but its wake-ups never preempt the running thread: it runs
 // when a core is free or at the next scheduler tick. Nothing is starved, so unlike
-// `--agents-yield` (nice 19, startup_priority.hpp) no bound is needed for the participant
-// lease, and the agents' start-up CPU is the same: only the partition's interruptions go.
+// a lower nice no bound is needed for the participant lease, and the agents' start-up CPU is
+// the same: only the partition's interruptions go.
 // After the assignment the round loop's latency matters again, hence the return.
 //
 // Switching between SCHED_OTHER and SCHED_BATCH at the same nice needs no privilege.
@@ -21,7 +21,7 @@
 
 #include <string>
 
-namespace tessera::agent {
+namespace tessera::launch {
 
 /// In a forked agent before its first thread: the calling thread to SCHED_BATCH (every thread
 /// created later inherits it). Returns whether it did.
@@ -33,4 +33,4 @@ bool enter_startup_batch();
 /// --verbose ("" if nothing was done).
 std::string restore_startup_batch();
 
-}  // namespace tessera::agent
+}  // namespace tessera::launch

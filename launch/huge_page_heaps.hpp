@@ -4,7 +4,7 @@
 // `glibc.malloc.hugetlb=1` tunable: malloc madvises its heap MADV_HUGEPAGE). A freshly forked
 // agent touches ~1000 new 4 KB pages before the coordinator's partition ends, and on the
 // virtual machines measured a page fault costs ~10 us of CPU, spent while the partition wants
-// both cores (docs/dds-runtime.md, "Session 11 (start11)"). With huge pages the agents fault
+// both cores (docs/dds-runtime.md, "Fork server"). With huge pages the agents fault
 // ~20-25 % less up to the assignment and ~35 % less over a CSAIL run.
 //
 // A tunable is read when a program starts, so it goes into launch's own environment before
@@ -13,7 +13,7 @@
 
 #include <string>
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 /// `tunables` (the value of GLIBC_TUNABLES, "" when unset) with glibc.malloc.hugetlb=1
 /// added, unless it already names glibc.malloc.hugetlb (then unchanged).
@@ -23,4 +23,4 @@ std::string with_huge_page_heaps(const std::string& tunables);
 /// starts from now on.
 void request_huge_page_heaps();
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

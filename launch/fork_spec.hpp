@@ -1,5 +1,5 @@
 #pragma once
-// What `tessera launch` asks its fork server (tessera-fork-server, cli/fork_server/) to start:
+// What `tessera launch` asks its fork server (tessera-fork-server, launch/fork_server/) to start:
 // the coordinator and the agents, each with the argv its standalone executable would get.
 // Plain data and a flat encoding, free of Fast DDS, so that `tessera` (which never links
 // Fast DDS) can write it and the fork server read it back. It goes through a pipe, not the
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace tessera::cli {
+namespace tessera::launch {
 
 /// Which entry function a forked child runs (the one the standalone executable's main calls).
 enum class ForkRole { kCoordinator, kAgent };
@@ -23,9 +23,6 @@ struct ForkChild {
   int stdout_fd = -1;
   /// Its argv, argv[0] first (the standalone executable's path: what ps shows).
   std::vector<std::string> argv;
-  /// A session of its own (setsid) besides its own process group; the coordinator always has
-  /// one. launch's own use (the fork server), not part of the spec the server reads.
-  bool own_session = false;
 };
 
 /// Everything the fork server needs.
@@ -33,23 +30,18 @@ struct ForkSpec {
   /// Inherited descriptor on which the server writes one line "<pid>\n" per child, in order.
   int pid_fd = -1;
   std::vector<ForkChild> children;
-  /// Nice value at which the agents start when the coordinator partitions launch's file while
-  /// they start (its argv has --graph), until their assignment (agent/startup_priority.hpp;
-  /// launch --agents-yield). 0 = off (default); range 0..19.
-  int agents_nice = 0;
   /// The agents start with every thread in SCHED_BATCH when the coordinator partitions
-  /// launch's file while they start, until their assignment (agent/startup_batch.hpp; launch's
+  /// launch's file while they start, until their assignment (launch/startup_batch.hpp; launch's
   /// default, --no-agents-batch turns it off).
   bool agents_batch = false;
 
   /// Throws InputError naming the bad field: pid_fd < 0, no children, a child without argv
-  /// or log, a stdout_fd < -1, or agents_nice outside 0..19.
+  /// or log, or a stdout_fd < -1.
   void validate() const;
 };
 
-/// The spec as a list of strings: "--pid-fd FD", "--agents-nice N" when N > 0, "--agents-batch"
-/// when set, then, per
-/// child, "--child ROLE LOG STDOUT_FD ARGC ARGV...". Validates `spec` first.
+/// The spec as a list of strings: "--pid-fd FD", "--agents-batch" when set, then, per child,
+/// "--child ROLE LOG STDOUT_FD ARGC ARGV...". Validates `spec` first.
 std::vector<std::string> encode_fork_spec(const ForkSpec& spec);
 
 /// Inverse of encode_fork_spec(); throws InputError naming the bad item on malformed input.
@@ -76,4 +68,4 @@ const char* fork_role_name(ForkRole role);
 /// `child.stdout_fd` (or the log) and stderr to `child.log`, created or truncated.
 void enter_child_process(const ForkChild& child);
 
-}  // namespace tessera::cli
+}  // namespace tessera::launch

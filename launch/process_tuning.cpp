@@ -1,0 +1,17 @@
+#include "launch/process_tuning.hpp"
+
+#include "launch/heap_retention.hpp"
+#include "launch/startup_batch.hpp"
+
+namespace tessera::launch {
+
+void begin_agent_process() {
+  retain_freed_heap();
+}
+
+std::string end_agent_startup() {
+  const std::string unbatched = restore_startup_batch();
+  return unbatched.empty() ? "" : "start-up batch: " + unbatched;
+}
+
+}  // namespace tessera::launch

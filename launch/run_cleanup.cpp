@@ -1,0 +1,40 @@
+#include "launch/run_cleanup.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+#include <system_error>
+
+#include "launch/shm_leftovers.hpp"
+
+namespace tessera::launch {
+
+WorkDir::WorkDir() {
+  char tmpl[] = "/tmp/tessera-launch-XXXXXX";
+  if (!mkdtemp(tmpl)) throw std::runtime_error("launch: cannot create a temporary folder");
+  path_ = tmpl;
+}
+
+// In process (no `sh -c rm -rf`: two more process starts at the end of every run).
+WorkDir::~WorkDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+  if (ec)
+    std::fprintf(stderr, "tessera launch: could not remove %s: %s\n", path_.c_str(),
+                 ec.message().c_str());
+}
+
+void remove_dead_files_of(int domain, std::set<std::string> segments, const char* when) {
+  ShmCleanupOptions shm;
+  shm.domain = domain;
+  shm.segments = std::move(segments);
+  const ShmCleanupResult r = remove_dead_shm_files(shm);
+  if (!r.removed.empty())
+    std::fprintf(stderr,
+                 "tessera launch: removed %zu shared-memory files of dead processes of domain %d "
+                 "from /dev/shm %s\n",
+                 r.removed.size(), domain, when);
+}
+
+}  // namespace tessera::launch
