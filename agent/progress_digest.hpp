@@ -1,6 +1,6 @@
 #pragma once
 // An agent's progress digest for the coordinator (wire::AgentProgress, docs/dds-runtime.md,
-// "Session 10 (relay10)"). The coordinator used to read every agent's status of every round
+// "Progress digests"). The coordinator used to read every agent's status of every round
 // (N deliveries and N wake-ups of its receive thread a round, ~1/5 of a cheap round's
 // deliveries) only to print progress, time the rounds and spot lagging agents. Each agent
 // already sees every status of a step (it needs them for the step's sums), so it can tell the

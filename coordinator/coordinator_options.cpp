@@ -35,7 +35,7 @@ options:
   --status-relay       agents send their round statuses to agent 0 alone, which forwards
                        each step's as one bundle to everyone (2N - 1 deliveries a round
                        instead of N^2; same iterates; ignored with --rejoin-timeout or
-                       --replicas; docs/dds-runtime.md, "Session 9"; default on)
+                       --replicas; docs/dds-runtime.md; default on)
   --no-status-relay    round statuses all to all instead (N^2 deliveries a round)
   --output FILE        write the merged poses as g2o (VERTEX lines only)
   --tum FILE           write the merged poses in the TUM format

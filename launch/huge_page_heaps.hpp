@@ -4,7 +4,7 @@
 // `glibc.malloc.hugetlb=1` tunable: malloc madvises its heap MADV_HUGEPAGE). A freshly forked
 // agent touches ~1000 new 4 KB pages before the coordinator's partition ends, and on the
 // virtual machines measured a page fault costs ~10 us of CPU, spent while the partition wants
-// both cores (docs/dds-runtime.md, "Fork server"). With huge pages the agents fault
+// both cores (docs/dds-runtime.md, "Start-up"). With huge pages the agents fault
 // ~20-25 % less up to the assignment and ~35 % less over a CSAIL run.
 //
 // A tunable is read when a program starts, so it goes into launch's own environment before

@@ -8,7 +8,7 @@
 // 5 agents of a CSAIL run up to the partition's end), and under the kernel's wake-up
 // preemption each wake-up of a normal thread may stop a partition thread on the spot; a
 // stopped island then holds up the barrier for the other. Measured (docs/dds-runtime.md,
-// "Fork server"): the coordinator's threads were scheduled ~3x as often as the
+// "Start-up"): the coordinator's threads were scheduled ~3x as often as the
 // in-process run's for the same partition. A SCHED_BATCH thread gets the same fair share of
 // the CPU (its nice is unchanged) but its wake-ups never preempt the running thread: it runs
 // when a core is free or at the next scheduler tick. Nothing is starved, so unlike

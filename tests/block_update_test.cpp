@@ -90,7 +90,7 @@ TEST(BlockUpdate, GradReductionEndsAMultiStepUpdateOnceTheBlockGradientFell) {
 
 TEST(BlockUpdate, IrbcdSettingsApplyToIrbcdOnly) {
   DistributedOptions o;
-  // Defaults: IRBCD may take a second step (docs/irbcd.md section 22), RBCD++ takes one.
+  // Defaults: IRBCD may take a second step (docs/irbcd.md section 5), RBCD++ takes one.
   o.algorithm = DistributedAlgorithm::kIrbcd;
   EXPECT_EQ(o.algorithm_block_update().trust_region_steps, 2);
   EXPECT_EQ(o.algorithm_block_update().grad_reduction, 0.2);

@@ -65,7 +65,7 @@ TEST(Irbcd, RecurrencesFollowThePaper) {
 TEST(Irbcd, StartsWithTheMomentumOfA0) {
   IrbcdOptions o;
   EXPECT_EQ(o.a0, 1.0);
-  EXPECT_FALSE(o.adaptive_sigma);  // the default since session 6 (docs/irbcd.md section 15)
+  EXPECT_FALSE(o.adaptive_sigma);  // the default (docs/irbcd.md section 3)
   o.reset_on_restart = true;
   const double n = 3;
   IrbcdScheme s(o, n);
@@ -114,7 +114,7 @@ TEST(Irbcd, KeptGammaIsBoundedByItsFixedPointAndSurvivesARestart) {
   EXPECT_EQ(r.coefficients().gamma, gamma0);
 }
 
-// Adaptive sigma (docs/irbcd.md section 13). sigma 1e-2 with n = 2 puts gamma's fixed point
+// Adaptive sigma (docs/irbcd.md section 3). sigma 1e-2 with n = 2 puts gamma's fixed point
 // 1/sqrt(sigma) = 10 within a few dozen rounds.
 IrbcdOptions adaptive_options() {
   IrbcdOptions o;

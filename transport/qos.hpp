@@ -25,7 +25,7 @@ constexpr std::int32_t kWriterHistory = 16;
 /// write() until the next acknowledgement (measured: 5 agents broadcasting one status per
 /// step, 3-4% of the writes waited > 10 ms; mean step 2.4-3.0 ms -> 1.3-1.5 ms with 64). A
 /// volatile writer drops a sample as soon as every reader acknowledged it, so the deeper
-/// bound costs memory only while acknowledgements lag. 256 since session 10: the distributed
+/// bound costs memory only while acknowledgements lag. 256 because the distributed
 /// rounding writes one status per message step (~0.85 ms on 2 cores), ~59 per heartbeat
 /// period, and 64 filled at times (every agent's status writer at once, each write() then
 /// blocked for its 10 ms max_blocking_time and retried); 256 holds 50 ms of messages at 0.2 ms.

@@ -4,7 +4,7 @@
 // relay alone; an agent that updated its block in that step also sends its new public poses
 // to each neighbour, the relay among them. Packed into the status, the block for the relay
 // costs no delivery of its own: one sem_post and one wake-up of the relay's Fast DDS receive
-// thread less (docs/dds-runtime.md, "Session 13 (round13)"). The blocks keep the status's
+// thread less (docs/dds-runtime.md, "Riding blocks"). The blocks keep the status's
 // sender and epoch; the relay routes them as if they had come on its block topic. Internal
 // to transport/.
 

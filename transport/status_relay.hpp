@@ -1,9 +1,9 @@
 #pragma once
-// Round statuses through one relay agent instead of all to all (docs/dds-runtime.md, "Session 9
-// (round9)"). Each round's status step is a reduction every agent computes over the N
-// statuses; sent all to all over DDS it costs N (N - 1) deliveries, plus N to the coordinator,
-// and every delivery wakes a Fast DDS receive thread (the cost that dominates a cheap round on
-// 2 cores). Relayed, the other agents send their status to the relay agent only (its own
+// Round statuses through one relay agent instead of all to all (docs/dds-runtime.md,
+// "Round statuses through a relay"). Each round's status step is a reduction every agent computes
+// over the N statuses; sent all to all over DDS it costs N (N - 1) deliveries, plus N to the
+// coordinator, and every delivery wakes a Fast DDS receive thread (the cost that dominates a cheap
+// round on 2 cores). Relayed, the other agents send their status to the relay agent only (its own
 // topic, kRelayStatusTopic), and the relay, once it has all N of a step, sends them as one
 // bundle on kStatusTopic, which every agent and the coordinator read: 2 (N - 1) + 1
 // deliveries instead of N^2. The statuses themselves are unchanged (each receiver unpacks the

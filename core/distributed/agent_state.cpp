@@ -167,7 +167,7 @@ LocalStatus AgentState::status(bool newton_score) {
 Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
                                    const BlockUpdateOptions& options) {
   set_point(X0, neighbours);
-  // The tangent factor needs rank-d points (docs/irbcd.md section 12): the active rows of a
+  // The tangent factor needs rank-d points (docs/irbcd.md section 5): the active rows of a
   // lifted start. After a saddle escape (every row active), when its factor would be too large
   // or fails, the Q_BB factor is used.
   // Every row active (r = d, or after a saddle escape): work on X0 itself, no copy of it.

@@ -13,15 +13,14 @@ namespace {
 // 2004). Arcs are collected first and then laid out per node (CSR: a node's arcs are
 // contiguous, each with the index of its reverse arc). Which maximum flow is found does not
 // matter: the residual sets used below (what s reaches, what reaches t) are the same for every
-// maximum flow, so every partition is bit-identical to the earlier Dinic versions' (session 9:
-// CSR; session 11: levels towards t). Dinic rebuilt its level graph with one scan of the
-// network per phase, ~22 % of a highest run on rim even after session 11; the two search trees
-// here (one from s, one into t) are kept between augmentations and only repaired where an
-// augmentation saturated a tree arc (session 13, part13).
+// maximum flow, so every partition is bit-identical to the earlier Dinic code's. Dinic rebuilt
+// its level graph with one scan of the network per phase (~22 % of a highest run on rim); the
+// two search trees here (one from s, one into t) are kept between augmentations and only
+// repaired where an augmentation saturated a tree arc.
 class FlowNetwork {
  public:
   /// Empties the network and gives it n nodes; keeps the buffers' memory, since one network
-  /// is rebuilt for every block pair and corridor size of a round (session 11, speed11).
+  /// is rebuilt for every block pair and corridor size of a round.
   void reset(int n) {
     first_.assign(static_cast<std::size_t>(n) + 1, 0);
     pending_.clear();

@@ -73,9 +73,8 @@ struct PresetPlan {
 // `highest` re-splits its best partition (block_resplit.hpp): torus3D (14048) and the smaller
 // benchmark graphs at N <= 5; cubicle (18236) and the larger ones spend ~3-4.4 s already.
 constexpr double kResplitSize = 16000.0;
-// Larger problems: sub-searches (0 = none, session 11's behaviour; 2 in session 12), a
-// sub-search's share of the step budget, and how separable the kept block must be
-// (BlockResplitOptions::max_cut_ratio).
+// Larger problems: sub-searches (0 = none), a sub-search's share of the step budget, and how
+// separable the kept block must be (BlockResplitOptions::max_cut_ratio).
 constexpr int kResplitLargeSearches = 4;
 constexpr double kResplitLargeBudget = 0.5;
 constexpr double kResplitCutRatio = 0.6;
@@ -94,10 +93,9 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
       // Initial partitioning dominated fast at many blocks (73 % of grid3D N = 25: coarse
       // vertices stay below lmax/30, so its coarsest graph has ~1100 vertices). From 12 blocks
       // on, the runs shrink with the coarsest graph (3 around 600 vertices, i.e. N = 16; 2 from
-      // ~900, N = 25) and a third FM pass per level wins back what the fewer runs lose
-      // (session 6, 12 graphs x N = 16, 25 x seeds 1-5: cut geomean ratio 1.007, sum 71340
-      // instead of 71406; grid3D N = 25 CPU 45 -> 32 ms; docs/partitioning.md). Below 12
-      // blocks fast is cheap (<= 24 ms) and unchanged.
+      // ~900, N = 25) and a third FM pass per level wins back what the fewer runs lose (cut
+      // geomean ratio 1.007, grid3D N = 25 CPU 45 -> 32 ms; docs/partitioning.md). Below 12
+      // blocks fast is cheap and unchanged.
       if (k >= 12) {
         cp.fm.max_passes = 3;
         cp.initial.repeat_budget = 1600;
@@ -158,39 +156,29 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // tournament winners towards one light block (a V-cycle under bounds that keep that
         // block at 0.88-0.98 of the average, then one under the real bounds). The best known
         // cuts mostly have one light block and the others at the bound (rim 2100 2096 1867 2032
-        // 2100). Light steps mixed into the whole search (20 %) found sphere2500 179 but lost
-        // city10000/grid3D at seed 1; as a tail the search before it is unchanged (session 5,
-        // seeds 1-3: torus3D 242/240/242 instead of 242/241/243, rim 258/266/243 instead of
-        // 260/266/243; docs/partitioning.md). strong too since session 6 (with mutation rate
-        // 0.5, seeds 1-3: parking-garage 28/28/28 instead of 32/28/28, the rest unchanged).
+        // 2100). As a tail the search before it is unchanged, so no cut gets worse; mixed into
+        // the whole search it lost city10000/grid3D (docs/partitioning.md, item 7).
         plan.evolution.light_tail = 40;
         // highest: after the search, the 2 best global layouts read off the Laplacian
         // embedding (bands, a + b layouts, arcs around rings; spectral_layouts.hpp) are
         // combined with its best and replace it when better. The search before is unchanged,
         // so no cut gets worse; sphere2500 (a twisted cylinder) gets the seam-aligned 3 + 2
-        // layout (179) that the search never reaches (180 on every seed, session 6).
+        // layout (179) that the search never reaches (180 on every seed).
         plan.evolution.spectral_seeds = strong ? 0 : 2;
         // highest: the search's best then gets 4 relax / repair rounds (relaxed_polish.hpp):
         // FM and flows under bounds raised by 0.2-3 %, rebalance, FM and flows under the real
         // bound. With several blocks at the bound a better cut can need a chain of moves that
         // no bounded move starts (rim seed 4: 247 -> 243, 10 vertices). After the search, so
         // the search is unchanged and no cut gets worse; it helps most at large N, where the
-        // search has few steps (session 7: rim/grid3D/city10000 N = 25 1167/2427/519 ->
-        // 1155/2403/502).
+        // search has few steps (rim N = 25: 1167 -> 1155).
         plan.evolution.polish.rounds = strong ? 0 : 4;
         // highest: two islands (island_search.hpp), each with all of the budget above on its
         // own thread. One search settles into one global arrangement (rim: 258 or 243 by
         // seed); two independent ones reach the better one more often for the same wall time
         // on two cores. A fixed count, not the machine's core count, so that a seed gives the
-        // same partition everywhere. No exchanges: with the best individuals exchanged every
-        // quarter of the budget the islands fell into one arrangement early (session 8, rim
-        // seeds 1-4 258/264/243/262, torus3D 242/240/244/245 instead of 258/266/243/243 and
-        // 242/240/242/246 for one island; docs/partitioning.md).
-        // Four islands (PartitionOptions::islands = 4, `--islands 4`) reach torus3D's 240 at
-        // seed 1 (242 with two) and change no other small benchmark graph's partition, for
-        // twice the CPU; the distributed solve on torus3D's 240 split needs 162 IRBCD rounds
-        // against 91 on the 242 split. So two stay the default (session 9,
-        // docs/partitioning.md "Four islands as an option, not the default").
+        // same partition everywhere. No exchanges: with exchanges the islands fell into one
+        // arrangement early (docs/partitioning.md, item 10). Four islands (`--islands 4`) cost
+        // twice the CPU for no other small graph's gain, so two stay the default.
         plan.evolution.islands.islands = strong ? 1 : 2;
         plan.evolution.islands.exchange_every = 0;
         // highest: and a third, short island (a fifth of the step budget, its own thread):
@@ -199,7 +187,7 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // on rim seed 1 (246 instead of 258, at step 11 of 70), torus3D seed 4 (243 instead of
         // 246, step 8) and city10000 seed 3 (131 instead of 134, step 8); a fifth (rim 14
         // steps) keeps all three for ~1.1 s CPU on rim, about half of it wall time on two
-        // cores (session 10, docs/partitioning.md).
+        // cores (docs/partitioning.md, item 10).
         // Only where its steps are at least as many as its population: a short island costs
         // its population (2 x population operations) plus its steps, so with a small step
         // budget (many blocks: rim/grid3D N = 25 get 4 steps) it would cost ~75 % of a full
@@ -217,22 +205,19 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         // right (torus3D seeds 1, 7, 8: 242/241/245 -> 240/240/243, keeping its two strips). Only
         // where (n + edges) x max(1, N/5) <= 16000 (torus3D and smaller at N = 4, 5): there the
         // whole run costs <= ~2.2 s idle and the sub-searches add ~0.3-1 s; on rim / city10000 /
-        // grid3D (~4.2-4.4 s idle) they would pass 5 s, and on rim they did not find the 243
-        // (session 11, docs/partitioning.md).
+        // grid3D they would pass 5 s (docs/partitioning.md, item 11).
         if (!strong && per_op <= kResplitSize) plan.evolution.resplit.searches = 2;
         plan.evolution.resplit.kept = 2;
         plan.evolution.resplit.population = 4;
         plan.evolution.resplit.budget = 1.0;
-        // highest, larger problems (session 12): cheaper sub-searches (half the budget) that
+        // highest, larger problems: cheaper sub-searches (half the budget) that
         // keep only the most separable block, and only when it is clearly separable (its cut
         // edges at most kResplitCutRatio x the mean block cut). rim's light block (49 cut
         // edges, mean 98) is shared by its 246 and 243 partitions, which arrange the other four
         // blocks differently; a fresh search of those four found the 243 arrangement in 1/5-1/3
         // of the tries. Meshes (grid3D 0.92) and city10000 (0.81) have no such block and keep
-        // their ~3.3-4.2 s (session 12, docs/partitioning.md). Four sub-searches instead of two
-        // since session 13, paid for by the cheaper max flows (flow_refinement.cpp): rim seeds
-        // 1, 10, 15 reach 243 (mean over seeds 1-16 249.7 -> 248.1); the first two are the same
-        // as before, so no cut gets worse.
+        // their time (docs/partitioning.md, item 11). Four sub-searches, paid for by the cheap
+        // max flows (flow_refinement.cpp): rim seeds 1, 10, 15 reach 243 with four, not two.
         if (!strong && per_op > kResplitSize) {
           plan.evolution.resplit.searches = kResplitLargeSearches;
           plan.evolution.resplit.kept = 1;
@@ -241,9 +226,8 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
         }
         // Coarse levels balance to 1.03 x the bound, the input graph to the bound itself. The
         // best cuts often have one light block and the others at the bound; with the exact
-        // bound on every level the coarse searches rarely reach such shapes (session 4, seeds
-        // 1-2: highest intel 34/34 instead of 35/35, grid3D 925/925 instead of 943/938; strong
-        // ais2klinik 14/14 instead of 15/15; docs/partitioning.md).
+        // bound on every level the coarse searches rarely reach such shapes (highest intel 34
+        // instead of 35, grid3D 925 instead of 943 at seed 1).
         cp.coarse_relax = 0.03;
       }
       break;

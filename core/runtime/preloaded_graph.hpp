@@ -2,7 +2,7 @@
 // A whole-graph file parsed once by tessera-fork-server before it forks the agents of a run,
 // so that the N agents inherit the parsed graph (copy-on-write pages they only read) instead
 // of each parsing the same file while the coordinator partitions it on both cores
-// (docs/dds-runtime.md, "Session 11 (start11)"). Only a cache: an agent whose --graph was not
+// (docs/dds-runtime.md, "Start-up"). Only a cache: an agent whose --graph was not
 // preloaded, or was not parsed, reads the file itself and reports its errors as before.
 
 #include <string>

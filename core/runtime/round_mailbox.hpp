@@ -48,8 +48,8 @@ class Mailbox {
     while (!protocol.done()) {
       // Sleep until the current step can move on, not once per arriving message: a status
       // step needs every other agent's status, and each wake-up of this thread costs more
-      // than handling a small message (docs/dds-runtime.md, session 8). By name when the
-      // protocol can tell: a count also counts messages of later steps (session 13, wake13).
+      // than handling a small message (docs/dds-runtime.md, "Round waits"). By name when
+      // the protocol can tell: a count also counts messages of later steps.
       const std::optional<AwaitedMessages> awaited = protocol.awaited();
       std::optional<ProtocolMessage> msg =
           awaited ? receive(*awaited) : receive(protocol.messages_needed());

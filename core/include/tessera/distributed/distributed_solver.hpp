@@ -50,13 +50,9 @@ struct DistributedOptions {
   /// trust_region_steps) and the block-gradient reduction that ends it early (< 1; negative =
   /// block_update's grad_reduction). Default: a second step only when the first left the
   /// block's gradient above 0.2 of its start value (the paper's "minimise the block" done a
-  /// little more exactly where one step is not enough). Measured (docs/irbcd.md section 22;
-  /// rounds to 0.01, N = 5, highest, chordal, partition seeds 1-3): IRBCD beats RBCD++ on 27 of
-  /// 30 paper-graph cells instead of 25 (parking-garage 22/22/21 instead of 23/22/23 against
-  /// RBCD++'s 23/25/23); every other cell within -21..+18 rounds of one step (ais2klinik seed 1
-  /// 1087 vs 1069, kitti_02 1314 vs 1335), most of them bit-identical (the second step never
-  /// fires); CPU per round unchanged. RBCD++ with the same rule: same or more rounds (kitti_02
-  /// 1526 vs 1478), so it keeps one step.
+  /// little more exactly where one step is not enough): IRBCD then beats RBCD++ on 27 of 30
+  /// paper-graph cells instead of 25 at the same CPU per round; RBCD++ gains nothing from it and
+  /// keeps one step (docs/irbcd.md section 5).
   int irbcd_trust_region_steps = 2;
   double irbcd_grad_reduction = 0.2;
   RbcdPlusPlusOptions rbcd_plus_plus;

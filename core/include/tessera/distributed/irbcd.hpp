@@ -20,17 +20,13 @@ enum class IrbcdDimension {
 struct IrbcdOptions {
   /// Strong-convexity estimate ("rho" read as sigma); >= 0, < n^2. 1e-4 rather than the
   /// paper's 1e-3: with parallel rounds fewer rounds on 10 of 13 benchmark graphs (kitti_00
-  /// 936 vs 2170), more on intel and MIT (+8%, +12%); docs/irbcd.md section 9.
+  /// 936 vs 2170), more on intel and MIT (+8%, +12%); docs/irbcd.md, "Defaults".
   double sigma = 1e-4;
   /// Initial a; <= 0 means 1/n (the paper's a_0). With b_0 = 1 the first gamma solves
   /// gamma^2 - gamma/n = (1 - gamma sigma/n) a_0^2: a_0 = 1 starts gamma at ~1.2 (n = 3) instead
   /// of the paper's (1 + sqrt 5)/(2n) ~ 0.54, i.e. the momentum starts where the paper's reaches
-  /// after ~2n rounds (RBCD++ starts at 1/n). Default 1 since session 6, by measurement at main
-  /// be9349e (rounds to 0.01, N = 5, highest, chordal; a_0 = 1 / 1/n / RBCD++): parking-garage
-  /// 20/23/23, cubicle 172/223/201, CSAIL 111/110/126, intel 68/76/90, city10000 107/109/137,
-  /// manhattan3500 183/182/218, sphere2500 115/113/134, torus3D 91/95/106, ais2klinik
-  /// 1070/1070/1152, kitti_02 1259/1362/1239, grid 8000 66/66/77, with adaptive sigma on (fixed
-  /// sigma, the default now: kitti_02 1206, ais2klinik 1069, the rest equal; section 15).
+  /// after ~2n rounds (RBCD++ starts at 1/n). Default 1: as few or fewer rounds than 1/n on
+  /// the paper graphs (cubicle 172 vs 223, kitti_02 1259 vs 1362; docs/irbcd.md, "Defaults").
   double a0 = 1.0;
   double b0 = 1.0;  ///< Initial b, > 0.
   IrbcdDimension dimension = IrbcdDimension::kUnits;
@@ -39,23 +35,20 @@ struct IrbcdOptions {
   /// c1 of the restart rule; < 0 disables restarts.
   double restart_c = 0.0;
   /// After a restart, reset a and b to a0, b0 (true: as RBCD++ resets its gamma), or keep the
-  /// recurrences running (false, the default since session 5). Keeping is safe only because
-  /// sigma > 0 bounds gamma by 1/sqrt(sigma) (RBCD++'s gamma would grow without bound): the
-  /// restart still discards the round and sets V := Y, but the momentum schedule is not thrown
-  /// away. Rounds to 0.01 at main 098acb3, keep / reset: CSAIL 100/114, intel 74/87,
-  /// sphere2500 107/131, city10000 111/134, torus3D 91/103, grid 8000 66/75, kitti_02
-  /// 1424/1578, ais2klinik 842/919, manhattan3500 172/181, garage 25/25, cubicle 173/166
-  /// (docs/irbcd.md section 13).
+  /// recurrences running (false, the default). Keeping is safe only because sigma > 0 bounds
+  /// gamma by 1/sqrt(sigma): the restart still discards the round and sets V := Y, but the
+  /// momentum schedule is kept, which saved rounds on 10 of 11 paper graphs (docs/irbcd.md,
+  /// "Defaults").
   bool reset_on_restart = false;
   /// Greedy selection with parallel rounds: the colour class with the largest class gradient
   /// norm sqrt(sum_{B in class} ||grad_B f||^2) (kClassNorm), or the class of the block with the
   /// largest ||grad_B f|| (kLargestBlock, RBCD's and RBCD++'s rule). n counts colour classes,
   /// so the class is the coordinate unit of the recurrences and its own gradient norm is its
   /// Gauss-Southwell score. No message change: every agent already has every block's norm.
-  /// One block per round: both are the same rule. docs/irbcd.md section 20.
+  /// One block per round: both are the same rule. docs/irbcd.md section 3.
   ClassScore class_score = ClassScore::kLargestBlock;
 
-  /// Adaptive sigma (ours, not the paper's; docs/irbcd.md section 13). sigma is the
+  /// Adaptive sigma (ours, not the paper's; docs/irbcd.md section 3). sigma is the
   /// strong-convexity estimate of Nesterov's ACDM, whose gamma settles at 1/sqrt(sigma). Two
   /// observations adjust it, both from quantities every agent already has (the round's gamma
   /// and the restart decision, itself computed from the reduced f), so all agents keep
@@ -67,13 +60,9 @@ struct IrbcdOptions {
   ///   sigma := 1 / (sigma_restart_theta gamma_r)^2 (gamma's new fixed point theta gamma_r;
   ///   always an increase, since gamma_r <= 1/sqrt(sigma)).
   /// sigma stays in [sigma_min, sigma_max]; `sigma` is the start value; sigma_max = 1e-4 (= the
-  /// start) by default, so a restart can only undo earlier shrinks. Measured (docs/irbcd.md
-  /// section 13): before the tangent preconditioner (main b2418ed) kitti_02 4455 -> 2810 rounds
-  /// (RBCD++ 2959); with it (main 098acb3) the rule rarely acts: runs under ~180 n rounds cannot
-  /// saturate, kitti_02 1579 -> 1578, ais2klinik 919 = 919. A larger sigma_max (1e-1, 1e-3)
-  /// measured worse. Default OFF since session 6 (docs/irbcd.md section 15): with a0 = 1 it acts
-  /// only on the two long runs and costs rounds there (main be9349e, fixed / adaptive: kitti_02
-  /// 1206 / 1259, RBCD++ 1239; ais2klinik 1069 / 1070); every other paper graph: same rounds.
+  /// start) by default, so a restart can only undo earlier shrinks. Off by default: with the
+  /// tangent preconditioner and a0 = 1 it acts only on the two longest paper runs and costs
+  /// rounds there (kitti_02 1259 vs 1206; docs/irbcd.md, "Defaults").
   bool adaptive_sigma = false;
   double sigma_shrink = 0.25;        ///< In (0, 1].
   double sigma_saturation = 0.9;     ///< In (0, 1].

@@ -3,7 +3,7 @@
 // The selected block minimises its local objective over (St(r,d) x R^r)^m with the
 // neighbours' poses held fixed, by a few Riemannian trust-region steps (truncated CG,
 // preconditioned by a factor computed once per agent: the tangent-coordinate one at rank d,
-// else the block's constant Q_BB; docs/irbcd.md section 12).
+// else the block's constant Q_BB; docs/irbcd.md section 5).
 
 #include <Eigen/Core>
 #include <tessera/problem/block_problem.hpp>
@@ -27,7 +27,7 @@ struct BlockUpdateOptions {
   double tcg_kappa = 0.1;         ///< tCG linear convergence target, in (0, 1).
   bool precondition = true;       ///< Use a preconditioner (else the identity).
   /// Precondition with the tangent-coordinate factor (solvers/tangent_preconditioner.hpp,
-  /// docs/irbcd.md section 12) when the point has rank d (the agents' active rows) and the
+  /// docs/irbcd.md section 5) when the point has rank d (the agents' active rows) and the
   /// factor is not too large or failing; otherwise, and when false, with the Euclidean Q_BB
   /// factor (solvers/block_preconditioner.hpp).
   bool tangent_preconditioner = true;
@@ -41,7 +41,7 @@ struct BlockUpdateOptions {
   /// of the preconditioned gradient norm sqrt(<P g, g>) (> 0). That norm is the length of P's
   /// Newton step, so with the (nearly exact) tangent factor a radius of 1 stops tCG on the
   /// boundary after one iteration; 3 lets it converge (sphere_bignoise 257 -> 187 rounds,
-  /// cubicle 187 -> 166, docs/irbcd.md section 12). Q_BB-preconditioned updates keep 1: their
+  /// cubicle 187 -> 166, docs/irbcd.md section 5). Q_BB-preconditioned updates keep 1: their
   /// norm is inflated by the amplified normal components.
   double tangent_radius_scale = 3.0;
 

@@ -37,7 +37,7 @@ struct PartitionOptions {
   /// Search islands of strong / highest, each a whole search on its own thread
   /// (docs/partitioning.md item 10): 0 = the preset's own (highest 2, strong 1); else 1..8.
   /// highest adds a short island (a fifth of the step budget) to any count but 1, where that
-  /// fifth is at least its population (docs/partitioning.md "Session 10").
+  /// fifth is at least its population (docs/partitioning.md item 10).
   /// Each island costs a full search's CPU time, so a caller that shares the cores with other
   /// work (e.g. agents starting up) may want 1. The partition depends on this value and the
   /// seed, never on the machine's core count.

@@ -1,12 +1,12 @@
 #pragma once
 // Tangent-coordinate preconditioner for a block's trust-region steps at rank r = d (the agents'
-// active rows after a chordal or distributed lift; docs/irbcd.md section 12).
+// active rows after a chordal or distributed lift; docs/irbcd.md section 5).
 //
 // Why: the Euclidean preconditioner (2 (Q_BB + lambda I))^{-1} followed by the tangent projection
 // (block_preconditioner.hpp) is far from the inverse of the Hessian on the tangent space when a
 // block is held by few cut edges: Q_BB is then nearly singular along the lifted gauge X -> M X,
 // whose normal components Q_BB^{-1} amplifies and the projection throws away (parking-garage: ~44
-// tCG iterations per update, docs/irbcd.md section 7). Working in tangent coordinates avoids it.
+// tCG iterations per update, docs/irbcd.md section 5). Working in tangent coordinates avoids it.
 //
 // What: each pose i = [Y_i | t_i] (Y_i in O(d)) gets p = d(d+1)/2 coordinates c_i = (omega, u):
 // rotation part Y_i Omega(omega) (Omega: the skew basis E_ab = e_b e_a^T - e_a e_b^T, a < b) and
