@@ -380,7 +380,7 @@ TEST(DdsShmLeftovers, OnlyDeadPortsOfTheDomainAndDeadSegmentsOfTheRunAreRemoved)
 
 // Dead ports of the run's domain that an earlier run's processes left (an abort, a SIGKILLed agent
 // started by hand) are removed before launch starts its processes: left there, they kept every
-// later launch on that domain from discovering its peers (session 13). A run that ends normally
+// later launch on that domain from discovering its peers. A run that ends normally
 // removes nothing afterwards, so without the removal before the run the planted files stay.
 TEST(DdsShmLeftovers, LaunchRemovesTheDomainsDeadPortsBeforeTheRun) {
   const int domain = 218;

@@ -135,8 +135,8 @@ void restarted_after_repartition_is_refused(int domain, bool checkpoint) {
   // rounds, core's "stalled" stop) on a graph large enough that this takes several seconds,
   // and a round limit as a bound. 8000 poses: the refused process leaves 2.8-5.2 s before the
   // survivors finish on a quiet machine; 4000 poses left no margin once rounds got cheaper
-  // (session 7: the survivors stalled ~2 s after the re-partition, before a restarted process
-  // had read the assignment naming it lost).
+  // (the survivors then stalled ~2 s after the re-partition, before a restarted process had
+  // read the assignment naming it lost).
   LossRun r = make_run(domain, checkpoint ? "refused-ckpt" : "refused-fresh", 8000);
   r.grad_tol = "1e-12";
   Process coord = r.coordinator(1, {"--max-rounds", "600"});

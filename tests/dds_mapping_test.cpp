@@ -355,7 +355,7 @@ TEST(DdsHandoff, InconsistentHandoffsAreReported) {
 
 // The relay waiting in round 3's update step for the blocks of agents 1 and 4: agent 1's block
 // rides in its status sample, so its block and its next status arrive together. A count of 2
-// wakes the waiter there; the awaited set wakes it only with agent 4's block (session 13, wake13).
+// wakes the waiter there; the awaited set wakes it only with agent 4's block.
 TEST(DdsEpochRouting, AwaitedSendersWakeTheWaiterOnlyWhenTheStepIsComplete) {
   auto block = [](std::uint32_t round, std::uint32_t sender) {
     PoseBlockMessage b;

@@ -1,8 +1,7 @@
 // The coordinator's round reports (RoundReports), without processes: from round statuses (read
 // while lost agents are arbitrated) a round completes when every active agent reported it, at
 // the time its last status was read; from progress digests, the round timing and the last line
-// come from agent 0's last digest (docs/dds-runtime.md, "Session 10 (relay10)"). (stall10's
-// status wake-up threshold, statuses_to_complete, went with the status reading it served.)
+// come from agent 0's last digest (docs/dds-runtime.md, "Progress digests").
 
 #include <gtest/gtest.h>
 

@@ -109,7 +109,7 @@ TEST(MessagesNeeded, IsALowerBoundOnWhatEachStepWaitsFor) {
 }
 
 // AgentProcess::awaited names the messages the step lacks (the DDS agent sleeps until all of
-// them are queued, session 13): handing the agent everything else queued never moves it on,
+// them are queued): handing the agent everything else queued never moves it on,
 // the named ones do, with the last of them -- and the agents still run the same rounds.
 TEST(MessagesNeeded, AwaitedNamesExactlyTheMessagesThatCompleteTheStep) {
   FourAgents run;

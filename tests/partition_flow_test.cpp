@@ -1,8 +1,8 @@
 // Max-flow refinement between block pairs (flow_refinement.hpp): a jagged boundary becomes the
 // minimum cut through the corridor, and on irregular graphs the cut never gets worse, the
 // returned cut is the partition's, the bounds hold and the same seed gives the same result.
-// (The max flow inside changed from Dinic to Boykov-Kolmogorov search trees in session 13; the
-// partitions must not depend on which maximum flow is found.)
+// (The max flow inside is Boykov-Kolmogorov's search trees, formerly Dinic; the partitions must
+// not depend on which maximum flow is found.)
 
 #include <gtest/gtest.h>
 

@@ -229,8 +229,8 @@ std::uint32_t DistributedRounding::translations() {
   // n = L M w, are independent: the reduction and the neighbours' public entries of M w
   // travel in ONE message step per iteration. Plain PCG needs two (<p, L p>, then <r, z>
   // with the new z's public entries): intel's rounding took 105 message steps, ~0.85 ms each
-  // on 2 cores, 62 this way (docs/dds-runtime.md, stall10). Each step also carries x's public
-  // entries, so the last one gives the neighbours' final translations.
+  // on 2 cores, 62 this way (docs/dds-runtime.md, "The rounding's message steps"). Each step also
+  // carries x's public entries, so the last one gives the neighbours' final translations.
   Eigen::MatrixXd x = Eigen::MatrixXd::Zero(m, d), r = b;
   Eigen::MatrixXd u, w, p, s, q, n_rec;
   const std::uint32_t max_it = 5000;

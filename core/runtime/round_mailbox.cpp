@@ -59,7 +59,7 @@ std::map<std::uint32_t, ProtocolMessage> Mailbox::gather(
     std::sort(awaited.senders.begin(), awaited.senders.end());
     // Sleep until the missing senders' messages have come, not once per message: a reduction
     // waits for every other agent's status, and each wake-up of this thread costs more than
-    // handling a small message (as run_protocol's steps; docs/dds-runtime.md, stall10).
+    // handling a small message (as run_protocol's steps; docs/dds-runtime.md, "Round waits").
     std::optional<ProtocolMessage> msg = receive(awaited);
     if (!msg) {
       std::string who;

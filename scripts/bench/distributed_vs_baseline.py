@@ -10,7 +10,7 @@ usage: distributed_vs_baseline.py [--bin build/bin/tessera] [--graphs CSAIL,inte
                                   [--algorithms rbcd,rbcd++,irbcd] [--extra "--parallel"] [--out FILE.csv]
                                   [--timeout SECONDS] [--repeat-short K] [--short-s SECONDS]
 
-Rounds are those of the solver's defaults: since session 3 a round updates a whole colour class
+Rounds are those of the solver's defaults: a round updates a whole colour class
 of blocks (an independent set, `--parallel`, the default); `--extra=--sequential` gives one block
 per round, as the baseline counts them (docs/irbcd.md section 4).
 

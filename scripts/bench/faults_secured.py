@@ -12,7 +12,7 @@ A secured trial counts as finished when launch exits 0 with the unsecured run's 
 cost error is against that trial's unsecured run; extra time is the secured wall time minus
 the unsecured one (handshakes, encryption). The outsider's sample count must be 0 (and the same
 outsider must read > 0 samples of the unsecured run: the control that it works); the impostor
-must read 0 samples and stop nothing (before session 6 it stopped secured runs).
+must read 0 samples and stop nothing.
 
 Writes docs/benchmarks/faults_secured.csv (column contract of scripts/bench/faults.py),
 docs/benchmarks/faults/secured.md (per-trial table) and re-assembles faults.md.

@@ -4,6 +4,8 @@
 // process with the exit code it was about to return; disarmed, nothing changes. Each case
 // runs in a forked child (no participant needed: the failures are simulated).
 
+#include "transport/teardown_guard.hpp"
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -14,8 +16,6 @@
 #include <cstdlib>
 #include <functional>
 #include <thread>
-
-#include "transport/teardown_guard.hpp"
 
 namespace {
 
@@ -33,7 +33,7 @@ int in_child(const std::function<void()>& body) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-TEST(DdsTeardownGuard, AnAbortDuringTeardownExitsWithTheIntendedCode) {
+TEST(TeardownGuard, AnAbortDuringTeardownExitsWithTheIntendedCode) {
   EXPECT_EQ(in_child([] {
               TeardownGuard guard(3, "test", std::chrono::seconds(10));
               std::abort();  // what Fast DDS's failed assertion does
@@ -47,7 +47,7 @@ TEST(DdsTeardownGuard, AnAbortDuringTeardownExitsWithTheIntendedCode) {
             0);
 }
 
-TEST(DdsTeardownGuard, ATeardownThatHangsEndsAfterTheBound) {
+TEST(TeardownGuard, ATeardownThatHangsEndsAfterTheBound) {
   const auto start = std::chrono::steady_clock::now();
   EXPECT_EQ(in_child([] {
               TeardownGuard guard(4, "test", std::chrono::milliseconds(200));
@@ -57,7 +57,7 @@ TEST(DdsTeardownGuard, ATeardownThatHangsEndsAfterTheBound) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
 }
 
-TEST(DdsTeardownGuard, ATeardownThatFinishesChangesNothing) {
+TEST(TeardownGuard, ATeardownThatFinishesChangesNothing) {
   EXPECT_EQ(in_child([] {
               { TeardownGuard guard(5, "test", std::chrono::seconds(10)); }
               _exit(7);  // the process's own exit code stands
@@ -73,7 +73,7 @@ TEST(DdsTeardownGuard, ATeardownThatFinishesChangesNothing) {
 
 // The agent's cover from the coordinator's FINISHED on (cli/session_process.cpp): an abort
 // counts as the end of a finished run only once the flag is set; before, it is an abort.
-TEST(DdsTeardownGuard, ACoverOnAFlagHoldsOnlyOnceTheFlagIsSet) {
+TEST(TeardownGuard, ACoverOnAFlagHoldsOnlyOnceTheFlagIsSet) {
   EXPECT_EQ(in_child([] {
               std::atomic<bool> finished{false};
               TeardownGuard cover(0, "test", std::chrono::seconds(0), &finished);
@@ -99,7 +99,7 @@ TEST(DdsTeardownGuard, ACoverOnAFlagHoldsOnlyOnceTheFlagIsSet) {
 
 // The participant's deletion is guarded inside the agent's cover: the inner guard takes over
 // (its exit code, unconditionally), and the outer one holds again after it.
-TEST(DdsTeardownGuard, GuardsNestAndTheOuterOneHoldsAgainAfterTheInner) {
+TEST(TeardownGuard, GuardsNestAndTheOuterOneHoldsAgainAfterTheInner) {
   EXPECT_EQ(in_child([] {
               std::atomic<bool> finished{false};
               TeardownGuard cover(0, "test", std::chrono::seconds(0), &finished);

@@ -1,6 +1,6 @@
 // The rounding's waits (agent::Mailbox::gather), without processes: each wait asks the channel
 // to sleep until as many messages as the step still lacks have come, instead of waking for
-// every message (docs/dds-runtime.md, "Session 10 (stall10)"), and never for more than that.
+// every message (docs/dds-runtime.md, "Round waits"), and never for more than that.
 
 #include <gtest/gtest.h>
 
