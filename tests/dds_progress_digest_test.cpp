@@ -1,8 +1,8 @@
 // The agents' progress digests and what the coordinator makes of them (docs/dds-runtime.md,
-// "Session 10 (relay10)"), without processes: the digest an agent builds from the statuses it
-// sends and receives (agent/progress_digest.hpp), the rate-limited progress lines
-// (coordinator/progress_printer.hpp) and the lag lines from digests (coordinator/run_monitor.hpp);
-// the round timing from agent 0's last digest: dds_round_reports_test.cpp.
+// "Progress digests"), without processes: the digest an agent builds from the statuses it
+// sends and receives (agent/progress_digest.hpp) and the rate-limited progress lines
+// (runtime/progress_printer.hpp); the lag lines from digests: run_monitor_test.cpp; the round
+// timing from agent 0's last digest: dds_round_reports_test.cpp.
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,6 @@
 
 #include "agent/progress_digest.hpp"
 #include "runtime/progress_printer.hpp"
-#include "runtime/run_monitor.hpp"
 
 namespace {
 
@@ -122,37 +121,6 @@ TEST(ProgressPrinter, PrintsTheFirstRestartsAndTheLastAndAtMostOneLinePerInterva
   off.on_step({0, 1, 1.0, 1.0}, 0.0);
   off.finish();
   EXPECT_TRUE(quiet.str().empty());
-}
-
-TEST(RunMonitor, FromDigestsNamesSilentAgentsAndTheAgentEveryLongWaiterWaitsFor) {
-  std::ostringstream out;
-  coordinator::RunMonitor m(4, coordinator::MonitorOptions{5.0, 2, 3.0}, out, t0);
-  // Digests are samples: rounds far apart are no lag.
-  m.on_digest(0, 100u, {}, 0.0, at(1));
-  m.on_digest(1, 40u, {}, 0.0, at(1));
-  m.on_digest(2, 70u, {2u}, 0.01, at(1));
-  m.on_digest(3, 90u, {}, 0.0, at(1));
-  EXPECT_EQ(m.line(at(1)), "status 1.0s: 4/4 agents alive; rounds 0:100 1:40 2:70 3:90");
-  // Agent 3 hangs: its digests stop; the relay (0) waits for it alone, the others (no bundle
-  // yet) for everyone but themselves.
-  m.on_digest(0, 120u, {3u}, 3.5, at(4.5));
-  m.on_digest(1, 119u, {0u, 2u, 3u}, 3.4, at(4.5));
-  m.on_digest(2, 119u, {0u, 1u, 3u}, 3.4, at(4.5));
-  EXPECT_EQ(m.line(at(4.5)),
-            "status 4.5s: 4/4 agents alive; rounds 0:120 1:119 2:119 3:90; lagging: 3; agents "
-            "0,1,2 wait for 3");
-  m.tick(at(4.5));  // the lagging set changed: printed at once
-  EXPECT_NE(out.str().find("lagging: 3"), std::string::npos) << out.str();
-  // An agent done with the rounds (its final digest) sends no more: never lagging.
-  coordinator::RunMonitor done(2, coordinator::MonitorOptions{5.0, 2, 3.0}, out, t0);
-  done.on_digest(0, 9u, {}, 0.0, at(1), /*final=*/true);
-  done.on_digest(1, 8u, {0u}, 4.0, at(5));
-  EXPECT_EQ(done.line(at(5)), "status 5.0s: 2/2 agents alive; rounds 0:9 1:8");
-  // A short wait names nobody.
-  coordinator::RunMonitor brief(2, coordinator::MonitorOptions{5.0, 2, 3.0}, out, t0);
-  brief.on_digest(0, 5u, {1u}, 0.2, at(1));
-  brief.on_digest(1, 5u, {}, 0.0, at(1));
-  EXPECT_EQ(brief.line(at(1)), "status 1.0s: 2/2 agents alive; rounds 0:5 1:5");
 }
 
 }  // namespace

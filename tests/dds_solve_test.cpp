@@ -166,8 +166,8 @@ TEST(DdsLaunch, StatusRelayFlagsExcludeEachOther) {
 // are the direct solve's where that is hardest: kitti_02, a 4661-pose trajectory, 5 agents,
 // positions up to ~1.5 km from pose 0. The pipelined PCG stopped on its recurrence's residual
 // was 3e-6 m off; restarted from x until a residual computed from x is small enough, 1.3e-8 m
-// as plain PCG (docs/dds-runtime.md, stall10). Two rounds only: the rounding solves the same
-// translation Laplacian whatever the rotations.
+// as plain PCG (docs/dds-runtime.md, "The rounding's message steps"). Two rounds only: the rounding
+// solves the same translation Laplacian whatever the rotations.
 TEST(DdsLaunch, RoundingOfALongTrajectoryIsTheDirectSolves) {
   const std::string graph = std::string(TESSERA_SHARED_DIR) + "/datasets/kitti_02.g2o";
   if (!std::ifstream(graph)) GTEST_SKIP() << "no " << graph;
@@ -269,7 +269,9 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
 // from being declared lost) is named by the coordinator's status line, with the status relay
 // on (the default) and the coordinator following the agents' progress digests, not their
 // round statuses: its digests stop while the others' go on from their waits
-// (docs/dds-runtime.md, "Session 10"). Once it goes on, so does the run.
+// (docs/dds-runtime.md, "Waiting, failure and shutdown"). An agent that waits for the hung
+// one's pose blocks is waited for too, but its digests go on: only agent 1 is named. Once it
+// goes on, so does the run.
 TEST(DdsLaunch, HungAgentIsNamedAsLaggingAndTheRunGoesOn) {
   const std::string dir = temp_dir();
   const std::string run_id = "hung-" + std::to_string(getpid());

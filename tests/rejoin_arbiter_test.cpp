@@ -1,6 +1,7 @@
-// The coordinator's decisions on lost agents (RejoinArbiter) and its operator status lines
-// (RunMonitor), without processes: which rollback round is chosen, when it gives up, and what
-// the status line says about alive, lagging and lost agents.
+// The coordinator's decisions on lost agents (RejoinArbiter), without processes: which rollback
+// round is chosen and when it gives up.
+
+#include "runtime/rejoin_arbiter.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +9,6 @@
 #include <sstream>
 #include <string>
 #include <tessera/util/input_error.hpp>
-
-#include "runtime/rejoin_arbiter.hpp"
-#include "runtime/run_monitor.hpp"
 
 namespace tessera::coordinator {
 namespace {
@@ -69,56 +67,6 @@ TEST(RejoinArbiter, GivesUpWhenNobodyComesBackOrNoRoundIsCommon) {
   RejoinArbiter off(2, 0.0);
   off.on_lost(1, at(0));
   EXPECT_EQ(off.decide(at(0)).kind, Kind::kGiveUp);
-}
-
-TEST(RunMonitor, OptionsOutOfRangeAreErrorsNamingTheField) {
-  EXPECT_NO_THROW(MonitorOptions{}.validate());
-  EXPECT_NO_THROW((MonitorOptions{0.0, 1, 0.5}.validate()));  // 0 = only on changes
-  const struct {
-    MonitorOptions options;
-    const char* field;
-  } bad[] = {{{-1.0, 2, 3.0}, "interval_s"},
-             {{1e9, 2, 3.0}, "interval_s"},
-             {{std::nan(""), 2, 3.0}, "interval_s"},
-             {{5.0, 0, 3.0}, "lag_rounds"},
-             {{5.0, 2, 0.0}, "lag_s"},
-             {{5.0, 2, std::nan("")}, "lag_s"}};
-  for (const auto& b : bad) {
-    try {
-      b.options.validate();
-      ADD_FAILURE() << "accepted a bad " << b.field;
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(std::string("MonitorOptions.") + b.field),
-                std::string::npos)
-          << e.what();
-    }
-    std::ostringstream out;
-    EXPECT_THROW(RunMonitor(3, b.options, out, t0), InputError) << b.field;
-  }
-}
-
-TEST(RunMonitor, ReportsAliveRoundsLaggingAndLostAgents) {
-  std::ostringstream out;
-  RunMonitor m(3, MonitorOptions{5.0, 2, 3.0}, out, t0);
-  m.on_status(0, 10, at(1));
-  m.on_status(1, 10, at(1));
-  m.on_status(2, 7, at(1));
-  EXPECT_EQ(m.line(at(1)), "status 1.0s: 3/3 agents alive; rounds 0:10 1:10 2:7; lagging: 2");
-  m.tick(at(1));  // lagging set changed: printed at once
-  EXPECT_NE(out.str().find("lagging: 2"), std::string::npos) << out.str();
-  m.on_status(2, 10, at(2));
-  m.set_lost({1}, at(2.5));
-  EXPECT_NE(out.str().find("status 2.5s: agent 1 lost"), std::string::npos) << out.str();
-  EXPECT_EQ(m.line(at(2.5)), "status 2.5s: 2/3 agents alive; rounds 0:10 1:10 2:10; lost: 1");
-  // Silent while another agent reports: lagging after lag_s.
-  m.on_status(0, 11, at(6));
-  EXPECT_NE(m.line(at(6)).find("lagging: 2"), std::string::npos) << m.line(at(6));
-  m.set_lost({}, at(7));
-  EXPECT_NE(out.str().find("agent 1 is back"), std::string::npos) << out.str();
-  const std::size_t before = out.str().size();
-  m.tick(at(7.5));
-  m.tick(at(13));
-  EXPECT_GT(out.str().size(), before) << "a periodic line after the interval";
 }
 
 }  // namespace

@@ -130,6 +130,15 @@ std::pair<std::vector<std::uint32_t>, std::vector<std::uint32_t>> RunMonitor::wa
   if (out.second.empty()) return out;
   for (std::uint32_t j = 0; j < n_; ++j)
     if (all[j] && !lost_[j] && !done_[j]) out.first.push_back(j);
+  // A hung agent's protocol messages stop with its digests, so an agent that needs them cannot
+  // send its status either and is waited for as well, though its digests go on. When some of
+  // the waited-for agents have gone quiet, they are the cause: name only them. Half of lag_s
+  // is far above a live agent's digest period and below a hung agent's quiet time once a wait
+  // has lasted lag_s.
+  std::vector<std::uint32_t> quiet;
+  for (auto j : out.first)
+    if (secs(now - last_seen_[j]) >= opt_.lag_s / 2) quiet.push_back(j);
+  if (!quiet.empty()) out.first = std::move(quiet);
   return out;
 }
 

@@ -12,7 +12,9 @@
 // waiting for at least `lag_s` in its current step waits for (digests are samples taken at
 // different moments, so their rounds are not compared; a waiting agent names the senders it
 // misses, and with the status relay the agents other than the relay miss everyone, hence the
-// intersection). The line then adds "agents A,B wait for K".
+// intersection). An agent blocked on a hung agent's messages is waited for too but still
+// sends digests: when some waited-for agents have gone quiet (no digest for lag_s / 2), only
+// they are named. The line then adds "agents A,B wait for K".
 
 #include <chrono>
 #include <cstdint>
