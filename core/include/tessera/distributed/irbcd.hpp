@@ -20,13 +20,13 @@ enum class IrbcdDimension {
 struct IrbcdOptions {
   /// Strong-convexity estimate ("rho" read as sigma); >= 0, < n^2. 1e-4 rather than the
   /// paper's 1e-3: with parallel rounds fewer rounds on 10 of 13 benchmark graphs (kitti_00
-  /// 936 vs 2170), more on intel and MIT (+8%, +12%); docs/irbcd.md, "Defaults".
+  /// 936 vs 2170), more on intel and MIT (+8%, +12%); docs/irbcd.md section 3.
   double sigma = 1e-4;
   /// Initial a; <= 0 means 1/n (the paper's a_0). With b_0 = 1 the first gamma solves
   /// gamma^2 - gamma/n = (1 - gamma sigma/n) a_0^2: a_0 = 1 starts gamma at ~1.2 (n = 3) instead
   /// of the paper's (1 + sqrt 5)/(2n) ~ 0.54, i.e. the momentum starts where the paper's reaches
-  /// after ~2n rounds (RBCD++ starts at 1/n). Default 1: as few or fewer rounds than 1/n on
-  /// the paper graphs (cubicle 172 vs 223, kitti_02 1259 vs 1362; docs/irbcd.md, "Defaults").
+  /// after ~2n rounds (RBCD++ starts at 1/n). Default 1: equal or fewer rounds than 1/n on 8
+  /// of 11 paper graphs (cubicle 172 vs 223, kitti_02 1259 vs 1362; docs/irbcd.md section 3).
   double a0 = 1.0;
   double b0 = 1.0;  ///< Initial b, > 0.
   IrbcdDimension dimension = IrbcdDimension::kUnits;
@@ -37,8 +37,8 @@ struct IrbcdOptions {
   /// After a restart, reset a and b to a0, b0 (true: as RBCD++ resets its gamma), or keep the
   /// recurrences running (false, the default). Keeping is safe only because sigma > 0 bounds
   /// gamma by 1/sqrt(sigma): the restart still discards the round and sets V := Y, but the
-  /// momentum schedule is kept, which saved rounds on 10 of 11 paper graphs (docs/irbcd.md,
-  /// "Defaults").
+  /// momentum schedule is kept, which saved rounds on 9 of 11 paper graphs (docs/irbcd.md
+  /// section 3).
   bool reset_on_restart = false;
   /// Greedy selection with parallel rounds: the colour class with the largest class gradient
   /// norm sqrt(sum_{B in class} ||grad_B f||^2) (kClassNorm), or the class of the block with the
@@ -62,7 +62,7 @@ struct IrbcdOptions {
   /// sigma stays in [sigma_min, sigma_max]; `sigma` is the start value; sigma_max = 1e-4 (= the
   /// start) by default, so a restart can only undo earlier shrinks. Off by default: with the
   /// tangent preconditioner and a0 = 1 it acts only on the two longest paper runs and costs
-  /// rounds there (kitti_02 1259 vs 1206; docs/irbcd.md, "Defaults").
+  /// rounds there (kitti_02 1259 vs 1206; docs/irbcd.md section 3).
   bool adaptive_sigma = false;
   double sigma_shrink = 0.25;        ///< In (0, 1].
   double sigma_saturation = 0.9;     ///< In (0, 1].
