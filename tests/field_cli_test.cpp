@@ -142,6 +142,27 @@ TEST(FieldCli, PlotWritesAPng) {
   in.read(magic, 4);
   EXPECT_EQ(std::string(magic + 1, 3), "PNG");
   EXPECT_GT(std::filesystem::file_size(png), 10000u);
+  // Coloured by block, with cut and rejected measurements; a partition of the wrong size is
+  // refused naming the file.
+  ASSERT_EQ(run_command(bin("tessera") + " partition " + g.graph + " --parts 3 --out " + g.dir +
+                            "/part.txt",
+                        &out),
+            0)
+      << out;
+  std::ofstream(g.dir + "/rej.txt")
+      << tessera::gtsam_key('a', 0) << " " << tessera::gtsam_key('a', 1) << "\n";
+  ASSERT_EQ(run_command(bin("tessera") + " plot " + g.graph + " --partition " + g.dir +
+                            "/part.txt --rejected " + g.dir + "/rej.txt --out " + png,
+                        &out),
+            0)
+      << out;
+  std::ofstream(g.dir + "/short.txt") << "0\n1\n";
+  EXPECT_EQ(run_command(bin("tessera") + " plot " + g.graph + " --partition " + g.dir +
+                            "/short.txt --out " + png,
+                        &out),
+            2)
+      << out;
+  EXPECT_TRUE(contains(out, g.dir + "/short.txt: 2 blocks for a graph of 90 poses")) << out;
 }
 
 TEST(FieldCli, BadInputsExitTwoNamingFileAndLine) {
