@@ -12,7 +12,7 @@ void write_poses(const std::string& path, const PoseGraph& graph, const std::vec
                  const PoseKeys& keys) {
   const bool tum = path.size() >= 4 && path.compare(path.size() - 4, 4, ".tum") == 0;
   if (tum)
-    write_tum(poses, path);
+    write_tum(poses, keys, path);
   else
     write_g2o(graph, keys, poses, path);
 }
@@ -25,7 +25,7 @@ void write_solution_files(const Arguments& a, const PoseGraph& graph, const Pose
                           std::vector<Pose> poses) {
   move_to_input_frame(graph, keys, poses);
   if (auto p = a.get("out")) write_poses(*p, graph, poses, keys);
-  if (auto p = a.get("tum")) write_tum(poses, *p);
+  if (auto p = a.get("tum")) write_tum(poses, keys, *p);
   if (auto dir = a.get("tum-dir")) {
     const auto files = write_robot_trajectories(graph, keys, poses, *dir);
     std::fprintf(stderr, "wrote %zu robot trajectories into %s\n", files.size(), dir->c_str());

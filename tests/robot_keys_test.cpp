@@ -15,6 +15,7 @@
 #include <tessera/io/g2o_writer.hpp>
 #include <tessera/io/robot_trajectories.hpp>
 #include <tessera/io/stamps_reader.hpp>
+#include <tessera/io/tum_writer.hpp>
 #include <tessera/partition/robot_partition.hpp>
 #include <tessera/util/input_error.hpp>
 #include <vector>
@@ -177,6 +178,10 @@ TEST(RobotKeys, WrittenGraphKeepsTheInputIdsAndFix) {
   EXPECT_EQ(back.keys.ids, r.keys.ids);
   EXPECT_EQ(back.keys.robot, r.keys.robot);
   EXPECT_EQ(back.keys.fixed, r.keys.fixed);
+  // One TUM file: the key as timestamp, exactly (no double rounding of a 64-bit id).
+  write_tum(r.graph.initial, r.keys, path + ".tum");
+  EXPECT_EQ(read_text(path + ".tum").rfind(std::to_string(key('a', 0)) + " 0 0 0 0 0 0 1\n", 0),
+            0u);
 }
 
 TEST(RobotKeys, SummaryCountsPosesOdometryAndClosuresPerRobot) {
