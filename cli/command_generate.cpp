@@ -4,6 +4,7 @@
 #include <string>
 #include <tessera/generate/generator.hpp>
 #include <tessera/io/g2o_writer.hpp>
+#include <tessera/io/stamps_reader.hpp>
 #include <tessera/io/tum_writer.hpp>
 #include <tessera/util/input_error.hpp>
 
@@ -35,7 +36,14 @@ const char* const kHelp =
     "  --inter-robot-closures P same for candidates between two robots, 0..1     [0.5]\n"
     "  --max-loop-closures K    keep at most K sampled closures (0 = no cap)      [0]\n"
     "  --out FILE.g2o           where to write the graph (required)\n"
-    "  --truth FILE.tum         also write the ground-truth trajectory (TUM format)\n"
+    "  --truth FILE            also write the ground truth: FILE.g2o = the graph with the\n"
+    "                           true poses as VERTEX lines (same ids; what tessera eval\n"
+    "                           matches by id), any other name = TUM (plain ids only)\n"
+    "  --keys plain|gtsam       pose ids: plain 0..n-1, or gtsam = robot r's pose k as the\n"
+    "                           GTSAM key ('a'+r) << 56 | k (up to 26 robots)    [plain]\n"
+    "  --stamps FILE            also write a timestamp per pose ('id stamp' lines): 10 Hz\n"
+    "                           from t = 1000 s, every robot starting at once (plain ids:\n"
+    "                           one clock along the ids)\n"
     "  --json FILE              also write a JSON summary\n"
     "  --split DIR              also write one file per robot, DIR/robot<r>.g2o: its poses'\n"
     "                           VERTEX lines and the measurements it recorded, global ids\n"
@@ -64,6 +72,35 @@ GeneratorOptions parse_options(const Arguments& args) {
       args.get_double("inter-robot-closures", o.inter_robot_closure_probability);
   o.max_loop_closures = get_count(args, "max-loop-closures", 0);
   return o;
+}
+
+// Robot r's k-th pose becomes the GTSAM key ('a' + r) << 56 | k.
+void name_by_robot(const GeneratorResult& result, std::size_t num_robots, PoseKeys& keys) {
+  if (num_robots > 26) throw InputError("option --keys gtsam: at most 26 robots (a..z)");
+  keys.ids.resize(result.graph.num_poses);
+  std::size_t begin = 0;
+  for (std::size_t k = 0; k < keys.ids.size(); ++k) {
+    if (k > 0 && result.robot_of[k] != result.robot_of[k - 1]) begin = k;
+    keys.ids[k] = gtsam_key(static_cast<char>('a' + result.robot_of[k]), k - begin);
+  }
+  assign_robots(keys, result.graph.num_poses, KeyScheme::kGtsam);
+}
+
+// 10 Hz from t = 1000 s: every robot starts at once (its index), plain ids along the ids.
+void stamp_poses(std::size_t num_poses, PoseKeys& keys) {
+  keys.stamps.resize(num_poses);
+  for (std::size_t k = 0; k < keys.stamps.size(); ++k)
+    keys.stamps[k] = 1000.0 + 0.1 * static_cast<double>(keys.index_in_robot(k));
+}
+
+void write_truth(const GeneratorResult& result, const PoseKeys& keys, const std::string& path) {
+  const bool g2o = path.size() >= 4 && path.compare(path.size() - 4, 4, ".g2o") == 0;
+  if (g2o) return write_g2o(result.graph, keys, result.ground_truth, path);
+  if (keys.scheme != KeyScheme::kPlain)
+    throw InputError(
+        "option --truth: a TUM file cannot tell the robots of GTSAM keys apart; "
+        "give a name ending in .g2o");
+  write_tum(result.ground_truth, path);
 }
 
 struct Timing {
@@ -104,11 +141,11 @@ void write_json(const std::string& path, const GeneratorOptions& o, const Genera
 }  // namespace
 
 int run_generate(const Args& argv) {
-  const Arguments args(
-      argv,
-      {"kind", "poses", "robots", "seed", "rot-noise", "trans-noise", "loop-closures",
-       "inter-robot-closures", "max-loop-closures", "out", "truth", "json", "split"},
-      {"help"});
+  const Arguments args(argv,
+                       {"kind", "poses", "robots", "seed", "rot-noise", "trans-noise",
+                        "loop-closures", "inter-robot-closures", "max-loop-closures", "out",
+                        "truth", "json", "split", "keys", "stamps"},
+                       {"help"});
   if (args.has("help")) {
     std::fputs(kHelp, stdout);
     return 0;
@@ -122,13 +159,23 @@ int run_generate(const Args& argv) {
   Timing timing;
   auto start = std::chrono::steady_clock::now();
   const GeneratorResult result = generate_pose_graph(options);
+  const std::string keys = args.get_or("keys", "plain");
+  if (keys != "plain" && keys != "gtsam")
+    throw InputError("option --keys: '" + keys + "' is not one of plain, gtsam");
+  PoseKeys pose_keys;
+  if (keys == "gtsam") name_by_robot(result, options.num_robots, pose_keys);
+  if (args.has("stamps")) stamp_poses(result.graph.num_poses, pose_keys);
   timing.generate_s = seconds_since(start);
   start = std::chrono::steady_clock::now();
-  write_g2o(result.graph, *out);
+  write_g2o(result.graph, pose_keys, result.graph.initial, *out);
   timing.write_s = seconds_since(start);  // the g2o file only
-  if (auto truth = args.get("truth")) write_tum(result.ground_truth, *truth);
+  if (auto truth = args.get("truth")) write_truth(result, pose_keys, *truth);
+  if (auto stamps = args.get("stamps"))
+    write_stamps_file(pose_keys, result.graph.num_poses, *stamps);
   if (auto json = args.get("json")) write_json(*json, options, result, *out, timing);
   if (auto split = args.get("split")) {
+    if (keys == "gtsam")
+      throw InputError("option --split writes ids 0..n-1: not with --keys gtsam");
     const auto files = write_robot_files(*out, result.graph.num_poses, options.num_robots, *split);
     std::printf("wrote %zu robot files into %s\n", files.size(), split->c_str());
   }

@@ -4,31 +4,50 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <tessera/graph/robot_summary.hpp>
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/util/input_error.hpp>
 
 #include "arguments.hpp"
 #include "commands.hpp"
+#include "graph_input.hpp"
 #include "json_writer.hpp"
 
 namespace tessera::cli {
 namespace {
 
 const char* const kHelp =
-    "usage: tessera info GRAPH [--json FILE]\n"
+    "usage: tessera info GRAPH [--json FILE] [--keys auto|plain|gtsam]\n"
     "\n"
-    "Reads the g2o pose graph GRAPH and prints poses, edges, dimension, connected components,\n"
+    "Reads the pose graph GRAPH (g2o or TORO) and prints its robots (poses, odometry, loop\n"
+    "closures inside the robot and with other robots),  poses, edges, dimension, connected "
+    "components,\n"
     "parallel edges (measurements on an already-seen unordered pair), backward edges (i > j),\n"
     "information matrices that are not positive definite and whether VERTEX lines exist.\n"
     "A disconnected graph is accepted here (its component count is reported).\n"
     "\n"
     "options:\n"
     "  --json FILE   also write the figures as one JSON object to FILE ('-' for stdout)\n"
+    "  --keys auto|plain|gtsam   how pose ids name robots (default auto: detected)\n"
     "  --help        show this text\n"
     "\n"
     "exit status: 0 on success, 2 on bad input (the message names file, line and problem).\n";
 
-JsonObject info_json(const G2oReadResult& r, double load_s) {
+std::vector<JsonObject> robot_objects(const RobotSummary& robots) {
+  std::vector<JsonObject> out;
+  for (const auto& rc : robots.robots) {
+    JsonObject o;
+    o.add("name", rc.name)
+        .add("poses", rc.poses)
+        .add("odometry_edges", rc.odometry)
+        .add("intra_robot_closures", rc.intra_closures)
+        .add("inter_robot_closures", rc.inter_closures);
+    out.push_back(o);
+  }
+  return out;
+}
+
+JsonObject info_json(const G2oReadResult& r, const RobotSummary& robots, double load_s) {
   const auto& g = r.graph;
   const auto& s = r.stats;
   JsonObject j;
@@ -48,6 +67,12 @@ JsonObject info_json(const G2oReadResult& r, double load_s) {
       .add("blank_lines", s.blank_lines)
       .add("comment_lines", s.comment_lines)
       .add("max_quaternion_norm_error", s.max_quaternion_norm_error)
+      .add("format", s.format)
+      .add("keys", key_scheme_name(r.keys.scheme))
+      .add("robots", robot_objects(robots))
+      .add("odometry_edges", robots.odometry)
+      .add("intra_robot_closures", robots.intra_closures)
+      .add("inter_robot_closures", robots.inter_closures)
       .add("load_s", load_s);
   return j;
 }
@@ -55,7 +80,7 @@ JsonObject info_json(const G2oReadResult& r, double load_s) {
 }  // namespace
 
 int run_info(const Args& args) {
-  Arguments a(args, {"json"}, {"help"});
+  Arguments a(args, {"json", "keys"}, {"help"});
   if (a.has("help")) {
     std::fputs(kHelp, stdout);
     return 0;
@@ -66,6 +91,7 @@ int run_info(const Args& args) {
   G2oReadOptions options;
   options.allow_disconnected = true;
   const auto start = std::chrono::steady_clock::now();
+  options.keys = parse_keys_option(a.get_or("keys", "auto"));
   const G2oReadResult r = read_g2o_file(a.positional()[0], options);
   const double load_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -94,9 +120,23 @@ int run_info(const Args& args) {
   if (s.blank_lines + s.comment_lines + s.fix_lines > 0)
     std::printf("skipped lines:              %zu blank, %zu comment, %zu FIX\n", s.blank_lines,
                 s.comment_lines, s.fix_lines);
+  std::printf("format:                     %s, %s ids%s%s\n", s.format.c_str(),
+              key_scheme_name(r.keys.scheme), s.keys_detected.empty() ? "" : ": ",
+              s.keys_detected.c_str());
+  if (r.keys.fixed)
+    std::printf("fixed pose (FIX):           %llu\n",
+                static_cast<unsigned long long>(r.keys.id(*r.keys.fixed)));
+  const RobotSummary robots = summarize_robots(g, r.keys);
+  std::printf(
+      "robots:                     %zu  (loop closures: %zu intra-robot, %zu inter-robot; "
+      "%zu odometry)\n",
+      robots.robots.size(), robots.intra_closures, robots.inter_closures, robots.odometry);
+  for (const auto& rc : robots.robots)
+    std::printf("  robot %-4s %9zu poses, %zu odometry, loop closures: %zu intra / %zu inter\n",
+                rc.name.c_str(), rc.poses, rc.odometry, rc.intra_closures, rc.inter_closures);
   std::printf("load time:                  %.1f ms\n", load_s * 1e3);
 
-  if (auto path = a.get("json")) write_output(*path, info_json(r, load_s).str());
+  if (auto path = a.get("json")) write_output(*path, info_json(r, robots, load_s).str());
   return 0;
 }
 

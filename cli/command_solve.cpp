@@ -14,6 +14,7 @@
 
 #include "arguments.hpp"
 #include "commands.hpp"
+#include "graph_input.hpp"
 #include "json_writer.hpp"
 #include "solve_distributed.hpp"
 #include "solve_output.hpp"
@@ -24,7 +25,8 @@ namespace {
 const char* kHelp =
     "usage: tessera solve GRAPH --algorithm centralized|rbcd|rbcd++|irbcd [options]\n"
     "\n"
-    "Optimises the pose graph GRAPH (g2o) and prints a summary.\n"
+    "Optimises the pose graph GRAPH (g2o or TORO) and prints a summary. Written poses are in\n"
+    "the input's frame (the FIX pose, else the first pose, keeps its VERTEX value) and ids.\n"
     "\n"
     "  --algorithm centralized   certifiable centralized solver (SE-Sync family): chordal\n"
     "                            initialization, Riemannian trust region, Riemannian staircase\n"
@@ -65,7 +67,8 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
                               std::chrono::steady_clock::time_point start) {
   G2oReadOptions read;
   read.normalize_quaternions = !a.has("raw-quaternions");
-  const PoseGraph graph = read_g2o(graph_path, read);
+  const G2oReadResult input = read_graph_input(a, graph_path, read);
+  const PoseGraph& graph = input.graph;
   CentralizedOptions opt;
   opt.initialization = parse_init(a.get_or("init", "chordal"));
   opt.initial_rank = static_cast<int>(a.get_long("rank", opt.initial_rank));
@@ -82,8 +85,7 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
               r.certified ? (*r.certified ? "certified optimal" : "NOT certified")
                           : "not certified (skipped)",
               wall_s);
-  if (auto p = a.get("out")) write_poses(*p, graph, r.poses);
-  if (auto p = a.get("tum")) write_tum(r.poses, *p);
+  write_solution_files(a, graph, input.keys, r.poses);
   if (auto p = a.get("trace")) write_trace(*p, r);
   if (auto p = a.get("json")) {
     SolveSummary summary;
@@ -111,14 +113,15 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
 
 int run_solve(const Args& args) {
   const auto start = std::chrono::steady_clock::now();
-  std::set<std::string> valued = {"algorithm", "out",  "tum",      "json",    "trace",
-                                  "init",      "rank", "max-rank", "grad-tol"};
+  std::set<std::string> valued = {"algorithm", "out",  "tum",      "json",     "trace",
+                                  "init",      "rank", "max-rank", "grad-tol", "tum-dir"};
+  for (const char* const* o = kGraphInputOptions; *o; ++o) valued.insert(*o);
   std::set<std::string> switches = {"help", "no-certify", "raw-quaternions"};
   for (const char* const* o = kDistributedValued; *o; ++o) valued.insert(*o);
   for (const char* const* o = kDistributedSwitches; *o; ++o) switches.insert(*o);
   Arguments a(args, valued, switches);
   if (a.has("help")) {
-    std::printf("%s%s", kHelp, kDistributedHelp);
+    std::printf("%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp);
     return 0;
   }
   if (a.positional().size() != 1)

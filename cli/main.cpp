@@ -22,6 +22,8 @@ const Command kCommands[] = {
     {"solve", tessera::cli::run_solve, "optimise a pose graph (centralized or distributed)"},
     {"partition", tessera::cli::run_partition, "split a graph into balanced blocks"},
     {"launch", tessera::cli::run_launch, "run a distributed solve as DDS processes on this host"},
+    {"eval", tessera::cli::run_eval, "accuracy of an estimate against ground truth (ATE, RPE)"},
+    {"plot", tessera::cli::run_plot, "draw trajectories and loop closures into a PNG"},
 };
 
 void print_usage() {

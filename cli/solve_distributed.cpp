@@ -7,10 +7,12 @@
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/io/tum_writer.hpp>
 #include <tessera/partition/partitioner.hpp>
+#include <tessera/partition/robot_partition.hpp>
 #include <tessera/partition/sequential_partition.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "graph_input.hpp"
 #include "json_writer.hpp"
 #include "solve_output.hpp"
 
@@ -228,7 +230,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
 
   G2oReadOptions read;
   read.normalize_quaternions = !a.has("raw-quaternions");
-  const PoseGraph graph = read_g2o(graph_path, read);
+  const G2oReadResult input = read_graph_input(a, graph_path, read);
+  const PoseGraph& graph = input.graph;
   const double load_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (static_cast<std::size_t>(agents) > graph.num_poses)
@@ -238,7 +241,13 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   popt.parts = static_cast<int>(agents);
   popt.preset = parse_preset(a.get_or("partition", "highest"));
   popt.seed = opt.seed;
-  const PartitionResult part = partition_graph(graph_structure_from_pose_graph(graph), popt);
+  PartitionResult part = partition_graph(graph_structure_from_pose_graph(graph), popt);
+  if (popt.preset == PartitionPreset::kSequential)  // a multi-robot file: each robot its poses
+    if (auto by_robot = robot_partition(input.keys, graph.num_poses, popt.parts)) {
+      part.assignment = std::move(*by_robot);
+      part.metrics = compute_partition_metrics(graph_structure_from_pose_graph(graph),
+                                               part.assignment, popt.parts);
+    }
   const DistributedResult r = solve_distributed(graph, part.assignment, opt);
 
   std::optional<double> fstar;
@@ -273,8 +282,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         r.certificate_tolerance, r.certificate_residual, r.certificate_rounds,
         r.certificate_bytes / 1e6, r.escape_rounds, r.escape_bytes / 1e6, r.final_rank);
   }
-  if (auto p = a.get("out")) write_poses(*p, graph, r.poses);
-  if (auto p = a.get("tum")) write_tum(r.poses, *p);
+  write_solution_files(a, graph, input.keys, r.poses);
   if (auto p = a.get("trace")) write_trace(*p, r);
   if (auto p = a.get("json")) {
     SolveSummary summary;

@@ -8,15 +8,27 @@
 #include <string>
 #include <tessera/graph/pose.hpp>
 #include <tessera/graph/pose_graph.hpp>
+#include <tessera/graph/pose_keys.hpp>
 #include <vector>
 
+#include "arguments.hpp"
 #include "json_writer.hpp"
 
 namespace tessera::cli {
 
 /// Writes `poses` to `path`: TUM text when the name ends in ".tum", otherwise a g2o file
-/// with the vertices and `graph`'s edges. Throws InputError naming the path if it cannot.
-void write_poses(const std::string& path, const PoseGraph& graph, const std::vector<Pose>& poses);
+/// with the vertices and `graph`'s edges (with the ids of `keys`). Throws InputError naming
+/// the path if it cannot.
+void write_poses(const std::string& path, const PoseGraph& graph, const std::vector<Pose>& poses,
+                 const PoseKeys& keys = {});
+
+/// Help lines for --out, --tum and --tum-dir.
+extern const char* const kSolutionOutputHelp;
+
+/// Moves `poses` into the input's frame (graph/input_frame.hpp) and writes the files that
+/// options --out, --tum and --tum-dir of `a` ask for, with the input's ids and stamps.
+void write_solution_files(const Arguments& a, const PoseGraph& graph, const PoseKeys& keys,
+                          std::vector<Pose> poses);
 
 /// The result fields every solver reports.
 struct SolveSummary {

@@ -4,6 +4,7 @@
 #include <exception>
 #include <mutex>
 #include <tessera/io/g2o_reader.hpp>
+#include <tessera/partition/robot_partition.hpp>
 #include <thread>
 #include <utility>
 
@@ -19,8 +20,12 @@ std::optional<FilePartition> partition_graph_file(const std::string& path, std::
   try {
     FilePartition fp;
     std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    std::optional<std::vector<int>> by_robot;
     {
-      const PoseGraph graph = read_g2o(path);  // values dropped at the end of this scope
+      const G2oReadResult read = read_g2o_file(path);  // values dropped at the end of this scope
+      const PoseGraph& graph = read.graph;
+      if (preset == "sequential")
+        by_robot = robot_partition(read.keys, graph.num_poses, static_cast<int>(num_agents));
       fp.num_poses = graph.num_poses;
       pairs.reserve(graph.measurements.size());
       fp.edge_i.reserve(graph.measurements.size());
@@ -34,6 +39,12 @@ std::optional<FilePartition> partition_graph_file(const std::string& path, std::
     // The same call, on the same structure, as the partition of the announcements.
     const GraphStructure structure = make_graph_structure(fp.num_poses, pairs, path);
     fp.part = partition_for_agents(structure, num_agents, preset, seed);
+    if (by_robot) {  // a multi-robot file's sequential baseline: each robot keeps its poses
+      fp.part.owner.assign(by_robot->begin(), by_robot->end());
+      fp.part.cut_edges = 0;
+      for (std::size_t e = 0; e < fp.edge_i.size(); ++e)
+        fp.part.cut_edges += fp.part.owner[fp.edge_i[e]] != fp.part.owner[fp.edge_j[e]];
+    }
     fp.part.early = true;
     return fp;
   } catch (const std::exception& e) {

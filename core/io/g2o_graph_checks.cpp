@@ -1,6 +1,7 @@
 #include "io/g2o_graph_checks.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/util/input_error.hpp>
 #include <utility>
@@ -10,11 +11,14 @@ namespace {
 
 class GraphChecks {
  public:
-  GraphChecks(const std::string& name, bool allow_disconnected, std::size_t lines,
+  GraphChecks(const std::string& name, const G2oReadOptions& options, std::size_t lines,
               const std::vector<std::uint32_t>& edge_lines,
-              std::vector<G2oLooseVertex>& loose_vertices, G2oReadResult& result)
+              std::vector<G2oLooseVertex>& loose_vertices, const std::vector<G2oLooseVertex>& fixes,
+              G2oReadResult& result)
       : name_(name),
-        allow_disconnected_(allow_disconnected),
+        options_(options),
+        allow_disconnected_(options.allow_disconnected),
+        fixes_(fixes),
         lines_(lines),
         edge_lines_(edge_lines),
         loose_(loose_vertices),
@@ -39,6 +43,7 @@ class GraphChecks {
       n = check_edge_ids();
     }
     g.num_poses = static_cast<std::size_t>(n);
+    assign_keys();
     count_pairs();
     const auto labels = connected_components(g);
     std::size_t k = 0, outside = 0;
@@ -49,8 +54,9 @@ class GraphChecks {
     stats().components = k;
     if (k > 1 && !allow_disconnected_)
       fail(0, "the graph is disconnected: " + std::to_string(k) +
-                  " connected components (no chain of edges links pose " + std::to_string(outside) +
-                  " to pose 0)");
+                  " connected components (no chain of edges links pose " +
+                  std::to_string(result_.keys.id(outside)) + " to pose " +
+                  std::to_string(result_.keys.id(0)) + ")");
   }
 
  private:
@@ -59,8 +65,8 @@ class GraphChecks {
                                 " (the file has VERTEX lines, but none for this id)");
   }
 
-  // Vertices in any order: ids unique, every edge endpoint a vertex, ids exactly 0..n-1;
-  // then their poses go to graph.initial by id.
+  // Vertices in any order: ids unique, every edge endpoint a vertex; then their poses go to
+  // graph.initial by id (ids 0..n-1) or by rank among the ids (any other ids).
   std::uint64_t check_loose_vertices() {
     std::vector<std::pair<std::uint64_t, std::uint32_t>> ids;  // (id, line)
     ids.reserve(loose_.size());
@@ -89,46 +95,88 @@ class GraphChecks {
     for (std::size_t e = 0; e < ms.size(); ++e)
       for (std::size_t id : {ms[e].i, ms[e].j})
         if (!has_vertex(id)) fail_missing_pose(e, id);
-    if (!dense) {
-      std::uint64_t missing = 0;
-      while (missing < ids.size() && ids[missing].first == missing) ++missing;
-      fail(0, "pose id " + std::to_string(missing) + " appears on no line, but ids must be 0.." +
-                  std::to_string(n - 1) + " (largest VERTEX id " + std::to_string(n - 1) +
-                  " on line " + std::to_string(ids.back().second) + ")");
-    }
     auto& initial = result_.graph.initial;
-    initial.resize(static_cast<std::size_t>(n));
-    for (auto& v : loose_) initial[v.id] = std::move(v.pose);
-    return n;
+    initial.resize(ids.size());
+    if (dense) {
+      for (auto& v : loose_) initial[v.id] = std::move(v.pose);
+      return n;
+    }
+    auto& keys = result_.keys.ids;
+    keys.resize(ids.size());
+    for (std::size_t k = 0; k < ids.size(); ++k) keys[k] = ids[k].first;
+    for (auto& v : loose_) initial[dense_index(v.id)] = std::move(v.pose);
+    renumber_edges();
+    return ids.size();
   }
 
-  // Without VERTEX lines: n = 1 + the largest edge id and every id 0..n-1 must be used.
+  // Dense number of a file id that is in keys.ids.
+  std::size_t dense_index(std::uint64_t id) const {
+    const auto& keys = result_.keys.ids;
+    return static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), id) - keys.begin());
+  }
+
+  // Edge endpoints from file ids to dense numbers (keys.ids holds every id).
+  void renumber_edges() {
+    for (auto& m : result_.graph.measurements) {
+      m.i = dense_index(m.i);
+      m.j = dense_index(m.j);
+    }
+  }
+
+  // Robots from the ids (options.keys, or detected), and the fixed pose.
+  void assign_keys() {
+    auto& g = result_.graph;
+    PoseKeys& keys = result_.keys;
+    const KeyScheme scheme = options_.keys == KeyScheme::kPlain
+                                 ? KeyScheme::kPlain
+                                 : detect_key_scheme(keys, g.num_poses);
+    assign_robots(keys, g.num_poses, scheme);
+    if (scheme != KeyScheme::kPlain) {
+      std::string names;
+      for (const auto& r : keys.robot_names) names += (names.empty() ? "" : ", ") + r;
+      stats().keys_detected =
+          std::string(scheme == KeyScheme::kGtsam
+                          ? "gtsam keys (robot = character in bits 56-63, index = bits 0-55)"
+                          : "gtsam labeled keys (robot = label in bits 48-55, index = bits 0-47)") +
+          ": " + std::to_string(keys.num_robots()) + " robots " + names;
+    } else if (!keys.ids.empty()) {
+      stats().keys_detected = "plain ids (one robot), not 0..n-1: " + std::to_string(g.num_poses) +
+                              " ids from " + std::to_string(keys.ids.front()) + " to " +
+                              std::to_string(keys.ids.back());
+    }
+    if (fixes_.empty()) return;
+    const std::uint64_t id = fixes_.front().id;
+    std::optional<std::size_t> k = keys.find(id);
+    if (keys.ids.empty() && id < g.num_poses) k = static_cast<std::size_t>(id);
+    if (!k)
+      fail(fixes_.front().line,
+           "FIX names pose " + std::to_string(id) + ", which no VERTEX or EDGE line has");
+    keys.fixed = *k;
+  }
+
+  // Without VERTEX lines: the poses are the edge endpoints.
   std::uint64_t check_edge_ids() {
     const auto& ms = result_.graph.measurements;
     std::uint64_t max_id = 0;
-    std::size_t max_line = 0;
-    for (std::size_t e = 0; e < ms.size(); ++e) {
-      const std::uint64_t m = std::max(ms[e].i, ms[e].j);
-      if (m > max_id || max_line == 0) {
-        max_id = m;
-        max_line = edge_lines_[e];
-      }
+    for (const auto& m : ms) max_id = std::max<std::uint64_t>(max_id, std::max(m.i, m.j));
+    // 2E endpoints cannot cover more than 2E ids: only then can they be exactly 0..max_id,
+    // checked on a bitmap without allocating for a huge id.
+    if (max_id < 2 * ms.size()) {
+      std::vector<char> seen(max_id + 1, 0);
+      for (const auto& m : ms) seen[m.i] = seen[m.j] = 1;
+      if (std::find(seen.begin(), seen.end(), 0) == seen.end()) return max_id + 1;
     }
-    const std::uint64_t n = max_id + 1;
-    // 2E endpoints cannot cover more than 2E ids, so a bitmap of 2E + 1 entries always finds
-    // the smallest unused id without allocating for a huge bogus id.
-    const std::uint64_t limit = std::min<std::uint64_t>(n, 2 * ms.size() + 1);
-    std::vector<char> seen(limit, 0);
+    auto& keys = result_.keys.ids;
+    keys.reserve(2 * ms.size());
     for (const auto& m : ms) {
-      if (m.i < limit) seen[m.i] = 1;
-      if (m.j < limit) seen[m.j] = 1;
+      keys.push_back(m.i);
+      keys.push_back(m.j);
     }
-    for (std::uint64_t id = 0; id < limit; ++id)
-      if (!seen[id])
-        fail(0, "pose id " + std::to_string(id) + " appears on no line, but ids must be 0.." +
-                    std::to_string(max_id) + " (largest id " + std::to_string(max_id) +
-                    " on line " + std::to_string(max_line) + ")");
-    return n;
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    keys.shrink_to_fit();
+    renumber_edges();
+    return keys.size();
   }
 
   void count_pairs() {
@@ -153,7 +201,9 @@ class GraphChecks {
   }
 
   const std::string& name_;
+  const G2oReadOptions& options_;
   const bool allow_disconnected_;
+  const std::vector<G2oLooseVertex>& fixes_;
   const std::size_t lines_;
   const std::vector<std::uint32_t>& edge_lines_;
   std::vector<G2oLooseVertex>& loose_;
@@ -162,10 +212,11 @@ class GraphChecks {
 
 }  // namespace
 
-void check_g2o_graph(const std::string& name, bool allow_disconnected, std::size_t lines,
+void check_g2o_graph(const std::string& name, const G2oReadOptions& options, std::size_t lines,
                      const std::vector<std::uint32_t>& edge_lines,
-                     std::vector<G2oLooseVertex>& loose_vertices, G2oReadResult& result) {
-  GraphChecks(name, allow_disconnected, lines, edge_lines, loose_vertices, result).run();
+                     std::vector<G2oLooseVertex>& loose_vertices,
+                     const std::vector<G2oLooseVertex>& fixes, G2oReadResult& result) {
+  GraphChecks(name, options, lines, edge_lines, loose_vertices, fixes, result).run();
 }
 
 }  // namespace tessera

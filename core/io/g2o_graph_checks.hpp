@@ -20,15 +20,19 @@ struct G2oLooseVertex {
 };
 
 /// Completes `result` after the last of `lines` lines of the file `name` was parsed into
-/// result.graph.measurements (edge e read on line edge_lines[e]) and either graph.initial
-/// (vertices in id order) or `loose_vertices` (any order; moved into graph.initial by id).
-/// Sets graph.num_poses = 1 + the largest pose id and stats.backward_edges, distinct_pairs,
-/// parallel_edges and components. Throws InputError(name, line, what) when the file has no
-/// edges, a VERTEX id repeats, an edge names a pose without a VERTEX line (when there are
-/// VERTEX lines), an id in 0..n-1 appears on no line, or the graph is disconnected and
-/// `allow_disconnected` is false; `line` is the offending line, or 0 for the file as a whole.
-void check_g2o_graph(const std::string& name, bool allow_disconnected, std::size_t lines,
+/// result.graph.measurements (edge e read on line edge_lines[e], endpoints as the file's ids)
+/// and either graph.initial (vertices in id order 0, 1, ...) or `loose_vertices` (any ids,
+/// any order). Numbers the poses 0..n-1 (ids 0..n-1 stay as they are; any other ids in
+/// increasing order, kept in result.keys.ids), assigns robots by options.keys (detected
+/// when unset; stats.keys_detected says what was found), maps the first of `fixes` (a
+/// FIX id and its line) to result.keys.fixed, and sets stats.backward_edges,
+/// distinct_pairs, parallel_edges and components. Throws InputError(name, line, what) when
+/// the file has no edges, a VERTEX id repeats, an edge names a pose without a VERTEX line
+/// (when there are VERTEX lines), a FIX id names no pose, or the graph is disconnected and
+/// options.allow_disconnected is false; `line` is the offending line, or 0 for the file.
+void check_g2o_graph(const std::string& name, const G2oReadOptions& options, std::size_t lines,
                      const std::vector<std::uint32_t>& edge_lines,
-                     std::vector<G2oLooseVertex>& loose_vertices, G2oReadResult& result);
+                     std::vector<G2oLooseVertex>& loose_vertices,
+                     const std::vector<G2oLooseVertex>& fixes, G2oReadResult& result);
 
 }  // namespace tessera

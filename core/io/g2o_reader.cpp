@@ -17,14 +17,13 @@
 #include "io/g2o_graph_checks.hpp"
 #include "io/number_token.hpp"
 #include "io/rotation_text.hpp"
+#include "io/toro_records.hpp"
 
 namespace tessera {
 namespace {
 
 // The longest record (EDGE_SE3:QUAT) has 31 tokens; longer lines are only counted.
 constexpr std::size_t kMaxTokens = 32;
-// Ids are bounded so that pairs pack into 64 bits and n stays an int-sized count.
-constexpr std::uint64_t kMaxPoseId = 2147483646;
 // Quaternions shorter than this cannot be turned into a rotation meaningfully.
 constexpr double kMinQuaternionNorm = 1e-6;
 // Larger inputs are refused rather than read forever (e.g. /dev/zero); the biggest public
@@ -37,17 +36,23 @@ struct RecordSpec {
   bool edge;
   std::size_t values;  // tokens after the tag
   const char* layout;
+  bool toro;  // TORO dialect (toro_records.hpp converts its values)
 };
 
 const RecordSpec kSpecs[] = {
-    {"VERTEX_SE2", 2, false, 4, "id x y theta"},
-    {"EDGE_SE2", 2, true, 11, "i j dx dy dtheta and 6 information values"},
-    {"VERTEX_SE3:QUAT", 3, false, 8, "id x y z qx qy qz qw"},
-    {"EDGE_SE3:QUAT", 3, true, 30, "i j x y z qx qy qz qw and 21 information values"},
+    {"VERTEX_SE2", 2, false, 4, "id x y theta", false},
+    {"EDGE_SE2", 2, true, 11, "i j dx dy dtheta and 6 information values", false},
+    {"VERTEX_SE3:QUAT", 3, false, 8, "id x y z qx qy qz qw", false},
+    {"EDGE_SE3:QUAT", 3, true, 30, "i j x y z qx qy qz qw and 21 information values", false},
+    {"VERTEX2", 2, false, 4, "id x y theta", true},
+    {"EDGE2", 2, true, 11, "i j dx dy dtheta Ixx Ixy Iyy Itt Ixt Iyt", true},
+    {"VERTEX3", 3, false, 7, "id x y z roll pitch yaw", true},
+    {"EDGE3", 3, true, 29, "i j x y z roll pitch yaw and 21 information values", true},
 };
 
 // Name of value k (0-based, after the tag) of a record, for error messages.
 std::string field_name(const RecordSpec& spec, std::size_t k) {
+  if (spec.toro) return "value " + std::to_string(k + 1);
   static const char* const kVertex2[] = {"id", "x", "y", "theta"};
   static const char* const kVertex3[] = {"id", "x", "y", "z", "qx", "qy", "qz", "qw"};
   static const char* const kEdge2[] = {"i", "j", "dx", "dy", "dtheta"};
@@ -114,7 +119,8 @@ class Parser {
 
   G2oReadResult finish() {
     stats().lines = line_;
-    check_g2o_graph(name_, options_.allow_disconnected, line_, edge_lines_, loose_, result_);
+    stats().format = toro_ ? "toro" : "g2o";
+    check_g2o_graph(name_, options_, line_, edge_lines_, loose_, fixes_, result_);
     return std::move(result_);
   }
 
@@ -145,9 +151,12 @@ class Parser {
       return;
     }
     if (tag == "FIX") {
-      // Fixing a pose only chooses the gauge, which the solvers choose themselves.
+      // The first fixed pose chooses the gauge of the output (g2o_graph_checks.cpp).
       if (count_ < 2) fail(line_, "FIX needs at least one pose id");
-      for (std::size_t k = 1; k < count_ && k < kMaxTokens; ++k) parse_id(tok_[k], "FIX pose id");
+      for (std::size_t k = 1; k < count_ && k < kMaxTokens; ++k) {
+        const std::uint64_t id = parse_id(tok_[k], "FIX pose id");
+        if (fixes_.empty()) fixes_.push_back({id, static_cast<std::uint32_t>(line_), Pose{}});
+      }
       if (count_ > kMaxTokens) fail(line_, "FIX line has too many fields");
       ++stats().fix_lines;
       return;
@@ -157,17 +166,22 @@ class Parser {
       if (tag == s.tag) spec = &s;
     if (!spec)
       fail(line_, "unknown tag " + quoted_token(tag) +
-                      " (expected VERTEX_SE2, EDGE_SE2, VERTEX_SE3:QUAT, EDGE_SE3:QUAT or FIX)");
+                      " (not a g2o file: VERTEX_SE2, EDGE_SE2, VERTEX_SE3:QUAT, EDGE_SE3:QUAT, "
+                      "FIX; nor a TORO file: VERTEX2, EDGE2, VERTEX3, EDGE3)");
     if (count_ - 1 != spec->values)
       fail(line_, std::string(spec->tag) + " needs " + std::to_string(spec->values) + " values (" +
                       spec->layout + "), found " + std::to_string(count_ - 1));
     if (d_ == 0) {
+      toro_ = spec->toro;
       d_ = spec->d;
       d_line_ = line_;
       d_tag_ = spec->tag;
       result_.graph.d = d_;
     } else if (d_ != spec->d) {
       fail(line_, "mixed 2D and 3D records: " + std::string(spec->tag) + " here, but line " +
+                      std::to_string(d_line_) + " has " + d_tag_);
+    } else if (toro_ != spec->toro) {
+      fail(line_, "mixed g2o and TORO records: " + std::string(spec->tag) + " here, but line " +
                       std::to_string(d_line_) + " has " + d_tag_);
     }
     if (spec->edge)
@@ -185,9 +199,12 @@ class Parser {
     auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), id);
     if (ptr != s.data() + s.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
       fail(line_, role + " " + quoted_token(s) + " is not a non-negative integer");
-    if (ec == std::errc::result_out_of_range || id > kMaxPoseId)
-      fail(line_, role + " " + quoted_token(s) + " is too large (at most " +
-                      std::to_string(kMaxPoseId) + ")");
+    if (ec == std::errc::result_out_of_range)
+      fail(line_, role + " " + quoted_token(s) + " is too large (at most 2^64 - 1)");
+    if (options_.keys == KeyScheme::kGtsam && !is_gtsam_key(id))
+      fail(line_, role + " " + quoted_token(s) +
+                      " is not a GTSAM key (--keys gtsam): its top byte " +
+                      std::to_string(id >> 56) + " is not a robot letter A-Z or a-z");
     return id;
   }
 
@@ -221,7 +238,11 @@ class Parser {
     const std::uint64_t id = parse_id(tok_[1], "pose id");
     parse_values(spec, 1);
     Pose pose;
-    if (spec.d == 2) {
+    if (spec.toro && spec.d == 3) {
+      pose.R = rotation_from_roll_pitch_yaw(vals_[4], vals_[5], vals_[6]);
+      pose.t.resize(3);
+      pose.t << vals_[1], vals_[2], vals_[3];
+    } else if (spec.d == 2) {
       pose.R = planar_rotation(vals_[3]);
       pose.t.resize(2);
       pose.t << vals_[1], vals_[2];
@@ -260,7 +281,23 @@ class Parser {
     m.j = static_cast<std::size_t>(j);
     const double* info;
     IsotropicWeights w;
-    if (spec.d == 2) {
+    if (spec.toro) {
+      if (spec.d == 2) {
+        m.R = planar_rotation(vals_[4]);
+        m.t.resize(2);
+        m.t << vals_[2], vals_[3];
+        toro_information_2d(&vals_[5], info_.data());
+        info = info_.data();
+        w = isotropic_weights_2d(info);
+      } else {
+        m.R = rotation_from_roll_pitch_yaw(vals_[5], vals_[6], vals_[7]);
+        m.t.resize(3);
+        m.t << vals_[2], vals_[3], vals_[4];
+        toro_information_3d(&vals_[8], info_.data());
+        info = info_.data();
+        w = isotropic_weights_3d(info);
+      }
+    } else if (spec.d == 2) {
       m.R = planar_rotation(vals_[4]);
       m.t.resize(2);
       m.t << vals_[2], vals_[3];
@@ -306,7 +343,10 @@ class Parser {
   std::array<std::string_view, kMaxTokens> tok_{};
   std::size_t count_ = 0;
   std::array<double, 30> vals_{};
+  std::array<double, 21> info_{};  // a TORO information matrix in g2o's order
   int d_ = 0;
+  bool toro_ = false;
+  std::vector<G2oLooseVertex> fixes_;  // the first FIX id (pose unused) and its line
   std::size_t d_line_ = 0;
   std::string d_tag_;
   std::vector<std::uint32_t> vertex_lines_;  // line of graph.initial[k] while in order

@@ -28,10 +28,12 @@ void append_pose_fields(std::string& out, const Eigen::MatrixXd& R, const Eigen:
   }
 }
 
-void check_writable(const PoseGraph& graph, const std::vector<Pose>& poses,
+void check_writable(const PoseGraph& graph, const PoseKeys& keys, const std::vector<Pose>& poses,
                     const std::string& path) {
   if (graph.d != 2 && graph.d != 3)
     throw InputError(path, 0, "cannot write a graph of dimension " + std::to_string(graph.d));
+  if (!keys.ids.empty() && keys.ids.size() != graph.num_poses)
+    throw InputError(path, 0, "the graph's id list does not have one id per pose");
   if (!poses.empty() && poses.size() != graph.num_poses)
     throw InputError(path, 0,
                      std::to_string(poses.size()) + " vertex poses given for a graph of " +
@@ -47,7 +49,12 @@ void check_writable(const PoseGraph& graph, const std::vector<Pose>& poses,
 }  // namespace
 
 void write_g2o(const PoseGraph& graph, const std::vector<Pose>& poses, const std::string& path) {
-  check_writable(graph, poses, path);
+  write_g2o(graph, PoseKeys{}, poses, path);
+}
+
+void write_g2o(const PoseGraph& graph, const PoseKeys& keys, const std::vector<Pose>& poses,
+               const std::string& path) {
+  check_writable(graph, keys, poses, path);
   const bool planar = graph.d == 2;
   const char* vertex_tag = planar ? "VERTEX_SE2 " : "VERTEX_SE3:QUAT ";
   const char* edge_tag = planar ? "EDGE_SE2 " : "EDGE_SE3:QUAT ";
@@ -57,21 +64,26 @@ void write_g2o(const PoseGraph& graph, const std::vector<Pose>& poses, const std
   std::string& out = file.buffer();
   for (std::size_t id = 0; id < poses.size(); ++id) {
     out += vertex_tag;
-    append_integer(out, id);
+    append_integer(out, keys.id(id));
     append_pose_fields(out, poses[id].R, poses[id].t);
     out += '\n';
     file.maybe_flush();
   }
   for (const auto& m : graph.measurements) {
     out += edge_tag;
-    append_integer(out, m.i);
+    append_integer(out, keys.id(m.i));
     out += ' ';
-    append_integer(out, m.j);
+    append_integer(out, keys.id(m.j));
     append_pose_fields(out, m.R, m.t);
     auto info = information_from_weights(graph.d, m.kappa, m.tau);
     append_numbers(out, info.data(), info_size);
     out += '\n';
     file.maybe_flush();
+  }
+  if (keys.fixed && !poses.empty()) {
+    out += "FIX ";
+    append_integer(out, keys.id(*keys.fixed));
+    out += '\n';
   }
   file.close();
 }

@@ -8,6 +8,11 @@
 namespace tessera {
 
 void write_tum(const std::vector<Pose>& poses, const std::string& path) {
+  write_tum(poses, PoseKeys{}, path);
+}
+
+void write_tum(const std::vector<Pose>& poses, const PoseKeys& keys, const std::string& path) {
+  const bool stamped = keys.stamps.size() == poses.size() && !poses.empty();
   for (const auto& p : poses)
     if ((p.dim() != 2 && p.dim() != 3) || p.R.rows() != p.dim() || p.R.cols() != p.dim())
       throw InputError(path, 0, "cannot write a pose of dimension " + std::to_string(p.dim()));
@@ -16,7 +21,10 @@ void write_tum(const std::vector<Pose>& poses, const std::string& path) {
   std::string& out = file.buffer();
   for (std::size_t k = 0; k < poses.size(); ++k) {
     const Pose& p = poses[k];
-    append_integer(out, k);
+    if (stamped)
+      append_number(out, keys.stamps[k]);
+    else
+      append_integer(out, keys.id(k));
     for (int c = 0; c < 3; ++c) {
       out += ' ';
       append_number(out, c < p.dim() ? p.t(c) : 0.0);

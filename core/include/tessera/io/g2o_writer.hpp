@@ -4,6 +4,7 @@
 #include <string>
 #include <tessera/graph/pose.hpp>
 #include <tessera/graph/pose_graph.hpp>
+#include <tessera/graph/pose_keys.hpp>
 #include <vector>
 
 namespace tessera {
@@ -19,6 +20,11 @@ namespace tessera {
 /// Throws InputError naming `path` when the file cannot be written, and when `poses` is
 /// neither empty nor of size graph.num_poses, or the graph's dimension is not 2 or 3.
 void write_g2o(const PoseGraph& graph, const std::vector<Pose>& poses, const std::string& path);
+
+/// Same, with the file's ids keys.id(k) instead of 0..n-1 (keys.ids empty or one per pose),
+/// and a last line "FIX id" when keys.fixed is set and there are VERTEX lines.
+void write_g2o(const PoseGraph& graph, const PoseKeys& keys, const std::vector<Pose>& poses,
+               const std::string& path);
 
 /// Same, with the VERTEX lines taken from graph.initial (none when it is empty).
 void write_g2o(const PoseGraph& graph, const std::string& path);

@@ -3,6 +3,7 @@
 
 #include <string>
 #include <tessera/graph/pose.hpp>
+#include <tessera/graph/pose_keys.hpp>
 #include <vector>
 
 namespace tessera {
@@ -12,5 +13,9 @@ namespace tessera {
 /// about z. Numbers are in shortest round-trip form. Throws InputError naming `path` when
 /// the file cannot be written or a pose is not 2D or 3D.
 void write_tum(const std::vector<Pose>& poses, const std::string& path);
+
+/// Same, with the input's names as timestamps: the pose's stamp when keys.stamps has one per
+/// pose, else its id keys.id(k) (an integer, so GTSAM keys stay exact).
+void write_tum(const std::vector<Pose>& poses, const PoseKeys& keys, const std::string& path);
 
 }  // namespace tessera

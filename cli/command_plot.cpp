@@ -1,0 +1,160 @@
+// `tessera plot GRAPH_OR_SOLUTION --out fig.png`: the trajectories seen from above (and in 3D
+// for 3D graphs), coloured by robot or by block, with the loop closures. The figure is drawn
+// by scripts/plot_trajectories.py (matplotlib) from a JSON file this command writes.
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <tessera/eval/trajectory_error.hpp>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/io/trajectory_reader.hpp>
+#include <tessera/util/input_error.hpp>
+
+#include "arguments.hpp"
+#include "commands.hpp"
+#include "graph_input.hpp"
+#include "json_writer.hpp"
+#include "plot_figure.hpp"
+
+namespace tessera::cli {
+namespace {
+
+const char* const kHelp =
+    "usage: tessera plot GRAPH_OR_SOLUTION --out fig.png [options]\n"
+    "\n"
+    "Draws the poses of a graph file with VERTEX lines (g2o or TORO: an input, or the\n"
+    "output of tessera solve --out) or of a trajectory (TUM file, folder of per-robot TUM\n"
+    "files) seen from above, and for 3D graphs also in 3D: one colour per robot (or per\n"
+    "block with --partition), odometry as lines, loop closures as thin lines (inter-robot\n"
+    "ones and measurements cut by the partition highlighted, rejected ones in red), the\n"
+    "ground truth in grey beside it (aligned onto the estimate). Needs python3-matplotlib.\n"
+    "\n"
+    "  --out FILE.png          where to write the figure (required)\n"
+    "  --partition FILE        block of every pose: one block id per line (tessera\n"
+    "                          partition --out) or a JSON object with an \"assignment\" array\n"
+    "  --truth FILE            ground truth to draw beside (as tessera eval reads it)\n"
+    "  --rejected FILE         measurements rejected as outliers: lines 'i j' (input ids)\n"
+    "  --title TEXT            figure title (default: the file name)\n"
+    "  --keys auto|plain|gtsam how ids name robots                                [auto]\n"
+    "  --help                  this text\n";
+
+// Block of every pose: "b0\nb1\n..." or JSON {..., "assignment": [b0, b1, ...]}.
+std::vector<int> read_partition(const std::string& path, std::size_t n) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, 0, "cannot open the partition file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  const auto key = text.find("\"assignment\"");
+  if (key != std::string::npos) {
+    const auto open = text.find('[', key), close = text.find(']', key);
+    if (open == std::string::npos || close == std::string::npos)
+      throw InputError(path, 0, "\"assignment\" is not an array");
+    text = text.substr(open + 1, close - open - 1);
+    for (char& c : text)
+      if (c == ',') c = '\n';
+  }
+  std::vector<int> blocks;
+  std::istringstream lines(text);
+  std::string line;
+  std::size_t number = 0;
+  while (std::getline(lines, line)) {
+    ++number;
+    std::istringstream ls(line);
+    std::string tok;
+    if (!(ls >> tok) || tok[0] == '#') continue;
+    char* end = nullptr;
+    const long b = std::strtol(tok.c_str(), &end, 10);
+    if (*end != '\0' || b < 0)
+      throw InputError(path, key == std::string::npos ? number : 0,
+                       "block '" + tok + "' is not a non-negative integer");
+    blocks.push_back(static_cast<int>(b));
+  }
+  if (blocks.size() != n)
+    throw InputError(
+        path, 0,
+        std::to_string(blocks.size()) + " blocks for a graph of " + std::to_string(n) + " poses");
+  return blocks;
+}
+
+// Pairs of input ids, one "i j" per line.
+std::set<std::pair<std::uint64_t, std::uint64_t>> read_rejected(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, 0, "cannot open the rejected-measurements file");
+  std::set<std::pair<std::uint64_t, std::uint64_t>> out;
+  std::string line;
+  std::size_t number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    std::istringstream ls(line);
+    std::string a, b;
+    if (!(ls >> a) || a[0] == '#') continue;
+    unsigned long long i = 0, j = 0;
+    if (!(ls >> b) || std::sscanf(a.c_str(), "%llu", &i) != 1 ||
+        std::sscanf(b.c_str(), "%llu", &j) != 1)
+      throw InputError(path, number, "expected two pose ids 'i j'");
+    out.insert({std::min(i, j), std::max(i, j)});
+  }
+  return out;
+}
+
+}  // namespace
+
+int run_plot(const Args& args) {
+  const Arguments a(args, {"out", "partition", "truth", "rejected", "title", "keys", "stamps"},
+                    {"help"});
+  if (a.has("help")) {
+    std::fputs(kHelp, stdout);
+    return 0;
+  }
+  if (a.positional().size() != 1)
+    throw InputError("expected one GRAPH_OR_SOLUTION (see tessera plot --help)");
+  const auto out = a.get("out");
+  if (!out) throw InputError("option --out FILE.png is required (see tessera plot --help)");
+  const std::string input = a.positional()[0];
+
+  PlotFigure fig;
+  fig.title = a.get_or("title", std::filesystem::path(input).filename().string());
+  TrajectoryReadOptions read;
+  read.keys = parse_keys_option(a.get_or("keys", "auto"));
+  const Trajectory probe = read_trajectory(input, read);  // any of the accepted inputs
+  std::optional<G2oReadResult> graph;
+  if (!std::filesystem::is_directory(input)) {
+    try {
+      G2oReadOptions g;
+      g.keys = read.keys;
+      g.allow_disconnected = true;
+      graph = read_g2o_file(input, g);
+    } catch (const InputError&) {
+      // Not a graph: a TUM trajectory (probe read it), drawn without measurements.
+    }
+  }
+  if (graph) {
+    std::vector<int> blocks;
+    if (auto p = a.get("partition")) blocks = read_partition(*p, graph->graph.num_poses);
+    std::set<std::pair<std::uint64_t, std::uint64_t>> rejected;
+    if (auto p = a.get("rejected")) rejected = read_rejected(*p);
+    fig = figure_of_graph(graph->graph, graph->keys, blocks, rejected, fig.title);
+  } else {
+    if (a.has("partition") || a.has("rejected"))
+      throw InputError(input, 0, "--partition and --rejected need a graph file, not a trajectory");
+    fig = figure_of_trajectory(probe, fig.title);
+  }
+  if (auto t = a.get("truth")) {
+    const Trajectory truth = read_trajectory(*t, read);
+    add_truth(fig, probe, truth);
+  }
+  draw_figure(fig, *out);
+  std::printf("wrote %s\n", out->c_str());
+  return 0;
+}
+
+}  // namespace tessera::cli
