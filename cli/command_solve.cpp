@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "json_writer.hpp"
 #include "solve_distributed.hpp"
+#include "solve_online.hpp"
 #include "solve_output.hpp"
 
 namespace tessera::cli {
@@ -116,13 +117,16 @@ int run_solve(const Args& args) {
   std::set<std::string> switches = {"help", "no-certify", "raw-quaternions"};
   for (const char* const* o = kDistributedValued; *o; ++o) valued.insert(*o);
   for (const char* const* o = kDistributedSwitches; *o; ++o) switches.insert(*o);
+  for (const char* const* o = kOnlineValued; *o; ++o) valued.insert(*o);
+  for (const char* const* o = kOnlineSwitches; *o; ++o) switches.insert(*o);
   Arguments a(args, valued, switches);
   if (a.has("help")) {
-    std::printf("%s%s", kHelp, kDistributedHelp);
+    std::printf("%s%s%s", kHelp, kDistributedHelp, kOnlineHelp);
     return 0;
   }
   if (a.positional().size() != 1)
     throw InputError("expected exactly one GRAPH argument (see tessera solve --help)");
+  if (a.has("online")) return solve_online_command(a, a.positional()[0], start);
   const std::string algorithm = a.get_or("algorithm", "centralized");
   if (algorithm == "centralized") return solve_centralized_command(a, a.positional()[0], start);
   if (algorithm == "rbcd" || algorithm == "rbcd++" || algorithm == "irbcd")

@@ -14,5 +14,6 @@ int run_generate(const Args& args);
 int run_solve(const Args& args);
 int run_partition(const Args& args);
 int run_launch(const Args& args);
+int run_replay(const Args& args);
 
 }  // namespace tessera::cli

@@ -22,6 +22,7 @@ const Command kCommands[] = {
     {"solve", tessera::cli::run_solve, "optimise a pose graph (centralized or distributed)"},
     {"partition", tessera::cli::run_partition, "split a graph into balanced blocks"},
     {"launch", tessera::cli::run_launch, "run a distributed solve as DDS processes on this host"},
+    {"replay", tessera::cli::run_replay, "play a multi-robot graph onto the online input topic"},
 };
 
 void print_usage() {

@@ -11,6 +11,7 @@
 namespace tessera {
 
 void OnlineOptions::validate() const {
+  rebalance.validate();
   DistributedOptions s = solver;
   s.certify = certify_at_end;  // the staircase options matter only then
   try {
@@ -42,15 +43,6 @@ void OnlineEngine::receive(const StreamBatch& batch) {
   received_.push_back(batch);
 }
 
-std::vector<int> OnlineEngine::assignment() const {
-  const auto& robots = stream_.robots();
-  std::vector<int> a;
-  a.reserve(stream_.robot_of_pose().size());
-  for (std::uint32_t r : stream_.robot_of_pose())
-    a.push_back(static_cast<int>(std::find(robots.begin(), robots.end(), r) - robots.begin()));
-  return a;
-}
-
 std::vector<Pose> OnlineEngine::estimate() const {
   if (X_.cols() == 0 || count_components(stream_.graph()) != 1) return {};
   return round_solution(stream_.graph(), X_);
@@ -78,6 +70,15 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   // Idle: nothing new and already converged, so no round and no message.
   if ((u.poses == 0 && u.measurements == 0 && converged_) || graph.num_poses == 0) return u;
 
+  // New poses join their robot's block; then the blocks follow the graph's growth.
+  const auto& robots = stream_.robots();
+  for (std::size_t k = owner_.size(); k < graph.num_poses; ++k)
+    owner_.push_back(static_cast<int>(
+        std::find(robots.begin(), robots.end(), stream_.robot_of_pose()[k]) - robots.begin()));
+  const RebalanceResult moves =
+      rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
+  u.moved = moves.moved;
+  u.largest_block = moves.largest_after;
   X_ = extend_estimate(graph, X_, stream_.guesses()).X;
   DistributedOptions solver = options_.solver;
   solver.certify = false;
@@ -95,6 +96,8 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.cpu_s = cpu_now() - cpu_start;
   u.latency_s = now_s - oldest + u.ms / 1000.0;
   totals_.rounds += u.rounds;
+  totals_.repartitions += u.moved > 0 ? 1 : 0;
+  totals_.poses_moved += u.moved;
   totals_.bytes += u.bytes;
   totals_.cpu_s += u.cpu_s;
   totals_.updates.push_back(u);
@@ -103,7 +106,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
 
 DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
   const PoseGraph& graph = stream_.graph();
-  const std::vector<int> blocks = assignment();
+  const std::vector<int>& blocks = owner_;
   std::vector<char> linked(graph.num_poses, 0);
   for (const Measurement& m : graph.measurements) linked[m.i] = linked[m.j] = 1;
   const Eigen::Index w = graph.d + 1;

@@ -17,6 +17,7 @@
 #include <optional>
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/online/block_rebalance.hpp>
 #include <tessera/online/graph_stream.hpp>
 #include <tessera/online/stream_batch.hpp>
 #include <vector>
@@ -31,6 +32,9 @@ struct OnlineOptions {
   /// Run the distributed certificate (with the staircase of solver.staircase) after the
   /// last batch.
   bool certify_at_end = true;
+  /// The partition follows the graph: blocks start as the robots and border poses move out of
+  /// over-full blocks (block_rebalance.hpp) after each absorbed step.
+  RebalanceOptions rebalance;
   /// run_online only. false: one step per distinct batch stamp (deterministic). true: the
   /// stamps are a real-time clock; a step absorbs every batch published by the time the
   /// previous step ended (its measured wall time), as a live run would.
@@ -48,10 +52,12 @@ struct OnlineUpdate {
   std::size_t measurements = 0;  ///< New measurements.
   std::size_t total_poses = 0;   ///< Graph size after the step.
   std::size_t total_measurements = 0;
-  int agents = 0;      ///< Blocks (robots) during the step.
-  int rounds = 0;      ///< Rounds until the gradient was back under tolerance.
-  double ms = 0.0;     ///< Wall time of the step (absorb, extend, rounds).
-  double cpu_s = 0.0;  ///< Process CPU time of the step.
+  int agents = 0;                 ///< Blocks (robots) during the step.
+  std::size_t moved = 0;          ///< Poses that changed block (rebalance) before the rounds.
+  std::size_t largest_block = 0;  ///< Largest block's poses during the rounds.
+  int rounds = 0;                 ///< Rounds until the gradient was back under tolerance.
+  double ms = 0.0;                ///< Wall time of the step (absorb, extend, rounds).
+  double cpu_s = 0.0;             ///< Process CPU time of the step.
   /// Publication of the oldest absorbed batch to the end of the step (stream clock; with
   /// real_time the step's wall time counts as stream time).
   double latency_s = 0.0;
@@ -65,7 +71,9 @@ struct OnlineUpdate {
 
 struct OnlineResult {
   std::vector<OnlineUpdate> updates;
-  int rounds = 0;  ///< All steps' rounds (the final certificate's excluded).
+  int rounds = 0;               ///< All steps' rounds (the final certificate's excluded).
+  int repartitions = 0;         ///< Steps that moved poses between blocks.
+  std::size_t poses_moved = 0;  ///< Poses moved over all steps.
   std::uint64_t bytes = 0;
   double cpu_s = 0.0;  ///< All steps' process CPU time.
   // The final solve from the last iterate, with the certificate when certify_at_end.
@@ -98,8 +106,9 @@ class OnlineEngine {
   /// Current estimate rounded to SE(d), by stream id; empty while the graph received is not
   /// connected (robots that have not met yet share no frame).
   std::vector<Pose> estimate() const;
-  /// Block (agent) of each stream id: its robot's position in stream().robots().
-  std::vector<int> assignment() const;
+  /// Block (agent) of each stream id: its robot's position in stream().robots() unless the
+  /// rebalance moved it.
+  const std::vector<int>& assignment() const { return owner_; }
 
  private:
   /// Runs the agents from X_ on the poses some measurement touches and writes their result
@@ -110,7 +119,8 @@ class OnlineEngine {
   GraphStream stream_;
   std::vector<StreamBatch> received_;
   Eigen::MatrixXd X_;
-  bool converged_ = true;  // gradient under tolerance at X_
+  std::vector<int> owner_;  // block of each stream id
+  bool converged_ = true;   // gradient under tolerance at X_
   OnlineResult totals_;
 };
 
