@@ -17,6 +17,7 @@
 #include "graph_input.hpp"
 #include "json_writer.hpp"
 #include "solve_distributed.hpp"
+#include "solve_online.hpp"
 #include "solve_output.hpp"
 
 namespace tessera::cli {
@@ -119,13 +120,17 @@ int run_solve(const Args& args) {
   std::set<std::string> switches = {"help", "no-certify", "raw-quaternions"};
   for (const char* const* o = kDistributedValued; *o; ++o) valued.insert(*o);
   for (const char* const* o = kDistributedSwitches; *o; ++o) switches.insert(*o);
+  for (const char* const* o = kOnlineValued; *o; ++o) valued.insert(*o);
+  for (const char* const* o = kOnlineSwitches; *o; ++o) switches.insert(*o);
   Arguments a(args, valued, switches);
   if (a.has("help")) {
-    std::printf("%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp);
+    std::printf("%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
+                kOnlineHelp);
     return 0;
   }
   if (a.positional().size() != 1)
     throw InputError("expected exactly one GRAPH argument (see tessera solve --help)");
+  if (a.has("online")) return solve_online_command(a, a.positional()[0], start);
   const std::string algorithm = a.get_or("algorithm", "centralized");
   if (algorithm == "centralized") return solve_centralized_command(a, a.positional()[0], start);
   if (algorithm == "rbcd" || algorithm == "rbcd++" || algorithm == "irbcd")

@@ -16,5 +16,6 @@ int run_partition(const Args& args);
 int run_launch(const Args& args);
 int run_eval(const Args& args);
 int run_plot(const Args& args);
+int run_replay(const Args& args);
 
 }  // namespace tessera::cli

@@ -24,6 +24,7 @@ const Command kCommands[] = {
     {"launch", tessera::cli::run_launch, "run a distributed solve as DDS processes on this host"},
     {"eval", tessera::cli::run_eval, "accuracy of an estimate against ground truth (ATE, RPE)"},
     {"plot", tessera::cli::run_plot, "draw trajectories and loop closures into a PNG"},
+    {"replay", tessera::cli::run_replay, "play a multi-robot graph onto the online input topic"},
 };
 
 void print_usage() {

@@ -201,10 +201,12 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
   }
   res.relaxation_cost = res.trace.empty() ? 0.0 : res.trace.back().cost;
   res.grad_norm = res.trace.empty() ? 0.0 : res.trace.back().grad_norm;
-  const auto rounding_start = Clock::now();
-  res.poses = round_solution(graph, res.X);
-  res.rounding_s = since(rounding_start);
-  res.cost = evaluate_objective(graph, res.poses);
+  if (options.round_result) {
+    const auto rounding_start = Clock::now();
+    res.poses = round_solution(graph, res.X);
+    res.rounding_s = since(rounding_start);
+    res.cost = evaluate_objective(graph, res.poses);
+  }
   res.wall_s = since(start);
   return res;
 }

@@ -61,6 +61,10 @@ struct DistributedOptions {
   /// (docs/distributed-certification.md). Off by default for `tessera solve`.
   bool certify = false;
   StaircaseOptions staircase;
+  /// Round the final iterate to SE(d) (`poses`, `cost`). Off for callers that keep the lifted
+  /// iterate and whose graph may not be connected yet (the online engine's steps), where the
+  /// translation solve of the rounding has no unique answer.
+  bool round_result = true;
   DeliveryOrder delivery = DeliveryOrder::kFifo;  ///< In-process delivery order (tests).
   std::uint64_t delivery_seed = 1;
 

@@ -1,0 +1,233 @@
+#include "solve_online.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <ctime>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/online/online_engine.hpp>
+#include <tessera/online/replay_schedule.hpp>
+#include <tessera/problem/objective.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/util/input_error.hpp>
+#include <vector>
+
+#include "json_writer.hpp"
+#include "robot_files.hpp"
+#include "runtime/replay_input.hpp"
+
+namespace tessera::cli {
+
+const char* const kOnlineValued[] = {"rate", "speedup", "start", "checkpoints", nullptr};
+const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", nullptr};
+
+const char* kOnlineHelp =
+    "\n"
+    "Online (--online; docs/online.md): the graph arrives as the robots' front ends would\n"
+    "publish it (`tessera replay`'s timeline) while one agent per robot solves in this\n"
+    "process; every new batch is absorbed at a round boundary and solved from the current\n"
+    "estimate until ||grad f|| <= --grad-tol again. GRAPH: a g2o file or robot files.\n"
+    "  --algorithm rbcd|rbcd++|irbcd, --grad-tol T, --max-rounds K, --rank R   as above\n"
+    "  --robots R                robots sharing a whole g2o file (default 1)\n"
+    "  --rate R                  poses per second per robot (default 10)\n"
+    "  --speedup S               time divisor of the replay (default 1)\n"
+    "  --start S0,S1,...         seconds at which each robot starts (default all 0)\n"
+    "  --real-time               a step absorbs all batches published while the previous one\n"
+    "                            ran (its wall time counts as stream time); default: one step\n"
+    "                            per publication time\n"
+    "  --checkpoints K           at K evenly spaced steps, the estimate's relative gap to the\n"
+    "                            optimum of the graph received so far (centralized solver,\n"
+    "                            computed after the run, not timed)\n"
+    "  --baseline                also re-solve from scratch (the front ends' guesses, no warm\n"
+    "                            start) after every step that brought a loop closure, and\n"
+    "                            report its CPU time\n"
+    "  --no-certify              skip the final certificate\n"
+    "  --json FILE               summary with the `updates` array (one object per step)\n";
+
+namespace {
+
+double cpu_now() {
+  return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(pos);
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+struct Checkpoint {
+  double time_s = 0.0;
+  PoseGraph graph;
+  double cost = 0.0;
+  double optimum = 0.0;
+};
+
+}  // namespace
+
+int solve_online_command(const Arguments& a, const std::string& graph_path,
+                         std::chrono::steady_clock::time_point start) {
+  OnlineOptions options;
+  options.solver.algorithm = parse_algorithm(a.get_or("algorithm", "irbcd"));
+  options.solver.grad_norm_tol = a.get_double("grad-tol", options.solver.grad_norm_tol);
+  options.solver.max_rounds = static_cast<int>(a.get_long("max-rounds", options.solver.max_rounds));
+  options.solver.rank = static_cast<int>(a.get_long("rank", options.solver.rank));
+  options.certify_at_end = !a.has("no-certify");
+  options.real_time = a.has("real-time");
+  options.validate();
+  ReplayOptions replay;
+  replay.rate = a.get_double("rate", replay.rate);
+  replay.speedup = a.get_double("speedup", replay.speedup);
+  for (const std::string& s : a.get_list("start")) {
+    try {
+      replay.start_s.push_back(std::stod(s));
+    } catch (const std::exception&) {
+      throw InputError("option --start: '" + s + "' is not a number");
+    }
+  }
+  replay.validate();
+  const long checkpoints = a.get_long("checkpoints", 0);
+  if (checkpoints < 0) throw InputError("option --checkpoints: must be >= 0");
+
+  const auto files = robot_files_of(graph_path);
+  const long robots = a.get_long("robots", 1);
+  if (!files.empty() && a.has("robots"))
+    throw InputError("option --robots: robot files say who owns what; use it with one g2o file");
+  const runtime::ReplayInput input =
+      files.empty() ? runtime::replay_input_from_file(
+                          graph_path, robots > 0 ? static_cast<std::size_t>(robots) : 0)
+                    : runtime::replay_input_from_robot_files(files);
+  const ReplayPlan plan = plan_replay(input.graph, input.robot_of_pose, replay);
+
+  // Steps sampled for checkpoints: every `every`-th step that did work (the count is known
+  // only afterwards, so sample on the number of batches instead: one per tick).
+  const std::size_t every =
+      checkpoints > 0
+          ? std::max<std::size_t>(1, plan.batches.size() / static_cast<std::size_t>(checkpoints))
+          : 0;
+  std::vector<Checkpoint> marks;
+  std::size_t seen_batches = 0, next_mark = every;
+  double baseline_cpu_s = 0.0;
+  int baseline_solves = 0;
+  const bool baseline = a.has("baseline");
+  auto observer = [&](const OnlineEngine& engine, const OnlineUpdate& u) {
+    seen_batches += u.batches;
+    const PoseGraph& g = engine.stream().graph();
+    if (every > 0 && seen_batches >= next_mark) {
+      const std::vector<Pose> estimate = engine.estimate();
+      if (!estimate.empty()) {  // empty until the robots met (no common frame)
+        next_mark += every;
+        Checkpoint c;
+        c.time_s = u.time_s;
+        c.graph = g;
+        c.cost = evaluate_objective(g, estimate);
+        marks.push_back(std::move(c));
+      }
+    }
+    if (!baseline) return;
+    const auto& kinds = engine.stream().kinds();
+    const bool closure =
+        std::any_of(kinds.end() - static_cast<std::ptrdiff_t>(u.measurements), kinds.end(),
+                    [](MeasurementKind k) { return k != MeasurementKind::kOdometry; });
+    // From scratch: the same agents from the front ends' guesses (no warm start). A pose no
+    // measurement touches yet would leave its block without a problem: skip such steps.
+    std::vector<char> linked(g.num_poses, 0);
+    for (const Measurement& m : g.measurements) linked[m.i] = linked[m.j] = 1;
+    if (!closure || std::find(linked.begin(), linked.end(), 0) != linked.end()) return;
+    DistributedOptions scratch = options.solver;
+    scratch.certify = false;
+    scratch.round_result = false;  // the graph may not be connected yet
+    const double c0 = cpu_now();
+    solve_distributed(g, engine.assignment(), scratch, engine.stream().guesses());
+    baseline_cpu_s += cpu_now() - c0;
+    ++baseline_solves;
+  };
+  const OnlineResult res = run_online(input.graph.d, plan.batches, options, observer);
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  std::vector<double> latency, gaps;
+  for (const auto& u : res.updates) latency.push_back(u.latency_s);
+  for (auto& c : marks) {
+    c.optimum = solve_centralized(c.graph).cost;
+    gaps.push_back((c.cost - c.optimum) / c.optimum);
+  }
+  std::printf(
+      "%s online: %zu poses, %zu measurements, %zu robots, %zu steps, %d rounds; "
+      "latency median %.4f s, p95 %.4f s; final cost %.10g, %s, %.3f s\n",
+      graph_path.c_str(), res.graph.num_poses, res.graph.measurements.size(), input.robots,
+      res.updates.size(), res.rounds, percentile(latency, 0.5), percentile(latency, 0.95), res.cost,
+      res.certified ? (*res.certified ? "certified optimal" : "NOT certified")
+                    : "not certified (skipped)",
+      wall_s);
+  if (auto p = a.get("json")) {
+    std::vector<JsonObject> updates, cps;
+    for (const auto& u : res.updates) {
+      JsonObject j;
+      j.add("time_s", u.time_s)
+          .add("batches", u.batches)
+          .add("poses", u.poses)
+          .add("measurements", u.measurements)
+          .add("total_poses", u.total_poses)
+          .add("total_measurements", u.total_measurements)
+          .add("agents", u.agents)
+          .add("moved", u.moved)
+          .add("largest_block", u.largest_block)
+          .add("rounds", u.rounds)
+          .add("ms", u.ms)
+          .add("cpu_s", u.cpu_s)
+          .add("latency_s", u.latency_s)
+          .add("bytes", static_cast<std::size_t>(u.bytes))
+          .add("grad_norm", u.grad_norm)
+          .add("stop_reason", u.stop_reason);
+      updates.push_back(std::move(j));
+    }
+    for (const auto& c : marks) {
+      JsonObject j;
+      j.add("time_s", c.time_s)
+          .add("poses", c.graph.num_poses)
+          .add("measurements", c.graph.measurements.size())
+          .add("cost", c.cost)
+          .add("optimum", c.optimum)
+          .add("rel_gap", (c.cost - c.optimum) / c.optimum);
+      cps.push_back(std::move(j));
+    }
+    JsonObject j;
+    j.add("graph", graph_path)
+        .add("mode", "online")
+        .add("algorithm", algorithm_name(options.solver.algorithm))
+        .add("d", input.graph.d)
+        .add("robots", input.robots)
+        .add("poses", res.graph.num_poses)
+        .add("measurements", res.graph.measurements.size())
+        .add("batches", plan.batches.size())
+        .add("rate", replay.rate)
+        .add("speedup", replay.speedup)
+        .add("real_time", options.real_time)
+        .add("grad_tol", options.solver.grad_norm_tol)
+        .add("steps", res.updates.size())
+        .add("rounds", res.rounds)
+        .add("bytes", static_cast<std::size_t>(res.bytes))
+        .add("cpu_s", res.cpu_s)
+        .add("latency_median_s", percentile(latency, 0.5))
+        .add("latency_p95_s", percentile(latency, 0.95))
+        .add("max_checkpoint_rel_gap",
+             gaps.empty() ? 0.0 : *std::max_element(gaps.begin(), gaps.end()))
+        .add("repartitions", res.repartitions)
+        .add("poses_moved", res.poses_moved)
+        .add("final_rounds", res.final_rounds)
+        .add("cost", res.cost)
+        .add("grad_norm", res.grad_norm)
+        .add("certified", res.certified)
+        .add("min_eigenvalue", res.min_eigenvalue)
+        .add("wall_s", wall_s);
+    if (baseline) j.add("baseline_solves", baseline_solves).add("baseline_cpu_s", baseline_cpu_s);
+    j.add("checkpoints", cps).add("updates", updates);
+    write_output(*p, j.str());
+  }
+  return 0;
+}
+
+}  // namespace tessera::cli

@@ -1,0 +1,135 @@
+#pragma once
+// The online run in one process: stream batches arrive while the agents solve; at each step
+// (a round boundary) the engine absorbs what was received (in one process every agent holds
+// the same batches; over DDS absorb_gate.hpp decides what all of them hold), extends the estimate
+// to the new poses by composition (estimate_extension.hpp), and runs the agents' round protocol
+// (in_process_driver.hpp) from the current iterate until the gradient is back under the tolerance.
+// The blocks follow the robots: one agent per robot seen so far, so a robot that starts late gets
+// its agent when its first pose arrives. A step with nothing new and the gradient under the
+// tolerance does no round and exchanges no message (the agents idle). The momentum of the
+// accelerated methods restarts at every change of the problem: it carries curvature information of
+// the old objective, which a new measurement makes wrong. At the end a certificate is run
+// (DistributedOptions::certify's staircase) from the last iterate.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/online/block_rebalance.hpp>
+#include <tessera/online/graph_stream.hpp>
+#include <tessera/online/stream_batch.hpp>
+#include <vector>
+
+namespace tessera {
+
+struct OnlineOptions {
+  /// The agents' solver (algorithm, rank, tolerance, selection, ...). Its `certify` and
+  /// `initialization` are not used: poses are initialised by composition, and certification
+  /// is `certify_at_end`.
+  DistributedOptions solver;
+  /// Run the distributed certificate (with the staircase of solver.staircase) after the
+  /// last batch.
+  bool certify_at_end = true;
+  /// The partition follows the graph: blocks start as the robots and border poses move out of
+  /// over-full blocks (block_rebalance.hpp) after each absorbed step.
+  RebalanceOptions rebalance;
+  /// run_online only. false: one step per distinct batch stamp (deterministic). true: the
+  /// stamps are a real-time clock; a step absorbs every batch published by the time the
+  /// previous step ended (its measured wall time), as a live run would.
+  bool real_time = false;
+
+  /// Throws InputError naming the first invalid field.
+  void validate() const;
+};
+
+/// One step of the online run (the JSON `updates` array of `tessera launch --online`).
+struct OnlineUpdate {
+  double time_s = 0.0;           ///< When the step began (stream clock).
+  std::size_t batches = 0;       ///< Batches absorbed.
+  std::size_t poses = 0;         ///< New poses.
+  std::size_t measurements = 0;  ///< New measurements.
+  std::size_t total_poses = 0;   ///< Graph size after the step.
+  std::size_t total_measurements = 0;
+  int agents = 0;                 ///< Blocks (robots) during the step.
+  std::size_t moved = 0;          ///< Poses that changed block (rebalance) before the rounds.
+  std::size_t largest_block = 0;  ///< Largest block's poses during the rounds.
+  int rounds = 0;                 ///< Rounds until the gradient was back under tolerance.
+  double ms = 0.0;                ///< Wall time of the step (absorb, extend, rounds).
+  double cpu_s = 0.0;             ///< Process CPU time of the step.
+  /// Publication of the oldest absorbed batch to the end of the step (stream clock; with
+  /// real_time the step's wall time counts as stream time).
+  double latency_s = 0.0;
+  std::uint64_t bytes = 0;  ///< Protocol bytes of the step's rounds.
+  double grad_norm = 0.0;   ///< ||grad f|| at the end of the step.
+  /// Why the rounds stopped: grad_norm, or stalled (the iterate stopped moving just above the
+  /// tolerance; the next data restarts it), or max_rounds.
+  std::string stop_reason;
+  double relaxation_cost = 0.0;  ///< f(Y) at the end of the step.
+};
+
+struct OnlineResult {
+  std::vector<OnlineUpdate> updates;
+  int rounds = 0;               ///< All steps' rounds (the final certificate's excluded).
+  int repartitions = 0;         ///< Steps that moved poses between blocks.
+  std::size_t poses_moved = 0;  ///< Poses moved over all steps.
+  std::uint64_t bytes = 0;
+  double cpu_s = 0.0;  ///< All steps' process CPU time.
+  // The final solve from the last iterate, with the certificate when certify_at_end.
+  std::optional<bool> certified;
+  double min_eigenvalue = 0.0;
+  int final_rounds = 0;  ///< Rounds of that final solve (0 when already converged).
+  double cost = 0.0;     ///< Objective of `poses` (reference convention).
+  double grad_norm = 0.0;
+  std::vector<Pose> poses;    ///< Final estimate, by stream id (graph order).
+  PoseGraph graph;            ///< The graph received (stream ids).
+  std::vector<PoseKey> keys;  ///< Stream key of each id.
+};
+
+class OnlineEngine {
+ public:
+  /// `d`: the stream's dimension (2 or 3). Throws InputError for bad options.
+  OnlineEngine(int d, const OnlineOptions& options);
+
+  /// A batch arrives (buffered: it enters the problem at the next step).
+  void receive(const StreamBatch& batch);
+  /// A round boundary: absorbs the received batches and solves until the gradient is under
+  /// the tolerance; idle (no round, no message) when nothing is new and it already is.
+  OnlineUpdate step(double now_s = 0.0);
+  /// Solves from the current iterate (certifying when asked) and returns the run's figures.
+  OnlineResult finish();
+
+  const GraphStream& stream() const { return stream_; }
+  /// Current lifted iterate (r x (d+1)n, stream ids); empty before the first pose.
+  const Eigen::MatrixXd& iterate() const { return X_; }
+  /// Current estimate rounded to SE(d), by stream id; empty while the graph received is not
+  /// connected (robots that have not met yet share no frame).
+  std::vector<Pose> estimate() const;
+  /// Block (agent) of each stream id: its robot's position in stream().robots() unless the
+  /// rebalance moved it.
+  const std::vector<int>& assignment() const { return owner_; }
+
+ private:
+  /// Runs the agents from X_ on the poses some measurement touches and writes their result
+  /// back into X_ (when the rank did not change: a staircase climb leaves X_ as it was).
+  DistributedResult solve_linked(const DistributedOptions& solver);
+
+  OnlineOptions options_;
+  GraphStream stream_;
+  std::vector<StreamBatch> received_;
+  Eigen::MatrixXd X_;
+  std::vector<int> owner_;  // block of each stream id
+  bool converged_ = true;   // gradient under tolerance at X_
+  OnlineResult totals_;
+};
+
+/// Called after every step of run_online that did work (not for idle steps).
+using OnlineObserver = std::function<void(const OnlineEngine&, const OnlineUpdate&)>;
+
+/// Plays `batches` (ordered by stamp) into an engine (see OnlineOptions::real_time) and
+/// finishes it.
+OnlineResult run_online(int d, const std::vector<StreamBatch>& batches,
+                        const OnlineOptions& options, const OnlineObserver& observer = {});
+
+}  // namespace tessera

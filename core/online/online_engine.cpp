@@ -1,0 +1,204 @@
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <tessera/graph/connectivity.hpp>
+#include <tessera/online/estimate_extension.hpp>
+#include <tessera/online/online_engine.hpp>
+#include <tessera/problem/objective.hpp>
+#include <tessera/problem/rounding.hpp>
+#include <tessera/util/input_error.hpp>
+
+namespace tessera {
+
+void OnlineOptions::validate() const {
+  rebalance.validate();
+  DistributedOptions s = solver;
+  s.certify = certify_at_end;  // the staircase options matter only then
+  try {
+    s.validate();
+  } catch (const InputError& e) {
+    throw InputError(std::string("OnlineOptions.solver: ") + e.what());
+  }
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double cpu_now() {
+  return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
+}
+
+}  // namespace
+
+OnlineEngine::OnlineEngine(int d, const OnlineOptions& options)
+    : options_(options), stream_(d, "online stream") {
+  options_.validate();
+  if (options_.solver.rank < d)
+    throw InputError("OnlineOptions.solver.rank must be >= d = " + std::to_string(d));
+  X_.resize(options_.solver.rank, 0);
+}
+
+void OnlineEngine::receive(const StreamBatch& batch) {
+  received_.push_back(batch);
+}
+
+std::vector<Pose> OnlineEngine::estimate() const {
+  if (X_.cols() == 0 || count_components(stream_.graph()) != 1) return {};
+  return round_solution(stream_.graph(), X_);
+}
+
+OnlineUpdate OnlineEngine::step(double now_s) {
+  const auto wall_start = Clock::now();
+  const double cpu_start = cpu_now();
+  OnlineUpdate u;
+  u.time_s = now_s;
+  double oldest = now_s;
+  const std::size_t poses_before = stream_.graph().num_poses;
+  const std::size_t measurements_before = stream_.graph().measurements.size();
+  for (const StreamBatch& b : received_) {
+    u.batches += stream_.absorb(b).batches;
+    oldest = std::min(oldest, b.stamp);
+  }
+  received_.clear();
+  const PoseGraph& graph = stream_.graph();
+  u.poses = graph.num_poses - poses_before;
+  u.measurements = graph.measurements.size() - measurements_before;
+  u.total_poses = graph.num_poses;
+  u.total_measurements = graph.measurements.size();
+  u.agents = static_cast<int>(stream_.robots().size());
+  // Idle: nothing new and already converged, so no round and no message.
+  if ((u.poses == 0 && u.measurements == 0 && converged_) || graph.num_poses == 0) return u;
+
+  // New poses join their robot's block; then the blocks follow the graph's growth.
+  const auto& robots = stream_.robots();
+  for (std::size_t k = owner_.size(); k < graph.num_poses; ++k)
+    owner_.push_back(static_cast<int>(
+        std::find(robots.begin(), robots.end(), stream_.robot_of_pose()[k]) - robots.begin()));
+  const RebalanceResult moves =
+      rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
+  u.moved = moves.moved;
+  u.largest_block = moves.largest_after;
+  X_ = extend_estimate(graph, X_, stream_.guesses()).X;
+  DistributedOptions solver = options_.solver;
+  solver.certify = false;
+  solver.round_result = false;  // the graph may not be connected yet
+  const DistributedResult res = solve_linked(solver);
+  // A stalled iterate (RoundProtocol: cost and gradient repeated bit for bit) cannot improve
+  // on this problem: iterating again before new data arrives would only burn rounds.
+  converged_ = res.grad_norm <= solver.grad_norm_tol || res.stop_reason == "stalled";
+  u.rounds = res.rounds;
+  u.bytes = res.bytes_exchanged;
+  u.grad_norm = res.grad_norm;
+  u.stop_reason = res.stop_reason;
+  u.relaxation_cost = res.relaxation_cost;
+  u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
+  u.cpu_s = cpu_now() - cpu_start;
+  u.latency_s = now_s - oldest + u.ms / 1000.0;
+  totals_.rounds += u.rounds;
+  totals_.repartitions += u.moved > 0 ? 1 : 0;
+  totals_.poses_moved += u.moved;
+  totals_.bytes += u.bytes;
+  totals_.cpu_s += u.cpu_s;
+  totals_.updates.push_back(u);
+  return u;
+}
+
+DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
+  const PoseGraph& graph = stream_.graph();
+  const std::vector<int>& blocks = owner_;
+  std::vector<char> linked(graph.num_poses, 0);
+  for (const Measurement& m : graph.measurements) linked[m.i] = linked[m.j] = 1;
+  const Eigen::Index w = graph.d + 1;
+  if (std::all_of(linked.begin(), linked.end(), [](char c) { return c != 0; })) {
+    DistributedResult res = solve_distributed_from_lifted(graph, blocks, solver, X_);
+    if (res.X.rows() == X_.rows()) X_ = res.X;
+    return res;
+  }
+  // A pose no measurement touches yet (a robot's first pose before its odometry) has nothing
+  // to optimise and would make its block's Q_BB zero: solve the linked poses only, with the
+  // blocks that have some, numbered compactly.
+  PoseGraph sub;
+  sub.d = graph.d;
+  sub.source = graph.source;
+  std::vector<std::size_t> sub_id(graph.num_poses, 0), full_id;
+  for (std::size_t k = 0; k < graph.num_poses; ++k)
+    if (linked[k]) {
+      sub_id[k] = full_id.size();
+      full_id.push_back(k);
+    }
+  sub.num_poses = full_id.size();
+  for (const Measurement& m : graph.measurements) {
+    Measurement e = m;
+    e.i = sub_id[m.i];
+    e.j = sub_id[m.j];
+    sub.measurements.push_back(std::move(e));
+  }
+  std::vector<int> compact(static_cast<std::size_t>(stream_.robots().size()), -1);
+  std::vector<int> sub_blocks;
+  int next = 0;
+  Eigen::MatrixXd X0(X_.rows(), w * static_cast<Eigen::Index>(sub.num_poses));
+  for (std::size_t s = 0; s < full_id.size(); ++s) {
+    int& b = compact[static_cast<std::size_t>(blocks[full_id[s]])];
+    if (b < 0) b = next++;
+    sub_blocks.push_back(b);
+    X0.middleCols(w * static_cast<Eigen::Index>(s), w) =
+        X_.middleCols(w * static_cast<Eigen::Index>(full_id[s]), w);
+  }
+  DistributedResult res;
+  if (sub.num_poses == 0) return res;
+  res = solve_distributed_from_lifted(sub, sub_blocks, solver, X0);
+  if (res.X.rows() == X_.rows())
+    for (std::size_t s = 0; s < full_id.size(); ++s)
+      X_.middleCols(w * static_cast<Eigen::Index>(full_id[s]), w) =
+          res.X.middleCols(w * static_cast<Eigen::Index>(s), w);
+  res.poses.clear();  // in the sub-graph's ids
+  return res;
+}
+
+OnlineResult OnlineEngine::finish() {
+  if (!received_.empty()) step(received_.back().stamp);
+  OnlineResult out = totals_;
+  out.graph = stream_.graph();
+  out.keys = stream_.key_of_pose();
+  if (out.graph.num_poses == 0) return out;
+  DistributedOptions solver = options_.solver;
+  solver.certify = options_.certify_at_end;
+  // Rounding needs one connected graph (its translation solve fixes one gauge); a mission
+  // whose robots never met has no common frame to report.
+  solver.round_result = count_components(out.graph) == 1;
+  const double cpu_start = cpu_now();
+  const DistributedResult res = solve_linked(solver);
+  out.cpu_s += cpu_now() - cpu_start;
+  out.certified = res.certified;
+  out.min_eigenvalue = res.min_eigenvalue;
+  out.final_rounds = res.rounds;
+  out.bytes += res.bytes_exchanged;
+  out.cost = res.cost;
+  out.grad_norm = res.grad_norm;
+  out.poses = res.poses;
+  if (solver.round_result && out.poses.size() != out.graph.num_poses) {
+    out.poses = round_solution(out.graph, X_);
+    out.cost = evaluate_objective(out.graph, out.poses);
+  }
+  return out;
+}
+
+OnlineResult run_online(int d, const std::vector<StreamBatch>& batches,
+                        const OnlineOptions& options, const OnlineObserver& observer) {
+  OnlineEngine engine(d, options);
+  double clock = 0.0;
+  std::size_t next = 0;
+  while (next < batches.size()) {
+    // Without real time, each distinct stamp is one step; with it, everything published
+    // while the previous step ran enters together.
+    clock = std::max(clock, batches[next].stamp);
+    while (next < batches.size() && batches[next].stamp <= clock) engine.receive(batches[next++]);
+    const OnlineUpdate u = engine.step(clock);
+    if (observer && (u.poses > 0 || u.measurements > 0 || u.rounds > 0)) observer(engine, u);
+    if (options.real_time) clock += u.ms / 1000.0;
+  }
+  return engine.finish();
+}
+
+}  // namespace tessera

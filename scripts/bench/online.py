@@ -1,0 +1,133 @@
+#!/usr/bin/env python3
+"""Online runs (docs/online.md): a multi-robot graph is replayed as its robots' front ends would
+publish it while one agent per robot solves in one process (`tessera solve GRAPH --online`).
+
+Per run: median and 95th percentile latency (publication of the oldest batch of a step to the
+end of that step, when the gradient is back under the tolerance; with --real-time the steps'
+wall time is stream time), the relative gap to the optimum of the graph received so far at
+sampled checkpoints (centralized solver, offline), rounds and bytes per second of stream,
+the CPU time of the online run against re-solving from scratch after every step that brought
+a loop closure (same script, same agents), and the final cost against the batch optimum f*
+(centralized solver on the whole graph) with the certificate.
+
+Writes docs/benchmarks/online.csv, online.png and online.md. The default sizes are small: the machine is
+shared; --full runs the issue's sizes (city10000 / 5 robots, a 50,000-pose grid / 10 robots,
+sphere2500).
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import bench_common as bc  # noqa: E402
+
+
+def cases(args, work, tessera):
+    shared = os.path.join(args.shared, "datasets")
+    if args.full:
+        city, sphere = os.path.join(shared, "city10000.g2o"), os.path.join(shared, "sphere2500.g2o")
+        grid = os.path.join(work, "grid50000.g2o")
+        subprocess.run([tessera, "generate", "--kind", "grid3d", "--poses", "50000", "--robots", "10",
+                        "--out", grid], check=True, stdout=subprocess.DEVNULL)
+        return [("city10000", city, 5, "city10000"), ("grid3d-50000", grid, 10, grid),
+                ("sphere2500", sphere, 5, "sphere2500")]
+    out = []
+    for kind, poses, robots in (("city", args.poses, 5), ("grid3d", args.poses, 5), ("sphere", args.poses, 5)):
+        path = os.path.join(work, f"{kind}{poses}.g2o")
+        subprocess.run([tessera, "generate", "--kind", kind, "--poses", str(poses), "--robots", str(robots),
+                        "--seed", "1", "--out", path], check=True, stdout=subprocess.DEVNULL)
+        out.append((f"{kind}-{poses} (generated)", path, robots, path))
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    bc.add_common_args(ap)
+    ap.add_argument("--poses", type=int, default=300, help="poses of each generated graph (default 300)")
+    ap.add_argument("--rate", type=float, default=10.0, help="poses per second per robot (default 10)")
+    ap.add_argument("--speedup", type=float, default=10.0, help="replay speedup (default 10)")
+    ap.add_argument("--grad-tol", type=float, default=1e-3, help="agents' gradient tolerance (default 1e-3)")
+    ap.add_argument("--checkpoints", type=int, default=5, help="checkpoints per run (default 5)")
+    ap.add_argument("--full", action="store_true", help="the issue's sizes (long on a shared machine)")
+    args = ap.parse_args()
+    ctx = bc.Ctx(args)
+    rows, runs = [], []
+    for name, path, robots, fkey in cases(args, ctx.work, ctx.bin):
+        load = os.getloadavg()[0]
+        js = os.path.join(ctx.work, os.path.basename(path) + ".online.json")
+        cmd = [ctx.bin, "solve", path, "--online", "--robots", str(robots), "--rate", str(args.rate),
+               "--speedup", str(args.speedup), "--real-time", "--grad-tol", str(args.grad_tol),
+               "--checkpoints", str(args.checkpoints), "--baseline", "--json", js]
+        ctx.log(cmd)
+        bc.progress(" ".join(cmd))
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        with open(js) as f:
+            s = json.load(f)
+        fstar, _ = ctx.fstar(fkey)
+        stream_s = max(u["time_s"] for u in s["updates"]) or 1.0
+        row = {
+            "graph": name, "robots": robots, "poses": s["poses"], "measurements": s["measurements"],
+            "steps": s["steps"], "rate": args.rate, "speedup": args.speedup, "grad_tol": args.grad_tol,
+            "latency_median_s": s["latency_median_s"], "latency_p95_s": s["latency_p95_s"],
+            "max_checkpoint_rel_gap": s["max_checkpoint_rel_gap"],
+            "rounds_per_s": s["rounds"] / stream_s, "bytes_per_s_per_agent": s["bytes"] / stream_s / robots,
+            "online_cpu_s": s["cpu_s"], "baseline_cpu_s": s.get("baseline_cpu_s"),
+            "baseline_solves": s.get("baseline_solves"),
+            "cpu_ratio": s["cpu_s"] / s["baseline_cpu_s"] if s.get("baseline_cpu_s") else None,
+            "repartitions": 0, "poses_moved": 0,
+            "final_cost": s["cost"], "fstar": fstar, "final_rel_gap": (s["cost"] - fstar) / fstar,
+            "certified": s["certified"], "load_1min": round(load, 2),
+        }
+        rows.append(row)
+        runs.append((name, s))
+    headers = ["graph", "poses", "steps", "lat med s", "lat p95 s", "max gap", "online CPU s",
+               "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
+    table = bc.print_table(
+        f"online runs (rate {args.rate}/s per robot, speedup {args.speedup}, --real-time, grad tol {args.grad_tol})",
+        headers,
+        [[r["graph"], r["poses"], r["steps"], bc.fmt(r["latency_median_s"], "{:.4f}"),
+          bc.fmt(r["latency_p95_s"], "{:.4f}"), bc.fmt(r["max_checkpoint_rel_gap"], "{:.2e}"),
+          bc.fmt(r["online_cpu_s"], "{:.2f}"), bc.fmt(r["baseline_cpu_s"], "{:.2f}"),
+          bc.fmt(r["cpu_ratio"], "{:.3f}"), bc.fmt(r["final_rel_gap"], "{:.1e}"), r["certified"], r["load_1min"]]
+         for r in rows])
+    bc.write_csv(os.path.join(ctx.out_dir, "online.csv"), rows)
+    plt = bc.pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for name, s in runs:
+        t = [u["time_s"] for u in s["updates"]]
+        axes[0].plot(t, [max(u["latency_s"], 1e-4) for u in s["updates"]], ".", ms=3, label=name)
+        axes[1].plot(t, [u["rounds"] for u in s["updates"]], ".", ms=3, label=name)
+    bc.style_log_axes(axes[0], "stream time (s)", "latency per step", "seconds")
+    axes[1].set_xlabel("stream time (s)")
+    axes[1].set_ylabel("rounds")
+    axes[1].set_title("rounds per step")
+    for ax in axes:
+        ax.legend(fontsize=7)
+    bc.save_figure(ctx, fig, "online.png")
+    print("\n" + table)
+    print("\n" + bc.machine())
+    md = os.path.join(ctx.out_dir, "online.md")
+    with open(md, "w") as f:
+        f.write("# Online runs\n\nWritten by `scripts/bench/online.py` (docs/online.md); do not edit by hand.\n\n")
+        f.write("- Command: `scripts/bench/online.py " + " ".join(sys.argv[1:]) + "`\n")
+        f.write("- Machine when written: " + bc.machine() + "\n")
+        f.write("- Runs (`load` = 1-minute load average at the start of each; the machine is shared, so "
+                "latencies and CPU times are inflated by other jobs; rounds are not):\n\n")
+        for c in ctx.commands:
+            f.write(f"      {c}\n")
+        f.write("\n" + table + "\n\n")
+        f.write("Columns: latency = publication of the oldest batch a step absorbed to the end of that step "
+                "(gradient back under the tolerance or stalled), median and 95th percentile over the steps; max "
+                "gap = largest relative gap (f(estimate) - f*_k) / f*_k over the checkpoints, f*_k the centralized "
+                "optimum of the graph received by checkpoint k; online CPU = process CPU of all steps and the final "
+                "certificate; re-solve CPU = the same agents solving from scratch (chordal start) after every step "
+                "that brought a loop closure; final rel gap = (cost - f*) / f* with f* of the whole graph. The "
+                "in-process engine keeps one block per robot: re-partitions and poses moved are 0.\n\n"
+                "![online](online.png)\n")
+    print(f"wrote {os.path.relpath(md, bc.ROOT)}")
+
+
+if __name__ == "__main__":
+    main()

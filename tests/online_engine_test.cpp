@@ -1,0 +1,195 @@
+// The replay timeline and the in-process online engine: a replayed graph arrives whole, the
+// online run ends at the batch optimum (also with a robot that starts late), and agents with
+// nothing new idle.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <tessera/generate/generator.hpp>
+#include <tessera/online/graph_stream.hpp>
+#include <tessera/online/online_engine.hpp>
+#include <tessera/online/replay_schedule.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/util/input_error.hpp>
+#include <tuple>
+
+#include "test_support.hpp"
+
+namespace tessera {
+namespace {
+
+GeneratorResult small_graph(TrajectoryKind kind, std::size_t n, std::size_t robots) {
+  GeneratorOptions o;
+  o.kind = kind;
+  o.num_poses = n;
+  o.num_robots = robots;
+  o.seed = 3;
+  return generate_pose_graph(o);
+}
+
+// A measurement by its original endpoints and values, for comparing graphs whose ids differ.
+using EdgeKey = std::tuple<std::size_t, std::size_t, double, double, double>;
+
+EdgeKey edge_key(const Measurement& m, std::size_t i, std::size_t j) {
+  return {i, j, m.t(0), m.R(0, 0), m.kappa};
+}
+
+TEST(Replay, PublishesEveryMeasurementOnceBothPosesExistInTimeOrder) {
+  const auto gen = small_graph(TrajectoryKind::kCity, 120, 3);
+  ReplayOptions opt;
+  opt.rate = 10;
+  opt.speedup = 4;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, opt);
+  EXPECT_EQ(plan.batches.size(), 120u);
+  EXPECT_EQ(plan.measurements, gen.graph.measurements.size());
+  EXPECT_DOUBLE_EQ(plan.duration_s, 39.0 / 10 / 4);
+  EXPECT_TRUE(
+      std::is_sorted(plan.batches.begin(), plan.batches.end(),
+                     [](const StreamBatch& a, const StreamBatch& b) { return a.stamp < b.stamp; }));
+  // Played in publication order, no measurement has to wait for a pose.
+  GraphStream stream(gen.graph.d);
+  for (const auto& b : plan.batches) {
+    stream.absorb(b);
+    EXPECT_EQ(stream.held_measurements(), 0u);
+  }
+  // Inter-robot closures are published by the robot that reached its pose last.
+  for (const auto& b : plan.batches)
+    for (const auto& m : b.measurements) {
+      if (m.kind == MeasurementKind::kInterLoop) {
+        EXPECT_TRUE(m.from.robot == b.robot || m.to.robot == b.robot);
+      }
+    }
+}
+
+TEST(Replay, OfAFileEqualsTheBatchGraphAtTheEnd) {
+  const auto gen = small_graph(TrajectoryKind::kGrid3d, 150, 4);
+  ReplayOptions opt;
+  opt.start_s = {0.0, 3.0, 0.5, 7.0};  // late robots change the order, not the graph
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, opt);
+  GraphStream stream(gen.graph.d);
+  for (const auto& b : plan.batches) stream.absorb(b);
+  const PoseGraph& got = stream.graph();
+  ASSERT_EQ(got.num_poses, gen.graph.num_poses);
+  ASSERT_EQ(got.measurements.size(), gen.graph.measurements.size());
+  auto original = [&](std::size_t id) {
+    const PoseKey k = stream.key_of_pose()[id];
+    return plan.original_id[k.robot][k.index];
+  };
+  std::multiset<EdgeKey> want, have;
+  for (const auto& m : gen.graph.measurements) want.insert(edge_key(m, m.i, m.j));
+  for (const auto& m : got.measurements) have.insert(edge_key(m, original(m.i), original(m.j)));
+  EXPECT_EQ(want, have);
+  for (std::size_t id = 0; id < got.num_poses; ++id)
+    EXPECT_EQ((got.initial[id].t - gen.graph.initial[original(id)].t).norm(), 0.0);
+}
+
+TEST(Replay, RejectsBadOptionsNamingTheField) {
+  ReplayOptions o;
+  o.rate = 0;
+  EXPECT_NE(test::validation_message(o).find("ReplayOptions.rate"), std::string::npos);
+  o = {};
+  o.speedup = -1;
+  EXPECT_NE(test::validation_message(o).find("ReplayOptions.speedup"), std::string::npos);
+  o = {};
+  o.start_s = {0.0, -2.0};
+  EXPECT_NE(test::validation_message(o).find("ReplayOptions.start_s[1]"), std::string::npos);
+}
+
+OnlineOptions online_options() {
+  OnlineOptions o;
+  o.solver.grad_norm_tol = 1e-5;
+  o.solver.max_rounds = 20000;
+  return o;
+}
+
+double batch_optimum(const PoseGraph& g) {
+  return solve_centralized(g).cost;
+}
+
+TEST(OnlineEngine, EndsAtTheBatchOptimumCertified) {
+  const auto gen = small_graph(TrajectoryKind::kCity, 90, 3);
+  ReplayOptions ro;
+  ro.rate = 10;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  const OnlineResult res = run_online(gen.graph.d, plan.batches, online_options());
+  const double f_star = batch_optimum(gen.graph);
+  EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
+  ASSERT_TRUE(res.certified.has_value());
+  EXPECT_TRUE(*res.certified);
+  EXPECT_EQ(res.graph.measurements.size(), gen.graph.measurements.size());
+  // One step per tick, and each ends with the gradient back under the tolerance (or stalled
+  // a hair above it, where no update is accepted any more).
+  EXPECT_EQ(res.updates.size(), 30u);
+  for (const auto& u : res.updates) {
+    EXPECT_TRUE(u.grad_norm <= 1e-5 || (u.stop_reason == "stalled" && u.grad_norm < 2e-5))
+        << u.grad_norm << " " << u.stop_reason;
+  }
+}
+
+TEST(OnlineEngine, ALateRobotJoinsAndTheFinalAnswerEqualsTheBatchOptimum) {
+  const auto gen = small_graph(TrajectoryKind::kGrid3d, 96, 3);
+  ReplayOptions ro;
+  ro.rate = 10;
+  ro.start_s = {0.0, 0.0, 4.0};  // robot 2 starts after robots 0 and 1 finished (3.1 s)
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  const OnlineResult res = run_online(gen.graph.d, plan.batches, online_options());
+  // The run had two agents until robot 2's first pose, then three.
+  EXPECT_EQ(res.updates.front().agents, 2);
+  EXPECT_EQ(res.updates.back().agents, 3);
+  const double f_star = batch_optimum(gen.graph);
+  EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
+  ASSERT_TRUE(res.certified.has_value());
+  EXPECT_TRUE(*res.certified);
+}
+
+TEST(OnlineEngine, AgentsWithNoNewDataAndASmallGradientDoNothing) {
+  const auto gen = small_graph(TrajectoryKind::kCity, 40, 2);
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ReplayOptions{});
+  OnlineEngine engine(gen.graph.d, online_options());
+  for (const auto& b : plan.batches) engine.receive(b);
+  const OnlineUpdate first = engine.step(1.0);
+  EXPECT_GT(first.rounds, 0);
+  EXPECT_LE(first.grad_norm, 1e-5);
+  const Eigen::MatrixXd before = engine.iterate();
+  for (int k = 0; k < 3; ++k) {
+    const OnlineUpdate idle = engine.step(2.0 + k);
+    EXPECT_EQ(idle.rounds, 0);
+    EXPECT_EQ(idle.bytes, 0u);
+    EXPECT_EQ(idle.batches, 0u);
+  }
+  EXPECT_EQ((engine.iterate() - before).norm(), 0.0);
+}
+
+TEST(OnlineEngine, APoseThatOnlyExtendsOdometryNeedsNoRound) {
+  // Composition puts the new pose where its odometry says: its measurement has no residual,
+  // so the gradient does not move and the agents stay idle.
+  const auto gen = small_graph(TrajectoryKind::kCity, 60, 1);
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ReplayOptions{});
+  OnlineEngine engine(gen.graph.d, online_options());
+  int rounds_on_odometry_only = 0, odometry_only_steps = 0;
+  for (const auto& b : plan.batches) {
+    engine.receive(b);
+    const bool odometry_only =
+        std::all_of(b.measurements.begin(), b.measurements.end(),
+                    [](const auto& m) { return m.kind == MeasurementKind::kOdometry; });
+    const OnlineUpdate u = engine.step(b.stamp);
+    if (odometry_only && b.sequence > 0) {
+      rounds_on_odometry_only += u.rounds;
+      ++odometry_only_steps;
+    }
+  }
+  EXPECT_GT(odometry_only_steps, 10);
+  EXPECT_EQ(rounds_on_odometry_only, 0);
+}
+
+TEST(OnlineEngine, RejectsBadOptionsNamingTheField) {
+  OnlineOptions o;
+  o.solver.grad_norm_tol = -1;
+  EXPECT_NE(
+      test::validation_message(o).find("OnlineOptions.solver: DistributedOptions.grad_norm_tol"),
+      std::string::npos);
+}
+
+}  // namespace
+}  // namespace tessera
