@@ -35,6 +35,14 @@ const char* const kHelp =
     "                           is kept, 0..1                                     [0.5]\n"
     "  --inter-robot-closures P same for candidates between two robots, 0..1     [0.5]\n"
     "  --max-loop-closures K    keep at most K sampled closures (0 = no cap)      [0]\n"
+    "  --outliers F             add wrong loop closures, F times the number of loop\n"
+    "                           closures, 0..0.9, appended after the clean edges  [0]\n"
+    "  --outlier-kind KIND      random | group | inter-robot                      [random]\n"
+    "                           random: random pose pairs, random relative poses;\n"
+    "                           group: groups of 10 mutually consistent wrong closures;\n"
+    "                           inter-robot: random, ends on different robots\n"
+    "  --labels FILE            write the indices of the added edges (from 0 over the\n"
+    "                           EDGE lines) as JSON {\"outliers\": [...]}\n"
     "  --out FILE.g2o           where to write the graph (required)\n"
     "  --truth FILE            also write the ground truth: FILE.g2o = the graph with the\n"
     "                           true poses as VERTEX lines (same ids; what tessera eval\n"
@@ -71,6 +79,9 @@ GeneratorOptions parse_options(const Arguments& args) {
   o.inter_robot_closure_probability =
       args.get_double("inter-robot-closures", o.inter_robot_closure_probability);
   o.max_loop_closures = get_count(args, "max-loop-closures", 0);
+  o.outlier_fraction = args.get_double("outliers", o.outlier_fraction);
+  o.outlier_kind =
+      parse_outlier_kind(args.get_or("outlier-kind", outlier_kind_name(o.outlier_kind)));
   return o;
 }
 
@@ -131,6 +142,9 @@ void write_json(const std::string& path, const GeneratorOptions& o, const Genera
       .add("loop_closure_probability", o.loop_closure_probability)
       .add("inter_robot_closure_probability", o.inter_robot_closure_probability)
       .add("max_loop_closures", o.max_loop_closures)
+      .add("outlier_fraction", o.outlier_fraction)
+      .add("outlier_kind", outlier_kind_name(o.outlier_kind))
+      .add("outliers", r.outliers.size())
       .add("kappa", r.graph.measurements.front().kappa)
       .add("tau", r.graph.measurements.front().tau)
       .add("generate_s", timing.generate_s)
@@ -141,11 +155,12 @@ void write_json(const std::string& path, const GeneratorOptions& o, const Genera
 }  // namespace
 
 int run_generate(const Args& argv) {
-  const Arguments args(argv,
-                       {"kind", "poses", "robots", "seed", "rot-noise", "trans-noise",
-                        "loop-closures", "inter-robot-closures", "max-loop-closures", "out",
-                        "truth", "json", "split", "keys", "stamps"},
-                       {"help"});
+  const Arguments args(
+      argv,
+      {"kind", "poses", "robots", "seed", "rot-noise", "trans-noise", "loop-closures",
+       "inter-robot-closures", "max-loop-closures", "outliers", "outlier-kind", "labels", "out",
+       "truth", "json", "split", "keys", "stamps"},
+      {"help"});
   if (args.has("help")) {
     std::fputs(kHelp, stdout);
     return 0;
@@ -173,6 +188,8 @@ int run_generate(const Args& argv) {
   if (auto stamps = args.get("stamps"))
     write_stamps_file(pose_keys, result.graph.num_poses, *stamps);
   if (auto json = args.get("json")) write_json(*json, options, result, *out, timing);
+  if (auto labels = args.get("labels"))
+    write_output(*labels, JsonObject().add("outliers", result.outliers).str());
   if (auto split = args.get("split")) {
     if (keys == "gtsam")
       throw InputError("option --split writes ids 0..n-1: not with --keys gtsam");
@@ -180,12 +197,15 @@ int run_generate(const Args& argv) {
     std::printf("wrote %zu robot files into %s\n", files.size(), split->c_str());
   }
 
+  const std::string outliers =
+      result.outliers.empty() ? "" : ", " + std::to_string(result.outliers.size()) + " outliers";
   std::printf(
       "generated %s: %zu poses, %zu edges, %zu robots, %zu loop closures (%zu intra-robot, %zu "
-      "inter-robot, %zu rendezvous), %zu odometry -> %s\n",
+      "inter-robot, %zu rendezvous), %zu odometry%s -> %s\n",
       trajectory_kind_name(options.kind), result.graph.num_poses, result.graph.num_measurements(),
       options.num_robots, result.loop_closures(), result.intra_robot_closures,
-      result.inter_robot_closures, result.rendezvous_edges, result.odometry_edges, out->c_str());
+      result.inter_robot_closures, result.rendezvous_edges, result.odometry_edges, outliers.c_str(),
+      out->c_str());
   return 0;
 }
 

@@ -3,8 +3,10 @@
 
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <tessera/graph/robot_summary.hpp>
+#include <tessera/io/dpgo_csv_reader.hpp>
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/util/input_error.hpp>
 
@@ -77,6 +79,47 @@ JsonObject info_json(const G2oReadResult& r, const RobotSummary& robots, double 
   return j;
 }
 
+// dpgo measurement CSV (a .csv file or a folder of robot<k>/measurements.csv).
+int csv_info(const std::string& path, const std::optional<std::string>& json) {
+  const auto start = std::chrono::steady_clock::now();
+  const DpgoCsvGraph r = read_dpgo_csv(path);
+  const double load_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::size_t known = 0, inter = 0;
+  for (std::size_t e = 0; e < r.graph.num_measurements(); ++e) {
+    known += r.known_inlier[e] ? 1 : 0;
+    const Measurement& m = r.graph.measurements[e];
+    inter += r.robot_of[m.i] != r.robot_of[m.j] ? 1 : 0;
+  }
+  const std::size_t robots =
+      r.robot_of.empty() ? 0 : 1 + static_cast<std::size_t>(r.robot_of.back());
+  std::printf("graph:                      %s (dpgo measurement CSV)\n", path.c_str());
+  std::printf("dimension:                  3D (SE(3))\n");
+  std::printf("poses:                      %zu\n", r.graph.num_poses);
+  std::printf("edges:                      %zu\n", r.graph.num_measurements());
+  std::printf("robots:                     %zu\n", robots);
+  std::printf("inter-robot edges:          %zu\n", inter);
+  std::printf("known inliers:              %zu\n", known);
+  std::printf("duplicate rows skipped:     %zu\n", r.duplicates);
+  std::printf("load time:                  %.1f ms\n", load_s * 1e3);
+  if (json) {
+    JsonObject j;
+    j.add("graph", path)
+        .add("format", "dpgo-csv")
+        .add("poses", r.graph.num_poses)
+        .add("edges", r.graph.num_measurements())
+        .add("d", 3)
+        .add("components", 1)
+        .add("robots", robots)
+        .add("inter_robot_edges", inter)
+        .add("known_inliers", known)
+        .add("duplicates", r.duplicates)
+        .add("load_s", load_s);
+    write_output(*json, j.str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run_info(const Args& args) {
@@ -88,6 +131,7 @@ int run_info(const Args& args) {
   if (a.positional().size() != 1)
     throw InputError(std::string(a.positional().empty() ? "missing GRAPH" : "more than one GRAPH") +
                      " (usage: tessera info GRAPH [--json FILE]; see --help)");
+  if (is_dpgo_csv(a.positional()[0])) return csv_info(a.positional()[0], a.get("json"));
   G2oReadOptions options;
   options.allow_disconnected = true;
   const auto start = std::chrono::steady_clock::now();

@@ -9,6 +9,7 @@
 #include <string>
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/io/tum_writer.hpp>
+#include <tessera/robust/gnc_centralized.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/util/input_error.hpp>
 
@@ -16,9 +17,11 @@
 #include "commands.hpp"
 #include "graph_input.hpp"
 #include "json_writer.hpp"
+#include "robust_args.hpp"
 #include "solve_distributed.hpp"
 #include "solve_online.hpp"
 #include "solve_output.hpp"
+#include "solver_graph.hpp"
 
 namespace tessera::cli {
 namespace {
@@ -26,7 +29,8 @@ namespace {
 const char* kHelp =
     "usage: tessera solve GRAPH --algorithm centralized|rbcd|rbcd++|irbcd [options]\n"
     "\n"
-    "Optimises the pose graph GRAPH (g2o or TORO) and prints a summary. Written poses are in\n"
+    "Optimises the pose graph GRAPH (g2o, TORO, or dpgo measurement CSV: a .csv file or a\n"
+    "folder of robot<k>/measurements.csv) and prints a summary. Written poses are in\n"
     "the input's frame (the FIX pose, else the first pose, keeps its VERTEX value) and ids.\n"
     "\n"
     "  --algorithm centralized   certifiable centralized solver (SE-Sync family): chordal\n"
@@ -65,10 +69,11 @@ void write_trace(const std::string& path, const CentralizedResult& r) {
 }
 
 int solve_centralized_command(const Arguments& a, const std::string& graph_path,
+                              const RobustOptions& robust,
                               std::chrono::steady_clock::time_point start) {
   G2oReadOptions read;
   read.normalize_quaternions = !a.has("raw-quaternions");
-  const G2oReadResult input = read_graph_input(a, graph_path, read);
+  const LoadedGraph input = load_graph(a, graph_path, read);
   const PoseGraph& graph = input.graph;
   CentralizedOptions opt;
   opt.initialization = parse_init(a.get_or("init", "chordal"));
@@ -76,7 +81,12 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   opt.max_rank = static_cast<int>(a.get_long("max-rank", std::max(opt.max_rank, opt.initial_rank)));
   opt.trust_region.grad_norm_tol = a.get_double("grad-tol", opt.trust_region.grad_norm_tol);
   opt.certify = !a.has("no-certify");
-  const CentralizedResult r = solve_centralized(graph, opt);
+  GncCentralizedResult gnc;
+  if (robust.kind == RobustKind::kGncTls)
+    gnc = solve_gnc_centralized(graph, {opt, robust, input.known_inlier});
+  else
+    gnc.final_solve = solve_centralized(graph, opt);
+  const CentralizedResult& r = gnc.final_solve;
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -86,6 +96,21 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
               r.certified ? (*r.certified ? "certified optimal" : "NOT certified")
                           : "not certified (skipped)",
               wall_s);
+  RobustSummary robust_summary;
+  robust_summary.options = robust;
+  robust_summary.outer_iterations = gnc.outer_iterations;
+  robust_summary.total_iterations = gnc.inner_iterations;
+  robust_summary.measurements = graph.num_measurements();
+  robust_summary.rejected = gnc.rejected;
+  robust_summary.threshold_squared = gnc.threshold_squared;
+  robust_summary.weights_converged = gnc.weights_converged;
+  if (robust.kind != RobustKind::kNone)
+    std::printf(
+        "robust %s: %d outer steps, %zu of %zu measurements rejected, cost over the "
+        "kept ones\n",
+        robust_kind_name(robust.kind), gnc.outer_iterations, gnc.rejected.size(),
+        graph.num_measurements());
+  if (auto p = a.get("rejected")) write_rejected(*p, gnc.rejected);
   write_solution_files(a, graph, input.keys, r.poses);
   if (auto p = a.get("trace")) write_trace(*p, r);
   if (auto p = a.get("json")) {
@@ -98,6 +123,7 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
     summary.relaxation_cost = r.relaxation_cost;
     summary.certified = r.certified;
     JsonObject j = solve_json(graph_path, graph, summary);
+    if (robust.kind != RobustKind::kNone) add_robust_fields(j, robust_summary);
     j.add("min_eigenvalue", r.min_eigenvalue)
         .add("final_rank", r.final_rank)
         .add("init_s", r.init_s)
@@ -122,19 +148,22 @@ int run_solve(const Args& args) {
   for (const char* const* o = kDistributedSwitches; *o; ++o) switches.insert(*o);
   for (const char* const* o = kOnlineValued; *o; ++o) valued.insert(*o);
   for (const char* const* o = kOnlineSwitches; *o; ++o) switches.insert(*o);
+  for (const char* const* o = kRobustValued; *o; ++o) valued.insert(*o);
   Arguments a(args, valued, switches);
   if (a.has("help")) {
-    std::printf("%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
-                kOnlineHelp);
+    std::printf("%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
+                kOnlineHelp, kRobustHelp);
     return 0;
   }
   if (a.positional().size() != 1)
     throw InputError("expected exactly one GRAPH argument (see tessera solve --help)");
   if (a.has("online")) return solve_online_command(a, a.positional()[0], start);
   const std::string algorithm = a.get_or("algorithm", "centralized");
-  if (algorithm == "centralized") return solve_centralized_command(a, a.positional()[0], start);
+  const RobustOptions robust = parse_robust_options(a);
+  if (algorithm == "centralized")
+    return solve_centralized_command(a, a.positional()[0], robust, start);
   if (algorithm == "rbcd" || algorithm == "rbcd++" || algorithm == "irbcd")
-    return solve_distributed_command(a, a.positional()[0], start);
+    return solve_distributed_command(a, a.positional()[0], robust, start);
   throw InputError("option --algorithm: '" + algorithm +
                    "' is not one of centralized, rbcd, rbcd++, irbcd");
 }

@@ -9,12 +9,15 @@
 #include <tessera/partition/partitioner.hpp>
 #include <tessera/partition/robot_partition.hpp>
 #include <tessera/partition/sequential_partition.hpp>
+#include <tessera/robust/gnc_distributed.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/util/input_error.hpp>
 
 #include "graph_input.hpp"
 #include "json_writer.hpp"
+#include "robust_args.hpp"
 #include "solve_output.hpp"
+#include "solver_graph.hpp"
 
 namespace tessera::cli {
 
@@ -143,6 +146,7 @@ void write_trace(const std::string& path, const DistributedResult& r) {
 }  // namespace
 
 int solve_distributed_command(const Arguments& a, const std::string& graph_path,
+                              const RobustOptions& robust,
                               std::chrono::steady_clock::time_point start) {
   DistributedOptions opt;
   opt.algorithm = parse_algorithm(a.get_or("algorithm", "irbcd"));
@@ -230,7 +234,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
 
   G2oReadOptions read;
   read.normalize_quaternions = !a.has("raw-quaternions");
-  const G2oReadResult input = read_graph_input(a, graph_path, read);
+  const LoadedGraph input = load_graph(a, graph_path, read);
   const PoseGraph& graph = input.graph;
   const double load_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -248,7 +252,12 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       part.metrics = compute_partition_metrics(graph_structure_from_pose_graph(graph),
                                                part.assignment, popt.parts);
     }
-  const DistributedResult r = solve_distributed(graph, part.assignment, opt);
+  GncDistributedResult gnc;
+  if (robust.kind == RobustKind::kGncTls)
+    gnc = solve_gnc_distributed(graph, part.assignment, {opt, robust, input.known_inlier});
+  else
+    gnc.final_solve = solve_distributed(graph, part.assignment, opt);
+  const DistributedResult& r = gnc.final_solve;
 
   std::optional<double> fstar;
   if (a.has("reference")) fstar = solve_centralized(graph).cost;
@@ -282,6 +291,13 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         r.certificate_tolerance, r.certificate_residual, r.certificate_rounds,
         r.certificate_bytes / 1e6, r.escape_rounds, r.escape_bytes / 1e6, r.final_rank);
   }
+  if (robust.kind != RobustKind::kNone)
+    std::printf(
+        "  robust %s: %d outer steps, %zu of %zu measurements rejected, %d rounds and %.3f MB "
+        "in all; cost over the kept ones\n",
+        robust_kind_name(robust.kind), gnc.outer_iterations, gnc.rejected.size(),
+        graph.num_measurements(), gnc.total_rounds, gnc.total_bytes / 1e6);
+  if (auto p = a.get("rejected")) write_rejected(*p, gnc.rejected);
   write_solution_files(a, graph, input.keys, r.poses);
   if (auto p = a.get("trace")) write_trace(*p, r);
   if (auto p = a.get("json")) {
@@ -338,6 +354,19 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       j.add_null("min_eigenvalue").add_null("certificate_rounds");
     }
     if (fstar) j.add("f_star", *fstar);
+    if (robust.kind != RobustKind::kNone) {
+      RobustSummary rs;
+      rs.options = robust;
+      rs.outer_iterations = gnc.outer_iterations;
+      rs.total_iterations = gnc.total_rounds;
+      rs.measurements = graph.num_measurements();
+      rs.rejected = gnc.rejected;
+      rs.threshold_squared = gnc.threshold_squared;
+      rs.weights_converged = gnc.weights_converged;
+      add_robust_fields(j, rs);
+      j.add("total_rounds", gnc.total_rounds)
+          .add("total_bytes", static_cast<long long>(gnc.total_bytes));
+    }
     write_output(*p, j.str());
   }
   return 0;

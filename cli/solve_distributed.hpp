@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <string>
+#include <tessera/robust/robust_options.hpp>
 
 #include "arguments.hpp"
 
@@ -15,7 +16,10 @@ extern const char* const kDistributedSwitches[];
 /// The help text of the distributed algorithms (appended to solve --help).
 extern const char* kDistributedHelp;
 
+/// With robust.kind = kGncTls the solve is GNC-TLS around the distributed solver
+/// (robust/gnc_distributed.hpp) and the summary gets the robust fields.
 int solve_distributed_command(const Arguments& args, const std::string& graph_path,
+                              const RobustOptions& robust,
                               std::chrono::steady_clock::time_point start);
 
 }  // namespace tessera::cli

@@ -1,8 +1,10 @@
+#include <cmath>
 #include <string>
 #include <tessera/generate/generator.hpp>
 
 #include "generate/closure_sampling.hpp"
 #include "generate/noise_model.hpp"
+#include "generate/outlier_sampling.hpp"
 #include "generate/random_stream.hpp"
 #include "generate/robot_ranges.hpp"
 #include "generate/trajectory.hpp"
@@ -13,12 +15,16 @@ namespace {
 // Independent random streams of one seed (stream 1 is the city walk, see trajectory.cpp).
 constexpr std::uint64_t kClosureStream = 2;
 constexpr std::uint64_t kNoiseStream = 3;
+constexpr std::uint64_t kOutlierStream = 4;
 
 std::string describe(const GeneratorOptions& o) {
   return std::string("generated ") + trajectory_kind_name(o.kind) +
          " poses=" + std::to_string(o.num_poses) + " robots=" + std::to_string(o.num_robots) +
          " seed=" + std::to_string(o.seed) + " rot_noise=" + std::to_string(o.rotation_noise) +
-         " trans_noise=" + std::to_string(o.translation_noise);
+         " trans_noise=" + std::to_string(o.translation_noise) +
+         (o.outlier_fraction > 0 ? std::string(" outliers=") + std::to_string(o.outlier_fraction) +
+                                       " " + outlier_kind_name(o.outlier_kind)
+                                 : std::string());
 }
 
 // Chain measurements (k, k+1) in id order, composed into the initial guess as they go.
@@ -51,6 +57,20 @@ void add_closures(const std::vector<PosePair>& closures, const std::vector<Pose>
   }
 }
 
+void add_outliers(const GeneratorOptions& o, const std::vector<Pose>& truth,
+                  const NoiseModel& noise, GeneratorResult& result) {
+  const auto count = static_cast<std::size_t>(
+      std::llround(o.outlier_fraction * static_cast<double>(result.loop_closures())));
+  if (count == 0) return;
+  RandomStream random(o.seed, kOutlierStream);
+  auto wrong = sample_outliers(count, o.outlier_kind, truth, result.robot_of, noise, random);
+  auto& measurements = result.graph.measurements;
+  for (auto& m : wrong) {
+    result.outliers.push_back(measurements.size());
+    measurements.push_back(std::move(m));
+  }
+}
+
 }  // namespace
 
 GeneratorResult generate_pose_graph(const GeneratorOptions& options) {
@@ -77,6 +97,7 @@ GeneratorResult generate_pose_graph(const GeneratorOptions& options) {
   result.graph.measurements.reserve(n - 1 + closures.size());
   add_chain(trajectory.poses, noise, noise_random, result);
   add_closures(closures, trajectory.poses, noise, noise_random, result);
+  add_outliers(options, trajectory.poses, noise, result);
   result.ground_truth = std::move(trajectory.poses);
   return result;
 }

@@ -17,6 +17,14 @@ constexpr KindName kKindNames[] = {{TrajectoryKind::kGrid3d, "grid3d"},
                                    {TrajectoryKind::kTorus, "torus"},
                                    {TrajectoryKind::kCity, "city"}};
 
+struct OutlierKindName {
+  OutlierKind kind;
+  const char* name;
+};
+constexpr OutlierKindName kOutlierKindNames[] = {{OutlierKind::kRandom, "random"},
+                                                 {OutlierKind::kGroup, "group"},
+                                                 {OutlierKind::kInterRobot, "inter-robot"}};
+
 std::string number_text(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", x);
@@ -35,6 +43,21 @@ const char* trajectory_kind_name(TrajectoryKind kind) {
   for (const auto& k : kKindNames)
     if (k.kind == kind) return k.name;
   return "unknown";
+}
+
+const char* outlier_kind_name(OutlierKind kind) {
+  for (const auto& k : kOutlierKindNames)
+    if (k.kind == kind) return k.name;
+  return "unknown";
+}
+
+OutlierKind parse_outlier_kind(const std::string& name) {
+  std::string valid;
+  for (const auto& k : kOutlierKindNames) {
+    if (name == k.name) return k.kind;
+    valid += valid.empty() ? k.name : std::string(", ") + k.name;
+  }
+  throw InputError("unknown outlier kind '" + name + "' (valid kinds: " + valid + ")");
 }
 
 TrajectoryKind parse_trajectory_kind(const std::string& name) {
@@ -59,6 +82,12 @@ void GeneratorOptions::validate() const {
                    "");
   require_in_range("rotation_noise", rotation_noise, 0.0, 1.0, " rad");
   require_in_range("translation_noise", translation_noise, 0.0, 100.0, " m");
+  require_in_range("outlier_fraction", outlier_fraction, 0.0, 0.9, "");
+  if (outlier_kind_name(outlier_kind) == std::string("unknown"))
+    throw InputError("generator option outlier_kind: not a known outlier kind");
+  if (outlier_fraction > 0 && outlier_kind == OutlierKind::kInterRobot && num_robots < 2)
+    throw InputError("generator option outlier_kind = inter-robot: needs num_robots >= 2 (got " +
+                     std::to_string(num_robots) + ")");
   if (trajectory_kind_name(kind) == std::string("unknown"))
     throw InputError("generator option kind: not a known trajectory kind");
 }

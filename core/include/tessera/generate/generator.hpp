@@ -13,8 +13,9 @@ namespace tessera {
 struct GeneratorResult {
   /// Noisy measurements: first the chain (k, k+1) for k = 0..n-2 -- odometry inside a robot,
   /// a rendezvous link where one robot's range ends and the next begins -- then the sampled
-  /// loop closures sorted by (i, j), always i < j. `initial` is the chain composed from
-  /// pose 0's true pose (odometry per robot, robots joined by their rendezvous links).
+  /// loop closures sorted by (i, j), always i < j, then the wrong closures (`outliers`). `initial`
+  /// is the chain composed from pose 0's true pose (odometry per robot, robots joined by their
+  /// rendezvous links).
   PoseGraph graph;
   std::vector<Pose> ground_truth;     ///< True pose of every id.
   std::vector<std::size_t> robot_of;  ///< Robot of every id (contiguous ranges).
@@ -22,6 +23,9 @@ struct GeneratorResult {
   std::size_t rendezvous_edges = 0;   ///< Chain edges between robots r and r+1 (N - 1).
   std::size_t intra_robot_closures = 0;
   std::size_t inter_robot_closures = 0;  ///< Sampled ones, rendezvous links not included.
+  /// Indices in graph.measurements of the added wrong closures (options.outlier_fraction):
+  /// always the last ones, in order. Not counted in the closure counts above.
+  std::vector<std::size_t> outliers;
 
   /// All non-odometry edges: intra + inter-robot closures + rendezvous links.
   std::size_t loop_closures() const {

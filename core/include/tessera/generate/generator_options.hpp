@@ -17,6 +17,18 @@ enum class TrajectoryKind {
             ///< revisits.
 };
 
+/// Which wrong loop closures the generator adds (GeneratorOptions::outlier_fraction).
+enum class OutlierKind {
+  kRandom,      ///< Random pose pairs with random relative poses.
+  kGroup,       ///< Groups of mutually consistent wrong closures (the harder case).
+  kInterRobot,  ///< Random, with the two ends on different robots.
+};
+
+/// "random", "group" or "inter-robot".
+const char* outlier_kind_name(OutlierKind kind);
+/// Inverse of outlier_kind_name; throws InputError listing the valid names otherwise.
+OutlierKind parse_outlier_kind(const std::string& name);
+
 /// "grid3d", "sphere", "torus" or "city".
 const char* trajectory_kind_name(TrajectoryKind kind);
 /// Inverse of trajectory_kind_name; throws InputError listing the valid names otherwise.
@@ -44,6 +56,12 @@ struct GeneratorOptions {
   /// Translation noise: standard deviation in metres of each component of the translation
   /// error, added in the frame of pose i. In [0, 100].
   double translation_noise = 0.05;
+  /// Wrong loop closures to add, as a fraction of the graph's loop closures (intra, inter and
+  /// rendezvous), in [0, 0.9]: round(F * loop closures) measurements, appended after the clean
+  /// ones from their own random stream, so the graph without them is the F = 0 graph.
+  double outlier_fraction = 0.0;
+  /// What the added closures look like; kInterRobot needs num_robots >= 2.
+  OutlierKind outlier_kind = OutlierKind::kRandom;
   /// Seeds every random choice; the same options give byte-identical graphs.
   std::uint64_t seed = 1;
 

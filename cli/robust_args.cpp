@@ -1,0 +1,76 @@
+#include "robust_args.hpp"
+
+#include <tessera/util/input_error.hpp>
+
+namespace tessera::cli {
+
+const char* const kRobustValued[] = {"robust",        "inlier-threshold", "inlier-quantile",
+                                     "gnc-max-outer", "gnc-mu-step",      "gnc-inner-rounds",
+                                     "known-inliers", "rejected",         nullptr};
+
+const char* const kRobustHelp =
+    "\n"
+    "Outlier rejection (docs/robust.md):\n"
+    "  --robust none|gnc-tls     none: plain least squares (default); gnc-tls: graduated\n"
+    "                            non-convexity with a truncated least-squares cost, then the\n"
+    "                            certified solve of the kept measurements (--certify for the\n"
+    "                            distributed algorithms)\n"
+    "  --inlier-threshold C      residual bound c: TLS charges min(r^2, c^2), r^2 = the edge's\n"
+    "                            term of the objective (default 0 = from the chi-square\n"
+    "                            quantile below, d(d+1)/2 degrees of freedom)\n"
+    "  --inlier-quantile P       chi-square probability of that default, in (0, 1); 0 =\n"
+    "                            1 - 1e-4/m for m rejectable edges (union bound) [0]\n"
+    "  --gnc-max-outer K         most outer steps, >= 1 [100]\n"
+    "  --gnc-mu-step S           mu grows by S per outer step, > 1 [1.4]\n"
+    "  --gnc-inner-rounds K      distributed: most rounds per inner solve, 0 = no cap [0]\n"
+    "  --known-inliers odometry|none   never reject edges between consecutive ids [odometry]\n"
+    "  --rejected FILE           write the rejected edge indices (from 0 over the EDGE lines)\n";
+
+RobustOptions parse_robust_options(const Arguments& args) {
+  RobustOptions o;
+  o.kind = parse_robust_kind(args.get_or("robust", robust_kind_name(o.kind)));
+  o.inlier_threshold = args.get_double("inlier-threshold", o.inlier_threshold);
+  o.inlier_quantile = args.get_double("inlier-quantile", o.inlier_quantile);
+  o.max_outer_iterations = static_cast<int>(args.get_long("gnc-max-outer", o.max_outer_iterations));
+  o.mu_step = args.get_double("gnc-mu-step", o.mu_step);
+  o.inner_max_rounds = static_cast<int>(args.get_long("gnc-inner-rounds", o.inner_max_rounds));
+  o.known_inliers =
+      parse_known_inliers(args.get_or("known-inliers", known_inliers_name(o.known_inliers)));
+  try {
+    o.validate();
+  } catch (const InputError& e) {
+    // Name the flag the user typed as well as the field.
+    const std::string what = e.what();
+    const char* flag = what.find("inlier_threshold") != std::string::npos   ? "--inlier-threshold"
+                       : what.find("inlier_quantile") != std::string::npos  ? "--inlier-quantile"
+                       : what.find("max_outer") != std::string::npos        ? "--gnc-max-outer"
+                       : what.find("mu_step") != std::string::npos          ? "--gnc-mu-step"
+                       : what.find("inner_max_rounds") != std::string::npos ? "--gnc-inner-rounds"
+                                                                            : "--robust";
+    throw InputError("option " + std::string(flag) + ": " + what);
+  }
+  if (o.kind == RobustKind::kNone && args.has("rejected"))
+    throw InputError("option --rejected: needs --robust gnc-tls");
+  return o;
+}
+
+void add_robust_fields(JsonObject& json, const RobustSummary& s) {
+  json.add("robust", robust_kind_name(s.options.kind))
+      .add("outer_iterations", s.outer_iterations)
+      .add("total_iterations", s.total_iterations)
+      .add("inliers", s.measurements - s.rejected.size())
+      .add("outliers", s.rejected.size())
+      .add("rejected", s.rejected)
+      .add("inlier_threshold_squared", s.threshold_squared)
+      .add("known_inliers", known_inliers_name(s.options.known_inliers))
+      .add("gnc_mu_step", s.options.mu_step)
+      .add("weights_converged", s.weights_converged);
+}
+
+void write_rejected(const std::string& path, const std::vector<std::size_t>& rejected) {
+  std::string text;
+  for (std::size_t e : rejected) text += std::to_string(e) + "\n";
+  write_output(path, text);
+}
+
+}  // namespace tessera::cli

@@ -1,0 +1,41 @@
+#pragma once
+// The robust-solve options of `tessera solve` (--robust, --inlier-threshold, ...) and the
+// JSON fields and --rejected file a robust solve adds to its output (docs/robust.md).
+
+#include <cstddef>
+#include <string>
+#include <tessera/robust/robust_options.hpp>
+#include <vector>
+
+#include "arguments.hpp"
+#include "json_writer.hpp"
+
+namespace tessera::cli {
+
+/// Valued option names (without "--"), null-terminated.
+extern const char* const kRobustValued[];
+/// Help text of those options.
+extern const char* const kRobustHelp;
+
+/// The options as given (defaults for absent ones), validated: InputError names the option.
+RobustOptions parse_robust_options(const Arguments& args);
+
+/// What a robust solve reports besides the usual summary.
+struct RobustSummary {
+  RobustOptions options;
+  int outer_iterations = 0;
+  int total_iterations = 0;  ///< Solver iterations (or rounds) of every solve, final included.
+  std::size_t measurements = 0;
+  std::vector<std::size_t> rejected;  ///< Indices over the EDGE lines, from 0, ascending.
+  double threshold_squared = 0;
+  bool weights_converged = false;
+};
+
+/// Appends robust, outer_iterations, total_iterations, inliers, outliers, rejected,
+/// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged.
+void add_robust_fields(JsonObject& json, const RobustSummary& summary);
+
+/// Writes one rejected index per line to `path` (InputError when it cannot).
+void write_rejected(const std::string& path, const std::vector<std::size_t>& rejected);
+
+}  // namespace tessera::cli

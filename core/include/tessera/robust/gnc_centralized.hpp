@@ -1,0 +1,47 @@
+#pragma once
+// GNC-TLS around the centralized certifiable solver (`tessera solve --algorithm centralized
+// --robust gnc-tls`): a plain solve, then outer steps of (closed-form weight update,
+// warm-started weighted solve) while mu grows, then the certified solve of the inlier set.
+
+#include <cstddef>
+#include <tessera/graph/pose_graph.hpp>
+#include <tessera/robust/robust_options.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <vector>
+
+namespace tessera {
+
+struct GncCentralizedOptions {
+  /// Settings of every solve. The inner (weighted) solves run without the certificate and
+  /// start from the previous solve's poses; the final solve of the inlier set uses them as
+  /// given (certify on: `certified` is then about the inlier set).
+  CentralizedOptions solver;
+  RobustOptions robust;  ///< kind is ignored: this is the GNC-TLS path.
+  /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
+  /// rule's measurements (a dpgo CSV file's is_known_inlier column).
+  std::vector<bool> known_inlier_flags;
+  /// Throws InputError naming the first bad field.
+  void validate() const;
+};
+
+struct GncCentralizedResult {
+  /// The final solve on the inlier graph: poses, cost over the kept measurements, certificate.
+  CentralizedResult final_solve;
+  std::vector<double> weights;        ///< Last weight of every measurement, in [0, 1].
+  std::vector<std::size_t> rejected;  ///< Measurements with weight 0 (< 0.5 if never binary).
+  int outer_iterations = 0;           ///< Weighted solves after the first plain one.
+  int inner_iterations = 0;           ///< Trust-region iterations of every solve, final included.
+  double threshold_squared = 0;       ///< c^2 used.
+  double final_mu = 0;                ///< mu of the last outer step (0: no step was needed).
+  bool weights_converged = false;     ///< sum w(1 - w) fell below the tolerance.
+};
+
+/// Runs GNC-TLS on `graph` and certifies the result on the inlier set. Measurements that the
+/// known-inlier rule names keep weight 1. Throws InputError on invalid options, and when the
+/// kept measurements no longer connect the poses (e.g. every measurement looks like an
+/// outlier): the message says how many were rejected and how many parts remain, instead of
+/// returning a collapsed estimate.
+GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
+                                           const GncCentralizedOptions& options);
+
+}  // namespace tessera

@@ -1,0 +1,69 @@
+#pragma once
+// GNC-TLS around the distributed solvers (`tessera solve --algorithm irbcd|rbcd|rbcd++
+// --robust gnc-tls`, in one process): each outer step is a warm-started distributed solve of
+// the weighted problem; the weight of every measurement is computed by one agent, the
+// *owner of its lower pose id* (assignment[min(i, j)]), from what that agent holds after a
+// solve: its own lifted poses and its neighbours' public ones. mu's start needs the largest
+// residual (a max over the agents' local maxima) and the stop needs every agent's "my
+// weights are binary" vote: two scalars per agent and outer step, the size of a round status.
+
+#include <cstddef>
+#include <cstdint>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/graph/pose_graph.hpp>
+#include <tessera/robust/robust_options.hpp>
+#include <vector>
+
+namespace tessera {
+
+struct GncDistributedOptions {
+  /// Settings of every distributed solve. Inner solves run without certification, warm-started
+  /// from the previous lifted iterate; the final solve of the inlier set certifies when
+  /// solver.certify is on.
+  DistributedOptions solver;
+  RobustOptions robust;  ///< kind is ignored: this is the GNC-TLS path.
+  /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
+  /// rule's measurements (a dpgo CSV file's is_known_inlier column).
+  std::vector<bool> known_inlier_flags;
+  void validate() const;  ///< Throws InputError naming the first bad field.
+};
+
+/// What one agent decides in an outer step.
+struct AgentWeights {
+  std::vector<std::size_t> measurements;  ///< The measurements it owns (ascending).
+  std::vector<double> weights;            ///< Their new weights, same order.
+  double max_residual_squared = 0;        ///< Over its owned non-known-inlier measurements.
+  double weight_spread = 0;               ///< sum w (1 - w) over its measurements.
+};
+
+/// The agent that computes measurement m's weight: the owner of min(m.i, m.j).
+int weight_owner(const Measurement& m, const std::vector<int>& assignment);
+
+/// Agent `agent`'s step: residuals of its measurements at the lifted iterate X (r x (d+1)n,
+/// global order; only the columns of its own poses and of the other ends of its measurements
+/// are read) and, for mu > 0, their TLS weights (known inliers keep 1). With mu = 0 the
+/// weights are all 1 (the residual maximum is what is wanted then). `flags`: empty or one
+/// per measurement, true = known inlier (GncDistributedOptions::known_inlier_flags).
+AgentWeights agent_weights(int agent, const PoseGraph& graph, const std::vector<int>& assignment,
+                           const Eigen::MatrixXd& X, const RobustOptions& robust, double c2,
+                           double mu, const std::vector<bool>& flags = {});
+
+struct GncDistributedResult {
+  DistributedResult final_solve;      ///< The inlier-set solve (cost over kept measurements).
+  std::vector<double> weights;        ///< Last weight of every measurement.
+  std::vector<std::size_t> rejected;  ///< Measurements with weight < 0.5 (0 when binary).
+  int outer_iterations = 0;
+  int total_rounds = 0;           ///< Rounds of every solve, final included.
+  std::uint64_t total_bytes = 0;  ///< Bytes of every solve plus the outer steps' votes.
+  double threshold_squared = 0;
+  bool weights_converged = false;
+};
+
+/// Runs GNC-TLS with the distributed solver on `assignment`'s blocks. Throws InputError on
+/// bad options and, like solve_gnc_centralized(), when the kept measurements leave the poses
+/// unconnected.
+GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
+                                           const std::vector<int>& assignment,
+                                           const GncDistributedOptions& options);
+
+}  // namespace tessera

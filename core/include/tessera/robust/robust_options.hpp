@@ -1,0 +1,63 @@
+#pragma once
+// Options of the robust (outlier-rejecting) solve: `--robust`, `--inlier-threshold`,
+// `--inlier-quantile`, `--gnc-max-outer`, `--gnc-mu-step`, `--known-inliers` (docs/robust.md).
+
+#include <string>
+
+namespace tessera {
+
+/// The robust scheme. kNone solves plain least squares (every measurement weight 1).
+enum class RobustKind {
+  kNone,
+  /// Graduated non-convexity with a truncated-least-squares cost (Yang, Antonante, Tzoumas,
+  /// Carlone 2020): an outer loop over mu, each step a warm-started weighted solve followed
+  /// by the closed-form TLS weight update.
+  kGncTls,
+};
+
+/// Which measurements are never down-weighted.
+enum class KnownInliers {
+  kOdometry,  ///< Measurements between consecutive pose ids (|i - j| = 1): odometry.
+  kNone,      ///< Every measurement may be rejected.
+};
+
+const char* robust_kind_name(RobustKind kind);              ///< "none" or "gnc-tls".
+RobustKind parse_robust_kind(const std::string& name);      ///< InputError lists valid names.
+const char* known_inliers_name(KnownInliers known);         ///< "odometry" or "none".
+KnownInliers parse_known_inliers(const std::string& name);  ///< InputError lists valid names.
+
+struct RobustOptions {
+  RobustKind kind = RobustKind::kNone;
+  /// Bound c on a measurement's whitened residual r (r^2 = kappa ||R_j - R_i R_ij||_F^2 +
+  /// tau ||t_j - t_i - R_i t_ij||^2, the measurement's term of the objective): TLS charges
+  /// min(r^2, c^2). 0 (default) means c^2 = a quantile of the chi-square distribution with
+  /// d(d+1)/2 degrees of freedom (3 in 2D, 6 in 3D), which is r^2's law for a measurement
+  /// whose noise matches its information (inlier_quantile says which). > 0 otherwise.
+  double inlier_threshold = 0.0;
+  /// Probability of that quantile, in (0, 1); 0 (default) means 1 - 1e-4 / m for m
+  /// measurements that may be rejected: the chance that *any* true measurement lies beyond
+  /// the bound at the truth is then about 1e-4 whatever the graph's size (a union bound).
+  /// Why so far out: GNC-TLS starts every edge with r^2 > c^2 / sqrt(2) below full weight and
+  /// can push such an edge out, and real files have true edges with r^2 near 27 at their
+  /// optimum (cubicle, 16,869 edges: 26.3; manhattan3500_sesync: 26.3), which 1 - 0.01 / m
+  /// (cubicle: c^2 = 37.7; sesync manhattan: 4 edges lost) or a fixed 0.9999 (c^2 = 27.9,
+  /// cubicle lost 3) do not clear. Outliers of any use lie orders of magnitude further out.
+  double inlier_quantile = 0.0;
+  /// Most outer GNC steps (weighted solves after the first plain one), >= 1.
+  int max_outer_iterations = 100;
+  /// mu grows by this factor each outer step, > 1. 1.4 is the paper's value.
+  double mu_step = 1.4;
+  /// Distributed solvers only: most rounds of each weighted inner solve (the first plain solve
+  /// and the final solve of the inlier set run to the solver's tolerance), >= 0, 0 = no cap. GNC
+  /// needs only a rough minimiser between weight updates (dpgo's robust mode also updates weights
+  /// after a fixed number of iterations).
+  int inner_max_rounds = 0;
+  KnownInliers known_inliers = KnownInliers::kOdometry;
+  /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
+  double weight_tolerance = 1e-6;
+
+  /// Throws InputError naming the first field out of range (e.g. "RobustOptions.mu_step").
+  void validate() const;
+};
+
+}  // namespace tessera

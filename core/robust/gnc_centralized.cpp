@@ -1,0 +1,87 @@
+#include <algorithm>
+#include <stdexcept>
+#include <tessera/robust/gnc_centralized.hpp>
+#include <tessera/robust/tls_weights.hpp>
+#include <tessera/robust/weighted_graph.hpp>
+
+namespace tessera {
+namespace {
+
+std::vector<double> residuals(const PoseGraph& graph, const std::vector<Pose>& poses) {
+  std::vector<double> r2(graph.num_measurements());
+  for (std::size_t e = 0; e < r2.size(); ++e) {
+    const Measurement& m = graph.measurements[e];
+    r2[e] = residual_squared(m, poses[m.i], poses[m.j]);
+  }
+  return r2;
+}
+
+void add_iterations(GncCentralizedResult& out, const CentralizedResult& solve) {
+  out.inner_iterations += solve.iterations;
+}
+
+}  // namespace
+
+void GncCentralizedOptions::validate() const {
+  solver.validate();
+  robust.validate();
+}
+
+GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
+                                           const GncCentralizedOptions& options) {
+  options.validate();
+  if (!options.known_inlier_flags.empty() &&
+      options.known_inlier_flags.size() != graph.num_measurements())
+    throw std::invalid_argument("solve_gnc_centralized: one known-inlier flag per measurement");
+  GncCentralizedResult out;
+  const RobustOptions& robust = options.robust;
+  const std::size_t m = graph.num_measurements();
+  std::vector<bool> known(m);
+  for (std::size_t e = 0; e < m; ++e)
+    known[e] = is_known_inlier(graph.measurements[e], robust.known_inliers) ||
+               (!options.known_inlier_flags.empty() && options.known_inlier_flags[e]);
+  out.threshold_squared = tls_threshold_squared(
+      robust, graph.d, static_cast<std::size_t>(std::count(known.begin(), known.end(), false)));
+  const double c2 = out.threshold_squared;
+
+  // Inner solves: no certificate (it only matters for the final inlier set), warm start.
+  CentralizedOptions inner = options.solver;
+  inner.certify = false;
+  CentralizedResult solve = solve_centralized(graph, inner);  // plain least squares
+  add_iterations(out, solve);
+  inner.initialization = Initialization::kFile;
+
+  out.weights.assign(m, 1.0);
+  std::vector<double> r2 = residuals(graph, solve.poses);
+  double max_r2 = 0;
+  for (std::size_t e = 0; e < m; ++e)
+    if (!known[e]) max_r2 = std::max(max_r2, r2[e]);
+  double mu = gnc_initial_mu(max_r2, c2);
+  out.weights_converged = mu == 0;  // every residual inside the bound: nothing to reject
+  while (!out.weights_converged && out.outer_iterations < robust.max_outer_iterations) {
+    double spread = 0;
+    for (std::size_t e = 0; e < m; ++e) {
+      out.weights[e] = known[e] ? 1.0 : tls_weight(r2[e], c2, mu);
+      spread += out.weights[e] * (1 - out.weights[e]);
+    }
+    solve = solve_centralized(weighted_graph(graph, out.weights, solve.poses), inner);
+    add_iterations(out, solve);
+    ++out.outer_iterations;
+    out.final_mu = mu;
+    r2 = residuals(graph, solve.poses);
+    out.weights_converged = spread <= robust.weight_tolerance;
+    mu *= robust.mu_step;
+  }
+
+  for (std::size_t e = 0; e < m; ++e)
+    if (out.weights[e] < 0.5) out.rejected.push_back(e);
+  PoseGraph inliers = inlier_graph(graph, out.rejected, solve.poses);
+  require_connected_inliers(graph, inliers, out.rejected.size());
+  CentralizedOptions final_options = options.solver;
+  final_options.initialization = Initialization::kFile;
+  out.final_solve = solve_centralized(inliers, final_options);
+  add_iterations(out, out.final_solve);
+  return out;
+}
+
+}  // namespace tessera

@@ -1,0 +1,134 @@
+#include <algorithm>
+#include <stdexcept>
+#include <tessera/robust/gnc_distributed.hpp>
+#include <tessera/robust/tls_weights.hpp>
+#include <tessera/robust/weighted_graph.hpp>
+
+namespace tessera {
+namespace {
+
+// Bytes of one agent's outer-step broadcast: its residual maximum and its weight spread (two
+// doubles, to N - 1 agents) and, per cut measurement it owns, the index and the weight it
+// sends to the other end.
+std::uint64_t outer_step_bytes(const PoseGraph& graph, const std::vector<int>& assignment,
+                               int agents) {
+  std::uint64_t cut = 0;
+  for (const auto& m : graph.measurements)
+    if (assignment[m.i] != assignment[m.j]) ++cut;
+  return static_cast<std::uint64_t>(agents) * static_cast<std::uint64_t>(agents - 1) * 16 +
+         cut * 16;
+}
+
+// The lifted residual of m at X: the measurement's term of the relaxed objective,
+// kappa ||Y_j - Y_i R_ij||_F^2 + tau ||p_j - p_i - Y_i t_ij||^2 (the rounded residual when X
+// has rank d).
+double lifted_residual_squared(const Measurement& m, const Eigen::MatrixXd& X, int d) {
+  const Eigen::Index w = d + 1;
+  const auto Xi = X.middleCols(w * static_cast<Eigen::Index>(m.i), w);
+  const auto Xj = X.middleCols(w * static_cast<Eigen::Index>(m.j), w);
+  const auto Yi = Xi.leftCols(d);
+  return m.kappa * (Xj.leftCols(d) - Yi * m.R).squaredNorm() +
+         m.tau * (Xj.col(d) - Xi.col(d) - Yi * m.t).squaredNorm();
+}
+
+}  // namespace
+
+void GncDistributedOptions::validate() const {
+  solver.validate();
+  robust.validate();
+}
+
+int weight_owner(const Measurement& m, const std::vector<int>& assignment) {
+  return assignment[std::min(m.i, m.j)];
+}
+
+AgentWeights agent_weights(int agent, const PoseGraph& graph, const std::vector<int>& assignment,
+                           const Eigen::MatrixXd& X, const RobustOptions& robust, double c2,
+                           double mu, const std::vector<bool>& flags) {
+  AgentWeights out;
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e) {
+    const Measurement& m = graph.measurements[e];
+    if (weight_owner(m, assignment) != agent) continue;
+    double w = 1.0;
+    if (!is_known_inlier(m, robust.known_inliers) && (flags.empty() || !flags[e])) {
+      const double r2 = lifted_residual_squared(m, X, graph.d);
+      out.max_residual_squared = std::max(out.max_residual_squared, r2);
+      if (mu > 0) w = tls_weight(r2, c2, mu);
+    }
+    out.measurements.push_back(e);
+    out.weights.push_back(w);
+    out.weight_spread += w * (1 - w);
+  }
+  return out;
+}
+
+GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
+                                           const std::vector<int>& assignment,
+                                           const GncDistributedOptions& options) {
+  options.validate();
+  if (!options.known_inlier_flags.empty() &&
+      options.known_inlier_flags.size() != graph.num_measurements())
+    throw std::invalid_argument("solve_gnc_distributed: one known-inlier flag per measurement");
+  GncDistributedResult out;
+  const RobustOptions& robust = options.robust;
+  // The candidates' count is one more integer in the first residual vote.
+  std::size_t candidates = 0;
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e)
+    candidates += is_known_inlier(graph.measurements[e], robust.known_inliers) ||
+                          (!options.known_inlier_flags.empty() && options.known_inlier_flags[e])
+                      ? 0
+                      : 1;
+  out.threshold_squared = tls_threshold_squared(robust, graph.d, candidates);
+  const double c2 = out.threshold_squared;
+  const int agents = *std::max_element(assignment.begin(), assignment.end()) + 1;
+  const std::uint64_t vote_bytes = outer_step_bytes(graph, assignment, agents);
+
+  DistributedOptions inner = options.solver;
+  inner.certify = false;
+  DistributedResult solve = solve_distributed(graph, assignment, inner);
+  out.total_rounds += solve.rounds;
+  out.total_bytes += solve.bytes_exchanged;
+
+  // Every agent reports its residual maximum; all take the same max (agent-id order).
+  double max_r2 = 0;
+  for (int a = 0; a < agents; ++a)
+    max_r2 = std::max(max_r2, agent_weights(a, graph, assignment, solve.X, robust, c2, 0,
+                                            options.known_inlier_flags)
+                                  .max_residual_squared);
+  out.total_bytes += vote_bytes;
+  // The plain solve runs to the tolerance (mu's start and the first weights depend on its
+  // residuals); only the weighted solves between weight updates are capped.
+  if (robust.inner_max_rounds > 0)
+    inner.max_rounds = std::min(inner.max_rounds, robust.inner_max_rounds);
+  out.weights.assign(graph.num_measurements(), 1.0);
+  double mu = gnc_initial_mu(max_r2, c2);
+  out.weights_converged = mu == 0;
+  while (!out.weights_converged && out.outer_iterations < robust.max_outer_iterations) {
+    double spread = 0;
+    for (int a = 0; a < agents; ++a) {
+      const AgentWeights mine =
+          agent_weights(a, graph, assignment, solve.X, robust, c2, mu, options.known_inlier_flags);
+      for (std::size_t k = 0; k < mine.measurements.size(); ++k)
+        out.weights[mine.measurements[k]] = mine.weights[k];
+      spread += mine.weight_spread;
+    }
+    solve = solve_distributed_from_lifted(weighted_graph(graph, out.weights, {}), assignment, inner,
+                                          solve.X);
+    out.total_rounds += solve.rounds;
+    out.total_bytes += solve.bytes_exchanged + vote_bytes;
+    ++out.outer_iterations;
+    out.weights_converged = spread <= robust.weight_tolerance;
+    mu *= robust.mu_step;
+  }
+
+  for (std::size_t e = 0; e < out.weights.size(); ++e)
+    if (out.weights[e] < 0.5) out.rejected.push_back(e);
+  const PoseGraph inliers = inlier_graph(graph, out.rejected, {});
+  require_connected_inliers(graph, inliers, out.rejected.size());
+  out.final_solve = solve_distributed_from_lifted(inliers, assignment, options.solver, solve.X);
+  out.total_rounds += out.final_solve.rounds;
+  out.total_bytes += out.final_solve.bytes_exchanged;
+  return out;
+}
+
+}  // namespace tessera

@@ -1,0 +1,58 @@
+#include <cmath>
+#include <cstdio>
+#include <tessera/robust/robust_options.hpp>
+#include <tessera/util/input_error.hpp>
+
+namespace tessera {
+namespace {
+
+std::string number_text(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+[[noreturn]] void bad_field(const char* field, const std::string& value, const char* rule) {
+  throw InputError(std::string("RobustOptions.") + field + " = " + value + ": " + rule);
+}
+
+}  // namespace
+
+const char* robust_kind_name(RobustKind kind) {
+  return kind == RobustKind::kGncTls ? "gnc-tls" : "none";
+}
+
+RobustKind parse_robust_kind(const std::string& name) {
+  if (name == "none") return RobustKind::kNone;
+  if (name == "gnc-tls") return RobustKind::kGncTls;
+  throw InputError("unknown robust scheme '" + name + "' (valid: none, gnc-tls)");
+}
+
+const char* known_inliers_name(KnownInliers known) {
+  return known == KnownInliers::kOdometry ? "odometry" : "none";
+}
+
+KnownInliers parse_known_inliers(const std::string& name) {
+  if (name == "odometry") return KnownInliers::kOdometry;
+  if (name == "none") return KnownInliers::kNone;
+  throw InputError("unknown known-inlier set '" + name + "' (valid: odometry, none)");
+}
+
+void RobustOptions::validate() const {
+  if (!(std::isfinite(inlier_threshold) && inlier_threshold >= 0))
+    bad_field("inlier_threshold", number_text(inlier_threshold),
+              "must be >= 0 (0 = from the chi-square quantile)");
+  if (!(inlier_quantile >= 0 && inlier_quantile < 1))
+    bad_field("inlier_quantile", number_text(inlier_quantile),
+              "must be in (0, 1), or 0 for 1 - 1e-4 / measurements");
+  if (max_outer_iterations < 1)
+    bad_field("max_outer_iterations", std::to_string(max_outer_iterations), "must be >= 1");
+  if (inner_max_rounds < 0)
+    bad_field("inner_max_rounds", std::to_string(inner_max_rounds), "must be >= 0 (0 = no cap)");
+  if (!(std::isfinite(mu_step) && mu_step > 1))
+    bad_field("mu_step", number_text(mu_step), "must be > 1");
+  if (!(std::isfinite(weight_tolerance) && weight_tolerance >= 0))
+    bad_field("weight_tolerance", number_text(weight_tolerance), "must be >= 0");
+}
+
+}  // namespace tessera

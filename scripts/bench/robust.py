@@ -1,0 +1,413 @@
+#!/usr/bin/env python3
+"""Outlier rejection benchmark: `tessera solve --robust gnc-tls` against the plain solve of the
+same file, on graphs with known wrong loop closures (docs/benchmarks/README.md, "Robust").
+
+Per graph, the clean file is solved once (its optimum f*_clean and poses are the reference);
+then for each outlier kind and fraction F (of the graph's loop closures) wrong closures are
+appended and the robust and plain solves run. Per cell: precision and recall of the rejected
+set against the labels, relative gap of the robust cost (over the kept measurements) to
+f*_clean, ATE of the estimate against the clean optimum after a rigid alignment, outer steps,
+solver iterations, wall time, certified; beside it the plain solve's cost gap and ATE.
+
+Generated 3D grid: `tessera generate --outliers F --outlier-kind K --labels FILE`. Shared
+datasets: the outliers are appended here in the same way (random: uniform pose pairs, random
+relative pose, the information of a random loop closure of the file; group: groups of 10
+closures (a+k, b+k) all measuring one wrong rigid motion of the clean optimum), since the
+generator only makes synthetic graphs.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+import bench_common  # noqa: E402
+
+GROUP = 10
+ALL_GRAPHS = ["grid3d", "intel", "CSAIL", "manhattan3500", "sphere2500", "torus3D", "city10000"]
+
+
+def progress(msg):
+    print(f"[{time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
+
+
+# ---- SE(d) helpers (poses as (R, t): 2D (theta, [x, y]); 3D (quaternion [w, x, y, z], [x, y, z]))
+def qmul(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return [w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2]
+
+
+def qconj(q):
+    return [q[0], -q[1], -q[2], -q[3]]
+
+
+def qrot(q, v):
+    return qmul(qmul(q, [0.0] + list(v)), qconj(q))[1:]
+
+
+def compose(d, a, b):
+    if d == 2:
+        c, s = math.cos(a[0]), math.sin(a[0])
+        return (a[0] + b[0], [a[1][0] + c * b[1][0] - s * b[1][1], a[1][1] + s * b[1][0] + c * b[1][1]])
+    t = qrot(a[0], b[1])
+    return (qmul(a[0], b[0]), [a[1][k] + t[k] for k in range(3)])
+
+
+def inverse(d, a):
+    if d == 2:
+        c, s = math.cos(a[0]), math.sin(a[0])
+        return (-a[0], [-(c * a[1][0] + s * a[1][1]), -(-s * a[1][0] + c * a[1][1])])
+    qi = qconj(a[0])
+    t = qrot(qi, a[1])
+    return (qi, [-x for x in t])
+
+
+def random_rotation(d, rng):
+    if d == 2:
+        return rng.uniform(-math.pi, math.pi)
+    q = [rng.gauss(0, 1) for _ in range(4)]
+    n = math.sqrt(sum(x * x for x in q))
+    return [x / n for x in q]
+
+
+# ---- g2o files
+def read_edges(path):
+    """(d, vertex lines, edge lines as token lists)."""
+    vertices, edges, d = [], [], 0
+    with open(path) as f:
+        for line in f:
+            tok = line.split()
+            if not tok:
+                continue
+            if tok[0].startswith("VERTEX"):
+                vertices.append(line.rstrip("\n"))
+            elif tok[0].startswith("EDGE"):
+                d = 2 if tok[0] == "EDGE_SE2" else 3
+                edges.append(tok)
+    return d, vertices, edges
+
+
+def read_tum(path, d):
+    """Poses of a TUM file written by tessera (2D: yaw from the quaternion)."""
+    poses = []
+    with open(path) as f:
+        for line in f:
+            v = [float(x) for x in line.split()]
+            if len(v) < 8:
+                continue
+            t, (qx, qy, qz, qw) = v[1:4], v[4:8]
+            if d == 2:
+                poses.append((2 * math.atan2(qz, qw), t[:2]))
+            else:
+                poses.append(([qw, qx, qy, qz], t))
+    return poses
+
+
+def edge_tokens(d, i, j, rel, info):
+    if d == 2:
+        return ["EDGE_SE2", str(i), str(j), repr(rel[1][0]), repr(rel[1][1]), repr(rel[0])] + info
+    q = rel[0]
+    return ["EDGE_SE3:QUAT", str(i), str(j)] + [repr(x) for x in rel[1]] + [repr(q[1]), repr(q[2]), repr(q[3]),
+                                                                             repr(q[0])] + info
+
+
+def inject(clean_path, out_path, labels_path, fraction, kind, seed, optimum):
+    """Appends round(F * loop closures) wrong closures to the clean file; writes the labels."""
+    d, vertices, edges = read_edges(clean_path)
+    rng = random.Random(seed)
+    n = len(optimum)
+    closures = [e for e in edges if abs(int(e[1]) - int(e[2])) != 1] or edges
+    count = int(round(fraction * len(closures)))
+    info_at = 6 if d == 2 else 10
+    lo = [min(p[1][k] for p in optimum) for k in range(d)]
+    size = [max(1.0, max(p[1][k] for p in optimum) - lo[k]) for k in range(d)]
+
+    def random_pose():
+        return (random_rotation(d, rng), [lo[k] + size[k] * rng.uniform(0, 1) for k in range(d)])
+
+    added = []
+    while len(added) < count:
+        info = rng.choice(closures)[info_at:]
+        if kind == "random" or n < 2 * GROUP + 2:
+            while True:
+                a, b = sorted((rng.randrange(n), rng.randrange(n)))
+                if b > a + 1:
+                    break
+            added.append(edge_tokens(d, a, b, random_pose(), info))
+            continue
+        g = min(GROUP, count - len(added))
+        a = rng.randrange(n - 2 * g - 1)
+        b = a + g + 1 + rng.randrange(n - 2 * g - a)
+        motion = random_pose()
+        for k in range(g):
+            moved = compose(d, motion, optimum[b + k])
+            rel = compose(d, inverse(d, optimum[a + k]), moved)
+            added.append(edge_tokens(d, a + k, b + k, rel, info))
+    with open(out_path, "w") as f:
+        for v in vertices:
+            f.write(v + "\n")
+        for e in edges + added:
+            f.write(" ".join(e) + "\n")
+    with open(labels_path, "w") as f:
+        json.dump({"outliers": list(range(len(edges), len(edges) + len(added)))}, f)
+
+
+# ---- alignment (Horn's closed form; 3D eigenvector by Jacobi rotations)
+def jacobi_top_eigenvector(a):
+    n = len(a)
+    a = [row[:] for row in a]
+    v = [[1.0 if i == j else 0.0 for j in range(n)] for i in range(n)]
+    for _ in range(100):
+        off = sum(a[i][j] ** 2 for i in range(n) for j in range(n) if i != j)
+        if off < 1e-30:
+            break
+        for p in range(n):
+            for q in range(p + 1, n):
+                if abs(a[p][q]) < 1e-300:
+                    continue
+                theta = (a[q][q] - a[p][p]) / (2 * a[p][q])
+                t = (1 if theta >= 0 else -1) / (abs(theta) + math.sqrt(theta * theta + 1))
+                c = 1 / math.sqrt(t * t + 1)
+                s = t * c
+                for k in range(n):
+                    akp, akq = a[k][p], a[k][q]
+                    a[k][p], a[k][q] = c * akp - s * akq, s * akp + c * akq
+                for k in range(n):
+                    apk, aqk = a[p][k], a[q][k]
+                    a[p][k], a[q][k] = c * apk - s * aqk, s * apk + c * aqk
+                for k in range(n):
+                    vkp, vkq = v[k][p], v[k][q]
+                    v[k][p], v[k][q] = c * vkp - s * vkq, s * vkp + c * vkq
+    best = max(range(n), key=lambda i: a[i][i])
+    return [v[k][best] for k in range(n)]
+
+
+def ate(estimate, reference, d):
+    """RMS translation error after the rigid motion that best aligns estimate to reference."""
+    n = len(reference)
+    ps = [p[1] for p in estimate]
+    qs = [p[1] for p in reference]
+    cp = [sum(p[k] for p in ps) / n for k in range(d)]
+    cq = [sum(q[k] for q in qs) / n for k in range(d)]
+    x = [[p[k] - cp[k] for k in range(d)] for p in ps]
+    y = [[q[k] - cq[k] for k in range(d)] for q in qs]
+    if d == 2:
+        sxx = sum(a[0] * b[0] + a[1] * b[1] for a, b in zip(x, y))
+        sxy = sum(a[0] * b[1] - a[1] * b[0] for a, b in zip(x, y))
+        th = math.atan2(sxy, sxx)
+        c, s = math.cos(th), math.sin(th)
+        err = sum((c * a[0] - s * a[1] - b[0]) ** 2 + (s * a[0] + c * a[1] - b[1]) ** 2 for a, b in zip(x, y))
+        return math.sqrt(err / n)
+    m = [[sum(a[i] * b[j] for a, b in zip(x, y)) for j in range(3)] for i in range(3)]
+    (sxx, sxy, sxz), (syx, syy, syz), (szx, szy, szz) = m
+    nmat = [[sxx + syy + szz, syz - szy, szx - sxz, sxy - syx],
+            [syz - szy, sxx - syy - szz, sxy + syx, szx + sxz],
+            [szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy],
+            [sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz]]
+    q = jacobi_top_eigenvector(nmat)
+    err = 0.0
+    for a, b in zip(x, y):
+        r = qrot(q, a)
+        err += sum((r[k] - b[k]) ** 2 for k in range(3))
+    return math.sqrt(err / n)
+
+
+# ---- runs
+def solve(tessera, graph, work, tag, extra, timeout, algorithm="centralized"):
+    js = os.path.join(work, tag + ".json")
+    tum = os.path.join(work, tag + ".tum")
+    cmd = [tessera, "solve", graph, "--algorithm", algorithm, "--json", js, "--out", tum] + extra
+    if algorithm != "centralized":
+        # N = 5 agents on contiguous id ranges (the robots of the multi-robot convention)
+        cmd += ["--agents", "5", "--partition", "sequential", "--certify"]
+    t0 = time.monotonic()
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    wall = time.monotonic() - t0
+    if p.returncode != 0:
+        return None, None, wall, p.stdout.strip().splitlines()[-1] if p.stdout.strip() else str(p.returncode)
+    with open(js) as f:
+        return json.load(f), tum, wall, ""
+
+
+def clean_graph(args, work, name):
+    if name == "grid3d":
+        path = os.path.join(work, "grid3d_clean.g2o")
+        subprocess.run([args.bin, "generate", "--kind", "grid3d", "--poses", str(args.grid_poses), "--robots",
+                        "5", "--seed", "1", "--out", path], check=True, stdout=subprocess.DEVNULL)
+        return path
+    return os.path.join(args.shared, "datasets", name + ".g2o")
+
+
+def dirty_graph(args, work, name, clean, kind, fraction, optimum):
+    tag = f"{name}_{kind}_{fraction}"
+    path, labels = os.path.join(work, tag + ".g2o"), os.path.join(work, tag + ".labels.json")
+    if name == "grid3d":
+        subprocess.run([args.bin, "generate", "--kind", "grid3d", "--poses", str(args.grid_poses), "--robots", "5",
+                        "--seed", "1", "--outliers", str(fraction), "--outlier-kind", kind, "--labels", labels,
+                        "--out", path], check=True, stdout=subprocess.DEVNULL)
+    else:
+        inject(clean, path, labels, fraction, kind, args.seed, optimum)
+    with open(labels) as f:
+        return path, json.load(f)["outliers"]
+
+
+def plot(csv_path, png_path):
+    """Three panels against F: recall and precision of the rejected set, |relative gap| to
+    f*_clean, ATE of the robust and of the plain estimate (solid random, dashed group)."""
+    plt = bench_common.pyplot()
+    with open(csv_path) as f:
+        rows = list(csv.DictReader(f))
+    graphs = []
+    for r in rows:
+        if r["graph"] not in graphs:
+            graphs.append(r["graph"])
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+
+    def series(g, kind, key):
+        pts = []
+        for r in rows:
+            if r["graph"] == g and (r["kind"] == kind or float(r["F"]) == 0) and r.get(key, "") != "":
+                pts.append((float(r["F"]), float(r[key])))
+        return sorted(pts)
+
+    for n, g in enumerate(graphs):
+        c = colours[n % len(colours)]
+        for kind, style in (("random", "-"), ("group", "--")):
+            label = f"{g} {kind}"
+            pts = series(g, kind, "recall")
+            if pts:
+                ax[0].plot(*zip(*pts), style, color=c, marker="o", label=label)
+            pts = series(g, kind, "precision")
+            if pts:
+                ax[0].plot(*zip(*pts), style, color=c, marker="x", alpha=0.5)
+            pts = [(x, max(abs(y), 1e-16)) for x, y in series(g, kind, "gap")]
+            if pts:
+                ax[1].semilogy(*zip(*pts), style, color=c, marker="o", label=label)
+            pts = [(x, max(y, 1e-9)) for x, y in series(g, kind, "ate_m")]
+            if pts:
+                ax[2].semilogy(*zip(*pts), style, color=c, marker="o", label=label + " robust")
+            pts = [(x, max(y, 1e-9)) for x, y in series(g, kind, "plain_ate_m")]
+            if pts:
+                ax[2].semilogy(*zip(*pts), style, color=c, marker="s", alpha=0.35)
+    ax[0].set(xlabel="outlier fraction F", ylabel="recall (o) / precision (x)", title="rejected set vs labels")
+    ax[1].set(xlabel="outlier fraction F", ylabel="|cost - f*_clean| / f*_clean", title="cost over the kept edges")
+    ax[2].set(xlabel="outlier fraction F", ylabel="ATE to the clean optimum [m]",
+              title="ATE: robust (o) vs plain (faint squares)")
+    ax[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(png_path, dpi=90)
+    plt.close(fig)
+    progress(f"wrote {png_path}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin", "tessera"))
+    ap.add_argument("--shared", default=bench_common.DEFAULT_SHARED)
+    ap.add_argument("--out-dir", default=bench_common.OUT_DIR)
+    ap.add_argument("--graphs", default=",".join(ALL_GRAPHS))
+    ap.add_argument("--fractions", default="0,0.1,0.25,0.5,0.75")
+    ap.add_argument("--kinds", default="random,group")
+    ap.add_argument("--grid-poses", type=int, default=1000)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--timeout", type=float, default=1800, help="seconds per solve")
+    ap.add_argument("--no-distributed", dest="distributed", action="store_false",
+                    help="skip the distributed (irbcd, 5 agents) column")
+    ap.add_argument("--csv", default="robust.csv", help="file name in --out-dir (rows are appended per cell)")
+    ap.add_argument("--plot-only", action="store_true", help="only redraw the figure from the CSV")
+    args = ap.parse_args()
+    os.makedirs(args.out_dir, exist_ok=True)
+    out_csv = os.path.join(args.out_dir, args.csv)
+    png = os.path.join(args.out_dir, os.path.splitext(args.csv)[0] + ".png")
+    if args.plot_only:
+        plot(out_csv, png)
+        return
+    fields = ["graph", "kind", "F", "outliers", "rejected", "precision", "recall", "gap", "ate_m", "outer",
+              "iterations", "wall_s", "certified", "plain_gap", "plain_ate_m", "plain_wall_s",
+              "d_rejected", "d_precision", "d_recall", "d_gap", "d_ate_m", "d_outer", "d_rounds", "d_clean_rounds",
+              "d_round_ratio", "d_bytes", "d_wall_s", "d_certified", "load", "note"]
+    with open(out_csv, "w", newline="") as f:
+        csv.writer(f).writerow(fields)
+    work = tempfile.mkdtemp(prefix="tessera-robust-")
+    for name in args.graphs.split(","):
+        clean = clean_graph(args, work, name)
+        progress(f"{name}: clean solve")
+        ref, ref_tum, _, err = solve(args.bin, clean, work, name + "_clean", [], args.timeout)
+        if ref is None:
+            progress(f"{name}: clean solve failed: {err}")
+            continue
+        d = ref["d"]
+        optimum = read_tum(ref_tum, d)
+        fstar = ref["cost"]
+        dref = None
+        if args.distributed:
+            dref, _, _, _ = solve(args.bin, clean, work, name + "_dclean", [], args.timeout, "irbcd")
+        for kind in args.kinds.split(","):
+            for fraction in [float(x) for x in args.fractions.split(",")]:
+                if fraction == 0 and kind != args.kinds.split(",")[0]:
+                    continue  # F = 0 is the same file for every kind
+                path, labels = dirty_graph(args, work, name, clean, kind, fraction, optimum)
+                tag = f"{name}_{kind}_{fraction}"
+                progress(f"{tag}: {len(labels)} outliers")
+                load = open("/proc/loadavg").read().split()[0]
+                rej = os.path.join(work, tag + ".rejected")
+                rob, rob_tum, wall, err = solve(args.bin, path, work, tag + "_robust",
+                                                ["--robust", "gnc-tls", "--rejected", rej], args.timeout)
+                plain, plain_tum, plain_wall, _ = solve(args.bin, path, work, tag + "_plain", [], args.timeout)
+                row = {"graph": name, "kind": kind, "F": fraction, "outliers": len(labels), "load": load}
+                if plain is not None:
+                    row.update(plain_gap=(plain["cost"] - fstar) / fstar,
+                               plain_ate_m=ate(read_tum(plain_tum, d), optimum, d), plain_wall_s=round(plain_wall, 2))
+                if rob is None:
+                    row["note"] = err
+                else:
+                    rejected = set(rob["rejected"])
+                    truth = set(labels)
+                    hit = len(rejected & truth)
+                    row.update(rejected=len(rejected),
+                               precision=hit / len(rejected) if rejected else 1.0,
+                               recall=hit / len(truth) if truth else 1.0,
+                               gap=(rob["cost"] - fstar) / fstar,
+                               ate_m=ate(read_tum(rob_tum, d), optimum, d),
+                               outer=rob["outer_iterations"], iterations=rob["total_iterations"],
+                               wall_s=round(wall, 2), certified=rob["certified"])
+                if args.distributed:
+                    drob, drob_tum, dwall, derr = solve(args.bin, path, work, tag + "_drobust",
+                                                        ["--robust", "gnc-tls"], args.timeout, "irbcd")
+                    if drob is None:
+                        row["note"] = (row.get("note", "") + " distributed: " + derr).strip()
+                    else:
+                        rejected = set(drob["rejected"])
+                        truth = set(labels)
+                        hit = len(rejected & truth)
+                        row.update(d_rejected=len(rejected),
+                                   d_precision=hit / len(rejected) if rejected else 1.0,
+                                   d_recall=hit / len(truth) if truth else 1.0,
+                                   d_gap=(drob["cost"] - fstar) / fstar,
+                                   d_ate_m=ate(read_tum(drob_tum, d), optimum, d),
+                                   d_outer=drob["outer_iterations"], d_rounds=drob["total_rounds"],
+                                   d_bytes=drob["total_bytes"], d_wall_s=round(dwall, 2),
+                                   d_certified=drob["certified"])
+                        if dref is not None:
+                            row.update(d_clean_rounds=dref["rounds"],
+                                       d_round_ratio=drob["total_rounds"] / max(1, dref["rounds"]))
+                progress("  " + ", ".join(f"{k}={row.get(k, '')}" for k in fields[3:]))
+                with open(out_csv, "a", newline="") as f:
+                    csv.writer(f).writerow([row.get(k, "") for k in fields])
+    progress(f"wrote {out_csv}")
+    plot(out_csv, png)
+
+
+if __name__ == "__main__":
+    main()
