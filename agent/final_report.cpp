@@ -8,6 +8,7 @@
 #include "agent/dds_channel.hpp"
 #include "agent/test_abort_hook.hpp"
 #include "runtime/local_dump.hpp"
+#include "runtime/peak_memory.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
 
@@ -48,6 +49,7 @@ void deliver_final_estimate(Session& s, const AgentLocalData& local, const Round
   for (const Pose& p : result.poses) append_flat_pose(fin.pose_data(), p);
   fin.bytes_sent(s.stats().bytes_sent + serialized_size(fin));
   fin.epoch(s.epoch());
+  fin.peak_rss_bytes(peak_resident_bytes());
   s.publish(fin);
   // Until FINISHED, a rollback (another agent rejoined) means doing the rounds again.
   const auto wait_start = std::chrono::steady_clock::now();

@@ -42,6 +42,14 @@ void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timel
   };
   const auto t0 = std::chrono::steady_clock::now();
   timeline.mark_at("session", t0);
+  // The set-up's steps as progress lines: on a large graph they take minutes before the first
+  // round, which would otherwise show only the status line's "rounds -".
+  const auto setup_line = [&](const std::string& what) {
+    if (!o.progress) return;
+    char at[32];
+    std::snprintf(at, sizeof(at), "set-up %.1fs: ", ms_since(t0) / 1000.0);
+    std::cout << at << what << "\n" << std::flush;
+  };
   const std::uint32_t N = o.agents;
 
   // 0. With the whole file on this host (--graph, as tessera launch runs): its partition has
@@ -80,6 +88,8 @@ void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timel
   log("all " + std::to_string(N) + " agents announced (" +
       std::to_string(static_cast<long>(discovery_ms)) + " ms): " + std::to_string(rs.num_poses) +
       " poses, " + std::to_string(rs.num_measurements) + " measurements");
+  setup_line("all " + std::to_string(N) + " agents announced: " + std::to_string(rs.num_poses) +
+             " poses, " + std::to_string(rs.num_measurements) + " measurements");
 
   // 2. Partition (unless the file's, computed above, is this very structure) and publish the
   // assignment.
@@ -95,10 +105,15 @@ void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timel
     log("partition (" + o.partition + "): cut " + std::to_string(part.cut_edges) +
         " measurements in " + std::to_string(part.ms) + " ms");
   }
+  setup_line("partition (" + o.partition + "): cut " + std::to_string(part.cut_edges) +
+             " measurements in " + std::to_string(static_cast<long>(part.ms)) + " ms");
   const wire::PartitionAssignment base = make_assignment(o, rs, part);
   publish_assignment(s, base, o.certify, o.net.timeout_s);
   log("all agents ready");
   timeline.mark("ready");
+  setup_line(
+      "assignment sent, all agents ready: they initialise, hand off and set up their "
+      "blocks until the first round");
 
   // 3. Final estimates (progress from round statuses meanwhile; lost agents go to the
   // arbiter, which waits for them to rejoin).

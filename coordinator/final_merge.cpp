@@ -20,10 +20,12 @@ MergedEstimate merge_final_estimates(const std::vector<wire::FinalEstimate>& fin
   MergedEstimate out;
   out.poses.resize(n);
   out.bytes.assign(num_agents, 0);
+  out.peak_rss.assign(num_agents, 0);
   std::vector<bool> seen(n, false);
   for (const auto& f : finals) {
     if (f.sender() >= num_agents || f.epoch() < epoch) continue;
     out.bytes[f.sender()] = f.bytes_sent();
+    out.peak_rss[f.sender()] = f.peak_rss_bytes();
     out.rounds = std::max(out.rounds, f.rounds());
     auto list = final_poses(f);
     for (auto& [id, pose] : list) {

@@ -14,9 +14,10 @@
 namespace tessera::coordinator {
 
 struct MergedEstimate {
-  std::vector<Pose> poses;           ///< Every pose of the graph, by id.
-  std::vector<std::uint64_t> bytes;  ///< Bytes each agent sent, by agent id.
-  std::uint32_t rounds = 0;          ///< The most rounds any agent ran.
+  std::vector<Pose> poses;              ///< Every pose of the graph, by id.
+  std::vector<std::uint64_t> bytes;     ///< Bytes each agent sent, by agent id.
+  std::vector<std::uint64_t> peak_rss;  ///< Each agent's peak resident set, bytes, by id.
+  std::uint32_t rounds = 0;             ///< The most rounds any agent ran.
 };
 
 /// Merges the final estimates of epoch >= `epoch` (older ones are from before a

@@ -1,9 +1,11 @@
 #include "coordinator/run_summary.hpp"
 
+#include <algorithm>
 #include <optional>
 #include <vector>
 
 #include "json_writer.hpp"
+#include "runtime/peak_memory.hpp"
 
 namespace tessera::coordinator {
 
@@ -55,6 +57,22 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("total_ms", in.total_ms)
       .add("bytes_sent", std::vector<std::size_t>(in.merged.bytes.begin(), in.merged.bytes.end()))
       .add("hosts", in.structure.hosts);
+  // Peak resident sets (MB): each agent's as it sent its final estimate, the coordinator's now,
+  // and their sum, an upper bound of the run's (the processes need not peak at once, and pages
+  // shared copy-on-write with the fork server count in each).
+  const double mb = 1024.0 * 1024.0;
+  std::vector<double> agent_mb;
+  double agent_max = 0.0, run_mb = 0.0;
+  for (auto b : in.merged.peak_rss) {
+    agent_mb.push_back(static_cast<double>(b) / mb);
+    agent_max = std::max(agent_max, agent_mb.back());
+    run_mb += agent_mb.back();
+  }
+  const double coordinator_mb = static_cast<double>(agent::peak_resident_bytes()) / mb;
+  j.add("peak_rss_mb_per_agent", agent_mb)
+      .add("peak_rss_mb_agent_max", agent_max)
+      .add("peak_rss_mb_coordinator", coordinator_mb)
+      .add("peak_rss_mb_run", run_mb + coordinator_mb);
   if (in.timeline)
     j.add("timeline_ms", in.timeline->json())
         .add("started_monotonic_ms", in.timeline->started_monotonic_ms());

@@ -147,6 +147,41 @@ TEST(DdsLaunch, EndToEndOnAGeneratedGraphPrintsTheSummary) {
   EXPECT_EQ(vertices, 150);
 }
 
+// The summary reports each agent's peak resident set, the coordinator's and their sum, and the
+// set-up's steps are progress lines before the first round.
+TEST(DdsLaunch, ReportsPeakMemoryPerAgentAndTheSetUpSteps) {
+  const std::string dir = temp_dir();
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch --agents 2 --poses 120 --domain 61 " +
+                                 "--partition fast --timeout 60 --json " + dir + "/s.json 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  for (const char* step : {"agents announced: 120 poses", "partition (fast): cut",
+                           "assignment sent, all agents ready"})
+    EXPECT_NE(out.find(step), std::string::npos) << step << "\n" << out;
+  // Before the rounds' progress lines.
+  EXPECT_LT(out.find("set-up "), out.find("\nround ")) << out;
+  const std::string json = slurp(dir + "/s.json");
+  const std::string key = "\"peak_rss_mb_per_agent\":[";
+  const std::size_t at = json.find(key);
+  ASSERT_NE(at, std::string::npos) << json;
+  std::vector<double> per_agent;
+  std::istringstream list(json.substr(at + key.size(), json.find(']', at) - at - key.size()));
+  for (std::string v; std::getline(list, v, ',');) per_agent.push_back(std::stod(v));
+  ASSERT_EQ(per_agent.size(), 2u) << json;
+  const double agent_max = json_field(json, "peak_rss_mb_agent_max");
+  const double coordinator = json_field(json, "peak_rss_mb_coordinator");
+  for (double mb : per_agent) {
+    EXPECT_GT(mb, 1.0) << json;  // a live process with Fast DDS loaded: megabytes at least
+    EXPECT_LE(mb, agent_max) << json;
+  }
+  EXPECT_EQ(agent_max, std::max(per_agent[0], per_agent[1])) << json;
+  EXPECT_GT(coordinator, 1.0) << json;
+  EXPECT_NEAR(json_field(json, "peak_rss_mb_run"), per_agent[0] + per_agent[1] + coordinator,
+              1e-6 * json_field(json, "peak_rss_mb_run"))
+      << json;
+}
+
 // The status relay is the default; --no-status-relay turns it off, and both at once are an
 // error naming them (launch and the coordinator).
 TEST(DdsLaunch, StatusRelayFlagsExcludeEachOther) {

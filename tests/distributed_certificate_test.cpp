@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -20,6 +21,7 @@
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
+#include <vector>
 
 #include "lifted_blocks.hpp"
 #include "random_graph.hpp"
@@ -40,9 +42,13 @@ PoseGraph saddle_graph() {
 }
 
 // Runs only the certificate protocol of N agents on an arbitrary lifted point X.
+// `update` configures the agents (their Q_BB factor cap); `too_large`, when given, receives
+// each agent's block_factor_too_large().
 DistributedCertificateResult certify_in_process(const PoseGraph& g, const Eigen::MatrixXd& X,
                                                 const std::vector<int>& assignment,
-                                                DeliveryOrder order) {
+                                                DeliveryOrder order,
+                                                const BlockUpdateOptions& update = {},
+                                                std::vector<bool>* too_large = nullptr) {
   const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, assignment);
   std::vector<std::unique_ptr<AgentState>> states;
   std::vector<std::unique_ptr<CertificateProtocol>> protocols;
@@ -50,7 +56,8 @@ DistributedCertificateResult certify_in_process(const PoseGraph& g, const Eigen:
   for (int b = 0; b < layout.num_blocks; ++b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
     states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
-                                                  test::pose_columns(X, g.d, ids)));
+                                                  test::pose_columns(X, g.d, ids), update));
+    if (too_large) too_large->push_back(states.back()->block_factor_too_large());
     states.back()->Yn = test::pose_columns(X, g.d, states.back()->problem().neighbors());
     protocols.push_back(std::make_unique<CertificateProtocol>(*states.back(), layout,
                                                               DistributedCertificateOptions{}));
@@ -87,6 +94,43 @@ TEST(DistributedCertificate, MinimumEigenvalueMatchesCentralizedAtAnyPoint) {
   EXPECT_NEAR(dist.min_eigenvalue, central.min_eigenvalue, 1e-3 * std::abs(central.min_eigenvalue));
   // theta is a Rayleigh quotient: never below the true minimum (up to round-off).
   EXPECT_GE(dist.min_eigenvalue, central.min_eigenvalue - 1e-9 * std::abs(central.min_eigenvalue));
+}
+
+// An agent whose Q_BB factor is too large preconditions the certificate pose by pose (the
+// (d+1) x (d+1) diagonal blocks of its shifted S_BB) instead of factoring its whole block: the
+// same minimum eigenvalue, memory linear in the block.
+TEST(DistributedCertificate, PoseWisePreconditionerAboveTheFactorCapFindsTheSameEigenvalue) {
+  test::RandomGraphSpec spec;
+  spec.d = 3;
+  spec.poses = 60;
+  spec.loop_closures = 30;
+  spec.seed = 5;
+  spec.rotation_noise = 0.3;
+  const PoseGraph g = test::random_pose_graph(spec);
+  Eigen::MatrixXd X = lift_poses(g.initial, 4);
+  X.row(3) = 0.3 * X.row(0);
+  const BlockProblem whole = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  X = whole.manifold(4).project(X);
+  const CertificateResult central = verify_certificate(whole, X);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 3);
+  BlockUpdateOptions capped;
+  capped.max_factor_entries = 1;
+  std::vector<bool> too_large;
+  const DistributedCertificateResult pose_wise =
+      certify_in_process(g, X, parts, DeliveryOrder::kFifo, capped, &too_large);
+  EXPECT_EQ(too_large, std::vector<bool>(3, true));
+  std::vector<bool> exact_too_large;
+  const DistributedCertificateResult exact =
+      certify_in_process(g, X, parts, DeliveryOrder::kFifo, {}, &exact_too_large);
+  EXPECT_EQ(exact_too_large, std::vector<bool>(3, false));
+  EXPECT_TRUE(pose_wise.converged);
+  EXPECT_EQ(pose_wise.certified, central.certified);
+  EXPECT_NEAR(pose_wise.min_eigenvalue, central.min_eigenvalue,
+              1e-3 * std::max(1.0, std::abs(central.min_eigenvalue)));
+  EXPECT_NEAR(pose_wise.min_eigenvalue, exact.min_eigenvalue,
+              1e-3 * std::max(1.0, std::abs(exact.min_eigenvalue)));
+  // A weaker preconditioner: at least as many iterations as the block factor's.
+  EXPECT_GE(pose_wise.iterations, exact.iterations);
 }
 
 TEST(DistributedCertificate, CertifiesTheOptimumOfAWellBehavedGraph) {

@@ -395,6 +395,69 @@ TEST(DistributedSolver, ColourClassesAreIndependentSets) {
       for (int y : cls) EXPECT_LT(L.adjacency_index(x, y), 0);
 }
 
+// What an agent builds from the whole graph's endpoints alone (8 bytes a measurement) is the
+// layout built from the measurements themselves.
+TEST(DistributedSolver, LayoutFromEndpointsEqualsLayoutFromMeasurements) {
+  const PoseGraph g = small_graph(3, 80, 23);
+  std::vector<int> a(g.num_poses);
+  for (std::size_t i = 0; i < g.num_poses; ++i) a[i] = static_cast<int>((i * 7) % 5);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ends;
+  for (const Measurement& m : g.measurements)
+    ends.emplace_back(static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j));
+  const BlockLayout from_measurements = make_block_layout(g.num_poses, g.measurements, a);
+  const BlockLayout from_endpoints = make_block_layout(g.num_poses, ends, a);
+  EXPECT_EQ(from_endpoints.num_blocks, from_measurements.num_blocks);
+  EXPECT_EQ(from_endpoints.owner, from_measurements.owner);
+  EXPECT_EQ(from_endpoints.poses, from_measurements.poses);
+  EXPECT_EQ(from_endpoints.adjacent, from_measurements.adjacent);
+  EXPECT_EQ(from_endpoints.public_to, from_measurements.public_to);
+  EXPECT_EQ(from_endpoints.colour, from_measurements.colour);
+  ends.back().second = static_cast<std::uint32_t>(g.num_poses);  // out of range
+  EXPECT_THROW(make_block_layout(g.num_poses, ends, a), InputError);
+}
+
+// An agent frees its Q_BB factor while it certifies; the next update computes it again and
+// takes exactly the step it would have taken with the factor kept.
+TEST(DistributedSolver, ReleasedBlockFactorGivesTheSameUpdate) {
+  const PoseGraph g = small_graph(3, 60, 29);
+  std::vector<int> a(g.num_poses);
+  for (std::size_t i = 0; i < g.num_poses; ++i) a[i] = i < g.num_poses / 2 ? 0 : 1;
+  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
+  const Eigen::MatrixXd X = lift_poses(g.initial, 5);
+  BlockUpdateOptions o;
+  o.tangent_preconditioner = false;  // the Q_BB factor preconditions every update
+  AgentState kept(0, 3, layout, g.measurements, pose_columns(X, 3, layout.poses[0]), o);
+  AgentState released(0, 3, layout, g.measurements, pose_columns(X, 3, layout.poses[0]), o);
+  kept.Yn = released.Yn = pose_columns(X, 3, kept.problem().neighbors());
+  released.release_block_factor();
+  const Eigen::MatrixXd a_step = kept.update(kept.Y, kept.Yn, o);
+  const Eigen::MatrixXd b_step = released.update(released.Y, released.Yn, o);
+  EXPECT_EQ(a_step, b_step);
+  EXPECT_GT((a_step - kept.Y).norm(), 0.0);
+}
+
+// Above max_factor_entries the agent's preconditioner is the block diagonal of Q_BB (memory
+// linear in the block), and the solve still reaches the optimum.
+TEST(DistributedSolver, BlockDiagonalFallbackAboveTheFactorCap) {
+  const PoseGraph g = small_graph(3, 60, 31);
+  std::vector<int> a(g.num_poses);
+  for (std::size_t i = 0; i < g.num_poses; ++i) a[i] = i < g.num_poses / 2 ? 0 : 1;
+  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
+  const Eigen::MatrixXd X = lift_poses(g.initial, 5);
+  BlockUpdateOptions capped;
+  capped.max_factor_entries = 1;
+  AgentState small(0, 3, layout, g.measurements, pose_columns(X, 3, layout.poses[0]), capped);
+  EXPECT_TRUE(small.block_factor_too_large());
+  AgentState exact(0, 3, layout, g.measurements, pose_columns(X, 3, layout.poses[0]));
+  EXPECT_FALSE(exact.block_factor_too_large());
+  DistributedOptions opt;
+  opt.block_update.max_factor_entries = 1;
+  const DistributedResult r = solve_distributed(g, a, opt);
+  EXPECT_LE(r.grad_norm, opt.grad_norm_tol);
+  const double fstar = optimum(g);
+  EXPECT_NEAR(r.cost, fstar, 1e-4 * fstar);
+}
+
 TEST(DistributedSolver, BadOptionsNameTheField) {
   auto message_of = [](auto&& f) {
     try {

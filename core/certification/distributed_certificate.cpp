@@ -1,3 +1,4 @@
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
@@ -5,6 +6,7 @@
 #include <stdexcept>
 #include <tessera/certification/distributed_certificate.hpp>
 #include <tessera/util/input_error.hpp>
+#include <vector>
 
 namespace tessera {
 
@@ -29,10 +31,46 @@ double certificate_start_entry(std::uint64_t seed, std::size_t pose, int coordin
 }
 
 // The agent's diagonal block of S, shifted until positive definite and factored once; applied
-// locally, it makes each LOBPCG step an inverse iteration on the agent's own poses.
+// locally, it makes each LOBPCG step an inverse iteration on the agent's own poses. When the
+// agent's Q_BB factor was too large (AgentState::block_factor_too_large: S_BB has Q_BB's pattern,
+// so its factor would be as large; a 10,000-pose 3D grid block's took 61 MB, and fill grows like
+// m^(4/3)), only the (d+1) x (d+1) diagonal blocks of the shifted S_BB are inverted, one per pose:
+// memory linear in the block, more iterations.
 struct BlockJacobi {
   Eigen::SimplicialLLT<SparseMatrix> factor;
+  int w = 0;                           // > 0: the pose-wise fallback, blocks of w x w
+  std::vector<double> block_inverses;  // w x w inverses one after the other (column-major)
   double shift = 0.0;
+
+  // Pose-wise inverses of the diagonal blocks of A; false when one is not positive definite.
+  bool invert_diagonal_blocks(const SparseMatrix& A, int width) {
+    w = width;
+    const Eigen::Index blocks = A.rows() / w;
+    block_inverses.assign(static_cast<std::size_t>(blocks * w * w), 0.0);
+    Eigen::MatrixXd B(w, w);
+    for (Eigen::Index b = 0; b < blocks; ++b) {
+      B.setZero();
+      for (int c = 0; c < w; ++c)
+        for (SparseMatrix::InnerIterator it(A, b * w + c); it; ++it)
+          if (it.row() >= b * w && it.row() < (b + 1) * w) B(it.row() - b * w, c) = it.value();
+      Eigen::LLT<Eigen::MatrixXd> llt(B);
+      if (llt.info() != Eigen::Success) return false;
+      Eigen::Map<Eigen::MatrixXd>(block_inverses.data() + b * w * w, w, w) =
+          llt.solve(Eigen::MatrixXd::Identity(w, w));
+    }
+    return true;
+  }
+
+  // r (one row) times the preconditioner.
+  Eigen::MatrixXd apply(const Eigen::MatrixXd& r) const {
+    if (w == 0) return factor.solve(r.transpose()).transpose();
+    Eigen::MatrixXd z(r.rows(), r.cols());
+    for (Eigen::Index b = 0; b < r.cols() / w; ++b)
+      z.middleCols(b * w, w).noalias() =
+          r.middleCols(b * w, w) *
+          Eigen::Map<const Eigen::MatrixXd>(block_inverses.data() + b * w * w, w, w);
+    return z;
+  }
 };
 
 CertificateProtocol::CertificateProtocol(const AgentState& state, const BlockLayout& layout,
@@ -86,9 +124,14 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
     SparseMatrix I(S.rows(), S.cols());
     I.setIdentity();
     double shift = std::max(options_.relative_tolerance, 1e-12) * local_scale;
+    const bool pose_wise = state_.block_factor_too_large();
     for (;;) {
-      precon_->factor.compute(S + shift * I);
-      if (precon_->factor.info() == Eigen::Success) break;
+      if (pose_wise) {
+        if (precon_->invert_diagonal_blocks(S + shift * I, static_cast<int>(w))) break;
+      } else {
+        precon_->factor.compute(S + shift * I);
+        if (precon_->factor.info() == Eigen::Success) break;
+      }
       shift *= 10.0;
       if (shift > 1e4 * local_scale)
         throw std::runtime_error("certificate: agent " + std::to_string(state_.id()) +
@@ -192,7 +235,7 @@ void CertificateProtocol::begin_iteration(std::vector<OutgoingMessage>& out) {
   const Eigen::MatrixXd r = Sx_ - theta_ * x_;
   rr_local_ = r.squaredNorm();
   if (precon_)
-    w_ = precon_->factor.solve(r.transpose()).transpose();
+    w_ = precon_->apply(r);
   else
     w_ = r;
   send_boundary(w_, iteration_, out);

@@ -30,7 +30,8 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
     : id_(id),
       d_(d),
       layout_(layout),
-      problem_(d, layout.poses[static_cast<std::size_t>(id)], measurements) {
+      problem_(d, layout.poses[static_cast<std::size_t>(id)], measurements),
+      max_factor_entries_(options.max_factor_entries) {
   const Eigen::Index cols = (d + 1) * static_cast<Eigen::Index>(problem_.num_owned());
   if (Y0.cols() != cols)
     throw std::invalid_argument("AgentState: initial block has the wrong size");
@@ -58,7 +59,11 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
 }
 
 BlockPreconditioner& AgentState::euclidean() {
-  if (!precon_) precon_ = std::make_unique<BlockPreconditioner>(problem_);
+  if (!precon_) {
+    precon_ = std::make_unique<BlockPreconditioner>(
+        problem_, BlockPreconditioner::kDefaultRelativeShift, max_factor_entries_);
+    block_factor_too_large_ = precon_->block_diagonal();
+  }
   return *precon_;
 }
 

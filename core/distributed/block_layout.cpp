@@ -12,8 +12,24 @@ int BlockLayout::adjacency_index(int b, int a) const {
   return (it != adj.end() && *it == a) ? static_cast<int>(it - adj.begin()) : -1;
 }
 
-BlockLayout make_block_layout(std::size_t num_poses, const std::vector<Measurement>& measurements,
-                              const std::vector<int>& assignment) {
+namespace {
+
+std::size_t first_of(const Measurement& m) {
+  return m.i;
+}
+std::size_t second_of(const Measurement& m) {
+  return m.j;
+}
+std::size_t first_of(const std::pair<std::uint32_t, std::uint32_t>& e) {
+  return e.first;
+}
+std::size_t second_of(const std::pair<std::uint32_t, std::uint32_t>& e) {
+  return e.second;
+}
+
+template <class Edge>
+BlockLayout layout_of(std::size_t num_poses, const std::vector<Edge>& measurements,
+                      const std::vector<int>& assignment) {
   if (assignment.size() != num_poses)
     throw InputError("partition: assignment has " + std::to_string(assignment.size()) +
                      " entries for " + std::to_string(num_poses) + " poses");
@@ -35,12 +51,13 @@ BlockLayout make_block_layout(std::size_t num_poses, const std::vector<Measureme
   std::vector<std::vector<std::set<std::size_t>>> publish(
       static_cast<std::size_t>(N), std::vector<std::set<std::size_t>>(static_cast<std::size_t>(N)));
   for (const auto& m : measurements) {
-    if (m.i >= num_poses || m.j >= num_poses)
+    const std::size_t i = first_of(m), j = second_of(m);
+    if (i >= num_poses || j >= num_poses)
       throw InputError("partition: measurement id out of range");
-    const int bi = assignment[m.i], bj = assignment[m.j];
+    const int bi = assignment[i], bj = assignment[j];
     if (bi == bj) continue;
-    publish[static_cast<std::size_t>(bi)][static_cast<std::size_t>(bj)].insert(m.i);
-    publish[static_cast<std::size_t>(bj)][static_cast<std::size_t>(bi)].insert(m.j);
+    publish[static_cast<std::size_t>(bi)][static_cast<std::size_t>(bj)].insert(i);
+    publish[static_cast<std::size_t>(bj)][static_cast<std::size_t>(bi)].insert(j);
   }
   L.adjacent.assign(static_cast<std::size_t>(N), {});
   L.public_to.assign(static_cast<std::size_t>(N), {});
@@ -65,6 +82,19 @@ BlockLayout make_block_layout(std::size_t num_poses, const std::vector<Measureme
     L.colour_classes[static_cast<std::size_t>(c)].push_back(b);
   }
   return L;
+}
+
+}  // namespace
+
+BlockLayout make_block_layout(std::size_t num_poses, const std::vector<Measurement>& measurements,
+                              const std::vector<int>& assignment) {
+  return layout_of(num_poses, measurements, assignment);
+}
+
+BlockLayout make_block_layout(std::size_t num_poses,
+                              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& endpoints,
+                              const std::vector<int>& assignment) {
+  return layout_of(num_poses, endpoints, assignment);
 }
 
 }  // namespace tessera

@@ -105,6 +105,7 @@ void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& ou
     case StageKind::kCertify: {
       DistributedCertificateOptions c = options_.staircase.certificate;
       c.seed = options_.seed;
+      state_.release_block_factor();  // not needed until the next solve stage, if any
       certify_ = std::make_unique<CertificateProtocol>(state_, layout_, c);
       current_ = certify_.get();
       break;

@@ -62,8 +62,8 @@ struct AgentLocalData {
   /// instead of lifting `initial` (a run continued by survivors after a permanent loss).
   Eigen::MatrixXd lifted_start;
   /// Endpoints (i, j) of every measurement of the whole graph, no values: with `owner`
-  /// enough for core's make_block_layout (give it Measurements with only i and j set), so
-  /// every agent builds the same layout (neighbours, public poses, colouring).
+  /// enough for core's make_block_layout, so every agent builds the same layout (neighbours,
+  /// public poses, colouring).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;
   RunOptions options;
 };

@@ -61,6 +61,14 @@ class AgentState {
   long long tcg_iterations() const { return tcg_iterations_; }
   long long tangent_updates() const { return tangent_updates_; }
   int tangent_factorizations() const { return tangent_ ? tangent_->factorizations() : 0; }
+  /// True when this block's Q_BB factor was predicted too large and the block diagonal is used
+  /// instead (BlockPreconditioner::block_diagonal): any factor of a matrix with Q_BB's pattern
+  /// (the certificate's S_BB) would be as large.
+  bool block_factor_too_large() const { return block_factor_too_large_; }
+  /// Frees the Q_BB factor while no update needs it (the certificate factors its own block
+  /// meanwhile: without this both are held at once); the next update that needs it computes it
+  /// again, the same factor.
+  void release_block_factor() { precon_.reset(); }
   /// Starts the sequences afresh at Y0 (any rank, e.g. r + 1 after a saddle escape) with
   /// neighbours at Yn0 (same rank, neighbour order).
   void reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd& Yn0);
@@ -91,6 +99,8 @@ class AgentState {
   std::unique_ptr<BlockPreconditioner> precon_;
   std::unique_ptr<TangentPreconditioner> tangent_;
   bool tangent_tried_ = false;
+  bool block_factor_too_large_ = false;
+  std::size_t max_factor_entries_;  // BlockUpdateOptions::max_factor_entries of the constructor
   long long block_updates_ = 0, tcg_iterations_ = 0, tangent_updates_ = 0;
   Eigen::MatrixXd neighbours_set_;  // what problem_ holds, so X_N Q_NB is rebuilt only on change
   // Rows of the current point that are not identically zero, in increasing order. A lifted

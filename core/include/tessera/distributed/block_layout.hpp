@@ -6,7 +6,9 @@
 // updated in the same round without interacting).
 
 #include <cstddef>
+#include <cstdint>
 #include <tessera/graph/measurement.hpp>
+#include <utility>
 #include <vector>
 
 namespace tessera {
@@ -29,6 +31,12 @@ struct BlockLayout {
 /// The colouring is greedy in block-id order (smallest free colour), so it is deterministic.
 /// Throws InputError when the assignment is malformed.
 BlockLayout make_block_layout(std::size_t num_poses, const std::vector<Measurement>& measurements,
+                              const std::vector<int>& assignment);
+
+/// The same layout from the measurements' endpoints (i, j) alone: what an agent holds of the
+/// whole graph (8 bytes a measurement instead of a Measurement's 72 without its values).
+BlockLayout make_block_layout(std::size_t num_poses,
+                              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& endpoints,
                               const std::vector<int>& assignment);
 
 }  // namespace tessera

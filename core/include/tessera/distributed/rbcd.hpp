@@ -6,6 +6,7 @@
 // else the block's constant Q_BB; docs/irbcd.md section 5).
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/solvers/block_preconditioner.hpp>
 #include <tessera/solvers/tangent_preconditioner.hpp>
@@ -44,6 +45,11 @@ struct BlockUpdateOptions {
   /// cubicle 187 -> 166, docs/irbcd.md section 5). Q_BB-preconditioned updates keep 1: their
   /// norm is inflated by the amplified normal components.
   double tangent_radius_scale = 3.0;
+  /// Entries of the block's Q_BB Cholesky factor (CHOLMOD's prediction) above which the block
+  /// diagonal is used instead, for the updates and the certificate's preconditioner alike
+  /// (solvers/block_preconditioner.hpp; 0 = always the exact factor). The default, 16 M entries
+  /// (128 MB), bounds an agent's factor memory: 3D grid blocks beyond ~15,000 poses fall back.
+  std::size_t max_factor_entries = BlockPreconditioner::kDefaultMaxFactorEntries;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;

@@ -28,13 +28,16 @@ class BlockPreconditioner : public RiemannianPreconditioner {
   /// Factor entries above which the exact factor is supernodal LL^T rather than simplicial
   /// LDL^T (1 M entries = 8 MB; measured crossover ~0.6 M, see the .cpp).
   static constexpr std::size_t kDefaultSupernodalMinEntries = 1'000'000;
+  /// lambda relative to the largest diagonal entry of Q_BB.
+  static constexpr double kDefaultRelativeShift = 1e-6;
 
   /// `relative_shift`: lambda = relative_shift * max diagonal entry of Q_BB.
   /// `max_factor_entries`: when CHOLMOD's symbolic analysis predicts a larger Cholesky factor,
   /// use the block-diagonal fallback instead; 0 = always the exact factor.
   /// `supernodal_min_entries`: exact factors with more entries are supernodal (same operator
   /// up to round-off); 0 = always simplicial.
-  explicit BlockPreconditioner(const BlockProblem& problem, double relative_shift = 1e-6,
+  explicit BlockPreconditioner(const BlockProblem& problem,
+                               double relative_shift = kDefaultRelativeShift,
                                std::size_t max_factor_entries = kDefaultMaxFactorEntries,
                                std::size_t supernodal_min_entries = kDefaultSupernodalMinEntries);
   ~BlockPreconditioner() override;

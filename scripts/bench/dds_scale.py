@@ -1,0 +1,201 @@
+#!/usr/bin/env python3
+"""Memory and phases of `tessera launch` on a generated 3D grid: where a large run's wall time and
+memory go, and the memory model that says how large a run fits on one host.
+
+Each run: `tessera generate --kind grid3d --poses P --robots N` (once per size, into --work), then
+`tessera launch GRID --agents N --partition fast --init distributed` (the distributed
+initialisation: `chordal` gathers the whole graph on agent 0, which does not scale), certified by
+default. While it runs, the resident set (RSS) and proportional set (PSS: shared pages divided
+among the processes sharing them, so the sum over processes is what the run takes from the host)
+of launch and every process it started (the fork server, the coordinator, the agents: launch is
+their subreaper) are sampled every --period seconds from /proc. Printed and written to
+docs/benchmarks/dds_scale.csv, one row per run:
+  - the phases of the coordinator's timeline (`timeline_ms` of the summary): start (launch to the
+    coordinator's session), discovery and partition (to the assignment), ready (the readiness
+    barrier), setup (initialisation, hand-off and the agents' set-up to the first round status),
+    rounds (first to last round status), finish (last status to the final estimates: certificate,
+    rounding, final report) and merge (to the summary);
+  - the summary's peak memory fields (`peak_rss_mb_per_agent`, `peak_rss_mb_agent_max`,
+    `peak_rss_mb_coordinator`, `peak_rss_mb_run`), the sampled peak PSS of the largest agent and the
+    sampled peak of the run's PSS sum (the host's real cost), and the load average.
+Timings taken on a shared machine move with its load (printed beside them); the memory figures
+do not.
+
+docs/scale.md reads its memory model off these rows.
+
+usage: dds_scale.py [--bin build/bin/tessera] [--sizes 20000:2,100000:10] [--domain 65]
+                    [--work DIR] [--timeout 3600] [--period 0.5] [--csv FILE] [--launch-args="..."]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import threading
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, HERE)
+import bench_common as bc  # noqa: E402
+
+PHASES = [("start", None, "session"), ("discovery+partition", "session", "partitioned"),
+          ("ready", "partitioned", "ready"), ("setup", "ready", "first_status"),
+          ("rounds", "first_status", "last_status"), ("finish", "last_status", "finals"),
+          ("merge", "finals", "merged")]
+
+
+def status_kb(pid, key, name="status"):
+    try:
+        with open(f"/proc/{pid}/{name}") as f:
+            for line in f:
+                if line.startswith(key):
+                    return int(line.split()[1])
+    except OSError:
+        return None
+    return None
+
+
+def descendants(root):
+    """pids of root and everything below it (by parent pid)."""
+    children = {}
+    for p in os.listdir("/proc"):
+        if not p.isdigit():
+            continue
+        try:
+            with open(f"/proc/{p}/stat") as f:
+                ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+        except (OSError, IndexError, ValueError):
+            continue
+        children.setdefault(ppid, []).append(int(p))
+    out, todo = [], [root]
+    while todo:
+        p = todo.pop()
+        out.append(p)
+        todo.extend(children.get(p, []))
+    return out
+
+
+def role_of(pid):
+    try:
+        with open(f"/proc/{pid}/cmdline") as f:
+            args = f.read().split("\0")
+        with open(f"/proc/{pid}/comm") as f:
+            comm = f.read().strip()
+    except OSError:
+        return None
+    if not comm.startswith("tessera"):
+        return None
+    for k, a in enumerate(args[:-1]):
+        if a == "--id":
+            return "agent" + args[k + 1]
+    return comm
+
+
+class Sampler(threading.Thread):
+    """Peak RSS and PSS (kB) per role and the peak of the PSS sum over the run's processes."""
+
+    def __init__(self, root, period):
+        super().__init__(daemon=True)
+        self.root, self.period = root, period
+        self.rss, self.pss, self.pss_sum, self.stop = {}, {}, 0, False
+
+    def run(self):
+        while not self.stop:
+            total = 0
+            for p in descendants(self.root):
+                role = role_of(p)
+                if role is None:
+                    continue
+                rss = status_kb(p, "VmRSS:")
+                pss = status_kb(p, "Pss:", "smaps_rollup")
+                if rss is None or pss is None:
+                    continue
+                self.rss[role] = max(self.rss.get(role, 0), rss)
+                self.pss[role] = max(self.pss.get(role, 0), pss)
+                total += pss
+            self.pss_sum = max(self.pss_sum, total)
+            time.sleep(self.period)
+
+
+def load():
+    with open("/proc/loadavg") as f:
+        return float(f.read().split()[0])
+
+
+def run_one(args, poses, agents, domain):
+    graph = os.path.join(args.work, f"grid3d_{poses}_{agents}.g2o")
+    if not os.path.exists(graph):
+        bc.progress(f"generating {graph}")
+        subprocess.run([args.bin, "generate", "--kind", "grid3d", "--poses", str(poses), "--robots",
+                        str(agents), "--out", graph], check=True, stdout=subprocess.DEVNULL)
+    summary = os.path.join(args.work, f"summary_{poses}_{agents}.json")
+    cmd = [args.bin, "launch", graph, "--agents", str(agents), "--partition", "fast", "--init",
+           "distributed", "--domain", str(domain), "--json", summary, "--timeout",
+           str(args.timeout), "--status-interval", "30"] + args.launch_args.split()
+    bc.progress(" ".join(cmd))
+    load0 = load()
+    t0 = time.monotonic()
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    sampler = Sampler(proc.pid, args.period)
+    sampler.start()
+    for line in proc.stdout:  # progress stays visible
+        if not line.startswith("summary:") and not line.startswith(" ") and not line.startswith("{"):
+            sys.stdout.write("  | " + line)
+    rc = proc.wait()
+    wall = time.monotonic() - t0
+    sampler.stop = True
+    sampler.join()
+    row = {"poses": poses, "agents": agents, "launch_args": args.launch_args, "rc": rc, "wall_s": round(wall, 1),
+           "load_start": load0, "load_end": load()}
+    if rc != 0 or not os.path.exists(summary):
+        return row
+    with open(summary) as f:
+        s = json.load(f)
+    tl = s.get("timeline_ms", {})
+    for name, a, b in PHASES:
+        if b in tl and (a is None or a in tl):
+            row[name + "_s"] = round((tl[b] - (tl[a] if a else 0.0)) / 1000.0, 2)
+    agent_pss = {k: v for k, v in sampler.pss.items() if k.startswith("agent")}
+    row.update({
+        "edges": s.get("edges"), "rounds": s.get("rounds"), "certified": s.get("certified"),
+        "min_eigenvalue": s.get("min_eigenvalue"), "cut_edges": s.get("cut_edges"),
+        "peak_rss_mb_agent_max": round(s.get("peak_rss_mb_agent_max", 0), 1),
+        "peak_rss_mb_coordinator": round(s.get("peak_rss_mb_coordinator", 0), 1),
+        "peak_rss_mb_run": round(s.get("peak_rss_mb_run", 0), 1),
+        "peak_pss_mb_agent_max": round(max(agent_pss.values(), default=0) / 1024, 1),
+        "peak_pss_mb_coordinator": round(sampler.pss.get("tessera-coordin", 0) / 1024, 1),
+        "peak_pss_mb_fork_server": round(sampler.pss.get("tessera-fork-se", 0) / 1024, 1),
+        "peak_pss_mb_run_sum": round(sampler.pss_sum / 1024, 1),
+    })
+    return row
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin", "tessera"))
+    ap.add_argument("--sizes", default="20000:2,100000:10", help="POSES:AGENTS,...")
+    ap.add_argument("--domain", type=int, default=65)
+    ap.add_argument("--work", default="/tmp/tessera-dds-scale")
+    ap.add_argument("--timeout", type=int, default=3600)
+    ap.add_argument("--period", type=float, default=0.5)
+    ap.add_argument("--csv", default=os.path.join(bc.OUT_DIR, "dds_scale.csv"))
+    ap.add_argument("--launch-args", default="", help="more launch options, e.g. \"--max-rounds 20\"")
+    args = ap.parse_args()
+    args.bin = os.path.abspath(args.bin)
+    os.makedirs(args.work, exist_ok=True)
+    rows = []
+    for k, spec in enumerate(args.sizes.split(",")):
+        poses, agents = (int(x) for x in spec.split(":"))
+        rows.append(run_one(args, poses, agents, args.domain + k))
+    cols = ["poses", "agents", "rc", "wall_s"] + [p[0] + "_s" for p in PHASES] + [
+        "rounds", "certified", "peak_rss_mb_agent_max", "peak_pss_mb_agent_max", "peak_rss_mb_coordinator",
+        "peak_pss_mb_fork_server", "peak_rss_mb_run", "peak_pss_mb_run_sum", "load_start", "load_end"]
+    bc.print_table("tessera launch on generated 3D grids (fast partition, distributed init, certified)",
+                   cols, [[bc.fmt(r.get(c, "-")) if not isinstance(r.get(c), str) else r[c] for c in cols]
+                          for r in rows])
+    bc.write_csv(args.csv, rows)
+
+
+if __name__ == "__main__":
+    main()
