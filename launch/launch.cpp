@@ -22,15 +22,15 @@
 
 namespace tessera::launch {
 
-namespace {
-
-std::string self_dir() {
+std::string running_program_dir() {
   char buf[PATH_MAX];
   const ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
   if (n <= 0) return ".";
   std::string p(buf, static_cast<std::size_t>(n));
   return p.substr(0, p.find_last_of('/'));
 }
+
+namespace {
 
 // Whether the fork server is used: asked for and present (else exec, with a word on stderr).
 bool use_fork_server(const LaunchOptions& o, const std::string& fork_server) {
@@ -72,27 +72,10 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-std::string LaunchResult::full_report() const {
-  std::ostringstream out;
-  out << "run " << run_id << ": "
-      << (exit_code == 0     ? "done"
-          : exit_code == 130 ? "interrupted"
-                             : "failed");
-  if (!failure.empty()) out << " (" << failure << ")";
-  out << ", exit code " << exit_code << "\n";
-  char wall[64];
-  std::snprintf(wall, sizeof(wall), "%.2f", wall_s);
-  out << "wall time " << wall << " s\n";
-  for (const auto& p : lost) out << "lost during the run: " << p << "\n";
-  for (const auto& n : notes) out << "note: " << n << "\n";
-  out << "summary: " << (summary_json.empty() ? "none\n" : "\n" + summary_json);
-  return out.str();
-}
-
 LaunchResult launch(LaunchOptions o) {
   o.validate();
   if (o.choose_transport) o.net.session.transport = launch_transport(o.net.session, o.loss);
-  const std::string bin = self_dir();
+  const std::string bin = o.bin_dir.empty() ? running_program_dir() : o.bin_dir;
   for (const char* exe : {"tessera-agent", "tessera-coordinator"})
     if (access((bin + "/" + exe).c_str(), X_OK) != 0)
       throw InputError("launch: " + bin + "/" + exe + " not found (build it next to tessera)");

@@ -59,6 +59,9 @@ struct LaunchOptions {
   bool agents_batch = true;
   /// Round statuses relayed through agent 0 instead of all to all.
   bool status_relay = true;
+  /// Folder of tessera-coordinator, tessera-agent and tessera-fork-server; "" = the running
+  /// program's own.
+  std::string bin_dir;
 
   /// The robot files named by `graph` (empty for one whole file or a generated graph).
   std::vector<std::string> robot_files() const;

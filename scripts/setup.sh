@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs every Debian package Tessera needs (skipped when already present), then
 # configures and builds into build/. Idempotent; a second run only rebuilds what changed.
-#   scripts/setup.sh            Release build
-#   TESSERA_WERROR=ON scripts/setup.sh   warnings as errors (CI)
+#   scripts/setup.sh                      Release build, warnings as errors
+#   TESSERA_WERROR=OFF scripts/setup.sh   warnings allowed
+# demo.sh and test.sh both build through here with the same settings, so the second of them
+# reuses the first one's build. ccache is used when it is installed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -30,5 +32,8 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 JOBS=$(nproc 2>/dev/null || echo 2)
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTESSERA_WERROR="${TESSERA_WERROR:-OFF}" >/dev/null
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTESSERA_WERROR="${TESSERA_WERROR:-ON}" \
+  "${launcher[@]}" >/dev/null
 cmake --build build -j "$JOBS"

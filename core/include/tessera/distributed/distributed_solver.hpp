@@ -132,6 +132,10 @@ struct DistributedResult {
   /// message (stage, round), the slowest agent's CPU time, summed (DeliveryStats). With
   /// `parallel` several agents compute in one round; this is the time that then matters.
   double critical_path_cpu_s = 0.0;
+
+  /// A readable report of the run (agents, rounds and stop, cost, certificate, staircase,
+  /// traffic, timing), like CentralizedResult::full_report(); distributed_report.cpp.
+  std::string full_report() const;
 };
 
 /// Solves `graph` with the blocks of `assignment` (block id per pose, 0..N-1, none empty).

@@ -1,0 +1,82 @@
+// launch() of the public API (<tessera/dds/launch.hpp>): the options become `tessera launch`'s
+// command line, so a program and the command parse, check and run the same way.
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <sstream>
+#include <tessera/dds/launch.hpp>
+
+#include "launch/launch.hpp"
+
+namespace tessera::dds {
+
+namespace {
+
+std::string exact(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.17g", x);
+  return buf;
+}
+
+// `bin_dir`, else the folder of the running program when it holds tessera-agent, else the
+// installed executables.
+std::string executables_dir(const std::string& bin_dir) {
+  if (!bin_dir.empty()) return bin_dir;
+  const std::string self = launch::running_program_dir();
+  if (access((self + "/tessera-agent").c_str(), X_OK) == 0) return self;
+#ifdef TESSERA_INSTALL_BINDIR
+  return TESSERA_INSTALL_BINDIR;
+#else
+  return self;
+#endif
+}
+
+}  // namespace
+
+std::string LaunchResult::full_report() const {
+  std::ostringstream out;
+  out << "run " << run_id << ": "
+      << (exit_code == 0     ? "done"
+          : exit_code == 130 ? "interrupted"
+                             : "failed");
+  if (!failure.empty()) out << " (" << failure << ")";
+  out << ", exit code " << exit_code << "\n";
+  char wall[64];
+  std::snprintf(wall, sizeof(wall), "%.2f", wall_s);
+  out << "wall time " << wall << " s\n";
+  for (const auto& p : lost) out << "lost during the run: " << p << "\n";
+  for (const auto& n : notes) out << "note: " << n << "\n";
+  out << "summary: " << (summary_json.empty() ? "none\n" : "\n" + summary_json);
+  return out.str();
+}
+
+std::vector<std::string> LaunchOptions::argv() const {
+  std::vector<std::string> a;
+  if (!graph.empty()) a.push_back(graph);
+  a.insert(a.end(), {"--agents", std::to_string(agents), "--algorithm", algorithm, "--partition",
+                     partition, "--grad-tol", exact(grad_tol), "--timeout", exact(timeout_s)});
+  if (!certify) a.push_back("--no-certify");
+  if (!json.empty()) a.insert(a.end(), {"--json", json});
+  if (!out.empty()) a.insert(a.end(), {"--out", out});
+  if (quiet) a.push_back("--quiet");
+  const SessionOptions defaults;
+  // launch makes a fresh run id per run unless one is given.
+  if (session.run_id != defaults.run_id) a.insert(a.end(), {"--run-id", session.run_id});
+  const std::vector<std::string> s = session.argv(false);
+  a.insert(a.end(), s.begin() + 2, s.end());  // without the --run-id pair
+  a.insert(a.end(), extra_args.begin(), extra_args.end());
+  return a;
+}
+
+void LaunchOptions::validate() const {
+  launch::parse_launch_options(argv());
+}
+
+LaunchResult launch(const LaunchOptions& options) {
+  launch::LaunchOptions o = launch::parse_launch_options(options.argv());
+  o.bin_dir = executables_dir(options.bin_dir);
+  return launch::launch(std::move(o));
+}
+
+}  // namespace tessera::dds

@@ -1,0 +1,132 @@
+// `tessera launch`'s options (launch/launch_options.hpp) and the command lines built from them
+// (launch/launch_argv.hpp), without starting any process: forwarded flags reach the processes
+// they are meant for, bad values are named, removed flags are refused, and the public
+// dds::LaunchOptions say the same as the command line.
+
+#include "launch/launch_options.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <tessera/dds/launch.hpp>
+#include <tessera/util/input_error.hpp>
+#include <vector>
+
+#include "launch/forwarded_flags.hpp"
+#include "launch/launch_argv.hpp"
+
+namespace tessera::launch {
+namespace {
+
+using Argv = std::vector<std::string>;
+
+bool has_pair(const Argv& argv, const std::string& flag, const std::string& value) {
+  for (std::size_t k = 0; k + 1 < argv.size(); ++k)
+    if (argv[k] == flag && argv[k + 1] == value) return true;
+  return false;
+}
+
+bool has(const Argv& argv, const std::string& flag) {
+  return std::find(argv.begin(), argv.end(), flag) != argv.end();
+}
+
+std::string error_of(const Argv& argv) {
+  try {
+    parse_launch_options(argv);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+RunPaths paths() {
+  return {"/opt/tessera/bin", "/tmp/run", "/data/graph.g2o", "/tmp/run/summary.json"};
+}
+
+TEST(LaunchOptions, ForwardedFlagsReachOnlyTheCoordinatorWithTheirValues) {
+  LaunchOptions o = parse_launch_options(
+      {"--agents", "2", "--out", "merged.g2o", "--status-interval", "0.5", "--run-id", "r1"});
+  o.graph = "/data/graph.g2o";
+  const Argv coordinator = coordinator_argv(o, paths());
+  EXPECT_TRUE(has_pair(coordinator, "--output", "merged.g2o"));  // renamed for the coordinator
+  EXPECT_TRUE(has_pair(coordinator, "--status-interval", "0.5"));
+  EXPECT_TRUE(has_pair(coordinator, "--run-id", "r1"));
+  EXPECT_FALSE(has(coordinator, "--progress-interval"));  // not given: not forwarded
+  const Argv agent = agent_argv(o, paths(), 1);
+  EXPECT_FALSE(has(agent, "--output"));
+  EXPECT_FALSE(has(agent, "--status-interval"));
+  EXPECT_TRUE(has_pair(agent, "--id", "1"));
+  EXPECT_TRUE(has_pair(agent, "--run-id", "r1"));
+}
+
+TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
+  const std::string help = launch_help();
+  for (const ForwardedFlag& f : forwarded_flags()) {
+    EXPECT_NE(help.find(std::string("--") + f.name), std::string::npos) << f.name;
+    Argv argv = {std::string("--") + f.name};
+    if (f.valued) argv.push_back("1");
+    EXPECT_EQ(error_of(argv), "") << f.name;
+  }
+}
+
+TEST(LaunchOptions, BadValuesAreNamedAndRemovedFlagsRefused) {
+  EXPECT_NE(error_of({"--agents", "0"}).find("--agents"), std::string::npos);
+  EXPECT_NE(error_of({"--status-interval", "-1"}).find("--status-interval"), std::string::npos);
+  EXPECT_NE(error_of({"--progress-interval", "x"}).find("--progress-interval"), std::string::npos);
+  EXPECT_NE(error_of({"--certify", "--no-certify"}).find("exclude"), std::string::npos);
+  EXPECT_NE(error_of({"--agents-yield"}).find("--agents-yield"), std::string::npos);
+  EXPECT_EQ(launch_help().find("agents-yield"), std::string::npos);
+}
+
+TEST(LaunchOptions, TuningFlagsSitUnderTheAdvancedHeading) {
+  const std::string help = launch_help();
+  const std::size_t advanced = help.find("advanced");
+  ASSERT_NE(advanced, std::string::npos);
+  for (const char* flag : {"--no-fork-server", "--no-agents-batch", "--no-status-relay"})
+    EXPECT_GT(help.find(flag), advanced) << flag;
+}
+
+TEST(LaunchOptions, GradientToleranceReachesTheCoordinatorAsTheSameNumber) {
+  for (const char* text : {"0.01", "1e-7", "0.1", "0.3333333333333333"}) {
+    const LaunchOptions o = parse_launch_options({"--grad-tol", text});
+    const Argv coordinator = coordinator_argv(o, paths());
+    const auto at = std::find(coordinator.begin(), coordinator.end(), "--grad-tol");
+    ASSERT_NE(at, coordinator.end());
+    EXPECT_EQ(std::stod(*(at + 1)), std::stod(text)) << *(at + 1);
+  }
+}
+
+TEST(LaunchOptions, PublicOptionsParseToTheSameRun) {
+  dds::LaunchOptions pub;
+  pub.agents = 4;
+  pub.algorithm = "rbcd++";
+  pub.partition = "eco";
+  pub.grad_tol = 1e-3;
+  pub.certify = false;
+  pub.out = "x.g2o";
+  pub.session.run_id = "public-run";
+  pub.session.domain = 12;
+  pub.extra_args = {"--progress-interval", "0"};
+  const LaunchOptions o = parse_launch_options(pub.argv());
+  EXPECT_EQ(o.agents, 4);
+  EXPECT_EQ(o.algorithm, "rbcd++");
+  EXPECT_EQ(o.partition, "eco");
+  EXPECT_EQ(o.grad_tol, 1e-3);
+  EXPECT_FALSE(o.certify);
+  EXPECT_EQ(o.net.session.run_id, "public-run");
+  EXPECT_EQ(o.net.session.domain, 12);
+  const Argv coordinator = coordinator_argv(o, paths());
+  EXPECT_TRUE(has_pair(coordinator, "--output", "x.g2o"));
+  EXPECT_TRUE(has_pair(coordinator, "--progress-interval", "0"));
+  pub.agents = 65;
+  try {
+    pub.validate();
+    ADD_FAILURE() << "65 agents accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--agents"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace tessera::launch
