@@ -8,7 +8,7 @@
 #include <memory>
 
 #include "session_args.hpp"
-#include "transport/teardown_guard.hpp"
+#include "transport/fastdds/teardown_guard.hpp"
 
 namespace tessera::cli {
 

@@ -42,8 +42,8 @@ struct ProcessRole {
   /// Agents: once the coordinator's FINISHED has arrived (the merged result is written, the
   /// run is complete), an abort in what is left (the last steps, the others' participants
   /// leaving, the deletion of ours) ends the process with exit code 0 and a note instead of
-  /// SIGABRT (Fast DDS 2.9's lease-check race, transport/teardown_guard.hpp). An abort before
-  /// FINISHED stays an abort: the run fails.
+  /// SIGABRT (Fast DDS 2.9's lease-check race, transport/fastdds/teardown_guard.hpp). An abort
+  /// before FINISHED stays an abort: the run fails.
   bool cover_after_finished = false;
 };
 

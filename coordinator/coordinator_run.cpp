@@ -22,8 +22,8 @@
 #include "runtime/partition_step.hpp"
 #include "runtime/progress_lines.hpp"
 #include "runtime/run_monitor.hpp"
+#include "transport/fastdds/teardown_guard.hpp"
 #include "transport/run_failure.hpp"
-#include "transport/teardown_guard.hpp"
 
 namespace tessera::coordinator {
 
@@ -151,7 +151,7 @@ void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timel
   if (o.progress && !o.summary.empty()) std::cout << kSummaryWrittenLine << "\n" << std::flush;
 
   // 5. Tell the agents they may leave. The result is written: while the agents' participants
-  // leave, Fast DDS 2.9's lease check may abort this process (transport/teardown_guard.hpp;
+  // leave, Fast DDS 2.9's lease check may abort this process (transport/fastdds/teardown_guard.hpp;
   // seen once here in an idle launch), which must not turn a finished run into a crash.
   const double flush_s = std::min(3.0, o.net.timeout_s);
   const TeardownGuard finished(kExitOk, "tessera-coordinator", Seconds(flush_s + kFinishedMarginS));

@@ -56,7 +56,7 @@ std::string tail_of(const std::string& path, std::size_t max_lines);
 
 /// The lines of the log at `path` that are notes ("<tag>: note: ..."), each as one line: a
 /// finished run's logs are removed, and a note (e.g. a Fast DDS abort covered at the end of the
-/// run, transport/teardown_guard.hpp) should still be seen.
+/// run, transport/fastdds/teardown_guard.hpp) should still be seen.
 std::vector<std::string> notes_of(const std::string& path);
 
 }  // namespace tessera::launch

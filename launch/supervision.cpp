@@ -64,7 +64,7 @@ void judge_ended(std::vector<Child>& children, const SupervisionOptions& o,
   for (auto& c : children) {
     if (c.running || c.judged) continue;
     c.judged = true;
-    // A note means a teardown guard ended it (transport/teardown_guard.hpp): with its code,
+    // A note means a teardown guard ended it (transport/fastdds/teardown_guard.hpp): with its code,
     // but from inside Fast DDS, so its files stay like a failed process's.
     if (!notes_of(c.log).empty()) out.guard_ended = true;
     if (c.code != 0 || out.guard_ended) note_segments(children, out.run_segments);

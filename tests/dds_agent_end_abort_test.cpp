@@ -1,8 +1,8 @@
 // An agent that aborts at the end of a run (issue #5: Fast DDS 2.9's lease-check assertion
 // while the other participants leave, seen once in agent 0 in ~100 launches). Once the
 // coordinator's FINISHED has arrived the run is complete, and such an abort must end the agent
-// with exit code 0 and a note (cli/session_process.cpp, transport/teardown_guard.hpp), so that
-// launch reports the finished run as finished; before its result is delivered an abort must
+// with exit code 0 and a note (cli/session_process.cpp, transport/fastdds/teardown_guard.hpp), so
+// that launch reports the finished run as finished; before its result is delivered an abort must
 // still fail the run. The abort is raised by the test-only TESSERA_TEST_AGENT_ABORT
 // (agent/test_abort_hook.hpp), given through /usr/bin/env.
 // Domains used here: 106-108 (each test its own, so ctest -j is safe).

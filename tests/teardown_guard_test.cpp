@@ -1,10 +1,10 @@
-// The guard around deleting a DDS participant at exit (transport/teardown_guard.hpp): Fast DDS
-// 2.9 was seen to abort (assertion in PDP.cpp) or deadlock (DDS Security) in there after the
+// The guard around deleting a DDS participant at exit (transport/fastdds/teardown_guard.hpp): Fast
+// DDS 2.9 was seen to abort (assertion in PDP.cpp) or deadlock (DDS Security) in there after the
 // run's work was done. While armed, an abort or a teardown that overruns its bound ends the
 // process with the exit code it was about to return; disarmed, nothing changes. Each case
 // runs in a forked child (no participant needed: the failures are simulated).
 
-#include "transport/teardown_guard.hpp"
+#include "transport/fastdds/teardown_guard.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>

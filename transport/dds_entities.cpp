@@ -8,7 +8,7 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
 
-#include "transport/teardown_guard.hpp"
+#include "transport/fastdds/teardown_guard.hpp"
 
 namespace tessera::transport {
 
@@ -152,7 +152,7 @@ void DdsEntities::close(int exit_code, const std::string& who) {
   if (!participant_) return;
   trace_("closing: deleting the DDS entities and the participant");
   {
-    // Fast DDS 2.9 may abort or deadlock in here (transport/teardown_guard.hpp).
+    // Fast DDS 2.9 may abort or deadlock in here (transport/fastdds/teardown_guard.hpp).
     TeardownGuard guard(exit_code, who, Seconds(kTeardownTimeoutS));
     participant_->delete_contained_entities();
     dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);

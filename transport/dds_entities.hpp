@@ -2,8 +2,8 @@
 // The DDS entities of one session: the participant, its publisher and subscriber
 // (Partition = run id), one topic per message type, and the typed writers and readers with
 // their QoS (qos.hpp) and listeners (dds_listeners.hpp). Creation registers what each
-// endpoint must match with Readiness; teardown is bounded (teardown_guard.hpp). Internal to
-// transport/.
+// endpoint must match with Readiness; teardown is bounded (fastdds/teardown_guard.hpp).
+// Internal to transport/.
 
 #include <atomic>
 #include <cstdint>

@@ -62,7 +62,7 @@ class Readiness {
   bool endpoints_matched(std::string* missing) const;
   bool finished() const;
   /// FINISHED received, readable without the mutex (from a signal handler: the agent's
-  /// end-of-run cover, transport/teardown_guard.hpp). Lives as long as this object.
+  /// end-of-run cover, transport/fastdds/teardown_guard.hpp). Lives as long as this object.
   const std::atomic<bool>& finished_flag() const { return finished_; }
   WaitStatus wait_finished(Seconds timeout);
 

@@ -206,8 +206,9 @@ class Session {
   /// leaves no shared-memory files behind. Same as close(1).
   void close();
   /// Same, for a process about to exit with `exit_code`: if Fast DDS aborts or hangs while
-  /// the participant is deleted (known Fast DDS 2.9 teardown bugs, transport/teardown_guard.hpp),
-  /// the process exits at once with `exit_code` instead of crashing or hanging.
+  /// the participant is deleted (known Fast DDS 2.9 teardown bugs,
+  /// transport/fastdds/teardown_guard.hpp), the process exits at once with `exit_code` instead of
+  /// crashing or hanging.
   void close(int exit_code);
 
  private:

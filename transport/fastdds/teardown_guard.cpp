@@ -1,4 +1,4 @@
-#include "transport/teardown_guard.hpp"
+#include "transport/fastdds/teardown_guard.hpp"
 
 #include <unistd.h>
 
