@@ -41,7 +41,9 @@ const char* const kHelp =
     "  --partition FILE        block of every pose: one block id per line (tessera\n"
     "                          partition --out) or a JSON object with an \"assignment\" array\n"
     "  --truth FILE            ground truth to draw beside (as tessera eval reads it)\n"
-    "  --rejected FILE         measurements rejected as outliers: lines 'i j' (input ids)\n"
+    "  --rejected FILE         measurements rejected as outliers: one measurement index per\n"
+    "                          line (tessera solve --robust gnc-tls --rejected), or 'i j'\n"
+    "                          (input ids)\n"
     "  --title TEXT            figure title (default: the file name)\n"
     "  --keys auto|plain|gtsam how ids name robots                                [auto]\n"
     "  --help                  this text\n";
@@ -85,23 +87,47 @@ std::vector<int> read_partition(const std::string& path, std::size_t n) {
   return blocks;
 }
 
-// Pairs of input ids, one "i j" per line.
-std::set<std::pair<std::uint64_t, std::uint64_t>> read_rejected(const std::string& path) {
+// Which measurements were rejected: a line "e" names measurement e (0-based over the EDGE
+// lines, as tessera solve --rejected writes), a line "i j" every measurement between the
+// poses with input ids i and j.
+std::vector<bool> read_rejected(const std::string& path, const PoseGraph& graph,
+                                const PoseKeys& keys) {
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, "cannot open the rejected-measurements file");
-  std::set<std::pair<std::uint64_t, std::uint64_t>> out;
+  std::set<std::pair<std::uint64_t, std::uint64_t>> pairs;
+  std::vector<bool> out(graph.measurements.size(), false);
   std::string line;
   std::size_t number = 0;
+  auto number_of = [&](const std::string& tok) {
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(tok.c_str(), &end, 10);
+    if (tok.empty() || tok[0] == '-' || *end != '\0')
+      throw InputError(path, number, "'" + tok + "' is not a non-negative integer");
+    return static_cast<std::uint64_t>(v);
+  };
   while (std::getline(in, line)) {
     ++number;
     std::istringstream ls(line);
-    std::string a, b;
-    if (!(ls >> a) || a[0] == '#') continue;
-    unsigned long long i = 0, j = 0;
-    if (!(ls >> b) || std::sscanf(a.c_str(), "%llu", &i) != 1 ||
-        std::sscanf(b.c_str(), "%llu", &j) != 1)
-      throw InputError(path, number, "expected two pose ids 'i j'");
-    out.insert({std::min(i, j), std::max(i, j)});
+    std::vector<std::string> tok;
+    for (std::string t; ls >> t;) tok.push_back(t);
+    if (tok.empty() || tok[0][0] == '#') continue;
+    if (tok.size() == 1) {
+      const std::uint64_t e = number_of(tok[0]);
+      if (e >= out.size())
+        throw InputError(path, number,
+                         "measurement " + tok[0] + " does not exist (the graph has " +
+                             std::to_string(out.size()) + ")");
+      out[e] = true;
+    } else if (tok.size() == 2) {
+      const std::uint64_t i = number_of(tok[0]), j = number_of(tok[1]);
+      pairs.insert({std::min(i, j), std::max(i, j)});
+    } else {
+      throw InputError(path, number, "expected a measurement index 'e' or two pose ids 'i j'");
+    }
+  }
+  for (std::size_t e = 0; e < out.size(); ++e) {
+    const std::uint64_t a = keys.id(graph.measurements[e].i), b = keys.id(graph.measurements[e].j);
+    if (pairs.count({std::min(a, b), std::max(a, b)})) out[e] = true;
   }
   return out;
 }
@@ -140,8 +166,8 @@ int run_plot(const Args& args) {
   if (graph) {
     std::vector<int> blocks;
     if (auto p = a.get("partition")) blocks = read_partition(*p, graph->graph.num_poses);
-    std::set<std::pair<std::uint64_t, std::uint64_t>> rejected;
-    if (auto p = a.get("rejected")) rejected = read_rejected(*p);
+    std::vector<bool> rejected;
+    if (auto p = a.get("rejected")) rejected = read_rejected(*p, graph->graph, graph->keys);
     fig = figure_of_graph(graph->graph, graph->keys, blocks, rejected, fig.title);
   } else {
     if (a.has("partition") || a.has("rejected"))

@@ -78,8 +78,7 @@ std::string script_path() {
 }  // namespace
 
 PlotFigure figure_of_graph(const PoseGraph& graph, const PoseKeys& keys,
-                           const std::vector<int>& blocks,
-                           const std::set<std::pair<std::uint64_t, std::uint64_t>>& rejected,
+                           const std::vector<int>& blocks, const std::vector<bool>& rejected,
                            const std::string& title) {
   if (!graph.has_initial())
     throw InputError(graph.source, 0, "has no VERTEX lines: no poses to draw");
@@ -101,10 +100,10 @@ PlotFigure figure_of_graph(const PoseGraph& graph, const PoseKeys& keys,
       f.names.push_back("robot " + keys.robot_name(r));
   else
     for (int b = 0; b < num_blocks; ++b) f.names.push_back("block " + std::to_string(b));
-  for (const Measurement& m : graph.measurements) {
-    const std::uint64_t a = keys.id(m.i), b = keys.id(m.j);
+  for (std::size_t e = 0; e < graph.measurements.size(); ++e) {
+    const Measurement& m = graph.measurements[e];
     std::string kind;
-    if (rejected.count({std::min(a, b), std::max(a, b)}))
+    if (e < rejected.size() && rejected[e])
       kind = "rejected";
     else if (!blocks.empty() && blocks[m.i] != blocks[m.j])
       kind = "cut";

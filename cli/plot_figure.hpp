@@ -36,10 +36,9 @@ struct PlotFigure {
 };
 
 /// The graph's VERTEX poses per robot with its loop closures: inter-robot, cut by `blocks`
-/// (when given: then coloured by block), rejected (pairs of input ids).
+/// (when given: then coloured by block), rejected (rejected[e] for measurement e, when given).
 PlotFigure figure_of_graph(const PoseGraph& graph, const PoseKeys& keys,
-                           const std::vector<int>& blocks,
-                           const std::set<std::pair<std::uint64_t, std::uint64_t>>& rejected,
+                           const std::vector<int>& blocks, const std::vector<bool>& rejected,
                            const std::string& title);
 
 /// A trajectory without measurements.

@@ -150,7 +150,7 @@ TEST(FieldCli, PlotWritesAPng) {
             0)
       << out;
   std::ofstream(g.dir + "/rej.txt")
-      << tessera::gtsam_key('a', 0) << " " << tessera::gtsam_key('a', 1) << "\n";
+      << tessera::gtsam_key('a', 0) << " " << tessera::gtsam_key('a', 1) << "\n5\n";
   ASSERT_EQ(run_command(bin("tessera") + " plot " + g.graph + " --partition " + g.dir +
                             "/part.txt --rejected " + g.dir + "/rej.txt --out " + png,
                         &out),
@@ -163,6 +163,13 @@ TEST(FieldCli, PlotWritesAPng) {
             2)
       << out;
   EXPECT_TRUE(contains(out, g.dir + "/short.txt: 2 blocks for a graph of 90 poses")) << out;
+  std::ofstream(g.dir + "/rej2.txt") << "3\n99999\n";
+  EXPECT_EQ(run_command(bin("tessera") + " plot " + g.graph + " --rejected " + g.dir +
+                            "/rej2.txt --out " + png,
+                        &out),
+            2)
+      << out;
+  EXPECT_TRUE(contains(out, g.dir + "/rej2.txt:2: measurement 99999 does not exist")) << out;
 }
 
 TEST(FieldCli, BadInputsExitTwoNamingFileAndLine) {

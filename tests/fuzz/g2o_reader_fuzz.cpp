@@ -26,6 +26,13 @@ void check_graph(const tessera::G2oReadResult& r) {
   check(g.num_poses > 0 && !g.measurements.empty());
   check(g.initial.empty() || g.initial.size() == g.num_poses);
   check(r.stats.parallel_edges + r.stats.distinct_pairs == g.measurements.size());
+  // The file's ids: none (0..n-1) or one per pose, strictly increasing; robots for every pose.
+  const auto& ids = r.keys.ids;
+  check(ids.empty() || ids.size() == g.num_poses);
+  for (std::size_t k = 1; k < ids.size(); ++k) check(ids[k - 1] < ids[k]);
+  check(r.keys.robot.empty() || r.keys.robot.size() == g.num_poses);
+  for (auto robot : r.keys.robot) check(robot < r.keys.num_robots());
+  check(!r.keys.fixed || *r.keys.fixed < g.num_poses);
   for (const auto& m : g.measurements) {
     check(m.i < g.num_poses && m.j < g.num_poses && m.i != m.j);
     check(std::isfinite(m.kappa) && m.kappa > 0 && std::isfinite(m.tau) && m.tau > 0);
@@ -38,7 +45,8 @@ bool same(const tessera::G2oReadResult& a, const tessera::G2oReadResult& b) {
   if (a.graph.num_poses != b.graph.num_poses || a.graph.d != b.graph.d ||
       a.graph.measurements.size() != b.graph.measurements.size() ||
       a.graph.initial.size() != b.graph.initial.size() || a.stats.lines != b.stats.lines ||
-      a.stats.components != b.stats.components)
+      a.stats.components != b.stats.components || a.keys.ids != b.keys.ids ||
+      a.keys.robot != b.keys.robot || a.keys.fixed != b.keys.fixed)
     return false;
   for (std::size_t k = 0; k < a.graph.measurements.size(); ++k) {
     const auto& x = a.graph.measurements[k];
