@@ -17,7 +17,8 @@
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {"rate", "speedup", "start", "checkpoints", nullptr};
+const char* const kOnlineValued[] = {"rate",        "speedup",       "start",
+                                     "checkpoints", "certify-every", nullptr};
 const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", nullptr};
 
 const char* kOnlineHelp =
@@ -40,6 +41,8 @@ const char* kOnlineHelp =
     "  --baseline                also re-solve from scratch (the front ends' guesses, no warm\n"
     "                            start) after every step that brought a loop closure, and\n"
     "                            report its CPU time\n"
+    "  --certify-every S         also certify every S seconds of stream time (default 0: at\n"
+    "                            the end only)\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step)\n";
 
@@ -76,6 +79,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.solver.rank = static_cast<int>(a.get_long("rank", options.solver.rank));
   options.certify_at_end = !a.has("no-certify");
   options.real_time = a.has("real-time");
+  options.certify_every_s = a.get_double("certify-every", 0.0);
   options.validate();
   ReplayOptions replay;
   replay.rate = a.get_double("rate", replay.rate);
@@ -194,6 +198,16 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("rel_gap", (c.cost - c.optimum) / c.optimum);
       cps.push_back(std::move(j));
     }
+    std::vector<JsonObject> certs;
+    for (const auto& c : res.certificates) {
+      JsonObject o;
+      o.add("time_s", c.time_s)
+          .add("poses", c.poses)
+          .add("certified", c.certified)
+          .add("min_eigenvalue", c.min_eigenvalue)
+          .add("cpu_s", c.cpu_s);
+      certs.push_back(std::move(o));
+    }
     JsonObject j;
     j.add("graph", graph_path)
         .add("mode", "online")
@@ -224,7 +238,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("min_eigenvalue", res.min_eigenvalue)
         .add("wall_s", wall_s);
     if (baseline) j.add("baseline_solves", baseline_solves).add("baseline_cpu_s", baseline_cpu_s);
-    j.add("checkpoints", cps).add("updates", updates);
+    j.add("certificates", certs).add("checkpoints", cps).add("updates", updates);
     write_output(*p, j.str());
   }
   return 0;
