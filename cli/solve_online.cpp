@@ -153,7 +153,12 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   std::vector<double> latency, gaps;
-  for (const auto& u : res.updates) latency.push_back(u.latency_s);
+  double setup_s = 0.0, rounds_cpu_s = 0.0;
+  for (const auto& u : res.updates) {
+    latency.push_back(u.latency_s);
+    setup_s += u.setup_s;
+    rounds_cpu_s += u.rounds_cpu_s;
+  }
   for (auto& c : marks) {
     c.optimum = solve_centralized(c.graph).cost;
     gaps.push_back((c.cost - c.optimum) / c.optimum);
@@ -182,6 +187,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("rounds", u.rounds)
           .add("ms", u.ms)
           .add("cpu_s", u.cpu_s)
+          .add("setup_s", u.setup_s)
+          .add("rounds_cpu_s", u.rounds_cpu_s)
           .add("latency_s", u.latency_s)
           .add("bytes", static_cast<std::size_t>(u.bytes))
           .add("grad_norm", u.grad_norm)
@@ -225,6 +232,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("rounds", res.rounds)
         .add("bytes", static_cast<std::size_t>(res.bytes))
         .add("cpu_s", res.cpu_s)
+        .add("setup_s", setup_s)
+        .add("rounds_cpu_s", rounds_cpu_s)
         .add("latency_median_s", percentile(latency, 0.5))
         .add("latency_p95_s", percentile(latency, 0.95))
         .add("max_checkpoint_rel_gap",

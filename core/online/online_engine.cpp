@@ -94,6 +94,8 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.bytes = res.bytes_exchanged;
   u.grad_norm = res.grad_norm;
   u.stop_reason = res.stop_reason;
+  u.setup_s = res.init_s;
+  u.rounds_cpu_s = res.solve_cpu_s;
   u.relaxation_cost = res.relaxation_cost;
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;

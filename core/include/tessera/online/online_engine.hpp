@@ -62,6 +62,10 @@ struct OnlineUpdate {
   int rounds = 0;                 ///< Rounds until the gradient was back under tolerance.
   double ms = 0.0;                ///< Wall time of the step (absorb, extend, rounds).
   double cpu_s = 0.0;             ///< Process CPU time of the step.
+  /// Of the step's wall time: the agents' set-up (block problems, preconditioner factors),
+  /// and the process CPU of the rounds alone.
+  double setup_s = 0.0;
+  double rounds_cpu_s = 0.0;
   /// Publication of the oldest absorbed batch to the end of the step (stream clock; with
   /// real_time the step's wall time counts as stream time).
   double latency_s = 0.0;
