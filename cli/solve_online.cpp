@@ -17,7 +17,8 @@
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {"rate", "speedup", "start", "checkpoints", nullptr};
+const char* const kOnlineValued[] = {"rate",        "speedup",       "start",
+                                     "checkpoints", "certify-every", nullptr};
 const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", nullptr};
 
 const char* kOnlineHelp =
@@ -40,6 +41,8 @@ const char* kOnlineHelp =
     "  --baseline                also re-solve from scratch (the front ends' guesses, no warm\n"
     "                            start) after every step that brought a loop closure, and\n"
     "                            report its CPU time\n"
+    "  --certify-every S         also certify every S seconds of stream time (default 0: at\n"
+    "                            the end only)\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step)\n";
 
@@ -76,6 +79,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.solver.rank = static_cast<int>(a.get_long("rank", options.solver.rank));
   options.certify_at_end = !a.has("no-certify");
   options.real_time = a.has("real-time");
+  options.certify_every_s = a.get_double("certify-every", 0.0);
   options.validate();
   ReplayOptions replay;
   replay.rate = a.get_double("rate", replay.rate);
@@ -149,7 +153,12 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   std::vector<double> latency, gaps;
-  for (const auto& u : res.updates) latency.push_back(u.latency_s);
+  double setup_s = 0.0, rounds_cpu_s = 0.0;
+  for (const auto& u : res.updates) {
+    latency.push_back(u.latency_s);
+    setup_s += u.setup_s;
+    rounds_cpu_s += u.rounds_cpu_s;
+  }
   for (auto& c : marks) {
     c.optimum = solve_centralized(c.graph).cost;
     gaps.push_back((c.cost - c.optimum) / c.optimum);
@@ -178,6 +187,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("rounds", u.rounds)
           .add("ms", u.ms)
           .add("cpu_s", u.cpu_s)
+          .add("setup_s", u.setup_s)
+          .add("rounds_cpu_s", u.rounds_cpu_s)
           .add("latency_s", u.latency_s)
           .add("bytes", static_cast<std::size_t>(u.bytes))
           .add("grad_norm", u.grad_norm)
@@ -193,6 +204,16 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("optimum", c.optimum)
           .add("rel_gap", (c.cost - c.optimum) / c.optimum);
       cps.push_back(std::move(j));
+    }
+    std::vector<JsonObject> certs;
+    for (const auto& c : res.certificates) {
+      JsonObject o;
+      o.add("time_s", c.time_s)
+          .add("poses", c.poses)
+          .add("certified", c.certified)
+          .add("min_eigenvalue", c.min_eigenvalue)
+          .add("cpu_s", c.cpu_s);
+      certs.push_back(std::move(o));
     }
     JsonObject j;
     j.add("graph", graph_path)
@@ -211,6 +232,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("rounds", res.rounds)
         .add("bytes", static_cast<std::size_t>(res.bytes))
         .add("cpu_s", res.cpu_s)
+        .add("setup_s", setup_s)
+        .add("rounds_cpu_s", rounds_cpu_s)
         .add("latency_median_s", percentile(latency, 0.5))
         .add("latency_p95_s", percentile(latency, 0.95))
         .add("max_checkpoint_rel_gap",
@@ -224,7 +247,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("min_eigenvalue", res.min_eigenvalue)
         .add("wall_s", wall_s);
     if (baseline) j.add("baseline_solves", baseline_solves).add("baseline_cpu_s", baseline_cpu_s);
-    j.add("checkpoints", cps).add("updates", updates);
+    j.add("certificates", certs).add("checkpoints", cps).add("updates", updates);
     write_output(*p, j.str());
   }
   return 0;

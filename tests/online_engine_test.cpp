@@ -183,12 +183,36 @@ TEST(OnlineEngine, APoseThatOnlyExtendsOdometryNeedsNoRound) {
   EXPECT_EQ(rounds_on_odometry_only, 0);
 }
 
+TEST(OnlineEngine, CertifiesWhileTheGraphGrowsWhenAsked) {
+  const auto gen = small_graph(TrajectoryKind::kCity, 90, 3);
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ReplayOptions{});
+  OnlineOptions o = online_options();
+  o.certify_every_s = 1.0;
+  const OnlineResult res = run_online(gen.graph.d, plan.batches, o);
+  // 3 s of stream, but no certificate before the robots met (no common frame).
+  ASSERT_FALSE(res.certificates.empty());
+  double last = -1.0;
+  for (const auto& c : res.certificates) {
+    EXPECT_TRUE(c.certified) << "at " << c.time_s << " s, " << c.poses << " poses";
+    EXPECT_GE(c.time_s, last + 1.0);
+    last = c.time_s;
+  }
+  const double f_star = batch_optimum(gen.graph);
+  EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
+}
+
 TEST(OnlineEngine, RejectsBadOptionsNamingTheField) {
   OnlineOptions o;
   o.solver.grad_norm_tol = -1;
   EXPECT_NE(
       test::validation_message(o).find("OnlineOptions.solver: DistributedOptions.grad_norm_tol"),
       std::string::npos);
+  o = {};
+  o.certify_every_s = -1;
+  EXPECT_NE(test::validation_message(o).find("OnlineOptions.certify_every_s"), std::string::npos);
+  o = {};
+  o.rebalance.slack = -1;
+  EXPECT_NE(test::validation_message(o).find("RebalanceOptions.slack"), std::string::npos);
 }
 
 }  // namespace

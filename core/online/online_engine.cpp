@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
@@ -12,6 +13,8 @@ namespace tessera {
 
 void OnlineOptions::validate() const {
   rebalance.validate();
+  if (!(certify_every_s >= 0) || !std::isfinite(certify_every_s))
+    throw InputError("OnlineOptions.certify_every_s must be a finite number >= 0 (seconds)");
   DistributedOptions s = solver;
   s.certify = certify_at_end;  // the staircase options matter only then
   try {
@@ -91,6 +94,8 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.bytes = res.bytes_exchanged;
   u.grad_norm = res.grad_norm;
   u.stop_reason = res.stop_reason;
+  u.setup_s = res.init_s;
+  u.rounds_cpu_s = res.solve_cpu_s;
   u.relaxation_cost = res.relaxation_cost;
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;
@@ -184,10 +189,29 @@ OnlineResult OnlineEngine::finish() {
   return out;
 }
 
+std::optional<OnlineCertificate> OnlineEngine::certify(double now_s) {
+  if (X_.cols() == 0 || count_components(stream_.graph()) != 1) return std::nullopt;
+  DistributedOptions solver = options_.solver;
+  solver.certify = true;
+  solver.round_result = false;
+  const double cpu_start = cpu_now();
+  const DistributedResult res = solve_linked(solver);
+  OnlineCertificate c;
+  c.time_s = now_s;
+  c.poses = stream_.graph().num_poses;
+  c.certified = res.certified.value_or(false);
+  c.min_eigenvalue = res.min_eigenvalue;
+  c.cpu_s = cpu_now() - cpu_start;
+  totals_.cpu_s += c.cpu_s;
+  totals_.bytes += res.bytes_exchanged;
+  totals_.certificates.push_back(c);
+  return c;
+}
+
 OnlineResult run_online(int d, const std::vector<StreamBatch>& batches,
                         const OnlineOptions& options, const OnlineObserver& observer) {
   OnlineEngine engine(d, options);
-  double clock = 0.0;
+  double clock = 0.0, next_certificate = options.certify_every_s;
   std::size_t next = 0;
   while (next < batches.size()) {
     // Without real time, each distinct stamp is one step; with it, everything published
@@ -197,6 +221,9 @@ OnlineResult run_online(int d, const std::vector<StreamBatch>& batches,
     const OnlineUpdate u = engine.step(clock);
     if (observer && (u.poses > 0 || u.measurements > 0 || u.rounds > 0)) observer(engine, u);
     if (options.real_time) clock += u.ms / 1000.0;
+    if (options.certify_every_s > 0 && clock >= next_certificate &&
+        engine.certify(clock).has_value())
+      next_certificate = clock + options.certify_every_s;
   }
   return engine.finish();
 }

@@ -39,6 +39,10 @@ struct OnlineOptions {
   /// stamps are a real-time clock; a step absorbs every batch published by the time the
   /// previous step ended (its measured wall time), as a live run would.
   bool real_time = false;
+  /// run_online only: > 0 runs the distributed certificate every this many seconds of
+  /// stream time (at the first step after each period, once the graph is connected), on the
+  /// graph received so far; 0 = only at the end. >= 0.
+  double certify_every_s = 0.0;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
@@ -58,6 +62,10 @@ struct OnlineUpdate {
   int rounds = 0;                 ///< Rounds until the gradient was back under tolerance.
   double ms = 0.0;                ///< Wall time of the step (absorb, extend, rounds).
   double cpu_s = 0.0;             ///< Process CPU time of the step.
+  /// Of the step's wall time: the agents' set-up (block problems, preconditioner factors),
+  /// and the process CPU of the rounds alone.
+  double setup_s = 0.0;
+  double rounds_cpu_s = 0.0;
   /// Publication of the oldest absorbed batch to the end of the step (stream clock; with
   /// real_time the step's wall time counts as stream time).
   double latency_s = 0.0;
@@ -69,8 +77,18 @@ struct OnlineUpdate {
   double relaxation_cost = 0.0;  ///< f(Y) at the end of the step.
 };
 
+/// A certificate taken while the graph was growing (OnlineOptions::certify_every_s).
+struct OnlineCertificate {
+  double time_s = 0.0;
+  std::size_t poses = 0;
+  bool certified = false;
+  double min_eigenvalue = 0.0;
+  double cpu_s = 0.0;
+};
+
 struct OnlineResult {
   std::vector<OnlineUpdate> updates;
+  std::vector<OnlineCertificate> certificates;  ///< Taken during the run (certify_every_s).
   int rounds = 0;               ///< All steps' rounds (the final certificate's excluded).
   int repartitions = 0;         ///< Steps that moved poses between blocks.
   std::size_t poses_moved = 0;  ///< Poses moved over all steps.
@@ -97,6 +115,10 @@ class OnlineEngine {
   /// A round boundary: absorbs the received batches and solves until the gradient is under
   /// the tolerance; idle (no round, no message) when nothing is new and it already is.
   OnlineUpdate step(double now_s = 0.0);
+  /// Certifies the current iterate on the graph received so far (the distributed certificate
+  /// after the rounds; a saddle's staircase climb is not kept: the next data restarts from
+  /// rank r). nullopt while the graph is not connected.
+  std::optional<OnlineCertificate> certify(double now_s);
   /// Solves from the current iterate (certifying when asked) and returns the run's figures.
   OnlineResult finish();
 
