@@ -1,5 +1,5 @@
-// `tessera partition GRAPH --parts N [--preset P] [--eps E] [--seed S] [--islands K] [--out FILE]
-// [--json FILE]`:
+// `tessera partition GRAPH --parts N [--preset P] [--eps E] [--seed S] [--islands K]
+// [--objective O] [--colour-slack F] [--out FILE] [--json FILE]`:
 // splits a pose graph (g2o) or a METIS graph into N balanced blocks and reports the quality.
 
 #include <cstdio>
@@ -21,7 +21,8 @@ namespace {
 
 const char* const kHelp =
     "usage: tessera partition GRAPH --parts N [--preset P] [--eps E] [--seed S]\n"
-    "                         [--islands K] [--out FILE] [--json FILE] [--format F]\n"
+    "                         [--islands K] [--objective cut|rounds] [--colour-slack F]\n"
+    "                         [--out FILE] [--json FILE] [--format F]\n"
     "\n"
     "Splits the poses of GRAPH into N balanced blocks (one per agent) with few cut edges,\n"
     "using only the graph's structure. Every block holds at most floor((1+eps)*ceil(n/N))\n"
@@ -42,6 +43,10 @@ const char* const kHelp =
     "                 of the budget) unless K = 1 or that is fewer steps than its population.\n"
     "                 The partition depends on K and the seed, never on the machine\n"
     "                 (default 0)\n"
+    "  --objective O  cut: fewest cut edges (default); rounds: then fewer colours of the\n"
+    "                 block adjacency graph, i.e. more blocks per IRBCD round, for at most\n"
+    "                 --colour-slack more cut (docs/partitioning.md)\n"
+    "  --colour-slack F  objective rounds: largest relative cut increase, 0..10 (default 0.25)\n"
     "  --out FILE     write the block id of pose i on line i (0-based, one per line)\n"
     "  --json FILE    write the figures as one JSON object to FILE ('-' for stdout)\n"
     "  --format F     g2o | metis: override the format detection\n"
@@ -94,6 +99,7 @@ std::string result_json(const GraphStructure& g, const PartitionOptions& o,
       .add("eps", o.eps)
       .add("seed", static_cast<long long>(o.seed))  // parsed from a non-negative long
       .add("islands", o.islands)
+      .add("objective", objective_name(o.objective))
       .add("cut_edges", m.cut_edges)
       .add("cut_pairs", m.cut_pairs)
       .add("block_sizes", m.block_sizes)
@@ -103,6 +109,8 @@ std::string result_json(const GraphStructure& g, const PartitionOptions& o,
       .add("imbalance", m.imbalance)
       .add("cvolume", m.cvolume)
       .add("boundary_vertices", m.boundary_vertices)
+      .add("adjacent_block_pairs", r.adjacent_block_pairs)
+      .add("colours", r.colours)
       .add("time_ms", r.time_ms)
       .add("cpu_ms", r.cpu_ms)
       .add("trace", trace)
@@ -112,7 +120,9 @@ std::string result_json(const GraphStructure& g, const PartitionOptions& o,
 }  // namespace
 
 int run_partition(const Args& args) {
-  Arguments a(args, {"parts", "preset", "eps", "seed", "islands", "out", "json", "format"},
+  Arguments a(args,
+              {"parts", "preset", "eps", "seed", "islands", "objective", "colour-slack", "out",
+               "json", "format"},
               {"help"});
   if (a.has("help")) {
     std::fputs(kHelp, stdout);
@@ -138,6 +148,11 @@ int run_partition(const Args& args) {
   if (islands < 0 || islands > 8)
     throw InputError("option --islands: " + std::to_string(islands) + " is outside 0..8");
   options.islands = static_cast<int>(islands);
+  options.objective = parse_objective(a.get_or("objective", "cut"));
+  options.colour_cut_slack = a.get_double("colour-slack", options.colour_cut_slack);
+  if (!(options.colour_cut_slack >= 0.0 && options.colour_cut_slack <= 10.0))
+    throw InputError("option --colour-slack: " + a.get_or("colour-slack", "") +
+                     " is outside 0..10");
   options.validate();
 
   const GraphStructure g = load_structure(a.positional()[0], a.get_or("format", ""));
@@ -168,6 +183,8 @@ int run_partition(const Args& args) {
   std::printf("balance:      max_block_ratio %.4f, imbalance %.4f\n", m.max_block_ratio,
               m.imbalance);
   std::printf("cvolume:      %.4f\n", m.cvolume);
+  std::printf("quotient:     %d adjacent block pairs, %d colours (objective %s)\n",
+              r.adjacent_block_pairs, r.colours, objective_name(options.objective));
   std::printf("time:         %.1f ms (cpu %.1f ms)\n", r.time_ms, r.cpu_ms);
   return 0;
 }

@@ -100,6 +100,7 @@ void expect_partition_of_the_agents_graph(const std::string& coordinator_file, i
   popt.parts = 3;
   popt.preset = parse_preset("highest");
   popt.seed = 2;
+  popt.objective = PartitionObjective::kRounds;  // the coordinator's (partition_step.hpp)
   const std::vector<int> part =
       partition_graph(graph_structure_from_pose_graph(read_g2o(graph)), popt).assignment;
   EXPECT_EQ(assignment_of(dir, 3), part) << "not the partition of the agents' graph";

@@ -189,6 +189,7 @@ TEST(DdsRobotFiles, DdsRunFromPerRobotFilesEqualsTheSingleFile) {
   PartitionOptions popt;
   popt.parts = N;
   popt.preset = parse_preset("highest");
+  popt.objective = PartitionObjective::kRounds;  // solve's and the coordinator's default
   const std::vector<int> part =
       partition_graph(graph_structure_from_pose_graph(g), popt).assignment;
   DistributedOptions opt;

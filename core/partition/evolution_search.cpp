@@ -118,7 +118,10 @@ Individual EvolutionSearch::fresh_individual() {
 }
 
 void EvolutionSearch::build_population() {
-  for (int i = 0; i < std::max(1, params_.population); ++i) pop_.push_back(fresh_individual());
+  for (int i = 0; i < std::max(1, params_.population); ++i) {
+    if (i > 0 && params_.past_deadline()) break;
+    pop_.push_back(fresh_individual());
+  }
 }
 
 const Individual& EvolutionSearch::best() const {
@@ -136,6 +139,7 @@ bool EvolutionSearch::run(int max_steps) {
 
 bool EvolutionSearch::step() {
   if (gen_ >= params_.generations || pop_.size() <= 1 || tail_ == 0) return false;
+  if (params_.past_deadline()) return false;
   if (tail_ < 0 && stalled_ >= params_.stall_limit) {
     if (params_.light_tail <= 0) return false;
     tail_ = params_.light_tail;

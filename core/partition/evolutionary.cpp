@@ -54,7 +54,7 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
         [&] { layouts = fm_refined_layouts(g, k, ub, params.spectral, scycle, srng); });
   IslandSearchResult found = island_search(g, k, ub, params, rng, trace, side_jobs);
   Individual top{std::move(found.part), found.cut};
-  if (params.polish.rounds > 0) {
+  if (params.polish.rounds > 0 && !params.past_deadline()) {
     // Its own generator (seeded from a copy of the search's).
     Rng copy = rng;
     Rng prng(copy.next() ^ 0x5DEECE66DULL);
@@ -66,7 +66,7 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
                 std::to_string(before),
             top.cut);
   }
-  if (spectral) {
+  if (spectral && !params.past_deadline()) {
     std::string cuts;
     // Layouts far above the search's best after FM are not worth V-cycles and combines.
     const long long useful =
@@ -85,7 +85,7 @@ std::vector<int> evolve(const WorkGraph& g, int k, const std::vector<long long>&
       trace("spectral", "global layouts after V-cycles: " + (cuts.empty() ? "none" : cuts),
             top.cut);
   }
-  if (params.resplit.searches > 0 && k <= params.resplit.max_parts) {
+  if (params.resplit.searches > 0 && k <= params.resplit.max_parts && !params.past_deadline()) {
     const long long before = top.cut;
     const BlockResplitResult r = block_resplit(g, k, ub, top.part, params, rng);
     top.cut = r.cut;

@@ -5,6 +5,7 @@
 // parent, so a child is never worse than it) and mutations (V-cycles and combines with fresh
 // partitions). Everything is counted in operations, not seconds, so a seed fixes the result.
 
+#include <chrono>
 #include <functional>
 #include <string>
 #include <vector>
@@ -70,6 +71,11 @@ struct EvolutionParams {
   /// result replaces the best only when strictly better. searches = 0: off.
   BlockResplitOptions resplit;
   CycleParams cycle;
+  /// Wall-clock cap: no step starts after it, the population stops growing (at least one
+  /// individual), and the phases after the search (polish, spectral layouts, re-split) are
+  /// skipped. The default never comes; with a real deadline the result depends on the machine.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  bool past_deadline() const { return std::chrono::steady_clock::now() >= deadline; }
 
   /// Throws InputError naming the first field out of range (the polish and spectral options
   /// included; the cycle's parameters are the presets' own).

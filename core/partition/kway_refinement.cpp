@@ -30,16 +30,26 @@ struct Move {
   long long gain = LLONG_MIN;
 };
 
+// Whether v (its connectivity in c) may move to block b: no neighbour of v may then sit in a
+// block that is forbidden next to b.
+bool allowed(const Connectivity& c, int b, int k, const ForbiddenPairs* forbidden) {
+  if (!forbidden) return true;
+  for (int q : c.touched)
+    if (q != b && (*forbidden)[static_cast<std::size_t>(b) * k + q]) return false;
+  return true;
+}
+
 // Best feasible move of v among the blocks it has neighbours in (ties: the lighter block).
 Move best_adjacent_move(const WorkGraph& g, const std::vector<int>& part,
                         const std::vector<long long>& bw, const std::vector<long long>& ub,
-                        Connectivity& c, int v) {
+                        Connectivity& c, int v, const ForbiddenPairs* forbidden = nullptr) {
   c.compute(g, part, v);
   const int own = part[v];
   const long long internal = c.conn[own];
+  const int k = static_cast<int>(bw.size());
   Move best;
   for (int b : c.touched) {
-    if (b == own || bw[b] + g.vw[v] > ub[b]) continue;
+    if (b == own || bw[b] + g.vw[v] > ub[b] || !allowed(c, b, k, forbidden)) continue;
     const long long gain = c.conn[b] - internal;
     if (gain > best.gain || (gain == best.gain && bw[b] < bw[best.target])) best = {b, gain};
   }
@@ -56,15 +66,17 @@ long long key_of(long long gain, Rng& rng) {
 // vertices, stops after `stop_after` moves without a new best and rolls back to the best point.
 class FmEngine {
  public:
-  FmEngine(const WorkGraph& g, int k, std::vector<int>& part, const std::vector<long long>& ub)
+  FmEngine(const WorkGraph& g, int k, std::vector<int>& part, const std::vector<long long>& ub,
+           const ForbiddenPairs* forbidden)
       : g_(g),
         part_(part),
         ub_(ub),
+        forbidden_(forbidden),
         bw_(block_weights(g, part, k)),
         conn_(k),
         queue_(g.n),
         lock_(static_cast<std::size_t>(g.n), 0) {
-    if (k == 2) init_two_way();
+    if (k == 2 && !forbidden) init_two_way();
   }
 
   bool boundary(int v) const {
@@ -151,7 +163,7 @@ class FmEngine {
   }
 
   Move best_move(int v) {
-    if (!two_way_) return best_adjacent_move(g_, part_, bw_, ub_, conn_, v);
+    if (!two_way_) return best_adjacent_move(g_, part_, bw_, ub_, conn_, v, forbidden_);
     const int other = 1 - part_[v];
     if (external_[v] == 0 || bw_[other] + g_.vw[v] > ub_[other]) return {};
     return {other, 2 * external_[v] - weighted_degree_[v]};
@@ -171,6 +183,7 @@ class FmEngine {
   const WorkGraph& g_;
   std::vector<int>& part_;
   const std::vector<long long>& ub_;
+  const ForbiddenPairs* forbidden_;
   std::vector<long long> bw_;
   Connectivity conn_;
   GainQueue queue_;
@@ -185,10 +198,10 @@ class FmEngine {
 
 long long kway_fm(const WorkGraph& g, int k, std::vector<int>& part,
                   const std::vector<long long>& ub, const FmParams& params, Rng& rng,
-                  long long known_cut) {
+                  long long known_cut, const ForbiddenPairs* forbidden) {
   long long cut = known_cut >= 0 ? known_cut : edge_cut(g, part);
   if (k < 2) return cut;
-  FmEngine fm(g, k, part, ub);
+  FmEngine fm(g, k, part, ub, forbidden);
   for (int pass = 0; pass < params.max_passes; ++pass) {
     std::vector<int> seeds;
     for (int v : random_order(g.n, rng))
@@ -217,8 +230,8 @@ long long kway_fm(const WorkGraph& g, int k, std::vector<int>& part,
   return cut;
 }
 
-bool rebalance(const WorkGraph& g, int k, std::vector<int>& part,
-               const std::vector<long long>& ub) {
+bool rebalance(const WorkGraph& g, int k, std::vector<int>& part, const std::vector<long long>& ub,
+               const ForbiddenPairs* forbidden) {
   std::vector<long long> bw = block_weights(g, part, k);
   auto overloaded = [&](int b) { return bw[b] > ub[b]; };
   bool any = false;
@@ -227,10 +240,10 @@ bool rebalance(const WorkGraph& g, int k, std::vector<int>& part,
   Connectivity c(k);
   // Best move of v anywhere: an adjacent block with room, or else the block with most room.
   auto best_move = [&](int v) {
-    Move m = best_adjacent_move(g, part, bw, ub, c, v);
+    Move m = best_adjacent_move(g, part, bw, ub, c, v, forbidden);
     int roomiest = -1;
     for (int b = 0; b < k; ++b)
-      if (b != part[v] && bw[b] + g.vw[v] <= ub[b] &&
+      if (b != part[v] && bw[b] + g.vw[v] <= ub[b] && allowed(c, b, k, forbidden) &&
           (roomiest < 0 || ub[b] - bw[b] > ub[roomiest] - bw[roomiest]))
         roomiest = b;
     if (roomiest >= 0) {

@@ -9,6 +9,7 @@
 
 #include "partition/evolutionary.hpp"
 #include "partition/multilevel.hpp"
+#include "partition/quotient_colouring.hpp"
 
 namespace tessera {
 
@@ -37,6 +38,16 @@ PartitionPreset parse_preset(const std::string& name) {
   throw InputError("unknown preset '" + name + "' (valid: sequential, fast, eco, strong, highest)");
 }
 
+const char* objective_name(PartitionObjective objective) {
+  return objective == PartitionObjective::kRounds ? "rounds" : "cut";
+}
+
+PartitionObjective parse_objective(const std::string& name) {
+  if (name == "cut") return PartitionObjective::kCut;
+  if (name == "rounds") return PartitionObjective::kRounds;
+  throw InputError("unknown partition objective '" + name + "' (valid: cut, rounds)");
+}
+
 void PartitionOptions::validate() const {
   if (parts < 1 || parts > 64)
     throw InputError("PartitionOptions.parts = " + std::to_string(parts) + ": must be in 1..64");
@@ -45,6 +56,15 @@ void PartitionOptions::validate() const {
   if (islands < 0 || islands > 8)
     throw InputError("PartitionOptions.islands = " + std::to_string(islands) +
                      ": must be in 0..8 (0 = the preset's own)");
+  if (!std::isfinite(colour_cut_slack) || colour_cut_slack < 0.0 || colour_cut_slack > 10.0)
+    throw InputError("PartitionOptions.colour_cut_slack = " + std::to_string(colour_cut_slack) +
+                     ": must be in 0..10");
+  if (!std::isfinite(time_limit_s) || time_limit_s < 0.0)
+    throw InputError("PartitionOptions.time_limit_s = " + std::to_string(time_limit_s) +
+                     ": must be >= 0 seconds (0 = no cap)");
+  if (stall_steps < 0)
+    throw InputError("PartitionOptions.stall_steps = " + std::to_string(stall_steps) +
+                     ": must be >= 0 (0 = the preset's own)");
 }
 
 namespace {
@@ -302,6 +322,13 @@ PresetPlan preset_plan(PartitionPreset preset, const WorkGraph& g, int k, long l
 
 }  // namespace
 
+BlockAdjacency block_adjacency(const GraphStructure& graph, const std::vector<int>& assignment,
+                               int parts) {
+  compute_partition_metrics(graph, assignment, parts);  // validates the assignment
+  const QuotientColouring q = colour_quotient(to_work_graph(graph), assignment, parts);
+  return {q.adjacent_pairs, q.colours};
+}
+
 PartitionResult partition_graph(const GraphStructure& graph, const PartitionOptions& options) {
   options.validate();
   const std::size_t n = graph.num_vertices;
@@ -326,6 +353,9 @@ PartitionResult partition_graph(const GraphStructure& graph, const PartitionOpti
     result.metrics = compute_partition_metrics(graph, result.assignment, k);
     phase("sequential", std::to_string(k) + " contiguous id ranges",
           static_cast<long long>(result.metrics.cut_edges), t0);
+    const QuotientColouring q = colour_quotient(to_work_graph(graph), result.assignment, k);
+    result.adjacent_block_pairs = q.adjacent_pairs;
+    result.colours = q.colours;
     return result;
   }
 
@@ -343,6 +373,10 @@ PartitionResult partition_graph(const GraphStructure& graph, const PartitionOpti
       plan.evolution.resplit.searches = 0;
     }
   }
+  if (options.stall_steps > 0) plan.evolution.stall_limit = options.stall_steps;
+  if (options.time_limit_s > 0.0)
+    plan.evolution.deadline = t0 + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double>(options.time_limit_s));
   const CycleParams& cp = plan.cycle;
   Rng rng(options.seed);
   std::vector<int> part;
@@ -354,6 +388,7 @@ PartitionResult partition_graph(const GraphStructure& graph, const PartitionOpti
   if (!plan.evolve) {
     long long best = -1;
     for (int r = 0; r < plan.runs; ++r) {
+      if (r > 0 && plan.evolution.past_deadline()) break;
       const auto tr = Clock::now();
       CycleStats s;
       std::vector<int> p = multilevel_partition(g, k, ub, cp, rng, &s);
@@ -364,6 +399,7 @@ PartitionResult partition_graph(const GraphStructure& graph, const PartitionOpti
       phase("multilevel", describe(s), best, tr);
     }
     for (int c = 0; c < plan.vcycles; ++c) {
+      if (plan.evolution.past_deadline()) break;
       const auto tc = Clock::now();
       CycleStats s;
       std::vector<int> p = guided_cycle(g, k, ub, part, part, cp, rng, &s);
@@ -382,6 +418,26 @@ PartitionResult partition_graph(const GraphStructure& graph, const PartitionOpti
                   });
   }
   rebalance(g, k, part, ub);  // no-op for balanced results; a safety net for the promise above
+  if (options.objective == PartitionObjective::kRounds && k > 2) {
+    const auto tc = Clock::now();
+    ColourPassOptions co;
+    co.max_cut_increase = options.colour_cut_slack;
+    // The constrained FM is the pass's only refinement (flows ignore the constraint), so it
+    // gets at least the strong presets' effort whatever the preset (milliseconds).
+    co.fm = cp.fm;
+    co.fm.max_passes = std::max(co.fm.max_passes, 6);
+    co.fm.stop_after = std::max(co.fm.stop_after, 400);
+    co.fm.local_rounds = std::max(co.fm.local_rounds, 2);
+    const ColourPassResult cr = colour_pass(g, k, ub, part, co, rng);
+    phase("colours",
+          std::to_string(cr.colours_before) + " -> " + std::to_string(cr.colours_after) +
+              " colours (cut " + std::to_string(cr.cut_before) + " -> " +
+              std::to_string(cr.cut_after) + ")",
+          cr.cut_after, tc);
+  }
+  const QuotientColouring q = colour_quotient(g, part, k);
+  result.adjacent_block_pairs = q.adjacent_pairs;
+  result.colours = q.colours;
   result.assignment = std::move(part);
   result.time_ms = ms_since(t0);
   result.cpu_ms = cpu_ms_since(c0);

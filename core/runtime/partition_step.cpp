@@ -10,6 +10,9 @@ PartitionStepResult partition_for_agents(const GraphStructure& graph, std::uint3
   opt.parts = static_cast<int>(num_agents);
   opt.preset = parse_preset(preset);
   opt.seed = seed;
+  // Agents run IRBCD: fewer colour classes of the block adjacency graph mean more blocks per
+  // round and fewer rounds (docs/partitioning.md "Partitions for convergence").
+  opt.objective = PartitionObjective::kRounds;
   opt.validate();
   PartitionResult r = partition_graph(graph, opt);
   PartitionStepResult out;

@@ -17,8 +17,8 @@ struct PartitionStepResult {
 };
 
 /// Splits the structure among `num_agents` agents with core's partitioner (`preset` as
-/// parse_preset accepts: sequential, fast, eco, strong, highest). Throws InputError on a bad
-/// preset or more agents than poses.
+/// parse_preset accepts: sequential, fast, eco, strong, highest) and the `rounds` objective.
+/// Throws InputError on a bad preset or more agents than poses.
 PartitionStepResult partition_for_agents(const GraphStructure& graph, std::uint32_t num_agents,
                                          const std::string& preset, std::uint64_t seed);
 

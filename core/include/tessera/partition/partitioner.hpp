@@ -22,6 +22,20 @@ namespace tessera {
 
 enum class PartitionPreset { kSequential, kFast, kEco, kStrong, kHighest };
 
+/// What a partition is chosen for.
+///   cut     fewest cut edges (the presets' search alone).
+///   rounds  then a final pass for IRBCD's convergence: IRBCD updates one colour class of the
+///           block adjacency (quotient) graph per round, so the pass lowers the number of
+///           colours while the cut stays within (1 + colour_cut_slack) x the search's cut, and
+///           numbers the blocks in colour order (docs/partitioning.md "Partitions for
+///           convergence").
+enum class PartitionObjective { kCut, kRounds };
+
+/// "cut", "rounds".
+const char* objective_name(PartitionObjective objective);
+/// Inverse of objective_name; throws InputError listing the valid names.
+PartitionObjective parse_objective(const std::string& name);
+
 /// "sequential", "fast", "eco", "strong", "highest".
 const char* preset_name(PartitionPreset preset);
 /// Inverse of preset_name; throws InputError listing the valid names.
@@ -42,9 +56,21 @@ struct PartitionOptions {
   /// work (e.g. agents starting up) may want 1. The partition depends on this value and the
   /// seed, never on the machine's core count.
   int islands = 0;
+  PartitionObjective objective = PartitionObjective::kCut;
+  /// objective rounds: the largest relative cut increase the colour pass may pay, 0..10.
+  double colour_cut_slack = 0.25;
+  /// Wall-time cap of the search in seconds, 0 = none (the default: effort is then counted in
+  /// operations and a seed fixes the partition). Once passed, no further search step, run or
+  /// V-cycle starts and the phases after the search are skipped; one multilevel run always
+  /// completes. With a cap the partition depends on the machine's speed and load.
+  double time_limit_s = 0.0;
+  /// strong / highest: end the search after this many steps in a row without a better cut;
+  /// 0 = the preset's own window, max(40, a third of its step budget).
+  int stall_steps = 0;
 
   /// Throws InputError naming the bad field (parts outside 1..64, eps negative, above 1 or not
-  /// finite, islands outside 0..8).
+  /// finite, islands outside 0..8, colour_cut_slack outside 0..10, time_limit_s negative or not
+  /// finite, stall_steps negative).
   void validate() const;
 };
 
@@ -63,7 +89,20 @@ struct PartitionResult {
   double time_ms = 0.0;            ///< Wall time of the partitioning (metrics excluded).
   double cpu_ms = 0.0;  ///< Process CPU time of the same (tells contention apart on busy hosts).
   std::vector<PartitionPhase> trace;
+  /// The block adjacency graph: pairs of blocks joined by a measurement, and its chromatic
+  /// number (the colour classes IRBCD cycles through).
+  int adjacent_block_pairs = 0;
+  int colours = 0;
 };
+
+/// The block adjacency graph of `assignment` (block 0..parts-1 per vertex): the pairs of blocks
+/// joined by an edge, and its chromatic number (PartitionResult's two fields).
+struct BlockAdjacency {
+  int adjacent_block_pairs = 0;
+  int colours = 0;
+};
+BlockAdjacency block_adjacency(const GraphStructure& graph, const std::vector<int>& assignment,
+                               int parts);
 
 /// Partitions `graph`. Throws InputError when the options are invalid or N exceeds the number of
 /// vertices. The result always satisfies the balance bound and assigns every vertex one block.
