@@ -11,6 +11,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "partition/quotient_colouring.hpp"
+#include "runtime/partition_step.hpp"
 #include "structure_graphs.hpp"
 #include "test_support.hpp"
 
@@ -163,6 +164,21 @@ TEST(PartitionObjective, RoundsGivesNoMoreColoursForABoundedCutAndIsDeterministi
     const WorkGraph g = to_work_graph(s);
     EXPECT_EQ(colour_quotient(g, b.assignment, k).colours, b.colours);
   }
+}
+
+TEST(PartitionObjective, TheCoordinatorPartitionsForRounds) {
+  const GraphStructure s = test::grid_with_chords(20, 20, 3);
+  PartitionOptions o;
+  o.parts = 5;
+  o.preset = PartitionPreset::kEco;
+  o.seed = 4;
+  o.objective = PartitionObjective::kRounds;
+  const PartitionResult r = partition_graph(s, o);
+  const coordinator::PartitionStepResult step = coordinator::partition_for_agents(s, 5, "eco", 4);
+  ASSERT_EQ(step.owner.size(), r.assignment.size());
+  for (std::size_t v = 0; v < step.owner.size(); ++v)
+    ASSERT_EQ(static_cast<int>(step.owner[v]), r.assignment[v]) << "pose " << v;
+  EXPECT_EQ(step.cut_edges, r.metrics.cut_edges);
 }
 
 TEST(PartitionObjective, NamesAndValidation) {
