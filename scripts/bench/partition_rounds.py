@@ -43,6 +43,7 @@ def main():
     ap.add_argument("--presets", default="eco,highest", help="partition presets (default eco,highest)")
     ap.add_argument("--agents", type=int, default=5, help="N (default 5)")
     ap.add_argument("--csv", default="", help="analyse the runs of this CSV instead of running them")
+    ap.add_argument("--note", default="", help="a line for the markdown file (e.g. the load of a --csv run)")
     args = ap.parse_args()
     ctx = bc.Ctx(args)
     labels = ["torus3D", "grid3d-8000 (generated)"]
@@ -81,11 +82,11 @@ def main():
         r["prediction_error"] = round(r["predicted_rounds"] - r["rounds"], 1)
         table.append([r["graph"], r["preset"], r["objective"], r["seed"], r["cut_edges"],
                       r["adjacent_block_pairs"], r["colours"], r["rounds"], r["predicted_rounds"],
-                      r["prediction_error"], r["partition_cpu_ms"]])
+                      r["prediction_error"], r["partition_ms"], r.get("partition_cpu_ms") or "-"])
     load = open("/proc/loadavg").read().split()[:3]
     md = [bc.print_table(f"IRBCD rounds to |grad| <= 0.01, N = {args.agents}",
                          ["graph", "preset", "objective", "seed", "cut", "adjacent pairs", "colours", "rounds",
-                          "model", "model - rounds", "partition CPU ms"], table)]
+                          "model", "model - rounds", "partition ms", "partition CPU ms"], table)]
     summary = []
     for label in labels:
         for preset in sorted({r["preset"] for r in rows}):
@@ -100,13 +101,17 @@ def main():
     md.append(bc.print_table("Summary over seeds 1-%d" % args.seeds,
                              ["graph", "preset", "objective", "rounds by seed", "max", "mean cut", "colours by seed",
                               "model (fitted on cut runs)", "mean |model - rounds|"], summary))
-    print(f"\nload while this ran: {' '.join(load)} (/proc/loadavg); rounds are counts, partition CPU ms "
-          f"is process CPU time.")
+    print(f"\nload while this ran: {' '.join(load)} (/proc/loadavg); rounds are counts, partition ms is "
+          f"wall time (inflated by the load), partition CPU ms process CPU time (- = not recorded).")
     bc.write_csv(os.path.join(ctx.out_dir, "partition_rounds.csv"), rows)
     with open(os.path.join(ctx.out_dir, "partition_rounds.md"), "w") as f:
+        run = ("tessera solve G --algorithm irbcd --agents N --partition P --seed S "
+               "--partition-objective O --json F")
+        cmds = ctx.commands if ctx.commands else [f"{run}   (every row; read back with --csv)"]
         f.write("# IRBCD rounds against the partition\n\nWritten by `scripts/bench/partition_rounds.py`"
-                f" (load {' '.join(load)} while it ran; rounds are counts).\n\n" + "\n\n".join(md) +
-                "\n\nCommands:\n\n" + "\n".join(f"    {c}" for c in ctx.commands) + "\n")
+                f" (load {' '.join(load)} when it finished; rounds are counts, partition ms is wall time and"
+                " grows with the load). " + args.note + "\n\n" + "\n\n".join(md) +
+                "\n\nCommands:\n\n" + "\n".join(f"    {c}" for c in cmds) + "\n")
     print(f"wrote {os.path.relpath(os.path.join(ctx.out_dir, 'partition_rounds.md'), bc.ROOT)}")
 
 
