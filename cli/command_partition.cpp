@@ -22,6 +22,7 @@ namespace {
 const char* const kHelp =
     "usage: tessera partition GRAPH --parts N [--preset P] [--eps E] [--seed S]\n"
     "                         [--islands K] [--objective cut|rounds] [--colour-slack F]\n"
+    "                         [--time-limit S] [--stall-steps K]\n"
     "                         [--out FILE] [--json FILE] [--format F]\n"
     "\n"
     "Splits the poses of GRAPH into N balanced blocks (one per agent) with few cut edges,\n"
@@ -47,6 +48,10 @@ const char* const kHelp =
     "                 block adjacency graph, i.e. more blocks per IRBCD round, for at most\n"
     "                 --colour-slack more cut (docs/partitioning.md)\n"
     "  --colour-slack F  objective rounds: largest relative cut increase, 0..10 (default 0.25)\n"
+    "  --time-limit S strong/highest/eco: stop the search after S seconds of wall time\n"
+    "                 (default 0: no cap; with a cap the partition depends on the machine)\n"
+    "  --stall-steps K  strong/highest: end the search after K steps in a row without a\n"
+    "                 better cut (default 0: the preset's window, max(40, a third of its steps))\n"
     "  --out FILE     write the block id of pose i on line i (0-based, one per line)\n"
     "  --json FILE    write the figures as one JSON object to FILE ('-' for stdout)\n"
     "  --format F     g2o | metis: override the format detection\n"
@@ -121,8 +126,8 @@ std::string result_json(const GraphStructure& g, const PartitionOptions& o,
 
 int run_partition(const Args& args) {
   Arguments a(args,
-              {"parts", "preset", "eps", "seed", "islands", "objective", "colour-slack", "out",
-               "json", "format"},
+              {"parts", "preset", "eps", "seed", "islands", "objective", "colour-slack",
+               "time-limit", "stall-steps", "out", "json", "format"},
               {"help"});
   if (a.has("help")) {
     std::fputs(kHelp, stdout);
@@ -153,6 +158,13 @@ int run_partition(const Args& args) {
   if (!(options.colour_cut_slack >= 0.0 && options.colour_cut_slack <= 10.0))
     throw InputError("option --colour-slack: " + a.get_or("colour-slack", "") +
                      " is outside 0..10");
+  options.time_limit_s = a.get_double("time-limit", 0.0);
+  if (!(options.time_limit_s >= 0.0))
+    throw InputError("option --time-limit: must be >= 0 seconds (0 = no cap)");
+  const long stall = a.get_long("stall-steps", 0);
+  if (stall < 0 || stall > 1000000)
+    throw InputError("option --stall-steps: " + std::to_string(stall) + " is outside 0..1000000");
+  options.stall_steps = static_cast<int>(stall);
   options.validate();
 
   const GraphStructure g = load_structure(a.positional()[0], a.get_or("format", ""));

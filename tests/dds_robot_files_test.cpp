@@ -206,14 +206,16 @@ TEST(DdsRobotFiles, LaunchOnAFolderOfRobotFilesAgreesWithSolve) {
   const std::string dir = temp_dir();
   const std::string whole = generate_split(dir, "city", 200, 3);
   std::string out;
-  ASSERT_EQ(run_command(bin("tessera") + " launch " + dir + "/robots --domain 204 --quiet --json " +
-                            dir + "/launch.json",
-                        &out),
-            0)
+  // The preset is explicit: launch's and solve's default presets need not be the same.
+  ASSERT_EQ(
+      run_command(bin("tessera") + " launch " + dir +
+                      "/robots --partition eco --domain 204 --quiet --json " + dir + "/launch.json",
+                  &out),
+      0)
       << out;
   ASSERT_EQ(run_command(bin("tessera") + " solve " + whole +
-                            " --algorithm irbcd --agents 3 --certify --json " + dir +
-                            "/solve.json",  // launch certifies by default
+                            " --algorithm irbcd --agents 3 --partition eco --certify --json " +
+                            dir + "/solve.json",  // launch certifies by default
                         &out),
             0)
       << out;

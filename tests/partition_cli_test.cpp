@@ -58,6 +58,23 @@ TEST(PartitionCli, G2oInputWritesAssignmentAndJson) {
     EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
 }
 
+// --objective rounds runs the colour pass (a "colours" phase in the trace) and the JSON reports
+// the objective and the block adjacency graph.
+TEST(PartitionCli, ObjectiveRoundsReportsTheBlockAdjacencyGraph) {
+  const std::string dir = tessera::test::temp_dir();
+  const std::string g = write_file(dir, "chain.g2o", chain_g2o(60));
+  std::string out;
+  ASSERT_EQ(
+      partition(g + " --parts 4 --preset eco --objective rounds --json " + dir + "/p.json", &out),
+      0)
+      << out;
+  EXPECT_NE(out.find("colours (objective rounds)"), std::string::npos) << out;
+  const std::string json = read_all(dir + "/p.json");
+  for (const char* key : {"\"objective\": \"rounds\"",
+                          "\"colours\":", "\"adjacent_block_pairs\":", "\"phase\": \"colours\""})
+    EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
+}
+
 // --islands reaches PartitionOptions::islands: highest with four islands traces island 3 and
 // then its short island 4, and the JSON says how many were asked for.
 TEST(PartitionCli, IslandsOptionSetsTheSearchCount) {
@@ -105,6 +122,10 @@ TEST(PartitionCli, BadInputIsAClearError) {
       {g + " --parts 2 --eps -0.5", "--eps: -0.5 is outside 0..1"},
       {g + " --parts 2 --islands 9", "--islands: 9 is outside 0..8"},
       {g + " --parts 2 --preset best", "unknown preset 'best'"},
+      {g + " --parts 2 --objective speed", "unknown partition objective 'speed'"},
+      {g + " --parts 2 --colour-slack 11", "--colour-slack: 11 is outside 0..10"},
+      {g + " --parts 2 --time-limit -1", "--time-limit: must be >= 0"},
+      {g + " --parts 2 --stall-steps -3", "--stall-steps: -3 is outside"},
       {g, "--parts N is required"},
       {g + " --parts 2 --colour red", "unknown option --colour"},
       {write_file(dir, "h.graph", "3 two\n2\n1 3\n2\n") + " --parts 2",
