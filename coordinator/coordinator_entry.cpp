@@ -33,7 +33,7 @@ int coordinator_main(int argc, char** argv) {
   std::unique_ptr<FilePartitionJob> file_job;
   if (!options.graph.empty())
     file_job = std::make_unique<FilePartitionJob>(options.graph, options.agents, options.partition,
-                                                  options.partition_seed);
+                                                  options.partition_seed, options.partition_time_s);
   const cli::ProcessRole role{"tessera-coordinator", options.net.timeout_s};
   return cli::run_session_process(coordinator_session_options(options), role, signals,
                                   [&](transport::Session& session) {

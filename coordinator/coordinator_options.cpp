@@ -22,6 +22,8 @@ options:
   --run-timeout S      bound on the wait for the final estimates, seconds (default 3600)
   --partition PRESET   sequential, fast, eco, strong or highest (default eco)
   --partition-seed K   seed of the partitioner (default 1)
+  --partition-time S   cap of the partitioner's search in seconds of wall time (default 0:
+                       none; with a cap the partition depends on the machine's speed)
   --rank R             rank r of the relaxation sent to the agents (default 0 = core's, 5)
   --algorithm NAME     solver name sent to the agents (default: core's default)
   --init NAME          initialisation the agents run: chordal | distributed | file (the
@@ -75,6 +77,7 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "run-timeout",
                                                             "partition",
                                                             "partition-seed",
+                                                            "partition-time",
                                                             "rank",
                                                             "algorithm",
                                                             "init",
@@ -112,6 +115,9 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
     return v;
   };
   a.partition_seed = static_cast<std::uint64_t>(nonneg("partition-seed", 1));
+  a.partition_time_s = args.get_double("partition-time", 0);
+  if (!(a.partition_time_s >= 0))
+    throw InputError("option --partition-time: must be >= 0 seconds (0 = no cap)");
   a.rank = static_cast<std::uint32_t>(nonneg("rank", 0));
   a.algorithm = args.get_or("algorithm", "");
   a.init = args.get_or("init", init_name(DistributedOptions{}.initialization));

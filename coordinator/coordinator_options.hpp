@@ -18,8 +18,9 @@ struct CoordinatorOptions {
   double run_timeout_s = 3600;  ///< Bound on the wait for the final estimates, > 0 s.
   std::string partition = "eco";
   std::uint64_t partition_seed = 1;
-  std::uint32_t rank = 0;                 ///< 0 = core's default (5).
-  std::string algorithm, init;            ///< Empty algorithm = core's default (irbcd).
+  double partition_time_s = 0;  ///< --partition-time: cap of the partitioner's search, s; 0 = none.
+  std::uint32_t rank = 0;       ///< 0 = core's default (5).
+  std::string algorithm, init;  ///< Empty algorithm = core's default (irbcd).
   std::uint32_t max_rounds = 0;           ///< 0 = core's default.
   double grad_tol = 0, rel_cost_tol = 0;  ///< 0 = core's defaults.
   std::uint64_t seed = 1;

@@ -97,8 +97,9 @@ void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timel
   if (early && !use_early)
     log("the announced structure is not " + o.graph + "'s: partitioning the announced one");
   const PartitionStepResult part =
-      use_early ? std::move(early->part)
-                : partition_for_agents(rs.graph, N, o.partition, o.partition_seed);
+      use_early
+          ? std::move(early->part)
+          : partition_for_agents(rs.graph, N, o.partition, o.partition_seed, o.partition_time_s);
   early.reset();
   if (!use_early) {
     timeline.mark("partitioned");

@@ -16,7 +16,7 @@ bool FilePartition::fits(const RunStructure& rs) const {
 
 std::optional<FilePartition> partition_graph_file(const std::string& path, std::uint32_t num_agents,
                                                   const std::string& preset, std::uint64_t seed,
-                                                  std::string* why) {
+                                                  std::string* why, double time_limit_s) {
   try {
     FilePartition fp;
     std::vector<std::pair<std::size_t, std::size_t>> pairs;
@@ -38,7 +38,7 @@ std::optional<FilePartition> partition_graph_file(const std::string& path, std::
     }
     // The same call, on the same structure, as the partition of the announcements.
     const GraphStructure structure = make_graph_structure(fp.num_poses, pairs, path);
-    fp.part = partition_for_agents(structure, num_agents, preset, seed);
+    fp.part = partition_for_agents(structure, num_agents, preset, seed, time_limit_s);
     if (by_robot) {  // a multi-robot file's sequential baseline: each robot keeps its poses
       fp.part.owner.assign(by_robot->begin(), by_robot->end());
       fp.part.cut_edges = 0;
@@ -63,12 +63,14 @@ struct FilePartitionJob::State {
 };
 
 FilePartitionJob::FilePartitionJob(std::string path, std::uint32_t num_agents, std::string preset,
-                                   std::uint64_t seed)
+                                   std::uint64_t seed, double time_limit_s)
     : state_(std::make_shared<State>()) {
-  std::thread([st = state_, path = std::move(path), num_agents, preset = std::move(preset), seed] {
+  std::thread([st = state_, path = std::move(path), num_agents, preset = std::move(preset), seed,
+               time_limit_s] {
     const auto started = std::chrono::steady_clock::now();
     std::string why;
-    std::optional<FilePartition> r = partition_graph_file(path, num_agents, preset, seed, &why);
+    std::optional<FilePartition> r =
+        partition_graph_file(path, num_agents, preset, seed, &why, time_limit_s);
     const auto ended = std::chrono::steady_clock::now();
     std::lock_guard<std::mutex> lock(st->mutex);
     st->result = std::move(r);

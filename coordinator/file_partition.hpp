@@ -41,7 +41,7 @@ struct FilePartition {
 /// own error if the file is bad).
 std::optional<FilePartition> partition_graph_file(const std::string& path, std::uint32_t num_agents,
                                                   const std::string& preset, std::uint64_t seed,
-                                                  std::string* why);
+                                                  std::string* why, double time_limit_s = 0.0);
 
 /// partition_graph_file on a thread of its own, started at once. The thread is detached: a
 /// process that fails before taking the result exits (cli::exit_process) without waiting for
@@ -49,7 +49,7 @@ std::optional<FilePartition> partition_graph_file(const std::string& path, std::
 class FilePartitionJob {
  public:
   FilePartitionJob(std::string path, std::uint32_t num_agents, std::string preset,
-                   std::uint64_t seed);
+                   std::uint64_t seed, double time_limit_s = 0.0);
   /// True once the result is there; waits at most `wait` for it.
   bool ready(std::chrono::milliseconds wait) const;
   /// Waits for the result (local work with no timeout, like the partition of the

@@ -5,7 +5,8 @@
 namespace tessera::coordinator {
 
 PartitionStepResult partition_for_agents(const GraphStructure& graph, std::uint32_t num_agents,
-                                         const std::string& preset, std::uint64_t seed) {
+                                         const std::string& preset, std::uint64_t seed,
+                                         double time_limit_s) {
   PartitionOptions opt;
   opt.parts = static_cast<int>(num_agents);
   opt.preset = parse_preset(preset);
@@ -13,6 +14,7 @@ PartitionStepResult partition_for_agents(const GraphStructure& graph, std::uint3
   // Agents run IRBCD: fewer colour classes of the block adjacency graph mean more blocks per
   // round and fewer rounds (docs/partitioning.md "Partitions for convergence").
   opt.objective = PartitionObjective::kRounds;
+  opt.time_limit_s = time_limit_s;
   opt.validate();
   PartitionResult r = partition_graph(graph, opt);
   PartitionStepResult out;
