@@ -8,7 +8,9 @@
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/io/metis_reader.hpp>
 #include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partition_metrics.hpp>
 #include <tessera/partition/partitioner.hpp>
+#include <tessera/partition/robot_partition.hpp>
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
@@ -33,7 +35,8 @@ const char* const kHelp =
     "options:\n"
     "  --parts N      number of blocks, 1..64 and at most the number of poses (required)\n"
     "  --preset P     sequential | fast | eco | strong | highest (default strong)\n"
-    "                 sequential: N contiguous id ranges, sizes differing by at most one;\n"
+    "                 sequential: N contiguous id ranges, sizes differing by at most one\n"
+    "                 (a file with N robots, e.g. GTSAM keys: each robot its own poses);\n"
     "                 fast/eco/strong/highest: multilevel partitioner, increasing effort\n"
     "                 (see docs/partitioning.md)\n"
     "  --eps E        balance slack, 0..1 (default 0.03)\n"
@@ -64,7 +67,8 @@ bool ends_with(const std::string& s, const std::string& suffix) {
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-GraphStructure load_structure(const std::string& path, const std::string& format) {
+// A g2o/TORO file's pose keys go to `keys` (its robots make the sequential baseline).
+GraphStructure load_structure(const std::string& path, const std::string& format, PoseKeys& keys) {
   bool metis;
   if (format == "metis") {
     metis = true;
@@ -81,7 +85,9 @@ GraphStructure load_structure(const std::string& path, const std::string& format
     metis = looks_like_metis(path);
   }
   if (metis) return read_metis(path);
-  return graph_structure_from_pose_graph(read_g2o(path));
+  G2oReadResult read = read_g2o_file(path);
+  keys = std::move(read.keys);
+  return graph_structure_from_pose_graph(read.graph);
 }
 
 std::string result_json(const GraphStructure& g, const PartitionOptions& o,
@@ -167,8 +173,14 @@ int run_partition(const Args& args) {
   options.stall_steps = static_cast<int>(stall);
   options.validate();
 
-  const GraphStructure g = load_structure(a.positional()[0], a.get_or("format", ""));
-  const PartitionResult r = partition_graph(g, options);
+  PoseKeys keys;
+  const GraphStructure g = load_structure(a.positional()[0], a.get_or("format", ""), keys);
+  PartitionResult r = partition_graph(g, options);
+  if (options.preset == PartitionPreset::kSequential)  // a multi-robot file: each robot its poses
+    if (auto by_robot = robot_partition(keys, g.num_vertices, options.parts)) {
+      r.assignment = std::move(*by_robot);
+      r.metrics = compute_partition_metrics(g, r.assignment, options.parts);
+    }
   const auto& m = r.metrics;
 
   if (auto out = a.get("out")) {

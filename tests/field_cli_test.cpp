@@ -126,6 +126,12 @@ TEST(FieldCli, SequentialBaselineOfAGtsamFileIsOneBlockPerRobot) {
   ASSERT_NE(at, std::string::npos) << info;
   const std::string inter = info.substr(at + 24, info.find_first_of(",\n", at + 24) - at - 24);
   EXPECT_TRUE(contains(out, "sequential partition (cut " + inter + ")")) << out << info;
+  ASSERT_EQ(run_command(bin("tessera") + " partition " + g.graph +
+                            " --parts 3 --preset sequential --json -",
+                        &out),
+            0)
+      << out;
+  EXPECT_TRUE(contains(out, "\"cut_edges\": " + inter + ",")) << out;
 }
 
 TEST(FieldCli, PlotWritesAPng) {
