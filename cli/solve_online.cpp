@@ -154,8 +154,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
 
   std::vector<double> latency, gaps;
   double setup_s = 0.0, rounds_cpu_s = 0.0;
+  latency = res.batch_latency_s;
   for (const auto& u : res.updates) {
-    latency.push_back(u.latency_s);
     setup_s += u.setup_s;
     rounds_cpu_s += u.rounds_cpu_s;
   }

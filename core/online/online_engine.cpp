@@ -59,9 +59,11 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   double oldest = now_s;
   const std::size_t poses_before = stream_.graph().num_poses;
   const std::size_t measurements_before = stream_.graph().measurements.size();
+  std::vector<double> stamps;
   for (const StreamBatch& b : received_) {
     u.batches += stream_.absorb(b).batches;
     oldest = std::min(oldest, b.stamp);
+    stamps.push_back(b.stamp);
   }
   received_.clear();
   const PoseGraph& graph = stream_.graph();
@@ -100,6 +102,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;
   u.latency_s = now_s - oldest + u.ms / 1000.0;
+  for (double stamp : stamps) totals_.batch_latency_s.push_back(now_s - stamp + u.ms / 1000.0);
   totals_.rounds += u.rounds;
   totals_.repartitions += u.moved > 0 ? 1 : 0;
   totals_.poses_moved += u.moved;

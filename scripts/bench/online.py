@@ -2,9 +2,9 @@
 """Online runs (docs/online.md): a multi-robot graph is replayed as its robots' front ends would
 publish it while one agent per robot solves in one process (`tessera solve GRAPH --online`).
 
-Per run: median and 95th percentile latency (publication of the oldest batch of a step to the
-end of that step, when the gradient is back under the tolerance; with --real-time the steps'
-wall time is stream time), the relative gap to the optimum of the graph received so far at
+Per run: median and 95th percentile latency over the batches (publication of a batch to the
+end of the step that absorbed it, when the gradient is back under the tolerance; with
+--real-time the steps' wall time is stream time), the relative gap to the optimum of the graph received so far at
 sampled checkpoints (centralized solver, offline), rounds and bytes per second of stream,
 the CPU time of the online run against re-solving from scratch after every step that brought
 a loop closure (same script, same agents), and the final cost against the batch optimum f*
@@ -120,8 +120,8 @@ def main():
         for c in ctx.commands:
             f.write(f"      {c}\n")
         f.write("\n" + table + "\n\n")
-        f.write("Columns: latency = publication of the oldest batch a step absorbed to the end of that step "
-                "(gradient back under the tolerance or stalled), median and 95th percentile over the steps; max "
+        f.write("Columns: latency = publication of a batch to the end of the step that absorbed it "
+                "(gradient back under the tolerance or stalled), median and 95th percentile over all batches; max "
                 "gap = largest relative gap (f(estimate) - f*_k) / f*_k over the checkpoints, f*_k the centralized "
                 "optimum of the graph received by checkpoint k; online CPU = process CPU of all steps and the final "
                 "certificate; set-up s = wall time of the agents' set-up (block problems, preconditioner factors) over the steps; rounds CPU s = process CPU of the rounds alone; re-solve CPU = the same agents solving from scratch (chordal start) after every step "

@@ -88,6 +88,10 @@ struct OnlineCertificate {
 
 struct OnlineResult {
   std::vector<OnlineUpdate> updates;
+  /// For every absorbed batch: its publication to the end of the step that absorbed it
+  /// (stream clock), in absorption order. Steps that take long absorb many batches, so this,
+  /// not the per-step latency_s, is what a robot waiting for its estimate sees.
+  std::vector<double> batch_latency_s;
   std::vector<OnlineCertificate> certificates;  ///< Taken during the run (certify_every_s).
   int rounds = 0;               ///< All steps' rounds (the final certificate's excluded).
   int repartitions = 0;         ///< Steps that moved poses between blocks.
