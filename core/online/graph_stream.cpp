@@ -78,7 +78,7 @@ StreamGrowth GraphStream::absorb(const StreamBatch& batch) {
        it = queue.find(absorbed_batches(batch.robot))) {
     const StreamBatch next = std::move(it->second);
     queue.erase(it);
-    absorb_one(next, growth);
+    absorb_one(next);
     ++next_sequence_[batch.robot];
     ++growth.batches;
   }
@@ -87,8 +87,7 @@ StreamGrowth GraphStream::absorb(const StreamBatch& batch) {
   return growth;
 }
 
-void GraphStream::absorb_one(const StreamBatch& batch, StreamGrowth& growth) {
-  (void)growth;
+void GraphStream::absorb_one(const StreamBatch& batch) {
   const int d = graph_.d;
   const std::string where = source_ + ": robot " + std::to_string(batch.robot) + " batch " +
                             std::to_string(batch.sequence);

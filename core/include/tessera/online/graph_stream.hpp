@@ -39,7 +39,8 @@ class GraphStream {
 
   /// Queues `batch`; absorbs it and every queued batch it unblocks (the next sequence numbers
   /// of their robots). Throws InputError for a batch that cannot be right (see above) or a
-  /// sequence number that was already received.
+  /// sequence number that was already received. A refused batch changes nothing and is
+  /// dropped: its robot's later batches wait until that sequence number arrives valid.
   StreamGrowth absorb(const StreamBatch& batch);
 
   const PoseGraph& graph() const { return graph_; }
@@ -61,7 +62,7 @@ class GraphStream {
   std::size_t held_measurements() const { return held_.size(); }
 
  private:
-  void absorb_one(const StreamBatch& batch, StreamGrowth& growth);
+  void absorb_one(const StreamBatch& batch);
   bool try_add(const StreamMeasurement& m);
 
   std::string source_;
