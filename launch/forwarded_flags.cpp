@@ -29,6 +29,10 @@ void check_progress_interval(const std::string& v) {
   number_in(v, "progress-interval", 0, 3600, "0..3600");
 }
 
+void check_partition_time(const std::string& v) {
+  number_in(v, "partition-time", 0, 86400, "0..86400");
+}
+
 }  // namespace
 
 const std::vector<ForwardedFlag>& forwarded_flags() {
@@ -47,6 +51,11 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "the restarts and the last; 0 = every round the coordinator\n"
        "sees (every round with replicas or rejoin)             [0.1]",
        check_progress_interval},
+      {"partition-time", "partition-time", true, ForwardTo::kCoordinator, "--partition-time S",
+       "cap the partitioner's search at S seconds of wall time; 0 =\n"
+       "none, the preset's own effort (with a cap the partition\n"
+       "depends on the machine's speed)                           [0]",
+       check_partition_time},
   };
   return flags;
 }

@@ -21,7 +21,7 @@ struct LaunchOptions {
   /// rbcd | rbcd++ | irbcd.
   std::string algorithm = "irbcd";
   /// Partition preset of the coordinator: sequential | fast | eco | strong | highest.
-  std::string partition = "highest";
+  std::string partition = "eco";
   /// chordal | distributed | file.
   std::string init = "chordal";
   /// Stop when the gradient norm is at most this (> 0).

@@ -74,6 +74,7 @@ TEST(LaunchOptions, BadValuesAreNamedAndRemovedFlagsRefused) {
   EXPECT_NE(error_of({"--agents", "0"}).find("--agents"), std::string::npos);
   EXPECT_NE(error_of({"--status-interval", "-1"}).find("--status-interval"), std::string::npos);
   EXPECT_NE(error_of({"--progress-interval", "x"}).find("--progress-interval"), std::string::npos);
+  EXPECT_NE(error_of({"--partition-time", "-2"}).find("--partition-time"), std::string::npos);
   EXPECT_NE(error_of({"--certify", "--no-certify"}).find("exclude"), std::string::npos);
   EXPECT_NE(error_of({"--agents-yield"}).find("--agents-yield"), std::string::npos);
   EXPECT_EQ(launch_help().find("agents-yield"), std::string::npos);
@@ -85,6 +86,17 @@ TEST(LaunchOptions, TuningFlagsSitUnderTheAdvancedHeading) {
   ASSERT_NE(advanced, std::string::npos);
   for (const char* flag : {"--no-fork-server", "--no-agents-batch", "--no-status-relay"})
     EXPECT_GT(help.find(flag), advanced) << flag;
+}
+
+// launch partitions with eco by default (a small share of the run, docs/partitioning.md) and
+// hands --partition-time to the coordinator only.
+TEST(LaunchOptions, DefaultPresetIsEcoAndThePartitionTimeReachesTheCoordinator) {
+  LaunchOptions o = parse_launch_options({"--partition-time", "2.5"});
+  EXPECT_EQ(o.partition, "eco");
+  const Argv coordinator = coordinator_argv(o, paths());
+  EXPECT_TRUE(has_pair(coordinator, "--partition", "eco"));
+  EXPECT_TRUE(has_pair(coordinator, "--partition-time", "2.5"));
+  EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--partition-time"));
 }
 
 TEST(LaunchOptions, GradientToleranceReachesTheCoordinatorAsTheSameNumber) {

@@ -12,10 +12,10 @@ namespace tessera::dds {
 struct LaunchOptions {
   /// A g2o file, a folder of robot files or a comma-separated list; "" = a generated grid.
   std::string graph;
-  long agents = 3;                    ///< 1..64
-  std::string algorithm = "irbcd";    ///< rbcd | rbcd++ | irbcd
-  std::string partition = "highest";  ///< sequential | fast | eco | strong | highest
-  double grad_tol = 0.01;             ///< > 0
+  long agents = 3;                  ///< 1..64
+  std::string algorithm = "irbcd";  ///< rbcd | rbcd++ | irbcd
+  std::string partition = "eco";    ///< sequential | fast | eco | strong | highest
+  double grad_tol = 0.01;           ///< > 0
   bool certify = true;
   std::string json;        ///< Also write the summary here ("" = not).
   std::string out;         ///< Merged poses (g2o); "" = not written.
