@@ -304,11 +304,40 @@ def plot(csv_path, png_path):
     ax[1].set(xlabel="outlier fraction F", ylabel="|cost - f*_clean| / f*_clean", title="cost over the kept edges")
     ax[2].set(xlabel="outlier fraction F", ylabel="ATE to the clean optimum [m]",
               title="ATE: robust (o) vs plain (faint squares)")
+    ax[0].set_ylim(-0.02, 1.05)
+    ax[1].set_ylim(1e-16, 1e4)
     ax[0].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(png_path, dpi=90)
     plt.close(fig)
     progress(f"wrote {png_path}")
+
+
+def table(csv_path):
+    """The CSV as a markdown table (the columns that matter, rounded)."""
+    with open(csv_path) as f:
+        rows = list(csv.DictReader(f))
+
+    def num(v, spec):
+        try:
+            return spec.format(float(v))
+        except ValueError:
+            return v or "-"
+
+    head = ("| graph | kind | F | outliers | rejected | precision | recall | gap to f*_clean | ATE m | outer | "
+            "certified | plain gap | plain ATE m | dist. rejected | dist. recall | dist. gap | dist. rounds "
+            "(clean) | dist. MB | dist. certified | load |")
+    lines = [head, "|" + "---|" * head.count("|")[:-1] if False else "|" + "---|" * (head.count("|") - 1)]
+    for r in rows:
+        lines.append("| " + " | ".join([
+            r["graph"], r["kind"], r["F"], r["outliers"], r["rejected"] or "-", num(r["precision"], "{:.3f}"),
+            num(r["recall"], "{:.3f}"), num(r["gap"], "{:.1e}"), num(r["ate_m"], "{:.2g}"), r["outer"] or "-",
+            r["certified"] or "-", num(r["plain_gap"], "{:.3g}"), num(r["plain_ate_m"], "{:.2g}"),
+            r.get("d_rejected", "") or "-", num(r.get("d_recall", ""), "{:.3f}"), num(r.get("d_gap", ""), "{:.1e}"),
+            (f"{r['d_rounds']} ({r['d_clean_rounds']})" if r.get("d_rounds") else "-"),
+            num(str(float(r["d_bytes"]) / 1e6) if r.get("d_bytes") else "", "{:.1f}"),
+            r.get("d_certified", "") or "-", r["load"]]) + " |")
+    return "\n".join(lines)
 
 
 def main():
@@ -332,6 +361,7 @@ def main():
     png = os.path.join(args.out_dir, os.path.splitext(args.csv)[0] + ".png")
     if args.plot_only:
         plot(out_csv, png)
+        print(table(out_csv))
         return
     fields = ["graph", "kind", "F", "outliers", "rejected", "precision", "recall", "gap", "ate_m", "outer",
               "iterations", "wall_s", "certified", "plain_gap", "plain_ate_m", "plain_wall_s",
