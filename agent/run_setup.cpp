@@ -130,9 +130,13 @@ RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log
         std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
   }
 
-  // 7. Hand-off, peer to peer: exactly one message to every other agent.
-  std::vector<ReceivedHandoff> received = exchange_handoffs(s, share, asg.owner(), o.id, o.robots,
-                                                            o.net.session.run_id, o.net.timeout_s);
+  // 7. Hand-off, peer to peer: exactly one message to every other agent. A peer sends its
+  // hand-off when its initialisation is done, which is computation (minutes for 25 agents of a
+  // 1M-pose grid on 2 cores: 30 s timed out), so the wait is bounded like a round's, not like a
+  // network step; a dead peer is noticed by its lease meanwhile.
+  std::vector<ReceivedHandoff> received =
+      exchange_handoffs(s, share, asg.owner(), o.id, o.robots, o.net.session.run_id,
+                        std::max(o.net.timeout_s, o.round_timeout_s));
   out.local =
       assemble_local(share, asg.owner(), o.id, o.robots, std::move(received), run_options_of(asg));
   out.local.structure = std::move(structure);

@@ -162,11 +162,12 @@ TEST(DdsLaunch, ReportsPeakMemoryPerAgentAndTheSetUpSteps) {
   // Before the rounds' progress lines.
   EXPECT_LT(out.find("set-up "), out.find("\nround ")) << out;
   const std::string json = slurp(dir + "/s.json");
-  const std::string key = "\"peak_rss_mb_per_agent\":[";
-  const std::size_t at = json.find(key);
-  ASSERT_NE(at, std::string::npos) << json;
+  const std::size_t key = json.find("\"peak_rss_mb_per_agent\":");
+  ASSERT_NE(key, std::string::npos) << json;
+  const std::size_t open = json.find('[', key), close = json.find(']', key);
+  ASSERT_LT(open, close) << json;
   std::vector<double> per_agent;
-  std::istringstream list(json.substr(at + key.size(), json.find(']', at) - at - key.size()));
+  std::istringstream list(json.substr(open + 1, close - open - 1));
   for (std::string v; std::getline(list, v, ',');) per_agent.push_back(std::stod(v));
   ASSERT_EQ(per_agent.size(), 2u) << json;
   const double agent_max = json_field(json, "peak_rss_mb_agent_max");

@@ -139,15 +139,26 @@ def run_one(args, poses, agents, domain):
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     sampler = Sampler(proc.pid, args.period)
     sampler.start()
-    for line in proc.stdout:  # progress stays visible
-        if not line.startswith("summary:") and not line.startswith(" ") and not line.startswith("{"):
+    in_summary = False
+    for line in proc.stdout:  # progress and errors stay visible; the summary is read from its file
+        in_summary = in_summary or line.startswith("summary:")
+        if not in_summary:
             sys.stdout.write("  | " + line)
+        in_summary = in_summary and not line.startswith("}")
     rc = proc.wait()
     wall = time.monotonic() - t0
     sampler.stop = True
     sampler.join()
+    agent_pss = {k: v for k, v in sampler.pss.items() if k.startswith("agent")}
+    agent_rss = {k: v for k, v in sampler.rss.items() if k.startswith("agent")}
     row = {"poses": poses, "agents": agents, "launch_args": args.launch_args, "rc": rc, "wall_s": round(wall, 1),
-           "load_start": load0, "load_end": load()}
+           "load_start": load0, "load_end": load(),
+           # sampled, so known for a failed run too
+           "peak_pss_mb_agent_max": round(max(agent_pss.values(), default=0) / 1024, 1),
+           "sampled_rss_mb_agent_max": round(max(agent_rss.values(), default=0) / 1024, 1),
+           "peak_pss_mb_coordinator": round(sampler.pss.get("tessera-coordin", 0) / 1024, 1),
+           "peak_pss_mb_fork_server": round(sampler.pss.get("tessera-fork-se", 0) / 1024, 1),
+           "peak_pss_mb_run_sum": round(sampler.pss_sum / 1024, 1)}
     if rc != 0 or not os.path.exists(summary):
         return row
     with open(summary) as f:
@@ -156,17 +167,12 @@ def run_one(args, poses, agents, domain):
     for name, a, b in PHASES:
         if b in tl and (a is None or a in tl):
             row[name + "_s"] = round((tl[b] - (tl[a] if a else 0.0)) / 1000.0, 2)
-    agent_pss = {k: v for k, v in sampler.pss.items() if k.startswith("agent")}
     row.update({
         "edges": s.get("edges"), "rounds": s.get("rounds"), "certified": s.get("certified"),
         "min_eigenvalue": s.get("min_eigenvalue"), "cut_edges": s.get("cut_edges"),
         "peak_rss_mb_agent_max": round(s.get("peak_rss_mb_agent_max", 0), 1),
         "peak_rss_mb_coordinator": round(s.get("peak_rss_mb_coordinator", 0), 1),
         "peak_rss_mb_run": round(s.get("peak_rss_mb_run", 0), 1),
-        "peak_pss_mb_agent_max": round(max(agent_pss.values(), default=0) / 1024, 1),
-        "peak_pss_mb_coordinator": round(sampler.pss.get("tessera-coordin", 0) / 1024, 1),
-        "peak_pss_mb_fork_server": round(sampler.pss.get("tessera-fork-se", 0) / 1024, 1),
-        "peak_pss_mb_run_sum": round(sampler.pss_sum / 1024, 1),
     })
     return row
 
