@@ -190,8 +190,9 @@ TEST(DdsStatusRelay, BundlesCarryEveryStatusOfAStepExactly) {
     EXPECT_EQ(back[k].block_grad_norm(), 1.0 / (k + 7.0));
     EXPECT_EQ(back[k].done_vote(), k == 2);
     EXPECT_FALSE(back[k].restart_vote());
-    EXPECT_EQ(back[k].coarse(),
-              k == 1 ? std::vector<double>{0.2, -0.2, 7.0} : std::vector<double>{});
+    const std::vector<double> coarse =
+        k == 1 ? std::vector<double>{0.2, -0.2, 7.0} : std::vector<double>{};
+    EXPECT_EQ(back[k].coarse(), coarse);
   }
   EXPECT_TRUE(relay.take_bundles("r", kRelayAgent).empty());
   // A rollback to epoch 2: what epoch 1 collected is void, statuses of it are ignored.

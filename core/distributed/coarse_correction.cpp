@@ -22,25 +22,24 @@ CoarseTerms::CoarseTerms(int id, int d, const BlockLayout& layout,
                          const std::vector<std::size_t>& owned,
                          const std::vector<std::size_t>& neighbours,
                          const std::vector<Measurement>& measurements)
-    : d_(d), degree_(layout.adjacent[static_cast<std::size_t>(id)].size()) {
+    : d_(d), num_upper_(0) {
+  const auto& adj = layout.adjacent[static_cast<std::size_t>(id)];
+  std::vector<int> upper(adj.size(), -1);
+  for (std::size_t k = 0; k < adj.size(); ++k)
+    if (adj[k] > id) upper[k] = num_upper_++;
   std::unordered_map<std::size_t, std::size_t> own_slot, neighbour_slot;
   for (std::size_t k = 0; k < owned.size(); ++k) own_slot[owned[k]] = k;
   for (std::size_t k = 0; k < neighbours.size(); ++k) neighbour_slot[neighbours[k]] = k;
   for (const Measurement& m : measurements) {
-    // Counted by the owner of the source pose only, so each cut edge enters Q_c once.
-    const auto i = own_slot.find(m.i);
-    const auto j = neighbour_slot.find(m.j);
-    if (i == own_slot.end() || j == neighbour_slot.end()) continue;
-    const int b = layout.owner[m.j];
-    const int k = layout.adjacency_index(id, b);
+    const bool source_own = own_slot.count(m.i) && neighbour_slot.count(m.j);
+    const bool target_own = own_slot.count(m.j) && neighbour_slot.count(m.i);
+    if (!source_own && !target_own) continue;  // inside the block (or not ours): rigid-invariant
+    const std::size_t nb = source_own ? m.j : m.i;
+    const int k = layout.adjacency_index(id, layout.owner[nb]);
     if (k < 0) throw std::logic_error("CoarseTerms: cut edge to a block that is not adjacent");
-    edges_.push_back(Edge{i->second, j->second, k, m.R, m.t, m.kappa, m.tau});
+    edges_.push_back(Edge{own_slot[source_own ? m.i : m.j], neighbour_slot[nb], source_own,
+                          upper[static_cast<std::size_t>(k)], m.R, m.t, m.kappa, m.tau});
   }
-}
-
-std::size_t CoarseTerms::size(int r) const {
-  const std::size_t s = static_cast<std::size_t>(r) + 1;
-  return 3 * s * s * degree_;
 }
 
 std::vector<double> CoarseTerms::compute(const Eigen::MatrixXd& X,
@@ -48,25 +47,58 @@ std::vector<double> CoarseTerms::compute(const Eigen::MatrixXd& X,
   const int r = static_cast<int>(X.rows());
   const int s = r + 1;
   const int w = d_ + 1;
-  std::vector<double> out(size(r), 0.0);
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(s, w), B = Eigen::MatrixXd::Zero(s, w);
+  // For a cut edge i -> j, the residual is Z_target A - Z_source B with
+  // A = [sqrt(kappa) [Y_j; 0], sqrt(tau) [p_j; 1]] and B = [sqrt(kappa) [Y_i R; 0],
+  // sqrt(tau) [p_i + Y_i t; 1]]. U is the own pose's matrix, W the neighbour's:
+  // Q_aa += U U^T, Q_ab += -U W^T (a = this block, b = the neighbour's).
+  Eigen::MatrixXd Qaa = Eigen::MatrixXd::Zero(s, s);
+  std::vector<Eigen::MatrixXd> Qab(static_cast<std::size_t>(num_upper_),
+                                   Eigen::MatrixXd::Zero(s, s));
+  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(s, w), W = Eigen::MatrixXd::Zero(s, w);
+  auto target = [&](Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::MatrixXd>& P, double sk,
+                    double st) {
+    M.topLeftCorner(r, d_) = sk * P.leftCols(d_);
+    M.col(d_).head(r) = st * P.col(d_);
+    M(r, d_) = st;
+  };
+  auto source = [&](Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::MatrixXd>& P, const Edge& e,
+                    double sk, double st) {
+    M.topLeftCorner(r, d_) = sk * (P.leftCols(d_) * e.R);
+    M.col(d_).head(r) = st * (P.col(d_) + P.leftCols(d_) * e.t);
+    M(r, d_) = st;
+  };
   for (const Edge& e : edges_) {
-    const auto Xi = X.middleCols(static_cast<Eigen::Index>(w * e.own_slot), w);
-    const auto Xj = Xn.middleCols(static_cast<Eigen::Index>(w * e.neighbour_slot), w);
+    const auto Po = X.middleCols(static_cast<Eigen::Index>(w * e.own_slot), w);
+    const auto Pn = Xn.middleCols(static_cast<Eigen::Index>(w * e.neighbour_slot), w);
     const double sk = std::sqrt(e.kappa), st = std::sqrt(e.tau);
-    A.topLeftCorner(r, d_) = sk * Xj.leftCols(d_);
-    A.col(d_).head(r) = st * Xj.col(d_);
-    A(r, d_) = st;
-    B.topLeftCorner(r, d_) = sk * (Xi.leftCols(d_) * e.R);
-    B.col(d_).head(r) = st * (Xi.col(d_) + Xi.leftCols(d_) * e.t);
-    B(r, d_) = st;
-    double* base = out.data() + 3 * s * s * e.adjacency;
-    Eigen::Map<Eigen::MatrixXd> Daa(base, s, s), Dbb(base + s * s, s, s),
-        Dab(base + 2 * s * s, s, s);
-    Daa.noalias() += B * B.transpose();
-    Dbb.noalias() += A * A.transpose();
-    Dab.noalias() -= B * A.transpose();
+    if (e.own_is_source) {
+      source(U, Po, e, sk, st);
+      target(W, Pn, sk, st);
+    } else {
+      target(U, Po, sk, st);
+      source(W, Pn, e, sk, st);
+    }
+    Qaa.noalias() += U * U.transpose();
+    if (e.upper >= 0) Qab[static_cast<std::size_t>(e.upper)].noalias() -= U * W.transpose();
   }
+  // Rows this agent's poses use: the others' entries are exact zeros and are not sent.
+  std::vector<int> rows;
+  double mask = 0.0;
+  for (int k = 0; k < r; ++k)
+    if ((X.row(k).array() != 0.0).any() || (Xn.cols() > 0 && (Xn.row(k).array() != 0.0).any())) {
+      rows.push_back(k);
+      mask += std::ldexp(1.0, k);
+    }
+  rows.push_back(r);
+  const std::size_t m = rows.size();
+  std::vector<double> out;
+  out.reserve(1 + m * (m + 1) / 2 + m * m * Qab.size());
+  out.push_back(mask);
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t i = 0; i <= j; ++i) out.push_back(Qaa(rows[i], rows[j]));
+  for (const auto& Q : Qab)
+    for (std::size_t j = 0; j < m; ++j)
+      for (std::size_t i = 0; i < m; ++i) out.push_back(Q(rows[i], rows[j]));
   return out;
 }
 
@@ -97,35 +129,48 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
                           const CoarseOptions& options) {
   const int N = layout.num_blocks;
   const int s = r + 1;
-  const std::size_t ss = static_cast<std::size_t>(s * s);
   if (terms.size() != static_cast<std::size_t>(N))
     throw std::runtime_error("coarse correction: " + std::to_string(terms.size()) +
                              " term vectors for " + std::to_string(N) + " blocks");
+  // Q_c in full (r+1) blocks from the agents' compact terms.
   CoarseMatrix Q;
   Q.diag.assign(static_cast<std::size_t>(N), Mat::Zero(s, s));
   Q.off.resize(static_cast<std::size_t>(N));
   for (int a = 0; a < N; ++a) {
-    const auto& adj = layout.adjacent[static_cast<std::size_t>(a)];
-    for (int b : adj) {
-      Q.off[static_cast<std::size_t>(a)][b] = Mat::Zero(s, s);
-      Q.off[static_cast<std::size_t>(b)][a] = Mat::Zero(s, s);
-    }
-  }
-  for (int a = 0; a < N; ++a) {
-    const auto& adj = layout.adjacent[static_cast<std::size_t>(a)];
     const std::vector<double>& t = *terms[static_cast<std::size_t>(a)];
-    if (t.size() != 3 * ss * adj.size())
-      throw std::runtime_error("malformed message: coarse terms of agent " + std::to_string(a) +
-                               " have " + std::to_string(t.size()) + " values, expected " +
-                               std::to_string(3 * ss * adj.size()));
-    for (std::size_t k = 0; k < adj.size(); ++k) {
-      const int b = adj[k];
-      const double* base = t.data() + 3 * ss * k;
-      Eigen::Map<const Mat> Daa(base, s, s), Dbb(base + ss, s, s), Dab(base + 2 * ss, s, s);
-      Q.diag[static_cast<std::size_t>(a)] += Daa;
-      Q.diag[static_cast<std::size_t>(b)] += Dbb;
-      Q.off[static_cast<std::size_t>(a)][b] += Dab;
-      Q.off[static_cast<std::size_t>(b)][a] += Dab.transpose();
+    auto bad = [&](const std::string& why) {
+      return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(a) +
+                                ": " + why);
+    };
+    if (t.empty()) throw bad("none");
+    const double mask = t[0];
+    if (!(mask >= 0 && mask < std::ldexp(1.0, r)) || std::floor(mask) != mask)
+      throw bad("row mask " + std::to_string(mask) + " does not fit rank " + std::to_string(r));
+    std::vector<int> rows;
+    const auto bits = static_cast<unsigned long long>(mask);
+    for (int k = 0; k < r; ++k)
+      if (bits & (1ull << k)) rows.push_back(k);
+    rows.push_back(r);
+    const std::size_t m = rows.size();
+    std::vector<int> upper;
+    for (int b : layout.adjacent[static_cast<std::size_t>(a)])
+      if (b > a) upper.push_back(b);
+    const std::size_t expected = 1 + m * (m + 1) / 2 + m * m * upper.size();
+    if (t.size() != expected)
+      throw bad(std::to_string(t.size()) + " values, expected " + std::to_string(expected));
+    std::size_t at = 1;
+    Mat& D = Q.diag[static_cast<std::size_t>(a)];
+    for (std::size_t j = 0; j < m; ++j)
+      for (std::size_t i = 0; i <= j; ++i, ++at) {
+        D(rows[i], rows[j]) = t[at];
+        D(rows[j], rows[i]) = t[at];
+      }
+    for (int b : upper) {
+      Mat M = Mat::Zero(s, s);
+      for (std::size_t j = 0; j < m; ++j)
+        for (std::size_t i = 0; i < m; ++i, ++at) M(rows[i], rows[j]) = t[at];
+      Q.off[static_cast<std::size_t>(b)][a] = M.transpose();
+      Q.off[static_cast<std::size_t>(a)][b] = std::move(M);
     }
   }
 
@@ -140,28 +185,37 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
         break;
       }
   const int q = static_cast<int>(act.size());
+  // From here on the problem lives on those rows and the homogeneous one: Z_a = [G_a c_a] is
+  // q x (q+1) (the full motion is the identity elsewhere).
+  {
+    std::vector<int> idx = act;
+    idx.push_back(r);
+    for (auto& D : Q.diag) D = D(idx, idx).eval();
+    for (auto& o : Q.off)
+      for (auto& [b, M] : o) M = M(idx, idx).eval();
+  }
+  const int sc = q + 1;
   std::vector<std::pair<int, int>> gens;  // rotation generators e_i e_j^T - e_j e_i^T
   for (int i = 0; i < q; ++i)
-    for (int j = i + 1; j < q; ++j) gens.emplace_back(act[i], act[j]);
+    for (int j = i + 1; j < q; ++j) gens.emplace_back(i, j);
   const int m = static_cast<int>(gens.size());
   const int p = m + q;  // unknowns per block
 
   CoarseResult res;
-  std::vector<Mat> Z(static_cast<std::size_t>(N), Mat::Zero(r, s));
-  for (auto& z : Z) z.leftCols(r).setIdentity();
+  std::vector<Mat> Z(static_cast<std::size_t>(N), Mat::Zero(q, sc));
+  for (auto& z : Z) z.leftCols(q).setIdentity();
   res.cost_before = coarse_cost(Q, Z);
   double cost = res.cost_before;
 
-  // Directions of block a's unknowns at Z_a: [S G_a, 0] per generator, e_k in column r.
+  // Directions of block a's unknowns at Z_a: [S G_a, 0] per generator, e_k in the last column.
   auto directions = [&](const Mat& Za) {
-    std::vector<Mat> D(static_cast<std::size_t>(p), Mat::Zero(r, s));
+    std::vector<Mat> D(static_cast<std::size_t>(p), Mat::Zero(q, sc));
     for (int k = 0; k < m; ++k) {
       const auto [i, j] = gens[static_cast<std::size_t>(k)];
-      D[static_cast<std::size_t>(k)].row(i).head(r) = Za.row(j).head(r);
-      D[static_cast<std::size_t>(k)].row(j).head(r) = -Za.row(i).head(r);
+      D[static_cast<std::size_t>(k)].row(i).head(q) = Za.row(j).head(q);
+      D[static_cast<std::size_t>(k)].row(j).head(q) = -Za.row(i).head(q);
     }
-    for (int k = 0; k < q; ++k)
-      D[static_cast<std::size_t>(m + k)](act[static_cast<std::size_t>(k)], r) = 1.0;
+    for (int k = 0; k < q; ++k) D[static_cast<std::size_t>(m + k)](k, q) = 1.0;
     return D;
   };
 
@@ -213,27 +267,19 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
       }
       const Eigen::VectorXd x = ldlt.solve(-g);
       std::vector<Mat> Zn = Z;
+      const Mat I = Mat::Identity(q, q);
       for (int a = 0; a < N; ++a) {
         const std::size_t ua = static_cast<std::size_t>(a);
-        Mat W = Mat::Zero(q, q);
+        Mat Wa = Mat::Zero(q, q);
         for (int k = 0; k < m; ++k) {
           const auto [i, j] = gens[static_cast<std::size_t>(k)];
-          const auto ii = std::find(act.begin(), act.end(), i) - act.begin();
-          const auto jj = std::find(act.begin(), act.end(), j) - act.begin();
-          W(ii, jj) += x(a * p + k);
-          W(jj, ii) -= x(a * p + k);
+          Wa(i, j) += x(a * p + k);
+          Wa(j, i) -= x(a * p + k);
         }
-        // Cayley transform: exactly orthogonal up to round-off, and the identity on unused rows.
-        const Mat I = Mat::Identity(q, q);
-        const Mat C = (I - 0.5 * W).partialPivLu().solve(I + 0.5 * W);
-        Mat rows(q, r);
-        for (int k = 0; k < q; ++k)
-          rows.row(k) = Z[ua].row(act[static_cast<std::size_t>(k)]).head(r);
-        rows = C * rows;
-        for (int k = 0; k < q; ++k) {
-          Zn[ua].row(act[static_cast<std::size_t>(k)]).head(r) = rows.row(k);
-          Zn[ua](act[static_cast<std::size_t>(k)], r) += x(a * p + m + k);
-        }
+        // Cayley transform: orthogonal up to round-off.
+        const Mat C = (I - 0.5 * Wa).partialPivLu().solve(I + 0.5 * Wa);
+        Zn[ua].leftCols(q) = C * Z[ua].leftCols(q);
+        Zn[ua].col(q) += x.segment(a * p + m, q);
       }
       const double cn = coarse_cost(Q, Zn);
       if (std::isfinite(cn) && cn < cost) {
@@ -243,19 +289,26 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
         res.moved = true;
         accepted = true;
         lambda = std::max(lambda * 0.1, 1e-12);
-        if (decrease < options.rel_tol * cost) {
-          res.cost_after = cost;
-          res.motions = std::move(Z);
-          return res;
-        }
+        if (decrease < options.rel_tol * cost) lambda = 1e300;  // converged: leave both loops
       } else {
         lambda *= 10;
       }
     }
-    if (!accepted) break;
+    if (!accepted || lambda > 1e8) break;
   }
   res.cost_after = cost;
-  res.motions = std::move(Z);
+  // The full r x (r+1) motions: the identity outside the used rows.
+  res.motions.assign(static_cast<std::size_t>(N), Mat::Zero(r, s));
+  for (int a = 0; a < N; ++a) {
+    Mat& full = res.motions[static_cast<std::size_t>(a)];
+    full.leftCols(r).setIdentity();
+    for (int i = 0; i < q; ++i) {
+      for (int j = 0; j < q; ++j)
+        full(act[static_cast<std::size_t>(i)], act[static_cast<std::size_t>(j)]) =
+            Z[static_cast<std::size_t>(a)](i, j);
+      full(act[static_cast<std::size_t>(i)], r) = Z[static_cast<std::size_t>(a)](i, q);
+    }
+  }
   return res;
 }
 

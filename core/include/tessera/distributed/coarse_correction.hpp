@@ -43,8 +43,9 @@ struct CoarseOptions {
   bool scheduled(int round) const { return enabled && round % every == 0; }
 };
 
-/// One agent's cut edges whose source pose it owns (so every cut edge is counted by exactly
-/// one agent), and the coarse terms they give at a point.
+/// One agent's cut edges, and the coarse terms they give at a point: its own diagonal block of
+/// Q_c and the off-diagonal blocks to its higher-numbered neighbours (each block of Q_c is
+/// computed by exactly one agent), on the rows its poses use.
 class CoarseTerms {
  public:
   /// `owned` and `neighbours`: the block's poses and neighbour poses in the orders of its own
@@ -53,24 +54,24 @@ class CoarseTerms {
               const std::vector<std::size_t>& neighbours,
               const std::vector<Measurement>& measurements);
 
-  /// The terms at own poses X (r x (d+1)m) and neighbour copies Xn: for each adjacent block b
-  /// (layout.adjacent[id] order) three (r+1) x (r+1) matrices, column-major: the sums over
-  /// this agent's cut edges to b of B B^T (block id's diagonal), A A^T (b's diagonal) and
-  /// -B A^T (the (id, b) block of Q_c).
+  /// The terms at own poses X (r x (d+1)m) and neighbour copies Xn. Layout: a bit mask of the
+  /// rows k < r that X or Xn use (rows of a rank-d start stay zero, so their entries are exact
+  /// zeros and are not sent); with I = those rows and row r (s = |I|), the upper triangle of
+  /// Q_aa on I (column by column), then for each adjacent block b > id (layout.adjacent order)
+  /// Q_ab on I x I, column-major.
   std::vector<double> compute(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn) const;
-  /// Number of values compute() returns at rank r.
-  std::size_t size(int r) const;
 
  private:
   struct Edge {
     std::size_t own_slot, neighbour_slot;
-    int adjacency;  // index of the neighbour block in layout.adjacent[id]
+    bool own_is_source;  // the measurement goes from the own pose to the neighbour's
+    int upper;           // index among the adjacent blocks > id, or -1 (the neighbour sends)
     Eigen::MatrixXd R;
     Eigen::VectorXd t;
     double kappa, tau;
   };
   int d_;
-  std::size_t degree_;
+  int num_upper_;
   std::vector<Edge> edges_;
 };
 
