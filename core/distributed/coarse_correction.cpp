@@ -16,6 +16,8 @@ void CoarseOptions::validate() const {
   if (every < 1) throw InputError("CoarseOptions.every must be >= 1");
   if (max_iterations < 1) throw InputError("CoarseOptions.max_iterations must be >= 1");
   if (!(rel_tol >= 0 && rel_tol < 1)) throw InputError("CoarseOptions.rel_tol must be in [0, 1)");
+  if (!(min_gain >= 0 && std::isfinite(min_gain)))
+    throw InputError("CoarseOptions.min_gain must be finite and >= 0");
 }
 
 CoarseTerms::CoarseTerms(int id, int d, const BlockLayout& layout,

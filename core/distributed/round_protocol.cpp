@@ -299,7 +299,7 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   // The coarse correction moves Y^k before the block updates; f moves by exactly the coarse
   // cost's change, so the next restart test compares against the corrected cost.
   if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_))
-    f += coarse_correct(inbox);
+    f += coarse_correct(inbox, round_ > 0 ? f_prev_ - f : 0.0);
   f_prev_ = f;
   gsq_prev_ = gsq;
   selection_ = select_blocks(config_.selection, config_.parallel, config_.seed,
@@ -320,12 +320,13 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   begin_update(out);
 }
 
-double RoundProtocol::coarse_correct(const Inbox& inbox) {
+double RoundProtocol::coarse_correct(const Inbox& inbox, double last_decrease) {
   std::vector<const std::vector<double>*> terms;
   terms.reserve(inbox.size());
   for (const auto& [sender, m] : inbox) terms.push_back(&std::get<RoundStatusMessage>(m).coarse);
   const CoarseResult c = solve_coarse(layout_, state_.rank(), terms, config_.coarse);
-  if (!c.moved) return 0.0;
+  if (!c.moved || c.cost_before - c.cost_after < config_.coarse.min_gain * last_decrease)
+    return 0.0;
   state_.apply_coarse(c.motions);
   ++coarse_corrections_;
   coarse_decrease_ += c.cost_before - c.cost_after;

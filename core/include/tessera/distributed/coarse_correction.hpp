@@ -36,6 +36,10 @@ struct CoarseOptions {
   /// A coarse solve stops when an accepted step lowers the coarse cost by less than this
   /// fraction of it (in [0, 1)).
   double rel_tol = 1e-4;
+  /// A solved correction is applied only when it lowers f by at least this fraction of what
+  /// the last round's block updates did (>= 0; 0 = whenever it lowers f). When the blocks are
+  /// already aligned (few blocks), a tiny correction only disturbs the momentum.
+  double min_gain = 0.0;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;

@@ -141,7 +141,8 @@ class RoundProtocol : public AgentProcess {
   double coarse_decrease_ = 0.0;
   // Solves the coarse problem from the status inbox and moves the blocks; returns the change
   // of f (<= 0).
-  double coarse_correct(const Inbox& inbox);
+  // `last_decrease`: f's decrease over the last round (gates the correction, min_gain).
+  double coarse_correct(const Inbox& inbox, double last_decrease);
   std::string stop_reason_;
   RoundHistory trace_;  // snapshots copy it every round: cheap copies
   std::chrono::steady_clock::time_point start_time_;
