@@ -52,6 +52,7 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   ro.relative_cost_tolerance = asg.relative_cost_tolerance();
   ro.seed = asg.seed();
   ro.certify = asg.certify();
+  ro.coarse_every = asg.coarse_every();
   return ro;
 }
 

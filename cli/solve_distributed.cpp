@@ -55,6 +55,9 @@ const char* const kDistributedValued[] = {"agents",
                                           "irbcd-class-score",
                                           "partition-objective",
                                           "partition-time",
+                                          "coarse",
+                                          "coarse-every",
+                                          "coarse-min-gain",
                                           nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
@@ -115,6 +118,12 @@ const char* kDistributedHelp =
     "  --irbcd-class-score norm|max   IRBCD, parallel greedy rounds: the colour class with the\n"
     "                            largest class gradient norm, or the class of the largest\n"
     "                            block gradient (RBCD++'s rule) (default: max)\n"
+    "  --coarse on|off           two-level rounds: each scheduled round also moves every block\n"
+    "                            rigidly by the solution of a small coarse problem over the cut\n"
+    "                            (docs/irbcd.md, \"Coarse correction\") (default off)\n"
+    "  --coarse-every K          with --coarse on: correct every K-th round (default 1)\n"
+    "  --coarse-min-gain F       apply a correction only when it lowers f by >= F times the\n"
+    "                            last round's decrease (default 0)\n"
     "  --irbcd-keep-ab           IRBCD: keep a, b running after a restart (the default)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
     "  --irbcd-n units|variables IRBCD: n = selectable blocks (default) or scalar variables\n"
@@ -204,6 +213,14 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     opt.irbcd.restart_c = a.get_double("restart-c", 0);
     opt.rbcd_plus_plus.restart_c = opt.irbcd.restart_c;
   }
+  if (a.has("coarse")) {
+    const std::string c = a.get_or("coarse", "");
+    if (c != "on" && c != "off")
+      throw InputError("option --coarse: '" + c + "' is not one of on, off");
+    opt.coarse.enabled = c == "on";
+  }
+  opt.coarse.every = static_cast<int>(a.get_long("coarse-every", opt.coarse.every));
+  opt.coarse.min_gain = a.get_double("coarse-min-gain", opt.coarse.min_gain);
   opt.irbcd.sigma = a.get_double("sigma", opt.irbcd.sigma);
   opt.irbcd.a0 = a.get_double("irbcd-a0", opt.irbcd.a0);
   if (a.has("irbcd-class-score"))

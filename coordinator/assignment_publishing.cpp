@@ -31,6 +31,7 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   asg.replicas(options.replicas);
   asg.status_relay(options.status_relay);
   asg.replica_every(options.replica_every);
+  asg.coarse_every(options.coarse_every);
   return asg;
 }
 

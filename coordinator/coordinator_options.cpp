@@ -61,6 +61,9 @@ options:
                        has its block re-partitioned among the survivors, and the run goes on
                        with N-1 agents. 0 = off: the run stops (default 0)
   --replica-every K    rounds between lifted-pose replicas (default 10)
+  --coarse-every K     two-level rounds: the agents add a rigid coarse correction of every
+                       block every K-th round (docs/irbcd.md, "Coarse correction"); 0 = off
+                       (default 0)
   --status-interval S  print a status line (agents alive, their rounds, lagging or lost
                        agents) every S seconds and on changes; 0 = off (default 5)
   --verbose            print each phase
@@ -93,7 +96,8 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "status-interval",
                                                             "progress-interval",
                                                             "replicas",
-                                                            "replica-every"},
+                                                            "replica-every",
+                                                            "coarse-every"},
                                                            cli::SessionArgsFor::kProcess);
   valued.insert("graph");
   cli::Arguments args(
@@ -147,6 +151,7 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   if (a.replicas > 8) throw InputError("option --replicas: must be 0..8");
   a.replica_every = static_cast<std::uint32_t>(nonneg("replica-every", 10));
   if (a.replica_every < 1) throw InputError("option --replica-every: must be >= 1");
+  a.coarse_every = static_cast<std::uint32_t>(nonneg("coarse-every", a.coarse_every));
   a.verbose = args.has("verbose");
   a.certify = args.has("certify");
   if (args.has("status-relay") && args.has("no-status-relay"))

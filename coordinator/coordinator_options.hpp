@@ -40,6 +40,8 @@ struct CoordinatorOptions {
   /// bundle (transport/status_relay.hpp); on by default (--status-relay, still accepted),
   /// --no-status-relay: all to all. Agents ignore it with rejoin or replicas.
   bool status_relay = true;
+  /// Two-level rounds: a coarse correction every this many rounds; 0 = off (--coarse-every).
+  std::uint32_t coarse_every = 0;
 };
 
 /// The --help text; its "%s" stands for the shared session options (cli::process_help).

@@ -73,7 +73,9 @@ TEST(DdsMapping, RoundStatusRoundTrips) {
   m.block_grad_norm = 0.25;
   m.restart_vote = true;
   m.done_vote = false;
+  m.coarse = {0.5, -1e-300, 3.0};
   RoundStatusMessage back = from_wire(to_wire_status(m, "r", true, {}));
+  EXPECT_EQ(back.coarse, m.coarse);
   EXPECT_EQ(back.round, 2u);
   EXPECT_EQ(back.phase, 3u);
   EXPECT_EQ(back.cost, 12.5);
@@ -155,6 +157,7 @@ TEST(DdsStatusRelay, BundlesCarryEveryStatusOfAStepExactly) {
     m.grad_norm_sq = cost / 3.0;
     m.block_grad_norm = 1.0 / (sender + 7.0);
     m.done_vote = sender == 2;
+    if (sender == 1) m.coarse = {cost, -cost, 7.0};  // coarse terms: a variable-length record
     wire::RoundStatus w = to_wire_status(m, "r", true, {});
     w.epoch(epoch);
     return w;
@@ -187,6 +190,9 @@ TEST(DdsStatusRelay, BundlesCarryEveryStatusOfAStepExactly) {
     EXPECT_EQ(back[k].block_grad_norm(), 1.0 / (k + 7.0));
     EXPECT_EQ(back[k].done_vote(), k == 2);
     EXPECT_FALSE(back[k].restart_vote());
+    const std::vector<double> coarse =
+        k == 1 ? std::vector<double>{0.2, -0.2, 7.0} : std::vector<double>{};
+    EXPECT_EQ(back[k].coarse(), coarse);
   }
   EXPECT_TRUE(relay.take_bundles("r", kRelayAgent).empty());
   // A rollback to epoch 2: what epoch 1 collected is void, statuses of it are ignored.
@@ -202,6 +208,9 @@ TEST(DdsStatusRelay, BundlesCarryEveryStatusOfAStepExactly) {
   EXPECT_THROW(StatusRelay::unpack(bad), TransportError);
   bad = bundles[0];
   bad.bundle()[0] = -1.0;
+  EXPECT_THROW(StatusRelay::unpack(bad), TransportError);
+  bad = bundles[0];
+  bad.bundle()[6] = 1e9;  // a coarse count beyond the bundle
   EXPECT_THROW(StatusRelay::unpack(bad), TransportError);
 }
 

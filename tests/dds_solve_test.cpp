@@ -1,6 +1,6 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-170 (each test its own, so ctest -j is safe).
+// Domains used here: 161-170 and 55-56 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -51,12 +51,14 @@ DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int
   return r;
 }
 
-void expect_same_as_in_process(const std::string& algorithm, int domain, bool status_relay = true) {
+void expect_same_as_in_process(const std::string& algorithm, int domain, bool status_relay = true,
+                               bool coarse = false) {
   const std::string dir = temp_dir();
   const std::string graph = generate(dir, 240, 3, 5);
   std::vector<std::string> coordinator_args = {"--partition", "eco", "--algorithm", algorithm,
                                                "--seed",      "7",   "--init",      "file"};
   if (!status_relay) coordinator_args.push_back("--no-status-relay");
+  if (coarse) coordinator_args.insert(coordinator_args.end(), {"--coarse-every", "1"});
   const DdsRun dds = run_dds(dir, graph, 3, domain, coordinator_args);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(dds.assignment.size(), g.num_poses);
@@ -64,6 +66,7 @@ void expect_same_as_in_process(const std::string& algorithm, int domain, bool st
   DistributedOptions opt;
   opt.algorithm = parse_algorithm(algorithm);
   opt.seed = 7;
+  opt.coarse.enabled = coarse;
   const DistributedResult ref = solve_distributed(g, dds.assignment, opt, g.initial);
   ASSERT_GT(ref.rounds, 1) << "the graph should need a few rounds";
 
@@ -113,6 +116,13 @@ TEST(DdsSolve, RbcdPlusPlusOverDdsGivesTheInProcessIterates) {
 TEST(DdsSolve, StatusesAllToAllGiveTheInProcessIterates) {
   expect_same_as_in_process("irbcd", 167, false);
   expect_same_as_in_process("rbcd++", 168, false);
+}
+
+// Two-level rounds: the coarse terms ride on the statuses (through the relay's bundle, or all
+// to all), every agent solves the same coarse problem, so the same iterates as in process.
+TEST(DdsSolve, CoarseCorrectionOverDdsGivesTheInProcessIterates) {
+  expect_same_as_in_process("irbcd", 55, true, true);
+  expect_same_as_in_process("irbcd", 56, false, true);
 }
 
 // Kills whatever processes of run `run_id` a test leaves running when an assertion fails (a

@@ -51,6 +51,7 @@ wire::RoundStatus to_wire_status(const RoundStatusMessage& m, const std::string&
   w.block_grad_norm(m.block_grad_norm);
   w.restart_vote(m.restart_vote);
   w.done_vote(m.done_vote);
+  w.coarse(m.coarse);
   return w;
 }
 
@@ -84,6 +85,7 @@ RoundStatusMessage from_wire(const wire::RoundStatus& w) {
   m.block_grad_norm = w.block_grad_norm();
   m.restart_vote = w.restart_vote();
   m.done_vote = w.done_vote();
+  m.coarse = w.coarse();
   return m;
 }
 

@@ -8,7 +8,9 @@
 namespace tessera::transport {
 
 namespace {
-constexpr std::size_t kFields = 6;  // per bundled status (see StatusRelay::pack)
+// Per bundled status (see StatusRelay::pack): the fixed fields, then the coarse terms' count
+// and the terms themselves.
+constexpr std::size_t kFields = 7;
 }  // namespace
 
 bool StatusRelay::add(const wire::RoundStatus& m, std::uint32_t current_epoch) {
@@ -56,18 +58,27 @@ std::vector<double> StatusRelay::pack(const std::vector<wire::RoundStatus>& stat
     out.push_back(s.block_grad_norm());
     out.push_back(s.restart_vote() ? 1.0 : 0.0);
     out.push_back(s.done_vote() ? 1.0 : 0.0);
+    out.push_back(static_cast<double>(s.coarse().size()));
+    out.insert(out.end(), s.coarse().begin(), s.coarse().end());
   }
   return out;
 }
 
 std::vector<wire::RoundStatus> StatusRelay::unpack(const wire::RoundStatus& bundle) {
   const std::vector<double>& v = bundle.bundle();
-  if (v.size() % kFields != 0)
-    throw TransportError("malformed message: status bundle from agent " +
-                         std::to_string(bundle.sender()) + " has " + std::to_string(v.size()) +
-                         " values, not a multiple of " + std::to_string(kFields));
+  auto malformed = [&]() {
+    return TransportError("malformed message: status bundle from agent " +
+                          std::to_string(bundle.sender()) + " has " + std::to_string(v.size()) +
+                          " values, which do not split into statuses");
+  };
   std::vector<wire::RoundStatus> out;
-  for (std::size_t k = 0; k < v.size(); k += kFields) {
+  for (std::size_t k = 0; k < v.size();) {
+    if (v.size() - k < kFields) throw malformed();
+    const double count = v[k + 6];
+    if (!(count >= 0 && count <= static_cast<double>(v.size() - k - kFields)) ||
+        std::floor(count) != count)
+      throw malformed();
+    const std::size_t terms = static_cast<std::size_t>(count);
     const double sender = v[k];
     if (!(sender >= 0 && sender < 4294967296.0) || std::floor(sender) != sender)
       throw TransportError("malformed message: status bundle from agent " +
@@ -85,7 +96,10 @@ std::vector<wire::RoundStatus> StatusRelay::unpack(const wire::RoundStatus& bund
     s.block_grad_norm(v[k + 3]);
     s.restart_vote(v[k + 4] != 0.0);
     s.done_vote(v[k + 5] != 0.0);
+    const auto first = v.begin() + static_cast<std::ptrdiff_t>(k + kFields);
+    s.coarse(std::vector<double>(first, first + static_cast<std::ptrdiff_t>(terms)));
     out.push_back(std::move(s));
+    k += kFields + terms;
   }
   return out;
 }

@@ -28,6 +28,7 @@ RoundConfig make_round_config(const DistributedOptions& options, const MomentumS
   config.rel_cost_decrease_tol = options.rel_cost_decrease_tol;
   config.update = options.algorithm_block_update();
   config.scheme = scheme;
+  config.coarse = options.coarse;
   return config;
 }
 

@@ -31,6 +31,7 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
       d_(d),
       layout_(layout),
       problem_(d, layout.poses[static_cast<std::size_t>(id)], measurements),
+      coarse_(id, d, layout, problem_.owned(), problem_.neighbors(), measurements),
       max_factor_entries_(options.max_factor_entries) {
   const Eigen::Index cols = (d + 1) * static_cast<Eigen::Index>(problem_.num_owned());
   if (Y0.cols() != cols)
@@ -56,6 +57,18 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
     if (static_cast<int>(rows.size()) == d) build_tangent(Y0(rows, Eigen::all), options);
   }
   if (q.block_diagonal()) tangent_tried_ = true;  // never build it later either
+}
+
+void AgentState::apply_coarse(const std::vector<Eigen::MatrixXd>& motions) {
+  const Eigen::MatrixXd& own = motions[static_cast<std::size_t>(id_)];
+  apply_motion(own, d_, Y);
+  apply_motion(own, d_, V);
+  const auto& nb = problem_.neighbors();
+  for (std::size_t k = 0; k < nb.size(); ++k) {
+    const Eigen::MatrixXd& z = motions[static_cast<std::size_t>(layout_.owner[nb[k]])];
+    apply_motion(z, d_, Yn, static_cast<Eigen::Index>(k), 1);
+    apply_motion(z, d_, Vn, static_cast<Eigen::Index>(k), 1);
+  }
 }
 
 BlockPreconditioner& AgentState::euclidean() {

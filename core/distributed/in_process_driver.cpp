@@ -13,7 +13,8 @@ std::size_t message_bytes(const ProtocolMessage& message) {
   if (const auto* p = std::get_if<PoseBlockMessage>(&message))
     return 5 * sizeof(std::uint32_t) + 1 + p->pose_ids.size() * sizeof(std::uint32_t) +
            p->data.size() * sizeof(double);
-  return 3 * sizeof(std::uint32_t) + 3 * sizeof(double) + 2;
+  return 3 * sizeof(std::uint32_t) + 3 * sizeof(double) + 2 +
+         std::get<RoundStatusMessage>(message).coarse.size() * sizeof(double);
 }
 
 namespace {

@@ -21,6 +21,7 @@ RoundProtocol::RoundProtocol(AgentState& state, const BlockLayout& layout,
                              const RoundConfig& config)
     : state_(state), layout_(layout), config_(config) {
   config_.update.validate();
+  config_.coarse.validate();
   if (config_.scheme) scheme_ = config_.scheme->clone();
   config_.scheme = nullptr;  // the clone is ours; the caller's object may go away
 }
@@ -230,6 +231,8 @@ void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessag
   m.cost = s.cost_share;
   m.grad_norm_sq = s.grad_norm_sq;
   m.block_grad_norm = s.block_grad_norm;
+  if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_))
+    m.coarse = state_.coarse_terms();
   // Our own status goes straight into the inbox: the reduction then treats every agent alike.
   pending_[key(u32(round_), phase)].emplace(state_.id(), m);
   OutgoingMessage o;
@@ -293,6 +296,10 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
     done_ = true;
     return;
   }
+  // The coarse correction moves Y^k before the block updates; f moves by exactly the coarse
+  // cost's change, so the next restart test compares against the corrected cost.
+  if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_))
+    f += coarse_correct(inbox, round_ > 0 ? f_prev_ - f : 0.0);
   f_prev_ = f;
   gsq_prev_ = gsq;
   selection_ = select_blocks(config_.selection, config_.parallel, config_.seed,
@@ -311,6 +318,19 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   extrapolate_into(state_.manifold(), coeff_, state_.Y, state_.V, state_.P);
   extrapolate_into(state_.manifold(), coeff_, state_.Yn, state_.Vn, state_.Pn);
   begin_update(out);
+}
+
+double RoundProtocol::coarse_correct(const Inbox& inbox, double last_decrease) {
+  std::vector<const std::vector<double>*> terms;
+  terms.reserve(inbox.size());
+  for (const auto& [sender, m] : inbox) terms.push_back(&std::get<RoundStatusMessage>(m).coarse);
+  const CoarseResult c = solve_coarse(layout_, state_.rank(), terms, config_.coarse);
+  if (!c.moved || c.cost_before - c.cost_after < config_.coarse.min_gain * last_decrease)
+    return 0.0;
+  state_.apply_coarse(c.motions);
+  ++coarse_corrections_;
+  coarse_decrease_ += c.cost_before - c.cost_after;
+  return c.cost_after - c.cost_before;
 }
 
 bool RoundProtocol::stalled(const RoundRecord& rec) const {

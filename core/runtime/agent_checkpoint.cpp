@@ -65,6 +65,7 @@ std::string encode_checkpoint(const std::string& run_id, const AgentLocalData& l
   w.f64(o.relative_cost_tolerance);
   w.u64(o.seed);
   w.u32(o.certify ? 1 : 0);
+  w.u32(o.coarse_every);
   w.u64(snapshots.size());
   for (const auto& s : snapshots) encode(w, s);
   return w.bytes();
@@ -118,6 +119,7 @@ AgentCheckpoint decode_checkpoint(const std::string& payload, const std::string&
     o.relative_cost_tolerance = r.f64("relative cost tolerance");
     o.seed = r.u64("seed");
     o.certify = r.u32("certify") != 0;
+    o.coarse_every = r.u32("coarse every");
     const std::uint64_t n = r.u64("number of snapshots");
     for (std::uint64_t k = 0; k < n; ++k) c.snapshots.push_back(decode_snapshot(r));
     r.expect_end();

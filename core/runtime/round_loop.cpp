@@ -28,6 +28,8 @@ DistributedOptions options_of(const RunOptions& o) {
   opt.rel_cost_decrease_tol = o.relative_cost_tolerance;
   opt.seed = o.seed;
   opt.certify = o.certify;
+  opt.coarse.enabled = o.coarse_every > 0;
+  if (o.coarse_every > 0) opt.coarse.every = static_cast<int>(o.coarse_every);
   opt.validate();
   return opt;
 }

@@ -41,6 +41,7 @@ struct RunOptions {
   double relative_cost_tolerance = 0;
   std::uint64_t seed = 1;
   bool certify = false;  ///< Certified sequence (solve -> certify -> escape ...), core's defaults.
+  std::uint32_t coarse_every = 0;  ///< Coarse correction every this many rounds; 0 = off.
 };
 
 /// Everything one agent knows after the hand-off.

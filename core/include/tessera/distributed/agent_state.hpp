@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/coarse_correction.hpp>
 #include <tessera/distributed/rbcd.hpp>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/protocol/messages.hpp>
@@ -52,6 +53,11 @@ class AgentState {
   /// Block update from X0 with neighbours at `neighbours`.
   Eigen::MatrixXd update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
                          const BlockUpdateOptions& options);
+  /// This agent's coarse terms at (Y, Yn) (coarse_correction.hpp).
+  std::vector<double> coarse_terms() const { return coarse_.compute(Y, Yn); }
+  /// Moves every block rigidly by motions[b] (coarse_correction.hpp): the own sequences Y and
+  /// V by motions[id], the neighbour copies Yn and Vn pose by pose by their owners' motions.
+  void apply_coarse(const std::vector<Eigen::MatrixXd>& motions);
   /// Local objective f_B(X) with neighbours at `neighbours`.
   double local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
   /// Totals over this agent's block updates so far (BlockUpdateStats summed): updates,
@@ -91,6 +97,7 @@ class AgentState {
   int d_;
   const BlockLayout& layout_;
   BlockProblem problem_;
+  CoarseTerms coarse_;
   /// The Q_BB preconditioner (built in the constructor).
   BlockPreconditioner& euclidean();
   /// Builds and factors the tangent preconditioner at X (rank d) once; false when unusable.

@@ -22,7 +22,8 @@ class CheckpointError : public std::runtime_error {
   explicit CheckpointError(const std::string& what) : std::runtime_error(what) {}
 };
 
-constexpr std::uint32_t kCheckpointFormatVersion = 2;  // 2: snapshots carry the neighbours' V (Vn)
+// 2: snapshots carry the neighbours' V (Vn); 3: the run options carry the coarse schedule.
+constexpr std::uint32_t kCheckpointFormatVersion = 3;
 
 /// Writes `payload` to `path` atomically (see above). Throws CheckpointError naming the file
 /// and the failing system call.

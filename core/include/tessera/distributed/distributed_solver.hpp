@@ -57,6 +57,9 @@ struct DistributedOptions {
   double irbcd_grad_reduction = 0.2;
   RbcdPlusPlusOptions rbcd_plus_plus;
   IrbcdOptions irbcd;
+  /// Two-level rounds: a rigid correction of every block per scheduled round
+  /// (coarse_correction.hpp; docs/irbcd.md, "Coarse correction").
+  CoarseOptions coarse;
   /// After the solve, certify global optimality distributedly and climb the staircase
   /// (docs/distributed-certification.md). Off by default for `tessera solve`.
   bool certify = false;

@@ -32,6 +32,7 @@
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/block_selection.hpp>
+#include <tessera/distributed/coarse_correction.hpp>
 #include <tessera/distributed/momentum.hpp>
 #include <tessera/distributed/rbcd.hpp>
 #include <tessera/distributed/round_history.hpp>
@@ -63,6 +64,8 @@ struct RoundConfig {
   BlockUpdateOptions update;
   /// Null for plain RBCD; otherwise RBCD++ or IRBCD (each agent keeps its own clone).
   const MomentumScheme* scheme = nullptr;
+  /// Two-level rounds: the blocks' rigid coarse correction (coarse_correction.hpp).
+  CoarseOptions coarse;
 };
 
 class RoundProtocol : public AgentProcess {
@@ -95,6 +98,9 @@ class RoundProtocol : public AgentProcess {
   std::optional<AwaitedMessages> awaited() const override;
   int rounds() const { return round_; }
   int restarts() const { return restarts_; }
+  /// Coarse corrections that moved the blocks (CoarseOptions), and the f they removed in total.
+  int coarse_corrections() const { return coarse_corrections_; }
+  double coarse_decrease() const { return coarse_decrease_; }
   /// grad_norm, max_rounds, relative_decrease, or stalled (the cost and gradient norm
   /// repeated bit for bit for max(20, 10 x blocks) rounds: no update is accepted any more).
   const std::string& stop_reason() const { return stop_reason_; }
@@ -131,6 +137,12 @@ class RoundProtocol : public AgentProcess {
   bool stalled(const RoundRecord& rec) const;
   bool done_ = false;
   int restarts_ = 0;
+  int coarse_corrections_ = 0;
+  double coarse_decrease_ = 0.0;
+  // Solves the coarse problem from the status inbox and moves the blocks; returns the change
+  // of f (<= 0).
+  // `last_decrease`: f's decrease over the last round (gates the correction, min_gain).
+  double coarse_correct(const Inbox& inbox, double last_decrease);
   std::string stop_reason_;
   RoundHistory trace_;  // snapshots copy it every round: cheap copies
   std::chrono::steady_clock::time_point start_time_;

@@ -38,6 +38,9 @@ struct RoundStatusMessage {
   double block_grad_norm = 0.0;  ///< This block's own gradient norm (greedy selection).
   bool restart_vote = false;
   bool done_vote = false;
+  /// Coarse-correction rounds only: this agent's coarse terms (distributed/coarse_correction.hpp);
+  /// empty otherwise.
+  std::vector<double> coarse;
 };
 
 using ProtocolMessage = std::variant<PoseBlockMessage, RoundStatusMessage>;
