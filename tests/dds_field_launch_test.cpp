@@ -5,8 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <tessera/graph/pose_keys.hpp>
 #include <tessera/io/g2o_reader.hpp>
@@ -16,19 +14,10 @@
 namespace {
 
 using tessera::test::bin;
+using tessera::test::contains;
+using tessera::test::read_text_file;
 using tessera::test::run_command;
 using tessera::test::temp_dir;
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 TEST(DdsFieldLaunch, GtsamFileRunsPerRobotAndWritesTheInputsIdsAndStamps) {
   const std::string dir = temp_dir();
@@ -55,7 +44,7 @@ TEST(DdsFieldLaunch, GtsamFileRunsPerRobotAndWritesTheInputsIdsAndStamps) {
   // Each robot its own poses: the cut is exactly the inter-robot measurements.
   EXPECT_TRUE(contains(out, "\"cut_edges\": " + inter + ",")) << out;
   for (const char* r : {"a", "b", "c"}) {
-    const std::string text = read_text(dir + "/tum/robot_" + r + ".tum");
+    const std::string text = read_text_file(dir + "/tum/robot_" + r + ".tum");
     EXPECT_TRUE(contains(text, "# robot " + std::string(r) + ": 30 poses")) << text;
     EXPECT_TRUE(contains(text, "\n1002.9 ")) << text;  // pose 29 at 1000 + 0.1 * 29
   }

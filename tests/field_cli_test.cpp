@@ -17,19 +17,10 @@
 namespace {
 
 using tessera::test::bin;
+using tessera::test::contains;
+using tessera::test::read_text_file;
 using tessera::test::run_command;
 using tessera::test::temp_dir;
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 struct Generated {
   std::string dir, graph, truth, stamps;
@@ -65,7 +56,7 @@ TEST(FieldCli, GeneratedGtsamFileIsReadWithItsRobots) {
   EXPECT_TRUE(contains(out, "gtsam keys (robot = character in bits 56-63")) << out;
   EXPECT_TRUE(contains(out, "robots:                     3")) << out;
   EXPECT_TRUE(contains(out, "robot a           40 poses, 39 odometry")) << out;
-  const std::string json = read_text(g.dir + "/i.json");
+  const std::string json = read_text_file(g.dir + "/i.json");
   EXPECT_TRUE(contains(json, "\"keys\": \"gtsam\"")) << json;
   EXPECT_TRUE(contains(json, "\"inter_robot_closures\"")) << json;
 }
@@ -81,7 +72,7 @@ TEST(FieldCli, SolveWritesPerRobotTumWithTheInputStampsAndFrame) {
       << out;
   EXPECT_TRUE(contains(out, "certified optimal")) << out;
   for (const char* r : {"a", "b", "c"}) {
-    const std::string text = read_text(tum + "/robot_" + r + ".tum");
+    const std::string text = read_text_file(tum + "/robot_" + r + ".tum");
     EXPECT_TRUE(contains(text, "# robot " + std::string(r) + ": 40 poses")) << text;
     // Stamps are 1000 + 0.1 k: pose 39 of every robot at 1003.9.
     EXPECT_TRUE(contains(text, "\n1003.9 ")) << text;
@@ -99,7 +90,7 @@ TEST(FieldCli, SolveWritesPerRobotTumWithTheInputStampsAndFrame) {
       0)
       << out;
   EXPECT_TRUE(contains(out, "120 poses matched by index")) << out;
-  const std::string json = read_text(g.dir + "/e.json");
+  const std::string json = read_text_file(g.dir + "/e.json");
   for (const char* field : {"\"ate\"", "\"rpe\"", "\"rmse\"", "\"median\"", "\"robots\""})
     EXPECT_TRUE(contains(json, field)) << json;
   ASSERT_EQ(
@@ -185,7 +176,7 @@ TEST(FieldCli, BadInputsExitTwoNamingFileAndLine) {
   const Generated g = generate();
   std::string out;
   const std::string bad = g.dir + "/bad.g2o";
-  std::ofstream(bad) << read_text(g.graph) << "EDGE_SE2 3 4 1 0 0 1 0 0 1 0 1\n";
+  std::ofstream(bad) << read_text_file(g.graph) << "EDGE_SE2 3 4 1 0 0 1 0 0 1 0 1\n";
   EXPECT_EQ(run_command(bin("tessera") + " info " + bad + " --keys gtsam", &out), 2) << out;
   EXPECT_TRUE(contains(out, "is not a GTSAM key")) << out;
   EXPECT_TRUE(contains(out, bad + ":")) << out;

@@ -2,8 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "test_support.hpp"
@@ -11,6 +9,8 @@
 namespace {
 
 using tessera::test::bin;
+using tessera::test::contains;
+using tessera::test::read_text_file;
 using tessera::test::run_command;
 using tessera::test::temp_dir;
 using tessera::test::write_file;
@@ -19,17 +19,6 @@ const std::string kInfo2 = " 10 0 0 10 0 5";
 
 std::string edge2(int i, int j) {
   return "EDGE_SE2 " + std::to_string(i) + " " + std::to_string(j) + " 1 0 0" + kInfo2 + "\n";
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
 }
 
 TEST(InfoCommand, PrintsFiguresAndJson) {
@@ -48,7 +37,7 @@ TEST(InfoCommand, PrintsFiguresAndJson) {
   EXPECT_TRUE(contains(out, "backward edges (i > j):     2")) << out;
   EXPECT_TRUE(contains(out, "VERTEX lines:               none")) << out;
 
-  const std::string j = read_text(json);
+  const std::string j = read_text_file(json);
   EXPECT_TRUE(contains(j, "\"poses\": 4,")) << j;
   EXPECT_TRUE(contains(j, "\"edges\": 4,")) << j;
   EXPECT_TRUE(contains(j, "\"d\": 2,")) << j;

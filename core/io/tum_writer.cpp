@@ -3,7 +3,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "io/number_text.hpp"
-#include "io/rotation_text.hpp"
+#include "io/tum_line.hpp"
 
 namespace tessera {
 
@@ -25,15 +25,7 @@ void write_tum(const std::vector<Pose>& poses, const PoseKeys& keys, const std::
       append_number(out, keys.stamps[k]);
     else
       append_integer(out, keys.id(k));
-    for (int c = 0; c < 3; ++c) {
-      out += ' ';
-      append_number(out, c < p.dim() ? p.t(c) : 0.0);
-    }
-    for (double q : unit_quaternion(p.R)) {
-      out += ' ';
-      append_number(out, q);
-    }
-    out += '\n';
+    append_tum_pose(out, p);
     file.maybe_flush();
   }
   file.close();

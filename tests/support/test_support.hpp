@@ -18,6 +18,12 @@ std::string temp_dir();
 /// Writes `text` into `dir/name` and returns the path.
 std::string write_file(const std::string& dir, const std::string& name, const std::string& text);
 
+/// The whole text of the file at `path` ("" when it cannot be read).
+std::string read_text_file(const std::string& path);
+
+/// Whether `part` occurs in `text`: for checking printed output and written files.
+bool contains(const std::string& text, const std::string& part);
+
 /// Runs a shell command, returns its exit code and captures stdout+stderr into `output`.
 int run_command(const std::string& command, std::string* output);
 
