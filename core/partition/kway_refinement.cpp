@@ -3,27 +3,11 @@
 #include <algorithm>
 #include <climits>
 
+#include "partition/block_connectivity.hpp"
 #include "partition/gain_queue.hpp"
 
 namespace tessera::partition_detail {
 namespace {
-
-// Connectivity of one vertex to the blocks around it, reused across calls.
-struct Connectivity {
-  std::vector<long long> conn;
-  std::vector<int> touched;
-  explicit Connectivity(int k) : conn(static_cast<std::size_t>(k), 0) {}
-
-  void compute(const WorkGraph& g, const std::vector<int>& part, int v) {
-    for (int b : touched) conn[b] = 0;
-    touched.clear();
-    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
-      const int b = part[g.adj[e]];
-      if (conn[b] == 0) touched.push_back(b);
-      conn[b] += g.ew[e];
-    }
-  }
-};
 
 struct Move {
   int target = -1;
@@ -32,7 +16,7 @@ struct Move {
 
 // Whether v (its connectivity in c) may move to block b: no neighbour of v may then sit in a
 // block that is forbidden next to b.
-bool allowed(const Connectivity& c, int b, int k, const ForbiddenPairs* forbidden) {
+bool allowed(const BlockConnectivity& c, int b, int k, const ForbiddenPairs* forbidden) {
   if (!forbidden) return true;
   for (int q : c.touched)
     if (q != b && (*forbidden)[static_cast<std::size_t>(b) * k + q]) return false;
@@ -42,7 +26,7 @@ bool allowed(const Connectivity& c, int b, int k, const ForbiddenPairs* forbidde
 // Best feasible move of v among the blocks it has neighbours in (ties: the lighter block).
 Move best_adjacent_move(const WorkGraph& g, const std::vector<int>& part,
                         const std::vector<long long>& bw, const std::vector<long long>& ub,
-                        Connectivity& c, int v, const ForbiddenPairs* forbidden = nullptr) {
+                        BlockConnectivity& c, int v, const ForbiddenPairs* forbidden = nullptr) {
   c.compute(g, part, v);
   const int own = part[v];
   const long long internal = c.conn[own];
@@ -185,7 +169,7 @@ class FmEngine {
   const std::vector<long long>& ub_;
   const ForbiddenPairs* forbidden_;
   std::vector<long long> bw_;
-  Connectivity conn_;
+  BlockConnectivity conn_;
   GainQueue queue_;
   std::vector<int> lock_;
   int stamp_ = 0;
@@ -237,7 +221,7 @@ bool rebalance(const WorkGraph& g, int k, std::vector<int>& part, const std::vec
   bool any = false;
   for (int b = 0; b < k; ++b) any = any || overloaded(b);
   if (!any) return true;
-  Connectivity c(k);
+  BlockConnectivity c(k);
   // Best move of v anywhere: an adjacent block with room, or else the block with most room.
   auto best_move = [&](int v) {
     Move m = best_adjacent_move(g, part, bw, ub, c, v, forbidden);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "partition/block_connectivity.hpp"
+
 namespace tessera::partition_detail {
 namespace {
 
@@ -73,22 +75,6 @@ class MinColouring {
   int best_ = 0;
 };
 
-// Neighbour weight per block of one vertex (the blocks it touches listed once).
-struct Touch {
-  std::vector<long long> conn;
-  std::vector<int> touched;
-  explicit Touch(int k) : conn(static_cast<std::size_t>(k), 0) {}
-  void compute(const WorkGraph& g, const std::vector<int>& part, int v) {
-    for (int b : touched) conn[b] = 0;
-    touched.clear();
-    for (int e = g.xadj[v]; e < g.xadj[v + 1]; ++e) {
-      const int b = part[g.adj[e]];
-      if (conn[b] == 0) touched.push_back(b);
-      conn[b] += g.ew[e];
-    }
-  }
-};
-
 // Moves every vertex that has a neighbour in a block forbidden next to its own into the block
 // (allowed next to all of its neighbours' blocks) it is joined to most. A move removes the
 // vertex's forbidden edges and adds none, so the forbidden weight falls with every move.
@@ -97,7 +83,7 @@ bool repair(const WorkGraph& g, int k, std::vector<int>& part, const ForbiddenPa
             Rng& rng) {
   const std::vector<int> order = random_order(g.n, rng);
   std::vector<long long> bw = block_weights(g, part, k);
-  Touch t(k);
+  BlockConnectivity t(k);
   auto forbidden_pair = [&](int a, int b) {
     return forbidden[static_cast<std::size_t>(a) * k + b] != 0;
   };
