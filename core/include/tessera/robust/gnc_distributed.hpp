@@ -3,12 +3,13 @@
 // --robust gnc-tls`, in one process): each outer step is a warm-started distributed solve of
 // the weighted problem; the weight of every measurement is computed by one agent, the
 // *owner of its lower pose id* (assignment[min(i, j)]), from what that agent holds after a
-// solve: its own lifted poses and its neighbours' public ones. mu's start needs the largest
-// residual (a max over the agents' local maxima) and the stop needs every agent's "my
-// weights are binary" vote: two scalars per agent and outer step, the size of a round status.
+// solve: its own lifted poses and its neighbours' public ones. The outer loop is the agents'
+// own (robust/gnc_agent.hpp), run here by the in-process driver and over DDS by the agents'
+// round loop: the same messages, the same iterates.
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/graph/pose_graph.hpp>
 #include <tessera/robust/robust_options.hpp>
@@ -25,6 +26,11 @@ struct GncDistributedOptions {
   /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
   /// rule's measurements (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier_flags;
+  /// Optional: called after every weight exchange with (agent, outer step, that agent's
+  /// measurements by file position, the weights it uses for them); tests compare the two ends
+  /// of every cut measurement with it.
+  std::function<void(int, int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
+      weight_observer;
   void validate() const;  ///< Throws InputError naming the first bad field.
 };
 
