@@ -1,5 +1,7 @@
 #include <algorithm>
 #include <stdexcept>
+#include <tessera/distributed/distributed_initialization.hpp>
+#include <tessera/graph/connectivity.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
@@ -29,6 +31,27 @@ double lifted_residual_squared(const Measurement& m, const Eigen::MatrixXd& X, i
   const auto Yi = Xi.leftCols(d);
   return m.kappa * (Xj.leftCols(d) - Yi * m.R).squaredNorm() +
          m.tau * (Xj.col(d) - Xi.col(d) - Yi * m.t).squaredNorm();
+}
+
+// Re-admission passes after the final solve (each one more solve of the inlier set).
+constexpr int kMaxReadmissionPasses = 3;
+
+// `graph` with only the measurements flagged in `known`.
+PoseGraph known_subgraph(const PoseGraph& graph, const std::vector<bool>& known) {
+  PoseGraph out;
+  out.d = graph.d;
+  out.num_poses = graph.num_poses;
+  out.source = graph.source;
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e)
+    if (known[e]) out.measurements.push_back(graph.measurements[e]);
+  return out;
+}
+
+std::vector<std::size_t> zero_weight(const std::vector<double>& weights) {
+  std::vector<std::size_t> out;
+  for (std::size_t e = 0; e < weights.size(); ++e)
+    if (weights[e] == 0) out.push_back(e);
+  return out;
 }
 
 }  // namespace
@@ -72,12 +95,13 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   GncDistributedResult out;
   const RobustOptions& robust = options.robust;
   // The candidates' count is one more integer in the first residual vote.
+  std::vector<bool> known(graph.num_measurements());
   std::size_t candidates = 0;
-  for (std::size_t e = 0; e < graph.num_measurements(); ++e)
-    candidates += is_known_inlier(graph.measurements[e], robust.known_inliers) ||
-                          (!options.known_inlier_flags.empty() && options.known_inlier_flags[e])
-                      ? 0
-                      : 1;
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e) {
+    known[e] = is_known_inlier(graph.measurements[e], robust.known_inliers) ||
+               (!options.known_inlier_flags.empty() && options.known_inlier_flags[e]);
+    candidates += known[e] ? 0 : 1;
+  }
   out.threshold_squared = tls_threshold_squared(robust, graph.d, candidates);
   const double c2 = out.threshold_squared;
   const int agents = *std::max_element(assignment.begin(), assignment.end()) + 1;
@@ -85,7 +109,21 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
 
   DistributedOptions inner = options.solver;
   inner.certify = false;
-  DistributedResult solve = solve_distributed(graph, assignment, inner);
+  // The known inliers alone connect the poses (the usual case: odometry chains joined by
+  // rendezvous links): then the start can come from them, and an edge whose weight is exactly
+  // 0 can leave the weighted solves (it adds nothing to the cost; without it the block
+  // adjacency graph has fewer colours, so more agents update per round).
+  const PoseGraph known_graph = known_subgraph(graph, known);
+  const bool known_connected = count_components(known_graph) <= 1;
+  std::vector<Pose> start;
+  if (options.known_inlier_start && known_connected)
+    start = distributed_initialization(known_graph, inner.robots > 0 ? inner.robots : agents);
+  // Every solve before the final one is capped: GNC needs only a rough minimiser between two
+  // weight updates, and the first (plain) solve only has to tell the wrong closures' residuals
+  // from the right ones'. Misjudged measurements are re-admitted at the end.
+  if (robust.inner_max_rounds > 0)
+    inner.max_rounds = std::min(inner.max_rounds, robust.inner_max_rounds);
+  DistributedResult solve = solve_distributed(graph, assignment, inner, start);
   out.total_rounds += solve.rounds;
   out.total_bytes += solve.bytes_exchanged;
 
@@ -96,10 +134,6 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
                                             options.known_inlier_flags)
                                   .max_residual_squared);
   out.total_bytes += vote_bytes;
-  // The plain solve runs to the tolerance (mu's start and the first weights depend on its
-  // residuals); only the weighted solves between weight updates are capped.
-  if (robust.inner_max_rounds > 0)
-    inner.max_rounds = std::min(inner.max_rounds, robust.inner_max_rounds);
   out.weights.assign(graph.num_measurements(), 1.0);
   double mu = gnc_initial_mu(max_r2, c2);
   out.weights_converged = mu == 0;
@@ -112,8 +146,9 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
         out.weights[mine.measurements[k]] = mine.weights[k];
       spread += mine.weight_spread;
     }
-    solve = solve_distributed_from_lifted(weighted_graph(graph, out.weights, {}), assignment, inner,
-                                          solve.X);
+    PoseGraph weighted = weighted_graph(graph, out.weights, {});
+    if (known_connected) weighted = inlier_graph(weighted, zero_weight(out.weights), {});
+    solve = solve_distributed_from_lifted(weighted, assignment, inner, solve.X);
     out.total_rounds += solve.rounds;
     out.total_bytes += solve.bytes_exchanged + vote_bytes;
     ++out.outer_iterations;
@@ -123,11 +158,29 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
 
   for (std::size_t e = 0; e < out.weights.size(); ++e)
     if (out.weights[e] < 0.5) out.rejected.push_back(e);
-  const PoseGraph inliers = inlier_graph(graph, out.rejected, {});
-  require_connected_inliers(graph, inliers, out.rejected.size());
-  out.final_solve = solve_distributed_from_lifted(inliers, assignment, options.solver, solve.X);
-  out.total_rounds += out.final_solve.rounds;
-  out.total_bytes += out.final_solve.bytes_exchanged;
+  // The final solve of the inlier set, to the solver's tolerance. A rejected measurement whose
+  // residual at that solution is within the bound (r^2 <= c^2: TLS would count it as an
+  // inlier there) was misjudged on a rough iterate and is taken back, then the set is solved
+  // again; each weight owner checks its own rejected measurements (a vote per agent).
+  for (int pass = 0;; ++pass) {
+    const PoseGraph inliers = inlier_graph(graph, out.rejected, {});
+    require_connected_inliers(graph, inliers, out.rejected.size());
+    out.final_solve = solve_distributed_from_lifted(inliers, assignment, options.solver, solve.X);
+    out.total_rounds += out.final_solve.rounds;
+    out.total_bytes += out.final_solve.bytes_exchanged;
+    if (pass == kMaxReadmissionPasses || out.rejected.empty()) break;
+    std::vector<std::size_t> still;
+    for (std::size_t e : out.rejected)
+      if (lifted_residual_squared(graph.measurements[e], out.final_solve.X, graph.d) <= c2)
+        out.weights[e] = 1.0;
+      else
+        still.push_back(e);
+    out.total_bytes += vote_bytes;
+    if (still.size() == out.rejected.size()) break;
+    out.readmitted += out.rejected.size() - still.size();
+    out.rejected = std::move(still);
+    solve = out.final_solve;
+  }
   return out;
 }
 
