@@ -162,16 +162,20 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   // residual at that solution is within the bound (r^2 <= c^2: TLS would count it as an
   // inlier there) was misjudged on a rough iterate and is taken back, then the set is solved
   // again; each weight owner checks its own rejected measurements (a vote per agent).
+  // Re-admission runs on uncertified solves (the staircase may raise the rank, which a further
+  // solve could not start from); the certificate is taken once, on the set that stays.
+  DistributedOptions full = options.solver;
+  full.certify = false;
   for (int pass = 0;; ++pass) {
     const PoseGraph inliers = inlier_graph(graph, out.rejected, {});
     require_connected_inliers(graph, inliers, out.rejected.size());
-    out.final_solve = solve_distributed_from_lifted(inliers, assignment, options.solver, solve.X);
-    out.total_rounds += out.final_solve.rounds;
-    out.total_bytes += out.final_solve.bytes_exchanged;
+    solve = solve_distributed_from_lifted(inliers, assignment, full, solve.X);
+    out.total_rounds += solve.rounds;
+    out.total_bytes += solve.bytes_exchanged;
     if (pass == kMaxReadmissionPasses || out.rejected.empty()) break;
     std::vector<std::size_t> still;
     for (std::size_t e : out.rejected)
-      if (lifted_residual_squared(graph.measurements[e], out.final_solve.X, graph.d) <= c2)
+      if (lifted_residual_squared(graph.measurements[e], solve.X, graph.d) <= c2)
         out.weights[e] = 1.0;
       else
         still.push_back(e);
@@ -179,7 +183,14 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
     if (still.size() == out.rejected.size()) break;
     out.readmitted += out.rejected.size() - still.size();
     out.rejected = std::move(still);
-    solve = out.final_solve;
+  }
+  if (options.solver.certify) {
+    out.final_solve = solve_distributed_from_lifted(inlier_graph(graph, out.rejected, {}),
+                                                    assignment, options.solver, solve.X);
+    out.total_rounds += out.final_solve.rounds;
+    out.total_bytes += out.final_solve.bytes_exchanged;
+  } else {
+    out.final_solve = std::move(solve);
   }
   return out;
 }
