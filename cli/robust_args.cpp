@@ -14,8 +14,9 @@ const char* const kRobustHelp =
     "  --robust none|gnc-tls     none: plain least squares (default); gnc-tls: graduated\n"
     "                            non-convexity with a truncated least-squares cost, then the\n"
     "                            certified solve of the kept measurements (--certify for the\n"
-    "                            distributed algorithms); centralized: --init odometry\n"
-    "                            unless --init is given\n"
+    "                            distributed algorithms); starts from the odometry\n"
+    "                            (centralized: --init odometry; distributed: the known\n"
+    "                            inliers' initialization) unless --init is given\n"
     "  --inlier-threshold C      residual bound c: TLS charges min(r^2, c^2), r^2 = the edge's\n"
     "                            term of the objective (default 0 = from the chi-square\n"
     "                            quantile below, d(d+1)/2 degrees of freedom)\n"
@@ -23,7 +24,8 @@ const char* const kRobustHelp =
     "                            1 - 1e-4/m for m rejectable edges (union bound) [0]\n"
     "  --gnc-max-outer K         most outer steps, >= 1 [100]\n"
     "  --gnc-mu-step S           mu grows by S per outer step, > 1 [1.4]\n"
-    "  --gnc-inner-rounds K      distributed: most rounds per inner solve, 0 = no cap [0]\n"
+    "  --gnc-inner-rounds K      distributed: most rounds of each solve before the final\n"
+    "                            one (first and weighted), 0 = no cap [5]\n"
     "  --known-inliers odometry|none   never reject edges between consecutive ids [odometry]\n"
     "  --rejected FILE           write the rejected edge indices (from 0 over the EDGE lines)\n";
 

@@ -291,7 +291,9 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     }
   GncDistributedResult gnc;
   if (robust.kind == RobustKind::kGncTls)
-    gnc = solve_gnc_distributed(graph, part.assignment, {opt, robust, input.known_inlier, {}});
+    // Like the centralized robust solve: the known inliers' start unless --init is given.
+    gnc = solve_gnc_distributed(graph, part.assignment,
+                                {opt, robust, input.known_inlier, !a.has("init"), {}});
   else
     gnc.final_solve = solve_distributed(graph, part.assignment, opt);
   const DistributedResult& r = gnc.final_solve;

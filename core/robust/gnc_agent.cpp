@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/stage_tag.hpp>
@@ -19,6 +20,41 @@ std::uint32_t sender_of(const ProtocolMessage& m) {
   return std::visit([](const auto& x) { return x.sender; }, m);
 }
 
+// Endpoints only: what connectivity and the block layout need.
+Measurement endpoints(const std::pair<std::uint32_t, std::uint32_t>& e) {
+  Measurement m;
+  m.i = e.first;
+  m.j = e.second;
+  return m;
+}
+
+// The parts the measurements of `structure` not in `dropped` (ascending) split the poses into.
+std::size_t components_without(
+    std::size_t num_poses, int d,
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    const std::vector<std::uint64_t>& dropped, bool only_known, const std::vector<bool>& known) {
+  PoseGraph g;
+  g.d = d;
+  g.num_poses = num_poses;
+  for (std::size_t e = 0; e < structure.size(); ++e) {
+    if (only_known && !known[e]) continue;
+    if (std::binary_search(dropped.begin(), dropped.end(), static_cast<std::uint64_t>(e))) continue;
+    g.measurements.push_back(endpoints(structure[e]));
+  }
+  return count_components(g);
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> without(
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    const std::vector<std::uint64_t>& dropped) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+  out.reserve(structure.size());
+  for (std::size_t e = 0; e < structure.size(); ++e)
+    if (!std::binary_search(dropped.begin(), dropped.end(), static_cast<std::uint64_t>(e)))
+      out.push_back(structure[e]);
+  return out;
+}
+
 }  // namespace
 
 GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bool final_solve)
@@ -27,18 +63,38 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   const std::size_t m = in_.measurements.size();
   if (in_.measurement_index.size() != m)
     throw std::invalid_argument("GncAgent: one file position per measurement expected");
-  if (!in_.known_inlier.empty() && in_.known_inlier.size() != m)
+  if (!in_.known_inlier.empty() && in_.known_inlier.size() != in_.structure.size())
     throw std::invalid_argument("GncAgent: one known-inlier flag per measurement expected");
   if (!std::is_sorted(in_.measurement_index.begin(), in_.measurement_index.end()))
     throw std::invalid_argument("GncAgent: measurements must be in file order");
-  if (options_.robust.max_outer_iterations + 2 > static_cast<int>(kMaxGncSteps))
+  if (options_.robust.max_outer_iterations + kMaxReadmissionPasses + 3 >
+      static_cast<int>(kMaxGncSteps))
     throw InputError("RobustOptions.max_outer_iterations must be <= " +
-                     std::to_string(kMaxGncSteps - 2) + " for the distributed solve");
-  layout_ =
-      std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
+                     std::to_string(kMaxGncSteps - kMaxReadmissionPasses - 3) +
+                     " for the distributed solve");
+  base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
+  layout_ = std::make_unique<BlockLayout>(*base_);
+  // Every agent knows every measurement's known-inlier status (rule + flags), hence how many may
+  // be rejected (c^2's default) and whether the known inliers alone connect the poses.
+  known_.resize(in_.structure.size());
+  std::size_t candidates = 0;
+  for (std::size_t e = 0; e < in_.structure.size(); ++e) {
+    known_[e] = is_known_inlier(endpoints(in_.structure[e]), options_.robust.known_inliers) ||
+                (!in_.known_inlier.empty() && in_.known_inlier[e]);
+    candidates += known_[e] ? 0 : 1;
+  }
+  c2_ = tls_threshold_squared(options_.robust, in_.d, candidates);
+  known_connected_ = components_without(in_.num_poses, in_.d, in_.structure, {}, true, known_) <= 1;
   weights_.assign(m, 1.0);
-  for (std::size_t k = 0; k < m; ++k)
-    if (weight_owner(in_.measurements[k], in_.owner) == in_.id) owned_.push_back(k);
+  for (std::size_t k = 0; k < m; ++k) {
+    const Measurement& x = in_.measurements[k];
+    if (weight_owner(x, in_.owner) == in_.id) owned_.push_back(k);
+    for (std::size_t p : {x.i, x.j})
+      if (in_.owner[p] != in_.id) base_neighbours_.push_back(p);
+  }
+  std::sort(base_neighbours_.begin(), base_neighbours_.end());
+  base_neighbours_.erase(std::unique(base_neighbours_.begin(), base_neighbours_.end()),
+                         base_neighbours_.end());
 }
 
 GncAgent::~GncAgent() = default;
@@ -48,8 +104,7 @@ int GncAgent::total_rounds() const {
 }
 
 bool GncAgent::may_reject(std::size_t k) const {
-  return !is_known_inlier(in_.measurements[k], options_.robust.known_inliers) &&
-         (in_.known_inlier.empty() || !in_.known_inlier[k]);
+  return !known_[in_.measurement_index[k]];
 }
 
 // The measurement's term of the relaxed objective at the current lifted iterate: the own
@@ -57,14 +112,14 @@ bool GncAgent::may_reject(std::size_t k) const {
 double GncAgent::residual_squared_at(std::size_t k) const {
   const Measurement& m = in_.measurements[k];
   const Eigen::Index w = in_.d + 1;
-  const auto& own = layout_->poses[static_cast<std::size_t>(in_.id)];
-  const auto& nb = state_->problem().neighbors();
+  const auto& own = base_->poses[static_cast<std::size_t>(in_.id)];
   auto block = [&](std::size_t p) -> Eigen::MatrixXd {
     if (in_.owner[p] == in_.id) {
       const auto s = std::lower_bound(own.begin(), own.end(), p) - own.begin();
       return state_->Y.middleCols(w * s, w);
     }
-    const auto s = std::lower_bound(nb.begin(), nb.end(), p) - nb.begin();
+    const auto s = std::lower_bound(base_neighbours_.begin(), base_neighbours_.end(), p) -
+                   base_neighbours_.begin();
     return neighbours_.middleCols(w * s, w);
   };
   return lifted_residual_squared(m, block(m.i), block(m.j));
@@ -86,24 +141,31 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   solve_.reset();
   solve_options_ = options_.solver;
   std::vector<Measurement> measurements;
-  if (final_solve_) {
+  if (solve_kind_ != Solve::kGnc) {
     measurements = kept_;
+    if (solve_kind_ == Solve::kInlierPass) solve_options_.certify = false;
   } else {
     solve_options_.certify = false;
-    measurements = in_.measurements;
-    if (g_ > 0) {
-      // The weighted solves between weight updates need only a rough minimiser.
-      if (options_.robust.inner_max_rounds > 0)
-        solve_options_.max_rounds =
-            std::min(solve_options_.max_rounds, options_.robust.inner_max_rounds);
-      for (std::size_t k = 0; k < measurements.size(); ++k) {
-        const double w = std::max(weights_[k], kMinInnerWeight);
-        measurements[k].kappa *= w;
-        measurements[k].tau *= w;
+    // Every solve before the inlier passes needs only a rough minimiser.
+    if (options_.robust.inner_max_rounds > 0)
+      solve_options_.max_rounds =
+          std::min(solve_options_.max_rounds, options_.robust.inner_max_rounds);
+    for (std::size_t k = 0; k < in_.measurements.size(); ++k) {
+      // A weight of exactly 0 adds nothing: such an edge leaves the solve when the known
+      // inliers keep the poses connected (fewer block neighbours, fewer colours); otherwise it
+      // stays at a tiny pull so no part is cut off.
+      if (known_connected_ && weights_[k] == 0) continue;
+      Measurement x = in_.measurements[k];
+      const double w = std::max(weights_[k], kMinInnerWeight);
+      if (g_ > 0) {
+        x.kappa *= w;
+        x.tau *= w;
       }
+      measurements.push_back(std::move(x));
     }
   }
   const Eigen::MatrixXd Y = state_ ? state_->Y : in_.Y0;
+  if (solve_kind_ == Solve::kInlierPass) last_pass_start_ = Y;
   state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
                                         solve_options_.block_update);
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
@@ -131,6 +193,8 @@ std::uint32_t GncAgent::exchange_phase() const {
       return gnc_phase(g_, GncExchange::kWeights);
     case Step::kRejected:
       return gnc_phase(g_, GncExchange::kRejected);
+    case Step::kReadmitted:
+      return gnc_phase(g_, GncExchange::kReadmitted);
     default:
       return 0;
   }
@@ -160,31 +224,44 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   };
   switch (step) {
     case Step::kPoses: {
-      // Weights are computed at the iterate itself: the owners' public poses, sent once.
-      const auto& nb = state_->problem().neighbors();
-      neighbours_ = Eigen::MatrixXd::Zero(state_->Y.rows(),
-                                          (in_.d + 1) * static_cast<Eigen::Index>(nb.size()));
-      for (int b : layout_->adjacent[static_cast<std::size_t>(in_.id)]) {
-        out.push_back(OutgoingMessage{state_->publish(state_->Y, BlockKind::kY, b, 0, phase),
-                                      false,
-                                      {static_cast<std::uint32_t>(b)}});
-        waiting_.push_back(static_cast<std::uint32_t>(b));
+      // Weights are computed at the iterate itself: the owners' public poses of every
+      // measurement (the base layout: a measurement out of the current solve still needs
+      // its residual).
+      const Eigen::Index w = (in_.d + 1) * state_->Y.rows();
+      neighbours_ = Eigen::MatrixXd::Zero(
+          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
+      const auto& own = base_->poses[me];
+      const auto& adjacent = base_->adjacent[me];
+      for (std::size_t q = 0; q < adjacent.size(); ++q) {
+        PoseBlockMessage b;
+        b.sender = me;
+        b.phase = phase;
+        b.kind = BlockKind::kY;
+        b.rank = static_cast<std::uint32_t>(state_->Y.rows());
+        b.dim = static_cast<std::uint32_t>(in_.d);
+        const auto& ids = base_->public_to[me][q];
+        b.data.resize(ids.size() * static_cast<std::size_t>(w));
+        double* to = b.data.data();
+        for (std::size_t id : ids) {
+          const auto s = std::lower_bound(own.begin(), own.end(), id) - own.begin();
+          b.pose_ids.push_back(static_cast<std::uint32_t>(id));
+          std::memcpy(to, state_->Y.data() + w * s, sizeof(double) * static_cast<std::size_t>(w));
+          to += w;
+        }
+        const auto to_agent = static_cast<std::uint32_t>(adjacent[q]);
+        out.push_back(OutgoingMessage{std::move(b), false, {to_agent}});
+        waiting_.push_back(to_agent);
       }
       break;
     }
     case Step::kVotes: {
-      // mu's start needs the largest residual; c^2's default needs how many may be rejected.
+      // mu's start needs the largest residual over every measurement that may be rejected.
       double max_r2 = 0;
-      double candidates = 0;
       for (std::size_t k : owned_)
-        if (may_reject(k)) {
-          max_r2 = std::max(max_r2, residual_squared_at(k));
-          candidates += 1;
-        }
-      votes_[me] = {max_r2, candidates};
+        if (may_reject(k)) max_r2 = std::max(max_r2, residual_squared_at(k));
+      votes_[me] = {max_r2, 0};
       RoundStatusMessage st;
       st.cost = max_r2;
-      st.grad_norm_sq = candidates;
       to_others(st, true, nullptr);
       break;
     }
@@ -193,15 +270,25 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       double spread = 0;
       for (std::size_t k : owned_) spread += weights_[k] * (1 - weights_[k]);
       votes_[me] = {spread, 0};
+      zero_cut_.clear();
+      for (std::size_t k : owned_) {
+        const Measurement& m = in_.measurements[k];
+        if (weights_[k] == 0 && in_.owner[m.i] != in_.owner[m.j])
+          zero_cut_.push_back(in_.measurement_index[k]);
+      }
       RoundStatusMessage st;
       st.grad_norm_sq = spread;
       to_others(st, false, [&](std::uint32_t a, RoundStatusMessage& s) {
-        // The cut measurements this agent weighs whose other end `a` holds.
+        // The recipient's cut measurements this agent weighs, then (with weight 0) its other
+        // cut measurements that leave the solve, for the recipient's block layout.
         for (std::size_t k : owned_) {
           const Measurement& m = in_.measurements[k];
-          if (static_cast<std::uint32_t>(in_.owner[std::max(m.i, m.j)]) != a) continue;
-          s.measurement_ids.push_back(in_.measurement_index[k]);
-          s.weights.push_back(weights_[k]);
+          const auto other = static_cast<std::uint32_t>(in_.owner[std::max(m.i, m.j)]);
+          const bool cut = in_.owner[m.i] != in_.owner[m.j];
+          if (other == a || (known_connected_ && cut && weights_[k] == 0)) {
+            s.measurement_ids.push_back(in_.measurement_index[k]);
+            s.weights.push_back(weights_[k]);
+          }
         }
       });
       break;
@@ -215,6 +302,19 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       to_others(st, true, nullptr);
       break;
     }
+    case Step::kReadmitted: {
+      // A rejected measurement within the bound at the kept set's solution (TLS would count
+      // it as an inlier there) was misjudged on a rough iterate: it comes back.
+      taken_back_.clear();
+      for (std::size_t k : owned_)
+        if (std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k]) &&
+            residual_squared_at(k) <= c2_)
+          taken_back_.push_back(in_.measurement_index[k]);
+      RoundStatusMessage st;
+      st.measurement_ids = taken_back_;
+      to_others(st, true, nullptr);
+      break;
+    }
     default:
       break;
   }
@@ -222,14 +322,65 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   if (!done_ && step_ == step && exchange_phase() == phase && waiting_.empty()) after_exchange(out);
 }
 
+void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
+  // The kept set must connect every pose (every agent checks the same set).
+  const std::size_t parts =
+      components_without(in_.num_poses, in_.d, in_.structure, rejected_, false, known_);
+  if (parts > 1)
+    throw InputError("robust solve: " + std::to_string(rejected_.size()) + " of " +
+                     std::to_string(in_.structure.size()) +
+                     " measurements look like outliers, and the kept ones split the poses into " +
+                     std::to_string(parts) +
+                     " unconnected parts, so no estimate is defined (too few consistent "
+                     "measurements; try --known-inliers odometry or a larger --inlier-threshold)");
+  kept_.clear();
+  kept_index_.clear();
+  for (std::size_t k = 0; k < in_.measurements.size(); ++k)
+    if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
+      kept_.push_back(in_.measurements[k]);
+      kept_index_.push_back(in_.measurement_index[k]);
+    }
+  auto layout = std::make_unique<BlockLayout>(
+      make_block_layout(in_.num_poses, without(in_.structure, rejected_), in_.owner));
+  // The state refers to the layout: keep the iterate, then replace both.
+  in_.Y0 = state_->Y;
+  solve_.reset();
+  state_.reset();
+  layout_ = std::move(layout);
+  solve_kind_ = Solve::kInlierPass;
+  ++g_;
+  begin_solve(out);
+}
+
+void GncAgent::finish(std::vector<OutgoingMessage>& out) {
+  if (!options_.solver.certify || !final_solve_wanted_) {
+    done_ = true;
+    step_ = Step::kDone;
+    return;
+  }
+  // The certificate once, on the set that stays (re-admission ran on uncertified solves: the
+  // staircase may raise the rank, which a further pass could not start from).
+  solve_kind_ = Solve::kFinal;
+  ++g_;
+  begin_solve(out);
+}
+
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
-  if (final_solve_) {
+  if (solve_kind_ == Solve::kFinal) {
     final_rounds_ += solve_->total_rounds();
     done_ = true;
     step_ = Step::kDone;
     return;
   }
   gnc_rounds_ += solve_->total_rounds();
+  if (solve_kind_ == Solve::kInlierPass) {
+    if (pass_ == kMaxReadmissionPasses || rejected_.empty()) {
+      finish(out);
+      return;
+    }
+    begin_exchange(Step::kPoses, out);
+    return;
+  }
   if (g_ > 0 && (converged_ || outer_ >= options_.robust.max_outer_iterations)) {
     begin_exchange(Step::kRejected, out);
     return;
@@ -240,16 +391,15 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
 void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   switch (step_) {
     case Step::kPoses:
-      begin_exchange(voted_ ? Step::kWeights : Step::kVotes, out);
+      if (solve_kind_ == Solve::kInlierPass)
+        begin_exchange(Step::kReadmitted, out);
+      else
+        begin_exchange(voted_ ? Step::kWeights : Step::kVotes, out);
       return;
     case Step::kVotes: {
       voted_ = true;
-      double max_r2 = 0, candidates = 0;
-      for (const auto& [sender, v] : votes_) {  // agent-id order
-        max_r2 = std::max(max_r2, v.first);
-        candidates += v.second;
-      }
-      c2_ = tls_threshold_squared(options_.robust, in_.d, static_cast<std::size_t>(candidates));
+      double max_r2 = 0;
+      for (const auto& [sender, v] : votes_) max_r2 = std::max(max_r2, v.first);
       mu_ = gnc_initial_mu(max_r2, c2_);
       converged_ = mu_ == 0;
       begin_exchange(converged_ ? Step::kRejected : Step::kWeights, out);
@@ -262,62 +412,40 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
       converged_ = spread <= options_.robust.weight_tolerance;
       mu_ *= options_.robust.mu_step;
+      if (known_connected_) {
+        // This step's block layout: without the cut measurements of weight 0 (every agent's).
+        std::sort(zero_cut_.begin(), zero_cut_.end());
+        auto layout = std::make_unique<BlockLayout>(
+            make_block_layout(in_.num_poses, without(in_.structure, zero_cut_), in_.owner));
+        in_.Y0 = state_->Y;
+        solve_.reset();
+        state_.reset();
+        layout_ = std::move(layout);
+      }
       ++g_;
       begin_solve(out);
       return;
     }
-    case Step::kRejected: {
+    case Step::kRejected:
       std::sort(rejected_.begin(), rejected_.end());
-      // The kept set must connect every pose (every agent checks the same set).
-      PoseGraph kept_structure;
-      kept_structure.d = in_.d;
-      kept_structure.num_poses = in_.num_poses;
-      std::size_t next = 0;
-      std::vector<std::pair<std::uint32_t, std::uint32_t>> kept_endpoints;
-      for (std::size_t e = 0; e < in_.structure.size(); ++e) {
-        if (next < rejected_.size() && rejected_[next] == e) {
-          ++next;
-          continue;
-        }
-        kept_endpoints.push_back(in_.structure[e]);
-        Measurement m;
-        m.i = in_.structure[e].first;
-        m.j = in_.structure[e].second;
-        kept_structure.measurements.push_back(std::move(m));
-      }
-      const std::size_t parts = count_components(kept_structure);
-      if (parts > 1)
-        throw InputError(
-            "robust solve: " + std::to_string(rejected_.size()) + " of " +
-            std::to_string(in_.structure.size()) +
-            " measurements look like outliers, and the kept ones split the poses into " +
-            std::to_string(parts) +
-            " unconnected parts, so no estimate is defined (too few consistent measurements; "
-            "try --known-inliers odometry or a larger --inlier-threshold)");
-      kept_.clear();
-      kept_index_.clear();
-      for (std::size_t k = 0; k < in_.measurements.size(); ++k)
-        if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
-          kept_.push_back(in_.measurements[k]);
-          kept_index_.push_back(in_.measurement_index[k]);
-        }
-      if (!final_solve_wanted_) {
-        done_ = true;
-        step_ = Step::kDone;
+      begin_inlier_pass(out);
+      return;
+    case Step::kReadmitted: {
+      ++pass_;
+      if (taken_back_.empty()) {
+        finish(out);
         return;
       }
-      // The kept set's layout (a rejected cut measurement may end a neighbourhood); the
-      // state keeps the iterate.
-      auto layout = std::make_unique<BlockLayout>(
-          make_block_layout(in_.num_poses, kept_endpoints, in_.owner));
-      const Eigen::MatrixXd Y = state_->Y;
-      solve_.reset();
-      state_.reset();
-      layout_ = std::move(layout);
-      in_.Y0 = Y;
-      final_solve_ = true;
-      ++g_;
-      begin_solve(out);
+      std::sort(taken_back_.begin(), taken_back_.end());
+      for (std::size_t k = 0; k < in_.measurements.size(); ++k)
+        if (std::binary_search(taken_back_.begin(), taken_back_.end(), in_.measurement_index[k]))
+          weights_[k] = 1.0;
+      std::vector<std::uint64_t> still;
+      std::set_difference(rejected_.begin(), rejected_.end(), taken_back_.begin(),
+                          taken_back_.end(), std::back_inserter(still));
+      readmitted_ += rejected_.size() - still.size();
+      rejected_ = std::move(still);
+      begin_inlier_pass(out);
       return;
     }
     default:
@@ -339,40 +467,56 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
   }
   const std::uint32_t sender = sender_of(message);
   auto it = std::find(waiting_.begin(), waiting_.end(), sender);
+  const std::string me = "agent " + std::to_string(in_.id) + ": ";
   if (it == waiting_.end())
-    throw std::runtime_error("agent " + std::to_string(in_.id) + ": unexpected robust message " +
-                             std::to_string(phase) + " from agent " + std::to_string(sender));
+    throw std::runtime_error(me + "unexpected robust message " + std::to_string(phase) +
+                             " from agent " + std::to_string(sender));
   waiting_.erase(it);
   if (step_ == Step::kPoses) {
     const auto* block = std::get_if<PoseBlockMessage>(&message);
-    if (!block)
-      throw std::runtime_error("agent " + std::to_string(in_.id) + ": status where poses belong");
-    state_->absorb(*block, neighbours_);
+    const Eigen::Index w = (in_.d + 1) * neighbours_.rows();
+    if (!block || block->rank != static_cast<std::uint32_t>(neighbours_.rows()) ||
+        block->data.size() != block->pose_ids.size() * static_cast<std::size_t>(w))
+      throw std::runtime_error(me + "malformed robust pose message from agent " +
+                               std::to_string(sender));
+    for (std::size_t q = 0; q < block->pose_ids.size(); ++q) {
+      const auto p = static_cast<std::size_t>(block->pose_ids[q]);
+      const auto s = std::lower_bound(base_neighbours_.begin(), base_neighbours_.end(), p);
+      if (s == base_neighbours_.end() || *s != p)
+        throw std::runtime_error(me + "pose " + std::to_string(p) + " from agent " +
+                                 std::to_string(sender) + " is not a neighbour");
+      std::memcpy(neighbours_.data() + w * (s - base_neighbours_.begin()),
+                  block->data.data() + w * static_cast<Eigen::Index>(q),
+                  sizeof(double) * static_cast<std::size_t>(w));
+    }
   } else {
     const auto* st = std::get_if<RoundStatusMessage>(&message);
-    if (!st)
-      throw std::runtime_error("agent " + std::to_string(in_.id) +
-                               ": poses where a status belongs");
-    if (step_ == Step::kVotes) votes_[sender] = {st->cost, st->grad_norm_sq};
+    if (!st) throw std::runtime_error(me + "poses where a robust status belongs");
+    if (step_ == Step::kVotes) votes_[sender] = {st->cost, 0};
     if (step_ == Step::kWeights) {
       votes_[sender] = {st->grad_norm_sq, 0};
       if (st->weights.size() != st->measurement_ids.size())
-        throw std::runtime_error("agent " + std::to_string(in_.id) + ": weights from agent " +
-                                 std::to_string(sender) + " do not match their measurements");
+        throw std::runtime_error(me + "weights from agent " + std::to_string(sender) +
+                                 " do not match their measurements");
       for (std::size_t q = 0; q < st->weights.size(); ++q) {
-        const auto pos = std::lower_bound(in_.measurement_index.begin(),
-                                          in_.measurement_index.end(), st->measurement_ids[q]);
-        const auto k = static_cast<std::size_t>(pos - in_.measurement_index.begin());
-        if (pos == in_.measurement_index.end() || *pos != st->measurement_ids[q] ||
-            weight_owner(in_.measurements[k], in_.owner) != static_cast<int>(sender))
-          throw std::runtime_error("agent " + std::to_string(in_.id) + ": agent " +
-                                   std::to_string(sender) + " sent the weight of measurement " +
-                                   std::to_string(st->measurement_ids[q]) + ", not its own");
-        weights_[k] = st->weights[q];
+        const std::uint64_t id = st->measurement_ids[q];
+        if (id >= in_.structure.size() ||
+            in_.owner[std::min(in_.structure[id].first, in_.structure[id].second)] !=
+                static_cast<int>(sender))
+          throw std::runtime_error(me + "agent " + std::to_string(sender) +
+                                   " sent the weight of measurement " + std::to_string(id) +
+                                   ", not its own");
+        const auto pos =
+            std::lower_bound(in_.measurement_index.begin(), in_.measurement_index.end(), id);
+        if (pos != in_.measurement_index.end() && *pos == id)
+          weights_[static_cast<std::size_t>(pos - in_.measurement_index.begin())] = st->weights[q];
+        if (st->weights[q] == 0) zero_cut_.push_back(id);
       }
     }
     if (step_ == Step::kRejected)
       rejected_.insert(rejected_.end(), st->measurement_ids.begin(), st->measurement_ids.end());
+    if (step_ == Step::kReadmitted)
+      taken_back_.insert(taken_back_.end(), st->measurement_ids.begin(), st->measurement_ids.end());
   }
   if (waiting_.empty()) after_exchange(out);
 }
@@ -434,7 +578,9 @@ std::optional<AwaitedMessages> GncAgent::awaited() const {
     if (a) a->phase += g_ * kGncStepStride;
     return a;
   }
-  return AwaitedMessages{0, exchange_phase(), waiting_};
+  std::vector<std::uint32_t> senders = waiting_;
+  std::sort(senders.begin(), senders.end());
+  return AwaitedMessages{0, exchange_phase(), senders};
 }
 
 }  // namespace tessera

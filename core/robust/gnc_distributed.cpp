@@ -4,6 +4,7 @@
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/distributed/in_process_driver.hpp>
+#include <tessera/graph/connectivity.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/robust/gnc_agent.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
@@ -20,6 +21,17 @@ double lifted_residual_squared(const Measurement& m, const Eigen::MatrixXd& X, i
   const Eigen::Index w = d + 1;
   return lifted_residual_squared(m, X.middleCols(w * static_cast<Eigen::Index>(m.i), w),
                                  X.middleCols(w * static_cast<Eigen::Index>(m.j), w));
+}
+
+// `graph` with only the measurements flagged in `known`.
+PoseGraph known_subgraph(const PoseGraph& graph, const std::vector<bool>& known) {
+  PoseGraph out;
+  out.d = graph.d;
+  out.num_poses = graph.num_poses;
+  out.source = graph.source;
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e)
+    if (known[e]) out.measurements.push_back(graph.measurements[e]);
+  return out;
 }
 
 }  // namespace
@@ -53,6 +65,24 @@ AgentWeights agent_weights(int agent, const PoseGraph& graph, const std::vector<
   return out;
 }
 
+std::vector<Pose> gnc_start(const PoseGraph& graph, const GncDistributedOptions& options,
+                            int agents) {
+  const DistributedOptions& solver = options.solver;
+  const int robots = solver.robots > 0 ? solver.robots : agents;
+  if (options.known_inlier_start) {
+    // The known inliers alone connect the poses (the usual case: odometry chains joined by
+    // rendezvous links): start from them, like the centralized robust solve starts from the
+    // odometry. A chordal start fits the outliers too.
+    std::vector<bool> known(graph.num_measurements());
+    for (std::size_t e = 0; e < graph.num_measurements(); ++e)
+      known[e] = is_known_inlier(graph.measurements[e], options.robust.known_inliers) ||
+                 (!options.known_inlier_flags.empty() && options.known_inlier_flags[e]);
+    const PoseGraph known_graph = known_subgraph(graph, known);
+    if (count_components(known_graph) <= 1) return distributed_initialization(known_graph, robots);
+  }
+  return initial_poses(graph, solver.initialization, robots);
+}
+
 GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
                                            const std::vector<int>& assignment,
                                            const GncDistributedOptions& options) {
@@ -65,10 +95,16 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
     throw InputError("DistributedOptions.rank must be >= d = " + std::to_string(graph.d));
   const BlockLayout layout = make_block_layout(graph.num_poses, graph.measurements, assignment);
   const int agents = layout.num_blocks;
-  const std::vector<Pose> init =
-      initial_poses(graph, solver.initialization, solver.robots > 0 ? solver.robots : agents);
-  const Eigen::MatrixXd X0 = lift_poses(init, solver.rank);
+  const Eigen::MatrixXd X0 = lift_poses(gnc_start(graph, options, agents), solver.rank);
   const Eigen::Index w = graph.d + 1;
+  auto block_of = [&](const Eigen::MatrixXd& X, int b) {
+    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+    Eigen::MatrixXd Y(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
+    for (std::size_t s = 0; s < ids.size(); ++s)
+      Y.middleCols(w * static_cast<Eigen::Index>(s), w) =
+          X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
+    return Y;
+  };
 
   // Every agent gets what a DDS agent holds after the hand-off: the endpoints of the whole
   // graph, the measurements touching its poses and its block of the starting point.
@@ -86,19 +122,15 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
     in.num_poses = graph.num_poses;
     in.owner = assignment;
     in.structure = structure;
+    in.known_inlier = options.known_inlier_flags;
     for (std::size_t e = 0; e < graph.num_measurements(); ++e) {
       const Measurement& m = graph.measurements[e];
       if (assignment[m.i] != b && assignment[m.j] != b) continue;
       in.measurements.push_back(m);
       in.measurement_index.push_back(e);
-      if (!options.known_inlier_flags.empty())
-        in.known_inlier.push_back(options.known_inlier_flags[e]);
     }
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    in.Y0.resize(solver.rank, w * static_cast<Eigen::Index>(ids.size()));
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      in.Y0.middleCols(w * static_cast<Eigen::Index>(s), w) =
-          X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
+    in.Y0 = block_of(X0, b);
+    // Without the final certified solve: it runs below, for its full record.
     gnc.push_back(std::make_unique<GncAgent>(std::move(in), options, false));
     if (options.weight_observer)
       gnc.back()->set_weight_observer([&options, b](int outer,
@@ -115,16 +147,9 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   out.outer_iterations = lead.outer_iterations();
   out.weights_converged = lead.weights_converged();
   out.threshold_squared = lead.threshold_squared();
+  out.readmitted = lead.readmitted();
   out.rejected.assign(lead.rejected().begin(), lead.rejected().end());
   out.weights.assign(graph.num_measurements(), 1.0);
-  Eigen::MatrixXd X(solver.rank, w * static_cast<Eigen::Index>(graph.num_poses));
-  for (int b = 0; b < agents; ++b) {
-    const GncAgent& a = *gnc[static_cast<std::size_t>(b)];
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
-          a.state().Y.middleCols(w * static_cast<Eigen::Index>(s), w);
-  }
   // Each measurement's weight as its owner computed it.
   for (int b = 0; b < agents; ++b) {
     const GncAgent& a = *gnc[static_cast<std::size_t>(b)];
@@ -136,10 +161,27 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   out.total_rounds = lead.gnc_rounds();
   out.total_bytes = stats.bytes;
 
+  // The last solve of the kept set with its full record (trace, certificate): with
+  // certification the certified solve from the agents' iterate; without, the agents' last
+  // inlier pass again from its start (the same arithmetic, so the same iterate).
   const PoseGraph inliers = inlier_graph(graph, out.rejected, {});
-  out.final_solve = solve_distributed_from_lifted(inliers, assignment, solver, X);
-  out.total_rounds += out.final_solve.rounds;
-  out.total_bytes += out.final_solve.bytes_exchanged;
+  const bool certify = solver.certify;
+  Eigen::MatrixXd X(solver.rank, w * static_cast<Eigen::Index>(graph.num_poses));
+  for (int b = 0; b < agents; ++b) {
+    const GncAgent& a = *gnc[static_cast<std::size_t>(b)];
+    const Eigen::MatrixXd& Y = certify ? a.state().Y : a.last_pass_start();
+    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+    for (std::size_t s = 0; s < ids.size(); ++s)
+      X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
+          Y.middleCols(w * static_cast<Eigen::Index>(s), w);
+  }
+  DistributedOptions last = solver;
+  last.certify = certify;
+  out.final_solve = solve_distributed_from_lifted(inliers, assignment, last, X);
+  if (certify) {
+    out.total_rounds += out.final_solve.rounds;
+    out.total_bytes += out.final_solve.bytes_exchanged;
+  }
   return out;
 }
 

@@ -325,18 +325,21 @@ def table(csv_path):
             return v or "-"
 
     head = ("| graph | kind | F | outliers | rejected | precision | recall | gap to f*_clean | ATE m | outer | "
-            "certified | plain gap | plain ATE m | dist. rejected | dist. recall | dist. gap | dist. rounds "
-            "(clean) | dist. MB | dist. certified | load |")
-    lines = [head, "|" + "---|" * head.count("|")[:-1] if False else "|" + "---|" * (head.count("|") - 1)]
+            "certified | wall s | plain gap | plain ATE m | dist. rejected | dist. precision | dist. recall | "
+            "dist. gap | dist. ATE m | dist. rounds (clean) | dist. MB | dist. wall s | dist. certified | load |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         lines.append("| " + " | ".join([
             r["graph"], r["kind"], r["F"], r["outliers"], r["rejected"] or "-", num(r["precision"], "{:.3f}"),
             num(r["recall"], "{:.3f}"), num(r["gap"], "{:.1e}"), num(r["ate_m"], "{:.2g}"), r["outer"] or "-",
-            r["certified"] or "-", num(r["plain_gap"], "{:.3g}"), num(r["plain_ate_m"], "{:.2g}"),
-            r.get("d_rejected", "") or "-", num(r.get("d_recall", ""), "{:.3f}"), num(r.get("d_gap", ""), "{:.1e}"),
+            r["certified"] or "-", num(r["wall_s"], "{:.3g}"), num(r["plain_gap"], "{:.3g}"),
+            num(r["plain_ate_m"], "{:.2g}"),
+            r.get("d_rejected", "") or "-", num(r.get("d_precision", ""), "{:.3f}"),
+            num(r.get("d_recall", ""), "{:.3f}"), num(r.get("d_gap", ""), "{:.1e}"),
+            num(r.get("d_ate_m", ""), "{:.2g}"),
             (f"{r['d_rounds']} ({r['d_clean_rounds']})" if r.get("d_rounds") else "-"),
             num(str(float(r["d_bytes"]) / 1e6) if r.get("d_bytes") else "", "{:.1f}"),
-            r.get("d_certified", "") or "-", r["load"]]) + " |")
+            num(r.get("d_wall_s", ""), "{:.3g}"), r.get("d_certified", "") or "-", r["load"]]) + " |")
     return "\n".join(lines)
 
 
@@ -354,6 +357,8 @@ def main():
     ap.add_argument("--no-distributed", dest="distributed", action="store_false",
                     help="skip the distributed (irbcd, 5 agents) column")
     ap.add_argument("--csv", default="robust.csv", help="file name in --out-dir (rows are appended per cell)")
+    ap.add_argument("--append", action="store_true",
+                    help="add rows to an existing --csv (e.g. the large graphs with fewer fractions)")
     ap.add_argument("--plot-only", action="store_true", help="only redraw the figure from the CSV")
     args = ap.parse_args()
     os.makedirs(args.out_dir, exist_ok=True)
@@ -367,8 +372,9 @@ def main():
               "iterations", "wall_s", "certified", "plain_gap", "plain_ate_m", "plain_wall_s",
               "d_rejected", "d_precision", "d_recall", "d_gap", "d_ate_m", "d_outer", "d_rounds", "d_clean_rounds",
               "d_round_ratio", "d_bytes", "d_wall_s", "d_certified", "load", "note"]
-    with open(out_csv, "w", newline="") as f:
-        csv.writer(f).writerow(fields)
+    if not (args.append and os.path.exists(out_csv)):
+        with open(out_csv, "w", newline="") as f:
+            csv.writer(f).writerow(fields)
     work = tempfile.mkdtemp(prefix="tessera-robust-")
     for name in args.graphs.split(","):
         clean = clean_graph(args, work, name)

@@ -2,18 +2,24 @@
 // One agent's side of distributed GNC-TLS as a single state machine for any driver (the
 // in-process driver, the DDS round loop), so both run the same code:
 //
-//   solve 0 (plain, to the solver's tolerance)
+//   solve 0 (plain; every solve before the final one is capped at
+//           RobustOptions::inner_max_rounds rounds: GNC needs only a rough minimiser)
 //   poses    -> neighbours: the public poses of the iterate (every weight is computed at the
 //               iterate itself, not at a neighbour copy that may lag a round)
-//   votes    -> every agent: largest residual^2 of the measurements it owns, and how many of
-//               them may be rejected; every agent sums them in agent-id order: c^2 and mu's start
+//   votes    -> every agent: largest residual^2 of the measurements it owns; the max over the
+//               agents gives mu's start
 //   outer step k = 1, 2, ...:
 //     weights -> every agent: the TLS weights of the cut measurements it owns whose other end
-//               the recipient holds, and its weight spread sum w (1 - w) (the stop vote)
-//     solve k (weighted, warm-started, at most RobustOptions::inner_max_rounds rounds)
+//               the recipient holds, the ids of its other cut measurements of weight 0 (they
+//               leave the weighted solve, so every agent must know the block adjacency), and
+//               its weight spread sum w (1 - w) (the stop vote)
+//     solve k (weighted, warm-started)
 //     poses  -> neighbours (when another step follows)
 //   rejected -> every agent: the measurements it owns with weight < 0.5
-//   final solve of the kept measurements (certified when the solver options say so)
+//   inlier pass p = 0.. 3: solve of the kept set to the solver's tolerance (uncertified);
+//     poses, then readmitted -> every agent: its rejected measurements within the bound at
+//     that solution (misjudged on a rough iterate); none anywhere ends the passes
+//   final: with certification, the certified solve of the kept set
 //
 // Each weight is computed by one agent, the owner of the measurement's lower pose id
 // (weight_owner()); the other end receives it, so both ends always use the same weight. The
@@ -38,14 +44,24 @@
 
 namespace tessera {
 
-/// Phases of GNC step g (0 = first solve, k = k-th weighted solve, then the final solve):
+/// Re-admission passes after the GNC loop (each one more solve of the kept set).
+constexpr int kMaxReadmissionPasses = 3;
+
+/// Phases of GNC step g (0 = first solve, k = k-th weighted solve, then the inlier passes and
+/// the final solve):
 /// g * kGncStepStride + the inner solve's stage-tagged phase (stage_tag.hpp), or + the GNC
 /// exchange's own phase. The stride is a multiple of 3 * kStagePhaseStride so stage_kind() of a
 /// tagged phase is still the inner stage's kind (certificate traffic is counted by it).
 constexpr std::uint32_t kGncStepStride = 3000000;
 /// The GNC exchanges sit after every inner stage of their step (inner stages stay below 999).
 constexpr std::uint32_t kGncExchangeBase = 999000;
-enum class GncExchange : std::uint32_t { kPoses = 1, kVotes = 2, kWeights = 3, kRejected = 4 };
+enum class GncExchange : std::uint32_t {
+  kPoses = 1,
+  kVotes = 2,
+  kWeights = 3,
+  kRejected = 4,
+  kReadmitted = 5
+};
 inline std::uint32_t gnc_phase(std::uint32_t step, GncExchange e) {
   return step * kGncStepStride + kGncExchangeBase + static_cast<std::uint32_t>(e);
 }
@@ -65,16 +81,16 @@ struct GncAgentInput {
   /// The measurements touching this agent's poses, file order, and their file positions.
   std::vector<Measurement> measurements;
   std::vector<std::uint64_t> measurement_index;
-  /// Empty, or one per measurement above: true = never down-weighted (a dpgo CSV file's
-  /// is_known_inlier column).
+  /// Empty, or one per measurement of the whole graph (file order): true = never
+  /// down-weighted (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier;
   Eigen::MatrixXd Y0;  ///< Own block's lifted start, r x (d+1)m, ascending pose ids.
 };
 
 class GncAgent : public AgentProcess {
  public:
-  /// `options` must outlive the agent. With `final_solve` false the agent is done once the
-  /// rejected set is known (the caller solves the kept set itself).
+  /// `options` must outlive the agent. With `final_solve` false the agent is done before the
+  /// certified solve of the kept set (the caller runs it, or uses the last inlier pass).
   GncAgent(GncAgentInput input, const GncDistributedOptions& options, bool final_solve = true);
   ~GncAgent() override;
 
@@ -96,10 +112,14 @@ class GncAgent : public AgentProcess {
   // Results, identical on every agent once done() (rejected, counts, threshold).
   const std::vector<std::uint64_t>& rejected() const { return rejected_; }  ///< Ascending.
   int outer_iterations() const { return outer_; }
+  std::size_t readmitted() const { return readmitted_; }  ///< Taken back by the passes.
   bool weights_converged() const { return converged_; }
   double threshold_squared() const { return c2_; }
-  /// Rounds of the GNC solves (first and weighted) and of the final solve.
+  /// Rounds of the solves before the final certified one (first, weighted, inlier passes).
   int gnc_rounds() const { return gnc_rounds_; }
+  /// The own block at the start of the last inlier pass (what the caller of an agent without
+  /// the final solve starts that pass from to get its full record).
+  const Eigen::MatrixXd& last_pass_start() const { return last_pass_start_; }
   int total_rounds() const;
   /// The current weight of each of this agent's measurements (same order as the input's).
   const std::vector<double>& weights() const { return weights_; }
@@ -107,13 +127,16 @@ class GncAgent : public AgentProcess {
   /// The iterate: own block, lifted (after the final solve: of the kept set).
   const AgentState& state() const { return *state_; }
   /// The final solve (nullptr before it or without it), its layout and kept measurements.
-  const CertifiedAgent* final_sequence() const { return final_solve_ ? solve_.get() : nullptr; }
+  const CertifiedAgent* final_sequence() const {
+    return solve_kind_ == Solve::kFinal ? solve_.get() : nullptr;
+  }
   const BlockLayout& layout() const { return *layout_; }
   const std::vector<Measurement>& kept_measurements() const { return kept_; }
   const std::vector<std::uint64_t>& kept_index() const { return kept_index_; }
 
  private:
-  enum class Step { kSolve, kPoses, kVotes, kWeights, kRejected, kDone };
+  enum class Step { kSolve, kPoses, kVotes, kWeights, kRejected, kReadmitted, kDone };
+  enum class Solve { kGnc, kInlierPass, kFinal };
   void begin_solve(std::vector<OutgoingMessage>& out);
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
   void after_solve(std::vector<OutgoingMessage>& out);
@@ -125,6 +148,8 @@ class GncAgent : public AgentProcess {
   double residual_squared_at(std::size_t k) const;
   bool may_reject(std::size_t k) const;
   void weights_at_mu(double mu);
+  void begin_inlier_pass(std::vector<OutgoingMessage>& out);
+  void finish(std::vector<OutgoingMessage>& out);
 
   GncAgentInput in_;
   const GncDistributedOptions& options_;
@@ -135,8 +160,17 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<CertifiedAgent> solve_;
   std::uint32_t g_ = 0;  // GNC step
   Step step_ = Step::kSolve;
-  bool final_solve_ = false;            // the running solve is the final one
-  bool voted_ = false;                  // the votes of mu's start are in
+  Solve solve_kind_ = Solve::kGnc;
+  bool voted_ = false;  // the votes of mu's start are in
+  int pass_ = 0;        // inlier passes done
+  std::size_t readmitted_ = 0;
+  std::vector<std::uint64_t> taken_back_;     // the current re-admission exchange's ids
+  std::vector<bool> known_;                   // per measurement of the whole graph
+  bool known_connected_ = false;              // the known inliers alone connect the poses
+  std::vector<std::uint64_t> zero_cut_;       // cut measurements of weight 0 (others' too)
+  std::unique_ptr<BlockLayout> base_;         // of every measurement: whose poses go where
+  std::vector<std::size_t> base_neighbours_;  // other ends of the own measurements, ascending
+  Eigen::MatrixXd last_pass_start_;
   std::vector<std::uint32_t> waiting_;  // senders the current exchange still lacks
   std::vector<std::size_t> owned_;      // indices (into in_.measurements) this agent weighs
   std::vector<double> weights_;         // per in_.measurements

@@ -26,6 +26,13 @@ struct GncDistributedOptions {
   /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
   /// rule's measurements (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier_flags;
+  /// Start from the distributed initialization of the known inliers alone (with the default
+  /// rule: each robot's odometry chain, robots joined by their consecutive-id links), like the
+  /// centralized robust solve starts from the odometry; solver.initialization is then unused.
+  /// A chordal start fits every measurement, outliers included, and the plain solve from
+  /// there settles in a distorted solution that costs many rounds and can make true closures
+  /// look wrong. When the known inliers do not connect the poses, solver.initialization is used.
+  bool known_inlier_start = true;
   /// Optional: called after every weight exchange with (agent, outer step, that agent's
   /// measurements by file position, the weights it uses for them); tests compare the two ends
   /// of every cut measurement with it.
@@ -61,9 +68,18 @@ struct GncDistributedResult {
   int outer_iterations = 0;
   int total_rounds = 0;           ///< Rounds of every solve, final included.
   std::uint64_t total_bytes = 0;  ///< Bytes of every solve plus the outer steps' votes.
+  /// Measurements GNC had rejected whose residual at the inlier set's solution was within the
+  /// bound (r^2 <= c^2), taken back before the final solve.
+  std::size_t readmitted = 0;
   double threshold_squared = 0;
   bool weights_converged = false;
 };
+
+/// The starting poses of distributed GNC: with options.known_inlier_start, the distributed
+/// initialization of the known inliers alone when they connect the poses; otherwise
+/// solver.initialization's (with solver.robots, or `agents`, robots).
+std::vector<Pose> gnc_start(const PoseGraph& graph, const GncDistributedOptions& options,
+                            int agents);
 
 /// Runs GNC-TLS with the distributed solver on `assignment`'s blocks. Throws InputError on
 /// bad options and, like solve_gnc_centralized(), when the kept measurements leave the poses
