@@ -122,6 +122,7 @@ LaunchOptions parse_launch_options(const std::vector<std::string>& argv) {
   o.algorithm = args.get_or("algorithm", o.algorithm);
   o.partition = args.get_or("partition", o.partition);
   o.init = args.get_or("init", init_name(DistributedOptions{}.initialization));
+  o.init_given = args.has("init");
   o.grad_tol = args.get_double("grad-tol", o.grad_tol);
   o.max_rounds = args.get_long("max-rounds", o.max_rounds);
   o.rank = args.get_long("rank", o.rank);

@@ -127,6 +127,8 @@ class GncAgent : public AgentProcess {
   /// The iterate: own block, lifted (after the final solve: of the kept set).
   const AgentState& state() const { return *state_; }
   /// The final solve (nullptr before it or without it), its layout and kept measurements.
+  /// The last solve (the certified one, or the last inlier pass); valid once done().
+  const CertifiedAgent& last_solve() const { return *solve_; }
   const CertifiedAgent* final_sequence() const {
     return solve_kind_ == Solve::kFinal ? solve_.get() : nullptr;
   }
