@@ -1,0 +1,124 @@
+// Robust (GNC-TLS) distributed solves over DDS: separate agent processes run the same state
+// machine as the in-process engine (robust/gnc_agent.hpp), so the same outer steps, rounds,
+// rejected set and cost.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/robust/gnc_distributed.hpp>
+#include <tessera/robust/tls_weights.hpp>
+#include <vector>
+
+#include "dds_process_support.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+// A JSON array of integers of a flat summary (e.g. "rejected" or the labels' "outliers").
+std::vector<std::size_t> json_array(const std::string& json, const std::string& name) {
+  std::smatch m;
+  std::vector<std::size_t> out;
+  if (!std::regex_search(json, m, std::regex("\"" + name + "\": \\[([^\\]]*)\\]"))) return out;
+  std::istringstream list(m[1].str());
+  for (std::string v; std::getline(list, v, ',');)
+    if (v.find_first_of("0123456789") != std::string::npos) out.push_back(std::stoul(v));
+  return out;
+}
+
+std::vector<std::size_t> lines_of(const std::string& path) {
+  std::vector<std::size_t> out;
+  std::ifstream f(path);
+  for (std::string line; std::getline(f, line);)
+    if (!line.empty()) out.push_back(std::stoul(line));
+  return out;
+}
+
+struct RobustRun {
+  std::string dir, graph, summary;
+  std::vector<std::size_t> labels;
+  std::vector<int> assignment;
+};
+
+// A 216-pose 3D grid of 3 robots with 25 % wrong loop closures, solved by 3 agent processes
+// (sequential partition: one robot each) with GNC-TLS and the certificate.
+RobustRun robust_dds_run(int domain, const std::vector<std::string>& extra = {}) {
+  RobustRun r;
+  r.dir = temp_dir();
+  r.graph = generate_graph(r.dir + "/graph.g2o",
+                           "--kind grid3d --poses 216 --robots 3 --seed 4 --outliers 0.25 "
+                           "--labels " +
+                               r.dir + "/labels.json");
+  r.labels = json_array(slurp(r.dir + "/labels.json"), "outliers");
+  const std::string run = "robust-" + std::to_string(getpid()) + "-" + std::to_string(domain);
+  std::vector<std::string> args = {"--timeout",   "20",         "--run-timeout",
+                                   "120",         "--summary",  r.dir + "/summary.json",
+                                   "--partition", "sequential", "--seed",
+                                   "7",           "--certify",  "--robust",
+                                   "gnc-tls",     "--rejected", r.dir + "/rejected.txt"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  run_to_the_end(r.dir, r.graph, 3, run, domain, args, 120);
+  r.summary = slurp(r.dir + "/summary.json");
+  r.assignment = assignment_of(r.dir, 3);
+  return r;
+}
+
+GncDistributedOptions in_process_options() {
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.seed = 7;
+  o.solver.certify = true;
+  return o;
+}
+
+TEST(DdsRobust, IteratesAndRejectedSetEqualTheInProcessEngine) {
+  const RobustRun dds = robust_dds_run(42);
+  const PoseGraph g = read_g2o(dds.graph);
+  ASSERT_EQ(dds.assignment.size(), g.num_poses);
+  ASSERT_FALSE(dds.labels.empty());
+
+  const GncDistributedResult ref = solve_gnc_distributed(g, dds.assignment, in_process_options());
+  ASSERT_GT(ref.outer_iterations, 3) << "the outliers should take a few outer steps";
+  ASSERT_TRUE(ref.final_solve.certified.value_or(false));
+
+  EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "readmitted"), static_cast<double>(ref.readmitted));
+  EXPECT_EQ(json_field(dds.summary, "outliers"), static_cast<double>(ref.rejected.size()));
+  EXPECT_EQ(json_field(dds.summary, "inliers"),
+            static_cast<double>(g.num_measurements() - ref.rejected.size()));
+  EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
+  EXPECT_EQ(lines_of(dds.dir + "/rejected.txt"), ref.rejected);
+  // The cost over the kept measurements, rounded by the agents without a central step.
+  EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost)
+      << dds.summary;
+  EXPECT_NE(dds.summary.find("\"certified\": true"), std::string::npos) << dds.summary;
+  EXPECT_NE(dds.summary.find("\"robust\": \"gnc-tls\""), std::string::npos) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "min_eigenvalue"), ref.final_solve.min_eigenvalue);
+
+  // Every wrong closure found, nothing else, and no odometry edge (a known inlier) rejected.
+  EXPECT_EQ(ref.rejected, dds.labels);
+  for (std::size_t e : json_array(dds.summary, "rejected"))
+    EXPECT_FALSE(is_known_inlier(g.measurements[e], KnownInliers::kOdometry)) << e;
+}
+
+// With --known-inliers none every measurement may go; the known inliers' start is then not
+// available (odometry is not known), and the run still equals the in-process engine.
+TEST(DdsRobust, WithoutKnownInliersTheRunStillEqualsTheInProcessEngine) {
+  const RobustRun dds = robust_dds_run(43, {"--known-inliers", "none", "--init", "chordal"});
+  const PoseGraph g = read_g2o(dds.graph);
+  GncDistributedOptions o = in_process_options();
+  o.robust.known_inliers = KnownInliers::kNone;
+  const GncDistributedResult ref = solve_gnc_distributed(g, dds.assignment, o);
+  EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
+  EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
+  EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
