@@ -36,10 +36,18 @@ void check_partition_time(const std::string& v) {
 
 // The robust options are checked as RobustOptions checks them (the error names the field).
 void check_robust(const std::string& v) {
-  parse_robust_kind(v);
+  try {
+    parse_robust_kind(v);
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --robust: ") + e.what());
+  }
 }
 void check_known_inliers(const std::string& v) {
-  parse_known_inliers(v);
+  try {
+    parse_known_inliers(v);
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --known-inliers: ") + e.what());
+  }
 }
 template <class Set>
 void check_robust_field(const std::string& v, const char* flag, Set set) {

@@ -120,5 +120,41 @@ TEST(DdsRobust, WithoutKnownInliersTheRunStillEqualsTheInProcessEngine) {
   EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
 }
 
+// `tessera launch` end to end: the robust fields in the summary, and an input whose every
+// measurement looks wrong ends with a message naming the cause instead of a collapsed graph.
+TEST(DdsRobust, LaunchReportsTheRejectedSetAndRefusesAnAllOutlierInput) {
+  const std::string dir = temp_dir();
+  const std::string graph =
+      generate_graph(dir + "/graph.g2o",
+                     "--kind grid3d --poses 125 --robots 3 --seed 2 --outliers 0.25 "
+                     "--labels " +
+                         dir + "/labels.json");
+  std::string out;
+  int rc = run_command(bin("tessera") + " launch " + graph +
+                           " --agents 3 --domain 44 --timeout 60 --robust gnc-tls --json " + dir +
+                           "/s.json --rejected " + dir + "/rejected.txt 2>&1",
+                       &out);
+  ASSERT_EQ(rc, 0) << out;
+  const std::string json = slurp(dir + "/s.json");
+  const std::vector<std::size_t> labels = json_array(slurp(dir + "/labels.json"), "outliers");
+  EXPECT_EQ(json_array(json, "rejected"), labels) << json;
+  EXPECT_EQ(lines_of(dir + "/rejected.txt"), labels);
+  EXPECT_GT(json_field(json, "outer_iterations"), 0) << json;
+  EXPECT_NE(json.find("\"certified\": true"), std::string::npos) << json;
+
+  rc = run_command(bin("tessera") + " launch " + graph +
+                       " --agents 3 --domain 45 --timeout 60 --robust gnc-tls --known-inliers none "
+                       "--inlier-threshold 1e-6 2>&1",
+                   &out);
+  EXPECT_NE(rc, 0) << out;
+  EXPECT_NE(out.find("unconnected parts, so no estimate is defined"), std::string::npos) << out;
+
+  // Bad options name the flag and the field before anything starts.
+  rc = run_command(bin("tessera") + " launch " + graph + " --robust gnc-tls --gnc-mu-step 1 2>&1",
+                   &out);
+  EXPECT_EQ(rc, 2) << out;
+  EXPECT_NE(out.find("--gnc-mu-step: RobustOptions.mu_step"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace tessera::test::dds
