@@ -4,11 +4,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <regex>
 #include <string>
+#include <tessera/io/dpgo_csv_reader.hpp>
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
 #include <tessera/robust/tls_weights.hpp>
@@ -154,6 +157,53 @@ TEST(DdsRobust, LaunchReportsTheRejectedSetAndRefusesAnAllOutlierInput) {
                    &out);
   EXPECT_EQ(rc, 2) << out;
   EXPECT_NE(out.find("--gnc-mu-step: RobustOptions.mu_step"), std::string::npos) << out;
+}
+
+// `tessera launch` on dpgo's measurement CSV: robot k of the file is agent k (its own g2o file
+// written by launch), and the robust run equals the in-process engine on the same CSV.
+TEST(DdsRobust, LaunchOnADpgoCsvFileEqualsTheInProcessEngine) {
+  const std::string dir = temp_dir();
+  const std::string graph = generate_graph(
+      dir + "/graph.g2o", "--kind grid3d --poses 216 --robots 3 --seed 4 --outliers 0.25");
+  const PoseGraph g = read_g2o(graph);
+  std::string csv =
+      "robot_src,pose_src,robot_dst,pose_dst,qx,qy,qz,qw,tx,ty,tz,kappa,tau,is_known_inlier,"
+      "weight\n";
+  for (const Measurement& m : g.measurements) {
+    const Eigen::Quaterniond q(Eigen::Matrix3d(m.R));
+    char row[512];
+    std::snprintf(row, sizeof row,
+                  "%zu,%zu,%zu,%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,0,1\n",
+                  m.i / 72, m.i % 72, m.j / 72, m.j % 72, q.x(), q.y(), q.z(), q.w(), m.t(0),
+                  m.t(1), m.t(2), m.kappa, m.tau);
+    csv += row;
+  }
+  std::ofstream(dir + "/measurements.csv") << csv;
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch " + dir +
+                                 "/measurements.csv --agents 3 --partition sequential --domain 46 "
+                                 "--timeout 60 --seed 7 --robust gnc-tls --json " +
+                                 dir + "/s.json 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  const std::string json = slurp(dir + "/s.json");
+
+  const DpgoCsvGraph read = read_dpgo_csv(dir + "/measurements.csv");
+  const GncDistributedResult ref = solve_gnc_distributed(
+      read.graph, std::vector<int>(read.robot_of.begin(), read.robot_of.end()),
+      in_process_options());
+  EXPECT_EQ(json_field(json, "poses"), 216);
+  EXPECT_EQ(json_field(json, "outer_iterations"), ref.outer_iterations) << json;
+  EXPECT_EQ(json_field(json, "rounds"), ref.total_rounds) << json;
+  EXPECT_EQ(json_array(json, "rejected"), ref.rejected) << json;
+  EXPECT_NEAR(json_field(json, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  EXPECT_NE(json.find("\"certified\": true"), std::string::npos) << json;
+
+  // One agent per robot of the file.
+  EXPECT_NE(
+      run_command(bin("tessera") + " launch " + dir + "/measurements.csv --agents 2 2>&1", &out),
+      0);
+  EXPECT_NE(out.find("holds 3 robots but --agents is 2"), std::string::npos) << out;
 }
 
 }  // namespace
