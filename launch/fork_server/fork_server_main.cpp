@@ -39,11 +39,11 @@
 
 #include "agent/agent_entry.hpp"
 #include "agent/agent_options.hpp"
-#include "cli/session_process.hpp"
 #include "coordinator/coordinator_entry.hpp"
 #include "launch/fork_spec.hpp"
 #include "launch/startup_batch.hpp"
 #include "runtime/preloaded_graph.hpp"
+#include "transport/fastdds/process_exit.hpp"
 
 using namespace tessera;
 
@@ -172,7 +172,7 @@ bool agents_batch_at_start(const launch::ForkSpec& spec) {
   const int code = c.role == launch::ForkRole::kCoordinator
                        ? coordinator::coordinator_main(argc, argv.data())
                        : agent::agent_main(argc, argv.data());
-  cli::exit_process(code);
+  transport::exit_process(code);
 }
 
 }  // namespace
@@ -228,5 +228,5 @@ int main(int argc, char** argv) {
     }
   }
   close(spec.pid_fd);
-  cli::exit_process(0);
+  transport::exit_process(0);
 }
