@@ -93,7 +93,7 @@ std::string shared_agent_graph(const launch::ForkSpec& spec) {
 // What every agent would otherwise do on its own at start-up, done once here so that the
 // agents inherit it (copy-on-write pages they only read); measured ~3 ms of CPU per agent
 // each, spent while the coordinator partitions on both cores (docs/dds-runtime.md, "Start-up"):
-// - the shared graph file, parsed (agent/preloaded_graph.hpp; a file that does not parse is
+// - the shared graph file, parsed (core/runtime/preloaded_graph.hpp; a file that does not parse is
 //   left to each agent, which reports it);
 // - Fast DDS's TypeObjectFactory singleton (builtin types and annotations), which each
 //   process otherwise builds when it announces its first endpoint. It is a table of type
