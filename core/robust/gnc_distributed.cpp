@@ -2,6 +2,7 @@
 #include <stdexcept>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/graph/connectivity.hpp>
+#include <tessera/problem/lifting.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
@@ -45,6 +46,24 @@ PoseGraph known_subgraph(const PoseGraph& graph, const std::vector<bool>& known)
   for (std::size_t e = 0; e < graph.num_measurements(); ++e)
     if (known[e]) out.measurements.push_back(graph.measurements[e]);
   return out;
+}
+
+// sum over measurements of r^2 (known inliers) or min(r^2, c^2) (the others) at `poses`.
+double tls_cost(const PoseGraph& graph, const std::vector<bool>& known,
+                const std::vector<Pose>& poses, double c2) {
+  double f = 0;
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e) {
+    const Measurement& m = graph.measurements[e];
+    const double r2 = residual_squared(m, poses[m.i], poses[m.j]);
+    f += known[e] ? r2 : std::min(r2, c2);
+  }
+  return f;
+}
+
+double lifted_cost(const PoseGraph& graph, const Eigen::MatrixXd& X) {
+  double f = 0;
+  for (const Measurement& m : graph.measurements) f += lifted_residual_squared(m, X, graph.d);
+  return f;
 }
 
 std::vector<std::size_t> zero_weight(const std::vector<double>& weights) {
@@ -115,9 +134,20 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   // adjacency graph has fewer colours, so more agents update per round).
   const PoseGraph known_graph = known_subgraph(graph, known);
   const bool known_connected = count_components(known_graph) <= 1;
-  std::vector<Pose> start;
-  if (options.known_inlier_start && known_connected)
-    start = distributed_initialization(known_graph, inner.robots > 0 ? inner.robots : agents);
+  // Two candidate starts: the known inliers' initialization (it does not see the wrong
+  // closures, but drifts) and the solver's own (chordal fits every closure, wrong ones too;
+  // on clean data it is nearly the optimum). The one with the lower TLS cost (the robust
+  // objective: every rejectable term capped at c^2; a sum over the weight owners, one scalar
+  // vote each) is taken. Clean files then start where the plain solve starts, contaminated
+  // ones from the odometry.
+  const int robots = inner.robots > 0 ? inner.robots : agents;
+  std::vector<Pose> start = initial_poses(graph, inner.initialization, robots);
+  if (options.known_inlier_start && known_connected) {
+    std::vector<Pose> chains = distributed_initialization(known_graph, robots);
+    if (tls_cost(graph, known, chains, c2) < tls_cost(graph, known, start, c2))
+      start = std::move(chains);
+    out.total_bytes += vote_bytes;
+  }
   // Every solve before the final one is capped: GNC needs only a rough minimiser between two
   // weight updates, and the first (plain) solve only has to tell the wrong closures' residuals
   // from the right ones'. Misjudged measurements are re-admitted at the end.
@@ -169,7 +199,20 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   for (int pass = 0;; ++pass) {
     const PoseGraph inliers = inlier_graph(graph, out.rejected, {});
     require_connected_inliers(graph, inliers, out.rejected.size());
-    solve = solve_distributed_from_lifted(inliers, assignment, full, solve.X);
+    Eigen::MatrixXd X0 = solve.X;
+    if (pass == 0) {
+      // The capped solves leave the slow, long-range part of the error behind; on the inlier
+      // set (no wrong closures left) the solver's own initialization is usually far closer to
+      // the optimum. Both costs are a sum over the agents (one more scalar vote): the better
+      // start wins.
+      Eigen::MatrixXd guess =
+          lift_poses(initial_poses(inliers, options.solver.initialization,
+                                   options.solver.robots > 0 ? options.solver.robots : agents),
+                     static_cast<int>(X0.rows()));
+      if (lifted_cost(inliers, guess) < lifted_cost(inliers, X0)) X0 = std::move(guess);
+      out.total_bytes += vote_bytes;
+    }
+    solve = solve_distributed_from_lifted(inliers, assignment, full, X0);
     out.total_rounds += solve.rounds;
     out.total_bytes += solve.bytes_exchanged;
     if (pass == kMaxReadmissionPasses || out.rejected.empty()) break;

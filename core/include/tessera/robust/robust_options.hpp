@@ -52,7 +52,7 @@ struct RobustOptions {
   /// GNC needs only a rough minimiser between weight updates (dpgo's robust mode also updates
   /// weights after a fixed number of iterations); measurements misjudged on a rough iterate
   /// are re-admitted after the final solve of the inlier set, which runs to the tolerance.
-  /// 5: on the 1000-pose grid with 25 % random outliers, 156 rounds in all (4x the clean run)
+  /// 5: on the 1000-pose grid with 25 % random outliers, 152 rounds in all (3.9x the clean run)
   /// with the same rejected set as full inner solves (2388 rounds) (docs/robust.md, "Rounds").
   int inner_max_rounds = 5;
   KnownInliers known_inliers = KnownInliers::kOdometry;
