@@ -289,6 +289,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       part.adjacent_block_pairs = adjacency.adjacent_block_pairs;
       part.colours = adjacency.colours;
     }
+  if (robust.kind == RobustKind::kPcmGnc)
+    throw InputError("option --robust: pcm-gnc is centralized only (--algorithm centralized)");
   GncDistributedResult gnc;
   if (robust.kind == RobustKind::kGncTls)
     // Like the centralized robust solve: the known inliers' start unless --init is given.
@@ -407,6 +409,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       rs.rejected = gnc.rejected;
       rs.threshold_squared = gnc.threshold_squared;
       rs.weights_converged = gnc.weights_converged;
+      rs.readmitted = gnc.readmitted;
       add_robust_fields(j, rs);
       j.add("total_rounds", gnc.total_rounds)
           .add("total_bytes", static_cast<long long>(gnc.total_bytes));

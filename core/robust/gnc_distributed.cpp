@@ -34,9 +34,6 @@ double lifted_residual_squared(const Measurement& m, const Eigen::MatrixXd& X, i
          m.tau * (Xj.col(d) - Xi.col(d) - Yi * m.t).squaredNorm();
 }
 
-// Re-admission passes after the final solve (each one more solve of the inlier set).
-constexpr int kMaxReadmissionPasses = 3;
-
 // `graph` with only the measurements flagged in `known`.
 PoseGraph known_subgraph(const PoseGraph& graph, const std::vector<bool>& known) {
   PoseGraph out;
@@ -215,7 +212,7 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
     solve = solve_distributed_from_lifted(inliers, assignment, full, X0);
     out.total_rounds += solve.rounds;
     out.total_bytes += solve.bytes_exchanged;
-    if (pass == kMaxReadmissionPasses || out.rejected.empty()) break;
+    if (pass == robust.readmission_passes || out.rejected.empty()) break;
     std::vector<std::size_t> still;
     for (std::size_t e : out.rejected)
       if (lifted_residual_squared(graph.measurements[e], solve.X, graph.d) <= c2)
