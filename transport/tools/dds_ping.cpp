@@ -4,7 +4,7 @@
 //    (mutual discovery and every endpoint matched);
 //  - round trip: ping sends a pose block (kind P) of --poses poses of rank --rank in
 //    dimension --dim to echo, which sends it straight back; --count round trips.
-// Prints one line of key=value results (times in ms). Used by scripts/bench/dds_roundtrip.sh.
+// Prints one line of key=value results (times in ms). Used by scripts/bench/dds_transport.sh.
 
 #include <algorithm>
 #include <chrono>
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 #include "transport/signal_watcher.hpp"
 
 using namespace tessera;
@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   so.agent_id = pinger ? 0 : 1;
   so.num_agents = 2;
   so.expect_coordinator = false;
-  Session s(so);
+  AgentSession s(so);
   signals.start(
       [&s](int signo) { s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted"); });
   auto ms_since = [](std::chrono::steady_clock::time_point t) {
