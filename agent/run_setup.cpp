@@ -63,6 +63,7 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
     ro.robust.mu_step = asg.gnc_mu_step();
     ro.robust.inner_max_rounds = static_cast<int>(asg.gnc_inner_max_rounds());
     ro.robust.known_inliers = parse_known_inliers(asg.known_inliers());
+    ro.robust.readmission_passes = static_cast<int>(asg.gnc_readmission_passes());
     ro.robust.validate();
     ro.gnc_known_start = asg.gnc_known_start();
   }

@@ -114,9 +114,9 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     rs.rejected = r.robust->rejected;
     rs.threshold_squared = r.robust->threshold_squared;
     rs.weights_converged = r.robust->weights_converged;
+    rs.readmitted = r.robust->readmitted;
     cli::add_robust_fields(j, rs);
-    j.add("readmitted", r.robust->readmitted)
-        .add("total_rounds", static_cast<long long>(in.merged.rounds));
+    j.add("total_rounds", static_cast<long long>(in.merged.rounds));
   } else {
     j.add("robust", robust_kind_name(o.robust.kind));
   }

@@ -36,11 +36,16 @@ void check_partition_time(const std::string& v) {
 
 // The robust options are checked as RobustOptions checks them (the error names the field).
 void check_robust(const std::string& v) {
+  RobustKind kind;
   try {
-    parse_robust_kind(v);
+    kind = parse_robust_kind(v);
   } catch (const InputError& e) {
     throw InputError(std::string("option --robust: ") + e.what());
   }
+  if (kind == RobustKind::kPcmGnc)
+    throw InputError(
+        "option --robust: pcm-gnc is centralized only (tessera solve --algorithm "
+        "centralized); over DDS use gnc-tls");
 }
 void check_known_inliers(const std::string& v) {
   try {

@@ -67,11 +67,13 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
     throw std::invalid_argument("GncAgent: one known-inlier flag per measurement expected");
   if (!std::is_sorted(in_.measurement_index.begin(), in_.measurement_index.end()))
     throw std::invalid_argument("GncAgent: measurements must be in file order");
-  if (options_.robust.max_outer_iterations + kMaxReadmissionPasses + 3 >
-      static_cast<int>(kMaxGncSteps))
-    throw InputError("RobustOptions.max_outer_iterations must be <= " +
-                     std::to_string(kMaxGncSteps - kMaxReadmissionPasses - 3) +
-                     " for the distributed solve");
+  // Every solve is a GNC step of the phase field: the first, the weighted ones, the passes and
+  // the final one.
+  if (static_cast<long long>(options_.robust.max_outer_iterations) +
+          options_.robust.readmission_passes + 3 >
+      static_cast<long long>(kMaxGncSteps))
+    throw InputError("RobustOptions.max_outer_iterations + readmission_passes must be <= " +
+                     std::to_string(kMaxGncSteps - 3) + " for the distributed solve");
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   layout_ = std::make_unique<BlockLayout>(*base_);
   // Every agent knows every measurement's known-inlier status (rule + flags), hence how many may
@@ -108,21 +110,54 @@ bool GncAgent::may_reject(std::size_t k) const {
 }
 
 // The measurement's term of the relaxed objective at the current lifted iterate: the own
-// block's columns and the neighbours' public poses just received.
+// block's columns and the neighbours' public poses just received (or at another such pair).
 double GncAgent::residual_squared_at(std::size_t k) const {
+  return residual_squared_at(k, state_->Y, neighbours_);
+}
+
+double GncAgent::residual_squared_at(std::size_t k, const Eigen::MatrixXd& own_block,
+                                     const Eigen::MatrixXd& neighbour_block) const {
   const Measurement& m = in_.measurements[k];
   const Eigen::Index w = in_.d + 1;
   const auto& own = base_->poses[static_cast<std::size_t>(in_.id)];
   auto block = [&](std::size_t p) -> Eigen::MatrixXd {
     if (in_.owner[p] == in_.id) {
       const auto s = std::lower_bound(own.begin(), own.end(), p) - own.begin();
-      return state_->Y.middleCols(w * s, w);
+      return own_block.middleCols(w * s, w);
     }
     const auto s = std::lower_bound(base_neighbours_.begin(), base_neighbours_.end(), p) -
                    base_neighbours_.begin();
-    return neighbours_.middleCols(w * s, w);
+    return neighbour_block.middleCols(w * s, w);
   };
   return lifted_residual_squared(m, block(m.i), block(m.j));
+}
+
+void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
+                       std::vector<OutgoingMessage>& out) {
+  const auto me = static_cast<std::uint32_t>(in_.id);
+  const Eigen::Index w = (in_.d + 1) * Y.rows();
+  const auto& own = base_->poses[me];
+  const auto& adjacent = base_->adjacent[me];
+  for (std::size_t q = 0; q < adjacent.size(); ++q) {
+    PoseBlockMessage b;
+    b.sender = me;
+    b.phase = phase;
+    b.kind = kind;
+    b.rank = static_cast<std::uint32_t>(Y.rows());
+    b.dim = static_cast<std::uint32_t>(in_.d);
+    const auto& ids = base_->public_to[me][q];
+    b.data.resize(ids.size() * static_cast<std::size_t>(w));
+    double* to = b.data.data();
+    for (std::size_t id : ids) {
+      const auto s = std::lower_bound(own.begin(), own.end(), id) - own.begin();
+      b.pose_ids.push_back(static_cast<std::uint32_t>(id));
+      std::memcpy(to, Y.data() + w * s, sizeof(double) * static_cast<std::size_t>(w));
+      to += w;
+    }
+    const auto to_agent = static_cast<std::uint32_t>(adjacent[q]);
+    out.push_back(OutgoingMessage{std::move(b), false, {to_agent}});
+    waiting_.push_back(to_agent);  // one message from that neighbour per message sent
+  }
 }
 
 void GncAgent::weights_at_mu(double mu) {
@@ -195,6 +230,10 @@ std::uint32_t GncAgent::exchange_phase() const {
       return gnc_phase(g_, GncExchange::kRejected);
     case Step::kReadmitted:
       return gnc_phase(g_, GncExchange::kReadmitted);
+    case Step::kCandidatePoses:
+      return gnc_phase(g_, GncExchange::kCandidatePoses);
+    case Step::kCandidateVotes:
+      return gnc_phase(g_, GncExchange::kCandidateVotes);
     default:
       return 0;
   }
@@ -223,35 +262,35 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     }
   };
   switch (step) {
-    case Step::kPoses: {
+    case Step::kPoses:
       // Weights are computed at the iterate itself: the owners' public poses of every
       // measurement (the base layout: a measurement out of the current solve still needs
       // its residual).
-      const Eigen::Index w = (in_.d + 1) * state_->Y.rows();
       neighbours_ = Eigen::MatrixXd::Zero(
           state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
-      const auto& own = base_->poses[me];
-      const auto& adjacent = base_->adjacent[me];
-      for (std::size_t q = 0; q < adjacent.size(); ++q) {
-        PoseBlockMessage b;
-        b.sender = me;
-        b.phase = phase;
-        b.kind = BlockKind::kY;
-        b.rank = static_cast<std::uint32_t>(state_->Y.rows());
-        b.dim = static_cast<std::uint32_t>(in_.d);
-        const auto& ids = base_->public_to[me][q];
-        b.data.resize(ids.size() * static_cast<std::size_t>(w));
-        double* to = b.data.data();
-        for (std::size_t id : ids) {
-          const auto s = std::lower_bound(own.begin(), own.end(), id) - own.begin();
-          b.pose_ids.push_back(static_cast<std::uint32_t>(id));
-          std::memcpy(to, state_->Y.data() + w * s, sizeof(double) * static_cast<std::size_t>(w));
-          to += w;
+      publish(state_->Y, BlockKind::kY, phase, out);
+      break;
+    case Step::kCandidatePoses:
+      // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
+      neighbours_ = Eigen::MatrixXd::Zero(
+          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
+      candidate_neighbours_ = neighbours_;
+      publish(state_->Y, BlockKind::kY, phase, out);
+      publish(candidate_, BlockKind::kP, phase, out);
+      break;
+    case Step::kCandidateVotes: {
+      // Each kept measurement's cost at both starts, summed by its weight owner.
+      double at_iterate = 0, at_candidate = 0;
+      for (std::size_t k : owned_)
+        if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
+          at_iterate += residual_squared_at(k);
+          at_candidate += residual_squared_at(k, candidate_, candidate_neighbours_);
         }
-        const auto to_agent = static_cast<std::uint32_t>(adjacent[q]);
-        out.push_back(OutgoingMessage{std::move(b), false, {to_agent}});
-        waiting_.push_back(to_agent);
-      }
+      votes_[me] = {at_iterate, at_candidate};
+      RoundStatusMessage st;
+      st.cost = at_iterate;
+      st.grad_norm_sq = at_candidate;
+      to_others(st, true, nullptr);
       break;
     }
     case Step::kVotes: {
@@ -374,7 +413,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
   }
   gnc_rounds_ += solve_->total_rounds();
   if (solve_kind_ == Solve::kInlierPass) {
-    if (pass_ == kMaxReadmissionPasses || rejected_.empty()) {
+    if (pass_ >= options_.robust.readmission_passes || rejected_.empty()) {
       finish(out);
       return;
     }
@@ -428,8 +467,28 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     }
     case Step::kRejected:
       std::sort(rejected_.begin(), rejected_.end());
+      if (in_.inlier_start) {
+        candidate_ = in_.inlier_start(rejected_, static_cast<int>(state_->Y.rows()));
+        begin_exchange(Step::kCandidatePoses, out);
+        return;
+      }
       begin_inlier_pass(out);
       return;
+    case Step::kCandidatePoses:
+      begin_exchange(Step::kCandidateVotes, out);
+      return;
+    case Step::kCandidateVotes: {
+      double at_iterate = 0, at_candidate = 0;
+      for (const auto& [sender, v] : votes_) {  // agent-id order
+        at_iterate += v.first;
+        at_candidate += v.second;
+      }
+      if (at_candidate < at_iterate) state_->Y = candidate_;
+      candidate_.resize(0, 0);
+      candidate_neighbours_.resize(0, 0);
+      begin_inlier_pass(out);
+      return;
+    }
     case Step::kReadmitted: {
       ++pass_;
       if (taken_back_.empty()) {
@@ -472,7 +531,7 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     throw std::runtime_error(me + "unexpected robust message " + std::to_string(phase) +
                              " from agent " + std::to_string(sender));
   waiting_.erase(it);
-  if (step_ == Step::kPoses) {
+  if (step_ == Step::kPoses || step_ == Step::kCandidatePoses) {
     const auto* block = std::get_if<PoseBlockMessage>(&message);
     const Eigen::Index w = (in_.d + 1) * neighbours_.rows();
     if (!block || block->rank != static_cast<std::uint32_t>(neighbours_.rows()) ||
@@ -485,7 +544,8 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
       if (s == base_neighbours_.end() || *s != p)
         throw std::runtime_error(me + "pose " + std::to_string(p) + " from agent " +
                                  std::to_string(sender) + " is not a neighbour");
-      std::memcpy(neighbours_.data() + w * (s - base_neighbours_.begin()),
+      Eigen::MatrixXd& into = block->kind == BlockKind::kP ? candidate_neighbours_ : neighbours_;
+      std::memcpy(into.data() + w * (s - base_neighbours_.begin()),
                   block->data.data() + w * static_cast<Eigen::Index>(q),
                   sizeof(double) * static_cast<std::size_t>(w));
     }
@@ -493,6 +553,7 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     const auto* st = std::get_if<RoundStatusMessage>(&message);
     if (!st) throw std::runtime_error(me + "poses where a robust status belongs");
     if (step_ == Step::kVotes) votes_[sender] = {st->cost, 0};
+    if (step_ == Step::kCandidateVotes) votes_[sender] = {st->cost, st->grad_norm_sq};
     if (step_ == Step::kWeights) {
       votes_[sender] = {st->grad_norm_sq, 0};
       if (st->weights.size() != st->measurement_ids.size())
@@ -580,6 +641,7 @@ std::optional<AwaitedMessages> GncAgent::awaited() const {
   }
   std::vector<std::uint32_t> senders = waiting_;
   std::sort(senders.begin(), senders.end());
+  senders.erase(std::unique(senders.begin(), senders.end()), senders.end());
   return AwaitedMessages{0, exchange_phase(), senders};
 }
 

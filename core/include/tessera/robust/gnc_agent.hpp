@@ -16,7 +16,10 @@
 //     solve k (weighted, warm-started)
 //     poses  -> neighbours (when another step follows)
 //   rejected -> every agent: the measurements it owns with weight < 0.5
-//   inlier pass p = 0.. 3: solve of the kept set to the solver's tolerance (uncertified);
+//   [with GncAgentInput::inlier_start: poses of the iterate and of the other start, then a vote
+//    on their costs over the kept set; the first pass starts from the cheaper]
+//   inlier pass p = 0.. readmission_passes: solve of the kept set to the solver's tolerance
+//   (uncertified);
 //     poses, then readmitted -> every agent: its rejected measurements within the bound at
 //     that solution (misjudged on a rough iterate); none anywhere ends the passes
 //   final: with certification, the certified solve of the kept set
@@ -44,9 +47,6 @@
 
 namespace tessera {
 
-/// Re-admission passes after the GNC loop (each one more solve of the kept set).
-constexpr int kMaxReadmissionPasses = 3;
-
 /// Phases of GNC step g (0 = first solve, k = k-th weighted solve, then the inlier passes and
 /// the final solve):
 /// g * kGncStepStride + the inner solve's stage-tagged phase (stage_tag.hpp), or + the GNC
@@ -60,7 +60,9 @@ enum class GncExchange : std::uint32_t {
   kVotes = 2,
   kWeights = 3,
   kRejected = 4,
-  kReadmitted = 5
+  kReadmitted = 5,
+  kCandidatePoses = 6,
+  kCandidateVotes = 7
 };
 inline std::uint32_t gnc_phase(std::uint32_t step, GncExchange e) {
   return step * kGncStepStride + kGncExchangeBase + static_cast<std::uint32_t>(e);
@@ -85,6 +87,11 @@ struct GncAgentInput {
   /// down-weighted (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier;
   Eigen::MatrixXd Y0;  ///< Own block's lifted start, r x (d+1)m, ascending pose ids.
+  /// Optional: the own block of another start for the first inlier pass (the solver's own
+  /// initialization of the kept set, lifted to `rank`), given the rejected measurements. The
+  /// pass then starts from whichever of it and the GNC iterate has the lower cost over the
+  /// kept set (a vote). Empty: the GNC iterate (the DDS agents have no such stage yet).
+  std::function<Eigen::MatrixXd(const std::vector<std::uint64_t>& rejected, int rank)> inlier_start;
 };
 
 class GncAgent : public AgentProcess {
@@ -137,7 +144,17 @@ class GncAgent : public AgentProcess {
   const std::vector<std::uint64_t>& kept_index() const { return kept_index_; }
 
  private:
-  enum class Step { kSolve, kPoses, kVotes, kWeights, kRejected, kReadmitted, kDone };
+  enum class Step {
+    kSolve,
+    kPoses,
+    kVotes,
+    kWeights,
+    kRejected,
+    kReadmitted,
+    kCandidatePoses,
+    kCandidateVotes,
+    kDone
+  };
   enum class Solve { kGnc, kInlierPass, kFinal };
   void begin_solve(std::vector<OutgoingMessage>& out);
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
@@ -148,6 +165,10 @@ class GncAgent : public AgentProcess {
   std::uint32_t exchange_phase() const;
   bool in_current_solve(std::uint32_t phase) const;
   double residual_squared_at(std::size_t k) const;
+  double residual_squared_at(std::size_t k, const Eigen::MatrixXd& own,
+                             const Eigen::MatrixXd& neighbours) const;
+  void publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
+               std::vector<OutgoingMessage>& out);
   bool may_reject(std::size_t k) const;
   void weights_at_mu(double mu);
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
@@ -173,10 +194,11 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<BlockLayout> base_;         // of every measurement: whose poses go where
   std::vector<std::size_t> base_neighbours_;  // other ends of the own measurements, ascending
   Eigen::MatrixXd last_pass_start_;
-  std::vector<std::uint32_t> waiting_;  // senders the current exchange still lacks
-  std::vector<std::size_t> owned_;      // indices (into in_.measurements) this agent weighs
-  std::vector<double> weights_;         // per in_.measurements
-  Eigen::MatrixXd neighbours_;          // neighbours' public poses of the current iterate
+  Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
+  std::vector<std::uint32_t> waiting_;                // senders the current exchange still lacks
+  std::vector<std::size_t> owned_;  // indices (into in_.measurements) this agent weighs
+  std::vector<double> weights_;     // per in_.measurements
+  Eigen::MatrixXd neighbours_;      // neighbours' public poses of the current iterate
   std::map<std::uint32_t, std::vector<ProtocolMessage>> later_;  // by phase
   // Sums of the current exchange (in agent-id order: own and received values kept by sender).
   std::map<std::uint32_t, std::pair<double, double>> votes_;

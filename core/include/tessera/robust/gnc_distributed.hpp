@@ -26,18 +26,25 @@ struct GncDistributedOptions {
   /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
   /// rule's measurements (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier_flags;
-  /// Start from the distributed initialization of the known inliers alone (with the default
-  /// rule: each robot's odometry chain, robots joined by their consecutive-id links), like the
-  /// centralized robust solve starts from the odometry; solver.initialization is then unused.
-  /// A chordal start fits every measurement, outliers included, and the plain solve from
-  /// there settles in a distorted solution that costs many rounds and can make true closures
-  /// look wrong. When the known inliers do not connect the poses, solver.initialization is used.
+  /// Consider the distributed initialization of the known inliers alone (with the default
+  /// rule: each robot's odometry chain, robots joined by their consecutive-id links) as the
+  /// start besides solver.initialization, and take the one with the lower TLS cost. A chordal
+  /// start fits every measurement, outliers included, and the plain solve from there settles
+  /// in a distorted solution that costs many rounds and can make true closures look wrong; on
+  /// clean data it is nearly the optimum. Unused when the known inliers do not connect the
+  /// poses; false: always solver.initialization.
   bool known_inlier_start = true;
   /// Optional: called after every weight exchange with (agent, outer step, that agent's
   /// measurements by file position, the weights it uses for them); tests compare the two ends
   /// of every cut measurement with it.
   std::function<void(int, int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
       weight_observer;
+  /// With known_inlier_start: compare the two starts' TLS costs (false: the known inliers'
+  /// whenever they connect the poses, what the DDS agents do: they compute one initialization).
+  bool start_vote = true;
+  /// The first inlier pass may start from the solver's initialization of the kept set when that
+  /// costs less (GncAgentInput::inlier_start; false: from the GNC iterate, as over DDS).
+  bool inlier_set_start = true;
   void validate() const;  ///< Throws InputError naming the first bad field.
 };
 
