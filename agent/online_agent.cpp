@@ -8,6 +8,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <set>
 #include <stdexcept>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
@@ -52,6 +53,7 @@ options:
   --no-certify        no certificate at the end
   --timeout S         give up when a peer sends nothing for S seconds [120]
   --json FILE         write this agent's summary (agent 0's has the final answer)
+  --verbose           print each epoch (members, what entered, solve or idle)
   --help              this text
 
 exit codes: 0 done, 1 the run failed (a peer went silent), 2 bad options or input.
@@ -74,13 +76,14 @@ struct Options {
   OnlineOptions online;
   double timeout_s = 120.0;
   std::string json;
+  bool verbose = false;
 };
 
 Options parse(const std::vector<std::string>& argv) {
   const cli::Arguments args(argv,
                             {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol",
                              "max-rounds", "timeout", "json"},
-                            {"online", "no-certify", "help"});
+                            {"online", "no-certify", "verbose", "help"});
   Options o;
   const auto run_id = args.get("run-id");
   if (!run_id) throw InputError("option --run-id ID is required (see --help)");
@@ -105,6 +108,7 @@ Options parse(const std::vector<std::string>& argv) {
   o.timeout_s = args.get_double("timeout", 120.0);
   if (!(o.timeout_s > 0)) throw InputError("option --timeout: must be > 0");
   o.json = args.get_or("json", "");
+  o.verbose = args.has("verbose");
   o.online.validate();
   return o;
 }
@@ -141,6 +145,10 @@ class OnlineAgent {
   void pump_stream();
   void pump_channel();
   void wait_for_reports();
+  bool reports_complete();
+  void wait_matched(std::size_t peers);
+  /// The agents that take part in the current epoch (agent 0's previous report says so).
+  const std::set<std::uint32_t>& members() const;
   SolveOutcome solve(bool certify);
   void send(const std::vector<OutgoingMessage>& out, std::uint32_t epoch);
   void write_json(bool lead_result);
@@ -157,6 +165,8 @@ class OnlineAgent {
   std::vector<double> own_data_;
   int own_rank_ = 0;
   std::map<std::uint32_t, std::map<std::uint32_t, transport::OnlineReportSample>> reports_;
+  std::map<std::uint32_t, std::set<std::uint32_t>> members_{{0, {0}}};
+  std::set<std::uint32_t> seen_;  // agents heard from (hello or report)
   std::vector<transport::OnlineProtocolSample> pending_;
   std::map<std::pair<std::uint32_t, std::uint64_t>, double> received_at_;
   // Figures.
@@ -184,25 +194,54 @@ void OnlineAgent::pump_stream() {
 }
 
 void OnlineAgent::pump_channel() {
-  for (auto& r : channel_.take_reports()) reports_[r.epoch][r.sender] = std::move(r);
+  for (auto& r : channel_.take_reports()) {
+    if (r.sender < static_cast<std::uint32_t>(o_.robots)) seen_.insert(r.sender);
+    if (r.epoch == transport::kHelloEpoch) continue;
+    if (r.sender == 0)
+      members_[r.epoch + 1] = std::set<std::uint32_t>(r.next_members.begin(), r.next_members.end());
+    if (r.epoch >= epoch_) reports_[r.epoch][r.sender] = std::move(r);
+  }
   for (auto& m : channel_.take_messages())
     if (m.epoch >= epoch_) pending_.push_back(std::move(m));
 }
 
+const std::set<std::uint32_t>& OnlineAgent::members() const {
+  return members_.at(epoch_);
+}
+
+bool OnlineAgent::reports_complete() {
+  const auto& have = reports_[epoch_];
+  for (std::uint32_t m : members())
+    if (have.count(m) == 0) return false;
+  return true;
+}
+
 void OnlineAgent::wait_for_reports() {
+  // The timeout runs once the epoch began (some report of it arrived): a joiner may wait for
+  // the next epoch as long as the members idle.
   auto last_progress = Clock::now();
   std::size_t have = 0;
-  while (reports_[epoch_].size() < static_cast<std::size_t>(o_.robots)) {
-    channel_.wait(0.02);
+  while (!reports_complete()) {
+    channel_.wait(0.05);
     pump_channel();
     pump_stream();
     if (reports_[epoch_].size() != have) {
       have = reports_[epoch_].size();
       last_progress = Clock::now();
-    } else if (since(last_progress) > o_.timeout_s) {
+    } else if (have > 0 && since(last_progress) > o_.timeout_s) {
       silent_peer("epoch " + std::to_string(epoch_) + " reports incomplete (" +
-                  std::to_string(have) + " of " + std::to_string(o_.robots) + ")");
+                  std::to_string(have) + " of " + std::to_string(members().size()) + ")");
     }
+  }
+}
+
+void OnlineAgent::wait_matched(std::size_t peers) {
+  const auto start = Clock::now();
+  while (channel_.matched_peers() < static_cast<int>(peers)) {
+    if (since(start) > o_.timeout_s) silent_peer("peers not all matched");
+    channel_.wait(0.01);
+    pump_channel();
+    pump_stream();
   }
 }
 
@@ -286,73 +325,128 @@ SolveOutcome OnlineAgent::solve(bool certify) {
 }
 
 int OnlineAgent::run() {
-  // Every agent's endpoints matched before the first protocol message (volatile topics).
-  const auto match_start = Clock::now();
-  while (channel_.matched_readers() < o_.robots) {
-    if (since(match_start) > o_.timeout_s) silent_peer("peers not all discovered");
-    pump_stream();
-    channel_.wait(0.02);
+  const auto me = static_cast<std::uint32_t>(o_.id);
+  // Membership: agent 0 starts alone (epoch 0) and admits every agent it has heard from at
+  // the next epoch boundary (its report's next_members), so the run needs no start barrier
+  // and an agent started late is taken in the same way. A joiner first follows the epochs it
+  // missed from the reports (kept for late readers): the same entered batches and block
+  // poses give it the members' graph and estimate.
+  if (me != 0) {
+    transport::OnlineReportSample hello;
+    hello.epoch = transport::kHelloEpoch;
+    hello.sender = me;
+    report_bytes_ += channel_.send_report(hello);
   }
   bool finishing = false;
   for (;;) {
     pump_stream();
-    transport::OnlineReportSample mine;
-    mine.epoch = epoch_;
-    mine.sender = static_cast<std::uint32_t>(o_.id);
-    mine.held = view_.held();
-    mine.converged = converged_;
-    mine.rank = own_rank_;
-    mine.dim = view_.dim();
-    mine.pose_ids = own_ids_;
-    mine.data = own_data_;
-    report_bytes_ += channel_.send_report(mine);
+    pump_channel();
+    const bool member = members().count(me) > 0;
+    if (member) {
+      wait_matched(members().size());
+      transport::OnlineReportSample mine;
+      mine.epoch = epoch_;
+      mine.sender = me;
+      mine.held = view_.held();
+      mine.converged = converged_;
+      mine.rank = own_rank_;
+      mine.dim = view_.dim();
+      mine.pose_ids = own_ids_;
+      mine.data = own_data_;
+      if (me == 0) {
+        std::set<std::uint32_t> next = members();
+        next.insert(seen_.begin(), seen_.end());
+        mine.next_members.assign(next.begin(), next.end());
+      }
+      report_bytes_ += channel_.send_report(mine);
+    }
     wait_for_reports();
     std::vector<Watermarks> held;
+    bool all_converged = true;
     for (const auto& [sender, r] : reports_[epoch_]) {
-      if (sender != static_cast<std::uint32_t>(o_.id) && r.dim != 0 && view_.dim() != 0)
+      if (members().count(sender) == 0) continue;
+      if (sender != me && r.dim != 0) {
+        if (view_.dim() == 0) pump_stream();  // the block's graph must be there first
         view_.apply_block(r.pose_ids, r.data, r.rank);
+      }
       held.push_back(r.held);
+      all_converged = all_converged && r.converged;
     }
+    converged_ = all_converged;
     if (finishing) break;  // every block's final poses are in
     AbsorbGate gate;
-    const Watermarks decision = gate.decide(held);
+    Watermarks decision = gate.decide(held);
+    // Only the members' robots: a robot's data waits for its agent.
+    for (auto& [robot, count] : decision)
+      if (members().count(robot) == 0) count = 0;
+    // The members hold what they decided; a joiner following missed epochs may not yet.
+    for (;;) {
+      bool have_all = true;
+      const Watermarks mine = view_.held();
+      for (const auto& [robot, count] : decision) {
+        auto it = mine.find(robot);
+        if (count > (it == mine.end() ? 0 : it->second)) have_all = false;
+      }
+      if (have_all) break;
+      pump_stream();
+      channel_.wait(0.01);
+    }
     const double step_start = since(start_);
     const double cpu_start = cpu_now();
     const runtime::EnteredData in = view_.enter(decision);
     const bool changed = in.poses > 0 || in.measurements > 0;
+    if (o_.verbose) {
+      std::string who;
+      for (std::uint32_t m : members()) who += " " + std::to_string(m);
+      std::fprintf(stderr, "agent %d: epoch %u members%s: +%zu poses +%zu measurements%s%s\n",
+                   o_.id, epoch_, who.c_str(), in.poses, in.measurements,
+                   member ? "" : " (following)", converged_ ? " converged" : "");
+    }
     reports_.erase(epoch_);
     if (view_.stream_over()) {
-      final_ = solve(o_.online.certify_at_end);
+      if (member) final_ = solve(o_.online.certify_at_end);
+      if (o_.verbose)
+        std::fprintf(stderr, "agent %d: final solve: %d rounds, certified %s\n", o_.id,
+                     final_.rounds, final_.certified.value_or(false) ? "yes" : "no");
       cpu_s_ += cpu_now() - cpu_start;
       finishing = true;
       ++epoch_;
       continue;
     }
+    if (!member) {
+      ++epoch_;
+      continue;
+    }
     if (!changed && converged_) {
-      // Idle: a blocking wait for new data (ours, or another agent's next report); nothing is
-      // sent meanwhile.
+      // Idle: a blocking wait for new data (ours, another agent's next report, or a hello
+      // for agent 0 to admit); nothing is sent meanwhile.
       ++idle_waits_;
-      const std::uint64_t sent_before = messages_sent_;
-      auto idle_start = Clock::now();
       for (;;) {
         pump_stream();
+        pump_channel();
         const Watermarks now = view_.held();
         bool more = false;
         for (const auto& [robot, count] : now) {
           auto it = decision.find(robot);
-          if (count > (it == decision.end() ? 0 : it->second)) more = true;
+          if (members().count(robot) > 0 && count > (it == decision.end() ? 0 : it->second))
+            more = true;
         }
-        pump_channel();
-        if (more || reports_.count(epoch_ + 1) > 0) break;
-        if (since(idle_start) > o_.timeout_s) silent_peer("no new data and no peer report");
+        bool joiner = false;
+        if (me == 0)
+          for (std::uint32_t a : seen_) joiner = joiner || members().count(a) == 0;
+        if (more || joiner || reports_.count(epoch_ + 1) > 0) break;
         channel_.wait(0.05);
       }
-      idle_messages_ += messages_sent_ - sent_before;
       ++epoch_;
       continue;
     }
+    const std::uint64_t messages_before = messages_sent_;
     const SolveOutcome s = solve(false);
+    if (o_.verbose)
+      std::fprintf(stderr, "agent %d: solve: %d rounds, gradient norm %g (%s)\n", o_.id, s.rounds,
+                   s.grad_norm, s.stop_reason.c_str());
     converged_ = s.grad_norm <= o_.online.solver.grad_norm_tol || s.stop_reason == "stalled";
+    if (s.rounds == 0 && !changed) idle_messages_ += messages_sent_ - messages_before;
     const double step_end = since(start_);
     cpu_s_ += cpu_now() - cpu_start;
     rounds_ += s.rounds;
@@ -375,7 +469,7 @@ int OnlineAgent::run() {
         .add("measurements", in.measurements)
         .add("total_poses", g.graph().num_poses)
         .add("total_measurements", g.graph().measurements.size())
-        .add("agents", static_cast<long long>(g.robots().size()))
+        .add("agents", static_cast<long long>(members().size()))
         .add("moved", in.moved)
         .add("largest_block", in.largest_block)
         .add("rounds", s.rounds)

@@ -1,5 +1,6 @@
 #include "transport/online_channel.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -26,6 +27,11 @@ namespace tessera::transport {
 namespace dds = eprosima::fastdds::dds;
 using eprosima::fastrtps::Duration_t;
 using eprosima::fastrtps::types::ReturnCode_t;
+
+namespace {
+// Reports kept per agent for joiners: one per epoch boundary.
+constexpr std::int32_t kReportHistory = 100000;
+}  // namespace
 
 struct OnlineChannel::Impl : public dds::DataReaderListener {
   std::string run_id;
@@ -70,6 +76,17 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       wq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
       dds::DataReaderQos rq = reader_qos(transient, 10.0, agents, net, false);
       rq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+      if (transient) {
+        // Every report of the run stays with its writer (acknowledged or not): a joiner
+        // follows the epochs it missed from them.
+        wq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+        wq.history().depth = kReportHistory;
+        wq.resource_limits().max_samples = kReportHistory;
+        wq.resource_limits().max_samples_per_instance = kReportHistory;
+        rq.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+        rq.resource_limits().max_samples = kReportHistory;
+        rq.resource_limits().max_samples_per_instance = kReportHistory;
+      }
       writer = publisher->create_datawriter(topic, wq);
       reader = subscriber->create_datareader(topic, rq, this);
       if (!writer || !reader)
@@ -131,6 +148,7 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   w.dim(static_cast<std::uint32_t>(r.dim));
   w.pose_ids(r.pose_ids);
   w.data(r.data);
+  w.next_members(r.next_members);
   if (!impl_->report_writer->write(&w))
     throw std::runtime_error("online channel: a report write failed");
   return serialized_size(w);
@@ -163,6 +181,7 @@ std::vector<OnlineReportSample> OnlineChannel::take_reports() {
     r.dim = static_cast<int>(w.dim());
     r.pose_ids = w.pose_ids();
     r.data = w.data();
+    r.next_members = w.next_members();
     out.push_back(std::move(r));
   }
   return out;
@@ -188,11 +207,16 @@ std::vector<OnlineProtocolSample> OnlineChannel::take_messages() {
   return out;
 }
 
-int OnlineChannel::matched_readers() const {
+int OnlineChannel::matched_peers() const {
   int fewest = 1 << 30;
-  for (auto* w : {impl_->block_writer, impl_->status_writer, impl_->report_writer}) {
+  for (auto* w : {impl_->block_writer, impl_->status_writer}) {
     dds::PublicationMatchedStatus s;
     w->get_publication_matched_status(s);
+    fewest = std::min(fewest, s.current_count);
+  }
+  for (auto* r : {impl_->block_reader, impl_->status_reader}) {
+    dds::SubscriptionMatchedStatus s;
+    r->get_subscription_matched_status(s);
     fewest = std::min(fewest, s.current_count);
   }
   return fewest;

@@ -26,7 +26,12 @@ struct OnlineReportSample {
   int rank = 0, dim = 0;
   std::vector<std::uint32_t> pose_ids;
   std::vector<double> data;  ///< r*(d+1) per pose, column-major.
+  /// Agent 0's reports: the agents that take part in the next epoch (joiners admitted).
+  std::vector<std::uint32_t> next_members;
 };
+
+/// The epoch of a hello: an agent that is not a member yet asks to join.
+inline constexpr std::uint32_t kHelloEpoch = 0xFFFFFFFFu;
 
 /// A protocol message as received, with its routing (ids are the epoch's protocol ids).
 struct OnlineProtocolSample {
@@ -54,8 +59,9 @@ class OnlineChannel {
   bool wait(double timeout_s);
   std::vector<OnlineReportSample> take_reports();
   std::vector<OnlineProtocolSample> take_messages();
-  /// Fewest readers matched by any of this agent's writers (its own included).
-  int matched_readers() const;
+  /// Fewest peers matched by any of this agent's protocol writers and readers (itself
+  /// included): a message is delivered reliably to a reader its writer has matched.
+  int matched_peers() const;
   /// Waits until every matched reader acknowledged what was sent, at most `timeout_s`.
   void flush(double timeout_s);
 
