@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -14,6 +15,7 @@
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/certified_agent.hpp>
 #include <tessera/graph/connectivity.hpp>
+#include <tessera/io/tum_writer.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
 #include <tessera/util/input_error.hpp>
@@ -53,6 +55,13 @@ options:
   --no-certify        no certificate at the end
   --timeout S         give up when a peer sends nothing for S seconds [120]
   --json FILE         write this agent's summary (agent 0's has the final answer)
+  --certify-every S   also certify the graph received so far every S seconds (agent 0's
+                      clock; at the next epoch that brought data, once the graph is
+                      connected; no staircase climb)                  [0 = off]
+  --publish-every S   publish this robot's current estimate (rounded to SE(d)) on topic
+                      tessera_online_estimate every S seconds, and at the end [0 = off]
+  --tum-dir DIR       write DIR/robot<I>.tum (TUM, timestamp = pose index) at every
+                      publication and at the end
   --verbose           print each epoch (members, what entered, solve or idle)
   --help              this text
 
@@ -77,13 +86,17 @@ struct Options {
   double timeout_s = 120.0;
   std::string json;
   bool verbose = false;
+  double certify_every_s = 0.0;
+  double publish_every_s = 0.0;
+  std::string tum_dir;
 };
 
 Options parse(const std::vector<std::string>& argv) {
-  const cli::Arguments args(argv,
-                            {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol",
-                             "max-rounds", "timeout", "json"},
-                            {"online", "no-certify", "verbose", "help"});
+  const cli::Arguments args(
+      argv,
+      {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol", "max-rounds", "timeout",
+       "json", "certify-every", "publish-every", "tum-dir"},
+      {"online", "no-certify", "verbose", "help"});
   Options o;
   const auto run_id = args.get("run-id");
   if (!run_id) throw InputError("option --run-id ID is required (see --help)");
@@ -109,6 +122,11 @@ Options parse(const std::vector<std::string>& argv) {
   if (!(o.timeout_s > 0)) throw InputError("option --timeout: must be > 0");
   o.json = args.get_or("json", "");
   o.verbose = args.has("verbose");
+  o.certify_every_s = args.get_double("certify-every", 0.0);
+  if (!(o.certify_every_s >= 0)) throw InputError("option --certify-every: must be >= 0");
+  o.publish_every_s = args.get_double("publish-every", 0.0);
+  if (!(o.publish_every_s >= 0)) throw InputError("option --publish-every: must be >= 0");
+  o.tum_dir = args.get_or("tum-dir", "");
   o.online.validate();
   return o;
 }
@@ -149,7 +167,8 @@ class OnlineAgent {
   void wait_matched(std::size_t peers);
   /// The agents that take part in the current epoch (agent 0's previous report says so).
   const std::set<std::uint32_t>& members() const;
-  SolveOutcome solve(bool certify);
+  SolveOutcome solve(bool certify, bool climb = true);
+  void publish_estimate();
   void send(const std::vector<OutgoingMessage>& out, std::uint32_t epoch);
   void write_json(bool lead_result);
   [[noreturn]] void silent_peer(const std::string& what) const;
@@ -167,6 +186,10 @@ class OnlineAgent {
   std::map<std::uint32_t, std::map<std::uint32_t, transport::OnlineReportSample>> reports_;
   std::map<std::uint32_t, std::set<std::uint32_t>> members_{{0, {0}}};
   std::set<std::uint32_t> seen_;  // agents heard from (hello or report)
+  double next_certificate_ = 0.0, last_publish_ = -1e300;
+  bool changed_since_certificate_ = false;
+  std::vector<cli::JsonObject> certificates_;
+  std::size_t publications_ = 0;
   std::vector<transport::OnlineProtocolSample> pending_;
   std::map<std::pair<std::uint32_t, std::uint64_t>, double> received_at_;
   // Figures.
@@ -252,7 +275,7 @@ void OnlineAgent::send(const std::vector<OutgoingMessage>& out, std::uint32_t ep
   }
 }
 
-SolveOutcome OnlineAgent::solve(bool certify) {
+SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
   SolveOutcome out;
   const LinkedProblem p = view_.problem();
   const int c = p.compact_block(view_.own_block());
@@ -262,6 +285,9 @@ SolveOutcome OnlineAgent::solve(bool certify) {
   DistributedOptions solver = o_.online.solver;
   solver.certify = certify;
   solver.round_result = false;
+  // A certificate while the graph grows does not climb the staircase: the iterate keeps its
+  // rank for the next data (a saddle is reported as not certified).
+  if (!climb) solver.staircase.max_rank = solver.rank;
   const BlockLayout layout = make_block_layout(p.graph.num_poses, p.graph.measurements, p.blocks);
   const Eigen::Index w = p.graph.d + 1;
   const auto& ids = layout.poses[static_cast<std::size_t>(c)];
@@ -324,6 +350,33 @@ SolveOutcome OnlineAgent::solve(bool certify) {
   return out;
 }
 
+void OnlineAgent::publish_estimate() {
+  last_publish_ = since(start_);
+  const GraphStream* stream = view_.stream();
+  if (!stream || count_components(stream->graph()) != 1) return;  // no common frame yet
+  const std::vector<Pose> poses = round_solution(stream->graph(), view_.iterate());
+  const int d = stream->graph().d;
+  std::vector<std::uint64_t> index;
+  std::vector<double> data;
+  std::vector<Pose> mine;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    if (stream->robot_of_pose()[k] != static_cast<std::uint32_t>(o_.id)) continue;
+    index.push_back(stream->key_of_pose()[k].index);
+    data.insert(data.end(), poses[k].R.data(), poses[k].R.data() + d * d);
+    data.insert(data.end(), poses[k].t.data(), poses[k].t.data() + d);
+    mine.push_back(poses[k]);
+  }
+  if (mine.empty()) return;
+  channel_.publish_estimate(epoch_, d, index, data);
+  if (!o_.tum_dir.empty()) {
+    // Replaced whole: a reader never sees half a snapshot.
+    const std::string path = o_.tum_dir + "/robot" + std::to_string(o_.id) + ".tum";
+    write_tum(mine, path + ".part");
+    std::filesystem::rename(path + ".part", path);
+  }
+  ++publications_;
+}
+
 int OnlineAgent::run() {
   const auto me = static_cast<std::uint32_t>(o_.id);
   // Membership: agent 0 starts alone (epoch 0) and admits every agent it has heard from at
@@ -354,6 +407,12 @@ int OnlineAgent::run() {
       mine.pose_ids = own_ids_;
       mine.data = own_data_;
       if (me == 0) {
+        if (o_.certify_every_s > 0 && changed_since_certificate_ &&
+            since(start_) >= next_certificate_) {
+          mine.certify = true;
+          next_certificate_ = since(start_) + o_.certify_every_s;
+          changed_since_certificate_ = false;
+        }
         std::set<std::uint32_t> next = members();
         next.insert(seen_.begin(), seen_.end());
         mine.next_members.assign(next.begin(), next.end());
@@ -373,7 +432,14 @@ int OnlineAgent::run() {
       all_converged = all_converged && r.converged;
     }
     converged_ = all_converged;
-    if (finishing) break;  // every block's final poses are in
+    const bool certify_now = reports_[epoch_].count(0) > 0 && reports_[epoch_][0].certify;
+    // The estimate is whole here (every block's poses of the last solve arrived).
+    if (finishing) {
+      if (o_.publish_every_s > 0 || !o_.tum_dir.empty()) publish_estimate();
+      break;
+    }
+    if (o_.publish_every_s > 0 && since(start_) - last_publish_ >= o_.publish_every_s)
+      publish_estimate();
     AbsorbGate gate;
     Watermarks decision = gate.decide(held);
     // Only the members' robots: a robot's data waits for its agent.
@@ -414,6 +480,24 @@ int OnlineAgent::run() {
       continue;
     }
     if (!member) {
+      ++epoch_;
+      continue;
+    }
+    if (changed) changed_since_certificate_ = true;
+    if (certify_now && count_components(view_.stream()->graph()) == 1) {
+      const SolveOutcome c = solve(true, false);
+      converged_ = c.grad_norm <= o_.online.solver.grad_norm_tol || c.stop_reason == "stalled";
+      cpu_s_ += cpu_now() - cpu_start;
+      rounds_ += c.rounds;
+      cli::JsonObject j;
+      j.add("epoch", static_cast<long long>(epoch_))
+          .add("time_s", step_start)
+          .add("poses", view_.stream()->graph().num_poses)
+          .add("certified", c.certified)
+          .add("min_eigenvalue", c.min_eigenvalue)
+          .add("rounds", c.rounds)
+          .add("ms", 1000.0 * (since(start_) - step_start));
+      certificates_.push_back(std::move(j));
       ++epoch_;
       continue;
     }
@@ -519,7 +603,9 @@ void OnlineAgent::write_json(bool lead_result) {
       .add("min_eigenvalue", final_.min_eigenvalue)
       .add("grad_norm", final_.grad_norm);
   if (lead_result && have_cost_) j.add("cost", cost_);
+  j.add("publications", publications_);
   j.add("updates", updates_);
+  if (!certificates_.empty()) j.add("certificates", certificates_);
   cli::write_output(o_.json, j.str());
 }
 

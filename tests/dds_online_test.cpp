@@ -5,8 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
+#include <mutex>
 #include <string>
 #include <tessera/io/g2o_reader.hpp>
 #include <thread>
@@ -47,15 +50,14 @@ double batch_optimum(const std::string& dir, const std::string& graph) {
 // (epoch, total poses, total measurements) of every update an agent wrote.
 std::map<long, std::pair<long, long>> updates_of(const std::string& json) {
   std::map<long, std::pair<long, long>> out;
-  std::size_t at = json.find("\"updates\"");
-  while (at != std::string::npos) {
-    at = json.find("{\"epoch\": ", at);
-    if (at == std::string::npos) break;
-    const long epoch = std::stol(field(json, "epoch", at));
-    out[epoch] = {std::stol(field(json, "total_poses", at)),
-                  std::stol(field(json, "total_measurements", at))};
-    ++at;
-  }
+  const std::size_t begin = json.find("\"updates\"");
+  if (begin == std::string::npos) return out;
+  const std::string updates = json.substr(begin, json.find("\n  ]", begin) - begin);
+  for (std::size_t at = updates.find("{\"epoch\": "); at != std::string::npos;
+       at = updates.find("{\"epoch\": ", at + 1))
+    out[std::stol(field(updates, "epoch", at))] = {
+        std::stol(field(updates, "total_poses", at)),
+        std::stol(field(updates, "total_measurements", at))};
   return out;
 }
 
@@ -65,12 +67,13 @@ TEST(DdsOnline, TheOnlineLaunchEndsAtTheBatchOptimumAndEveryAgentSolvesTheSameGr
   generate_graph(graph, "--kind grid3d --poses 150 --robots 3");
   const double f_star = batch_optimum(dir, graph);
   std::string out;
-  ASSERT_EQ(run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
-                            " --agents 3 --online --rate 40 --speedup 4 --domain 57 --timeout 60"
-                            " --json " +
-                            dir + "/online.json --keep-logs " + dir + "/logs",
-                        &out),
-            0)
+  ASSERT_EQ(
+      run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
+                      " --agents 3 --online --rate 40 --speedup 4 --domain 57 --timeout 60"
+                      " --publish-every 0.2 --certify-every 0.5 --tum-dir " +
+                      dir + "/tum --json " + dir + "/online.json --keep-logs " + dir + "/logs",
+                  &out),
+      0)
       << out;
   const std::string json = read_text_file(dir + "/online.json");
   EXPECT_EQ(field(json, "certified"), "true");
@@ -79,6 +82,12 @@ TEST(DdsOnline, TheOnlineLaunchEndsAtTheBatchOptimumAndEveryAgentSolvesTheSameGr
   EXPECT_EQ(number(json, "total_poses"), static_cast<double>(batch.num_poses));
   EXPECT_EQ(number(json, "total_measurements"), static_cast<double>(batch.measurements.size()));
   EXPECT_GT(number(json, "solves"), 3);
+  // Per-robot TUM snapshots: the last one holds each robot's 50 poses.
+  for (int r = 0; r < 3; ++r) {
+    const std::string tum = read_text_file(dir + "/tum/robot" + std::to_string(r) + ".tum");
+    EXPECT_EQ(std::count(tum.begin(), tum.end(), '\n'), 50) << "robot " << r;
+  }
+  EXPECT_GE(number(json, "publications"), 1);
   // A new measurement (inter-robot closures included) enters every agent at the same epoch:
   // whenever two agents solved at an epoch, they solved the same graph.
   const auto lead = updates_of(read_text_file(dir + "/logs/agent-0.json"));
@@ -105,8 +114,22 @@ TEST(DdsOnline, ALateAgentJoinsIdleAgentsSendNothingAndTheAnswerIsTheBatchOptimu
   const double f_star = batch_optimum(dir, graph);
   // Robots 0 and 1 play their 50 poses each in about 0.6 s; robot 2 starts 6 s later. Its
   // agent starts at 4 s: until then the run has two agents, which have nothing new from
-  // about 1 s on.
-  transport::OnlineChannel snoop(58, run, 99, 3);  // reads the agents' topics, never writes
+  // about 1 s on (nothing may be sent between 2.5 and 3.5 s).
+  // Reads the agents' topics (never writes) and notes when each sample arrived.
+  transport::OnlineChannel snoop(58, run, 99, 3);
+  std::mutex mutex;
+  std::vector<double> arrivals;
+  std::atomic<bool> stop{false};
+  const auto t0 = Clock::now();
+  auto seconds = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  std::thread reader([&] {
+    while (!stop) {
+      snoop.wait(0.01);
+      const std::size_t n = snoop.take_reports().size() + snoop.take_messages().size();
+      std::lock_guard<std::mutex> lock(mutex);
+      arrivals.insert(arrivals.end(), n, seconds());
+    }
+  });
   Process replay =
       start({bin("tessera"), "replay", graph, "--robots", "3", "--run-id", run, "--domain", "58",
              "--rate", "40", "--speedup", "2", "--start", "0,0,12", "--linger", "1"},
@@ -117,18 +140,20 @@ TEST(DdsOnline, ALateAgentJoinsIdleAgentsSendNothingAndTheAnswerIsTheBatchOptimu
                   dir + "/agent" + std::to_string(id) + ".json"},
                  dir + "/agent" + std::to_string(id) + ".log");
   };
-  const auto t0 = Clock::now();
   Process a0 = agent(0), a1 = agent(1);
-  auto seconds = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
-  while (seconds() < 2.5) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  snoop.take_reports();
-  snoop.take_messages();
-  while (seconds() < 3.5) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  const std::size_t idle_samples = snoop.take_reports().size() + snoop.take_messages().size();
-  EXPECT_EQ(idle_samples, 0u) << "the idle agents sent something between 2.5 s and 3.5 s";
   while (seconds() < 4.0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   Process a2 = agent(2);
-  ASSERT_TRUE(wait_all({&replay, &a0, &a1, &a2}, 180)) << "a process hung";
+  const bool ended = wait_all({&replay, &a0, &a1, &a2}, 180);
+  stop = true;
+  reader.join();
+  ASSERT_TRUE(ended) << "a process hung";
+  std::size_t idle_samples = 0, samples_before = 0;
+  for (double t : arrivals) {
+    idle_samples += t >= 2.5 && t < 3.5 ? 1 : 0;
+    samples_before += t < 2.5 ? 1 : 0;
+  }
+  EXPECT_GT(samples_before, 0u);  // the snoop did hear the run
+  EXPECT_EQ(idle_samples, 0u) << "the idle agents sent something between 2.5 s and 3.5 s";
   for (Process* p : {&replay, &a0, &a1, &a2}) EXPECT_EQ(p->exit_code, 0) << p->output();
   const std::string json = read_text_file(dir + "/agent0.json");
   EXPECT_EQ(field(json, "certified"), "true");

@@ -33,6 +33,18 @@ namespace {
 constexpr std::int32_t kReportHistory = 100000;
 }  // namespace
 
+// A reliable write that finds the bounded history full of samples some reader has not
+// acknowledged yet (a slow peer) waits for acknowledgements and tries again, up to a minute,
+// instead of failing the run.
+template <class Sample>
+bool write_patiently(dds::DataWriter* writer, Sample& sample) {
+  for (int attempt = 0; attempt < 600; ++attempt) {
+    if (writer->write(&sample)) return true;
+    writer->wait_for_acknowledgments(Duration_t(0, 100000000));
+  }
+  return false;
+}
+
 struct OnlineChannel::Impl : public dds::DataReaderListener {
   std::string run_id;
   std::uint32_t agent;
@@ -42,6 +54,8 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
   dds::TypeSupport block_type{new wire::PoseBlockPubSubType()};
   dds::TypeSupport status_type{new wire::RoundStatusPubSubType()};
   dds::TypeSupport report_type{new wire::OnlineReportPubSubType()};
+  dds::TypeSupport estimate_type{new wire::FinalEstimatePubSubType()};
+  dds::DataWriter* estimate_writer = nullptr;
   dds::DataWriter *block_writer = nullptr, *status_writer = nullptr, *report_writer = nullptr;
   dds::DataReader *block_reader = nullptr, *status_reader = nullptr, *report_reader = nullptr;
   std::mutex mutex;
@@ -62,6 +76,7 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     block_type.register_type(participant);
     status_type.register_type(participant);
     report_type.register_type(participant);
+    estimate_type.register_type(participant);
     publisher = participant->create_publisher(publisher_qos(run_id));
     subscriber = participant->create_subscriber(subscriber_qos(run_id));
     if (!publisher || !subscriber)
@@ -97,6 +112,18 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     // Reports are kept for readers that match later: the first epoch's reports may be sent
     // before every agent's reader is discovered.
     endpoints(kOnlineReportTopic, report_type, true, report_writer, report_reader);
+    // Estimates: for whoever listens (a monitor, the robots); the newest per robot matters.
+    dds::Topic* estimates = participant->create_topic(
+        kOnlineEstimateTopic, estimate_type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    dds::DataWriterQos eq = dds::DATAWRITER_QOS_DEFAULT;
+    eq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+    eq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+    eq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+    eq.history().depth = 1;
+    eq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+    estimate_writer = estimates ? publisher->create_datawriter(estimates, eq) : nullptr;
+    if (!estimate_writer)
+      throw std::runtime_error("online channel: cannot create the estimate writer");
   }
   ~Impl() override {
     for (auto* r : {block_reader, status_reader, report_reader})
@@ -122,14 +149,14 @@ std::size_t OnlineChannel::send(const OutgoingMessage& m, std::uint32_t epoch) {
   if (const auto* block = std::get_if<PoseBlockMessage>(&m.message)) {
     wire::PoseBlock w = to_wire_block(*block, impl_->run_id, m.broadcast, m.recipients);
     w.epoch(epoch);
-    if (!impl_->block_writer->write(&w))
+    if (!write_patiently(impl_->block_writer, w))
       throw std::runtime_error("online channel: a pose block write failed");
     return serialized_size(w);
   }
   wire::RoundStatus w = to_wire_status(std::get<RoundStatusMessage>(m.message), impl_->run_id,
                                        m.broadcast, m.recipients);
   w.epoch(epoch);
-  if (!impl_->status_writer->write(&w))
+  if (!write_patiently(impl_->status_writer, w))
     throw std::runtime_error("online channel: a round status write failed");
   return serialized_size(w);
 }
@@ -149,9 +176,24 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   w.pose_ids(r.pose_ids);
   w.data(r.data);
   w.next_members(r.next_members);
-  if (!impl_->report_writer->write(&w))
+  w.certify(r.certify);
+  if (!write_patiently(impl_->report_writer, w))
     throw std::runtime_error("online channel: a report write failed");
   return serialized_size(w);
+}
+
+void OnlineChannel::publish_estimate(std::uint32_t epoch, int d,
+                                     const std::vector<std::uint64_t>& index,
+                                     const std::vector<double>& poses) {
+  wire::FinalEstimate w;
+  w.run_id(impl_->run_id);
+  w.sender(impl_->agent);
+  w.dim(static_cast<std::uint32_t>(d));
+  w.epoch(epoch);
+  for (std::uint64_t k : index) w.pose_ids().push_back(static_cast<std::uint32_t>(k));
+  w.pose_data(poses);
+  if (!write_patiently(impl_->estimate_writer, w))
+    throw std::runtime_error("online channel: an estimate write failed");
 }
 
 bool OnlineChannel::wait(double timeout_s) {
@@ -182,6 +224,7 @@ std::vector<OnlineReportSample> OnlineChannel::take_reports() {
     r.pose_ids = w.pose_ids();
     r.data = w.data();
     r.next_members = w.next_members();
+    r.certify = w.certify();
     out.push_back(std::move(r));
   }
   return out;

@@ -5,6 +5,7 @@
 // the graph stream's: an online run has no coordinator hand-shake (the agents agree on the
 // graph through the reports), so the Session's set-up topics have nothing to carry.
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -17,6 +18,7 @@ namespace tessera::transport {
 inline constexpr const char* kOnlineBlockTopic = "tessera_online_block";
 inline constexpr const char* kOnlineStatusTopic = "tessera_online_status";
 inline constexpr const char* kOnlineReportTopic = "tessera_online_report";
+inline constexpr const char* kOnlineEstimateTopic = "tessera_online_estimate";
 
 struct OnlineReportSample {
   std::uint32_t epoch = 0;
@@ -28,6 +30,7 @@ struct OnlineReportSample {
   std::vector<double> data;  ///< r*(d+1) per pose, column-major.
   /// Agent 0's reports: the agents that take part in the next epoch (joiners admitted).
   std::vector<std::uint32_t> next_members;
+  bool certify = false;  ///< Agent 0's reports: certify at this epoch.
 };
 
 /// The epoch of a hello: an agent that is not a member yet asks to join.
@@ -55,6 +58,10 @@ class OnlineChannel {
   std::size_t send(const OutgoingMessage& m, std::uint32_t epoch);
   /// Sends a report; returns its serialized size in bytes.
   std::size_t send_report(const OnlineReportSample& r);
+  /// Publishes this agent's robot's current estimate: pose indices and [R | t] (d*(d+1)
+  /// values per pose, column-major).
+  void publish_estimate(std::uint32_t epoch, int d, const std::vector<std::uint64_t>& index,
+                        const std::vector<double>& poses);
   /// Blocks until something arrived since the last take (or `timeout_s` passed).
   bool wait(double timeout_s);
   std::vector<OnlineReportSample> take_reports();
