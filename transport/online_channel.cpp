@@ -133,11 +133,64 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       dds::DomainParticipantFactory::get_instance()->delete_participant(participant);
     }
   }
-  void on_data_available(dds::DataReader*) override {
+  // Samples are taken here, as they arrive, into the buffers the agent's loop empties: a
+  // reader whose bounded history filled while its agent computed (or waited in a write of
+  // its own) would stop acknowledging, and two agents doing that to each other would block
+  // each other's writes for good.
+  void on_data_available(dds::DataReader* reader) override {
     std::lock_guard<std::mutex> lock(mutex);
+    try {
+      if (reader == report_reader) {
+        take_reports_locked();
+      } else if (reader == block_reader) {
+        wire::PoseBlock w;
+        dds::SampleInfo info;
+        while (block_reader->take_next_sample(&w, &info) == ReturnCode_t::RETCODE_OK)
+          if (info.valid_data && w.run_id() == run_id)
+            messages.push_back(
+                {w.epoch(), w.sender(), w.broadcast(), w.recipients(), from_wire(w)});
+      } else if (reader == status_reader) {
+        wire::RoundStatus w;
+        dds::SampleInfo info;
+        while (status_reader->take_next_sample(&w, &info) == ReturnCode_t::RETCODE_OK)
+          if (info.valid_data && w.run_id() == run_id)
+            messages.push_back(
+                {w.epoch(), w.sender(), w.broadcast(), w.recipients(), from_wire(w)});
+      }
+    } catch (const std::exception& e) {
+      if (error.empty()) error = e.what();
+    }
     available = true;
     cv.notify_all();
   }
+
+  void take_reports_locked() {
+    wire::OnlineReport w;
+    dds::SampleInfo info;
+    while (report_reader->take_next_sample(&w, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || w.run_id() != run_id) continue;
+      if (w.held_robot().size() != w.held_count().size())
+        throw TransportError("online report of agent " + std::to_string(w.sender()) +
+                             ": held arrays of different lengths");
+      OnlineReportSample r;
+      r.epoch = w.epoch();
+      r.sender = w.sender();
+      for (std::size_t k = 0; k < w.held_robot().size(); ++k)
+        r.held[w.held_robot()[k]] = w.held_count()[k];
+      r.converged = w.converged();
+      r.rank = static_cast<int>(w.rank());
+      r.dim = static_cast<int>(w.dim());
+      r.pose_ids = w.pose_ids();
+      r.data = w.data();
+      r.next_members = w.next_members();
+      r.certify = w.certify();
+      reports.push_back(std::move(r));
+    }
+  }
+
+  std::vector<OnlineReportSample> reports;
+  std::vector<OnlineProtocolSample> messages;
+  std::string error;
 };
 
 OnlineChannel::OnlineChannel(int domain, const std::string& run_id, std::uint32_t agent,
@@ -205,48 +258,18 @@ bool OnlineChannel::wait(double timeout_s) {
 }
 
 std::vector<OnlineReportSample> OnlineChannel::take_reports() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (!impl_->error.empty()) throw TransportError(impl_->error);
   std::vector<OnlineReportSample> out;
-  wire::OnlineReport w;
-  dds::SampleInfo info;
-  while (impl_->report_reader->take_next_sample(&w, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || w.run_id() != impl_->run_id) continue;
-    if (w.held_robot().size() != w.held_count().size())
-      throw TransportError("online report of agent " + std::to_string(w.sender()) +
-                           ": held arrays of different lengths");
-    OnlineReportSample r;
-    r.epoch = w.epoch();
-    r.sender = w.sender();
-    for (std::size_t k = 0; k < w.held_robot().size(); ++k)
-      r.held[w.held_robot()[k]] = w.held_count()[k];
-    r.converged = w.converged();
-    r.rank = static_cast<int>(w.rank());
-    r.dim = static_cast<int>(w.dim());
-    r.pose_ids = w.pose_ids();
-    r.data = w.data();
-    r.next_members = w.next_members();
-    r.certify = w.certify();
-    out.push_back(std::move(r));
-  }
+  out.swap(impl_->reports);
   return out;
 }
 
 std::vector<OnlineProtocolSample> OnlineChannel::take_messages() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (!impl_->error.empty()) throw TransportError(impl_->error);
   std::vector<OnlineProtocolSample> out;
-  dds::SampleInfo info;
-  {
-    wire::PoseBlock w;
-    while (impl_->block_reader->take_next_sample(&w, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data || w.run_id() != impl_->run_id) continue;
-      out.push_back({w.epoch(), w.sender(), w.broadcast(), w.recipients(), from_wire(w)});
-    }
-  }
-  {
-    wire::RoundStatus w;
-    while (impl_->status_reader->take_next_sample(&w, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data || w.run_id() != impl_->run_id) continue;
-      out.push_back({w.epoch(), w.sender(), w.broadcast(), w.recipients(), from_wire(w)});
-    }
-  }
+  out.swap(impl_->messages);
   return out;
 }
 
