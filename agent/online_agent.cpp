@@ -55,6 +55,7 @@ options:
   --no-certify        no certificate at the end
   --timeout S         give up when a peer sends nothing for S seconds [120]
   --json FILE         write this agent's summary (agent 0's has the final answer)
+  --certify-iters K   certificate iteration cap (LOBPCG)               [300]
   --certify-every S   also certify the graph received so far every S seconds (agent 0's
                       clock; at the next epoch that brought data, once the graph is
                       connected; no staircase climb)                  [0 = off]
@@ -95,7 +96,7 @@ Options parse(const std::vector<std::string>& argv) {
   const cli::Arguments args(
       argv,
       {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol", "max-rounds", "timeout",
-       "json", "certify-every", "publish-every", "tum-dir"},
+       "json", "certify-every", "certify-iters", "publish-every", "tum-dir"},
       {"online", "no-certify", "verbose", "help"});
   Options o;
   const auto run_id = args.get("run-id");
@@ -118,6 +119,8 @@ Options parse(const std::vector<std::string>& argv) {
   if (!(s.grad_norm_tol > 0)) throw InputError("option --grad-tol: must be > 0");
   s.max_rounds = static_cast<int>(args.get_long("max-rounds", 10000));
   o.online.certify_at_end = !args.has("no-certify");
+  s.staircase.certificate.max_iterations =
+      static_cast<int>(args.get_long("certify-iters", s.staircase.certificate.max_iterations));
   o.timeout_s = args.get_double("timeout", 120.0);
   if (!(o.timeout_s > 0)) throw InputError("option --timeout: must be > 0");
   o.json = args.get_or("json", "");
@@ -196,7 +199,7 @@ class OnlineAgent {
   std::vector<cli::JsonObject> updates_;
   std::vector<double> batch_latency_s_;
   std::uint64_t bytes_sent_ = 0, messages_sent_ = 0, report_bytes_ = 0;
-  std::uint64_t idle_waits_ = 0, idle_messages_ = 0;
+  std::uint64_t idle_waits_ = 0;
   int rounds_ = 0, solves_ = 0;
   double cpu_s_ = 0.0;
   SolveOutcome final_;
@@ -524,13 +527,11 @@ int OnlineAgent::run() {
       ++epoch_;
       continue;
     }
-    const std::uint64_t messages_before = messages_sent_;
     const SolveOutcome s = solve(false);
     if (o_.verbose)
       std::fprintf(stderr, "agent %d: solve: %d rounds, gradient norm %g (%s)\n", o_.id, s.rounds,
                    s.grad_norm, s.stop_reason.c_str());
     converged_ = s.grad_norm <= o_.online.solver.grad_norm_tol || s.stop_reason == "stalled";
-    if (s.rounds == 0 && !changed) idle_messages_ += messages_sent_ - messages_before;
     const double step_end = since(start_);
     cpu_s_ += cpu_now() - cpu_start;
     rounds_ += s.rounds;
@@ -594,7 +595,6 @@ void OnlineAgent::write_json(bool lead_result) {
       .add("messages_sent", static_cast<long long>(messages_sent_))
       .add("report_bytes", static_cast<long long>(report_bytes_))
       .add("idle_waits", static_cast<long long>(idle_waits_))
-      .add("idle_messages", static_cast<long long>(idle_messages_))
       .add("cpu_s", cpu_s_)
       .add("wall_s", since(start_))
       .add("latency_median_s", percentile(batch_latency_s_, 0.5))

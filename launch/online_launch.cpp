@@ -45,6 +45,7 @@ new, and certify the estimate after every robot's last batch.
   --grad-tol G        gradient-norm tolerance of every solve         [0.01]
   --no-certify        no certificate at the end
   --timeout S         an agent gives up when a peer is silent S seconds [120]
+  --certify-iters K   certificate iteration cap (LOBPCG)             [300]
   --certify-every S   also certify the graph received so far every S seconds
   --publish-every S   each agent publishes its robot's estimate every S seconds
                       (topic tessera_online_estimate)
@@ -111,11 +112,11 @@ int run_online_launch(const std::vector<std::string>& argv) {
       std::fputs(kOnlineHelp, stdout);
       return 0;
     }
-  const cli::Arguments args(
-      argv,
-      {"agents", "rate", "speedup", "start", "run-id", "domain", "algorithm", "rank", "grad-tol",
-       "timeout", "json", "keep-logs", "certify-every", "publish-every", "tum-dir"},
-      {"online", "no-certify"});
+  const cli::Arguments args(argv,
+                            {"agents", "rate", "speedup", "start", "run-id", "domain", "algorithm",
+                             "rank", "grad-tol", "timeout", "json", "keep-logs", "certify-every",
+                             "certify-iters", "publish-every", "tum-dir"},
+                            {"online", "no-certify"});
   if (args.positional().size() != 1)
     throw InputError("launch --online: expected one GRAPH argument (see --online --help)");
   const std::string graph = args.positional().front();
@@ -156,8 +157,8 @@ int run_online_launch(const std::vector<std::string>& argv) {
     std::vector<std::string> a = {bin + "/tessera-agent", "--online", "--robots",
                                   std::to_string(agents), "--id",     std::to_string(i)};
     a.insert(a.end(), common.begin(), common.end());
-    for (const char* flag :
-         {"algorithm", "rank", "grad-tol", "timeout", "certify-every", "publish-every", "tum-dir"})
+    for (const char* flag : {"algorithm", "rank", "grad-tol", "timeout", "certify-every",
+                             "certify-iters", "publish-every", "tum-dir"})
       if (auto v = args.get(flag)) {
         a.push_back(std::string("--") + flag);
         a.push_back(*v);
@@ -219,7 +220,7 @@ int run_online_launch(const std::vector<std::string>& argv) {
     const std::string j = read_text(work + "/agent-" + std::to_string(i) + ".json");
     per_agent += std::string(i ? ",\n" : "") + "    {\"agent\": " + std::to_string(i);
     for (const char* key : {"solves", "rounds", "bytes_sent", "messages_sent", "report_bytes",
-                            "idle_waits", "idle_messages", "publications", "cpu_s", "wall_s"})
+                            "idle_waits", "publications", "cpu_s", "wall_s"})
       per_agent += std::string(", \"") + key + "\": " + field_text(j, key);
     per_agent += "}";
   }
