@@ -255,8 +255,11 @@ void OnlineAgent::wait_for_reports() {
       have = reports_[epoch_].size();
       last_progress = Clock::now();
     } else if (have > 0 && since(last_progress) > o_.timeout_s) {
-      silent_peer("epoch " + std::to_string(epoch_) + " reports incomplete (" +
-                  std::to_string(have) + " of " + std::to_string(members().size()) + ")");
+      std::string missing;
+      for (std::uint32_t m : members())
+        if (reports_[epoch_].count(m) == 0)
+          missing += (missing.empty() ? "" : ",") + std::to_string(m);
+      silent_peer("no epoch " + std::to_string(epoch_) + " report from agent " + missing);
     }
   }
 }
@@ -331,7 +334,17 @@ SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
     channel_.wait(0.02);
     pump_channel();
     pump_stream();
-    if (since(last_message) > o_.timeout_s) silent_peer("no protocol message");
+    if (since(last_message) > o_.timeout_s) {
+      // Name the agents whose messages the protocol still waits for (block -> robot = agent).
+      std::string missing;
+      if (const auto awaited = agent.awaited())
+        for (std::uint32_t b : awaited->senders)
+          if (b < p.block_of.size())
+            missing +=
+                (missing.empty() ? " from agent " : ",") +
+                std::to_string(view_.stream()->robots()[static_cast<std::size_t>(p.block_of[b])]);
+      silent_peer("no protocol message" + missing);
+    }
   }
   // This agent's poses go out with the next report (the estimate made whole everywhere).
   own_rank_ = state.rank();

@@ -2,6 +2,8 @@
 // the graph while the replay streams it in, agree on the epoch each batch enters, idle
 // without traffic, take in an agent started late, and end at the batch optimum, certified.
 // Domains used here: 57-59 (each test its own).
+// A member that goes silent stops the run (the survivors name it); they do not yet go on
+// without it.
 
 #include <gtest/gtest.h>
 
@@ -166,6 +168,31 @@ TEST(DdsOnline, ALateAgentJoinsIdleAgentsSendNothingAndTheAnswerIsTheBatchOptimu
   const std::string late = read_text_file(dir + "/agent2.json");
   EXPECT_GT(number(late, "solves") + number(late, "final_rounds"), 0);
   EXPECT_EQ(field(late, "certified"), "true");
+}
+
+TEST(DdsOnline, WhenAMemberGoesSilentTheOthersStopNamingIt) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/grid.g2o";
+  const std::string run = "online-silent";
+  generate_graph(graph, "--kind grid3d --poses 300 --robots 3");
+  // 100 poses per robot at 20 per second: the stream lasts 5 s; agent 2 ends after 2 s.
+  Process replay = start({bin("tessera"), "replay", graph, "--robots", "3", "--run-id", run,
+                          "--domain", "59", "--rate", "20", "--linger", "1"},
+                         dir + "/replay.log");
+  std::vector<Process> agents;
+  for (int id = 0; id < 3; ++id)
+    agents.push_back(
+        start({bin("tessera-agent"), "--online", "--robots", "3", "--id", std::to_string(id),
+               "--run-id", run, "--domain", "59", "--timeout", "3"},
+              dir + "/agent" + std::to_string(id) + ".log"));
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  kill(agents[2].pid, SIGTERM);
+  ASSERT_TRUE(wait_all({&replay, &agents[0], &agents[1], &agents[2]}, 60)) << "a process hung";
+  for (int id = 0; id < 2; ++id) {
+    EXPECT_EQ(agents[static_cast<std::size_t>(id)].exit_code, 1);
+    EXPECT_TRUE(contains(agents[static_cast<std::size_t>(id)].output(), "agent 2"))
+        << agents[static_cast<std::size_t>(id)].output();
+  }
 }
 
 }  // namespace
