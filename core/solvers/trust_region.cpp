@@ -18,6 +18,11 @@ void TrustRegionOptions::validate() const {
     fail("relative_grad_tol", "must be in [0, 1)");
   if (max_accepted_steps < 0) fail("max_accepted_steps", "must be >= 0");
   if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
+  if (!(paired_grad_norm_tol >= 0)) fail("paired_grad_norm_tol", "must be >= 0");
+  if (!(preconditioned_grad_norm_tol >= 0)) fail("preconditioned_grad_norm_tol", "must be >= 0");
+  if (!(step_norm_tol >= 0)) fail("step_norm_tol", "must be >= 0");
+  if (!(predicted_rel_decrease_tol >= 0 && predicted_rel_decrease_tol < 1))
+    fail("predicted_rel_decrease_tol", "must be in [0, 1)");
   if (!(max_radius > 0)) fail("max_radius", "must be > 0");
   if (!(initial_radius_scale > 0 && std::isfinite(initial_radius_scale)))
     fail("initial_radius_scale", "must be finite and > 0");
@@ -32,6 +37,13 @@ namespace {
 
 double inner(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
   return A.cwiseProduct(B).sum();
+}
+
+// Frobenius norm of the Stiefel columns of a tangent vector (pose i: columns (d+1)i .. (d+1)i+d-1).
+double rotation_norm(const Eigen::MatrixXd& V, int d) {
+  double sq = 0.0;
+  for (Eigen::Index c = 0; c + d < V.cols() + 1; c += d + 1) sq += V.middleCols(c, d).squaredNorm();
+  return std::sqrt(sq);
 }
 
 struct TcgOutcome {
@@ -126,10 +138,39 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     radius = std::max(
         1e-10, options.initial_radius_scale * std::sqrt(std::max(0.0, inner(precon_grad, grad))));
   }
+  auto ensure_precon_grad = [&] {
+    if (have_precon_grad) return;
+    precon_grad = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
+    have_precon_grad = true;
+  };
+  // Both stops below need the preconditioned gradient only when they are on; the next tCG starts
+  // from the same vector, so computing it costs nothing extra.
+  const bool paired_stop =
+      options.paired_grad_norm_tol > 0 && options.preconditioned_grad_norm_tol > 0;
+  auto paired_met = [&] {
+    if (!paired_stop || grad_norm > options.paired_grad_norm_tol) return false;
+    ensure_precon_grad();
+    return std::sqrt(inner(precon_grad, precon_grad)) <= options.preconditioned_grad_norm_tol;
+  };
+  // 1/2 <P g, g> is the decrease of the model's Newton step when P is the inverse Hessian: what
+  // the next step can still gain.
+  auto predicted_decrease = [&] {
+    ensure_precon_grad();
+    return 0.5 * std::max(0.0, inner(precon_grad, grad));
+  };
   res.stop_reason = "max_iterations";
   for (int it = 0; it < options.max_iterations; ++it) {
     if (grad_norm <= grad_tol) {
       res.stop_reason = "grad_norm";
+      break;
+    }
+    if (paired_met()) {
+      res.stop_reason = "preconditioned_grad_norm";
+      break;
+    }
+    if (options.predicted_rel_decrease_tol > 0 &&
+        predicted_decrease() <= options.predicted_rel_decrease_tol * std::abs(f)) {
+      res.stop_reason = "predicted_decrease";
       break;
     }
     if (elapsed() > options.max_time_s) {
@@ -178,10 +219,17 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     }
     res.iterations = it + 1;
     if (options.record_trace)
-      res.trace.push_back(
-          {it + 1, f, grad_norm, radius, rho, step.iterations, accepted, elapsed()});
+      res.trace.push_back({it + 1, f, grad_norm, radius, rho, step.iterations, accepted, elapsed(),
+                           options.predicted_rel_decrease_tol > 0
+                               ? predicted_decrease()
+                               : std::numeric_limits<double>::quiet_NaN()});
     if (accepted && decrease <= options.rel_cost_decrease_tol * std::abs(f)) {
       res.stop_reason = "relative_decrease";
+      break;
+    }
+    if (accepted && options.step_norm_tol > 0 &&
+        rotation_norm(step.eta, M.dim()) < options.step_norm_tol) {
+      res.stop_reason = "step_norm";
       break;
     }
     if (radius < 1e-14) {
