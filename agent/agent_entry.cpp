@@ -40,7 +40,7 @@ int agent_main(int argc, char** argv) {
   const cli::ProcessRole role{tag, options.net.timeout_s, true, true};
   return cli::run_session_process(
       agent_session_options(options), role, signals,
-      [&](transport::Session& session) { run_agent(options, session, std::move(restart)); });
+      [&](transport::AgentSession& session) { run_agent(options, session, std::move(restart)); });
 }
 
 }  // namespace tessera::agent

@@ -12,7 +12,7 @@ namespace tessera::agent {
 
 using namespace tessera::transport;
 
-void pass_agent_gate(Session& s, const AgentOptions& o, const std::function<void()>& on_poll) {
+void pass_agent_gate(AgentSession& s, const AgentOptions& o, const std::function<void()>& on_poll) {
   PeerGateOptions gate;
   gate.timeout_s = o.net.timeout_s;
   gate.stall_after_s = o.handshake_stall_s;

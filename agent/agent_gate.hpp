@@ -9,13 +9,13 @@
 #include <functional>
 
 #include "agent/agent_options.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
 /// Returns once the gate passed. `on_poll` runs on every look at the peers (it may throw to
 /// end the wait, e.g. refuse_if_lost). Throws RunFailure on a stop or a timeout.
-void pass_agent_gate(transport::Session& session, const AgentOptions& options,
+void pass_agent_gate(transport::AgentSession& session, const AgentOptions& options,
                      const std::function<void()>& on_poll = {});
 
 }  // namespace tessera::agent

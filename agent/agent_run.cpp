@@ -28,7 +28,7 @@ namespace {
 // Step 7: THE SEAM, core's round protocol over DDS, until the coordinator confirms the
 // merged result (step 8, inside the loop: an order while waiting for it repeats the rounds).
 // `local` is the block of the first epoch (fresh or from the checkpoint).
-void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLocalData& local,
+void solve(AgentSession& s, const AgentOptions& o, const AgentLog& log, const AgentLocalData& local,
            const std::optional<AgentCheckpoint>& restart, const RunSetup* setup,
            std::chrono::steady_clock::time_point t0) {
   const bool rejoin_enabled = setup && setup->rejoin_enabled;
@@ -47,11 +47,13 @@ void solve(Session& s, const AgentOptions& o, const AgentLog& log, const AgentLo
   // lost agents are arbitrated: the rejoin arbiter picks the rollback round from each agent's
   // own last status, which a relay waiting for a dead agent (or dead itself) would hold back.
   // Every agent reads the same assignment, so all choose alike.
-  s.set_status_relay(setup && setup->status_relay && !arbitrated);
+  RoundTraffic traffic;
+  traffic.status_relay = setup && setup->status_relay && !arbitrated;
   // The coordinator reads each round's statuses only while it arbitrates lost agents (the
   // rollback round is the newest every agent has sent its status for); otherwise it follows
   // the agents' progress digests, a few a second (agent/progress_digest.hpp).
-  s.set_coordinator_follows_rounds(arbitrated);
+  traffic.coordinator_follows_rounds = arbitrated;
+  s.set_round_traffic(traffic);
   if (!arbitrated) channel.report_progress(o.id, local.num_agents);
   const AgentLocalData* cur = &local;  // the survivors' new block after a re-partition
   if (replication.enabled() && !restart) replication.start(local, channel, o.net.timeout_s);
@@ -130,7 +132,7 @@ std::optional<AgentCheckpoint> find_restart_checkpoint(const AgentOptions& o) {
   return restart;
 }
 
-void run_agent(const AgentOptions& o, Session& s, std::optional<AgentCheckpoint> restart) {
+void run_agent(const AgentOptions& o, AgentSession& s, std::optional<AgentCheckpoint> restart) {
   const AgentLog log{agent_tag(o.id), o.verbose};
   const auto t0 = std::chrono::steady_clock::now();
   try {

@@ -9,7 +9,7 @@
 
 #include "agent/agent_options.hpp"
 #include "runtime/agent_checkpoint.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
@@ -23,7 +23,7 @@ std::optional<AgentCheckpoint> find_restart_checkpoint(const AgentOptions& optio
 /// Runs the agent on an open session (from `restart` when set). Throws RunFailure (or
 /// InputError for bad input files) when the run fails; cli::run_session_process turns that
 /// into the ABORT and the exit code. Removes the checkpoint when the run completes.
-void run_agent(const AgentOptions& options, transport::Session& session,
+void run_agent(const AgentOptions& options, transport::AgentSession& session,
                std::optional<AgentCheckpoint> restart);
 
 }  // namespace tessera::agent

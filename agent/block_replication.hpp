@@ -15,7 +15,7 @@
 #include "runtime/round_loop.hpp"
 #include "runtime/survivor_takeover.hpp"
 #include "tessera.h"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
@@ -23,7 +23,7 @@ class BlockReplication {
  public:
   /// Agent `self` with `replicas` holders (0: disabled; then only enabled() is called),
   /// sending its lifted poses every `replica_every` (>= 1) rounds.
-  BlockReplication(transport::Session& session, std::uint32_t self, std::uint32_t replicas,
+  BlockReplication(transport::AgentSession& session, std::uint32_t self, std::uint32_t replicas,
                    std::uint32_t replica_every, const AgentLog& log)
       : session_(session),
         self_(self),
@@ -48,7 +48,7 @@ class BlockReplication {
                                   double timeout_s);
 
  private:
-  transport::Session& session_;
+  transport::AgentSession& session_;
   std::uint32_t self_;
   std::uint32_t replicas_, replica_every_;
   AgentLog log_;

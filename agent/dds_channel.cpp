@@ -45,7 +45,7 @@ void DdsProtocolChannel::publish_progress_if_due() {
   session_.publish(std::move(d));
 }
 
-std::optional<RollbackRequested> take_rollback(transport::Session& session) {
+std::optional<RollbackRequested> take_rollback(transport::AgentSession& session) {
   const std::uint32_t current = session.epoch();
   std::optional<RollbackRequested> newest;
   for (const auto& c : session.rollbacks().take_all())
@@ -54,7 +54,7 @@ std::optional<RollbackRequested> take_rollback(transport::Session& session) {
   return newest;
 }
 
-std::optional<wire::PartitionAssignment> take_reassignment(transport::Session& session) {
+std::optional<wire::PartitionAssignment> take_reassignment(transport::AgentSession& session) {
   const std::uint32_t current = session.epoch();
   std::optional<wire::PartitionAssignment> newest;
   for (auto& a : session.assignments().take_all())
@@ -70,7 +70,7 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_after(double timeout_
                                                                  std::size_t wake_after) {
   // Back to a wake-up per message however this wait ends: the threshold is this step's only.
   struct ThresholdGuard {
-    transport::Session& session;
+    transport::AgentSession& session;
     bool set;
     ~ThresholdGuard() {
       if (set) session.set_protocol_wake_threshold(1);
@@ -88,7 +88,7 @@ std::optional<ProtocolMessage> DdsProtocolChannel::receive_awaiting(
   if (intercept_) return receive_after(timeout_s, awaited.senders.size());
   // Back to a wake-up per message however this wait ends: the awaited set is this step's only.
   struct AwaitedGuard {
-    transport::Session& session;
+    transport::AgentSession& session;
     ~AwaitedGuard() { session.set_protocol_awaited(std::nullopt); }
   } guard{session_};
   session_.set_protocol_awaited(awaited);

@@ -1,5 +1,5 @@
 #pragma once
-// The ProtocolChannel of the DDS runtime: core ProtocolMessages over a transport Session.
+// The ProtocolChannel of the DDS runtime: core ProtocolMessages over an agent's AgentSession.
 // A ROLLBACK order of the coordinator (newer epoch than this process's) interrupts a wait
 // with RollbackRequested.
 
@@ -9,22 +9,22 @@
 
 #include "agent/progress_digest.hpp"
 #include "runtime/round_loop.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
 class DdsProtocolChannel : public ProtocolChannel {
  public:
-  explicit DdsProtocolChannel(transport::Session& session) : session_(session) {}
+  explicit DdsProtocolChannel(transport::AgentSession& session) : session_(session) {}
   void send(const OutgoingMessage& message) override;
-  /// Session::send_all: blocks to the status relay ride in the step's status sample.
+  /// AgentSession::send_all: blocks to the status relay ride in the step's status sample.
   void send_all(const std::vector<OutgoingMessage>& messages) override;
   std::optional<ProtocolMessage> receive(double timeout_s) override;
   /// The listener wakes this thread only once `wake_after` protocol messages are queued
-  /// (Session::set_protocol_wake_threshold); rollbacks, re-partitions and stops as receive().
+  /// (AgentSession::set_protocol_wake_threshold); rollbacks, re-partitions and stops as receive().
   std::optional<ProtocolMessage> receive_after(double timeout_s, std::size_t wake_after) override;
   /// The listener wakes this thread only once every awaited message is queued
-  /// (Session::set_protocol_awaited); rollbacks, re-partitions and stops as receive(). With an
+  /// (AgentSession::set_protocol_awaited); rollbacks, re-partitions and stops as receive(). With an
   /// intercept set (replicas): receive_after(timeout_s, awaited.senders.size()) instead.
   std::optional<ProtocolMessage> receive_awaiting(double timeout_s,
                                                   const AwaitedMessages& awaited) override;
@@ -47,7 +47,7 @@ class DdsProtocolChannel : public ProtocolChannel {
   // The wait of receive_after and receive_awaiting, once the session knows what wakes it.
   std::optional<ProtocolMessage> wait_and_take(double timeout_s);
 
-  transport::Session& session_;
+  transport::AgentSession& session_;
   std::function<bool(const ProtocolMessage&)> intercept_;
   std::optional<ProgressDigest> progress_;
 };
@@ -65,10 +65,10 @@ class RepartitionRequested : public std::runtime_error {
 };
 
 /// Takes the coordinator's newest assignment with an epoch above the session's, if any.
-std::optional<wire::PartitionAssignment> take_reassignment(transport::Session& session);
+std::optional<wire::PartitionAssignment> take_reassignment(transport::AgentSession& session);
 
 /// Takes the coordinator's newest ROLLBACK order with an epoch above the session's (older
 /// ones are discarded), if any.
-std::optional<RollbackRequested> take_rollback(transport::Session& session);
+std::optional<RollbackRequested> take_rollback(transport::AgentSession& session);
 
 }  // namespace tessera::agent

@@ -16,9 +16,9 @@ namespace tessera::agent {
 
 using namespace tessera::transport;
 
-void deliver_final_estimate(Session& s, const AgentLocalData& local, const RoundLoopResult& result,
-                            const AgentOptions& o, const AgentLog& log,
-                            std::chrono::steady_clock::time_point t0) {
+void deliver_final_estimate(AgentSession& s, const AgentLocalData& local,
+                            const RoundLoopResult& result, const AgentOptions& o,
+                            const AgentLog& log, std::chrono::steady_clock::time_point t0) {
   Mailroom& room = s.mailroom();
   if (result.poses.size() != local.owned.size())
     throw RunFailure(kExitRunFailed, "the round loop returned " +

@@ -9,7 +9,7 @@
 #include "agent/agent_options.hpp"
 #include "runtime/agent_log.hpp"
 #include "runtime/round_loop.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
@@ -17,7 +17,7 @@ namespace tessera::agent {
 /// coordinator's FINISHED (bounded by --timeout), then prints the "done" line (times counted
 /// from `t0`). Throws RollbackRequested or RepartitionRequested when ordered meanwhile, and
 /// RunFailure on a stop, a timeout or a result that does not match `local`.
-void deliver_final_estimate(transport::Session& session, const AgentLocalData& local,
+void deliver_final_estimate(transport::AgentSession& session, const AgentLocalData& local,
                             const RoundLoopResult& result, const AgentOptions& options,
                             const AgentLog& log, std::chrono::steady_clock::time_point t0);
 

@@ -10,7 +10,7 @@ namespace tessera::agent {
 
 using namespace tessera::transport;
 
-std::vector<ReceivedHandoff> exchange_handoffs(Session& s, const RobotShare& share,
+std::vector<ReceivedHandoff> exchange_handoffs(AgentSession& s, const RobotShare& share,
                                                const std::vector<std::uint32_t>& owner,
                                                std::uint32_t self, std::uint32_t robots,
                                                const std::string& run_id, double timeout_s) {

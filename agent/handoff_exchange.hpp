@@ -9,14 +9,15 @@
 #include <vector>
 
 #include "runtime/local_share.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
 /// Publishes `share`'s hand-off to every agent but `self` under `owner`, then waits up to
 /// `timeout_s` for a hand-off from each of them. Returns them decoded, in arrival order.
 /// Throws RunFailure on a stop or the timeout (naming the agents not heard from).
-std::vector<ReceivedHandoff> exchange_handoffs(transport::Session& session, const RobotShare& share,
+std::vector<ReceivedHandoff> exchange_handoffs(transport::AgentSession& session,
+                                               const RobotShare& share,
                                                const std::vector<std::uint32_t>& owner,
                                                std::uint32_t self, std::uint32_t robots,
                                                const std::string& run_id, double timeout_s);

@@ -23,7 +23,7 @@ void refuse_if_lost(const wire::PartitionAssignment& a, std::uint32_t agent_id,
   if (auto e = epoch_that_lost(a, agent_id)) throw LostForGood(agent_id, run_id, *e);
 }
 
-void refuse_if_lost(transport::Session& session, std::uint32_t agent_id) {
+void refuse_if_lost(transport::AgentSession& session, std::uint32_t agent_id) {
   auto& inbox = session.assignments();
   const std::optional<wire::PartitionAssignment> losing =
       session.mailroom().with_lock([&]() -> std::optional<wire::PartitionAssignment> {

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "session_process.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
@@ -34,6 +34,6 @@ void refuse_if_lost(const wire::PartitionAssignment& a, std::uint32_t agent_id,
 /// hand-off logic still sees them) and throws LostForGood when one names `agent_id` among
 /// the lost. Assignments are kept by the coordinator's writer (transient local), so a
 /// process that joins late receives every epoch's assignment shortly after matching.
-void refuse_if_lost(transport::Session& session, std::uint32_t agent_id);
+void refuse_if_lost(transport::AgentSession& session, std::uint32_t agent_id);
 
 }  // namespace tessera::agent

@@ -18,7 +18,7 @@ namespace {
 
 // `also`: checked on every pass (throws to end the wait early).
 void wait_matched(
-    transport::Session& s, double timeout_s, const std::string& why,
+    transport::AgentSession& s, double timeout_s, const std::string& why,
     const std::function<void()>& also = [] {}) {
   std::string missing;
   const auto deadline = std::chrono::steady_clock::now() +
@@ -40,7 +40,7 @@ void wait_matched(
 
 }  // namespace
 
-RollbackRequested request_rejoin(transport::Session& s, std::uint32_t agent_id,
+RollbackRequested request_rejoin(transport::AgentSession& s, std::uint32_t agent_id,
                                  const std::vector<ProtocolSnapshot>& snapshots, double timeout_s) {
   if (snapshots.empty())
     throw RunFailure(transport::kExitBadInput, "the checkpoint holds no round to rejoin from");
@@ -78,7 +78,7 @@ RollbackRequested request_rejoin(transport::Session& s, std::uint32_t agent_id,
   return RollbackRequested(answer.round(), answer.epoch(), answer.agent());
 }
 
-const ProtocolSnapshot& prepare_rollback(transport::Session& s, const CheckpointKeeper& keeper,
+const ProtocolSnapshot& prepare_rollback(transport::AgentSession& s, const CheckpointKeeper& keeper,
                                          const RollbackRequested& order, double timeout_s) {
   const ProtocolSnapshot* snap = keeper.find(static_cast<int>(order.round));
   if (!snap)

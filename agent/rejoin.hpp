@@ -14,19 +14,19 @@
 
 #include "runtime/checkpoint_keeper.hpp"
 #include "runtime/round_loop.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
 /// The restarted agent's hand-shake. Returns the coordinator's answer (its round is one of
 /// `snapshots`' rounds). Throws transport::RunFailure on timeout or stop.
-RollbackRequested request_rejoin(transport::Session& session, std::uint32_t agent_id,
+RollbackRequested request_rejoin(transport::AgentSession& session, std::uint32_t agent_id,
                                  const std::vector<ProtocolSnapshot>& snapshots, double timeout_s);
 
 /// Every agent, before resuming after `order`: endpoints matched (bounded by `timeout_s`),
 /// epoch set. Returns the snapshot to resume from; transport::RunFailure when the keeper no
 /// longer holds that round.
-const ProtocolSnapshot& prepare_rollback(transport::Session& session,
+const ProtocolSnapshot& prepare_rollback(transport::AgentSession& session,
                                          const CheckpointKeeper& keeper,
                                          const RollbackRequested& order, double timeout_s);
 

@@ -58,7 +58,7 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
 
 }  // namespace
 
-RunSetup set_up_fresh_run(Session& s, const AgentOptions& o, const AgentLog& log) {
+RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog& log) {
   Mailroom& room = s.mailroom();
   RunSetup out;
 

@@ -9,7 +9,7 @@
 #include "agent/agent_options.hpp"
 #include "runtime/agent_log.hpp"
 #include "runtime/round_loop.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
@@ -24,7 +24,7 @@ struct RunSetup {
 
 /// Runs steps 1-6 (and writes --dump-local). Throws InputError on bad input files,
 /// RunFailure on a stop, a timeout or an assignment that does not fit this agent.
-RunSetup set_up_fresh_run(transport::Session& session, const AgentOptions& options,
+RunSetup set_up_fresh_run(transport::AgentSession& session, const AgentOptions& options,
                           const AgentLog& log);
 
 }  // namespace tessera::agent

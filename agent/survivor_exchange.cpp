@@ -34,7 +34,7 @@ wire::MeasurementHandoff encode(const std::string& run_id, std::uint32_t sender,
 
 }  // namespace
 
-void send_problem_replicas(Session& session, const AgentLocalData& local, std::uint32_t self,
+void send_problem_replicas(AgentSession& session, const AgentLocalData& local, std::uint32_t self,
                            const Eigen::MatrixXd& Y0, const std::vector<std::uint32_t>& holders) {
   const std::vector<double> data(Y0.data(), Y0.data() + Y0.size());
   for (std::uint32_t h : holders)
@@ -43,7 +43,7 @@ void send_problem_replicas(Session& session, const AgentLocalData& local, std::u
                            local.owned, data));
 }
 
-void absorb_problem_replicas(Session& session, ReplicaStore& store) {
+void absorb_problem_replicas(AgentSession& session, ReplicaStore& store) {
   for (auto& w : session.replicas().take_all()) {
     HandoffContent c = from_wire(w);
     const std::size_t width = static_cast<std::size_t>(w.rank()) * (w.dim() + 1);
@@ -67,8 +67,8 @@ Reassignment reassignment_of(const wire::PartitionAssignment& a,
   return r;
 }
 
-AgentLocalData exchange_takeover(Session& session, const TakeoverSource& src, const Reassignment& r,
-                                 double timeout_s) {
+AgentLocalData exchange_takeover(AgentSession& session, const TakeoverSource& src,
+                                 const Reassignment& r, double timeout_s) {
   const int d = src.local->d;
   const auto rank = static_cast<std::uint32_t>(src.Y.rows());
   for (std::uint32_t b : r.survivors) {

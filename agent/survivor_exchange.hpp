@@ -7,18 +7,18 @@
 
 #include "runtime/survivor_takeover.hpp"
 #include "tessera.h"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 
 namespace tessera::agent {
 
 /// Sends this agent's local problem (measurements, lifted initial poses `Y0`) to each holder
 /// (hand-off messages of purpose 1).
-void send_problem_replicas(transport::Session& session, const AgentLocalData& local,
+void send_problem_replicas(transport::AgentSession& session, const AgentLocalData& local,
                            std::uint32_t self, const Eigen::MatrixXd& Y0,
                            const std::vector<std::uint32_t>& holders);
 
 /// Moves every replica hand-off the session received into `store`.
-void absorb_problem_replicas(transport::Session& session, ReplicaStore& store);
+void absorb_problem_replicas(transport::AgentSession& session, ReplicaStore& store);
 
 /// The re-partition in `a` (epoch > 0) with the assignment before it (`old_owner`).
 /// Throws transport::RunFailure when it is malformed.
@@ -28,7 +28,7 @@ Reassignment reassignment_of(const wire::PartitionAssignment& a,
 /// The take-over over DDS: one message to every other survivor (purpose 2, at r.epoch), waits
 /// (bounded by `timeout_s`) for one from each of them, then assembles the new local problem.
 /// Throws transport::RunFailure on timeout or a stopped run.
-AgentLocalData exchange_takeover(transport::Session& session, const TakeoverSource& src,
+AgentLocalData exchange_takeover(transport::AgentSession& session, const TakeoverSource& src,
                                  const Reassignment& r, double timeout_s);
 
 }  // namespace tessera::agent

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <type_traits>
 
 #include "session_args.hpp"
 #include "transport/fastdds/teardown_guard.hpp"
@@ -65,17 +66,17 @@ int leave(Session& session, const ProcessRole& role, int code, const std::string
   return code;
 }
 
-}  // namespace
-
-int run_session_process(const SessionOptions& options, const ProcessRole& role,
-                        SignalWatcher& signals, const std::function<void(Session&)>& body) {
+// run_session_process for the session of either role: only agents read FINISHED.
+template <class RoleSession>
+int run_role_process(const SessionOptions& options, const ProcessRole& role, SignalWatcher& signals,
+                     const std::function<void(RoleSession&)>& body) {
   // stdout may be a pipe its reader closes first (launch leaves on the first failure while the
   // coordinator still prints lag or progress lines): a failed write must not kill the process
   // (exit 141) before it has told the others and written why it stops.
   std::signal(SIGPIPE, SIG_IGN);
-  std::unique_ptr<Session> session;
+  std::unique_ptr<RoleSession> session;
   try {
-    session = std::make_unique<Session>(options);
+    session = std::make_unique<RoleSession>(options);
   } catch (const InputError& e) {
     std::cerr << role.tag << ": error: " << e.what() << "\n";
     return kExitBadInput;
@@ -83,12 +84,13 @@ int run_session_process(const SessionOptions& options, const ProcessRole& role,
     std::cerr << role.tag << ": error: " << e.what() << "\n";
     return kExitRunFailed;
   }
-  Session& s = *session;
+  RoleSession& s = *session;
   // After the session (destroyed first: it reads the session's flag) and around everything
   // up to the participant's deletion, whose own guard takes over inside it.
   std::optional<TeardownGuard> finished_cover;
-  if (role.cover_after_finished)
-    finished_cover.emplace(kExitOk, role.tag, Seconds(0), &s.finished_flag());
+  if constexpr (std::is_same_v<RoleSession, AgentSession>)
+    if (role.cover_after_finished)
+      finished_cover.emplace(kExitOk, role.tag, Seconds(0), &s.finished_flag());
   signals.start([&s](int signo) {
     s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted by " + signal_name(signo));
   });
@@ -112,6 +114,19 @@ int run_session_process(const SessionOptions& options, const ProcessRole& role,
   signals.stop();  // the callback refers to the session
   s.close(code);   // a Fast DDS abort or hang while deleting still exits with `code`
   return code;
+}
+
+}  // namespace
+
+int run_session_process(const SessionOptions& options, const ProcessRole& role,
+                        SignalWatcher& signals, const std::function<void(AgentSession&)>& body) {
+  return run_role_process(options, role, signals, body);
+}
+
+int run_session_process(const SessionOptions& options, const ProcessRole& role,
+                        SignalWatcher& signals,
+                        const std::function<void(CoordinatorSession&)>& body) {
+  return run_role_process(options, role, signals, body);
 }
 
 }  // namespace tessera::cli

@@ -12,8 +12,9 @@
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
+#include "transport/agent_session.hpp"
+#include "transport/coordinator_session.hpp"
 #include "transport/run_failure.hpp"
-#include "transport/session.hpp"
 #include "transport/session_options.hpp"
 #include "transport/signal_watcher.hpp"
 
@@ -39,7 +40,7 @@ struct ProcessRole {
   /// On bad input, also wait the whole linger for peers not seen yet (an agent fails at
   /// start-up, typically before it has discovered everyone, and they should learn why).
   bool patient_on_bad_input = false;
-  /// Agents: once the coordinator's FINISHED has arrived (the merged result is written, the
+  /// Agents only: once the coordinator's FINISHED has arrived (the merged result is written, the
   /// run is complete), an abort in what is left (the last steps, the others' participants
   /// leaving, the deletion of ours) ends the process with exit code 0 and a note instead of
   /// SIGABRT (Fast DDS 2.9's lease-check race, transport/fastdds/teardown_guard.hpp). An abort
@@ -58,14 +59,19 @@ std::optional<int> parse_process_options(const std::vector<std::string>& argv,
                                          const std::string& program, const std::string& help,
                                          Parse parse, Options& out);
 
-/// Opens the session (exit 2 on bad session input, 1 on any other failure to open it), routes
-/// the first SIGINT/SIGTERM into a stop of every wait, and runs `body`. A failure in `body`
-/// is printed, relayed to the others as ABORT (their own reasons unprefixed, so everyone
-/// learns the first cause) and mapped to its exit code; a stop requested while failing wins
-/// over the secondary error it caused. Returns the exit code (0 when `body` returned).
+/// Opens the session of the role (exit 2 on bad session input, 1 on any other failure to open
+/// it), routes the first SIGINT/SIGTERM into a stop of every wait, and runs `body`. A failure
+/// in `body` is printed, relayed to the others as ABORT (their own reasons unprefixed, so
+/// everyone learns the first cause) and mapped to its exit code; a stop requested while
+/// failing wins over the secondary error it caused. Returns the exit code (0 when `body`
+/// returned).
 int run_session_process(const transport::SessionOptions& options, const ProcessRole& role,
                         transport::SignalWatcher& signals,
-                        const std::function<void(transport::Session&)>& body);
+                        const std::function<void(transport::AgentSession&)>& body);
+/// The same for the coordinator (ProcessRole::cover_after_finished does not apply).
+int run_session_process(const transport::SessionOptions& options, const ProcessRole& role,
+                        transport::SignalWatcher& signals,
+                        const std::function<void(transport::CoordinatorSession&)>& body);
 
 /// Ends the process with `code` once run_session_process() has returned (the participant is
 /// deleted, nothing is left in /dev/shm): flushes stdout and stderr and exits WITHOUT

@@ -9,7 +9,8 @@ namespace tessera::coordinator {
 
 using namespace tessera::transport;
 
-std::vector<wire::AgentAnnouncement> await_announcements(Session& session, std::uint32_t num_agents,
+std::vector<wire::AgentAnnouncement> await_announcements(CoordinatorSession& session,
+                                                         std::uint32_t num_agents,
                                                          const std::string& run_id,
                                                          double timeout_s) {
   const std::uint32_t N = num_agents;

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "tessera.h"
-#include "transport/session.hpp"
+#include "transport/coordinator_session.hpp"
 
 namespace tessera::coordinator {
 
@@ -15,7 +15,7 @@ namespace tessera::coordinator {
 /// (any order; an announcement naming another N or an id out of range ends the wait early so
 /// that merge_announcements can name the offender). Throws RunFailure on a stop, or on the
 /// timeout naming the agents still missing and those present.
-std::vector<wire::AgentAnnouncement> await_announcements(transport::Session& session,
+std::vector<wire::AgentAnnouncement> await_announcements(transport::CoordinatorSession& session,
                                                          std::uint32_t num_agents,
                                                          const std::string& run_id,
                                                          double timeout_s);

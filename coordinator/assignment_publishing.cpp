@@ -35,7 +35,7 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   return asg;
 }
 
-void publish_assignment(Session& session, wire::PartitionAssignment base, bool certify,
+void publish_assignment(CoordinatorSession& session, wire::PartitionAssignment base, bool certify,
                         double timeout_s) {
   base.certify(certify);
   session.publish(base);

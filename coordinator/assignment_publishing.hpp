@@ -8,7 +8,7 @@
 #include "coordinator/run_structure.hpp"
 #include "runtime/partition_step.hpp"
 #include "tessera.h"
-#include "transport/session.hpp"
+#include "transport/coordinator_session.hpp"
 
 namespace tessera::coordinator {
 
@@ -22,7 +22,7 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
 /// Publishes `base` with certify = `certify`, then waits up to `timeout_s` until every
 /// process of the run is ready. Throws RunFailure on a stop or the timeout (naming who is
 /// missing).
-void publish_assignment(transport::Session& session, wire::PartitionAssignment base, bool certify,
-                        double timeout_s);
+void publish_assignment(transport::CoordinatorSession& session, wire::PartitionAssignment base,
+                        bool certify, double timeout_s);
 
 }  // namespace tessera::coordinator

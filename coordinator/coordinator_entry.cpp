@@ -36,7 +36,7 @@ int coordinator_main(int argc, char** argv) {
                                                   options.partition_seed, options.partition_time_s);
   const cli::ProcessRole role{"tessera-coordinator", options.net.timeout_s};
   return cli::run_session_process(coordinator_session_options(options), role, signals,
-                                  [&](transport::Session& session) {
+                                  [&](transport::CoordinatorSession& session) {
                                     run_coordinator(options, session, timeline, file_job.get());
                                   });
 }

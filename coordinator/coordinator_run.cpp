@@ -35,7 +35,7 @@ namespace {
 constexpr double kFinishedMarginS = 5.0;
 }  // namespace
 
-void run_coordinator(const CoordinatorOptions& o, Session& s, RunTimeline& timeline,
+void run_coordinator(const CoordinatorOptions& o, CoordinatorSession& s, RunTimeline& timeline,
                      FilePartitionJob* file_job) {
   const auto log = [&](const std::string& what) {
     if (o.verbose) std::cerr << "tessera-coordinator: " << what << "\n";

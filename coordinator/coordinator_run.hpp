@@ -7,7 +7,7 @@
 #include "coordinator/coordinator_options.hpp"
 #include "coordinator/file_partition.hpp"
 #include "coordinator/run_timeline.hpp"
-#include "transport/session.hpp"
+#include "transport/coordinator_session.hpp"
 
 namespace tessera::coordinator {
 
@@ -15,7 +15,7 @@ namespace tessera::coordinator {
 /// announcements) when the run fails; cli::run_session_process turns that into the ABORT
 /// and the exit code. Marks the end of each step on `timeline` (reported in the summary).
 /// `file_job`: the partition of --graph, started before the session (null without --graph).
-void run_coordinator(const CoordinatorOptions& options, transport::Session& session,
+void run_coordinator(const CoordinatorOptions& options, transport::CoordinatorSession& session,
                      RunTimeline& timeline, FilePartitionJob* file_job);
 
 }  // namespace tessera::coordinator

@@ -12,7 +12,7 @@ namespace tessera::coordinator {
 
 using namespace tessera::transport;
 
-LossHandling::LossHandling(const CoordinatorOptions& options, Session& session,
+LossHandling::LossHandling(const CoordinatorOptions& options, CoordinatorSession& session,
                            const GraphStructure& graph, const wire::PartitionAssignment& base,
                            RunMonitor* monitor, Clock::time_point t_run)
     : options_(options),

@@ -17,7 +17,7 @@
 #include "runtime/rejoin_arbiter.hpp"
 #include "runtime/run_monitor.hpp"
 #include "tessera.h"
-#include "transport/session.hpp"
+#include "transport/coordinator_session.hpp"
 
 namespace tessera::coordinator {
 
@@ -46,7 +46,7 @@ class LossHandling {
   /// `base`: the assignment the agents received (its owner map is the one in force);
   /// `graph`: the run's structure, for the survivors' re-partition; `monitor` may be null.
   /// With --rejoin-timeout or --replicas, makes the session tolerate lost agents.
-  LossHandling(const CoordinatorOptions& options, transport::Session& session,
+  LossHandling(const CoordinatorOptions& options, transport::CoordinatorSession& session,
                const GraphStructure& graph, const wire::PartitionAssignment& base,
                RunMonitor* monitor, Clock::time_point t_run);
 
@@ -70,7 +70,7 @@ class LossHandling {
   void report(const std::string& what, Clock::time_point now);
 
   const CoordinatorOptions& options_;
-  transport::Session& session_;
+  transport::CoordinatorSession& session_;
   const GraphStructure& graph_;
   wire::PartitionAssignment base_;
   RunMonitor* monitor_;

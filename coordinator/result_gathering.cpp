@@ -12,8 +12,8 @@ namespace tessera::coordinator {
 
 using namespace tessera::transport;
 
-void await_final_estimates(Session& s, const CoordinatorOptions& options, RoundReports& reports,
-                           LossHandling& losses, RunMonitor* monitor,
+void await_final_estimates(CoordinatorSession& s, const CoordinatorOptions& options,
+                           RoundReports& reports, LossHandling& losses, RunMonitor* monitor,
                            std::chrono::steady_clock::time_point t_run) {
   Mailroom& room = s.mailroom();
   // Called with the inbox locked (inside a wait's predicate).

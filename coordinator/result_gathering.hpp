@@ -9,7 +9,7 @@
 #include "coordinator/loss_handling.hpp"
 #include "coordinator/round_reports.hpp"
 #include "runtime/run_monitor.hpp"
-#include "transport/session.hpp"
+#include "transport/coordinator_session.hpp"
 
 namespace tessera::coordinator {
 
@@ -17,8 +17,9 @@ namespace tessera::coordinator {
 /// the current epoch) are queued in session.finals(). Throws RunFailure on a stop, on
 /// --run-timeout (counted from `t_run`, naming the agents whose estimates are missing), or
 /// when `losses` decides the run cannot go on. `monitor` may be null.
-void await_final_estimates(transport::Session& session, const CoordinatorOptions& options,
-                           RoundReports& reports, LossHandling& losses, RunMonitor* monitor,
+void await_final_estimates(transport::CoordinatorSession& session,
+                           const CoordinatorOptions& options, RoundReports& reports,
+                           LossHandling& losses, RunMonitor* monitor,
                            std::chrono::steady_clock::time_point t_run);
 
 }  // namespace tessera::coordinator

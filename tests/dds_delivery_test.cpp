@@ -3,7 +3,7 @@
 // the round statuses the coordinator reads (coordinator_reads_status) reach the coordinator
 // (the solve's only while it follows the rounds; otherwise the agents' progress digests), and
 // round statuses go through the relay agent (one bundle per step). A coordinator and three
-// agents, each a Session of its own in this process, on DDS domain 60.
+// agents, each a session of its own in this process, on DDS domain 60.
 
 #include <gtest/gtest.h>
 
@@ -16,7 +16,8 @@
 #include <variant>
 #include <vector>
 
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
+#include "transport/coordinator_session.hpp"
 #include "transport/topic_names.hpp"
 
 namespace {
@@ -65,6 +66,15 @@ OutgoingMessage status(std::uint32_t phase, std::uint32_t sender = 0, std::uint3
   return m;
 }
 
+// Opens a session of role S on `o`, kept in `sessions` (closed in reverse order at the end).
+template <class S>
+S& open_session(std::vector<std::unique_ptr<Session>>& sessions, const SessionOptions& o) {
+  auto owned = std::make_unique<S>(o);
+  S& session = *owned;
+  sessions.push_back(std::move(owned));
+  return session;
+}
+
 // Every session passes the readiness barrier (every endpoint matched, READY from all), all at
 // once as separate processes would.
 void pass_readiness_barriers(std::vector<std::unique_ptr<Session>>& sessions) {
@@ -78,7 +88,7 @@ void pass_readiness_barriers(std::vector<std::unique_ptr<Session>>& sessions) {
 }
 
 // The phases of the protocol messages `s` has received, in arrival order per type.
-std::vector<std::uint32_t> received_phases(Session& s, std::size_t expected) {
+std::vector<std::uint32_t> received_phases(AgentSession& s, std::size_t expected) {
   std::vector<std::uint32_t> out;
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   while (out.size() < expected && std::chrono::steady_clock::now() < until) {
@@ -97,13 +107,11 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   ASSERT_FALSE(coordinator_reads_status(300, true));  // the initialisation stage
 
   std::vector<std::unique_ptr<Session>> sessions;
-  sessions.push_back(std::make_unique<Session>(options_for(true, 0)));
-  for (std::uint32_t k = 0; k < kAgents; ++k)
-    sessions.push_back(std::make_unique<Session>(options_for(false, k)));
-  Session& coordinator = *sessions[0];
-  Session& a0 = *sessions[1];
-  Session& a1 = *sessions[2];
-  Session& a2 = *sessions[3];
+  CoordinatorSession& coordinator =
+      open_session<CoordinatorSession>(sessions, options_for(true, 0));
+  AgentSession& a0 = open_session<AgentSession>(sessions, options_for(false, 0));
+  AgentSession& a1 = open_session<AgentSession>(sessions, options_for(false, 1));
+  AgentSession& a2 = open_session<AgentSession>(sessions, options_for(false, 2));
 
   // Every process passes the readiness barrier (every endpoint matched, READY from all).
   ASSERT_NO_FATAL_FAILURE(pass_readiness_barriers(sessions));
@@ -116,10 +124,10 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   // when the agents turn it on (as tessera-agent does unless lost agents are arbitrated):
   // agents 1 and 2 send theirs to it alone ... (the coordinator follows the rounds here, as
   // while it arbitrates lost agents)
-  for (Session* a : {&a0, &a1, &a2}) {
-    a->set_status_relay(true);
-    a->set_coordinator_follows_rounds(true);
-  }
+  RoundTraffic traffic;
+  traffic.status_relay = true;
+  traffic.coordinator_follows_rounds = true;
+  for (AgentSession* a : {&a0, &a1, &a2}) a->set_round_traffic(traffic);
   a1.send(status(1, 1));
   a2.send(status(1, 2));
   const std::vector<std::uint32_t> at0 = received_phases(a0, 2);
@@ -169,7 +177,8 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   // By default the coordinator follows the agents' progress digests: the statuses of the
   // solve and their bundle stay among the agents; the coordinator gets the digest and agent
   // 0's report, nothing else.
-  for (Session* a : {&a0, &a1, &a2}) a->set_coordinator_follows_rounds(false);
+  traffic.coordinator_follows_rounds = false;
+  for (AgentSession* a : {&a0, &a1, &a2}) a->set_round_traffic(traffic);
   a1.send(status(1, 1, 8));
   a2.send(status(1, 2, 8));
   EXPECT_EQ(received_phases(a0, 2), (std::vector<std::uint32_t>{1u, 1u}));
@@ -181,8 +190,8 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   digest.cost(4.5);
   a1.publish(digest);
   a0.send(status(200, 0, 8));  // agent 0's final report
-  for (Session* a : {&a0, &a1, &a2}) a->flush(Seconds(10));
-  for (Session* a : {&a1, &a2}) {
+  for (AgentSession* a : {&a0, &a1, &a2}) a->flush(Seconds(10));
+  for (AgentSession* a : {&a1, &a2}) {
     const std::vector<std::uint32_t> at = received_phases(*a, 3);
     EXPECT_EQ(std::count(at.begin(), at.end(), 1u), 2);
     EXPECT_EQ(std::count(at.begin(), at.end(), 200u), 1);
@@ -207,23 +216,26 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   for (auto it = sessions.rbegin(); it != sessions.rend(); ++it) (*it)->close();
 }
 
-// Blocks to the relay ride in the sender's relayed status (Session::send_all,
+// Blocks to the relay ride in the sender's relayed status (AgentSession::send_all,
 // transport/riding_blocks.hpp): one sample reaches the relay for both, the block's other
 // recipients get it as before, and a step without a relayed status sends its blocks alone.
 TEST(DdsDelivery, BlocksToTheRelayRideInTheSendersStatusSample) {
   constexpr int kRidingDomain = 226;
-  std::vector<std::unique_ptr<Session>> sessions;
-  for (std::uint32_t k = 0; k <= kAgents; ++k) {
-    SessionOptions o = options_for(k == 0, k == 0 ? 0 : k - 1);
+  auto riding = [](bool coordinator, std::uint32_t agent) {
+    SessionOptions o = options_for(coordinator, agent);
     o.run_id = "riding-test";
     o.domain = kRidingDomain;
-    sessions.push_back(std::make_unique<Session>(o));
-  }
-  Session& a0 = *sessions[1];
-  Session& a1 = *sessions[2];
-  Session& a2 = *sessions[3];
+    return o;
+  };
+  std::vector<std::unique_ptr<Session>> sessions;
+  open_session<CoordinatorSession>(sessions, riding(true, 0));
+  AgentSession& a0 = open_session<AgentSession>(sessions, riding(false, 0));
+  AgentSession& a1 = open_session<AgentSession>(sessions, riding(false, 1));
+  AgentSession& a2 = open_session<AgentSession>(sessions, riding(false, 2));
   ASSERT_NO_FATAL_FAILURE(pass_readiness_barriers(sessions));
-  for (Session* a : {&a0, &a1, &a2}) a->set_status_relay(true);
+  RoundTraffic traffic;
+  traffic.status_relay = true;
+  for (AgentSession* a : {&a0, &a1, &a2}) a->set_round_traffic(traffic);
 
   auto block_from_1 = [](std::vector<std::uint32_t> to, std::uint32_t pose) {
     OutgoingMessage m = block_to(std::move(to), 3);  // an update step's Y poses

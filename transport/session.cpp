@@ -1,19 +1,18 @@
 // Session (session.hpp): opens the participant and the role's endpoints, then forwards each
-// public call to the part that owns the concept (session_parts.hpp).
+// shared call to the part that owns the concept (session_parts.hpp). The role's own calls are
+// in agent_session.cpp and coordinator_session.cpp.
 
 #include "transport/session.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <random>
-#include <variant>
 
-#include "transport/message_mapping.hpp"
-#include "transport/riding_blocks.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/security.hpp"
 #include "transport/session_parts.hpp"
 #include "transport/topic_names.hpp"
+#include "transport/transport_error.hpp"
 
 namespace tessera::transport {
 
@@ -30,7 +29,11 @@ SessionParts::SessionParts(const SessionOptions& options, int domain_id)
       writer(entities, opt, me.coordinator, trace) {}
 
 namespace {
-int resolved_domain(const SessionOptions& options) {
+int resolved_domain(const SessionOptions& options, bool coordinator_role) {
+  if (options.coordinator != coordinator_role)
+    throw TransportError(std::string("a session of the ") +
+                         (coordinator_role ? "coordinator" : "agent") +
+                         " role was opened with the options of the other role");
   options.validate();
   return options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
 }
@@ -53,24 +56,10 @@ GuidPrefix successor_prefix(const GuidPrefix& old, bool secured, std::size_t gen
   return p;
 }
 
-// A pose block as Session::send writes it, to `recipients` (or everyone when `broadcast`).
-void write_block(SessionParts& s, std::uint32_t epoch, const PoseBlockMessage& block,
-                 bool broadcast, const std::vector<std::uint32_t>& recipients) {
-  wire::PoseBlock w = to_wire_block(block, s.opt.run_id, broadcast, recipients);
-  w.epoch(epoch);
-  // Addressed blocks reach only their recipients (one sample on each one's own topic);
-  // broadcasts, and everything after a renumbering re-partition, use the shared topic.
-  if (broadcast || s.renumbered || s.opt.num_agents > kMaxAgentsWithRecipientTopics) {
-    s.writer.write(kBlockTopic, w);
-  } else {
-    for (std::uint32_t k : recipients)
-      if (k != s.me.agent_id) s.writer.write(block_topic_for(k), w);
-  }
-}
 }  // namespace
 
-Session::Session(const SessionOptions& options)
-    : impl_(std::make_unique<SessionParts>(options, resolved_domain(options))) {
+Session::Session(const SessionOptions& options, bool coordinator_role)
+    : impl_(std::make_unique<SessionParts>(options, resolved_domain(options, coordinator_role))) {
   SessionParts& s = *impl_;
   if (!options.security_dir.empty())
     s.security = security_properties(security_files(
@@ -106,168 +95,6 @@ Mailroom& Session::mailroom() {
   return impl_->room;
 }
 
-Inbox<wire::AgentAnnouncement>& Session::announcements() {
-  return impl_->announce_in;
-}
-Inbox<wire::PartitionAssignment>& Session::assignments() {
-  return impl_->assignment_in;
-}
-Inbox<wire::MeasurementHandoff>& Session::handoffs() {
-  return impl_->handoff_in;
-}
-Inbox<wire::MeasurementHandoff>& Session::replicas() {
-  return impl_->replica_in;
-}
-Inbox<ProtocolMessage>& Session::protocol() {
-  return impl_->protocol_in;
-}
-
-void Session::set_protocol_wake_threshold(std::size_t n) {
-  impl_->router.set_wake_threshold(n);
-}
-void Session::set_protocol_awaited(std::optional<AwaitedMessages> awaited) {
-  impl_->router.set_awaited(std::move(awaited));
-}
-bool Session::protocol_ready_locked() const {
-  return impl_->router.ready_locked();
-}
-Inbox<wire::RoundStatus>& Session::status_watch() {
-  return impl_->status_in;
-}
-Inbox<wire::AgentProgress>& Session::progress() {
-  return impl_->progress_in;
-}
-Inbox<wire::FinalEstimate>& Session::finals() {
-  return impl_->final_in;
-}
-Inbox<wire::Control>& Session::rejoins() {
-  return impl_->rejoin_in;
-}
-Inbox<wire::Control>& Session::rollbacks() {
-  return impl_->rollback_in;
-}
-
-std::uint32_t Session::epoch() const {
-  return impl_->router.epoch();
-}
-
-void Session::set_epoch(std::uint32_t e) {
-  impl_->router.set_epoch(e, protocol_id());
-}
-
-std::uint32_t Session::protocol_id() const {
-  return impl_->router.protocol_id();
-}
-
-void Session::set_epoch(std::uint32_t e, std::uint32_t protocol_id) {
-  impl_->renumbered = true;
-  impl_->router.set_epoch(e, protocol_id);
-}
-
-void Session::publish(const wire::AgentAnnouncement& m) {
-  impl_->writer.write(kAnnounceTopic, m);
-}
-void Session::publish(const wire::PartitionAssignment& m) {
-  impl_->writer.write(kAssignmentTopic, m);
-}
-void Session::publish(const wire::MeasurementHandoff& m) {
-  impl_->writer.write(kHandoffTopic, m);
-}
-void Session::publish(const wire::FinalEstimate& m) {
-  impl_->writer.write(kFinalTopic, m);
-}
-void Session::publish(wire::AgentProgress m) {
-  m.run_id(impl_->opt.run_id);
-  impl_->writer.write(kProgressTopic, m);
-}
-
-void Session::send(const OutgoingMessage& m) {
-  const std::string& run = impl_->opt.run_id;
-  const std::uint32_t e = epoch();
-  if (const auto* block = std::get_if<PoseBlockMessage>(&m.message)) {
-    write_block(*impl_, e, *block, m.broadcast, m.recipients);
-  } else {
-    const auto& status = std::get<RoundStatusMessage>(m.message);
-    wire::RoundStatus w = to_wire_status(status, run, m.broadcast, m.recipients);
-    w.epoch(e);
-    if (relayed_phase(status.phase) && impl_->relays_statuses()) {
-      if (impl_->me.agent_id != kRelayAgent) {
-        impl_->writer.write(kRelayStatusTopic, w);
-        return;
-      }
-      // The relay's own status completes a step when the others' came first.
-      impl_->room.with_lock([&] { return impl_->relay.add(w, impl_->router.epoch_locked()); });
-      relay_statuses();
-      return;
-    }
-    impl_->writer.write(coordinator_reads_status(status.phase, impl_->rounds_followed)
-                            ? kStatusTopic
-                            : kAgentStatusTopic,
-                        w);
-  }
-}
-
-void Session::send_all(const std::vector<OutgoingMessage>& messages) {
-  SessionParts& s = *impl_;
-  const std::uint32_t me = s.me.agent_id;
-  const bool to_relay = s.relays_statuses() && me != kRelayAgent && !s.renumbered &&
-                        s.opt.num_agents <= kMaxAgentsWithRecipientTopics;
-  // This step's status for the relay (a step has at most one; the first counts).
-  const OutgoingMessage* status = nullptr;
-  if (to_relay)
-    for (const auto& m : messages)
-      if (const auto* st = std::get_if<RoundStatusMessage>(&m.message);
-          st && relayed_phase(st->phase)) {
-        status = &m;
-        break;
-      }
-  const auto rides = [&](const OutgoingMessage& m) {
-    const auto* b = std::get_if<PoseBlockMessage>(&m.message);
-    return status && b && !m.broadcast && rides_with_status(b->phase) &&
-           std::find(m.recipients.begin(), m.recipients.end(), kRelayAgent) != m.recipients.end();
-  };
-  if (!status || std::none_of(messages.begin(), messages.end(), rides)) {
-    for (const auto& m : messages) send(m);
-    return;
-  }
-  for (const auto& m : messages) {
-    if (&m == status) {
-      wire::RoundStatus w = to_wire_status(std::get<RoundStatusMessage>(m.message), s.opt.run_id,
-                                           m.broadcast, m.recipients);
-      w.epoch(epoch());
-      for (const auto& b : messages)
-        if (rides(b)) attach_block(w, std::get<PoseBlockMessage>(b.message));
-      s.writer.write(kRelayStatusTopic, w);
-    } else if (rides(m)) {
-      std::vector<std::uint32_t> others;  // its other recipients get it as usual
-      for (std::uint32_t k : m.recipients)
-        if (k != kRelayAgent) others.push_back(k);
-      if (!others.empty())
-        write_block(s, epoch(), std::get<PoseBlockMessage>(m.message), false, others);
-    } else {
-      send(m);
-    }
-  }
-}
-
-void Session::set_status_relay(bool on) {
-  impl_->relay_enabled = on;
-}
-
-void Session::set_coordinator_follows_rounds(bool on) {
-  impl_->rounds_followed = on;
-}
-
-void Session::relay_statuses() {
-  SessionParts& s = *impl_;
-  if (!s.relays_statuses() || s.me.agent_id != kRelayAgent) return;
-  std::vector<wire::RoundStatus> bundles =
-      s.room.with_lock([&] { return s.relay.take_bundles(s.opt.run_id, kRelayAgent); });
-  // Bundles carry solve statuses: the coordinator's topic only when it follows them.
-  const char* topic = s.rounds_followed ? kStatusTopic : kAgentStatusTopic;
-  for (const auto& b : bundles) s.writer.write(topic, b);
-}
-
 void Session::send_control(wire::ControlKind kind, const std::string& reason) {
   wire::Control c;
   c.run_id(impl_->opt.run_id);
@@ -299,18 +126,6 @@ WaitStatus Session::ready_barrier(Seconds timeout, std::string* missing) {
   return impl_->readiness.barrier(
       timeout, missing, [this] { send_control(wire::CONTROL_READY); },
       [this] { impl_->entities.trace_match_state("barrier timeout"); });
-}
-
-bool Session::finished() const {
-  return impl_->readiness.finished();
-}
-
-const std::atomic<bool>& Session::finished_flag() const {
-  return impl_->readiness.finished_flag();
-}
-
-WaitStatus Session::wait_finished(Seconds timeout) {
-  return impl_->readiness.wait_finished(timeout);
 }
 
 std::vector<PeerIdentity> Session::live_peers() const {
@@ -386,10 +201,6 @@ std::vector<std::uint32_t> Session::lost_agents() const {
 
 void Session::flush(Seconds timeout) {
   impl_->writer.flush(timeout);
-}
-
-bool Session::handoffs_acknowledged(Seconds timeout) {
-  return impl_->writer.wait_acknowledged(kHandoffTopic, timeout);
 }
 
 void Session::linger_for_control(Seconds timeout, Seconds unseen_patience) {

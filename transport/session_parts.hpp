@@ -52,14 +52,14 @@ struct SessionParts {
   EpochRouter router;
   DdsEntities entities;
   SampleWriter writer;
-  // Set once a re-partition renumbered the protocol ids (Session::set_epoch with an id):
+  // Set once a re-partition renumbered the protocol ids (AgentSession::set_epoch with an id):
   // recipients are then no longer agent ids, so addressed pose blocks go on the shared
   // kBlockTopic (every agent's router picks its own) instead of block_topic_for(recipient).
   bool renumbered = false;
   // The relay agent's collection of round statuses (guarded by room's mutex).
   StatusRelay relay{opt.num_agents};
-  bool relay_enabled = false;    // Session::set_status_relay
-  bool rounds_followed = false;  // Session::set_coordinator_follows_rounds
+  bool relay_enabled = false;    // AgentSession::set_round_traffic
+  bool rounds_followed = false;  // AgentSession::set_round_traffic
   /// Whether this agent's round statuses go through the relay (status_relay.hpp): agents of
   /// runs of at least kMinAgentsForRelay that enabled it, until a re-partition renumbers the
   /// protocol ids (the relay is agent kRelayAgent, whose id that changes).

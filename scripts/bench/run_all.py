@@ -13,7 +13,8 @@ Experiments (each also runs alone: scripts/bench/exp_*.py):
   6 scale (10k/100k/1M poses)            exp_scale.py
 
 Each prints its table, writes CSV and one PNG figure under --out-dir; this command then writes
---out-dir/README.md with every table, figure, the machine (and its load) and the exact commands.
+--out-dir/README.md with every table, figure and the machine (and its load); the exact commands go to
+commands.txt beside it.
 --quick: small graphs and fewer rounds (a few minutes; CI smoke test). The full run is planned for
 30 minutes on a 2-core machine. Progress goes to stderr.
 """
@@ -121,11 +122,14 @@ def write_readme(a, ctx, results, failures, machine_before, started, total, pend
     for r in results:
         out.append(r.markdown(ctx.out_dir))
         out.append(f"_({r.seconds:.0f} s wall, {r.cpu_seconds:.0f} s CPU)_\n")
-    out += ["## Exact commands", "", "Every tessera command this invocation ran, in order "
-            "(`$WORK` = its scratch folder, `OUT.json`/`TRACE.csv` = temporary outputs):", "", "```"]
-    out += ctx.commands
-    out += ["```", ""]
     readme = a.readme or os.path.join(ctx.out_dir, "README.md")
+    # The command list is long (~240 lines): it goes beside the README, which links it.
+    commands = os.path.join(os.path.dirname(readme), "commands.txt")
+    with open(commands, "w") as f:
+        f.write("# Every tessera command of the run_all.py invocation that wrote README.md, in order\n"
+                "# ($WORK = its scratch folder, OUT.json / TRACE.csv = temporary outputs)\n")
+        f.write("\n".join(ctx.commands) + "\n")
+    out += ["Every tessera command this invocation ran, in order: [commands.txt](commands.txt).", ""]
     with open(readme, "w") as f:
         f.write("\n".join(out))
     print(f"\nwrote {os.path.relpath(readme, bc.ROOT)} ({total / 60:.1f} min)")

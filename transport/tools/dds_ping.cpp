@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "transport/session.hpp"
+#include "transport/agent_session.hpp"
 #include "transport/signal_watcher.hpp"
 
 using namespace tessera;
@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   so.agent_id = pinger ? 0 : 1;
   so.num_agents = 2;
   so.expect_coordinator = false;
-  Session s(so);
+  AgentSession s(so);
   signals.start(
       [&s](int signo) { s.mailroom().request_stop(exit_code_for_signal(signo), "interrupted"); });
   auto ms_since = [](std::chrono::steady_clock::time_point t) {
