@@ -5,8 +5,8 @@
 // in its forked children.
 
 #include "agent/agent_entry.hpp"
-#include "session_process.hpp"
+#include "transport/fastdds/process_exit.hpp"
 
 int main(int argc, char** argv) {
-  tessera::cli::exit_process(tessera::agent::agent_main(argc, argv));
+  tessera::transport::exit_process(tessera::agent::agent_main(argc, argv));
 }

@@ -54,7 +54,7 @@ class DdsProtocolChannel : public ProtocolChannel {
 
 /// Raised by the channel when the coordinator publishes a re-partition for the survivors (an
 /// assignment of a newer epoch): every survivor abandons its round and takes over its new
-/// block (agent/survivor_takeover.hpp).
+/// block (core/runtime/survivor_takeover.hpp).
 class RepartitionRequested : public std::runtime_error {
  public:
   explicit RepartitionRequested(wire::PartitionAssignment a)

@@ -118,7 +118,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   expect_ready(ready, room, o.net.timeout_s, "the other processes to be ready", missing);
   log("all processes ready");
 
-  // 6. Initial poses of our share (agent/initialization_stage.hpp), before they move.
+  // 6. Initial poses of our share (core/runtime/initialization_stage.hpp), before they move.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> structure =
       structure_of(asg, share.num_poses);
   DdsProtocolChannel channel(s);

@@ -1,6 +1,6 @@
 #pragma once
 // The DDS side of replication and take-over after a permanent agent loss (the bookkeeping is
-// agent/survivor_takeover.hpp; the flow is described in docs/fault-tolerance.md).
+// core/runtime/survivor_takeover.hpp; the flow is described in docs/fault-tolerance.md).
 
 #include <cstdint>
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
 // `tessera generate --split DIR`: one g2o file per robot, in the convention of
-// agent/robot_file.hpp (docs/dds-runtime.md, "One file per robot"): robot r's file holds the
+// core/runtime/robot_file.hpp (docs/dds-runtime.md, "One file per robot"): robot r's file holds the
 // header lines, the VERTEX lines of its poses [r n / R, (r + 1) n / R) and the EDGE lines of
 // the measurements it recorded (first endpoint among its poses), copied byte for byte from
 // the whole graph's g2o text so every value parses to the same double.

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <csignal>
 #include <cstdio>
-#include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <type_traits>
@@ -29,13 +28,6 @@ bool asks_for_help(const std::vector<std::string>& argv) {
 
 void print_help(const std::string& help) {
   std::fputs(help.c_str(), stdout);
-}
-
-void exit_process(int code) {
-  std::cout.flush();
-  std::cerr.flush();
-  std::fflush(nullptr);
-  std::_Exit(code);
 }
 
 void print_option_error(const std::string& program, const std::string& why) {

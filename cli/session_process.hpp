@@ -64,7 +64,7 @@ std::optional<int> parse_process_options(const std::vector<std::string>& argv,
 /// in `body` is printed, relayed to the others as ABORT (their own reasons unprefixed, so
 /// everyone learns the first cause) and mapped to its exit code; a stop requested while
 /// failing wins over the secondary error it caused. Returns the exit code (0 when `body`
-/// returned).
+/// returned); main() then ends with transport::exit_process (transport/fastdds/process_exit.hpp).
 int run_session_process(const transport::SessionOptions& options, const ProcessRole& role,
                         transport::SignalWatcher& signals,
                         const std::function<void(transport::AgentSession&)>& body);
@@ -72,12 +72,6 @@ int run_session_process(const transport::SessionOptions& options, const ProcessR
 int run_session_process(const transport::SessionOptions& options, const ProcessRole& role,
                         transport::SignalWatcher& signals,
                         const std::function<void(transport::CoordinatorSession&)>& body);
-
-/// Ends the process with `code` once run_session_process() has returned (the participant is
-/// deleted, nothing is left in /dev/shm): flushes stdout and stderr and exits WITHOUT
-/// running static destructors, because Fast DDS 2.9's DomainParticipantFactory destructor
-/// sleeps 100 ms at exit (seen with gdb), which every process of a run paid at its end.
-[[noreturn]] void exit_process(int code);
 
 // ---- implementation of the template
 

@@ -6,8 +6,8 @@
 // server also runs in its forked child.
 
 #include "coordinator/coordinator_entry.hpp"
-#include "session_process.hpp"
+#include "transport/fastdds/process_exit.hpp"
 
 int main(int argc, char** argv) {
-  tessera::cli::exit_process(tessera::coordinator::coordinator_main(argc, argv));
+  tessera::transport::exit_process(tessera::coordinator::coordinator_main(argc, argv));
 }

@@ -29,7 +29,7 @@ struct CoordinatorOptions {
   bool progress = false, verbose = false;
   double rejoin_timeout_s = 0;   ///< 0..86400 s; 0 = a lost agent stops the run.
   double status_interval_s = 5;  ///< 0..86400 s; 0 = no status lines.
-  /// Seconds between progress lines, 0..3600 (coordinator/progress_printer.hpp; the first, the
+  /// Seconds between progress lines, 0..3600 (core/runtime/progress_printer.hpp; the first, the
   /// restarts and the last always print). 0 = every completed step the coordinator sees: every
   /// round while it reads the round statuses (rejoin, replicas), else one per progress digest.
   double progress_interval_s = 0.1;

@@ -44,7 +44,7 @@ std::optional<FilePartition> partition_graph_file(const std::string& path, std::
                                                   std::string* why, double time_limit_s = 0.0);
 
 /// partition_graph_file on a thread of its own, started at once. The thread is detached: a
-/// process that fails before taking the result exits (cli::exit_process) without waiting for
+/// process that fails before taking the result exits (transport::exit_process) without waiting for
 /// it.
 class FilePartitionJob {
  public:

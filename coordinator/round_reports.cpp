@@ -40,7 +40,7 @@ void RoundReports::on_completed(const CompletedStep& step, double ms) {
 }
 
 bool RoundReports::on_report(const wire::RoundStatus& m) {
-  // The report fields ride on the status's numeric fields (agent/round_loop.hpp says which).
+  // The report fields ride on the status's numeric fields (core/runtime/round_loop.hpp says which).
   if (m.phase() == kAgentCertificateReportPhase) {
     results_.certificate =
         CertificateReport{m.restart_vote(), m.cost(), m.grad_norm_sq(), m.block_grad_norm()};

@@ -18,7 +18,7 @@
 
 namespace tessera::coordinator {
 
-// Status phases of agent 0's reports (agent/round_loop.hpp: kFinalReportPhase,
+// Status phases of agent 0's reports (core/runtime/round_loop.hpp: kFinalReportPhase,
 // kCertificateReportPhase, kCertificateBytesPhase; the coordinator does not link the agent).
 constexpr std::uint32_t kAgentFinalReportPhase = 200;
 constexpr std::uint32_t kAgentCertificateReportPhase = 201;

@@ -98,7 +98,7 @@ LaunchResult launch(LaunchOptions o) {
   // Ports of this domain that dead processes of an earlier run left (a SIGKILLed agent started by
   // hand, an abort inside Fast DDS) can keep this run's participants from discovering each other
   // (every later launch on that domain failed until they were removed). Only files no live
-  // process holds or maps go (shm_leftovers.hpp).
+  // process holds or maps go (transport/fastdds/shm_leftovers.hpp).
   const int run_domain =
       o.net.session.domain >= 0 ? o.net.session.domain : transport::domain_for_run(result.run_id);
   {

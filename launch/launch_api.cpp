@@ -4,8 +4,11 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <tessera/dds/launch.hpp>
+#include <tessera/util/input_error.hpp>
+#include <vector>
 
 #include "launch/launch.hpp"
 
@@ -19,17 +22,35 @@ std::string exact(double x) {
   return buf;
 }
 
-// `bin_dir`, else the folder of the running program when it holds tessera-agent, else the
-// installed executables.
+// Whether `dir` holds the executables launch starts.
+bool holds_executables(const std::string& dir) {
+  return access((dir + "/tessera-agent").c_str(), X_OK) == 0 &&
+         access((dir + "/tessera-coordinator").c_str(), X_OK) == 0;
+}
+
+// The folder of the executables (LaunchOptions::bin_dir in <tessera/dds/launch.hpp>): `bin_dir`
+// when given; else the first that holds them of the running program's folder (a build tree, or
+// a program installed beside them), the bindir of the install prefix this library was
+// configured for, and the folders on PATH (an installed package moved to another prefix whose
+// bin/ is on PATH). Throws InputError naming the folders looked in.
 std::string executables_dir(const std::string& bin_dir) {
   if (!bin_dir.empty()) return bin_dir;
-  const std::string self = launch::running_program_dir();
-  if (access((self + "/tessera-agent").c_str(), X_OK) == 0) return self;
+  std::vector<std::string> candidates{launch::running_program_dir()};
 #ifdef TESSERA_INSTALL_BINDIR
-  return TESSERA_INSTALL_BINDIR;
-#else
-  return self;
+  candidates.push_back(TESSERA_INSTALL_BINDIR);
 #endif
+  for (const std::string& dir : candidates)
+    if (holds_executables(dir)) return dir;
+  if (const char* path = std::getenv("PATH")) {
+    std::istringstream dirs(path);
+    for (std::string dir; std::getline(dirs, dir, ':');)
+      if (!dir.empty() && holds_executables(dir)) return dir;
+  }
+  std::string looked;
+  for (const std::string& dir : candidates) looked += dir + ", ";
+  throw InputError("launch: tessera-agent and tessera-coordinator not found in " + looked +
+                   "or on PATH; set LaunchOptions::bin_dir (find_package(Tessera) sets "
+                   "Tessera_BINDIR to the package's)");
 }
 
 }  // namespace

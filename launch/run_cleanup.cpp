@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "launch/shm_leftovers.hpp"
+#include "transport/fastdds/shm_leftovers.hpp"
 
 namespace tessera::launch {
 
@@ -26,10 +26,10 @@ WorkDir::~WorkDir() {
 }
 
 void remove_dead_files_of(int domain, std::set<std::string> segments, const char* when) {
-  ShmCleanupOptions shm;
+  transport::ShmCleanupOptions shm;
   shm.domain = domain;
   shm.segments = std::move(segments);
-  const ShmCleanupResult r = remove_dead_shm_files(shm);
+  const transport::ShmCleanupResult r = transport::remove_dead_shm_files(shm);
   if (!r.removed.empty())
     std::fprintf(stderr,
                  "tessera launch: removed %zu shared-memory files of dead processes of domain %d "

@@ -1,6 +1,6 @@
 #pragma once
 // What a launch run leaves behind and how it goes: its temporary folder, and the Fast DDS
-// shared-memory files of killed processes (shm_leftovers.hpp).
+// shared-memory files of killed processes (transport/fastdds/shm_leftovers.hpp).
 
 #include <set>
 #include <string>

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "launch/shm_leftovers.hpp"
 #include "runtime/progress_lines.hpp"
+#include "transport/fastdds/shm_leftovers.hpp"
 
 namespace tessera::launch {
 
@@ -20,12 +20,13 @@ void on_signal(int signo) {
 }
 
 // Adds the data segments the running `children` map now to `segments`: a killed process
-// cannot remove its own, and only its peers' maps tell its segment apart (shm_leftovers.hpp).
+// cannot remove its own, and only its peers' maps tell its segment apart
+// (transport/fastdds/shm_leftovers.hpp).
 void note_segments(const std::vector<Child>& children, std::set<std::string>& segments) {
   std::vector<pid_t> pids;
   for (const auto& c : children)
     if (c.running) pids.push_back(c.pid);
-  const auto mapped = mapped_segments(pids);
+  const auto mapped = transport::mapped_segments(pids);
   segments.insert(mapped.begin(), mapped.end());
 }
 

@@ -49,7 +49,8 @@ struct SupervisionOutcome {
   std::string summary;  ///< its text
   /// A process ended through a teardown guard (a note in its log).
   bool guard_ended = false;
-  /// Data segments the run's processes mapped when one of them failed (shm_leftovers.hpp).
+  /// Data segments the run's processes mapped when one of them failed
+  /// (transport/fastdds/shm_leftovers.hpp).
   std::set<std::string> run_segments;
 };
 

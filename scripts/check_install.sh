@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Installs a build tree into a temporary prefix, builds examples/ against it as a project of its
 # own (find_package(Tessera)) and runs the examples on a small generated graph: the centralized
-# and the in-process distributed solve, and one agent of a DDS run hosted by host_agent (the
-# coordinator and the other agent are the installed executables).
-#   scripts/check_install.sh [BUILD_DIR]      (default: build; DDS domain $TESSERA_EXAMPLE_DOMAIN, 14)
+# and the in-process distributed solve, one agent of a DDS run hosted by host_agent (the
+# coordinator and the other agent are the installed executables), and a whole DDS run launched
+# by launch_run from the prefix's executables.
+#   scripts/check_install.sh [BUILD_DIR]      (default: build; DDS domains $TESSERA_EXAMPLE_DOMAIN,
+#   14, and $TESSERA_EXAMPLE_LAUNCH_DOMAIN, 39)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:-$root/build}" && pwd)
@@ -49,5 +51,16 @@ if [ -x "$tmp/ex/host_agent" ]; then
     exit 1
   fi
   echo "hosted agent: run $run finished, summary has its rounds"
+fi
+if [ -x "$tmp/ex/launch_run" ]; then
+  # launch() finds the executables of a package installed into a prefix other than the
+  # configured one (Tessera_BINDIR).
+  if ! timeout 300 "$tmp/ex/launch_run" "$tmp/g.g2o" 2 "${TESSERA_EXAMPLE_LAUNCH_DOMAIN:-39}" \
+    > "$tmp/launch.log" 2>&1 || ! grep -q "done, exit code 0" "$tmp/launch.log"; then
+    echo "check_install: the launched run failed" >&2
+    tail -5 "$tmp/launch.log" >&2
+    exit 1
+  fi
+  echo "launched run: done"
 fi
 echo "check_install: OK (prefix, find_package(Tessera), examples)"

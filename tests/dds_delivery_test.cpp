@@ -19,6 +19,7 @@
 #include "transport/agent_session.hpp"
 #include "transport/coordinator_session.hpp"
 #include "transport/topic_names.hpp"
+#include "transport/transport_error.hpp"
 
 namespace {
 
@@ -97,6 +98,13 @@ std::vector<std::uint32_t> received_phases(AgentSession& s, std::size_t expected
       out.push_back(std::visit([](const auto& x) { return x.phase; }, m));
   }
   return out;
+}
+
+// The session's type is its role: options of the other role are refused before any
+// participant exists.
+TEST(DdsDelivery, ASessionRefusesTheOptionsOfTheOtherRole) {
+  EXPECT_THROW(AgentSession{options_for(true, 0)}, TransportError);
+  EXPECT_THROW(CoordinatorSession{options_for(false, 1)}, TransportError);
 }
 
 TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyItsStatuses) {

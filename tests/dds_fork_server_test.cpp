@@ -33,8 +33,8 @@
 #include "launch/fork_spec.hpp"
 #include "launch/huge_page_heaps.hpp"
 #include "launch/launch_children.hpp"
-#include "launch/shm_leftovers.hpp"
 #include "launch/startup_batch.hpp"
+#include "transport/fastdds/shm_leftovers.hpp"
 
 namespace tessera::test::dds {
 namespace {
@@ -302,9 +302,9 @@ TEST(DdsForkServer, StopAllKillsAndNamesAChildThatIgnoresSigint) {
 }
 
 // After a run that lost a process, launch removes the shared-memory files its dead processes
-// left (shm_leftovers.hpp): ports of its domain and segments its processes mapped, each only
-// when no live process holds its lock. Here in a directory of its own, with locks held by this
-// test (flock locks of two open() calls conflict, even in one process).
+// left (transport/fastdds/shm_leftovers.hpp): ports of its domain and segments its processes
+// mapped, each only when no live process holds its lock. Here in a directory of its own, with locks
+// held by this test (flock locks of two open() calls conflict, even in one process).
 TEST(DdsShmLeftovers, OnlyDeadPortsOfTheDomainAndDeadSegmentsOfTheRunAreRemoved) {
   const std::string dir = temp_dir();
   auto touch = [&](const std::string& name) { std::ofstream(dir + "/" + name) << "x"; };
@@ -343,11 +343,11 @@ TEST(DdsShmLeftovers, OnlyDeadPortsOfTheDomainAndDeadSegmentsOfTheRunAreRemoved)
   const int port_lock = hold("fastrtps_port8161_el");
   const int segment_lock = hold("fastrtps_aaaaaaaaaaaaaaaa_el");
 
-  launch::ShmCleanupOptions o;
+  transport::ShmCleanupOptions o;
   o.domain = 3;
   o.dir = dir;
   o.segments = {"fastrtps_0123456789abcdef", "fastrtps_aaaaaaaaaaaaaaaa"};
-  const launch::ShmCleanupResult r = launch::remove_dead_shm_files(o);
+  const transport::ShmCleanupResult r = transport::remove_dead_shm_files(o);
   std::vector<std::string> expected = dead_port;
   expected.insert(expected.end(), dead_shared_port.begin(), dead_shared_port.end());
   expected.insert(expected.end(), lock_gone.begin(), lock_gone.end());
@@ -371,11 +371,11 @@ TEST(DdsShmLeftovers, OnlyDeadPortsOfTheDomainAndDeadSegmentsOfTheRunAreRemoved)
   ASSERT_GE(fd, 0);
   void* map = mmap(nullptr, 4096, PROT_READ, MAP_SHARED, fd, 0);
   ASSERT_NE(map, MAP_FAILED);
-  EXPECT_EQ(launch::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 1u);
+  EXPECT_EQ(transport::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 1u);
   munmap(map, 4096);
   close(fd);
   unlink(shm.c_str());
-  EXPECT_EQ(launch::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 0u);
+  EXPECT_EQ(transport::mapped_segments({getpid()}).count("fastrtps_5a5a5a5a5a5a5a5a"), 0u);
 }
 
 // Dead ports of the run's domain that an earlier run's processes left (an abort, a SIGKILLed agent

@@ -1,4 +1,5 @@
-// The agents' initialisation stage (agent/initialization_stage.hpp), over DDS and in process.
+// The agents' initialisation stage (core/runtime/initialization_stage.hpp), over DDS and in
+// process.
 //  - In process (threads and an in-memory channel, no DDS): every agent's poses equal core's
 //    chordal / distributed initialisation of the whole graph bit for bit.
 //  - Over DDS (processes): a graph without VERTEX lines, `--init distributed` and the default
@@ -55,8 +56,8 @@ class Exchange {
     if (!cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
                       [&] { return !queues_[self].empty(); }))
       return std::nullopt;
-    // GCC 12 at -O2 reports the moved-from variant's scalars as maybe uninitialized (a known
-    // false positive of -Wmaybe-uninitialized with std::variant); every field has an initializer.
+      // GCC 12 at -O2 reports the moved-from variant's scalars as maybe uninitialized (a known
+      // false positive of -Wmaybe-uninitialized with std::variant); every field has an initializer.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
     ProtocolMessage m = std::move(queues_[self].front());

@@ -345,8 +345,9 @@ inline std::string join(const std::set<std::string>& s) {
 }
 
 /// After a launch in which a process died inside Fast DDS (SIGKILL, an abort): launch's output
-/// `out` says it removed the dead shared-memory files of `domain` (launch/shm_leftovers.hpp) and
-/// none of them is left since `before` (whatever is, is removed here after the check).
+/// `out` says it removed the dead shared-memory files of `domain`
+/// (transport/fastdds/shm_leftovers.hpp) and none of them is left since `before` (whatever is, is
+/// removed here after the check).
 inline void expect_launch_removed_dead_shm_files(const std::string& out,
                                                  const std::set<std::string>& before, int domain) {
   EXPECT_NE(out.find("shared-memory files of dead processes of domain " + std::to_string(domain)),

@@ -1,5 +1,5 @@
-// One file per robot (agent/robot_file.hpp, `tessera generate --split`, `tessera launch DIR`):
-// reading a robot's own file gives the same share as taking its part of the whole file, and
+// One file per robot (core/runtime/robot_file.hpp, `tessera generate --split`, `tessera launch
+// DIR`): reading a robot's own file gives the same share as taking its part of the whole file, and
 // a run from per-robot files gives the same result as from the single file.
 // Domains used here: 203-204 (each test its own, so ctest -j is safe).
 
@@ -103,7 +103,7 @@ TEST(DdsRobotFiles, WithoutIndexOrVerticesTheConventionStillHolds) {
   EXPECT_THROW(agent::adopt_num_poses(own, 60, path), InputError);  // poses beyond n
 }
 
-// The fork server's graph cache (agent/preloaded_graph.hpp): the same graph as reading the
+// The fork server's graph cache (core/runtime/preloaded_graph.hpp): the same graph as reading the
 // file, only for that exact path, and nothing kept (no throw) for a robot file or a file
 // that does not parse, which each agent then reads itself and reports.
 TEST(DdsRobotFiles, PreloadedGraphIsTheFilesGraphForThatPathOnly) {

@@ -307,7 +307,7 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
   EXPECT_NE(out.find("error: lost agent 1"), std::string::npos) << out;
   EXPECT_NE(out.find("participant lease"), std::string::npos) << out;
   // The killed agent could not remove its shared-memory files; launch removed them after the
-  // run (launch/shm_leftovers.hpp): no file of this domain that no process uses is left.
+  // run (transport/fastdds/shm_leftovers.hpp): no file of this domain that no process uses is left.
   expect_launch_removed_dead_shm_files(out, before, 166);
 }
 

@@ -1,4 +1,4 @@
-// The flat layout of a measurement's values (core/graph/flat_measurement.hpp): R
+// The flat layout of a measurement's values (core/include/tessera/graph/flat_measurement.hpp): R
 // column-major and t, into separate arrays (the hand-off) or one array (the initialisation
 // stage), read back at offsets, short arrays refused.
 

@@ -1,5 +1,5 @@
-// The flat pose layout (core/graph/flat_pose.hpp): R column-major then t, padding, reading
-// at an offset, and refusing arrays that are too short.
+// The flat pose layout (core/include/tessera/graph/flat_pose.hpp): R column-major then t, padding,
+// reading at an offset, and refusing arrays that are too short.
 
 #include <gtest/gtest.h>
 

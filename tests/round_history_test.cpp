@@ -1,6 +1,6 @@
-// RoundHistory (core/distributed/round_history.hpp): the protocol's trace, which snapshots
-// copy every round. Copies share full chunks, yet behave as independent values: records read
-// back in order across chunk boundaries, and changing or growing one copy never shows in
+// RoundHistory (core/include/tessera/distributed/round_history.hpp): the protocol's trace, which
+// snapshots copy every round. Copies share full chunks, yet behave as independent values: records
+// read back in order across chunk boundaries, and changing or growing one copy never shows in
 // another (a snapshot keeps the restart flag and length it was taken with).
 
 #include <gtest/gtest.h>

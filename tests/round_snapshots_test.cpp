@@ -1,4 +1,4 @@
-// When an agent takes round snapshots (agent/checkpoint_keeper.hpp, snapshots_needed): a
+// When an agent takes round snapshots (core/runtime/checkpoint_keeper.hpp, snapshots_needed): a
 // snapshot copies every block matrix each round (the trace shares its older records,
 // distributed/round_history.hpp), so only runs where something reads them (rollback for a
 // rejoin, a restart, checkpoint files, replicas) take them. That the iterates are unchanged either

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <tessera/util/input_error.hpp>
 
+#include "transport/fastdds/handshake_stall.hpp"
 #include "transport/session.hpp"
 
 namespace tessera::transport {
@@ -49,10 +50,7 @@ GateStep judge_peers(const SessionOptions& self, bool secured, const std::vector
     if (!v) {
       what = want.describe() + " (not discovered yet)";
     } else if (!v->authenticated) {
-      // Exactly one side of a pair re-creates: this agent when the peer is the coordinator
-      // (which never does) or an agent with a smaller id.
-      const bool ours = want.coordinator || self.agent_id > want.agent_id;
-      if (ours && v->known_for_s >= stall_after_s)
+      if (cures_stalled_handshake(self.agent_id, want, v->known_for_s, stall_after_s))
         return {GateStep::kReopenStalled, want.describe()};
       what = want.describe() + " (not authenticated yet)";
     }

@@ -5,12 +5,9 @@
 // participant (Session::replace_participant) on the way, each bounded:
 // - the coordinator talks UDP only (its run keeps replicas / waits for rejoins) while this
 //   agent's participant still has shared memory: one re-creation, UDP only;
-// - DDS Security: a peer stays discovered but unauthenticated for `stall_after`. Fast DDS 2.9
-//   sometimes never completes one pair's PKI-DH handshake (one side's handshake writer never
-//   sends to that peer; docs/dds-runtime.md, "secured set-up stall"), and nothing in its API
-//   restarts a handshake; a new participant starts a new one. Exactly one side of a stalled
-//   pair re-creates: the agent, when the peer is the coordinator; the larger id, when both are
-//   agents. At most `max_reopens` times.
+// - DDS Security: a peer stays discovered but unauthenticated for `stall_after` (a Fast DDS 2.9
+//   defect; which side of the pair re-creates: transport/fastdds/handshake_stall.hpp). At most
+//   `max_reopens` times.
 // Nothing was announced yet, so a re-created participant is invisible to the run except that
 // peers forget the old one (ParticipantTags::replaces) instead of treating it as lost.
 

@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <random>
 
+#include "transport/fastdds/successor_prefix.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/security.hpp"
 #include "transport/session_parts.hpp"
@@ -36,24 +36,6 @@ int resolved_domain(const SessionOptions& options, bool coordinator_role) {
                          " role was opened with the options of the other role");
   options.validate();
   return options.domain >= 0 ? options.domain : domain_for_run(options.run_id);
-}
-// The GUID prefix of a re-created participant. Fast DDS would derive the same one as before
-// (host, process, lowest free participant number; with DDS Security a hash of that and the
-// identity), and peers that still hold state of the deleted participant then mistake the new
-// one for it (seen: its endpoints never match, "Cannot find remote writer"). Unsecured: same
-// vendor, host and process bytes (Fast DDS's locality checks read them), a participant
-// number no first participant has. Secured: the prefix is only a seed that Fast DDS hashes,
-// so any unused value does.
-GuidPrefix successor_prefix(const GuidPrefix& old, bool secured, std::size_t generation) {
-  static std::mt19937 random(std::random_device{}());
-  GuidPrefix p = old;
-  p.value[0] = 0x01;  // eProsima's vendor id
-  p.value[1] = 0x0f;
-  if (secured)
-    for (int k = 2; k < 8; ++k) p.value[k] = static_cast<std::uint8_t>(random());
-  p.value[8] = static_cast<std::uint8_t>(0xf0 | (generation & 0x0f));
-  for (int k = 9; k < 12; ++k) p.value[k] = static_cast<std::uint8_t>(random());
-  return p;
 }
 
 }  // namespace
@@ -173,6 +155,7 @@ void Session::replace_participant(bool shared_memory, Seconds notice, const std:
   tags.udp_only = !s.opt.uses_shared_memory();
   tags.retiring = false;
   tags.replaces = s.former_prefixes;
+  // Not the prefix Fast DDS would derive: peers would take it for the old one.
   const GuidPrefix next = successor_prefix(old, !s.security.empty(), s.former_prefixes.size());
   try {
     s.entities.open(s.domain, s.me, s.security, tags.encode(), &next);

@@ -29,16 +29,16 @@ inline constexpr const char* kProgressTopic = "tessera_agent_progress";
 
 /// Whether a round status of this phase is one of core's round statuses of the solve
 /// (ProtocolPhase::kStatus = 1, and kRedoStatus = 5 after a momentum restart;
-/// core/distributed/round_protocol.hpp): the ones the coordinator follows for progress and loss
-/// handling, and the ones the status relay bundles.
+/// core/include/tessera/distributed/round_protocol.hpp): the ones the coordinator follows for
+/// progress and loss handling, and the ones the status relay bundles.
 inline bool is_solve_status_phase(std::uint32_t phase) {
   return phase == 1 || phase == 5;
 }
 
 /// Whether the coordinator reads round statuses of this phase (they go on kStatusTopic, the
 /// others on kAgentStatusTopic): agent 0's reports (200..299: final report, certificate;
-/// agent/round_loop.hpp) always, and core's round statuses of the solve (phase 1, and 5 after
-/// a restart; coordinator/round_reports.hpp's is_round_status) only when `rounds_followed`:
+/// core/runtime/round_loop.hpp) always, and core's round statuses of the solve (phase 1, and 5
+/// after a restart; coordinator/round_reports.hpp's is_round_status) only when `rounds_followed`:
 /// while the coordinator arbitrates lost agents (rejoin, replicas), whose rollback round and
 /// lag checks need each agent's own latest round. Otherwise it follows the agents' progress
 /// digests (kProgressTopic) and is not woken by the N statuses of every round.

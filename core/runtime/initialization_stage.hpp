@@ -8,7 +8,8 @@
 //                values it recorded to agent 0, which solves it on the whole graph exactly as
 //                `tessera solve` does (measurements in file order) and broadcasts the poses.
 //                Centralized by definition (it is the reference); agent 0 sees every value.
-//   distributed  no central solve (core/distributed/distributed_initialization.hpp): each
+//   distributed  no central solve
+//   (core/include/tessera/distributed/distributed_initialization.hpp): each
 //                robot runs chordal on its own measurements (robot_units); every robot then
 //                broadcasts its unit count, its unit poses at the ends of inter-robot
 //                measurements and the inter-robot measurements it recorded; each agent aligns

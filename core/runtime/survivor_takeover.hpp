@@ -4,8 +4,8 @@
 //
 // 1. Replication: after the hand-off every agent sends its local problem (every measurement
 //    touching its poses, and its lifted initial poses) to its replica holders
-//    (core/distributed/replica_plan.hpp), and every `replica_every` rounds its current lifted
-//    poses. A holder keeps them in a ReplicaStore.
+//    (core/include/tessera/distributed/replica_plan.hpp), and every `replica_every` rounds its
+//    current lifted poses. A holder keeps them in a ReplicaStore.
 // 2. Take-over: when the coordinator publishes a re-partition for the survivors, every survivor
 //    sends every other survivor one take-over message: the measurements touching the poses the
 //    recipient gains (from its own problem and from the replicas of lost agents it holds) and

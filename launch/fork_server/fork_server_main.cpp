@@ -39,11 +39,11 @@
 
 #include "agent/agent_entry.hpp"
 #include "agent/agent_options.hpp"
-#include "cli/session_process.hpp"
 #include "coordinator/coordinator_entry.hpp"
 #include "launch/fork_spec.hpp"
 #include "launch/startup_batch.hpp"
 #include "runtime/preloaded_graph.hpp"
+#include "transport/fastdds/process_exit.hpp"
 
 using namespace tessera;
 
@@ -93,7 +93,7 @@ std::string shared_agent_graph(const launch::ForkSpec& spec) {
 // What every agent would otherwise do on its own at start-up, done once here so that the
 // agents inherit it (copy-on-write pages they only read); measured ~3 ms of CPU per agent
 // each, spent while the coordinator partitions on both cores (docs/dds-runtime.md, "Start-up"):
-// - the shared graph file, parsed (agent/preloaded_graph.hpp; a file that does not parse is
+// - the shared graph file, parsed (core/runtime/preloaded_graph.hpp; a file that does not parse is
 //   left to each agent, which reports it);
 // - Fast DDS's TypeObjectFactory singleton (builtin types and annotations), which each
 //   process otherwise builds when it announces its first endpoint. It is a table of type
@@ -172,7 +172,7 @@ bool agents_batch_at_start(const launch::ForkSpec& spec) {
   const int code = c.role == launch::ForkRole::kCoordinator
                        ? coordinator::coordinator_main(argc, argv.data())
                        : agent::agent_main(argc, argv.data());
-  cli::exit_process(code);
+  transport::exit_process(code);
 }
 
 }  // namespace
@@ -228,5 +228,5 @@ int main(int argc, char** argv) {
     }
   }
   close(spec.pid_fd);
-  cli::exit_process(0);
+  transport::exit_process(0);
 }

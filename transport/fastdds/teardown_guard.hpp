@@ -9,8 +9,8 @@
 //    timer (SecurityManager::remove_participant destroys its handshake timer while the event
 //    thread waits for the PDP mutex): the process never exits.
 // The abort also struck a coordinator once after its summary, while the agents' participants
-// left (coordinator_run.cpp guards that step too), and an agent at the end of a run (session
-// 13: cli/session_process.cpp covers an agent from the coordinator's FINISHED on). Both are
+// left (coordinator_run.cpp guards that step too), and an agent at the end of a run
+// (cli/session_process.cpp covers an agent from the coordinator's FINISHED on). Both are
 // inside Fast DDS and cannot be avoided from the API. While a TeardownGuard lives, a
 // SIGABRT or a teardown longer than `timeout` ends the process at once with `exit_code` (the
 // code the process was about to return) and a one-line note on stderr, so a finished run is

@@ -4,7 +4,7 @@
 //    (mutual discovery and every endpoint matched);
 //  - round trip: ping sends a pose block (kind P) of --poses poses of rank --rank in
 //    dimension --dim to echo, which sends it straight back; --count round trips.
-// Prints one line of key=value results (times in ms). Used by scripts/bench/dds_roundtrip.sh.
+// Prints one line of key=value results (times in ms). Used by scripts/bench/dds_transport.sh.
 
 #include <algorithm>
 #include <chrono>

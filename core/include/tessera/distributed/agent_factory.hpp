@@ -1,7 +1,7 @@
 #pragma once
 // How one agent of a distributed solve is configured from the run's options, shared by the
-// in-process engine (distributed_solver.cpp) and the DDS agent (agent/round_loop.cpp), so both
-// build identical agents and therefore produce identical iterates.
+// in-process engine (distributed_solver.cpp) and the DDS agent (core/runtime/round_loop.cpp), so
+// both build identical agents and therefore produce identical iterates.
 
 #include <Eigen/Core>
 #include <memory>

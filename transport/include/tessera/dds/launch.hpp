@@ -23,8 +23,12 @@ struct LaunchOptions {
   bool quiet = false;      ///< No progress lines.
   /// The session options of every process (its timeout_s is not used: see timeout_s).
   SessionOptions session;
-  /// Folder of tessera-coordinator and tessera-agent; "" = next to the running program, else
-  /// the installed ones.
+  /// Folder of tessera-coordinator and tessera-agent. "" = the first folder that holds both of:
+  /// the running program's folder (a build tree, or a program installed beside them); the
+  /// bindir of the install prefix the library was configured with; the folders on PATH. A
+  /// package installed into another prefix (`cmake --install --prefix P`) is found through
+  /// PATH or through this field: after find_package(Tessera), `Tessera_BINDIR` is P's bindir,
+  /// e.g. `target_compile_definitions(app PRIVATE TESSERA_BINDIR="${Tessera_BINDIR}")`.
   std::string bin_dir;
   /// More `tessera launch` options, as on its command line (tessera launch --help).
   std::vector<std::string> extra_args;

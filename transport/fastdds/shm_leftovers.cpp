@@ -1,4 +1,4 @@
-#include "launch/shm_leftovers.hpp"
+#include "transport/fastdds/shm_leftovers.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -11,7 +11,7 @@
 #include <fstream>
 #include <map>
 
-namespace tessera::launch {
+namespace tessera::transport {
 
 namespace {
 
@@ -160,4 +160,4 @@ ShmCleanupResult remove_dead_shm_files(const ShmCleanupOptions& options) {
   return result;
 }
 
-}  // namespace tessera::launch
+}  // namespace tessera::transport
