@@ -161,6 +161,15 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     b.block_grad_norm = res.escape_rounds;
     channel.send(OutgoingMessage{b, true, {}});
   }
+  if (local.agent_id == 0) {  // agent 0's times, for the coordinator's phase split
+    RoundStatusMessage t;
+    t.round = res.rounds;
+    t.phase = kPhaseTimesPhase;
+    t.sender = 0;
+    t.cost = res.solve_s;
+    t.grad_norm_sq = res.rounding_s;
+    channel.send(OutgoingMessage{t, true, {}});
+  }
   if (local.agent_id == 0) {  // one report for the coordinator's summary
     RoundStatusMessage st;
     st.round = res.rounds;

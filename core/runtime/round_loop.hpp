@@ -155,6 +155,10 @@ constexpr std::uint32_t kCertificateReportPhase = 201;
 /// And its traffic: cost = certificate bytes, grad_norm_sq = escape bytes (all agents),
 /// block_grad_norm = escape rounds.
 constexpr std::uint32_t kCertificateBytesPhase = 202;
+/// And, before the final report in every run, its own times: cost = solve_s (core's protocol:
+/// rounds, and certificate and escapes when certified), grad_norm_sq = rounding_s (seconds), so
+/// the coordinator can split the time after the last round into certificate and rounding.
+constexpr std::uint32_t kPhaseTimesPhase = 203;
 
 /// Optional recovery hooks of the round loop.
 struct RoundLoopHooks {
