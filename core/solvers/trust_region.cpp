@@ -27,6 +27,9 @@ void TrustRegionOptions::validate() const {
   if (!(initial_radius_scale > 0 && std::isfinite(initial_radius_scale)))
     fail("initial_radius_scale", "must be finite and > 0");
   if (!(tcg_kappa > 0 && tcg_kappa < 1)) fail("tcg_kappa", "must be in (0, 1)");
+  if (!(tcg_kappa_near >= 0 && tcg_kappa_near < 1)) fail("tcg_kappa_near", "must be in [0, 1)");
+  if (!(near_relative_grad >= 0 && near_relative_grad <= 1))
+    fail("near_relative_grad", "must be in [0, 1]");
   if (!(tcg_theta > 0 && tcg_theta <= 1)) fail("tcg_theta", "must be in (0, 1]");
   if (!(acceptance_ratio >= 0 && acceptance_ratio < 0.25))
     fail("acceptance_ratio", "must be in [0, 0.25)");
@@ -58,8 +61,8 @@ struct TcgOutcome {
 TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
                         const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
                         const Eigen::MatrixXd& grad, double radius, const TrustRegionOptions& opt,
-                        const RiemannianPreconditioner* precon,
-                        const Eigen::MatrixXd* precon_grad) {
+                        const RiemannianPreconditioner* precon, const Eigen::MatrixXd* precon_grad,
+                        double kappa) {
   auto precondition = [&](const Eigen::MatrixXd& v) { return precon ? precon->apply(M, X, v) : v; };
   TcgOutcome out;
   out.eta = Eigen::MatrixXd::Zero(X.rows(), X.cols());
@@ -93,7 +96,7 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
     r += alpha * Hdelta;
     r = M.tangent_project(X, r);  // keep rounding errors from leaving the tangent space
     const double r_norm = std::sqrt(inner(r, r));
-    if (r_norm <= r0_norm * std::min(std::pow(r0_norm, opt.tcg_theta), opt.tcg_kappa)) return out;
+    if (r_norm <= r0_norm * std::min(std::pow(r0_norm, opt.tcg_theta), kappa)) return out;
     z = precondition(r);
     const double z_r_old = z_r;
     z_r = inner(z, r);
@@ -125,6 +128,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   Eigen::MatrixXd egrad = problem.euclidean_gradient(res.X);
   Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
   double grad_norm = std::sqrt(inner(grad, grad));
+  const double grad_norm0 = grad_norm;
   const double grad_tol = std::max(options.grad_norm_tol, options.relative_grad_tol * grad_norm);
   int accepted_steps = 0;
   double radius = options.initial_radius;
@@ -177,8 +181,12 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       res.stop_reason = "time";
       break;
     }
+    const double kappa =
+        options.tcg_kappa_near > 0 && grad_norm <= options.near_relative_grad * grad_norm0
+            ? options.tcg_kappa_near
+            : options.tcg_kappa;
     TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner,
-                                   have_precon_grad ? &precon_grad : nullptr);
+                                   have_precon_grad ? &precon_grad : nullptr, kappa);
     res.total_inner_iterations += step.iterations;
     Eigen::MatrixXd X_new =
         options.retraction ? options.retraction(res.X, step.eta) : M.retract(res.X, step.eta);

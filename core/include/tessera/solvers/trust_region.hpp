@@ -44,9 +44,15 @@ struct TrustRegionOptions {
   /// With initial_radius <= 0 the radius is this times sqrt(<P g, g>) (the preconditioned
   /// gradient norm: the length of the Newton step when P is the exact inverse Hessian); > 0.
   double initial_radius_scale = 1.0;
-  double max_radius = 1e12;        ///< > 0.
-  double tcg_kappa = 0.1;          ///< Linear convergence target of tCG, in (0, 1).
-  double tcg_theta = 1.0;          ///< Superlinear exponent of tCG, in (0, 1].
+  double max_radius = 1e12;  ///< > 0.
+  double tcg_kappa = 0.1;    ///< Linear convergence target of tCG, in (0, 1).
+  double tcg_theta = 1.0;    ///< Superlinear exponent of tCG, in (0, 1].
+  /// Near the solution, the linear forcing term to use instead of tcg_kappa (in [0, 1); 0 = off):
+  /// once ||grad f|| <= near_relative_grad x its value at X0 (in [0, 1]). Far from it a loose
+  /// kappa keeps steps short where the model is poor; near it a tighter one makes each costly
+  /// step count.
+  double tcg_kappa_near = 0.0;
+  double near_relative_grad = 1e-2;
   double acceptance_ratio = 1e-4;  ///< Minimum rho to accept a step, in [0, 0.25).
   double max_time_s = 1e9;         ///< Wall-clock budget, seconds (> 0).
   bool record_trace = true;
