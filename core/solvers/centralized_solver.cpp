@@ -135,7 +135,12 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   }
   const BlockProblem problem =
       BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
-  const BlockPreconditioner precon(problem, options.preconditioner_shift, 0);  // always exact
+  // Always the exact factor, and always simplicial LDL^T: its solves with r right-hand sides are
+  // what the tCG repeats (docs/centralized-solver.md). The distributed blocks' switch to
+  // supernodal above 1 M entries made cubicle's and city10000's whole-graph factors supernodal:
+  // CPU in alternated pairs (load 7-8) cubicle 1.41/1.80/2.50 s simplicial vs 1.67/1.99/2.28 s,
+  // city10000 1.28/1.12/1.18 vs 1.39/1.84/1.41.
+  const BlockPreconditioner precon(problem, options.preconditioner_shift, 0, 0);
   std::unique_ptr<TranslationElimination> elimination;
   PointRefinement refine;
   if (options.eliminate_translations) {
