@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "agent/share_announcement.hpp"
 #include "launch/process_tuning.hpp"
 #include "runtime/initialization_stage.hpp"
+#include "runtime/known_inlier_start.hpp"
 #include "runtime/local_dump.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
@@ -53,6 +55,18 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   ro.seed = asg.seed();
   ro.certify = asg.certify();
   ro.coarse_every = asg.coarse_every();
+  if (!asg.robust().empty()) {
+    ro.robust.kind = parse_robust_kind(asg.robust());
+    ro.robust.inlier_threshold = asg.inlier_threshold();
+    ro.robust.inlier_quantile = asg.inlier_quantile();
+    ro.robust.max_outer_iterations = static_cast<int>(asg.gnc_max_outer());
+    ro.robust.mu_step = asg.gnc_mu_step();
+    ro.robust.inner_max_rounds = static_cast<int>(asg.gnc_inner_max_rounds());
+    ro.robust.known_inliers = parse_known_inliers(asg.known_inliers());
+    ro.robust.readmission_passes = static_cast<int>(asg.gnc_readmission_passes());
+    ro.robust.validate();
+    ro.gnc_known_start = asg.gnc_known_start();
+  }
   return ro;
 }
 
@@ -122,10 +136,19 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   std::vector<std::pair<std::uint32_t, std::uint32_t>> structure =
       structure_of(asg, share.num_poses);
   DdsProtocolChannel channel(s);
+  const RunOptions run_options = run_options_of(asg);
   {
+    // A robust run starts from the known inliers alone when they connect the poses, like the
+    // in-process engine (robust/gnc_distributed.hpp, gnc_start()).
+    std::optional<KnownInlierStart> known;
+    if (run_options.robust.kind != RobustKind::kNone && run_options.gnc_known_start)
+      known = known_inlier_start(share, structure, run_options.robust.known_inliers);
     InitializationResult init =
-        run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(), o.graph,
-                                 channel, o.round_timeout_s);
+        known ? run_initialization_stage(known->share, o.id, o.robots, known->structure,
+                                         "distributed", o.graph, channel, o.round_timeout_s)
+              : run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(),
+                                         o.graph, channel, o.round_timeout_s);
+    if (known) init.method += " (known inliers)";
     share.initial = std::move(init.poses);
     log("initialisation '" + init.method + "' done in " +
         std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
@@ -138,8 +161,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   std::vector<ReceivedHandoff> received =
       exchange_handoffs(s, share, asg.owner(), o.id, o.robots, o.net.session.run_id,
                         std::max(o.net.timeout_s, o.round_timeout_s));
-  out.local =
-      assemble_local(share, asg.owner(), o.id, o.robots, std::move(received), run_options_of(asg));
+  out.local = assemble_local(share, asg.owner(), o.id, o.robots, std::move(received), run_options);
   out.local.structure = std::move(structure);
   log("hand-off complete: " + std::to_string(out.local.owned.size()) + " poses, " +
       std::to_string(out.local.measurements.size()) + " measurements");

@@ -88,7 +88,7 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   // solve from there settles where GNC rejects true edges too (intel, 25 % random outliers:
   // 121 rejected for 64 wrong, against exactly the 64 from odometry).
   opt.initialization =
-      parse_init(a.get_or("init", robust.kind == RobustKind::kGncTls ? "odometry" : "chordal"));
+      parse_init(a.get_or("init", robust.kind != RobustKind::kNone ? "odometry" : "chordal"));
   opt.initial_rank = static_cast<int>(a.get_long("rank", opt.initial_rank));
   opt.max_rank = static_cast<int>(a.get_long("max-rank", std::max(opt.max_rank, opt.initial_rank)));
   opt.trust_region.grad_norm_tol = a.get_double("grad-tol", opt.trust_region.grad_norm_tol);
@@ -99,7 +99,7 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   else if (stop != "reference")
     throw InputError("option --stop: '" + stop + "' is not one of reference, gradient");
   GncCentralizedResult gnc;
-  if (robust.kind == RobustKind::kGncTls)
+  if (robust.kind != RobustKind::kNone)
     gnc = solve_gnc_centralized(graph, {opt, robust, input.known_inlier});
   else
     gnc.final_solve = solve_centralized(graph, opt);
@@ -121,6 +121,7 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   robust_summary.rejected = gnc.rejected;
   robust_summary.threshold_squared = gnc.threshold_squared;
   robust_summary.weights_converged = gnc.weights_converged;
+  robust_summary.readmitted = gnc.readmitted;
   if (robust.kind != RobustKind::kNone)
     std::printf(
         "robust %s: %d outer steps, %zu of %zu measurements rejected, cost over the "

@@ -19,9 +19,23 @@ std::vector<std::string> write_robot_files(const std::string& whole, std::size_t
                                            std::size_t robots, const std::string& dir) {
   if (robots < 1 || robots > num_poses)
     throw InputError("option --split: needs 1 <= robots <= poses");
+  return write_robot_files(whole, robot_of_poses(num_poses, robots), robots, dir);
+}
+
+std::vector<std::string> write_robot_files(const std::string& whole,
+                                           const std::vector<std::size_t>& robot,
+                                           std::size_t robots, const std::string& dir) {
+  const std::size_t num_poses = robot.size();
+  // Each robot's range [begin[r], begin[r + 1]).
+  std::vector<std::size_t> begin(robots + 1, num_poses);
+  for (std::size_t id = num_poses; id-- > 0;) {
+    if (robot[id] >= robots || (id > 0 && robot[id - 1] > robot[id]))
+      throw InputError(whole, 0, "robots must own contiguous id ranges in robot order");
+    begin[robot[id]] = id;
+  }
+  for (std::size_t r = robots; r-- > 0;) begin[r] = std::min(begin[r], begin[r + 1]);
   if (mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST)
     throw InputError(dir, 0, std::string("cannot create the folder: ") + std::strerror(errno));
-  const std::vector<std::size_t> robot = robot_of_poses(num_poses, robots);
   std::vector<std::string> body(robots);
   std::vector<std::string> index(robots);
   std::ifstream in(whole);
@@ -45,8 +59,7 @@ std::vector<std::string> write_robot_files(const std::string& whole, std::size_t
     name.insert(0, width - name.size(), '0');
     const std::string path = dir + "/robot" + name + ".g2o";
     std::ofstream out(path);
-    out << "# tessera-robot poses " << robot_begin(r, num_poses, robots) << " "
-        << robot_begin(r + 1, num_poses, robots) << "\n"
+    out << "# tessera-robot poses " << begin[r] << " " << begin[r + 1] << "\n"
         << "# tessera-measurement-index" << index[r] << "\n"
         << "# robot " << r << " of " << robots << " of " << whole
         << ": its poses and the measurements it recorded (global ids)\n"

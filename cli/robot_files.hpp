@@ -17,6 +17,12 @@ namespace tessera::cli {
 std::vector<std::string> write_robot_files(const std::string& whole, std::size_t num_poses,
                                            std::size_t robots, const std::string& dir);
 
+/// Same with the robot of every pose given (`robot_of`, n entries, each robot's ids
+/// contiguous and robots in id order, e.g. a dpgo CSV file's robots).
+std::vector<std::string> write_robot_files(const std::string& whole,
+                                           const std::vector<std::size_t>& robot_of,
+                                           std::size_t robots, const std::string& dir);
+
 }  // namespace tessera::cli
 
 namespace tessera::cli {

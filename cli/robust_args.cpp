@@ -11,11 +11,14 @@ const char* const kRobustValued[] = {"robust",        "inlier-threshold", "inlie
 const char* const kRobustHelp =
     "\n"
     "Outlier rejection (docs/robust.md):\n"
-    "  --robust none|gnc-tls     none: plain least squares (default); gnc-tls: graduated\n"
+    "  --robust none|gnc-tls|pcm-gnc   none: plain least squares (default); gnc-tls: graduated\n"
     "                            non-convexity with a truncated least-squares cost, then the\n"
     "                            certified solve of the kept measurements (--certify for the\n"
-    "                            distributed algorithms); centralized: --init odometry\n"
-    "                            unless --init is given\n"
+    "                            distributed algorithms); starts from the odometry\n"
+    "                            (centralized: --init odometry; distributed: the known\n"
+    "                            inliers' initialization) unless --init is given\n"
+    "                            pcm-gnc (centralized): closures outside the largest\n"
+    "                            pairwise-consistent set start GNC at weight 0\n"
     "  --inlier-threshold C      residual bound c: TLS charges min(r^2, c^2), r^2 = the edge's\n"
     "                            term of the objective (default 0 = from the chi-square\n"
     "                            quantile below, d(d+1)/2 degrees of freedom)\n"
@@ -23,7 +26,8 @@ const char* const kRobustHelp =
     "                            1 - 1e-4/m for m rejectable edges (union bound) [0]\n"
     "  --gnc-max-outer K         most outer steps, >= 1 [100]\n"
     "  --gnc-mu-step S           mu grows by S per outer step, > 1 [1.4]\n"
-    "  --gnc-inner-rounds K      distributed: most rounds per inner solve, 0 = no cap [0]\n"
+    "  --gnc-inner-rounds K      distributed: most rounds of each solve before the final\n"
+    "                            one (first and weighted), 0 = no cap [5]\n"
     "  --known-inliers odometry|none   never reject edges between consecutive ids [odometry]\n"
     "  --rejected FILE           write the rejected edge indices (from 0 over the EDGE lines)\n";
 
@@ -51,7 +55,7 @@ RobustOptions parse_robust_options(const Arguments& args) {
     throw InputError("option " + std::string(flag) + ": " + what);
   }
   if (o.kind == RobustKind::kNone && args.has("rejected"))
-    throw InputError("option --rejected: needs --robust gnc-tls");
+    throw InputError("option --rejected: needs --robust gnc-tls or pcm-gnc");
   return o;
 }
 
@@ -65,7 +69,8 @@ void add_robust_fields(JsonObject& json, const RobustSummary& s) {
       .add("inlier_threshold_squared", s.threshold_squared)
       .add("known_inliers", known_inliers_name(s.options.known_inliers))
       .add("gnc_mu_step", s.options.mu_step)
-      .add("weights_converged", s.weights_converged);
+      .add("weights_converged", s.weights_converged)
+      .add("readmitted", s.readmitted);
 }
 
 void write_rejected(const std::string& path, const std::vector<std::size_t>& rejected) {

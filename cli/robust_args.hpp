@@ -29,10 +29,11 @@ struct RobustSummary {
   std::vector<std::size_t> rejected;  ///< Indices over the EDGE lines, from 0, ascending.
   double threshold_squared = 0;
   bool weights_converged = false;
+  std::size_t readmitted = 0;  ///< Rejected by GNC, taken back at the inlier set's solution.
 };
 
 /// Appends robust, outer_iterations, total_iterations, inliers, outliers, rejected,
-/// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged.
+/// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged, readmitted.
 void add_robust_fields(JsonObject& json, const RobustSummary& summary);
 
 /// Writes one rejected index per line to `path` (InputError when it cannot).

@@ -290,11 +290,20 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       part.adjacent_block_pairs = adjacency.adjacent_block_pairs;
       part.colours = adjacency.colours;
     }
+  if (robust.kind == RobustKind::kPcmGnc)
+    throw InputError("option --robust: pcm-gnc is centralized only (--algorithm centralized)");
   GncDistributedResult gnc;
-  if (robust.kind == RobustKind::kGncTls)
-    gnc = solve_gnc_distributed(graph, part.assignment, {opt, robust, input.known_inlier});
-  else
+  if (robust.kind == RobustKind::kGncTls) {
+    // Like the centralized robust solve: the known inliers' start unless --init is given.
+    GncDistributedOptions options;
+    options.solver = opt;
+    options.robust = robust;
+    options.known_inlier_flags = input.known_inlier;
+    options.known_inlier_start = !a.has("init");
+    gnc = solve_gnc_distributed(graph, part.assignment, options);
+  } else {
     gnc.final_solve = solve_distributed(graph, part.assignment, opt);
+  }
   const DistributedResult& r = gnc.final_solve;
 
   std::optional<double> fstar;
@@ -406,6 +415,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       rs.rejected = gnc.rejected;
       rs.threshold_squared = gnc.threshold_squared;
       rs.weights_converged = gnc.weights_converged;
+      rs.readmitted = gnc.readmitted;
       add_robust_fields(j, rs);
       j.add("total_rounds", gnc.total_rounds)
           .add("total_bytes", static_cast<long long>(gnc.total_bytes));

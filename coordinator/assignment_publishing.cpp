@@ -1,6 +1,7 @@
 #include "coordinator/assignment_publishing.hpp"
 
 #include <string>
+#include <tessera/robust/robust_options.hpp>
 
 #include "transport/run_failure.hpp"
 
@@ -32,6 +33,18 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   asg.status_relay(options.status_relay);
   asg.replica_every(options.replica_every);
   asg.coarse_every(options.coarse_every);
+  if (options.robust.kind != RobustKind::kNone) {
+    const RobustOptions& r = options.robust;
+    asg.robust(robust_kind_name(r.kind));
+    asg.inlier_threshold(r.inlier_threshold);
+    asg.inlier_quantile(r.inlier_quantile);
+    asg.gnc_max_outer(static_cast<std::uint32_t>(r.max_outer_iterations));
+    asg.gnc_mu_step(r.mu_step);
+    asg.gnc_inner_max_rounds(static_cast<std::uint32_t>(r.inner_max_rounds));
+    asg.known_inliers(known_inliers_name(r.known_inliers));
+    asg.gnc_known_start(options.gnc_known_start);
+    asg.gnc_readmission_passes(static_cast<std::uint32_t>(r.readmission_passes));
+  }
   return asg;
 }
 

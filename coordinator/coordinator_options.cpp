@@ -6,6 +6,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "arguments.hpp"
+#include "robust_args.hpp"
 
 namespace tessera::coordinator {
 
@@ -65,6 +66,16 @@ options:
   --coarse-every K     two-level rounds: the agents add a rigid coarse correction of every
                        block every K-th round (docs/irbcd.md, "Coarse correction"); 0 = off
                        (default 0)
+  --robust none|gnc-tls  gnc-tls: reject outlier measurements by graduated non-convexity
+                       with a truncated least-squares cost, then solve (and with --certify
+                       certify) the kept ones; every agent weighs the measurements of its
+                       lower pose ids (docs/robust.md) (default none)
+  --inlier-threshold C, --inlier-quantile P, --gnc-max-outer K, --gnc-mu-step S,
+  --gnc-inner-rounds K, --known-inliers odometry|none
+                       the GNC options, as for `tessera solve` (docs/robust.md)
+  --rejected FILE      write the rejected measurement indices (from 0 over the EDGE lines)
+  --gnc-solver-start   GNC starts from --init's poses, not from the known inliers'
+                       distributed initialization (tessera launch passes it with --init)
   --status-interval S  print a status line (agents alive, their rounds, lagging or lost
                        agents) every S seconds and on changes; 0 = off (default 5)
   --verbose            print each phase
@@ -101,8 +112,10 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "coarse-every"},
                                                            cli::SessionArgsFor::kProcess);
   valued.insert("graph");
-  cli::Arguments args(
-      argv, valued, {"progress", "verbose", "help", "certify", "status-relay", "no-status-relay"});
+  for (const char* const* r = cli::kRobustValued; *r; ++r) valued.insert(*r);
+  cli::Arguments args(argv, valued,
+                      {"progress", "verbose", "help", "certify", "status-relay", "no-status-relay",
+                       "gnc-solver-start"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   CoordinatorOptions a;
@@ -158,6 +171,17 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   if (args.has("status-relay") && args.has("no-status-relay"))
     throw InputError("options --status-relay and --no-status-relay exclude each other");
   a.status_relay = !args.has("no-status-relay");
+  a.robust = cli::parse_robust_options(args);
+  a.gnc_known_start = !args.has("gnc-solver-start");
+  a.rejected = args.get_or("rejected", "");
+  if (a.robust.kind == RobustKind::kPcmGnc)
+    throw InputError(
+        "option --robust: pcm-gnc is centralized only (tessera solve --algorithm "
+        "centralized); over DDS use gnc-tls");
+  if (a.robust.kind != RobustKind::kNone && (a.rejoin_timeout_s > 0 || a.replicas > 0))
+    throw InputError(
+        "option --robust: a robust run cannot roll back or re-partition; drop --rejoin-timeout "
+        "and --replicas");
   return a;
 }
 

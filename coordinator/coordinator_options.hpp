@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <tessera/robust/robust_options.hpp>
 #include <vector>
 
 #include "session_args.hpp"
@@ -42,6 +43,12 @@ struct CoordinatorOptions {
   bool status_relay = true;
   /// Two-level rounds: a coarse correction every this many rounds; 0 = off (--coarse-every).
   std::uint32_t coarse_every = 0;
+  /// Robust solve (--robust, --inlier-threshold, --inlier-quantile, --gnc-max-outer,
+  /// --gnc-mu-step, --gnc-inner-rounds, --known-inliers; docs/robust.md).
+  RobustOptions robust;
+  /// GNC starts from the known inliers (off when --init is given, like `tessera solve`).
+  bool gnc_known_start = true;
+  std::string rejected;  ///< --rejected FILE: the rejected measurements, one index a line.
 };
 
 /// The --help text; its "%s" stands for the shared session options (cli::process_help).

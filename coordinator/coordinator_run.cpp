@@ -18,6 +18,7 @@
 #include "coordinator/run_structure.hpp"
 #include "coordinator/run_summary.hpp"
 #include "json_writer.hpp"
+#include "robust_args.hpp"
 #include "runtime/elapsed.hpp"
 #include "runtime/partition_step.hpp"
 #include "runtime/progress_lines.hpp"
@@ -146,6 +147,11 @@ void run_coordinator(const CoordinatorOptions& o, CoordinatorSession& s, RunTime
     cli::write_output(
         o.summary, run_summary_json({o, rs, part, merged, reports.results(), losses.record(),
                                      s.domain(), discovery_ms, solve_ms, ms_since(t0), &timeline}));
+  if (!o.rejected.empty()) {
+    if (!reports.results().robust)
+      throw std::runtime_error("the agents sent no robust report (no rejected set to write)");
+    cli::write_rejected(o.rejected, reports.results().robust->rejected);
+  }
   // The result is complete: tessera launch prints the summary on this line (kSummaryWrittenLine)
   // instead of after every process has left (FINISHED, flush, participant deletion: ~0.07 s
   // idle, several tenths under load).

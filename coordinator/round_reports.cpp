@@ -56,6 +56,16 @@ bool RoundReports::on_report(const wire::RoundStatus& m) {
     results_.agent_rounding_s = m.grad_norm_sq();
     return true;
   }
+  if (m.phase() == kAgentRobustReportPhase) {
+    RobustReport r;
+    r.outer_iterations = static_cast<int>(m.cost());
+    r.readmitted = static_cast<std::size_t>(m.grad_norm_sq());
+    r.threshold_squared = m.block_grad_norm();
+    r.weights_converged = m.done_vote();
+    r.rejected.assign(m.measurement_ids().begin(), m.measurement_ids().end());
+    results_.robust = std::move(r);
+    return true;
+  }
   if (m.phase() == kAgentFinalReportPhase) {
     results_.final_cost = m.cost();
     results_.final_grad_norm = std::sqrt(m.grad_norm_sq());

@@ -11,6 +11,7 @@
 #include <optional>
 #include <ostream>
 #include <utility>
+#include <vector>
 
 #include "runtime/progress_printer.hpp"
 #include "tessera.h"
@@ -23,7 +24,8 @@ namespace tessera::coordinator {
 constexpr std::uint32_t kAgentFinalReportPhase = 200;
 constexpr std::uint32_t kAgentCertificateReportPhase = 201;
 constexpr std::uint32_t kAgentCertificateBytesPhase = 202;
-constexpr std::uint32_t kAgentPhaseTimesPhase = 203;
+constexpr std::uint32_t kAgentRobustReportPhase = 203;
+constexpr std::uint32_t kAgentPhaseTimesPhase = 204;
 
 /// Core's round statuses (phase 1: a round; phase 5: a restart of the momentum).
 inline bool is_round_status(const wire::RoundStatus& m) {
@@ -38,6 +40,15 @@ struct CertificateTraffic {
   double certificate, escape, escape_rounds;  ///< Bytes, bytes, rounds.
 };
 
+/// A robust run's decisions (runtime/round_loop.hpp, kRobustReportPhase).
+struct RobustReport {
+  int outer_iterations = 0;
+  std::size_t readmitted = 0;
+  double threshold_squared = 0;
+  bool weights_converged = false;
+  std::vector<std::size_t> rejected;  ///< Measurement indices in file order, ascending.
+};
+
 /// Everything reported so far (for the summary).
 struct ReportedResults {
   // From agent 0's final report.
@@ -46,6 +57,7 @@ struct ReportedResults {
   bool have_final_report = false;
   std::optional<CertificateReport> certificate;
   std::optional<CertificateTraffic> certificate_bytes;
+  std::optional<RobustReport> robust;
   // Agent 0's own clock: its time in core's protocol (rounds, certificate, escapes) and in the
   // distributed rounding, seconds.
   std::optional<double> agent_solve_s, agent_rounding_s;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "json_writer.hpp"
+#include "robust_args.hpp"
 #include "runtime/peak_memory.hpp"
 
 namespace tessera::coordinator {
@@ -108,6 +109,21 @@ std::string run_summary_json(const RunSummaryInputs& in) {
   } else {
     j.add_null("min_eigenvalue").add_null("certificate_rounds");
     j.add("final_rank", static_cast<long long>(o.rank ? o.rank : 5));
+  }
+  if (r.robust) {
+    cli::RobustSummary rs;
+    rs.options = o.robust;
+    rs.outer_iterations = r.robust->outer_iterations;
+    rs.total_iterations = static_cast<int>(in.merged.rounds);
+    rs.measurements = in.structure.num_measurements;
+    rs.rejected = r.robust->rejected;
+    rs.threshold_squared = r.robust->threshold_squared;
+    rs.weights_converged = r.robust->weights_converged;
+    rs.readmitted = r.robust->readmitted;
+    cli::add_robust_fields(j, rs);
+    j.add("total_rounds", static_cast<long long>(in.merged.rounds));
+  } else {
+    j.add("robust", robust_kind_name(o.robust.kind));
   }
   return j.str();
 }

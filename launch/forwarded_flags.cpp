@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstdlib>
+#include <tessera/robust/robust_options.hpp>
 #include <tessera/util/input_error.hpp>
 
 namespace tessera::launch {
@@ -33,6 +34,58 @@ void check_partition_time(const std::string& v) {
   number_in(v, "partition-time", 0, 86400, "0..86400");
 }
 
+// The robust options are checked as RobustOptions checks them (the error names the field).
+void check_robust(const std::string& v) {
+  RobustKind kind;
+  try {
+    kind = parse_robust_kind(v);
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --robust: ") + e.what());
+  }
+  if (kind == RobustKind::kPcmGnc)
+    throw InputError(
+        "option --robust: pcm-gnc is centralized only (tessera solve --algorithm "
+        "centralized); over DDS use gnc-tls");
+}
+void check_known_inliers(const std::string& v) {
+  try {
+    parse_known_inliers(v);
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --known-inliers: ") + e.what());
+  }
+}
+template <class Set>
+void check_robust_field(const std::string& v, const char* flag, Set set) {
+  RobustOptions o;
+  set(o, number_in(v, flag, -1e300, 1e300, ""));
+  try {
+    o.validate();
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --") + flag + ": " + e.what());
+  }
+}
+void check_inlier_threshold(const std::string& v) {
+  check_robust_field(v, "inlier-threshold",
+                     [](RobustOptions& o, double x) { o.inlier_threshold = x; });
+}
+void check_inlier_quantile(const std::string& v) {
+  check_robust_field(v, "inlier-quantile",
+                     [](RobustOptions& o, double x) { o.inlier_quantile = x; });
+}
+void check_gnc_max_outer(const std::string& v) {
+  check_robust_field(v, "gnc-max-outer", [](RobustOptions& o, double x) {
+    o.max_outer_iterations = x == static_cast<int>(x) ? static_cast<int>(x) : 0;
+  });
+}
+void check_gnc_mu_step(const std::string& v) {
+  check_robust_field(v, "gnc-mu-step", [](RobustOptions& o, double x) { o.mu_step = x; });
+}
+void check_gnc_inner_rounds(const std::string& v) {
+  check_robust_field(v, "gnc-inner-rounds", [](RobustOptions& o, double x) {
+    o.inner_max_rounds = x == static_cast<int>(x) ? static_cast<int>(x) : -1;
+  });
+}
+
 }  // namespace
 
 const std::vector<ForwardedFlag>& forwarded_flags() {
@@ -56,6 +109,34 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "none, the preset's own effort (with a cap the partition\n"
        "depends on the machine's speed)                           [0]",
        check_partition_time},
+      {"robust", "robust", true, ForwardTo::kCoordinator, "--robust none|gnc-tls",
+       "gnc-tls: reject outlier measurements (graduated non-\n"
+       "convexity, truncated least squares), each weighed by the\n"
+       "agent of its lower pose id, then solve and certify the\n"
+       "kept ones; starts from the known inliers unless --init\n"
+       "is given (docs/robust.md)                            [none]",
+       check_robust},
+      {"inlier-threshold", "inlier-threshold", true, ForwardTo::kCoordinator,
+       "--inlier-threshold C", "residual bound c (0 = chi-square quantile)          [0]",
+       check_inlier_threshold},
+      {"inlier-quantile", "inlier-quantile", true, ForwardTo::kCoordinator, "--inlier-quantile P",
+       "quantile of that bound, 0 = 1 - 1e-4/m               [0]", check_inlier_quantile},
+      {"gnc-max-outer", "gnc-max-outer", true, ForwardTo::kCoordinator, "--gnc-max-outer K",
+       "most GNC outer steps, >= 1                           [100]", check_gnc_max_outer},
+      {"gnc-mu-step", "gnc-mu-step", true, ForwardTo::kCoordinator, "--gnc-mu-step S",
+       "mu grows by S per outer step, > 1                    [1.4]", check_gnc_mu_step},
+      {"gnc-inner-rounds", "gnc-inner-rounds", true, ForwardTo::kCoordinator,
+       "--gnc-inner-rounds K",
+       "most rounds of each solve before the final one, 0 = no\n"
+       "cap                                                  [5]",
+       check_gnc_inner_rounds},
+      {"known-inliers", "known-inliers", true, ForwardTo::kCoordinator,
+       "--known-inliers odometry|none", "never reject edges between consecutive ids [odometry]",
+       check_known_inliers},
+      {"rejected", "rejected", true, ForwardTo::kCoordinator, "--rejected FILE",
+       "write the rejected edge indices (from 0 over the EDGE\n"
+       "lines), one a line",
+       nullptr},
   };
   return flags;
 }

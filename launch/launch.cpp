@@ -12,6 +12,7 @@
 #include <sstream>
 #include <tessera/util/input_error.hpp>
 
+#include "launch/dpgo_csv_input.hpp"
 #include "launch/huge_page_heaps.hpp"
 #include "launch/launch_argv.hpp"
 #include "launch/launch_children.hpp"
@@ -83,6 +84,9 @@ LaunchResult launch(LaunchOptions o) {
   const bool forked = use_fork_server(o, fork_server);
 
   const WorkDir work;
+  // A dpgo CSV: the robots' g2o files, one agent each.
+  if (const std::string dir = dpgo_csv_as_robot_files(o.graph, o.agents, work.path()); !dir.empty())
+    o.graph = dir;
   RunPaths paths;
   paths.bin = bin;
   paths.work = work.path();

@@ -61,6 +61,7 @@ std::vector<std::string> coordinator_argv(const LaunchOptions& o, const RunPaths
                                 std::to_string(o.timeout_s),
                                 "--progress"};
   if (o.certify) a.push_back("--certify");
+  if (o.init_given) a.push_back("--gnc-solver-start");
   // The coordinator relays by default (docs/dds-runtime.md).
   if (!o.status_relay) a.push_back("--no-status-relay");
   // Every process runs here and the coordinator can read the whole file: it partitions the

@@ -4,6 +4,7 @@
 #include <set>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/io/dpgo_csv_reader.hpp>
 #include <tessera/util/input_error.hpp>
 
 #include "cli/arguments.hpp"
@@ -22,7 +23,9 @@ constexpr const char* kHelp =
 
 Runs a distributed solve on this host as separate processes: one tessera-coordinator and N
 tessera-agent processes (robot k reads its sequential share of GRAPH, or the k-th robot file
-of a folder or list, as written by tessera generate --split) talking peer to peer
+of a folder or list, as written by tessera generate --split; a dpgo measurement CSV, file or
+folder of robot<k>/measurements.csv, gives robot k the CSV's robot k: --agents = robots)
+talking peer to peer
 over Fast DDS. Prints progress (round, cost, gradient norm) while it runs and the JSON
 summary at the end. Any failing process (a dead agent only with --on-agent-loss stop, the
 default), the time limit or Ctrl-C stops every process; the exit code is then non-zero.
@@ -71,7 +74,9 @@ exit codes: 0 done, 1 the run failed (a process failed, or the time limit), 2 ba
 }  // namespace
 
 std::vector<std::string> LaunchOptions::robot_files() const {
-  return graph.empty() ? std::vector<std::string>{} : cli::robot_files_of(graph);
+  // A dpgo CSV (file or folder) becomes robot files only when the run starts (launch.cpp).
+  return graph.empty() || is_dpgo_csv(graph) ? std::vector<std::string>{}
+                                             : cli::robot_files_of(graph);
 }
 
 void LaunchOptions::validate() const {
@@ -123,6 +128,7 @@ LaunchOptions parse_launch_options(const std::vector<std::string>& argv) {
   o.algorithm = args.get_or("algorithm", o.algorithm);
   o.partition = args.get_or("partition", o.partition);
   o.init = args.get_or("init", init_name(DistributedOptions{}.initialization));
+  o.init_given = args.has("init");
   o.grad_tol = args.get_double("grad-tol", o.grad_tol);
   o.max_rounds = args.get_long("max-rounds", o.max_rounds);
   o.rank = args.get_long("rank", o.rank);

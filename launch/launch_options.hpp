@@ -24,6 +24,8 @@ struct LaunchOptions {
   std::string partition = "auto";
   /// chordal | distributed | file.
   std::string init = "chordal";
+  /// --init was given: a robust run then starts from it instead of the known inliers.
+  bool init_given = false;
   /// Stop when the gradient norm is at most this (> 0).
   double grad_tol = 0.01;
   /// Round limit, >= 0 (0 = the solver's default).

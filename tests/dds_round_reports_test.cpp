@@ -76,7 +76,7 @@ TEST(RoundReports, RoundTimingAndTheLastLineComeFromAgentZerosFinalDigest) {
 namespace tessera::coordinator {
 namespace {
 
-// Agent 0's own times ride on a report status (phase 203): solve and rounding seconds.
+// Agent 0's own times ride on a report status (phase 204): solve and rounding seconds.
 TEST(RoundReports, AgentZerosPhaseTimesAreKeptForTheSummary) {
   std::ostringstream out;
   RoundReports r(false, out);

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
+#include <tessera/distributed/in_process_driver.hpp>
 #include <tessera/generate/generator.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
@@ -52,6 +54,56 @@ TEST(GncDistributed, EveryWeightIsComputedByExactlyTheOwnerOfTheLowerPose) {
     if (blocks[m.i] != blocks[m.j]) ++cut;
   }
   EXPECT_GT(cut, 0u);  // the property matters: some measurements join two agents
+}
+
+// After every weight exchange, the two agents holding a cut measurement use the same weight: the
+// owner's, received by the other end. A lost or misrouted weight leaves the receiver at its
+// previous value (1 at first), which this catches once any cut weight has moved off 1.
+TEST(GncDistributed, BothEndsOfEveryCutMeasurementUseTheSameWeightAfterEveryOuterStep) {
+  const GeneratorResult r = grid_with_outliers(0.25);
+  const std::vector<int> blocks = robots_as_blocks(r);
+  GncDistributedOptions o = irbcd_gnc();
+  // (outer step, measurement) -> weight at each agent that holds the measurement.
+  std::map<std::pair<int, std::uint64_t>, std::map<int, double>> seen;
+  std::map<int, int> steps_per_agent;
+  o.weight_observer = [&](int agent, int outer, const std::vector<std::uint64_t>& index,
+                          const std::vector<double>& weights) {
+    ASSERT_EQ(index.size(), weights.size());
+    ++steps_per_agent[agent];
+    for (std::size_t k = 0; k < index.size(); ++k) seen[{outer, index[k]}][agent] = weights[k];
+  };
+  const GncDistributedResult res = solve_gnc_distributed(r.graph, blocks, o);
+  ASSERT_GT(res.outer_iterations, 2);
+  ASSERT_EQ(steps_per_agent.size(), 5u);
+  for (const auto& [agent, steps] : steps_per_agent) EXPECT_EQ(steps, res.outer_iterations);
+  std::size_t cut_checks = 0, cut_down_weighted = 0;
+  for (const auto& [key, at] : seen) {
+    const Measurement& m = r.graph.measurements[key.second];
+    const bool cut = blocks[m.i] != blocks[m.j];
+    ASSERT_EQ(at.size(), cut ? 2u : 1u) << "measurement " << key.second;
+    if (!cut) continue;
+    ++cut_checks;
+    EXPECT_EQ(at.begin()->second, at.rbegin()->second)
+        << "measurement " << key.second << " at outer step " << key.first;
+    if (at.begin()->second < 1.0) ++cut_down_weighted;
+  }
+  EXPECT_GT(cut_checks, 0u);
+  EXPECT_GT(cut_down_weighted, 0u) << "no cut weight moved: the check would be vacuous";
+}
+
+// The agents buffer every exchange by step and sum in agent-id order, so the order in which the
+// driver delivers messages cannot change what they decide.
+TEST(GncDistributed, DeliveryOrderDoesNotChangeTheOutcome) {
+  const GeneratorResult r = grid_with_outliers(0.25);
+  GncDistributedOptions o = irbcd_gnc();
+  const GncDistributedResult fifo = solve_gnc_distributed(r.graph, robots_as_blocks(r), o);
+  o.solver.delivery = DeliveryOrder::kShuffled;
+  o.solver.delivery_seed = 3;
+  const GncDistributedResult shuffled = solve_gnc_distributed(r.graph, robots_as_blocks(r), o);
+  EXPECT_EQ(shuffled.rejected, fifo.rejected);
+  EXPECT_EQ(shuffled.outer_iterations, fifo.outer_iterations);
+  EXPECT_EQ(shuffled.total_rounds, fifo.total_rounds);
+  EXPECT_EQ(shuffled.final_solve.cost, fifo.final_solve.cost);
 }
 
 TEST(GncDistributed, RejectsTheSameOutliersAsTheCentralizedLoopAndCertifiesTheInlierSet) {

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <string>
 #include <tessera/dds/launch.hpp>
 #include <tessera/util/input_error.hpp>
@@ -62,10 +63,15 @@ TEST(LaunchOptions, ForwardedFlagsReachOnlyTheCoordinatorWithTheirValues) {
 
 TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
   const std::string help = launch_help();
+  // A valid value of each flag: "1" unless that is out of the flag's range.
+  const std::map<std::string, std::string> value = {{"robust", "gnc-tls"},
+                                                    {"known-inliers", "odometry"},
+                                                    {"gnc-mu-step", "1.4"},
+                                                    {"inlier-quantile", "0.5"}};
   for (const ForwardedFlag& f : forwarded_flags()) {
     EXPECT_NE(help.find(std::string("--") + f.name), std::string::npos) << f.name;
     Argv argv = {std::string("--") + f.name};
-    if (f.valued) argv.push_back("1");
+    if (f.valued) argv.push_back(value.count(f.name) ? value.at(f.name) : "1");
     EXPECT_EQ(error_of(argv), "") << f.name;
   }
 }

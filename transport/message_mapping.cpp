@@ -52,6 +52,8 @@ wire::RoundStatus to_wire_status(const RoundStatusMessage& m, const std::string&
   w.restart_vote(m.restart_vote);
   w.done_vote(m.done_vote);
   w.coarse(m.coarse);
+  w.measurement_ids(m.measurement_ids);
+  w.weights(m.weights);
   return w;
 }
 
@@ -86,6 +88,12 @@ RoundStatusMessage from_wire(const wire::RoundStatus& w) {
   m.restart_vote = w.restart_vote();
   m.done_vote = w.done_vote();
   m.coarse = w.coarse();
+  require(w.weights().size() == w.measurement_ids().size() || w.weights().empty(),
+          "status from agent " + std::to_string(w.sender()) + " has " +
+              std::to_string(w.weights().size()) + " weights for " +
+              std::to_string(w.measurement_ids().size()) + " measurements");
+  m.measurement_ids = w.measurement_ids();
+  m.weights = w.weights();
   return m;
 }
 

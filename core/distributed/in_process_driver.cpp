@@ -13,8 +13,9 @@ std::size_t message_bytes(const ProtocolMessage& message) {
   if (const auto* p = std::get_if<PoseBlockMessage>(&message))
     return 5 * sizeof(std::uint32_t) + 1 + p->pose_ids.size() * sizeof(std::uint32_t) +
            p->data.size() * sizeof(double);
-  return 3 * sizeof(std::uint32_t) + 3 * sizeof(double) + 2 +
-         std::get<RoundStatusMessage>(message).coarse.size() * sizeof(double);
+  const auto& s = std::get<RoundStatusMessage>(message);
+  return 3 * sizeof(std::uint32_t) + 3 * sizeof(double) + 2 + s.coarse.size() * sizeof(double) +
+         s.measurement_ids.size() * sizeof(std::uint64_t) + s.weights.size() * sizeof(double);
 }
 
 namespace {

@@ -1,8 +1,12 @@
 #include <algorithm>
 #include <stdexcept>
+#include <tessera/distributed/distributed_initialization.hpp>
+#include <tessera/graph/connectivity.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
+#include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
+#include <tessera/util/input_error.hpp>
 
 namespace tessera {
 namespace {
@@ -43,25 +47,49 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   out.threshold_squared = tls_threshold_squared(
       robust, graph.d, static_cast<std::size_t>(std::count(known.begin(), known.end(), false)));
   const double c2 = out.threshold_squared;
+  // pcm-gnc: closures outside the largest pairwise-consistent set start with weight 0.
+  std::vector<bool> dropped(m, false);
+  if (robust.kind == RobustKind::kPcmGnc) {
+    PoseGraph chain_graph;
+    chain_graph.d = graph.d;
+    chain_graph.num_poses = graph.num_poses;
+    chain_graph.source = graph.source;
+    for (std::size_t e = 0; e < m; ++e)
+      if (known[e]) chain_graph.measurements.push_back(graph.measurements[e]);
+    if (count_components(chain_graph) > 1)
+      throw InputError(graph.source, 0,
+                       "robust pcm-gnc: the known inliers do not connect the poses, so there is "
+                       "no odometry to test closures against (use --robust gnc-tls)");
+    out.pcm = pairwise_consistency(graph, known, distributed_initialization(chain_graph, 1), c2);
+    for (std::size_t e : out.pcm.inconsistent) dropped[e] = true;
+  }
 
   // Inner solves: no certificate (it only matters for the final inlier set), warm start.
   CentralizedOptions inner = options.solver;
   inner.certify = false;
-  CentralizedResult solve = solve_centralized(graph, inner);  // plain least squares
+  std::vector<double> first(m, 1.0);  // plain least squares (pcm-gnc: without the dropped)
+  for (std::size_t e = 0; e < m; ++e)
+    if (dropped[e]) first[e] = 0.0;
+  CentralizedResult solve =
+      robust.kind == RobustKind::kPcmGnc
+          ? solve_centralized(weighted_graph(graph, first, graph.initial), inner)
+          : solve_centralized(graph, inner);
   add_iterations(out, solve);
   inner.initialization = Initialization::kFile;
 
   out.weights.assign(m, 1.0);
   std::vector<double> r2 = residuals(graph, solve.poses);
   double max_r2 = 0;
-  for (std::size_t e = 0; e < m; ++e)
-    if (!known[e]) max_r2 = std::max(max_r2, r2[e]);
+  for (std::size_t e = 0; e < m; ++e) {
+    if (dropped[e]) out.weights[e] = 0.0;
+    if (!known[e] && !dropped[e]) max_r2 = std::max(max_r2, r2[e]);
+  }
   double mu = gnc_initial_mu(max_r2, c2);
   out.weights_converged = mu == 0;  // every residual inside the bound: nothing to reject
   while (!out.weights_converged && out.outer_iterations < robust.max_outer_iterations) {
     double spread = 0;
     for (std::size_t e = 0; e < m; ++e) {
-      out.weights[e] = known[e] ? 1.0 : tls_weight(r2[e], c2, mu);
+      out.weights[e] = known[e] ? 1.0 : dropped[e] ? 0.0 : tls_weight(r2[e], c2, mu);
       spread += out.weights[e] * (1 - out.weights[e]);
     }
     solve = solve_centralized(weighted_graph(graph, out.weights, solve.poses), inner);
@@ -75,12 +103,31 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
 
   for (std::size_t e = 0; e < m; ++e)
     if (out.weights[e] < 0.5) out.rejected.push_back(e);
-  PoseGraph inliers = inlier_graph(graph, out.rejected, solve.poses);
-  require_connected_inliers(graph, inliers, out.rejected.size());
+  // Re-admission (RobustOptions::readmission_passes): rejected measurements within the bound
+  // at the inlier set's solution are taken back and the set solved again.
   CentralizedOptions final_options = options.solver;
   final_options.initialization = Initialization::kFile;
-  out.final_solve = solve_centralized(inliers, final_options);
-  add_iterations(out, out.final_solve);
+  std::vector<Pose> start = solve.poses;
+  for (int pass = 0;; ++pass) {
+    PoseGraph inliers = inlier_graph(graph, out.rejected, start);
+    require_connected_inliers(graph, inliers, out.rejected.size());
+    out.final_solve = solve_centralized(inliers, final_options);
+    add_iterations(out, out.final_solve);
+    if (pass == robust.readmission_passes || out.rejected.empty()) break;
+    std::vector<std::size_t> still;
+    const std::vector<Pose>& poses = out.final_solve.poses;
+    for (std::size_t e : out.rejected) {
+      const Measurement& m = graph.measurements[e];
+      if (residual_squared(m, poses[m.i], poses[m.j]) <= c2)
+        out.weights[e] = 1.0;
+      else
+        still.push_back(e);
+    }
+    if (still.size() == out.rejected.size()) break;
+    out.readmitted += out.rejected.size() - still.size();
+    out.rejected = std::move(still);
+    start = poses;
+  }
   return out;
 }
 

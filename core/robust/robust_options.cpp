@@ -19,13 +19,15 @@ std::string number_text(double x) {
 }  // namespace
 
 const char* robust_kind_name(RobustKind kind) {
+  if (kind == RobustKind::kPcmGnc) return "pcm-gnc";
   return kind == RobustKind::kGncTls ? "gnc-tls" : "none";
 }
 
 RobustKind parse_robust_kind(const std::string& name) {
   if (name == "none") return RobustKind::kNone;
   if (name == "gnc-tls") return RobustKind::kGncTls;
-  throw InputError("unknown robust scheme '" + name + "' (valid: none, gnc-tls)");
+  if (name == "pcm-gnc") return RobustKind::kPcmGnc;
+  throw InputError("unknown robust scheme '" + name + "' (valid: none, gnc-tls, pcm-gnc)");
 }
 
 const char* known_inliers_name(KnownInliers known) {
@@ -51,6 +53,8 @@ void RobustOptions::validate() const {
     bad_field("inner_max_rounds", std::to_string(inner_max_rounds), "must be >= 0 (0 = no cap)");
   if (!(std::isfinite(mu_step) && mu_step > 1))
     bad_field("mu_step", number_text(mu_step), "must be > 1");
+  if (readmission_passes < 0)
+    bad_field("readmission_passes", std::to_string(readmission_passes), "must be >= 0");
   if (!(std::isfinite(weight_tolerance) && weight_tolerance >= 0))
     bad_field("weight_tolerance", number_text(weight_tolerance), "must be >= 0");
 }

@@ -42,6 +42,14 @@ double residual_squared(const Measurement& m, const Pose& a, const Pose& b) {
   return m.kappa * (b.R - a.R * m.R).squaredNorm() + m.tau * (b.t - a.t - a.R * m.t).squaredNorm();
 }
 
+double lifted_residual_squared(const Measurement& m, const Eigen::MatrixXd& Xi,
+                               const Eigen::MatrixXd& Xj) {
+  const Eigen::Index d = m.t.size();
+  const auto Yi = Xi.leftCols(d);
+  return m.kappa * (Xj.leftCols(d) - Yi * m.R).squaredNorm() +
+         m.tau * (Xj.col(d) - Xi.col(d) - Yi * m.t).squaredNorm();
+}
+
 double chi_square_quantile(double p, int dof) {
   if (dof < 1 || !(p > 0 && p < 1))
     throw std::invalid_argument("chi_square_quantile: dof >= 1 and p in (0, 1) expected");

@@ -12,14 +12,13 @@
 #include <tessera/distributed/round_protocol.hpp>
 #include <tessera/problem/lifting.hpp>
 
-#include "runtime/distributed_rounding.hpp"
+#include "runtime/gnc_round_loop.hpp"
+#include "runtime/round_finish.hpp"
 #include "runtime/round_mailbox.hpp"
 
 namespace tessera::agent {
 
-namespace {
-
-DistributedOptions options_of(const RunOptions& o) {
+DistributedOptions distributed_options_of(const RunOptions& o) {
   DistributedOptions opt;
   if (!o.algorithm.empty()) opt.algorithm = parse_algorithm(o.algorithm);
   if (o.rank > 0) opt.rank = static_cast<int>(o.rank);
@@ -33,8 +32,6 @@ DistributedOptions options_of(const RunOptions& o) {
   opt.validate();
   return opt;
 }
-
-}  // namespace
 
 void ProtocolChannel::send_all(const std::vector<OutgoingMessage>& messages) {
   for (const auto& m : messages) send(m);
@@ -52,7 +49,13 @@ std::optional<ProtocolMessage> ProtocolChannel::receive_awaiting(double timeout_
 
 RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
                                double receive_timeout_s, const RoundLoopHooks& hooks) {
-  const DistributedOptions options = options_of(local.options);
+  if (local.options.robust.kind != RobustKind::kNone) {
+    if (hooks.resume_from)
+      throw std::runtime_error("agent " + std::to_string(local.agent_id) +
+                               ": a robust run cannot resume from a checkpoint");
+    return run_gnc_round_loop(local, channel, receive_timeout_s);
+  }
+  const DistributedOptions options = distributed_options_of(local.options);
   const bool lifted = local.lifted_start.size() > 0;
   if (lifted &&
       (local.lifted_start.cols() != (local.d + 1) * static_cast<Eigen::Index>(local.owned.size()) ||
@@ -124,63 +127,8 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     res.escape_rounds = static_cast<std::uint32_t>(sequence->escape_trials());
   }
   res.final_rank = static_cast<std::uint32_t>(state.rank());
-  const auto t1 = std::chrono::steady_clock::now();
-
-  DistributedRounding rounding(local, layout, state, mail);
-  res = rounding.run(std::move(res));
-  if (sequence) {
-    double escape_bytes = 0.0;
-    res.certificate_bytes = static_cast<std::uint64_t>(
-        rounding.sum_over_agents(kTraffic, static_cast<double>(mail.certificate_bytes),
-                                 static_cast<double>(mail.escape_bytes), &escape_bytes));
-    res.escape_bytes = static_cast<std::uint64_t>(escape_bytes);
-  }
-  res.solve_s = std::chrono::duration<double>(t1 - t0).count();
-  res.rounding_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-  res.wait_s = mail.wait_s;
-  res.send_s = mail.send_s;
-  res.rounding_steps = mail.gathers;
-
-  if (local.agent_id == 0 && res.certified) {  // before the final report, which ends the wait
-    RoundStatusMessage c;
-    c.round = res.rounds;
-    c.phase = kCertificateReportPhase;
-    c.sender = 0;
-    c.cost = res.min_eigenvalue;
-    c.grad_norm_sq = res.certificate_rounds;
-    c.block_grad_norm = res.final_rank;
-    c.restart_vote = *res.certified;
-    c.done_vote = true;
-    channel.send(OutgoingMessage{c, true, {}});
-    RoundStatusMessage b;
-    b.round = res.rounds;
-    b.phase = kCertificateBytesPhase;
-    b.sender = 0;
-    b.cost = static_cast<double>(res.certificate_bytes);
-    b.grad_norm_sq = static_cast<double>(res.escape_bytes);
-    b.block_grad_norm = res.escape_rounds;
-    channel.send(OutgoingMessage{b, true, {}});
-  }
-  if (local.agent_id == 0) {  // agent 0's times, for the coordinator's phase split
-    RoundStatusMessage t;
-    t.round = res.rounds;
-    t.phase = kPhaseTimesPhase;
-    t.sender = 0;
-    t.cost = res.solve_s;
-    t.grad_norm_sq = res.rounding_s;
-    channel.send(OutgoingMessage{t, true, {}});
-  }
-  if (local.agent_id == 0) {  // one report for the coordinator's summary
-    RoundStatusMessage st;
-    st.round = res.rounds;
-    st.phase = kFinalReportPhase;
-    st.sender = 0;
-    st.cost = res.cost;
-    st.grad_norm_sq = res.grad_norm * res.grad_norm;
-    st.block_grad_norm = static_cast<double>(res.restarts);
-    channel.send(OutgoingMessage{st, true, {}});
-  }
-  return res;
+  return round_and_report(local, layout, state, mail, channel, std::move(res), sequence != nullptr,
+                          t0);
 }
 
 }  // namespace tessera::agent

@@ -18,10 +18,12 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/graph/measurement.hpp>
 #include <tessera/graph/pose.hpp>
 #include <tessera/protocol/awaited_messages.hpp>
 #include <tessera/protocol/messages.hpp>
+#include <tessera/robust/robust_options.hpp>
 #include <utility>
 #include <vector>
 
@@ -42,6 +44,11 @@ struct RunOptions {
   std::uint64_t seed = 1;
   bool certify = false;  ///< Certified sequence (solve -> certify -> escape ...), core's defaults.
   std::uint32_t coarse_every = 0;  ///< Coarse correction every this many rounds; 0 = off.
+  /// Robust solve (`--robust`; robust/gnc_agent.hpp runs it): kind none = plain least squares.
+  RobustOptions robust;
+  /// GNC starts from the known inliers' distributed initialization when they connect the poses
+  /// (GncDistributedOptions::known_inlier_start; off when --init is given).
+  bool gnc_known_start = true;
 };
 
 /// Everything one agent knows after the hand-off.
@@ -119,6 +126,15 @@ class ProtocolChannel {
                                                           const AwaitedMessages& awaited);
 };
 
+/// What a robust run decided (robust/gnc_agent.hpp), the same on every agent.
+struct RobustRunReport {
+  int outer_iterations = 0;
+  std::vector<std::uint64_t> rejected;  ///< File positions, ascending.
+  std::size_t readmitted = 0;
+  double threshold_squared = 0;
+  bool weights_converged = false;
+};
+
 struct RoundLoopResult {
   std::vector<Pose> poses;  ///< Final (rounded) poses of `owned`, same order.
   std::uint32_t rounds = 0;
@@ -141,6 +157,9 @@ struct RoundLoopResult {
   std::uint32_t certificate_rounds = 0, escape_rounds = 0;
   std::uint64_t certificate_bytes = 0, escape_bytes = 0;
   std::uint32_t final_rank = 0;
+  // Robust solve (RunOptions::robust): identical on every agent. `rounds` then counts every
+  // solve (the GNC steps, the inlier passes, the final one) and `cost` is over the kept set.
+  std::optional<RobustRunReport> robust;
 };
 
 /// Status phases of the messages the round loop adds after core's protocol (distributed
@@ -155,10 +174,14 @@ constexpr std::uint32_t kCertificateReportPhase = 201;
 /// And its traffic: cost = certificate bytes, grad_norm_sq = escape bytes (all agents),
 /// block_grad_norm = escape rounds.
 constexpr std::uint32_t kCertificateBytesPhase = 202;
+/// Agent 0's robust report (RunOptions::robust), before the final report: cost = outer
+/// iterations, grad_norm_sq = re-admitted measurements, block_grad_norm = c^2, done_vote =
+/// weights converged, measurement_ids = the rejected measurements.
+constexpr std::uint32_t kRobustReportPhase = 203;
 /// And, before the final report in every run, its own times: cost = solve_s (core's protocol:
 /// rounds, and certificate and escapes when certified), grad_norm_sq = rounding_s (seconds), so
 /// the coordinator can split the time after the last round into certificate and rounding.
-constexpr std::uint32_t kPhaseTimesPhase = 203;
+constexpr std::uint32_t kPhaseTimesPhase = 204;
 
 /// Optional recovery hooks of the round loop.
 struct RoundLoopHooks {
@@ -168,6 +191,9 @@ struct RoundLoopHooks {
   /// initial poses; every other agent must resume from its snapshot of the same round.
   const ProtocolSnapshot* resume_from = nullptr;
 };
+
+/// Core's solver options for `options` (core's defaults where a field is 0 or empty).
+DistributedOptions distributed_options_of(const RunOptions& options);
 
 /// Runs this agent's part of the distributed solve. `receive_timeout_s` bounds every wait
 /// for a peer's message (a throw names the missing sender). RollbackRequested from the

@@ -325,18 +325,21 @@ def table(csv_path):
             return v or "-"
 
     head = ("| graph | kind | F | outliers | rejected | precision | recall | gap to f*_clean | ATE m | outer | "
-            "certified | plain gap | plain ATE m | dist. rejected | dist. recall | dist. gap | dist. rounds "
-            "(clean) | dist. MB | dist. certified | load |")
-    lines = [head, "|" + "---|" * head.count("|")[:-1] if False else "|" + "---|" * (head.count("|") - 1)]
+            "certified | wall s | plain gap | plain ATE m | dist. rejected | dist. precision | dist. recall | "
+            "dist. gap | dist. ATE m | dist. rounds (clean) | dist. MB | dist. wall s | dist. certified | load |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         lines.append("| " + " | ".join([
             r["graph"], r["kind"], r["F"], r["outliers"], r["rejected"] or "-", num(r["precision"], "{:.3f}"),
             num(r["recall"], "{:.3f}"), num(r["gap"], "{:.1e}"), num(r["ate_m"], "{:.2g}"), r["outer"] or "-",
-            r["certified"] or "-", num(r["plain_gap"], "{:.3g}"), num(r["plain_ate_m"], "{:.2g}"),
-            r.get("d_rejected", "") or "-", num(r.get("d_recall", ""), "{:.3f}"), num(r.get("d_gap", ""), "{:.1e}"),
+            r["certified"] or "-", num(r["wall_s"], "{:.3g}"), num(r["plain_gap"], "{:.3g}"),
+            num(r["plain_ate_m"], "{:.2g}"),
+            r.get("d_rejected", "") or "-", num(r.get("d_precision", ""), "{:.3f}"),
+            num(r.get("d_recall", ""), "{:.3f}"), num(r.get("d_gap", ""), "{:.1e}"),
+            num(r.get("d_ate_m", ""), "{:.2g}"),
             (f"{r['d_rounds']} ({r['d_clean_rounds']})" if r.get("d_rounds") else "-"),
             num(str(float(r["d_bytes"]) / 1e6) if r.get("d_bytes") else "", "{:.1f}"),
-            r.get("d_certified", "") or "-", r["load"]]) + " |")
+            num(r.get("d_wall_s", ""), "{:.3g}"), r.get("d_certified", "") or "-", r["load"]]) + " |")
     return "\n".join(lines)
 
 
@@ -354,6 +357,15 @@ def main():
     ap.add_argument("--no-distributed", dest="distributed", action="store_false",
                     help="skip the distributed (irbcd, 5 agents) column")
     ap.add_argument("--csv", default="robust.csv", help="file name in --out-dir (rows are appended per cell)")
+    ap.add_argument("--scheme", default="gnc-tls", choices=["gnc-tls", "pcm-gnc"],
+                    help="--robust value of the centralized robust solve (the distributed one is gnc-tls)")
+    ap.add_argument("--no-plain", dest="plain", action="store_false",
+                    help="skip the plain (non-robust) centralized solve of the contaminated file (slow on "
+                         "large graphs)")
+    ap.add_argument("--no-centralized", dest="centralized", action="store_false",
+                    help="skip the centralized robust solve")
+    ap.add_argument("--append", action="store_true",
+                    help="add rows to an existing --csv (e.g. the large graphs with fewer fractions)")
     ap.add_argument("--plot-only", action="store_true", help="only redraw the figure from the CSV")
     args = ap.parse_args()
     os.makedirs(args.out_dir, exist_ok=True)
@@ -363,12 +375,13 @@ def main():
         plot(out_csv, png)
         print(table(out_csv))
         return
-    fields = ["graph", "kind", "F", "outliers", "rejected", "precision", "recall", "gap", "ate_m", "outer",
+    fields = ["graph", "kind", "F", "scheme", "outliers", "rejected", "precision", "recall", "gap", "ate_m", "outer",
               "iterations", "wall_s", "certified", "plain_gap", "plain_ate_m", "plain_wall_s",
               "d_rejected", "d_precision", "d_recall", "d_gap", "d_ate_m", "d_outer", "d_rounds", "d_clean_rounds",
               "d_round_ratio", "d_bytes", "d_wall_s", "d_certified", "load", "note"]
-    with open(out_csv, "w", newline="") as f:
-        csv.writer(f).writerow(fields)
+    if not (args.append and os.path.exists(out_csv)):
+        with open(out_csv, "w", newline="") as f:
+            csv.writer(f).writerow(fields)
     work = tempfile.mkdtemp(prefix="tessera-robust-")
     for name in args.graphs.split(","):
         clean = clean_graph(args, work, name)
@@ -392,15 +405,21 @@ def main():
                 progress(f"{tag}: {len(labels)} outliers")
                 load = open("/proc/loadavg").read().split()[0]
                 rej = os.path.join(work, tag + ".rejected")
-                rob, rob_tum, wall, err = solve(args.bin, path, work, tag + "_robust",
-                                                ["--robust", "gnc-tls", "--rejected", rej], args.timeout)
-                plain, plain_tum, plain_wall, _ = solve(args.bin, path, work, tag + "_plain", [], args.timeout)
-                row = {"graph": name, "kind": kind, "F": fraction, "outliers": len(labels), "load": load}
+                rob, rob_tum, wall, err = None, None, 0, "not run"
+                if args.centralized:
+                    rob, rob_tum, wall, err = solve(args.bin, path, work, tag + "_robust",
+                                                    ["--robust", args.scheme, "--rejected", rej], args.timeout)
+                plain = None
+                if args.plain:
+                    plain, plain_tum, plain_wall, _ = solve(args.bin, path, work, tag + "_plain", [], args.timeout)
+                row = {"graph": name, "kind": kind, "F": fraction, "scheme": args.scheme, "outliers": len(labels),
+                       "load": load}
                 if plain is not None:
                     row.update(plain_gap=(plain["cost"] - fstar) / fstar,
                                plain_ate_m=ate(read_tum(plain_tum, d), optimum, d), plain_wall_s=round(plain_wall, 2))
                 if rob is None:
-                    row["note"] = err
+                    if args.centralized:
+                        row["note"] = err
                 else:
                     rejected = set(rob["rejected"])
                     truth = set(labels)

@@ -41,6 +41,10 @@ struct RoundStatusMessage {
   /// Coarse-correction rounds only: this agent's coarse terms (distributed/coarse_correction.hpp);
   /// empty otherwise.
   std::vector<double> coarse;
+  /// Robust (GNC) exchanges only (robust/gnc_agent.hpp): measurements by their position in the
+  /// input file and their weights, same order; empty otherwise.
+  std::vector<std::uint64_t> measurement_ids;
+  std::vector<double> weights;
 };
 
 using ProtocolMessage = std::variant<PoseBlockMessage, RoundStatusMessage>;

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <tessera/graph/pose_graph.hpp>
+#include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/robust_options.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
 #include <vector>
@@ -16,7 +17,7 @@ struct GncCentralizedOptions {
   /// start from the previous solve's poses; the final solve of the inlier set uses them as
   /// given (certify on: `certified` is then about the inlier set).
   CentralizedOptions solver;
-  RobustOptions robust;  ///< kind is ignored: this is the GNC-TLS path.
+  RobustOptions robust;  ///< kPcmGnc: the consistency check first; otherwise GNC-TLS.
   /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
   /// rule's measurements (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier_flags;
@@ -34,6 +35,9 @@ struct GncCentralizedResult {
   double threshold_squared = 0;       ///< c^2 used.
   double final_mu = 0;                ///< mu of the last outer step (0: no step was needed).
   bool weights_converged = false;     ///< sum w(1 - w) fell below the tolerance.
+  /// Rejected measurements taken back after the final solve (RobustOptions::readmission_passes).
+  std::size_t readmitted = 0;
+  PairwiseConsistencyResult pcm;  ///< kPcmGnc: the consistency check (empty otherwise).
 };
 
 /// Runs GNC-TLS on `graph` and certifies the result on the inlier set. Measurements that the

@@ -3,12 +3,13 @@
 // --robust gnc-tls`, in one process): each outer step is a warm-started distributed solve of
 // the weighted problem; the weight of every measurement is computed by one agent, the
 // *owner of its lower pose id* (assignment[min(i, j)]), from what that agent holds after a
-// solve: its own lifted poses and its neighbours' public ones. mu's start needs the largest
-// residual (a max over the agents' local maxima) and the stop needs every agent's "my
-// weights are binary" vote: two scalars per agent and outer step, the size of a round status.
+// solve: its own lifted poses and its neighbours' public ones. The outer loop is the agents'
+// own (robust/gnc_agent.hpp), run here by the in-process driver and over DDS by the agents'
+// round loop: the same messages, the same iterates.
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/graph/pose_graph.hpp>
 #include <tessera/robust/robust_options.hpp>
@@ -25,6 +26,25 @@ struct GncDistributedOptions {
   /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
   /// rule's measurements (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier_flags;
+  /// Consider the distributed initialization of the known inliers alone (with the default
+  /// rule: each robot's odometry chain, robots joined by their consecutive-id links) as the
+  /// start besides solver.initialization, and take the one with the lower TLS cost. A chordal
+  /// start fits every measurement, outliers included, and the plain solve from there settles
+  /// in a distorted solution that costs many rounds and can make true closures look wrong; on
+  /// clean data it is nearly the optimum. Unused when the known inliers do not connect the
+  /// poses; false: always solver.initialization.
+  bool known_inlier_start = true;
+  /// Optional: called after every weight exchange with (agent, outer step, that agent's
+  /// measurements by file position, the weights it uses for them); tests compare the two ends
+  /// of every cut measurement with it.
+  std::function<void(int, int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
+      weight_observer;
+  /// With known_inlier_start: compare the two starts' TLS costs (false: the known inliers'
+  /// whenever they connect the poses, what the DDS agents do: they compute one initialization).
+  bool start_vote = true;
+  /// The first inlier pass may start from the solver's initialization of the kept set when that
+  /// costs less (GncAgentInput::inlier_start; false: from the GNC iterate, as over DDS).
+  bool inlier_set_start = true;
   void validate() const;  ///< Throws InputError naming the first bad field.
 };
 
@@ -55,9 +75,18 @@ struct GncDistributedResult {
   int outer_iterations = 0;
   int total_rounds = 0;           ///< Rounds of every solve, final included.
   std::uint64_t total_bytes = 0;  ///< Bytes of every solve plus the outer steps' votes.
+  /// Measurements GNC had rejected whose residual at the inlier set's solution was within the
+  /// bound (r^2 <= c^2), taken back before the final solve.
+  std::size_t readmitted = 0;
   double threshold_squared = 0;
   bool weights_converged = false;
 };
+
+/// The starting poses of distributed GNC: with options.known_inlier_start, the distributed
+/// initialization of the known inliers alone when they connect the poses; otherwise
+/// solver.initialization's (with solver.robots, or `agents`, robots).
+std::vector<Pose> gnc_start(const PoseGraph& graph, const GncDistributedOptions& options,
+                            int agents);
 
 /// Runs GNC-TLS with the distributed solver on `assignment`'s blocks. Throws InputError on
 /// bad options and, like solve_gnc_centralized(), when the kept measurements leave the poses

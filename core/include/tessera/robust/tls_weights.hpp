@@ -16,6 +16,11 @@ namespace tessera {
 /// r^2 = kappa ||R_j - R_i R_ij||_F^2 + tau ||t_j - t_i - R_i t_ij||^2.
 double residual_squared(const Measurement& m, const Pose& a, const Pose& b);
 
+/// The same term of the relaxed objective at lifted poses Xi, Xj (r x (d+1) each, [Y | p]):
+/// kappa ||Y_j - Y_i R_ij||_F^2 + tau ||p_j - p_i - Y_i t_ij||^2 (r^2 above when the rank is d).
+double lifted_residual_squared(const Measurement& m, const Eigen::MatrixXd& Xi,
+                               const Eigen::MatrixXd& Xj);
+
 /// x with P(chi^2_dof <= x) = p (regularised incomplete gamma, bisection to 1e-12 relative).
 /// dof >= 1, p in (0, 1).
 double chi_square_quantile(double p, int dof);

@@ -1,0 +1,217 @@
+#pragma once
+// One agent's side of distributed GNC-TLS as a single state machine for any driver (the
+// in-process driver, the DDS round loop), so both run the same code:
+//
+//   solve 0 (plain; every solve before the final one is capped at
+//           RobustOptions::inner_max_rounds rounds: GNC needs only a rough minimiser)
+//   poses    -> neighbours: the public poses of the iterate (every weight is computed at the
+//               iterate itself, not at a neighbour copy that may lag a round)
+//   votes    -> every agent: largest residual^2 of the measurements it owns; the max over the
+//               agents gives mu's start
+//   outer step k = 1, 2, ...:
+//     weights -> every agent: the TLS weights of the cut measurements it owns whose other end
+//               the recipient holds, the ids of its other cut measurements of weight 0 (they
+//               leave the weighted solve, so every agent must know the block adjacency), and
+//               its weight spread sum w (1 - w) (the stop vote)
+//     solve k (weighted, warm-started)
+//     poses  -> neighbours (when another step follows)
+//   rejected -> every agent: the measurements it owns with weight < 0.5
+//   [with GncAgentInput::inlier_start: poses of the iterate and of the other start, then a vote
+//    on their costs over the kept set; the first pass starts from the cheaper]
+//   inlier pass p = 0.. readmission_passes: solve of the kept set to the solver's tolerance
+//   (uncertified);
+//     poses, then readmitted -> every agent: its rejected measurements within the bound at
+//     that solution (misjudged on a rough iterate); none anywhere ends the passes
+//   final: with certification, the certified solve of the kept set
+//
+// Each weight is computed by one agent, the owner of the measurement's lower pose id
+// (weight_owner()); the other end receives it, so both ends always use the same weight. The
+// stop follows from the summed spread, identical on every agent: no central step.
+// Messages carry their step in `phase` (gnc_phase()); a fast agent's messages of later steps
+// are kept until this agent gets there.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <tessera/distributed/agent_process.hpp>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/certified_agent.hpp>
+#include <tessera/graph/measurement.hpp>
+#include <tessera/robust/gnc_distributed.hpp>
+#include <utility>
+#include <vector>
+
+namespace tessera {
+
+/// Phases of GNC step g (0 = first solve, k = k-th weighted solve, then the inlier passes and
+/// the final solve):
+/// g * kGncStepStride + the inner solve's stage-tagged phase (stage_tag.hpp), or + the GNC
+/// exchange's own phase. The stride is a multiple of 3 * kStagePhaseStride so stage_kind() of a
+/// tagged phase is still the inner stage's kind (certificate traffic is counted by it).
+constexpr std::uint32_t kGncStepStride = 3000000;
+/// The GNC exchanges sit after every inner stage of their step (inner stages stay below 999).
+constexpr std::uint32_t kGncExchangeBase = 999000;
+enum class GncExchange : std::uint32_t {
+  kPoses = 1,
+  kVotes = 2,
+  kWeights = 3,
+  kRejected = 4,
+  kReadmitted = 5,
+  kCandidatePoses = 6,
+  kCandidateVotes = 7
+};
+inline std::uint32_t gnc_phase(std::uint32_t step, GncExchange e) {
+  return step * kGncStepStride + kGncExchangeBase + static_cast<std::uint32_t>(e);
+}
+/// Most GNC steps the phase field can tag (the first solve, the weighted ones, the final one).
+constexpr std::uint32_t kMaxGncSteps = 4294967295u / kGncStepStride;
+
+/// What one agent starts from.
+struct GncAgentInput {
+  int id = 0;
+  int num_agents = 1;
+  int d = 0;
+  std::size_t num_poses = 0;
+  std::vector<int> owner;  ///< Agent of every pose 0..n-1.
+  /// Endpoints of every measurement of the whole graph, in file order (the layout, the
+  /// connectivity check of the kept set).
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;
+  /// The measurements touching this agent's poses, file order, and their file positions.
+  std::vector<Measurement> measurements;
+  std::vector<std::uint64_t> measurement_index;
+  /// Empty, or one per measurement of the whole graph (file order): true = never
+  /// down-weighted (a dpgo CSV file's is_known_inlier column).
+  std::vector<bool> known_inlier;
+  Eigen::MatrixXd Y0;  ///< Own block's lifted start, r x (d+1)m, ascending pose ids.
+  /// Optional: the own block of another start for the first inlier pass (the solver's own
+  /// initialization of the kept set, lifted to `rank`), given the rejected measurements. The
+  /// pass then starts from whichever of it and the GNC iterate has the lower cost over the
+  /// kept set (a vote). Empty: the GNC iterate (the DDS agents have no such stage yet).
+  std::function<Eigen::MatrixXd(const std::vector<std::uint64_t>& rejected, int rank)> inlier_start;
+};
+
+class GncAgent : public AgentProcess {
+ public:
+  /// `options` must outlive the agent. With `final_solve` false the agent is done before the
+  /// certified solve of the kept set (the caller runs it, or uses the last inlier pass).
+  GncAgent(GncAgentInput input, const GncDistributedOptions& options, bool final_solve = true);
+  ~GncAgent() override;
+
+  std::vector<OutgoingMessage> start() override;
+  std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
+  bool done() const override { return done_; }
+  std::size_t messages_needed() const override;
+  std::optional<AwaitedMessages> awaited() const override;
+
+  /// Called after every weight exchange with the outer step (1, 2, ...) and the weight this
+  /// agent uses for each of its measurements (file positions, weights): what tests compare
+  /// across the two ends of a cut measurement.
+  void set_weight_observer(
+      std::function<void(int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
+          observer) {
+    weight_observer_ = std::move(observer);
+  }
+
+  // Results, identical on every agent once done() (rejected, counts, threshold).
+  const std::vector<std::uint64_t>& rejected() const { return rejected_; }  ///< Ascending.
+  int outer_iterations() const { return outer_; }
+  std::size_t readmitted() const { return readmitted_; }  ///< Taken back by the passes.
+  bool weights_converged() const { return converged_; }
+  double threshold_squared() const { return c2_; }
+  /// Rounds of the solves before the final certified one (first, weighted, inlier passes).
+  int gnc_rounds() const { return gnc_rounds_; }
+  /// The own block at the start of the last inlier pass (what the caller of an agent without
+  /// the final solve starts that pass from to get its full record).
+  const Eigen::MatrixXd& last_pass_start() const { return last_pass_start_; }
+  int total_rounds() const;
+  /// The current weight of each of this agent's measurements (same order as the input's).
+  const std::vector<double>& weights() const { return weights_; }
+  const std::vector<std::uint64_t>& measurement_index() const { return in_.measurement_index; }
+  /// The iterate: own block, lifted (after the final solve: of the kept set).
+  const AgentState& state() const { return *state_; }
+  /// The final solve (nullptr before it or without it), its layout and kept measurements.
+  /// The last solve (the certified one, or the last inlier pass); valid once done().
+  const CertifiedAgent& last_solve() const { return *solve_; }
+  const CertifiedAgent* final_sequence() const {
+    return solve_kind_ == Solve::kFinal ? solve_.get() : nullptr;
+  }
+  const BlockLayout& layout() const { return *layout_; }
+  const std::vector<Measurement>& kept_measurements() const { return kept_; }
+  const std::vector<std::uint64_t>& kept_index() const { return kept_index_; }
+
+ private:
+  enum class Step {
+    kSolve,
+    kPoses,
+    kVotes,
+    kWeights,
+    kRejected,
+    kReadmitted,
+    kCandidatePoses,
+    kCandidateVotes,
+    kDone
+  };
+  enum class Solve { kGnc, kInlierPass, kFinal };
+  void begin_solve(std::vector<OutgoingMessage>& out);
+  void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
+  void after_solve(std::vector<OutgoingMessage>& out);
+  void after_exchange(std::vector<OutgoingMessage>& out);
+  void feed(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
+  void replay(std::vector<OutgoingMessage>& out);
+  std::uint32_t exchange_phase() const;
+  bool in_current_solve(std::uint32_t phase) const;
+  double residual_squared_at(std::size_t k) const;
+  double residual_squared_at(std::size_t k, const Eigen::MatrixXd& own,
+                             const Eigen::MatrixXd& neighbours) const;
+  void publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
+               std::vector<OutgoingMessage>& out);
+  bool may_reject(std::size_t k) const;
+  void weights_at_mu(double mu);
+  void begin_inlier_pass(std::vector<OutgoingMessage>& out);
+  void finish(std::vector<OutgoingMessage>& out);
+
+  GncAgentInput in_;
+  const GncDistributedOptions& options_;
+  bool final_solve_wanted_;
+  DistributedOptions solve_options_;  // the running solve's options
+  std::unique_ptr<BlockLayout> layout_;
+  std::unique_ptr<AgentState> state_;
+  std::unique_ptr<CertifiedAgent> solve_;
+  std::uint32_t g_ = 0;  // GNC step
+  Step step_ = Step::kSolve;
+  Solve solve_kind_ = Solve::kGnc;
+  bool voted_ = false;  // the votes of mu's start are in
+  int pass_ = 0;        // inlier passes done
+  std::size_t readmitted_ = 0;
+  std::vector<std::uint64_t> taken_back_;     // the current re-admission exchange's ids
+  std::vector<bool> known_;                   // per measurement of the whole graph
+  bool known_connected_ = false;              // the known inliers alone connect the poses
+  std::vector<std::uint64_t> zero_cut_;       // cut measurements of weight 0 (others' too)
+  std::unique_ptr<BlockLayout> base_;         // of every measurement: whose poses go where
+  std::vector<std::size_t> base_neighbours_;  // other ends of the own measurements, ascending
+  Eigen::MatrixXd last_pass_start_;
+  Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
+  std::vector<std::uint32_t> waiting_;                // senders the current exchange still lacks
+  std::vector<std::size_t> owned_;  // indices (into in_.measurements) this agent weighs
+  std::vector<double> weights_;     // per in_.measurements
+  Eigen::MatrixXd neighbours_;      // neighbours' public poses of the current iterate
+  std::map<std::uint32_t, std::vector<ProtocolMessage>> later_;  // by phase
+  // Sums of the current exchange (in agent-id order: own and received values kept by sender).
+  std::map<std::uint32_t, std::pair<double, double>> votes_;
+  double mu_ = 0, c2_ = 0;
+  int outer_ = 0;
+  bool converged_ = false;
+  std::vector<std::uint64_t> rejected_;
+  std::vector<Measurement> kept_;
+  std::vector<std::uint64_t> kept_index_;
+  int gnc_rounds_ = 0, final_rounds_ = 0;
+  bool done_ = false;
+  std::function<void(int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
+      weight_observer_;
+};
+
+}  // namespace tessera

@@ -1,0 +1,648 @@
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <tessera/distributed/stage_tag.hpp>
+#include <tessera/graph/connectivity.hpp>
+#include <tessera/robust/gnc_agent.hpp>
+#include <tessera/robust/tls_weights.hpp>
+#include <tessera/robust/weighted_graph.hpp>
+#include <tessera/util/input_error.hpp>
+
+namespace tessera {
+
+namespace {
+
+std::uint32_t phase_of(const ProtocolMessage& m) {
+  return std::visit([](const auto& x) { return x.phase; }, m);
+}
+std::uint32_t sender_of(const ProtocolMessage& m) {
+  return std::visit([](const auto& x) { return x.sender; }, m);
+}
+
+// Endpoints only: what connectivity and the block layout need.
+Measurement endpoints(const std::pair<std::uint32_t, std::uint32_t>& e) {
+  Measurement m;
+  m.i = e.first;
+  m.j = e.second;
+  return m;
+}
+
+// The parts the measurements of `structure` not in `dropped` (ascending) split the poses into.
+std::size_t components_without(
+    std::size_t num_poses, int d,
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    const std::vector<std::uint64_t>& dropped, bool only_known, const std::vector<bool>& known) {
+  PoseGraph g;
+  g.d = d;
+  g.num_poses = num_poses;
+  for (std::size_t e = 0; e < structure.size(); ++e) {
+    if (only_known && !known[e]) continue;
+    if (std::binary_search(dropped.begin(), dropped.end(), static_cast<std::uint64_t>(e))) continue;
+    g.measurements.push_back(endpoints(structure[e]));
+  }
+  return count_components(g);
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> without(
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    const std::vector<std::uint64_t>& dropped) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+  out.reserve(structure.size());
+  for (std::size_t e = 0; e < structure.size(); ++e)
+    if (!std::binary_search(dropped.begin(), dropped.end(), static_cast<std::uint64_t>(e)))
+      out.push_back(structure[e]);
+  return out;
+}
+
+}  // namespace
+
+GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bool final_solve)
+    : in_(std::move(input)), options_(options), final_solve_wanted_(final_solve) {
+  options_.validate();
+  const std::size_t m = in_.measurements.size();
+  if (in_.measurement_index.size() != m)
+    throw std::invalid_argument("GncAgent: one file position per measurement expected");
+  if (!in_.known_inlier.empty() && in_.known_inlier.size() != in_.structure.size())
+    throw std::invalid_argument("GncAgent: one known-inlier flag per measurement expected");
+  if (!std::is_sorted(in_.measurement_index.begin(), in_.measurement_index.end()))
+    throw std::invalid_argument("GncAgent: measurements must be in file order");
+  // Every solve is a GNC step of the phase field: the first, the weighted ones, the passes and
+  // the final one.
+  if (static_cast<long long>(options_.robust.max_outer_iterations) +
+          options_.robust.readmission_passes + 3 >
+      static_cast<long long>(kMaxGncSteps))
+    throw InputError("RobustOptions.max_outer_iterations + readmission_passes must be <= " +
+                     std::to_string(kMaxGncSteps - 3) + " for the distributed solve");
+  base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
+  layout_ = std::make_unique<BlockLayout>(*base_);
+  // Every agent knows every measurement's known-inlier status (rule + flags), hence how many may
+  // be rejected (c^2's default) and whether the known inliers alone connect the poses.
+  known_.resize(in_.structure.size());
+  std::size_t candidates = 0;
+  for (std::size_t e = 0; e < in_.structure.size(); ++e) {
+    known_[e] = is_known_inlier(endpoints(in_.structure[e]), options_.robust.known_inliers) ||
+                (!in_.known_inlier.empty() && in_.known_inlier[e]);
+    candidates += known_[e] ? 0 : 1;
+  }
+  c2_ = tls_threshold_squared(options_.robust, in_.d, candidates);
+  known_connected_ = components_without(in_.num_poses, in_.d, in_.structure, {}, true, known_) <= 1;
+  weights_.assign(m, 1.0);
+  for (std::size_t k = 0; k < m; ++k) {
+    const Measurement& x = in_.measurements[k];
+    if (weight_owner(x, in_.owner) == in_.id) owned_.push_back(k);
+    for (std::size_t p : {x.i, x.j})
+      if (in_.owner[p] != in_.id) base_neighbours_.push_back(p);
+  }
+  std::sort(base_neighbours_.begin(), base_neighbours_.end());
+  base_neighbours_.erase(std::unique(base_neighbours_.begin(), base_neighbours_.end()),
+                         base_neighbours_.end());
+}
+
+GncAgent::~GncAgent() = default;
+
+int GncAgent::total_rounds() const {
+  return gnc_rounds_ + final_rounds_;
+}
+
+bool GncAgent::may_reject(std::size_t k) const {
+  return !known_[in_.measurement_index[k]];
+}
+
+// The measurement's term of the relaxed objective at the current lifted iterate: the own
+// block's columns and the neighbours' public poses just received (or at another such pair).
+double GncAgent::residual_squared_at(std::size_t k) const {
+  return residual_squared_at(k, state_->Y, neighbours_);
+}
+
+double GncAgent::residual_squared_at(std::size_t k, const Eigen::MatrixXd& own_block,
+                                     const Eigen::MatrixXd& neighbour_block) const {
+  const Measurement& m = in_.measurements[k];
+  const Eigen::Index w = in_.d + 1;
+  const auto& own = base_->poses[static_cast<std::size_t>(in_.id)];
+  auto block = [&](std::size_t p) -> Eigen::MatrixXd {
+    if (in_.owner[p] == in_.id) {
+      const auto s = std::lower_bound(own.begin(), own.end(), p) - own.begin();
+      return own_block.middleCols(w * s, w);
+    }
+    const auto s = std::lower_bound(base_neighbours_.begin(), base_neighbours_.end(), p) -
+                   base_neighbours_.begin();
+    return neighbour_block.middleCols(w * s, w);
+  };
+  return lifted_residual_squared(m, block(m.i), block(m.j));
+}
+
+void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
+                       std::vector<OutgoingMessage>& out) {
+  const auto me = static_cast<std::uint32_t>(in_.id);
+  const Eigen::Index w = (in_.d + 1) * Y.rows();
+  const auto& own = base_->poses[me];
+  const auto& adjacent = base_->adjacent[me];
+  for (std::size_t q = 0; q < adjacent.size(); ++q) {
+    PoseBlockMessage b;
+    b.sender = me;
+    b.phase = phase;
+    b.kind = kind;
+    b.rank = static_cast<std::uint32_t>(Y.rows());
+    b.dim = static_cast<std::uint32_t>(in_.d);
+    const auto& ids = base_->public_to[me][q];
+    b.data.resize(ids.size() * static_cast<std::size_t>(w));
+    double* to = b.data.data();
+    for (std::size_t id : ids) {
+      const auto s = std::lower_bound(own.begin(), own.end(), id) - own.begin();
+      b.pose_ids.push_back(static_cast<std::uint32_t>(id));
+      std::memcpy(to, Y.data() + w * s, sizeof(double) * static_cast<std::size_t>(w));
+      to += w;
+    }
+    const auto to_agent = static_cast<std::uint32_t>(adjacent[q]);
+    out.push_back(OutgoingMessage{std::move(b), false, {to_agent}});
+    waiting_.push_back(to_agent);  // one message from that neighbour per message sent
+  }
+}
+
+void GncAgent::weights_at_mu(double mu) {
+  for (std::size_t k : owned_)
+    if (may_reject(k)) weights_[k] = tls_weight(residual_squared_at(k), c2_, mu);
+}
+
+std::vector<OutgoingMessage> GncAgent::start() {
+  std::vector<OutgoingMessage> out;
+  begin_solve(out);
+  return out;
+}
+
+void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
+  step_ = Step::kSolve;
+  solve_.reset();
+  solve_options_ = options_.solver;
+  std::vector<Measurement> measurements;
+  if (solve_kind_ != Solve::kGnc) {
+    measurements = kept_;
+    if (solve_kind_ == Solve::kInlierPass) solve_options_.certify = false;
+  } else {
+    solve_options_.certify = false;
+    // Every solve before the inlier passes needs only a rough minimiser.
+    if (options_.robust.inner_max_rounds > 0)
+      solve_options_.max_rounds =
+          std::min(solve_options_.max_rounds, options_.robust.inner_max_rounds);
+    for (std::size_t k = 0; k < in_.measurements.size(); ++k) {
+      // A weight of exactly 0 adds nothing: such an edge leaves the solve when the known
+      // inliers keep the poses connected (fewer block neighbours, fewer colours); otherwise it
+      // stays at a tiny pull so no part is cut off.
+      if (known_connected_ && weights_[k] == 0) continue;
+      Measurement x = in_.measurements[k];
+      const double w = std::max(weights_[k], kMinInnerWeight);
+      if (g_ > 0) {
+        x.kappa *= w;
+        x.tau *= w;
+      }
+      measurements.push_back(std::move(x));
+    }
+  }
+  const Eigen::MatrixXd Y = state_ ? state_->Y : in_.Y0;
+  if (solve_kind_ == Solve::kInlierPass) last_pass_start_ = Y;
+  state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
+                                        solve_options_.block_update);
+  solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
+  std::vector<OutgoingMessage> first = solve_->start();
+  for (auto& o : first) {
+    std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
+    out.push_back(std::move(o));
+  }
+  const std::uint32_t g = g_;
+  replay(out);
+  if (!done_ && g_ == g && step_ == Step::kSolve && solve_->done()) after_solve(out);
+}
+
+bool GncAgent::in_current_solve(std::uint32_t phase) const {
+  return phase >= g_ * kGncStepStride && phase < g_ * kGncStepStride + kGncExchangeBase;
+}
+
+std::uint32_t GncAgent::exchange_phase() const {
+  switch (step_) {
+    case Step::kPoses:
+      return gnc_phase(g_, GncExchange::kPoses);
+    case Step::kVotes:
+      return gnc_phase(g_, GncExchange::kVotes);
+    case Step::kWeights:
+      return gnc_phase(g_, GncExchange::kWeights);
+    case Step::kRejected:
+      return gnc_phase(g_, GncExchange::kRejected);
+    case Step::kReadmitted:
+      return gnc_phase(g_, GncExchange::kReadmitted);
+    case Step::kCandidatePoses:
+      return gnc_phase(g_, GncExchange::kCandidatePoses);
+    case Step::kCandidateVotes:
+      return gnc_phase(g_, GncExchange::kCandidateVotes);
+    default:
+      return 0;
+  }
+}
+
+void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
+  step_ = step;
+  const std::uint32_t phase = exchange_phase();
+  const auto me = static_cast<std::uint32_t>(in_.id);
+  waiting_.clear();
+  votes_.clear();
+  auto to_others = [&](RoundStatusMessage st, bool broadcast,
+                       const std::function<void(std::uint32_t, RoundStatusMessage&)>& fill) {
+    st.phase = phase;
+    st.sender = me;
+    for (std::uint32_t a = 0; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
+      if (a != me) waiting_.push_back(a);
+    if (broadcast) {
+      if (!waiting_.empty()) out.push_back(OutgoingMessage{st, true, {}});
+      return;
+    }
+    for (std::uint32_t a : waiting_) {
+      RoundStatusMessage s = st;
+      fill(a, s);
+      out.push_back(OutgoingMessage{std::move(s), false, {a}});
+    }
+  };
+  switch (step) {
+    case Step::kPoses:
+      // Weights are computed at the iterate itself: the owners' public poses of every
+      // measurement (the base layout: a measurement out of the current solve still needs
+      // its residual).
+      neighbours_ = Eigen::MatrixXd::Zero(
+          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
+      publish(state_->Y, BlockKind::kY, phase, out);
+      break;
+    case Step::kCandidatePoses:
+      // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
+      neighbours_ = Eigen::MatrixXd::Zero(
+          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
+      candidate_neighbours_ = neighbours_;
+      publish(state_->Y, BlockKind::kY, phase, out);
+      publish(candidate_, BlockKind::kP, phase, out);
+      break;
+    case Step::kCandidateVotes: {
+      // Each kept measurement's cost at both starts, summed by its weight owner.
+      double at_iterate = 0, at_candidate = 0;
+      for (std::size_t k : owned_)
+        if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
+          at_iterate += residual_squared_at(k);
+          at_candidate += residual_squared_at(k, candidate_, candidate_neighbours_);
+        }
+      votes_[me] = {at_iterate, at_candidate};
+      RoundStatusMessage st;
+      st.cost = at_iterate;
+      st.grad_norm_sq = at_candidate;
+      to_others(st, true, nullptr);
+      break;
+    }
+    case Step::kVotes: {
+      // mu's start needs the largest residual over every measurement that may be rejected.
+      double max_r2 = 0;
+      for (std::size_t k : owned_)
+        if (may_reject(k)) max_r2 = std::max(max_r2, residual_squared_at(k));
+      votes_[me] = {max_r2, 0};
+      RoundStatusMessage st;
+      st.cost = max_r2;
+      to_others(st, true, nullptr);
+      break;
+    }
+    case Step::kWeights: {
+      weights_at_mu(mu_);
+      double spread = 0;
+      for (std::size_t k : owned_) spread += weights_[k] * (1 - weights_[k]);
+      votes_[me] = {spread, 0};
+      zero_cut_.clear();
+      for (std::size_t k : owned_) {
+        const Measurement& m = in_.measurements[k];
+        if (weights_[k] == 0 && in_.owner[m.i] != in_.owner[m.j])
+          zero_cut_.push_back(in_.measurement_index[k]);
+      }
+      RoundStatusMessage st;
+      st.grad_norm_sq = spread;
+      to_others(st, false, [&](std::uint32_t a, RoundStatusMessage& s) {
+        // The recipient's cut measurements this agent weighs, then (with weight 0) its other
+        // cut measurements that leave the solve, for the recipient's block layout.
+        for (std::size_t k : owned_) {
+          const Measurement& m = in_.measurements[k];
+          const auto other = static_cast<std::uint32_t>(in_.owner[std::max(m.i, m.j)]);
+          const bool cut = in_.owner[m.i] != in_.owner[m.j];
+          if (other == a || (known_connected_ && cut && weights_[k] == 0)) {
+            s.measurement_ids.push_back(in_.measurement_index[k]);
+            s.weights.push_back(weights_[k]);
+          }
+        }
+      });
+      break;
+    }
+    case Step::kRejected: {
+      rejected_.clear();
+      for (std::size_t k : owned_)
+        if (weights_[k] < 0.5) rejected_.push_back(in_.measurement_index[k]);
+      RoundStatusMessage st;
+      st.measurement_ids = rejected_;
+      to_others(st, true, nullptr);
+      break;
+    }
+    case Step::kReadmitted: {
+      // A rejected measurement within the bound at the kept set's solution (TLS would count
+      // it as an inlier there) was misjudged on a rough iterate: it comes back.
+      taken_back_.clear();
+      for (std::size_t k : owned_)
+        if (std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k]) &&
+            residual_squared_at(k) <= c2_)
+          taken_back_.push_back(in_.measurement_index[k]);
+      RoundStatusMessage st;
+      st.measurement_ids = taken_back_;
+      to_others(st, true, nullptr);
+      break;
+    }
+    default:
+      break;
+  }
+  replay(out);
+  if (!done_ && step_ == step && exchange_phase() == phase && waiting_.empty()) after_exchange(out);
+}
+
+void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
+  // The kept set must connect every pose (every agent checks the same set).
+  const std::size_t parts =
+      components_without(in_.num_poses, in_.d, in_.structure, rejected_, false, known_);
+  if (parts > 1)
+    throw InputError("robust solve: " + std::to_string(rejected_.size()) + " of " +
+                     std::to_string(in_.structure.size()) +
+                     " measurements look like outliers, and the kept ones split the poses into " +
+                     std::to_string(parts) +
+                     " unconnected parts, so no estimate is defined (too few consistent "
+                     "measurements; try --known-inliers odometry or a larger --inlier-threshold)");
+  kept_.clear();
+  kept_index_.clear();
+  for (std::size_t k = 0; k < in_.measurements.size(); ++k)
+    if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
+      kept_.push_back(in_.measurements[k]);
+      kept_index_.push_back(in_.measurement_index[k]);
+    }
+  auto layout = std::make_unique<BlockLayout>(
+      make_block_layout(in_.num_poses, without(in_.structure, rejected_), in_.owner));
+  // The state refers to the layout: keep the iterate, then replace both.
+  in_.Y0 = state_->Y;
+  solve_.reset();
+  state_.reset();
+  layout_ = std::move(layout);
+  solve_kind_ = Solve::kInlierPass;
+  ++g_;
+  begin_solve(out);
+}
+
+void GncAgent::finish(std::vector<OutgoingMessage>& out) {
+  if (!options_.solver.certify || !final_solve_wanted_) {
+    done_ = true;
+    step_ = Step::kDone;
+    return;
+  }
+  // The certificate once, on the set that stays (re-admission ran on uncertified solves: the
+  // staircase may raise the rank, which a further pass could not start from).
+  solve_kind_ = Solve::kFinal;
+  ++g_;
+  begin_solve(out);
+}
+
+void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
+  if (solve_kind_ == Solve::kFinal) {
+    final_rounds_ += solve_->total_rounds();
+    done_ = true;
+    step_ = Step::kDone;
+    return;
+  }
+  gnc_rounds_ += solve_->total_rounds();
+  if (solve_kind_ == Solve::kInlierPass) {
+    if (pass_ >= options_.robust.readmission_passes || rejected_.empty()) {
+      finish(out);
+      return;
+    }
+    begin_exchange(Step::kPoses, out);
+    return;
+  }
+  if (g_ > 0 && (converged_ || outer_ >= options_.robust.max_outer_iterations)) {
+    begin_exchange(Step::kRejected, out);
+    return;
+  }
+  begin_exchange(Step::kPoses, out);
+}
+
+void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
+  switch (step_) {
+    case Step::kPoses:
+      if (solve_kind_ == Solve::kInlierPass)
+        begin_exchange(Step::kReadmitted, out);
+      else
+        begin_exchange(voted_ ? Step::kWeights : Step::kVotes, out);
+      return;
+    case Step::kVotes: {
+      voted_ = true;
+      double max_r2 = 0;
+      for (const auto& [sender, v] : votes_) max_r2 = std::max(max_r2, v.first);
+      mu_ = gnc_initial_mu(max_r2, c2_);
+      converged_ = mu_ == 0;
+      begin_exchange(converged_ ? Step::kRejected : Step::kWeights, out);
+      return;
+    }
+    case Step::kWeights: {
+      double spread = 0;
+      for (const auto& [sender, v] : votes_) spread += v.first;  // agent-id order
+      ++outer_;
+      if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
+      converged_ = spread <= options_.robust.weight_tolerance;
+      mu_ *= options_.robust.mu_step;
+      if (known_connected_) {
+        // This step's block layout: without the cut measurements of weight 0 (every agent's).
+        std::sort(zero_cut_.begin(), zero_cut_.end());
+        auto layout = std::make_unique<BlockLayout>(
+            make_block_layout(in_.num_poses, without(in_.structure, zero_cut_), in_.owner));
+        in_.Y0 = state_->Y;
+        solve_.reset();
+        state_.reset();
+        layout_ = std::move(layout);
+      }
+      ++g_;
+      begin_solve(out);
+      return;
+    }
+    case Step::kRejected:
+      std::sort(rejected_.begin(), rejected_.end());
+      if (in_.inlier_start) {
+        candidate_ = in_.inlier_start(rejected_, static_cast<int>(state_->Y.rows()));
+        begin_exchange(Step::kCandidatePoses, out);
+        return;
+      }
+      begin_inlier_pass(out);
+      return;
+    case Step::kCandidatePoses:
+      begin_exchange(Step::kCandidateVotes, out);
+      return;
+    case Step::kCandidateVotes: {
+      double at_iterate = 0, at_candidate = 0;
+      for (const auto& [sender, v] : votes_) {  // agent-id order
+        at_iterate += v.first;
+        at_candidate += v.second;
+      }
+      if (at_candidate < at_iterate) state_->Y = candidate_;
+      candidate_.resize(0, 0);
+      candidate_neighbours_.resize(0, 0);
+      begin_inlier_pass(out);
+      return;
+    }
+    case Step::kReadmitted: {
+      ++pass_;
+      if (taken_back_.empty()) {
+        finish(out);
+        return;
+      }
+      std::sort(taken_back_.begin(), taken_back_.end());
+      for (std::size_t k = 0; k < in_.measurements.size(); ++k)
+        if (std::binary_search(taken_back_.begin(), taken_back_.end(), in_.measurement_index[k]))
+          weights_[k] = 1.0;
+      std::vector<std::uint64_t> still;
+      std::set_difference(rejected_.begin(), rejected_.end(), taken_back_.begin(),
+                          taken_back_.end(), std::back_inserter(still));
+      readmitted_ += rejected_.size() - still.size();
+      rejected_ = std::move(still);
+      begin_inlier_pass(out);
+      return;
+    }
+    default:
+      return;
+  }
+}
+
+void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>& out) {
+  const std::uint32_t phase = phase_of(message);
+  if (step_ == Step::kSolve) {
+    ProtocolMessage m = message;
+    std::visit([&](auto& x) { x.phase -= g_ * kGncStepStride; }, m);
+    for (auto& o : solve_->handle(m)) {
+      std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
+      out.push_back(std::move(o));
+    }
+    if (solve_->done()) after_solve(out);
+    return;
+  }
+  const std::uint32_t sender = sender_of(message);
+  auto it = std::find(waiting_.begin(), waiting_.end(), sender);
+  const std::string me = "agent " + std::to_string(in_.id) + ": ";
+  if (it == waiting_.end())
+    throw std::runtime_error(me + "unexpected robust message " + std::to_string(phase) +
+                             " from agent " + std::to_string(sender));
+  waiting_.erase(it);
+  if (step_ == Step::kPoses || step_ == Step::kCandidatePoses) {
+    const auto* block = std::get_if<PoseBlockMessage>(&message);
+    const Eigen::Index w = (in_.d + 1) * neighbours_.rows();
+    if (!block || block->rank != static_cast<std::uint32_t>(neighbours_.rows()) ||
+        block->data.size() != block->pose_ids.size() * static_cast<std::size_t>(w))
+      throw std::runtime_error(me + "malformed robust pose message from agent " +
+                               std::to_string(sender));
+    for (std::size_t q = 0; q < block->pose_ids.size(); ++q) {
+      const auto p = static_cast<std::size_t>(block->pose_ids[q]);
+      const auto s = std::lower_bound(base_neighbours_.begin(), base_neighbours_.end(), p);
+      if (s == base_neighbours_.end() || *s != p)
+        throw std::runtime_error(me + "pose " + std::to_string(p) + " from agent " +
+                                 std::to_string(sender) + " is not a neighbour");
+      Eigen::MatrixXd& into = block->kind == BlockKind::kP ? candidate_neighbours_ : neighbours_;
+      std::memcpy(into.data() + w * (s - base_neighbours_.begin()),
+                  block->data.data() + w * static_cast<Eigen::Index>(q),
+                  sizeof(double) * static_cast<std::size_t>(w));
+    }
+  } else {
+    const auto* st = std::get_if<RoundStatusMessage>(&message);
+    if (!st) throw std::runtime_error(me + "poses where a robust status belongs");
+    if (step_ == Step::kVotes) votes_[sender] = {st->cost, 0};
+    if (step_ == Step::kCandidateVotes) votes_[sender] = {st->cost, st->grad_norm_sq};
+    if (step_ == Step::kWeights) {
+      votes_[sender] = {st->grad_norm_sq, 0};
+      if (st->weights.size() != st->measurement_ids.size())
+        throw std::runtime_error(me + "weights from agent " + std::to_string(sender) +
+                                 " do not match their measurements");
+      for (std::size_t q = 0; q < st->weights.size(); ++q) {
+        const std::uint64_t id = st->measurement_ids[q];
+        if (id >= in_.structure.size() ||
+            in_.owner[std::min(in_.structure[id].first, in_.structure[id].second)] !=
+                static_cast<int>(sender))
+          throw std::runtime_error(me + "agent " + std::to_string(sender) +
+                                   " sent the weight of measurement " + std::to_string(id) +
+                                   ", not its own");
+        const auto pos =
+            std::lower_bound(in_.measurement_index.begin(), in_.measurement_index.end(), id);
+        if (pos != in_.measurement_index.end() && *pos == id)
+          weights_[static_cast<std::size_t>(pos - in_.measurement_index.begin())] = st->weights[q];
+        if (st->weights[q] == 0) zero_cut_.push_back(id);
+      }
+    }
+    if (step_ == Step::kRejected)
+      rejected_.insert(rejected_.end(), st->measurement_ids.begin(), st->measurement_ids.end());
+    if (step_ == Step::kReadmitted)
+      taken_back_.insert(taken_back_.end(), st->measurement_ids.begin(), st->measurement_ids.end());
+  }
+  if (waiting_.empty()) after_exchange(out);
+}
+
+void GncAgent::replay(std::vector<OutgoingMessage>& out) {
+  // Messages of the step just begun that came while this agent was behind.
+  while (!done_ && !later_.empty()) {
+    const std::uint32_t phase = later_.begin()->first;
+    const bool current =
+        step_ == Step::kSolve ? in_current_solve(phase) : phase == exchange_phase();
+    if (!current) {
+      const std::uint32_t lower = step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
+      if (phase >= lower) return;
+      later_.erase(later_.begin());  // of a step this agent has left
+      continue;
+    }
+    std::vector<ProtocolMessage> kept = std::move(later_.begin()->second);
+    later_.erase(later_.begin());
+    const Step step = step_;
+    const std::uint32_t g = g_;
+    for (std::size_t q = 0; q < kept.size(); ++q) {
+      if (done_ || step_ != step || g_ != g) {
+        // The step moved on: what is left goes back in line.
+        auto& back = later_[phase];
+        back.insert(back.begin(), kept.begin() + static_cast<std::ptrdiff_t>(q), kept.end());
+        break;
+      }
+      feed(kept[q], out);
+    }
+  }
+}
+
+std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {
+  std::vector<OutgoingMessage> out;
+  if (done_) return out;
+  const std::uint32_t phase = phase_of(message);
+  const bool current = step_ == Step::kSolve ? in_current_solve(phase) : phase == exchange_phase();
+  if (current) {
+    feed(message, out);
+    replay(out);
+    return out;
+  }
+  const std::uint32_t lower = step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
+  if (phase < lower) return out;  // a step this agent has left needs nothing more
+  later_[phase].push_back(message);
+  return out;
+}
+
+std::size_t GncAgent::messages_needed() const {
+  if (done_) return 0;
+  if (step_ == Step::kSolve) return std::max<std::size_t>(solve_->messages_needed(), 1);
+  return std::max<std::size_t>(waiting_.size(), 1);
+}
+
+std::optional<AwaitedMessages> GncAgent::awaited() const {
+  if (done_) return std::nullopt;
+  if (step_ == Step::kSolve) {
+    std::optional<AwaitedMessages> a = solve_->awaited();
+    if (a) a->phase += g_ * kGncStepStride;
+    return a;
+  }
+  std::vector<std::uint32_t> senders = waiting_;
+  std::sort(senders.begin(), senders.end());
+  senders.erase(std::unique(senders.begin(), senders.end()), senders.end());
+  return AwaitedMessages{0, exchange_phase(), senders};
+}
+
+}  // namespace tessera

@@ -1,0 +1,82 @@
+#include "runtime/gnc_round_loop.hpp"
+
+#include <chrono>
+#include <string>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/robust/gnc_agent.hpp>
+
+#include "runtime/round_finish.hpp"
+#include "runtime/round_mailbox.hpp"
+
+namespace tessera::agent {
+
+RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel& channel,
+                                   double receive_timeout_s) {
+  GncDistributedOptions options;
+  options.solver = distributed_options_of(local.options);
+  options.robust = local.options.robust;
+  options.known_inlier_start = local.options.gnc_known_start;
+  if (options.solver.rank < local.d)
+    throw std::runtime_error("rank " + std::to_string(options.solver.rank) +
+                             " is below d = " + std::to_string(local.d));
+  if (local.initial.size() != local.owned.size())
+    throw std::runtime_error("agent " + std::to_string(local.agent_id) + ": " +
+                             std::to_string(local.initial.size()) + " initial poses for " +
+                             std::to_string(local.owned.size()) + " owned poses");
+
+  GncAgentInput in;
+  in.id = static_cast<int>(local.agent_id);
+  in.num_agents = static_cast<int>(local.num_agents);
+  in.d = local.d;
+  in.num_poses = local.num_poses;
+  in.owner.assign(local.owner.begin(), local.owner.end());
+  in.structure = local.structure;
+  in.measurements = local.measurements;
+  in.measurement_index = local.measurement_index;
+  in.Y0 = lift_poses(local.initial, options.solver.rank);
+  GncAgent agent(std::move(in), options, true);
+
+  Mailbox mail(channel, receive_timeout_s, local.agent_id);
+  mail.set_num_agents(local.num_agents);
+  const auto t0 = std::chrono::steady_clock::now();
+  mail.run_protocol(agent, agent.start(), [&] {
+    return "outer step " + std::to_string(agent.outer_iterations()) + " of the robust solve";
+  });
+
+  // The last solve of the kept set: the certified one when certification ran, else the last
+  // inlier pass.
+  const CertifiedAgent& last = agent.last_solve();
+  RoundLoopResult res;
+  res.rounds = static_cast<std::uint32_t>(agent.total_rounds());
+  res.restarts = static_cast<std::uint32_t>(last.total_restarts());
+  res.stop_reason = last.solves().back().stop_reason;
+  if (!last.solves().back().trace.empty()) {
+    res.relaxation_cost = last.solves().back().trace.back().cost;
+    res.grad_norm = last.solves().back().trace.back().grad_norm;
+  }
+  const bool certified_sequence = agent.final_sequence() != nullptr;
+  if (certified_sequence) {
+    res.certified = last.certified();
+    if (!last.certificates().empty())
+      res.min_eigenvalue = last.certificates().back().result.min_eigenvalue;
+    res.certificate_rounds = static_cast<std::uint32_t>(last.certificate_iterations());
+    res.escape_rounds = static_cast<std::uint32_t>(last.escape_trials());
+  }
+  res.final_rank = static_cast<std::uint32_t>(agent.state().rank());
+  RobustRunReport report;
+  report.outer_iterations = agent.outer_iterations();
+  report.rejected = agent.rejected();
+  report.readmitted = agent.readmitted();
+  report.threshold_squared = agent.threshold_squared();
+  report.weights_converged = agent.weights_converged();
+  res.robust = std::move(report);
+
+  // The rounding sees the kept measurements (the cost is over them).
+  AgentLocalData kept = local;
+  kept.measurements = agent.kept_measurements();
+  kept.measurement_index = agent.kept_index();
+  return round_and_report(kept, agent.layout(), agent.state(), mail, channel, std::move(res),
+                          certified_sequence, t0);
+}
+
+}  // namespace tessera::agent

@@ -1,0 +1,28 @@
+#pragma once
+// A robust run's start over DDS (GncDistributedOptions::known_inlier_start): the agents'
+// distributed initialization of the known inliers alone, as the in-process engine's
+// gnc_start() computes it, when those measurements connect the poses. Every agent decides the
+// same from the structure (endpoints of every measurement, and the known-inlier rule on them).
+
+#include <cstdint>
+#include <optional>
+#include <tessera/robust/robust_options.hpp>
+#include <utility>
+#include <vector>
+
+#include "runtime/local_share.hpp"
+
+namespace tessera::agent {
+
+struct KnownInlierStart {
+  RobotShare share;  ///< The robot's share without its measurements that may be rejected.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;  ///< Known inliers only.
+};
+
+/// `share` and `structure` restricted to the measurements `rule` says are known inliers, or
+/// nullopt when those leave the poses unconnected (the run's own initialization is used then).
+std::optional<KnownInlierStart> known_inlier_start(
+    const RobotShare& share, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    KnownInliers rule);
+
+}  // namespace tessera::agent

@@ -1,0 +1,213 @@
+// Robust (GNC-TLS) distributed solves over DDS: separate agent processes run the same state
+// machine as the in-process engine (robust/gnc_agent.hpp), so the same outer steps, rounds,
+// rejected set and cost.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <tessera/io/dpgo_csv_reader.hpp>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/robust/gnc_distributed.hpp>
+#include <tessera/robust/tls_weights.hpp>
+#include <vector>
+
+#include "dds_process_support.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+// A JSON array of integers of a flat summary (e.g. "rejected" or the labels' "outliers").
+std::vector<std::size_t> json_array(const std::string& json, const std::string& name) {
+  std::smatch m;
+  std::vector<std::size_t> out;
+  if (!std::regex_search(json, m, std::regex("\"" + name + "\": \\[([^\\]]*)\\]"))) return out;
+  std::istringstream list(m[1].str());
+  for (std::string v; std::getline(list, v, ',');)
+    if (v.find_first_of("0123456789") != std::string::npos) out.push_back(std::stoul(v));
+  return out;
+}
+
+std::vector<std::size_t> lines_of(const std::string& path) {
+  std::vector<std::size_t> out;
+  std::ifstream f(path);
+  for (std::string line; std::getline(f, line);)
+    if (!line.empty()) out.push_back(std::stoul(line));
+  return out;
+}
+
+struct RobustRun {
+  std::string dir, graph, summary;
+  std::vector<std::size_t> labels;
+  std::vector<int> assignment;
+};
+
+// A 216-pose 3D grid of 3 robots with 25 % wrong loop closures, solved by 3 agent processes
+// (sequential partition: one robot each) with GNC-TLS and the certificate.
+RobustRun robust_dds_run(int domain, const std::vector<std::string>& extra = {}) {
+  RobustRun r;
+  r.dir = temp_dir();
+  r.graph = generate_graph(r.dir + "/graph.g2o",
+                           "--kind grid3d --poses 216 --robots 3 --seed 4 --outliers 0.25 "
+                           "--labels " +
+                               r.dir + "/labels.json");
+  r.labels = json_array(slurp(r.dir + "/labels.json"), "outliers");
+  const std::string run = "robust-" + std::to_string(getpid()) + "-" + std::to_string(domain);
+  std::vector<std::string> args = {"--timeout",   "20",         "--run-timeout",
+                                   "120",         "--summary",  r.dir + "/summary.json",
+                                   "--partition", "sequential", "--seed",
+                                   "7",           "--certify",  "--robust",
+                                   "gnc-tls",     "--rejected", r.dir + "/rejected.txt"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  run_to_the_end(r.dir, r.graph, 3, run, domain, args, 120);
+  r.summary = slurp(r.dir + "/summary.json");
+  r.assignment = assignment_of(r.dir, 3);
+  return r;
+}
+
+GncDistributedOptions in_process_options() {
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.seed = 7;
+  o.solver.certify = true;
+  // What the DDS agents do: one start (no vote), the first inlier pass from the GNC iterate.
+  o.start_vote = false;
+  o.inlier_set_start = false;
+  return o;
+}
+
+TEST(DdsRobust, IteratesAndRejectedSetEqualTheInProcessEngine) {
+  const RobustRun dds = robust_dds_run(42);
+  const PoseGraph g = read_g2o(dds.graph);
+  ASSERT_EQ(dds.assignment.size(), g.num_poses);
+  ASSERT_FALSE(dds.labels.empty());
+
+  const GncDistributedResult ref = solve_gnc_distributed(g, dds.assignment, in_process_options());
+  ASSERT_GT(ref.outer_iterations, 3) << "the outliers should take a few outer steps";
+  ASSERT_TRUE(ref.final_solve.certified.value_or(false));
+
+  EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "readmitted"), static_cast<double>(ref.readmitted));
+  EXPECT_EQ(json_field(dds.summary, "outliers"), static_cast<double>(ref.rejected.size()));
+  EXPECT_EQ(json_field(dds.summary, "inliers"),
+            static_cast<double>(g.num_measurements() - ref.rejected.size()));
+  EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
+  EXPECT_EQ(lines_of(dds.dir + "/rejected.txt"), ref.rejected);
+  // The cost over the kept measurements, rounded by the agents without a central step.
+  EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost)
+      << dds.summary;
+  EXPECT_NE(dds.summary.find("\"certified\": true"), std::string::npos) << dds.summary;
+  EXPECT_NE(dds.summary.find("\"robust\": \"gnc-tls\""), std::string::npos) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "min_eigenvalue"), ref.final_solve.min_eigenvalue);
+
+  // Every wrong closure found, nothing else, and no odometry edge (a known inlier) rejected.
+  EXPECT_EQ(ref.rejected, dds.labels);
+  for (std::size_t e : json_array(dds.summary, "rejected"))
+    EXPECT_FALSE(is_known_inlier(g.measurements[e], KnownInliers::kOdometry)) << e;
+}
+
+// With --known-inliers none every measurement may go; the known inliers' start is then not
+// available (odometry is not known), and the run still equals the in-process engine.
+TEST(DdsRobust, WithoutKnownInliersTheRunStillEqualsTheInProcessEngine) {
+  const RobustRun dds = robust_dds_run(43, {"--known-inliers", "none", "--init", "chordal"});
+  const PoseGraph g = read_g2o(dds.graph);
+  GncDistributedOptions o = in_process_options();
+  o.robust.known_inliers = KnownInliers::kNone;
+  const GncDistributedResult ref = solve_gnc_distributed(g, dds.assignment, o);
+  EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
+  EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
+  EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+}
+
+// `tessera launch` end to end: the robust fields in the summary, and an input whose every
+// measurement looks wrong ends with a message naming the cause instead of a collapsed graph.
+TEST(DdsRobust, LaunchReportsTheRejectedSetAndRefusesAnAllOutlierInput) {
+  const std::string dir = temp_dir();
+  const std::string graph =
+      generate_graph(dir + "/graph.g2o",
+                     "--kind grid3d --poses 125 --robots 3 --seed 2 --outliers 0.25 "
+                     "--labels " +
+                         dir + "/labels.json");
+  std::string out;
+  int rc = run_command(bin("tessera") + " launch " + graph +
+                           " --agents 3 --domain 44 --timeout 60 --robust gnc-tls --json " + dir +
+                           "/s.json --rejected " + dir + "/rejected.txt 2>&1",
+                       &out);
+  ASSERT_EQ(rc, 0) << out;
+  const std::string json = slurp(dir + "/s.json");
+  const std::vector<std::size_t> labels = json_array(slurp(dir + "/labels.json"), "outliers");
+  EXPECT_EQ(json_array(json, "rejected"), labels) << json;
+  EXPECT_EQ(lines_of(dir + "/rejected.txt"), labels);
+  EXPECT_GT(json_field(json, "outer_iterations"), 0) << json;
+  EXPECT_NE(json.find("\"certified\": true"), std::string::npos) << json;
+
+  rc = run_command(bin("tessera") + " launch " + graph +
+                       " --agents 3 --domain 45 --timeout 60 --robust gnc-tls --known-inliers none "
+                       "--inlier-threshold 1e-6 2>&1",
+                   &out);
+  EXPECT_NE(rc, 0) << out;
+  EXPECT_NE(out.find("unconnected parts, so no estimate is defined"), std::string::npos) << out;
+
+  // Bad options name the flag and the field before anything starts.
+  rc = run_command(bin("tessera") + " launch " + graph + " --robust gnc-tls --gnc-mu-step 1 2>&1",
+                   &out);
+  EXPECT_EQ(rc, 2) << out;
+  EXPECT_NE(out.find("--gnc-mu-step: RobustOptions.mu_step"), std::string::npos) << out;
+}
+
+// `tessera launch` on dpgo's measurement CSV: robot k of the file is agent k (its own g2o file
+// written by launch), and the robust run equals the in-process engine on the same CSV.
+TEST(DdsRobust, LaunchOnADpgoCsvFileEqualsTheInProcessEngine) {
+  const std::string dir = temp_dir();
+  const std::string graph = generate_graph(
+      dir + "/graph.g2o", "--kind grid3d --poses 216 --robots 3 --seed 4 --outliers 0.25");
+  const PoseGraph g = read_g2o(graph);
+  std::string csv =
+      "robot_src,pose_src,robot_dst,pose_dst,qx,qy,qz,qw,tx,ty,tz,kappa,tau,is_known_inlier,"
+      "weight\n";
+  for (const Measurement& m : g.measurements) {
+    const Eigen::Quaterniond q(Eigen::Matrix3d(m.R));
+    char row[512];
+    std::snprintf(row, sizeof row,
+                  "%zu,%zu,%zu,%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,0,1\n",
+                  m.i / 72, m.i % 72, m.j / 72, m.j % 72, q.x(), q.y(), q.z(), q.w(), m.t(0),
+                  m.t(1), m.t(2), m.kappa, m.tau);
+    csv += row;
+  }
+  std::ofstream(dir + "/measurements.csv") << csv;
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch " + dir +
+                                 "/measurements.csv --agents 3 --partition sequential --domain 46 "
+                                 "--timeout 60 --seed 7 --robust gnc-tls --json " +
+                                 dir + "/s.json 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  const std::string json = slurp(dir + "/s.json");
+
+  const DpgoCsvGraph read = read_dpgo_csv(dir + "/measurements.csv");
+  const GncDistributedResult ref = solve_gnc_distributed(
+      read.graph, std::vector<int>(read.robot_of.begin(), read.robot_of.end()),
+      in_process_options());
+  EXPECT_EQ(json_field(json, "poses"), 216);
+  EXPECT_EQ(json_field(json, "outer_iterations"), ref.outer_iterations) << json;
+  EXPECT_EQ(json_field(json, "rounds"), ref.total_rounds) << json;
+  EXPECT_EQ(json_array(json, "rejected"), ref.rejected) << json;
+  EXPECT_NEAR(json_field(json, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  EXPECT_NE(json.find("\"certified\": true"), std::string::npos) << json;
+
+  // One agent per robot of the file.
+  EXPECT_NE(
+      run_command(bin("tessera") + " launch " + dir + "/measurements.csv --agents 2 2>&1", &out),
+      0);
+  EXPECT_NE(out.find("holds 3 robots but --agents is 2"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace tessera::test::dds

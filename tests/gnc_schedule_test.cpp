@@ -1,0 +1,95 @@
+// The outer schedule of distributed GNC-TLS (in one process): capped solves before the final
+// one, the known inliers' start, re-admission of measurements misjudged on a rough iterate.
+#include <gtest/gtest.h>
+
+#include <tessera/generate/generator.hpp>
+#include <tessera/robust/gnc_distributed.hpp>
+#include <vector>
+
+namespace tessera {
+namespace {
+
+GeneratorResult grid(double fraction, std::uint64_t seed = 3) {
+  GeneratorOptions o;
+  o.kind = TrajectoryKind::kGrid3d;
+  o.num_poses = 125;
+  o.num_robots = 5;
+  o.seed = seed;
+  o.outlier_fraction = fraction;
+  return generate_pose_graph(o);
+}
+
+std::vector<int> robots_as_blocks(const GeneratorResult& r) {
+  return std::vector<int>(r.robot_of.begin(), r.robot_of.end());
+}
+
+GncDistributedOptions irbcd_gnc() {
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.algorithm = DistributedAlgorithm::kIrbcd;
+  o.solver.grad_norm_tol = 1e-3;
+  return o;
+}
+
+GncDistributedResult run(const GeneratorResult& r, int cap, double mu_step, bool known_start) {
+  GncDistributedOptions o = irbcd_gnc();
+  o.robust.inner_max_rounds = cap;
+  o.robust.mu_step = mu_step;
+  o.known_inlier_start = known_start;
+  return solve_gnc_distributed(r.graph, robots_as_blocks(r), o);
+}
+
+TEST(GncSchedule, CappedSolvesRejectTheSameSetAsFullSolvesInAFractionOfTheRounds) {
+  const GeneratorResult r = grid(0.25);
+  ASSERT_FALSE(r.outliers.empty());
+  const GncDistributedResult full = run(r, 0, 1.4, true);
+  const GncDistributedResult capped = run(r, RobustOptions{}.inner_max_rounds, 1.4, true);
+  EXPECT_EQ(full.rejected, r.outliers);
+  EXPECT_EQ(capped.rejected, r.outliers);
+  EXPECT_NEAR(capped.final_solve.cost, full.final_solve.cost, 1e-6 * full.final_solve.cost);
+  EXPECT_LT(2 * capped.total_rounds, full.total_rounds);
+}
+
+TEST(GncSchedule, TrueClosuresMisjudgedOnARoughIterateAreReadmitted) {
+  // One round between weight updates and a steep mu schedule: the iterate lags, some true
+  // closures still look wrong when their weights reach 0, and the check at the inlier set's
+  // solution takes them back.
+  const GeneratorResult r = grid(0.25);
+  const GncDistributedResult g = run(r, 1, 4.0, true);
+  EXPECT_GT(g.readmitted, 0u);
+  EXPECT_EQ(g.rejected, r.outliers);
+  for (std::size_t e : r.outliers) EXPECT_EQ(g.weights[e], 0.0);
+}
+
+TEST(GncSchedule, ACleanGraphStartsWhereThePlainSolveStarts) {
+  // On clean data the solver's own (chordal) start has the lower TLS cost: nothing to
+  // reject, no outer step, and the rounds of the plain solve plus the capped first solve.
+  const GeneratorResult clean = grid(0.0);
+  const GncDistributedResult g = run(clean, RobustOptions{}.inner_max_rounds, 1.4, true);
+  const DistributedResult plain =
+      solve_distributed(clean.graph, robots_as_blocks(clean), irbcd_gnc().solver);
+  EXPECT_TRUE(g.rejected.empty());
+  EXPECT_EQ(g.outer_iterations, 0);
+  EXPECT_LE(g.total_rounds, plain.rounds + RobustOptions{}.inner_max_rounds);
+}
+
+TEST(GncSchedule, TheKnownInliersStartNeedsFewerRoundsThanTheChordalStart) {
+  // The chordal guess fits the wrong closures too; the odometry chains do not see them.
+  const GeneratorResult r = grid(0.25);
+  const GncDistributedResult known = run(r, 1, 1.4, true);
+  const GncDistributedResult chordal = run(r, 1, 1.4, false);
+  EXPECT_EQ(known.rejected, r.outliers);
+  EXPECT_LT(known.total_rounds, chordal.total_rounds);
+}
+
+TEST(GncSchedule, WithoutConnectedKnownInliersTheSolversOwnStartIsUsed) {
+  const GeneratorResult clean = grid(0.0);
+  GncDistributedOptions o = irbcd_gnc();
+  o.robust.known_inliers = KnownInliers::kNone;  // nothing known: no chain to start from
+  const GncDistributedResult r = solve_gnc_distributed(clean.graph, robots_as_blocks(clean), o);
+  EXPECT_TRUE(r.rejected.empty());
+  EXPECT_EQ(r.readmitted, 0u);
+}
+
+}  // namespace
+}  // namespace tessera
