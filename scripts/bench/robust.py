@@ -231,7 +231,10 @@ def solve(tessera, graph, work, tag, extra, timeout, algorithm="centralized"):
         # N = 5 agents on contiguous id ranges (the robots of the multi-robot convention)
         cmd += ["--agents", "5", "--partition", "sequential", "--certify"]
     t0 = time.monotonic()
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    try:
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None, None, time.monotonic() - t0, f"timed out after {timeout:.0f} s"
     wall = time.monotonic() - t0
     if p.returncode != 0:
         return None, None, wall, p.stdout.strip().splitlines()[-1] if p.stdout.strip() else str(p.returncode)
