@@ -12,6 +12,7 @@
 
 #include "agent/agent_options.hpp"
 #include "agent/agent_run.hpp"
+#include "agent/online_agent.hpp"
 #include "cli/session_process.hpp"
 #include "launch/process_tuning.hpp"
 #include "runtime/agent_log.hpp"
@@ -20,6 +21,9 @@
 namespace tessera::agent {
 
 int agent_main(int argc, char** argv) {
+  // An online agent has no Session: default signal handling (SIGTERM ends it).
+  if (wants_online(std::vector<std::string>(argv + 1, argv + argc)))
+    return online_agent_main(std::vector<std::string>(argv + 1, argv + argc));
   transport::SignalWatcher
       signals;                    // first: every thread created later inherits the blocked signals
   launch::begin_agent_process();  // process-level tuning (launch/process_tuning.hpp)

@@ -8,11 +8,13 @@
 
 #include "commands.hpp"
 #include "launch/launch.hpp"
+#include "launch/online_launch.hpp"
 #include "launch_outputs.hpp"
 
 namespace tessera::cli {
 
 int run_launch(const Args& argv) {
+  if (launch::wants_online_launch(argv)) return launch::run_online_launch(argv);
   if (launch::wants_launch_help(argv)) {
     std::fputs(launch::launch_help().c_str(), stdout);
     std::printf("\nOutputs in GRAPH's terms (one whole GRAPH file):\n%s", kLaunchOutputHelp);

@@ -45,6 +45,11 @@ const char* kHelp =
     "  --rank R                  initial relaxation rank r0 >= d (default 5)\n"
     "  --max-rank R              staircase ceiling (default 10)\n"
     "  --grad-tol T              relative gradient-norm tolerance (default 1e-5)\n"
+    "  --stop reference|gradient  reference (default): also stop where the reference solver's\n"
+    "                            rule (gradient 1e-2 with preconditioned gradient 1e-4, or a\n"
+    "                            step decreasing f by < 1e-6 f) holds, or before a step predicted\n"
+    "                            to decrease f by < 1e-7 f (ends within ~1e-8 of f*); gradient:\n"
+    "                            only --grad-tol (f* to round-off)\n"
     "  --no-certify              skip the certificate (and the staircase)\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
@@ -58,12 +63,14 @@ Initialization parse_init(const std::string& s) {
 void write_trace(const std::string& path, const CentralizedResult& r) {
   std::ofstream out(path);
   if (!out) throw InputError(path, 0, "cannot open for writing");
-  out << "rank,iteration,cost,grad_norm,radius,rho,inner_iterations,accepted,elapsed_s\n";
+  out << "rank,iteration,cost,grad_norm,radius,rho,inner_iterations,accepted,elapsed_s,"
+         "predicted_decrease\n";
   char buf[256];
   for (const auto& row : r.trace) {
-    std::snprintf(buf, sizeof buf, "%d,%d,%.17g,%.17g,%.6g,%.6g,%d,%d,%.6f\n", row.rank,
+    std::snprintf(buf, sizeof buf, "%d,%d,%.17g,%.17g,%.6g,%.6g,%d,%d,%.6f,%.6g\n", row.rank,
                   row.tr.iteration, row.tr.cost, row.tr.grad_norm, row.tr.radius, row.tr.rho,
-                  row.tr.inner_iterations, row.tr.accepted ? 1 : 0, row.tr.elapsed_s);
+                  row.tr.inner_iterations, row.tr.accepted ? 1 : 0, row.tr.elapsed_s,
+                  row.tr.predicted_decrease);
     out << buf;
   }
 }
@@ -86,6 +93,11 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   opt.max_rank = static_cast<int>(a.get_long("max-rank", std::max(opt.max_rank, opt.initial_rank)));
   opt.trust_region.grad_norm_tol = a.get_double("grad-tol", opt.trust_region.grad_norm_tol);
   opt.certify = !a.has("no-certify");
+  const std::string stop = a.get_or("stop", "reference");
+  if (stop == "gradient")
+    opt.stop = CentralizedStop::kGradient;
+  else if (stop != "reference")
+    throw InputError("option --stop: '" + stop + "' is not one of reference, gradient");
   GncCentralizedResult gnc;
   if (robust.kind != RobustKind::kNone)
     gnc = solve_gnc_centralized(graph, {opt, robust, input.known_inlier});
@@ -132,6 +144,7 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
     if (robust.kind != RobustKind::kNone) add_robust_fields(j, robust_summary);
     j.add("min_eigenvalue", r.min_eigenvalue)
         .add("final_rank", r.final_rank)
+        .add("stop_reason", r.levels.empty() ? std::string() : r.levels.back().stop_reason)
         .add("init_s", r.init_s)
         .add("optimize_s", r.optimize_s)
         .add("certify_s", r.certify_s)
@@ -146,8 +159,8 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
 
 int run_solve(const Args& args) {
   const auto start = std::chrono::steady_clock::now();
-  std::set<std::string> valued = {"algorithm", "out",  "tum",      "json",     "trace",
-                                  "init",      "rank", "max-rank", "grad-tol", "tum-dir"};
+  std::set<std::string> valued = {"algorithm", "out",      "tum",      "json",    "trace", "init",
+                                  "rank",      "max-rank", "grad-tol", "tum-dir", "stop"};
   for (const char* const* o = kGraphInputOptions; *o; ++o) valued.insert(*o);
   std::set<std::string> switches = {"help", "no-certify", "raw-quaternions"};
   for (const char* const* o = kDistributedValued; *o; ++o) valued.insert(*o);

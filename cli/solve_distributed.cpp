@@ -70,9 +70,10 @@ const char* kDistributedHelp =
     "algorithm\n"
     "                            of the reference paper; see docs/irbcd.md)\n"
     "  --agents N                number of agents / blocks (default 5)\n"
-    "  --partition PRESET        sequential|fast|eco|strong|highest (default eco: its time\n"
-    "                            grows with the graph like the solve's, a few % of it;\n"
-    "                            highest searches far longer for a few % less cut)\n"
+    "  --partition PRESET        auto|sequential|fast|eco|strong|highest (default auto: fast\n"
+    "                            below 2000 poses, where the run is short and fast needs\n"
+    "                            the same rounds, else eco; strong, highest search far\n"
+    "                            longer for a few % less cut)\n"
     "  --partition-objective cut|rounds   rounds (default): after the preset's search, a\n"
     "                            pass that gives the block adjacency graph fewer colours\n"
     "                            (more blocks per IRBCD round) for at most 25 % more cut;\n"
@@ -271,7 +272,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
                      std::to_string(graph.num_poses) + " poses");
   PartitionOptions popt;
   popt.parts = static_cast<int>(agents);
-  popt.preset = parse_preset(a.get_or("partition", "eco"));
+  popt.preset = parse_preset_for(a.get_or("partition", "auto"), graph.num_poses);
   popt.seed = opt.seed;
   popt.objective = parse_objective(a.get_or("partition-objective", "rounds"));
   popt.time_limit_s = a.get_double("partition-time", 0.0);

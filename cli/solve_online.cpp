@@ -78,6 +78,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.solver.max_rounds = static_cast<int>(a.get_long("max-rounds", options.solver.max_rounds));
   options.solver.rank = static_cast<int>(a.get_long("rank", options.solver.rank));
   options.certify_at_end = !a.has("no-certify");
+  options.solver.staircase.certificate.max_iterations = static_cast<int>(
+      a.get_long("certify-iters", options.solver.staircase.certificate.max_iterations));
   options.real_time = a.has("real-time");
   options.certify_every_s = a.get_double("certify-every", 0.0);
   options.validate();

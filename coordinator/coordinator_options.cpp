@@ -21,7 +21,8 @@ the merged result. It never receives measurement values.
 options:
   --agents N           number of agents of the run (required)
   --run-timeout S      bound on the wait for the final estimates, seconds (default 3600)
-  --partition PRESET   sequential, fast, eco, strong or highest (default eco)
+  --partition PRESET   auto, sequential, fast, eco, strong or highest (default
+                       auto: fast below 2000 poses, else eco)
   --partition-seed K   seed of the partitioner (default 1)
   --partition-time S   cap of the partitioner's search in seconds of wall time (default 0:
                        none; with a cap the partition depends on the machine's speed)

@@ -17,7 +17,7 @@ struct CoordinatorOptions {
   std::uint32_t agents = 0;     ///< --agents, 1..1000 (required).
   cli::SessionArgs net;         ///< run id, domain, lease, peers, --timeout (cli/session_args.hpp)
   double run_timeout_s = 3600;  ///< Bound on the wait for the final estimates, > 0 s.
-  std::string partition = "eco";
+  std::string partition = "auto";
   std::uint64_t partition_seed = 1;
   double partition_time_s = 0;  ///< --partition-time: cap of the partitioner's search, s; 0 = none.
   std::uint32_t rank = 0;       ///< 0 = core's default (5).

@@ -51,6 +51,11 @@ bool RoundReports::on_report(const wire::RoundStatus& m) {
         CertificateTraffic{m.cost(), m.grad_norm_sq(), m.block_grad_norm()};
     return true;
   }
+  if (m.phase() == kAgentPhaseTimesPhase) {
+    results_.agent_solve_s = m.cost();
+    results_.agent_rounding_s = m.grad_norm_sq();
+    return true;
+  }
   if (m.phase() == kAgentRobustReportPhase) {
     RobustReport r;
     r.outer_iterations = static_cast<int>(m.cost());

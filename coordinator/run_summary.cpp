@@ -56,6 +56,11 @@ std::string run_summary_json(const RunSummaryInputs& in) {
                                ? std::optional<double>(rounds_ms / (r.completed_statuses - 1))
                                : std::nullopt)
       .add("total_ms", in.total_ms)
+      // Agent 0's clock: core's protocol (rounds + certificate + escapes) and the rounding.
+      .add("agent_solve_ms",
+           r.agent_solve_s ? std::optional<double>(1000 * *r.agent_solve_s) : std::nullopt)
+      .add("rounding_ms",
+           r.agent_rounding_s ? std::optional<double>(1000 * *r.agent_rounding_s) : std::nullopt)
       .add("bytes_sent", std::vector<std::size_t>(in.merged.bytes.begin(), in.merged.bytes.end()))
       .add("hosts", in.structure.hosts);
   // Peak resident sets (MB): each agent's as it sent its final estimate, the coordinator's now,

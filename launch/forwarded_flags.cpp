@@ -114,13 +114,13 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "convexity, truncated least squares), each weighed by the\n"
        "agent of its lower pose id, then solve and certify the\n"
        "kept ones; starts from the known inliers unless --init\n"
-       "is given (docs/robust.md)                              [none]",
+       "is given (docs/robust.md)                            [none]",
        check_robust},
       {"inlier-threshold", "inlier-threshold", true, ForwardTo::kCoordinator,
-       "--inlier-threshold C", "residual bound c (0 = chi-square quantile)           [0]",
+       "--inlier-threshold C", "residual bound c (0 = chi-square quantile)          [0]",
        check_inlier_threshold},
       {"inlier-quantile", "inlier-quantile", true, ForwardTo::kCoordinator, "--inlier-quantile P",
-       "quantile of that bound, 0 = 1 - 1e-4/m                 [0]", check_inlier_quantile},
+       "quantile of that bound, 0 = 1 - 1e-4/m               [0]", check_inlier_quantile},
       {"gnc-max-outer", "gnc-max-outer", true, ForwardTo::kCoordinator, "--gnc-max-outer K",
        "most GNC outer steps, >= 1                           [100]", check_gnc_max_outer},
       {"gnc-mu-step", "gnc-mu-step", true, ForwardTo::kCoordinator, "--gnc-mu-step S",
@@ -128,11 +128,11 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
       {"gnc-inner-rounds", "gnc-inner-rounds", true, ForwardTo::kCoordinator,
        "--gnc-inner-rounds K",
        "most rounds of each solve before the final one, 0 = no\n"
-       "cap                                                    [5]",
+       "cap                                                  [5]",
        check_gnc_inner_rounds},
       {"known-inliers", "known-inliers", true, ForwardTo::kCoordinator,
-       "--known-inliers odometry|none",
-       "never reject edges between consecutive ids      [odometry]", check_known_inliers},
+       "--known-inliers odometry|none", "never reject edges between consecutive ids [odometry]",
+       check_known_inliers},
       {"rejected", "rejected", true, ForwardTo::kCoordinator, "--rejected FILE",
        "write the rejected edge indices (from 0 over the EDGE\n"
        "lines), one a line",

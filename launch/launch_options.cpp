@@ -36,7 +36,8 @@ Without GRAPH, a 3D grid is generated into a temporary folder
 options:
   --agents N           number of agent processes, 1..64                     [3]
   --algorithm NAME     rbcd | rbcd++ | irbcd                                 [irbcd]
-  --partition PRESET   sequential | fast | eco | strong | highest           [eco]
+  --partition PRESET   auto | sequential | fast | eco | strong | highest    [auto]
+                       auto: fast below 2000 poses, eco from there
   --init NAME          chordal | distributed | file (VERTEX poses)           [chordal]
   --grad-tol X         stop when the gradient norm is at most X (> 0)       [0.01]
   --max-rounds K       round limit (0 = the solver's default, 10000)        [0]

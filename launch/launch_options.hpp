@@ -20,8 +20,8 @@ struct LaunchOptions {
   long agents = 3;
   /// rbcd | rbcd++ | irbcd.
   std::string algorithm = "irbcd";
-  /// Partition preset of the coordinator: sequential | fast | eco | strong | highest.
-  std::string partition = "eco";
+  /// Partition preset of the coordinator: auto | sequential | fast | eco | strong | highest.
+  std::string partition = "auto";
   /// chordal | distributed | file.
   std::string init = "chordal";
   /// --init was given: a robust run then starts from it instead of the known inliers.

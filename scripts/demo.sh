@@ -7,5 +7,5 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh
 mkdir -p out
 build/bin/tessera generate --kind grid3d --poses 1000 --robots 5 --seed 1 --out out/demo.g2o
-build/bin/tessera launch out/demo.g2o --agents 5 --algorithm irbcd --partition eco \
+build/bin/tessera launch out/demo.g2o --agents 5 --algorithm irbcd \
   --json out/demo.json --out out/demo_solution.g2o

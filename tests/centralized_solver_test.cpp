@@ -18,6 +18,7 @@
 #include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
 #include <tessera/solvers/translation_elimination.hpp>
+#include <tessera/solvers/trust_region.hpp>
 #include <tessera/util/input_error.hpp>
 
 #include "random_graph.hpp"
@@ -91,11 +92,13 @@ TEST(CentralizedSolver, StaircaseEscapesFromRankDeficientSaddle) {
   // The default tolerance is relative to the first gradient, which is large from odometry;
   // a tight one makes the comparison below about the optimum, not about the tolerance.
   opt.trust_region.grad_norm_tol = 1e-8;
+  opt.stop = CentralizedStop::kGradient;
   const CentralizedResult r = solve_centralized(g, opt);
   EXPECT_TRUE(*r.certified);
   EXPECT_GT(r.final_rank, 2) << "expected the rank-2 start to need the staircase";
   CentralizedOptions ref;
   ref.trust_region.grad_norm_tol = 1e-8;
+  ref.stop = CentralizedStop::kGradient;
   const CentralizedResult best = solve_centralized(g, ref);
   EXPECT_NEAR(r.cost, best.cost, 1e-6 * best.cost);
 }
@@ -137,6 +140,7 @@ TEST_P(CentralizedTest, ExplicitAndEliminatedTranslationsReachTheSameOptimum) {
   auto g = test::random_pose_graph({d, 80, 50, 0.1, 0.1, 17});
   CentralizedOptions opt;
   opt.trust_region.grad_norm_tol = 1e-8;
+  opt.stop = CentralizedStop::kGradient;
   opt.eliminate_translations = true;
   const CentralizedResult a = solve_centralized(g, opt);
   opt.eliminate_translations = false;
@@ -186,6 +190,63 @@ TEST(CentralizedSolver, RejectsInvalidOptionsNamingTheField) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("certified_lanczos_tolerance"), std::string::npos)
         << e.what();
+  }
+}
+
+TEST(CentralizedSolver, ReferenceStopSavesStepsAndStaysWithinItsAccuracy) {
+  GeneratorOptions o;
+  o.kind = TrajectoryKind::kGrid3d;
+  o.num_poses = 1000;
+  o.seed = 3;
+  const PoseGraph g = generate_pose_graph(o).graph;
+  const CentralizedResult fast = solve_centralized(g);
+  CentralizedOptions tight;
+  tight.stop = CentralizedStop::kGradient;
+  const CentralizedResult best = solve_centralized(g, tight);
+  ASSERT_TRUE(fast.certified.has_value());
+  EXPECT_TRUE(*fast.certified);
+  EXPECT_TRUE(best.certified.value_or(false));
+  EXPECT_LT(fast.iterations, best.iterations);
+  ASSERT_EQ(fast.levels.size(), 1u);
+  EXPECT_NE(fast.levels.front().stop_reason, "grad_norm");
+  // The reference's rule ends within ~1e-8 of f*; its worst shared graph is 1.06e-6 above it.
+  EXPECT_NEAR(fast.cost, best.cost, 1e-7 * best.cost);
+  EXPECT_GE(fast.relaxation_cost, best.relaxation_cost - 1e-9 * best.relaxation_cost);
+}
+
+TEST(TrustRegion, PairedGradientAndPredictedDecreaseStopsEndTheRunWhereTheyHold) {
+  auto g = test::random_pose_graph({3, 30, 20, 0.05, 0.1, 5});
+  const BlockProblem P = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  const Eigen::MatrixXd X0 = lift_poses(g.initial, 3);
+  TrustRegionOptions paired;
+  paired.paired_grad_norm_tol = 1e12;
+  paired.preconditioned_grad_norm_tol = 1e12;
+  const TrustRegionResult a = solve_trust_region(P, X0, paired);
+  EXPECT_EQ(a.stop_reason, "preconditioned_grad_norm");
+  EXPECT_EQ(a.iterations, 0);
+  // Only one of the pair large: no stop there.
+  paired.preconditioned_grad_norm_tol = 1e-300;
+  paired.max_iterations = 3;
+  EXPECT_NE(solve_trust_region(P, X0, paired).stop_reason, "preconditioned_grad_norm");
+  // Without a preconditioner the prediction is 1/2 |g|^2: the run stops at the first iterate
+  // where that is below the given fraction of f, and the trace shows it.
+  TrustRegionOptions predicted;
+  predicted.predicted_rel_decrease_tol = 1e-3;
+  const TrustRegionResult b = solve_trust_region(P, X0, predicted);
+  EXPECT_EQ(b.stop_reason, "predicted_decrease");
+  ASSERT_FALSE(b.trace.empty());
+  EXPECT_LE(b.trace.back().predicted_decrease, 1e-3 * b.cost);
+  EXPECT_NEAR(b.trace.back().predicted_decrease, 0.5 * b.grad_norm * b.grad_norm, 1e-12 * b.cost);
+  for (std::size_t k = 0; k + 1 < b.trace.size(); ++k)
+    if (b.trace[k].accepted) {
+      EXPECT_GT(b.trace[k].predicted_decrease, 1e-3 * b.trace[k].cost);
+    }
+  predicted.predicted_rel_decrease_tol = 1.5;
+  try {
+    predicted.validate();
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("predicted_rel_decrease_tol"), std::string::npos);
   }
 }
 

@@ -72,3 +72,28 @@ TEST(RoundReports, RoundTimingAndTheLastLineComeFromAgentZerosFinalDigest) {
 
 }  // namespace
 }  // namespace tessera::coordinator
+
+namespace tessera::coordinator {
+namespace {
+
+// Agent 0's own times ride on a report status (phase 204): solve and rounding seconds.
+TEST(RoundReports, AgentZerosPhaseTimesAreKeptForTheSummary) {
+  std::ostringstream out;
+  RoundReports r(false, out);
+  EXPECT_FALSE(r.results().agent_solve_s.has_value());
+  wire::RoundStatus m;
+  m.sender(0);
+  m.round(45);
+  m.phase(kAgentPhaseTimesPhase);
+  m.cost(0.25);
+  m.grad_norm_sq(0.125);
+  EXPECT_TRUE(r.on_report(m));
+  ASSERT_TRUE(r.results().agent_solve_s.has_value());
+  EXPECT_EQ(*r.results().agent_solve_s, 0.25);
+  EXPECT_EQ(*r.results().agent_rounding_s, 0.125);
+  m.phase(1);  // a round status is not a report
+  EXPECT_FALSE(r.on_report(m));
+}
+
+}  // namespace
+}  // namespace tessera::coordinator

@@ -94,13 +94,13 @@ TEST(LaunchOptions, TuningFlagsSitUnderTheAdvancedHeading) {
     EXPECT_GT(help.find(flag), advanced) << flag;
 }
 
-// launch partitions with eco by default (a small share of the run, docs/partitioning.md) and
-// hands --partition-time to the coordinator only.
-TEST(LaunchOptions, DefaultPresetIsEcoAndThePartitionTimeReachesTheCoordinator) {
+// launch partitions with auto by default (fast or eco by the graph's size, a small share of the
+// run, docs/partitioning.md) and hands --partition-time to the coordinator only.
+TEST(LaunchOptions, DefaultPresetIsAutoAndThePartitionTimeReachesTheCoordinator) {
   LaunchOptions o = parse_launch_options({"--partition-time", "2.5"});
-  EXPECT_EQ(o.partition, "eco");
+  EXPECT_EQ(o.partition, "auto");
   const Argv coordinator = coordinator_argv(o, paths());
-  EXPECT_TRUE(has_pair(coordinator, "--partition", "eco"));
+  EXPECT_TRUE(has_pair(coordinator, "--partition", "auto"));
   EXPECT_TRUE(has_pair(coordinator, "--partition-time", "2.5"));
   EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--partition-time"));
 }

@@ -181,6 +181,23 @@ TEST(PartitionObjective, TheCoordinatorPartitionsForRounds) {
   EXPECT_EQ(step.cut_edges, r.metrics.cut_edges);
 }
 
+// solve's and launch's default: fast on a small graph, eco on a large one, the same partition as
+// naming that preset.
+TEST(PartitionObjective, TheAutoPresetIsFastOnSmallGraphsAndEcoOnLargeOnes) {
+  EXPECT_EQ(auto_preset(kAutoPresetFastBelow - 1), PartitionPreset::kFast);
+  EXPECT_EQ(auto_preset(kAutoPresetFastBelow), PartitionPreset::kEco);
+  EXPECT_EQ(parse_preset_for("auto", 10), PartitionPreset::kFast);
+  EXPECT_EQ(parse_preset_for("highest", 10), PartitionPreset::kHighest);
+  EXPECT_THROW(parse_preset("auto"), InputError);  // tessera partition names its effort
+  for (int side : {20, 50}) {                      // 400 and 2500 poses
+    const GraphStructure s = test::grid_with_chords(side, side, 3);
+    const char* named = s.num_vertices < kAutoPresetFastBelow ? "fast" : "eco";
+    const coordinator::PartitionStepResult a = coordinator::partition_for_agents(s, 5, "auto", 2);
+    const coordinator::PartitionStepResult b = coordinator::partition_for_agents(s, 5, named, 2);
+    EXPECT_EQ(a.owner, b.owner) << named;
+  }
+}
+
 TEST(PartitionObjective, NamesAndValidation) {
   EXPECT_EQ(parse_objective("cut"), PartitionObjective::kCut);
   EXPECT_EQ(parse_objective("rounds"), PartitionObjective::kRounds);

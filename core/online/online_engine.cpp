@@ -4,6 +4,7 @@
 #include <ctime>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
+#include <tessera/online/linked_problem.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
@@ -113,54 +114,12 @@ OnlineUpdate OnlineEngine::step(double now_s) {
 }
 
 DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
-  const PoseGraph& graph = stream_.graph();
-  const std::vector<int>& blocks = owner_;
-  std::vector<char> linked(graph.num_poses, 0);
-  for (const Measurement& m : graph.measurements) linked[m.i] = linked[m.j] = 1;
-  const Eigen::Index w = graph.d + 1;
-  if (std::all_of(linked.begin(), linked.end(), [](char c) { return c != 0; })) {
-    DistributedResult res = solve_distributed_from_lifted(graph, blocks, solver, X_);
-    if (res.X.rows() == X_.rows()) X_ = res.X;
-    return res;
-  }
-  // A pose no measurement touches yet (a robot's first pose before its odometry) has nothing
-  // to optimise and would make its block's Q_BB zero: solve the linked poses only, with the
-  // blocks that have some, numbered compactly.
-  PoseGraph sub;
-  sub.d = graph.d;
-  sub.source = graph.source;
-  std::vector<std::size_t> sub_id(graph.num_poses, 0), full_id;
-  for (std::size_t k = 0; k < graph.num_poses; ++k)
-    if (linked[k]) {
-      sub_id[k] = full_id.size();
-      full_id.push_back(k);
-    }
-  sub.num_poses = full_id.size();
-  for (const Measurement& m : graph.measurements) {
-    Measurement e = m;
-    e.i = sub_id[m.i];
-    e.j = sub_id[m.j];
-    sub.measurements.push_back(std::move(e));
-  }
-  std::vector<int> compact(static_cast<std::size_t>(stream_.robots().size()), -1);
-  std::vector<int> sub_blocks;
-  int next = 0;
-  Eigen::MatrixXd X0(X_.rows(), w * static_cast<Eigen::Index>(sub.num_poses));
-  for (std::size_t s = 0; s < full_id.size(); ++s) {
-    int& b = compact[static_cast<std::size_t>(blocks[full_id[s]])];
-    if (b < 0) b = next++;
-    sub_blocks.push_back(b);
-    X0.middleCols(w * static_cast<Eigen::Index>(s), w) =
-        X_.middleCols(w * static_cast<Eigen::Index>(full_id[s]), w);
-  }
+  const LinkedProblem p = make_linked_problem(stream_.graph(), owner_, X_);
   DistributedResult res;
-  if (sub.num_poses == 0) return res;
-  res = solve_distributed_from_lifted(sub, sub_blocks, solver, X0);
-  if (res.X.rows() == X_.rows())
-    for (std::size_t s = 0; s < full_id.size(); ++s)
-      X_.middleCols(w * static_cast<Eigen::Index>(full_id[s]), w) =
-          res.X.middleCols(w * static_cast<Eigen::Index>(s), w);
-  res.poses.clear();  // in the sub-graph's ids
+  if (p.graph.num_poses == 0) return res;
+  res = solve_distributed_from_lifted(p.graph, p.blocks, solver, p.X0);
+  if (res.X.rows() == X_.rows()) p.write_back(res.X, X_);
+  if (!p.whole) res.poses.clear();  // in the linked graph's ids
   return res;
 }
 

@@ -35,7 +35,17 @@ PartitionPreset parse_preset(const std::string& name) {
   for (auto p : {PartitionPreset::kSequential, PartitionPreset::kFast, PartitionPreset::kEco,
                  PartitionPreset::kStrong, PartitionPreset::kHighest})
     if (name == preset_name(p)) return p;
-  throw InputError("unknown preset '" + name + "' (valid: sequential, fast, eco, strong, highest)");
+  throw InputError("unknown preset '" + name +
+                   "' (valid: sequential, fast, eco, strong, highest; solve and launch: auto)");
+}
+
+PartitionPreset auto_preset(std::size_t num_vertices) {
+  return num_vertices < kAutoPresetFastBelow ? PartitionPreset::kFast : PartitionPreset::kEco;
+}
+
+PartitionPreset parse_preset_for(const std::string& name, std::size_t num_vertices) {
+  if (name == "auto") return auto_preset(num_vertices);
+  return parse_preset(name);
 }
 
 const char* objective_name(PartitionObjective objective) {

@@ -9,7 +9,7 @@ PartitionStepResult partition_for_agents(const GraphStructure& graph, std::uint3
                                          double time_limit_s) {
   PartitionOptions opt;
   opt.parts = static_cast<int>(num_agents);
-  opt.preset = parse_preset(preset);
+  opt.preset = parse_preset_for(preset, graph.num_vertices);
   opt.seed = seed;
   // Agents run IRBCD: fewer colour classes of the block adjacency graph mean more blocks per
   // round and fewer rounds (docs/partitioning.md "Partitions for convergence").

@@ -17,7 +17,8 @@ struct PartitionStepResult {
 };
 
 /// Splits the structure among `num_agents` agents with core's partitioner (`preset` as
-/// parse_preset accepts: sequential, fast, eco, strong, highest) and the `rounds` objective.
+/// parse_preset_for accepts: auto, sequential, fast, eco, strong, highest) and the `rounds`
+/// objective.
 /// `time_limit_s` > 0 caps the search's wall time (PartitionOptions::time_limit_s).
 /// Throws InputError on a bad preset or more agents than poses.
 PartitionStepResult partition_for_agents(const GraphStructure& graph, std::uint32_t num_agents,

@@ -57,6 +57,15 @@ RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout&
     r.measurement_ids = res.robust->rejected;
     channel.send(OutgoingMessage{r, true, {}});
   }
+  if (local.agent_id == 0) {  // agent 0's times, for the coordinator's phase split
+    RoundStatusMessage t;
+    t.round = res.rounds;
+    t.phase = kPhaseTimesPhase;
+    t.sender = 0;
+    t.cost = res.solve_s;
+    t.grad_norm_sq = res.rounding_s;
+    channel.send(OutgoingMessage{t, true, {}});
+  }
   if (local.agent_id == 0) {  // one report for the coordinator's summary
     RoundStatusMessage st;
     st.round = res.rounds;

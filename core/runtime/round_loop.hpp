@@ -178,6 +178,10 @@ constexpr std::uint32_t kCertificateBytesPhase = 202;
 /// iterations, grad_norm_sq = re-admitted measurements, block_grad_norm = c^2, done_vote =
 /// weights converged, measurement_ids = the rejected measurements.
 constexpr std::uint32_t kRobustReportPhase = 203;
+/// And, before the final report in every run, its own times: cost = solve_s (core's protocol:
+/// rounds, and certificate and escapes when certified), grad_norm_sq = rounding_s (seconds), so
+/// the coordinator can split the time after the last round into certificate and rounding.
+constexpr std::uint32_t kPhaseTimesPhase = 204;
 
 /// Optional recovery hooks of the round loop.
 struct RoundLoopHooks {

@@ -18,10 +18,18 @@ void TrustRegionOptions::validate() const {
     fail("relative_grad_tol", "must be in [0, 1)");
   if (max_accepted_steps < 0) fail("max_accepted_steps", "must be >= 0");
   if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
+  if (!(paired_grad_norm_tol >= 0)) fail("paired_grad_norm_tol", "must be >= 0");
+  if (!(preconditioned_grad_norm_tol >= 0)) fail("preconditioned_grad_norm_tol", "must be >= 0");
+  if (!(step_norm_tol >= 0)) fail("step_norm_tol", "must be >= 0");
+  if (!(predicted_rel_decrease_tol >= 0 && predicted_rel_decrease_tol < 1))
+    fail("predicted_rel_decrease_tol", "must be in [0, 1)");
   if (!(max_radius > 0)) fail("max_radius", "must be > 0");
   if (!(initial_radius_scale > 0 && std::isfinite(initial_radius_scale)))
     fail("initial_radius_scale", "must be finite and > 0");
   if (!(tcg_kappa > 0 && tcg_kappa < 1)) fail("tcg_kappa", "must be in (0, 1)");
+  if (!(tcg_kappa_near >= 0 && tcg_kappa_near < 1)) fail("tcg_kappa_near", "must be in [0, 1)");
+  if (!(near_relative_grad >= 0 && near_relative_grad <= 1))
+    fail("near_relative_grad", "must be in [0, 1]");
   if (!(tcg_theta > 0 && tcg_theta <= 1)) fail("tcg_theta", "must be in (0, 1]");
   if (!(acceptance_ratio >= 0 && acceptance_ratio < 0.25))
     fail("acceptance_ratio", "must be in [0, 0.25)");
@@ -32,6 +40,13 @@ namespace {
 
 double inner(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
   return A.cwiseProduct(B).sum();
+}
+
+// Frobenius norm of the Stiefel columns of a tangent vector (pose i: columns (d+1)i .. (d+1)i+d-1).
+double rotation_norm(const Eigen::MatrixXd& V, int d) {
+  double sq = 0.0;
+  for (Eigen::Index c = 0; c + d < V.cols() + 1; c += d + 1) sq += V.middleCols(c, d).squaredNorm();
+  return std::sqrt(sq);
 }
 
 struct TcgOutcome {
@@ -46,8 +61,8 @@ struct TcgOutcome {
 TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
                         const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
                         const Eigen::MatrixXd& grad, double radius, const TrustRegionOptions& opt,
-                        const RiemannianPreconditioner* precon,
-                        const Eigen::MatrixXd* precon_grad) {
+                        const RiemannianPreconditioner* precon, const Eigen::MatrixXd* precon_grad,
+                        double kappa) {
   auto precondition = [&](const Eigen::MatrixXd& v) { return precon ? precon->apply(M, X, v) : v; };
   TcgOutcome out;
   out.eta = Eigen::MatrixXd::Zero(X.rows(), X.cols());
@@ -81,7 +96,7 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
     r += alpha * Hdelta;
     r = M.tangent_project(X, r);  // keep rounding errors from leaving the tangent space
     const double r_norm = std::sqrt(inner(r, r));
-    if (r_norm <= r0_norm * std::min(std::pow(r0_norm, opt.tcg_theta), opt.tcg_kappa)) return out;
+    if (r_norm <= r0_norm * std::min(std::pow(r0_norm, opt.tcg_theta), kappa)) return out;
     z = precondition(r);
     const double z_r_old = z_r;
     z_r = inner(z, r);
@@ -113,6 +128,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   Eigen::MatrixXd egrad = problem.euclidean_gradient(res.X);
   Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
   double grad_norm = std::sqrt(inner(grad, grad));
+  const double grad_norm0 = grad_norm;
   const double grad_tol = std::max(options.grad_norm_tol, options.relative_grad_tol * grad_norm);
   int accepted_steps = 0;
   double radius = options.initial_radius;
@@ -126,18 +142,51 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     radius = std::max(
         1e-10, options.initial_radius_scale * std::sqrt(std::max(0.0, inner(precon_grad, grad))));
   }
+  auto ensure_precon_grad = [&] {
+    if (have_precon_grad) return;
+    precon_grad = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
+    have_precon_grad = true;
+  };
+  // Both stops below need the preconditioned gradient only when they are on; the next tCG starts
+  // from the same vector, so computing it costs nothing extra.
+  const bool paired_stop =
+      options.paired_grad_norm_tol > 0 && options.preconditioned_grad_norm_tol > 0;
+  auto paired_met = [&] {
+    if (!paired_stop || grad_norm > options.paired_grad_norm_tol) return false;
+    ensure_precon_grad();
+    return std::sqrt(inner(precon_grad, precon_grad)) <= options.preconditioned_grad_norm_tol;
+  };
+  // 1/2 <P g, g> is the decrease of the model's Newton step when P is the inverse Hessian: what
+  // the next step can still gain.
+  auto predicted_decrease = [&] {
+    ensure_precon_grad();
+    return 0.5 * std::max(0.0, inner(precon_grad, grad));
+  };
   res.stop_reason = "max_iterations";
   for (int it = 0; it < options.max_iterations; ++it) {
     if (grad_norm <= grad_tol) {
       res.stop_reason = "grad_norm";
       break;
     }
+    if (paired_met()) {
+      res.stop_reason = "preconditioned_grad_norm";
+      break;
+    }
+    if (options.predicted_rel_decrease_tol > 0 &&
+        predicted_decrease() <= options.predicted_rel_decrease_tol * std::abs(f)) {
+      res.stop_reason = "predicted_decrease";
+      break;
+    }
     if (elapsed() > options.max_time_s) {
       res.stop_reason = "time";
       break;
     }
+    const double kappa =
+        options.tcg_kappa_near > 0 && grad_norm <= options.near_relative_grad * grad_norm0
+            ? options.tcg_kappa_near
+            : options.tcg_kappa;
     TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner,
-                                   have_precon_grad ? &precon_grad : nullptr);
+                                   have_precon_grad ? &precon_grad : nullptr, kappa);
     res.total_inner_iterations += step.iterations;
     Eigen::MatrixXd X_new =
         options.retraction ? options.retraction(res.X, step.eta) : M.retract(res.X, step.eta);
@@ -178,10 +227,17 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     }
     res.iterations = it + 1;
     if (options.record_trace)
-      res.trace.push_back(
-          {it + 1, f, grad_norm, radius, rho, step.iterations, accepted, elapsed()});
+      res.trace.push_back({it + 1, f, grad_norm, radius, rho, step.iterations, accepted, elapsed(),
+                           options.predicted_rel_decrease_tol > 0
+                               ? predicted_decrease()
+                               : std::numeric_limits<double>::quiet_NaN()});
     if (accepted && decrease <= options.rel_cost_decrease_tol * std::abs(f)) {
       res.stop_reason = "relative_decrease";
+      break;
+    }
+    if (accepted && options.step_norm_tol > 0 &&
+        rotation_norm(step.eta, M.dim()) < options.step_norm_tol) {
+      res.stop_reason = "step_norm";
       break;
     }
     if (radius < 1e-14) {

@@ -51,9 +51,12 @@ def main():
     ap.add_argument("--grad-tol", type=float, default=1e-3, help="agents' gradient tolerance (default 1e-3)")
     ap.add_argument("--checkpoints", type=int, default=5, help="checkpoints per run (default 5)")
     ap.add_argument("--full", action="store_true", help="the issue's sizes (long on a shared machine)")
+    ap.add_argument("--dds", action="store_true",
+                    help="also run each case over DDS (tessera launch --online: one agent process per robot)")
+    ap.add_argument("--domain", type=int, default=63, help="DDS domain of the --dds runs (default 63)")
     args = ap.parse_args()
     ctx = bc.Ctx(args)
-    rows, runs = [], []
+    rows, runs, dds_rows = [], [], []
     for name, path, robots, fkey in cases(args, ctx.work, ctx.bin):
         load = os.getloadavg()[0]
         js = os.path.join(ctx.work, os.path.basename(path) + ".online.json")
@@ -82,6 +85,8 @@ def main():
         }
         rows.append(row)
         runs.append((name, s))
+        if args.dds:
+            dds_rows.append(run_dds(args, ctx, name, path, robots, fstar))
     headers = ["graph", "poses", "steps", "lat med s", "lat p95 s", "max gap", "online CPU s", "set-up s",
                "rounds CPU s",
                "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
@@ -95,6 +100,19 @@ def main():
           bc.fmt(r["cpu_ratio"], "{:.3f}"), bc.fmt(r["final_rel_gap"], "{:.1e}"), r["certified"], r["load_1min"]]
          for r in rows])
     bc.write_csv(os.path.join(ctx.out_dir, "online.csv"), rows)
+    dds_table = ""
+    if dds_rows:
+        dds_table = bc.print_table(
+            f"online runs over DDS (tessera launch --online, rate {args.rate}/s per robot, speedup {args.speedup}, "
+            f"grad tol {args.grad_tol})",
+            ["graph", "agents", "solves", "rounds", "lat med s", "lat p95 s", "agents CPU s", "KB/s per agent",
+             "repartitions", "poses moved", "final rel gap", "certified", "wall s", "load"],
+            [[r["graph"], r["agents"], r["solves"], r["rounds"], bc.fmt(r["latency_median_s"], "{:.3f}"),
+              bc.fmt(r["latency_p95_s"], "{:.3f}"), bc.fmt(r["agents_cpu_s"], "{:.2f}"),
+              bc.fmt(r["kbytes_per_s_per_agent"], "{:.0f}"), r["repartitions"], r["poses_moved"],
+              bc.fmt(r["final_rel_gap"], "{:.1e}"), r["certified"], bc.fmt(r["wall_s"], "{:.1f}"), r["load_1min"]]
+             for r in dds_rows])
+        bc.write_csv(os.path.join(ctx.out_dir, "online_dds.csv"), dds_rows)
     plt = bc.pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
     for name, s in runs:
@@ -120,6 +138,13 @@ def main():
         for c in ctx.commands:
             f.write(f"      {c}\n")
         f.write("\n" + table + "\n\n")
+        if dds_table:
+            f.write(dds_table + "\n\n")
+            f.write("Over DDS: one `tessera-agent --online` process per robot and `tessera replay`; latency = a "
+                    "batch's arrival at an agent to the end of the solve that absorbed it (agent 0); rounds = all "
+                    "solves' rounds plus the final certified solve's; agents CPU = sum of the agents' process CPU "
+                    "of their epochs; KB/s per agent = protocol and report bytes sent over the run's wall time; "
+                    "repartitions = solves that moved poses between blocks.\n\n")
         f.write("Columns: latency = publication of a batch to the end of the step that absorbed it "
                 "(gradient back under the tolerance or stalled), median and 95th percentile over all batches; max "
                 "gap = largest relative gap (f(estimate) - f*_k) / f*_k over the checkpoints, f*_k the centralized "
@@ -129,6 +154,31 @@ def main():
                 "in-process engine keeps one block per robot: re-partitions and poses moved are 0.\n\n"
                 "![online](online.png)\n")
     print(f"wrote {os.path.relpath(md, bc.ROOT)}")
+
+
+def run_dds(args, ctx, name, path, robots, fstar):
+    load = os.getloadavg()[0]
+    js = os.path.join(ctx.work, os.path.basename(path) + ".online_dds.json")
+    cmd = [ctx.bin, "launch", path, "--agents", str(robots), "--online", "--rate", str(args.rate),
+           "--speedup", str(args.speedup), "--grad-tol", str(args.grad_tol), "--domain", str(args.domain),
+           "--json", js]
+    ctx.log(cmd)
+    bc.progress(" ".join(cmd))
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    with open(js) as f:
+        s = json.load(f)
+    wall = s["launch_wall_s"] or 1.0
+    return {
+        "graph": name, "agents": robots, "poses": s["total_poses"], "solves": s["solves"],
+        "rounds": s["rounds"] + s["final_rounds"], "latency_median_s": s["latency_median_s"],
+        "latency_p95_s": s["latency_p95_s"], "agents_cpu_s": sum(a["cpu_s"] for a in s["agents"]),
+        "kbytes_per_s_per_agent": sum(a["bytes_sent"] + a["report_bytes"] for a in s["agents"]) / wall / robots / 1e3,
+        "repartitions": sum(1 for u in s["updates"] if u["moved"] > 0),
+        "poses_moved": sum(u["moved"] for u in s["updates"]),
+        "final_cost": s.get("cost"), "fstar": fstar,
+        "final_rel_gap": (s["cost"] - fstar) / fstar if s.get("cost") is not None else None,
+        "certified": s["certified"], "wall_s": wall, "load_1min": round(load, 2),
+    }
 
 
 if __name__ == "__main__":

@@ -41,6 +41,17 @@ const char* preset_name(PartitionPreset preset);
 /// Inverse of preset_name; throws InputError listing the valid names.
 PartitionPreset parse_preset(const std::string& name);
 
+/// Graphs with fewer poses than this get `fast` from auto_preset, larger ones `eco`.
+constexpr std::size_t kAutoPresetFastBelow = 2000;
+/// The effort `solve` and `launch` choose by default ("auto"): `fast` below kAutoPresetFastBelow
+/// vertices, `eco` from there. On small graphs the whole distributed run takes well under a
+/// second, eco's search would be 15-25 % of it, and fast with the rounds objective needs the
+/// same rounds (1000-pose grid, MIT, CSAIL, intel). On larger ones eco is a few % of the run and
+/// fast's partitions cost the long chains rounds (ais2klinik 1238 vs 485, kitti_00 725 vs 519).
+PartitionPreset auto_preset(std::size_t num_vertices);
+/// parse_preset, plus "auto" = auto_preset(num_vertices).
+PartitionPreset parse_preset_for(const std::string& name, std::size_t num_vertices);
+
 struct PartitionOptions {
   int parts = 2;  ///< N, number of blocks: 1..64 (and at most the number of vertices).
   PartitionPreset preset = PartitionPreset::kEco;

@@ -24,13 +24,35 @@ struct TrustRegionOptions {
   int max_accepted_steps = 0;
   /// Stop when an accepted step decreases f by less than this fraction of f (>= 0).
   double rel_cost_decrease_tol = 1e-12;
+  /// A second gradient stop that needs both norms small (absolute, >= 0; the stop is off while
+  /// either is 0): ||grad f|| <= paired_grad_norm_tol and ||P grad f|| <=
+  /// preconditioned_grad_norm_tol, P the preconditioner (identity when none). ||P grad f||
+  /// approximates the Newton step, so the pair says "the gradient is small and so is the step it
+  /// would still cause", which does not depend on how the weights scale the gradient.
+  double paired_grad_norm_tol = 0.0;
+  double preconditioned_grad_norm_tol = 0.0;
+  /// Stop after an accepted step whose rotation part (the Stiefel columns of the update) has a
+  /// Frobenius norm below this (>= 0; 0 = off). Translations are left out: they are in the
+  /// graph's length unit, rotations are not.
+  double step_norm_tol = 0.0;
+  /// Stop before a step when the decrease the model's Newton step would bring, 1/2 <P grad f,
+  /// grad f>, is below this fraction of f (in [0, 1); 0 = off). This is the relative-decrease stop
+  /// taken before the step instead of after it: the step that would only confirm convergence is
+  /// not computed. With P below the inverse Hessian the estimate is low by P's error.
+  double predicted_rel_decrease_tol = 0.0;
   double initial_radius = 0.0;  ///< <= 0: set from the first preconditioned gradient.
   /// With initial_radius <= 0 the radius is this times sqrt(<P g, g>) (the preconditioned
   /// gradient norm: the length of the Newton step when P is the exact inverse Hessian); > 0.
   double initial_radius_scale = 1.0;
-  double max_radius = 1e12;        ///< > 0.
-  double tcg_kappa = 0.1;          ///< Linear convergence target of tCG, in (0, 1).
-  double tcg_theta = 1.0;          ///< Superlinear exponent of tCG, in (0, 1].
+  double max_radius = 1e12;  ///< > 0.
+  double tcg_kappa = 0.1;    ///< Linear convergence target of tCG, in (0, 1).
+  double tcg_theta = 1.0;    ///< Superlinear exponent of tCG, in (0, 1].
+  /// Near the solution, the linear forcing term to use instead of tcg_kappa (in [0, 1); 0 = off):
+  /// once ||grad f|| <= near_relative_grad x its value at X0 (in [0, 1]). Far from it a loose
+  /// kappa keeps steps short where the model is poor; near it a tighter one makes each costly
+  /// step count.
+  double tcg_kappa_near = 0.0;
+  double near_relative_grad = 1e-2;
   double acceptance_ratio = 1e-4;  ///< Minimum rho to accept a step, in [0, 0.25).
   double max_time_s = 1e9;         ///< Wall-clock budget, seconds (> 0).
   bool record_trace = true;
@@ -51,6 +73,9 @@ struct TrustRegionIteration {
   int inner_iterations;
   bool accepted;
   double elapsed_s;
+  /// 1/2 <P grad f, grad f> at the iterate after this step (NaN unless predicted_rel_decrease_tol
+  /// is on).
+  double predicted_decrease;
 };
 
 struct TrustRegionResult {

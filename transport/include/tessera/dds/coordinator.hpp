@@ -14,7 +14,7 @@ namespace tessera::dds {
 struct CoordinatorOptions {
   std::uint32_t agents = 0;  ///< Agents of the run, 1..1000 (required).
   SessionOptions session;
-  std::string partition = "eco";    ///< sequential | fast | eco | strong | highest
+  std::string partition = "auto";   ///< auto | sequential | fast | eco | strong | highest
   std::string algorithm = "irbcd";  ///< rbcd | rbcd++ | irbcd
   double grad_tol = 0;              ///< Stop at this gradient norm; 0 = the solver's default.
   std::uint32_t max_rounds = 0;     ///< 0 = the solver's default.

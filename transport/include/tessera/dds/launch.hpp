@@ -14,7 +14,7 @@ struct LaunchOptions {
   std::string graph;
   long agents = 3;                  ///< 1..64
   std::string algorithm = "irbcd";  ///< rbcd | rbcd++ | irbcd
-  std::string partition = "eco";    ///< sequential | fast | eco | strong | highest
+  std::string partition = "auto";   ///< auto | sequential | fast | eco | strong | highest
   double grad_tol = 0.01;           ///< > 0
   bool certify = true;
   std::string json;        ///< Also write the summary here ("" = not).

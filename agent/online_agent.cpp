@@ -1,0 +1,649 @@
+#include "agent/online_agent.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/certified_agent.hpp>
+#include <tessera/graph/connectivity.hpp>
+#include <tessera/io/tum_writer.hpp>
+#include <tessera/problem/objective.hpp>
+#include <tessera/problem/rounding.hpp>
+#include <tessera/util/input_error.hpp>
+#include <utility>
+
+#include "arguments.hpp"
+#include "json_writer.hpp"
+#include "runtime/online_agent_view.hpp"
+#include "transport/graph_stream_topic.hpp"
+#include "transport/online_channel.hpp"
+#include "transport/run_identity.hpp"
+#include "transport/transport_error.hpp"
+
+namespace tessera::agent {
+
+namespace {
+
+const char* const kOnlineUsage =
+    R"(usage: tessera-agent --online --robots N --id I --run-id ID [options]
+
+One robot's agent of an online run (docs/online.md): reads every robot's batches from the
+DDS topic tessera_graph_stream (partition = run id; `tessera replay` or a front end writes
+them), agrees with the other agents on the batches that enter at each epoch boundary,
+solves the grown graph from the current estimate until the gradient is under --grad-tol,
+idles without sending anything while nothing is new, and certifies the estimate when every
+robot has sent its last batch. Robot I's block is this agent's.
+
+options:
+  --robots N          robots = agents of the run (required)
+  --id I              this agent's robot, 0..N-1 (required)
+  --run-id ID         the run (required)
+  --domain D          DDS domain 0..232                              [from the run id]
+  --algorithm A       rbcd, rbcd++ or irbcd                          [irbcd]
+  --rank R            lifted rank r >= d                             [5]
+  --grad-tol G        gradient-norm tolerance of every solve, > 0    [0.01]
+  --max-rounds K      rounds per solve at most                       [10000]
+  --no-certify        no certificate at the end
+  --timeout S         give up when a peer sends nothing for S seconds [120]
+  --json FILE         write this agent's summary (agent 0's has the final answer)
+  --certify-iters K   certificate iteration cap (LOBPCG)               [300]
+  --certify-every S   also certify the graph received so far every S seconds (agent 0's
+                      clock; at the next epoch that brought data, once the graph is
+                      connected; no staircase climb)                  [0 = off]
+  --publish-every S   publish this robot's current estimate (rounded to SE(d)) on topic
+                      tessera_online_estimate every S seconds, and at the end [0 = off]
+  --tum-dir DIR       write DIR/robot<I>.tum (TUM, timestamp = pose index) at every
+                      publication and at the end
+  --verbose           print each epoch (members, what entered, solve or idle)
+  --help              this text
+
+exit codes: 0 done, 1 the run failed (a peer went silent), 2 bad options or input.
+)";
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+double cpu_now() {
+  return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
+}
+
+struct Options {
+  int robots = 0, id = -1;
+  std::string run_id;
+  int domain = 0;
+  OnlineOptions online;
+  double timeout_s = 120.0;
+  std::string json;
+  bool verbose = false;
+  double certify_every_s = 0.0;
+  double publish_every_s = 0.0;
+  std::string tum_dir;
+};
+
+Options parse(const std::vector<std::string>& argv) {
+  const cli::Arguments args(
+      argv,
+      {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol", "max-rounds", "timeout",
+       "json", "certify-every", "certify-iters", "publish-every", "tum-dir"},
+      {"online", "no-certify", "verbose", "help"});
+  Options o;
+  const auto run_id = args.get("run-id");
+  if (!run_id) throw InputError("option --run-id ID is required (see --help)");
+  transport::validate_run_id(*run_id);
+  o.run_id = *run_id;
+  o.robots = static_cast<int>(args.get_long("robots", 0));
+  o.id = static_cast<int>(args.get_long("id", -1));
+  if (o.robots < 1) throw InputError("option --robots N is required (N >= 1)");
+  if (o.id < 0 || o.id >= o.robots)
+    throw InputError("option --id: must be 0.." + std::to_string(o.robots - 1));
+  const long domain = args.get_long("domain", transport::domain_for_run(o.run_id));
+  if (domain < 0 || domain > transport::kMaxDomain)
+    throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));
+  o.domain = static_cast<int>(domain);
+  DistributedOptions& s = o.online.solver;
+  s.algorithm = parse_algorithm(args.get_or("algorithm", "irbcd"));
+  s.rank = static_cast<int>(args.get_long("rank", 5));
+  s.grad_norm_tol = args.get_double("grad-tol", 0.01);
+  if (!(s.grad_norm_tol > 0)) throw InputError("option --grad-tol: must be > 0");
+  s.max_rounds = static_cast<int>(args.get_long("max-rounds", 10000));
+  o.online.certify_at_end = !args.has("no-certify");
+  s.staircase.certificate.max_iterations =
+      static_cast<int>(args.get_long("certify-iters", s.staircase.certificate.max_iterations));
+  o.timeout_s = args.get_double("timeout", 120.0);
+  if (!(o.timeout_s > 0)) throw InputError("option --timeout: must be > 0");
+  o.json = args.get_or("json", "");
+  o.verbose = args.has("verbose");
+  o.certify_every_s = args.get_double("certify-every", 0.0);
+  if (!(o.certify_every_s >= 0)) throw InputError("option --certify-every: must be >= 0");
+  o.publish_every_s = args.get_double("publish-every", 0.0);
+  if (!(o.publish_every_s >= 0)) throw InputError("option --publish-every: must be >= 0");
+  o.tum_dir = args.get_or("tum-dir", "");
+  o.online.validate();
+  return o;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
+  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
+}
+
+// The outcome of one solve of the epoch's graph by this agent's block.
+struct SolveOutcome {
+  int rounds = 0;
+  double grad_norm = 0.0;
+  std::string stop_reason;
+  std::optional<bool> certified;
+  double min_eigenvalue = 0.0;
+};
+
+class OnlineAgent {
+ public:
+  explicit OnlineAgent(const Options& o)
+      : o_(o),
+        view_(o.id, o.robots, o.online),
+        stream_(o.domain, o.run_id),
+        channel_(o.domain, o.run_id, static_cast<std::uint32_t>(o.id),
+                 static_cast<std::uint32_t>(o.robots)),
+        start_(Clock::now()) {}
+
+  int run();
+
+ private:
+  void pump_stream();
+  void pump_channel();
+  void wait_for_reports();
+  bool reports_complete();
+  void wait_matched(std::size_t peers);
+  /// The agents that take part in the current epoch (agent 0's previous report says so).
+  const std::set<std::uint32_t>& members() const;
+  SolveOutcome solve(bool certify, bool climb = true);
+  void publish_estimate();
+  void send(const std::vector<OutgoingMessage>& out, std::uint32_t epoch);
+  void write_json(bool lead_result);
+  [[noreturn]] void silent_peer(const std::string& what) const;
+
+  Options o_;
+  runtime::OnlineAgentView view_;
+  transport::GraphStreamReader stream_;
+  transport::OnlineChannel channel_;
+  Clock::time_point start_;
+  std::uint32_t epoch_ = 0;
+  bool converged_ = true;
+  std::vector<std::uint32_t> own_ids_;
+  std::vector<double> own_data_;
+  int own_rank_ = 0;
+  std::map<std::uint32_t, std::map<std::uint32_t, transport::OnlineReportSample>> reports_;
+  std::map<std::uint32_t, std::set<std::uint32_t>> members_{{0, {0}}};
+  std::set<std::uint32_t> seen_;  // agents heard from (hello or report)
+  double next_certificate_ = 0.0, last_publish_ = -1e300;
+  bool changed_since_certificate_ = false;
+  std::vector<cli::JsonObject> certificates_;
+  std::size_t publications_ = 0;
+  std::vector<transport::OnlineProtocolSample> pending_;
+  std::map<std::pair<std::uint32_t, std::uint64_t>, double> received_at_;
+  // Figures.
+  std::vector<cli::JsonObject> updates_;
+  std::vector<double> batch_latency_s_;
+  std::uint64_t bytes_sent_ = 0, messages_sent_ = 0, report_bytes_ = 0;
+  std::uint64_t idle_waits_ = 0;
+  int rounds_ = 0, solves_ = 0;
+  double cpu_s_ = 0.0;
+  SolveOutcome final_;
+  double cost_ = 0.0;
+  bool have_cost_ = false;
+};
+
+[[noreturn]] void OnlineAgent::silent_peer(const std::string& what) const {
+  throw transport::TransportError("online agent " + std::to_string(o_.id) + ": " + what + " for " +
+                                  std::to_string(o_.timeout_s) + " s (--timeout)");
+}
+
+void OnlineAgent::pump_stream() {
+  for (const auto& r : stream_.take(0.0)) {
+    received_at_.emplace(std::make_pair(r.batch.robot, r.batch.sequence), since(start_));
+    view_.receive(r.batch, r.dim, r.last);
+  }
+}
+
+void OnlineAgent::pump_channel() {
+  for (auto& r : channel_.take_reports()) {
+    if (r.sender < static_cast<std::uint32_t>(o_.robots)) seen_.insert(r.sender);
+    if (r.epoch == transport::kHelloEpoch) continue;
+    if (r.sender == 0)
+      members_[r.epoch + 1] = std::set<std::uint32_t>(r.next_members.begin(), r.next_members.end());
+    if (r.epoch >= epoch_) reports_[r.epoch][r.sender] = std::move(r);
+  }
+  for (auto& m : channel_.take_messages())
+    if (m.epoch >= epoch_) pending_.push_back(std::move(m));
+}
+
+const std::set<std::uint32_t>& OnlineAgent::members() const {
+  return members_.at(epoch_);
+}
+
+bool OnlineAgent::reports_complete() {
+  const auto& have = reports_[epoch_];
+  for (std::uint32_t m : members())
+    if (have.count(m) == 0) return false;
+  return true;
+}
+
+void OnlineAgent::wait_for_reports() {
+  // The timeout runs once the epoch began (some report of it arrived): a joiner may wait for
+  // the next epoch as long as the members idle.
+  auto last_progress = Clock::now();
+  std::size_t have = 0;
+  while (!reports_complete()) {
+    channel_.wait(0.05);
+    pump_channel();
+    pump_stream();
+    if (reports_[epoch_].size() != have) {
+      have = reports_[epoch_].size();
+      last_progress = Clock::now();
+    } else if (have > 0 && since(last_progress) > o_.timeout_s) {
+      std::string missing;
+      for (std::uint32_t m : members())
+        if (reports_[epoch_].count(m) == 0)
+          missing += (missing.empty() ? "" : ",") + std::to_string(m);
+      silent_peer("no epoch " + std::to_string(epoch_) + " report from agent " + missing);
+    }
+  }
+}
+
+void OnlineAgent::wait_matched(std::size_t peers) {
+  const auto start = Clock::now();
+  while (channel_.matched_peers() < static_cast<int>(peers)) {
+    if (since(start) > o_.timeout_s) silent_peer("peers not all matched");
+    channel_.wait(0.01);
+    pump_channel();
+    pump_stream();
+  }
+}
+
+void OnlineAgent::send(const std::vector<OutgoingMessage>& out, std::uint32_t epoch) {
+  for (const auto& m : out) {
+    bytes_sent_ += channel_.send(m, epoch);
+    ++messages_sent_;
+  }
+}
+
+SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
+  SolveOutcome out;
+  const LinkedProblem p = view_.problem();
+  const int c = p.compact_block(view_.own_block());
+  own_ids_.clear();
+  own_data_.clear();
+  if (p.graph.num_poses == 0 || c < 0) return out;  // nothing of ours to solve yet
+  DistributedOptions solver = o_.online.solver;
+  solver.certify = certify;
+  solver.round_result = false;
+  // A certificate while the graph grows does not climb the staircase: the iterate keeps its
+  // rank for the next data (a saddle is reported as not certified).
+  if (!climb) solver.staircase.max_rank = solver.rank;
+  const BlockLayout layout = make_block_layout(p.graph.num_poses, p.graph.measurements, p.blocks);
+  const Eigen::Index w = p.graph.d + 1;
+  const auto& ids = layout.poses[static_cast<std::size_t>(c)];
+  Eigen::MatrixXd Yb(p.X0.rows(), w * static_cast<Eigen::Index>(ids.size()));
+  for (std::size_t s = 0; s < ids.size(); ++s)
+    Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
+        p.X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
+  AgentState state(c, p.graph.d, layout, p.graph.measurements, Yb, solver.block_update);
+  CertifiedAgent agent(state, layout, solver);
+  const auto me = static_cast<std::uint32_t>(c);
+  send(agent.start(), epoch_);
+  auto last_message = Clock::now();
+  while (!agent.done()) {
+    bool handled = false;
+    for (std::size_t k = 0; k < pending_.size() && !agent.done();) {
+      const auto& m = pending_[k];
+      if (m.epoch != epoch_ || m.sender == me ||
+          !(m.broadcast ||
+            std::find(m.recipients.begin(), m.recipients.end(), me) != m.recipients.end())) {
+        // Older epochs' leftovers go; later epochs' wait for their solve.
+        if (m.epoch < epoch_ || m.epoch == epoch_) {
+          pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(k));
+        } else {
+          ++k;
+        }
+        continue;
+      }
+      ProtocolMessage msg = std::move(pending_[k].message);
+      pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(k));
+      send(agent.handle(msg), epoch_);
+      handled = true;
+    }
+    if (agent.done()) break;
+    if (handled) {
+      last_message = Clock::now();
+      continue;
+    }
+    channel_.wait(0.02);
+    pump_channel();
+    pump_stream();
+    if (since(last_message) > o_.timeout_s) {
+      // Name the agents whose messages the protocol still waits for (block -> robot = agent).
+      std::string missing;
+      if (const auto awaited = agent.awaited())
+        for (std::uint32_t b : awaited->senders)
+          if (b < p.block_of.size())
+            missing +=
+                (missing.empty() ? " from agent " : ",") +
+                std::to_string(view_.stream()->robots()[static_cast<std::size_t>(p.block_of[b])]);
+      silent_peer("no protocol message" + missing);
+    }
+  }
+  // This agent's poses go out with the next report (the estimate made whole everywhere).
+  own_rank_ = state.rank();
+  const std::size_t per_pose = static_cast<std::size_t>(own_rank_ * w);
+  own_data_.resize(ids.size() * per_pose);
+  for (std::size_t s = 0; s < ids.size(); ++s) {
+    own_ids_.push_back(static_cast<std::uint32_t>(p.full_id[ids[s]]));
+    Eigen::Map<Eigen::MatrixXd>(own_data_.data() + s * per_pose, own_rank_, w) =
+        state.Y.middleCols(w * static_cast<Eigen::Index>(s), w);
+  }
+  view_.apply_block(own_ids_, own_data_, own_rank_);
+  out.rounds = agent.total_rounds();
+  const auto& last = agent.solves().back();
+  out.stop_reason = last.stop_reason;
+  out.grad_norm = last.trace.empty() ? 0.0 : last.trace.back().grad_norm;
+  out.certified = agent.certified();
+  if (!agent.certificates().empty())
+    out.min_eigenvalue = agent.certificates().back().result.min_eigenvalue;
+  return out;
+}
+
+void OnlineAgent::publish_estimate() {
+  last_publish_ = since(start_);
+  const GraphStream* stream = view_.stream();
+  if (!stream || count_components(stream->graph()) != 1) return;  // no common frame yet
+  const std::vector<Pose> poses = round_solution(stream->graph(), view_.iterate());
+  const int d = stream->graph().d;
+  std::vector<std::uint64_t> index;
+  std::vector<double> data;
+  std::vector<Pose> mine;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    if (stream->robot_of_pose()[k] != static_cast<std::uint32_t>(o_.id)) continue;
+    index.push_back(stream->key_of_pose()[k].index);
+    data.insert(data.end(), poses[k].R.data(), poses[k].R.data() + d * d);
+    data.insert(data.end(), poses[k].t.data(), poses[k].t.data() + d);
+    mine.push_back(poses[k]);
+  }
+  if (mine.empty()) return;
+  channel_.publish_estimate(epoch_, d, index, data);
+  if (!o_.tum_dir.empty()) {
+    // Replaced whole: a reader never sees half a snapshot.
+    const std::string path = o_.tum_dir + "/robot" + std::to_string(o_.id) + ".tum";
+    write_tum(mine, path + ".part");
+    std::filesystem::rename(path + ".part", path);
+  }
+  ++publications_;
+}
+
+int OnlineAgent::run() {
+  const auto me = static_cast<std::uint32_t>(o_.id);
+  // Membership: agent 0 starts alone (epoch 0) and admits every agent it has heard from at
+  // the next epoch boundary (its report's next_members), so the run needs no start barrier
+  // and an agent started late is taken in the same way. A joiner first follows the epochs it
+  // missed from the reports (kept for late readers): the same entered batches and block
+  // poses give it the members' graph and estimate.
+  if (me != 0) {
+    transport::OnlineReportSample hello;
+    hello.epoch = transport::kHelloEpoch;
+    hello.sender = me;
+    report_bytes_ += channel_.send_report(hello);
+  }
+  bool finishing = false;
+  for (;;) {
+    pump_stream();
+    pump_channel();
+    const bool member = members().count(me) > 0;
+    if (member) {
+      wait_matched(members().size());
+      transport::OnlineReportSample mine;
+      mine.epoch = epoch_;
+      mine.sender = me;
+      mine.held = view_.held();
+      mine.converged = converged_;
+      mine.rank = own_rank_;
+      mine.dim = view_.dim();
+      mine.pose_ids = own_ids_;
+      mine.data = own_data_;
+      if (me == 0) {
+        if (o_.certify_every_s > 0 && changed_since_certificate_ &&
+            since(start_) >= next_certificate_) {
+          mine.certify = true;
+          next_certificate_ = since(start_) + o_.certify_every_s;
+          changed_since_certificate_ = false;
+        }
+        std::set<std::uint32_t> next = members();
+        next.insert(seen_.begin(), seen_.end());
+        mine.next_members.assign(next.begin(), next.end());
+      }
+      report_bytes_ += channel_.send_report(mine);
+    }
+    wait_for_reports();
+    std::vector<Watermarks> held;
+    bool all_converged = true;
+    for (const auto& [sender, r] : reports_[epoch_]) {
+      if (members().count(sender) == 0) continue;
+      if (sender != me && r.dim != 0) {
+        if (view_.dim() == 0) pump_stream();  // the block's graph must be there first
+        view_.apply_block(r.pose_ids, r.data, r.rank);
+      }
+      held.push_back(r.held);
+      all_converged = all_converged && r.converged;
+    }
+    converged_ = all_converged;
+    const bool certify_now = reports_[epoch_].count(0) > 0 && reports_[epoch_][0].certify;
+    // The estimate is whole here (every block's poses of the last solve arrived).
+    if (finishing) {
+      if (o_.publish_every_s > 0 || !o_.tum_dir.empty()) publish_estimate();
+      break;
+    }
+    if (o_.publish_every_s > 0 && since(start_) - last_publish_ >= o_.publish_every_s)
+      publish_estimate();
+    AbsorbGate gate;
+    Watermarks decision = gate.decide(held);
+    // Only the members' robots: a robot's data waits for its agent.
+    for (auto& [robot, count] : decision)
+      if (members().count(robot) == 0) count = 0;
+    // The members hold what they decided; a joiner following missed epochs may not yet.
+    for (;;) {
+      bool have_all = true;
+      const Watermarks mine = view_.held();
+      for (const auto& [robot, count] : decision) {
+        auto it = mine.find(robot);
+        if (count > (it == mine.end() ? 0 : it->second)) have_all = false;
+      }
+      if (have_all) break;
+      pump_stream();
+      channel_.wait(0.01);
+    }
+    const double step_start = since(start_);
+    const double cpu_start = cpu_now();
+    const runtime::EnteredData in = view_.enter(decision);
+    const bool changed = in.poses > 0 || in.measurements > 0;
+    if (o_.verbose) {
+      std::string who;
+      for (std::uint32_t m : members()) who += " " + std::to_string(m);
+      std::fprintf(stderr, "agent %d: epoch %u members%s: +%zu poses +%zu measurements%s%s\n",
+                   o_.id, epoch_, who.c_str(), in.poses, in.measurements,
+                   member ? "" : " (following)", converged_ ? " converged" : "");
+    }
+    reports_.erase(epoch_);
+    if (view_.stream_over()) {
+      if (member) final_ = solve(o_.online.certify_at_end);
+      if (o_.verbose)
+        std::fprintf(stderr, "agent %d: final solve: %d rounds, certified %s\n", o_.id,
+                     final_.rounds, final_.certified.value_or(false) ? "yes" : "no");
+      cpu_s_ += cpu_now() - cpu_start;
+      finishing = true;
+      ++epoch_;
+      continue;
+    }
+    if (!member) {
+      ++epoch_;
+      continue;
+    }
+    if (changed) changed_since_certificate_ = true;
+    if (certify_now && count_components(view_.stream()->graph()) == 1) {
+      const SolveOutcome c = solve(true, false);
+      converged_ = c.grad_norm <= o_.online.solver.grad_norm_tol || c.stop_reason == "stalled";
+      cpu_s_ += cpu_now() - cpu_start;
+      rounds_ += c.rounds;
+      cli::JsonObject j;
+      j.add("epoch", static_cast<long long>(epoch_))
+          .add("time_s", step_start)
+          .add("poses", view_.stream()->graph().num_poses)
+          .add("certified", c.certified)
+          .add("min_eigenvalue", c.min_eigenvalue)
+          .add("rounds", c.rounds)
+          .add("ms", 1000.0 * (since(start_) - step_start));
+      certificates_.push_back(std::move(j));
+      ++epoch_;
+      continue;
+    }
+    if (!changed && converged_) {
+      // Idle: a blocking wait for new data (ours, another agent's next report, or a hello
+      // for agent 0 to admit); nothing is sent meanwhile.
+      ++idle_waits_;
+      for (;;) {
+        pump_stream();
+        pump_channel();
+        const Watermarks now = view_.held();
+        bool more = false;
+        for (const auto& [robot, count] : now) {
+          auto it = decision.find(robot);
+          if (members().count(robot) > 0 && count > (it == decision.end() ? 0 : it->second))
+            more = true;
+        }
+        bool joiner = false;
+        if (me == 0)
+          for (std::uint32_t a : seen_) joiner = joiner || members().count(a) == 0;
+        if (more || joiner || reports_.count(epoch_ + 1) > 0) break;
+        channel_.wait(0.05);
+      }
+      ++epoch_;
+      continue;
+    }
+    const SolveOutcome s = solve(false);
+    if (o_.verbose)
+      std::fprintf(stderr, "agent %d: solve: %d rounds, gradient norm %g (%s)\n", o_.id, s.rounds,
+                   s.grad_norm, s.stop_reason.c_str());
+    converged_ = s.grad_norm <= o_.online.solver.grad_norm_tol || s.stop_reason == "stalled";
+    const double step_end = since(start_);
+    cpu_s_ += cpu_now() - cpu_start;
+    rounds_ += s.rounds;
+    ++solves_;
+    const GraphStream& g = *view_.stream();
+    double oldest = step_start;
+    for (const auto& [key, t] : received_at_)
+      if (key.second < g.absorbed_batches(key.first)) {
+        batch_latency_s_.push_back(step_end - t);
+        oldest = std::min(oldest, t);
+      }
+    for (auto it = received_at_.begin(); it != received_at_.end();)
+      it = it->first.second < g.absorbed_batches(it->first.first) ? received_at_.erase(it)
+                                                                  : std::next(it);
+    cli::JsonObject u;
+    u.add("epoch", static_cast<long long>(epoch_))
+        .add("time_s", step_start)
+        .add("batches", in.batches)
+        .add("poses", in.poses)
+        .add("measurements", in.measurements)
+        .add("total_poses", g.graph().num_poses)
+        .add("total_measurements", g.graph().measurements.size())
+        .add("agents", static_cast<long long>(members().size()))
+        .add("moved", in.moved)
+        .add("largest_block", in.largest_block)
+        .add("rounds", s.rounds)
+        .add("ms", 1000.0 * (step_end - step_start))
+        .add("latency_s", step_end - oldest)
+        .add("grad_norm", s.grad_norm)
+        .add("stop_reason", s.stop_reason);
+    updates_.push_back(std::move(u));
+    ++epoch_;
+  }
+  // The lead rounds the whole estimate (every block's poses arrived with the last reports).
+  if (o_.id == 0) {
+    const PoseGraph& graph = view_.stream()->graph();
+    if (graph.num_poses > 0 && count_components(graph) == 1) {
+      const std::vector<Pose> poses = round_solution(graph, view_.iterate());
+      cost_ = evaluate_objective(graph, poses);
+      have_cost_ = true;
+    }
+  }
+  channel_.flush(5.0);
+  if (!o_.json.empty()) write_json(o_.id == 0);
+  return 0;
+}
+
+void OnlineAgent::write_json(bool lead_result) {
+  const GraphStream* g = view_.stream();
+  cli::JsonObject j;
+  j.add("agent", o_.id)
+      .add("robots", o_.robots)
+      .add("run_id", o_.run_id)
+      .add("epochs", static_cast<long long>(epoch_))
+      .add("solves", solves_)
+      .add("rounds", rounds_)
+      .add("final_rounds", final_.rounds)
+      .add("total_poses", g ? g->graph().num_poses : std::size_t{0})
+      .add("total_measurements", g ? g->graph().measurements.size() : std::size_t{0})
+      .add("bytes_sent", static_cast<long long>(bytes_sent_))
+      .add("messages_sent", static_cast<long long>(messages_sent_))
+      .add("report_bytes", static_cast<long long>(report_bytes_))
+      .add("idle_waits", static_cast<long long>(idle_waits_))
+      .add("cpu_s", cpu_s_)
+      .add("wall_s", since(start_))
+      .add("latency_median_s", percentile(batch_latency_s_, 0.5))
+      .add("latency_p95_s", percentile(batch_latency_s_, 0.95))
+      .add("certified", final_.certified)
+      .add("min_eigenvalue", final_.min_eigenvalue)
+      .add("grad_norm", final_.grad_norm);
+  if (lead_result && have_cost_) j.add("cost", cost_);
+  j.add("publications", publications_);
+  j.add("updates", updates_);
+  if (!certificates_.empty()) j.add("certificates", certificates_);
+  cli::write_output(o_.json, j.str());
+}
+
+}  // namespace
+
+bool wants_online(const std::vector<std::string>& argv) {
+  return std::find(argv.begin(), argv.end(), "--online") != argv.end();
+}
+
+int online_agent_main(const std::vector<std::string>& argv) {
+  try {
+    if (std::find(argv.begin(), argv.end(), "--help") != argv.end()) {
+      std::fputs(kOnlineUsage, stdout);
+      return 0;
+    }
+    const Options o = parse(argv);
+    OnlineAgent agent(o);
+    return agent.run();
+  } catch (const InputError& e) {
+    std::cerr << "tessera-agent: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "tessera-agent: run failed: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace tessera::agent

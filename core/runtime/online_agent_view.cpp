@@ -1,0 +1,139 @@
+#include "runtime/online_agent_view.hpp"
+
+#include <algorithm>
+#include <string>
+#include <tessera/online/block_rebalance.hpp>
+#include <tessera/online/estimate_extension.hpp>
+#include <tessera/util/input_error.hpp>
+#include <tuple>
+
+namespace tessera::runtime {
+
+OnlineAgentView::OnlineAgentView(int agent, int robots, const OnlineOptions& options)
+    : agent_(agent), robots_(robots), options_(options) {
+  options_.validate();
+  if (robots < 1) throw InputError("online agent: robots must be >= 1");
+  if (agent < 0 || agent >= robots)
+    throw InputError("online agent: agent id " + std::to_string(agent) + " is not in 0.." +
+                     std::to_string(robots - 1));
+}
+
+void OnlineAgentView::receive(const StreamBatch& batch, int dim, bool last) {
+  const std::string where =
+      "robot " + std::to_string(batch.robot) + " batch " + std::to_string(batch.sequence);
+  if (batch.robot >= static_cast<std::uint32_t>(robots_))
+    throw InputError("graph stream: " + where + ": robot is not one of the run's " +
+                     std::to_string(robots_) + " robots (0.." + std::to_string(robots_ - 1) + ")");
+  if (d_ == 0) {
+    if (dim != 2 && dim != 3) throw InputError("graph stream: " + where + ": dim must be 2 or 3");
+    if (options_.solver.rank < dim)
+      throw InputError("online agent: rank " + std::to_string(options_.solver.rank) +
+                       " is below d = " + std::to_string(dim));
+    d_ = dim;
+    stream_.emplace(dim, "graph stream");
+    X_.resize(options_.solver.rank, 0);
+  } else if (dim != d_) {
+    throw InputError("graph stream: " + where + ": dim " + std::to_string(dim) +
+                     " differs from the stream's " + std::to_string(d_));
+  }
+  if (last) last_count_[batch.robot] = batch.sequence + 1;
+  if (batch.sequence >= stream_->absorbed_batches(batch.robot))
+    pending_[batch.robot].emplace(batch.sequence, batch);
+}
+
+Watermarks OnlineAgentView::held() const {
+  Watermarks out;
+  if (!stream_) return out;
+  for (const auto& [robot, batches] : pending_) {
+    std::uint64_t next = stream_->absorbed_batches(robot);
+    for (auto it = batches.find(next); it != batches.end() && it->first == next; ++it) ++next;
+    out[robot] = next;
+  }
+  for (std::uint32_t robot : stream_->robots())
+    out.emplace(robot, stream_->absorbed_batches(robot));
+  return out;
+}
+
+EnteredData OnlineAgentView::enter(const Watermarks& decision) {
+  EnteredData e;
+  if (!stream_) return e;
+  std::vector<StreamBatch> in;
+  for (auto& [robot, batches] : pending_) {
+    auto limit = decision.find(robot);
+    const std::uint64_t until = limit == decision.end() ? 0 : limit->second;
+    for (auto it = batches.begin(); it != batches.end() && it->first < until;) {
+      in.push_back(std::move(it->second));
+      it = batches.erase(it);
+    }
+  }
+  if (in.empty()) return e;
+  // One order on every agent: graph ids follow absorption.
+  std::sort(in.begin(), in.end(), [](const StreamBatch& a, const StreamBatch& b) {
+    return std::tie(a.stamp, a.robot, a.sequence) < std::tie(b.stamp, b.robot, b.sequence);
+  });
+  const std::size_t poses_before = stream_->graph().num_poses;
+  const std::size_t measurements_before = stream_->graph().measurements.size();
+  for (const StreamBatch& b : in) {
+    e.batches += stream_->absorb(b).batches;
+    e.stamps.push_back(b.stamp);
+  }
+  const PoseGraph& graph = stream_->graph();
+  e.poses = graph.num_poses - poses_before;
+  e.measurements = graph.measurements.size() - measurements_before;
+  const auto& robots = stream_->robots();
+  for (std::size_t k = owner_.size(); k < graph.num_poses; ++k)
+    owner_.push_back(static_cast<int>(
+        std::find(robots.begin(), robots.end(), stream_->robot_of_pose()[k]) - robots.begin()));
+  const RebalanceResult moves =
+      rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
+  e.moved = moves.moved;
+  e.largest_block = moves.largest_after;
+  X_ = extend_estimate(graph, X_, stream_->guesses()).X;
+  return e;
+}
+
+bool OnlineAgentView::stream_over() const {
+  if (!stream_) return false;
+  for (int r = 0; r < robots_; ++r) {
+    auto it = last_count_.find(static_cast<std::uint32_t>(r));
+    if (it == last_count_.end() ||
+        stream_->absorbed_batches(static_cast<std::uint32_t>(r)) < it->second)
+      return false;
+  }
+  return true;
+}
+
+void OnlineAgentView::apply_block(const std::vector<std::uint32_t>& ids,
+                                  const std::vector<double>& data, int rank) {
+  if (d_ == 0 || ids.empty()) return;
+  const Eigen::Index w = d_ + 1;
+  if (rank > X_.rows()) {
+    Eigen::MatrixXd wider = Eigen::MatrixXd::Zero(rank, X_.cols());
+    wider.topRows(X_.rows()) = X_;
+    X_ = std::move(wider);
+  }
+  const std::size_t per_pose = static_cast<std::size_t>(rank * w);
+  if (data.size() != ids.size() * per_pose)
+    throw InputError("online report: " + std::to_string(data.size()) + " values for " +
+                     std::to_string(ids.size()) + " poses of rank " + std::to_string(rank));
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (static_cast<Eigen::Index>(ids[k]) * w >= X_.cols())
+      throw InputError("online report: pose " + std::to_string(ids[k]) + " is not in the graph");
+    auto cols = X_.middleCols(w * static_cast<Eigen::Index>(ids[k]), w);
+    cols.setZero();
+    cols.topRows(rank) = Eigen::Map<const Eigen::MatrixXd>(data.data() + k * per_pose, rank, w);
+  }
+}
+
+LinkedProblem OnlineAgentView::problem() const {
+  return make_linked_problem(stream_->graph(), owner_, X_);
+}
+
+int OnlineAgentView::own_block() const {
+  if (!stream_) return -1;
+  const auto& robots = stream_->robots();
+  auto it = std::find(robots.begin(), robots.end(), static_cast<std::uint32_t>(agent_));
+  return it == robots.end() ? -1 : static_cast<int>(it - robots.begin());
+}
+
+}  // namespace tessera::runtime

@@ -1,0 +1,77 @@
+#pragma once
+// One DDS agent's view of an online run, without DDS (the loop is agent/online_agent.cpp).
+// Every agent reads every robot's stream: the graph's structure and measurements are small
+// next to the iterates, and an inter-robot closure published by one robot must reach the
+// agents of both of its poses. Batches wait in a buffer until all agents hold them: at each
+// epoch boundary the agents exchange what they hold (OnlineReport), AbsorbGate takes the
+// element-wise minimum, and enter() absorbs exactly those batches in one canonical order
+// (stamp, robot, batch), so every agent builds the same graph with the same ids, the same
+// blocks (robot-aligned, refined by rebalance_blocks) and the same composed start for the new
+// poses, exactly as the in-process engine (online_engine.hpp) does at a step.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <tessera/online/absorb_gate.hpp>
+#include <tessera/online/graph_stream.hpp>
+#include <tessera/online/linked_problem.hpp>
+#include <tessera/online/online_engine.hpp>
+#include <vector>
+
+namespace tessera::runtime {
+
+/// What one enter() let in.
+struct EnteredData {
+  std::size_t batches = 0, poses = 0, measurements = 0;
+  std::vector<double> stamps;  ///< Publication stamp of each absorbed batch.
+  std::size_t moved = 0;       ///< Poses the rebalance moved to another block.
+  std::size_t largest_block = 0;
+};
+
+class OnlineAgentView {
+ public:
+  /// `agent` owns robot `agent`'s block; the run ends once each of robots 0..robots-1 sent its
+  /// last batch and it entered. Throws InputError for bad options.
+  OnlineAgentView(int agent, int robots, const OnlineOptions& options);
+
+  /// Buffers a received batch (`last`: its robot publishes nothing after it). Throws
+  /// InputError for a dimension that differs from earlier batches or a robot >= robots.
+  void receive(const StreamBatch& batch, int dim, bool last);
+  /// d of the stream, 0 before the first batch.
+  int dim() const { return d_; }
+  /// Batches held per robot: absorbed plus those buffered without a gap after them.
+  Watermarks held() const;
+  /// Absorbs the buffered batches below `decision` (AbsorbGate's common watermarks), extends
+  /// the estimate to the new poses and rebalances the blocks.
+  EnteredData enter(const Watermarks& decision);
+  /// Every robot's last batch entered: the stream is over.
+  bool stream_over() const;
+  /// Writes a peer's block (stream ids, r*(d+1) values per pose) into the iterate; a larger
+  /// rank (the final staircase) widens it.
+  void apply_block(const std::vector<std::uint32_t>& ids, const std::vector<double>& data,
+                   int rank);
+  /// The problem of the next solve (linked poses).
+  LinkedProblem problem() const;
+  /// Block (robot position in the stream) of this agent's robot, -1 before its first pose.
+  int own_block() const;
+
+  const GraphStream* stream() const { return stream_ ? &*stream_ : nullptr; }
+  Eigen::MatrixXd& iterate() { return X_; }
+  const Eigen::MatrixXd& iterate() const { return X_; }
+  const OnlineOptions& options() const { return options_; }
+  int agent() const { return agent_; }
+  int robots() const { return robots_; }
+
+ private:
+  int agent_, robots_, d_ = 0;
+  OnlineOptions options_;
+  std::optional<GraphStream> stream_;
+  std::map<std::uint32_t, std::map<std::uint64_t, StreamBatch>> pending_;
+  std::map<std::uint32_t, std::uint64_t> last_count_;  // robot -> its batches (after `last`)
+  Eigen::MatrixXd X_;
+  std::vector<int> owner_;
+};
+
+}  // namespace tessera::runtime

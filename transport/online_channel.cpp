@@ -1,0 +1,296 @@
+#include "transport/online_channel.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <mutex>
+#include <stdexcept>
+
+#include "tesseraPubSubTypes.h"
+#include "transport/message_mapping.hpp"
+#include "transport/network_profile.hpp"
+#include "transport/qos.hpp"
+#include "transport/run_identity.hpp"
+
+namespace tessera::transport {
+
+namespace dds = eprosima::fastdds::dds;
+using eprosima::fastrtps::Duration_t;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+namespace {
+// Reports kept per agent for joiners: one per epoch boundary.
+constexpr std::int32_t kReportHistory = 100000;
+}  // namespace
+
+// A reliable write that finds the bounded history full of samples some reader has not
+// acknowledged yet (a slow peer) waits for acknowledgements and tries again, up to a minute,
+// instead of failing the run.
+template <class Sample>
+bool write_patiently(dds::DataWriter* writer, Sample& sample) {
+  for (int attempt = 0; attempt < 600; ++attempt) {
+    if (writer->write(&sample)) return true;
+    writer->wait_for_acknowledgments(Duration_t(0, 100000000));
+  }
+  return false;
+}
+
+struct OnlineChannel::Impl : public dds::DataReaderListener {
+  std::string run_id;
+  std::uint32_t agent;
+  dds::DomainParticipant* participant = nullptr;
+  dds::Publisher* publisher = nullptr;
+  dds::Subscriber* subscriber = nullptr;
+  dds::TypeSupport block_type{new wire::PoseBlockPubSubType()};
+  dds::TypeSupport status_type{new wire::RoundStatusPubSubType()};
+  dds::TypeSupport report_type{new wire::OnlineReportPubSubType()};
+  dds::TypeSupport estimate_type{new wire::FinalEstimatePubSubType()};
+  dds::DataWriter* estimate_writer = nullptr;
+  dds::DataWriter *block_writer = nullptr, *status_writer = nullptr, *report_writer = nullptr;
+  dds::DataReader *block_reader = nullptr, *status_reader = nullptr, *report_reader = nullptr;
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool available = false;
+
+  Impl(int domain, const std::string& run, std::uint32_t me, std::uint32_t agents)
+      : run_id(run), agent(me) {
+    validate_run_id(run_id);
+    dds::DomainParticipantQos pq = dds::PARTICIPANT_QOS_DEFAULT;
+    // Not "tessera:<run>:..." (participant_name): not a Session peer of any run.
+    pq.name("tessera-online:" + run_id + ":" + std::to_string(me));
+    auto* factory = dds::DomainParticipantFactory::get_instance();
+    participant = factory->create_participant(domain, pq);
+    if (!participant)
+      throw std::runtime_error("online channel: cannot create a DDS participant on domain " +
+                               std::to_string(domain));
+    block_type.register_type(participant);
+    status_type.register_type(participant);
+    report_type.register_type(participant);
+    estimate_type.register_type(participant);
+    publisher = participant->create_publisher(publisher_qos(run_id));
+    subscriber = participant->create_subscriber(subscriber_qos(run_id));
+    if (!publisher || !subscriber)
+      throw std::runtime_error("online channel: cannot create a publisher or subscriber");
+    const NetworkProfile net;
+    auto endpoints = [&](const char* name, dds::TypeSupport& type, bool transient,
+                         dds::DataWriter*& writer, dds::DataReader*& reader) {
+      dds::Topic* topic =
+          participant->create_topic(name, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+      if (!topic) throw std::runtime_error(std::string("online channel: cannot create ") + name);
+      dds::DataWriterQos wq = writer_qos(transient, 10.0, agents, net, false);
+      wq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+      dds::DataReaderQos rq = reader_qos(transient, 10.0, agents, net, false);
+      rq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+      if (transient) {
+        // Every report of the run stays with its writer (acknowledged or not): a joiner
+        // follows the epochs it missed from them.
+        wq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+        wq.history().depth = kReportHistory;
+        wq.resource_limits().max_samples = kReportHistory;
+        wq.resource_limits().max_samples_per_instance = kReportHistory;
+        rq.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+        rq.resource_limits().max_samples = kReportHistory;
+        rq.resource_limits().max_samples_per_instance = kReportHistory;
+      }
+      writer = publisher->create_datawriter(topic, wq);
+      reader = subscriber->create_datareader(topic, rq, this);
+      if (!writer || !reader)
+        throw std::runtime_error(std::string("online channel: cannot create endpoints of ") + name);
+    };
+    endpoints(kOnlineBlockTopic, block_type, false, block_writer, block_reader);
+    endpoints(kOnlineStatusTopic, status_type, false, status_writer, status_reader);
+    // Reports are kept for readers that match later: the first epoch's reports may be sent
+    // before every agent's reader is discovered.
+    endpoints(kOnlineReportTopic, report_type, true, report_writer, report_reader);
+    // Estimates: for whoever listens (a monitor, the robots); the newest per robot matters.
+    dds::Topic* estimates = participant->create_topic(
+        kOnlineEstimateTopic, estimate_type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    dds::DataWriterQos eq = dds::DATAWRITER_QOS_DEFAULT;
+    eq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+    eq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+    eq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+    eq.history().depth = 1;
+    eq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+    estimate_writer = estimates ? publisher->create_datawriter(estimates, eq) : nullptr;
+    if (!estimate_writer)
+      throw std::runtime_error("online channel: cannot create the estimate writer");
+  }
+  ~Impl() override {
+    for (auto* r : {block_reader, status_reader, report_reader})
+      if (r) r->set_listener(nullptr);
+    if (participant) {
+      participant->delete_contained_entities();
+      dds::DomainParticipantFactory::get_instance()->delete_participant(participant);
+    }
+  }
+  // Samples are taken here, as they arrive, into the buffers the agent's loop empties: a
+  // reader whose bounded history filled while its agent computed (or waited in a write of
+  // its own) would stop acknowledging, and two agents doing that to each other would block
+  // each other's writes for good.
+  void on_data_available(dds::DataReader* reader) override {
+    std::lock_guard<std::mutex> lock(mutex);
+    try {
+      if (reader == report_reader) {
+        take_reports_locked();
+      } else if (reader == block_reader) {
+        wire::PoseBlock w;
+        dds::SampleInfo info;
+        while (block_reader->take_next_sample(&w, &info) == ReturnCode_t::RETCODE_OK)
+          if (info.valid_data && w.run_id() == run_id)
+            messages.push_back(
+                {w.epoch(), w.sender(), w.broadcast(), w.recipients(), from_wire(w)});
+      } else if (reader == status_reader) {
+        wire::RoundStatus w;
+        dds::SampleInfo info;
+        while (status_reader->take_next_sample(&w, &info) == ReturnCode_t::RETCODE_OK)
+          if (info.valid_data && w.run_id() == run_id)
+            messages.push_back(
+                {w.epoch(), w.sender(), w.broadcast(), w.recipients(), from_wire(w)});
+      }
+    } catch (const std::exception& e) {
+      if (error.empty()) error = e.what();
+    }
+    available = true;
+    cv.notify_all();
+  }
+
+  void take_reports_locked() {
+    wire::OnlineReport w;
+    dds::SampleInfo info;
+    while (report_reader->take_next_sample(&w, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || w.run_id() != run_id) continue;
+      if (w.held_robot().size() != w.held_count().size())
+        throw TransportError("online report of agent " + std::to_string(w.sender()) +
+                             ": held arrays of different lengths");
+      OnlineReportSample r;
+      r.epoch = w.epoch();
+      r.sender = w.sender();
+      for (std::size_t k = 0; k < w.held_robot().size(); ++k)
+        r.held[w.held_robot()[k]] = w.held_count()[k];
+      r.converged = w.converged();
+      r.rank = static_cast<int>(w.rank());
+      r.dim = static_cast<int>(w.dim());
+      r.pose_ids = w.pose_ids();
+      r.data = w.data();
+      r.next_members = w.next_members();
+      r.certify = w.certify();
+      reports.push_back(std::move(r));
+    }
+  }
+
+  std::vector<OnlineReportSample> reports;
+  std::vector<OnlineProtocolSample> messages;
+  std::string error;
+};
+
+OnlineChannel::OnlineChannel(int domain, const std::string& run_id, std::uint32_t agent,
+                             std::uint32_t agents)
+    : impl_(std::make_unique<Impl>(domain, run_id, agent, agents)) {}
+OnlineChannel::~OnlineChannel() = default;
+
+std::size_t OnlineChannel::send(const OutgoingMessage& m, std::uint32_t epoch) {
+  if (const auto* block = std::get_if<PoseBlockMessage>(&m.message)) {
+    wire::PoseBlock w = to_wire_block(*block, impl_->run_id, m.broadcast, m.recipients);
+    w.epoch(epoch);
+    if (!write_patiently(impl_->block_writer, w))
+      throw std::runtime_error("online channel: a pose block write failed");
+    return serialized_size(w);
+  }
+  wire::RoundStatus w = to_wire_status(std::get<RoundStatusMessage>(m.message), impl_->run_id,
+                                       m.broadcast, m.recipients);
+  w.epoch(epoch);
+  if (!write_patiently(impl_->status_writer, w))
+    throw std::runtime_error("online channel: a round status write failed");
+  return serialized_size(w);
+}
+
+std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
+  wire::OnlineReport w;
+  w.run_id(impl_->run_id);
+  w.epoch(r.epoch);
+  w.sender(r.sender);
+  for (const auto& [robot, count] : r.held) {
+    w.held_robot().push_back(robot);
+    w.held_count().push_back(count);
+  }
+  w.converged(r.converged);
+  w.rank(static_cast<std::uint32_t>(r.rank));
+  w.dim(static_cast<std::uint32_t>(r.dim));
+  w.pose_ids(r.pose_ids);
+  w.data(r.data);
+  w.next_members(r.next_members);
+  w.certify(r.certify);
+  if (!write_patiently(impl_->report_writer, w))
+    throw std::runtime_error("online channel: a report write failed");
+  return serialized_size(w);
+}
+
+void OnlineChannel::publish_estimate(std::uint32_t epoch, int d,
+                                     const std::vector<std::uint64_t>& index,
+                                     const std::vector<double>& poses) {
+  wire::FinalEstimate w;
+  w.run_id(impl_->run_id);
+  w.sender(impl_->agent);
+  w.dim(static_cast<std::uint32_t>(d));
+  w.epoch(epoch);
+  for (std::uint64_t k : index) w.pose_ids().push_back(static_cast<std::uint32_t>(k));
+  w.pose_data(poses);
+  if (!write_patiently(impl_->estimate_writer, w))
+    throw std::runtime_error("online channel: an estimate write failed");
+}
+
+bool OnlineChannel::wait(double timeout_s) {
+  std::unique_lock<std::mutex> lock(impl_->mutex);
+  const bool got = impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                                      [&] { return impl_->available; });
+  impl_->available = false;
+  return got;
+}
+
+std::vector<OnlineReportSample> OnlineChannel::take_reports() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (!impl_->error.empty()) throw TransportError(impl_->error);
+  std::vector<OnlineReportSample> out;
+  out.swap(impl_->reports);
+  return out;
+}
+
+std::vector<OnlineProtocolSample> OnlineChannel::take_messages() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (!impl_->error.empty()) throw TransportError(impl_->error);
+  std::vector<OnlineProtocolSample> out;
+  out.swap(impl_->messages);
+  return out;
+}
+
+int OnlineChannel::matched_peers() const {
+  int fewest = 1 << 30;
+  for (auto* w : {impl_->block_writer, impl_->status_writer}) {
+    dds::PublicationMatchedStatus s;
+    w->get_publication_matched_status(s);
+    fewest = std::min(fewest, s.current_count);
+  }
+  for (auto* r : {impl_->block_reader, impl_->status_reader}) {
+    dds::SubscriptionMatchedStatus s;
+    r->get_subscription_matched_status(s);
+    fewest = std::min(fewest, s.current_count);
+  }
+  return fewest;
+}
+
+void OnlineChannel::flush(double timeout_s) {
+  for (auto* w : {impl_->block_writer, impl_->status_writer, impl_->report_writer})
+    w->wait_for_acknowledgments(Duration_t(timeout_s));
+}
+
+}  // namespace tessera::transport

@@ -1,0 +1,80 @@
+#pragma once
+// The agents' own topics in an online run (agent/online_agent.cpp): the round protocol's pose
+// blocks and statuses, tagged with the epoch (the solve of the growing graph they belong to),
+// and the per-epoch reports (OnlineReport: batches held, block poses). Its own participant, as
+// the graph stream's: an online run has no coordinator hand-shake (the agents agree on the
+// graph through the reports), so the Session's set-up topics have nothing to carry.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <tessera/online/absorb_gate.hpp>
+#include <tessera/protocol/messages.hpp>
+#include <vector>
+
+namespace tessera::transport {
+
+inline constexpr const char* kOnlineBlockTopic = "tessera_online_block";
+inline constexpr const char* kOnlineStatusTopic = "tessera_online_status";
+inline constexpr const char* kOnlineReportTopic = "tessera_online_report";
+inline constexpr const char* kOnlineEstimateTopic = "tessera_online_estimate";
+
+struct OnlineReportSample {
+  std::uint32_t epoch = 0;
+  std::uint32_t sender = 0;
+  Watermarks held;
+  bool converged = false;
+  int rank = 0, dim = 0;
+  std::vector<std::uint32_t> pose_ids;
+  std::vector<double> data;  ///< r*(d+1) per pose, column-major.
+  /// Agent 0's reports: the agents that take part in the next epoch (joiners admitted).
+  std::vector<std::uint32_t> next_members;
+  bool certify = false;  ///< Agent 0's reports: certify at this epoch.
+};
+
+/// The epoch of a hello: an agent that is not a member yet asks to join.
+inline constexpr std::uint32_t kHelloEpoch = 0xFFFFFFFFu;
+
+/// A protocol message as received, with its routing (ids are the epoch's protocol ids).
+struct OnlineProtocolSample {
+  std::uint32_t epoch = 0;
+  std::uint32_t sender = 0;
+  bool broadcast = true;
+  std::vector<std::uint32_t> recipients;
+  ProtocolMessage message;
+};
+
+class OnlineChannel {
+ public:
+  /// Joins `domain` with partition `run_id` (validated: InputError). `agents` sizes the
+  /// history limits. Throws std::runtime_error when DDS refuses.
+  OnlineChannel(int domain, const std::string& run_id, std::uint32_t agent, std::uint32_t agents);
+  ~OnlineChannel();
+  OnlineChannel(const OnlineChannel&) = delete;
+  OnlineChannel& operator=(const OnlineChannel&) = delete;
+
+  /// Sends one protocol message of `epoch`; returns its serialized size in bytes.
+  std::size_t send(const OutgoingMessage& m, std::uint32_t epoch);
+  /// Sends a report; returns its serialized size in bytes.
+  std::size_t send_report(const OnlineReportSample& r);
+  /// Publishes this agent's robot's current estimate: pose indices and [R | t] (d*(d+1)
+  /// values per pose, column-major).
+  void publish_estimate(std::uint32_t epoch, int d, const std::vector<std::uint64_t>& index,
+                        const std::vector<double>& poses);
+  /// Blocks until something arrived since the last take (or `timeout_s` passed).
+  bool wait(double timeout_s);
+  std::vector<OnlineReportSample> take_reports();
+  std::vector<OnlineProtocolSample> take_messages();
+  /// Fewest peers matched by any of this agent's protocol writers and readers (itself
+  /// included): a message is delivered reliably to a reader its writer has matched.
+  int matched_peers() const;
+  /// Waits until every matched reader acknowledged what was sent, at most `timeout_s`.
+  void flush(double timeout_s);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tessera::transport
