@@ -231,7 +231,10 @@ def solve(tessera, graph, work, tag, extra, timeout, algorithm="centralized"):
         # N = 5 agents on contiguous id ranges (the robots of the multi-robot convention)
         cmd += ["--agents", "5", "--partition", "sequential", "--certify"]
     t0 = time.monotonic()
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    try:
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None, None, time.monotonic() - t0, f"timed out after {timeout:.0f} s"
     wall = time.monotonic() - t0
     if p.returncode != 0:
         return None, None, wall, p.stdout.strip().splitlines()[-1] if p.stdout.strip() else str(p.returncode)
@@ -262,8 +265,9 @@ def dirty_graph(args, work, name, clean, kind, fraction, optimum):
 
 
 def plot(csv_path, png_path):
-    """Three panels against F: recall and precision of the rejected set, |relative gap| to
-    f*_clean, ATE of the robust and of the plain estimate (solid random, dashed group)."""
+    """Four panels against F: recall and precision of the rejected set, |relative gap| to
+    f*_clean, ATE of the robust and of the plain estimate (centralized), and the distributed
+    run's rounds over the clean run's (solid random, dashed group)."""
     plt = bench_common.pyplot()
     with open(csv_path) as f:
         rows = list(csv.DictReader(f))
@@ -271,7 +275,7 @@ def plot(csv_path, png_path):
     for r in rows:
         if r["graph"] not in graphs:
             graphs.append(r["graph"])
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    fig, ax = plt.subplots(1, 4, figsize=(20, 4.2))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
 
     def series(g, kind, key):
@@ -300,10 +304,16 @@ def plot(csv_path, png_path):
             pts = [(x, max(y, 1e-9)) for x, y in series(g, kind, "plain_ate_m")]
             if pts:
                 ax[2].semilogy(*zip(*pts), style, color=c, marker="s", alpha=0.35)
+            pts = series(g, kind, "d_round_ratio")
+            if pts:
+                ax[3].plot(*zip(*pts), style, color=c, marker="o", label=label)
     ax[0].set(xlabel="outlier fraction F", ylabel="recall (o) / precision (x)", title="rejected set vs labels")
     ax[1].set(xlabel="outlier fraction F", ylabel="|cost - f*_clean| / f*_clean", title="cost over the kept edges")
     ax[2].set(xlabel="outlier fraction F", ylabel="ATE to the clean optimum [m]",
               title="ATE: robust (o) vs plain (faint squares)")
+    ax[3].axhline(5, color="grey", linestyle=":")
+    ax[3].set(xlabel="outlier fraction F", ylabel="rounds / clean run's rounds",
+              title="distributed (irbcd, 5 agents): all rounds")
     ax[0].set_ylim(-0.02, 1.05)
     ax[1].set_ylim(1e-16, 1e4)
     ax[0].legend(fontsize=7)
