@@ -35,7 +35,7 @@ an A/B of the start-up cost (docs/dds-runtime.md, "Fork server").
 
 `--repeat K` runs K alternated pairs (in process, then DDS) per graph and adds a line with the
 median ratio and its range: on a shared or virtual machine one pair's in-process wall alone can
-move by 20-40 % between passes (docs/dds-runtime.md, sessions 7-12), so a single pair of a short
+move by 20-40 % between passes, so a single pair of a short
 graph says little. The final median is then over the graphs' medians; the CSV has a row per pair.
 
 usage: dds_overhead.py [--bin build/bin] [--graphs CSAIL,intel] [--agents 5] [--domain 210]

@@ -83,7 +83,7 @@ def write_contract_csv(path, rows):
 
 
 def assemble(out_dir):
-    """Rebuilds faults.md from every faults_*.csv of the contract, then every faults/*.md."""
+    """Rebuilds faults.md from every faults_*.csv of the contract, with links to every faults/*.md."""
     rows, sources = [], []
     for path in sorted(glob.glob(os.path.join(out_dir, "faults_*.csv"))):
         with open(path) as f:
@@ -94,15 +94,21 @@ def assemble(out_dir):
             for r in reader:
                 rows.append(r)
         sources.append(os.path.basename(path))
-    lines = ["# Fault table (issue 8)", "",
+    lines = ["# Fault table", "",
              "Assembled by `scripts/bench/faults.py` from " + ", ".join("`%s`" % s for s in sources) +
              " (columns: %s; see scripts/bench/faults_common.py for their meaning)." % ", ".join(COLUMNS), "",
              "| fault | trials | finished | cost error | extra time (s) |", "|---|---|---|---|---|"]
     for r in rows:
         lines.append("| %s | %s | %s | %s | %s |" % tuple(r[c] for c in COLUMNS))
+    # Each experiment's notes stay in faults/<name>.md; the table links them instead of copying them.
+    notes = []
     for extra in sorted(glob.glob(os.path.join(out_dir, "faults", "*.md"))):
         with open(extra) as f:
-            lines += ["", f.read().strip()]
+            title = f.readline().lstrip("#").strip() or os.path.basename(extra)
+        notes.append("[%s](faults/%s)" % (title, os.path.basename(extra)))
+    if notes:
+        lines += ["", "Each experiment's notes (the exact command, the machine's load, a table per trial; the "
+                  "trials also in `faults/*_trials.csv`): " + ", ".join(notes) + "."]
     with open(os.path.join(out_dir, "faults.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("wrote %s (%d rows)" % (os.path.join(out_dir, "faults.md"), len(rows)))
