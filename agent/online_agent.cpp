@@ -24,6 +24,7 @@
 #include "arguments.hpp"
 #include "json_writer.hpp"
 #include "runtime/online_agent_view.hpp"
+#include "transport/fastdds/teardown_guard.hpp"
 #include "transport/graph_stream_topic.hpp"
 #include "transport/online_channel.hpp"
 #include "transport/run_identity.hpp"
@@ -629,21 +630,31 @@ bool wants_online(const std::vector<std::string>& argv) {
 }
 
 int online_agent_main(const std::vector<std::string>& argv) {
+  std::unique_ptr<OnlineAgent> agent;
+  int code = 0;
   try {
     if (std::find(argv.begin(), argv.end(), "--help") != argv.end()) {
       std::fputs(kOnlineUsage, stdout);
       return 0;
     }
     const Options o = parse(argv);
-    OnlineAgent agent(o);
-    return agent.run();
+    agent = std::make_unique<OnlineAgent>(o);
+    code = agent->run();
   } catch (const InputError& e) {
     std::cerr << "tessera-agent: error: " << e.what() << "\n";
-    return 2;
+    code = 2;
   } catch (const std::exception& e) {
-    std::cerr << "tessera-agent: run failed: " << e.what() << "\n";
-    return 1;
+    std::cerr << "tessera-agent: run failed: " << e.what() << std::endl;
+    code = 1;
   }
+  // The result or the error is out; deleting the participants comes last and is bounded, since
+  // Fast DDS 2.9 can hang or abort there while a peer's removal races with it
+  // (transport/fastdds/teardown_guard.hpp): a hang must not keep a failed or finished agent alive.
+  if (agent) {
+    const transport::TeardownGuard guard(code, "tessera-agent", std::chrono::seconds(5));
+    agent.reset();
+  }
+  return code;
 }
 
 }  // namespace tessera::agent

@@ -31,6 +31,9 @@ using eprosima::fastrtps::types::ReturnCode_t;
 namespace {
 // Reports kept per agent for joiners: one per epoch boundary.
 constexpr std::int32_t kReportHistory = 100000;
+// Participant lease of an online agent, seconds (Session's default is 1 s; 2 s leaves room for
+// a loaded host, where 1 s once declared a live peer lost).
+constexpr double kOnlineLeaseS = 2.0;
 }  // namespace
 
 // A reliable write that finds the bounded history full of samples some reader has not
@@ -68,6 +71,12 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     dds::DomainParticipantQos pq = dds::PARTICIPANT_QOS_DEFAULT;
     // Not "tessera:<run>:..." (participant_name): not a Session peer of any run.
     pq.name("tessera-online:" + run_id + ":" + std::to_string(me));
+    // A killed agent's readers stay matched until its participant lease expires, and writes
+    // to them wait for acknowledgements meanwhile: Fast DDS's default lease (20 s) would hold
+    // the survivors that long before their report wait can name the silent agent.
+    pq.wire_protocol().builtin.discovery_config.leaseDuration = Duration_t(kOnlineLeaseS);
+    pq.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod =
+        Duration_t(kOnlineLeaseS / 5.0);
     auto* factory = dds::DomainParticipantFactory::get_instance();
     participant = factory->create_participant(domain, pq);
     if (!participant)
