@@ -9,31 +9,14 @@
 #include <tessera/robust/gnc_distributed.hpp>
 #include <vector>
 
+#include "gnc_fixtures.hpp"
+
 namespace tessera {
 namespace {
 
-GeneratorResult grid_with_outliers(double fraction) {
-  GeneratorOptions o;
-  o.kind = TrajectoryKind::kGrid3d;
-  o.num_poses = 125;
-  o.num_robots = 5;
-  o.seed = 3;
-  o.outlier_fraction = fraction;
-  return generate_pose_graph(o);
-}
-
-// The generator's robots as the blocks: robot r owns a contiguous id range.
-std::vector<int> robots_as_blocks(const GeneratorResult& r) {
-  return std::vector<int>(r.robot_of.begin(), r.robot_of.end());
-}
-
-GncDistributedOptions irbcd_gnc() {
-  GncDistributedOptions o;
-  o.robust.kind = RobustKind::kGncTls;
-  o.solver.algorithm = DistributedAlgorithm::kIrbcd;
-  o.solver.grad_norm_tol = 1e-3;
-  return o;
-}
+using test::grid_with_outliers;
+using test::irbcd_gnc;
+using test::robots_as_blocks;
 
 TEST(GncDistributed, EveryWeightIsComputedByExactlyTheOwnerOfTheLowerPose) {
   const GeneratorResult r = grid_with_outliers(0.25);

@@ -6,30 +6,14 @@
 #include <tessera/robust/gnc_distributed.hpp>
 #include <vector>
 
+#include "gnc_fixtures.hpp"
+
 namespace tessera {
 namespace {
 
-GeneratorResult grid(double fraction, std::uint64_t seed = 3) {
-  GeneratorOptions o;
-  o.kind = TrajectoryKind::kGrid3d;
-  o.num_poses = 125;
-  o.num_robots = 5;
-  o.seed = seed;
-  o.outlier_fraction = fraction;
-  return generate_pose_graph(o);
-}
-
-std::vector<int> robots_as_blocks(const GeneratorResult& r) {
-  return std::vector<int>(r.robot_of.begin(), r.robot_of.end());
-}
-
-GncDistributedOptions irbcd_gnc() {
-  GncDistributedOptions o;
-  o.robust.kind = RobustKind::kGncTls;
-  o.solver.algorithm = DistributedAlgorithm::kIrbcd;
-  o.solver.grad_norm_tol = 1e-3;
-  return o;
-}
+using test::grid_with_outliers;
+using test::irbcd_gnc;
+using test::robots_as_blocks;
 
 GncDistributedResult run(const GeneratorResult& r, int cap, double mu_step, bool known_start) {
   GncDistributedOptions o = irbcd_gnc();
@@ -40,7 +24,7 @@ GncDistributedResult run(const GeneratorResult& r, int cap, double mu_step, bool
 }
 
 TEST(GncSchedule, CappedSolvesRejectTheSameSetAsFullSolvesInAFractionOfTheRounds) {
-  const GeneratorResult r = grid(0.25);
+  const GeneratorResult r = grid_with_outliers(0.25);
   ASSERT_FALSE(r.outliers.empty());
   const GncDistributedResult full = run(r, 0, 1.4, true);
   const GncDistributedResult capped = run(r, RobustOptions{}.inner_max_rounds, 1.4, true);
@@ -54,7 +38,7 @@ TEST(GncSchedule, TrueClosuresMisjudgedOnARoughIterateAreReadmitted) {
   // One round between weight updates and a steep mu schedule: the iterate lags, some true
   // closures still look wrong when their weights reach 0, and the check at the inlier set's
   // solution takes them back.
-  const GeneratorResult r = grid(0.25);
+  const GeneratorResult r = grid_with_outliers(0.25);
   const GncDistributedResult g = run(r, 1, 4.0, true);
   EXPECT_GT(g.readmitted, 0u);
   EXPECT_EQ(g.rejected, r.outliers);
@@ -64,7 +48,7 @@ TEST(GncSchedule, TrueClosuresMisjudgedOnARoughIterateAreReadmitted) {
 TEST(GncSchedule, ACleanGraphStartsWhereThePlainSolveStarts) {
   // On clean data the solver's own (chordal) start has the lower TLS cost: nothing to
   // reject, no outer step, and the rounds of the plain solve plus the capped first solve.
-  const GeneratorResult clean = grid(0.0);
+  const GeneratorResult clean = grid_with_outliers(0.0);
   const GncDistributedResult g = run(clean, RobustOptions{}.inner_max_rounds, 1.4, true);
   const DistributedResult plain =
       solve_distributed(clean.graph, robots_as_blocks(clean), irbcd_gnc().solver);
@@ -75,7 +59,7 @@ TEST(GncSchedule, ACleanGraphStartsWhereThePlainSolveStarts) {
 
 TEST(GncSchedule, TheKnownInliersStartNeedsFewerRoundsThanTheChordalStart) {
   // The chordal guess fits the wrong closures too; the odometry chains do not see them.
-  const GeneratorResult r = grid(0.25);
+  const GeneratorResult r = grid_with_outliers(0.25);
   const GncDistributedResult known = run(r, 1, 1.4, true);
   const GncDistributedResult chordal = run(r, 1, 1.4, false);
   EXPECT_EQ(known.rejected, r.outliers);
@@ -83,7 +67,7 @@ TEST(GncSchedule, TheKnownInliersStartNeedsFewerRoundsThanTheChordalStart) {
 }
 
 TEST(GncSchedule, WithoutConnectedKnownInliersTheSolversOwnStartIsUsed) {
-  const GeneratorResult clean = grid(0.0);
+  const GeneratorResult clean = grid_with_outliers(0.0);
   GncDistributedOptions o = irbcd_gnc();
   o.robust.known_inliers = KnownInliers::kNone;  // nothing known: no chain to start from
   const GncDistributedResult r = solve_gnc_distributed(clean.graph, robots_as_blocks(clean), o);

@@ -1,0 +1,27 @@
+#include "gnc_fixtures.hpp"
+
+namespace tessera::test {
+
+GeneratorResult grid_with_outliers(double fraction, std::uint64_t seed) {
+  GeneratorOptions o;
+  o.kind = TrajectoryKind::kGrid3d;
+  o.num_poses = 125;
+  o.num_robots = 5;
+  o.seed = seed;
+  o.outlier_fraction = fraction;
+  return generate_pose_graph(o);
+}
+
+std::vector<int> robots_as_blocks(const GeneratorResult& r) {
+  return std::vector<int>(r.robot_of.begin(), r.robot_of.end());
+}
+
+GncDistributedOptions irbcd_gnc() {
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.algorithm = DistributedAlgorithm::kIrbcd;
+  o.solver.grad_norm_tol = 1e-3;
+  return o;
+}
+
+}  // namespace tessera::test

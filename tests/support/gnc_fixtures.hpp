@@ -1,0 +1,18 @@
+#pragma once
+// Shared fixtures of the distributed GNC-TLS tests: a small generated grid with outliers, its
+// robots as the blocks, and IRBCD inside GNC-TLS.
+#include <cstdint>
+#include <tessera/generate/generator.hpp>
+#include <tessera/robust/gnc_distributed.hpp>
+#include <vector>
+
+namespace tessera::test {
+
+/// 125-pose 3D grid of 5 robots with `fraction` of its loop closures as random outliers.
+GeneratorResult grid_with_outliers(double fraction, std::uint64_t seed = 3);
+/// The generator's robots as the blocks: robot r owns a contiguous id range.
+std::vector<int> robots_as_blocks(const GeneratorResult& r);
+/// GNC-TLS around IRBCD, solved to a gradient norm of 1e-3.
+GncDistributedOptions irbcd_gnc();
+
+}  // namespace tessera::test
