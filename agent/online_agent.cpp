@@ -309,24 +309,27 @@ SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
   auto last_message = Clock::now();
   while (!agent.done()) {
     bool handled = false;
-    for (std::size_t k = 0; k < pending_.size() && !agent.done();) {
-      const auto& m = pending_[k];
-      if (m.epoch != epoch_ || m.sender == me ||
-          !(m.broadcast ||
-            std::find(m.recipients.begin(), m.recipients.end(), me) != m.recipients.end())) {
-        // Older epochs' leftovers go; later epochs' wait for their solve.
-        if (m.epoch < epoch_ || m.epoch == epoch_) {
-          pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(k));
-        } else {
-          ++k;
-        }
-        continue;
+    // One pass over the queue, compacting it in place (no erase from its middle per message):
+    // this epoch's messages for this agent are handled in arrival order, later epochs' wait for
+    // their solve, older epochs' leftovers and messages for others go. Once the solve is done,
+    // the rest stays queued as it is.
+    std::size_t keep = 0, k = 0;
+    for (; k < pending_.size() && !agent.done(); ++k) {
+      auto& m = pending_[k];
+      const bool mine = m.epoch == epoch_ && m.sender != me &&
+                        (m.broadcast || std::find(m.recipients.begin(), m.recipients.end(), me) !=
+                                            m.recipients.end());
+      if (mine) {
+        send(agent.handle(m.message), epoch_);
+        handled = true;
+      } else if (m.epoch > epoch_) {
+        if (keep != k) pending_[keep] = std::move(m);
+        ++keep;
       }
-      ProtocolMessage msg = std::move(pending_[k].message);
-      pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(k));
-      send(agent.handle(msg), epoch_);
-      handled = true;
     }
+    for (; k < pending_.size(); ++k, ++keep)
+      if (keep != k) pending_[keep] = std::move(pending_[k]);
+    pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(keep), pending_.end());
     if (agent.done()) break;
     if (handled) {
       last_message = Clock::now();
