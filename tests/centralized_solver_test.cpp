@@ -81,6 +81,33 @@ TEST_P(CentralizedTest, CertificateEigenvalueMatchesDenseComputation) {
   EXPECT_NEAR(c2.min_eigenvector.dot(S2 * c2.min_eigenvector), dense_min2, 1e-6 * S2.norm());
 }
 
+// Once the factorization has certified X, lambda_min is only reported, and the Lanczos run starts
+// from X's rows (S's null space at a critical point): a narrow Krylov space gives the same value
+// as the wide cold start with far fewer solves.
+TEST_P(CentralizedTest, CertifiedEigenvalueFromTheSolutionsRowsNeedsFewSolves) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 80, 40, 0.05, 0.05, 3});
+  const BlockProblem P = BlockProblem::whole_graph(d, g.num_poses, g.measurements);
+  const CentralizedResult r = solve_centralized(g);
+  ASSERT_TRUE(*r.certified);
+  CertificateOptions cold;
+  cold.certified_lanczos_subspace = cold.lanczos_subspace;  // as wide as the random start's
+  const CertificateResult warm = verify_certificate(P, r.X);
+  const CertificateResult wide = verify_certificate(P, r.X, cold);
+  ASSERT_TRUE(warm.certified);
+  EXPECT_LE(warm.lanczos_solves, CertificateOptions{}.certified_lanczos_subspace + 1);
+  EXPECT_LT(warm.lanczos_solves, wide.lanczos_solves);
+  EXPECT_NEAR(warm.min_eigenvalue, wide.min_eigenvalue, 1e-3 * warm.tolerance);
+  CertificateOptions bad;
+  bad.certified_lanczos_subspace = 2;
+  try {
+    verify_certificate(P, r.X, bad);
+    ADD_FAILURE() << "a subspace of 2 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("certified_lanczos_subspace"), std::string::npos);
+  }
+}
+
 TEST(CentralizedSolver, StaircaseEscapesFromRankDeficientSaddle) {
   // With large rotation noise and an odometry start at rank r = d, this graph's rank-2 solve
   // stops at a critical point that the certificate rejects; the solver must escape along
