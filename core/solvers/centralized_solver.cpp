@@ -122,7 +122,13 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   std::vector<Pose> init;
   switch (options.initialization) {
     case Initialization::kChordal:
-      init = chordal_initialization(graph);
+      // With translation elimination the trust region replaces the start's translations by
+      // their exact minimiser before its first step (the same weighted Laplacian solve), so
+      // the chordal start's own translation solve would be done twice.
+      init = options.eliminate_translations
+                 ? assemble_poses(chordal_rotations(graph),
+                                  Eigen::MatrixXd::Zero(graph.d, graph.num_poses))
+                 : chordal_initialization(graph);
       break;
     case Initialization::kOdometry:
       init = odometry_initialization(graph);
@@ -167,6 +173,9 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     tr.rel_cost_decrease_tol = std::min(tr.rel_cost_decrease_tol, 1e-14);
   }
   {
+    // The relative tolerance is measured at the start the trust region sees: with elimination
+    // its translations are the exact ones (the chordal start above has none yet).
+    if (refine) refine(X);
     const LiftedManifold M = problem.manifold(graph.d);
     const double g0 = M.tangent_project(X, problem.euclidean_gradient(X)).norm();
     tr.grad_norm_tol = options.trust_region.grad_norm_tol * std::max(1.0, g0);
@@ -218,7 +227,19 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   // Report X at the relaxation rank: the rows that were never active are zero.
   if (X.rows() < res.final_rank) X = pad_rank(X, res.final_rank - static_cast<int>(X.rows()));
   res.X = X;
-  res.poses = round_solution(graph, X);
+  if (elimination) {
+    // The rounded rotations' optimal translations through the factor computed once above
+    // (round_solution would build and factor the same Laplacian again).
+    const Eigen::MatrixXd R = round_rotations(X, graph.d);
+    Eigen::MatrixXd rounded =
+        lift_poses(assemble_poses(R, Eigen::MatrixXd::Zero(graph.d, graph.num_poses)), graph.d);
+    elimination->optimize_translations(rounded);
+    res.poses = assemble_poses(R, Eigen::MatrixXd::Zero(graph.d, graph.num_poses));
+    for (std::size_t i = 0; i < graph.num_poses; ++i)
+      res.poses[i].t = rounded.col((graph.d + 1) * static_cast<Eigen::Index>(i) + graph.d);
+  } else {
+    res.poses = round_solution(graph, X);
+  }
   res.cost = evaluate_objective(graph, res.poses);
   res.total_s = seconds_since(start);
   return res;
