@@ -218,6 +218,30 @@ TEST(CentralizedSolver, RejectsInvalidOptionsNamingTheField) {
     EXPECT_NE(std::string(e.what()).find("certified_lanczos_tolerance"), std::string::npos)
         << e.what();
   }
+  CentralizedOptions opt4;
+  opt4.threads = 3;
+  try {
+    solve_centralized(g, opt4);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("threads"), std::string::npos) << e.what();
+  }
+}
+
+// The second thread only moves the preconditioner's factorization off the start's critical
+// path: one and two threads give the same iterates, bit for bit.
+TEST_P(CentralizedTest, OneAndTwoThreadsGiveTheSameIterates) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 60, 30, 0.05, 0.05, 8});
+  CentralizedOptions one;
+  one.threads = 1;
+  CentralizedOptions two;
+  two.threads = 2;
+  const CentralizedResult a = solve_centralized(g, one);
+  const CentralizedResult b = solve_centralized(g, two);
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_EQ(a.cost, b.cost);
+  EXPECT_EQ(a.X, b.X);
 }
 
 TEST(CentralizedSolver, ReferenceStopSavesStepsAndStaysWithinItsAccuracy) {

@@ -1,5 +1,6 @@
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <memory>
 #include <sstream>
 #include <tessera/problem/block_problem.hpp>
@@ -59,6 +60,7 @@ void CentralizedOptions::validate() const {
     throw InputError("CentralizedOptions.certified_lanczos_tolerance must be in (0, 1)");
   if (!(preconditioner_shift > 0))
     throw InputError("CentralizedOptions.preconditioner_shift must be > 0");
+  if (threads < 1 || threads > 2) throw InputError("CentralizedOptions.threads must be 1 or 2");
   trust_region.validate();
   certificate.validate();
 }
@@ -119,6 +121,20 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   const auto start = Clock::now();
   CentralizedResult res;
 
+  const BlockProblem problem =
+      BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
+  // Always the exact factor, and always simplicial LDL^T: its solves with r right-hand sides are
+  // what the tCG repeats (docs/centralized-solver.md). The distributed blocks' switch to
+  // supernodal above 1 M entries made cubicle's and city10000's whole-graph factors supernodal:
+  // CPU in alternated pairs (load 7-8) cubicle 1.41/1.80/2.50 s simplicial vs 1.67/1.99/2.28 s,
+  // city10000 1.28/1.12/1.18 vs 1.39/1.84/1.41.
+  const auto build_preconditioner = [&problem, &options] {
+    return std::make_unique<BlockPreconditioner>(problem, options.preconditioner_shift, 0, 0);
+  };
+  // The factorization does not depend on the start: with a second thread it runs while the
+  // start is computed (each CHOLMOD factor has its own workspace, so the two do not share state).
+  std::future<std::unique_ptr<BlockPreconditioner>> pending;
+  if (options.threads > 1) pending = std::async(std::launch::async, build_preconditioner);
   std::vector<Pose> init;
   switch (options.initialization) {
     case Initialization::kChordal:
@@ -139,14 +155,6 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
       init = graph.initial;
       break;
   }
-  const BlockProblem problem =
-      BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
-  // Always the exact factor, and always simplicial LDL^T: its solves with r right-hand sides are
-  // what the tCG repeats (docs/centralized-solver.md). The distributed blocks' switch to
-  // supernodal above 1 M entries made cubicle's and city10000's whole-graph factors supernodal:
-  // CPU in alternated pairs (load 7-8) cubicle 1.41/1.80/2.50 s simplicial vs 1.67/1.99/2.28 s,
-  // city10000 1.28/1.12/1.18 vs 1.39/1.84/1.41.
-  const BlockPreconditioner precon(problem, options.preconditioner_shift, 0, 0);
   std::unique_ptr<TranslationElimination> elimination;
   PointRefinement refine;
   if (options.eliminate_translations) {
@@ -154,6 +162,9 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
         std::make_unique<TranslationElimination>(graph.d, graph.num_poses, graph.measurements);
     refine = [&elimination](Eigen::MatrixXd& Y) { elimination->optimize_translations(Y); };
   }
+  const std::unique_ptr<BlockPreconditioner> precon_factor =
+      pending.valid() ? pending.get() : build_preconditioner();
+  const BlockPreconditioner& precon = *precon_factor;
   // Only the rows of X that can be non-zero are stored ("active rows"). The lifted initial
   // guess [I_d; 0] R has r - d zero rows, and the trust region keeps them exactly zero (the
   // gradient, the Hessian, the row-wise preconditioner, the tangent projection and the polar
