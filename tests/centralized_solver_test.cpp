@@ -301,6 +301,25 @@ TEST(TrustRegion, PairedGradientAndPredictedDecreaseStopsEndTheRunWhereTheyHold)
   }
 }
 
+// With the prediction on, a step that decreased f by little ends the run only where the model
+// also predicts little: a loose relative-decrease tolerance alone stops after the first accepted
+// step here, the pair only where the prediction holds.
+TEST(TrustRegion, ASmallDecreaseStopsOnlyWhereThePredictionAgrees) {
+  auto g = test::random_pose_graph({3, 30, 20, 0.05, 0.1, 5});
+  const BlockProblem P = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  const Eigen::MatrixXd X0 = lift_poses(g.initial, 3);
+  TrustRegionOptions loose;
+  loose.rel_cost_decrease_tol = 0.99;  // any accepted step "decreases f by less than 0.99 f"
+  const TrustRegionResult alone = solve_trust_region(P, X0, loose);
+  EXPECT_EQ(alone.stop_reason, "relative_decrease");
+  loose.predicted_rel_decrease_tol = 1e-6;
+  const TrustRegionResult paired = solve_trust_region(P, X0, loose);
+  EXPECT_GT(paired.iterations, alone.iterations);
+  ASSERT_FALSE(paired.trace.empty());
+  EXPECT_LE(paired.trace.back().predicted_decrease, 1e-6 * paired.cost);
+  EXPECT_LT(paired.cost, alone.cost);
+}
+
 struct GeneratedCase {
   TrajectoryKind kind;
   std::size_t poses;
