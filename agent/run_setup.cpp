@@ -138,20 +138,28 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   DdsProtocolChannel channel(s);
   const RunOptions run_options = run_options_of(asg);
   {
-    // A robust run starts from the known inliers alone when they connect the poses, like the
-    // in-process engine (robust/gnc_distributed.hpp, gnc_start()).
+    // A robust run also computes the known inliers' start when they connect the poses; the
+    // agents vote between the two before the first solve, like the in-process engine
+    // (robust/gnc_distributed.hpp, known_inlier_poses(); robust/gnc_agent.hpp).
     std::optional<KnownInlierStart> known;
     if (run_options.robust.kind != RobustKind::kNone && run_options.gnc_known_start)
       known = known_inlier_start(share, structure, run_options.robust.known_inliers);
-    InitializationResult init =
-        known ? run_initialization_stage(known->share, o.id, o.robots, known->structure,
-                                         "distributed", o.graph, channel, o.round_timeout_s)
-              : run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(),
-                                         o.graph, channel, o.round_timeout_s);
-    if (known) init.method += " (known inliers)";
-    share.initial = std::move(init.poses);
-    log("initialisation '" + init.method + "' done in " +
-        std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
+    if (known) {
+      auto [init, known_init] = run_initialization_stages(
+          share, known->share, o.id, o.robots, structure, known->structure, asg.initialization(),
+          "distributed", o.graph, channel, o.round_timeout_s);
+      share.initial = std::move(init.poses);
+      share.known_initial = std::move(known_init.poses);
+      log("initialisation '" + init.method + "' and 'distributed' of the known inliers done in " +
+          std::to_string(static_cast<long>((init.seconds + known_init.seconds) * 1000)) + " ms");
+    } else {
+      InitializationResult init =
+          run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(), o.graph,
+                                   channel, o.round_timeout_s);
+      share.initial = std::move(init.poses);
+      log("initialisation '" + init.method + "' done in " +
+          std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
+    }
   }
 
   // 7. Hand-off, peer to peer: exactly one message to every other agent. A peer sends its

@@ -75,9 +75,6 @@ GncDistributedOptions in_process_options() {
   o.robust.kind = RobustKind::kGncTls;
   o.solver.seed = 7;
   o.solver.certify = true;
-  // What the DDS agents do: one start (no vote), the first inlier pass from the GNC iterate.
-  o.start_vote = false;
-  o.inlier_set_start = false;
   return o;
 }
 

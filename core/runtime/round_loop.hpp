@@ -66,6 +66,9 @@ struct AgentLocalData {
   std::vector<std::uint64_t> measurement_index;
   /// Initial poses of `owned` (same order), from the initialisation stage.
   std::vector<Pose> initial;
+  /// A robust run's second candidate start of `owned` (same order), the known inliers'
+  /// initialization (GncAgentInput::Y0_known), or empty.
+  std::vector<Pose> known_initial;
   /// When not empty: the lifted starting point of `owned` (r x (d+1)m, same order), used
   /// instead of lifting `initial` (a run continued by survivors after a permanent loss).
   Eigen::MatrixXd lifted_start;
