@@ -431,7 +431,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   if (!done_ && step_ == step && exchange_phase() == phase && waiting_.empty()) after_exchange(out);
 }
 
-void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
+void GncAgent::require_kept_connected() const {
   // The kept set must connect every pose (every agent checks the same set).
   const std::size_t parts =
       components_without(in_.num_poses, in_.d, in_.structure, rejected_, false, known_);
@@ -442,6 +442,10 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
                      std::to_string(parts) +
                      " unconnected parts, so no estimate is defined (too few consistent "
                      "measurements; try --known-inliers odometry or a larger --inlier-threshold)");
+}
+
+void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
+  require_kept_connected();
   kept_.clear();
   kept_index_.clear();
   for (std::size_t k = 0; k < in_.measurements.size(); ++k)
@@ -585,6 +589,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       std::sort(rejected_.begin(), rejected_.end());
       // Nothing rejected: the GNC iterate is already the plain solve's.
       if (fresh_start_ && !rejected_.empty()) {
+        require_kept_connected();  // before initializing the kept set
         begin_exchange(Step::kKeptStart, out);
         return;
       }

@@ -19,10 +19,12 @@ struct KnownInlierStart {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;  ///< Known inliers only.
 };
 
-/// `share` and `structure` restricted to the measurements `rule` says are known inliers, or
-/// nullopt when those leave the poses unconnected (the run's own initialization is used then).
+/// `share` and `structure` restricted to the known inliers (by `rule`, or flagged in `flags`:
+/// empty or one per measurement of `structure`, the share's measurement_index being positions
+/// in it), or nullopt when those leave the poses unconnected (the run's own initialization is
+/// used then).
 std::optional<KnownInlierStart> known_inlier_start(
     const RobotShare& share, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
-    KnownInliers rule);
+    KnownInliers rule, const std::vector<bool>& flags = {});
 
 }  // namespace tessera::agent

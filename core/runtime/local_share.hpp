@@ -25,6 +25,9 @@ struct RobotShare {
   /// A robust run's second candidate start of [begin, end) (the known inliers'
   /// initialization, runtime/known_inlier_start.hpp), or empty.
   std::vector<Pose> known_initial;
+  /// measurement_index values of the share's measurements flagged as known inliers (a robot
+  /// file's '# tessera-known-inliers' line, from a dpgo CSV file), ascending.
+  std::vector<std::uint64_t> known_inlier_index;
 };
 
 /// Throws InputError (naming graph.source) when N > n.

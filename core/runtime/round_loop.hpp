@@ -76,6 +76,9 @@ struct AgentLocalData {
   /// enough for core's make_block_layout, so every agent builds the same layout (neighbours,
   /// public poses, colouring).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;
+  /// Empty, or one flag per measurement of `structure`: true = a known inlier by the input's
+  /// own flag (a dpgo CSV file's is_known_inlier; the coordinator's assignment carries them).
+  std::vector<bool> known_inlier;
   RunOptions options;
 };
 

@@ -195,6 +195,7 @@ class GncAgent : public AgentProcess {
                std::vector<OutgoingMessage>& out);
   bool may_reject(std::size_t k) const;
   void weights_at_mu(double mu);
+  void require_kept_connected() const;  // throws InputError naming the parts left
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
   void finish(std::vector<OutgoingMessage>& out);
   void start_kept_set(std::vector<OutgoingMessage>& out);
