@@ -293,5 +293,34 @@ TEST(DdsRobust, ACsvKnownInlierFlagIsNeverRejectedOverDds) {
   EXPECT_EQ(std::count(unflagged.rejected.begin(), unflagged.rejected.end(), flagged), 1);
 }
 
+// --robust pcm-gnc over DDS: agent 0 runs the pairwise consistency check on the values the
+// others send it, every agent starts GNC with the inconsistent closures at weight 0; the run
+// equals the in-process engine and finds a group of mutually consistent wrong closures.
+TEST(DdsRobust, PcmGncOverDdsEqualsTheInProcessEngine) {
+  const std::string dir = temp_dir();
+  const std::string graph = generate_graph(dir + "/graph.g2o",
+                                           "--kind grid3d --poses 216 --robots 3 --seed 4 "
+                                           "--outliers 0.1 --outlier-kind group --labels " +
+                                               dir + "/labels.json");
+  const std::string run = "robust-pcm-" + std::to_string(getpid());
+  run_to_the_end(dir, graph, 3, run, 72,
+                 {"--timeout", "20", "--run-timeout", "120", "--summary", dir + "/summary.json",
+                  "--partition", "sequential", "--seed", "7", "--certify", "--robust", "pcm-gnc"},
+                 120);
+  const std::string summary = slurp(dir + "/summary.json");
+  const PoseGraph g = read_g2o(graph);
+  const std::vector<int> assignment = assignment_of(dir, 3);
+  GncDistributedOptions o = in_process_options();
+  o.robust.kind = RobustKind::kPcmGnc;
+  const GncDistributedResult ref = solve_gnc_distributed(g, assignment, o);
+  EXPECT_NE(summary.find("\"robust\": \"pcm-gnc\""), std::string::npos) << summary;
+  EXPECT_EQ(json_field(summary, "outer_iterations"), ref.outer_iterations) << summary;
+  EXPECT_EQ(json_field(summary, "rounds"), ref.total_rounds) << summary;
+  EXPECT_EQ(json_array(summary, "rejected"), ref.rejected) << summary;
+  EXPECT_NEAR(json_field(summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  EXPECT_NE(summary.find("\"certified\": true"), std::string::npos) << summary;
+  EXPECT_EQ(ref.rejected, json_array(slurp(dir + "/labels.json"), "outliers"));
+}
+
 }  // namespace
 }  // namespace tessera::test::dds

@@ -6,6 +6,7 @@
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/robust/gnc_agent.hpp>
+#include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
@@ -81,6 +82,7 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
     throw InputError("RobustOptions.max_outer_iterations + readmission_passes must be <= " +
                      std::to_string(kMaxGncSteps - 4) + " for the distributed solve");
   fresh_start_ = in_.kept_set_start && in_.initialization == DistributedInit::kChordal;
+  dropped_.assign(in_.measurements.size(), false);
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   layout_ = std::make_unique<BlockLayout>(*base_);
   // Every agent knows every measurement's known-inlier status (rule + flags), hence how many may
@@ -174,15 +176,25 @@ void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t p
 
 void GncAgent::weights_at_mu(double mu) {
   for (std::size_t k : owned_)
-    if (may_reject(k)) weights_[k] = tls_weight(residual_squared_at(k), c2_, mu);
+    if (may_reject(k) && !dropped_[k]) weights_[k] = tls_weight(residual_squared_at(k), c2_, mu);
 }
 
 std::vector<OutgoingMessage> GncAgent::start() {
   std::vector<OutgoingMessage> out;
-  if (in_.Y0_known.size() > 0)
+  if (in_.pcm) {
+    if (!known_connected_) {
+      const std::string why =
+          "robust pcm-gnc: the known inliers do not connect the poses, so there is no odometry "
+          "to test closures against (use --robust gnc-tls)";
+      if (in_.source.empty()) throw InputError(why);
+      throw InputError(in_.source, 0, why);
+    }
+    begin_exchange(Step::kPcm, out);
+  } else if (in_.Y0_known.size() > 0) {
     begin_exchange(Step::kStartPoses, out);
-  else
+  } else {
     begin_solve(out);
+  }
   return out;
 }
 
@@ -252,6 +264,8 @@ std::uint32_t GncAgent::exchange_phase() const {
       return gnc_phase(g_, GncExchange::kCandidatePoses);
     case Step::kCandidateVotes:
       return gnc_phase(g_, GncExchange::kCandidateVotes);
+    case Step::kPcm:
+      return gnc_phase(g_, in_.id == 0 ? GncExchange::kPcmValues : GncExchange::kPcmDropped);
     case Step::kStartPoses:
       return gnc_phase(g_, GncExchange::kStartPoses);
     case Step::kStartVotes:
@@ -315,6 +329,29 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       to_others(st, true, nullptr);
       break;
     }
+    case Step::kPcm:
+      if (me != 0) {
+        // Every measurement this agent weighs goes to agent 0 (each measurement once).
+        std::vector<const Measurement*> values;
+        std::vector<std::uint64_t> index;
+        for (std::size_t k : owned_) {
+          values.push_back(&in_.measurements[k]);
+          index.push_back(in_.measurement_index[k]);
+        }
+        out.push_back(
+            OutgoingMessage{encode_measurement_block(me, gnc_phase(g_, GncExchange::kPcmValues),
+                                                     in_.d, values, index),
+                            false,
+                            {0}});
+        waiting_.push_back(0);
+      } else {
+        kept_values_.clear();
+        for (std::size_t k : owned_)
+          kept_values_.emplace_back(in_.measurement_index[k], in_.measurements[k]);
+        for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
+          waiting_.push_back(a);
+      }
+      break;
     case Step::kKeptStart:
       if (me != 0) {
         // The kept measurements this agent weighs go to agent 0 (each measurement once).
@@ -367,7 +404,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // mu's start needs the largest residual over every measurement that may be rejected.
       double max_r2 = 0;
       for (std::size_t k : owned_)
-        if (may_reject(k)) max_r2 = std::max(max_r2, residual_squared_at(k));
+        if (may_reject(k) && !dropped_[k]) max_r2 = std::max(max_r2, residual_squared_at(k));
       votes_[me] = {max_r2, 0};
       RoundStatusMessage st;
       st.cost = max_r2;
@@ -476,6 +513,34 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   solve_kind_ = Solve::kFinal;
   ++g_;
   begin_solve(out);
+}
+
+void GncAgent::after_step_zero(std::vector<OutgoingMessage>& out) {
+  first_solve_g_ = ++g_;
+  begin_solve(out);
+}
+
+void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
+  // Weight 0 from the start, never re-weighted (the inlier passes may take them back).
+  zero_cut_.clear();
+  for (std::uint64_t id : ids) {
+    if (id >= in_.structure.size())
+      throw std::runtime_error("robust pcm-gnc: measurement " + std::to_string(id) +
+                               " out of range");
+    const auto pos =
+        std::lower_bound(in_.measurement_index.begin(), in_.measurement_index.end(), id);
+    if (pos != in_.measurement_index.end() && *pos == id) {
+      const auto k = static_cast<std::size_t>(pos - in_.measurement_index.begin());
+      dropped_[k] = true;
+      weights_[k] = 0.0;
+    }
+    const auto& [i, j] = in_.structure[id];
+    if (in_.owner[i] != in_.owner[j]) zero_cut_.push_back(id);
+  }
+  // They leave the solves (the known inliers connect the poses): the layout without them.
+  std::sort(zero_cut_.begin(), zero_cut_.end());
+  layout_ = std::make_unique<BlockLayout>(
+      make_block_layout(in_.num_poses, without(in_.structure, zero_cut_), in_.owner));
 }
 
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
@@ -599,6 +664,41 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       if (in_.id == 0) start_kept_set(out);
       begin_exchange(Step::kCandidatePoses, out);
       return;
+    case Step::kPcm: {
+      if (in_.id == 0) {
+        // The whole graph in file order, as the in-process engine's check sees it.
+        std::sort(kept_values_.begin(), kept_values_.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        PoseGraph graph;
+        graph.d = in_.d;
+        graph.num_poses = in_.num_poses;
+        graph.source = in_.source;
+        for (auto& [e, m] : kept_values_) graph.measurements.push_back(std::move(m));
+        kept_values_.clear();
+        if (graph.measurements.size() != in_.structure.size())
+          throw std::runtime_error("robust pcm-gnc: agent 0 has " +
+                                   std::to_string(graph.measurements.size()) + " of " +
+                                   std::to_string(in_.structure.size()) + " measurements");
+        PoseGraph chains = graph;
+        chains.measurements.clear();
+        for (std::size_t e = 0; e < graph.measurements.size(); ++e)
+          if (known_[e]) chains.measurements.push_back(graph.measurements[e]);
+        const PairwiseConsistencyResult pcm =
+            pairwise_consistency(graph, known_, distributed_initialization(chains, 1), c2_);
+        const std::vector<std::uint64_t> ids(pcm.inconsistent.begin(), pcm.inconsistent.end());
+        RoundStatusMessage st;
+        st.sender = 0;
+        st.phase = gnc_phase(g_, GncExchange::kPcmDropped);
+        st.measurement_ids = ids;
+        if (in_.num_agents > 1) out.push_back(OutgoingMessage{std::move(st), true, {}});
+        drop_inconsistent(ids);
+      }
+      if (in_.Y0_known.size() > 0)
+        begin_exchange(Step::kStartPoses, out);
+      else
+        after_step_zero(out);
+      return;
+    }
     case Step::kStartPoses:
       begin_exchange(Step::kStartVotes, out);
       return;
@@ -611,8 +711,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       if (at_known < at_start) in_.Y0 = std::move(in_.Y0_known);
       in_.Y0_known.resize(0, 0);
       candidate_neighbours_.resize(0, 0);
-      first_solve_g_ = ++g_;
-      begin_solve(out);
+      after_step_zero(out);
       return;
     }
     case Step::kCandidatePoses:
@@ -672,7 +771,17 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     throw std::runtime_error(me + "unexpected robust message " + std::to_string(phase) +
                              " from agent " + std::to_string(sender));
   waiting_.erase(it);
-  if (step_ == Step::kKeptStart) {
+  if (step_ == Step::kPcm) {
+    if (in_.id == 0) {
+      const auto* block = std::get_if<PoseBlockMessage>(&message);
+      if (!block) throw std::runtime_error(me + "a status where measurements belong");
+      decode_measurement_block(*block, in_.d, in_.num_poses, "robust pcm-gnc", kept_values_);
+    } else {
+      const auto* st = std::get_if<RoundStatusMessage>(&message);
+      if (!st) throw std::runtime_error(me + "poses where the consistency check belongs");
+      drop_inconsistent(st->measurement_ids);
+    }
+  } else if (step_ == Step::kKeptStart) {
     const auto* block = std::get_if<PoseBlockMessage>(&message);
     if (!block) throw std::runtime_error(me + "a status where the kept set's start belongs");
     if (in_.id == 0) {

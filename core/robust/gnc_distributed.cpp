@@ -134,6 +134,7 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
     in.kept_set_start = options.kept_set_start;
     in.initialization = solver.initialization;
     in.source = graph.source;
+    in.pcm = options.robust.kind == RobustKind::kPcmGnc;
     // Without the final certified solve: it runs below, for its full record.
     gnc.push_back(std::make_unique<GncAgent>(std::move(in), options, false));
     if (options.weight_observer)

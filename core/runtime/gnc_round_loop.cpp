@@ -35,6 +35,7 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   in.measurements = local.measurements;
   in.measurement_index = local.measurement_index;
   in.known_inlier = local.known_inlier;
+  in.pcm = local.options.robust.kind == RobustKind::kPcmGnc;
   in.Y0 = lift_poses(local.initial, options.solver.rank);
   if (!local.known_initial.empty())
     in.Y0_known = lift_poses(local.known_initial, options.solver.rank);

@@ -2,6 +2,9 @@
 // One agent's side of distributed GNC-TLS as a single state machine for any driver (the
 // in-process driver, the DDS round loop), so both run the same code:
 //
+//   [with GncAgentInput::pcm: every agent's values -> agent 0, which runs the pairwise
+//    consistency check (robust/pairwise_consistency.hpp) and sends every agent the closures
+//    outside the largest consistent set: they start at weight 0 and stay there]
 //   [with GncAgentInput::Y0_known: poses of both starts, then a vote on their TLS costs;
 //    every agent starts from the cheaper]
 //   solve 0 (plain; every solve before the final one is capped at
@@ -72,8 +75,10 @@ enum class GncExchange : std::uint32_t {
   kKeptStart = 7,
   kCandidatePoses = 8,
   kCandidateVotes = 9,
-  kStartPoses = 10,
-  kStartVotes = 11
+  kPcmValues = 10,
+  kPcmDropped = 11,
+  kStartPoses = 12,
+  kStartVotes = 13
 };
 inline std::uint32_t gnc_phase(std::uint32_t step, GncExchange e) {
   return step * kGncStepStride + kGncExchangeBase + static_cast<std::uint32_t>(e);
@@ -113,6 +118,11 @@ struct GncAgentInput {
   bool kept_set_start = false;
   DistributedInit initialization = DistributedInit::kChordal;
   std::string source;  ///< Names the input in the fresh start's errors.
+  /// `--robust pcm-gnc`: the pairwise consistency check before GNC. It needs every closure
+  /// against every other and the odometry between their ends, a global test, so agent 0 runs
+  /// it on the values the others send it (like the chordal initialization); what it decides is
+  /// a pre-filter, the weights stay the owners'. Needs known inliers that connect the poses.
+  bool pcm = false;
 };
 
 class GncAgent : public AgentProcess {
@@ -175,6 +185,7 @@ class GncAgent : public AgentProcess {
     kKeptStart,
     kCandidatePoses,
     kCandidateVotes,
+    kPcm,
     kStartPoses,
     kStartVotes,
     kDone
@@ -199,6 +210,8 @@ class GncAgent : public AgentProcess {
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
   void finish(std::vector<OutgoingMessage>& out);
   void start_kept_set(std::vector<OutgoingMessage>& out);
+  void after_step_zero(std::vector<OutgoingMessage>& out);
+  void drop_inconsistent(const std::vector<std::uint64_t>& ids);
   double tls_term(std::size_t k, double r2) const;
 
   GncAgentInput in_;
@@ -211,7 +224,8 @@ class GncAgent : public AgentProcess {
   std::uint32_t g_ = 0;              // GNC step
   std::uint32_t first_solve_g_ = 0;  // 1 after a start vote (step 0 is the vote's)
   bool fresh_start_ = false;         // the kept set's fresh start (kept_set_start, chordal)
-  std::vector<std::pair<std::uint64_t, Measurement>> kept_values_;  // agent 0's gather
+  std::vector<std::pair<std::uint64_t, Measurement>> kept_values_;  // agent 0's gathers
+  std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
   Solve solve_kind_ = Solve::kGnc;
   bool voted_ = false;  // the votes of mu's start are in

@@ -23,7 +23,7 @@ struct GncDistributedOptions {
   /// from the previous lifted iterate; the final solve of the inlier set certifies when
   /// solver.certify is on.
   DistributedOptions solver;
-  RobustOptions robust;  ///< kind is ignored: this is the GNC-TLS path.
+  RobustOptions robust;  ///< kPcmGnc: the consistency check first (GncAgentInput::pcm).
   /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
   /// rule's measurements (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier_flags;
