@@ -354,9 +354,11 @@ def table(csv_path):
 
 
 def optima(shared):
-    """f* of every shared dataset (reference/optima.csv)."""
+    """f* of every shared dataset (reference/optima.csv); for the 3D files the `_qnorm` row (the
+    same graph with unit quaternions, which is what tessera solves: reference/README.md)."""
     with open(os.path.join(shared, "reference", "optima.csv")) as f:
-        return {r["dataset"]: float(r["f_star"]) for r in csv.DictReader(f)}
+        rows = {r["dataset"]: float(r["f_star"]) for r in csv.DictReader(f)}
+    return {k: rows.get(k + "_qnorm", v) for k, v in rows.items() if not k.endswith("_qnorm")}
 
 
 def clean_all(args, out_csv):
@@ -369,7 +371,7 @@ def clean_all(args, out_csv):
     if args.graphs != ",".join(ALL_GRAPHS):
         names = [n for n in names if n in args.graphs.split(",")]
     fields = ["graph", "engine", "poses", "edges", "rejected", "cost", "f_star", "gap", "certified", "outer",
-              "rounds", "wall_s", "load", "note"]
+              "rounds", "wall_s", "load", "extra", "note"]
     if not (args.append and os.path.exists(out_csv)):
         with open(out_csv, "w", newline="") as f:
             csv.writer(f).writerow(fields)
@@ -378,17 +380,19 @@ def clean_all(args, out_csv):
     for name in names:
         graph = os.path.join(args.shared, "datasets", name + ".g2o")
         for engine in engines:
-            js = os.path.join(work, f"{name}_{engine[:3]}.json")
+            js = os.path.join(work, f"{name}_{engine.replace(' ', '_')}.json")
             if engine == "dds":
                 cmd = [args.bin, "launch", graph, "--agents", "5", "--robust", "gnc-tls", "--domain",
                        str(args.domain), "--json", js]
             else:
                 cmd = [args.bin, "solve", graph, "--algorithm", "irbcd", "--agents", "5", "--robust", "gnc-tls",
                        "--certify", "--json", js]
+            cmd += args.clean_extra.split()
             load = open("/proc/loadavg").read().split()[0]
             progress(f"{name} ({engine}): " + " ".join(cmd[1:]))
             t0 = time.monotonic()
-            row = {"graph": name, "engine": engine, "f_star": fstar.get(name, ""), "load": load}
+            row = {"graph": name, "engine": engine, "f_star": fstar.get(name, ""), "load": load,
+                   "extra": args.clean_extra}
             try:
                 p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                    timeout=args.timeout)
@@ -416,11 +420,12 @@ def clean_table(csv_path):
     """The F = 0 table as markdown."""
     with open(csv_path) as f:
         rows = list(csv.DictReader(f))
-    head = "| graph | engine | poses | edges | rejected | cost | f* | gap | certified | outer | rounds | wall s | load |"
+    head = ("| graph | engine | options | poses | edges | rejected | cost | f* | gap | certified | outer | rounds | "
+            "wall s | load |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         gap = f"{float(r['gap']):.1e}" if r["gap"] else "-"
-        lines.append("| " + " | ".join([r["graph"], r["engine"], r["poses"] or "-", r["edges"] or "-",
+        lines.append("| " + " | ".join([r["graph"], r["engine"], r.get("extra") or "-", r["poses"] or "-", r["edges"] or "-",
                                         r["rejected"] or "-", r["cost"] or "-", r["f_star"] or "-", gap,
                                         r["certified"] or r["note"] or "-", r["outer"] or "-", r["rounds"] or "-",
                                         r["wall_s"], r["load"]]) + " |")
@@ -456,6 +461,7 @@ def main():
                          "solve with 5 agents, CSV robust_clean.csv")
     ap.add_argument("--dds", action="store_true", help="--clean-all: also `tessera launch` (over DDS)")
     ap.add_argument("--domain", type=int, default=70, help="--clean-all --dds: DDS domain id")
+    ap.add_argument("--clean-extra", default="", help="--clean-all: more options for every run (e.g. --grad-tol 1e-4)")
     args = ap.parse_args()
     os.makedirs(args.out_dir, exist_ok=True)
     if args.clean_all:
