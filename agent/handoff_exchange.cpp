@@ -1,8 +1,11 @@
 #include "agent/handoff_exchange.hpp"
 
+#include <algorithm>
 #include <deque>
+#include <map>
 #include <set>
 
+#include "transport/addressed_filter.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/run_failure.hpp"
 
@@ -10,39 +13,86 @@ namespace tessera::agent {
 
 using namespace tessera::transport;
 
+namespace {
+
+// Measurements and poses per part: 240 of each serialize to ~55 KB in 3D (128 B a
+// measurement, 100 B a pose), under kMaxAddressedSampleBytes, so each part is one transport
+// message that the writer filters for its recipient.
+constexpr std::size_t kItemsPerPart = 240;
+
+template <class T>
+std::vector<T> slice(const std::vector<T>& v, std::size_t begin, std::size_t count) {
+  begin = std::min(begin, v.size());
+  const std::size_t end = std::min(v.size(), begin + count);
+  return std::vector<T>(v.begin() + static_cast<std::ptrdiff_t>(begin),
+                        v.begin() + static_cast<std::ptrdiff_t>(end));
+}
+
+// Whether every part of every other agent's hand-off is in `q`; names the missing senders.
+bool complete(const std::deque<wire::MeasurementHandoff>& q, std::uint32_t self,
+              std::uint32_t robots, std::string* absent) {
+  std::map<std::uint32_t, std::set<std::uint32_t>> parts_of;
+  std::map<std::uint32_t, std::uint32_t> expected;
+  for (const auto& h : q) {
+    parts_of[h.sender()].insert(h.part());
+    expected[h.sender()] = std::max<std::uint32_t>(1, h.parts());
+  }
+  absent->clear();
+  for (std::uint32_t b = 0; b < robots; ++b) {
+    if (b == self) continue;
+    auto it = parts_of.find(b);
+    if (it == parts_of.end() || it->second.size() < expected[b])
+      *absent += (absent->empty() ? "agent " : ", agent ") + std::to_string(b);
+  }
+  return absent->empty();
+}
+
+}  // namespace
+
 std::vector<ReceivedHandoff> exchange_handoffs(AgentSession& s, const RobotShare& share,
                                                const std::vector<std::uint32_t>& owner,
                                                std::uint32_t self, std::uint32_t robots,
                                                const std::string& run_id, double timeout_s) {
   for (std::uint32_t b = 0; b < robots; ++b) {
     if (b == self) continue;
-    HandoffPlan plan = plan_handoff(share, owner, b);
-    s.publish(to_wire_handoff(run_id, self, b, share.d, plan.measurements, plan.measurement_index,
-                              plan.poses, plan.known_poses));
+    const HandoffPlan plan = plan_handoff(share, owner, b);
+    const std::size_t items = std::max(plan.measurements.size(), plan.poses.size());
+    const std::size_t parts = std::max<std::size_t>(1, (items + kItemsPerPart - 1) / kItemsPerPart);
+    for (std::size_t p = 0; p < parts; ++p) {
+      const std::size_t at = p * kItemsPerPart;
+      wire::MeasurementHandoff w = to_wire_handoff(
+          run_id, self, b, share.d, slice(plan.measurements, at, kItemsPerPart),
+          slice(plan.measurement_index, at, kItemsPerPart), slice(plan.poses, at, kItemsPerPart));
+      w.part(static_cast<std::uint32_t>(p));
+      w.parts(static_cast<std::uint32_t>(parts));
+      s.publish(w);
+    }
   }
-  const std::size_t others = robots - 1;
-  auto senders_missing = [&](const std::deque<wire::MeasurementHandoff>& q) {
-    std::set<std::uint32_t> have;
-    for (const auto& h : q) have.insert(h.sender());
-    std::string out;
-    for (std::uint32_t b = 0; b < robots; ++b)
-      if (b != self && !have.count(b))
-        out += (out.empty() ? "agent " : ", agent ") + std::to_string(b);
-    return out;
-  };
   std::string absent;
-  expect_ready(s.handoffs().wait_for(
-                   [&](const auto& q) {
-                     absent = senders_missing(q);
-                     return q.size() >= others && absent.empty();
-                   },
-                   Seconds(timeout_s)),
-               s.mailroom(), timeout_s, "measurement hand-offs", "none yet from " + absent);
-  std::vector<ReceivedHandoff> received;
+  expect_ready(
+      s.handoffs().wait_for([&](const auto& q) { return complete(q, self, robots, &absent); },
+                            Seconds(timeout_s)),
+      s.mailroom(), timeout_s, "measurement hand-offs", "none complete yet from " + absent);
+  // One hand-off per sender, its parts in order (so its measurements keep the sender's order).
+  std::map<std::uint32_t, std::map<std::uint32_t, wire::MeasurementHandoff>> by_sender;
   for (auto& w : s.handoffs().take_all()) {
-    HandoffContent c = from_wire(w);
-    received.push_back({w.sender(), std::move(c.measurements), std::move(c.measurement_index),
-                        std::move(c.poses), std::move(c.known_poses)});
+    const std::uint32_t sender = w.sender(), part = w.part();
+    by_sender[sender].emplace(part, std::move(w));
+  }
+  std::vector<ReceivedHandoff> received;
+  for (auto& [sender, parts] : by_sender) {
+    ReceivedHandoff r{sender, {}, {}, {}};
+    for (auto& [part, w] : parts) {
+      HandoffContent c = from_wire(w);
+      r.measurements.insert(r.measurements.end(), std::make_move_iterator(c.measurements.begin()),
+                            std::make_move_iterator(c.measurements.end()));
+      r.measurement_index.insert(r.measurement_index.end(), c.measurement_index.begin(),
+                                 c.measurement_index.end());
+      r.poses.insert(r.poses.end(), std::make_move_iterator(c.poses.begin()),
+                     std::make_move_iterator(c.poses.end()));
+      w = wire::MeasurementHandoff();  // decoded: free its arrays now
+    }
+    received.push_back(std::move(r));
   }
   return received;
 }

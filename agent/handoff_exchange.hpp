@@ -1,8 +1,11 @@
 #pragma once
 // Step 6 of a fresh run on the agent's side: the hand-off, peer to peer. Every agent sends
-// every other agent exactly one message with the measurements and initial poses of its
+// every other agent exactly one hand-off with the measurements and initial poses of its
 // share that the other now owns (the coordinator never sees measurement values), and waits
-// for one from each of them.
+// for one from each of them. A hand-off travels in parts of one transport message each, on a
+// topic filtered by recipient (transport/addressed_filter.hpp), so that an agent receives only
+// its own: at a million poses over 25 agents, every agent receiving every hand-off (the whole
+// graph's measurements that change owner, 24 times over) stalled the shared-memory transport.
 
 #include <cstdint>
 #include <string>
@@ -14,7 +17,8 @@
 namespace tessera::agent {
 
 /// Publishes `share`'s hand-off to every agent but `self` under `owner`, then waits up to
-/// `timeout_s` for a hand-off from each of them. Returns them decoded, in arrival order.
+/// `timeout_s` for every part of a hand-off from each of them. Returns them decoded, one per
+/// sender (its parts joined in order), by sender id.
 /// Throws RunFailure on a stop or the timeout (naming the agents not heard from).
 std::vector<ReceivedHandoff> exchange_handoffs(transport::AgentSession& session,
                                                const RobotShare& share,

@@ -4,10 +4,12 @@
 #include "transport/agent_session.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <string>
 #include <utility>
 #include <variant>
 
+#include "transport/addressed_filter.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/riding_blocks.hpp"
 #include "transport/session_parts.hpp"
@@ -24,8 +26,12 @@ void write_block(SessionParts& s, std::uint32_t epoch, const PoseBlockMessage& b
   w.epoch(epoch);
   // Addressed blocks reach only their recipients (one sample on each one's own topic);
   // broadcasts, and everything after a renumbering re-partition, use the shared topic.
-  if (broadcast || s.renumbered || s.opt.num_agents > kMaxAgentsWithRecipientTopics) {
+  if (broadcast || s.renumbered) {
     s.writer.write(kBlockTopic, w);
+  } else if (s.opt.num_agents > kMaxAgentsWithRecipientTopics) {
+    // One sample; the filter picks the recipients, if it can (addressed_filter.hpp).
+    s.writer.write(
+        serialized_size(w) <= kMaxAddressedSampleBytes ? kAddressedBlockTopic : kBlockTopic, w);
   } else {
     for (std::uint32_t k : recipients)
       if (k != s.me.agent_id) s.writer.write(block_topic_for(k), w);
@@ -82,7 +88,7 @@ void AgentSession::publish(const wire::AgentAnnouncement& m) {
   parts().writer.write(kAnnounceTopic, m);
 }
 void AgentSession::publish(const wire::MeasurementHandoff& m) {
-  parts().writer.write(kHandoffTopic, m);
+  parts().writer.write(m.purpose() == 0 ? kAddressedHandoffTopic : kHandoffTopic, m);
 }
 void AgentSession::publish(const wire::FinalEstimate& m) {
   parts().writer.write(kFinalTopic, m);
@@ -189,7 +195,11 @@ WaitStatus AgentSession::wait_finished(Seconds timeout) {
 }
 
 bool AgentSession::handoffs_acknowledged(Seconds timeout) {
-  return parts().writer.wait_acknowledged(kHandoffTopic, timeout);
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  return parts().writer.wait_acknowledged(kAddressedHandoffTopic, timeout) &&
+         parts().writer.wait_acknowledged(
+             kHandoffTopic,
+             std::max(Seconds(0), Seconds(until - std::chrono::steady_clock::now())));
 }
 
 }  // namespace tessera::transport

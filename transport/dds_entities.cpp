@@ -64,6 +64,9 @@ void DdsEntities::open(int domain, const PeerIdentity& me,
                                     " (certificate, key, permissions or governance rejected; "
                                     "TESSERA_DDS_LOG=1 shows Fast DDS's reason)"));
   peers_.add_own_prefix(participant_->guid().guidPrefix);
+  // On every participant, so that writers filter for the addressed readers.
+  if (!register_addressed_filter(*participant_))
+    throw TransportError("cannot register the addressed content filter");
   publisher_ = participant_->create_publisher(publisher_qos(opt_.run_id));
   subscriber_ = participant_->create_subscriber(subscriber_qos(opt_.run_id));
   if (!publisher_ || !subscriber_) throw TransportError("cannot create DDS publisher/subscriber");

@@ -18,10 +18,12 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "transport/addressed_filter.hpp"
 #include "transport/dds_listeners.hpp"
 #include "transport/dds_trace.hpp"
 #include "transport/inbox.hpp"
@@ -75,9 +77,13 @@ class DdsEntities {
   /// A reader on topic `name` whose samples of this run go to `deliver` (on a listener
   /// thread, in arrival order); a sample `deliver` rejects by throwing stops the session.
   /// Must match the peers of `e` before the readiness barrier passes. Throws TransportError.
+  /// With `addressed`, the reader reads through a content filter (addressed_filter.hpp) that
+  /// passes only the samples of that layout addressed to agent `agent`.
   template <class PubSubType, class T>
   void make_reader(const std::string& name, bool transient_local, Expect e,
-                   std::function<void(T&&)> deliver);
+                   std::function<void(T&&)> deliver,
+                   std::optional<AddressedLayout> addressed = std::nullopt,
+                   std::uint32_t agent = 0);
 
   /// The writer of topic `name`, or nullptr if this process does not write it (or is closed).
   eprosima::fastdds::dds::DataWriter* writer(const std::string& name) const;
@@ -166,9 +172,17 @@ void DdsEntities::make_writer(const std::string& name, bool transient_local, Exp
 
 template <class PubSubType, class T>
 void DdsEntities::make_reader(const std::string& name, bool transient_local, Expect e,
-                              std::function<void(T&&)> deliver) {
+                              std::function<void(T&&)> deliver,
+                              std::optional<AddressedLayout> addressed, std::uint32_t agent) {
   namespace dds = eprosima::fastdds::dds;
   dds::Topic* t = topic<PubSubType>(name);
+  dds::TopicDescription* read_from = t;
+  if (addressed) {
+    read_from = participant_->create_contentfilteredtopic(
+        name + "_for_" + std::to_string(agent), t, addressed_expression(*addressed),
+        {std::to_string(agent)}, kAddressedFilterClass);
+    if (!read_from) throw TransportError("cannot create the addressed DDS reader of " + name);
+  }
   // Per-round traffic is not traced sample by sample, and has no liveliness lease.
   const bool set_up_topic = !is_round_topic(name);
   auto drain = [this, deliver, set_up_topic, name](dds::DataReader* reader) {
@@ -199,7 +213,7 @@ void DdsEntities::make_reader(const std::string& name, bool transient_local, Exp
                          << dds::StatusMask::subscription_matched()
                          << dds::StatusMask::liveliness_changed();
   dds::DataReader* r = subscriber_->create_datareader(
-      t, reader_qos(transient_local, opt_.lease_s, opt_.num_agents, net_, set_up_topic),
+      read_from, reader_qos(transient_local, opt_.lease_s, opt_.num_agents, net_, set_up_topic),
       reader_listeners_.back().get(), mask);
   if (!r) throw TransportError("cannot create DDS reader for " + name);
   readers_.push_back(r);

@@ -87,8 +87,10 @@ dds::SubscriberQos subscriber_qos(const std::string& run_id) {
 
 dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_t num_agents,
                               const NetworkProfile& net, bool liveliness) {
-  (void)num_agents;
   dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
+  // Room to filter for every agent's reader on the writer's side (addressed_filter.hpp):
+  // Fast DDS's default of 32 would leave the readers past it to filter for themselves.
+  q.writer_resource_limits().reader_filters_allocation.maximum = num_agents + 8;
   q.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
   // write() never blocks long: when the bounded history is full it returns and we retry
   // after waiting for acknowledgements (Session::Impl::write).

@@ -73,13 +73,19 @@ void create_agent_endpoints(SessionParts& s) {
   e.make_writer<wire::AgentAnnouncementPubSubType>(kAnnounceTopic, true, Expect::kNone);
   e.make_writer<wire::ControlPubSubType>(kControlTopic, true, Expect::kNone);
   e.make_writer<wire::MeasurementHandoffPubSubType>(kHandoffTopic, false, Expect::kOtherAgents);
-  // Broadcast pose blocks on kBlockTopic, addressed ones on the recipient's own topic.
+  e.make_writer<wire::MeasurementHandoffPubSubType>(kAddressedHandoffTopic, false,
+                                                    Expect::kOtherAgents);
+  // Broadcast pose blocks on kBlockTopic.
   e.make_writer<wire::PoseBlockPubSubType>(kBlockTopic, false, Expect::kOtherAgents);
   const bool recipient_topics = s.opt.num_agents <= kMaxAgentsWithRecipientTopics;
-  if (recipient_topics)
+  // Addressed ones: on the recipient's own topic, or one filtered topic in a large run.
+  if (recipient_topics) {
     for (std::uint32_t k = 0; k < s.opt.num_agents; ++k)
       if (k != me)
         e.make_writer<wire::PoseBlockPubSubType>(block_topic_for(k), false, Expect::kAgent, k);
+  } else {
+    e.make_writer<wire::PoseBlockPubSubType>(kAddressedBlockTopic, false, Expect::kOtherAgents);
+  }
   // Statuses the coordinator reads (coordinator_reads_status) on kStatusTopic, the others on
   // kAgentStatusTopic; its progress digests on kProgressTopic.
   e.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false,
@@ -95,23 +101,32 @@ void create_agent_endpoints(SessionParts& s) {
   e.make_reader<wire::PartitionAssignmentPubSubType, wire::PartitionAssignment>(
       kAssignmentTopic, true, Expect::kNone,
       [&s](wire::PartitionAssignment&& m) { s.assignment_in.push(std::move(m)); });
+  auto deliver_handoff = [&s, me](wire::MeasurementHandoff&& m) {
+    if (m.recipient() != me || m.sender() == me) return;
+    if (m.purpose() == 1)
+      s.replica_in.push(std::move(m));
+    else
+      s.handoff_in.push(std::move(m));
+  };
   e.make_reader<wire::MeasurementHandoffPubSubType, wire::MeasurementHandoff>(
-      kHandoffTopic, false, Expect::kOtherAgents, [&s, me](wire::MeasurementHandoff&& m) {
-        if (m.recipient() != me || m.sender() == me) return;
-        if (m.purpose() == 1)
-          s.replica_in.push(std::move(m));
-        else
-          s.handoff_in.push(std::move(m));
-      });
-  std::vector<std::string> block_topics{kBlockTopic};
-  if (recipient_topics) block_topics.push_back(block_topic_for(me));
-  for (const std::string& topic : block_topics)
-    e.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(
-        topic, false, Expect::kOtherAgents, [&s](wire::PoseBlock&& m) {
-          ++s.protocol_samples;
-          s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
-                           ProtocolMessage(from_wire(m)));
-        });
+      kHandoffTopic, false, Expect::kOtherAgents, deliver_handoff);
+  e.make_reader<wire::MeasurementHandoffPubSubType, wire::MeasurementHandoff>(
+      kAddressedHandoffTopic, false, Expect::kOtherAgents, deliver_handoff,
+      AddressedLayout::kHandoff, me);
+  auto deliver_block = [&s](wire::PoseBlock&& m) {
+    ++s.protocol_samples;
+    s.router.deliver(m.epoch(), m.sender(), m.broadcast(), m.recipients(),
+                     ProtocolMessage(from_wire(m)));
+  };
+  e.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(kBlockTopic, false,
+                                                            Expect::kOtherAgents, deliver_block);
+  if (recipient_topics)
+    e.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(block_topic_for(me), false,
+                                                              Expect::kOtherAgents, deliver_block);
+  else
+    e.make_reader<wire::PoseBlockPubSubType, wire::PoseBlock>(kAddressedBlockTopic, false,
+                                                              Expect::kOtherAgents, deliver_block,
+                                                              AddressedLayout::kBlock, me);
   for (const char* topic : {kStatusTopic, kAgentStatusTopic})
     e.make_reader<wire::RoundStatusPubSubType, wire::RoundStatus>(
         topic, false, Expect::kOtherAgents, [&s](wire::RoundStatus&& m) {

@@ -13,7 +13,15 @@ namespace tessera::transport {
 inline constexpr const char* kAnnounceTopic = "tessera_announce";
 inline constexpr const char* kAssignmentTopic = "tessera_assignment";
 inline constexpr const char* kHandoffTopic = "tessera_handoff";
+/// The parts of the hand-offs (purpose 0), read through a content filter on the recipient
+/// (addressed_filter.hpp): each agent receives only its own. kHandoffTopic carries the rest
+/// (replicas and take-over hand-offs: large samples, which Fast DDS 2.9 cannot filter on the
+/// writer's side when they are sent in fragments).
+inline constexpr const char* kAddressedHandoffTopic = "tessera_handoff_addressed";
 inline constexpr const char* kBlockTopic = "tessera_pose_block";
+/// Pose blocks addressed by agent id in runs of more than kMaxAgentsWithRecipientTopics agents
+/// (before any renumbering re-partition): one topic, read through a filter on the recipients.
+inline constexpr const char* kAddressedBlockTopic = "tessera_pose_block_addressed";
 inline constexpr const char* kStatusTopic = "tessera_round_status";
 inline constexpr const char* kFinalTopic = "tessera_final";
 inline constexpr const char* kControlTopic = "tessera_control";
@@ -47,7 +55,8 @@ inline bool coordinator_reads_status(std::uint32_t phase, bool rounds_followed) 
 }
 
 /// Runs of at most this many agents use block_topic_for(k); larger ones send addressed blocks on
-/// kBlockTopic as well. Each agent writes every other agent's topic, so endpoints grow as N^2:
+/// kAddressedBlockTopic, which each agent reads through a content filter on the recipients
+/// (addressed_filter.hpp). Each agent writes every other agent's topic, so endpoints grow as N^2:
 /// at N = 25 (600 more writers) the discovery burst on 2 cores delayed participant
 /// announcements until a participant lease expired during set-up.
 inline constexpr std::uint32_t kMaxAgentsWithRecipientTopics = 8;
