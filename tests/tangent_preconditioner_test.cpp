@@ -225,6 +225,29 @@ TEST(TangentPreconditioner, BlockSolveReachesTheSameMinimiserAsTheDataMatrixFact
     }
 }
 
+// Far over the cap, the pose-level pattern's estimate alone rules the factor out (A is never
+// built); near the cap the exact analysis decides as before. The estimate is close to the
+// exact count, so it never rules out a factor the cap would have allowed.
+TEST(TangentPreconditioner, APoseLevelEstimateRulesOutOnlyFactorsFarOverTheCap) {
+  for (int d : {2, 3}) {
+    const Block b = half_block(d, 6, d);
+    const BlockProblem problem(d, b.owned, b.graph.measurements);
+    const std::size_t exact = TangentPreconditioner(problem, 1e-9, 0).factor_entries();
+    ASSERT_GT(exact, 100u);
+    const TangentPreconditioner at_cap(problem, 1e-9, exact);
+    EXPECT_TRUE(at_cap.usable()) << "d = " << d;
+    EXPECT_EQ(at_cap.factor_entries(), exact);
+    const TangentPreconditioner below(problem, 1e-9, exact - 1);
+    EXPECT_FALSE(below.usable());
+    EXPECT_EQ(below.factor_entries(), exact) << "decided by the exact analysis";
+    const TangentPreconditioner far_below(problem, 1e-9, exact / 4);
+    EXPECT_FALSE(far_below.usable());
+    const double estimate = static_cast<double>(far_below.factor_entries());
+    EXPECT_GT(estimate, 0.5 * static_cast<double>(exact)) << "d = " << d;
+    EXPECT_LT(estimate, 2.0 * static_cast<double>(exact)) << "d = " << d;
+  }
+}
+
 TEST(TangentPreconditioner, OptionsAreValidated) {
   BlockUpdateOptions o;
   o.tangent_refresh_interval = -1;

@@ -99,6 +99,34 @@ Eigen::MatrixXd pose_basis(const Eigen::Ref<const Eigen::MatrixXd>& Y,
   return G;
 }
 
+// The pose-level estimate is skipped to the exact analysis below this multiple of the cap,
+// so that a factor near the cap is decided by its exact size as before.
+constexpr double kSkipFactor = 2.0;
+
+// Entries of A's LDL^T factor estimated from the pose-level pattern (`rows`: the row blocks of
+// each block column, diagonal included): the pose-level factor's entries (same AMD ordering,
+// symbolic only), each off-diagonal block p x p dense and each diagonal block triangular.
+double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& rows, int p) {
+  const Eigen::Index m = static_cast<Eigen::Index>(rows.size());
+  std::vector<Eigen::Triplet<double>> t;
+  for (Eigen::Index j = 0; j < m; ++j)
+    for (Eigen::Index i : rows[static_cast<std::size_t>(j)])
+      t.emplace_back(i, j, i == j ? static_cast<double>(m) : 1.0);
+  SparseMatrix B(m, m);
+  B.setFromTriplets(t.begin(), t.end());
+  Eigen::CholmodDecomposition<SparseMatrix> symbolic;
+  symbolic.setMode(Eigen::CholmodLDLt);
+  cholmod_common& c = symbolic.cholmod();
+  c.nmethods = 1;
+  c.method[0].ordering = CHOLMOD_AMD;
+  c.postorder = 1;
+  symbolic.analyzePattern(B);
+  if (symbolic.info() != Eigen::Success) return 0.0;  // no estimate: the exact analysis decides
+  const double block_entries = static_cast<double>(symbolic.cholmod().lnz);  // with diagonal
+  const double md = static_cast<double>(m);
+  return (block_entries - md) * p * p + md * p * (p + 1) / 2.0;
+}
+
 }  // namespace
 
 TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double relative_shift,
@@ -124,6 +152,16 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
       for (SparseMatrix::InnerIterator it(Q, j * w + s); it; ++it) r.push_back(it.row() / w);
     std::sort(r.begin(), r.end());
     r.erase(std::unique(r.begin(), r.end()), r.end());
+  }
+  // A factor far over the cap is known from the pose-level pattern alone (m x m, p^2 times
+  // smaller than A's): then A is never built. On a 40,000-pose block of a 3D grid, A's
+  // pattern and Q's dense blocks alone were ~300 MB per agent, for a factor never used.
+  if (max_factor_entries > 0) {
+    const double estimate = pose_level_fill_estimate(rows, f.p);
+    if (estimate > kSkipFactor * static_cast<double>(max_factor_entries)) {
+      f.entries = static_cast<std::size_t>(estimate);
+      return;  // not usable
+    }
   }
   f.block_start.assign(1, 0);
   for (Eigen::Index j = 0; j < f.m; ++j) {
@@ -174,6 +212,13 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   if (f.llt.info() != Eigen::Success) return;  // not usable
   f.entries = static_cast<std::size_t>(f.llt.cholmod().lnz);
   f.usable = max_factor_entries == 0 || f.entries <= max_factor_entries;
+  if (!f.usable) {  // what only the factor needs goes now, not with the preconditioner
+    f.A = SparseMatrix();
+    std::vector<double>().swap(f.q_blocks);
+    std::vector<Eigen::Index>().swap(f.block_row);
+    std::vector<Eigen::Index>().swap(f.block_start);
+    std::vector<Eigen::Index>().swap(f.diagonal_slot);
+  }
 }
 
 TangentPreconditioner::~TangentPreconditioner() = default;
