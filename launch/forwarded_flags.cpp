@@ -34,6 +34,11 @@ void check_partition_time(const std::string& v) {
   number_in(v, "partition-time", 0, 86400, "0..86400");
 }
 
+void check_setup_timeout(const std::string& v) {
+  if (number_in(v, "setup-timeout", 0, 86400, "(0, 86400]") <= 0)
+    throw InputError("launch: --setup-timeout must be in (0, 86400] seconds");
+}
+
 // The robust options are checked as RobustOptions checks them (the error names the field).
 void check_robust(const std::string& v) {
   try {
@@ -104,6 +109,11 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "none, the preset's own effort (with a cap the partition\n"
        "depends on the machine's speed)                           [0]",
        check_partition_time},
+      {"setup-timeout", "timeout", true, ForwardTo::kBoth, "--setup-timeout S",
+       "bound on each set-up wait of a process (the agents'\n"
+       "announcements, the assignment, the readiness barrier);\n"
+       "large runs on a loaded host read and parse for longer     [30]",
+       check_setup_timeout},
       {"robust", "robust", true, ForwardTo::kCoordinator, "--robust none|gnc-tls|pcm-gnc",
        "gnc-tls: reject outlier measurements (graduated non-\n"
        "convexity, truncated least squares), each weighed by the\n"

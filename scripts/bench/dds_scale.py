@@ -125,10 +125,14 @@ def load():
 
 def run_one(args, poses, agents, domain):
     graph = os.path.join(args.work, f"grid3d_{poses}_{agents}.g2o")
-    if not os.path.exists(graph):
+    robots_dir = os.path.join(args.work, f"grid3d_{poses}_{agents}_robots")
+    if not os.path.exists(graph) or (args.robot_files and not os.path.isdir(robots_dir)):
         bc.progress(f"generating {graph}")
+        split = ["--split", robots_dir] if args.robot_files else []
         subprocess.run([args.bin, "generate", "--kind", "grid3d", "--poses", str(poses), "--robots",
-                        str(agents), "--out", graph], check=True, stdout=subprocess.DEVNULL)
+                        str(agents), "--out", graph] + split, check=True, stdout=subprocess.DEVNULL)
+    if args.robot_files:
+        graph = robots_dir  # one file per robot: each agent reads its own, nothing preloaded
     summary = os.path.join(args.work, f"summary_{poses}_{agents}.json")
     cmd = [args.bin, "launch", graph, "--agents", str(agents), "--partition", "fast", "--init",
            "distributed", "--domain", str(domain), "--json", summary, "--timeout",
@@ -151,7 +155,8 @@ def run_one(args, poses, agents, domain):
     sampler.join()
     agent_pss = {k: v for k, v in sampler.pss.items() if k.startswith("agent")}
     agent_rss = {k: v for k, v in sampler.rss.items() if k.startswith("agent")}
-    row = {"poses": poses, "agents": agents, "launch_args": args.launch_args, "rc": rc, "wall_s": round(wall, 1),
+    row = {"poses": poses, "agents": agents, "input": "robot files" if args.robot_files else "one file",
+           "launch_args": args.launch_args, "rc": rc, "wall_s": round(wall, 1),
            "load_start": load0, "load_end": load(),
            # sampled, so known for a failed run too
            "peak_pss_mb_agent_max": round(max(agent_pss.values(), default=0) / 1024, 1),
@@ -186,6 +191,8 @@ def main():
     ap.add_argument("--timeout", type=int, default=3600)
     ap.add_argument("--period", type=float, default=0.5)
     ap.add_argument("--csv", default=os.path.join(bc.OUT_DIR, "dds_scale.csv"))
+    ap.add_argument("--robot-files", action="store_true",
+                    help="launch the folder of robot files (generate --split) instead of the whole file")
     ap.add_argument("--launch-args", default="", help="more launch options, e.g. \"--max-rounds 20\"")
     args = ap.parse_args()
     args.bin = os.path.abspath(args.bin)
@@ -194,7 +201,7 @@ def main():
     for k, spec in enumerate(args.sizes.split(",")):
         poses, agents = (int(x) for x in spec.split(":"))
         rows.append(run_one(args, poses, agents, args.domain + k))
-    cols = ["poses", "agents", "rc", "wall_s"] + [p[0] + "_s" for p in PHASES] + [
+    cols = ["poses", "agents", "input", "rc", "wall_s"] + [p[0] + "_s" for p in PHASES] + [
         "rounds", "certified", "peak_rss_mb_agent_max", "peak_pss_mb_agent_max", "peak_rss_mb_coordinator",
         "peak_pss_mb_fork_server", "peak_rss_mb_run", "peak_pss_mb_run_sum", "load_start", "load_end"]
     bc.print_table("tessera launch on generated 3D grids (fast partition, distributed init, certified)",
