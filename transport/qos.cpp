@@ -10,10 +10,28 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <memory>
 
+#include "transport/topic_names.hpp"
+
 namespace tessera::transport {
 
 namespace dds = eprosima::fastdds::dds;
 using eprosima::fastrtps::Duration_t;
+
+namespace {
+
+// The shared-memory transport. A writer's outgoing samples live in its participant's segment
+// until every reader took them: Fast DDS's 512 KB default holds 9 hand-off parts (one
+// transport message each, addressed_filter.hpp), so in a large run each agent's ~7,000 parts
+// (1M poses, 25 agents) trickled out a few per acknowledgement and the writes timed out. Runs
+// above kMaxAgentsWithRecipientTopics agents get 8 MB (pages are taken only as they are used).
+std::shared_ptr<eprosima::fastdds::rtps::SharedMemTransportDescriptor> shared_memory_transport(
+    std::uint32_t num_agents) {
+  auto shm = std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>();
+  if (num_agents > kMaxAgentsWithRecipientTopics) shm->segment_size(8u << 20);
+  return shm;
+}
+
+}  // namespace
 
 dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
@@ -39,8 +57,7 @@ dds::DomainParticipantQos participant_qos(
     // every participant of the domain opens), and creates no UDP socket, receive thread or
     // interface list. Peers at --peers addresses are unreachable (SessionOptions::validate).
     q.transport().use_builtin_transports = false;
-    q.transport().user_transports.push_back(
-        std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+    q.transport().user_transports.push_back(shared_memory_transport(num_agents));
   } else if (net.udp_max_message_size != 0 || net.socket_buffer_bytes != 0 || !shared_memory) {
     // Our own UDPv4 transport instead of the built-in one, plus shared memory as built in
     // (same-host peers keep using it) unless `shared_memory` is off. Fast DDS fragments every
@@ -50,9 +67,7 @@ dds::DomainParticipantQos participant_qos(
     udp->sendBufferSize = net.socket_buffer_bytes;
     udp->receiveBufferSize = net.socket_buffer_bytes;
     q.transport().use_builtin_transports = false;
-    if (shared_memory)
-      q.transport().user_transports.push_back(
-          std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+    if (shared_memory) q.transport().user_transports.push_back(shared_memory_transport(num_agents));
     q.transport().user_transports.push_back(udp);
     q.transport().send_socket_buffer_size = net.socket_buffer_bytes;
     q.transport().listen_socket_buffer_size = net.socket_buffer_bytes;
