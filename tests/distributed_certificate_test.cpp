@@ -229,6 +229,24 @@ TEST(DistributedStaircase, InconclusiveCertificateRefinesTheSameRankBeforeEscapi
   EXPECT_TRUE(*r.certified);
 }
 
+// max_rounds is the run's round budget: a solve that runs out of it is certified once (its
+// minimum eigenvalue is the reported gap), neither refined nor escaped from.
+TEST(DistributedStaircase, ASolveOutOfRoundsIsCertifiedOnceAndNotContinued) {
+  const PoseGraph g = saddle_graph();
+  DistributedOptions opt = saddle_options(DeliveryOrder::kFifo);
+  opt.max_rounds = 2;
+  const DistributedResult r =
+      solve_distributed(g, sequential_partition(g.num_poses, 4), opt, g.initial);
+  ASSERT_EQ(r.certificates.size(), 1u);
+  EXPECT_FALSE(r.certificates[0].result.certified);
+  EXPECT_EQ(r.min_eigenvalue, r.certificates[0].result.min_eigenvalue);
+  EXPECT_TRUE(r.escapes.empty());
+  EXPECT_EQ(r.refine_rounds, 0);
+  EXPECT_LE(r.rounds, 2);
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_FALSE(*r.certified);
+}
+
 // The acceptance rule at loose solve tolerances: a certificate that holds at a point that is
 // not (yet) critical must also hold for the centralized certificate at that same point, with
 // the same minimum eigenvalue to within eta. Refinement off, so each verdict stands as is.

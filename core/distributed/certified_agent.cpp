@@ -188,6 +188,13 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
           done_ = true;
           break;
         }
+        // The solve ran out of rounds (max_rounds is the run's budget): refining or escaping
+        // would spend rounds past it, from a point that is not stationary. The certificate's
+        // minimum eigenvalue is then the reported gap.
+        if (!solves_.empty() && solves_.back().stop_reason == "max_rounds") {
+          done_ = true;
+          break;
+        }
         // Not certified at the solver's tolerance: Lambda(X) may be off by the residual
         // gradient, so the verdict is inconclusive. Refine the same rank to the tighter
         // tolerance (the next solve stage, skipping the escape) and certify again.
