@@ -23,8 +23,13 @@ do not.
 
 docs/scale.md reads its memory model off these rows.
 
+With --robot-files the grid is also written as one file per robot (generate --split) and launch
+reads that folder: each agent parses only its own file and nothing is preloaded, as robots with
+their own data would run (the fork server's preloaded whole graph is in every agent's RSS).
+
 usage: dds_scale.py [--bin build/bin/tessera] [--sizes 20000:2,100000:10] [--domain 65]
-                    [--work DIR] [--timeout 3600] [--period 0.5] [--csv FILE] [--launch-args="..."]
+                    [--work DIR] [--timeout 3600] [--period 0.5] [--csv FILE] [--robot-files]
+                    [--launch-args="..."]
 """
 import argparse
 import json
@@ -175,6 +180,7 @@ def run_one(args, poses, agents, domain):
     row.update({
         "edges": s.get("edges"), "rounds": s.get("rounds"), "certified": s.get("certified"),
         "min_eigenvalue": s.get("min_eigenvalue"), "cut_edges": s.get("cut_edges"),
+        "cost": s.get("cost"), "grad_norm": s.get("grad_norm"),
         "peak_rss_mb_agent_max": round(s.get("peak_rss_mb_agent_max", 0), 1),
         "peak_rss_mb_coordinator": round(s.get("peak_rss_mb_coordinator", 0), 1),
         "peak_rss_mb_run": round(s.get("peak_rss_mb_run", 0), 1),
@@ -202,7 +208,7 @@ def main():
         poses, agents = (int(x) for x in spec.split(":"))
         rows.append(run_one(args, poses, agents, args.domain + k))
     cols = ["poses", "agents", "input", "rc", "wall_s"] + [p[0] + "_s" for p in PHASES] + [
-        "rounds", "certified", "peak_rss_mb_agent_max", "peak_pss_mb_agent_max", "peak_rss_mb_coordinator",
+        "rounds", "grad_norm", "certified", "min_eigenvalue", "peak_rss_mb_agent_max", "peak_pss_mb_agent_max", "peak_rss_mb_coordinator",
         "peak_pss_mb_fork_server", "peak_rss_mb_run", "peak_pss_mb_run_sum", "load_start", "load_end"]
     bc.print_table("tessera launch on generated 3D grids (fast partition, distributed init, certified)",
                    cols, [[bc.fmt(r.get(c, "-")) if not isinstance(r.get(c), str) else r[c] for c in cols]
