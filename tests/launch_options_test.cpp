@@ -61,6 +61,17 @@ TEST(LaunchOptions, ForwardedFlagsReachOnlyTheCoordinatorWithTheirValues) {
   EXPECT_TRUE(has_pair(agent, "--run-id", "r1"));
 }
 
+TEST(LaunchOptions, SetUpTimeoutReachesEveryProcessAsItsWaitBound) {
+  LaunchOptions o = parse_launch_options({"--agents", "2", "--setup-timeout", "300"});
+  o.graph = "/data/graph.g2o";
+  EXPECT_TRUE(has_pair(coordinator_argv(o, paths()), "--timeout", "300"));
+  EXPECT_TRUE(has_pair(agent_argv(o, paths(), 0), "--timeout", "300"));
+  EXPECT_TRUE(has_pair(agent_argv(o, paths(), 1), "--timeout", "300"));
+  const LaunchOptions plain = parse_launch_options({"--agents", "2"});
+  EXPECT_FALSE(has(agent_argv(plain, paths(), 0), "--timeout"));  // the processes' own 30 s
+  EXPECT_NE(error_of({"--setup-timeout", "0"}).find("--setup-timeout"), std::string::npos);
+}
+
 TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
   const std::string help = launch_help();
   // A valid value of each flag: "1" unless that is out of the flag's range.
