@@ -15,10 +15,11 @@ using namespace tessera::transport;
 
 namespace {
 
-// Measurements and poses per part: 240 of each serialize to ~55 KB in 3D (128 B a
-// measurement, 100 B a pose), under kMaxAddressedSampleBytes, so each part is one transport
-// message that the writer filters for its recipient.
-constexpr std::size_t kItemsPerPart = 240;
+// Measurements and poses per part: 160 of each, with a robust run's second start for those
+// poses, serialize to ~53 KB in 3D (128 B a measurement, 100 B a pose, 100 B its second
+// start), under kMaxAddressedSampleBytes, so each part is one transport message that the writer
+// filters for its recipient.
+constexpr std::size_t kItemsPerPart = 160;
 
 template <class T>
 std::vector<T> slice(const std::vector<T>& v, std::size_t begin, std::size_t count) {
@@ -56,13 +57,15 @@ std::vector<ReceivedHandoff> exchange_handoffs(AgentSession& s, const RobotShare
   for (std::uint32_t b = 0; b < robots; ++b) {
     if (b == self) continue;
     const HandoffPlan plan = plan_handoff(share, owner, b);
-    const std::size_t items = std::max(plan.measurements.size(), plan.poses.size());
+    const std::size_t items =
+        std::max({plan.measurements.size(), plan.poses.size(), plan.known_poses.size()});
     const std::size_t parts = std::max<std::size_t>(1, (items + kItemsPerPart - 1) / kItemsPerPart);
     for (std::size_t p = 0; p < parts; ++p) {
       const std::size_t at = p * kItemsPerPart;
       wire::MeasurementHandoff w = to_wire_handoff(
           run_id, self, b, share.d, slice(plan.measurements, at, kItemsPerPart),
-          slice(plan.measurement_index, at, kItemsPerPart), slice(plan.poses, at, kItemsPerPart));
+          slice(plan.measurement_index, at, kItemsPerPart), slice(plan.poses, at, kItemsPerPart),
+          slice(plan.known_poses, at, kItemsPerPart));
       w.part(static_cast<std::uint32_t>(p));
       w.parts(static_cast<std::uint32_t>(parts));
       s.publish(w);
@@ -81,7 +84,7 @@ std::vector<ReceivedHandoff> exchange_handoffs(AgentSession& s, const RobotShare
   }
   std::vector<ReceivedHandoff> received;
   for (auto& [sender, parts] : by_sender) {
-    ReceivedHandoff r{sender, {}, {}, {}};
+    ReceivedHandoff r{sender, {}, {}, {}, {}};
     for (auto& [part, w] : parts) {
       HandoffContent c = from_wire(w);
       r.measurements.insert(r.measurements.end(), std::make_move_iterator(c.measurements.begin()),
@@ -90,6 +93,8 @@ std::vector<ReceivedHandoff> exchange_handoffs(AgentSession& s, const RobotShare
                                  c.measurement_index.end());
       r.poses.insert(r.poses.end(), std::make_move_iterator(c.poses.begin()),
                      std::make_move_iterator(c.poses.end()));
+      r.known_poses.insert(r.known_poses.end(), std::make_move_iterator(c.known_poses.begin()),
+                           std::make_move_iterator(c.known_poses.end()));
       w = wire::MeasurementHandoff();  // decoded: free its arrays now
     }
     received.push_back(std::move(r));
