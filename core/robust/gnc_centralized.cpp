@@ -103,8 +103,13 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
 
   for (std::size_t e = 0; e < m; ++e)
     if (out.weights[e] < 0.5) out.rejected.push_back(e);
-  // Re-admission (RobustOptions::readmission_passes): rejected measurements within the bound
-  // at the inlier set's solution are taken back and the set solved again.
+  // Re-check passes (RobustOptions::readmission_passes): at the inlier set's solution every
+  // measurement that may be rejected is judged by TLS itself: a rejected one within the bound
+  // (r^2 <= c^2) comes back, a kept one beyond it leaves, and the new set is solved again. Each
+  // pass is a step of block-coordinate descent on the TLS cost (binary weights given the poses,
+  // then the poses given the weights), so the TLS cost never rises. Kept measurements beyond the
+  // bound are wrong closures that GNC's last iterate still fitted with the help of a distortion;
+  // without them the solve relaxes it.
   CentralizedOptions final_options = options.solver;
   final_options.initialization = Initialization::kFile;
   std::vector<Pose> start = solve.poses;
@@ -114,18 +119,23 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
     out.final_solve = solve_centralized(inliers, final_options);
     add_iterations(out, out.final_solve);
     if (pass == robust.readmission_passes || out.rejected.empty()) break;
-    std::vector<std::size_t> still;
+    std::vector<std::size_t> next;
+    std::size_t back = 0;
     const std::vector<Pose>& poses = out.final_solve.poses;
-    for (std::size_t e : out.rejected) {
-      const Measurement& m = graph.measurements[e];
-      if (residual_squared(m, poses[m.i], poses[m.j]) <= c2)
-        out.weights[e] = 1.0;
-      else
-        still.push_back(e);
+    for (std::size_t e = 0; e < m; ++e) {
+      if (known[e]) continue;
+      const Measurement& x = graph.measurements[e];
+      const bool was_rejected = std::binary_search(out.rejected.begin(), out.rejected.end(), e);
+      const bool fits = residual_squared(x, poses[x.i], poses[x.j]) <= c2;
+      if (!fits) next.push_back(e);
+      if (was_rejected && fits) ++back;
     }
-    if (still.size() == out.rejected.size()) break;
-    out.readmitted += out.rejected.size() - still.size();
-    out.rejected = std::move(still);
+    if (next == out.rejected) break;
+    for (std::size_t e = 0; e < m; ++e)
+      if (!known[e]) out.weights[e] = std::binary_search(next.begin(), next.end(), e) ? 0.0 : 1.0;
+    out.readmitted += back;
+    out.late_rejected += next.size() + back - out.rejected.size();
+    out.rejected = std::move(next);
     start = poses;
   }
   return out;
