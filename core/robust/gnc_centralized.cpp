@@ -4,6 +4,7 @@
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
 #include <tessera/robust/pairwise_consistency.hpp>
+#include <tessera/robust/tls_recheck.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
@@ -119,23 +120,16 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
     out.final_solve = solve_centralized(inliers, final_options);
     add_iterations(out, out.final_solve);
     if (pass == robust.readmission_passes || out.rejected.empty()) break;
-    std::vector<std::size_t> next;
-    std::size_t back = 0;
     const std::vector<Pose>& poses = out.final_solve.poses;
-    for (std::size_t e = 0; e < m; ++e) {
-      if (known[e]) continue;
-      const Measurement& x = graph.measurements[e];
-      const bool was_rejected = std::binary_search(out.rejected.begin(), out.rejected.end(), e);
-      const bool fits = residual_squared(x, poses[x.i], poses[x.j]) <= c2;
-      if (!fits) next.push_back(e);
-      if (was_rejected && fits) ++back;
-    }
-    if (next == out.rejected) break;
+    TlsRecheck verdict = tls_recheck(graph, known, poses, c2, out.rejected);
+    if (verdict.rejected == out.rejected) break;
     for (std::size_t e = 0; e < m; ++e)
-      if (!known[e]) out.weights[e] = std::binary_search(next.begin(), next.end(), e) ? 0.0 : 1.0;
-    out.readmitted += back;
-    out.late_rejected += next.size() + back - out.rejected.size();
-    out.rejected = std::move(next);
+      if (!known[e])
+        out.weights[e] =
+            std::binary_search(verdict.rejected.begin(), verdict.rejected.end(), e) ? 0.0 : 1.0;
+    out.readmitted += verdict.taken_back;
+    out.late_rejected += verdict.dropped;
+    out.rejected = std::move(verdict.rejected);
     start = poses;
   }
   return out;
