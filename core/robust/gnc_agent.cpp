@@ -178,7 +178,14 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   std::vector<Measurement> measurements;
   if (solve_kind_ != Solve::kGnc) {
     measurements = kept_;
-    if (solve_kind_ == Solve::kInlierPass) solve_options_.certify = false;
+    if (solve_kind_ == Solve::kInlierPass) {
+      solve_options_.certify = false;
+      // A pass whose set may still change needs only a rough solution; the verdict that ends
+      // the passes is taken at a converged one (after_exchange, kReadmitted).
+      if (pass_capped_)
+        solve_options_.max_rounds =
+            std::min(solve_options_.max_rounds, options_.robust.recheck_max_rounds);
+    }
   } else {
     solve_options_.certify = false;
     // Every solve before the inlier passes needs only a rough minimiser.
@@ -397,6 +404,8 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
   state_.reset();
   layout_ = std::move(layout);
   solve_kind_ = Solve::kInlierPass;
+  pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;
+  full_pass_next_ = false;
   ++g_;
   begin_solve(out);
 }
@@ -502,6 +511,12 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     case Step::kReadmitted: {
       ++pass_;
       if (taken_back_.empty() && dropped_.empty()) {
+        if (pass_capped_) {
+          // No change at a rough solution: the same set once more, solved to the tolerance.
+          full_pass_next_ = true;
+          begin_inlier_pass(out);
+          return;
+        }
         finish(out);
         return;
       }

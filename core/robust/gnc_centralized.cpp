@@ -7,6 +7,7 @@
 #include <tessera/robust/tls_recheck.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
+#include <tessera/solvers/chordal_initialization.hpp>
 #include <tessera/util/input_error.hpp>
 
 namespace tessera {
@@ -19,6 +20,12 @@ std::vector<double> residuals(const PoseGraph& graph, const std::vector<Pose>& p
     r2[e] = residual_squared(m, poses[m.i], poses[m.j]);
   }
   return r2;
+}
+
+double kept_cost(const PoseGraph& graph, const std::vector<Pose>& poses) {
+  double f = 0;
+  for (const Measurement& m : graph.measurements) f += residual_squared(m, poses[m.i], poses[m.j]);
+  return f;
 }
 
 void add_iterations(GncCentralizedResult& out, const CentralizedResult& solve) {
@@ -117,6 +124,12 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   for (int pass = 0;; ++pass) {
     PoseGraph inliers = inlier_graph(graph, out.rejected, start);
     require_connected_inliers(graph, inliers, out.rejected.size());
+    // Start from the cheaper of the last estimate and the chordal guess of the kept set: an
+    // estimate that GNC bent around wrong closures can lead the local solve to a poor solution
+    // of the kept set, and without the wrong closures chordal is close to its optimum again
+    // (the distributed passes vote the same way).
+    const std::vector<Pose> guess = chordal_initialization(inliers);
+    if (kept_cost(inliers, guess) < kept_cost(inliers, start)) inliers.initial = guess;
     out.final_solve = solve_centralized(inliers, final_options);
     add_iterations(out, out.final_solve);
     if (pass == robust.readmission_passes || out.rejected.empty()) break;

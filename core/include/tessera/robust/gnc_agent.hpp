@@ -187,8 +187,10 @@ class GncAgent : public AgentProcess {
   std::uint32_t g_ = 0;  // GNC step
   Step step_ = Step::kSolve;
   Solve solve_kind_ = Solve::kGnc;
-  bool voted_ = false;  // the votes of mu's start are in
-  int pass_ = 0;        // inlier passes done
+  bool voted_ = false;           // the votes of mu's start are in
+  int pass_ = 0;                 // inlier passes done
+  bool pass_capped_ = false;     // the current pass stops at RobustOptions::recheck_max_rounds
+  bool full_pass_next_ = false;  // the next pass is solved to the tolerance
   std::size_t readmitted_ = 0;
   std::vector<std::uint64_t> taken_back_;  // the current re-check exchange's ids back in
   std::vector<std::uint64_t> dropped_;     // and its ids newly out
