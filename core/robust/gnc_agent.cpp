@@ -433,6 +433,12 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
   gnc_rounds_ += solve_->total_rounds();
   if (solve_kind_ == Solve::kInlierPass) {
     if (pass_ >= options_.robust.readmission_passes || rejected_.empty()) {
+      // Without a certified solve to follow, the last pass must reach the tolerance itself.
+      if (pass_capped_ && !options_.solver.certify) {
+        full_pass_next_ = true;
+        begin_inlier_pass(out);
+        return;
+      }
       finish(out);
       return;
     }
