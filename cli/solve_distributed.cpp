@@ -290,10 +290,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       part.adjacent_block_pairs = adjacency.adjacent_block_pairs;
       part.colours = adjacency.colours;
     }
-  if (robust.kind == RobustKind::kPcmGnc)
-    throw InputError("option --robust: pcm-gnc is centralized only (--algorithm centralized)");
   GncDistributedResult gnc;
-  if (robust.kind == RobustKind::kGncTls) {
+  if (robust.kind != RobustKind::kNone) {
     // Like the centralized robust solve: the known inliers' start unless --init is given.
     GncDistributedOptions options;
     options.solver = opt;
