@@ -461,19 +461,19 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // wrong closure that GNC's iterate fitted with the help of a distortion and leaves
       // (weight 0). Each pass is a descent step of the TLS cost (binary weights given the poses).
       taken_back_.clear();
-      dropped_.clear();
+      cut_now_.clear();
       for (std::size_t k : owned_) {
         if (!may_reject(k)) continue;
         const std::uint64_t id = in_.measurement_index[k];
         const bool was_rejected = std::binary_search(rejected_.begin(), rejected_.end(), id);
         const bool fits = residual_squared_at(k) <= c2_;
         if (was_rejected && fits) taken_back_.push_back(id);
-        if (!was_rejected && !fits) dropped_.push_back(id);
+        if (!was_rejected && !fits) cut_now_.push_back(id);
       }
       RoundStatusMessage st;
       st.measurement_ids = taken_back_;
       st.weights.assign(taken_back_.size(), 1.0);
-      st.measurement_ids.insert(st.measurement_ids.end(), dropped_.begin(), dropped_.end());
+      st.measurement_ids.insert(st.measurement_ids.end(), cut_now_.begin(), cut_now_.end());
       st.weights.resize(st.measurement_ids.size(), 0.0);
       to_others(st, true, nullptr);
       break;
@@ -756,7 +756,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     }
     case Step::kReadmitted: {
       ++pass_;
-      if (taken_back_.empty() && dropped_.empty()) {
+      if (taken_back_.empty() && cut_now_.empty()) {
         if (pass_capped_) {
           // No change at a rough solution: the same set once more, solved to the tolerance.
           full_pass_next_ = true;
@@ -767,19 +767,19 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
         return;
       }
       std::sort(taken_back_.begin(), taken_back_.end());
-      std::sort(dropped_.begin(), dropped_.end());
+      std::sort(cut_now_.begin(), cut_now_.end());
       for (std::size_t k = 0; k < in_.measurements.size(); ++k) {
         const std::uint64_t id = in_.measurement_index[k];
         if (std::binary_search(taken_back_.begin(), taken_back_.end(), id)) weights_[k] = 1.0;
-        if (std::binary_search(dropped_.begin(), dropped_.end(), id)) weights_[k] = 0.0;
+        if (std::binary_search(cut_now_.begin(), cut_now_.end(), id)) weights_[k] = 0.0;
       }
       std::vector<std::uint64_t> still;
       std::set_difference(rejected_.begin(), rejected_.end(), taken_back_.begin(),
                           taken_back_.end(), std::back_inserter(still));
       readmitted_ += rejected_.size() - still.size();
-      late_rejected_ += dropped_.size();
+      late_rejected_ += cut_now_.size();
       rejected_.clear();
-      std::merge(still.begin(), still.end(), dropped_.begin(), dropped_.end(),
+      std::merge(still.begin(), still.end(), cut_now_.begin(), cut_now_.end(),
                  std::back_inserter(rejected_));
       begin_inlier_pass(out);
       return;
@@ -888,7 +888,7 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
         throw std::runtime_error(me + "re-check from agent " + std::to_string(sender) +
                                  " does not match its measurements");
       for (std::size_t q = 0; q < st->measurement_ids.size(); ++q)
-        (st->weights.empty() || st->weights[q] > 0.5 ? taken_back_ : dropped_)
+        (st->weights.empty() || st->weights[q] > 0.5 ? taken_back_ : cut_now_)
             .push_back(st->measurement_ids[q]);
     }
   }

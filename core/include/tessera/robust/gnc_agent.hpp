@@ -237,7 +237,7 @@ class GncAgent : public AgentProcess {
   bool full_pass_next_ = false;  // the next pass is solved to the tolerance
   std::size_t readmitted_ = 0;
   std::vector<std::uint64_t> taken_back_;  // the current re-check exchange's ids back in
-  std::vector<std::uint64_t> dropped_;     // and its ids newly out
+  std::vector<std::uint64_t> cut_now_;     // and its ids newly out
   std::size_t late_rejected_ = 0;
   std::vector<bool> known_;                   // per measurement of the whole graph
   bool known_connected_ = false;              // the known inliers alone connect the poses
