@@ -45,6 +45,24 @@ TEST(GncSchedule, TrueClosuresMisjudgedOnARoughIterateAreReadmitted) {
   for (std::size_t e : r.outliers) EXPECT_EQ(g.weights[e], 0.0);
 }
 
+TEST(GncSchedule, CappedReCheckPassesEndWithTheSameSetInFewerRounds) {
+  // The schedule above leaves true closures to take back, so passes run: solved to the
+  // tolerance each, or capped while the set may still change (the last one never is).
+  const GeneratorResult r = grid_with_outliers(0.25);
+  GncDistributedOptions o = irbcd_gnc();
+  o.robust.inner_max_rounds = 1;
+  o.robust.mu_step = 4.0;
+  o.robust.recheck_max_rounds = 0;
+  const GncDistributedResult full = solve_gnc_distributed(r.graph, robots_as_blocks(r), o);
+  o.robust.recheck_max_rounds = 2;
+  const GncDistributedResult capped = solve_gnc_distributed(r.graph, robots_as_blocks(r), o);
+  ASSERT_GT(full.readmitted, 0u);
+  EXPECT_EQ(full.rejected, r.outliers);
+  EXPECT_EQ(capped.rejected, r.outliers);
+  EXPECT_NEAR(capped.final_solve.cost, full.final_solve.cost, 1e-6 * full.final_solve.cost);
+  EXPECT_LT(capped.total_rounds, full.total_rounds);
+}
+
 TEST(GncSchedule, ACleanGraphStartsWhereThePlainSolveStarts) {
   // On clean data the solver's own (chordal) start has the lower TLS cost: nothing to
   // reject, no outer step, and the rounds of the plain solve plus the capped first solve.

@@ -5,6 +5,7 @@
 #include <string>
 #include <tessera/generate/generator.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
+#include <tessera/robust/tls_recheck.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
@@ -123,6 +124,34 @@ TEST(GncCentralized, CleanGraphLosesNothingAndEndsAtThePlainOptimum) {
   EXPECT_TRUE(robust.rejected.empty());
   EXPECT_NEAR(robust.final_solve.cost, plain.cost, 1e-6 * plain.cost);
   EXPECT_TRUE(robust.final_solve.certified.value_or(false));
+}
+
+TEST(TlsRecheck, AtTheCleanOptimumTheVerdictIsExactlyTheWrongClosures) {
+  // A set that keeps one wrong closure and cuts one true closure: at the clean optimum TLS's
+  // own verdict (r^2 > c^2) drops the first and takes the second back.
+  const GeneratorResult clean = grid_with_outliers(0.0);
+  const GeneratorResult dirty = grid_with_outliers(0.25);
+  ASSERT_GE(dirty.outliers.size(), 2u);
+  const std::vector<Pose> optimum = solve_centralized(clean.graph).poses;
+  std::vector<bool> known(dirty.graph.num_measurements());
+  std::size_t true_closure = dirty.graph.num_measurements();
+  for (std::size_t e = 0; e < known.size(); ++e) {
+    known[e] = is_known_inlier(dirty.graph.measurements[e], KnownInliers::kOdometry);
+    if (!known[e] && e < dirty.outliers.front()) true_closure = e;
+  }
+  ASSERT_LT(true_closure, dirty.outliers.front());
+  std::vector<std::size_t> rejected(dirty.outliers.begin() + 1, dirty.outliers.end());
+  rejected.insert(rejected.begin(), true_closure);
+  const double c2 = tls_threshold_squared(RobustOptions{}, 3, dirty.outliers.size());
+  const TlsRecheck r = tls_recheck(dirty.graph, known, optimum, c2, rejected);
+  EXPECT_EQ(r.rejected, dirty.outliers);
+  EXPECT_EQ(r.taken_back, 1u);
+  EXPECT_EQ(r.dropped, 1u);
+  // Known inliers are never judged, however far off.
+  std::vector<Pose> bent = optimum;
+  bent[1].t.array() += 30.0;
+  for (std::size_t e : tls_recheck(dirty.graph, known, bent, c2, r.rejected).rejected)
+    EXPECT_FALSE(known[e]);
 }
 
 TEST(GncCentralized, KnownOdometryInliersAreNeverRejected) {

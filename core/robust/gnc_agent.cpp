@@ -205,7 +205,14 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   std::vector<Measurement> measurements;
   if (solve_kind_ != Solve::kGnc) {
     measurements = kept_;
-    if (solve_kind_ == Solve::kInlierPass) solve_options_.certify = false;
+    if (solve_kind_ == Solve::kInlierPass) {
+      solve_options_.certify = false;
+      // A pass whose set may still change needs only a rough solution; the verdict that ends
+      // the passes is taken at a converged one (after_exchange, kReadmitted).
+      if (pass_capped_)
+        solve_options_.max_rounds =
+            std::min(solve_options_.max_rounds, options_.robust.recheck_max_rounds);
+    }
   } else {
     solve_options_.certify = false;
     // Every solve before the inlier passes needs only a rough minimiser.
@@ -449,15 +456,25 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       break;
     }
     case Step::kReadmitted: {
-      // A rejected measurement within the bound at the kept set's solution (TLS would count
-      // it as an inlier there) was misjudged on a rough iterate: it comes back.
+      // TLS's own verdict at the kept set's solution: a rejected measurement within the bound
+      // was misjudged on a rough iterate and comes back (weight 1), a kept one beyond it is a
+      // wrong closure that GNC's iterate fitted with the help of a distortion and leaves
+      // (weight 0). Each pass is a descent step of the TLS cost (binary weights given the poses).
       taken_back_.clear();
-      for (std::size_t k : owned_)
-        if (std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k]) &&
-            residual_squared_at(k) <= c2_)
-          taken_back_.push_back(in_.measurement_index[k]);
+      cut_now_.clear();
+      for (std::size_t k : owned_) {
+        if (!may_reject(k)) continue;
+        const std::uint64_t id = in_.measurement_index[k];
+        const bool was_rejected = std::binary_search(rejected_.begin(), rejected_.end(), id);
+        const bool fits = residual_squared_at(k) <= c2_;
+        if (was_rejected && fits) taken_back_.push_back(id);
+        if (!was_rejected && !fits) cut_now_.push_back(id);
+      }
       RoundStatusMessage st;
       st.measurement_ids = taken_back_;
+      st.weights.assign(taken_back_.size(), 1.0);
+      st.measurement_ids.insert(st.measurement_ids.end(), cut_now_.begin(), cut_now_.end());
+      st.weights.resize(st.measurement_ids.size(), 0.0);
       to_others(st, true, nullptr);
       break;
     }
@@ -498,6 +515,8 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
   state_.reset();
   layout_ = std::move(layout);
   solve_kind_ = Solve::kInlierPass;
+  pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;
+  full_pass_next_ = false;
   ++g_;
   begin_solve(out);
 }
@@ -599,6 +618,12 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
   gnc_rounds_ += solve_->total_rounds();
   if (solve_kind_ == Solve::kInlierPass) {
     if (pass_ >= options_.robust.readmission_passes || rejected_.empty()) {
+      // Without a certified solve to follow, the last pass must reach the tolerance itself.
+      if (pass_capped_ && !options_.solver.certify) {
+        full_pass_next_ = true;
+        begin_inlier_pass(out);
+        return;
+      }
       finish(out);
       return;
     }
@@ -731,19 +756,31 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     }
     case Step::kReadmitted: {
       ++pass_;
-      if (taken_back_.empty()) {
+      if (taken_back_.empty() && cut_now_.empty()) {
+        if (pass_capped_) {
+          // No change at a rough solution: the same set once more, solved to the tolerance.
+          full_pass_next_ = true;
+          begin_inlier_pass(out);
+          return;
+        }
         finish(out);
         return;
       }
       std::sort(taken_back_.begin(), taken_back_.end());
-      for (std::size_t k = 0; k < in_.measurements.size(); ++k)
-        if (std::binary_search(taken_back_.begin(), taken_back_.end(), in_.measurement_index[k]))
-          weights_[k] = 1.0;
+      std::sort(cut_now_.begin(), cut_now_.end());
+      for (std::size_t k = 0; k < in_.measurements.size(); ++k) {
+        const std::uint64_t id = in_.measurement_index[k];
+        if (std::binary_search(taken_back_.begin(), taken_back_.end(), id)) weights_[k] = 1.0;
+        if (std::binary_search(cut_now_.begin(), cut_now_.end(), id)) weights_[k] = 0.0;
+      }
       std::vector<std::uint64_t> still;
       std::set_difference(rejected_.begin(), rejected_.end(), taken_back_.begin(),
                           taken_back_.end(), std::back_inserter(still));
       readmitted_ += rejected_.size() - still.size();
-      rejected_ = std::move(still);
+      late_rejected_ += cut_now_.size();
+      rejected_.clear();
+      std::merge(still.begin(), still.end(), cut_now_.begin(), cut_now_.end(),
+                 std::back_inserter(rejected_));
       begin_inlier_pass(out);
       return;
     }
@@ -845,8 +882,15 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     }
     if (step_ == Step::kRejected)
       rejected_.insert(rejected_.end(), st->measurement_ids.begin(), st->measurement_ids.end());
-    if (step_ == Step::kReadmitted)
-      taken_back_.insert(taken_back_.end(), st->measurement_ids.begin(), st->measurement_ids.end());
+    if (step_ == Step::kReadmitted) {
+      // Weight 1: taken back; 0: rejected at the kept set's solution (no weights: taken back).
+      if (!st->weights.empty() && st->weights.size() != st->measurement_ids.size())
+        throw std::runtime_error(me + "re-check from agent " + std::to_string(sender) +
+                                 " does not match its measurements");
+      for (std::size_t q = 0; q < st->measurement_ids.size(); ++q)
+        (st->weights.empty() || st->weights[q] > 0.5 ? taken_back_ : cut_now_)
+            .push_back(st->measurement_ids[q]);
+    }
   }
   if (waiting_.empty()) after_exchange(out);
 }

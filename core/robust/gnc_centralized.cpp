@@ -4,8 +4,10 @@
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
 #include <tessera/robust/pairwise_consistency.hpp>
+#include <tessera/robust/tls_recheck.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
+#include <tessera/solvers/chordal_initialization.hpp>
 #include <tessera/util/input_error.hpp>
 
 namespace tessera {
@@ -18,6 +20,12 @@ std::vector<double> residuals(const PoseGraph& graph, const std::vector<Pose>& p
     r2[e] = residual_squared(m, poses[m.i], poses[m.j]);
   }
   return r2;
+}
+
+double kept_cost(const PoseGraph& graph, const std::vector<Pose>& poses) {
+  double f = 0;
+  for (const Measurement& m : graph.measurements) f += residual_squared(m, poses[m.i], poses[m.j]);
+  return f;
 }
 
 void add_iterations(GncCentralizedResult& out, const CentralizedResult& solve) {
@@ -103,29 +111,38 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
 
   for (std::size_t e = 0; e < m; ++e)
     if (out.weights[e] < 0.5) out.rejected.push_back(e);
-  // Re-admission (RobustOptions::readmission_passes): rejected measurements within the bound
-  // at the inlier set's solution are taken back and the set solved again.
+  // Re-check passes (RobustOptions::readmission_passes): at the inlier set's solution every
+  // measurement that may be rejected is judged by TLS itself: a rejected one within the bound
+  // (r^2 <= c^2) comes back, a kept one beyond it leaves, and the new set is solved again. Each
+  // pass is a step of block-coordinate descent on the TLS cost (binary weights given the poses,
+  // then the poses given the weights), so the TLS cost never rises. Kept measurements beyond the
+  // bound are wrong closures that GNC's last iterate still fitted with the help of a distortion;
+  // without them the solve relaxes it.
   CentralizedOptions final_options = options.solver;
   final_options.initialization = Initialization::kFile;
   std::vector<Pose> start = solve.poses;
   for (int pass = 0;; ++pass) {
     PoseGraph inliers = inlier_graph(graph, out.rejected, start);
     require_connected_inliers(graph, inliers, out.rejected.size());
+    // Start from the cheaper of the last estimate and the chordal guess of the kept set: an
+    // estimate that GNC bent around wrong closures can lead the local solve to a poor solution
+    // of the kept set, and without the wrong closures chordal is close to its optimum again
+    // (the distributed passes vote the same way).
+    const std::vector<Pose> guess = chordal_initialization(inliers);
+    if (kept_cost(inliers, guess) < kept_cost(inliers, start)) inliers.initial = guess;
     out.final_solve = solve_centralized(inliers, final_options);
     add_iterations(out, out.final_solve);
     if (pass == robust.readmission_passes || out.rejected.empty()) break;
-    std::vector<std::size_t> still;
     const std::vector<Pose>& poses = out.final_solve.poses;
-    for (std::size_t e : out.rejected) {
-      const Measurement& m = graph.measurements[e];
-      if (residual_squared(m, poses[m.i], poses[m.j]) <= c2)
-        out.weights[e] = 1.0;
-      else
-        still.push_back(e);
-    }
-    if (still.size() == out.rejected.size()) break;
-    out.readmitted += out.rejected.size() - still.size();
-    out.rejected = std::move(still);
+    TlsRecheck verdict = tls_recheck(graph, known, poses, c2, out.rejected);
+    if (verdict.rejected == out.rejected) break;
+    for (std::size_t e = 0; e < m; ++e)
+      if (!known[e])
+        out.weights[e] =
+            std::binary_search(verdict.rejected.begin(), verdict.rejected.end(), e) ? 0.0 : 1.0;
+    out.readmitted += verdict.taken_back;
+    out.late_rejected += verdict.dropped;
+    out.rejected = std::move(verdict.rejected);
     start = poses;
   }
   return out;

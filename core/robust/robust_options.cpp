@@ -53,6 +53,9 @@ void RobustOptions::validate() const {
     bad_field("inner_max_rounds", std::to_string(inner_max_rounds), "must be >= 0 (0 = no cap)");
   if (!(std::isfinite(mu_step) && mu_step > 1))
     bad_field("mu_step", number_text(mu_step), "must be > 1");
+  if (recheck_max_rounds < 0)
+    bad_field("recheck_max_rounds", std::to_string(recheck_max_rounds),
+              "must be >= 0 (0 = no cap)");
   if (readmission_passes < 0)
     bad_field("readmission_passes", std::to_string(readmission_passes), "must be >= 0");
   if (!(std::isfinite(weight_tolerance) && weight_tolerance >= 0))

@@ -27,7 +27,8 @@
 //   inlier pass p = 0.. readmission_passes: solve of the kept set to the solver's tolerance
 //   (uncertified);
 //     poses, then readmitted -> every agent: its rejected measurements within the bound at
-//     that solution (misjudged on a rough iterate); none anywhere ends the passes
+//     that solution (misjudged on a rough iterate; weight 1) and its kept ones beyond it
+//     (weight 0); no change anywhere ends the passes
 //   final: with certification, the certified solve of the kept set
 //
 // Each weight is computed by one agent, the owner of the measurement's lower pose id
@@ -151,6 +152,8 @@ class GncAgent : public AgentProcess {
   const std::vector<std::uint64_t>& rejected() const { return rejected_; }  ///< Ascending.
   int outer_iterations() const { return outer_; }
   std::size_t readmitted() const { return readmitted_; }  ///< Taken back by the passes.
+  /// Kept by GNC, rejected by a pass (beyond the bound at the kept set's solution).
+  std::size_t late_rejected() const { return late_rejected_; }
   bool weights_converged() const { return converged_; }
   double threshold_squared() const { return c2_; }
   /// Rounds of the solves before the final certified one (first, weighted, inlier passes).
@@ -228,10 +231,14 @@ class GncAgent : public AgentProcess {
   std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
   Solve solve_kind_ = Solve::kGnc;
-  bool voted_ = false;  // the votes of mu's start are in
-  int pass_ = 0;        // inlier passes done
+  bool voted_ = false;           // the votes of mu's start are in
+  int pass_ = 0;                 // inlier passes done
+  bool pass_capped_ = false;     // the current pass stops at RobustOptions::recheck_max_rounds
+  bool full_pass_next_ = false;  // the next pass is solved to the tolerance
   std::size_t readmitted_ = 0;
-  std::vector<std::uint64_t> taken_back_;     // the current re-admission exchange's ids
+  std::vector<std::uint64_t> taken_back_;  // the current re-check exchange's ids back in
+  std::vector<std::uint64_t> cut_now_;     // and its ids newly out
+  std::size_t late_rejected_ = 0;
   std::vector<bool> known_;                   // per measurement of the whole graph
   bool known_connected_ = false;              // the known inliers alone connect the poses
   std::vector<std::uint64_t> zero_cut_;       // cut measurements of weight 0 (others' too)

@@ -74,6 +74,9 @@ struct GncDistributedResult {
   /// Measurements GNC had rejected whose residual at the inlier set's solution was within the
   /// bound (r^2 <= c^2), taken back before the final solve.
   std::size_t readmitted = 0;
+  /// Measurements GNC had kept whose residual at an inlier set's solution was beyond the bound,
+  /// rejected by the same passes.
+  std::size_t late_rejected = 0;
   double threshold_squared = 0;
   bool weights_converged = false;
 };

@@ -1,0 +1,26 @@
+#pragma once
+// TLS's own verdict on a set of kept measurements at given poses: the step after GNC that
+// judges every rejectable measurement at the inlier set's solution (RobustOptions::
+// readmission_passes). With the poses fixed, the binary weights that minimise the TLS cost
+// sum_e min(r_e^2, c^2) are w_e = [r_e^2 <= c^2]; alternating this with a solve of the kept set
+// never raises the TLS cost.
+
+#include <cstddef>
+#include <tessera/graph/pose_graph.hpp>
+#include <vector>
+
+namespace tessera {
+
+struct TlsRecheck {
+  std::vector<std::size_t> rejected;  ///< Measurements with r^2 > c^2 (not known), ascending.
+  std::size_t taken_back = 0;         ///< Rejected before, within the bound now.
+  std::size_t dropped = 0;            ///< Kept before, beyond the bound now.
+};
+
+/// The verdict at `poses` for every measurement with known[e] false (known ones are never
+/// rejected), compared with the previous `rejected` set (ascending).
+TlsRecheck tls_recheck(const PoseGraph& graph, const std::vector<bool>& known,
+                       const std::vector<Pose>& poses, double c2,
+                       const std::vector<std::size_t>& rejected);
+
+}  // namespace tessera
