@@ -2,6 +2,7 @@
 #include <chrono>
 #include <ctime>
 #include <memory>
+#include <tessera/certification/rounding_gap.hpp>
 #include <tessera/distributed/agent_factory.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
@@ -207,6 +208,9 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
     res.poses = round_solution(graph, res.X);
     res.rounding_s = since(rounding_start);
     res.cost = evaluate_objective(graph, res.poses);
+    // Certified X, rounding far above f(X): the relaxation is not tight, the estimate unproven.
+    if (res.certified && *res.certified && !rounding_is_tight(res.cost, res.relaxation_cost))
+      res.certified = false;
   }
   res.wall_s = since(start);
   return res;

@@ -3,6 +3,7 @@
 #include <future>
 #include <memory>
 #include <sstream>
+#include <tessera/certification/rounding_gap.hpp>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/problem/objective.hpp>
@@ -252,6 +253,10 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     res.poses = round_solution(graph, X);
   }
   res.cost = evaluate_objective(graph, res.poses);
+  // A certified X whose rounding lands far above f(X) is a relaxation that is not tight: the
+  // estimate is not proven optimal.
+  if (res.certified && *res.certified && !rounding_is_tight(res.cost, res.relaxation_cost))
+    res.certified = false;
   res.total_s = seconds_since(start);
   return res;
 }
@@ -269,7 +274,11 @@ std::string CentralizedResult::full_report() const {
     os << ", stop: " << l.stop_reason << ", " << l.elapsed_s << " s\n";
   }
   os << "  rounded cost " << cost << " (relaxation " << relaxation_cost << ")\n";
-  os << "  certified: " << (certified ? (*certified ? "yes" : "no") : "not checked") << "\n";
+  os << "  certified: " << (certified ? (*certified ? "yes" : "no") : "not checked");
+  if (certified && !*certified && !levels.empty() && levels.back().certified)
+    os << " (relaxation certified but not tight: the rounded cost is "
+       << relative_rounding_gap(cost, relaxation_cost) << " relative above f(X))";
+  os << "\n";
   os << "  time: init " << init_s << " s, optimize " << optimize_s << " s, certify " << certify_s
      << " s, total " << total_s << " s\n";
   return os.str();

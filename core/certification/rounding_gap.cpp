@@ -1,0 +1,15 @@
+#include <algorithm>
+#include <cmath>
+#include <tessera/certification/rounding_gap.hpp>
+
+namespace tessera {
+
+double relative_rounding_gap(double rounded_cost, double relaxation_cost) {
+  return (rounded_cost - relaxation_cost) / std::max(1.0, std::abs(relaxation_cost));
+}
+
+bool rounding_is_tight(double rounded_cost, double relaxation_cost, double tolerance) {
+  return relative_rounding_gap(rounded_cost, relaxation_cost) <= tolerance;
+}
+
+}  // namespace tessera
