@@ -121,7 +121,10 @@ TEST(CentralizedSolver, StaircaseEscapesFromRankDeficientSaddle) {
   opt.trust_region.grad_norm_tol = 1e-8;
   opt.stop = CentralizedStop::kGradient;
   const CentralizedResult r = solve_centralized(g, opt);
-  EXPECT_TRUE(*r.certified);
+  // The relaxation's certificate: at this noise the relaxation is not tight, so the rounded
+  // estimate itself is not certified (rounding_gap_test).
+  ASSERT_FALSE(r.levels.empty());
+  EXPECT_TRUE(r.levels.back().certified);
   EXPECT_GT(r.final_rank, 2) << "expected the rank-2 start to need the staircase";
   CentralizedOptions ref;
   ref.trust_region.grad_norm_tol = 1e-8;

@@ -56,10 +56,13 @@ TEST(DdsCertificate, StaircaseOverDdsGivesTheInProcessResult) {
   opt.rank = 2;
   opt.certify = true;
   const DistributedResult ref = solve_distributed(g, assignment, opt, g.initial);
-  ASSERT_TRUE(ref.certified.value_or(false));
+  ASSERT_TRUE(ref.certified.has_value());
+  ASSERT_TRUE(ref.certificates.back().result.certified);
   ASSERT_FALSE(ref.escapes.empty()) << "the graph should need the staircase";
 
-  EXPECT_EQ(json_text(summary, "certified"), "true") << summary;
+  // Same verdict on the estimate as in process (the relaxation's certificate and the rounding
+  // gap rule: rounding_gap_test).
+  EXPECT_EQ(json_text(summary, "certified"), *ref.certified ? "true" : "false") << summary;
   EXPECT_EQ(json_number(summary, "final_rank"), ref.final_rank) << summary;
   EXPECT_EQ(json_number(summary, "certificate_rounds"), ref.certificate_rounds) << summary;
   EXPECT_EQ(json_number(summary, "escape_rounds"), ref.escape_rounds) << summary;
