@@ -17,8 +17,8 @@
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {"rate",        "speedup",       "start",
-                                     "checkpoints", "certify-every", nullptr};
+const char* const kOnlineValued[] = {"rate",        "speedup",       "start",          "checkpoints",
+                                     "certify-every", "refactor-growth", nullptr};
 const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", nullptr};
 
 const char* kOnlineHelp =
@@ -43,6 +43,9 @@ const char* kOnlineHelp =
     "                            report its CPU time\n"
     "  --certify-every S         also certify every S seconds of stream time (default 0: at\n"
     "                            the end only)\n"
+    "  --refactor-growth G       a growing block keeps its preconditioner factor until it\n"
+    "                            has G times more poses than it was computed for (default\n"
+    "                            0.25; 0 = a new factor whenever the block gets data)\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step)\n";
 
@@ -82,6 +85,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       a.get_long("certify-iters", options.solver.staircase.certificate.max_iterations));
   options.real_time = a.has("real-time");
   options.certify_every_s = a.get_double("certify-every", 0.0);
+  options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
   options.validate();
   ReplayOptions replay;
   replay.rate = a.get_double("rate", replay.rate);

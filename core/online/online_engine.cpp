@@ -4,7 +4,6 @@
 #include <ctime>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
-#include <tessera/online/linked_problem.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
@@ -14,6 +13,8 @@ namespace tessera {
 
 void OnlineOptions::validate() const {
   rebalance.validate();
+  if (!(refactor_growth >= 0) || !std::isfinite(refactor_growth))
+    throw InputError("OnlineOptions.refactor_growth must be a finite number >= 0");
   if (!(certify_every_s >= 0) || !std::isfinite(certify_every_s))
     throw InputError("OnlineOptions.certify_every_s must be a finite number >= 0 (seconds)");
   DistributedOptions s = solver;
@@ -85,7 +86,9 @@ OnlineUpdate OnlineEngine::step(double now_s) {
       rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
   u.moved = moves.moved;
   u.largest_block = moves.largest_after;
-  X_ = extend_estimate(graph, X_, stream_.guesses()).X;
+  // Only the measurements since the last extension can touch a new pose.
+  if (u.poses > 0) X_ = extend_estimate(graph, X_, stream_.guesses(), extended_measurements_).X;
+  extended_measurements_ = graph.measurements.size();
   DistributedOptions solver = options_.solver;
   solver.certify = false;
   solver.round_result = false;  // the graph may not be connected yet
@@ -114,12 +117,20 @@ OnlineUpdate OnlineEngine::step(double now_s) {
 }
 
 DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
-  const LinkedProblem p = make_linked_problem(stream_.graph(), owner_, X_);
   DistributedResult res;
-  if (p.graph.num_poses == 0) return res;
-  res = solve_distributed_from_lifted(p.graph, p.blocks, solver, p.X0);
-  if (res.X.rows() == X_.rows()) p.write_back(res.X, X_);
-  if (!p.whole) res.poses.clear();  // in the linked graph's ids
+  if (!blocks_)
+    blocks_ = std::make_unique<LiveBlocks>(stream_.graph().d, solver.block_update,
+                                           options_.refactor_growth);
+  const auto setup_start = Clock::now();
+  blocks_->sync(stream_.graph(), owner_, X_);
+  const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
+  if (blocks_->graph().num_poses == 0) return res;
+  DistributedOptions run = solver;
+  run.round_result = false;  // in the linked graph's ids: the caller rounds X_
+  res = solve_distributed_with_states(blocks_->graph(), blocks_->layout(), blocks_->all_states(),
+                                      run);
+  res.init_s += setup_s;
+  if (res.X.rows() == X_.rows()) blocks_->write_back(res.X, X_);
   return res;
 }
 
@@ -141,10 +152,14 @@ OnlineResult OnlineEngine::finish() {
   out.min_eigenvalue = res.min_eigenvalue;
   out.final_rounds = res.rounds;
   out.bytes += res.bytes_exchanged;
-  out.cost = res.cost;
   out.grad_norm = res.grad_norm;
-  out.poses = res.poses;
-  if (solver.round_result && out.poses.size() != out.graph.num_poses) {
+  if (res.X.rows() > X_.rows()) {  // the staircase climbed: the result has more rows
+    Eigen::MatrixXd wide = Eigen::MatrixXd::Zero(res.X.rows(), X_.cols());
+    wide.topRows(X_.rows()) = X_;
+    blocks_->write_back(res.X, wide);
+    X_ = std::move(wide);
+  }
+  if (solver.round_result) {
     out.poses = round_solution(out.graph, X_);
     out.cost = evaluate_objective(out.graph, out.poses);
   }

@@ -14,11 +14,13 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/online/block_rebalance.hpp>
 #include <tessera/online/graph_stream.hpp>
+#include <tessera/online/live_blocks.hpp>
 #include <tessera/online/stream_batch.hpp>
 #include <vector>
 
@@ -43,6 +45,11 @@ struct OnlineOptions {
   /// stream time (at the first step after each period, once the graph is connected), on the
   /// graph received so far; 0 = only at the end. >= 0.
   double certify_every_s = 0.0;
+  /// A block that grows keeps its preconditioner factor (new poses get their own diagonal
+  /// blocks) until it holds this fraction more poses than the factor was computed for; then the
+  /// factor is computed again (live_blocks.hpp). Amortises the factorisation over the growth
+  /// of the block: 0 = a new factor at every step that brought data to the block. >= 0.
+  double refactor_growth = 0.25;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
@@ -143,6 +150,8 @@ class OnlineEngine {
 
   OnlineOptions options_;
   GraphStream stream_;
+  std::unique_ptr<LiveBlocks> blocks_;     // the agents' states, kept from step to step
+  std::size_t extended_measurements_ = 0;  // measurements the iterate was extended over
   std::vector<StreamBatch> received_;
   Eigen::MatrixXd X_;
   std::vector<int> owner_;  // block of each stream id
