@@ -45,7 +45,7 @@ const char* kOnlineHelp =
     "                            the end only)\n"
     "  --refactor-growth G       a growing block keeps its preconditioner factor until it\n"
     "                            has G times more poses than it was computed for (default\n"
-    "                            0.25; 0 = a new factor whenever the block gets data)\n"
+    "                            0: a new factor whenever the block gets new poses)\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step)\n";
 

@@ -98,24 +98,29 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
   out.new_measurements = graph_.measurements.size() - first_new;
   if (n == 0) return out;
 
-  if (moved) {
-    // A block may have lost every linked pose: number the blocks again from the start.
-    block_of_.clear();
-    compact_block_of_.clear();
-    states_.clear();
-  }
-  const std::size_t renumber_from = moved ? 0 : n_old;
-  for (std::size_t s = renumber_from; s < n; ++s) {
-    const int b = owner_[s];
+  // Compact blocks: the blocks with linked poses in increasing order (as make_linked_problem
+  // numbers them, so an agent keeps its protocol id once every block has linked poses). A new
+  // block before an existing one, or one that lost its last linked pose, renumbers them: every
+  // state is built again then (the numbering does not depend on how the data was grouped into
+  // syncs, so every agent that syncs the same graph agrees on it).
+  std::vector<char> present;
+  for (int b : owner_) {
     if (b < 0) throw std::invalid_argument("LiveBlocks::sync: negative block");
-    if (static_cast<std::size_t>(b) >= compact_block_of_.size())
-      compact_block_of_.resize(static_cast<std::size_t>(b) + 1, -1);
-    int& c = compact_block_of_[static_cast<std::size_t>(b)];
-    if (c < 0) {
-      c = static_cast<int>(block_of_.size());
-      block_of_.push_back(b);
-    }
+    if (static_cast<std::size_t>(b) >= present.size())
+      present.resize(static_cast<std::size_t>(b) + 1, 0);
+    present[static_cast<std::size_t>(b)] = 1;
   }
+  std::vector<int> order;
+  for (std::size_t b = 0; b < present.size(); ++b)
+    if (present[b]) order.push_back(static_cast<int>(b));
+  const bool renumber = moved || order.size() < block_of_.size() ||
+                        !std::equal(block_of_.begin(), block_of_.end(), order.begin());
+  if (renumber) states_.clear();
+  block_of_ = std::move(order);
+  compact_block_of_.assign(present.size(), -1);
+  for (std::size_t c = 0; c < block_of_.size(); ++c)
+    compact_block_of_[static_cast<std::size_t>(block_of_[c])] = static_cast<int>(c);
+  const std::size_t renumber_from = renumber ? 0 : n_old;
   blocks_.resize(n);
   for (std::size_t s = renumber_from; s < n; ++s)
     blocks_[s] = compact_block_of_[static_cast<std::size_t>(owner_[s])];

@@ -9,10 +9,11 @@
 // or gained poses through a re-partition (rebalance_blocks) is built again.
 //
 // The solved graph is the linked part of the stream's graph (linked_problem.hpp: a pose no
-// measurement touches yet has nothing to optimise), numbered in the order its poses became
-// linked and its blocks in the order they got their first linked pose, so the numbering only
-// ever grows and every kept state stays valid. Every agent that builds it from the same stream
-// graph and blocks gets the same numbering (the DDS agents hold only their own block's state).
+// measurement touches yet has nothing to optimise), its poses numbered in the order they became
+// linked (so the numbering only ever grows and every kept state stays valid) and its blocks, as
+// in linked_problem.hpp, in increasing order of the blocks that have linked poses. Every agent
+// that builds it from the same stream graph and blocks gets the same numbering, however the
+// data was grouped into syncs (the DDS agents hold only their own block's state).
 
 #include <Eigen/Core>
 #include <cstddef>
