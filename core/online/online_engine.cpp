@@ -87,22 +87,38 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.moved = moves.moved;
   u.largest_block = moves.largest_after;
   // Only the measurements since the last extension can touch a new pose.
-  if (u.poses > 0) X_ = extend_estimate(graph, X_, stream_.guesses(), extended_measurements_).X;
+  std::size_t composed = 0;
+  if (u.poses > 0) {
+    EstimateExtension e = extend_estimate(graph, X_, stream_.guesses(), extended_measurements_);
+    X_ = std::move(e.X);
+    composed = e.composed;
+  }
   extended_measurements_ = graph.measurements.size();
-  DistributedOptions solver = options_.solver;
-  solver.certify = false;
-  solver.round_result = false;  // the graph may not be connected yet
-  const DistributedResult res = solve_linked(solver);
-  // A stalled iterate (RoundProtocol: cost and gradient repeated bit for bit) cannot improve
-  // on this problem: iterating again before new data arrives would only burn rounds.
-  converged_ = res.grad_norm <= solver.grad_norm_tol || res.stop_reason == "stalled";
-  u.rounds = res.rounds;
-  u.bytes = res.bytes_exchanged;
-  u.grad_norm = res.grad_norm;
-  u.stop_reason = res.stop_reason;
-  u.setup_s = res.init_s;
-  u.rounds_cpu_s = res.solve_cpu_s;
-  u.relaxation_cost = res.relaxation_cost;
+  if (converged_ && composed == u.measurements) {
+    // Every new measurement placed a new pose (odometry, mostly): each has zero residual at
+    // the composed poses, so f and its gradient are what they were and the agents, which were
+    // converged, have nothing to do. Their blocks take the new data in at the next solve.
+    u.grad_norm = last_grad_norm_;
+    u.relaxation_cost = last_relaxation_cost_;
+    u.stop_reason = "unchanged";
+  } else {
+    DistributedOptions solver = options_.solver;
+    solver.certify = false;
+    solver.round_result = false;  // the graph may not be connected yet
+    const DistributedResult res = solve_linked(solver);
+    // A stalled iterate (RoundProtocol: cost and gradient repeated bit for bit) cannot improve
+    // on this problem: iterating again before new data arrives would only burn rounds.
+    converged_ = res.grad_norm <= solver.grad_norm_tol || res.stop_reason == "stalled";
+    last_grad_norm_ = res.grad_norm;
+    last_relaxation_cost_ = res.relaxation_cost;
+    u.rounds = res.rounds;
+    u.bytes = res.bytes_exchanged;
+    u.grad_norm = res.grad_norm;
+    u.stop_reason = res.stop_reason;
+    u.setup_s = res.init_s;
+    u.rounds_cpu_s = res.solve_cpu_s;
+    u.relaxation_cost = res.relaxation_cost;
+  }
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;
   u.latency_s = now_s - oldest + u.ms / 1000.0;

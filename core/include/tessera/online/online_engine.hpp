@@ -81,7 +81,9 @@ struct OnlineUpdate {
   std::uint64_t bytes = 0;  ///< Protocol bytes of the step's rounds.
   double grad_norm = 0.0;   ///< ||grad f|| at the end of the step.
   /// Why the rounds stopped: grad_norm, or stalled (the iterate stopped moving just above the
-  /// tolerance; the next data restarts it), or max_rounds.
+  /// tolerance; the next data restarts it), or max_rounds; unchanged when no round ran because
+  /// every new measurement only placed a new pose (zero residual: the gradient of the converged
+  /// iterate did not change).
   std::string stop_reason;
   double relaxation_cost = 0.0;  ///< f(Y) at the end of the step.
 };
@@ -156,8 +158,9 @@ class OnlineEngine {
   std::size_t extended_measurements_ = 0;  // measurements the iterate was extended over
   std::vector<StreamBatch> received_;
   Eigen::MatrixXd X_;
-  std::vector<int> owner_;  // block of each stream id
-  bool converged_ = true;   // gradient under tolerance at X_
+  std::vector<int> owner_;                                    // block of each stream id
+  bool converged_ = true;                                     // gradient under tolerance at X_
+  double last_grad_norm_ = 0.0, last_relaxation_cost_ = 0.0;  // at the end of the last solve
   OnlineResult totals_;
 };
 
