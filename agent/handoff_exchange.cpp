@@ -18,7 +18,7 @@ std::vector<ReceivedHandoff> exchange_handoffs(AgentSession& s, const RobotShare
     if (b == self) continue;
     HandoffPlan plan = plan_handoff(share, owner, b);
     s.publish(to_wire_handoff(run_id, self, b, share.d, plan.measurements, plan.measurement_index,
-                              plan.poses));
+                              plan.poses, plan.known_poses));
   }
   const std::size_t others = robots - 1;
   auto senders_missing = [&](const std::deque<wire::MeasurementHandoff>& q) {
@@ -42,7 +42,7 @@ std::vector<ReceivedHandoff> exchange_handoffs(AgentSession& s, const RobotShare
   for (auto& w : s.handoffs().take_all()) {
     HandoffContent c = from_wire(w);
     received.push_back({w.sender(), std::move(c.measurements), std::move(c.measurement_index),
-                        std::move(c.poses)});
+                        std::move(c.poses), std::move(c.known_poses)});
   }
   return received;
 }

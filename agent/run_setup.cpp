@@ -137,21 +137,39 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
       structure_of(asg, share.num_poses);
   DdsProtocolChannel channel(s);
   const RunOptions run_options = run_options_of(asg);
+  // The input's own known-inlier flags (a dpgo CSV file's), every measurement's.
+  std::vector<bool> known_flags;
+  if (!asg.known_inlier().empty()) {
+    known_flags.assign(structure.size(), false);
+    for (std::uint32_t e : asg.known_inlier()) {
+      if (e >= structure.size())
+        throw RunFailure(kExitRunFailed, "the assignment flags a measurement out of range");
+      known_flags[e] = true;
+    }
+  }
   {
-    // A robust run starts from the known inliers alone when they connect the poses, like the
-    // in-process engine (robust/gnc_distributed.hpp, gnc_start()).
+    // A robust run also computes the known inliers' start when they connect the poses; the
+    // agents vote between the two before the first solve, like the in-process engine
+    // (robust/gnc_distributed.hpp, known_inlier_poses(); robust/gnc_agent.hpp).
     std::optional<KnownInlierStart> known;
     if (run_options.robust.kind != RobustKind::kNone && run_options.gnc_known_start)
-      known = known_inlier_start(share, structure, run_options.robust.known_inliers);
-    InitializationResult init =
-        known ? run_initialization_stage(known->share, o.id, o.robots, known->structure,
-                                         "distributed", o.graph, channel, o.round_timeout_s)
-              : run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(),
-                                         o.graph, channel, o.round_timeout_s);
-    if (known) init.method += " (known inliers)";
-    share.initial = std::move(init.poses);
-    log("initialisation '" + init.method + "' done in " +
-        std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
+      known = known_inlier_start(share, structure, run_options.robust.known_inliers, known_flags);
+    if (known) {
+      auto [init, known_init] = run_initialization_stages(
+          share, known->share, o.id, o.robots, structure, known->structure, asg.initialization(),
+          "distributed", o.graph, channel, o.round_timeout_s);
+      share.initial = std::move(init.poses);
+      share.known_initial = std::move(known_init.poses);
+      log("initialisation '" + init.method + "' and 'distributed' of the known inliers done in " +
+          std::to_string(static_cast<long>((init.seconds + known_init.seconds) * 1000)) + " ms");
+    } else {
+      InitializationResult init =
+          run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(), o.graph,
+                                   channel, o.round_timeout_s);
+      share.initial = std::move(init.poses);
+      log("initialisation '" + init.method + "' done in " +
+          std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
+    }
   }
 
   // 7. Hand-off, peer to peer: exactly one message to every other agent. A peer sends its
@@ -163,6 +181,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
                         std::max(o.net.timeout_s, o.round_timeout_s));
   out.local = assemble_local(share, asg.owner(), o.id, o.robots, std::move(received), run_options);
   out.local.structure = std::move(structure);
+  out.local.known_inlier = std::move(known_flags);
   log("hand-off complete: " + std::to_string(out.local.owned.size()) + " poses, " +
       std::to_string(out.local.measurements.size()) + " measurements");
   if (!o.dump_local.empty()) write_local_dump(out.local, o.dump_local);

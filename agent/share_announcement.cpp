@@ -23,6 +23,7 @@ wire::AgentAnnouncement announcement_of(const RobotShare& share, const std::stri
     ann.edge_j().push_back(static_cast<std::uint32_t>(m.j));
   }
   ann.edge_index(share.measurement_index);
+  ann.known_inlier_index(share.known_inlier_index);
   return ann;
 }
 

@@ -47,8 +47,9 @@ const char* kHelp =
     "  --grad-tol T              relative gradient-norm tolerance (default 1e-5)\n"
     "  --stop reference|gradient  reference (default): also stop where the reference solver's\n"
     "                            rule (gradient 1e-2 with preconditioned gradient 1e-4, or a\n"
-    "                            step decreasing f by < 1e-6 f) holds, or before a step predicted\n"
-    "                            to decrease f by < 1e-7 f (ends within ~1e-8 of f*); gradient:\n"
+    "                            step decreasing f by < 1e-6 f while the next is predicted to\n"
+    "                            gain < 1e-8 f) holds, or before a step predicted to decrease f\n"
+    "                            by < 1e-8 f (ends within ~1e-8 of f*); gradient:\n"
     "                            only --grad-tol (f* to round-off)\n"
     "  --no-certify              skip the certificate (and the staircase)\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";

@@ -24,7 +24,8 @@ std::vector<std::string> write_robot_files(const std::string& whole, std::size_t
 
 std::vector<std::string> write_robot_files(const std::string& whole,
                                            const std::vector<std::size_t>& robot,
-                                           std::size_t robots, const std::string& dir) {
+                                           std::size_t robots, const std::string& dir,
+                                           const std::vector<bool>& known_inlier) {
   const std::size_t num_poses = robot.size();
   // Each robot's range [begin[r], begin[r + 1]).
   std::vector<std::size_t> begin(robots + 1, num_poses);
@@ -37,7 +38,7 @@ std::vector<std::string> write_robot_files(const std::string& whole,
   if (mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST)
     throw InputError(dir, 0, std::string("cannot create the folder: ") + std::strerror(errno));
   std::vector<std::string> body(robots);
-  std::vector<std::string> index(robots);
+  std::vector<std::string> index(robots), known(robots);
   std::ifstream in(whole);
   if (!in) throw InputError(whole, 0, "cannot read the graph back");
   std::size_t edge = 0, line_no = 0;
@@ -50,7 +51,11 @@ std::vector<std::string> write_robot_files(const std::string& whole,
     if (!(t >> id) || id >= num_poses)
       throw InputError(whole, line_no, "unexpected line while splitting");
     body[robot[id]] += line + "\n";  // VERTEX: its pose; EDGE: its first endpoint's robot
-    if (tag.rfind("EDGE", 0) == 0) index[robot[id]] += " " + std::to_string(edge++);
+    if (tag.rfind("EDGE", 0) == 0) {
+      if (edge < known_inlier.size() && known_inlier[edge])
+        known[robot[id]] += " " + std::to_string(edge);
+      index[robot[id]] += " " + std::to_string(edge++);
+    }
   }
   const std::size_t width = std::to_string(robots - 1).size();
   std::vector<std::string> paths;
@@ -61,7 +66,8 @@ std::vector<std::string> write_robot_files(const std::string& whole,
     std::ofstream out(path);
     out << "# tessera-robot poses " << begin[r] << " " << begin[r + 1] << "\n"
         << "# tessera-measurement-index" << index[r] << "\n"
-        << "# robot " << r << " of " << robots << " of " << whole
+        << (known[r].empty() ? "" : "# tessera-known-inliers" + known[r] + "\n") << "# robot " << r
+        << " of " << robots << " of " << whole
         << ": its poses and the measurements it recorded (global ids)\n"
         << body[r];
     if (!out) throw InputError(path, 0, "cannot write the file");

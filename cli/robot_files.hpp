@@ -18,10 +18,13 @@ std::vector<std::string> write_robot_files(const std::string& whole, std::size_t
                                            std::size_t robots, const std::string& dir);
 
 /// Same with the robot of every pose given (`robot_of`, n entries, each robot's ids
-/// contiguous and robots in id order, e.g. a dpgo CSV file's robots).
+/// contiguous and robots in id order, e.g. a dpgo CSV file's robots). `known_inlier`: empty or
+/// one flag per EDGE line of `whole`; the flagged ones go to each robot file's
+/// '# tessera-known-inliers' line.
 std::vector<std::string> write_robot_files(const std::string& whole,
                                            const std::vector<std::size_t>& robot_of,
-                                           std::size_t robots, const std::string& dir);
+                                           std::size_t robots, const std::string& dir,
+                                           const std::vector<bool>& known_inlier = {});
 
 }  // namespace tessera::cli
 

@@ -115,7 +115,8 @@ const char* kDistributedHelp =
     "                            (docs/irbcd.md section 3), or keep it fixed (default)\n"
     "  --sigma-shrink F, --sigma-saturation S, --sigma-theta T, --sigma-min A, --sigma-max B\n"
     "                            adaptive sigma's constants (IrbcdOptions)\n"
-    "  --irbcd-a0 A              IRBCD: initial a (default 1; <= 0: 1/n, the paper's)\n"
+    "  --irbcd-a0 A              IRBCD: initial a (default: the a whose first gamma is 1;\n"
+    "                            <= 0: 1/n, the paper's)\n"
     "  --irbcd-class-score norm|max   IRBCD, parallel greedy rounds: the colour class with the\n"
     "                            largest class gradient norm, or the class of the largest\n"
     "                            block gradient (RBCD++'s rule) (default: max)\n"
@@ -223,6 +224,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   opt.coarse.every = static_cast<int>(a.get_long("coarse-every", opt.coarse.every));
   opt.coarse.min_gain = a.get_double("coarse-min-gain", opt.coarse.min_gain);
   opt.irbcd.sigma = a.get_double("sigma", opt.irbcd.sigma);
+  if (a.has("irbcd-a0")) opt.irbcd.unit_first_gamma = false;
   opt.irbcd.a0 = a.get_double("irbcd-a0", opt.irbcd.a0);
   if (a.has("irbcd-class-score"))
     opt.irbcd.class_score = parse_class_score(a.get_or("irbcd-class-score", ""));
@@ -290,10 +292,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       part.adjacent_block_pairs = adjacency.adjacent_block_pairs;
       part.colours = adjacency.colours;
     }
-  if (robust.kind == RobustKind::kPcmGnc)
-    throw InputError("option --robust: pcm-gnc is centralized only (--algorithm centralized)");
   GncDistributedResult gnc;
-  if (robust.kind == RobustKind::kGncTls) {
+  if (robust.kind != RobustKind::kNone) {
     // Like the centralized robust solve: the known inliers' start unless --init is given.
     GncDistributedOptions options;
     options.solver = opt;

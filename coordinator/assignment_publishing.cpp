@@ -44,6 +44,7 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
     asg.known_inliers(known_inliers_name(r.known_inliers));
     asg.gnc_known_start(options.gnc_known_start);
     asg.gnc_readmission_passes(static_cast<std::uint32_t>(r.readmission_passes));
+    asg.known_inlier(structure.known_inlier);
   }
   return asg;
 }

@@ -174,10 +174,6 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   a.robust = cli::parse_robust_options(args);
   a.gnc_known_start = !args.has("gnc-solver-start");
   a.rejected = args.get_or("rejected", "");
-  if (a.robust.kind == RobustKind::kPcmGnc)
-    throw InputError(
-        "option --robust: pcm-gnc is centralized only (tessera solve --algorithm "
-        "centralized); over DDS use gnc-tls");
   if (a.robust.kind != RobustKind::kNone && (a.rejoin_timeout_s > 0 || a.replicas > 0))
     throw InputError(
         "option --robust: a robust run cannot roll back or re-partition; drop --rejoin-timeout "

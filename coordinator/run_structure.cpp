@@ -26,6 +26,7 @@ RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& ann
   struct Edge {
     std::uint64_t index;
     std::uint32_t agent, i, j;
+    bool known;
   };
   std::vector<Edge> edges;
   for (std::uint32_t k = 0; k < num_agents; ++k)
@@ -58,11 +59,18 @@ RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& ann
                        "), which does not continue the previous agents' ranges");
     if (a.edge_i().size() != a.edge_j().size() || a.edge_index().size() != a.edge_i().size())
       throw InputError(who + ": edge endpoint and index arrays differ in length");
+    std::vector<std::uint64_t> known(a.known_inlier_index().begin(), a.known_inlier_index().end());
+    std::sort(known.begin(), known.end());
+    std::size_t flagged = 0;
     for (std::size_t e = 0; e < a.edge_i().size(); ++e) {
       if (a.edge_i()[e] >= rs.num_poses || a.edge_j()[e] >= rs.num_poses)
         throw InputError(who + ": edge endpoint out of range");
-      edges.push_back({a.edge_index()[e], k, a.edge_i()[e], a.edge_j()[e]});
+      const bool k_in = std::binary_search(known.begin(), known.end(), a.edge_index()[e]);
+      flagged += k_in ? 1 : 0;
+      edges.push_back({a.edge_index()[e], k, a.edge_i()[e], a.edge_j()[e], k_in});
     }
+    if (flagged != known.size())
+      throw InputError(who + ": a known-inlier flag names a measurement it does not hold");
     rs.hosts.push_back(a.host());
   }
   // Canonical order: the measurements' positions in the input, whatever the agents' order,
@@ -77,6 +85,7 @@ RunStructure merge_announcements(const std::vector<wire::AgentAnnouncement>& ann
                        std::to_string(edges[e].agent) + " both announced measurement #" +
                        std::to_string(edges[e].index) + ": were they given overlapping files?");
     pairs.emplace_back(edges[e].i, edges[e].j);
+    if (edges[e].known) rs.known_inlier.push_back(static_cast<std::uint32_t>(e));
     rs.edge_i.push_back(edges[e].i);
     rs.edge_j.push_back(edges[e].j);
   }

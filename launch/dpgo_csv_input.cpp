@@ -29,7 +29,7 @@ std::string dpgo_csv_as_robot_files(const std::string& graph, long agents,
   write_g2o(csv.graph, whole);
   std::vector<std::size_t> robot_of(csv.robot_of.begin(), csv.robot_of.end());
   const std::string dir = work + "/robots";
-  cli::write_robot_files(whole, robot_of, robots, dir);
+  cli::write_robot_files(whole, robot_of, robots, dir, csv.known_inlier);
   return dir;
 }
 

@@ -36,16 +36,11 @@ void check_partition_time(const std::string& v) {
 
 // The robust options are checked as RobustOptions checks them (the error names the field).
 void check_robust(const std::string& v) {
-  RobustKind kind;
   try {
-    kind = parse_robust_kind(v);
+    parse_robust_kind(v);
   } catch (const InputError& e) {
     throw InputError(std::string("option --robust: ") + e.what());
   }
-  if (kind == RobustKind::kPcmGnc)
-    throw InputError(
-        "option --robust: pcm-gnc is centralized only (tessera solve --algorithm "
-        "centralized); over DDS use gnc-tls");
 }
 void check_known_inliers(const std::string& v) {
   try {
@@ -109,12 +104,14 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "none, the preset's own effort (with a cap the partition\n"
        "depends on the machine's speed)                           [0]",
        check_partition_time},
-      {"robust", "robust", true, ForwardTo::kCoordinator, "--robust none|gnc-tls",
+      {"robust", "robust", true, ForwardTo::kCoordinator, "--robust none|gnc-tls|pcm-gnc",
        "gnc-tls: reject outlier measurements (graduated non-\n"
        "convexity, truncated least squares), each weighed by the\n"
        "agent of its lower pose id, then solve and certify the\n"
-       "kept ones; starts from the known inliers unless --init\n"
-       "is given (docs/robust.md)                            [none]",
+       "kept ones; starts from the known inliers' or the\n"
+       "solver's initialization (a vote) unless --init is given;\n"
+       "pcm-gnc: agent 0 first drops closures outside the\n"
+       "largest pairwise-consistent set (docs/robust.md)    [none]",
        check_robust},
       {"inlier-threshold", "inlier-threshold", true, ForwardTo::kCoordinator,
        "--inlier-threshold C", "residual bound c (0 = chi-square quantile)          [0]",

@@ -81,6 +81,33 @@ TEST_P(CentralizedTest, CertificateEigenvalueMatchesDenseComputation) {
   EXPECT_NEAR(c2.min_eigenvector.dot(S2 * c2.min_eigenvector), dense_min2, 1e-6 * S2.norm());
 }
 
+// Once the factorization has certified X, lambda_min is only reported, and the Lanczos run starts
+// from X's rows (S's null space at a critical point): a narrow Krylov space gives the same value
+// as the wide cold start with far fewer solves.
+TEST_P(CentralizedTest, CertifiedEigenvalueFromTheSolutionsRowsNeedsFewSolves) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 80, 40, 0.05, 0.05, 3});
+  const BlockProblem P = BlockProblem::whole_graph(d, g.num_poses, g.measurements);
+  const CentralizedResult r = solve_centralized(g);
+  ASSERT_TRUE(*r.certified);
+  CertificateOptions cold;
+  cold.certified_lanczos_subspace = cold.lanczos_subspace;  // as wide as the random start's
+  const CertificateResult warm = verify_certificate(P, r.X);
+  const CertificateResult wide = verify_certificate(P, r.X, cold);
+  ASSERT_TRUE(warm.certified);
+  EXPECT_LE(warm.lanczos_solves, CertificateOptions{}.certified_lanczos_subspace + 1);
+  EXPECT_LT(warm.lanczos_solves, wide.lanczos_solves);
+  EXPECT_NEAR(warm.min_eigenvalue, wide.min_eigenvalue, 1e-3 * warm.tolerance);
+  CertificateOptions bad;
+  bad.certified_lanczos_subspace = 2;
+  try {
+    verify_certificate(P, r.X, bad);
+    ADD_FAILURE() << "a subspace of 2 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("certified_lanczos_subspace"), std::string::npos);
+  }
+}
+
 TEST(CentralizedSolver, StaircaseEscapesFromRankDeficientSaddle) {
   // With large rotation noise and an odometry start at rank r = d, this graph's rank-2 solve
   // stops at a critical point that the certificate rejects; the solver must escape along
@@ -191,6 +218,30 @@ TEST(CentralizedSolver, RejectsInvalidOptionsNamingTheField) {
     EXPECT_NE(std::string(e.what()).find("certified_lanczos_tolerance"), std::string::npos)
         << e.what();
   }
+  CentralizedOptions opt4;
+  opt4.threads = 3;
+  try {
+    solve_centralized(g, opt4);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("threads"), std::string::npos) << e.what();
+  }
+}
+
+// The second thread only moves the preconditioner's factorization off the start's critical
+// path: one and two threads give the same iterates, bit for bit.
+TEST_P(CentralizedTest, OneAndTwoThreadsGiveTheSameIterates) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 60, 30, 0.05, 0.05, 8});
+  CentralizedOptions one;
+  one.threads = 1;
+  CentralizedOptions two;
+  two.threads = 2;
+  const CentralizedResult a = solve_centralized(g, one);
+  const CentralizedResult b = solve_centralized(g, two);
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_EQ(a.cost, b.cost);
+  EXPECT_EQ(a.X, b.X);
 }
 
 TEST(CentralizedSolver, ReferenceStopSavesStepsAndStaysWithinItsAccuracy) {
@@ -248,6 +299,25 @@ TEST(TrustRegion, PairedGradientAndPredictedDecreaseStopsEndTheRunWhereTheyHold)
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("predicted_rel_decrease_tol"), std::string::npos);
   }
+}
+
+// With the prediction on, a step that decreased f by little ends the run only where the model
+// also predicts little: a loose relative-decrease tolerance alone stops after the first accepted
+// step here, the pair only where the prediction holds.
+TEST(TrustRegion, ASmallDecreaseStopsOnlyWhereThePredictionAgrees) {
+  auto g = test::random_pose_graph({3, 30, 20, 0.05, 0.1, 5});
+  const BlockProblem P = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  const Eigen::MatrixXd X0 = lift_poses(g.initial, 3);
+  TrustRegionOptions loose;
+  loose.rel_cost_decrease_tol = 0.99;  // any accepted step "decreases f by less than 0.99 f"
+  const TrustRegionResult alone = solve_trust_region(P, X0, loose);
+  EXPECT_EQ(alone.stop_reason, "relative_decrease");
+  loose.predicted_rel_decrease_tol = 1e-6;
+  const TrustRegionResult paired = solve_trust_region(P, X0, loose);
+  EXPECT_GT(paired.iterations, alone.iterations);
+  ASSERT_FALSE(paired.trace.empty());
+  EXPECT_LE(paired.trace.back().predicted_decrease, 1e-6 * paired.cost);
+  EXPECT_LT(paired.cost, alone.cost);
 }
 
 struct GeneratedCase {

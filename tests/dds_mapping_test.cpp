@@ -237,7 +237,26 @@ TEST(DdsMapping, HandoffCarriesMeasurementsAndPosesExactly) {
   EXPECT_EQ(c.poses[0].first, 4u);
   EXPECT_EQ(c.poses[0].second.R, p.R);
   EXPECT_EQ(c.poses[0].second.t, p.t);
+  EXPECT_TRUE(c.known_poses.empty());
   w.meas_t().pop_back();
+  EXPECT_THROW(from_wire(w), TransportError);
+}
+
+// A robust run's second start (the known inliers' initialization) rides in the lifted fields
+// of a plain hand-off and comes back exactly; a replica's lifted data is not mistaken for it.
+TEST(DdsMapping, HandoffCarriesTheKnownInliersStartExactly) {
+  Pose p = pose2(1, 2, -0.7), q = pose2(-3, 0.5, 2.1);
+  wire::MeasurementHandoff w = to_wire_handoff("r", 0, 1, 2, {}, {}, {{4u, &p}}, {{4u, &q}});
+  HandoffContent c = from_wire(w);
+  ASSERT_EQ(c.known_poses.size(), 1u);
+  EXPECT_EQ(c.known_poses[0].first, 4u);
+  EXPECT_EQ(c.known_poses[0].second.R, q.R);
+  EXPECT_EQ(c.known_poses[0].second.t, q.t);
+  EXPECT_EQ(c.poses[0].second.t, p.t);
+  w.purpose(1);
+  EXPECT_TRUE(from_wire(w).known_poses.empty());
+  w.purpose(0);
+  w.lifted_data().pop_back();
   EXPECT_THROW(from_wire(w), TransportError);
 }
 
@@ -337,7 +356,7 @@ TEST(DdsHandoff, EveryMeasurementReachesBothOwnersAndPosesTheirOwner) {
       agent::HandoffPlan plan = agent::plan_handoff(shares[b], owner, a);
       HandoffContent c = from_wire(
           to_wire_handoff("r", b, a, 2, plan.measurements, plan.measurement_index, plan.poses));
-      received.push_back({b, c.measurements, c.measurement_index, c.poses});
+      received.push_back({b, c.measurements, c.measurement_index, c.poses, c.known_poses});
     }
     agent::AgentLocalData local = agent::assemble_local(shares[a], owner, a, 3, received, {});
     std::vector<std::uint64_t> expected;

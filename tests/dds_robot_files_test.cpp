@@ -156,6 +156,28 @@ TEST(DdsRobotFiles, BadRobotFilesNameTheFileAndLine) {
   EXPECT_NE(message(p).find("expected '# tessera-robot poses BEGIN END'"), std::string::npos);
   p = write("# tessera-robot poses 0 2\n# tessera-measurement-index 4 5\nEDGE_SE2 0 1" + edge);
   EXPECT_NE(message(p).find("lists 2 positions for 1 EDGE lines"), std::string::npos) << message(p);
+  p = write(
+      "# tessera-robot poses 0 2\n# tessera-measurement-index 4\n# tessera-known-inliers 5\n"
+      "EDGE_SE2 0 1" +
+      edge);
+  EXPECT_NE(message(p).find("bad.g2o:3"), std::string::npos) << message(p);
+  EXPECT_NE(message(p).find("names measurement 5, which is not one of this file's EDGE lines"),
+            std::string::npos)
+      << message(p);
+}
+
+// A robot file's '# tessera-known-inliers' line (a dpgo CSV's is_known_inlier column) gives the
+// share the file positions of its flagged measurements.
+TEST(DdsRobotFiles, KnownInlierFlagsTravelInTheRobotFile) {
+  const std::string dir = temp_dir();
+  const std::string p = dir + "/robot0.g2o";
+  const std::string edge = " 1 0 0 1 0 0 1 0 1\n";
+  std::ofstream(p) << "# tessera-robot poses 0 3\n# tessera-measurement-index 2 7 9\n"
+                      "# tessera-known-inliers 9 2\n"
+                      "EDGE_SE2 0 1" +
+                          edge + "EDGE_SE2 1 2" + edge + "EDGE_SE2 2 5" + edge;
+  const agent::RobotShare s = agent::read_robot_file(p, 0);
+  EXPECT_EQ(s.known_inlier_index, (std::vector<std::uint64_t>{2, 9}));
 }
 
 // The agents read their own files; the coordinator learns n from their ranges.

@@ -70,14 +70,32 @@ RobustRun robust_dds_run(int domain, const std::vector<std::string>& extra = {})
   return r;
 }
 
+// dpgo's measurement CSV of a generated graph whose robots hold `per_robot` poses each;
+// `flagged` measurements get is_known_inlier = 1.
+std::string dpgo_csv_of(const PoseGraph& g, std::size_t per_robot,
+                        const std::vector<std::size_t>& flagged = {}) {
+  std::string csv =
+      "robot_src,pose_src,robot_dst,pose_dst,qx,qy,qz,qw,tx,ty,tz,kappa,tau,is_known_inlier,"
+      "weight\n";
+  for (std::size_t e = 0; e < g.measurements.size(); ++e) {
+    const Measurement& m = g.measurements[e];
+    const Eigen::Quaterniond q(Eigen::Matrix3d(m.R));
+    const int known = std::count(flagged.begin(), flagged.end(), e) > 0 ? 1 : 0;
+    char row[512];
+    std::snprintf(row, sizeof row,
+                  "%zu,%zu,%zu,%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d,1\n",
+                  m.i / per_robot, m.i % per_robot, m.j / per_robot, m.j % per_robot, q.x(), q.y(),
+                  q.z(), q.w(), m.t(0), m.t(1), m.t(2), m.kappa, m.tau, known);
+    csv += row;
+  }
+  return csv;
+}
+
 GncDistributedOptions in_process_options() {
   GncDistributedOptions o;
   o.robust.kind = RobustKind::kGncTls;
   o.solver.seed = 7;
   o.solver.certify = true;
-  // What the DDS agents do: one start (no vote), the first inlier pass from the GNC iterate.
-  o.start_vote = false;
-  o.inlier_set_start = false;
   return o;
 }
 
@@ -110,6 +128,40 @@ TEST(DdsRobust, IteratesAndRejectedSetEqualTheInProcessEngine) {
   EXPECT_EQ(ref.rejected, dds.labels);
   for (std::size_t e : json_array(dds.summary, "rejected"))
     EXPECT_FALSE(is_known_inlier(g.measurements[e], KnownInliers::kOdometry)) << e;
+
+  // The steps the DDS agents took matter here: with the wrong closures the vote takes the
+  // known inliers' start, and without it and the kept set's fresh start the run differs.
+  GncDistributedOptions plain_start = in_process_options();
+  plain_start.known_inlier_start = false;
+  plain_start.kept_set_start = false;
+  EXPECT_NE(solve_gnc_distributed(g, dds.assignment, plain_start).total_rounds, ref.total_rounds);
+}
+
+// Clean data: the start vote takes the solver's own (chordal) start, which is nearly the
+// optimum, over the odometry chains; over DDS as in process (same rounds, same cost).
+TEST(DdsRobust, OnCleanDataTheVoteTakesTheSolversStartAsInProcess) {
+  const std::string dir = temp_dir();
+  const std::string graph =
+      generate_graph(dir + "/graph.g2o", "--kind grid3d --poses 216 --robots 3 --seed 4");
+  const std::string run = "robust-clean-" + std::to_string(getpid());
+  run_to_the_end(dir, graph, 3, run, 70,
+                 {"--timeout", "20", "--run-timeout", "120", "--summary", dir + "/summary.json",
+                  "--partition", "sequential", "--seed", "7", "--certify", "--robust", "gnc-tls"},
+                 120);
+  const std::string summary = slurp(dir + "/summary.json");
+  const PoseGraph g = read_g2o(graph);
+  const std::vector<int> assignment = assignment_of(dir, 3);
+  const GncDistributedResult ref = solve_gnc_distributed(g, assignment, in_process_options());
+  EXPECT_TRUE(ref.rejected.empty());
+  EXPECT_EQ(json_field(summary, "rounds"), ref.total_rounds) << summary;
+  EXPECT_EQ(json_field(summary, "outliers"), 0) << summary;
+  EXPECT_NEAR(json_field(summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  EXPECT_NE(summary.find("\"certified\": true"), std::string::npos) << summary;
+  // The vote's choice: the run from the solver's start alone takes the same rounds, the one
+  // from the known inliers' start alone (the odometry chains) more.
+  GncDistributedOptions solver_start = in_process_options();
+  solver_start.known_inlier_start = false;
+  EXPECT_EQ(solve_gnc_distributed(g, assignment, solver_start).total_rounds, ref.total_rounds);
 }
 
 // With --known-inliers none every measurement may go; the known inliers' start is then not
@@ -169,19 +221,7 @@ TEST(DdsRobust, LaunchOnADpgoCsvFileEqualsTheInProcessEngine) {
   const std::string graph = generate_graph(
       dir + "/graph.g2o", "--kind grid3d --poses 216 --robots 3 --seed 4 --outliers 0.25");
   const PoseGraph g = read_g2o(graph);
-  std::string csv =
-      "robot_src,pose_src,robot_dst,pose_dst,qx,qy,qz,qw,tx,ty,tz,kappa,tau,is_known_inlier,"
-      "weight\n";
-  for (const Measurement& m : g.measurements) {
-    const Eigen::Quaterniond q(Eigen::Matrix3d(m.R));
-    char row[512];
-    std::snprintf(row, sizeof row,
-                  "%zu,%zu,%zu,%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,0,1\n",
-                  m.i / 72, m.i % 72, m.j / 72, m.j % 72, q.x(), q.y(), q.z(), q.w(), m.t(0),
-                  m.t(1), m.t(2), m.kappa, m.tau);
-    csv += row;
-  }
-  std::ofstream(dir + "/measurements.csv") << csv;
+  std::ofstream(dir + "/measurements.csv") << dpgo_csv_of(g, 72);
   std::string out;
   const int rc = run_command(bin("tessera") + " launch " + dir +
                                  "/measurements.csv --agents 3 --partition sequential --domain 46 "
@@ -207,6 +247,79 @@ TEST(DdsRobust, LaunchOnADpgoCsvFileEqualsTheInProcessEngine) {
       run_command(bin("tessera") + " launch " + dir + "/measurements.csv --agents 2 2>&1", &out),
       0);
   EXPECT_NE(out.find("holds 3 robots but --agents is 2"), std::string::npos) << out;
+}
+
+// A CSV's is_known_inlier flag reaches the DDS agents (robot file, announcement, assignment):
+// a wrong inter-robot closure flagged as a known inlier is never rejected over DDS, the run
+// equals the in-process engine given the same flags, and without the flag it is rejected.
+TEST(DdsRobust, ACsvKnownInlierFlagIsNeverRejectedOverDds) {
+  const std::string dir = temp_dir();
+  const std::string graph = generate_graph(dir + "/graph.g2o",
+                                           "--kind grid3d --poses 216 --robots 3 --seed 4 "
+                                           "--outliers 0.25 --labels " +
+                                               dir + "/labels.json");
+  const PoseGraph g = read_g2o(graph);
+  const std::vector<std::size_t> labels = json_array(slurp(dir + "/labels.json"), "outliers");
+  std::size_t flagged = g.measurements.size();
+  for (std::size_t e : labels)
+    if (g.measurements[e].i / 72 != g.measurements[e].j / 72) {
+      flagged = e;
+      break;
+    }
+  ASSERT_LT(flagged, g.measurements.size()) << "an inter-robot wrong closure to flag";
+  std::ofstream(dir + "/measurements.csv") << dpgo_csv_of(g, 72, {flagged});
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch " + dir +
+                                 "/measurements.csv --agents 3 --partition sequential --domain 71 "
+                                 "--timeout 60 --seed 7 --robust gnc-tls --json " +
+                                 dir + "/s.json 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  const std::string json = slurp(dir + "/s.json");
+  const std::vector<std::size_t> rejected = json_array(json, "rejected");
+  EXPECT_EQ(std::count(rejected.begin(), rejected.end(), flagged), 0) << json;
+
+  const DpgoCsvGraph read = read_dpgo_csv(dir + "/measurements.csv");
+  const std::vector<int> robots(read.robot_of.begin(), read.robot_of.end());
+  GncDistributedOptions o = in_process_options();
+  o.known_inlier_flags = read.known_inlier;
+  const GncDistributedResult ref = solve_gnc_distributed(read.graph, robots, o);
+  EXPECT_EQ(rejected, ref.rejected) << json;
+  EXPECT_EQ(json_field(json, "rounds"), ref.total_rounds) << json;
+  EXPECT_NEAR(json_field(json, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+
+  o.known_inlier_flags.clear();
+  const GncDistributedResult unflagged = solve_gnc_distributed(read.graph, robots, o);
+  EXPECT_EQ(std::count(unflagged.rejected.begin(), unflagged.rejected.end(), flagged), 1);
+}
+
+// --robust pcm-gnc over DDS: agent 0 runs the pairwise consistency check on the values the
+// others send it, every agent starts GNC with the inconsistent closures at weight 0; the run
+// equals the in-process engine and finds a group of mutually consistent wrong closures.
+TEST(DdsRobust, PcmGncOverDdsEqualsTheInProcessEngine) {
+  const std::string dir = temp_dir();
+  const std::string graph = generate_graph(dir + "/graph.g2o",
+                                           "--kind grid3d --poses 216 --robots 3 --seed 4 "
+                                           "--outliers 0.1 --outlier-kind group --labels " +
+                                               dir + "/labels.json");
+  const std::string run = "robust-pcm-" + std::to_string(getpid());
+  run_to_the_end(dir, graph, 3, run, 72,
+                 {"--timeout", "20", "--run-timeout", "120", "--summary", dir + "/summary.json",
+                  "--partition", "sequential", "--seed", "7", "--certify", "--robust", "pcm-gnc"},
+                 120);
+  const std::string summary = slurp(dir + "/summary.json");
+  const PoseGraph g = read_g2o(graph);
+  const std::vector<int> assignment = assignment_of(dir, 3);
+  GncDistributedOptions o = in_process_options();
+  o.robust.kind = RobustKind::kPcmGnc;
+  const GncDistributedResult ref = solve_gnc_distributed(g, assignment, o);
+  EXPECT_NE(summary.find("\"robust\": \"pcm-gnc\""), std::string::npos) << summary;
+  EXPECT_EQ(json_field(summary, "outer_iterations"), ref.outer_iterations) << summary;
+  EXPECT_EQ(json_field(summary, "rounds"), ref.total_rounds) << summary;
+  EXPECT_EQ(json_array(summary, "rejected"), ref.rejected) << summary;
+  EXPECT_NEAR(json_field(summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  EXPECT_NE(summary.find("\"certified\": true"), std::string::npos) << summary;
+  EXPECT_EQ(ref.rejected, json_array(slurp(dir + "/labels.json"), "outliers"));
 }
 
 }  // namespace

@@ -29,8 +29,9 @@ TEST(Irbcd, GammaSolvesItsQuadraticAndIsAtLeastOneOverN) {
 }
 
 TEST(Irbcd, RecurrencesFollowThePaper) {
-  IrbcdOptions o;  // sigma 1e-4, b0 = 1
-  o.a0 = 0.0;      // the paper's a_0 = 1/n (the default is 1, see StartsWithTheMomentumOfA0)
+  IrbcdOptions o;              // sigma 1e-4, b0 = 1
+  o.unit_first_gamma = false;  // a0 as given (the default: gamma_0 = 1, see StartsWithUnitGamma)
+  o.a0 = 0.0;                  // the paper's a_0 = 1/n
   o.adaptive_sigma = false;
   o.reset_on_restart = true;
   const double n = 5;
@@ -60,30 +61,37 @@ TEST(Irbcd, RecurrencesFollowThePaper) {
   EXPECT_DOUBLE_EQ(keep.a(), a1);
 }
 
-// The default a_0 = 1 (not the paper's 1/n): the first gamma solves the recurrence's quadratic
-// with a = b = 1, exceeds the paper's start, and a reset (reset_on_restart) returns to it.
-TEST(Irbcd, StartsWithTheMomentumOfA0) {
+// The default start: a_0 such that the first gamma is exactly 1 (so V^1 = Y^1), for any n and
+// sigma; a reset (reset_on_restart) returns to it. With unit_first_gamma off, a0 is taken as given
+// (a0 = 1: the first gamma solves the quadratic with a = b = 1 and exceeds 1).
+TEST(Irbcd, StartsWithUnitGamma) {
   IrbcdOptions o;
-  EXPECT_EQ(o.a0, 1.0);
+  EXPECT_TRUE(o.unit_first_gamma);
   EXPECT_FALSE(o.adaptive_sigma);  // the default (docs/irbcd.md section 3)
+  for (double n : {2.0, 3.0, 7.0})
+    for (double sigma : {1e-4, 1e-2, 0.5}) {
+      IrbcdOptions u = o;
+      u.sigma = sigma;
+      EXPECT_NEAR(IrbcdScheme(u, n).coefficients().gamma, 1.0, 1e-12) << n << " " << sigma;
+    }
   o.reset_on_restart = true;
   const double n = 3;
   IrbcdScheme s(o, n);
-  EXPECT_DOUBLE_EQ(s.a(), 1.0);
   const double g0 = s.coefficients().gamma;
-  EXPECT_DOUBLE_EQ(g0, irbcd_gamma(n, o.sigma, 1.0, 1.0));
-  EXPECT_NEAR(g0 * g0 - g0 / n, 1 - g0 * o.sigma / n, 1e-12);
-  IrbcdOptions paper = o;
-  paper.a0 = 0.0;
-  const double g_paper = IrbcdScheme(paper, n).coefficients().gamma;
-  EXPECT_NEAR(g_paper, (1 + std::sqrt(5.0)) / (2 * n), 1e-4);
-  EXPECT_GT(g0, 2 * g_paper);
   for (int k = 0; k < 30; ++k) s.advance();
   EXPECT_GT(s.coefficients().gamma, g0);
   s.restart();
-  EXPECT_DOUBLE_EQ(s.a(), 1.0);
-  EXPECT_DOUBLE_EQ(s.b(), 1.0);
   EXPECT_EQ(s.coefficients().gamma, g0);
+  IrbcdOptions given = o;
+  given.unit_first_gamma = false;
+  given.a0 = 1.0;
+  IrbcdScheme one(given, n);
+  EXPECT_DOUBLE_EQ(one.a(), 1.0);
+  const double g1 = one.coefficients().gamma;
+  EXPECT_DOUBLE_EQ(g1, irbcd_gamma(n, o.sigma, 1.0, 1.0));
+  EXPECT_GT(g1, 1.0);
+  given.a0 = 0.0;
+  EXPECT_NEAR(IrbcdScheme(given, n).coefficients().gamma, (1 + std::sqrt(5.0)) / (2 * n), 1e-4);
 }
 
 // Keeping a, b across restarts (the default) relies on gamma staying below its fixed point
@@ -121,8 +129,9 @@ IrbcdOptions adaptive_options() {
   o.sigma = 1e-2;
   o.adaptive_sigma = true;
   o.sigma_max = 1e-1;
-  o.reset_on_restart = true;  // the restart test checks the reset too
-  o.a0 = 0.0;                 // ... to the paper's a_0 = 1/n
+  o.reset_on_restart = true;   // the restart test checks the reset too
+  o.unit_first_gamma = false;  // ... to the paper's a_0 = 1/n
+  o.a0 = 0.0;
   return o;
 }
 

@@ -105,7 +105,8 @@ wire::MeasurementHandoff to_wire_handoff(
     const std::string& run_id, std::uint32_t sender, std::uint32_t recipient, int d,
     const std::vector<const Measurement*>& measurements,
     const std::vector<std::uint64_t>& measurement_index,
-    const std::vector<std::pair<std::uint32_t, const Pose*>>& poses) {
+    const std::vector<std::pair<std::uint32_t, const Pose*>>& poses,
+    const std::vector<std::pair<std::uint32_t, const Pose*>>& known_poses) {
   wire::MeasurementHandoff w;
   w.run_id(run_id);
   w.sender(sender);
@@ -134,6 +135,15 @@ wire::MeasurementHandoff to_wire_handoff(
     w.pose_ids().push_back(id);
     append_flat_pose(w.pose_data(), *pose);
   }
+  if (!known_poses.empty()) {
+    w.rank(static_cast<std::uint32_t>(d));
+    w.lifted_ids().reserve(known_poses.size());
+    w.lifted_data().reserve(known_poses.size() * flat_pose_size(d));
+    for (const auto& [id, pose] : known_poses) {
+      w.lifted_ids().push_back(id);
+      append_flat_pose(w.lifted_data(), *pose);
+    }
+  }
   return w;
 }
 
@@ -161,6 +171,15 @@ HandoffContent from_wire(const wire::MeasurementHandoff& w) {
   out.poses.reserve(w.pose_ids().size());
   for (std::size_t k = 0; k < w.pose_ids().size(); ++k)
     out.poses.emplace_back(w.pose_ids()[k], pose_at(w.pose_data(), k, d));
+  if (w.purpose() == 0 && !w.lifted_ids().empty()) {
+    require(w.rank() == static_cast<std::uint32_t>(d) &&
+                w.lifted_data().size() == w.lifted_ids().size() * flat_pose_size(d),
+            "hand-off from agent " + std::to_string(w.sender()) +
+                ": the known inliers' start arrays differ in length");
+    out.known_poses.reserve(w.lifted_ids().size());
+    for (std::size_t k = 0; k < w.lifted_ids().size(); ++k)
+      out.known_poses.emplace_back(w.lifted_ids()[k], pose_at(w.lifted_data(), k, d));
+  }
   return out;
 }
 

@@ -37,12 +37,17 @@ struct HandoffContent {
   std::vector<Measurement> measurements;
   std::vector<std::uint64_t> measurement_index;       ///< Position of each in the original input.
   std::vector<std::pair<std::uint32_t, Pose>> poses;  ///< Initial poses (id, pose).
+  /// A robust run's second candidate start (id, pose): the known inliers' initialization.
+  std::vector<std::pair<std::uint32_t, Pose>> known_poses;
 };
+/// `known_poses` (a robust run's second start) travel in the hand-off's lifted fields at rank d,
+/// which a purpose-0 hand-off does not use otherwise.
 wire::MeasurementHandoff to_wire_handoff(
     const std::string& run_id, std::uint32_t sender, std::uint32_t recipient, int d,
     const std::vector<const Measurement*>& measurements,
     const std::vector<std::uint64_t>& measurement_index,
-    const std::vector<std::pair<std::uint32_t, const Pose*>>& poses);
+    const std::vector<std::pair<std::uint32_t, const Pose*>>& poses,
+    const std::vector<std::pair<std::uint32_t, const Pose*>>& known_poses = {});
 HandoffContent from_wire(const wire::MeasurementHandoff& w);
 
 /// Poses (id, pose) of a final estimate.

@@ -17,6 +17,10 @@ void CertificateOptions::validate() const {
     throw InputError("CertificateOptions.lanczos_max_iterations must be > 0");
   if (!(lanczos_tolerance > 0))
     throw InputError("CertificateOptions.lanczos_tolerance must be > 0");
+  if (lanczos_subspace < 3 || lanczos_subspace > 1000)
+    throw InputError("CertificateOptions.lanczos_subspace must be in [3, 1000]");
+  if (certified_lanczos_subspace < 3 || certified_lanczos_subspace > 1000)
+    throw InputError("CertificateOptions.certified_lanczos_subspace must be in [3, 1000]");
 }
 
 SparseMatrix certificate_matrix(const BlockProblem& problem, const Eigen::MatrixXd& X) {
@@ -83,16 +87,21 @@ SparseMatrix shifted(const SparseMatrix& S, double shift) {
 }
 
 // Largest eigenvalue of (S + shift I)^{-1}: 1/(lambda_min + shift). Returns lambda_min.
+// `start`: the Lanczos start vector, or null for Spectra's random one.
 double min_eigen_by_shift_invert(const Factor& factor, Eigen::Index n, double shift,
-                                 const CertificateOptions& opt, Eigen::VectorXd* vec, int* iters) {
+                                 const CertificateOptions& opt, int subspace,
+                                 const Eigen::VectorXd* start, Eigen::VectorXd* vec,
+                                 CertificateResult* counts) {
   ShiftInvertOp op(factor, n);
-  // A wide Krylov space: near a certified optimum the top of the inverted spectrum is a
-  // cluster (S's null space), which a narrow one resolves slowly.
-  const Eigen::Index ncv = std::min<Eigen::Index>(n, 40);
+  const Eigen::Index ncv = std::min<Eigen::Index>(n, subspace);
   Spectra::SymEigsSolver<ShiftInvertOp> eigs(op, 1, ncv);
-  eigs.init();
+  if (start)
+    eigs.init(start->data());
+  else
+    eigs.init();
   eigs.compute(Spectra::SortRule::LargestAlge, opt.lanczos_max_iterations, opt.lanczos_tolerance);
-  *iters += static_cast<int>(eigs.num_iterations());
+  counts->lanczos_iterations += static_cast<int>(eigs.num_iterations());
+  counts->lanczos_solves += static_cast<int>(eigs.num_operations());
   if (eigs.info() != Spectra::CompInfo::Successful) return std::numeric_limits<double>::quiet_NaN();
   const double nu = eigs.eigenvalues()(0);
   if (vec) *vec = eigs.eigenvectors().col(0);
@@ -128,8 +137,19 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
     ++res.factorizations;
   }
   Eigen::VectorXd v;
-  res.min_eigenvalue = min_eigen_by_shift_invert(
-      factor, n, shift, options, res.certified ? nullptr : &v, &res.lanczos_iterations);
+  if (res.certified) {
+    // Only reported: start from X's rows, (about) S's null space at a critical point.
+    Eigen::VectorXd start = X.colwise().sum().transpose();
+    const double norm = start.norm();
+    const bool usable = std::isfinite(norm) && norm > 0;
+    if (usable) start /= norm;
+    res.min_eigenvalue =
+        min_eigen_by_shift_invert(factor, n, shift, options, options.certified_lanczos_subspace,
+                                  usable ? &start : nullptr, nullptr, &res);
+  } else {
+    res.min_eigenvalue = min_eigen_by_shift_invert(factor, n, shift, options,
+                                                   options.lanczos_subspace, nullptr, &v, &res);
+  }
   if (!res.certified) {
     // The search shift can be far above -lambda_min, leaving lambda_min poorly separated in
     // the inverted spectrum (an inaccurate eigenvector). Move the shift just past the
@@ -141,8 +161,8 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
       refined.compute(shifted(S, tight));
       ++res.factorizations;
       if (refined.info() == Eigen::Success)
-        res.min_eigenvalue =
-            min_eigen_by_shift_invert(refined, n, tight, options, &v, &res.lanczos_iterations);
+        res.min_eigenvalue = min_eigen_by_shift_invert(refined, n, tight, options,
+                                                       options.lanczos_subspace, nullptr, &v, &res);
     }
   }
   if (!res.certified && v.size() > 0) res.min_eigenvector = v.normalized();

@@ -98,8 +98,14 @@ void IrbcdScheme::set_sigma(double s) {
 }
 
 void IrbcdScheme::reset() {
-  a_ = options_.a0 > 0 ? options_.a0 : 1.0 / n_;
   b_ = options_.b0;
+  if (options_.unit_first_gamma) {
+    // gamma = 1 in gamma^2 - gamma/n = (1 - gamma sigma/n) a^2/b^2 (sigma < n, so > 0 inside).
+    a_ = b_ * std::sqrt((1.0 - 1.0 / n_) / (1.0 - sigma_ / n_));
+    if (!(a_ > 0)) a_ = 1.0 / n_;  // n = 1: gamma = 1/n = 1 already
+    return;
+  }
+  a_ = options_.a0 > 0 ? options_.a0 : 1.0 / n_;
 }
 
 std::vector<double> IrbcdScheme::save() const {

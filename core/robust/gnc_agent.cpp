@@ -4,10 +4,14 @@
 #include <string>
 #include <tessera/distributed/stage_tag.hpp>
 #include <tessera/graph/connectivity.hpp>
+#include <tessera/problem/lifting.hpp>
 #include <tessera/robust/gnc_agent.hpp>
+#include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
+
+#include "distributed/measurement_block.hpp"
 
 namespace tessera {
 
@@ -67,13 +71,18 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
     throw std::invalid_argument("GncAgent: one known-inlier flag per measurement expected");
   if (!std::is_sorted(in_.measurement_index.begin(), in_.measurement_index.end()))
     throw std::invalid_argument("GncAgent: measurements must be in file order");
-  // Every solve is a GNC step of the phase field: the first, the weighted ones, the passes and
-  // the final one.
+  if (in_.Y0_known.size() > 0 &&
+      (in_.Y0_known.rows() != in_.Y0.rows() || in_.Y0_known.cols() != in_.Y0.cols()))
+    throw std::invalid_argument("GncAgent: the known inliers' start must have Y0's shape");
+  // Every solve is a GNC step of the phase field: the start vote, the first, the weighted
+  // ones, the passes and the final one.
   if (static_cast<long long>(options_.robust.max_outer_iterations) +
-          options_.robust.readmission_passes + 3 >
+          options_.robust.readmission_passes + 4 >
       static_cast<long long>(kMaxGncSteps))
     throw InputError("RobustOptions.max_outer_iterations + readmission_passes must be <= " +
-                     std::to_string(kMaxGncSteps - 3) + " for the distributed solve");
+                     std::to_string(kMaxGncSteps - 4) + " for the distributed solve");
+  fresh_start_ = in_.kept_set_start && in_.initialization == DistributedInit::kChordal;
+  dropped_.assign(in_.measurements.size(), false);
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   layout_ = std::make_unique<BlockLayout>(*base_);
   // Every agent knows every measurement's known-inlier status (rule + flags), hence how many may
@@ -107,6 +116,11 @@ int GncAgent::total_rounds() const {
 
 bool GncAgent::may_reject(std::size_t k) const {
   return !known_[in_.measurement_index[k]];
+}
+
+// The measurement's term of the TLS cost: r^2 for a known inlier, min(r^2, c^2) otherwise.
+double GncAgent::tls_term(std::size_t k, double r2) const {
+  return may_reject(k) ? std::min(r2, c2_) : r2;
 }
 
 // The measurement's term of the relaxed objective at the current lifted iterate: the own
@@ -162,12 +176,25 @@ void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t p
 
 void GncAgent::weights_at_mu(double mu) {
   for (std::size_t k : owned_)
-    if (may_reject(k)) weights_[k] = tls_weight(residual_squared_at(k), c2_, mu);
+    if (may_reject(k) && !dropped_[k]) weights_[k] = tls_weight(residual_squared_at(k), c2_, mu);
 }
 
 std::vector<OutgoingMessage> GncAgent::start() {
   std::vector<OutgoingMessage> out;
-  begin_solve(out);
+  if (in_.pcm) {
+    if (!known_connected_) {
+      const std::string why =
+          "robust pcm-gnc: the known inliers do not connect the poses, so there is no odometry "
+          "to test closures against (use --robust gnc-tls)";
+      if (in_.source.empty()) throw InputError(why);
+      throw InputError(in_.source, 0, why);
+    }
+    begin_exchange(Step::kPcm, out);
+  } else if (in_.Y0_known.size() > 0) {
+    begin_exchange(Step::kStartPoses, out);
+  } else {
+    begin_solve(out);
+  }
   return out;
 }
 
@@ -192,7 +219,7 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
       if (known_connected_ && weights_[k] == 0) continue;
       Measurement x = in_.measurements[k];
       const double w = std::max(weights_[k], kMinInnerWeight);
-      if (g_ > 0) {
+      if (g_ > first_solve_g_) {
         x.kappa *= w;
         x.tau *= w;
       }
@@ -230,10 +257,19 @@ std::uint32_t GncAgent::exchange_phase() const {
       return gnc_phase(g_, GncExchange::kRejected);
     case Step::kReadmitted:
       return gnc_phase(g_, GncExchange::kReadmitted);
+    case Step::kKeptStart:
+      // Agent 0 gathers the kept values; the others wait for its start.
+      return gnc_phase(g_, in_.id == 0 ? GncExchange::kKeptValues : GncExchange::kKeptStart);
     case Step::kCandidatePoses:
       return gnc_phase(g_, GncExchange::kCandidatePoses);
     case Step::kCandidateVotes:
       return gnc_phase(g_, GncExchange::kCandidateVotes);
+    case Step::kPcm:
+      return gnc_phase(g_, in_.id == 0 ? GncExchange::kPcmValues : GncExchange::kPcmDropped);
+    case Step::kStartPoses:
+      return gnc_phase(g_, GncExchange::kStartPoses);
+    case Step::kStartVotes:
+      return gnc_phase(g_, GncExchange::kStartVotes);
     default:
       return 0;
   }
@@ -270,6 +306,77 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
           state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
       publish(state_->Y, BlockKind::kY, phase, out);
       break;
+    case Step::kStartPoses:
+      // Both starts' public poses: the solver's initialization (kind Y) and the known
+      // inliers' (kind P).
+      neighbours_ = Eigen::MatrixXd::Zero(
+          in_.Y0.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
+      candidate_neighbours_ = neighbours_;
+      publish(in_.Y0, BlockKind::kY, phase, out);
+      publish(in_.Y0_known, BlockKind::kP, phase, out);
+      break;
+    case Step::kStartVotes: {
+      // The TLS cost of each measurement at both starts, summed by its weight owner.
+      double at_start = 0, at_known = 0;
+      for (std::size_t k : owned_) {
+        at_start += tls_term(k, residual_squared_at(k, in_.Y0, neighbours_));
+        at_known += tls_term(k, residual_squared_at(k, in_.Y0_known, candidate_neighbours_));
+      }
+      votes_[me] = {at_start, at_known};
+      RoundStatusMessage st;
+      st.cost = at_start;
+      st.grad_norm_sq = at_known;
+      to_others(st, true, nullptr);
+      break;
+    }
+    case Step::kPcm:
+      if (me != 0) {
+        // Every measurement this agent weighs goes to agent 0 (each measurement once).
+        std::vector<const Measurement*> values;
+        std::vector<std::uint64_t> index;
+        for (std::size_t k : owned_) {
+          values.push_back(&in_.measurements[k]);
+          index.push_back(in_.measurement_index[k]);
+        }
+        out.push_back(
+            OutgoingMessage{encode_measurement_block(me, gnc_phase(g_, GncExchange::kPcmValues),
+                                                     in_.d, values, index),
+                            false,
+                            {0}});
+        waiting_.push_back(0);
+      } else {
+        kept_values_.clear();
+        for (std::size_t k : owned_)
+          kept_values_.emplace_back(in_.measurement_index[k], in_.measurements[k]);
+        for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
+          waiting_.push_back(a);
+      }
+      break;
+    case Step::kKeptStart:
+      if (me != 0) {
+        // The kept measurements this agent weighs go to agent 0 (each measurement once).
+        std::vector<const Measurement*> values;
+        std::vector<std::uint64_t> index;
+        for (std::size_t k : owned_)
+          if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
+            values.push_back(&in_.measurements[k]);
+            index.push_back(in_.measurement_index[k]);
+          }
+        out.push_back(
+            OutgoingMessage{encode_measurement_block(me, gnc_phase(g_, GncExchange::kKeptValues),
+                                                     in_.d, values, index),
+                            false,
+                            {0}});
+        waiting_.push_back(0);
+      } else {
+        kept_values_.clear();
+        for (std::size_t k : owned_)
+          if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k]))
+            kept_values_.emplace_back(in_.measurement_index[k], in_.measurements[k]);
+        for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
+          waiting_.push_back(a);
+      }
+      break;
     case Step::kCandidatePoses:
       // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
       neighbours_ = Eigen::MatrixXd::Zero(
@@ -297,7 +404,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // mu's start needs the largest residual over every measurement that may be rejected.
       double max_r2 = 0;
       for (std::size_t k : owned_)
-        if (may_reject(k)) max_r2 = std::max(max_r2, residual_squared_at(k));
+        if (may_reject(k) && !dropped_[k]) max_r2 = std::max(max_r2, residual_squared_at(k));
       votes_[me] = {max_r2, 0};
       RoundStatusMessage st;
       st.cost = max_r2;
@@ -361,7 +468,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   if (!done_ && step_ == step && exchange_phase() == phase && waiting_.empty()) after_exchange(out);
 }
 
-void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
+void GncAgent::require_kept_connected() const {
   // The kept set must connect every pose (every agent checks the same set).
   const std::size_t parts =
       components_without(in_.num_poses, in_.d, in_.structure, rejected_, false, known_);
@@ -372,6 +479,10 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
                      std::to_string(parts) +
                      " unconnected parts, so no estimate is defined (too few consistent "
                      "measurements; try --known-inliers odometry or a larger --inlier-threshold)");
+}
+
+void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
+  require_kept_connected();
   kept_.clear();
   kept_index_.clear();
   for (std::size_t k = 0; k < in_.measurements.size(); ++k)
@@ -404,6 +515,80 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   begin_solve(out);
 }
 
+void GncAgent::after_step_zero(std::vector<OutgoingMessage>& out) {
+  first_solve_g_ = ++g_;
+  begin_solve(out);
+}
+
+void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
+  // Weight 0 from the start, never re-weighted (the inlier passes may take them back).
+  zero_cut_.clear();
+  for (std::uint64_t id : ids) {
+    if (id >= in_.structure.size())
+      throw std::runtime_error("robust pcm-gnc: measurement " + std::to_string(id) +
+                               " out of range");
+    const auto pos =
+        std::lower_bound(in_.measurement_index.begin(), in_.measurement_index.end(), id);
+    if (pos != in_.measurement_index.end() && *pos == id) {
+      const auto k = static_cast<std::size_t>(pos - in_.measurement_index.begin());
+      dropped_[k] = true;
+      weights_[k] = 0.0;
+    }
+    const auto& [i, j] = in_.structure[id];
+    if (in_.owner[i] != in_.owner[j]) zero_cut_.push_back(id);
+  }
+  // They leave the solves (the known inliers connect the poses): the layout without them.
+  std::sort(zero_cut_.begin(), zero_cut_.end());
+  layout_ = std::make_unique<BlockLayout>(
+      make_block_layout(in_.num_poses, without(in_.structure, zero_cut_), in_.owner));
+}
+
+void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
+  // Agent 0: the kept set in file order, as the in-process engine's initialization sees it.
+  std::sort(kept_values_.begin(), kept_values_.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  PoseGraph kept;
+  kept.d = in_.d;
+  kept.num_poses = in_.num_poses;
+  kept.source = in_.source;
+  kept.measurements.reserve(kept_values_.size());
+  for (std::size_t k = 0; k < kept_values_.size(); ++k) {
+    if (k > 0 && kept_values_[k].first == kept_values_[k - 1].first)
+      throw std::runtime_error("robust solve: measurement #" +
+                               std::to_string(kept_values_[k].first) + " was sent twice");
+    kept.measurements.push_back(std::move(kept_values_[k].second));
+  }
+  kept_values_.clear();
+  if (kept.measurements.size() + rejected_.size() != in_.structure.size())
+    throw std::runtime_error("robust solve: agent 0 has " +
+                             std::to_string(kept.measurements.size()) + " kept measurements, not " +
+                             std::to_string(in_.structure.size() - rejected_.size()));
+  const Eigen::MatrixXd X = lift_poses(initial_poses(kept, in_.initialization, in_.num_agents),
+                                       static_cast<int>(state_->Y.rows()));
+  const Eigen::Index w = (in_.d + 1);
+  auto block_of = [&](std::size_t a) {
+    const auto& ids = base_->poses[a];
+    Eigen::MatrixXd Y(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
+    for (std::size_t s = 0; s < ids.size(); ++s)
+      Y.middleCols(w * static_cast<Eigen::Index>(s), w) =
+          X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
+    return Y;
+  };
+  for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a) {
+    const Eigen::MatrixXd Y = block_of(a);
+    PoseBlockMessage b;
+    b.sender = 0;
+    b.phase = gnc_phase(g_, GncExchange::kKeptStart);
+    b.kind = BlockKind::kP;
+    b.rank = static_cast<std::uint32_t>(Y.rows());
+    b.dim = static_cast<std::uint32_t>(in_.d);
+    for (std::size_t id : base_->poses[a]) b.pose_ids.push_back(static_cast<std::uint32_t>(id));
+    b.data.assign(Y.data(), Y.data() + Y.size());
+    out.push_back(OutgoingMessage{std::move(b), false, {a}});
+  }
+  candidate_ = block_of(0);
+}
+
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
   if (solve_kind_ == Solve::kFinal) {
     final_rounds_ += solve_->total_rounds();
@@ -420,7 +605,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     begin_exchange(Step::kPoses, out);
     return;
   }
-  if (g_ > 0 && (converged_ || outer_ >= options_.robust.max_outer_iterations)) {
+  if (g_ > first_solve_g_ && (converged_ || outer_ >= options_.robust.max_outer_iterations)) {
     begin_exchange(Step::kRejected, out);
     return;
   }
@@ -467,13 +652,68 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     }
     case Step::kRejected:
       std::sort(rejected_.begin(), rejected_.end());
-      if (in_.inlier_start) {
-        candidate_ = in_.inlier_start(rejected_, static_cast<int>(state_->Y.rows()));
-        begin_exchange(Step::kCandidatePoses, out);
+      // Nothing rejected: the GNC iterate is already the plain solve's.
+      if (fresh_start_ && !rejected_.empty()) {
+        require_kept_connected();  // before initializing the kept set
+        begin_exchange(Step::kKeptStart, out);
         return;
       }
       begin_inlier_pass(out);
       return;
+    case Step::kKeptStart:
+      if (in_.id == 0) start_kept_set(out);
+      begin_exchange(Step::kCandidatePoses, out);
+      return;
+    case Step::kPcm: {
+      if (in_.id == 0) {
+        // The whole graph in file order, as the in-process engine's check sees it.
+        std::sort(kept_values_.begin(), kept_values_.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        PoseGraph graph;
+        graph.d = in_.d;
+        graph.num_poses = in_.num_poses;
+        graph.source = in_.source;
+        for (auto& [e, m] : kept_values_) graph.measurements.push_back(std::move(m));
+        kept_values_.clear();
+        if (graph.measurements.size() != in_.structure.size())
+          throw std::runtime_error("robust pcm-gnc: agent 0 has " +
+                                   std::to_string(graph.measurements.size()) + " of " +
+                                   std::to_string(in_.structure.size()) + " measurements");
+        PoseGraph chains = graph;
+        chains.measurements.clear();
+        for (std::size_t e = 0; e < graph.measurements.size(); ++e)
+          if (known_[e]) chains.measurements.push_back(graph.measurements[e]);
+        const PairwiseConsistencyResult pcm =
+            pairwise_consistency(graph, known_, distributed_initialization(chains, 1), c2_);
+        const std::vector<std::uint64_t> ids(pcm.inconsistent.begin(), pcm.inconsistent.end());
+        RoundStatusMessage st;
+        st.sender = 0;
+        st.phase = gnc_phase(g_, GncExchange::kPcmDropped);
+        st.measurement_ids = ids;
+        if (in_.num_agents > 1) out.push_back(OutgoingMessage{std::move(st), true, {}});
+        drop_inconsistent(ids);
+      }
+      if (in_.Y0_known.size() > 0)
+        begin_exchange(Step::kStartPoses, out);
+      else
+        after_step_zero(out);
+      return;
+    }
+    case Step::kStartPoses:
+      begin_exchange(Step::kStartVotes, out);
+      return;
+    case Step::kStartVotes: {
+      double at_start = 0, at_known = 0;
+      for (const auto& [sender, v] : votes_) {  // agent-id order
+        at_start += v.first;
+        at_known += v.second;
+      }
+      if (at_known < at_start) in_.Y0 = std::move(in_.Y0_known);
+      in_.Y0_known.resize(0, 0);
+      candidate_neighbours_.resize(0, 0);
+      after_step_zero(out);
+      return;
+    }
     case Step::kCandidatePoses:
       begin_exchange(Step::kCandidateVotes, out);
       return;
@@ -531,7 +771,35 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     throw std::runtime_error(me + "unexpected robust message " + std::to_string(phase) +
                              " from agent " + std::to_string(sender));
   waiting_.erase(it);
-  if (step_ == Step::kPoses || step_ == Step::kCandidatePoses) {
+  if (step_ == Step::kPcm) {
+    if (in_.id == 0) {
+      const auto* block = std::get_if<PoseBlockMessage>(&message);
+      if (!block) throw std::runtime_error(me + "a status where measurements belong");
+      decode_measurement_block(*block, in_.d, in_.num_poses, "robust pcm-gnc", kept_values_);
+    } else {
+      const auto* st = std::get_if<RoundStatusMessage>(&message);
+      if (!st) throw std::runtime_error(me + "poses where the consistency check belongs");
+      drop_inconsistent(st->measurement_ids);
+    }
+  } else if (step_ == Step::kKeptStart) {
+    const auto* block = std::get_if<PoseBlockMessage>(&message);
+    if (!block) throw std::runtime_error(me + "a status where the kept set's start belongs");
+    if (in_.id == 0) {
+      decode_measurement_block(*block, in_.d, in_.num_poses, "robust solve", kept_values_);
+    } else {
+      // Agent 0's fresh start of the kept set: this agent's block, lifted.
+      const auto& own = base_->poses[static_cast<std::size_t>(in_.id)];
+      const Eigen::Index w = (in_.d + 1) * state_->Y.rows();
+      if (block->rank != static_cast<std::uint32_t>(state_->Y.rows()) ||
+          block->pose_ids.size() != own.size() ||
+          block->data.size() != own.size() * static_cast<std::size_t>(w) ||
+          !std::equal(own.begin(), own.end(), block->pose_ids.begin()))
+        throw std::runtime_error(me + "malformed start of the kept set from agent 0");
+      candidate_.resize(state_->Y.rows(), state_->Y.cols());
+      std::memcpy(candidate_.data(), block->data.data(), sizeof(double) * block->data.size());
+    }
+  } else if (step_ == Step::kPoses || step_ == Step::kCandidatePoses ||
+             step_ == Step::kStartPoses) {
     const auto* block = std::get_if<PoseBlockMessage>(&message);
     const Eigen::Index w = (in_.d + 1) * neighbours_.rows();
     if (!block || block->rank != static_cast<std::uint32_t>(neighbours_.rows()) ||
@@ -553,7 +821,8 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     const auto* st = std::get_if<RoundStatusMessage>(&message);
     if (!st) throw std::runtime_error(me + "poses where a robust status belongs");
     if (step_ == Step::kVotes) votes_[sender] = {st->cost, 0};
-    if (step_ == Step::kCandidateVotes) votes_[sender] = {st->cost, st->grad_norm_sq};
+    if (step_ == Step::kCandidateVotes || step_ == Step::kStartVotes)
+      votes_[sender] = {st->cost, st->grad_norm_sq};
     if (step_ == Step::kWeights) {
       votes_[sender] = {st->grad_norm_sq, 0};
       if (st->weights.size() != st->measurement_ids.size())

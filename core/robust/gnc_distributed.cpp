@@ -34,18 +34,6 @@ PoseGraph known_subgraph(const PoseGraph& graph, const std::vector<bool>& known)
   return out;
 }
 
-// sum over measurements of r^2 (known inliers) or min(r^2, c^2) (the others) at `poses`.
-double tls_cost(const PoseGraph& graph, const std::vector<bool>& known,
-                const std::vector<Pose>& poses, double c2) {
-  double f = 0;
-  for (std::size_t e = 0; e < graph.num_measurements(); ++e) {
-    const Measurement& m = graph.measurements[e];
-    const double r2 = residual_squared(m, poses[m.i], poses[m.j]);
-    f += known[e] ? r2 : std::min(r2, c2);
-  }
-  return f;
-}
-
 }  // namespace
 
 void GncDistributedOptions::validate() const {
@@ -77,32 +65,18 @@ AgentWeights agent_weights(int agent, const PoseGraph& graph, const std::vector<
   return out;
 }
 
-std::vector<Pose> gnc_start(const PoseGraph& graph, const GncDistributedOptions& options,
-                            int agents) {
-  const DistributedOptions& solver = options.solver;
-  const int robots = solver.robots > 0 ? solver.robots : agents;
-  std::vector<Pose> start = initial_poses(graph, solver.initialization, robots);
-  if (!options.known_inlier_start) return start;
+std::optional<std::vector<Pose>> known_inlier_poses(const PoseGraph& graph,
+                                                    const GncDistributedOptions& options,
+                                                    int agents) {
+  if (!options.known_inlier_start) return std::nullopt;
   std::vector<bool> known(graph.num_measurements());
-  std::size_t candidates = 0;
-  for (std::size_t e = 0; e < graph.num_measurements(); ++e) {
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e)
     known[e] = is_known_inlier(graph.measurements[e], options.robust.known_inliers) ||
                (!options.known_inlier_flags.empty() && options.known_inlier_flags[e]);
-    candidates += known[e] ? 0 : 1;
-  }
-  // Two candidate starts: the known inliers' initialization (it does not see the wrong
-  // closures, but drifts) and the solver's own (chordal fits every closure, wrong ones too; on
-  // clean data it is nearly the optimum). The one with the lower TLS cost (every rejectable term
-  // capped at c^2) is taken: clean files start where the plain solve starts, contaminated ones
-  // from the odometry.
   const PoseGraph known_graph = known_subgraph(graph, known);
-  if (count_components(known_graph) > 1) return start;
-  std::vector<Pose> chains = distributed_initialization(known_graph, robots);
-  if (!options.start_vote) return chains;
-  const double c2 = tls_threshold_squared(options.robust, graph.d, candidates);
-  if (tls_cost(graph, known, chains, c2) < tls_cost(graph, known, start, c2))
-    start = std::move(chains);
-  return start;
+  if (count_components(known_graph) > 1) return std::nullopt;
+  const int robots = options.solver.robots > 0 ? options.solver.robots : agents;
+  return distributed_initialization(known_graph, robots);
 }
 
 GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
@@ -117,7 +91,11 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
     throw InputError("DistributedOptions.rank must be >= d = " + std::to_string(graph.d));
   const BlockLayout layout = make_block_layout(graph.num_poses, graph.measurements, assignment);
   const int agents = layout.num_blocks;
-  const Eigen::MatrixXd X0 = lift_poses(gnc_start(graph, options, agents), solver.rank);
+  const int robots = solver.robots > 0 ? solver.robots : agents;
+  const Eigen::MatrixXd X0 =
+      lift_poses(initial_poses(graph, solver.initialization, robots), solver.rank);
+  const std::optional<std::vector<Pose>> known = known_inlier_poses(graph, options, agents);
+  const Eigen::MatrixXd X0_known = known ? lift_poses(*known, solver.rank) : Eigen::MatrixXd();
   const Eigen::Index w = graph.d + 1;
   auto block_of = [&](const Eigen::MatrixXd& X, int b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
@@ -136,8 +114,6 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
     structure.emplace_back(static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j));
   std::vector<std::unique_ptr<GncAgent>> gnc;
   std::vector<AgentProcess*> processes;
-  std::unique_ptr<Eigen::MatrixXd> inlier_guess;
-  std::vector<std::uint64_t> inlier_guess_for;
   for (int b = 0; b < agents; ++b) {
     GncAgentInput in;
     in.id = b;
@@ -154,20 +130,11 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
       in.measurement_index.push_back(e);
     }
     in.Y0 = block_of(X0, b);
-    // The first inlier pass may start from the solver's own initialization of the kept set
-    // (computed once, for every agent), when its cost is lower (the agents' vote).
-    if (options.inlier_set_start)
-      in.inlier_start = [&, b](const std::vector<std::uint64_t>& rejected, int rank) {
-        if (!inlier_guess || inlier_guess_for != rejected) {
-          const std::vector<std::size_t> r(rejected.begin(), rejected.end());
-          inlier_guess = std::make_unique<Eigen::MatrixXd>(
-              lift_poses(initial_poses(inlier_graph(graph, r, {}), solver.initialization,
-                                       solver.robots > 0 ? solver.robots : agents),
-                         rank));
-          inlier_guess_for = rejected;
-        }
-        return block_of(*inlier_guess, b);
-      };
+    if (known) in.Y0_known = block_of(X0_known, b);
+    in.kept_set_start = options.kept_set_start;
+    in.initialization = solver.initialization;
+    in.source = graph.source;
+    in.pcm = options.robust.kind == RobustKind::kPcmGnc;
     // Without the final certified solve: it runs below, for its full record.
     gnc.push_back(std::make_unique<GncAgent>(std::move(in), options, false));
     if (options.weight_observer)

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <string>
+#include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/robust/gnc_agent.hpp>
 
@@ -33,7 +34,16 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   in.structure = local.structure;
   in.measurements = local.measurements;
   in.measurement_index = local.measurement_index;
+  in.known_inlier = local.known_inlier;
+  in.pcm = local.options.robust.kind == RobustKind::kPcmGnc;
   in.Y0 = lift_poses(local.initial, options.solver.rank);
+  if (!local.known_initial.empty())
+    in.Y0_known = lift_poses(local.known_initial, options.solver.rank);
+  in.kept_set_start = options.kept_set_start;
+  // The run's initialization (the kept set's fresh start uses the same).
+  in.initialization = local.options.initialization.empty()
+                          ? DistributedOptions{}.initialization
+                          : parse_init(local.options.initialization);
   GncAgent agent(std::move(in), options, true);
 
   Mailbox mail(channel, receive_timeout_s, local.agent_id);

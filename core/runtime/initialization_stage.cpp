@@ -13,6 +13,8 @@
 #include <tessera/util/input_error.hpp>
 #include <variant>
 
+#include "distributed/measurement_block.hpp"
+
 namespace tessera::agent {
 
 namespace {
@@ -25,11 +27,6 @@ enum InitPhase : std::uint32_t {
   kCrossing                               // all -> all: inter-robot measurements recorded
 };
 
-// A measurement travels as one entry of a pose block of rank 4: [i, j, kappa, tau, R, t]
-// (R column-major), 4 + d^2 + d <= 4 (d + 1) doubles for d = 2, 3; pose_ids carries its
-// position in the file.
-constexpr std::uint32_t kMeasurementRank = 4;
-
 std::uint32_t phase_of(const ProtocolMessage& m) {
   return std::visit([](const auto& x) { return x.phase; }, m);
 }
@@ -38,14 +35,23 @@ std::uint32_t sender_of(const ProtocolMessage& m) {
 }
 
 // Receives until every agent of `senders` has sent its message of `phase`; keeps messages of
-// the stage's other phases for later. A message of another stage cannot arrive (see the header).
+// the stage's other phases for later. A message of another stage cannot arrive (see the header),
+// except the second stage of run_initialization_stages(), which runs on the same mailbox with
+// its phases moved by `offset` so its messages are kept, not mistaken for the first's.
 class StageMailbox {
  public:
   StageMailbox(ProtocolChannel& channel, double timeout_s, std::uint32_t self)
       : channel_(channel), timeout_s_(timeout_s), self_(self) {}
 
-  std::map<std::uint32_t, ProtocolMessage> gather(std::uint32_t phase,
+  void set_offset(std::uint32_t offset) { offset_ = offset; }
+  void send(OutgoingMessage m) {
+    std::visit([&](auto& x) { x.phase += offset_; }, m.message);
+    channel_.send(m);
+  }
+
+  std::map<std::uint32_t, ProtocolMessage> gather(std::uint32_t stage_phase,
                                                   const std::vector<std::uint32_t>& senders) {
+    const std::uint32_t phase = stage_phase + offset_;
     for (;;) {
       auto& have = stash_[phase];
       std::string missing;
@@ -74,6 +80,7 @@ class StageMailbox {
   ProtocolChannel& channel_;
   double timeout_s_;
   std::uint32_t self_;
+  std::uint32_t offset_ = 0;
   std::map<std::uint32_t, std::map<std::uint32_t, ProtocolMessage>> stash_;
 };
 
@@ -88,49 +95,6 @@ PoseBlockMessage block(std::uint32_t self, std::uint32_t phase, std::uint32_t ra
 
 std::size_t width_of(const PoseBlockMessage& m) {
   return static_cast<std::size_t>(m.rank) * (m.dim + 1);
-}
-
-// Measurements as pose-block entries (see kMeasurementRank).
-PoseBlockMessage encode_measurements(std::uint32_t self, std::uint32_t phase, int d,
-                                     const std::vector<const Measurement*>& meas,
-                                     const std::vector<std::uint64_t>& index) {
-  PoseBlockMessage m = block(self, phase, kMeasurementRank, d);
-  const std::size_t width = width_of(m);
-  for (std::size_t k = 0; k < meas.size(); ++k) {
-    if (index[k] > 0xFFFFFFFFull)
-      throw std::runtime_error("initialisation: measurement index beyond 32 bits");
-    m.pose_ids.push_back(static_cast<std::uint32_t>(index[k]));
-    const Measurement& e = *meas[k];
-    const std::size_t start = m.data.size();
-    m.data.insert(m.data.end(),
-                  {static_cast<double>(e.i), static_cast<double>(e.j), e.kappa, e.tau});
-    append_measurement_rt(m.data, m.data, e);  // R then t
-    m.data.resize(start + width, 0.0);
-  }
-  return m;
-}
-
-void decode_measurements(const PoseBlockMessage& m, int d, std::size_t num_poses,
-                         std::vector<std::pair<std::uint64_t, Measurement>>& out) {
-  const std::size_t width = width_of(m), dd = static_cast<std::size_t>(d);
-  if (m.rank != kMeasurementRank || m.dim != static_cast<std::uint32_t>(d) ||
-      m.data.size() != m.pose_ids.size() * width)
-    throw std::runtime_error("initialisation: malformed measurements from agent " +
-                             std::to_string(m.sender));
-  for (std::size_t k = 0; k < m.pose_ids.size(); ++k) {
-    const double* v = m.data.data() + k * width;
-    Measurement e;
-    if (!(v[0] >= 0 && v[0] < static_cast<double>(num_poses) && v[1] >= 0 &&
-          v[1] < static_cast<double>(num_poses)))
-      throw std::runtime_error("initialisation: agent " + std::to_string(m.sender) +
-                               " sent a measurement with a pose out of range");
-    e.i = static_cast<std::size_t>(v[0]);
-    e.j = static_cast<std::size_t>(v[1]);
-    e.kappa = v[2];
-    e.tau = v[3];
-    read_measurement_rt(m.data, k * width + 4, m.data, k * width + 4 + dd * dd, d, e);
-    out.emplace_back(m.pose_ids[k], std::move(e));
-  }
 }
 
 std::vector<std::uint32_t> others(std::uint32_t self, std::uint32_t n) {
@@ -155,15 +119,14 @@ std::vector<Measurement> in_file_order(std::vector<std::pair<std::uint64_t, Meas
 }
 
 std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std::uint32_t N,
-                                const std::string& source, ProtocolChannel& channel,
-                                StageMailbox& mail) {
+                                const std::string& source, StageMailbox& mail) {
   const int d = share.d;
   const std::size_t width = flat_pose_size(d);
   std::vector<const Measurement*> mine;
   for (const auto& m : share.measurements) mine.push_back(&m);
   if (self != 0) {
-    channel.send(OutgoingMessage{
-        encode_measurements(self, kChordalMeasurements, d, mine, share.measurement_index),
+    mail.send(OutgoingMessage{
+        encode_measurement_block(self, kChordalMeasurements, d, mine, share.measurement_index),
         false,
         {0}});
     const auto got = mail.gather(kChordalPoses, {0});
@@ -187,7 +150,8 @@ std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std
   for (std::size_t k = 0; k < share.measurements.size(); ++k)
     all.emplace_back(share.measurement_index[k], share.measurements[k]);
   for (auto& [sender, msg] : mail.gather(kChordalMeasurements, others(self, N)))
-    decode_measurements(std::get<PoseBlockMessage>(msg), d, share.num_poses, all);
+    decode_measurement_block(std::get<PoseBlockMessage>(msg), d, share.num_poses, "initialisation",
+                             all);
   PoseGraph graph;
   graph.d = d;
   graph.num_poses = share.num_poses;
@@ -200,7 +164,7 @@ std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std
       out.pose_ids.push_back(static_cast<std::uint32_t>(id));
       append_flat_pose(out.data, poses[id], width);
     }
-    channel.send(OutgoingMessage{std::move(out), true, {}});
+    mail.send(OutgoingMessage{std::move(out), true, {}});
   }
   return std::vector<Pose>(poses.begin() + share.begin, poses.begin() + share.end);
 }
@@ -208,8 +172,7 @@ std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std
 std::vector<Pose> distributed_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t N,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
-    const std::string& source, ProtocolChannel& channel, StageMailbox& mail,
-    std::uint64_t* total_units) {
+    const std::string& source, StageMailbox& mail, std::uint64_t* total_units) {
   const int d = share.d;
   auto mine = [&](std::size_t id) { return id >= share.begin && id < share.end; };
   // 1. Our own units (what this robot computes alone).
@@ -244,10 +207,10 @@ std::vector<Pose> distributed_stage(
   count.phase = kUnitCount;
   count.cost = static_cast<double>(units.members.size());
   if (N > 1) {
-    channel.send(OutgoingMessage{ends, true, {}});
-    channel.send(OutgoingMessage{count, true, {}});
-    channel.send(OutgoingMessage{
-        encode_measurements(self, kCrossing, d, crossing_mine, crossing_index), true, {}});
+    mail.send(OutgoingMessage{ends, true, {}});
+    mail.send(OutgoingMessage{count, true, {}});
+    mail.send(OutgoingMessage{
+        encode_measurement_block(self, kCrossing, d, crossing_mine, crossing_index), true, {}});
   }
   // 3. Everyone's: unit numbering in agent order (ranges tile 0..n-1 in agent order, so this
   //    is the order of the units' smallest poses, as in the in-process engine).
@@ -284,7 +247,8 @@ std::vector<Pose> distributed_stage(
   for (std::size_t k = 0; k < crossing_mine.size(); ++k)
     all.emplace_back(crossing_index[k], *crossing_mine[k]);
   for (auto& [a, msg] : mail.gather(kCrossing, others(self, N)))
-    decode_measurements(std::get<PoseBlockMessage>(msg), d, share.num_poses, all);
+    decode_measurement_block(std::get<PoseBlockMessage>(msg), d, share.num_poses, "initialisation",
+                             all);
   const std::vector<Measurement> crossing = in_file_order(std::move(all));
   // 4. The same spanning tree on every agent; our poses in the common frame.
   const std::vector<Pose> frame = align_units(d, offset[N], crossing, endpoint);
@@ -303,16 +267,16 @@ std::string default_initialization() {
   return init_name(DistributedOptions{}.initialization);
 }
 
-InitializationResult run_initialization_stage(
+namespace {
+
+InitializationResult run_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t num_agents,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
-    const std::string& method, const std::string& source, ProtocolChannel& channel,
-    double timeout_s) {
+    const std::string& method, const std::string& source, StageMailbox& mail) {
   const auto t0 = std::chrono::steady_clock::now();
   InitializationResult res;
   res.method = method.empty() ? default_initialization() : method;
   const DistributedInit init = parse_init(res.method);
-  StageMailbox mail(channel, timeout_s, self);
   if (init == DistributedInit::kFile) {
     if (share.initial.size() != share.end - share.begin)
       throw InputError(source, 0,
@@ -321,13 +285,37 @@ InitializationResult run_initialization_stage(
                            std::to_string(share.end - 1) + "); use --init chordal or distributed");
     res.poses = share.initial;
   } else if (init == DistributedInit::kChordal) {
-    res.poses = chordal_stage(share, self, num_agents, source, channel, mail);
+    res.poses = chordal_stage(share, self, num_agents, source, mail);
   } else {
-    res.poses =
-        distributed_stage(share, self, num_agents, structure, source, channel, mail, &res.units);
+    res.poses = distributed_stage(share, self, num_agents, structure, source, mail, &res.units);
   }
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
+}
+
+}  // namespace
+
+InitializationResult run_initialization_stage(
+    const RobotShare& share, std::uint32_t self, std::uint32_t num_agents,
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    const std::string& method, const std::string& source, ProtocolChannel& channel,
+    double timeout_s) {
+  StageMailbox mail(channel, timeout_s, self);
+  return run_stage(share, self, num_agents, structure, method, source, mail);
+}
+
+std::pair<InitializationResult, InitializationResult> run_initialization_stages(
+    const RobotShare& share, const RobotShare& second_share, std::uint32_t self,
+    std::uint32_t num_agents, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& second_structure,
+    const std::string& method, const std::string& second_method, const std::string& source,
+    ProtocolChannel& channel, double timeout_s) {
+  StageMailbox mail(channel, timeout_s, self);
+  InitializationResult first = run_stage(share, self, num_agents, structure, method, source, mail);
+  mail.set_offset(kSecondStagePhaseOffset);
+  InitializationResult second =
+      run_stage(second_share, self, num_agents, second_structure, second_method, source, mail);
+  return {std::move(first), std::move(second)};
 }
 
 }  // namespace tessera::agent

@@ -34,6 +34,8 @@
 namespace tessera::agent {
 
 constexpr std::uint32_t kInitPhaseBase = 300;
+/// Phases of run_initialization_stages()' second stage: its own phases plus this (< 400).
+constexpr std::uint32_t kSecondStagePhaseOffset = 50;
 
 /// The initialisation name an empty RunOptions::initialization stands for: the in-process
 /// engine's default (DistributedOptions), so `tessera launch` and `tessera solve` agree.
@@ -56,5 +58,17 @@ InitializationResult run_initialization_stage(
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::string& method, const std::string& source, ProtocolChannel& channel,
     double timeout_s);
+
+/// Two stages back to back on one inbox (a robust run's two candidate starts: `method` on
+/// `share`, then `second_method` on `second_share`, e.g. the distributed initialization of the
+/// known inliers alone, runtime/known_inlier_start.hpp). The second stage's phases are moved by
+/// kSecondStagePhaseOffset, so a faster agent's messages of it are kept while this agent is
+/// still in the first (two separate calls would drop them).
+std::pair<InitializationResult, InitializationResult> run_initialization_stages(
+    const RobotShare& share, const RobotShare& second_share, std::uint32_t self,
+    std::uint32_t num_agents, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& second_structure,
+    const std::string& method, const std::string& second_method, const std::string& source,
+    ProtocolChannel& channel, double timeout_s);
 
 }  // namespace tessera::agent

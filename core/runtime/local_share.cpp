@@ -45,8 +45,49 @@ HandoffPlan plan_handoff(const RobotShare& share, const std::vector<std::uint32_
   if (!share.initial.empty())
     for (std::uint32_t id = share.begin; id < share.end; ++id)
       if (owner[id] == recipient) plan.poses.emplace_back(id, &share.initial[id - share.begin]);
+  if (!share.known_initial.empty())
+    for (std::uint32_t id = share.begin; id < share.end; ++id)
+      if (owner[id] == recipient)
+        plan.known_poses.emplace_back(id, &share.known_initial[id - share.begin]);
   return plan;
 }
+
+namespace {
+
+// The poses of `own_range` (share's [begin, end), or empty: none) and those `field` of the
+// hand-offs carries, in the order of `owned`.
+std::vector<Pose> owned_poses(const std::vector<Pose>& own_range, const RobotShare& share,
+                              const std::vector<std::uint32_t>& owner, std::uint32_t self,
+                              const std::vector<ReceivedHandoff>& received,
+                              const std::vector<std::uint32_t>& owned,
+                              std::vector<std::pair<std::uint32_t, Pose>> ReceivedHandoff::*field,
+                              const std::string& what) {
+  std::vector<Pose> out;
+  if (own_range.empty()) return out;
+  std::vector<const Pose*> slot(owner.size(), nullptr);
+  for (std::uint32_t id = share.begin; id < share.end; ++id)
+    if (owner[id] == self) slot[id] = &own_range[id - share.begin];
+  for (const ReceivedHandoff& h : received)
+    for (const auto& [id, pose] : h.*field) {
+      if (id >= owner.size() || owner[id] != self)
+        throw std::runtime_error("agent " + std::to_string(h.sender) + " handed over " + what +
+                                 " " + std::to_string(id) + " which agent " + std::to_string(self) +
+                                 " does not own");
+      if (slot[id])
+        throw std::runtime_error(what + " " + std::to_string(id) + " was handed over twice");
+      slot[id] = &pose;
+    }
+  out.reserve(owned.size());
+  for (std::uint32_t id : owned) {
+    if (!slot[id])
+      throw std::runtime_error(what + " " + std::to_string(id) +
+                               " was never handed over to agent " + std::to_string(self));
+    out.push_back(*slot[id]);
+  }
+  return out;
+}
+
+}  // namespace
 
 AgentLocalData assemble_local(const RobotShare& share, const std::vector<std::uint32_t>& owner,
                               std::uint32_t self, std::uint32_t num_agents,
@@ -86,28 +127,10 @@ AgentLocalData assemble_local(const RobotShare& share, const std::vector<std::ui
   }
 
   // Initial poses: from our own range, or handed over by the robot that had them.
-  const bool with_initial = !share.initial.empty();
-  if (with_initial) {
-    std::vector<const Pose*> slot(owner.size(), nullptr);
-    for (std::uint32_t id = share.begin; id < share.end; ++id)
-      if (owner[id] == self) slot[id] = &share.initial[id - share.begin];
-    for (const ReceivedHandoff& h : received)
-      for (const auto& [id, pose] : h.poses) {
-        if (id >= owner.size() || owner[id] != self)
-          throw std::runtime_error("agent " + std::to_string(h.sender) + " handed over pose " +
-                                   std::to_string(id) + " which agent " + std::to_string(self) +
-                                   " does not own");
-        if (slot[id])
-          throw std::runtime_error("pose " + std::to_string(id) + " was handed over twice");
-        slot[id] = &pose;
-      }
-    for (std::uint32_t id : local.owned) {
-      if (!slot[id])
-        throw std::runtime_error("initial pose " + std::to_string(id) +
-                                 " was never handed over to agent " + std::to_string(self));
-      local.initial.push_back(*slot[id]);
-    }
-  }
+  local.initial = owned_poses(share.initial, share, owner, self, received, local.owned,
+                              &ReceivedHandoff::poses, "initial pose");
+  local.known_initial = owned_poses(share.known_initial, share, owner, self, received, local.owned,
+                                    &ReceivedHandoff::known_poses, "known inliers' start pose");
   return local;
 }
 

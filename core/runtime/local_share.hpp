@@ -22,6 +22,12 @@ struct RobotShare {
   std::vector<Measurement> measurements;
   std::vector<std::uint64_t> measurement_index;  ///< Position in the file.
   std::vector<Pose> initial;                     ///< end - begin poses, or empty.
+  /// A robust run's second candidate start of [begin, end) (the known inliers'
+  /// initialization, runtime/known_inlier_start.hpp), or empty.
+  std::vector<Pose> known_initial;
+  /// measurement_index values of the share's measurements flagged as known inliers (a robot
+  /// file's '# tessera-known-inliers' line, from a dpgo CSV file), ascending.
+  std::vector<std::uint64_t> known_inlier_index;
 };
 
 /// Throws InputError (naming graph.source) when N > n.
@@ -34,6 +40,7 @@ struct HandoffPlan {
   std::vector<const Measurement*> measurements;
   std::vector<std::uint64_t> measurement_index;
   std::vector<std::pair<std::uint32_t, const Pose*>> poses;
+  std::vector<std::pair<std::uint32_t, const Pose*>> known_poses;  ///< Of share.known_initial.
 };
 HandoffPlan plan_handoff(const RobotShare& share, const std::vector<std::uint32_t>& owner,
                          std::uint32_t recipient);
@@ -44,12 +51,14 @@ struct ReceivedHandoff {
   std::vector<Measurement> measurements;
   std::vector<std::uint64_t> measurement_index;
   std::vector<std::pair<std::uint32_t, Pose>> poses;
+  std::vector<std::pair<std::uint32_t, Pose>> known_poses;
 };
 
 /// The local problem of agent `self` after the hand-off: its owned poses, every
 /// measurement touching them (own share's and received, sorted by file position, no
-/// duplicates) and their initial poses. Throws std::runtime_error naming what is
-/// inconsistent (a pose never handed over, a measurement received twice, ...).
+/// duplicates) and their initial poses (and known_initial when the share has it). Throws
+/// std::runtime_error naming what is inconsistent (a pose never handed over, a measurement received
+/// twice, ...).
 AgentLocalData assemble_local(const RobotShare& share, const std::vector<std::uint32_t>& owner,
                               std::uint32_t self, std::uint32_t num_agents,
                               std::vector<ReceivedHandoff> received, const RunOptions& options);

@@ -69,6 +69,8 @@ RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
   std::uint64_t begin = 0, end = 0;
   bool have_index = false;
   std::vector<std::uint64_t> index;
+  std::vector<std::uint64_t> known;  // '# tessera-known-inliers': positions of flagged ones
+  std::size_t known_line = 0;
   struct Record {
     std::size_t line;  // 0-based
     bool vertex;
@@ -87,6 +89,10 @@ RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
         end = parse_id(path, k + 1, t[4], "END");
         if (end <= begin) throw InputError(path, k + 1, "the robot's pose range is empty");
         have_range = true;
+      } else if (is_header(t, "tessera-known-inliers")) {
+        known_line = k + 1;
+        for (std::size_t c = 2; c < t.size(); ++c)
+          known.push_back(parse_id(path, k + 1, t[c], "known-inlier measurement index"));
       } else if (is_header(t, "tessera-measurement-index")) {
         have_index = true;
         for (std::size_t c = 2; c < t.size(); ++c)
@@ -198,6 +204,15 @@ RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
                                              : (static_cast<std::uint64_t>(robot) << 40) + k);
   }
   if (g.has_initial()) s.initial.assign(g.initial.begin(), g.initial.begin() + (end - begin));
+  std::sort(known.begin(), known.end());
+  std::vector<std::uint64_t> held = s.measurement_index;
+  std::sort(held.begin(), held.end());
+  for (std::uint64_t e : known)
+    if (!std::binary_search(held.begin(), held.end(), e))
+      throw InputError(path, known_line,
+                       "'# tessera-known-inliers' names measurement " + std::to_string(e) +
+                           ", which is not one of this file's EDGE lines");
+  s.known_inlier_index = std::move(known);
   return s;
 }
 

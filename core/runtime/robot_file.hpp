@@ -12,7 +12,11 @@
 //     contiguous);
 //   - `# tessera-measurement-index K1 K2 ...` (optional): each EDGE line's position in the
 //     whole graph, in line order, so the run orders measurements exactly as the single file
-//     would; without it a measurement's position is (robot id << 40) + its line order.
+//     would; without it a measurement's position is (robot id << 40) + its line order;
+//   - `# tessera-known-inliers K1 K2 ...` (optional): the positions of the measurements a
+//     robust run must never down-weight (a dpgo CSV file's is_known_inlier column; `tessera
+//     launch` on a CSV writes it). The agents announce them and the coordinator's assignment
+//     gives every agent the whole set.
 // The file does not say how many poses the whole graph has: n is the end of the last
 // robot's range, learned from the announcements (the coordinator checks that the ranges
 // tile 0..n-1 in agent order and sends n in the assignment).

@@ -66,6 +66,9 @@ struct AgentLocalData {
   std::vector<std::uint64_t> measurement_index;
   /// Initial poses of `owned` (same order), from the initialisation stage.
   std::vector<Pose> initial;
+  /// A robust run's second candidate start of `owned` (same order), the known inliers'
+  /// initialization (GncAgentInput::Y0_known), or empty.
+  std::vector<Pose> known_initial;
   /// When not empty: the lifted starting point of `owned` (r x (d+1)m, same order), used
   /// instead of lifting `initial` (a run continued by survivors after a permanent loss).
   Eigen::MatrixXd lifted_start;
@@ -73,6 +76,9 @@ struct AgentLocalData {
   /// enough for core's make_block_layout, so every agent builds the same layout (neighbours,
   /// public poses, colouring).
   std::vector<std::pair<std::uint32_t, std::uint32_t>> structure;
+  /// Empty, or one flag per measurement of `structure`: true = a known inlier by the input's
+  /// own flag (a dpgo CSV file's is_known_inlier; the coordinator's assignment carries them).
+  std::vector<bool> known_inlier;
   RunOptions options;
 };
 

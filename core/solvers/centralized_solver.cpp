@@ -1,5 +1,6 @@
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <memory>
 #include <sstream>
 #include <tessera/problem/block_problem.hpp>
@@ -59,6 +60,7 @@ void CentralizedOptions::validate() const {
     throw InputError("CentralizedOptions.certified_lanczos_tolerance must be in (0, 1)");
   if (!(preconditioner_shift > 0))
     throw InputError("CentralizedOptions.preconditioner_shift must be > 0");
+  if (threads < 1 || threads > 2) throw InputError("CentralizedOptions.threads must be 1 or 2");
   trust_region.validate();
   certificate.validate();
 }
@@ -119,10 +121,30 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   const auto start = Clock::now();
   CentralizedResult res;
 
+  const BlockProblem problem =
+      BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
+  // Always the exact factor, and always simplicial LDL^T: its solves with r right-hand sides are
+  // what the tCG repeats (docs/centralized-solver.md). The distributed blocks' switch to
+  // supernodal above 1 M entries made cubicle's and city10000's whole-graph factors supernodal:
+  // CPU in alternated pairs (load 7-8) cubicle 1.41/1.80/2.50 s simplicial vs 1.67/1.99/2.28 s,
+  // city10000 1.28/1.12/1.18 vs 1.39/1.84/1.41.
+  const auto build_preconditioner = [&problem, &options] {
+    return std::make_unique<BlockPreconditioner>(problem, options.preconditioner_shift, 0, 0);
+  };
+  // The factorization does not depend on the start: with a second thread it runs while the
+  // start is computed (each CHOLMOD factor has its own workspace, so the two do not share state).
+  std::future<std::unique_ptr<BlockPreconditioner>> pending;
+  if (options.threads > 1) pending = std::async(std::launch::async, build_preconditioner);
   std::vector<Pose> init;
   switch (options.initialization) {
     case Initialization::kChordal:
-      init = chordal_initialization(graph);
+      // With translation elimination the trust region replaces the start's translations by
+      // their exact minimiser before its first step (the same weighted Laplacian solve), so
+      // the chordal start's own translation solve would be done twice.
+      init = options.eliminate_translations
+                 ? assemble_poses(chordal_rotations(graph),
+                                  Eigen::MatrixXd::Zero(graph.d, graph.num_poses))
+                 : chordal_initialization(graph);
       break;
     case Initialization::kOdometry:
       init = odometry_initialization(graph);
@@ -133,14 +155,6 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
       init = graph.initial;
       break;
   }
-  const BlockProblem problem =
-      BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
-  // Always the exact factor, and always simplicial LDL^T: its solves with r right-hand sides are
-  // what the tCG repeats (docs/centralized-solver.md). The distributed blocks' switch to
-  // supernodal above 1 M entries made cubicle's and city10000's whole-graph factors supernodal:
-  // CPU in alternated pairs (load 7-8) cubicle 1.41/1.80/2.50 s simplicial vs 1.67/1.99/2.28 s,
-  // city10000 1.28/1.12/1.18 vs 1.39/1.84/1.41.
-  const BlockPreconditioner precon(problem, options.preconditioner_shift, 0, 0);
   std::unique_ptr<TranslationElimination> elimination;
   PointRefinement refine;
   if (options.eliminate_translations) {
@@ -148,6 +162,9 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
         std::make_unique<TranslationElimination>(graph.d, graph.num_poses, graph.measurements);
     refine = [&elimination](Eigen::MatrixXd& Y) { elimination->optimize_translations(Y); };
   }
+  const std::unique_ptr<BlockPreconditioner> precon_factor =
+      pending.valid() ? pending.get() : build_preconditioner();
+  const BlockPreconditioner& precon = *precon_factor;
   // Only the rows of X that can be non-zero are stored ("active rows"). The lifted initial
   // guess [I_d; 0] R has r - d zero rows, and the trust region keeps them exactly zero (the
   // gradient, the Hessian, the row-wise preconditioner, the tangent projection and the polar
@@ -167,6 +184,9 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     tr.rel_cost_decrease_tol = std::min(tr.rel_cost_decrease_tol, 1e-14);
   }
   {
+    // The relative tolerance is measured at the start the trust region sees: with elimination
+    // its translations are the exact ones (the chordal start above has none yet).
+    if (refine) refine(X);
     const LiftedManifold M = problem.manifold(graph.d);
     const double g0 = M.tangent_project(X, problem.euclidean_gradient(X)).norm();
     tr.grad_norm_tol = options.trust_region.grad_norm_tol * std::max(1.0, g0);
@@ -218,7 +238,19 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   // Report X at the relaxation rank: the rows that were never active are zero.
   if (X.rows() < res.final_rank) X = pad_rank(X, res.final_rank - static_cast<int>(X.rows()));
   res.X = X;
-  res.poses = round_solution(graph, X);
+  if (elimination) {
+    // The rounded rotations' optimal translations through the factor computed once above
+    // (round_solution would build and factor the same Laplacian again).
+    const Eigen::MatrixXd R = round_rotations(X, graph.d);
+    Eigen::MatrixXd rounded =
+        lift_poses(assemble_poses(R, Eigen::MatrixXd::Zero(graph.d, graph.num_poses)), graph.d);
+    elimination->optimize_translations(rounded);
+    res.poses = assemble_poses(R, Eigen::MatrixXd::Zero(graph.d, graph.num_poses));
+    for (std::size_t i = 0; i < graph.num_poses; ++i)
+      res.poses[i].t = rounded.col((graph.d + 1) * static_cast<Eigen::Index>(i) + graph.d);
+  } else {
+    res.poses = round_solution(graph, X);
+  }
   res.cost = evaluate_objective(graph, res.poses);
   res.total_s = seconds_since(start);
   return res;

@@ -8,7 +8,7 @@ bytes a round exchanges (all messages, each recipient counted: pose blocks and s
 coarse terms riding on the statuses), one-level (`--coarse off`) beside two-level
 (`--coarse on`). Prints one table and writes docs/benchmarks/coarse_rounds.csv.
 
-  scripts/bench/coarse_rounds.py [--agents 4,9,16,25,49] [--partition highest] [--every 1]
+  scripts/bench/coarse_rounds.py [--agents 4,9,16,25,49] [--partition auto] [--every 1]
                                  [--max-rounds 2000] [--poses 8000] [--bin B] [--out-dir D]
 """
 import argparse
@@ -25,7 +25,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     bc.add_common_args(ap)
     ap.add_argument("--agents", default="4,9,16,25,49")
-    ap.add_argument("--partition", default="highest")
+    ap.add_argument("--partition", default="auto", help="partition preset (default auto, what solve uses)")
     ap.add_argument("--every", type=int, default=1, help="--coarse-every of the two-level runs")
     ap.add_argument("--max-rounds", type=int, default=2000)
     ap.add_argument("--poses", type=int, default=8000)
@@ -52,21 +52,22 @@ def main():
             if n == agents[0]:
                 base[mode] = r01
             per_round = [int(r["bytes"]) for r in tr if "bytes" in r and int(r["round"]) < s["rounds"]]
-            row = {"agents": n, "coarse": mode, "cut_edges": s["cut_edges"], "rounds_to_grad_0.01": r01,
+            row = {"agents": n, "coarse": mode, "cut_edges": s["cut_edges"], "colours": s.get("colours"),
+                   "rounds_to_grad_0.01": r01,
                    "ratio_to_first_N": (r01 / base[mode]) if r01 and base.get(mode) else None,
                    "bytes_per_round_mean": statistics.mean(per_round) if per_round else None,
                    "bytes_per_round_max": max(per_round) if per_round else None,
                    "cpu_ms_per_round": s.get("cpu_ms_per_round"), "stop": s["stop_reason"],
                    "final_grad_norm": s["grad_norm"], "cost": s["cost"]}
             rows.append(row)
-            table.append([n, mode, s["cut_edges"], bc.fmt(r01), bc.fmt(row["ratio_to_first_N"], "{:.2f}"),
+            table.append([n, mode, s["cut_edges"], bc.fmt(s.get("colours")), bc.fmt(r01), bc.fmt(row["ratio_to_first_N"], "{:.2f}"),
                           bc.fmt(row["bytes_per_round_mean"], "{:.0f}"), bc.fmt(row["bytes_per_round_max"], "{:.0f}"),
                           bc.fmt(row["cpu_ms_per_round"], "{:.1f}"), s["stop_reason"]])
     with open("/proc/loadavg") as f:
         load = f.read().split()[0]
     bc.print_table(f"IRBCD rounds against N, generated grid {args.poses}, {args.partition} partition "
                    f"(load {load})",
-                   ["N", "coarse", "cut", "rounds to |g|<=0.01", f"x rounds at N={agents[0]}", "bytes/round",
+                   ["N", "coarse", "cut", "colours", "rounds to |g|<=0.01", f"x rounds at N={agents[0]}", "bytes/round",
                     "max bytes/round", "cpu ms/round", "stop"], table)
     bc.write_csv(os.path.join(ctx.out_dir, "coarse_rounds.csv"), rows)
     print("\ncommands:\n" + "\n".join(ctx.commands))

@@ -9,6 +9,10 @@ set against the labels, relative gap of the robust cost (over the kept measureme
 f*_clean, ATE of the estimate against the clean optimum after a rigid alignment, outer steps,
 solver iterations, wall time, certified; beside it the plain solve's cost gap and ATE.
 
+With --clean-all instead: F = 0 on every shared dataset, the robust distributed solve with 5
+agents in process (and with --dds over DDS too), against f* of ../shared/reference/optima.csv
+(robust_clean.csv; docs/benchmarks/robust.md, "F = 0 on every shared dataset").
+
 Generated 3D grid: `tessera generate --outliers F --outlier-kind K --labels FILE`. Shared
 datasets: the outliers are appended here in the same way (random: uniform pose pairs, random
 relative pose, the information of a random loop closure of the file; group: groups of 10
@@ -353,6 +357,86 @@ def table(csv_path):
     return "\n".join(lines)
 
 
+def optima(shared):
+    """f* of every shared dataset (reference/optima.csv); for the 3D files the `_qnorm` row (the
+    same graph with unit quaternions, which is what tessera solves: reference/README.md)."""
+    with open(os.path.join(shared, "reference", "optima.csv")) as f:
+        rows = {r["dataset"]: float(r["f_star"]) for r in csv.DictReader(f)}
+    return {k: rows.get(k + "_qnorm", v) for k, v in rows.items() if not k.endswith("_qnorm")}
+
+
+def clean_all(args, out_csv):
+    """F = 0 on every shared dataset: the robust distributed solve (5 agents) must reject nothing
+    and end at f* (optima.csv), certified. In process (`tessera solve --algorithm irbcd`), and with
+    --dds also over DDS (`tessera launch`, one process per agent)."""
+    fstar = optima(args.shared)
+    names = sorted(os.path.splitext(n)[0] for n in os.listdir(os.path.join(args.shared, "datasets"))
+                   if n.endswith(".g2o"))
+    if args.graphs != ",".join(ALL_GRAPHS):
+        names = [n for n in names if n in args.graphs.split(",")]
+    fields = ["graph", "engine", "poses", "edges", "rejected", "cost", "f_star", "gap", "certified", "outer",
+              "rounds", "wall_s", "load", "extra", "note"]
+    if not (args.append and os.path.exists(out_csv)):
+        with open(out_csv, "w", newline="") as f:
+            csv.writer(f).writerow(fields)
+    work = tempfile.mkdtemp(prefix="tessera-robust-clean-")
+    engines = (["in process"] if not args.dds_only else []) + (["dds"] if args.dds or args.dds_only else [])
+    for name in names:
+        graph = os.path.join(args.shared, "datasets", name + ".g2o")
+        for engine in engines:
+            js = os.path.join(work, f"{name}_{engine.replace(' ', '_')}.json")
+            if engine == "dds":
+                cmd = [args.bin, "launch", graph, "--agents", "5", "--robust", "gnc-tls", "--domain",
+                       str(args.domain), "--json", js]
+            else:
+                cmd = [args.bin, "solve", graph, "--algorithm", "irbcd", "--agents", "5", "--robust", "gnc-tls",
+                       "--certify", "--json", js]
+            cmd += args.clean_extra.split()
+            load = open("/proc/loadavg").read().split()[0]
+            progress(f"{name} ({engine}): " + " ".join(cmd[1:]))
+            t0 = time.monotonic()
+            row = {"graph": name, "engine": engine, "f_star": fstar.get(name, ""), "load": load,
+                   "extra": args.clean_extra}
+            try:
+                p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                   timeout=args.timeout)
+                rc, out = p.returncode, p.stdout
+            except subprocess.TimeoutExpired:
+                rc, out = None, f"timed out after {args.timeout:.0f} s"
+            row["wall_s"] = round(time.monotonic() - t0, 2)
+            if rc != 0:
+                row["note"] = out.strip().splitlines()[-1] if out.strip() else str(rc)
+            else:
+                with open(js) as f:
+                    s = json.load(f)
+                row.update(poses=s["poses"], edges=s.get("edges", s.get("measurements", "")),
+                           rejected=len(s["rejected"]), cost=s["cost"], certified=s["certified"],
+                           outer=s["outer_iterations"], rounds=s.get("total_rounds", s.get("rounds", "")))
+                if name in fstar:
+                    row["gap"] = (s["cost"] - fstar[name]) / fstar[name]
+            progress("  " + ", ".join(f"{k}={row.get(k, '')}" for k in fields[1:]))
+            with open(out_csv, "a", newline="") as f:
+                csv.writer(f).writerow([row.get(k, "") for k in fields])
+    print(clean_table(out_csv))
+
+
+def clean_table(csv_path):
+    """The F = 0 table as markdown."""
+    with open(csv_path) as f:
+        rows = list(csv.DictReader(f))
+    head = ("| graph | engine | options | poses | edges | rejected | cost | f* | gap | certified | outer | rounds | "
+            "wall s | load |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for r in rows:
+        gap = f"{float(r['gap']):.1e}" if r["gap"] else "-"
+        lines.append("| " + " | ".join([r["graph"], r["engine"], r.get("extra") or "-", r["poses"] or "-", r["edges"] or "-",
+                                        r["rejected"] or "-", f"{float(r['cost']):.10g}" if r["cost"] else "-",
+                                        r["f_star"] or "-", gap,
+                                        r["certified"] or r["note"] or "-", r["outer"] or "-", r["rounds"] or "-",
+                                        r["wall_s"], r["load"]]) + " |")
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin", "tessera"))
@@ -377,8 +461,18 @@ def main():
     ap.add_argument("--append", action="store_true",
                     help="add rows to an existing --csv (e.g. the large graphs with fewer fractions)")
     ap.add_argument("--plot-only", action="store_true", help="only redraw the figure from the CSV")
+    ap.add_argument("--clean-all", action="store_true",
+                    help="instead: F = 0 on every shared dataset (--graphs narrows them), robust distributed "
+                         "solve with 5 agents, CSV robust_clean.csv")
+    ap.add_argument("--dds", action="store_true", help="--clean-all: also `tessera launch` (over DDS)")
+    ap.add_argument("--dds-only", action="store_true", help="--clean-all: only `tessera launch`")
+    ap.add_argument("--domain", type=int, default=70, help="--clean-all --dds: DDS domain id")
+    ap.add_argument("--clean-extra", default="", help="--clean-all: more options for every run (e.g. --grad-tol 1e-4)")
     args = ap.parse_args()
     os.makedirs(args.out_dir, exist_ok=True)
+    if args.clean_all:
+        clean_all(args, os.path.join(args.out_dir, "robust_clean.csv"))
+        return
     out_csv = os.path.join(args.out_dir, args.csv)
     png = os.path.join(args.out_dir, os.path.splitext(args.csv)[0] + ".png")
     if args.plot_only:

@@ -7,14 +7,15 @@ initialisation, partition seeds 1..S, this runs
 
   tessera solve G --algorithm irbcd --agents 5 --partition P --seed S --init chordal --grad-tol 0.01
 
-with `--partition` each of --presets (default: `eco`, what solve and launch use, and `highest`), and reads
+with `--partition` each of --presets (default: `auto`, what solve and launch use: `fast` below 2000 poses,
+`eco` above), and reads
 from the trace the first round with ||grad f|| <= 0.2 and <= 0.01. The target (issue: "at most 0.35x")
 compares the median over seeds of the rounds to 0.2 with the baseline's *fewest* rounds to its 0.1 over
 all of its partitions (sequential and the paper's highest). Rounds are counts: they do not depend on load.
 Writes docs/benchmarks/rounds_vs_baseline.{csv,md}.
 
   scripts/bench/rounds_vs_baseline.py [--bin build/bin/tessera] [--shared ../shared]
-      [--seeds 5] [--presets eco,highest] [--graphs intel,CSAIL,...]
+      [--seeds 5] [--presets auto] [--graphs intel,CSAIL,...] [--extra "SOLVE OPTIONS"]
 """
 import argparse
 import os
@@ -53,9 +54,10 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     bc.add_common_args(ap)
     ap.add_argument("--seeds", type=int, default=5, help="partition seeds 1..S (default 5)")
-    ap.add_argument("--presets", default="eco,highest", help="partition presets (default eco,highest)")
+    ap.add_argument("--presets", default="auto", help="partition presets, comma-separated (default auto)")
     ap.add_argument("--graphs", default=",".join(GRAPHS), help="comma-separated dataset names")
     ap.add_argument("--max-rounds", type=int, default=3000)
+    ap.add_argument("--extra", default="", help="further solve options, space-separated (e.g. \"--irbcd-a0 0.5\")")
     args = ap.parse_args()
     ctx = bc.Ctx(args)
     base = baseline_fewest(ctx.shared)
@@ -71,7 +73,8 @@ def main():
                 s, trace, _, _ = bc.run_tessera(ctx, ["solve", path, "--algorithm", "irbcd", "--agents", "5",
                                                       "--partition", preset, "--seed", str(seed), "--init",
                                                       "chordal", "--grad-tol", "0.01", "--max-rounds",
-                                                      str(args.max_rounds), "--no-certify"])
+                                                      str(args.max_rounds), "--no-certify"]
+                                             + args.extra.split())
                 a, b = bc.first_round(trace, 0.2), bc.first_round(trace, 0.01)
                 r02.append(a)
                 r001.append(b)

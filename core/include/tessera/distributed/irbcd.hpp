@@ -28,6 +28,12 @@ struct IrbcdOptions {
   /// after ~2n rounds (RBCD++ starts at 1/n). Default 1: equal or fewer rounds than 1/n on 8
   /// of 11 paper graphs (cubicle 172 vs 223, kitti_02 1259 vs 1362; docs/irbcd.md section 3).
   double a0 = 1.0;
+  /// Instead of `a0`, start a where the first round's gamma is exactly 1 (the default):
+  /// with V^0 = P^0 = Y^0, V^1 = P^0 + gamma_0 (Y^1 - P^0) is then the first iterate itself, so
+  /// the momentum starts at what the first block updates found and does not extrapolate past
+  /// it. a0 = 1 gives gamma_0 = 1.28 with two colour classes, and the overshoot cost
+  /// parking-garage a round to the baseline's threshold (docs/benchmarks/rounds_vs_baseline.md).
+  bool unit_first_gamma = true;
   double b0 = 1.0;  ///< Initial b, > 0.
   IrbcdDimension dimension = IrbcdDimension::kUnits;
   /// Unselected blocks take P^k (as in accelerated coordinate descent) instead of keeping Y^k.

@@ -2,6 +2,11 @@
 // One agent's side of distributed GNC-TLS as a single state machine for any driver (the
 // in-process driver, the DDS round loop), so both run the same code:
 //
+//   [with GncAgentInput::pcm: every agent's values -> agent 0, which runs the pairwise
+//    consistency check (robust/pairwise_consistency.hpp) and sends every agent the closures
+//    outside the largest consistent set: they start at weight 0 and stay there]
+//   [with GncAgentInput::Y0_known: poses of both starts, then a vote on their TLS costs;
+//    every agent starts from the cheaper]
 //   solve 0 (plain; every solve before the final one is capped at
 //           RobustOptions::inner_max_rounds rounds: GNC needs only a rough minimiser)
 //   poses    -> neighbours: the public poses of the iterate (every weight is computed at the
@@ -16,7 +21,8 @@
 //     solve k (weighted, warm-started)
 //     poses  -> neighbours (when another step follows)
 //   rejected -> every agent: the measurements it owns with weight < 0.5
-//   [with GncAgentInput::inlier_start: poses of the iterate and of the other start, then a vote
+//   [with GncAgentInput::kept_set_start: kept values -> agent 0, which initializes the kept
+//    set and sends each agent its block; poses of the iterate and of that start, then a vote
 //    on their costs over the kept set; the first pass starts from the cheaper]
 //   inlier pass p = 0.. readmission_passes: solve of the kept set to the solver's tolerance
 //   (uncertified);
@@ -36,10 +42,12 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <tessera/distributed/agent_process.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/certified_agent.hpp>
+#include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/graph/measurement.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
 #include <utility>
@@ -55,14 +63,22 @@ namespace tessera {
 constexpr std::uint32_t kGncStepStride = 3000000;
 /// The GNC exchanges sit after every inner stage of their step (inner stages stay below 999).
 constexpr std::uint32_t kGncExchangeBase = 999000;
+/// In the order they happen within a step (a message of a phase below the current one is of a
+/// step this agent has left). The start vote has step 0 to itself (the first solve is step 1).
 enum class GncExchange : std::uint32_t {
   kPoses = 1,
   kVotes = 2,
   kWeights = 3,
   kRejected = 4,
   kReadmitted = 5,
-  kCandidatePoses = 6,
-  kCandidateVotes = 7
+  kKeptValues = 6,
+  kKeptStart = 7,
+  kCandidatePoses = 8,
+  kCandidateVotes = 9,
+  kPcmValues = 10,
+  kPcmDropped = 11,
+  kStartPoses = 12,
+  kStartVotes = 13
 };
 inline std::uint32_t gnc_phase(std::uint32_t step, GncExchange e) {
   return step * kGncStepStride + kGncExchangeBase + static_cast<std::uint32_t>(e);
@@ -87,11 +103,26 @@ struct GncAgentInput {
   /// down-weighted (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier;
   Eigen::MatrixXd Y0;  ///< Own block's lifted start, r x (d+1)m, ascending pose ids.
-  /// Optional: the own block of another start for the first inlier pass (the solver's own
-  /// initialization of the kept set, lifted to `rank`), given the rejected measurements. The
-  /// pass then starts from whichever of it and the GNC iterate has the lower cost over the
-  /// kept set (a vote). Empty: the GNC iterate (the DDS agents have no such stage yet).
-  std::function<Eigen::MatrixXd(const std::vector<std::uint64_t>& rejected, int rank)> inlier_start;
+  /// Optional: the own block of a second start, the known inliers' initialization (lifted like
+  /// Y0). The agents then vote before the first solve: each sums the TLS cost (known inliers
+  /// r^2, the others min(r^2, c^2)) of the measurements it weighs at both starts, and every
+  /// agent starts from the cheaper (Y0 on a tie). A chordal start fits every measurement,
+  /// wrong ones too, and settles in a distorted solution; on clean data it is nearly the
+  /// optimum. Empty: Y0.
+  Eigen::MatrixXd Y0_known;
+  /// The first inlier pass may start from a fresh `initialization` of the kept set instead of
+  /// the GNC iterate, when that costs less over the kept set (a vote). Only for kChordal:
+  /// agent 0 gathers the kept values and solves, as the chordal initialization does; the
+  /// distributed initialization exists to avoid that gather, and the file's poses are no
+  /// initialization of a subset. Otherwise no fresh start.
+  bool kept_set_start = false;
+  DistributedInit initialization = DistributedInit::kChordal;
+  std::string source;  ///< Names the input in the fresh start's errors.
+  /// `--robust pcm-gnc`: the pairwise consistency check before GNC. It needs every closure
+  /// against every other and the odometry between their ends, a global test, so agent 0 runs
+  /// it on the values the others send it (like the chordal initialization); what it decides is
+  /// a pre-filter, the weights stay the owners'. Needs known inliers that connect the poses.
+  bool pcm = false;
 };
 
 class GncAgent : public AgentProcess {
@@ -151,8 +182,12 @@ class GncAgent : public AgentProcess {
     kWeights,
     kRejected,
     kReadmitted,
+    kKeptStart,
     kCandidatePoses,
     kCandidateVotes,
+    kPcm,
+    kStartPoses,
+    kStartVotes,
     kDone
   };
   enum class Solve { kGnc, kInlierPass, kFinal };
@@ -171,8 +206,13 @@ class GncAgent : public AgentProcess {
                std::vector<OutgoingMessage>& out);
   bool may_reject(std::size_t k) const;
   void weights_at_mu(double mu);
+  void require_kept_connected() const;  // throws InputError naming the parts left
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
   void finish(std::vector<OutgoingMessage>& out);
+  void start_kept_set(std::vector<OutgoingMessage>& out);
+  void after_step_zero(std::vector<OutgoingMessage>& out);
+  void drop_inconsistent(const std::vector<std::uint64_t>& ids);
+  double tls_term(std::size_t k, double r2) const;
 
   GncAgentInput in_;
   const GncDistributedOptions& options_;
@@ -181,7 +221,11 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<BlockLayout> layout_;
   std::unique_ptr<AgentState> state_;
   std::unique_ptr<CertifiedAgent> solve_;
-  std::uint32_t g_ = 0;  // GNC step
+  std::uint32_t g_ = 0;              // GNC step
+  std::uint32_t first_solve_g_ = 0;  // 1 after a start vote (step 0 is the vote's)
+  bool fresh_start_ = false;         // the kept set's fresh start (kept_set_start, chordal)
+  std::vector<std::pair<std::uint64_t, Measurement>> kept_values_;  // agent 0's gathers
+  std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
   Solve solve_kind_ = Solve::kGnc;
   bool voted_ = false;  // the votes of mu's start are in

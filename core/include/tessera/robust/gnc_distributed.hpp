@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/graph/pose_graph.hpp>
 #include <tessera/robust/robust_options.hpp>
@@ -22,29 +23,24 @@ struct GncDistributedOptions {
   /// from the previous lifted iterate; the final solve of the inlier set certifies when
   /// solver.certify is on.
   DistributedOptions solver;
-  RobustOptions robust;  ///< kind is ignored: this is the GNC-TLS path.
+  RobustOptions robust;  ///< kPcmGnc: the consistency check first (GncAgentInput::pcm).
   /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
   /// rule's measurements (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier_flags;
   /// Consider the distributed initialization of the known inliers alone (with the default
   /// rule: each robot's odometry chain, robots joined by their consecutive-id links) as the
-  /// start besides solver.initialization, and take the one with the lower TLS cost. A chordal
-  /// start fits every measurement, outliers included, and the plain solve from there settles
-  /// in a distorted solution that costs many rounds and can make true closures look wrong; on
-  /// clean data it is nearly the optimum. Unused when the known inliers do not connect the
-  /// poses; false: always solver.initialization.
+  /// start besides solver.initialization; the agents take the one with the lower TLS cost (a
+  /// vote, GncAgentInput::Y0_known). Unused when the known inliers do not connect the poses;
+  /// false: always solver.initialization.
   bool known_inlier_start = true;
+  /// The first inlier pass may start from solver.initialization of the kept set when that costs
+  /// less than the GNC iterate (GncAgentInput::kept_set_start; chordal only).
+  bool kept_set_start = true;
   /// Optional: called after every weight exchange with (agent, outer step, that agent's
   /// measurements by file position, the weights it uses for them); tests compare the two ends
   /// of every cut measurement with it.
   std::function<void(int, int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
       weight_observer;
-  /// With known_inlier_start: compare the two starts' TLS costs (false: the known inliers'
-  /// whenever they connect the poses, what the DDS agents do: they compute one initialization).
-  bool start_vote = true;
-  /// The first inlier pass may start from the solver's initialization of the kept set when that
-  /// costs less (GncAgentInput::inlier_start; false: from the GNC iterate, as over DDS).
-  bool inlier_set_start = true;
   void validate() const;  ///< Throws InputError naming the first bad field.
 };
 
@@ -82,11 +78,13 @@ struct GncDistributedResult {
   bool weights_converged = false;
 };
 
-/// The starting poses of distributed GNC: with options.known_inlier_start, the distributed
-/// initialization of the known inliers alone when they connect the poses; otherwise
-/// solver.initialization's (with solver.robots, or `agents`, robots).
-std::vector<Pose> gnc_start(const PoseGraph& graph, const GncDistributedOptions& options,
-                            int agents);
+/// The known inliers' start of distributed GNC (GncDistributedOptions::known_inlier_start): the
+/// distributed initialization (with solver.robots, or `agents`, robots) of the measurements that
+/// are known inliers by the rule or the flags, or nullopt when the option is off or those
+/// measurements leave the poses unconnected.
+std::optional<std::vector<Pose>> known_inlier_poses(const PoseGraph& graph,
+                                                    const GncDistributedOptions& options,
+                                                    int agents);
 
 /// Runs GNC-TLS with the distributed solver on `assignment`'s blocks. Throws InputError on
 /// bad options and, like solve_gnc_centralized(), when the kept measurements leave the poses

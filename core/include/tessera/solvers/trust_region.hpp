@@ -39,6 +39,8 @@ struct TrustRegionOptions {
   /// grad f>, is below this fraction of f (in [0, 1); 0 = off). This is the relative-decrease stop
   /// taken before the step instead of after it: the step that would only confirm convergence is
   /// not computed. With P below the inverse Hessian the estimate is low by P's error.
+  /// When on, the after-step test of rel_cost_decrease_tol also needs this prediction to hold
+  /// (a small step does not end the run while the model still predicts more).
   double predicted_rel_decrease_tol = 0.0;
   double initial_radius = 0.0;  ///< <= 0: set from the first preconditioned gradient.
   /// With initial_radius <= 0 the radius is this times sqrt(<P g, g>) (the preconditioned
