@@ -16,6 +16,7 @@
 #include <tessera/distributed/certified_agent.hpp>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/io/tum_writer.hpp>
+#include <tessera/online/live_blocks.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
 #include <tessera/util/input_error.hpp>
@@ -179,6 +180,7 @@ class OnlineAgent {
 
   Options o_;
   runtime::OnlineAgentView view_;
+  std::unique_ptr<LiveBlocks> live_;  // this agent's block state, grown from solve to solve
   transport::GraphStreamReader stream_;
   transport::OnlineChannel channel_;
   Clock::time_point start_;
@@ -284,25 +286,27 @@ void OnlineAgent::send(const std::vector<OutgoingMessage>& out, std::uint32_t ep
 
 SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
   SolveOutcome out;
-  const LinkedProblem p = view_.problem();
-  const int c = p.compact_block(view_.own_block());
   own_ids_.clear();
   own_data_.clear();
-  if (p.graph.num_poses == 0 || c < 0) return out;  // nothing of ours to solve yet
+  const GraphStream* stream = view_.stream();
+  if (!stream || view_.own_block() < 0) return out;  // nothing of ours to solve yet
+  // This agent's block problem is kept from solve to solve and grown with the new data.
+  if (!live_)
+    live_ = std::make_unique<LiveBlocks>(stream->graph().d, o_.online.solver.block_update,
+                                         o_.online.refactor_growth, view_.own_block());
+  live_->sync(stream->graph(), view_.owner(), view_.iterate());
+  const int c = live_->compact_block(view_.own_block());
+  if (live_->graph().num_poses == 0 || c < 0) return out;
   DistributedOptions solver = o_.online.solver;
   solver.certify = certify;
   solver.round_result = false;
   // A certificate while the graph grows does not climb the staircase: the iterate keeps its
   // rank for the next data (a saddle is reported as not certified).
   if (!climb) solver.staircase.max_rank = solver.rank;
-  const BlockLayout layout = make_block_layout(p.graph.num_poses, p.graph.measurements, p.blocks);
-  const Eigen::Index w = p.graph.d + 1;
+  const BlockLayout& layout = live_->layout();
+  const Eigen::Index w = live_->graph().d + 1;
   const auto& ids = layout.poses[static_cast<std::size_t>(c)];
-  Eigen::MatrixXd Yb(p.X0.rows(), w * static_cast<Eigen::Index>(ids.size()));
-  for (std::size_t s = 0; s < ids.size(); ++s)
-    Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
-        p.X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-  AgentState state(c, p.graph.d, layout, p.graph.measurements, Yb, solver.block_update);
+  AgentState& state = *live_->states()[static_cast<std::size_t>(c)];
   CertifiedAgent agent(state, layout, solver);
   const auto me = static_cast<std::uint32_t>(c);
   send(agent.start(), epoch_);
@@ -343,10 +347,11 @@ SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
       std::string missing;
       if (const auto awaited = agent.awaited())
         for (std::uint32_t b : awaited->senders)
-          if (b < p.block_of.size())
+          if (b < live_->block_of().size())
             missing +=
                 (missing.empty() ? " from agent " : ",") +
-                std::to_string(view_.stream()->robots()[static_cast<std::size_t>(p.block_of[b])]);
+                std::to_string(
+                    view_.stream()->robots()[static_cast<std::size_t>(live_->block_of()[b])]);
       silent_peer("no protocol message" + missing);
     }
   }
@@ -355,7 +360,7 @@ SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
   const std::size_t per_pose = static_cast<std::size_t>(own_rank_ * w);
   own_data_.resize(ids.size() * per_pose);
   for (std::size_t s = 0; s < ids.size(); ++s) {
-    own_ids_.push_back(static_cast<std::uint32_t>(p.full_id[ids[s]]));
+    own_ids_.push_back(static_cast<std::uint32_t>(live_->full_id()[ids[s]]));
     Eigen::Map<Eigen::MatrixXd>(own_data_.data() + s * per_pose, own_rank_, w) =
         state.Y.middleCols(w * static_cast<Eigen::Index>(s), w);
   }

@@ -31,7 +31,7 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
       d_(d),
       layout_(layout),
       problem_(d, layout.poses[static_cast<std::size_t>(id)], measurements),
-      coarse_(id, d, layout, problem_.owned(), problem_.neighbors(), measurements),
+      coarse_(std::in_place, id, d, layout, problem_.owned(), problem_.neighbors(), measurements),
       max_factor_entries_(options.max_factor_entries) {
   const Eigen::Index cols = (d + 1) * static_cast<Eigen::Index>(problem_.num_owned());
   if (Y0.cols() != cols)
@@ -57,6 +57,54 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
     if (static_cast<int>(rows.size()) == d) build_tangent(Y0(rows, Eigen::all), options);
   }
   if (q.block_diagonal()) tangent_tried_ = true;  // never build it later either
+}
+
+const CoarseTerms& AgentState::coarse() const {
+  if (!coarse_)
+    coarse_.emplace(id_, d_, layout_, problem_.owned(), problem_.neighbors(), *coarse_source_);
+  return *coarse_;
+}
+
+void AgentState::extend(const std::vector<Measurement>& measurements, std::size_t first_new,
+                        const Eigen::MatrixXd& Y0, double refactor_growth) {
+  const auto& own = layout_.poses[static_cast<std::size_t>(id_)];
+  const auto& had = problem_.owned();
+  if (own.size() < had.size() || !std::equal(had.begin(), had.end(), own.begin()))
+    throw std::invalid_argument("AgentState::extend: the block lost or reordered poses");
+  const Eigen::Index w = d_ + 1;
+  if (Y0.cols() != w * static_cast<Eigen::Index>(own.size()))
+    throw std::invalid_argument("AgentState::extend: block of the wrong size");
+  const std::size_t m_old = had.size();
+  problem_.extend(
+      std::vector<std::size_t>(own.begin() + static_cast<std::ptrdiff_t>(m_old), own.end()),
+      measurements, first_new);
+  coarse_.reset();
+  coarse_source_ = &measurements;
+  Y = P = V = Y_prev = V_prev = Y0;
+  Yn = Pn = Vn = Yn_prev =
+      Eigen::MatrixXd::Zero(Y0.rows(), w * static_cast<Eigen::Index>(problem_.num_neighbors()));
+  neighbours_set_.resize(0, 0);
+  rows_.clear();
+  updated_grad_norm_sq_ = -1.0;
+  precon_.reset();
+  if (tangent_ && tangent_->factored()) {
+    // Poses outside the factor after this growth, against the poses it was computed for.
+    const double unfactored = static_cast<double>(problem_.num_owned() - m_old) +
+                              static_cast<double>(tangent_->grown_poses());
+    const double factored =
+        static_cast<double>(m_old) - static_cast<double>(tangent_->grown_poses());
+    const std::vector<Eigen::Index> rows = nonzero_rows(Y0, Eigen::MatrixXd());
+    const bool grown = unfactored <= refactor_growth * factored &&
+                       static_cast<int>(rows.size()) == d_ &&
+                       tangent_->grow(problem_, Y0(rows, Eigen::all));
+    if (!grown) {
+      tangent_.reset();
+      tangent_tried_ = false;
+    }
+  } else if (!block_factor_too_large_) {
+    tangent_.reset();
+    tangent_tried_ = false;
+  }
 }
 
 void AgentState::apply_coarse(const std::vector<Eigen::MatrixXd>& motions) {

@@ -2,6 +2,7 @@
 #include <chrono>
 #include <ctime>
 #include <memory>
+#include <stdexcept>
 #include <tessera/certification/rounding_gap.hpp>
 #include <tessera/distributed/agent_factory.hpp>
 #include <tessera/distributed/agent_state.hpp>
@@ -121,10 +122,9 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
                      std::to_string(w * static_cast<Eigen::Index>(graph.num_poses)));
   const BlockLayout layout = make_block_layout(graph.num_poses, graph.measurements, assignment);
   const int N = layout.num_blocks;
-  DistributedResult res;
-  res.agents = N;
 
   std::vector<std::unique_ptr<AgentState>> states;
+  std::vector<AgentState*> pointers;
   for (int b = 0; b < N; ++b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
     Eigen::MatrixXd Yb(options.rank, w * static_cast<Eigen::Index>(ids.size()));
@@ -133,7 +133,27 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
           X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
     states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb,
                                                   options.block_update));
+    pointers.push_back(states.back().get());
   }
+  const double setup_s = since(start);
+  DistributedResult res = solve_distributed_with_states(graph, layout, pointers, options);
+  res.init_s += setup_s;
+  res.wall_s = since(start);
+  return res;
+}
+
+DistributedResult solve_distributed_with_states(const PoseGraph& graph, const BlockLayout& layout,
+                                                const std::vector<AgentState*>& states,
+                                                const DistributedOptions& options) {
+  const auto start = Clock::now();
+  check_options(graph, options);
+  const Eigen::Index w = graph.d + 1;
+  const int N = layout.num_blocks;
+  if (static_cast<int>(states.size()) != N || layout.owner.size() != graph.num_poses)
+    throw std::invalid_argument(
+        "distributed solve: one state per block of the graph's layout expected");
+  DistributedResult res;
+  res.agents = N;
 
   // One certified sequence per agent (with certification off: exactly the round protocol).
   std::vector<std::unique_ptr<CertifiedAgent>> sequences;

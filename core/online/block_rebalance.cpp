@@ -26,6 +26,8 @@ RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner
   auto over = [&](std::size_t s) {
     return static_cast<double>(s) > bound + static_cast<double>(options.min_excess);
   };
+  // Nothing over the bound (most steps): done before the graph's adjacency is built.
+  if (std::none_of(size.begin(), size.end(), over)) return res;
   std::vector<std::vector<std::size_t>> adjacent(n);
   for (const Measurement& m : graph.measurements) {
     adjacent[m.i].push_back(m.j);

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <deque>
 #include <stdexcept>
 #include <string>
@@ -6,7 +7,8 @@
 namespace tessera {
 
 EstimateExtension extend_estimate(const PoseGraph& graph, const Eigen::MatrixXd& X,
-                                  const std::vector<Pose>& guesses) {
+                                  const std::vector<Pose>& guesses,
+                                  std::size_t first_new_measurement) {
   const int d = graph.d;
   const Eigen::Index w = d + 1;
   const Eigen::Index r = X.rows();
@@ -20,19 +22,26 @@ EstimateExtension extend_estimate(const PoseGraph& graph, const Eigen::MatrixXd&
                                 " guesses for " + std::to_string(n) + " poses");
   const std::size_t m = static_cast<std::size_t>(X.cols() / w);
   EstimateExtension out;
-  out.X = Eigen::MatrixXd::Zero(r, w * static_cast<Eigen::Index>(n));
-  out.X.leftCols(X.cols()) = X;
-  if (m == n) return out;
-
-  // Adjacency of the new poses only (measurements among old poses cannot place anything).
-  std::vector<std::vector<std::size_t>> touching(n);
-  for (std::size_t e = 0; e < graph.measurements.size(); ++e) {
-    const Measurement& me = graph.measurements[e];
-    if (me.i >= m) touching[me.i].push_back(e);
-    if (me.j >= m) touching[me.j].push_back(e);
+  if (m == n) {
+    out.X = X;
+    return out;
   }
-  std::vector<char> known(n, 0);
-  std::fill(known.begin(), known.begin() + static_cast<std::ptrdiff_t>(m), 1);
+  out.X.resize(r, w * static_cast<Eigen::Index>(n));
+  out.X.leftCols(X.cols()) = X;
+  out.X.rightCols(out.X.cols() - X.cols()).setZero();
+  const std::size_t first = std::min(first_new_measurement, graph.measurements.size());
+
+  // Adjacency of the new poses only (measurements among old poses cannot place anything), by
+  // new pose k - m.
+  std::vector<std::vector<std::size_t>> touching(n - m);
+  for (std::size_t e = first; e < graph.measurements.size(); ++e) {
+    const Measurement& me = graph.measurements[e];
+    if (me.i >= m) touching[me.i - m].push_back(e);
+    if (me.j >= m) touching[me.j - m].push_back(e);
+  }
+  // Known: the old poses (every id < m) and the new ones placed so far.
+  std::vector<char> placed(n - m, 0);
+  auto is_known = [&](std::size_t k) { return k < m || placed[k - m] != 0; };
   auto Y = [&](std::size_t k) { return out.X.middleCols(w * static_cast<Eigen::Index>(k), d); };
   auto p = [&](std::size_t k) { return out.X.col(w * static_cast<Eigen::Index>(k) + d); };
 
@@ -48,29 +57,29 @@ EstimateExtension extend_estimate(const PoseGraph& graph, const Eigen::MatrixXd&
       Y(me.i) = Y(me.j) * me.R.transpose();
       p(me.i) = p(me.j) - Y(me.i) * me.t;
     }
-    known[target] = 1;
+    placed[target - m] = 1;
     queue.push_back(target);
   };
   auto spread = [&]() {
     while (!queue.empty()) {
       const std::size_t k = queue.front();
       queue.pop_front();
-      for (std::size_t e : touching[k]) {
+      for (std::size_t e : touching[k - m]) {
         const Measurement& me = graph.measurements[e];
         const std::size_t other = me.i == k ? me.j : me.i;
-        if (!known[other]) {
+        if (!is_known(other)) {
           place(e, other);
           ++out.composed;
         }
       }
     }
   };
-  for (std::size_t e = 0; e < graph.measurements.size(); ++e) {
+  for (std::size_t e = first; e < graph.measurements.size(); ++e) {
     const Measurement& me = graph.measurements[e];
-    if (me.i < m && me.j >= m && !known[me.j]) {
+    if (me.i < m && me.j >= m && !is_known(me.j)) {
       place(e, me.j);
       ++out.composed;
-    } else if (me.j < m && me.i >= m && !known[me.i]) {
+    } else if (me.j < m && me.i >= m && !is_known(me.i)) {
       place(e, me.i);
       ++out.composed;
     }
@@ -78,12 +87,12 @@ EstimateExtension extend_estimate(const PoseGraph& graph, const Eigen::MatrixXd&
   }
   // Pieces with no path to the estimate: start each from its first pose's guess.
   for (std::size_t k = m; k < n; ++k) {
-    if (known[k]) continue;
+    if (is_known(k)) continue;
     Y(k).setZero();
     Y(k).topRows(d) = guesses[k].R;
     p(k).setZero();
     p(k).head(d) = guesses[k].t;
-    known[k] = 1;
+    placed[k - m] = 1;
     ++out.from_guess;
     queue.push_back(k);
     spread();

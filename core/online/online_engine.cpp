@@ -4,7 +4,6 @@
 #include <ctime>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
-#include <tessera/online/linked_problem.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
@@ -14,6 +13,8 @@ namespace tessera {
 
 void OnlineOptions::validate() const {
   rebalance.validate();
+  if (!(refactor_growth >= 0) || !std::isfinite(refactor_growth))
+    throw InputError("OnlineOptions.refactor_growth must be a finite number >= 0");
   if (!(certify_every_s >= 0) || !std::isfinite(certify_every_s))
     throw InputError("OnlineOptions.certify_every_s must be a finite number >= 0 (seconds)");
   DistributedOptions s = solver;
@@ -85,21 +86,39 @@ OnlineUpdate OnlineEngine::step(double now_s) {
       rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
   u.moved = moves.moved;
   u.largest_block = moves.largest_after;
-  X_ = extend_estimate(graph, X_, stream_.guesses()).X;
-  DistributedOptions solver = options_.solver;
-  solver.certify = false;
-  solver.round_result = false;  // the graph may not be connected yet
-  const DistributedResult res = solve_linked(solver);
-  // A stalled iterate (RoundProtocol: cost and gradient repeated bit for bit) cannot improve
-  // on this problem: iterating again before new data arrives would only burn rounds.
-  converged_ = res.grad_norm <= solver.grad_norm_tol || res.stop_reason == "stalled";
-  u.rounds = res.rounds;
-  u.bytes = res.bytes_exchanged;
-  u.grad_norm = res.grad_norm;
-  u.stop_reason = res.stop_reason;
-  u.setup_s = res.init_s;
-  u.rounds_cpu_s = res.solve_cpu_s;
-  u.relaxation_cost = res.relaxation_cost;
+  // Only the measurements since the last extension can touch a new pose.
+  std::size_t composed = 0;
+  if (u.poses > 0) {
+    EstimateExtension e = extend_estimate(graph, X_, stream_.guesses(), extended_measurements_);
+    X_ = std::move(e.X);
+    composed = e.composed;
+  }
+  extended_measurements_ = graph.measurements.size();
+  if (converged_ && composed == u.measurements) {
+    // Every new measurement placed a new pose (odometry, mostly): each has zero residual at
+    // the composed poses, so f and its gradient are what they were and the agents, which were
+    // converged, have nothing to do. Their blocks take the new data in at the next solve.
+    u.grad_norm = last_grad_norm_;
+    u.relaxation_cost = last_relaxation_cost_;
+    u.stop_reason = "unchanged";
+  } else {
+    DistributedOptions solver = options_.solver;
+    solver.certify = false;
+    solver.round_result = false;  // the graph may not be connected yet
+    const DistributedResult res = solve_linked(solver);
+    // A stalled iterate (RoundProtocol: cost and gradient repeated bit for bit) cannot improve
+    // on this problem: iterating again before new data arrives would only burn rounds.
+    converged_ = res.grad_norm <= solver.grad_norm_tol || res.stop_reason == "stalled";
+    last_grad_norm_ = res.grad_norm;
+    last_relaxation_cost_ = res.relaxation_cost;
+    u.rounds = res.rounds;
+    u.bytes = res.bytes_exchanged;
+    u.grad_norm = res.grad_norm;
+    u.stop_reason = res.stop_reason;
+    u.setup_s = res.init_s;
+    u.rounds_cpu_s = res.solve_cpu_s;
+    u.relaxation_cost = res.relaxation_cost;
+  }
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;
   u.latency_s = now_s - oldest + u.ms / 1000.0;
@@ -114,12 +133,20 @@ OnlineUpdate OnlineEngine::step(double now_s) {
 }
 
 DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
-  const LinkedProblem p = make_linked_problem(stream_.graph(), owner_, X_);
   DistributedResult res;
-  if (p.graph.num_poses == 0) return res;
-  res = solve_distributed_from_lifted(p.graph, p.blocks, solver, p.X0);
-  if (res.X.rows() == X_.rows()) p.write_back(res.X, X_);
-  if (!p.whole) res.poses.clear();  // in the linked graph's ids
+  if (!blocks_)
+    blocks_ = std::make_unique<LiveBlocks>(stream_.graph().d, solver.block_update,
+                                           options_.refactor_growth);
+  const auto setup_start = Clock::now();
+  blocks_->sync(stream_.graph(), owner_, X_);
+  const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
+  if (blocks_->graph().num_poses == 0) return res;
+  DistributedOptions run = solver;
+  run.round_result = false;  // in the linked graph's ids: the caller rounds X_
+  res = solve_distributed_with_states(blocks_->graph(), blocks_->layout(), blocks_->all_states(),
+                                      run);
+  res.init_s += setup_s;
+  if (res.X.rows() == X_.rows()) blocks_->write_back(res.X, X_);
   return res;
 }
 
@@ -141,10 +168,14 @@ OnlineResult OnlineEngine::finish() {
   out.min_eigenvalue = res.min_eigenvalue;
   out.final_rounds = res.rounds;
   out.bytes += res.bytes_exchanged;
-  out.cost = res.cost;
   out.grad_norm = res.grad_norm;
-  out.poses = res.poses;
-  if (solver.round_result && out.poses.size() != out.graph.num_poses) {
+  if (res.X.rows() > X_.rows()) {  // the staircase climbed: the result has more rows
+    Eigen::MatrixXd wide = Eigen::MatrixXd::Zero(res.X.rows(), X_.cols());
+    wide.topRows(X_.rows()) = X_;
+    blocks_->write_back(res.X, wide);
+    X_ = std::move(wide);
+  }
+  if (solver.round_result) {
     out.poses = round_solution(out.graph, X_);
     out.cost = evaluate_objective(out.graph, out.poses);
   }

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/pose_kernels.hpp>
 
@@ -74,6 +75,99 @@ BlockProblem BlockProblem::whole_graph(int d, std::size_t num_poses,
   std::vector<std::size_t> all(num_poses);
   for (std::size_t i = 0; i < num_poses; ++i) all[i] = i;
   return BlockProblem(d, std::move(all), measurements);
+}
+
+void BlockProblem::extend(const std::vector<std::size_t>& new_owned,
+                          const std::vector<Measurement>& measurements, std::size_t first_new) {
+  if (first_new > measurements.size())
+    throw std::invalid_argument("BlockProblem::extend: first_new beyond the measurements");
+  if (owned_slot_.size() != owned_.size()) {
+    owned_slot_.clear();
+    owned_slot_.reserve(owned_.size() + new_owned.size());
+    for (std::size_t s = 0; s < owned_.size(); ++s) owned_slot_.emplace(owned_[s], s);
+  }
+  for (std::size_t id : new_owned) {
+    if (std::binary_search(neighbors_.begin(), neighbors_.end(), id))
+      throw std::invalid_argument("BlockProblem::extend: pose " + std::to_string(id) +
+                                  " is a neighbour, not a new pose");
+    if (!owned_slot_.emplace(id, owned_.size()).second)
+      throw std::invalid_argument("BlockProblem::extend: pose listed twice in block");
+    owned_.push_back(id);
+  }
+  const std::size_t m_old = owned_.size() - new_owned.size(), m = owned_.size();
+  const std::size_t k_old = neighbors_.size();
+  auto owned = [&](std::size_t id) { return owned_slot_.count(id) != 0; };
+  // The new measurements touching the block and the neighbours they bring.
+  std::vector<std::size_t> touching, added;
+  for (std::size_t k = first_new; k < measurements.size(); ++k) {
+    const Measurement& me = measurements[k];
+    const bool oi = owned(me.i), oj = owned(me.j);
+    if (!oi && !oj) continue;
+    if (me.R.rows() != d_ || me.R.cols() != d_ || me.t.size() != d_)
+      throw std::invalid_argument("BlockProblem: measurement of the wrong dimension");
+    touching.push_back(k);
+    for (std::size_t other : {oi ? std::size_t(-1) : me.i, oj ? std::size_t(-1) : me.j})
+      if (other != std::size_t(-1) &&
+          !std::binary_search(neighbors_.begin(), neighbors_.end(), other))
+        added.push_back(other);
+  }
+  std::sort(added.begin(), added.end());
+  added.erase(std::unique(added.begin(), added.end()), added.end());
+  // Merged neighbour order; remap[k] = new index of old neighbour k (increasing, so the rows
+  // of Q_NB keep their order inside every column).
+  std::vector<std::size_t> merged(k_old + added.size()), remap(k_old);
+  std::merge(neighbors_.begin(), neighbors_.end(), added.begin(), added.end(), merged.begin());
+  for (std::size_t k = 0, at = 0; k < k_old; ++k) {
+    while (merged[at] != neighbors_[k]) ++at;
+    remap[k] = at;
+  }
+  neighbors_ = std::move(merged);
+  auto neighbour_slot = [&](std::size_t id) {
+    return m + static_cast<std::size_t>(std::lower_bound(neighbors_.begin(), neighbors_.end(), id) -
+                                        neighbors_.begin());
+  };
+  for (Edge& e : edges_) {
+    if (e.slot_i >= m_old) e.slot_i = m + remap[e.slot_i - m_old];
+    if (e.slot_j >= m_old) e.slot_j = m + remap[e.slot_j - m_old];
+  }
+  std::vector<const Measurement*> ptrs;
+  std::vector<std::size_t> si, sj;
+  const std::size_t stride = static_cast<std::size_t>(d_ * d_ + d_ + 2);
+  std::size_t at = packed_.size();
+  packed_.resize(packed_.size() + touching.size() * stride);
+  for (std::size_t k : touching) {
+    const Measurement& me = measurements[k];
+    ptrs.push_back(&me);
+    si.push_back(owned(me.i) ? owned_slot_[me.i] : neighbour_slot(me.i));
+    sj.push_back(owned(me.j) ? owned_slot_[me.j] : neighbour_slot(me.j));
+    edges_.push_back({si.back(), sj.back()});
+    double* out = packed_.data() + at;
+    for (int b = 0; b < d_; ++b)
+      for (int c = 0; c < d_; ++c) out[b * d_ + c] = me.R(c, b);
+    for (int c = 0; c < d_; ++c) out[d_ * d_ + c] = me.t(c);
+    out[d_ * d_ + d_] = me.kappa;
+    out[d_ * d_ + d_ + 1] = me.tau;
+    at += stride;
+  }
+  // The old matrices in the new slots (Q_NB's rows renumbered in place), plus the new terms.
+  const Eigen::Index w = d_ + 1;
+  Q_nb_.makeCompressed();
+  for (Eigen::Index e = 0; e < Q_nb_.nonZeros(); ++e) {
+    int& row = Q_nb_.innerIndexPtr()[e];
+    row = static_cast<int>(w * static_cast<Eigen::Index>(remap[static_cast<std::size_t>(row / w)]) +
+                           row % w);
+  }
+  const DataMatrixBlocks delta =
+      build_data_matrix_blocks(ptrs, si, sj, d_, m + neighbors_.size(), m);
+  Q_bb_.conservativeResize(w * static_cast<Eigen::Index>(m), w * static_cast<Eigen::Index>(m));
+  Q_nb_.conservativeResize(w * static_cast<Eigen::Index>(neighbors_.size()),
+                           w * static_cast<Eigen::Index>(m));
+  if (delta.own.nonZeros() > 0) Q_bb_ = SparseMatrix(Q_bb_ + delta.own);
+  if (delta.neighbour.nonZeros() > 0) Q_nb_ = SparseMatrix(Q_nb_ + delta.neighbour);
+  Q_bb_.makeCompressed();
+  Q_nb_.makeCompressed();
+  X_n_.resize(0, 0);  // the neighbours' poses are stale: set_neighbor_poses again
+  linear_.resize(0, 0);
 }
 
 void BlockProblem::set_neighbor_poses(const Eigen::MatrixXd& X_neighbors) {

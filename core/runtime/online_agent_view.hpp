@@ -56,6 +56,8 @@ class OnlineAgentView {
   LinkedProblem problem() const;
   /// Block (robot position in the stream) of this agent's robot, -1 before its first pose.
   int own_block() const;
+  /// Block of every stream id (robot-aligned, refined by the rebalance).
+  const std::vector<int>& owner() const { return owner_; }
 
   const GraphStream* stream() const { return stream_ ? &*stream_ : nullptr; }
   Eigen::MatrixXd& iterate() { return X_; }

@@ -63,6 +63,12 @@ struct TangentPreconditioner::Factor {
   std::size_t entries = 0;
   bool usable = false;
   bool factored = false;
+  double lambda = 0.0;  // the shift of the last factorization
+  // grow(): inverses of the p x p diagonal blocks of the poses after the factored m, one after
+  // the other (column-major), and the coordinates of those poses during an apply.
+  Eigen::Index extra = 0;
+  std::vector<double> extra_inverse;
+  Eigen::VectorXd extra_b;
   int factorizations = 0;
   int calls_since_factor = 0;
 
@@ -246,7 +252,7 @@ int TangentPreconditioner::coordinates_per_pose() const {
 bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
   Factor& f = *factor_;
   const int d = f.d, w = d + 1, p = f.p;
-  if (!f.usable || X.rows() != d || X.cols() != w * f.m) return false;
+  if (!f.usable || f.extra > 0 || X.rows() != d || X.cols() != w * f.m) return false;
   const auto pairs = skew_pairs(d);
   std::vector<Eigen::MatrixXd> G(static_cast<std::size_t>(f.m));
   for (Eigen::Index i = 0; i < f.m; ++i)
@@ -276,6 +282,7 @@ bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
     }
   }
   const double lambda = f.relative_shift * std::max(1e-12, max_diagonal);
+  f.lambda = lambda;
   for (Eigen::Index j = 0; j < f.m; ++j)
     for (int c = 0; c < p; ++c)
       f.A.valuePtr()[f.value_offset(j, f.diagonal_slot[static_cast<std::size_t>(j)], c) + c] +=
@@ -290,6 +297,46 @@ bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
   }
   f.factored = true;
   return true;
+}
+
+bool TangentPreconditioner::grow(const BlockProblem& problem, const Eigen::MatrixXd& X) {
+  Factor& f = *factor_;
+  const int d = f.d, w = d + 1, p = f.p;
+  const Eigen::Index total = static_cast<Eigen::Index>(problem.num_owned());
+  if (!factored() || problem.dim() != d || total < f.m + f.extra || X.rows() != d ||
+      X.cols() != w * total)
+    return false;
+  const SparseMatrix& Q = problem.data_matrix();
+  const auto pairs = skew_pairs(d);
+  std::vector<double> inverses;
+  Eigen::MatrixXd Qii(w, w), T(d * w, p), B(p, p);
+  for (Eigen::Index i = f.m + f.extra; i < total; ++i) {
+    Qii.setZero();
+    for (int s = 0; s < w; ++s)
+      for (SparseMatrix::InnerIterator it(Q, i * w + s); it; ++it)
+        if (it.row() >= i * w && it.row() < (i + 1) * w) Qii(it.row() - i * w, s) = it.value();
+    const Eigen::MatrixXd G = pose_basis(X.block(0, i * w, d, d), pairs);
+    for (int t = 0; t < w; ++t) {
+      auto row = T.middleRows(t * d, d);
+      row.setZero();
+      for (int u = 0; u < w; ++u)
+        if (Qii(t, u) != 0.0) row.noalias() += Qii(t, u) * G.middleRows(u * d, d);
+    }
+    B.noalias() = 2.0 * G.transpose() * T;
+    B = 0.5 * (B + B.transpose()).eval();
+    B.diagonal().array() += f.lambda;
+    Eigen::LLT<Eigen::MatrixXd> llt(B);
+    if (llt.info() != Eigen::Success) return false;
+    const Eigen::MatrixXd inverse = llt.solve(Eigen::MatrixXd::Identity(p, p));
+    inverses.insert(inverses.end(), inverse.data(), inverse.data() + p * p);
+  }
+  f.extra_inverse.insert(f.extra_inverse.end(), inverses.begin(), inverses.end());
+  f.extra = total - f.m;
+  return true;
+}
+
+Eigen::Index TangentPreconditioner::grown_poses() const {
+  return factor_->extra;
 }
 
 bool TangentPreconditioner::prepare(const Eigen::MatrixXd& X, int refresh_interval) {
@@ -309,13 +356,12 @@ namespace {
 // product is summed over k = 0..d-1 in order, as Eigen's lazy products of the previous
 // version did, so the result is bit-identical to it.
 template <int D>
-void tangent_coordinates(const Eigen::MatrixXd& X, const Eigen::MatrixXd& V, Eigen::Index m,
-                         double* b) {
+void tangent_coordinates(const double* X, const double* V, Eigen::Index m, double* b) {
   constexpr int W = D + 1, P = D * (D + 1) / 2, NR = P - D;
   for (Eigen::Index i = 0; i < m; ++i) {
-    const double* Y = X.data() + i * W * D;   // d x d rotation block, column-major
-    const double* Vi = V.data() + i * W * D;  // d x (d+1) pose block
-    double Wm[D][W];                          // Wm[a][c] = (Y^T V_i)(a, c)
+    const double* Y = X + i * W * D;   // d x d rotation block, column-major
+    const double* Vi = V + i * W * D;  // d x (d+1) pose block
+    double Wm[D][W];                   // Wm[a][c] = (Y^T V_i)(a, c)
     for (int c = 0; c < W; ++c)
       for (int a = 0; a < D; ++a) {
         double s = Y[a * D] * Vi[c * D];
@@ -331,10 +377,10 @@ void tangent_coordinates(const Eigen::MatrixXd& X, const Eigen::MatrixXd& V, Eig
 }
 
 template <int D>
-void tangent_vector(const Eigen::MatrixXd& X, const double* c, Eigen::Index m, Eigen::MatrixXd& Z) {
+void tangent_vector(const double* X, const double* c, Eigen::Index m, double* Z) {
   constexpr int W = D + 1, P = D * (D + 1) / 2, NR = P - D;
   for (Eigen::Index i = 0; i < m; ++i) {
-    const double* Y = X.data() + i * W * D;
+    const double* Y = X + i * W * D;
     const double* ci = c + i * P;
     double S[W][D] = {};  // S[col][row]: Omega(omega) and u
     int k = 0;
@@ -344,7 +390,7 @@ void tangent_vector(const Eigen::MatrixXd& X, const double* c, Eigen::Index m, E
         S[bb][a] -= ci[k];
       }
     for (int a = 0; a < D; ++a) S[D][a] = ci[NR + a];
-    double* Zi = Z.data() + i * W * D;
+    double* Zi = Z + i * W * D;
     for (int col = 0; col < W; ++col)
       for (int row = 0; row < D; ++row) {
         double s = Y[row] * S[col][0];
@@ -360,22 +406,38 @@ Eigen::MatrixXd TangentPreconditioner::apply(const LiftedManifold&, const Eigen:
                                              const Eigen::MatrixXd& V) const {
   Factor& f = *factor_;
   const int d = f.d, w = d + 1, p = f.p;
-  if (!factored() || X.rows() != d || V.rows() != d || X.cols() != w * f.m || V.cols() != X.cols())
+  const Eigen::Index all = f.m + f.extra;
+  if (!factored() || X.rows() != d || V.rows() != d || X.cols() != w * all || V.cols() != X.cols())
     throw std::logic_error("TangentPreconditioner::apply: not factored, or not a rank-d point");
   // b = J^T V, pose by pose: omega_ab = <Y E_ab, V_R> = (Y^T V_R)(b, a) - (Y^T V_R)(a, b),
-  // u = Y^T v.
+  // u = Y^T v. The factored poses' coordinates go to the factor's solve, the grown ones' to
+  // their diagonal blocks.
+  const Eigen::Index skip = w * d * f.m;
   f.b.resize(f.m * p);
-  if (d == 2)
-    tangent_coordinates<2>(X, V, f.m, f.b.data());
-  else
-    tangent_coordinates<3>(X, V, f.m, f.b.data());
+  f.extra_b.resize(f.extra * p);
+  if (d == 2) {
+    tangent_coordinates<2>(X.data(), V.data(), f.m, f.b.data());
+    tangent_coordinates<2>(X.data() + skip, V.data() + skip, f.extra, f.extra_b.data());
+  } else {
+    tangent_coordinates<3>(X.data(), V.data(), f.m, f.b.data());
+    tangent_coordinates<3>(X.data() + skip, V.data() + skip, f.extra, f.extra_b.data());
+  }
   const double* c = f.solve();
+  for (Eigen::Index i = 0; i < f.extra; ++i) {
+    auto bi = f.extra_b.segment(i * p, p);
+    const Eigen::VectorXd ci =
+        Eigen::Map<const Eigen::MatrixXd>(f.extra_inverse.data() + i * p * p, p, p) * bi;
+    bi = ci;
+  }
   // Z = J c: rotation Y Omega(omega), translation Y u.
   Eigen::MatrixXd Z(d, V.cols());
-  if (d == 2)
-    tangent_vector<2>(X, c, f.m, Z);
-  else
-    tangent_vector<3>(X, c, f.m, Z);
+  if (d == 2) {
+    tangent_vector<2>(X.data(), c, f.m, Z.data());
+    tangent_vector<2>(X.data() + skip, f.extra_b.data(), f.extra, Z.data() + skip);
+  } else {
+    tangent_vector<3>(X.data(), c, f.m, Z.data());
+    tangent_vector<3>(X.data() + skip, f.extra_b.data(), f.extra, Z.data() + skip);
+  }
   return Z;
 }
 

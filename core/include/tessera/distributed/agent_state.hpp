@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/coarse_correction.hpp>
 #include <tessera/distributed/rbcd.hpp>
@@ -54,7 +55,7 @@ class AgentState {
   Eigen::MatrixXd update(const Eigen::MatrixXd& X0, const Eigen::MatrixXd& neighbours,
                          const BlockUpdateOptions& options);
   /// This agent's coarse terms at (Y, Yn) (coarse_correction.hpp).
-  std::vector<double> coarse_terms() const { return coarse_.compute(Y, Yn); }
+  std::vector<double> coarse_terms() const { return coarse().compute(Y, Yn); }
   /// Moves every block rigidly by motions[b] (coarse_correction.hpp): the own sequences Y and
   /// V by motions[id], the neighbour copies Yn and Vn pose by pose by their owners' motions.
   void apply_coarse(const std::vector<Eigen::MatrixXd>& motions);
@@ -75,6 +76,20 @@ class AgentState {
   /// meanwhile: without this both are held at once); the next update that needs it computes it
   /// again, the same factor.
   void release_block_factor() { precon_.reset(); }
+  /// The block grew in place (an online run's new data): the layout this state was built with
+  /// now lists more poses for this block (the old ones first, in the same order) and
+  /// `measurements` (the same growing vector, which must outlive this state) has new entries
+  /// from `first_new` on. Extends the local problem with them (BlockProblem::extend: the new
+  /// data and a pass over the block's own entries, no scan of the whole graph) and starts the
+  /// sequences afresh at Y0 (the grown block) with the neighbour copies at zero: call
+  /// reset_iterate with the neighbours' poses (problem().neighbors() order) before a solve. The
+  /// tangent factor is kept and grown (TangentPreconditioner::grow) while the block has at most
+  /// `refactor_growth` times the poses it was factored with more; beyond that, or when growing
+  /// fails, it is built again at the next update. The Q_BB factor is built again when an update
+  /// needs it. Throws std::invalid_argument when the block lost or reordered poses (build a new
+  /// state then).
+  void extend(const std::vector<Measurement>& measurements, std::size_t first_new,
+              const Eigen::MatrixXd& Y0, double refactor_growth);
   /// Starts the sequences afresh at Y0 (any rank, e.g. r + 1 after a saddle escape) with
   /// neighbours at Yn0 (same rank, neighbour order).
   void reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd& Yn0);
@@ -97,7 +112,10 @@ class AgentState {
   int d_;
   const BlockLayout& layout_;
   BlockProblem problem_;
-  CoarseTerms coarse_;
+  // Built in the constructor; after extend() on first use, from *coarse_source_.
+  mutable std::optional<CoarseTerms> coarse_;
+  const std::vector<Measurement>* coarse_source_ = nullptr;
+  const CoarseTerms& coarse() const;
   /// The Q_BB preconditioner (built in the constructor).
   BlockPreconditioner& euclidean();
   /// Builds and factors the tangent preconditioner at X (rank d) once; false when unusable.

@@ -156,4 +156,13 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
                                                 const DistributedOptions& options,
                                                 const Eigen::MatrixXd& X0);
 
+class AgentState;
+/// The same with agents whose states already exist (states[b] = block b of `layout`, built
+/// over `graph`'s measurements, each at its starting point): an online run keeps them from
+/// step to step and grows them in place (live_blocks.hpp) instead of building every block
+/// problem and preconditioner again. The states hold the final iterate afterwards.
+DistributedResult solve_distributed_with_states(const PoseGraph& graph, const BlockLayout& layout,
+                                                const std::vector<AgentState*>& states,
+                                                const DistributedOptions& options);
+
 }  // namespace tessera

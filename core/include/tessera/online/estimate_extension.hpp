@@ -26,9 +26,12 @@ struct EstimateExtension {
 /// Extends `X` (r x (d+1)m, poses 0..m-1 of `graph`) to all graph.num_poses poses. Poses are
 /// visited breadth first from the estimated ones over the measurements in graph order, so a
 /// chain of new poses is composed pose after pose along its odometry. `guesses` (graph.d,
-/// one per pose of the graph) seed the unreachable pieces. Throws std::invalid_argument when
-/// sizes do not fit.
+/// one per pose of the graph) seed the unreachable pieces. `first_new_measurement`: the
+/// measurements before it touch none of the new poses (they were there before the new poses
+/// arrived), so only the rest is read and the cost follows the new data, not the graph; the
+/// result is the same as with 0. Throws std::invalid_argument when sizes do not fit.
 EstimateExtension extend_estimate(const PoseGraph& graph, const Eigen::MatrixXd& X,
-                                  const std::vector<Pose>& guesses);
+                                  const std::vector<Pose>& guesses,
+                                  std::size_t first_new_measurement = 0);
 
 }  // namespace tessera

@@ -12,6 +12,7 @@
 #include <tessera/graph/measurement.hpp>
 #include <tessera/manifold/lifted_manifold.hpp>
 #include <tessera/problem/data_matrix.hpp>
+#include <unordered_map>
 #include <vector>
 
 namespace tessera {
@@ -22,6 +23,18 @@ class BlockProblem {
   /// touching an owned pose are ignored; a measurement's other endpoint, when not owned,
   /// becomes a neighbour pose. Neighbours are ordered by global id.
   BlockProblem(int d, std::vector<std::size_t> owned, const std::vector<Measurement>& measurements);
+
+  /// Grows the problem in place to what the constructor would build from the owned poses
+  /// followed by `new_owned` and `measurements` (a growing graph: its first `first_new`
+  /// measurements are the ones this problem was built or last extended from, in the same order).
+  /// Only measurements[first_new, end) are read, so the cost is that of the new data plus a pass
+  /// over this block's own entries, not a scan of the whole graph. `new_owned` must be poses no
+  /// earlier measurement touches (new poses of the graph): a pose that moves in from another
+  /// block needs a new problem (std::invalid_argument when it is one of the neighbours).
+  /// Neighbours stay ordered by id. The neighbours' poses must be set again afterwards.
+  /// Q_BB and Q_NB equal the rebuilt ones up to the order of floating-point additions.
+  void extend(const std::vector<std::size_t>& new_owned,
+              const std::vector<Measurement>& measurements, std::size_t first_new);
 
   /// The centralized problem: every pose 0..n-1 owned.
   static BlockProblem whole_graph(int d, std::size_t num_poses,
@@ -70,6 +83,8 @@ class BlockProblem {
 
   int d_;
   std::vector<std::size_t> owned_;
+  // Slot of each owned id, built on the first extend() (the constructor does not need it).
+  std::unordered_map<std::size_t, std::size_t> owned_slot_;
   std::vector<std::size_t> neighbors_;
   std::vector<Edge> edges_;
   // Per edge, in edges_ order: R (column-major), t, kappa, tau. The problem's only copy of

@@ -57,6 +57,17 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   /// Returns true when apply() may be used at X (X has d rows and a factor is held).
   bool prepare(const Eigen::MatrixXd& X, int refresh_interval);
 
+  /// The block grew (`problem` after BlockProblem::extend, `X` its rank-d point with the new
+  /// poses appended): the new poses are preconditioned with their own p x p diagonal blocks of
+  /// A at X, the factored poses with the held factor (block Jacobi over {factored poses, each
+  /// new pose}: still symmetric positive definite, merely less exact), so a growing block is
+  /// not refactored for every few poses. Returns false (nothing changed) when no factor is held,
+  /// X does not fit or a new block is not positive definite. factorize() then refuses (the
+  /// caller builds a new preconditioner for the grown block instead).
+  bool grow(const BlockProblem& problem, const Eigen::MatrixXd& X);
+  /// Poses preconditioned by grow()'s diagonal blocks.
+  Eigen::Index grown_poses() const;
+
   /// J(X) A^{-1} J(X)^T V for a tangent vector V at X (d rows): a tangent vector at X.
   Eigen::MatrixXd apply(const LiftedManifold& manifold, const Eigen::MatrixXd& X,
                         const Eigen::MatrixXd& V) const override;

@@ -1,0 +1,200 @@
+// Block problems grown in place as an online run's data arrives (LiveBlocks, AgentState::extend,
+// BlockProblem::extend, TangentPreconditioner::grow) are the problems a rebuild on the final
+// graph gives, and the grown preconditioner is still a symmetric positive definite map.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <random>
+#include <tessera/generate/generator.hpp>
+#include <tessera/online/estimate_extension.hpp>
+#include <tessera/online/graph_stream.hpp>
+#include <tessera/online/live_blocks.hpp>
+#include <tessera/online/replay_schedule.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/solvers/tangent_preconditioner.hpp>
+
+namespace tessera {
+namespace {
+
+GeneratorResult small_graph(TrajectoryKind kind, std::size_t n, std::size_t robots) {
+  GeneratorOptions o;
+  o.kind = kind;
+  o.num_poses = n;
+  o.num_robots = robots;
+  o.seed = 5;
+  return generate_pose_graph(o);
+}
+
+double relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).norm() / std::max(1.0, b.norm());
+}
+
+// Columns of the poses `ids` of X (r x (d+1)n).
+Eigen::MatrixXd pose_columns(const Eigen::MatrixXd& X, int d, const std::vector<std::size_t>& ids) {
+  const Eigen::Index w = d + 1;
+  Eigen::MatrixXd out(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
+  for (std::size_t s = 0; s < ids.size(); ++s)
+    out.middleCols(w * static_cast<Eigen::Index>(s), w) =
+        X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
+  return out;
+}
+
+// Plays `gen` as its robots' front ends would and syncs a LiveBlocks (blocks = robots) every
+// `every` batches, as the online engine does at its steps.
+struct GrownRun {
+  GraphStream stream;
+  LiveBlocks live;
+  Eigen::MatrixXd X;  // stream ids
+  int extended = 0, built = 0, kept = 0;
+
+  GrownRun(const GeneratorResult& gen, std::size_t every, double refactor_growth)
+      : stream(gen.graph.d), live(gen.graph.d, BlockUpdateOptions{}, refactor_growth) {
+    ReplayOptions opt;
+    opt.rate = 10;
+    const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, opt);
+    X.resize(5, 0);
+    std::size_t extended_over = 0;
+    for (std::size_t b = 0; b < plan.batches.size(); ++b) {
+      stream.absorb(plan.batches[b]);
+      if ((b + 1) % every != 0 && b + 1 != plan.batches.size()) continue;
+      const PoseGraph& g = stream.graph();
+      X = extend_estimate(g, X, stream.guesses(), extended_over).X;
+      extended_over = g.measurements.size();
+      std::vector<int> owner;
+      for (std::size_t k = 0; k < g.num_poses; ++k)
+        owner.push_back(static_cast<int>(stream.robot_of_pose()[k]));
+      const LiveSync s = live.sync(g, owner, X);
+      extended += s.extended;
+      built += s.built;
+      kept += s.kept;
+    }
+  }
+};
+
+TEST(LiveBlocks, BlocksGrownInPlaceEqualBlocksBuiltOnTheFinalGraph) {
+  // Small steps, and steps of many batches at once (a step that lagged behind the stream).
+  for (auto [kind, every] :
+       {std::pair{TrajectoryKind::kSphere, 7}, std::pair{TrajectoryKind::kCity, 7},
+        std::pair{TrajectoryKind::kSphere, 97}}) {
+    const auto gen = small_graph(kind, 240, 4);
+    GrownRun run(gen, static_cast<std::size_t>(every), 0.25);
+    const PoseGraph& g = run.live.graph();
+    const int d = g.d;
+    EXPECT_EQ(g.num_poses, gen.graph.num_poses);
+    EXPECT_EQ(g.measurements.size(), gen.graph.measurements.size());
+    // Most syncs grew blocks; only the robots' first appearances built one.
+    EXPECT_EQ(run.built, 4);
+    EXPECT_GT(run.extended, every == 7 ? 40 : 4);
+    // The compact iterate of the linked graph, and a second point to evaluate at.
+    Eigen::MatrixXd Xc = pose_columns(run.X, d, run.live.full_id());
+    std::mt19937 rng(7);
+    std::normal_distribution<double> noise(0.0, 0.1);
+    Eigen::MatrixXd Xr = Xc.unaryExpr([&](double v) { return v + noise(rng); });
+    const BlockLayout& layout = run.live.layout();
+    ASSERT_EQ(layout.num_blocks, 4);
+    for (int c = 0; c < layout.num_blocks; ++c) {
+      const AgentState& state = *run.live.states()[static_cast<std::size_t>(c)];
+      BlockProblem grown = state.problem();  // a copy, to set its neighbours here
+      BlockProblem fresh(d, layout.poses[static_cast<std::size_t>(c)], g.measurements);
+      EXPECT_EQ(grown.owned(), fresh.owned());
+      EXPECT_EQ(grown.neighbors(), fresh.neighbors());
+      EXPECT_EQ(grown.num_measurements(), fresh.num_measurements());
+      EXPECT_LT(relative_difference(Eigen::MatrixXd(grown.data_matrix()),
+                                    Eigen::MatrixXd(fresh.data_matrix())),
+                1e-14);
+      // The state starts from the iterate.
+      EXPECT_EQ(state.Y, pose_columns(Xc, d, layout.poses[static_cast<std::size_t>(c)]));
+      for (const Eigen::MatrixXd* P : {&Xc, &Xr}) {
+        const Eigen::MatrixXd Xb = pose_columns(*P, d, grown.owned());
+        const Eigen::MatrixXd Xn = pose_columns(*P, d, grown.neighbors());
+        grown.set_neighbor_poses(Xn);
+        fresh.set_neighbor_poses(Xn);
+        const double f = fresh.cost(Xb);
+        EXPECT_NEAR(grown.cost(Xb), f, 1e-12 * std::max(1.0, f));
+        EXPECT_NEAR(grown.cost_share(Xb), fresh.cost_share(Xb), 1e-12 * std::max(1.0, f));
+        EXPECT_LT(relative_difference(grown.euclidean_gradient(Xb), fresh.euclidean_gradient(Xb)),
+                  1e-12);
+      }
+    }
+  }
+}
+
+TEST(LiveBlocks, ABlockWithNoNewDataIsKeptAsItIs) {
+  const auto gen = small_graph(TrajectoryKind::kSphere, 120, 3);
+  GrownRun run(gen, 5, 0.25);
+  const AgentState* before = run.live.states()[0].get();
+  const std::vector<std::size_t> neighbours = before->problem().neighbors();
+  std::vector<int> owner;
+  for (std::size_t k = 0; k < run.stream.graph().num_poses; ++k)
+    owner.push_back(static_cast<int>(run.stream.robot_of_pose()[k]));
+  const LiveSync again = run.live.sync(run.stream.graph(), owner, run.X);
+  EXPECT_EQ(again.new_measurements, 0u);
+  EXPECT_EQ(again.kept, 3);
+  EXPECT_EQ(again.extended + again.built, 0);
+  EXPECT_EQ(run.live.states()[0].get(), before);
+  EXPECT_EQ(before->problem().neighbors(), neighbours);
+}
+
+TEST(LiveBlocks, MovedPosesRebuildTheBlocks) {
+  const auto gen = small_graph(TrajectoryKind::kSphere, 120, 3);
+  GrownRun run(gen, 5, 0.25);
+  std::vector<int> owner;
+  for (std::size_t k = 0; k < run.stream.graph().num_poses; ++k)
+    owner.push_back(static_cast<int>(run.stream.robot_of_pose()[k]));
+  // The last pose of robot 0 moves to robot 1's block.
+  std::size_t last0 = 0;
+  for (std::size_t k = 0; k < owner.size(); ++k)
+    if (owner[k] == 0) last0 = k;
+  owner[last0] = 1;
+  const LiveSync s = run.live.sync(run.stream.graph(), owner, run.X);
+  EXPECT_EQ(s.built, 3);
+  const std::size_t compact =
+      std::find(run.live.full_id().begin(), run.live.full_id().end(), last0) -
+      run.live.full_id().begin();
+  EXPECT_EQ(run.live.block_of()[static_cast<std::size_t>(run.live.layout().owner[compact])], 1);
+}
+
+TEST(TangentPreconditionerGrow, TheGrownPreconditionerIsSymmetricPositiveDefinite) {
+  const auto gen = small_graph(TrajectoryKind::kSphere, 90, 1);
+  const PoseGraph& g = gen.graph;
+  const int d = g.d;
+  const Eigen::MatrixXd X = lift_poses(g.initial, d);  // rank d: the tangent preconditioner's
+  std::vector<std::size_t> first, rest;
+  for (std::size_t k = 0; k < g.num_poses; ++k) (k < 60 ? first : rest).push_back(k);
+  // The problem of the first 60 poses' measurements, then grown by the other 30.
+  std::vector<Measurement> early;
+  std::vector<Measurement> ordered;
+  for (const Measurement& m : g.measurements)
+    if (m.i < 60 && m.j < 60) early.push_back(m);
+  ordered = early;
+  for (const Measurement& m : g.measurements)
+    if (m.i >= 60 || m.j >= 60) ordered.push_back(m);
+  BlockProblem problem(d, first, early);
+  TangentPreconditioner precon(problem);
+  ASSERT_TRUE(precon.factorize(X.leftCols((d + 1) * 60)));
+  problem.extend(rest, ordered, early.size());
+  ASSERT_TRUE(precon.grow(problem, X));
+  EXPECT_EQ(precon.grown_poses(), 30);
+  EXPECT_FALSE(precon.factorize(X));  // a grown factor is replaced, not refreshed
+  const LiftedManifold M = problem.manifold(d);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise;
+  auto tangent = [&] {
+    Eigen::MatrixXd V = Eigen::MatrixXd::NullaryExpr(d, X.cols(), [&] { return noise(rng); });
+    return M.tangent_project(X, V);
+  };
+  for (int trial = 0; trial < 5; ++trial) {
+    const Eigen::MatrixXd u = tangent(), v = tangent();
+    const Eigen::MatrixXd Pu = precon.apply(M, X, u), Pv = precon.apply(M, X, v);
+    EXPECT_GT((v.array() * Pv.array()).sum(), 0.0);
+    const double uPv = (u.array() * Pv.array()).sum(), vPu = (v.array() * Pu.array()).sum();
+    EXPECT_NEAR(uPv, vPu, 1e-9 * std::max(1.0, std::abs(uPv)));
+    // A tangent vector at X.
+    EXPECT_LT((M.tangent_project(X, Pv) - Pv).norm(), 1e-9 * std::max(1.0, Pv.norm()));
+  }
+}
+
+}  // namespace
+}  // namespace tessera
