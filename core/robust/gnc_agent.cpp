@@ -282,6 +282,35 @@ std::uint32_t GncAgent::exchange_phase() const {
   }
 }
 
+// Agent 0 gathers the values of the measurements the agents weigh (each measurement once; with
+// `kept_only` the ones not rejected): the others send theirs, agent 0 keeps its own and waits.
+void GncAgent::gather_values_at_lead(GncExchange exchange, bool kept_only,
+                                     std::vector<OutgoingMessage>& out) {
+  const auto me = static_cast<std::uint32_t>(in_.id);
+  auto wanted = [&](std::size_t k) {
+    return !kept_only ||
+           !std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k]);
+  };
+  if (me != 0) {
+    std::vector<const Measurement*> values;
+    std::vector<std::uint64_t> index;
+    for (std::size_t k : owned_)
+      if (wanted(k)) {
+        values.push_back(&in_.measurements[k]);
+        index.push_back(in_.measurement_index[k]);
+      }
+    out.push_back(OutgoingMessage{
+        encode_measurement_block(me, gnc_phase(g_, exchange), in_.d, values, index), false, {0}});
+    waiting_.push_back(0);
+    return;
+  }
+  kept_values_.clear();
+  for (std::size_t k : owned_)
+    if (wanted(k)) kept_values_.emplace_back(in_.measurement_index[k], in_.measurements[k]);
+  for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
+    waiting_.push_back(a);
+}
+
 void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   step_ = step;
   const std::uint32_t phase = exchange_phase();
@@ -337,52 +366,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       break;
     }
     case Step::kPcm:
-      if (me != 0) {
-        // Every measurement this agent weighs goes to agent 0 (each measurement once).
-        std::vector<const Measurement*> values;
-        std::vector<std::uint64_t> index;
-        for (std::size_t k : owned_) {
-          values.push_back(&in_.measurements[k]);
-          index.push_back(in_.measurement_index[k]);
-        }
-        out.push_back(
-            OutgoingMessage{encode_measurement_block(me, gnc_phase(g_, GncExchange::kPcmValues),
-                                                     in_.d, values, index),
-                            false,
-                            {0}});
-        waiting_.push_back(0);
-      } else {
-        kept_values_.clear();
-        for (std::size_t k : owned_)
-          kept_values_.emplace_back(in_.measurement_index[k], in_.measurements[k]);
-        for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
-          waiting_.push_back(a);
-      }
+      gather_values_at_lead(GncExchange::kPcmValues, false, out);
       break;
     case Step::kKeptStart:
-      if (me != 0) {
-        // The kept measurements this agent weighs go to agent 0 (each measurement once).
-        std::vector<const Measurement*> values;
-        std::vector<std::uint64_t> index;
-        for (std::size_t k : owned_)
-          if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
-            values.push_back(&in_.measurements[k]);
-            index.push_back(in_.measurement_index[k]);
-          }
-        out.push_back(
-            OutgoingMessage{encode_measurement_block(me, gnc_phase(g_, GncExchange::kKeptValues),
-                                                     in_.d, values, index),
-                            false,
-                            {0}});
-        waiting_.push_back(0);
-      } else {
-        kept_values_.clear();
-        for (std::size_t k : owned_)
-          if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k]))
-            kept_values_.emplace_back(in_.measurement_index[k], in_.measurements[k]);
-        for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
-          waiting_.push_back(a);
-      }
+      gather_values_at_lead(GncExchange::kKeptValues, true, out);
       break;
     case Step::kCandidatePoses:
       // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).

@@ -196,6 +196,8 @@ class GncAgent : public AgentProcess {
   enum class Solve { kGnc, kInlierPass, kFinal };
   void begin_solve(std::vector<OutgoingMessage>& out);
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
+  void gather_values_at_lead(GncExchange exchange, bool kept_only,
+                             std::vector<OutgoingMessage>& out);
   void after_solve(std::vector<OutgoingMessage>& out);
   void after_exchange(std::vector<OutgoingMessage>& out);
   void feed(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
