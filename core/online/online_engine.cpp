@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <tessera/certification/rounding_gap.hpp>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
 #include <tessera/online/online_engine.hpp>
@@ -178,6 +179,10 @@ OnlineResult OnlineEngine::finish() {
   if (solver.round_result) {
     out.poses = round_solution(out.graph, X_);
     out.cost = evaluate_objective(out.graph, out.poses);
+    // As in the batch solvers: a certified X that rounds far above f(X) leaves the estimate
+    // uncertified (the relaxation is not tight).
+    if (out.certified && *out.certified && !rounding_is_tight(out.cost, res.relaxation_cost))
+      out.certified = false;
   }
   return out;
 }
