@@ -11,6 +11,7 @@
 #include <memory>
 #include <set>
 #include <stdexcept>
+#include <tessera/certification/rounding_gap.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/certified_agent.hpp>
@@ -150,6 +151,7 @@ struct SolveOutcome {
   std::string stop_reason;
   std::optional<bool> certified;
   double min_eigenvalue = 0.0;
+  std::optional<double> relaxation_cost;  ///< f of the last lifted iterate (summed over agents).
 };
 
 class OnlineAgent {
@@ -369,6 +371,7 @@ SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
   const auto& last = agent.solves().back();
   out.stop_reason = last.stop_reason;
   out.grad_norm = last.trace.empty() ? 0.0 : last.trace.back().grad_norm;
+  if (!last.trace.empty()) out.relaxation_cost = last.trace.back().cost;
   out.certified = agent.certified();
   if (!agent.certificates().empty())
     out.min_eigenvalue = agent.certificates().back().result.min_eigenvalue;
@@ -594,6 +597,11 @@ int OnlineAgent::run() {
       const std::vector<Pose> poses = round_solution(graph, view_.iterate());
       cost_ = evaluate_objective(graph, poses);
       have_cost_ = true;
+      // As in the batch runs: a certified X that rounds far above f(X) (a relaxation that is
+      // not tight) leaves the estimate uncertified.
+      if (final_.certified && *final_.certified && final_.relaxation_cost &&
+          !rounding_is_tight(cost_, *final_.relaxation_cost))
+        final_.certified = false;
     }
   }
   channel_.flush(5.0);
