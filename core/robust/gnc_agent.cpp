@@ -12,6 +12,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "distributed/measurement_block.hpp"
+#include "robust/gnc_local_terms.hpp"
 
 namespace tessera {
 
@@ -22,41 +23,6 @@ std::uint32_t phase_of(const ProtocolMessage& m) {
 }
 std::uint32_t sender_of(const ProtocolMessage& m) {
   return std::visit([](const auto& x) { return x.sender; }, m);
-}
-
-// Endpoints only: what connectivity and the block layout need.
-Measurement endpoints(const std::pair<std::uint32_t, std::uint32_t>& e) {
-  Measurement m;
-  m.i = e.first;
-  m.j = e.second;
-  return m;
-}
-
-// The parts the measurements of `structure` not in `dropped` (ascending) split the poses into.
-std::size_t components_without(
-    std::size_t num_poses, int d,
-    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
-    const std::vector<std::uint64_t>& dropped, bool only_known, const std::vector<bool>& known) {
-  PoseGraph g;
-  g.d = d;
-  g.num_poses = num_poses;
-  for (std::size_t e = 0; e < structure.size(); ++e) {
-    if (only_known && !known[e]) continue;
-    if (std::binary_search(dropped.begin(), dropped.end(), static_cast<std::uint64_t>(e))) continue;
-    g.measurements.push_back(endpoints(structure[e]));
-  }
-  return count_components(g);
-}
-
-std::vector<std::pair<std::uint32_t, std::uint32_t>> without(
-    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
-    const std::vector<std::uint64_t>& dropped) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
-  out.reserve(structure.size());
-  for (std::size_t e = 0; e < structure.size(); ++e)
-    if (!std::binary_search(dropped.begin(), dropped.end(), static_cast<std::uint64_t>(e)))
-      out.push_back(structure[e]);
-  return out;
 }
 
 }  // namespace
@@ -85,65 +51,22 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   dropped_.assign(in_.measurements.size(), false);
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   layout_ = std::make_unique<BlockLayout>(*base_);
-  // Every agent knows every measurement's known-inlier status (rule + flags), hence how many may
-  // be rejected (c^2's default) and whether the known inliers alone connect the poses.
-  known_.resize(in_.structure.size());
-  std::size_t candidates = 0;
-  for (std::size_t e = 0; e < in_.structure.size(); ++e) {
-    known_[e] = is_known_inlier(endpoints(in_.structure[e]), options_.robust.known_inliers) ||
-                (!in_.known_inlier.empty() && in_.known_inlier[e]);
-    candidates += known_[e] ? 0 : 1;
-  }
-  c2_ = tls_threshold_squared(options_.robust, in_.d, candidates);
-  known_connected_ = components_without(in_.num_poses, in_.d, in_.structure, {}, true, known_) <= 1;
+  terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
   weights_.assign(m, 1.0);
-  for (std::size_t k = 0; k < m; ++k) {
-    const Measurement& x = in_.measurements[k];
-    if (weight_owner(x, in_.owner) == in_.id) owned_.push_back(k);
-    for (std::size_t p : {x.i, x.j})
-      if (in_.owner[p] != in_.id) base_neighbours_.push_back(p);
-  }
-  std::sort(base_neighbours_.begin(), base_neighbours_.end());
-  base_neighbours_.erase(std::unique(base_neighbours_.begin(), base_neighbours_.end()),
-                         base_neighbours_.end());
 }
 
 GncAgent::~GncAgent() = default;
+
+double GncAgent::threshold_squared() const {
+  return terms_->c2();
+}
 
 int GncAgent::total_rounds() const {
   return gnc_rounds_ + final_rounds_;
 }
 
-bool GncAgent::may_reject(std::size_t k) const {
-  return !known_[in_.measurement_index[k]];
-}
-
-// The measurement's term of the TLS cost: r^2 for a known inlier, min(r^2, c^2) otherwise.
-double GncAgent::tls_term(std::size_t k, double r2) const {
-  return may_reject(k) ? std::min(r2, c2_) : r2;
-}
-
-// The measurement's term of the relaxed objective at the current lifted iterate: the own
-// block's columns and the neighbours' public poses just received (or at another such pair).
 double GncAgent::residual_squared_at(std::size_t k) const {
-  return residual_squared_at(k, state_->Y, neighbours_);
-}
-
-double GncAgent::residual_squared_at(std::size_t k, const Eigen::MatrixXd& own_block,
-                                     const Eigen::MatrixXd& neighbour_block) const {
-  const Measurement& m = in_.measurements[k];
-  const Eigen::Index w = in_.d + 1;
-  const auto& own = base_->poses[static_cast<std::size_t>(in_.id)];
-  auto block = [&](std::size_t p) -> Eigen::MatrixXd {
-    if (in_.owner[p] == in_.id) {
-      const auto s = std::lower_bound(own.begin(), own.end(), p) - own.begin();
-      return own_block.middleCols(w * s, w);
-    }
-    const auto s = std::lower_bound(base_neighbours_.begin(), base_neighbours_.end(), p) -
-                   base_neighbours_.begin();
-    return neighbour_block.middleCols(w * s, w);
-  };
-  return lifted_residual_squared(m, block(m.i), block(m.j));
+  return terms_->residual_squared(k, state_->Y, neighbours_);
 }
 
 void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
@@ -175,14 +98,15 @@ void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t p
 }
 
 void GncAgent::weights_at_mu(double mu) {
-  for (std::size_t k : owned_)
-    if (may_reject(k) && !dropped_[k]) weights_[k] = tls_weight(residual_squared_at(k), c2_, mu);
+  for (std::size_t k : terms_->owned())
+    if (terms_->may_reject(k) && !dropped_[k])
+      weights_[k] = tls_weight(residual_squared_at(k), terms_->c2(), mu);
 }
 
 std::vector<OutgoingMessage> GncAgent::start() {
   std::vector<OutgoingMessage> out;
   if (in_.pcm) {
-    if (!known_connected_) {
+    if (!terms_->known_connected()) {
       const std::string why =
           "robust pcm-gnc: the known inliers do not connect the poses, so there is no odometry "
           "to test closures against (use --robust gnc-tls)";
@@ -223,7 +147,7 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
       // A weight of exactly 0 adds nothing: such an edge leaves the solve when the known
       // inliers keep the poses connected (fewer block neighbours, fewer colours); otherwise it
       // stays at a tiny pull so no part is cut off.
-      if (known_connected_ && weights_[k] == 0) continue;
+      if (terms_->known_connected() && weights_[k] == 0) continue;
       Measurement x = in_.measurements[k];
       const double w = std::max(weights_[k], kMinInnerWeight);
       if (g_ > first_solve_g_) {
@@ -294,7 +218,7 @@ void GncAgent::gather_values_at_lead(GncExchange exchange, bool kept_only,
   if (me != 0) {
     std::vector<const Measurement*> values;
     std::vector<std::uint64_t> index;
-    for (std::size_t k : owned_)
+    for (std::size_t k : terms_->owned())
       if (wanted(k)) {
         values.push_back(&in_.measurements[k]);
         index.push_back(in_.measurement_index[k]);
@@ -305,7 +229,7 @@ void GncAgent::gather_values_at_lead(GncExchange exchange, bool kept_only,
     return;
   }
   kept_values_.clear();
-  for (std::size_t k : owned_)
+  for (std::size_t k : terms_->owned())
     if (wanted(k)) kept_values_.emplace_back(in_.measurement_index[k], in_.measurements[k]);
   for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
     waiting_.push_back(a);
@@ -339,14 +263,14 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // measurement (the base layout: a measurement out of the current solve still needs
       // its residual).
       neighbours_ = Eigen::MatrixXd::Zero(
-          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
+          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(terms_->neighbours().size()));
       publish(state_->Y, BlockKind::kY, phase, out);
       break;
     case Step::kStartPoses:
       // Both starts' public poses: the solver's initialization (kind Y) and the known
       // inliers' (kind P).
       neighbours_ = Eigen::MatrixXd::Zero(
-          in_.Y0.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
+          in_.Y0.rows(), (in_.d + 1) * static_cast<Eigen::Index>(terms_->neighbours().size()));
       candidate_neighbours_ = neighbours_;
       publish(in_.Y0, BlockKind::kY, phase, out);
       publish(in_.Y0_known, BlockKind::kP, phase, out);
@@ -354,9 +278,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     case Step::kStartVotes: {
       // The TLS cost of each measurement at both starts, summed by its weight owner.
       double at_start = 0, at_known = 0;
-      for (std::size_t k : owned_) {
-        at_start += tls_term(k, residual_squared_at(k, in_.Y0, neighbours_));
-        at_known += tls_term(k, residual_squared_at(k, in_.Y0_known, candidate_neighbours_));
+      for (std::size_t k : terms_->owned()) {
+        at_start += terms_->tls_term(k, terms_->residual_squared(k, in_.Y0, neighbours_));
+        at_known +=
+            terms_->tls_term(k, terms_->residual_squared(k, in_.Y0_known, candidate_neighbours_));
       }
       votes_[me] = {at_start, at_known};
       RoundStatusMessage st;
@@ -374,7 +299,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     case Step::kCandidatePoses:
       // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
       neighbours_ = Eigen::MatrixXd::Zero(
-          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(base_neighbours_.size()));
+          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(terms_->neighbours().size()));
       candidate_neighbours_ = neighbours_;
       publish(state_->Y, BlockKind::kY, phase, out);
       publish(candidate_, BlockKind::kP, phase, out);
@@ -382,10 +307,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     case Step::kCandidateVotes: {
       // Each kept measurement's cost at both starts, summed by its weight owner.
       double at_iterate = 0, at_candidate = 0;
-      for (std::size_t k : owned_)
+      for (std::size_t k : terms_->owned())
         if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
           at_iterate += residual_squared_at(k);
-          at_candidate += residual_squared_at(k, candidate_, candidate_neighbours_);
+          at_candidate += terms_->residual_squared(k, candidate_, candidate_neighbours_);
         }
       votes_[me] = {at_iterate, at_candidate};
       RoundStatusMessage st;
@@ -397,8 +322,9 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     case Step::kVotes: {
       // mu's start needs the largest residual over every measurement that may be rejected.
       double max_r2 = 0;
-      for (std::size_t k : owned_)
-        if (may_reject(k) && !dropped_[k]) max_r2 = std::max(max_r2, residual_squared_at(k));
+      for (std::size_t k : terms_->owned())
+        if (terms_->may_reject(k) && !dropped_[k])
+          max_r2 = std::max(max_r2, residual_squared_at(k));
       votes_[me] = {max_r2, 0};
       RoundStatusMessage st;
       st.cost = max_r2;
@@ -408,10 +334,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     case Step::kWeights: {
       weights_at_mu(mu_);
       double spread = 0;
-      for (std::size_t k : owned_) spread += weights_[k] * (1 - weights_[k]);
+      for (std::size_t k : terms_->owned()) spread += weights_[k] * (1 - weights_[k]);
       votes_[me] = {spread, 0};
       zero_cut_.clear();
-      for (std::size_t k : owned_) {
+      for (std::size_t k : terms_->owned()) {
         const Measurement& m = in_.measurements[k];
         if (weights_[k] == 0 && in_.owner[m.i] != in_.owner[m.j])
           zero_cut_.push_back(in_.measurement_index[k]);
@@ -421,11 +347,11 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       to_others(st, false, [&](std::uint32_t a, RoundStatusMessage& s) {
         // The recipient's cut measurements this agent weighs, then (with weight 0) its other
         // cut measurements that leave the solve, for the recipient's block layout.
-        for (std::size_t k : owned_) {
+        for (std::size_t k : terms_->owned()) {
           const Measurement& m = in_.measurements[k];
           const auto other = static_cast<std::uint32_t>(in_.owner[std::max(m.i, m.j)]);
           const bool cut = in_.owner[m.i] != in_.owner[m.j];
-          if (other == a || (known_connected_ && cut && weights_[k] == 0)) {
+          if (other == a || (terms_->known_connected() && cut && weights_[k] == 0)) {
             s.measurement_ids.push_back(in_.measurement_index[k]);
             s.weights.push_back(weights_[k]);
           }
@@ -435,7 +361,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     }
     case Step::kRejected: {
       rejected_.clear();
-      for (std::size_t k : owned_)
+      for (std::size_t k : terms_->owned())
         if (weights_[k] < 0.5) rejected_.push_back(in_.measurement_index[k]);
       RoundStatusMessage st;
       st.measurement_ids = rejected_;
@@ -449,11 +375,11 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // (weight 0). Each pass is a descent step of the TLS cost (binary weights given the poses).
       taken_back_.clear();
       cut_now_.clear();
-      for (std::size_t k : owned_) {
-        if (!may_reject(k)) continue;
+      for (std::size_t k : terms_->owned()) {
+        if (!terms_->may_reject(k)) continue;
         const std::uint64_t id = in_.measurement_index[k];
         const bool was_rejected = std::binary_search(rejected_.begin(), rejected_.end(), id);
-        const bool fits = residual_squared_at(k) <= c2_;
+        const bool fits = residual_squared_at(k) <= terms_->c2();
         if (was_rejected && fits) taken_back_.push_back(id);
         if (!was_rejected && !fits) cut_now_.push_back(id);
       }
@@ -475,7 +401,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
 void GncAgent::require_kept_connected() const {
   // The kept set must connect every pose (every agent checks the same set).
   const std::size_t parts =
-      components_without(in_.num_poses, in_.d, in_.structure, rejected_, false, known_);
+      components_without(in_.num_poses, in_.d, in_.structure, rejected_, false, terms_->known());
   if (parts > 1)
     throw InputError("robust solve: " + std::to_string(rejected_.size()) + " of " +
                      std::to_string(in_.structure.size()) +
@@ -495,7 +421,7 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
       kept_index_.push_back(in_.measurement_index[k]);
     }
   auto layout = std::make_unique<BlockLayout>(
-      make_block_layout(in_.num_poses, without(in_.structure, rejected_), in_.owner));
+      make_block_layout(in_.num_poses, structure_without(in_.structure, rejected_), in_.owner));
   // The state refers to the layout: keep the iterate, then replace both.
   in_.Y0 = state_->Y;
   solve_.reset();
@@ -546,7 +472,7 @@ void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
   // They leave the solves (the known inliers connect the poses): the layout without them.
   std::sort(zero_cut_.begin(), zero_cut_.end());
   layout_ = std::make_unique<BlockLayout>(
-      make_block_layout(in_.num_poses, without(in_.structure, zero_cut_), in_.owner));
+      make_block_layout(in_.num_poses, structure_without(in_.structure, zero_cut_), in_.owner));
 }
 
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
@@ -636,7 +562,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       voted_ = true;
       double max_r2 = 0;
       for (const auto& [sender, v] : votes_) max_r2 = std::max(max_r2, v.first);
-      mu_ = gnc_initial_mu(max_r2, c2_);
+      mu_ = gnc_initial_mu(max_r2, terms_->c2());
       converged_ = mu_ == 0;
       begin_exchange(converged_ ? Step::kRejected : Step::kWeights, out);
       return;
@@ -648,11 +574,11 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
       converged_ = spread <= options_.robust.weight_tolerance;
       mu_ *= options_.robust.mu_step;
-      if (known_connected_) {
+      if (terms_->known_connected()) {
         // This step's block layout: without the cut measurements of weight 0 (every agent's).
         std::sort(zero_cut_.begin(), zero_cut_.end());
-        auto layout = std::make_unique<BlockLayout>(
-            make_block_layout(in_.num_poses, without(in_.structure, zero_cut_), in_.owner));
+        auto layout = std::make_unique<BlockLayout>(make_block_layout(
+            in_.num_poses, structure_without(in_.structure, zero_cut_), in_.owner));
         in_.Y0 = state_->Y;
         solve_.reset();
         state_.reset();
@@ -694,9 +620,9 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
         PoseGraph chains = graph;
         chains.measurements.clear();
         for (std::size_t e = 0; e < graph.measurements.size(); ++e)
-          if (known_[e]) chains.measurements.push_back(graph.measurements[e]);
-        const PairwiseConsistencyResult pcm =
-            pairwise_consistency(graph, known_, distributed_initialization(chains, 1), c2_);
+          if (terms_->known()[e]) chains.measurements.push_back(graph.measurements[e]);
+        const PairwiseConsistencyResult pcm = pairwise_consistency(
+            graph, terms_->known(), distributed_initialization(chains, 1), terms_->c2());
         const std::vector<std::uint64_t> ids(pcm.inconsistent.begin(), pcm.inconsistent.end());
         RoundStatusMessage st;
         st.sender = 0;
@@ -832,12 +758,12 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
                                std::to_string(sender));
     for (std::size_t q = 0; q < block->pose_ids.size(); ++q) {
       const auto p = static_cast<std::size_t>(block->pose_ids[q]);
-      const auto s = std::lower_bound(base_neighbours_.begin(), base_neighbours_.end(), p);
-      if (s == base_neighbours_.end() || *s != p)
+      const auto s = std::lower_bound(terms_->neighbours().begin(), terms_->neighbours().end(), p);
+      if (s == terms_->neighbours().end() || *s != p)
         throw std::runtime_error(me + "pose " + std::to_string(p) + " from agent " +
                                  std::to_string(sender) + " is not a neighbour");
       Eigen::MatrixXd& into = block->kind == BlockKind::kP ? candidate_neighbours_ : neighbours_;
-      std::memcpy(into.data() + w * (s - base_neighbours_.begin()),
+      std::memcpy(into.data() + w * (s - terms_->neighbours().begin()),
                   block->data.data() + w * static_cast<Eigen::Index>(q),
                   sizeof(double) * static_cast<std::size_t>(w));
     }

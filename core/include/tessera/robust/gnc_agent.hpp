@@ -126,12 +126,16 @@ struct GncAgentInput {
   bool pcm = false;
 };
 
+class GncLocalTerms;  // internal: the TLS math over one agent's view
+
 class GncAgent : public AgentProcess {
  public:
   /// `options` must outlive the agent. With `final_solve` false the agent is done before the
   /// certified solve of the kept set (the caller runs it, or uses the last inlier pass).
   GncAgent(GncAgentInput input, const GncDistributedOptions& options, bool final_solve = true);
   ~GncAgent() override;
+  GncAgent(const GncAgent&) = delete;  // its parts refer to its input
+  GncAgent& operator=(const GncAgent&) = delete;
 
   std::vector<OutgoingMessage> start() override;
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
@@ -155,7 +159,7 @@ class GncAgent : public AgentProcess {
   /// Kept by GNC, rejected by a pass (beyond the bound at the kept set's solution).
   std::size_t late_rejected() const { return late_rejected_; }
   bool weights_converged() const { return converged_; }
-  double threshold_squared() const { return c2_; }
+  double threshold_squared() const;
   /// Rounds of the solves before the final certified one (first, weighted, inlier passes).
   int gnc_rounds() const { return gnc_rounds_; }
   /// The own block at the start of the last inlier pass (what the caller of an agent without
@@ -205,11 +209,8 @@ class GncAgent : public AgentProcess {
   std::uint32_t exchange_phase() const;
   bool in_current_solve(std::uint32_t phase) const;
   double residual_squared_at(std::size_t k) const;
-  double residual_squared_at(std::size_t k, const Eigen::MatrixXd& own,
-                             const Eigen::MatrixXd& neighbours) const;
   void publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
                std::vector<OutgoingMessage>& out);
-  bool may_reject(std::size_t k) const;
   void weights_at_mu(double mu);
   void require_kept_connected() const;  // throws InputError naming the parts left
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
@@ -217,7 +218,6 @@ class GncAgent : public AgentProcess {
   void start_kept_set(std::vector<OutgoingMessage>& out);
   void after_step_zero(std::vector<OutgoingMessage>& out);
   void drop_inconsistent(const std::vector<std::uint64_t>& ids);
-  double tls_term(std::size_t k, double r2) const;
 
   GncAgentInput in_;
   const GncDistributedOptions& options_;
@@ -241,21 +241,18 @@ class GncAgent : public AgentProcess {
   std::vector<std::uint64_t> taken_back_;  // the current re-check exchange's ids back in
   std::vector<std::uint64_t> cut_now_;     // and its ids newly out
   std::size_t late_rejected_ = 0;
-  std::vector<bool> known_;                   // per measurement of the whole graph
-  bool known_connected_ = false;              // the known inliers alone connect the poses
-  std::vector<std::uint64_t> zero_cut_;       // cut measurements of weight 0 (others' too)
-  std::unique_ptr<BlockLayout> base_;         // of every measurement: whose poses go where
-  std::vector<std::size_t> base_neighbours_;  // other ends of the own measurements, ascending
+  std::vector<std::uint64_t> zero_cut_;   // cut measurements of weight 0 (others' too)
+  std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where
+  std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view
   Eigen::MatrixXd last_pass_start_;
   Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
   std::vector<std::uint32_t> waiting_;                // senders the current exchange still lacks
-  std::vector<std::size_t> owned_;  // indices (into in_.measurements) this agent weighs
-  std::vector<double> weights_;     // per in_.measurements
-  Eigen::MatrixXd neighbours_;      // neighbours' public poses of the current iterate
+  std::vector<double> weights_;                       // per in_.measurements
+  Eigen::MatrixXd neighbours_;  // neighbours' public poses of the current iterate
   std::map<std::uint32_t, std::vector<ProtocolMessage>> later_;  // by phase
   // Sums of the current exchange (in agent-id order: own and received values kept by sender).
   std::map<std::uint32_t, std::pair<double, double>> votes_;
-  double mu_ = 0, c2_ = 0;
+  double mu_ = 0;
   int outer_ = 0;
   bool converged_ = false;
   std::vector<std::uint64_t> rejected_;
