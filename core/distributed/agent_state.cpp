@@ -6,6 +6,8 @@
 #include <tessera/distributed/agent_state.hpp>
 #include <utility>
 
+#include "distributed/pose_block_codec.hpp"
+
 namespace tessera {
 
 namespace {
@@ -140,46 +142,11 @@ PoseBlockMessage AgentState::publish(const Eigen::MatrixXd& X, BlockKind kind, i
                                      std::uint32_t round, std::uint32_t phase) const {
   const int k = layout_.adjacency_index(id_, recipient);
   if (k < 0) throw std::logic_error("AgentState::publish: recipient is not a neighbour block");
-  const auto& ids = layout_.public_to[static_cast<std::size_t>(id_)][static_cast<std::size_t>(k)];
-  const auto& own = layout_.poses[static_cast<std::size_t>(id_)];
-  const Eigen::Index w = (d_ + 1) * X.rows();
-  PoseBlockMessage m;
-  m.round = round;
-  m.sender = static_cast<std::uint32_t>(id_);
-  m.phase = phase;
-  m.kind = kind;
-  m.rank = static_cast<std::uint32_t>(X.rows());
-  m.dim = static_cast<std::uint32_t>(d_);
-  m.pose_ids.reserve(ids.size());
-  m.data.resize(ids.size() * static_cast<std::size_t>(w));
-  double* out = m.data.data();
-  for (std::size_t id : ids) {
-    const auto slot = std::lower_bound(own.begin(), own.end(), id) - own.begin();
-    m.pose_ids.push_back(static_cast<std::uint32_t>(id));
-    std::memcpy(out, X.data() + w * slot, sizeof(double) * static_cast<std::size_t>(w));
-    out += w;
-  }
-  return m;
+  return encode_public_poses(layout_, id_, static_cast<std::size_t>(k), d_, X, kind, round, phase);
 }
 
 void AgentState::absorb(const PoseBlockMessage& m, Eigen::MatrixXd& copy) const {
-  const Eigen::Index r = copy.rows();
-  const Eigen::Index w = (d_ + 1) * r;
-  if (m.rank != static_cast<std::uint32_t>(r) || m.dim != static_cast<std::uint32_t>(d_) ||
-      m.data.size() != m.pose_ids.size() * static_cast<std::size_t>(w))
-    throw std::runtime_error("agent " + std::to_string(id_) + ": pose message from agent " +
-                             std::to_string(m.sender) + " has the wrong shape");
-  const auto& nb = problem_.neighbors();
-  const double* in = m.data.data();
-  for (std::uint32_t id : m.pose_ids) {
-    auto it = std::lower_bound(nb.begin(), nb.end(), static_cast<std::size_t>(id));
-    if (it == nb.end() || *it != id)
-      throw std::runtime_error("agent " + std::to_string(id_) + ": pose " + std::to_string(id) +
-                               " from agent " + std::to_string(m.sender) + " is not a neighbour");
-    std::memcpy(copy.data() + w * (it - nb.begin()), in,
-                sizeof(double) * static_cast<std::size_t>(w));
-    in += w;
-  }
+  decode_neighbour_poses(m, problem_.neighbors(), d_, id_, copy);
 }
 
 void AgentState::set_point(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours) {

@@ -12,6 +12,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "distributed/measurement_block.hpp"
+#include "distributed/pose_block_codec.hpp"
 #include "robust/gnc_local_terms.hpp"
 
 namespace tessera {
@@ -71,28 +72,11 @@ double GncAgent::residual_squared_at(std::size_t k) const {
 
 void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
                        std::vector<OutgoingMessage>& out) {
-  const auto me = static_cast<std::uint32_t>(in_.id);
-  const Eigen::Index w = (in_.d + 1) * Y.rows();
-  const auto& own = base_->poses[me];
-  const auto& adjacent = base_->adjacent[me];
+  const auto& adjacent = base_->adjacent[static_cast<std::size_t>(in_.id)];
   for (std::size_t q = 0; q < adjacent.size(); ++q) {
-    PoseBlockMessage b;
-    b.sender = me;
-    b.phase = phase;
-    b.kind = kind;
-    b.rank = static_cast<std::uint32_t>(Y.rows());
-    b.dim = static_cast<std::uint32_t>(in_.d);
-    const auto& ids = base_->public_to[me][q];
-    b.data.resize(ids.size() * static_cast<std::size_t>(w));
-    double* to = b.data.data();
-    for (std::size_t id : ids) {
-      const auto s = std::lower_bound(own.begin(), own.end(), id) - own.begin();
-      b.pose_ids.push_back(static_cast<std::uint32_t>(id));
-      std::memcpy(to, Y.data() + w * s, sizeof(double) * static_cast<std::size_t>(w));
-      to += w;
-    }
     const auto to_agent = static_cast<std::uint32_t>(adjacent[q]);
-    out.push_back(OutgoingMessage{std::move(b), false, {to_agent}});
+    out.push_back(OutgoingMessage{
+        encode_public_poses(*base_, in_.id, q, in_.d, Y, kind, 0, phase), false, {to_agent}});
     waiting_.push_back(to_agent);  // one message from that neighbour per message sent
   }
 }
@@ -751,22 +735,11 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
   } else if (step_ == Step::kPoses || step_ == Step::kCandidatePoses ||
              step_ == Step::kStartPoses) {
     const auto* block = std::get_if<PoseBlockMessage>(&message);
-    const Eigen::Index w = (in_.d + 1) * neighbours_.rows();
-    if (!block || block->rank != static_cast<std::uint32_t>(neighbours_.rows()) ||
-        block->data.size() != block->pose_ids.size() * static_cast<std::size_t>(w))
-      throw std::runtime_error(me + "malformed robust pose message from agent " +
-                               std::to_string(sender));
-    for (std::size_t q = 0; q < block->pose_ids.size(); ++q) {
-      const auto p = static_cast<std::size_t>(block->pose_ids[q]);
-      const auto s = std::lower_bound(terms_->neighbours().begin(), terms_->neighbours().end(), p);
-      if (s == terms_->neighbours().end() || *s != p)
-        throw std::runtime_error(me + "pose " + std::to_string(p) + " from agent " +
-                                 std::to_string(sender) + " is not a neighbour");
-      Eigen::MatrixXd& into = block->kind == BlockKind::kP ? candidate_neighbours_ : neighbours_;
-      std::memcpy(into.data() + w * (s - terms_->neighbours().begin()),
-                  block->data.data() + w * static_cast<Eigen::Index>(q),
-                  sizeof(double) * static_cast<std::size_t>(w));
-    }
+    if (!block)
+      throw std::runtime_error(me + "a status where robust poses from agent " +
+                               std::to_string(sender) + " belong");
+    decode_neighbour_poses(*block, terms_->neighbours(), in_.d, in_.id,
+                           block->kind == BlockKind::kP ? candidate_neighbours_ : neighbours_);
   } else {
     const auto* st = std::get_if<RoundStatusMessage>(&message);
     if (!st) throw std::runtime_error(me + "poses where a robust status belongs");
