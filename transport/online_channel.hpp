@@ -31,10 +31,16 @@ struct OnlineReportSample {
   /// Agent 0's reports: the agents that take part in the next epoch (joiners admitted).
   std::vector<std::uint32_t> next_members;
   bool certify = false;  ///< Agent 0's reports: certify at this epoch.
+  /// Take-over votes (epoch kTakeoverEpoch): the agents the sender counts as lost and the
+  /// epoch it was in; `held` is then what entered its graph.
+  std::vector<std::uint32_t> lost;
+  std::uint32_t at_epoch = 0;
 };
 
 /// The epoch of a hello: an agent that is not a member yet asks to join.
 inline constexpr std::uint32_t kHelloEpoch = 0xFFFFFFFFu;
+/// The epoch of a take-over vote: a member was lost and the survivors agree on its block.
+inline constexpr std::uint32_t kTakeoverEpoch = 0xFFFFFFFEu;
 
 /// A protocol message as received, with its routing (ids are the epoch's protocol ids).
 struct OnlineProtocolSample {
@@ -71,6 +77,9 @@ class OnlineChannel {
   int matched_peers() const;
   /// Waits until every matched reader acknowledged what was sent, at most `timeout_s`.
   void flush(double timeout_s);
+  /// Agents (ids from their participant names) whose participant left or whose liveliness
+  /// lease expired since this channel started.
+  std::vector<std::uint32_t> lost_agents() const;
 
  private:
   struct Impl;
