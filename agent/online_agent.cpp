@@ -817,6 +817,7 @@ void OnlineAgent::take_over() {
       .add("noticed_at_s", at)
       .add("taken_over_at_s", since(start_))
       .add("epoch", static_cast<long long>(epoch_))
+      .add("total_poses", view_.stream() ? view_.stream()->graph().num_poses : std::size_t{0})
       .add("moved_poses", moves.moved)
       .add("cut_edges_after", moves.cut_after);
   faults_.push_back(std::move(f));
