@@ -471,25 +471,33 @@ void OnlineAgent::publish_estimate() {
   if (!stream || count_components(stream->graph()) != 1) return;  // no common frame yet
   const std::vector<Pose> poses = round_solution(stream->graph(), view_.iterate());
   const int d = stream->graph().d;
-  std::vector<std::uint64_t> index;
-  std::vector<double> data;
-  std::vector<Pose> mine;
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    if (stream->robot_of_pose()[k] != static_cast<std::uint32_t>(o_.id)) continue;
-    index.push_back(stream->key_of_pose()[k].index);
-    data.insert(data.end(), poses[k].R.data(), poses[k].R.data() + d * d);
-    data.insert(data.end(), poses[k].t.data(), poses[k].t.data() + d);
-    mine.push_back(poses[k]);
+  // This agent's robot, and the robots of lost agents whose blocks this agent adopted.
+  std::vector<std::uint32_t> robots = {static_cast<std::uint32_t>(o_.id)};
+  for (std::uint32_t r : view_.lost())
+    if (view_.own_block() >= 0 && view_.adopter(r) == view_.own_block()) robots.push_back(r);
+  bool any = false;
+  for (std::uint32_t robot : robots) {
+    std::vector<std::uint64_t> index;
+    std::vector<double> data;
+    std::vector<Pose> mine;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      if (stream->robot_of_pose()[k] != robot) continue;
+      index.push_back(stream->key_of_pose()[k].index);
+      data.insert(data.end(), poses[k].R.data(), poses[k].R.data() + d * d);
+      data.insert(data.end(), poses[k].t.data(), poses[k].t.data() + d);
+      mine.push_back(poses[k]);
+    }
+    if (mine.empty()) continue;
+    channel_.publish_estimate(epoch_, d, index, data, robot);
+    if (!o_.tum_dir.empty()) {
+      // Replaced whole: a reader never sees half a snapshot.
+      const std::string path = o_.tum_dir + "/robot" + std::to_string(robot) + ".tum";
+      write_tum(mine, path + ".part");
+      std::filesystem::rename(path + ".part", path);
+    }
+    any = true;
   }
-  if (mine.empty()) return;
-  channel_.publish_estimate(epoch_, d, index, data);
-  if (!o_.tum_dir.empty()) {
-    // Replaced whole: a reader never sees half a snapshot.
-    const std::string path = o_.tum_dir + "/robot" + std::to_string(o_.id) + ".tum";
-    write_tum(mine, path + ".part");
-    std::filesystem::rename(path + ".part", path);
-  }
-  ++publications_;
+  if (any) ++publications_;
 }
 
 int OnlineAgent::run() {

@@ -3,10 +3,12 @@
 // liveliness, the survivors take over its block and its robot's later batches, and the run
 // ends at the batch optimum of the whole graph, certified, with every pose; also when the lost
 // agent was the lead (agent 0). Survivors skip the solve of an epoch whose new data only
-// placed new poses (the "unchanged" shortcut). Domains used here: 110-111 (each test its own).
+// placed new poses (the "unchanged" shortcut). The lost robot's trajectory is written by the
+// survivor that adopted its block. Domains used here: 110-111 (each test its own).
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <thread>
@@ -65,6 +67,8 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim)
                           "60",
                           "--on-agent-loss",
                           "continue",
+                          "--tum-dir",
+                          dir + "/tum",
                           "--json",
                           dir + "/online.json",
                           "--keep-logs",
@@ -107,6 +111,11 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim)
   EXPECT_GT(number(json, "moved_poses", fault), 0);
   EXPECT_LT(number(json, "total_poses", fault), 300);
   EXPECT_GT(number(json, "total_poses", fault), 0);
+  // Every robot's trajectory is written at the end, the lost one's by its block's adopter.
+  for (int r = 0; r < 3; ++r) {
+    const std::string tum = read_text_file(dir + "/tum/robot" + std::to_string(r) + ".tum");
+    EXPECT_EQ(std::count(tum.begin(), tum.end(), '\n'), 100) << "robot " << r;
+  }
   // Epochs whose data only placed new poses cost no round (the shortcut over DDS).
   EXPECT_TRUE(contains(json, "\"rounds\": 0, ") && contains(json, "\"unchanged\""));
 }

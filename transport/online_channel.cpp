@@ -156,7 +156,9 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     eq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     eq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
     eq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-    eq.history().depth = 1;
+    // The newest of every robot this agent publishes (its own, and robots whose lost agents'
+    // blocks it adopted) stays for late readers.
+    eq.history().depth = static_cast<std::int32_t>(std::max<std::uint32_t>(1, agents));
     eq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
     estimate_writer = estimates ? publisher->create_datawriter(estimates, eq) : nullptr;
     if (!estimate_writer)
@@ -278,10 +280,10 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
 
 void OnlineChannel::publish_estimate(std::uint32_t epoch, int d,
                                      const std::vector<std::uint64_t>& index,
-                                     const std::vector<double>& poses) {
+                                     const std::vector<double>& poses, std::uint32_t robot) {
   wire::FinalEstimate w;
   w.run_id(impl_->run_id);
-  w.sender(impl_->agent);
+  w.sender(robot == kOwnRobot ? impl_->agent : robot);
   w.dim(static_cast<std::uint32_t>(d));
   w.epoch(epoch);
   for (std::uint64_t k : index) w.pose_ids().push_back(static_cast<std::uint32_t>(k));

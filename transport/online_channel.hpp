@@ -64,10 +64,12 @@ class OnlineChannel {
   std::size_t send(const OutgoingMessage& m, std::uint32_t epoch);
   /// Sends a report; returns its serialized size in bytes.
   std::size_t send_report(const OnlineReportSample& r);
-  /// Publishes this agent's robot's current estimate: pose indices and [R | t] (d*(d+1)
+  /// Publishes a robot's current estimate (this agent's robot unless `robot` says which: a
+  /// lost agent's robot whose block this agent adopted): pose indices and [R | t] (d*(d+1)
   /// values per pose, column-major).
   void publish_estimate(std::uint32_t epoch, int d, const std::vector<std::uint64_t>& index,
-                        const std::vector<double>& poses);
+                        const std::vector<double>& poses, std::uint32_t robot = kOwnRobot);
+  static constexpr std::uint32_t kOwnRobot = 0xFFFFFFFFu;
   /// Blocks until something arrived since the last take (or `timeout_s` passed).
   bool wait(double timeout_s);
   std::vector<OnlineReportSample> take_reports();

@@ -150,6 +150,11 @@ RebalanceResult OnlineAgentView::rebalance_live_blocks() {
   return r;
 }
 
+int OnlineAgentView::adopter(std::uint32_t robot) const {
+  auto it = adopter_.find(robot);
+  return it == adopter_.end() ? -1 : it->second;
+}
+
 Watermarks OnlineAgentView::entered() const {
   Watermarks out;
   if (!stream_) return out;

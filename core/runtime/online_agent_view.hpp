@@ -67,6 +67,8 @@ class OnlineAgentView {
   TakeoverMoves take_over(const std::set<std::uint32_t>& lost);
   /// Robots whose agents were lost (their blocks are empty, their data goes to adopters).
   const std::set<std::uint32_t>& lost() const { return lost_; }
+  /// The block that takes lost robot `robot`'s poses, -1 when none has yet.
+  int adopter(std::uint32_t robot) const;
   /// Writes a peer's block (stream ids, r*(d+1) values per pose) into the iterate; a larger
   /// rank (the final staircase) widens it.
   void apply_block(const std::vector<std::uint32_t>& ids, const std::vector<double>& data,
