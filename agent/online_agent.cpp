@@ -268,6 +268,11 @@ void OnlineAgent::pump_channel() {
       seen_.insert(r.sender);
     if (r.epoch == transport::kHelloEpoch) continue;
     if (r.epoch == transport::kTakeoverEpoch) {
+      // Counted lost: a live member whose lease lapsed, or a process started again with the
+      // id of an agent whose block was taken over (the votes are kept for late readers).
+      if (std::find(r.lost.begin(), r.lost.end(), static_cast<std::uint32_t>(o_.id)) !=
+          r.lost.end())
+        counted_lost();
       // Votes about losses already taken over are late copies.
       if (std::any_of(r.lost.begin(), r.lost.end(),
                       [&](std::uint32_t a) { return dead_.count(a) == 0; }))
@@ -565,6 +570,10 @@ bool OnlineAgent::epoch_step() {
       }
       std::set<std::uint32_t> next = members();
       next.insert(seen_.begin(), seen_.end());
+      // An agent that said hello and died before it was admitted is not admitted.
+      if (o_.continue_on_loss)
+        for (std::uint32_t a : channel_.lost_agents())
+          if (members().count(a) == 0) next.erase(a);
       mine.next_members.assign(next.begin(), next.end());
     }
     report_bytes_ += channel_.send_report(mine);

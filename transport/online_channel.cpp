@@ -77,8 +77,9 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
         dds::DomainParticipant*,
         eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
       using Info = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
-      if (info.status != Info::REMOVED_PARTICIPANT && info.status != Info::DROPPED_PARTICIPANT)
-        return;
+      const bool gone =
+          info.status == Info::REMOVED_PARTICIPANT || info.status == Info::DROPPED_PARTICIPANT;
+      if (!gone && info.status != Info::DISCOVERED_PARTICIPANT) return;
       const std::string name = info.info.m_participantName.to_string();
       const std::string prefix = "tessera-online:" + impl->run_id + ":";
       if (name.compare(0, prefix.size(), prefix) != 0) return;
@@ -86,7 +87,12 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       if (id.empty() || id.size() > 9 || id.find_first_not_of("0123456789") != std::string::npos)
         return;
       std::lock_guard<std::mutex> lock(impl->mutex);
-      impl->lost.insert(static_cast<std::uint32_t>(std::stoul(id)));
+      // A participant of that agent discovered again (a process started again, or a live one
+      // the lease dropped) is not lost any more.
+      if (gone)
+        impl->lost.insert(static_cast<std::uint32_t>(std::stoul(id)));
+      else
+        impl->lost.erase(static_cast<std::uint32_t>(std::stoul(id)));
       impl->available = true;
       impl->cv.notify_all();
     }

@@ -80,7 +80,7 @@ class OnlineChannel {
   /// Waits until every matched reader acknowledged what was sent, at most `timeout_s`.
   void flush(double timeout_s);
   /// Agents (ids from their participant names) whose participant left or whose liveliness
-  /// lease expired since this channel started.
+  /// lease expired, and that were not discovered again since.
   std::vector<std::uint32_t> lost_agents() const;
 
  private:
