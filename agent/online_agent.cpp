@@ -23,10 +23,10 @@
 #include <tessera/util/input_error.hpp>
 #include <utility>
 
+#include "agent/takeover_vote.hpp"
 #include "arguments.hpp"
 #include "json_writer.hpp"
 #include "runtime/online_agent_view.hpp"
-#include "runtime/takeover_agreement.hpp"
 #include "transport/fastdds/teardown_guard.hpp"
 #include "transport/graph_stream_topic.hpp"
 #include "transport/online_channel.hpp"
@@ -749,72 +749,36 @@ void OnlineAgent::wait_to_hold(const Watermarks& decision) {
 void OnlineAgent::take_over() {
   const auto me = static_cast<std::uint32_t>(o_.id);
   const double at = since(start_);
-  runtime::TakeoverAgreement agreement(members(), me);
-  std::map<std::uint32_t, transport::OnlineReportSample> votes;
-  auto read_votes = [&] {
-    bool grew = false;
-    for (auto& v : votes_) {
-      runtime::TakeoverVote t;
-      t.sender = v.sender;
-      t.lost = std::set<std::uint32_t>(v.lost.begin(), v.lost.end());
-      t.at_epoch = v.at_epoch;
-      t.entered = v.held;
-      grew = agreement.vote(t) || grew;
-      votes[v.sender] = std::move(v);
-    }
-    votes_.clear();
-    const auto seen = channel_.lost_agents();
-    grew = agreement.suspect(std::set<std::uint32_t>(seen.begin(), seen.end())) || grew;
-    if (agreement.counts_me_lost()) counted_lost();
-    return grew;
-  };
-  read_votes();
-  auto last_progress = Clock::now();
-  for (bool vote = true;; vote = read_votes()) {
-    if (vote) {
-      // This agent's vote: what it counts as lost, where it was, its graph and its block.
-      transport::OnlineReportSample mine;
-      mine.epoch = transport::kTakeoverEpoch;
-      mine.sender = me;
-      mine.held = view_.entered();
-      mine.rank = own_rank_;
-      mine.dim = view_.dim();
-      mine.pose_ids = own_ids_;
-      mine.data = own_data_;
-      mine.lost.assign(agreement.lost().begin(), agreement.lost().end());
-      mine.at_epoch = epoch_;
-      report_bytes_ += channel_.send_report(mine);
-      votes_.push_back(std::move(mine));
-      read_votes();
-      last_progress = Clock::now();
-    }
-    if (agreement.complete()) break;
-    if (since(last_progress) > o_.timeout_s) {
-      std::string missing;
-      for (std::uint32_t a : agreement.survivors())
-        if (votes.count(a) == 0) missing += (missing.empty() ? "" : ",") + std::to_string(a);
-      silent_peer("no take-over vote from agent " + missing);
-    }
-    channel_.wait(0.05);
+  OwnVote mine;
+  mine.me = me;
+  mine.epoch = epoch_;
+  mine.entered = view_.entered();
+  mine.rank = own_rank_;
+  mine.dim = view_.dim();
+  mine.pose_ids = own_ids_;
+  mine.data = own_data_;
+  const TakeoverVoteOutcome vote = hold_takeover_vote(channel_, members(), mine, o_.timeout_s, [&] {
     pump_channel();
     pump_stream();
-  }
+    std::vector<transport::OnlineReportSample> v;
+    v.swap(votes_);
+    return v;
+  });
+  report_bytes_ += vote.bytes_sent;
   // The survivors are at most one epoch boundary apart: the ones behind enter what the one
   // ahead entered, so all hold the same graph before the blocks move.
-  const Watermarks target = agreement.entered();
+  const Watermarks target = vote.entered;
   wait_to_hold(target);
   view_.enter(target);
-  for (std::uint32_t a : agreement.survivors()) {
-    const auto& v = votes.at(a);
+  for (const auto& [a, v] : vote.votes)
     if (a != me && v.dim != 0) view_.apply_block(v.pose_ids, v.data, v.rank);
-  }
-  const runtime::TakeoverMoves moves = view_.take_over(agreement.lost());
-  const std::set<std::uint32_t> survivors = agreement.survivors();
-  dead_.insert(agreement.lost().begin(), agreement.lost().end());
+  const runtime::TakeoverMoves moves = view_.take_over(vote.lost);
+  const std::set<std::uint32_t>& survivors = vote.survivors;
+  dead_.insert(vote.lost.begin(), vote.lost.end());
   for (std::uint32_t a : dead_) seen_.erase(a);
   // The run goes on at an epoch no survivor has used: leftovers of the abandoned one (its
   // messages, reports, the lead's admissions) are dropped.
-  epoch_ = agreement.next_epoch();
+  epoch_ = vote.next_epoch;
   floor_ = epoch_;
   members_.erase(members_.begin(), members_.lower_bound(epoch_));
   members_[epoch_] = survivors;
@@ -825,7 +789,7 @@ void OnlineAgent::take_over() {
                  pending_.end());
   converged_ = false;  // the blocks changed: solve again
   finishing_ = false;  // a final solve the loss interrupted runs again
-  std::vector<std::size_t> lost_ids(agreement.lost().begin(), agreement.lost().end());
+  std::vector<std::size_t> lost_ids(vote.lost.begin(), vote.lost.end());
   std::vector<std::size_t> survivor_ids(survivors.begin(), survivors.end());
   cli::JsonObject f;
   f.add("kind", "lost_for_good")
