@@ -61,9 +61,10 @@ options:
   --on-agent-loss A   what a member whose DDS liveliness lapsed does to the run: stop
                       (the others stop after --timeout, naming it) or continue (the
                       survivors take over its block and its robot's stream)  [stop]
-  --json FILE         write this agent's summary (agent 0's has the final answer)
+  --json FILE         write this agent's summary (the lead's has the final answer: agent
+                      0's, or after its loss the lowest surviving agent's)
   --certify-iters K   certificate iteration cap (LOBPCG)               [300]
-  --certify-every S   also certify the graph received so far every S seconds (agent 0's
+  --certify-every S   also certify the graph received so far every S seconds (the lead's
                       clock; at the next epoch that brought data, once the graph is
                       connected; no staircase climb)                  [0 = off]
   --publish-every S   publish this robot's current estimate (rounded to SE(d)) on topic
