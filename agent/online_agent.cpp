@@ -23,6 +23,7 @@
 #include <tessera/util/input_error.hpp>
 #include <utility>
 
+#include "agent/takeover_vote.hpp"
 #include "arguments.hpp"
 #include "json_writer.hpp"
 #include "runtime/online_agent_view.hpp"
@@ -57,9 +58,13 @@ options:
   --max-rounds K      rounds per solve at most                       [10000]
   --no-certify        no certificate at the end
   --timeout S         give up when a peer sends nothing for S seconds [120]
-  --json FILE         write this agent's summary (agent 0's has the final answer)
+  --on-agent-loss A   what a member whose DDS liveliness lapsed does to the run: stop
+                      (the others stop after --timeout, naming it) or continue (the
+                      survivors take over its block and its robot's stream)  [stop]
+  --json FILE         write this agent's summary (the lead's has the final answer: agent
+                      0's, or after its loss the lowest surviving agent's)
   --certify-iters K   certificate iteration cap (LOBPCG)               [300]
-  --certify-every S   also certify the graph received so far every S seconds (agent 0's
+  --certify-every S   also certify the graph received so far every S seconds (the lead's
                       clock; at the next epoch that brought data, once the graph is
                       connected; no staircase climb)                  [0 = off]
   --publish-every S   publish this robot's current estimate (rounded to SE(d)) on topic
@@ -69,7 +74,8 @@ options:
   --verbose           print each epoch (members, what entered, solve or idle)
   --help              this text
 
-exit codes: 0 done, 1 the run failed (a peer went silent), 2 bad options or input.
+exit codes: 0 done, 1 the run failed (a peer went silent, or this agent was counted lost and
+its block taken over), 2 bad options or input.
 )";
 
 using Clock = std::chrono::steady_clock;
@@ -88,6 +94,7 @@ struct Options {
   int domain = 0;
   OnlineOptions online;
   double timeout_s = 120.0;
+  bool continue_on_loss = false;
   std::string json;
   bool verbose = false;
   double certify_every_s = 0.0;
@@ -99,7 +106,7 @@ Options parse(const std::vector<std::string>& argv) {
   const cli::Arguments args(
       argv,
       {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol", "max-rounds", "timeout",
-       "json", "certify-every", "certify-iters", "publish-every", "tum-dir"},
+       "json", "certify-every", "certify-iters", "publish-every", "tum-dir", "on-agent-loss"},
       {"online", "no-certify", "verbose", "help"});
   Options o;
   const auto run_id = args.get("run-id");
@@ -126,6 +133,10 @@ Options parse(const std::vector<std::string>& argv) {
       static_cast<int>(args.get_long("certify-iters", s.staircase.certificate.max_iterations));
   o.timeout_s = args.get_double("timeout", 120.0);
   if (!(o.timeout_s > 0)) throw InputError("option --timeout: must be > 0");
+  const std::string loss = args.get_or("on-agent-loss", "stop");
+  if (loss != "stop" && loss != "continue")
+    throw InputError("option --on-agent-loss: '" + loss + "' is not one of stop, continue");
+  o.continue_on_loss = loss == "continue";
   o.json = args.get_or("json", "");
   o.verbose = args.has("verbose");
   o.certify_every_s = args.get_double("certify-every", 0.0);
@@ -143,6 +154,11 @@ double percentile(std::vector<double> v, double q) {
   const std::size_t k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
   return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
 }
+
+// Thrown out of a wait when a member was lost (or a survivor voted so) and the run goes on
+// without it (--on-agent-loss continue): the epoch is abandoned and the survivors agree on
+// the take-over (OnlineAgent::take_over).
+struct TakeoverNeeded {};
 
 // The outcome of one solve of the epoch's graph by this agent's block.
 struct SolveOutcome {
@@ -172,9 +188,26 @@ class OnlineAgent {
   void wait_for_reports();
   bool reports_complete();
   void wait_matched(std::size_t peers);
-  /// The agents that take part in the current epoch (agent 0's previous report says so).
+  /// The agents that take part in the current epoch (the lead's previous report says so).
   const std::set<std::uint32_t>& members() const;
+  /// The member that admits joiners, asks for certificates and writes the answer: the lowest
+  /// member of `epoch` (agent 0 unless it was lost).
+  std::uint32_t lead_of(std::uint32_t epoch) const;
+  /// Throws TakeoverNeeded when --on-agent-loss continue and a member was lost.
+  void check_losses();
+  /// The survivors agree on what was lost, reach the same graph and move the lost blocks.
+  void take_over();
+  [[noreturn]] void counted_lost() const;
+  void keep_own_poses(const AgentState& state, const std::vector<std::size_t>& ids);
   SolveOutcome solve(bool certify, bool climb = true);
+  /// The round protocol of the epoch's solve, until `agent` is done.
+  void solve_rounds(CertifiedAgent& agent, std::uint32_t me);
+  /// One epoch: report, agree, enter, solve or idle. Returns false once the run is over.
+  bool epoch_step();
+  /// Whether `robot`'s batches may enter: its agent is a member, or it was lost and its
+  /// block's adopter absorbs them.
+  bool absorbs(std::uint32_t robot) const;
+  void wait_to_hold(const Watermarks& decision);
   void publish_estimate();
   void send(const std::vector<OutgoingMessage>& out, std::uint32_t epoch);
   void write_json(bool lead_result);
@@ -194,6 +227,11 @@ class OnlineAgent {
   std::map<std::uint32_t, std::map<std::uint32_t, transport::OnlineReportSample>> reports_;
   std::map<std::uint32_t, std::set<std::uint32_t>> members_{{0, {0}}};
   std::set<std::uint32_t> seen_;  // agents heard from (hello or report)
+  std::set<std::uint32_t> dead_;  // members lost and taken over
+  std::uint32_t floor_ = 0;       // reports of epochs below it belong to an abandoned epoch
+  std::vector<transport::OnlineReportSample> votes_;  // take-over votes not yet read
+  std::vector<cli::JsonObject> faults_;
+  bool finishing_ = false;
   double next_certificate_ = 0.0, last_publish_ = -1e300;
   bool changed_since_certificate_ = false;
   std::vector<cli::JsonObject> certificates_;
@@ -209,6 +247,7 @@ class OnlineAgent {
   double cpu_s_ = 0.0;
   SolveOutcome final_;
   double cost_ = 0.0;
+  double last_grad_norm_ = 0.0;
   bool have_cost_ = false;
 };
 
@@ -226,9 +265,23 @@ void OnlineAgent::pump_stream() {
 
 void OnlineAgent::pump_channel() {
   for (auto& r : channel_.take_reports()) {
-    if (r.sender < static_cast<std::uint32_t>(o_.robots)) seen_.insert(r.sender);
+    if (r.sender < static_cast<std::uint32_t>(o_.robots) && dead_.count(r.sender) == 0)
+      seen_.insert(r.sender);
     if (r.epoch == transport::kHelloEpoch) continue;
-    if (r.sender == 0)
+    if (r.epoch == transport::kTakeoverEpoch) {
+      // Counted lost: a live member whose lease lapsed, or a process started again with the
+      // id of an agent whose block was taken over (the votes are kept for late readers).
+      if (std::find(r.lost.begin(), r.lost.end(), static_cast<std::uint32_t>(o_.id)) !=
+          r.lost.end())
+        counted_lost();
+      // Votes about losses already taken over are late copies.
+      if (std::any_of(r.lost.begin(), r.lost.end(),
+                      [&](std::uint32_t a) { return dead_.count(a) == 0; }))
+        votes_.push_back(std::move(r));
+      continue;
+    }
+    if (r.epoch < floor_) continue;  // an epoch abandoned at a take-over
+    if (r.sender == lead_of(r.epoch))
       members_[r.epoch + 1] = std::set<std::uint32_t>(r.next_members.begin(), r.next_members.end());
     if (r.epoch >= epoch_) reports_[r.epoch][r.sender] = std::move(r);
   }
@@ -238,6 +291,25 @@ void OnlineAgent::pump_channel() {
 
 const std::set<std::uint32_t>& OnlineAgent::members() const {
   return members_.at(epoch_);
+}
+
+std::uint32_t OnlineAgent::lead_of(std::uint32_t epoch) const {
+  auto it = members_.find(epoch);
+  return it == members_.end() || it->second.empty() ? 0 : *it->second.begin();
+}
+
+void OnlineAgent::check_losses() {
+  if (!o_.continue_on_loss || members().count(static_cast<std::uint32_t>(o_.id)) == 0) return;
+  if (!votes_.empty()) throw TakeoverNeeded{};
+  for (std::uint32_t a : channel_.lost_agents())
+    if (members().count(a) > 0 && a != static_cast<std::uint32_t>(o_.id)) throw TakeoverNeeded{};
+}
+
+[[noreturn]] void OnlineAgent::counted_lost() const {
+  throw transport::TransportError(
+      "online agent " + std::to_string(o_.id) +
+      " was counted as lost by the survivors (its liveliness lapsed): its block was taken over "
+      "and the run goes on without it");
 }
 
 bool OnlineAgent::reports_complete() {
@@ -256,6 +328,10 @@ void OnlineAgent::wait_for_reports() {
     channel_.wait(0.05);
     pump_channel();
     pump_stream();
+    // A member that finished the run leaves after its last report arrived: only a report
+    // still missing after the pump makes its absence a loss.
+    if (reports_complete()) break;
+    check_losses();
     if (reports_[epoch_].size() != have) {
       have = reports_[epoch_].size();
       last_progress = Clock::now();
@@ -272,6 +348,7 @@ void OnlineAgent::wait_for_reports() {
 void OnlineAgent::wait_matched(std::size_t peers) {
   const auto start = Clock::now();
   while (channel_.matched_peers() < static_cast<int>(peers)) {
+    check_losses();
     if (since(start) > o_.timeout_s) silent_peer("peers not all matched");
     channel_.wait(0.01);
     pump_channel();
@@ -306,11 +383,30 @@ SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
   // rank for the next data (a saddle is reported as not certified).
   if (!climb) solver.staircase.max_rank = solver.rank;
   const BlockLayout& layout = live_->layout();
-  const Eigen::Index w = live_->graph().d + 1;
   const auto& ids = layout.poses[static_cast<std::size_t>(c)];
   AgentState& state = *live_->states()[static_cast<std::size_t>(c)];
   CertifiedAgent agent(state, layout, solver);
   const auto me = static_cast<std::uint32_t>(c);
+  try {
+    solve_rounds(agent, me);
+  } catch (const TakeoverNeeded&) {
+    // The iterate so far is a valid point of the problem: the take-over starts from it.
+    keep_own_poses(state, ids);
+    throw;
+  }
+  keep_own_poses(state, ids);
+  out.rounds = agent.total_rounds();
+  const auto& last = agent.solves().back();
+  out.stop_reason = last.stop_reason;
+  out.grad_norm = last.trace.empty() ? 0.0 : last.trace.back().grad_norm;
+  if (!last.trace.empty()) out.relaxation_cost = last.trace.back().cost;
+  out.certified = agent.certified();
+  if (!agent.certificates().empty())
+    out.min_eigenvalue = agent.certificates().back().result.min_eigenvalue;
+  return out;
+}
+
+void OnlineAgent::solve_rounds(CertifiedAgent& agent, std::uint32_t me) {
   send(agent.start(), epoch_);
   auto last_message = Clock::now();
   while (!agent.done()) {
@@ -341,6 +437,7 @@ SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
       last_message = Clock::now();
       continue;
     }
+    check_losses();
     channel_.wait(0.02);
     pump_channel();
     pump_stream();
@@ -357,7 +454,12 @@ SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
       silent_peer("no protocol message" + missing);
     }
   }
+}
+
+void OnlineAgent::keep_own_poses(const AgentState& state, const std::vector<std::size_t>& ids) {
   // This agent's poses go out with the next report (the estimate made whole everywhere).
+  const Eigen::Index w = live_->graph().d + 1;
+  own_ids_.clear();
   own_rank_ = state.rank();
   const std::size_t per_pose = static_cast<std::size_t>(own_rank_ * w);
   own_data_.resize(ids.size() * per_pose);
@@ -367,15 +469,6 @@ SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
         state.Y.middleCols(w * static_cast<Eigen::Index>(s), w);
   }
   view_.apply_block(own_ids_, own_data_, own_rank_);
-  out.rounds = agent.total_rounds();
-  const auto& last = agent.solves().back();
-  out.stop_reason = last.stop_reason;
-  out.grad_norm = last.trace.empty() ? 0.0 : last.trace.back().grad_norm;
-  if (!last.trace.empty()) out.relaxation_cost = last.trace.back().cost;
-  out.certified = agent.certified();
-  if (!agent.certificates().empty())
-    out.min_eigenvalue = agent.certificates().back().result.min_eigenvalue;
-  return out;
 }
 
 void OnlineAgent::publish_estimate() {
@@ -384,25 +477,33 @@ void OnlineAgent::publish_estimate() {
   if (!stream || count_components(stream->graph()) != 1) return;  // no common frame yet
   const std::vector<Pose> poses = round_solution(stream->graph(), view_.iterate());
   const int d = stream->graph().d;
-  std::vector<std::uint64_t> index;
-  std::vector<double> data;
-  std::vector<Pose> mine;
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    if (stream->robot_of_pose()[k] != static_cast<std::uint32_t>(o_.id)) continue;
-    index.push_back(stream->key_of_pose()[k].index);
-    data.insert(data.end(), poses[k].R.data(), poses[k].R.data() + d * d);
-    data.insert(data.end(), poses[k].t.data(), poses[k].t.data() + d);
-    mine.push_back(poses[k]);
+  // This agent's robot, and the robots of lost agents whose blocks this agent adopted.
+  std::vector<std::uint32_t> robots = {static_cast<std::uint32_t>(o_.id)};
+  for (std::uint32_t r : view_.lost())
+    if (view_.own_block() >= 0 && view_.adopter(r) == view_.own_block()) robots.push_back(r);
+  bool any = false;
+  for (std::uint32_t robot : robots) {
+    std::vector<std::uint64_t> index;
+    std::vector<double> data;
+    std::vector<Pose> mine;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      if (stream->robot_of_pose()[k] != robot) continue;
+      index.push_back(stream->key_of_pose()[k].index);
+      data.insert(data.end(), poses[k].R.data(), poses[k].R.data() + d * d);
+      data.insert(data.end(), poses[k].t.data(), poses[k].t.data() + d);
+      mine.push_back(poses[k]);
+    }
+    if (mine.empty()) continue;
+    channel_.publish_estimate(epoch_, d, index, data, robot);
+    if (!o_.tum_dir.empty()) {
+      // Replaced whole: a reader never sees half a snapshot.
+      const std::string path = o_.tum_dir + "/robot" + std::to_string(robot) + ".tum";
+      write_tum(mine, path + ".part");
+      std::filesystem::rename(path + ".part", path);
+    }
+    any = true;
   }
-  if (mine.empty()) return;
-  channel_.publish_estimate(epoch_, d, index, data);
-  if (!o_.tum_dir.empty()) {
-    // Replaced whole: a reader never sees half a snapshot.
-    const std::string path = o_.tum_dir + "/robot" + std::to_string(o_.id) + ".tum";
-    write_tum(mine, path + ".part");
-    std::filesystem::rename(path + ".part", path);
-  }
-  ++publications_;
+  if (any) ++publications_;
 }
 
 int OnlineAgent::run() {
@@ -418,180 +519,16 @@ int OnlineAgent::run() {
     hello.sender = me;
     report_bytes_ += channel_.send_report(hello);
   }
-  bool finishing = false;
   for (;;) {
-    pump_stream();
-    pump_channel();
-    const bool member = members().count(me) > 0;
-    if (member) {
-      wait_matched(members().size());
-      transport::OnlineReportSample mine;
-      mine.epoch = epoch_;
-      mine.sender = me;
-      mine.held = view_.held();
-      mine.converged = converged_;
-      mine.rank = own_rank_;
-      mine.dim = view_.dim();
-      mine.pose_ids = own_ids_;
-      mine.data = own_data_;
-      if (me == 0) {
-        if (o_.certify_every_s > 0 && changed_since_certificate_ &&
-            since(start_) >= next_certificate_) {
-          mine.certify = true;
-          next_certificate_ = since(start_) + o_.certify_every_s;
-          changed_since_certificate_ = false;
-        }
-        std::set<std::uint32_t> next = members();
-        next.insert(seen_.begin(), seen_.end());
-        mine.next_members.assign(next.begin(), next.end());
-      }
-      report_bytes_ += channel_.send_report(mine);
+    try {
+      if (!epoch_step()) break;
+    } catch (const TakeoverNeeded&) {
+      take_over();
     }
-    wait_for_reports();
-    std::vector<Watermarks> held;
-    bool all_converged = true;
-    for (const auto& [sender, r] : reports_[epoch_]) {
-      if (members().count(sender) == 0) continue;
-      if (sender != me && r.dim != 0) {
-        if (view_.dim() == 0) pump_stream();  // the block's graph must be there first
-        view_.apply_block(r.pose_ids, r.data, r.rank);
-      }
-      held.push_back(r.held);
-      all_converged = all_converged && r.converged;
-    }
-    converged_ = all_converged;
-    const bool certify_now = reports_[epoch_].count(0) > 0 && reports_[epoch_][0].certify;
-    // The estimate is whole here (every block's poses of the last solve arrived).
-    if (finishing) {
-      if (o_.publish_every_s > 0 || !o_.tum_dir.empty()) publish_estimate();
-      break;
-    }
-    if (o_.publish_every_s > 0 && since(start_) - last_publish_ >= o_.publish_every_s)
-      publish_estimate();
-    AbsorbGate gate;
-    Watermarks decision = gate.decide(held);
-    // Only the members' robots: a robot's data waits for its agent.
-    for (auto& [robot, count] : decision)
-      if (members().count(robot) == 0) count = 0;
-    // The members hold what they decided; a joiner following missed epochs may not yet.
-    for (;;) {
-      bool have_all = true;
-      const Watermarks mine = view_.held();
-      for (const auto& [robot, count] : decision) {
-        auto it = mine.find(robot);
-        if (count > (it == mine.end() ? 0 : it->second)) have_all = false;
-      }
-      if (have_all) break;
-      pump_stream();
-      channel_.wait(0.01);
-    }
-    const double step_start = since(start_);
-    const double cpu_start = cpu_now();
-    const runtime::EnteredData in = view_.enter(decision);
-    const bool changed = in.poses > 0 || in.measurements > 0;
-    if (o_.verbose) {
-      std::string who;
-      for (std::uint32_t m : members()) who += " " + std::to_string(m);
-      std::fprintf(stderr, "agent %d: epoch %u members%s: +%zu poses +%zu measurements%s%s\n",
-                   o_.id, epoch_, who.c_str(), in.poses, in.measurements,
-                   member ? "" : " (following)", converged_ ? " converged" : "");
-    }
-    reports_.erase(epoch_);
-    if (view_.stream_over()) {
-      if (member) final_ = solve(o_.online.certify_at_end);
-      if (o_.verbose)
-        std::fprintf(stderr, "agent %d: final solve: %d rounds, certified %s\n", o_.id,
-                     final_.rounds, final_.certified.value_or(false) ? "yes" : "no");
-      cpu_s_ += cpu_now() - cpu_start;
-      finishing = true;
-      ++epoch_;
-      continue;
-    }
-    if (!member) {
-      ++epoch_;
-      continue;
-    }
-    if (changed) changed_since_certificate_ = true;
-    if (certify_now && count_components(view_.stream()->graph()) == 1) {
-      const SolveOutcome c = solve(true, false);
-      converged_ = c.grad_norm <= o_.online.solver.grad_norm_tol || c.stop_reason == "stalled";
-      cpu_s_ += cpu_now() - cpu_start;
-      rounds_ += c.rounds;
-      cli::JsonObject j;
-      j.add("epoch", static_cast<long long>(epoch_))
-          .add("time_s", step_start)
-          .add("poses", view_.stream()->graph().num_poses)
-          .add("certified", c.certified)
-          .add("min_eigenvalue", c.min_eigenvalue)
-          .add("rounds", c.rounds)
-          .add("ms", 1000.0 * (since(start_) - step_start));
-      certificates_.push_back(std::move(j));
-      ++epoch_;
-      continue;
-    }
-    if (!changed && converged_) {
-      // Idle: a blocking wait for new data (ours, another agent's next report, or a hello
-      // for agent 0 to admit); nothing is sent meanwhile.
-      ++idle_waits_;
-      for (;;) {
-        pump_stream();
-        pump_channel();
-        const Watermarks now = view_.held();
-        bool more = false;
-        for (const auto& [robot, count] : now) {
-          auto it = decision.find(robot);
-          if (members().count(robot) > 0 && count > (it == decision.end() ? 0 : it->second))
-            more = true;
-        }
-        bool joiner = false;
-        if (me == 0)
-          for (std::uint32_t a : seen_) joiner = joiner || members().count(a) == 0;
-        if (more || joiner || reports_.count(epoch_ + 1) > 0) break;
-        channel_.wait(0.05);
-      }
-      ++epoch_;
-      continue;
-    }
-    const SolveOutcome s = solve(false);
-    if (o_.verbose)
-      std::fprintf(stderr, "agent %d: solve: %d rounds, gradient norm %g (%s)\n", o_.id, s.rounds,
-                   s.grad_norm, s.stop_reason.c_str());
-    converged_ = s.grad_norm <= o_.online.solver.grad_norm_tol || s.stop_reason == "stalled";
-    const double step_end = since(start_);
-    cpu_s_ += cpu_now() - cpu_start;
-    rounds_ += s.rounds;
-    ++solves_;
-    const GraphStream& g = *view_.stream();
-    double oldest = step_start;
-    for (const auto& [key, t] : received_at_)
-      if (key.second < g.absorbed_batches(key.first)) {
-        batch_latency_s_.push_back(step_end - t);
-        oldest = std::min(oldest, t);
-      }
-    for (auto it = received_at_.begin(); it != received_at_.end();)
-      it = it->first.second < g.absorbed_batches(it->first.first) ? received_at_.erase(it)
-                                                                  : std::next(it);
-    cli::JsonObject u;
-    u.add("epoch", static_cast<long long>(epoch_))
-        .add("time_s", step_start)
-        .add("batches", in.batches)
-        .add("poses", in.poses)
-        .add("measurements", in.measurements)
-        .add("total_poses", g.graph().num_poses)
-        .add("total_measurements", g.graph().measurements.size())
-        .add("agents", static_cast<long long>(members().size()))
-        .add("moved", in.moved)
-        .add("largest_block", in.largest_block)
-        .add("rounds", s.rounds)
-        .add("ms", 1000.0 * (step_end - step_start))
-        .add("latency_s", step_end - oldest)
-        .add("grad_norm", s.grad_norm)
-        .add("stop_reason", s.stop_reason);
-    updates_.push_back(std::move(u));
-    ++epoch_;
   }
   // The lead rounds the whole estimate (every block's poses arrived with the last reports).
-  if (o_.id == 0) {
+  const bool lead = me == lead_of(epoch_);
+  if (lead) {
     const PoseGraph& graph = view_.stream()->graph();
     if (graph.num_poses > 0 && count_components(graph) == 1) {
       const std::vector<Pose> poses = round_solution(graph, view_.iterate());
@@ -605,8 +542,271 @@ int OnlineAgent::run() {
     }
   }
   channel_.flush(5.0);
-  if (!o_.json.empty()) write_json(o_.id == 0);
+  if (!o_.json.empty()) write_json(lead);
   return 0;
+}
+
+bool OnlineAgent::epoch_step() {
+  const auto me = static_cast<std::uint32_t>(o_.id);
+  pump_stream();
+  pump_channel();
+  const bool member = members().count(me) > 0;
+  if (member) {
+    wait_matched(members().size());
+    transport::OnlineReportSample mine;
+    mine.epoch = epoch_;
+    mine.sender = me;
+    mine.held = view_.held();
+    mine.converged = converged_;
+    mine.rank = own_rank_;
+    mine.dim = view_.dim();
+    mine.pose_ids = own_ids_;
+    mine.data = own_data_;
+    if (me == lead_of(epoch_)) {
+      if (o_.certify_every_s > 0 && changed_since_certificate_ &&
+          since(start_) >= next_certificate_) {
+        mine.certify = true;
+        next_certificate_ = since(start_) + o_.certify_every_s;
+        changed_since_certificate_ = false;
+      }
+      std::set<std::uint32_t> next = members();
+      next.insert(seen_.begin(), seen_.end());
+      // An agent that said hello and died before it was admitted is not admitted.
+      if (o_.continue_on_loss)
+        for (std::uint32_t a : channel_.lost_agents())
+          if (members().count(a) == 0) next.erase(a);
+      mine.next_members.assign(next.begin(), next.end());
+    }
+    report_bytes_ += channel_.send_report(mine);
+  }
+  wait_for_reports();
+  std::vector<Watermarks> held;
+  bool all_converged = true;
+  for (const auto& [sender, r] : reports_[epoch_]) {
+    if (members().count(sender) == 0) continue;
+    if (sender != me && r.dim != 0) {
+      if (view_.dim() == 0) pump_stream();  // the block's graph must be there first
+      view_.apply_block(r.pose_ids, r.data, r.rank);
+    }
+    held.push_back(r.held);
+    all_converged = all_converged && r.converged;
+  }
+  converged_ = all_converged;
+  const std::uint32_t lead = lead_of(epoch_);
+  const bool certify_now = reports_[epoch_].count(lead) > 0 && reports_[epoch_][lead].certify;
+  // The estimate is whole here (every block's poses of the last solve arrived).
+  if (finishing_) {
+    if (o_.publish_every_s > 0 || !o_.tum_dir.empty()) publish_estimate();
+    return false;
+  }
+  if (o_.publish_every_s > 0 && since(start_) - last_publish_ >= o_.publish_every_s)
+    publish_estimate();
+  AbsorbGate gate;
+  Watermarks decision = gate.decide(held);
+  // Only the members' robots and those of lost agents (their blocks' adopters absorb them): a
+  // robot's data waits for its agent.
+  for (auto& [robot, count] : decision)
+    if (!absorbs(robot)) count = 0;
+  // The members hold what they decided; a joiner following missed epochs may not yet.
+  wait_to_hold(decision);
+  const double step_start = since(start_);
+  const double cpu_start = cpu_now();
+  const runtime::EnteredData in = view_.enter(decision);
+  const bool changed = in.poses > 0 || in.measurements > 0;
+  if (o_.verbose) {
+    std::string who;
+    for (std::uint32_t m : members()) who += " " + std::to_string(m);
+    std::fprintf(stderr, "agent %d: epoch %u members%s: +%zu poses +%zu measurements%s%s\n", o_.id,
+                 epoch_, who.c_str(), in.poses, in.measurements, member ? "" : " (following)",
+                 converged_ ? " converged" : "");
+  }
+  reports_.erase(epoch_);
+  if (view_.stream_over()) {
+    if (member) final_ = solve(o_.online.certify_at_end);
+    if (o_.verbose)
+      std::fprintf(stderr, "agent %d: final solve: %d rounds, certified %s\n", o_.id, final_.rounds,
+                   final_.certified.value_or(false) ? "yes" : "no");
+    cpu_s_ += cpu_now() - cpu_start;
+    finishing_ = true;
+    ++epoch_;
+    return true;
+  }
+  if (!member) {
+    ++epoch_;
+    return true;
+  }
+  if (changed) changed_since_certificate_ = true;
+  if (certify_now && count_components(view_.stream()->graph()) == 1) {
+    const SolveOutcome c = solve(true, false);
+    converged_ = c.grad_norm <= o_.online.solver.grad_norm_tol || c.stop_reason == "stalled";
+    cpu_s_ += cpu_now() - cpu_start;
+    rounds_ += c.rounds;
+    cli::JsonObject j;
+    j.add("epoch", static_cast<long long>(epoch_))
+        .add("time_s", step_start)
+        .add("poses", view_.stream()->graph().num_poses)
+        .add("certified", c.certified)
+        .add("min_eigenvalue", c.min_eigenvalue)
+        .add("rounds", c.rounds)
+        .add("ms", 1000.0 * (since(start_) - step_start));
+    certificates_.push_back(std::move(j));
+    ++epoch_;
+    return true;
+  }
+  if (!changed && converged_) {
+    // Idle: a blocking wait for new data (ours, another agent's next report, or a hello
+    // for the lead to admit); nothing is sent meanwhile.
+    ++idle_waits_;
+    for (;;) {
+      pump_stream();
+      pump_channel();
+      check_losses();
+      const Watermarks now = view_.held();
+      bool more = false;
+      for (const auto& [robot, count] : now) {
+        auto it = decision.find(robot);
+        if (absorbs(robot) && count > (it == decision.end() ? 0 : it->second)) more = true;
+      }
+      bool joiner = false;
+      if (me == lead)
+        for (std::uint32_t a : seen_) joiner = joiner || members().count(a) == 0;
+      if (more || joiner || reports_.count(epoch_ + 1) > 0) break;
+      channel_.wait(0.05);
+    }
+    ++epoch_;
+    return true;
+  }
+  // Every new measurement only placed a new pose (odometry, mostly) and every member voted
+  // converged in its report: each new measurement has zero residual at the composed poses,
+  // so f and its gradient are what they were. Every member sees the same votes and the same
+  // entered data, so all skip the solve together, without a message of their own; the new
+  // poses join their blocks at the next solve.
+  const bool unchanged = converged_ && in.composed == in.measurements;
+  SolveOutcome s;
+  if (unchanged) {
+    s.stop_reason = "unchanged";
+    s.grad_norm = last_grad_norm_;
+  } else {
+    s = solve(false);
+    if (o_.verbose)
+      std::fprintf(stderr, "agent %d: solve: %d rounds, gradient norm %g (%s)\n", o_.id, s.rounds,
+                   s.grad_norm, s.stop_reason.c_str());
+    converged_ = s.grad_norm <= o_.online.solver.grad_norm_tol || s.stop_reason == "stalled";
+    last_grad_norm_ = s.grad_norm;
+    ++solves_;
+  }
+  const double step_end = since(start_);
+  cpu_s_ += cpu_now() - cpu_start;
+  rounds_ += s.rounds;
+  const GraphStream& g = *view_.stream();
+  double oldest = step_start;
+  for (const auto& [key, t] : received_at_)
+    if (key.second < g.absorbed_batches(key.first)) {
+      batch_latency_s_.push_back(step_end - t);
+      oldest = std::min(oldest, t);
+    }
+  for (auto it = received_at_.begin(); it != received_at_.end();)
+    it = it->first.second < g.absorbed_batches(it->first.first) ? received_at_.erase(it)
+                                                                : std::next(it);
+  cli::JsonObject u;
+  u.add("epoch", static_cast<long long>(epoch_))
+      .add("time_s", step_start)
+      .add("batches", in.batches)
+      .add("poses", in.poses)
+      .add("measurements", in.measurements)
+      .add("total_poses", g.graph().num_poses)
+      .add("total_measurements", g.graph().measurements.size())
+      .add("agents", static_cast<long long>(members().size()))
+      .add("moved", in.moved)
+      .add("largest_block", in.largest_block)
+      .add("rounds", s.rounds)
+      .add("ms", 1000.0 * (step_end - step_start))
+      .add("latency_s", step_end - oldest)
+      .add("grad_norm", s.grad_norm)
+      .add("stop_reason", s.stop_reason);
+  updates_.push_back(std::move(u));
+  ++epoch_;
+  return true;
+}
+
+bool OnlineAgent::absorbs(std::uint32_t robot) const {
+  return members().count(robot) > 0 || dead_.count(robot) > 0;
+}
+
+void OnlineAgent::wait_to_hold(const Watermarks& decision) {
+  for (;;) {
+    bool have_all = true;
+    const Watermarks mine = view_.held();
+    for (const auto& [robot, count] : decision) {
+      auto it = mine.find(robot);
+      if (count > (it == mine.end() ? 0 : it->second)) have_all = false;
+    }
+    if (have_all) return;
+    pump_stream();
+    channel_.wait(0.01);
+  }
+}
+
+void OnlineAgent::take_over() {
+  const auto me = static_cast<std::uint32_t>(o_.id);
+  const double at = since(start_);
+  OwnVote mine;
+  mine.me = me;
+  mine.epoch = epoch_;
+  mine.entered = view_.entered();
+  mine.rank = own_rank_;
+  mine.dim = view_.dim();
+  mine.pose_ids = own_ids_;
+  mine.data = own_data_;
+  const TakeoverVoteOutcome vote = hold_takeover_vote(channel_, members(), mine, o_.timeout_s, [&] {
+    pump_channel();
+    pump_stream();
+    std::vector<transport::OnlineReportSample> v;
+    v.swap(votes_);
+    return v;
+  });
+  report_bytes_ += vote.bytes_sent;
+  // The survivors are at most one epoch boundary apart: the ones behind enter what the one
+  // ahead entered, so all hold the same graph before the blocks move.
+  const Watermarks target = vote.entered;
+  wait_to_hold(target);
+  view_.enter(target);
+  for (const auto& [a, v] : vote.votes)
+    if (a != me && v.dim != 0) view_.apply_block(v.pose_ids, v.data, v.rank);
+  const runtime::TakeoverMoves moves = view_.take_over(vote.lost);
+  const std::set<std::uint32_t>& survivors = vote.survivors;
+  dead_.insert(vote.lost.begin(), vote.lost.end());
+  for (std::uint32_t a : dead_) seen_.erase(a);
+  // The run goes on at an epoch no survivor has used: leftovers of the abandoned one (its
+  // messages, reports, the lead's admissions) are dropped.
+  epoch_ = vote.next_epoch;
+  floor_ = epoch_;
+  members_.erase(members_.begin(), members_.lower_bound(epoch_));
+  members_[epoch_] = survivors;
+  for (auto it = reports_.begin(); it != reports_.end();)
+    it = it->first < epoch_ ? reports_.erase(it) : std::next(it);
+  pending_.erase(std::remove_if(pending_.begin(), pending_.end(),
+                                [&](const auto& m) { return m.epoch < epoch_; }),
+                 pending_.end());
+  converged_ = false;  // the blocks changed: solve again
+  finishing_ = false;  // a final solve the loss interrupted runs again
+  std::vector<std::size_t> lost_ids(vote.lost.begin(), vote.lost.end());
+  std::vector<std::size_t> survivor_ids(survivors.begin(), survivors.end());
+  cli::JsonObject f;
+  f.add("kind", "lost_for_good")
+      .add("lost_agents", lost_ids)
+      .add("survivors", survivor_ids)
+      .add("noticed_at_s", at)
+      .add("taken_over_at_s", since(start_))
+      .add("epoch", static_cast<long long>(epoch_))
+      .add("total_poses", view_.stream() ? view_.stream()->graph().num_poses : std::size_t{0})
+      .add("moved_poses", moves.moved)
+      .add("cut_edges_after", moves.cut_after);
+  faults_.push_back(std::move(f));
+  if (o_.verbose)
+    std::fprintf(stderr,
+                 "agent %d: took over the blocks of %zu lost agent(s): %zu poses moved, epoch %u\n",
+                 o_.id, lost_ids.size(), moves.moved, epoch_);
 }
 
 void OnlineAgent::write_json(bool lead_result) {
@@ -636,6 +836,7 @@ void OnlineAgent::write_json(bool lead_result) {
   j.add("publications", publications_);
   j.add("updates", updates_);
   if (!certificates_.empty()) j.add("certificates", certificates_);
+  if (!faults_.empty()) j.add("faults", faults_);
   cli::write_output(o_.json, j.str());
 }
 

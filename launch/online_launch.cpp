@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -45,14 +46,16 @@ new, and certify the estimate after every robot's last batch.
   --grad-tol G        gradient-norm tolerance of every solve         [0.01]
   --no-certify        no certificate at the end
   --timeout S         an agent gives up when a peer is silent S seconds [120]
+  --on-agent-loss A   stop: a failed agent stops the run; continue: the survivors take over
+                      a lost agent's block and its robot's stream, and the run goes on [stop]
   --certify-iters K   certificate iteration cap (LOBPCG)             [300]
   --certify-every S   also certify the graph received so far every S seconds
   --publish-every S   each agent publishes its robot's estimate every S seconds
                       (topic tessera_online_estimate)
   --tum-dir DIR       per-robot TUM snapshots DIR/robot<r>.tum, rewritten at every
                       publication and at the end
-  --json FILE         the summary: agent 0's (updates, final answer) and every agent's
-                      traffic under "agents"
+  --json FILE         the summary: the lead's (agent 0, or the lowest surviving agent:
+                      updates, final answer) and every agent's traffic under "agents"
   --keep-logs DIR     keep the processes' logs and summaries in DIR
 )";
 
@@ -115,7 +118,7 @@ int run_online_launch(const std::vector<std::string>& argv) {
   const cli::Arguments args(argv,
                             {"agents", "rate", "speedup", "start", "run-id", "domain", "algorithm",
                              "rank", "grad-tol", "timeout", "json", "keep-logs", "certify-every",
-                             "certify-iters", "publish-every", "tum-dir"},
+                             "certify-iters", "publish-every", "tum-dir", "on-agent-loss"},
                             {"online", "no-certify"});
   if (args.positional().size() != 1)
     throw InputError("launch --online: expected one GRAPH argument (see --online --help)");
@@ -128,6 +131,10 @@ int run_online_launch(const std::vector<std::string>& argv) {
       "online-" + std::to_string(getpid()) + "-" +
           std::to_string(std::chrono::steady_clock::now().time_since_epoch().count() % 1000000));
   transport::validate_run_id(run_id);
+  const std::string on_loss = args.get_or("on-agent-loss", "stop");
+  if (on_loss != "stop" && on_loss != "continue")
+    throw InputError("option --on-agent-loss: '" + on_loss + "' is not one of stop, continue");
+  const bool continue_on_loss = on_loss == "continue";
   const long domain = args.get_long("domain", transport::domain_for_run(run_id));
   if (domain < 0 || domain > transport::kMaxDomain)
     throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));
@@ -158,7 +165,7 @@ int run_online_launch(const std::vector<std::string>& argv) {
                                   std::to_string(agents), "--id",     std::to_string(i)};
     a.insert(a.end(), common.begin(), common.end());
     for (const char* flag : {"algorithm", "rank", "grad-tol", "timeout", "certify-every",
-                             "certify-iters", "publish-every", "tum-dir"})
+                             "certify-iters", "publish-every", "tum-dir", "on-agent-loss"})
       if (auto v = args.get(flag)) {
         a.push_back(std::string("--") + flag);
         a.push_back(*v);
@@ -187,8 +194,10 @@ int run_online_launch(const std::vector<std::string>& argv) {
                        work + "/replay.json"});
     procs.push_back(start("replay", r, work + "/replay.log"));
   }
-  // Wait; the first failure stops the others.
+  // Wait; the first failure stops the others (with --on-agent-loss continue, a failed agent
+  // does not: the survivors take its block over).
   int failed = 0;
+  std::vector<long> lost_agents;
   std::size_t running = procs.size();
   while (running > 0) {
     int status = 0;
@@ -198,7 +207,13 @@ int run_online_launch(const std::vector<std::string>& argv) {
       if (p.pid == pid) {
         p.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
         --running;
-        if (p.code != 0 && failed == 0) {
+        const bool agent = &p - procs.data() < agents;
+        if (p.code != 0 && continue_on_loss && agent && failed == 0) {
+          lost_agents.push_back(static_cast<long>(&p - procs.data()));
+          std::fprintf(stderr,
+                       "tessera launch: %s ended with exit %d; the others go on without it\n",
+                       p.name.c_str(), p.code);
+        } else if (p.code != 0 && failed == 0) {
           failed = p.code == 2 ? 2 : 1;
           std::fprintf(stderr, "tessera launch: %s failed (exit %d):\n%s", p.name.c_str(), p.code,
                        read_text(p.log).c_str());
@@ -210,15 +225,22 @@ int run_online_launch(const std::vector<std::string>& argv) {
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (failed != 0) return failed;
+  if (static_cast<long>(lost_agents.size()) == agents)
+    throw std::runtime_error("launch: every agent failed");
 
-  std::string lead = read_text(work + "/agent-0.json");
+  // The lead's summary: agent 0's, or after its loss the lowest surviving agent's.
+  long lead_id = 0;
+  while (std::find(lost_agents.begin(), lost_agents.end(), lead_id) != lost_agents.end()) ++lead_id;
+  std::string lead = read_text(work + "/agent-" + std::to_string(lead_id) + ".json");
   const std::size_t close = lead.find_last_of('}');
   if (lead.empty() || close == std::string::npos)
-    throw std::runtime_error("launch: agent 0 wrote no summary");
+    throw std::runtime_error("launch: agent " + std::to_string(lead_id) + " wrote no summary");
   std::string per_agent;
   for (long i = 0; i < agents; ++i) {
+    if (std::find(lost_agents.begin(), lost_agents.end(), i) != lost_agents.end()) continue;
     const std::string j = read_text(work + "/agent-" + std::to_string(i) + ".json");
-    per_agent += std::string(i ? ",\n" : "") + "    {\"agent\": " + std::to_string(i);
+    per_agent +=
+        std::string(per_agent.empty() ? "" : ",\n") + "    {\"agent\": " + std::to_string(i);
     for (const char* key : {"solves", "rounds", "bytes_sent", "messages_sent", "report_bytes",
                             "idle_waits", "publications", "cpu_s", "wall_s"})
       per_agent += std::string(", \"") + key + "\": " + field_text(j, key);

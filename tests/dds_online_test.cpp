@@ -2,8 +2,8 @@
 // the graph while the replay streams it in, agree on the epoch each batch enters, idle
 // without traffic, take in an agent started late, and end at the batch optimum, certified.
 // Domains used here: 57-59 (each test its own).
-// A member that goes silent stops the run (the survivors name it); they do not yet go on
-// without it.
+// A member that goes silent stops the run (the survivors name it) unless the agents run with
+// --on-agent-loss continue (dds_online_loss_test).
 
 #include <gtest/gtest.h>
 

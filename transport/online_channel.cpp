@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
+#include <fastdds/dds/core/status/StatusMask.hpp>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -14,6 +16,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 
 #include "tesseraPubSubTypes.h"
@@ -64,6 +67,36 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
   std::mutex mutex;
   std::condition_variable cv;
   bool available = false;
+  std::set<std::uint32_t> lost;  // agents whose participant left or was dropped
+
+  // Liveliness of the other agents: their participants' names say which agent they are. A
+  // waiting agent is woken, so a take-over does not wait for a timeout.
+  struct Discovery : public dds::DomainParticipantListener {
+    Impl* impl = nullptr;
+    void on_participant_discovery(
+        dds::DomainParticipant*,
+        eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+      using Info = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+      const bool gone =
+          info.status == Info::REMOVED_PARTICIPANT || info.status == Info::DROPPED_PARTICIPANT;
+      if (!gone && info.status != Info::DISCOVERED_PARTICIPANT) return;
+      const std::string name = info.info.m_participantName.to_string();
+      const std::string prefix = "tessera-online:" + impl->run_id + ":";
+      if (name.compare(0, prefix.size(), prefix) != 0) return;
+      const std::string id = name.substr(prefix.size());
+      if (id.empty() || id.size() > 9 || id.find_first_not_of("0123456789") != std::string::npos)
+        return;
+      std::lock_guard<std::mutex> lock(impl->mutex);
+      // A participant of that agent discovered again (a process started again, or a live one
+      // the lease dropped) is not lost any more.
+      if (gone)
+        impl->lost.insert(static_cast<std::uint32_t>(std::stoul(id)));
+      else
+        impl->lost.erase(static_cast<std::uint32_t>(std::stoul(id)));
+      impl->available = true;
+      impl->cv.notify_all();
+    }
+  } discovery;
 
   Impl(int domain, const std::string& run, std::uint32_t me, std::uint32_t agents)
       : run_id(run), agent(me) {
@@ -78,7 +111,8 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     pq.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod =
         Duration_t(kOnlineLeaseS / 5.0);
     auto* factory = dds::DomainParticipantFactory::get_instance();
-    participant = factory->create_participant(domain, pq);
+    discovery.impl = this;
+    participant = factory->create_participant(domain, pq, &discovery, dds::StatusMask::none());
     if (!participant)
       throw std::runtime_error("online channel: cannot create a DDS participant on domain " +
                                std::to_string(domain));
@@ -128,7 +162,9 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     eq.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     eq.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
     eq.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-    eq.history().depth = 1;
+    // The newest of every robot this agent publishes (its own, and robots whose lost agents'
+    // blocks it adopted) stays for late readers.
+    eq.history().depth = static_cast<std::int32_t>(std::max<std::uint32_t>(1, agents));
     eq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
     estimate_writer = estimates ? publisher->create_datawriter(estimates, eq) : nullptr;
     if (!estimate_writer)
@@ -193,6 +229,8 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       r.data = w.data();
       r.next_members = w.next_members();
       r.certify = w.certify();
+      r.lost = w.lost();
+      r.at_epoch = w.at_epoch();
       reports.push_back(std::move(r));
     }
   }
@@ -239,6 +277,8 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   w.data(r.data);
   w.next_members(r.next_members);
   w.certify(r.certify);
+  w.lost(r.lost);
+  w.at_epoch(r.at_epoch);
   if (!write_patiently(impl_->report_writer, w))
     throw std::runtime_error("online channel: a report write failed");
   return serialized_size(w);
@@ -246,10 +286,10 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
 
 void OnlineChannel::publish_estimate(std::uint32_t epoch, int d,
                                      const std::vector<std::uint64_t>& index,
-                                     const std::vector<double>& poses) {
+                                     const std::vector<double>& poses, std::uint32_t robot) {
   wire::FinalEstimate w;
   w.run_id(impl_->run_id);
-  w.sender(impl_->agent);
+  w.sender(robot == kOwnRobot ? impl_->agent : robot);
   w.dim(static_cast<std::uint32_t>(d));
   w.epoch(epoch);
   for (std::uint64_t k : index) w.pose_ids().push_back(static_cast<std::uint32_t>(k));
@@ -300,6 +340,11 @@ int OnlineChannel::matched_peers() const {
 void OnlineChannel::flush(double timeout_s) {
   for (auto* w : {impl_->block_writer, impl_->status_writer, impl_->report_writer})
     w->wait_for_acknowledgments(Duration_t(timeout_s));
+}
+
+std::vector<std::uint32_t> OnlineChannel::lost_agents() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return {impl_->lost.begin(), impl_->lost.end()};
 }
 
 }  // namespace tessera::transport

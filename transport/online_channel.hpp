@@ -31,10 +31,16 @@ struct OnlineReportSample {
   /// Agent 0's reports: the agents that take part in the next epoch (joiners admitted).
   std::vector<std::uint32_t> next_members;
   bool certify = false;  ///< Agent 0's reports: certify at this epoch.
+  /// Take-over votes (epoch kTakeoverEpoch): the agents the sender counts as lost and the
+  /// epoch it was in; `held` is then what entered its graph.
+  std::vector<std::uint32_t> lost;
+  std::uint32_t at_epoch = 0;
 };
 
 /// The epoch of a hello: an agent that is not a member yet asks to join.
 inline constexpr std::uint32_t kHelloEpoch = 0xFFFFFFFFu;
+/// The epoch of a take-over vote: a member was lost and the survivors agree on its block.
+inline constexpr std::uint32_t kTakeoverEpoch = 0xFFFFFFFEu;
 
 /// A protocol message as received, with its routing (ids are the epoch's protocol ids).
 struct OnlineProtocolSample {
@@ -58,10 +64,12 @@ class OnlineChannel {
   std::size_t send(const OutgoingMessage& m, std::uint32_t epoch);
   /// Sends a report; returns its serialized size in bytes.
   std::size_t send_report(const OnlineReportSample& r);
-  /// Publishes this agent's robot's current estimate: pose indices and [R | t] (d*(d+1)
+  /// Publishes a robot's current estimate (this agent's robot unless `robot` says which: a
+  /// lost agent's robot whose block this agent adopted): pose indices and [R | t] (d*(d+1)
   /// values per pose, column-major).
   void publish_estimate(std::uint32_t epoch, int d, const std::vector<std::uint64_t>& index,
-                        const std::vector<double>& poses);
+                        const std::vector<double>& poses, std::uint32_t robot = kOwnRobot);
+  static constexpr std::uint32_t kOwnRobot = 0xFFFFFFFFu;
   /// Blocks until something arrived since the last take (or `timeout_s` passed).
   bool wait(double timeout_s);
   std::vector<OnlineReportSample> take_reports();
@@ -71,6 +79,9 @@ class OnlineChannel {
   int matched_peers() const;
   /// Waits until every matched reader acknowledged what was sent, at most `timeout_s`.
   void flush(double timeout_s);
+  /// Agents (ids from their participant names) whose participant left or whose liveliness
+  /// lease expired, and that were not discovered again since.
+  std::vector<std::uint32_t> lost_agents() const;
 
  private:
   struct Impl;

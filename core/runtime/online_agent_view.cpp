@@ -1,11 +1,14 @@
 #include "runtime/online_agent_view.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 #include <tessera/online/block_rebalance.hpp>
 #include <tessera/online/estimate_extension.hpp>
 #include <tessera/util/input_error.hpp>
 #include <tuple>
+
+#include "runtime/online_takeover.hpp"
 
 namespace tessera::runtime {
 
@@ -81,15 +84,111 @@ EnteredData OnlineAgentView::enter(const Watermarks& decision) {
   e.poses = graph.num_poses - poses_before;
   e.measurements = graph.measurements.size() - measurements_before;
   const auto& robots = stream_->robots();
-  for (std::size_t k = owner_.size(); k < graph.num_poses; ++k)
+  const std::size_t first_new = owner_.size();
+  for (std::size_t k = first_new; k < graph.num_poses; ++k)
     owner_.push_back(static_cast<int>(
         std::find(robots.begin(), robots.end(), stream_->robot_of_pose()[k]) - robots.begin()));
-  const RebalanceResult moves =
-      rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
+  RebalanceResult moves;
+  if (lost_.empty()) {
+    moves = rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
+  } else {
+    adopt_lost_poses(first_new);
+    moves = rebalance_live_blocks();
+  }
   e.moved = moves.moved;
   e.largest_block = moves.largest_after;
-  X_ = extend_estimate(graph, X_, stream_->guesses()).X;
+  EstimateExtension x = extend_estimate(graph, X_, stream_->guesses());
+  X_ = std::move(x.X);
+  e.composed = x.composed;
   return e;
+}
+
+bool OnlineAgentView::is_lost_block(int b) const {
+  return lost_.count(stream_->robots()[static_cast<std::size_t>(b)]) > 0;
+}
+
+void OnlineAgentView::adopt_lost_poses(std::size_t first_new) {
+  // A lost robot's new poses join the block that adopted it; a robot lost before its first
+  // pose is adopted by the smallest live block (lowest on ties) when that pose enters.
+  const auto& robots = stream_->robots();
+  for (std::size_t k = first_new; k < owner_.size(); ++k) {
+    const std::uint32_t robot = robots[static_cast<std::size_t>(owner_[k])];
+    if (lost_.count(robot) == 0) continue;
+    int& adopter = adopter_[robot];
+    if (adopter < 0) {
+      std::vector<std::size_t> size(robots.size(), 0);
+      for (int b : owner_) ++size[static_cast<std::size_t>(b)];
+      for (int b = 0; b < static_cast<int>(robots.size()); ++b)
+        if (!is_lost_block(b) && (adopter < 0 || size[static_cast<std::size_t>(b)] <
+                                                     size[static_cast<std::size_t>(adopter)]))
+          adopter = b;
+      if (adopter < 0)
+        throw std::runtime_error("online agent: robot " + std::to_string(robot) +
+                                 "'s agent was lost and no survivor's robot has a block yet");
+    }
+    owner_[k] = adopter;
+  }
+}
+
+RebalanceResult OnlineAgentView::rebalance_live_blocks() {
+  // The bound is over the live blocks: counting the lost (empty) ones would make every
+  // survivor's block look over-full and move poses back and forth between them.
+  const int blocks = static_cast<int>(stream_->robots().size());
+  std::vector<int> dense(static_cast<std::size_t>(blocks), -1), block_of;
+  for (int b = 0; b < blocks; ++b)
+    if (!is_lost_block(b)) {
+      dense[static_cast<std::size_t>(b)] = static_cast<int>(block_of.size());
+      block_of.push_back(b);
+    }
+  std::vector<int> owner(owner_.size());
+  for (std::size_t k = 0; k < owner_.size(); ++k)
+    owner[k] = dense[static_cast<std::size_t>(owner_[k])];
+  const RebalanceResult r = rebalance_blocks(stream_->graph(), owner,
+                                             static_cast<int>(block_of.size()), options_.rebalance);
+  for (std::size_t k = 0; k < owner_.size(); ++k)
+    owner_[k] = block_of[static_cast<std::size_t>(owner[k])];
+  return r;
+}
+
+int OnlineAgentView::adopter(std::uint32_t robot) const {
+  auto it = adopter_.find(robot);
+  return it == adopter_.end() ? -1 : it->second;
+}
+
+Watermarks OnlineAgentView::entered() const {
+  Watermarks out;
+  if (!stream_) return out;
+  for (std::uint32_t robot : stream_->robots()) out[robot] = stream_->absorbed_batches(robot);
+  return out;
+}
+
+TakeoverMoves OnlineAgentView::take_over(const std::set<std::uint32_t>& lost) {
+  lost_.insert(lost.begin(), lost.end());
+  TakeoverMoves out;
+  if (!stream_) {
+    for (std::uint32_t r : lost_) adopter_.emplace(r, -1);
+    return out;
+  }
+  SurvivorRepartitionOptions options;
+  options.eps = std::min(1.0, options_.rebalance.slack);
+  const OnlineTakeoverPlan plan =
+      plan_online_takeover(stream_->graph(), owner_, stream_->robots(), lost_, options);
+  owner_ = plan.owner;
+  // A robot adopted earlier by a block lost now follows that block's poses.
+  for (std::uint32_t robot : lost_) {
+    auto it = adopter_.find(robot);
+    int a = it == adopter_.end() ? -1 : it->second;
+    if (a < 0 || is_lost_block(a)) {
+      const int fresh = plan.adopter.at(robot);
+      a = fresh >= 0 ? fresh
+          : a >= 0   ? plan.adopter.at(stream_->robots()[static_cast<std::size_t>(a)])
+                     : -1;
+    }
+    adopter_[robot] = a;
+  }
+  out.moved = plan.moved;
+  out.cut_after = plan.cut_after;
+  return out;
 }
 
 bool OnlineAgentView::stream_over() const {

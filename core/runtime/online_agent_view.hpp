@@ -14,7 +14,9 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <tessera/online/absorb_gate.hpp>
+#include <tessera/online/block_rebalance.hpp>
 #include <tessera/online/graph_stream.hpp>
 #include <tessera/online/linked_problem.hpp>
 #include <tessera/online/online_engine.hpp>
@@ -28,6 +30,15 @@ struct EnteredData {
   std::vector<double> stamps;  ///< Publication stamp of each absorbed batch.
   std::size_t moved = 0;       ///< Poses the rebalance moved to another block.
   std::size_t largest_block = 0;
+  /// New poses placed by composing a new measurement from an estimated pose: when this equals
+  /// `measurements`, every new measurement has zero residual at the extended estimate.
+  std::size_t composed = 0;
+};
+
+/// What one take_over() moved.
+struct TakeoverMoves {
+  std::size_t moved = 0;      ///< Poses of the lost blocks that went to survivor blocks.
+  std::size_t cut_after = 0;  ///< Measurements between blocks afterwards.
 };
 
 class OnlineAgentView {
@@ -48,6 +59,16 @@ class OnlineAgentView {
   EnteredData enter(const Watermarks& decision);
   /// Every robot's last batch entered: the stream is over.
   bool stream_over() const;
+  /// Batches per robot that entered the graph.
+  Watermarks entered() const;
+  /// The agents of `lost` robots are gone for good: their blocks' poses go to the survivor
+  /// blocks (runtime/online_takeover.hpp) and their robots' future poses to the block that
+  /// adopted each. Deterministic: every survivor holding the same graph makes the same moves.
+  TakeoverMoves take_over(const std::set<std::uint32_t>& lost);
+  /// Robots whose agents were lost (their blocks are empty, their data goes to adopters).
+  const std::set<std::uint32_t>& lost() const { return lost_; }
+  /// The block that takes lost robot `robot`'s poses, -1 when none has yet.
+  int adopter(std::uint32_t robot) const;
   /// Writes a peer's block (stream ids, r*(d+1) values per pose) into the iterate; a larger
   /// rank (the final staircase) widens it.
   void apply_block(const std::vector<std::uint32_t>& ids, const std::vector<double>& data,
@@ -67,6 +88,10 @@ class OnlineAgentView {
   int robots() const { return robots_; }
 
  private:
+  bool is_lost_block(int b) const;
+  void adopt_lost_poses(std::size_t first_new);
+  RebalanceResult rebalance_live_blocks();
+
   int agent_, robots_, d_ = 0;
   OnlineOptions options_;
   std::optional<GraphStream> stream_;
@@ -74,6 +99,8 @@ class OnlineAgentView {
   std::map<std::uint32_t, std::uint64_t> last_count_;  // robot -> its batches (after `last`)
   Eigen::MatrixXd X_;
   std::vector<int> owner_;
+  std::set<std::uint32_t> lost_;
+  std::map<std::uint32_t, int> adopter_;  // lost robot -> block taking its new poses
 };
 
 }  // namespace tessera::runtime

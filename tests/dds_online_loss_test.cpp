@@ -1,0 +1,153 @@
+// A lost agent in an online run over DDS (tessera launch --online --on-agent-loss continue):
+// an agent SIGKILLed while the replay is still streaming is noticed through its DDS
+// liveliness, the survivors take over its block and its robot's later batches, and the run
+// ends at the batch optimum of the whole graph, certified, with every pose; also when the lost
+// agent was the lead (agent 0). Survivors skip the solve of an epoch whose new data only
+// placed new poses (the "unchanged" shortcut). The lost robot's trajectory is written by the
+// survivor that adopted its block. Domains used here: 110-111 (each test its own).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <thread>
+
+#include "dds_process_support.hpp"
+#include "transport/online_channel.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+// A field of a summary written by cli::JsonObject (`"key": value`), as text.
+std::string field(const std::string& json, const std::string& key, std::size_t from = 0) {
+  const std::string tag = "\"" + key + "\": ";
+  const std::size_t at = json.find(tag, from);
+  if (at == std::string::npos) return "";
+  const std::size_t begin = at + tag.size();
+  return json.substr(begin, json.find_first_of(",\n}", begin) - begin);
+}
+
+double number(const std::string& json, const std::string& key, std::size_t from = 0) {
+  const std::string text = field(json, key, from);
+  EXPECT_FALSE(text.empty()) << "no " << key;
+  return text.empty() || text == "null" ? NAN : std::stod(text);
+}
+
+// Kills agent `victim` of a `tessera launch --online` run once the agents' reports show that
+// 60 of the stream's 300 batches have entered (with `restart`, starts it again after the
+// survivors' vote), and checks that the run still ends at f*.
+void kill_mid_replay_and_finish(int domain, const std::string& name, int victim, bool restart) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/grid.g2o";
+  const std::string run = name + "-" + std::to_string(getpid());
+  generate_graph(graph, "--kind grid3d --poses 300 --robots 3");
+  std::string out;
+  ASSERT_EQ(
+      run_command(bin("tessera") + " solve " + graph + " --json " + dir + "/batch.json", &out), 0)
+      << out;
+  const std::string batch = read_text_file(dir + "/batch.json");
+  ASSERT_EQ(field(batch, "certified"), "true");
+  const double f_star = number(batch, "cost");
+  // Reads the agents' reports (never writes) to see how far the stream has entered.
+  transport::OnlineChannel snoop(domain, run, 99, 3);
+  // 100 poses per robot at 10 per second: the stream lasts 10 s once the agents are up.
+  Process launch = start({bin("tessera"),
+                          "launch",
+                          graph,
+                          "--agents",
+                          "3",
+                          "--online",
+                          "--rate",
+                          "10",
+                          "--run-id",
+                          run,
+                          "--domain",
+                          std::to_string(domain),
+                          "--timeout",
+                          "60",
+                          "--on-agent-loss",
+                          "continue",
+                          "--tum-dir",
+                          dir + "/tum",
+                          "--json",
+                          dir + "/online.json",
+                          "--keep-logs",
+                          dir + "/logs"},
+                         dir + "/launch.log");
+  const auto until = Clock::now() + std::chrono::seconds(60);
+  std::uint64_t entered = 0;
+  while (entered < 60 && Clock::now() < until) {
+    snoop.wait(0.05);
+    for (const auto& r : snoop.take_reports()) {
+      std::uint64_t held = 0;
+      for (const auto& [robot, count] : r.held) held += count;
+      if (r.epoch != transport::kHelloEpoch) entered = std::max(entered, held);
+    }
+  }
+  ASSERT_GE(entered, 60u) << "the stream did not start: " << launch.output();
+  std::string pid;
+  // "[t]" keeps the pattern from matching the shell that runs pgrep.
+  run_command("pgrep -f '[t]essera-agent --online --robots 3 --id " + std::to_string(victim) +
+                  " --run-id " + run + " ' | head -1",
+              &pid);
+  ASSERT_FALSE(pid.empty()) << launch.output();
+  ASSERT_EQ(kill(static_cast<pid_t>(std::stol(pid)), SIGKILL), 0);
+  if (restart) {
+    // Once the survivors voted, the victim started again with its id is told it was lost
+    // for good and leaves (the votes are kept for late readers); the run goes on.
+    bool voted = false;
+    while (!voted && Clock::now() < until + std::chrono::seconds(60)) {
+      snoop.wait(0.05);
+      for (const auto& r : snoop.take_reports())
+        voted = voted || r.epoch == transport::kTakeoverEpoch;
+    }
+    ASSERT_TRUE(voted) << launch.output();
+    Process again =
+        start({bin("tessera-agent"), "--online", "--robots", "3", "--id", std::to_string(victim),
+               "--run-id", run, "--domain", std::to_string(domain), "--on-agent-loss", "continue",
+               "--timeout", "60"},
+              dir + "/again.log");
+    ASSERT_TRUE(wait_all({&again}, 60)) << again.output();
+    EXPECT_EQ(again.exit_code, 1) << again.output();
+    EXPECT_TRUE(contains(again.output(), "counted as lost")) << again.output();
+  }
+  const bool ended = wait_all({&launch}, 180);
+  if (!ended)
+    run_command("pkill -9 -f '[t]essera-.*--run-id " + run + " '", nullptr);  // stragglers
+  ASSERT_TRUE(ended) << "the run hung: " << launch.output();
+  ASSERT_EQ(launch.exit_code, 0) << launch.output();
+  EXPECT_TRUE(contains(launch.output(), "the others go on without it")) << launch.output();
+
+  const std::string json = read_text_file(dir + "/online.json");
+  EXPECT_EQ(field(json, "certified"), "true") << json.substr(0, 2000);
+  EXPECT_NEAR(number(json, "cost"), f_star, 1e-6 * f_star);
+  EXPECT_EQ(number(json, "total_poses"), 300.0);
+  // The take-over: the victim's block went to the two survivors while the stream was still
+  // coming in (the graph was not complete yet), and its poses moved.
+  const std::size_t fault = json.find("\"faults\"");
+  ASSERT_NE(fault, std::string::npos) << json.substr(0, 2000);
+  EXPECT_EQ(field(json, "lost_agents", fault), "[" + std::to_string(victim) + "]");
+  EXPECT_GT(number(json, "moved_poses", fault), 0);
+  EXPECT_LT(number(json, "total_poses", fault), 300);
+  EXPECT_GT(number(json, "total_poses", fault), 0);
+  // Every robot's trajectory is written at the end, the lost one's by its block's adopter.
+  for (int r = 0; r < 3; ++r) {
+    const std::string tum = read_text_file(dir + "/tum/robot" + std::to_string(r) + ".tum");
+    EXPECT_EQ(std::count(tum.begin(), tum.end(), '\n'), 100) << "robot " << r;
+  }
+  // Epochs whose data only placed new poses cost no round (the shortcut over DDS).
+  EXPECT_TRUE(contains(json, "\"rounds\": 0, ") && contains(json, "\"unchanged\""));
+}
+
+TEST(DdsOnlineLoss, AnAgentKilledMidReplayIsTakenOverAndTheRunEndsAtTheBatchOptimum) {
+  // Started again after the take-over, the killed agent leaves with exit code 1.
+  kill_mid_replay_and_finish(110, "online-loss", 2, true);
+}
+
+TEST(DdsOnlineLoss, WhenTheLeadIsKilledTheLowestSurvivorLeadsAndWritesTheAnswer) {
+  kill_mid_replay_and_finish(111, "online-lead-loss", 0, false);
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
