@@ -118,6 +118,7 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   robust_summary.options = robust;
   robust_summary.outer_iterations = gnc.outer_iterations;
   robust_summary.total_iterations = gnc.inner_iterations;
+  if (robust.kind != RobustKind::kNone) robust_summary.total_cg_iterations = gnc.cg_iterations;
   robust_summary.measurements = graph.num_measurements();
   robust_summary.rejected = gnc.rejected;
   robust_summary.threshold_squared = gnc.threshold_squared;

@@ -6,7 +6,8 @@ namespace tessera::cli {
 
 const char* const kRobustValued[] = {"robust",        "inlier-threshold", "inlier-quantile",
                                      "gnc-max-outer", "gnc-mu-step",      "gnc-inner-rounds",
-                                     "known-inliers", "rejected",         nullptr};
+                                     "known-inliers", "rejected",         "gnc-inner-iterations",
+                                     nullptr};
 
 const char* const kRobustHelp =
     "\n"
@@ -30,6 +31,8 @@ const char* const kRobustHelp =
     "  --gnc-mu-step S           mu grows by S per outer step, > 1 [1.4]\n"
     "  --gnc-inner-rounds K      distributed: most rounds of each solve before the final\n"
     "                            one (first and weighted), 0 = no cap [5]\n"
+    "  --gnc-inner-iterations K  centralized: most trust-region iterations of each solve\n"
+    "                            before the re-check passes (first and weighted), 0 = no cap [0]\n"
     "  --known-inliers odometry|none   never reject edges between consecutive ids [odometry]\n"
     "  --rejected FILE           write the rejected edge indices (from 0 over the EDGE lines)\n";
 
@@ -41,6 +44,8 @@ RobustOptions parse_robust_options(const Arguments& args) {
   o.max_outer_iterations = static_cast<int>(args.get_long("gnc-max-outer", o.max_outer_iterations));
   o.mu_step = args.get_double("gnc-mu-step", o.mu_step);
   o.inner_max_rounds = static_cast<int>(args.get_long("gnc-inner-rounds", o.inner_max_rounds));
+  o.inner_max_iterations =
+      static_cast<int>(args.get_long("gnc-inner-iterations", o.inner_max_iterations));
   o.known_inliers =
       parse_known_inliers(args.get_or("known-inliers", known_inliers_name(o.known_inliers)));
   try {
@@ -53,7 +58,9 @@ RobustOptions parse_robust_options(const Arguments& args) {
                        : what.find("max_outer") != std::string::npos        ? "--gnc-max-outer"
                        : what.find("mu_step") != std::string::npos          ? "--gnc-mu-step"
                        : what.find("inner_max_rounds") != std::string::npos ? "--gnc-inner-rounds"
-                                                                            : "--robust";
+                       : what.find("inner_max_iterations") != std::string::npos
+                           ? "--gnc-inner-iterations"
+                           : "--robust";
     throw InputError("option " + std::string(flag) + ": " + what);
   }
   if (o.kind == RobustKind::kNone && args.has("rejected"))
@@ -73,6 +80,7 @@ void add_robust_fields(JsonObject& json, const RobustSummary& s) {
       .add("gnc_mu_step", s.options.mu_step)
       .add("weights_converged", s.weights_converged)
       .add("readmitted", s.readmitted);
+  if (s.total_cg_iterations >= 0) json.add("total_cg_iterations", s.total_cg_iterations);
 }
 
 void write_rejected(const std::string& path, const std::vector<std::size_t>& rejected) {

@@ -25,6 +25,8 @@ struct RobustSummary {
   RobustOptions options;
   int outer_iterations = 0;
   int total_iterations = 0;  ///< Solver iterations (or rounds) of every solve, final included.
+  /// Centralized: truncated-CG iterations of every solve (-1: distributed, not written).
+  int total_cg_iterations = -1;
   std::size_t measurements = 0;
   std::vector<std::size_t> rejected;  ///< Indices over the EDGE lines, from 0, ascending.
   double threshold_squared = 0;
@@ -33,7 +35,8 @@ struct RobustSummary {
 };
 
 /// Appends robust, outer_iterations, total_iterations, inliers, outliers, rejected,
-/// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged, readmitted.
+/// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged, readmitted (and
+/// total_cg_iterations when set).
 void add_robust_fields(JsonObject& json, const RobustSummary& summary);
 
 /// Writes one rejected index per line to `path` (InputError when it cannot).

@@ -92,6 +92,9 @@ TEST(RobustOptions, BadOptionsNameTheField) {
   o.inlier_threshold = -1;
   EXPECT_NE(message(o).find("RobustOptions.inlier_threshold"), std::string::npos);
   o = {};
+  o.inner_max_iterations = -1;
+  EXPECT_NE(message(o).find("RobustOptions.inner_max_iterations"), std::string::npos);
+  o = {};
   o.inlier_quantile = 1;
   EXPECT_NE(message(o).find("RobustOptions.inlier_quantile"), std::string::npos);
   EXPECT_THROW(parse_robust_kind("gnc"), InputError);
@@ -115,6 +118,23 @@ TEST(GncCentralized, RejectsExactlyTheRandomOutliersAndReachesTheCleanOptimum) {
   // The plain solve of the same file is dragged away: far above f*_clean.
   const CentralizedResult plain = solve_centralized(dirty.graph);
   EXPECT_GT(plain.cost, 10 * reference.cost);
+}
+
+TEST(GncCentralized, CappedInnerSolvesRejectTheSameOutliersInFewerIterations) {
+  // On a graph whose odometry start is good, capping the weighted solves between two weight
+  // updates (inner_max_iterations) finds the same outliers and the same optimum: only the kept
+  // set's solve has to be exact.
+  const GeneratorResult dirty = grid_with_outliers(0.25);
+  const GncCentralizedResult uncapped = solve_gnc_centralized(dirty.graph, gnc_options());
+  GncCentralizedOptions cap = gnc_options();
+  cap.robust.inner_max_iterations = 3;
+  const GncCentralizedResult capped = solve_gnc_centralized(dirty.graph, cap);
+  EXPECT_EQ(uncapped.rejected, dirty.outliers);
+  EXPECT_EQ(capped.rejected, dirty.outliers);
+  EXPECT_NEAR(capped.final_solve.cost, uncapped.final_solve.cost, 1e-6 * uncapped.final_solve.cost);
+  EXPECT_TRUE(capped.final_solve.certified.value_or(false));
+  EXPECT_LT(capped.inner_iterations, uncapped.inner_iterations);
+  EXPECT_LT(capped.cg_iterations, uncapped.cg_iterations);
 }
 
 TEST(GncCentralized, CleanGraphLosesNothingAndEndsAtThePlainOptimum) {

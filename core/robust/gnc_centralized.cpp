@@ -30,6 +30,8 @@ double kept_cost(const PoseGraph& graph, const std::vector<Pose>& poses) {
 
 void add_iterations(GncCentralizedResult& out, const CentralizedResult& solve) {
   out.inner_iterations += solve.iterations;
+  for (const CentralizedIteration& step : solve.trace)
+    out.cg_iterations += step.tr.inner_iterations;
 }
 
 }  // namespace
@@ -55,32 +57,57 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   out.threshold_squared = tls_threshold_squared(
       robust, graph.d, static_cast<std::size_t>(std::count(known.begin(), known.end(), false)));
   const double c2 = out.threshold_squared;
+  // A measurement of weight exactly 0 adds nothing to the weighted cost; when the known inliers
+  // keep the poses connected it leaves the weighted solve (as in the distributed engine) instead
+  // of staying at kMinInnerWeight: wrong closures between random poses are what fills the
+  // factor of the weighted problem.
+  PoseGraph known_graph;
+  known_graph.d = graph.d;
+  known_graph.num_poses = graph.num_poses;
+  known_graph.source = graph.source;
+  for (std::size_t e = 0; e < m; ++e)
+    if (known[e]) known_graph.measurements.push_back(graph.measurements[e]);
+  const bool known_connected = count_components(known_graph) <= 1;
+  auto weighted_solve_graph = [&](const PoseGraph& g, const std::vector<double>& weights,
+                                  const std::vector<Pose>& start) {
+    PoseGraph weighted = weighted_graph(g, weights, start);
+    if (!known_connected) return weighted;
+    std::vector<std::size_t> zero;
+    for (std::size_t e = 0; e < weights.size(); ++e)
+      if (weights[e] == 0) zero.push_back(e);
+    return zero.empty() ? weighted : inlier_graph(weighted, zero, start);
+  };
+
   // pcm-gnc: closures outside the largest pairwise-consistent set start with weight 0.
   std::vector<bool> dropped(m, false);
   if (robust.kind == RobustKind::kPcmGnc) {
-    PoseGraph chain_graph;
-    chain_graph.d = graph.d;
-    chain_graph.num_poses = graph.num_poses;
-    chain_graph.source = graph.source;
-    for (std::size_t e = 0; e < m; ++e)
-      if (known[e]) chain_graph.measurements.push_back(graph.measurements[e]);
-    if (count_components(chain_graph) > 1)
+    if (!known_connected)
       throw InputError(graph.source, 0,
                        "robust pcm-gnc: the known inliers do not connect the poses, so there is "
                        "no odometry to test closures against (use --robust gnc-tls)");
-    out.pcm = pairwise_consistency(graph, known, distributed_initialization(chain_graph, 1), c2);
+    out.pcm = pairwise_consistency(graph, known, distributed_initialization(known_graph, 1), c2);
     for (std::size_t e : out.pcm.inconsistent) dropped[e] = true;
   }
 
-  // Inner solves: no certificate (it only matters for the final inlier set), warm start.
+  // Inner solves: no certificate (it only matters for the final inlier set), warm start, and
+  // with RobustOptions::inner_max_iterations at most that many trust-region steps (off by
+  // default: where the start is far from the optimum, GNC needs real minimisers).
   CentralizedOptions inner = options.solver;
   inner.certify = false;
+  // One thread: the weighted solves start from given poses, so there is no start to factor
+  // beside (the first solve only loses that overlap), and on one thread a dense factor (wrong
+  // closures between random poses) is computed supernodally (CentralizedOptions::
+  // supernodal_min_flops).
+  inner.threads = 1;
+  if (robust.inner_max_iterations > 0)
+    inner.trust_region.max_iterations =
+        std::min(inner.trust_region.max_iterations, robust.inner_max_iterations);
   std::vector<double> first(m, 1.0);  // plain least squares (pcm-gnc: without the dropped)
   for (std::size_t e = 0; e < m; ++e)
     if (dropped[e]) first[e] = 0.0;
   CentralizedResult solve =
       robust.kind == RobustKind::kPcmGnc
-          ? solve_centralized(weighted_graph(graph, first, graph.initial), inner)
+          ? solve_centralized(weighted_solve_graph(graph, first, graph.initial), inner)
           : solve_centralized(graph, inner);
   add_iterations(out, solve);
   inner.initialization = Initialization::kFile;
@@ -100,7 +127,7 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
       out.weights[e] = known[e] ? 1.0 : dropped[e] ? 0.0 : tls_weight(r2[e], c2, mu);
       spread += out.weights[e] * (1 - out.weights[e]);
     }
-    solve = solve_centralized(weighted_graph(graph, out.weights, solve.poses), inner);
+    solve = solve_centralized(weighted_solve_graph(graph, out.weights, solve.poses), inner);
     add_iterations(out, solve);
     ++out.outer_iterations;
     out.final_mu = mu;
@@ -120,6 +147,7 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   // without them the solve relaxes it.
   CentralizedOptions final_options = options.solver;
   final_options.initialization = Initialization::kFile;
+  final_options.threads = 1;
   std::vector<Pose> start = solve.poses;
   for (int pass = 0;; ++pass) {
     PoseGraph inliers = inlier_graph(graph, out.rejected, start);

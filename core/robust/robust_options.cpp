@@ -51,6 +51,9 @@ void RobustOptions::validate() const {
     bad_field("max_outer_iterations", std::to_string(max_outer_iterations), "must be >= 1");
   if (inner_max_rounds < 0)
     bad_field("inner_max_rounds", std::to_string(inner_max_rounds), "must be >= 0 (0 = no cap)");
+  if (inner_max_iterations < 0)
+    bad_field("inner_max_iterations", std::to_string(inner_max_iterations),
+              "must be >= 0 (0 = no cap)");
   if (!(std::isfinite(mu_step) && mu_step > 1))
     bad_field("mu_step", number_text(mu_step), "must be > 1");
   if (recheck_max_rounds < 0)

@@ -59,6 +59,8 @@ void CentralizedOptions::validate() const {
     throw InputError("CentralizedOptions.max_rank must be >= initial_rank");
   if (!(certified_lanczos_tolerance > 0 && certified_lanczos_tolerance < 1))
     throw InputError("CentralizedOptions.certified_lanczos_tolerance must be in (0, 1)");
+  if (!(supernodal_min_flops > 0))
+    throw InputError("CentralizedOptions.supernodal_min_flops must be > 0");
   if (!(preconditioner_shift > 0))
     throw InputError("CentralizedOptions.preconditioner_shift must be > 0");
   if (threads < 1 || threads > 2) throw InputError("CentralizedOptions.threads must be 1 or 2");
@@ -124,13 +126,19 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
 
   const BlockProblem problem =
       BlockProblem::whole_graph(graph.d, graph.num_poses, graph.measurements);
-  // Always the exact factor, and always simplicial LDL^T: its solves with r right-hand sides are
-  // what the tCG repeats (docs/centralized-solver.md). The distributed blocks' switch to
-  // supernodal above 1 M entries made cubicle's and city10000's whole-graph factors supernodal:
-  // CPU in alternated pairs (load 7-8) cubicle 1.41/1.80/2.50 s simplicial vs 1.67/1.99/2.28 s,
-  // city10000 1.28/1.12/1.18 vs 1.39/1.84/1.41.
-  const auto build_preconditioner = [&problem, &options] {
-    return std::make_unique<BlockPreconditioner>(problem, options.preconditioner_shift, 0, 0);
+  // Always the exact factor, and simplicial LDL^T unless the factorization is dense
+  // (supernodal_min_flops): its solves with r right-hand sides are what the tCG repeats
+  // (docs/centralized-solver.md). The distributed blocks' switch to supernodal above 1 M entries
+  // made cubicle's and city10000's whole-graph factors supernodal: CPU in alternated pairs (load
+  // 7-8) cubicle 1.41/1.80/2.50 s simplicial vs 1.67/1.99/2.28 s, city10000 1.28/1.12/1.18 vs
+  // 1.39/1.84/1.41.
+  // The flops rule only on one thread: a supernodal factorization calls BLAS, and the start
+  // and the translation factor on the other thread may too (CHOLMOD's automatic choice), while
+  // the serial OpenBLAS build has no locks for concurrent calls.
+  const double supernodal_min_flops = options.threads > 1 ? 0.0 : options.supernodal_min_flops;
+  const auto build_preconditioner = [&problem, &options, supernodal_min_flops] {
+    return std::make_unique<BlockPreconditioner>(problem, options.preconditioner_shift, 0, 0,
+                                                 supernodal_min_flops);
   };
   // The factorization does not depend on the start: with a second thread it runs while the
   // start is computed (each CHOLMOD factor has its own workspace, so the two do not share state).

@@ -32,6 +32,7 @@ struct GncCentralizedResult {
   std::vector<std::size_t> rejected;  ///< Measurements with weight 0 (< 0.5 if never binary).
   int outer_iterations = 0;           ///< Weighted solves after the first plain one.
   int inner_iterations = 0;           ///< Trust-region iterations of every solve, final included.
+  int cg_iterations = 0;              ///< Their truncated-CG iterations (the work of a solve).
   double threshold_squared = 0;       ///< c^2 used.
   double final_mu = 0;                ///< mu of the last outer step (0: no step was needed).
   bool weights_converged = false;     ///< sum w(1 - w) fell below the tolerance.

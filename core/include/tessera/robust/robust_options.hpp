@@ -58,6 +58,15 @@ struct RobustOptions {
   /// 5: on the 1000-pose grid with 25 % random outliers, 152 rounds in all (3.9x the clean run)
   /// with the same rejected set as full inner solves (2388 rounds) (docs/robust.md, "Rounds").
   int inner_max_rounds = 5;
+  /// Centralized solver only: most trust-region iterations of every solve before the re-check
+  /// passes (the first, unweighted solve and each weighted solve between two weight updates),
+  /// >= 0, 0 = no cap (default). The centralized counterpart of inner_max_rounds. Off by
+  /// default because it costs quality where GNC needs real minimisers: manhattan3500 with 25 %
+  /// random outliers keeps 1 wrong closure and cuts 4 true ones uncapped (certified), 3 and 7
+  /// with a cap of 3, 1 and 10 with 5 (not certified), for 2.5x / 1.1x fewer CG iterations. What
+  /// made large contaminated files slow was the factorization, not the iterations
+  /// (CentralizedOptions::supernodal_min_flops; docs/benchmarks/robust.md).
+  int inner_max_iterations = 0;
   KnownInliers known_inliers = KnownInliers::kOdometry;
   /// Re-check passes after GNC: at the inlier set's solution each measurement that may be
   /// rejected gets TLS's own verdict: a rejected one within the bound (r^2 <= c^2) was misjudged

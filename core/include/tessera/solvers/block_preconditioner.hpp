@@ -36,10 +36,13 @@ class BlockPreconditioner : public RiemannianPreconditioner {
   /// use the block-diagonal fallback instead; 0 = always the exact factor.
   /// `supernodal_min_entries`: exact factors with more entries are supernodal (same operator
   /// up to round-off); 0 = always simplicial.
+  /// `supernodal_min_flops`: exact factors whose factorization CHOLMOD's analysis predicts to
+  /// take more floating-point operations are supernodal too; 0 = no such rule.
   explicit BlockPreconditioner(const BlockProblem& problem,
                                double relative_shift = kDefaultRelativeShift,
                                std::size_t max_factor_entries = kDefaultMaxFactorEntries,
-                               std::size_t supernodal_min_entries = kDefaultSupernodalMinEntries);
+                               std::size_t supernodal_min_entries = kDefaultSupernodalMinEntries,
+                               double supernodal_min_flops = 0);
   ~BlockPreconditioner() override;
   BlockPreconditioner(const BlockPreconditioner&) = delete;
   BlockPreconditioner& operator=(const BlockPreconditioner&) = delete;

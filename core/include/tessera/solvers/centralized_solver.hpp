@@ -42,6 +42,14 @@ struct CentralizedOptions {
   /// 1126 instead of 1788 tCG iterations (a long chain: its soft modes sit near the shift), the
   /// other shared graphs within 2 %.
   double preconditioner_shift = 1e-12;
+  /// The preconditioner's factor is supernodal when its factorization takes more than this many
+  /// floating-point operations (CHOLMOD's prediction), simplicial otherwise; > 0. The clean
+  /// shared graphs need at most 3.6e8 (torus3D; simplicial solves are faster there); graphs with
+  /// wrong loop closures between random poses need 1e8-1e11 (city10000 with 25 % random
+  /// outliers: 7.9e10, where simplicial factorization is what a robust solve spends its time on).
+  /// Only with threads = 1 (the robust solve's weighted and kept-set solves): the factor is then
+  /// not computed beside the start, whose own factorizations may call BLAS too.
+  double supernodal_min_flops = 5e8;
   /// Re-solve the translations exactly for the rotations of every trial point (SE-Sync's
   /// translation elimination; see solvers/translation_elimination.hpp). false: plain
   /// explicit-translation trust region.
