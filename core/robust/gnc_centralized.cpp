@@ -28,6 +28,18 @@ double kept_cost(const PoseGraph& graph, const std::vector<Pose>& poses) {
   return f;
 }
 
+// The TLS cost the start vote compares: known inliers count in full, the others up to c^2.
+double tls_cost(const PoseGraph& graph, const std::vector<bool>& known,
+                const std::vector<Pose>& poses, double c2) {
+  double f = 0;
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e) {
+    const Measurement& m = graph.measurements[e];
+    const double r2 = residual_squared(m, poses[m.i], poses[m.j]);
+    f += known[e] ? r2 : std::min(r2, c2);
+  }
+  return f;
+}
+
 void add_iterations(GncCentralizedResult& out, const CentralizedResult& solve) {
   out.inner_iterations += solve.iterations;
   for (const CentralizedIteration& step : solve.trace)
@@ -105,10 +117,24 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   std::vector<double> first(m, 1.0);  // plain least squares (pcm-gnc: without the dropped)
   for (std::size_t e = 0; e < m; ++e)
     if (dropped[e]) first[e] = 0.0;
-  CentralizedResult solve =
-      robust.kind == RobustKind::kPcmGnc
-          ? solve_centralized(weighted_solve_graph(graph, first, graph.initial), inner)
-          : solve_centralized(graph, inner);
+  CentralizedResult solve;
+  if (robust.kind == RobustKind::kPcmGnc) {
+    solve = solve_centralized(weighted_solve_graph(graph, first, graph.initial), inner);
+  } else if (options.known_inlier_start && known_connected &&
+             options.solver.initialization == Initialization::kChordal) {
+    PoseGraph start_graph = graph;
+    start_graph.initial = chordal_initialization(graph);
+    std::vector<Pose> known_start = chordal_initialization(known_graph);
+    if (tls_cost(graph, known, known_start, c2) < tls_cost(graph, known, start_graph.initial, c2)) {
+      start_graph.initial = std::move(known_start);
+      out.started_from_known_inliers = true;
+    }
+    CentralizedOptions from_start = inner;
+    from_start.initialization = Initialization::kFile;
+    solve = solve_centralized(start_graph, from_start);
+  } else {
+    solve = solve_centralized(graph, inner);
+  }
   add_iterations(out, solve);
   inner.initialization = Initialization::kFile;
 

@@ -21,6 +21,14 @@ struct GncCentralizedOptions {
   /// Empty, or one flag per measurement: true = never down-weighted, like the known-inlier
   /// rule's measurements (a dpgo CSV file's is_known_inlier column).
   std::vector<bool> known_inlier_flags;
+  /// With solver.initialization kChordal and GNC-TLS: the first solve starts from the cheaper,
+  /// in TLS cost (known inliers r^2, the others min(r^2, c^2)), of the chordal guess and the
+  /// known inliers' own chordal initialization (the odometry chain when they are the odometry),
+  /// as the distributed engine's start vote does. The chordal guess fits every measurement,
+  /// wrong ones too, and then settles in a distorted solution; on clean data it is nearly the
+  /// optimum, where the odometry chain's drift can lead the plain solve to another critical
+  /// point whose residuals GNC then cuts. Unused when the known inliers do not connect the poses.
+  bool known_inlier_start = true;
   /// Throws InputError naming the first bad field.
   void validate() const;
 };
@@ -41,6 +49,8 @@ struct GncCentralizedResult {
   /// Kept measurements beyond the bound at an inlier set's solution, rejected by a re-check pass.
   std::size_t late_rejected = 0;
   PairwiseConsistencyResult pcm;  ///< kPcmGnc: the consistency check (empty otherwise).
+  /// The start vote (GncCentralizedOptions::known_inlier_start) chose the known inliers' start.
+  bool started_from_known_inliers = false;
 };
 
 /// Runs GNC-TLS on `graph` and certifies the result on the inlier set. Measurements that the
