@@ -31,7 +31,10 @@ enum RoundingPhase : std::uint32_t {
   kResidual,                   // pipelined PCG: <r,u>, <w,u>, <r,r> of an iteration
   kTranslations,               // retired: the final translations ride on the last CG step
   kCost,                       // cost share of the rounded poses
-  kTraffic                     // certificate and escape bytes sent (certification only)
+  kTraffic,                    // certificate and escape bytes sent (certification only)
+  kWarmStartAnchor,            // pose 0's translation in the rounded frame (its owner's)
+  kWarmStartValues,            // public entries of the warm start
+  kWarmStartNorm               // |b|^2, with the warm start's step
 };
 
 /// One agent's side of the rounding. It keeps references to its arguments (they must outlive
@@ -96,11 +99,22 @@ class DistributedRounding {
 
   void rotations();
 
+  // The translations CG starts from: the iterate's, in the rounded frame, pose 0 at 0.
+  Eigen::MatrixXd warm_start();
+
   // Preconditioned CG on L t = b (the translation Laplacian without the anchor pose 0), with
   // each agent's own Laplacian block as the preconditioner (solved exactly by Cholesky), in
-  // its pipelined form: one message step per iteration.
-  std::uint32_t translations();
+  // its pipelined form: one message step per iteration. Stops when the residual is 1e-12 of
+  // b's or the cost it could still remove is below kSettleTolerance * max(1, relaxation_cost).
+  std::uint32_t translations(double relaxation_cost);
 
+ public:
+  /// Cost the translation solve may leave, relative to max(1, f(X)): 1e-5 of the rounding-gap
+  /// tolerance (certification/rounding_gap.hpp) and below, estimated over the last kSettleWindow steps.
+  static constexpr double kSettleTolerance = 1e-10;
+  static constexpr std::size_t kSettleWindow = 10;
+
+ private:
   // Cost of the rounded poses: internal measurements in full, cut ones half (as core's status).
   double cost();
 
@@ -113,6 +127,8 @@ class DistributedRounding {
   const Eigen::MatrixXd& Y_;
   std::vector<std::uint32_t> everyone_, neighbours_;
   std::map<std::size_t, Pose> poses_;  // own and neighbours' rounded poses
+  Eigen::MatrixXd frame_;              // r x d: the Gram matrix's top-d eigenvectors
+  bool reflected_ = false;             // last row flipped so most blocks are rotations
 };
 
 }  // namespace tessera::agent
