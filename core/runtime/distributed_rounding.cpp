@@ -8,9 +8,19 @@
 #include <stdexcept>
 #include <string>
 #include <tessera/problem/lifting.hpp>
+#include <tessera/util/input_error.hpp>
 #include <variant>
 
 namespace tessera::agent {
+
+void DistributedRoundingOptions::validate() const {
+  if (!(settle_tolerance >= 0.0 && settle_tolerance <= 1e-6))
+    throw InputError("DistributedRoundingOptions::settle_tolerance must be in [0, 1e-6], got " +
+                     std::to_string(settle_tolerance));
+  if (settle_window < 1 || settle_window > 1000)
+    throw InputError("DistributedRoundingOptions::settle_window must be in [1, 1000], got " +
+                     std::to_string(settle_window));
+}
 
 RoundLoopResult DistributedRounding::run(RoundLoopResult res) {
   rotations();
@@ -263,7 +273,7 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
   // projection, so the iterate's translations are close to the optimal ones; from x = 0 the
   // solve first has to build the whole map (a 1M-pose grid: hundreds of all-agent steps more).
   // One message step: the neighbours' start and |b|^2 (the residual stop stays relative to b).
-  Eigen::MatrixXd x = warm_start();
+  Eigen::MatrixXd x = options_.warm_start ? warm_start() : Eigen::MatrixXd::Zero(m, d);
   send_publics(kWarmStartValues, 0, 1, rows_of(&x, nullptr));
   double bb = reduce(kWarmStartNorm, 0, b.squaredNorm(), 0.0, nullptr);
   Eigen::MatrixXd r = b - apply(x, gather_publics(kWarmStartValues, 0, 1));
@@ -281,15 +291,14 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
   // - the residual computed from x is below 1e-12 of b's (the exact solve to rounding error);
   // - the cost is settled: the translation part of the rounded cost is t^T L t - 2 b^T t + c,
   //   and a CG step lowers it by exactly alpha <r, M r>, so the sum of those over the last
-  //   kSettleWindow steps estimates what the rest of the solve could still remove (Strakos and
+  //   settle_window steps estimates what the rest of the solve could still remove (Strakos and
   //   Tichy's estimate of the error in the L-norm, which is that excess cost). It stops when
-  //   that is below kSettleTolerance * max(1, f(X)): 1e-5 of the rounding-gap tolerance
-  //   (certification/rounding_gap.hpp), so the inexact solve cannot decide whether the
-  //   certificate carries over to the estimate, nor move the reported cost visibly.
+  //   that is below settle_tolerance * max(1, f(X)) (DistributedRoundingOptions says why 1e-10).
   Eigen::MatrixXd u, w, p, s, q, n_rec;
   const std::uint32_t max_it = 5000;
   std::uint32_t it = 0, step = 1, restarts = 0;
-  const double tol = 1e-24 * bb, settle = kSettleTolerance * std::max(1.0, relaxation_cost);
+  const double tol = 1e-24 * bb,
+               settle = options_.settle_tolerance * std::max(1.0, relaxation_cost);
   double gamma_old = 0.0, alpha_old = 0.0;
   std::vector<double> decreases;  // alpha * gamma of every step taken
   // Whether r is b - L x as computed (a start), not as the recurrences carried it.
@@ -316,12 +325,13 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
                                 (w.array() * u.array()).sum(), &delta, r.squaredNorm(), &rr);
     mx = gather_publics(kDirection, step, 2);
     ++step;
-    if (decreases.size() >= kSettleWindow) {
-      double left = 0.0;
-      for (std::size_t k = decreases.size() - kSettleWindow; k < decreases.size(); ++k)
-        left += decreases[k];
-      if (left <= settle) break;  // x and the neighbours' x (in mx) are the same step's
-    }
+    double left = 0.0;  // cost removed by the last settle_window steps
+    for (std::size_t k = decreases.size() - std::min(decreases.size(), options_.settle_window);
+         k < decreases.size(); ++k)
+      left += decreases[k];
+    mail_.report_progress(ProgressStage::kRounding, it, left);
+    // x and the neighbours' x (in mx) are the same step's here.
+    if (settle > 0 && decreases.size() >= options_.settle_window && left <= settle) break;
     const double beta = fresh ? 0.0 : gamma / gamma_old;
     const double pAp = fresh ? delta : delta - beta * gamma / alpha_old;  // <p, L p>
     if (!(rr > tol) || !(pAp > 0)) {

@@ -37,13 +37,35 @@ enum RoundingPhase : std::uint32_t {
   kWarmStartNorm               // |b|^2, with the warm start's step
 };
 
+/// How the rounding solves for the translations (every agent must use the same).
+struct DistributedRoundingOptions {
+  /// Start the translation CG from the iterate's own translations (in the rounded frame, pose 0
+  /// at the origin) instead of from zero. Near a critical point they are close to the optimal
+  /// translations for the rounded rotations, so the CG has little left to do.
+  bool warm_start = true;
+  /// Also stop the CG once the rounded cost it could still remove, estimated over the last
+  /// `settle_window` steps, is at most settle_tolerance * max(1, f(X)); 0 = only the residual
+  /// stop (1e-12 of b's). [0, 1e-6]; the default, 1e-10, is 1e-5 of the rounding-gap tolerance
+  /// (certification/rounding_gap.hpp), so the inexact solve cannot decide whether the
+  /// certificate carries over to the estimate.
+  double settle_tolerance = 1e-10;
+  /// Steps over which the remaining cost is estimated, [1, 1000].
+  std::size_t settle_window = 10;
+
+  /// Throws InputError naming the field when it is out of range.
+  void validate() const;
+};
+
 /// One agent's side of the rounding. It keeps references to its arguments (they must outlive
-/// it) and rounds the iterate `state.Y` as it is when run() is called.
+/// it) and rounds the iterate `state.Y` as it is when run() is called. Throws InputError when
+/// `options` are invalid.
 class DistributedRounding {
  public:
   DistributedRounding(const AgentLocalData& local, const BlockLayout& layout,
-                      const AgentState& state, Mailbox& mail)
-      : local_(local),
+                      const AgentState& state, Mailbox& mail,
+                      DistributedRoundingOptions options = {})
+      : options_((options.validate(), options)),
+        local_(local),
         layout_(layout),
         mail_(mail),
         self_(local.agent_id),
@@ -105,19 +127,13 @@ class DistributedRounding {
   // Preconditioned CG on L t = b (the translation Laplacian without the anchor pose 0), with
   // each agent's own Laplacian block as the preconditioner (solved exactly by Cholesky), in
   // its pipelined form: one message step per iteration. Stops when the residual is 1e-12 of
-  // b's or the cost it could still remove is below kSettleTolerance * max(1, relaxation_cost).
+  // b's or (options_.settle_tolerance) the cost it could still remove is small enough.
   std::uint32_t translations(double relaxation_cost);
 
- public:
-  /// Cost the translation solve may leave, relative to max(1, f(X)): 1e-5 of the rounding-gap
-  /// tolerance (certification/rounding_gap.hpp) and below, estimated over the last kSettleWindow steps.
-  static constexpr double kSettleTolerance = 1e-10;
-  static constexpr std::size_t kSettleWindow = 10;
-
- private:
   // Cost of the rounded poses: internal measurements in full, cut ones half (as core's status).
   double cost();
 
+  DistributedRoundingOptions options_;
   const AgentLocalData& local_;
   const BlockLayout& layout_;
   Mailbox& mail_;
