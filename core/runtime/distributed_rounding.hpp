@@ -1,9 +1,10 @@
 #pragma once
-// The distributed rounding of the final lifted iterate to SE(d), with no central step: the
-// same result as core's round_solution (rank-d truncation via the r x r Gram matrix summed
-// over the agents, reflection by majority, per-block projection to SO(d), translations
-// optimal for those rotations with pose 0 at the origin, by a distributed preconditioned
-// conjugate gradient) up to floating-point summation order. Runs after core's protocol in
+// The distributed rounding of the final lifted iterate to SE(d), with no central step: core's
+// round_solution (rank-d truncation via the r x r Gram matrix summed over the agents,
+// reflection by majority, per-block projection to SO(d), translations optimal for those
+// rotations with pose 0 at the origin, by a distributed preconditioned conjugate gradient) up
+// to floating-point summation order and the CG's stop (its cost within
+// DistributedRoundingOptions::cost_bound() of the exact solve's). Runs after core's protocol in
 // run_round_loop, over the same Mailbox.
 
 #include <Eigen/Core>
