@@ -54,6 +54,12 @@ bool RoundReports::on_report(const wire::RoundStatus& m) {
   if (m.phase() == kAgentPhaseTimesPhase) {
     results_.agent_solve_s = m.cost();
     results_.agent_rounding_s = m.grad_norm_sq();
+    results_.rounding_cg_iterations = static_cast<std::uint32_t>(m.block_grad_norm());
+    return true;
+  }
+  if (m.phase() == kAgentStageProgressPhase) {
+    lines_.on_stage(static_cast<std::uint32_t>(m.block_grad_norm()),
+                    static_cast<std::uint32_t>(m.grad_norm_sq()), m.cost());
     return true;
   }
   if (m.phase() == kAgentRobustReportPhase) {

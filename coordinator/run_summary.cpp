@@ -61,6 +61,9 @@ std::string run_summary_json(const RunSummaryInputs& in) {
            r.agent_solve_s ? std::optional<double>(1000 * *r.agent_solve_s) : std::nullopt)
       .add("rounding_ms",
            r.agent_rounding_s ? std::optional<double>(1000 * *r.agent_rounding_s) : std::nullopt)
+      .add("rounding_cg_iterations", r.rounding_cg_iterations
+                                         ? std::optional<double>(*r.rounding_cg_iterations)
+                                         : std::nullopt)
       .add("bytes_sent", std::vector<std::size_t>(in.merged.bytes.begin(), in.merged.bytes.end()))
       .add("hosts", in.structure.hosts);
   // Peak resident sets (MB): each agent's as it sent its final estimate, the coordinator's now,

@@ -92,14 +92,16 @@ void expect_same_as_in_process(const std::string& algorithm, int domain, bool st
   }
   EXPECT_NEAR(f, ref.cost, 1e-8 * ref.cost);  // g2o text keeps ~17 digits per value
 
-  // The distributed rounding's translations are the direct solve's (core's round_solution).
+  // The distributed rounding's translations are the direct solve's (core's round_solution) up to
+  // the translation CG's stop: it ends once the cost it could still remove is below 1e-10 of
+  // f(X) (runtime/distributed_rounding.hpp), here ~1e-8 m.
   ASSERT_EQ(ref.poses.size(), g.num_poses);
   double worst = 0.0;
   for (std::size_t k = 0; k < g.num_poses; ++k)
     worst = std::max(
         worst,
         (in_frame_of_pose_0(merged_graph.initial, k) - in_frame_of_pose_0(ref.poses, k)).norm());
-  EXPECT_LT(worst, 1e-9);
+  EXPECT_LT(worst, 1e-7);
 }
 
 TEST(DdsSolve, IrbcdOverDdsGivesTheInProcessIterates) {

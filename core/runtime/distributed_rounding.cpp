@@ -4,16 +4,27 @@
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <tessera/problem/lifting.hpp>
+#include <tessera/util/input_error.hpp>
 #include <variant>
 
 namespace tessera::agent {
 
+void DistributedRoundingOptions::validate() const {
+  if (!(settle_tolerance >= 0.0 && settle_tolerance <= 1e-6))
+    throw InputError("DistributedRoundingOptions::settle_tolerance must be in [0, 1e-6], got " +
+                     std::to_string(settle_tolerance));
+  if (settle_window < 1 || settle_window > 1000)
+    throw InputError("DistributedRoundingOptions::settle_window must be in [1, 1000], got " +
+                     std::to_string(settle_window));
+}
+
 RoundLoopResult DistributedRounding::run(RoundLoopResult res) {
   rotations();
-  res.translation_iterations = translations();
+  res.translation_iterations = translations(res.relaxation_cost);
   res.poses.clear();
   for (std::size_t s = 0; s < own_.size(); ++s) res.poses.push_back(poses_.at(own_[s]));
   res.cost = cost();
@@ -132,7 +143,8 @@ void DistributedRounding::rotations() {
         S(k, c) += msg.data[static_cast<std::size_t>(c * r * (d + 1) + k)];
   }
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
-  const Eigen::MatrixXd U = eig.eigenvectors().rightCols(d);
+  frame_ = eig.eigenvectors().rightCols(d);
+  const Eigen::MatrixXd& U = frame_;
   Eigen::MatrixXd R(d, d * m);
   double negative = 0;
   for (Eigen::Index i = 0; i < m; ++i) {
@@ -141,9 +153,10 @@ void DistributedRounding::rotations() {
   }
   const double total_negative = reduce(kNegative, 0, negative, 0.0, nullptr);
   const double n = static_cast<double>(local_.num_poses);
+  reflected_ = 2 * total_negative > n;
   for (Eigen::Index i = 0; i < m; ++i) {
     Eigen::MatrixXd Ri = R.middleCols(d * i, d);
-    if (2 * total_negative > n) Ri.row(d - 1) *= -1.0;
+    if (reflected_) Ri.row(d - 1) *= -1.0;
     poses_[own_[static_cast<std::size_t>(i)]] =
         Pose{project_to_rotation(Ri), Eigen::VectorXd::Zero(d)};
   }
@@ -155,15 +168,41 @@ void DistributedRounding::rotations() {
     poses_[id] = Pose{Eigen::Map<const Eigen::MatrixXd>(v.data(), d, d), Eigen::VectorXd::Zero(d)};
 }
 
-std::uint32_t DistributedRounding::translations() {
+Eigen::MatrixXd DistributedRounding::warm_start() {
+  // The iterate's own translations in the rounded frame (U^T y_i, reflected as the rotations
+  // were), shifted so that pose 0 sits at the origin as the solve fixes it. Pose 0's owner
+  // gives its translation through a sum to which every other agent adds zeros (exact).
+  const Eigen::Index d = d_, m = static_cast<Eigen::Index>(own_.size());
+  Eigen::MatrixXd x(m, d);
+  for (Eigen::Index i = 0; i < m; ++i)
+    x.row(i) = (frame_.transpose() * Y_.col((d + 1) * i + d)).transpose();
+  if (reflected_) x.col(d - 1) *= -1.0;
+  double t0[3] = {0.0, 0.0, 0.0};
+  if (local_.owner[0] == self_)
+    for (Eigen::Index i = 0; i < m; ++i)
+      if (own_[static_cast<std::size_t>(i)] == 0)
+        for (Eigen::Index k = 0; k < d; ++k) t0[k] = x(i, k);
+  t0[0] = reduce(kWarmStartAnchor, 0, t0[0], t0[1], &t0[1], t0[2], &t0[2]);
+  for (Eigen::Index i = 0; i < m; ++i)
+    for (Eigen::Index k = 0; k < d; ++k) x(i, k) -= t0[k];
+  return x;
+}
+
+std::uint32_t DistributedRounding::translations(double relaxation_cost) {
   const Eigen::Index d = d_, m = static_cast<Eigen::Index>(own_.size());
   std::map<std::size_t, Eigen::Index> slot;
   for (Eigen::Index s = 0; s < m; ++s) slot[own_[static_cast<std::size_t>(s)]] = s;
   auto free = [&](std::size_t id) { return id != 0; };
+  // The neighbours' public poses this agent's measurements read, as columns of L_nb.
+  std::map<std::size_t, Eigen::Index> nb_slot;
+  std::vector<std::size_t> nb_ids;
   Eigen::MatrixXd b = Eigen::MatrixXd::Zero(m, d);
-  std::vector<Eigen::Triplet<double>> trip;
-  for (Eigen::Index s = 0; s < m; ++s)
-    if (!free(own_[static_cast<std::size_t>(s)])) trip.emplace_back(s, s, 1.0);  // fixed at 0
+  std::vector<Eigen::Triplet<double>> trip, trip_nb;
+  auto column_of = [&](std::size_t id) {
+    auto [it, added] = nb_slot.emplace(id, static_cast<Eigen::Index>(nb_ids.size()));
+    if (added) nb_ids.push_back(id);
+    return it->second;
+  };
   for (const Measurement& e : local_.measurements) {
     const Eigen::VectorXd c = poses_.at(e.i).R * e.t;
     auto si = slot.find(e.i), sj = slot.find(e.j);
@@ -171,16 +210,26 @@ std::uint32_t DistributedRounding::translations() {
     if (oi) {
       b.row(si->second) -= e.tau * c.transpose();
       trip.emplace_back(si->second, si->second, e.tau);
+      if (oj)
+        trip.emplace_back(si->second, sj->second, -e.tau);
+      else if (sj == slot.end() && free(e.j))
+        trip_nb.emplace_back(si->second, column_of(e.j), -e.tau);
     }
     if (oj) {
       b.row(sj->second) += e.tau * c.transpose();
       trip.emplace_back(sj->second, sj->second, e.tau);
-    }
-    if (oi && oj) {
-      trip.emplace_back(si->second, sj->second, -e.tau);
-      trip.emplace_back(sj->second, si->second, -e.tau);
+      if (oi)
+        trip.emplace_back(sj->second, si->second, -e.tau);
+      else if (si == slot.end() && free(e.i))
+        trip_nb.emplace_back(sj->second, column_of(e.i), -e.tau);
     }
   }
+  // L's rows of the free owned poses: L_own on the owned columns, L_nb on the neighbours'.
+  Eigen::SparseMatrix<double> L_own(m, m), L_nb(m, static_cast<Eigen::Index>(nb_ids.size()));
+  L_own.setFromTriplets(trip.begin(), trip.end());
+  L_nb.setFromTriplets(trip_nb.begin(), trip_nb.end());
+  for (Eigen::Index s = 0; s < m; ++s)
+    if (!free(own_[static_cast<std::size_t>(s)])) trip.emplace_back(s, s, 1.0);  // fixed at 0
   Eigen::SparseMatrix<double> Lbb(m, m);
   Lbb.setFromTriplets(trip.begin(), trip.end());
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> chol(Lbb);
@@ -192,22 +241,20 @@ std::uint32_t DistributedRounding::translations() {
       if (!free(own_[static_cast<std::size_t>(s)])) z.row(s).setZero();
     return z;
   };
-  // L p for owned rows, given p on owned poses and the neighbours' public entries.
+  // L p for owned rows, given p on owned poses and the neighbours' public entries (the
+  // first d of each), as two sparse products (index maps built once, not per product).
   auto apply = [&](const Eigen::MatrixXd& p, const std::map<std::size_t, std::vector<double>>& pn) {
-    auto value = [&](std::size_t id) -> Eigen::VectorXd {
-      if (!free(id)) return Eigen::VectorXd::Zero(d);
-      auto s = slot.find(id);
-      if (s != slot.end()) return p.row(s->second).transpose();
-      const auto& v = pn.at(id);
-      return Eigen::Map<const Eigen::VectorXd>(v.data(), d);
-    };
-    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(m, d);
-    for (const Measurement& e : local_.measurements) {
-      const Eigen::VectorXd diff = e.tau * (value(e.j) - value(e.i));
-      auto si = slot.find(e.i), sj = slot.find(e.j);
-      if (si != slot.end() && free(e.i)) out.row(si->second) -= diff.transpose();
-      if (sj != slot.end() && free(e.j)) out.row(sj->second) += diff.transpose();
+    Eigen::MatrixXd P(static_cast<Eigen::Index>(nb_ids.size()), d);
+    for (std::size_t k = 0; k < nb_ids.size(); ++k) {
+      auto v = pn.find(nb_ids[k]);
+      if (v == pn.end())
+        throw std::runtime_error("rounding: no value for pose " + std::to_string(nb_ids[k]) +
+                                 " from its owner");
+      P.row(static_cast<Eigen::Index>(k)) =
+          Eigen::Map<const Eigen::RowVectorXd>(v->second.data(), d);
     }
+    Eigen::MatrixXd out = L_own * p;
+    out.noalias() += L_nb * P;
     return out;
   };
   // The public rows of `a` (and of `b2` after them) for send_publics.
@@ -222,6 +269,14 @@ std::uint32_t DistributedRounding::translations() {
       return v;
     };
   };
+  // Warm start: near a critical point the rounded rotations are the iterate's up to a small
+  // projection, so the iterate's translations are close to the optimal ones; from x = 0 the
+  // solve first has to build the whole map (a 1M-pose grid: hundreds of all-agent steps more).
+  // One message step: the neighbours' start and |b|^2 (the residual stop stays relative to b).
+  Eigen::MatrixXd x = options_.warm_start ? warm_start() : Eigen::MatrixXd::Zero(m, d);
+  send_publics(kWarmStartValues, 0, 1, rows_of(&x, nullptr));
+  double bb = reduce(kWarmStartNorm, 0, b.squaredNorm(), 0.0, nullptr);
+  Eigen::MatrixXd r = b - apply(x, gather_publics(kWarmStartValues, 0, 1));
   // Pipelined PCG (Ghysels & Vanroose, "Hiding global synchronization latency in the
   // preconditioned conjugate gradient algorithm", 2014): PCG's iterates in exact arithmetic,
   // with w = L u, s = L p, q = M s and n = L q carried by recurrences, so that an iteration's
@@ -231,11 +286,21 @@ std::uint32_t DistributedRounding::translations() {
   // with the new z's public entries): intel's rounding took 105 message steps, ~0.85 ms each
   // on 2 cores, 62 this way (docs/dds-runtime.md, "The rounding's message steps"). Each step also
   // carries x's public entries, so the last one gives the neighbours' final translations.
-  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(m, d), r = b;
+  //
+  // Two stops, whichever comes first (every agent sees the same sums, so all stop together):
+  // - the residual computed from x is below 1e-12 of b's (the exact solve to rounding error);
+  // - the cost is settled: the translation part of the rounded cost is t^T L t - 2 b^T t + c,
+  //   and a CG step lowers it by exactly alpha <r, M r>, so the sum of those over the last
+  //   settle_window steps estimates what the rest of the solve could still remove (Strakos and
+  //   Tichy's estimate of the error in the L-norm, which is that excess cost). It stops when
+  //   that is below settle_tolerance * max(1, f(X)) (DistributedRoundingOptions says why 1e-10).
   Eigen::MatrixXd u, w, p, s, q, n_rec;
   const std::uint32_t max_it = 5000;
-  std::uint32_t it = 0, step = 0, restarts = 0;
-  double rr0 = -1.0, tol = 0.0, gamma_old = 0.0, alpha_old = 0.0;
+  std::uint32_t it = 0, step = 1, restarts = 0;
+  const double tol = 1e-24 * bb,
+               settle = options_.settle_tolerance * std::max(1.0, relaxation_cost);
+  double gamma_old = 0.0, alpha_old = 0.0;
+  std::vector<double> decreases;  // alpha * gamma of every step taken
   // Whether r is b - L x as computed (a start), not as the recurrences carried it.
   bool fresh = true;
   std::map<std::size_t, std::vector<double>> mx;  // neighbours' public M w and x
@@ -260,10 +325,13 @@ std::uint32_t DistributedRounding::translations() {
                                 (w.array() * u.array()).sum(), &delta, r.squaredNorm(), &rr);
     mx = gather_publics(kDirection, step, 2);
     ++step;
-    if (rr0 < 0) {  // the first reduction: b's residual
-      rr0 = rr;
-      tol = 1e-24 * rr0;  // relative residual 1e-12
-    }
+    double left = 0.0;  // cost removed by the last settle_window steps
+    for (std::size_t k = decreases.size() - std::min(decreases.size(), options_.settle_window);
+         k < decreases.size(); ++k)
+      left += decreases[k];
+    mail_.report_progress(ProgressStage::kRounding, it, left);
+    // x and the neighbours' x (in mx) are the same step's here.
+    if (settle > 0 && decreases.size() >= options_.settle_window && left <= settle) break;
     const double beta = fresh ? 0.0 : gamma / gamma_old;
     const double pAp = fresh ? delta : delta - beta * gamma / alpha_old;  // <p, L p>
     if (!(rr > tol) || !(pAp > 0)) {
@@ -294,6 +362,7 @@ std::uint32_t DistributedRounding::translations() {
     w -= alpha * n_rec;
     gamma_old = gamma;
     alpha_old = alpha;
+    decreases.push_back(alpha * gamma);
     fresh = false;
     ++it;
   }

@@ -18,6 +18,20 @@ void ProgressPrinter::finish() {
   if (pending_) print(*pending_, last_ms_.value_or(0));
 }
 
+void ProgressPrinter::on_stage(std::uint32_t stage, std::uint32_t iteration, double value) {
+  if (!enabled_) return;
+  finish();  // the rounds' last line first
+  char buf[160];
+  if (stage == 1)
+    std::snprintf(buf, sizeof(buf), "certificate: iteration %u, lambda_min estimate %.3e\n",
+                  iteration, value);
+  else
+    std::snprintf(buf, sizeof(buf),
+                  "rounding: translation CG iteration %u, cost moved by the last steps %.3e\n",
+                  iteration, value);
+  out_ << buf << std::flush;
+}
+
 void ProgressPrinter::print(const CompletedStep& step, double ms) {
   char buf[160];
   std::snprintf(buf, sizeof(buf), "round %u%s: cost %.10g, grad norm %.3e\n", step.round,

@@ -28,6 +28,10 @@ class ProgressPrinter {
   void on_step(const CompletedStep& step, double ms);
   /// Prints the newest step if it was held back (the run's last line of progress).
   void finish();
+  /// Agent 0's progress report of a stage after the rounds (runtime/stage_progress.hpp; it
+  /// sends a few a minute): stage 1 "certificate: iteration K, lambda_min estimate V",
+  /// stage 2 "rounding: translation CG iteration K, cost still moving V"; printed at once.
+  void on_stage(std::uint32_t stage, std::uint32_t iteration, double value);
 
  private:
   void print(const CompletedStep& step, double ms);

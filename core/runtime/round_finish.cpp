@@ -69,6 +69,7 @@ RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout&
     t.sender = 0;
     t.cost = res.solve_s;
     t.grad_norm_sq = res.rounding_s;
+    t.block_grad_norm = res.translation_iterations;
     channel.send(OutgoingMessage{t, true, {}});
   }
   if (local.agent_id == 0) {  // one report for the coordinator's summary

@@ -109,6 +109,11 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     // The certified sequence. Checkpoints and rollbacks cover its first solve stage.
     sequence = std::make_unique<CertifiedAgent>(state, layout, options);
     if (hooks.on_round) sequence->set_round_observer(hooks.on_round);
+    mail.after_handled = [&] {
+      const auto p = sequence->certificate_progress();
+      if (p && p->first > 0)  // from its first iteration on: a lambda_min estimate to show
+        mail.report_progress(ProgressStage::kCertificate, p->first, p->second);
+    };
     mail.run_protocol(
         *sequence, hooks.resume_from ? sequence->resume(*hooks.resume_from) : sequence->start(),
         [&] { return "stage " + std::to_string(sequence->stage()) + " of the certified solve"; });
@@ -125,6 +130,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
       res.min_eigenvalue = sequence->certificates().back().result.min_eigenvalue;
     res.certificate_rounds = static_cast<std::uint32_t>(sequence->certificate_iterations());
     res.escape_rounds = static_cast<std::uint32_t>(sequence->escape_trials());
+    mail.after_handled = nullptr;
   }
   res.final_rank = static_cast<std::uint32_t>(state.rank());
   return round_and_report(local, layout, state, mail, channel, std::move(res), sequence != nullptr,

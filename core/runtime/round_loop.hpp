@@ -186,8 +186,12 @@ constexpr std::uint32_t kCertificateBytesPhase = 202;
 constexpr std::uint32_t kRobustReportPhase = 203;
 /// And, before the final report in every run, its own times: cost = solve_s (core's protocol:
 /// rounds, and certificate and escapes when certified), grad_norm_sq = rounding_s (seconds), so
-/// the coordinator can split the time after the last round into certificate and rounding.
+/// the coordinator can split the time after the last round into certificate and rounding;
+/// block_grad_norm = the rounding's translation CG iterations.
 constexpr std::uint32_t kPhaseTimesPhase = 204;
+/// Agent 0's progress during the certificate and the rounding (runtime/stage_progress.hpp):
+/// round = the stage's iteration, cost = its figure, block_grad_norm = the stage.
+constexpr std::uint32_t kStageProgressPhase = 205;
 
 /// Optional recovery hooks of the round loop.
 struct RoundLoopHooks {

@@ -5,6 +5,7 @@
 // the waits and the sends and counts the certificate and escape traffic this agent sends.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "runtime/round_loop.hpp"
+#include "runtime/stage_progress.hpp"
 
 namespace tessera::agent {
 
@@ -61,7 +63,19 @@ class Mailbox {
         continue;
       }
       send_all(protocol.handle(*msg));
+      if (after_handled) after_handled();
     }
+  }
+
+  /// Called in run_protocol() after each message the protocol handled (agent 0's progress
+  /// reports during the certificate); may be empty.
+  std::function<void()> after_handled;
+
+  /// Agent 0's progress report of a stage after the rounds (runtime/stage_progress.hpp); on
+  /// the other agents it does nothing.
+  void report_progress(ProgressStage stage, std::uint32_t iteration, double value) {
+    if (!progress_) progress_.emplace(self_ == 0, channel_);
+    progress_->report(stage, iteration, value);
   }
 
   /// Waits for the rounding messages of (phase, round) from every agent in `senders` and
@@ -89,6 +103,7 @@ class Mailbox {
   std::uint32_t self_;
   std::uint32_t num_agents_ = 1;
   bool sent_since_gather_ = false;
+  std::optional<StageProgress> progress_;
 
  public:
   std::uint64_t certificate_bytes = 0, escape_bytes = 0;  // sent by this agent

@@ -181,6 +181,8 @@ def run_one(args, poses, agents, domain):
         "edges": s.get("edges"), "rounds": s.get("rounds"), "certified": s.get("certified"),
         "min_eigenvalue": s.get("min_eigenvalue"), "cut_edges": s.get("cut_edges"),
         "cost": s.get("cost"), "grad_norm": s.get("grad_norm"),
+        "rounding_s": round(s["rounding_ms"] / 1000.0, 1) if s.get("rounding_ms") else None,
+        "rounding_cg_iterations": s.get("rounding_cg_iterations"),
         "peak_rss_mb_agent_max": round(s.get("peak_rss_mb_agent_max", 0), 1),
         "peak_rss_mb_coordinator": round(s.get("peak_rss_mb_coordinator", 0), 1),
         "peak_rss_mb_run": round(s.get("peak_rss_mb_run", 0), 1),

@@ -78,6 +78,9 @@ class CertificateProtocol : public AgentProcess {
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
   bool done() const override { return done_; }
   const DistributedCertificateResult& result() const { return result_; }
+  /// While it runs: LOBPCG iterations done and the current estimate of lambda_min (progress).
+  std::uint32_t iteration() const { return iteration_; }
+  double ritz_value() const { return theta_; }
 
  private:
   enum Step : std::uint32_t { kVector = 1, kReduce = 2 };

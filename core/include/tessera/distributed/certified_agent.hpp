@@ -30,6 +30,7 @@
 #include <tessera/distributed/round_protocol.hpp>
 #include <tessera/distributed/saddle_escape.hpp>
 #include <tessera/distributed/stage_records.hpp>
+#include <utility>
 #include <vector>
 
 namespace tessera {
@@ -70,6 +71,12 @@ class CertifiedAgent : public AgentProcess {
   int certificate_iterations() const;
   int escape_trials() const;
   std::uint32_t stage() const { return stage_; }
+  /// While a certificate stage runs: its iterations so far and its current lambda_min
+  /// estimate (for progress reports); nullopt in the other stages.
+  std::optional<std::pair<std::uint32_t, double>> certificate_progress() const {
+    if (!certify_ || current_ != certify_.get()) return std::nullopt;
+    return std::make_pair(certify_->iteration(), certify_->ritz_value());
+  }
 
  private:
   void begin(std::uint32_t stage, std::vector<OutgoingMessage>& out,

@@ -1,0 +1,63 @@
+#pragma once
+// Agent 0's progress reports during the stages after the rounds: the certificate's LOBPCG
+// iterations and the rounding's translation CG iterations. Each is one all-agent step, and at a
+// million poses there are hundreds of them taking many minutes; without these reports the
+// coordinator's output showed only that the agents were alive. A report is a round status of
+// phase kStageProgressPhase (read by the coordinator, as agent 0's other reports), sent when the
+// stage begins and then at most once per period, so its traffic does not depend on how fast
+// the iterations go.
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+
+#include "runtime/round_loop.hpp"
+
+namespace tessera::agent {
+
+/// Which stage a report is about (the status's block_grad_norm).
+enum class ProgressStage : std::uint32_t { kCertificate = 1, kRounding = 2 };
+
+struct StageProgressOptions {
+  /// Seconds between two reports of one stage, (0, 3600]: the coordinator prints each as a
+  /// line, so this is launch's line rate during the certificate and the rounding.
+  double period_s = 2.0;
+
+  /// Throws InputError naming the field when it is out of range.
+  void validate() const;
+};
+
+/// The report status: round = `sequence` (the reports of one agent run count up: the transport
+/// keeps one status per sender, phase and round, so two stages' iteration 0 must not share a
+/// round), grad_norm_sq = the stage's iteration, cost = `value` (certificate: the current
+/// estimate of lambda_min; rounding: the cost its last steps removed, which its stop
+/// compares), block_grad_norm = the stage.
+RoundStatusMessage stage_progress_status(std::uint32_t sequence, ProgressStage stage,
+                                         std::uint32_t iteration, double value);
+
+/// One per agent run (the Mailbox holds it), so that its reports' sequence numbers are unique.
+class StageProgress {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  /// `reporter`: this agent sends the reports (agent 0); the others' calls do nothing.
+  /// `channel` must outlive this object. Throws InputError when `options` are invalid.
+  StageProgress(bool reporter, ProtocolChannel& channel, StageProgressOptions options = {});
+
+  /// Sends a report when this is the reporter and the stage is new or a period has passed
+  /// since the last report.
+  void report(ProgressStage stage, std::uint32_t iteration, double value,
+              Clock::time_point now = Clock::now());
+
+  std::uint32_t sent() const { return sent_; }
+
+ private:
+  bool reporter_;
+  ProtocolChannel& channel_;
+  Clock::duration period_;
+  std::optional<ProgressStage> stage_;
+  Clock::time_point last_{};
+  std::uint32_t sent_ = 0;
+};
+
+}  // namespace tessera::agent
