@@ -146,6 +146,28 @@ TEST(GncCentralized, CleanGraphLosesNothingAndEndsAtThePlainOptimum) {
   EXPECT_TRUE(robust.final_solve.certified.value_or(false));
 }
 
+TEST(GncCentralized, TheStartVoteTakesChordalOnCleanDataAndTheOdometryUnderOutliers) {
+  // The chordal guess fits every edge: on clean data it is nearly the optimum (lower TLS cost
+  // than the drifting odometry chain), with wrong closures it is distorted (higher).
+  const GeneratorResult clean = grid_with_outliers(0.0);
+  const GncCentralizedResult on_clean = solve_gnc_centralized(clean.graph, gnc_options());
+  EXPECT_FALSE(on_clean.started_from_known_inliers);
+  EXPECT_TRUE(on_clean.rejected.empty());
+
+  const GeneratorResult dirty = grid_with_outliers(0.25);
+  const GncCentralizedResult on_dirty = solve_gnc_centralized(dirty.graph, gnc_options());
+  EXPECT_TRUE(on_dirty.started_from_known_inliers);
+  EXPECT_EQ(on_dirty.rejected, dirty.outliers);
+
+  // Without the vote (or from another initialization) the first solve starts where told.
+  GncCentralizedOptions no_vote = gnc_options();
+  no_vote.known_inlier_start = false;
+  EXPECT_FALSE(solve_gnc_centralized(dirty.graph, no_vote).started_from_known_inliers);
+  GncCentralizedOptions from_odometry = gnc_options();
+  from_odometry.solver.initialization = Initialization::kOdometry;
+  EXPECT_FALSE(solve_gnc_centralized(clean.graph, from_odometry).started_from_known_inliers);
+}
+
 TEST(TlsRecheck, AtTheCleanOptimumTheVerdictIsExactlyTheWrongClosures) {
   // A set that keeps one wrong closure and cuts one true closure: at the clean optimum TLS's
   // own verdict (r^2 > c^2) drops the first and takes the second back.
