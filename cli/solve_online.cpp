@@ -17,10 +17,11 @@
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {"rate",           "speedup",       "start",
-                                     "checkpoints",    "certify-every", "refactor-growth",
-                                     "baseline-every", nullptr};
-const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", nullptr};
+const char* const kOnlineValued[] = {"rate",           "speedup",         "start",
+                                     "checkpoints",    "certify-every",   "refactor-growth",
+                                     "baseline-every", "local-threshold", nullptr};
+const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", "no-local-rounds",
+                                       nullptr};
 
 const char* kOnlineHelp =
     "\n"
@@ -50,6 +51,9 @@ const char* kOnlineHelp =
     "  --refactor-growth G       a growing block keeps its preconditioner factor until it\n"
     "                            has G times more poses than it was computed for (default\n"
     "                            0: a new factor whenever the block gets new poses)\n"
+    "  --local-threshold F       local rounds: a block works only while its gradient norm\n"
+    "                            is above F * grad-tol / sqrt(blocks), in (0, 1] (default 1)\n"
+    "  --no-local-rounds         every block works and sends in every round\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step)\n";
 
@@ -90,6 +94,9 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.real_time = a.has("real-time");
   options.certify_every_s = a.get_double("certify-every", 0.0);
   options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
+  options.solver.local_rounds.enabled = !a.has("no-local-rounds");
+  options.solver.local_rounds.threshold =
+      a.get_double("local-threshold", options.solver.local_rounds.threshold);
   options.validate();
   ReplayOptions replay;
   replay.rate = a.get_double("rate", replay.rate);
@@ -156,7 +163,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
     ++baseline_sampled;
     DistributedOptions scratch = options.solver;
     scratch.certify = false;
-    scratch.round_result = false;  // the graph may not be connected yet
+    scratch.round_result = false;          // the graph may not be connected yet
+    scratch.local_rounds.enabled = false;  // a solve from scratch: every block has work
     const double c0 = cpu_now();
     solve_distributed(g, engine.assignment(), scratch, engine.stream().guesses());
     baseline_cpu_s += cpu_now() - c0;

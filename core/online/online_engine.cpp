@@ -12,6 +12,12 @@
 
 namespace tessera {
 
+DistributedOptions online_solver_options() {
+  DistributedOptions o;
+  o.local_rounds.enabled = true;
+  return o;
+}
+
 void OnlineOptions::validate() const {
   rebalance.validate();
   if (!(refactor_growth >= 0) || !std::isfinite(refactor_growth))

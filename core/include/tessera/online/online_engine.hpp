@@ -26,11 +26,15 @@
 
 namespace tessera {
 
+/// The agents' solver of an online run: DistributedOptions' defaults with local rounds on
+/// (after a batch, most blocks are converged and only those near the new data need work).
+DistributedOptions online_solver_options();
+
 struct OnlineOptions {
-  /// The agents' solver (algorithm, rank, tolerance, selection, ...). Its `certify` and
-  /// `initialization` are not used: poses are initialised by composition, and certification
-  /// is `certify_at_end`.
-  DistributedOptions solver;
+  /// The agents' solver (algorithm, rank, tolerance, selection, local rounds, ...). Its
+  /// `certify` and `initialization` are not used: poses are initialised by composition, and
+  /// certification is `certify_at_end`.
+  DistributedOptions solver = online_solver_options();
   /// Run the distributed certificate (with the staircase of solver.staircase) after the
   /// last batch.
   bool certify_at_end = true;
