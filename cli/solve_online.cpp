@@ -19,7 +19,8 @@ namespace tessera::cli {
 
 const char* const kOnlineValued[] = {"rate",           "speedup",         "start",
                                      "checkpoints",    "certify-every",   "refactor-growth",
-                                     "baseline-every", "local-threshold", nullptr};
+                                     "baseline-every", "local-threshold", "step-every",
+                                     nullptr};
 const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", "no-local-rounds",
                                        nullptr};
 
@@ -37,6 +38,8 @@ const char* kOnlineHelp =
     "  --real-time               a step absorbs all batches published while the previous one\n"
     "                            ran (its wall time counts as stream time); default: one step\n"
     "                            per publication time\n"
+    "  --step-every S            a step every S seconds of stream time (absorbing all that\n"
+    "                            was published by then), whatever the machine's load\n"
     "  --checkpoints K           at K evenly spaced steps, the estimate's relative gap to the\n"
     "                            optimum of the graph received so far (centralized solver,\n"
     "                            computed after the run, not timed)\n"
@@ -93,6 +96,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       a.get_long("certify-iters", options.solver.staircase.certificate.max_iterations));
   options.real_time = a.has("real-time");
   options.certify_every_s = a.get_double("certify-every", 0.0);
+  options.step_every_s = a.get_double("step-every", 0.0);
   options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
   options.solver.local_rounds.enabled = !a.has("no-local-rounds");
   options.solver.local_rounds.threshold =
@@ -210,6 +214,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("cpu_s", u.cpu_s)
           .add("setup_s", u.setup_s)
           .add("rounds_cpu_s", u.rounds_cpu_s)
+          .add("critical_path_cpu_s", u.critical_path_cpu_s)
           .add("latency_s", u.latency_s)
           .add("bytes", static_cast<std::size_t>(u.bytes))
           .add("grad_norm", u.grad_norm)
@@ -248,6 +253,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("rate", replay.rate)
         .add("speedup", replay.speedup)
         .add("real_time", options.real_time)
+        .add("step_every_s", options.step_every_s)
         .add("grad_tol", options.solver.grad_norm_tol)
         .add("steps", res.updates.size())
         .add("rounds", res.rounds)

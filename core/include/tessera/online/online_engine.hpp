@@ -45,6 +45,11 @@ struct OnlineOptions {
   /// stamps are a real-time clock; a step absorbs every batch published by the time the
   /// previous step ended (its measured wall time), as a live run would.
   bool real_time = false;
+  /// run_online only, > 0: a step every this many seconds of stream time, absorbing every batch
+  /// published by then (a back end that steps at a fixed period: the same steps whatever the
+  /// machine's load, so a step's CPU time against this period says whether the agents keep
+  /// up). 0 = off. Not with real_time. >= 0.
+  double step_every_s = 0.0;
   /// run_online only: > 0 runs the distributed certificate every this many seconds of
   /// stream time (at the first step after each period, once the graph is connected), on the
   /// graph received so far; 0 = only at the end. >= 0.
@@ -79,6 +84,9 @@ struct OnlineUpdate {
   /// and the process CPU of the rounds alone.
   double setup_s = 0.0;
   double rounds_cpu_s = 0.0;
+  /// The rounds' compute time with each agent on its own machine: per message step, the
+  /// slowest agent's CPU time, summed (DistributedResult::critical_path_cpu_s).
+  double critical_path_cpu_s = 0.0;
   /// Publication of the oldest absorbed batch to the end of the step (stream clock; with
   /// real_time the step's wall time counts as stream time).
   double latency_s = 0.0;
