@@ -34,8 +34,11 @@ def cases(args, work, tessera):
                             "--out", grid], check=True, stdout=subprocess.DEVNULL)
         # Re-solving from scratch after every closure step of the larger graphs would take hours:
         # those baselines re-solve at every K-th such step and scale (--baseline-every).
-        out = [("sphere2500", sphere, 5, "sphere2500", 1), ("city10000", city, 5, "city10000", 10),
-               ("grid3d-50000", grid, 10, grid, 40)]
+        # With steps shorter than a real-time step's (tick, or a fixed period) there are many more
+        # closure steps: sample more sparsely.
+        every = (1, 10, 40) if args.steps == "real-time" else (5, 40, 200)
+        out = [("sphere2500", sphere, 5, "sphere2500", every[0]),
+               ("city10000", city, 5, "city10000", every[1]), ("grid3d-50000", grid, 10, grid, every[2])]
         return [c for c in out if not args.cases or c[0] in args.cases.split(",")]
     out = []
     for kind, poses, robots in (("city", args.poses, 5), ("grid3d", args.poses, 5), ("sphere", args.poses, 5)):
