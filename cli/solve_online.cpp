@@ -17,10 +17,12 @@
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {"rate",           "speedup",       "start",
-                                     "checkpoints",    "certify-every", "refactor-growth",
-                                     "baseline-every", nullptr};
-const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", nullptr};
+const char* const kOnlineValued[] = {"rate",           "speedup",         "start",
+                                     "checkpoints",    "certify-every",   "refactor-growth",
+                                     "baseline-every", "local-threshold", "step-every",
+                                     nullptr};
+const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", "no-local-rounds",
+                                       nullptr};
 
 const char* kOnlineHelp =
     "\n"
@@ -36,6 +38,8 @@ const char* kOnlineHelp =
     "  --real-time               a step absorbs all batches published while the previous one\n"
     "                            ran (its wall time counts as stream time); default: one step\n"
     "                            per publication time\n"
+    "  --step-every S            a step every S seconds of stream time (absorbing all that\n"
+    "                            was published by then), whatever the machine's load\n"
     "  --checkpoints K           at K evenly spaced steps, the estimate's relative gap to the\n"
     "                            optimum of the graph received so far (centralized solver,\n"
     "                            computed after the run, not timed)\n"
@@ -50,6 +54,9 @@ const char* kOnlineHelp =
     "  --refactor-growth G       a growing block keeps its preconditioner factor until it\n"
     "                            has G times more poses than it was computed for (default\n"
     "                            0: a new factor whenever the block gets new poses)\n"
+    "  --local-threshold F       local rounds: a block works only while its gradient norm\n"
+    "                            is above F * grad-tol / sqrt(blocks), in (0, 1] (default 1)\n"
+    "  --no-local-rounds         every block works and sends in every round\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step)\n";
 
@@ -89,7 +96,11 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       a.get_long("certify-iters", options.solver.staircase.certificate.max_iterations));
   options.real_time = a.has("real-time");
   options.certify_every_s = a.get_double("certify-every", 0.0);
+  options.step_every_s = a.get_double("step-every", 0.0);
   options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
+  options.solver.local_rounds.enabled = !a.has("no-local-rounds");
+  options.solver.local_rounds.threshold =
+      a.get_double("local-threshold", options.solver.local_rounds.threshold);
   options.validate();
   ReplayOptions replay;
   replay.rate = a.get_double("rate", replay.rate);
@@ -156,7 +167,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
     ++baseline_sampled;
     DistributedOptions scratch = options.solver;
     scratch.certify = false;
-    scratch.round_result = false;  // the graph may not be connected yet
+    scratch.round_result = false;          // the graph may not be connected yet
+    scratch.local_rounds.enabled = false;  // a solve from scratch: every block has work
     const double c0 = cpu_now();
     solve_distributed(g, engine.assignment(), scratch, engine.stream().guesses());
     baseline_cpu_s += cpu_now() - c0;
@@ -202,6 +214,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("cpu_s", u.cpu_s)
           .add("setup_s", u.setup_s)
           .add("rounds_cpu_s", u.rounds_cpu_s)
+          .add("critical_path_cpu_s", u.critical_path_cpu_s)
           .add("latency_s", u.latency_s)
           .add("bytes", static_cast<std::size_t>(u.bytes))
           .add("grad_norm", u.grad_norm)
@@ -240,6 +253,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("rate", replay.rate)
         .add("speedup", replay.speedup)
         .add("real_time", options.real_time)
+        .add("step_every_s", options.step_every_s)
         .add("grad_tol", options.solver.grad_norm_tol)
         .add("steps", res.updates.size())
         .add("rounds", res.rounds)

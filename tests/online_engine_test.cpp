@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <tessera/generate/generator.hpp>
 #include <tessera/online/graph_stream.hpp>
@@ -213,6 +214,32 @@ TEST(OnlineEngine, RejectsBadOptionsNamingTheField) {
   o = {};
   o.rebalance.slack = -1;
   EXPECT_NE(test::validation_message(o).find("RebalanceOptions.slack"), std::string::npos);
+  o = {};
+  o.step_every_s = 0.5;
+  o.real_time = true;
+  EXPECT_NE(test::validation_message(o).find("OnlineOptions.step_every_s"), std::string::npos);
+}
+
+TEST(OnlineEngine, AFixedStepPeriodAbsorbsEachPeriodsBatchesAndEndsAtTheBatchOptimum) {
+  const auto gen = small_graph(TrajectoryKind::kCity, 90, 3);
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ReplayOptions{});
+  OnlineOptions o = online_options();
+  o.step_every_s = 0.5;
+  std::size_t batches = 0;
+  double last = 0.0;
+  const OnlineResult res = run_online(gen.graph.d, plan.batches, o);
+  for (const OnlineUpdate& u : res.updates) {
+    // Steps at multiples of the period, each absorbing what was published since the last.
+    EXPECT_NEAR(u.time_s / 0.5, std::round(u.time_s / 0.5), 1e-9) << u.time_s;
+    EXPECT_GT(u.time_s, last);
+    last = u.time_s;
+    batches += u.batches;
+  }
+  EXPECT_EQ(batches, plan.batches.size());
+  // 30 poses a robot at 10 per second: 3 s of stream, six periods (one step is the last).
+  EXPECT_LE(res.updates.size(), 7u);
+  const double f_star = batch_optimum(gen.graph);
+  EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
 }
 
 }  // namespace

@@ -29,6 +29,7 @@ RoundConfig make_round_config(const DistributedOptions& options, const MomentumS
   config.update = options.algorithm_block_update();
   config.scheme = scheme;
   config.coarse = options.coarse;
+  config.local = options.local_rounds;
   return config;
 }
 

@@ -48,6 +48,9 @@ void DistributedOptions::validate() const {
   if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
   block_update.validate();
   coarse.validate();
+  local_rounds.validate();
+  if (local_rounds.enabled && coarse.enabled)
+    fail("local_rounds.enabled", "cannot be combined with coarse.enabled");
   if (irbcd_trust_region_steps < 0) fail("irbcd_trust_region_steps", "must be >= 0");
   if (!(irbcd_grad_reduction < 1)) fail("irbcd_grad_reduction", "must be < 1");
   algorithm_block_update().validate();

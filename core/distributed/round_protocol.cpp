@@ -24,6 +24,22 @@ RoundProtocol::RoundProtocol(AgentState& state, const BlockLayout& layout,
   config_.coarse.validate();
   if (config_.scheme) scheme_ = config_.scheme->clone();
   config_.scheme = nullptr;  // the clone is ours; the caller's object may go away
+  if (config_.local.enabled) {
+    if (config_.coarse.enabled)
+      throw std::invalid_argument("RoundProtocol: local rounds do not combine with coarse ones");
+    local_.emplace(layout_, config_.local, config_.grad_norm_tol);
+    for (std::size_t id : state_.problem().neighbors())
+      neighbour_owner_.push_back(layout_.owner[id]);
+  }
+}
+
+void RoundProtocol::freeze_inactive_neighbours(Eigen::MatrixXd& copy) const {
+  if (!local_) return;
+  const Eigen::Index w = state_.problem().dim() + 1;
+  for (std::size_t k = 0; k < neighbour_owner_.size(); ++k)
+    if (!local_->active(neighbour_owner_[k]))
+      copy.middleCols(w * static_cast<Eigen::Index>(k), w) =
+          state_.Yn.middleCols(w * static_cast<Eigen::Index>(k), w);
 }
 
 bool RoundProtocol::selected(int block) const {
@@ -75,6 +91,7 @@ std::vector<OutgoingMessage> RoundProtocol::resume(const ProtocolSnapshot& s) {
                              std::to_string(s.round) + ": " + why);
   };
   if (s.agent != state_.id()) fail("it belongs to agent " + std::to_string(s.agent));
+  if (local_) fail("local rounds keep no snapshot of the other blocks' statuses");
   auto same = [](const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
     return a.rows() == b.rows() && a.cols() == b.cols();
   };
@@ -205,9 +222,12 @@ void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
       if (scheme_ && scheme_->unselected_take_extrapolation()) state_.Yn = state_.Pn;
       for (auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), state_.Yn);
       // The neighbours' V^{k+1}, exactly as each of them forms its own (same scalars, same
-      // pose-wise arithmetic), from the coefficients of the round just finished.
-      if (scheme_)
+      // pose-wise arithmetic), from the coefficients of the round just finished; an inactive
+      // one's V is its Y.
+      if (scheme_) {
         momentum_update_into(state_.manifold(), coeff_, state_.Vn, state_.Pn, state_.Yn, state_.Vn);
+        freeze_inactive_neighbours(state_.Vn);
+      }
       ++round_;
       begin_status(ProtocolPhase::kStatus, out);
       return;
@@ -223,6 +243,14 @@ void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
 
 void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessage>& out) {
   if (phase == ProtocolPhase::kStatus && observer_) observer_(snapshot());
+  if (local_) {
+    // Only blocks whose status can have changed send one; the others' last one stands.
+    std::vector<int> senders = local_->status_senders();
+    if (!local_->sends_status(state_.id())) {
+      expect(u32(round_), phase, std::move(senders));
+      return;
+    }
+  }
   const LocalStatus s = state_.status(config_.selection == SelectionRule::kGreedyNewton);
   RoundStatusMessage m;
   m.round = u32(round_);
@@ -239,6 +267,10 @@ void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessag
   o.message = m;
   o.broadcast = true;
   out.push_back(std::move(o));
+  if (local_) {
+    expect(u32(round_), phase, local_->status_senders());
+    return;
+  }
   std::vector<int> everyone(static_cast<std::size_t>(layout_.num_blocks));
   for (int b = 0; b < layout_.num_blocks; ++b) everyone[static_cast<std::size_t>(b)] = b;
   expect(u32(round_), phase, std::move(everyone));
@@ -249,11 +281,22 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   // The reduction: summed in agent-id order (the map's order) by every agent.
   double f = 0.0, gsq = 0.0;
   std::vector<double> norms(static_cast<std::size_t>(layout_.num_blocks), 0.0);
-  for (const auto& [sender, m] : inbox) {
-    const auto& s = std::get<RoundStatusMessage>(m);
-    f += s.cost;
-    gsq += s.grad_norm_sq;
-    norms[static_cast<std::size_t>(sender)] = s.block_grad_norm;
+  if (local_) {
+    for (const auto& [sender, m] : inbox) {
+      const auto& s = std::get<RoundStatusMessage>(m);
+      local_->record(sender, s.cost, s.grad_norm_sq, s.block_grad_norm);
+    }
+    local_->update_activity();
+    f = local_->cost();
+    gsq = local_->grad_norm_sq();
+    norms = local_->scores();  // inactive blocks score 0
+  } else {
+    for (const auto& [sender, m] : inbox) {
+      const auto& s = std::get<RoundStatusMessage>(m);
+      f += s.cost;
+      gsq += s.grad_norm_sq;
+      norms[static_cast<std::size_t>(sender)] = s.block_grad_norm;
+    }
   }
   const int me = state_.id();
   const bool restart = phase == ProtocolPhase::kStatus && scheme_ && round_ > 0 &&
@@ -302,12 +345,15 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
     f += coarse_correct(inbox, round_ > 0 ? f_prev_ - f : 0.0);
   f_prev_ = f;
   gsq_prev_ = gsq;
+  const ClassScore class_score = scheme_ ? scheme_->class_score() : ClassScore::kLargestBlock;
   selection_ = select_blocks(config_.selection, config_.parallel, config_.seed,
-                             static_cast<std::uint64_t>(round_), norms, layout_,
-                             scheme_ ? scheme_->class_score() : ClassScore::kLargestBlock);
+                             static_cast<std::uint64_t>(round_), norms, layout_, class_score);
+  // A block that did not move since the last round still holds Y^{k-1} in Y_prev.
+  const bool keep_prev = !local_ || local_->moved(me);
+  if (local_) select_local(class_score, norms);
   rec.selected = selection_;
   trace_.push_back(rec);
-  state_.Y_prev = state_.Y;
+  if (keep_prev) state_.Y_prev = state_.Y;
   state_.Yn_prev = state_.Yn;
   if (!scheme_) {
     begin_update(out);
@@ -315,9 +361,31 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   }
   coeff_ = scheme_->coefficients();
   // P^k needs no exchange: the neighbours' public P^k is formed from their mirrored V^k.
-  extrapolate_into(state_.manifold(), coeff_, state_.Y, state_.V, state_.P);
+  if (active_self()) extrapolate_into(state_.manifold(), coeff_, state_.Y, state_.V, state_.P);
   extrapolate_into(state_.manifold(), coeff_, state_.Yn, state_.Vn, state_.Pn);
+  freeze_inactive_neighbours(state_.Pn);
   begin_update(out);
+}
+
+void RoundProtocol::select_local(ClassScore class_score, const std::vector<double>& scores) {
+  auto keep_active = [&] {
+    selection_.erase(std::remove_if(selection_.begin(), selection_.end(),
+                                    [&](int b) { return !local_->active(b); }),
+                     selection_.end());
+  };
+  keep_active();
+  // Uniform or round-robin may draw a unit with no active block: take the greedy one instead
+  // (scores are 0 for inactive blocks), so every round moves some block that has work.
+  if (selection_.empty()) {
+    selection_ = select_blocks(SelectionRule::kGreedy, config_.parallel, config_.seed,
+                               static_cast<std::uint64_t>(round_), scores, layout_, class_score);
+    keep_active();
+  }
+  std::vector<int> movers = selection_;
+  if (scheme_ && scheme_->unselected_take_extrapolation())
+    for (int b = 0; b < layout_.num_blocks; ++b)
+      if (local_->active(b) && !selected(b)) movers.push_back(b);
+  local_->set_moved(movers);
 }
 
 double RoundProtocol::coarse_correct(const Inbox& inbox, double last_decrease) {
@@ -358,12 +426,23 @@ void RoundProtocol::begin_update(std::vector<OutgoingMessage>& out) {
                         : state_.update(state_.Y, state_.Yn, config_.update);
     send_poses(Y_new, BlockKind::kY, ProtocolPhase::kUpdate,
                layout_.adjacent[static_cast<std::size_t>(me)], out);
+  } else if (!active_self()) {
+    // Inactive: Y stays, and V := Y so that the momentum starts afresh when the block wakes
+    // up (its neighbours' copies do the same).
+    if (accelerated) {
+      if (!frozen_) state_.V = state_.Y;
+      frozen_ = true;
+      scheme_->advance();
+    }
+    expect(u32(round_), ProtocolPhase::kUpdate, selected_neighbours());
+    return;
   } else {
     Y_new = (accelerated && scheme_->unselected_take_extrapolation()) ? state_.P : state_.Y;
   }
   if (accelerated) {
     momentum_update_into(state_.manifold(), coeff_, state_.V, state_.P, Y_new, state_.V);
     scheme_->advance();
+    frozen_ = false;
   }
   state_.Y = std::move(Y_new);
   expect(u32(round_), ProtocolPhase::kUpdate, selected_neighbours());

@@ -12,12 +12,22 @@
 
 namespace tessera {
 
+DistributedOptions online_solver_options() {
+  DistributedOptions o;
+  o.local_rounds.enabled = true;
+  return o;
+}
+
 void OnlineOptions::validate() const {
   rebalance.validate();
   if (!(refactor_growth >= 0) || !std::isfinite(refactor_growth))
     throw InputError("OnlineOptions.refactor_growth must be a finite number >= 0");
   if (!(certify_every_s >= 0) || !std::isfinite(certify_every_s))
     throw InputError("OnlineOptions.certify_every_s must be a finite number >= 0 (seconds)");
+  if (!(step_every_s >= 0) || !std::isfinite(step_every_s))
+    throw InputError("OnlineOptions.step_every_s must be a finite number >= 0 (seconds)");
+  if (step_every_s > 0 && real_time)
+    throw InputError("OnlineOptions.step_every_s: a fixed step period excludes real_time");
   DistributedOptions s = solver;
   s.certify = certify_at_end;  // the staircase options matter only then
   try {
@@ -118,6 +128,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     u.stop_reason = res.stop_reason;
     u.setup_s = res.init_s;
     u.rounds_cpu_s = res.solve_cpu_s;
+    u.critical_path_cpu_s = res.critical_path_cpu_s;
     u.relaxation_cost = res.relaxation_cost;
   }
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
@@ -214,7 +225,12 @@ OnlineResult run_online(int d, const std::vector<StreamBatch>& batches,
   while (next < batches.size()) {
     // Without real time, each distinct stamp is one step; with it, everything published
     // while the previous step ran enters together.
-    clock = std::max(clock, batches[next].stamp);
+    if (options.step_every_s > 0)  // the first period that holds the next batch
+      clock =
+          std::max(clock + options.step_every_s,
+                   std::ceil(batches[next].stamp / options.step_every_s) * options.step_every_s);
+    else
+      clock = std::max(clock, batches[next].stamp);
     while (next < batches.size() && batches[next].stamp <= clock) engine.receive(batches[next++]);
     const OnlineUpdate u = engine.step(clock);
     if (observer && (u.poses > 0 || u.measurements > 0 || u.rounds > 0)) observer(engine, u);

@@ -34,8 +34,11 @@ def cases(args, work, tessera):
                             "--out", grid], check=True, stdout=subprocess.DEVNULL)
         # Re-solving from scratch after every closure step of the larger graphs would take hours:
         # those baselines re-solve at every K-th such step and scale (--baseline-every).
-        out = [("sphere2500", sphere, 5, "sphere2500", 1), ("city10000", city, 5, "city10000", 10),
-               ("grid3d-50000", grid, 10, grid, 40)]
+        # With steps shorter than a real-time step's (tick, or a fixed period) there are many more
+        # closure steps: sample more sparsely.
+        every = (1, 10, 40) if args.steps == "real-time" else (5, 40, 200)
+        out = [("sphere2500", sphere, 5, "sphere2500", every[0]),
+               ("city10000", city, 5, "city10000", every[1]), ("grid3d-50000", grid, 10, grid, every[2])]
         return [c for c in out if not args.cases or c[0] in args.cases.split(",")]
     out = []
     for kind, poses, robots in (("city", args.poses, 5), ("grid3d", args.poses, 5), ("sphere", args.poses, 5)):
@@ -55,6 +58,12 @@ def main():
     ap.add_argument("--grad-tol", type=float, default=1e-3, help="agents' gradient tolerance (default 1e-3)")
     ap.add_argument("--checkpoints", type=int, default=5, help="checkpoints per run (default 5)")
     ap.add_argument("--full", action="store_true", help="the issue's sizes (long on a shared machine)")
+    ap.add_argument("--steps", default="real-time",
+                    help="real-time (a step absorbs what was published while the last one ran: depends on the "
+                         "load), tick (one step per publication time: load-free, re-solving after every tick that "
+                         "brought a loop closure), or a number S (a step every S seconds of stream time)")
+    ap.add_argument("--no-baseline", action="store_true", help="skip the re-solving baseline")
+    ap.add_argument("--no-certify", action="store_true", help="skip the final certificate")
     ap.add_argument("--cases", default="", help="with --full: comma list of sphere2500,city10000,grid3d-50000")
     ap.add_argument("--dds", action="store_true",
                     help="also run each case over DDS (tessera launch --online: one agent process per robot)")
@@ -66,10 +75,14 @@ def main():
         load = os.getloadavg()[0]
         js = os.path.join(ctx.work, os.path.basename(path) + ".online.json")
         cmd = [ctx.bin, "solve", path, "--online", "--robots", str(robots), "--rate", str(args.rate),
-               "--speedup", str(args.speedup), "--real-time", "--grad-tol", str(args.grad_tol),
-               "--checkpoints", str(args.checkpoints), "--baseline", "--json", js]
-        if every > 1:
+               "--speedup", str(args.speedup)] + step_args(args) + [
+               "--grad-tol", str(args.grad_tol), "--checkpoints", str(args.checkpoints), "--json", js]
+        if not args.no_baseline:
+            cmd += ["--baseline"]
+        if every > 1 and not args.no_baseline:
             cmd += ["--baseline-every", str(every)]
+        if args.no_certify:
+            cmd += ["--no-certify"]
         if args.full:
             # Robot-aligned blocks cut city10000 thousands of times: the certificate's LOBPCG needs
             # more than its default 300 iterations there (docs/online.md, Figures).
@@ -90,8 +103,11 @@ def main():
             "online_cpu_s": s["cpu_s"], "online_setup_s": s["setup_s"], "online_rounds_cpu_s": s["rounds_cpu_s"], "baseline_cpu_s": s.get("baseline_cpu_s"),
             "baseline_solves": s.get("baseline_solves"), "baseline_resolved": s.get("baseline_resolved"),
             "cpu_ratio": s["cpu_s"] / s["baseline_cpu_s"] if s.get("baseline_cpu_s") else None,
+            "max_step_cpu_s": max((u["cpu_s"] for u in s["updates"]), default=0.0),
+            "critical_path_cpu_s": sum(u.get("critical_path_cpu_s", 0.0) for u in s["updates"]),
             "repartitions": 0, "poses_moved": 0,
-            "final_cost": s["cost"], "fstar": fstar, "final_rel_gap": (s["cost"] - fstar) / fstar,
+            "final_cost": s["cost"], "fstar": fstar,
+            "final_rel_gap": (s["cost"] - fstar) / fstar if s.get("cost") else None,
             "certified": s["certified"], "load_1min": round(load, 2),
         }
         rows.append(row)
@@ -101,16 +117,26 @@ def main():
         write_outputs(args, ctx, rows, runs, dds_rows)  # after each case: a long run keeps what it did
 
 
+def step_args(args):
+    if args.steps == "real-time":
+        return ["--real-time"]
+    if args.steps == "tick":
+        return []
+    return ["--step-every", str(float(args.steps))]
+
+
 def write_outputs(args, ctx, rows, runs, dds_rows):
     headers = ["graph", "poses", "steps", "lat med s", "lat p95 s", "max gap", "online CPU s", "set-up s",
-               "rounds CPU s", "re-solves", "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
+               "rounds CPU s", "max step CPU s", "critical path s", "re-solves", "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
     table = bc.print_table(
-        f"online runs (rate {args.rate}/s per robot, speedup {args.speedup}, --real-time, grad tol {args.grad_tol})",
+        f"online runs (rate {args.rate}/s per robot, speedup {args.speedup}, steps {args.steps}, "
+        f"grad tol {args.grad_tol})",
         headers,
         [[r["graph"], r["poses"], r["steps"], bc.fmt(r["latency_median_s"], "{:.4f}"),
           bc.fmt(r["latency_p95_s"], "{:.4f}"), bc.fmt(r["max_checkpoint_rel_gap"], "{:.2e}"),
           bc.fmt(r["online_cpu_s"], "{:.2f}"), bc.fmt(r["online_setup_s"], "{:.2f}"),
-          bc.fmt(r["online_rounds_cpu_s"], "{:.2f}"),
+          bc.fmt(r["online_rounds_cpu_s"], "{:.2f}"), bc.fmt(r["max_step_cpu_s"], "{:.2f}"),
+          bc.fmt(r["critical_path_cpu_s"], "{:.2f}"),
           f"{r['baseline_resolved']}/{r['baseline_solves']}", bc.fmt(r["baseline_cpu_s"], "{:.2f}"),
           bc.fmt(r["cpu_ratio"], "{:.3f}"), bc.fmt(r["final_rel_gap"], "{:.1e}"), r["certified"], r["load_1min"]]
          for r in rows])
@@ -164,7 +190,7 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
                 "(gradient back under the tolerance or stalled), median and 95th percentile over all batches; max "
                 "gap = largest relative gap (f(estimate) - f*_k) / f*_k over the checkpoints, f*_k the centralized "
                 "optimum of the graph received by checkpoint k; online CPU = process CPU of all steps and the final "
-                "certificate; set-up s = wall time of the agents' set-up (block problems, preconditioner factors) over the steps; rounds CPU s = process CPU of the rounds alone; re-solves = steps re-solved / steps that brought a loop closure; re-solve CPU = the same agents "
+                "certificate; max step CPU s = the longest step's process CPU (all agents); critical path s = the rounds' compute time summed over the steps with every agent on its own machine (per message step the slowest agent); set-up s = wall time of the agents' set-up (block problems, preconditioner factors) over the steps; rounds CPU s = process CPU of the rounds alone; re-solves = steps re-solved / steps that brought a loop closure; re-solve CPU = the same agents "
                 "solving from scratch (the front ends' guesses) after every step that brought a loop closure (when "
                 "only every K-th such step is re-solved, their CPU times (steps / re-solved)); ratio = online CPU / "
                 "re-solve CPU; final rel gap = (cost - f*) / f* with f* of the whole graph. The "

@@ -10,6 +10,7 @@
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/distributed/in_process_driver.hpp>
 #include <tessera/distributed/irbcd.hpp>
+#include <tessera/distributed/local_rounds.hpp>
 #include <tessera/distributed/rbcd.hpp>
 #include <tessera/distributed/rbcd_plus_plus.hpp>
 #include <tessera/distributed/stage_records.hpp>
@@ -60,6 +61,10 @@ struct DistributedOptions {
   /// Two-level rounds: a rigid correction of every block per scheduled round
   /// (coarse_correction.hpp; docs/irbcd.md, "Coarse correction").
   CoarseOptions coarse;
+  /// Local rounds: only blocks whose gradient is above a bound update, take momentum steps
+  /// and send (local_rounds.hpp). Off for batch solves (every block starts far from its
+  /// optimum there); the online runs turn it on. Not with `coarse`.
+  LocalRoundOptions local_rounds;
   /// After the solve, certify global optimality distributedly and climb the staircase
   /// (docs/distributed-certification.md). Off by default for `tessera solve`.
   bool certify = false;

@@ -27,12 +27,14 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tessera/distributed/agent_process.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/block_selection.hpp>
 #include <tessera/distributed/coarse_correction.hpp>
+#include <tessera/distributed/local_rounds.hpp>
 #include <tessera/distributed/momentum.hpp>
 #include <tessera/distributed/rbcd.hpp>
 #include <tessera/distributed/round_history.hpp>
@@ -66,6 +68,9 @@ struct RoundConfig {
   const MomentumScheme* scheme = nullptr;
   /// Two-level rounds: the blocks' rigid coarse correction (coarse_correction.hpp).
   CoarseOptions coarse;
+  /// Only blocks with a gradient above a bound work and send (local_rounds.hpp). Not with
+  /// `coarse` (its rounds need every block's terms and move every block).
+  LocalRoundOptions local;
 };
 
 class RoundProtocol : public AgentProcess {
@@ -119,12 +124,22 @@ class RoundProtocol : public AgentProcess {
                   const std::vector<int>& recipients, std::vector<OutgoingMessage>& out);
   bool selected(int block) const;
   std::vector<int> selected_neighbours() const;
+  // Local rounds: whether this agent's block (or neighbour copy slot k's owner) is active.
+  bool active_self() const { return !local_ || local_->active(state_.id()); }
+  // Local rounds: the neighbour copies of inactive blocks' poses are set to Yn in `copy`.
+  void freeze_inactive_neighbours(Eigen::MatrixXd& copy) const;
+  // Local rounds: keeps the active blocks of the selection (a greedy one when none is), and
+  // records who moves this round.
+  void select_local(ClassScore class_score, const std::vector<double>& scores);
+  bool frozen_ = false;  // local rounds: this block is inactive and V == Y
 
   AgentState& state_;
   const BlockLayout& layout_;
   RoundConfig config_;
   std::unique_ptr<MomentumScheme> scheme_;
   MomentumCoefficients coeff_;
+  std::optional<LocalRounds> local_;
+  std::vector<int> neighbour_owner_;  // block of each neighbour copy slot (local rounds)
 
   int round_ = 0;
   ProtocolPhase phase_ = ProtocolPhase::kInit;

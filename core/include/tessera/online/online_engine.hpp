@@ -26,11 +26,15 @@
 
 namespace tessera {
 
+/// The agents' solver of an online run: DistributedOptions' defaults with local rounds on
+/// (after a batch, most blocks are converged and only those near the new data need work).
+DistributedOptions online_solver_options();
+
 struct OnlineOptions {
-  /// The agents' solver (algorithm, rank, tolerance, selection, ...). Its `certify` and
-  /// `initialization` are not used: poses are initialised by composition, and certification
-  /// is `certify_at_end`.
-  DistributedOptions solver;
+  /// The agents' solver (algorithm, rank, tolerance, selection, local rounds, ...). Its
+  /// `certify` and `initialization` are not used: poses are initialised by composition, and
+  /// certification is `certify_at_end`.
+  DistributedOptions solver = online_solver_options();
   /// Run the distributed certificate (with the staircase of solver.staircase) after the
   /// last batch.
   bool certify_at_end = true;
@@ -41,6 +45,11 @@ struct OnlineOptions {
   /// stamps are a real-time clock; a step absorbs every batch published by the time the
   /// previous step ended (its measured wall time), as a live run would.
   bool real_time = false;
+  /// run_online only, > 0: a step every this many seconds of stream time, absorbing every batch
+  /// published by then (a back end that steps at a fixed period: the same steps whatever the
+  /// machine's load, so a step's CPU time against this period says whether the agents keep
+  /// up). 0 = off. Not with real_time. >= 0.
+  double step_every_s = 0.0;
   /// run_online only: > 0 runs the distributed certificate every this many seconds of
   /// stream time (at the first step after each period, once the graph is connected), on the
   /// graph received so far; 0 = only at the end. >= 0.
@@ -75,6 +84,9 @@ struct OnlineUpdate {
   /// and the process CPU of the rounds alone.
   double setup_s = 0.0;
   double rounds_cpu_s = 0.0;
+  /// The rounds' compute time with each agent on its own machine: per message step, the
+  /// slowest agent's CPU time, summed (DistributedResult::critical_path_cpu_s).
+  double critical_path_cpu_s = 0.0;
   /// Publication of the oldest absorbed batch to the end of the step (stream clock; with
   /// real_time the step's wall time counts as stream time).
   double latency_s = 0.0;
