@@ -2,9 +2,9 @@
 // The smoothed coarse space of the two-level rounds (CoarseSpaceKind::kSmoothed): smoothed
 // aggregation for the pose graph. The slow error of block updates is smooth bending of the
 // map (the rotation varying across it, the translations following), not a rigid drift of
-// whole blocks: measured on the generated 8000-pose grid at N = 49, one rigid motion per block
-// can remove 12 % of f - f*, 32 rigid pieces per block 40 %, the same pieces blended smoothly
-// 65-90 % (docs/irbcd.md, "Coarse correction").
+// whole blocks: measured on the generated 8000-pose grid at N = 49, one correction with one
+// rigid motion per block removes 6 % of f - f*, with 16 rigid pieces per block 29 %, with the
+// same pieces blended smoothly 64-79 % (docs/irbcd.md, "Coarse correction").
 //
 // The space: each block's own graph is cut into `aggregates` pieces grown by BFS (a block
 // whose own graph falls apart gets a piece per part); every piece alpha may move rigidly,
