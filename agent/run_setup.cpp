@@ -55,6 +55,8 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   ro.seed = asg.seed();
   ro.certify = asg.certify();
   ro.coarse_every = asg.coarse_every();
+  ro.coarse_aggregates = asg.coarse_aggregates();
+  ro.coarse_smoothing = asg.coarse_smoothing();
   if (!asg.robust().empty()) {
     ro.robust.kind = parse_robust_kind(asg.robust());
     ro.robust.inlier_threshold = asg.inlier_threshold();

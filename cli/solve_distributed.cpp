@@ -58,6 +58,9 @@ const char* const kDistributedValued[] = {"agents",
                                           "coarse",
                                           "coarse-every",
                                           "coarse-min-gain",
+                                          "coarse-space",
+                                          "coarse-aggregates",
+                                          "coarse-smoothing",
                                           nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
@@ -126,6 +129,11 @@ const char* kDistributedHelp =
     "  --coarse-every K          with --coarse on: correct every K-th round (default 1)\n"
     "  --coarse-min-gain F       apply a correction only when it lowers f by >= F times the\n"
     "                            last round's decrease (default 0)\n"
+    "  --coarse-space blocks|smoothed   with --coarse on: one rigid motion per block, or a few\n"
+    "                            rigid pieces per block blended smoothly across their borders\n"
+    "                            (smoothed aggregation; default blocks)\n"
+    "  --coarse-aggregates K     smoothed: pieces grown per block (default 4)\n"
+    "  --coarse-smoothing S      smoothed: smoothing steps of the blend, 0..8 (default 1)\n"
     "  --irbcd-keep-ab           IRBCD: keep a, b running after a restart (the default)\n"
     "  --unselected take|keep    IRBCD: unselected blocks take P^k or keep Y^k (default take)\n"
     "  --irbcd-n units|variables IRBCD: n = selectable blocks (default) or scalar variables\n"
@@ -223,6 +231,10 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   }
   opt.coarse.every = static_cast<int>(a.get_long("coarse-every", opt.coarse.every));
   opt.coarse.min_gain = a.get_double("coarse-min-gain", opt.coarse.min_gain);
+  if (a.has("coarse-space")) opt.coarse.space = parse_coarse_space(a.get_or("coarse-space", ""));
+  opt.coarse.aggregates = static_cast<int>(a.get_long("coarse-aggregates", opt.coarse.aggregates));
+  opt.coarse.smoothing_steps =
+      static_cast<int>(a.get_long("coarse-smoothing", opt.coarse.smoothing_steps));
   opt.irbcd.sigma = a.get_double("sigma", opt.irbcd.sigma);
   if (a.has("irbcd-a0")) opt.irbcd.unit_first_gamma = false;
   opt.irbcd.a0 = a.get_double("irbcd-a0", opt.irbcd.a0);

@@ -33,6 +33,8 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   asg.status_relay(options.status_relay);
   asg.replica_every(options.replica_every);
   asg.coarse_every(options.coarse_every);
+  asg.coarse_aggregates(options.coarse_aggregates);
+  asg.coarse_smoothing(options.coarse_smoothing);
   if (options.robust.kind != RobustKind::kNone) {
     const RobustOptions& r = options.robust;
     asg.robust(robust_kind_name(r.kind));

@@ -66,6 +66,10 @@ options:
   --coarse-every K     two-level rounds: the agents add a rigid coarse correction of every
                        block every K-th round (docs/irbcd.md, "Coarse correction"); 0 = off
                        (default 0)
+  --coarse-space blocks|smoothed  the coarse space: one rigid motion per block, or K rigid
+                       pieces per block blended smoothly across their borders (default blocks)
+  --coarse-aggregates K  smoothed: pieces per block (default 4)
+  --coarse-smoothing S   smoothed: smoothing steps of the blend, 0..8 (default 1)
   --robust none|gnc-tls  gnc-tls: reject outlier measurements by graduated non-convexity
                        with a truncated least-squares cost, then solve (and with --certify
                        certify) the kept ones; every agent weighs the measurements of its
@@ -109,7 +113,10 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "progress-interval",
                                                             "replicas",
                                                             "replica-every",
-                                                            "coarse-every"},
+                                                            "coarse-every",
+                                                            "coarse-space",
+                                                            "coarse-aggregates",
+                                                            "coarse-smoothing"},
                                                            cli::SessionArgsFor::kProcess);
   valued.insert("graph");
   for (const char* const* r = cli::kRobustValued; *r; ++r) valued.insert(*r);
@@ -166,6 +173,15 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   a.replica_every = static_cast<std::uint32_t>(nonneg("replica-every", 10));
   if (a.replica_every < 1) throw InputError("option --replica-every: must be >= 1");
   a.coarse_every = static_cast<std::uint32_t>(nonneg("coarse-every", a.coarse_every));
+  if (parse_coarse_space(args.get_or("coarse-space", "blocks")) == CoarseSpaceKind::kSmoothed) {
+    CoarseOptions c;  // the core's defaults and ranges
+    c.aggregates = static_cast<int>(nonneg("coarse-aggregates", c.aggregates));
+    c.smoothing_steps = static_cast<int>(nonneg("coarse-smoothing", c.smoothing_steps));
+    if (c.aggregates < 1) throw InputError("option --coarse-aggregates: must be >= 1");
+    if (c.smoothing_steps > 8) throw InputError("option --coarse-smoothing: must be 0..8");
+    a.coarse_aggregates = static_cast<std::uint32_t>(c.aggregates);
+    a.coarse_smoothing = static_cast<std::uint32_t>(c.smoothing_steps);
+  }
   a.verbose = args.has("verbose");
   a.certify = args.has("certify");
   if (args.has("status-relay") && args.has("no-status-relay"))

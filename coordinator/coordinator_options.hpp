@@ -43,6 +43,11 @@ struct CoordinatorOptions {
   bool status_relay = true;
   /// Two-level rounds: a coarse correction every this many rounds; 0 = off (--coarse-every).
   std::uint32_t coarse_every = 0;
+  /// The coarse space: 0 = one rigid motion per block (--coarse-space blocks); K > 0 = the
+  /// smoothed space with K pieces per block (--coarse-space smoothed, --coarse-aggregates K)
+  /// and coarse_smoothing smoothing steps (--coarse-smoothing S).
+  std::uint32_t coarse_aggregates = 0;
+  std::uint32_t coarse_smoothing = 1;
   /// Robust solve (--robust, --inlier-threshold, --inlier-quantile, --gnc-max-outer,
   /// --gnc-mu-step, --gnc-inner-rounds, --known-inliers; docs/robust.md).
   RobustOptions robust;

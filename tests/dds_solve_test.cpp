@@ -52,13 +52,16 @@ DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int
 }
 
 void expect_same_as_in_process(const std::string& algorithm, int domain, bool status_relay = true,
-                               bool coarse = false) {
+                               bool coarse = false, bool smoothed = false) {
   const std::string dir = temp_dir();
   const std::string graph = generate(dir, 240, 3, 5);
   std::vector<std::string> coordinator_args = {"--partition", "eco", "--algorithm", algorithm,
                                                "--seed",      "7",   "--init",      "file"};
   if (!status_relay) coordinator_args.push_back("--no-status-relay");
   if (coarse) coordinator_args.insert(coordinator_args.end(), {"--coarse-every", "1"});
+  if (smoothed)
+    coordinator_args.insert(coordinator_args.end(),
+                            {"--coarse-space", "smoothed", "--coarse-aggregates", "2"});
   const DdsRun dds = run_dds(dir, graph, 3, domain, coordinator_args);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(dds.assignment.size(), g.num_poses);
@@ -67,6 +70,10 @@ void expect_same_as_in_process(const std::string& algorithm, int domain, bool st
   opt.algorithm = parse_algorithm(algorithm);
   opt.seed = 7;
   opt.coarse.enabled = coarse;
+  if (smoothed) {
+    opt.coarse.space = CoarseSpaceKind::kSmoothed;
+    opt.coarse.aggregates = 2;
+  }
   const DistributedResult ref = solve_distributed(g, dds.assignment, opt, g.initial);
   ASSERT_GT(ref.rounds, 1) << "the graph should need a few rounds";
 
@@ -125,6 +132,12 @@ TEST(DdsSolve, StatusesAllToAllGiveTheInProcessIterates) {
 TEST(DdsSolve, CoarseCorrectionOverDdsGivesTheInProcessIterates) {
   expect_same_as_in_process("irbcd", 55, true, true);
   expect_same_as_in_process("irbcd", 56, false, true);
+}
+
+// The smoothed coarse space: every agent builds it from the structure it holds, the terms ride
+// in the statuses as before, so the DDS agents give the in-process iterates.
+TEST(DdsSolve, SmoothedCoarseCorrectionOverDdsGivesTheInProcessIterates) {
+  expect_same_as_in_process("irbcd", 75, true, true, true);
 }
 
 // Kills whatever processes of run `run_id` a test leaves running when an assertion fails (a

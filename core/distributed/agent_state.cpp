@@ -82,6 +82,8 @@ void AgentState::extend(const std::vector<Measurement>& measurements, std::size_
       measurements, first_new);
   coarse_.reset();
   coarse_source_ = &measurements;
+  smoothed_.reset();  // built for the old blocks
+  space_.reset();
   Y = P = V = Y_prev = V_prev = Y0;
   Yn = Pn = Vn = Yn_prev =
       Eigen::MatrixXd::Zero(Y0.rows(), w * static_cast<Eigen::Index>(problem_.num_neighbors()));
@@ -119,6 +121,21 @@ void AgentState::apply_coarse(const std::vector<Eigen::MatrixXd>& motions) {
     apply_motion(z, d_, Yn, static_cast<Eigen::Index>(k), 1);
     apply_motion(z, d_, Vn, static_cast<Eigen::Index>(k), 1);
   }
+}
+
+void AgentState::use_coarse_space(std::shared_ptr<const CoarseSpace> space,
+                                  const std::vector<Measurement>& measurements) {
+  smoothed_.reset();
+  space_ = std::move(space);
+  if (space_)
+    smoothed_.emplace(*space_, id_, d_, problem_.owned(), problem_.neighbors(), measurements);
+}
+
+void AgentState::apply_smoothed_coarse(const std::vector<Eigen::MatrixXd>& motions) {
+  apply_blended_motions(*space_, motions, d_, problem_.owned(), Y);
+  apply_blended_motions(*space_, motions, d_, problem_.owned(), V);
+  apply_blended_motions(*space_, motions, d_, problem_.neighbors(), Yn);
+  apply_blended_motions(*space_, motions, d_, problem_.neighbors(), Vn);
 }
 
 BlockPreconditioner& AgentState::euclidean() {

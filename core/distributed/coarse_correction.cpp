@@ -10,6 +10,8 @@
 #include <tessera/util/input_error.hpp>
 #include <unordered_map>
 
+#include "distributed/coarse_problem.hpp"
+
 namespace tessera {
 
 void CoarseOptions::validate() const {
@@ -18,6 +20,21 @@ void CoarseOptions::validate() const {
   if (!(rel_tol >= 0 && rel_tol < 1)) throw InputError("CoarseOptions.rel_tol must be in [0, 1)");
   if (!(min_gain >= 0 && std::isfinite(min_gain)))
     throw InputError("CoarseOptions.min_gain must be finite and >= 0");
+  if (aggregates < 1) throw InputError("CoarseOptions.aggregates must be >= 1");
+  if (smoothing_steps < 0 || smoothing_steps > 8)
+    throw InputError("CoarseOptions.smoothing_steps must be in 0..8");
+  if (!(smoothing_weight > 0 && smoothing_weight <= 1))
+    throw InputError("CoarseOptions.smoothing_weight must be in (0, 1]");
+}
+
+const char* coarse_space_name(CoarseSpaceKind kind) {
+  return kind == CoarseSpaceKind::kSmoothed ? "smoothed" : "blocks";
+}
+
+CoarseSpaceKind parse_coarse_space(const std::string& name) {
+  if (name == "blocks") return CoarseSpaceKind::kBlocks;
+  if (name == "smoothed") return CoarseSpaceKind::kSmoothed;
+  throw InputError("coarse space '" + name + "' is not one of blocks, smoothed");
 }
 
 CoarseTerms::CoarseTerms(int id, int d, const BlockLayout& layout,
@@ -108,12 +125,6 @@ namespace {
 
 using Mat = Eigen::MatrixXd;
 
-// Q_c in blocks: diag[a] = Q_aa, off[a][b] = Q_ab for every adjacent b (both directions kept).
-struct CoarseMatrix {
-  std::vector<Mat> diag;
-  std::vector<std::map<int, Mat>> off;
-};
-
 double coarse_cost(const CoarseMatrix& Q, const std::vector<Mat>& Z) {
   double f = 0.0;
   for (std::size_t a = 0; a < Z.size(); ++a) {
@@ -176,6 +187,12 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
     }
   }
 
+  return solve_coarse_matrix(std::move(Q), r, options);
+}
+
+CoarseResult solve_coarse_matrix(CoarseMatrix Q, int r, const CoarseOptions& options) {
+  const int N = static_cast<int>(Q.diag.size());
+  const int s = r + 1;
   // Rows of the lifted space that some pose uses. An iterate with r - d zero rows (chordal
   // start) keeps them exactly zero: the motions act on the used rows only, so the agents'
   // row-restricted local math stays as cheap as before.

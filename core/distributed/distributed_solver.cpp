@@ -138,6 +138,12 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
                                                   options.block_update));
     pointers.push_back(states.back().get());
   }
+  if (options.coarse.enabled && options.coarse.space == CoarseSpaceKind::kSmoothed) {
+    // Every agent would build this same space from the structure; in one process once.
+    const auto space = std::make_shared<const CoarseSpace>(
+        make_coarse_space(graph.num_poses, graph.measurements, assignment, options.coarse));
+    for (AgentState* s : pointers) s->use_coarse_space(space, graph.measurements);
+  }
   const double setup_s = since(start);
   DistributedResult res = solve_distributed_with_states(graph, layout, pointers, options);
   res.init_s += setup_s;

@@ -260,7 +260,7 @@ void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessag
   m.grad_norm_sq = s.grad_norm_sq;
   m.block_grad_norm = s.block_grad_norm;
   if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_))
-    m.coarse = state_.coarse_terms();
+    m.coarse = state_.coarse_space() ? state_.smoothed_coarse_terms() : state_.coarse_terms();
   // Our own status goes straight into the inbox: the reduction then treats every agent alike.
   pending_[key(u32(round_), phase)].emplace(state_.id(), m);
   OutgoingMessage o;
@@ -392,10 +392,17 @@ double RoundProtocol::coarse_correct(const Inbox& inbox, double last_decrease) {
   std::vector<const std::vector<double>*> terms;
   terms.reserve(inbox.size());
   for (const auto& [sender, m] : inbox) terms.push_back(&std::get<RoundStatusMessage>(m).coarse);
-  const CoarseResult c = solve_coarse(layout_, state_.rank(), terms, config_.coarse);
+  const CoarseSpace* space = state_.coarse_space();
+  const CoarseResult c = space ? solve_smoothed_coarse(*space, state_.rank(), terms, config_.coarse)
+                               : solve_coarse(layout_, state_.rank(), terms, config_.coarse);
   if (!c.moved || c.cost_before - c.cost_after < config_.coarse.min_gain * last_decrease)
     return 0.0;
-  state_.apply_coarse(c.motions);
+  // The smoothed space's blend is put back on the manifold afterwards, so its f moves by the
+  // coarse decrease to second order in the step (coarse_space.hpp).
+  if (space)
+    state_.apply_smoothed_coarse(c.motions);
+  else
+    state_.apply_coarse(c.motions);
   ++coarse_corrections_;
   coarse_decrease_ += c.cost_before - c.cost_after;
   return c.cost_after - c.cost_before;

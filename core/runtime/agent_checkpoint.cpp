@@ -66,6 +66,8 @@ std::string encode_checkpoint(const std::string& run_id, const AgentLocalData& l
   w.u64(o.seed);
   w.u32(o.certify ? 1 : 0);
   w.u32(o.coarse_every);
+  w.u32(o.coarse_aggregates);
+  w.u32(o.coarse_smoothing);
   w.u64(snapshots.size());
   for (const auto& s : snapshots) encode(w, s);
   return w.bytes();
@@ -120,6 +122,8 @@ AgentCheckpoint decode_checkpoint(const std::string& payload, const std::string&
     o.seed = r.u64("seed");
     o.certify = r.u32("certify") != 0;
     o.coarse_every = r.u32("coarse every");
+    o.coarse_aggregates = r.u32("coarse aggregates");
+    o.coarse_smoothing = r.u32("coarse smoothing");
     const std::uint64_t n = r.u64("number of snapshots");
     for (std::uint64_t k = 0; k < n; ++k) c.snapshots.push_back(decode_snapshot(r));
     r.expect_end();

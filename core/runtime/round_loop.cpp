@@ -29,6 +29,11 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
   opt.certify = o.certify;
   opt.coarse.enabled = o.coarse_every > 0;
   if (o.coarse_every > 0) opt.coarse.every = static_cast<int>(o.coarse_every);
+  if (o.coarse_aggregates > 0) {
+    opt.coarse.space = CoarseSpaceKind::kSmoothed;
+    opt.coarse.aggregates = static_cast<int>(o.coarse_aggregates);
+    opt.coarse.smoothing_steps = static_cast<int>(o.coarse_smoothing);
+  }
   opt.validate();
   return opt;
 }
@@ -83,6 +88,13 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   // Core's agent, configured as the in-process engine configures it.
   AgentState state(static_cast<int>(local.agent_id), local.d, layout, local.measurements,
                    lifted ? local.lifted_start : lift_poses(local.initial, options.rank));
+  if (options.coarse.enabled && options.coarse.space == CoarseSpaceKind::kSmoothed)
+    // Every agent builds the same space from the structure: no message needed.
+    state.use_coarse_space(
+        std::make_shared<const CoarseSpace>(make_coarse_space(
+            local.num_poses, local.structure,
+            std::vector<int>(local.owner.begin(), local.owner.end()), options.coarse)),
+        local.measurements);
   const double variables =
       static_cast<double>(options.rank) * (local.d + 1) * static_cast<double>(local.num_poses);
   const auto scheme = make_momentum_scheme(options, layout, variables);

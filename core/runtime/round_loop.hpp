@@ -44,6 +44,10 @@ struct RunOptions {
   std::uint64_t seed = 1;
   bool certify = false;  ///< Certified sequence (solve -> certify -> escape ...), core's defaults.
   std::uint32_t coarse_every = 0;  ///< Coarse correction every this many rounds; 0 = off.
+  /// The coarse space: 0 = one rigid motion per block; K > 0 = the smoothed space with K
+  /// pieces per block and coarse_smoothing smoothing steps (coarse_space.hpp).
+  std::uint32_t coarse_aggregates = 0;
+  std::uint32_t coarse_smoothing = 1;
   /// Robust solve (`--robust`; robust/gnc_agent.hpp runs it): kind none = plain least squares.
   RobustOptions robust;
   /// GNC starts from the known inliers' distributed initialization when they connect the poses

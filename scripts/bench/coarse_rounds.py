@@ -5,10 +5,12 @@ IRBCD on the generated 8000-pose grid (`tessera generate --kind grid3d --poses 8
 --seed 1`), N = 4, 9, 16, 25, 49 agents, chordal initialisation, in-process engine (the same
 messages as over DDS): rounds to ||grad f|| <= 0.01, the ratio to the rounds at N = 4, and the
 bytes a round exchanges (all messages, each recipient counted: pose blocks and statuses, the
-coarse terms riding on the statuses), one-level (`--coarse off`) beside two-level
-(`--coarse on`). Prints one table and writes docs/benchmarks/coarse_rounds.csv.
+coarse terms riding on the statuses; and the same divided by N, what one agent receives), one-level
+(`--coarse off`) beside two-level over each coarse space of `--spaces` (`--coarse on --coarse-space
+blocks|smoothed`). Prints one table and writes docs/benchmarks/coarse_rounds.csv.
 
   scripts/bench/coarse_rounds.py [--agents 4,9,16,25,49] [--partition auto] [--every 1]
+                                 [--spaces blocks,smoothed] [--aggregates 4] [--smoothing 1]
                                  [--max-rounds 2000] [--poses 8000] [--bin B] [--out-dir D]
 """
 import argparse
@@ -27,6 +29,9 @@ def main():
     ap.add_argument("--agents", default="4,9,16,25,49")
     ap.add_argument("--partition", default="auto", help="partition preset (default auto, what solve uses)")
     ap.add_argument("--every", type=int, default=1, help="--coarse-every of the two-level runs")
+    ap.add_argument("--spaces", default="blocks,smoothed", help="coarse spaces of the two-level runs")
+    ap.add_argument("--aggregates", type=int, default=4, help="--coarse-aggregates of the smoothed runs")
+    ap.add_argument("--smoothing", type=int, default=1, help="--coarse-smoothing of the smoothed runs")
     ap.add_argument("--max-rounds", type=int, default=2000)
     ap.add_argument("--poses", type=int, default=8000)
     ap.add_argument("--seed", type=int, default=1, help="shared seed (partitioner, selection)")
@@ -42,11 +47,16 @@ def main():
     rows, table = [], []
     base = {}
     for n in agents:
-        for mode in ("off", "on"):
+        for mode in ["off"] + args.spaces.split(","):
             bc.progress(f"IRBCD, grid {args.poses}, N = {n}, coarse {mode}")
             cmd = ["solve", path, "--algorithm", "irbcd", "--agents", str(n), "--partition", args.partition,
-                   "--seed", str(args.seed), "--grad-tol", "0.01", "--max-rounds", str(args.max_rounds),
-                   "--coarse", mode, "--coarse-every", str(args.every)]
+                   "--seed", str(args.seed), "--grad-tol", "0.01", "--max-rounds", str(args.max_rounds)]
+            if mode == "off":
+                cmd += ["--coarse", "off"]
+            else:
+                cmd += ["--coarse", "on", "--coarse-space", mode, "--coarse-every", str(args.every)]
+            if mode == "smoothed":
+                cmd += ["--coarse-aggregates", str(args.aggregates), "--coarse-smoothing", str(args.smoothing)]
             s, tr, _, wall = bc.run_tessera(ctx, cmd)
             r01 = bc.first_round(tr, 0.01)
             if n == agents[0]:
@@ -57,18 +67,19 @@ def main():
                    "ratio_to_first_N": (r01 / base[mode]) if r01 and base.get(mode) else None,
                    "bytes_per_round_mean": statistics.mean(per_round) if per_round else None,
                    "bytes_per_round_max": max(per_round) if per_round else None,
+                   "bytes_per_agent_round": statistics.mean(per_round) / n if per_round else None,
                    "cpu_ms_per_round": s.get("cpu_ms_per_round"), "stop": s["stop_reason"],
                    "final_grad_norm": s["grad_norm"], "cost": s["cost"]}
             rows.append(row)
             table.append([n, mode, s["cut_edges"], bc.fmt(s.get("colours")), bc.fmt(r01), bc.fmt(row["ratio_to_first_N"], "{:.2f}"),
-                          bc.fmt(row["bytes_per_round_mean"], "{:.0f}"), bc.fmt(row["bytes_per_round_max"], "{:.0f}"),
+                          bc.fmt(row["bytes_per_round_mean"], "{:.0f}"), bc.fmt(row["bytes_per_agent_round"], "{:.0f}"),
                           bc.fmt(row["cpu_ms_per_round"], "{:.1f}"), s["stop_reason"]])
     with open("/proc/loadavg") as f:
         load = f.read().split()[0]
     bc.print_table(f"IRBCD rounds against N, generated grid {args.poses}, {args.partition} partition "
                    f"(load {load})",
                    ["N", "coarse", "cut", "colours", "rounds to |g|<=0.01", f"x rounds at N={agents[0]}", "bytes/round",
-                    "max bytes/round", "cpu ms/round", "stop"], table)
+                    "bytes/agent/round", "cpu ms/round", "stop"], table)
     bc.write_csv(os.path.join(ctx.out_dir, "coarse_rounds.csv"), rows)
     print("\ncommands:\n" + "\n".join(ctx.commands))
 

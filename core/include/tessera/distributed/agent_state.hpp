@@ -10,6 +10,7 @@
 #include <optional>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/coarse_correction.hpp>
+#include <tessera/distributed/coarse_space.hpp>
 #include <tessera/distributed/rbcd.hpp>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/protocol/messages.hpp>
@@ -59,6 +60,17 @@ class AgentState {
   /// Moves every block rigidly by motions[b] (coarse_correction.hpp): the own sequences Y and
   /// V by motions[id], the neighbour copies Yn and Vn pose by pose by their owners' motions.
   void apply_coarse(const std::vector<Eigen::MatrixXd>& motions);
+  /// Two-level rounds over the smoothed coarse space (coarse_space.hpp) instead of one rigid
+  /// motion per block: `space` is the one every agent built; `measurements` (those touching
+  /// this block, or the whole graph's) give this agent's edges of the coarse problem.
+  void use_coarse_space(std::shared_ptr<const CoarseSpace> space,
+                        const std::vector<Measurement>& measurements);
+  /// The smoothed coarse space in use, or null (one rigid motion per block).
+  const CoarseSpace* coarse_space() const { return space_.get(); }
+  /// This agent's smoothed coarse terms at (Y, Yn); needs use_coarse_space.
+  std::vector<double> smoothed_coarse_terms() const { return smoothed_->compute(Y, Yn); }
+  /// Moves Y, V and the neighbour copies Yn, Vn by their blended motions (one per aggregate).
+  void apply_smoothed_coarse(const std::vector<Eigen::MatrixXd>& motions);
   /// Local objective f_B(X) with neighbours at `neighbours`.
   double local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
   /// Totals over this agent's block updates so far (BlockUpdateStats summed): updates,
@@ -116,6 +128,8 @@ class AgentState {
   mutable std::optional<CoarseTerms> coarse_;
   const std::vector<Measurement>* coarse_source_ = nullptr;
   const CoarseTerms& coarse() const;
+  std::shared_ptr<const CoarseSpace> space_;
+  std::optional<SmoothedCoarseTerms> smoothed_;
   /// The Q_BB preconditioner (built in the constructor).
   BlockPreconditioner& euclidean();
   /// Builds and factors the tangent preconditioner at X (rank d) once; false when unusable.

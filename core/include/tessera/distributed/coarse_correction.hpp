@@ -19,15 +19,40 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <string>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/graph/measurement.hpp>
 #include <vector>
 
 namespace tessera {
 
+/// The coarse space of the two-level rounds.
+///   kBlocks    one rigid motion per block: the coarse problem sees only the cut.
+///   kSmoothed  a few rigid motions per block (BFS aggregates of the block's own graph), blended
+///              smoothly across aggregate and block borders (smoothed aggregation,
+///              coarse_space.hpp): the slow error of a pose graph is smooth bending, which a
+///              piecewise-rigid space represents only with a kink at every border.
+enum class CoarseSpaceKind { kBlocks, kSmoothed };
+
+/// "blocks", "smoothed".
+const char* coarse_space_name(CoarseSpaceKind kind);
+/// Inverse of coarse_space_name; throws InputError listing the valid names.
+CoarseSpaceKind parse_coarse_space(const std::string& name);
+
 struct CoarseOptions {
   /// Apply the coarse correction (off: the plain one-level round).
   bool enabled = false;
+  /// The coarse space (kBlocks: one rigid motion per block).
+  CoarseSpaceKind space = CoarseSpaceKind::kBlocks;
+  /// kSmoothed: aggregates grown per block (>= 1; a block whose own graph falls apart gets
+  /// one more per extra piece).
+  int aggregates = 4;
+  /// kSmoothed: Jacobi smoothing steps of the aggregates' indicator functions over the whole
+  /// graph (0..8; 0 = piecewise rigid). Each step widens every blend by one measurement hop.
+  int smoothing_steps = 1;
+  /// kSmoothed: the damping omega of a smoothing step w <- (1 - omega) w + omega D^-1 A w, in
+  /// (0, 1].
+  double smoothing_weight = 2.0 / 3.0;
   /// Rounds between corrections (>= 1): a correction at every round k with k % every == 0.
   /// Only those rounds' status messages carry the coarse terms.
   int every = 1;

@@ -1,0 +1,432 @@
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <stdexcept>
+#include <string>
+#include <tessera/distributed/coarse_space.hpp>
+#include <tessera/manifold/lifted_manifold.hpp>
+#include <unordered_map>
+
+#include "distributed/coarse_problem.hpp"
+
+namespace tessera {
+
+namespace {
+
+using Mat = Eigen::MatrixXd;
+using Edges = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+using Weights = std::vector<std::pair<int, double>>;  // aggregate -> weight, ascending
+
+// Adjacency lists (CSR) of the edges kept by `keep`, self-loops left out, parallel edges kept
+// (a pose's degree counts each measurement).
+struct Adjacency {
+  std::vector<std::size_t> start;
+  std::vector<std::size_t> next;
+  template <class Keep>
+  Adjacency(std::size_t n, const Edges& edges, Keep keep) : start(n + 1, 0) {
+    for (const auto& [i, j] : edges)
+      if (i != j && keep(i, j)) ++start[i + 1], ++start[j + 1];
+    for (std::size_t k = 0; k < n; ++k) start[k + 1] += start[k];
+    next.resize(start[n]);
+    std::vector<std::size_t> at(start.begin(), start.end() - 1);
+    for (const auto& [i, j] : edges)
+      if (i != j && keep(i, j)) {
+        next[at[i]++] = j;
+        next[at[j]++] = i;
+      }
+  }
+};
+
+// Splits each block's own graph into about k pieces: seeds by farthest-point BFS (the first
+// seed the pose farthest from the block's first pose), every pose to its nearest seed in hops
+// (ties to the earlier seed); a part of the block that no seed reaches gets a piece of its own.
+void grow_aggregates(CoarseSpace& s, const Adjacency& inside,
+                     const std::vector<std::vector<std::size_t>>& block_poses, int k) {
+  const std::size_t n = s.owner.size();
+  s.aggregate.assign(n, -1);
+  std::vector<int> dist(n, -1);
+  std::deque<std::size_t> queue;
+  auto bfs = [&](const std::vector<std::size_t>& mine, const std::vector<std::size_t>& seeds) {
+    for (std::size_t i : mine) dist[i] = -1;
+    for (std::size_t v : seeds) {
+      dist[v] = 0;
+      queue.push_back(v);
+    }
+    while (!queue.empty()) {
+      const std::size_t u = queue.front();
+      queue.pop_front();
+      for (std::size_t e = inside.start[u]; e < inside.start[u + 1]; ++e)
+        if (dist[inside.next[e]] < 0) {
+          dist[inside.next[e]] = dist[u] + 1;
+          queue.push_back(inside.next[e]);
+        }
+    }
+  };
+  // The pose farthest from the seeds (unreached counts as farthest), lowest id on ties.
+  auto farthest = [&](const std::vector<std::size_t>& mine, int* how_far) {
+    std::size_t best = mine.front();
+    int far = -1;
+    for (std::size_t i : mine) {
+      const int di = dist[i] < 0 ? (1 << 30) : dist[i];
+      if (di > far) {
+        far = di;
+        best = i;
+      }
+    }
+    *how_far = far;
+    return best;
+  };
+  for (int b = 0; b < s.num_blocks; ++b) {
+    const auto& mine = block_poses[static_cast<std::size_t>(b)];
+    std::vector<std::size_t> seeds;
+    int far = 0;
+    bfs(mine, {mine.front()});
+    seeds.push_back(farthest(mine, &far));
+    while (static_cast<int>(seeds.size()) < k) {
+      bfs(mine, seeds);
+      const std::size_t v = farthest(mine, &far);
+      if (far <= 0) break;  // every pose is a seed already
+      seeds.push_back(v);
+    }
+    // Label by a multi-source BFS; then each unreached part of the block its own piece.
+    const int first = s.num_aggregates;
+    for (std::size_t q = 0; q < seeds.size(); ++q) {
+      s.aggregate[seeds[q]] = first + static_cast<int>(q);
+      queue.push_back(seeds[q]);
+    }
+    int count = static_cast<int>(seeds.size());
+    std::size_t scan = 0;
+    for (;;) {
+      while (!queue.empty()) {
+        const std::size_t u = queue.front();
+        queue.pop_front();
+        for (std::size_t e = inside.start[u]; e < inside.start[u + 1]; ++e)
+          if (s.aggregate[inside.next[e]] < 0) {
+            s.aggregate[inside.next[e]] = s.aggregate[u];
+            queue.push_back(inside.next[e]);
+          }
+      }
+      while (scan < mine.size() && s.aggregate[mine[scan]] >= 0) ++scan;
+      if (scan == mine.size()) break;
+      s.aggregate[mine[scan]] = first + count++;
+      queue.push_back(mine[scan]);
+    }
+    s.num_aggregates += count;
+    s.aggregate_block.insert(s.aggregate_block.end(), static_cast<std::size_t>(count), b);
+  }
+}
+
+// w <- (1 - omega) w + omega D^-1 A w, `steps` times, from the pieces' indicators.
+std::vector<Weights> smooth_weights(const CoarseSpace& s, const Adjacency& all, int steps,
+                                    double omega) {
+  const std::size_t n = s.owner.size();
+  std::vector<Weights> w(n);
+  for (std::size_t i = 0; i < n; ++i) w[i] = {{s.aggregate[i], 1.0}};
+  std::unordered_map<int, double> acc;
+  for (int step = 0; step < steps; ++step) {
+    std::vector<Weights> nw(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t deg = all.start[i + 1] - all.start[i];
+      if (deg == 0) {
+        nw[i] = w[i];
+        continue;
+      }
+      acc.clear();
+      for (const auto& [a, v] : w[i]) acc[a] += (1.0 - omega) * v;
+      const double share = omega / static_cast<double>(deg);
+      for (std::size_t e = all.start[i]; e < all.start[i + 1]; ++e)
+        for (const auto& [a, v] : w[all.next[e]]) acc[a] += share * v;
+      nw[i].assign(acc.begin(), acc.end());
+      std::sort(nw[i].begin(), nw[i].end());
+    }
+    w.swap(nw);
+  }
+  return w;
+}
+
+template <class Edge>
+std::pair<std::uint32_t, std::uint32_t> ends(const Edge& e) {
+  return {e.first, e.second};
+}
+template <>
+std::pair<std::uint32_t, std::uint32_t> ends(const Measurement& m) {
+  return {static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j)};
+}
+
+}  // namespace
+
+bool CoarseSpace::sums_edge(int agent, std::size_t i, std::size_t j) const {
+  const int a = owner[i], b = owner[j];
+  return a == b ? a == agent : std::min(a, b) == agent;
+}
+
+bool CoarseSpace::rigid_invariant(std::size_t i, std::size_t j) const {
+  return weight_start[i + 1] - weight_start[i] == 1 && weight_start[j + 1] - weight_start[j] == 1 &&
+         weight_aggregate[weight_start[i]] == weight_aggregate[weight_start[j]];
+}
+
+CoarseSpace make_coarse_space(std::size_t num_poses, const Edges& edges,
+                              const std::vector<int>& assignment, const CoarseOptions& options) {
+  options.validate();
+  if (assignment.size() != num_poses)
+    throw std::invalid_argument("make_coarse_space: assignment of the wrong size");
+  CoarseSpace s;
+  s.owner = assignment;
+  for (int b : assignment) s.num_blocks = std::max(s.num_blocks, b + 1);
+  std::vector<std::vector<std::size_t>> block_poses(static_cast<std::size_t>(s.num_blocks));
+  for (std::size_t i = 0; i < num_poses; ++i)
+    block_poses[static_cast<std::size_t>(assignment[i])].push_back(i);
+  for (const auto& p : block_poses)
+    if (p.empty()) throw std::invalid_argument("make_coarse_space: empty block");
+  for (const auto& [i, j] : edges)
+    if (i >= num_poses || j >= num_poses)
+      throw std::invalid_argument("make_coarse_space: edge out of range");
+  {
+    const Adjacency inside(num_poses, edges, [&](std::uint32_t i, std::uint32_t j) {
+      return assignment[i] == assignment[j];
+    });
+    grow_aggregates(s, inside, block_poses, options.aggregates);
+  }
+  {
+    const Adjacency all(num_poses, edges, [](std::uint32_t, std::uint32_t) { return true; });
+    const std::vector<Weights> w =
+        smooth_weights(s, all, options.smoothing_steps, options.smoothing_weight);
+    s.weight_start.assign(num_poses + 1, 0);
+    for (std::size_t i = 0; i < num_poses; ++i) {
+      s.weight_start[i + 1] = s.weight_start[i] + w[i].size();
+      for (const auto& [a, v] : w[i]) {
+        s.weight_aggregate.push_back(a);
+        s.weight.push_back(v);
+      }
+    }
+  }
+  // Each agent's pairs: every pair of pieces some edge it sums couples.
+  std::vector<std::vector<std::pair<int, int>>> pairs(static_cast<std::size_t>(s.num_blocks));
+  std::vector<int> support;
+  for (const auto& [i, j] : edges) {
+    if (i == j || s.rigid_invariant(i, j)) continue;
+    const int agent = s.owner[i] == s.owner[j] ? s.owner[i] : std::min(s.owner[i], s.owner[j]);
+    support.clear();
+    for (std::size_t e = s.weight_start[i]; e < s.weight_start[i + 1]; ++e)
+      support.push_back(s.weight_aggregate[e]);
+    for (std::size_t e = s.weight_start[j]; e < s.weight_start[j + 1]; ++e)
+      support.push_back(s.weight_aggregate[e]);
+    std::sort(support.begin(), support.end());
+    support.erase(std::unique(support.begin(), support.end()), support.end());
+    auto& p = pairs[static_cast<std::size_t>(agent)];
+    for (std::size_t x = 0; x < support.size(); ++x)
+      for (std::size_t y = x; y < support.size(); ++y) p.emplace_back(support[x], support[y]);
+  }
+  s.pair_start.assign(static_cast<std::size_t>(s.num_blocks) + 1, 0);
+  for (int a = 0; a < s.num_blocks; ++a) {
+    auto& p = pairs[static_cast<std::size_t>(a)];
+    std::sort(p.begin(), p.end());
+    p.erase(std::unique(p.begin(), p.end()), p.end());
+    s.pairs.insert(s.pairs.end(), p.begin(), p.end());
+    s.pair_start[static_cast<std::size_t>(a) + 1] = s.pairs.size();
+  }
+  return s;
+}
+
+CoarseSpace make_coarse_space(std::size_t num_poses, const std::vector<Measurement>& measurements,
+                              const std::vector<int>& assignment, const CoarseOptions& options) {
+  Edges edges;
+  edges.reserve(measurements.size());
+  for (const Measurement& m : measurements) edges.push_back(ends(m));
+  return make_coarse_space(num_poses, edges, assignment, options);
+}
+
+SmoothedCoarseTerms::SmoothedCoarseTerms(const CoarseSpace& space, int id, int d,
+                                         const std::vector<std::size_t>& owned,
+                                         const std::vector<std::size_t>& neighbours,
+                                         const std::vector<Measurement>& measurements)
+    : space_(space), id_(id), d_(d) {
+  std::unordered_map<std::size_t, std::size_t> own_slot, neighbour_slot;
+  for (std::size_t k = 0; k < owned.size(); ++k) own_slot[owned[k]] = k;
+  for (std::size_t k = 0; k < neighbours.size(); ++k) neighbour_slot[neighbours[k]] = k;
+  auto slot = [&](std::size_t v, bool* own) {
+    auto it = own_slot.find(v);
+    if (it != own_slot.end()) {
+      *own = true;
+      return it->second;
+    }
+    *own = false;
+    auto jt = neighbour_slot.find(v);
+    if (jt == neighbour_slot.end())
+      throw std::logic_error("SmoothedCoarseTerms: an edge it sums has an unknown end");
+    return jt->second;
+  };
+  for (const Measurement& m : measurements) {
+    if (m.i == m.j || m.i >= space.owner.size() || m.j >= space.owner.size()) continue;
+    if (!space.sums_edge(id, m.i, m.j) || space.rigid_invariant(m.i, m.j)) continue;
+    if (!own_slot.count(m.i) && !own_slot.count(m.j)) continue;  // not ours (whole-graph list)
+    Edge e;
+    e.i_slot = slot(m.i, &e.i_own);
+    e.j_slot = slot(m.j, &e.j_own);
+    e.i = m.i;
+    e.j = m.j;
+    e.R = m.R;
+    e.t = m.t;
+    e.kappa = m.kappa;
+    e.tau = m.tau;
+    edges_.push_back(std::move(e));
+  }
+}
+
+std::vector<double> SmoothedCoarseTerms::compute(const Eigen::MatrixXd& X,
+                                                 const Eigen::MatrixXd& Xn) const {
+  const int r = static_cast<int>(X.rows());
+  const int s = r + 1;
+  const int w = d_ + 1;
+  const std::size_t first = space_.pair_start[static_cast<std::size_t>(id_)];
+  const std::size_t count = space_.pair_start[static_cast<std::size_t>(id_) + 1] - first;
+  const auto pair_begin = space_.pairs.begin() + static_cast<std::ptrdiff_t>(first);
+  const auto pair_end = pair_begin + static_cast<std::ptrdiff_t>(count);
+  std::vector<Mat> Q(count, Mat::Zero(s, s));
+  Mat A = Mat::Zero(s, w), B = Mat::Zero(s, w);
+  std::vector<int> support;
+  std::vector<Mat> C;
+  for (const Edge& e : edges_) {
+    const auto Pi = e.i_own ? X.middleCols(static_cast<Eigen::Index>(w * e.i_slot), w)
+                            : Xn.middleCols(static_cast<Eigen::Index>(w * e.i_slot), w);
+    const auto Pj = e.j_own ? X.middleCols(static_cast<Eigen::Index>(w * e.j_slot), w)
+                            : Xn.middleCols(static_cast<Eigen::Index>(w * e.j_slot), w);
+    const double sk = std::sqrt(e.kappa), st = std::sqrt(e.tau);
+    // The residual after the blend is sum_alpha Z_alpha (w_j,alpha A - w_i,alpha B), with A, B
+    // as in CoarseTerms (target j, transported source i).
+    A.topLeftCorner(r, d_) = sk * Pj.leftCols(d_);
+    A.col(d_).head(r) = st * Pj.col(d_);
+    A(r, d_) = st;
+    B.topLeftCorner(r, d_) = sk * (Pi.leftCols(d_) * e.R);
+    B.col(d_).head(r) = st * (Pi.col(d_) + Pi.leftCols(d_) * e.t);
+    B(r, d_) = st;
+    support.clear();
+    C.clear();
+    const std::size_t i0 = space_.weight_start[e.i], i1 = space_.weight_start[e.i + 1];
+    const std::size_t j0 = space_.weight_start[e.j], j1 = space_.weight_start[e.j + 1];
+    std::size_t x = i0, y = j0;
+    while (x < i1 || y < j1) {  // merge of the two ascending weight lists
+      const int ax = x < i1 ? space_.weight_aggregate[x] : INT32_MAX;
+      const int ay = y < j1 ? space_.weight_aggregate[y] : INT32_MAX;
+      const int a = std::min(ax, ay);
+      Mat Ca = Mat::Zero(s, w);
+      if (ay == a) Ca += space_.weight[y++] * A;
+      if (ax == a) Ca -= space_.weight[x++] * B;
+      support.push_back(a);
+      C.push_back(std::move(Ca));
+    }
+    for (std::size_t p = 0; p < support.size(); ++p)
+      for (std::size_t q = p; q < support.size(); ++q) {
+        const auto it =
+            std::lower_bound(pair_begin, pair_end, std::make_pair(support[p], support[q]));
+        if (it == pair_end || *it != std::make_pair(support[p], support[q]))
+          throw std::logic_error("SmoothedCoarseTerms: a pair missing from the space");
+        Q[static_cast<std::size_t>(it - pair_begin)].noalias() += C[p] * C[q].transpose();
+      }
+  }
+  std::vector<int> rows;
+  double mask = 0.0;
+  for (int k = 0; k < r; ++k)
+    if ((X.row(k).array() != 0.0).any() || (Xn.cols() > 0 && (Xn.row(k).array() != 0.0).any())) {
+      rows.push_back(k);
+      mask += std::ldexp(1.0, k);
+    }
+  rows.push_back(r);
+  const std::size_t m = rows.size();
+  std::vector<double> out;
+  out.reserve(1 + count * m * m);
+  out.push_back(mask);
+  for (std::size_t k = 0; k < count; ++k) {
+    const bool diagonal = pair_begin[static_cast<std::ptrdiff_t>(k)].first ==
+                          pair_begin[static_cast<std::ptrdiff_t>(k)].second;
+    for (std::size_t j = 0; j < m; ++j)
+      for (std::size_t i = 0; i < (diagonal ? j + 1 : m); ++i)
+        out.push_back(Q[k](rows[i], rows[j]));
+  }
+  return out;
+}
+
+CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
+                                   const std::vector<const std::vector<double>*>& terms,
+                                   const CoarseOptions& options) {
+  const int N = space.num_blocks;
+  const int s = r + 1;
+  if (terms.size() != static_cast<std::size_t>(N))
+    throw std::runtime_error("coarse correction: " + std::to_string(terms.size()) +
+                             " term vectors for " + std::to_string(N) + " blocks");
+  CoarseMatrix Q;
+  Q.diag.assign(static_cast<std::size_t>(space.num_aggregates), Mat::Zero(s, s));
+  Q.off.resize(static_cast<std::size_t>(space.num_aggregates));
+  // Summed in agent-id order, so every agent assembles bit-identical blocks.
+  for (int a = 0; a < N; ++a) {
+    const std::vector<double>& t = *terms[static_cast<std::size_t>(a)];
+    auto bad = [&](const std::string& why) {
+      return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(a) +
+                                ": " + why);
+    };
+    if (t.empty()) throw bad("none");
+    const double mask = t[0];
+    if (!(mask >= 0 && mask < std::ldexp(1.0, r)) || std::floor(mask) != mask)
+      throw bad("row mask " + std::to_string(mask) + " does not fit rank " + std::to_string(r));
+    std::vector<int> rows;
+    const auto bits = static_cast<unsigned long long>(mask);
+    for (int k = 0; k < r; ++k)
+      if (bits & (1ull << k)) rows.push_back(k);
+    rows.push_back(r);
+    const std::size_t m = rows.size();
+    const std::size_t p0 = space.pair_start[static_cast<std::size_t>(a)];
+    const std::size_t p1 = space.pair_start[static_cast<std::size_t>(a) + 1];
+    std::size_t expected = 1;
+    for (std::size_t k = p0; k < p1; ++k)
+      expected += space.pairs[k].first == space.pairs[k].second ? m * (m + 1) / 2 : m * m;
+    if (t.size() != expected)
+      throw bad(std::to_string(t.size()) + " values, expected " + std::to_string(expected));
+    std::size_t at = 1;
+    for (std::size_t k = p0; k < p1; ++k) {
+      const auto [alpha, beta] = space.pairs[k];
+      if (alpha == beta) {
+        Mat& D = Q.diag[static_cast<std::size_t>(alpha)];
+        for (std::size_t j = 0; j < m; ++j)
+          for (std::size_t i = 0; i <= j; ++i, ++at) {
+            D(rows[i], rows[j]) += t[at];
+            if (i != j) D(rows[j], rows[i]) += t[at];
+          }
+      } else {
+        Mat M = Mat::Zero(s, s);
+        for (std::size_t j = 0; j < m; ++j)
+          for (std::size_t i = 0; i < m; ++i, ++at) M(rows[i], rows[j]) = t[at];
+        auto& ab = Q.off[static_cast<std::size_t>(alpha)][beta];
+        if (ab.size() == 0) ab = Mat::Zero(s, s);
+        ab += M;
+        auto& ba = Q.off[static_cast<std::size_t>(beta)][alpha];
+        if (ba.size() == 0) ba = Mat::Zero(s, s);
+        ba += M.transpose();
+      }
+    }
+  }
+  return solve_coarse_matrix(std::move(Q), r, options);
+}
+
+void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
+                           int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X) {
+  const Eigen::Index r = X.rows();
+  const Eigen::Index w = d + 1;
+  Mat M(r, r + 1);
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t i = ids[k];
+    auto Xi = X.middleCols(w * static_cast<Eigen::Index>(k), w);
+    const std::size_t e0 = space.weight_start[i], e1 = space.weight_start[i + 1];
+    M.setZero();
+    for (std::size_t e = e0; e < e1; ++e)
+      M += space.weight[e] * motions[static_cast<std::size_t>(space.weight_aggregate[e])];
+    const Mat Y = M.leftCols(r) * Xi.leftCols(d);
+    const Eigen::VectorXd p = M.leftCols(r) * Xi.col(d) + M.col(r);
+    // A blend of rotations is not one: back to the manifold by the polar factor (a single
+    // rigid motion is orthogonal already and is kept bit for bit).
+    Xi.leftCols(d) = e1 - e0 == 1 ? Y : polar_factor(Y);
+    Xi.col(d) = p;
+  }
+}
+
+}  // namespace tessera
