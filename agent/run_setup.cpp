@@ -55,6 +55,9 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   ro.seed = asg.seed();
   ro.certify = asg.certify();
   ro.coarse_every = asg.coarse_every();
+  ro.refine = asg.refine() == "newton";
+  ro.refine_grad_tol = asg.refine_grad_tol();
+  ro.refine_rel_tol = asg.refine_rel_tol();
   if (!asg.robust().empty()) {
     ro.robust.kind = parse_robust_kind(asg.robust());
     ro.robust.inlier_threshold = asg.inlier_threshold();

@@ -33,6 +33,9 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   asg.status_relay(options.status_relay);
   asg.replica_every(options.replica_every);
   asg.coarse_every(options.coarse_every);
+  asg.refine(options.refine);
+  asg.refine_grad_tol(options.refine_grad_tol);
+  asg.refine_rel_tol(options.refine_rel_tol);
   if (options.robust.kind != RobustKind::kNone) {
     const RobustOptions& r = options.robust;
     asg.robust(robust_kind_name(r.kind));

@@ -66,6 +66,11 @@ options:
   --coarse-every K     two-level rounds: the agents add a rigid coarse correction of every
                        block every K-th round (docs/irbcd.md, "Coarse correction"); 0 = off
                        (default 0)
+  --refine newton|none after the rounds, trust-region Newton steps on the whole problem
+                       (docs/newton-refine.md) (default none)
+  --refine-grad-tol T, --refine-rel-tol F
+                       its stops: ||grad f|| <= T, or a step lowered f by < F f (0 = the
+                       defaults, 1e-6 and 1e-5)
   --robust none|gnc-tls  gnc-tls: reject outlier measurements by graduated non-convexity
                        with a truncated least-squares cost, then solve (and with --certify
                        certify) the kept ones; every agent weighs the measurements of its
@@ -109,7 +114,10 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "progress-interval",
                                                             "replicas",
                                                             "replica-every",
-                                                            "coarse-every"},
+                                                            "coarse-every",
+                                                            "refine",
+                                                            "refine-grad-tol",
+                                                            "refine-rel-tol"},
                                                            cli::SessionArgsFor::kProcess);
   valued.insert("graph");
   for (const char* const* r = cli::kRobustValued; *r; ++r) valued.insert(*r);
@@ -166,6 +174,13 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   a.replica_every = static_cast<std::uint32_t>(nonneg("replica-every", 10));
   if (a.replica_every < 1) throw InputError("option --replica-every: must be >= 1");
   a.coarse_every = static_cast<std::uint32_t>(nonneg("coarse-every", a.coarse_every));
+  a.refine = args.get_or("refine", a.refine);
+  if (a.refine != "none" && a.refine != "newton")
+    throw InputError("option --refine: '" + a.refine + "' is not one of newton, none");
+  a.refine_grad_tol = args.get_double("refine-grad-tol", 0);
+  a.refine_rel_tol = args.get_double("refine-rel-tol", 0);
+  if (!(a.refine_grad_tol >= 0)) throw InputError("option --refine-grad-tol: must be >= 0");
+  if (!(a.refine_rel_tol >= 0)) throw InputError("option --refine-rel-tol: must be >= 0");
   a.verbose = args.has("verbose");
   a.certify = args.has("certify");
   if (args.has("status-relay") && args.has("no-status-relay"))

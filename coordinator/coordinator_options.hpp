@@ -43,6 +43,11 @@ struct CoordinatorOptions {
   bool status_relay = true;
   /// Two-level rounds: a coarse correction every this many rounds; 0 = off (--coarse-every).
   std::uint32_t coarse_every = 0;
+  /// Newton refinement after the rounds: "none" or "newton" (--refine), with its tolerances
+  /// (--refine-grad-tol, --refine-rel-tol; 0 = core's defaults).
+  std::string refine = "none";
+  double refine_grad_tol = 0;
+  double refine_rel_tol = 0;
   /// Robust solve (--robust, --inlier-threshold, --inlier-quantile, --gnc-max-outer,
   /// --gnc-mu-step, --gnc-inner-rounds, --known-inliers; docs/robust.md).
   RobustOptions robust;

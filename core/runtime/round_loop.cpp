@@ -29,6 +29,9 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
   opt.certify = o.certify;
   opt.coarse.enabled = o.coarse_every > 0;
   if (o.coarse_every > 0) opt.coarse.every = static_cast<int>(o.coarse_every);
+  opt.refine.enabled = o.refine;
+  if (o.refine_grad_tol > 0) opt.refine.grad_norm_tol = o.refine_grad_tol;
+  if (o.refine_rel_tol > 0) opt.refine.relative_decrease_tol = o.refine_rel_tol;
   opt.validate();
   return opt;
 }
@@ -92,7 +95,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   RoundLoopResult res;
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<CertifiedAgent> sequence;
-  if (!options.certify) {
+  if (!options.certify && !options.refine.enabled) {
     RoundProtocol protocol(state, layout, config);
     if (hooks.on_round) protocol.set_round_observer(hooks.on_round);
     mail.run_protocol(
@@ -120,15 +123,14 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
       res.relaxation_cost = last.trace.back().cost;
       res.grad_norm = last.trace.back().grad_norm;
     }
-    res.certified = sequence->certified();
+    if (options.certify) res.certified = sequence->certified();
     if (!sequence->certificates().empty())
       res.min_eigenvalue = sequence->certificates().back().result.min_eigenvalue;
     res.certificate_rounds = static_cast<std::uint32_t>(sequence->certificate_iterations());
     res.escape_rounds = static_cast<std::uint32_t>(sequence->escape_trials());
   }
   res.final_rank = static_cast<std::uint32_t>(state.rank());
-  return round_and_report(local, layout, state, mail, channel, std::move(res), sequence != nullptr,
-                          t0);
+  return round_and_report(local, layout, state, mail, channel, std::move(res), options.certify, t0);
 }
 
 }  // namespace tessera::agent

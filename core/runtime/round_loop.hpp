@@ -44,6 +44,10 @@ struct RunOptions {
   std::uint64_t seed = 1;
   bool certify = false;  ///< Certified sequence (solve -> certify -> escape ...), core's defaults.
   std::uint32_t coarse_every = 0;  ///< Coarse correction every this many rounds; 0 = off.
+  /// Newton refinement after the rounds (newton_refine.hpp) and its tolerances (0 = core's).
+  bool refine = false;
+  double refine_grad_tol = 0;
+  double refine_rel_tol = 0;
   /// Robust solve (`--robust`; robust/gnc_agent.hpp runs it): kind none = plain least squares.
   RobustOptions robust;
   /// GNC starts from the known inliers' distributed initialization when they connect the poses
