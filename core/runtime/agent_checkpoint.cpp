@@ -66,6 +66,9 @@ std::string encode_checkpoint(const std::string& run_id, const AgentLocalData& l
   w.u64(o.seed);
   w.u32(o.certify ? 1 : 0);
   w.u32(o.coarse_every);
+  w.u32(o.refine ? 1 : 0);  // a restarted agent must refine as the others do
+  w.f64(o.refine_grad_tol);
+  w.f64(o.refine_rel_tol);
   w.u64(snapshots.size());
   for (const auto& s : snapshots) encode(w, s);
   return w.bytes();
@@ -120,6 +123,9 @@ AgentCheckpoint decode_checkpoint(const std::string& payload, const std::string&
     o.seed = r.u64("seed");
     o.certify = r.u32("certify") != 0;
     o.coarse_every = r.u32("coarse every");
+    o.refine = r.u32("refine") != 0;
+    o.refine_grad_tol = r.f64("refine grad tolerance");
+    o.refine_rel_tol = r.f64("refine relative tolerance");
     const std::uint64_t n = r.u64("number of snapshots");
     for (std::uint64_t k = 0; k < n; ++k) c.snapshots.push_back(decode_snapshot(r));
     r.expect_end();
