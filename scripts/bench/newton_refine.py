@@ -93,7 +93,8 @@ def main():
                       bc.fmt(row["tight_tol"]), bc.fmt(row["tight_rounds"]), bc.fmt(row["tight_gap"], "{:.1e}"),
                       row["message_steps_rounds"], f"{row['solve_s_refine']:.2f} / {row['solve_s_rounds']:.2f}",
                       f"{row['load']:.1f}"])
-        bc.progress(f"{name}: done")
+        bc.progress(f"{name}: " + ", ".join(f"{k}={v}" for k, v in row.items()))
+        bc.write_csv(a.csv, rows, announce=False)  # a long run keeps what it has
     bc.print_table(f"IRBCD rounds vs rounds + Newton refinement, N = {a.agents} (in process, counts load-free)",
                    ["graph", "rounds", "gap", "CG / steps", "exchanges", "sums", "gap refined",
                     "msg steps refined", "tighter tol", "rounds", "gap", "msg steps rounds",
