@@ -15,6 +15,7 @@ machine's load; the seconds printed beside them do (the load is printed). f* is 
 
 usage: newton_refine.py [--bin build/bin] [--graphs parking-garage,...] [--agents 5]
                         [--tols 1e-3,1e-4,3e-5,1e-5] [--target 1e-6] [--csv FILE]
+(--tols "": no tighter runs; ais2klinik's take tens of minutes)
 """
 import argparse
 import json
@@ -68,7 +69,7 @@ def main():
         ref = solve(a, graph, fstar, ["--refine", "newton"])
         tight = None
         if base["rel_gap"] > a.target:
-            for t in a.tols.split(","):
+            for t in [x for x in a.tols.split(",") if x]:
                 tight = solve(a, graph, fstar, ["--grad-tol", t])
                 tight["grad_tol"] = float(t)
                 if tight["rel_gap"] <= a.target:
