@@ -59,6 +59,9 @@ struct NewtonRefineOptions {
   double initial_radius = 0.0;
   /// A trial is accepted when its ratio of actual to predicted decrease is above this. [0, 0.25).
   double accept_ratio = 0.05;
+  /// A rejected trial is tried again at a quarter of the step, up to this many times, before
+  /// the trust region shrinks and CG runs again. >= 0.
+  int max_backtracks = 6;
   /// Throws InputError naming the bad field.
   void validate() const;
 };
@@ -69,7 +72,9 @@ struct NewtonRefineStep {
   double radius = 0.0;                   ///< Trust radius the step was computed in (0 = unbounded).
   double predicted = 0.0, actual = 0.0;  ///< Decreases of the model and of f.
   bool accepted = false;
-  std::string cg_stop;     ///< residual, boundary, negative_curvature or cap.
+  /// residual, boundary, negative_curvature or cap; backtrack: the last CG step scaled down
+  /// (cg_iterations 0).
+  std::string cg_stop;
   double cost = 0.0;       ///< f after the step (the old one when rejected).
   double grad_norm = 0.0;  ///< ||grad f|| there.
 };
@@ -147,8 +152,12 @@ class NewtonRefineProtocol : public AgentProcess {
   double gamma_old_ = 0.0, alpha_old_ = 0.0, pHp_old_ = 0.0;
   double e_Pe_ = 0.0, e_Pd_ = 0.0, d_Pd_ = 0.0;  // <s,P^-1 s>, <s,P^-1 p>, <p,P^-1 p>
   double model_ = 0.0;                           // m(s) = <g, s> + <s, H s> / 2
-  double cg_target_ = 0.0;                       // residual norm that ends the CG
-  double radius_ = 0.0;                          // 0 = unbounded
+  double gs_ = 0.0, sHs_ = 0.0;                  // <g, s>, <s, H s> of the CG step
+  Eigen::MatrixXd s_full_;                       // the CG step; a backtrack tries scale_ of it
+  double scale_ = 1.0;
+  int backtracks_ = 0;
+  double cg_target_ = 0.0;  // residual norm that ends the CG
+  double radius_ = 0.0;     // 0 = unbounded
   NewtonRefineStep step_;
   bool done_ = false;
   NewtonRefineResult result_;
