@@ -74,7 +74,7 @@ def main():
                 tight["grad_tol"] = float(t)
                 if tight["rel_gap"] <= a.target:
                     break
-        row = dict(graph=name, poses=base["num_poses"] if "num_poses" in base else None,
+        row = dict(graph=name, poses=base.get("poses"),
                    rounds=base["rounds"], rounds_gap=base["rel_gap"],
                    refine_rounds=ref["rounds"], cg=ref["refine_cg_iterations"],
                    steps=ref["refine_steps"], exchanges=ref["refine_exchanges"],
