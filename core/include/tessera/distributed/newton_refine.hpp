@@ -17,7 +17,10 @@
 // The trust region (Steihaug-Toint truncated CG in the preconditioner's norm, ratio test on the
 // true cost) keeps a step that leaves the quadratic model's region from raising the cost: the
 // trial point's public poses are exchanged and its cost and gradient summed (one exchange and
-// one reduction per step); an accepted trial is the next point with no further message.
+// one reduction per step); an accepted trial is the next point with no further message. A
+// rejected trial is retried along the same CG step at a quarter of its length (no new CG) before
+// the region shrinks. The Hessian product is projected onto the tangent space (CG's residual must
+// be tangent: the tangent preconditioner maps a normal part to zero).
 // One agent's state machine (messages in -> messages out, no transport), driven like
 // RoundProtocol and CertificateProtocol, so in-process and DDS runs take identical iterates.
 
@@ -42,7 +45,8 @@ struct NewtonRefineOptions {
   /// Stop after an accepted step that lowered f by at most this fraction of f. A Newton step's
   /// decrease is about the gap it closes (parking-garage: predicted 9.0e-4, 3.3e-6, 3.1e-7 at
   /// gaps of 9.0e-4, 3.6e-6, 3.1e-7 before the step), and what is left after it much less
-  /// (2.4e-7 of f after the step that lowered f by 2.6e-6 of f). >= 0; 0 = off.
+  /// (2.4e-7 of f after the step that lowered f by 2.6e-6 of f). Only at a gradient norm at or
+  /// below the start's: a step cut short by the trust region lowers f little too. >= 0; 0 = off.
   double relative_decrease_tol = 1e-5;
   /// Most trust-region steps (accepted or not). > 0.
   int max_steps = 20;
