@@ -57,6 +57,9 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   ro.coarse_every = asg.coarse_every();
   ro.coarse_aggregates = asg.coarse_aggregates();
   ro.coarse_smoothing = asg.coarse_smoothing();
+  ro.refine = asg.refine() == "newton";
+  ro.refine_grad_tol = asg.refine_grad_tol();
+  ro.refine_rel_tol = asg.refine_rel_tol();
   if (!asg.robust().empty()) {
     ro.robust.kind = parse_robust_kind(asg.robust());
     ro.robust.inlier_threshold = asg.inlier_threshold();

@@ -61,6 +61,10 @@ const char* const kDistributedValued[] = {"agents",
                                           "coarse-space",
                                           "coarse-aggregates",
                                           "coarse-smoothing",
+                                          "refine",
+                                          "refine-grad-tol",
+                                          "refine-cg-iters",
+                                          "refine-rel-tol",
                                           nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
@@ -152,7 +156,14 @@ const char* kDistributedHelp =
     "  --certify-iters K         certificate iteration cap (default 300)\n"
     "  --certify-residual T      certificate stops at Ritz residual <= T max(1, max diag Q)\n"
     "                            (default 1e-6)\n"
-    "  --certify-precon block-jacobi|none   certificate preconditioner (default block-jacobi)\n";
+    "  --certify-precon block-jacobi|none   certificate preconditioner (default block-jacobi)\n"
+    "  --refine newton|none      after the rounds reach --grad-tol, trust-region Newton steps\n"
+    "                            on the whole problem, CG over neighbour exchanges and\n"
+    "                            all-agent sums (docs/newton-refine.md) (default none)\n"
+    "  --refine-grad-tol T       the refinement stops at ||grad f|| <= T (default 1e-6) or\n"
+    "                            after a step that lowered f by < F f, --refine-rel-tol F\n"
+    "                            (default 1e-5)\n"
+    "  --refine-cg-iters K       its CG iteration cap, all steps (default 3000)\n";
 
 namespace {
 
@@ -269,6 +280,17 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   }
   opt.staircase.certificate.max_iterations =
       static_cast<int>(a.get_long("certify-iters", opt.staircase.certificate.max_iterations));
+  {
+    const std::string refine = a.get_or("refine", "none");
+    if (refine != "newton" && refine != "none")
+      throw InputError("option --refine: '" + refine + "' is not one of newton, none");
+    opt.refine.enabled = refine == "newton";
+    opt.refine.grad_norm_tol = a.get_double("refine-grad-tol", opt.refine.grad_norm_tol);
+    opt.refine.relative_decrease_tol =
+        a.get_double("refine-rel-tol", opt.refine.relative_decrease_tol);
+    opt.refine.max_cg_iterations =
+        static_cast<int>(a.get_long("refine-cg-iters", opt.refine.max_cg_iterations));
+  }
   const long agents = a.get_long("agents", 5);
   if (agents < 1 || agents > 64) throw InputError("option --agents: must be in 1..64");
   if (a.has("reference") && a.has("reference-cost"))
@@ -351,6 +373,20 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         r.certificate_tolerance, r.certificate_residual, r.certificate_rounds,
         r.certificate_bytes / 1e6, r.escape_rounds, r.escape_bytes / 1e6, r.final_rank);
   }
+  for (const NewtonRefineResult& n : r.refines)
+    std::printf(
+        "  newton refine: %d steps (%d accepted), %d CG iterations, %d exchanges, %d all-agent "
+        "sums, |grad f| %.3g -> %.3g, f %.10g -> %.10g, stop: %s\n",
+        n.steps, n.accepted_steps, n.cg_iterations, n.exchanges, n.reductions, n.initial_grad_norm,
+        n.grad_norm, n.initial_cost, n.cost, n.stop_reason.c_str());
+  for (const NewtonRefineResult& n : r.refines)
+    for (std::size_t k = 0; k < n.trace.size(); ++k) {
+      const NewtonRefineStep& t = n.trace[k];
+      std::printf(
+          "    step %zu: %d CG (%s), predicted %.3g, actual %.3g, %s, f %.12g, |grad f| %.3g\n",
+          k + 1, t.cg_iterations, t.cg_stop.c_str(), t.predicted, t.actual,
+          t.accepted ? "accepted" : "rejected", t.cost, t.grad_norm);
+    }
   if (robust.kind != RobustKind::kNone)
     std::printf(
         "  robust %s: %d outer steps, %zu of %zu measurements rejected, %d rounds and %.3f MB "
@@ -416,6 +452,19 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
           .add("staircase_levels", static_cast<int>(r.certificates.size()));
     } else {
       j.add_null("min_eigenvalue").add_null("certificate_rounds");
+    }
+    if (opt.refine.enabled) {
+      int steps = 0, cg = 0, exchanges = 0, reductions = 0;
+      for (const NewtonRefineResult& n : r.refines) {
+        steps += n.steps;
+        cg += n.cg_iterations;
+        exchanges += n.exchanges;
+        reductions += n.reductions;
+      }
+      j.add("refine_steps", steps)
+          .add("refine_cg_iterations", cg)
+          .add("refine_exchanges", exchanges)
+          .add("refine_reductions", reductions);
     }
     if (fstar) j.add("f_star", *fstar);
     if (robust.kind != RobustKind::kNone) {

@@ -35,6 +35,9 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   asg.coarse_every(options.coarse_every);
   asg.coarse_aggregates(options.coarse_aggregates);
   asg.coarse_smoothing(options.coarse_smoothing);
+  asg.refine(options.refine);
+  asg.refine_grad_tol(options.refine_grad_tol);
+  asg.refine_rel_tol(options.refine_rel_tol);
   if (options.robust.kind != RobustKind::kNone) {
     const RobustOptions& r = options.robust;
     asg.robust(robust_kind_name(r.kind));

@@ -70,6 +70,11 @@ options:
                        pieces per block blended smoothly across their borders (default blocks)
   --coarse-aggregates K  smoothed: pieces per block (default 4)
   --coarse-smoothing S   smoothed: smoothing steps of the blend, 0..8 (default 1)
+  --refine newton|none after the rounds, trust-region Newton steps on the whole problem
+                       (docs/newton-refine.md) (default none)
+  --refine-grad-tol T, --refine-rel-tol F
+                       its stops: ||grad f|| <= T, or a step lowered f by < F f (0 = the
+                       defaults, 1e-6 and 1e-5)
   --robust none|gnc-tls  gnc-tls: reject outlier measurements by graduated non-convexity
                        with a truncated least-squares cost, then solve (and with --certify
                        certify) the kept ones; every agent weighs the measurements of its
@@ -116,7 +121,10 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "coarse-every",
                                                             "coarse-space",
                                                             "coarse-aggregates",
-                                                            "coarse-smoothing"},
+                                                            "coarse-smoothing",
+                                                            "refine",
+                                                            "refine-grad-tol",
+                                                            "refine-rel-tol"},
                                                            cli::SessionArgsFor::kProcess);
   valued.insert("graph");
   for (const char* const* r = cli::kRobustValued; *r; ++r) valued.insert(*r);
@@ -182,6 +190,13 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
     a.coarse_aggregates = static_cast<std::uint32_t>(c.aggregates);
     a.coarse_smoothing = static_cast<std::uint32_t>(c.smoothing_steps);
   }
+  a.refine = args.get_or("refine", a.refine);
+  if (a.refine != "none" && a.refine != "newton")
+    throw InputError("option --refine: '" + a.refine + "' is not one of newton, none");
+  a.refine_grad_tol = args.get_double("refine-grad-tol", 0);
+  a.refine_rel_tol = args.get_double("refine-rel-tol", 0);
+  if (!(a.refine_grad_tol >= 0)) throw InputError("option --refine-grad-tol: must be >= 0");
+  if (!(a.refine_rel_tol >= 0)) throw InputError("option --refine-rel-tol: must be >= 0");
   a.verbose = args.has("verbose");
   a.certify = args.has("certify");
   if (args.has("status-relay") && args.has("no-status-relay"))

@@ -34,6 +34,26 @@ void check_partition_time(const std::string& v) {
   number_in(v, "partition-time", 0, 86400, "0..86400");
 }
 
+void check_refine(const std::string& v) {
+  if (v != "newton" && v != "none")
+    throw InputError("option --refine: '" + v + "' is not one of newton, none");
+}
+
+// A tolerance >= 0 (0 = the solver's default), else an InputError naming the flag.
+void check_tolerance(const std::string& v, const char* flag) {
+  errno = 0;
+  char* end = nullptr;
+  const double x = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != '\0' || errno != 0 || !(x >= 0))
+    throw InputError(std::string("option --") + flag + ": '" + v + "' is not a number >= 0");
+}
+void check_refine_grad_tol(const std::string& v) {
+  check_tolerance(v, "refine-grad-tol");
+}
+void check_refine_rel_tol(const std::string& v) {
+  check_tolerance(v, "refine-rel-tol");
+}
+
 void check_setup_timeout(const std::string& v) {
   if (number_in(v, "setup-timeout", 0, 86400, "(0, 86400]") <= 0)
     throw InputError("launch: --setup-timeout must be in (0, 86400] seconds");
@@ -140,6 +160,15 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
       {"known-inliers", "known-inliers", true, ForwardTo::kCoordinator,
        "--known-inliers odometry|none", "never reject edges between consecutive ids [odometry]",
        check_known_inliers},
+      {"refine", "refine", true, ForwardTo::kCoordinator, "--refine newton|none",
+       "after the rounds reach --grad-tol, trust-region Newton\n"
+       "steps on the whole problem: CG over neighbour exchanges\n"
+       "and all-agent sums (docs/newton-refine.md)          [none]",
+       check_refine},
+      {"refine-grad-tol", "refine-grad-tol", true, ForwardTo::kCoordinator, "--refine-grad-tol T",
+       "the refinement stops at ||grad f|| <= T       [1e-6]", check_refine_grad_tol},
+      {"refine-rel-tol", "refine-rel-tol", true, ForwardTo::kCoordinator, "--refine-rel-tol F",
+       "or after a step that lowered f by < F f           [1e-5]", check_refine_rel_tol},
       {"rejected", "rejected", true, ForwardTo::kCoordinator, "--rejected FILE",
        "write the rejected edge indices (from 0 over the EDGE\n"
        "lines), one a line",

@@ -78,7 +78,8 @@ TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
   const std::map<std::string, std::string> value = {{"robust", "gnc-tls"},
                                                     {"known-inliers", "odometry"},
                                                     {"gnc-mu-step", "1.4"},
-                                                    {"inlier-quantile", "0.5"}};
+                                                    {"inlier-quantile", "0.5"},
+                                                    {"refine", "newton"}};
   for (const ForwardedFlag& f : forwarded_flags()) {
     EXPECT_NE(help.find(std::string("--") + f.name), std::string::npos) << f.name;
     Argv argv = {std::string("--") + f.name};

@@ -250,6 +250,18 @@ Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::Matri
   return updated_X_;
 }
 
+Eigen::MatrixXd AgentState::precondition(const Eigen::MatrixXd& X, const Eigen::MatrixXd& G) {
+  const LiftedManifold manifold = problem_.manifold(static_cast<int>(X.rows()));
+  if (X.rows() == d_ && tangent_ && tangent_->factored()) return tangent_->apply(manifold, X, G);
+  return euclidean().apply(manifold, X, G);
+}
+
+bool AgentState::refresh_tangent(const Eigen::MatrixXd& X) {
+  if (X.rows() != d_ || euclidean().block_diagonal()) return false;
+  if (!tangent_) return build_tangent(X, BlockUpdateOptions{});  // factored at X when built
+  return tangent_->usable() && tangent_->factorize(X);
+}
+
 double AgentState::local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours) {
   set_point(X, neighbours);
   return problem_.cost(active_part(X));

@@ -127,8 +127,21 @@ void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& ou
   for (auto& m : kept) {
     if (current_->done()) break;
     std::visit([](auto& x) { x.phase = step_of_phase(x.phase); }, m);
-    emit(current_->handle(m), out);
+    dispatch(m, out);
   }
+}
+
+void CertifiedAgent::dispatch(const ProtocolMessage& message, std::vector<OutgoingMessage>& out) {
+  if (stage_kind(stage_) == StageKind::kSolve && current_ != refine_.get() &&
+      NewtonRefineProtocol::is_refine_step(message_phase(message))) {
+    refine_early_.push_back(message);
+    return;
+  }
+  // The finished rounds' stragglers are of no use to the refinement.
+  if (refine_ && current_ == refine_.get() &&
+      !NewtonRefineProtocol::is_refine_step(message_phase(message)))
+    return;
+  emit(current_->handle(message), out);
 }
 
 std::size_t CertifiedAgent::messages_needed() const {
@@ -157,7 +170,7 @@ std::vector<OutgoingMessage> CertifiedAgent::handle(const ProtocolMessage& messa
   }
   ProtocolMessage m = message;
   std::visit([](auto& x) { x.phase = step_of_phase(x.phase); }, m);
-  emit(current_->handle(m), out);
+  dispatch(m, out);
   advance(out);
   return out;
 }
@@ -167,9 +180,41 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
     const int rank = state_.rank();
     switch (stage_kind(stage_)) {
       case StageKind::kSolve: {
-        solves_.push_back({stage_, rank, solve_->rounds(), solve_->restarts(),
-                           solve_->stop_reason(), solve_->trace().to_vector(), solve_tolerance(),
-                           refining_});
+        if (!refine_) {  // the block-coordinate rounds just ended
+          solves_.push_back({stage_, rank, solve_->rounds(), solve_->restarts(),
+                             solve_->stop_reason(), solve_->trace().to_vector(), solve_tolerance(),
+                             refining_});
+          const std::string& stop = solves_.back().stop_reason;
+          // A solve out of rounds is not refined: max_rounds is the run's budget.
+          if (options_.refine.enabled && !solves_.back().trace.empty() &&
+              (stop == "grad_norm" || stop == "relative_decrease" || stop == "stalled")) {
+            refine_ = std::make_unique<NewtonRefineProtocol>(state_, layout_, options_.refine);
+            current_ = refine_.get();
+            emit(refine_->start(), out);
+            std::vector<ProtocolMessage> early = std::move(refine_early_);
+            refine_early_.clear();
+            for (const auto& m : early) {
+              if (current_->done()) break;
+              emit(current_->handle(m), out);
+            }
+            continue;
+          }
+        } else {
+          // The refinement's point ends the stage's trace, so the cost and gradient reported
+          // (and the escape's reference cost) are the refined ones.
+          const NewtonRefineResult& r = refine_->result();
+          refines_.push_back(r);
+          if (r.accepted_steps > 0) {
+            RoundRecord last = solves_.back().trace.back();
+            last.cost = r.cost;
+            last.grad_norm = r.grad_norm;
+            last.selected.clear();
+            last.restart = false;
+            solves_.back().trace.push_back(std::move(last));
+          }
+          refine_.reset();
+          current_ = solve_.get();
+        }
         if (!options_.certify || solve_->trace().empty()) {
           done_ = true;
           break;

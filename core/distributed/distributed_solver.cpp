@@ -56,6 +56,7 @@ void DistributedOptions::validate() const {
   algorithm_block_update().validate();
   rbcd_plus_plus.validate();
   irbcd.validate();
+  if (refine.enabled) refine.validate();
   if (certify) {
     staircase.validate();
     if (staircase.max_rank < rank) fail("staircase.max_rank", "must be >= rank");
@@ -207,6 +208,7 @@ DistributedResult solve_distributed_with_states(const PoseGraph& graph, const Bl
   res.certified = lead.certified();
   res.certificates = lead.certificates();
   res.escapes = lead.escapes();
+  res.refines = lead.refines();
   if (!res.certificates.empty()) {
     const auto& c = res.certificates.back().result;
     res.min_eigenvalue = c.min_eigenvalue;

@@ -34,6 +34,9 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
     opt.coarse.aggregates = static_cast<int>(o.coarse_aggregates);
     opt.coarse.smoothing_steps = static_cast<int>(o.coarse_smoothing);
   }
+  opt.refine.enabled = o.refine;
+  if (o.refine_grad_tol > 0) opt.refine.grad_norm_tol = o.refine_grad_tol;
+  if (o.refine_rel_tol > 0) opt.refine.relative_decrease_tol = o.refine_rel_tol;
   opt.validate();
   return opt;
 }
@@ -104,7 +107,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   RoundLoopResult res;
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<CertifiedAgent> sequence;
-  if (!options.certify) {
+  if (!options.certify && !options.refine.enabled) {
     RoundProtocol protocol(state, layout, config);
     if (hooks.on_round) protocol.set_round_observer(hooks.on_round);
     mail.run_protocol(
@@ -137,7 +140,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
       res.relaxation_cost = last.trace.back().cost;
       res.grad_norm = last.trace.back().grad_norm;
     }
-    res.certified = sequence->certified();
+    if (options.certify) res.certified = sequence->certified();
     if (!sequence->certificates().empty())
       res.min_eigenvalue = sequence->certificates().back().result.min_eigenvalue;
     res.certificate_rounds = static_cast<std::uint32_t>(sequence->certificate_iterations());
@@ -145,8 +148,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     mail.after_handled = nullptr;
   }
   res.final_rank = static_cast<std::uint32_t>(state.rank());
-  return round_and_report(local, layout, state, mail, channel, std::move(res), sequence != nullptr,
-                          t0);
+  return round_and_report(local, layout, state, mail, channel, std::move(res), options.certify, t0);
 }
 
 }  // namespace tessera::agent

@@ -48,6 +48,10 @@ struct RunOptions {
   /// pieces per block and coarse_smoothing smoothing steps (coarse_space.hpp).
   std::uint32_t coarse_aggregates = 0;
   std::uint32_t coarse_smoothing = 1;
+  /// Newton refinement after the rounds (newton_refine.hpp) and its tolerances (0 = core's).
+  bool refine = false;
+  double refine_grad_tol = 0;
+  double refine_rel_tol = 0;
   /// Robust solve (`--robust`; robust/gnc_agent.hpp runs it): kind none = plain least squares.
   RobustOptions robust;
   /// GNC starts from the known inliers' distributed initialization when they connect the poses

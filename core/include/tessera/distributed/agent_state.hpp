@@ -71,6 +71,14 @@ class AgentState {
   std::vector<double> smoothed_coarse_terms() const { return smoothed_->compute(Y, Yn); }
   /// Moves Y, V and the neighbour copies Yn, Vn by their blended motions (one per aggregate).
   void apply_smoothed_coarse(const std::vector<Eigen::MatrixXd>& motions);
+  /// This block's preconditioner applied to a tangent vector G at X (X: the block's point on
+  /// its active rows, any rank): the tangent factor when X has d rows and one is held, else the
+  /// Q_BB factor. A symmetric positive definite map of the tangent space at X (the Newton
+  /// refinement's block-Jacobi preconditioner, newton_refine.hpp).
+  Eigen::MatrixXd precondition(const Eigen::MatrixXd& X, const Eigen::MatrixXd& G);
+  /// Factors the tangent preconditioner at X (d rows) when this block can have one (built on
+  /// first use): precondition() is then exact for Q_BB's part at X. False when it cannot.
+  bool refresh_tangent(const Eigen::MatrixXd& X);
   /// Local objective f_B(X) with neighbours at `neighbours`.
   double local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
   /// Totals over this agent's block updates so far (BlockUpdateStats summed): updates,

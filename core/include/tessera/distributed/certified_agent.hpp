@@ -26,6 +26,7 @@
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/newton_refine.hpp>
 #include <tessera/distributed/protocol_snapshot.hpp>
 #include <tessera/distributed/round_protocol.hpp>
 #include <tessera/distributed/saddle_escape.hpp>
@@ -60,6 +61,8 @@ class CertifiedAgent : public AgentProcess {
   const std::vector<SolveStageRecord>& solves() const { return solves_; }
   const std::vector<CertifyStageRecord>& certificates() const { return certificates_; }
   const std::vector<EscapeStageRecord>& escapes() const { return escapes_; }
+  /// The Newton refinements run (options.refine), in order.
+  const std::vector<NewtonRefineResult>& refines() const { return refines_; }
   /// nullopt when certification is off; otherwise the last certificate held at a point where
   /// the solve converged (stopped on its gradient or relative-decrease test).
   std::optional<bool> certified() const;
@@ -83,6 +86,9 @@ class CertifiedAgent : public AgentProcess {
              const ProtocolSnapshot* resume_from = nullptr);
   void advance(std::vector<OutgoingMessage>& out);
   void emit(std::vector<OutgoingMessage>&& sub, std::vector<OutgoingMessage>& out) const;
+  /// Hands a message of the current stage (step phase) to the running protocol; a solve
+  /// stage's refinement messages wait until its refinement runs.
+  void dispatch(const ProtocolMessage& message, std::vector<OutgoingMessage>& out);
   /// The current solve stage's gradient tolerance: the solver's own, or refine_tolerance()
   /// while refining an inconclusive certificate.
   double solve_tolerance() const;
@@ -95,6 +101,9 @@ class CertifiedAgent : public AgentProcess {
   std::unique_ptr<RoundProtocol> solve_;
   std::unique_ptr<CertificateProtocol> certify_;
   std::unique_ptr<SaddleEscapeProtocol> escape_;
+  std::unique_ptr<NewtonRefineProtocol> refine_;  // runs after the current solve stage
+  std::vector<ProtocolMessage> refine_early_;     // its messages that came before it began
+  std::vector<NewtonRefineResult> refines_;
   AgentProcess* current_ = nullptr;
   Eigen::MatrixXd direction_;  // the last certificate's Ritz vector (own block)
   std::map<std::uint32_t, std::vector<ProtocolMessage>> later_;  // by stage

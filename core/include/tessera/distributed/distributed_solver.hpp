@@ -11,6 +11,7 @@
 #include <tessera/distributed/in_process_driver.hpp>
 #include <tessera/distributed/irbcd.hpp>
 #include <tessera/distributed/local_rounds.hpp>
+#include <tessera/distributed/newton_refine.hpp>
 #include <tessera/distributed/rbcd.hpp>
 #include <tessera/distributed/rbcd_plus_plus.hpp>
 #include <tessera/distributed/stage_records.hpp>
@@ -69,6 +70,9 @@ struct DistributedOptions {
   /// (docs/distributed-certification.md). Off by default for `tessera solve`.
   bool certify = false;
   StaircaseOptions staircase;
+  /// After each solve stage that converged, Newton steps on the whole problem to
+  /// refine.grad_norm_tol (newton_refine.hpp; off unless refine.enabled).
+  NewtonRefineOptions refine;
   /// Round the final iterate to SE(d) (`poses`, `cost`). Off for callers that keep the lifted
   /// iterate and whose graph may not be connected yet (the online engine's steps), where the
   /// translation solve of the rounding has no unique answer.
@@ -114,6 +118,8 @@ struct DistributedResult {
   /// Solver rounds (included in `rounds`) spent refining ranks whose certificate at the
   /// solver's tolerance was inconclusive (StaircaseOptions::grad_norm_tol).
   int refine_rounds = 0;
+  /// The Newton refinements (DistributedOptions::refine), one per refined solve stage.
+  std::vector<NewtonRefineResult> refines;
   int escape_rounds = 0;  ///< Line-search trials, all escapes.
   std::uint64_t escape_bytes = 0;
   int final_rank = 0;

@@ -1,0 +1,170 @@
+#pragma once
+// Distributed second-order refinement of a lifted iterate: Riemannian trust-region Newton steps
+// on the WHOLE lifted problem, run by the agents together after the block-coordinate rounds.
+//
+// Why: block-coordinate descent reaches a gradient of 1e-2 in tens of rounds, but on long chains
+// (parking-garage, ais2klinik) its slow modes leave the iterate 1e-4 relative above the optimum,
+// and each further decade costs hundreds of rounds (docs/benchmarks/launch_phases.md). A Newton
+// step solves for all modes at once; its truncated conjugate gradient (CG) needs only what the
+// agents already exchange:
+//   * Hessian-vector product: each agent forms its own block's rows of Hess f(X)[v] from its own
+//     entries of v and its neighbours' public entries (one neighbour exchange per product);
+//   * CG's inner products are all-agent sums in agent-id order (bit-identical on every agent);
+//   * the preconditioner is block Jacobi: each agent applies its own block preconditioner
+//     (AgentState::precondition: the tangent factor of its block, else its Q_BB factor).
+// CG is in the Chronopoulos-Gear form (the two inner products of an iteration from one
+// reduction, <p, Hp> by recurrence), so an iteration is one exchange then one reduction.
+// The trust region (Steihaug-Toint truncated CG in the preconditioner's norm, ratio test on the
+// true cost) keeps a step that leaves the quadratic model's region from raising the cost: the
+// trial point's public poses are exchanged and its cost and gradient summed (one exchange and
+// one reduction per step); an accepted trial is the next point with no further message. A
+// rejected trial is retried along the same CG step at a quarter of its length (no new CG) before
+// the region shrinks. The Hessian product is projected onto the tangent space (CG's residual must
+// be tangent: the tangent preconditioner maps a normal part to zero).
+// One agent's state machine (messages in -> messages out, no transport), driven like
+// RoundProtocol and CertificateProtocol, so in-process and DDS runs take identical iterates.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <tessera/distributed/agent_process.hpp>
+#include <tessera/distributed/agent_state.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/message_gate.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <vector>
+
+namespace tessera {
+
+struct NewtonRefineOptions {
+  /// Run the refinement after the block-coordinate solve reached its own tolerance (a solve
+  /// that ran out of rounds is not refined). Off by default; `--refine newton` switches it on.
+  bool enabled = false;
+  /// Stop when ||grad f|| <= this (absolute, as the solver's grad_norm_tol). > 0.
+  double grad_norm_tol = 1e-6;
+  /// Stop after an accepted step that lowered f by at most this fraction of f. A Newton step's
+  /// decrease is about the gap it closes (parking-garage: predicted 9.0e-4, 3.3e-6, 3.1e-7 at
+  /// gaps of 9.0e-4, 3.6e-6, 3.1e-7 before the step), and what is left after it much less
+  /// (2.4e-7 of f after the step that lowered f by 2.6e-6 of f). Only at a gradient norm at or
+  /// below the start's: a step cut short by the trust region lowers f little too. >= 0; 0 = off.
+  double relative_decrease_tol = 1e-5;
+  /// Most trust-region steps (accepted or not). > 0.
+  int max_steps = 20;
+  /// Most CG iterations over all steps (each one exchange and one reduction). > 0.
+  int max_cg_iterations = 3000;
+  /// A step's CG stops when its residual is below
+  ///   max(0.5 grad_norm_tol, ||g|| min(forcing, ||g||^forcing_power)), g = the step's gradient
+  /// (the superlinear forcing of truncated Newton; the floor avoids solving beyond need).
+  /// forcing in (0, 1), forcing_power >= 0.
+  double forcing = 0.1;
+  double forcing_power = 1.0;
+  /// First trust-region radius in the preconditioner's norm; 0 = unbounded (a plain Newton
+  /// step first: the start is a converged block-coordinate iterate). >= 0.
+  double initial_radius = 0.0;
+  /// A trial is accepted when its ratio of actual to predicted decrease is above this. [0, 0.25).
+  double accept_ratio = 0.05;
+  /// A rejected trial is tried again at a quarter of the step, up to this many times, before
+  /// the trust region shrinks and CG runs again. >= 0.
+  int max_backtracks = 6;
+  /// Throws InputError naming the bad field.
+  void validate() const;
+};
+
+/// One trust-region step, identical on every agent.
+struct NewtonRefineStep {
+  int cg_iterations = 0;
+  double radius = 0.0;                   ///< Trust radius the step was computed in (0 = unbounded).
+  double predicted = 0.0, actual = 0.0;  ///< Decreases of the model and of f.
+  bool accepted = false;
+  /// residual, boundary, negative_curvature or cap; backtrack: the last CG step scaled down
+  /// (cg_iterations 0).
+  std::string cg_stop;
+  double cost = 0.0;       ///< f after the step (the old one when rejected).
+  double grad_norm = 0.0;  ///< ||grad f|| there.
+};
+
+/// Identical on every agent.
+struct NewtonRefineResult {
+  /// grad_norm (reached the tolerance), max_steps, max_cg_iterations or stalled (the trust
+  /// region shrank below round-off).
+  std::string stop_reason;
+  double initial_cost = 0.0, initial_grad_norm = 0.0;
+  double cost = 0.0, grad_norm = 0.0;  ///< At the final point.
+  int steps = 0, accepted_steps = 0, cg_iterations = 0;
+  /// Message steps: neighbour exchanges (CG directions and trial poses) and all-agent sums.
+  int exchanges = 0, reductions = 0;
+  std::vector<NewtonRefineStep> trace;
+};
+
+class NewtonRefineProtocol : public AgentProcess {
+ public:
+  /// Protocol steps (on the wire: the solve stage's phase base + these; RoundProtocol uses
+  /// 0..5 in the same stage).
+  enum Step : std::uint32_t {
+    kStatus = 60,     ///< Cost share, ||g||^2 and active rows at the start point.
+    kDirection = 61,  ///< Public entries of the preconditioned residual z.
+    kSums = 62,       ///< CG's <r, z>, <z, H z>, <r, r>.
+    kTrial = 63,      ///< Public poses of the trial point.
+    kTrialSums = 64   ///< Cost share and ||g||^2 at the trial point.
+  };
+  static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kTrialSums; }
+
+  /// `state`: the agent at the point to refine (Y, and Yn = the neighbours' public poses of the
+  /// same point). It must outlive the protocol; on done() its sequences are reset to the final
+  /// point (AgentState::reset_iterate).
+  NewtonRefineProtocol(AgentState& state, const BlockLayout& layout,
+                       const NewtonRefineOptions& options);
+
+  std::vector<OutgoingMessage> start() override;
+  std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
+  bool done() const override { return done_; }
+  const NewtonRefineResult& result() const { return result_; }
+
+ private:
+  void pump(std::vector<OutgoingMessage>& out);
+  void send_public(const Eigen::MatrixXd& v, std::uint32_t step, std::vector<OutgoingMessage>& out);
+  void broadcast(std::uint32_t step, const std::vector<double>& values,
+                 std::vector<OutgoingMessage>& out);
+  Eigen::MatrixXd neighbours_of(const MessageGate::Inbox& inbox) const;
+  // Local pieces at (X_, Xn_): egrad_, g_ and the cost share.
+  double evaluate_point();
+  Eigen::MatrixXd hessian(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
+  void after_status(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void begin_cg(std::vector<OutgoingMessage>& out);
+  void send_direction(std::vector<OutgoingMessage>& out);
+  void after_direction(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void after_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void try_step(const std::string& cg_stop, std::vector<OutgoingMessage>& out);
+  void after_trial(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void after_trial_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void finish(const std::string& why);
+  std::vector<int> everyone() const;
+
+  AgentState& state_;
+  const BlockLayout& layout_;
+  NewtonRefineOptions options_;
+  BlockProblem problem_;  // own copy: its neighbour poses are set to directions
+  MessageGate gate_;
+  std::uint32_t message_round_ = 0;  // one per message step, the same on every agent
+  std::vector<Eigen::Index> rows_;   // active rows (non-zero on some agent)
+  // The point and its local pieces; the trial point.
+  Eigen::MatrixXd X_, Xn_, egrad_, g_, Xt_, Xtn_, egrad_t_, g_t_;
+  double f_ = 0.0, gnorm_ = 0.0;
+  // CG on H s = -g: s, r, z = P r, w = H z, p, q = H p.
+  Eigen::MatrixXd s_, r_, z_, w_, p_, q_;
+  int cg_it_ = 0;
+  double gamma_old_ = 0.0, alpha_old_ = 0.0, pHp_old_ = 0.0;
+  double e_Pe_ = 0.0, e_Pd_ = 0.0, d_Pd_ = 0.0;  // <s,P^-1 s>, <s,P^-1 p>, <p,P^-1 p>
+  double model_ = 0.0;                           // m(s) = <g, s> + <s, H s> / 2
+  double gs_ = 0.0, sHs_ = 0.0;                  // <g, s>, <s, H s> of the CG step
+  Eigen::MatrixXd s_full_;                       // the CG step; a backtrack tries scale_ of it
+  double scale_ = 1.0;
+  int backtracks_ = 0;
+  double cg_target_ = 0.0;  // residual norm that ends the CG
+  double radius_ = 0.0;     // 0 = unbounded
+  NewtonRefineStep step_;
+  bool done_ = false;
+  NewtonRefineResult result_;
+};
+
+}  // namespace tessera

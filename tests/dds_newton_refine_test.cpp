@@ -1,0 +1,88 @@
+// The Newton refinement over DDS: agents started with `--refine newton` through the coordinator
+// take the in-process engine's iterates (same rounds, same refined cost), and `tessera launch
+// --refine newton` forwards the option and ends at the optimum.
+// Domains used here: 80-81 (each test its own, so ctest -j is safe).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <regex>
+#include <string>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/io/g2o_reader.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <vector>
+
+#include "dds_process_support.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+std::string json_text(const std::string& json, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eEa-z]+)"))) return "";
+  return m[1];
+}
+double json_number(const std::string& json, const std::string& name) {
+  const std::string t = json_text(json, name);
+  return t.empty() ? NAN : std::stod(t);
+}
+
+// A chain-like generated graph: a lawnmower path with 4 loop closures, where the rounds stop
+// ~1e-5 above f* at gradient 0.01.
+const char* kChain =
+    "--kind grid3d --poses 600 --max-loop-closures 4 --rot-noise 0.1 --trans-noise 1 --seed 3";
+
+TEST(DdsNewtonRefine, AgentsOverDdsTakeTheInProcessIterates) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/chain.g2o";
+  generate_graph(graph, kChain);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const int agents = 3, domain = 80;
+  const std::string run = "refine-" + std::to_string(getpid());
+  run_to_the_end(dir, graph, agents, run, domain,
+                 {"--timeout", "20", "--run-timeout", "90", "--summary", dir + "/summary.json",
+                  "--partition", "eco", "--refine", "newton", "--init", "file"},
+                 90);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const std::string summary = slurp(dir + "/summary.json");
+
+  const std::vector<int> assignment = assignment_of(dir, agents);
+  const PoseGraph g = read_g2o(graph);
+  ASSERT_EQ(assignment.size(), g.num_poses);
+  DistributedOptions opt;
+  opt.refine.enabled = true;
+  const DistributedResult ref = solve_distributed(g, assignment, opt, g.initial);
+  ASSERT_EQ(ref.refines.size(), 1u);
+  ASSERT_GE(ref.refines[0].accepted_steps, 1);
+  EXPECT_EQ(json_number(summary, "rounds"), ref.rounds) << summary;
+  // The refined point (its gradient norm, summed in agent-id order as in process) and its
+  // rounding (the DDS agents' distributed rounding: equal up to summation order).
+  EXPECT_NEAR(json_number(summary, "grad_norm"), ref.grad_norm, 1e-9 * ref.grad_norm) << summary;
+  EXPECT_NEAR(json_number(summary, "cost"), ref.cost, 1e-9 * ref.cost) << summary;
+  // And that is the optimum, which the rounds alone do not reach on this chain.
+  const double fstar = solve_centralized(g).cost;
+  EXPECT_NEAR(json_number(summary, "cost"), fstar, 1e-8 * fstar) << summary;
+}
+
+TEST(DdsNewtonRefine, LaunchForwardsRefineAndEndsCertifiedAtTheOptimum) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/chain.g2o";
+  generate_graph(graph, kChain);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch " + graph +
+                                 " --agents 3 --domain 81 --refine newton --timeout 90 --json " +
+                                 dir + "/s.json 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  const std::string json = slurp(dir + "/s.json");
+  EXPECT_EQ(json_text(json, "certified"), "true") << json;
+  const PoseGraph g = read_g2o(graph);
+  const double fstar = solve_centralized(g).cost;
+  EXPECT_NEAR(json_number(json, "cost"), fstar, 1e-8 * fstar) << json;
+}
+
+}  // namespace
+}  // namespace tessera::test::dds

@@ -1,0 +1,141 @@
+// The distributed Newton refinement (newton_refine.hpp): from where the block-coordinate rounds
+// stop, it reaches the centralized optimum of a long chain (the case the rounds are slow on)
+// in a few trust-region steps; every agent takes the same steps whatever the delivery order;
+// its options refuse bad values by name.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/newton_refine.hpp>
+#include <tessera/generate/generator.hpp>
+#include <tessera/partition/sequential_partition.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/util/input_error.hpp>
+#include <vector>
+
+namespace tessera {
+namespace {
+
+// A long 3D chain with 4 loop closures (like parking-garage: the rounds' slow modes are the
+// chain's bending), small enough for a unit test. With 4 agents the rounds stop at gradient
+// 0.01 1.5e-5 above f* (159 rounds).
+PoseGraph long_chain() {
+  GeneratorOptions g;
+  g.kind = TrajectoryKind::kGrid3d;
+  g.num_poses = 600;
+  g.max_loop_closures = 4;
+  g.rotation_noise = 0.1;
+  g.translation_noise = 1.0;
+  g.seed = 3;
+  return generate_pose_graph(g).graph;
+}
+
+DistributedOptions refined(bool on) {
+  DistributedOptions o;
+  o.grad_norm_tol = 0.01;
+  o.refine.enabled = on;
+  return o;
+}
+
+TEST(NewtonRefine, ReachesTheCentralizedOptimumWhereTheRoundsStopShortOfIt) {
+  const PoseGraph g = long_chain();
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  const double fstar = solve_centralized(g).cost;
+  const DistributedResult plain = solve_distributed(g, parts, refined(false));
+  const DistributedResult newton = solve_distributed(g, parts, refined(true));
+  // The same rounds first (the refinement starts where the plain run stops).
+  EXPECT_EQ(newton.rounds, plain.rounds);
+  ASSERT_EQ(newton.refines.size(), 1u);
+  const NewtonRefineResult& n = newton.refines.front();
+  EXPECT_TRUE(n.stop_reason == "grad_norm" || n.stop_reason == "relative_decrease")
+      << n.stop_reason;
+  EXPECT_EQ(n.initial_cost, plain.relaxation_cost);
+  EXPECT_GE(n.accepted_steps, 1);
+  EXPECT_LE(n.steps, 6);
+  // Each CG iteration is one neighbour exchange and one all-agent sum; each step adds one of
+  // each for its trial point, plus the start's sum and a step's last CG exchange.
+  EXPECT_GE(n.exchanges, n.cg_iterations + n.steps);
+  EXPECT_LE(n.exchanges, n.cg_iterations + 2 * n.steps);
+  EXPECT_EQ(n.reductions, n.exchanges + 1);
+  // The rounds stop measurably above f*; the refined estimate is at f*.
+  const double gap_plain = (plain.cost - fstar) / fstar;
+  const double gap_newton = (newton.cost - fstar) / fstar;
+  EXPECT_GT(gap_plain, 1e-6) << "the chain should be slow for the rounds";
+  EXPECT_LT(std::abs(gap_newton), 1e-8) << "plain " << gap_plain;
+  EXPECT_LT(newton.grad_norm, plain.grad_norm);
+  EXPECT_EQ(newton.relaxation_cost, n.cost);
+}
+
+TEST(NewtonRefine, EveryAgentTakesTheSameStepsInAnyDeliveryOrder) {
+  const PoseGraph g = long_chain();
+  const std::vector<int> parts = sequential_partition(g.num_poses, 3);
+  DistributedOptions fifo = refined(true);
+  DistributedOptions shuffled = fifo;
+  shuffled.delivery = DeliveryOrder::kShuffled;
+  shuffled.delivery_seed = 11;
+  const DistributedResult a = solve_distributed(g, parts, fifo);
+  const DistributedResult b = solve_distributed(g, parts, shuffled);
+  ASSERT_EQ(a.refines.size(), 1u);
+  ASSERT_EQ(b.refines.size(), 1u);
+  EXPECT_EQ(a.refines[0].cg_iterations, b.refines[0].cg_iterations);
+  EXPECT_EQ(a.refines[0].cost, b.refines[0].cost);  // bit for bit: sums in agent-id order
+  EXPECT_EQ(a.X, b.X);
+}
+
+TEST(NewtonRefine, RunsAfterEachSolveStageOfTheCertifiedSequenceAndKeepsTheCertificate) {
+  const PoseGraph g = long_chain();
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  DistributedOptions o = refined(true);
+  o.certify = true;
+  const DistributedResult r = solve_distributed(g, parts, o);
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_TRUE(*r.certified);
+  EXPECT_EQ(r.refines.size(), r.certificates.size());  // one solve stage per certificate here
+  EXPECT_EQ(r.relaxation_cost, r.refines.back().cost);
+}
+
+TEST(NewtonRefine, IsNotRunAfterASolveOutOfRounds) {
+  const PoseGraph g = long_chain();
+  DistributedOptions o = refined(true);
+  o.max_rounds = 2;
+  o.grad_norm_tol = 1e-9;
+  const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 3), o);
+  EXPECT_EQ(r.stop_reason, "max_rounds");
+  EXPECT_TRUE(r.refines.empty());
+}
+
+TEST(NewtonRefineOptions, ValidateNamesTheBadField) {
+  auto message = [](NewtonRefineOptions o) {
+    try {
+      o.validate();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  NewtonRefineOptions o;
+  EXPECT_EQ(message(o), "");
+  o.grad_norm_tol = 0;
+  EXPECT_NE(message(o).find("grad_norm_tol"), std::string::npos);
+  o = {};
+  o.max_cg_iterations = 0;
+  EXPECT_NE(message(o).find("max_cg_iterations"), std::string::npos);
+  o = {};
+  o.forcing = 1.0;
+  EXPECT_NE(message(o).find("forcing"), std::string::npos);
+  o = {};
+  o.relative_decrease_tol = -1;
+  EXPECT_NE(message(o).find("relative_decrease_tol"), std::string::npos);
+  o = {};
+  o.accept_ratio = 0.5;
+  EXPECT_NE(message(o).find("accept_ratio"), std::string::npos);
+  DistributedOptions d;
+  d.refine.enabled = true;
+  d.refine.max_steps = 0;
+  EXPECT_THROW(d.validate(), InputError);
+}
+
+}  // namespace
+}  // namespace tessera
