@@ -151,19 +151,11 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
   Q.off.resize(static_cast<std::size_t>(N));
   for (int a = 0; a < N; ++a) {
     const std::vector<double>& t = *terms[static_cast<std::size_t>(a)];
+    const std::vector<int> rows = coarse_term_rows(t, r, a);
     auto bad = [&](const std::string& why) {
       return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(a) +
                                 ": " + why);
     };
-    if (t.empty()) throw bad("none");
-    const double mask = t[0];
-    if (!(mask >= 0 && mask < std::ldexp(1.0, r)) || std::floor(mask) != mask)
-      throw bad("row mask " + std::to_string(mask) + " does not fit rank " + std::to_string(r));
-    std::vector<int> rows;
-    const auto bits = static_cast<unsigned long long>(mask);
-    for (int k = 0; k < r; ++k)
-      if (bits & (1ull << k)) rows.push_back(k);
-    rows.push_back(r);
     const std::size_t m = rows.size();
     std::vector<int> upper;
     for (int b : layout.adjacent[static_cast<std::size_t>(a)])
@@ -188,6 +180,23 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
   }
 
   return solve_coarse_matrix(std::move(Q), r, options);
+}
+
+std::vector<int> coarse_term_rows(const std::vector<double>& terms, int r, int agent) {
+  auto bad = [&](const std::string& why) {
+    return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(agent) +
+                              ": " + why);
+  };
+  if (terms.empty()) throw bad("none");
+  const double mask = terms[0];
+  if (!(mask >= 0 && mask < std::ldexp(1.0, r)) || std::floor(mask) != mask)
+    throw bad("row mask " + std::to_string(mask) + " does not fit rank " + std::to_string(r));
+  std::vector<int> rows;
+  const auto bits = static_cast<unsigned long long>(mask);
+  for (int k = 0; k < r; ++k)
+    if (bits & (1ull << k)) rows.push_back(k);
+  rows.push_back(r);
+  return rows;
 }
 
 CoarseResult solve_coarse_matrix(CoarseMatrix Q, int r, const CoarseOptions& options) {

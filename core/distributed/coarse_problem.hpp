@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <string>
 #include <tessera/distributed/coarse_correction.hpp>
 #include <vector>
 
@@ -16,6 +17,12 @@ struct CoarseMatrix {
   std::vector<Eigen::MatrixXd> diag;
   std::vector<std::map<int, Eigen::MatrixXd>> off;
 };
+
+/// The rows of the lifted space an agent's coarse terms use, read from their first entry (a
+/// bit mask over the r rows), with the translation row r appended. Throws runtime_error
+/// ("malformed message: coarse terms of agent ...") on an empty vector or a mask that is not
+/// an integer in [0, 2^r).
+std::vector<int> coarse_term_rows(const std::vector<double>& terms, int r, int agent);
 
 /// Levenberg-Marquardt from the identity motions in the tangent space of the rigid motions
 /// (Cayley retraction), on the rows of the lifted space that some pose uses. Deterministic:

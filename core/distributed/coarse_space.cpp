@@ -361,19 +361,11 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
   // Summed in agent-id order, so every agent assembles bit-identical blocks.
   for (int a = 0; a < N; ++a) {
     const std::vector<double>& t = *terms[static_cast<std::size_t>(a)];
+    const std::vector<int> rows = coarse_term_rows(t, r, a);
     auto bad = [&](const std::string& why) {
       return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(a) +
                                 ": " + why);
     };
-    if (t.empty()) throw bad("none");
-    const double mask = t[0];
-    if (!(mask >= 0 && mask < std::ldexp(1.0, r)) || std::floor(mask) != mask)
-      throw bad("row mask " + std::to_string(mask) + " does not fit rank " + std::to_string(r));
-    std::vector<int> rows;
-    const auto bits = static_cast<unsigned long long>(mask);
-    for (int k = 0; k < r; ++k)
-      if (bits & (1ull << k)) rows.push_back(k);
-    rows.push_back(r);
     const std::size_t m = rows.size();
     const std::size_t p0 = space.pair_start[static_cast<std::size_t>(a)];
     const std::size_t p1 = space.pair_start[static_cast<std::size_t>(a) + 1];
