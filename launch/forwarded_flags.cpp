@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstdlib>
+#include <string>
 #include <tessera/robust/robust_options.hpp>
 #include <tessera/util/input_error.hpp>
 
@@ -52,6 +53,29 @@ void check_refine_grad_tol(const std::string& v) {
 }
 void check_refine_rel_tol(const std::string& v) {
   check_tolerance(v, "refine-rel-tol");
+}
+
+// A whole number in [lo, hi], else an InputError naming the flag.
+void whole_number_in(const std::string& v, const char* flag, long lo, long hi) {
+  errno = 0;
+  char* end = nullptr;
+  const long x = std::strtol(v.c_str(), &end, 10);
+  if (v.empty() || *end != '\0' || errno != 0 || x < lo || x > hi)
+    throw InputError(std::string("option --") + flag + ": '" + v + "' is not a whole number in " +
+                     std::to_string(lo) + ".." + std::to_string(hi));
+}
+void check_coarse_every(const std::string& v) {
+  whole_number_in(v, "coarse-every", 0, 1000000);
+}
+void check_coarse_space(const std::string& v) {
+  if (v != "blocks" && v != "smoothed")
+    throw InputError("option --coarse-space: '" + v + "' is not one of blocks, smoothed");
+}
+void check_coarse_aggregates(const std::string& v) {
+  whole_number_in(v, "coarse-aggregates", 1, 1000);
+}
+void check_coarse_smoothing(const std::string& v) {
+  whole_number_in(v, "coarse-smoothing", 0, 8);
 }
 
 void check_setup_timeout(const std::string& v) {
@@ -160,6 +184,21 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
       {"known-inliers", "known-inliers", true, ForwardTo::kCoordinator,
        "--known-inliers odometry|none", "never reject edges between consecutive ids [odometry]",
        check_known_inliers},
+      {"coarse-every", "coarse-every", true, ForwardTo::kCoordinator, "--coarse-every K",
+       "two-level rounds: a coarse correction every K-th round,\n"
+       "0 = off (docs/irbcd.md, \"Coarse correction\")            [0]",
+       check_coarse_every},
+      {"coarse-space", "coarse-space", true, ForwardTo::kCoordinator,
+       "--coarse-space blocks|smoothed",
+       "one rigid motion per block, or K rigid pieces per block\n"
+       "blended across their borders                      [blocks]",
+       check_coarse_space},
+      {"coarse-aggregates", "coarse-aggregates", true, ForwardTo::kCoordinator,
+       "--coarse-aggregates K", "smoothed: pieces per block, 1..1000                  [4]",
+       check_coarse_aggregates},
+      {"coarse-smoothing", "coarse-smoothing", true, ForwardTo::kCoordinator,
+       "--coarse-smoothing S", "smoothed: smoothing steps of the blend, 0..8         [1]",
+       check_coarse_smoothing},
       {"refine", "refine", true, ForwardTo::kCoordinator, "--refine newton|none",
        "after the rounds reach --grad-tol, trust-region Newton\n"
        "steps on the whole problem: CG over neighbour exchanges\n"

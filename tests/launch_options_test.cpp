@@ -75,11 +75,9 @@ TEST(LaunchOptions, SetUpTimeoutReachesEveryProcessAsItsWaitBound) {
 TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
   const std::string help = launch_help();
   // A valid value of each flag: "1" unless that is out of the flag's range.
-  const std::map<std::string, std::string> value = {{"robust", "gnc-tls"},
-                                                    {"known-inliers", "odometry"},
-                                                    {"gnc-mu-step", "1.4"},
-                                                    {"inlier-quantile", "0.5"},
-                                                    {"refine", "newton"}};
+  const std::map<std::string, std::string> value = {
+      {"robust", "gnc-tls"},      {"known-inliers", "odometry"}, {"gnc-mu-step", "1.4"},
+      {"inlier-quantile", "0.5"}, {"refine", "newton"},          {"coarse-space", "smoothed"}};
   for (const ForwardedFlag& f : forwarded_flags()) {
     EXPECT_NE(help.find(std::string("--") + f.name), std::string::npos) << f.name;
     Argv argv = {std::string("--") + f.name};
@@ -96,6 +94,22 @@ TEST(LaunchOptions, BadValuesAreNamedAndRemovedFlagsRefused) {
   EXPECT_NE(error_of({"--certify", "--no-certify"}).find("exclude"), std::string::npos);
   EXPECT_NE(error_of({"--agents-yield"}).find("--agents-yield"), std::string::npos);
   EXPECT_EQ(launch_help().find("agents-yield"), std::string::npos);
+}
+
+TEST(LaunchOptions, CoarseSpaceFlagsReachTheCoordinatorOnly) {
+  LaunchOptions o = parse_launch_options({"--coarse-every", "1", "--coarse-space", "smoothed",
+                                          "--coarse-aggregates", "8", "--coarse-smoothing", "2"});
+  o.graph = "/data/graph.g2o";
+  const Argv coordinator = coordinator_argv(o, paths());
+  EXPECT_TRUE(has_pair(coordinator, "--coarse-every", "1"));
+  EXPECT_TRUE(has_pair(coordinator, "--coarse-space", "smoothed"));
+  EXPECT_TRUE(has_pair(coordinator, "--coarse-aggregates", "8"));
+  EXPECT_TRUE(has_pair(coordinator, "--coarse-smoothing", "2"));
+  EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--coarse-space"));
+  EXPECT_NE(error_of({"--coarse-space", "rigid"}).find("--coarse-space"), std::string::npos);
+  EXPECT_NE(error_of({"--coarse-smoothing", "9"}).find("--coarse-smoothing"), std::string::npos);
+  EXPECT_NE(error_of({"--coarse-aggregates", "0"}).find("--coarse-aggregates"), std::string::npos);
+  EXPECT_NE(error_of({"--coarse-every", "x"}).find("--coarse-every"), std::string::npos);
 }
 
 TEST(LaunchOptions, TuningFlagsSitUnderTheAdvancedHeading) {
