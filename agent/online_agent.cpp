@@ -10,11 +10,8 @@
 #include <set>
 #include <stdexcept>
 #include <tessera/certification/rounding_gap.hpp>
-#include <tessera/distributed/agent_state.hpp>
-#include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/certified_agent.hpp>
 #include <tessera/graph/connectivity.hpp>
-#include <tessera/online/live_blocks.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
 #include <tessera/util/input_error.hpp>
@@ -22,6 +19,7 @@
 
 #include "agent/online_agent_options.hpp"
 #include "agent/online_agent_summary.hpp"
+#include "agent/online_block_solver.hpp"
 #include "agent/online_estimate_publication.hpp"
 #include "agent/online_solve_outcome.hpp"
 #include "agent/online_takeover_step.hpp"
@@ -55,7 +53,8 @@ class OnlineAgent {
         stream_(o.domain, o.run_id),
         channel_(o.domain, o.run_id, static_cast<std::uint32_t>(o.id),
                  static_cast<std::uint32_t>(o.robots)),
-        start_(Clock::now()) {}
+        start_(Clock::now()),
+        block_(o.online) {}
 
   int run();
 
@@ -75,7 +74,6 @@ class OnlineAgent {
   /// The survivors agree on what was lost, reach the same graph and move the lost blocks.
   void take_over();
   [[noreturn]] void counted_lost() const;
-  void keep_own_poses(const AgentState& state, const std::vector<std::size_t>& ids);
   SolveOutcome solve(bool certify, bool climb = true);
   /// The round protocol of the epoch's solve, until `agent` is done.
   void solve_rounds(CertifiedAgent& agent, std::uint32_t me);
@@ -92,15 +90,12 @@ class OnlineAgent {
 
   OnlineAgentOptions o_;
   runtime::OnlineAgentView view_;
-  std::unique_ptr<LiveBlocks> live_;  // this agent's block state, grown from solve to solve
   transport::GraphStreamReader stream_;
   transport::OnlineChannel channel_;
   Clock::time_point start_;
   std::uint32_t epoch_ = 0;
   bool converged_ = true;
-  std::vector<std::uint32_t> own_ids_;
-  std::vector<double> own_data_;
-  int own_rank_ = 0;
+  OnlineBlockSolver block_;  // this agent's block, grown from solve to solve
   std::map<std::uint32_t, std::map<std::uint32_t, transport::OnlineReportSample>> reports_;
   std::map<std::uint32_t, std::set<std::uint32_t>> members_{{0, {0}}};
   std::set<std::uint32_t> seen_;  // agents heard from (hello or report)
@@ -232,46 +227,8 @@ void OnlineAgent::send(const std::vector<OutgoingMessage>& out, std::uint32_t ep
 }
 
 SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
-  SolveOutcome out;
-  own_ids_.clear();
-  own_data_.clear();
-  const GraphStream* stream = view_.stream();
-  if (!stream || view_.own_block() < 0) return out;  // nothing of ours to solve yet
-  // This agent's block problem is kept from solve to solve and grown with the new data.
-  if (!live_)
-    live_ = std::make_unique<LiveBlocks>(stream->graph().d, o_.online.solver.block_update,
-                                         o_.online.refactor_growth, view_.own_block());
-  live_->sync(stream->graph(), view_.owner(), view_.iterate());
-  const int c = live_->compact_block(view_.own_block());
-  if (live_->graph().num_poses == 0 || c < 0) return out;
-  DistributedOptions solver = o_.online.solver;
-  solver.certify = certify;
-  solver.round_result = false;
-  // A certificate while the graph grows does not climb the staircase: the iterate keeps its
-  // rank for the next data (a saddle is reported as not certified).
-  if (!climb) solver.staircase.max_rank = solver.rank;
-  const BlockLayout& layout = live_->layout();
-  const auto& ids = layout.poses[static_cast<std::size_t>(c)];
-  AgentState& state = *live_->states()[static_cast<std::size_t>(c)];
-  CertifiedAgent agent(state, layout, solver);
-  const auto me = static_cast<std::uint32_t>(c);
-  try {
-    solve_rounds(agent, me);
-  } catch (const TakeoverNeeded&) {
-    // The iterate so far is a valid point of the problem: the take-over starts from it.
-    keep_own_poses(state, ids);
-    throw;
-  }
-  keep_own_poses(state, ids);
-  out.rounds = agent.total_rounds();
-  const auto& last = agent.solves().back();
-  out.stop_reason = last.stop_reason;
-  out.grad_norm = last.trace.empty() ? 0.0 : last.trace.back().grad_norm;
-  if (!last.trace.empty()) out.relaxation_cost = last.trace.back().cost;
-  out.certified = agent.certified();
-  if (!agent.certificates().empty())
-    out.min_eigenvalue = agent.certificates().back().result.min_eigenvalue;
-  return out;
+  return block_.solve(view_, certify, climb,
+                      [&](CertifiedAgent& agent, std::uint32_t me) { solve_rounds(agent, me); });
 }
 
 void OnlineAgent::solve_rounds(CertifiedAgent& agent, std::uint32_t me) {
@@ -314,29 +271,11 @@ void OnlineAgent::solve_rounds(CertifiedAgent& agent, std::uint32_t me) {
       std::string missing;
       if (const auto awaited = agent.awaited())
         for (std::uint32_t b : awaited->senders)
-          if (b < live_->block_of().size())
-            missing +=
-                (missing.empty() ? " from agent " : ",") +
-                std::to_string(
-                    view_.stream()->robots()[static_cast<std::size_t>(live_->block_of()[b])]);
+          if (const long robot = block_.robot_of_block(view_, b); robot >= 0)
+            missing += (missing.empty() ? " from agent " : ",") + std::to_string(robot);
       silent_peer("no protocol message" + missing);
     }
   }
-}
-
-void OnlineAgent::keep_own_poses(const AgentState& state, const std::vector<std::size_t>& ids) {
-  // This agent's poses go out with the next report (the estimate made whole everywhere).
-  const Eigen::Index w = live_->graph().d + 1;
-  own_ids_.clear();
-  own_rank_ = state.rank();
-  const std::size_t per_pose = static_cast<std::size_t>(own_rank_ * w);
-  own_data_.resize(ids.size() * per_pose);
-  for (std::size_t s = 0; s < ids.size(); ++s) {
-    own_ids_.push_back(static_cast<std::uint32_t>(live_->full_id()[ids[s]]));
-    Eigen::Map<Eigen::MatrixXd>(own_data_.data() + s * per_pose, own_rank_, w) =
-        state.Y.middleCols(w * static_cast<Eigen::Index>(s), w);
-  }
-  view_.apply_block(own_ids_, own_data_, own_rank_);
 }
 
 void OnlineAgent::publish_estimate() {
@@ -398,10 +337,10 @@ bool OnlineAgent::epoch_step() {
     mine.sender = me;
     mine.held = view_.held();
     mine.converged = converged_;
-    mine.rank = own_rank_;
+    mine.rank = block_.own_rank();
     mine.dim = view_.dim();
-    mine.pose_ids = own_ids_;
-    mine.data = own_data_;
+    mine.pose_ids = block_.own_ids();
+    mine.data = block_.own_data();
     if (me == lead_of(epoch_)) {
       if (o_.certify_every_s > 0 && changed_since_certificate_ &&
           since(start_) >= next_certificate_) {
@@ -594,10 +533,10 @@ void OnlineAgent::take_over() {
   mine.me = me;
   mine.epoch = epoch_;
   mine.entered = view_.entered();
-  mine.rank = own_rank_;
+  mine.rank = block_.own_rank();
   mine.dim = view_.dim();
-  mine.pose_ids = own_ids_;
-  mine.data = own_data_;
+  mine.pose_ids = block_.own_ids();
+  mine.data = block_.own_data();
   const TakeoverStepResult step = takeover_step(
       channel_, view_, members(), mine, o_.timeout_s,
       [&] {
