@@ -19,6 +19,7 @@
 
 #include "agent/online_agent_options.hpp"
 #include "agent/online_agent_summary.hpp"
+#include "agent/online_batch_arrivals.hpp"
 #include "agent/online_block_solver.hpp"
 #include "agent/online_estimate_publication.hpp"
 #include "agent/online_solve_outcome.hpp"
@@ -106,7 +107,7 @@ class OnlineAgent {
   double next_certificate_ = 0.0, last_publish_ = -1e300;
   bool changed_since_certificate_ = false;
   std::vector<transport::OnlineProtocolSample> pending_;
-  std::map<std::pair<std::uint32_t, std::uint64_t>, double> received_at_;
+  BatchArrivals arrivals_;
   OnlineFigures fig_;
   SolveOutcome final_;
   double cost_ = 0.0;
@@ -121,7 +122,7 @@ class OnlineAgent {
 
 void OnlineAgent::pump_stream() {
   for (const auto& r : stream_.take(0.0)) {
-    received_at_.emplace(std::make_pair(r.batch.robot, r.batch.sequence), since(start_));
+    arrivals_.arrived(r.batch.robot, r.batch.sequence, since(start_));
     view_.receive(r.batch, r.dim, r.last);
   }
 }
@@ -478,15 +479,7 @@ bool OnlineAgent::epoch_step() {
   fig_.cpu_s += cpu_now() - cpu_start;
   fig_.rounds += s.rounds;
   const GraphStream& g = *view_.stream();
-  double oldest = step_start;
-  for (const auto& [key, t] : received_at_)
-    if (key.second < g.absorbed_batches(key.first)) {
-      fig_.batch_latency_s.push_back(step_end - t);
-      oldest = std::min(oldest, t);
-    }
-  for (auto it = received_at_.begin(); it != received_at_.end();)
-    it = it->first.second < g.absorbed_batches(it->first.first) ? received_at_.erase(it)
-                                                                : std::next(it);
+  const double oldest = arrivals_.absorbed(g, step_end, step_start, fig_.batch_latency_s);
   cli::JsonObject u;
   u.add("epoch", static_cast<long long>(epoch_))
       .add("time_s", step_start)
