@@ -2,81 +2,39 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <set>
 #include <stdexcept>
 #include <tessera/certification/rounding_gap.hpp>
-#include <tessera/distributed/agent_state.hpp>
-#include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/certified_agent.hpp>
 #include <tessera/graph/connectivity.hpp>
-#include <tessera/io/tum_writer.hpp>
-#include <tessera/online/live_blocks.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
 #include <tessera/util/input_error.hpp>
 #include <utility>
 
+#include "agent/online_agent_options.hpp"
+#include "agent/online_agent_summary.hpp"
+#include "agent/online_batch_arrivals.hpp"
+#include "agent/online_block_solver.hpp"
+#include "agent/online_estimate_publication.hpp"
+#include "agent/online_solve_outcome.hpp"
+#include "agent/online_takeover_step.hpp"
 #include "agent/takeover_vote.hpp"
-#include "arguments.hpp"
 #include "json_writer.hpp"
 #include "runtime/online_agent_view.hpp"
 #include "transport/fastdds/teardown_guard.hpp"
 #include "transport/graph_stream_topic.hpp"
 #include "transport/online_channel.hpp"
-#include "transport/run_identity.hpp"
 #include "transport/transport_error.hpp"
 
 namespace tessera::agent {
 
 namespace {
-
-const char* const kOnlineUsage =
-    R"(usage: tessera-agent --online --robots N --id I --run-id ID [options]
-
-One robot's agent of an online run (docs/online.md): reads every robot's batches from the
-DDS topic tessera_graph_stream (partition = run id; `tessera replay` or a front end writes
-them), agrees with the other agents on the batches that enter at each epoch boundary,
-solves the grown graph from the current estimate until the gradient is under --grad-tol,
-idles without sending anything while nothing is new, and certifies the estimate when every
-robot has sent its last batch. Robot I's block is this agent's.
-
-options:
-  --robots N          robots = agents of the run (required)
-  --id I              this agent's robot, 0..N-1 (required)
-  --run-id ID         the run (required)
-  --domain D          DDS domain 0..232                              [from the run id]
-  --algorithm A       rbcd, rbcd++ or irbcd                          [irbcd]
-  --rank R            lifted rank r >= d                             [5]
-  --grad-tol G        gradient-norm tolerance of every solve, > 0    [0.01]
-  --max-rounds K      rounds per solve at most                       [10000]
-  --no-certify        no certificate at the end
-  --timeout S         give up when a peer sends nothing for S seconds [120]
-  --on-agent-loss A   what a member whose DDS liveliness lapsed does to the run: stop
-                      (the others stop after --timeout, naming it) or continue (the
-                      survivors take over its block and its robot's stream)  [stop]
-  --json FILE         write this agent's summary (the lead's has the final answer: agent
-                      0's, or after its loss the lowest surviving agent's)
-  --certify-iters K   certificate iteration cap (LOBPCG)               [300]
-  --certify-every S   also certify the graph received so far every S seconds (the lead's
-                      clock; at the next epoch that brought data, once the graph is
-                      connected; no staircase climb)                  [0 = off]
-  --publish-every S   publish this robot's current estimate (rounded to SE(d)) on topic
-                      tessera_online_estimate every S seconds, and at the end [0 = off]
-  --tum-dir DIR       write DIR/robot<I>.tum (TUM, timestamp = pose index) at every
-                      publication and at the end
-  --verbose           print each epoch (members, what entered, solve or idle)
-  --help              this text
-
-exit codes: 0 done, 1 the run failed (a peer went silent, or this agent was counted lost and
-its block taken over), 2 bad options or input.
-)";
 
 using Clock = std::chrono::steady_clock;
 
@@ -88,97 +46,16 @@ double cpu_now() {
   return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
 }
 
-struct Options {
-  int robots = 0, id = -1;
-  std::string run_id;
-  int domain = 0;
-  OnlineOptions online;
-  double timeout_s = 120.0;
-  bool continue_on_loss = false;
-  std::string json;
-  bool verbose = false;
-  double certify_every_s = 0.0;
-  double publish_every_s = 0.0;
-  std::string tum_dir;
-};
-
-Options parse(const std::vector<std::string>& argv) {
-  const cli::Arguments args(
-      argv,
-      {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol", "max-rounds", "timeout",
-       "json", "certify-every", "certify-iters", "publish-every", "tum-dir", "on-agent-loss"},
-      {"online", "no-certify", "verbose", "help"});
-  Options o;
-  const auto run_id = args.get("run-id");
-  if (!run_id) throw InputError("option --run-id ID is required (see --help)");
-  transport::validate_run_id(*run_id);
-  o.run_id = *run_id;
-  o.robots = static_cast<int>(args.get_long("robots", 0));
-  o.id = static_cast<int>(args.get_long("id", -1));
-  if (o.robots < 1) throw InputError("option --robots N is required (N >= 1)");
-  if (o.id < 0 || o.id >= o.robots)
-    throw InputError("option --id: must be 0.." + std::to_string(o.robots - 1));
-  const long domain = args.get_long("domain", transport::domain_for_run(o.run_id));
-  if (domain < 0 || domain > transport::kMaxDomain)
-    throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));
-  o.domain = static_cast<int>(domain);
-  DistributedOptions& s = o.online.solver;
-  s.algorithm = parse_algorithm(args.get_or("algorithm", "irbcd"));
-  s.rank = static_cast<int>(args.get_long("rank", 5));
-  s.grad_norm_tol = args.get_double("grad-tol", 0.01);
-  if (!(s.grad_norm_tol > 0)) throw InputError("option --grad-tol: must be > 0");
-  s.max_rounds = static_cast<int>(args.get_long("max-rounds", 10000));
-  o.online.certify_at_end = !args.has("no-certify");
-  s.staircase.certificate.max_iterations =
-      static_cast<int>(args.get_long("certify-iters", s.staircase.certificate.max_iterations));
-  o.timeout_s = args.get_double("timeout", 120.0);
-  if (!(o.timeout_s > 0)) throw InputError("option --timeout: must be > 0");
-  const std::string loss = args.get_or("on-agent-loss", "stop");
-  if (loss != "stop" && loss != "continue")
-    throw InputError("option --on-agent-loss: '" + loss + "' is not one of stop, continue");
-  o.continue_on_loss = loss == "continue";
-  o.json = args.get_or("json", "");
-  o.verbose = args.has("verbose");
-  o.certify_every_s = args.get_double("certify-every", 0.0);
-  if (!(o.certify_every_s >= 0)) throw InputError("option --certify-every: must be >= 0");
-  o.publish_every_s = args.get_double("publish-every", 0.0);
-  if (!(o.publish_every_s >= 0)) throw InputError("option --publish-every: must be >= 0");
-  o.tum_dir = args.get_or("tum-dir", "");
-  o.online.validate();
-  return o;
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
-  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
-}
-
-// Thrown out of a wait when a member was lost (or a survivor voted so) and the run goes on
-// without it (--on-agent-loss continue): the epoch is abandoned and the survivors agree on
-// the take-over (OnlineAgent::take_over).
-struct TakeoverNeeded {};
-
-// The outcome of one solve of the epoch's graph by this agent's block.
-struct SolveOutcome {
-  int rounds = 0;
-  double grad_norm = 0.0;
-  std::string stop_reason;
-  std::optional<bool> certified;
-  double min_eigenvalue = 0.0;
-  std::optional<double> relaxation_cost;  ///< f of the last lifted iterate (summed over agents).
-};
-
 class OnlineAgent {
  public:
-  explicit OnlineAgent(const Options& o)
+  explicit OnlineAgent(const OnlineAgentOptions& o)
       : o_(o),
         view_(o.id, o.robots, o.online),
         stream_(o.domain, o.run_id),
         channel_(o.domain, o.run_id, static_cast<std::uint32_t>(o.id),
                  static_cast<std::uint32_t>(o.robots)),
-        start_(Clock::now()) {}
+        start_(Clock::now()),
+        block_(o.online) {}
 
   int run();
 
@@ -198,7 +75,6 @@ class OnlineAgent {
   /// The survivors agree on what was lost, reach the same graph and move the lost blocks.
   void take_over();
   [[noreturn]] void counted_lost() const;
-  void keep_own_poses(const AgentState& state, const std::vector<std::size_t>& ids);
   SolveOutcome solve(bool certify, bool climb = true);
   /// The round protocol of the epoch's solve, until `agent` is done.
   void solve_rounds(CertifiedAgent& agent, std::uint32_t me);
@@ -213,38 +89,26 @@ class OnlineAgent {
   void write_json(bool lead_result);
   [[noreturn]] void silent_peer(const std::string& what) const;
 
-  Options o_;
+  OnlineAgentOptions o_;
   runtime::OnlineAgentView view_;
-  std::unique_ptr<LiveBlocks> live_;  // this agent's block state, grown from solve to solve
   transport::GraphStreamReader stream_;
   transport::OnlineChannel channel_;
   Clock::time_point start_;
   std::uint32_t epoch_ = 0;
   bool converged_ = true;
-  std::vector<std::uint32_t> own_ids_;
-  std::vector<double> own_data_;
-  int own_rank_ = 0;
+  OnlineBlockSolver block_;  // this agent's block, grown from solve to solve
   std::map<std::uint32_t, std::map<std::uint32_t, transport::OnlineReportSample>> reports_;
   std::map<std::uint32_t, std::set<std::uint32_t>> members_{{0, {0}}};
   std::set<std::uint32_t> seen_;  // agents heard from (hello or report)
   std::set<std::uint32_t> dead_;  // members lost and taken over
   std::uint32_t floor_ = 0;       // reports of epochs below it belong to an abandoned epoch
   std::vector<transport::OnlineReportSample> votes_;  // take-over votes not yet read
-  std::vector<cli::JsonObject> faults_;
   bool finishing_ = false;
   double next_certificate_ = 0.0, last_publish_ = -1e300;
   bool changed_since_certificate_ = false;
-  std::vector<cli::JsonObject> certificates_;
-  std::size_t publications_ = 0;
   std::vector<transport::OnlineProtocolSample> pending_;
-  std::map<std::pair<std::uint32_t, std::uint64_t>, double> received_at_;
-  // Figures.
-  std::vector<cli::JsonObject> updates_;
-  std::vector<double> batch_latency_s_;
-  std::uint64_t bytes_sent_ = 0, messages_sent_ = 0, report_bytes_ = 0;
-  std::uint64_t idle_waits_ = 0;
-  int rounds_ = 0, solves_ = 0;
-  double cpu_s_ = 0.0;
+  BatchArrivals arrivals_;
+  OnlineFigures fig_;
   SolveOutcome final_;
   double cost_ = 0.0;
   double last_grad_norm_ = 0.0;
@@ -258,7 +122,7 @@ class OnlineAgent {
 
 void OnlineAgent::pump_stream() {
   for (const auto& r : stream_.take(0.0)) {
-    received_at_.emplace(std::make_pair(r.batch.robot, r.batch.sequence), since(start_));
+    arrivals_.arrived(r.batch.robot, r.batch.sequence, since(start_));
     view_.receive(r.batch, r.dim, r.last);
   }
 }
@@ -358,52 +222,14 @@ void OnlineAgent::wait_matched(std::size_t peers) {
 
 void OnlineAgent::send(const std::vector<OutgoingMessage>& out, std::uint32_t epoch) {
   for (const auto& m : out) {
-    bytes_sent_ += channel_.send(m, epoch);
-    ++messages_sent_;
+    fig_.bytes_sent += channel_.send(m, epoch);
+    ++fig_.messages_sent;
   }
 }
 
 SolveOutcome OnlineAgent::solve(bool certify, bool climb) {
-  SolveOutcome out;
-  own_ids_.clear();
-  own_data_.clear();
-  const GraphStream* stream = view_.stream();
-  if (!stream || view_.own_block() < 0) return out;  // nothing of ours to solve yet
-  // This agent's block problem is kept from solve to solve and grown with the new data.
-  if (!live_)
-    live_ = std::make_unique<LiveBlocks>(stream->graph().d, o_.online.solver.block_update,
-                                         o_.online.refactor_growth, view_.own_block());
-  live_->sync(stream->graph(), view_.owner(), view_.iterate());
-  const int c = live_->compact_block(view_.own_block());
-  if (live_->graph().num_poses == 0 || c < 0) return out;
-  DistributedOptions solver = o_.online.solver;
-  solver.certify = certify;
-  solver.round_result = false;
-  // A certificate while the graph grows does not climb the staircase: the iterate keeps its
-  // rank for the next data (a saddle is reported as not certified).
-  if (!climb) solver.staircase.max_rank = solver.rank;
-  const BlockLayout& layout = live_->layout();
-  const auto& ids = layout.poses[static_cast<std::size_t>(c)];
-  AgentState& state = *live_->states()[static_cast<std::size_t>(c)];
-  CertifiedAgent agent(state, layout, solver);
-  const auto me = static_cast<std::uint32_t>(c);
-  try {
-    solve_rounds(agent, me);
-  } catch (const TakeoverNeeded&) {
-    // The iterate so far is a valid point of the problem: the take-over starts from it.
-    keep_own_poses(state, ids);
-    throw;
-  }
-  keep_own_poses(state, ids);
-  out.rounds = agent.total_rounds();
-  const auto& last = agent.solves().back();
-  out.stop_reason = last.stop_reason;
-  out.grad_norm = last.trace.empty() ? 0.0 : last.trace.back().grad_norm;
-  if (!last.trace.empty()) out.relaxation_cost = last.trace.back().cost;
-  out.certified = agent.certified();
-  if (!agent.certificates().empty())
-    out.min_eigenvalue = agent.certificates().back().result.min_eigenvalue;
-  return out;
+  return block_.solve(view_, certify, climb,
+                      [&](CertifiedAgent& agent, std::uint32_t me) { solve_rounds(agent, me); });
 }
 
 void OnlineAgent::solve_rounds(CertifiedAgent& agent, std::uint32_t me) {
@@ -446,64 +272,18 @@ void OnlineAgent::solve_rounds(CertifiedAgent& agent, std::uint32_t me) {
       std::string missing;
       if (const auto awaited = agent.awaited())
         for (std::uint32_t b : awaited->senders)
-          if (b < live_->block_of().size())
-            missing +=
-                (missing.empty() ? " from agent " : ",") +
-                std::to_string(
-                    view_.stream()->robots()[static_cast<std::size_t>(live_->block_of()[b])]);
+          if (const long robot = block_.robot_of_block(view_, b); robot >= 0)
+            missing += (missing.empty() ? " from agent " : ",") + std::to_string(robot);
       silent_peer("no protocol message" + missing);
     }
   }
 }
 
-void OnlineAgent::keep_own_poses(const AgentState& state, const std::vector<std::size_t>& ids) {
-  // This agent's poses go out with the next report (the estimate made whole everywhere).
-  const Eigen::Index w = live_->graph().d + 1;
-  own_ids_.clear();
-  own_rank_ = state.rank();
-  const std::size_t per_pose = static_cast<std::size_t>(own_rank_ * w);
-  own_data_.resize(ids.size() * per_pose);
-  for (std::size_t s = 0; s < ids.size(); ++s) {
-    own_ids_.push_back(static_cast<std::uint32_t>(live_->full_id()[ids[s]]));
-    Eigen::Map<Eigen::MatrixXd>(own_data_.data() + s * per_pose, own_rank_, w) =
-        state.Y.middleCols(w * static_cast<Eigen::Index>(s), w);
-  }
-  view_.apply_block(own_ids_, own_data_, own_rank_);
-}
-
 void OnlineAgent::publish_estimate() {
   last_publish_ = since(start_);
-  const GraphStream* stream = view_.stream();
-  if (!stream || count_components(stream->graph()) != 1) return;  // no common frame yet
-  const std::vector<Pose> poses = round_solution(stream->graph(), view_.iterate());
-  const int d = stream->graph().d;
-  // This agent's robot, and the robots of lost agents whose blocks this agent adopted.
-  std::vector<std::uint32_t> robots = {static_cast<std::uint32_t>(o_.id)};
-  for (std::uint32_t r : view_.lost())
-    if (view_.own_block() >= 0 && view_.adopter(r) == view_.own_block()) robots.push_back(r);
-  bool any = false;
-  for (std::uint32_t robot : robots) {
-    std::vector<std::uint64_t> index;
-    std::vector<double> data;
-    std::vector<Pose> mine;
-    for (std::size_t k = 0; k < poses.size(); ++k) {
-      if (stream->robot_of_pose()[k] != robot) continue;
-      index.push_back(stream->key_of_pose()[k].index);
-      data.insert(data.end(), poses[k].R.data(), poses[k].R.data() + d * d);
-      data.insert(data.end(), poses[k].t.data(), poses[k].t.data() + d);
-      mine.push_back(poses[k]);
-    }
-    if (mine.empty()) continue;
-    channel_.publish_estimate(epoch_, d, index, data, robot);
-    if (!o_.tum_dir.empty()) {
-      // Replaced whole: a reader never sees half a snapshot.
-      const std::string path = o_.tum_dir + "/robot" + std::to_string(robot) + ".tum";
-      write_tum(mine, path + ".part");
-      std::filesystem::rename(path + ".part", path);
-    }
-    any = true;
-  }
-  if (any) ++publications_;
+  if (publish_online_estimate(view_, channel_, epoch_, static_cast<std::uint32_t>(o_.id),
+                              o_.tum_dir))
+    ++fig_.publications;
 }
 
 int OnlineAgent::run() {
@@ -517,7 +297,7 @@ int OnlineAgent::run() {
     transport::OnlineReportSample hello;
     hello.epoch = transport::kHelloEpoch;
     hello.sender = me;
-    report_bytes_ += channel_.send_report(hello);
+    fig_.report_bytes += channel_.send_report(hello);
   }
   for (;;) {
     try {
@@ -558,10 +338,10 @@ bool OnlineAgent::epoch_step() {
     mine.sender = me;
     mine.held = view_.held();
     mine.converged = converged_;
-    mine.rank = own_rank_;
+    mine.rank = block_.own_rank();
     mine.dim = view_.dim();
-    mine.pose_ids = own_ids_;
-    mine.data = own_data_;
+    mine.pose_ids = block_.own_ids();
+    mine.data = block_.own_data();
     if (me == lead_of(epoch_)) {
       if (o_.certify_every_s > 0 && changed_since_certificate_ &&
           since(start_) >= next_certificate_) {
@@ -577,7 +357,7 @@ bool OnlineAgent::epoch_step() {
           if (members().count(a) == 0) next.erase(a);
       mine.next_members.assign(next.begin(), next.end());
     }
-    report_bytes_ += channel_.send_report(mine);
+    fig_.report_bytes += channel_.send_report(mine);
   }
   wait_for_reports();
   std::vector<Watermarks> held;
@@ -626,7 +406,7 @@ bool OnlineAgent::epoch_step() {
     if (o_.verbose)
       std::fprintf(stderr, "agent %d: final solve: %d rounds, certified %s\n", o_.id, final_.rounds,
                    final_.certified.value_or(false) ? "yes" : "no");
-    cpu_s_ += cpu_now() - cpu_start;
+    fig_.cpu_s += cpu_now() - cpu_start;
     finishing_ = true;
     ++epoch_;
     return true;
@@ -639,8 +419,8 @@ bool OnlineAgent::epoch_step() {
   if (certify_now && count_components(view_.stream()->graph()) == 1) {
     const SolveOutcome c = solve(true, false);
     converged_ = c.grad_norm <= o_.online.solver.grad_norm_tol || c.stop_reason == "stalled";
-    cpu_s_ += cpu_now() - cpu_start;
-    rounds_ += c.rounds;
+    fig_.cpu_s += cpu_now() - cpu_start;
+    fig_.rounds += c.rounds;
     cli::JsonObject j;
     j.add("epoch", static_cast<long long>(epoch_))
         .add("time_s", step_start)
@@ -649,14 +429,14 @@ bool OnlineAgent::epoch_step() {
         .add("min_eigenvalue", c.min_eigenvalue)
         .add("rounds", c.rounds)
         .add("ms", 1000.0 * (since(start_) - step_start));
-    certificates_.push_back(std::move(j));
+    fig_.certificates.push_back(std::move(j));
     ++epoch_;
     return true;
   }
   if (!changed && converged_) {
     // Idle: a blocking wait for new data (ours, another agent's next report, or a hello
     // for the lead to admit); nothing is sent meanwhile.
-    ++idle_waits_;
+    ++fig_.idle_waits;
     for (;;) {
       pump_stream();
       pump_channel();
@@ -693,21 +473,13 @@ bool OnlineAgent::epoch_step() {
                    s.grad_norm, s.stop_reason.c_str());
     converged_ = s.grad_norm <= o_.online.solver.grad_norm_tol || s.stop_reason == "stalled";
     last_grad_norm_ = s.grad_norm;
-    ++solves_;
+    ++fig_.solves;
   }
   const double step_end = since(start_);
-  cpu_s_ += cpu_now() - cpu_start;
-  rounds_ += s.rounds;
+  fig_.cpu_s += cpu_now() - cpu_start;
+  fig_.rounds += s.rounds;
   const GraphStream& g = *view_.stream();
-  double oldest = step_start;
-  for (const auto& [key, t] : received_at_)
-    if (key.second < g.absorbed_batches(key.first)) {
-      batch_latency_s_.push_back(step_end - t);
-      oldest = std::min(oldest, t);
-    }
-  for (auto it = received_at_.begin(); it != received_at_.end();)
-    it = it->first.second < g.absorbed_batches(it->first.first) ? received_at_.erase(it)
-                                                                : std::next(it);
+  const double oldest = arrivals_.absorbed(g, step_end, step_start, fig_.batch_latency_s);
   cli::JsonObject u;
   u.add("epoch", static_cast<long long>(epoch_))
       .add("time_s", step_start)
@@ -724,7 +496,7 @@ bool OnlineAgent::epoch_step() {
       .add("latency_s", step_end - oldest)
       .add("grad_norm", s.grad_norm)
       .add("stop_reason", s.stop_reason);
-  updates_.push_back(std::move(u));
+  fig_.updates.push_back(std::move(u));
   ++epoch_;
   return true;
 }
@@ -754,32 +526,27 @@ void OnlineAgent::take_over() {
   mine.me = me;
   mine.epoch = epoch_;
   mine.entered = view_.entered();
-  mine.rank = own_rank_;
+  mine.rank = block_.own_rank();
   mine.dim = view_.dim();
-  mine.pose_ids = own_ids_;
-  mine.data = own_data_;
-  const TakeoverVoteOutcome vote = hold_takeover_vote(channel_, members(), mine, o_.timeout_s, [&] {
-    pump_channel();
-    pump_stream();
-    std::vector<transport::OnlineReportSample> v;
-    v.swap(votes_);
-    return v;
-  });
-  report_bytes_ += vote.bytes_sent;
-  // The survivors are at most one epoch boundary apart: the ones behind enter what the one
-  // ahead entered, so all hold the same graph before the blocks move.
-  const Watermarks target = vote.entered;
-  wait_to_hold(target);
-  view_.enter(target);
-  for (const auto& [a, v] : vote.votes)
-    if (a != me && v.dim != 0) view_.apply_block(v.pose_ids, v.data, v.rank);
-  const runtime::TakeoverMoves moves = view_.take_over(vote.lost);
-  const std::set<std::uint32_t>& survivors = vote.survivors;
-  dead_.insert(vote.lost.begin(), vote.lost.end());
+  mine.pose_ids = block_.own_ids();
+  mine.data = block_.own_data();
+  const TakeoverStepResult step = takeover_step(
+      channel_, view_, members(), mine, o_.timeout_s,
+      [&] {
+        pump_channel();
+        pump_stream();
+        std::vector<transport::OnlineReportSample> v;
+        v.swap(votes_);
+        return v;
+      },
+      [&](const Watermarks& target) { wait_to_hold(target); });
+  fig_.report_bytes += step.vote.bytes_sent;
+  const std::set<std::uint32_t>& survivors = step.vote.survivors;
+  dead_.insert(step.vote.lost.begin(), step.vote.lost.end());
   for (std::uint32_t a : dead_) seen_.erase(a);
   // The run goes on at an epoch no survivor has used: leftovers of the abandoned one (its
   // messages, reports, the lead's admissions) are dropped.
-  epoch_ = vote.next_epoch;
+  epoch_ = step.vote.next_epoch;
   floor_ = epoch_;
   members_.erase(members_.begin(), members_.lower_bound(epoch_));
   members_[epoch_] = survivors;
@@ -790,54 +557,23 @@ void OnlineAgent::take_over() {
                  pending_.end());
   converged_ = false;  // the blocks changed: solve again
   finishing_ = false;  // a final solve the loss interrupted runs again
-  std::vector<std::size_t> lost_ids(vote.lost.begin(), vote.lost.end());
-  std::vector<std::size_t> survivor_ids(survivors.begin(), survivors.end());
-  cli::JsonObject f;
-  f.add("kind", "lost_for_good")
-      .add("lost_agents", lost_ids)
-      .add("survivors", survivor_ids)
-      .add("noticed_at_s", at)
-      .add("taken_over_at_s", since(start_))
-      .add("epoch", static_cast<long long>(epoch_))
-      .add("total_poses", view_.stream() ? view_.stream()->graph().num_poses : std::size_t{0})
-      .add("moved_poses", moves.moved)
-      .add("cut_edges_after", moves.cut_after);
-  faults_.push_back(std::move(f));
+  fig_.faults.push_back(
+      lost_for_good_fault(step, at, since(start_), epoch_,
+                          view_.stream() ? view_.stream()->graph().num_poses : std::size_t{0}));
   if (o_.verbose)
     std::fprintf(stderr,
                  "agent %d: took over the blocks of %zu lost agent(s): %zu poses moved, epoch %u\n",
-                 o_.id, lost_ids.size(), moves.moved, epoch_);
+                 o_.id, step.vote.lost.size(), step.moves.moved, epoch_);
 }
 
 void OnlineAgent::write_json(bool lead_result) {
-  const GraphStream* g = view_.stream();
-  cli::JsonObject j;
-  j.add("agent", o_.id)
-      .add("robots", o_.robots)
-      .add("run_id", o_.run_id)
-      .add("epochs", static_cast<long long>(epoch_))
-      .add("solves", solves_)
-      .add("rounds", rounds_)
-      .add("final_rounds", final_.rounds)
-      .add("total_poses", g ? g->graph().num_poses : std::size_t{0})
-      .add("total_measurements", g ? g->graph().measurements.size() : std::size_t{0})
-      .add("bytes_sent", static_cast<long long>(bytes_sent_))
-      .add("messages_sent", static_cast<long long>(messages_sent_))
-      .add("report_bytes", static_cast<long long>(report_bytes_))
-      .add("idle_waits", static_cast<long long>(idle_waits_))
-      .add("cpu_s", cpu_s_)
-      .add("wall_s", since(start_))
-      .add("latency_median_s", percentile(batch_latency_s_, 0.5))
-      .add("latency_p95_s", percentile(batch_latency_s_, 0.95))
-      .add("certified", final_.certified)
-      .add("min_eigenvalue", final_.min_eigenvalue)
-      .add("grad_norm", final_.grad_norm);
-  if (lead_result && have_cost_) j.add("cost", cost_);
-  j.add("publications", publications_);
-  j.add("updates", updates_);
-  if (!certificates_.empty()) j.add("certificates", certificates_);
-  if (!faults_.empty()) j.add("faults", faults_);
-  cli::write_output(o_.json, j.str());
+  OnlineSummaryState state;
+  state.epochs = epoch_;
+  state.graph = view_.stream();
+  state.final_solve = final_;
+  state.wall_s = since(start_);
+  if (lead_result && have_cost_) state.cost = cost_;
+  cli::write_output(o_.json, online_summary_json(o_, state, fig_));
 }
 
 }  // namespace
@@ -851,10 +587,10 @@ int online_agent_main(const std::vector<std::string>& argv) {
   int code = 0;
   try {
     if (std::find(argv.begin(), argv.end(), "--help") != argv.end()) {
-      std::fputs(kOnlineUsage, stdout);
+      std::fputs(online_agent_usage(), stdout);
       return 0;
     }
-    const Options o = parse(argv);
+    const OnlineAgentOptions o = parse_online_agent_options(argv);
     agent = std::make_unique<OnlineAgent>(o);
     code = agent->run();
   } catch (const InputError& e) {

@@ -2,7 +2,8 @@
 // The survivors' vote after a member of an online run was lost (docs/online.md, "Lost
 // agents"): each survivor sends its vote on the report topic (epoch kTakeoverEpoch) and reads
 // the others' until runtime::TakeoverAgreement is complete, voting again whenever it learns of
-// more lost members. The DDS side of the agreement; agent/online_agent.cpp acts on the outcome.
+// more lost members. The DDS side of the agreement; agent/online_takeover_step.cpp acts on the
+// outcome.
 
 #include <cstdint>
 #include <functional>
