@@ -6,14 +6,14 @@ the start, stop once the cost has settled to 1e-10 of f(X)).
 Each CG iteration of the rounding (core/runtime/distributed_rounding.cpp) is one all-agent sum,
 a barrier step of every agent; at a million poses over 25 processes that is seconds. The
 counts come from the rounding run in process (one thread per agent over an in-memory channel,
-the code the DDS agents run) on the in-process solver's iterate: tests/distributed_rounding_test's
-DISABLED_IterationsOnThePaperGraphs, on each shared paper graph with 5 contiguous blocks, after
+the code the DDS agents run) on the in-process solver's iterate: build/bin/rounding_iterations_bench
+(tests/rounding_iterations_bench.cpp), on each shared paper graph with 5 contiguous blocks, after
 30 rounds and at the default tolerance (0.01). Counts and costs do not depend on the load.
 
 Prints a table and writes docs/benchmarks/rounding_iterations.csv.
 
-usage: rounding_iterations.py [--test build/bin/distributed_rounding_test] [--csv FILE]
-                              [--from-output SAVED_TEST_OUTPUT]
+usage: rounding_iterations.py [--bench build/bin/rounding_iterations_bench] [--csv FILE]
+                              [--from-output SAVED_BENCH_OUTPUT]
 (15 min at load 40 on 2 cores; most of it the in-process solves.)
 """
 import argparse
@@ -31,18 +31,16 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--test", default=os.path.join(ROOT, "build", "bin", "distributed_rounding_test"))
+    ap.add_argument("--bench", default=os.path.join(ROOT, "build", "bin", "rounding_iterations_bench"))
     ap.add_argument("--csv", default=os.path.join(bc.OUT_DIR, "rounding_iterations.csv"))
-    ap.add_argument("--from-output", help="read a saved output of the test instead of running it")
+    ap.add_argument("--from-output", help="read a saved output of the bench instead of running it")
     args = ap.parse_args()
     if args.from_output:
         with open(args.from_output) as f:
             out = f.read()
     else:
-        out = subprocess.run([args.test, "--gtest_also_run_disabled_tests",
-                              "--gtest_filter=*DISABLED_IterationsOnThePaperGraphs*"],
-                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                             check=True).stdout
+        out = subprocess.run([args.bench], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                             text=True, check=True).stdout
     rows = []
     for line in out.splitlines():
         if not line.startswith("ROUNDING "):

@@ -1,0 +1,35 @@
+#pragma once
+// The agents' distributed rounding (core/runtime/distributed_rounding.hpp) run in process: one
+// thread per agent over an in-memory channel, no DDS. Used by distributed_rounding_test and by
+// rounding_iterations_bench (scripts/bench/rounding_iterations.py).
+
+#include <cstdint>
+#include <string>
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/graph/pose_graph.hpp>
+#include <vector>
+
+#include "runtime/distributed_rounding.hpp"
+
+namespace tessera::agent {
+
+/// A graph, its block assignment and the in-process solver's result on it (the iterate the
+/// rounding starts from).
+struct RoundingCase {
+  PoseGraph graph;
+  std::vector<int> assignment;
+  DistributedResult solved;
+};
+
+struct Rounded {
+  std::vector<Pose> poses;  ///< Global order.
+  double cost = 0;          ///< As the agents summed it.
+  std::uint32_t iterations = 0;
+  /// Empty when every agent finished with the same cost and iteration count; else what failed.
+  std::vector<std::string> errors;
+};
+
+/// Runs DistributedRounding with `options` on every block of `c` in its own thread.
+Rounded round_in_threads(const RoundingCase& c, const DistributedRoundingOptions& options);
+
+}  // namespace tessera::agent
