@@ -5,6 +5,20 @@
 #include <tessera/problem/pose_kernels.hpp>
 
 namespace tessera {
+namespace {
+
+// One measurement as the cost loops read it (edge_term): R column-major, t, kappa, tau.
+void pack_measurement(const Measurement& me, int d, double* out) {
+  if (me.R.rows() != d || me.R.cols() != d || me.t.size() != d)
+    throw std::invalid_argument("BlockProblem: measurement of the wrong dimension");
+  for (int b = 0; b < d; ++b)
+    for (int c = 0; c < d; ++c) out[b * d + c] = me.R(c, b);
+  for (int c = 0; c < d; ++c) out[d * d + c] = me.t(c);
+  out[d * d + d] = me.kappa;
+  out[d * d + d + 1] = me.tau;
+}
+
+}  // namespace
 
 BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
                            const std::vector<Measurement>& measurements)
@@ -53,17 +67,8 @@ BlockProblem::BlockProblem(int d, std::vector<std::size_t> owned,
   // The measurements packed contiguously for the cost loops (edge_term).
   const std::size_t stride = static_cast<std::size_t>(d_ * d_ + d_ + 2);
   packed_.resize(ptrs.size() * stride);
-  for (std::size_t k = 0; k < ptrs.size(); ++k) {
-    const Measurement& me = *ptrs[k];
-    if (me.R.rows() != d_ || me.R.cols() != d_ || me.t.size() != d_)
-      throw std::invalid_argument("BlockProblem: measurement of the wrong dimension");
-    double* out = packed_.data() + k * stride;
-    for (int b = 0; b < d_; ++b)
-      for (int c = 0; c < d_; ++c) out[b * d_ + c] = me.R(c, b);
-    for (int c = 0; c < d_; ++c) out[d_ * d_ + c] = me.t(c);
-    out[d_ * d_ + d_] = me.kappa;
-    out[d_ * d_ + d_ + 1] = me.tau;
-  }
+  for (std::size_t k = 0; k < ptrs.size(); ++k)
+    pack_measurement(*ptrs[k], d_, packed_.data() + k * stride);
   DataMatrixBlocks Q =
       build_data_matrix_blocks(ptrs, si, sj, d_, owned_.size() + neighbors_.size(), owned_.size());
   Q_bb_ = std::move(Q.own);
@@ -103,6 +108,7 @@ void BlockProblem::extend(const std::vector<std::size_t>& new_owned,
     const Measurement& me = measurements[k];
     const bool oi = owned(me.i), oj = owned(me.j);
     if (!oi && !oj) continue;
+    // Checked before the block changes further (pack_measurement checks again, later).
     if (me.R.rows() != d_ || me.R.cols() != d_ || me.t.size() != d_)
       throw std::invalid_argument("BlockProblem: measurement of the wrong dimension");
     touching.push_back(k);
@@ -141,12 +147,7 @@ void BlockProblem::extend(const std::vector<std::size_t>& new_owned,
     si.push_back(owned(me.i) ? owned_slot_[me.i] : neighbour_slot(me.i));
     sj.push_back(owned(me.j) ? owned_slot_[me.j] : neighbour_slot(me.j));
     edges_.push_back({si.back(), sj.back()});
-    double* out = packed_.data() + at;
-    for (int b = 0; b < d_; ++b)
-      for (int c = 0; c < d_; ++c) out[b * d_ + c] = me.R(c, b);
-    for (int c = 0; c < d_; ++c) out[d_ * d_ + c] = me.t(c);
-    out[d_ * d_ + d_] = me.kappa;
-    out[d_ * d_ + d_ + 1] = me.tau;
+    pack_measurement(me, d_, packed_.data() + at);
     at += stride;
   }
   // The old matrices in the new slots (Q_NB's rows renumbered in place), plus the new terms.
