@@ -314,11 +314,8 @@ int OnlineAgent::run() {
       const std::vector<Pose> poses = round_solution(graph, view_.iterate());
       cost_ = evaluate_objective(graph, poses);
       have_cost_ = true;
-      // As in the batch runs: a certified X that rounds far above f(X) (a relaxation that is
-      // not tight) leaves the estimate uncertified.
-      if (final_.certified && *final_.certified && final_.relaxation_cost &&
-          !rounding_is_tight(cost_, *final_.relaxation_cost))
-        final_.certified = false;
+      if (final_.relaxation_cost)
+        final_.certified = estimate_certified(final_.certified, cost_, *final_.relaxation_cost);
     }
   }
   channel_.flush(5.0);

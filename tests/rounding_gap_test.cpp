@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <tessera/certification/rounding_gap.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/generate/generator.hpp>
@@ -31,6 +32,13 @@ TEST(RoundingGap, IsRelativeToTheRelaxationCostAndBoundedBelowByOne) {
   EXPECT_TRUE(rounding_is_tight(100.0 + 1e-4, 100.0));
   EXPECT_FALSE(rounding_is_tight(100.01, 100.0));
   EXPECT_TRUE(rounding_is_tight(100.01, 100.0, 1e-3));
+}
+
+TEST(RoundingGap, OnlyACertifiedRelaxationWithALooseRoundingChangesTheVerdict) {
+  EXPECT_EQ(estimate_certified(true, 100.0, 100.0), std::optional<bool>(true));
+  EXPECT_EQ(estimate_certified(true, 101.0, 100.0), std::optional<bool>(false));
+  EXPECT_EQ(estimate_certified(false, 100.0, 100.0), std::optional<bool>(false));
+  EXPECT_EQ(estimate_certified(std::nullopt, 101.0, 100.0), std::nullopt);
 }
 
 TEST(RoundingGap, ACertifiedRelaxationThatIsNotTightLeavesTheEstimateUncertified) {

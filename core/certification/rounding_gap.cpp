@@ -12,4 +12,12 @@ bool rounding_is_tight(double rounded_cost, double relaxation_cost, double toler
   return relative_rounding_gap(rounded_cost, relaxation_cost) <= tolerance;
 }
 
+std::optional<bool> estimate_certified(std::optional<bool> relaxation_certified,
+                                       double rounded_cost, double relaxation_cost) {
+  if (relaxation_certified && *relaxation_certified &&
+      !rounding_is_tight(rounded_cost, relaxation_cost))
+    return false;
+  return relaxation_certified;
+}
+
 }  // namespace tessera

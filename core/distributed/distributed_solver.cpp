@@ -239,9 +239,7 @@ DistributedResult solve_distributed_with_states(const PoseGraph& graph, const Bl
     res.poses = round_solution(graph, res.X);
     res.rounding_s = since(rounding_start);
     res.cost = evaluate_objective(graph, res.poses);
-    // Certified X, rounding far above f(X): the relaxation is not tight, the estimate unproven.
-    if (res.certified && *res.certified && !rounding_is_tight(res.cost, res.relaxation_cost))
-      res.certified = false;
+    res.certified = estimate_certified(res.certified, res.cost, res.relaxation_cost);
   }
   res.wall_s = since(start);
   return res;

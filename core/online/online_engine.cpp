@@ -190,10 +190,7 @@ OnlineResult OnlineEngine::finish() {
   if (solver.round_result) {
     out.poses = round_solution(out.graph, X_);
     out.cost = evaluate_objective(out.graph, out.poses);
-    // As in the batch solvers: a certified X that rounds far above f(X) leaves the estimate
-    // uncertified (the relaxation is not tight).
-    if (out.certified && *out.certified && !rounding_is_tight(out.cost, res.relaxation_cost))
-      out.certified = false;
+    out.certified = estimate_certified(out.certified, out.cost, res.relaxation_cost);
   }
   return out;
 }

@@ -14,9 +14,7 @@ RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout&
 
   DistributedRounding rounding(local, layout, state, mail);
   res = rounding.run(std::move(res));
-  // Certified X, rounding far above f(X): the relaxation is not tight, the estimate unproven.
-  if (res.certified && *res.certified && !rounding_is_tight(res.cost, res.relaxation_cost))
-    res.certified = false;
+  res.certified = estimate_certified(res.certified, res.cost, res.relaxation_cost);
   if (certified_sequence) {
     double escape_bytes = 0.0;
     res.certificate_bytes = static_cast<std::uint64_t>(

@@ -261,10 +261,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     res.poses = round_solution(graph, X);
   }
   res.cost = evaluate_objective(graph, res.poses);
-  // A certified X whose rounding lands far above f(X) is a relaxation that is not tight: the
-  // estimate is not proven optimal.
-  if (res.certified && *res.certified && !rounding_is_tight(res.cost, res.relaxation_cost))
-    res.certified = false;
+  res.certified = estimate_certified(res.certified, res.cost, res.relaxation_cost);
   res.total_s = seconds_since(start);
   return res;
 }

@@ -8,6 +8,8 @@
 // that is not tight (heavy noise, or outliers a robust run kept) certifies X but leaves the
 // estimate many times above f(X): then the estimate is not certified.
 
+#include <optional>
+
 namespace tessera {
 
 /// Default bound on (rounded_cost - relaxation_cost) / max(1, |relaxation_cost|) for a
@@ -23,5 +25,11 @@ double relative_rounding_gap(double rounded_cost, double relaxation_cost);
 /// relative rounding gap is at most `tolerance` (>= 0).
 bool rounding_is_tight(double rounded_cost, double relaxation_cost,
                        double tolerance = kDefaultRoundingGapTolerance);
+
+/// The estimate's verdict from the relaxation's: a certified relaxation whose rounding is not
+/// tight (rounding_is_tight) leaves the estimate uncertified; anything else passes unchanged
+/// (no certificate stays none, false stays false). Every solver's `certified` goes through this.
+std::optional<bool> estimate_certified(std::optional<bool> relaxation_certified,
+                                       double rounded_cost, double relaxation_cost);
 
 }  // namespace tessera
