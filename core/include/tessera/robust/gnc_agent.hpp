@@ -126,7 +126,8 @@ struct GncAgentInput {
   bool pcm = false;
 };
 
-class GncLocalTerms;  // internal: the TLS math over one agent's view
+class GncLocalTerms;    // internal: the TLS math over one agent's view
+struct RecheckVerdict;  // internal: an inlier pass's re-check
 
 class GncAgent : public AgentProcess {
  public:
@@ -208,7 +209,6 @@ class GncAgent : public AgentProcess {
   void replay(std::vector<OutgoingMessage>& out);
   std::uint32_t exchange_phase() const;
   bool in_current_solve(std::uint32_t phase) const;
-  double residual_squared_at(std::size_t k) const;
   void publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
                std::vector<OutgoingMessage>& out);
   void weights_at_mu(double mu);
@@ -238,8 +238,7 @@ class GncAgent : public AgentProcess {
   bool pass_capped_ = false;     // the current pass stops at RobustOptions::recheck_max_rounds
   bool full_pass_next_ = false;  // the next pass is solved to the tolerance
   std::size_t readmitted_ = 0;
-  std::vector<std::uint64_t> taken_back_;  // the current re-check exchange's ids back in
-  std::vector<std::uint64_t> cut_now_;     // and its ids newly out
+  std::unique_ptr<RecheckVerdict> recheck_;  // the current re-check exchange's, every agent's
   std::size_t late_rejected_ = 0;
   std::vector<std::uint64_t> zero_cut_;   // cut measurements of weight 0 (others' too)
   std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where
