@@ -58,13 +58,4 @@ Eigen::MatrixXd kept_set_start(GatheredValues& values, const GncAgentInput& in,
   return lift_poses(initial_poses(kept, in.initialization, in.num_agents), r);
 }
 
-Eigen::MatrixXd block_of(const Eigen::MatrixXd& X, const std::vector<std::size_t>& ids, int d) {
-  const Eigen::Index w = d + 1;
-  Eigen::MatrixXd Y(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
-  for (std::size_t s = 0; s < ids.size(); ++s)
-    Y.middleCols(w * static_cast<Eigen::Index>(s), w) =
-        X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-  return Y;
-}
-
 }  // namespace tessera

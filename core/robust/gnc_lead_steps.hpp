@@ -29,7 +29,4 @@ std::vector<std::uint64_t> inconsistent_closures(GatheredValues& values, const G
 Eigen::MatrixXd kept_set_start(GatheredValues& values, const GncAgentInput& in,
                                std::size_t rejected, int r);
 
-/// The columns of the poses `ids` (ascending) of X (r x (d+1)n, every pose): one agent's block.
-Eigen::MatrixXd block_of(const Eigen::MatrixXd& X, const std::vector<std::size_t>& ids, int d);
-
 }  // namespace tessera

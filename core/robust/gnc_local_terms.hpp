@@ -57,4 +57,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_without(
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::vector<std::uint64_t>& dropped);
 
+/// The columns of the poses `ids` (ascending) of X (r x (d+1)n, every pose): one agent's block.
+Eigen::MatrixXd block_of(const Eigen::MatrixXd& X, const std::vector<std::size_t>& ids, int d);
+
 }  // namespace tessera
