@@ -153,8 +153,22 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   if (!done_ && g_ == g && step_ == Step::kSolve && solve_->done()) after_solve(out);
 }
 
-bool GncAgent::in_current_solve(std::uint32_t phase) const {
+bool GncAgent::is_current(std::uint32_t phase) const {
+  if (step_ != Step::kSolve) return phase == exchange_phase();
   return phase >= g_ * kGncStepStride && phase < g_ * kGncStepStride + kGncExchangeBase;
+}
+
+std::uint32_t GncAgent::lowest_current_phase() const {
+  return step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
+}
+
+std::pair<double, double> GncAgent::summed_votes() const {
+  std::pair<double, double> sum{0, 0};
+  for (const auto& [sender, v] : votes_) {  // agent-id order: the same sums on every agent
+    sum.first += v.first;
+    sum.second += v.second;
+  }
+  return sum;
 }
 
 std::uint32_t GncAgent::exchange_phase() const {
@@ -326,18 +340,22 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
       kept_.push_back(in_.measurements[k]);
       kept_index_.push_back(in_.measurement_index[k]);
     }
-  auto layout = std::make_unique<BlockLayout>(
-      make_block_layout(in_.num_poses, structure_without(in_.structure, rejected_), in_.owner));
-  // The state refers to the layout: keep the iterate, then replace both.
-  in_.Y0 = state_->Y;
-  solve_.reset();
-  state_.reset();
-  layout_ = std::move(layout);
+  solve_without(rejected_);
   solve_kind_ = Solve::kInlierPass;
   pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;
   full_pass_next_ = false;
   ++g_;
   begin_solve(out);
+}
+
+void GncAgent::solve_without(const std::vector<std::uint64_t>& dropped) {
+  auto layout = std::make_unique<BlockLayout>(
+      make_block_layout(in_.num_poses, structure_without(in_.structure, dropped), in_.owner));
+  // The state refers to the layout: keep the iterate as the next start, then replace both.
+  if (state_) in_.Y0 = state_->Y;
+  solve_.reset();
+  state_.reset();
+  layout_ = std::move(layout);
 }
 
 void GncAgent::finish(std::vector<OutgoingMessage>& out) {
@@ -377,8 +395,7 @@ void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
   }
   // They leave the solves (the known inliers connect the poses): the layout without them.
   std::sort(zero_cut_.begin(), zero_cut_.end());
-  layout_ = std::make_unique<BlockLayout>(
-      make_block_layout(in_.num_poses, structure_without(in_.structure, zero_cut_), in_.owner));
+  solve_without(zero_cut_);
 }
 
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
@@ -441,8 +458,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     }
     case Step::kWeights: {
-      double spread = 0;
-      for (const auto& [sender, v] : votes_) spread += v.first;  // agent-id order
+      const double spread = summed_votes().first;
       ++outer_;
       if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
       converged_ = spread <= options_.robust.weight_tolerance;
@@ -450,12 +466,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       if (terms_->known_connected()) {
         // This step's block layout: without the cut measurements of weight 0 (every agent's).
         std::sort(zero_cut_.begin(), zero_cut_.end());
-        auto layout = std::make_unique<BlockLayout>(make_block_layout(
-            in_.num_poses, structure_without(in_.structure, zero_cut_), in_.owner));
-        in_.Y0 = state_->Y;
-        solve_.reset();
-        state_.reset();
-        layout_ = std::move(layout);
+        solve_without(zero_cut_);
       }
       ++g_;
       begin_solve(out);
@@ -494,11 +505,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       begin_exchange(Step::kStartVotes, out);
       return;
     case Step::kStartVotes: {
-      double at_start = 0, at_known = 0;
-      for (const auto& [sender, v] : votes_) {  // agent-id order
-        at_start += v.first;
-        at_known += v.second;
-      }
+      const auto [at_start, at_known] = summed_votes();
       if (at_known < at_start) in_.Y0 = std::move(in_.Y0_known);
       in_.Y0_known.resize(0, 0);
       candidate_neighbours_.resize(0, 0);
@@ -509,11 +516,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       begin_exchange(Step::kCandidateVotes, out);
       return;
     case Step::kCandidateVotes: {
-      double at_iterate = 0, at_candidate = 0;
-      for (const auto& [sender, v] : votes_) {  // agent-id order
-        at_iterate += v.first;
-        at_candidate += v.second;
-      }
+      const auto [at_iterate, at_candidate] = summed_votes();
       if (at_candidate < at_iterate) state_->Y = candidate_;
       candidate_.resize(0, 0);
       candidate_neighbours_.resize(0, 0);
@@ -636,11 +639,8 @@ void GncAgent::replay(std::vector<OutgoingMessage>& out) {
   // Messages of the step just begun that came while this agent was behind.
   while (!done_ && !later_.empty()) {
     const std::uint32_t phase = later_.begin()->first;
-    const bool current =
-        step_ == Step::kSolve ? in_current_solve(phase) : phase == exchange_phase();
-    if (!current) {
-      const std::uint32_t lower = step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
-      if (phase >= lower) return;
+    if (!is_current(phase)) {
+      if (phase >= lowest_current_phase()) return;
       later_.erase(later_.begin());  // of a step this agent has left
       continue;
     }
@@ -664,14 +664,12 @@ std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {
   std::vector<OutgoingMessage> out;
   if (done_) return out;
   const std::uint32_t phase = phase_of(message);
-  const bool current = step_ == Step::kSolve ? in_current_solve(phase) : phase == exchange_phase();
-  if (current) {
+  if (is_current(phase)) {
     feed(message, out);
     replay(out);
     return out;
   }
-  const std::uint32_t lower = step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
-  if (phase < lower) return out;  // a step this agent has left needs nothing more
+  if (phase < lowest_current_phase()) return out;  // a step this agent has left needs nothing more
   later_[phase].push_back(message);
   return out;
 }

@@ -208,7 +208,12 @@ class GncAgent : public AgentProcess {
   void feed(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
   void replay(std::vector<OutgoingMessage>& out);
   std::uint32_t exchange_phase() const;
-  bool in_current_solve(std::uint32_t phase) const;
+  // The current step's phase (a solve's: any of its inner phases), the lowest of them.
+  bool is_current(std::uint32_t phase) const;
+  std::uint32_t lowest_current_phase() const;
+  std::pair<double, double> summed_votes() const;  // of the current exchange, every agent's
+  // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
+  void solve_without(const std::vector<std::uint64_t>& dropped);
   void publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
                std::vector<OutgoingMessage>& out);
   void weights_at_mu(double mu);
