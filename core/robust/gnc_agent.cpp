@@ -383,12 +383,9 @@ void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
     if (id >= in_.structure.size())
       throw std::runtime_error("robust pcm-gnc: measurement " + std::to_string(id) +
                                " out of range");
-    const auto pos =
-        std::lower_bound(in_.measurement_index.begin(), in_.measurement_index.end(), id);
-    if (pos != in_.measurement_index.end() && *pos == id) {
-      const auto k = static_cast<std::size_t>(pos - in_.measurement_index.begin());
-      dropped_[k] = true;
-      weights_[k] = 0.0;
+    if (const auto k = position_of(in_.measurement_index, id)) {
+      dropped_[*k] = true;
+      weights_[*k] = 0.0;
     }
     const auto& [i, j] = in_.structure[id];
     if (in_.owner[i] != in_.owner[j]) zero_cut_.push_back(id);

@@ -45,6 +45,12 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_without(
   return out;
 }
 
+std::optional<std::size_t> position_of(const std::vector<std::uint64_t>& index, std::uint64_t id) {
+  const auto pos = std::lower_bound(index.begin(), index.end(), id);
+  if (pos == index.end() || *pos != id) return std::nullopt;
+  return static_cast<std::size_t>(pos - index.begin());
+}
+
 Eigen::MatrixXd block_of(const Eigen::MatrixXd& X, const std::vector<std::size_t>& ids, int d) {
   const Eigen::Index w = d + 1;
   Eigen::MatrixXd Y(X.rows(), w * static_cast<Eigen::Index>(ids.size()));

@@ -73,9 +73,7 @@ void read_weights_message(const RoundStatusMessage& st, std::uint32_t sender,
       throw std::runtime_error(me + "agent " + std::to_string(sender) +
                                " sent the weight of measurement " + std::to_string(id) +
                                ", not its own");
-    const auto pos = std::lower_bound(in.measurement_index.begin(), in.measurement_index.end(), id);
-    if (pos != in.measurement_index.end() && *pos == id)
-      weights[static_cast<std::size_t>(pos - in.measurement_index.begin())] = st.weights[q];
+    if (const auto k = position_of(in.measurement_index, id)) weights[*k] = st.weights[q];
     if (st.weights[q] == 0) zero_cut.push_back(id);
   }
 }
