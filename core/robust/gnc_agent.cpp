@@ -143,14 +143,19 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
                                         solve_options_.block_update);
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
-  std::vector<OutgoingMessage> first = solve_->start();
-  for (auto& o : first) {
-    std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
-    out.push_back(std::move(o));
-  }
+  pass_on(solve_->start(), out);
   const std::uint32_t g = g_;
   replay(out);
   if (!done_ && g_ == g && step_ == Step::kSolve && solve_->done()) after_solve(out);
+}
+
+// The inner solve's messages, tagged with this GNC step.
+void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out,
+                       std::vector<OutgoingMessage>& out) const {
+  for (auto& o : solve_out) {
+    std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
+    out.push_back(std::move(o));
+  }
 }
 
 bool GncAgent::is_current(std::uint32_t phase) const {
@@ -549,10 +554,7 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
   if (step_ == Step::kSolve) {
     ProtocolMessage m = message;
     std::visit([&](auto& x) { x.phase -= g_ * kGncStepStride; }, m);
-    for (auto& o : solve_->handle(m)) {
-      std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
-      out.push_back(std::move(o));
-    }
+    pass_on(solve_->handle(m), out);
     if (solve_->done()) after_solve(out);
     return;
   }

@@ -211,6 +211,8 @@ class GncAgent : public AgentProcess {
   // The current step's phase (a solve's: any of its inner phases), the lowest of them.
   bool is_current(std::uint32_t phase) const;
   std::uint32_t lowest_current_phase() const;
+  // The inner solve's messages, tagged with this GNC step.
+  void pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) const;
   std::pair<double, double> summed_votes() const;  // of the current exchange, every agent's
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
