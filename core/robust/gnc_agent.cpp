@@ -1,19 +1,18 @@
 #include <algorithm>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/stage_tag.hpp>
-#include <tessera/graph/connectivity.hpp>
-#include <tessera/problem/lifting.hpp>
 #include <tessera/robust/gnc_agent.hpp>
-#include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
 
 #include "distributed/measurement_block.hpp"
 #include "distributed/pose_block_codec.hpp"
+#include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
+#include "robust/gnc_messages.hpp"
+#include "robust/gnc_votes.hpp"
 
 namespace tessera {
 
@@ -53,6 +52,7 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   layout_ = std::make_unique<BlockLayout>(*base_);
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
+  recheck_ = std::make_unique<RecheckVerdict>();
   weights_.assign(m, 1.0);
 }
 
@@ -64,10 +64,6 @@ double GncAgent::threshold_squared() const {
 
 int GncAgent::total_rounds() const {
   return gnc_rounds_ + final_rounds_;
-}
-
-double GncAgent::residual_squared_at(std::size_t k) const {
-  return terms_->residual_squared(k, state_->Y, neighbours_);
 }
 
 void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
@@ -84,7 +80,8 @@ void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t p
 void GncAgent::weights_at_mu(double mu) {
   for (std::size_t k : terms_->owned())
     if (terms_->may_reject(k) && !dropped_[k])
-      weights_[k] = tls_weight(residual_squared_at(k), terms_->c2(), mu);
+      weights_[k] =
+          tls_weight(terms_->residual_squared(k, state_->Y, neighbours_), terms_->c2(), mu);
 }
 
 std::vector<OutgoingMessage> GncAgent::start() {
@@ -146,18 +143,37 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
                                         solve_options_.block_update);
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
-  std::vector<OutgoingMessage> first = solve_->start();
-  for (auto& o : first) {
-    std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
-    out.push_back(std::move(o));
-  }
+  pass_on(solve_->start(), out);
   const std::uint32_t g = g_;
   replay(out);
   if (!done_ && g_ == g && step_ == Step::kSolve && solve_->done()) after_solve(out);
 }
 
-bool GncAgent::in_current_solve(std::uint32_t phase) const {
+// The inner solve's messages, tagged with this GNC step.
+void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out,
+                       std::vector<OutgoingMessage>& out) const {
+  for (auto& o : solve_out) {
+    std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
+    out.push_back(std::move(o));
+  }
+}
+
+bool GncAgent::is_current(std::uint32_t phase) const {
+  if (step_ != Step::kSolve) return phase == exchange_phase();
   return phase >= g_ * kGncStepStride && phase < g_ * kGncStepStride + kGncExchangeBase;
+}
+
+std::uint32_t GncAgent::lowest_current_phase() const {
+  return step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
+}
+
+std::pair<double, double> GncAgent::summed_votes() const {
+  std::pair<double, double> sum{0, 0};
+  for (const auto& [sender, v] : votes_) {  // agent-id order: the same sums on every agent
+    sum.first += v.first;
+    sum.second += v.second;
+  }
+  return sum;
 }
 
 std::uint32_t GncAgent::exchange_phase() const {
@@ -194,29 +210,16 @@ std::uint32_t GncAgent::exchange_phase() const {
 // `kept_only` the ones not rejected): the others send theirs, agent 0 keeps its own and waits.
 void GncAgent::gather_values_at_lead(GncExchange exchange, bool kept_only,
                                      std::vector<OutgoingMessage>& out) {
-  const auto me = static_cast<std::uint32_t>(in_.id);
-  auto wanted = [&](std::size_t k) {
-    return !kept_only ||
-           !std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k]);
-  };
-  if (me != 0) {
-    std::vector<const Measurement*> values;
-    std::vector<std::uint64_t> index;
-    for (std::size_t k : terms_->owned())
-      if (wanted(k)) {
-        values.push_back(&in_.measurements[k]);
-        index.push_back(in_.measurement_index[k]);
-      }
+  const std::vector<std::uint64_t>* rejected = kept_only ? &rejected_ : nullptr;
+  if (in_.id != 0) {
     out.push_back(OutgoingMessage{
-        encode_measurement_block(me, gnc_phase(g_, exchange), in_.d, values, index), false, {0}});
+        owned_values_block(in_, *terms_, rejected, gnc_phase(g_, exchange)), false, {0}});
     waiting_.push_back(0);
     return;
   }
   kept_values_.clear();
-  for (std::size_t k : terms_->owned())
-    if (wanted(k)) kept_values_.emplace_back(in_.measurement_index[k], in_.measurements[k]);
-  for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
-    waiting_.push_back(a);
+  append_owned_values(in_, *terms_, rejected, kept_values_);
+  waiting_ = other_agents(0, in_.num_agents);
 }
 
 void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
@@ -225,21 +228,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   const auto me = static_cast<std::uint32_t>(in_.id);
   waiting_.clear();
   votes_.clear();
-  auto to_others = [&](RoundStatusMessage st, bool broadcast,
-                       const std::function<void(std::uint32_t, RoundStatusMessage&)>& fill) {
-    st.phase = phase;
-    st.sender = me;
-    for (std::uint32_t a = 0; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
-      if (a != me) waiting_.push_back(a);
-    if (broadcast) {
-      if (!waiting_.empty()) out.push_back(OutgoingMessage{st, true, {}});
-      return;
-    }
-    for (std::uint32_t a : waiting_) {
-      RoundStatusMessage s = st;
-      fill(a, s);
-      out.push_back(OutgoingMessage{std::move(s), false, {a}});
-    }
+  // A status to every other agent, each of which answers with its own.
+  auto to_others = [&](RoundStatusMessage st) {
+    waiting_ = other_agents(me, in_.num_agents);
+    broadcast_status(std::move(st), me, phase, in_.num_agents, out);
   };
   switch (step) {
     case Step::kPoses:
@@ -259,21 +251,12 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       publish(in_.Y0, BlockKind::kY, phase, out);
       publish(in_.Y0_known, BlockKind::kP, phase, out);
       break;
-    case Step::kStartVotes: {
+    case Step::kStartVotes:
       // The TLS cost of each measurement at both starts, summed by its weight owner.
-      double at_start = 0, at_known = 0;
-      for (std::size_t k : terms_->owned()) {
-        at_start += terms_->tls_term(k, terms_->residual_squared(k, in_.Y0, neighbours_));
-        at_known +=
-            terms_->tls_term(k, terms_->residual_squared(k, in_.Y0_known, candidate_neighbours_));
-      }
-      votes_[me] = {at_start, at_known};
-      RoundStatusMessage st;
-      st.cost = at_start;
-      st.grad_norm_sq = at_known;
-      to_others(st, true, nullptr);
+      votes_[me] =
+          start_vote_costs(*terms_, in_.Y0, neighbours_, in_.Y0_known, candidate_neighbours_);
+      to_others(vote_message(votes_[me]));
       break;
-    }
     case Step::kPcm:
       gather_values_at_lead(GncExchange::kPcmValues, false, out);
       break;
@@ -288,37 +271,20 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       publish(state_->Y, BlockKind::kY, phase, out);
       publish(candidate_, BlockKind::kP, phase, out);
       break;
-    case Step::kCandidateVotes: {
+    case Step::kCandidateVotes:
       // Each kept measurement's cost at both starts, summed by its weight owner.
-      double at_iterate = 0, at_candidate = 0;
-      for (std::size_t k : terms_->owned())
-        if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
-          at_iterate += residual_squared_at(k);
-          at_candidate += terms_->residual_squared(k, candidate_, candidate_neighbours_);
-        }
-      votes_[me] = {at_iterate, at_candidate};
-      RoundStatusMessage st;
-      st.cost = at_iterate;
-      st.grad_norm_sq = at_candidate;
-      to_others(st, true, nullptr);
+      votes_[me] = kept_set_costs(*terms_, in_.measurement_index, rejected_, state_->Y, neighbours_,
+                                  candidate_, candidate_neighbours_);
+      to_others(vote_message(votes_[me]));
       break;
-    }
-    case Step::kVotes: {
+    case Step::kVotes:
       // mu's start needs the largest residual over every measurement that may be rejected.
-      double max_r2 = 0;
-      for (std::size_t k : terms_->owned())
-        if (terms_->may_reject(k) && !dropped_[k])
-          max_r2 = std::max(max_r2, residual_squared_at(k));
-      votes_[me] = {max_r2, 0};
-      RoundStatusMessage st;
-      st.cost = max_r2;
-      to_others(st, true, nullptr);
+      votes_[me] = {largest_rejectable_residual(*terms_, dropped_, state_->Y, neighbours_), 0};
+      to_others(vote_message(votes_[me]));
       break;
-    }
     case Step::kWeights: {
       weights_at_mu(mu_);
-      double spread = 0;
-      for (std::size_t k : terms_->owned()) spread += weights_[k] * (1 - weights_[k]);
+      const double spread = weight_spread(*terms_, weights_);
       votes_[me] = {spread, 0};
       zero_cut_.clear();
       for (std::size_t k : terms_->owned()) {
@@ -326,21 +292,13 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
         if (weights_[k] == 0 && in_.owner[m.i] != in_.owner[m.j])
           zero_cut_.push_back(in_.measurement_index[k]);
       }
-      RoundStatusMessage st;
-      st.grad_norm_sq = spread;
-      to_others(st, false, [&](std::uint32_t a, RoundStatusMessage& s) {
-        // The recipient's cut measurements this agent weighs, then (with weight 0) its other
-        // cut measurements that leave the solve, for the recipient's block layout.
-        for (std::size_t k : terms_->owned()) {
-          const Measurement& m = in_.measurements[k];
-          const auto other = static_cast<std::uint32_t>(in_.owner[std::max(m.i, m.j)]);
-          const bool cut = in_.owner[m.i] != in_.owner[m.j];
-          if (other == a || (terms_->known_connected() && cut && weights_[k] == 0)) {
-            s.measurement_ids.push_back(in_.measurement_index[k]);
-            s.weights.push_back(weights_[k]);
-          }
-        }
-      });
+      waiting_ = other_agents(me, in_.num_agents);
+      for (std::uint32_t a : waiting_) {
+        RoundStatusMessage st = weights_message(a, spread, in_, *terms_, weights_);
+        st.phase = phase;
+        st.sender = me;
+        out.push_back(OutgoingMessage{std::move(st), false, {a}});
+      }
       break;
     }
     case Step::kRejected: {
@@ -349,32 +307,15 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
         if (weights_[k] < 0.5) rejected_.push_back(in_.measurement_index[k]);
       RoundStatusMessage st;
       st.measurement_ids = rejected_;
-      to_others(st, true, nullptr);
+      to_others(std::move(st));
       break;
     }
-    case Step::kReadmitted: {
-      // TLS's own verdict at the kept set's solution: a rejected measurement within the bound
-      // was misjudged on a rough iterate and comes back (weight 1), a kept one beyond it is a
-      // wrong closure that GNC's iterate fitted with the help of a distortion and leaves
-      // (weight 0). Each pass is a descent step of the TLS cost (binary weights given the poses).
-      taken_back_.clear();
-      cut_now_.clear();
-      for (std::size_t k : terms_->owned()) {
-        if (!terms_->may_reject(k)) continue;
-        const std::uint64_t id = in_.measurement_index[k];
-        const bool was_rejected = std::binary_search(rejected_.begin(), rejected_.end(), id);
-        const bool fits = residual_squared_at(k) <= terms_->c2();
-        if (was_rejected && fits) taken_back_.push_back(id);
-        if (!was_rejected && !fits) cut_now_.push_back(id);
-      }
-      RoundStatusMessage st;
-      st.measurement_ids = taken_back_;
-      st.weights.assign(taken_back_.size(), 1.0);
-      st.measurement_ids.insert(st.measurement_ids.end(), cut_now_.begin(), cut_now_.end());
-      st.weights.resize(st.measurement_ids.size(), 0.0);
-      to_others(st, true, nullptr);
+    case Step::kReadmitted:
+      // TLS's own verdict at the kept set's solution (gnc_votes.hpp); every agent gathers all.
+      *recheck_ =
+          recheck_verdict(*terms_, in_.measurement_index, rejected_, state_->Y, neighbours_);
+      to_others(readmitted_message(*recheck_));
       break;
-    }
     default:
       break;
   }
@@ -404,18 +345,22 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
       kept_.push_back(in_.measurements[k]);
       kept_index_.push_back(in_.measurement_index[k]);
     }
-  auto layout = std::make_unique<BlockLayout>(
-      make_block_layout(in_.num_poses, structure_without(in_.structure, rejected_), in_.owner));
-  // The state refers to the layout: keep the iterate, then replace both.
-  in_.Y0 = state_->Y;
-  solve_.reset();
-  state_.reset();
-  layout_ = std::move(layout);
+  solve_without(rejected_);
   solve_kind_ = Solve::kInlierPass;
   pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;
   full_pass_next_ = false;
   ++g_;
   begin_solve(out);
+}
+
+void GncAgent::solve_without(const std::vector<std::uint64_t>& dropped) {
+  auto layout = std::make_unique<BlockLayout>(
+      make_block_layout(in_.num_poses, structure_without(in_.structure, dropped), in_.owner));
+  // The state refers to the layout: keep the iterate as the next start, then replace both.
+  if (state_) in_.Y0 = state_->Y;
+  solve_.reset();
+  state_.reset();
+  layout_ = std::move(layout);
 }
 
 void GncAgent::finish(std::vector<OutgoingMessage>& out) {
@@ -443,66 +388,29 @@ void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
     if (id >= in_.structure.size())
       throw std::runtime_error("robust pcm-gnc: measurement " + std::to_string(id) +
                                " out of range");
-    const auto pos =
-        std::lower_bound(in_.measurement_index.begin(), in_.measurement_index.end(), id);
-    if (pos != in_.measurement_index.end() && *pos == id) {
-      const auto k = static_cast<std::size_t>(pos - in_.measurement_index.begin());
-      dropped_[k] = true;
-      weights_[k] = 0.0;
+    if (const auto k = position_of(in_.measurement_index, id)) {
+      dropped_[*k] = true;
+      weights_[*k] = 0.0;
     }
     const auto& [i, j] = in_.structure[id];
     if (in_.owner[i] != in_.owner[j]) zero_cut_.push_back(id);
   }
   // They leave the solves (the known inliers connect the poses): the layout without them.
   std::sort(zero_cut_.begin(), zero_cut_.end());
-  layout_ = std::make_unique<BlockLayout>(
-      make_block_layout(in_.num_poses, structure_without(in_.structure, zero_cut_), in_.owner));
+  solve_without(zero_cut_);
 }
 
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
-  // Agent 0: the kept set in file order, as the in-process engine's initialization sees it.
-  std::sort(kept_values_.begin(), kept_values_.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
-  PoseGraph kept;
-  kept.d = in_.d;
-  kept.num_poses = in_.num_poses;
-  kept.source = in_.source;
-  kept.measurements.reserve(kept_values_.size());
-  for (std::size_t k = 0; k < kept_values_.size(); ++k) {
-    if (k > 0 && kept_values_[k].first == kept_values_[k - 1].first)
-      throw std::runtime_error("robust solve: measurement #" +
-                               std::to_string(kept_values_[k].first) + " was sent twice");
-    kept.measurements.push_back(std::move(kept_values_[k].second));
-  }
-  kept_values_.clear();
-  if (kept.measurements.size() + rejected_.size() != in_.structure.size())
-    throw std::runtime_error("robust solve: agent 0 has " +
-                             std::to_string(kept.measurements.size()) + " kept measurements, not " +
-                             std::to_string(in_.structure.size() - rejected_.size()));
-  const Eigen::MatrixXd X = lift_poses(initial_poses(kept, in_.initialization, in_.num_agents),
-                                       static_cast<int>(state_->Y.rows()));
-  const Eigen::Index w = (in_.d + 1);
-  auto block_of = [&](std::size_t a) {
-    const auto& ids = base_->poses[a];
-    Eigen::MatrixXd Y(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      Y.middleCols(w * static_cast<Eigen::Index>(s), w) =
-          X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-    return Y;
-  };
-  for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a) {
-    const Eigen::MatrixXd Y = block_of(a);
-    PoseBlockMessage b;
-    b.sender = 0;
-    b.phase = gnc_phase(g_, GncExchange::kKeptStart);
-    b.kind = BlockKind::kP;
-    b.rank = static_cast<std::uint32_t>(Y.rows());
-    b.dim = static_cast<std::uint32_t>(in_.d);
-    for (std::size_t id : base_->poses[a]) b.pose_ids.push_back(static_cast<std::uint32_t>(id));
-    b.data.assign(Y.data(), Y.data() + Y.size());
-    out.push_back(OutgoingMessage{std::move(b), false, {a}});
-  }
-  candidate_ = block_of(0);
+  // Agent 0: the kept set's initialization, each agent's block sent, its own kept.
+  const Eigen::MatrixXd X =
+      kept_set_start(kept_values_, in_, rejected_.size(), static_cast<int>(state_->Y.rows()));
+  for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
+    out.push_back(
+        OutgoingMessage{kept_start_block(block_of(X, base_->poses[a], in_.d), base_->poses[a],
+                                         in_.d, gnc_phase(g_, GncExchange::kKeptStart)),
+                        false,
+                        {a}});
+  candidate_ = block_of(X, base_->poses[0], in_.d);
 }
 
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
@@ -552,8 +460,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     }
     case Step::kWeights: {
-      double spread = 0;
-      for (const auto& [sender, v] : votes_) spread += v.first;  // agent-id order
+      const double spread = summed_votes().first;
       ++outer_;
       if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
       converged_ = spread <= options_.robust.weight_tolerance;
@@ -561,12 +468,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       if (terms_->known_connected()) {
         // This step's block layout: without the cut measurements of weight 0 (every agent's).
         std::sort(zero_cut_.begin(), zero_cut_.end());
-        auto layout = std::make_unique<BlockLayout>(make_block_layout(
-            in_.num_poses, structure_without(in_.structure, zero_cut_), in_.owner));
-        in_.Y0 = state_->Y;
-        solve_.reset();
-        state_.reset();
-        layout_ = std::move(layout);
+        solve_without(zero_cut_);
       }
       ++g_;
       begin_solve(out);
@@ -588,31 +490,11 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kPcm: {
       if (in_.id == 0) {
-        // The whole graph in file order, as the in-process engine's check sees it.
-        std::sort(kept_values_.begin(), kept_values_.end(),
-                  [](const auto& a, const auto& b) { return a.first < b.first; });
-        PoseGraph graph;
-        graph.d = in_.d;
-        graph.num_poses = in_.num_poses;
-        graph.source = in_.source;
-        for (auto& [e, m] : kept_values_) graph.measurements.push_back(std::move(m));
-        kept_values_.clear();
-        if (graph.measurements.size() != in_.structure.size())
-          throw std::runtime_error("robust pcm-gnc: agent 0 has " +
-                                   std::to_string(graph.measurements.size()) + " of " +
-                                   std::to_string(in_.structure.size()) + " measurements");
-        PoseGraph chains = graph;
-        chains.measurements.clear();
-        for (std::size_t e = 0; e < graph.measurements.size(); ++e)
-          if (terms_->known()[e]) chains.measurements.push_back(graph.measurements[e]);
-        const PairwiseConsistencyResult pcm = pairwise_consistency(
-            graph, terms_->known(), distributed_initialization(chains, 1), terms_->c2());
-        const std::vector<std::uint64_t> ids(pcm.inconsistent.begin(), pcm.inconsistent.end());
+        const std::vector<std::uint64_t> ids = inconsistent_closures(kept_values_, in_, *terms_);
         RoundStatusMessage st;
-        st.sender = 0;
-        st.phase = gnc_phase(g_, GncExchange::kPcmDropped);
         st.measurement_ids = ids;
-        if (in_.num_agents > 1) out.push_back(OutgoingMessage{std::move(st), true, {}});
+        broadcast_status(std::move(st), 0, gnc_phase(g_, GncExchange::kPcmDropped), in_.num_agents,
+                         out);
         drop_inconsistent(ids);
       }
       if (in_.Y0_known.size() > 0)
@@ -625,11 +507,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       begin_exchange(Step::kStartVotes, out);
       return;
     case Step::kStartVotes: {
-      double at_start = 0, at_known = 0;
-      for (const auto& [sender, v] : votes_) {  // agent-id order
-        at_start += v.first;
-        at_known += v.second;
-      }
+      const auto [at_start, at_known] = summed_votes();
       if (at_known < at_start) in_.Y0 = std::move(in_.Y0_known);
       in_.Y0_known.resize(0, 0);
       candidate_neighbours_.resize(0, 0);
@@ -640,11 +518,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       begin_exchange(Step::kCandidateVotes, out);
       return;
     case Step::kCandidateVotes: {
-      double at_iterate = 0, at_candidate = 0;
-      for (const auto& [sender, v] : votes_) {  // agent-id order
-        at_iterate += v.first;
-        at_candidate += v.second;
-      }
+      const auto [at_iterate, at_candidate] = summed_votes();
       if (at_candidate < at_iterate) state_->Y = candidate_;
       candidate_.resize(0, 0);
       candidate_neighbours_.resize(0, 0);
@@ -653,7 +527,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     }
     case Step::kReadmitted: {
       ++pass_;
-      if (taken_back_.empty() && cut_now_.empty()) {
+      if (recheck_->empty()) {
         if (pass_capped_) {
           // No change at a rough solution: the same set once more, solved to the tolerance.
           full_pass_next_ = true;
@@ -663,21 +537,10 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
         finish(out);
         return;
       }
-      std::sort(taken_back_.begin(), taken_back_.end());
-      std::sort(cut_now_.begin(), cut_now_.end());
-      for (std::size_t k = 0; k < in_.measurements.size(); ++k) {
-        const std::uint64_t id = in_.measurement_index[k];
-        if (std::binary_search(taken_back_.begin(), taken_back_.end(), id)) weights_[k] = 1.0;
-        if (std::binary_search(cut_now_.begin(), cut_now_.end(), id)) weights_[k] = 0.0;
-      }
-      std::vector<std::uint64_t> still;
-      std::set_difference(rejected_.begin(), rejected_.end(), taken_back_.begin(),
-                          taken_back_.end(), std::back_inserter(still));
-      readmitted_ += rejected_.size() - still.size();
-      late_rejected_ += cut_now_.size();
-      rejected_.clear();
-      std::merge(still.begin(), still.end(), cut_now_.begin(), cut_now_.end(),
-                 std::back_inserter(rejected_));
+      const RecheckCounts counts =
+          apply_recheck(*recheck_, in_.measurement_index, rejected_, weights_);
+      readmitted_ += counts.readmitted;
+      late_rejected_ += counts.late_rejected;
       begin_inlier_pass(out);
       return;
     }
@@ -691,10 +554,7 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
   if (step_ == Step::kSolve) {
     ProtocolMessage m = message;
     std::visit([&](auto& x) { x.phase -= g_ * kGncStepStride; }, m);
-    for (auto& o : solve_->handle(m)) {
-      std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
-      out.push_back(std::move(o));
-    }
+    pass_on(solve_->handle(m), out);
     if (solve_->done()) after_solve(out);
     return;
   }
@@ -705,78 +565,71 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     throw std::runtime_error(me + "unexpected robust message " + std::to_string(phase) +
                              " from agent " + std::to_string(sender));
   waiting_.erase(it);
-  if (step_ == Step::kPcm) {
-    if (in_.id == 0) {
-      const auto* block = std::get_if<PoseBlockMessage>(&message);
-      if (!block) throw std::runtime_error(me + "a status where measurements belong");
-      decode_measurement_block(*block, in_.d, in_.num_poses, "robust pcm-gnc", kept_values_);
-    } else {
-      const auto* st = std::get_if<RoundStatusMessage>(&message);
-      if (!st) throw std::runtime_error(me + "poses where the consistency check belongs");
-      drop_inconsistent(st->measurement_ids);
+  // The message's expected kind, or an error naming what arrived where.
+  auto block_message = [&](const ProtocolMessage& m,
+                           const std::string& what) -> const PoseBlockMessage& {
+    const auto* block = std::get_if<PoseBlockMessage>(&m);
+    if (!block) throw std::runtime_error(me + what);
+    return *block;
+  };
+  auto status_message = [&](const ProtocolMessage& m,
+                            const char* what) -> const RoundStatusMessage& {
+    const auto* st = std::get_if<RoundStatusMessage>(&m);
+    if (!st) throw std::runtime_error(me + what);
+    return *st;
+  };
+  const char* const kStatusBelongs = "poses where a robust status belongs";
+  switch (step_) {
+    case Step::kPcm:
+      if (in_.id == 0)
+        decode_measurement_block(block_message(message, "a status where measurements belong"),
+                                 in_.d, in_.num_poses, "robust pcm-gnc", kept_values_);
+      else
+        drop_inconsistent(
+            status_message(message, "poses where the consistency check belongs").measurement_ids);
+      break;
+    case Step::kKeptStart: {
+      const PoseBlockMessage& block =
+          block_message(message, "a status where the kept set's start belongs");
+      if (in_.id == 0)
+        decode_measurement_block(block, in_.d, in_.num_poses, "robust solve", kept_values_);
+      else  // agent 0's fresh start of the kept set: this agent's block, lifted
+        candidate_ = read_kept_start(block, base_->poses[static_cast<std::size_t>(in_.id)],
+                                     state_->Y.rows(), in_.d, in_.id);
+      break;
     }
-  } else if (step_ == Step::kKeptStart) {
-    const auto* block = std::get_if<PoseBlockMessage>(&message);
-    if (!block) throw std::runtime_error(me + "a status where the kept set's start belongs");
-    if (in_.id == 0) {
-      decode_measurement_block(*block, in_.d, in_.num_poses, "robust solve", kept_values_);
-    } else {
-      // Agent 0's fresh start of the kept set: this agent's block, lifted.
-      const auto& own = base_->poses[static_cast<std::size_t>(in_.id)];
-      const Eigen::Index w = (in_.d + 1) * state_->Y.rows();
-      if (block->rank != static_cast<std::uint32_t>(state_->Y.rows()) ||
-          block->pose_ids.size() != own.size() ||
-          block->data.size() != own.size() * static_cast<std::size_t>(w) ||
-          !std::equal(own.begin(), own.end(), block->pose_ids.begin()))
-        throw std::runtime_error(me + "malformed start of the kept set from agent 0");
-      candidate_.resize(state_->Y.rows(), state_->Y.cols());
-      std::memcpy(candidate_.data(), block->data.data(), sizeof(double) * block->data.size());
+    case Step::kPoses:
+    case Step::kCandidatePoses:
+    case Step::kStartPoses: {
+      const PoseBlockMessage& block = block_message(
+          message, "a status where robust poses from agent " + std::to_string(sender) + " belong");
+      decode_neighbour_poses(block, terms_->neighbours(), in_.d, in_.id,
+                             block.kind == BlockKind::kP ? candidate_neighbours_ : neighbours_);
+      break;
     }
-  } else if (step_ == Step::kPoses || step_ == Step::kCandidatePoses ||
-             step_ == Step::kStartPoses) {
-    const auto* block = std::get_if<PoseBlockMessage>(&message);
-    if (!block)
-      throw std::runtime_error(me + "a status where robust poses from agent " +
-                               std::to_string(sender) + " belong");
-    decode_neighbour_poses(*block, terms_->neighbours(), in_.d, in_.id,
-                           block->kind == BlockKind::kP ? candidate_neighbours_ : neighbours_);
-  } else {
-    const auto* st = std::get_if<RoundStatusMessage>(&message);
-    if (!st) throw std::runtime_error(me + "poses where a robust status belongs");
-    if (step_ == Step::kVotes) votes_[sender] = {st->cost, 0};
-    if (step_ == Step::kCandidateVotes || step_ == Step::kStartVotes)
-      votes_[sender] = {st->cost, st->grad_norm_sq};
-    if (step_ == Step::kWeights) {
-      votes_[sender] = {st->grad_norm_sq, 0};
-      if (st->weights.size() != st->measurement_ids.size())
-        throw std::runtime_error(me + "weights from agent " + std::to_string(sender) +
-                                 " do not match their measurements");
-      for (std::size_t q = 0; q < st->weights.size(); ++q) {
-        const std::uint64_t id = st->measurement_ids[q];
-        if (id >= in_.structure.size() ||
-            in_.owner[std::min(in_.structure[id].first, in_.structure[id].second)] !=
-                static_cast<int>(sender))
-          throw std::runtime_error(me + "agent " + std::to_string(sender) +
-                                   " sent the weight of measurement " + std::to_string(id) +
-                                   ", not its own");
-        const auto pos =
-            std::lower_bound(in_.measurement_index.begin(), in_.measurement_index.end(), id);
-        if (pos != in_.measurement_index.end() && *pos == id)
-          weights_[static_cast<std::size_t>(pos - in_.measurement_index.begin())] = st->weights[q];
-        if (st->weights[q] == 0) zero_cut_.push_back(id);
-      }
+    case Step::kVotes:
+      votes_[sender] = {status_message(message, kStatusBelongs).cost, 0};
+      break;
+    case Step::kCandidateVotes:
+    case Step::kStartVotes:
+      votes_[sender] = read_vote(status_message(message, kStatusBelongs));
+      break;
+    case Step::kWeights: {
+      const RoundStatusMessage& st = status_message(message, kStatusBelongs);
+      votes_[sender] = {st.grad_norm_sq, 0};
+      read_weights_message(st, sender, in_, weights_, zero_cut_);
+      break;
     }
-    if (step_ == Step::kRejected)
-      rejected_.insert(rejected_.end(), st->measurement_ids.begin(), st->measurement_ids.end());
-    if (step_ == Step::kReadmitted) {
-      // Weight 1: taken back; 0: rejected at the kept set's solution (no weights: taken back).
-      if (!st->weights.empty() && st->weights.size() != st->measurement_ids.size())
-        throw std::runtime_error(me + "re-check from agent " + std::to_string(sender) +
-                                 " does not match its measurements");
-      for (std::size_t q = 0; q < st->measurement_ids.size(); ++q)
-        (st->weights.empty() || st->weights[q] > 0.5 ? taken_back_ : cut_now_)
-            .push_back(st->measurement_ids[q]);
+    case Step::kRejected: {
+      const RoundStatusMessage& st = status_message(message, kStatusBelongs);
+      rejected_.insert(rejected_.end(), st.measurement_ids.begin(), st.measurement_ids.end());
+      break;
     }
+    case Step::kReadmitted:
+      read_readmitted_message(status_message(message, kStatusBelongs), sender, in_.id, *recheck_);
+      break;
+    default:
+      break;
   }
   if (waiting_.empty()) after_exchange(out);
 }
@@ -785,11 +638,8 @@ void GncAgent::replay(std::vector<OutgoingMessage>& out) {
   // Messages of the step just begun that came while this agent was behind.
   while (!done_ && !later_.empty()) {
     const std::uint32_t phase = later_.begin()->first;
-    const bool current =
-        step_ == Step::kSolve ? in_current_solve(phase) : phase == exchange_phase();
-    if (!current) {
-      const std::uint32_t lower = step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
-      if (phase >= lower) return;
+    if (!is_current(phase)) {
+      if (phase >= lowest_current_phase()) return;
       later_.erase(later_.begin());  // of a step this agent has left
       continue;
     }
@@ -813,14 +663,12 @@ std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {
   std::vector<OutgoingMessage> out;
   if (done_) return out;
   const std::uint32_t phase = phase_of(message);
-  const bool current = step_ == Step::kSolve ? in_current_solve(phase) : phase == exchange_phase();
-  if (current) {
+  if (is_current(phase)) {
     feed(message, out);
     replay(out);
     return out;
   }
-  const std::uint32_t lower = step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
-  if (phase < lower) return out;  // a step this agent has left needs nothing more
+  if (phase < lowest_current_phase()) return out;  // a step this agent has left needs nothing more
   later_[phase].push_back(message);
   return out;
 }

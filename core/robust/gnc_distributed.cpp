@@ -12,6 +12,8 @@
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "robust/gnc_local_terms.hpp"
+
 namespace tessera {
 namespace {
 
@@ -97,14 +99,6 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   const std::optional<std::vector<Pose>> known = known_inlier_poses(graph, options, agents);
   const Eigen::MatrixXd X0_known = known ? lift_poses(*known, solver.rank) : Eigen::MatrixXd();
   const Eigen::Index w = graph.d + 1;
-  auto block_of = [&](const Eigen::MatrixXd& X, int b) {
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    Eigen::MatrixXd Y(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      Y.middleCols(w * static_cast<Eigen::Index>(s), w) =
-          X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-    return Y;
-  };
 
   // Every agent gets what a DDS agent holds after the hand-off: the endpoints of the whole
   // graph, the measurements touching its poses and its block of the starting point.
@@ -129,8 +123,9 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
       in.measurements.push_back(m);
       in.measurement_index.push_back(e);
     }
-    in.Y0 = block_of(X0, b);
-    if (known) in.Y0_known = block_of(X0_known, b);
+    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+    in.Y0 = block_of(X0, ids, graph.d);
+    if (known) in.Y0_known = block_of(X0_known, ids, graph.d);
     in.kept_set_start = options.kept_set_start;
     in.initialization = solver.initialization;
     in.source = graph.source;

@@ -126,7 +126,8 @@ struct GncAgentInput {
   bool pcm = false;
 };
 
-class GncLocalTerms;  // internal: the TLS math over one agent's view
+class GncLocalTerms;    // internal: the TLS math over one agent's view
+struct RecheckVerdict;  // internal: an inlier pass's re-check
 
 class GncAgent : public AgentProcess {
  public:
@@ -207,8 +208,14 @@ class GncAgent : public AgentProcess {
   void feed(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
   void replay(std::vector<OutgoingMessage>& out);
   std::uint32_t exchange_phase() const;
-  bool in_current_solve(std::uint32_t phase) const;
-  double residual_squared_at(std::size_t k) const;
+  // The current step's phase (a solve's: any of its inner phases), the lowest of them.
+  bool is_current(std::uint32_t phase) const;
+  std::uint32_t lowest_current_phase() const;
+  // The inner solve's messages, tagged with this GNC step.
+  void pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) const;
+  std::pair<double, double> summed_votes() const;  // of the current exchange, every agent's
+  // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
+  void solve_without(const std::vector<std::uint64_t>& dropped);
   void publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
                std::vector<OutgoingMessage>& out);
   void weights_at_mu(double mu);
@@ -238,8 +245,7 @@ class GncAgent : public AgentProcess {
   bool pass_capped_ = false;     // the current pass stops at RobustOptions::recheck_max_rounds
   bool full_pass_next_ = false;  // the next pass is solved to the tolerance
   std::size_t readmitted_ = 0;
-  std::vector<std::uint64_t> taken_back_;  // the current re-check exchange's ids back in
-  std::vector<std::uint64_t> cut_now_;     // and its ids newly out
+  std::unique_ptr<RecheckVerdict> recheck_;  // the current re-check exchange's, every agent's
   std::size_t late_rejected_ = 0;
   std::vector<std::uint64_t> zero_cut_;   // cut measurements of weight 0 (others' too)
   std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where

@@ -1,0 +1,32 @@
+#pragma once
+// What agent 0 computes over the measurement values the agents send it (GncAgent gathers them):
+// the pairwise consistency check of `--robust pcm-gnc` and the fresh start of the kept set.
+// Both are global, like the chordal initialization, so they run on one agent.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <tessera/graph/measurement.hpp>
+#include <tessera/robust/gnc_agent.hpp>
+#include <utility>
+#include <vector>
+
+#include "robust/gnc_local_terms.hpp"
+
+namespace tessera {
+
+/// (file position, value) of each gathered measurement, in any order.
+using GatheredValues = std::vector<std::pair<std::uint64_t, Measurement>>;
+
+/// The closures outside the largest consistent set (file positions, ascending), from every
+/// measurement of the graph in `values` (consumed). Throws std::runtime_error when some are
+/// missing.
+std::vector<std::uint64_t> inconsistent_closures(GatheredValues& values, const GncAgentInput& in,
+                                                 const GncLocalTerms& terms);
+
+/// The initialization of the kept set (every measurement but the `rejected` ones, in `values`,
+/// consumed), lifted to rank `r`: r x (d+1)n, every pose. Throws std::runtime_error on a
+/// measurement sent twice or a count that does not match.
+Eigen::MatrixXd kept_set_start(GatheredValues& values, const GncAgentInput& in,
+                               std::size_t rejected, int r);
+
+}  // namespace tessera

@@ -1,0 +1,148 @@
+#include "robust/gnc_messages.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "distributed/measurement_block.hpp"
+#include "distributed/pose_block_codec.hpp"
+
+namespace tessera {
+
+namespace {
+
+std::string agent_prefix(int id) {
+  return "agent " + std::to_string(id) + ": ";
+}
+
+bool wanted(const std::vector<std::uint64_t>* rejected, std::uint64_t id) {
+  return !rejected || !std::binary_search(rejected->begin(), rejected->end(), id);
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> other_agents(std::uint32_t me, int num_agents) {
+  std::vector<std::uint32_t> others;
+  for (std::uint32_t a = 0; a < static_cast<std::uint32_t>(num_agents); ++a)
+    if (a != me) others.push_back(a);
+  return others;
+}
+
+void broadcast_status(RoundStatusMessage st, std::uint32_t me, std::uint32_t phase, int num_agents,
+                      std::vector<OutgoingMessage>& out) {
+  if (num_agents <= 1) return;
+  st.phase = phase;
+  st.sender = me;
+  out.push_back(OutgoingMessage{std::move(st), true, {}});
+}
+
+RoundStatusMessage vote_message(const std::pair<double, double>& sums) {
+  RoundStatusMessage st;
+  st.cost = sums.first;
+  st.grad_norm_sq = sums.second;
+  return st;
+}
+
+RoundStatusMessage weights_message(std::uint32_t to, double spread, const GncAgentInput& in,
+                                   const GncLocalTerms& terms, const std::vector<double>& weights) {
+  RoundStatusMessage st;
+  st.grad_norm_sq = spread;
+  for (std::size_t k : terms.owned()) {
+    const Measurement& m = in.measurements[k];
+    const auto other = static_cast<std::uint32_t>(in.owner[std::max(m.i, m.j)]);
+    const bool cut = in.owner[m.i] != in.owner[m.j];
+    if (other == to || (terms.known_connected() && cut && weights[k] == 0)) {
+      st.measurement_ids.push_back(in.measurement_index[k]);
+      st.weights.push_back(weights[k]);
+    }
+  }
+  return st;
+}
+
+void read_weights_message(const RoundStatusMessage& st, std::uint32_t sender,
+                          const GncAgentInput& in, std::vector<double>& weights,
+                          std::vector<std::uint64_t>& zero_cut) {
+  const std::string me = agent_prefix(in.id);
+  if (st.weights.size() != st.measurement_ids.size())
+    throw std::runtime_error(me + "weights from agent " + std::to_string(sender) +
+                             " do not match their measurements");
+  for (std::size_t q = 0; q < st.weights.size(); ++q) {
+    const std::uint64_t id = st.measurement_ids[q];
+    if (id >= in.structure.size() ||
+        in.owner[std::min(in.structure[id].first, in.structure[id].second)] !=
+            static_cast<int>(sender))
+      throw std::runtime_error(me + "agent " + std::to_string(sender) +
+                               " sent the weight of measurement " + std::to_string(id) +
+                               ", not its own");
+    if (const auto k = position_of(in.measurement_index, id)) weights[*k] = st.weights[q];
+    if (st.weights[q] == 0) zero_cut.push_back(id);
+  }
+}
+
+PoseBlockMessage owned_values_block(const GncAgentInput& in, const GncLocalTerms& terms,
+                                    const std::vector<std::uint64_t>* rejected,
+                                    std::uint32_t phase) {
+  std::vector<const Measurement*> values;
+  std::vector<std::uint64_t> index;
+  for (std::size_t k : terms.owned())
+    if (wanted(rejected, in.measurement_index[k])) {
+      values.push_back(&in.measurements[k]);
+      index.push_back(in.measurement_index[k]);
+    }
+  return encode_measurement_block(static_cast<std::uint32_t>(in.id), phase, in.d, values, index);
+}
+
+void append_owned_values(const GncAgentInput& in, const GncLocalTerms& terms,
+                         const std::vector<std::uint64_t>* rejected, GatheredValues& values) {
+  for (std::size_t k : terms.owned())
+    if (wanted(rejected, in.measurement_index[k]))
+      values.emplace_back(in.measurement_index[k], in.measurements[k]);
+}
+
+RoundStatusMessage readmitted_message(const RecheckVerdict& verdict) {
+  RoundStatusMessage st;
+  st.measurement_ids = verdict.taken_back;
+  st.weights.assign(verdict.taken_back.size(), 1.0);
+  st.measurement_ids.insert(st.measurement_ids.end(), verdict.cut_now.begin(),
+                            verdict.cut_now.end());
+  st.weights.resize(st.measurement_ids.size(), 0.0);
+  return st;
+}
+
+void read_readmitted_message(const RoundStatusMessage& st, std::uint32_t sender, int receiver,
+                             RecheckVerdict& into) {
+  // Weight 1: taken back; 0: rejected at the kept set's solution (no weights: taken back).
+  if (!st.weights.empty() && st.weights.size() != st.measurement_ids.size())
+    throw std::runtime_error(agent_prefix(receiver) + "re-check from agent " +
+                             std::to_string(sender) + " does not match its measurements");
+  for (std::size_t q = 0; q < st.measurement_ids.size(); ++q)
+    (st.weights.empty() || st.weights[q] > 0.5 ? into.taken_back : into.cut_now)
+        .push_back(st.measurement_ids[q]);
+}
+
+PoseBlockMessage kept_start_block(const Eigen::MatrixXd& Y, const std::vector<std::size_t>& ids,
+                                  int d, std::uint32_t phase) {
+  PoseBlockMessage b;
+  b.sender = 0;
+  b.phase = phase;
+  b.kind = BlockKind::kP;
+  b.rank = static_cast<std::uint32_t>(Y.rows());
+  b.dim = static_cast<std::uint32_t>(d);
+  for (std::size_t id : ids) b.pose_ids.push_back(static_cast<std::uint32_t>(id));
+  b.data.assign(Y.data(), Y.data() + Y.size());
+  return b;
+}
+
+Eigen::MatrixXd read_kept_start(const PoseBlockMessage& block, const std::vector<std::size_t>& own,
+                                Eigen::Index r, int d, int receiver) {
+  const Eigen::Index w = (d + 1) * r;
+  if (block.rank != static_cast<std::uint32_t>(r) || block.pose_ids.size() != own.size() ||
+      block.data.size() != own.size() * static_cast<std::size_t>(w) ||
+      !std::equal(own.begin(), own.end(), block.pose_ids.begin()))
+    throw std::runtime_error(agent_prefix(receiver) +
+                             "malformed start of the kept set from agent 0");
+  Eigen::MatrixXd Y(r, (d + 1) * static_cast<Eigen::Index>(own.size()));
+  decode_neighbour_poses(block, own, d, receiver, Y);
+  return Y;
+}
+
+}  // namespace tessera

@@ -1,0 +1,70 @@
+#pragma once
+// The messages of GNC's own exchanges (GncAgent decides when they are sent): building them from
+// one agent's view and reading them back with their checks. Pose exchanges use
+// distributed/pose_block_codec.hpp, measurement values distributed/measurement_block.hpp.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <tessera/distributed/agent_process.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/protocol/messages.hpp>
+#include <tessera/robust/gnc_agent.hpp>
+#include <utility>
+#include <vector>
+
+#include "robust/gnc_lead_steps.hpp"
+#include "robust/gnc_local_terms.hpp"
+#include "robust/gnc_votes.hpp"
+
+namespace tessera {
+
+/// Every agent but `me`, ascending: whom a status exchange waits for.
+std::vector<std::uint32_t> other_agents(std::uint32_t me, int num_agents);
+
+/// `st` as `me`'s message of `phase`, one broadcast (nothing without another agent).
+void broadcast_status(RoundStatusMessage st, std::uint32_t me, std::uint32_t phase, int num_agents,
+                      std::vector<OutgoingMessage>& out);
+
+/// A vote's two sums (cost, grad_norm_sq), and back.
+RoundStatusMessage vote_message(const std::pair<double, double>& sums);
+inline std::pair<double, double> read_vote(const RoundStatusMessage& st) {
+  return {st.cost, st.grad_norm_sq};
+}
+
+/// The weights message for agent `to`: the weights of the cut measurements this agent weighs
+/// whose other end `to` holds, then (with weight 0) its other cut measurements that leave the
+/// solve (for `to`'s block layout), and the weight spread (grad_norm_sq, the stop vote).
+RoundStatusMessage weights_message(std::uint32_t to, double spread, const GncAgentInput& in,
+                                   const GncLocalTerms& terms, const std::vector<double>& weights);
+
+/// Checks `st` from `sender` (ids and weights match; every id is the sender's to weigh) and
+/// applies it: the weights of this agent's measurements, every id of weight 0 to `zero_cut`.
+/// Throws std::runtime_error naming this agent and the sender.
+void read_weights_message(const RoundStatusMessage& st, std::uint32_t sender,
+                          const GncAgentInput& in, std::vector<double>& weights,
+                          std::vector<std::uint64_t>& zero_cut);
+
+/// The values of the measurements this agent weighs (all, or with `rejected` non-null those not
+/// in it) as agent 0 gathers them: this agent's block to send, or agent 0's own entries.
+PoseBlockMessage owned_values_block(const GncAgentInput& in, const GncLocalTerms& terms,
+                                    const std::vector<std::uint64_t>* rejected,
+                                    std::uint32_t phase);
+void append_owned_values(const GncAgentInput& in, const GncLocalTerms& terms,
+                         const std::vector<std::uint64_t>* rejected, GatheredValues& values);
+
+/// A re-check verdict: ids taken back (weight 1), then ids cut now (weight 0); and back, added
+/// to `into` (no weights: every id taken back). Throws std::runtime_error on a size mismatch.
+RoundStatusMessage readmitted_message(const RecheckVerdict& verdict);
+void read_readmitted_message(const RoundStatusMessage& st, std::uint32_t sender, int receiver,
+                             RecheckVerdict& into);
+
+/// Agent 0's message of another agent's block Y of the kept set's start (poses `ids`).
+PoseBlockMessage kept_start_block(const Eigen::MatrixXd& Y, const std::vector<std::size_t>& ids,
+                                  int d, std::uint32_t phase);
+/// The own block of the kept set's start (r x (d+1)|own|) from agent 0's `block`. Throws
+/// std::runtime_error naming `receiver` when it is not exactly the poses `own` at rank r.
+Eigen::MatrixXd read_kept_start(const PoseBlockMessage& block, const std::vector<std::size_t>& own,
+                                Eigen::Index r, int d, int receiver);
+
+}  // namespace tessera

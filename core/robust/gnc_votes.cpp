@@ -1,0 +1,97 @@
+#include "robust/gnc_votes.hpp"
+
+#include <algorithm>
+#include <iterator>
+
+namespace tessera {
+
+namespace {
+
+bool contains(const std::vector<std::uint64_t>& sorted, std::uint64_t id) {
+  return std::binary_search(sorted.begin(), sorted.end(), id);
+}
+
+}  // namespace
+
+std::pair<double, double> start_vote_costs(const GncLocalTerms& terms, const Eigen::MatrixXd& Y,
+                                           const Eigen::MatrixXd& neighbours,
+                                           const Eigen::MatrixXd& Y_other,
+                                           const Eigen::MatrixXd& other_neighbours) {
+  double at_first = 0, at_second = 0;
+  for (std::size_t k : terms.owned()) {
+    at_first += terms.tls_term(k, terms.residual_squared(k, Y, neighbours));
+    at_second += terms.tls_term(k, terms.residual_squared(k, Y_other, other_neighbours));
+  }
+  return {at_first, at_second};
+}
+
+std::pair<double, double> kept_set_costs(const GncLocalTerms& terms,
+                                         const std::vector<std::uint64_t>& index,
+                                         const std::vector<std::uint64_t>& rejected,
+                                         const Eigen::MatrixXd& Y,
+                                         const Eigen::MatrixXd& neighbours,
+                                         const Eigen::MatrixXd& Y_other,
+                                         const Eigen::MatrixXd& other_neighbours) {
+  double at_first = 0, at_second = 0;
+  for (std::size_t k : terms.owned())
+    if (!contains(rejected, index[k])) {
+      at_first += terms.residual_squared(k, Y, neighbours);
+      at_second += terms.residual_squared(k, Y_other, other_neighbours);
+    }
+  return {at_first, at_second};
+}
+
+double largest_rejectable_residual(const GncLocalTerms& terms, const std::vector<bool>& dropped,
+                                   const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours) {
+  double max_r2 = 0;
+  for (std::size_t k : terms.owned())
+    if (terms.may_reject(k) && !dropped[k])
+      max_r2 = std::max(max_r2, terms.residual_squared(k, Y, neighbours));
+  return max_r2;
+}
+
+double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weights) {
+  double spread = 0;
+  for (std::size_t k : terms.owned()) spread += weights[k] * (1 - weights[k]);
+  return spread;
+}
+
+RecheckVerdict recheck_verdict(const GncLocalTerms& terms, const std::vector<std::uint64_t>& index,
+                               const std::vector<std::uint64_t>& rejected, const Eigen::MatrixXd& Y,
+                               const Eigen::MatrixXd& neighbours) {
+  // A rejected measurement within the bound was misjudged on a rough iterate; a kept one beyond
+  // it is a wrong closure that GNC's iterate fitted with the help of a distortion. Each pass is
+  // a descent step of the TLS cost (binary weights given the poses).
+  RecheckVerdict v;
+  for (std::size_t k : terms.owned()) {
+    if (!terms.may_reject(k)) continue;
+    const std::uint64_t id = index[k];
+    const bool was_rejected = contains(rejected, id);
+    const bool fits = terms.residual_squared(k, Y, neighbours) <= terms.c2();
+    if (was_rejected && fits) v.taken_back.push_back(id);
+    if (!was_rejected && !fits) v.cut_now.push_back(id);
+  }
+  return v;
+}
+
+RecheckCounts apply_recheck(RecheckVerdict& verdict, const std::vector<std::uint64_t>& index,
+                            std::vector<std::uint64_t>& rejected, std::vector<double>& weights) {
+  std::sort(verdict.taken_back.begin(), verdict.taken_back.end());
+  std::sort(verdict.cut_now.begin(), verdict.cut_now.end());
+  for (std::size_t k = 0; k < index.size(); ++k) {
+    if (contains(verdict.taken_back, index[k])) weights[k] = 1.0;
+    if (contains(verdict.cut_now, index[k])) weights[k] = 0.0;
+  }
+  std::vector<std::uint64_t> still;
+  std::set_difference(rejected.begin(), rejected.end(), verdict.taken_back.begin(),
+                      verdict.taken_back.end(), std::back_inserter(still));
+  RecheckCounts counts;
+  counts.readmitted = rejected.size() - still.size();
+  counts.late_rejected = verdict.cut_now.size();
+  rejected.clear();
+  std::merge(still.begin(), still.end(), verdict.cut_now.begin(), verdict.cut_now.end(),
+             std::back_inserter(rejected));
+  return counts;
+}
+
+}  // namespace tessera

@@ -1,0 +1,63 @@
+#pragma once
+// The sums and verdicts one agent computes over its view for GNC's exchanges (GncAgent sends
+// them, GncLocalTerms supplies the per-measurement terms): the start vote's TLS costs at two
+// starts, the kept set's costs at the iterate and a candidate start, the largest residual that
+// may be rejected (mu's start), the weight spread (the stop vote) and the inlier passes'
+// re-check verdict with its effect on the rejected set.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "robust/gnc_local_terms.hpp"
+
+namespace tessera {
+
+/// Sum of the TLS terms of the measurements this agent weighs at two starts (own block,
+/// neighbours' public poses each): (at the first, at the second).
+std::pair<double, double> start_vote_costs(const GncLocalTerms& terms, const Eigen::MatrixXd& Y,
+                                           const Eigen::MatrixXd& neighbours,
+                                           const Eigen::MatrixXd& Y_other,
+                                           const Eigen::MatrixXd& other_neighbours);
+
+/// Sum of the squared residuals of the measurements this agent weighs that are not in
+/// `rejected` (file positions, ascending), at two starts: (at the first, at the second).
+std::pair<double, double> kept_set_costs(const GncLocalTerms& terms,
+                                         const std::vector<std::uint64_t>& index,
+                                         const std::vector<std::uint64_t>& rejected,
+                                         const Eigen::MatrixXd& Y,
+                                         const Eigen::MatrixXd& neighbours,
+                                         const Eigen::MatrixXd& Y_other,
+                                         const Eigen::MatrixXd& other_neighbours);
+
+/// The largest squared residual over the measurements this agent weighs that may be rejected
+/// and are not `dropped` (per measurement of the agent): mu's start is taken from the max.
+double largest_rejectable_residual(const GncLocalTerms& terms, const std::vector<bool>& dropped,
+                                   const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours);
+
+/// sum w (1 - w) over the measurements this agent weighs: the stop vote.
+double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weights);
+
+/// TLS's own verdict at the kept set's solution over the measurements this agent weighs.
+struct RecheckVerdict {
+  std::vector<std::uint64_t> taken_back;  ///< Rejected, within the bound: back in (weight 1).
+  std::vector<std::uint64_t> cut_now;     ///< Kept, beyond the bound: out (weight 0).
+  bool empty() const { return taken_back.empty() && cut_now.empty(); }
+};
+RecheckVerdict recheck_verdict(const GncLocalTerms& terms, const std::vector<std::uint64_t>& index,
+                               const std::vector<std::uint64_t>& rejected, const Eigen::MatrixXd& Y,
+                               const Eigen::MatrixXd& neighbours);
+
+/// How many measurements one re-check moved.
+struct RecheckCounts {
+  std::size_t readmitted = 0;
+  std::size_t late_rejected = 0;
+};
+/// Applies every agent's verdict (gathered in `verdict`; sorted here) to `weights` (per
+/// measurement of `index`) and to `rejected` (ascending, stays so).
+RecheckCounts apply_recheck(RecheckVerdict& verdict, const std::vector<std::uint64_t>& index,
+                            std::vector<std::uint64_t>& rejected, std::vector<double>& weights);
+
+}  // namespace tessera
