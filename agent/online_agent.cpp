@@ -74,7 +74,6 @@ class OnlineAgent {
   void check_losses();
   /// The survivors agree on what was lost, reach the same graph and move the lost blocks.
   void take_over();
-  [[noreturn]] void counted_lost() const;
   SolveOutcome solve(bool certify, bool climb = true);
   /// The round protocol of the epoch's solve, until `agent` is done.
   void solve_rounds(CertifiedAgent& agent, std::uint32_t me);
@@ -137,7 +136,7 @@ void OnlineAgent::pump_channel() {
       // id of an agent whose block was taken over (the votes are kept for late readers).
       if (std::find(r.lost.begin(), r.lost.end(), static_cast<std::uint32_t>(o_.id)) !=
           r.lost.end())
-        counted_lost();
+        throw counted_lost_error(static_cast<std::uint32_t>(o_.id));
       // Votes about losses already taken over are late copies.
       if (std::any_of(r.lost.begin(), r.lost.end(),
                       [&](std::uint32_t a) { return dead_.count(a) == 0; }))
@@ -167,13 +166,6 @@ void OnlineAgent::check_losses() {
   if (!votes_.empty()) throw TakeoverNeeded{};
   for (std::uint32_t a : channel_.lost_agents())
     if (members().count(a) > 0 && a != static_cast<std::uint32_t>(o_.id)) throw TakeoverNeeded{};
-}
-
-[[noreturn]] void OnlineAgent::counted_lost() const {
-  throw transport::TransportError(
-      "online agent " + std::to_string(o_.id) +
-      " was counted as lost by the survivors (its liveliness lapsed): its block was taken over "
-      "and the run goes on without it");
 }
 
 bool OnlineAgent::reports_complete() {

@@ -5,9 +5,15 @@
 #include <utility>
 
 #include "runtime/takeover_agreement.hpp"
-#include "transport/transport_error.hpp"
 
 namespace tessera::agent {
+
+transport::TransportError counted_lost_error(std::uint32_t me) {
+  return transport::TransportError(
+      "online agent " + std::to_string(me) +
+      " was counted as lost by the survivors (its liveliness lapsed): its block was taken over "
+      "and the run goes on without it");
+}
 
 TakeoverVoteOutcome hold_takeover_vote(
     transport::OnlineChannel& channel, const std::set<std::uint32_t>& members, const OwnVote& mine,
@@ -32,11 +38,7 @@ TakeoverVoteOutcome hold_takeover_vote(
     for (auto& v : take_votes()) grew = count(std::move(v)) || grew;
     const auto seen = channel.lost_agents();
     grew = agreement.suspect(std::set<std::uint32_t>(seen.begin(), seen.end())) || grew;
-    if (agreement.counts_me_lost())
-      throw transport::TransportError(
-          "online agent " + std::to_string(mine.me) +
-          " was counted as lost by the survivors (its liveliness lapsed): its block was taken "
-          "over and the run goes on without it");
+    if (agreement.counts_me_lost()) throw counted_lost_error(mine.me);
     return grew;
   };
   read();

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "transport/online_channel.hpp"
+#include "transport/transport_error.hpp"
 
 namespace tessera::agent {
 
@@ -33,6 +34,10 @@ struct TakeoverVoteOutcome {
   std::map<std::uint32_t, transport::OnlineReportSample> votes;  ///< Survivors' latest votes.
   std::size_t bytes_sent = 0;
 };
+
+/// The failure of agent `me` when a take-over vote counts it as lost (its liveliness lapsed
+/// while it was alive, or it started again with the id of an agent taken over).
+transport::TransportError counted_lost_error(std::uint32_t me);
 
 /// Holds the vote among `members`. `take_votes` pumps the channel (and the stream) and returns
 /// the take-over votes that arrived since its last call. Throws transport::TransportError when

@@ -182,11 +182,17 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   if (a.replica_every < 1) throw InputError("option --replica-every: must be >= 1");
   a.coarse_every = static_cast<std::uint32_t>(nonneg("coarse-every", a.coarse_every));
   if (parse_coarse_space(args.get_or("coarse-space", "blocks")) == CoarseSpaceKind::kSmoothed) {
-    CoarseOptions c;  // the core's defaults and ranges
-    c.aggregates = static_cast<int>(nonneg("coarse-aggregates", c.aggregates));
-    c.smoothing_steps = static_cast<int>(nonneg("coarse-smoothing", c.smoothing_steps));
-    if (c.aggregates < 1) throw InputError("option --coarse-aggregates: must be >= 1");
-    if (c.smoothing_steps > 8) throw InputError("option --coarse-smoothing: must be 0..8");
+    CoarseOptions c;  // the core's defaults, and its ranges (validate)
+    auto coarse = [&](const char* flag, int& field) {
+      field = static_cast<int>(nonneg(flag, field));
+      try {
+        c.validate();
+      } catch (const InputError& e) {
+        throw InputError(std::string("option --") + flag + ": " + e.what());
+      }
+    };
+    coarse("coarse-aggregates", c.aggregates);
+    coarse("coarse-smoothing", c.smoothing_steps);
     a.coarse_aggregates = static_cast<std::uint32_t>(c.aggregates);
     a.coarse_smoothing = static_cast<std::uint32_t>(c.smoothing_steps);
   }

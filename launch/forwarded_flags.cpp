@@ -1,8 +1,10 @@
 #include "launch/forwarded_flags.hpp"
 
 #include <cerrno>
+#include <climits>
 #include <cstdlib>
 #include <string>
+#include <tessera/distributed/coarse_correction.hpp>
 #include <tessera/robust/robust_options.hpp>
 #include <tessera/util/input_error.hpp>
 
@@ -10,14 +12,20 @@ namespace tessera::launch {
 
 namespace {
 
-// A number in [lo, hi], else an InputError naming the flag.
-double number_in(const std::string& value, const char* flag, double lo, double hi,
-                 const char* range) {
+// `value` as a number, else an InputError naming the flag.
+double number(const std::string& value, const char* flag) {
   errno = 0;
   char* end = nullptr;
   const double x = std::strtod(value.c_str(), &end);
   if (value.empty() || *end != '\0' || errno != 0)
     throw InputError(std::string("option --") + flag + ": '" + value + "' is not a number");
+  return x;
+}
+
+// A number in [lo, hi], else an InputError naming the flag.
+double number_in(const std::string& value, const char* flag, double lo, double hi,
+                 const char* range) {
+  const double x = number(value, flag);
   if (!(x >= lo && x <= hi))
     throw InputError(std::string("launch: --") + flag + " must be in " + range + " seconds");
   return x;
@@ -42,10 +50,7 @@ void check_refine(const std::string& v) {
 
 // A tolerance >= 0 (0 = the solver's default), else an InputError naming the flag.
 void check_tolerance(const std::string& v, const char* flag) {
-  errno = 0;
-  char* end = nullptr;
-  const double x = std::strtod(v.c_str(), &end);
-  if (v.empty() || *end != '\0' || errno != 0 || !(x >= 0))
+  if (!(number(v, flag) >= 0))
     throw InputError(std::string("option --") + flag + ": '" + v + "' is not a number >= 0");
 }
 void check_refine_grad_tol(const std::string& v) {
@@ -55,27 +60,52 @@ void check_refine_rel_tol(const std::string& v) {
   check_tolerance(v, "refine-rel-tol");
 }
 
-// A whole number in [lo, hi], else an InputError naming the flag.
-void whole_number_in(const std::string& v, const char* flag, long lo, long hi) {
+// `v` as a whole number, else an InputError naming the flag.
+long whole_number(const std::string& v, const char* flag) {
   errno = 0;
   char* end = nullptr;
   const long x = std::strtol(v.c_str(), &end, 10);
-  if (v.empty() || *end != '\0' || errno != 0 || x < lo || x > hi)
+  if (v.empty() || *end != '\0' || errno != 0)
+    throw InputError(std::string("option --") + flag + ": '" + v + "' is not a whole number");
+  return x;
+}
+
+// A whole number in [lo, hi], else an InputError naming the flag.
+void whole_number_in(const std::string& v, const char* flag, long lo, long hi) {
+  const long x = whole_number(v, flag);
+  if (x < lo || x > hi)
     throw InputError(std::string("option --") + flag + ": '" + v + "' is not a whole number in " +
                      std::to_string(lo) + ".." + std::to_string(hi));
 }
 void check_coarse_every(const std::string& v) {
   whole_number_in(v, "coarse-every", 0, 1000000);
 }
+// The coarse space's names and ranges are the core's (parse_coarse_space, CoarseOptions).
 void check_coarse_space(const std::string& v) {
-  if (v != "blocks" && v != "smoothed")
-    throw InputError("option --coarse-space: '" + v + "' is not one of blocks, smoothed");
+  try {
+    parse_coarse_space(v);
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --coarse-space: ") + e.what());
+  }
+}
+template <class Set>
+void check_coarse_field(const std::string& v, const char* flag, Set set) {
+  CoarseOptions o;
+  const long x = whole_number(v, flag);
+  if (x < INT_MIN || x > INT_MAX)
+    throw InputError(std::string("option --") + flag + ": '" + v + "' is out of range");
+  set(o, static_cast<int>(x));
+  try {
+    o.validate();
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --") + flag + ": " + e.what());
+  }
 }
 void check_coarse_aggregates(const std::string& v) {
-  whole_number_in(v, "coarse-aggregates", 1, 1000);
+  check_coarse_field(v, "coarse-aggregates", [](CoarseOptions& o, int x) { o.aggregates = x; });
 }
 void check_coarse_smoothing(const std::string& v) {
-  whole_number_in(v, "coarse-smoothing", 0, 8);
+  check_coarse_field(v, "coarse-smoothing", [](CoarseOptions& o, int x) { o.smoothing_steps = x; });
 }
 
 void check_setup_timeout(const std::string& v) {
@@ -101,7 +131,7 @@ void check_known_inliers(const std::string& v) {
 template <class Set>
 void check_robust_field(const std::string& v, const char* flag, Set set) {
   RobustOptions o;
-  set(o, number_in(v, flag, -1e300, 1e300, ""));
+  set(o, number(v, flag));
   try {
     o.validate();
   } catch (const InputError& e) {
@@ -194,7 +224,7 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "blended across their borders                      [blocks]",
        check_coarse_space},
       {"coarse-aggregates", "coarse-aggregates", true, ForwardTo::kCoordinator,
-       "--coarse-aggregates K", "smoothed: pieces per block, 1..1000                  [4]",
+       "--coarse-aggregates K", "smoothed: pieces per block, >= 1                    [4]",
        check_coarse_aggregates},
       {"coarse-smoothing", "coarse-smoothing", true, ForwardTo::kCoordinator,
        "--coarse-smoothing S", "smoothed: smoothing steps of the blend, 0..8         [1]",

@@ -19,6 +19,7 @@
 
 #include "arguments.hpp"
 #include "launch/launch.hpp"
+#include "launch/launch_loss_policy.hpp"
 #include "transport/run_identity.hpp"
 
 namespace tessera::launch {
@@ -131,10 +132,10 @@ int run_online_launch(const std::vector<std::string>& argv) {
       "online-" + std::to_string(getpid()) + "-" +
           std::to_string(std::chrono::steady_clock::now().time_since_epoch().count() % 1000000));
   transport::validate_run_id(run_id);
-  const std::string on_loss = args.get_or("on-agent-loss", "stop");
-  if (on_loss != "stop" && on_loss != "continue")
-    throw InputError("option --on-agent-loss: '" + on_loss + "' is not one of stop, continue");
-  const bool continue_on_loss = on_loss == "continue";
+  // The flag of the offline launch (its loss options --rejoin-timeout, --replicas and
+  // --replica-every are not options of an online launch).
+  const bool continue_on_loss =
+      parse_launch_loss_options(args).action == AgentLossAction::kContinue;
   const long domain = args.get_long("domain", transport::domain_for_run(run_id));
   if (domain < 0 || domain > transport::kMaxDomain)
     throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));

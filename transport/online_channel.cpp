@@ -80,19 +80,16 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       const bool gone =
           info.status == Info::REMOVED_PARTICIPANT || info.status == Info::DROPPED_PARTICIPANT;
       if (!gone && info.status != Info::DISCOVERED_PARTICIPANT) return;
-      const std::string name = info.info.m_participantName.to_string();
-      const std::string prefix = "tessera-online:" + impl->run_id + ":";
-      if (name.compare(0, prefix.size(), prefix) != 0) return;
-      const std::string id = name.substr(prefix.size());
-      if (id.empty() || id.size() > 9 || id.find_first_not_of("0123456789") != std::string::npos)
-        return;
+      const auto id =
+          parse_online_participant_name(info.info.m_participantName.to_string(), impl->run_id);
+      if (!id) return;
       std::lock_guard<std::mutex> lock(impl->mutex);
       // A participant of that agent discovered again (a process started again, or a live one
       // the lease dropped) is not lost any more.
       if (gone)
-        impl->lost.insert(static_cast<std::uint32_t>(std::stoul(id)));
+        impl->lost.insert(*id);
       else
-        impl->lost.erase(static_cast<std::uint32_t>(std::stoul(id)));
+        impl->lost.erase(*id);
       impl->available = true;
       impl->cv.notify_all();
     }
@@ -102,8 +99,7 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       : run_id(run), agent(me) {
     validate_run_id(run_id);
     dds::DomainParticipantQos pq = dds::PARTICIPANT_QOS_DEFAULT;
-    // Not "tessera:<run>:..." (participant_name): not a Session peer of any run.
-    pq.name("tessera-online:" + run_id + ":" + std::to_string(me));
+    pq.name(online_participant_name(run_id, me));
     // A killed agent's readers stay matched until its participant lease expires, and writes
     // to them wait for acknowledgements meanwhile: Fast DDS's default lease (20 s) would hold
     // the survivors that long before their report wait can name the silent agent.

@@ -29,6 +29,17 @@ int domain_for_run(const std::string& run_id) {
   return 1 + static_cast<int>(h % static_cast<std::uint32_t>(kMaxDomain));
 }
 
+namespace {
+// An agent id as participant names write it: decimal digits only, below kCoordinatorId.
+std::optional<std::uint32_t> parse_agent_id(const std::string& id) {
+  if (id.empty() || id.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  errno = 0;
+  const unsigned long v = std::strtoul(id.c_str(), nullptr, 10);
+  if (errno != 0 || v >= kCoordinatorId) return std::nullopt;
+  return static_cast<std::uint32_t>(v);
+}
+}  // namespace
+
 std::string PeerIdentity::describe() const {
   return coordinator ? std::string("the coordinator") : "agent " + std::to_string(agent_id);
 }
@@ -52,15 +63,22 @@ std::optional<PeerIdentity> parse_participant_name(const std::string& name) {
   }
   auto pos = rest.rfind(":agent:");
   if (pos == std::string::npos) return std::nullopt;
-  std::string id = rest.substr(pos + 7);
-  if (id.empty()) return std::nullopt;
-  errno = 0;
-  char* end = nullptr;
-  unsigned long v = std::strtoul(id.c_str(), &end, 10);
-  if (*end != '\0' || errno != 0 || v > 0xFFFFFFFEul) return std::nullopt;
+  const auto id = parse_agent_id(rest.substr(pos + 7));
+  if (!id) return std::nullopt;
   who.run_id = rest.substr(0, pos);
-  who.agent_id = static_cast<std::uint32_t>(v);
+  who.agent_id = *id;
   return who;
+}
+
+std::string online_participant_name(const std::string& run_id, std::uint32_t agent) {
+  return "tessera-online:" + run_id + ":" + std::to_string(agent);
+}
+
+std::optional<std::uint32_t> parse_online_participant_name(const std::string& name,
+                                                           const std::string& run_id) {
+  const std::string prefix = "tessera-online:" + run_id + ":";
+  if (name.compare(0, prefix.size(), prefix) != 0) return std::nullopt;
+  return parse_agent_id(name.substr(prefix.size()));
 }
 
 std::string host_name() {

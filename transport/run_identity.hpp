@@ -38,6 +38,13 @@ std::string participant_name(const PeerIdentity& who);
 /// The inverse of participant_name; nullopt for names not made by it (other software).
 std::optional<PeerIdentity> parse_participant_name(const std::string& name);
 
+/// "tessera-online:<run>:<k>": agent k's participant of an online run (OnlineChannel). Not
+/// parse_participant_name's form: an online agent is no Session peer of any run.
+std::string online_participant_name(const std::string& run_id, std::uint32_t agent);
+/// The agent id of an online_participant_name of run `run_id`; nullopt for any other name.
+std::optional<std::uint32_t> parse_online_participant_name(const std::string& name,
+                                                           const std::string& run_id);
+
 /// This machine's host name (for announcements and messages).
 std::string host_name();
 
