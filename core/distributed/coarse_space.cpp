@@ -295,12 +295,8 @@ std::vector<double> SmoothedCoarseTerms::compute(const Eigen::MatrixXd& X,
     const double sk = std::sqrt(e.kappa), st = std::sqrt(e.tau);
     // The residual after the blend is sum_alpha Z_alpha (w_j,alpha A - w_i,alpha B), with A, B
     // as in CoarseTerms (target j, transported source i).
-    A.topLeftCorner(r, d_) = sk * Pj.leftCols(d_);
-    A.col(d_).head(r) = st * Pj.col(d_);
-    A(r, d_) = st;
-    B.topLeftCorner(r, d_) = sk * (Pi.leftCols(d_) * e.R);
-    B.col(d_).head(r) = st * (Pi.col(d_) + Pi.leftCols(d_) * e.t);
-    B(r, d_) = st;
+    lift_target(A, Pj, d_, sk, st);
+    lift_source(B, Pi, e.R, e.t, d_, sk, st);
     support.clear();
     C.clear();
     const std::size_t i0 = space_.weight_start[e.i], i1 = space_.weight_start[e.i + 1];
@@ -325,14 +321,8 @@ std::vector<double> SmoothedCoarseTerms::compute(const Eigen::MatrixXd& X,
         Q[static_cast<std::size_t>(it - pair_begin)].noalias() += C[p] * C[q].transpose();
       }
   }
-  std::vector<int> rows;
   double mask = 0.0;
-  for (int k = 0; k < r; ++k)
-    if ((X.row(k).array() != 0.0).any() || (Xn.cols() > 0 && (Xn.row(k).array() != 0.0).any())) {
-      rows.push_back(k);
-      mask += std::ldexp(1.0, k);
-    }
-  rows.push_back(r);
+  const std::vector<int> rows = coarse_rows_in_use(X, Xn, mask);
   const std::size_t m = rows.size();
   std::vector<double> out;
   out.reserve(1 + count * m * m);
@@ -378,16 +368,10 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
     for (std::size_t k = p0; k < p1; ++k) {
       const auto [alpha, beta] = space.pairs[k];
       if (alpha == beta) {
-        Mat& D = Q.diag[static_cast<std::size_t>(alpha)];
-        for (std::size_t j = 0; j < m; ++j)
-          for (std::size_t i = 0; i <= j; ++i, ++at) {
-            D(rows[i], rows[j]) += t[at];
-            if (i != j) D(rows[j], rows[i]) += t[at];
-          }
+        add_packed_block(t, at, rows, true, Q.diag[static_cast<std::size_t>(alpha)]);
       } else {
         Mat M = Mat::Zero(s, s);
-        for (std::size_t j = 0; j < m; ++j)
-          for (std::size_t i = 0; i < m; ++i, ++at) M(rows[i], rows[j]) = t[at];
+        add_packed_block(t, at, rows, false, M);
         auto& ab = Q.off[static_cast<std::size_t>(alpha)][beta];
         if (ab.size() == 0) ab = Mat::Zero(s, s);
         ab += M;
