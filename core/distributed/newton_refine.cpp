@@ -6,6 +6,8 @@
 #include <tessera/problem/pose_kernels.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "distributed/used_rows.hpp"
+
 namespace tessera {
 
 void NewtonRefineOptions::validate() const {
@@ -29,14 +31,11 @@ double dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a.array() * b.array()).sum();
 }
 
-// The rows of X and of Y that are non-zero somewhere.
+// 1 for each row of X or Y that is non-zero somewhere, 0 for the others: summed over the agents,
+// the rows in use anywhere.
 std::vector<double> row_indicators(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) {
   std::vector<double> used(static_cast<std::size_t>(X.rows()), 0.0);
-  for (Eigen::Index k = 0; k < X.rows(); ++k) {
-    const bool nz =
-        (X.row(k).array() != 0.0).any() || (Y.cols() > 0 && (Y.row(k).array() != 0.0).any());
-    used[static_cast<std::size_t>(k)] = nz ? 1.0 : 0.0;
-  }
+  for (int k : used_rows(X, Y)) used[static_cast<std::size_t>(k)] = 1.0;
   return used;
 }
 
