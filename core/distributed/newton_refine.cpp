@@ -45,12 +45,8 @@ NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout&
                                            const NewtonRefineOptions& options)
     : state_(state), layout_(layout), options_(options), problem_(state.problem()) {
   options_.validate();
-}
-
-std::vector<int> NewtonRefineProtocol::everyone() const {
-  std::vector<int> all(static_cast<std::size_t>(layout_.num_blocks));
-  for (int b = 0; b < layout_.num_blocks; ++b) all[static_cast<std::size_t>(b)] = b;
-  return all;
+  everyone_.resize(static_cast<std::size_t>(layout_.num_blocks));
+  for (int b = 0; b < layout_.num_blocks; ++b) everyone_[static_cast<std::size_t>(b)] = b;
 }
 
 void NewtonRefineProtocol::send_public(const Eigen::MatrixXd& v, std::uint32_t step,
@@ -75,16 +71,16 @@ void NewtonRefineProtocol::broadcast(std::uint32_t step, const std::vector<doubl
   o.message = std::move(m);
   o.broadcast = true;
   out.push_back(std::move(o));
-  gate_.expect(message_round_, step, everyone());
+  gate_.expect(message_round_, step, everyone_);
   ++result_.reductions;
 }
 
-Eigen::MatrixXd NewtonRefineProtocol::neighbours_of(const MessageGate::Inbox& inbox) const {
-  Eigen::MatrixXd vn = Eigen::MatrixXd::Zero(
-      static_cast<Eigen::Index>(rows_.size()),
-      (problem_.dim() + 1) * static_cast<Eigen::Index>(problem_.num_neighbors()));
+void NewtonRefineProtocol::neighbours_into(const MessageGate::Inbox& inbox,
+                                           Eigen::MatrixXd& vn) const {
+  // setZero(rows, cols) keeps the storage of a buffer that has the size already (every CG step).
+  vn.setZero(static_cast<Eigen::Index>(rows_.size()),
+             (problem_.dim() + 1) * static_cast<Eigen::Index>(problem_.num_neighbors()));
   for (const auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), vn);
-  return vn;
 }
 
 double NewtonRefineProtocol::evaluate_point() {
@@ -210,7 +206,8 @@ void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
 
 void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
-  w_ = hessian(z_, neighbours_of(inbox));
+  neighbours_into(inbox, zn_);
+  w_ = hessian(z_, zn_);
   broadcast(kSums, {dot(r_, z_), dot(z_, w_), r_.squaredNorm()}, out);
 }
 
@@ -288,7 +285,7 @@ void NewtonRefineProtocol::try_step(const std::string& cg_stop, std::vector<Outg
 
 void NewtonRefineProtocol::after_trial(const MessageGate::Inbox& inbox,
                                        std::vector<OutgoingMessage>& out) {
-  Xtn_ = neighbours_of(inbox);
+  neighbours_into(inbox, Xtn_);
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(Xtn_);
   double share = 0.0;
   problem_.cost(Xt_, &share);
