@@ -11,7 +11,7 @@
 #include <unordered_map>
 
 #include "distributed/coarse_problem.hpp"
-#include "distributed/used_rows.hpp"
+#include "distributed/nonzero_rows.hpp"
 
 namespace tessera {
 
@@ -160,9 +160,12 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
 
 std::vector<int> coarse_rows_in_use(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
                                     double& mask) {
-  std::vector<int> rows = used_rows(X, Xn);
+  std::vector<int> rows;
   mask = 0.0;
-  for (int k : rows) mask += std::ldexp(1.0, k);
+  for (Eigen::Index k : nonzero_rows(X, Xn)) {
+    rows.push_back(static_cast<int>(k));
+    mask += std::ldexp(1.0, static_cast<int>(k));
+  }
   rows.push_back(static_cast<int>(X.rows()));
   return rows;
 }

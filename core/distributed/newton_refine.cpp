@@ -6,7 +6,7 @@
 #include <tessera/problem/pose_kernels.hpp>
 #include <tessera/util/input_error.hpp>
 
-#include "distributed/used_rows.hpp"
+#include "distributed/nonzero_rows.hpp"
 
 namespace tessera {
 
@@ -35,7 +35,7 @@ double dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
 // the rows in use anywhere.
 std::vector<double> row_indicators(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) {
   std::vector<double> used(static_cast<std::size_t>(X.rows()), 0.0);
-  for (int k : used_rows(X, Y)) used[static_cast<std::size_t>(k)] = 1.0;
+  for (Eigen::Index k : nonzero_rows(X, Y)) used[static_cast<std::size_t>(k)] = 1.0;
   return used;
 }
 
