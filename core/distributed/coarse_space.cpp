@@ -145,15 +145,6 @@ std::vector<Weights> smooth_weights(const CoarseSpace& s, const Adjacency& all, 
   return w;
 }
 
-template <class Edge>
-std::pair<std::uint32_t, std::uint32_t> ends(const Edge& e) {
-  return {e.first, e.second};
-}
-template <>
-std::pair<std::uint32_t, std::uint32_t> ends(const Measurement& m) {
-  return {static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j)};
-}
-
 }  // namespace
 
 bool CoarseSpace::sums_edge(int agent, std::size_t i, std::size_t j) const {
@@ -233,7 +224,8 @@ CoarseSpace make_coarse_space(std::size_t num_poses, const std::vector<Measureme
                               const std::vector<int>& assignment, const CoarseOptions& options) {
   Edges edges;
   edges.reserve(measurements.size());
-  for (const Measurement& m : measurements) edges.push_back(ends(m));
+  for (const Measurement& m : measurements)
+    edges.emplace_back(static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j));
   return make_coarse_space(num_poses, edges, assignment, options);
 }
 
