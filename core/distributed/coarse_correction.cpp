@@ -95,11 +95,8 @@ std::vector<double> CoarseTerms::compute(const Eigen::MatrixXd& X,
   std::vector<double> out;
   out.reserve(1 + m * (m + 1) / 2 + m * m * Qab.size());
   out.push_back(mask);
-  for (std::size_t j = 0; j < m; ++j)
-    for (std::size_t i = 0; i <= j; ++i) out.push_back(Qaa(rows[i], rows[j]));
-  for (const auto& Q : Qab)
-    for (std::size_t j = 0; j < m; ++j)
-      for (std::size_t i = 0; i < m; ++i) out.push_back(Q(rows[i], rows[j]));
+  append_packed_block(Qaa, rows, true, out);
+  for (const auto& Q : Qab) append_packed_block(Q, rows, false, out);
   return out;
 }
 
@@ -168,6 +165,13 @@ std::vector<int> coarse_rows_in_use(const Eigen::MatrixXd& X, const Eigen::Matri
   }
   rows.push_back(static_cast<int>(X.rows()));
   return rows;
+}
+
+void append_packed_block(const Eigen::MatrixXd& M, const std::vector<int>& rows, bool symmetric,
+                         std::vector<double>& out) {
+  const std::size_t m = rows.size();
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t i = 0; i < (symmetric ? j + 1 : m); ++i) out.push_back(M(rows[i], rows[j]));
 }
 
 void add_packed_block(const std::vector<double>& t, std::size_t& at, const std::vector<int>& rows,

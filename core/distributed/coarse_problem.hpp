@@ -30,6 +30,10 @@ std::vector<int> coarse_term_rows(const std::vector<double>& terms, int r, int a
 std::vector<int> coarse_rows_in_use(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
                                     double& mask);
 
+/// Appends M's entries at (rows[i], rows[j]) to `out` in the order add_packed_block reads them.
+void append_packed_block(const Eigen::MatrixXd& M, const std::vector<int>& rows, bool symmetric,
+                         std::vector<double>& out);
+
 /// Adds the values t[at], t[at+1], ... to M at (rows[i], rows[j]): the upper triangle column by
 /// column, mirrored (`symmetric`), or the whole rows x rows block column by column. Leaves `at`
 /// after the last value read.

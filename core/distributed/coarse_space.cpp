@@ -322,9 +322,7 @@ std::vector<double> SmoothedCoarseTerms::compute(const Eigen::MatrixXd& X,
   for (std::size_t k = 0; k < count; ++k) {
     const bool diagonal = pair_begin[static_cast<std::ptrdiff_t>(k)].first ==
                           pair_begin[static_cast<std::ptrdiff_t>(k)].second;
-    for (std::size_t j = 0; j < m; ++j)
-      for (std::size_t i = 0; i < (diagonal ? j + 1 : m); ++i)
-        out.push_back(Q[k](rows[i], rows[j]));
+    append_packed_block(Q[k], rows, diagonal, out);
   }
   return out;
 }
