@@ -121,9 +121,7 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
                           const CoarseOptions& options) {
   const int N = layout.num_blocks;
   const int s = r + 1;
-  if (terms.size() != static_cast<std::size_t>(N))
-    throw std::runtime_error("coarse correction: " + std::to_string(terms.size()) +
-                             " term vectors for " + std::to_string(N) + " blocks");
+  check_coarse_term_vectors(terms.size(), N);
   // Q_c in full (r+1) blocks from the agents' compact terms.
   CoarseMatrix Q;
   Q.diag.assign(static_cast<std::size_t>(N), Mat::Zero(s, s));
@@ -131,17 +129,12 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
   for (int a = 0; a < N; ++a) {
     const std::vector<double>& t = *terms[static_cast<std::size_t>(a)];
     const std::vector<int> rows = coarse_term_rows(t, r, a);
-    auto bad = [&](const std::string& why) {
-      return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(a) +
-                                ": " + why);
-    };
     const std::size_t m = rows.size();
     std::vector<int> upper;
     for (int b : layout.adjacent[static_cast<std::size_t>(a)])
       if (b > a) upper.push_back(b);
     const std::size_t expected = 1 + m * (m + 1) / 2 + m * m * upper.size();
-    if (t.size() != expected)
-      throw bad(std::to_string(t.size()) + " values, expected " + std::to_string(expected));
+    check_coarse_term_size(t, expected, a);
     std::size_t at = 1;
     add_packed_block(t, at, rows, true, Q.diag[static_cast<std::size_t>(a)]);
     for (int b : upper) {
@@ -184,11 +177,29 @@ void add_packed_block(const std::vector<double>& t, std::size_t& at, const std::
     }
 }
 
+namespace {
+
+std::runtime_error malformed_terms(int agent, const std::string& why) {
+  return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(agent) +
+                            ": " + why);
+}
+
+}  // namespace
+
+void check_coarse_term_vectors(std::size_t vectors, int blocks) {
+  if (vectors != static_cast<std::size_t>(blocks))
+    throw std::runtime_error("coarse correction: " + std::to_string(vectors) +
+                             " term vectors for " + std::to_string(blocks) + " blocks");
+}
+
+void check_coarse_term_size(const std::vector<double>& terms, std::size_t expected, int agent) {
+  if (terms.size() != expected)
+    throw malformed_terms(
+        agent, std::to_string(terms.size()) + " values, expected " + std::to_string(expected));
+}
+
 std::vector<int> coarse_term_rows(const std::vector<double>& terms, int r, int agent) {
-  auto bad = [&](const std::string& why) {
-    return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(agent) +
-                              ": " + why);
-  };
+  auto bad = [&](const std::string& why) { return malformed_terms(agent, why); };
   if (terms.empty()) throw bad("none");
   const double mask = terms[0];
   if (!(mask >= 0 && mask < std::ldexp(1.0, r)) || std::floor(mask) != mask)

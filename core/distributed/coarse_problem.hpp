@@ -18,6 +18,14 @@ struct CoarseMatrix {
   std::vector<std::map<int, Eigen::MatrixXd>> off;
 };
 
+/// Throws runtime_error ("coarse correction: ... term vectors for ... blocks") unless there is
+/// one term vector per block.
+void check_coarse_term_vectors(std::size_t vectors, int blocks);
+
+/// Throws runtime_error ("malformed message: coarse terms of agent ...: ... values, expected
+/// ...") when agent's terms do not hold `expected` values.
+void check_coarse_term_size(const std::vector<double>& terms, std::size_t expected, int agent);
+
 /// The rows of the lifted space an agent's coarse terms use, read from their first entry (a
 /// bit mask over the r rows), with the translation row r appended. Throws runtime_error
 /// ("malformed message: coarse terms of agent ...") on an empty vector or a mask that is not

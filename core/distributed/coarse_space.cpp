@@ -332,9 +332,7 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
                                    const CoarseOptions& options) {
   const int N = space.num_blocks;
   const int s = r + 1;
-  if (terms.size() != static_cast<std::size_t>(N))
-    throw std::runtime_error("coarse correction: " + std::to_string(terms.size()) +
-                             " term vectors for " + std::to_string(N) + " blocks");
+  check_coarse_term_vectors(terms.size(), N);
   CoarseMatrix Q;
   Q.diag.assign(static_cast<std::size_t>(space.num_aggregates), Mat::Zero(s, s));
   Q.off.resize(static_cast<std::size_t>(space.num_aggregates));
@@ -342,18 +340,13 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
   for (int a = 0; a < N; ++a) {
     const std::vector<double>& t = *terms[static_cast<std::size_t>(a)];
     const std::vector<int> rows = coarse_term_rows(t, r, a);
-    auto bad = [&](const std::string& why) {
-      return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(a) +
-                                ": " + why);
-    };
     const std::size_t m = rows.size();
     const std::size_t p0 = space.pair_start[static_cast<std::size_t>(a)];
     const std::size_t p1 = space.pair_start[static_cast<std::size_t>(a) + 1];
     std::size_t expected = 1;
     for (std::size_t k = p0; k < p1; ++k)
       expected += space.pairs[k].first == space.pairs[k].second ? m * (m + 1) / 2 : m * m;
-    if (t.size() != expected)
-      throw bad(std::to_string(t.size()) + " values, expected " + std::to_string(expected));
+    check_coarse_term_size(t, expected, a);
     std::size_t at = 1;
     for (std::size_t k = p0; k < p1; ++k) {
       const auto [alpha, beta] = space.pairs[k];
