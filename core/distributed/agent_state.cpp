@@ -6,25 +6,10 @@
 #include <tessera/distributed/agent_state.hpp>
 #include <utility>
 
+#include "distributed/nonzero_rows.hpp"
 #include "distributed/pose_block_codec.hpp"
 
 namespace tessera {
-
-namespace {
-
-// The rows of X (and of `also`, when it has entries) that are non-zero somewhere: the rows a
-// lifted point actually uses.
-std::vector<Eigen::Index> nonzero_rows(const Eigen::MatrixXd& X, const Eigen::MatrixXd& also) {
-  Eigen::Array<bool, Eigen::Dynamic, 1> nonzero = (X.array() != 0.0).rowwise().any();
-  if (also.size() > 0) nonzero = nonzero || (also.array() != 0.0).rowwise().any();
-  std::vector<Eigen::Index> rows;
-  rows.reserve(static_cast<std::size_t>(X.rows()));
-  for (Eigen::Index k = 0; k < X.rows(); ++k)
-    if (nonzero(k)) rows.push_back(k);
-  return rows;
-}
-
-}  // namespace
 
 AgentState::AgentState(int id, int d, const BlockLayout& layout,
                        const std::vector<Measurement>& measurements, const Eigen::MatrixXd& Y0,

@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "distributed/coarse_problem.hpp"
+#include "distributed/nonzero_rows.hpp"
 
 namespace tessera {
 
@@ -74,50 +75,28 @@ std::vector<double> CoarseTerms::compute(const Eigen::MatrixXd& X,
   std::vector<Eigen::MatrixXd> Qab(static_cast<std::size_t>(num_upper_),
                                    Eigen::MatrixXd::Zero(s, s));
   Eigen::MatrixXd U = Eigen::MatrixXd::Zero(s, w), W = Eigen::MatrixXd::Zero(s, w);
-  auto target = [&](Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::MatrixXd>& P, double sk,
-                    double st) {
-    M.topLeftCorner(r, d_) = sk * P.leftCols(d_);
-    M.col(d_).head(r) = st * P.col(d_);
-    M(r, d_) = st;
-  };
-  auto source = [&](Eigen::MatrixXd& M, const Eigen::Ref<const Eigen::MatrixXd>& P, const Edge& e,
-                    double sk, double st) {
-    M.topLeftCorner(r, d_) = sk * (P.leftCols(d_) * e.R);
-    M.col(d_).head(r) = st * (P.col(d_) + P.leftCols(d_) * e.t);
-    M(r, d_) = st;
-  };
   for (const Edge& e : edges_) {
     const auto Po = X.middleCols(static_cast<Eigen::Index>(w * e.own_slot), w);
     const auto Pn = Xn.middleCols(static_cast<Eigen::Index>(w * e.neighbour_slot), w);
     const double sk = std::sqrt(e.kappa), st = std::sqrt(e.tau);
     if (e.own_is_source) {
-      source(U, Po, e, sk, st);
-      target(W, Pn, sk, st);
+      lift_source(U, Po, e.R, e.t, d_, sk, st);
+      lift_target(W, Pn, d_, sk, st);
     } else {
-      target(U, Po, sk, st);
-      source(W, Pn, e, sk, st);
+      lift_target(U, Po, d_, sk, st);
+      lift_source(W, Pn, e.R, e.t, d_, sk, st);
     }
     Qaa.noalias() += U * U.transpose();
     if (e.upper >= 0) Qab[static_cast<std::size_t>(e.upper)].noalias() -= U * W.transpose();
   }
-  // Rows this agent's poses use: the others' entries are exact zeros and are not sent.
-  std::vector<int> rows;
   double mask = 0.0;
-  for (int k = 0; k < r; ++k)
-    if ((X.row(k).array() != 0.0).any() || (Xn.cols() > 0 && (Xn.row(k).array() != 0.0).any())) {
-      rows.push_back(k);
-      mask += std::ldexp(1.0, k);
-    }
-  rows.push_back(r);
+  const std::vector<int> rows = coarse_rows_in_use(X, Xn, mask);
   const std::size_t m = rows.size();
   std::vector<double> out;
   out.reserve(1 + m * (m + 1) / 2 + m * m * Qab.size());
   out.push_back(mask);
-  for (std::size_t j = 0; j < m; ++j)
-    for (std::size_t i = 0; i <= j; ++i) out.push_back(Qaa(rows[i], rows[j]));
-  for (const auto& Q : Qab)
-    for (std::size_t j = 0; j < m; ++j)
-      for (std::size_t i = 0; i < m; ++i) out.push_back(Q(rows[i], rows[j]));
+  append_packed_block(Qaa, rows, true, out);
+  for (const auto& Q : Qab) append_packed_block(Q, rows, false, out);
   return out;
 }
 
@@ -142,9 +121,7 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
                           const CoarseOptions& options) {
   const int N = layout.num_blocks;
   const int s = r + 1;
-  if (terms.size() != static_cast<std::size_t>(N))
-    throw std::runtime_error("coarse correction: " + std::to_string(terms.size()) +
-                             " term vectors for " + std::to_string(N) + " blocks");
+  check_coarse_term_vectors(terms.size(), N);
   // Q_c in full (r+1) blocks from the agents' compact terms.
   CoarseMatrix Q;
   Q.diag.assign(static_cast<std::size_t>(N), Mat::Zero(s, s));
@@ -152,28 +129,17 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
   for (int a = 0; a < N; ++a) {
     const std::vector<double>& t = *terms[static_cast<std::size_t>(a)];
     const std::vector<int> rows = coarse_term_rows(t, r, a);
-    auto bad = [&](const std::string& why) {
-      return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(a) +
-                                ": " + why);
-    };
     const std::size_t m = rows.size();
     std::vector<int> upper;
     for (int b : layout.adjacent[static_cast<std::size_t>(a)])
       if (b > a) upper.push_back(b);
     const std::size_t expected = 1 + m * (m + 1) / 2 + m * m * upper.size();
-    if (t.size() != expected)
-      throw bad(std::to_string(t.size()) + " values, expected " + std::to_string(expected));
+    check_coarse_term_size(t, expected, a);
     std::size_t at = 1;
-    Mat& D = Q.diag[static_cast<std::size_t>(a)];
-    for (std::size_t j = 0; j < m; ++j)
-      for (std::size_t i = 0; i <= j; ++i, ++at) {
-        D(rows[i], rows[j]) = t[at];
-        D(rows[j], rows[i]) = t[at];
-      }
+    add_packed_block(t, at, rows, true, Q.diag[static_cast<std::size_t>(a)]);
     for (int b : upper) {
       Mat M = Mat::Zero(s, s);
-      for (std::size_t j = 0; j < m; ++j)
-        for (std::size_t i = 0; i < m; ++i, ++at) M(rows[i], rows[j]) = t[at];
+      add_packed_block(t, at, rows, false, M);
       Q.off[static_cast<std::size_t>(b)][a] = M.transpose();
       Q.off[static_cast<std::size_t>(a)][b] = std::move(M);
     }
@@ -182,11 +148,58 @@ CoarseResult solve_coarse(const BlockLayout& layout, int r,
   return solve_coarse_matrix(std::move(Q), r, options);
 }
 
+std::vector<int> coarse_rows_in_use(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
+                                    double& mask) {
+  std::vector<int> rows;
+  mask = 0.0;
+  for (Eigen::Index k : nonzero_rows(X, Xn)) {
+    rows.push_back(static_cast<int>(k));
+    mask += std::ldexp(1.0, static_cast<int>(k));
+  }
+  rows.push_back(static_cast<int>(X.rows()));
+  return rows;
+}
+
+void append_packed_block(const Eigen::MatrixXd& M, const std::vector<int>& rows, bool symmetric,
+                         std::vector<double>& out) {
+  const std::size_t m = rows.size();
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t i = 0; i < (symmetric ? j + 1 : m); ++i) out.push_back(M(rows[i], rows[j]));
+}
+
+void add_packed_block(const std::vector<double>& t, std::size_t& at, const std::vector<int>& rows,
+                      bool symmetric, Eigen::MatrixXd& M) {
+  const std::size_t m = rows.size();
+  for (std::size_t j = 0; j < m; ++j)
+    for (std::size_t i = 0; i < (symmetric ? j + 1 : m); ++i, ++at) {
+      M(rows[i], rows[j]) += t[at];
+      if (symmetric && i != j) M(rows[j], rows[i]) += t[at];
+    }
+}
+
+namespace {
+
+std::runtime_error malformed_terms(int agent, const std::string& why) {
+  return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(agent) +
+                            ": " + why);
+}
+
+}  // namespace
+
+void check_coarse_term_vectors(std::size_t vectors, int blocks) {
+  if (vectors != static_cast<std::size_t>(blocks))
+    throw std::runtime_error("coarse correction: " + std::to_string(vectors) +
+                             " term vectors for " + std::to_string(blocks) + " blocks");
+}
+
+void check_coarse_term_size(const std::vector<double>& terms, std::size_t expected, int agent) {
+  if (terms.size() != expected)
+    throw malformed_terms(
+        agent, std::to_string(terms.size()) + " values, expected " + std::to_string(expected));
+}
+
 std::vector<int> coarse_term_rows(const std::vector<double>& terms, int r, int agent) {
-  auto bad = [&](const std::string& why) {
-    return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(agent) +
-                              ": " + why);
-  };
+  auto bad = [&](const std::string& why) { return malformed_terms(agent, why); };
   if (terms.empty()) throw bad("none");
   const double mask = terms[0];
   if (!(mask >= 0 && mask < std::ldexp(1.0, r)) || std::floor(mask) != mask)

@@ -145,15 +145,6 @@ std::vector<Weights> smooth_weights(const CoarseSpace& s, const Adjacency& all, 
   return w;
 }
 
-template <class Edge>
-std::pair<std::uint32_t, std::uint32_t> ends(const Edge& e) {
-  return {e.first, e.second};
-}
-template <>
-std::pair<std::uint32_t, std::uint32_t> ends(const Measurement& m) {
-  return {static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j)};
-}
-
 }  // namespace
 
 bool CoarseSpace::sums_edge(int agent, std::size_t i, std::size_t j) const {
@@ -233,7 +224,8 @@ CoarseSpace make_coarse_space(std::size_t num_poses, const std::vector<Measureme
                               const std::vector<int>& assignment, const CoarseOptions& options) {
   Edges edges;
   edges.reserve(measurements.size());
-  for (const Measurement& m : measurements) edges.push_back(ends(m));
+  for (const Measurement& m : measurements)
+    edges.emplace_back(static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j));
   return make_coarse_space(num_poses, edges, assignment, options);
 }
 
@@ -295,12 +287,8 @@ std::vector<double> SmoothedCoarseTerms::compute(const Eigen::MatrixXd& X,
     const double sk = std::sqrt(e.kappa), st = std::sqrt(e.tau);
     // The residual after the blend is sum_alpha Z_alpha (w_j,alpha A - w_i,alpha B), with A, B
     // as in CoarseTerms (target j, transported source i).
-    A.topLeftCorner(r, d_) = sk * Pj.leftCols(d_);
-    A.col(d_).head(r) = st * Pj.col(d_);
-    A(r, d_) = st;
-    B.topLeftCorner(r, d_) = sk * (Pi.leftCols(d_) * e.R);
-    B.col(d_).head(r) = st * (Pi.col(d_) + Pi.leftCols(d_) * e.t);
-    B(r, d_) = st;
+    lift_target(A, Pj, d_, sk, st);
+    lift_source(B, Pi, e.R, e.t, d_, sk, st);
     support.clear();
     C.clear();
     const std::size_t i0 = space_.weight_start[e.i], i1 = space_.weight_start[e.i + 1];
@@ -325,14 +313,8 @@ std::vector<double> SmoothedCoarseTerms::compute(const Eigen::MatrixXd& X,
         Q[static_cast<std::size_t>(it - pair_begin)].noalias() += C[p] * C[q].transpose();
       }
   }
-  std::vector<int> rows;
   double mask = 0.0;
-  for (int k = 0; k < r; ++k)
-    if ((X.row(k).array() != 0.0).any() || (Xn.cols() > 0 && (Xn.row(k).array() != 0.0).any())) {
-      rows.push_back(k);
-      mask += std::ldexp(1.0, k);
-    }
-  rows.push_back(r);
+  const std::vector<int> rows = coarse_rows_in_use(X, Xn, mask);
   const std::size_t m = rows.size();
   std::vector<double> out;
   out.reserve(1 + count * m * m);
@@ -340,9 +322,7 @@ std::vector<double> SmoothedCoarseTerms::compute(const Eigen::MatrixXd& X,
   for (std::size_t k = 0; k < count; ++k) {
     const bool diagonal = pair_begin[static_cast<std::ptrdiff_t>(k)].first ==
                           pair_begin[static_cast<std::ptrdiff_t>(k)].second;
-    for (std::size_t j = 0; j < m; ++j)
-      for (std::size_t i = 0; i < (diagonal ? j + 1 : m); ++i)
-        out.push_back(Q[k](rows[i], rows[j]));
+    append_packed_block(Q[k], rows, diagonal, out);
   }
   return out;
 }
@@ -352,9 +332,7 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
                                    const CoarseOptions& options) {
   const int N = space.num_blocks;
   const int s = r + 1;
-  if (terms.size() != static_cast<std::size_t>(N))
-    throw std::runtime_error("coarse correction: " + std::to_string(terms.size()) +
-                             " term vectors for " + std::to_string(N) + " blocks");
+  check_coarse_term_vectors(terms.size(), N);
   CoarseMatrix Q;
   Q.diag.assign(static_cast<std::size_t>(space.num_aggregates), Mat::Zero(s, s));
   Q.off.resize(static_cast<std::size_t>(space.num_aggregates));
@@ -362,32 +340,21 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
   for (int a = 0; a < N; ++a) {
     const std::vector<double>& t = *terms[static_cast<std::size_t>(a)];
     const std::vector<int> rows = coarse_term_rows(t, r, a);
-    auto bad = [&](const std::string& why) {
-      return std::runtime_error("malformed message: coarse terms of agent " + std::to_string(a) +
-                                ": " + why);
-    };
     const std::size_t m = rows.size();
     const std::size_t p0 = space.pair_start[static_cast<std::size_t>(a)];
     const std::size_t p1 = space.pair_start[static_cast<std::size_t>(a) + 1];
     std::size_t expected = 1;
     for (std::size_t k = p0; k < p1; ++k)
       expected += space.pairs[k].first == space.pairs[k].second ? m * (m + 1) / 2 : m * m;
-    if (t.size() != expected)
-      throw bad(std::to_string(t.size()) + " values, expected " + std::to_string(expected));
+    check_coarse_term_size(t, expected, a);
     std::size_t at = 1;
     for (std::size_t k = p0; k < p1; ++k) {
       const auto [alpha, beta] = space.pairs[k];
       if (alpha == beta) {
-        Mat& D = Q.diag[static_cast<std::size_t>(alpha)];
-        for (std::size_t j = 0; j < m; ++j)
-          for (std::size_t i = 0; i <= j; ++i, ++at) {
-            D(rows[i], rows[j]) += t[at];
-            if (i != j) D(rows[j], rows[i]) += t[at];
-          }
+        add_packed_block(t, at, rows, true, Q.diag[static_cast<std::size_t>(alpha)]);
       } else {
         Mat M = Mat::Zero(s, s);
-        for (std::size_t j = 0; j < m; ++j)
-          for (std::size_t i = 0; i < m; ++i, ++at) M(rows[i], rows[j]) = t[at];
+        add_packed_block(t, at, rows, false, M);
         auto& ab = Q.off[static_cast<std::size_t>(alpha)][beta];
         if (ab.size() == 0) ab = Mat::Zero(s, s);
         ab += M;

@@ -6,6 +6,8 @@
 #include <tessera/problem/pose_kernels.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "distributed/nonzero_rows.hpp"
+
 namespace tessera {
 
 void NewtonRefineOptions::validate() const {
@@ -29,14 +31,11 @@ double dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a.array() * b.array()).sum();
 }
 
-// The rows of X and of Y that are non-zero somewhere.
+// 1 for each row of X or Y that is non-zero somewhere, 0 for the others: summed over the agents,
+// the rows in use anywhere.
 std::vector<double> row_indicators(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) {
   std::vector<double> used(static_cast<std::size_t>(X.rows()), 0.0);
-  for (Eigen::Index k = 0; k < X.rows(); ++k) {
-    const bool nz =
-        (X.row(k).array() != 0.0).any() || (Y.cols() > 0 && (Y.row(k).array() != 0.0).any());
-    used[static_cast<std::size_t>(k)] = nz ? 1.0 : 0.0;
-  }
+  for (Eigen::Index k : nonzero_rows(X, Y)) used[static_cast<std::size_t>(k)] = 1.0;
   return used;
 }
 
@@ -46,12 +45,8 @@ NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout&
                                            const NewtonRefineOptions& options)
     : state_(state), layout_(layout), options_(options), problem_(state.problem()) {
   options_.validate();
-}
-
-std::vector<int> NewtonRefineProtocol::everyone() const {
-  std::vector<int> all(static_cast<std::size_t>(layout_.num_blocks));
-  for (int b = 0; b < layout_.num_blocks; ++b) all[static_cast<std::size_t>(b)] = b;
-  return all;
+  everyone_.resize(static_cast<std::size_t>(layout_.num_blocks));
+  for (int b = 0; b < layout_.num_blocks; ++b) everyone_[static_cast<std::size_t>(b)] = b;
 }
 
 void NewtonRefineProtocol::send_public(const Eigen::MatrixXd& v, std::uint32_t step,
@@ -76,16 +71,16 @@ void NewtonRefineProtocol::broadcast(std::uint32_t step, const std::vector<doubl
   o.message = std::move(m);
   o.broadcast = true;
   out.push_back(std::move(o));
-  gate_.expect(message_round_, step, everyone());
+  gate_.expect(message_round_, step, everyone_);
   ++result_.reductions;
 }
 
-Eigen::MatrixXd NewtonRefineProtocol::neighbours_of(const MessageGate::Inbox& inbox) const {
-  Eigen::MatrixXd vn = Eigen::MatrixXd::Zero(
-      static_cast<Eigen::Index>(rows_.size()),
-      (problem_.dim() + 1) * static_cast<Eigen::Index>(problem_.num_neighbors()));
+void NewtonRefineProtocol::neighbours_into(const MessageGate::Inbox& inbox,
+                                           Eigen::MatrixXd& vn) const {
+  // setZero(rows, cols) keeps the storage of a buffer that has the size already (every CG step).
+  vn.setZero(static_cast<Eigen::Index>(rows_.size()),
+             (problem_.dim() + 1) * static_cast<Eigen::Index>(problem_.num_neighbors()));
   for (const auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), vn);
-  return vn;
 }
 
 double NewtonRefineProtocol::evaluate_point() {
@@ -211,7 +206,8 @@ void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
 
 void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
-  w_ = hessian(z_, neighbours_of(inbox));
+  neighbours_into(inbox, zn_);
+  w_ = hessian(z_, zn_);
   broadcast(kSums, {dot(r_, z_), dot(z_, w_), r_.squaredNorm()}, out);
 }
 
@@ -289,7 +285,7 @@ void NewtonRefineProtocol::try_step(const std::string& cg_stop, std::vector<Outg
 
 void NewtonRefineProtocol::after_trial(const MessageGate::Inbox& inbox,
                                        std::vector<OutgoingMessage>& out) {
-  Xtn_ = neighbours_of(inbox);
+  neighbours_into(inbox, Xtn_);
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(Xtn_);
   double share = 0.0;
   problem_.cost(Xt_, &share);

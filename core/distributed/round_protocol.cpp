@@ -243,37 +243,34 @@ void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
 
 void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessage>& out) {
   if (phase == ProtocolPhase::kStatus && observer_) observer_(snapshot());
+  // Local rounds: only blocks whose status can have changed send one; the others' last one
+  // stands. Otherwise every block sends.
+  std::vector<int> senders;
   if (local_) {
-    // Only blocks whose status can have changed send one; the others' last one stands.
-    std::vector<int> senders = local_->status_senders();
-    if (!local_->sends_status(state_.id())) {
-      expect(u32(round_), phase, std::move(senders));
-      return;
-    }
+    senders = local_->status_senders();
+  } else {
+    senders.resize(static_cast<std::size_t>(layout_.num_blocks));
+    for (int b = 0; b < layout_.num_blocks; ++b) senders[static_cast<std::size_t>(b)] = b;
   }
-  const LocalStatus s = state_.status(config_.selection == SelectionRule::kGreedyNewton);
-  RoundStatusMessage m;
-  m.round = u32(round_);
-  m.sender = u32(state_.id());
-  m.phase = static_cast<std::uint32_t>(phase);
-  m.cost = s.cost_share;
-  m.grad_norm_sq = s.grad_norm_sq;
-  m.block_grad_norm = s.block_grad_norm;
-  if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_))
-    m.coarse = state_.coarse_space() ? state_.smoothed_coarse_terms() : state_.coarse_terms();
-  // Our own status goes straight into the inbox: the reduction then treats every agent alike.
-  pending_[key(u32(round_), phase)].emplace(state_.id(), m);
-  OutgoingMessage o;
-  o.message = m;
-  o.broadcast = true;
-  out.push_back(std::move(o));
-  if (local_) {
-    expect(u32(round_), phase, local_->status_senders());
-    return;
+  if (!local_ || local_->sends_status(state_.id())) {
+    const LocalStatus s = state_.status(config_.selection == SelectionRule::kGreedyNewton);
+    RoundStatusMessage m;
+    m.round = u32(round_);
+    m.sender = u32(state_.id());
+    m.phase = static_cast<std::uint32_t>(phase);
+    m.cost = s.cost_share;
+    m.grad_norm_sq = s.grad_norm_sq;
+    m.block_grad_norm = s.block_grad_norm;
+    if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_))
+      m.coarse = state_.coarse_space() ? state_.smoothed_coarse_terms() : state_.coarse_terms();
+    // Our own status goes straight into the inbox: the reduction then treats every agent alike.
+    pending_[key(u32(round_), phase)].emplace(state_.id(), m);
+    OutgoingMessage o;
+    o.message = m;
+    o.broadcast = true;
+    out.push_back(std::move(o));
   }
-  std::vector<int> everyone(static_cast<std::size_t>(layout_.num_blocks));
-  for (int b = 0; b < layout_.num_blocks; ++b) everyone[static_cast<std::size_t>(b)] = b;
-  expect(u32(round_), phase, std::move(everyone));
+  expect(u32(round_), phase, std::move(senders));
 }
 
 void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,

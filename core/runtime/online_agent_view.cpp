@@ -176,8 +176,7 @@ TakeoverMoves OnlineAgentView::take_over(const std::set<std::uint32_t>& lost) {
   owner_ = plan.owner;
   // A robot adopted earlier by a block lost now follows that block's poses.
   for (std::uint32_t robot : lost_) {
-    auto it = adopter_.find(robot);
-    int a = it == adopter_.end() ? -1 : it->second;
+    int a = adopter(robot);
     if (a < 0 || is_lost_block(a)) {
       const int fresh = plan.adopter.at(robot);
       a = fresh >= 0 ? fresh

@@ -1,5 +1,6 @@
 #include "runtime/online_takeover.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <tessera/partition/graph_structure.hpp>
 
@@ -14,17 +15,17 @@ OnlineTakeoverPlan plan_online_takeover(const PoseGraph& graph, const std::vecto
   for (std::uint32_t r : lost) plan.adopter[r] = -1;
   const int num_blocks = static_cast<int>(robots.size());
   std::vector<int> lost_blocks;
-  bool any_live = false;
-  for (int b = 0; b < num_blocks; ++b) {
-    if (lost.count(robots[static_cast<std::size_t>(b)]) > 0)
+  std::vector<char> is_lost(static_cast<std::size_t>(num_blocks), 0);
+  for (int b = 0; b < num_blocks; ++b)
+    if (lost.count(robots[static_cast<std::size_t>(b)]) > 0) {
       lost_blocks.push_back(b);
-    else
-      any_live = true;
-  }
-  std::size_t lost_poses = 0;
-  for (int b : owner)
-    for (int l : lost_blocks) lost_poses += b == l ? 1 : 0;
-  if (lost_poses == 0) return plan;
+      is_lost[static_cast<std::size_t>(b)] = 1;
+    }
+  const bool any_live = lost_blocks.size() < static_cast<std::size_t>(num_blocks);
+  const bool lost_poses = std::any_of(owner.begin(), owner.end(), [&](int b) {
+    return b >= 0 && b < num_blocks && is_lost[static_cast<std::size_t>(b)];
+  });
+  if (!lost_poses) return plan;
   if (!any_live)
     throw std::runtime_error(
         "the lost agents' poses have no survivor block to go to (no "

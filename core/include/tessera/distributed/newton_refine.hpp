@@ -125,7 +125,8 @@ class NewtonRefineProtocol : public AgentProcess {
   void send_public(const Eigen::MatrixXd& v, std::uint32_t step, std::vector<OutgoingMessage>& out);
   void broadcast(std::uint32_t step, const std::vector<double>& values,
                  std::vector<OutgoingMessage>& out);
-  Eigen::MatrixXd neighbours_of(const MessageGate::Inbox& inbox) const;
+  // The neighbours' public entries of a vector sent in one step, into vn (zero elsewhere).
+  void neighbours_into(const MessageGate::Inbox& inbox, Eigen::MatrixXd& vn) const;
   // Local pieces at (X_, Xn_): egrad_, g_ and the cost share.
   double evaluate_point();
   Eigen::MatrixXd hessian(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
@@ -138,7 +139,6 @@ class NewtonRefineProtocol : public AgentProcess {
   void after_trial(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void after_trial_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void finish(const std::string& why);
-  std::vector<int> everyone() const;
 
   AgentState& state_;
   const BlockLayout& layout_;
@@ -146,12 +146,14 @@ class NewtonRefineProtocol : public AgentProcess {
   BlockProblem problem_;  // own copy: its neighbour poses are set to directions
   MessageGate gate_;
   std::uint32_t message_round_ = 0;  // one per message step, the same on every agent
+  std::vector<int> everyone_;        // the agents every reduction waits for: 0 .. N-1
   std::vector<Eigen::Index> rows_;   // active rows (non-zero on some agent)
   // The point and its local pieces; the trial point.
   Eigen::MatrixXd X_, Xn_, egrad_, g_, Xt_, Xtn_, egrad_t_, g_t_;
   double f_ = 0.0, gnorm_ = 0.0;
   // CG on H s = -g: s, r, z = P r, w = H z, p, q = H p.
   Eigen::MatrixXd s_, r_, z_, w_, p_, q_;
+  Eigen::MatrixXd zn_;  // the neighbours' z, kept between CG steps for its storage
   int cg_it_ = 0;
   double gamma_old_ = 0.0, alpha_old_ = 0.0, pHp_old_ = 0.0;
   double e_Pe_ = 0.0, e_Pd_ = 0.0, d_Pd_ = 0.0;  // <s,P^-1 s>, <s,P^-1 p>, <p,P^-1 p>
