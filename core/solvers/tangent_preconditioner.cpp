@@ -424,10 +424,10 @@ Eigen::MatrixXd TangentPreconditioner::apply(const LiftedManifold&, const Eigen:
     tangent_coordinates<3>(X.data() + skip, V.data() + skip, f.extra, f.extra_b.data());
   }
   const double* c = f.solve();
+  Eigen::VectorXd ci(f.extra > 0 ? p : 0);  // one buffer for every grown pose of this call
   for (Eigen::Index i = 0; i < f.extra; ++i) {
     auto bi = f.extra_b.segment(i * p, p);
-    const Eigen::VectorXd ci =
-        Eigen::Map<const Eigen::MatrixXd>(f.extra_inverse.data() + i * p * p, p, p) * bi;
+    ci.noalias() = Eigen::Map<const Eigen::MatrixXd>(f.extra_inverse.data() + i * p * p, p, p) * bi;
     bi = ci;
   }
   // Z = J c: rotation Y Omega(omega), translation Y u.
