@@ -11,10 +11,10 @@
 #include <future>
 #include <memory>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include "agent/handoff_exchange.hpp"
+#include "dds_session_support.hpp"
 #include "tesseraPubSubTypes.h"
 #include "transport/addressed_filter.hpp"
 #include "transport/agent_session.hpp"
@@ -26,6 +26,8 @@ namespace {
 
 using namespace tessera;
 using namespace tessera::transport;
+using tessera::transport::test::pass_readiness_barriers;
+using tessera::transport::test::received_phases;
 
 constexpr int kDomain = 95;
 constexpr std::uint32_t kAgents = kMaxAgentsWithRecipientTopics + 2;
@@ -127,17 +129,6 @@ OutgoingMessage block_to(std::vector<std::uint32_t> recipients, std::uint32_t ph
   return m;
 }
 
-std::vector<std::uint32_t> received_phases(AgentSession& s, std::size_t expected) {
-  std::vector<std::uint32_t> out;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (out.size() < expected && std::chrono::steady_clock::now() < until) {
-    ProtocolMessage m;
-    if (s.protocol().take(Seconds(0.2), &m) == WaitStatus::kReady)
-      out.push_back(std::visit([](const auto& x) { return x.phase; }, m));
-  }
-  return out;
-}
-
 TEST(DdsAddressedDelivery, BlocksAndHandoffsReachOnlyTheirRecipientInALargeRun) {
   std::vector<std::unique_ptr<Session>> sessions;
   sessions.push_back(std::make_unique<CoordinatorSession>(options_for(true, 0)));
@@ -147,15 +138,7 @@ TEST(DdsAddressedDelivery, BlocksAndHandoffsReachOnlyTheirRecipientInALargeRun) 
     agents.push_back(a.get());
     sessions.push_back(std::move(a));
   }
-  {
-    std::vector<std::future<WaitStatus>> barriers;
-    for (auto& s : sessions)
-      barriers.push_back(std::async(std::launch::async, [&s] {
-        std::string missing;
-        return s->ready_barrier(Seconds(60), &missing);
-      }));
-    for (auto& b : barriers) ASSERT_EQ(b.get(), WaitStatus::kReady);
-  }
+  ASSERT_NO_FATAL_FAILURE(pass_readiness_barriers(sessions, Seconds(60)));
 
   // A small block to agent 1 (filtered topic), a large one to agent 2 (over one transport
   // message: the shared topic, dropped by every other agent's router).

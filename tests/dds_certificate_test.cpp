@@ -21,17 +21,6 @@
 namespace tessera::test::dds {
 namespace {
 
-// A field of the (flat) JSON summary as text ("" when absent).
-std::string json_text(const std::string& json, const std::string& name) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eEa-z]+)"))) return "";
-  return m[1];
-}
-double json_number(const std::string& json, const std::string& name) {
-  const std::string t = json_text(json, name);
-  return t.empty() ? NAN : std::stod(t);
-}
-
 TEST(DdsCertificate, StaircaseOverDdsGivesTheInProcessResult) {
   const std::string dir = temp_dir();
   const std::string graph = dir + "/city.g2o";

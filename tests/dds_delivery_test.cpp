@@ -9,13 +9,12 @@
 
 #include <algorithm>
 #include <chrono>
-#include <future>
 #include <memory>
 #include <string>
 #include <thread>
-#include <variant>
 #include <vector>
 
+#include "dds_session_support.hpp"
 #include "transport/agent_session.hpp"
 #include "transport/coordinator_session.hpp"
 #include "transport/topic_names.hpp"
@@ -25,6 +24,8 @@ namespace {
 
 using namespace tessera;
 using namespace tessera::transport;
+using tessera::transport::test::pass_readiness_barriers;
+using tessera::transport::test::received_phases;
 
 constexpr int kDomain = 60;
 constexpr std::uint32_t kAgents = 3;
@@ -76,30 +77,6 @@ S& open_session(std::vector<std::unique_ptr<Session>>& sessions, const SessionOp
   return session;
 }
 
-// Every session passes the readiness barrier (every endpoint matched, READY from all), all at
-// once as separate processes would.
-void pass_readiness_barriers(std::vector<std::unique_ptr<Session>>& sessions) {
-  std::vector<std::future<WaitStatus>> barriers;
-  for (auto& s : sessions)
-    barriers.push_back(std::async(std::launch::async, [&s] {
-      std::string missing;
-      return s->ready_barrier(Seconds(30), &missing);
-    }));
-  for (auto& b : barriers) ASSERT_EQ(b.get(), WaitStatus::kReady);
-}
-
-// The phases of the protocol messages `s` has received, in arrival order per type.
-std::vector<std::uint32_t> received_phases(AgentSession& s, std::size_t expected) {
-  std::vector<std::uint32_t> out;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (out.size() < expected && std::chrono::steady_clock::now() < until) {
-    ProtocolMessage m;
-    if (s.protocol().take(Seconds(0.2), &m) == WaitStatus::kReady)
-      out.push_back(std::visit([](const auto& x) { return x.phase; }, m));
-  }
-  return out;
-}
-
 // The session's type is its role: options of the other role are refused before any
 // participant exists.
 TEST(DdsDelivery, ASessionRefusesTheOptionsOfTheOtherRole) {
@@ -122,7 +99,7 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   AgentSession& a2 = open_session<AgentSession>(sessions, options_for(false, 2));
 
   // Every process passes the readiness barrier (every endpoint matched, READY from all).
-  ASSERT_NO_FATAL_FAILURE(pass_readiness_barriers(sessions));
+  ASSERT_NO_FATAL_FAILURE(pass_readiness_barriers(sessions, Seconds(30)));
 
   a0.send(block_to({1}, 2));  // addressed to agent 1 only
   a0.send(block_to({}, 3));   // broadcast
@@ -240,7 +217,7 @@ TEST(DdsDelivery, BlocksToTheRelayRideInTheSendersStatusSample) {
   AgentSession& a0 = open_session<AgentSession>(sessions, riding(false, 0));
   AgentSession& a1 = open_session<AgentSession>(sessions, riding(false, 1));
   AgentSession& a2 = open_session<AgentSession>(sessions, riding(false, 2));
-  ASSERT_NO_FATAL_FAILURE(pass_readiness_barriers(sessions));
+  ASSERT_NO_FATAL_FAILURE(pass_readiness_barriers(sessions, Seconds(30)));
   RoundTraffic traffic;
   traffic.status_relay = true;
   for (AgentSession* a : {&a0, &a1, &a2}) a->set_round_traffic(traffic);

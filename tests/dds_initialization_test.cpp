@@ -13,11 +13,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <deque>
 #include <fstream>
 #include <map>
-#include <mutex>
 #include <regex>
 #include <sstream>
 #include <tessera/distributed/distributed_solver.hpp>
@@ -32,75 +29,18 @@
 #include "dds_process_support.hpp"
 #include "runtime/initialization_stage.hpp"
 #include "runtime/known_inlier_start.hpp"
+#include "thread_exchange.hpp"
 
 namespace tessera::test::dds {
 namespace {
 
 // ---------------------------------------------------------------- in process
 
-// N mailboxes; send() copies into the recipients' queues (never back to the sender).
-class Exchange {
- public:
-  explicit Exchange(std::uint32_t n) : queues_(n) {}
-  std::uint32_t size() const { return static_cast<std::uint32_t>(queues_.size()); }
-  void post(std::uint32_t from, const OutgoingMessage& m) {
-    std::lock_guard<std::mutex> lock(mu_);
-    for (std::uint32_t a = 0; a < queues_.size(); ++a) {
-      if (a == from) continue;
-      if (!m.broadcast &&
-          std::find(m.recipients.begin(), m.recipients.end(), a) == m.recipients.end())
-        continue;
-      queues_[a].push_back(m.message);
-      ++posted_;
-    }
-    cv_.notify_all();
-  }
-  std::optional<ProtocolMessage> take(std::uint32_t self, double timeout_s) {
-    std::unique_lock<std::mutex> lock(mu_);
-    if (!cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
-                      [&] { return !queues_[self].empty(); }))
-      return std::nullopt;
-      // GCC 12 at -O2 reports the moved-from variant's scalars as maybe uninitialized (a known
-      // false positive of -Wmaybe-uninitialized with std::variant); every field has an initializer.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-    ProtocolMessage m = std::move(queues_[self].front());
-#pragma GCC diagnostic pop
-    queues_[self].pop_front();
-    return m;
-  }
-  std::size_t left_over() {
-    std::lock_guard<std::mutex> lock(mu_);
-    std::size_t n = 0;
-    for (auto& q : queues_) n += q.size();
-    return n;
-  }
-
- private:
-  std::mutex mu_;
-  std::condition_variable cv_;
-  std::vector<std::deque<ProtocolMessage>> queues_;
-  std::size_t posted_ = 0;
-};
-
-class ThreadChannel : public agent::ProtocolChannel {
- public:
-  ThreadChannel(Exchange& ex, std::uint32_t self) : ex_(ex), self_(self) {}
-  void send(const OutgoingMessage& m) override { ex_.post(self_, m); }
-  std::optional<ProtocolMessage> receive(double timeout_s) override {
-    return ex_.take(self_, timeout_s);
-  }
-
- private:
-  Exchange& ex_;
-  std::uint32_t self_;
-};
-
 // Like ThreadChannel, but what this agent sends to agent `slow` arrives `delay` later (DDS
 // orders one sender's messages, not messages of different senders to one recipient).
 class LaggingChannel : public agent::ProtocolChannel {
  public:
-  LaggingChannel(Exchange& ex, std::uint32_t self, std::uint32_t slow,
+  LaggingChannel(ThreadExchange& ex, std::uint32_t self, std::uint32_t slow,
                  std::chrono::milliseconds delay)
       : ex_(ex), self_(self), slow_(slow), delay_(delay) {}
   ~LaggingChannel() override {
@@ -127,7 +67,7 @@ class LaggingChannel : public agent::ProtocolChannel {
   }
 
  private:
-  Exchange& ex_;
+  ThreadExchange& ex_;
   std::uint32_t self_, slow_;
   std::chrono::milliseconds delay_;
   std::vector<std::thread> late_;
@@ -143,7 +83,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_of(const PoseGrap
 // Runs the stage for every agent in its own thread; returns the poses in global order.
 std::vector<Pose> run_stage(const PoseGraph& g, std::uint32_t N, const std::string& method,
                             std::size_t* leftover = nullptr) {
-  Exchange ex(N);
+  ThreadExchange ex(N);
   std::vector<agent::RobotShare> shares;
   for (std::uint32_t k = 0; k < N; ++k) shares.push_back(agent::robot_share(g, k, N));
   std::vector<agent::InitializationResult> out(N);
@@ -219,7 +159,7 @@ TEST(DdsInitializationStage, ChordalGivesCoresPosesBitForBit) {
 TEST(DdsInitializationStage, TwoStagesOnOneInboxKeepALateAgentsMessages) {
   const PoseGraph g = generated(TrajectoryKind::kGrid3d, 216, 3, 4);
   const std::uint32_t N = 3;
-  Exchange ex(N);
+  ThreadExchange ex(N);
   const auto structure = structure_of(g);
   std::vector<agent::RobotShare> shares;
   std::vector<agent::KnownInlierStart> known;
@@ -272,7 +212,7 @@ TEST(DdsInitializationStage, FileWithoutVertexLinesAndUnknownNamesAreInputErrors
   PoseGraph g = generated(TrajectoryKind::kCity, 60, 2, 3);
   g.initial.clear();
   const agent::RobotShare share = agent::robot_share(g, 1, 2);
-  Exchange ex(2);
+  ThreadExchange ex(2);
   ThreadChannel ch(ex, 1);
   try {
     agent::run_initialization_stage(share, 1, 2, structure_of(g), "file", "robot1.g2o", ch, 1.0);
@@ -289,7 +229,7 @@ TEST(DdsInitializationStage, FileWithoutVertexLinesAndUnknownNamesAreInputErrors
 TEST(DdsInitializationStage, AMissingPeerTimesOutNamingIt) {
   const PoseGraph g = generated(TrajectoryKind::kCity, 60, 3, 3);
   const agent::RobotShare share = agent::robot_share(g, 0, 3);
-  Exchange ex(3);
+  ThreadExchange ex(3);
   ThreadChannel ch(ex, 0);
   try {
     agent::run_initialization_stage(share, 0, 3, structure_of(g), "distributed", "x", ch, 0.2);

@@ -19,16 +19,6 @@
 namespace tessera::test::dds {
 namespace {
 
-std::string json_text(const std::string& json, const std::string& name) {
-  std::smatch m;
-  if (!std::regex_search(json, m, std::regex("\"" + name + "\": ([-+0-9.eEa-z]+)"))) return "";
-  return m[1];
-}
-double json_number(const std::string& json, const std::string& name) {
-  const std::string t = json_text(json, name);
-  return t.empty() ? NAN : std::stod(t);
-}
-
 // A chain-like generated graph: a lawnmower path with 4 loop closures, where the rounds stop
 // ~1e-5 above f* at gradient 0.01.
 const char* kChain =

@@ -19,21 +19,6 @@
 namespace tessera::test::dds {
 namespace {
 
-// A field of a summary written by cli::JsonObject (`"key": value`), as text.
-std::string field(const std::string& json, const std::string& key, std::size_t from = 0) {
-  const std::string tag = "\"" + key + "\": ";
-  const std::size_t at = json.find(tag, from);
-  if (at == std::string::npos) return "";
-  const std::size_t begin = at + tag.size();
-  return json.substr(begin, json.find_first_of(",\n}", begin) - begin);
-}
-
-double number(const std::string& json, const std::string& key, std::size_t from = 0) {
-  const std::string text = field(json, key, from);
-  EXPECT_FALSE(text.empty()) << "no " << key;
-  return text.empty() || text == "null" ? NAN : std::stod(text);
-}
-
 // Kills agent `victim` of a `tessera launch --online` run once the agents' reports show that
 // 60 of the stream's 300 batches have entered (with `restart`, starts it again after the
 // survivors' vote), and checks that the run still ends at f*.
@@ -47,8 +32,8 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim,
       run_command(bin("tessera") + " solve " + graph + " --json " + dir + "/batch.json", &out), 0)
       << out;
   const std::string batch = read_text_file(dir + "/batch.json");
-  ASSERT_EQ(field(batch, "certified"), "true");
-  const double f_star = number(batch, "cost");
+  ASSERT_EQ(json_text(batch, "certified"), "true");
+  const double f_star = json_number(batch, "cost");
   // Reads the agents' reports (never writes) to see how far the stream has entered.
   transport::OnlineChannel snoop(domain, run, 99, 3);
   // 100 poses per robot at 10 per second: the stream lasts 10 s once the agents are up.
@@ -120,17 +105,17 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim,
   EXPECT_TRUE(contains(launch.output(), "the others go on without it")) << launch.output();
 
   const std::string json = read_text_file(dir + "/online.json");
-  EXPECT_EQ(field(json, "certified"), "true") << json.substr(0, 2000);
-  EXPECT_NEAR(number(json, "cost"), f_star, 1e-6 * f_star);
-  EXPECT_EQ(number(json, "total_poses"), 300.0);
+  EXPECT_EQ(json_text(json, "certified"), "true") << json.substr(0, 2000);
+  EXPECT_NEAR(json_number(json, "cost"), f_star, 1e-6 * f_star);
+  EXPECT_EQ(json_number(json, "total_poses"), 300.0);
   // The take-over: the victim's block went to the two survivors while the stream was still
   // coming in (the graph was not complete yet), and its poses moved.
   const std::size_t fault = json.find("\"faults\"");
   ASSERT_NE(fault, std::string::npos) << json.substr(0, 2000);
-  EXPECT_EQ(field(json, "lost_agents", fault), "[" + std::to_string(victim) + "]");
-  EXPECT_GT(number(json, "moved_poses", fault), 0);
-  EXPECT_LT(number(json, "total_poses", fault), 300);
-  EXPECT_GT(number(json, "total_poses", fault), 0);
+  EXPECT_EQ(json_text(json, "lost_agents", fault), "[" + std::to_string(victim) + "]");
+  EXPECT_GT(json_number(json, "moved_poses", fault), 0);
+  EXPECT_LT(json_number(json, "total_poses", fault), 300);
+  EXPECT_GT(json_number(json, "total_poses", fault), 0);
   // Every robot's trajectory is written at the end, the lost one's by its block's adopter.
   for (int r = 0; r < 3; ++r) {
     const std::string tum = read_text_file(dir + "/tum/robot" + std::to_string(r) + ".tum");

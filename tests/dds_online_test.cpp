@@ -23,21 +23,6 @@
 namespace tessera::test::dds {
 namespace {
 
-// A field of a summary written by cli::JsonObject (`"key": value`), as text.
-std::string field(const std::string& json, const std::string& key, std::size_t from = 0) {
-  const std::string tag = "\"" + key + "\": ";
-  const std::size_t at = json.find(tag, from);
-  if (at == std::string::npos) return "";
-  const std::size_t begin = at + tag.size();
-  return json.substr(begin, json.find_first_of(",\n}", begin) - begin);
-}
-
-double number(const std::string& json, const std::string& key) {
-  const std::string text = field(json, key);
-  EXPECT_FALSE(text.empty()) << "no " << key;
-  return text.empty() || text == "null" ? NAN : std::stod(text);
-}
-
 // The batch optimum f* of `graph` (centralized solver, certified).
 double batch_optimum(const std::string& dir, const std::string& graph) {
   std::string out;
@@ -45,8 +30,8 @@ double batch_optimum(const std::string& dir, const std::string& graph) {
       run_command(bin("tessera") + " solve " + graph + " --json " + dir + "/batch.json", &out), 0)
       << out;
   const std::string json = read_text_file(dir + "/batch.json");
-  EXPECT_EQ(field(json, "certified"), "true");
-  return number(json, "cost");
+  EXPECT_EQ(json_text(json, "certified"), "true");
+  return json_number(json, "cost");
 }
 
 // (epoch, total poses, total measurements) of every update an agent wrote.
@@ -57,9 +42,9 @@ std::map<long, std::pair<long, long>> updates_of(const std::string& json) {
   const std::string updates = json.substr(begin, json.find("\n  ]", begin) - begin);
   for (std::size_t at = updates.find("{\"epoch\": "); at != std::string::npos;
        at = updates.find("{\"epoch\": ", at + 1))
-    out[std::stol(field(updates, "epoch", at))] = {
-        std::stol(field(updates, "total_poses", at)),
-        std::stol(field(updates, "total_measurements", at))};
+    out[std::stol(json_text(updates, "epoch", at))] = {
+        std::stol(json_text(updates, "total_poses", at)),
+        std::stol(json_text(updates, "total_measurements", at))};
   return out;
 }
 
@@ -78,18 +63,19 @@ TEST(DdsOnline, TheOnlineLaunchEndsAtTheBatchOptimumAndEveryAgentSolvesTheSameGr
       0)
       << out;
   const std::string json = read_text_file(dir + "/online.json");
-  EXPECT_EQ(field(json, "certified"), "true");
-  EXPECT_NEAR(number(json, "cost"), f_star, 1e-6 * f_star);
+  EXPECT_EQ(json_text(json, "certified"), "true");
+  EXPECT_NEAR(json_number(json, "cost"), f_star, 1e-6 * f_star);
   const PoseGraph batch = read_g2o(graph);
-  EXPECT_EQ(number(json, "total_poses"), static_cast<double>(batch.num_poses));
-  EXPECT_EQ(number(json, "total_measurements"), static_cast<double>(batch.measurements.size()));
-  EXPECT_GE(number(json, "solves"), 2);
+  EXPECT_EQ(json_number(json, "total_poses"), static_cast<double>(batch.num_poses));
+  EXPECT_EQ(json_number(json, "total_measurements"),
+            static_cast<double>(batch.measurements.size()));
+  EXPECT_GE(json_number(json, "solves"), 2);
   // Per-robot TUM snapshots: the last one holds each robot's 50 poses.
   for (int r = 0; r < 3; ++r) {
     const std::string tum = read_text_file(dir + "/tum/robot" + std::to_string(r) + ".tum");
     EXPECT_EQ(std::count(tum.begin(), tum.end(), '\n'), 50) << "robot " << r;
   }
-  EXPECT_GE(number(json, "publications"), 1);
+  EXPECT_GE(json_number(json, "publications"), 1);
   // A new measurement (inter-robot closures included) enters every agent at the same epoch:
   // whenever two agents solved at an epoch, they solved the same graph.
   const auto lead = updates_of(read_text_file(dir + "/logs/agent-0.json"));
@@ -158,16 +144,16 @@ TEST(DdsOnline, ALateAgentJoinsIdleAgentsSendNothingAndTheAnswerIsTheBatchOptimu
   EXPECT_EQ(idle_samples, 0u) << "the idle agents sent something between 2.5 s and 3.5 s";
   for (Process* p : {&replay, &a0, &a1, &a2}) EXPECT_EQ(p->exit_code, 0) << p->output();
   const std::string json = read_text_file(dir + "/agent0.json");
-  EXPECT_EQ(field(json, "certified"), "true");
-  EXPECT_NEAR(number(json, "cost"), f_star, 1e-6 * f_star);
-  EXPECT_EQ(number(json, "total_poses"), 150.0);
+  EXPECT_EQ(json_text(json, "certified"), "true");
+  EXPECT_NEAR(json_number(json, "cost"), f_star, 1e-6 * f_star);
+  EXPECT_EQ(json_number(json, "total_poses"), 150.0);
   // The idle stretch shows in the summaries: waits without a solve.
-  EXPECT_GE(number(json, "idle_waits"), 1);
+  EXPECT_GE(json_number(json, "idle_waits"), 1);
   // The late agent solved with the others once its robot's data entered (in the final solve
   // at least: when its robot's whole trajectory entered at once, the stream was over).
   const std::string late = read_text_file(dir + "/agent2.json");
-  EXPECT_GT(number(late, "solves") + number(late, "final_rounds"), 0);
-  EXPECT_EQ(field(late, "certified"), "true");
+  EXPECT_GT(json_number(late, "solves") + json_number(late, "final_rounds"), 0);
+  EXPECT_EQ(json_text(late, "certified"), "true");
 }
 
 TEST(DdsOnline, WhenAMemberGoesSilentTheOthersStopNamingIt) {

@@ -373,6 +373,24 @@ inline double json_field(const std::string& json, const std::string& name) {
   return std::stod(m[1]);
 }
 
+/// A field of a summary written by cli::JsonObject (`"key": value`) as text, the first at or
+/// after offset `from`; "" when absent.
+inline std::string json_text(const std::string& json, const std::string& key,
+                             std::size_t from = 0) {
+  const std::string tag = "\"" + key + "\": ";
+  const std::size_t at = json.find(tag, from);
+  if (at == std::string::npos) return "";
+  const std::size_t begin = at + tag.size();
+  return json.substr(begin, json.find_first_of(",\n}", begin) - begin);
+}
+
+/// That field's number; NaN when null or absent (absent also fails the test).
+inline double json_number(const std::string& json, const std::string& key, std::size_t from = 0) {
+  const std::string text = json_text(json, key, from);
+  EXPECT_FALSE(text.empty()) << "no " << key;
+  return text.empty() || text == "null" ? NAN : std::stod(text);
+}
+
 /// Owned pose ids listed in an agent's --dump-local file.
 inline std::vector<int> owned_of(const std::string& path) {
   std::ifstream f(path);

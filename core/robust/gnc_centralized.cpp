@@ -2,6 +2,7 @@
 #include <stdexcept>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/graph/connectivity.hpp>
+#include <tessera/problem/objective.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
 #include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/tls_recheck.hpp>
@@ -22,21 +23,12 @@ std::vector<double> residuals(const PoseGraph& graph, const std::vector<Pose>& p
   return r2;
 }
 
-double kept_cost(const PoseGraph& graph, const std::vector<Pose>& poses) {
-  double f = 0;
-  for (const Measurement& m : graph.measurements) f += residual_squared(m, poses[m.i], poses[m.j]);
-  return f;
-}
-
 // The TLS cost the start vote compares: known inliers count in full, the others up to c^2.
 double tls_cost(const PoseGraph& graph, const std::vector<bool>& known,
                 const std::vector<Pose>& poses, double c2) {
+  const std::vector<double> r2 = residuals(graph, poses);
   double f = 0;
-  for (std::size_t e = 0; e < graph.num_measurements(); ++e) {
-    const Measurement& m = graph.measurements[e];
-    const double r2 = residual_squared(m, poses[m.i], poses[m.j]);
-    f += known[e] ? r2 : std::min(r2, c2);
-  }
+  for (std::size_t e = 0; e < r2.size(); ++e) f += known[e] ? r2[e] : std::min(r2[e], c2);
   return f;
 }
 
@@ -73,12 +65,7 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   // keep the poses connected it leaves the weighted solve (as in the distributed engine) instead
   // of staying at kMinInnerWeight: wrong closures between random poses are what fills the
   // factor of the weighted problem.
-  PoseGraph known_graph;
-  known_graph.d = graph.d;
-  known_graph.num_poses = graph.num_poses;
-  known_graph.source = graph.source;
-  for (std::size_t e = 0; e < m; ++e)
-    if (known[e]) known_graph.measurements.push_back(graph.measurements[e]);
+  const PoseGraph known_graph = known_subgraph(graph, known);
   const bool known_connected = count_components(known_graph) <= 1;
   auto weighted_solve_graph = [&](const PoseGraph& g, const std::vector<double>& weights,
                                   const std::vector<Pose>& start) {
@@ -183,7 +170,8 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
     // of the kept set, and without the wrong closures chordal is close to its optimum again
     // (the distributed passes vote the same way).
     const std::vector<Pose> guess = chordal_initialization(inliers);
-    if (kept_cost(inliers, guess) < kept_cost(inliers, start)) inliers.initial = guess;
+    if (evaluate_objective(inliers, guess) < evaluate_objective(inliers, start))
+      inliers.initial = guess;
     out.final_solve = solve_centralized(inliers, final_options);
     add_iterations(out, out.final_solve);
     if (pass == robust.readmission_passes || out.rejected.empty()) break;

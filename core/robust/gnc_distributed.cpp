@@ -25,17 +25,6 @@ double lifted_residual_squared(const Measurement& m, const Eigen::MatrixXd& X, i
                                  X.middleCols(w * static_cast<Eigen::Index>(m.j), w));
 }
 
-// `graph` with only the measurements flagged in `known`.
-PoseGraph known_subgraph(const PoseGraph& graph, const std::vector<bool>& known) {
-  PoseGraph out;
-  out.d = graph.d;
-  out.num_poses = graph.num_poses;
-  out.source = graph.source;
-  for (std::size_t e = 0; e < graph.num_measurements(); ++e)
-    if (known[e]) out.measurements.push_back(graph.measurements[e]);
-  return out;
-}
-
 }  // namespace
 
 void GncDistributedOptions::validate() const {

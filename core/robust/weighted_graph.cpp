@@ -25,6 +25,16 @@ PoseGraph weighted_graph(const PoseGraph& graph, const std::vector<double>& weig
   return out;
 }
 
+PoseGraph known_subgraph(const PoseGraph& graph, const std::vector<bool>& keep) {
+  PoseGraph out;
+  out.d = graph.d;
+  out.num_poses = graph.num_poses;
+  out.source = graph.source;
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e)
+    if (keep[e]) out.measurements.push_back(graph.measurements[e]);
+  return out;
+}
+
 PoseGraph inlier_graph(const PoseGraph& graph, const std::vector<std::size_t>& rejected,
                        const std::vector<Pose>& initial) {
   PoseGraph out;

@@ -105,6 +105,19 @@ Eigen::MatrixXd pose_basis(const Eigen::Ref<const Eigen::MatrixXd>& Y,
   return G;
 }
 
+// Block (i, j) of A, 2 G_i^T (Q_ij kron I_d) G_j (p x p), into B; T (d(d+1) x p) is scratch.
+void tangent_block(const Eigen::Ref<const Eigen::MatrixXd>& Qij, const Eigen::MatrixXd& Gi,
+                   const Eigen::MatrixXd& Gj, int d, Eigen::MatrixXd& T, Eigen::MatrixXd& B) {
+  const int w = d + 1;
+  for (int t = 0; t < w; ++t) {
+    auto row = T.middleRows(t * d, d);
+    row.setZero();
+    for (int u = 0; u < w; ++u)
+      if (Qij(t, u) != 0.0) row.noalias() += Qij(t, u) * Gj.middleRows(u * d, d);
+  }
+  B.noalias() = 2.0 * Gi.transpose() * T;
+}
+
 // The pose-level estimate is skipped to the exact analysis below this multiple of the cap,
 // so that a factor near the cap is decided by its exact size as before.
 constexpr double kSkipFactor = 2.0;
@@ -266,13 +279,7 @@ bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
          s < f.block_start[static_cast<std::size_t>(j) + 1]; ++s) {
       const Eigen::Index i = f.block_row[static_cast<std::size_t>(s)];
       const Eigen::Map<const Eigen::MatrixXd> Qij(f.q_blocks.data() + s * w * w, w, w);
-      for (int t = 0; t < w; ++t) {
-        auto row = T.middleRows(t * d, d);
-        row.setZero();
-        for (int u = 0; u < w; ++u)
-          if (Qij(t, u) != 0.0) row.noalias() += Qij(t, u) * Gj.middleRows(u * d, d);
-      }
-      B.noalias() = 2.0 * G[static_cast<std::size_t>(i)].transpose() * T;
+      tangent_block(Qij, G[static_cast<std::size_t>(i)], Gj, d, T, B);
       if (i == j) {
         B = 0.5 * (B + B.transpose()).eval();  // exactly symmetric
         max_diagonal = std::max(max_diagonal, B.diagonal().maxCoeff());
@@ -316,13 +323,7 @@ bool TangentPreconditioner::grow(const BlockProblem& problem, const Eigen::Matri
       for (SparseMatrix::InnerIterator it(Q, i * w + s); it; ++it)
         if (it.row() >= i * w && it.row() < (i + 1) * w) Qii(it.row() - i * w, s) = it.value();
     const Eigen::MatrixXd G = pose_basis(X.block(0, i * w, d, d), pairs);
-    for (int t = 0; t < w; ++t) {
-      auto row = T.middleRows(t * d, d);
-      row.setZero();
-      for (int u = 0; u < w; ++u)
-        if (Qii(t, u) != 0.0) row.noalias() += Qii(t, u) * G.middleRows(u * d, d);
-    }
-    B.noalias() = 2.0 * G.transpose() * T;
+    tangent_block(Qii, G, G, d, T, B);
     B = 0.5 * (B + B.transpose()).eval();
     B.diagonal().array() += f.lambda;
     Eigen::LLT<Eigen::MatrixXd> llt(B);
@@ -423,10 +424,10 @@ Eigen::MatrixXd TangentPreconditioner::apply(const LiftedManifold&, const Eigen:
     tangent_coordinates<3>(X.data() + skip, V.data() + skip, f.extra, f.extra_b.data());
   }
   const double* c = f.solve();
+  Eigen::VectorXd ci(f.extra > 0 ? p : 0);  // one buffer for every grown pose of this call
   for (Eigen::Index i = 0; i < f.extra; ++i) {
     auto bi = f.extra_b.segment(i * p, p);
-    const Eigen::VectorXd ci =
-        Eigen::Map<const Eigen::MatrixXd>(f.extra_inverse.data() + i * p * p, p, p) * bi;
+    ci.noalias() = Eigen::Map<const Eigen::MatrixXd>(f.extra_inverse.data() + i * p * p, p, p) * bi;
     bi = ci;
   }
   // Z = J c: rotation Y Omega(omega), translation Y u.

@@ -26,16 +26,9 @@ using namespace tessera;
 
 namespace {
 
+// f at a lifted iterate of the whole graph.
 double f_of(const PoseGraph& g, const Eigen::MatrixXd& X) {
-  const int d = g.d;
-  double f = 0.0;
-  for (const Measurement& m : g.measurements) {
-    const auto Xi = X.middleCols(static_cast<Eigen::Index>((d + 1) * m.i), d + 1);
-    const auto Xj = X.middleCols(static_cast<Eigen::Index>((d + 1) * m.j), d + 1);
-    f += m.kappa * (Xj.leftCols(d) - Xi.leftCols(d) * m.R).squaredNorm() +
-         m.tau * (Xj.col(d) - Xi.col(d) - Xi.leftCols(d) * m.t).squaredNorm();
-  }
-  return f;
+  return BlockProblem::whole_graph(g.d, g.num_poses, g.measurements).cost(X);
 }
 
 Eigen::MatrixXd columns(const Eigen::MatrixXd& X, int d, const std::vector<std::size_t>& ids) {

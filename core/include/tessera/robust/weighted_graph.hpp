@@ -24,6 +24,11 @@ PoseGraph weighted_graph(const PoseGraph& graph, const std::vector<double>& weig
 PoseGraph inlier_graph(const PoseGraph& graph, const std::vector<std::size_t>& rejected,
                        const std::vector<Pose>& initial);
 
+/// `graph` with only the measurements flagged in `keep` (one flag per measurement), without an
+/// initial guess: the known inliers' graph, whose connectivity decides whether they can start
+/// or test a robust solve.
+PoseGraph known_subgraph(const PoseGraph& graph, const std::vector<bool>& keep);
+
 /// Throws InputError (naming graph.source) when `inliers`, the graph left after `rejected`
 /// measurements were removed, no longer connects its poses: every robust solve ends with a
 /// clear message then, never with a collapsed estimate.
