@@ -40,15 +40,16 @@ std::vector<int> coarse_unknowns_of(const CoarseSpace* space, const BlockLayout&
   return out;
 }
 
-PoseBlockMessage coarse_terms_message(int sender, std::uint32_t round, std::uint32_t phase, int r,
-                                      int d, std::vector<double> terms) {
+PoseBlockMessage coarse_terms_message(int sender, std::uint32_t round, std::uint32_t phase,
+                                      std::vector<double> terms) {
   PoseBlockMessage m;
   m.round = round;
   m.sender = static_cast<std::uint32_t>(sender);
   m.phase = phase;
   m.kind = BlockKind::kY;
-  m.rank = static_cast<std::uint32_t>(r);
-  m.dim = static_cast<std::uint32_t>(d);
+  m.rank = static_cast<std::uint32_t>(terms.size());
+  m.dim = 0;
+  m.pose_ids = {0};
   m.data = std::move(terms);
   return m;
 }
@@ -56,7 +57,8 @@ PoseBlockMessage coarse_terms_message(int sender, std::uint32_t round, std::uint
 const std::vector<double>& coarse_terms_of(const ProtocolMessage& message) {
   const auto* p = std::get_if<PoseBlockMessage>(&message);
   if (!p) malformed(std::get<RoundStatusMessage>(message).sender, "a status instead of terms");
-  if (!p->pose_ids.empty()) malformed(p->sender, "terms with pose ids");
+  if (p->pose_ids.size() != 1 || p->dim != 0 || p->data.size() != p->rank)
+    malformed(p->sender, "terms not shaped as one column of values");
   return p->data;
 }
 
@@ -75,13 +77,16 @@ PoseBlockMessage coarse_motions_message(int sender, std::uint32_t round, std::ui
   if (!applied) return m;
   const std::size_t width = static_cast<std::size_t>(r * (r + 1));
   m.pose_ids.reserve(unknowns.size());
-  m.data.reserve(unknowns.size() * width + 1);
+  m.data.reserve((unknowns.size() + 1) * width);
   for (int u : unknowns) {
     const Eigen::MatrixXd& Z = motions[static_cast<std::size_t>(u)];
     m.pose_ids.push_back(static_cast<std::uint32_t>(u));
     m.data.insert(m.data.end(), Z.data(), Z.data() + Z.size());
   }
+  // The decrease as one more "pose" of the same shape, so the message stays a pose block.
+  m.pose_ids.push_back(kCoarseDecreaseId);
   m.data.push_back(decrease);
+  m.data.resize(m.data.size() + width - 1, 0.0);
   return m;
 }
 
@@ -98,18 +103,18 @@ ReceivedCoarseMotions read_coarse_motions(const ProtocolMessage& message, int r,
   if (p->rank != static_cast<std::uint32_t>(r) || p->dim != static_cast<std::uint32_t>(r))
     malformed(p->sender,
               "motions of rank " + std::to_string(p->rank) + ", expected " + std::to_string(r));
-  if (p->pose_ids.size() != expected.size() ||
+  if (p->pose_ids.size() != expected.size() + 1 || p->pose_ids.back() != kCoarseDecreaseId ||
       !std::equal(expected.begin(), expected.end(), p->pose_ids.begin(),
                   [](int a, std::uint32_t b) { return static_cast<std::uint32_t>(a) == b; }))
     malformed(p->sender, "motions of other coarse unknowns than this agent's");
-  if (p->data.size() != expected.size() * width + 1)
+  if (p->data.size() != (expected.size() + 1) * width)
     malformed(p->sender, std::to_string(p->data.size()) + " values, expected " +
-                             std::to_string(expected.size() * width + 1));
+                             std::to_string((expected.size() + 1) * width));
   for (std::size_t k = 0; k < expected.size(); ++k)
     out.motions[static_cast<std::size_t>(expected[k])] =
         Eigen::Map<const Eigen::MatrixXd>(p->data.data() + k * width, r, r + 1);
   out.applied = true;
-  out.decrease = p->data.back();
+  out.decrease = p->data[expected.size() * width];
   return out;
 }
 

@@ -276,9 +276,8 @@ void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessag
       } else {
         // Beside the status, to the solver only (its own straight into its inbox).
         const auto step = ProtocolPhase::kCoarseTerms;
-        PoseBlockMessage t =
-            coarse_terms_message(state_.id(), u32(round_), static_cast<std::uint32_t>(step),
-                                 state_.rank(), state_.problem().dim(), std::move(terms));
+        PoseBlockMessage t = coarse_terms_message(
+            state_.id(), u32(round_), static_cast<std::uint32_t>(step), std::move(terms));
         if (state_.id() == kCoarseSolver) {
           pending_[key(u32(round_), step)].emplace(state_.id(), std::move(t));
         } else {

@@ -10,8 +10,10 @@
 // replacing agent takes the lost agent's id. Since the solver runs the same code on the same
 // terms as every agent did all to all, the motions, and so the iterates, are bit-identical.
 //
-// Both messages are PoseBlockMessages, so they take the addressed (filtered) paths of pose
-// blocks over DDS; a status would reach every agent's reader.
+// Both messages are PoseBlockMessages shaped like pose blocks (pose_ids.size() x rank x (dim+1)
+// values), so they take the addressed (filtered) paths of pose blocks over DDS, where a status
+// would reach every agent's reader, and the terms can ride in the status sample to the relay
+// agent, which is the solver.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -24,6 +26,8 @@ namespace tessera {
 
 /// The agent that gathers the terms and solves the coarse problem.
 constexpr int kCoarseSolver = 0;
+/// The id of the motions message's last entry, which carries f's decrease.
+constexpr std::uint32_t kCoarseDecreaseId = 0xFFFFFFFFu;
 
 /// The coarse unknowns whose motions move agent `agent`'s own poses or its copies of its
 /// neighbours' public poses, ascending: with the smoothed space (`space` not null) the
@@ -31,16 +35,18 @@ constexpr int kCoarseSolver = 0;
 /// blocks. Computed from what every agent knows (layout, space), so solver and agent agree.
 std::vector<int> coarse_unknowns_of(const CoarseSpace* space, const BlockLayout& layout, int agent);
 
-/// Agent `sender`'s coarse terms for the solver: no poses, data = the terms (rank r, dim d).
-PoseBlockMessage coarse_terms_message(int sender, std::uint32_t round, std::uint32_t phase, int r,
-                                      int d, std::vector<double> terms);
+/// Agent `sender`'s coarse terms for the solver: one column of values (one "pose", id 0,
+/// rank = the number of terms, dim 0).
+PoseBlockMessage coarse_terms_message(int sender, std::uint32_t round, std::uint32_t phase,
+                                      std::vector<double> terms);
 /// The terms of such a message; throws std::runtime_error ("malformed message") when it is
 /// not one.
 const std::vector<double>& coarse_terms_of(const ProtocolMessage& message);
 
 /// The solver's answer to one agent: the motions Z = [G c] of `unknowns` as r x (r+1)
-/// "poses" (rank r, dim r; pose_ids = the unknowns), then f's decrease as one last value.
-/// With `applied` false (the correction is not taken): no poses and no values.
+/// "poses" (rank r, dim r; pose_ids = the unknowns), then one more "pose" with id
+/// kCoarseDecreaseId whose first value is f's decrease. With `applied` false (the correction is
+/// not taken): no poses and no values.
 PoseBlockMessage coarse_motions_message(int sender, std::uint32_t round, std::uint32_t phase,
                                         const std::vector<int>& unknowns,
                                         const std::vector<Eigen::MatrixXd>& motions,
