@@ -162,8 +162,8 @@ const char* kDistributedHelp =
     "                            all-agent sums (docs/newton-refine.md) (default none)\n"
     "  --refine-grad-tol T       the refinement stops at ||grad f|| <= T (default 1e-6) or\n"
     "                            after a step that lowered f by < F f, --refine-rel-tol F\n"
-    "                            (default 1e-5)\n"
-    "  --refine-cg-iters K       its CG iteration cap, all steps (default 3000)\n";
+    "                            (default 1e-7)\n"
+    "  --refine-cg-iters K       its CG iteration cap, all steps (default 10000)\n";
 
 namespace {
 

@@ -74,7 +74,7 @@ options:
                        (docs/newton-refine.md) (default none)
   --refine-grad-tol T, --refine-rel-tol F
                        its stops: ||grad f|| <= T, or a step lowered f by < F f (0 = the
-                       defaults, 1e-6 and 1e-5)
+                       defaults, 1e-6 and 1e-7)
   --robust none|gnc-tls  gnc-tls: reject outlier measurements by graduated non-convexity
                        with a truncated least-squares cost, then solve (and with --certify
                        certify) the kept ones; every agent weighs the measurements of its

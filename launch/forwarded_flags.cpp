@@ -237,7 +237,7 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
       {"refine-grad-tol", "refine-grad-tol", true, ForwardTo::kCoordinator, "--refine-grad-tol T",
        "the refinement stops at ||grad f|| <= T       [1e-6]", check_refine_grad_tol},
       {"refine-rel-tol", "refine-rel-tol", true, ForwardTo::kCoordinator, "--refine-rel-tol F",
-       "or after a step that lowered f by < F f           [1e-5]", check_refine_rel_tol},
+       "or after a step that lowered f by < F f           [1e-7]", check_refine_rel_tol},
       {"rejected", "rejected", true, ForwardTo::kCoordinator, "--rejected FILE",
        "write the rejected edge indices (from 0 over the EDGE\n"
        "lines), one a line",

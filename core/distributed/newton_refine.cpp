@@ -7,6 +7,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "distributed/nonzero_rows.hpp"
+#include "distributed/rigid_retraction.hpp"
 
 namespace tessera {
 
@@ -279,7 +280,7 @@ void NewtonRefineProtocol::try_step(const std::string& cg_stop, std::vector<Outg
   s_full_ = s_;
   scale_ = 1.0;
   backtracks_ = 0;
-  Xt_ = problem_.manifold(static_cast<int>(X_.rows())).retract(X_, s_);
+  Xt_ = retract_rigid(problem_.manifold(static_cast<int>(X_.rows())), problem_.dim(), X_, s_);
   send_public(Xt_, kTrial, out);
 }
 
@@ -346,7 +347,7 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
     step_.radius = radius_;
     step_.cg_stop = "backtrack";
     step_.predicted = -(scale_ * gs_ + 0.5 * scale_ * scale_ * sHs_);
-    Xt_ = problem_.manifold(static_cast<int>(X_.rows())).retract(X_, s_);
+    Xt_ = retract_rigid(problem_.manifold(static_cast<int>(X_.rows())), problem_.dim(), X_, s_);
     send_public(Xt_, kTrial, out);
     return;
   }
