@@ -59,7 +59,7 @@ bool RoundReports::on_report(const wire::RoundStatus& m) {
   }
   if (m.phase() == kAgentStageProgressPhase) {
     lines_.on_stage(static_cast<std::uint32_t>(m.block_grad_norm()),
-                    static_cast<std::uint32_t>(m.grad_norm_sq()), m.cost());
+                    static_cast<std::uint64_t>(m.grad_norm_sq()), m.cost());
     return true;
   }
   if (m.phase() == kAgentRobustReportPhase) {

@@ -18,17 +18,21 @@ void ProgressPrinter::finish() {
   if (pending_) print(*pending_, last_ms_.value_or(0));
 }
 
-void ProgressPrinter::on_stage(std::uint32_t stage, std::uint32_t iteration, double value) {
+void ProgressPrinter::on_stage(std::uint32_t stage, std::uint64_t iteration, double value) {
   if (!enabled_) return;
   finish();  // the rounds' last line first
   char buf[160];
+  const auto low = static_cast<unsigned>(iteration & 0xffffffffu);
   if (stage == 1)
-    std::snprintf(buf, sizeof(buf), "certificate: iteration %u, lambda_min estimate %.3e\n",
-                  iteration, value);
+    std::snprintf(buf, sizeof(buf), "certificate: iteration %u, lambda_min estimate %.3e\n", low,
+                  value);
+  else if (stage == 3)
+    std::snprintf(buf, sizeof(buf), "refinement: Newton step %u, CG iteration %u, gradient %.3e\n",
+                  static_cast<unsigned>(iteration >> 32), low, value);
   else
     std::snprintf(buf, sizeof(buf),
-                  "rounding: translation CG iteration %u, cost moved by the last steps %.3e\n",
-                  iteration, value);
+                  "rounding: translation CG iteration %u, cost moved by the last steps %.3e\n", low,
+                  value);
   out_ << buf << std::flush;
 }
 

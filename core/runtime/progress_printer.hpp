@@ -30,8 +30,10 @@ class ProgressPrinter {
   void finish();
   /// Agent 0's progress report of a stage after the rounds (runtime/stage_progress.hpp; it
   /// sends a few a minute): stage 1 "certificate: iteration K, lambda_min estimate V",
-  /// stage 2 "rounding: translation CG iteration K, cost still moving V"; printed at once.
-  void on_stage(std::uint32_t stage, std::uint32_t iteration, double value);
+  /// stage 2 "rounding: translation CG iteration K, cost still moving V", stage 3
+  /// "refinement: Newton step S, CG iteration K, gradient G" (`iteration` packs S and K:
+  /// refinement_iteration()); printed at once.
+  void on_stage(std::uint32_t stage, std::uint64_t iteration, double value);
 
  private:
   void print(const CompletedStep& step, double ms);

@@ -128,6 +128,9 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
       const auto p = sequence->certificate_progress();
       if (p && p->first > 0)  // from its first iteration on: a lambda_min estimate to show
         mail.report_progress(ProgressStage::kCertificate, p->first, p->second);
+      else if (const auto r = sequence->refine_progress())
+        mail.report_progress(ProgressStage::kRefinement,
+                             refinement_iteration(r->step, r->cg_iteration), r->grad_norm);
     };
     mail.run_protocol(
         *sequence, hooks.resume_from ? sequence->resume(*hooks.resume_from) : sequence->start(),

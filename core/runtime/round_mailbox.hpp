@@ -68,12 +68,12 @@ class Mailbox {
   }
 
   /// Called in run_protocol() after each message the protocol handled (agent 0's progress
-  /// reports during the certificate); may be empty.
+  /// reports during the certificate and the Newton refinement); may be empty.
   std::function<void()> after_handled;
 
   /// Agent 0's progress report of a stage after the rounds (runtime/stage_progress.hpp); on
   /// the other agents it does nothing.
-  void report_progress(ProgressStage stage, std::uint32_t iteration, double value) {
+  void report_progress(ProgressStage stage, std::uint64_t iteration, double value) {
     if (!progress_) progress_.emplace(self_ == 0, channel_);
     progress_->report(stage, iteration, value);
   }

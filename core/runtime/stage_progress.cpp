@@ -12,7 +12,7 @@ void StageProgressOptions::validate() const {
 }
 
 RoundStatusMessage stage_progress_status(std::uint32_t sequence, ProgressStage stage,
-                                         std::uint32_t iteration, double value) {
+                                         std::uint64_t iteration, double value) {
   RoundStatusMessage m;
   m.round = sequence;
   m.grad_norm_sq = static_cast<double>(iteration);
@@ -29,7 +29,7 @@ StageProgress::StageProgress(bool reporter, ProtocolChannel& channel, StageProgr
       period_(std::chrono::duration_cast<Clock::duration>(
           std::chrono::duration<double>((options.validate(), options.period_s)))) {}
 
-void StageProgress::report(ProgressStage stage, std::uint32_t iteration, double value,
+void StageProgress::report(ProgressStage stage, std::uint64_t iteration, double value,
                            Clock::time_point now) {
   if (!reporter_) return;
   if (stage_ == stage && now - last_ < period_) return;

@@ -80,6 +80,12 @@ class CertifiedAgent : public AgentProcess {
     if (!certify_ || current_ != certify_.get()) return std::nullopt;
     return std::make_pair(certify_->iteration(), certify_->ritz_value());
   }
+  /// While a Newton refinement runs: its progress (NewtonRefineProtocol::progress());
+  /// nullopt in the other stages.
+  std::optional<NewtonRefineProtocol::Progress> refine_progress() const {
+    if (!refine_ || current_ != refine_.get()) return std::nullopt;
+    return refine_->progress();
+  }
 
  private:
   void begin(std::uint32_t stage, std::vector<OutgoingMessage>& out,

@@ -29,6 +29,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <tessera/distributed/agent_process.hpp>
 #include <tessera/distributed/agent_state.hpp>
@@ -124,6 +125,19 @@ class NewtonRefineProtocol : public AgentProcess {
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
   bool done() const override { return done_; }
   const NewtonRefineResult& result() const { return result_; }
+
+  /// Where the refinement is, for progress reports: the trust-region step being computed
+  /// (1-based, rejected ones and backtracks counted), the CG iterations of that step so far and
+  /// ||grad f|| at the current point. nullopt until the start point's sums are in.
+  struct Progress {
+    std::uint32_t step = 0, cg_iteration = 0;
+    double grad_norm = 0.0;
+  };
+  std::optional<Progress> progress() const {
+    if (message_round_ == 0) return std::nullopt;
+    return Progress{static_cast<std::uint32_t>(result_.steps + 1),
+                    static_cast<std::uint32_t>(step_.cg_iterations), gnorm_};
+  }
 
  private:
   void pump(std::vector<OutgoingMessage>& out);
