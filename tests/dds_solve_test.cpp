@@ -1,6 +1,6 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-170 and 55-56 (each test its own, so ctest -j is safe).
+// Domains used here: 161-170, 55-56, 75 and 112-113 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -52,7 +52,7 @@ DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int
 }
 
 void expect_same_as_in_process(const std::string& algorithm, int domain, bool status_relay = true,
-                               bool coarse = false, bool smoothed = false) {
+                               bool coarse = false, bool smoothed = false, int agents = 3) {
   const std::string dir = temp_dir();
   const std::string graph = generate(dir, 240, 3, 5);
   std::vector<std::string> coordinator_args = {"--partition", "eco", "--algorithm", algorithm,
@@ -62,7 +62,7 @@ void expect_same_as_in_process(const std::string& algorithm, int domain, bool st
   if (smoothed)
     coordinator_args.insert(coordinator_args.end(),
                             {"--coarse-space", "smoothed", "--coarse-aggregates", "2"});
-  const DdsRun dds = run_dds(dir, graph, 3, domain, coordinator_args);
+  const DdsRun dds = run_dds(dir, graph, agents, domain, coordinator_args);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(dds.assignment.size(), g.num_poses);
 
@@ -127,17 +127,25 @@ TEST(DdsSolve, StatusesAllToAllGiveTheInProcessIterates) {
   expect_same_as_in_process("rbcd++", 168, false);
 }
 
-// Two-level rounds: the coarse terms ride on the statuses (through the relay's bundle, or all
-// to all), every agent solves the same coarse problem, so the same iterates as in process.
+// Two-level rounds: the coarse terms go to agent 0 (riding in the status to the relay, or on
+// their own), which solves and sends each agent its motions: the same iterates as in process.
 TEST(DdsSolve, CoarseCorrectionOverDdsGivesTheInProcessIterates) {
   expect_same_as_in_process("irbcd", 55, true, true);
   expect_same_as_in_process("irbcd", 56, false, true);
 }
 
-// The smoothed coarse space: every agent builds it from the structure it holds, the terms ride
-// in the statuses as before, so the DDS agents give the in-process iterates.
+// The smoothed coarse space: every agent builds it from the structure it holds (solver and
+// agents agree on who needs which motions), so the DDS agents give the in-process iterates.
 TEST(DdsSolve, SmoothedCoarseCorrectionOverDdsGivesTheInProcessIterates) {
   expect_same_as_in_process("irbcd", 75, true, true, true);
+}
+
+// The gathered coarse exchange with more agents: the terms go to agent 0 (riding in the status
+// to the relay, or on their own), agent 0 solves and sends each agent its motions addressed, and
+// the DDS agents give the in-process iterates.
+TEST(DdsSolve, GatheredCoarseExchangeWithSixAgentsGivesTheInProcessIterates) {
+  expect_same_as_in_process("irbcd", 112, true, true, true, 6);
+  expect_same_as_in_process("irbcd", 113, false, true, true, 6);
 }
 
 // Kills whatever processes of run `run_id` a test leaves running when an assertion fails (a

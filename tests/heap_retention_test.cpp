@@ -1,6 +1,8 @@
 // The agent's malloc settings (launch/heap_retention.hpp): freed memory at the top of the heap
 // stays in the process instead of being trimmed and faulted back in by the next round. Each
 // case runs in a forked child, since the settings are process-wide.
+#include "launch/heap_retention.hpp"
+
 #include <gtest/gtest.h>
 #include <malloc.h>
 #include <sys/wait.h>
@@ -9,8 +11,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <vector>
-
-#include "launch/heap_retention.hpp"
 
 namespace {
 

@@ -35,10 +35,11 @@ inline bool relayed_phase(std::uint32_t phase) {
 
 /// Whether a pose block of this phase to the relay may ride in the sender's relayed status
 /// sample (Session::send_all): the solve's blocks (core's ProtocolPhase kInit, kUpdate,
-/// kRedoUpdate), which core buffers by (round, phase, sender), so that they may arrive on
-/// another topic than the sender's other blocks.
+/// kRedoUpdate, and kCoarseTerms: the relay is the coarse solver, coarse_exchange.hpp), which
+/// core buffers by (round, phase, sender), so that they may arrive on another topic than the
+/// sender's other blocks.
 inline bool rides_with_status(std::uint32_t phase) {
-  return phase == 0 || phase == 3 || phase == 4;
+  return phase == 0 || phase == 3 || phase == 4 || phase == 6;
 }
 
 /// The relay's collection of one process. Not thread-safe: the session guards it with its

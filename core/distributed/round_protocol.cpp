@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <tessera/distributed/coarse_exchange.hpp>
 #include <tessera/distributed/protocol_snapshot.hpp>
 #include <tessera/distributed/round_protocol.hpp>
 
@@ -139,7 +140,7 @@ std::vector<OutgoingMessage> RoundProtocol::handle(const ProtocolMessage& messag
     round = s.round, phase = s.phase, sender = s.sender;
   }
   if (sender >= u32(layout_.num_blocks) ||
-      phase > static_cast<std::uint32_t>(ProtocolPhase::kRedoStatus))
+      phase > static_cast<std::uint32_t>(ProtocolPhase::kCoarseMotions))
     throw std::runtime_error("agent " + std::to_string(state_.id()) +
                              ": malformed message (sender " + std::to_string(sender) + ", phase " +
                              std::to_string(phase) + ")");
@@ -238,6 +239,12 @@ void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {
       ++round_;
       begin_status(ProtocolPhase::kRedoStatus, out);
       return;
+    case ProtocolPhase::kCoarseTerms:
+      solve_gathered_coarse(inbox, out);
+      return;
+    case ProtocolPhase::kCoarseMotions:
+      take_coarse_motions(inbox, out);
+      return;
   }
 }
 
@@ -261,8 +268,27 @@ void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessag
     m.cost = s.cost_share;
     m.grad_norm_sq = s.grad_norm_sq;
     m.block_grad_norm = s.block_grad_norm;
-    if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_))
-      m.coarse = state_.coarse_space() ? state_.smoothed_coarse_terms() : state_.coarse_terms();
+    if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_)) {
+      std::vector<double> terms =
+          state_.coarse_space() ? state_.smoothed_coarse_terms() : state_.coarse_terms();
+      if (!config_.coarse.gather) {
+        m.coarse = std::move(terms);
+      } else {
+        // Beside the status, to the solver only (its own straight into its inbox).
+        const auto step = ProtocolPhase::kCoarseTerms;
+        PoseBlockMessage t = coarse_terms_message(
+            state_.id(), u32(round_), static_cast<std::uint32_t>(step), std::move(terms));
+        if (state_.id() == kCoarseSolver) {
+          pending_[key(u32(round_), step)].emplace(state_.id(), std::move(t));
+        } else {
+          OutgoingMessage o;
+          o.message = std::move(t);
+          o.broadcast = false;
+          o.recipients = {u32(kCoarseSolver)};
+          out.push_back(std::move(o));
+        }
+      }
+    }
     // Our own status goes straight into the inbox: the reduction then treats every agent alike.
     pending_[key(u32(round_), phase)].emplace(state_.id(), m);
     OutgoingMessage o;
@@ -300,7 +326,9 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
                        scheme_->restart_constant() >= 0 &&
                        f_prev_ - f < scheme_->restart_constant() * gsq_prev_;
   if (restart) {
-    // Back to Y^{k-1}; the same blocks redo a plain update from there.
+    // Back to Y^{k-1}; the same blocks redo a plain update from there. Round k's coarse
+    // terms (gathered) are not used.
+    pending_.erase(key(u32(round_), ProtocolPhase::kCoarseTerms));
     ++restarts_;
     trace_.back().restart = true;
     --round_;
@@ -338,8 +366,27 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   }
   // The coarse correction moves Y^k before the block updates; f moves by exactly the coarse
   // cost's change, so the next restart test compares against the corrected cost.
-  if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_))
+  if (phase == ProtocolPhase::kStatus && config_.coarse.scheduled(round_)) {
+    if (config_.coarse.gather) {
+      held_ = {rec, f, gsq, norms};
+      if (me == kCoarseSolver) {
+        std::vector<int> all(static_cast<std::size_t>(layout_.num_blocks));
+        for (int b = 0; b < layout_.num_blocks; ++b) all[static_cast<std::size_t>(b)] = b;
+        expect(u32(round_), ProtocolPhase::kCoarseTerms, std::move(all));
+      } else {
+        expect(u32(round_), ProtocolPhase::kCoarseMotions, {kCoarseSolver});
+      }
+      return;
+    }
     f += coarse_correct(inbox, round_ > 0 ? f_prev_ - f : 0.0);
+  }
+  continue_round(rec, f, gsq, norms, out);
+}
+
+void RoundProtocol::continue_round(RoundRecord rec, double f, double gsq,
+                                   const std::vector<double>& norms,
+                                   std::vector<OutgoingMessage>& out) {
+  const int me = state_.id();
   f_prev_ = f;
   gsq_prev_ = gsq;
   const ClassScore class_score = scheme_ ? scheme_->class_score() : ClassScore::kLargestBlock;
@@ -403,6 +450,66 @@ double RoundProtocol::coarse_correct(const Inbox& inbox, double last_decrease) {
   ++coarse_corrections_;
   coarse_decrease_ += c.cost_before - c.cost_after;
   return c.cost_after - c.cost_before;
+}
+
+const std::vector<int>& RoundProtocol::coarse_unknowns(int agent) {
+  if (coarse_unknowns_.empty())
+    coarse_unknowns_.resize(static_cast<std::size_t>(layout_.num_blocks));
+  auto& u = coarse_unknowns_[static_cast<std::size_t>(agent)];
+  if (u.empty()) u = coarse_unknowns_of(state_.coarse_space(), layout_, agent);
+  return u;
+}
+
+void RoundProtocol::solve_gathered_coarse(const Inbox& inbox, std::vector<OutgoingMessage>& out) {
+  std::vector<const std::vector<double>*> terms;
+  terms.reserve(inbox.size());
+  for (const auto& [sender, m] : inbox) terms.push_back(&coarse_terms_of(m));
+  const CoarseSpace* space = state_.coarse_space();
+  const double last_decrease = round_ > 0 ? f_prev_ - held_.f : 0.0;
+  const CoarseResult c = space ? solve_smoothed_coarse(*space, state_.rank(), terms, config_.coarse)
+                               : solve_coarse(layout_, state_.rank(), terms, config_.coarse);
+  const bool applied =
+      c.moved && c.cost_before - c.cost_after >= config_.coarse.min_gain * last_decrease;
+  const double decrease = c.cost_before - c.cost_after;
+  for (int a = 0; a < layout_.num_blocks; ++a) {
+    if (a == state_.id()) continue;
+    OutgoingMessage o;
+    o.message = coarse_motions_message(state_.id(), u32(round_),
+                                       static_cast<std::uint32_t>(ProtocolPhase::kCoarseMotions),
+                                       coarse_unknowns(a), c.motions, decrease, applied);
+    o.broadcast = false;
+    o.recipients = {u32(a)};
+    out.push_back(std::move(o));
+  }
+  double f = held_.f;
+  if (applied) {
+    if (space)
+      state_.apply_smoothed_coarse(c.motions);
+    else
+      state_.apply_coarse(c.motions);
+    ++coarse_corrections_;
+    coarse_decrease_ += decrease;
+    f -= decrease;
+  }
+  continue_round(held_.rec, f, held_.gsq, held_.norms, out);
+}
+
+void RoundProtocol::take_coarse_motions(const Inbox& inbox, std::vector<OutgoingMessage>& out) {
+  const CoarseSpace* space = state_.coarse_space();
+  const int count = space ? space->num_aggregates : layout_.num_blocks;
+  const ReceivedCoarseMotions c = read_coarse_motions(inbox.at(kCoarseSolver), state_.rank(), count,
+                                                      coarse_unknowns(state_.id()));
+  double f = held_.f;
+  if (c.applied) {
+    if (space)
+      state_.apply_smoothed_coarse(c.motions);
+    else
+      state_.apply_coarse(c.motions);
+    ++coarse_corrections_;
+    coarse_decrease_ += c.decrease;
+    f -= c.decrease;
+  }
+  continue_round(held_.rec, f, held_.gsq, held_.norms, out);
 }
 
 bool RoundProtocol::stalled(const RoundRecord& rec) const {

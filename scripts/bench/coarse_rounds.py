@@ -4,8 +4,9 @@
 IRBCD on the generated 8000-pose grid (`tessera generate --kind grid3d --poses 8000 --robots 5
 --seed 1`), N = 4, 9, 16, 25, 49 agents, chordal initialisation, in-process engine (the same
 messages as over DDS): rounds to ||grad f|| <= 0.01, the ratio to the rounds at N = 4, and the
-bytes a round exchanges (all messages, each recipient counted: pose blocks and statuses, the
-coarse terms riding on the statuses; and the same divided by N, what one agent receives), one-level
+bytes a round exchanges (all messages, each recipient counted: pose blocks, statuses, the coarse
+terms to the solver agent and its motions back; and the same divided by N, what one agent receives on
+average), one-level
 (`--coarse off`) beside two-level over each coarse space of `--spaces` (`--coarse on --coarse-space
 blocks|smoothed`). Prints one table and writes docs/benchmarks/coarse_rounds.csv.
 

@@ -9,7 +9,8 @@ initialisation, partition seeds 1..S, this runs
 
 with `--partition` each of --presets (default: `auto`, what solve and launch use: `fast` below 2000 poses,
 `eco` above), and reads
-from the trace the first round with ||grad f|| <= 0.2 and <= 0.01. The target (issue: "at most 0.35x")
+from the trace the first round with ||grad f|| <= 0.2 and <= 0.01, and the KB a round exchanges (all messages,
+each recipient counted) and the CPU milliseconds a round (all agents; load-dependent), medians over seeds. The target (issue: "at most 0.35x")
 compares the median over seeds of the rounds to 0.2 with the baseline's *fewest* rounds to its 0.1 over
 all of its partitions (sequential and the paper's highest). Rounds are counts: they do not depend on load.
 Writes docs/benchmarks/rounds_vs_baseline.{csv,md}.
@@ -28,6 +29,12 @@ import bench_common as bc  # noqa: E402
 
 GRAPHS = ["intel", "CSAIL", "sphere2500", "torus3D", "parking-garage", "cubicle", "manhattan3500", "city10000"]
 TARGET = 0.35
+
+
+def median_of(values):
+    """Median of the known values (None when there is none)."""
+    known = [v for v in values if v is not None]
+    return statistics.median(known) if known else None
 
 
 def baseline_fewest(shared):
@@ -67,7 +74,7 @@ def main():
         if not os.path.exists(path):
             sys.exit(f"rounds_vs_baseline: {path} is missing (../shared/datasets must be beside the repo)")
         for preset in args.presets.split(","):
-            r02, r001 = [], []
+            r02, r001, kb, cpu = [], [], [], []
             for seed in range(1, args.seeds + 1):
                 bc.progress(f"{g}: IRBCD, {preset} partition, seed {seed}")
                 s, trace, _, _ = bc.run_tessera(ctx, ["solve", path, "--algorithm", "irbcd", "--agents", "5",
@@ -78,16 +85,21 @@ def main():
                 a, b = bc.first_round(trace, 0.2), bc.first_round(trace, 0.01)
                 r02.append(a)
                 r001.append(b)
+                per_round = [int(r["bytes"]) for r in trace if "bytes" in r and int(r["round"]) < s["rounds"]]
+                kb.append(statistics.mean(per_round) / 1000 if per_round else None)
+                cpu.append(s.get("cpu_ms_per_round"))
                 rows.append({"graph": g, "preset": preset, "seed": seed, "cut_edges": s["cut_edges"],
-                             "colours": s.get("colours"), "rounds_to_0.2": a, "rounds_to_0.01": b})
+                             "colours": s.get("colours"), "rounds_to_0.2": a, "rounds_to_0.01": b,
+                             "kb_per_round": kb[-1], "cpu_ms_per_round": cpu[-1]})
             med = statistics.median([x for x in r02 if x is not None]) if all(x is not None for x in r02) else None
             fewest, where = base.get(g, (None, ""))
             ratio = med / fewest if med is not None and fewest else None
             table.append([g, preset, " ".join(str(x) for x in r02), bc.fmt(med), " ".join(str(x) for x in r001),
                           f"{fewest} ({where})" if fewest else "-", bc.fmt(ratio, "{:.3f}"),
-                          "-" if ratio is None else ("yes" if ratio <= TARGET else "NO")])
+                          "-" if ratio is None else ("yes" if ratio <= TARGET else "NO"),
+                          bc.fmt(median_of(kb), "{:.1f}"), bc.fmt(median_of(cpu), "{:.1f}")])
     headers = ["graph", "partition", "IRBCD rounds to 0.2, seeds 1..", "median", "rounds to 0.01",
-               "baseline RBCD++ fewest to 0.1", "ratio", f"<= {TARGET}"]
+               "baseline RBCD++ fewest to 0.1", "ratio", f"<= {TARGET}", "KB/round", "cpu ms/round"]
     md = bc.print_table("IRBCD (N = 5, chordal start) against the public RBCD++ baseline's fewest rounds", headers,
                         table)
     bc.write_csv(os.path.join(ctx.out_dir, "rounds_vs_baseline.csv"), rows)

@@ -11,9 +11,10 @@
 // pose i. Summed over the cut this is tr(Z Q_c Z^T) with Q_c an N(r+1) x N(r+1) matrix whose
 // (a, b) block is non-zero only for adjacent blocks: one small pose-graph-like problem over N
 // rigid motions. Each agent contributes its cut edges' sums ((r+1)^2 numbers per neighbour and
-// matrix), they travel with the round status every agent broadcasts anyway, and every agent
-// solves the same small problem in the same order, so all agents apply bit-identical motions
-// without a coordinator and without another message step. The motions keep every pose on the
+// matrix); one agent gathers them, solves the small problem and sends each agent the motions
+// it needs (coarse_exchange.hpp; or, CoarseOptions::gather off, the terms ride in the status
+// every agent broadcasts and every agent solves the same problem in the same order), so all
+// agents apply bit-identical motions without a coordinator. The motions keep every pose on the
 // manifold (G orthogonal), so the iterate stays feasible and the certificate is unaffected;
 // a motion is applied only when it lowers f, by exactly the coarse cost's decrease.
 
@@ -54,7 +55,7 @@ struct CoarseOptions {
   /// (0, 1].
   double smoothing_weight = 2.0 / 3.0;
   /// Rounds between corrections (>= 1): a correction at every round k with k % every == 0.
-  /// Only those rounds' status messages carry the coarse terms.
+  /// Only those rounds carry coarse terms.
   int every = 1;
   /// Most Levenberg-Marquardt iterations of one coarse solve (>= 1).
   int max_iterations = 10;
@@ -65,6 +66,12 @@ struct CoarseOptions {
   /// the last round's block updates did (>= 0; 0 = whenever it lowers f). When the blocks are
   /// already aligned (few blocks), a tiny correction only disturbs the momentum.
   double min_gain = 0.0;
+  /// How terms and motions travel (coarse_exchange.hpp). true: every agent sends its terms to
+  /// one solver agent, which solves once and sends each agent only the motions it moves by
+  /// (bytes a round grow with N; one more message step on correction rounds). false: the terms
+  /// ride in the status every agent broadcasts and every agent solves the same problem (no
+  /// extra step; bytes grow with N^2, N solves). Bit-identical iterates either way.
+  bool gather = true;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;

@@ -16,6 +16,10 @@
 //               same two message steps as a plain RBCD round.
 //   UPDATE      the selected agents update their block and send their public Y^{k+1} poses;
 //               every agent then advances its own V and its copy of the neighbours' V.
+//   COARSE      (correction rounds, CoarseOptions; after the status reduction, before the
+//               selection) the coarse correction moves Y^k; gathered, the solver agent waits
+//               for every agent's terms (sent beside the status) and each other agent for
+//               the solver's motions: one more message step.
 //   Restart:    if the STATUS of round k+1 shows f(Y^k) - f(Y^{k+1}) < c ||grad f(Y^k)||^2,
 //               every agent returns to Y^k, S_k redo a plain block update from Y^k (REDO_UPDATE),
 //               V := Y, and the status is taken again (REDO_STATUS).
@@ -52,7 +56,11 @@ enum class ProtocolPhase : std::uint32_t {
   kExtrapolate = 2,  ///< Retired (P^k is formed locally); the number stays reserved.
   kUpdate = 3,       ///< Public Y^{k+1} poses of the selected blocks.
   kRedoUpdate = 4,   ///< Same after a restart.
-  kRedoStatus = 5    ///< Round status after a restart.
+  kRedoStatus = 5,   ///< Round status after a restart.
+  /// Coarse-correction rounds, gathered exchange (coarse_exchange.hpp): an agent's coarse terms
+  /// for the solver agent, sent beside the status, and the solver's motions for an agent.
+  kCoarseTerms = 6,
+  kCoarseMotions = 7
 };
 
 /// What the protocol needs to know; identical on every agent.
@@ -158,6 +166,21 @@ class RoundProtocol : public AgentProcess {
   // of f (<= 0).
   // `last_decrease`: f's decrease over the last round (gates the correction, min_gain).
   double coarse_correct(const Inbox& inbox, double last_decrease);
+  // Gathered exchange: the solver's step (all terms in) and the others' (the motions in).
+  void solve_gathered_coarse(const Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void take_coarse_motions(const Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // The coarse unknowns each agent moves by (coarse_exchange.hpp); the solver fills all.
+  const std::vector<int>& coarse_unknowns(int agent);
+  std::vector<std::vector<int>> coarse_unknowns_;
+  // The status step's outcome while the gathered correction is in flight.
+  struct HeldStatus {
+    RoundRecord rec;
+    double f = 0.0, gsq = 0.0;
+    std::vector<double> norms;
+  } held_;
+  // The rest of the status step (after any coarse correction): selection and update.
+  void continue_round(RoundRecord rec, double f, double gsq, const std::vector<double>& norms,
+                      std::vector<OutgoingMessage>& out);
   std::string stop_reason_;
   RoundHistory trace_;  // snapshots copy it every round: cheap copies
   std::chrono::steady_clock::time_point start_time_;

@@ -38,8 +38,8 @@ struct RoundStatusMessage {
   double block_grad_norm = 0.0;  ///< This block's own gradient norm (greedy selection).
   bool restart_vote = false;
   bool done_vote = false;
-  /// Coarse-correction rounds only: this agent's coarse terms (distributed/coarse_correction.hpp);
-  /// empty otherwise.
+  /// Coarse-correction rounds exchanged all to all (CoarseOptions::gather off) only: this
+  /// agent's coarse terms (distributed/coarse_correction.hpp); empty otherwise.
   std::vector<double> coarse;
   /// Robust (GNC) exchanges only (robust/gnc_agent.hpp): measurements by their position in the
   /// input file and their weights, same order; empty otherwise.
