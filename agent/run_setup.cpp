@@ -15,6 +15,7 @@
 #include "agent/lost_for_good.hpp"
 #include "agent/robot_data.hpp"
 #include "agent/share_announcement.hpp"
+#include "launch/heap_retention.hpp"
 #include "launch/process_tuning.hpp"
 #include "runtime/initialization_stage.hpp"
 #include "runtime/known_inlier_start.hpp"
@@ -83,6 +84,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
 
   // 1. Our share of the graph: robot I's part of the whole file, or the robot's own file.
   RobotShare share = load_robot_share(o.graph, o.id, o.robots);
+  launch::release_freed_heap();  // the file's text
   log("read " + o.graph + ": poses [" + std::to_string(share.begin) + ", " +
       std::to_string(share.end) + ") of " + std::to_string(share.num_poses) + ", " +
       std::to_string(share.measurements.size()) + " measurements");
@@ -177,6 +179,8 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
     }
   }
 
+  launch::release_freed_heap();  // the initialisation's factorizations and the assignment's copy
+
   // 7. Hand-off, peer to peer: exactly one message to every other agent. A peer sends its
   // hand-off when its initialisation is done, which is computation (minutes for 25 agents of a
   // 1M-pose grid on 2 cores: 30 s timed out), so the wait is bounded like a round's, not like a
@@ -190,6 +194,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   log("hand-off complete: " + std::to_string(out.local.owned.size()) + " poses, " +
       std::to_string(out.local.measurements.size()) + " measurements");
   if (!o.dump_local.empty()) write_local_dump(out.local, o.dump_local);
+  launch::release_freed_heap();  // the hand-off's messages
   return out;
 }
 

@@ -12,4 +12,8 @@ bool retain_freed_heap() {
   return mapping && trim;
 }
 
+void release_freed_heap() {
+  malloc_trim(0);
+}
+
 }  // namespace tessera::launch

@@ -42,17 +42,23 @@ struct BlockJacobi {
   std::vector<double> block_inverses;  // w x w inverses one after the other (column-major)
   double shift = 0.0;
 
-  // Pose-wise inverses of the diagonal blocks of A; false when one is not positive definite.
-  bool invert_diagonal_blocks(const SparseMatrix& A, int width) {
+  // Pose-wise inverses of the diagonal blocks of Q - L + shift I (the same sums, in the same
+  // order, as forming that matrix); false when one is not positive definite.
+  bool invert_diagonal_blocks(const SparseMatrix& Q, const SparseMatrix& L, double shift,
+                              int width) {
     w = width;
-    const Eigen::Index blocks = A.rows() / w;
+    const Eigen::Index blocks = Q.rows() / w;
     block_inverses.assign(static_cast<std::size_t>(blocks * w * w), 0.0);
     Eigen::MatrixXd B(w, w);
     for (Eigen::Index b = 0; b < blocks; ++b) {
       B.setZero();
-      for (int c = 0; c < w; ++c)
-        for (SparseMatrix::InnerIterator it(A, b * w + c); it; ++it)
+      for (int c = 0; c < w; ++c) {
+        for (SparseMatrix::InnerIterator it(Q, b * w + c); it; ++it)
           if (it.row() >= b * w && it.row() < (b + 1) * w) B(it.row() - b * w, c) = it.value();
+        for (SparseMatrix::InnerIterator it(L, b * w + c); it; ++it)
+          if (it.row() >= b * w && it.row() < (b + 1) * w) B(it.row() - b * w, c) -= it.value();
+        B(c, c) += shift;
+      }
       Eigen::LLT<Eigen::MatrixXd> llt(B);
       if (llt.info() != Eigen::Success) return false;
       Eigen::Map<Eigen::MatrixXd>(block_inverses.data() + b * w * w, w, w) =
@@ -87,11 +93,16 @@ std::vector<int> CertificateProtocol::everyone() const {
   return all;
 }
 
+Eigen::MatrixXd CertificateProtocol::gradient(const Eigen::MatrixXd& v,
+                                              const Eigen::MatrixXd& vn) const {
+  return problem_.num_neighbors() > 0 ? problem_.euclidean_gradient(v, vn)
+                                      : problem_.euclidean_gradient(v);
+}
+
 Eigen::MatrixXd CertificateProtocol::apply(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn) {
   // (v S)_B = v_B Q_BB + v_N Q_NB - v_B Lambda_B; euclidean_gradient is 2 (X Q_BB + X_N Q_NB)
   // and the halving is exact.
-  if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(vn);
-  Eigen::MatrixXd out = 0.5 * problem_.euclidean_gradient(v);
+  Eigen::MatrixXd out = 0.5 * gradient(v, vn);
   out -= v * lambda_;
   return out;
 }
@@ -101,8 +112,7 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
   const Eigen::Index w = d + 1;
   const Eigen::Index m = static_cast<Eigen::Index>(problem_.num_owned());
   const Eigen::MatrixXd& Y = state_.Y;
-  if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(state_.Yn);
-  const Eigen::MatrixXd G = 0.5 * problem_.euclidean_gradient(Y);  // (X Q)_B
+  const Eigen::MatrixXd G = 0.5 * gradient(Y, state_.Yn);  // (X Q)_B
   std::vector<Eigen::Triplet<double>> trip;
   trip.reserve(static_cast<std::size_t>(m * d * d));
   for (Eigen::Index i = 0; i < m; ++i) {
@@ -120,14 +130,20 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
   if (options_.preconditioner == CertificatePreconditioner::kBlockJacobi && m > 0) {
     const double local_scale = std::max(1.0, local_max_diag_);
     precon_ = std::make_unique<BlockJacobi>();
-    SparseMatrix S = Q - lambda_;
-    SparseMatrix I(S.rows(), S.cols());
-    I.setIdentity();
     double shift = std::max(options_.relative_tolerance, 1e-12) * local_scale;
     const bool pose_wise = state_.block_factor_too_large();
+    // The exact factor's matrix S_BB = Q_BB - Lambda_B; the pose-wise fallback (large blocks)
+    // reads S_BB's diagonal blocks straight from Q_BB and Lambda_B instead: two matrices the
+    // size of Q_BB less at the agent's memory peak.
+    SparseMatrix S, I;
+    if (!pose_wise) {
+      S = Q - lambda_;
+      I.resize(S.rows(), S.cols());
+      I.setIdentity();
+    }
     for (;;) {
       if (pose_wise) {
-        if (precon_->invert_diagonal_blocks(S + shift * I, static_cast<int>(w))) break;
+        if (precon_->invert_diagonal_blocks(Q, lambda_, shift, static_cast<int>(w))) break;
       } else {
         precon_->factor.compute(S + shift * I);
         if (precon_->factor.info() == Eigen::Success) break;

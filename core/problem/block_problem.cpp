@@ -191,6 +191,20 @@ Eigen::MatrixXd BlockProblem::euclidean_gradient(const Eigen::MatrixXd& X) const
   return G;
 }
 
+Eigen::MatrixXd BlockProblem::euclidean_gradient(const Eigen::MatrixXd& X,
+                                                 const Eigen::MatrixXd& X_neighbors) const {
+  if (X_neighbors.cols() != (d_ + 1) * static_cast<Eigen::Index>(neighbors_.size()))
+    throw std::invalid_argument("BlockProblem: neighbour poses have the wrong size");
+  Eigen::MatrixXd G;
+  scaled_dense_times_sparse(X, Q_bb_, 2.0, G);
+  if (!neighbors_.empty()) {
+    Eigen::MatrixXd linear;
+    scaled_dense_times_sparse(X_neighbors, Q_nb_, 1.0, linear);
+    G += 2.0 * linear;
+  }
+  return G;
+}
+
 Eigen::MatrixXd BlockProblem::riemannian_gradient(const Eigen::MatrixXd& X,
                                                   const Eigen::MatrixXd& egrad) const {
   return manifold(static_cast<int>(X.rows())).tangent_project(X, egrad);

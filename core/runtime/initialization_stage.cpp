@@ -22,9 +22,10 @@ namespace {
 enum InitPhase : std::uint32_t {
   kChordalMeasurements = kInitPhaseBase,  // agent k -> agent 0: the values it recorded
   kChordalPoses,                          // agent 0 -> all: the chordal poses of every pose
-  kUnitPoses = kInitPhaseBase + 10,       // all -> all: unit poses at inter-robot endpoints
+  kUnitPoses = kInitPhaseBase + 10,       // agent k -> agent 0: unit poses at inter-robot ends
   kUnitCount,                             // all -> all: number of units (status: cost)
-  kCrossing                               // all -> all: inter-robot measurements recorded
+  kCrossing,                              // agent k -> agent 0: inter-robot measurements recorded
+  kUnitFrames                             // agent 0 -> all: every unit's frame
 };
 
 std::uint32_t phase_of(const ProtocolMessage& m) {
@@ -169,6 +170,74 @@ std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std
   return std::vector<Pose>(poses.begin() + share.begin, poses.begin() + share.end);
 }
 
+// Agent 0: every agent's unit poses at inter-robot ends and inter-robot measurements, aligned
+// into one frame per unit (align_units), sent to every other agent.
+std::vector<Pose> unit_frames_of_agent0(const RobotShare& share, const PoseBlockMessage& ends,
+                                        std::uint32_t N, const std::vector<std::size_t>& offset,
+                                        const std::vector<const Measurement*>& crossing_mine,
+                                        const std::vector<std::uint64_t>& crossing_index,
+                                        StageMailbox& mail) {
+  const int d = share.d;
+  const std::uint32_t self = 0;
+  const std::uint32_t unit_rank = static_cast<std::uint32_t>(d + 1);
+  const std::vector<Pose> frame = [&] {
+    auto end_poses = mail.gather(kUnitPoses, others(self, N));
+    end_poses[self] = ends;
+    std::map<std::size_t, UnitPose> endpoint;
+    for (const auto& [a, msg] : end_poses) {
+      const auto& m = std::get<PoseBlockMessage>(msg);
+      const std::size_t w = width_of(m);
+      if (m.rank != unit_rank || m.dim != static_cast<std::uint32_t>(d) ||
+          m.data.size() != m.pose_ids.size() * w)
+        throw std::runtime_error("initialisation: malformed unit poses from agent " +
+                                 std::to_string(a));
+      for (std::size_t k = 0; k < m.pose_ids.size(); ++k) {
+        const double u = m.data[k * w + flat_pose_size(d)];
+        if (!(u >= 0 && u < static_cast<double>(offset[a + 1] - offset[a])))
+          throw std::runtime_error("initialisation: agent " + std::to_string(a) +
+                                   " named a unit it does not have");
+        endpoint[m.pose_ids[k]] = {offset[a] + static_cast<std::size_t>(u),
+                                   read_flat_pose(m.data, k * w, d)};
+      }
+    }
+    std::vector<std::pair<std::uint64_t, Measurement>> all;
+    for (std::size_t k = 0; k < crossing_mine.size(); ++k)
+      all.emplace_back(crossing_index[k], *crossing_mine[k]);
+    for (auto& [a, msg] : mail.gather(kCrossing, others(self, N)))
+      decode_measurement_block(std::get<PoseBlockMessage>(msg), d, share.num_poses,
+                               "initialisation", all);
+    const std::vector<Measurement> crossing = in_file_order(std::move(all));
+    return align_units(d, offset[N], crossing, endpoint);
+  }();
+  if (N > 1) {
+    PoseBlockMessage out = block(self, kUnitFrames, static_cast<std::uint32_t>(d), d);
+    const std::size_t width = flat_pose_size(d);
+    for (std::size_t u = 0; u < frame.size(); ++u) {
+      out.pose_ids.push_back(static_cast<std::uint32_t>(u));
+      append_flat_pose(out.data, frame[u], width);
+    }
+    mail.send(OutgoingMessage{std::move(out), true, {}});
+  }
+  return frame;
+}
+
+// Another agent: the units' frames from agent 0.
+std::vector<Pose> received_unit_frames(StageMailbox& mail, int d, std::size_t num_units) {
+  const auto got = mail.gather(kUnitFrames, {0});
+  const auto& m = std::get<PoseBlockMessage>(got.at(0));
+  const std::size_t width = flat_pose_size(d);
+  if (m.rank != static_cast<std::uint32_t>(d) || m.data.size() != m.pose_ids.size() * width ||
+      m.pose_ids.size() != num_units)
+    throw std::runtime_error("initialisation: malformed unit frames from agent 0");
+  std::vector<Pose> frame(num_units);
+  for (std::size_t k = 0; k < num_units; ++k) {
+    if (m.pose_ids[k] != k)
+      throw std::runtime_error("initialisation: malformed unit frames from agent 0");
+    frame[k] = read_flat_pose(m.data, k * width, d);
+  }
+  return frame;
+}
+
 std::vector<Pose> distributed_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t N,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
@@ -206,11 +275,18 @@ std::vector<Pose> distributed_stage(
   count.sender = self;
   count.phase = kUnitCount;
   count.cost = static_cast<double>(units.members.size());
+  // Agent 0 aligns the units and sends every agent their frames (one pose a unit): the
+  // alignment needs every inter-robot measurement and the unit poses at both its ends, which
+  // in every agent grew with the team and the graph (302,994 inter-robot measurements on a 1M
+  // grid over 64 robots, several hundred MB an agent). Agent 0 computes what each agent
+  // computed before, from the same data, so the frames are the same.
   if (N > 1) {
-    mail.send(OutgoingMessage{ends, true, {}});
+    if (self != 0) {
+      mail.send(OutgoingMessage{ends, false, {0}});
+      mail.send(OutgoingMessage{
+          encode_measurement_block(self, kCrossing, d, crossing_mine, crossing_index), false, {0}});
+    }
     mail.send(OutgoingMessage{count, true, {}});
-    mail.send(OutgoingMessage{
-        encode_measurement_block(self, kCrossing, d, crossing_mine, crossing_index), true, {}});
   }
   // 3. Everyone's: unit numbering in agent order (ranges tile 0..n-1 in agent order, so this
   //    is the order of the units' smallest poses, as in the in-process engine).
@@ -224,34 +300,9 @@ std::vector<Pose> distributed_stage(
                                " reported an impossible number of units");
     offset[a + 1] = offset[a] + static_cast<std::size_t>(c);
   }
-  auto end_poses = mail.gather(kUnitPoses, others(self, N));
-  end_poses[self] = ends;
-  std::map<std::size_t, UnitPose> endpoint;
-  for (const auto& [a, msg] : end_poses) {
-    const auto& m = std::get<PoseBlockMessage>(msg);
-    const std::size_t w = width_of(m);
-    if (m.rank != unit_rank || m.dim != static_cast<std::uint32_t>(d) ||
-        m.data.size() != m.pose_ids.size() * w)
-      throw std::runtime_error("initialisation: malformed unit poses from agent " +
-                               std::to_string(a));
-    for (std::size_t k = 0; k < m.pose_ids.size(); ++k) {
-      const double u = m.data[k * w + flat_pose_size(d)];
-      if (!(u >= 0 && u < static_cast<double>(offset[a + 1] - offset[a])))
-        throw std::runtime_error("initialisation: agent " + std::to_string(a) +
-                                 " named a unit it does not have");
-      endpoint[m.pose_ids[k]] = {offset[a] + static_cast<std::size_t>(u),
-                                 read_flat_pose(m.data, k * w, d)};
-    }
-  }
-  std::vector<std::pair<std::uint64_t, Measurement>> all;
-  for (std::size_t k = 0; k < crossing_mine.size(); ++k)
-    all.emplace_back(crossing_index[k], *crossing_mine[k]);
-  for (auto& [a, msg] : mail.gather(kCrossing, others(self, N)))
-    decode_measurement_block(std::get<PoseBlockMessage>(msg), d, share.num_poses, "initialisation",
-                             all);
-  const std::vector<Measurement> crossing = in_file_order(std::move(all));
-  // 4. The same spanning tree on every agent; our poses in the common frame.
-  const std::vector<Pose> frame = align_units(d, offset[N], crossing, endpoint);
+  const std::vector<Pose> frame =
+      self == 0 ? unit_frames_of_agent0(share, ends, N, offset, crossing_mine, crossing_index, mail)
+                : received_unit_frames(mail, d, offset[N]);
   std::vector<Pose> out(share.end - share.begin);
   for (std::size_t u = 0; u < units.members.size(); ++u)
     for (std::size_t k = 0; k < units.members[u].size(); ++k)

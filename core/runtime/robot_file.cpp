@@ -34,14 +34,6 @@ std::uint64_t parse_id(const std::string& path, std::size_t line, const std::str
   return v;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, 0, "cannot open the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 bool is_header(const std::vector<std::string>& t, const char* name) {
   return t.size() >= 2 && t[0] == "#" && t[1] == name;
 }
@@ -60,9 +52,12 @@ bool is_robot_file(const std::string& path) {
 }
 
 RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
+  // One copy of the file's text at a time (its lines, then the reader's text, then the graph):
+  // the reading is an agent's first memory peak, and what it frees stays in the agent's heap.
   std::vector<std::string> lines;
   {
-    std::istringstream in(slurp(path));
+    std::ifstream in(path);
+    if (!in) throw InputError(path, 0, "cannot open the file");
     for (std::string l; std::getline(in, l);) lines.push_back(l);
   }
   bool have_range = false;
@@ -72,9 +67,8 @@ RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
   std::vector<std::uint64_t> known;  // '# tessera-known-inliers': positions of flagged ones
   std::size_t known_line = 0;
   struct Record {
-    std::size_t line;  // 0-based
+    std::size_t line;  // 0-based; its tokens are read again from lines[line] when needed
     bool vertex;
-    std::vector<std::string> tok;
   };
   std::vector<Record> records;
   std::vector<std::uint64_t> vertex_ids;
@@ -106,7 +100,7 @@ RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
     const std::size_t ids = vertex ? 1 : 2;
     if (t.size() <= ids) continue;  // the reader reports the short line
     if (vertex) vertex_ids.push_back(parse_id(path, k + 1, t[1], "pose id"));
-    records.push_back({k, vertex, std::move(t)});
+    records.push_back({k, vertex});
   }
   if (!have_range) {
     if (vertex_ids.empty())
@@ -135,11 +129,12 @@ RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
   std::map<std::uint64_t, std::uint64_t> foreign;
   std::vector<bool> used(end - begin, !vertex_ids.empty());
   std::size_t edges = 0;
-  for (auto& r : records) {
+  for (const auto& r : records) {
     if (r.vertex) continue;
     ++edges;
-    const std::uint64_t i = parse_id(path, r.line + 1, r.tok[1], "pose id");
-    const std::uint64_t j = parse_id(path, r.line + 1, r.tok[2], "pose id");
+    const auto tok = tokens(lines[r.line]);
+    const std::uint64_t i = parse_id(path, r.line + 1, tok[1], "pose id");
+    const std::uint64_t j = parse_id(path, r.line + 1, tok[2], "pose id");
     if (!own(i) && !own(j))
       throw InputError(path, r.line + 1,
                        "measurement " + std::to_string(i) + "-" + std::to_string(j) +
@@ -167,17 +162,29 @@ RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
   }
   auto compact = [&](std::uint64_t id) { return own(id) ? id - begin : foreign.at(id); };
   bool d2 = false;
-  for (auto& r : records) {
-    d2 = d2 || r.tok[0].find("SE2") != std::string::npos;
+  for (const auto& r : records) {
+    auto tok = tokens(lines[r.line]);
+    d2 = d2 || tok[0].find("SE2") != std::string::npos;
     const std::size_t ids = r.vertex ? 1 : 2;
     for (std::size_t c = 1; c <= ids; ++c)
-      r.tok[c] = std::to_string(compact(parse_id(path, r.line + 1, r.tok[c], "pose id")));
+      tok[c] = std::to_string(compact(parse_id(path, r.line + 1, tok[c], "pose id")));
     std::string l;
-    for (const auto& t : r.tok) l += (l.empty() ? "" : " ") + t;
-    lines[r.line] = l;
+    for (const auto& t : tok) l += (l.empty() ? "" : " ") + t;
+    lines[r.line] = std::move(l);
   }
+  std::vector<Record>().swap(records);
   std::string text;
-  for (const auto& l : lines) text += l + "\n";
+  {
+    std::size_t size = 0;
+    for (const auto& l : lines) size += l.size() + 1;
+    text.reserve(size);
+  }
+  for (auto& l : lines) {
+    text += l;
+    text += '\n';
+    std::string().swap(l);
+  }
+  std::vector<std::string>().swap(lines);
   if (!vertex_ids.empty())  // the reader wants a VERTEX for every endpoint: placeholders
     for (const auto& [id, c] : foreign)
       text += (d2 ? "VERTEX_SE2 " + std::to_string(c) + " 0 0 0\n"
@@ -185,6 +192,7 @@ RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
   G2oReadOptions opt;
   opt.allow_disconnected = true;  // other robots' poses are missing by nature
   PoseGraph g = read_g2o_text(text, path, opt).graph;
+  std::string().swap(text);
 
   if (have_index && index.size() != g.measurements.size())
     throw InputError(path, 0,
@@ -195,11 +203,12 @@ RobotShare read_robot_file(const std::string& path, std::uint32_t robot) {
   s.num_poses = 0;  // unknown until the assignment
   s.begin = static_cast<std::uint32_t>(begin);
   s.end = static_cast<std::uint32_t>(end);
-  for (std::size_t k = 0; k < g.measurements.size(); ++k) {
-    Measurement m = g.measurements[k];
+  s.measurements = std::move(g.measurements);
+  s.measurement_index.reserve(s.measurements.size());
+  for (std::size_t k = 0; k < s.measurements.size(); ++k) {
+    Measurement& m = s.measurements[k];
     m.i = global[m.i];
     m.j = global[m.j];
-    s.measurements.push_back(std::move(m));
     s.measurement_index.push_back(have_index ? index[k]
                                              : (static_cast<std::uint64_t>(robot) << 40) + k);
   }

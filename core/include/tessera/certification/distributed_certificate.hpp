@@ -85,6 +85,7 @@ class CertificateProtocol : public AgentProcess {
  private:
   enum Step : std::uint32_t { kVector = 1, kReduce = 2 };
   Eigen::MatrixXd apply(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
+  Eigen::MatrixXd gradient(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn) const;
   void pump(std::vector<OutgoingMessage>& out);
   void send_boundary(const Eigen::MatrixXd& v, std::uint32_t round,
                      std::vector<OutgoingMessage>& out);
@@ -99,8 +100,10 @@ class CertificateProtocol : public AgentProcess {
   const AgentState& state_;
   const BlockLayout& layout_;
   DistributedCertificateOptions options_;
-  BlockProblem problem_;  // own copy: its neighbour poses are set to vectors, not to Yn
-  SparseMatrix lambda_;   // Lambda_B on the block's coordinates
+  // The agent's own problem, read only (the vectors' neighbour values are passed to each
+  // product): a copy would be the block's largest transient (its Q_BB and edge data).
+  const BlockProblem& problem_;
+  SparseMatrix lambda_;  // Lambda_B on the block's coordinates
   std::unique_ptr<BlockJacobi> precon_;
   double local_max_diag_ = 0.0;
   MessageGate gate_;

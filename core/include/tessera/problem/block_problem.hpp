@@ -61,6 +61,11 @@ class BlockProblem {
   double cost(const Eigen::MatrixXd& X, double* share = nullptr) const;
   /// Euclidean gradient 2 (X Q_BB + X_N Q_NB).
   Eigen::MatrixXd euclidean_gradient(const Eigen::MatrixXd& X) const;
+  /// The same with other neighbour poses `X_neighbors` (neighbors() order) than the ones set,
+  /// which stay set: a reader of a shared problem (the certificate's vectors) needs no copy of
+  /// it. Bit-identical to set_neighbor_poses(X_neighbors) then euclidean_gradient(X).
+  Eigen::MatrixXd euclidean_gradient(const Eigen::MatrixXd& X,
+                                     const Eigen::MatrixXd& X_neighbors) const;
   /// Riemannian gradient on the block's manifold.
   Eigen::MatrixXd riemannian_gradient(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad) const;
   /// Riemannian Hessian applied to tangent V at X (egrad = Euclidean gradient at X).
