@@ -431,6 +431,13 @@ void GncAgent::begin_probe(double tls, std::vector<OutgoingMessage>& out) {
   cut.cut_now = std::move(recheck_->probe);
   apply_recheck(cut, in_.measurement_index, rejected_, weights_);
   pass_ = 0;
+  // The iterate was bent around what the probe cut, and a local solve keeps such a fold; the
+  // kept set's fresh start (voted on its cost, as after GNC) does not have it.
+  if (fresh_start_) {
+    require_kept_connected();
+    begin_exchange(Step::kKeptStart, out);
+    return;
+  }
   begin_inlier_pass(out);
 }
 
