@@ -312,9 +312,12 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     }
     case Step::kReadmitted:
       // TLS's own verdict at the kept set's solution (gnc_votes.hpp); every agent gathers all.
-      *recheck_ =
-          recheck_verdict(*terms_, in_.measurement_index, rejected_, state_->Y, neighbours_);
-      to_others(readmitted_message(*recheck_));
+      // With it the probe's list (only used when nothing else changes) and the TLS cost a probe
+      // is judged by.
+      *recheck_ = recheck_verdict(*terms_, in_.measurement_index, rejected_, state_->Y, neighbours_,
+                                  may_probe() ? options_.robust.probe_ratio : 0.0);
+      votes_[me] = {tls_cost(*terms_, state_->Y, neighbours_), 0};
+      to_others(readmitted_message(*recheck_, votes_[me].first));
       break;
     default:
       break;
@@ -413,6 +416,46 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   candidate_ = block_of(X, base_->poses[0], in_.d);
 }
 
+bool GncAgent::may_probe() const {
+  // Only with the known inliers connecting the poses: a probe cuts many closures at once.
+  return !probing_ && probes_ < options_.robust.recheck_probes && terms_->known_connected() &&
+         options_.robust.readmission_passes > 0;
+}
+
+void GncAgent::begin_probe(double tls, std::vector<OutgoingMessage>& out) {
+  // Every agent holds every agent's probe list (the verdict exchange): the same cut everywhere.
+  ++probes_;
+  probing_ = true;
+  probe_base_ = ProbeBase{tls, rejected_, weights_, state_->Y, readmitted_, late_rejected_};
+  RecheckVerdict cut;
+  cut.cut_now = std::move(recheck_->probe);
+  apply_recheck(cut, in_.measurement_index, rejected_, weights_);
+  pass_ = 0;
+  // The iterate was bent around what the probe cut, and a local solve keeps such a fold; the
+  // kept set's fresh start (voted on its cost, as after GNC) does not have it.
+  if (fresh_start_) {
+    require_kept_connected();
+    begin_exchange(Step::kKeptStart, out);
+    return;
+  }
+  begin_inlier_pass(out);
+}
+
+void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out) {
+  probing_ = false;
+  rejected_ = std::move(probe_base_.rejected);
+  weights_ = std::move(probe_base_.weights);
+  readmitted_ = probe_base_.readmitted;
+  late_rejected_ = probe_base_.late_rejected;
+  // The own block has the same shape whatever the kept set: the next pass starts from it.
+  state_->Y = std::move(probe_base_.Y);
+  // One last pass on the restored set (from its converged iterate, so it costs few rounds),
+  // then the final solve.
+  pass_ = options_.robust.readmission_passes;
+  full_pass_next_ = true;
+  begin_inlier_pass(out);
+}
+
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
   if (solve_kind_ == Solve::kFinal) {
     final_rounds_ += solve_->total_rounds();
@@ -422,6 +465,11 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
   }
   gnc_rounds_ += solve_->total_rounds();
   if (solve_kind_ == Solve::kInlierPass) {
+    if (probing_ && pass_ >= options_.robust.readmission_passes) {
+      // The probe's passes ran out before a verdict could judge it: it does not stay.
+      restore_before_probe(out);
+      return;
+    }
     if (pass_ >= options_.robust.readmission_passes || rejected_.empty()) {
       // Without a certified solve to follow, the last pass must reach the tolerance itself.
       if (pass_capped_ && !options_.solver.certify) {
@@ -534,6 +582,20 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
           begin_inlier_pass(out);
           return;
         }
+        const double tls = summed_votes().first;
+        if (probing_) {
+          probing_ = false;
+          // A probe stays only if it lowered the TLS cost (beyond the solves' own accuracy).
+          if (!(tls < probe_base_.tls - 1e-9 * std::abs(probe_base_.tls))) {
+            restore_before_probe(out);
+            return;
+          }
+          ++probes_kept_;
+        }
+        if (may_probe() && !recheck_->probe.empty()) {
+          begin_probe(tls, out);
+          return;
+        }
         finish(out);
         return;
       }
@@ -625,9 +687,12 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
       rejected_.insert(rejected_.end(), st.measurement_ids.begin(), st.measurement_ids.end());
       break;
     }
-    case Step::kReadmitted:
-      read_readmitted_message(status_message(message, kStatusBelongs), sender, in_.id, *recheck_);
+    case Step::kReadmitted: {
+      const RoundStatusMessage& st = status_message(message, kStatusBelongs);
+      read_readmitted_message(st, sender, in_.id, *recheck_);
+      votes_[sender] = {st.cost, 0};
       break;
+    }
     default:
       break;
   }

@@ -138,6 +138,8 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   out.threshold_squared = lead.threshold_squared();
   out.readmitted = lead.readmitted();
   out.late_rejected = lead.late_rejected();
+  out.probes = lead.probes();
+  out.probes_kept = lead.probes_kept();
   out.rejected.assign(lead.rejected().begin(), lead.rejected().end());
   out.weights.assign(graph.num_measurements(), 1.0);
   // Each measurement's weight as its owner computed it.

@@ -98,13 +98,16 @@ void append_owned_values(const GncAgentInput& in, const GncLocalTerms& terms,
       values.emplace_back(in.measurement_index[k], in.measurements[k]);
 }
 
-RoundStatusMessage readmitted_message(const RecheckVerdict& verdict) {
+RoundStatusMessage readmitted_message(const RecheckVerdict& verdict, double tls_cost) {
   RoundStatusMessage st;
   st.measurement_ids = verdict.taken_back;
   st.weights.assign(verdict.taken_back.size(), 1.0);
   st.measurement_ids.insert(st.measurement_ids.end(), verdict.cut_now.begin(),
                             verdict.cut_now.end());
   st.weights.resize(st.measurement_ids.size(), 0.0);
+  st.measurement_ids.insert(st.measurement_ids.end(), verdict.probe.begin(), verdict.probe.end());
+  st.weights.resize(st.measurement_ids.size(), 0.5);
+  st.cost = tls_cost;
   return st;
 }
 
@@ -114,9 +117,13 @@ void read_readmitted_message(const RoundStatusMessage& st, std::uint32_t sender,
   if (!st.weights.empty() && st.weights.size() != st.measurement_ids.size())
     throw std::runtime_error(agent_prefix(receiver) + "re-check from agent " +
                              std::to_string(sender) + " does not match its measurements");
-  for (std::size_t q = 0; q < st.measurement_ids.size(); ++q)
-    (st.weights.empty() || st.weights[q] > 0.5 ? into.taken_back : into.cut_now)
+  for (std::size_t q = 0; q < st.measurement_ids.size(); ++q) {
+    const double w = st.weights.empty() ? 1.0 : st.weights[q];
+    (w > 0.75   ? into.taken_back
+     : w < 0.25 ? into.cut_now
+                : into.probe)
         .push_back(st.measurement_ids[q]);
+  }
 }
 
 PoseBlockMessage kept_start_block(const Eigen::MatrixXd& Y, const std::vector<std::size_t>& ids,

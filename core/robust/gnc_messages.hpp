@@ -53,9 +53,10 @@ PoseBlockMessage owned_values_block(const GncAgentInput& in, const GncLocalTerms
 void append_owned_values(const GncAgentInput& in, const GncLocalTerms& terms,
                          const std::vector<std::uint64_t>* rejected, GatheredValues& values);
 
-/// A re-check verdict: ids taken back (weight 1), then ids cut now (weight 0); and back, added
-/// to `into` (no weights: every id taken back). Throws std::runtime_error on a size mismatch.
-RoundStatusMessage readmitted_message(const RecheckVerdict& verdict);
+/// A re-check verdict: ids taken back (weight 1), then ids cut now (weight 0), then the probe's
+/// (weight 0.5), and the agent's TLS cost in `cost`; and back, added to `into` (no weights:
+/// every id taken back). Throws std::runtime_error on a size mismatch.
+RoundStatusMessage readmitted_message(const RecheckVerdict& verdict, double tls_cost);
 void read_readmitted_message(const RoundStatusMessage& st, std::uint32_t sender, int receiver,
                              RecheckVerdict& into);
 

@@ -58,20 +58,41 @@ double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weig
 
 RecheckVerdict recheck_verdict(const GncLocalTerms& terms, const std::vector<std::uint64_t>& index,
                                const std::vector<std::uint64_t>& rejected, const Eigen::MatrixXd& Y,
-                               const Eigen::MatrixXd& neighbours) {
+                               const Eigen::MatrixXd& neighbours, double probe_ratio) {
   // A rejected measurement within the bound was misjudged on a rough iterate; a kept one beyond
   // it is a wrong closure that GNC's iterate fitted with the help of a distortion. Each pass is
   // a descent step of the TLS cost (binary weights given the poses).
   RecheckVerdict v;
+  std::vector<std::pair<double, std::uint64_t>> kept;  // (r^2, id) of the kept ones that fit
   for (std::size_t k : terms.owned()) {
     if (!terms.may_reject(k)) continue;
     const std::uint64_t id = index[k];
     const bool was_rejected = contains(rejected, id);
-    const bool fits = terms.residual_squared(k, Y, neighbours) <= terms.c2();
+    const double r2 = terms.residual_squared(k, Y, neighbours);
+    const bool fits = r2 <= terms.c2();
     if (was_rejected && fits) v.taken_back.push_back(id);
     if (!was_rejected && !fits) v.cut_now.push_back(id);
+    if (!was_rejected && fits) kept.emplace_back(r2, id);
+  }
+  if (probe_ratio > 0 && !kept.empty()) {
+    // The median of the agent's own kept residuals: a local scale, so no extra exchange.
+    std::vector<double> r2s;
+    for (const auto& e : kept) r2s.push_back(e.first);
+    auto mid = r2s.begin() + static_cast<std::ptrdiff_t>(r2s.size() / 2);
+    std::nth_element(r2s.begin(), mid, r2s.end());
+    const double bound = probe_ratio * *mid;
+    for (const auto& [r2, id] : kept)
+      if (r2 > bound) v.probe.push_back(id);
   }
   return v;
+}
+
+double tls_cost(const GncLocalTerms& terms, const Eigen::MatrixXd& Y,
+                const Eigen::MatrixXd& neighbours) {
+  double f = 0;
+  for (std::size_t k : terms.owned())
+    f += terms.tls_term(k, terms.residual_squared(k, Y, neighbours));
+  return f;
 }
 
 RecheckCounts apply_recheck(RecheckVerdict& verdict, const std::vector<std::uint64_t>& index,

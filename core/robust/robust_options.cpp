@@ -61,6 +61,10 @@ void RobustOptions::validate() const {
               "must be >= 0 (0 = no cap)");
   if (readmission_passes < 0)
     bad_field("readmission_passes", std::to_string(readmission_passes), "must be >= 0");
+  if (recheck_probes < 0)
+    bad_field("recheck_probes", std::to_string(recheck_probes), "must be >= 0 (0 = none)");
+  if (!(std::isfinite(probe_ratio) && probe_ratio > 1))
+    bad_field("probe_ratio", number_text(probe_ratio), "must be > 1");
   if (!(std::isfinite(weight_tolerance) && weight_tolerance >= 0))
     bad_field("weight_tolerance", number_text(weight_tolerance), "must be >= 0");
 }

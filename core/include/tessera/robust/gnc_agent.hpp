@@ -160,6 +160,9 @@ class GncAgent : public AgentProcess {
   /// Kept by GNC, rejected by a pass (beyond the bound at the kept set's solution).
   std::size_t late_rejected() const { return late_rejected_; }
   bool weights_converged() const { return converged_; }
+  /// Probes run after the re-check passes, and those that lowered the TLS cost and stayed.
+  int probes() const { return probes_; }
+  int probes_kept() const { return probes_kept_; }
   double threshold_squared() const;
   /// Rounds of the solves before the final certified one (first, weighted, inlier passes).
   int gnc_rounds() const { return gnc_rounds_; }
@@ -225,6 +228,9 @@ class GncAgent : public AgentProcess {
   void start_kept_set(std::vector<OutgoingMessage>& out);
   void after_step_zero(std::vector<OutgoingMessage>& out);
   void drop_inconsistent(const std::vector<std::uint64_t>& ids);
+  bool may_probe() const;  // RobustOptions::recheck_probes
+  void begin_probe(double tls, std::vector<OutgoingMessage>& out);
+  void restore_before_probe(std::vector<OutgoingMessage>& out);
 
   GncAgentInput in_;
   const GncDistributedOptions& options_;
@@ -247,6 +253,18 @@ class GncAgent : public AgentProcess {
   std::size_t readmitted_ = 0;
   std::unique_ptr<RecheckVerdict> recheck_;  // the current re-check exchange's, every agent's
   std::size_t late_rejected_ = 0;
+  // Probes (RobustOptions::recheck_probes): what a probe that does not lower the TLS cost
+  // goes back to.
+  struct ProbeBase {
+    double tls = 0;
+    std::vector<std::uint64_t> rejected;
+    std::vector<double> weights;
+    Eigen::MatrixXd Y;
+    std::size_t readmitted = 0, late_rejected = 0;
+  };
+  ProbeBase probe_base_;
+  bool probing_ = false;  // a probe's passes are running
+  int probes_ = 0, probes_kept_ = 0;
   std::vector<std::uint64_t> zero_cut_;   // cut measurements of weight 0 (others' too)
   std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where
   std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view

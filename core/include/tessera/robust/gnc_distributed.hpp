@@ -77,6 +77,10 @@ struct GncDistributedResult {
   /// Measurements GNC had kept whose residual at an inlier set's solution was beyond the bound,
   /// rejected by the same passes.
   std::size_t late_rejected = 0;
+  /// Probes after the passes (RobustOptions::recheck_probes) and those that lowered the TLS
+  /// cost and stayed.
+  int probes = 0;
+  int probes_kept = 0;
   double threshold_squared = 0;
   bool weights_converged = false;
 };
