@@ -1,6 +1,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <deque>
 #include <stdexcept>
 #include <string>
@@ -405,8 +406,12 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
   return solve_coarse_matrix(std::move(Q), r, options);
 }
 
-void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
-                           int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X) {
+namespace {
+
+// Moves X's poses and, when `V` is given, V's: a pose of V equal to X's (bit for bit; an
+// inactive block has V = Y) gets X's moved pose without a second polar factor.
+void move_blended(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions, int d,
+                  const std::vector<std::size_t>& ids, Eigen::MatrixXd& X, Eigen::MatrixXd* V) {
   const Eigen::Index r = X.rows();
   const Eigen::Index w = d + 1;
   // Work space kept from pose to pose (the SVD reallocates nothing when the sizes repeat); the
@@ -414,13 +419,7 @@ void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::Ma
   Mat M(r, r + 1), Y(r, d);
   Eigen::VectorXd p(r);
   Eigen::JacobiSVD<Mat> svd(r, d, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  for (std::size_t k = 0; k < ids.size(); ++k) {
-    const std::size_t i = ids[k];
-    auto Xi = X.middleCols(w * static_cast<Eigen::Index>(k), w);
-    const std::size_t e0 = space.weight_start[i], e1 = space.weight_start[i + 1];
-    M.setZero();
-    for (std::size_t e = e0; e < e1; ++e)
-      M += space.weight[e] * motions[static_cast<std::size_t>(space.weight_aggregate[e])];
+  auto move = [&](std::size_t e0, std::size_t e1, auto Xi) {
     Y.noalias() = M.leftCols(r) * Xi.leftCols(d);
     p.noalias() = M.leftCols(r) * Xi.col(d);
     p += M.col(r);
@@ -433,6 +432,45 @@ void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::Ma
       Xi.leftCols(d).noalias() = svd.matrixU() * svd.matrixV().transpose();
     }
     Xi.col(d) = p;
+  };
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t i = ids[k];
+    const std::size_t e0 = space.weight_start[i], e1 = space.weight_start[i + 1];
+    M.setZero();
+    for (std::size_t e = e0; e < e1; ++e)
+      M += space.weight[e] * motions[static_cast<std::size_t>(space.weight_aggregate[e])];
+    auto Xi = X.middleCols(w * static_cast<Eigen::Index>(k), w);
+    if (V == nullptr) {
+      move(e0, e1, Xi);
+      continue;
+    }
+    auto Vi = V->middleCols(w * static_cast<Eigen::Index>(k), w);
+    // Columns of a column-major matrix: one contiguous run each, compared bit for bit.
+    const bool same =
+        std::memcmp(Vi.data(), Xi.data(), sizeof(double) * static_cast<std::size_t>(r * w)) == 0;
+    move(e0, e1, Xi);
+    if (same)
+      Vi = Xi;
+    else
+      move(e0, e1, Vi);
+  }
+}
+
+}  // namespace
+
+void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
+                           int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X) {
+  move_blended(space, motions, d, ids, X, nullptr);
+}
+
+void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
+                           int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X,
+                           Eigen::MatrixXd& V) {
+  if (V.rows() == X.rows() && V.cols() == X.cols()) {
+    move_blended(space, motions, d, ids, X, &V);
+  } else {
+    move_blended(space, motions, d, ids, X, nullptr);
+    move_blended(space, motions, d, ids, V, nullptr);
   }
 }
 

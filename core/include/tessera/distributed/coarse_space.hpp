@@ -114,5 +114,10 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
 /// puts each Y_i back on the manifold (polar factor); a pose of one aggregate moves rigidly.
 void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
                            int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X);
+/// The same for an iterate X and its momentum V (the same poses, same shape): where a pose of
+/// V equals X's (bit for bit), V gets X's moved pose, computed once.
+void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
+                           int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X,
+                           Eigen::MatrixXd& V);
 
 }  // namespace tessera
