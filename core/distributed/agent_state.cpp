@@ -117,10 +117,8 @@ void AgentState::use_coarse_space(std::shared_ptr<const CoarseSpace> space,
 }
 
 void AgentState::apply_smoothed_coarse(const std::vector<Eigen::MatrixXd>& motions) {
-  apply_blended_motions(*space_, motions, d_, problem_.owned(), Y);
-  apply_blended_motions(*space_, motions, d_, problem_.owned(), V);
-  apply_blended_motions(*space_, motions, d_, problem_.neighbors(), Yn);
-  apply_blended_motions(*space_, motions, d_, problem_.neighbors(), Vn);
+  apply_blended_motions(*space_, motions, d_, problem_.owned(), Y, V);
+  apply_blended_motions(*space_, motions, d_, problem_.neighbors(), Yn, Vn);
 }
 
 BlockPreconditioner& AgentState::euclidean() {

@@ -1,6 +1,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <deque>
 #include <stdexcept>
 #include <string>
@@ -249,6 +250,12 @@ SmoothedCoarseTerms::SmoothedCoarseTerms(const CoarseSpace& space, int id, int d
       throw std::logic_error("SmoothedCoarseTerms: an edge it sums has an unknown end");
     return jt->second;
   };
+  const auto pair_begin = space.pairs.begin() + static_cast<std::ptrdiff_t>(
+                                                    space.pair_start[static_cast<std::size_t>(id)]);
+  const auto pair_end =
+      space.pairs.begin() +
+      static_cast<std::ptrdiff_t>(space.pair_start[static_cast<std::size_t>(id) + 1]);
+  std::vector<int> support;
   for (const Measurement& m : measurements) {
     if (m.i == m.j || m.i >= space.owner.size() || m.j >= space.owner.size()) continue;
     if (!space.sums_edge(id, m.i, m.j) || space.rigid_invariant(m.i, m.j)) continue;
@@ -256,12 +263,38 @@ SmoothedCoarseTerms::SmoothedCoarseTerms(const CoarseSpace& space, int id, int d
     Edge e;
     e.i_slot = slot(m.i, &e.i_own);
     e.j_slot = slot(m.j, &e.j_own);
-    e.i = m.i;
-    e.j = m.j;
     e.R = m.R;
     e.t = m.t;
     e.kappa = m.kappa;
     e.tau = m.tau;
+    // The merge of the two ends' ascending weight lists, and the agent's pair of each two of
+    // its pieces.
+    e.piece_begin = pieces_.size();
+    support.clear();
+    const std::size_t i0 = space.weight_start[m.i], i1 = space.weight_start[m.i + 1];
+    const std::size_t j0 = space.weight_start[m.j], j1 = space.weight_start[m.j + 1];
+    std::size_t x = i0, y = j0;
+    while (x < i1 || y < j1) {
+      const int ax = x < i1 ? space.weight_aggregate[x] : INT32_MAX;
+      const int ay = y < j1 ? space.weight_aggregate[y] : INT32_MAX;
+      const int a = std::min(ax, ay);
+      Piece piece{ay == a, ax == a, 0.0, 0.0};
+      if (piece.at_j) piece.w_j = space.weight[y++];
+      if (piece.at_i) piece.w_i = space.weight[x++];
+      pieces_.push_back(piece);
+      support.push_back(a);
+    }
+    e.piece_end = pieces_.size();
+    max_pieces_ = std::max(max_pieces_, e.piece_end - e.piece_begin);
+    e.pair_begin = pair_index_.size();
+    for (std::size_t p = 0; p < support.size(); ++p)
+      for (std::size_t q = p; q < support.size(); ++q) {
+        const auto it =
+            std::lower_bound(pair_begin, pair_end, std::make_pair(support[p], support[q]));
+        if (it == pair_end || *it != std::make_pair(support[p], support[q]))
+          throw std::logic_error("SmoothedCoarseTerms: a pair missing from the space");
+        pair_index_.push_back(static_cast<std::size_t>(it - pair_begin));
+      }
     edges_.push_back(std::move(e));
   }
 }
@@ -273,56 +306,62 @@ std::vector<double> SmoothedCoarseTerms::compute(const Eigen::MatrixXd& X,
   const int w = d_ + 1;
   const std::size_t first = space_.pair_start[static_cast<std::size_t>(id_)];
   const std::size_t count = space_.pair_start[static_cast<std::size_t>(id_) + 1] - first;
-  const auto pair_begin = space_.pairs.begin() + static_cast<std::ptrdiff_t>(first);
-  const auto pair_end = pair_begin + static_cast<std::ptrdiff_t>(count);
-  std::vector<Mat> Q(count, Mat::Zero(s, s));
+  double mask = 0.0;
+  const std::vector<int> rows = coarse_rows_in_use(X, Xn, mask);
+  const std::size_t m = rows.size();
+  // The terms are summed straight into their packed layout, on the used rows only: the other
+  // rows of Q are never sent, and each packed entry gets the same sums in the same order as
+  // the full Q would (so the terms do not change by a bit).
+  std::vector<std::size_t> offset(count);
+  std::size_t total = 1;
+  for (std::size_t k = 0; k < count; ++k) {
+    offset[k] = total;
+    const auto& pair = space_.pairs[first + k];
+    total += pair.first == pair.second ? m * (m + 1) / 2 : m * m;
+  }
+  std::vector<double> out(total, 0.0);
+  out[0] = mask;
   Mat A = Mat::Zero(s, w), B = Mat::Zero(s, w);
-  std::vector<int> support;
-  std::vector<Mat> C;
+  // C_p on the used rows, per piece p of the edge: m x w, column-major.
+  const std::size_t cm = m * static_cast<std::size_t>(w);
+  std::vector<double> C(max_pieces_ * cm);
   for (const Edge& e : edges_) {
     const auto Pi = e.i_own ? X.middleCols(static_cast<Eigen::Index>(w * e.i_slot), w)
                             : Xn.middleCols(static_cast<Eigen::Index>(w * e.i_slot), w);
     const auto Pj = e.j_own ? X.middleCols(static_cast<Eigen::Index>(w * e.j_slot), w)
                             : Xn.middleCols(static_cast<Eigen::Index>(w * e.j_slot), w);
     const double sk = std::sqrt(e.kappa), st = std::sqrt(e.tau);
-    // The residual after the blend is sum_alpha Z_alpha (w_j,alpha A - w_i,alpha B), with A, B
-    // as in CoarseTerms (target j, transported source i).
+    // The residual after the blend is sum_alpha Z_alpha C_alpha, C_alpha = w_j,alpha A -
+    // w_i,alpha B, with A, B as in CoarseTerms (target j, transported source i).
     lift_target(A, Pj, d_, sk, st);
     lift_source(B, Pi, e.R, e.t, d_, sk, st);
-    support.clear();
-    C.clear();
-    const std::size_t i0 = space_.weight_start[e.i], i1 = space_.weight_start[e.i + 1];
-    const std::size_t j0 = space_.weight_start[e.j], j1 = space_.weight_start[e.j + 1];
-    std::size_t x = i0, y = j0;
-    while (x < i1 || y < j1) {  // merge of the two ascending weight lists
-      const int ax = x < i1 ? space_.weight_aggregate[x] : INT32_MAX;
-      const int ay = y < j1 ? space_.weight_aggregate[y] : INT32_MAX;
-      const int a = std::min(ax, ay);
-      Mat Ca = Mat::Zero(s, w);
-      if (ay == a) Ca += space_.weight[y++] * A;
-      if (ax == a) Ca -= space_.weight[x++] * B;
-      support.push_back(a);
-      C.push_back(std::move(Ca));
+    const std::size_t np = e.piece_end - e.piece_begin;
+    for (std::size_t p = 0; p < np; ++p) {
+      const Piece& piece = pieces_[e.piece_begin + p];
+      double* Cp = C.data() + p * cm;
+      for (int k = 0; k < w; ++k)
+        for (std::size_t a = 0; a < m; ++a) {
+          double c = 0.0;
+          if (piece.at_j) c += piece.w_j * A(rows[a], k);
+          if (piece.at_i) c -= piece.w_i * B(rows[a], k);
+          Cp[a + m * static_cast<std::size_t>(k)] = c;
+        }
     }
-    for (std::size_t p = 0; p < support.size(); ++p)
-      for (std::size_t q = p; q < support.size(); ++q) {
-        const auto it =
-            std::lower_bound(pair_begin, pair_end, std::make_pair(support[p], support[q]));
-        if (it == pair_end || *it != std::make_pair(support[p], support[q]))
-          throw std::logic_error("SmoothedCoarseTerms: a pair missing from the space");
-        Q[static_cast<std::size_t>(it - pair_begin)].noalias() += C[p] * C[q].transpose();
+    // Q_pq += C_p C_q^T, entry by entry: each a sum over the w columns from 0.
+    std::size_t pair = e.pair_begin;
+    for (std::size_t p = 0; p < np; ++p)
+      for (std::size_t q = p; q < np; ++q, ++pair) {
+        const double* Cp = C.data() + p * cm;
+        const double* Cq = C.data() + q * cm;
+        double* o = out.data() + offset[pair_index_[pair]];
+        for (std::size_t j = 0; j < m; ++j)
+          for (std::size_t i = 0; i < (p == q ? j + 1 : m); ++i) {
+            double acc = 0.0;
+            for (std::size_t k = 0; k < static_cast<std::size_t>(w); ++k)
+              acc += Cp[i + m * k] * Cq[j + m * k];
+            *o++ += acc;
+          }
       }
-  }
-  double mask = 0.0;
-  const std::vector<int> rows = coarse_rows_in_use(X, Xn, mask);
-  const std::size_t m = rows.size();
-  std::vector<double> out;
-  out.reserve(1 + count * m * m);
-  out.push_back(mask);
-  for (std::size_t k = 0; k < count; ++k) {
-    const bool diagonal = pair_begin[static_cast<std::ptrdiff_t>(k)].first ==
-                          pair_begin[static_cast<std::ptrdiff_t>(k)].second;
-    append_packed_block(Q[k], rows, diagonal, out);
   }
   return out;
 }
@@ -367,24 +406,71 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
   return solve_coarse_matrix(std::move(Q), r, options);
 }
 
-void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
-                           int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X) {
+namespace {
+
+// Moves X's poses and, when `V` is given, V's: a pose of V equal to X's (bit for bit; an
+// inactive block has V = Y) gets X's moved pose without a second polar factor.
+void move_blended(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions, int d,
+                  const std::vector<std::size_t>& ids, Eigen::MatrixXd& X, Eigen::MatrixXd* V) {
   const Eigen::Index r = X.rows();
   const Eigen::Index w = d + 1;
-  Mat M(r, r + 1);
+  // Work space kept from pose to pose (the SVD reallocates nothing when the sizes repeat); the
+  // arithmetic is polar_factor's, so the moved poses are the same to the bit.
+  Mat M(r, r + 1), Y(r, d);
+  Eigen::VectorXd p(r);
+  Eigen::JacobiSVD<Mat> svd(r, d, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  auto move = [&](std::size_t e0, std::size_t e1, auto Xi) {
+    Y.noalias() = M.leftCols(r) * Xi.leftCols(d);
+    p.noalias() = M.leftCols(r) * Xi.col(d);
+    p += M.col(r);
+    // A blend of rotations is not one: back to the manifold by the polar factor (a single
+    // rigid motion is orthogonal already and is kept bit for bit).
+    if (e1 - e0 == 1) {
+      Xi.leftCols(d) = Y;
+    } else {
+      svd.compute(Y, Eigen::ComputeThinU | Eigen::ComputeThinV);
+      Xi.leftCols(d).noalias() = svd.matrixU() * svd.matrixV().transpose();
+    }
+    Xi.col(d) = p;
+  };
   for (std::size_t k = 0; k < ids.size(); ++k) {
     const std::size_t i = ids[k];
-    auto Xi = X.middleCols(w * static_cast<Eigen::Index>(k), w);
     const std::size_t e0 = space.weight_start[i], e1 = space.weight_start[i + 1];
     M.setZero();
     for (std::size_t e = e0; e < e1; ++e)
       M += space.weight[e] * motions[static_cast<std::size_t>(space.weight_aggregate[e])];
-    const Mat Y = M.leftCols(r) * Xi.leftCols(d);
-    const Eigen::VectorXd p = M.leftCols(r) * Xi.col(d) + M.col(r);
-    // A blend of rotations is not one: back to the manifold by the polar factor (a single
-    // rigid motion is orthogonal already and is kept bit for bit).
-    Xi.leftCols(d) = e1 - e0 == 1 ? Y : polar_factor(Y);
-    Xi.col(d) = p;
+    auto Xi = X.middleCols(w * static_cast<Eigen::Index>(k), w);
+    if (V == nullptr) {
+      move(e0, e1, Xi);
+      continue;
+    }
+    auto Vi = V->middleCols(w * static_cast<Eigen::Index>(k), w);
+    // Columns of a column-major matrix: one contiguous run each, compared bit for bit.
+    const bool same =
+        std::memcmp(Vi.data(), Xi.data(), sizeof(double) * static_cast<std::size_t>(r * w)) == 0;
+    move(e0, e1, Xi);
+    if (same)
+      Vi = Xi;
+    else
+      move(e0, e1, Vi);
+  }
+}
+
+}  // namespace
+
+void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
+                           int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X) {
+  move_blended(space, motions, d, ids, X, nullptr);
+}
+
+void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
+                           int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X,
+                           Eigen::MatrixXd& V) {
+  if (V.rows() == X.rows() && V.cols() == X.cols()) {
+    move_blended(space, motions, d, ids, X, &V);
+  } else {
+    move_blended(space, motions, d, ids, X, nullptr);
+    move_blended(space, motions, d, ids, V, nullptr);
   }
 }
 

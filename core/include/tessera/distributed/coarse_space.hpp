@@ -79,17 +79,29 @@ class SmoothedCoarseTerms {
   std::vector<double> compute(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn) const;
 
  private:
+  // One piece in the blend of an edge's ends: its weight at the target j and at the source i
+  // (0 where the piece is not in that end's blend).
+  struct Piece {
+    bool at_j, at_i;
+    double w_j, w_i;
+  };
   struct Edge {
     bool i_own, j_own;  // whether the source / target is an own pose (else a neighbour copy)
-    std::size_t i_slot, j_slot, i, j;
+    std::size_t i_slot, j_slot;
     Eigen::MatrixXd R;
     Eigen::VectorXd t;
     double kappa, tau;
+    // The pieces of both ends (aggregates ascending) and, for each piece pair p <= q in that
+    // order, its index among the agent's pairs: fixed by the space, so found once here.
+    std::size_t piece_begin, piece_end, pair_begin;
   };
   const CoarseSpace& space_;
   int id_;
   int d_;
   std::vector<Edge> edges_;
+  std::vector<Piece> pieces_;
+  std::vector<std::size_t> pair_index_;
+  std::size_t max_pieces_ = 0;
 };
 
 /// Solves the smoothed coarse problem from every agent's terms (agent-id order). motions[alpha]
@@ -102,5 +114,10 @@ CoarseResult solve_smoothed_coarse(const CoarseSpace& space, int r,
 /// puts each Y_i back on the manifold (polar factor); a pose of one aggregate moves rigidly.
 void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
                            int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X);
+/// The same for an iterate X and its momentum V (the same poses, same shape): where a pose of
+/// V equals X's (bit for bit), V gets X's moved pose, computed once.
+void apply_blended_motions(const CoarseSpace& space, const std::vector<Eigen::MatrixXd>& motions,
+                           int d, const std::vector<std::size_t>& ids, Eigen::MatrixXd& X,
+                           Eigen::MatrixXd& V);
 
 }  // namespace tessera
