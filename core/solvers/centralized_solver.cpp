@@ -29,6 +29,12 @@ TrustRegionOptions CentralizedOptions::default_trust_region() {
   o.paired_grad_norm_tol = 1e-2;
   o.preconditioned_grad_norm_tol = 1e-4;
   o.rel_cost_decrease_tol = 1e-6;
+  // The same gradient bound paired with the predicted decrease below the reference's relative
+  // decrease tolerance: ends parking-garage one step (287 of 984 tCG iterations) earlier, 1.2e-8
+  // f above f* (the reference: 1.06e-6), where ||P g|| is still 0.26; on the other shared graphs
+  // the gradient reaches 1e-2 only at or after the step where the run already ends (MIT: one
+  // step earlier, 6.3e-9 above f*, the reference 9.3e-9).
+  o.paired_predicted_rel_decrease_tol = 1e-6;
   // Its fourth test, an accepted step's norm below 1e-3, is left out: on small graphs (40 poses)
   // such a step still moves f by 1e-6 of f.
   // The relative-decrease test taken before the step on the predicted decrease 1/2 <P g, g>, so the
@@ -107,10 +113,14 @@ Eigen::MatrixXd escape_saddle(const BlockProblem& problem, const Eigen::MatrixXd
     if (problem.cost(Xp) >= f0) continue;
     Eigen::MatrixXd g = M.tangent_project(Xp, problem.euclidean_gradient(Xp));
     if (g.norm() <= tr.grad_norm_tol) continue;
-    const bool paired = tr.paired_grad_norm_tol > 0 && tr.preconditioned_grad_norm_tol > 0;
-    if (!paired || g.norm() > tr.paired_grad_norm_tol ||
-        precon.apply(M, Xp, g).norm() > tr.preconditioned_grad_norm_tol)
-      return Xp;
+    if (tr.paired_grad_norm_tol <= 0 || g.norm() > tr.paired_grad_norm_tol) return Xp;
+    const Eigen::MatrixXd Pg = precon.apply(M, Xp, g);
+    const bool paired_norm =
+        tr.preconditioned_grad_norm_tol > 0 && Pg.norm() <= tr.preconditioned_grad_norm_tol;
+    const bool paired_decrease =
+        tr.paired_predicted_rel_decrease_tol > 0 &&
+        0.5 * Pg.cwiseProduct(g).sum() <= tr.paired_predicted_rel_decrease_tol * problem.cost(Xp);
+    if (!paired_norm && !paired_decrease) return Xp;
   }
   throw std::runtime_error("saddle escape: no descent step found along the eigenvector");
 }
@@ -188,6 +198,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   if (options.stop == CentralizedStop::kGradient) {
     tr.paired_grad_norm_tol = 0;
     tr.preconditioned_grad_norm_tol = 0;
+    tr.paired_predicted_rel_decrease_tol = 0;
     tr.predicted_rel_decrease_tol = 0;
     tr.step_norm_tol = 0;
     tr.rel_cost_decrease_tol = std::min(tr.rel_cost_decrease_tol, 1e-14);
@@ -233,6 +244,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     // of iterations or time is not certified, whatever the eigenvalue says.
     const bool converged =
         level.stop_reason == "grad_norm" || level.stop_reason == "preconditioned_grad_norm" ||
+        level.stop_reason == "paired_predicted_decrease" ||
         level.stop_reason == "predicted_decrease" || level.stop_reason == "relative_decrease" ||
         level.stop_reason == "step_norm";
     info.certified = cert.certified && converged;

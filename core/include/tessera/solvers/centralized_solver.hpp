@@ -80,8 +80,9 @@ struct StaircaseLevel {
   std::optional<double> min_eigenvalue;
   bool certified;
   double elapsed_s;
-  /// Why the trust region stopped: grad_norm, preconditioned_grad_norm, predicted_decrease,
-  /// relative_decrease (the converged ones), or max_iterations, time, radius.
+  /// Why the trust region stopped: grad_norm, preconditioned_grad_norm,
+  /// paired_predicted_decrease, predicted_decrease, relative_decrease (the converged ones), or
+  /// max_iterations, time, radius.
   std::string stop_reason;
 };
 
