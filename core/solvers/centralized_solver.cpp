@@ -67,6 +67,8 @@ void CentralizedOptions::validate() const {
     throw InputError("CentralizedOptions.certified_lanczos_tolerance must be in (0, 1)");
   if (!(supernodal_min_flops > 0))
     throw InputError("CentralizedOptions.supernodal_min_flops must be > 0");
+  if (!(concurrent_supernodal_min_flops > 0))
+    throw InputError("CentralizedOptions.concurrent_supernodal_min_flops must be > 0");
   if (!(preconditioner_shift > 0))
     throw InputError("CentralizedOptions.preconditioner_shift must be > 0");
   if (threads < 1 || threads > 2) throw InputError("CentralizedOptions.threads must be 1 or 2");
@@ -142,13 +144,21 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   // made cubicle's and city10000's whole-graph factors supernodal: CPU in alternated pairs (load
   // 7-8) cubicle 1.41/1.80/2.50 s simplicial vs 1.67/1.99/2.28 s, city10000 1.28/1.12/1.18 vs
   // 1.39/1.84/1.41.
-  // The flops rule only on one thread: a supernodal factorization calls BLAS, and the start
-  // and the translation factor on the other thread may too (CHOLMOD's automatic choice), while
-  // the serial OpenBLAS build has no locks for concurrent calls.
-  const double supernodal_min_flops = options.threads > 1 ? 0.0 : options.supernodal_min_flops;
-  const auto build_preconditioner = [&problem, &options, supernodal_min_flops] {
+  // A supernodal factorization calls BLAS, and the serial OpenBLAS build has no locks for
+  // concurrent calls. With two threads and translation elimination the preconditioner's
+  // factorization (second thread) is supernodal above concurrent_supernodal_min_flops and
+  // converted to simplicial LDL^T for the solves, while the start's and the translations'
+  // factorizations (first thread) are simplicial: cubicle's preconditioner 1.35 -> 0.57 G
+  // instructions, the chordal start 0.36 -> 0.69 G, so the first thread no longer waits.
+  // Otherwise (one thread, or explicit translations, whose start may factor supernodally
+  // meanwhile) the flops rule applies only on one thread.
+  const bool concurrent = options.threads > 1 && options.eliminate_translations;
+  const double supernodal_min_flops =
+      concurrent ? options.concurrent_supernodal_min_flops
+                 : (options.threads > 1 ? 0.0 : options.supernodal_min_flops);
+  const auto build_preconditioner = [&problem, &options, supernodal_min_flops, concurrent] {
     return std::make_unique<BlockPreconditioner>(problem, options.preconditioner_shift, 0, 0,
-                                                 supernodal_min_flops);
+                                                 supernodal_min_flops, concurrent);
   };
   // The factorization does not depend on the start: with a second thread it runs while the
   // start is computed (each CHOLMOD factor has its own workspace, so the two do not share state).
@@ -161,7 +171,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
       // their exact minimiser before its first step (the same weighted Laplacian solve), so
       // the chordal start's own translation solve would be done twice.
       init = options.eliminate_translations
-                 ? assemble_poses(chordal_rotations(graph),
+                 ? assemble_poses(chordal_rotations(graph, concurrent),
                                   Eigen::MatrixXd::Zero(graph.d, graph.num_poses))
                  : chordal_initialization(graph);
       break;
@@ -177,8 +187,8 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   std::unique_ptr<TranslationElimination> elimination;
   PointRefinement refine;
   if (options.eliminate_translations) {
-    elimination =
-        std::make_unique<TranslationElimination>(graph.d, graph.num_poses, graph.measurements);
+    elimination = std::make_unique<TranslationElimination>(graph.d, graph.num_poses,
+                                                           graph.measurements, concurrent);
     refine = [&elimination](Eigen::MatrixXd& Y) { elimination->optimize_translations(Y); };
   }
   const std::unique_ptr<BlockPreconditioner> precon_factor =
