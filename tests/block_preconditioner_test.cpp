@@ -53,12 +53,13 @@ TEST(BlockPreconditioner, ExactFactorInvertsTheShiftedDataMatrix) {
 
 // The exact factor against a dense solve of a well-conditioned shifted matrix, to round-off, for
 // every rank the solvers use (and beyond), simplicial LDL^T and supernodal LL^T alike (chosen by
-// the factor's entries or by its factorization's flops).
+// the factor's entries or by its factorization's flops), and a supernodal factor converted to
+// simplicial LDL^T for the solves.
 TEST(BlockPreconditioner, ExactFactorMatchesADenseSolveForEveryRank) {
   for (int d : {2, 3})
-    for (int mode : {0, 1, 2}) {  // simplicial, supernodal by entries, supernodal by flops
+    for (int mode : {0, 1, 2, 3}) {  // simplicial, supernodal by entries / flops, converted
       const std::size_t supernodal_from = mode == 1 ? 1 : 0;
-      const double supernodal_flops = mode == 2 ? 1.0 : 0.0;
+      const double supernodal_flops = mode >= 2 ? 1.0 : 0.0;
       test::RandomGraphSpec spec;
       spec.d = d;
       spec.poses = 40;
@@ -69,7 +70,8 @@ TEST(BlockPreconditioner, ExactFactorMatchesADenseSolveForEveryRank) {
       for (std::size_t i = 0; i < spec.poses / 2; ++i) b.owned.push_back(i);
       const BlockProblem problem(d, b.owned, b.graph.measurements);
       const double shift = 1e-2;
-      const BlockPreconditioner precon(problem, shift, 0, supernodal_from, supernodal_flops);
+      const BlockPreconditioner precon(problem, shift, 0, supernodal_from, supernodal_flops,
+                                       mode == 3);
       EXPECT_FALSE(precon.block_diagonal());
       EXPECT_EQ(precon.supernodal(), mode != 0);
       Eigen::MatrixXd A = Eigen::MatrixXd(problem.data_matrix());

@@ -268,6 +268,44 @@ TEST(CentralizedSolver, ReferenceStopSavesStepsAndStaysWithinItsAccuracy) {
   EXPECT_GE(fast.relaxation_cost, best.relaxation_cost - 1e-9 * best.relaxation_cost);
 }
 
+// A 2D chain of 200 poses with 3 loop closures and little noise: f ~ 0.16, so the gradient falls
+// below the paired bound (1e-2) while the relative tests still ask for a step (as on
+// parking-garage). The paired predicted-decrease stop ends the level at the first iterate where
+// gradient and prediction are both small, one step before the tight rule, at the same optimum.
+TEST(CentralizedSolver, PairedPredictedDecreaseStopsAChainWhereGradientAndPredictionAreSmall) {
+  const PoseGraph g = test::random_pose_graph({2, 200, 3, 0.001, 0.001, 1});
+  const CentralizedResult fast = solve_centralized(g);
+  ASSERT_EQ(fast.levels.size(), 1u);
+  EXPECT_EQ(fast.levels.front().stop_reason, "paired_predicted_decrease");
+  EXPECT_TRUE(fast.certified.value_or(false));
+  const TrustRegionOptions tr = CentralizedOptions::default_trust_region();
+  const auto holds = [&tr](const TrustRegionIteration& it) {
+    return it.grad_norm <= tr.paired_grad_norm_tol &&
+           it.predicted_decrease <= tr.paired_predicted_rel_decrease_tol * std::abs(it.cost);
+  };
+  ASSERT_FALSE(fast.trace.empty());
+  EXPECT_TRUE(holds(fast.trace.back().tr));
+  for (std::size_t k = 0; k + 1 < fast.trace.size(); ++k) EXPECT_FALSE(holds(fast.trace[k].tr));
+  CentralizedOptions tight;
+  tight.stop = CentralizedStop::kGradient;
+  const CentralizedResult best = solve_centralized(g, tight);
+  EXPECT_LT(fast.iterations, best.iterations);
+  EXPECT_NEAR(fast.cost, best.cost, 1e-8 * best.cost);
+  // Without the rule the level runs on to another test.
+  CentralizedOptions off;
+  off.trust_region.paired_predicted_rel_decrease_tol = 0;
+  const CentralizedResult longer = solve_centralized(g, off);
+  EXPECT_NE(longer.levels.front().stop_reason, "paired_predicted_decrease");
+  EXPECT_GT(longer.iterations, fast.iterations);
+  off.trust_region.paired_predicted_rel_decrease_tol = 1.0;
+  try {
+    off.validate();
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("paired_predicted_rel_decrease_tol"), std::string::npos);
+  }
+}
+
 TEST(TrustRegion, PairedGradientAndPredictedDecreaseStopsEndTheRunWhereTheyHold) {
   auto g = test::random_pose_graph({3, 30, 20, 0.05, 0.1, 5});
   const BlockProblem P = BlockProblem::whole_graph(3, g.num_poses, g.measurements);

@@ -24,6 +24,14 @@ namespace {
 const char* kChain =
     "--kind grid3d --poses 600 --max-loop-closures 4 --rot-noise 0.1 --trans-noise 1 --seed 3";
 
+// f* to round-off (the centralized solver's gradient stop): its default stop may end ~1e-7 above
+// f* on long chains like this one, which is not what the refinement is measured against.
+double tight_optimum(const PoseGraph& g) {
+  CentralizedOptions o;
+  o.stop = CentralizedStop::kGradient;
+  return solve_centralized(g, o).cost;
+}
+
 TEST(DdsNewtonRefine, AgentsOverDdsTakeTheInProcessIterates) {
   const std::string dir = temp_dir();
   const std::string graph = dir + "/chain.g2o";
@@ -52,7 +60,7 @@ TEST(DdsNewtonRefine, AgentsOverDdsTakeTheInProcessIterates) {
   EXPECT_NEAR(json_number(summary, "grad_norm"), ref.grad_norm, 1e-9 * ref.grad_norm) << summary;
   EXPECT_NEAR(json_number(summary, "cost"), ref.cost, 1e-9 * ref.cost) << summary;
   // And that is the optimum, which the rounds alone do not reach on this chain.
-  const double fstar = solve_centralized(g).cost;
+  const double fstar = tight_optimum(g);
   EXPECT_NEAR(json_number(summary, "cost"), fstar, 1e-8 * fstar) << summary;
 }
 
@@ -72,7 +80,7 @@ TEST(DdsNewtonRefine, LaunchForwardsRefineAndEndsCertifiedAtTheOptimum) {
   const std::string json = slurp(dir + "/s.json");
   EXPECT_EQ(json_text(json, "certified"), "true") << json;
   const PoseGraph g = read_g2o(graph);
-  const double fstar = solve_centralized(g).cost;
+  const double fstar = tight_optimum(g);
   EXPECT_NEAR(json_number(json, "cost"), fstar, 1e-8 * fstar) << json;
 }
 

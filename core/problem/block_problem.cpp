@@ -231,12 +231,16 @@ double edge_term(const double* Xi, const double* Xj, const double* m, Eigen::Ind
   const double* Rm = m;
   const double* t = m + D * D;
   double rot = 0.0, tr = 0.0;
+#pragma GCC unroll 16
   for (Eigen::Index a = 0; a < r; ++a) {
     double ta = Xj[D * r + a] - Xi[D * r + a];
+#pragma GCC unroll 16
     for (int c = 0; c < D; ++c) ta -= Xi[c * r + a] * t[c];
     tr += ta * ta;
+#pragma GCC unroll 16
     for (int b = 0; b < D; ++b) {
       double v = Xj[b * r + a];
+#pragma GCC unroll 16
       for (int c = 0; c < D; ++c) v -= Xi[c * r + a] * Rm[b * D + c];
       rot += v * v;
     }

@@ -27,17 +27,23 @@ void dense_times_sparse(const double* X, Eigen::Index r, const SparseMatrix& Q, 
 }
 
 // S = sym(A^T B) for the r x D column blocks A, B (column-major, leading dimension r).
+// The unroll pragmas: -O2 alone keeps these fixed-count loops rolled (see tangent_project_poses).
 template <int D, int R>
 inline void sym_product(const double* A, const double* B, Eigen::Index r, double (&S)[D][D]) {
   const Eigen::Index rr = R > 0 ? R : r;
   double P[D][D];
+#pragma GCC unroll 16
   for (int a = 0; a < D; ++a)
+#pragma GCC unroll 16
     for (int b = 0; b < D; ++b) {
       double acc = 0.0;
+#pragma GCC unroll 16
       for (Eigen::Index k = 0; k < rr; ++k) acc += A[a * rr + k] * B[b * rr + k];
       P[a][b] = acc;
     }
+#pragma GCC unroll 16
   for (int a = 0; a < D; ++a)
+#pragma GCC unroll 16
     for (int b = 0; b < D; ++b) S[a][b] = 0.5 * (P[a][b] + P[b][a]);
 }
 
@@ -53,12 +59,15 @@ void hessian_projection(const double* X, const double* G, const double* V, Eigen
     double SH[D][D], SG[D][D];
     sym_product<D, R>(Xi, Hi, rr, SH);
     sym_product<D, R>(Xi, G + stride * i, rr, SG);
+#pragma GCC unroll 16
     for (int b = 0; b < D; ++b) {
       double* h = Hi + b * rr;
+#pragma GCC unroll 16
       for (int a = 0; a < D; ++a) {
         const double wx = SH[a][b], wv = SG[a][b];
         const double* xa = Xi + a * rr;
         const double* va = Vi + a * rr;
+#pragma GCC unroll 16
         for (Eigen::Index k = 0; k < rr; ++k) h[k] -= wx * xa[k] + wv * va[k];
       }
     }

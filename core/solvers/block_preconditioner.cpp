@@ -14,8 +14,12 @@ struct BlockPreconditioner::Factor {
   // LDL^T vs CHOLMOD's automatic choice (supernodal on these graphs): city10000 2.6 vs 4.8 ms,
   // sphere2500 1.2 vs 2.0 ms, cubicle 5.0 vs 5.9 ms, ais2klinik 0.78 vs 0.72 ms
   // (docs/centralized-solver.md). Supernodal LL^T for large ones (see the constructor).
-  std::unique_ptr<Eigen::CholmodDecomposition<SparseMatrix>> llt =
-      std::make_unique<Eigen::CholmodDecomposition<SparseMatrix>>();
+  // Eigen's wrapper with access to CHOLMOD's factor (to convert it after factorization).
+  struct Cholmod : Eigen::CholmodDecomposition<SparseMatrix> {
+    cholmod_factor* raw() { return m_cholmodFactor; }
+  };
+  std::unique_ptr<Cholmod> llt = std::make_unique<Cholmod>();
+  bool supernodal = false;
   // Fallback: inverses of the (d+1) x (d+1) diagonal blocks, one after the other (column-major).
   int w = 0;
   std::vector<double> block_inverses;
@@ -47,7 +51,7 @@ std::vector<double> diagonal_block_inverses(const SparseMatrix& A, int w) {
 BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double relative_shift,
                                          std::size_t max_factor_entries,
                                          std::size_t supernodal_min_entries,
-                                         double supernodal_min_flops)
+                                         double supernodal_min_flops, bool simplicial_solves)
     : factor_(std::make_unique<Factor>()) {
   const SparseMatrix& Q = problem.data_matrix();
   const double lambda = relative_shift * std::max(1e-12, Q.diagonal().maxCoeff());
@@ -60,7 +64,7 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
   };
   bool fallback = too_large(0.5 * static_cast<double>(A.nonZeros() + A.rows()));
   const auto analyze = [&](Eigen::CholmodMode mode) {
-    factor_->llt = std::make_unique<Eigen::CholmodDecomposition<SparseMatrix>>();
+    factor_->llt = std::make_unique<Factor::Cholmod>();
     factor_->llt->setMode(mode);
     // AMD only. CHOLMOD's default also tries METIS when AMD's fill looks high (it does on 3D
     // grids) and keeps the better one: METIS never won on any block measured (more fill than
@@ -70,6 +74,14 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
     c.nmethods = 1;
     c.method[0].ordering = CHOLMOD_AMD;
     c.postorder = 1;
+    // A factor to be converted for simplicial solves keeps only fundamental supernodes: the
+    // default relaxed amalgamation stores explicit zeros (cubicle: 1.72 M entries instead of
+    // 1.45 M) that every simplicial solve would then traverse.
+    if (simplicial_solves && mode == Eigen::CholmodSupernodalLLt)
+      for (int k = 0; k < 3; ++k) {
+        c.nrelax[k] = 0;
+        c.zrelax[k] = 0.0;
+      }
     factor_->llt->analyzePattern(A);
     if (factor_->llt->info() != Eigen::Success)
       throw std::runtime_error("BlockPreconditioner: symbolic analysis failed");
@@ -102,6 +114,15 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
   factor_->llt->factorize(A);
   if (factor_->llt->info() != Eigen::Success)
     throw std::runtime_error("BlockPreconditioner: Cholesky factorization failed");
+  factor_->supernodal = factor_->llt->cholmod().supernodal == CHOLMOD_SUPERNODAL;
+  // The supernodal solve's BLAS calls on small supernodes cost more than they save with a few
+  // right-hand sides: the factor is converted to the simplicial LDL^T form, whose solves cost
+  // what the simplicial factorization's do (cubicle: 779 M instructions for 20 solves either
+  // way), while the factorization drops from 1.26 G to 0.46 G instructions.
+  if (factor_->supernodal && simplicial_solves &&
+      !cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/0, /*to_super=*/0, /*to_packed=*/1,
+                             /*to_monotonic=*/1, factor_->llt->raw(), &factor_->llt->cholmod()))
+    throw std::runtime_error("BlockPreconditioner: converting the factor failed");
 }
 
 bool BlockPreconditioner::block_diagonal() const {
@@ -109,7 +130,7 @@ bool BlockPreconditioner::block_diagonal() const {
 }
 
 bool BlockPreconditioner::supernodal() const {
-  return factor_->w == 0 && factor_->llt->cholmod().supernodal == CHOLMOD_SUPERNODAL;
+  return factor_->w == 0 && factor_->supernodal;
 }
 
 BlockPreconditioner::~BlockPreconditioner() = default;

@@ -8,7 +8,7 @@
 
 namespace tessera {
 
-Eigen::MatrixXd chordal_rotations(const PoseGraph& graph) {
+Eigen::MatrixXd chordal_rotations(const PoseGraph& graph, bool simplicial) {
   using Index = Eigen::Index;
   const Index d = graph.d;
   const Index n = static_cast<Index>(graph.num_poses);
@@ -44,7 +44,8 @@ Eigen::MatrixXd chordal_rotations(const PoseGraph& graph) {
   Eigen::MatrixXd rhs = -Eigen::MatrixXd(H.bottomLeftCorner(m, d));
   H = Eigen::SparseMatrix<double>();
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> chol;
-  chol.setMode(Eigen::CholmodAuto);  // CHOLMOD chooses simplicial or supernodal
+  // CHOLMOD chooses simplicial or supernodal unless the caller needs it BLAS-free.
+  chol.setMode(simplicial ? Eigen::CholmodLDLt : Eigen::CholmodAuto);
   chol.compute(Hrr);
   if (chol.info() != Eigen::Success)
     throw std::runtime_error("chordal initialization: factorization failed (disconnected graph?)");

@@ -10,7 +10,8 @@ struct TranslationElimination::Factor {
 };
 
 TranslationElimination::TranslationElimination(int d, std::size_t num_poses,
-                                               const std::vector<Measurement>& measurements)
+                                               const std::vector<Measurement>& measurements,
+                                               bool simplicial)
     : d_(d), n_(num_poses), edges_(measurements), factor_(std::make_unique<Factor>()) {
   if (n_ < 2) return;  // a single pose: nothing to solve
   // Unknowns p_1..p_{n-1} (pose 0 fixed): variable k is pose k+1.
@@ -28,7 +29,7 @@ TranslationElimination::TranslationElimination(int d, std::size_t num_poses,
   const Eigen::Index m = static_cast<Eigen::Index>(n_ - 1);
   Eigen::SparseMatrix<double> L(m, m);
   L.setFromTriplets(trip.begin(), trip.end());
-  factor_->llt.setMode(Eigen::CholmodAuto);
+  factor_->llt.setMode(simplicial ? Eigen::CholmodLDLt : Eigen::CholmodAuto);
   factor_->llt.compute(L);
   if (factor_->llt.info() != Eigen::Success)
     throw std::runtime_error(

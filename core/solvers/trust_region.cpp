@@ -20,6 +20,8 @@ void TrustRegionOptions::validate() const {
   if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
   if (!(paired_grad_norm_tol >= 0)) fail("paired_grad_norm_tol", "must be >= 0");
   if (!(preconditioned_grad_norm_tol >= 0)) fail("preconditioned_grad_norm_tol", "must be >= 0");
+  if (!(paired_predicted_rel_decrease_tol >= 0 && paired_predicted_rel_decrease_tol < 1))
+    fail("paired_predicted_rel_decrease_tol", "must be in [0, 1)");
   if (!(step_norm_tol >= 0)) fail("step_norm_tol", "must be >= 0");
   if (!(predicted_rel_decrease_tol >= 0 && predicted_rel_decrease_tol < 1))
     fail("predicted_rel_decrease_tol", "must be in [0, 1)");
@@ -170,6 +172,12 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     }
     if (paired_met()) {
       res.stop_reason = "preconditioned_grad_norm";
+      break;
+    }
+    if (options.paired_predicted_rel_decrease_tol > 0 &&
+        grad_norm <= options.paired_grad_norm_tol &&
+        predicted_decrease() <= options.paired_predicted_rel_decrease_tol * std::abs(f)) {
+      res.stop_reason = "paired_predicted_decrease";
       break;
     }
     if (options.predicted_rel_decrease_tol > 0 &&

@@ -38,11 +38,13 @@ class BlockPreconditioner : public RiemannianPreconditioner {
   /// up to round-off); 0 = always simplicial.
   /// `supernodal_min_flops`: exact factors whose factorization CHOLMOD's analysis predicts to
   /// take more floating-point operations are supernodal too; 0 = no such rule.
+  /// `simplicial_solves`: a supernodal factor, once computed, is converted to the simplicial
+  /// LDL^T form for the solves (the same factor; faster to solve with a few right-hand sides).
   explicit BlockPreconditioner(const BlockProblem& problem,
                                double relative_shift = kDefaultRelativeShift,
                                std::size_t max_factor_entries = kDefaultMaxFactorEntries,
                                std::size_t supernodal_min_entries = kDefaultSupernodalMinEntries,
-                               double supernodal_min_flops = 0);
+                               double supernodal_min_flops = 0, bool simplicial_solves = false);
   ~BlockPreconditioner() override;
   BlockPreconditioner(const BlockPreconditioner&) = delete;
   BlockPreconditioner& operator=(const BlockPreconditioner&) = delete;
@@ -53,7 +55,8 @@ class BlockPreconditioner : public RiemannianPreconditioner {
 
   /// True when the exact factor was too large and the block diagonal is used.
   bool block_diagonal() const;
-  /// True when the exact factor is supernodal.
+  /// True when the exact factor was computed supernodally (solves may use it converted to
+  /// simplicial form, see simplicial_solves).
   bool supernodal() const;
 
  private:

@@ -50,6 +50,13 @@ struct CentralizedOptions {
   /// Only with threads = 1 (the robust solve's weighted and kept-set solves): the factor is then
   /// not computed beside the start, whose own factorizations may call BLAS too.
   double supernodal_min_flops = 5e8;
+  /// With threads = 2 and translation elimination: the preconditioner's factorization on the
+  /// second thread is supernodal above this many flops (CHOLMOD's prediction; > 0), converted to
+  /// simplicial LDL^T for the solves, while the start's and the translations' factorizations on
+  /// the first thread are simplicial (no BLAS calls beside the other thread's). 1.5e8: cubicle
+  /// (2.3e8 flops) goes supernodal, city10000 (9.7e7) not: there the supernodal factorization
+  /// took more instructions (0.79 vs 0.68 G) and its round-off led the tCG one step longer.
+  double concurrent_supernodal_min_flops = 1.5e8;
   /// Re-solve the translations exactly for the rotations of every trial point (SE-Sync's
   /// translation elimination; see solvers/translation_elimination.hpp). false: plain
   /// explicit-translation trust region.
@@ -80,8 +87,9 @@ struct StaircaseLevel {
   std::optional<double> min_eigenvalue;
   bool certified;
   double elapsed_s;
-  /// Why the trust region stopped: grad_norm, preconditioned_grad_norm, predicted_decrease,
-  /// relative_decrease (the converged ones), or max_iterations, time, radius.
+  /// Why the trust region stopped: grad_norm, preconditioned_grad_norm,
+  /// paired_predicted_decrease, predicted_decrease, relative_decrease (the converged ones), or
+  /// max_iterations, time, radius.
   std::string stop_reason;
 };
 

@@ -14,7 +14,9 @@ namespace tessera {
 /// cannot be factored (a measurement graph that is not connected).
 std::vector<Pose> chordal_initialization(const PoseGraph& graph);
 
-/// Only the rotations, d x dn (the same ones chordal_initialization uses).
-Eigen::MatrixXd chordal_rotations(const PoseGraph& graph);
+/// Only the rotations, d x dn (the same ones chordal_initialization uses). `simplicial`: factor
+/// simplicially (no BLAS calls), for a caller that runs a supernodal factorization on another
+/// thread at the same time (the serial OpenBLAS build has no locks); false: CHOLMOD chooses.
+Eigen::MatrixXd chordal_rotations(const PoseGraph& graph, bool simplicial = false);
 
 }  // namespace tessera

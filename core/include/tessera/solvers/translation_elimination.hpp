@@ -25,9 +25,10 @@ namespace tessera {
 class TranslationElimination {
  public:
   /// Factors the translation Laplacian of a connected graph with poses 0..num_poses-1.
-  /// Throws std::runtime_error when the factorization fails (disconnected graph).
-  TranslationElimination(int d, std::size_t num_poses,
-                         const std::vector<Measurement>& measurements);
+  /// `simplicial`: no supernodal factorization (no BLAS calls, see chordal_rotations); false:
+  /// CHOLMOD chooses. Throws std::runtime_error when the factorization fails (disconnected graph).
+  TranslationElimination(int d, std::size_t num_poses, const std::vector<Measurement>& measurements,
+                         bool simplicial = false);
   ~TranslationElimination();
   TranslationElimination(const TranslationElimination&) = delete;
   TranslationElimination& operator=(const TranslationElimination&) = delete;

@@ -31,6 +31,12 @@ struct TrustRegionOptions {
   /// would still cause", which does not depend on how the weights scale the gradient.
   double paired_grad_norm_tol = 0.0;
   double preconditioned_grad_norm_tol = 0.0;
+  /// The same gradient bound paired with the model's predicted decrease instead (in [0, 1);
+  /// 0 = off): stop before a step when ||grad f|| <= paired_grad_norm_tol and 1/2 <P grad f,
+  /// grad f> <= this fraction of f. ||P grad f|| with an almost unregularised P is inflated by
+  /// the soft modes of long lever arms (parking-garage: 0.26 where f is 1.2e-8 f above f*); the
+  /// decrease weighs each mode by its gradient and is relative to f, as the decrease tests are.
+  double paired_predicted_rel_decrease_tol = 0.0;
   /// Stop after an accepted step whose rotation part (the Stiefel columns of the update) has a
   /// Frobenius norm below this (>= 0; 0 = off). Translations are left out: they are in the
   /// graph's length unit, rotations are not.
