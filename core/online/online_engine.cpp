@@ -28,6 +28,8 @@ void OnlineOptions::validate() const {
     throw InputError("OnlineOptions.step_every_s must be a finite number >= 0 (seconds)");
   if (step_every_s > 0 && real_time)
     throw InputError("OnlineOptions.step_every_s: a fixed step period excludes real_time");
+  if (!(newton_after_grad_tol > 0))
+    throw InputError("OnlineOptions.newton_after_grad_tol must be > 0 (+infinity: no round)");
   DistributedOptions s = solver;
   s.certify = certify_at_end;  // the staircase options matter only then
   try {
@@ -113,13 +115,10 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     u.relaxation_cost = last_relaxation_cost_;
     u.stop_reason = "unchanged";
   } else {
-    DistributedOptions solver = options_.solver;
-    solver.certify = false;
-    solver.round_result = false;  // the graph may not be connected yet
-    const DistributedResult res = solve_linked(solver);
+    const DistributedResult res = solve_linked(step_solver());
     // A stalled iterate (RoundProtocol: cost and gradient repeated bit for bit) cannot improve
     // on this problem: iterating again before new data arrives would only burn rounds.
-    converged_ = res.grad_norm <= solver.grad_norm_tol || res.stop_reason == "stalled";
+    converged_ = res.grad_norm <= options_.solver.grad_norm_tol || res.stop_reason == "stalled";
     last_grad_norm_ = res.grad_norm;
     last_relaxation_cost_ = res.relaxation_cost;
     u.rounds = res.rounds;
@@ -130,6 +129,13 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     u.rounds_cpu_s = res.solve_cpu_s;
     u.critical_path_cpu_s = res.critical_path_cpu_s;
     u.relaxation_cost = res.relaxation_cost;
+    for (const NewtonRefineResult& n : res.refines) {
+      u.newton_steps += n.steps;
+      u.newton_cg_iterations += n.cg_iterations;
+      u.newton_message_steps += n.exchanges + n.reductions;
+    }
+    // The step ended where the Newton steps stopped (grad_norm, stalled, or a cap).
+    if (!res.refines.empty()) u.stop_reason = res.refines.back().stop_reason;
   }
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;
@@ -142,6 +148,21 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   totals_.cpu_s += u.cpu_s;
   totals_.updates.push_back(u);
   return u;
+}
+
+DistributedOptions OnlineEngine::step_solver() const {
+  DistributedOptions solver = options_.solver;
+  solver.certify = false;
+  solver.round_result = false;  // the graph may not be connected yet
+  if (options_.newton_steps) {
+    solver.refine.enabled = true;
+    solver.refine.grad_norm_tol = options_.solver.grad_norm_tol;
+    // The step is done only under the tolerance: a small decrease is no reason to stop.
+    solver.refine.relative_decrease_tol = 0.0;
+    solver.refine.refactor_every_step = false;
+    solver.grad_norm_tol = std::max(options_.newton_after_grad_tol, solver.grad_norm_tol);
+  }
+  return solver;
 }
 
 DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -61,6 +62,17 @@ struct OnlineOptions {
   /// poses: the default, because the diagonal blocks precondition a new chain of poses poorly
   /// (instructions of a 400-pose sphere replay, 5 robots: 7.0 G at 0, 12.0 G at 0.05). >= 0.
   double refactor_growth = 0.0;
+  /// How a step brings ||grad f|| back under solver.grad_norm_tol after new data. true: block-
+  /// coordinate rounds down to max(newton_after_grad_tol, the tolerance), then distributed
+  /// trust-region Newton steps (newton_refine.hpp, solver.refine's settings with its tolerance
+  /// set to the solver's and its relative-decrease stop off) from there; false: rounds only.
+  /// Why: a new loop closure bends whole chains, a smooth error that rounds remove slowly (a
+  /// generated 1,000-pose city, 5 robots, a step every 0.1 s: ~290 rounds a step), while one or
+  /// two Newton steps from the warm start take it out at once (docs/online.md, "Newton steps").
+  bool newton_steps = true;
+  /// See newton_steps: +infinity (the default) starts Newton from the warm start with no round.
+  /// > 0.
+  double newton_after_grad_tol = std::numeric_limits<double>::infinity();
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
@@ -98,6 +110,11 @@ struct OnlineUpdate {
   /// iterate did not change).
   std::string stop_reason;
   double relaxation_cost = 0.0;  ///< f(Y) at the end of the step.
+  /// OnlineOptions::newton_steps: the step's Newton steps (accepted or not), their CG
+  /// iterations, and message steps (neighbour exchanges plus all-agent sums; a round is one).
+  int newton_steps = 0;
+  int newton_cg_iterations = 0;
+  int newton_message_steps = 0;
 };
 
 /// A certificate taken while the graph was growing (OnlineOptions::certify_every_s).
@@ -163,6 +180,8 @@ class OnlineEngine {
   /// Runs the agents from X_ on the poses some measurement touches and writes their result
   /// back into X_ (when the rank did not change: a staircase climb leaves X_ as it was).
   DistributedResult solve_linked(const DistributedOptions& solver);
+  /// The solver of a step that absorbed new data (OnlineOptions::newton_steps).
+  DistributedOptions step_solver() const;
 
   OnlineOptions options_;
   GraphStream stream_;
