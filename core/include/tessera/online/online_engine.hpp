@@ -65,18 +65,26 @@ struct OnlineOptions {
   /// How a step brings ||grad f|| back under solver.grad_norm_tol after new data. true: block-
   /// coordinate rounds down to max(newton_after_grad_tol, the tolerance), then distributed
   /// trust-region Newton steps (newton_refine.hpp, solver.refine's settings with its tolerance
-  /// set to the solver's and its relative-decrease stop off) from there; false: rounds only.
-  /// Why: a new loop closure bends whole chains, a smooth error that rounds remove slowly (a
-  /// generated 1,000-pose city, 5 robots, a step every 0.1 s: ~290 rounds a step), while one or
-  /// two Newton steps from the warm start take it out at once (docs/online.md, "Newton steps").
+  /// set to the solver's, its relative-decrease stop off and the block factors kept across its
+  /// steps) from there; Newton steps that stop above the tolerance (a cap, or a stalled trust
+  /// region) are followed by rounds from where they stopped, in the same step (in process; over
+  /// DDS the next epoch solves again). false: rounds only. Why: a new loop closure bends whole
+  /// chains, a smooth error the rounds remove slowly, while the Newton steps' CG works on all
+  /// blocks at once (a generated 1,000-pose city, 5 robots, a step every 0.1 s of stream: ~290
+  /// rounds a step against 4-7 Newton steps and ~100 CG iterations; docs/online.md, "Newton
+  /// steps").
   bool newton_steps = true;
-  /// See newton_steps: +infinity (the default) starts Newton from the warm start with no round.
-  /// > 0.
+  /// See newton_steps: +infinity (the default) starts the Newton steps from the warm start,
+  /// with no round. > 0.
   double newton_after_grad_tol = std::numeric_limits<double>::infinity();
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
 };
+
+/// The agents' solver for a step that absorbed new data (OnlineOptions::newton_steps): the
+/// in-process engine's and `tessera-agent --online`'s, so both take the same steps.
+DistributedOptions online_step_solver(const OnlineOptions& options);
 
 /// One step of the online run (the JSON `updates` array of `tessera launch --online`).
 struct OnlineUpdate {
@@ -180,8 +188,8 @@ class OnlineEngine {
   /// Runs the agents from X_ on the poses some measurement touches and writes their result
   /// back into X_ (when the rank did not change: a staircase climb leaves X_ as it was).
   DistributedResult solve_linked(const DistributedOptions& solver);
-  /// The solver of a step that absorbed new data (OnlineOptions::newton_steps).
-  DistributedOptions step_solver() const;
+  /// A step's solver with rounds only (after Newton steps that stopped above the tolerance).
+  DistributedOptions plain_step_solver() const;
 
   OnlineOptions options_;
   GraphStream stream_;
