@@ -156,6 +156,7 @@ TEST(OnlineEngine, AgentsWithNoNewDataAndASmallGradientDoNothing) {
   for (int k = 0; k < 3; ++k) {
     const OnlineUpdate idle = engine.step(2.0 + k);
     EXPECT_EQ(idle.rounds, 0);
+    EXPECT_EQ(idle.newton_steps, 0);
     EXPECT_EQ(idle.bytes, 0u);
     EXPECT_EQ(idle.batches, 0u);
   }
@@ -201,7 +202,7 @@ TEST(OnlineEngine, APoseThatOnlyExtendsOdometryNeedsNoRound) {
                     [](const auto& m) { return m.kind == MeasurementKind::kOdometry; });
     const OnlineUpdate u = engine.step(b.stamp);
     if (odometry_only && b.sequence > 0) {
-      rounds_on_odometry_only += u.rounds;
+      rounds_on_odometry_only += u.rounds + u.newton_steps;
       ++odometry_only_steps;
     }
   }
