@@ -2,6 +2,7 @@
 
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
+#include <tessera/online/online_engine.hpp>
 
 #include "agent/online_takeover_step.hpp"
 
@@ -21,7 +22,9 @@ SolveOutcome OnlineBlockSolver::solve(runtime::OnlineAgentView& view, bool certi
   live_->sync(stream->graph(), view.owner(), view.iterate());
   const int c = live_->compact_block(view.own_block());
   if (live_->graph().num_poses == 0 || c < 0) return out;
-  DistributedOptions solver = options_.solver;
+  // A step's solve (Newton steps from the warm start by default); the certified one is the
+  // plain solver's, from a converged iterate.
+  DistributedOptions solver = certify ? options_.solver : online_step_solver(options_);
   solver.certify = certify;
   solver.round_result = false;
   // A certificate while the graph grows does not climb the staircase: the iterate keeps its

@@ -20,7 +20,7 @@ namespace tessera::cli {
 const char* const kOnlineValued[] = {"rate",           "speedup",         "start",
                                      "checkpoints",    "certify-every",   "refactor-growth",
                                      "baseline-every", "local-threshold", "step-every",
-                                     nullptr};
+                                     "step-solver",    "newton-after",    nullptr};
 const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", "no-local-rounds",
                                        nullptr};
 
@@ -57,6 +57,10 @@ const char* kOnlineHelp =
     "  --local-threshold F       local rounds: a block works only while its gradient norm\n"
     "                            is above F * grad-tol / sqrt(blocks), in (0, 1] (default 1)\n"
     "  --no-local-rounds         every block works and sends in every round\n"
+    "  --step-solver newton|rounds   how a step gets the gradient back under --grad-tol:\n"
+    "                            distributed Newton steps from the warm start (default) or\n"
+    "                            block-coordinate rounds only\n"
+    "  --newton-after T          newton: rounds first, down to ||grad f|| <= T (default: none)\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step)\n";
 
@@ -101,6 +105,13 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.solver.local_rounds.enabled = !a.has("no-local-rounds");
   options.solver.local_rounds.threshold =
       a.get_double("local-threshold", options.solver.local_rounds.threshold);
+  {
+    const std::string step_solver = a.get_or("step-solver", "newton");
+    if (step_solver != "newton" && step_solver != "rounds")
+      throw InputError("option --step-solver: '" + step_solver + "' is not one of newton, rounds");
+    options.newton_steps = step_solver == "newton";
+    options.newton_after_grad_tol = a.get_double("newton-after", options.newton_after_grad_tol);
+  }
   options.validate();
   ReplayOptions replay;
   replay.rate = a.get_double("rate", replay.rate);
@@ -218,7 +229,10 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("latency_s", u.latency_s)
           .add("bytes", static_cast<std::size_t>(u.bytes))
           .add("grad_norm", u.grad_norm)
-          .add("stop_reason", u.stop_reason);
+          .add("stop_reason", u.stop_reason)
+          .add("newton_steps", u.newton_steps)
+          .add("newton_cg_iterations", u.newton_cg_iterations)
+          .add("newton_message_steps", u.newton_message_steps);
       updates.push_back(std::move(j));
     }
     for (const auto& c : marks) {
@@ -254,6 +268,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("speedup", replay.speedup)
         .add("real_time", options.real_time)
         .add("step_every_s", options.step_every_s)
+        .add("step_solver", options.newton_steps ? "newton" : "rounds")
         .add("grad_tol", options.solver.grad_norm_tol)
         .add("steps", res.updates.size())
         .add("rounds", res.rounds)

@@ -10,8 +10,11 @@
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/distributed/newton_refine.hpp>
 #include <tessera/generate/generator.hpp>
+#include <tessera/online/live_blocks.hpp>
 #include <tessera/partition/sequential_partition.hpp>
+#include <tessera/problem/lifting.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
+#include <tessera/solvers/chordal_initialization.hpp>
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
@@ -112,6 +115,64 @@ TEST(NewtonRefine, IsNotRunAfterASolveOutOfRounds) {
   const DistributedResult r = solve_distributed(g, sequential_partition(g.num_poses, 3), o);
   EXPECT_EQ(r.stop_reason, "max_rounds");
   EXPECT_TRUE(r.refines.empty());
+}
+
+// On the same block states (as an online run keeps them): rounds to a gradient of 1, then
+// Newton steps alone to 1e-2, then on to 1e-6 from there. Returns each block's tangent
+// factorizations after each of the three solves, and the final cost.
+struct ThreeSolves {
+  std::vector<std::vector<int>> factorizations;
+  double cost = 0.0;
+};
+
+ThreeSolves rounds_then_refine_twice(bool refactor_every_step) {
+  const PoseGraph g = long_chain();
+  LiveBlocks live(3, BlockUpdateOptions{}, 0.0);
+  live.sync(g, sequential_partition(g.num_poses, 4), lift_poses(chordal_initialization(g), 5));
+  DistributedOptions o;
+  o.round_result = false;
+  o.grad_norm_tol = 1.0;
+  ThreeSolves out;
+  for (double tol : {0.0, 1e-2, 1e-6}) {
+    if (tol > 0) {
+      o.grad_norm_tol = 1e300;  // no round: the refinement from where the last solve stopped
+      o.refine.enabled = true;
+      o.refine.grad_norm_tol = tol;
+      o.refine.relative_decrease_tol = 0.0;
+      o.refine.refactor_every_step = refactor_every_step;
+    }
+    const DistributedResult r =
+        solve_distributed_with_states(live.graph(), live.layout(), live.all_states(), o);
+    if (tol > 0) {
+      EXPECT_EQ(r.rounds, 0);
+      EXPECT_LE(r.grad_norm, tol);
+      EXPECT_GE(r.refines.at(0).accepted_steps, 1);
+    }
+    out.factorizations.emplace_back();
+    for (const AgentState* s : live.all_states())
+      out.factorizations.back().push_back(s->tangent_factorizations());
+    out.cost = r.relaxation_cost;
+  }
+  return out;
+}
+
+TEST(NewtonRefine, WithoutRefactoringEveryStepABlockKeepsTheFactorItHolds) {
+  // The online steps' setting: a block that holds a factor (from the rounds) keeps it through
+  // later refinements on the same problem (the point moved, the data did not).
+  const ThreeSolves kept = rounds_then_refine_twice(false);
+  for (std::size_t b = 0; b < 4; ++b) {
+    EXPECT_GE(kept.factorizations[0][b], 1) << b;
+    EXPECT_EQ(kept.factorizations[1][b], kept.factorizations[0][b]) << b;
+    EXPECT_EQ(kept.factorizations[2][b], kept.factorizations[0][b]) << b;
+  }
+  // Refactoring at every step: at the start of each refinement and after each accepted step
+  // that is followed by another CG; the same optimum either way.
+  const ThreeSolves fresh = rounds_then_refine_twice(true);
+  for (std::size_t b = 0; b < 4; ++b) {
+    EXPECT_GT(fresh.factorizations[1][b], fresh.factorizations[0][b]) << b;
+    EXPECT_GT(fresh.factorizations[2][b], fresh.factorizations[1][b]) << b;
+  }
+  EXPECT_NEAR(kept.cost, fresh.cost, 1e-9 * fresh.cost);
 }
 
 TEST(NewtonRefineOptions, ValidateNamesTheBadField) {

@@ -150,16 +150,42 @@ TEST(OnlineEngine, AgentsWithNoNewDataAndASmallGradientDoNothing) {
   OnlineEngine engine(gen.graph.d, online_options());
   for (const auto& b : plan.batches) engine.receive(b);
   const OnlineUpdate first = engine.step(1.0);
-  EXPECT_GT(first.rounds, 0);
+  EXPECT_GT(first.rounds + first.newton_message_steps, 0);
   EXPECT_LE(first.grad_norm, 1e-5);
   const Eigen::MatrixXd before = engine.iterate();
   for (int k = 0; k < 3; ++k) {
     const OnlineUpdate idle = engine.step(2.0 + k);
     EXPECT_EQ(idle.rounds, 0);
+    EXPECT_EQ(idle.newton_steps, 0);
     EXPECT_EQ(idle.bytes, 0u);
     EXPECT_EQ(idle.batches, 0u);
   }
   EXPECT_EQ((engine.iterate() - before).norm(), 0.0);
+}
+
+TEST(OnlineEngine, NewtonStepsEndEveryStepUnderTheToleranceWithoutARound) {
+  const auto gen = small_graph(TrajectoryKind::kCity, 150, 3);
+  ReplayOptions ro;
+  ro.rate = 10;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  OnlineOptions o = online_options();
+  o.step_every_s = 0.5;
+  o.certify_at_end = false;
+  o.newton_steps = false;
+  const OnlineResult rounds = run_online(gen.graph.d, plan.batches, o);
+  o.newton_steps = true;
+  const OnlineResult newton = run_online(gen.graph.d, plan.batches, o);
+  int newton_messages = 0;
+  for (const OnlineUpdate& u : newton.updates) {
+    EXPECT_EQ(u.rounds, 0) << "Newton from the warm start, no round first";
+    EXPECT_LE(u.grad_norm, 1e-5) << u.stop_reason;
+    newton_messages += u.newton_message_steps;
+  }
+  EXPECT_EQ(newton.updates.size(), rounds.updates.size());
+  EXPECT_GT(newton_messages, 0);
+  const double f_star = batch_optimum(gen.graph);
+  EXPECT_NEAR(newton.cost, f_star, 1e-6 * f_star);
+  EXPECT_NEAR(rounds.cost, f_star, 1e-6 * f_star);
 }
 
 TEST(OnlineEngine, APoseThatOnlyExtendsOdometryNeedsNoRound) {
@@ -176,7 +202,7 @@ TEST(OnlineEngine, APoseThatOnlyExtendsOdometryNeedsNoRound) {
                     [](const auto& m) { return m.kind == MeasurementKind::kOdometry; });
     const OnlineUpdate u = engine.step(b.stamp);
     if (odometry_only && b.sequence > 0) {
-      rounds_on_odometry_only += u.rounds;
+      rounds_on_odometry_only += u.rounds + u.newton_steps;
       ++odometry_only_steps;
     }
   }
@@ -218,6 +244,10 @@ TEST(OnlineEngine, RejectsBadOptionsNamingTheField) {
   o.step_every_s = 0.5;
   o.real_time = true;
   EXPECT_NE(test::validation_message(o).find("OnlineOptions.step_every_s"), std::string::npos);
+  o = {};
+  o.newton_after_grad_tol = 0;
+  EXPECT_NE(test::validation_message(o).find("OnlineOptions.newton_after_grad_tol"),
+            std::string::npos);
 }
 
 TEST(OnlineEngine, AFixedStepPeriodAbsorbsEachPeriodsBatchesAndEndsAtTheBatchOptimum) {

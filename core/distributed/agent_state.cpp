@@ -240,9 +240,18 @@ Eigen::MatrixXd AgentState::precondition(const Eigen::MatrixXd& X, const Eigen::
 }
 
 bool AgentState::refresh_tangent(const Eigen::MatrixXd& X) {
-  if (X.rows() != d_ || euclidean().block_diagonal()) return false;
+  // The Q_BB factor's size decides (a tangent factor would be larger still); when it is not
+  // held (released, or the block grew), the answer of its last build stands: building it only
+  // to ask would cost a factorization the tangent factor makes unnecessary.
+  if (X.rows() != d_ || (precon_ ? precon_->block_diagonal() : block_factor_too_large_))
+    return false;
   if (!tangent_) return build_tangent(X, BlockUpdateOptions{});  // factored at X when built
   return tangent_->usable() && tangent_->factorize(X);
+}
+
+bool AgentState::ensure_tangent(const Eigen::MatrixXd& X) {
+  if (X.rows() == d_ && tangent_ && tangent_->factored()) return true;
+  return refresh_tangent(X);
 }
 
 double AgentState::local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours) {

@@ -183,11 +183,22 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
   result_.initial_grad_norm = result_.grad_norm = gnorm_;
   radius_ = options_.initial_radius;
   if (gnorm_ <= options_.grad_norm_tol) return finish("grad_norm");
-  state_.refresh_tangent(X_);
+  prepare_preconditioner();
   begin_cg(out);
 }
 
+void NewtonRefineProtocol::prepare_preconditioner() {
+  if (options_.refactor_every_step)
+    state_.refresh_tangent(X_);
+  else
+    state_.ensure_tangent(X_);
+  refactor_due_ = false;
+}
+
 void NewtonRefineProtocol::begin_cg(std::vector<OutgoingMessage>& out) {
+  // Only before a CG that will run: the factor at the point where the refinement stops would
+  // not be used.
+  if (refactor_due_) prepare_preconditioner();
   step_ = NewtonRefineStep{};
   step_.radius = radius_;
   cg_it_ = 0;
@@ -320,7 +331,7 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
     f_ = ft;
     gnorm_ = gt;
     ++result_.accepted_steps;
-    state_.refresh_tangent(X_);  // each CG solve preconditioned at its own point
+    refactor_due_ = true;  // each CG solve preconditioned at its own point (when asked)
   }
   step_.cost = f_;
   step_.grad_norm = gnorm_;

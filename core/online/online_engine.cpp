@@ -28,6 +28,8 @@ void OnlineOptions::validate() const {
     throw InputError("OnlineOptions.step_every_s must be a finite number >= 0 (seconds)");
   if (step_every_s > 0 && real_time)
     throw InputError("OnlineOptions.step_every_s: a fixed step period excludes real_time");
+  if (!(newton_after_grad_tol > 0))
+    throw InputError("OnlineOptions.newton_after_grad_tol must be > 0 (+infinity: no round)");
   DistributedOptions s = solver;
   s.certify = certify_at_end;  // the staircase options matter only then
   try {
@@ -113,13 +115,23 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     u.relaxation_cost = last_relaxation_cost_;
     u.stop_reason = "unchanged";
   } else {
-    DistributedOptions solver = options_.solver;
-    solver.certify = false;
-    solver.round_result = false;  // the graph may not be connected yet
-    const DistributedResult res = solve_linked(solver);
+    DistributedResult res = solve_linked(online_step_solver(options_));
+    // Newton steps that stopped above the tolerance (a step far from the model's region, e.g.
+    // the closures of sphere2500's last rings: 20 trust-region steps left |grad f| at 9) hand
+    // over to the rounds from where they stopped: the step ends under the tolerance either way.
+    const bool newton_short = !res.refines.empty() && res.grad_norm > options_.solver.grad_norm_tol;
+    const std::vector<NewtonRefineResult> refines = res.refines;
+    if (newton_short) {
+      DistributedResult more = solve_linked(plain_step_solver());
+      more.bytes_exchanged += res.bytes_exchanged;
+      more.init_s += res.init_s;
+      more.solve_cpu_s += res.solve_cpu_s;
+      more.critical_path_cpu_s += res.critical_path_cpu_s;
+      res = std::move(more);
+    }
     // A stalled iterate (RoundProtocol: cost and gradient repeated bit for bit) cannot improve
     // on this problem: iterating again before new data arrives would only burn rounds.
-    converged_ = res.grad_norm <= solver.grad_norm_tol || res.stop_reason == "stalled";
+    converged_ = res.grad_norm <= options_.solver.grad_norm_tol || res.stop_reason == "stalled";
     last_grad_norm_ = res.grad_norm;
     last_relaxation_cost_ = res.relaxation_cost;
     u.rounds = res.rounds;
@@ -130,6 +142,14 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     u.rounds_cpu_s = res.solve_cpu_s;
     u.critical_path_cpu_s = res.critical_path_cpu_s;
     u.relaxation_cost = res.relaxation_cost;
+    for (const NewtonRefineResult& n : refines) {
+      u.newton_steps += n.steps;
+      u.newton_cg_iterations += n.cg_iterations;
+      u.newton_message_steps += n.exchanges + n.reductions;
+    }
+    // The step ended where the Newton steps stopped (grad_norm), or where the rounds after them
+    // did.
+    if (!refines.empty() && !newton_short) u.stop_reason = refines.back().stop_reason;
   }
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;
@@ -142,6 +162,27 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   totals_.cpu_s += u.cpu_s;
   totals_.updates.push_back(u);
   return u;
+}
+
+DistributedOptions OnlineEngine::plain_step_solver() const {
+  OnlineOptions rounds = options_;
+  rounds.newton_steps = false;
+  return online_step_solver(rounds);
+}
+
+DistributedOptions online_step_solver(const OnlineOptions& options) {
+  DistributedOptions solver = options.solver;
+  solver.certify = false;
+  solver.round_result = false;  // the graph may not be connected yet
+  if (options.newton_steps) {
+    solver.refine.enabled = true;
+    solver.refine.grad_norm_tol = options.solver.grad_norm_tol;
+    // The step is done only under the tolerance: a small decrease is no reason to stop.
+    solver.refine.relative_decrease_tol = 0.0;
+    solver.refine.refactor_every_step = false;
+    solver.grad_norm_tol = std::max(options.newton_after_grad_tol, solver.grad_norm_tol);
+  }
+  return solver;
 }
 
 DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {

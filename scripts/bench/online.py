@@ -68,6 +68,9 @@ def main():
     ap.add_argument("--dds", action="store_true",
                     help="also run each case over DDS (tessera launch --online: one agent process per robot)")
     ap.add_argument("--domain", type=int, default=63, help="DDS domain of the --dds runs (default 63)")
+    ap.add_argument("--name", default="online",
+                    help="stem of the files written into --out-dir (default online: online.md, .csv, .png)")
+    ap.add_argument("--extra", default="", help="more arguments for every `tessera solve --online` run")
     args = ap.parse_args()
     ctx = bc.Ctx(args)
     rows, runs, dds_rows = [], [], []
@@ -83,6 +86,7 @@ def main():
             cmd += ["--baseline-every", str(every)]
         if args.no_certify:
             cmd += ["--no-certify"]
+        cmd += args.extra.split()
         if args.full:
             # Robot-aligned blocks cut city10000 thousands of times: the certificate's LOBPCG needs
             # more than its default 300 iterations there (docs/online.md, Figures).
@@ -105,6 +109,9 @@ def main():
             "cpu_ratio": s["cpu_s"] / s["baseline_cpu_s"] if s.get("baseline_cpu_s") else None,
             "max_step_cpu_s": max((u["cpu_s"] for u in s["updates"]), default=0.0),
             "critical_path_cpu_s": sum(u.get("critical_path_cpu_s", 0.0) for u in s["updates"]),
+            "step_solver": s.get("step_solver", "rounds"),
+            "newton_cg_iterations": sum(u.get("newton_cg_iterations", 0) for u in s["updates"]),
+            "message_steps": s["rounds"] + sum(u.get("newton_message_steps", 0) for u in s["updates"]),
             "repartitions": 0, "poses_moved": 0,
             "final_cost": s["cost"], "fstar": fstar,
             "final_rel_gap": (s["cost"] - fstar) / fstar if s.get("cost") else None,
@@ -126,13 +133,14 @@ def step_args(args):
 
 
 def write_outputs(args, ctx, rows, runs, dds_rows):
-    headers = ["graph", "poses", "steps", "lat med s", "lat p95 s", "max gap", "online CPU s", "set-up s",
+    headers = ["graph", "poses", "steps", "step solver", "message steps", "Newton CG", "lat med s", "lat p95 s", "max gap", "online CPU s", "set-up s",
                "rounds CPU s", "max step CPU s", "critical path s", "re-solves", "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
     table = bc.print_table(
         f"online runs (rate {args.rate}/s per robot, speedup {args.speedup}, steps {args.steps}, "
         f"grad tol {args.grad_tol})",
         headers,
-        [[r["graph"], r["poses"], r["steps"], bc.fmt(r["latency_median_s"], "{:.4f}"),
+        [[r["graph"], r["poses"], r["steps"], r["step_solver"], r["message_steps"], r["newton_cg_iterations"],
+          bc.fmt(r["latency_median_s"], "{:.4f}"),
           bc.fmt(r["latency_p95_s"], "{:.4f}"), bc.fmt(r["max_checkpoint_rel_gap"], "{:.2e}"),
           bc.fmt(r["online_cpu_s"], "{:.2f}"), bc.fmt(r["online_setup_s"], "{:.2f}"),
           bc.fmt(r["online_rounds_cpu_s"], "{:.2f}"), bc.fmt(r["max_step_cpu_s"], "{:.2f}"),
@@ -140,7 +148,7 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
           f"{r['baseline_resolved']}/{r['baseline_solves']}", bc.fmt(r["baseline_cpu_s"], "{:.2f}"),
           bc.fmt(r["cpu_ratio"], "{:.3f}"), bc.fmt(r["final_rel_gap"], "{:.1e}"), r["certified"], r["load_1min"]]
          for r in rows])
-    bc.write_csv(os.path.join(ctx.out_dir, "online.csv"), rows)
+    bc.write_csv(os.path.join(ctx.out_dir, args.name + ".csv"), rows)
     dds_table = ""
     if dds_rows:
         dds_table = bc.print_table(
@@ -166,10 +174,10 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
     axes[1].set_title("rounds per step")
     for ax in axes:
         ax.legend(fontsize=7)
-    bc.save_figure(ctx, fig, "online.png")
+    bc.save_figure(ctx, fig, args.name + ".png")
     print("\n" + table)
     print("\n" + bc.machine())
-    md = os.path.join(ctx.out_dir, "online.md")
+    md = os.path.join(ctx.out_dir, args.name + ".md")
     with open(md, "w") as f:
         f.write("# Online runs\n\nWritten by `scripts/bench/online.py` (docs/online.md); do not edit by hand.\n\n")
         f.write("- Command: `scripts/bench/online.py " + " ".join(sys.argv[1:]) + "`\n")
@@ -186,7 +194,11 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
                     "solves' rounds plus the final certified solve's; agents CPU = sum of the agents' process CPU "
                     "of their epochs; KB/s per agent = protocol and report bytes sent over the run's wall time; "
                     "repartitions = solves that moved poses between blocks.\n\n")
-        f.write("Columns: latency = publication of a batch to the end of the step that absorbed it "
+        f.write("Columns: step solver = how a step brings the gradient back under the tolerance (newton: "
+                "distributed Newton steps from the warm start, the default; rounds: block-coordinate rounds); "
+                "message steps = rounds plus the Newton steps' neighbour exchanges and all-agent sums over all "
+                "steps (load-free); Newton CG = their CG iterations; "
+                "latency = publication of a batch to the end of the step that absorbed it "
                 "(gradient back under the tolerance or stalled), median and 95th percentile over all batches; max "
                 "gap = largest relative gap (f(estimate) - f*_k) / f*_k over the checkpoints, f*_k the centralized "
                 "optimum of the graph received by checkpoint k; online CPU = process CPU of all steps and the final "
@@ -195,7 +207,7 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
                 "only every K-th such step is re-solved, their CPU times (steps / re-solved)); ratio = online CPU / "
                 "re-solve CPU; final rel gap = (cost - f*) / f* with f* of the whole graph. The "
                 "in-process engine keeps one block per robot: re-partitions and poses moved are 0.\n\n"
-                "![online](online.png)\n")
+                f"![online]({args.name}.png)\n")
     print(f"wrote {os.path.relpath(md, bc.ROOT)}")
 
 

@@ -79,6 +79,9 @@ class AgentState {
   /// Factors the tangent preconditioner at X (d rows) when this block can have one (built on
   /// first use): precondition() is then exact for Q_BB's part at X. False when it cannot.
   bool refresh_tangent(const Eigen::MatrixXd& X);
+  /// As refresh_tangent, but a block that holds a factor keeps it (computed at an earlier point
+  /// or grown: stale, still positive definite); factors only when it holds none.
+  bool ensure_tangent(const Eigen::MatrixXd& X);
   /// Local objective f_B(X) with neighbours at `neighbours`.
   double local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
   /// Totals over this agent's block updates so far (BlockUpdateStats summed): updates,

@@ -72,6 +72,15 @@ struct NewtonRefineOptions {
   /// A rejected trial is tried again at a quarter of the step, up to this many times, before
   /// the trust region shrinks and CG runs again. >= 0.
   int max_backtracks = 6;
+  /// true: every CG solve is preconditioned with factors computed at its own point (each block
+  /// refactors its tangent preconditioner at the start and after every accepted step). false:
+  /// a block keeps the factor it holds (computed at an earlier point: still symmetric positive
+  /// definite, merely less exact, since it depends on the point only through the relative
+  /// rotations of the block's poses) and factors only when it holds none. The online steps use
+  /// false: their start is a warm one, and the factorizations (with their symbolic analyses)
+  /// were a third of their instructions on a generated 1,000-pose city (docs/online.md,
+  /// "Newton steps").
+  bool refactor_every_step = true;
   /// Throws InputError naming the bad field.
   void validate() const;
 };
@@ -151,6 +160,8 @@ class NewtonRefineProtocol : public AgentProcess {
   Eigen::MatrixXd hessian(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
   void after_status(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void begin_cg(std::vector<OutgoingMessage>& out);
+  // The block preconditioner for the next CG solve (options_.refactor_every_step).
+  void prepare_preconditioner();
   void send_direction(std::vector<OutgoingMessage>& out);
   void after_direction(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void after_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
@@ -181,8 +192,9 @@ class NewtonRefineProtocol : public AgentProcess {
   Eigen::MatrixXd s_full_;                       // the CG step; a backtrack tries scale_ of it
   double scale_ = 1.0;
   int backtracks_ = 0;
-  double cg_target_ = 0.0;  // residual norm that ends the CG
-  double radius_ = 0.0;     // 0 = unbounded
+  double cg_target_ = 0.0;     // residual norm that ends the CG
+  double radius_ = 0.0;        // 0 = unbounded
+  bool refactor_due_ = false;  // a step was accepted since the last factorization
   NewtonRefineStep step_;
   bool done_ = false;
   NewtonRefineResult result_;

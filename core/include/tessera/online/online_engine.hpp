@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -61,10 +62,29 @@ struct OnlineOptions {
   /// poses: the default, because the diagonal blocks precondition a new chain of poses poorly
   /// (instructions of a 400-pose sphere replay, 5 robots: 7.0 G at 0, 12.0 G at 0.05). >= 0.
   double refactor_growth = 0.0;
+  /// How a step brings ||grad f|| back under solver.grad_norm_tol after new data. true: block-
+  /// coordinate rounds down to max(newton_after_grad_tol, the tolerance), then distributed
+  /// trust-region Newton steps (newton_refine.hpp, solver.refine's settings with its tolerance
+  /// set to the solver's, its relative-decrease stop off and the block factors kept across its
+  /// steps) from there; Newton steps that stop above the tolerance (a cap, or a stalled trust
+  /// region) are followed by rounds from where they stopped, in the same step (in process; over
+  /// DDS the next epoch solves again). false: rounds only. Why: a new loop closure bends whole
+  /// chains, a smooth error the rounds remove slowly, while the Newton steps' CG works on all
+  /// blocks at once (a generated 1,000-pose city, 5 robots, a step every 0.1 s of stream: ~290
+  /// rounds a step against 4-7 Newton steps and ~100 CG iterations; docs/online.md, "Newton
+  /// steps").
+  bool newton_steps = true;
+  /// See newton_steps: +infinity (the default) starts the Newton steps from the warm start,
+  /// with no round. > 0.
+  double newton_after_grad_tol = std::numeric_limits<double>::infinity();
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
 };
+
+/// The agents' solver for a step that absorbed new data (OnlineOptions::newton_steps): the
+/// in-process engine's and `tessera-agent --online`'s, so both take the same steps.
+DistributedOptions online_step_solver(const OnlineOptions& options);
 
 /// One step of the online run (the JSON `updates` array of `tessera launch --online`).
 struct OnlineUpdate {
@@ -98,6 +118,11 @@ struct OnlineUpdate {
   /// iterate did not change).
   std::string stop_reason;
   double relaxation_cost = 0.0;  ///< f(Y) at the end of the step.
+  /// OnlineOptions::newton_steps: the step's Newton steps (accepted or not), their CG
+  /// iterations, and message steps (neighbour exchanges plus all-agent sums; a round is one).
+  int newton_steps = 0;
+  int newton_cg_iterations = 0;
+  int newton_message_steps = 0;
 };
 
 /// A certificate taken while the graph was growing (OnlineOptions::certify_every_s).
@@ -163,6 +188,8 @@ class OnlineEngine {
   /// Runs the agents from X_ on the poses some measurement touches and writes their result
   /// back into X_ (when the rank did not change: a staircase climb leaves X_ as it was).
   DistributedResult solve_linked(const DistributedOptions& solver);
+  /// A step's solver with rounds only (after Newton steps that stopped above the tolerance).
+  DistributedOptions plain_step_solver() const;
 
   OnlineOptions options_;
   GraphStream stream_;
