@@ -33,6 +33,15 @@ std::optional<MessageGate::Inbox> MessageGate::take_ready() {
   return ready;
 }
 
+std::vector<int> MessageGate::missing() const {
+  const auto it = pending_.find(key(round_, step_));
+  std::vector<int> out;
+  for (int s : senders_)
+    if (it == pending_.end() || !it->second.count(s)) out.push_back(s);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 PoseBlockMessage make_reduction_message(int sender, std::uint32_t round, std::uint32_t phase,
                                         const std::vector<double>& values) {
   PoseBlockMessage m;

@@ -137,6 +137,21 @@ std::vector<OutgoingMessage> NewtonRefineProtocol::handle(const ProtocolMessage&
   return out;
 }
 
+std::size_t NewtonRefineProtocol::messages_needed() const {
+  if (done_) return 0;
+  return std::max<std::size_t>(gate_.missing().size(), 1);
+}
+
+std::optional<AwaitedMessages> NewtonRefineProtocol::awaited() const {
+  if (done_) return std::nullopt;
+  AwaitedMessages a;
+  a.round = gate_.round();
+  a.phase = gate_.step();
+  for (int s : gate_.missing()) a.senders.push_back(static_cast<std::uint32_t>(s));
+  if (a.senders.empty()) return std::nullopt;  // not after pump(); never a wait for nothing
+  return a;
+}
+
 void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
   while (!done_) {
     std::optional<MessageGate::Inbox> ready = gate_.take_ready();

@@ -23,6 +23,8 @@ class MessageGate {
   bool add(int sender, std::uint32_t round, std::uint32_t step, ProtocolMessage message);
   /// The expected step's messages once all are in (removed from the gate), else nullopt.
   std::optional<Inbox> take_ready();
+  /// The expected step's senders whose message has not arrived yet, ascending.
+  std::vector<int> missing() const;
   std::uint32_t round() const { return round_; }
   std::uint32_t step() const { return step_; }
 

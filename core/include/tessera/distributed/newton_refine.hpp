@@ -133,6 +133,9 @@ class NewtonRefineProtocol : public AgentProcess {
   std::vector<OutgoingMessage> start() override;
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
   bool done() const override { return done_; }
+  std::size_t messages_needed() const override;
+  /// The current message step's missing senders (a stalled run names them).
+  std::optional<AwaitedMessages> awaited() const override;
   const NewtonRefineResult& result() const { return result_; }
 
   /// Where the refinement is, for progress reports: the trust-region step being computed
