@@ -37,6 +37,10 @@ options:
   --json FILE         write this agent's summary (the lead's has the final answer: agent
                       0's, or after its loss the lowest surviving agent's)
   --certify-iters K   certificate iteration cap (LOBPCG)               [300]
+  --step-solver S     how a solve gets the gradient back under --grad-tol: newton
+                      (distributed Newton steps from the warm start) or rounds [newton]
+  --newton-after T    newton: block-coordinate rounds first, down to ||grad f|| <= T
+                                                                     [none]
   --certify-every S   also certify the graph received so far every S seconds (the lead's
                       clock; at the next epoch that brought data, once the graph is
                       connected; no staircase climb)                  [0 = off]
@@ -61,7 +65,8 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
   const cli::Arguments args(
       argv,
       {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol", "max-rounds", "timeout",
-       "json", "certify-every", "certify-iters", "publish-every", "tum-dir", "on-agent-loss"},
+       "json", "certify-every", "certify-iters", "publish-every", "tum-dir", "on-agent-loss",
+       "step-solver", "newton-after"},
       {"online", "no-certify", "verbose", "help"});
   OnlineAgentOptions o;
   const auto run_id = args.get("run-id");
@@ -99,6 +104,11 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
   o.publish_every_s = args.get_double("publish-every", 0.0);
   if (!(o.publish_every_s >= 0)) throw InputError("option --publish-every: must be >= 0");
   o.tum_dir = args.get_or("tum-dir", "");
+  const std::string step_solver = args.get_or("step-solver", "newton");
+  if (step_solver != "newton" && step_solver != "rounds")
+    throw InputError("option --step-solver: '" + step_solver + "' is not one of newton, rounds");
+  o.online.newton_steps = step_solver == "newton";
+  o.online.newton_after_grad_tol = args.get_double("newton-after", o.online.newton_after_grad_tol);
   o.online.validate();
   return o;
 }

@@ -20,6 +20,7 @@ std::string online_summary_json(const OnlineAgentOptions& o, const OnlineSummary
   j.add("agent", o.id)
       .add("robots", o.robots)
       .add("run_id", o.run_id)
+      .add("step_solver", o.online.newton_steps ? "newton" : "rounds")
       .add("epochs", static_cast<long long>(state.epochs))
       .add("solves", f.solves)
       .add("rounds", f.rounds)

@@ -51,6 +51,8 @@ new, and certify the estimate after every robot's last batch.
                       a lost agent's block and its robot's stream, and the run goes on [stop]
   --certify-iters K   certificate iteration cap (LOBPCG)             [300]
   --certify-every S   also certify the graph received so far every S seconds
+  --step-solver S     newton or rounds: how the agents solve a grown graph [newton]
+  --newton-after T    newton: rounds first, down to ||grad f|| <= T  [none]
   --publish-every S   each agent publishes its robot's estimate every S seconds
                       (topic tessera_online_estimate)
   --tum-dir DIR       per-robot TUM snapshots DIR/robot<r>.tum, rewritten at every
@@ -116,11 +118,12 @@ int run_online_launch(const std::vector<std::string>& argv) {
       std::fputs(kOnlineHelp, stdout);
       return 0;
     }
-  const cli::Arguments args(argv,
-                            {"agents", "rate", "speedup", "start", "run-id", "domain", "algorithm",
-                             "rank", "grad-tol", "timeout", "json", "keep-logs", "certify-every",
-                             "certify-iters", "publish-every", "tum-dir", "on-agent-loss"},
-                            {"online", "no-certify"});
+  const cli::Arguments args(
+      argv,
+      {"agents", "rate", "speedup", "start", "run-id", "domain", "algorithm", "rank", "grad-tol",
+       "timeout", "json", "keep-logs", "certify-every", "certify-iters", "publish-every", "tum-dir",
+       "on-agent-loss", "step-solver", "newton-after"},
+      {"online", "no-certify"});
   if (args.positional().size() != 1)
     throw InputError("launch --online: expected one GRAPH argument (see --online --help)");
   const std::string graph = args.positional().front();
@@ -136,6 +139,10 @@ int run_online_launch(const std::vector<std::string>& argv) {
   // --replica-every are not options of an online launch).
   const bool continue_on_loss =
       parse_launch_loss_options(args).action == AgentLossAction::kContinue;
+  if (auto solver = args.get("step-solver"); solver && *solver != "newton" && *solver != "rounds")
+    throw InputError("option --step-solver: '" + *solver + "' is not one of newton, rounds");
+  if (args.has("newton-after") && !(args.get_double("newton-after", 0.0) > 0))
+    throw InputError("option --newton-after: must be > 0");
   const long domain = args.get_long("domain", transport::domain_for_run(run_id));
   if (domain < 0 || domain > transport::kMaxDomain)
     throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));
@@ -165,8 +172,9 @@ int run_online_launch(const std::vector<std::string>& argv) {
     std::vector<std::string> a = {bin + "/tessera-agent", "--online", "--robots",
                                   std::to_string(agents), "--id",     std::to_string(i)};
     a.insert(a.end(), common.begin(), common.end());
-    for (const char* flag : {"algorithm", "rank", "grad-tol", "timeout", "certify-every",
-                             "certify-iters", "publish-every", "tum-dir", "on-agent-loss"})
+    for (const char* flag :
+         {"algorithm", "rank", "grad-tol", "timeout", "certify-every", "certify-iters",
+          "publish-every", "tum-dir", "on-agent-loss", "step-solver", "newton-after"})
       if (auto v = args.get(flag)) {
         a.push_back(std::string("--") + flag);
         a.push_back(*v);

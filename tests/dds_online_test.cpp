@@ -94,6 +94,36 @@ TEST(DdsOnline, TheOnlineLaunchEndsAtTheBatchOptimumAndEveryAgentSolvesTheSameGr
   }
 }
 
+TEST(DdsOnline, TheOnlineLaunchForwardsTheStepSolverToEveryAgent) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/grid.g2o";
+  generate_graph(graph, "--kind grid3d --poses 150 --robots 3");
+  const double f_star = batch_optimum(dir, graph);
+  std::string out;
+  ASSERT_EQ(run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
+                            " --agents 3 --online --rate 20 --speedup 2 --domain 136 --timeout 60"
+                            " --step-solver rounds --json " +
+                            dir + "/online.json --keep-logs " + dir + "/logs",
+                        &out),
+            0)
+      << out;
+  const std::string json = read_text_file(dir + "/online.json");
+  EXPECT_EQ(json_text(json, "certified"), "true");
+  EXPECT_NEAR(json_number(json, "cost"), f_star, 1e-6 * f_star);
+  for (int a = 0; a < 3; ++a) {
+    const std::string agent = read_text_file(dir + "/logs/agent-" + std::to_string(a) + ".json");
+    EXPECT_EQ(json_text(agent, "step_solver"), "\"rounds\"") << "agent " << a;
+    // Rounds only: the steps that solved did it by block-coordinate rounds.
+    EXPECT_GT(json_number(agent, "rounds"), 0) << "agent " << a;
+  }
+  // A bad value is an input error of launch itself, before any process starts.
+  EXPECT_EQ(run_command(bin("tessera") + " launch " + graph +
+                            " --agents 3 --online --step-solver gauss 2>&1",
+                        &out),
+            2);
+  EXPECT_NE(out.find("--step-solver"), std::string::npos) << out;
+}
+
 TEST(DdsOnline, ALateAgentJoinsIdleAgentsSendNothingAndTheAnswerIsTheBatchOptimum) {
   const std::string dir = temp_dir();
   const std::string graph = dir + "/grid.g2o";
