@@ -12,6 +12,7 @@
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
 #include "robust/gnc_messages.hpp"
+#include "robust/gnc_probes.hpp"
 #include "robust/gnc_votes.hpp"
 
 namespace tessera {
@@ -53,6 +54,7 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   layout_ = std::make_unique<BlockLayout>(*base_);
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
   recheck_ = std::make_unique<RecheckVerdict>();
+  probes_ = std::make_unique<GncProbes>(options_.robust.recheck_probes);
   weights_.assign(m, 1.0);
 }
 
@@ -416,17 +418,21 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   candidate_ = block_of(X, base_->poses[0], in_.d);
 }
 
+int GncAgent::probes() const {
+  return probes_->started();
+}
+
+int GncAgent::probes_kept() const {
+  return probes_->kept();
+}
+
 bool GncAgent::may_probe() const {
-  // Only with the known inliers connecting the poses: a probe cuts many closures at once.
-  return !probing_ && probes_ < options_.robust.recheck_probes && terms_->known_connected() &&
-         options_.robust.readmission_passes > 0;
+  return probes_->may_start(terms_->known_connected(), options_.robust.readmission_passes);
 }
 
 void GncAgent::begin_probe(double tls, std::vector<OutgoingMessage>& out) {
   // Every agent holds every agent's probe list (the verdict exchange): the same cut everywhere.
-  ++probes_;
-  probing_ = true;
-  probe_base_ = ProbeBase{tls, rejected_, weights_, state_->Y, readmitted_, late_rejected_};
+  probes_->start(GncProbeBase{tls, rejected_, weights_, state_->Y, readmitted_, late_rejected_});
   RecheckVerdict cut;
   cut.cut_now = std::move(recheck_->probe);
   apply_recheck(cut, in_.measurement_index, rejected_, weights_);
@@ -442,13 +448,13 @@ void GncAgent::begin_probe(double tls, std::vector<OutgoingMessage>& out) {
 }
 
 void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out) {
-  probing_ = false;
-  rejected_ = std::move(probe_base_.rejected);
-  weights_ = std::move(probe_base_.weights);
-  readmitted_ = probe_base_.readmitted;
-  late_rejected_ = probe_base_.late_rejected;
+  GncProbeBase base = probes_->take_base();
+  rejected_ = std::move(base.rejected);
+  weights_ = std::move(base.weights);
+  readmitted_ = base.readmitted;
+  late_rejected_ = base.late_rejected;
   // The own block has the same shape whatever the kept set: the next pass starts from it.
-  state_->Y = std::move(probe_base_.Y);
+  state_->Y = std::move(base.Y);
   // One last pass on the restored set (from its converged iterate, so it costs few rounds),
   // then the final solve.
   pass_ = options_.robust.readmission_passes;
@@ -465,7 +471,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
   }
   gnc_rounds_ += solve_->total_rounds();
   if (solve_kind_ == Solve::kInlierPass) {
-    if (probing_ && pass_ >= options_.robust.readmission_passes) {
+    if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
       return;
@@ -583,14 +589,9 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
           return;
         }
         const double tls = summed_votes().first;
-        if (probing_) {
-          probing_ = false;
-          // A probe stays only if it lowered the TLS cost (beyond the solves' own accuracy).
-          if (!(tls < probe_base_.tls - 1e-9 * std::abs(probe_base_.tls))) {
-            restore_before_probe(out);
-            return;
-          }
-          ++probes_kept_;
+        if (probes_->running() && !probes_->keeps(tls)) {
+          restore_before_probe(out);
+          return;
         }
         if (may_probe() && !recheck_->probe.empty()) {
           begin_probe(tls, out);

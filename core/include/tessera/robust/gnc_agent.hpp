@@ -128,6 +128,7 @@ struct GncAgentInput {
 
 class GncLocalTerms;    // internal: the TLS math over one agent's view
 struct RecheckVerdict;  // internal: an inlier pass's re-check
+class GncProbes;        // internal: probes after the re-check passes
 
 class GncAgent : public AgentProcess {
  public:
@@ -161,8 +162,8 @@ class GncAgent : public AgentProcess {
   std::size_t late_rejected() const { return late_rejected_; }
   bool weights_converged() const { return converged_; }
   /// Probes run after the re-check passes, and those that lowered the TLS cost and stayed.
-  int probes() const { return probes_; }
-  int probes_kept() const { return probes_kept_; }
+  int probes() const;
+  int probes_kept() const;
   double threshold_squared() const;
   /// Rounds of the solves before the final certified one (first, weighted, inlier passes).
   int gnc_rounds() const { return gnc_rounds_; }
@@ -253,18 +254,7 @@ class GncAgent : public AgentProcess {
   std::size_t readmitted_ = 0;
   std::unique_ptr<RecheckVerdict> recheck_;  // the current re-check exchange's, every agent's
   std::size_t late_rejected_ = 0;
-  // Probes (RobustOptions::recheck_probes): what a probe that does not lower the TLS cost
-  // goes back to.
-  struct ProbeBase {
-    double tls = 0;
-    std::vector<std::uint64_t> rejected;
-    std::vector<double> weights;
-    Eigen::MatrixXd Y;
-    std::size_t readmitted = 0, late_rejected = 0;
-  };
-  ProbeBase probe_base_;
-  bool probing_ = false;  // a probe's passes are running
-  int probes_ = 0, probes_kept_ = 0;
+  std::unique_ptr<GncProbes> probes_;     // RobustOptions::recheck_probes
   std::vector<std::uint64_t> zero_cut_;   // cut measurements of weight 0 (others' too)
   std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where
   std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view

@@ -1,0 +1,63 @@
+#pragma once
+// Probes after the distributed re-check passes (RobustOptions::recheck_probes): how many may
+// run, the kept set and iterate a running probe started from, and the rule that keeps it.
+// GncAgent decides when a probe starts and what it cuts; this holds what a probe that fails
+// goes back to, so the state machine does not carry a second copy of its own fields.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace tessera {
+
+/// What a probe goes back to when it does not lower the TLS cost.
+struct GncProbeBase {
+  double tls = 0;  ///< Summed TLS cost before the probe.
+  std::vector<std::uint64_t> rejected;
+  std::vector<double> weights;
+  Eigen::MatrixXd Y;
+  std::size_t readmitted = 0, late_rejected = 0;
+};
+
+class GncProbes {
+ public:
+  explicit GncProbes(int allowed) : allowed_(allowed) {}
+
+  /// Another probe may start: none running, fewer than `allowed` so far, and the known inliers
+  /// connect the poses (a probe cuts many closures at once) with re-check passes to judge it.
+  bool may_start(bool known_connected, int readmission_passes) const {
+    return !running_ && started_ < allowed_ && known_connected && readmission_passes > 0;
+  }
+  void start(GncProbeBase base) {
+    ++started_;
+    running_ = true;
+    base_ = std::move(base);
+  }
+  bool running() const { return running_; }
+  /// Ends the running probe's judgement: it stays (and counts as kept) only if the summed TLS
+  /// cost fell below the base's beyond the solves' own accuracy.
+  bool keeps(double tls) {
+    running_ = false;
+    const bool kept = tls < base_.tls - 1e-9 * std::abs(base_.tls);
+    if (kept) ++kept_;
+    return kept;
+  }
+  /// Ends the running probe without keeping it; the state to restore.
+  GncProbeBase take_base() {
+    running_ = false;
+    return std::move(base_);
+  }
+  int started() const { return started_; }
+  int kept() const { return kept_; }
+
+ private:
+  int allowed_ = 0;
+  bool running_ = false;
+  int started_ = 0, kept_ = 0;
+  GncProbeBase base_;
+};
+
+}  // namespace tessera
