@@ -631,15 +631,11 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
   // The message's expected kind, or an error naming what arrived where.
   auto block_message = [&](const ProtocolMessage& m,
                            const std::string& what) -> const PoseBlockMessage& {
-    const auto* block = std::get_if<PoseBlockMessage>(&m);
-    if (!block) throw std::runtime_error(me + what);
-    return *block;
+    return expect_pose_block(m, in_.id, what);
   };
   auto status_message = [&](const ProtocolMessage& m,
                             const char* what) -> const RoundStatusMessage& {
-    const auto* st = std::get_if<RoundStatusMessage>(&m);
-    if (!st) throw std::runtime_error(me + what);
-    return *st;
+    return expect_status(m, in_.id, what);
   };
   const char* const kStatusBelongs = "poses where a robust status belongs";
   switch (step_) {

@@ -35,6 +35,19 @@ void broadcast_status(RoundStatusMessage st, std::uint32_t me, std::uint32_t pha
   out.push_back(OutgoingMessage{std::move(st), true, {}});
 }
 
+const PoseBlockMessage& expect_pose_block(const ProtocolMessage& m, int me,
+                                          const std::string& what) {
+  const auto* block = std::get_if<PoseBlockMessage>(&m);
+  if (!block) throw std::runtime_error("agent " + std::to_string(me) + ": " + what);
+  return *block;
+}
+
+const RoundStatusMessage& expect_status(const ProtocolMessage& m, int me, const std::string& what) {
+  const auto* st = std::get_if<RoundStatusMessage>(&m);
+  if (!st) throw std::runtime_error("agent " + std::to_string(me) + ": " + what);
+  return *st;
+}
+
 RoundStatusMessage vote_message(const std::pair<double, double>& sums) {
   RoundStatusMessage st;
   st.cost = sums.first;

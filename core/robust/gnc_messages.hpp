@@ -26,6 +26,13 @@ std::vector<std::uint32_t> other_agents(std::uint32_t me, int num_agents);
 void broadcast_status(RoundStatusMessage st, std::uint32_t me, std::uint32_t phase, int num_agents,
                       std::vector<OutgoingMessage>& out);
 
+/// `m` as the pose block an exchange step expects, or std::runtime_error "agent <me>: <what>"
+/// naming what arrived where.
+const PoseBlockMessage& expect_pose_block(const ProtocolMessage& m, int me,
+                                          const std::string& what);
+/// `m` as the status an exchange step expects; the same error otherwise.
+const RoundStatusMessage& expect_status(const ProtocolMessage& m, int me, const std::string& what);
+
 /// A vote's two sums (cost, grad_norm_sq), and back.
 RoundStatusMessage vote_message(const std::pair<double, double>& sums);
 inline std::pair<double, double> read_vote(const RoundStatusMessage& st) {
