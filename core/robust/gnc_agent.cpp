@@ -288,12 +288,8 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       weights_at_mu(mu_);
       const double spread = weight_spread(*terms_, weights_);
       votes_[me] = {spread, 0};
-      zero_cut_.clear();
-      for (std::size_t k : terms_->owned()) {
-        const Measurement& m = in_.measurements[k];
-        if (weights_[k] == 0 && in_.owner[m.i] != in_.owner[m.j])
-          zero_cut_.push_back(in_.measurement_index[k]);
-      }
+      zero_cut_ =
+          zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
       waiting_ = other_agents(me, in_.num_agents);
       for (std::uint32_t a : waiting_) {
         RoundStatusMessage st = weights_message(a, spread, in_, *terms_, weights_);
@@ -304,9 +300,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       break;
     }
     case Step::kRejected: {
-      rejected_.clear();
-      for (std::size_t k : terms_->owned())
-        if (weights_[k] < 0.5) rejected_.push_back(in_.measurement_index[k]);
+      rejected_ = rejected_by_weight(*terms_, in_.measurement_index, weights_);
       RoundStatusMessage st;
       st.measurement_ids = rejected_;
       to_others(std::move(st));

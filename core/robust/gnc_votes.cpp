@@ -50,6 +50,28 @@ double largest_rejectable_residual(const GncLocalTerms& terms, const std::vector
   return max_r2;
 }
 
+std::vector<std::uint64_t> rejected_by_weight(const GncLocalTerms& terms,
+                                              const std::vector<std::uint64_t>& index,
+                                              const std::vector<double>& weights) {
+  std::vector<std::uint64_t> out;
+  for (std::size_t k : terms.owned())
+    if (weights[k] < 0.5) out.push_back(index[k]);
+  return out;
+}
+
+std::vector<std::uint64_t> zero_weight_cut(const GncLocalTerms& terms,
+                                           const std::vector<Measurement>& measurements,
+                                           const std::vector<int>& owner,
+                                           const std::vector<std::uint64_t>& index,
+                                           const std::vector<double>& weights) {
+  std::vector<std::uint64_t> out;
+  for (std::size_t k : terms.owned()) {
+    const Measurement& m = measurements[k];
+    if (weights[k] == 0 && owner[m.i] != owner[m.j]) out.push_back(index[k]);
+  }
+  return out;
+}
+
 double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weights) {
   double spread = 0;
   for (std::size_t k : terms.owned()) spread += weights[k] * (1 - weights[k]);

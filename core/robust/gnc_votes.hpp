@@ -37,6 +37,19 @@ std::pair<double, double> kept_set_costs(const GncLocalTerms& terms,
 double largest_rejectable_residual(const GncLocalTerms& terms, const std::vector<bool>& dropped,
                                    const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours);
 
+/// The measurements this agent weighs that TLS's weights reject (w < 1/2), as file indices.
+std::vector<std::uint64_t> rejected_by_weight(const GncLocalTerms& terms,
+                                              const std::vector<std::uint64_t>& index,
+                                              const std::vector<double>& weights);
+
+/// The cut measurements (ends owned by different agents) this agent weighs at weight 0, as file
+/// indices: they leave the next solve's block layout.
+std::vector<std::uint64_t> zero_weight_cut(const GncLocalTerms& terms,
+                                           const std::vector<Measurement>& measurements,
+                                           const std::vector<int>& owner,
+                                           const std::vector<std::uint64_t>& index,
+                                           const std::vector<double>& weights);
+
 /// sum w (1 - w) over the measurements this agent weighs: the stop vote.
 double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weights);
 
