@@ -6,6 +6,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <tessera/util/input_error.hpp>
 #include <utility>
 #include <vector>
 
@@ -144,6 +145,14 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
       structure_of(asg, share.num_poses);
   DdsProtocolChannel channel(s);
   const RunOptions run_options = run_options_of(asg);
+  SetupTurnOptions turns;
+  turns.max_at_once = asg.setup_at_once();
+  turns.after_local_solve = [] { launch::release_freed_heap(); };
+  try {
+    turns.validate();
+  } catch (const InputError& e) {
+    throw RunFailure(kExitRunFailed, std::string("the assignment: ") + e.what());
+  }
   // The input's own known-inlier flags (a dpgo CSV file's), every measurement's.
   std::vector<bool> known_flags;
   if (!asg.known_inlier().empty()) {
@@ -164,7 +173,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
     if (known) {
       auto [init, known_init] = run_initialization_stages(
           share, known->share, o.id, o.robots, structure, known->structure, asg.initialization(),
-          "distributed", o.graph, channel, o.round_timeout_s);
+          "distributed", o.graph, channel, o.round_timeout_s, turns);
       share.initial = std::move(init.poses);
       share.known_initial = std::move(known_init.poses);
       log("initialisation '" + init.method + "' and 'distributed' of the known inliers done in " +
@@ -172,7 +181,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
     } else {
       InitializationResult init =
           run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(), o.graph,
-                                   channel, o.round_timeout_s);
+                                   channel, o.round_timeout_s, turns);
       share.initial = std::move(init.poses);
       log("initialisation '" + init.method + "' done in " +
           std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");

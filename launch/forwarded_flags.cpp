@@ -77,6 +77,9 @@ void whole_number_in(const std::string& v, const char* flag, long lo, long hi) {
     throw InputError(std::string("option --") + flag + ": '" + v + "' is not a whole number in " +
                      std::to_string(lo) + ".." + std::to_string(hi));
 }
+void check_setup_at_once(const std::string& v) {
+  whole_number_in(v, "setup-at-once", 0, 1000);
+}
 void check_coarse_every(const std::string& v) {
   whole_number_in(v, "coarse-every", 0, 1000000);
 }
@@ -238,6 +241,11 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "the refinement stops at ||grad f|| <= T       [1e-6]", check_refine_grad_tol},
       {"refine-rel-tol", "refine-rel-tol", true, ForwardTo::kCoordinator, "--refine-rel-tol F",
        "or after a step that lowered f by < F f           [1e-7]", check_refine_rel_tol},
+      {"setup-at-once", "setup-at-once", true, ForwardTo::kCoordinator, "--setup-at-once K",
+       "at most K agents in the distributed initialisation's\n"
+       "local chordal solve at once (the set-up's memory peak);\n"
+       "0 = all at once                                      [8]",
+       check_setup_at_once},
       {"rejected", "rejected", true, ForwardTo::kCoordinator, "--rejected FILE",
        "write the rejected edge indices (from 0 over the EDGE\n"
        "lines), one a line",

@@ -15,7 +15,8 @@
 //                measurements and the inter-robot measurements it recorded; each agent aligns
 //                the units with the same breadth-first spanning tree (align_units) and keeps
 //                its own poses. Same arithmetic as the in-process engine, so bit-identical
-//                poses when the agents' shares are the generator's robot ranges.
+//                poses when the agents' shares are the generator's robot ranges. The local
+//                solves take turns, a bounded number at once (runtime/setup_turns.hpp).
 //
 // Messages use phases kInitPhaseBase.. (>= 300), which the round protocol (0..5), the rounding
 // (100..) and the final report (200) never use. Every message of the stage is consumed by
@@ -30,6 +31,7 @@
 
 #include "runtime/local_share.hpp"
 #include "runtime/round_loop.hpp"
+#include "runtime/setup_turns.hpp"
 
 namespace tessera::agent {
 
@@ -53,11 +55,14 @@ struct InitializationResult {
 /// (from the assignment; used to find this robot's poses at the ends of inter-robot
 /// measurements). Every wait is bounded by `timeout_s` (the error names the missing agents).
 /// Throws InputError on an unknown method or 'file' without VERTEX poses (naming `source`).
+/// `turns`: how many agents run the distributed initialisation's local solve at once
+/// (runtime/setup_turns.hpp; every agent of the run must pass the same max_at_once). The
+/// waits that span other agents' turns are bounded by `timeout_s` per turn.
 InitializationResult run_initialization_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t num_agents,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::string& method, const std::string& source, ProtocolChannel& channel,
-    double timeout_s);
+    double timeout_s, const SetupTurnOptions& turns = {});
 
 /// Two stages back to back on one inbox (a robust run's two candidate starts: `method` on
 /// `share`, then `second_method` on `second_share`, e.g. the distributed initialization of the
@@ -69,6 +74,6 @@ std::pair<InitializationResult, InitializationResult> run_initialization_stages(
     std::uint32_t num_agents, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& second_structure,
     const std::string& method, const std::string& second_method, const std::string& source,
-    ProtocolChannel& channel, double timeout_s);
+    ProtocolChannel& channel, double timeout_s, const SetupTurnOptions& turns = {});
 
 }  // namespace tessera::agent
