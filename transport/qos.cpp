@@ -33,7 +33,7 @@ std::shared_ptr<eprosima::fastdds::rtps::SharedMemTransportDescriptor> shared_me
 
 // The UDP socket buffers: the profile's, else 4 MB above kMaxAgentsWithRecipientTopics agents
 // (0 = the system's default, 208 KB here). 64 agents handing off over UDP on one loaded host
-// overflowed the default receive buffers: 41 M datagrams dropped in 6 minutes, the
+// overflowed the default receive buffers: 41 M datagrams dropped in 9 minutes, the
 // repairs dropped in turn, and the hand-off never completed.
 std::uint32_t socket_buffer_bytes(const NetworkProfile& net, std::uint32_t num_agents) {
   if (net.socket_buffer_bytes != 0) return net.socket_buffer_bytes;
