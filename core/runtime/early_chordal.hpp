@@ -6,10 +6,11 @@
 // values every agent sends it (runtime/initialization_stage.hpp). Under `tessera launch` the
 // fork server has already parsed the whole file that every agent's share comes from
 // (runtime/preloaded_graph.hpp), so agent 0 can solve it while the processes discover each other
-// and the coordinator partitions: that solve was most of the time from the assignment to the
-// first round. The stage still gathers the values (nothing changes on the wire) and uses the
-// early poses only when the gathered graph is the one solved, value for value; otherwise it
-// solves the gathered graph as before. Same input, same deterministic solve: same poses.
+// and the coordinator partitions: that solve was the largest part of agent 0's work from the
+// readiness barrier to the first round. The stage still gathers the values (nothing changes on the
+// wire) and uses the early poses only when the gathered graph is the one solved, value for value;
+// otherwise it solves the gathered graph as before. Same input, same deterministic solve: same
+// poses.
 
 #include <future>
 #include <optional>
