@@ -118,6 +118,28 @@ void tangent_block(const Eigen::Ref<const Eigen::MatrixXd>& Qij, const Eigen::Ma
   B.noalias() = 2.0 * Gi.transpose() * T;
 }
 
+// tangent_block for a fixed d (2 or 3), written straight into A's value array (column c of the
+// block at out + c * stride): fixed-size products instead of dynamic ones, whose per-call
+// dispatch and temporaries made the assembly as costly as the numeric factorization (a block
+// that grew is assembled again at every online step).
+template <int D>
+void tangent_block_fixed(const double* Qij, const Eigen::MatrixXd& Gi, const Eigen::MatrixXd& Gj,
+                         double* out, Eigen::Index stride) {
+  constexpr int W = D + 1, P = D * (D + 1) / 2;
+  const Eigen::Map<const Eigen::Matrix<double, D * W, P>> gi(Gi.data()), gj(Gj.data());
+  Eigen::Matrix<double, D * W, P> T;
+  for (int t = 0; t < W; ++t) {
+    auto row = T.template middleRows<D>(t * D);
+    row.setZero();
+    for (int u = 0; u < W; ++u) {
+      const double q = Qij[u * W + t];
+      if (q != 0.0) row.noalias() += q * gj.template middleRows<D>(u * D);
+    }
+  }
+  const Eigen::Matrix<double, P, P> B = 2.0 * gi.transpose() * T;
+  for (int c = 0; c < P; ++c) std::copy(B.col(c).data(), B.col(c).data() + P, out + c * stride);
+}
+
 // The pose-level estimate is skipped to the exact analysis below this multiple of the cap,
 // so that a factor near the cap is decided by its exact size as before.
 constexpr double kSkipFactor = 2.0;
@@ -270,22 +292,32 @@ bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
   std::vector<Eigen::MatrixXd> G(static_cast<std::size_t>(f.m));
   for (Eigen::Index i = 0; i < f.m; ++i)
     G[static_cast<std::size_t>(i)] = pose_basis(X.block(0, i * w, d, d), pairs);
-  // Block (i, j) of A = 2 G_i^T (Q_ij kron I_d) G_j.
+  // Block (i, j) of A = 2 G_i^T (Q_ij kron I_d) G_j, for i >= j only: CHOLMOD reads A's lower
+  // half, so the blocks above the diagonal are never computed (they stay 0).
   Eigen::MatrixXd T(d * w, p), B(p, p);
   double max_diagonal = 0.0;
   for (Eigen::Index j = 0; j < f.m; ++j) {
     const Eigen::MatrixXd& Gj = G[static_cast<std::size_t>(j)];
-    for (Eigen::Index s = f.block_start[static_cast<std::size_t>(j)];
+    const Eigen::Index begin = f.block_start[static_cast<std::size_t>(j)];
+    const Eigen::Index column_size = (f.block_start[static_cast<std::size_t>(j) + 1] - begin) * p;
+    for (Eigen::Index s = f.diagonal_slot[static_cast<std::size_t>(j)];
          s < f.block_start[static_cast<std::size_t>(j) + 1]; ++s) {
       const Eigen::Index i = f.block_row[static_cast<std::size_t>(s)];
-      const Eigen::Map<const Eigen::MatrixXd> Qij(f.q_blocks.data() + s * w * w, w, w);
-      tangent_block(Qij, G[static_cast<std::size_t>(i)], Gj, d, T, B);
+      double* out = f.A.valuePtr() + f.value_offset(j, s, 0);
       if (i == j) {
+        const Eigen::Map<const Eigen::MatrixXd> Qij(f.q_blocks.data() + s * w * w, w, w);
+        tangent_block(Qij, G[static_cast<std::size_t>(i)], Gj, d, T, B);
         B = 0.5 * (B + B.transpose()).eval();  // exactly symmetric
         max_diagonal = std::max(max_diagonal, B.diagonal().maxCoeff());
+        for (int c = 0; c < p; ++c)
+          std::copy(B.col(c).data(), B.col(c).data() + p, out + c * column_size);
+      } else if (d == 2) {
+        tangent_block_fixed<2>(f.q_blocks.data() + s * w * w, G[static_cast<std::size_t>(i)], Gj,
+                               out, column_size);
+      } else {
+        tangent_block_fixed<3>(f.q_blocks.data() + s * w * w, G[static_cast<std::size_t>(i)], Gj,
+                               out, column_size);
       }
-      for (int c = 0; c < p; ++c)
-        std::copy(B.col(c).data(), B.col(c).data() + p, f.A.valuePtr() + f.value_offset(j, s, c));
     }
   }
   const double lambda = f.relative_shift * std::max(1e-12, max_diagonal);
