@@ -134,10 +134,11 @@ void tangent_block(const Eigen::Ref<const Eigen::MatrixXd>& Qij, const Eigen::Ma
 // tangent_block for a fixed d (2 or 3), written straight into A's value array (column c of the
 // block at out + c * stride): fixed-size products instead of dynamic ones, whose per-call
 // dispatch and temporaries made the assembly as costly as the numeric factorization (a block
-// that grew is assembled again at every online step).
+// that grew is assembled again at every online step). `diagonal` (a diagonal block, i = j):
+// the block is made exactly symmetric and its largest diagonal entry returned there.
 template <int D>
 void tangent_block_fixed(const double* Qij, const Eigen::MatrixXd& Gi, const Eigen::MatrixXd& Gj,
-                         double* out, Eigen::Index stride) {
+                         double* out, Eigen::Index stride, double* diagonal = nullptr) {
   constexpr int W = D + 1, P = D * (D + 1) / 2;
   const Eigen::Map<const Eigen::Matrix<double, D * W, P>> gi(Gi.data()), gj(Gj.data());
   Eigen::Matrix<double, D * W, P> T;
@@ -149,7 +150,11 @@ void tangent_block_fixed(const double* Qij, const Eigen::MatrixXd& Gi, const Eig
       if (q != 0.0) row.noalias() += q * gj.template middleRows<D>(u * D);
     }
   }
-  const Eigen::Matrix<double, P, P> B = 2.0 * gi.transpose() * T;
+  Eigen::Matrix<double, P, P> B = 2.0 * gi.transpose() * T;
+  if (diagonal) {
+    B = (0.5 * (B + B.transpose())).eval();  // exactly symmetric
+    *diagonal = B.diagonal().maxCoeff();
+  }
   for (int c = 0; c < P; ++c) std::copy(B.col(c).data(), B.col(c).data() + P, out + c * stride);
 }
 
@@ -328,7 +333,6 @@ bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
     G[static_cast<std::size_t>(i)] = pose_basis(X.block(0, i * w, d, d), pairs);
   // Block (i, j) of A = 2 G_i^T (Q_ij kron I_d) G_j, for i >= j only: CHOLMOD reads A's lower
   // half, so the blocks above the diagonal are never computed (they stay 0).
-  Eigen::MatrixXd T(d * w, p), B(p, p);
   double max_diagonal = 0.0;
   for (Eigen::Index j = 0; j < f.m; ++j) {
     const Eigen::MatrixXd& Gj = G[static_cast<std::size_t>(j)];
@@ -338,20 +342,14 @@ bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
          s < f.block_start[static_cast<std::size_t>(j) + 1]; ++s) {
       const Eigen::Index i = f.block_row[static_cast<std::size_t>(s)];
       double* out = f.A.valuePtr() + f.value_offset(j, s, 0);
-      if (i == j) {
-        const Eigen::Map<const Eigen::MatrixXd> Qij(f.q_blocks.data() + s * w * w, w, w);
-        tangent_block(Qij, G[static_cast<std::size_t>(i)], Gj, d, T, B);
-        B = 0.5 * (B + B.transpose()).eval();  // exactly symmetric
-        max_diagonal = std::max(max_diagonal, B.diagonal().maxCoeff());
-        for (int c = 0; c < p; ++c)
-          std::copy(B.col(c).data(), B.col(c).data() + p, out + c * column_size);
-      } else if (d == 2) {
+      double diagonal = 0.0;
+      if (d == 2)
         tangent_block_fixed<2>(f.q_blocks.data() + s * w * w, G[static_cast<std::size_t>(i)], Gj,
-                               out, column_size);
-      } else {
+                               out, column_size, i == j ? &diagonal : nullptr);
+      else
         tangent_block_fixed<3>(f.q_blocks.data() + s * w * w, G[static_cast<std::size_t>(i)], Gj,
-                               out, column_size);
-      }
+                               out, column_size, i == j ? &diagonal : nullptr);
+      max_diagonal = std::max(max_diagonal, diagonal);
     }
   }
   const double lambda = f.relative_shift * std::max(1e-12, max_diagonal);
