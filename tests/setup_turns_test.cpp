@@ -132,7 +132,7 @@ std::vector<Pose> run_with_turns(const PoseGraph& g, std::uint32_t n, std::uint3
       };
       try {
         out[k] = agent::run_initialization_stage(shares[k], k, n, structure, "distributed", "test",
-                                                 ch, 20.0, turns);
+                                                 ch, 20.0, nullptr, turns);
       } catch (const std::exception& e) {
         errors[k] = e.what();
       }
