@@ -20,6 +20,7 @@
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/online/block_rebalance.hpp>
+#include <tessera/online/component_alignment.hpp>
 #include <tessera/online/graph_stream.hpp>
 #include <tessera/online/live_blocks.hpp>
 #include <tessera/online/stream_batch.hpp>
@@ -77,6 +78,13 @@ struct OnlineOptions {
   /// See newton_steps: +infinity (the default) starts the Newton steps from the warm start,
   /// with no round. > 0.
   double newton_after_grad_tol = std::numeric_limits<double>::infinity();
+  /// When a measurement first links two pieces of the graph (robots that meet, a robot's first
+  /// poses started from its front end's guess), move the smaller piece rigidly so that the
+  /// measurement has zero residual (component_alignment.hpp). false: the pieces meet in the
+  /// frames their guesses and the solver left them in, which drift apart without bound on long
+  /// trajectories (a generated 50,000-pose grid over 10 robots replayed in real time ended at a
+  /// critical point 5.3x above f*; docs/online.md, "Pieces that meet").
+  bool align_merged_pieces = true;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
@@ -123,6 +131,10 @@ struct OnlineUpdate {
   int newton_steps = 0;
   int newton_cg_iterations = 0;
   int newton_message_steps = 0;
+  /// OnlineOptions::align_merged_pieces: measurements that linked two pieces of the graph at
+  /// this step, and the poses moved to align them.
+  std::size_t merges = 0;
+  std::size_t merge_poses_moved = 0;
 };
 
 /// A certificate taken while the graph was growing (OnlineOptions::certify_every_s).
@@ -132,6 +144,10 @@ struct OnlineCertificate {
   bool certified = false;
   double min_eigenvalue = 0.0;
   double cpu_s = 0.0;
+  /// The certificate failed and the staircase's climb found a certified optimum at a higher
+  /// rank: the iterate was brought back to the run's rank from there (project_to_rank).
+  bool escaped = false;
+  double cost_before = 0.0, cost_after = 0.0;  ///< f(Y) before the certificate and after it.
 };
 
 struct OnlineResult {
@@ -168,8 +184,11 @@ class OnlineEngine {
   /// the tolerance; idle (no round, no message) when nothing is new and it already is.
   OnlineUpdate step(double now_s = 0.0);
   /// Certifies the current iterate on the graph received so far (the distributed certificate
-  /// after the rounds; a saddle's staircase climb is not kept: the next data restarts from
-  /// rank r). nullopt while the graph is not connected.
+  /// after the rounds). When it fails, the staircase climbs from the critical point; a climb
+  /// that ends certified at a higher rank is brought back to rank r (project_to_rank: exact when
+  /// that optimum has rank <= r, as on exact relaxations) and the run goes on from there, so a
+  /// spurious critical point found while streaming is left at once, not at the end. nullopt
+  /// while the graph is not connected.
   std::optional<OnlineCertificate> certify(double now_s);
   /// Solves from the current iterate (certifying when asked) and returns the run's figures.
   OnlineResult finish();
@@ -194,6 +213,7 @@ class OnlineEngine {
   OnlineOptions options_;
   GraphStream stream_;
   std::unique_ptr<LiveBlocks> blocks_;     // the agents' states, kept from step to step
+  ComponentAlignment pieces_;              // the graph's pieces, aligned when they meet
   std::size_t extended_measurements_ = 0;  // measurements the iterate was extended over
   std::vector<StreamBatch> received_;
   Eigen::MatrixXd X_;
