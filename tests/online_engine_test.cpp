@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -221,11 +222,48 @@ TEST(OnlineEngine, CertifiesWhileTheGraphGrowsWhenAsked) {
   double last = -1.0;
   for (const auto& c : res.certificates) {
     EXPECT_TRUE(c.certified) << "at " << c.time_s << " s, " << c.poses << " poses";
+    // A certified iterate is kept as it is: no escape, the cost where the step left it.
+    EXPECT_FALSE(c.escaped);
+    EXPECT_NEAR(c.cost_after, c.cost_before, 1e-9 * c.cost_before);
     EXPECT_GE(c.time_s, last + 1.0);
     last = c.time_s;
   }
   const double f_star = batch_optimum(gen.graph);
   EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
+}
+
+TEST(OnlineEngine, RobotsWhoseGuessesSitInUnrelatedFramesAreAlignedWhereTheyMeet) {
+  auto gen = small_graph(TrajectoryKind::kGrid3d, 150, 3);
+  // Each robot's front end guesses in a frame of its own (a long drift, or no common start):
+  // a rotation of 2-3 rad and a shift per robot.
+  ASSERT_TRUE(gen.graph.has_initial());
+  for (std::size_t k = 0; k < gen.graph.num_poses; ++k) {
+    const double r = static_cast<double>(gen.robot_of[k]);
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(2.0 + 0.4 * r, Eigen::Vector3d(1.0, r, 2.0 - r).normalized())
+            .toRotationMatrix();
+    Pose& p = gen.graph.initial[k];
+    p.R = turn * p.R;
+    p.t = turn * p.t + Eigen::Vector3d(40.0 * r, -25.0 * r, 10.0);
+  }
+  ReplayOptions ro;
+  ro.rate = 10;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  const OnlineResult res = run_online(gen.graph.d, plan.batches, online_options());
+  std::size_t merges = 0, moved = 0;
+  for (const auto& u : res.updates) {
+    merges += u.merges;
+    moved += u.merge_poses_moved;
+  }
+  // Three robots' pieces meet twice at least (robot pieces, and pieces a robot's own closures
+  // join); the moved pieces are the smaller ones.
+  EXPECT_GE(merges, 2u);
+  EXPECT_GT(moved, 0u);
+  EXPECT_LT(moved, merges * gen.graph.num_poses / 2);
+  const double f_star = batch_optimum(gen.graph);
+  EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
+  ASSERT_TRUE(res.certified.has_value());
+  EXPECT_TRUE(*res.certified);
 }
 
 TEST(OnlineEngine, RejectsBadOptionsNamingTheField) {
