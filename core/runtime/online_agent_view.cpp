@@ -100,6 +100,7 @@ EnteredData OnlineAgentView::enter(const Watermarks& decision) {
   EstimateExtension x = extend_estimate(graph, X_, stream_->guesses());
   X_ = std::move(x.X);
   e.composed = x.composed;
+  e.merges = pieces_.absorb(graph, X_, options_.align_merged_pieces).merges;
   return e;
 }
 
