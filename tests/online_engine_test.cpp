@@ -217,7 +217,7 @@ TEST(OnlineEngine, CertifiesWhileTheGraphGrowsWhenAsked) {
   OnlineOptions o = online_options();
   o.certify_every_s = 1.0;
   const OnlineResult res = run_online(gen.graph.d, plan.batches, o);
-  // 3 s of stream, but no certificate before the robots met (no common frame).
+  // 3 s of stream: a certificate every second, robots that have not met yet included.
   ASSERT_FALSE(res.certificates.empty());
   double last = -1.0;
   for (const auto& c : res.certificates) {

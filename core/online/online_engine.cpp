@@ -243,7 +243,7 @@ OnlineResult OnlineEngine::finish() {
 }
 
 std::optional<OnlineCertificate> OnlineEngine::certify(double now_s) {
-  if (X_.cols() == 0 || count_components(stream_.graph()) != 1) return std::nullopt;
+  if (X_.cols() == 0 || blocks_ == nullptr) return std::nullopt;
   DistributedOptions solver = options_.solver;
   solver.certify = true;
   solver.round_result = false;

@@ -53,8 +53,8 @@ struct OnlineOptions {
   /// up). 0 = off. Not with real_time. >= 0.
   double step_every_s = 0.0;
   /// run_online only: > 0 runs the distributed certificate every this many seconds of
-  /// stream time (at the first step after each period, once the graph is connected), on the
-  /// graph received so far; 0 = only at the end. >= 0.
+  /// stream time (at the first step after each period), on the graph received so far, robots
+  /// that have not met included (OnlineEngine::certify); 0 = only at the end. >= 0.
   double certify_every_s = 0.0;
   /// A block that grows keeps its tangent preconditioner factor (its new poses preconditioned
   /// by their own diagonal blocks) until it holds this fraction more poses than the factor was
@@ -187,8 +187,10 @@ class OnlineEngine {
   /// after the rounds). When it fails, the staircase climbs from the critical point; a climb
   /// that ends certified at a higher rank is brought back to rank r (project_to_rank: exact when
   /// that optimum has rank <= r, as on exact relaxations) and the run goes on from there, so a
-  /// spurious critical point found while streaming is left at once, not at the end. nullopt
-  /// while the graph is not connected.
+  /// spurious critical point found while streaming is left at once, not at the end. Pieces of
+  /// the graph that have not met are certified together (the certificate matrix is block
+  /// diagonal over them: it needs no common frame, unlike rounding). nullopt before the first
+  /// solve.
   std::optional<OnlineCertificate> certify(double now_s);
   /// Solves from the current iterate (certifying when asked) and returns the run's figures.
   OnlineResult finish();
