@@ -249,7 +249,9 @@ TEST(OnlineEngine, RobotsWhoseGuessesSitInUnrelatedFramesAreAlignedWhereTheyMeet
   ReplayOptions ro;
   ro.rate = 10;
   const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
-  const OnlineResult res = run_online(gen.graph.d, plan.batches, online_options());
+  OnlineOptions o = online_options();
+  o.align_merged_pieces = true;
+  const OnlineResult res = run_online(gen.graph.d, plan.batches, o);
   std::size_t merges = 0, moved = 0;
   for (const auto& u : res.updates) {
     merges += u.merges;
