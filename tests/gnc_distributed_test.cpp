@@ -124,9 +124,10 @@ TEST(GncDistributed, CleanGraphLosesNothing) {
 // A probe (RobustOptions::recheck_probes) cuts the kept measurements far above their agent's
 // median residual at once, runs the passes again and keeps the result only if the TLS cost fell.
 // With the file's noise matching its information nothing is far enough above the median to be
-// probed at the default ratio; with a ratio of 1.5 half the true closures are probed, the passes
-// take them back, the TLS cost does not fall, and the set and iterate from before come back:
-// the same outliers, the clean optimum, certified, whatever the delivery order.
+// probed at the default ratio (nor is the residuals' mean far enough above their median:
+// probe_tail_ratio); with a ratio of 1.5 and no tail rule half the true closures are probed,
+// the passes take them back, the TLS cost does not fall, and the set and iterate from before
+// come back: the same outliers, the clean optimum, certified, whatever the delivery order.
 TEST(GncDistributed, AProbeThatDoesNotLowerTheTlsCostIsUndone) {
   const GeneratorResult clean = grid_with_outliers(0.0);
   const GeneratorResult dirty = grid_with_outliers(0.25);
@@ -137,6 +138,9 @@ TEST(GncDistributed, AProbeThatDoesNotLowerTheTlsCostIsUndone) {
   EXPECT_EQ(plain.rejected, dirty.outliers);
 
   o.robust.probe_ratio = 1.5;
+  o.robust.probe_tail_ratio = 1.5;  // the default: these residuals have no heavy tail
+  EXPECT_EQ(solve_gnc_distributed(dirty.graph, robots_as_blocks(dirty), o).probes, 0);
+  o.robust.probe_tail_ratio = 0;
   const GncDistributedResult probed =
       solve_gnc_distributed(dirty.graph, robots_as_blocks(dirty), o);
   EXPECT_EQ(probed.probes, 1);

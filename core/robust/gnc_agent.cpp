@@ -313,7 +313,8 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // With it the probe's list (only used when nothing else changes) and the TLS cost a probe
       // is judged by.
       *recheck_ = recheck_verdict(*terms_, in_.measurement_index, rejected_, state_->Y, neighbours_,
-                                  may_probe() ? options_.robust.probe_ratio : 0.0);
+                                  may_probe() ? options_.robust.probe_ratio : 0.0,
+                                  options_.robust.probe_tail_ratio);
       votes_[me] = {tls_cost(*terms_, state_->Y, neighbours_), 0};
       to_others(readmitted_message(*recheck_, votes_[me].first));
       break;
