@@ -101,7 +101,7 @@ struct RobustOptions {
   /// above this times their median, >= 0 (0 = always). Residuals that match their information
   /// have a mean near the median (chi-square: 1.27x in 2D, 1.12x in 3D); a bent map has a heavy
   /// tail. 1.5: sphere2500 with 25 % random outliers, whose agents have 1.2-1.33, ran a probe
-  /// that could not lower the TLS cost (70 rounds, 5.5x the clean run instead of 4.5x), while
+  /// that could not lower the TLS cost (65 rounds: 371, 5.5x the clean run, instead of 306), while
   /// manhattan3500's agents have 1.64-5.5 and keep their probe (docs/robust.md, "Probes").
   double probe_tail_ratio = 1.5;
   /// Distributed solvers only: the final solve of the kept set (weights fixed) ends with the
