@@ -73,6 +73,9 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
     ro.robust.inner_max_rounds = static_cast<int>(asg.gnc_inner_max_rounds());
     ro.robust.known_inliers = parse_known_inliers(asg.known_inliers());
     ro.robust.readmission_passes = static_cast<int>(asg.gnc_readmission_passes());
+    ro.robust.recheck_probes = static_cast<int>(asg.gnc_recheck_probes());
+    ro.robust.probe_ratio = asg.gnc_probe_ratio();
+    ro.robust.final_refine = asg.gnc_final_refine();
     ro.robust.validate();
     ro.gnc_known_start = asg.gnc_known_start();
   }
