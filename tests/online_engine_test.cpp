@@ -248,6 +248,11 @@ TEST(OnlineEngine, RejectsBadOptionsNamingTheField) {
   o.newton_after_grad_tol = 0;
   EXPECT_NE(test::validation_message(o).find("OnlineOptions.newton_after_grad_tol"),
             std::string::npos);
+  for (double bad : {0.0, 1.0, std::nan("")}) {
+    o = {};
+    o.newton_forcing = bad;
+    EXPECT_NE(test::validation_message(o).find("OnlineOptions.newton_forcing"), std::string::npos);
+  }
 }
 
 TEST(OnlineEngine, AFixedStepPeriodAbsorbsEachPeriodsBatchesAndEndsAtTheBatchOptimum) {

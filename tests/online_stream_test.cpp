@@ -8,6 +8,7 @@
 #include <tessera/online/absorb_gate.hpp>
 #include <tessera/online/estimate_extension.hpp>
 #include <tessera/online/graph_stream.hpp>
+#include <tessera/online/new_pose_placement.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/util/input_error.hpp>
 
@@ -156,6 +157,66 @@ TEST(EstimateExtension, StartsAnUnlinkedRobotFromItsGuessAndComposesTheRest) {
   EXPECT_EQ(ext.X.block(2, 3, 1, 3).norm(), 0.0);  // the lifted extra row stays zero
   Eigen::Vector2d expected = first.guess.t + first.guess.R * Eigen::Vector2d(1, 0);
   EXPECT_LT((ext.X.block(0, 8, 2, 1) - expected).norm(), 1e-12);
+}
+
+// The lifted objective sum kappa ||Y_j - Y_i R_ij||^2 + tau ||p_j - p_i - Y_i t_ij||^2.
+double lifted_cost(const PoseGraph& g, const Eigen::MatrixXd& X) {
+  const int d = g.d, w = d + 1;
+  double f = 0.0;
+  for (const Measurement& m : g.measurements) {
+    const auto Yi = X.middleCols(w * static_cast<Eigen::Index>(m.i), d);
+    const auto Yj = X.middleCols(w * static_cast<Eigen::Index>(m.j), d);
+    const auto pi = X.col(w * static_cast<Eigen::Index>(m.i) + d);
+    const auto pj = X.col(w * static_cast<Eigen::Index>(m.j) + d);
+    f += m.kappa * (Yj - Yi * m.R).squaredNorm() + m.tau * (pj - pi - Yi * m.t).squaredNorm();
+  }
+  return f;
+}
+
+// Pose 0 estimated; a new chain 1, 2, 3 whose odometry turns a little too far, and a closure
+// from 3 back to 0 that disagrees with the composed chain.
+GraphStream loop_of_new_poses() {
+  GraphStream s(2);
+  s.absorb(batch(0, 0, {pose(0, 0)}));
+  s.absorb(batch(0, 1, {pose(0, 1), pose(0, 2), pose(0, 3)},
+                 {link({0, 0}, {0, 1}, planar(1, 0, 1.65), MeasurementKind::kOdometry),
+                  link({0, 1}, {0, 2}, planar(1, 0, 1.65), MeasurementKind::kOdometry),
+                  link({0, 2}, {0, 3}, planar(1, 0, 1.65), MeasurementKind::kOdometry),
+                  link({0, 3}, {0, 0}, planar(1, 0, 1.5708), MeasurementKind::kIntraLoop)}));
+  return s;
+}
+
+TEST(NewPosePlacement, ALoopClosureOfNewPosesLowersTheCostOfTheComposedStart) {
+  const GraphStream s = loop_of_new_poses();
+  Eigen::MatrixXd X0 = lift_poses({planar(2, -1, 0.3)}, 3);
+  const Eigen::MatrixXd Q = Eigen::MatrixXd::Random(3, 3).householderQr().householderQ();
+  X0 = Q * X0;
+  Eigen::MatrixXd X = extend_estimate(s.graph(), X0, s.guesses()).X;
+  const double composed = lifted_cost(s.graph(), X);
+  const NewPosePlacement placed = place_new_poses(s.graph(), X, 1, 0);
+  EXPECT_EQ(placed.placed, 3u);
+  EXPECT_EQ(placed.measurements, 4u);
+  const double after = lifted_cost(s.graph(), X);
+  EXPECT_GT(composed, 0.05);  // the closure disagrees with the chain by 0.24 rad
+  EXPECT_LT(after, 0.5 * composed);
+  // The estimated pose does not move and the new ones stay on the Stiefel manifold.
+  EXPECT_EQ(X.leftCols(3), X0);
+  for (int k = 1; k < 4; ++k) {
+    const Eigen::MatrixXd Y = X.middleCols(3 * k, 2);
+    EXPECT_LT((Y.transpose() * Y - Eigen::MatrixXd::Identity(2, 2)).norm(), 1e-12);
+  }
+}
+
+TEST(NewPosePlacement, LeavesNewPosesThatOnlyExtendOdometryAsComposed) {
+  GraphStream s(2);
+  s.absorb(batch(0, 0, {pose(0, 0)}));
+  s.absorb(batch(0, 1, {pose(0, 1), pose(0, 2)},
+                 {link({0, 0}, {0, 1}, planar(1, 0, 0.5), MeasurementKind::kOdometry),
+                  link({0, 1}, {0, 2}, planar(1, 0, 0.5), MeasurementKind::kOdometry)}));
+  Eigen::MatrixXd X = extend_estimate(s.graph(), lift_poses({planar(0, 0, 0)}, 3), s.guesses()).X;
+  const Eigen::MatrixXd composed = X;
+  EXPECT_EQ(place_new_poses(s.graph(), X, 1, 0).placed, 0u);
+  EXPECT_EQ(X, composed);
 }
 
 TEST(AbsorbGate, ANewCutMeasurementEntersBothAgentsOnTheSameRound) {

@@ -5,6 +5,7 @@
 #include <tessera/certification/rounding_gap.hpp>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
+#include <tessera/online/new_pose_placement.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
@@ -28,6 +29,8 @@ void OnlineOptions::validate() const {
     throw InputError("OnlineOptions.step_every_s must be a finite number >= 0 (seconds)");
   if (step_every_s > 0 && real_time)
     throw InputError("OnlineOptions.step_every_s: a fixed step period excludes real_time");
+  if (!(newton_forcing > 0 && newton_forcing < 1))
+    throw InputError("OnlineOptions.newton_forcing must be in (0, 1)");
   if (!(newton_after_grad_tol > 0))
     throw InputError("OnlineOptions.newton_after_grad_tol must be > 0 (+infinity: no round)");
   DistributedOptions s = solver;
@@ -102,9 +105,11 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   // Only the measurements since the last extension can touch a new pose.
   std::size_t composed = 0;
   if (u.poses > 0) {
+    const std::size_t estimated = static_cast<std::size_t>(X_.cols()) / (graph.d + 1);
     EstimateExtension e = extend_estimate(graph, X_, stream_.guesses(), extended_measurements_);
     X_ = std::move(e.X);
     composed = e.composed;
+    if (options_.place_new_poses) place_new_poses(graph, X_, estimated, extended_measurements_);
   }
   extended_measurements_ = graph.measurements.size();
   if (converged_ && composed == u.measurements) {
@@ -180,6 +185,7 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     // The step is done only under the tolerance: a small decrease is no reason to stop.
     solver.refine.relative_decrease_tol = 0.0;
     solver.refine.refactor_every_step = false;
+    solver.refine.forcing = options.newton_forcing;
     solver.grad_norm_tol = std::max(options.newton_after_grad_tol, solver.grad_norm_tol);
   }
   return solver;

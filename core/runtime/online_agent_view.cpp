@@ -5,6 +5,7 @@
 #include <string>
 #include <tessera/online/block_rebalance.hpp>
 #include <tessera/online/estimate_extension.hpp>
+#include <tessera/online/new_pose_placement.hpp>
 #include <tessera/util/input_error.hpp>
 #include <tuple>
 
@@ -97,8 +98,10 @@ EnteredData OnlineAgentView::enter(const Watermarks& decision) {
   }
   e.moved = moves.moved;
   e.largest_block = moves.largest_after;
+  const std::size_t estimated = static_cast<std::size_t>(X_.cols()) / (graph.d + 1);
   EstimateExtension x = extend_estimate(graph, X_, stream_->guesses());
   X_ = std::move(x.X);
+  if (options_.place_new_poses) place_new_poses(graph, X_, estimated, measurements_before);
   e.composed = x.composed;
   return e;
 }

@@ -15,6 +15,19 @@ namespace {
 class CholmodLdlt : public Eigen::CholmodDecomposition<SparseMatrix> {
  public:
   cholmod_factor* factor() const { return m_cholmodFactor; }
+  // analyzePattern with a fill-reducing ordering given by the caller (`perm`: CHOLMOD's Perm,
+  // row perm[k] of A is row k of the permuted matrix) instead of CHOLMOD's own search.
+  void analyze_with_ordering(const SparseMatrix& A, std::vector<int>& perm) {
+    if (m_cholmodFactor) cholmod_free_factor(&m_cholmodFactor, &cholmod());
+    cholmod_sparse a = Eigen::viewAsCholmod(A.selfadjointView<Eigen::Lower>());
+    cholmod().nmethods = 1;
+    cholmod().method[0].ordering = CHOLMOD_GIVEN;
+    m_cholmodFactor = cholmod_analyze_p(&a, perm.data(), nullptr, 0, &cholmod());
+    m_isInitialized = true;
+    m_info = m_cholmodFactor ? Eigen::Success : Eigen::NumericalIssue;
+    m_analysisIsOk = m_cholmodFactor != nullptr;
+    m_factorizationIsOk = false;
+  }
 };
 
 }  // namespace
@@ -121,6 +134,33 @@ void tangent_block(const Eigen::Ref<const Eigen::MatrixXd>& Qij, const Eigen::Ma
   B.noalias() = 2.0 * Gi.transpose() * T;
 }
 
+// tangent_block for a fixed d (2 or 3), written straight into A's value array (column c of the
+// block at out + c * stride): fixed-size products instead of dynamic ones, whose per-call
+// dispatch and temporaries made the assembly as costly as the numeric factorization (a block
+// that grew is assembled again at every online step). `diagonal` (a diagonal block, i = j):
+// the block is made exactly symmetric and its largest diagonal entry returned there.
+template <int D>
+void tangent_block_fixed(const double* Qij, const Eigen::MatrixXd& Gi, const Eigen::MatrixXd& Gj,
+                         double* out, Eigen::Index stride, double* diagonal = nullptr) {
+  constexpr int W = D + 1, P = D * (D + 1) / 2;
+  const Eigen::Map<const Eigen::Matrix<double, D * W, P>> gi(Gi.data()), gj(Gj.data());
+  Eigen::Matrix<double, D * W, P> T;
+  for (int t = 0; t < W; ++t) {
+    auto row = T.template middleRows<D>(t * D);
+    row.setZero();
+    for (int u = 0; u < W; ++u) {
+      const double q = Qij[u * W + t];
+      if (q != 0.0) row.noalias() += q * gj.template middleRows<D>(u * D);
+    }
+  }
+  Eigen::Matrix<double, P, P> B = 2.0 * gi.transpose() * T;
+  if (diagonal) {
+    B = (0.5 * (B + B.transpose())).eval();  // exactly symmetric
+    *diagonal = B.diagonal().maxCoeff();
+  }
+  for (int c = 0; c < P; ++c) std::copy(B.col(c).data(), B.col(c).data() + P, out + c * stride);
+}
+
 // The pose-level estimate is skipped to the exact analysis below this multiple of the cap,
 // so that a factor near the cap is decided by its exact size as before.
 constexpr double kSkipFactor = 2.0;
@@ -128,7 +168,9 @@ constexpr double kSkipFactor = 2.0;
 // Entries of A's LDL^T factor estimated from the pose-level pattern (`rows`: the row blocks of
 // each block column, diagonal included): the pose-level factor's entries (same AMD ordering,
 // symbolic only), each off-diagonal block p x p dense and each diagonal block triangular.
-double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& rows, int p) {
+// `order` (when not null) receives the pose-level analysis' ordering (CHOLMOD's Perm, postordered).
+double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& rows, int p,
+                                std::vector<int>* order = nullptr) {
   const Eigen::Index m = static_cast<Eigen::Index>(rows.size());
   std::vector<Eigen::Triplet<double>> t;
   for (Eigen::Index j = 0; j < m; ++j)
@@ -136,7 +178,7 @@ double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& ro
       t.emplace_back(i, j, i == j ? static_cast<double>(m) : 1.0);
   SparseMatrix B(m, m);
   B.setFromTriplets(t.begin(), t.end());
-  Eigen::CholmodDecomposition<SparseMatrix> symbolic;
+  CholmodLdlt symbolic;
   symbolic.setMode(Eigen::CholmodLDLt);
   cholmod_common& c = symbolic.cholmod();
   c.nmethods = 1;
@@ -145,6 +187,11 @@ double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& ro
   symbolic.analyzePattern(B);
   if (symbolic.info() != Eigen::Success) return 0.0;  // no estimate: the exact analysis decides
   const double block_entries = static_cast<double>(symbolic.cholmod().lnz);  // with diagonal
+  if (order) {
+    const cholmod_factor* L = symbolic.factor();
+    const int* perm = static_cast<const int*>(L->Perm);
+    order->assign(perm, perm + m);
+  }
   const double md = static_cast<double>(m);
   return (block_entries - md) * p * p + md * p * (p + 1) / 2.0;
 }
@@ -179,9 +226,13 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   // A factor far over the cap is known from the pose-level pattern alone (m x m, p^2 times
   // smaller than A's): then A is never built. On a 40,000-pose block of a 3D grid, A's
   // pattern and Q's dense blocks alone were ~300 MB per agent, for a factor never used.
-  if (max_factor_entries > 0) {
-    const double estimate = pose_level_fill_estimate(rows, f.p);
-    if (estimate > kSkipFactor * static_cast<double>(max_factor_entries)) {
+  // Its ordering, each pose's p coordinates kept together, is A's: AMD on A itself found the
+  // same blocks (p coordinates per pose) at p^2 times the work.
+  std::vector<int> pose_order;
+  {
+    const double estimate = pose_level_fill_estimate(rows, f.p, &pose_order);
+    if (max_factor_entries > 0 &&
+        estimate > kSkipFactor * static_cast<double>(max_factor_entries)) {
       f.entries = static_cast<std::size_t>(estimate);
       return;  // not usable
     }
@@ -225,13 +276,23 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
     }
   f.A.outerIndexPtr()[n] = static_cast<int>(pos);
 
-  // Symbolic analysis once (AMD only, as the Euclidean preconditioner; simplicial LDL^T).
+  // Symbolic analysis once (the pose-level AMD ordering above, else AMD; simplicial LDL^T:
+  // supernodal LL^T took 6 % more instructions on the online steps of a 1,000-pose grid).
   f.llt.setMode(Eigen::CholmodLDLt);
   cholmod_common& c = f.llt.cholmod();
   c.nmethods = 1;
   c.method[0].ordering = CHOLMOD_AMD;
   c.postorder = 1;
-  f.llt.analyzePattern(f.A);
+  if (f.m > 0 && pose_order.size() == static_cast<std::size_t>(f.m)) {
+    std::vector<int> order(static_cast<std::size_t>(n));
+    for (Eigen::Index k = 0; k < f.m; ++k)
+      for (int q = 0; q < f.p; ++q)
+        order[static_cast<std::size_t>(k * f.p + q)] =
+            pose_order[static_cast<std::size_t>(k)] * f.p + q;
+    f.llt.analyze_with_ordering(f.A, order);
+  } else {
+    f.llt.analyzePattern(f.A);
+  }
   if (f.llt.info() != Eigen::Success) return;  // not usable
   f.entries = static_cast<std::size_t>(f.llt.cholmod().lnz);
   f.flops = f.llt.cholmod().fl;
@@ -312,31 +373,34 @@ bool TangentPreconditioner::factorize_impl(const Eigen::MatrixXd& X, const Eigen
   std::vector<Eigen::MatrixXd> G(static_cast<std::size_t>(f.m));
   for (Eigen::Index i = 0; i < f.m; ++i)
     G[static_cast<std::size_t>(i)] = pose_basis(X.block(0, i * w, d, d), pairs);
-  // Block (i, j) of A = 2 G_i^T (Q_ij kron I_d) G_j.
-  Eigen::MatrixXd T(d * w, p), B(p, p);
+  // Block (i, j) of A = 2 G_i^T (Q_ij kron I_d) G_j, for i >= j only: CHOLMOD reads A's lower
+  // half, so the blocks above the diagonal are never computed (they stay 0).
   double max_diagonal = 0.0;
   for (Eigen::Index j = 0; j < f.m; ++j) {
     const Eigen::MatrixXd& Gj = G[static_cast<std::size_t>(j)];
-    for (Eigen::Index s = f.block_start[static_cast<std::size_t>(j)];
+    const Eigen::Index begin = f.block_start[static_cast<std::size_t>(j)];
+    const Eigen::Index column_size = (f.block_start[static_cast<std::size_t>(j) + 1] - begin) * p;
+    for (Eigen::Index s = f.diagonal_slot[static_cast<std::size_t>(j)];
          s < f.block_start[static_cast<std::size_t>(j) + 1]; ++s) {
       const Eigen::Index i = f.block_row[static_cast<std::size_t>(s)];
-      const Eigen::Map<const Eigen::MatrixXd> Qij(f.q_blocks.data() + s * w * w, w, w);
+      const double* Qij = f.q_blocks.data() + s * w * w;
       if (egrad && i == j) {
         // S = Q - Lambda: the multipliers sit on the rotation part of the diagonal blocks.
-        Qm = Qij;
+        Qm = Eigen::Map<const Eigen::MatrixXd>(Qij, w, w);
         const Eigen::MatrixXd YG =
             X.block(0, j * w, d, d).transpose() * egrad->block(0, j * w, d, d);
         Qm.topLeftCorner(d, d) -= 0.25 * (YG + YG.transpose());
-        tangent_block(Qm, G[static_cast<std::size_t>(i)], Gj, d, T, B);
-      } else {
-        tangent_block(Qij, G[static_cast<std::size_t>(i)], Gj, d, T, B);
+        Qij = Qm.data();
       }
-      if (i == j) {
-        B = 0.5 * (B + B.transpose()).eval();  // exactly symmetric
-        max_diagonal = std::max(max_diagonal, B.diagonal().maxCoeff());
-      }
-      for (int c = 0; c < p; ++c)
-        std::copy(B.col(c).data(), B.col(c).data() + p, f.A.valuePtr() + f.value_offset(j, s, c));
+      double* out = f.A.valuePtr() + f.value_offset(j, s, 0);
+      double diagonal = 0.0;
+      if (d == 2)
+        tangent_block_fixed<2>(Qij, G[static_cast<std::size_t>(i)], Gj, out, column_size,
+                               i == j ? &diagonal : nullptr);
+      else
+        tangent_block_fixed<3>(Qij, G[static_cast<std::size_t>(i)], Gj, out, column_size,
+                               i == j ? &diagonal : nullptr);
+      max_diagonal = std::max(max_diagonal, diagonal);
     }
   }
   const double lambda = f.relative_shift * std::max(1e-12, max_diagonal);
