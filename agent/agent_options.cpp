@@ -38,6 +38,10 @@ options:
   --handshake-retries K  at most K such re-creations, 0..10 (default 3)
   --handshake-force-once  (a test hook) with --security: re-create the participant once at
                      the first handshake not finished yet, without using up a retry
+  --early-chordal    agent 0, whole file parsed by tessera launch's fork server: solve the
+                     whole graph's chordal initialization while the processes discover each
+                     other; used only if the run's --init is chordal and the values the agents
+                     send are that file's (tessera launch passes it with --init chordal)
   --verbose          print each phase
   --help             this text
 
@@ -53,7 +57,7 @@ AgentOptions parse_agent_options(const std::vector<std::string>& argv) {
                                                  "dump-local", "checkpoint-dir", "checkpoint-every",
                                                  "handshake-stall", "handshake-retries"},
                                                 cli::SessionArgsFor::kProcess),
-                      {"verbose", "help", "udp-only", "handshake-force-once"});
+                      {"verbose", "help", "udp-only", "handshake-force-once", "early-chordal"});
   if (!args.positional().empty())
     throw InputError("unexpected argument '" + args.positional().front() + "' (see --help)");
   AgentOptions a;
@@ -83,6 +87,7 @@ AgentOptions parse_agent_options(const std::vector<std::string>& argv) {
   if (retries < 0 || retries > 10) throw InputError("option --handshake-retries: must be 0..10");
   a.handshake_retries = static_cast<int>(retries);
   a.handshake_force_once = args.has("handshake-force-once");
+  a.early_chordal = args.has("early-chordal");
   a.verbose = args.has("verbose");
   return a;
 }

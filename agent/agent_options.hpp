@@ -31,6 +31,9 @@ struct AgentOptions {
   /// --handshake-force-once (a test hook): re-create once at the first unfinished handshake,
   /// outside the handshake_retries budget (PeerGateOptions::force_one_reopen).
   bool handshake_force_once = false;
+  /// --early-chordal: agent 0 starts the whole graph's chordal initialization as soon as it has
+  /// the preloaded file (runtime/early_chordal.hpp).
+  bool early_chordal = false;
   bool verbose = false;
 };
 

@@ -17,9 +17,11 @@
 #include "agent/share_announcement.hpp"
 #include "launch/heap_retention.hpp"
 #include "launch/process_tuning.hpp"
+#include "runtime/early_chordal.hpp"
 #include "runtime/initialization_stage.hpp"
 #include "runtime/known_inlier_start.hpp"
 #include "runtime/local_dump.hpp"
+#include "runtime/preloaded_graph.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
 
@@ -88,6 +90,15 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   log("read " + o.graph + ": poses [" + std::to_string(share.begin) + ", " +
       std::to_string(share.end) + ") of " + std::to_string(share.num_poses) + ", " +
       std::to_string(share.measurements.size()) + " measurements");
+  // Agent 0 solves the chordal start while discovery and the partition run; the stage uses it
+  // only if the gathered values are this graph's (runtime/early_chordal.hpp). Only for a graph
+  // the fork server parsed: the agent holds no whole graph otherwise.
+  std::optional<EarlyChordal> early;
+  if (o.early_chordal && o.id == 0)
+    if (const PoseGraph* whole = preloaded_graph(o.graph)) {
+      early.emplace(*whole);
+      log("chordal initialization of the whole graph started");
+    }
 
   // 2. Before announcing: know the coordinator and, in a secured run, have authenticated every
   // other process. On the way the participant may be re-created (UDP only when the
@@ -154,6 +165,8 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
       known_flags[e] = true;
     }
   }
+  double init_s = 0.0;
+  bool init_early = false;
   {
     // A robust run also computes the known inliers' start when they connect the poses; the
     // agents vote between the two before the first solve, like the in-process engine
@@ -164,27 +177,34 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
     if (known) {
       auto [init, known_init] = run_initialization_stages(
           share, known->share, o.id, o.robots, structure, known->structure, asg.initialization(),
-          "distributed", o.graph, channel, o.round_timeout_s);
+          "distributed", o.graph, channel, o.round_timeout_s, early ? &*early : nullptr);
       share.initial = std::move(init.poses);
       share.known_initial = std::move(known_init.poses);
+      init_s = init.seconds + known_init.seconds;
+      init_early = init.early;
       log("initialisation '" + init.method + "' and 'distributed' of the known inliers done in " +
           std::to_string(static_cast<long>((init.seconds + known_init.seconds) * 1000)) + " ms");
     } else {
       InitializationResult init =
           run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(), o.graph,
-                                   channel, o.round_timeout_s);
+                                   channel, o.round_timeout_s, early ? &*early : nullptr);
       share.initial = std::move(init.poses);
+      init_s = init.seconds;
+      init_early = init.early;
       log("initialisation '" + init.method + "' done in " +
-          std::to_string(static_cast<long>(init.seconds * 1000)) + " ms");
+          std::to_string(static_cast<long>(init.seconds * 1000)) + " ms" +
+          (init.early ? " (solved while the run started)" : ""));
     }
   }
 
+  early.reset();                 // an unused early solve: wait for it, drop it
   launch::release_freed_heap();  // the initialisation's factorizations and the assignment's copy
 
   // 7. Hand-off, peer to peer: exactly one message to every other agent. A peer sends its
   // hand-off when its initialisation is done, which is computation (minutes for 25 agents of a
   // 1M-pose grid on 2 cores: 30 s timed out), so the wait is bounded like a round's, not like a
   // network step; a dead peer is noticed by its lease meanwhile.
+  const auto handoff_start = std::chrono::steady_clock::now();
   std::vector<ReceivedHandoff> received =
       exchange_handoffs(s, share, asg.owner(), o.id, o.robots, o.net.session.run_id,
                         std::max(o.net.timeout_s, o.round_timeout_s));
@@ -193,6 +213,16 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   out.local.known_inlier = std::move(known_flags);
   log("hand-off complete: " + std::to_string(out.local.owned.size()) + " poses, " +
       std::to_string(out.local.measurements.size()) + " measurements");
+  if (o.id == 0) {  // the coordinator's summary splits the time to the first round with these
+    RoundStatusMessage t;
+    t.phase = kSetupTimesPhase;
+    t.sender = 0;
+    t.cost = init_s;
+    t.grad_norm_sq =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - handoff_start).count();
+    t.block_grad_norm = init_early ? 1.0 : 0.0;
+    channel.send(OutgoingMessage{t, false, {}});
+  }
   if (!o.dump_local.empty()) write_local_dump(out.local, o.dump_local);
   launch::release_freed_heap();  // the hand-off's messages
   return out;

@@ -57,6 +57,12 @@ bool RoundReports::on_report(const wire::RoundStatus& m) {
     results_.rounding_cg_iterations = static_cast<std::uint32_t>(m.block_grad_norm());
     return true;
   }
+  if (m.phase() == kAgentSetupTimesPhase) {
+    results_.agent_init_s = m.cost();
+    results_.agent_handoff_s = m.grad_norm_sq();
+    results_.init_early = m.block_grad_norm() != 0.0;
+    return true;
+  }
   if (m.phase() == kAgentStageProgressPhase) {
     lines_.on_stage(static_cast<std::uint32_t>(m.block_grad_norm()),
                     static_cast<std::uint64_t>(m.grad_norm_sq()), m.cost());

@@ -27,6 +27,7 @@ constexpr std::uint32_t kAgentCertificateBytesPhase = 202;
 constexpr std::uint32_t kAgentRobustReportPhase = 203;
 constexpr std::uint32_t kAgentPhaseTimesPhase = 204;
 constexpr std::uint32_t kAgentStageProgressPhase = 205;  // runtime/stage_progress.hpp
+constexpr std::uint32_t kAgentSetupTimesPhase = 206;
 
 /// Core's round statuses (phase 1: a round; phase 5: a restart of the momentum).
 inline bool is_round_status(const wire::RoundStatus& m) {
@@ -64,6 +65,10 @@ struct ReportedResults {
   std::optional<double> agent_solve_s, agent_rounding_s;
   // The rounding's translation CG iterations (each one all-agent sum), with those times.
   std::optional<std::uint32_t> rounding_cg_iterations;
+  // Agent 0's set-up (its clock, seconds): the initialisation stage and the hand-off, and
+  // whether its chordal start was solved while the run started.
+  std::optional<double> agent_init_s, agent_handoff_s;
+  std::optional<bool> init_early;
   // Round timing from the status completions: excludes the fixed costs (hand-off,
   // initialisation, rounding, shutdown) that the solve time holds. From digests: the first is
   // when agent 0's first completion reached the coordinator, the last that plus agent 0's own

@@ -64,6 +64,11 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("rounding_cg_iterations", r.rounding_cg_iterations
                                          ? std::optional<double>(*r.rounding_cg_iterations)
                                          : std::nullopt)
+      // Agent 0's set-up: its initialisation stage and hand-off (runtime/early_chordal.hpp).
+      .add("init_ms", r.agent_init_s ? std::optional<double>(1000 * *r.agent_init_s) : std::nullopt)
+      .add("handoff_ms",
+           r.agent_handoff_s ? std::optional<double>(1000 * *r.agent_handoff_s) : std::nullopt)
+      .add("init_early", r.init_early)
       .add("bytes_sent", std::vector<std::size_t>(in.merged.bytes.begin(), in.merged.bytes.end()))
       .add("hosts", in.structure.hosts);
   // Peak resident sets (MB): each agent's as it sent its final estimate, the coordinator's now,

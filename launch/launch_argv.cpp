@@ -84,6 +84,10 @@ std::vector<std::string> agent_argv(const LaunchOptions& o, const RunPaths& path
                                 std::to_string(o.agents),
                                 "--id",
                                 std::to_string(k)};
+  // Agent 0 solves the chordal start from the fork server's parsed file while the processes
+  // discover each other (runtime/early_chordal.hpp).
+  if (k == 0 && files.empty() && o.fork_server && o.init == "chordal")
+    a.push_back("--early-chordal");
   const std::vector<std::string> common = cli::session_argv(o.net.session);
   a.insert(a.end(), common.begin(), common.end());
   for (const auto& x : agent_loss_argv(o.loss)) a.push_back(x);

@@ -95,5 +95,27 @@ TEST(RoundReports, AgentZerosPhaseTimesAreKeptForTheSummary) {
   EXPECT_FALSE(r.on_report(m));
 }
 
+// And its set-up (phase 206, before the first round): initialisation and hand-off seconds, and
+// whether the chordal start had been solved while the run started (runtime/early_chordal.hpp).
+TEST(RoundReports, AgentZerosSetUpTimesAreKeptForTheSummary) {
+  std::ostringstream out;
+  RoundReports r(false, out);
+  EXPECT_FALSE(r.results().init_early.has_value());
+  wire::RoundStatus m;
+  m.sender(0);
+  m.phase(kAgentSetupTimesPhase);
+  m.cost(0.0625);
+  m.grad_norm_sq(0.03125);
+  m.block_grad_norm(1.0);
+  EXPECT_TRUE(r.on_report(m));
+  ASSERT_TRUE(r.results().agent_init_s.has_value());
+  EXPECT_EQ(*r.results().agent_init_s, 0.0625);
+  EXPECT_EQ(*r.results().agent_handoff_s, 0.03125);
+  EXPECT_TRUE(*r.results().init_early);
+  m.block_grad_norm(0.0);
+  EXPECT_TRUE(r.on_report(m));
+  EXPECT_FALSE(*r.results().init_early);
+}
+
 }  // namespace
 }  // namespace tessera::coordinator

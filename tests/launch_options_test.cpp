@@ -72,6 +72,20 @@ TEST(LaunchOptions, SetUpTimeoutReachesEveryProcessAsItsWaitBound) {
   EXPECT_NE(error_of({"--setup-timeout", "0"}).find("--setup-timeout"), std::string::npos);
 }
 
+TEST(LaunchOptions, AgentZeroSolvesTheChordalStartEarlyOnlyFromTheForkServersWholeFile) {
+  LaunchOptions o = parse_launch_options({"--agents", "3"});
+  o.graph = "/data/graph.g2o";
+  EXPECT_TRUE(has(agent_argv(o, paths(), 0), "--early-chordal"));
+  EXPECT_FALSE(has(agent_argv(o, paths(), 1), "--early-chordal"));  // only agent 0 solves it
+  EXPECT_FALSE(has(coordinator_argv(o, paths()), "--early-chordal"));
+  LaunchOptions distributed = parse_launch_options({"--agents", "3", "--init", "distributed"});
+  distributed.graph = o.graph;
+  EXPECT_FALSE(has(agent_argv(distributed, paths(), 0), "--early-chordal"));
+  LaunchOptions exec = parse_launch_options({"--agents", "3", "--no-fork-server"});
+  exec.graph = o.graph;  // no parsed file to solve from
+  EXPECT_FALSE(has(agent_argv(exec, paths(), 0), "--early-chordal"));
+}
+
 TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
   const std::string help = launch_help();
   // A valid value of each flag: "1" unless that is out of the flag's range.

@@ -102,6 +102,8 @@ void scaled_dense_times_sparse(const Eigen::MatrixXd& X, const SparseMatrix& Q, 
   const Eigen::Index r = X.rows();
   out.resize(r, Q.cols());
   switch (r) {
+    case 1:  // the certificate's vectors (one row): the dynamic kernel zeroed a heap row a column
+      return dense_times_sparse<1>(X.data(), r, Q, scale, out.data());
     case 2:
       return dense_times_sparse<2>(X.data(), r, Q, scale, out.data());
     case 3:

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <tessera/distributed/distributed_initialization.hpp>
@@ -120,7 +121,8 @@ std::vector<Measurement> in_file_order(std::vector<std::pair<std::uint64_t, Meas
 }
 
 std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std::uint32_t N,
-                                const std::string& source, StageMailbox& mail) {
+                                const std::string& source, StageMailbox& mail, EarlyChordal* early,
+                                bool* used_early) {
   const int d = share.d;
   const std::size_t width = flat_pose_size(d);
   std::vector<const Measurement*> mine;
@@ -158,7 +160,10 @@ std::vector<Pose> chordal_stage(const RobotShare& share, std::uint32_t self, std
   graph.num_poses = share.num_poses;
   graph.source = source;
   graph.measurements = in_file_order(std::move(all));
-  const std::vector<Pose> poses = chordal_initialization(graph);
+  std::optional<std::vector<Pose>> solved;
+  if (early) solved = early->take_if_same(graph);
+  if (used_early) *used_early = solved.has_value();
+  const std::vector<Pose> poses = solved ? std::move(*solved) : chordal_initialization(graph);
   if (N > 1) {
     PoseBlockMessage out = block(self, kChordalPoses, static_cast<std::uint32_t>(d), d);
     for (std::size_t id = 0; id < poses.size(); ++id) {
@@ -323,7 +328,7 @@ namespace {
 InitializationResult run_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t num_agents,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
-    const std::string& method, const std::string& source, StageMailbox& mail) {
+    const std::string& method, const std::string& source, StageMailbox& mail, EarlyChordal* early) {
   const auto t0 = std::chrono::steady_clock::now();
   InitializationResult res;
   res.method = method.empty() ? default_initialization() : method;
@@ -336,7 +341,7 @@ InitializationResult run_stage(
                            std::to_string(share.end - 1) + "); use --init chordal or distributed");
     res.poses = share.initial;
   } else if (init == DistributedInit::kChordal) {
-    res.poses = chordal_stage(share, self, num_agents, source, mail);
+    res.poses = chordal_stage(share, self, num_agents, source, mail, early, &res.early);
   } else {
     res.poses = distributed_stage(share, self, num_agents, structure, source, mail, &res.units);
   }
@@ -350,9 +355,9 @@ InitializationResult run_initialization_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t num_agents,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::string& method, const std::string& source, ProtocolChannel& channel,
-    double timeout_s) {
+    double timeout_s, EarlyChordal* early) {
   StageMailbox mail(channel, timeout_s, self);
-  return run_stage(share, self, num_agents, structure, method, source, mail);
+  return run_stage(share, self, num_agents, structure, method, source, mail, early);
 }
 
 std::pair<InitializationResult, InitializationResult> run_initialization_stages(
@@ -360,12 +365,13 @@ std::pair<InitializationResult, InitializationResult> run_initialization_stages(
     std::uint32_t num_agents, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& second_structure,
     const std::string& method, const std::string& second_method, const std::string& source,
-    ProtocolChannel& channel, double timeout_s) {
+    ProtocolChannel& channel, double timeout_s, EarlyChordal* early) {
   StageMailbox mail(channel, timeout_s, self);
-  InitializationResult first = run_stage(share, self, num_agents, structure, method, source, mail);
+  InitializationResult first =
+      run_stage(share, self, num_agents, structure, method, source, mail, early);
   mail.set_offset(kSecondStagePhaseOffset);
-  InitializationResult second =
-      run_stage(second_share, self, num_agents, second_structure, second_method, source, mail);
+  InitializationResult second = run_stage(second_share, self, num_agents, second_structure,
+                                          second_method, source, mail, nullptr);
   return {std::move(first), std::move(second)};
 }
 

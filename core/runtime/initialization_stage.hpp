@@ -28,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include "runtime/early_chordal.hpp"
 #include "runtime/local_share.hpp"
 #include "runtime/round_loop.hpp"
 
@@ -45,6 +46,8 @@ struct InitializationResult {
   std::string method;       ///< What ran ("chordal", "distributed", "file").
   std::vector<Pose> poses;  ///< Initial poses of [share.begin, share.end).
   std::uint64_t units = 0;  ///< distributed: units (robot components) of the whole graph.
+  /// chordal, agent 0: the poses came from the EarlyChordal solve (the gathered graph was it).
+  bool early = false;
   double seconds = 0.0;
 };
 
@@ -53,11 +56,13 @@ struct InitializationResult {
 /// (from the assignment; used to find this robot's poses at the ends of inter-robot
 /// measurements). Every wait is bounded by `timeout_s` (the error names the missing agents).
 /// Throws InputError on an unknown method or 'file' without VERTEX poses (naming `source`).
+/// `early` (agent 0, chordal only; may be null): the whole graph's chordal solve started
+/// before the stage, used when the gathered graph is the one it solved.
 InitializationResult run_initialization_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t num_agents,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::string& method, const std::string& source, ProtocolChannel& channel,
-    double timeout_s);
+    double timeout_s, EarlyChordal* early = nullptr);
 
 /// Two stages back to back on one inbox (a robust run's two candidate starts: `method` on
 /// `share`, then `second_method` on `second_share`, e.g. the distributed initialization of the
@@ -69,6 +74,6 @@ std::pair<InitializationResult, InitializationResult> run_initialization_stages(
     std::uint32_t num_agents, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& second_structure,
     const std::string& method, const std::string& second_method, const std::string& source,
-    ProtocolChannel& channel, double timeout_s);
+    ProtocolChannel& channel, double timeout_s, EarlyChordal* early = nullptr);
 
 }  // namespace tessera::agent

@@ -200,6 +200,11 @@ constexpr std::uint32_t kPhaseTimesPhase = 204;
 /// Agent 0's progress during the certificate and the rounding (runtime/stage_progress.hpp):
 /// round = the stage's iteration, cost = its figure, block_grad_norm = the stage.
 constexpr std::uint32_t kStageProgressPhase = 205;
+/// Agent 0's set-up times, to the coordinator only, after its hand-off (before the first round):
+/// cost = the initialisation stage's seconds, grad_norm_sq = the hand-off's seconds (exchange
+/// and assembly of the local problem), block_grad_norm = 1 when the chordal start had been
+/// solved while the run started (runtime/early_chordal.hpp), else 0.
+constexpr std::uint32_t kSetupTimesPhase = 206;
 
 /// Optional recovery hooks of the round loop.
 struct RoundLoopHooks {

@@ -20,8 +20,11 @@ alternately, and prints the launch run's phases on its critical path, in seconds
   rounding     agent 0's distributed rounding (plus the final estimates' transfer)
   merge        to the merged summary printed by launch
   shutdown     summary to launch's exit (processes leave, participants are deleted)
-and the total, the centralized wall, their ratio (launch to exit / centralized), the relative gap of
-each to f* (optima.csv), certification, rounds and the load. Writes docs/benchmarks/launch_phases.csv.
+agent 0's own clock for two parts of init, in the CSV: its initialisation stage (`init_own_s`;
+with the chordal start solved while the run started, `init_early`, little more than the wait for
+the others' values) and its hand-off (`handoff_own_s`); and the total, the centralized wall, their
+ratio (launch to exit / centralized), the relative gap of each to f* (optima.csv), certification,
+rounds and the load. Writes docs/benchmarks/launch_phases.csv.
 Wall times depend on the machine's load: it is printed per graph; phases are the coordinator's
 timeline (CLOCK_MONOTONIC, shared by the processes of the host) and agent 0's clock.
 
@@ -108,6 +111,10 @@ def phases(s, t0_ms, summary_wall, exit_wall):
     return out
 
 
+def ms_to_s(ms):
+    return round(ms / 1000, 4) if ms is not None else None
+
+
 def run_centralized(a, graph, tmp):
     js = os.path.join(tmp, "central.json")
     u0 = bc.children_usage()
@@ -172,6 +179,8 @@ def main():
                            **{p + "_s": round(s["phases_s"][p], 4) for p in PHASES},
                            total_s=round(s["exit_wall_s"], 4), to_summary_s=round(s["summary_wall_s"], 4),
                            partition_own_s=round(s["partition_ms"] / 1000, 4),
+                           init_own_s=ms_to_s(s.get("init_ms")), handoff_own_s=ms_to_s(s.get("handoff_ms")),
+                           init_early=s.get("init_early"),
                            launch_cpu_s=round(s["cpu_s"], 3), centralized_s=round(c["wall_s_process"], 4),
                            centralized_cpu_s=round(c["cpu_s"], 3),
                            ratio=round(s["exit_wall_s"] / c["wall_s_process"], 3),
