@@ -10,8 +10,10 @@
 //   * Hessian-vector product: each agent forms its own block's rows of Hess f(X)[v] from its own
 //     entries of v and its neighbours' public entries (one neighbour exchange per product);
 //   * CG's inner products are all-agent sums in agent-id order (bit-identical on every agent);
-//   * the preconditioner is block Jacobi: each agent applies its own block preconditioner
-//     (AgentState::precondition: the tangent factor of its block, else its Q_BB factor).
+//   * the preconditioner is block Jacobi (AgentState::precondition: the tangent factor of its
+//     block, else its Q_BB factor) with a coarse correction over rigid motions of smoothed
+//     pieces of the blocks (options.coarse, distributed/tangent_coarse_space.hpp): block Jacobi
+//     alone moves information one block boundary per CG iteration.
 // CG is in the Chronopoulos-Gear form (the two inner products of an iteration from one
 // reduction, <p, Hp> by recurrence), so an iteration is one exchange then one reduction.
 // The trust region (Steihaug-Toint truncated CG in the preconditioner's norm, ratio test on the
@@ -200,6 +202,9 @@ class NewtonRefineProtocol : public AgentProcess {
   void start_cg(std::vector<OutgoingMessage>& out);
   // x's entries at the coarse unknowns this agent touches (coarse_hphi_'s columns).
   Eigen::VectorXd touched_of(const Eigen::VectorXd& x) const;
+  // (H Phi)^T y over the own rows, one entry per touched unknown; v -= (H Phi) x.
+  Eigen::VectorXd hphi_dot(const Eigen::MatrixXd& y) const;
+  void subtract_hphi(const Eigen::VectorXd& x, Eigen::MatrixXd& v) const;
   // The block preconditioner for the next CG solve (options_.refactor_every_step).
   void prepare_preconditioner();
   void send_direction(std::vector<OutgoingMessage>& out);
@@ -240,8 +245,13 @@ class NewtonRefineProtocol : public AgentProcess {
   // (recurrences, as r and q: Phi^T w rides in each iteration's sum).
   std::unique_ptr<TangentCoarseSpace> coarse_;
   Eigen::MatrixXd coarse_inverse_, coarse_matrix_;
-  Eigen::MatrixXd coarse_hphi_;  // balancing: own rows of H Phi, one column per touched unknown
-  Eigen::VectorXd coarse_hy_;    // balancing: this agent's share of (H Phi)^T y
+  // Balancing: the own rows of H Phi, one column per touched unknown, on its non-zero poses.
+  struct HphiColumn {
+    std::vector<Eigen::Index> slots;  // pose slots
+    std::vector<double> values;       // r x (d+1) per slot, column-major
+  };
+  std::vector<HphiColumn> coarse_hphi_;
+  Eigen::VectorXd coarse_hy_;  // balancing: this agent's share of (H Phi)^T y
   Eigen::VectorXd coarse_g_, coarse_r_, coarse_q_;
   bool coarse_due_ = true;  // the point changed since the coarse matrix was summed
   NewtonRefineStep step_;
