@@ -65,6 +65,9 @@ const char* const kDistributedValued[] = {"agents",
                                           "refine-grad-tol",
                                           "refine-cg-iters",
                                           "refine-rel-tol",
+                                          "refine-coarse",
+                                          "refine-coarse-form",
+                                          "refine-coarse-aggregates",
                                           nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
@@ -163,7 +166,14 @@ const char* kDistributedHelp =
     "  --refine-grad-tol T       the refinement stops at ||grad f|| <= T (default 1e-6) or\n"
     "                            after a step that lowered f by < F f, --refine-rel-tol F\n"
     "                            (default 1e-7)\n"
-    "  --refine-cg-iters K       its CG iteration cap, all steps (default 10000)\n";
+    "  --refine-cg-iters K       its CG iteration cap, all steps (default 10000)\n"
+    "  --refine-coarse smoothed|blocks|none   the coarse correction of its CG's block-Jacobi\n"
+    "                            preconditioner: rigid motions of K pieces per block blended\n"
+    "                            smoothly, one rigid motion per block, or none (default\n"
+    "                            smoothed)\n"
+    "  --refine-coarse-aggregates K   pieces per block of the smoothed space (default 8)\n"
+    "  --refine-coarse-form balancing|additive   how the coarse correction joins block\n"
+    "                            Jacobi (default balancing)\n";
 
 namespace {
 
@@ -290,6 +300,20 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         a.get_double("refine-rel-tol", opt.refine.relative_decrease_tol);
     opt.refine.max_cg_iterations =
         static_cast<int>(a.get_long("refine-cg-iters", opt.refine.max_cg_iterations));
+    const std::string coarse = a.get_or("refine-coarse", "smoothed");
+    if (coarse != "blocks" && coarse != "smoothed" && coarse != "none")
+      throw InputError("option --refine-coarse: '" + coarse +
+                       "' is not one of blocks, smoothed, none");
+    const std::string form = a.get_or("refine-coarse-form", "balancing");
+    if (form != "balancing" && form != "additive")
+      throw InputError("option --refine-coarse-form: '" + form +
+                       "' is not one of balancing, additive");
+    opt.refine.coarse_balancing = form == "balancing";
+    opt.refine.coarse_aggregates =
+        static_cast<int>(a.get_long("refine-coarse-aggregates", opt.refine.coarse_aggregates));
+    opt.refine.coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
+                        : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
+                                               : NewtonRefineOptions::Coarse::kNone;
   }
   const long agents = a.get_long("agents", 5);
   if (agents < 1 || agents > 64) throw InputError("option --agents: must be in 1..64");
@@ -376,9 +400,9 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   for (const NewtonRefineResult& n : r.refines)
     std::printf(
         "  newton refine: %d steps (%d accepted), %d CG iterations, %d exchanges, %d all-agent "
-        "sums, |grad f| %.3g -> %.3g, f %.10g -> %.10g, stop: %s\n",
-        n.steps, n.accepted_steps, n.cg_iterations, n.exchanges, n.reductions, n.initial_grad_norm,
-        n.grad_norm, n.initial_cost, n.cost, n.stop_reason.c_str());
+        "sums, %d coarse unknowns, |grad f| %.3g -> %.3g, f %.10g -> %.10g, stop: %s\n",
+        n.steps, n.accepted_steps, n.cg_iterations, n.exchanges, n.reductions, n.coarse_unknowns,
+        n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost, n.stop_reason.c_str());
   for (const NewtonRefineResult& n : r.refines)
     for (std::size_t k = 0; k < n.trace.size(); ++k) {
       const NewtonRefineStep& t = n.trace[k];

@@ -145,6 +145,11 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
         make_coarse_space(graph.num_poses, graph.measurements, assignment, options.coarse));
     for (AgentState* s : pointers) s->use_coarse_space(space, graph.measurements);
   }
+  if (options.refine.enabled && options.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed) {
+    const auto space = std::make_shared<const CoarseSpace>(make_coarse_space(
+        graph.num_poses, graph.measurements, assignment, options.refine.coarse_space_options()));
+    for (AgentState* s : pointers) s->use_refine_space(space);
+  }
   const double setup_s = since(start);
   DistributedResult res = solve_distributed_with_states(graph, layout, pointers, options);
   res.init_s += setup_s;

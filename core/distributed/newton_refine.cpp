@@ -8,6 +8,7 @@
 
 #include "distributed/nonzero_rows.hpp"
 #include "distributed/rigid_retraction.hpp"
+#include "distributed/tangent_coarse_space.hpp"
 
 namespace tessera {
 
@@ -24,6 +25,17 @@ void NewtonRefineOptions::validate() const {
   if (!(initial_radius >= 0)) fail("initial_radius", "must be >= 0");
   if (!(accept_ratio >= 0 && accept_ratio < 0.25)) fail("accept_ratio", "must be in [0, 0.25)");
   if (max_backtracks < 0) fail("max_backtracks", "must be >= 0");
+  if (coarse_aggregates < 1) fail("coarse_aggregates", "must be >= 1");
+  if (coarse_smoothing_steps < 0 || coarse_smoothing_steps > 8)
+    fail("coarse_smoothing_steps", "must be in 0..8");
+}
+
+CoarseOptions NewtonRefineOptions::coarse_space_options() const {
+  CoarseOptions c;
+  c.space = CoarseSpaceKind::kSmoothed;
+  c.aggregates = coarse_aggregates;
+  c.smoothing_steps = coarse_smoothing_steps;
+  return c;
 }
 
 namespace {
@@ -49,6 +61,8 @@ NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout&
   everyone_.resize(static_cast<std::size_t>(layout_.num_blocks));
   for (int b = 0; b < layout_.num_blocks; ++b) everyone_[static_cast<std::size_t>(b)] = b;
 }
+
+NewtonRefineProtocol::~NewtonRefineProtocol() = default;
 
 void NewtonRefineProtocol::send_public(const Eigen::MatrixXd& v, std::uint32_t step,
                                        std::vector<OutgoingMessage>& out) {
@@ -171,6 +185,9 @@ void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
       case kTrial:
         after_trial(*ready, out);
         break;
+      case kCoarse:
+        after_coarse(*ready, out);
+        break;
       default:
         after_trial_sums(*ready, out);
         break;
@@ -198,6 +215,14 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
   result_.initial_grad_norm = result_.grad_norm = gnorm_;
   radius_ = options_.initial_radius;
   if (gnorm_ <= options_.grad_norm_tol) return finish("grad_norm");
+  if (options_.coarse != NewtonRefineOptions::Coarse::kNone) {
+    const CoarseSpace* space =
+        options_.coarse == NewtonRefineOptions::Coarse::kSmoothed ? state_.refine_space() : nullptr;
+    coarse_ =
+        std::make_unique<TangentCoarseSpace>(space, layout_, problem_.owned(), problem_.neighbors(),
+                                             problem_.dim(), static_cast<int>(rows_.size()));
+    result_.coarse_unknowns = coarse_->size();
+  }
   prepare_preconditioner();
   begin_cg(out);
 }
@@ -214,11 +239,107 @@ void NewtonRefineProtocol::begin_cg(std::vector<OutgoingMessage>& out) {
   // Only before a CG that will run: the factor at the point where the refinement stops would
   // not be used.
   if (refactor_due_) prepare_preconditioner();
+  if (coarse_ && coarse_due_) return send_coarse(out);
+  start_cg(out);
+}
+
+void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
+  // This agent's rows of A = Phi^T H Phi: column u is Phi^T (H Phi e_u) over the own poses,
+  // with Phi e_u on the own poses and the neighbour copies (the agent knows both). The share
+  // is symmetrized (only the sum over the agents is symmetric); upper triangle, then Phi^T g.
+  const int n = coarse_->size();
+  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXd v, vn;
+  const std::vector<int>& touched = coarse_->touched();
+  // Balancing also keeps the own rows of H Phi (one column per touched unknown).
+  if (options_.coarse_balancing) coarse_hphi_.assign(touched.size(), {});
+  for (std::size_t c = 0; c < touched.size(); ++c) {
+    const int u = touched[c];
+    coarse_->unit(X_, Xn_, u, v, vn);
+    const Eigen::MatrixXd hv = hessian(v, vn);
+    coarse_->project(X_, hv, L.col(u).data());
+    if (options_.coarse_balancing) {
+      // Only the poses it is non-zero on (its piece's support and one hop around it): the
+      // products with H Phi cost about one Hessian product an iteration, not one per column.
+      HphiColumn& col = coarse_hphi_[c];
+      const Eigen::Index w = hv.rows() * (problem_.dim() + 1);
+      for (Eigen::Index s = 0; s * w < hv.size(); ++s) {
+        const Eigen::Map<const Eigen::VectorXd> b(hv.data() + s * w, w);
+        if (b.squaredNorm() == 0.0) continue;
+        col.slots.push_back(s);
+        col.values.insert(col.values.end(), b.data(), b.data() + w);
+      }
+    }
+  }
+  std::vector<double> values;
+  values.reserve(static_cast<std::size_t>(n * (n + 1) / 2 + n));
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i <= j; ++i) values.push_back(0.5 * (L(i, j) + L(j, i)));
+  const std::size_t at = values.size();
+  values.resize(at + static_cast<std::size_t>(n), 0.0);
+  coarse_->project(X_, g_, values.data() + at);
+  broadcast(kCoarse, values, out);
+}
+
+void NewtonRefineProtocol::after_coarse(const MessageGate::Inbox& inbox,
+                                        std::vector<OutgoingMessage>& out) {
+  const int n = coarse_->size();
+  const std::vector<double> t =
+      reduce_in_id_order(inbox, static_cast<std::size_t>(n * (n + 1) / 2 + n));
+  Eigen::MatrixXd A(n, n);
+  std::size_t at = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i <= j; ++i) A(i, j) = A(j, i) = t[at++];
+  coarse_inverse_ = coarse_->pseudo_inverse(A);
+  coarse_matrix_ = A;
+  coarse_g_ = Eigen::Map<const Eigen::VectorXd>(t.data() + at, n);
+  coarse_due_ = false;
+  ++result_.coarse_assemblies;
+  start_cg(out);
+}
+
+Eigen::VectorXd NewtonRefineProtocol::hphi_dot(const Eigen::MatrixXd& y) const {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(coarse_hphi_.size()));
+  const Eigen::Index w = y.rows() * (problem_.dim() + 1);
+  for (std::size_t c = 0; c < coarse_hphi_.size(); ++c) {
+    const HphiColumn& col = coarse_hphi_[c];
+    double acc = 0.0;
+    for (std::size_t q = 0; q < col.slots.size(); ++q)
+      acc +=
+          Eigen::Map<const Eigen::VectorXd>(col.values.data() + static_cast<Eigen::Index>(q) * w, w)
+              .dot(Eigen::Map<const Eigen::VectorXd>(y.data() + col.slots[q] * w, w));
+    out(static_cast<Eigen::Index>(c)) = acc;
+  }
+  return out;
+}
+
+void NewtonRefineProtocol::subtract_hphi(const Eigen::VectorXd& x, Eigen::MatrixXd& v) const {
+  const Eigen::Index w = v.rows() * (problem_.dim() + 1);
+  for (std::size_t c = 0; c < coarse_hphi_.size(); ++c) {
+    const HphiColumn& col = coarse_hphi_[c];
+    const double a = x(static_cast<Eigen::Index>(c));
+    for (std::size_t q = 0; q < col.slots.size(); ++q)
+      Eigen::Map<Eigen::VectorXd>(v.data() + col.slots[q] * w, w) -=
+          a * Eigen::Map<const Eigen::VectorXd>(
+                  col.values.data() + static_cast<Eigen::Index>(q) * w, w);
+  }
+}
+
+Eigen::VectorXd NewtonRefineProtocol::touched_of(const Eigen::VectorXd& x) const {
+  const std::vector<int>& touched = coarse_->touched();
+  Eigen::VectorXd out(static_cast<Eigen::Index>(touched.size()));
+  for (std::size_t c = 0; c < touched.size(); ++c)
+    out(static_cast<Eigen::Index>(c)) = x(touched[c]);
+  return out;
+}
+
+void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
   step_ = NewtonRefineStep{};
   step_.radius = radius_;
   cg_it_ = 0;
   s_ = Eigen::MatrixXd::Zero(X_.rows(), X_.cols());
   r_ = -g_;
+  if (coarse_) coarse_r_ = -coarse_g_;
   e_Pe_ = e_Pd_ = d_Pd_ = model_ = gs_ = sHs_ = 0.0;
   cg_target_ =
       std::max(0.5 * options_.grad_norm_tol,
@@ -227,7 +348,24 @@ void NewtonRefineProtocol::begin_cg(std::vector<OutgoingMessage>& out) {
 }
 
 void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
-  z_ = state_.precondition(X_, r_);
+  if (!coarse_) {
+    z_ = state_.precondition(X_, r_);
+  } else if (!options_.coarse_balancing) {
+    // Additive: z = B r + Phi A^+ Phi^T r (Phi^T r identical everywhere).
+    z_ = state_.precondition(X_, r_);
+    coarse_->expand(X_, coarse_inverse_ * coarse_r_, z_);
+  } else {
+    // Balancing, z = C r + (I - C H) B (I - H C) r with C = Phi A^+ Phi^T: here y = B (r - H Phi
+    // xi), xi = A^+ Phi^T r, and z' = y + Phi xi is sent; the last term -C H y needs the sum
+    // (H Phi)^T y, which rides in this iteration's sum, and is taken off z' and H z' then
+    // (after_sums: in the coarse space, H of it is the kept H Phi columns: no exchange).
+    const Eigen::VectorXd xi = coarse_inverse_ * coarse_r_;
+    Eigen::MatrixXd t = r_;
+    subtract_hphi(touched_of(xi), t);
+    z_ = state_.precondition(X_, t);
+    coarse_hy_ = hphi_dot(z_);
+    coarse_->expand(X_, xi, z_);
+  }
   send_public(z_, kDirection, out);
 }
 
@@ -235,13 +373,41 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
   neighbours_into(inbox, zn_);
   w_ = hessian(z_, zn_);
-  broadcast(kSums, {dot(r_, z_), dot(z_, w_), r_.squaredNorm()}, out);
+  std::vector<double> values{dot(r_, z_), dot(z_, w_), r_.squaredNorm()};
+  if (coarse_) {  // Phi^T w, for Phi^T q and so Phi^T r by their recurrences
+    const std::size_t n = static_cast<std::size_t>(coarse_->size());
+    values.resize(3 + (options_.coarse_balancing ? 2 : 1) * n, 0.0);
+    coarse_->project(X_, w_, values.data() + 3);
+    if (options_.coarse_balancing) {  // and (H Phi)^T y
+      const std::vector<int>& touched = coarse_->touched();
+      for (std::size_t c = 0; c < touched.size(); ++c)
+        values[3 + n + static_cast<std::size_t>(touched[c])] =
+            coarse_hy_(static_cast<Eigen::Index>(c));
+    }
+  }
+  broadcast(kSums, values, out);
 }
 
 void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
                                       std::vector<OutgoingMessage>& out) {
-  const std::vector<double> t = reduce_in_id_order(inbox, 3);
-  const double gamma = t[0], delta = t[1], rnorm = std::sqrt(std::max(0.0, t[2]));
+  const std::size_t n = static_cast<std::size_t>(coarse_ ? coarse_->size() : 0);
+  const std::vector<double> t =
+      reduce_in_id_order(inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n);
+  double gamma = t[0], delta = t[1];
+  const double rnorm = std::sqrt(std::max(0.0, t[2]));
+  Eigen::VectorXd coarse_w;  // Phi^T w
+  if (coarse_) coarse_w = Eigen::Map<const Eigen::VectorXd>(t.data() + 3, coarse_->size());
+  if (coarse_ && options_.coarse_balancing) {
+    // z = z' - Phi eta, H z = w' - H Phi eta with eta = A^+ (H Phi)^T y; the sums follow from
+    // the ones of z' and Phi^T w' = (H Phi)^T z'.
+    const Eigen::VectorXd eta =
+        coarse_inverse_ * Eigen::Map<const Eigen::VectorXd>(t.data() + 3 + n, coarse_->size());
+    gamma -= coarse_r_.dot(eta);
+    delta += -2.0 * eta.dot(coarse_w) + eta.dot(coarse_matrix_ * eta);
+    coarse_->expand(X_, -eta, z_);
+    subtract_hphi(touched_of(eta), w_);
+    coarse_w -= coarse_matrix_ * eta;
+  }
   if (cg_it_ > 0 && rnorm <= cg_target_) return try_step("residual", out);
   if (result_.cg_iterations >= options_.max_cg_iterations) {
     if (cg_it_ > 0) return try_step("cap", out);
@@ -254,6 +420,12 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   // Chronopoulos-Gear: beta from <r, z>; <p, H p> from <z, H z> and the recurrences.
   const double beta = cg_it_ == 0 ? 0.0 : gamma / gamma_old_;
   const double pHp = cg_it_ == 0 ? delta : delta - beta * gamma / alpha_old_;
+  if (coarse_) {
+    if (cg_it_ == 0)
+      coarse_q_ = coarse_w;
+    else
+      coarse_q_ = coarse_w + beta * coarse_q_;
+  }
   if (cg_it_ == 0) {
     p_ = z_;
     q_ = w_;
@@ -290,6 +462,7 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   }
   s_ += alpha * p_;
   r_ -= alpha * q_;
+  if (coarse_) coarse_r_ -= alpha * coarse_q_;
   model_ += -alpha * gamma + 0.5 * alpha * alpha * pHp;
   gs_ += -alpha * gamma;
   sHs_ += alpha * alpha * pHp;
@@ -346,6 +519,7 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
     f_ = ft;
     gnorm_ = gt;
     ++result_.accepted_steps;
+    coarse_due_ = true;
     refactor_due_ = true;  // each CG solve preconditioned at its own point (when asked)
   }
   step_.cost = f_;

@@ -192,6 +192,8 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     solver.refine.relative_decrease_tol = 0.0;
     solver.refine.refactor_every_step = false;
     solver.refine.forcing = options.newton_forcing;
+    // Not measured on the online steps (a few CG iterations from a warm start): block Jacobi.
+    solver.refine.coarse = NewtonRefineOptions::Coarse::kNone;
     solver.grad_norm_tol = std::max(options.newton_after_grad_tol, solver.grad_norm_tol);
   }
   return solver;

@@ -98,6 +98,10 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
             local.num_poses, local.structure,
             std::vector<int>(local.owner.begin(), local.owner.end()), options.coarse)),
         local.measurements);
+  if (options.refine.enabled && options.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed)
+    state.use_refine_space(std::make_shared<const CoarseSpace>(make_coarse_space(
+        local.num_poses, local.structure, std::vector<int>(local.owner.begin(), local.owner.end()),
+        options.refine.coarse_space_options())));
   const double variables =
       static_cast<double>(options.rank) * (local.d + 1) * static_cast<double>(local.num_poses);
   const auto scheme = make_momentum_scheme(options, layout, variables);

@@ -67,6 +67,13 @@ class AgentState {
                         const std::vector<Measurement>& measurements);
   /// The smoothed coarse space in use, or null (one rigid motion per block).
   const CoarseSpace* coarse_space() const { return space_.get(); }
+  /// The pieces of the Newton refinement's coarse preconditioner (newton_refine.hpp,
+  /// NewtonRefineOptions::Coarse::kSmoothed), kept apart from the rounds' space: the rounds
+  /// switch to smoothed terms when they hold one.
+  void use_refine_space(std::shared_ptr<const CoarseSpace> space) {
+    refine_space_ = std::move(space);
+  }
+  const CoarseSpace* refine_space() const { return refine_space_.get(); }
   /// This agent's smoothed coarse terms at (Y, Yn); needs use_coarse_space.
   std::vector<double> smoothed_coarse_terms() const { return smoothed_->compute(Y, Yn); }
   /// Moves Y, V and the neighbour copies Yn, Vn by their blended motions (one per aggregate).
@@ -140,6 +147,7 @@ class AgentState {
   const std::vector<Measurement>* coarse_source_ = nullptr;
   const CoarseTerms& coarse() const;
   std::shared_ptr<const CoarseSpace> space_;
+  std::shared_ptr<const CoarseSpace> refine_space_;
   std::optional<SmoothedCoarseTerms> smoothed_;
   /// The Q_BB preconditioner (built in the constructor).
   BlockPreconditioner& euclidean();

@@ -10,8 +10,10 @@
 //   * Hessian-vector product: each agent forms its own block's rows of Hess f(X)[v] from its own
 //     entries of v and its neighbours' public entries (one neighbour exchange per product);
 //   * CG's inner products are all-agent sums in agent-id order (bit-identical on every agent);
-//   * the preconditioner is block Jacobi: each agent applies its own block preconditioner
-//     (AgentState::precondition: the tangent factor of its block, else its Q_BB factor).
+//   * the preconditioner is block Jacobi (AgentState::precondition: the tangent factor of its
+//     block, else its Q_BB factor) with a coarse correction over rigid motions of smoothed
+//     pieces of the blocks (options.coarse, distributed/tangent_coarse_space.hpp): block Jacobi
+//     alone moves information one block boundary per CG iteration.
 // CG is in the Chronopoulos-Gear form (the two inner products of an iteration from one
 // reduction, <p, Hp> by recurrence), so an iteration is one exchange then one reduction.
 // The trust region (Steihaug-Toint truncated CG in the preconditioner's norm, ratio test on the
@@ -29,16 +31,20 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <tessera/distributed/agent_process.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/coarse_correction.hpp>
 #include <tessera/distributed/message_gate.hpp>
 #include <tessera/problem/block_problem.hpp>
 #include <vector>
 
 namespace tessera {
+
+class TangentCoarseSpace;
 
 struct NewtonRefineOptions {
   /// Run the refinement after the block-coordinate solve reached its own tolerance (a solve
@@ -81,6 +87,27 @@ struct NewtonRefineOptions {
   /// were a third of their instructions on a generated 1,000-pose city (docs/online.md,
   /// "Newton steps").
   bool refactor_every_step = true;
+  /// The preconditioner's coarse correction (two-level additive Schwarz,
+  /// distributed/tangent_coarse_space.hpp). kBlocks: block Jacobi plus one rigid motion per
+  /// block, Phi A^+ Phi^T r with A = Phi^T Hess f Phi summed once per point (one all-agent sum
+  /// per accepted step) and Phi^T r carried in each CG iteration's sum (k(k+1)/2 numbers per
+  /// block at k active rows: no extra message step). kNone: block Jacobi alone, whose CG
+  /// iterations grow with the chain's length (ais2klinik: 4,540).
+  /// kSmoothed: `coarse_aggregates` pieces per block blended over `coarse_smoothing_steps`
+  /// measurement hops (the smoothed aggregation of coarse_space.hpp; AgentState::refine_space(),
+  /// built from the graph's structure where the agents are set up; blocks where there is none).
+  enum class Coarse { kNone, kBlocks, kSmoothed };
+  Coarse coarse = Coarse::kSmoothed;
+  /// How the coarse correction joins block Jacobi B. true: balancing,
+  /// C + (I - C H) B (I - H C) with C = Phi A^+ Phi^T (the coarse space's error removed exactly;
+  /// (H Phi)^T y rides in the same sum, so still one exchange and one sum an iteration, each
+  /// agent keeping its rows of H Phi). false: additive, B + C.
+  bool coarse_balancing = true;
+  /// kSmoothed: pieces per block (>= 1) and smoothing steps of their weights (0..8).
+  int coarse_aggregates = 8;
+  int coarse_smoothing_steps = 1;
+  /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
+  CoarseOptions coarse_space_options() const;
   /// Throws InputError naming the bad field.
   void validate() const;
 };
@@ -108,6 +135,9 @@ struct NewtonRefineResult {
   int steps = 0, accepted_steps = 0, cg_iterations = 0;
   /// Message steps: neighbour exchanges (CG directions and trial poses) and all-agent sums.
   int exchanges = 0, reductions = 0;
+  /// Coarse correction: its unknowns (pieces x generators; 0 without), and how many times its
+  /// matrix was summed (one all-agent sum each, counted in `reductions`).
+  int coarse_unknowns = 0, coarse_assemblies = 0;
   std::vector<NewtonRefineStep> trace;
 };
 
@@ -120,15 +150,17 @@ class NewtonRefineProtocol : public AgentProcess {
     kDirection = 61,  ///< Public entries of the preconditioned residual z.
     kSums = 62,       ///< CG's <r, z>, <z, H z>, <r, r>.
     kTrial = 63,      ///< Public poses of the trial point.
-    kTrialSums = 64   ///< Cost share and ||g||^2 at the trial point.
+    kTrialSums = 64,  ///< Cost share and ||g||^2 at the trial point.
+    kCoarse = 65      ///< The coarse matrix's share and Phi^T g at the current point.
   };
-  static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kTrialSums; }
+  static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kCoarse; }
 
   /// `state`: the agent at the point to refine (Y, and Yn = the neighbours' public poses of the
   /// same point). It must outlive the protocol; on done() its sequences are reset to the final
   /// point (AgentState::reset_iterate).
   NewtonRefineProtocol(AgentState& state, const BlockLayout& layout,
                        const NewtonRefineOptions& options);
+  ~NewtonRefineProtocol() override;
 
   std::vector<OutgoingMessage> start() override;
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
@@ -163,6 +195,16 @@ class NewtonRefineProtocol : public AgentProcess {
   Eigen::MatrixXd hessian(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
   void after_status(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void begin_cg(std::vector<OutgoingMessage>& out);
+  // The coarse matrix's share at the current point, summed by every agent (kCoarse).
+  void send_coarse(std::vector<OutgoingMessage>& out);
+  void after_coarse(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // CG from s = 0 at the current point (the coarse matrix, if any, is current).
+  void start_cg(std::vector<OutgoingMessage>& out);
+  // x's entries at the coarse unknowns this agent touches (coarse_hphi_'s columns).
+  Eigen::VectorXd touched_of(const Eigen::VectorXd& x) const;
+  // (H Phi)^T y over the own rows, one entry per touched unknown; v -= (H Phi) x.
+  Eigen::VectorXd hphi_dot(const Eigen::MatrixXd& y) const;
+  void subtract_hphi(const Eigen::VectorXd& x, Eigen::MatrixXd& v) const;
   // The block preconditioner for the next CG solve (options_.refactor_every_step).
   void prepare_preconditioner();
   void send_direction(std::vector<OutgoingMessage>& out);
@@ -198,6 +240,20 @@ class NewtonRefineProtocol : public AgentProcess {
   double cg_target_ = 0.0;     // residual norm that ends the CG
   double radius_ = 0.0;        // 0 = unbounded
   bool refactor_due_ = false;  // a step was accepted since the last factorization
+  // Coarse correction (options_.coarse): the space at the active rows, the pseudo-inverse of
+  // its Galerkin matrix, Phi^T g at the current point, Phi^T r and Phi^T q of the CG
+  // (recurrences, as r and q: Phi^T w rides in each iteration's sum).
+  std::unique_ptr<TangentCoarseSpace> coarse_;
+  Eigen::MatrixXd coarse_inverse_, coarse_matrix_;
+  // Balancing: the own rows of H Phi, one column per touched unknown, on its non-zero poses.
+  struct HphiColumn {
+    std::vector<Eigen::Index> slots;  // pose slots
+    std::vector<double> values;       // r x (d+1) per slot, column-major
+  };
+  std::vector<HphiColumn> coarse_hphi_;
+  Eigen::VectorXd coarse_hy_;  // balancing: this agent's share of (H Phi)^T y
+  Eigen::VectorXd coarse_g_, coarse_r_, coarse_q_;
+  bool coarse_due_ = true;  // the point changed since the coarse matrix was summed
   NewtonRefineStep step_;
   bool done_ = false;
   NewtonRefineResult result_;

@@ -1,0 +1,157 @@
+#include "distributed/tangent_coarse_space.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace tessera {
+
+TangentCoarseSpace::Poses TangentCoarseSpace::weights_of(const CoarseSpace* space,
+                                                         const BlockLayout& layout,
+                                                         const std::vector<std::size_t>& ids) {
+  Poses p;
+  p.start.reserve(ids.size() + 1);
+  p.start.push_back(0);
+  for (std::size_t id : ids) {
+    if (space) {
+      for (std::size_t q = space->weight_start[id]; q < space->weight_start[id + 1]; ++q)
+        p.weights.push_back({space->weight_aggregate[q], space->weight[q]});
+    } else {
+      p.weights.push_back({layout.owner[id], 1.0});
+    }
+    p.start.push_back(p.weights.size());
+  }
+  return p;
+}
+
+TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayout& layout,
+                                       const std::vector<std::size_t>& owned,
+                                       const std::vector<std::size_t>& neighbours, int d, int k)
+    : d_(d),
+      k_(k),
+      g_(k * (k - 1) / 2 + k),
+      pieces_(space ? space->num_aggregates : layout.num_blocks) {
+  if (k < 1) throw std::invalid_argument("TangentCoarseSpace: no active rows");
+  for (int a = 0; a < k; ++a)
+    for (int b = a + 1; b < k; ++b) rotation_pairs_.emplace_back(a, b);
+  own_poses_ = weights_of(space, layout, owned);
+  neighbour_poses_ = weights_of(space, layout, neighbours);
+  std::vector<char> own(static_cast<std::size_t>(pieces_), 0), any = own;
+  for (const Weight& w : own_poses_.weights)
+    own[static_cast<std::size_t>(w.piece)] = any[static_cast<std::size_t>(w.piece)] = 1;
+  for (const Weight& w : neighbour_poses_.weights) any[static_cast<std::size_t>(w.piece)] = 1;
+  for (int a = 0; a < pieces_; ++a)
+    for (int j = 0; j < g_; ++j) {
+      if (own[static_cast<std::size_t>(a)]) own_.push_back(a * g_ + j);
+      if (any[static_cast<std::size_t>(a)]) touched_.push_back(a * g_ + j);
+    }
+}
+
+void TangentCoarseSpace::add_generator(int j, double x, Eigen::MatrixXd& E) const {
+  const int rotations = static_cast<int>(rotation_pairs_.size());
+  if (j < rotations) {
+    const auto [a, b] = rotation_pairs_[static_cast<std::size_t>(j)];
+    E(a, b) += x;
+    E(b, a) -= x;
+  } else {
+    E(j - rotations, k_) += x;
+  }
+}
+
+void TangentCoarseSpace::move(const Eigen::MatrixXd& E, const Eigen::MatrixXd& X, Eigen::Index s,
+                              Eigen::MatrixXd& v) const {
+  const Eigen::Index c = s * (d_ + 1);
+  v.middleCols(c, d_ + 1).noalias() += E.leftCols(k_) * X.middleCols(c, d_ + 1);
+  v.col(c + d_) += E.col(k_);
+}
+
+void TangentCoarseSpace::project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
+                                 double* out) const {
+  // Per piece, sum_i w_i [v_i X_i^T, v_i's translation] (k x (k+1)); <E, that> for each
+  // generator E is its coordinate.
+  const Eigen::Index kk = k_ * (k_ + 1);
+  std::vector<double> acc(static_cast<std::size_t>(pieces_ * kk), 0.0);
+  Eigen::MatrixXd N(k_, k_ + 1);
+  const std::size_t n = own_poses_.start.size() - 1;
+  for (std::size_t s = 0; s < n; ++s) {
+    const Eigen::Index c = static_cast<Eigen::Index>(s) * (d_ + 1);
+    N.leftCols(k_).noalias() = v.middleCols(c, d_ + 1) * X.middleCols(c, d_ + 1).transpose();
+    N.col(k_) = v.col(c + d_);
+    for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
+      const Weight& w = own_poses_.weights[q];
+      Eigen::Map<Eigen::MatrixXd>(acc.data() + w.piece * kk, k_, k_ + 1) += w.w * N;
+    }
+  }
+  const int rotations = static_cast<int>(rotation_pairs_.size());
+  for (int alpha = 0; alpha < pieces_; ++alpha) {
+    const Eigen::Map<const Eigen::MatrixXd> A(acc.data() + alpha * kk, k_, k_ + 1);
+    double* o = out + alpha * g_;
+    for (int j = 0; j < rotations; ++j) {
+      const auto [a, b] = rotation_pairs_[static_cast<std::size_t>(j)];
+      o[j] += A(a, b) - A(b, a);
+    }
+    for (int a = 0; a < k_; ++a) o[rotations + a] += A(a, k_);
+  }
+}
+
+void TangentCoarseSpace::expand(const Eigen::MatrixXd& X, const Eigen::VectorXd& xi,
+                                Eigen::MatrixXd& v) const {
+  std::vector<Eigen::MatrixXd> E(static_cast<std::size_t>(pieces_));
+  for (int u : own_) {
+    Eigen::MatrixXd& e = E[static_cast<std::size_t>(u / g_)];
+    if (e.size() == 0) e = Eigen::MatrixXd::Zero(k_, k_ + 1);
+    add_generator(u % g_, xi(u), e);
+  }
+  Eigen::MatrixXd Ei(k_, k_ + 1);
+  const std::size_t n = own_poses_.start.size() - 1;
+  for (std::size_t s = 0; s < n; ++s) {
+    Ei.setZero();
+    for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
+      const Weight& w = own_poses_.weights[q];
+      Ei += w.w * E[static_cast<std::size_t>(w.piece)];
+    }
+    move(Ei, X, static_cast<Eigen::Index>(s), v);
+  }
+}
+
+void TangentCoarseSpace::unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
+                              Eigen::MatrixXd& v, Eigen::MatrixXd& vn) const {
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(k_, k_ + 1);
+  add_generator(unknown % g_, 1.0, E);
+  const int piece = unknown / g_;
+  auto fill = [&](const Poses& p, const Eigen::MatrixXd& P, Eigen::MatrixXd& out) {
+    out.setZero(P.rows(), P.cols());
+    const std::size_t n = p.start.size() - 1;
+    for (std::size_t s = 0; s < n; ++s)
+      for (std::size_t q = p.start[s]; q < p.start[s + 1]; ++q)
+        if (p.weights[q].piece == piece)
+          move(p.weights[q].w * E, P, static_cast<Eigen::Index>(s), out);
+  };
+  fill(own_poses_, X, v);
+  fill(neighbour_poses_, Xn, vn);
+}
+
+Eigen::MatrixXd TangentCoarseSpace::pseudo_inverse(const Eigen::MatrixXd& A, double tol) const {
+  const Eigen::Index n = size();
+  if (A.rows() != n || A.cols() != n)
+    throw std::invalid_argument("TangentCoarseSpace: coarse matrix of the wrong size");
+  // P = I - U U^T, U's columns the global motions (generator j on every piece) normalized.
+  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, g_);
+  const double s = 1.0 / std::sqrt(static_cast<double>(pieces_));
+  for (int alpha = 0; alpha < pieces_; ++alpha)
+    for (int j = 0; j < g_; ++j) U(alpha * g_ + j, j) = s;
+  const Eigen::MatrixXd PA = A - U * (U.transpose() * A);
+  Eigen::MatrixXd B = PA - (PA * U) * U.transpose();
+  B = (0.5 * (B + B.transpose())).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(B);
+  const Eigen::VectorXd& l = eig.eigenvalues();
+  const double top = l.size() > 0 ? l(l.size() - 1) : 0.0;
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(l.size());
+  for (Eigen::Index i = 0; i < l.size(); ++i)
+    if (top > 0 && l(i) > tol * top) inv(i) = 1.0 / l(i);
+  const Eigen::MatrixXd& V = eig.eigenvectors();
+  return V * inv.asDiagonal() * V.transpose();
+}
+
+}  // namespace tessera

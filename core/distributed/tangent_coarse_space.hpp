@@ -1,0 +1,88 @@
+#pragma once
+// The coarse space of the Newton refinement's preconditioner (newton_refine.hpp): infinitesimal
+// rigid motions of pieces of the map, as tangent vectors of the lifted problem.
+//
+// Why: block Jacobi cannot see the slow modes of a long chain, the blocks' motions against each
+// other (ais2klinik: the parts north and south of agent 0's corridor turn rigidly by +0.14 and
+// -0.19 rad), so each CG iteration moves information across one block boundary only. Each piece
+// alpha (a block, or an aggregate of the smoothed space, coarse_space.hpp) gets the generators
+// E = [Omega c] of se(k) on the k active rows (Omega skew k x k, c in R^k; k(k-1)/2 + k of
+// them); pose i moves by sum_alpha w_i,alpha E_alpha [X_i; 0 1] = [Omega_i Y_i, Omega_i p_i + c_i],
+// which is tangent (Y^T Omega Y is skew). Phi is the map from the coarse coordinates xi
+// (pieces x generators) to such a tangent vector; the preconditioner adds Phi A^+ Phi^T r, with
+// A = Phi^T Hess f Phi the Galerkin matrix (two-level additive Schwarz).
+//
+// Each agent knows the weights of its own poses and of its copies of its neighbours' poses from
+// the space (identical on every agent), so Phi and Phi^T of its rows need no message.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/coarse_space.hpp>
+#include <vector>
+
+namespace tessera {
+
+class TangentCoarseSpace {
+ public:
+  /// `space`: the pieces and weights (null: one piece per block, weight 1, from the layout).
+  /// `owned`, `neighbours`: global ids of the block's poses and neighbour copies (BlockProblem
+  /// order); `d`: the poses' dimension; `k`: the rows of the vectors it maps (the refinement's
+  /// active rows).
+  TangentCoarseSpace(const CoarseSpace* space, const BlockLayout& layout,
+                     const std::vector<std::size_t>& owned,
+                     const std::vector<std::size_t>& neighbours, int d, int k);
+
+  /// Generators per piece: k(k-1)/2 rotations then k translations.
+  int generators() const { return g_; }
+  int pieces() const { return pieces_; }
+  /// Coarse unknowns: pieces() x generators(), unknown alpha * generators() + j.
+  int size() const { return pieces_ * g_; }
+  /// The unknowns whose vectors are non-zero on an own pose or a neighbour copy, ascending:
+  /// the columns of A this agent's rows contribute to.
+  const std::vector<int>& touched() const { return touched_; }
+  /// The unknowns non-zero on an own pose, ascending.
+  const std::vector<int>& own() const { return own_; }
+
+  /// out += Phi^T v over the own poses (X: the own point, v: a vector of its shape; out has
+  /// size() entries).
+  void project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, double* out) const;
+  /// v += Phi xi on the own poses (X's shape).
+  void expand(const Eigen::MatrixXd& X, const Eigen::VectorXd& xi, Eigen::MatrixXd& v) const;
+  /// The vector of one unknown on the own poses (v) and the neighbour copies (vn), set to the
+  /// shapes of X and Xn.
+  void unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown, Eigen::MatrixXd& v,
+            Eigen::MatrixXd& vn) const;
+
+  /// A positive semi-definite inverse of the Galerkin matrix A (size() x size(), symmetric):
+  /// the global rigid motions (every piece the same generator: f does not change along them)
+  /// are projected out, then eigenvalues at or below `tol` times the largest (the gauge,
+  /// generators that move no pose, and any negative curvature, which a preconditioner must
+  /// not invert) are dropped. Deterministic: the same A gives the same bits on every agent.
+  Eigen::MatrixXd pseudo_inverse(const Eigen::MatrixXd& A, double tol = 1e-10) const;
+
+ private:
+  struct Weight {
+    int piece;
+    double w;
+  };
+  // Pose slot s's pieces: weights[start[s] .. start[s+1]).
+  struct Poses {
+    std::vector<std::size_t> start;
+    std::vector<Weight> weights;
+  };
+  static Poses weights_of(const CoarseSpace* space, const BlockLayout& layout,
+                          const std::vector<std::size_t>& ids);
+  // [Omega c] of generator j scaled by x, added to E (k x (k+1)).
+  void add_generator(int j, double x, Eigen::MatrixXd& E) const;
+  // v's slot s += E [X_s; 0 1].
+  void move(const Eigen::MatrixXd& E, const Eigen::MatrixXd& X, Eigen::Index s,
+            Eigen::MatrixXd& v) const;
+
+  int d_, k_, g_, pieces_;
+  Poses own_poses_, neighbour_poses_;
+  std::vector<int> touched_, own_;
+  std::vector<std::pair<int, int>> rotation_pairs_;  // (a, b), a < b, for generators 0..
+};
+
+}  // namespace tessera
