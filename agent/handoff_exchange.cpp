@@ -21,6 +21,12 @@ namespace {
 // filters for its recipient.
 constexpr std::size_t kItemsPerPart = 160;
 
+// Parts written before the agent waits for them to be acknowledged (~850 KB in 3D): every agent
+// hands off at once, so without a bound each writer has up to its whole history (256 parts,
+// ~13 MB) in flight; 64 agents over UDP on one host overflowed the receivers' socket buffers,
+// and the repairs of what was dropped were dropped in turn.
+constexpr std::size_t kPartsInFlight = 16;
+
 template <class T>
 std::vector<T> slice(const std::vector<T>& v, std::size_t begin, std::size_t count) {
   begin = std::min(begin, v.size());
@@ -54,6 +60,7 @@ std::vector<ReceivedHandoff> exchange_handoffs(AgentSession& s, const RobotShare
                                                const std::vector<std::uint32_t>& owner,
                                                std::uint32_t self, std::uint32_t robots,
                                                const std::string& run_id, double timeout_s) {
+  std::size_t unacknowledged = 0;
   for (std::uint32_t b = 0; b < robots; ++b) {
     if (b == self) continue;
     const HandoffPlan plan = plan_handoff(share, owner, b);
@@ -68,7 +75,15 @@ std::vector<ReceivedHandoff> exchange_handoffs(AgentSession& s, const RobotShare
           slice(plan.known_poses, at, kItemsPerPart));
       w.part(static_cast<std::uint32_t>(p));
       w.parts(static_cast<std::uint32_t>(parts));
-      s.publish(w);
+      // The hand-off's own bound, not a network step's 30 s: an agent sends thousands of parts
+      // to peers that may still be computing on a loaded host (64 agents at load 65-115: not
+      // acknowledged in 30 s); a dead peer frees the history when its lease expires.
+      s.publish(w, timeout_s);
+      if (++unacknowledged == kPartsInFlight) {
+        // Not acknowledged in time: go on; the write then waits for room as before.
+        (void)s.handoffs_acknowledged(Seconds(std::min(timeout_s, 30.0)));
+        unacknowledged = 0;
+      }
     }
   }
   std::string absent;

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <tessera/util/input_error.hpp>
 #include <utility>
 #include <vector>
 
@@ -72,6 +73,9 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
     ro.robust.inner_max_rounds = static_cast<int>(asg.gnc_inner_max_rounds());
     ro.robust.known_inliers = parse_known_inliers(asg.known_inliers());
     ro.robust.readmission_passes = static_cast<int>(asg.gnc_readmission_passes());
+    ro.robust.recheck_probes = static_cast<int>(asg.gnc_recheck_probes());
+    ro.robust.probe_ratio = asg.gnc_probe_ratio();
+    ro.robust.final_refine = asg.gnc_final_refine();
     ro.robust.validate();
     ro.gnc_known_start = asg.gnc_known_start();
   }
@@ -155,6 +159,14 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
       structure_of(asg, share.num_poses);
   DdsProtocolChannel channel(s);
   const RunOptions run_options = run_options_of(asg);
+  SetupTurnOptions turns;
+  turns.max_at_once = asg.setup_at_once();
+  turns.after_local_solve = [] { launch::release_freed_heap(); };
+  try {
+    turns.validate();
+  } catch (const InputError& e) {
+    throw RunFailure(kExitRunFailed, std::string("the assignment: ") + e.what());
+  }
   // The input's own known-inlier flags (a dpgo CSV file's), every measurement's.
   std::vector<bool> known_flags;
   if (!asg.known_inlier().empty()) {
@@ -177,7 +189,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
     if (known) {
       auto [init, known_init] = run_initialization_stages(
           share, known->share, o.id, o.robots, structure, known->structure, asg.initialization(),
-          "distributed", o.graph, channel, o.round_timeout_s, early ? &*early : nullptr);
+          "distributed", o.graph, channel, o.round_timeout_s, early ? &*early : nullptr, turns);
       share.initial = std::move(init.poses);
       share.known_initial = std::move(known_init.poses);
       init_s = init.seconds + known_init.seconds;
@@ -187,7 +199,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
     } else {
       InitializationResult init =
           run_initialization_stage(share, o.id, o.robots, structure, asg.initialization(), o.graph,
-                                   channel, o.round_timeout_s, early ? &*early : nullptr);
+                                   channel, o.round_timeout_s, early ? &*early : nullptr, turns);
       share.initial = std::move(init.poses);
       init_s = init.seconds;
       init_early = init.early;

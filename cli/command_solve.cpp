@@ -44,7 +44,7 @@ const char* kHelp =
     "  --init chordal|odometry|file   initial guess (default chordal; file = VERTEX lines)\n"
     "  --rank R                  initial relaxation rank r0 >= d (default 5)\n"
     "  --max-rank R              staircase ceiling (default 10)\n"
-    "  --grad-tol T              relative gradient-norm tolerance (default 1e-5)\n"
+    "  --grad-tol T              relative gradient-norm tolerance (default 1e-6)\n"
     "  --stop reference|gradient  reference (default): also stop where the reference solver's\n"
     "                            rule (gradient 1e-2 with preconditioned gradient 1e-4 or\n"
     "                            with a predicted decrease < 1e-6 f, or a\n"

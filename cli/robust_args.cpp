@@ -7,6 +7,7 @@ namespace tessera::cli {
 const char* const kRobustValued[] = {"robust",        "inlier-threshold", "inlier-quantile",
                                      "gnc-max-outer", "gnc-mu-step",      "gnc-inner-rounds",
                                      "known-inliers", "rejected",         "gnc-inner-iterations",
+                                     "gnc-probes",    "gnc-probe-ratio",  "gnc-final-refine",
                                      nullptr};
 
 const char* const kRobustHelp =
@@ -33,8 +34,26 @@ const char* const kRobustHelp =
     "                            one (first and weighted), 0 = no cap [5]\n"
     "  --gnc-inner-iterations K  centralized: most trust-region iterations of each solve\n"
     "                            before the re-check passes (first and weighted), 0 = no cap [0]\n"
+    "  --gnc-probes K            distributed: most probes after the re-check passes (the kept\n"
+    "                            edges far above their agent's median residual leave together;\n"
+    "                            the result stays only if the TLS cost fell), 0 = none [2]\n"
+    "  --gnc-probe-ratio R       distributed: a probe takes the kept edges with r^2 above R x\n"
+    "                            the median r^2 of the kept edges their agent weighs, > 1 [5]\n"
+    "  --gnc-final-refine newton|none   distributed: the final solve of the kept set ends with\n"
+    "                            Newton refinement to --refine-grad-tol (runs without\n"
+    "                            --certify too) [newton]\n"
     "  --known-inliers odometry|none   never reject edges between consecutive ids [odometry]\n"
     "  --rejected FILE           write the rejected edge indices (from 0 over the EDGE lines)\n";
+
+const char* final_refine_name(const RobustOptions& options) {
+  return options.final_refine ? "newton" : "none";
+}
+
+bool parse_final_refine(const std::string& name) {
+  if (name == "newton") return true;
+  if (name == "none") return false;
+  throw InputError("option --gnc-final-refine: '" + name + "' is not one of newton, none");
+}
 
 RobustOptions parse_robust_options(const Arguments& args) {
   RobustOptions o;
@@ -46,6 +65,9 @@ RobustOptions parse_robust_options(const Arguments& args) {
   o.inner_max_rounds = static_cast<int>(args.get_long("gnc-inner-rounds", o.inner_max_rounds));
   o.inner_max_iterations =
       static_cast<int>(args.get_long("gnc-inner-iterations", o.inner_max_iterations));
+  o.recheck_probes = static_cast<int>(args.get_long("gnc-probes", o.recheck_probes));
+  o.probe_ratio = args.get_double("gnc-probe-ratio", o.probe_ratio);
+  o.final_refine = parse_final_refine(args.get_or("gnc-final-refine", final_refine_name(o)));
   o.known_inliers =
       parse_known_inliers(args.get_or("known-inliers", known_inliers_name(o.known_inliers)));
   try {
@@ -60,7 +82,9 @@ RobustOptions parse_robust_options(const Arguments& args) {
                        : what.find("inner_max_rounds") != std::string::npos ? "--gnc-inner-rounds"
                        : what.find("inner_max_iterations") != std::string::npos
                            ? "--gnc-inner-iterations"
-                           : "--robust";
+                       : what.find("recheck_probes") != std::string::npos ? "--gnc-probes"
+                       : what.find("probe_ratio") != std::string::npos    ? "--gnc-probe-ratio"
+                                                                          : "--robust";
     throw InputError("option " + std::string(flag) + ": " + what);
   }
   if (o.kind == RobustKind::kNone && args.has("rejected"))
@@ -79,7 +103,10 @@ void add_robust_fields(JsonObject& json, const RobustSummary& s) {
       .add("known_inliers", known_inliers_name(s.options.known_inliers))
       .add("gnc_mu_step", s.options.mu_step)
       .add("weights_converged", s.weights_converged)
-      .add("readmitted", s.readmitted);
+      .add("readmitted", s.readmitted)
+      .add("probes", s.probes)
+      .add("probes_kept", s.probes_kept)
+      .add("gnc_final_refine", final_refine_name(s.options));
   if (s.total_cg_iterations >= 0) json.add("total_cg_iterations", s.total_cg_iterations);
 }
 

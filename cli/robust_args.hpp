@@ -17,6 +17,11 @@ extern const char* const kRobustValued[];
 /// Help text of those options.
 extern const char* const kRobustHelp;
 
+/// RobustOptions::final_refine as `--gnc-final-refine` spells it: "newton" or "none".
+const char* final_refine_name(const RobustOptions& options);
+/// "newton" -> true, "none" -> false; InputError naming the flag otherwise.
+bool parse_final_refine(const std::string& name);
+
 /// The options as given (defaults for absent ones), validated: InputError names the option.
 RobustOptions parse_robust_options(const Arguments& args);
 
@@ -32,11 +37,15 @@ struct RobustSummary {
   double threshold_squared = 0;
   bool weights_converged = false;
   std::size_t readmitted = 0;  ///< Rejected by GNC, taken back at the inlier set's solution.
+  /// Probes after the re-check passes (distributed; RobustOptions::recheck_probes) and those
+  /// that lowered the TLS cost and stayed. The centralized solve runs none.
+  int probes = 0;
+  int probes_kept = 0;
 };
 
 /// Appends robust, outer_iterations, total_iterations, inliers, outliers, rejected,
-/// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged, readmitted (and
-/// total_cg_iterations when set).
+/// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged, readmitted,
+/// probes, probes_kept, gnc_final_refine (and total_cg_iterations when set).
 void add_robust_fields(JsonObject& json, const RobustSummary& summary);
 
 /// Writes one rejected index per line to `path` (InputError when it cannot).

@@ -77,7 +77,11 @@ std::string session_options_help(SessionArgsFor who) {
   if (who == SessionArgsFor::kProcess)
     h += "  --timeout S        bound on each wait for peers during set-up, in seconds (default 30)\n";
   h += "  --lease S          participant/liveliness lease in seconds: a dead peer is noticed after\n"
-       "                     about this long (default 1, range 0.2..60)\n"
+       "                     about this long (default 1, range 0.2..60)\n";
+  if (who == SessionArgsFor::kLaunch)
+    h += "                     (launch, more than 32 agents: default 30; a loaded host may not\n"
+         "                     schedule a process for seconds)\n";
+  h +=
        "  --peers IP[,IP]    IPv4 addresses to contact by unicast (when multicast is not available)\n"
        "  --network NAME     transport profile: default, or lossy for links that drop packets\n"
        "                     (1400-byte datagrams, 4 MB socket buffers, 10 ms heartbeat)\n";
@@ -89,7 +93,8 @@ std::string session_options_help(SessionArgsFor who) {
     h += "  --transport T      DDS transports of every process: default (shared memory + UDPv4),\n"
          "                     shm (shared memory only) or udp (UDPv4 only). Default here: shm,\n"
          "                     unless --peers, --network lossy, --security or --on-agent-loss\n"
-         "                     continue (then default)\n";
+         "                     continue (then default); udp above 32 agents (Fast DDS's shared-\n"
+         "                     memory port locks time out with that many on a loaded host)\n";
   h +=
        "  --security DIR     DDS Security: authentication, access control and encryption with\n"
        "                     the CA, the signed governance and this process's identity in DIR\n"

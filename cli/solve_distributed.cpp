@@ -453,7 +453,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     } else {
       j.add_null("min_eigenvalue").add_null("certificate_rounds");
     }
-    if (opt.refine.enabled) {
+    // --refine newton, or the robust final solve's refinement (--gnc-final-refine).
+    if (opt.refine.enabled || !r.refines.empty()) {
       int steps = 0, cg = 0, exchanges = 0, reductions = 0;
       for (const NewtonRefineResult& n : r.refines) {
         steps += n.steps;
@@ -477,6 +478,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       rs.threshold_squared = gnc.threshold_squared;
       rs.weights_converged = gnc.weights_converged;
       rs.readmitted = gnc.readmitted;
+      rs.probes = gnc.probes;
+      rs.probes_kept = gnc.probes_kept;
       add_robust_fields(j, rs);
       j.add("total_rounds", gnc.total_rounds)
           .add("total_bytes", static_cast<long long>(gnc.total_bytes));

@@ -232,7 +232,10 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("stop_reason", u.stop_reason)
           .add("newton_steps", u.newton_steps)
           .add("newton_cg_iterations", u.newton_cg_iterations)
-          .add("newton_message_steps", u.newton_message_steps);
+          .add("newton_message_steps", u.newton_message_steps)
+          .add("relaxation_cost", u.relaxation_cost)
+          .add("merges", u.merges)
+          .add("merge_poses_moved", u.merge_poses_moved);
       updates.push_back(std::move(j));
     }
     for (const auto& c : marks) {
@@ -252,7 +255,10 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("poses", c.poses)
           .add("certified", c.certified)
           .add("min_eigenvalue", c.min_eigenvalue)
-          .add("cpu_s", c.cpu_s);
+          .add("cpu_s", c.cpu_s)
+          .add("escaped", c.escaped)
+          .add("cost_before", c.cost_before)
+          .add("cost_after", c.cost_after);
       certs.push_back(std::move(o));
     }
     JsonObject j;

@@ -38,6 +38,7 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   asg.refine(options.refine);
   asg.refine_grad_tol(options.refine_grad_tol);
   asg.refine_rel_tol(options.refine_rel_tol);
+  asg.setup_at_once(options.setup_at_once);
   if (options.robust.kind != RobustKind::kNone) {
     const RobustOptions& r = options.robust;
     asg.robust(robust_kind_name(r.kind));
@@ -49,6 +50,9 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
     asg.known_inliers(known_inliers_name(r.known_inliers));
     asg.gnc_known_start(options.gnc_known_start);
     asg.gnc_readmission_passes(static_cast<std::uint32_t>(r.readmission_passes));
+    asg.gnc_recheck_probes(static_cast<std::uint32_t>(r.recheck_probes));
+    asg.gnc_probe_ratio(r.probe_ratio);
+    asg.gnc_final_refine(r.final_refine);
     asg.known_inlier(structure.known_inlier);
   }
   return asg;

@@ -7,6 +7,7 @@
 
 #include "arguments.hpp"
 #include "robust_args.hpp"
+#include "runtime/setup_turns.hpp"
 
 namespace tessera::coordinator {
 
@@ -75,12 +76,16 @@ options:
   --refine-grad-tol T, --refine-rel-tol F
                        its stops: ||grad f|| <= T, or a step lowered f by < F f (0 = the
                        defaults, 1e-6 and 1e-7)
+  --setup-at-once K    at most K agents run the distributed initialisation's local chordal
+                       solve at once (agent a after agent a - K): those factorizations are
+                       the set-up's memory peak; 0 = all at once (default 8)
   --robust none|gnc-tls  gnc-tls: reject outlier measurements by graduated non-convexity
                        with a truncated least-squares cost, then solve (and with --certify
                        certify) the kept ones; every agent weighs the measurements of its
                        lower pose ids (docs/robust.md) (default none)
   --inlier-threshold C, --inlier-quantile P, --gnc-max-outer K, --gnc-mu-step S,
-  --gnc-inner-rounds K, --known-inliers odometry|none
+  --gnc-inner-rounds K, --known-inliers odometry|none, --gnc-probes K,
+  --gnc-probe-ratio R, --gnc-final-refine newton|none
                        the GNC options, as for `tessera solve` (docs/robust.md)
   --rejected FILE      write the rejected measurement indices (from 0 over the EDGE lines)
   --gnc-solver-start   GNC starts from --init's poses, not from the known inliers'
@@ -124,7 +129,8 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "coarse-smoothing",
                                                             "refine",
                                                             "refine-grad-tol",
-                                                            "refine-rel-tol"},
+                                                            "refine-rel-tol",
+                                                            "setup-at-once"},
                                                            cli::SessionArgsFor::kProcess);
   valued.insert("graph");
   for (const char* const* r = cli::kRobustValued; *r; ++r) valued.insert(*r);
@@ -203,6 +209,10 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   a.refine_rel_tol = args.get_double("refine-rel-tol", 0);
   if (!(a.refine_grad_tol >= 0)) throw InputError("option --refine-grad-tol: must be >= 0");
   if (!(a.refine_rel_tol >= 0)) throw InputError("option --refine-rel-tol: must be >= 0");
+  a.setup_at_once = static_cast<std::uint32_t>(nonneg("setup-at-once", a.setup_at_once));
+  if (a.setup_at_once > agent::SetupTurnOptions::kMaxSetupAtOnce)
+    throw InputError("option --setup-at-once: must be 0.." +
+                     std::to_string(agent::SetupTurnOptions::kMaxSetupAtOnce));
   a.verbose = args.has("verbose");
   a.certify = args.has("certify");
   if (args.has("status-relay") && args.has("no-status-relay"))

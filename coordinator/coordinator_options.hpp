@@ -53,6 +53,10 @@ struct CoordinatorOptions {
   std::string refine = "none";
   double refine_grad_tol = 0;
   double refine_rel_tol = 0;
+  /// At most this many agents in the distributed initialisation's local solve at once
+  /// (--setup-at-once; core/runtime/setup_turns.hpp): their factorizations are the set-up's
+  /// memory peak, and on a few cores they share the CPU anyway. 0 = all at once.
+  std::uint32_t setup_at_once = 8;
   /// Robust solve (--robust, --inlier-threshold, --inlier-quantile, --gnc-max-outer,
   /// --gnc-mu-step, --gnc-inner-rounds, --known-inliers; docs/robust.md).
   RobustOptions robust;

@@ -48,6 +48,7 @@ struct RobustReport {
   std::size_t readmitted = 0;
   double threshold_squared = 0;
   bool weights_converged = false;
+  int probes = 0, probes_kept = 0;    ///< RobustOptions::recheck_probes: run, and kept.
   std::vector<std::size_t> rejected;  ///< Measurement indices in file order, ascending.
 };
 

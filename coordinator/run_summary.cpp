@@ -128,6 +128,8 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     rs.threshold_squared = r.robust->threshold_squared;
     rs.weights_converged = r.robust->weights_converged;
     rs.readmitted = r.robust->readmitted;
+    rs.probes = r.robust->probes;
+    rs.probes_kept = r.robust->probes_kept;
     cli::add_robust_fields(j, rs);
     j.add("total_rounds", static_cast<long long>(in.merged.rounds));
   } else {

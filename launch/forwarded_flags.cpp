@@ -77,6 +77,9 @@ void whole_number_in(const std::string& v, const char* flag, long lo, long hi) {
     throw InputError(std::string("option --") + flag + ": '" + v + "' is not a whole number in " +
                      std::to_string(lo) + ".." + std::to_string(hi));
 }
+void check_setup_at_once(const std::string& v) {
+  whole_number_in(v, "setup-at-once", 0, 1000);
+}
 void check_coarse_every(const std::string& v) {
   whole_number_in(v, "coarse-every", 0, 1000000);
 }
@@ -159,6 +162,18 @@ void check_gnc_inner_rounds(const std::string& v) {
     o.inner_max_rounds = x == static_cast<int>(x) ? static_cast<int>(x) : -1;
   });
 }
+void check_gnc_probes(const std::string& v) {
+  check_robust_field(v, "gnc-probes", [](RobustOptions& o, double x) {
+    o.recheck_probes = x == static_cast<int>(x) ? static_cast<int>(x) : -1;
+  });
+}
+void check_gnc_probe_ratio(const std::string& v) {
+  check_robust_field(v, "gnc-probe-ratio", [](RobustOptions& o, double x) { o.probe_ratio = x; });
+}
+void check_gnc_final_refine(const std::string& v) {
+  if (v != "newton" && v != "none")
+    throw InputError("option --gnc-final-refine: '" + v + "' is not one of newton, none");
+}
 
 }  // namespace
 
@@ -211,6 +226,17 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "most rounds of each solve before the final one, 0 = no\n"
        "cap                                                  [5]",
        check_gnc_inner_rounds},
+      {"gnc-probes", "gnc-probes", true, ForwardTo::kCoordinator, "--gnc-probes K",
+       "most probes after the re-check passes, 0 = none      [2]", check_gnc_probes},
+      {"gnc-probe-ratio", "gnc-probe-ratio", true, ForwardTo::kCoordinator, "--gnc-probe-ratio R",
+       "a probe takes the kept edges with r^2 above R x their\n"
+       "agent's median r^2, > 1                              [5]",
+       check_gnc_probe_ratio},
+      {"gnc-final-refine", "gnc-final-refine", true, ForwardTo::kCoordinator,
+       "--gnc-final-refine newton|none",
+       "the final solve of the kept set ends with Newton\n"
+       "refinement to --refine-grad-tol                 [newton]",
+       check_gnc_final_refine},
       {"known-inliers", "known-inliers", true, ForwardTo::kCoordinator,
        "--known-inliers odometry|none", "never reject edges between consecutive ids [odometry]",
        check_known_inliers},
@@ -238,6 +264,11 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "the refinement stops at ||grad f|| <= T       [1e-6]", check_refine_grad_tol},
       {"refine-rel-tol", "refine-rel-tol", true, ForwardTo::kCoordinator, "--refine-rel-tol F",
        "or after a step that lowered f by < F f           [1e-7]", check_refine_rel_tol},
+      {"setup-at-once", "setup-at-once", true, ForwardTo::kCoordinator, "--setup-at-once K",
+       "at most K agents in the distributed initialisation's\n"
+       "local chordal solve at once (the set-up's memory peak);\n"
+       "0 = all at once                                      [8]",
+       check_setup_at_once},
       {"rejected", "rejected", true, ForwardTo::kCoordinator, "--rejected FILE",
        "write the rejected edge indices (from 0 over the EDGE\n"
        "lines), one a line",

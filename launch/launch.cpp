@@ -75,7 +75,9 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 LaunchResult launch(LaunchOptions o) {
   o.validate();
-  if (o.choose_transport) o.net.session.transport = launch_transport(o.net.session, o.loss);
+  const auto team = static_cast<std::uint32_t>(o.agents);
+  if (o.choose_transport) o.net.session.transport = launch_transport(o.net.session, o.loss, team);
+  o.net.session.lease_s = launch_lease_s(o.net.session.lease_s, !o.choose_lease, team);
   const std::string bin = o.bin_dir.empty() ? running_program_dir() : o.bin_dir;
   for (const char* exe : {"tessera-agent", "tessera-coordinator"})
     if (access((bin + "/" + exe).c_str(), X_OK) != 0)

@@ -148,6 +148,7 @@ LaunchOptions parse_launch_options(const std::vector<std::string>& argv) {
   o.net = cli::parse_session_args(args, cli::SessionArgsFor::kLaunch);
   o.loss = parse_launch_loss_options(args);
   o.choose_transport = !args.has("transport");
+  o.choose_lease = !args.has("lease");
   if (!args.has("run-id")) o.net.session.run_id.clear();  // launch() makes a fresh one
   for (const ForwardedFlag& f : forwarded_flags())
     if (args.has(f.name)) o.forwarded.emplace_back(f.name, f.valued ? *args.get(f.name) : "");

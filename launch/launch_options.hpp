@@ -50,6 +50,8 @@ struct LaunchOptions {
   cli::SessionArgs net;
   /// launch picks the transport (launch_transport.hpp) unless --transport was given.
   bool choose_transport = true;
+  /// --lease was not given: launch chooses it for the team's size (launch_lease_s).
+  bool choose_lease = true;
   /// Flags passed on as they are (forwarded_flags.hpp): (name without "--", value; "" for a
   /// switch), in any order.
   std::vector<std::pair<std::string, std::string>> forwarded;

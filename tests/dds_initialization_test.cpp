@@ -5,7 +5,7 @@
 //  - Over DDS (processes): a graph without VERTEX lines, `--init distributed` and the default
 //    (chordal), gives the in-process engine's rounds and cost; the coordinator's `highest`
 //    partition is the one `tessera solve` computes from the file.
-// Domains used here: 201-203 (each test its own, so ctest -j is safe).
+// Domains used here: 201-203 and 177 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -272,13 +272,15 @@ std::string graph_without_vertices(const std::string& dir, const std::string& ki
   return path;
 }
 
-void expect_same_as_solve(const std::string& init, int domain) {
+void expect_same_as_solve(const std::string& init, int domain,
+                          const std::vector<std::string>& extra = {}) {
   const std::string dir = temp_dir();
   const int N = 3;
   const std::string graph = graph_without_vertices(dir, "grid3d", 250, N);
   std::vector<std::string> args = {"--partition", "highest",          "--seed",
                                    "3",           "--partition-seed", "3"};
   if (!init.empty()) args.insert(args.end(), {"--init", init});
+  args.insert(args.end(), extra.begin(), extra.end());
   const std::string summary = run_dds(dir, graph, N, domain, args);
   const PoseGraph g = read_g2o(graph);
   ASSERT_FALSE(g.has_initial());
@@ -312,6 +314,12 @@ TEST(DdsInitialization, DistributedOverDdsGivesTheInProcessIterates) {
 
 TEST(DdsInitialization, DefaultOverDdsIsSolvesDefaultWithTheSameIterates) {
   expect_same_as_solve("", 202);
+}
+
+// The local solves one agent at a time (core/runtime/setup_turns.hpp), through the coordinator's
+// assignment: the same initial poses, so the same iterates.
+TEST(DdsInitialization, DistributedInTurnsOfOneGivesTheInProcessIterates) {
+  expect_same_as_solve("distributed", 177, {"--setup-at-once", "1"});
 }
 
 }  // namespace

@@ -13,11 +13,13 @@
 #include <string>
 #include <tessera/io/dpgo_csv_reader.hpp>
 #include <tessera/io/g2o_reader.hpp>
+#include <tessera/io/g2o_writer.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <vector>
 
 #include "dds_process_support.hpp"
+#include "gnc_fixtures.hpp"
 
 namespace tessera::test::dds {
 namespace {
@@ -176,6 +178,36 @@ TEST(DdsRobust, WithoutKnownInliersTheRunStillEqualsTheInProcessEngine) {
   EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
   EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
   EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+}
+
+// The probes over DDS: on a soft map with group outliers a probe runs and stays (the in-process
+// engine's GncDistributed.AProbeThatLowersTheTlsCostStaysAndFindsMoreOutliers), and the agents
+// take the same steps as in process: the same probes, rounds, rejected set and cost.
+TEST(DdsRobust, AProbeOverDdsEqualsTheInProcessEngine) {
+  const std::string dir = temp_dir();
+  const GeneratorResult city = flexible_city(0.1, OutlierKind::kGroup, 3);
+  const std::string graph = dir + "/graph.g2o";
+  write_g2o(city.graph, graph);
+  const std::string run = "robust-probe-" + std::to_string(getpid());
+  run_to_the_end(
+      dir, graph, 3, run, 137,
+      {"--timeout", "20", "--run-timeout", "120", "--summary", dir + "/summary.json", "--partition",
+       "sequential", "--seed", "7", "--certify", "--robust", "gnc-tls", "--gnc-probes", "1"},
+      120);
+  const std::string summary = slurp(dir + "/summary.json");
+  const PoseGraph g = read_g2o(graph);
+  const std::vector<int> assignment = assignment_of(dir, 3);
+  GncDistributedOptions o = in_process_options();
+  o.robust.recheck_probes = 1;
+  const GncDistributedResult ref = solve_gnc_distributed(g, assignment, o);
+  ASSERT_EQ(ref.probes, 1);
+  EXPECT_EQ(ref.probes_kept, 1);
+  EXPECT_EQ(json_field(summary, "probes"), ref.probes) << summary;
+  EXPECT_EQ(json_field(summary, "probes_kept"), ref.probes_kept) << summary;
+  EXPECT_EQ(json_field(summary, "rounds"), ref.total_rounds) << summary;
+  EXPECT_EQ(json_array(summary, "rejected"), ref.rejected) << summary;
+  EXPECT_NEAR(json_field(summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  EXPECT_NE(summary.find("\"certified\": true"), std::string::npos) << summary;
 }
 
 // `tessera launch` end to end: the robust fields in the summary, and an input whose every

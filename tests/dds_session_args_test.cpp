@@ -129,6 +129,19 @@ TEST(DdsSessionArgs, LaunchUsesSharedMemoryOnlyWhenEveryPeerIsOnThisHost) {
   EXPECT_EQ(launch_transport(transport::SessionOptions{}, carry_on), "default");
 }
 
+TEST(DdsSessionArgs, LaunchGivesALargeTeamUdpAndALongerLeaseUnlessTold) {
+  const LaunchLossOptions stop;
+  const transport::SessionOptions here = parse({}, SessionArgsFor::kLaunch).session;
+  EXPECT_EQ(launch_transport(here, stop, kMaxSharedMemoryAgents), "shm");
+  EXPECT_EQ(launch_transport(here, stop, kMaxSharedMemoryAgents + 1), "udp");
+  EXPECT_EQ(
+      launch_transport(parse({"--peers", "10.0.0.1"}, SessionArgsFor::kLaunch).session, stop, 64),
+      "default");
+  EXPECT_EQ(launch_lease_s(1.0, false, kMaxSharedMemoryAgents), 1.0);
+  EXPECT_EQ(launch_lease_s(1.0, false, 64), kLargeTeamLeaseS);
+  EXPECT_EQ(launch_lease_s(2.5, true, 64), 2.5) << "an explicit --lease is kept";
+}
+
 TEST(DdsSessionArgs, LaunchKeepsItsOwnTimeout) {
   // `tessera launch --timeout` is the whole run's limit, not the processes' set-up bound.
   EXPECT_TRUE(session_option_names(SessionArgsFor::kProcess).count("timeout"));

@@ -2,12 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <string>
 #include <tessera/distributed/in_process_driver.hpp>
 #include <tessera/generate/generator.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
+#include <tessera/robust/weighted_graph.hpp>
 #include <vector>
 
 #include "gnc_fixtures.hpp"
@@ -15,6 +17,7 @@
 namespace tessera {
 namespace {
 
+using test::flexible_city;
 using test::grid_with_outliers;
 using test::irbcd_gnc;
 using test::robots_as_blocks;
@@ -121,9 +124,10 @@ TEST(GncDistributed, CleanGraphLosesNothing) {
 // A probe (RobustOptions::recheck_probes) cuts the kept measurements far above their agent's
 // median residual at once, runs the passes again and keeps the result only if the TLS cost fell.
 // With the file's noise matching its information nothing is far enough above the median to be
-// probed at the default ratio; with a ratio of 1.5 half the true closures are probed, the passes
-// take them back, the TLS cost does not fall, and the set and iterate from before come back:
-// the same outliers, the clean optimum, certified, whatever the delivery order.
+// probed at the default ratio (nor is the residuals' mean far enough above their median:
+// probe_tail_ratio); with a ratio of 1.5 and no tail rule half the true closures are probed,
+// the passes take them back, the TLS cost does not fall, and the set and iterate from before
+// come back: the same outliers, the clean optimum, certified, whatever the delivery order.
 TEST(GncDistributed, AProbeThatDoesNotLowerTheTlsCostIsUndone) {
   const GeneratorResult clean = grid_with_outliers(0.0);
   const GeneratorResult dirty = grid_with_outliers(0.25);
@@ -134,6 +138,9 @@ TEST(GncDistributed, AProbeThatDoesNotLowerTheTlsCostIsUndone) {
   EXPECT_EQ(plain.rejected, dirty.outliers);
 
   o.robust.probe_ratio = 1.5;
+  o.robust.probe_tail_ratio = 1.5;  // the default: these residuals have no heavy tail
+  EXPECT_EQ(solve_gnc_distributed(dirty.graph, robots_as_blocks(dirty), o).probes, 0);
+  o.robust.probe_tail_ratio = 0;
   const GncDistributedResult probed =
       solve_gnc_distributed(dirty.graph, robots_as_blocks(dirty), o);
   EXPECT_EQ(probed.probes, 1);
@@ -151,6 +158,76 @@ TEST(GncDistributed, AProbeThatDoesNotLowerTheTlsCostIsUndone) {
   EXPECT_EQ(shuffled.rejected, probed.rejected);
   EXPECT_EQ(shuffled.total_rounds, probed.total_rounds);
   EXPECT_EQ(shuffled.final_solve.cost, probed.final_solve.cost);
+}
+
+// The case probes exist for: on a map whose information states more noise than its data has,
+// GNC's iterate bends until several wrong closures of a group fit within the bound, and the
+// re-check passes, which judge one closure at a time, keep them. The probe cuts every kept
+// closure far above its agent's median residual at once, the passes put back what fits, and
+// the result stays because the TLS cost fell: more wrong closures found.
+TEST(GncDistributed, AProbeThatLowersTheTlsCostStaysAndFindsMoreOutliers) {
+  const GeneratorResult g = flexible_city(0.1, OutlierKind::kGroup, 3);
+  const std::vector<int> blocks = robots_as_blocks(g);
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.certify = true;
+  o.robust.recheck_probes = 0;
+  const GncDistributedResult without = solve_gnc_distributed(g.graph, blocks, o);
+  o.robust.recheck_probes = 2;
+  const GncDistributedResult with = solve_gnc_distributed(g.graph, blocks, o);
+  EXPECT_EQ(without.probes, 0);
+  EXPECT_EQ(with.probes, 1);
+  EXPECT_EQ(with.probes_kept, 1);
+  EXPECT_NE(with.rejected, without.rejected);
+
+  auto found = [&](const GncDistributedResult& r) {
+    std::size_t hit = 0;
+    for (std::size_t e : r.rejected)
+      hit += std::binary_search(g.outliers.begin(), g.outliers.end(), e) ? 1 : 0;
+    return hit;
+  };
+  EXPECT_GT(found(with), found(without) + 3) << found(with) << " vs " << found(without);
+  // The passes end with every kept measurement within the bound, so the TLS cost is the kept
+  // cost plus c^2 per rejected measurement.
+  auto tls = [](const GncDistributedResult& r) {
+    return r.final_solve.cost + r.threshold_squared * static_cast<double>(r.rejected.size());
+  };
+  EXPECT_LT(tls(with), tls(without));
+  EXPECT_TRUE(with.final_solve.certified.value_or(false));
+}
+
+// The final solve of the kept set ends with the Newton refinement (RobustOptions::final_refine):
+// the rounds stop at the solver's gradient tolerance, the refinement goes on to the kept set's
+// optimum. Without certification the final solve still runs for it; switched off, the last
+// inlier pass is the answer and nothing is refined.
+TEST(GncDistributed, TheFinalSolveIsRefinedToTheOptimumOfTheKeptSet) {
+  const GeneratorResult dirty = flexible_city(0.25, OutlierKind::kRandom, 1);
+  const std::vector<int> blocks = robots_as_blocks(dirty);
+  GncDistributedOptions o;  // the solver's defaults: the rounds stop at ||grad f|| <= 0.01
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.certify = true;
+  const GncDistributedResult refined = solve_gnc_distributed(dirty.graph, blocks, o);
+  ASSERT_EQ(refined.rejected, dirty.outliers);
+  const double fstar = solve_centralized(inlier_graph(dirty.graph, refined.rejected, {})).cost;
+  ASSERT_FALSE(refined.final_solve.refines.empty());
+  EXPECT_LT(refined.final_solve.refines.back().grad_norm,
+            refined.final_solve.refines.front().initial_grad_norm);
+  EXPECT_NEAR(refined.final_solve.cost, fstar, 1e-9 * fstar);
+  EXPECT_TRUE(refined.final_solve.certified.value_or(false));
+
+  o.robust.final_refine = false;
+  const GncDistributedResult rounds_only = solve_gnc_distributed(dirty.graph, blocks, o);
+  EXPECT_EQ(rounds_only.rejected, refined.rejected);
+  EXPECT_TRUE(rounds_only.final_solve.refines.empty());
+  EXPECT_GT(rounds_only.final_solve.cost - fstar, 1e-8 * fstar);  // the gradient stop's gap
+
+  o.robust.final_refine = true;
+  o.solver.certify = false;
+  const GncDistributedResult uncertified = solve_gnc_distributed(dirty.graph, blocks, o);
+  EXPECT_EQ(uncertified.rejected, refined.rejected);
+  EXPECT_FALSE(uncertified.final_solve.certified.has_value());
+  ASSERT_FALSE(uncertified.final_solve.refines.empty());
+  EXPECT_NEAR(uncertified.final_solve.cost, fstar, 1e-9 * fstar);
 }
 
 TEST(GncDistributed, BadProbeOptionsNameTheField) {

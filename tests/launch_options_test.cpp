@@ -91,7 +91,8 @@ TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
   // A valid value of each flag: "1" unless that is out of the flag's range.
   const std::map<std::string, std::string> value = {
       {"robust", "gnc-tls"},      {"known-inliers", "odometry"}, {"gnc-mu-step", "1.4"},
-      {"inlier-quantile", "0.5"}, {"refine", "newton"},          {"coarse-space", "smoothed"}};
+      {"inlier-quantile", "0.5"}, {"refine", "newton"},          {"coarse-space", "smoothed"},
+      {"gnc-probe-ratio", "5"},   {"gnc-final-refine", "none"}};
   for (const ForwardedFlag& f : forwarded_flags()) {
     EXPECT_NE(help.find(std::string("--") + f.name), std::string::npos) << f.name;
     Argv argv = {std::string("--") + f.name};
@@ -124,6 +125,24 @@ TEST(LaunchOptions, CoarseSpaceFlagsReachTheCoordinatorOnly) {
   EXPECT_NE(error_of({"--coarse-smoothing", "9"}).find("--coarse-smoothing"), std::string::npos);
   EXPECT_NE(error_of({"--coarse-aggregates", "0"}).find("--coarse-aggregates"), std::string::npos);
   EXPECT_NE(error_of({"--coarse-every", "x"}).find("--coarse-every"), std::string::npos);
+}
+
+TEST(LaunchOptions, ProbeAndFinalRefineFlagsReachTheCoordinatorAndNameBadValues) {
+  LaunchOptions o = parse_launch_options({"--robust", "gnc-tls", "--gnc-probes", "3",
+                                          "--gnc-probe-ratio", "8", "--gnc-final-refine", "none"});
+  o.graph = "/data/graph.g2o";
+  const Argv coordinator = coordinator_argv(o, paths());
+  EXPECT_TRUE(has_pair(coordinator, "--gnc-probes", "3"));
+  EXPECT_TRUE(has_pair(coordinator, "--gnc-probe-ratio", "8"));
+  EXPECT_TRUE(has_pair(coordinator, "--gnc-final-refine", "none"));
+  const std::string ratio = error_of({"--gnc-probe-ratio", "1"});
+  EXPECT_NE(ratio.find("--gnc-probe-ratio"), std::string::npos) << ratio;
+  EXPECT_NE(ratio.find("probe_ratio"), std::string::npos) << ratio;
+  const std::string probes = error_of({"--gnc-probes", "-1"});
+  EXPECT_NE(probes.find("--gnc-probes"), std::string::npos) << probes;
+  EXPECT_NE(probes.find("recheck_probes"), std::string::npos) << probes;
+  EXPECT_NE(error_of({"--gnc-final-refine", "lbfgs"}).find("--gnc-final-refine"),
+            std::string::npos);
 }
 
 TEST(LaunchOptions, TuningFlagsSitUnderTheAdvancedHeading) {

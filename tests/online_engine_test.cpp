@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -216,16 +217,123 @@ TEST(OnlineEngine, CertifiesWhileTheGraphGrowsWhenAsked) {
   OnlineOptions o = online_options();
   o.certify_every_s = 1.0;
   const OnlineResult res = run_online(gen.graph.d, plan.batches, o);
-  // 3 s of stream, but no certificate before the robots met (no common frame).
+  // 3 s of stream: a certificate every second, robots that have not met yet included.
   ASSERT_FALSE(res.certificates.empty());
   double last = -1.0;
   for (const auto& c : res.certificates) {
     EXPECT_TRUE(c.certified) << "at " << c.time_s << " s, " << c.poses << " poses";
+    // A certified iterate is kept as it is: no escape, the cost where the step left it.
+    EXPECT_FALSE(c.escaped);
+    EXPECT_NEAR(c.cost_after, c.cost_before, 1e-9 * c.cost_before);
     EXPECT_GE(c.time_s, last + 1.0);
     last = c.time_s;
   }
   const double f_star = batch_optimum(gen.graph);
   EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
+}
+
+TEST(OnlineEngine, RobotsWhoseGuessesSitInUnrelatedFramesAreAlignedWhereTheyMeet) {
+  auto gen = small_graph(TrajectoryKind::kGrid3d, 150, 3);
+  // Each robot's front end guesses in a frame of its own (a long drift, or no common start):
+  // a rotation of 2-3 rad and a shift per robot.
+  ASSERT_TRUE(gen.graph.has_initial());
+  for (std::size_t k = 0; k < gen.graph.num_poses; ++k) {
+    const double r = static_cast<double>(gen.robot_of[k]);
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(2.0 + 0.4 * r, Eigen::Vector3d(1.0, r, 2.0 - r).normalized())
+            .toRotationMatrix();
+    Pose& p = gen.graph.initial[k];
+    p.R = turn * p.R;
+    p.t = turn * p.t + Eigen::Vector3d(40.0 * r, -25.0 * r, 10.0);
+  }
+  ReplayOptions ro;
+  ro.rate = 10;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  OnlineOptions o = online_options();
+  o.align_merged_pieces = true;
+  const OnlineResult res = run_online(gen.graph.d, plan.batches, o);
+  std::size_t merges = 0, moved = 0;
+  for (const auto& u : res.updates) {
+    merges += u.merges;
+    moved += u.merge_poses_moved;
+  }
+  // Three robots' pieces meet twice at least (robot pieces, and pieces a robot's own closures
+  // join); the moved pieces are the smaller ones.
+  EXPECT_GE(merges, 2u);
+  EXPECT_GT(moved, 0u);
+  EXPECT_LT(moved, merges * gen.graph.num_poses / 2);
+  const double f_star = batch_optimum(gen.graph);
+  EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
+  ASSERT_TRUE(res.certified.has_value());
+  EXPECT_TRUE(*res.certified);
+}
+
+// A ring of n poses (2D, noise-free: f* = 0) whose poses all arrive first, from guesses wound
+// twice around it, and whose measurements all arrive a second later: the local search starts
+// from a configuration that the rank-2 problem cannot unwind (every relative turn stays far from
+// pi), so inside the iterate's 2-dimensional subspace it stops at a critical point far from
+// the optimum; in the rank-5 problem that point is a saddle.
+std::vector<StreamBatch> twice_wound_ring(std::size_t n) {
+  const double pi = std::acos(-1.0), alpha = 2.0 * pi / static_cast<double>(n);
+  auto rot = [](double a) {
+    Eigen::Matrix2d R;
+    R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+    return R;
+  };
+  auto pose_at = [&](double angle, double radius) {
+    Pose p;
+    p.R = rot(angle + pi / 2);
+    p.t = radius * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    return p;
+  };
+  StreamBatch poses, measurements;
+  poses.stamp = 0.0;
+  measurements.sequence = 1;
+  measurements.stamp = 1.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    StreamPose sp;
+    sp.key = {0, k};
+    sp.guess = pose_at(2.0 * alpha * static_cast<double>(k), 5.0);  // wound twice
+    poses.poses.push_back(sp);
+    const Pose a = pose_at(alpha * static_cast<double>(k), 10.0);  // the truth
+    const Pose b = pose_at(alpha * static_cast<double>(k + 1), 10.0);
+    StreamMeasurement m;
+    m.from = {0, k};
+    m.to = {0, (k + 1) % n};
+    m.kind = k + 1 < n ? MeasurementKind::kOdometry : MeasurementKind::kIntraLoop;
+    m.stamp = 1.0;
+    m.relative.R = a.R.transpose() * b.R;
+    m.relative.t = a.R.transpose() * (b.t - a.t);
+    measurements.measurements.push_back(m);
+  }
+  return {poses, measurements};
+}
+
+TEST(OnlineEngine, AStreamThatStopsAtASaddleIsLeftByACertificateWhileStreaming) {
+  const std::vector<StreamBatch> ring = twice_wound_ring(24);
+  OnlineOptions o = online_options();
+  o.certify_at_end = false;
+  // Without a certificate the run ends where the local search stopped: gradient under the
+  // tolerance, cost far above f* = 0.
+  const OnlineResult stuck = run_online(2, ring, o);
+  EXPECT_LE(stuck.grad_norm, 1e-5);
+  EXPECT_GT(stuck.cost, 1.0);
+  // A certificate after the step sees the saddle, the staircase leaves it, and the run goes on
+  // from the climb's optimum brought back to rank 5: the batch optimum.
+  o.certify_every_s = 0.5;
+  const OnlineResult res = run_online(2, ring, o);
+  ASSERT_EQ(res.certificates.size(), 1u);
+  const OnlineCertificate& c = res.certificates.front();
+  EXPECT_TRUE(c.escaped);
+  EXPECT_GT(c.cost_before, 1.0);
+  EXPECT_LT(c.cost_after, 1e-6);
+  EXPECT_LT(res.cost, 1e-6);
+  // The final certificate alone (the default) catches it too.
+  OnlineOptions at_end = online_options();
+  const OnlineResult end = run_online(2, ring, at_end);
+  ASSERT_TRUE(end.certified.has_value());
+  EXPECT_TRUE(*end.certified);
+  EXPECT_LT(end.cost, 1e-6);
 }
 
 TEST(OnlineEngine, RejectsBadOptionsNamingTheField) {

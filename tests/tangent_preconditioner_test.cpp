@@ -95,6 +95,42 @@ TEST(TangentPreconditioner, InvertsTheTangentRestrictedHessianAtItsPoint) {
   }
 }
 
+// With the first-order multipliers Lambda(X) (factorize(X, egrad)), A is the Riemannian Hessian
+// in tangent coordinates: near a minimiser (positive definite there) P inverts Proj_X(Hess f[.]),
+// in 2D and 3D; and the supernodal factorization gives the same operator as the simplicial one.
+TEST(TangentPreconditioner, WithMultipliersInvertsTheRiemannianHessianNearAMinimiser) {
+  for (int d : {2, 3}) {
+    const Block b = half_block(d, 5, d);
+    BlockProblem problem(d, b.owned, b.graph.measurements);
+    problem.set_neighbor_poses(gather(b.all, problem.neighbors(), d));
+    TangentPreconditioner precon(problem, /*relative_shift=*/0.0, 0);
+    TangentPreconditioner supernodal(problem, 0.0, 0, /*supernodal_min_flops=*/1.0);
+    EXPECT_FALSE(precon.supernodal());
+    EXPECT_TRUE(supernodal.supernodal());
+    EXPECT_GT(precon.factor_flops(), 0.0);
+    const LiftedManifold M = problem.manifold(d);
+    std::srand(3);
+    Eigen::MatrixXd X = gather(b.all, b.owned, d);
+    X = M.retract(X, 0.01 * M.tangent_project(X, Eigen::MatrixXd::Random(d, X.cols())));
+    const Eigen::MatrixXd egrad = problem.euclidean_gradient(X);
+    ASSERT_TRUE(precon.factorize(X, egrad));
+    ASSERT_TRUE(supernodal.factorize(X, egrad));
+    EXPECT_TRUE(precon.with_multipliers());
+    EXPECT_TRUE(supernodal.with_multipliers());
+    for (int trial = 0; trial < 3; ++trial) {
+      const Eigen::MatrixXd V = M.tangent_project(X, Eigen::MatrixXd::Random(d, X.cols()));
+      const Eigen::MatrixXd HV = M.tangent_project(X, problem.hessian_vector(X, egrad, V));
+      const Eigen::MatrixXd Z = precon.apply(M, X, HV);
+      EXPECT_LT((Z - V).cwiseAbs().maxCoeff(), 1e-8 * V.cwiseAbs().maxCoeff()) << "d = " << d;
+      const Eigen::MatrixXd Zs = supernodal.apply(M, X, HV);
+      EXPECT_LT((Zs - Z).cwiseAbs().maxCoeff(), 1e-8 * Z.cwiseAbs().maxCoeff()) << "d = " << d;
+    }
+    // Without the multipliers the factor is the Euclidean restriction again.
+    ASSERT_TRUE(precon.factorize(X));
+    EXPECT_FALSE(precon.with_multipliers());
+  }
+}
+
 // A factor from an earlier point (refresh interval 0) stays a symmetric positive definite map
 // of the current tangent space to itself: tCG's requirement.
 TEST(TangentPreconditioner, StaleFactorIsSymmetricPositiveDefiniteOnTheCurrentTangentSpace) {

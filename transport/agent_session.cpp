@@ -87,8 +87,9 @@ void AgentSession::set_epoch(std::uint32_t e, std::uint32_t protocol_id) {
 void AgentSession::publish(const wire::AgentAnnouncement& m) {
   parts().writer.write(kAnnounceTopic, m);
 }
-void AgentSession::publish(const wire::MeasurementHandoff& m) {
-  parts().writer.write(m.purpose() == 0 ? kAddressedHandoffTopic : kHandoffTopic, m);
+void AgentSession::publish(const wire::MeasurementHandoff& m, double write_timeout_s) {
+  parts().writer.write(m.purpose() == 0 ? kAddressedHandoffTopic : kHandoffTopic, m,
+                       write_timeout_s);
 }
 void AgentSession::publish(const wire::FinalEstimate& m) {
   parts().writer.write(kFinalTopic, m);

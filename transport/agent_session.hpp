@@ -68,7 +68,9 @@ class AgentSession final : public Session {
 
   // ---- sending (retries while the history is full; throws TransportError after write_timeout_s)
   void publish(const wire::AgentAnnouncement& m);
-  void publish(const wire::MeasurementHandoff& m);
+  /// `write_timeout_s` > 0: how long the write may wait for acknowledgements (see
+  /// SampleWriter::write); 0 = the session's write timeout.
+  void publish(const wire::MeasurementHandoff& m, double write_timeout_s = 0);
   void publish(const wire::FinalEstimate& m);
   /// A progress digest for the coordinator (run id filled in here).
   void publish(wire::AgentProgress m);

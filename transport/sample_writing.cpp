@@ -16,14 +16,15 @@ SampleWriter::SampleWriter(const DdsEntities& entities, const SessionOptions& op
                            bool coordinator, const DdsTrace& trace)
     : entities_(entities), opt_(options), coordinator_(coordinator), trace_(trace) {}
 
-void SampleWriter::write_raw(const std::string& name, void* sample, std::size_t size) {
+void SampleWriter::write_raw(const std::string& name, void* sample, std::size_t size,
+                             double timeout_s) {
+  const double bound_s = timeout_s > 0 ? timeout_s : opt_.write_timeout_s;
   eprosima::fastdds::dds::DataWriter* w = entities_.writer(name);
   if (!w)
     throw TransportError("this " + std::string(coordinator_ ? "coordinator" : "agent") +
                          " does not write " + name);
-  const auto deadline =
-      std::chrono::steady_clock::now() +
-      std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(opt_.write_timeout_s));
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(bound_s));
   for (;;) {
     // The handle overload reports why a write failed (the plain one only returns a bool).
     ReturnCode_t rc = w->write(sample, rtps::c_InstanceHandle_Unknown);
@@ -45,7 +46,7 @@ void SampleWriter::write_raw(const std::string& name, void* sample, std::size_t 
            rc());
     if (std::chrono::steady_clock::now() > deadline) {
       char buf[64];
-      std::snprintf(buf, sizeof(buf), "%g s (return code %u)", opt_.write_timeout_s, rc());
+      std::snprintf(buf, sizeof(buf), "%g s (return code %u)", bound_s, rc());
       throw TransportError("could not send on " + name + " within " + buf +
                            ": the receivers do not acknowledge (history full)");
     }

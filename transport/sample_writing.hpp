@@ -26,9 +26,11 @@ class SampleWriter {
   /// Writes `sample` on topic `topic` (retrying as above). Throws TransportError if this
   /// process has no writer for the topic, the write fails for another reason than a full
   /// history, or the history stays full past the write timeout.
+  /// `timeout_s` > 0 replaces the write timeout for this write (a step whose receivers may be
+  /// busy computing for longer; a dead one frees the history when its lease expires).
   template <class T>
-  void write(const std::string& topic, const T& sample) {
-    write_raw(topic, const_cast<T*>(&sample), serialized_size(sample));
+  void write(const std::string& topic, const T& sample, double timeout_s = 0) {
+    write_raw(topic, const_cast<T*>(&sample), serialized_size(sample), timeout_s);
   }
 
   /// Waits until every writer's samples are acknowledged, for at most `timeout` in total.
@@ -42,7 +44,7 @@ class SampleWriter {
   std::uint64_t write_retries() const { return retries_.load(); }
 
  private:
-  void write_raw(const std::string& topic, void* sample, std::size_t bytes);
+  void write_raw(const std::string& topic, void* sample, std::size_t bytes, double timeout_s);
 
   const DdsEntities& entities_;
   const SessionOptions& opt_;

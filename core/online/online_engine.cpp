@@ -6,6 +6,7 @@
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
 #include <tessera/online/new_pose_placement.hpp>
+#include <tessera/online/lifted_rank.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
@@ -112,6 +113,11 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     if (options_.place_new_poses) place_new_poses(graph, X_, estimated, extended_measurements_);
   }
   extended_measurements_ = graph.measurements.size();
+  {
+    const ComponentMerges merges = pieces_.absorb(graph, X_, options_.align_merged_pieces);
+    u.merges = merges.merges;
+    u.merge_poses_moved = merges.poses_moved;
+  }
   if (converged_ && composed == u.measurements) {
     // Every new measurement placed a new pose (odometry, mostly): each has zero residual at
     // the composed poses, so f and its gradient are what they were and the agents, which were
@@ -243,17 +249,32 @@ OnlineResult OnlineEngine::finish() {
 }
 
 std::optional<OnlineCertificate> OnlineEngine::certify(double now_s) {
-  if (X_.cols() == 0 || count_components(stream_.graph()) != 1) return std::nullopt;
+  if (X_.cols() == 0 || blocks_ == nullptr) return std::nullopt;
   DistributedOptions solver = options_.solver;
   solver.certify = true;
   solver.round_result = false;
   const double cpu_start = cpu_now();
-  const DistributedResult res = solve_linked(solver);
   OnlineCertificate c;
   c.time_s = now_s;
   c.poses = stream_.graph().num_poses;
+  c.cost_before = last_relaxation_cost_;
+  const DistributedResult res = solve_linked(solver);
   c.certified = res.certified.value_or(false);
   c.min_eigenvalue = res.min_eigenvalue;
+  c.cost_after = res.relaxation_cost;
+  if (res.X.rows() > X_.rows() && c.certified) {
+    // The climb left a critical point that was not optimal and reached a certified optimum at
+    // a higher rank: continue from it, brought back to rank r (exact for a rank <= r optimum).
+    Eigen::MatrixXd wide = Eigen::MatrixXd::Zero(res.X.rows(), X_.cols());
+    wide.topRows(X_.rows()) = X_;
+    blocks_->write_back(res.X, wide);
+    X_ = project_to_rank(wide, stream_.graph().d, static_cast<int>(X_.rows()));
+    c.escaped = true;
+    converged_ = false;  // the next step solves from the projected point
+  } else if (res.X.rows() == X_.rows()) {
+    last_relaxation_cost_ = res.relaxation_cost;
+    last_grad_norm_ = res.grad_norm;
+  }
   c.cpu_s = cpu_now() - cpu_start;
   totals_.cpu_s += c.cpu_s;
   totals_.bytes += res.bytes_exchanged;

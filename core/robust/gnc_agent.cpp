@@ -120,6 +120,8 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
         solve_options_.max_rounds =
             std::min(solve_options_.max_rounds, options_.robust.recheck_max_rounds);
     }
+    if (solve_kind_ == Solve::kFinal && options_.robust.final_refine)
+      solve_options_.refine.enabled = true;  // the answer to the refinement's tolerance
   } else {
     solve_options_.certify = false;
     // Every solve before the inlier passes needs only a rough minimiser.
@@ -311,7 +313,8 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // With it the probe's list (only used when nothing else changes) and the TLS cost a probe
       // is judged by.
       *recheck_ = recheck_verdict(*terms_, in_.measurement_index, rejected_, state_->Y, neighbours_,
-                                  may_probe() ? options_.robust.probe_ratio : 0.0);
+                                  may_probe() ? options_.robust.probe_ratio : 0.0,
+                                  options_.robust.probe_tail_ratio);
       votes_[me] = {tls_cost(*terms_, state_->Y, neighbours_), 0};
       to_others(readmitted_message(*recheck_, votes_[me].first));
       break;
@@ -362,8 +365,12 @@ void GncAgent::solve_without(const std::vector<std::uint64_t>& dropped) {
   layout_ = std::move(layout);
 }
 
+bool GncAgent::final_solve_runs() const {
+  return options_.solver.certify || options_.robust.final_refine;
+}
+
 void GncAgent::finish(std::vector<OutgoingMessage>& out) {
-  if (!options_.solver.certify || !final_solve_wanted_) {
+  if (!final_solve_runs() || !final_solve_wanted_) {
     done_ = true;
     step_ = Step::kDone;
     return;
@@ -471,8 +478,8 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
       return;
     }
     if (pass_ >= options_.robust.readmission_passes || rejected_.empty()) {
-      // Without a certified solve to follow, the last pass must reach the tolerance itself.
-      if (pass_capped_ && !options_.solver.certify) {
+      // Without a final solve to follow, the last pass must reach the tolerance itself.
+      if (pass_capped_ && !final_solve_runs()) {
         full_pass_next_ = true;
         begin_inlier_pass(out);
         return;

@@ -141,6 +141,10 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   // closures between random poses) is computed supernodally (CentralizedOptions::
   // supernodal_min_flops).
   inner.threads = 1;
+  // The Euclidean factor of the weighted Q: with wrong closures between random poses the tangent
+  // factor (6 coordinates a 3D pose against 4 rows) is dense and refactored for every weighted
+  // solve (a generated 1000-pose 3D grid with 25 % random outliers: 1.6 -> 4.1 s CPU).
+  inner.preconditioning = CentralizedPreconditioning::kEuclidean;
   if (robust.inner_max_iterations > 0)
     inner.trust_region.max_iterations =
         std::min(inner.trust_region.max_iterations, robust.inner_max_iterations);

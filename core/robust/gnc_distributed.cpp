@@ -153,24 +153,25 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   out.total_rounds = lead.gnc_rounds();
   out.total_bytes = stats.bytes;
 
-  // The last solve of the kept set with its full record (trace, certificate): with
-  // certification the certified solve from the agents' iterate; without, the agents' last
-  // inlier pass again from its start (the same arithmetic, so the same iterate).
+  // The last solve of the kept set with its full record (trace, certificate, refinement): when
+  // the agents run a final solve (certification or RobustOptions::final_refine) that one, from
+  // the agents' iterate; without, the agents' last inlier pass again from its start (the same
+  // arithmetic, so the same iterate).
   const PoseGraph inliers = inlier_graph(graph, out.rejected, {});
-  const bool certify = solver.certify;
+  const bool final_runs = lead.final_solve_runs();
   Eigen::MatrixXd X(solver.rank, w * static_cast<Eigen::Index>(graph.num_poses));
   for (int b = 0; b < agents; ++b) {
     const GncAgent& a = *gnc[static_cast<std::size_t>(b)];
-    const Eigen::MatrixXd& Y = certify ? a.state().Y : a.last_pass_start();
+    const Eigen::MatrixXd& Y = final_runs ? a.state().Y : a.last_pass_start();
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
     for (std::size_t s = 0; s < ids.size(); ++s)
       X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
           Y.middleCols(w * static_cast<Eigen::Index>(s), w);
   }
   DistributedOptions last = solver;
-  last.certify = certify;
+  if (final_runs && options.robust.final_refine) last.refine.enabled = true;
   out.final_solve = solve_distributed_from_lifted(inliers, assignment, last, X);
-  if (certify) {
+  if (final_runs) {
     out.total_rounds += out.final_solve.rounds;
     out.total_bytes += out.final_solve.bytes_exchanged;
   }

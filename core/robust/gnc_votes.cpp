@@ -80,7 +80,8 @@ double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weig
 
 RecheckVerdict recheck_verdict(const GncLocalTerms& terms, const std::vector<std::uint64_t>& index,
                                const std::vector<std::uint64_t>& rejected, const Eigen::MatrixXd& Y,
-                               const Eigen::MatrixXd& neighbours, double probe_ratio) {
+                               const Eigen::MatrixXd& neighbours, double probe_ratio,
+                               double probe_tail_ratio) {
   // A rejected measurement within the bound was misjudged on a rough iterate; a kept one beyond
   // it is a wrong closure that GNC's iterate fitted with the help of a distortion. Each pass is
   // a descent step of the TLS cost (binary weights given the poses).
@@ -102,9 +103,14 @@ RecheckVerdict recheck_verdict(const GncLocalTerms& terms, const std::vector<std
     for (const auto& e : kept) r2s.push_back(e.first);
     auto mid = r2s.begin() + static_cast<std::ptrdiff_t>(r2s.size() / 2);
     std::nth_element(r2s.begin(), mid, r2s.end());
+    double sum = 0;
+    for (double r2 : r2s) sum += r2;
+    // Without a heavy tail (mean near the median, as for residuals that match their
+    // information) there is no bend for a probe to undo.
+    const bool tail = sum > probe_tail_ratio * *mid * static_cast<double>(r2s.size());
     const double bound = probe_ratio * *mid;
     for (const auto& [r2, id] : kept)
-      if (r2 > bound) v.probe.push_back(id);
+      if (tail && r2 > bound) v.probe.push_back(id);
   }
   return v;
 }

@@ -58,15 +58,17 @@ struct RecheckVerdict {
   std::vector<std::uint64_t> taken_back;  ///< Rejected, within the bound: back in (weight 1).
   std::vector<std::uint64_t> cut_now;     ///< Kept, beyond the bound: out (weight 0).
   /// Kept, within the bound, but above probe_ratio x the median residual of the kept
-  /// measurements the agent weighs (RobustOptions::recheck_probes): what a probe cuts. Not a
-  /// change of the verdict (empty() ignores it).
+  /// measurements the agent weighs (RobustOptions::recheck_probes), when their mean is above
+  /// probe_tail_ratio x that median: what a probe cuts. Not a change of the verdict (empty()
+  /// ignores it).
   std::vector<std::uint64_t> probe;
   bool empty() const { return taken_back.empty() && cut_now.empty(); }
 };
 /// `probe_ratio` 0: no probe list.
 RecheckVerdict recheck_verdict(const GncLocalTerms& terms, const std::vector<std::uint64_t>& index,
                                const std::vector<std::uint64_t>& rejected, const Eigen::MatrixXd& Y,
-                               const Eigen::MatrixXd& neighbours, double probe_ratio = 0);
+                               const Eigen::MatrixXd& neighbours, double probe_ratio = 0,
+                               double probe_tail_ratio = 0);
 
 /// The TLS cost of the measurements this agent weighs (known inliers r^2, the others
 /// min(r^2, c^2)): what a probe must lower to stay.

@@ -65,6 +65,8 @@ void RobustOptions::validate() const {
     bad_field("recheck_probes", std::to_string(recheck_probes), "must be >= 0 (0 = none)");
   if (!(std::isfinite(probe_ratio) && probe_ratio > 1))
     bad_field("probe_ratio", number_text(probe_ratio), "must be > 1");
+  if (!(std::isfinite(probe_tail_ratio) && probe_tail_ratio >= 0))
+    bad_field("probe_tail_ratio", number_text(probe_tail_ratio), "must be >= 0 (0 = always)");
   if (!(std::isfinite(weight_tolerance) && weight_tolerance >= 0))
     bad_field("weight_tolerance", number_text(weight_tolerance), "must be >= 0");
 }

@@ -53,8 +53,8 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
     return "outer step " + std::to_string(agent.outer_iterations()) + " of the robust solve";
   });
 
-  // The last solve of the kept set: the certified one when certification ran, else the last
-  // inlier pass.
+  // The last solve of the kept set: the final one when it ran (certification or
+  // RobustOptions::final_refine), else the last inlier pass.
   const CertifiedAgent& last = agent.last_solve();
   RoundLoopResult res;
   res.rounds = static_cast<std::uint32_t>(agent.total_rounds());
@@ -64,7 +64,7 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
     res.relaxation_cost = last.solves().back().trace.back().cost;
     res.grad_norm = last.solves().back().trace.back().grad_norm;
   }
-  const bool certified_sequence = agent.final_sequence() != nullptr;
+  const bool certified_sequence = agent.final_sequence() != nullptr && options.solver.certify;
   if (certified_sequence) {
     res.certified = last.certified();
     if (!last.certificates().empty())
@@ -79,6 +79,8 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   report.readmitted = agent.readmitted();
   report.threshold_squared = agent.threshold_squared();
   report.weights_converged = agent.weights_converged();
+  report.probes = agent.probes();
+  report.probes_kept = agent.probes_kept();
   res.robust = std::move(report);
 
   // The rounding sees the kept measurements (the cost is over them).

@@ -26,7 +26,8 @@ enum InitPhase : std::uint32_t {
   kUnitPoses = kInitPhaseBase + 10,       // agent k -> agent 0: unit poses at inter-robot ends
   kUnitCount,                             // all -> all: number of units (status: cost)
   kCrossing,                              // agent k -> agent 0: inter-robot measurements recorded
-  kUnitFrames                             // agent 0 -> all: every unit's frame
+  kUnitFrames,                            // agent 0 -> all: every unit's frame
+  kSetupTurnDone = kInitPhaseBase + 20    // agent a -> a + K: my local solve is done (turns)
 };
 
 std::uint32_t phase_of(const ProtocolMessage& m) {
@@ -46,6 +47,7 @@ class StageMailbox {
       : channel_(channel), timeout_s_(timeout_s), self_(self) {}
 
   void set_offset(std::uint32_t offset) { offset_ = offset; }
+  double timeout_s() const { return timeout_s_; }
   void send(OutgoingMessage m) {
     std::visit([&](auto& x) { x.phase += offset_; }, m.message);
     channel_.send(m);
@@ -53,6 +55,12 @@ class StageMailbox {
 
   std::map<std::uint32_t, ProtocolMessage> gather(std::uint32_t stage_phase,
                                                   const std::vector<std::uint32_t>& senders) {
+    return gather(stage_phase, senders, timeout_s_);
+  }
+  // With its own bound: a wait that spans other agents' turns of computation (setup_turns.hpp).
+  std::map<std::uint32_t, ProtocolMessage> gather(std::uint32_t stage_phase,
+                                                  const std::vector<std::uint32_t>& senders,
+                                                  double timeout_s) {
     const std::uint32_t phase = stage_phase + offset_;
     for (;;) {
       auto& have = stash_[phase];
@@ -60,11 +68,11 @@ class StageMailbox {
       for (auto s : senders)
         if (!have.count(s)) missing += " " + std::to_string(s);
       if (missing.empty()) break;
-      std::optional<ProtocolMessage> msg = channel_.receive(timeout_s_);
+      std::optional<ProtocolMessage> msg = channel_.receive(timeout_s);
       if (!msg)
         throw std::runtime_error("agent " + std::to_string(self_) + ": initialisation step " +
                                  std::to_string(phase) + ": nothing received for " +
-                                 std::to_string(timeout_s_) + " s; waiting for agent(s)" + missing);
+                                 std::to_string(timeout_s) + " s; waiting for agent(s)" + missing);
       const std::uint32_t p = phase_of(*msg);
       if (p < kInitPhaseBase)
         throw std::runtime_error("agent " + std::to_string(self_) + ": a message of phase " +
@@ -82,6 +90,7 @@ class StageMailbox {
   ProtocolChannel& channel_;
   double timeout_s_;
   std::uint32_t self_;
+
   std::uint32_t offset_ = 0;
   std::map<std::uint32_t, std::map<std::uint32_t, ProtocolMessage>> stash_;
 };
@@ -181,12 +190,12 @@ std::vector<Pose> unit_frames_of_agent0(const RobotShare& share, const PoseBlock
                                         std::uint32_t N, const std::vector<std::size_t>& offset,
                                         const std::vector<const Measurement*>& crossing_mine,
                                         const std::vector<std::uint64_t>& crossing_index,
-                                        StageMailbox& mail) {
+                                        StageMailbox& mail, double wait_s) {
   const int d = share.d;
   const std::uint32_t self = 0;
   const std::uint32_t unit_rank = static_cast<std::uint32_t>(d + 1);
   const std::vector<Pose> frame = [&] {
-    auto end_poses = mail.gather(kUnitPoses, others(self, N));
+    auto end_poses = mail.gather(kUnitPoses, others(self, N), wait_s);
     end_poses[self] = ends;
     std::map<std::size_t, UnitPose> endpoint;
     for (const auto& [a, msg] : end_poses) {
@@ -208,7 +217,7 @@ std::vector<Pose> unit_frames_of_agent0(const RobotShare& share, const PoseBlock
     std::vector<std::pair<std::uint64_t, Measurement>> all;
     for (std::size_t k = 0; k < crossing_mine.size(); ++k)
       all.emplace_back(crossing_index[k], *crossing_mine[k]);
-    for (auto& [a, msg] : mail.gather(kCrossing, others(self, N)))
+    for (auto& [a, msg] : mail.gather(kCrossing, others(self, N), wait_s))
       decode_measurement_block(std::get<PoseBlockMessage>(msg), d, share.num_poses,
                                "initialisation", all);
     const std::vector<Measurement> crossing = in_file_order(std::move(all));
@@ -227,8 +236,9 @@ std::vector<Pose> unit_frames_of_agent0(const RobotShare& share, const PoseBlock
 }
 
 // Another agent: the units' frames from agent 0.
-std::vector<Pose> received_unit_frames(StageMailbox& mail, int d, std::size_t num_units) {
-  const auto got = mail.gather(kUnitFrames, {0});
+std::vector<Pose> received_unit_frames(StageMailbox& mail, int d, std::size_t num_units,
+                                       double wait_s) {
+  const auto got = mail.gather(kUnitFrames, {0}, wait_s);
   const auto& m = std::get<PoseBlockMessage>(got.at(0));
   const std::size_t width = flat_pose_size(d);
   if (m.rank != static_cast<std::uint32_t>(d) || m.data.size() != m.pose_ids.size() * width ||
@@ -246,11 +256,25 @@ std::vector<Pose> received_unit_frames(StageMailbox& mail, int d, std::size_t nu
 std::vector<Pose> distributed_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t N,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
-    const std::string& source, StageMailbox& mail, std::uint64_t* total_units) {
+    const std::string& source, StageMailbox& mail, const SetupTurnOptions& turns,
+    std::uint64_t* total_units) {
   const int d = share.d;
   auto mine = [&](std::size_t id) { return id >= share.begin && id < share.end; };
-  // 1. Our own units (what this robot computes alone).
+  // 1. Our own units (what this robot computes alone), in our turn (setup_turns.hpp). Each
+  //    wait may span the solves before ours in the chain, each bounded by the timeout; what
+  //    follows waits for every agent, so for the longest chain.
+  const SetupTurn turn = setup_turn(self, N, turns.max_at_once);
+  const double wait_s = mail.timeout_s() * turn.chain_length;
+  if (turn.waits_for)
+    mail.gather(kSetupTurnDone, {*turn.waits_for}, mail.timeout_s() * turn.position);
   const RobotUnits units = robot_units(d, share.begin, share.end, share.measurements, source);
+  if (turns.after_local_solve) turns.after_local_solve();
+  if (turn.passes_to) {
+    RoundStatusMessage done;
+    done.sender = self;
+    done.phase = kSetupTurnDone;
+    mail.send(OutgoingMessage{done, false, {*turn.passes_to}});
+  }
   std::vector<std::pair<std::size_t, std::size_t>> slot(share.end - share.begin);
   for (std::size_t u = 0; u < units.members.size(); ++u)
     for (std::size_t k = 0; k < units.members[u].size(); ++k)
@@ -295,7 +319,7 @@ std::vector<Pose> distributed_stage(
   }
   // 3. Everyone's: unit numbering in agent order (ranges tile 0..n-1 in agent order, so this
   //    is the order of the units' smallest poses, as in the in-process engine).
-  auto counts = mail.gather(kUnitCount, others(self, N));
+  auto counts = mail.gather(kUnitCount, others(self, N), wait_s);
   counts[self] = count;
   std::vector<std::size_t> offset(N + 1, 0);
   for (std::uint32_t a = 0; a < N; ++a) {
@@ -305,9 +329,10 @@ std::vector<Pose> distributed_stage(
                                " reported an impossible number of units");
     offset[a + 1] = offset[a] + static_cast<std::size_t>(c);
   }
-  const std::vector<Pose> frame =
-      self == 0 ? unit_frames_of_agent0(share, ends, N, offset, crossing_mine, crossing_index, mail)
-                : received_unit_frames(mail, d, offset[N]);
+  const std::vector<Pose> frame = self == 0
+                                      ? unit_frames_of_agent0(share, ends, N, offset, crossing_mine,
+                                                              crossing_index, mail, wait_s)
+                                      : received_unit_frames(mail, d, offset[N], wait_s);
   std::vector<Pose> out(share.end - share.begin);
   for (std::size_t u = 0; u < units.members.size(); ++u)
     for (std::size_t k = 0; k < units.members[u].size(); ++k)
@@ -328,7 +353,8 @@ namespace {
 InitializationResult run_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t num_agents,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
-    const std::string& method, const std::string& source, StageMailbox& mail, EarlyChordal* early) {
+    const std::string& method, const std::string& source, StageMailbox& mail, EarlyChordal* early,
+    const SetupTurnOptions& turns) {
   const auto t0 = std::chrono::steady_clock::now();
   InitializationResult res;
   res.method = method.empty() ? default_initialization() : method;
@@ -343,7 +369,8 @@ InitializationResult run_stage(
   } else if (init == DistributedInit::kChordal) {
     res.poses = chordal_stage(share, self, num_agents, source, mail, early, &res.early);
   } else {
-    res.poses = distributed_stage(share, self, num_agents, structure, source, mail, &res.units);
+    res.poses =
+        distributed_stage(share, self, num_agents, structure, source, mail, turns, &res.units);
   }
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
@@ -355,9 +382,10 @@ InitializationResult run_initialization_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t num_agents,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::string& method, const std::string& source, ProtocolChannel& channel,
-    double timeout_s, EarlyChordal* early) {
+    double timeout_s, EarlyChordal* early, const SetupTurnOptions& turns) {
+  turns.validate();
   StageMailbox mail(channel, timeout_s, self);
-  return run_stage(share, self, num_agents, structure, method, source, mail, early);
+  return run_stage(share, self, num_agents, structure, method, source, mail, early, turns);
 }
 
 std::pair<InitializationResult, InitializationResult> run_initialization_stages(
@@ -365,13 +393,15 @@ std::pair<InitializationResult, InitializationResult> run_initialization_stages(
     std::uint32_t num_agents, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& second_structure,
     const std::string& method, const std::string& second_method, const std::string& source,
-    ProtocolChannel& channel, double timeout_s, EarlyChordal* early) {
+    ProtocolChannel& channel, double timeout_s, EarlyChordal* early,
+    const SetupTurnOptions& turns) {
+  turns.validate();
   StageMailbox mail(channel, timeout_s, self);
   InitializationResult first =
-      run_stage(share, self, num_agents, structure, method, source, mail, early);
+      run_stage(share, self, num_agents, structure, method, source, mail, early, turns);
   mail.set_offset(kSecondStagePhaseOffset);
   InitializationResult second = run_stage(second_share, self, num_agents, second_structure,
-                                          second_method, source, mail, nullptr);
+                                          second_method, source, mail, nullptr, turns);
   return {std::move(first), std::move(second)};
 }
 

@@ -15,7 +15,8 @@
 //                measurements and the inter-robot measurements it recorded; each agent aligns
 //                the units with the same breadth-first spanning tree (align_units) and keeps
 //                its own poses. Same arithmetic as the in-process engine, so bit-identical
-//                poses when the agents' shares are the generator's robot ranges.
+//                poses when the agents' shares are the generator's robot ranges. The local
+//                solves take turns, a bounded number at once (runtime/setup_turns.hpp).
 //
 // Messages use phases kInitPhaseBase.. (>= 300), which the round protocol (0..5), the rounding
 // (100..) and the final report (200) never use. Every message of the stage is consumed by
@@ -31,6 +32,7 @@
 #include "runtime/early_chordal.hpp"
 #include "runtime/local_share.hpp"
 #include "runtime/round_loop.hpp"
+#include "runtime/setup_turns.hpp"
 
 namespace tessera::agent {
 
@@ -58,11 +60,14 @@ struct InitializationResult {
 /// Throws InputError on an unknown method or 'file' without VERTEX poses (naming `source`).
 /// `early` (agent 0, chordal only; may be null): the whole graph's chordal solve started
 /// before the stage, used when the gathered graph is the one it solved.
+/// `turns`: how many agents run the distributed initialisation's local solve at once
+/// (runtime/setup_turns.hpp; every agent of the run must pass the same max_at_once). The
+/// waits that span other agents' turns are bounded by `timeout_s` per turn.
 InitializationResult run_initialization_stage(
     const RobotShare& share, std::uint32_t self, std::uint32_t num_agents,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::string& method, const std::string& source, ProtocolChannel& channel,
-    double timeout_s, EarlyChordal* early = nullptr);
+    double timeout_s, EarlyChordal* early = nullptr, const SetupTurnOptions& turns = {});
 
 /// Two stages back to back on one inbox (a robust run's two candidate starts: `method` on
 /// `share`, then `second_method` on `second_share`, e.g. the distributed initialization of the
@@ -74,6 +79,7 @@ std::pair<InitializationResult, InitializationResult> run_initialization_stages(
     std::uint32_t num_agents, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
     const std::vector<std::pair<std::uint32_t, std::uint32_t>>& second_structure,
     const std::string& method, const std::string& second_method, const std::string& source,
-    ProtocolChannel& channel, double timeout_s, EarlyChordal* early = nullptr);
+    ProtocolChannel& channel, double timeout_s, EarlyChordal* early = nullptr,
+    const SetupTurnOptions& turns = {});
 
 }  // namespace tessera::agent

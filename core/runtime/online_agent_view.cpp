@@ -103,6 +103,7 @@ EnteredData OnlineAgentView::enter(const Watermarks& decision) {
   X_ = std::move(x.X);
   if (options_.place_new_poses) place_new_poses(graph, X_, estimated, measurements_before);
   e.composed = x.composed;
+  e.merges = pieces_.absorb(graph, X_, options_.align_merged_pieces).merges;
   return e;
 }
 

@@ -17,6 +17,7 @@
 #include <set>
 #include <tessera/online/absorb_gate.hpp>
 #include <tessera/online/block_rebalance.hpp>
+#include <tessera/online/component_alignment.hpp>
 #include <tessera/online/graph_stream.hpp>
 #include <tessera/online/linked_problem.hpp>
 #include <tessera/online/online_engine.hpp>
@@ -33,6 +34,8 @@ struct EnteredData {
   /// New poses placed by composing a new measurement from an estimated pose: when this equals
   /// `measurements`, every new measurement has zero residual at the extended estimate.
   std::size_t composed = 0;
+  /// Measurements that linked two pieces of the graph (OnlineOptions::align_merged_pieces).
+  std::size_t merges = 0;
 };
 
 /// What one take_over() moved.
@@ -99,6 +102,7 @@ class OnlineAgentView {
   std::map<std::uint32_t, std::uint64_t> last_count_;  // robot -> its batches (after `last`)
   Eigen::MatrixXd X_;
   std::vector<int> owner_;
+  ComponentAlignment pieces_;  // the graph's pieces, aligned when they meet (same on every agent)
   std::set<std::uint32_t> lost_;
   std::map<std::uint32_t, int> adopter_;  // lost robot -> block taking its new poses
 };

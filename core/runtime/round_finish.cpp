@@ -58,6 +58,8 @@ RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout&
     r.block_grad_norm = res.robust->threshold_squared;
     r.done_vote = res.robust->weights_converged;
     r.measurement_ids = res.robust->rejected;
+    r.coarse = {static_cast<double>(res.robust->probes),
+                static_cast<double>(res.robust->probes_kept)};
     channel.send(OutgoingMessage{r, true, {}});
   }
   if (local.agent_id == 0) {  // agent 0's times, for the coordinator's phase split

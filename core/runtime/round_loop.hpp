@@ -147,6 +147,7 @@ struct RobustRunReport {
   std::size_t readmitted = 0;
   double threshold_squared = 0;
   bool weights_converged = false;
+  int probes = 0, probes_kept = 0;  ///< RobustOptions::recheck_probes: run, and kept.
 };
 
 struct RoundLoopResult {
@@ -190,7 +191,8 @@ constexpr std::uint32_t kCertificateReportPhase = 201;
 constexpr std::uint32_t kCertificateBytesPhase = 202;
 /// Agent 0's robust report (RunOptions::robust), before the final report: cost = outer
 /// iterations, grad_norm_sq = re-admitted measurements, block_grad_norm = c^2, done_vote =
-/// weights converged, measurement_ids = the rejected measurements.
+/// weights converged, measurement_ids = the rejected measurements, coarse = {probes run,
+/// probes kept}.
 constexpr std::uint32_t kRobustReportPhase = 203;
 /// And, before the final report in every run, its own times: cost = solve_s (core's protocol:
 /// rounds, and certificate and escapes when certified), grad_norm_sq = rounding_s (seconds), so

@@ -74,6 +74,9 @@ struct TangentPreconditioner::Factor {
   Eigen::VectorXd b;
   cholmod_dense *solve_x = nullptr, *solve_y = nullptr, *solve_e = nullptr;
   std::size_t entries = 0;
+  double flops = 0.0;
+  bool supernodal = false;
+  bool with_multipliers = false;
   bool usable = false;
   bool factored = false;
   double lambda = 0.0;  // the shift of the last factorization
@@ -196,7 +199,8 @@ double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& ro
 }  // namespace
 
 TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double relative_shift,
-                                             std::size_t max_factor_entries)
+                                             std::size_t max_factor_entries,
+                                             double supernodal_min_flops)
     : factor_(std::make_unique<Factor>()) {
   if (!(relative_shift >= 0))
     throw std::invalid_argument("TangentPreconditioner: relative_shift must be >= 0");
@@ -291,6 +295,21 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   }
   if (f.llt.info() != Eigen::Success) return;  // not usable
   f.entries = static_cast<std::size_t>(f.llt.cholmod().lnz);
+  f.flops = f.llt.cholmod().fl;
+  // A dense factorization (3D graphs: p = 6 coordinates a pose, (6/4)^3 the flops of the
+  // Euclidean factor of Q) is several times cheaper with BLAS on its supernodes. The re-analysis
+  // repeats the AMD ordering, a small part of such a factorization.
+  if (supernodal_min_flops > 0 && f.flops > supernodal_min_flops) {
+    f.llt.setMode(Eigen::CholmodSupernodalLLt);
+    cholmod_common& cs = f.llt.cholmod();
+    cs.nmethods = 1;
+    cs.method[0].ordering = CHOLMOD_AMD;
+    cs.postorder = 1;
+    f.llt.analyzePattern(f.A);
+    if (f.llt.info() != Eigen::Success) return;  // not usable
+    f.entries = static_cast<std::size_t>(f.llt.cholmod().lnz);
+    f.supernodal = true;
+  }
   f.usable = max_factor_entries == 0 || f.entries <= max_factor_entries;
   if (!f.usable) {  // what only the factor needs goes now, not with the preconditioner
     f.A = SparseMatrix();
@@ -319,14 +338,37 @@ std::size_t TangentPreconditioner::factor_entries() const {
   return factor_->entries;
 }
 
+double TangentPreconditioner::factor_flops() const {
+  return factor_->flops;
+}
+
+bool TangentPreconditioner::supernodal() const {
+  return factor_->supernodal;
+}
+
 int TangentPreconditioner::coordinates_per_pose() const {
   return factor_->p;
 }
 
 bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
+  return factorize_impl(X, nullptr);
+}
+
+bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad) {
+  if (egrad.rows() != X.rows() || egrad.cols() != X.cols())
+    throw std::invalid_argument("TangentPreconditioner::factorize: egrad is not the size of X");
+  return factorize_impl(X, &egrad);
+}
+
+bool TangentPreconditioner::with_multipliers() const {
+  return factor_->with_multipliers;
+}
+
+bool TangentPreconditioner::factorize_impl(const Eigen::MatrixXd& X, const Eigen::MatrixXd* egrad) {
   Factor& f = *factor_;
   const int d = f.d, w = d + 1, p = f.p;
   if (!f.usable || f.extra > 0 || X.rows() != d || X.cols() != w * f.m) return false;
+  Eigen::MatrixXd Qm(w, w);
   const auto pairs = skew_pairs(d);
   std::vector<Eigen::MatrixXd> G(static_cast<std::size_t>(f.m));
   for (Eigen::Index i = 0; i < f.m; ++i)
@@ -341,14 +383,23 @@ bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
     for (Eigen::Index s = f.diagonal_slot[static_cast<std::size_t>(j)];
          s < f.block_start[static_cast<std::size_t>(j) + 1]; ++s) {
       const Eigen::Index i = f.block_row[static_cast<std::size_t>(s)];
+      const double* Qij = f.q_blocks.data() + s * w * w;
+      if (egrad && i == j) {
+        // S = Q - Lambda: the multipliers sit on the rotation part of the diagonal blocks.
+        Qm = Eigen::Map<const Eigen::MatrixXd>(Qij, w, w);
+        const Eigen::MatrixXd YG =
+            X.block(0, j * w, d, d).transpose() * egrad->block(0, j * w, d, d);
+        Qm.topLeftCorner(d, d) -= 0.25 * (YG + YG.transpose());
+        Qij = Qm.data();
+      }
       double* out = f.A.valuePtr() + f.value_offset(j, s, 0);
       double diagonal = 0.0;
       if (d == 2)
-        tangent_block_fixed<2>(f.q_blocks.data() + s * w * w, G[static_cast<std::size_t>(i)], Gj,
-                               out, column_size, i == j ? &diagonal : nullptr);
+        tangent_block_fixed<2>(Qij, G[static_cast<std::size_t>(i)], Gj, out, column_size,
+                               i == j ? &diagonal : nullptr);
       else
-        tangent_block_fixed<3>(f.q_blocks.data() + s * w * w, G[static_cast<std::size_t>(i)], Gj,
-                               out, column_size, i == j ? &diagonal : nullptr);
+        tangent_block_fixed<3>(Qij, G[static_cast<std::size_t>(i)], Gj, out, column_size,
+                               i == j ? &diagonal : nullptr);
       max_diagonal = std::max(max_diagonal, diagonal);
     }
   }
@@ -361,6 +412,16 @@ bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
   f.llt.factorize(f.A);
   ++f.factorizations;
   f.calls_since_factor = 0;
+  bool positive = f.llt.info() == Eigen::Success;
+  if (positive && !f.supernodal) {
+    // Simplicial LDL^T does not fail on an indefinite A: check D.
+    const cholmod_factor* L = f.llt.factor();
+    const auto* col = static_cast<const int*>(L->p);
+    const auto* x = static_cast<const double*>(L->x);
+    for (std::size_t j = 0; j < L->n && positive; ++j) positive = x[col[j]] > 0;
+  }
+  f.with_multipliers = egrad != nullptr && positive;
+  if (egrad && !positive) return factorize_impl(X, nullptr);
   if (f.llt.info() != Eigen::Success) {
     f.usable = false;  // keep the caller on its Euclidean preconditioner from now on
     f.factored = false;

@@ -29,11 +29,16 @@ their own data would run (the fork server's preloaded whole graph is in every ag
 
 usage: dds_scale.py [--bin build/bin/tessera] [--sizes 20000:2,100000:10] [--domain 65]
                     [--work DIR] [--timeout 3600] [--period 0.5] [--csv FILE] [--robot-files]
-                    [--launch-args="..."]
+                    [--launch-args="..."] [--min-available-mb MB]
+
+The set-up's peaks (setup_pss_mb_*) are sampled until the coordinator's first round line;
+--min-available-mb stops a run (SIGTERM to launch) when the host's MemAvailable falls below it.
 """
 import argparse
 import json
 import os
+import re
+import signal
 import subprocess
 import sys
 import threading
@@ -97,17 +102,31 @@ def role_of(pid):
     return comm
 
 
-class Sampler(threading.Thread):
-    """Peak RSS and PSS (kB) per role and the peak of the PSS sum over the run's processes."""
+def mem_available_mb():
+    with open("/proc/meminfo") as f:
+        for line in f:
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) // 1024
+    return None
 
-    def __init__(self, root, period):
+
+class Sampler(threading.Thread):
+    """Peak RSS and PSS (kB) per role and the peak of the PSS sum over the run's processes, split
+    at the first round (set-up before it, the rounds, certificate and rounding after). With
+    min_available_mb > 0 a watchdog: when the host's MemAvailable falls below it, launch is sent
+    SIGTERM (other jobs share the host; a run must not push it into the OOM killer)."""
+
+    def __init__(self, root, period, min_available_mb=0):
         super().__init__(daemon=True)
-        self.root, self.period = root, period
+        self.root, self.period, self.min_available_mb = root, period, min_available_mb
         self.rss, self.pss, self.pss_sum, self.stop = {}, {}, 0, False
+        self.in_rounds, self.setup_pss_sum, self.setup_pss_agent = False, 0, 0
+        self.stopped_by_watchdog, self.least_available_mb = False, None
 
     def run(self):
         while not self.stop:
             total = 0
+            largest = 0
             for p in descendants(self.root):
                 role = role_of(p)
                 if role is None:
@@ -118,8 +137,24 @@ class Sampler(threading.Thread):
                     continue
                 self.rss[role] = max(self.rss.get(role, 0), rss)
                 self.pss[role] = max(self.pss.get(role, 0), pss)
+                if role.startswith("agent"):
+                    largest = max(largest, pss)
                 total += pss
             self.pss_sum = max(self.pss_sum, total)
+            if not self.in_rounds:
+                self.setup_pss_sum = max(self.setup_pss_sum, total)
+                self.setup_pss_agent = max(self.setup_pss_agent, largest)
+            avail = mem_available_mb()
+            if avail is not None:
+                self.least_available_mb = min(avail, self.least_available_mb or avail)
+                if self.min_available_mb and avail < self.min_available_mb and not self.stopped_by_watchdog:
+                    self.stopped_by_watchdog = True
+                    bc.progress(f"watchdog: MemAvailable {avail} MB < {self.min_available_mb} MB: "
+                                f"stopping the run (PSS sum {total // 1024} MB)")
+                    try:
+                        os.kill(self.root, signal.SIGTERM)
+                    except OSError:
+                        pass
             time.sleep(self.period)
 
 
@@ -146,13 +181,16 @@ def run_one(args, poses, agents, domain):
     load0 = load()
     t0 = time.monotonic()
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    sampler = Sampler(proc.pid, args.period)
+    sampler = Sampler(proc.pid, args.period, args.min_available_mb)
     sampler.start()
     in_summary = False
     for line in proc.stdout:  # progress and errors stay visible; the summary is read from its file
         in_summary = in_summary or line.startswith("summary:")
+        # The coordinator's first round progress line ends the set-up.
+        if not sampler.in_rounds and re.search(r"round \d+\S*: cost", line):
+            sampler.in_rounds = True
         if not in_summary:
-            sys.stdout.write("  | " + line)
+            sys.stdout.write(f"  | {time.monotonic() - t0:7.1f}s " + line)
         in_summary = in_summary and not line.startswith("}")
     rc = proc.wait()
     wall = time.monotonic() - t0
@@ -168,7 +206,11 @@ def run_one(args, poses, agents, domain):
            "sampled_rss_mb_agent_max": round(max(agent_rss.values(), default=0) / 1024, 1),
            "peak_pss_mb_coordinator": round(sampler.pss.get("tessera-coordin", 0) / 1024, 1),
            "peak_pss_mb_fork_server": round(sampler.pss.get("tessera-fork-se", 0) / 1024, 1),
-           "peak_pss_mb_run_sum": round(sampler.pss_sum / 1024, 1)}
+           "peak_pss_mb_run_sum": round(sampler.pss_sum / 1024, 1),
+           "setup_pss_mb_run_sum": round(sampler.setup_pss_sum / 1024, 1),
+           "setup_pss_mb_agent_max": round(sampler.setup_pss_agent / 1024, 1),
+           "least_mem_available_mb": sampler.least_available_mb,
+           "stopped_by_watchdog": sampler.stopped_by_watchdog}
     if rc != 0 or not os.path.exists(summary):
         return row
     with open(summary) as f:
@@ -202,6 +244,8 @@ def main():
     ap.add_argument("--robot-files", action="store_true",
                     help="launch the folder of robot files (generate --split) instead of the whole file")
     ap.add_argument("--launch-args", default="", help="more launch options, e.g. \"--max-rounds 20\"")
+    ap.add_argument("--min-available-mb", type=int, default=0,
+                    help="watchdog: stop a run when the host's MemAvailable falls below this (0 = off)")
     args = ap.parse_args()
     args.bin = os.path.abspath(args.bin)
     os.makedirs(args.work, exist_ok=True)
@@ -211,7 +255,8 @@ def main():
         rows.append(run_one(args, poses, agents, args.domain + k))
     cols = ["poses", "agents", "input", "rc", "wall_s"] + [p[0] + "_s" for p in PHASES] + [
         "rounds", "grad_norm", "certified", "min_eigenvalue", "peak_rss_mb_agent_max", "peak_pss_mb_agent_max", "peak_rss_mb_coordinator",
-        "peak_pss_mb_fork_server", "peak_rss_mb_run", "peak_pss_mb_run_sum", "load_start", "load_end"]
+        "peak_pss_mb_fork_server", "peak_rss_mb_run", "peak_pss_mb_run_sum", "setup_pss_mb_agent_max",
+        "setup_pss_mb_run_sum", "load_start", "load_end"]
     bc.print_table("tessera launch on generated 3D grids (fast partition, distributed init, certified)",
                    cols, [[bc.fmt(r.get(c, "-")) if not isinstance(r.get(c), str) else r[c] for c in cols]
                           for r in rows])

@@ -340,7 +340,8 @@ def table(csv_path):
 
     head = ("| graph | kind | F | outliers | rejected | precision | recall | gap to f*_clean | ATE m | outer | "
             "certified | wall s | plain gap | plain ATE m | dist. rejected | dist. precision | dist. recall | "
-            "dist. gap | dist. ATE m | dist. rounds (clean) | dist. MB | dist. wall s | dist. certified | load |")
+            "dist. gap | dist. ATE m | dist. rounds (clean) | dist. probes (kept) | dist. refine steps | dist. MB | "
+            "dist. wall s | dist. certified | load |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         lines.append("| " + " | ".join([
@@ -352,6 +353,8 @@ def table(csv_path):
             num(r.get("d_recall", ""), "{:.3f}"), num(r.get("d_gap", ""), "{:.1e}"),
             num(r.get("d_ate_m", ""), "{:.2g}"),
             (f"{r['d_rounds']} ({r['d_clean_rounds']})" if r.get("d_rounds") else "-"),
+            (f"{r['d_probes']} ({r['d_probes_kept']})" if r.get("d_probes") else "-"),
+            r.get("d_refine_steps", "") or "-",
             num(str(float(r["d_bytes"]) / 1e6) if r.get("d_bytes") else "", "{:.1f}"),
             num(r.get("d_wall_s", ""), "{:.3g}"), r.get("d_certified", "") or "-", r["load"]]) + " |")
     return "\n".join(lines)
@@ -482,7 +485,8 @@ def main():
     fields = ["graph", "kind", "F", "scheme", "outliers", "rejected", "precision", "recall", "gap", "ate_m", "outer",
               "iterations", "wall_s", "certified", "plain_gap", "plain_ate_m", "plain_wall_s",
               "d_rejected", "d_precision", "d_recall", "d_gap", "d_ate_m", "d_outer", "d_rounds", "d_clean_rounds",
-              "d_round_ratio", "d_bytes", "d_wall_s", "d_certified", "load", "note"]
+              "d_round_ratio", "d_bytes", "d_wall_s", "d_certified", "load", "note",
+              "d_probes", "d_probes_kept", "d_refine_steps"]
     if not (args.append and os.path.exists(out_csv)):
         with open(out_csv, "w", newline="") as f:
             csv.writer(f).writerow(fields)
@@ -551,7 +555,11 @@ def main():
                                    d_ate_m=ate(read_tum(drob_tum, d), optimum, d),
                                    d_outer=drob["outer_iterations"], d_rounds=drob["total_rounds"],
                                    d_bytes=drob["total_bytes"], d_wall_s=round(dwall, 2),
-                                   d_certified=drob["certified"])
+                                   d_certified=drob["certified"], d_probes=drob.get("probes", ""),
+                                   d_probes_kept=drob.get("probes_kept", ""),
+                                   # message steps of the final solve's Newton refinement
+                                   d_refine_steps=drob.get("refine_exchanges", 0) +
+                                   drob.get("refine_reductions", 0))
                         if dref is not None:
                             row.update(d_clean_rounds=dref["rounds"],
                                        d_round_ratio=drob["total_rounds"] / max(1, dref["rounds"]))

@@ -12,6 +12,22 @@ GeneratorResult grid_with_outliers(double fraction, std::uint64_t seed) {
   return generate_pose_graph(o);
 }
 
+GeneratorResult flexible_city(double fraction, OutlierKind kind, std::uint64_t seed) {
+  GeneratorOptions o;
+  o.kind = TrajectoryKind::kCity;
+  o.num_poses = 300;
+  o.num_robots = 5;
+  o.seed = seed;
+  o.outlier_fraction = fraction;
+  o.outlier_kind = kind;
+  GeneratorResult r = generate_pose_graph(o);
+  for (Measurement& m : r.graph.measurements) {
+    m.kappa *= 0.03;
+    m.tau *= 0.03;
+  }
+  return r;
+}
+
 std::vector<int> robots_as_blocks(const GeneratorResult& r) {
   return std::vector<int>(r.robot_of.begin(), r.robot_of.end());
 }

@@ -29,7 +29,8 @@
 //     poses, then readmitted -> every agent: its rejected measurements within the bound at
 //     that solution (misjudged on a rough iterate; weight 1) and its kept ones beyond it
 //     (weight 0); no change anywhere ends the passes
-//   final: with certification, the certified solve of the kept set
+//   final: with certification or RobustOptions::final_refine, the solve of the kept set
+//          (certified with certification, ending with the Newton refinement with final_refine)
 //
 // Each weight is computed by one agent, the owner of the measurement's lower pose id
 // (weight_owner()); the other end receives it, so both ends always use the same weight. The
@@ -182,6 +183,10 @@ class GncAgent : public AgentProcess {
   const CertifiedAgent* final_sequence() const {
     return solve_kind_ == Solve::kFinal ? solve_.get() : nullptr;
   }
+  /// Whether a final solve of the kept set follows the inlier passes (with certification or
+  /// RobustOptions::final_refine); otherwise the last pass, solved to the tolerance, is the
+  /// answer.
+  bool final_solve_runs() const;
   const BlockLayout& layout() const { return *layout_; }
   const std::vector<Measurement>& kept_measurements() const { return kept_; }
   const std::vector<std::uint64_t>& kept_index() const { return kept_index_; }

@@ -97,6 +97,23 @@ struct RobustOptions {
   /// noise matches its information (median r^2 about 2.4 in 2D, 5.3 in 3D, c^2 37-48) probes
   /// may run and are undone when the TLS cost does not fall: they cost rounds, not accuracy.
   double probe_ratio = 5.0;
+  /// An agent proposes probes only when the mean residual of the kept measurements it weighs is
+  /// above this times their median, >= 0 (0 = always). Residuals that match their information
+  /// have a mean near the median (chi-square: 1.27x in 2D, 1.12x in 3D); a bent map has a heavy
+  /// tail. 1.5: sphere2500 with 25 % random outliers, whose agents have 1.2-1.33, ran a probe
+  /// that could not lower the TLS cost (65 rounds: 371, 5.5x the clean run, instead of 306), while
+  /// manhattan3500's agents have 1.64-5.5 and keep their probe (docs/robust.md, "Probes").
+  double probe_tail_ratio = 1.5;
+  /// Distributed solvers only: the final solve of the kept set (weights fixed) ends with the
+  /// distributed Newton refinement (distributed/newton_refine.hpp, with the solver's
+  /// DistributedOptions::refine settings: ||grad f|| <= 1e-6 by default), whatever
+  /// DistributedOptions::refine.enabled says for the other solves; with it that solve runs even
+  /// without certification. Why: the block-coordinate rounds stop at the solver's gradient
+  /// tolerance, which leaves the cost a few 1e-6 above the optimum of the kept set
+  /// (manhattan3500, 25 % random outliers: 8e-6 relative), while the refinement reaches it to
+  /// rounding error in fewer rounds than the block updates would need (docs/robust.md, "Final
+  /// solve").
+  bool final_refine = true;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 

@@ -28,6 +28,16 @@ enum class CentralizedStop {
   kGradient,
 };
 
+/// Which preconditioner the trust region's tCG uses at rank-d points (see
+/// docs/centralized-solver.md; above rank d, after a saddle escape, it is always the Euclidean).
+enum class CentralizedPreconditioning {
+  /// J A^{-1} J^T in tangent coordinates, A = J^T 2Q J + lambda I at the current rotations
+  /// (<tessera/solvers/tangent_preconditioner.hpp>): the exact inverse of the Hessian's Q part.
+  kTangent,
+  /// (2 (Q + lambda I))^{-1} followed by the tangent projection, factored once.
+  kEuclidean,
+};
+
 struct CentralizedOptions {
   int initial_rank = 5;  ///< r0 >= d. 5 matches the reference optima's runs.
   int max_rank = 10;     ///< Staircase ceiling, >= initial_rank.
@@ -42,6 +52,17 @@ struct CentralizedOptions {
   /// 1126 instead of 1788 tCG iterations (a long chain: its soft modes sit near the shift), the
   /// other shared graphs within 2 %.
   double preconditioner_shift = 1e-12;
+  CentralizedPreconditioning preconditioning = CentralizedPreconditioning::kTangent;
+  /// kTangent: lambda of A relative to its largest diagonal entry, > 0 (A is singular along the
+  /// global translation).
+  double tangent_shift = 1e-9;
+  /// kTangent: at a new iterate, A is refactored once the solves done with the current factor
+  /// cost this many times a factorization (CHOLMOD's predicted flops; >= 0, 0 = factored once at
+  /// the start). A stale factor is still a valid preconditioner, merely less exact.
+  double tangent_refresh_ratio = 1.0;
+  /// kTangent: the factorization is supernodal above this many flops (CHOLMOD's prediction),
+  /// simplicial below; > 0.
+  double tangent_supernodal_min_flops = 1.5e8;
   /// The preconditioner's factor is supernodal when its factorization takes more than this many
   /// floating-point operations (CHOLMOD's prediction), simplicial otherwise; > 0. The clean
   /// shared graphs need at most 3.6e8 (torus3D; simplicial solves are faster there); graphs with

@@ -37,8 +37,13 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   /// A positive definite for a block whose tangent Hessian is singular, e.g. one without cut
   /// edges). `max_factor_entries`: when CHOLMOD's symbolic analysis predicts a larger factor,
   /// usable() is false (the caller keeps its Euclidean preconditioner); 0 = no limit.
+  /// `supernodal_min_flops`: when CHOLMOD's analysis predicts a factorization of more
+  /// floating-point operations, the factor is supernodal LL^T (dense BLAS kernels on its
+  /// supernodes) instead of simplicial LDL^T; 0 = always simplicial (same operator up to
+  /// round-off).
   explicit TangentPreconditioner(const BlockProblem& problem, double relative_shift = 1e-9,
-                                 std::size_t max_factor_entries = 16'000'000);
+                                 std::size_t max_factor_entries = 16'000'000,
+                                 double supernodal_min_flops = 0);
   ~TangentPreconditioner() override;
   TangentPreconditioner(const TangentPreconditioner&) = delete;
   TangentPreconditioner& operator=(const TangentPreconditioner&) = delete;
@@ -51,6 +56,14 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   /// Computes A at X (d x (d+1)m, each rotation block orthogonal) and factors it. Returns false
   /// when X does not have d rows, or when the factorization fails (then usable() becomes false).
   bool factorize(const Eigen::MatrixXd& X);
+  /// The same with the Hessian's second-order part: A = J^T 2 (Q_BB - Lambda(X)) J + lambda I,
+  /// Lambda_i = sym(Y_i^T egrad_i) / 2 the first-order multipliers of pose i (`egrad` = 2 X Q_BB,
+  /// the block's Euclidean gradient at X), i.e. the Riemannian Hessian in tangent coordinates.
+  /// Where that A is not positive definite (far from a minimiser) A is factored without Lambda.
+  /// Returns what factorize(X) returns; with_multipliers() says which A was factored.
+  bool factorize(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad);
+  /// True when the last factorization included the multipliers.
+  bool with_multipliers() const;
 
   /// Readies the factor for an update at X: factors A at X on the first call and, when
   /// `refresh_interval` > 0, again on every refresh_interval-th call after it (0: built once).
@@ -76,6 +89,11 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   int factorizations() const;
   /// Entries of the Cholesky factor predicted by the symbolic analysis.
   std::size_t factor_entries() const;
+  /// Floating-point operations of one factorization, as the symbolic analysis predicts them
+  /// (0 when no analysis was done).
+  double factor_flops() const;
+  /// True when the factor is supernodal (see supernodal_min_flops).
+  bool supernodal() const;
   /// Coordinates per pose, d(d+1)/2.
   int coordinates_per_pose() const;
 
@@ -84,6 +102,8 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   Eigen::MatrixXd basis(const Eigen::MatrixXd& X) const;
 
  private:
+  bool factorize_impl(const Eigen::MatrixXd& X, const Eigen::MatrixXd* egrad);
+
   struct Factor;
   std::unique_ptr<Factor> factor_;
 };
