@@ -53,6 +53,10 @@ const char* kHelp =
     "                            by < 1e-8 f (ends within ~1e-8 of f*); gradient:\n"
     "                            only --grad-tol (f* to round-off)\n"
     "  --no-certify              skip the certificate (and the staircase)\n"
+    "  --precond-max-flops F     robust centralized: most predicted flops of each solve's\n"
+    "                            preconditioner factorization; beyond it the factor keeps the\n"
+    "                            known inliers and the highest-weight others that fit; 0 = all\n"
+    "                            measurements (docs/robust.md) [1e9]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {
@@ -102,9 +106,20 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   else if (stop != "reference")
     throw InputError("option --stop: '" + stop + "' is not one of reference, gradient");
   GncCentralizedResult gnc;
-  if (robust.kind != RobustKind::kNone)
-    gnc = solve_gnc_centralized(graph, {opt, robust, input.known_inlier});
-  else
+  if (robust.kind != RobustKind::kNone) {
+    GncCentralizedOptions gnc_options;
+    gnc_options.solver = opt;
+    gnc_options.robust = robust;
+    gnc_options.known_inlier_flags = input.known_inlier;
+    gnc_options.preconditioner.max_flops =
+        a.get_double("precond-max-flops", gnc_options.preconditioner.max_flops);
+    try {
+      gnc_options.preconditioner.validate();
+    } catch (const InputError& e) {
+      throw InputError(std::string("option --precond-max-flops: ") + e.what());
+    }
+    gnc = solve_gnc_centralized(graph, gnc_options);
+  } else
     gnc.final_solve = solve_centralized(graph, opt);
   const CentralizedResult& r = gnc.final_solve;
   const double wall_s =
@@ -132,6 +147,17 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
         "kept ones\n",
         robust_kind_name(robust.kind), gnc.outer_iterations, gnc.rejected.size(),
         graph.num_measurements());
+  // Each solve's truncated-CG work against its preconditioner's predicted factorization flops.
+  double precond_flops = 0, full_flops = 0;
+  for (const GncSolveWork& w : gnc.solves) {
+    std::printf(
+        "  solve: %d trust-region / %d CG iterations, preconditioner %zu of %zu measurements, "
+        "%.3g flops (all: %.3g)\n",
+        w.trust_region_iterations, w.cg_iterations, w.preconditioner_measurements, w.measurements,
+        w.preconditioner_flops, w.full_flops);
+    precond_flops += w.preconditioner_flops;
+    full_flops += w.full_flops;
+  }
   if (auto p = a.get("rejected")) write_rejected(*p, gnc.rejected);
   write_solution_files(a, graph, input.keys, r.poses);
   if (auto p = a.get("trace")) write_trace(*p, r);
@@ -145,7 +171,10 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
     summary.relaxation_cost = r.relaxation_cost;
     summary.certified = r.certified;
     JsonObject j = solve_json(graph_path, graph, summary);
-    if (robust.kind != RobustKind::kNone) add_robust_fields(j, robust_summary);
+    if (robust.kind != RobustKind::kNone) {
+      add_robust_fields(j, robust_summary);
+      j.add("precond_flops", precond_flops).add("precond_full_flops", full_flops);
+    }
     j.add("min_eigenvalue", r.min_eigenvalue)
         .add("final_rank", r.final_rank)
         .add("stop_reason", r.levels.empty() ? std::string() : r.levels.back().stop_reason)
@@ -172,6 +201,7 @@ int run_solve(const Args& args) {
   for (const char* const* o = kOnlineValued; *o; ++o) valued.insert(*o);
   for (const char* const* o = kOnlineSwitches; *o; ++o) switches.insert(*o);
   for (const char* const* o = kRobustValued; *o; ++o) valued.insert(*o);
+  valued.insert("precond-max-flops");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,

@@ -32,10 +32,40 @@ double tls_cost(const PoseGraph& graph, const std::vector<bool>& known,
   return f;
 }
 
-void add_iterations(GncCentralizedResult& out, const CentralizedResult& solve) {
-  out.inner_iterations += solve.iterations;
+// A solve's problem with what its preconditioner's selection ranks by: each measurement's
+// weight and whether it is a known inlier.
+struct SolveInput {
+  PoseGraph graph;
+  std::vector<double> weights;
+  std::vector<bool> known;
+};
+
+// Solves `in` with a preconditioner on the measurements select_preconditioner_edges keeps (the
+// known inliers, then by weight within the flop budget), and books the solve's work. Without
+// connected known inliers nothing guarantees that a subset holds the poses together, so the
+// preconditioner keeps every measurement.
+CentralizedResult run_solve(const SolveInput& in, const CentralizedOptions& solver,
+                            const PreconditionerEdgeOptions& precon, bool known_connected,
+                            GncCentralizedResult& out) {
+  const PoseGraph& g = in.graph;
+  PreconditionerEdgeOptions budget = precon;
+  if (!known_connected) budget.max_flops = 0;
+  const PreconditionerEdges edges =
+      select_preconditioner_edges(g.d, g.num_poses, g.measurements, in.weights, in.known, budget);
+  CentralizedResult solve =
+      edges.all ? solve_centralized(g, solver) : solve_centralized(g, solver, &edges.kept);
+  GncSolveWork work;
+  work.trust_region_iterations = solve.iterations;
   for (const CentralizedIteration& step : solve.trace)
-    out.cg_iterations += step.tr.inner_iterations;
+    work.cg_iterations += step.tr.inner_iterations;
+  work.measurements = g.num_measurements();
+  work.preconditioner_measurements = edges.kept.size();
+  work.full_flops = edges.full_flops;
+  work.preconditioner_flops = edges.kept_flops;
+  out.inner_iterations += work.trust_region_iterations;
+  out.cg_iterations += work.cg_iterations;
+  out.solves.push_back(work);
+  return solve;
 }
 
 }  // namespace
@@ -43,6 +73,7 @@ void add_iterations(GncCentralizedResult& out, const CentralizedResult& solve) {
 void GncCentralizedOptions::validate() const {
   solver.validate();
   robust.validate();
+  preconditioner.validate();
 }
 
 GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
@@ -67,14 +98,26 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   // factor of the weighted problem.
   const PoseGraph known_graph = known_subgraph(graph, known);
   const bool known_connected = count_components(known_graph) <= 1;
-  auto weighted_solve_graph = [&](const PoseGraph& g, const std::vector<double>& weights,
+  auto weighted_solve_input = [&](const std::vector<double>& weights,
                                   const std::vector<Pose>& start) {
-    PoseGraph weighted = weighted_graph(g, weights, start);
-    if (!known_connected) return weighted;
+    SolveInput in{weighted_graph(graph, weights, start), weights, known};
+    if (!known_connected) return in;
     std::vector<std::size_t> zero;
-    for (std::size_t e = 0; e < weights.size(); ++e)
-      if (weights[e] == 0) zero.push_back(e);
-    return zero.empty() ? weighted : inlier_graph(weighted, zero, start);
+    in.weights.clear();
+    in.known.clear();
+    for (std::size_t e = 0; e < weights.size(); ++e) {
+      if (weights[e] == 0) {
+        zero.push_back(e);
+      } else {
+        in.weights.push_back(weights[e]);
+        in.known.push_back(known[e]);
+      }
+    }
+    if (!zero.empty()) in.graph = inlier_graph(in.graph, zero, start);
+    return in;
+  };
+  auto run = [&](SolveInput in, const CentralizedOptions& solver) {
+    return run_solve(in, solver, options.preconditioner, known_connected, out);
   };
 
   // pcm-gnc: closures outside the largest pairwise-consistent set start with weight 0.
@@ -110,7 +153,7 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
     if (dropped[e]) first[e] = 0.0;
   CentralizedResult solve;
   if (robust.kind == RobustKind::kPcmGnc) {
-    solve = solve_centralized(weighted_solve_graph(graph, first, graph.initial), inner);
+    solve = run(weighted_solve_input(first, graph.initial), inner);
   } else if (options.known_inlier_start && known_connected &&
              options.solver.initialization == Initialization::kChordal) {
     PoseGraph start_graph = graph;
@@ -122,11 +165,10 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
     }
     CentralizedOptions from_start = inner;
     from_start.initialization = Initialization::kFile;
-    solve = solve_centralized(start_graph, from_start);
+    solve = run({std::move(start_graph), first, known}, from_start);
   } else {
-    solve = solve_centralized(graph, inner);
+    solve = run({graph, first, known}, inner);
   }
-  add_iterations(out, solve);
   inner.initialization = Initialization::kFile;
 
   out.weights.assign(m, 1.0);
@@ -144,8 +186,7 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
       out.weights[e] = known[e] ? 1.0 : dropped[e] ? 0.0 : tls_weight(r2[e], c2, mu);
       spread += out.weights[e] * (1 - out.weights[e]);
     }
-    solve = solve_centralized(weighted_solve_graph(graph, out.weights, solve.poses), inner);
-    add_iterations(out, solve);
+    solve = run(weighted_solve_input(out.weights, solve.poses), inner);
     ++out.outer_iterations;
     out.final_mu = mu;
     r2 = residuals(graph, solve.poses);
@@ -176,8 +217,16 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
     const std::vector<Pose> guess = chordal_initialization(inliers);
     if (evaluate_objective(inliers, guess) < evaluate_objective(inliers, start))
       inliers.initial = guess;
-    out.final_solve = solve_centralized(inliers, final_options);
-    add_iterations(out, out.final_solve);
+    std::vector<bool> kept_known;
+    kept_known.reserve(inliers.num_measurements());
+    for (std::size_t e = 0, next = 0; e < m; ++e) {
+      if (next < out.rejected.size() && out.rejected[next] == e)
+        ++next;
+      else
+        kept_known.push_back(known[e]);
+    }
+    const std::vector<double> ones(inliers.num_measurements(), 1.0);
+    out.final_solve = run({std::move(inliers), ones, std::move(kept_known)}, final_options);
     if (pass == robust.readmission_passes || out.rejected.empty()) break;
     const std::vector<Pose>& poses = out.final_solve.poses;
     TlsRecheck verdict = tls_recheck(graph, known, poses, c2, out.rejected);

@@ -139,7 +139,8 @@ Eigen::MatrixXd escape_saddle(const BlockProblem& problem, const Eigen::MatrixXd
 
 }  // namespace
 
-CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOptions& options) {
+CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOptions& options,
+                                    const std::vector<std::size_t>* preconditioner_measurements) {
   options.validate();
   if (options.initial_rank < graph.d)
     throw InputError("CentralizedOptions.initial_rank must be >= d = " + std::to_string(graph.d));
@@ -166,8 +167,18 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   const double supernodal_min_flops =
       concurrent ? options.concurrent_supernodal_min_flops
                  : (options.threads > 1 ? 0.0 : options.supernodal_min_flops);
-  const auto build_preconditioner = [&problem, &options, supernodal_min_flops, concurrent] {
-    return std::make_unique<BlockPreconditioner>(problem, options.preconditioner_shift, 0, 0,
+  // A preconditioner on a subset of the measurements has its own data matrix; the trust region
+  // and the certificate keep the whole problem.
+  std::optional<BlockProblem> subset_problem;
+  if (preconditioner_measurements) {
+    std::vector<Measurement> kept;
+    kept.reserve(preconditioner_measurements->size());
+    for (std::size_t e : *preconditioner_measurements) kept.push_back(graph.measurements.at(e));
+    subset_problem = BlockProblem::whole_graph(graph.d, graph.num_poses, kept);
+  }
+  const BlockProblem& precon_problem = subset_problem ? *subset_problem : problem;
+  const auto build_preconditioner = [&precon_problem, &options, supernodal_min_flops, concurrent] {
+    return std::make_unique<BlockPreconditioner>(precon_problem, options.preconditioner_shift, 0, 0,
                                                  supernodal_min_flops, concurrent);
   };
   const bool tangent = options.preconditioning == CentralizedPreconditioning::kTangent;

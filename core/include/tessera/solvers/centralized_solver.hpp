@@ -143,6 +143,13 @@ struct CentralizedResult {
 /// lifted solution to SE(d) and fills every field of the result (trace and timings included;
 /// `certified` stays empty when certify is off). Throws InputError when the options are
 /// invalid, initial_rank < d, or kFile is asked of a graph without VERTEX lines.
-CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOptions& options = {});
+/// `preconditioner_measurements`: null, or the indices of the measurements whose data matrix the
+/// trust region's preconditioner factors (any subset that connects the poses; see
+/// solvers/preconditioner_edges.hpp). The iterates then differ only through the preconditioner
+/// (the tCG's steps and the preconditioned stop tests); the certificate always uses every
+/// measurement.
+CentralizedResult solve_centralized(
+    const PoseGraph& graph, const CentralizedOptions& options = {},
+    const std::vector<std::size_t>* preconditioner_measurements = nullptr);
 
 }  // namespace tessera
