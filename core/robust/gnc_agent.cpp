@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <tessera/distributed/coarse_space.hpp>
 #include <tessera/distributed/stage_tag.hpp>
 #include <tessera/robust/gnc_agent.hpp>
 #include <tessera/robust/tls_weights.hpp>
@@ -146,11 +147,33 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   if (solve_kind_ == Solve::kInlierPass) last_pass_start_ = Y;
   state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
                                         solve_options_.block_update);
+  if (solve_options_.refine.enabled &&
+      solve_options_.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed)
+    // The refinement's coarse space over the graph this solve works on, as the in-process
+    // solve of the same graph builds it (every agent the same, no message).
+    state_->use_refine_space(std::make_shared<const CoarseSpace>(
+        make_coarse_space(in_.num_poses, solve_structure(), in_.owner,
+                          solve_options_.refine.coarse_space_options())));
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
   pass_on(solve_->start(), out);
   const std::uint32_t g = g_;
   replay(out);
   if (!done_ && g_ == g && step_ == Step::kSolve && solve_->done()) after_solve(out);
+}
+
+// Endpoints of the measurements the current solve works on, file order: the kept set for the
+// passes and the final solve, the whole graph for GNC's weighted solves.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> GncAgent::solve_structure() const {
+  if (solve_kind_ == Solve::kGnc) return in_.structure;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> kept;
+  kept.reserve(in_.structure.size() - std::min(in_.structure.size(), rejected_.size()));
+  auto r = rejected_.begin();
+  for (std::size_t e = 0; e < in_.structure.size(); ++e) {
+    while (r != rejected_.end() && *r < e) ++r;
+    if (r != rejected_.end() && *r == e) continue;
+    kept.push_back(in_.structure[e]);
+  }
+  return kept;
 }
 
 // The inner solve's messages, tagged with this GNC step.

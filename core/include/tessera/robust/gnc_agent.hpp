@@ -229,6 +229,7 @@ class GncAgent : public AgentProcess {
                std::vector<OutgoingMessage>& out);
   void weights_at_mu(double mu);
   void require_kept_connected() const;  // throws InputError naming the parts left
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> solve_structure() const;
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
   void finish(std::vector<OutgoingMessage>& out);
   void start_kept_set(std::vector<OutgoingMessage>& out);
