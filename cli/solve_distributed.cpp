@@ -170,7 +170,7 @@ const char* kDistributedHelp =
     "  --refine-coarse smoothed|blocks|none   the coarse correction of its CG's block-Jacobi\n"
     "                            preconditioner: rigid motions of K pieces per block blended\n"
     "                            smoothly, one rigid motion per block, or none (default\n"
-    "                            smoothed)\n"
+    "                            none)\n"
     "  --refine-coarse-aggregates K   pieces per block of the smoothed space (default 8)\n"
     "  --refine-coarse-form balancing|additive   how the coarse correction joins block\n"
     "                            Jacobi (default balancing)\n";
@@ -300,7 +300,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         a.get_double("refine-rel-tol", opt.refine.relative_decrease_tol);
     opt.refine.max_cg_iterations =
         static_cast<int>(a.get_long("refine-cg-iters", opt.refine.max_cg_iterations));
-    const std::string coarse = a.get_or("refine-coarse", "smoothed");
+    const std::string coarse = a.get_or("refine-coarse", "none");
     if (coarse != "blocks" && coarse != "smoothed" && coarse != "none")
       throw InputError("option --refine-coarse: '" + coarse +
                        "' is not one of blocks, smoothed, none");

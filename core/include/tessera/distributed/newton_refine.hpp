@@ -97,7 +97,10 @@ struct NewtonRefineOptions {
   /// measurement hops (the smoothed aggregation of coarse_space.hpp; AgentState::refine_space(),
   /// built from the graph's structure where the agents are set up; blocks where there is none).
   enum class Coarse { kNone, kBlocks, kSmoothed };
-  Coarse coarse = Coarse::kSmoothed;
+  /// Default kNone: the coarse correction cuts CG iterations (parking-garage 889 -> 175) but
+  /// costs more per iteration than it saves where it cuts few (ais2klinik in process: 3,410
+  /// iterations and 30 CPU-s smoothed, 4,318 and 12 CPU-s without; docs/newton-refine.md).
+  Coarse coarse = Coarse::kNone;
   /// How the coarse correction joins block Jacobi B. true: balancing,
   /// C + (I - C H) B (I - H C) with C = Phi A^+ Phi^T (the coarse space's error removed exactly;
   /// (H Phi)^T y rides in the same sum, so still one exchange and one sum an iteration, each
