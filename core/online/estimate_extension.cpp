@@ -4,6 +4,8 @@
 #include <string>
 #include <tessera/online/estimate_extension.hpp>
 
+#include "online/new_pose_adjacency.hpp"
+
 namespace tessera {
 
 EstimateExtension extend_estimate(const PoseGraph& graph, const Eigen::MatrixXd& X,
@@ -31,14 +33,9 @@ EstimateExtension extend_estimate(const PoseGraph& graph, const Eigen::MatrixXd&
   out.X.rightCols(out.X.cols() - X.cols()).setZero();
   const std::size_t first = std::min(first_new_measurement, graph.measurements.size());
 
-  // Adjacency of the new poses only (measurements among old poses cannot place anything), by
-  // new pose k - m.
-  std::vector<std::vector<std::size_t>> touching(n - m);
-  for (std::size_t e = first; e < graph.measurements.size(); ++e) {
-    const Measurement& me = graph.measurements[e];
-    if (me.i >= m) touching[me.i - m].push_back(e);
-    if (me.j >= m) touching[me.j - m].push_back(e);
-  }
+  // Adjacency of the new poses only, by new pose k - m.
+  const std::vector<std::vector<std::size_t>> touching =
+      new_pose_adjacency(graph, m, first_new_measurement);
   // Known: the old poses (every id < m) and the new ones placed so far.
   std::vector<char> placed(n - m, 0);
   auto is_known = [&](std::size_t k) { return k < m || placed[k - m] != 0; };

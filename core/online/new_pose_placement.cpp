@@ -7,6 +7,8 @@
 #include <tessera/online/new_pose_placement.hpp>
 #include <vector>
 
+#include "online/new_pose_adjacency.hpp"
+
 namespace tessera {
 
 namespace {
@@ -29,12 +31,8 @@ NewPosePlacement place_new_poses(const PoseGraph& graph, Eigen::MatrixXd& X,
   if (m == 0 || m == n) return out;
   const std::size_t first = std::min(first_new_measurement, graph.measurements.size());
   // The new poses reachable from an estimated one over the new measurements.
-  std::vector<std::vector<std::size_t>> touching(n - m);
-  for (std::size_t e = first; e < graph.measurements.size(); ++e) {
-    const Measurement& me = graph.measurements[e];
-    if (me.i >= m) touching[me.i - m].push_back(e);
-    if (me.j >= m) touching[me.j - m].push_back(e);
-  }
+  const std::vector<std::vector<std::size_t>> touching =
+      new_pose_adjacency(graph, m, first_new_measurement);
   std::vector<std::size_t> index(n - m, kNone);  // unknown number of each anchored new pose
   std::vector<std::size_t> ids;
   std::deque<std::size_t> queue;
