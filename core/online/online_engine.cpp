@@ -5,8 +5,8 @@
 #include <tessera/certification/rounding_gap.hpp>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
-#include <tessera/online/new_pose_placement.hpp>
 #include <tessera/online/lifted_rank.hpp>
+#include <tessera/online/new_pose_placement.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
