@@ -53,7 +53,7 @@ class OnlineAgent {
         view_(o.id, o.robots, o.online),
         stream_(o.domain, o.run_id),
         channel_(o.domain, o.run_id, static_cast<std::uint32_t>(o.id),
-                 static_cast<std::uint32_t>(o.robots)),
+                 static_cast<std::uint32_t>(o.robots), o.lease_s),
         start_(Clock::now()),
         block_(o.online) {}
 

@@ -31,6 +31,7 @@ options:
   --max-rounds K      rounds per solve at most                       [10000]
   --no-certify        no certificate at the end
   --timeout S         give up when a peer sends nothing for S seconds [120]
+  --lease S           DDS participant lease: a member silent S seconds is lost, 0.2..60 [2]
   --on-agent-loss A   what a member whose DDS liveliness lapsed does to the run: stop
                       (the others stop after --timeout, naming it) or continue (the
                       survivors take over its block and its robot's stream)  [stop]
@@ -66,7 +67,7 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
       argv,
       {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol", "max-rounds", "timeout",
        "json", "certify-every", "certify-iters", "publish-every", "tum-dir", "on-agent-loss",
-       "step-solver", "newton-after"},
+       "step-solver", "newton-after", "lease"},
       {"online", "no-certify", "verbose", "help"});
   OnlineAgentOptions o;
   const auto run_id = args.get("run-id");
@@ -93,6 +94,8 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
       static_cast<int>(args.get_long("certify-iters", s.staircase.certificate.max_iterations));
   o.timeout_s = args.get_double("timeout", 120.0);
   if (!(o.timeout_s > 0)) throw InputError("option --timeout: must be > 0");
+  o.lease_s = args.get_double("lease", o.lease_s);
+  if (!(o.lease_s >= 0.2 && o.lease_s <= 60)) throw InputError("option --lease: must be 0.2..60");
   const std::string loss = args.get_or("on-agent-loss", "stop");
   if (loss != "stop" && loss != "continue")
     throw InputError("option --on-agent-loss: '" + loss + "' is not one of stop, continue");

@@ -14,6 +14,7 @@ struct OnlineAgentOptions {
   int domain = 0;                 ///< DDS domain, 0..232 (from the run id unless --domain).
   OnlineOptions online;           ///< Solver, certificate and growth options of every solve.
   double timeout_s = 120.0;       ///< Seconds a peer may stay silent, > 0.
+  double lease_s = 2.0;           ///< DDS participant lease, seconds, 0.2..60.
   bool continue_on_loss = false;  ///< --on-agent-loss continue (else stop).
   std::string json;               ///< Summary file ("" = none).
   bool verbose = false;

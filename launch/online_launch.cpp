@@ -47,6 +47,8 @@ new, and certify the estimate after every robot's last batch.
   --grad-tol G        gradient-norm tolerance of every solve         [0.01]
   --no-certify        no certificate at the end
   --timeout S         an agent gives up when a peer is silent S seconds [120]
+  --lease S           the agents' DDS participant lease: a member silent S seconds is lost
+                      (a loaded host may not schedule a process for seconds), 0.2..60 [2]
   --on-agent-loss A   stop: a failed agent stops the run; continue: the survivors take over
                       a lost agent's block and its robot's stream, and the run goes on [stop]
   --certify-iters K   certificate iteration cap (LOBPCG)             [300]
@@ -119,10 +121,10 @@ int run_online_launch(const std::vector<std::string>& argv) {
       return 0;
     }
   const cli::Arguments args(
-      argv,
-      {"agents", "rate", "speedup", "start", "run-id", "domain", "algorithm", "rank", "grad-tol",
-       "timeout", "json", "keep-logs", "certify-every", "certify-iters", "publish-every", "tum-dir",
-       "on-agent-loss", "step-solver", "newton-after"},
+      argv, {"agents",  "rate",          "speedup",       "start",         "run-id",
+             "domain",  "algorithm",     "rank",          "grad-tol",      "timeout",
+             "json",    "keep-logs",     "certify-every", "certify-iters", "publish-every",
+             "tum-dir", "on-agent-loss", "step-solver",   "newton-after",  "lease"},
       {"online", "no-certify"});
   if (args.positional().size() != 1)
     throw InputError("launch --online: expected one GRAPH argument (see --online --help)");
@@ -143,6 +145,9 @@ int run_online_launch(const std::vector<std::string>& argv) {
     throw InputError("option --step-solver: '" + *solver + "' is not one of newton, rounds");
   if (args.has("newton-after") && !(args.get_double("newton-after", 0.0) > 0))
     throw InputError("option --newton-after: must be > 0");
+  if (args.has("lease") &&
+      !(args.get_double("lease", 0.0) >= 0.2 && args.get_double("lease", 0.0) <= 60))
+    throw InputError("option --lease: must be 0.2..60");
   const long domain = args.get_long("domain", transport::domain_for_run(run_id));
   if (domain < 0 || domain > transport::kMaxDomain)
     throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));
@@ -174,7 +179,7 @@ int run_online_launch(const std::vector<std::string>& argv) {
     a.insert(a.end(), common.begin(), common.end());
     for (const char* flag :
          {"algorithm", "rank", "grad-tol", "timeout", "certify-every", "certify-iters",
-          "publish-every", "tum-dir", "on-agent-loss", "step-solver", "newton-after"})
+          "publish-every", "tum-dir", "on-agent-loss", "step-solver", "newton-after", "lease"})
       if (auto v = args.get(flag)) {
         a.push_back(std::string("--") + flag);
         a.push_back(*v);

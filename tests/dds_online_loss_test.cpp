@@ -37,29 +37,15 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim,
   // Reads the agents' reports (never writes) to see how far the stream has entered.
   transport::OnlineChannel snoop(domain, run, 99, 3);
   // 100 poses per robot at 10 per second: the stream lasts 10 s once the agents are up.
-  Process launch = start({bin("tessera"),
-                          "launch",
-                          graph,
-                          "--agents",
-                          "3",
-                          "--online",
-                          "--rate",
-                          "10",
-                          "--run-id",
-                          run,
-                          "--domain",
-                          std::to_string(domain),
-                          "--timeout",
-                          "60",
-                          "--on-agent-loss",
-                          "continue",
-                          "--tum-dir",
-                          dir + "/tum",
-                          "--json",
-                          dir + "/online.json",
-                          "--keep-logs",
-                          dir + "/logs"},
-                         dir + "/launch.log");
+  Process launch = start(
+      {bin("tessera"), "launch", graph, "--agents", "3", "--online", "--rate", "10", "--run-id",
+       run, "--domain", std::to_string(domain), "--timeout", "60", "--on-agent-loss", "continue",
+       // 3 s, not the default 2 s: under the suite's parallel DDS runs on 2
+       // cores a live survivor once went unscheduled that long and was
+       // counted as lost beside the killed agent.
+       "--lease", "3", "--tum-dir", dir + "/tum", "--json", dir + "/online.json", "--keep-logs",
+       dir + "/logs"},
+      dir + "/launch.log");
   const auto until = Clock::now() + std::chrono::seconds(60);
   std::uint64_t entered = 0;
   while (entered < 60 && Clock::now() < until) {
@@ -91,7 +77,7 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim,
     Process again =
         start({bin("tessera-agent"), "--online", "--robots", "3", "--id", std::to_string(victim),
                "--run-id", run, "--domain", std::to_string(domain), "--on-agent-loss", "continue",
-               "--timeout", "60"},
+               "--timeout", "60", "--lease", "3"},
               dir + "/again.log");
     ASSERT_TRUE(wait_all({&again}, 60)) << again.output();
     EXPECT_EQ(again.exit_code, 1) << again.output();

@@ -34,9 +34,6 @@ using eprosima::fastrtps::types::ReturnCode_t;
 namespace {
 // Reports kept per agent for joiners: one per epoch boundary.
 constexpr std::int32_t kReportHistory = 100000;
-// Participant lease of an online agent, seconds (Session's default is 1 s; 2 s leaves room for
-// a loaded host, where 1 s once declared a live peer lost).
-constexpr double kOnlineLeaseS = 2.0;
 }  // namespace
 
 // A reliable write that finds the bounded history full of samples some reader has not
@@ -95,7 +92,7 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     }
   } discovery;
 
-  Impl(int domain, const std::string& run, std::uint32_t me, std::uint32_t agents)
+  Impl(int domain, const std::string& run, std::uint32_t me, std::uint32_t agents, double lease_s)
       : run_id(run), agent(me) {
     validate_run_id(run_id);
     dds::DomainParticipantQos pq = dds::PARTICIPANT_QOS_DEFAULT;
@@ -103,9 +100,9 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     // A killed agent's readers stay matched until its participant lease expires, and writes
     // to them wait for acknowledgements meanwhile: Fast DDS's default lease (20 s) would hold
     // the survivors that long before their report wait can name the silent agent.
-    pq.wire_protocol().builtin.discovery_config.leaseDuration = Duration_t(kOnlineLeaseS);
+    pq.wire_protocol().builtin.discovery_config.leaseDuration = Duration_t(lease_s);
     pq.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod =
-        Duration_t(kOnlineLeaseS / 5.0);
+        Duration_t(lease_s / 5.0);
     auto* factory = dds::DomainParticipantFactory::get_instance();
     discovery.impl = this;
     participant = factory->create_participant(domain, pq, &discovery, dds::StatusMask::none());
@@ -237,8 +234,8 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
 };
 
 OnlineChannel::OnlineChannel(int domain, const std::string& run_id, std::uint32_t agent,
-                             std::uint32_t agents)
-    : impl_(std::make_unique<Impl>(domain, run_id, agent, agents)) {}
+                             std::uint32_t agents, double lease_s)
+    : impl_(std::make_unique<Impl>(domain, run_id, agent, agents, lease_s)) {}
 OnlineChannel::~OnlineChannel() = default;
 
 std::size_t OnlineChannel::send(const OutgoingMessage& m, std::uint32_t epoch) {
