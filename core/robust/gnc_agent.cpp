@@ -134,13 +134,9 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
       // inliers keep the poses connected (fewer block neighbours, fewer colours); otherwise it
       // stays at a tiny pull so no part is cut off.
       if (terms_->known_connected() && weights_[k] == 0) continue;
-      Measurement x = in_.measurements[k];
-      const double w = std::max(weights_[k], kMinInnerWeight);
-      if (g_ > first_solve_g_) {
-        x.kappa *= w;
-        x.tau *= w;
-      }
-      measurements.push_back(std::move(x));
+      measurements.push_back(g_ > first_solve_g_
+                                 ? weighted_measurement(in_.measurements[k], weights_[k])
+                                 : in_.measurements[k]);
     }
   }
   const Eigen::MatrixXd Y = state_ ? state_->Y : in_.Y0;
@@ -164,16 +160,7 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
 // Endpoints of the measurements the current solve works on, file order: the kept set for the
 // passes and the final solve, the whole graph for GNC's weighted solves.
 std::vector<std::pair<std::uint32_t, std::uint32_t>> GncAgent::solve_structure() const {
-  if (solve_kind_ == Solve::kGnc) return in_.structure;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> kept;
-  kept.reserve(in_.structure.size() - std::min(in_.structure.size(), rejected_.size()));
-  auto r = rejected_.begin();
-  for (std::size_t e = 0; e < in_.structure.size(); ++e) {
-    while (r != rejected_.end() && *r < e) ++r;
-    if (r != rejected_.end() && *r == e) continue;
-    kept.push_back(in_.structure[e]);
-  }
-  return kept;
+  return solve_kind_ == Solve::kGnc ? in_.structure : inlier_structure(in_.structure, rejected_);
 }
 
 // The inner solve's messages, tagged with this GNC step.
@@ -652,28 +639,22 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     throw std::runtime_error(me + "unexpected robust message " + std::to_string(phase) +
                              " from agent " + std::to_string(sender));
   waiting_.erase(it);
-  // The message's expected kind, or an error naming what arrived where.
-  auto block_message = [&](const ProtocolMessage& m,
-                           const std::string& what) -> const PoseBlockMessage& {
-    return expect_pose_block(m, in_.id, what);
-  };
-  auto status_message = [&](const ProtocolMessage& m,
-                            const char* what) -> const RoundStatusMessage& {
-    return expect_status(m, in_.id, what);
-  };
+  // Each step's message kind, or an error naming what arrived where (gnc_messages).
   const char* const kStatusBelongs = "poses where a robust status belongs";
   switch (step_) {
     case Step::kPcm:
       if (in_.id == 0)
-        decode_measurement_block(block_message(message, "a status where measurements belong"),
-                                 in_.d, in_.num_poses, "robust pcm-gnc", kept_values_);
+        decode_measurement_block(
+            expect_pose_block(message, in_.id, "a status where measurements belong"), in_.d,
+            in_.num_poses, "robust pcm-gnc", kept_values_);
       else
         drop_inconsistent(
-            status_message(message, "poses where the consistency check belongs").measurement_ids);
+            expect_status(message, in_.id, "poses where the consistency check belongs")
+                .measurement_ids);
       break;
     case Step::kKeptStart: {
       const PoseBlockMessage& block =
-          block_message(message, "a status where the kept set's start belongs");
+          expect_pose_block(message, in_.id, "a status where the kept set's start belongs");
       if (in_.id == 0)
         decode_measurement_block(block, in_.d, in_.num_poses, "robust solve", kept_values_);
       else  // agent 0's fresh start of the kept set: this agent's block, lifted
@@ -684,32 +665,33 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     case Step::kPoses:
     case Step::kCandidatePoses:
     case Step::kStartPoses: {
-      const PoseBlockMessage& block = block_message(
-          message, "a status where robust poses from agent " + std::to_string(sender) + " belong");
+      const PoseBlockMessage& block = expect_pose_block(
+          message, in_.id,
+          "a status where robust poses from agent " + std::to_string(sender) + " belong");
       decode_neighbour_poses(block, terms_->neighbours(), in_.d, in_.id,
                              block.kind == BlockKind::kP ? candidate_neighbours_ : neighbours_);
       break;
     }
     case Step::kVotes:
-      votes_[sender] = {status_message(message, kStatusBelongs).cost, 0};
+      votes_[sender] = {expect_status(message, in_.id, kStatusBelongs).cost, 0};
       break;
     case Step::kCandidateVotes:
     case Step::kStartVotes:
-      votes_[sender] = read_vote(status_message(message, kStatusBelongs));
+      votes_[sender] = read_vote(expect_status(message, in_.id, kStatusBelongs));
       break;
     case Step::kWeights: {
-      const RoundStatusMessage& st = status_message(message, kStatusBelongs);
+      const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
       votes_[sender] = {st.grad_norm_sq, 0};
       read_weights_message(st, sender, in_, weights_, zero_cut_);
       break;
     }
     case Step::kRejected: {
-      const RoundStatusMessage& st = status_message(message, kStatusBelongs);
+      const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
       rejected_.insert(rejected_.end(), st.measurement_ids.begin(), st.measurement_ids.end());
       break;
     }
     case Step::kReadmitted: {
-      const RoundStatusMessage& st = status_message(message, kStatusBelongs);
+      const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
       read_readmitted_message(st, sender, in_.id, *recheck_);
       votes_[sender] = {st.cost, 0};
       break;

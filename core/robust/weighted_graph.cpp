@@ -7,6 +7,27 @@
 
 namespace tessera {
 
+Measurement weighted_measurement(Measurement m, double weight) {
+  const double w = std::max(weight, kMinInnerWeight);
+  m.kappa *= w;
+  m.tau *= w;
+  return m;
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> inlier_structure(
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    const std::vector<std::uint64_t>& rejected) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> kept;
+  kept.reserve(structure.size() - std::min(structure.size(), rejected.size()));
+  auto r = rejected.begin();
+  for (std::size_t e = 0; e < structure.size(); ++e) {
+    while (r != rejected.end() && *r < e) ++r;
+    if (r != rejected.end() && *r == e) continue;
+    kept.push_back(structure[e]);
+  }
+  return kept;
+}
+
 PoseGraph weighted_graph(const PoseGraph& graph, const std::vector<double>& weights,
                          const std::vector<Pose>& initial) {
   if (weights.size() != graph.num_measurements())
@@ -16,12 +37,9 @@ PoseGraph weighted_graph(const PoseGraph& graph, const std::vector<double>& weig
   out.num_poses = graph.num_poses;
   out.source = graph.source;
   out.initial = initial;
-  out.measurements = graph.measurements;
-  for (std::size_t e = 0; e < weights.size(); ++e) {
-    const double w = std::max(weights[e], kMinInnerWeight);
-    out.measurements[e].kappa *= w;
-    out.measurements[e].tau *= w;
-  }
+  out.measurements.reserve(weights.size());
+  for (std::size_t e = 0; e < weights.size(); ++e)
+    out.measurements.push_back(weighted_measurement(graph.measurements[e], weights[e]));
   return out;
 }
 

@@ -3,7 +3,9 @@
 // solves of GNC) and the inlier graph without the rejected ones (the final certified solve).
 
 #include <cstddef>
+#include <cstdint>
 #include <tessera/graph/pose_graph.hpp>
+#include <utility>
 #include <vector>
 
 namespace tessera {
@@ -12,6 +14,10 @@ namespace tessera {
 /// inner solves so that the graph keeps its connectivity (a cut-off part would leave the
 /// translation solve singular), at a pull 1e-10 times its plain weight.
 constexpr double kMinInnerWeight = 1e-10;
+
+/// `m` with kappa and tau multiplied by max(weight, kMinInnerWeight): one measurement of an
+/// inner solve.
+Measurement weighted_measurement(Measurement m, double weight);
 
 /// `graph` with every measurement's kappa and tau multiplied by max(weights[e],
 /// kMinInnerWeight), and `initial` = `initial` (the warm start). weights.size() must equal
@@ -23,6 +29,12 @@ PoseGraph weighted_graph(const PoseGraph& graph, const std::vector<double>& weig
 /// `initial` as its initial guess.
 PoseGraph inlier_graph(const PoseGraph& graph, const std::vector<std::size_t>& rejected,
                        const std::vector<Pose>& initial);
+
+/// The endpoints of `structure` (one per measurement, file order) without those whose indices
+/// are in `rejected` (ascending): the structure of inlier_graph()'s graph.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> inlier_structure(
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& structure,
+    const std::vector<std::uint64_t>& rejected);
 
 /// `graph` with only the measurements flagged in `keep` (one flag per measurement), without an
 /// initial guess: the known inliers' graph, whose connectivity decides whether they can start
