@@ -57,6 +57,9 @@ const char* kHelp =
     "                            preconditioner factorization; beyond it the factor keeps the\n"
     "                            known inliers and the highest-weight others that fit; 0 = all\n"
     "                            measurements (docs/robust.md) [1e9]\n"
+    "  --gnc-cluster-probes K    robust centralized: most probes that cut a run of kept\n"
+    "                            closures side by side at once (the result stays only if the\n"
+    "                            TLS cost fell), 0 = none [0]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {
@@ -118,6 +121,11 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
     } catch (const InputError& e) {
       throw InputError(std::string("option --precond-max-flops: ") + e.what());
     }
+    gnc_options.cluster_probes =
+        static_cast<int>(a.get_long("gnc-cluster-probes", gnc_options.cluster_probes));
+    if (gnc_options.cluster_probes < 0)
+      throw InputError("option --gnc-cluster-probes: GncCentralizedOptions.cluster_probes = " +
+                       std::to_string(gnc_options.cluster_probes) + ": must be >= 0 (0 = none)");
     gnc = solve_gnc_centralized(graph, gnc_options);
   } else
     gnc.final_solve = solve_centralized(graph, opt);
@@ -141,6 +149,8 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   robust_summary.threshold_squared = gnc.threshold_squared;
   robust_summary.weights_converged = gnc.weights_converged;
   robust_summary.readmitted = gnc.readmitted;
+  robust_summary.probes = gnc.probes;
+  robust_summary.probes_kept = gnc.probes_kept;
   if (robust.kind != RobustKind::kNone)
     std::printf(
         "robust %s: %d outer steps, %zu of %zu measurements rejected, cost over the "
@@ -202,6 +212,7 @@ int run_solve(const Args& args) {
   for (const char* const* o = kOnlineSwitches; *o; ++o) switches.insert(*o);
   for (const char* const* o = kRobustValued; *o; ++o) valued.insert(*o);
   valued.insert("precond-max-flops");
+  valued.insert("gnc-cluster-probes");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,

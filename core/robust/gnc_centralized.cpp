@@ -1,8 +1,11 @@
 #include <algorithm>
+#include <iterator>
 #include <stdexcept>
+#include <string>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/problem/objective.hpp>
+#include <tessera/robust/closure_clusters.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
 #include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/tls_recheck.hpp>
@@ -74,6 +77,10 @@ void GncCentralizedOptions::validate() const {
   solver.validate();
   robust.validate();
   preconditioner.validate();
+  if (cluster_probes < 0)
+    throw InputError("GncCentralizedOptions.cluster_probes = " + std::to_string(cluster_probes) +
+                     ": must be >= 0 (0 = none)");
+  clusters.validate();
 }
 
 GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
@@ -206,40 +213,120 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   CentralizedOptions final_options = options.solver;
   final_options.initialization = Initialization::kFile;
   final_options.threads = 1;
-  std::vector<Pose> start = solve.poses;
-  for (int pass = 0;; ++pass) {
-    PoseGraph inliers = inlier_graph(graph, out.rejected, start);
-    require_connected_inliers(graph, inliers, out.rejected.size());
-    // Start from the cheaper of the last estimate and the chordal guess of the kept set: an
-    // estimate that GNC bent around wrong closures can lead the local solve to a poor solution
-    // of the kept set, and without the wrong closures chordal is close to its optimum again
-    // (the distributed passes vote the same way).
-    const std::vector<Pose> guess = chordal_initialization(inliers);
-    if (evaluate_objective(inliers, guess) < evaluate_objective(inliers, start))
-      inliers.initial = guess;
-    std::vector<bool> kept_known;
-    kept_known.reserve(inliers.num_measurements());
-    for (std::size_t e = 0, next = 0; e < m; ++e) {
-      if (next < out.rejected.size() && out.rejected[next] == e)
-        ++next;
-      else
-        kept_known.push_back(known[e]);
+  // The re-check passes from `rejected` and `start`, solved with `solver`.
+  struct KeptSet {
+    CentralizedResult solve;
+    std::vector<std::size_t> rejected;
+    std::size_t readmitted = 0, late_rejected = 0;
+  };
+  auto solve_kept_set = [&](std::vector<std::size_t> rejected, std::vector<Pose> start,
+                            const CentralizedOptions& solver) {
+    KeptSet kept;
+    kept.rejected = std::move(rejected);
+    for (int pass = 0;; ++pass) {
+      PoseGraph inliers = inlier_graph(graph, kept.rejected, start);
+      require_connected_inliers(graph, inliers, kept.rejected.size());
+      // Start from the cheaper of the last estimate and the chordal guess of the kept set: an
+      // estimate that GNC bent around wrong closures can lead the local solve to a poor solution
+      // of the kept set, and without the wrong closures chordal is close to its optimum again
+      // (the distributed passes vote the same way).
+      const std::vector<Pose> guess = chordal_initialization(inliers);
+      if (evaluate_objective(inliers, guess) < evaluate_objective(inliers, start))
+        inliers.initial = guess;
+      std::vector<bool> kept_known;
+      kept_known.reserve(inliers.num_measurements());
+      for (std::size_t e = 0, next = 0; e < m; ++e) {
+        if (next < kept.rejected.size() && kept.rejected[next] == e)
+          ++next;
+        else
+          kept_known.push_back(known[e]);
+      }
+      const std::vector<double> ones(inliers.num_measurements(), 1.0);
+      kept.solve = run({std::move(inliers), ones, std::move(kept_known)}, solver);
+      if (pass == robust.readmission_passes || kept.rejected.empty()) break;
+      const std::vector<Pose>& poses = kept.solve.poses;
+      TlsRecheck verdict = tls_recheck(graph, known, poses, c2, kept.rejected);
+      if (verdict.rejected == kept.rejected) break;
+      kept.readmitted += verdict.taken_back;
+      kept.late_rejected += verdict.dropped;
+      kept.rejected = std::move(verdict.rejected);
+      start = poses;
     }
-    const std::vector<double> ones(inliers.num_measurements(), 1.0);
-    out.final_solve = run({std::move(inliers), ones, std::move(kept_known)}, final_options);
-    if (pass == robust.readmission_passes || out.rejected.empty()) break;
-    const std::vector<Pose>& poses = out.final_solve.poses;
-    TlsRecheck verdict = tls_recheck(graph, known, poses, c2, out.rejected);
-    if (verdict.rejected == out.rejected) break;
+    return kept;
+  };
+  auto adopt = [&](KeptSet&& kept) {
+    out.final_solve = std::move(kept.solve);
+    out.readmitted += kept.readmitted;
+    out.late_rejected += kept.late_rejected;
+    out.rejected = std::move(kept.rejected);
+  };
+  adopt(solve_kept_set(out.rejected, solve.poses, final_options));
+
+  // Cluster probes (GncCentralizedOptions::cluster_probes): a run of wrong closures that fit
+  // each other survives every one-at-a-time verdict, so cut a whole run of kept closures at
+  // once, let the re-check passes take back what fits without it, and keep the result only when
+  // the TLS cost over every measurement falls. Each accepted probe is a descent step of the TLS
+  // cost, like the passes; a refused one changes nothing.
+  if (options.cluster_probes > 0 && !out.rejected.empty()) {
+    CentralizedOptions trial = final_options;
+    trial.certify = false;  // only the set that stays is certified
+    double best = tls_cost(graph, known, out.final_solve.poses, c2);
+    // Probes tried since the set last changed, and the single clusters among them whose cut
+    // raised the TLS cost (with the rise): two runs that share a stretch can hold each other's
+    // bend, so that cutting either alone costs more and cutting both costs less (intel, group
+    // 0.5: 4821 -> 4893 and 4857 alone); those are then tried in pairs, smallest rises first.
+    std::vector<std::vector<std::size_t>> tried;
+    std::vector<std::pair<double, std::vector<std::size_t>>> raised;
+    auto untried = [&](const std::vector<std::size_t>& p) {
+      return std::find(tried.begin(), tried.end(), p) == tried.end();
+    };
+    bool improved = false;
+    while (out.probes < options.cluster_probes) {
+      std::vector<std::size_t> probe;
+      bool single = true;
+      for (const ClosureCluster& c : closure_clusters(graph, known, out.rejected, options.clusters))
+        if (untried(c.members)) {
+          probe = c.members;
+          break;
+        }
+      if (probe.empty()) {
+        single = false;
+        std::sort(raised.begin(), raised.end());
+        for (std::size_t x = 0; x < raised.size() && probe.empty(); ++x)
+          for (std::size_t y = x + 1; y < raised.size() && probe.empty(); ++y) {
+            std::vector<std::size_t> both;
+            std::merge(raised[x].second.begin(), raised[x].second.end(), raised[y].second.begin(),
+                       raised[y].second.end(), std::back_inserter(both));
+            if (untried(both)) probe = std::move(both);
+          }
+      }
+      if (probe.empty()) break;
+      tried.push_back(probe);
+      ++out.probes;
+      std::vector<std::size_t> rejected = out.rejected;
+      rejected.insert(rejected.end(), probe.begin(), probe.end());
+      std::sort(rejected.begin(), rejected.end());
+      KeptSet kept = solve_kept_set(std::move(rejected), out.final_solve.poses, trial);
+      const double cost = tls_cost(graph, known, kept.solve.poses, c2);
+      if (!(cost < best * (1 - 1e-6))) {  // not lower, or the same set solved again
+        if (single && cost > best * (1 + 1e-6)) raised.emplace_back(cost - best, probe);
+        continue;
+      }
+      best = cost;
+      ++out.probes_kept;
+      tried.clear();  // with the set changed, a cluster refused before may now lower the cost
+      raised.clear();
+      improved = true;
+      adopt(std::move(kept));
+    }
+    // The certificate (and the staircase) for the set that stayed.
+    if (improved) adopt(solve_kept_set(out.rejected, out.final_solve.poses, final_options));
+  }
+  if (out.readmitted + out.late_rejected > 0 || out.probes_kept > 0)
     for (std::size_t e = 0; e < m; ++e)
       if (!known[e])
         out.weights[e] =
-            std::binary_search(verdict.rejected.begin(), verdict.rejected.end(), e) ? 0.0 : 1.0;
-    out.readmitted += verdict.taken_back;
-    out.late_rejected += verdict.dropped;
-    out.rejected = std::move(verdict.rejected);
-    start = poses;
-  }
+            std::binary_search(out.rejected.begin(), out.rejected.end(), e) ? 0.0 : 1.0;
   return out;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <tessera/graph/pose_graph.hpp>
+#include <tessera/robust/closure_clusters.hpp>
 #include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/robust_options.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
@@ -38,6 +39,15 @@ struct GncCentralizedOptions {
   /// truncated CG. A graph whose full factor fits the budget (every clean shared graph) is solved
   /// exactly as with the full preconditioner. max_flops = 0: always the full one.
   PreconditionerEdgeOptions preconditioner;
+  /// Most cluster probes after the re-check passes, >= 0 (0 = none). A probe cuts one cluster of
+  /// kept closures that run side by side (closure_clusters.hpp, the one with the most rejected
+  /// closures near it that was not tried yet), runs the re-check passes from there and keeps the
+  /// result only when the TLS cost over every measurement falls. Why: a run of wrong closures
+  /// between two look-alike stretches bends the map until all of them fit, and the true closures
+  /// of the stretch are cut instead; no one-at-a-time verdict undoes that, while the truth has
+  /// the lower TLS cost (intel with group outliers; docs/benchmarks/robust.md, "Group outliers").
+  int cluster_probes = 0;
+  ClosureClusterOptions clusters;  ///< Which kept closures form a cluster.
   /// Throws InputError naming the first bad field.
   void validate() const;
 };
@@ -68,6 +78,8 @@ struct GncCentralizedResult {
   /// Kept measurements beyond the bound at an inlier set's solution, rejected by a re-check pass.
   std::size_t late_rejected = 0;
   PairwiseConsistencyResult pcm;  ///< kPcmGnc: the consistency check (empty otherwise).
+  int probes = 0;                 ///< Cluster probes run (GncCentralizedOptions::cluster_probes).
+  int probes_kept = 0;            ///< Of those, the ones that lowered the TLS cost and stayed.
   /// The start vote (GncCentralizedOptions::known_inlier_start) chose the known inliers' start.
   bool started_from_known_inliers = false;
   /// Every solve in order: the first (plain) one, the weighted ones, the kept set's.
