@@ -42,6 +42,18 @@ void ClosureClusterOptions::validate() const {
     throw InputError("ClosureClusterOptions.near = " + std::to_string(near) + ": must be >= 0");
 }
 
+bool clusters_meet(const ClosureCluster& a, const ClosureCluster& b, int near) {
+  // Two id ranges meet when the gap between them is at most `near`.
+  auto gap = [](std::size_t f1, std::size_t l1, std::size_t f2, std::size_t l2) {
+    return l1 < f2 ? f2 - l1 : l2 < f1 ? f1 - l2 : 0;
+  };
+  const std::size_t n = static_cast<std::size_t>(std::max(near, 0));
+  return gap(a.lo_first, a.lo_last, b.lo_first, b.lo_last) <= n ||
+         gap(a.lo_first, a.lo_last, b.hi_first, b.hi_last) <= n ||
+         gap(a.hi_first, a.hi_last, b.lo_first, b.lo_last) <= n ||
+         gap(a.hi_first, a.hi_last, b.hi_first, b.hi_last) <= n;
+}
+
 std::vector<ClosureCluster> closure_clusters(const PoseGraph& graph, const std::vector<bool>& known,
                                              const std::vector<std::size_t>& rejected,
                                              const ClosureClusterOptions& options) {
@@ -85,6 +97,10 @@ std::vector<ClosureCluster> closure_clusters(const PoseGraph& graph, const std::
       hi_last = std::max(hi_last, s.hi);
     }
     ClosureCluster c;
+    c.lo_first = lo_first;
+    c.lo_last = lo_last;
+    c.hi_first = hi_first;
+    c.hi_last = hi_last;
     for (std::size_t e : cut) {
       const Span s = span_of(graph.measurements[e]);
       const std::size_t d =
@@ -92,7 +108,7 @@ std::vector<ClosureCluster> closure_clusters(const PoseGraph& graph, const std::
                     distance_to(s.hi, lo_first, lo_last), distance_to(s.hi, hi_first, hi_last)});
       if (d <= near) ++c.rejected_near;
     }
-    if (c.rejected_near == 0) continue;
+    if (c.rejected_near < options.min_rejected_near) continue;
     c.members = std::move(g);
     out.push_back(std::move(c));
   }

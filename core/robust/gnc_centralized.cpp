@@ -272,44 +272,69 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
     trial.certify = false;  // only the set that stays is certified
     double best = tls_cost(graph, known, out.final_solve.poses, c2);
     // Probes tried since the set last changed, and the single clusters among them whose cut
-    // raised the TLS cost (with the rise): two runs that share a stretch can hold each other's
-    // bend, so that cutting either alone costs more and cutting both costs less (intel, group
-    // 0.5: 4821 -> 4893 and 4857 alone); those are then tried in pairs, smallest rises first.
+    // raised the TLS cost (with the rise): two runs that share a stretch can hold one bend
+    // together, so that cutting either alone costs more and cutting both costs less (intel,
+    // group 0.5: TLS 4821 -> 4893 and 4857 alone). When no single cluster is left, each of those
+    // (smallest rise first) is tried together with a cluster that shares a stretch with it: the
+    // others that raised the cost first, then any cluster, also one that no cut closure points at.
     std::vector<std::vector<std::size_t>> tried;
-    std::vector<std::pair<double, std::vector<std::size_t>>> raised;
+    // A probe: the clusters it cuts together, and their members (ascending).
+    struct Probe {
+      std::vector<ClosureCluster> parts;
+      std::vector<std::size_t> members;
+    };
+    std::vector<std::pair<double, Probe>> raised;
     auto untried = [&](const std::vector<std::size_t>& p) {
       return std::find(tried.begin(), tried.end(), p) == tried.end();
     };
+    ClosureClusterOptions every = options.clusters;
+    every.min_rejected_near = 0;
     bool improved = false;
     while (out.probes < options.cluster_probes) {
-      std::vector<std::size_t> probe;
-      bool single = true;
+      Probe probe;
       for (const ClosureCluster& c : closure_clusters(graph, known, out.rejected, options.clusters))
         if (untried(c.members)) {
-          probe = c.members;
+          probe.parts = {c};
+          probe.members = c.members;
           break;
         }
-      if (probe.empty()) {
-        single = false;
-        std::sort(raised.begin(), raised.end());
-        for (std::size_t x = 0; x < raised.size() && probe.empty(); ++x)
-          for (std::size_t y = x + 1; y < raised.size() && probe.empty(); ++y) {
+      if (probe.members.empty() && !raised.empty()) {
+        std::stable_sort(raised.begin(), raised.end(),
+                         [](const auto& x, const auto& y) { return x.first < y.first; });
+        std::vector<ClosureCluster> partners;
+        for (const auto& r : raised)
+          if (r.second.parts.size() == 1) partners.push_back(r.second.parts.front());
+        for (ClosureCluster& c : closure_clusters(graph, known, out.rejected, every))
+          partners.push_back(std::move(c));
+        for (std::size_t x = 0; x < raised.size() && probe.members.empty(); ++x)
+          for (std::size_t y = 0; y < partners.size() && probe.members.empty(); ++y) {
+            const Probe& a = raised[x].second;
+            const ClosureCluster& b = partners[y];
+            bool inside = false, meets = false;
+            for (const ClosureCluster& part : a.parts) {
+              inside = inside || part.members == b.members;
+              meets = meets || clusters_meet(part, b, options.clusters.near);
+            }
+            if (inside || !meets) continue;
             std::vector<std::size_t> both;
-            std::merge(raised[x].second.begin(), raised[x].second.end(), raised[y].second.begin(),
-                       raised[y].second.end(), std::back_inserter(both));
-            if (untried(both)) probe = std::move(both);
+            std::set_union(a.members.begin(), a.members.end(), b.members.begin(), b.members.end(),
+                           std::back_inserter(both));
+            if (!untried(both)) continue;
+            probe.parts = a.parts;
+            probe.parts.push_back(b);
+            probe.members = std::move(both);
           }
       }
-      if (probe.empty()) break;
-      tried.push_back(probe);
+      if (probe.members.empty()) break;
+      tried.push_back(probe.members);
       ++out.probes;
       std::vector<std::size_t> rejected = out.rejected;
-      rejected.insert(rejected.end(), probe.begin(), probe.end());
+      rejected.insert(rejected.end(), probe.members.begin(), probe.members.end());
       std::sort(rejected.begin(), rejected.end());
       KeptSet kept = solve_kept_set(std::move(rejected), out.final_solve.poses, trial);
       const double cost = tls_cost(graph, known, kept.solve.poses, c2);
       if (!(cost < best * (1 - 1e-6))) {  // not lower, or the same set solved again
-        if (single && cost > best * (1 + 1e-6)) raised.emplace_back(cost - best, probe);
+        if (cost > best * (1 + 1e-6)) raised.emplace_back(cost - best, std::move(probe));
         continue;
       }
       best = cost;

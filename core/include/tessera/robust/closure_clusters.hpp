@@ -25,6 +25,8 @@ struct ClosureClusterOptions {
   /// of one of the cluster's two stretches, >= 0. 20: on intel with group outliers the true
   /// closures cut beside a kept wrong run end within 40 ids of its stretches.
   int near = 20;
+  /// Fewest rejected closures near a cluster for it to be listed, >= 0 (0 = every cluster).
+  std::size_t min_rejected_near = 1;
   /// Throws InputError naming the first bad field.
   void validate() const;
 };
@@ -32,10 +34,17 @@ struct ClosureClusterOptions {
 struct ClosureCluster {
   std::vector<std::size_t> members;  ///< Measurement indices, ascending.
   std::size_t rejected_near = 0;     ///< Rejected closures with an end near its stretches.
+  /// Its two stretches: the id ranges of its members' lower and upper ends.
+  std::size_t lo_first = 0, lo_last = 0, hi_first = 0, hi_last = 0;
 };
 
+/// True when a stretch of `a` and a stretch of `b` lie within `near` pose ids of each other: two
+/// runs that share a stretch can hold one bend of the map together.
+bool clusters_meet(const ClosureCluster& a, const ClosureCluster& b, int near);
+
 /// The clusters of the kept closures (known[e] false, e not in `rejected`, which is ascending)
-/// with at least options.min_size members and at least one rejected closure near them, most
+/// with at least options.min_size members and at least options.min_rejected_near rejected
+/// closures near them, most
 /// rejected_near first (then larger first, then lower first member).
 std::vector<ClosureCluster> closure_clusters(const PoseGraph& graph, const std::vector<bool>& known,
                                              const std::vector<std::size_t>& rejected,
