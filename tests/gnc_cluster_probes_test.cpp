@@ -9,6 +9,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "gnc_fixtures.hpp"
+#include "test_support.hpp"
 
 namespace tessera {
 namespace {
@@ -145,6 +146,33 @@ TEST(GncCentralized, ClusterProbesLeaveAnExactAnswerAsItIs) {
   EXPECT_EQ(with.probes_kept, 0);
   EXPECT_EQ(with.rejected, without.rejected);
   EXPECT_EQ(with.final_solve.cost, without.final_solve.cost);
+}
+
+TEST(GncClusterProbesCli, TheFlagReachesTheSolveAndABadValueNamesItWithExitStatusTwo) {
+  const std::string dir = test::temp_dir();
+  const std::string file = dir + "/group.g2o", json = dir + "/out.json";
+  std::string output;
+  ASSERT_EQ(test::run_command(test::bin("tessera") +
+                                  " generate --kind grid3d --poses 125 --robots 5 --seed 2 "
+                                  "--outliers 0.25 --outlier-kind group --out " +
+                                  file,
+                              &output),
+            0)
+      << output;
+  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + file +
+                                  " --robust gnc-tls --gnc-cluster-probes -1",
+                              &output),
+            2);
+  EXPECT_TRUE(test::contains(output, "--gnc-cluster-probes")) << output;
+  EXPECT_TRUE(test::contains(output, "GncCentralizedOptions.cluster_probes")) << output;
+  ASSERT_EQ(test::run_command(test::bin("tessera") + " solve " + file +
+                                  " --robust gnc-tls --gnc-cluster-probes 2 --json " + json,
+                              &output),
+            0)
+      << output;
+  const std::string summary = test::read_text_file(json);
+  // Rejected closures lie near kept runs of the grid, so the budget of 2 is what ends the probes.
+  EXPECT_TRUE(test::contains(summary, "\"probes\": 2")) << summary;
 }
 
 }  // namespace
