@@ -95,6 +95,14 @@ TEST(ClosureClusters, BadOptionsNameTheField) {
     EXPECT_NE(std::string(e.what()).find("GncCentralizedOptions.cluster_probes"),
               std::string::npos);
   }
+  gnc.cluster_probes = 1;
+  gnc.readmit_ratio = -1;
+  try {
+    gnc.validate();
+    FAIL() << "readmit_ratio -1 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("GncCentralizedOptions.readmit_ratio"), std::string::npos);
+  }
 }
 
 // The case cluster probes exist for: on a map whose information states more noise than its data
