@@ -1,6 +1,5 @@
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/distributed_initialization.hpp>
@@ -15,6 +14,8 @@
 #include <tessera/solvers/chordal_initialization.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "robust/cluster_probes.hpp"
+
 namespace tessera {
 namespace {
 
@@ -25,15 +26,6 @@ std::vector<double> residuals(const PoseGraph& graph, const std::vector<Pose>& p
     r2[e] = residual_squared(m, poses[m.i], poses[m.j]);
   }
   return r2;
-}
-
-// The TLS cost the start vote compares: known inliers count in full, the others up to c^2.
-double tls_cost(const PoseGraph& graph, const std::vector<bool>& known,
-                const std::vector<Pose>& poses, double c2) {
-  const std::vector<double> r2 = residuals(graph, poses);
-  double f = 0;
-  for (std::size_t e = 0; e < r2.size(); ++e) f += known[e] ? r2[e] : std::min(r2[e], c2);
-  return f;
 }
 
 // A solve's problem with what its preconditioner's selection ranks by: each measurement's
@@ -274,116 +266,19 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   if (options.cluster_probes > 0 && !out.rejected.empty()) {
     CentralizedOptions trial = final_options;
     trial.certify = false;  // only the set that stays is certified
-    double best = tls_cost(graph, known, out.final_solve.poses, c2);
-    // Probes tried since the set last changed, and the single clusters among them whose cut
-    // raised the TLS cost (with the rise): two runs that share a stretch can hold one bend
-    // together, so that cutting either alone costs more and cutting both costs less (intel,
-    // group 0.5: TLS 4821 -> 4893 and 4857 alone). When no single cluster is left, each of those
-    // (smallest rise first) is tried together with a cluster that shares a stretch with it: the
-    // others that raised the cost first, then any cluster, also one that no cut closure points at.
-    std::vector<std::vector<std::size_t>> tried;
-    // A probe: the clusters it cuts together, and their members (ascending).
-    struct Probe {
-      std::vector<ClosureCluster> parts;
-      std::vector<std::size_t> members;
-    };
-    std::vector<std::pair<double, Probe>> raised;
-    std::vector<std::size_t> readmit_tried;  // rejected closures taken back alone since then
-    auto untried = [&](const std::vector<std::size_t>& p) {
-      return std::find(tried.begin(), tried.end(), p) == tried.end();
-    };
-    ClosureClusterOptions every = options.clusters;
-    every.min_rejected_near = 0;
-    bool improved = false;
-    while (out.probes < options.cluster_probes) {
-      Probe probe;
-      for (const ClosureCluster& c : closure_clusters(graph, known, out.rejected, options.clusters))
-        if (untried(c.members)) {
-          probe.parts = {c};
-          probe.members = c.members;
-          break;
-        }
-      if (probe.members.empty() && !raised.empty()) {
-        std::stable_sort(raised.begin(), raised.end(),
-                         [](const auto& x, const auto& y) { return x.first < y.first; });
-        std::vector<ClosureCluster> partners;
-        for (const auto& r : raised)
-          if (r.second.parts.size() == 1) partners.push_back(r.second.parts.front());
-        for (ClosureCluster& c : closure_clusters(graph, known, out.rejected, every))
-          partners.push_back(std::move(c));
-        for (std::size_t x = 0; x < raised.size() && probe.members.empty(); ++x)
-          for (std::size_t y = 0; y < partners.size() && probe.members.empty(); ++y) {
-            const Probe& a = raised[x].second;
-            const ClosureCluster& b = partners[y];
-            bool inside = false, meets = false;
-            for (const ClosureCluster& part : a.parts) {
-              inside = inside || part.members == b.members;
-              meets = meets || clusters_meet(part, b, options.clusters.near);
-            }
-            if (inside || !meets) continue;
-            std::vector<std::size_t> both;
-            std::set_union(a.members.begin(), a.members.end(), b.members.begin(), b.members.end(),
-                           std::back_inserter(both));
-            if (!untried(both)) continue;
-            probe.parts = a.parts;
-            probe.parts.push_back(b);
-            probe.members = std::move(both);
-          }
-      }
-      // Last, a rejected closure just beyond the bound (r^2 <= readmit_ratio c^2 at the kept
-      // set's solution), nearest first, taken back alone: a true closure that a cut run's bend
-      // pushed out can stay beyond the bound at a local solution that fitting it would move
-      // (intel, group 0.1: r^2 71.9 against c^2 = 32.8, 4.3 at the clean optimum).
-      std::size_t readmit = m;
-      if (probe.members.empty() && options.readmit_ratio > 0) {
-        const std::vector<double> r2_now = residuals(graph, out.final_solve.poses);
-        for (std::size_t e : out.rejected)
-          if (!known[e] && r2_now[e] <= options.readmit_ratio * c2 &&
-              std::find(readmit_tried.begin(), readmit_tried.end(), e) == readmit_tried.end() &&
-              (readmit == m || r2_now[e] < r2_now[readmit]))
-            readmit = e;
-      }
-      if (readmit != m) {
-        readmit_tried.push_back(readmit);
-        ++out.probes;
-        std::vector<std::size_t> rejected;
-        for (std::size_t e : out.rejected)
-          if (e != readmit) rejected.push_back(e);
-        KeptSet kept = solve_kept_set(std::move(rejected), out.final_solve.poses, trial);
-        const double cost = tls_cost(graph, known, kept.solve.poses, c2);
-        if (cost < best * (1 - 1e-6)) {
-          best = cost;
-          ++out.probes_kept;
-          tried.clear();
-          raised.clear();
-          readmit_tried.clear();
-          improved = true;
-          adopt(std::move(kept));
-        }
-        continue;
-      }
-      if (probe.members.empty()) break;
-      tried.push_back(probe.members);
-      ++out.probes;
-      std::vector<std::size_t> rejected = out.rejected;
-      rejected.insert(rejected.end(), probe.members.begin(), probe.members.end());
-      std::sort(rejected.begin(), rejected.end());
-      KeptSet kept = solve_kept_set(std::move(rejected), out.final_solve.poses, trial);
-      const double cost = tls_cost(graph, known, kept.solve.poses, c2);
-      if (!(cost < best * (1 - 1e-6))) {  // not lower, or the same set solved again
-        if (cost > best * (1 + 1e-6)) raised.emplace_back(cost - best, std::move(probe));
-        continue;
-      }
-      best = cost;
-      ++out.probes_kept;
-      tried.clear();  // with the set changed, a cluster refused before may now lower the cost
-      raised.clear();
-      readmit_tried.clear();
-      improved = true;
-      adopt(std::move(kept));
-    }
+    KeptSet last;
+    const ClusterProbeCounts counts = search_cluster_probes(
+        graph, known, c2, options.cluster_probes, options.clusters, options.readmit_ratio,
+        out.rejected, out.final_solve.poses,
+        [&](std::vector<std::size_t> rejected) {
+          last = solve_kept_set(std::move(rejected), out.final_solve.poses, trial);
+          return ClusterProbeTrial{last.rejected, last.solve.poses};
+        },
+        [&] { adopt(std::move(last)); });
+    out.probes = counts.probes;
+    out.probes_kept = counts.kept;
     // The certificate (and the staircase) for the set that stayed.
-    if (improved) adopt(solve_kept_set(out.rejected, out.final_solve.poses, final_options));
+    if (counts.kept > 0) adopt(solve_kept_set(out.rejected, out.final_solve.poses, final_options));
   }
   if (out.readmitted + out.late_rejected > 0 || out.probes_kept > 0)
     for (std::size_t e = 0; e < m; ++e)
