@@ -9,6 +9,12 @@ set against the labels, relative gap of the robust cost (over the kept measureme
 f*_clean, ATE of the estimate against the clean optimum after a rigid alignment, outer steps,
 solver iterations, wall time, certified; beside it the plain solve's cost gap and ATE.
 
+--cluster-probes K gives the centralized robust solve `--gnc-cluster-probes K`; --explain adds,
+for group cells, the TLS cost at the robust estimate and at the clean optimum, the groups that
+kept members and the true closures cut (is the wrong answer TLS's optimum, or a search failure?);
+--compare BASE prints two runs' centralized columns side by side (docs/benchmarks/robust.md,
+"Group outliers").
+
 With --clean-all instead: F = 0 on every shared dataset, the robust distributed solve with 5
 agents in process (and with --dds over DDS too), against f* of ../shared/reference/optima.csv
 (robust_clean.csv; docs/benchmarks/robust.md, "F = 0 on every shared dataset").
