@@ -20,11 +20,15 @@ namespace tessera {
 
 namespace {
 
-std::uint32_t phase_of(const ProtocolMessage& m) {
-  return std::visit([](const auto& x) { return x.phase; }, m);
+// The exchanges that carry two blocks per neighbour, both starts' poses (kind Y, kind P).
+bool two_starts(std::uint32_t phase) {
+  const std::uint32_t e = phase % kGncStepStride;
+  return e == kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kStartPoses) ||
+         e == kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kCandidatePoses);
 }
-std::uint32_t sender_of(const ProtocolMessage& m) {
-  return std::visit([](const auto& x) { return x.sender; }, m);
+
+std::vector<int> as_ints(const std::vector<std::uint32_t>& ids) {
+  return {ids.begin(), ids.end()};
 }
 
 }  // namespace
@@ -76,7 +80,6 @@ void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t p
     const auto to_agent = static_cast<std::uint32_t>(adjacent[q]);
     out.push_back(OutgoingMessage{
         encode_public_poses(*base_, in_.id, q, in_.d, Y, kind, 0, phase), false, {to_agent}});
-    waiting_.push_back(to_agent);  // one message from that neighbour per message sent
   }
 }
 
@@ -153,8 +156,21 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
   pass_on(solve_->start(), out);
   const std::uint32_t g = g_;
-  replay(out);
+  // Messages of this solve that came while this agent was behind; once the solve has ended,
+  // the rest are of no use.
+  for (const ProtocolMessage& m :
+       gate_.take_steps(g * kGncStepStride, g * kGncStepStride + kGncExchangeBase)) {
+    if (done_ || g_ != g || step_ != Step::kSolve) break;
+    to_solve(m, out);
+  }
   if (!done_ && g_ == g && step_ == Step::kSolve && solve_->done()) after_solve(out);
+}
+
+void GncAgent::to_solve(const ProtocolMessage& message, std::vector<OutgoingMessage>& out) {
+  ProtocolMessage m = message;
+  std::visit([&](auto& x) { x.phase -= g_ * kGncStepStride; }, m);
+  pass_on(solve_->handle(m), out);
+  if (solve_->done()) after_solve(out);
 }
 
 // Endpoints of the measurements the current solve works on, file order: the kept set for the
@@ -222,29 +238,31 @@ std::uint32_t GncAgent::exchange_phase() const {
 
 // Agent 0 gathers the values of the measurements the agents weigh (each measurement once; with
 // `kept_only` the ones not rejected): the others send theirs, agent 0 keeps its own and waits.
-void GncAgent::gather_values_at_lead(GncExchange exchange, bool kept_only,
-                                     std::vector<OutgoingMessage>& out) {
+// Returns whom this agent waits for (the others wait for agent 0's answer).
+std::vector<int> GncAgent::gather_values_at_lead(GncExchange exchange, bool kept_only,
+                                                 std::vector<OutgoingMessage>& out) {
   const std::vector<std::uint64_t>* rejected = kept_only ? &rejected_ : nullptr;
   if (in_.id != 0) {
     out.push_back(OutgoingMessage{
         owned_values_block(in_, *terms_, rejected, gnc_phase(g_, exchange)), false, {0}});
-    waiting_.push_back(0);
-    return;
+    return {0};
   }
   kept_values_.clear();
   append_owned_values(in_, *terms_, rejected, kept_values_);
-  waiting_ = other_agents(0, in_.num_agents);
+  return as_ints(other_agents(0, in_.num_agents));
 }
 
 void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   step_ = step;
   const std::uint32_t phase = exchange_phase();
   const auto me = static_cast<std::uint32_t>(in_.id);
-  waiting_.clear();
   votes_.clear();
+  // Whom this agent hears from: a pose exchange from its block neighbours (each sends what it
+  // was sent), a status exchange from every other agent.
+  std::vector<int> from = base_->adjacent[static_cast<std::size_t>(in_.id)];
   // A status to every other agent, each of which answers with its own.
   auto to_others = [&](RoundStatusMessage st) {
-    waiting_ = other_agents(me, in_.num_agents);
+    from = as_ints(other_agents(me, in_.num_agents));
     broadcast_status(std::move(st), me, phase, in_.num_agents, out);
   };
   switch (step) {
@@ -272,10 +290,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       to_others(vote_message(votes_[me]));
       break;
     case Step::kPcm:
-      gather_values_at_lead(GncExchange::kPcmValues, false, out);
+      from = gather_values_at_lead(GncExchange::kPcmValues, false, out);
       break;
     case Step::kKeptStart:
-      gather_values_at_lead(GncExchange::kKeptValues, true, out);
+      from = gather_values_at_lead(GncExchange::kKeptValues, true, out);
       break;
     case Step::kCandidatePoses:
       // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
@@ -302,8 +320,9 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       votes_[me] = {spread, 0};
       zero_cut_ =
           zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
-      waiting_ = other_agents(me, in_.num_agents);
-      for (std::uint32_t a : waiting_) {
+      const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
+      from = as_ints(others);
+      for (std::uint32_t a : others) {
         RoundStatusMessage st = weights_message(a, spread, in_, *terms_, weights_);
         st.phase = phase;
         st.sender = me;
@@ -331,8 +350,30 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     default:
       break;
   }
-  replay(out);
-  if (!done_ && step_ == step && exchange_phase() == phase && waiting_.empty()) after_exchange(out);
+  // Both starts' poses come as two parts: the kind Y blocks (part 0), then the kind P ones.
+  gate_.expect(0, phase, std::move(from));
+  take_exchange(out);
+}
+
+// The gate's round of a message: the inner solve's round, or the part of an exchange (the kind
+// P blocks of both starts' poses are part 1; an exchange's round on the wire is always 0).
+std::uint32_t GncAgent::gate_round(const ProtocolMessage& m) const {
+  const std::uint32_t phase = message_phase(m);
+  if (phase % kGncStepStride < kGncExchangeBase) return message_round(m);
+  const auto* block = std::get_if<PoseBlockMessage>(&m);
+  return two_starts(phase) && block && block->kind == BlockKind::kP ? 1 : 0;
+}
+
+void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
+  std::optional<MessageGate::Inbox> inbox = gate_.take_ready();
+  if (!inbox) return;
+  read_exchange(*inbox);
+  if (two_starts(gate_.step()) && gate_.round() == 0) {
+    gate_.expect(1, gate_.step(), gate_.senders());
+    take_exchange(out);
+    return;
+  }
+  after_exchange(out);
 }
 
 void GncAgent::require_kept_connected() const {
@@ -623,22 +664,17 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   }
 }
 
-void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>& out) {
-  const std::uint32_t phase = phase_of(message);
-  if (step_ == Step::kSolve) {
-    ProtocolMessage m = message;
-    std::visit([&](auto& x) { x.phase -= g_ * kGncStepStride; }, m);
-    pass_on(solve_->handle(m), out);
-    if (solve_->done()) after_solve(out);
-    return;
+void GncAgent::read_exchange(const MessageGate::Inbox& inbox) {
+  const std::vector<int>& expected = gate_.senders();
+  for (const auto& [from, message] : inbox) {
+    const auto sender = static_cast<std::uint32_t>(from);
+    if (std::find(expected.begin(), expected.end(), from) == expected.end())
+      throw unexpected(message);
+    read_message(sender, message);
   }
-  const std::uint32_t sender = sender_of(message);
-  auto it = std::find(waiting_.begin(), waiting_.end(), sender);
-  const std::string me = "agent " + std::to_string(in_.id) + ": ";
-  if (it == waiting_.end())
-    throw std::runtime_error(me + "unexpected robust message " + std::to_string(phase) +
-                             " from agent " + std::to_string(sender));
-  waiting_.erase(it);
+}
+
+void GncAgent::read_message(std::uint32_t sender, const ProtocolMessage& message) {
   // Each step's message kind, or an error naming what arrived where (gnc_messages).
   const char* const kStatusBelongs = "poses where a robust status belongs";
   switch (step_) {
@@ -699,52 +735,37 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     default:
       break;
   }
-  if (waiting_.empty()) after_exchange(out);
 }
 
-void GncAgent::replay(std::vector<OutgoingMessage>& out) {
-  // Messages of the step just begun that came while this agent was behind.
-  while (!done_ && !later_.empty()) {
-    const std::uint32_t phase = later_.begin()->first;
-    if (!is_current(phase)) {
-      if (phase >= lowest_current_phase()) return;
-      later_.erase(later_.begin());  // of a step this agent has left
-      continue;
-    }
-    std::vector<ProtocolMessage> kept = std::move(later_.begin()->second);
-    later_.erase(later_.begin());
-    const Step step = step_;
-    const std::uint32_t g = g_;
-    for (std::size_t q = 0; q < kept.size(); ++q) {
-      if (done_ || step_ != step || g_ != g) {
-        // The step moved on: what is left goes back in line.
-        auto& back = later_[phase];
-        back.insert(back.begin(), kept.begin() + static_cast<std::ptrdiff_t>(q), kept.end());
-        break;
-      }
-      feed(kept[q], out);
-    }
-  }
+std::runtime_error GncAgent::unexpected(const ProtocolMessage& message) const {
+  return std::runtime_error("agent " + std::to_string(in_.id) + ": unexpected robust message " +
+                            std::to_string(message_phase(message)) + " from agent " +
+                            std::to_string(message_sender(message)));
 }
 
 std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {
   std::vector<OutgoingMessage> out;
   if (done_) return out;
-  const std::uint32_t phase = phase_of(message);
-  if (is_current(phase)) {
-    feed(message, out);
-    replay(out);
+  const std::uint32_t phase = message_phase(message);
+  if (phase < lowest_current_phase()) return out;  // a step this agent has left needs nothing more
+  const bool current = is_current(phase);
+  if (current && step_ == Step::kSolve) {
+    to_solve(message, out);
     return out;
   }
-  if (phase < lowest_current_phase()) return out;  // a step this agent has left needs nothing more
-  later_[phase].push_back(message);
+  const std::vector<int>& expected = gate_.senders();
+  const auto sender = static_cast<int>(message_sender(message));
+  if (current && std::find(expected.begin(), expected.end(), sender) == expected.end())
+    throw unexpected(message);
+  if (!gate_.add(sender, gate_round(message), phase, message)) throw unexpected(message);
+  if (current) take_exchange(out);
   return out;
 }
 
 std::size_t GncAgent::messages_needed() const {
   if (done_) return 0;
   if (step_ == Step::kSolve) return std::max<std::size_t>(solve_->messages_needed(), 1);
-  return std::max<std::size_t>(waiting_.size(), 1);
+  return std::max<std::size_t>(gate_.missing().size(), 1);
 }
 
 std::optional<AwaitedMessages> GncAgent::awaited() const {
@@ -754,10 +775,8 @@ std::optional<AwaitedMessages> GncAgent::awaited() const {
     if (a) a->phase += g_ * kGncStepStride;
     return a;
   }
-  std::vector<std::uint32_t> senders = waiting_;
-  std::sort(senders.begin(), senders.end());
-  senders.erase(std::unique(senders.begin(), senders.end()), senders.end());
-  return AwaitedMessages{0, exchange_phase(), senders};
+  const std::vector<int> missing = gate_.missing();
+  return AwaitedMessages{0, exchange_phase(), {missing.begin(), missing.end()}};
 }
 
 }  // namespace tessera

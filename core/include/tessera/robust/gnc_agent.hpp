@@ -36,7 +36,8 @@
 // (weight_owner()); the other end receives it, so both ends always use the same weight. The
 // stop follows from the summed spread, identical on every agent: no central step.
 // Messages carry their step in `phase` (gnc_phase()); a fast agent's messages of later steps
-// are kept until this agent gets there.
+// wait in a MessageGate until this agent gets there, and each exchange reads its messages in
+// agent-id order once all are in.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -44,12 +45,14 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <tessera/distributed/agent_process.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/certified_agent.hpp>
 #include <tessera/distributed/distributed_initialization.hpp>
+#include <tessera/distributed/message_gate.hpp>
 #include <tessera/graph/measurement.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
 #include <utility>
@@ -210,12 +213,18 @@ class GncAgent : public AgentProcess {
   enum class Solve { kGnc, kInlierPass, kFinal };
   void begin_solve(std::vector<OutgoingMessage>& out);
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
-  void gather_values_at_lead(GncExchange exchange, bool kept_only,
-                             std::vector<OutgoingMessage>& out);
+  std::vector<int> gather_values_at_lead(GncExchange exchange, bool kept_only,
+                                         std::vector<OutgoingMessage>& out);
   void after_solve(std::vector<OutgoingMessage>& out);
   void after_exchange(std::vector<OutgoingMessage>& out);
-  void feed(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
-  void replay(std::vector<OutgoingMessage>& out);
+  // One message of the running solve, handed to it; after_solve() when that ends the solve.
+  void to_solve(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
+  // The current exchange's messages once all are in: read, then after_exchange().
+  void take_exchange(std::vector<OutgoingMessage>& out);
+  void read_exchange(const MessageGate::Inbox& inbox);
+  void read_message(std::uint32_t sender, const ProtocolMessage& m);  // one of the exchange's
+  std::runtime_error unexpected(const ProtocolMessage& m) const;
+  std::uint32_t gate_round(const ProtocolMessage& m) const;
   std::uint32_t exchange_phase() const;
   // The current step's phase (a solve's: any of its inner phases), the lowest of them.
   bool is_current(std::uint32_t phase) const;
@@ -266,10 +275,9 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view
   Eigen::MatrixXd last_pass_start_;
   Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
-  std::vector<std::uint32_t> waiting_;                // senders the current exchange still lacks
   std::vector<double> weights_;                       // per in_.measurements
   Eigen::MatrixXd neighbours_;  // neighbours' public poses of the current iterate
-  std::map<std::uint32_t, std::vector<ProtocolMessage>> later_;  // by phase
+  MessageGate gate_;            // the current exchange's messages and every later step's
   // Sums of the current exchange (in agent-id order: own and received values kept by sender).
   std::map<std::uint32_t, std::pair<double, double>> votes_;
   double mu_ = 0;
