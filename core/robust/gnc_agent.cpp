@@ -2,6 +2,7 @@
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/coarse_space.hpp>
+#include <tessera/distributed/message_gate.hpp>
 #include <tessera/distributed/stage_tag.hpp>
 #include <tessera/robust/gnc_agent.hpp>
 #include <tessera/robust/tls_weights.hpp>
@@ -12,6 +13,7 @@
 #include "distributed/pose_block_codec.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
+#include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
 #include "robust/gnc_probes.hpp"
 #include "robust/gnc_votes.hpp"
@@ -19,13 +21,6 @@
 namespace tessera {
 
 namespace {
-
-// The exchanges that carry two blocks per neighbour, both starts' poses (kind Y, kind P).
-bool two_starts(std::uint32_t phase) {
-  const std::uint32_t e = phase % kGncStepStride;
-  return e == kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kStartPoses) ||
-         e == kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kCandidatePoses);
-}
 
 std::vector<int> as_ints(const std::vector<std::uint32_t>& ids) {
   return {ids.begin(), ids.end()};
@@ -58,6 +53,7 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   layout_ = std::make_unique<BlockLayout>(*base_);
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
+  mail_ = std::make_unique<GncMailbox>(in_.id);
   recheck_ = std::make_unique<RecheckVerdict>();
   probes_ = std::make_unique<GncProbes>(options_.robust.recheck_probes);
   weights_.assign(m, 1.0);
@@ -158,8 +154,7 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   const std::uint32_t g = g_;
   // Messages of this solve that came while this agent was behind; once the solve has ended,
   // the rest are of no use.
-  for (const ProtocolMessage& m :
-       gate_.take_steps(g * kGncStepStride, g * kGncStepStride + kGncExchangeBase)) {
+  for (const ProtocolMessage& m : mail_->begin_solve(g)) {
     if (done_ || g_ != g || step_ != Step::kSolve) break;
     to_solve(m, out);
   }
@@ -186,15 +181,6 @@ void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out,
     std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
     out.push_back(std::move(o));
   }
-}
-
-bool GncAgent::is_current(std::uint32_t phase) const {
-  if (step_ != Step::kSolve) return phase == exchange_phase();
-  return phase >= g_ * kGncStepStride && phase < g_ * kGncStepStride + kGncExchangeBase;
-}
-
-std::uint32_t GncAgent::lowest_current_phase() const {
-  return step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
 }
 
 std::pair<double, double> GncAgent::summed_votes() const {
@@ -350,29 +336,14 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     default:
       break;
   }
-  // Both starts' poses come as two parts: the kind Y blocks (part 0), then the kind P ones.
-  gate_.expect(0, phase, std::move(from));
+  mail_->begin_exchange(phase, std::move(from));
   take_exchange(out);
 }
 
-// The gate's round of a message: the inner solve's round, or the part of an exchange (the kind
-// P blocks of both starts' poses are part 1; an exchange's round on the wire is always 0).
-std::uint32_t GncAgent::gate_round(const ProtocolMessage& m) const {
-  const std::uint32_t phase = message_phase(m);
-  if (phase % kGncStepStride < kGncExchangeBase) return message_round(m);
-  const auto* block = std::get_if<PoseBlockMessage>(&m);
-  return two_starts(phase) && block && block->kind == BlockKind::kP ? 1 : 0;
-}
-
 void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
-  std::optional<MessageGate::Inbox> inbox = gate_.take_ready();
-  if (!inbox) return;
-  read_exchange(*inbox);
-  if (two_starts(gate_.step()) && gate_.round() == 0) {
-    gate_.expect(1, gate_.step(), gate_.senders());
-    take_exchange(out);
-    return;
-  }
+  std::optional<std::vector<ProtocolMessage>> ready = mail_->take_exchange();
+  if (!ready) return;
+  for (const ProtocolMessage& m : *ready) read_message(m);
   after_exchange(out);
 }
 
@@ -664,17 +635,8 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   }
 }
 
-void GncAgent::read_exchange(const MessageGate::Inbox& inbox) {
-  const std::vector<int>& expected = gate_.senders();
-  for (const auto& [from, message] : inbox) {
-    const auto sender = static_cast<std::uint32_t>(from);
-    if (std::find(expected.begin(), expected.end(), from) == expected.end())
-      throw unexpected(message);
-    read_message(sender, message);
-  }
-}
-
-void GncAgent::read_message(std::uint32_t sender, const ProtocolMessage& message) {
+void GncAgent::read_message(const ProtocolMessage& message) {
+  const std::uint32_t sender = message_sender(message);
   // Each step's message kind, or an error naming what arrived where (gnc_messages).
   const char* const kStatusBelongs = "poses where a robust status belongs";
   switch (step_) {
@@ -737,35 +699,20 @@ void GncAgent::read_message(std::uint32_t sender, const ProtocolMessage& message
   }
 }
 
-std::runtime_error GncAgent::unexpected(const ProtocolMessage& message) const {
-  return std::runtime_error("agent " + std::to_string(in_.id) + ": unexpected robust message " +
-                            std::to_string(message_phase(message)) + " from agent " +
-                            std::to_string(message_sender(message)));
-}
-
 std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {
   std::vector<OutgoingMessage> out;
   if (done_) return out;
-  const std::uint32_t phase = message_phase(message);
-  if (phase < lowest_current_phase()) return out;  // a step this agent has left needs nothing more
-  const bool current = is_current(phase);
-  if (current && step_ == Step::kSolve) {
+  if (mail_->add(message))
     to_solve(message, out);
-    return out;
-  }
-  const std::vector<int>& expected = gate_.senders();
-  const auto sender = static_cast<int>(message_sender(message));
-  if (current && std::find(expected.begin(), expected.end(), sender) == expected.end())
-    throw unexpected(message);
-  if (!gate_.add(sender, gate_round(message), phase, message)) throw unexpected(message);
-  if (current) take_exchange(out);
+  else if (step_ != Step::kSolve)
+    take_exchange(out);
   return out;
 }
 
 std::size_t GncAgent::messages_needed() const {
   if (done_) return 0;
   if (step_ == Step::kSolve) return std::max<std::size_t>(solve_->messages_needed(), 1);
-  return std::max<std::size_t>(gate_.missing().size(), 1);
+  return mail_->messages_needed();
 }
 
 std::optional<AwaitedMessages> GncAgent::awaited() const {
@@ -775,8 +722,7 @@ std::optional<AwaitedMessages> GncAgent::awaited() const {
     if (a) a->phase += g_ * kGncStepStride;
     return a;
   }
-  const std::vector<int> missing = gate_.missing();
-  return AwaitedMessages{0, exchange_phase(), {missing.begin(), missing.end()}};
+  return mail_->awaited();
 }
 
 }  // namespace tessera

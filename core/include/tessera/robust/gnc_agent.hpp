@@ -36,8 +36,8 @@
 // (weight_owner()); the other end receives it, so both ends always use the same weight. The
 // stop follows from the summed spread, identical on every agent: no central step.
 // Messages carry their step in `phase` (gnc_phase()); a fast agent's messages of later steps
-// wait in a MessageGate until this agent gets there, and each exchange reads its messages in
-// agent-id order once all are in.
+// wait until this agent gets there, and each exchange reads its messages in agent-id order once
+// all are in (robust/gnc_mailbox.hpp).
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -45,14 +45,12 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <tessera/distributed/agent_process.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/certified_agent.hpp>
 #include <tessera/distributed/distributed_initialization.hpp>
-#include <tessera/distributed/message_gate.hpp>
 #include <tessera/graph/measurement.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
 #include <utility>
@@ -133,6 +131,7 @@ struct GncAgentInput {
 class GncLocalTerms;    // internal: the TLS math over one agent's view
 struct RecheckVerdict;  // internal: an inlier pass's re-check
 class GncProbes;        // internal: probes after the re-check passes
+class GncMailbox;       // internal: where incoming messages go
 
 class GncAgent : public AgentProcess {
  public:
@@ -221,14 +220,8 @@ class GncAgent : public AgentProcess {
   void to_solve(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
   // The current exchange's messages once all are in: read, then after_exchange().
   void take_exchange(std::vector<OutgoingMessage>& out);
-  void read_exchange(const MessageGate::Inbox& inbox);
-  void read_message(std::uint32_t sender, const ProtocolMessage& m);  // one of the exchange's
-  std::runtime_error unexpected(const ProtocolMessage& m) const;
-  std::uint32_t gate_round(const ProtocolMessage& m) const;
+  void read_message(const ProtocolMessage& m);  // one of the exchange's
   std::uint32_t exchange_phase() const;
-  // The current step's phase (a solve's: any of its inner phases), the lowest of them.
-  bool is_current(std::uint32_t phase) const;
-  std::uint32_t lowest_current_phase() const;
   // The inner solve's messages, tagged with this GNC step.
   void pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) const;
   std::pair<double, double> summed_votes() const;  // of the current exchange, every agent's
@@ -276,8 +269,8 @@ class GncAgent : public AgentProcess {
   Eigen::MatrixXd last_pass_start_;
   Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
   std::vector<double> weights_;                       // per in_.measurements
-  Eigen::MatrixXd neighbours_;  // neighbours' public poses of the current iterate
-  MessageGate gate_;            // the current exchange's messages and every later step's
+  Eigen::MatrixXd neighbours_;        // neighbours' public poses of the current iterate
+  std::unique_ptr<GncMailbox> mail_;  // where incoming messages go
   // Sums of the current exchange (in agent-id order: own and received values kept by sender).
   std::map<std::uint32_t, std::pair<double, double>> votes_;
   double mu_ = 0;
