@@ -16,6 +16,7 @@
 #include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
 #include "robust/gnc_probes.hpp"
+#include "robust/gnc_solve_setup.hpp"
 #include "robust/gnc_votes.hpp"
 
 namespace tessera {
@@ -108,36 +109,12 @@ std::vector<OutgoingMessage> GncAgent::start() {
 void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
   solve_.reset();
-  solve_options_ = options_.solver;
-  std::vector<Measurement> measurements;
-  if (solve_kind_ != Solve::kGnc) {
-    measurements = kept_;
-    if (solve_kind_ == Solve::kInlierPass) {
-      solve_options_.certify = false;
-      // A pass whose set may still change needs only a rough solution; the verdict that ends
-      // the passes is taken at a converged one (after_exchange, kReadmitted).
-      if (pass_capped_)
-        solve_options_.max_rounds =
-            std::min(solve_options_.max_rounds, options_.robust.recheck_max_rounds);
-    }
-    if (solve_kind_ == Solve::kFinal && options_.robust.final_refine)
-      solve_options_.refine.enabled = true;  // the answer to the refinement's tolerance
-  } else {
-    solve_options_.certify = false;
-    // Every solve before the inlier passes needs only a rough minimiser.
-    if (options_.robust.inner_max_rounds > 0)
-      solve_options_.max_rounds =
-          std::min(solve_options_.max_rounds, options_.robust.inner_max_rounds);
-    for (std::size_t k = 0; k < in_.measurements.size(); ++k) {
-      // A weight of exactly 0 adds nothing: such an edge leaves the solve when the known
-      // inliers keep the poses connected (fewer block neighbours, fewer colours); otherwise it
-      // stays at a tiny pull so no part is cut off.
-      if (terms_->known_connected() && weights_[k] == 0) continue;
-      measurements.push_back(g_ > first_solve_g_
-                                 ? weighted_measurement(in_.measurements[k], weights_[k])
-                                 : in_.measurements[k]);
-    }
-  }
+  solve_options_ = gnc_solve_options(options_, solve_kind_, pass_capped_);
+  const std::vector<Measurement> measurements =
+      solve_kind_ == Solve::kGnc
+          ? gnc_solve_measurements(in_.measurements, weights_, g_ > first_solve_g_,
+                                   terms_->known_connected())
+          : kept_;
   const Eigen::MatrixXd Y = state_ ? state_->Y : in_.Y0;
   if (solve_kind_ == Solve::kInlierPass) last_pass_start_ = Y;
   state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
@@ -362,13 +339,7 @@ void GncAgent::require_kept_connected() const {
 
 void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
   require_kept_connected();
-  kept_.clear();
-  kept_index_.clear();
-  for (std::size_t k = 0; k < in_.measurements.size(); ++k)
-    if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
-      kept_.push_back(in_.measurements[k]);
-      kept_index_.push_back(in_.measurement_index[k]);
-    }
+  gnc_kept_measurements(in_.measurements, in_.measurement_index, rejected_, kept_, kept_index_);
   solve_without(rejected_);
   solve_kind_ = Solve::kInlierPass;
   pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;

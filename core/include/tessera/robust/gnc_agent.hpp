@@ -128,6 +128,10 @@ struct GncAgentInput {
   bool pcm = false;
 };
 
+/// The solves of the distributed GNC: its own (the first and the weighted ones), the inlier
+/// passes over the kept set, and the final solve of the kept set.
+enum class GncSolveKind { kGnc, kInlierPass, kFinal };
+
 class GncLocalTerms;    // internal: the TLS math over one agent's view
 struct RecheckVerdict;  // internal: an inlier pass's re-check
 class GncProbes;        // internal: probes after the re-check passes
@@ -209,7 +213,7 @@ class GncAgent : public AgentProcess {
     kStartVotes,
     kDone
   };
-  enum class Solve { kGnc, kInlierPass, kFinal };
+  using Solve = GncSolveKind;
   void begin_solve(std::vector<OutgoingMessage>& out);
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
   std::vector<int> gather_values_at_lead(GncExchange exchange, bool kept_only,
