@@ -111,12 +111,12 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   solve_.reset();
   solve_options_ = gnc_solve_options(options_, solve_kind_, pass_capped_);
   const std::vector<Measurement> measurements =
-      solve_kind_ == Solve::kGnc
+      solve_kind_ == GncSolveKind::kGnc
           ? gnc_solve_measurements(in_.measurements, weights_, g_ > first_solve_g_,
                                    terms_->known_connected())
           : kept_;
   const Eigen::MatrixXd Y = state_ ? state_->Y : in_.Y0;
-  if (solve_kind_ == Solve::kInlierPass) last_pass_start_ = Y;
+  if (solve_kind_ == GncSolveKind::kInlierPass) last_pass_start_ = Y;
   state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
                                         solve_options_.block_update);
   if (solve_options_.refine.enabled &&
@@ -148,7 +148,8 @@ void GncAgent::to_solve(const ProtocolMessage& message, std::vector<OutgoingMess
 // Endpoints of the measurements the current solve works on, file order: the kept set for the
 // passes and the final solve, the whole graph for GNC's weighted solves.
 std::vector<std::pair<std::uint32_t, std::uint32_t>> GncAgent::solve_structure() const {
-  return solve_kind_ == Solve::kGnc ? in_.structure : inlier_structure(in_.structure, rejected_);
+  return solve_kind_ == GncSolveKind::kGnc ? in_.structure
+                                           : inlier_structure(in_.structure, rejected_);
 }
 
 // The inner solve's messages, tagged with this GNC step.
@@ -341,7 +342,7 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
   require_kept_connected();
   gnc_kept_measurements(in_.measurements, in_.measurement_index, rejected_, kept_, kept_index_);
   solve_without(rejected_);
-  solve_kind_ = Solve::kInlierPass;
+  solve_kind_ = GncSolveKind::kInlierPass;
   pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;
   full_pass_next_ = false;
   ++g_;
@@ -370,7 +371,7 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   }
   // The certificate once, on the set that stays (re-admission ran on uncertified solves: the
   // staircase may raise the rank, which a further pass could not start from).
-  solve_kind_ = Solve::kFinal;
+  solve_kind_ = GncSolveKind::kFinal;
   ++g_;
   begin_solve(out);
 }
@@ -457,14 +458,14 @@ void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out) {
 }
 
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
-  if (solve_kind_ == Solve::kFinal) {
+  if (solve_kind_ == GncSolveKind::kFinal) {
     final_rounds_ += solve_->total_rounds();
     done_ = true;
     step_ = Step::kDone;
     return;
   }
   gnc_rounds_ += solve_->total_rounds();
-  if (solve_kind_ == Solve::kInlierPass) {
+  if (solve_kind_ == GncSolveKind::kInlierPass) {
     if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
@@ -493,7 +494,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
 void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   switch (step_) {
     case Step::kPoses:
-      if (solve_kind_ == Solve::kInlierPass)
+      if (solve_kind_ == GncSolveKind::kInlierPass)
         begin_exchange(Step::kReadmitted, out);
       else
         begin_exchange(voted_ ? Step::kWeights : Step::kVotes, out);

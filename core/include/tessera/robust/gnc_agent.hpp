@@ -187,7 +187,7 @@ class GncAgent : public AgentProcess {
   /// The last solve (the certified one, or the last inlier pass); valid once done().
   const CertifiedAgent& last_solve() const { return *solve_; }
   const CertifiedAgent* final_sequence() const {
-    return solve_kind_ == Solve::kFinal ? solve_.get() : nullptr;
+    return solve_kind_ == GncSolveKind::kFinal ? solve_.get() : nullptr;
   }
   /// Whether a final solve of the kept set follows the inlier passes (with certification or
   /// RobustOptions::final_refine); otherwise the last pass, solved to the tolerance, is the
@@ -213,7 +213,6 @@ class GncAgent : public AgentProcess {
     kStartVotes,
     kDone
   };
-  using Solve = GncSolveKind;
   void begin_solve(std::vector<OutgoingMessage>& out);
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
   std::vector<int> gather_values_at_lead(GncExchange exchange, bool kept_only,
@@ -258,7 +257,7 @@ class GncAgent : public AgentProcess {
   std::vector<std::pair<std::uint64_t, Measurement>> kept_values_;  // agent 0's gathers
   std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
-  Solve solve_kind_ = Solve::kGnc;
+  GncSolveKind solve_kind_ = GncSolveKind::kGnc;
   bool voted_ = false;           // the votes of mu's start are in
   int pass_ = 0;                 // inlier passes done
   bool pass_capped_ = false;     // the current pass stops at RobustOptions::recheck_max_rounds
