@@ -110,11 +110,12 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
   solve_.reset();
   solve_options_ = gnc_solve_options(options_, solve_kind_, pass_capped_);
-  const std::vector<Measurement> measurements =
-      solve_kind_ == GncSolveKind::kGnc
-          ? gnc_solve_measurements(in_.measurements, weights_, g_ > first_solve_g_,
-                                   terms_->known_connected())
-          : kept_;
+  std::vector<Measurement> measurements;
+  if (solve_kind_ == GncSolveKind::kGnc)
+    measurements = gnc_solve_measurements(in_.measurements, weights_, g_ > first_solve_g_,
+                                          terms_->known_connected());
+  else
+    measurements = kept_;
   const Eigen::MatrixXd Y = state_ ? state_->Y : in_.Y0;
   if (solve_kind_ == GncSolveKind::kInlierPass) last_pass_start_ = Y;
   state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,

@@ -29,9 +29,15 @@ std::vector<Measurement> gnc_solve_measurements(const std::vector<Measurement>& 
                                                 const std::vector<double>& weights, bool weighted,
                                                 bool drop_zero) {
   std::vector<Measurement> out;
+  out.reserve(measurements.size());
   for (std::size_t k = 0; k < measurements.size(); ++k) {
     if (drop_zero && weights[k] == 0) continue;
-    out.push_back(weighted ? weighted_measurement(measurements[k], weights[k]) : measurements[k]);
+    // Not one push_back of a conditional: with a const lvalue on one side its result is a
+    // const prvalue, which push_back copies instead of moving.
+    if (weighted)
+      out.push_back(weighted_measurement(measurements[k], weights[k]));
+    else
+      out.push_back(measurements[k]);
   }
   return out;
 }
