@@ -56,6 +56,8 @@ struct TcgOutcome {
   Eigen::MatrixXd Heta;
   int iterations = 0;
   bool hit_boundary = false;
+  /// Ended because the preconditioner changes at its next application.
+  bool preconditioner_changed = false;
 };
 
 // Steihaug–Toint truncated CG on the model m(eta) = <g, eta> + 1/2 <H eta, eta>, with the
@@ -99,6 +101,12 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
     r = M.tangent_project(X, r);  // keep rounding errors from leaving the tangent space
     const double r_norm = std::sqrt(inner(r, r));
     if (r_norm <= r0_norm * std::min(std::pow(r0_norm, opt.tcg_theta), kappa)) return out;
+    // CG needs one fixed preconditioner: the step so far (a model decrease like any truncated
+    // tCG iterate) is taken and the next step starts with the new one.
+    if (precon && precon->changes_at_next_apply()) {
+      out.preconditioner_changed = true;
+      return out;
+    }
     z = precondition(r);
     const double z_r_old = z_r;
     z_r = inner(z, r);
@@ -144,6 +152,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     radius = std::max(
         1e-10, options.initial_radius_scale * std::sqrt(std::max(0.0, inner(precon_grad, grad))));
   }
+  bool reset_radius = false;
   auto ensure_precon_grad = [&] {
     if (have_precon_grad) return;
     precon_grad = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
@@ -193,6 +202,14 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
         options.tcg_kappa_near > 0 && grad_norm <= options.near_relative_grad * grad_norm0
             ? options.tcg_kappa_near
             : options.tcg_kappa;
+    if (reset_radius) {
+      // The radius is measured in the preconditioner's norm: after a change of preconditioner
+      // it is set again as at the start.
+      reset_radius = false;
+      ensure_precon_grad();
+      radius = std::max(
+          1e-10, options.initial_radius_scale * std::sqrt(std::max(0.0, inner(precon_grad, grad))));
+    }
     TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner,
                                    have_precon_grad ? &precon_grad : nullptr, kappa);
     res.total_inner_iterations += step.iterations;
@@ -232,6 +249,10 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       grad = M.tangent_project(res.X, egrad);
       grad_norm = std::sqrt(inner(grad, grad));
       ++accepted_steps;
+    }
+    if (step.preconditioner_changed) {
+      have_precon_grad = false;  // the old preconditioner's, also where the point is the same
+      reset_radius = options.initial_radius <= 0;
     }
     res.iterations = it + 1;
     if (options.record_trace)
