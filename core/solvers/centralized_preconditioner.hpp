@@ -35,21 +35,34 @@
 
 namespace tessera {
 
+/// The tangent factor's size predicted from the pose-level pattern of Q alone (an m x m
+/// symbolic analysis, AMD; p = d(d+1)/2 coordinates a pose make every pose-level entry a p x p
+/// block): a fraction of the cost of the exact analysis (which orders and analyses the mp x mp
+/// matrix, supernodally on the 3D graphs: as much as a Euclidean factorization on torus3D).
+struct TangentFactorEstimate {
+  double entries = 0;  ///< Of the LDL^T factor, p^2 per off-diagonal pose-level entry.
+  double flops = 0;    ///< Of one factorization, p^3 x the pose-level factorization's.
+  /// The factorization in units of solves with the factor (4 flops an entry each).
+  double solves() const { return entries > 0 ? flops / (4.0 * entries) : 0.0; }
+};
+TangentFactorEstimate estimate_tangent_factor(const BlockProblem& problem);
+
 class CentralizedPreconditioner : public RiemannianPreconditioner {
  public:
   using EuclideanBuilder = std::function<std::unique_ptr<BlockPreconditioner>()>;
+  using TangentBuilder = std::function<std::unique_ptr<TangentPreconditioner>()>;
 
-  /// `tangent`: the tangent factor (may be null or unusable: then the Euclidean factor is used
-  /// everywhere). When it is factored it is used at rank-d points from the start; when it is
-  /// only analysed the Euclidean factor is used until a switch (`switch_fraction`).
-  /// `euclidean`: builds the Euclidean factor on first use. `refresh_ratio` (>= 0): refactor the
-  /// tangent factor at a new rank-d point once the solves since the last factorization cost
-  /// refresh_ratio x a factorization; 0 = never refactor. `switch_fraction` (>= 0; 0 = never):
-  /// with an analysed, unfactored tangent factor, switch to it once the Euclidean solves at one
-  /// rank-d point cost switch_fraction x a tangent factorization.
+  /// `tangent`: the factored tangent factor, used at rank-d points from the start (may be null
+  /// or unusable: then the Euclidean factor is used). `euclidean`: builds the Euclidean factor
+  /// on first use. `refresh_ratio` (>= 0): refactor the tangent factor at a new rank-d point
+  /// once the solves since the last factorization cost refresh_ratio x a factorization; 0 =
+  /// never refactor. Without a tangent factor, `switch_to` (may be empty: never) builds one
+  /// (analysed, not factored) once the Euclidean solves at one rank-d point have cost
+  /// `switch_flops` (> 0), 4 d flops per entry of the Euclidean factor each; it is then
+  /// factored at that point and used from there on.
   CentralizedPreconditioner(std::unique_ptr<TangentPreconditioner> tangent,
                             EuclideanBuilder euclidean, double refresh_ratio,
-                            double switch_fraction = 0.0);
+                            TangentBuilder switch_to = {}, double switch_flops = 0.0);
   ~CentralizedPreconditioner() override;
 
   /// The tangent factor at rank-d points where it is in use, else the Euclidean one. Not
@@ -74,10 +87,11 @@ class CentralizedPreconditioner : public RiemannianPreconditioner {
  private:
   bool tangent_in_use() const;
 
-  std::unique_ptr<TangentPreconditioner> tangent_;
+  mutable std::unique_ptr<TangentPreconditioner> tangent_;
   EuclideanBuilder build_euclidean_;
   double refresh_ratio_;
-  mutable double switch_fraction_;  // set to 0 after the switch (one attempt)
+  mutable TangentBuilder switch_to_;  // emptied after the switch (one attempt)
+  double switch_flops_;
   mutable std::unique_ptr<BlockPreconditioner> euclidean_;
   // The last rank-d point seen, and the solves done since the last factorization.
   mutable Eigen::MatrixXd point_;

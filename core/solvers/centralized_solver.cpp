@@ -185,13 +185,13 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     return std::make_unique<BlockPreconditioner>(precon_problem, options.preconditioner_shift, 0, 0,
                                                  supernodal_min_flops, concurrent);
   };
-  // Which factor the trust region starts with. kAuto decides from the tangent factor's symbolic
-  // analysis (cheap: a pose-level AMD ordering and CHOLMOD's count): its factorization's
-  // predicted flops in units of its own solves (4 x its entries). Below
+  // Which factor the trust region starts with. kAuto decides from the tangent factor's size
+  // predicted from the pose-level pattern (estimate_tangent_factor: an m x m symbolic analysis,
+  // cheap beside the exact one): its factorization in units of its own solves. Up to
   // auto_start_tangent_solves it is built at once: even a graph whose Euclidean factor needs
-  // few tCG iterations loses no more than that (every 2D shared graph, parking-garage,
-  // smallGrid3D). Above it (the denser 3D graphs: torus3D 99 solves, sphere_bignoise_vertex3
-  // 85, sphere2500 63, cubicle 57) the trust region starts with the Euclidean factor and
+  // few tCG iterations then loses no more than that many solves (every 2D shared graph,
+  // parking-garage, smallGrid3D). Above it (the denser 3D graphs: torus3D, sphere2500,
+  // sphere_bignoise_vertex3, cubicle) the trust region starts with the Euclidean factor and
   // switches to the tangent one when a step's tCG shows that it needs many iterations
   // (auto_switch_fraction; solvers/centralized_preconditioner.hpp).
   const CentralizedPreconditioning mode = options.preconditioning;
@@ -199,22 +199,26 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     return std::make_unique<TangentPreconditioner>(problem, options.tangent_shift, 0,
                                                    options.tangent_supernodal_min_flops);
   };
-  const auto starts_tangent = [&options, mode](const TangentPreconditioner& t) {
-    if (mode != CentralizedPreconditioning::kAuto)
-      return mode == CentralizedPreconditioning::kTangent;
-    return t.usable() && t.factor_flops() <= options.auto_start_tangent_solves * 4.0 *
-                                                 static_cast<double>(t.factor_entries());
-  };
   struct Setup {
-    std::unique_ptr<TangentPreconditioner> tangent;  // analysed (kAuto, kTangent)
-    bool tangent_first = false;
+    std::unique_ptr<TangentPreconditioner>
+        tangent;  // analysed when the trust region starts with it
     std::unique_ptr<BlockPreconditioner> euclidean;  // built when the trust region starts with it
+    double switch_flops = 0;                         // kAuto started with the Euclidean factor
   };
   const auto setup = [&] {
     Setup out;
-    if (mode != CentralizedPreconditioning::kEuclidean) out.tangent = analyse_tangent();
-    out.tangent_first = out.tangent && starts_tangent(*out.tangent);
-    if (!out.tangent_first) out.euclidean = build_preconditioner();
+    bool tangent_first = mode == CentralizedPreconditioning::kTangent;
+    if (mode == CentralizedPreconditioning::kAuto) {
+      const TangentFactorEstimate estimate = estimate_tangent_factor(problem);
+      tangent_first = estimate.solves() <= options.auto_start_tangent_solves;
+      out.switch_flops = options.auto_switch_fraction * estimate.flops;
+    }
+    if (tangent_first) {
+      out.tangent = analyse_tangent();
+      out.switch_flops = 0;
+    } else {
+      out.euclidean = build_preconditioner();
+    }
     return out;
   };
   // The analysis and the Euclidean factorization do not depend on the start: with a second
@@ -251,7 +255,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   const auto factor_tangent = [&ready](Eigen::MatrixXd X0) {
     if (ready.tangent->usable()) ready.tangent->factorize(X0);
   };
-  if (ready.tangent_first && concurrent)
+  if (ready.tangent && concurrent)
     pending_tangent = std::async(std::launch::async, factor_tangent, lift_poses(init, graph.d));
   std::unique_ptr<TranslationElimination> elimination;
   PointRefinement refine;
@@ -260,7 +264,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
                                                            graph.measurements, concurrent);
     refine = [&elimination](Eigen::MatrixXd& Y) { elimination->optimize_translations(Y); };
   }
-  if (ready.tangent_first) {
+  if (ready.tangent) {
     if (pending_tangent.valid())
       pending_tangent.get();
     else
@@ -269,9 +273,8 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   std::unique_ptr<BlockPreconditioner> precon_factor = std::move(ready.euclidean);
   // Above rank d (after an escape), or if the tangent factor failed, the Euclidean factor is
   // built when first needed; nothing else runs then, so it may be supernodal and converted.
-  const bool may_switch = mode == CentralizedPreconditioning::kAuto && !ready.tangent_first;
   CentralizedPreconditioner precon(
-      may_switch || ready.tangent_first ? std::move(ready.tangent) : nullptr,
+      std::move(ready.tangent),
       [&problem, &options, &precon_factor]() {
         if (precon_factor) {
           std::unique_ptr<BlockPreconditioner> out;
@@ -282,7 +285,9 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
                                                      options.concurrent_supernodal_min_flops, true);
       },
       mode != CentralizedPreconditioning::kEuclidean ? options.tangent_refresh_ratio : 0.0,
-      may_switch ? options.auto_switch_fraction : 0.0);
+      ready.switch_flops > 0 ? CentralizedPreconditioner::TangentBuilder(analyse_tangent)
+                             : CentralizedPreconditioner::TangentBuilder(),
+      ready.switch_flops);
   // Only the rows of X that can be non-zero are stored ("active rows"). The lifted initial
   // guess [I_d; 0] R has r - d zero rows, and the trust region keeps them exactly zero (the
   // gradient, the Hessian, the row-wise preconditioner, the tangent projection and the polar
