@@ -56,7 +56,7 @@ struct TcgOutcome {
   Eigen::MatrixXd Heta;
   int iterations = 0;
   bool hit_boundary = false;
-  /// Ended because the preconditioner changes at its next application.
+  /// Ended because the preconditioner changes at its next application (the step is discarded).
   bool preconditioner_changed = false;
 };
 
@@ -101,8 +101,7 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
     r = M.tangent_project(X, r);  // keep rounding errors from leaving the tangent space
     const double r_norm = std::sqrt(inner(r, r));
     if (r_norm <= r0_norm * std::min(std::pow(r0_norm, opt.tcg_theta), kappa)) return out;
-    // CG needs one fixed preconditioner: the step so far (a model decrease like any truncated
-    // tCG iterate) is taken and the next step starts with the new one.
+    // CG needs one fixed preconditioner: the caller computes the step again with the new one.
     if (precon && precon->changes_at_next_apply()) {
       out.preconditioner_changed = true;
       return out;
@@ -153,6 +152,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
         1e-10, options.initial_radius_scale * std::sqrt(std::max(0.0, inner(precon_grad, grad))));
   }
   bool reset_radius = false;
+  bool recomputed_here = false;  // a step at the current point was computed again
   auto ensure_precon_grad = [&] {
     if (have_precon_grad) return;
     precon_grad = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
@@ -213,6 +213,19 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner,
                                    have_precon_grad ? &precon_grad : nullptr, kappa);
     res.total_inner_iterations += step.iterations;
+    if (step.preconditioner_changed) {
+      // The step is computed again from the same point with the new preconditioner, its
+      // gradient and radius set as at the start (taking the truncated step instead cost one
+      // more outer step on cubicle and sphere2500). Not counted as an iteration, once a point.
+      have_precon_grad = false;
+      reset_radius = options.initial_radius <= 0;
+      if (!recomputed_here) {
+        recomputed_here = true;
+        --it;
+      }
+      continue;
+    }
+    recomputed_here = false;
     Eigen::MatrixXd X_new =
         options.retraction ? options.retraction(res.X, step.eta) : M.retract(res.X, step.eta);
     if (refine) (*refine)(X_new);
@@ -249,10 +262,6 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       grad = M.tangent_project(res.X, egrad);
       grad_norm = std::sqrt(inner(grad, grad));
       ++accepted_steps;
-    }
-    if (step.preconditioner_changed) {
-      have_precon_grad = false;  // the old preconditioner's, also where the point is the same
-      reset_radius = options.initial_radius <= 0;
     }
     res.iterations = it + 1;
     if (options.record_trace)
