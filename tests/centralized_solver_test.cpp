@@ -410,6 +410,13 @@ TEST(CentralizedSolver, AutoPreconditionerKeepsTheEuclideanFactorWhileItsStepsNe
   EXPECT_EQ(a.inner_iterations, e.inner_iterations);
   EXPECT_EQ(a.X, e.X);
   EXPECT_TRUE(a.certified.value_or(false));
+  // The choice does not depend on the thread count (the Euclidean factor's form does, above
+  // its flops thresholds, so the iterates agree to round-off only).
+  CentralizedOptions one = automatic;
+  one.threads = 1;
+  const CentralizedResult a1 = solve_centralized(grid, one);
+  EXPECT_EQ(a1.preconditioner, "euclidean");
+  EXPECT_NEAR(a1.cost, a.cost, 1e-9 * a.cost);
 
   const PoseGraph chain = test::random_pose_graph({2, 200, 3, 0.001, 0.001, 1});
   CentralizedOptions forced;
@@ -420,6 +427,11 @@ TEST(CentralizedSolver, AutoPreconditionerKeepsTheEuclideanFactorWhileItsStepsNe
   const CentralizedResult t = solve_centralized(chain, tangent);
   const CentralizedResult ce = solve_centralized(chain, euclidean);
   EXPECT_EQ(s.preconditioner, "euclidean,tangent");
+  CentralizedOptions forced_one = forced;
+  forced_one.threads = 1;
+  const CentralizedResult s1 = solve_centralized(chain, forced_one);
+  EXPECT_EQ(s1.preconditioner, "euclidean,tangent");
+  EXPECT_NEAR(s1.cost, s.cost, 1e-12 * s.cost);
   EXPECT_EQ(s.iterations, t.iterations);
   EXPECT_NEAR(s.cost, t.cost, 1e-12 * t.cost);
   EXPECT_GT(s.inner_iterations, t.inner_iterations);
