@@ -53,6 +53,10 @@ const char* kHelp =
     "                            by < 1e-10 f (ends within ~1e-8 of f*); gradient:\n"
     "                            only --grad-tol (f* to round-off)\n"
     "  --no-certify              skip the certificate (and the staircase)\n"
+    "  --preconditioner auto|tangent|euclidean   centralized: the trust region's\n"
+    "                            preconditioner at rank d: tangent = the tangent-coordinate\n"
+    "                            factor, euclidean = the factor of Q; auto (default) chooses\n"
+    "                            per graph (docs/centralized-solver.md)\n"
     "  --precond-max-flops F     robust centralized: most predicted flops of each solve's\n"
     "                            preconditioner factorization; beyond it the factor keeps the\n"
     "                            known inliers and the highest-weight others that fit; 0 = all\n"
@@ -109,6 +113,16 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
     opt.stop = CentralizedStop::kGradient;
   else if (stop != "reference")
     throw InputError("option --stop: '" + stop + "' is not one of reference, gradient");
+  const std::string precon = a.get_or("preconditioner", "auto");
+  if (precon == "tangent")
+    opt.preconditioning = CentralizedPreconditioning::kTangent;
+  else if (precon == "euclidean")
+    opt.preconditioning = CentralizedPreconditioning::kEuclidean;
+  else if (precon == "auto")
+    opt.preconditioning = CentralizedPreconditioning::kAuto;
+  else
+    throw InputError("option --preconditioner: '" + precon +
+                     "' is not one of auto, tangent, euclidean");
   GncCentralizedResult gnc;
   if (robust.kind != RobustKind::kNone) {
     GncCentralizedOptions gnc_options;
@@ -189,6 +203,9 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
     j.add("min_eigenvalue", r.min_eigenvalue)
         .add("final_rank", r.final_rank)
         .add("stop_reason", r.levels.empty() ? std::string() : r.levels.back().stop_reason)
+        .add("preconditioner", r.preconditioner)
+        .add("inner_iterations", r.inner_iterations)
+        .add("tangent_factorizations", r.tangent_factorizations)
         .add("init_s", r.init_s)
         .add("optimize_s", r.optimize_s)
         .add("certify_s", r.certify_s)
@@ -205,6 +222,7 @@ int run_solve(const Args& args) {
   const auto start = std::chrono::steady_clock::now();
   std::set<std::string> valued = {"algorithm", "out",      "tum",      "json",    "trace", "init",
                                   "rank",      "max-rank", "grad-tol", "tum-dir", "stop"};
+  valued.insert("preconditioner");
   for (const char* const* o = kGraphInputOptions; *o; ++o) valued.insert(*o);
   std::set<std::string> switches = {"help", "no-certify", "raw-quaternions"};
   for (const char* const* o = kDistributedValued; *o; ++o) valued.insert(*o);
