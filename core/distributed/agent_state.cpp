@@ -249,6 +249,13 @@ bool AgentState::refresh_tangent(const Eigen::MatrixXd& X) {
   return tangent_->usable() && tangent_->factorize(X);
 }
 
+bool AgentState::refresh_tangent(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad) {
+  if (X.rows() != d_ || (precon_ ? precon_->block_diagonal() : block_factor_too_large_))
+    return false;
+  if (!tangent_ && !build_tangent(X, BlockUpdateOptions{})) return false;
+  return tangent_->usable() && tangent_->factorize(X, egrad);
+}
+
 bool AgentState::ensure_tangent(const Eigen::MatrixXd& X) {
   if (X.rows() == d_ && tangent_ && tangent_->factored()) return true;
   return refresh_tangent(X);

@@ -228,7 +228,9 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
 }
 
 void NewtonRefineProtocol::prepare_preconditioner() {
-  if (options_.refactor_every_step)
+  if (options_.refactor_every_step && options_.hessian_multipliers)
+    state_.refresh_tangent(X_, egrad_);
+  else if (options_.refactor_every_step)
     state_.refresh_tangent(X_);
   else
     state_.ensure_tangent(X_);

@@ -86,6 +86,11 @@ class AgentState {
   /// Factors the tangent preconditioner at X (d rows) when this block can have one (built on
   /// first use): precondition() is then exact for Q_BB's part at X. False when it cannot.
   bool refresh_tangent(const Eigen::MatrixXd& X);
+  /// As refresh_tangent(X), with the Hessian's multiplier term of each pose (`egrad`: the
+  /// block's Euclidean gradient at X, neighbour terms included): the factor is then this block's
+  /// diagonal block of the Riemannian Hessian in tangent coordinates where that is positive
+  /// definite (TangentPreconditioner::factorize(X, egrad)).
+  bool refresh_tangent(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad);
   /// As refresh_tangent, but a block that holds a factor keeps it (computed at an earlier point
   /// or grown: stale, still positive definite); factors only when it holds none.
   bool ensure_tangent(const Eigen::MatrixXd& X);
