@@ -16,6 +16,7 @@
 #include "agent/run_setup.hpp"
 #include "runtime/agent_log.hpp"
 #include "runtime/checkpoint_keeper.hpp"
+#include "runtime/phase_memory.hpp"
 #include "runtime/round_loop.hpp"
 #include "transport/run_failure.hpp"
 
@@ -82,12 +83,14 @@ void solve(AgentSession& s, const AgentOptions& o, const AgentLog& log, const Ag
       if (cur == &local) keeper.on_round(snap);
       if (replication.enabled()) replication.on_round(*cur, snap);
     };
+  if (o.verbose) hooks.on_phase = [&](const std::string& phase) { log(phase_memory_line(phase)); };
   log(std::string("round snapshots: ") +
       (hooks.on_round ? "kept (rejoin, checkpoints or replicas)" : "none (nothing reads them)"));
   for (;;) {
     try {
       hooks.resume_from = from ? &*from : nullptr;
       RoundLoopResult result = run_round_loop(*cur, channel, o.round_timeout_s, hooks);
+      log(phase_memory_line("the rounding"));
       channel.publish_final_progress();
       deliver_final_estimate(s, *cur, std::move(result), o, log, t0);
       break;

@@ -22,6 +22,7 @@
 #include "runtime/initialization_stage.hpp"
 #include "runtime/known_inlier_start.hpp"
 #include "runtime/local_dump.hpp"
+#include "runtime/phase_memory.hpp"
 #include "runtime/preloaded_graph.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
@@ -94,6 +95,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   log("read " + o.graph + ": poses [" + std::to_string(share.begin) + ", " +
       std::to_string(share.end) + ") of " + std::to_string(share.num_poses) + ", " +
       std::to_string(share.measurements.size()) + " measurements");
+  log(phase_memory_line("reading its share"));
   // Agent 0 solves the chordal start while discovery and the partition run; the stage uses it
   // only if the gathered values are this graph's (runtime/early_chordal.hpp). Only for a graph
   // the fork server parsed: the agent holds no whole graph otherwise.
@@ -137,6 +139,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   out.status_relay = asg.status_relay();
   log("assignment received (" +
       std::to_string(std::count(asg.owner().begin(), asg.owner().end(), o.id)) + " poses owned)");
+  log(phase_memory_line("the assignment"));
 
   // 5. Everyone's endpoints matched before any volatile agent-to-agent message.
   // With replicas a process restarted after the run gave its block away may have taken the
@@ -211,6 +214,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
 
   early.reset();                 // an unused early solve: wait for it, drop it
   launch::release_freed_heap();  // the initialisation's factorizations and the assignment's copy
+  log(phase_memory_line("the initialisation"));
 
   // 7. Hand-off, peer to peer: exactly one message to every other agent. A peer sends its
   // hand-off when its initialisation is done, which is computation (minutes for 25 agents of a
@@ -237,6 +241,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   }
   if (!o.dump_local.empty()) write_local_dump(out.local, o.dump_local);
   launch::release_freed_heap();  // the hand-off's messages
+  log(phase_memory_line("the hand-off"));
   return out;
 }
 

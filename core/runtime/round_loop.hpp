@@ -215,6 +215,10 @@ struct RoundLoopHooks {
   /// Continue from this snapshot (a coordinated rollback) instead of starting from the
   /// initial poses; every other agent must resume from its snapshot of the same round.
   const ProtocolSnapshot* resume_from = nullptr;
+  /// Called with the name of a phase after which the agent's memory is worth a line
+  /// (runtime/phase_memory.hpp): "block layout", "block set-up", "round K" at K = 1, 2, 5,
+  /// 10, 20, 50, ... of the solve, "rounds". Empty: not called.
+  std::function<void(const std::string&)> on_phase;
 };
 
 /// Core's solver options for `options` (core's defaults where a field is 0 or empty).
