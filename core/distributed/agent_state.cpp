@@ -44,6 +44,12 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
     if (static_cast<int>(rows.size()) == d) build_tangent(Y0(rows, Eigen::all), options);
   }
   if (q.block_diagonal()) tangent_tried_ = true;  // never build it later either
+  // With the tangent factor the rank-d updates do not read the Q_BB factor; held beside it, it
+  // was a third to a half of an agent's memory in the rounds (a 16,000-pose 3D block: ~70 of
+  // ~200 MB of heap). Whatever needs it later (an update above rank d, the greedy_newton score,
+  // a failed tangent factorization) factors it again: the same factor, so the same iterates.
+  else if (tangent_ && tangent_->factored())
+    precon_.reset();
 }
 
 const CoarseTerms& AgentState::coarse() const {
