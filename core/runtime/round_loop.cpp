@@ -116,6 +116,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     state.use_refine_space(std::make_shared<const CoarseSpace>(make_coarse_space(
         local.num_poses, local.structure, std::vector<int>(local.owner.begin(), local.owner.end()),
         options.refine.coarse_space_options())));
+  if (hooks.after_set_up) hooks.after_set_up();
   phase("block set-up");
   // The rounds' memory lines, from whichever protocol runs below.
   std::size_t last_round_logged = 0;

@@ -219,6 +219,9 @@ struct RoundLoopHooks {
   /// (runtime/phase_memory.hpp): "block layout", "block set-up", "round K" at K = 1, 2, 5,
   /// 10, 20, 50, ... of the solve, "rounds". Empty: not called.
   std::function<void(const std::string&)> on_phase;
+  /// Called once the block's problem and preconditioners are built, before the first round:
+  /// the set-up's temporaries are freed then (the agent hands that heap back to the kernel).
+  std::function<void()> after_set_up;
 };
 
 /// Core's solver options for `options` (core's defaults where a field is 0 or empty).
