@@ -24,6 +24,7 @@
 #include "runtime/local_dump.hpp"
 #include "runtime/phase_memory.hpp"
 #include "runtime/preloaded_graph.hpp"
+#include "runtime/team_memory.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
 
@@ -65,6 +66,8 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   ro.refine = asg.refine() == "newton";
   ro.refine_grad_tol = asg.refine_grad_tol();
   ro.refine_rel_tol = asg.refine_rel_tol();
+  // One host's factors share one budget (runtime/team_memory.hpp).
+  ro.max_factor_entries = team_factor_cap(asg.num_agents());
   if (!asg.robust().empty()) {
     ro.robust.kind = parse_robust_kind(asg.robust());
     ro.robust.inlier_threshold = asg.inlier_threshold();

@@ -139,7 +139,10 @@ BlockPreconditioner& AgentState::euclidean() {
 bool AgentState::build_tangent(const Eigen::MatrixXd& X, const BlockUpdateOptions& options) {
   if (tangent_tried_) return tangent_ && tangent_->usable();
   tangent_tried_ = true;
-  tangent_ = std::make_unique<TangentPreconditioner>(problem_, options.tangent_relative_shift);
+  // The Q_BB factor's cap bounds this one too (it may be set lower for a large team on one host,
+  // runtime/team_memory.hpp); 0 there means no cap here either.
+  tangent_ = std::make_unique<TangentPreconditioner>(problem_, options.tangent_relative_shift,
+                                                     max_factor_entries_);
   if (!tangent_->usable() || !tangent_->factorize(X)) tangent_.reset();
   return tangent_ != nullptr;
 }

@@ -47,6 +47,8 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
   opt.refine.enabled = o.refine;
   if (o.refine_grad_tol > 0) opt.refine.grad_norm_tol = o.refine_grad_tol;
   if (o.refine_rel_tol > 0) opt.refine.relative_decrease_tol = o.refine_rel_tol;
+  if (o.max_factor_entries > 0)
+    opt.block_update.max_factor_entries = static_cast<std::size_t>(o.max_factor_entries);
   opt.validate();
   return opt;
 }

@@ -52,6 +52,8 @@ struct RunOptions {
   bool refine = false;
   double refine_grad_tol = 0;
   double refine_rel_tol = 0;
+  /// BlockUpdateOptions::max_factor_entries (0 = core's default; runtime/team_memory.hpp).
+  std::uint64_t max_factor_entries = 0;
   /// Robust solve (`--robust`; robust/gnc_agent.hpp runs it): kind none = plain least squares.
   RobustOptions robust;
   /// GNC starts from the known inliers' distributed initialization when they connect the poses
