@@ -15,7 +15,9 @@ struct PhaseMemory {
   std::uint64_t hwm = 0;          ///< VmHWM: the peak of VmRSS so far.
   std::uint64_t heap_in_use = 0;  ///< malloc's live bytes, every arena and its own mappings.
   std::uint64_t heap_mapped = 0;  ///< Of those, blocks mapped on their own (large blocks).
-  std::uint64_t heap_free = 0;    ///< Freed bytes malloc keeps in its arenas.
+  /// Freed bytes malloc keeps in its arenas; after malloc_trim their whole pages are handed
+  /// back to the kernel but still counted here, so this bounds what is resident, it is not it.
+  std::uint64_t heap_free = 0;
   std::uint64_t heap_arenas = 0;  ///< Bytes of the arenas (in use + free, without own maps).
 };
 
