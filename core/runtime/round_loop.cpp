@@ -105,8 +105,11 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
                              ": owned poses do not match the assignment");
 
   // Core's agent, configured as the in-process engine configures it.
+  // Its block-update options too: they carry the factor cap (a large team's shared one,
+  // runtime/team_memory.hpp), which the constructor applies when it factors.
   AgentState state(static_cast<int>(local.agent_id), local.d, layout, local.measurements,
-                   lifted ? local.lifted_start : lift_poses(local.initial, options.rank));
+                   lifted ? local.lifted_start : lift_poses(local.initial, options.rank),
+                   options.block_update);
   if (options.coarse.enabled && options.coarse.space == CoarseSpaceKind::kSmoothed)
     // Every agent builds the same space from the structure: no message needed.
     state.use_coarse_space(
