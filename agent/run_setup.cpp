@@ -22,7 +22,9 @@
 #include "runtime/initialization_stage.hpp"
 #include "runtime/known_inlier_start.hpp"
 #include "runtime/local_dump.hpp"
+#include "runtime/phase_memory.hpp"
 #include "runtime/preloaded_graph.hpp"
+#include "runtime/team_memory.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
 
@@ -64,6 +66,8 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   ro.refine = asg.refine() == "newton";
   ro.refine_grad_tol = asg.refine_grad_tol();
   ro.refine_rel_tol = asg.refine_rel_tol();
+  // One host's factors share one budget (runtime/team_memory.hpp).
+  ro.max_factor_entries = team_factor_cap(asg.num_agents());
   if (!asg.robust().empty()) {
     ro.robust.kind = parse_robust_kind(asg.robust());
     ro.robust.inlier_threshold = asg.inlier_threshold();
@@ -94,6 +98,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   log("read " + o.graph + ": poses [" + std::to_string(share.begin) + ", " +
       std::to_string(share.end) + ") of " + std::to_string(share.num_poses) + ", " +
       std::to_string(share.measurements.size()) + " measurements");
+  log(phase_memory_line("reading its share"));
   // Agent 0 solves the chordal start while discovery and the partition run; the stage uses it
   // only if the gathered values are this graph's (runtime/early_chordal.hpp). Only for a graph
   // the fork server parsed: the agent holds no whole graph otherwise.
@@ -137,6 +142,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   out.status_relay = asg.status_relay();
   log("assignment received (" +
       std::to_string(std::count(asg.owner().begin(), asg.owner().end(), o.id)) + " poses owned)");
+  log(phase_memory_line("the assignment"));
 
   // 5. Everyone's endpoints matched before any volatile agent-to-agent message.
   // With replicas a process restarted after the run gave its block away may have taken the
@@ -157,6 +163,11 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   // 6. Initial poses of our share (core/runtime/initialization_stage.hpp), before they move.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> structure =
       structure_of(asg, share.num_poses);
+  // Copied out: the assignment's own endpoint arrays would otherwise stay through the
+  // initialisation and the hand-off (8 bytes a measurement of the whole graph: 16 MB an agent
+  // at 1M poses).
+  std::vector<std::uint32_t>().swap(asg.edge_i());
+  std::vector<std::uint32_t>().swap(asg.edge_j());
   DdsProtocolChannel channel(s);
   const RunOptions run_options = run_options_of(asg);
   SetupTurnOptions turns;
@@ -211,6 +222,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
 
   early.reset();                 // an unused early solve: wait for it, drop it
   launch::release_freed_heap();  // the initialisation's factorizations and the assignment's copy
+  log(phase_memory_line("the initialisation"));
 
   // 7. Hand-off, peer to peer: exactly one message to every other agent. A peer sends its
   // hand-off when its initialisation is done, which is computation (minutes for 25 agents of a
@@ -237,6 +249,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   }
   if (!o.dump_local.empty()) write_local_dump(out.local, o.dump_local);
   launch::release_freed_heap();  // the hand-off's messages
+  log(phase_memory_line("the hand-off"));
   return out;
 }
 

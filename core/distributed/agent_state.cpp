@@ -44,6 +44,12 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
     if (static_cast<int>(rows.size()) == d) build_tangent(Y0(rows, Eigen::all), options);
   }
   if (q.block_diagonal()) tangent_tried_ = true;  // never build it later either
+  // With the tangent factor the rank-d updates do not read the Q_BB factor; held beside it, it
+  // was a third to a half of an agent's memory in the rounds (a 16,000-pose 3D block: ~70 of
+  // ~200 MB of heap). Whatever needs it later (an update above rank d, the greedy_newton score,
+  // a failed tangent factorization) factors it again: the same factor, so the same iterates.
+  else if (tangent_ && tangent_->factored())
+    precon_.reset();
 }
 
 const CoarseTerms& AgentState::coarse() const {
@@ -133,7 +139,10 @@ BlockPreconditioner& AgentState::euclidean() {
 bool AgentState::build_tangent(const Eigen::MatrixXd& X, const BlockUpdateOptions& options) {
   if (tangent_tried_) return tangent_ && tangent_->usable();
   tangent_tried_ = true;
-  tangent_ = std::make_unique<TangentPreconditioner>(problem_, options.tangent_relative_shift);
+  // The Q_BB factor's cap bounds this one too (it may be set lower for a large team on one host,
+  // runtime/team_memory.hpp); 0 there means no cap here either.
+  tangent_ = std::make_unique<TangentPreconditioner>(problem_, options.tangent_relative_shift,
+                                                     max_factor_entries_);
   if (!tangent_->usable() || !tangent_->factorize(X)) tangent_.reset();
   return tangent_ != nullptr;
 }

@@ -18,6 +18,16 @@
 
 namespace tessera::agent {
 
+namespace {
+
+// 1, 2, 5, 10, 20, 50, ...: a few memory lines however long the solve runs.
+bool worth_a_memory_line(std::size_t round) {
+  while (round >= 10 && round % 10 == 0) round /= 10;
+  return round == 1 || round == 2 || round == 5;
+}
+
+}  // namespace
+
 DistributedOptions distributed_options_of(const RunOptions& o) {
   DistributedOptions opt;
   if (!o.algorithm.empty()) opt.algorithm = parse_algorithm(o.algorithm);
@@ -37,6 +47,8 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
   opt.refine.enabled = o.refine;
   if (o.refine_grad_tol > 0) opt.refine.grad_norm_tol = o.refine_grad_tol;
   if (o.refine_rel_tol > 0) opt.refine.relative_decrease_tol = o.refine_rel_tol;
+  if (o.max_factor_entries > 0)
+    opt.block_update.max_factor_entries = static_cast<std::size_t>(o.max_factor_entries);
   opt.validate();
   return opt;
 }
@@ -83,14 +95,21 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   // measurement of the whole graph: no Measurement copies, which held 72).
   const BlockLayout layout = make_block_layout(
       local.num_poses, local.structure, std::vector<int>(local.owner.begin(), local.owner.end()));
+  const auto phase = [&](const std::string& name) {
+    if (hooks.on_phase) hooks.on_phase(name);
+  };
+  phase("block layout");
   const auto& own = layout.poses[local.agent_id];
   if (own.size() != local.owned.size() || !std::equal(own.begin(), own.end(), local.owned.begin()))
     throw std::runtime_error("agent " + std::to_string(local.agent_id) +
                              ": owned poses do not match the assignment");
 
   // Core's agent, configured as the in-process engine configures it.
+  // Its block-update options too: they carry the factor cap (a large team's shared one,
+  // runtime/team_memory.hpp), which the constructor applies when it factors.
   AgentState state(static_cast<int>(local.agent_id), local.d, layout, local.measurements,
-                   lifted ? local.lifted_start : lift_poses(local.initial, options.rank));
+                   lifted ? local.lifted_start : lift_poses(local.initial, options.rank),
+                   options.block_update);
   if (options.coarse.enabled && options.coarse.space == CoarseSpaceKind::kSmoothed)
     // Every agent builds the same space from the structure: no message needed.
     state.use_coarse_space(
@@ -102,6 +121,15 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     state.use_refine_space(std::make_shared<const CoarseSpace>(make_coarse_space(
         local.num_poses, local.structure, std::vector<int>(local.owner.begin(), local.owner.end()),
         options.refine.coarse_space_options())));
+  if (hooks.after_set_up) hooks.after_set_up();
+  phase("block set-up");
+  // The rounds' memory lines, from whichever protocol runs below.
+  std::size_t last_round_logged = 0;
+  const auto round_phase = [&](std::size_t rounds) {
+    if (!hooks.on_phase || rounds == last_round_logged || !worth_a_memory_line(rounds)) return;
+    last_round_logged = rounds;
+    phase("round " + std::to_string(rounds));
+  };
   const double variables =
       static_cast<double>(options.rank) * (local.d + 1) * static_cast<double>(local.num_poses);
   const auto scheme = make_momentum_scheme(options, layout, variables);
@@ -114,9 +142,12 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   if (!options.certify && !options.refine.enabled) {
     RoundProtocol protocol(state, layout, config);
     if (hooks.on_round) protocol.set_round_observer(hooks.on_round);
+    if (hooks.on_phase)
+      mail.after_handled = [&] { round_phase(static_cast<std::size_t>(protocol.rounds())); };
     mail.run_protocol(
         protocol, hooks.resume_from ? protocol.resume(*hooks.resume_from) : protocol.start(),
         [&] { return "round " + std::to_string(protocol.rounds()) + " of the solve"; });
+    mail.after_handled = nullptr;
     res.rounds = static_cast<std::uint32_t>(protocol.rounds());
     res.restarts = static_cast<std::uint32_t>(protocol.restarts());
     res.stop_reason = protocol.stop_reason();
@@ -129,6 +160,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     sequence = std::make_unique<CertifiedAgent>(state, layout, options);
     if (hooks.on_round) sequence->set_round_observer(hooks.on_round);
     mail.after_handled = [&] {
+      round_phase(static_cast<std::size_t>(sequence->total_rounds()));
       const auto p = sequence->certificate_progress();
       if (p && p->first > 0)  // from its first iteration on: a lambda_min estimate to show
         mail.report_progress(ProgressStage::kCertificate, p->first, p->second);
@@ -154,6 +186,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     res.escape_rounds = static_cast<std::uint32_t>(sequence->escape_trials());
     mail.after_handled = nullptr;
   }
+  phase("rounds");
   res.final_rank = static_cast<std::uint32_t>(state.rank());
   return round_and_report(local, layout, state, mail, channel, std::move(res), options.certify, t0);
 }

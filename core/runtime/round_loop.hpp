@@ -52,6 +52,8 @@ struct RunOptions {
   bool refine = false;
   double refine_grad_tol = 0;
   double refine_rel_tol = 0;
+  /// BlockUpdateOptions::max_factor_entries (0 = core's default; runtime/team_memory.hpp).
+  std::uint64_t max_factor_entries = 0;
   /// Robust solve (`--robust`; robust/gnc_agent.hpp runs it): kind none = plain least squares.
   RobustOptions robust;
   /// GNC starts from the known inliers' distributed initialization when they connect the poses
@@ -215,6 +217,13 @@ struct RoundLoopHooks {
   /// Continue from this snapshot (a coordinated rollback) instead of starting from the
   /// initial poses; every other agent must resume from its snapshot of the same round.
   const ProtocolSnapshot* resume_from = nullptr;
+  /// Called with the name of a phase after which the agent's memory is worth a line
+  /// (runtime/phase_memory.hpp): "block layout", "block set-up", "round K" at K = 1, 2, 5,
+  /// 10, 20, 50, ... of the solve, "rounds". Empty: not called.
+  std::function<void(const std::string&)> on_phase;
+  /// Called once the block's problem and preconditioners are built, before the first round:
+  /// the set-up's temporaries are freed then (the agent hands that heap back to the kernel).
+  std::function<void()> after_set_up;
 };
 
 /// Core's solver options for `options` (core's defaults where a field is 0 or empty).
