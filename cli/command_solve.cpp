@@ -141,6 +141,8 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   robust_summary.threshold_squared = gnc.threshold_squared;
   robust_summary.weights_converged = gnc.weights_converged;
   robust_summary.readmitted = gnc.readmitted;
+  robust_summary.probes = gnc.probes;
+  robust_summary.probes_kept = gnc.probes_kept;
   if (robust.kind != RobustKind::kNone)
     std::printf(
         "robust %s: %d outer steps, %zu of %zu measurements rejected, cost over the "

@@ -1,4 +1,6 @@
 #include <algorithm>
+#include <cmath>
+#include <iterator>
 #include <stdexcept>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/graph/connectivity.hpp>
@@ -206,39 +208,77 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   CentralizedOptions final_options = options.solver;
   final_options.initialization = Initialization::kFile;
   final_options.threads = 1;
-  std::vector<Pose> start = solve.poses;
-  for (int pass = 0;; ++pass) {
-    PoseGraph inliers = inlier_graph(graph, out.rejected, start);
-    require_connected_inliers(graph, inliers, out.rejected.size());
-    // Start from the cheaper of the last estimate and the chordal guess of the kept set: an
-    // estimate that GNC bent around wrong closures can lead the local solve to a poor solution
-    // of the kept set, and without the wrong closures chordal is close to its optimum again
-    // (the distributed passes vote the same way).
-    const std::vector<Pose> guess = chordal_initialization(inliers);
-    if (evaluate_objective(inliers, guess) < evaluate_objective(inliers, start))
-      inliers.initial = guess;
-    std::vector<bool> kept_known;
-    kept_known.reserve(inliers.num_measurements());
-    for (std::size_t e = 0, next = 0; e < m; ++e) {
-      if (next < out.rejected.size() && out.rejected[next] == e)
-        ++next;
-      else
-        kept_known.push_back(known[e]);
+  auto passes = [&](std::vector<Pose> start) {
+    for (int pass = 0;; ++pass) {
+      PoseGraph inliers = inlier_graph(graph, out.rejected, start);
+      require_connected_inliers(graph, inliers, out.rejected.size());
+      // Start from the cheaper of the last estimate and the chordal guess of the kept set: an
+      // estimate that GNC bent around wrong closures can lead the local solve to a poor solution
+      // of the kept set, and without the wrong closures chordal is close to its optimum again
+      // (the distributed passes vote the same way).
+      const std::vector<Pose> guess = chordal_initialization(inliers);
+      if (evaluate_objective(inliers, guess) < evaluate_objective(inliers, start))
+        inliers.initial = guess;
+      std::vector<bool> kept_known;
+      kept_known.reserve(inliers.num_measurements());
+      for (std::size_t e = 0, next = 0; e < m; ++e) {
+        if (next < out.rejected.size() && out.rejected[next] == e)
+          ++next;
+        else
+          kept_known.push_back(known[e]);
+      }
+      const std::vector<double> ones(inliers.num_measurements(), 1.0);
+      out.final_solve = run({std::move(inliers), ones, std::move(kept_known)}, final_options);
+      if (pass == robust.readmission_passes || out.rejected.empty()) break;
+      const std::vector<Pose>& poses = out.final_solve.poses;
+      TlsRecheck verdict = tls_recheck(graph, known, poses, c2, out.rejected);
+      if (verdict.rejected == out.rejected) break;
+      for (std::size_t e = 0; e < m; ++e)
+        if (!known[e])
+          out.weights[e] =
+              std::binary_search(verdict.rejected.begin(), verdict.rejected.end(), e) ? 0.0 : 1.0;
+      out.readmitted += verdict.taken_back;
+      out.late_rejected += verdict.dropped;
+      out.rejected = std::move(verdict.rejected);
+      start = poses;
     }
-    const std::vector<double> ones(inliers.num_measurements(), 1.0);
-    out.final_solve = run({std::move(inliers), ones, std::move(kept_known)}, final_options);
-    if (pass == robust.readmission_passes || out.rejected.empty()) break;
-    const std::vector<Pose>& poses = out.final_solve.poses;
-    TlsRecheck verdict = tls_recheck(graph, known, poses, c2, out.rejected);
-    if (verdict.rejected == out.rejected) break;
-    for (std::size_t e = 0; e < m; ++e)
-      if (!known[e])
-        out.weights[e] =
-            std::binary_search(verdict.rejected.begin(), verdict.rejected.end(), e) ? 0.0 : 1.0;
-    out.readmitted += verdict.taken_back;
-    out.late_rejected += verdict.dropped;
-    out.rejected = std::move(verdict.rejected);
-    start = poses;
+  };
+  passes(solve.poses);
+
+  // Return probe (RobustOptions::probe_return_ratio, with the probes' budget): the rejected
+  // measurements beyond the bound but within probe_return_ratio x c^2 at the kept set's solution
+  // come back together, the passes run again, and the result stays only if the TLS cost fell. A
+  // true closure that alone ties two stretches of the map lies just beyond the bound once it is
+  // gone, so no pass takes it back.
+  if (robust.recheck_probes > 0 && robust.readmission_passes > 0 && known_connected) {
+    const std::vector<Pose> at = out.final_solve.poses;
+    const std::vector<double> r2_kept = residuals(graph, at);
+    std::vector<std::size_t> back;
+    for (std::size_t e : out.rejected)
+      if (r2_kept[e] > c2 && r2_kept[e] <= robust.probe_return_ratio * c2) back.push_back(e);
+    if (!back.empty()) {
+      GncCentralizedResult before = out;
+      const double tls_before = tls_cost(graph, known, at, c2);
+      std::vector<std::size_t> still;
+      std::set_difference(out.rejected.begin(), out.rejected.end(), back.begin(), back.end(),
+                          std::back_inserter(still));
+      out.rejected = std::move(still);
+      for (std::size_t e : back) out.weights[e] = 1.0;
+      out.readmitted += back.size();
+      ++out.probes;
+      passes(at);
+      const double tls_after = tls_cost(graph, known, out.final_solve.poses, c2);
+      if (tls_after < tls_before - 1e-9 * std::abs(tls_before)) {
+        ++out.probes_kept;
+      } else {
+        // Keep the work done, restore the answer.
+        before.inner_iterations = out.inner_iterations;
+        before.cg_iterations = out.cg_iterations;
+        before.solves = std::move(out.solves);
+        before.probes = out.probes;
+        out = std::move(before);
+      }
+    }
   }
   return out;
 }

@@ -67,6 +67,9 @@ struct GncCentralizedResult {
   std::size_t readmitted = 0;
   /// Kept measurements beyond the bound at an inlier set's solution, rejected by a re-check pass.
   std::size_t late_rejected = 0;
+  /// Return probes run after the re-check passes (RobustOptions::probe_return_ratio; at most
+  /// one) and those that stayed.
+  int probes = 0, probes_kept = 0;
   PairwiseConsistencyResult pcm;  ///< kPcmGnc: the consistency check (empty otherwise).
   /// The start vote (GncCentralizedOptions::known_inlier_start) chose the known inliers' start.
   bool started_from_known_inliers = false;
