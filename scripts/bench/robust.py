@@ -368,7 +368,7 @@ def merge(into_csv, from_csv):
     """Merges the cells of from_csv (a run with some of the solves switched off) into into_csv by
     (graph, kind, F, scheme): each solve that ran in from_csv (centralized robust, plain,
     distributed) replaces that solve's columns of the matching row, the others stay; a cell
-    not in into_csv is appended. The load column keeps one figure per side, "centralized /
+    not in into_csv is added (rows sorted by graph, kind, F). The load column keeps one figure per side, "centralized /
     distributed"; a note starting with "distributed" belongs to the distributed side."""
     with open(into_csv) as f:
         reader = csv.DictReader(f)
@@ -410,6 +410,12 @@ def merge(into_csv, from_csv):
             dist_load, old_dist = new["load"], new_dist
         old["load"] = central_load if central_load == dist_load else f"{central_load} / {dist_load}"
         old["note"] = "; ".join(old_central + old_dist)
+    # Each graph's cells together, kinds in order of first appearance, F ascending.
+    graphs, kinds = {}, {}
+    for r in rows:
+        graphs.setdefault(r["graph"], len(graphs))
+        kinds.setdefault(r["kind"], len(kinds))
+    rows.sort(key=lambda r: (graphs[r["graph"]], kinds[r["kind"]], float(r["F"])))
     with open(into_csv, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
