@@ -53,10 +53,18 @@ const char* kHelp =
     "                            by < 1e-10 f (ends within ~1e-8 of f*); gradient:\n"
     "                            only --grad-tol (f* to round-off)\n"
     "  --no-certify              skip the certificate (and the staircase)\n"
+    "  --preconditioner auto|tangent|euclidean   centralized: the trust region's\n"
+    "                            preconditioner at rank d: tangent = the tangent-coordinate\n"
+    "                            factor, euclidean = the factor of Q; auto (default) chooses\n"
+    "                            per graph (docs/centralized-solver.md)\n"
     "  --precond-max-flops F     robust centralized: most predicted flops of each solve's\n"
     "                            preconditioner factorization; beyond it the factor keeps the\n"
     "                            known inliers and the highest-weight others that fit; 0 = all\n"
     "                            measurements (docs/robust.md) [1e9]\n"
+    "  --gnc-cluster-probes K    robust centralized: most probes after the re-check passes,\n"
+    "                            each cutting a run of kept closures side by side at once (or\n"
+    "                            taking back one rejected closure near the bound); a probe's\n"
+    "                            result stays only if the TLS cost fell; 0 = none [0]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {
@@ -105,6 +113,16 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
     opt.stop = CentralizedStop::kGradient;
   else if (stop != "reference")
     throw InputError("option --stop: '" + stop + "' is not one of reference, gradient");
+  const std::string precon = a.get_or("preconditioner", "auto");
+  if (precon == "tangent")
+    opt.preconditioning = CentralizedPreconditioning::kTangent;
+  else if (precon == "euclidean")
+    opt.preconditioning = CentralizedPreconditioning::kEuclidean;
+  else if (precon == "auto")
+    opt.preconditioning = CentralizedPreconditioning::kAuto;
+  else
+    throw InputError("option --preconditioner: '" + precon +
+                     "' is not one of auto, tangent, euclidean");
   GncCentralizedResult gnc;
   if (robust.kind != RobustKind::kNone) {
     GncCentralizedOptions gnc_options;
@@ -118,6 +136,11 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
     } catch (const InputError& e) {
       throw InputError(std::string("option --precond-max-flops: ") + e.what());
     }
+    gnc_options.cluster_probes =
+        static_cast<int>(a.get_long("gnc-cluster-probes", gnc_options.cluster_probes));
+    if (gnc_options.cluster_probes < 0)
+      throw InputError("option --gnc-cluster-probes: GncCentralizedOptions.cluster_probes = " +
+                       std::to_string(gnc_options.cluster_probes) + ": must be >= 0 (0 = none)");
     gnc = solve_gnc_centralized(graph, gnc_options);
   } else
     gnc.final_solve = solve_centralized(graph, opt);
@@ -180,6 +203,9 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
     j.add("min_eigenvalue", r.min_eigenvalue)
         .add("final_rank", r.final_rank)
         .add("stop_reason", r.levels.empty() ? std::string() : r.levels.back().stop_reason)
+        .add("preconditioner", r.preconditioner)
+        .add("inner_iterations", r.inner_iterations)
+        .add("tangent_factorizations", r.tangent_factorizations)
         .add("init_s", r.init_s)
         .add("optimize_s", r.optimize_s)
         .add("certify_s", r.certify_s)
@@ -196,6 +222,7 @@ int run_solve(const Args& args) {
   const auto start = std::chrono::steady_clock::now();
   std::set<std::string> valued = {"algorithm", "out",      "tum",      "json",    "trace", "init",
                                   "rank",      "max-rank", "grad-tol", "tum-dir", "stop"};
+  valued.insert("preconditioner");
   for (const char* const* o = kGraphInputOptions; *o; ++o) valued.insert(*o);
   std::set<std::string> switches = {"help", "no-certify", "raw-quaternions"};
   for (const char* const* o = kDistributedValued; *o; ++o) valued.insert(*o);
@@ -204,6 +231,7 @@ int run_solve(const Args& args) {
   for (const char* const* o = kOnlineSwitches; *o; ++o) switches.insert(*o);
   for (const char* const* o = kRobustValued; *o; ++o) valued.insert(*o);
   valued.insert("precond-max-flops");
+  valued.insert("gnc-cluster-probes");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,

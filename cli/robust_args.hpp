@@ -37,8 +37,9 @@ struct RobustSummary {
   double threshold_squared = 0;
   bool weights_converged = false;
   std::size_t readmitted = 0;  ///< Rejected by GNC, taken back at the inlier set's solution.
-  /// Probes after the re-check passes (distributed; RobustOptions::recheck_probes) and those
-  /// that lowered the TLS cost and stayed. The centralized solve runs none.
+  /// Probes after the re-check passes (distributed: RobustOptions::recheck_probes; centralized:
+  /// the cluster probes, GncCentralizedOptions::cluster_probes) and those that lowered the TLS
+  /// cost and stayed.
   int probes = 0;
   int probes_kept = 0;
 };

@@ -17,11 +17,13 @@
 #include <tessera/problem/translation_solve.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
+#include <tessera/solvers/tangent_preconditioner.hpp>
 #include <tessera/solvers/translation_elimination.hpp>
 #include <tessera/solvers/trust_region.hpp>
 #include <tessera/util/input_error.hpp>
 
 #include "random_graph.hpp"
+#include "solvers/centralized_preconditioner.hpp"
 #include "test_support.hpp"
 
 namespace tessera {
@@ -359,6 +361,120 @@ TEST(CentralizedSolver, TangentPreconditionerNeedsFewerInnerIterationsForTheSame
     const CentralizedResult fast = solve_centralized(g);
     EXPECT_TRUE(fast.certified.value_or(false));
     EXPECT_NEAR(fast.cost, e.cost, 1e-8 * e.cost);
+  }
+}
+
+// kAuto's first rule: the tangent factor is built at once where its factorization costs few of
+// its own solves (a 2D chain: ~2-3), and the run is then the kTangent run, iterate for iterate.
+TEST(CentralizedSolver, AutoPreconditionerStartsWithTheTangentFactorWhereItIsCheap) {
+  const PoseGraph g = test::random_pose_graph({2, 200, 3, 0.001, 0.001, 1});
+  const BlockProblem problem = BlockProblem::whole_graph(2, g.num_poses, g.measurements);
+  CentralizedOptions automatic;
+  EXPECT_EQ(automatic.preconditioning, CentralizedPreconditioning::kAuto);
+  ASSERT_LE(estimate_tangent_factor(problem).solves(), automatic.auto_start_tangent_solves);
+  CentralizedOptions tangent;
+  tangent.preconditioning = CentralizedPreconditioning::kTangent;
+  const CentralizedResult a = solve_centralized(g, automatic);
+  const CentralizedResult t = solve_centralized(g, tangent);
+  EXPECT_EQ(a.preconditioner, "tangent");
+  EXPECT_EQ(t.preconditioner, "tangent");
+  EXPECT_EQ(a.inner_iterations, t.inner_iterations);
+  EXPECT_EQ(a.X, t.X);
+  EXPECT_TRUE(a.certified.value_or(false));
+}
+
+// kAuto's second rule on a 3D grid whose tangent factor costs more than
+// auto_start_tangent_solves of its solves: the Euclidean factor first. With noise its tCG needs
+// few iterations a step and it stays (the kEuclidean run, iterate for iterate); on the lightly
+// noisy 2D chain forced to start with it, the first step's tCG runs past the switch budget, the
+// tangent factor takes over and the step is computed again: the kTangent run's iterates, after
+// the discarded Euclidean iterations.
+TEST(CentralizedSolver, AutoPreconditionerKeepsTheEuclideanFactorWhileItsStepsNeedFewIterations) {
+  GeneratorOptions o;
+  o.kind = TrajectoryKind::kGrid3d;
+  o.num_poses = 512;
+  o.rotation_noise = 0.1;
+  o.translation_noise = 0.5;
+  o.seed = 1;
+  const PoseGraph grid = generate_pose_graph(o).graph;
+  const BlockProblem problem = BlockProblem::whole_graph(3, grid.num_poses, grid.measurements);
+  CentralizedOptions automatic;
+  ASSERT_GT(estimate_tangent_factor(problem).solves(), automatic.auto_start_tangent_solves);
+  CentralizedOptions euclidean;
+  euclidean.preconditioning = CentralizedPreconditioning::kEuclidean;
+  const CentralizedResult a = solve_centralized(grid, automatic);
+  const CentralizedResult e = solve_centralized(grid, euclidean);
+  EXPECT_EQ(a.preconditioner, "euclidean");
+  EXPECT_EQ(e.preconditioner, "euclidean");
+  EXPECT_EQ(a.tangent_factorizations, 0);
+  EXPECT_EQ(a.inner_iterations, e.inner_iterations);
+  EXPECT_EQ(a.X, e.X);
+  EXPECT_TRUE(a.certified.value_or(false));
+  // The choice does not depend on the thread count (the Euclidean factor's form does, above
+  // its flops thresholds, so the iterates agree to round-off only).
+  CentralizedOptions one = automatic;
+  one.threads = 1;
+  const CentralizedResult a1 = solve_centralized(grid, one);
+  EXPECT_EQ(a1.preconditioner, "euclidean");
+  EXPECT_NEAR(a1.cost, a.cost, 1e-9 * a.cost);
+
+  const PoseGraph chain = test::random_pose_graph({2, 200, 3, 0.001, 0.001, 1});
+  CentralizedOptions forced;
+  forced.auto_start_tangent_solves = 0;
+  CentralizedOptions tangent;
+  tangent.preconditioning = CentralizedPreconditioning::kTangent;
+  const CentralizedResult s = solve_centralized(chain, forced);
+  const CentralizedResult t = solve_centralized(chain, tangent);
+  const CentralizedResult ce = solve_centralized(chain, euclidean);
+  EXPECT_EQ(s.preconditioner, "euclidean,tangent");
+  CentralizedOptions forced_one = forced;
+  forced_one.threads = 1;
+  const CentralizedResult s1 = solve_centralized(chain, forced_one);
+  EXPECT_EQ(s1.preconditioner, "euclidean,tangent");
+  EXPECT_NEAR(s1.cost, s.cost, 1e-12 * s.cost);
+  EXPECT_EQ(s.iterations, t.iterations);
+  EXPECT_NEAR(s.cost, t.cost, 1e-12 * t.cost);
+  EXPECT_GT(s.inner_iterations, t.inner_iterations);
+  EXPECT_LT(s.inner_iterations, ce.inner_iterations);
+  EXPECT_TRUE(s.certified.value_or(false));
+  // A budget no step reaches keeps the Euclidean factor throughout.
+  forced.auto_switch_fraction = 1e12;
+  const CentralizedResult kept = solve_centralized(chain, forced);
+  EXPECT_EQ(kept.preconditioner, "euclidean");
+  EXPECT_EQ(kept.inner_iterations, ce.inner_iterations);
+  EXPECT_EQ(kept.X, ce.X);
+}
+
+TEST(CentralizedSolver, AutoPreconditionerOptionsAreValidatedByName) {
+  const PoseGraph g = test::random_pose_graph({2, 20, 5, 0.01, 0.01, 1});
+  for (const char* field : {"auto_start_tangent_solves", "auto_switch_fraction"}) {
+    CentralizedOptions bad;
+    if (std::string(field) == "auto_start_tangent_solves") bad.auto_start_tangent_solves = -1;
+    if (std::string(field) == "auto_switch_fraction") bad.auto_switch_fraction = 0;
+    try {
+      solve_centralized(g, bad);
+      FAIL() << "expected InputError for " << field;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  }
+}
+
+// The pose-level estimate of the tangent factor matches its exact symbolic analysis closely
+// (the same AMD ordering of the pose graph, each entry a p x p block).
+TEST(CentralizedSolver, TangentFactorEstimateMatchesTheExactAnalysis) {
+  GeneratorOptions o;
+  o.kind = TrajectoryKind::kGrid3d;
+  o.num_poses = 343;
+  o.seed = 2;
+  for (const PoseGraph& g :
+       {test::random_pose_graph({2, 200, 30, 0.01, 0.01, 1}), generate_pose_graph(o).graph}) {
+    const BlockProblem problem = BlockProblem::whole_graph(g.d, g.num_poses, g.measurements);
+    const TangentFactorEstimate estimate = estimate_tangent_factor(problem);
+    const TangentPreconditioner exact(problem, 1e-9, 0, 0);
+    EXPECT_NEAR(estimate.entries, static_cast<double>(exact.factor_entries()),
+                0.02 * static_cast<double>(exact.factor_entries()));
+    EXPECT_NEAR(estimate.flops, exact.factor_flops(), 0.3 * exact.factor_flops());
   }
 }
 

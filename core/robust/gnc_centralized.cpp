@@ -2,9 +2,11 @@
 #include <cmath>
 #include <iterator>
 #include <stdexcept>
+#include <string>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/problem/objective.hpp>
+#include <tessera/robust/closure_clusters.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
 #include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/tls_recheck.hpp>
@@ -12,6 +14,8 @@
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
 #include <tessera/util/input_error.hpp>
+
+#include "robust/cluster_probes.hpp"
 
 namespace tessera {
 namespace {
@@ -23,15 +27,6 @@ std::vector<double> residuals(const PoseGraph& graph, const std::vector<Pose>& p
     r2[e] = residual_squared(m, poses[m.i], poses[m.j]);
   }
   return r2;
-}
-
-// The TLS cost the start vote compares: known inliers count in full, the others up to c^2.
-double tls_cost(const PoseGraph& graph, const std::vector<bool>& known,
-                const std::vector<Pose>& poses, double c2) {
-  const std::vector<double> r2 = residuals(graph, poses);
-  double f = 0;
-  for (std::size_t e = 0; e < r2.size(); ++e) f += known[e] ? r2[e] : std::min(r2[e], c2);
-  return f;
 }
 
 // A solve's problem with what its preconditioner's selection ranks by: each measurement's
@@ -76,6 +71,13 @@ void GncCentralizedOptions::validate() const {
   solver.validate();
   robust.validate();
   preconditioner.validate();
+  if (cluster_probes < 0)
+    throw InputError("GncCentralizedOptions.cluster_probes = " + std::to_string(cluster_probes) +
+                     ": must be >= 0 (0 = none)");
+  clusters.validate();
+  if (!(std::isfinite(readmit_ratio) && readmit_ratio >= 0))
+    throw InputError("GncCentralizedOptions.readmit_ratio = " + std::to_string(readmit_ratio) +
+                     ": must be >= 0 (0 = never)");
 }
 
 GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
@@ -208,10 +210,19 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   CentralizedOptions final_options = options.solver;
   final_options.initialization = Initialization::kFile;
   final_options.threads = 1;
-  auto passes = [&](std::vector<Pose> start) {
+  // The re-check passes from `rejected` and `start`, solved with `solver`.
+  struct KeptSet {
+    CentralizedResult solve;
+    std::vector<std::size_t> rejected;
+    std::size_t readmitted = 0, late_rejected = 0;
+  };
+  auto solve_kept_set = [&](std::vector<std::size_t> rejected, std::vector<Pose> start,
+                            const CentralizedOptions& solver) {
+    KeptSet kept;
+    kept.rejected = std::move(rejected);
     for (int pass = 0;; ++pass) {
-      PoseGraph inliers = inlier_graph(graph, out.rejected, start);
-      require_connected_inliers(graph, inliers, out.rejected.size());
+      PoseGraph inliers = inlier_graph(graph, kept.rejected, start);
+      require_connected_inliers(graph, inliers, kept.rejected.size());
       // Start from the cheaper of the last estimate and the chordal guess of the kept set: an
       // estimate that GNC bent around wrong closures can lead the local solve to a poor solution
       // of the kept set, and without the wrong closures chordal is close to its optimum again
@@ -222,64 +233,87 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
       std::vector<bool> kept_known;
       kept_known.reserve(inliers.num_measurements());
       for (std::size_t e = 0, next = 0; e < m; ++e) {
-        if (next < out.rejected.size() && out.rejected[next] == e)
+        if (next < kept.rejected.size() && kept.rejected[next] == e)
           ++next;
         else
           kept_known.push_back(known[e]);
       }
       const std::vector<double> ones(inliers.num_measurements(), 1.0);
-      out.final_solve = run({std::move(inliers), ones, std::move(kept_known)}, final_options);
-      if (pass == robust.readmission_passes || out.rejected.empty()) break;
-      const std::vector<Pose>& poses = out.final_solve.poses;
-      TlsRecheck verdict = tls_recheck(graph, known, poses, c2, out.rejected);
-      if (verdict.rejected == out.rejected) break;
-      for (std::size_t e = 0; e < m; ++e)
-        if (!known[e])
-          out.weights[e] =
-              std::binary_search(verdict.rejected.begin(), verdict.rejected.end(), e) ? 0.0 : 1.0;
-      out.readmitted += verdict.taken_back;
-      out.late_rejected += verdict.dropped;
-      out.rejected = std::move(verdict.rejected);
+      kept.solve = run({std::move(inliers), ones, std::move(kept_known)}, solver);
+      if (pass == robust.readmission_passes || kept.rejected.empty()) break;
+      const std::vector<Pose>& poses = kept.solve.poses;
+      TlsRecheck verdict = tls_recheck(graph, known, poses, c2, kept.rejected);
+      if (verdict.rejected == kept.rejected) break;
+      kept.readmitted += verdict.taken_back;
+      kept.late_rejected += verdict.dropped;
+      kept.rejected = std::move(verdict.rejected);
       start = poses;
     }
+    return kept;
   };
-  passes(solve.poses);
+  auto adopt = [&](KeptSet&& kept) {
+    out.final_solve = std::move(kept.solve);
+    out.readmitted += kept.readmitted;
+    out.late_rejected += kept.late_rejected;
+    out.rejected = std::move(kept.rejected);
+  };
+  adopt(solve_kept_set(out.rejected, solve.poses, final_options));
 
+  // Cluster probes (GncCentralizedOptions::cluster_probes): a run of wrong closures that fit
+  // each other survives every one-at-a-time verdict, so cut a whole run of kept closures at
+  // once, let the re-check passes take back what fits without it, and keep the result only when
+  // the TLS cost over every measurement falls. Each accepted probe is a descent step of the TLS
+  // cost, like the passes; a refused one changes nothing.
+  if (options.cluster_probes > 0 && !out.rejected.empty()) {
+    CentralizedOptions trial = final_options;
+    trial.certify = false;  // only the set that stays is certified
+    KeptSet last;
+    const ClusterProbeCounts counts = search_cluster_probes(
+        graph, known, c2, options.cluster_probes, options.clusters, options.readmit_ratio,
+        out.rejected, out.final_solve.poses,
+        [&](std::vector<std::size_t> rejected) {
+          last = solve_kept_set(std::move(rejected), out.final_solve.poses, trial);
+          return ClusterProbeTrial{last.rejected, last.solve.poses};
+        },
+        [&] { adopt(std::move(last)); });
+    out.probes = counts.probes;
+    out.probes_kept = counts.kept;
+    // The certificate (and the staircase) for the set that stayed.
+    if (counts.kept > 0) adopt(solve_kept_set(out.rejected, out.final_solve.poses, final_options));
+  }
   // Return probe (RobustOptions::probe_return_ratio, with the probes' budget): the rejected
   // measurements beyond the bound but within probe_return_ratio x c^2 at the kept set's solution
   // come back together, the passes run again, and the result stays only if the TLS cost fell. A
   // true closure that alone ties two stretches of the map lies just beyond the bound once it is
   // gone, so no pass takes it back.
-  if (robust.recheck_probes > 0 && robust.readmission_passes > 0 && known_connected) {
+  if (robust.recheck_probes > 0 && robust.readmission_passes > 0 && known_connected &&
+      !out.rejected.empty()) {
     const std::vector<Pose> at = out.final_solve.poses;
     const std::vector<double> r2_kept = residuals(graph, at);
     std::vector<std::size_t> back;
     for (std::size_t e : out.rejected)
-      if (r2_kept[e] > c2 && r2_kept[e] <= robust.probe_return_ratio * c2) back.push_back(e);
+      if (!known[e] && r2_kept[e] > c2 && r2_kept[e] <= robust.probe_return_ratio * c2)
+        back.push_back(e);
     if (!back.empty()) {
-      GncCentralizedResult before = out;
-      const double tls_before = tls_cost(graph, known, at, c2);
       std::vector<std::size_t> still;
       std::set_difference(out.rejected.begin(), out.rejected.end(), back.begin(), back.end(),
                           std::back_inserter(still));
-      out.rejected = std::move(still);
-      for (std::size_t e : back) out.weights[e] = 1.0;
-      out.readmitted += back.size();
       ++out.probes;
-      passes(at);
-      const double tls_after = tls_cost(graph, known, out.final_solve.poses, c2);
-      if (tls_after < tls_before - 1e-9 * std::abs(tls_before)) {
+      const double tls_before = tls_cost(graph, known, at, c2);
+      KeptSet trial = solve_kept_set(std::move(still), at, final_options);
+      if (tls_cost(graph, known, trial.solve.poses, c2) <
+          tls_before - 1e-9 * std::abs(tls_before)) {
         ++out.probes_kept;
-      } else {
-        // Keep the work done, restore the answer.
-        before.inner_iterations = out.inner_iterations;
-        before.cg_iterations = out.cg_iterations;
-        before.solves = std::move(out.solves);
-        before.probes = out.probes;
-        out = std::move(before);
+        out.readmitted += back.size();
+        adopt(std::move(trial));
       }
     }
   }
+  if (out.readmitted + out.late_rejected > 0 || out.probes_kept > 0)
+    for (std::size_t e = 0; e < m; ++e)
+      if (!known[e])
+        out.weights[e] =
+            std::binary_search(out.rejected.begin(), out.rejected.end(), e) ? 0.0 : 1.0;
   return out;
 }
 

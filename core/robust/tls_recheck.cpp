@@ -20,4 +20,15 @@ TlsRecheck tls_recheck(const PoseGraph& graph, const std::vector<bool>& known,
   return out;
 }
 
+double tls_cost(const PoseGraph& graph, const std::vector<bool>& known,
+                const std::vector<Pose>& poses, double c2) {
+  double f = 0;
+  for (std::size_t e = 0; e < graph.num_measurements(); ++e) {
+    const Measurement& m = graph.measurements[e];
+    const double r2 = residual_squared(m, poses[m.i], poses[m.j]);
+    f += known[e] ? r2 : std::min(r2, c2);
+  }
+  return f;
+}
+
 }  // namespace tessera

@@ -81,6 +81,10 @@ void CentralizedOptions::validate() const {
     throw InputError("CentralizedOptions.tangent_refresh_ratio must be finite and >= 0");
   if (!(tangent_supernodal_min_flops > 0))
     throw InputError("CentralizedOptions.tangent_supernodal_min_flops must be > 0");
+  if (!(auto_start_tangent_solves >= 0 && std::isfinite(auto_start_tangent_solves)))
+    throw InputError("CentralizedOptions.auto_start_tangent_solves must be finite and >= 0");
+  if (!(auto_switch_fraction > 0 && std::isfinite(auto_switch_fraction)))
+    throw InputError("CentralizedOptions.auto_switch_fraction must be finite and > 0");
   if (threads < 1 || threads > 2) throw InputError("CentralizedOptions.threads must be 1 or 2");
   trust_region.validate();
   certificate.validate();
@@ -181,13 +185,48 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     return std::make_unique<BlockPreconditioner>(precon_problem, options.preconditioner_shift, 0, 0,
                                                  supernodal_min_flops, concurrent);
   };
-  const bool tangent = options.preconditioning == CentralizedPreconditioning::kTangent;
-  // The Euclidean factorization does not depend on the start: with a second thread it runs while
-  // the start is computed (each CHOLMOD factor has its own workspace, so the two do not share
-  // state). The tangent factor needs the start's rotations; it is built below.
-  std::future<std::unique_ptr<BlockPreconditioner>> pending;
-  if (options.threads > 1 && !tangent)
-    pending = std::async(std::launch::async, build_preconditioner);
+  // Which factor the trust region starts with. kAuto decides from the tangent factor's size
+  // predicted from the pose-level pattern (estimate_tangent_factor: an m x m symbolic analysis,
+  // cheap beside the exact one): its factorization in units of its own solves. Up to
+  // auto_start_tangent_solves it is built at once: even a graph whose Euclidean factor needs
+  // few tCG iterations then loses no more than that many solves (every 2D shared graph,
+  // parking-garage, smallGrid3D). Above it (the denser 3D graphs: torus3D, sphere2500,
+  // sphere_bignoise_vertex3, cubicle) the trust region starts with the Euclidean factor and
+  // switches to the tangent one when a step's tCG shows that it needs many iterations
+  // (auto_switch_fraction; solvers/centralized_preconditioner.hpp).
+  const CentralizedPreconditioning mode = options.preconditioning;
+  const auto analyse_tangent = [&problem, &options] {
+    return std::make_unique<TangentPreconditioner>(problem, options.tangent_shift, 0,
+                                                   options.tangent_supernodal_min_flops);
+  };
+  struct Setup {
+    std::unique_ptr<TangentPreconditioner>
+        tangent;  // analysed when the trust region starts with it
+    std::unique_ptr<BlockPreconditioner> euclidean;  // built when the trust region starts with it
+    double switch_flops = 0;                         // kAuto started with the Euclidean factor
+  };
+  const auto setup = [&] {
+    Setup out;
+    bool tangent_first = mode == CentralizedPreconditioning::kTangent;
+    if (mode == CentralizedPreconditioning::kAuto) {
+      const TangentFactorEstimate estimate = estimate_tangent_factor(problem);
+      tangent_first = estimate.solves() <= options.auto_start_tangent_solves;
+      out.switch_flops = options.auto_switch_fraction * estimate.flops;
+    }
+    if (tangent_first) {
+      out.tangent = analyse_tangent();
+      out.switch_flops = 0;
+    } else {
+      out.euclidean = build_preconditioner();
+    }
+    return out;
+  };
+  // The analysis and the Euclidean factorization do not depend on the start: with a second
+  // thread they run while the start is computed (each CHOLMOD factor has its own workspace, so
+  // the two do not share state). The tangent factor needs the start's rotations; it is
+  // factored below.
+  std::future<Setup> pending;
+  if (options.threads > 1) pending = std::async(std::launch::async, setup);
   std::vector<Pose> init;
   switch (options.initialization) {
     case Initialization::kChordal:
@@ -208,18 +247,16 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
       init = graph.initial;
       break;
   }
+  Setup ready = pending.valid() ? pending.get() : setup();
   // The tangent factor depends on the start's rotations only: with a second thread and
   // translation elimination it is computed beside the elimination's (simplicial) Laplacian
-  // factorization, as the Euclidean factor is beside the start otherwise.
-  const auto build_tangent = [&problem, &options](Eigen::MatrixXd X0) {
-    auto t = std::make_unique<TangentPreconditioner>(problem, options.tangent_shift, 0,
-                                                     options.tangent_supernodal_min_flops);
-    if (t->usable()) t->factorize(X0);
-    return t;
+  // factorization.
+  std::future<void> pending_tangent;
+  const auto factor_tangent = [&ready](Eigen::MatrixXd X0) {
+    if (ready.tangent->usable()) ready.tangent->factorize(X0);
   };
-  std::future<std::unique_ptr<TangentPreconditioner>> pending_tangent;
-  if (tangent && concurrent)
-    pending_tangent = std::async(std::launch::async, build_tangent, lift_poses(init, graph.d));
+  if (ready.tangent && concurrent)
+    pending_tangent = std::async(std::launch::async, factor_tangent, lift_poses(init, graph.d));
   std::unique_ptr<TranslationElimination> elimination;
   PointRefinement refine;
   if (options.eliminate_translations) {
@@ -227,16 +264,17 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
                                                            graph.measurements, concurrent);
     refine = [&elimination](Eigen::MatrixXd& Y) { elimination->optimize_translations(Y); };
   }
-  std::unique_ptr<BlockPreconditioner> precon_factor;
-  if (!tangent) precon_factor = pending.valid() ? pending.get() : build_preconditioner();
-  std::unique_ptr<TangentPreconditioner> tangent_factor;
-  if (tangent)
-    tangent_factor =
-        pending_tangent.valid() ? pending_tangent.get() : build_tangent(lift_poses(init, graph.d));
+  if (ready.tangent) {
+    if (pending_tangent.valid())
+      pending_tangent.get();
+    else
+      factor_tangent(lift_poses(init, graph.d));
+  }
+  std::unique_ptr<BlockPreconditioner> precon_factor = std::move(ready.euclidean);
   // Above rank d (after an escape), or if the tangent factor failed, the Euclidean factor is
   // built when first needed; nothing else runs then, so it may be supernodal and converted.
   CentralizedPreconditioner precon(
-      std::move(tangent_factor),
+      std::move(ready.tangent),
       [&problem, &options, &precon_factor]() {
         if (precon_factor) {
           std::unique_ptr<BlockPreconditioner> out;
@@ -246,7 +284,10 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
         return std::make_unique<BlockPreconditioner>(problem, options.preconditioner_shift, 0, 0,
                                                      options.concurrent_supernodal_min_flops, true);
       },
-      tangent ? options.tangent_refresh_ratio : 0.0);
+      mode != CentralizedPreconditioning::kEuclidean ? options.tangent_refresh_ratio : 0.0,
+      ready.switch_flops > 0 ? CentralizedPreconditioner::TangentBuilder(analyse_tangent)
+                             : CentralizedPreconditioner::TangentBuilder(),
+      ready.switch_flops);
   // Only the rows of X that can be non-zero are stored ("active rows"). The lifted initial
   // guess [I_d; 0] R has r - d zero rows, and the trust region keeps them exactly zero (the
   // gradient, the Hessian, the row-wise preconditioner, the tangent projection and the polar
@@ -283,6 +324,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     res.optimize_s += seconds_since(level_start);
     X = level.X;
     res.iterations += level.iterations;
+    res.inner_iterations += level.total_inner_iterations;
     for (const auto& it : level.trace) res.trace.push_back({r, it});
     StaircaseLevel info{
         r,     level.iterations,           level.cost,       level.grad_norm, std::nullopt,
@@ -322,6 +364,10 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
   // Report X at the relaxation rank: the rows that were never active are zero.
   if (X.rows() < res.final_rank) X = pad_rank(X, res.final_rank - static_cast<int>(X.rows()));
   res.X = X;
+  res.tangent_factorizations = precon.tangent_factorizations();
+  res.preconditioner = precon.switched()                ? "euclidean,tangent"
+                       : res.tangent_factorizations > 0 ? "tangent"
+                                                        : "euclidean";
   if (elimination) {
     // The rounded rotations' optimal translations through the factor computed once above
     // (round_solution would build and factor the same Laplacian again).

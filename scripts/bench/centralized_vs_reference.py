@@ -12,7 +12,7 @@ measured in the same run instead of read from the CSV.
 Printed per graph: our median wall and CPU (user + system) time, the reference's wall, the ratio,
 our relative gap to f* (optima.csv, _qnorm rows for 3D) beside the reference's, `acc` = ours is at
 least as accurate as the reference's (gap <= max(reference gap, 1e-8): below 1e-8 both are
-round-off and stopping-rule noise), the stop reason, steps, certificate. Writes
+round-off and stopping-rule noise), the stop reason, steps, certificate, the preconditioner that ran. Writes
 docs/benchmarks/centralized.csv. Wall times depend on the machine's load: the load average is
 printed at the start and the end; CPU time is the steadier figure on a shared machine.
 
@@ -106,7 +106,7 @@ def main():
                   else "sesync_times.csv, reference_wall_s_2threads")
     print(f"reference: {ref_source}")
     head = (f"{'dataset':24s} {'poses':>6s} {'ours_s':>7s} {'cpu_s':>6s} {'ref_s':>6s} {'ratio':>6s} "
-            f"{'rel_gap':>9s} {'ref_gap':>9s} {'acc':>4s} {'steps':>5s} {'stop':>24s} {'cert':>5s}")
+            f"{'rel_gap':>9s} {'ref_gap':>9s} {'acc':>4s} {'steps':>5s} {'stop':>24s} {'cert':>5s} precon")
     print(head)
     rows = []
     for name in names:
@@ -147,13 +147,15 @@ def main():
                    rel_gap=gap if gap is not None else "", reference_rel_gap=ref_gap if ref_gap is not None else "",
                    at_least_as_accurate="" if acc is None else acc, iterations=summary["iterations"],
                    stop_reason=summary.get("stop_reason", ""), certified=summary["certified"],
+                   preconditioner=summary.get("preconditioner", ""),
+                   inner_iterations=summary.get("inner_iterations", ""),
                    min_eigenvalue=summary["min_eigenvalue"], rank=summary["final_rank"],
                    load_avg_1min=round(os.getloadavg()[0], 2))
         rows.append(row)
         print(f"{name:24s} {row['poses']:6d} {wall:7.3f} {cpu:6.3f} {bc.fmt(ref_s, '{:6.3f}'):>6s} "
               f"{bc.fmt(ratio, '{:6.2f}'):>6s} {bc.fmt(gap, '{:9.2e}'):>9s} {bc.fmt(ref_gap, '{:9.2e}'):>9s} "
               f"{bc.fmt('' if acc is None else ('yes' if acc else 'NO')):>4s} {row['iterations']:5d} "
-              f"{row['stop_reason']:>24s} {str(row['certified']):>5s}", flush=True)
+              f"{row['stop_reason']:>24s} {str(row['certified']):>5s} {row['preconditioner']}", flush=True)
     print(f"machine at end: {bc.machine()}")
     if rows:
         os.makedirs(os.path.dirname(a.csv), exist_ok=True)

@@ -9,6 +9,12 @@ set against the labels, relative gap of the robust cost (over the kept measureme
 f*_clean, ATE of the estimate against the clean optimum after a rigid alignment, outer steps,
 solver iterations, wall time, certified; beside it the plain solve's cost gap and ATE.
 
+--cluster-probes K gives the centralized robust solve `--gnc-cluster-probes K`; --explain adds,
+for group cells, the TLS cost at the robust estimate and at the clean optimum, the groups that
+kept members and the true closures cut (is the wrong answer TLS's optimum, or a search failure?);
+--compare BASE prints two runs' centralized columns side by side (docs/benchmarks/robust.md,
+"Group outliers").
+
 With --clean-all instead: F = 0 on every shared dataset, the robust distributed solve with 5
 agents in process (and with --dds over DDS too), against f* of ../shared/reference/optima.csv
 (robust_clean.csv; docs/benchmarks/robust.md, "F = 0 on every shared dataset").
@@ -99,6 +105,82 @@ def read_edges(path):
                 d = 2 if tok[0] == "EDGE_SE2" else 3
                 edges.append(tok)
     return d, vertices, edges
+
+
+def rotation_matrix(d, r):
+    """Rotation of a pose as a d x d list of rows (2D: angle; 3D: quaternion [w, x, y, z])."""
+    if d == 2:
+        c, s = math.cos(r), math.sin(r)
+        return [[c, -s], [s, c]]
+    n = math.sqrt(sum(x * x for x in r))
+    w, x, y, z = (v / n for v in r)
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+
+
+def isotropic_weights(d, info):
+    """(kappa, tau) of a g2o information upper triangle, as tessera reads it
+    (core/io/information_weights.cpp)."""
+    info = [float(x) for x in info]
+    if d == 2:
+        a, b, c = info[0], info[1], info[3]
+        return info[5], 2.0 / ((a + c) / (a * c - b * b))
+
+    def trace_inv(k):
+        def a(r, c):
+            r, c = k + min(r, c), k + max(r, c)
+            return info[r * 6 - r * (r - 1) // 2 + (c - r)]
+        m00 = a(1, 1) * a(2, 2) - a(1, 2) ** 2
+        m11 = a(0, 0) * a(2, 2) - a(0, 2) ** 2
+        m22 = a(0, 0) * a(1, 1) - a(0, 1) ** 2
+        det = (a(0, 0) * m00 - a(0, 1) * (a(0, 1) * a(2, 2) - a(1, 2) * a(0, 2)) +
+               a(0, 2) * (a(0, 1) * a(1, 2) - a(1, 1) * a(0, 2)))
+        return (m00 + m11 + m22) / det
+    return 3.0 / (2.0 * trace_inv(3)), 3.0 / trace_inv(0)
+
+
+def residuals(path, poses):
+    """(i, j, r^2) of every EDGE line at `poses` (read_tum's): kappa ||R_j - R_i R_ij||_F^2 +
+    tau ||t_j - t_i - R_i t_ij||^2, the edge's term of the objective (quaternions normalised)."""
+    d, _, edges = read_edges(path)
+    rot = [rotation_matrix(d, r) for r, _ in poses]
+    out = []
+    for e in edges:
+        i, j = int(e[1]), int(e[2])
+        if d == 2:
+            rij, tij, info = rotation_matrix(2, float(e[5])), [float(e[3]), float(e[4])], e[6:12]
+        else:
+            rij = rotation_matrix(3, [float(e[9]), float(e[6]), float(e[7]), float(e[8])])
+            tij, info = [float(x) for x in e[3:6]], e[10:31]
+        kappa, tau = isotropic_weights(d, info)
+        ri, rj, ti, tj = rot[i], rot[j], poses[i][1], poses[j][1]
+        rot_err = sum((rj[a][b] - sum(ri[a][k] * rij[k][b] for k in range(d))) ** 2
+                      for a in range(d) for b in range(d))
+        tr_err = sum((tj[a] - ti[a] - sum(ri[a][k] * tij[k] for k in range(d))) ** 2 for a in range(d))
+        out.append((i, j, kappa * rot_err + tau * tr_err))
+    return out
+
+
+def explain(path, estimate, optimum, labels, rejected, c2):
+    """Why a group cell fails: the TLS cost sum min(r^2, c^2) (odometry r^2 in full) at the
+    robust estimate and at the clean optimum, split into odometry, true closures and wrong
+    closures, and the groups (GROUP consecutive labels) that kept members."""
+    wrong, rejected = set(labels), set(rejected)
+
+    def tls(poses):
+        parts = {"odometry": 0.0, "true": 0.0, "wrong": 0.0}
+        for n, (i, j, r2) in enumerate(residuals(path, poses)):
+            key = "odometry" if abs(i - j) == 1 else "wrong" if n in wrong else "true"
+            parts[key] += r2 if key == "odometry" else min(r2, c2)
+        return parts
+    at_est, at_clean = tls(estimate), tls(optimum)
+    groups = [labels[k:k + GROUP] for k in range(0, len(labels), GROUP)]
+    kept = [g for g in groups if any(n not in rejected for n in g)]
+    return {"tls": sum(at_est.values()), "tls_clean": sum(at_clean.values()),
+            "tls_parts": at_est, "tls_clean_parts": at_clean,
+            "groups_kept": f"{len(kept)}/{len(groups)}",
+            "true_cut": len(rejected - wrong)}
 
 
 def read_tum(path, d):
@@ -424,6 +506,40 @@ def merge(into_csv, from_csv):
     progress(f"merged {len(incoming)} rows of {from_csv} into {into_csv}")
 
 
+def compare_table(base_csv, new_csv):
+    """Centralized columns of two runs side by side, by (graph, kind, F): `base_csv` (e.g.
+    robust_group.csv, gnc-tls alone) and `new_csv` (e.g. robust_cluster.csv, with
+    --cluster-probes): rejected / precision / recall / gap / certified of each and, where --explain
+    wrote them, the TLS cost at the estimate (at the clean optimum), the groups that kept members
+    and the true closures cut; the new run's probes (kept) and wall."""
+    with open(base_csv) as f:
+        base = {(r["graph"], r["kind"], float(r["F"])): r for r in csv.DictReader(f)}
+    with open(new_csv) as f:
+        rows = list(csv.DictReader(f))
+
+    def num(v, spec):
+        try:
+            return spec.format(float(v))
+        except (TypeError, ValueError):
+            return v or "-"
+    head = ("| graph | kind | F | outliers | rejected | precision | recall | gap | certified | TLS (clean) | "
+            "groups kept | true cut | probes: rejected | precision | recall | gap | certified | probes (kept) | "
+            "wall s | TLS (clean) | groups kept | true cut |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for r in rows:
+        b = base.get((r["graph"], r["kind"], float(r["F"])), {})
+        lines.append("| " + " | ".join([
+            r["graph"], r["kind"], r["F"], r["outliers"], b.get("rejected") or "-",
+            num(b.get("precision"), "{:.3f}"), num(b.get("recall"), "{:.3f}"), num(b.get("gap"), "{:.1e}"),
+            b.get("certified") or "-", (f"{b['tls']} ({b['tls_clean']})" if b.get("tls") else "-"),
+            b.get("groups_kept") or "-", b.get("true_cut") or "-", r["rejected"] or "-", num(r["precision"], "{:.3f}"),
+            num(r["recall"], "{:.3f}"), num(r["gap"], "{:.1e}"), r["certified"] or "-",
+            f"{r.get('probes') or 0} ({r.get('probes_kept') or 0})", num(r["wall_s"], "{:.3g}"),
+            (f"{r['tls']} ({r['tls_clean']})" if r.get("tls") else "-"), r.get("groups_kept") or "-",
+            r.get("true_cut") or "-"]) + " |")
+    return "\n".join(lines)
+
+
 def optima(shared):
     """f* of every shared dataset (reference/optima.csv); for the 3D files the `_qnorm` row (the
     same graph with unit quaternions, which is what tessera solves: reference/README.md)."""
@@ -520,6 +636,11 @@ def main():
     ap.add_argument("--csv", default="robust.csv", help="file name in --out-dir (rows are appended per cell)")
     ap.add_argument("--scheme", default="gnc-tls", choices=["gnc-tls", "pcm-gnc"],
                     help="--robust value of the centralized robust solve (the distributed one is gnc-tls)")
+    ap.add_argument("--cluster-probes", type=int, default=0,
+                    help="--gnc-cluster-probes K for the centralized robust solve (scheme column: gnc-tls+cluster K)")
+    ap.add_argument("--explain", action="store_true",
+                    help="group cells: TLS cost at the centralized robust estimate and at the clean optimum, "
+                         "groups that kept members (columns tls, tls_clean, groups_kept, true_cut)")
     ap.add_argument("--no-plain", dest="plain", action="store_false",
                     help="skip the plain (non-robust) centralized solve of the contaminated file (slow on "
                          "large graphs)")
@@ -532,6 +653,8 @@ def main():
                     help="instead of running: merge the cells of CSV (a run with --no-distributed, "
                          "--no-centralized or --no-plain) into --csv by (graph, kind, F, scheme), each solve that "
                          "ran replacing its columns; then redraw the figure and print the table")
+    ap.add_argument("--compare", metavar="BASE_CSV",
+                    help="only print --csv's centralized columns beside BASE_CSV's (a file in --out-dir)")
     ap.add_argument("--clean-all", action="store_true",
                     help="instead: F = 0 on every shared dataset (--graphs narrows them), robust distributed "
                          "solve with 5 agents, CSV robust_clean.csv")
@@ -546,6 +669,9 @@ def main():
         return
     out_csv = os.path.join(args.out_dir, args.csv)
     png = os.path.join(args.out_dir, os.path.splitext(args.csv)[0] + ".png")
+    if args.compare:
+        print(compare_table(os.path.join(args.out_dir, args.compare), out_csv))
+        return
     if args.merge:
         merge(out_csv, args.merge)
     if args.plot_only or args.merge:
@@ -556,10 +682,16 @@ def main():
               "iterations", "wall_s", "certified", "plain_gap", "plain_ate_m", "plain_wall_s",
               "d_rejected", "d_precision", "d_recall", "d_gap", "d_ate_m", "d_outer", "d_rounds", "d_clean_rounds",
               "d_round_ratio", "d_bytes", "d_wall_s", "d_certified", "load", "note",
-              "d_probes", "d_probes_kept", "d_refine_steps"]
-    if not (args.append and os.path.exists(out_csv)):
+              "d_probes", "d_probes_kept", "d_refine_steps", "probes", "probes_kept", "tls", "tls_clean",
+              "groups_kept", "true_cut"]
+    if args.append and os.path.exists(out_csv):
+        with open(out_csv) as f:
+            fields = next(csv.reader(f))  # an older CSV: its own columns, new ones left out
+    else:
         with open(out_csv, "w", newline="") as f:
             csv.writer(f).writerow(fields)
+    scheme = args.scheme + (f"+cluster{args.cluster_probes}" if args.cluster_probes else "")
+    cluster_flags = ["--gnc-cluster-probes", str(args.cluster_probes)] if args.cluster_probes else []
     work = tempfile.mkdtemp(prefix="tessera-robust-")
     for name in args.graphs.split(","):
         clean = clean_graph(args, work, name)
@@ -586,11 +718,12 @@ def main():
                 rob, rob_tum, wall, err = None, None, 0, "not run"
                 if args.centralized:
                     rob, rob_tum, wall, err = solve(args.bin, path, work, tag + "_robust",
-                                                    ["--robust", args.scheme, "--rejected", rej], args.timeout)
+                                                    ["--robust", args.scheme, "--rejected", rej] + cluster_flags,
+                                                    args.timeout)
                 plain = None
                 if args.plain:
                     plain, plain_tum, plain_wall, _ = solve(args.bin, path, work, tag + "_plain", [], args.timeout)
-                row = {"graph": name, "kind": kind, "F": fraction, "scheme": args.scheme, "outliers": len(labels),
+                row = {"graph": name, "kind": kind, "F": fraction, "scheme": scheme, "outliers": len(labels),
                        "load": load}
                 if plain is not None:
                     row.update(plain_gap=(plain["cost"] - fstar) / fstar,
@@ -608,7 +741,16 @@ def main():
                                gap=(rob["cost"] - fstar) / fstar,
                                ate_m=ate(read_tum(rob_tum, d), optimum, d),
                                outer=rob["outer_iterations"], iterations=rob["total_iterations"],
-                               wall_s=round(wall, 2), certified=rob["certified"])
+                               wall_s=round(wall, 2), certified=rob["certified"],
+                               probes=rob.get("probes", ""), probes_kept=rob.get("probes_kept", ""))
+                    if args.explain and kind == "group" and labels:
+                        why = explain(path, read_tum(rob_tum, d), optimum, labels, rob["rejected"],
+                                      rob["inlier_threshold_squared"])
+                        row.update(tls=round(why["tls"], 1), tls_clean=round(why["tls_clean"], 1),
+                                   groups_kept=why["groups_kept"], true_cut=why["true_cut"])
+                        progress("  TLS at the estimate " + ", ".join(
+                            f"{k} {v:.1f}" for k, v in why["tls_parts"].items()) + "; at the clean optimum " +
+                            ", ".join(f"{k} {v:.1f}" for k, v in why["tls_clean_parts"].items()))
                 if args.distributed:
                     drob, drob_tum, dwall, derr = solve(args.bin, path, work, tag + "_drobust",
                                                         ["--robust", "gnc-tls"], args.timeout, "irbcd")

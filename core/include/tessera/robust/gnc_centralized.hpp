@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <tessera/graph/pose_graph.hpp>
+#include <tessera/robust/closure_clusters.hpp>
 #include <tessera/robust/pairwise_consistency.hpp>
 #include <tessera/robust/robust_options.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
@@ -38,6 +39,23 @@ struct GncCentralizedOptions {
   /// truncated CG. A graph whose full factor fits the budget (every clean shared graph) is solved
   /// exactly as with the full preconditioner. max_flops = 0: always the full one.
   PreconditionerEdgeOptions preconditioner;
+  /// Most cluster probes after the re-check passes, >= 0 (0 = none). A probe cuts one cluster of
+  /// kept closures that run side by side (closure_clusters.hpp, the one with the most rejected
+  /// closures near it that was not tried yet), runs the re-check passes from there and keeps the
+  /// result only when the TLS cost over every measurement falls. Why: a run of wrong closures
+  /// between two look-alike stretches bends the map until all of them fit, and the true closures
+  /// of the stretch are cut instead; no one-at-a-time verdict undoes that, while the truth has
+  /// the lower TLS cost (intel with group outliers; docs/benchmarks/robust.md, "Group outliers").
+  int cluster_probes = 0;
+  ClosureClusterOptions clusters;  ///< Which kept closures form a cluster.
+  /// With cluster probes: when no cluster is left to cut, a rejected closure with r^2 at most
+  /// this times c^2 at the kept set's solution is taken back alone (a probe of the same budget,
+  /// kept on the same rule), nearest to the bound first; >= 0, 0 = never. A true closure that a
+  /// wrong run's bend pushed beyond the bound can stay there after the run is cut: the local
+  /// solution does not move towards it unless it is in the problem (intel, group 0.1: r^2 71.9
+  /// against c^2 = 32.8, 4.3 at the clean optimum). 4: the wrong closures that GNC rejects on
+  /// intel and CSAIL lie above 35 c^2.
+  double readmit_ratio = 4.0;
   /// Throws InputError naming the first bad field.
   void validate() const;
 };
@@ -67,10 +85,11 @@ struct GncCentralizedResult {
   std::size_t readmitted = 0;
   /// Kept measurements beyond the bound at an inlier set's solution, rejected by a re-check pass.
   std::size_t late_rejected = 0;
-  /// Return probes run after the re-check passes (RobustOptions::probe_return_ratio; at most
-  /// one) and those that stayed.
-  int probes = 0, probes_kept = 0;
   PairwiseConsistencyResult pcm;  ///< kPcmGnc: the consistency check (empty otherwise).
+  /// Cluster probes run (GncCentralizedOptions::cluster_probes), plus the return probe
+  /// (RobustOptions::probe_return_ratio; at most one).
+  int probes = 0;
+  int probes_kept = 0;  ///< Of those, the ones that lowered the TLS cost and stayed.
   /// The start vote (GncCentralizedOptions::known_inlier_start) chose the known inliers' start.
   bool started_from_known_inliers = false;
   /// Every solve in order: the first (plain) one, the weighted ones, the kept set's.

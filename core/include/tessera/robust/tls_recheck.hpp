@@ -23,4 +23,10 @@ TlsRecheck tls_recheck(const PoseGraph& graph, const std::vector<bool>& known,
                        const std::vector<Pose>& poses, double c2,
                        const std::vector<std::size_t>& rejected);
 
+/// The TLS cost at `poses`: sum over the measurements of r^2 for known ones (known[e] true, never
+/// rejected) and min(r^2, c^2) for the others. What the start vote, the re-check passes and the
+/// cluster probes compare.
+double tls_cost(const PoseGraph& graph, const std::vector<bool>& known,
+                const std::vector<Pose>& poses, double c2);
+
 }  // namespace tessera

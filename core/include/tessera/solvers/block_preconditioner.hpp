@@ -58,6 +58,12 @@ class BlockPreconditioner : public RiemannianPreconditioner {
   /// True when the exact factor was computed supernodally (solves may use it converted to
   /// simplicial form, see simplicial_solves).
   bool supernodal() const;
+  /// Entries of the exact factor as its symbolic analysis predicted them (0 for the block
+  /// diagonal fallback).
+  std::size_t factor_entries() const;
+  /// Floating-point operations of the exact factorization, CHOLMOD's prediction (0 for the
+  /// block diagonal fallback).
+  double factor_flops() const;
 
  private:
   struct Factor;

@@ -31,6 +31,8 @@ enum class CentralizedStop {
 /// Which preconditioner the trust region's tCG uses at rank-d points (see
 /// docs/centralized-solver.md; above rank d, after a saddle escape, it is always the Euclidean).
 enum class CentralizedPreconditioning {
+  /// Chosen per graph (see CentralizedOptions and docs/centralized-solver.md).
+  kAuto,
   /// J A^{-1} J^T in tangent coordinates, A = J^T 2Q J + lambda I at the current rotations
   /// (<tessera/solvers/tangent_preconditioner.hpp>): the exact inverse of the Hessian's Q part.
   kTangent,
@@ -52,7 +54,19 @@ struct CentralizedOptions {
   /// 1126 instead of 1788 tCG iterations (a long chain: its soft modes sit near the shift), the
   /// other shared graphs within 2 %.
   double preconditioner_shift = 1e-12;
-  CentralizedPreconditioning preconditioning = CentralizedPreconditioning::kTangent;
+  /// kAuto (the default): per graph, from the tangent factor's symbolic analysis and the tCG
+  /// iterations the Euclidean factor needs (the two fields below; docs/centralized-solver.md).
+  CentralizedPreconditioning preconditioning = CentralizedPreconditioning::kAuto;
+  /// kAuto: start with the tangent factor when its factorization costs at most this many of its
+  /// own solves (CHOLMOD's predicted flops against 4 x its entries), else with the Euclidean
+  /// factor; finite, >= 0 (0: always start with the Euclidean factor). 30: every 2D shared graph
+  /// (at most 21), parking-garage (13), smallGrid3D (24) start with it; torus3D (99),
+  /// sphere_bignoise_vertex3 (85), sphere2500 (63), cubicle (57) do not.
+  double auto_start_tangent_solves = 30;
+  /// kAuto, started with the Euclidean factor: switch to the tangent factor once the Euclidean
+  /// solves at one iterate (one step's tCG; 4 d x its entries flops each) cost this fraction of
+  /// a tangent factorization; finite, > 0.
+  double auto_switch_fraction = 0.2;
   /// kTangent: lambda of A relative to its largest diagonal entry, > 0 (A is singular along the
   /// global translation).
   double tangent_shift = 1e-9;
@@ -130,6 +144,11 @@ struct CentralizedResult {
   std::optional<double> min_eigenvalue;
   std::vector<StaircaseLevel> levels;
   std::vector<CentralizedIteration> trace;
+  /// The preconditioner(s) the trust region used at rank d: "tangent", "euclidean", or
+  /// "euclidean,tangent" when kAuto switched from the Euclidean factor to the tangent one.
+  std::string preconditioner;
+  int inner_iterations = 0;        ///< tCG iterations over all levels.
+  int tangent_factorizations = 0;  ///< Numeric factorizations of the tangent factor.
   double init_s = 0.0, optimize_s = 0.0, certify_s = 0.0, total_s = 0.0;
   Eigen::MatrixXd X;  ///< Final lifted solution.
 

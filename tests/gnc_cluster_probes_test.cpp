@@ -1,0 +1,187 @@
+// Cluster probes of the centralized robust solve (GncCentralizedOptions::cluster_probes) and the
+// clusters of kept closures they cut (closure_clusters.hpp).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <tessera/robust/closure_clusters.hpp>
+#include <tessera/robust/gnc_centralized.hpp>
+#include <tessera/util/input_error.hpp>
+
+#include "gnc_fixtures.hpp"
+#include "test_support.hpp"
+
+namespace tessera {
+namespace {
+
+using test::flexible_city;
+
+// A 2D chain of n poses (odometry only) to hang closures on; only the structure matters here.
+PoseGraph chain(std::size_t n) {
+  PoseGraph g;
+  g.d = 2;
+  g.num_poses = n;
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    Measurement m;
+    m.i = i;
+    m.j = i + 1;
+    m.R = Eigen::Matrix2d::Identity();
+    m.t = Eigen::Vector2d(1, 0);
+    m.kappa = m.tau = 1;
+    g.measurements.push_back(m);
+  }
+  return g;
+}
+
+void add_closure(PoseGraph& g, std::size_t i, std::size_t j) {
+  Measurement m = g.measurements.front();
+  m.i = i;
+  m.j = j;
+  g.measurements.push_back(m);
+}
+
+std::vector<bool> odometry_flags(const PoseGraph& g) {
+  std::vector<bool> known;
+  for (const Measurement& m : g.measurements) known.push_back(m.j == m.i + 1 || m.i == m.j + 1);
+  return known;
+}
+
+TEST(ClosureClusters, ARunSideBySideIsOneClusterAndOnlyCutClosuresNearItPointAtIt) {
+  PoseGraph g = chain(200);
+  const std::size_t first = g.num_measurements();
+  for (std::size_t k = 0; k < 5; ++k) add_closure(g, 10 + k, 100 + k);  // a run, one id apart
+  add_closure(g, 107, 16);   // beside the run (written high to low): 2 and 3 ids from its ends
+  add_closure(g, 60, 160);   // alone: no cluster
+  add_closure(g, 150, 190);  // a second run of two, far from everything
+  add_closure(g, 152, 192);
+  add_closure(g, 20, 110);  // rejected, 5 ids from the first run's stretches
+  const std::size_t cut = g.num_measurements() - 1;
+  const std::vector<bool> known = odometry_flags(g);
+
+  EXPECT_TRUE(closure_clusters(g, known, {}, ClosureClusterOptions{}).empty())
+      << "nothing rejected: nothing points at a cluster";
+  ClosureClusterOptions o;
+  o.near = 10;
+  std::vector<ClosureCluster> c = closure_clusters(g, known, {cut}, o);
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_EQ(c[0].members,
+            (std::vector<std::size_t>{first, first + 1, first + 2, first + 3, first + 4}));
+  EXPECT_EQ(c[0].rejected_near, 1u);
+  o.near = 0;  // the cut closure no longer lies near the run
+  EXPECT_TRUE(closure_clusters(g, known, {cut}, o).empty());
+  o.window = 3;  // (107, 16) joins the run: its ends are within 3 ids of the last member
+  o.near = 10;
+  c = closure_clusters(g, known, {cut}, o);
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_EQ(c[0].members.size(), 6u);
+}
+
+TEST(ClosureClusters, BadOptionsNameTheField) {
+  const PoseGraph g = chain(10);
+  ClosureClusterOptions o;
+  o.window = 0;
+  try {
+    closure_clusters(g, odometry_flags(g), {}, o);
+    FAIL() << "window 0 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("ClosureClusterOptions.window"), std::string::npos);
+  }
+  GncCentralizedOptions gnc;
+  gnc.cluster_probes = -1;
+  try {
+    gnc.validate();
+    FAIL() << "cluster_probes -1 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("GncCentralizedOptions.cluster_probes"),
+              std::string::npos);
+  }
+  gnc.cluster_probes = 1;
+  gnc.readmit_ratio = -1;
+  try {
+    gnc.validate();
+    FAIL() << "readmit_ratio -1 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("GncCentralizedOptions.readmit_ratio"), std::string::npos);
+  }
+}
+
+// The case cluster probes exist for: on a map whose information states more noise than its data
+// has, GNC bends the map until whole groups of mutually consistent wrong closures fit, and cuts
+// the true closures of those stretches instead; the re-check passes judge one closure at a time
+// and keep the groups. A probe cuts a group at once, the passes take the true closures back, and
+// the TLS cost falls, so it stays: every wrong closure found, nothing else, at the clean cost.
+TEST(GncCentralized, ClusterProbesCutAGroupOfConsistentWrongClosuresThatGncAloneKeeps) {
+  const GeneratorResult g = flexible_city(0.1, OutlierKind::kGroup, 3);
+  GncCentralizedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  const GncCentralizedResult without = solve_gnc_centralized(g.graph, o);
+  o.cluster_probes = 20;
+  const GncCentralizedResult with = solve_gnc_centralized(g.graph, o);
+
+  auto found = [&](const GncCentralizedResult& r) {
+    std::size_t hit = 0;
+    for (std::size_t e : r.rejected)
+      hit += std::binary_search(g.outliers.begin(), g.outliers.end(), e) ? 1 : 0;
+    return hit;
+  };
+  EXPECT_EQ(without.probes, 0);
+  EXPECT_LT(found(without), g.outliers.size() - 5) << "GNC alone keeps a group";
+  EXPECT_GE(with.probes_kept, 1);
+  EXPECT_LE(with.probes, 20);
+  EXPECT_EQ(with.rejected, g.outliers);
+  // Every kept measurement is within the bound at the end, so the TLS cost is the kept cost plus
+  // c^2 per rejected measurement; the probes only ever lower it.
+  auto tls = [](const GncCentralizedResult& r) {
+    return r.final_solve.cost + r.threshold_squared * static_cast<double>(r.rejected.size());
+  };
+  EXPECT_LT(tls(with), tls(without));
+  EXPECT_TRUE(with.final_solve.certified.value_or(false));
+  for (std::size_t e = 0; e < with.weights.size(); ++e)
+    EXPECT_EQ(with.weights[e],
+              std::binary_search(with.rejected.begin(), with.rejected.end(), e) ? 0.0 : 1.0);
+}
+
+// Where GNC alone already finds every wrong closure, refused probes change nothing.
+TEST(GncCentralized, ClusterProbesLeaveAnExactAnswerAsItIs) {
+  const GeneratorResult g = flexible_city(0.1, OutlierKind::kGroup, 1);
+  GncCentralizedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  const GncCentralizedResult without = solve_gnc_centralized(g.graph, o);
+  o.cluster_probes = 5;
+  const GncCentralizedResult with = solve_gnc_centralized(g.graph, o);
+  EXPECT_EQ(without.rejected, g.outliers);
+  EXPECT_EQ(with.probes, 5);
+  EXPECT_EQ(with.probes_kept, 0);
+  EXPECT_EQ(with.rejected, without.rejected);
+  EXPECT_EQ(with.final_solve.cost, without.final_solve.cost);
+}
+
+TEST(GncClusterProbesCli, TheFlagReachesTheSolveAndABadValueNamesItWithExitStatusTwo) {
+  const std::string dir = test::temp_dir();
+  const std::string file = dir + "/group.g2o", json = dir + "/out.json";
+  std::string output;
+  ASSERT_EQ(test::run_command(test::bin("tessera") +
+                                  " generate --kind grid3d --poses 125 --robots 5 --seed 2 "
+                                  "--outliers 0.25 --outlier-kind group --out " +
+                                  file,
+                              &output),
+            0)
+      << output;
+  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + file +
+                                  " --robust gnc-tls --gnc-cluster-probes -1",
+                              &output),
+            2);
+  EXPECT_TRUE(test::contains(output, "--gnc-cluster-probes")) << output;
+  EXPECT_TRUE(test::contains(output, "GncCentralizedOptions.cluster_probes")) << output;
+  ASSERT_EQ(test::run_command(test::bin("tessera") + " solve " + file +
+                                  " --robust gnc-tls --gnc-cluster-probes 2 --json " + json,
+                              &output),
+            0)
+      << output;
+  const std::string summary = test::read_text_file(json);
+  // Rejected closures lie near kept runs of the grid, so the budget of 2 is what ends the probes.
+  EXPECT_TRUE(test::contains(summary, "\"probes\": 2")) << summary;
+}
+
+}  // namespace
+}  // namespace tessera
