@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "gnc_fixtures.hpp"
+#include "robust/gnc_local_terms.hpp"
+#include "robust/gnc_votes.hpp"
 
 namespace tessera {
 namespace {
@@ -230,6 +232,73 @@ TEST(GncDistributed, TheFinalSolveIsRefinedToTheOptimumOfTheKeptSet) {
   EXPECT_NEAR(uncertified.final_solve.cost, fstar, 1e-9 * fstar);
 }
 
+// A true closure that is the only tie of two stretches of a map lets them relax once GNC cut it:
+// at the kept set's solution it lies just beyond the bound, so the re-check (one verdict at a
+// time) never takes it back. A probe brings back the rejected measurements within
+// probe_return_ratio x c^2 there (and leaves the far ones out); applying the probe's list flips
+// them back in. Here: a straight 2D chain at its poses, c = 3, one rejected closure at r^2 =
+// 2 c^2, one at 10 c^2, a kept one at 0.5 c^2.
+TEST(GncDistributed, AProbeBringsBackARejectedClosureJustBeyondTheBound) {
+  const int n = 6;
+  GncAgentInput in;
+  in.d = 2;
+  in.num_poses = n;
+  in.owner.assign(n, 0);
+  auto edge = [&](std::size_t i, std::size_t j, double offset) {
+    Measurement m;
+    m.i = i;
+    m.j = j;
+    m.R = Eigen::Matrix2d::Identity();
+    m.t = Eigen::Vector2d(static_cast<double>(j) - static_cast<double>(i), offset);
+    in.measurement_index.push_back(in.measurements.size());
+    in.structure.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
+    in.measurements.push_back(m);
+  };
+  for (int k = 0; k + 1 < n; ++k) edge(k, k + 1, 0.0);  // odometry: known inliers, exact
+  const double c2 = 9.0;
+  edge(0, 5, std::sqrt(2 * c2));    // 5: rejected, r^2 = 2 c^2
+  edge(1, 4, std::sqrt(10 * c2));   // 6: rejected, r^2 = 10 c^2
+  edge(0, 3, std::sqrt(0.5 * c2));  // 7: kept, r^2 = c^2 / 2
+  RobustOptions robust;
+  robust.kind = RobustKind::kGncTls;
+  robust.inlier_threshold = 3.0;
+  const BlockLayout layout = make_block_layout(in.num_poses, in.structure, in.owner);
+  const GncLocalTerms terms(in, robust, layout);
+  ASSERT_DOUBLE_EQ(terms.c2(), c2);
+  Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(2, 3 * n);  // rank d: R = I, t = (k, 0)
+  for (int k = 0; k < n; ++k) {
+    Y.block(0, 3 * k, 2, 2).setIdentity();
+    Y(0, 3 * k + 2) = k;
+  }
+  const Eigen::MatrixXd no_neighbours(2, 0);
+  std::vector<std::uint64_t> rejected = {5, 6};
+  const double no_cut_probe = 1e300;  // a tail ratio nothing reaches: only the return side
+  RecheckVerdict v =
+      recheck_verdict(terms, in.measurement_index, rejected, Y, no_neighbours, 5.0, no_cut_probe);
+  EXPECT_TRUE(v.empty());  // no one-at-a-time verdict changes the set
+  EXPECT_EQ(v.probe, (std::vector<std::uint64_t>{5}));
+  EXPECT_TRUE(
+      recheck_verdict(terms, in.measurement_index, rejected, Y, no_neighbours, 0, no_cut_probe)
+          .probe.empty());  // no probe may start: no list
+
+  std::vector<double> weights = {1, 1, 1, 1, 1, 0, 0, 1};
+  RecheckVerdict probe;
+  probe.cut_now = v.probe;
+  const RecheckCounts counts = apply_recheck(probe, in.measurement_index, rejected, weights);
+  EXPECT_EQ(rejected, (std::vector<std::uint64_t>{6}));
+  EXPECT_EQ(weights[5], 1.0);
+  EXPECT_EQ(weights[6], 0.0);
+  EXPECT_EQ(counts.readmitted, 1u);
+  EXPECT_EQ(counts.late_rejected, 0u);
+
+  robust.probe_return_ratio = 1;  // none
+  const GncLocalTerms without(in, robust, layout);
+  rejected = {5, 6};
+  EXPECT_TRUE(
+      recheck_verdict(without, in.measurement_index, rejected, Y, no_neighbours, 5.0, no_cut_probe)
+          .probe.empty());
+}
+
 TEST(GncDistributed, BadProbeOptionsNameTheField) {
   GncDistributedOptions o = irbcd_gnc();
   o.robust.probe_ratio = 1.0;
@@ -246,6 +315,14 @@ TEST(GncDistributed, BadProbeOptionsNameTheField) {
     FAIL() << "recheck_probes -1 accepted";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("recheck_probes"), std::string::npos) << e.what();
+  }
+  o.robust.recheck_probes = 2;
+  o.robust.probe_return_ratio = 0.5;
+  try {
+    o.validate();
+    FAIL() << "probe_return_ratio 0.5 accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("probe_return_ratio"), std::string::npos) << e.what();
   }
 }
 

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/distributed_initialization.hpp>
@@ -279,6 +280,34 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
     out.probes_kept = counts.kept;
     // The certificate (and the staircase) for the set that stayed.
     if (counts.kept > 0) adopt(solve_kept_set(out.rejected, out.final_solve.poses, final_options));
+  }
+  // Return probe (RobustOptions::probe_return_ratio, with the probes' budget): the rejected
+  // measurements beyond the bound but within probe_return_ratio x c^2 at the kept set's solution
+  // come back together, the passes run again, and the result stays only if the TLS cost fell. A
+  // true closure that alone ties two stretches of the map lies just beyond the bound once it is
+  // gone, so no pass takes it back.
+  if (robust.recheck_probes > 0 && robust.readmission_passes > 0 && known_connected &&
+      !out.rejected.empty()) {
+    const std::vector<Pose> at = out.final_solve.poses;
+    const std::vector<double> r2_kept = residuals(graph, at);
+    std::vector<std::size_t> back;
+    for (std::size_t e : out.rejected)
+      if (!known[e] && r2_kept[e] > c2 && r2_kept[e] <= robust.probe_return_ratio * c2)
+        back.push_back(e);
+    if (!back.empty()) {
+      std::vector<std::size_t> still;
+      std::set_difference(out.rejected.begin(), out.rejected.end(), back.begin(), back.end(),
+                          std::back_inserter(still));
+      ++out.probes;
+      const double tls_before = tls_cost(graph, known, at, c2);
+      KeptSet trial = solve_kept_set(std::move(still), at, final_options);
+      if (tls_cost(graph, known, trial.solve.poses, c2) <
+          tls_before - 1e-9 * std::abs(tls_before)) {
+        ++out.probes_kept;
+        out.readmitted += back.size();
+        adopt(std::move(trial));
+      }
+    }
   }
   if (out.readmitted + out.late_rejected > 0 || out.probes_kept > 0)
     for (std::size_t e = 0; e < m; ++e)

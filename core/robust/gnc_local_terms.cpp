@@ -73,6 +73,7 @@ GncLocalTerms::GncLocalTerms(const GncAgentInput& in, const RobustOptions& robus
     candidates += known_[e] ? 0 : 1;
   }
   c2_ = tls_threshold_squared(robust, in_.d, candidates);
+  return_c2_ = robust.probe_return_ratio * c2_;
   known_connected_ = components_without(in_.num_poses, in_.d, in_.structure, {}, true, known_) <= 1;
   for (std::size_t k = 0; k < in_.measurements.size(); ++k) {
     const Measurement& x = in_.measurements[k];

@@ -28,6 +28,9 @@ class GncLocalTerms {
   /// The known inliers alone connect the poses.
   bool known_connected() const { return known_connected_; }
   double c2() const { return c2_; }
+  /// RobustOptions::probe_return_ratio x c^2: how far beyond the bound a rejected measurement
+  /// may lie and still be brought back by a probe.
+  double return_bound() const { return return_c2_; }
 
   bool may_reject(std::size_t k) const;
   /// The measurement's term of the TLS cost: r^2 for a known inlier, min(r^2, c^2) otherwise.
@@ -44,6 +47,7 @@ class GncLocalTerms {
   std::vector<bool> known_;
   bool known_connected_ = false;
   double c2_ = 0.0;
+  double return_c2_ = 0.0;
 };
 
 /// How many parts the measurements of `structure` not in `dropped` (ascending) split the poses

@@ -96,6 +96,8 @@ RecheckVerdict recheck_verdict(const GncLocalTerms& terms, const std::vector<std
     if (was_rejected && fits) v.taken_back.push_back(id);
     if (!was_rejected && !fits) v.cut_now.push_back(id);
     if (!was_rejected && fits) kept.emplace_back(r2, id);
+    if (probe_ratio > 0 && was_rejected && !fits && r2 <= terms.return_bound())
+      v.probe.push_back(id);
   }
   if (probe_ratio > 0 && !kept.empty()) {
     // The median of the agent's own kept residuals: a local scale, so no extra exchange.
@@ -125,6 +127,12 @@ double tls_cost(const GncLocalTerms& terms, const Eigen::MatrixXd& Y,
 
 RecheckCounts apply_recheck(RecheckVerdict& verdict, const std::vector<std::uint64_t>& index,
                             std::vector<std::uint64_t>& rejected, std::vector<double>& weights) {
+  // A probe's already rejected measurements come back (its list arrives as cut_now).
+  const auto returning = std::stable_partition(
+      verdict.cut_now.begin(), verdict.cut_now.end(),
+      [&](std::uint64_t id) { return !std::binary_search(rejected.begin(), rejected.end(), id); });
+  verdict.taken_back.insert(verdict.taken_back.end(), returning, verdict.cut_now.end());
+  verdict.cut_now.erase(returning, verdict.cut_now.end());
   std::sort(verdict.taken_back.begin(), verdict.taken_back.end());
   std::sort(verdict.cut_now.begin(), verdict.cut_now.end());
   for (std::size_t k = 0; k < index.size(); ++k) {

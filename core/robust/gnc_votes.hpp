@@ -59,8 +59,9 @@ struct RecheckVerdict {
   std::vector<std::uint64_t> cut_now;     ///< Kept, beyond the bound: out (weight 0).
   /// Kept, within the bound, but above probe_ratio x the median residual of the kept
   /// measurements the agent weighs (RobustOptions::recheck_probes), when their mean is above
-  /// probe_tail_ratio x that median: what a probe cuts. Not a change of the verdict (empty()
-  /// ignores it).
+  /// probe_tail_ratio x that median: what a probe cuts. Also rejected ones beyond the bound but
+  /// within GncLocalTerms::return_bound(): what a probe brings back. Not a change of the
+  /// verdict (empty() ignores it).
   std::vector<std::uint64_t> probe;
   bool empty() const { return taken_back.empty() && cut_now.empty(); }
 };
@@ -81,7 +82,9 @@ struct RecheckCounts {
   std::size_t late_rejected = 0;
 };
 /// Applies every agent's verdict (gathered in `verdict`; sorted here) to `weights` (per
-/// measurement of `index`) and to `rejected` (ascending, stays so).
+/// measurement of `index`) and to `rejected` (ascending, stays so). A probe's list is applied
+/// as `cut_now`: the ids in it that are already rejected come back instead (a probe flips its
+/// measurements).
 RecheckCounts apply_recheck(RecheckVerdict& verdict, const std::vector<std::uint64_t>& index,
                             std::vector<std::uint64_t>& rejected, std::vector<double>& weights);
 

@@ -67,6 +67,8 @@ void RobustOptions::validate() const {
     bad_field("probe_ratio", number_text(probe_ratio), "must be > 1");
   if (!(std::isfinite(probe_tail_ratio) && probe_tail_ratio >= 0))
     bad_field("probe_tail_ratio", number_text(probe_tail_ratio), "must be >= 0 (0 = always)");
+  if (!(std::isfinite(probe_return_ratio) && probe_return_ratio >= 1))
+    bad_field("probe_return_ratio", number_text(probe_return_ratio), "must be >= 1 (1 = none)");
   if (!(std::isfinite(weight_tolerance) && weight_tolerance >= 0))
     bad_field("weight_tolerance", number_text(weight_tolerance), "must be >= 0");
 }

@@ -442,6 +442,70 @@ def table(csv_path):
     return "\n".join(lines)
 
 
+CENTRAL_COLS = ["rejected", "precision", "recall", "gap", "ate_m", "outer", "iterations", "wall_s", "certified"]
+PLAIN_COLS = ["plain_gap", "plain_ate_m", "plain_wall_s"]
+
+
+def merge(into_csv, from_csv):
+    """Merges the cells of from_csv (a run with some of the solves switched off) into into_csv by
+    (graph, kind, F, scheme): each solve that ran in from_csv (centralized robust, plain,
+    distributed) replaces that solve's columns of the matching row, the others stay; a cell
+    not in into_csv is added (rows sorted by graph, kind, F). The load column keeps one figure per side, "centralized /
+    distributed"; a note starting with "distributed" belongs to the distributed side."""
+    with open(into_csv) as f:
+        reader = csv.DictReader(f)
+        fields = reader.fieldnames
+        rows = list(reader)
+    with open(from_csv) as f:
+        incoming = list(csv.DictReader(f))
+
+    def key(r):
+        return (r["graph"], r["kind"], float(r["F"]), r.get("scheme", ""))
+
+    def notes(r):
+        parts = [n.strip() for n in (r.get("note") or "").split(";") if n.strip()]
+        dist = [n for n in parts if n.startswith("distributed")]
+        return [n for n in parts if n not in dist], dist
+
+    dist_cols = [c for c in fields if c.startswith("d_")]
+    for new in incoming:
+        new_central, new_dist = notes(new)
+        ran_dist = any(new.get(c) for c in dist_cols) or bool(new_dist)
+        ran_central = any(new.get(c) for c in CENTRAL_COLS) or bool(new_central)
+        ran_plain = any(new.get(c) for c in PLAIN_COLS)
+        old = next((r for r in rows if key(r) == key(new)), None)
+        if old is None:
+            # after the graph's last row, so a graph's cells stay together
+            at = max((i + 1 for i, r in enumerate(rows) if r["graph"] == new["graph"]), default=len(rows))
+            rows.insert(at, {c: new.get(c, "") for c in fields})
+            continue
+        loads = [x.strip() for x in (old.get("load") or "").split(" / ")]
+        central_load, dist_load = loads[0], loads[-1]
+        old_central, old_dist = notes(old)
+        for cols, ran in ((CENTRAL_COLS, ran_central), (PLAIN_COLS, ran_plain), (dist_cols, ran_dist)):
+            if ran:
+                for c in cols:
+                    old[c] = new.get(c, "")
+        if ran_central or ran_plain:
+            central_load, old_central = new["load"], new_central
+        if ran_dist:
+            dist_load, old_dist = new["load"], new_dist
+        old["load"] = central_load if central_load == dist_load else f"{central_load} / {dist_load}"
+        old["note"] = "; ".join(old_central + old_dist)
+    # Each graph's cells together, kinds in order of first appearance, F ascending.
+    graphs, kinds = {}, {}
+    for r in rows:
+        graphs.setdefault(r["graph"], len(graphs))
+        kinds.setdefault(r["kind"], len(kinds))
+    rows.sort(key=lambda r: (graphs[r["graph"]], kinds[r["kind"]], float(r["F"])))
+    with open(into_csv, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        for r in rows:
+            w.writerow({c: r.get(c, "") for c in fields})
+    progress(f"merged {len(incoming)} rows of {from_csv} into {into_csv}")
+
+
 def compare_table(base_csv, new_csv):
     """Centralized columns of two runs side by side, by (graph, kind, F): `base_csv` (e.g.
     robust_group.csv, gnc-tls alone) and `new_csv` (e.g. robust_cluster.csv, with
@@ -585,6 +649,10 @@ def main():
     ap.add_argument("--append", action="store_true",
                     help="add rows to an existing --csv (e.g. the large graphs with fewer fractions)")
     ap.add_argument("--plot-only", action="store_true", help="only redraw the figure from the CSV")
+    ap.add_argument("--merge", metavar="CSV",
+                    help="instead of running: merge the cells of CSV (a run with --no-distributed, "
+                         "--no-centralized or --no-plain) into --csv by (graph, kind, F, scheme), each solve that "
+                         "ran replacing its columns; then redraw the figure and print the table")
     ap.add_argument("--compare", metavar="BASE_CSV",
                     help="only print --csv's centralized columns beside BASE_CSV's (a file in --out-dir)")
     ap.add_argument("--clean-all", action="store_true",
@@ -604,7 +672,9 @@ def main():
     if args.compare:
         print(compare_table(os.path.join(args.out_dir, args.compare), out_csv))
         return
-    if args.plot_only:
+    if args.merge:
+        merge(out_csv, args.merge)
+    if args.plot_only or args.merge:
         plot(out_csv, png)
         print(table(out_csv))
         return

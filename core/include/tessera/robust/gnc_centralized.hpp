@@ -86,8 +86,10 @@ struct GncCentralizedResult {
   /// Kept measurements beyond the bound at an inlier set's solution, rejected by a re-check pass.
   std::size_t late_rejected = 0;
   PairwiseConsistencyResult pcm;  ///< kPcmGnc: the consistency check (empty otherwise).
-  int probes = 0;                 ///< Cluster probes run (GncCentralizedOptions::cluster_probes).
-  int probes_kept = 0;            ///< Of those, the ones that lowered the TLS cost and stayed.
+  /// Cluster probes run (GncCentralizedOptions::cluster_probes), plus the return probe
+  /// (RobustOptions::probe_return_ratio; at most one).
+  int probes = 0;
+  int probes_kept = 0;  ///< Of those, the ones that lowered the TLS cost and stayed.
   /// The start vote (GncCentralizedOptions::known_inlier_start) chose the known inliers' start.
   bool started_from_known_inliers = false;
   /// Every solve in order: the first (plain) one, the weighted ones, the kept set's.
