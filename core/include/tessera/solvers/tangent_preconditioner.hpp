@@ -79,7 +79,7 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   /// changed) when no factor is held, X does not fit or the grown part is not positive definite.
   /// factorize() then refuses (the caller builds a new preconditioner for the grown block).
   bool grow(const BlockProblem& problem, const Eigen::MatrixXd& X);
-  /// Poses preconditioned by grow()'s diagonal blocks.
+  /// Poses appended to the factor by grow().
   Eigen::Index grown_poses() const;
 
   /// J(X) A^{-1} J(X)^T V for a tangent vector V at X (d rows): a tangent vector at X.
