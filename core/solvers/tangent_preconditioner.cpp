@@ -119,10 +119,11 @@ struct TangentPreconditioner::Factor {
     const Eigen::VectorXd ut = a - extra_k * (extra_h * a);
     extra_b -= extra_bt.transpose() * ut;  // z_n = S^-1 (b_n - A_no A'^-1 b_o)
     extra_b = extra_factor->solve(extra_b);
-    // z_o = A'^-1 (b_o - A_on z_n), in L's frame: v = y - W B z_n, then v - W H W^T D^-1 v.
-    y -= extra_w * (extra_bt * extra_b);
-    const Eigen::VectorXd a2 = extra_w.transpose() * d_inv(y);
-    y -= extra_w * (extra_h * a2);
+    // z_o = A'^-1 (b_o - A_on z_n), in L's frame: v = y - W B z_n, then v - W H W^T D^-1 v,
+    // where W^T D^-1 v = a - K B z_n: one product with W.
+    const Eigen::VectorXd bz = extra_bt * extra_b;
+    const Eigen::VectorXd a2 = a - extra_k * bz;
+    y -= extra_w * (bz + extra_h * a2);
     for (Eigen::Index k = n; k-- > 0;) {
       double s = y(k) / Lx[Lp[k]];
       for (int q = Lp[k] + 1; q < Lp[k] + Lnz[k]; ++q) s -= Lx[q] * y(Li[q]);
