@@ -62,7 +62,7 @@ struct OnlineOptions {
   /// (stale, still positive definite). 0 = a new factor at every step that brought the block new
   /// poses: the default, because the appended solves cost more than the factorizations they
   /// save (callgrind, a generated 1,000-pose grid, 5 robots, a step every 0.1 s: 3.30 G
-  /// instructions at 0, 3.93 G at 0.1, 6.51 G at 0.25; docs/online.md). >= 0.
+  /// instructions at 0, 3.79 G at 0.1, 6.38 G at 0.25; docs/online.md). >= 0.
   double refactor_growth = 0.0;
   /// How a step brings ||grad f|| back under solver.grad_norm_tol after new data. true: block-
   /// coordinate rounds down to max(newton_after_grad_tol, the tolerance), then distributed
