@@ -20,7 +20,8 @@ namespace tessera::cli {
 const char* const kOnlineValued[] = {"rate",           "speedup",         "start",
                                      "checkpoints",    "certify-every",   "refactor-growth",
                                      "baseline-every", "local-threshold", "step-every",
-                                     "step-solver",    "newton-after",    nullptr};
+                                     "step-solver",    "newton-after",    "threads",
+                                     nullptr};
 const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", "no-local-rounds",
                                        nullptr};
 
@@ -51,9 +52,12 @@ const char* kOnlineHelp =
     "                            re-solving after every closure would take hours (default 1)\n"
     "  --certify-every S         also certify every S seconds of stream time (default 0: at\n"
     "                            the end only)\n"
-    "  --refactor-growth G       a growing block keeps its preconditioner factor until it\n"
-    "                            has G times more poses than it was computed for (default\n"
-    "                            0: a new factor whenever the block gets new poses)\n"
+    "  --refactor-growth G       a growing block keeps its preconditioner factor, the new\n"
+    "                            poses appended to it, until it has G times more poses than\n"
+    "                            it was computed for (default 0: a new factor whenever the\n"
+    "                            block gets new poses)\n"
+    "  --threads T               the agents handle their messages on T threads (1..64,\n"
+    "                            default 1); the same iterates as one thread\n"
     "  --local-threshold F       local rounds: a block works only while its gradient norm\n"
     "                            is above F * grad-tol / sqrt(blocks), in (0, 1] (default 1)\n"
     "  --no-local-rounds         every block works and sends in every round\n"
@@ -102,6 +106,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.certify_every_s = a.get_double("certify-every", 0.0);
   options.step_every_s = a.get_double("step-every", 0.0);
   options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
+  options.solver.threads = static_cast<int>(a.get_long("threads", options.solver.threads));
   options.solver.local_rounds.enabled = !a.has("no-local-rounds");
   options.solver.local_rounds.threshold =
       a.get_double("local-threshold", options.solver.local_rounds.threshold);

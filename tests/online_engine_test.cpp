@@ -189,6 +189,33 @@ TEST(OnlineEngine, NewtonStepsEndEveryStepUnderTheToleranceWithoutARound) {
   EXPECT_NEAR(rounds.cost, f_star, 1e-6 * f_star);
 }
 
+// The agents' messages handled on two threads (FIFO waves) give the same iterates, bit for
+// bit, as one thread: with Newton steps and with rounds.
+TEST(OnlineEngine, TwoThreadsGiveTheSameStepsAsOne) {
+  const auto gen = small_graph(TrajectoryKind::kGrid3d, 120, 3);
+  ReplayOptions ro;
+  ro.rate = 10;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  for (bool newton : {true, false}) {
+    OnlineOptions o = online_options();
+    o.step_every_s = 0.5;
+    o.newton_steps = newton;
+    const OnlineResult one = run_online(gen.graph.d, plan.batches, o);
+    o.solver.threads = 2;
+    const OnlineResult two = run_online(gen.graph.d, plan.batches, o);
+    ASSERT_EQ(one.updates.size(), two.updates.size());
+    for (std::size_t k = 0; k < one.updates.size(); ++k) {
+      EXPECT_EQ(one.updates[k].rounds, two.updates[k].rounds);
+      EXPECT_EQ(one.updates[k].newton_cg_iterations, two.updates[k].newton_cg_iterations);
+      EXPECT_EQ(one.updates[k].grad_norm, two.updates[k].grad_norm);
+      EXPECT_EQ(one.updates[k].bytes, two.updates[k].bytes);
+    }
+    EXPECT_EQ(one.cost, two.cost);
+    ASSERT_TRUE(two.certified.has_value());
+    EXPECT_TRUE(*two.certified);
+  }
+}
+
 TEST(OnlineEngine, APoseThatOnlyExtendsOdometryNeedsNoRound) {
   // Composition puts the new pose where its odometry says: its measurement has no residual,
   // so the gradient does not move and the agents stay idle.

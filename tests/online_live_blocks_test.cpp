@@ -157,20 +157,21 @@ TEST(LiveBlocks, MovedPosesRebuildTheBlocks) {
 }
 
 TEST(TangentPreconditionerGrow, TheGrownPreconditionerIsSymmetricPositiveDefinite) {
-  const auto gen = small_graph(TrajectoryKind::kSphere, 90, 1);
+  const auto gen = small_graph(TrajectoryKind::kSphere, 91, 1);
   const PoseGraph& g = gen.graph;
   const int d = g.d;
-  const Eigen::MatrixXd X = lift_poses(g.initial, d);  // rank d: the tangent preconditioner's
+  // Poses 1..90 (pose 0 a neighbour: a block held in place, as in a run where robots met).
+  const Eigen::MatrixXd X = lift_poses(g.initial, d).rightCols((d + 1) * 90);
   std::vector<std::size_t> first, rest;
-  for (std::size_t k = 0; k < g.num_poses; ++k) (k < 60 ? first : rest).push_back(k);
+  for (std::size_t k = 1; k < g.num_poses; ++k) (k <= 60 ? first : rest).push_back(k);
   // The problem of the first 60 poses' measurements, then grown by the other 30.
   std::vector<Measurement> early;
   std::vector<Measurement> ordered;
   for (const Measurement& m : g.measurements)
-    if (m.i < 60 && m.j < 60) early.push_back(m);
+    if (m.i <= 60 && m.j <= 60) early.push_back(m);
   ordered = early;
   for (const Measurement& m : g.measurements)
-    if (m.i >= 60 || m.j >= 60) ordered.push_back(m);
+    if (m.i > 60 || m.j > 60) ordered.push_back(m);
   BlockProblem problem(d, first, early);
   TangentPreconditioner precon(problem);
   ASSERT_TRUE(precon.factorize(X.leftCols((d + 1) * 60)));
@@ -193,6 +194,49 @@ TEST(TangentPreconditionerGrow, TheGrownPreconditionerIsSymmetricPositiveDefinit
     EXPECT_NEAR(uPv, vPu, 1e-9 * std::max(1.0, std::abs(uPv)));
     // A tangent vector at X.
     EXPECT_LT((M.tangent_project(X, Pv) - Pv).norm(), 1e-9 * std::max(1.0, Pv.norm()));
+  }
+}
+
+// The grown poses are appended to the held factor (block LDL^T with their Schur complement; the
+// new measurements' share of the factored poses by Woodbury), not approximated: at the factor's
+// point the grown preconditioner is the exact inverse of A over all poses.
+TEST(TangentPreconditionerGrow, AppendedPosesGiveTheExactInverseAtTheFactorsPoint) {
+  for (TrajectoryKind kind : {TrajectoryKind::kCity, TrajectoryKind::kSphere}) {
+    const auto gen = small_graph(kind, 80, 1);
+    const PoseGraph& g = gen.graph;
+    const int d = g.d;
+    const Eigen::MatrixXd X = lift_poses(g.initial, d);
+    // The block: poses 1..49, then 50..79 with every measurement that touches them (loop
+    // closures to 1..49 included); pose 0 is a neighbour, so A is positive definite unshifted.
+    std::vector<std::size_t> first, rest, all_owned;
+    for (std::size_t k = 1; k < g.num_poses; ++k) {
+      (k < 50 ? first : rest).push_back(k);
+      all_owned.push_back(k);
+    }
+    std::vector<Measurement> early, late;
+    for (const Measurement& m : g.measurements)
+      (std::max(m.i, m.j) < 50 ? early : late).push_back(m);
+    std::vector<Measurement> all = early;
+    all.insert(all.end(), late.begin(), late.end());
+    BlockProblem problem(d, first, early);
+    TangentPreconditioner precon(problem, /*relative_shift=*/0.0, 0);
+    const Eigen::MatrixXd Xb = X.rightCols((d + 1) * (g.num_poses - 1));
+    ASSERT_TRUE(precon.factorize(Xb.leftCols((d + 1) * 49)));
+    problem.extend(rest, all, early.size());
+    ASSERT_TRUE(precon.grow(problem, Xb));
+    EXPECT_EQ(precon.grown_poses(), 30);
+    const BlockProblem whole(d, all_owned, all);
+    TangentPreconditioner fresh(whole, /*relative_shift=*/0.0, 0);
+    ASSERT_TRUE(fresh.factorize(Xb));
+    const LiftedManifold M = problem.manifold(d);
+    std::mt19937 rng(5);
+    std::normal_distribution<double> noise;
+    for (int trial = 0; trial < 3; ++trial) {
+      const Eigen::MatrixXd V = M.tangent_project(
+          Xb, Eigen::MatrixXd::NullaryExpr(d, Xb.cols(), [&] { return noise(rng); }));
+      const Eigen::MatrixXd grown = precon.apply(M, Xb, V), exact = fresh.apply(M, Xb, V);
+      EXPECT_LT((grown - exact).norm(), 1e-8 * exact.norm()) << "d = " << d;
+    }
   }
 }
 

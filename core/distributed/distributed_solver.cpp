@@ -45,6 +45,7 @@ void DistributedOptions::validate() const {
   if (robots < 0) fail("robots", "must be >= 0");
   if (!(grad_norm_tol >= 0)) fail("grad_norm_tol", "must be >= 0");
   if (max_rounds < 0) fail("max_rounds", "must be >= 0");
+  if (threads < 1 || threads > 64) fail("threads", "must be in 1..64");
   if (!(rel_cost_decrease_tol >= 0)) fail("rel_cost_decrease_tol", "must be >= 0");
   block_update.validate();
   coarse.validate();
@@ -182,7 +183,8 @@ DistributedResult solve_distributed_with_states(const PoseGraph& graph, const Bl
 
   const auto solve_start = Clock::now();
   const std::clock_t cpu_start = std::clock();
-  const DeliveryStats stats = run_in_process(agents, options.delivery, options.delivery_seed);
+  const DeliveryStats stats =
+      run_in_process(agents, options.delivery, options.delivery_seed, options.threads);
   res.solve_s = since(solve_start);
   res.solve_cpu_s = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   res.critical_path_cpu_s = stats.critical_path_cpu_s;

@@ -1,11 +1,16 @@
 #include <algorithm>
+#include <atomic>
+#include <condition_variable>
 #include <ctime>
 #include <deque>
+#include <exception>
 #include <functional>
+#include <mutex>
 #include <stdexcept>
 #include <tessera/distributed/in_process_driver.hpp>
 #include <tessera/distributed/message_gate.hpp>
 #include <tessera/distributed/stage_tag.hpp>
+#include <thread>
 
 namespace tessera {
 
@@ -36,8 +41,80 @@ std::uint32_t round_of(const ProtocolMessage& m) {
   return std::get<RoundStatusMessage>(m).round;
 }
 
+// Worker threads for the FIFO waves of deliver(): each wave, every thread (the caller's too)
+// takes recipients from a shared counter and runs `work(recipient)`.
+class WavePool {
+ public:
+  explicit WavePool(int threads) {
+    for (int t = 1; t < threads; ++t) workers_.emplace_back([this] { loop(); });
+  }
+  ~WavePool() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    start_.notify_all();
+    for (auto& w : workers_) w.join();
+  }
+  // Runs work(0 .. count-1), each index once, on every thread; returns when all are done.
+  void run(std::size_t count, const std::function<void(std::size_t)>& work) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      work_ = &work;
+      count_ = count;
+      next_ = 0;
+      busy_ = workers_.size();
+      ++generation_;
+    }
+    start_.notify_all();
+    take(work);
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [this] { return busy_ == 0; });
+    work_ = nullptr;
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+  }
+
+ private:
+  void take(const std::function<void(std::size_t)>& work) {
+    for (std::size_t k; (k = next_.fetch_add(1)) < count_;) {
+      try {
+        work(k);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!error_) error_ = std::current_exception();
+      }
+    }
+  }
+  void loop() {
+    std::uint64_t seen = 0;
+    for (;;) {
+      const std::function<void(std::size_t)>* work = nullptr;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        start_.wait(lock, [&] { return stop_ || generation_ != seen; });
+        if (stop_) return;
+        seen = generation_;
+        work = work_;
+      }
+      take(*work);
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (--busy_ == 0) done_.notify_one();
+    }
+  }
+
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable start_, done_;
+  const std::function<void(std::size_t)>* work_ = nullptr;
+  std::size_t count_ = 0, busy_ = 0;
+  std::atomic<std::size_t> next_{0};
+  std::uint64_t generation_ = 0;
+  bool stop_ = false;
+  std::exception_ptr error_;
+};
+
 DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder order,
-                      std::uint64_t delivery_seed,
+                      std::uint64_t delivery_seed, int threads,
                       const std::function<std::vector<OutgoingMessage>(std::size_t)>& begin) {
   DeliveryStats stats;
   std::deque<Delivery> queue;
@@ -82,6 +159,47 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
   // (the driver's queueing of the previous outputs, then this handle()) is charged to this
   // recipient. Two clock reads per delivery were ~4 % of a short solve's CPU (the thread clock is
   // a system call), and most deliveries only buffer a status message.
+  if (threads > 1 && order == DeliveryOrder::kFifo && n > 1) {
+    // FIFO in waves: the messages queued now are handled before any they cause (their outputs
+    // are queued behind all of them), so a wave's deliveries to different agents are
+    // independent. Each agent handles its own in queue order on one thread, and the outputs are
+    // queued in the wave's order: the same deliveries, in the same order per agent, as one
+    // thread gives, hence the same iterates.
+    WavePool pool(std::min<int>(threads, static_cast<int>(n)));
+    std::vector<std::vector<std::size_t>> mine(n);
+    while (!queue.empty()) {
+      std::vector<Delivery> wave(std::make_move_iterator(queue.begin()),
+                                 std::make_move_iterator(queue.end()));
+      queue.clear();
+      for (auto& m : mine) m.clear();
+      for (std::size_t k = 0; k < wave.size(); ++k) {
+        if (wave[k].recipient >= n)
+          throw std::logic_error("in-process driver: message to unknown agent");
+        mine[wave[k].recipient].push_back(k);
+      }
+      std::vector<std::vector<OutgoingMessage>> outs(wave.size());
+      std::vector<double> took(wave.size(), -1.0);  // < 0: not handled (agent done)
+      pool.run(n, [&](std::size_t r) {
+        double t0 = thread_cpu_s();
+        for (std::size_t k : mine[r]) {
+          if (agents[r]->done()) continue;
+          outs[k] = agents[r]->handle(wave[k].message);
+          const double t1 = thread_cpu_s();
+          took[k] = t1 - t0;
+          t0 = t1;
+        }
+      });
+      for (std::size_t k = 0; k < wave.size(); ++k) {
+        if (took[k] < 0) continue;
+        const std::size_t r = wave[k].recipient;
+        auto& per_agent =
+            cpu[{stage_of_phase(message_phase(wave[k].message)), round_of(wave[k].message)}];
+        if (per_agent.empty()) per_agent.assign(n, 0.0);
+        per_agent[r] += took[k];
+        post(r, std::move(outs[k]));
+      }
+    }
+  }
   double t_prev = thread_cpu_s();
   while (!queue.empty()) {
     Delivery d;
@@ -119,8 +237,9 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
 }  // namespace
 
 DeliveryStats run_in_process(const std::vector<AgentProcess*>& agents, DeliveryOrder order,
-                             std::uint64_t delivery_seed) {
-  return deliver(agents, order, delivery_seed, [&](std::size_t i) { return agents[i]->start(); });
+                             std::uint64_t delivery_seed, int threads) {
+  return deliver(agents, order, delivery_seed, threads,
+                 [&](std::size_t i) { return agents[i]->start(); });
 }
 
 DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
@@ -138,7 +257,7 @@ DeliveryStats resume_in_process(const std::vector<RoundProtocol*>& agents,
     if (s.round != snapshots.front().round)
       throw std::invalid_argument("resume_in_process: snapshots of different rounds");
   const std::vector<AgentProcess*> processes(agents.begin(), agents.end());
-  return deliver(processes, order, delivery_seed,
+  return deliver(processes, order, delivery_seed, 1,
                  [&](std::size_t i) { return agents[i]->resume(snapshots[i]); });
 }
 

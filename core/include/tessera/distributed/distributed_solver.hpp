@@ -79,6 +79,9 @@ struct DistributedOptions {
   bool round_result = true;
   DeliveryOrder delivery = DeliveryOrder::kFifo;  ///< In-process delivery order (tests).
   std::uint64_t delivery_seed = 1;
+  /// In process: the agents handle their messages on this many threads (with kFifo; the same
+  /// iterates as 1, see in_process_driver.hpp). 1..64.
+  int threads = 1;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;

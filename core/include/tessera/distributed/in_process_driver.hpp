@@ -44,8 +44,12 @@ std::size_t message_bytes(const ProtocolMessage& message);
 
 /// Delivers messages until every agent is done (or no message is left, which would be a
 /// protocol bug: then std::logic_error). `agents[i]` must be the agent with id i.
+/// `threads` > 1 (kFifo only; other orders run on one thread): the agents handle their messages
+/// on that many threads, in waves (all messages queued now, before those they cause), which is
+/// exactly the FIFO order per agent: the same iterates as one thread. The agents must share no
+/// mutable state (each holds its own block and factors).
 DeliveryStats run_in_process(const std::vector<AgentProcess*>& agents, DeliveryOrder order,
-                             std::uint64_t delivery_seed = 1);
+                             std::uint64_t delivery_seed = 1, int threads = 1);
 /// Same for plain round protocols.
 DeliveryStats run_in_process(const std::vector<RoundProtocol*>& agents, DeliveryOrder order,
                              std::uint64_t delivery_seed = 1);

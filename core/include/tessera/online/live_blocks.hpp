@@ -3,9 +3,9 @@
 // poses and measurements; building every block problem, its data matrices and its
 // preconditioner factors again for them (what a solve from scratch does) made the set-up cost
 // of a step grow with the whole graph. Here a block that got new data grows in place
-// (AgentState::extend: the new measurements are appended, its factor is kept for the poses it
-// was computed for and the new poses get their own diagonal blocks until the block has grown
-// by `refactor_growth`), a block with nothing new is kept as it is, and only a block that lost
+// (AgentState::extend: the new measurements are appended; with `refactor_growth` > 0 its factor
+// is kept and the new poses are appended to it until the block has grown by that fraction), a
+// block with nothing new is kept as it is, and only a block that lost
 // or gained poses through a re-partition (rebalance_blocks) is built again.
 //
 // The solved graph is the linked part of the stream's graph (linked_problem.hpp: a pose no

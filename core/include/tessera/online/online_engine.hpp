@@ -56,12 +56,13 @@ struct OnlineOptions {
   /// stream time (at the first step after each period), on the graph received so far, robots
   /// that have not met included (OnlineEngine::certify); 0 = only at the end. >= 0.
   double certify_every_s = 0.0;
-  /// A block that grows keeps its tangent preconditioner factor (its new poses preconditioned
-  /// by their own diagonal blocks) until it holds this fraction more poses than the factor was
+  /// A block that grows keeps its tangent preconditioner factor (its new poses appended to it,
+  /// TangentPreconditioner::grow) until it holds this fraction more poses than the factor was
   /// computed for (live_blocks.hpp); a block that only gets new measurements keeps its factor
   /// (stale, still positive definite). 0 = a new factor at every step that brought the block new
-  /// poses: the default, because the diagonal blocks precondition a new chain of poses poorly
-  /// (instructions of a 400-pose sphere replay, 5 robots: 7.0 G at 0, 12.0 G at 0.05). >= 0.
+  /// poses: the default, because the appended solves cost more than the factorizations they
+  /// save (callgrind, a generated 1,000-pose grid, 5 robots, a step every 0.1 s: 3.30 G
+  /// instructions at 0, 3.79 G at 0.1, 6.38 G at 0.25; docs/online.md). >= 0.
   double refactor_growth = 0.0;
   /// How a step brings ||grad f|| back under solver.grad_norm_tol after new data. true: block-
   /// coordinate rounds down to max(newton_after_grad_tol, the tolerance), then distributed

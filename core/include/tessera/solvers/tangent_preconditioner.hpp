@@ -71,14 +71,15 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   bool prepare(const Eigen::MatrixXd& X, int refresh_interval);
 
   /// The block grew (`problem` after BlockProblem::extend, `X` its rank-d point with the new
-  /// poses appended): the new poses are preconditioned with their own p x p diagonal blocks of
-  /// A at X, the factored poses with the held factor (block Jacobi over {factored poses, each
-  /// new pose}: still symmetric positive definite, merely less exact), so a growing block is
-  /// not refactored for every few poses. Returns false (nothing changed) when no factor is held,
-  /// X does not fit or a new block is not positive definite. factorize() then refuses (the
-  /// caller builds a new preconditioner for the grown block instead).
+  /// poses appended): the poses after the factored ones (this growth's and earlier ones') are
+  /// preconditioned with a factor of their own part of A at X (their couplings among themselves
+  /// kept, those to the factored poses left out), the factored poses with the held factor: block
+  /// Jacobi over {factored poses, grown poses}, still symmetric positive definite, merely less
+  /// exact, so a growing block is not refactored for every few poses. Returns false (nothing
+  /// changed) when no factor is held, X does not fit or the grown part is not positive definite.
+  /// factorize() then refuses (the caller builds a new preconditioner for the grown block).
   bool grow(const BlockProblem& problem, const Eigen::MatrixXd& X);
-  /// Poses preconditioned by grow()'s diagonal blocks.
+  /// Poses appended to the factor by grow().
   Eigen::Index grown_poses() const;
 
   /// J(X) A^{-1} J(X)^T V for a tangent vector V at X (d rows): a tangent vector at X.
