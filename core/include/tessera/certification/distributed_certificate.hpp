@@ -83,12 +83,20 @@ class CertificateProtocol : public AgentProcess {
   double ritz_value() const { return theta_; }
 
  private:
-  enum Step : std::uint32_t { kVector = 1, kReduce = 2 };
+  // kVector: the start vector's boundary entries (iteration 0 only); kPrecond: the boundary
+  // entries of T v and T S v for the vector v the iteration added (x, then each w); kReduce: the
+  // global reduction. kPrecond and kReduce leave together, so an iteration is one message step.
+  enum Step : std::uint32_t { kVector = 1, kReduce = 2, kPrecond = 3 };
   Eigen::MatrixXd apply(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
   Eigen::MatrixXd gradient(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn) const;
   void pump(std::vector<OutgoingMessage>& out);
-  void send_boundary(const Eigen::MatrixXd& v, std::uint32_t round,
+  void send_boundary(const Eigen::MatrixXd& v, std::uint32_t round, std::uint32_t step,
                      std::vector<OutgoingMessage>& out);
+  /// T v and T S v (own), their boundary entries sent to the neighbours.
+  void send_preconditioned(const Eigen::MatrixXd& v, const Eigen::MatrixXd& Sv, Eigen::MatrixXd& Tv,
+                           Eigen::MatrixXd& TSv, std::uint32_t round,
+                           std::vector<OutgoingMessage>& out);
+  void after_precond(const MessageGate::Inbox& inbox);
   void broadcast(std::uint32_t round, const std::vector<double>& values,
                  std::vector<OutgoingMessage>& out);
   void begin_iteration(std::vector<OutgoingMessage>& out);
@@ -109,6 +117,11 @@ class CertificateProtocol : public AgentProcess {
   MessageGate gate_;
   std::uint32_t iteration_ = 0;
   Eigen::MatrixXd x_, Sx_, w_, Sw_, p_, Sp_;
+  // The preconditioner T applied to the same vectors, own (T x, T S x, ...) and the neighbours'
+  // boundary entries of theirs (n*): w = T(S x - theta x) is formed from them, on the own and the
+  // neighbours' poses, without waiting for a neighbour after the reduction.
+  Eigen::MatrixXd Tx_, TSx_, Tw_, TSw_, Tp_, TSp_;
+  Eigen::MatrixXd nTx_, nTSx_, nTw_, nTSw_, nTp_, nTSp_;
   double theta_ = 0.0, rr_local_ = 0.0;
   bool has_p_ = false;
   bool done_ = false;
