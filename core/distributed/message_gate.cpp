@@ -42,6 +42,27 @@ std::vector<int> MessageGate::missing() const {
   return out;
 }
 
+std::vector<ProtocolMessage> MessageGate::take_steps(std::uint32_t first, std::uint32_t last) {
+  // The map is ordered by round first; collect the steps' entries, then order them by step.
+  std::vector<std::pair<std::uint64_t, Inbox>> taken;
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    const std::uint32_t step = step_of(it->first);
+    if (step < first || step >= last) {
+      ++it;
+      continue;
+    }
+    taken.emplace_back(it->first, std::move(it->second));
+    it = pending_.erase(it);
+  }
+  std::stable_sort(taken.begin(), taken.end(), [](const auto& a, const auto& b) {
+    return step_of(a.first) < step_of(b.first);
+  });
+  std::vector<ProtocolMessage> out;
+  for (auto& [k, inbox] : taken)
+    for (auto& [sender, m] : inbox) out.push_back(std::move(m));
+  return out;
+}
+
 PoseBlockMessage make_reduction_message(int sender, std::uint32_t round, std::uint32_t phase,
                                         const std::vector<double>& values) {
   PoseBlockMessage m;

@@ -2,6 +2,7 @@
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/coarse_space.hpp>
+#include <tessera/distributed/message_gate.hpp>
 #include <tessera/distributed/stage_tag.hpp>
 #include <tessera/robust/gnc_agent.hpp>
 #include <tessera/robust/tls_weights.hpp>
@@ -12,19 +13,18 @@
 #include "distributed/pose_block_codec.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
+#include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
 #include "robust/gnc_probes.hpp"
+#include "robust/gnc_solve_setup.hpp"
 #include "robust/gnc_votes.hpp"
 
 namespace tessera {
 
 namespace {
 
-std::uint32_t phase_of(const ProtocolMessage& m) {
-  return std::visit([](const auto& x) { return x.phase; }, m);
-}
-std::uint32_t sender_of(const ProtocolMessage& m) {
-  return std::visit([](const auto& x) { return x.sender; }, m);
+std::vector<int> as_ints(const std::vector<std::uint32_t>& ids) {
+  return {ids.begin(), ids.end()};
 }
 
 }  // namespace
@@ -54,6 +54,7 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   layout_ = std::make_unique<BlockLayout>(*base_);
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
+  mail_ = std::make_unique<GncMailbox>(in_.id);
   recheck_ = std::make_unique<RecheckVerdict>();
   probes_ = std::make_unique<GncProbes>(options_.robust.recheck_probes);
   weights_.assign(m, 1.0);
@@ -76,7 +77,6 @@ void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t p
     const auto to_agent = static_cast<std::uint32_t>(adjacent[q]);
     out.push_back(OutgoingMessage{
         encode_public_poses(*base_, in_.id, q, in_.d, Y, kind, 0, phase), false, {to_agent}});
-    waiting_.push_back(to_agent);  // one message from that neighbour per message sent
   }
 }
 
@@ -109,38 +109,15 @@ std::vector<OutgoingMessage> GncAgent::start() {
 void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
   solve_.reset();
-  solve_options_ = options_.solver;
+  solve_options_ = gnc_solve_options(options_, solve_kind_, pass_capped_);
   std::vector<Measurement> measurements;
-  if (solve_kind_ != Solve::kGnc) {
+  if (solve_kind_ == GncSolveKind::kGnc)
+    measurements = gnc_solve_measurements(in_.measurements, weights_, g_ > first_solve_g_,
+                                          terms_->known_connected());
+  else
     measurements = kept_;
-    if (solve_kind_ == Solve::kInlierPass) {
-      solve_options_.certify = false;
-      // A pass whose set may still change needs only a rough solution; the verdict that ends
-      // the passes is taken at a converged one (after_exchange, kReadmitted).
-      if (pass_capped_)
-        solve_options_.max_rounds =
-            std::min(solve_options_.max_rounds, options_.robust.recheck_max_rounds);
-    }
-    if (solve_kind_ == Solve::kFinal && options_.robust.final_refine)
-      solve_options_.refine.enabled = true;  // the answer to the refinement's tolerance
-  } else {
-    solve_options_.certify = false;
-    // Every solve before the inlier passes needs only a rough minimiser.
-    if (options_.robust.inner_max_rounds > 0)
-      solve_options_.max_rounds =
-          std::min(solve_options_.max_rounds, options_.robust.inner_max_rounds);
-    for (std::size_t k = 0; k < in_.measurements.size(); ++k) {
-      // A weight of exactly 0 adds nothing: such an edge leaves the solve when the known
-      // inliers keep the poses connected (fewer block neighbours, fewer colours); otherwise it
-      // stays at a tiny pull so no part is cut off.
-      if (terms_->known_connected() && weights_[k] == 0) continue;
-      measurements.push_back(g_ > first_solve_g_
-                                 ? weighted_measurement(in_.measurements[k], weights_[k])
-                                 : in_.measurements[k]);
-    }
-  }
   const Eigen::MatrixXd Y = state_ ? state_->Y : in_.Y0;
-  if (solve_kind_ == Solve::kInlierPass) last_pass_start_ = Y;
+  if (solve_kind_ == GncSolveKind::kInlierPass) last_pass_start_ = Y;
   state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
                                         solve_options_.block_update);
   if (solve_options_.refine.enabled &&
@@ -153,14 +130,27 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
   pass_on(solve_->start(), out);
   const std::uint32_t g = g_;
-  replay(out);
+  // Messages of this solve that came while this agent was behind; once the solve has ended,
+  // the rest are of no use.
+  for (const ProtocolMessage& m : mail_->begin_solve(g)) {
+    if (done_ || g_ != g || step_ != Step::kSolve) break;
+    to_solve(m, out);
+  }
   if (!done_ && g_ == g && step_ == Step::kSolve && solve_->done()) after_solve(out);
+}
+
+void GncAgent::to_solve(const ProtocolMessage& message, std::vector<OutgoingMessage>& out) {
+  ProtocolMessage m = message;
+  std::visit([&](auto& x) { x.phase -= g_ * kGncStepStride; }, m);
+  pass_on(solve_->handle(m), out);
+  if (solve_->done()) after_solve(out);
 }
 
 // Endpoints of the measurements the current solve works on, file order: the kept set for the
 // passes and the final solve, the whole graph for GNC's weighted solves.
 std::vector<std::pair<std::uint32_t, std::uint32_t>> GncAgent::solve_structure() const {
-  return solve_kind_ == Solve::kGnc ? in_.structure : inlier_structure(in_.structure, rejected_);
+  return solve_kind_ == GncSolveKind::kGnc ? in_.structure
+                                           : inlier_structure(in_.structure, rejected_);
 }
 
 // The inner solve's messages, tagged with this GNC step.
@@ -170,15 +160,6 @@ void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out,
     std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
     out.push_back(std::move(o));
   }
-}
-
-bool GncAgent::is_current(std::uint32_t phase) const {
-  if (step_ != Step::kSolve) return phase == exchange_phase();
-  return phase >= g_ * kGncStepStride && phase < g_ * kGncStepStride + kGncExchangeBase;
-}
-
-std::uint32_t GncAgent::lowest_current_phase() const {
-  return step_ == Step::kSolve ? g_ * kGncStepStride : exchange_phase();
 }
 
 std::pair<double, double> GncAgent::summed_votes() const {
@@ -222,29 +203,31 @@ std::uint32_t GncAgent::exchange_phase() const {
 
 // Agent 0 gathers the values of the measurements the agents weigh (each measurement once; with
 // `kept_only` the ones not rejected): the others send theirs, agent 0 keeps its own and waits.
-void GncAgent::gather_values_at_lead(GncExchange exchange, bool kept_only,
-                                     std::vector<OutgoingMessage>& out) {
+// Returns whom this agent waits for (the others wait for agent 0's answer).
+std::vector<int> GncAgent::gather_values_at_lead(GncExchange exchange, bool kept_only,
+                                                 std::vector<OutgoingMessage>& out) {
   const std::vector<std::uint64_t>* rejected = kept_only ? &rejected_ : nullptr;
   if (in_.id != 0) {
     out.push_back(OutgoingMessage{
         owned_values_block(in_, *terms_, rejected, gnc_phase(g_, exchange)), false, {0}});
-    waiting_.push_back(0);
-    return;
+    return {0};
   }
   kept_values_.clear();
   append_owned_values(in_, *terms_, rejected, kept_values_);
-  waiting_ = other_agents(0, in_.num_agents);
+  return as_ints(other_agents(0, in_.num_agents));
 }
 
 void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   step_ = step;
   const std::uint32_t phase = exchange_phase();
   const auto me = static_cast<std::uint32_t>(in_.id);
-  waiting_.clear();
   votes_.clear();
+  // Whom this agent hears from: a pose exchange from its block neighbours (each sends what it
+  // was sent), a status exchange from every other agent.
+  std::vector<int> from = base_->adjacent[static_cast<std::size_t>(in_.id)];
   // A status to every other agent, each of which answers with its own.
   auto to_others = [&](RoundStatusMessage st) {
-    waiting_ = other_agents(me, in_.num_agents);
+    from = as_ints(other_agents(me, in_.num_agents));
     broadcast_status(std::move(st), me, phase, in_.num_agents, out);
   };
   switch (step) {
@@ -272,10 +255,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       to_others(vote_message(votes_[me]));
       break;
     case Step::kPcm:
-      gather_values_at_lead(GncExchange::kPcmValues, false, out);
+      from = gather_values_at_lead(GncExchange::kPcmValues, false, out);
       break;
     case Step::kKeptStart:
-      gather_values_at_lead(GncExchange::kKeptValues, true, out);
+      from = gather_values_at_lead(GncExchange::kKeptValues, true, out);
       break;
     case Step::kCandidatePoses:
       // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
@@ -302,8 +285,9 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       votes_[me] = {spread, 0};
       zero_cut_ =
           zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
-      waiting_ = other_agents(me, in_.num_agents);
-      for (std::uint32_t a : waiting_) {
+      const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
+      from = as_ints(others);
+      for (std::uint32_t a : others) {
         RoundStatusMessage st = weights_message(a, spread, in_, *terms_, weights_);
         st.phase = phase;
         st.sender = me;
@@ -331,8 +315,15 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     default:
       break;
   }
-  replay(out);
-  if (!done_ && step_ == step && exchange_phase() == phase && waiting_.empty()) after_exchange(out);
+  mail_->begin_exchange(phase, std::move(from));
+  take_exchange(out);
+}
+
+void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
+  std::optional<std::vector<ProtocolMessage>> ready = mail_->take_exchange();
+  if (!ready) return;
+  for (const ProtocolMessage& m : *ready) read_message(m);
+  after_exchange(out);
 }
 
 void GncAgent::require_kept_connected() const {
@@ -350,15 +341,9 @@ void GncAgent::require_kept_connected() const {
 
 void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
   require_kept_connected();
-  kept_.clear();
-  kept_index_.clear();
-  for (std::size_t k = 0; k < in_.measurements.size(); ++k)
-    if (!std::binary_search(rejected_.begin(), rejected_.end(), in_.measurement_index[k])) {
-      kept_.push_back(in_.measurements[k]);
-      kept_index_.push_back(in_.measurement_index[k]);
-    }
+  gnc_kept_measurements(in_.measurements, in_.measurement_index, rejected_, kept_, kept_index_);
   solve_without(rejected_);
-  solve_kind_ = Solve::kInlierPass;
+  solve_kind_ = GncSolveKind::kInlierPass;
   pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;
   full_pass_next_ = false;
   ++g_;
@@ -387,7 +372,7 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   }
   // The certificate once, on the set that stays (re-admission ran on uncertified solves: the
   // staircase may raise the rank, which a further pass could not start from).
-  solve_kind_ = Solve::kFinal;
+  solve_kind_ = GncSolveKind::kFinal;
   ++g_;
   begin_solve(out);
 }
@@ -474,14 +459,14 @@ void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out) {
 }
 
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
-  if (solve_kind_ == Solve::kFinal) {
+  if (solve_kind_ == GncSolveKind::kFinal) {
     final_rounds_ += solve_->total_rounds();
     done_ = true;
     step_ = Step::kDone;
     return;
   }
   gnc_rounds_ += solve_->total_rounds();
-  if (solve_kind_ == Solve::kInlierPass) {
+  if (solve_kind_ == GncSolveKind::kInlierPass) {
     if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
@@ -510,7 +495,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
 void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   switch (step_) {
     case Step::kPoses:
-      if (solve_kind_ == Solve::kInlierPass)
+      if (solve_kind_ == GncSolveKind::kInlierPass)
         begin_exchange(Step::kReadmitted, out);
       else
         begin_exchange(voted_ ? Step::kWeights : Step::kVotes, out);
@@ -623,22 +608,8 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   }
 }
 
-void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>& out) {
-  const std::uint32_t phase = phase_of(message);
-  if (step_ == Step::kSolve) {
-    ProtocolMessage m = message;
-    std::visit([&](auto& x) { x.phase -= g_ * kGncStepStride; }, m);
-    pass_on(solve_->handle(m), out);
-    if (solve_->done()) after_solve(out);
-    return;
-  }
-  const std::uint32_t sender = sender_of(message);
-  auto it = std::find(waiting_.begin(), waiting_.end(), sender);
-  const std::string me = "agent " + std::to_string(in_.id) + ": ";
-  if (it == waiting_.end())
-    throw std::runtime_error(me + "unexpected robust message " + std::to_string(phase) +
-                             " from agent " + std::to_string(sender));
-  waiting_.erase(it);
+void GncAgent::read_message(const ProtocolMessage& message) {
+  const std::uint32_t sender = message_sender(message);
   // Each step's message kind, or an error naming what arrived where (gnc_messages).
   const char* const kStatusBelongs = "poses where a robust status belongs";
   switch (step_) {
@@ -699,52 +670,22 @@ void GncAgent::feed(const ProtocolMessage& message, std::vector<OutgoingMessage>
     default:
       break;
   }
-  if (waiting_.empty()) after_exchange(out);
-}
-
-void GncAgent::replay(std::vector<OutgoingMessage>& out) {
-  // Messages of the step just begun that came while this agent was behind.
-  while (!done_ && !later_.empty()) {
-    const std::uint32_t phase = later_.begin()->first;
-    if (!is_current(phase)) {
-      if (phase >= lowest_current_phase()) return;
-      later_.erase(later_.begin());  // of a step this agent has left
-      continue;
-    }
-    std::vector<ProtocolMessage> kept = std::move(later_.begin()->second);
-    later_.erase(later_.begin());
-    const Step step = step_;
-    const std::uint32_t g = g_;
-    for (std::size_t q = 0; q < kept.size(); ++q) {
-      if (done_ || step_ != step || g_ != g) {
-        // The step moved on: what is left goes back in line.
-        auto& back = later_[phase];
-        back.insert(back.begin(), kept.begin() + static_cast<std::ptrdiff_t>(q), kept.end());
-        break;
-      }
-      feed(kept[q], out);
-    }
-  }
 }
 
 std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {
   std::vector<OutgoingMessage> out;
   if (done_) return out;
-  const std::uint32_t phase = phase_of(message);
-  if (is_current(phase)) {
-    feed(message, out);
-    replay(out);
-    return out;
-  }
-  if (phase < lowest_current_phase()) return out;  // a step this agent has left needs nothing more
-  later_[phase].push_back(message);
+  if (mail_->add(message))
+    to_solve(message, out);
+  else if (step_ != Step::kSolve)
+    take_exchange(out);
   return out;
 }
 
 std::size_t GncAgent::messages_needed() const {
   if (done_) return 0;
   if (step_ == Step::kSolve) return std::max<std::size_t>(solve_->messages_needed(), 1);
-  return std::max<std::size_t>(waiting_.size(), 1);
+  return mail_->messages_needed();
 }
 
 std::optional<AwaitedMessages> GncAgent::awaited() const {
@@ -754,10 +695,7 @@ std::optional<AwaitedMessages> GncAgent::awaited() const {
     if (a) a->phase += g_ * kGncStepStride;
     return a;
   }
-  std::vector<std::uint32_t> senders = waiting_;
-  std::sort(senders.begin(), senders.end());
-  senders.erase(std::unique(senders.begin(), senders.end()), senders.end());
-  return AwaitedMessages{0, exchange_phase(), senders};
+  return mail_->awaited();
 }
 
 }  // namespace tessera

@@ -2,7 +2,8 @@
 // Buffers one agent's incoming messages by (round, step) until the step it waits for has a
 // message from every expected sender; the step then gets them ordered by sender id, so
 // reductions sum in agent-id order and every agent takes bit-identical decisions. Messages of
-// later steps (from faster agents) wait in the gate.
+// later steps (from faster agents) wait in the gate. A step is any 32-bit value, so a caller may
+// key by a whole wire phase (the GNC agent's steps tag theirs far beyond a protocol's few steps).
 
 #include <cstdint>
 #include <map>
@@ -25,13 +26,20 @@ class MessageGate {
   std::optional<Inbox> take_ready();
   /// The expected step's senders whose message has not arrived yet, ascending.
   std::vector<int> missing() const;
+  /// The expected step's senders, as given to expect().
+  const std::vector<int>& senders() const { return senders_; }
+  /// Every stored message of the steps [first, last), whatever its round, removed from the gate
+  /// and ordered by step, round and sender: for a caller that forwards a whole stage to a
+  /// protocol that waits for its own steps, instead of waiting for one step here.
+  std::vector<ProtocolMessage> take_steps(std::uint32_t first, std::uint32_t last);
   std::uint32_t round() const { return round_; }
   std::uint32_t step() const { return step_; }
 
  private:
   static std::uint64_t key(std::uint32_t round, std::uint32_t step) {
-    return (static_cast<std::uint64_t>(round) << 16) | step;
+    return (static_cast<std::uint64_t>(round) << 32) | step;
   }
+  static std::uint32_t step_of(std::uint64_t key) { return static_cast<std::uint32_t>(key); }
   std::map<std::uint64_t, Inbox> pending_;
   std::uint32_t round_ = 0, step_ = 0;
   std::vector<int> senders_;

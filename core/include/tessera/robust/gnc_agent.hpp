@@ -36,7 +36,8 @@
 // (weight_owner()); the other end receives it, so both ends always use the same weight. The
 // stop follows from the summed spread, identical on every agent: no central step.
 // Messages carry their step in `phase` (gnc_phase()); a fast agent's messages of later steps
-// are kept until this agent gets there.
+// wait until this agent gets there, and each exchange reads its messages in agent-id order once
+// all are in (robust/gnc_mailbox.hpp).
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -127,9 +128,14 @@ struct GncAgentInput {
   bool pcm = false;
 };
 
+/// The solves of the distributed GNC: its own (the first and the weighted ones), the inlier
+/// passes over the kept set, and the final solve of the kept set.
+enum class GncSolveKind { kGnc, kInlierPass, kFinal };
+
 class GncLocalTerms;    // internal: the TLS math over one agent's view
 struct RecheckVerdict;  // internal: an inlier pass's re-check
 class GncProbes;        // internal: probes after the re-check passes
+class GncMailbox;       // internal: where incoming messages go
 
 class GncAgent : public AgentProcess {
  public:
@@ -181,7 +187,7 @@ class GncAgent : public AgentProcess {
   /// The last solve (the certified one, or the last inlier pass); valid once done().
   const CertifiedAgent& last_solve() const { return *solve_; }
   const CertifiedAgent* final_sequence() const {
-    return solve_kind_ == Solve::kFinal ? solve_.get() : nullptr;
+    return solve_kind_ == GncSolveKind::kFinal ? solve_.get() : nullptr;
   }
   /// Whether a final solve of the kept set follows the inlier passes (with certification or
   /// RobustOptions::final_refine); otherwise the last pass, solved to the tolerance, is the
@@ -207,19 +213,18 @@ class GncAgent : public AgentProcess {
     kStartVotes,
     kDone
   };
-  enum class Solve { kGnc, kInlierPass, kFinal };
   void begin_solve(std::vector<OutgoingMessage>& out);
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
-  void gather_values_at_lead(GncExchange exchange, bool kept_only,
-                             std::vector<OutgoingMessage>& out);
+  std::vector<int> gather_values_at_lead(GncExchange exchange, bool kept_only,
+                                         std::vector<OutgoingMessage>& out);
   void after_solve(std::vector<OutgoingMessage>& out);
   void after_exchange(std::vector<OutgoingMessage>& out);
-  void feed(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
-  void replay(std::vector<OutgoingMessage>& out);
+  // One message of the running solve, handed to it; after_solve() when that ends the solve.
+  void to_solve(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
+  // The current exchange's messages once all are in: read, then after_exchange().
+  void take_exchange(std::vector<OutgoingMessage>& out);
+  void read_message(const ProtocolMessage& m);  // one of the exchange's
   std::uint32_t exchange_phase() const;
-  // The current step's phase (a solve's: any of its inner phases), the lowest of them.
-  bool is_current(std::uint32_t phase) const;
-  std::uint32_t lowest_current_phase() const;
   // The inner solve's messages, tagged with this GNC step.
   void pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) const;
   std::pair<double, double> summed_votes() const;  // of the current exchange, every agent's
@@ -252,7 +257,7 @@ class GncAgent : public AgentProcess {
   std::vector<std::pair<std::uint64_t, Measurement>> kept_values_;  // agent 0's gathers
   std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
-  Solve solve_kind_ = Solve::kGnc;
+  GncSolveKind solve_kind_ = GncSolveKind::kGnc;
   bool voted_ = false;           // the votes of mu's start are in
   int pass_ = 0;                 // inlier passes done
   bool pass_capped_ = false;     // the current pass stops at RobustOptions::recheck_max_rounds
@@ -266,10 +271,9 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view
   Eigen::MatrixXd last_pass_start_;
   Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
-  std::vector<std::uint32_t> waiting_;                // senders the current exchange still lacks
   std::vector<double> weights_;                       // per in_.measurements
-  Eigen::MatrixXd neighbours_;  // neighbours' public poses of the current iterate
-  std::map<std::uint32_t, std::vector<ProtocolMessage>> later_;  // by phase
+  Eigen::MatrixXd neighbours_;        // neighbours' public poses of the current iterate
+  std::unique_ptr<GncMailbox> mail_;  // where incoming messages go
   // Sums of the current exchange (in agent-id order: own and received values kept by sender).
   std::map<std::uint32_t, std::pair<double, double>> votes_;
   double mu_ = 0;

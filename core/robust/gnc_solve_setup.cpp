@@ -1,0 +1,58 @@
+#include "robust/gnc_solve_setup.hpp"
+
+#include <algorithm>
+#include <tessera/robust/weighted_graph.hpp>
+
+namespace tessera {
+
+DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSolveKind kind,
+                                     bool pass_capped) {
+  DistributedOptions o = options.solver;
+  switch (kind) {
+    case GncSolveKind::kGnc:
+      o.certify = false;
+      if (options.robust.inner_max_rounds > 0)
+        o.max_rounds = std::min(o.max_rounds, options.robust.inner_max_rounds);
+      break;
+    case GncSolveKind::kInlierPass:
+      o.certify = false;
+      if (pass_capped) o.max_rounds = std::min(o.max_rounds, options.robust.recheck_max_rounds);
+      break;
+    case GncSolveKind::kFinal:
+      if (options.robust.final_refine) o.refine.enabled = true;
+      break;
+  }
+  return o;
+}
+
+std::vector<Measurement> gnc_solve_measurements(const std::vector<Measurement>& measurements,
+                                                const std::vector<double>& weights, bool weighted,
+                                                bool drop_zero) {
+  std::vector<Measurement> out;
+  out.reserve(measurements.size());
+  for (std::size_t k = 0; k < measurements.size(); ++k) {
+    if (drop_zero && weights[k] == 0) continue;
+    // Not one push_back of a conditional: with a const lvalue on one side its result is a
+    // const prvalue, which push_back copies instead of moving.
+    if (weighted)
+      out.push_back(weighted_measurement(measurements[k], weights[k]));
+    else
+      out.push_back(measurements[k]);
+  }
+  return out;
+}
+
+void gnc_kept_measurements(const std::vector<Measurement>& measurements,
+                           const std::vector<std::uint64_t>& index,
+                           const std::vector<std::uint64_t>& rejected,
+                           std::vector<Measurement>& kept, std::vector<std::uint64_t>& kept_index) {
+  kept.clear();
+  kept_index.clear();
+  for (std::size_t k = 0; k < measurements.size(); ++k)
+    if (!std::binary_search(rejected.begin(), rejected.end(), index[k])) {
+      kept.push_back(measurements[k]);
+      kept_index.push_back(index[k]);
+    }
+}
+
+}  // namespace tessera
