@@ -224,12 +224,13 @@ void CertificateProtocol::send_preconditioned(const Eigen::MatrixXd& v, const Ei
                                               Eigen::MatrixXd& Tv, Eigen::MatrixXd& TSv,
                                               std::uint32_t round,
                                               std::vector<OutgoingMessage>& out) {
+  // One row at a time: the sparse triangular solves with a two-column right-hand side took
+  // five times the instructions of two one-column solves.
+  Tv = precon_ ? precon_->apply(v) : v;
+  TSv = precon_ ? precon_->apply(Sv) : Sv;
   Eigen::MatrixXd both(2, v.cols());
-  both.row(0) = v;
-  both.row(1) = Sv;
-  if (precon_) both = precon_->apply(both);
-  Tv = both.row(0);
-  TSv = both.row(1);
+  both.row(0) = Tv;
+  both.row(1) = TSv;
   send_boundary(both, round, kPrecond, out);
   gate_.expect(round, kPrecond, layout_.adjacent[static_cast<std::size_t>(state_.id())]);
 }
