@@ -124,10 +124,11 @@ TEST(GncCentralized, ClusterProbesCutAGroupOfConsistentWrongClosuresThatGncAlone
       hit += std::binary_search(g.outliers.begin(), g.outliers.end(), e) ? 1 : 0;
     return hit;
   };
-  EXPECT_EQ(without.probes, 0);
+  // Without cluster probes only the return probe (at most one) may run.
+  EXPECT_LE(without.probes, 1);
   EXPECT_LT(found(without), g.outliers.size() - 5) << "GNC alone keeps a group";
   EXPECT_GE(with.probes_kept, 1);
-  EXPECT_LE(with.probes, 20);
+  EXPECT_LE(with.probes, 20 + 1);
   EXPECT_EQ(with.rejected, g.outliers);
   // Every kept measurement is within the bound at the end, so the TLS cost is the kept cost plus
   // c^2 per rejected measurement; the probes only ever lower it.
