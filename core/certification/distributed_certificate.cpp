@@ -164,7 +164,7 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
           certificate_start_entry(options_.seed, owned[static_cast<std::size_t>(i)], c, d);
   std::vector<OutgoingMessage> out;
   iteration_ = 0;
-  send_boundary(x_, 0, kVector, out);
+  send_boundary(x_, 0, out);
   gate_.expect(0, kVector, layout_.adjacent[static_cast<std::size_t>(state_.id())]);
   pump(out);
   return out;
@@ -174,7 +174,7 @@ std::vector<OutgoingMessage> CertificateProtocol::handle(const ProtocolMessage& 
   const std::uint32_t sender = message_sender(message);
   const std::uint32_t step = message_phase(message);
   if (sender >= static_cast<std::uint32_t>(layout_.num_blocks) ||
-      (step != kVector && step != kReduce && step != kPrecond))
+      (step != kVector && step != kReduce))
     throw std::runtime_error("certificate: agent " + std::to_string(state_.id()) +
                              ": malformed message (sender " + std::to_string(sender) + ", step " +
                              std::to_string(step) + ")");
@@ -192,18 +192,16 @@ void CertificateProtocol::pump(std::vector<OutgoingMessage>& out) {
     if (!ready) return;
     if (gate_.step() == kVector)
       after_vector(*ready, out);
-    else if (gate_.step() == kPrecond)
-      after_precond(*ready);
     else
       after_reduce(*ready, out);
   }
 }
 
 void CertificateProtocol::send_boundary(const Eigen::MatrixXd& v, std::uint32_t round,
-                                        std::uint32_t step, std::vector<OutgoingMessage>& out) {
+                                        std::vector<OutgoingMessage>& out) {
   for (int a : layout_.adjacent[static_cast<std::size_t>(state_.id())]) {
     OutgoingMessage o;
-    o.message = state_.publish(v, BlockKind::kY, a, round, step);
+    o.message = state_.publish(v, BlockKind::kY, a, round, kVector);
     o.broadcast = false;
     o.recipients = {static_cast<std::uint32_t>(a)};
     out.push_back(std::move(o));
@@ -218,30 +216,7 @@ void CertificateProtocol::broadcast(std::uint32_t round, const std::vector<doubl
   o.message = std::move(m);
   o.broadcast = true;
   out.push_back(std::move(o));
-}
-
-void CertificateProtocol::send_preconditioned(const Eigen::MatrixXd& v, const Eigen::MatrixXd& Sv,
-                                              Eigen::MatrixXd& Tv, Eigen::MatrixXd& TSv,
-                                              std::uint32_t round,
-                                              std::vector<OutgoingMessage>& out) {
-  // One row at a time: the sparse triangular solves with a two-column right-hand side took
-  // five times the instructions of two one-column solves.
-  Tv = precon_ ? precon_->apply(v) : v;
-  TSv = precon_ ? precon_->apply(Sv) : Sv;
-  Eigen::MatrixXd both(2, v.cols());
-  both.row(0) = Tv;
-  both.row(1) = TSv;
-  send_boundary(both, round, kPrecond, out);
-  gate_.expect(round, kPrecond, layout_.adjacent[static_cast<std::size_t>(state_.id())]);
-}
-
-void CertificateProtocol::after_precond(const MessageGate::Inbox& inbox) {
-  Eigen::MatrixXd both = Eigen::MatrixXd::Zero(
-      2, (problem_.dim() + 1) * static_cast<Eigen::Index>(problem_.num_neighbors()));
-  for (const auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), both);
-  (iteration_ == 0 ? nTx_ : nTw_) = both.row(0);
-  (iteration_ == 0 ? nTSx_ : nTSw_) = both.row(1);
-  gate_.expect(iteration_, kReduce, everyone());
+  gate_.expect(round, kReduce, everyone());
 }
 
 namespace {
@@ -255,18 +230,12 @@ void CertificateProtocol::after_vector(const MessageGate::Inbox& inbox,
   Eigen::MatrixXd vn = Eigen::MatrixXd::Zero(
       1, (problem_.dim() + 1) * static_cast<Eigen::Index>(problem_.num_neighbors()));
   for (const auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), vn);
-  Sx_ = apply(x_, vn);
-  send_preconditioned(x_, Sx_, Tx_, TSx_, 0, out);
-  broadcast(0, {dot(x_, x_), dot(x_, Sx_), local_max_diag_}, out);
-}
-
-void CertificateProtocol::begin_iteration(std::vector<OutgoingMessage>& out) {
-  // r = S x - theta x, and w = T r on the own and the neighbours' poses from the carried T
-  // products (T is linear): S w needs no exchange of w.
-  rr_local_ = (Sx_ - theta_ * x_).squaredNorm();
-  w_ = TSx_ - theta_ * Tx_;
-  Sw_ = apply(w_, nTSx_ - theta_ * nTx_);
-  send_preconditioned(w_, Sw_, Tw_, TSw_, iteration_, out);
+  if (iteration_ == 0) {
+    Sx_ = apply(x_, vn);
+    broadcast(0, {dot(x_, x_), dot(x_, Sx_), local_max_diag_}, out);
+    return;
+  }
+  Sw_ = apply(w_, vn);
   const Eigen::MatrixXd* V[3] = {&x_, &w_, &p_};
   const Eigen::MatrixXd* SV[3] = {&Sx_, &Sw_, &Sp_};
   const int k = has_p_ ? 3 : 2;
@@ -276,6 +245,17 @@ void CertificateProtocol::begin_iteration(std::vector<OutgoingMessage>& out) {
   for (int i = 0; i < k; ++i)
     for (int j = i; j < k; ++j) values.push_back(dot(*V[i], *SV[j]));
   broadcast(iteration_, values, out);
+}
+
+void CertificateProtocol::begin_iteration(std::vector<OutgoingMessage>& out) {
+  const Eigen::MatrixXd r = Sx_ - theta_ * x_;
+  rr_local_ = r.squaredNorm();
+  if (precon_)
+    w_ = precon_->apply(r);
+  else
+    w_ = r;
+  send_boundary(w_, iteration_, out);
+  gate_.expect(iteration_, kVector, layout_.adjacent[static_cast<std::size_t>(state_.id())]);
 }
 
 void CertificateProtocol::finish(bool converged) {
@@ -294,7 +274,8 @@ void CertificateProtocol::after_reduce(const MessageGate::Inbox& inbox,
     result_.tolerance = options_.relative_tolerance * result_.scale;
     if (!(t[0] > 0)) throw std::runtime_error("certificate: zero start vector");
     const double norm = std::sqrt(t[0]);
-    for (Eigen::MatrixXd* v : {&x_, &Sx_, &Tx_, &TSx_, &nTx_, &nTSx_}) *v /= norm;
+    x_ /= norm;
+    Sx_ /= norm;
     theta_ = t[1] / t[0];
     iteration_ = 1;
     begin_iteration(out);
@@ -344,17 +325,6 @@ void CertificateProtocol::after_reduce(const MessageGate::Inbox& inbox,
   Sx_ = c(0) * Sx_ + Sp_new;
   p_ = std::move(p_new);
   Sp_ = std::move(Sp_new);
-  // The same combinations of the T products, own and the neighbours' boundary entries.
-  auto combine = [&](Eigen::MatrixXd& tx, Eigen::MatrixXd& tp, const Eigen::MatrixXd& tw) {
-    Eigen::MatrixXd np = c(1) * tw;
-    if (has_p_) np += cp * tp;
-    tx = c(0) * tx + np;
-    tp = std::move(np);
-  };
-  combine(Tx_, Tp_, Tw_);
-  combine(TSx_, TSp_, TSw_);
-  combine(nTx_, nTp_, nTw_);
-  combine(nTSx_, nTSp_, nTSw_);
   has_p_ = true;
   theta_ = ec.eigenvalues()(0);
   ++iteration_;

@@ -7,13 +7,9 @@
 // Each agent builds its own diagonal blocks Lambda_i = sym(Y_i^T (XQ)_i) from its own data and
 // its neighbours' boundary poses. The eigen-solver is LOBPCG with one vector (locally optimal
 // block preconditioned conjugate gradient, Knyazev 2001) on the vector [x, w, p]:
-//   * S v needs, besides the agent's own entries, only the neighbours' boundary entries of v.
-//     The next w = T (S x - theta x) is a combination of T x, T S x, T w, T S w, T p, T S p
-//     with coefficients every agent gets from the reduction (T, the preconditioner, is linear),
-//     so each agent sends the boundary entries of T w and T S w together with its share of the
-//     reduction, and after the reduction forms w and S w on its own and its neighbours' poses:
-//     one message step per iteration (S x, S p and the T products are carried along as the
-//     same combinations; the start vector costs one exchange more).
+//   * S v needs, besides the agent's own entries, only the neighbours' boundary entries of v:
+//     one neighbour exchange per iteration (of the preconditioned residual w; S x and S p are
+//     carried along as the same combinations of S w).
 //   * every inner product is a global reduction summed in agent-id order, so each agent solves
 //     the same 3x3 Rayleigh-Ritz problem bit for bit and takes the same decisions.
 //   * the preconditioner is block Jacobi: each agent factors its own diagonal block of S
@@ -46,7 +42,7 @@ struct DistributedCertificateOptions {
   double relative_tolerance = 1e-6;
   /// Stop when ||S x - theta x|| <= residual_tolerance * max(1, max diag Q). > 0.
   double residual_tolerance = 1e-6;
-  int max_iterations = 300;  ///< LOBPCG iteration cap (one message step each). > 0
+  int max_iterations = 300;  ///< LOBPCG iteration cap (one exchange + one reduction each). > 0
   CertificatePreconditioner preconditioner = CertificatePreconditioner::kBlockJacobi;
   std::uint64_t seed = 1;  ///< Start vector (hash of the global pose ids and this seed).
   /// Throws InputError naming the bad field.
@@ -61,7 +57,7 @@ struct DistributedCertificateResult {
   double residual = 0.0;        ///< ||S x - theta x|| at the end.
   double tolerance = 0.0;       ///< eta.
   double scale = 1.0;           ///< max(1, max diag Q).
-  int iterations = 0;           ///< LOBPCG iterations (each one message step).
+  int iterations = 0;           ///< LOBPCG iterations (each: one exchange, one reduction).
   Eigen::MatrixXd eigenvector;  ///< 1 x (d+1)m: this agent's block of the unit Ritz vector.
 };
 
@@ -87,20 +83,12 @@ class CertificateProtocol : public AgentProcess {
   double ritz_value() const { return theta_; }
 
  private:
-  // kVector: the start vector's boundary entries (iteration 0 only); kPrecond: the boundary
-  // entries of T v and T S v for the vector v the iteration added (x, then each w); kReduce: the
-  // global reduction. kPrecond and kReduce leave together, so an iteration is one message step.
-  enum Step : std::uint32_t { kVector = 1, kReduce = 2, kPrecond = 3 };
+  enum Step : std::uint32_t { kVector = 1, kReduce = 2 };
   Eigen::MatrixXd apply(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
   Eigen::MatrixXd gradient(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn) const;
   void pump(std::vector<OutgoingMessage>& out);
-  void send_boundary(const Eigen::MatrixXd& v, std::uint32_t round, std::uint32_t step,
+  void send_boundary(const Eigen::MatrixXd& v, std::uint32_t round,
                      std::vector<OutgoingMessage>& out);
-  /// T v and T S v (own), their boundary entries sent to the neighbours.
-  void send_preconditioned(const Eigen::MatrixXd& v, const Eigen::MatrixXd& Sv, Eigen::MatrixXd& Tv,
-                           Eigen::MatrixXd& TSv, std::uint32_t round,
-                           std::vector<OutgoingMessage>& out);
-  void after_precond(const MessageGate::Inbox& inbox);
   void broadcast(std::uint32_t round, const std::vector<double>& values,
                  std::vector<OutgoingMessage>& out);
   void begin_iteration(std::vector<OutgoingMessage>& out);
@@ -121,11 +109,6 @@ class CertificateProtocol : public AgentProcess {
   MessageGate gate_;
   std::uint32_t iteration_ = 0;
   Eigen::MatrixXd x_, Sx_, w_, Sw_, p_, Sp_;
-  // The preconditioner T applied to the same vectors, own (T x, T S x, ...) and the neighbours'
-  // boundary entries of theirs (n*): w = T(S x - theta x) is formed from them, on the own and the
-  // neighbours' poses, without waiting for a neighbour after the reduction.
-  Eigen::MatrixXd Tx_, TSx_, Tw_, TSw_, Tp_, TSp_;
-  Eigen::MatrixXd nTx_, nTSx_, nTw_, nTSw_, nTp_, nTSp_;
   double theta_ = 0.0, rr_local_ = 0.0;
   bool has_p_ = false;
   bool done_ = false;
