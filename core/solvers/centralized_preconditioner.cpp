@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "solvers/pose_level_analysis.hpp"
+
 namespace tessera {
 
 TangentFactorEstimate estimate_tangent_factor(const BlockProblem& problem) {
@@ -25,17 +27,11 @@ TangentFactorEstimate estimate_tangent_factor(const BlockProblem& problem) {
   }
   SparseMatrix B(m, m);
   B.setFromTriplets(entries.begin(), entries.end(), [](double a, double) { return a; });
-  Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower> symbolic;
-  symbolic.setMode(Eigen::CholmodLDLt);
-  cholmod_common& c = symbolic.cholmod();
-  c.nmethods = 1;
-  c.method[0].ordering = CHOLMOD_AMD;
-  c.postorder = 1;
-  symbolic.analyzePattern(B);
-  if (symbolic.info() != Eigen::Success) return out;
+  const PoseLevelAnalysis a = analyse_pose_level_pattern(B, false);
+  if (!a.ok) return out;
   const double md = static_cast<double>(m), pd = p;
-  out.entries = (static_cast<double>(c.lnz) - md) * pd * pd + md * pd * (pd + 1) / 2;
-  out.flops = static_cast<double>(c.fl) * pd * pd * pd;
+  out.entries = (a.factor_entries - md) * pd * pd + md * pd * (pd + 1) / 2;
+  out.flops = a.flops * pd * pd * pd;
   return out;
 }
 

@@ -7,6 +7,8 @@
 #include <tessera/solvers/tangent_preconditioner.hpp>
 #include <vector>
 
+#include "solvers/pose_level_analysis.hpp"
+
 namespace tessera {
 
 namespace {
@@ -224,21 +226,10 @@ double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& ro
       t.emplace_back(i, j, i == j ? static_cast<double>(m) : 1.0);
   SparseMatrix B(m, m);
   B.setFromTriplets(t.begin(), t.end());
-  CholmodLdlt symbolic;
-  symbolic.setMode(Eigen::CholmodLDLt);
-  cholmod_common& c = symbolic.cholmod();
-  c.nmethods = 1;
-  c.method[0].ordering = CHOLMOD_AMD;
-  c.postorder = 1;
-  symbolic.analyzePattern(B);
-  if (symbolic.info() != Eigen::Success) return 0.0;  // no estimate: the exact analysis decides
-  const double block_entries = static_cast<double>(symbolic.cholmod().lnz);  // with diagonal
-  if (order) {
-    const cholmod_factor* L = symbolic.factor();
-    const int* perm = static_cast<const int*>(L->Perm);
-    order->assign(perm, perm + m);
-  }
-  const double md = static_cast<double>(m);
+  const PoseLevelAnalysis a = analyse_pose_level_pattern(B, order != nullptr);
+  if (!a.ok) return 0.0;  // no estimate: the exact analysis decides
+  if (order) *order = a.order;
+  const double md = static_cast<double>(m), block_entries = a.factor_entries;
   return (block_entries - md) * p * p + md * p * (p + 1) / 2.0;
 }
 

@@ -1,0 +1,23 @@
+#pragma once
+// Symbolic analysis of a pose-level pattern (one row and column a pose), the way the tangent
+// factors are ordered: CHOLMOD's AMD with postordering, LDL^T, pattern only. It is how both the
+// tangent preconditioner and the centralized solver's choice of preconditioner estimate a
+// tangent factor's size (each pose's block dense) without assembling it.
+
+#include <tessera/problem/data_matrix.hpp>
+#include <vector>
+
+namespace tessera {
+
+struct PoseLevelAnalysis {
+  bool ok = false;            ///< false when CHOLMOD's analysis failed (nothing else is set)
+  double factor_entries = 0;  ///< entries of the pose-level factor, diagonal included (lnz)
+  double flops = 0;           ///< flops of its numeric factorization (CHOLMOD's fl)
+  std::vector<int> order;     ///< CHOLMOD's postordered Perm, only when asked for
+};
+
+/// Analyses `lower` (the pattern's lower triangle with the diagonal; values are ignored by the
+/// analysis, which reads the pattern only). With `want_order` the result holds the ordering.
+PoseLevelAnalysis analyse_pose_level_pattern(const SparseMatrix& lower, bool want_order);
+
+}  // namespace tessera
