@@ -1,16 +1,13 @@
 #include <algorithm>
-#include <atomic>
-#include <condition_variable>
 #include <ctime>
 #include <deque>
-#include <exception>
 #include <functional>
-#include <mutex>
 #include <stdexcept>
 #include <tessera/distributed/in_process_driver.hpp>
 #include <tessera/distributed/message_gate.hpp>
 #include <tessera/distributed/stage_tag.hpp>
-#include <thread>
+
+#include "distributed/wave_pool.hpp"
 
 namespace tessera {
 
@@ -41,78 +38,6 @@ std::uint32_t round_of(const ProtocolMessage& m) {
   return std::get<RoundStatusMessage>(m).round;
 }
 
-// Worker threads for the FIFO waves of deliver(): each wave, every thread (the caller's too)
-// takes recipients from a shared counter and runs `work(recipient)`.
-class WavePool {
- public:
-  explicit WavePool(int threads) {
-    for (int t = 1; t < threads; ++t) workers_.emplace_back([this] { loop(); });
-  }
-  ~WavePool() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    start_.notify_all();
-    for (auto& w : workers_) w.join();
-  }
-  // Runs work(0 .. count-1), each index once, on every thread; returns when all are done.
-  void run(std::size_t count, const std::function<void(std::size_t)>& work) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      work_ = &work;
-      count_ = count;
-      next_ = 0;
-      busy_ = workers_.size();
-      ++generation_;
-    }
-    start_.notify_all();
-    take(work);
-    std::unique_lock<std::mutex> lock(mutex_);
-    done_.wait(lock, [this] { return busy_ == 0; });
-    work_ = nullptr;
-    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
-  }
-
- private:
-  void take(const std::function<void(std::size_t)>& work) {
-    for (std::size_t k; (k = next_.fetch_add(1)) < count_;) {
-      try {
-        work(k);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        if (!error_) error_ = std::current_exception();
-      }
-    }
-  }
-  void loop() {
-    std::uint64_t seen = 0;
-    for (;;) {
-      const std::function<void(std::size_t)>* work = nullptr;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        start_.wait(lock, [&] { return stop_ || generation_ != seen; });
-        if (stop_) return;
-        seen = generation_;
-        work = work_;
-      }
-      take(*work);
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (--busy_ == 0) done_.notify_one();
-    }
-  }
-
-  std::vector<std::thread> workers_;
-  std::mutex mutex_;
-  std::condition_variable start_, done_;
-  const std::function<void(std::size_t)>* work_ = nullptr;
-  std::size_t count_ = 0, busy_ = 0;
-  std::atomic<std::size_t> next_{0};
-  std::uint64_t generation_ = 0;
-  bool stop_ = false;
-  std::exception_ptr error_;
-};
-
 DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder order,
                       std::uint64_t delivery_seed, int threads,
                       const std::function<std::vector<OutgoingMessage>(std::size_t)>& begin) {
@@ -120,6 +45,12 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
   std::deque<Delivery> queue;
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<double>> cpu;
   const std::size_t n = agents.size();
+  // CPU seconds of one handled message, charged to its recipient in the message's (stage, round).
+  auto charge = [&](const ProtocolMessage& message, std::size_t recipient, double seconds) {
+    auto& per_agent = cpu[{stage_of_phase(message_phase(message)), round_of(message)}];
+    if (per_agent.empty()) per_agent.assign(n, 0.0);
+    per_agent[recipient] += seconds;
+  };
   auto post = [&](std::size_t sender, std::vector<OutgoingMessage>&& out) {
     for (auto& o : out) {
       const std::size_t bytes = message_bytes(o.message);
@@ -167,9 +98,11 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
     // thread gives, hence the same iterates.
     WavePool pool(std::min<int>(threads, static_cast<int>(n)));
     std::vector<std::vector<std::size_t>> mine(n);
+    std::vector<Delivery> wave;
+    std::vector<std::vector<OutgoingMessage>> outs;
+    std::vector<double> took;  // < 0: not handled (agent done)
     while (!queue.empty()) {
-      std::vector<Delivery> wave(std::make_move_iterator(queue.begin()),
-                                 std::make_move_iterator(queue.end()));
+      wave.assign(std::make_move_iterator(queue.begin()), std::make_move_iterator(queue.end()));
       queue.clear();
       for (auto& m : mine) m.clear();
       for (std::size_t k = 0; k < wave.size(); ++k) {
@@ -177,8 +110,8 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
           throw std::logic_error("in-process driver: message to unknown agent");
         mine[wave[k].recipient].push_back(k);
       }
-      std::vector<std::vector<OutgoingMessage>> outs(wave.size());
-      std::vector<double> took(wave.size(), -1.0);  // < 0: not handled (agent done)
+      outs.assign(wave.size(), {});
+      took.assign(wave.size(), -1.0);
       pool.run(n, [&](std::size_t r) {
         double t0 = thread_cpu_s();
         for (std::size_t k : mine[r]) {
@@ -191,12 +124,8 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
       });
       for (std::size_t k = 0; k < wave.size(); ++k) {
         if (took[k] < 0) continue;
-        const std::size_t r = wave[k].recipient;
-        auto& per_agent =
-            cpu[{stage_of_phase(message_phase(wave[k].message)), round_of(wave[k].message)}];
-        if (per_agent.empty()) per_agent.assign(n, 0.0);
-        per_agent[r] += took[k];
-        post(r, std::move(outs[k]));
+        charge(wave[k].message, wave[k].recipient, took[k]);
+        post(wave[k].recipient, std::move(outs[k]));
       }
     }
   }
@@ -217,12 +146,9 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
     }
     if (d.recipient >= n) throw std::logic_error("in-process driver: message to unknown agent");
     if (agents[d.recipient]->done()) continue;
-    const auto slot = std::make_pair(stage_of_phase(message_phase(d.message)), round_of(d.message));
     std::vector<OutgoingMessage> out = agents[d.recipient]->handle(d.message);
     const double t = thread_cpu_s();
-    auto& per_agent = cpu[slot];
-    if (per_agent.empty()) per_agent.assign(n, 0.0);
-    per_agent[d.recipient] += t - t_prev;
+    charge(d.message, d.recipient, t - t_prev);
     t_prev = t;
     post(d.recipient, std::move(out));
   }
