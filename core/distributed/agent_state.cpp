@@ -249,20 +249,24 @@ Eigen::MatrixXd AgentState::precondition(const Eigen::MatrixXd& X, const Eigen::
 }
 
 bool AgentState::refresh_tangent(const Eigen::MatrixXd& X) {
+  return refactor_tangent(X, nullptr);
+}
+
+bool AgentState::refresh_tangent(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad) {
+  return refactor_tangent(X, &egrad);
+}
+
+bool AgentState::refactor_tangent(const Eigen::MatrixXd& X, const Eigen::MatrixXd* egrad) {
   // The Q_BB factor's size decides (a tangent factor would be larger still); when it is not
   // held (released, or the block grew), the answer of its last build stands: building it only
   // to ask would cost a factorization the tangent factor makes unnecessary.
   if (X.rows() != d_ || (precon_ ? precon_->block_diagonal() : block_factor_too_large_))
     return false;
-  if (!tangent_) return build_tangent(X, BlockUpdateOptions{});  // factored at X when built
-  return tangent_->usable() && tangent_->factorize(X);
-}
-
-bool AgentState::refresh_tangent(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad) {
-  if (X.rows() != d_ || (precon_ ? precon_->block_diagonal() : block_factor_too_large_))
-    return false;
-  if (!tangent_ && !build_tangent(X, BlockUpdateOptions{})) return false;
-  return tangent_->usable() && tangent_->factorize(X, egrad);
+  if (!tangent_) {
+    if (!build_tangent(X, BlockUpdateOptions{})) return false;
+    if (!egrad) return true;  // factored at X when built
+  }
+  return tangent_->usable() && (egrad ? tangent_->factorize(X, *egrad) : tangent_->factorize(X));
 }
 
 bool AgentState::ensure_tangent(const Eigen::MatrixXd& X) {

@@ -137,6 +137,8 @@ class AgentState {
   Eigen::MatrixXd Yn, Pn, Vn, Yn_prev;
 
  private:
+  // refresh_tangent's work; `egrad` null: without the multiplier term.
+  bool refactor_tangent(const Eigen::MatrixXd& X, const Eigen::MatrixXd* egrad);
   /// Selects the rows to compute on for the point (X, neighbours) and sets problem_'s
   /// neighbour poses to those rows.
   void set_point(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
