@@ -2,15 +2,13 @@
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/coarse_space.hpp>
-#include <tessera/distributed/message_gate.hpp>
 #include <tessera/distributed/stage_tag.hpp>
 #include <tessera/robust/gnc_agent.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
 
-#include "distributed/measurement_block.hpp"
-#include "distributed/pose_block_codec.hpp"
+#include "robust/gnc_exchange.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
 #include "robust/gnc_mailbox.hpp"
@@ -54,6 +52,7 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   layout_ = std::make_unique<BlockLayout>(*base_);
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
+  exchange_ = std::make_unique<GncExchangeBook>(in_, *terms_, *base_);
   mail_ = std::make_unique<GncMailbox>(in_.id);
   recheck_ = std::make_unique<RecheckVerdict>();
   probes_ = std::make_unique<GncProbes>(options_.robust.recheck_probes);
@@ -70,21 +69,11 @@ int GncAgent::total_rounds() const {
   return gnc_rounds_ + final_rounds_;
 }
 
-void GncAgent::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
-                       std::vector<OutgoingMessage>& out) {
-  const auto& adjacent = base_->adjacent[static_cast<std::size_t>(in_.id)];
-  for (std::size_t q = 0; q < adjacent.size(); ++q) {
-    const auto to_agent = static_cast<std::uint32_t>(adjacent[q]);
-    out.push_back(OutgoingMessage{
-        encode_public_poses(*base_, in_.id, q, in_.d, Y, kind, 0, phase), false, {to_agent}});
-  }
-}
-
 void GncAgent::weights_at_mu(double mu) {
   for (std::size_t k : terms_->owned())
     if (terms_->may_reject(k) && !dropped_[k])
-      weights_[k] =
-          tls_weight(terms_->residual_squared(k, state_->Y, neighbours_), terms_->c2(), mu);
+      weights_[k] = tls_weight(terms_->residual_squared(k, state_->Y, exchange_->neighbours()),
+                               terms_->c2(), mu);
 }
 
 std::vector<OutgoingMessage> GncAgent::start() {
@@ -162,66 +151,41 @@ void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out,
   }
 }
 
-std::pair<double, double> GncAgent::summed_votes() const {
-  std::pair<double, double> sum{0, 0};
-  for (const auto& [sender, v] : votes_) {  // agent-id order: the same sums on every agent
-    sum.first += v.first;
-    sum.second += v.second;
-  }
-  return sum;
-}
-
-std::uint32_t GncAgent::exchange_phase() const {
+GncExchange GncAgent::exchange() const {
   switch (step_) {
     case Step::kPoses:
-      return gnc_phase(g_, GncExchange::kPoses);
+      return GncExchange::kPoses;
     case Step::kVotes:
-      return gnc_phase(g_, GncExchange::kVotes);
+      return GncExchange::kVotes;
     case Step::kWeights:
-      return gnc_phase(g_, GncExchange::kWeights);
+      return GncExchange::kWeights;
     case Step::kRejected:
-      return gnc_phase(g_, GncExchange::kRejected);
+      return GncExchange::kRejected;
     case Step::kReadmitted:
-      return gnc_phase(g_, GncExchange::kReadmitted);
+      return GncExchange::kReadmitted;
     case Step::kKeptStart:
       // Agent 0 gathers the kept values; the others wait for its start.
-      return gnc_phase(g_, in_.id == 0 ? GncExchange::kKeptValues : GncExchange::kKeptStart);
+      return in_.id == 0 ? GncExchange::kKeptValues : GncExchange::kKeptStart;
     case Step::kCandidatePoses:
-      return gnc_phase(g_, GncExchange::kCandidatePoses);
+      return GncExchange::kCandidatePoses;
     case Step::kCandidateVotes:
-      return gnc_phase(g_, GncExchange::kCandidateVotes);
+      return GncExchange::kCandidateVotes;
     case Step::kPcm:
-      return gnc_phase(g_, in_.id == 0 ? GncExchange::kPcmValues : GncExchange::kPcmDropped);
+      return in_.id == 0 ? GncExchange::kPcmValues : GncExchange::kPcmDropped;
     case Step::kStartPoses:
-      return gnc_phase(g_, GncExchange::kStartPoses);
+      return GncExchange::kStartPoses;
     case Step::kStartVotes:
-      return gnc_phase(g_, GncExchange::kStartVotes);
-    default:
-      return 0;
+      return GncExchange::kStartVotes;
+    default:  // not an exchange: begin_exchange() is never called with it
+      throw std::logic_error("GncAgent: no exchange at this step");
   }
-}
-
-// Agent 0 gathers the values of the measurements the agents weigh (each measurement once; with
-// `kept_only` the ones not rejected): the others send theirs, agent 0 keeps its own and waits.
-// Returns whom this agent waits for (the others wait for agent 0's answer).
-std::vector<int> GncAgent::gather_values_at_lead(GncExchange exchange, bool kept_only,
-                                                 std::vector<OutgoingMessage>& out) {
-  const std::vector<std::uint64_t>* rejected = kept_only ? &rejected_ : nullptr;
-  if (in_.id != 0) {
-    out.push_back(OutgoingMessage{
-        owned_values_block(in_, *terms_, rejected, gnc_phase(g_, exchange)), false, {0}});
-    return {0};
-  }
-  kept_values_.clear();
-  append_owned_values(in_, *terms_, rejected, kept_values_);
-  return as_ints(other_agents(0, in_.num_agents));
 }
 
 void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   step_ = step;
-  const std::uint32_t phase = exchange_phase();
+  const std::uint32_t phase = gnc_phase(g_, exchange());
   const auto me = static_cast<std::uint32_t>(in_.id);
-  votes_.clear();
+  exchange_->begin();
   // Whom this agent hears from: a pose exchange from its block neighbours (each sends what it
   // was sent), a status exchange from every other agent.
   std::vector<int> from = base_->adjacent[static_cast<std::size_t>(in_.id)];
@@ -235,54 +199,52 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // Weights are computed at the iterate itself: the owners' public poses of every
       // measurement (the base layout: a measurement out of the current solve still needs
       // its residual).
-      neighbours_ = Eigen::MatrixXd::Zero(
-          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(terms_->neighbours().size()));
-      publish(state_->Y, BlockKind::kY, phase, out);
+      exchange_->expect_poses(state_->Y.rows(), false);
+      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
       break;
     case Step::kStartPoses:
       // Both starts' public poses: the solver's initialization (kind Y) and the known
       // inliers' (kind P).
-      neighbours_ = Eigen::MatrixXd::Zero(
-          in_.Y0.rows(), (in_.d + 1) * static_cast<Eigen::Index>(terms_->neighbours().size()));
-      candidate_neighbours_ = neighbours_;
-      publish(in_.Y0, BlockKind::kY, phase, out);
-      publish(in_.Y0_known, BlockKind::kP, phase, out);
+      exchange_->expect_poses(in_.Y0.rows(), true);
+      exchange_->publish(in_.Y0, BlockKind::kY, phase, out);
+      exchange_->publish(in_.Y0_known, BlockKind::kP, phase, out);
       break;
     case Step::kStartVotes:
       // The TLS cost of each measurement at both starts, summed by its weight owner.
-      votes_[me] =
-          start_vote_costs(*terms_, in_.Y0, neighbours_, in_.Y0_known, candidate_neighbours_);
-      to_others(vote_message(votes_[me]));
+      exchange_->own_vote() = start_vote_costs(*terms_, in_.Y0, exchange_->neighbours(),
+                                               in_.Y0_known, exchange_->candidate_neighbours());
+      to_others(vote_message(exchange_->own_vote()));
       break;
     case Step::kPcm:
-      from = gather_values_at_lead(GncExchange::kPcmValues, false, out);
+      from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kPcmValues), nullptr, out);
       break;
     case Step::kKeptStart:
-      from = gather_values_at_lead(GncExchange::kKeptValues, true, out);
+      from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kKeptValues), &rejected_,
+                                              out);
       break;
     case Step::kCandidatePoses:
       // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
-      neighbours_ = Eigen::MatrixXd::Zero(
-          state_->Y.rows(), (in_.d + 1) * static_cast<Eigen::Index>(terms_->neighbours().size()));
-      candidate_neighbours_ = neighbours_;
-      publish(state_->Y, BlockKind::kY, phase, out);
-      publish(candidate_, BlockKind::kP, phase, out);
+      exchange_->expect_poses(state_->Y.rows(), true);
+      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
+      exchange_->publish(exchange_->candidate(), BlockKind::kP, phase, out);
       break;
     case Step::kCandidateVotes:
       // Each kept measurement's cost at both starts, summed by its weight owner.
-      votes_[me] = kept_set_costs(*terms_, in_.measurement_index, rejected_, state_->Y, neighbours_,
-                                  candidate_, candidate_neighbours_);
-      to_others(vote_message(votes_[me]));
+      exchange_->own_vote() = kept_set_costs(*terms_, in_.measurement_index, rejected_, state_->Y,
+                                             exchange_->neighbours(), exchange_->candidate(),
+                                             exchange_->candidate_neighbours());
+      to_others(vote_message(exchange_->own_vote()));
       break;
     case Step::kVotes:
       // mu's start needs the largest residual over every measurement that may be rejected.
-      votes_[me] = {largest_rejectable_residual(*terms_, dropped_, state_->Y, neighbours_), 0};
-      to_others(vote_message(votes_[me]));
+      exchange_->own_vote() = {
+          largest_rejectable_residual(*terms_, dropped_, state_->Y, exchange_->neighbours()), 0};
+      to_others(vote_message(exchange_->own_vote()));
       break;
     case Step::kWeights: {
       weights_at_mu(mu_);
       const double spread = weight_spread(*terms_, weights_);
-      votes_[me] = {spread, 0};
+      exchange_->own_vote() = {spread, 0};
       zero_cut_ =
           zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
       const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
@@ -306,11 +268,11 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // TLS's own verdict at the kept set's solution (gnc_votes.hpp); every agent gathers all.
       // With it the probe's list (only used when nothing else changes) and the TLS cost a probe
       // is judged by.
-      *recheck_ = recheck_verdict(*terms_, in_.measurement_index, rejected_, state_->Y, neighbours_,
-                                  may_probe() ? options_.robust.probe_ratio : 0.0,
-                                  options_.robust.probe_tail_ratio);
-      votes_[me] = {tls_cost(*terms_, state_->Y, neighbours_), 0};
-      to_others(readmitted_message(*recheck_, votes_[me].first));
+      *recheck_ = recheck_verdict(
+          *terms_, in_.measurement_index, rejected_, state_->Y, exchange_->neighbours(),
+          may_probe() ? options_.robust.probe_ratio : 0.0, options_.robust.probe_tail_ratio);
+      exchange_->own_vote() = {tls_cost(*terms_, state_->Y, exchange_->neighbours()), 0};
+      to_others(readmitted_message(*recheck_, exchange_->own_vote().first));
       break;
     default:
       break;
@@ -322,7 +284,11 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
 void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
   std::optional<std::vector<ProtocolMessage>> ready = mail_->take_exchange();
   if (!ready) return;
-  for (const ProtocolMessage& m : *ready) read_message(m);
+  // Read into the book, or the agent's own data the exchange changes.
+  for (const ProtocolMessage& m : *ready)
+    exchange_->read(exchange(), m,
+                    GncExchangeTargets{weights_, zero_cut_, rejected_, *recheck_,
+                                       state_ ? state_->Y.rows() : in_.Y0.rows()});
   after_exchange(out);
 }
 
@@ -403,15 +369,15 @@ void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
 
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   // Agent 0: the kept set's initialization, each agent's block sent, its own kept.
-  const Eigen::MatrixXd X =
-      kept_set_start(kept_values_, in_, rejected_.size(), static_cast<int>(state_->Y.rows()));
+  const Eigen::MatrixXd X = kept_set_start(exchange_->kept_values(), in_, rejected_.size(),
+                                           static_cast<int>(state_->Y.rows()));
   for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
     out.push_back(
         OutgoingMessage{kept_start_block(block_of(X, base_->poses[a], in_.d), base_->poses[a],
                                          in_.d, gnc_phase(g_, GncExchange::kKeptStart)),
                         false,
                         {a}});
-  candidate_ = block_of(X, base_->poses[0], in_.d);
+  exchange_->candidate() = block_of(X, base_->poses[0], in_.d);
 }
 
 int GncAgent::probes() const {
@@ -502,15 +468,13 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kVotes: {
       voted_ = true;
-      double max_r2 = 0;
-      for (const auto& [sender, v] : votes_) max_r2 = std::max(max_r2, v.first);
-      mu_ = gnc_initial_mu(max_r2, terms_->c2());
+      mu_ = gnc_initial_mu(exchange_->largest_vote(), terms_->c2());
       converged_ = mu_ == 0;
       begin_exchange(converged_ ? Step::kRejected : Step::kWeights, out);
       return;
     }
     case Step::kWeights: {
-      const double spread = summed_votes().first;
+      const double spread = exchange_->summed_votes().first;
       ++outer_;
       if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
       converged_ = spread <= options_.robust.weight_tolerance;
@@ -540,12 +504,15 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kPcm: {
       if (in_.id == 0) {
-        const std::vector<std::uint64_t> ids = inconsistent_closures(kept_values_, in_, *terms_);
+        const std::vector<std::uint64_t> ids =
+            inconsistent_closures(exchange_->kept_values(), in_, *terms_);
         RoundStatusMessage st;
         st.measurement_ids = ids;
         broadcast_status(std::move(st), 0, gnc_phase(g_, GncExchange::kPcmDropped), in_.num_agents,
                          out);
         drop_inconsistent(ids);
+      } else {
+        drop_inconsistent(exchange_->pcm_dropped());
       }
       if (in_.Y0_known.size() > 0)
         begin_exchange(Step::kStartPoses, out);
@@ -557,10 +524,10 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       begin_exchange(Step::kStartVotes, out);
       return;
     case Step::kStartVotes: {
-      const auto [at_start, at_known] = summed_votes();
+      const auto [at_start, at_known] = exchange_->summed_votes();
       if (at_known < at_start) in_.Y0 = std::move(in_.Y0_known);
       in_.Y0_known.resize(0, 0);
-      candidate_neighbours_.resize(0, 0);
+      exchange_->forget_candidate_neighbours();
       after_step_zero(out);
       return;
     }
@@ -568,10 +535,10 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       begin_exchange(Step::kCandidateVotes, out);
       return;
     case Step::kCandidateVotes: {
-      const auto [at_iterate, at_candidate] = summed_votes();
-      if (at_candidate < at_iterate) state_->Y = candidate_;
-      candidate_.resize(0, 0);
-      candidate_neighbours_.resize(0, 0);
+      const auto [at_iterate, at_candidate] = exchange_->summed_votes();
+      if (at_candidate < at_iterate) state_->Y = exchange_->candidate();
+      exchange_->candidate().resize(0, 0);
+      exchange_->forget_candidate_neighbours();
       begin_inlier_pass(out);
       return;
     }
@@ -584,7 +551,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
           begin_inlier_pass(out);
           return;
         }
-        const double tls = summed_votes().first;
+        const double tls = exchange_->summed_votes().first;
         if (probes_->running() && !probes_->keeps(tls)) {
           restore_before_probe(out);
           return;
@@ -605,70 +572,6 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     }
     default:
       return;
-  }
-}
-
-void GncAgent::read_message(const ProtocolMessage& message) {
-  const std::uint32_t sender = message_sender(message);
-  // Each step's message kind, or an error naming what arrived where (gnc_messages).
-  const char* const kStatusBelongs = "poses where a robust status belongs";
-  switch (step_) {
-    case Step::kPcm:
-      if (in_.id == 0)
-        decode_measurement_block(
-            expect_pose_block(message, in_.id, "a status where measurements belong"), in_.d,
-            in_.num_poses, "robust pcm-gnc", kept_values_);
-      else
-        drop_inconsistent(
-            expect_status(message, in_.id, "poses where the consistency check belongs")
-                .measurement_ids);
-      break;
-    case Step::kKeptStart: {
-      const PoseBlockMessage& block =
-          expect_pose_block(message, in_.id, "a status where the kept set's start belongs");
-      if (in_.id == 0)
-        decode_measurement_block(block, in_.d, in_.num_poses, "robust solve", kept_values_);
-      else  // agent 0's fresh start of the kept set: this agent's block, lifted
-        candidate_ = read_kept_start(block, base_->poses[static_cast<std::size_t>(in_.id)],
-                                     state_->Y.rows(), in_.d, in_.id);
-      break;
-    }
-    case Step::kPoses:
-    case Step::kCandidatePoses:
-    case Step::kStartPoses: {
-      const PoseBlockMessage& block = expect_pose_block(
-          message, in_.id,
-          "a status where robust poses from agent " + std::to_string(sender) + " belong");
-      decode_neighbour_poses(block, terms_->neighbours(), in_.d, in_.id,
-                             block.kind == BlockKind::kP ? candidate_neighbours_ : neighbours_);
-      break;
-    }
-    case Step::kVotes:
-      votes_[sender] = {expect_status(message, in_.id, kStatusBelongs).cost, 0};
-      break;
-    case Step::kCandidateVotes:
-    case Step::kStartVotes:
-      votes_[sender] = read_vote(expect_status(message, in_.id, kStatusBelongs));
-      break;
-    case Step::kWeights: {
-      const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
-      votes_[sender] = {st.grad_norm_sq, 0};
-      read_weights_message(st, sender, in_, weights_, zero_cut_);
-      break;
-    }
-    case Step::kRejected: {
-      const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
-      rejected_.insert(rejected_.end(), st.measurement_ids.begin(), st.measurement_ids.end());
-      break;
-    }
-    case Step::kReadmitted: {
-      const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
-      read_readmitted_message(st, sender, in_.id, *recheck_);
-      votes_[sender] = {st.cost, 0};
-      break;
-    }
-    default:
-      break;
   }
 }
 

@@ -42,7 +42,6 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -136,6 +135,7 @@ class GncLocalTerms;    // internal: the TLS math over one agent's view
 struct RecheckVerdict;  // internal: an inlier pass's re-check
 class GncProbes;        // internal: probes after the re-check passes
 class GncMailbox;       // internal: where incoming messages go
+class GncExchangeBook;  // internal: the exchanges' messages and what they carry
 
 class GncAgent : public AgentProcess {
  public:
@@ -215,23 +215,17 @@ class GncAgent : public AgentProcess {
   };
   void begin_solve(std::vector<OutgoingMessage>& out);
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
-  std::vector<int> gather_values_at_lead(GncExchange exchange, bool kept_only,
-                                         std::vector<OutgoingMessage>& out);
   void after_solve(std::vector<OutgoingMessage>& out);
   void after_exchange(std::vector<OutgoingMessage>& out);
   // One message of the running solve, handed to it; after_solve() when that ends the solve.
   void to_solve(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
   // The current exchange's messages once all are in: read, then after_exchange().
   void take_exchange(std::vector<OutgoingMessage>& out);
-  void read_message(const ProtocolMessage& m);  // one of the exchange's
-  std::uint32_t exchange_phase() const;
+  GncExchange exchange() const;  // the current step's, as this agent sends or awaits it
   // The inner solve's messages, tagged with this GNC step.
   void pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) const;
-  std::pair<double, double> summed_votes() const;  // of the current exchange, every agent's
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
-  void publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
-               std::vector<OutgoingMessage>& out);
   void weights_at_mu(double mu);
   void require_kept_connected() const;  // throws InputError naming the parts left
   std::vector<std::pair<std::uint32_t, std::uint32_t>> solve_structure() const;
@@ -254,8 +248,7 @@ class GncAgent : public AgentProcess {
   std::uint32_t g_ = 0;              // GNC step
   std::uint32_t first_solve_g_ = 0;  // 1 after a start vote (step 0 is the vote's)
   bool fresh_start_ = false;         // the kept set's fresh start (kept_set_start, chordal)
-  std::vector<std::pair<std::uint64_t, Measurement>> kept_values_;  // agent 0's gathers
-  std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
+  std::vector<bool> dropped_;        // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
   GncSolveKind solve_kind_ = GncSolveKind::kGnc;
   bool voted_ = false;           // the votes of mu's start are in
@@ -270,12 +263,9 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where
   std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view
   Eigen::MatrixXd last_pass_start_;
-  Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
-  std::vector<double> weights_;                       // per in_.measurements
-  Eigen::MatrixXd neighbours_;        // neighbours' public poses of the current iterate
-  std::unique_ptr<GncMailbox> mail_;  // where incoming messages go
-  // Sums of the current exchange (in agent-id order: own and received values kept by sender).
-  std::map<std::uint32_t, std::pair<double, double>> votes_;
+  std::vector<double> weights_;                // per in_.measurements
+  std::unique_ptr<GncMailbox> mail_;           // where incoming messages go
+  std::unique_ptr<GncExchangeBook> exchange_;  // the exchanges' messages and state
   double mu_ = 0;
   int outer_ = 0;
   bool converged_ = false;

@@ -1,0 +1,82 @@
+#pragma once
+// The message side of GncAgent's exchanges (GncAgent decides the steps and runs the math): what
+// each exchange sends and gathers, and the state that lives from one exchange's start to the
+// step after it: the votes, the neighbours' public poses, the values agent 0 gathers and the
+// first inlier pass's other start. Kept apart so the state machine does not decode messages.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <tessera/distributed/agent_process.hpp>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/protocol/messages.hpp>
+#include <tessera/robust/gnc_agent.hpp>
+#include <utility>
+#include <vector>
+
+#include "robust/gnc_lead_steps.hpp"
+#include "robust/gnc_local_terms.hpp"
+#include "robust/gnc_votes.hpp"
+
+namespace tessera {
+
+/// The agent's data an exchange's messages write into (a weight, rejected, re-check exchange).
+struct GncExchangeTargets {
+  std::vector<double>& weights;
+  std::vector<std::uint64_t>& zero_cut;
+  std::vector<std::uint64_t>& rejected;
+  RecheckVerdict& recheck;
+  Eigen::Index rank;  // rows of the own block (the kept set's start is read at it)
+};
+
+class GncExchangeBook {
+ public:
+  /// All three must outlive the book (GncAgent's own members).
+  GncExchangeBook(const GncAgentInput& in, const GncLocalTerms& terms, const BlockLayout& base)
+      : in_(in), terms_(terms), base_(base) {}
+
+  /// A new exchange: no votes yet.
+  void begin() { votes_.clear(); }
+  /// This agent's vote of the current exchange (summed with the others' in agent-id order).
+  std::pair<double, double>& own_vote() { return votes_[static_cast<std::uint32_t>(in_.id)]; }
+  std::pair<double, double> summed_votes() const;  // every agent's, agent-id order
+  double largest_vote() const;                     // of the first sums
+
+  /// A pose exchange starts: the neighbours' poses zeroed at rank `rows` (with `both_starts`
+  /// those of the other start too).
+  void expect_poses(Eigen::Index rows, bool both_starts);
+  /// `Y`'s public poses to every block neighbour.
+  void publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
+               std::vector<OutgoingMessage>& out) const;
+  /// Agent 0 gathers the values of the measurements the agents weigh (each measurement once;
+  /// with `rejected` non-null those not in it): the others send theirs, agent 0 keeps its own
+  /// and waits. Returns whom this agent waits for (the others wait for agent 0's answer).
+  std::vector<int> gather_values_at_lead(std::uint32_t phase,
+                                         const std::vector<std::uint64_t>* rejected,
+                                         std::vector<OutgoingMessage>& out);
+
+  /// One message of exchange `e` (as this agent's phase names it), read into the book or `to`.
+  /// Throws std::runtime_error naming what arrived where.
+  void read(GncExchange e, const ProtocolMessage& message, GncExchangeTargets to);
+
+  const Eigen::MatrixXd& neighbours() const { return neighbours_; }
+  const Eigen::MatrixXd& candidate_neighbours() const { return candidate_neighbours_; }
+  void forget_candidate_neighbours() { candidate_neighbours_.resize(0, 0); }
+  Eigen::MatrixXd& candidate() { return candidate_; }
+  GatheredValues& kept_values() { return kept_values_; }
+  /// Agent 0's consistency check as another agent received it.
+  const std::vector<std::uint64_t>& pcm_dropped() const { return pcm_dropped_; }
+
+ private:
+  const GncAgentInput& in_;
+  const GncLocalTerms& terms_;
+  const BlockLayout& base_;  // of every measurement: whose poses go where
+  // Sums of the current exchange (in agent-id order: own and received values kept by sender).
+  std::map<std::uint32_t, std::pair<double, double>> votes_;
+  Eigen::MatrixXd neighbours_;  // neighbours' public poses of the current iterate
+  Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
+  GatheredValues kept_values_;                        // agent 0's gathers
+  std::vector<std::uint64_t> pcm_dropped_;
+};
+
+}  // namespace tessera
