@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fstream>
 #include <optional>
+#include <tessera/certification/certificate_cap.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/io/tum_writer.hpp>
@@ -288,11 +289,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
                                                    ? CertificatePreconditioner::kNone
                                                    : CertificatePreconditioner::kBlockJacobi;
   }
-  // Above the library's 300: block Jacobi needs more iterations the more measurements the
-  // partition cuts, and this command's `--partition sequential` (robot-aligned id ranges) cuts
-  // many: city10000 at 5 agents needs 720 there (cut 8,369) against 149 on the eco partition
-  // (cut 160). The cap only costs iterations where the certificate would be inconclusive.
-  opt.staircase.certificate.max_iterations = static_cast<int>(a.get_long("certify-iters", 1000));
+  opt.staircase.certificate.max_iterations =
+      static_cast<int>(a.get_long("certify-iters", kCommandCertificateIterations));
   {
     const std::string refine = a.get_or("refine", "none");
     if (refine != "newton" && refine != "none")
