@@ -6,7 +6,6 @@
 
 #include <Eigen/Dense>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <tessera/graph/input_frame.hpp>
@@ -74,13 +73,6 @@ void expect_error(const std::string& text, const std::string& where, const std::
     EXPECT_EQ(msg.rfind(where, 0), 0u) << "message: " << msg;
     EXPECT_NE(msg.find(problem), std::string::npos) << "message: " << msg;
   }
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 TEST(RobotKeys, GtsamKeysAreDetectedAndNumberedByRobotThenIndex) {
@@ -171,7 +163,7 @@ TEST(RobotKeys, WrittenGraphKeepsTheInputIdsAndFix) {
   const G2oReadResult r = read(two_robot_text() + "FIX " + std::to_string(key('a', 0)) + "\n");
   const std::string path = temp_dir() + "/out.g2o";
   write_g2o(r.graph, r.keys, r.graph.initial, path);
-  const std::string text = read_text(path);
+  const std::string text = test::read_text_file(path);
   EXPECT_NE(text.find("VERTEX_SE2 " + std::to_string(key('b', 2)) + " "), std::string::npos);
   EXPECT_NE(text.find("FIX " + std::to_string(key('a', 0))), std::string::npos);
   const G2oReadResult back = read_g2o_file(path);
@@ -180,7 +172,8 @@ TEST(RobotKeys, WrittenGraphKeepsTheInputIdsAndFix) {
   EXPECT_EQ(back.keys.fixed, r.keys.fixed);
   // One TUM file: the key as timestamp, exactly (no double rounding of a 64-bit id).
   write_tum(r.graph.initial, r.keys, path + ".tum");
-  EXPECT_EQ(read_text(path + ".tum").rfind(std::to_string(key('a', 0)) + " 0 0 0 0 0 0 1\n", 0),
+  EXPECT_EQ(test::read_text_file(path + ".tum")
+                .rfind(std::to_string(key('a', 0)) + " 0 0 0 0 0 0 1\n", 0),
             0u);
 }
 
@@ -216,12 +209,12 @@ TEST(RobotTrajectories, OneTumFilePerRobotWithIndicesOrStamps) {
   auto files = write_robot_trajectories(g, r.keys, g.initial, dir);
   ASSERT_EQ(files.size(), 2u);
   EXPECT_EQ(files[1], dir + "/robot_b.tum");
-  std::string b = read_text(files[1]);
+  std::string b = test::read_text_file(files[1]);
   EXPECT_NE(b.find(kTumIndexStampsNote), std::string::npos);
   EXPECT_NE(b.find("\n2 2 5 0 0 0 0 1\n"), std::string::npos) << b;
   r.keys.stamps = {10, 10.5, 11, 20, 20.25, 20.5};
   files = write_robot_trajectories(g, r.keys, g.initial, dir);
-  b = read_text(files[1]);
+  b = test::read_text_file(files[1]);
   EXPECT_NE(b.find("\n20.5 2 5 0 0 0 0 1\n"), std::string::npos) << b;
   EXPECT_EQ(b.find(kTumIndexStampsNote), std::string::npos);
 }
