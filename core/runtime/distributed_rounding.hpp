@@ -35,7 +35,9 @@ enum RoundingPhase : std::uint32_t {
   kTraffic,                    // certificate and escape bytes sent (certification only)
   kWarmStartAnchor,            // pose 0's translation in the rounded frame (its owner's)
   kWarmStartValues,            // public entries of the warm start
-  kWarmStartNorm               // |b|^2, with the warm start's step
+  kWarmStartNorm,              // |b|^2, with the warm start's step
+  kCoarseMatrix,               // a block's row of the coarse matrix E = Z^T L Z
+  kCoarseSums                  // the CG step's sums with the coarse level's terms
 };
 
 /// How the rounding solves for the translations (every agent must use the same).
@@ -55,6 +57,11 @@ struct DistributedRoundingOptions {
   double settle_tolerance = 1e-10;
   /// Steps over which the remaining cost is estimated, [1, 1000].
   std::size_t settle_window = 10;
+  /// Add a coarse level to the CG's block-Jacobi preconditioner: one translation offset per
+  /// block, its N x N matrix solved by every agent (runtime/rounding_coarse.hpp). Without it
+  /// the steps grow with the number of blocks: on a generated 100,000-pose grid after 5
+  /// rounds, ... (scripts/bench/rounding_blocks.py).
+  bool coarse_correction = true;
 
   /// Throws InputError naming the field when it is out of range.
   void validate() const;
@@ -127,6 +134,17 @@ class DistributedRounding {
   }
 
   void rotations();
+
+  // The sums of a CG step with the coarse level, in agent-id order: the three scalars of
+  // reduce() and the N x d matrices V = sum of every agent's `coupling` (non-zero in the rows
+  // of `touched`) and S (row k: agent k's `own`). One broadcast per agent.
+  struct CoarseSums {
+    double a = 0, b = 0, c = 0;
+    Eigen::MatrixXd V, S;
+  };
+  CoarseSums coarse_reduce(std::uint32_t round, const double (&scalars)[3],
+                           const Eigen::MatrixXd& coupling, const Eigen::RowVectorXd& own,
+                           const std::vector<std::uint32_t>& touched);
 
   // The translations CG starts from: the iterate's, in the rounded frame, pose 0 at 0.
   Eigen::MatrixXd warm_start();

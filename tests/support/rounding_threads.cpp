@@ -38,7 +38,10 @@ Rounded round_in_threads(const RoundingCase& c, const DistributedRoundingOptions
         for (std::size_t s = 0; s < local.owned.size(); ++s)
           Y.middleCols((d + 1) * static_cast<Eigen::Index>(s), d + 1) =
               c.solved.X.middleCols((d + 1) * static_cast<Eigen::Index>(local.owned[s]), d + 1);
-        const AgentState state(static_cast<int>(k), d, layout, local.measurements, Y);
+        // The rounding reads only the iterate: no block preconditioner to factorise.
+        BlockUpdateOptions no_factor;
+        no_factor.precondition = false;
+        const AgentState state(static_cast<int>(k), d, layout, local.measurements, Y, no_factor);
         test::ThreadChannel ch(ex, k);
         Mailbox mail(ch, 30.0, k);
         mail.set_num_agents(N);
