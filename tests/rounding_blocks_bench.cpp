@@ -74,8 +74,8 @@ int main(int argc, char** argv) {
       settled.coarse_correction = coarse;
       DistributedRoundingOptions exact = settled;
       exact.settle_tolerance = 0;
-      const Rounded a = round_in_threads(c, settled);
-      const Rounded b = round_in_threads(c, exact);
+      const Rounded a = round_in_threads(c, settled, 600.0);
+      const Rounded b = round_in_threads(c, exact, 600.0);
       for (const Rounded* r : {&a, &b})
         if (!r->errors.empty()) {
           std::fprintf(stderr, "%d blocks: %s\n", N, r->errors.front().c_str());
