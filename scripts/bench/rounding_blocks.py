@@ -17,8 +17,9 @@ Prints a table and writes docs/benchmarks/rounding_blocks.csv.
 
 usage: rounding_blocks.py [--poses 100000] [--blocks 16,25,64] [--rounds 5]
                           [--bench build/bin/rounding_blocks_bench] [--csv FILE]
-                          [--from-output SAVED_BENCH_OUTPUT]
-(100,000 poses, N = 16, 25, 64: ~15 min on 2 cores at load 10; most of it the in-process solves.)
+                          [--from-output SAVED_BENCH_OUTPUT...]
+(100,000 poses, N = 16, 25, 64: ~20 min on 2 cores at load 10-15; most of it the in-process
+solves. docs/benchmarks/rounding_blocks.csv holds that run and --poses 20000 --rounds 100.)
 """
 import argparse
 import csv
@@ -40,11 +41,14 @@ def main():
     ap.add_argument("--blocks", default="16,25,64")
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--csv", default=os.path.join(bc.OUT_DIR, "rounding_blocks.csv"))
-    ap.add_argument("--from-output", help="read a saved output of the bench instead of running it")
+    ap.add_argument("--from-output", nargs="+",
+                    help="read saved outputs of the bench (one table) instead of running it")
     args = ap.parse_args()
     if args.from_output:
-        with open(args.from_output) as f:
-            out = f.read()
+        out = ""
+        for name in args.from_output:
+            with open(name) as f:
+                out += f.read()
     else:
         out = subprocess.run([args.bench, "--poses", str(args.poses), "--blocks", args.blocks,
                               "--rounds", str(args.rounds)], stdout=subprocess.PIPE,
