@@ -19,7 +19,8 @@ usage: rounding_blocks.py [--poses 100000] [--blocks 16,25,64] [--rounds 5]
                           [--bench build/bin/rounding_blocks_bench] [--csv FILE]
                           [--from-output SAVED_BENCH_OUTPUT...]
 (100,000 poses, N = 16, 25, 64: ~20 min on 2 cores at load 10-15; most of it the in-process
-solves. docs/benchmarks/rounding_blocks.csv holds that run and --poses 20000 --rounds 100.)
+solves. docs/benchmarks/rounding_blocks.csv holds that run, --poses 200000 --blocks 64 (~20 min) and
+--poses 20000 --rounds 100.)
 """
 import argparse
 import csv
