@@ -400,17 +400,20 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   }
   for (const NewtonRefineResult& n : r.refines)
     std::printf(
-        "  newton refine: %d steps (%d accepted), %d CG iterations, %d exchanges, %d all-agent "
-        "sums, %d coarse unknowns, |grad f| %.3g -> %.3g, f %.10g -> %.10g, stop: %s\n",
-        n.steps, n.accepted_steps, n.cg_iterations, n.exchanges, n.reductions, n.coarse_unknowns,
-        n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost, n.stop_reason.c_str());
+        "  newton refine: %d steps (%d accepted), %d CG iterations, %d translation CG "
+        "iterations, %d exchanges, %d all-agent sums, %d coarse unknowns, |grad f| %.3g -> %.3g, "
+        "f %.10g -> %.10g, stop: %s\n",
+        n.steps, n.accepted_steps, n.cg_iterations, n.translation_iterations, n.exchanges,
+        n.reductions, n.coarse_unknowns, n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost,
+        n.stop_reason.c_str());
   for (const NewtonRefineResult& n : r.refines)
     for (std::size_t k = 0; k < n.trace.size(); ++k) {
       const NewtonRefineStep& t = n.trace[k];
       std::printf(
-          "    step %zu: %d CG (%s), predicted %.3g, actual %.3g, %s, f %.12g, |grad f| %.3g\n",
-          k + 1, t.cg_iterations, t.cg_stop.c_str(), t.predicted, t.actual,
-          t.accepted ? "accepted" : "rejected", t.cost, t.grad_norm);
+          "    step %zu: %d CG (%s), %d translation CG, predicted %.3g, actual %.3g, %s, f %.12g, "
+          "|grad f| %.3g\n",
+          k + 1, t.cg_iterations, t.cg_stop.c_str(), t.translation_iterations, t.predicted,
+          t.actual, t.accepted ? "accepted" : "rejected", t.cost, t.grad_norm);
     }
   if (robust.kind != RobustKind::kNone)
     std::printf(

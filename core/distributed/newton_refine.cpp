@@ -1,3 +1,4 @@
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -28,6 +29,8 @@ void NewtonRefineOptions::validate() const {
   if (coarse_aggregates < 1) fail("coarse_aggregates", "must be >= 1");
   if (coarse_smoothing_steps < 0 || coarse_smoothing_steps > 8)
     fail("coarse_smoothing_steps", "must be in 0..8");
+  if (translation_iterations < 0) fail("translation_iterations", "must be >= 0");
+  if (!(translation_tol > 0 && translation_tol < 1)) fail("translation_tol", "must be in (0, 1)");
 }
 
 CoarseOptions NewtonRefineOptions::coarse_space_options() const {
@@ -53,6 +56,12 @@ std::vector<double> row_indicators(const Eigen::MatrixXd& X, const Eigen::Matrix
 }
 
 }  // namespace
+
+// The block's translation Laplacian L_BB (its measurements' tau, cut ones on the diagonal),
+// factored: the translation Hessian's own block is 2 L_BB.
+struct NewtonRefineProtocol::TranslationFactor {
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+};
 
 NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout& layout,
                                            const NewtonRefineOptions& options)
@@ -188,6 +197,12 @@ void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
       case kCoarse:
         after_coarse(*ready, out);
         break;
+      case kTranslationDirection:
+        after_translation_direction(*ready, out);
+        break;
+      case kTranslationSums:
+        after_translation_sums(*ready, out);
+        break;
       default:
         after_trial_sums(*ready, out);
         break;
@@ -224,6 +239,7 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
     result_.coarse_unknowns = coarse_->size();
   }
   prepare_preconditioner();
+  if (options_.translation_iterations > 0) factor_translations();
   begin_cg(out);
 }
 
@@ -482,6 +498,7 @@ void NewtonRefineProtocol::try_step(const std::string& cg_stop, std::vector<Outg
   scale_ = 1.0;
   backtracks_ = 0;
   Xt_ = retract_rigid(problem_.manifold(static_cast<int>(X_.rows())), problem_.dim(), X_, s_);
+  translations_solved_ = false;
   send_public(Xt_, kTrial, out);
 }
 
@@ -489,6 +506,7 @@ void NewtonRefineProtocol::after_trial(const MessageGate::Inbox& inbox,
                                        std::vector<OutgoingMessage>& out) {
   neighbours_into(inbox, Xtn_);
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(Xtn_);
+  if (options_.translation_iterations > 0 && !translations_solved_) return start_translations(out);
   double share = 0.0;
   problem_.cost(Xt_, &share);
   egrad_t_ = problem_.euclidean_gradient(Xt_);
@@ -550,10 +568,115 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
     step_.cg_stop = "backtrack";
     step_.predicted = -(scale_ * gs_ + 0.5 * scale_ * scale_ * sHs_);
     Xt_ = retract_rigid(problem_.manifold(static_cast<int>(X_.rows())), problem_.dim(), X_, s_);
+    translations_solved_ = false;
     send_public(Xt_, kTrial, out);
     return;
   }
   begin_cg(out);
+}
+
+void NewtonRefineProtocol::keep_translations(Eigen::MatrixXd& v) const {
+  const Eigen::Index w = problem_.dim() + 1;
+  for (Eigen::Index c = 0; c < v.cols(); ++c)
+    if (c % w != w - 1) v.col(c).setZero();
+}
+
+void NewtonRefineProtocol::factor_translations() {
+  // L_BB is Q_BB's translation-translation part (each pose's last column).
+  const SparseMatrix& Q = problem_.data_matrix();
+  const int w = problem_.dim() + 1;
+  const Eigen::Index m = static_cast<Eigen::Index>(problem_.num_owned());
+  std::vector<Eigen::Triplet<double>> trip;
+  for (int k = 0; k < Q.outerSize(); ++k) {
+    if (k % w != w - 1) continue;
+    for (SparseMatrix::InnerIterator it(Q, k); it; ++it)
+      if (it.row() % w == w - 1) trip.emplace_back(it.row() / w, k / w, it.value());
+  }
+  SparseMatrix L(m, m);
+  L.setFromTriplets(trip.begin(), trip.end());
+  translation_factor_ = std::make_unique<TranslationFactor>();
+  translation_factor_->ldlt.compute(L);
+  if (translation_factor_->ldlt.info() != Eigen::Success) {
+    // A block with no cut measurement (one agent): L_BB is singular on the constants. Any
+    // positive definite preconditioner serves CG; a shift of 1e-9 of the largest weight does.
+    double top = 0.0;
+    for (Eigen::Index i = 0; i < m; ++i) top = std::max(top, L.coeff(i, i));
+    SparseMatrix I(m, m);
+    I.setIdentity();
+    translation_factor_->ldlt.compute(L + 1e-9 * std::max(top, 1.0) * I);
+  }
+}
+
+void NewtonRefineProtocol::start_translations(std::vector<OutgoingMessage>& out) {
+  // f at fixed rotations is quadratic in the translations: the CG's residual is minus the
+  // translation columns of the Euclidean gradient at the trial point.
+  tr_ = -problem_.euclidean_gradient(Xt_);
+  keep_translations(tr_);
+  tx_.setZero(Xt_.rows(), Xt_.cols());
+  tcg_it_ = 0;
+  send_translation_direction(out);
+}
+
+void NewtonRefineProtocol::send_translation_direction(std::vector<OutgoingMessage>& out) {
+  // z = (2 L_BB)^-1 r on the translation columns, zero elsewhere.
+  const int w = problem_.dim() + 1;
+  const Eigen::Index m = static_cast<Eigen::Index>(problem_.num_owned());
+  Eigen::MatrixXd rt(m, tr_.rows());
+  for (Eigen::Index i = 0; i < m; ++i) rt.row(i) = tr_.col(i * w + w - 1).transpose();
+  const Eigen::MatrixXd zt = translation_factor_->ldlt.solve(rt);
+  tz_.setZero(tr_.rows(), tr_.cols());
+  for (Eigen::Index i = 0; i < m; ++i) tz_.col(i * w + w - 1) = 0.5 * zt.row(i).transpose();
+  // An iteration = this exchange and its sum.
+  ++result_.translation_iterations;
+  ++step_.translation_iterations;
+  send_public(tz_, kTranslationDirection, out);
+}
+
+void NewtonRefineProtocol::after_translation_direction(const MessageGate::Inbox& inbox,
+                                                       std::vector<OutgoingMessage>& out) {
+  neighbours_into(inbox, tzn_);
+  // The translation Hessian's product: the Euclidean gradient of the direction (neighbours set
+  // to theirs), translation columns only; no projection (the translations are Euclidean).
+  if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(tzn_);
+  tw_ = problem_.euclidean_gradient(tz_);
+  keep_translations(tw_);
+  broadcast(kTranslationSums, {dot(tr_, tz_), dot(tz_, tw_)}, out);
+}
+
+void NewtonRefineProtocol::after_translation_sums(const MessageGate::Inbox& inbox,
+                                                  std::vector<OutgoingMessage>& out) {
+  const std::vector<double> t = reduce_in_id_order(inbox, 2);
+  const double gamma = t[0], delta = t[1];
+  bool stop = !(gamma > 0);
+  if (!stop) {
+    const double beta = tcg_it_ == 0 ? 0.0 : gamma / tgamma_old_;
+    const double pHp = tcg_it_ == 0 ? delta : delta - beta * gamma / talpha_old_;
+    if (tcg_it_ == 0) {
+      tp_ = tz_;
+      tq_ = tw_;
+    } else {
+      tp_ = tz_ + beta * tp_;
+      tq_ = tw_ + beta * tq_;
+    }
+    if (!(pHp > 0)) {
+      stop = true;
+    } else {
+      const double alpha = gamma / pHp;
+      tx_ += alpha * tp_;
+      tr_ -= alpha * tq_;
+      tgamma_old_ = gamma;
+      talpha_old_ = alpha;
+      ++tcg_it_;
+      // This iteration lowered f by alpha gamma / 2 (exact for the quadratic).
+      const double reg = std::max(1.0, std::abs(f_)) * std::numeric_limits<double>::epsilon();
+      stop = 0.5 * alpha * gamma <= options_.translation_tol * std::max(step_.predicted, reg) ||
+             tcg_it_ >= options_.translation_iterations;
+    }
+  }
+  if (!stop) return send_translation_direction(out);
+  Xt_ += tx_;
+  translations_solved_ = true;
+  send_public(Xt_, kTrial, out);
 }
 
 void NewtonRefineProtocol::finish(const std::string& why) {

@@ -117,6 +117,21 @@ struct NewtonRefineOptions {
   /// kSmoothed: pieces per block (>= 1) and smoothing steps of their weights (0..8).
   int coarse_aggregates = 8;
   int coarse_smoothing_steps = 1;
+  /// Translations re-solved at every trial point: after the retraction moves the poses, the
+  /// agents run up to this many iterations of a distributed conjugate gradient on the
+  /// translations alone (the rotations fixed, f is quadratic in them: Hessian 2 L, L the
+  /// translation Laplacian), block-Jacobi preconditioned with each block's own Laplacian block
+  /// (factored once: it does not depend on the point). Why: a Newton step on a long chain bends
+  /// it, turning poses by different angles about distant points; no pose-local retraction
+  /// places their translations right (lever arms of hundreds of metres on ais2klinik), so the
+  /// trust region stayed small and each step ended on its boundary after 150-300 CG iterations.
+  /// Each iteration lowers f (CG on a convex quadratic from the retracted point), so any count
+  /// is sound. Costs per iteration one exchange and one all-agent sum (2 numbers). >= 0; 0 = off.
+  int translation_iterations = 50;
+  /// The translation CG stops once an iteration lowers f by at most this fraction of the
+  /// Newton step's predicted decrease (the rest it could remove is then small against what the
+  /// ratio test weighs). (0, 1).
+  double translation_tol = 1e-3;
   /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
   CoarseOptions coarse_space_options() const;
   /// Throws InputError naming the bad field.
@@ -126,6 +141,7 @@ struct NewtonRefineOptions {
 /// One trust-region step, identical on every agent.
 struct NewtonRefineStep {
   int cg_iterations = 0;
+  int translation_iterations = 0;        ///< Of the trial point's translation solve.
   double radius = 0.0;                   ///< Trust radius the step was computed in (0 = unbounded).
   double predicted = 0.0, actual = 0.0;  ///< Decreases of the model and of f.
   bool accepted = false;
@@ -149,6 +165,9 @@ struct NewtonRefineResult {
   /// Coarse correction: its unknowns (pieces x generators; 0 without), and how many times its
   /// matrix was summed (one all-agent sum each, counted in `reductions`).
   int coarse_unknowns = 0, coarse_assemblies = 0;
+  /// Iterations of the trial points' translation solves (each one exchange and one sum,
+  /// counted in `exchanges` and `reductions`).
+  int translation_iterations = 0;
   std::vector<NewtonRefineStep> trace;
 };
 
@@ -157,14 +176,18 @@ class NewtonRefineProtocol : public AgentProcess {
   /// Protocol steps (on the wire: the solve stage's phase base + these; RoundProtocol uses
   /// 0..5 in the same stage).
   enum Step : std::uint32_t {
-    kStatus = 60,     ///< Cost share, ||g||^2 and active rows at the start point.
-    kDirection = 61,  ///< Public entries of the preconditioned residual z.
-    kSums = 62,       ///< CG's <r, z>, <z, H z>, <r, r>.
-    kTrial = 63,      ///< Public poses of the trial point.
-    kTrialSums = 64,  ///< Cost share and ||g||^2 at the trial point.
-    kCoarse = 65      ///< The coarse matrix's share and Phi^T g at the current point.
+    kStatus = 60,                ///< Cost share, ||g||^2 and active rows at the start point.
+    kDirection = 61,             ///< Public entries of the preconditioned residual z.
+    kSums = 62,                  ///< CG's <r, z>, <z, H z>, <r, r>.
+    kTrial = 63,                 ///< Public poses of the trial point.
+    kTrialSums = 64,             ///< Cost share and ||g||^2 at the trial point.
+    kCoarse = 65,                ///< The coarse matrix's share and Phi^T g at the current point.
+    kTranslationDirection = 66,  ///< Trial translations: public entries of the CG's z.
+    kTranslationSums = 67        ///< Trial translations: <r, z>, <z, H z>.
   };
-  static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kCoarse; }
+  static bool is_refine_step(std::uint32_t step) {
+    return step >= kStatus && step <= kTranslationSums;
+  }
 
   /// `state`: the agent at the point to refine (Y, and Yn = the neighbours' public poses of the
   /// same point). It must outlive the protocol; on done() its sequences are reset to the final
@@ -225,6 +248,15 @@ class NewtonRefineProtocol : public AgentProcess {
   void after_trial(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void after_trial_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void finish(const std::string& why);
+  // The trial point's translations re-solved for its rotations (translation_iterations).
+  void factor_translations();
+  void start_translations(std::vector<OutgoingMessage>& out);
+  void send_translation_direction(std::vector<OutgoingMessage>& out);
+  void after_translation_direction(const MessageGate::Inbox& inbox,
+                                   std::vector<OutgoingMessage>& out);
+  void after_translation_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // Zero in every column but the poses' translations.
+  void keep_translations(Eigen::MatrixXd& v) const;
 
   AgentState& state_;
   const BlockLayout& layout_;
@@ -265,6 +297,14 @@ class NewtonRefineProtocol : public AgentProcess {
   Eigen::VectorXd coarse_hy_;  // balancing: this agent's share of (H Phi)^T y
   Eigen::VectorXd coarse_g_, coarse_r_, coarse_q_;
   bool coarse_due_ = true;  // the point changed since the coarse matrix was summed
+  // Translation solve at the trial point: the own block's translation Laplacian factor, CG
+  // state (x the translation change, in the pose layout with zero rotation columns).
+  struct TranslationFactor;
+  std::unique_ptr<TranslationFactor> translation_factor_;
+  bool translations_solved_ = false;  // the current trial's translations are re-solved
+  Eigen::MatrixXd tx_, tr_, tz_, tzn_, tw_, tp_, tq_;
+  int tcg_it_ = 0;
+  double tgamma_old_ = 0.0, talpha_old_ = 0.0;
   NewtonRefineStep step_;
   bool done_ = false;
   NewtonRefineResult result_;
