@@ -194,6 +194,8 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     solver.refine.forcing = options.newton_forcing;
     // Not measured on the online steps (a few CG iterations from a warm start): block Jacobi.
     solver.refine.coarse = NewtonRefineOptions::Coarse::kNone;
+    // Nor the trial translations' re-solve (measured on long chains from a cold start).
+    solver.refine.translation_iterations = 0;
     solver.grad_norm_tol = std::max(options.newton_after_grad_tol, solver.grad_norm_tol);
   }
   return solver;
