@@ -161,9 +161,11 @@ const char* kDistributedHelp =
     "  --certify-residual T      certificate stops at Ritz residual <= T max(1, max diag Q)\n"
     "                            (default 1e-6)\n"
     "  --certify-precon block-jacobi|none   certificate preconditioner (default block-jacobi)\n"
-    "  --refine newton|none      after the rounds reach --grad-tol, trust-region Newton steps\n"
-    "                            on the whole problem, CG over neighbour exchanges and\n"
-    "                            all-agent sums (docs/newton-refine.md) (default none)\n"
+    "  --refine newton|auto|none   after the rounds reach --grad-tol, trust-region Newton\n"
+    "                            steps on the whole problem, CG over neighbour exchanges and\n"
+    "                            all-agent sums (docs/newton-refine.md) (default none); auto:\n"
+    "                            only where the rounds' last cost decreases say they stopped\n"
+    "                            more than 1e-7 of f above their limit\n"
     "  --refine-grad-tol T       the refinement stops at ||grad f|| <= T (default 1e-6) or\n"
     "                            after a step that lowered f by < F f, --refine-rel-tol F\n"
     "                            (default 1e-7)\n"
@@ -293,9 +295,10 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       static_cast<int>(a.get_long("certify-iters", kCommandCertificateIterations));
   {
     const std::string refine = a.get_or("refine", "none");
-    if (refine != "newton" && refine != "none")
-      throw InputError("option --refine: '" + refine + "' is not one of newton, none");
-    opt.refine.enabled = refine == "newton";
+    if (refine != "newton" && refine != "auto" && refine != "none")
+      throw InputError("option --refine: '" + refine + "' is not one of newton, auto, none");
+    opt.refine.enabled = refine != "none";
+    if (refine == "auto") opt.refine.when = NewtonRefineOptions::When::kIfRoundsSlow;
     opt.refine.grad_norm_tol = a.get_double("refine-grad-tol", opt.refine.grad_norm_tol);
     opt.refine.relative_decrease_tol =
         a.get_double("refine-rel-tol", opt.refine.relative_decrease_tol);
@@ -483,15 +486,17 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     }
     // --refine newton, or the robust final solve's refinement (--gnc-final-refine).
     if (opt.refine.enabled || !r.refines.empty()) {
-      int steps = 0, cg = 0, exchanges = 0, reductions = 0;
+      int steps = 0, cg = 0, translation_cg = 0, exchanges = 0, reductions = 0;
       for (const NewtonRefineResult& n : r.refines) {
         steps += n.steps;
         cg += n.cg_iterations;
+        translation_cg += n.translation_iterations;
         exchanges += n.exchanges;
         reductions += n.reductions;
       }
       j.add("refine_steps", steps)
           .add("refine_cg_iterations", cg)
+          .add("refine_translation_iterations", translation_cg)
           .add("refine_exchanges", exchanges)
           .add("refine_reductions", reductions);
     }

@@ -71,8 +71,9 @@ options:
                        pieces per block blended smoothly across their borders (default blocks)
   --coarse-aggregates K  smoothed: pieces per block (default 4)
   --coarse-smoothing S   smoothed: smoothing steps of the blend, 0..8 (default 1)
-  --refine newton|none after the rounds, trust-region Newton steps on the whole problem
-                       (docs/newton-refine.md) (default none)
+  --refine newton|auto|none after the rounds, trust-region Newton steps on the whole
+                       problem (docs/newton-refine.md); auto: only where the rounds stopped
+                       short of their limit (default none)
   --refine-grad-tol T, --refine-rel-tol F
                        its stops: ||grad f|| <= T, or a step lowered f by < F f (0 = the
                        defaults, 1e-6 and 1e-7)
@@ -203,8 +204,8 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
     a.coarse_smoothing = static_cast<std::uint32_t>(c.smoothing_steps);
   }
   a.refine = args.get_or("refine", a.refine);
-  if (a.refine != "none" && a.refine != "newton")
-    throw InputError("option --refine: '" + a.refine + "' is not one of newton, none");
+  if (a.refine != "none" && a.refine != "newton" && a.refine != "auto")
+    throw InputError("option --refine: '" + a.refine + "' is not one of newton, auto, none");
   a.refine_grad_tol = args.get_double("refine-grad-tol", 0);
   a.refine_rel_tol = args.get_double("refine-rel-tol", 0);
   if (!(a.refine_grad_tol >= 0)) throw InputError("option --refine-grad-tol: must be >= 0");

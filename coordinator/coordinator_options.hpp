@@ -48,7 +48,7 @@ struct CoordinatorOptions {
   /// and coarse_smoothing smoothing steps (--coarse-smoothing S).
   std::uint32_t coarse_aggregates = 0;
   std::uint32_t coarse_smoothing = 1;
-  /// Newton refinement after the rounds: "none" or "newton" (--refine), with its tolerances
+  /// Newton refinement after the rounds: "none", "newton" or "auto" (--refine), with its tolerances
   /// (--refine-grad-tol, --refine-rel-tol; 0 = core's defaults).
   std::string refine = "none";
   double refine_grad_tol = 0;

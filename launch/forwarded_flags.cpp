@@ -44,8 +44,8 @@ void check_partition_time(const std::string& v) {
 }
 
 void check_refine(const std::string& v) {
-  if (v != "newton" && v != "none")
-    throw InputError("option --refine: '" + v + "' is not one of newton, none");
+  if (v != "newton" && v != "auto" && v != "none")
+    throw InputError("option --refine: '" + v + "' is not one of newton, auto, none");
 }
 
 // A tolerance >= 0 (0 = the solver's default), else an InputError naming the flag.
@@ -255,10 +255,12 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
       {"coarse-smoothing", "coarse-smoothing", true, ForwardTo::kCoordinator,
        "--coarse-smoothing S", "smoothed: smoothing steps of the blend, 0..8         [1]",
        check_coarse_smoothing},
-      {"refine", "refine", true, ForwardTo::kCoordinator, "--refine newton|none",
+      {"refine", "refine", true, ForwardTo::kCoordinator, "--refine newton|auto|none",
        "after the rounds reach --grad-tol, trust-region Newton\n"
        "steps on the whole problem: CG over neighbour exchanges\n"
-       "and all-agent sums (docs/newton-refine.md)          [none]",
+       "and all-agent sums (docs/newton-refine.md); auto: only\n"
+       "where the rounds' last cost decreases say they stopped\n"
+       "more than 1e-7 of f above their limit               [none]",
        check_refine},
       {"refine-grad-tol", "refine-grad-tol", true, ForwardTo::kCoordinator, "--refine-grad-tol T",
        "the refinement stops at ||grad f|| <= T       [1e-6]", check_refine_grad_tol},

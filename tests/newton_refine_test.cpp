@@ -18,6 +18,7 @@
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
+#include "distributed/rounds_tail.hpp"
 #include "refine_harness.hpp"
 #include "test_support.hpp"
 
@@ -231,6 +232,49 @@ TEST(NewtonRefine, TrialTranslationsReSolvedLowerTheTrialCostAndReachTheOptimum)
   }
 }
 
+// A geometric tail c_k = f + a q^k: the estimate from two windows is the exact cost still to
+// come; a trace too short to tell says +infinity, a flat one 0.
+TEST(RoundsTail, AGeometricTailIsEstimatedExactly) {
+  std::vector<RoundRecord> trace;
+  const double f = 100.0, a = 0.5, q = 0.8;
+  for (int k = 0; k <= 30; ++k) {
+    RoundRecord r;
+    r.round = k;
+    r.cost = f + a * std::pow(q, k);
+    trace.push_back(r);
+  }
+  const double gap = a * std::pow(q, 30) / trace.back().cost;
+  EXPECT_NEAR(rounds_tail_gap(trace, 5, 0.99), gap, 1e-9 * gap);  // round-off of 100 + a q^k
+  // A rate above the cap is read as the cap: q^5 = 0.33 > 0.2.
+  const double d1 = trace[25].cost - trace[30].cost;
+  EXPECT_NEAR(rounds_tail_gap(trace, 5, 0.2), d1 * 0.2 / 0.8 / trace[30].cost, 1e-12);
+  const std::vector<RoundRecord> short_trace(trace.begin(), trace.begin() + 10);
+  EXPECT_TRUE(std::isinf(rounds_tail_gap(short_trace, 5, 0.9)));
+  for (auto& r : trace) r.cost = f;
+  EXPECT_EQ(rounds_tail_gap(trace, 5, 0.9), 0.0);
+}
+
+// `--refine auto`: the long chain's rounds stop 1.5e-5 above f* with the cost still falling,
+// so the refinement runs and ends at f*; asked for a gap the tail does not reach, it does not
+// run and the rounds' answer stands.
+TEST(NewtonRefine, AutoRefinesOnlyWhereTheRoundsTailSaysTheyStoppedShort) {
+  const PoseGraph g = long_chain();
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  const double fstar = test::tight_optimum(g);
+  DistributedOptions autoo = refined(true);
+  autoo.refine.when = NewtonRefineOptions::When::kIfRoundsSlow;
+  const DistributedResult a = solve_distributed(g, parts, autoo);
+  ASSERT_EQ(a.refines.size(), 1u);
+  EXPECT_LT(std::abs(a.cost - fstar) / fstar, 1e-8);
+  DistributedOptions loose = autoo;
+  loose.refine.auto_gap_tol = 1.0;
+  const DistributedResult b = solve_distributed(g, parts, loose);
+  const DistributedResult plain = solve_distributed(g, parts, refined(false));
+  EXPECT_TRUE(b.refines.empty());
+  EXPECT_EQ(b.cost, plain.cost);
+  EXPECT_EQ(b.rounds, a.rounds);
+}
+
 TEST(NewtonRefineOptions, ValidateNamesTheBadField) {
   auto message = [](const NewtonRefineOptions& o) { return test::validation_message(o); };
   NewtonRefineOptions o;
@@ -243,6 +287,12 @@ TEST(NewtonRefineOptions, ValidateNamesTheBadField) {
   o = {};
   o.forcing = 1.0;
   EXPECT_NE(message(o).find("forcing"), std::string::npos);
+  o = {};
+  o.auto_gap_tol = 0;
+  EXPECT_NE(message(o).find("auto_gap_tol"), std::string::npos);
+  o = {};
+  o.auto_window = 0;
+  EXPECT_NE(message(o).find("auto_window"), std::string::npos);
   o = {};
   o.translation_iterations = -1;
   EXPECT_NE(message(o).find("translation_iterations"), std::string::npos);

@@ -5,6 +5,8 @@
 #include <tessera/distributed/stage_tag.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "distributed/rounds_tail.hpp"
+
 namespace tessera {
 
 void StaircaseOptions::validate() const {
@@ -20,6 +22,11 @@ CertifiedAgent::CertifiedAgent(AgentState& state, const BlockLayout& layout,
 
 double CertifiedAgent::solve_tolerance() const {
   return refining_ ? refine_tolerance() : options_.grad_norm_tol;
+}
+
+bool CertifiedAgent::refine_wanted(const std::vector<RoundRecord>& trace) const {
+  if (options_.refine.when == NewtonRefineOptions::When::kAlways) return true;
+  return rounds_tail_gap(trace, options_.refine.auto_window, 0.9) > options_.refine.auto_gap_tol;
 }
 
 double CertifiedAgent::refine_tolerance() const {
@@ -194,7 +201,8 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
           const std::string& stop = solves_.back().stop_reason;
           // A solve out of rounds is not refined: max_rounds is the run's budget.
           if (options_.refine.enabled && !solves_.back().trace.empty() &&
-              (stop == "grad_norm" || stop == "relative_decrease" || stop == "stalled")) {
+              (stop == "grad_norm" || stop == "relative_decrease" || stop == "stalled") &&
+              refine_wanted(solves_.back().trace)) {
             refine_ = std::make_unique<NewtonRefineProtocol>(state_, layout_, options_.refine);
             current_ = refine_.get();
             emit(refine_->start(), out);

@@ -77,6 +77,7 @@ def main():
         row = dict(graph=name, poses=base.get("poses"),
                    rounds=base["rounds"], rounds_gap=base["rel_gap"],
                    refine_rounds=ref["rounds"], cg=ref["refine_cg_iterations"],
+                   translation_cg=ref.get("refine_translation_iterations", 0),
                    steps=ref["refine_steps"], exchanges=ref["refine_exchanges"],
                    sums=ref["refine_reductions"], refine_gap=ref["rel_gap"],
                    refine_certified=ref["certified"],
@@ -89,7 +90,7 @@ def main():
                    load=max(l0, load()))
         rows.append(row)
         table.append([name, row["rounds"], bc.fmt(row["rounds_gap"], "{:.1e}"),
-                      f"{row['cg']} / {row['steps']}", row["exchanges"], row["sums"],
+                      f"{row['cg']} / {row['translation_cg']} / {row['steps']}", row["exchanges"], row["sums"],
                       bc.fmt(row["refine_gap"], "{:.1e}"), row["message_steps_refine"],
                       bc.fmt(row["tight_tol"]), bc.fmt(row["tight_rounds"]), bc.fmt(row["tight_gap"], "{:.1e}"),
                       row["message_steps_rounds"], f"{row['solve_s_refine']:.2f} / {row['solve_s_rounds']:.2f}",
@@ -97,7 +98,7 @@ def main():
         bc.progress(f"{name}: " + ", ".join(f"{k}={v}" for k, v in row.items()))
         bc.write_csv(a.csv, rows, announce=False)  # a long run keeps what it has
     bc.print_table(f"IRBCD rounds vs rounds + Newton refinement, N = {a.agents} (in process, counts load-free)",
-                   ["graph", "rounds", "gap", "CG / steps", "exchanges", "sums", "gap refined",
+                   ["graph", "rounds", "gap", "CG / translation CG / steps", "exchanges", "sums", "gap refined",
                     "msg steps refined", "tighter tol", "rounds", "gap", "msg steps rounds",
                     "solve s refined / rounds", "load"], table)
     bc.write_csv(a.csv, rows)

@@ -104,6 +104,8 @@ class CertifiedAgent : public AgentProcess {
   /// while refining an inconclusive certificate.
   double solve_tolerance() const;
   double refine_tolerance() const;
+  /// Whether a converged solve with this trace is refined (NewtonRefineOptions::when).
+  bool refine_wanted(const std::vector<RoundRecord>& trace) const;
 
   AgentState& state_;
   const BlockLayout& layout_;
