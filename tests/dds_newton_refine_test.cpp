@@ -1,7 +1,8 @@
 // The Newton refinement over DDS: agents started with `--refine newton` through the coordinator
 // take the in-process engine's iterates (same rounds, same refined cost), and `tessera launch
-// --refine newton` forwards the option and ends at the optimum.
-// Domains used here: 80-81 (each test its own, so ctest -j is safe).
+// --refine newton` forwards the option and ends at the optimum; `--refine auto` refines this
+// chain too (its rounds stop short), as the in-process engine does.
+// Domains used here: 80-81, 99 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -82,6 +83,29 @@ TEST(DdsNewtonRefine, LaunchForwardsRefineAndEndsCertifiedAtTheOptimum) {
   const PoseGraph g = read_g2o(graph);
   const double fstar = tight_optimum(g);
   EXPECT_NEAR(json_number(json, "cost"), fstar, 1e-8 * fstar) << json;
+}
+
+TEST(DdsNewtonRefine, LaunchForwardsRefineAutoWhichRefinesAChainWhoseRoundsStopShort) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/chain.g2o";
+  generate_graph(graph, kChain);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch " + graph +
+                                 " --agents 3 --domain 99 --refine auto --timeout 90 --json " +
+                                 dir + "/s.json 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find("refinement: Newton step 1, CG iteration "), std::string::npos) << out;
+  const std::string json = slurp(dir + "/s.json");
+  EXPECT_EQ(json_text(json, "certified"), "true") << json;
+  const PoseGraph g = read_g2o(graph);
+  const double fstar = tight_optimum(g);
+  EXPECT_NEAR(json_number(json, "cost"), fstar, 1e-8 * fstar) << json;
+  // A value launch does not know is refused by name.
+  std::string bad;
+  EXPECT_EQ(run_command(bin("tessera") + " launch " + graph + " --refine sometimes 2>&1", &bad), 2);
+  EXPECT_NE(bad.find("--refine"), std::string::npos) << bad;
 }
 
 }  // namespace
