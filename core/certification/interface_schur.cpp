@@ -163,11 +163,15 @@ bool interface_positive_definite(const std::vector<InterfaceSchurBlock>& blocks,
     }
   }
   if (M == 0) return true;
-  Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(M, M);
+  // Sparse: Sigma is dense only within each block's interface; the cut couples few entries
+  // (city10000 at N = 5: 152k factor entries against 414k for the dense lower triangle).
+  std::vector<Eigen::Triplet<double>> t;
   for (const auto& b : blocks) {
     if (b.poses.empty()) continue;
     const Eigen::Index at = index.at(b.poses.front());
-    sigma.block(at, at, b.schur.rows(), b.schur.cols()) += b.schur;
+    for (Eigen::Index j = 0; j < b.schur.cols(); ++j)
+      for (Eigen::Index i = j; i < b.schur.rows(); ++i)
+        t.emplace_back(at + i, at + j, b.schur(i, j));
   }
   for (const auto& b : blocks)
     for (std::size_t k = 0; k < b.values.size(); ++k) {
@@ -176,10 +180,11 @@ bool interface_positive_definite(const std::vector<InterfaceSchurBlock>& blocks,
       if (ri == index.end() || ci == index.end())
         throw std::runtime_error("certificate: coupling outside the interface");
       const Eigen::Index r = ri->second + b.rows[k] % w, c = ci->second + b.cols[k] % w;
-      sigma(r, c) += b.values[k];
-      sigma(c, r) += b.values[k];
+      t.emplace_back(std::max(r, c), std::min(r, c), b.values[k]);
     }
-  Eigen::LLT<Eigen::MatrixXd> llt(sigma);
+  SparseMatrix sigma(M, M);
+  sigma.setFromTriplets(t.begin(), t.end());
+  Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower> llt(sigma);
   return llt.info() == Eigen::Success;
 }
 

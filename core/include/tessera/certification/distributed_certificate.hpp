@@ -56,8 +56,8 @@ struct DistributedCertificateOptions {
   CertificatePreconditioner preconditioner = CertificatePreconditioner::kBlockJacobi;
   std::uint64_t seed = 1;  ///< Start vector (hash of the global pose ids and this seed).
   /// The exact interface test runs when the team's interface (poses with a cut measurement)
-  /// has at most this many coordinates ((d+1) a pose): agent 0 factors a dense matrix that
-  /// large. 0 = LOBPCG only. >= 0.
+  /// has at most this many coordinates ((d+1) a pose): agent 0 factors a matrix that large,
+  /// dense within each block's interface. 0 = LOBPCG only. >= 0.
   int interface_max_coordinates = 1200;
   /// Throws InputError naming the bad field.
   void validate() const;
