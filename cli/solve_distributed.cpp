@@ -43,6 +43,7 @@ const char* const kDistributedValued[] = {"agents",
                                           "certify-iters",
                                           "certify-residual",
                                           "certify-precon",
+                                          "certify-interface",
                                           "block-precon",
                                           "tangent-refresh",
                                           "tcg-kappa",
@@ -161,6 +162,9 @@ const char* kDistributedHelp =
     "  --certify-residual T      certificate stops at Ritz residual <= T max(1, max diag Q)\n"
     "                            (default 1e-6)\n"
     "  --certify-precon block-jacobi|none   certificate preconditioner (default block-jacobi)\n"
+    "  --certify-interface C     exact test of S + eta I > 0 on the blocks' interfaces before\n"
+    "                            LOBPCG when they have at most C coordinates (default 1200;\n"
+    "                            0 = LOBPCG only; docs/distributed-certification.md)\n"
     "  --refine newton|auto|none   after the rounds reach --grad-tol, trust-region Newton\n"
     "                            steps on the whole problem, CG over neighbour exchanges and\n"
     "                            all-agent sums (docs/newton-refine.md) (default none); auto:\n"
@@ -293,6 +297,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   }
   opt.staircase.certificate.max_iterations =
       static_cast<int>(a.get_long("certify-iters", kCommandCertificateIterations));
+  opt.staircase.certificate.interface_max_coordinates = static_cast<int>(
+      a.get_long("certify-interface", opt.staircase.certificate.interface_max_coordinates));
   {
     const std::string refine = a.get_or("refine", "none");
     if (refine != "newton" && refine != "auto" && refine != "none")

@@ -8,6 +8,8 @@
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
+#include "certification/interface_schur.hpp"
+
 namespace tessera {
 
 void DistributedCertificateOptions::validate() const {
@@ -17,6 +19,7 @@ void DistributedCertificateOptions::validate() const {
   if (!(relative_tolerance >= 0)) fail("relative_tolerance", "must be >= 0");
   if (!(residual_tolerance > 0)) fail("residual_tolerance", "must be > 0");
   if (max_iterations <= 0) fail("max_iterations", "must be > 0");
+  if (interface_max_coordinates < 0) fail("interface_max_coordinates", "must be >= 0");
 }
 
 double certificate_start_entry(std::uint64_t seed, std::size_t pose, int coordinate, int d) {
@@ -107,6 +110,23 @@ Eigen::MatrixXd CertificateProtocol::apply(const Eigen::MatrixXd& v, const Eigen
   return out;
 }
 
+namespace {
+// Block b's interface: its poses that some neighbour block needs (a cut measurement touches
+// them), ascending ids.
+std::vector<std::size_t> interface_of(const BlockLayout& layout, int b) {
+  std::vector<std::size_t> poses;
+  for (const auto& to : layout.public_to[static_cast<std::size_t>(b)])
+    poses.insert(poses.end(), to.begin(), to.end());
+  std::sort(poses.begin(), poses.end());
+  poses.erase(std::unique(poses.begin(), poses.end()), poses.end());
+  return poses;
+}
+
+double dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a.array() * b.array()).sum();
+}
+}  // namespace
+
 std::vector<OutgoingMessage> CertificateProtocol::start() {
   const int d = problem_.dim();
   const Eigen::Index w = d + 1;
@@ -127,54 +147,174 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
   const SparseMatrix& Q = problem_.data_matrix();
   local_max_diag_ = Q.rows() > 0 ? Q.diagonal().maxCoeff() : 0.0;
 
-  if (options_.preconditioner == CertificatePreconditioner::kBlockJacobi && m > 0) {
-    const double local_scale = std::max(1.0, local_max_diag_);
-    precon_ = std::make_unique<BlockJacobi>();
-    double shift = std::max(options_.relative_tolerance, 1e-12) * local_scale;
-    const bool pose_wise = state_.block_factor_too_large();
-    // The exact factor's matrix S_BB = Q_BB - Lambda_B; the pose-wise fallback (large blocks)
-    // reads S_BB's diagonal blocks straight from Q_BB and Lambda_B instead: two matrices the
-    // size of Q_BB less at the agent's memory peak.
-    SparseMatrix S, I;
-    if (!pose_wise) {
-      S = Q - lambda_;
-      I.resize(S.rows(), S.cols());
-      I.setIdentity();
-    }
-    for (;;) {
-      if (pose_wise) {
-        if (precon_->invert_diagonal_blocks(Q, lambda_, shift, static_cast<int>(w))) break;
-      } else {
-        precon_->factor.compute(S + shift * I);
-        if (precon_->factor.info() == Eigen::Success) break;
-      }
-      shift *= 10.0;
-      if (shift > 1e4 * local_scale)
-        throw std::runtime_error("certificate: agent " + std::to_string(state_.id()) +
-                                 " found no positive definite shift of its block");
-    }
-    precon_->shift = shift;
-  }
-
-  x_.resize(1, w * m);
-  const auto& owned = problem_.owned();
-  for (Eigen::Index i = 0; i < m; ++i)
-    for (int c = 0; c < w; ++c)
-      x_(0, w * i + c) =
-          certificate_start_entry(options_.seed, owned[static_cast<std::size_t>(i)], c, d);
   std::vector<OutgoingMessage> out;
+  std::size_t interface = 0;
+  for (int b = 0; b < layout_.num_blocks; ++b) interface += interface_of(layout_, b).size();
+  if (options_.interface_max_coordinates > 0 &&
+      static_cast<double>(interface) * static_cast<double>(w) <=
+          static_cast<double>(options_.interface_max_coordinates)) {
+    // The reduction before the interface test: the global eta, whether an agent's block is too
+    // large to factor (then nobody tests), and the Gram matrices of Y's rows (Y Y^T, Y S Y^T,
+    // (Y S)(Y S)^T) for the Ritz pair on the row space.
+    const Eigen::MatrixXd YS = apply(Y, state_.Yn);
+    const Eigen::MatrixXd grams[3] = {Y * Y.transpose(), Y * YS.transpose(), YS * YS.transpose()};
+    std::vector<double> values{local_max_diag_, state_.block_factor_too_large() ? 1.0 : 0.0};
+    for (const auto& g : grams)
+      for (Eigen::Index i = 0; i < g.rows(); ++i)
+        for (Eigen::Index j = i; j < g.cols(); ++j) values.push_back(0.5 * (g(i, j) + g(j, i)));
+    broadcast(0, kSetup, values, out);
+  } else {
+    build_preconditioner();
+    start_lobpcg(out);
+  }
+  pump(out);
+  return out;
+}
+
+void CertificateProtocol::build_preconditioner() {
+  const Eigen::Index m = static_cast<Eigen::Index>(problem_.num_owned());
+  if (options_.preconditioner != CertificatePreconditioner::kBlockJacobi || m == 0) return;
+  const Eigen::Index w = problem_.dim() + 1;
+  const SparseMatrix& Q = problem_.data_matrix();
+  const double local_scale = std::max(1.0, local_max_diag_);
+  precon_ = std::make_unique<BlockJacobi>();
+  double shift = std::max(options_.relative_tolerance, 1e-12) * local_scale;
+  const bool pose_wise = state_.block_factor_too_large();
+  // The exact factor's matrix S_BB = Q_BB - Lambda_B; the pose-wise fallback (large blocks)
+  // reads S_BB's diagonal blocks straight from Q_BB and Lambda_B instead: two matrices the
+  // size of Q_BB less at the agent's memory peak.
+  SparseMatrix S, I;
+  if (!pose_wise) {
+    S = Q - lambda_;
+    I.resize(S.rows(), S.cols());
+    I.setIdentity();
+  }
+  for (;;) {
+    if (pose_wise) {
+      if (precon_->invert_diagonal_blocks(Q, lambda_, shift, static_cast<int>(w))) break;
+    } else {
+      precon_->factor.compute(S + shift * I);
+      if (precon_->factor.info() == Eigen::Success) break;
+    }
+    shift *= 10.0;
+    if (shift > 1e4 * local_scale)
+      throw std::runtime_error("certificate: agent " + std::to_string(state_.id()) +
+                               " found no positive definite shift of its block");
+  }
+  precon_->shift = shift;
+}
+
+void CertificateProtocol::start_lobpcg(std::vector<OutgoingMessage>& out) {
+  const int d = problem_.dim();
+  const Eigen::Index w = d + 1;
+  const Eigen::Index m = static_cast<Eigen::Index>(problem_.num_owned());
+  if (interface_certified_) {
+    // Only lambda_min's value is wanted: start where it is nearly found.
+    x_ = row_space_ritz_.transpose() * state_.Y;
+  } else {
+    x_.resize(1, w * m);
+    const auto& owned = problem_.owned();
+    for (Eigen::Index i = 0; i < m; ++i)
+      for (int c = 0; c < w; ++c)
+        x_(0, w * i + c) =
+            certificate_start_entry(options_.seed, owned[static_cast<std::size_t>(i)], c, d);
+  }
   iteration_ = 0;
   send_boundary(x_, 0, out);
   gate_.expect(0, kVector, layout_.adjacent[static_cast<std::size_t>(state_.id())]);
-  pump(out);
-  return out;
+}
+
+void CertificateProtocol::after_setup(const MessageGate::Inbox& inbox,
+                                      std::vector<OutgoingMessage>& out) {
+  const Eigen::Index r = state_.Y.rows();
+  const std::size_t tri = static_cast<std::size_t>(r * (r + 1) / 2);
+  const std::vector<double> t = reduce_in_id_order(inbox, 2 + 3 * tri, {0, 1});
+  result_.scale = std::max(1.0, t[0]);
+  result_.tolerance = options_.relative_tolerance * result_.scale;
+  Eigen::MatrixXd grams[3];
+  std::size_t at = 2;
+  for (auto& g : grams) {
+    g.resize(r, r);
+    for (Eigen::Index i = 0; i < r; ++i)
+      for (Eigen::Index j = i; j < r; ++j) g(i, j) = g(j, i) = t[at++];
+  }
+  // Rayleigh-Ritz on the row space (the same r x r problem on every agent): the smallest Ritz
+  // value and its residual ||x S - theta x||^2 = c^T (Y S)(Y S)^T c - theta^2 for c^T Y Y^T c = 1.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eb(grams[0]);
+  const double top = eb.eigenvalues().maxCoeff();
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < r; ++i)
+    if (eb.eigenvalues()(i) > 1e-10 * top) keep.push_back(i);
+  Eigen::MatrixXd Z(r, static_cast<Eigen::Index>(keep.size()));
+  for (std::size_t c = 0; c < keep.size(); ++c)
+    Z.col(static_cast<Eigen::Index>(c)) =
+        eb.eigenvectors().col(keep[c]) / std::sqrt(eb.eigenvalues()(keep[c]));
+  Eigen::MatrixXd C = Z.transpose() * grams[1] * Z;
+  C = (0.5 * (C + C.transpose())).eval();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ec(C);
+  row_space_ritz_ = Z * ec.eigenvectors().col(0);
+  row_space_theta_ = ec.eigenvalues()(0);
+  row_space_residual_ = std::sqrt(std::max(
+      0.0, row_space_ritz_.dot(grams[2] * row_space_ritz_) - row_space_theta_ * row_space_theta_));
+  if (t[1] > 0) {  // an agent's block is too large to factor: LOBPCG only
+    build_preconditioner();
+    start_lobpcg(out);
+    return;
+  }
+  const double shift = std::max(result_.tolerance, 1e-12 * result_.scale);
+  const InterfaceSchurBlock block =
+      local_interface_schur(problem_, lambda_, shift, interface_of(layout_, state_.id()));
+  PoseBlockMessage m =
+      make_reduction_message(state_.id(), 0, kSchur, encode_interface_schur(block));
+  if (state_.id() == 0) {
+    gate_.add(0, 0, kSchur, std::move(m));
+    gate_.expect(0, kSchur, everyone());
+  } else {
+    OutgoingMessage o;
+    o.message = std::move(m);
+    o.broadcast = false;
+    o.recipients = {0};
+    out.push_back(std::move(o));
+    gate_.expect(0, kVerdict, {0});
+  }
+}
+
+void CertificateProtocol::after_schur(const MessageGate::Inbox& inbox,
+                                      std::vector<OutgoingMessage>& out) {
+  std::vector<InterfaceSchurBlock> blocks;
+  for (const auto& [sender, m] : inbox) {
+    const auto& values = std::get<PoseBlockMessage>(m).data;
+    blocks.push_back(decode_interface_schur(values));
+  }
+  const bool pd = interface_positive_definite(blocks, problem_.dim());
+  PoseBlockMessage v = make_reduction_message(0, 0, kVerdict, {pd ? 1.0 : 0.0});
+  gate_.add(0, 0, kVerdict, v);
+  OutgoingMessage o;
+  o.message = std::move(v);
+  o.broadcast = true;
+  out.push_back(std::move(o));
+  gate_.expect(0, kVerdict, {0});
+}
+
+void CertificateProtocol::after_verdict(const MessageGate::Inbox& inbox,
+                                        std::vector<OutgoingMessage>& out) {
+  interface_certified_ = reduction_values(inbox.at(0), 1)[0] != 0.0;
+  result_.interface_test = true;
+  if (interface_certified_ && row_space_residual_ <= options_.residual_tolerance * result_.scale) {
+    theta_ = row_space_theta_;
+    x_ = row_space_ritz_.transpose() * state_.Y;
+    result_.residual = row_space_residual_;
+    result_.iterations = 0;
+    return finish(true);
+  }
+  build_preconditioner();
+  start_lobpcg(out);
 }
 
 std::vector<OutgoingMessage> CertificateProtocol::handle(const ProtocolMessage& message) {
   const std::uint32_t sender = message_sender(message);
   const std::uint32_t step = message_phase(message);
-  if (sender >= static_cast<std::uint32_t>(layout_.num_blocks) ||
-      (step != kVector && step != kReduce))
+  if (sender >= static_cast<std::uint32_t>(layout_.num_blocks) || step < kVector || step > kVerdict)
     throw std::runtime_error("certificate: agent " + std::to_string(state_.id()) +
                              ": malformed message (sender " + std::to_string(sender) + ", step " +
                              std::to_string(step) + ")");
@@ -190,10 +330,23 @@ void CertificateProtocol::pump(std::vector<OutgoingMessage>& out) {
   while (!done_) {
     std::optional<MessageGate::Inbox> ready = gate_.take_ready();
     if (!ready) return;
-    if (gate_.step() == kVector)
-      after_vector(*ready, out);
-    else
-      after_reduce(*ready, out);
+    switch (gate_.step()) {
+      case kVector:
+        after_vector(*ready, out);
+        break;
+      case kReduce:
+        after_reduce(*ready, out);
+        break;
+      case kSetup:
+        after_setup(*ready, out);
+        break;
+      case kSchur:
+        after_schur(*ready, out);
+        break;
+      default:
+        after_verdict(*ready, out);
+        break;
+    }
   }
 }
 
@@ -208,22 +361,17 @@ void CertificateProtocol::send_boundary(const Eigen::MatrixXd& v, std::uint32_t 
   }
 }
 
-void CertificateProtocol::broadcast(std::uint32_t round, const std::vector<double>& values,
+void CertificateProtocol::broadcast(std::uint32_t round, std::uint32_t step,
+                                    const std::vector<double>& values,
                                     std::vector<OutgoingMessage>& out) {
-  PoseBlockMessage m = make_reduction_message(state_.id(), round, kReduce, values);
-  gate_.add(state_.id(), round, kReduce, m);  // our own share joins the reduction like any other
+  PoseBlockMessage m = make_reduction_message(state_.id(), round, step, values);
+  gate_.add(state_.id(), round, step, m);  // our own share joins the reduction like any other
   OutgoingMessage o;
   o.message = std::move(m);
   o.broadcast = true;
   out.push_back(std::move(o));
-  gate_.expect(round, kReduce, everyone());
+  gate_.expect(round, step, everyone());
 }
-
-namespace {
-double dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a.array() * b.array()).sum();
-}
-}  // namespace
 
 void CertificateProtocol::after_vector(const MessageGate::Inbox& inbox,
                                        std::vector<OutgoingMessage>& out) {
@@ -232,7 +380,7 @@ void CertificateProtocol::after_vector(const MessageGate::Inbox& inbox,
   for (const auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), vn);
   if (iteration_ == 0) {
     Sx_ = apply(x_, vn);
-    broadcast(0, {dot(x_, x_), dot(x_, Sx_), local_max_diag_}, out);
+    broadcast(0, kReduce, {dot(x_, x_), dot(x_, Sx_), local_max_diag_}, out);
     return;
   }
   Sw_ = apply(w_, vn);
@@ -244,7 +392,7 @@ void CertificateProtocol::after_vector(const MessageGate::Inbox& inbox,
     for (int j = i; j < k; ++j) values.push_back(dot(*V[i], *V[j]));
   for (int i = 0; i < k; ++i)
     for (int j = i; j < k; ++j) values.push_back(dot(*V[i], *SV[j]));
-  broadcast(iteration_, values, out);
+  broadcast(iteration_, kReduce, values, out);
 }
 
 void CertificateProtocol::begin_iteration(std::vector<OutgoingMessage>& out) {
@@ -261,7 +409,11 @@ void CertificateProtocol::begin_iteration(std::vector<OutgoingMessage>& out) {
 void CertificateProtocol::finish(bool converged) {
   result_.converged = converged;
   result_.min_eigenvalue = theta_;
-  result_.certified = converged && theta_ >= -result_.tolerance;
+  // The interface test's verdict is a proof; LOBPCG after it only measured lambda_min (a
+  // Rayleigh quotient below -eta would contradict it: round-off, so not certified).
+  result_.certified = result_.interface_test ? interface_certified_ && theta_ >= -result_.tolerance
+                                             : converged && theta_ >= -result_.tolerance;
+  if (result_.interface_test) ++result_.iterations;
   result_.eigenvector = x_;
   done_ = true;
 }

@@ -19,6 +19,16 @@
 // Certified iff converged and theta >= -eta, eta = relative_tolerance * max(1, max diag Q)
 // (the centralized certificate's eta). theta is a Rayleigh quotient, so theta < -eta PROVES
 // that S is not PSD; the Ritz vector (each agent its block) is then the escape direction.
+//
+// When the blocks' interfaces are small (interface_max_coordinates), the agents first test
+// S + eta I > 0 exactly, by substructuring (interface_schur.hpp): one reduction (the global
+// eta), each agent's Schur complement on its interface to agent 0, agent 0's factorization of
+// the interface matrix and its verdict back: three message steps instead of LOBPCG's two an
+// iteration (city10000: 149 iterations). The verdict is a proof either way. Certified, the
+// reported lambda_min is the smallest Ritz value on the iterate's row space (S Y^T = 0 at a
+// critical point), refined by LOBPCG from there only when its residual is above the tolerance.
+// Not certified, LOBPCG runs as without the test, from the usual start, for the eigenvector
+// of the escape.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -45,6 +55,10 @@ struct DistributedCertificateOptions {
   int max_iterations = 300;  ///< LOBPCG iteration cap (one exchange + one reduction each). > 0
   CertificatePreconditioner preconditioner = CertificatePreconditioner::kBlockJacobi;
   std::uint64_t seed = 1;  ///< Start vector (hash of the global pose ids and this seed).
+  /// The exact interface test runs when the team's interface (poses with a cut measurement)
+  /// has at most this many coordinates ((d+1) a pose): agent 0 factors a matrix that large,
+  /// dense within each block's interface. 0 = LOBPCG only. >= 0.
+  int interface_max_coordinates = 1200;
   /// Throws InputError naming the bad field.
   void validate() const;
 };
@@ -57,7 +71,9 @@ struct DistributedCertificateResult {
   double residual = 0.0;        ///< ||S x - theta x|| at the end.
   double tolerance = 0.0;       ///< eta.
   double scale = 1.0;           ///< max(1, max diag Q).
-  int iterations = 0;           ///< LOBPCG iterations (each: one exchange, one reduction).
+  /// LOBPCG iterations (each: one exchange, one reduction), plus one for the interface test.
+  int iterations = 0;
+  bool interface_test = false;  ///< The exact interface test ran (its verdict decided).
   Eigen::MatrixXd eigenvector;  ///< 1 x (d+1)m: this agent's block of the unit Ritz vector.
 };
 
@@ -83,18 +99,23 @@ class CertificateProtocol : public AgentProcess {
   double ritz_value() const { return theta_; }
 
  private:
-  enum Step : std::uint32_t { kVector = 1, kReduce = 2 };
+  enum Step : std::uint32_t { kVector = 1, kReduce = 2, kSetup = 3, kSchur = 4, kVerdict = 5 };
   Eigen::MatrixXd apply(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
   Eigen::MatrixXd gradient(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn) const;
   void pump(std::vector<OutgoingMessage>& out);
   void send_boundary(const Eigen::MatrixXd& v, std::uint32_t round,
                      std::vector<OutgoingMessage>& out);
-  void broadcast(std::uint32_t round, const std::vector<double>& values,
+  void broadcast(std::uint32_t round, std::uint32_t step, const std::vector<double>& values,
                  std::vector<OutgoingMessage>& out);
   void begin_iteration(std::vector<OutgoingMessage>& out);
   void after_vector(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void after_reduce(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void finish(bool converged);
+  void build_preconditioner();
+  void start_lobpcg(std::vector<OutgoingMessage>& out);
+  void after_setup(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void after_schur(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  void after_verdict(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   std::vector<int> everyone() const;
 
   const AgentState& state_;
@@ -112,6 +133,10 @@ class CertificateProtocol : public AgentProcess {
   double theta_ = 0.0, rr_local_ = 0.0;
   bool has_p_ = false;
   bool done_ = false;
+  // The interface test: its verdict, and the Ritz pair on the iterate's row space.
+  bool interface_certified_ = false;
+  Eigen::VectorXd row_space_ritz_;  // coefficients over Y's rows
+  double row_space_theta_ = 0.0, row_space_residual_ = 0.0;
   DistributedCertificateResult result_;
 };
 

@@ -49,6 +49,8 @@ class BlockProblem {
   std::size_t num_measurements() const { return edges_.size(); }
   /// Q_BB: the quadratic form on the block's own poses.
   const SparseMatrix& data_matrix() const { return Q_bb_; }
+  /// Q_NB: the cut measurements' coupling, (d+1)k neighbour rows x (d+1)m owned columns.
+  const SparseMatrix& neighbor_matrix() const { return Q_nb_; }
   LiftedManifold manifold(int r) const { return LiftedManifold(r, d_, owned_.size()); }
 
   /// Fixes the neighbours' lifted poses (r x (d+1)k, neighbors() order). Must be called

@@ -1,0 +1,49 @@
+#pragma once
+// The exact distributed test of S + eta I > 0 by substructuring (non-overlapping domain
+// decomposition). Each block's poses split into its interface Gamma_b (poses with a measurement
+// to another block) and its interior I_b (the rest, coupled to nothing outside the block). Then
+//   S + eta I > 0  <=>  every block's S_BB + eta I > 0  and  Sigma > 0,
+//   Sigma = blockdiag_b(Schur_b) + (the cut measurements' coupling between interfaces),
+//   Schur_b = (S + eta I)_{Gamma_b Gamma_b} - S_{Gamma_b I_b} (S + eta I)_{I_b I_b}^-1 S_{I_b
+//   Gamma_b}
+// (the Schur complement lemma, applied to the interiors and then to each block's own
+// interface). Each agent computes Schur_b from one sparse factorization of its block with the
+// interface ordered last (Schur_b = L_GG L_GG^T, L_GG the factor's trailing block); Sigma is as
+// large as the interface, which is small when the partition's cut is. A proof like the
+// centralized certificate's factorization, not an iteration that may stop early.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/data_matrix.hpp>
+#include <vector>
+
+namespace tessera {
+
+/// One block's share of Sigma.
+struct InterfaceSchurBlock {
+  bool positive_definite = false;  ///< S_BB + eta I factored (else S + eta I is not PD).
+  std::vector<std::size_t> poses;  ///< Gamma_b: global ids, ascending.
+  Eigen::MatrixXd schur;           ///< Schur_b on poses' coordinates (pose-major).
+  /// Coupling entries to other blocks' interface poses, global coordinates (pose (d+1) + c),
+  /// each cut pose pair sent once: by the block owning the smaller pose id.
+  std::vector<Eigen::Index> rows, cols;
+  std::vector<double> values;
+};
+
+/// Block b's share. `lambda` is Lambda_B on the block's coordinates (owned order), `shift` is
+/// eta (> 0), `interface_poses` the block's interface (global ids, ascending, all owned).
+InterfaceSchurBlock local_interface_schur(const BlockProblem& problem, const SparseMatrix& lambda,
+                                          double shift,
+                                          const std::vector<std::size_t>& interface_poses);
+
+/// As a message's values and back (the layout of the values is private to these two).
+std::vector<double> encode_interface_schur(const InterfaceSchurBlock& block);
+/// Throws std::runtime_error when `values` are not an encoded block.
+InterfaceSchurBlock decode_interface_schur(const std::vector<double>& values);
+
+/// Every block's share (in block order) gives the verdict S + eta I > 0. d: the graph's
+/// dimension (a pose has d + 1 coordinates).
+bool interface_positive_definite(const std::vector<InterfaceSchurBlock>& blocks, int d);
+
+}  // namespace tessera
