@@ -76,7 +76,8 @@ struct GncCentralizedResult {
   double threshold_squared = 0;       ///< c^2 used.
   double final_mu = 0;                ///< mu of the last outer step (0: no step was needed).
   bool weights_converged = false;     ///< sum w(1 - w) fell below the tolerance.
-  /// Rejected measurements taken back by the re-check passes (RobustOptions::readmission_passes).
+  /// Rejected measurements taken back by the re-check passes (RobustOptions::readmission_passes)
+  /// and by kept return probes.
   std::size_t readmitted = 0;
   /// Kept measurements beyond the bound at an inlier set's solution, rejected by a re-check pass.
   std::size_t late_rejected = 0;
