@@ -7,6 +7,7 @@
 
 #include "agent/agent_entry.hpp"
 #include "agent/agent_options.hpp"
+#include "io/number_text.hpp"
 
 namespace tessera::dds {
 
@@ -15,12 +16,8 @@ std::vector<std::string> AgentOptions::argv() const {
       "--graph", graph, "--robots", std::to_string(robots), "--id", std::to_string(id)};
   const std::vector<std::string> s = session.argv();
   a.insert(a.end(), s.begin(), s.end());
-  if (round_timeout_s != AgentOptions{}.round_timeout_s) {
-    std::ostringstream t;
-    t.precision(17);
-    t << round_timeout_s;
-    a.insert(a.end(), {"--round-timeout", t.str()});
-  }
+  if (round_timeout_s != AgentOptions{}.round_timeout_s)
+    a.insert(a.end(), {"--round-timeout", exact_text(round_timeout_s)});
   if (!output.empty()) a.insert(a.end(), {"--output", output});
   if (!checkpoint_dir.empty()) a.insert(a.end(), {"--checkpoint-dir", checkpoint_dir});
   if (checkpoint_every != 1)

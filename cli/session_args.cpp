@@ -1,8 +1,8 @@
 #include "session_args.hpp"
 
-#include <cstdio>
 #include <tessera/util/input_error.hpp>
 
+#include "io/number_text.hpp"
 #include "transport/run_identity.hpp"
 
 namespace tessera::cli {
@@ -49,11 +49,7 @@ std::vector<std::string> session_argv(const transport::SessionOptions& o) {
   const transport::SessionOptions defaults;
   std::vector<std::string> out = {"--run-id", o.run_id};
   if (o.domain >= 0) out.insert(out.end(), {"--domain", std::to_string(o.domain)});
-  if (o.lease_s != defaults.lease_s) {
-    char buf[32];
-    std::snprintf(buf, sizeof(buf), "%.17g", o.lease_s);
-    out.insert(out.end(), {"--lease", buf});
-  }
+  if (o.lease_s != defaults.lease_s) out.insert(out.end(), {"--lease", exact_text(o.lease_s)});
   if (!o.initial_peers.empty()) {
     std::string list;
     for (const auto& ip : o.initial_peers) list += (list.empty() ? "" : ",") + ip;

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fstream>
 #include <optional>
+#include <tessera/certification/certificate_cap.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/io/tum_writer.hpp>
@@ -156,7 +157,7 @@ const char* kDistributedHelp =
     "                            certified; if that certificate does not hold, the rank is\n"
     "                            refined to this tolerance and certified again before a\n"
     "                            saddle escape (default 1e-4; 0 = escape without refining)\n"
-    "  --certify-iters K         certificate iteration cap (default 300)\n"
+    "  --certify-iters K         certificate iteration cap (default 1000)\n"
     "  --certify-residual T      certificate stops at Ritz residual <= T max(1, max diag Q)\n"
     "                            (default 1e-6)\n"
     "  --certify-precon block-jacobi|none   certificate preconditioner (default block-jacobi)\n"
@@ -289,7 +290,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
                                                    : CertificatePreconditioner::kBlockJacobi;
   }
   opt.staircase.certificate.max_iterations =
-      static_cast<int>(a.get_long("certify-iters", opt.staircase.certificate.max_iterations));
+      static_cast<int>(a.get_long("certify-iters", kCommandCertificateIterations));
   {
     const std::string refine = a.get_or("refine", "none");
     if (refine != "newton" && refine != "none")

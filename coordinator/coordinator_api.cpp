@@ -12,16 +12,11 @@
 
 #include "coordinator/coordinator_entry.hpp"
 #include "coordinator/coordinator_options.hpp"
+#include "io/number_text.hpp"
 
 namespace tessera::dds {
 
 namespace {
-
-std::string exact(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", x);
-  return buf;
-}
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
@@ -33,12 +28,12 @@ std::string slurp(const std::string& path) {
 }  // namespace
 
 std::vector<std::string> CoordinatorOptions::argv() const {
-  std::vector<std::string> a = {"--agents",      std::to_string(agents), "--partition",
-                                partition,       "--algorithm",          algorithm,
-                                "--run-timeout", exact(run_timeout_s)};
+  std::vector<std::string> a = {
+      "--agents",      std::to_string(agents),   "--partition", partition, "--algorithm", algorithm,
+      "--run-timeout", exact_text(run_timeout_s)};
   const std::vector<std::string> s = session.argv();
   a.insert(a.end(), s.begin(), s.end());
-  if (grad_tol > 0) a.insert(a.end(), {"--grad-tol", exact(grad_tol)});
+  if (grad_tol > 0) a.insert(a.end(), {"--grad-tol", exact_text(grad_tol)});
   if (max_rounds > 0) a.insert(a.end(), {"--max-rounds", std::to_string(max_rounds)});
   if (certify) a.push_back("--certify");
   if (!output.empty()) a.insert(a.end(), {"--output", output});

@@ -10,17 +10,12 @@
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
+#include "io/number_text.hpp"
 #include "launch/launch.hpp"
 
 namespace tessera::dds {
 
 namespace {
-
-std::string exact(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", x);
-  return buf;
-}
 
 // Whether `dir` holds the executables launch starts.
 bool holds_executables(const std::string& dir) {
@@ -75,8 +70,9 @@ std::string LaunchResult::full_report() const {
 std::vector<std::string> LaunchOptions::argv() const {
   std::vector<std::string> a;
   if (!graph.empty()) a.push_back(graph);
-  a.insert(a.end(), {"--agents", std::to_string(agents), "--algorithm", algorithm, "--partition",
-                     partition, "--grad-tol", exact(grad_tol), "--timeout", exact(timeout_s)});
+  a.insert(a.end(),
+           {"--agents", std::to_string(agents), "--algorithm", algorithm, "--partition", partition,
+            "--grad-tol", exact_text(grad_tol), "--timeout", exact_text(timeout_s)});
   if (!certify) a.push_back("--no-certify");
   if (!json.empty()) a.insert(a.end(), {"--json", json});
   if (!out.empty()) a.insert(a.end(), {"--out", out});

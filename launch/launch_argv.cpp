@@ -1,23 +1,11 @@
 #include "launch/launch_argv.hpp"
 
-#include <cstdio>
-#include <cstdlib>
-
+#include "io/number_text.hpp"
 #include "launch/forwarded_flags.hpp"
 
 namespace tessera::launch {
 
 namespace {
-
-// The shortest decimal text that reads back as `x` (the coordinator parses it again).
-std::string exact_text(double x) {
-  char buf[64];
-  for (int digits : {15, 16, 17}) {
-    std::snprintf(buf, sizeof(buf), "%.*g", digits, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
 
 // Appends the forwarded flags meant for `who` (in the table's order).
 void append_forwarded(const LaunchOptions& o, ForwardTo who, std::vector<std::string>& argv) {

@@ -3,8 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
 #include <tessera/io/g2o_writer.hpp>
 
 #include "random_graph.hpp"
@@ -12,13 +10,6 @@
 
 namespace tessera {
 namespace {
-
-std::string read_all(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 TEST(CentralizedCli, JsonNamesThePreconditionerThatRan) {
   const std::string dir = test::temp_dir();
@@ -32,7 +23,7 @@ TEST(CentralizedCli, JsonNamesThePreconditionerThatRan) {
                                 &out),
               0)
         << out;
-    const std::string j = read_all(dir + "/r.json");
+    const std::string j = test::read_text_file(dir + "/r.json");
     // A 2D graph's tangent factor is cheap: auto starts with it.
     const std::string expected = std::string(p) == "euclidean" ? "euclidean" : "tangent";
     EXPECT_NE(j.find("\"preconditioner\": \"" + expected + "\""), std::string::npos) << p << j;

@@ -27,6 +27,7 @@
 #include <thread>
 
 #include "dds_process_support.hpp"
+#include "initialization_threads.hpp"
 #include "runtime/initialization_stage.hpp"
 #include "runtime/known_inlier_start.hpp"
 #include "thread_exchange.hpp"
@@ -73,42 +74,14 @@ class LaggingChannel : public agent::ProtocolChannel {
   std::vector<std::thread> late_;
 };
 
-std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_of(const PoseGraph& g) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> s;
-  for (const auto& m : g.measurements)
-    s.emplace_back(static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j));
-  return s;
-}
-
 // Runs the stage for every agent in its own thread; returns the poses in global order.
 std::vector<Pose> run_stage(const PoseGraph& g, std::uint32_t N, const std::string& method,
                             std::size_t* leftover = nullptr) {
-  ThreadExchange ex(N);
-  std::vector<agent::RobotShare> shares;
-  for (std::uint32_t k = 0; k < N; ++k) shares.push_back(agent::robot_share(g, k, N));
-  std::vector<agent::InitializationResult> out(N);
-  std::vector<std::string> errors(N);
-  const auto structure = structure_of(g);
-  std::vector<std::thread> threads;
+  const StageThreadsRun run = run_initialization_threads(g, N, method);
   for (std::uint32_t k = 0; k < N; ++k)
-    threads.emplace_back([&, k] {
-      ThreadChannel ch(ex, k);
-      try {
-        out[k] =
-            agent::run_initialization_stage(shares[k], k, N, structure, method, "test", ch, 20.0);
-      } catch (const std::exception& e) {
-        errors[k] = e.what();
-      }
-    });
-  for (auto& t : threads) t.join();
-  std::vector<Pose> poses;
-  for (std::uint32_t k = 0; k < N; ++k) {
-    EXPECT_EQ(errors[k], "") << "agent " << k;
-    EXPECT_EQ(out[k].poses.size(), shares[k].end - shares[k].begin);
-    poses.insert(poses.end(), out[k].poses.begin(), out[k].poses.end());
-  }
-  if (leftover) *leftover = ex.left_over();
-  return poses;
+    EXPECT_EQ(run.results[k].poses.size(), run.shares[k].end - run.shares[k].begin);
+  if (leftover) *leftover = run.left_over;
+  return run.poses();
 }
 
 PoseGraph generated(TrajectoryKind kind, std::size_t poses, std::size_t robots,
@@ -119,14 +92,6 @@ PoseGraph generated(TrajectoryKind kind, std::size_t poses, std::size_t robots,
   o.num_robots = robots;
   o.seed = seed;
   return generate_pose_graph(o).graph;
-}
-
-void expect_identical(const std::vector<Pose>& a, const std::vector<Pose>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    ASSERT_TRUE(a[i].R == b[i].R) << "rotation of pose " << i;
-    ASSERT_TRUE(a[i].t == b[i].t) << "translation of pose " << i;
-  }
 }
 
 TEST(DdsInitializationStage, DistributedGivesCoresPosesBitForBit) {

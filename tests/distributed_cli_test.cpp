@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <fstream>
 #include <sstream>
 #include <tessera/io/g2o_writer.hpp>
 
@@ -12,13 +11,6 @@
 
 namespace tessera {
 namespace {
-
-std::string read_all(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::size_t occurrences(const std::string& text, const std::string& what) {
   std::size_t n = 0;
@@ -46,7 +38,7 @@ TEST(DistributedCli, JsonAndTrace) {
                             " --agents 3 --partition fast --reference --json " + dir +
                             "/r.json --trace " + dir + "/t.csv --out " + dir + "/o.g2o";
     ASSERT_EQ(test::run_command(cmd, &out), 0) << out;
-    const std::string j = read_all(dir + "/r.json");
+    const std::string j = test::read_text_file(dir + "/r.json");
     for (const char* key :
          {"\"algorithm\"", "\"graph\"", "\"poses\"", "\"edges\"", "\"d\"", "\"rank\"",
           "\"iterations\"", "\"grad_norm\"", "\"cost\"", "\"certified\": null", "\"wall_s\"",
@@ -54,10 +46,10 @@ TEST(DistributedCli, JsonAndTrace) {
           "\"bytes_exchanged\"", "\"rel_gap\"", "\"stop_reason\": \"grad_norm\""})
       EXPECT_NE(j.find(key), std::string::npos) << key << " in\n" << j;
     EXPECT_EQ(j.find("\"rel_gap\": null"), std::string::npos);
-    const std::string t = read_all(dir + "/t.csv");
+    const std::string t = test::read_text_file(dir + "/t.csv");
     EXPECT_EQ(t.rfind("round,cost,grad_norm,selected,restart,bytes", 0), 0u);
     EXPECT_GT(std::count(t.begin(), t.end(), '\n'), 2);
-    EXPECT_FALSE(read_all(dir + "/o.g2o").empty());
+    EXPECT_FALSE(test::read_text_file(dir + "/o.g2o").empty());
   }
 }
 
@@ -72,7 +64,7 @@ TEST(DistributedCli, EveryAlgorithmSharesTheSummaryHeadAndThePoseFileFormats) {
                             " --json " + dir + "/r.json --out " + dir + "/o.tum --tum " + dir +
                             "/t.tum";
     ASSERT_EQ(test::run_command(cmd, &out), 0) << out;
-    const std::string j = read_all(dir + "/r.json");
+    const std::string j = test::read_text_file(dir + "/r.json");
     EXPECT_EQ(j.find(std::string("\"algorithm\": \"") + alg + "\""), 4u) << j;
     std::size_t at = 0;
     for (const char* key :
@@ -85,17 +77,18 @@ TEST(DistributedCli, EveryAlgorithmSharesTheSummaryHeadAndThePoseFileFormats) {
     }
     // --out with ".tum" writes the same TUM text as --tum; a ".g2o" name writes vertices and
     // the graph's edges.
-    EXPECT_EQ(read_all(dir + "/o.tum"), read_all(dir + "/t.tum")) << alg;
-    EXPECT_EQ(read_all(dir + "/o.tum").find("VERTEX"), std::string::npos) << alg;
+    EXPECT_EQ(test::read_text_file(dir + "/o.tum"), test::read_text_file(dir + "/t.tum")) << alg;
+    EXPECT_EQ(test::read_text_file(dir + "/o.tum").find("VERTEX"), std::string::npos) << alg;
     ASSERT_EQ(test::run_command(test::bin("tessera") + " solve " + g + " --algorithm " + alg +
                                     " --out " + dir + "/o.g2o",
                                 &out),
               0)
         << out;
-    const std::string written = read_all(dir + "/o.g2o");
+    const std::string written = test::read_text_file(dir + "/o.g2o");
     EXPECT_EQ(written.rfind("VERTEX_SE2 0 ", 0), 0u) << alg;
     EXPECT_EQ(occurrences(written, "VERTEX_SE2 "), 60u) << alg;
-    EXPECT_EQ(occurrences(written, "EDGE_SE2 "), occurrences(read_all(g), "EDGE_SE2 ")) << alg;
+    EXPECT_EQ(occurrences(written, "EDGE_SE2 "), occurrences(test::read_text_file(g), "EDGE_SE2 "))
+        << alg;
   }
 }
 
@@ -120,7 +113,7 @@ TEST(DistributedCli, ParallelByDefaultSequentialOnRequest) {
   };
   // Selected blocks per round, from the trace's `selected` column ("0;2" = two blocks).
   auto most_selected = [&] {
-    std::istringstream t(read_all(dir + "/p.csv"));
+    std::istringstream t(test::read_text_file(dir + "/p.csv"));
     std::string line;
     std::getline(t, line);
     std::size_t most = 0;
@@ -136,10 +129,10 @@ TEST(DistributedCli, ParallelByDefaultSequentialOnRequest) {
   };
   std::string out;
   ASSERT_EQ(run("", &out), 0) << out;
-  EXPECT_NE(read_all(dir + "/p.json").find("\"parallel\": true"), std::string::npos);
+  EXPECT_NE(test::read_text_file(dir + "/p.json").find("\"parallel\": true"), std::string::npos);
   EXPECT_EQ(most_selected(), 2u);  // a chain of 4 blocks: classes {0,2} and {1,3}
   ASSERT_EQ(run("--sequential", &out), 0) << out;
-  EXPECT_NE(read_all(dir + "/p.json").find("\"parallel\": false"), std::string::npos);
+  EXPECT_NE(test::read_text_file(dir + "/p.json").find("\"parallel\": false"), std::string::npos);
   EXPECT_EQ(most_selected(), 1u);
   EXPECT_EQ(run("--parallel --sequential", &out), 2);
   EXPECT_NE(out.find("--sequential"), std::string::npos) << out;

@@ -10,11 +10,9 @@
 #include <string>
 #include <tessera/generate/generator.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
-#include <thread>
 #include <vector>
 
-#include "runtime/initialization_stage.hpp"
-#include "thread_exchange.hpp"
+#include "initialization_threads.hpp"
 
 namespace tessera::test {
 namespace {
@@ -28,21 +26,6 @@ PoseGraph grid(std::size_t poses, std::size_t robots) {
   return generate_pose_graph(o).graph;
 }
 
-void expect_identical(const std::vector<Pose>& a, const std::vector<Pose>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    ASSERT_TRUE(a[i].R == b[i].R) << "rotation of pose " << i;
-    ASSERT_TRUE(a[i].t == b[i].t) << "translation of pose " << i;
-  }
-}
-
-std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_of(const PoseGraph& g) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> s;
-  for (const auto& m : g.measurements)
-    s.emplace_back(static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j));
-  return s;
-}
-
 struct StageRun {
   std::vector<Pose> poses;  // every agent's, in global order
   std::vector<bool> early;  // InitializationResult::early of each agent
@@ -50,31 +33,11 @@ struct StageRun {
 
 // The chordal stage of N agents holding robot_share(g, k, N), agent 0 given `early` (or none).
 StageRun chordal_stage(const PoseGraph& g, std::uint32_t N, agent::EarlyChordal* early) {
-  ThreadExchange ex(N);
-  std::vector<agent::RobotShare> shares;
-  for (std::uint32_t k = 0; k < N; ++k) shares.push_back(agent::robot_share(g, k, N));
-  std::vector<agent::InitializationResult> out(N);
-  std::vector<std::string> errors(N);
-  const auto structure = structure_of(g);
-  std::vector<std::thread> threads;
-  for (std::uint32_t k = 0; k < N; ++k)
-    threads.emplace_back([&, k] {
-      ThreadChannel ch(ex, k);
-      try {
-        out[k] = agent::run_initialization_stage(shares[k], k, N, structure, "chordal", "test", ch,
-                                                 20.0, k == 0 ? early : nullptr);
-      } catch (const std::exception& e) {
-        errors[k] = e.what();
-      }
-    });
-  for (auto& t : threads) t.join();
+  const StageThreadsRun stage = run_initialization_threads(g, N, "chordal", early);
   StageRun run;
-  for (std::uint32_t k = 0; k < N; ++k) {
-    EXPECT_EQ(errors[k], "") << "agent " << k;
-    run.poses.insert(run.poses.end(), out[k].poses.begin(), out[k].poses.end());
-    run.early.push_back(out[k].early);
-  }
-  EXPECT_EQ(ex.left_over(), 0u);
+  run.poses = stage.poses();
+  for (const auto& r : stage.results) run.early.push_back(r.early);
+  EXPECT_EQ(stage.left_over, 0u);
   return run;
 }
 

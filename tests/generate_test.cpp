@@ -53,13 +53,6 @@ double residual_at_truth(const GeneratorResult& r) {
   return f;
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(Generator, SameSeedSameBytesOtherSeedOtherGraph) {
   const std::string dir = test::temp_dir();
   for (TrajectoryKind kind : kAllKinds) {
@@ -67,10 +60,10 @@ TEST(Generator, SameSeedSameBytesOtherSeedOtherGraph) {
     write_g2o(generate_pose_graph(options_for(kind, 300, 3, 5)).graph, dir + "/a.g2o");
     write_g2o(generate_pose_graph(options_for(kind, 300, 3, 5)).graph, dir + "/b.g2o");
     write_g2o(generate_pose_graph(options_for(kind, 300, 3, 6)).graph, dir + "/c.g2o");
-    const std::string a = read_text(dir + "/a.g2o");
+    const std::string a = test::read_text_file(dir + "/a.g2o");
     EXPECT_GT(a.size(), 1000u);
-    EXPECT_EQ(a, read_text(dir + "/b.g2o"));
-    EXPECT_NE(a, read_text(dir + "/c.g2o"));
+    EXPECT_EQ(a, test::read_text_file(dir + "/b.g2o"));
+    EXPECT_NE(a, test::read_text_file(dir + "/c.g2o"));
   }
 }
 
@@ -299,7 +292,7 @@ TEST(GenerateCommand, WritesGraphTruthAndJsonAndPrintsASummary) {
     EXPECT_EQ(first, double(lines));
   }
   EXPECT_EQ(lines, 120u);
-  const std::string json = read_text(dir + "/s.json");
+  const std::string json = test::read_text_file(dir + "/s.json");
   EXPECT_NE(json.find("\"poses\": 120,"), std::string::npos) << json;
   EXPECT_NE(json.find("\"edges\": " + std::to_string(g.num_measurements()) + ","),
             std::string::npos)
@@ -323,7 +316,7 @@ TEST(GenerateCommand, GeneratedGraphsAreSolvedAndCertified) {
                                 &out),
               0)
         << out;
-    const std::string json = read_text(dir + "/s.json");
+    const std::string json = test::read_text_file(dir + "/s.json");
     EXPECT_NE(json.find("\"certified\": true"), std::string::npos) << json;
   }
 }
@@ -333,8 +326,8 @@ TEST(GenerateCommand, SameCommandSameBytes) {
   const std::string args = " generate --kind city --poses 300 --robots 2 --seed 4 --out ";
   ASSERT_EQ(test::run_command(tessera() + args + dir + "/a.g2o", nullptr), 0);
   ASSERT_EQ(test::run_command(tessera() + args + dir + "/b.g2o", nullptr), 0);
-  EXPECT_EQ(read_text(dir + "/a.g2o"), read_text(dir + "/b.g2o"));
-  EXPECT_EQ(read_text(dir + "/a.g2o").rfind("VERTEX_SE2 0 ", 0), 0u);
+  EXPECT_EQ(test::read_text_file(dir + "/a.g2o"), test::read_text_file(dir + "/b.g2o"));
+  EXPECT_EQ(test::read_text_file(dir + "/a.g2o").rfind("VERTEX_SE2 0 ", 0), 0u);
 }
 
 TEST(GenerateCommand, HelpAndBadInput) {

@@ -326,5 +326,58 @@ TEST(GncDistributed, BadProbeOptionsNameTheField) {
   }
 }
 
+// Before the final solve the kept set's fresh start is voted once more
+// (GncDistributedOptions::final_kept_set_start). Where the passes ended on a solution of the kept
+// set, that solution costs less over the kept set than any fresh start, so the vote keeps it: the
+// run takes the same steps to the same answer, and pays only the vote's gather in bytes.
+TEST(GncDistributed, TheLastFreshStartVoteKeepsASolvedKeptSet) {
+  const GeneratorResult dirty = flexible_city(0.25, OutlierKind::kRandom, 1);
+  const std::vector<int> blocks = robots_as_blocks(dirty);
+  GncDistributedOptions o = irbcd_gnc();
+  o.solver.certify = true;
+  o.final_kept_set_start = false;
+  const GncDistributedResult without = solve_gnc_distributed(dirty.graph, blocks, o);
+  o.final_kept_set_start = true;
+  const GncDistributedResult with = solve_gnc_distributed(dirty.graph, blocks, o);
+  ASSERT_EQ(with.rejected, dirty.outliers);
+  EXPECT_EQ(with.rejected, without.rejected);
+  EXPECT_EQ(with.total_rounds, without.total_rounds);
+  EXPECT_EQ(with.readmitted, without.readmitted);
+  EXPECT_EQ(with.final_solve.cost, without.final_solve.cost);
+  EXPECT_TRUE(with.final_solve.certified.value_or(false));
+  EXPECT_GT(with.total_bytes, without.total_bytes);
+}
+
+// The same vote where the passes end on a rough iterate: with weak solves (block updates of 4
+// unpreconditioned tCG iterations, one round per GNC step and per pass, two passes) the passes
+// judge the set on an iterate far from the kept set's solution and leave true closures cut.
+// Over the kept set the fresh start then costs less than that iterate, wins the vote, and the
+// passes, run again from it, take those closures back: exactly the wrong closures go.
+TEST(GncDistributed, TheLastFreshStartVoteReplacesARoughIterateAndThePassesTakeBackTrueClosures) {
+  const GeneratorResult dirty = grid_with_outliers(0.5, 3);
+  const std::vector<int> blocks = robots_as_blocks(dirty);
+  GncDistributedOptions o = irbcd_gnc();
+  o.solver.certify = true;
+  o.solver.block_update.max_inner_iterations = 4;
+  o.solver.block_update.precondition = false;
+  o.robust.inner_max_rounds = 1;
+  o.robust.recheck_max_rounds = 1;
+  o.robust.readmission_passes = 2;
+  o.robust.recheck_probes = 0;
+  o.final_kept_set_start = false;
+  const GncDistributedResult without = solve_gnc_distributed(dirty.graph, blocks, o);
+  o.final_kept_set_start = true;
+  const GncDistributedResult with = solve_gnc_distributed(dirty.graph, blocks, o);
+
+  EXPECT_GT(without.rejected.size(), dirty.outliers.size());  // true closures stay cut
+  EXPECT_TRUE(std::includes(without.rejected.begin(), without.rejected.end(),
+                            dirty.outliers.begin(), dirty.outliers.end()));
+  EXPECT_EQ(with.rejected, dirty.outliers);
+  EXPECT_GT(with.readmitted, without.readmitted);
+  EXPECT_TRUE(with.final_solve.certified.value_or(false));
+  const double fstar = solve_centralized(grid_with_outliers(0.0, 3).graph).cost;
+  EXPECT_NEAR(with.final_solve.cost, fstar, 1e-6 * fstar);
+}
+
 }  // namespace
 }  // namespace tessera

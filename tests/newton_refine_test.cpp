@@ -9,30 +9,23 @@
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/distributed/newton_refine.hpp>
-#include <tessera/generate/generator.hpp>
 #include <tessera/online/live_blocks.hpp>
 #include <tessera/partition/sequential_partition.hpp>
 #include <tessera/problem/lifting.hpp>
-#include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
+#include "refine_harness.hpp"
+#include "test_support.hpp"
+
 namespace tessera {
 namespace {
 
-// A long 3D chain with 4 loop closures (like parking-garage: the rounds' slow modes are the
-// chain's bending), small enough for a unit test. With 4 agents the rounds stop at gradient
-// 0.01 1.5e-5 above f* (159 rounds).
+// The refinement tests' chain (refine_harness.hpp) at 600 poses. With 4 agents the rounds stop
+// at gradient 0.01 1.5e-5 above f* (159 rounds).
 PoseGraph long_chain() {
-  GeneratorOptions g;
-  g.kind = TrajectoryKind::kGrid3d;
-  g.num_poses = 600;
-  g.max_loop_closures = 4;
-  g.rotation_noise = 0.1;
-  g.translation_noise = 1.0;
-  g.seed = 3;
-  return generate_pose_graph(g).graph;
+  return test::refine_chain(600, 3);
 }
 
 DistributedOptions refined(bool on) {
@@ -42,18 +35,10 @@ DistributedOptions refined(bool on) {
   return o;
 }
 
-// f* to round-off (the centralized solver's gradient stop): its default stop may end ~1e-7 above
-// f* on long chains like this one, which is not what the refinement is measured against.
-double tight_optimum(const PoseGraph& g) {
-  CentralizedOptions o;
-  o.stop = CentralizedStop::kGradient;
-  return solve_centralized(g, o).cost;
-}
-
 TEST(NewtonRefine, ReachesTheCentralizedOptimumWhereTheRoundsStopShortOfIt) {
   const PoseGraph g = long_chain();
   const std::vector<int> parts = sequential_partition(g.num_poses, 4);
-  const double fstar = tight_optimum(g);
+  const double fstar = test::tight_optimum(g);
   const DistributedResult plain = solve_distributed(g, parts, refined(false));
   const DistributedResult newton = solve_distributed(g, parts, refined(true));
   // The same rounds first (the refinement starts where the plain run stops).
@@ -84,17 +69,7 @@ TEST(NewtonRefine, ReachesTheCentralizedOptimumWhereTheRoundsStopShortOfIt) {
 TEST(NewtonRefine, EveryAgentTakesTheSameStepsInAnyDeliveryOrder) {
   const PoseGraph g = long_chain();
   const std::vector<int> parts = sequential_partition(g.num_poses, 3);
-  DistributedOptions fifo = refined(true);
-  DistributedOptions shuffled = fifo;
-  shuffled.delivery = DeliveryOrder::kShuffled;
-  shuffled.delivery_seed = 11;
-  const DistributedResult a = solve_distributed(g, parts, fifo);
-  const DistributedResult b = solve_distributed(g, parts, shuffled);
-  ASSERT_EQ(a.refines.size(), 1u);
-  ASSERT_EQ(b.refines.size(), 1u);
-  EXPECT_EQ(a.refines[0].cg_iterations, b.refines[0].cg_iterations);
-  EXPECT_EQ(a.refines[0].cost, b.refines[0].cost);  // bit for bit: sums in agent-id order
-  EXPECT_EQ(a.X, b.X);
+  test::expect_same_refinement_in_any_delivery_order(g, parts, refined(true), 11);
 }
 
 TEST(NewtonRefine, RunsAfterEachSolveStageOfTheCertifiedSequenceAndKeepsTheCertificate) {
@@ -178,14 +153,7 @@ TEST(NewtonRefine, WithoutRefactoringEveryStepABlockKeepsTheFactorItHolds) {
 }
 
 TEST(NewtonRefineOptions, ValidateNamesTheBadField) {
-  auto message = [](NewtonRefineOptions o) {
-    try {
-      o.validate();
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto message = [](const NewtonRefineOptions& o) { return test::validation_message(o); };
   NewtonRefineOptions o;
   EXPECT_EQ(message(o), "");
   o.grad_norm_tol = 0;

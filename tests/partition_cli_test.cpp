@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <sstream>
 #include <string>
 
@@ -11,6 +10,7 @@
 namespace {
 
 using tessera::test::bin;
+using tessera::test::read_text_file;
 using tessera::test::run_command;
 using tessera::test::write_file;
 
@@ -19,13 +19,6 @@ std::string chain_g2o(int n) {
   std::ostringstream s;
   for (int v = 0; v + 1 < n; ++v) s << "EDGE_SE2 " << v << " " << v + 1 << " 1 0 0.1 1 0 0 1 0 1\n";
   for (int v = 10; v < n; v += 10) s << "EDGE_SE2 " << v - 7 << " " << v << " 0 1 0 1 0 0 1 0 1\n";
-  return s.str();
-}
-
-std::string read_all(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
   return s.str();
 }
 
@@ -43,7 +36,7 @@ TEST(PartitionCli, G2oInputWritesAssignmentAndJson) {
             0)
       << out;
   EXPECT_NE(out.find("cut edges:"), std::string::npos) << out;
-  std::istringstream lines(read_all(dir + "/p.txt"));
+  std::istringstream lines(read_text_file(dir + "/p.txt"));
   int count = 0, block;
   while (lines >> block) {
     EXPECT_GE(block, 0);
@@ -51,7 +44,7 @@ TEST(PartitionCli, G2oInputWritesAssignmentAndJson) {
     ++count;
   }
   EXPECT_EQ(count, 60);
-  const std::string json = read_all(dir + "/p.json");
+  const std::string json = read_text_file(dir + "/p.json");
   for (const char* key : {"\"parts\": 4", "\"preset\": \"eco\"", "\"cut_edges\":", "\"cut_pairs\":",
                           "\"max_block_ratio\":", "\"cvolume\":", "\"time_ms\":",
                           "\"block_sizes\":", "\"imbalance\":", "\"n\": 60", "\"trace\":"})
@@ -69,7 +62,7 @@ TEST(PartitionCli, ObjectiveRoundsReportsTheBlockAdjacencyGraph) {
       0)
       << out;
   EXPECT_NE(out.find("colours (objective rounds)"), std::string::npos) << out;
-  const std::string json = read_all(dir + "/p.json");
+  const std::string json = read_text_file(dir + "/p.json");
   for (const char* key : {"\"objective\": \"rounds\"",
                           "\"colours\":", "\"adjacent_block_pairs\":", "\"phase\": \"colours\""})
     EXPECT_NE(json.find(key), std::string::npos) << key << "\n" << json;
@@ -84,7 +77,7 @@ TEST(PartitionCli, IslandsOptionSetsTheSearchCount) {
   ASSERT_EQ(
       partition(g + " --parts 3 --preset highest --islands 4 --json " + dir + "/p.json", &out), 0)
       << out;
-  const std::string json = read_all(dir + "/p.json");
+  const std::string json = read_text_file(dir + "/p.json");
   EXPECT_NE(json.find("\"islands\": 4"), std::string::npos) << json;
   EXPECT_NE(json.find("island 3:"), std::string::npos) << json;
   EXPECT_NE(json.find("island 4: short"), std::string::npos) << json;  // the short island

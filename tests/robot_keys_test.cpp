@@ -6,7 +6,6 @@
 
 #include <Eigen/Dense>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <tessera/graph/input_frame.hpp>
@@ -20,11 +19,14 @@
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
+#include "g2o_text.hpp"
 #include "test_support.hpp"
 
 namespace {
 
 using namespace tessera;
+using tessera::test::expect_g2o_error;
+using tessera::test::read_test_g2o;
 using tessera::test::temp_dir;
 using tessera::test::write_file;
 
@@ -60,31 +62,8 @@ std::string two_robot_text() {
   return t;
 }
 
-G2oReadResult read(const std::string& text, const G2oReadOptions& options = {}) {
-  return read_g2o_text(text, "t.g2o", options);
-}
-
-void expect_error(const std::string& text, const std::string& where, const std::string& problem,
-                  const G2oReadOptions& options = {}) {
-  try {
-    read(text, options);
-    ADD_FAILURE() << "no error for input:\n" << text;
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.rfind(where, 0), 0u) << "message: " << msg;
-    EXPECT_NE(msg.find(problem), std::string::npos) << "message: " << msg;
-  }
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 TEST(RobotKeys, GtsamKeysAreDetectedAndNumberedByRobotThenIndex) {
-  const auto r = read(two_robot_text());
+  const auto r = read_test_g2o(two_robot_text());
   const PoseGraph& g = r.graph;
   const PoseKeys& keys = r.keys;
   ASSERT_EQ(g.num_poses, 6u);
@@ -105,23 +84,23 @@ TEST(RobotKeys, GtsamKeysAreDetectedAndNumberedByRobotThenIndex) {
 
 TEST(RobotKeys, LargestKeyAndPlainChoiceAreAccepted) {
   // 'a' << 56 is 6989586621679009792, the id the reader used to refuse.
-  const auto r = read(edge2(6989586621679009792ull, 6989586621679009793ull));
+  const auto r = read_test_g2o(edge2(6989586621679009792ull, 6989586621679009793ull));
   EXPECT_EQ(r.keys.id(0), 6989586621679009792ull);
   G2oReadOptions plain;
   plain.keys = KeyScheme::kPlain;
-  const auto p = read(two_robot_text(), plain);
+  const auto p = read_test_g2o(two_robot_text(), plain);
   EXPECT_EQ(p.keys.num_robots(), 1u);
   EXPECT_EQ(p.keys.scheme, KeyScheme::kPlain);
   // The largest 64-bit id is a valid (plain) id.
-  EXPECT_EQ(read(edge2(0, 18446744073709551615ull)).keys.id(1), 18446744073709551615ull);
+  EXPECT_EQ(read_test_g2o(edge2(0, 18446744073709551615ull)).keys.id(1), 18446744073709551615ull);
 }
 
 TEST(RobotKeys, LabeledKeysTakeTheRobotFromBits48To55) {
   auto labeled = [](char robot, std::uint64_t k) {
     return std::uint64_t{'x'} << 56 | std::uint64_t(static_cast<unsigned char>(robot)) << 48 | k;
   };
-  const auto r =
-      read(edge2(labeled('a', 0), labeled('a', 1)) + edge2(labeled('a', 1), labeled('c', 0)));
+  const auto r = read_test_g2o(edge2(labeled('a', 0), labeled('a', 1)) +
+                               edge2(labeled('a', 1), labeled('c', 0)));
   EXPECT_EQ(r.keys.scheme, KeyScheme::kGtsamLabeled);
   EXPECT_EQ(r.keys.robot_names, (std::vector<std::string>{"a", "c"}));
   EXPECT_EQ(r.keys.index_in_robot(1), 1u);
@@ -130,21 +109,22 @@ TEST(RobotKeys, LabeledKeysTakeTheRobotFromBits48To55) {
 TEST(RobotKeysErrors, BadKeyUnderGtsamNamesTheLine) {
   G2oReadOptions gtsam;
   gtsam.keys = KeyScheme::kGtsam;
-  expect_error(edge2(key('a', 0), key('a', 1)) + edge2(key('a', 1), 7),
-               "t.g2o:2: ", "pose id j '7' is not a GTSAM key (--keys gtsam)", gtsam);
+  expect_g2o_error(edge2(key('a', 0), key('a', 1)) + edge2(key('a', 1), 7),
+                   "t.g2o:2: ", "pose id j '7' is not a GTSAM key (--keys gtsam)", gtsam);
   // Without --keys gtsam the same file is plain ids (one robot).
-  EXPECT_EQ(read(edge2(key('a', 0), key('a', 1)) + edge2(key('a', 1), 7)).keys.num_robots(), 1u);
+  EXPECT_EQ(
+      read_test_g2o(edge2(key('a', 0), key('a', 1)) + edge2(key('a', 1), 7)).keys.num_robots(), 1u);
 }
 
 TEST(RobotKeysErrors, DuplicateKeyNamesBothLines) {
-  expect_error(vertex2(key('a', 0), 0, 0, 0) + vertex2(key('b', 0), 0, 0, 0) +
-                   vertex2(key('a', 0), 1, 0, 0) + edge2(key('a', 0), key('b', 0)),
-               "t.g2o:3: ", "duplicate VERTEX id 6989586621679009792 (first on line 1)");
+  expect_g2o_error(vertex2(key('a', 0), 0, 0, 0) + vertex2(key('b', 0), 0, 0, 0) +
+                       vertex2(key('a', 0), 1, 0, 0) + edge2(key('a', 0), key('b', 0)),
+                   "t.g2o:3: ", "duplicate VERTEX id 6989586621679009792 (first on line 1)");
 }
 
 TEST(RobotKeys, FixChoosesTheAnchorAndTheOutputKeepsItsVertexValue) {
   const std::string text = two_robot_text() + "FIX " + std::to_string(key('b', 1)) + "\n";
-  const G2oReadResult r = read(text);
+  const G2oReadResult r = read_test_g2o(text);
   const PoseGraph& g = r.graph;
   ASSERT_TRUE(r.keys.fixed.has_value());
   EXPECT_EQ(*r.keys.fixed, 4u);
@@ -164,14 +144,15 @@ TEST(RobotKeys, FixChoosesTheAnchorAndTheOutputKeepsItsVertexValue) {
 }
 
 TEST(RobotKeysErrors, FixOfAnUnknownPoseNamesTheLine) {
-  expect_error(edge2(0, 1) + "FIX 5\n", "t.g2o:2: ", "FIX names pose 5");
+  expect_g2o_error(edge2(0, 1) + "FIX 5\n", "t.g2o:2: ", "FIX names pose 5");
 }
 
 TEST(RobotKeys, WrittenGraphKeepsTheInputIdsAndFix) {
-  const G2oReadResult r = read(two_robot_text() + "FIX " + std::to_string(key('a', 0)) + "\n");
+  const G2oReadResult r =
+      read_test_g2o(two_robot_text() + "FIX " + std::to_string(key('a', 0)) + "\n");
   const std::string path = temp_dir() + "/out.g2o";
   write_g2o(r.graph, r.keys, r.graph.initial, path);
-  const std::string text = read_text(path);
+  const std::string text = test::read_text_file(path);
   EXPECT_NE(text.find("VERTEX_SE2 " + std::to_string(key('b', 2)) + " "), std::string::npos);
   EXPECT_NE(text.find("FIX " + std::to_string(key('a', 0))), std::string::npos);
   const G2oReadResult back = read_g2o_file(path);
@@ -180,12 +161,13 @@ TEST(RobotKeys, WrittenGraphKeepsTheInputIdsAndFix) {
   EXPECT_EQ(back.keys.fixed, r.keys.fixed);
   // One TUM file: the key as timestamp, exactly (no double rounding of a 64-bit id).
   write_tum(r.graph.initial, r.keys, path + ".tum");
-  EXPECT_EQ(read_text(path + ".tum").rfind(std::to_string(key('a', 0)) + " 0 0 0 0 0 0 1\n", 0),
+  EXPECT_EQ(test::read_text_file(path + ".tum")
+                .rfind(std::to_string(key('a', 0)) + " 0 0 0 0 0 0 1\n", 0),
             0u);
 }
 
 TEST(RobotKeys, SummaryCountsPosesOdometryAndClosuresPerRobot) {
-  const G2oReadResult r = read(two_robot_text());
+  const G2oReadResult r = read_test_g2o(two_robot_text());
   const RobotSummary s = summarize_robots(r.graph, r.keys);
   ASSERT_EQ(s.robots.size(), 2u);
   EXPECT_EQ(s.robots[0].name, "a");
@@ -201,33 +183,33 @@ TEST(RobotKeys, SummaryCountsPosesOdometryAndClosuresPerRobot) {
 }
 
 TEST(RobotKeys, SequentialBaselineOfAMultiRobotFileIsEachRobotItsPoses) {
-  const G2oReadResult r = read(two_robot_text());
+  const G2oReadResult r = read_test_g2o(two_robot_text());
   const auto parts = robot_partition(r.keys, 6, 2);
   ASSERT_TRUE(parts.has_value());
   EXPECT_EQ(*parts, (std::vector<int>{0, 0, 0, 1, 1, 1}));
   EXPECT_FALSE(robot_partition(r.keys, 6, 3).has_value());  // not one block per robot
-  EXPECT_FALSE(robot_partition(read(edge2(0, 1) + edge2(1, 2)).keys, 3, 2).has_value());
+  EXPECT_FALSE(robot_partition(read_test_g2o(edge2(0, 1) + edge2(1, 2)).keys, 3, 2).has_value());
 }
 
 TEST(RobotTrajectories, OneTumFilePerRobotWithIndicesOrStamps) {
-  G2oReadResult r = read(two_robot_text());
+  G2oReadResult r = read_test_g2o(two_robot_text());
   const PoseGraph& g = r.graph;
   const std::string dir = temp_dir() + "/tum";
   auto files = write_robot_trajectories(g, r.keys, g.initial, dir);
   ASSERT_EQ(files.size(), 2u);
   EXPECT_EQ(files[1], dir + "/robot_b.tum");
-  std::string b = read_text(files[1]);
+  std::string b = test::read_text_file(files[1]);
   EXPECT_NE(b.find(kTumIndexStampsNote), std::string::npos);
   EXPECT_NE(b.find("\n2 2 5 0 0 0 0 1\n"), std::string::npos) << b;
   r.keys.stamps = {10, 10.5, 11, 20, 20.25, 20.5};
   files = write_robot_trajectories(g, r.keys, g.initial, dir);
-  b = read_text(files[1]);
+  b = test::read_text_file(files[1]);
   EXPECT_NE(b.find("\n20.5 2 5 0 0 0 0 1\n"), std::string::npos) << b;
   EXPECT_EQ(b.find(kTumIndexStampsNote), std::string::npos);
 }
 
 TEST(Stamps, ByIdOrByOrder) {
-  const G2oReadResult r = read(two_robot_text());
+  const G2oReadResult r = read_test_g2o(two_robot_text());
   const std::string dir = temp_dir();
   std::string by_id = "# id stamp\n";
   for (int k = 2; k >= 0; --k)
@@ -244,7 +226,7 @@ TEST(Stamps, ByIdOrByOrder) {
 
 void expect_stamps_error(const std::string& text, const std::string& where,
                          const std::string& problem) {
-  const G2oReadResult r = read(two_robot_text());
+  const G2oReadResult r = read_test_g2o(two_robot_text());
   const std::string path = write_file(temp_dir(), "bad.txt", text);
   try {
     read_stamps_file(path, r.graph, r.keys);
@@ -273,9 +255,9 @@ TEST(StampsErrors, MismatchNamesFileAndLine) {
 TEST(Toro, TwoDRecordsReadLikeTheirG2oTwin) {
   // TORO's information order is xx xy yy tt xt yt; g2o's is xx xy xt yy yt tt.
   const auto toro =
-      read("VERTEX2 0 0 0 0\nVERTEX2 1 1 0 0.1\nEDGE2 0 1 1 0.2 0.1 10 1 20 5 0.5 0.25\n");
-  const auto g2o =
-      read("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0.1\nEDGE_SE2 0 1 1 0.2 0.1 10 1 0.5 20 0.25 5\n");
+      read_test_g2o("VERTEX2 0 0 0 0\nVERTEX2 1 1 0 0.1\nEDGE2 0 1 1 0.2 0.1 10 1 20 5 0.5 0.25\n");
+  const auto g2o = read_test_g2o(
+      "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0.1\nEDGE_SE2 0 1 1 0.2 0.1 10 1 0.5 20 0.25 5\n");
   EXPECT_EQ(toro.stats.format, "toro");
   EXPECT_EQ(g2o.stats.format, "g2o");
   const Measurement &a = toro.graph.measurements[0], &b = g2o.graph.measurements[0];
@@ -289,7 +271,7 @@ TEST(Toro, TwoDRecordsReadLikeTheirG2oTwin) {
 TEST(Toro, ThreeDRecordsUseRollPitchYawAndScaleTheRotationInformation) {
   // yaw = pi/2 about z; information diag(4, 4, 4, 3, 3, 3) on (x y z roll pitch yaw).
   const std::string info = " 4 0 0 0 0 0 4 0 0 0 0 4 0 0 0 3 0 0 3 0 3";
-  const auto r = read(
+  const auto r = read_test_g2o(
       "VERTEX3 0 0 0 0 0 0 0\nVERTEX3 1 1 2 3 0 0 1.5707963267948966\n"
       "EDGE3 0 1 1 2 3 0 0 1.5707963267948966" +
       info + "\n");
@@ -304,7 +286,8 @@ TEST(Toro, ThreeDRecordsUseRollPitchYawAndScaleTheRotationInformation) {
   // 3 / (2 trace(inv(12 I))) = 6, as the g2o twin "... 12 0 0 12 0 12" gives.
   EXPECT_DOUBLE_EQ(g.measurements[0].kappa, 6.0);
   // roll then pitch then yaw: R = Rz(yaw) Ry(pitch) Rx(roll).
-  const auto rp = read("EDGE3 0 1 0 0 0 0.3 -0.2 0.1" + info + "\n").graph.measurements[0].R;
+  const auto rp =
+      read_test_g2o("EDGE3 0 1 0 0 0 0.3 -0.2 0.1" + info + "\n").graph.measurements[0].R;
   const Eigen::Matrix3d expect = (Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()) *
                                   Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitY()) *
                                   Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))
@@ -313,13 +296,13 @@ TEST(Toro, ThreeDRecordsUseRollPitchYawAndScaleTheRotationInformation) {
 }
 
 TEST(ToroErrors, ShortRowMixedDialectsAndUnknownFormat) {
-  expect_error("VERTEX2 0 0 0 0\nEDGE2 0 1 1 0 0 10 0 10 5 0\n", "t.g2o:2: ",
-               "EDGE2 needs 11 values (i j dx dy dtheta Ixx Ixy Iyy Itt Ixt Iyt), found 10");
-  expect_error("EDGE3 0 1 0 0 0 0 0 0 1\n", "t.g2o:1: ", "EDGE3 needs 29 values");
-  expect_error("VERTEX2 0 0 0 0\nVERTEX_SE2 1 0 0 0\n",
-               "t.g2o:2: ", "mixed g2o and TORO records: VERTEX_SE2 here, but line 1 has VERTEX2");
-  expect_error("0.5 1 2 3 0 0 0 1\n", "t.g2o:1: ", "not a g2o file");
-  expect_error("0.5 1 2 3 0 0 0 1\n", "t.g2o:1: ", "nor a TORO file");
+  expect_g2o_error("VERTEX2 0 0 0 0\nEDGE2 0 1 1 0 0 10 0 10 5 0\n", "t.g2o:2: ",
+                   "EDGE2 needs 11 values (i j dx dy dtheta Ixx Ixy Iyy Itt Ixt Iyt), found 10");
+  expect_g2o_error("EDGE3 0 1 0 0 0 0 0 0 1\n", "t.g2o:1: ", "EDGE3 needs 29 values");
+  expect_g2o_error("VERTEX2 0 0 0 0\nVERTEX_SE2 1 0 0 0\n", "t.g2o:2: ",
+                   "mixed g2o and TORO records: VERTEX_SE2 here, but line 1 has VERTEX2");
+  expect_g2o_error("0.5 1 2 3 0 0 0 1\n", "t.g2o:1: ", "not a g2o file");
+  expect_g2o_error("0.5 1 2 3 0 0 0 1\n", "t.g2o:1: ", "nor a TORO file");
 }
 
 }  // namespace

@@ -15,12 +15,9 @@
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/generate/generator.hpp>
 #include <tessera/util/input_error.hpp>
-#include <thread>
 #include <vector>
 
-#include "runtime/initialization_stage.hpp"
-#include "runtime/local_share.hpp"
-#include "thread_exchange.hpp"
+#include "initialization_threads.hpp"
 
 namespace tessera::test {
 namespace {
@@ -102,57 +99,23 @@ TEST(SetupTurns, ABoundOutOfRangeIsRefusedByName) {
   EXPECT_THROW(setup_turn(5, 5, 2), std::invalid_argument);
 }
 
-std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_of(const PoseGraph& g) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> s;
-  for (const auto& m : g.measurements)
-    s.emplace_back(static_cast<std::uint32_t>(m.i), static_cast<std::uint32_t>(m.j));
-  return s;
-}
-
 // Runs the distributed initialisation of `g` over `n` agents in threads with turns of
 // `max_at_once`; returns the poses in global order and the order the local solves ended in.
 std::vector<Pose> run_with_turns(const PoseGraph& g, std::uint32_t n, std::uint32_t max_at_once,
                                  std::vector<std::uint32_t>* solve_order, std::size_t* leftover) {
-  ThreadExchange ex(n);
-  std::vector<agent::RobotShare> shares;
-  for (std::uint32_t k = 0; k < n; ++k) shares.push_back(agent::robot_share(g, k, n));
-  const auto structure = structure_of(g);
-  std::vector<agent::InitializationResult> out(n);
-  std::vector<std::string> errors(n);
   std::mutex mu;
-  std::vector<std::thread> threads;
-  for (std::uint32_t k = 0; k < n; ++k)
-    threads.emplace_back([&, k] {
-      ThreadChannel ch(ex, k);
-      agent::SetupTurnOptions turns;
-      turns.max_at_once = max_at_once;
-      turns.after_local_solve = [&, k] {
-        std::lock_guard<std::mutex> lock(mu);
-        solve_order->push_back(k);
-      };
-      try {
-        out[k] = agent::run_initialization_stage(shares[k], k, n, structure, "distributed", "test",
-                                                 ch, 20.0, nullptr, turns);
-      } catch (const std::exception& e) {
-        errors[k] = e.what();
-      }
-    });
-  for (auto& t : threads) t.join();
-  std::vector<Pose> poses;
-  for (std::uint32_t k = 0; k < n; ++k) {
-    EXPECT_EQ(errors[k], "") << "agent " << k;
-    poses.insert(poses.end(), out[k].poses.begin(), out[k].poses.end());
-  }
-  *leftover = ex.left_over();
-  return poses;
-}
-
-void expect_identical(const std::vector<Pose>& a, const std::vector<Pose>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    ASSERT_TRUE(a[i].R == b[i].R) << "rotation of pose " << i;
-    ASSERT_TRUE(a[i].t == b[i].t) << "translation of pose " << i;
-  }
+  const StageThreadsRun run =
+      run_initialization_threads(g, n, "distributed", nullptr, [&](std::uint32_t k) {
+        agent::SetupTurnOptions turns;
+        turns.max_at_once = max_at_once;
+        turns.after_local_solve = [&, k] {
+          std::lock_guard<std::mutex> lock(mu);
+          solve_order->push_back(k);
+        };
+        return turns;
+      });
+  *leftover = run.left_over;
+  return run.poses();
 }
 
 TEST(InitializationTurns, LocalSolvesEndInTurnOrderAndThePosesAreCores) {

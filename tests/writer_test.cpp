@@ -73,13 +73,6 @@ void expect_same_graph(const PoseGraph& a, const PoseGraph& b) {
   }
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(NumberText, ShortestRoundTripForm) {
   std::string s;
   append_number(s, 0.1);
@@ -118,7 +111,7 @@ TEST(G2oWriter, WithoutVerticesWritesOnlyEdges) {
   const std::string dir = test::temp_dir();
   const PoseGraph g = random_graph(3, 10, false);
   write_g2o(g, dir + "/g.g2o");
-  const std::string text = read_text(dir + "/g.g2o");
+  const std::string text = test::read_text_file(dir + "/g.g2o");
   EXPECT_EQ(text.find("VERTEX"), std::string::npos);
   EXPECT_EQ(text.rfind("EDGE_SE3:QUAT 0 1 ", 0), 0u) << text.substr(0, 80);
   expect_same_graph(g, read_g2o(dir + "/g.g2o"));
@@ -143,7 +136,7 @@ TEST(G2oWriter, LineFormatAndInformationMatrix) {
   g.measurements.push_back({0, 1, Eigen::Rotation2Dd(0.25).toRotationMatrix(), t, 7.0, 3.0});
   g.initial = {Pose::identity(2), Pose::identity(2)};
   write_g2o(g, dir + "/g.g2o");
-  EXPECT_EQ(read_text(dir + "/g.g2o"),
+  EXPECT_EQ(test::read_text_file(dir + "/g.g2o"),
             "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 0 0 0\nEDGE_SE2 0 1 1.5 -2 0.25 3 0 0 3 0 7\n");
 
   g.d = 3;
@@ -152,7 +145,7 @@ TEST(G2oWriter, LineFormatAndInformationMatrix) {
   g.measurements = {{0, 1, Eigen::Matrix3d::Identity(), t3, 7.0, 3.0}};
   g.initial.clear();
   write_g2o(g, dir + "/g3.g2o");
-  EXPECT_EQ(read_text(dir + "/g3.g2o"),
+  EXPECT_EQ(test::read_text_file(dir + "/g3.g2o"),
             "EDGE_SE3:QUAT 0 1 1 2 3 0 0 0 1 3 0 0 0 0 0 3 0 0 0 0 3 0 0 0 14 0 0 14 0 14\n");
 }
 
@@ -218,7 +211,8 @@ TEST(TumWriter, PlanarPosesLieAtZEqualsZeroRotatingAboutZ) {
   const std::vector<double> expected = {0, 1.25, -4, 0, 0, 0, std::sin(0.5), std::cos(0.5)};
   ASSERT_EQ(rows[0].size(), 8u);
   for (int c = 0; c < 8; ++c) EXPECT_NEAR(rows[0][c], expected[c], 1e-15) << c;
-  EXPECT_EQ(read_text(dir + "/t.tum").substr(read_text(dir + "/t.tum").find('\n') + 1),
+  EXPECT_EQ(test::read_text_file(dir + "/t.tum")
+                .substr(test::read_text_file(dir + "/t.tum").find('\n') + 1),
             "1 0 0 0 0 0 0 1\n");
 }
 

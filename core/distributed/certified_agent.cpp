@@ -120,28 +120,37 @@ void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& ou
   }
   emit(current_->start(), out);
   // Messages of this stage that arrived while we were still in an earlier one.
-  auto it = later_.find(stage);
-  if (it == later_.end()) return;
-  std::vector<ProtocolMessage> kept = std::move(it->second);
-  later_.erase(it);
-  for (auto& m : kept) {
+  for (const ProtocolMessage& m : kept_.take_steps(tag_phase(stage, 0), tag_phase(stage + 1, 0))) {
     if (current_->done()) break;
-    std::visit([](auto& x) { x.phase = step_of_phase(x.phase); }, m);
     dispatch(m, out);
   }
 }
 
+void CertifiedAgent::keep(const ProtocolMessage& message) {
+  // Keyed as the stage protocols' own gates key it (round, step, sender), so a second copy is
+  // refused here as it would be there.
+  const std::uint32_t sender = message_sender(message);
+  if (!kept_.add(static_cast<int>(sender), message_round(message), message_phase(message), message))
+    throw std::runtime_error("agent " + std::to_string(state_.id()) +
+                             ": duplicate message from agent " + std::to_string(sender));
+}
+
+void CertifiedAgent::to_current(const ProtocolMessage& message, std::vector<OutgoingMessage>& out) {
+  ProtocolMessage m = message;
+  std::visit([](auto& x) { x.phase = step_of_phase(x.phase); }, m);
+  emit(current_->handle(m), out);
+}
+
 void CertifiedAgent::dispatch(const ProtocolMessage& message, std::vector<OutgoingMessage>& out) {
-  if (stage_kind(stage_) == StageKind::kSolve && current_ != refine_.get() &&
-      NewtonRefineProtocol::is_refine_step(message_phase(message))) {
-    refine_early_.push_back(message);
+  const bool refine_step =
+      NewtonRefineProtocol::is_refine_step(step_of_phase(message_phase(message)));
+  if (stage_kind(stage_) == StageKind::kSolve && current_ != refine_.get() && refine_step) {
+    keep(message);  // until this stage's refinement begins
     return;
   }
   // The finished rounds' stragglers are of no use to the refinement.
-  if (refine_ && current_ == refine_.get() &&
-      !NewtonRefineProtocol::is_refine_step(message_phase(message)))
-    return;
-  emit(current_->handle(message), out);
+  if (refine_ && current_ == refine_.get() && !refine_step) return;
+  to_current(message, out);
 }
 
 std::size_t CertifiedAgent::messages_needed() const {
@@ -165,12 +174,10 @@ std::vector<OutgoingMessage> CertifiedAgent::handle(const ProtocolMessage& messa
     if (stage > stage_ + 3 * 64)
       throw std::runtime_error("agent " + std::to_string(state_.id()) +
                                ": message of an impossible stage " + std::to_string(stage));
-    later_[stage].push_back(message);
+    keep(message);
     return out;
   }
-  ProtocolMessage m = message;
-  std::visit([](auto& x) { x.phase = step_of_phase(x.phase); }, m);
-  dispatch(m, out);
+  dispatch(message, out);
   advance(out);
   return out;
 }
@@ -191,11 +198,11 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
             refine_ = std::make_unique<NewtonRefineProtocol>(state_, layout_, options_.refine);
             current_ = refine_.get();
             emit(refine_->start(), out);
-            std::vector<ProtocolMessage> early = std::move(refine_early_);
-            refine_early_.clear();
-            for (const auto& m : early) {
+            for (const ProtocolMessage& m :
+                 kept_.take_steps(tag_phase(stage_, NewtonRefineProtocol::kStatus),
+                                  tag_phase(stage_, NewtonRefineProtocol::kCoarse) + 1)) {
               if (current_->done()) break;
-              emit(current_->handle(m), out);
+              to_current(m, out);
             }
             continue;
           }

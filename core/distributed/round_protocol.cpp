@@ -8,8 +8,9 @@
 namespace tessera {
 namespace {
 
-std::uint64_t key(std::uint32_t round, ProtocolPhase phase) {
-  return (static_cast<std::uint64_t>(round) << 8) | static_cast<std::uint64_t>(phase);
+// A phase as the gate's step.
+std::uint32_t step_of(ProtocolPhase phase) {
+  return static_cast<std::uint32_t>(phase);
 }
 
 std::uint32_t u32(int x) {
@@ -120,7 +121,7 @@ std::vector<OutgoingMessage> RoundProtocol::resume(const ProtocolSnapshot& s) {
   trace_ = s.trace;
   done_ = false;
   stop_reason_.clear();
-  pending_.clear();
+  gate_ = MessageGate();
   const double elapsed = trace_.empty() ? 0.0 : trace_.back().elapsed_s;
   start_time_ = std::chrono::steady_clock::now() -
                 std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -144,8 +145,7 @@ std::vector<OutgoingMessage> RoundProtocol::handle(const ProtocolMessage& messag
     throw std::runtime_error("agent " + std::to_string(state_.id()) +
                              ": malformed message (sender " + std::to_string(sender) + ", phase " +
                              std::to_string(phase) + ")");
-  Inbox& inbox = pending_[key(round, static_cast<ProtocolPhase>(phase))];
-  if (!inbox.emplace(static_cast<int>(sender), message).second)
+  if (!gate_.add(static_cast<int>(sender), round, phase, message))
     throw std::runtime_error("agent " + std::to_string(state_.id()) +
                              ": duplicate message from agent " + std::to_string(sender));
   std::vector<OutgoingMessage> out;
@@ -154,42 +154,31 @@ std::vector<OutgoingMessage> RoundProtocol::handle(const ProtocolMessage& messag
 }
 
 void RoundProtocol::expect(std::uint32_t round, ProtocolPhase phase, std::vector<int> senders) {
-  wait_round_ = round;
   phase_ = phase;
-  wait_senders_ = std::move(senders);
+  gate_.expect(round, step_of(phase), std::move(senders));
 }
 
 std::size_t RoundProtocol::messages_needed() const {
   if (done_) return 0;
-  const auto it = pending_.find(key(wait_round_, phase_));
-  std::size_t missing = 0;
-  for (int s : wait_senders_)
-    if (it == pending_.end() || !it->second.count(s)) ++missing;
   // pump() leaves no complete step behind, so a running protocol always waits for one.
-  return std::max<std::size_t>(missing, 1);
+  return std::max<std::size_t>(gate_.missing().size(), 1);
 }
 
 std::optional<AwaitedMessages> RoundProtocol::awaited() const {
   if (done_) return std::nullopt;
   AwaitedMessages a;
-  a.round = wait_round_;
-  a.phase = static_cast<std::uint32_t>(phase_);
-  const auto it = pending_.find(key(wait_round_, phase_));
-  for (int s : wait_senders_)
-    if (it == pending_.end() || !it->second.count(s)) a.senders.push_back(u32(s));
-  std::sort(a.senders.begin(), a.senders.end());
+  a.round = gate_.round();
+  a.phase = gate_.step();
+  for (int s : gate_.missing()) a.senders.push_back(u32(s));
   if (a.senders.empty()) return std::nullopt;  // not after pump(); never a wait for nothing
   return a;
 }
 
 void RoundProtocol::pump(std::vector<OutgoingMessage>& out) {
   while (!done_) {
-    Inbox& inbox = pending_[key(wait_round_, phase_)];
-    for (int s : wait_senders_)
-      if (!inbox.count(s)) return;
-    Inbox taken = std::move(inbox);
-    pending_.erase(key(wait_round_, phase_));
-    complete(taken, out);
+    std::optional<Inbox> taken = gate_.take_ready();
+    if (!taken) return;
+    complete(*taken, out);
   }
 }
 
@@ -279,7 +268,7 @@ void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessag
         PoseBlockMessage t = coarse_terms_message(
             state_.id(), u32(round_), static_cast<std::uint32_t>(step), std::move(terms));
         if (state_.id() == kCoarseSolver) {
-          pending_[key(u32(round_), step)].emplace(state_.id(), std::move(t));
+          gate_.add(state_.id(), u32(round_), step_of(step), std::move(t));
         } else {
           OutgoingMessage o;
           o.message = std::move(t);
@@ -290,7 +279,7 @@ void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessag
       }
     }
     // Our own status goes straight into the inbox: the reduction then treats every agent alike.
-    pending_[key(u32(round_), phase)].emplace(state_.id(), m);
+    gate_.add(state_.id(), u32(round_), step_of(phase), m);
     OutgoingMessage o;
     o.message = m;
     o.broadcast = true;
@@ -328,7 +317,7 @@ void RoundProtocol::after_status(ProtocolPhase phase, const Inbox& inbox,
   if (restart) {
     // Back to Y^{k-1}; the same blocks redo a plain update from there. Round k's coarse
     // terms (gathered) are not used.
-    pending_.erase(key(u32(round_), ProtocolPhase::kCoarseTerms));
+    gate_.discard(u32(round_), step_of(ProtocolPhase::kCoarseTerms));
     ++restarts_;
     trace_.back().restart = true;
     --round_;

@@ -2,6 +2,8 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace tessera {
 
@@ -14,6 +16,15 @@ void append_number(std::string& out, double x) {
   char buf[32];
   auto res = std::to_chars(buf, buf + sizeof buf, x);
   out.append(buf, res.ptr);
+}
+
+std::string exact_text(double x) {
+  char buf[64];
+  for (int digits : {15, 16, 17}) {
+    std::snprintf(buf, sizeof(buf), "%.*g", digits, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
 }
 
 void append_integer(std::string& out, unsigned long long x) {

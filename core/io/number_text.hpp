@@ -11,6 +11,10 @@ namespace tessera {
 /// printf("%.17g") on large graphs. Non-finite values are written as "nan"/"inf"/"-inf".
 void append_number(std::string& out, double x);
 
+/// The shortest of x's 15, 16 and 17 significant-digit printf("%g") forms that strtod reads back
+/// to exactly x: for numbers on a child process's command line, which parses them again.
+std::string exact_text(double x);
+
 /// Appends a non-negative integer in decimal.
 void append_integer(std::string& out, unsigned long long x);
 

@@ -4,6 +4,8 @@
 #include <string>
 #include <tessera/manifold/lifted_manifold.hpp>
 
+#include "manifold/sym_product.hpp"
+
 namespace tessera {
 namespace {
 // d x d scratch matrices live on the stack (d <= 3): no heap traffic in per-pose loops.
@@ -66,11 +68,9 @@ void block_multiply_add(const double* C, const double* sym, Eigen::Index r, int 
 namespace {
 
 // tangent_project's loop for a fixed d and (R > 0) a fixed number of rows: the operations of
-// block_sym_product and block_multiply_add in the same order (bit-identical), unrolled. The
-// agents' updates run at r = d (their active rows), where this is most of a tCG iteration's
-// projections. The build's -O2 leaves fixed-count loops rolled (the scratch arrays then live in
-// memory); the unroll pragmas cut parking-garage's centralized solve from 14.0 to 11.5 G
-// instructions (here and in pose_kernels.cpp, block_problem.cpp), same results bit for bit.
+// block_sym_product and block_multiply_add in the same order (bit-identical), unrolled
+// (sym_product.hpp says why). The agents' updates run at r = d (their active rows), where this
+// is most of a tCG iteration's projections.
 template <int D, int R>
 void tangent_project_poses(const double* X, const double* V, Eigen::Index r_runtime, std::size_t n,
                            double* out) {
@@ -79,27 +79,15 @@ void tangent_project_poses(const double* X, const double* V, Eigen::Index r_runt
     const Eigen::Index offset = r * static_cast<Eigen::Index>((D + 1) * i);
     const double* A = X + offset;
     const double* B = V + offset;
-    double S[D * D], sym[D * D];
-#pragma GCC unroll 16
-    for (int a = 0; a < D; ++a)
-#pragma GCC unroll 16
-      for (int b = 0; b < D; ++b) {
-        double acc = 0.0;
-#pragma GCC unroll 16
-        for (Eigen::Index k = 0; k < r; ++k) acc += A[a * r + k] * B[b * r + k];
-        S[a * D + b] = acc;
-      }
-#pragma GCC unroll 16
-    for (int a = 0; a < D; ++a)
-#pragma GCC unroll 16
-      for (int b = 0; b < D; ++b) sym[a * D + b] = 0.5 * (S[a * D + b] + S[b * D + a]);
+    double sym[D][D];
+    sym_product<D, R>(A, B, r, sym);
     double* o0 = out + offset;
 #pragma GCC unroll 16
     for (int b = 0; b < D; ++b) {
       double* o = o0 + b * r;
 #pragma GCC unroll 16
       for (int a = 0; a < D; ++a) {
-        const double w = -1.0 * sym[a * D + b];
+        const double w = -1.0 * sym[a][b];
         const double* Ca = A + a * r;
 #pragma GCC unroll 16
         for (Eigen::Index k = 0; k < r; ++k) o[k] += w * Ca[k];

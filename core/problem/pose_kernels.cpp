@@ -1,6 +1,8 @@
 #include <stdexcept>
 #include <tessera/problem/pose_kernels.hpp>
 
+#include "manifold/sym_product.hpp"
+
 namespace tessera {
 namespace {
 
@@ -24,27 +26,6 @@ void dense_times_sparse(const double* X, Eigen::Index r, const SparseMatrix& Q, 
       acc += value[p] * ConstMap(X + r * static_cast<Eigen::Index>(inner[p]), r);
     Eigen::Map<Vec>(out + r * j, r) = scale * acc;
   }
-}
-
-// S = sym(A^T B) for the r x D column blocks A, B (column-major, leading dimension r).
-// The unroll pragmas: -O2 alone keeps these fixed-count loops rolled (see tangent_project_poses).
-template <int D, int R>
-inline void sym_product(const double* A, const double* B, Eigen::Index r, double (&S)[D][D]) {
-  const Eigen::Index rr = R > 0 ? R : r;
-  double P[D][D];
-#pragma GCC unroll 16
-  for (int a = 0; a < D; ++a)
-#pragma GCC unroll 16
-    for (int b = 0; b < D; ++b) {
-      double acc = 0.0;
-#pragma GCC unroll 16
-      for (Eigen::Index k = 0; k < rr; ++k) acc += A[a * rr + k] * B[b * rr + k];
-      P[a][b] = acc;
-    }
-#pragma GCC unroll 16
-  for (int a = 0; a < D; ++a)
-#pragma GCC unroll 16
-    for (int b = 0; b < D; ++b) S[a][b] = 0.5 * (P[a][b] + P[b][a]);
 }
 
 template <int D, int R>

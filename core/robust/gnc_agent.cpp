@@ -331,6 +331,17 @@ bool GncAgent::final_solve_runs() const {
 }
 
 void GncAgent::finish(std::vector<OutgoingMessage>& out) {
+  // Before the final solve (here or the caller's): is the passes' iterate worse over the kept
+  // set than the kept set's own fresh start (GncDistributedOptions::final_kept_set_start)? Then
+  // it is a fold, and the passes judged their set on it: they run again from the fresh start.
+  if (final_solve_runs() && fresh_start_ && options_.final_kept_set_start && !final_start_voted_ &&
+      !rejected_.empty()) {
+    final_start_voted_ = true;
+    final_start_vote_ = true;
+    require_kept_connected();
+    begin_exchange(Step::kKeptStart, out);
+    return;
+  }
   if (!final_solve_runs() || !final_solve_wanted_) {
     done_ = true;
     step_ = Step::kDone;
@@ -536,9 +547,18 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kCandidateVotes: {
       const auto [at_iterate, at_candidate] = exchange_->summed_votes();
-      if (at_candidate < at_iterate) state_->Y = exchange_->candidate();
+      const bool fresh = at_candidate < at_iterate;
+      if (fresh) state_->Y = exchange_->candidate();
       exchange_->candidate().resize(0, 0);
       exchange_->forget_candidate_neighbours();
+      if (final_start_vote_) {
+        final_start_vote_ = false;
+        if (!fresh) {
+          finish(out);  // the iterate stays: on to the final solve
+          return;
+        }
+        pass_ = 0;  // the passes again, with their own budget
+      }
       begin_inlier_pass(out);
       return;
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <tessera/certification/certificate_cap.hpp>
 #include <tessera/distributed/agent_factory.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
@@ -37,6 +38,7 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
   opt.rel_cost_decrease_tol = o.relative_cost_tolerance;
   opt.seed = o.seed;
   opt.certify = o.certify;
+  opt.staircase.certificate.max_iterations = kCommandCertificateIterations;
   opt.coarse.enabled = o.coarse_every > 0;
   if (o.coarse_every > 0) opt.coarse.every = static_cast<int>(o.coarse_every);
   if (o.coarse_aggregates > 0) {

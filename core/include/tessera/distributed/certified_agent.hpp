@@ -17,7 +17,6 @@
 
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -26,6 +25,7 @@
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/message_gate.hpp>
 #include <tessera/distributed/newton_refine.hpp>
 #include <tessera/distributed/protocol_snapshot.hpp>
 #include <tessera/distributed/round_protocol.hpp>
@@ -92,9 +92,14 @@ class CertifiedAgent : public AgentProcess {
              const ProtocolSnapshot* resume_from = nullptr);
   void advance(std::vector<OutgoingMessage>& out);
   void emit(std::vector<OutgoingMessage>&& sub, std::vector<OutgoingMessage>& out) const;
-  /// Hands a message of the current stage (step phase) to the running protocol; a solve
-  /// stage's refinement messages wait until its refinement runs.
+  /// Hands a message of the current stage (stage-tagged phase, as on the wire) to the running
+  /// protocol; a solve stage's refinement messages wait until its refinement runs.
   void dispatch(const ProtocolMessage& message, std::vector<OutgoingMessage>& out);
+  /// The running protocol's handle() of `message` with its stage taken off the phase.
+  void to_current(const ProtocolMessage& message, std::vector<OutgoingMessage>& out);
+  /// Keeps a message (stage-tagged phase) for a later stage, or for the current solve stage's
+  /// refinement; throws std::runtime_error on a second copy.
+  void keep(const ProtocolMessage& message);
   /// The current solve stage's gradient tolerance: the solver's own, or refine_tolerance()
   /// while refining an inconclusive certificate.
   double solve_tolerance() const;
@@ -108,11 +113,12 @@ class CertifiedAgent : public AgentProcess {
   std::unique_ptr<CertificateProtocol> certify_;
   std::unique_ptr<SaddleEscapeProtocol> escape_;
   std::unique_ptr<NewtonRefineProtocol> refine_;  // runs after the current solve stage
-  std::vector<ProtocolMessage> refine_early_;     // its messages that came before it began
   std::vector<NewtonRefineResult> refines_;
   AgentProcess* current_ = nullptr;
   Eigen::MatrixXd direction_;  // the last certificate's Ritz vector (own block)
-  std::map<std::uint32_t, std::vector<ProtocolMessage>> later_;  // by stage
+  // Messages that came early, by their stage-tagged phase: of later stages (from faster
+  // agents), and of the current solve stage's refinement before it begins.
+  MessageGate kept_;
   std::vector<SolveStageRecord> solves_;
   std::vector<CertifyStageRecord> certificates_;
   std::vector<EscapeStageRecord> escapes_;

@@ -32,6 +32,8 @@ class MessageGate {
   /// and ordered by step, round and sender: for a caller that forwards a whole stage to a
   /// protocol that waits for its own steps, instead of waiting for one step here.
   std::vector<ProtocolMessage> take_steps(std::uint32_t first, std::uint32_t last);
+  /// Drops the stored messages of step (round, step): for a step that will not be waited for.
+  void discard(std::uint32_t round, std::uint32_t step) { pending_.erase(key(round, step)); }
   std::uint32_t round() const { return round_; }
   std::uint32_t step() const { return step_; }
 

@@ -29,7 +29,6 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,6 +38,7 @@
 #include <tessera/distributed/block_selection.hpp>
 #include <tessera/distributed/coarse_correction.hpp>
 #include <tessera/distributed/local_rounds.hpp>
+#include <tessera/distributed/message_gate.hpp>
 #include <tessera/distributed/momentum.hpp>
 #include <tessera/distributed/rbcd.hpp>
 #include <tessera/distributed/round_history.hpp>
@@ -121,7 +121,7 @@ class RoundProtocol : public AgentProcess {
   const AgentState& state() const { return state_; }
 
  private:
-  using Inbox = std::map<int, ProtocolMessage>;  // by sender: processed in id order
+  using Inbox = MessageGate::Inbox;  // by sender: processed in id order
   void expect(std::uint32_t round, ProtocolPhase phase, std::vector<int> senders);
   void pump(std::vector<OutgoingMessage>& out);
   void complete(Inbox& inbox, std::vector<OutgoingMessage>& out);
@@ -150,10 +150,8 @@ class RoundProtocol : public AgentProcess {
   std::vector<int> neighbour_owner_;  // block of each neighbour copy slot (local rounds)
 
   int round_ = 0;
-  ProtocolPhase phase_ = ProtocolPhase::kInit;
-  std::uint32_t wait_round_ = 0;
-  std::vector<int> wait_senders_;
-  std::map<std::uint64_t, Inbox> pending_;
+  ProtocolPhase phase_ = ProtocolPhase::kInit;  // the step waited for (gate_.step())
+  MessageGate gate_;
   std::vector<int> selection_;
   double f_prev_ = 0.0, gsq_prev_ = 0.0;
   // Whether `rec` and the recent rounds show an iterate that no longer moves.

@@ -248,6 +248,8 @@ class GncAgent : public AgentProcess {
   std::uint32_t g_ = 0;              // GNC step
   std::uint32_t first_solve_g_ = 0;  // 1 after a start vote (step 0 is the vote's)
   bool fresh_start_ = false;         // the kept set's fresh start (kept_set_start, chordal)
+  bool final_start_voted_ = false;   // the vote before the final solve ran (once)
+  bool final_start_vote_ = false;    // the running candidate vote is that one
   std::vector<bool> dropped_;        // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
   GncSolveKind solve_kind_ = GncSolveKind::kGnc;
