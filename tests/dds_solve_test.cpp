@@ -231,7 +231,7 @@ TEST(DdsLaunch, StatusRelayFlagsExcludeEachOther) {
   EXPECT_NE(out.find("--status-relay and --no-status-relay"), std::string::npos) << out;
 }
 
-// The distributed rounding's translations (block-Jacobi pipelined PCG, relative residual 1e-12)
+// The distributed rounding's translations (two-level pipelined PCG, relative residual 1e-12)
 // are the direct solve's where that is hardest: kitti_02, a 4661-pose trajectory, 5 agents,
 // positions up to ~1.5 km from pose 0. The pipelined PCG stopped on its recurrence's residual
 // was 3e-6 m off; restarted from x until a residual computed from x is small enough, 1.3e-8 m

@@ -5,11 +5,14 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/util/input_error.hpp>
 #include <variant>
+
+#include "runtime/rounding_coarse.hpp"
 
 namespace tessera::agent {
 
@@ -59,6 +62,64 @@ std::vector<std::uint32_t> DistributedRounding::others() const {
   for (auto a : everyone_)
     if (a != self_) o.push_back(a);
   return o;
+}
+
+DistributedRounding::CoarseSums DistributedRounding::coarse_reduce(
+    std::uint32_t round, const double (&scalars)[3], const Eigen::MatrixXd& coupling,
+    const Eigen::RowVectorXd& own, const std::vector<std::uint32_t>& touched) {
+  // Entry k < N of the message: this agent's coupling row k, then (k = self) its own sum;
+  // entry N: the scalars.
+  const auto N = static_cast<std::uint32_t>(everyone_.size());
+  const Eigen::Index d = d_;
+  PoseBlockMessage msg;
+  msg.round = round;
+  msg.sender = self_;
+  msg.phase = kCoarseSums;
+  msg.rank = 2;
+  msg.dim = static_cast<std::uint32_t>(d);
+  const std::size_t width = width_of(2);
+  for (std::uint32_t k : touched) {
+    msg.pose_ids.push_back(k);
+    std::vector<double> v(width, 0.0);
+    for (Eigen::Index j = 0; j < d; ++j) {
+      v[static_cast<std::size_t>(j)] = coupling(static_cast<Eigen::Index>(k), j);
+      if (k == self_) v[static_cast<std::size_t>(d + j)] = own(j);
+    }
+    msg.data.insert(msg.data.end(), v.begin(), v.end());
+  }
+  msg.pose_ids.push_back(N);
+  std::vector<double> sc(width, 0.0);
+  std::copy(scalars, scalars + 3, sc.begin());
+  msg.data.insert(msg.data.end(), sc.begin(), sc.end());
+  mail_.send_all({OutgoingMessage{msg, true, {}}});
+  auto got = mail_.gather(kCoarseSums, round, others());
+  CoarseSums out;
+  out.V = Eigen::MatrixXd::Zero(N, d);
+  out.S = Eigen::MatrixXd::Zero(N, d);
+  for (std::uint32_t a : everyone_) {  // agent-id order: bit-identical sums everywhere
+    const PoseBlockMessage& m = a == self_ ? msg : std::get<PoseBlockMessage>(got.at(a));
+    if (m.data.size() != m.pose_ids.size() * width)
+      throw std::runtime_error("rounding: coarse sums of the wrong size from agent " +
+                               std::to_string(a));
+    for (std::size_t e = 0; e < m.pose_ids.size(); ++e) {
+      const double* v = m.data.data() + e * width;
+      const std::uint32_t k = m.pose_ids[e];
+      if (k > N)
+        throw std::runtime_error("rounding: coarse sums for block " + std::to_string(k) +
+                                 " from agent " + std::to_string(a));
+      if (k == N) {
+        out.a += v[0];
+        out.b += v[1];
+        out.c += v[2];
+        continue;
+      }
+      for (Eigen::Index j = 0; j < d; ++j) {
+        out.V(static_cast<Eigen::Index>(k), j) += v[j];
+        if (k == a) out.S(static_cast<Eigen::Index>(k), j) = v[d + j];
+      }
+    }
+  }
+  return out;
 }
 
 template <class F>
@@ -274,8 +335,49 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
   // solve first has to build the whole map (a 1M-pose grid: hundreds of all-agent steps more).
   // One message step: the neighbours' start and |b|^2 (the residual stop stays relative to b).
   Eigen::MatrixXd x = options_.warm_start ? warm_start() : Eigen::MatrixXd::Zero(m, d);
+  // The coarse level's rows of E travel in the same message step (sent before, gathered after).
+  const auto N = static_cast<std::uint32_t>(everyone_.size());
+  std::optional<RoundingCoarse> coarse;
+  PoseBlockMessage erow;
+  if (options_.coarse_correction && N > 1) {
+    std::vector<std::uint32_t> nb_block;
+    for (std::size_t id : nb_ids) nb_block.push_back(local_.owner[id]);
+    std::vector<bool> free_row(static_cast<std::size_t>(m));
+    for (Eigen::Index k = 0; k < m; ++k)
+      free_row[static_cast<std::size_t>(k)] = free(own_[static_cast<std::size_t>(k)]);
+    coarse.emplace(L_own, L_nb, nb_block, free_row, self_, N);
+    const Eigen::VectorXd row = coarse->own_row();
+    erow.sender = self_;
+    erow.phase = kCoarseMatrix;
+    erow.rank = 1;
+    erow.dim = static_cast<std::uint32_t>(d);
+    for (std::uint32_t k : coarse->touched()) {
+      erow.pose_ids.push_back(k);
+      std::vector<double> v(width_of(1), 0.0);
+      v[0] = row(static_cast<Eigen::Index>(k));
+      erow.data.insert(erow.data.end(), v.begin(), v.end());
+    }
+    mail_.send_all({OutgoingMessage{erow, true, {}}});
+  }
   send_publics(kWarmStartValues, 0, 1, rows_of(&x, nullptr));
   double bb = reduce(kWarmStartNorm, 0, b.squaredNorm(), 0.0, nullptr);
+  if (coarse) {
+    auto got = mail_.gather(kCoarseMatrix, 0, others());
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(N, N);
+    for (std::uint32_t a : everyone_) {
+      const PoseBlockMessage& em = a == self_ ? erow : std::get<PoseBlockMessage>(got.at(a));
+      if (em.data.size() != em.pose_ids.size() * width_of(1))
+        throw std::runtime_error("rounding: coarse row of the wrong size from agent " +
+                                 std::to_string(a));
+      for (std::size_t e = 0; e < em.pose_ids.size(); ++e) {
+        if (em.pose_ids[e] >= N)
+          throw std::runtime_error("rounding: coarse row entry " + std::to_string(em.pose_ids[e]) +
+                                   " from agent " + std::to_string(a));
+        E(a, em.pose_ids[e]) = em.data[e * width_of(1)];
+      }
+    }
+    if (!coarse->factorise(E)) coarse.reset();  // the same E everywhere: all agents agree
+  }
   Eigen::MatrixXd r = b - apply(x, gather_publics(kWarmStartValues, 0, 1));
   // Pipelined PCG (Ghysels & Vanroose, "Hiding global synchronization latency in the
   // preconditioned conjugate gradient algorithm", 2014): PCG's iterates in exact arithmetic,
@@ -295,6 +397,10 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
   //   Tichy's estimate of the error in the L-norm, which is that excess cost). It stops when
   //   that is below settle_tolerance * max(1, f(X)) (DistributedRoundingOptions says why 1e-10).
   Eigen::MatrixXd u, w, p, s, q, n_rec;
+  // With the coarse level: cw = Z^T w (every block's sum of w, known to every agent) and
+  // zc = Z^T n_rec, carried like w and n_rec; cw is reset each step to the sums just gathered
+  // (the step's Z^T w), so it drifts by one step's rounding at most.
+  Eigen::MatrixXd cw, zc;
   const std::uint32_t max_it = 5000;
   std::uint32_t it = 0, step = 1, restarts = 0;
   const double tol = 1e-24 * bb,
@@ -307,6 +413,16 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
   // (Re)starts from x with r = b - L x: one message step for w = L u.
   auto start = [&] {
     u = precondition(r);
+    if (coarse) {  // u = B r + Z E^-1 Z^T r needs Z^T r first: one more message step
+      const double none[3] = {0.0, 0.0, 0.0};
+      const CoarseSums cs = coarse_reduce(step, none, coarse->coupling_sums(u),
+                                          coarse->block_sum(r), coarse->touched());
+      ++step;
+      const Eigen::MatrixXd y = coarse->solve(cs.S);
+      coarse->add_offset(u, y);
+      cw = cs.V + coarse->times(y);  // Z^T L u = Z^T L B r + E y
+      zc = Eigen::MatrixXd::Zero(N, d);
+    }
     send_publics(kDirection, step, 1, rows_of(&u, nullptr));
     w = apply(u, gather_publics(kDirection, step, 1));
     ++step;
@@ -318,11 +434,28 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
   };
   start();
   for (;;) {
-    const Eigen::MatrixXd mw = precondition(w);
+    Eigen::MatrixXd mw = precondition(w), y, zn, cw_now;
+    const Eigen::MatrixXd Bw = coarse ? mw : Eigen::MatrixXd();
+    if (coarse) {
+      y = coarse->solve(cw);
+      coarse->add_offset(mw, y);
+    }
     send_publics(kDirection, step, 2, rows_of(&mw, &x));
-    double delta = 0.0, rr = 0.0;
-    const double gamma = reduce(kResidual, step, (r.array() * u.array()).sum(),
-                                (w.array() * u.array()).sum(), &delta, r.squaredNorm(), &rr);
+    double gamma = 0.0, delta = 0.0, rr = 0.0;
+    if (coarse) {
+      const double sc[3] = {(r.array() * u.array()).sum(), (w.array() * u.array()).sum(),
+                            r.squaredNorm()};
+      const CoarseSums cs = coarse_reduce(step, sc, coarse->coupling_sums(Bw), coarse->block_sum(w),
+                                          coarse->touched());
+      gamma = cs.a;
+      delta = cs.b;
+      rr = cs.c;
+      zn = cs.V + coarse->times(y);  // Z^T L M w = Z^T L B w + E y
+      cw_now = cs.S;
+    } else {
+      gamma = reduce(kResidual, step, (r.array() * u.array()).sum(), (w.array() * u.array()).sum(),
+                     &delta, r.squaredNorm(), &rr);
+    }
     mx = gather_publics(kDirection, step, 2);
     ++step;
     double left = 0.0;  // cost removed by the last settle_window steps
@@ -360,6 +493,10 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
     r -= alpha * s;
     u -= alpha * q;
     w -= alpha * n_rec;
+    if (coarse) {
+      zc = zn + beta * zc;
+      cw = cw_now - alpha * zc;
+    }
     gamma_old = gamma;
     alpha_old = alpha;
     decreases.push_back(alpha * gamma);

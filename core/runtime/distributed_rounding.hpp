@@ -35,7 +35,9 @@ enum RoundingPhase : std::uint32_t {
   kTraffic,                    // certificate and escape bytes sent (certification only)
   kWarmStartAnchor,            // pose 0's translation in the rounded frame (its owner's)
   kWarmStartValues,            // public entries of the warm start
-  kWarmStartNorm               // |b|^2, with the warm start's step
+  kWarmStartNorm,              // |b|^2, with the warm start's step
+  kCoarseMatrix,               // a block's row of the coarse matrix E = Z^T L Z
+  kCoarseSums                  // the CG step's sums with the coarse level's terms
 };
 
 /// How the rounding solves for the translations (every agent must use the same).
@@ -47,14 +49,21 @@ struct DistributedRoundingOptions {
   /// Also stop the CG once the rounded cost it could still remove, estimated over the last
   /// `settle_window` steps, is at most settle_tolerance * max(1, f(X)); 0 = only the residual
   /// stop (1e-12 of b's). [0, 1e-6]. The window's sum misses a slowly converging tail: on the
-  /// paper graphs the rounded cost ended up to 5.6x the target above the exact solve's
-  /// (city10000; scripts/bench/rounding_iterations.py). The bound that holds with margin,
+  /// paper graphs the rounded cost ended up to 0.92x the target above the exact solve's
+  /// (city10000; block Jacobi alone, before the coarse level: 5.6x;
+  /// scripts/bench/rounding_iterations.py). The bound that holds with margin,
   /// cost_bound() = 100 settle_tolerance, is at the default 1e-8 of max(1, f(X)), 1e-3 of
   /// the rounding-gap tolerance (certification/rounding_gap.hpp): the inexact solve cannot
   /// decide whether the certificate carries over to the estimate.
   double settle_tolerance = 1e-10;
   /// Steps over which the remaining cost is estimated, [1, 1000].
   std::size_t settle_window = 10;
+  /// Add a coarse level to the CG's block-Jacobi preconditioner: one translation offset per
+  /// block, its N x N matrix solved by every agent (runtime/rounding_coarse.hpp). Without it
+  /// the steps grow with the number of blocks: on a generated 100,000-pose grid after 5
+  /// rounds, 83 / 91 / 109 steps to the default stop at N = 16 / 25 / 64, with it 40 / 40 / 37
+  /// (scripts/bench/rounding_blocks.py).
+  bool coarse_correction = true;
 
   /// Throws InputError naming the field when it is out of range.
   void validate() const;
@@ -128,13 +137,25 @@ class DistributedRounding {
 
   void rotations();
 
+  // The sums of a CG step with the coarse level, in agent-id order: the three scalars of
+  // reduce() and the N x d matrices V = sum of every agent's `coupling` (non-zero in the rows
+  // of `touched`) and S (row k: agent k's `own`). One broadcast per agent.
+  struct CoarseSums {
+    double a = 0, b = 0, c = 0;
+    Eigen::MatrixXd V, S;
+  };
+  CoarseSums coarse_reduce(std::uint32_t round, const double (&scalars)[3],
+                           const Eigen::MatrixXd& coupling, const Eigen::RowVectorXd& own,
+                           const std::vector<std::uint32_t>& touched);
+
   // The translations CG starts from: the iterate's, in the rounded frame, pose 0 at 0.
   Eigen::MatrixXd warm_start();
 
   // Preconditioned CG on L t = b (the translation Laplacian without the anchor pose 0), with
-  // each agent's own Laplacian block as the preconditioner (solved exactly by Cholesky), in
-  // its pipelined form: one message step per iteration. Stops when the residual is 1e-12 of
-  // b's or (options_.settle_tolerance) the cost it could still remove is small enough.
+  // each agent's own Laplacian block as the preconditioner (solved exactly by Cholesky) and,
+  // with options_.coarse_correction, one offset per block on top, in its pipelined form: one
+  // message step per iteration. Stops when the residual is 1e-12 of b's or
+  // (options_.settle_tolerance) the cost it could still remove is small enough.
   std::uint32_t translations(double relaxation_cost);
 
   // Cost of the rounded poses: internal measurements in full, cut ones half (as core's status).

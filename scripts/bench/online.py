@@ -17,6 +17,7 @@ sphere2500).
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -71,6 +72,10 @@ def main():
     ap.add_argument("--name", default="online",
                     help="stem of the files written into --out-dir (default online: online.md, .csv, .png)")
     ap.add_argument("--extra", default="", help="more arguments for every `tessera solve --online` run")
+    ap.add_argument("--instructions", action="store_true",
+                    help="also count instructions (valgrind --tool=callgrind, load-free): the online run "
+                         "(run_online: steps and final certified solve) and its re-solves from scratch "
+                         "(solve_distributed), two more runs per case; slow (~50x)")
     args = ap.parse_args()
     ctx = bc.Ctx(args)
     rows, runs, dds_rows = [], [], []
@@ -117,11 +122,43 @@ def main():
             "final_rel_gap": (s["cost"] - fstar) / fstar if s.get("cost") else None,
             "certified": s["certified"], "load_1min": round(load, 2),
         }
+        if args.instructions:
+            row.update(count_instructions(ctx, cmd, js))
         rows.append(row)
         runs.append((name, s))
         if args.dds:
             dds_rows.append(run_dds(args, ctx, name, path, robots, fstar))
         write_outputs(args, ctx, rows, runs, dds_rows)  # after each case: a long run keeps what it did
+
+
+def callgrind(ctx, cmd, function):
+    """Instructions executed inside `function` (callgrind --toggle-collect) by `cmd`: load-free."""
+    out = os.path.join(ctx.work, "callgrind.out")
+    full = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", f"--toggle-collect={function}"] + cmd
+    ctx.log(full)
+    bc.progress(" ".join(full))
+    r = subprocess.run(full, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, check=True)
+    m = re.search(r"Collected\s*:\s*([0-9]+)", r.stderr)
+    os.remove(out)
+    return int(m.group(1)) if m else None
+
+
+def count_instructions(ctx, cmd, js):
+    """The online run (steps and final certified solve, without the checkpoints' and the baseline's
+    work) and the re-solves from scratch, counted in two runs of the same command."""
+    base = [c for c in cmd if c not in ("--baseline",)]
+    base = [c if c != js else js + ".cg" for c in base]
+    k = base.index("--checkpoints")
+    base[k + 1] = "0"
+    online = callgrind(ctx, base, "tessera::run_online(*")
+    scratch = callgrind(ctx, base + ["--baseline", "--no-certify"], "tessera::solve_distributed(*")
+    with open(js + ".cg") as f:  # --baseline-every K: scaled as the CPU time is
+        s = json.load(f)
+    if scratch and s.get("baseline_resolved"):
+        scratch = scratch * s["baseline_solves"] / s["baseline_resolved"]
+    return {"online_ginstr": online / 1e9 if online else None,
+            "baseline_ginstr": scratch / 1e9 if scratch else None,
+            "instr_ratio": online / scratch if online and scratch else None}
 
 
 def step_args(args):
@@ -135,6 +172,8 @@ def step_args(args):
 def write_outputs(args, ctx, rows, runs, dds_rows):
     headers = ["graph", "poses", "steps", "step solver", "message steps", "Newton CG", "lat med s", "lat p95 s", "max gap", "online CPU s", "set-up s",
                "rounds CPU s", "max step CPU s", "critical path s", "re-solves", "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
+    if args.instructions:
+        headers += ["online G instr", "re-solve G instr", "instr ratio"]
     table = bc.print_table(
         f"online runs (rate {args.rate}/s per robot, speedup {args.speedup}, steps {args.steps}, "
         f"grad tol {args.grad_tol})",
@@ -147,6 +186,8 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
           bc.fmt(r["critical_path_cpu_s"], "{:.2f}"),
           f"{r['baseline_resolved']}/{r['baseline_solves']}", bc.fmt(r["baseline_cpu_s"], "{:.2f}"),
           bc.fmt(r["cpu_ratio"], "{:.3f}"), bc.fmt(r["final_rel_gap"], "{:.1e}"), r["certified"], r["load_1min"]]
+         + ([bc.fmt(r.get("online_ginstr"), "{:.2f}"), bc.fmt(r.get("baseline_ginstr"), "{:.2f}"),
+             bc.fmt(r.get("instr_ratio"), "{:.3f}")] if args.instructions else [])
          for r in rows])
     bc.write_csv(os.path.join(ctx.out_dir, args.name + ".csv"), rows)
     dds_table = ""
@@ -205,7 +246,11 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
                 "certificate; max step CPU s = the longest step's process CPU (all agents); critical path s = the rounds' compute time summed over the steps with every agent on its own machine (per message step the slowest agent); set-up s = wall time of the agents' set-up (block problems, preconditioner factors) over the steps; rounds CPU s = process CPU of the rounds alone; re-solves = steps re-solved / steps that brought a loop closure; re-solve CPU = the same agents "
                 "solving from scratch (the front ends' guesses) after every step that brought a loop closure (when "
                 "only every K-th such step is re-solved, their CPU times (steps / re-solved)); ratio = online CPU / "
-                "re-solve CPU; final rel gap = (cost - f*) / f* with f* of the whole graph. The "
+                "re-solve CPU; final rel gap = (cost - f*) / f* with f* of the whole graph; with --instructions, "
+                "online / re-solve G instr = instructions (valgrind --tool=callgrind, load-free) of the online run "
+                "(tessera::run_online: the steps and the final certified solve) and of its re-solves from scratch "
+                "(tessera::solve_distributed), each in its own run of the same command, and instr ratio = their "
+                "ratio. The "
                 "in-process engine keeps one block per robot: re-partitions and poses moved are 0.\n\n"
                 f"![online]({args.name}.png)\n")
     print(f"wrote {os.path.relpath(md, bc.ROOT)}")

@@ -29,7 +29,9 @@ struct Rounded {
   std::vector<std::string> errors;
 };
 
-/// Runs DistributedRounding with `options` on every block of `c` in its own thread.
-Rounded round_in_threads(const RoundingCase& c, const DistributedRoundingOptions& options);
+/// Runs DistributedRounding with `options` on every block of `c` in its own thread; an agent
+/// that waits longer than `timeout_s` for a message fails (Rounded::errors).
+Rounded round_in_threads(const RoundingCase& c, const DistributedRoundingOptions& options,
+                         double timeout_s = 30.0);
 
 }  // namespace tessera::agent
