@@ -38,8 +38,8 @@ struct RobustSummary {
   bool weights_converged = false;
   std::size_t readmitted = 0;  ///< Rejected by GNC, taken back at the inlier set's solution.
   /// Probes after the re-check passes (distributed: RobustOptions::recheck_probes; centralized:
-  /// the cluster probes, GncCentralizedOptions::cluster_probes) and those that lowered the TLS
-  /// cost and stayed.
+  /// the cluster probes, GncCentralizedOptions::cluster_probes, and the return probes) and those
+  /// that lowered the TLS cost and stayed.
   int probes = 0;
   int probes_kept = 0;
 };

@@ -6,9 +6,12 @@
 #include <string>
 #include <tessera/robust/closure_clusters.hpp>
 #include <tessera/robust/gnc_centralized.hpp>
+#include <tessera/robust/tls_recheck.hpp>
+#include <tessera/robust/tls_weights.hpp>
 #include <tessera/util/input_error.hpp>
 
 #include "gnc_fixtures.hpp"
+#include "robust/cluster_probes.hpp"
 #include "test_support.hpp"
 
 namespace tessera {
@@ -96,13 +99,63 @@ TEST(ClosureClusters, BadOptionsNameTheField) {
               std::string::npos);
   }
   gnc.cluster_probes = 1;
-  gnc.readmit_ratio = -1;
+  gnc.robust.probe_return_ratio = 0.5;
   try {
     gnc.validate();
-    FAIL() << "readmit_ratio -1 accepted";
+    FAIL() << "probe_return_ratio 0.5 accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("GncCentralizedOptions.readmit_ratio"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("RobustOptions.probe_return_ratio"), std::string::npos);
   }
+}
+
+// Return probes (RobustOptions::probe_return_ratio): the rejected closures just beyond the bound
+// come back together first, then one at a time nearest first; a far one never does. On a 20-pose
+// chain, closure A (0-5) is at 2 c^2, B (10-15) at 3 c^2, C (12-18) at 10 c^2. The solve is a
+// stand-in: when A is back it returns poses stretched so that A fits (the odometry takes a
+// fifth of A's residual), and the re-check verdict there as its rejected set.
+TEST(ClusterProbes, AReturnProbeBringsBackTheClosuresJustBeyondTheBoundAndKeepsWhatLowersTheTls) {
+  PoseGraph g = chain(20);
+  std::vector<Pose> poses(20);
+  for (std::size_t i = 0; i < 20; ++i) {
+    poses[i].R = Eigen::Matrix2d::Identity();
+    poses[i].t = Eigen::Vector2d(static_cast<double>(i), 0);
+  }
+  const double delta = 1.0;
+  auto closure = [&](std::size_t i, std::size_t j, double offset) {
+    add_closure(g, i, j);
+    g.measurements.back().t = Eigen::Vector2d(static_cast<double>(j - i) + offset, 0);
+    return g.num_measurements() - 1;
+  };
+  const std::size_t a = closure(0, 5, delta), b = closure(10, 15, delta * std::sqrt(1.5)),
+                    c = closure(12, 18, delta * std::sqrt(5.0));
+  const std::vector<bool> known = odometry_flags(g);
+  const Measurement& ma = g.measurements[a];
+  const double c2 = residual_squared(ma, poses[ma.i], poses[ma.j]) / 2;
+  std::vector<Pose> stretched = poses;
+  for (std::size_t i = 0; i <= 5; ++i) stretched[i].t.x() -= delta * static_cast<double>(5 - i) / 5;
+  const std::vector<std::size_t> all = {a, b, c};
+  EXPECT_EQ(return_candidates(g, poses, c2, 4.0, all), (std::vector<std::size_t>{a, b}));
+
+  std::vector<std::vector<std::size_t>> asked;
+  auto solve = [&](std::vector<std::size_t> rejected) {
+    asked.push_back(rejected);
+    const bool a_back = !std::binary_search(rejected.begin(), rejected.end(), a);
+    const std::vector<Pose>& at = a_back ? stretched : poses;
+    return ClusterProbeTrial{tls_recheck(g, known, at, c2, rejected).rejected, at};
+  };
+  int kept_calls = 0;
+  const ClusterProbeCounts counts =
+      search_cluster_probes(g, known, c2, 10, false, ClosureClusterOptions{}, 4.0, all, poses,
+                            solve, [&] { ++kept_calls; });
+  // Together (A and B back): A fits, the passes cut B again, the TLS cost falls: kept. Then B
+  // alone at the new solution: nothing changes, refused. C is never asked back.
+  ASSERT_EQ(asked.size(), 2u);
+  EXPECT_EQ(asked[0], (std::vector<std::size_t>{c}));
+  EXPECT_EQ(asked[1], (std::vector<std::size_t>{c}));
+  EXPECT_EQ(counts.probes, 2);
+  EXPECT_EQ(counts.kept, 1);
+  EXPECT_EQ(kept_calls, 1);
+  EXPECT_EQ(counts.returned, 1u) << "A stays back, B was cut again";
 }
 
 // The case cluster probes exist for: on a map whose information states more noise than its data

@@ -1,6 +1,5 @@
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/distributed_initialization.hpp>
@@ -75,9 +74,6 @@ void GncCentralizedOptions::validate() const {
     throw InputError("GncCentralizedOptions.cluster_probes = " + std::to_string(cluster_probes) +
                      ": must be >= 0 (0 = none)");
   clusters.validate();
-  if (!(std::isfinite(readmit_ratio) && readmit_ratio >= 0))
-    throw InputError("GncCentralizedOptions.readmit_ratio = " + std::to_string(readmit_ratio) +
-                     ": must be >= 0 (0 = never)");
 }
 
 GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
@@ -259,18 +255,23 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   };
   adopt(solve_kept_set(out.rejected, solve.poses, final_options));
 
-  // Cluster probes (GncCentralizedOptions::cluster_probes): a run of wrong closures that fit
-  // each other survives every one-at-a-time verdict, so cut a whole run of kept closures at
-  // once, let the re-check passes take back what fits without it, and keep the result only when
-  // the TLS cost over every measurement falls. Each accepted probe is a descent step of the TLS
-  // cost, like the passes; a refused one changes nothing.
-  if (options.cluster_probes > 0 && !out.rejected.empty()) {
+  // Probes (GncCentralizedOptions::cluster_probes, RobustOptions::probe_return_ratio): a run of
+  // wrong closures that fit each other survives every one-at-a-time verdict, so a probe cuts a
+  // whole run of kept closures at once; a true closure just beyond the bound at the kept set's
+  // solution stays out until it is back in the problem, so a return probe brings it back. The
+  // re-check passes then run from there, and the result stays only when the TLS cost over every
+  // measurement falls: each kept probe is a descent step of the TLS cost, a refused one changes
+  // nothing. Without cluster probes one return probe may run (--gnc-probes 0: none).
+  const bool may_return =
+      robust.recheck_probes > 0 && robust.readmission_passes > 0 && known_connected;
+  const int budget = options.cluster_probes > 0 ? options.cluster_probes : may_return ? 1 : 0;
+  if (budget > 0 && !out.rejected.empty()) {
     CentralizedOptions trial = final_options;
     trial.certify = false;  // only the set that stays is certified
     KeptSet last;
     const ClusterProbeCounts counts = search_cluster_probes(
-        graph, known, c2, options.cluster_probes, options.clusters, options.readmit_ratio,
-        out.rejected, out.final_solve.poses,
+        graph, known, c2, budget, options.cluster_probes > 0, options.clusters,
+        may_return ? robust.probe_return_ratio : 1.0, out.rejected, out.final_solve.poses,
         [&](std::vector<std::size_t> rejected) {
           last = solve_kept_set(std::move(rejected), out.final_solve.poses, trial);
           return ClusterProbeTrial{last.rejected, last.solve.poses};
@@ -278,36 +279,9 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
         [&] { adopt(std::move(last)); });
     out.probes = counts.probes;
     out.probes_kept = counts.kept;
+    out.readmitted += counts.returned;
     // The certificate (and the staircase) for the set that stayed.
     if (counts.kept > 0) adopt(solve_kept_set(out.rejected, out.final_solve.poses, final_options));
-  }
-  // Return probe (RobustOptions::probe_return_ratio, with the probes' budget): the rejected
-  // measurements beyond the bound but within probe_return_ratio x c^2 at the kept set's solution
-  // come back together, the passes run again, and the result stays only if the TLS cost fell. A
-  // true closure that alone ties two stretches of the map lies just beyond the bound once it is
-  // gone, so no pass takes it back.
-  if (robust.recheck_probes > 0 && robust.readmission_passes > 0 && known_connected &&
-      !out.rejected.empty()) {
-    const std::vector<Pose> at = out.final_solve.poses;
-    const std::vector<double> r2_kept = residuals(graph, at);
-    std::vector<std::size_t> back;
-    for (std::size_t e : out.rejected)
-      if (!known[e] && r2_kept[e] > c2 && r2_kept[e] <= robust.probe_return_ratio * c2)
-        back.push_back(e);
-    if (!back.empty()) {
-      std::vector<std::size_t> still;
-      std::set_difference(out.rejected.begin(), out.rejected.end(), back.begin(), back.end(),
-                          std::back_inserter(still));
-      ++out.probes;
-      const double tls_before = tls_cost(graph, known, at, c2);
-      KeptSet trial = solve_kept_set(std::move(still), at, final_options);
-      if (tls_cost(graph, known, trial.solve.poses, c2) <
-          tls_before - 1e-9 * std::abs(tls_before)) {
-        ++out.probes_kept;
-        out.readmitted += back.size();
-        adopt(std::move(trial));
-      }
-    }
   }
   if (out.readmitted + out.late_rejected > 0 || out.probes_kept > 0)
     for (std::size_t e = 0; e < m; ++e)

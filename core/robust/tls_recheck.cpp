@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <tessera/robust/tls_recheck.hpp>
 #include <tessera/robust/tls_weights.hpp>
+#include <utility>
 
 namespace tessera {
 
@@ -17,6 +18,22 @@ TlsRecheck tls_recheck(const PoseGraph& graph, const std::vector<bool>& known,
     if (was_rejected && fits) ++out.taken_back;
     if (!was_rejected && !fits) ++out.dropped;
   }
+  return out;
+}
+
+std::vector<std::size_t> return_candidates(const PoseGraph& graph, const std::vector<Pose>& poses,
+                                           double c2, double return_ratio,
+                                           const std::vector<std::size_t>& rejected) {
+  std::vector<std::pair<double, std::size_t>> band;
+  for (std::size_t e : rejected) {
+    const Measurement& m = graph.measurements[e];
+    const double r2 = residual_squared(m, poses[m.i], poses[m.j]);
+    if (r2 > c2 && r2 <= return_ratio * c2) band.emplace_back(r2, e);
+  }
+  std::sort(band.begin(), band.end());
+  std::vector<std::size_t> out;
+  out.reserve(band.size());
+  for (const auto& b : band) out.push_back(b.second);
   return out;
 }
 

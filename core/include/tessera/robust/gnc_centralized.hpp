@@ -46,16 +46,11 @@ struct GncCentralizedOptions {
   /// between two look-alike stretches bends the map until all of them fit, and the true closures
   /// of the stretch are cut instead; no one-at-a-time verdict undoes that, while the truth has
   /// the lower TLS cost (intel with group outliers; docs/benchmarks/robust.md, "Group outliers").
+  /// When no cluster is left, the budget's return probes (RobustOptions::probe_return_ratio)
+  /// follow: the rejected closures just beyond the bound come back together, then one at a time.
+  /// Without cluster probes one return probe runs (RobustOptions::recheck_probes > 0).
   int cluster_probes = 0;
   ClosureClusterOptions clusters;  ///< Which kept closures form a cluster.
-  /// With cluster probes: when no cluster is left to cut, a rejected closure with r^2 at most
-  /// this times c^2 at the kept set's solution is taken back alone (a probe of the same budget,
-  /// kept on the same rule), nearest to the bound first; >= 0, 0 = never. A true closure that a
-  /// wrong run's bend pushed beyond the bound can stay there after the run is cut: the local
-  /// solution does not move towards it unless it is in the problem (intel, group 0.1: r^2 71.9
-  /// against c^2 = 32.8, 4.3 at the clean optimum). 4: the wrong closures that GNC rejects on
-  /// intel and CSAIL lie above 35 c^2.
-  double readmit_ratio = 4.0;
   /// Throws InputError naming the first bad field.
   void validate() const;
 };
@@ -81,13 +76,14 @@ struct GncCentralizedResult {
   double threshold_squared = 0;       ///< c^2 used.
   double final_mu = 0;                ///< mu of the last outer step (0: no step was needed).
   bool weights_converged = false;     ///< sum w(1 - w) fell below the tolerance.
-  /// Rejected measurements taken back by the re-check passes (RobustOptions::readmission_passes).
+  /// Rejected measurements taken back by the re-check passes (RobustOptions::readmission_passes)
+  /// and by kept return probes.
   std::size_t readmitted = 0;
   /// Kept measurements beyond the bound at an inlier set's solution, rejected by a re-check pass.
   std::size_t late_rejected = 0;
   PairwiseConsistencyResult pcm;  ///< kPcmGnc: the consistency check (empty otherwise).
-  /// Cluster probes run (GncCentralizedOptions::cluster_probes), plus the return probe
-  /// (RobustOptions::probe_return_ratio; at most one).
+  /// Probes run: cluster probes (GncCentralizedOptions::cluster_probes) and return probes
+  /// (RobustOptions::probe_return_ratio), within the budget (at most one without cluster probes).
   int probes = 0;
   int probes_kept = 0;  ///< Of those, the ones that lowered the TLS cost and stayed.
   /// The start vote (GncCentralizedOptions::known_inlier_start) chose the known inliers' start.

@@ -111,7 +111,9 @@ struct RobustOptions {
   /// just beyond the bound and no one-at-a-time verdict takes it back, while with it the TLS cost
   /// is lower (torus3D with 25 % random outliers: closure 4973-73 at r^2 = 48.6 against c^2 =
   /// 46.9 there, 5.6 at the clean optimum, TLS cost 24,227 with it against 24,257 without).
-  /// Random wrong closures lie far beyond (there: the nearest at 12.7 c^2).
+  /// Random wrong closures lie far beyond (there: the nearest at 12.7 c^2). Centralized, the
+  /// same band is the return probes' (gnc_centralized.hpp): all of it together, then, with
+  /// cluster probes, one closure at a time (tls_recheck.hpp, return_candidates).
   double probe_return_ratio = 4.0;
   /// Distributed solvers only: the final solve of the kept set (weights fixed) ends with the
   /// distributed Newton refinement (distributed/newton_refine.hpp, with the solver's

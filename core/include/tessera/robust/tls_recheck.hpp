@@ -23,6 +23,14 @@ TlsRecheck tls_recheck(const PoseGraph& graph, const std::vector<bool>& known,
                        const std::vector<Pose>& poses, double c2,
                        const std::vector<std::size_t>& rejected);
 
+/// What a return probe takes back (RobustOptions::probe_return_ratio): the rejected measurements
+/// (`rejected` ascending, known ones never in it) whose r^2 at `poses` lies beyond the bound but
+/// within return_ratio x c^2, nearest to the bound first. The same band the distributed probe's
+/// verdict names (gnc_votes). Empty when return_ratio <= 1.
+std::vector<std::size_t> return_candidates(const PoseGraph& graph, const std::vector<Pose>& poses,
+                                           double c2, double return_ratio,
+                                           const std::vector<std::size_t>& rejected);
+
 /// The TLS cost at `poses`: sum over the measurements of r^2 for known ones (known[e] true, never
 /// rejected) and min(r^2, c^2) for the others. What the start vote, the re-check passes and the
 /// cluster probes compare.
