@@ -9,7 +9,8 @@ default. While it runs, the resident set (RSS) and proportional set (PSS: shared
 among the processes sharing them, so the sum over processes is what the run takes from the host)
 of launch and every process it started (the fork server, the coordinator, the agents: launch is
 their subreaper) are sampled every --period seconds from /proc. Printed and written to
-docs/benchmarks/dds_scale.csv, one row per run:
+docs/benchmarks/dds_scale.csv, one row per run, appended to the rows already there (--replace: only
+this run's rows; --label names what was measured):
   - the phases of the coordinator's timeline (`timeline_ms` of the summary): start (launch to the
     coordinator's session), discovery and partition (to the assignment), ready (the readiness
     barrier), setup (initialisation, hand-off and the agents' set-up to the first round status),
@@ -35,6 +36,7 @@ The set-up's peaks (setup_pss_mb_*) are sampled until the coordinator's first ro
 --min-available-mb stops a run (SIGTERM to launch) when the host's MemAvailable falls below it.
 """
 import argparse
+import csv
 import json
 import os
 import re
@@ -244,6 +246,10 @@ def main():
     ap.add_argument("--robot-files", action="store_true",
                     help="launch the folder of robot files (generate --split) instead of the whole file")
     ap.add_argument("--launch-args", default="", help="more launch options, e.g. \"--max-rounds 20\"")
+    ap.add_argument("--label", default="",
+                    help="what was measured (the CSV's `binaries` column), e.g. the change under test")
+    ap.add_argument("--replace", action="store_true",
+                    help="write only this run's rows; by default they are appended to the CSV's rows")
     ap.add_argument("--min-available-mb", type=int, default=0,
                     help="watchdog: stop a run when the host's MemAvailable falls below this (0 = off)")
     args = ap.parse_args()
@@ -260,7 +266,14 @@ def main():
     bc.print_table("tessera launch on generated 3D grids (fast partition, distributed init, certified)",
                    cols, [[bc.fmt(r.get(c, "-")) if not isinstance(r.get(c), str) else r[c] for c in cols]
                           for r in rows])
-    bc.write_csv(args.csv, rows)
+    # The CSV is the record of every scale run: earlier rows stay unless --replace.
+    kept = []
+    if not args.replace and os.path.exists(args.csv):
+        with open(args.csv, newline="") as f:
+            kept = list(csv.DictReader(f))
+    for r in rows:
+        r["binaries"] = args.label
+    bc.write_csv(args.csv, kept + rows)
 
 
 if __name__ == "__main__":
