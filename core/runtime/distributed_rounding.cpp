@@ -434,9 +434,9 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
   };
   start();
   for (;;) {
-    Eigen::MatrixXd mw = precondition(w), y, zn, cw_now;
-    const Eigen::MatrixXd Bw = coarse ? mw : Eigen::MatrixXd();
+    Eigen::MatrixXd mw = precondition(w), y, zn, cw_now, coupling_Bw;
     if (coarse) {
+      coupling_Bw = coarse->coupling_sums(mw);  // of B w, before the offset makes it M w
       y = coarse->solve(cw);
       coarse->add_offset(mw, y);
     }
@@ -445,8 +445,8 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
     if (coarse) {
       const double sc[3] = {(r.array() * u.array()).sum(), (w.array() * u.array()).sum(),
                             r.squaredNorm()};
-      const CoarseSums cs = coarse_reduce(step, sc, coarse->coupling_sums(Bw), coarse->block_sum(w),
-                                          coarse->touched());
+      const CoarseSums cs =
+          coarse_reduce(step, sc, coupling_Bw, coarse->block_sum(w), coarse->touched());
       gamma = cs.a;
       delta = cs.b;
       rr = cs.c;
