@@ -63,8 +63,7 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   ro.coarse_every = asg.coarse_every();
   ro.coarse_aggregates = asg.coarse_aggregates();
   ro.coarse_smoothing = asg.coarse_smoothing();
-  ro.refine = asg.refine() == "newton" || asg.refine() == "auto";
-  ro.refine_auto = asg.refine() == "auto";
+  ro.refine = asg.refine();
   ro.refine_grad_tol = asg.refine_grad_tol();
   ro.refine_rel_tol = asg.refine_rel_tol();
   // One host's factors share one budget (runtime/team_memory.hpp).

@@ -300,11 +300,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   opt.staircase.certificate.interface_max_coordinates = static_cast<int>(
       a.get_long("certify-interface", opt.staircase.certificate.interface_max_coordinates));
   {
-    const std::string refine = a.get_or("refine", "none");
-    if (refine != "newton" && refine != "auto" && refine != "none")
-      throw InputError("option --refine: '" + refine + "' is not one of newton, auto, none");
-    opt.refine.enabled = refine != "none";
-    if (refine == "auto") opt.refine.when = NewtonRefineOptions::When::kIfRoundsSlow;
+    set_refine_mode(opt.refine, a.get_or("refine", "none"));
     opt.refine.grad_norm_tol = a.get_double("refine-grad-tol", opt.refine.grad_norm_tol);
     opt.refine.relative_decrease_tol =
         a.get_double("refine-rel-tol", opt.refine.relative_decrease_tol);

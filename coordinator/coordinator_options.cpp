@@ -204,8 +204,8 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
     a.coarse_smoothing = static_cast<std::uint32_t>(c.smoothing_steps);
   }
   a.refine = args.get_or("refine", a.refine);
-  if (a.refine != "none" && a.refine != "newton" && a.refine != "auto")
-    throw InputError("option --refine: '" + a.refine + "' is not one of newton, auto, none");
+  NewtonRefineOptions checked;
+  set_refine_mode(checked, a.refine);  // names a value the agents would not know
   a.refine_grad_tol = args.get_double("refine-grad-tol", 0);
   a.refine_rel_tol = args.get_double("refine-rel-tol", 0);
   if (!(a.refine_grad_tol >= 0)) throw InputError("option --refine-grad-tol: must be >= 0");

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <string>
 #include <tessera/distributed/coarse_correction.hpp>
+#include <tessera/distributed/newton_refine.hpp>
 #include <tessera/robust/robust_options.hpp>
 #include <tessera/util/input_error.hpp>
 
@@ -44,8 +45,8 @@ void check_partition_time(const std::string& v) {
 }
 
 void check_refine(const std::string& v) {
-  if (v != "newton" && v != "auto" && v != "none")
-    throw InputError("option --refine: '" + v + "' is not one of newton, auto, none");
+  NewtonRefineOptions checked;
+  set_refine_mode(checked, v);
 }
 
 // A tolerance >= 0 (0 = the solver's default), else an InputError naming the flag.

@@ -35,6 +35,14 @@ void NewtonRefineOptions::validate() const {
   if (!(translation_tol > 0 && translation_tol < 1)) fail("translation_tol", "must be in (0, 1)");
 }
 
+void set_refine_mode(NewtonRefineOptions& options, const std::string& mode) {
+  if (mode != "newton" && mode != "auto" && mode != "none")
+    throw InputError("option --refine: '" + mode + "' is not one of newton, auto, none");
+  options.enabled = mode != "none";
+  options.when = mode == "auto" ? NewtonRefineOptions::When::kIfRoundsSlow
+                                : NewtonRefineOptions::When::kAlways;
+}
+
 CoarseOptions NewtonRefineOptions::coarse_space_options() const {
   CoarseOptions c;
   c.space = CoarseSpaceKind::kSmoothed;

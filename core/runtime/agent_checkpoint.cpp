@@ -68,7 +68,7 @@ std::string encode_checkpoint(const std::string& run_id, const AgentLocalData& l
   w.u32(o.coarse_every);
   w.u32(o.coarse_aggregates);
   w.u32(o.coarse_smoothing);
-  w.u32(o.refine ? 1 : 0);  // a restarted agent must refine as the others do
+  w.string(o.refine);  // a restarted agent must refine as the others do
   w.f64(o.refine_grad_tol);
   w.f64(o.refine_rel_tol);
   w.u64(snapshots.size());
@@ -127,7 +127,7 @@ AgentCheckpoint decode_checkpoint(const std::string& payload, const std::string&
     o.coarse_every = r.u32("coarse every");
     o.coarse_aggregates = r.u32("coarse aggregates");
     o.coarse_smoothing = r.u32("coarse smoothing");
-    o.refine = r.u32("refine") != 0;
+    o.refine = r.string("refine");
     o.refine_grad_tol = r.f64("refine grad tolerance");
     o.refine_rel_tol = r.f64("refine relative tolerance");
     const std::uint64_t n = r.u64("number of snapshots");

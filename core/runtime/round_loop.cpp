@@ -46,8 +46,7 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
     opt.coarse.aggregates = static_cast<int>(o.coarse_aggregates);
     opt.coarse.smoothing_steps = static_cast<int>(o.coarse_smoothing);
   }
-  opt.refine.enabled = o.refine;
-  if (o.refine_auto) opt.refine.when = NewtonRefineOptions::When::kIfRoundsSlow;
+  set_refine_mode(opt.refine, o.refine);
   if (o.refine_grad_tol > 0) opt.refine.grad_norm_tol = o.refine_grad_tol;
   if (o.refine_rel_tol > 0) opt.refine.relative_decrease_tol = o.refine_rel_tol;
   if (o.max_factor_entries > 0)

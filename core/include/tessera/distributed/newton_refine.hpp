@@ -155,6 +155,11 @@ struct NewtonRefineOptions {
   void validate() const;
 };
 
+/// The `--refine` values as options: "none" (enabled off), "newton" (kAlways) or "auto"
+/// (kIfRoundsSlow). One parser for the command line, the coordinator, launch and the agents'
+/// assignment. Throws InputError "option --refine: 'v' is not one of newton, auto, none".
+void set_refine_mode(NewtonRefineOptions& options, const std::string& mode);
+
 /// One trust-region step, identical on every agent.
 struct NewtonRefineStep {
   int cg_iterations = 0;
