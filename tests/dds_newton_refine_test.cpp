@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "dds_process_support.hpp"
+#include "refine_harness.hpp"
 
 namespace tessera::test::dds {
 namespace {
@@ -25,12 +26,27 @@ namespace {
 const char* kChain =
     "--kind grid3d --poses 600 --max-loop-closures 4 --rot-noise 0.1 --trans-noise 1 --seed 3";
 
-// f* to round-off (the centralized solver's gradient stop): its default stop may end ~1e-7 above
-// f* on long chains like this one, which is not what the refinement is measured against.
-double tight_optimum(const PoseGraph& g) {
-  CentralizedOptions o;
-  o.stop = CentralizedStop::kGradient;
-  return solve_centralized(g, o).cost;
+// `tessera launch` of the chain with `refine` (a --refine value) on `domain`: it ends certified
+// at f* (to round-off) and agent 0 reported the refinement (as it reports the certificate: at
+// its start, then every 2 s). Returns the chain's file.
+std::string expect_launch_refines_to_the_optimum(const std::string& refine, int domain) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/chain.g2o";
+  generate_graph(graph, kChain);
+  if (::testing::Test::HasFailure()) return graph;
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch " + graph + " --agents 3 --domain " +
+                                 std::to_string(domain) + " --refine " + refine +
+                                 " --timeout 90 --json " + dir + "/s.json 2>&1",
+                             &out);
+  EXPECT_EQ(rc, 0) << out;
+  if (rc != 0) return graph;
+  EXPECT_NE(out.find("refinement: Newton step 1, CG iteration "), std::string::npos) << out;
+  const std::string json = slurp(dir + "/s.json");
+  EXPECT_EQ(json_text(json, "certified"), "true") << json;
+  const double fstar = tight_optimum(read_g2o(graph));
+  EXPECT_NEAR(json_number(json, "cost"), fstar, 1e-8 * fstar) << json;
+  return graph;
 }
 
 TEST(DdsNewtonRefine, AgentsOverDdsTakeTheInProcessIterates) {
@@ -66,42 +82,11 @@ TEST(DdsNewtonRefine, AgentsOverDdsTakeTheInProcessIterates) {
 }
 
 TEST(DdsNewtonRefine, LaunchForwardsRefineAndEndsCertifiedAtTheOptimum) {
-  const std::string dir = temp_dir();
-  const std::string graph = dir + "/chain.g2o";
-  generate_graph(graph, kChain);
-  ASSERT_FALSE(::testing::Test::HasFailure());
-  std::string out;
-  const int rc = run_command(bin("tessera") + " launch " + graph +
-                                 " --agents 3 --domain 81 --refine newton --timeout 90 --json " +
-                                 dir + "/s.json 2>&1",
-                             &out);
-  ASSERT_EQ(rc, 0) << out;
-  // Agent 0 reports the refinement as it reports the certificate: at its start, then every 2 s.
-  EXPECT_NE(out.find("refinement: Newton step 1, CG iteration "), std::string::npos) << out;
-  const std::string json = slurp(dir + "/s.json");
-  EXPECT_EQ(json_text(json, "certified"), "true") << json;
-  const PoseGraph g = read_g2o(graph);
-  const double fstar = tight_optimum(g);
-  EXPECT_NEAR(json_number(json, "cost"), fstar, 1e-8 * fstar) << json;
+  expect_launch_refines_to_the_optimum("newton", 81);
 }
 
 TEST(DdsNewtonRefine, LaunchForwardsRefineAutoWhichRefinesAChainWhoseRoundsStopShort) {
-  const std::string dir = temp_dir();
-  const std::string graph = dir + "/chain.g2o";
-  generate_graph(graph, kChain);
-  ASSERT_FALSE(::testing::Test::HasFailure());
-  std::string out;
-  const int rc = run_command(bin("tessera") + " launch " + graph +
-                                 " --agents 3 --domain 99 --refine auto --timeout 90 --json " +
-                                 dir + "/s.json 2>&1",
-                             &out);
-  ASSERT_EQ(rc, 0) << out;
-  EXPECT_NE(out.find("refinement: Newton step 1, CG iteration "), std::string::npos) << out;
-  const std::string json = slurp(dir + "/s.json");
-  EXPECT_EQ(json_text(json, "certified"), "true") << json;
-  const PoseGraph g = read_g2o(graph);
-  const double fstar = tight_optimum(g);
-  EXPECT_NEAR(json_number(json, "cost"), fstar, 1e-8 * fstar) << json;
+  const std::string graph = expect_launch_refines_to_the_optimum("auto", 99);
   // A value launch does not know is refused by name.
   std::string bad;
   EXPECT_EQ(run_command(bin("tessera") + " launch " + graph + " --refine sometimes 2>&1", &bad), 2);
