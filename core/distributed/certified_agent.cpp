@@ -208,7 +208,7 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
             emit(refine_->start(), out);
             for (const ProtocolMessage& m :
                  kept_.take_steps(tag_phase(stage_, NewtonRefineProtocol::kStatus),
-                                  tag_phase(stage_, NewtonRefineProtocol::kCoarse) + 1)) {
+                                  tag_phase(stage_, NewtonRefineProtocol::kLastStep) + 1)) {
               if (current_->done()) break;
               to_current(m, out);
             }

@@ -207,9 +207,9 @@ class NewtonRefineProtocol : public AgentProcess {
     kTranslationDirection = 66,  ///< Trial translations: public entries of the CG's z.
     kTranslationSums = 67        ///< Trial translations: <r, z>, <z, H z>.
   };
-  static bool is_refine_step(std::uint32_t step) {
-    return step >= kStatus && step <= kTranslationSums;
-  }
+  /// The last of the steps: [kStatus, kLastStep] are the refinement's.
+  static constexpr std::uint32_t kLastStep = kTranslationSums;
+  static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kLastStep; }
 
   /// `state`: the agent at the point to refine (Y, and Yn = the neighbours' public poses of the
   /// same point). It must outlive the protocol; on done() its sequences are reset to the final
