@@ -167,7 +167,7 @@ const char* kDistributedHelp =
     "                            0 = LOBPCG only; docs/distributed-certification.md)\n"
     "  --refine newton|auto|none   after the rounds reach --grad-tol, trust-region Newton\n"
     "                            steps on the whole problem, CG over neighbour exchanges and\n"
-    "                            all-agent sums (docs/newton-refine.md) (default none); auto:\n"
+    "                            all-agent sums (docs/newton-refine.md) (default auto); auto:\n"
     "                            only where the rounds' last cost decreases say they stopped\n"
     "                            more than 1e-7 of f above their limit\n"
     "  --refine-grad-tol T       the refinement stops at ||grad f|| <= T (default 1e-6) or\n"
@@ -300,7 +300,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   opt.staircase.certificate.interface_max_coordinates = static_cast<int>(
       a.get_long("certify-interface", opt.staircase.certificate.interface_max_coordinates));
   {
-    set_refine_mode(opt.refine, a.get_or("refine", "none"));
+    set_refine_mode(opt.refine, a.get_or("refine", "auto"));
     opt.refine.grad_norm_tol = a.get_double("refine-grad-tol", opt.refine.grad_norm_tol);
     opt.refine.relative_decrease_tol =
         a.get_double("refine-rel-tol", opt.refine.relative_decrease_tol);

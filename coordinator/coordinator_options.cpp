@@ -73,7 +73,7 @@ options:
   --coarse-smoothing S   smoothed: smoothing steps of the blend, 0..8 (default 1)
   --refine newton|auto|none after the rounds, trust-region Newton steps on the whole
                        problem (docs/newton-refine.md); auto: only where the rounds stopped
-                       short of their limit (default none)
+                       short of their limit (default auto)
   --refine-grad-tol T, --refine-rel-tol F
                        its stops: ||grad f|| <= T, or a step lowered f by < F f (0 = the
                        defaults, 1e-6 and 1e-7)

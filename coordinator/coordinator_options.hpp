@@ -50,7 +50,7 @@ struct CoordinatorOptions {
   std::uint32_t coarse_smoothing = 1;
   /// Newton refinement after the rounds: "none", "newton" or "auto" (--refine), with its tolerances
   /// (--refine-grad-tol, --refine-rel-tol; 0 = core's defaults).
-  std::string refine = "none";
+  std::string refine = "auto";
   double refine_grad_tol = 0;
   double refine_rel_tol = 0;
   /// At most this many agents in the distributed initialisation's local solve at once

@@ -261,7 +261,7 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "steps on the whole problem: CG over neighbour exchanges\n"
        "and all-agent sums (docs/newton-refine.md); auto: only\n"
        "where the rounds' last cost decreases say they stopped\n"
-       "more than 1e-7 of f above their limit               [none]",
+       "more than 1e-7 of f above their limit               [auto]",
        check_refine},
       {"refine-grad-tol", "refine-grad-tol", true, ForwardTo::kCoordinator, "--refine-grad-tol T",
        "the refinement stops at ||grad f|| <= T       [1e-6]", check_refine_grad_tol},

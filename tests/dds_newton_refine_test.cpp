@@ -67,7 +67,7 @@ TEST(DdsNewtonRefine, AgentsOverDdsTakeTheInProcessIterates) {
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(assignment.size(), g.num_poses);
   DistributedOptions opt;
-  opt.refine.enabled = true;
+  set_refine_mode(opt.refine, "newton");
   const DistributedResult ref = solve_distributed(g, assignment, opt, g.initial);
   ASSERT_EQ(ref.refines.size(), 1u);
   ASSERT_GE(ref.refines[0].accepted_steps, 1);

@@ -34,7 +34,7 @@ PoseGraph long_chain() {
 DistributedOptions refined(bool on) {
   DistributedOptions o;
   o.grad_norm_tol = 0.01;
-  o.refine.enabled = on;
+  set_refine_mode(o.refine, on ? "newton" : "none");
   return o;
 }
 
@@ -115,11 +115,12 @@ ThreeSolves rounds_then_refine_twice(bool refactor_every_step) {
   DistributedOptions o;
   o.round_result = false;
   o.grad_norm_tol = 1.0;
+  set_refine_mode(o.refine, "none");  // the first solve: rounds alone
   ThreeSolves out;
   for (double tol : {0.0, 1e-2, 1e-6}) {
     if (tol > 0) {
       o.grad_norm_tol = 1e300;  // no round: the refinement from where the last solve stopped
-      o.refine.enabled = true;
+      set_refine_mode(o.refine, "newton");
       o.refine.grad_norm_tol = tol;
       o.refine.relative_decrease_tol = 0.0;
       o.refine.refactor_every_step = refactor_every_step;
@@ -233,7 +234,7 @@ TEST(NewtonRefine, TrialTranslationsReSolvedLowerTheTrialCostAndReachTheOptimum)
 }
 
 // A geometric tail c_k = f + a q^k: the estimate from two windows is the exact cost still to
-// come; a trace too short to tell says +infinity, a flat one 0.
+// come; a flat one 0.
 TEST(RoundsTail, AGeometricTailIsEstimatedExactly) {
   std::vector<RoundRecord> trace;
   const double f = 100.0, a = 0.5, q = 0.8;
@@ -248,10 +249,31 @@ TEST(RoundsTail, AGeometricTailIsEstimatedExactly) {
   // A rate above the cap is read as the cap: q^5 = 0.33 > 0.2.
   const double d1 = trace[25].cost - trace[30].cost;
   EXPECT_NEAR(rounds_tail_gap(trace, 5, 0.2), d1 * 0.2 / 0.8 / trace[30].cost, 1e-12);
-  const std::vector<RoundRecord> short_trace(trace.begin(), trace.begin() + 10);
-  EXPECT_TRUE(std::isinf(rounds_tail_gap(short_trace, 5, 0.9)));
   for (auto& r : trace) r.cost = f;
   EXPECT_EQ(rounds_tail_gap(trace, 5, 0.9), 0.0);
+}
+
+// Fewer records than two windows: the last half's decrease at the capped rate, above the true
+// tail of a geometric one (its own rate, 0.8 here, is not read from so few rounds); no round
+// at all: nothing to go by, 0.
+TEST(RoundsTail, AShortTraceIsReadAtTheCappedRateAndNoRoundGivesZero) {
+  const double f = 100.0, a = 0.5, q = 0.8;
+  std::vector<RoundRecord> trace;
+  for (int k = 0; k <= 8; ++k) {  // 8 rounds, 9 records: shorter than 2 x 5 + 1
+    RoundRecord r;
+    r.round = k;
+    r.cost = f + a * std::pow(q, k);
+    trace.push_back(r);
+  }
+  const double d = trace[4].cost - trace[8].cost;  // the last 4 rounds
+  const double estimate = rounds_tail_gap(trace, 5, 0.9);
+  EXPECT_NEAR(estimate, d * 9.0 / trace[8].cost, 1e-12);
+  EXPECT_GT(estimate, a * std::pow(q, 8) / trace[8].cost);  // the true tail
+  const std::vector<RoundRecord> one_round(trace.begin(), trace.begin() + 2);
+  EXPECT_NEAR(rounds_tail_gap(one_round, 5, 0.9),
+              (trace[0].cost - trace[1].cost) * 9.0 / trace[1].cost, 1e-12);
+  const std::vector<RoundRecord> start_only(trace.begin(), trace.begin() + 1);
+  EXPECT_EQ(rounds_tail_gap(start_only, 5, 0.9), 0.0);
 }
 
 // `--refine auto`: the long chain's rounds stop 1.5e-5 above f* with the cost still falling,

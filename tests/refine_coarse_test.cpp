@@ -114,7 +114,7 @@ DistributedOptions refined(NewtonRefineOptions::Coarse coarse) {
   DistributedOptions o;
   o.grad_norm_tol = 1.0;
   o.certify = true;
-  o.refine.enabled = true;
+  set_refine_mode(o.refine, "newton");
   o.refine.coarse = coarse;
   return o;
 }

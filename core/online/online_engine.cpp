@@ -17,6 +17,9 @@ namespace tessera {
 DistributedOptions online_solver_options() {
   DistributedOptions o;
   o.local_rounds.enabled = true;
+  // The online engine's own settings: Newton steps after new data (online_step_solver), not
+  // the batch solve's `--refine auto`.
+  o.refine.enabled = false;
   return o;
 }
 
@@ -187,6 +190,7 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
   solver.round_result = false;  // the graph may not be connected yet
   if (options.newton_steps) {
     solver.refine.enabled = true;
+    solver.refine.when = NewtonRefineOptions::When::kAlways;
     solver.refine.grad_norm_tol = options.solver.grad_norm_tol;
     // The step is done only under the tolerance: a small decrease is no reason to stop.
     solver.refine.relative_decrease_tol = 0.0;

@@ -13,6 +13,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "robust/gnc_local_terms.hpp"
+#include "robust/gnc_solve_setup.hpp"
 
 namespace tessera {
 namespace {
@@ -169,7 +170,10 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
           Y.middleCols(w * static_cast<Eigen::Index>(s), w);
   }
   DistributedOptions last = solver;
-  if (final_runs && options.robust.final_refine) last.refine.enabled = true;
+  // The refinement as the agents' own solve of that kind had it.
+  last.refine = gnc_solve_options(
+                    options, final_runs ? GncSolveKind::kFinal : GncSolveKind::kInlierPass, false)
+                    .refine;
   out.final_solve = solve_distributed_from_lifted(inliers, assignment, last, X);
   if (final_runs) {
     out.total_rounds += out.final_solve.rounds;

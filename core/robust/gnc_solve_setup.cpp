@@ -8,18 +8,27 @@ namespace tessera {
 DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSolveKind kind,
                                      bool pass_capped) {
   DistributedOptions o = options.solver;
+  // `--refine auto` (the default) is about the accuracy of the answer: GNC's own solves and the
+  // inlier passes are intermediate iterates whose accuracy the schedule sets, so only an
+  // explicit `--refine newton` refines them.
+  const bool auto_refine = o.refine.when == NewtonRefineOptions::When::kIfRoundsSlow;
   switch (kind) {
     case GncSolveKind::kGnc:
       o.certify = false;
       if (options.robust.inner_max_rounds > 0)
         o.max_rounds = std::min(o.max_rounds, options.robust.inner_max_rounds);
+      if (auto_refine) o.refine.enabled = false;
       break;
     case GncSolveKind::kInlierPass:
       o.certify = false;
       if (pass_capped) o.max_rounds = std::min(o.max_rounds, options.robust.recheck_max_rounds);
+      if (auto_refine) o.refine.enabled = false;
       break;
     case GncSolveKind::kFinal:
-      if (options.robust.final_refine) o.refine.enabled = true;
+      if (options.robust.final_refine) {
+        o.refine.enabled = true;
+        o.refine.when = NewtonRefineOptions::When::kAlways;
+      }
       break;
   }
   return o;

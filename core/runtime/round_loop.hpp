@@ -49,7 +49,7 @@ struct RunOptions {
   std::uint32_t coarse_aggregates = 0;
   std::uint32_t coarse_smoothing = 1;
   /// Newton refinement after the rounds (newton_refine.hpp) and its tolerances (0 = core's).
-  std::string refine = "none";  ///< "none", "newton" or "auto" (set_refine_mode).
+  std::string refine = "auto";  ///< "none", "newton" or "auto" (set_refine_mode).
   double refine_grad_tol = 0;
   double refine_rel_tol = 0;
   /// BlockUpdateOptions::max_factor_entries (0 = core's default; runtime/team_memory.hpp).

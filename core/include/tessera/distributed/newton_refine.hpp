@@ -48,8 +48,11 @@ class TangentCoarseSpace;
 
 struct NewtonRefineOptions {
   /// Run the refinement after the block-coordinate solve reached its own tolerance (a solve
-  /// that ran out of rounds is not refined). Off by default; `--refine newton` switches it on.
-  bool enabled = false;
+  /// that ran out of rounds is not refined). On by default, with `when` = kIfRoundsSlow
+  /// (`--refine auto`, the default of `tessera solve`'s distributed algorithms, the coordinator
+  /// and `launch` alike, so in-process and DDS runs take the same steps); `--refine none`
+  /// switches it off. Code that sets it on for a refinement after every solve sets `when` too.
+  bool enabled = true;
   /// When an enabled refinement runs. kAlways (`--refine newton`): after every solve stage that
   /// converged. kIfRoundsSlow (`--refine auto`): only where the rounds' own trace says they
   /// stopped more than auto_gap_tol of f above their limit (distributed/rounds_tail.hpp: the
@@ -60,7 +63,7 @@ struct NewtonRefineOptions {
   /// (docs/newton-refine.md, "Reaching 1e-6 by default"). Identical on every agent (the
   /// trace's costs are all-agent sums).
   enum class When { kAlways, kIfRoundsSlow };
-  When when = When::kAlways;
+  When when = When::kIfRoundsSlow;
   /// kIfRoundsSlow: refine when the estimated relative gap is above this. > 0. The estimate
   /// was above the true gap on the paper graphs (parking-garage aside, 1.5-4x; there it is
   /// 3.8e-4 against 6.8e-4), so 1e-7 leaves a margin of ten to launch's goal of 1e-6.

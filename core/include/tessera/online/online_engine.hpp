@@ -29,7 +29,8 @@
 namespace tessera {
 
 /// The agents' solver of an online run: DistributedOptions' defaults with local rounds on
-/// (after a batch, most blocks are converged and only those near the new data need work).
+/// (after a batch, most blocks are converged and only those near the new data need work) and
+/// the batch refinement off (the steps' Newton steps are OnlineOptions::newton_steps).
 DistributedOptions online_solver_options();
 
 struct OnlineOptions {
