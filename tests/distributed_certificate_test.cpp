@@ -277,7 +277,8 @@ TEST(DistributedCertificate, HoldsAtALoosePointOnlyWhereTheCentralizedCertificat
       opt.rank = g.d;  // from rank d, so some verdicts are negative
       opt.certify = true;
       opt.grad_norm_tol = tol;
-      opt.staircase.grad_norm_tol = 0;  // no refinement: the loose verdict is final
+      opt.staircase.grad_norm_tol = 0;      // no refinement: the loose verdict is final
+      set_refine_mode(opt.refine, "none");  // nor the Newton one: the loose point is the test
       opt.staircase.max_rank = g.d + 1;
       const DistributedResult r =
           solve_distributed(g, sequential_partition(g.num_poses, 3), opt, g.initial);
