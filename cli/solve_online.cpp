@@ -23,7 +23,8 @@ const char* const kOnlineValued[] = {
     "rate",          "speedup",          "start",          "checkpoints",
     "certify-every", "refactor-growth",  "baseline-every", "local-threshold",
     "step-every",    "step-solver",      "newton-after",   "threads",
-    "baseline-per",  "baseline-samples", "baseline-init",  nullptr};
+    "baseline-per",  "baseline-samples", "baseline-init",  "baseline-solver",
+    nullptr};
 const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", "no-local-rounds",
                                        nullptr};
 
@@ -55,6 +56,8 @@ const char* kOnlineHelp =
     "                            closure, on the graph at the end of the step\n"
     "  --baseline-init guesses|chordal   the re-solves' start: the front ends' guesses\n"
     "                            (default) or the batch solver's chordal initialization\n"
+    "  --baseline-solver rounds|newton   the re-solves' solver: the batch solver's rounds\n"
+    "                            (default) or the online steps' Newton steps, from scratch\n"
     "  --baseline-every K        re-solve only every K-th of them and scale the CPU time by\n"
     "                            (counted / re-solved): an estimate for graphs where re-solving\n"
     "                            after every closure would take hours (default 1)\n"
@@ -101,6 +104,35 @@ struct Checkpoint {
 };
 
 }  // namespace
+
+// One re-solve of the baseline: the agents from `initial` (empty: the solver's chordal
+// initialization) to the online run's tolerance, without certificate. newton: the online
+// steps' solver (Newton steps from the start, rounds after them if they stop short), else the
+// batch solver's rounds. Not inlined: `scripts/bench/online.py --instructions` counts the
+// instructions inside it.
+[[gnu::noinline]] DistributedResult resolve_from_scratch(const PoseGraph& g,
+                                                         const std::vector<int>& assignment,
+                                                         const OnlineOptions& options, bool newton,
+                                                         const std::vector<Pose>& initial) {
+  OnlineOptions o = options;
+  o.newton_steps = newton;
+  DistributedOptions scratch = newton ? online_step_solver(o) : o.solver;
+  scratch.certify = false;
+  scratch.round_result = false;          // the graph may not be connected yet
+  scratch.local_rounds.enabled = false;  // a solve from scratch: every block has work
+  DistributedResult r = solve_distributed(g, assignment, scratch, initial);
+  if (newton && r.grad_norm > options.solver.grad_norm_tol) {
+    DistributedOptions rounds = o.solver;
+    rounds.certify = false;
+    rounds.round_result = false;
+    rounds.local_rounds.enabled = false;
+    const std::vector<NewtonRefineResult> refines = r.refines;
+    DistributedResult more = solve_distributed_from_lifted(g, assignment, rounds, r.X);
+    more.refines = refines;
+    r = std::move(more);
+  }
+  return r;
+}
 
 int solve_online_command(const Arguments& a, const std::string& graph_path,
                          std::chrono::steady_clock::time_point start) {
@@ -177,6 +209,11 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   if (baseline_init != "guesses" && baseline_init != "chordal")
     throw InputError("option --baseline-init: '" + baseline_init +
                      "' is not one of guesses, chordal");
+  const std::string baseline_solver = a.get_or("baseline-solver", "rounds");
+  if (baseline_solver != "rounds" && baseline_solver != "newton")
+    throw InputError("option --baseline-solver: '" + baseline_solver +
+                     "' is not one of rounds, newton");
+  const bool baseline_newton = baseline_solver == "newton";
   long baseline_every = a.get_long("baseline-every", 1);
   if (baseline_every < 1) throw InputError("option --baseline-every: must be >= 1");
   const long baseline_samples = a.get_long("baseline-samples", 0);
@@ -201,17 +238,13 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   std::size_t lag_next = 0;
   auto resolve = [&](const PoseGraph& g, const std::vector<int>& assignment,
                      const std::vector<Pose>& guesses) {
-    DistributedOptions scratch = options.solver;
-    scratch.certify = false;
-    scratch.round_result = false;          // the graph may not be connected yet
-    scratch.local_rounds.enabled = false;  // a solve from scratch: every block has work
     // Chordal initialization needs one connected graph; pieces that have not met yet start
     // from the guesses.
     const bool chordal = baseline_init == "chordal" && count_components(g) == 1;
     baseline_chordal += chordal ? 1 : 0;
     const double c0 = cpu_now();
-    const DistributedResult r =
-        solve_distributed(g, assignment, scratch, chordal ? std::vector<Pose>{} : guesses);
+    const DistributedResult r = resolve_from_scratch(g, assignment, options, baseline_newton,
+                                                     chordal ? std::vector<Pose>{} : guesses);
     baseline_cpu_s += cpu_now() - c0;
     baseline_rounds += r.rounds;
     for (const NewtonRefineResult& n : r.refines) baseline_cg += n.cg_iterations;
@@ -407,6 +440,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
     if (baseline)
       j.add("baseline_per", baseline_per)
           .add("baseline_init", baseline_init)
+          .add("baseline_solver", baseline_solver)
           .add("baseline_every", static_cast<int>(baseline_every))
           .add("baseline_closures", closures)
           .add("baseline_publications", publications)

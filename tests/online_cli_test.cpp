@@ -111,6 +111,16 @@ TEST(OnlineCli, PerStepTheBaselineReSolvesOncePerStepThatBroughtAClosure) {
   EXPECT_LT(json_number(j, "baseline_solves"), static_cast<double>(r.publications));
 }
 
+TEST(OnlineCli, TheBaselineReSolvesWithTheOnlineStepsNewtonStepsWhenAsked) {
+  const Replay r = generated();
+  const std::string rounds = solve(r, "--baseline-samples 4");
+  EXPECT_GT(json_number(rounds, "baseline_measured_rounds"), 0.0);
+  EXPECT_EQ(json_number(rounds, "baseline_measured_cg_iterations"), 0.0);
+  const std::string newton = solve(r, "--baseline-samples 4 --baseline-solver newton");
+  EXPECT_GT(json_number(newton, "baseline_measured_cg_iterations"), 0.0);
+  EXPECT_EQ(json_number(newton, "baseline_solves"), static_cast<double>(r.publications));
+}
+
 TEST(OnlineCli, AnUnknownBaselineModeIsRefusedWithExitCode2) {
   const Replay r = generated();
   std::string out;

@@ -72,6 +72,9 @@ def main():
     ap.add_argument("--baseline-samples", type=int, default=40,
                     help="re-solve about this many of them, spread evenly, and scale the CPU time by "
                          "(counted / re-solved); 0 = all (or --full's fixed strides) (default 40)")
+    ap.add_argument("--baseline-solver", default="rounds", choices=("rounds", "newton"),
+                    help="the re-solves' solver: the batch solver's rounds (default) or the online steps' "
+                         "Newton steps, from scratch")
     ap.add_argument("--baseline-init", default="guesses", choices=("guesses", "chordal"),
                     help="the re-solves' start: the front ends' guesses (default) or chordal "
                          "initialization (once the graph is connected)")
@@ -86,7 +89,7 @@ def main():
     ap.add_argument("--instructions", action="store_true",
                     help="also count instructions (valgrind --tool=callgrind, load-free): the online run "
                          "(run_online: steps and final certified solve) and its re-solves from scratch "
-                         "(solve_distributed), two more runs per case; slow (~50x)")
+                         "(resolve_from_scratch), two more runs per case; slow (~50x)")
     args = ap.parse_args()
     ctx = bc.Ctx(args)
     rows, runs, dds_rows = [], [], []
@@ -106,6 +109,8 @@ def main():
                 cmd += ["--baseline-every", str(every)]
             if args.baseline_init != "guesses":
                 cmd += ["--baseline-init", args.baseline_init]
+            if args.baseline_solver != "rounds":
+                cmd += ["--baseline-solver", args.baseline_solver]
         if args.no_certify:
             cmd += ["--no-certify"]
         cmd += args.extra.split()
@@ -173,7 +178,7 @@ def count_instructions(ctx, cmd, js):
     k = base.index("--checkpoints")
     base[k + 1] = "0"
     online = callgrind(ctx, base, "tessera::run_online(*")
-    scratch = callgrind(ctx, base + ["--baseline", "--no-certify"], "tessera::solve_distributed(*")
+    scratch = callgrind(ctx, base + ["--baseline", "--no-certify"], "tessera::cli::resolve_from_scratch(*")
     with open(js + ".cg") as f:  # --baseline-every K: scaled as the CPU time is
         s = json.load(f)
     if scratch and s.get("baseline_resolved"):
@@ -279,7 +284,7 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
                 "online CPU / re-solve CPU; final rel gap = (cost - f*) / f* with f* of the whole graph; with --instructions, "
                 "online / re-solve G instr = instructions (valgrind --tool=callgrind, load-free) of the online run "
                 "(tessera::run_online: the steps and the final certified solve) and of its re-solves from scratch "
-                "(tessera::solve_distributed), each in its own run of the same command, and instr ratio = their "
+                "(tessera::cli::resolve_from_scratch), each in its own run of the same command, and instr ratio = their "
                 "ratio. The "
                 "in-process engine keeps one block per robot: re-partitions and poses moved are 0.\n\n"
                 f"![online]({args.name}.png)\n")
