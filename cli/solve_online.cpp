@@ -54,10 +54,12 @@ const char* kOnlineHelp =
     "                            and with it; closure: once per closure measurement, on the\n"
     "                            graph up to and with it; step: once per step that brought a\n"
     "                            closure, on the graph at the end of the step\n"
-    "  --baseline-init guesses|chordal   the re-solves' start: the front ends' guesses\n"
-    "                            (default) or the batch solver's chordal initialization\n"
-    "  --baseline-solver rounds|newton   the re-solves' solver: the batch solver's rounds\n"
-    "                            (default) or the online steps' Newton steps, from scratch\n"
+    "  --baseline-init chordal|guesses   the re-solves' start: the batch solver's chordal\n"
+    "                            initialization (default; the front ends' guesses while the\n"
+    "                            graph is not connected) or the front ends' guesses\n"
+    "  --baseline-solver newton|rounds   the re-solves' solver: the online steps' Newton\n"
+    "                            steps from scratch (default: the cheaper on the generated\n"
+    "                            graphs) or the batch solver's rounds\n"
     "  --baseline-every K        re-solve only every K-th of them and scale the CPU time by\n"
     "                            (counted / re-solved): an estimate for graphs where re-solving\n"
     "                            after every closure would take hours (default 1)\n"
@@ -205,11 +207,11 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   if (baseline_per != "publication" && baseline_per != "closure" && baseline_per != "step")
     throw InputError("option --baseline-per: '" + baseline_per +
                      "' is not one of publication, closure, step");
-  const std::string baseline_init = a.get_or("baseline-init", "guesses");
+  const std::string baseline_init = a.get_or("baseline-init", "chordal");
   if (baseline_init != "guesses" && baseline_init != "chordal")
     throw InputError("option --baseline-init: '" + baseline_init +
                      "' is not one of guesses, chordal");
-  const std::string baseline_solver = a.get_or("baseline-solver", "rounds");
+  const std::string baseline_solver = a.get_or("baseline-solver", "newton");
   if (baseline_solver != "rounds" && baseline_solver != "newton")
     throw InputError("option --baseline-solver: '" + baseline_solver +
                      "' is not one of rounds, newton");
