@@ -19,12 +19,15 @@
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {
-    "rate",          "speedup",          "start",          "checkpoints",
-    "certify-every", "refactor-growth",  "baseline-every", "local-threshold",
-    "step-every",    "step-solver",      "newton-after",   "threads",
-    "baseline-per",  "baseline-samples", "baseline-init",  "baseline-solver",
-    nullptr};
+const char* const kOnlineValued[] = {"rate",           "speedup",
+                                     "start",          "checkpoints",
+                                     "certify-every",  "refactor-growth",
+                                     "baseline-every", "local-threshold",
+                                     "step-every",     "step-solver",
+                                     "newton-after",   "threads",
+                                     "baseline-per",   "baseline-samples",
+                                     "baseline-init",  "baseline-solver",
+                                     "step-coarse",    nullptr};
 const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", "no-local-rounds",
                                        nullptr};
 
@@ -80,6 +83,8 @@ const char* kOnlineHelp =
     "                            distributed Newton steps from the warm start (default) or\n"
     "                            block-coordinate rounds only\n"
     "  --newton-after T          newton: rounds first, down to ||grad f|| <= T (default: none)\n"
+    "  --step-coarse none|blocks newton: the CG's coarse correction (default none: block\n"
+    "                            Jacobi; blocks: plus one rigid motion per block)\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step)\n";
 
@@ -160,6 +165,11 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       throw InputError("option --step-solver: '" + step_solver + "' is not one of newton, rounds");
     options.newton_steps = step_solver == "newton";
     options.newton_after_grad_tol = a.get_double("newton-after", options.newton_after_grad_tol);
+    const std::string coarse = a.get_or("step-coarse", "none");
+    if (coarse != "none" && coarse != "blocks")
+      throw InputError("option --step-coarse: '" + coarse + "' is not one of none, blocks");
+    options.newton_coarse = coarse == "blocks" ? NewtonRefineOptions::Coarse::kBlocks
+                                               : NewtonRefineOptions::Coarse::kNone;
   }
   options.validate();
   ReplayOptions replay;
