@@ -295,10 +295,12 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       // A pose no measurement touches yet would leave its block without a problem: skip.
       std::vector<char> linked(g.num_poses, 0);
       for (const Measurement& m : g.measurements) linked[m.i] = linked[m.j] = 1;
-      if (std::find(linked.begin(), linked.end(), 0) != linked.end())
+      if (std::find(linked.begin(), linked.end(), 0) != linked.end()) {
         ++skipped;
-      else if (baseline_solves++ % baseline_every == 0)  // sampled: the others not re-solved
-        ++baseline_sampled, resolve(g, engine.assignment(), engine.stream().guesses());
+      } else if (baseline_solves++ % baseline_every == 0) {  // sampled: the others not re-solved
+        ++baseline_sampled;
+        resolve(g, engine.assignment(), engine.stream().guesses());
+      }
     }
     // The lagging stream takes the step's batches one at a time (same order, so the same ids
     // as the engine's stream).
