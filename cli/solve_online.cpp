@@ -2,10 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <ctime>
 #include <tessera/distributed/distributed_solver.hpp>
-#include <tessera/graph/connectivity.hpp>
-#include <tessera/online/graph_stream.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/online/replay_schedule.hpp>
 #include <tessera/problem/objective.hpp>
@@ -14,6 +11,7 @@
 #include <vector>
 
 #include "json_writer.hpp"
+#include "online_baseline.hpp"
 #include "robot_files.hpp"
 #include "runtime/replay_input.hpp"
 
@@ -90,10 +88,6 @@ const char* kOnlineHelp =
 
 namespace {
 
-double cpu_now() {
-  return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
-}
-
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -111,35 +105,6 @@ struct Checkpoint {
 };
 
 }  // namespace
-
-// One re-solve of the baseline: the agents from `initial` (empty: the solver's chordal
-// initialization) to the online run's tolerance, without certificate. newton: the online
-// steps' solver (Newton steps from the start, rounds after them if they stop short), else the
-// batch solver's rounds. Not inlined: `scripts/bench/online.py --instructions` counts the
-// instructions inside it.
-[[gnu::noinline]] DistributedResult resolve_from_scratch(const PoseGraph& g,
-                                                         const std::vector<int>& assignment,
-                                                         const OnlineOptions& options, bool newton,
-                                                         const std::vector<Pose>& initial) {
-  OnlineOptions o = options;
-  o.newton_steps = newton;
-  DistributedOptions scratch = newton ? online_step_solver(o) : o.solver;
-  scratch.certify = false;
-  scratch.round_result = false;          // the graph may not be connected yet
-  scratch.local_rounds.enabled = false;  // a solve from scratch: every block has work
-  DistributedResult r = solve_distributed(g, assignment, scratch, initial);
-  if (newton && r.grad_norm > options.solver.grad_norm_tol) {
-    DistributedOptions rounds = o.solver;
-    rounds.certify = false;
-    rounds.round_result = false;
-    rounds.local_rounds.enabled = false;
-    const std::vector<NewtonRefineResult> refines = r.refines;
-    DistributedResult more = solve_distributed_from_lifted(g, assignment, rounds, r.X);
-    more.refines = refines;
-    r = std::move(more);
-  }
-  return r;
-}
 
 int solve_online_command(const Arguments& a, const std::string& graph_path,
                          std::chrono::steady_clock::time_point start) {
@@ -204,73 +169,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           : 0;
   std::vector<Checkpoint> marks;
   std::size_t seen_batches = 0, next_mark = every;
-  // The baseline: re-solving from scratch after every loop closure (issue 24's target: the
-  // online run's CPU at most a tenth of it). Per publication (the default), once after every
-  // batch a front end published with loop closures in it, on the graph published up to and with
-  // that batch: closures that arrive together are served by one re-solve. Per closure, once
-  // per closure measurement, on the graph up to and with it (closures of one batch each get
-  // their own). A lagging copy of the stream absorbs the same batches one at a time so that
-  // each graph is known exactly, not only the step's. Per step: once per step that brought a
-  // closure, on the graph at the end of the step (fewer re-solves when steps are long).
-  const bool baseline = a.has("baseline");
-  const std::string baseline_per = a.get_or("baseline-per", "publication");
-  if (baseline_per != "publication" && baseline_per != "closure" && baseline_per != "step")
-    throw InputError("option --baseline-per: '" + baseline_per +
-                     "' is not one of publication, closure, step");
-  const std::string baseline_init = a.get_or("baseline-init", "chordal");
-  if (baseline_init != "guesses" && baseline_init != "chordal")
-    throw InputError("option --baseline-init: '" + baseline_init +
-                     "' is not one of guesses, chordal");
-  const std::string baseline_solver = a.get_or("baseline-solver", "newton");
-  if (baseline_solver != "rounds" && baseline_solver != "newton")
-    throw InputError("option --baseline-solver: '" + baseline_solver +
-                     "' is not one of rounds, newton");
-  const bool baseline_newton = baseline_solver == "newton";
-  long baseline_every = a.get_long("baseline-every", 1);
-  if (baseline_every < 1) throw InputError("option --baseline-every: must be >= 1");
-  const long baseline_samples = a.get_long("baseline-samples", 0);
-  if (baseline_samples < 0) throw InputError("option --baseline-samples: must be >= 0");
-  std::size_t plan_closures = 0, plan_publications = 0;
-  for (const StreamBatch& b : plan.batches) {
-    std::size_t k = 0;
-    for (const StreamMeasurement& m : b.measurements)
-      k += m.kind != MeasurementKind::kOdometry ? 1 : 0;
-    plan_closures += k;
-    plan_publications += k > 0 ? 1 : 0;
-  }
-  if (baseline_samples > 0)  // per step: at most one per publication, so K may be smaller
-    baseline_every = std::max<long>(
-        1, static_cast<long>(baseline_per == "closure" ? plan_closures : plan_publications) /
-               baseline_samples);
-  double baseline_cpu_s = 0.0;
-  int baseline_solves = 0, baseline_sampled = 0, baseline_rounds = 0, baseline_cg = 0;
-  int baseline_chordal = 0;
-  std::size_t closures = 0, publications = 0, closure_steps = 0, skipped = 0;
-  GraphStream lag(input.graph.d, "baseline stream");
-  std::size_t lag_next = 0;
-  auto resolve = [&](const PoseGraph& g, const std::vector<int>& assignment,
-                     const std::vector<Pose>& guesses) {
-    // Chordal initialization needs one connected graph; pieces that have not met yet start
-    // from the guesses.
-    const bool chordal = baseline_init == "chordal" && count_components(g) == 1;
-    baseline_chordal += chordal ? 1 : 0;
-    const double c0 = cpu_now();
-    const DistributedResult r = resolve_from_scratch(g, assignment, options, baseline_newton,
-                                                     chordal ? std::vector<Pose>{} : guesses);
-    baseline_cpu_s += cpu_now() - c0;
-    baseline_rounds += r.rounds;
-    for (const NewtonRefineResult& n : r.refines) baseline_cg += n.cg_iterations;
-  };
-  // Blocks numbered 0..k-1 in order of first use (a prefix may miss a later robot's block).
-  auto compact = [](std::vector<int> assignment) {
-    std::vector<int> label;
-    for (int& b : assignment) {
-      auto it = std::find(label.begin(), label.end(), b);
-      if (it == label.end()) it = label.insert(label.end(), b);
-      b = static_cast<int>(it - label.begin());
-    }
-    return assignment;
-  };
+  OnlineBaseline baseline(a, plan, input.graph.d, options);
   auto observer = [&](const OnlineEngine& engine, const OnlineUpdate& u) {
     seen_batches += u.batches;
     const PoseGraph& g = engine.stream().graph();
@@ -285,61 +184,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         marks.push_back(std::move(c));
       }
     }
-    if (!baseline) return;
-    const auto& kinds = engine.stream().kinds();
-    const bool closure =
-        std::any_of(kinds.end() - static_cast<std::ptrdiff_t>(u.measurements), kinds.end(),
-                    [](MeasurementKind k) { return k != MeasurementKind::kOdometry; });
-    closure_steps += closure ? 1 : 0;
-    if (baseline_per == "step" && closure) {
-      // A pose no measurement touches yet would leave its block without a problem: skip.
-      std::vector<char> linked(g.num_poses, 0);
-      for (const Measurement& m : g.measurements) linked[m.i] = linked[m.j] = 1;
-      if (std::find(linked.begin(), linked.end(), 0) != linked.end()) {
-        ++skipped;
-      } else if (baseline_solves++ % baseline_every == 0) {  // sampled: the others not re-solved
-        ++baseline_sampled;
-        resolve(g, engine.assignment(), engine.stream().guesses());
-      }
-    }
-    // The lagging stream takes the step's batches one at a time (same order, so the same ids
-    // as the engine's stream).
-    while ((lag.graph().num_poses < g.num_poses ||
-            lag.graph().measurements.size() < g.measurements.size()) &&
-           lag_next < plan.batches.size()) {
-      const StreamGrowth grown = lag.absorb(plan.batches[lag_next++]);
-      const PoseGraph& lg = lag.graph();
-      // Re-solves the graph of lg's poses and its first `count` measurements.
-      auto consider = [&](std::size_t count) {
-        PoseGraph prefix;
-        prefix.d = lg.d;
-        prefix.num_poses = lg.num_poses;
-        prefix.measurements.assign(lg.measurements.begin(),
-                                   lg.measurements.begin() + static_cast<std::ptrdiff_t>(count));
-        std::vector<char> linked(prefix.num_poses, 0);
-        for (const Measurement& m : prefix.measurements) linked[m.i] = linked[m.j] = 1;
-        if (std::find(linked.begin(), linked.end(), 0) != linked.end()) {
-          ++skipped;  // a pose without a measurement: no block problem
-          return;
-        }
-        // Sampled in the middle of every stride of baseline_every.
-        if (baseline_solves++ % baseline_every != baseline_every / 2) return;
-        ++baseline_sampled;
-        std::vector<int> assignment(
-            engine.assignment().begin(),
-            engine.assignment().begin() + static_cast<std::ptrdiff_t>(prefix.num_poses));
-        resolve(prefix, compact(std::move(assignment)), lag.guesses());
-      };
-      std::size_t in_batch = 0;
-      for (std::size_t k = grown.first_new_measurement;
-           k < grown.first_new_measurement + grown.num_new_measurements; ++k) {
-        if (lag.kinds()[k] == MeasurementKind::kOdometry) continue;
-        ++closures, ++in_batch;
-        if (baseline_per == "closure") consider(k + 1);
-      }
-      publications += in_batch > 0 ? 1 : 0;
-      if (baseline_per == "publication" && in_batch > 0) consider(lg.measurements.size());
-    }
+    baseline.observe(engine, u);
   };
   const OnlineResult res = run_online(input.graph.d, plan.batches, options, observer);
   const double wall_s =
@@ -451,23 +296,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("certified", res.certified)
         .add("min_eigenvalue", res.min_eigenvalue)
         .add("wall_s", wall_s);
-    if (baseline)
-      j.add("baseline_per", baseline_per)
-          .add("baseline_init", baseline_init)
-          .add("baseline_solver", baseline_solver)
-          .add("baseline_every", static_cast<int>(baseline_every))
-          .add("baseline_closures", closures)
-          .add("baseline_publications", publications)
-          .add("baseline_skipped", skipped)
-          .add("baseline_closure_steps", closure_steps)
-          .add("baseline_chordal_starts", baseline_chordal)
-          .add("baseline_measured_rounds", baseline_rounds)
-          .add("baseline_measured_cg_iterations", baseline_cg)
-          .add("baseline_solves", baseline_solves)
-          .add("baseline_resolved", baseline_sampled)
-          .add("baseline_measured_cpu_s", baseline_cpu_s)
-          .add("baseline_cpu_s",
-               baseline_sampled > 0 ? baseline_cpu_s * baseline_solves / baseline_sampled : 0.0);
+    baseline.add_to(j);
     j.add("certificates", certs).add("checkpoints", cps).add("updates", updates);
     write_output(*p, j.str());
   }
