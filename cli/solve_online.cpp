@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <ctime>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/online/replay_schedule.hpp>
@@ -12,16 +11,21 @@
 #include <vector>
 
 #include "json_writer.hpp"
+#include "online_baseline.hpp"
 #include "robot_files.hpp"
 #include "runtime/replay_input.hpp"
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {"rate",           "speedup",         "start",
-                                     "checkpoints",    "certify-every",   "refactor-growth",
-                                     "baseline-every", "local-threshold", "step-every",
-                                     "step-solver",    "newton-after",    "threads",
-                                     nullptr};
+const char* const kOnlineValued[] = {"rate",           "speedup",
+                                     "start",          "checkpoints",
+                                     "certify-every",  "refactor-growth",
+                                     "baseline-every", "local-threshold",
+                                     "step-every",     "step-solver",
+                                     "newton-after",   "threads",
+                                     "baseline-per",   "baseline-samples",
+                                     "baseline-init",  "baseline-solver",
+                                     "step-coarse",    nullptr};
 const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", "no-local-rounds",
                                        nullptr};
 
@@ -44,12 +48,24 @@ const char* kOnlineHelp =
     "  --checkpoints K           at K evenly spaced steps, the estimate's relative gap to the\n"
     "                            optimum of the graph received so far (centralized solver,\n"
     "                            computed after the run, not timed)\n"
-    "  --baseline                also re-solve from scratch (the front ends' guesses, no warm\n"
-    "                            start) after every step that brought a loop closure, and\n"
-    "                            report its CPU time\n"
-    "  --baseline-every K        re-solve only at every K-th such step and scale its CPU time\n"
-    "                            by (steps / re-solved steps): an estimate for graphs where\n"
-    "                            re-solving after every closure would take hours (default 1)\n"
+    "  --baseline                also re-solve from scratch (no warm start) after every loop\n"
+    "                            closure, to the same tolerance, and report its CPU time\n"
+    "  --baseline-per publication|closure|step   publication (default): once per batch a\n"
+    "                            front end published with closures in it, on the graph up to\n"
+    "                            and with it; closure: once per closure measurement, on the\n"
+    "                            graph up to and with it; step: once per step that brought a\n"
+    "                            closure, on the graph at the end of the step\n"
+    "  --baseline-init chordal|guesses   the re-solves' start: the batch solver's chordal\n"
+    "                            initialization (default; the front ends' guesses while the\n"
+    "                            graph is not connected) or the front ends' guesses\n"
+    "  --baseline-solver newton|rounds   the re-solves' solver: the online steps' Newton\n"
+    "                            steps from scratch (default: the cheaper on the generated\n"
+    "                            graphs) or the batch solver's rounds\n"
+    "  --baseline-every K        re-solve only every K-th of them and scale the CPU time by\n"
+    "                            (counted / re-solved): an estimate for graphs where re-solving\n"
+    "                            after every closure would take hours (default 1)\n"
+    "  --baseline-samples M      the same with K chosen for about M re-solves spread evenly\n"
+    "                            over the replay (default 0: use --baseline-every)\n"
     "  --certify-every S         also certify every S seconds of stream time (default 0: at\n"
     "                            the end only)\n"
     "  --refactor-growth G       a growing block keeps its preconditioner factor, the new\n"
@@ -65,14 +81,12 @@ const char* kOnlineHelp =
     "                            distributed Newton steps from the warm start (default) or\n"
     "                            block-coordinate rounds only\n"
     "  --newton-after T          newton: rounds first, down to ||grad f|| <= T (default: none)\n"
+    "  --step-coarse none|blocks newton: the CG's coarse correction (default none: block\n"
+    "                            Jacobi; blocks: plus one rigid motion per block)\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step)\n";
 
 namespace {
-
-double cpu_now() {
-  return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
-}
 
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
@@ -116,6 +130,11 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       throw InputError("option --step-solver: '" + step_solver + "' is not one of newton, rounds");
     options.newton_steps = step_solver == "newton";
     options.newton_after_grad_tol = a.get_double("newton-after", options.newton_after_grad_tol);
+    const std::string coarse = a.get_or("step-coarse", "none");
+    if (coarse != "none" && coarse != "blocks")
+      throw InputError("option --step-coarse: '" + coarse + "' is not one of none, blocks");
+    options.newton_coarse = coarse == "blocks" ? NewtonRefineOptions::Coarse::kBlocks
+                                               : NewtonRefineOptions::Coarse::kNone;
   }
   options.validate();
   ReplayOptions replay;
@@ -150,11 +169,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           : 0;
   std::vector<Checkpoint> marks;
   std::size_t seen_batches = 0, next_mark = every;
-  double baseline_cpu_s = 0.0;
-  int baseline_solves = 0, baseline_sampled = 0;
-  const bool baseline = a.has("baseline");
-  const long baseline_every = a.get_long("baseline-every", 1);
-  if (baseline_every < 1) throw InputError("option --baseline-every: must be >= 1");
+  OnlineBaseline baseline(a, plan, input.graph.d, options);
   auto observer = [&](const OnlineEngine& engine, const OnlineUpdate& u) {
     seen_batches += u.batches;
     const PoseGraph& g = engine.stream().graph();
@@ -169,25 +184,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         marks.push_back(std::move(c));
       }
     }
-    if (!baseline) return;
-    const auto& kinds = engine.stream().kinds();
-    const bool closure =
-        std::any_of(kinds.end() - static_cast<std::ptrdiff_t>(u.measurements), kinds.end(),
-                    [](MeasurementKind k) { return k != MeasurementKind::kOdometry; });
-    // From scratch: the same agents from the front ends' guesses (no warm start). A pose no
-    // measurement touches yet would leave its block without a problem: skip such steps.
-    std::vector<char> linked(g.num_poses, 0);
-    for (const Measurement& m : g.measurements) linked[m.i] = linked[m.j] = 1;
-    if (!closure || std::find(linked.begin(), linked.end(), 0) != linked.end()) return;
-    if (baseline_solves++ % baseline_every != 0) return;  // sampled: not re-solved here
-    ++baseline_sampled;
-    DistributedOptions scratch = options.solver;
-    scratch.certify = false;
-    scratch.round_result = false;          // the graph may not be connected yet
-    scratch.local_rounds.enabled = false;  // a solve from scratch: every block has work
-    const double c0 = cpu_now();
-    solve_distributed(g, engine.assignment(), scratch, engine.stream().guesses());
-    baseline_cpu_s += cpu_now() - c0;
+    baseline.observe(engine, u);
   };
   const OnlineResult res = run_online(input.graph.d, plan.batches, options, observer);
   const double wall_s =
@@ -299,12 +296,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("certified", res.certified)
         .add("min_eigenvalue", res.min_eigenvalue)
         .add("wall_s", wall_s);
-    if (baseline)
-      j.add("baseline_solves", baseline_solves)
-          .add("baseline_resolved", baseline_sampled)
-          .add("baseline_measured_cpu_s", baseline_cpu_s)
-          .add("baseline_cpu_s",
-               baseline_sampled > 0 ? baseline_cpu_s * baseline_solves / baseline_sampled : 0.0);
+    baseline.add_to(j);
     j.add("certificates", certs).add("checkpoints", cps).add("updates", updates);
     write_output(*p, j.str());
   }

@@ -35,6 +35,8 @@ void OnlineOptions::validate() const {
     throw InputError("OnlineOptions.step_every_s: a fixed step period excludes real_time");
   if (!(newton_forcing > 0 && newton_forcing < 1))
     throw InputError("OnlineOptions.newton_forcing must be in (0, 1)");
+  if (newton_coarse == NewtonRefineOptions::Coarse::kSmoothed)
+    throw InputError("OnlineOptions.newton_coarse: kSmoothed is not available (kNone or kBlocks)");
   if (!(newton_after_grad_tol > 0))
     throw InputError("OnlineOptions.newton_after_grad_tol must be > 0 (+infinity: no round)");
   DistributedOptions s = solver;
@@ -196,8 +198,7 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     solver.refine.relative_decrease_tol = 0.0;
     solver.refine.refactor_every_step = false;
     solver.refine.forcing = options.newton_forcing;
-    // Not measured on the online steps (a few CG iterations from a warm start): block Jacobi.
-    solver.refine.coarse = NewtonRefineOptions::Coarse::kNone;
+    solver.refine.coarse = options.newton_coarse;
     // Nor the trial translations' re-solve (measured on long chains from a cold start).
     solver.refine.translation_iterations = 0;
     solver.grad_norm_tol = std::max(options.newton_after_grad_tol, solver.grad_norm_tol);

@@ -6,8 +6,9 @@ Per run: median and 95th percentile latency over the batches (publication of a b
 end of the step that absorbed it, when the gradient is back under the tolerance; with
 --real-time the steps' wall time is stream time), the relative gap to the optimum of the graph received so far at
 sampled checkpoints (centralized solver, offline), rounds and bytes per second of stream,
-the CPU time of the online run against re-solving from scratch after every step that brought
-a loop closure (same script, same agents), and the final cost against the batch optimum f*
+the CPU time of the online run against re-solving from scratch after every loop closure (the
+issue's baseline: same agents and blocks, on the graph published up to and with each closure, a
+sample of them re-solved and scaled), and the final cost against the batch optimum f*
 (centralized solver on the whole graph) with the certificate.
 
 Writes docs/benchmarks/online.csv, online.png and online.md. The default sizes are small: the machine is
@@ -64,6 +65,19 @@ def main():
                          "load), tick (one step per publication time: load-free, re-solving after every tick that "
                          "brought a loop closure), or a number S (a step every S seconds of stream time)")
     ap.add_argument("--no-baseline", action="store_true", help="skip the re-solving baseline")
+    ap.add_argument("--baseline-per", default="publication", choices=("publication", "closure", "step"),
+                    help="the baseline re-solves from scratch after every loop closure: once per batch a "
+                         "front end published with closures in it (default; closures that arrive together "
+                         "share a re-solve), once per closure measurement, or once per step that brought one")
+    ap.add_argument("--baseline-samples", type=int, default=40,
+                    help="re-solve about this many of them, spread evenly, and scale the CPU time by "
+                         "(counted / re-solved); 0 = all (or --full's fixed strides) (default 40)")
+    ap.add_argument("--baseline-solver", default="newton", choices=("newton", "rounds"),
+                    help="the re-solves' solver: the online steps' Newton steps from scratch (default: "
+                         "cheaper than the rounds on the generated graphs) or the batch solver's rounds")
+    ap.add_argument("--baseline-init", default="chordal", choices=("chordal", "guesses"),
+                    help="the re-solves' start: chordal initialization (default; the front ends' guesses "
+                         "while the graph is not connected) or the front ends' guesses")
     ap.add_argument("--no-certify", action="store_true", help="skip the final certificate")
     ap.add_argument("--cases", default="", help="with --full: comma list of sphere2500,city10000,grid3d-50000")
     ap.add_argument("--dds", action="store_true",
@@ -75,7 +89,7 @@ def main():
     ap.add_argument("--instructions", action="store_true",
                     help="also count instructions (valgrind --tool=callgrind, load-free): the online run "
                          "(run_online: steps and final certified solve) and its re-solves from scratch "
-                         "(solve_distributed), two more runs per case; slow (~50x)")
+                         "(resolve_from_scratch), two more runs per case; slow (~50x)")
     args = ap.parse_args()
     ctx = bc.Ctx(args)
     rows, runs, dds_rows = [], [], []
@@ -87,8 +101,16 @@ def main():
                "--grad-tol", str(args.grad_tol), "--checkpoints", str(args.checkpoints), "--json", js]
         if not args.no_baseline:
             cmd += ["--baseline"]
-        if every > 1 and not args.no_baseline:
-            cmd += ["--baseline-every", str(every)]
+        if not args.no_baseline:
+            cmd += ["--baseline-per", args.baseline_per]
+            if args.baseline_samples > 0:
+                cmd += ["--baseline-samples", str(args.baseline_samples)]
+            elif every > 1:
+                cmd += ["--baseline-every", str(every)]
+            if args.baseline_init != "chordal":
+                cmd += ["--baseline-init", args.baseline_init]
+            if args.baseline_solver != "newton":
+                cmd += ["--baseline-solver", args.baseline_solver]
         if args.no_certify:
             cmd += ["--no-certify"]
         cmd += args.extra.split()
@@ -111,6 +133,13 @@ def main():
             "rounds_per_s": s["rounds"] / stream_s, "bytes_per_s_per_agent": s["bytes"] / stream_s / robots,
             "online_cpu_s": s["cpu_s"], "online_setup_s": s["setup_s"], "online_rounds_cpu_s": s["rounds_cpu_s"], "baseline_cpu_s": s.get("baseline_cpu_s"),
             "baseline_solves": s.get("baseline_solves"), "baseline_resolved": s.get("baseline_resolved"),
+            "baseline_per": s.get("baseline_per"), "closures": s.get("baseline_closures"),
+            "closure_publications": s.get("baseline_publications"),
+            "closure_steps": s.get("baseline_closure_steps"),
+            "baseline_rounds_per_solve": (s["baseline_measured_rounds"] / s["baseline_resolved"]
+                                          if s.get("baseline_resolved") else None),
+            "baseline_cg_per_solve": (s["baseline_measured_cg_iterations"] / s["baseline_resolved"]
+                                      if s.get("baseline_resolved") else None),
             "cpu_ratio": s["cpu_s"] / s["baseline_cpu_s"] if s.get("baseline_cpu_s") else None,
             "max_step_cpu_s": max((u["cpu_s"] for u in s["updates"]), default=0.0),
             "critical_path_cpu_s": sum(u.get("critical_path_cpu_s", 0.0) for u in s["updates"]),
@@ -151,7 +180,7 @@ def count_instructions(ctx, cmd, js):
     k = base.index("--checkpoints")
     base[k + 1] = "0"
     online = callgrind(ctx, base, "tessera::run_online(*")
-    scratch = callgrind(ctx, base + ["--baseline", "--no-certify"], "tessera::solve_distributed(*")
+    scratch = callgrind(ctx, base + ["--baseline", "--no-certify"], "tessera::cli::resolve_from_scratch(*")
     with open(js + ".cg") as f:  # --baseline-every K: scaled as the CPU time is
         s = json.load(f)
     if scratch and s.get("baseline_resolved"):
@@ -171,7 +200,7 @@ def step_args(args):
 
 def write_outputs(args, ctx, rows, runs, dds_rows):
     headers = ["graph", "poses", "steps", "step solver", "message steps", "Newton CG", "lat med s", "lat p95 s", "max gap", "online CPU s", "set-up s",
-               "rounds CPU s", "max step CPU s", "critical path s", "re-solves", "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
+               "rounds CPU s", "max step CPU s", "critical path s", "closures", "closure publications", "closure steps", "re-solves", "re-solve rounds", "re-solve CG", "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
     if args.instructions:
         headers += ["online G instr", "re-solve G instr", "instr ratio"]
     table = bc.print_table(
@@ -184,7 +213,10 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
           bc.fmt(r["online_cpu_s"], "{:.2f}"), bc.fmt(r["online_setup_s"], "{:.2f}"),
           bc.fmt(r["online_rounds_cpu_s"], "{:.2f}"), bc.fmt(r["max_step_cpu_s"], "{:.2f}"),
           bc.fmt(r["critical_path_cpu_s"], "{:.2f}"),
-          f"{r['baseline_resolved']}/{r['baseline_solves']}", bc.fmt(r["baseline_cpu_s"], "{:.2f}"),
+          r["closures"], r["closure_publications"], r["closure_steps"],
+          f"{r['baseline_resolved']}/{r['baseline_solves']}",
+          bc.fmt(r["baseline_rounds_per_solve"], "{:.0f}"), bc.fmt(r["baseline_cg_per_solve"], "{:.0f}"),
+          bc.fmt(r["baseline_cpu_s"], "{:.2f}"),
           bc.fmt(r["cpu_ratio"], "{:.3f}"), bc.fmt(r["final_rel_gap"], "{:.1e}"), r["certified"], r["load_1min"]]
          + ([bc.fmt(r.get("online_ginstr"), "{:.2f}"), bc.fmt(r.get("baseline_ginstr"), "{:.2f}"),
              bc.fmt(r.get("instr_ratio"), "{:.3f}")] if args.instructions else [])
@@ -243,13 +275,20 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
                 "(gradient back under the tolerance or stalled), median and 95th percentile over all batches; max "
                 "gap = largest relative gap (f(estimate) - f*_k) / f*_k over the checkpoints, f*_k the centralized "
                 "optimum of the graph received by checkpoint k; online CPU = process CPU of all steps and the final "
-                "certificate; max step CPU s = the longest step's process CPU (all agents); critical path s = the rounds' compute time summed over the steps with every agent on its own machine (per message step the slowest agent); set-up s = wall time of the agents' set-up (block problems, preconditioner factors) over the steps; rounds CPU s = process CPU of the rounds alone; re-solves = steps re-solved / steps that brought a loop closure; re-solve CPU = the same agents "
-                "solving from scratch (the front ends' guesses) after every step that brought a loop closure (when "
-                "only every K-th such step is re-solved, their CPU times (steps / re-solved)); ratio = online CPU / "
-                "re-solve CPU; final rel gap = (cost - f*) / f* with f* of the whole graph; with --instructions, "
+                "certificate; max step CPU s = the longest step's process CPU (all agents); critical path s = the rounds' compute time summed over the steps with every agent on its own machine (per message step the slowest agent); set-up s = wall time of the agents' set-up (block problems, preconditioner factors) over the steps; rounds CPU s = process CPU of the rounds alone; closures = loop closure measurements in the replay; closure publications = batches (one robot, one "
+                "publication time) with at least one; closure steps = steps that brought at least one; re-solves = "
+                "re-solved / counted (per " + args.baseline_per + ": one per closure publication, the issue's "
+                "re-solve after every loop closure with closures that arrive together sharing one; per closure one "
+                "per closure measurement; per step one per closure step); re-solve rounds / CG = mean rounds / "
+                "Newton CG iterations of a re-solve; re-solve CPU = the same agents and blocks solving from scratch (with " + args.baseline_solver +
+                ": newton = the online steps' Newton steps, rounds = the batch solver's rounds; no warm start; from " + args.baseline_init + ": chordal = the batch solver's chordal initialization "
+                "where the graph is connected, the front ends' guesses elsewhere) on the graph published up to "
+                "and with each, to the same tolerance, without certificate; when only a sample is re-solved "
+                "(every K-th, K = publications or closures / --baseline-samples), their CPU times (counted / re-solved); ratio = "
+                "online CPU / re-solve CPU; final rel gap = (cost - f*) / f* with f* of the whole graph; with --instructions, "
                 "online / re-solve G instr = instructions (valgrind --tool=callgrind, load-free) of the online run "
                 "(tessera::run_online: the steps and the final certified solve) and of its re-solves from scratch "
-                "(tessera::solve_distributed), each in its own run of the same command, and instr ratio = their "
+                "(tessera::cli::resolve_from_scratch), each in its own run of the same command, and instr ratio = their "
                 "ratio. The "
                 "in-process engine keeps one block per robot: re-partitions and poses moved are 0.\n\n"
                 f"![online]({args.name}.png)\n")

@@ -88,6 +88,13 @@ struct OnlineOptions {
   /// city / grid3d / sphere, 5 robots, a step every 0.1 s: Newton steps 108 / 97 / 77 at 0.1,
   /// 75 / 76 / 64 at 0.03; CG iterations 1,747 / 632 / 575 against 1,646 / 601 / 529. In (0, 1).
   double newton_forcing = 0.03;
+  /// The Newton steps' coarse correction (NewtonRefineOptions::coarse): kNone (block Jacobi,
+  /// the default) or kBlocks (plus one rigid motion per block). kSmoothed is not available here
+  /// (its space is built where batch agents are set up). Off because its fewer CG iterations
+  /// cost more than they save: on the generated 1,000-pose grid3d (5 robots, a step every
+  /// 0.1 s; valgrind --tool=callgrind, tessera::run_online) kBlocks took 547 CG iterations and
+  /// 6.97 G instructions against 601 and 3.25 G (docs/online.md).
+  NewtonRefineOptions::Coarse newton_coarse = NewtonRefineOptions::Coarse::kNone;
   /// New poses that new loop closures tie to the estimate are placed by least squares against
   /// every new measurement after composition (new_pose_placement.hpp), not only along their
   /// odometry. false: composition only.
