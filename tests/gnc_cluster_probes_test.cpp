@@ -144,9 +144,11 @@ TEST(ClusterProbes, AReturnProbeBringsBackTheClosuresJustBeyondTheBoundAndKeepsW
     return ClusterProbeTrial{tls_recheck(g, known, at, c2, rejected).rejected, at};
   };
   int kept_calls = 0;
+  ProbeRules rules;
+  rules.budget = 10;
+  rules.return_ratio = 4.0;
   const ClusterProbeCounts counts =
-      search_cluster_probes(g, known, c2, 10, false, ClosureClusterOptions{}, 4.0, all, poses,
-                            solve, [&] { ++kept_calls; });
+      search_cluster_probes(g, known, c2, rules, all, poses, solve, [&] { ++kept_calls; });
   // Together (A and B back): A fits, the passes cut B again, the TLS cost falls: kept. Then B
   // alone at the new solution: nothing changes, refused. C is never asked back.
   ASSERT_EQ(asked.size(), 2u);
@@ -167,6 +169,7 @@ TEST(GncCentralized, ClusterProbesCutAGroupOfConsistentWrongClosuresThatGncAlone
   const GeneratorResult g = flexible_city(0.1, OutlierKind::kGroup, 3);
   GncCentralizedOptions o;
   o.robust.kind = RobustKind::kGncTls;
+  o.robust.probe_tail_ratio = 1e9;  // no tail probe (the next test has it)
   const GncCentralizedResult without = solve_gnc_centralized(g.graph, o);
   o.cluster_probes = 20;
   const GncCentralizedResult with = solve_gnc_centralized(g.graph, o);
@@ -193,6 +196,33 @@ TEST(GncCentralized, ClusterProbesCutAGroupOfConsistentWrongClosuresThatGncAlone
   for (std::size_t e = 0; e < with.weights.size(); ++e)
     EXPECT_EQ(with.weights[e],
               std::binary_search(with.rejected.begin(), with.rejected.end(), e) ? 0.0 : 1.0);
+}
+
+// The tail probe (RobustOptions::probe_ratio, probe_tail_ratio; on by default): the same bent map
+// has a heavy tail of kept residuals (the closures the bend fits lie far above the median), so
+// the kept closures above 5 x the median leave together, the passes take back the true closures
+// that fit without them, and the TLS cost falls: it stays, and every wrong closure is found
+// without cluster probes.
+TEST(GncCentralized, ATailProbeCutsTheClosuresABentMapFitsAndStaysWhenTheTlsCostFalls) {
+  const GeneratorResult g = flexible_city(0.1, OutlierKind::kGroup, 3);
+  GncCentralizedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.robust.probe_tail_ratio = 1e9;  // the tail rule never holds: no tail probe
+  const GncCentralizedResult without = solve_gnc_centralized(g.graph, o);
+  o.robust.probe_tail_ratio = RobustOptions{}.probe_tail_ratio;
+  const GncCentralizedResult with = solve_gnc_centralized(g.graph, o);
+  EXPECT_NE(without.rejected, g.outliers);
+  EXPECT_EQ(with.rejected, g.outliers);
+  EXPECT_GE(with.probes_kept, 1);
+  EXPECT_LE(with.probes, RobustOptions{}.recheck_probes + 1);
+  auto tls = [](const GncCentralizedResult& r) {
+    return r.final_solve.cost + r.threshold_squared * static_cast<double>(r.rejected.size());
+  };
+  EXPECT_LT(tls(with), tls(without));
+  EXPECT_TRUE(with.final_solve.certified.value_or(false));
+  // With probes off (--gnc-probes 0) neither kind runs.
+  o.robust.recheck_probes = 0;
+  EXPECT_EQ(solve_gnc_centralized(g.graph, o).probes, 0);
 }
 
 // Where GNC alone already finds every wrong closure, refused probes change nothing.

@@ -255,23 +255,31 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   };
   adopt(solve_kept_set(out.rejected, solve.poses, final_options));
 
-  // Probes (GncCentralizedOptions::cluster_probes, RobustOptions::probe_return_ratio): a run of
-  // wrong closures that fit each other survives every one-at-a-time verdict, so a probe cuts a
-  // whole run of kept closures at once; a true closure just beyond the bound at the kept set's
-  // solution stays out until it is back in the problem, so a return probe brings it back. The
-  // re-check passes then run from there, and the result stays only when the TLS cost over every
-  // measurement falls: each kept probe is a descent step of the TLS cost, a refused one changes
-  // nothing. Without cluster probes one return probe may run (--gnc-probes 0: none).
-  const bool may_return =
+  // Probes (GncCentralizedOptions::cluster_probes, RobustOptions::recheck_probes,
+  // probe_return_ratio): a few wrong closures can bend the map until each fits within the bound,
+  // so a tail probe cuts the kept closures far above the median residual together; a run of
+  // wrong closures that fit each other survives every one-at-a-time verdict, so a cluster probe
+  // cuts a whole run of kept closures at once; a true closure just beyond the bound at the kept
+  // set's solution stays out until it is back in the problem, so a return probe brings it back.
+  // The re-check passes then run from there, and the result stays only when the TLS cost over
+  // every measurement falls: each kept probe is a descent step of the TLS cost, a refused one
+  // changes nothing. Without cluster probes one return probe may run (--gnc-probes 0: no probe).
+  const bool may_probe =
       robust.recheck_probes > 0 && robust.readmission_passes > 0 && known_connected;
-  const int budget = options.cluster_probes > 0 ? options.cluster_probes : may_return ? 1 : 0;
-  if (budget > 0 && !out.rejected.empty()) {
+  ProbeRules rules;
+  rules.budget = options.cluster_probes > 0 ? options.cluster_probes : may_probe ? 1 : 0;
+  rules.cut_clusters = options.cluster_probes > 0;
+  rules.clusters = options.clusters;
+  rules.return_ratio = may_probe ? robust.probe_return_ratio : 1.0;
+  rules.tail_probes = may_probe ? robust.recheck_probes : 0;
+  rules.tail_cut_ratio = robust.probe_ratio;
+  rules.tail_ratio = robust.probe_tail_ratio;
+  if ((rules.budget > 0 || rules.tail_probes > 0) && !out.rejected.empty()) {
     CentralizedOptions trial = final_options;
     trial.certify = false;  // only the set that stays is certified
     KeptSet last;
     const ClusterProbeCounts counts = search_cluster_probes(
-        graph, known, c2, budget, options.cluster_probes > 0, options.clusters,
-        may_return ? robust.probe_return_ratio : 1.0, out.rejected, out.final_solve.poses,
+        graph, known, c2, rules, out.rejected, out.final_solve.poses,
         [&](std::vector<std::size_t> rejected) {
           last = solve_kept_set(std::move(rejected), out.final_solve.poses, trial);
           return ClusterProbeTrial{last.rejected, last.solve.poses};

@@ -31,6 +31,16 @@ std::vector<std::size_t> return_candidates(const PoseGraph& graph, const std::ve
                                            double c2, double return_ratio,
                                            const std::vector<std::size_t>& rejected);
 
+/// What a tail probe cuts (RobustOptions::probe_ratio, probe_tail_ratio; the centralized form of
+/// the distributed probe's list, gnc_votes): the kept measurements that may be rejected (known[e]
+/// false, not in `rejected`, ascending) whose r^2 at `poses` is within the bound but above
+/// cut_ratio x the median r^2 of those kept ones, when their mean r^2 is above tail_ratio x that
+/// median (a heavy tail: a map bent until some wrong closures fit); otherwise none. Ascending.
+std::vector<std::size_t> tail_candidates(const PoseGraph& graph, const std::vector<bool>& known,
+                                         const std::vector<Pose>& poses, double c2,
+                                         double cut_ratio, double tail_ratio,
+                                         const std::vector<std::size_t>& rejected);
+
 /// The TLS cost at `poses`: sum over the measurements of r^2 for known ones (known[e] true, never
 /// rejected) and min(r^2, c^2) for the others. What the start vote, the re-check passes and the
 /// cluster probes compare.
