@@ -270,7 +270,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // is judged by.
       *recheck_ = recheck_verdict(
           *terms_, in_.measurement_index, rejected_, state_->Y, exchange_->neighbours(),
-          may_probe() ? options_.robust.probe_ratio : 0.0, options_.robust.probe_tail_ratio);
+          probes_->may_follow(terms_->known_connected(), options_.robust.readmission_passes)
+              ? options_.robust.probe_ratio
+              : 0.0,
+          options_.robust.probe_tail_ratio);
       exchange_->own_vote() = {tls_cost(*terms_, state_->Y, exchange_->neighbours()), 0};
       to_others(readmitted_message(*recheck_, exchange_->own_vote().first));
       break;

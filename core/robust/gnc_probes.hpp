@@ -31,6 +31,12 @@ class GncProbes {
   bool may_start(bool known_connected, int readmission_passes) const {
     return !running_ && started_ < allowed_ && known_connected && readmission_passes > 0;
   }
+  /// A probe may start once the running one (if any) ends: the same as may_start but for the
+  /// running probe. The verdict that ends a kept probe must already name the next probe's
+  /// candidates, or a budget of two probes would never start its second after a kept first.
+  bool may_follow(bool known_connected, int readmission_passes) const {
+    return started_ < allowed_ && known_connected && readmission_passes > 0;
+  }
   void start(GncProbeBase base) {
     ++started_;
     running_ = true;
