@@ -1,16 +1,16 @@
 #pragma once
 // The exact distributed test of S + eta I > 0 by substructuring (non-overlapping domain
-// decomposition). Each block's poses split into its interface Gamma_b (poses with a measurement
-// to another block) and its interior I_b (the rest, coupled to nothing outside the block). Then
-//   S + eta I > 0  <=>  every block's S_BB + eta I > 0  and  Sigma > 0,
-//   Sigma = blockdiag_b(Schur_b) + (the cut measurements' coupling between interfaces),
-//   Schur_b = (S + eta I)_{Gamma_b Gamma_b} - S_{Gamma_b I_b} (S + eta I)_{I_b I_b}^-1 S_{I_b
-//   Gamma_b}
-// (the Schur complement lemma, applied to the interiors and then to each block's own
-// interface). Each agent computes Schur_b from one sparse factorization of its block with the
-// interface ordered last (Schur_b = L_GG L_GG^T, L_GG the factor's trailing block); Sigma is as
-// large as the interface, which is small when the partition's cut is. A proof like the
-// centralized certificate's factorization, not an iteration that may stop early.
+// decomposition). A separator C covers the cut (every cut measurement has an endpoint in C);
+// block b's other poses I_b are coupled to nothing outside the block but separator poses. Then
+//   S + eta I > 0  <=>  every block's (S + eta I)_{I_b I_b} > 0  and  Sigma > 0,
+//   Sigma = (S + eta I)_CC - sum_b S_{C I_b} (S + eta I)_{I_b I_b}^-1 S_{I_b C}
+// (the Schur complement lemma). Block b's term lives on its own separator poses and the foreign
+// ones next to its eliminated poses (Gamma_b); each agent computes it from one supernodal
+// factorization (CHOLMOD) of its block and those foreign poses, ordered last, as Schur_b =
+// L_GG L_GG^T, L_GG the factor's trailing block. C = every pose with a cut measurement is the
+// classic interface (local_interface_schur); C = one endpoint per cut measurement halves Sigma
+// (local_separator_schur). A proof like the centralized certificate's factorization, not an
+// iteration that may stop early.
 
 #include <Eigen/Core>
 #include <cstddef>
