@@ -44,6 +44,7 @@ const char* const kDistributedValued[] = {"agents",
                                           "certify-residual",
                                           "certify-precon",
                                           "certify-interface",
+                                          "certify-interface-sides",
                                           "block-precon",
                                           "tangent-refresh",
                                           "tcg-kappa",
@@ -165,6 +166,9 @@ const char* kDistributedHelp =
     "  --certify-interface C     exact test of S + eta I > 0 on the blocks' interfaces before\n"
     "                            LOBPCG when they have at most C coordinates (default 1200;\n"
     "                            0 = LOBPCG only; docs/distributed-certification.md)\n"
+    "  --certify-interface-sides one|both   the interface test keeps one endpoint of each cut\n"
+    "                            measurement and eliminates the other in its block, or both\n"
+    "                            (default one: about half the coordinates)\n"
     "  --refine newton|auto|none   after the rounds reach --grad-tol, trust-region Newton\n"
     "                            steps on the whole problem, CG over neighbour exchanges and\n"
     "                            all-agent sums (docs/newton-refine.md) (default auto); auto:\n"
@@ -299,6 +303,12 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       static_cast<int>(a.get_long("certify-iters", kCommandCertificateIterations));
   opt.staircase.certificate.interface_max_coordinates = static_cast<int>(
       a.get_long("certify-interface", opt.staircase.certificate.interface_max_coordinates));
+  {
+    const std::string sides = a.get_or("certify-interface-sides", "one");
+    if (sides != "one" && sides != "both")
+      throw InputError("option --certify-interface-sides: '" + sides + "' is not one of one, both");
+    opt.staircase.certificate.interface_one_side = sides == "one";
+  }
   {
     set_refine_mode(opt.refine, a.get_or("refine", "auto"));
     opt.refine.grad_norm_tol = a.get_double("refine-grad-tol", opt.refine.grad_norm_tol);

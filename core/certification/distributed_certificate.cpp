@@ -122,6 +122,22 @@ std::vector<std::size_t> interface_of(const BlockLayout& layout, int b) {
   return poses;
 }
 
+// Block b's poses in the separator that one_side keeps: those some higher-numbered block needs,
+// i.e. the lower block's endpoint of every cut measurement (a vertex cover of the cut that every
+// agent derives from the layout alone).
+std::vector<std::size_t> lower_side_of(const BlockLayout& layout, int b) {
+  std::vector<std::size_t> poses;
+  const auto& adjacent = layout.adjacent[static_cast<std::size_t>(b)];
+  for (std::size_t k = 0; k < adjacent.size(); ++k)
+    if (adjacent[k] > b) {
+      const auto& to = layout.public_to[static_cast<std::size_t>(b)][k];
+      poses.insert(poses.end(), to.begin(), to.end());
+    }
+  std::sort(poses.begin(), poses.end());
+  poses.erase(std::unique(poses.begin(), poses.end()), poses.end());
+  return poses;
+}
+
 double dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a.array() * b.array()).sum();
 }
@@ -149,7 +165,9 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
 
   std::vector<OutgoingMessage> out;
   std::size_t interface = 0;
-  for (int b = 0; b < layout_.num_blocks; ++b) interface += interface_of(layout_, b).size();
+  for (int b = 0; b < layout_.num_blocks; ++b)
+    interface += options_.interface_one_side ? lower_side_of(layout_, b).size()
+                                             : interface_of(layout_, b).size();
   if (options_.interface_max_coordinates > 0 &&
       static_cast<double>(interface) * static_cast<double>(w) <=
           static_cast<double>(options_.interface_max_coordinates)) {
@@ -262,8 +280,16 @@ void CertificateProtocol::after_setup(const MessageGate::Inbox& inbox,
     return;
   }
   const double shift = std::max(result_.tolerance, 1e-12 * result_.scale);
-  const InterfaceSchurBlock block =
-      local_interface_schur(problem_, lambda_, shift, interface_of(layout_, state_.id()));
+  InterfaceSchurBlock block;
+  if (options_.interface_one_side) {
+    std::vector<char> kept(layout_.owner.size(), 0);
+    for (int b = 0; b < layout_.num_blocks; ++b)
+      for (std::size_t p : lower_side_of(layout_, b)) kept[p] = 1;
+    block = local_separator_schur(problem_, lambda_, shift, lower_side_of(layout_, state_.id()),
+                                  [&kept](std::size_t p) { return kept.at(p) != 0; });
+  } else {
+    block = local_interface_schur(problem_, lambda_, shift, interface_of(layout_, state_.id()));
+  }
   PoseBlockMessage m =
       make_reduction_message(state_.id(), 0, kSchur, encode_interface_schur(block));
   if (state_.id() == 0) {

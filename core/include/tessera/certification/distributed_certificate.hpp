@@ -59,6 +59,11 @@ struct DistributedCertificateOptions {
   /// has at most this many coordinates ((d+1) a pose): agent 0 factors a matrix that large,
   /// dense within each block's interface. 0 = LOBPCG only. >= 0.
   int interface_max_coordinates = 1200;
+  /// The interface test keeps one endpoint of each cut measurement (the one in the lower-
+  /// numbered block) and eliminates the other inside its block: Sigma has about half the
+  /// coordinates (torus3D, N = 5: 1,004 instead of 1,944), interface_max_coordinates counts
+  /// those. false: every pose with a cut measurement is kept (both endpoints).
+  bool interface_one_side = true;
   /// Throws InputError naming the bad field.
   void validate() const;
 };
