@@ -1,5 +1,6 @@
 #include "solve_distributed.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <optional>
@@ -71,6 +72,7 @@ const char* const kDistributedValued[] = {"agents",
                                           "refine-coarse",
                                           "refine-coarse-form",
                                           "refine-coarse-aggregates",
+                                          "refine-interface",
                                           nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
@@ -184,7 +186,11 @@ const char* kDistributedHelp =
     "                            none)\n"
     "  --refine-coarse-aggregates K   pieces per block of the smoothed space (default 8)\n"
     "  --refine-coarse-form balancing|additive   how the coarse correction joins block\n"
-    "                            Jacobi (default balancing)\n";
+    "                            Jacobi (default balancing)\n"
+    "  --refine-interface C      its CG's preconditioner solves with the Hessian exactly\n"
+    "                            through the blocks' interfaces where the team's interface has\n"
+    "                            at most C tangent coordinates; 0 = block Jacobi always\n"
+    "                            (default 1000)\n";
 
 namespace {
 
@@ -327,6 +333,10 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     opt.refine.coarse_balancing = form == "balancing";
     opt.refine.coarse_aggregates =
         static_cast<int>(a.get_long("refine-coarse-aggregates", opt.refine.coarse_aggregates));
+    const long interface = a.get_long("refine-interface", opt.refine.interface_max_coordinates);
+    if (interface < 0 || interface > 1000000)
+      throw InputError("option --refine-interface: must be in 0..1000000");
+    opt.refine.interface_max_coordinates = static_cast<int>(interface);
     opt.refine.coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
                         : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
                                                : NewtonRefineOptions::Coarse::kNone;
@@ -416,10 +426,12 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   for (const NewtonRefineResult& n : r.refines)
     std::printf(
         "  newton refine: %d steps (%d accepted), %d CG iterations, %d translation CG "
-        "iterations, %d exchanges, %d all-agent sums, %d coarse unknowns, |grad f| %.3g -> %.3g, "
-        "f %.10g -> %.10g, stop: %s\n",
+        "iterations, %d exchanges, %d all-agent sums, %d coarse unknowns, interface %d "
+        "coordinates (%d factorizations, %d fallbacks), |grad f| %.3g -> %.3g, f %.10g -> %.10g, "
+        "stop: %s\n",
         n.steps, n.accepted_steps, n.cg_iterations, n.translation_iterations, n.exchanges,
-        n.reductions, n.coarse_unknowns, n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost,
+        n.reductions, n.coarse_unknowns, n.interface_coordinates, n.interface_factorizations,
+        n.interface_fallbacks, n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost,
         n.stop_reason.c_str());
   for (const NewtonRefineResult& n : r.refines)
     for (std::size_t k = 0; k < n.trace.size(); ++k) {
@@ -499,7 +511,10 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     // --refine newton, or the robust final solve's refinement (--gnc-final-refine).
     if (opt.refine.enabled || !r.refines.empty()) {
       int steps = 0, cg = 0, translation_cg = 0, exchanges = 0, reductions = 0;
+      int interface = 0, interface_factorizations = 0;
       for (const NewtonRefineResult& n : r.refines) {
+        interface = std::max(interface, n.interface_coordinates);
+        interface_factorizations += n.interface_factorizations;
         steps += n.steps;
         cg += n.cg_iterations;
         translation_cg += n.translation_iterations;
@@ -510,7 +525,9 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
           .add("refine_cg_iterations", cg)
           .add("refine_translation_iterations", translation_cg)
           .add("refine_exchanges", exchanges)
-          .add("refine_reductions", reductions);
+          .add("refine_reductions", reductions)
+          .add("refine_interface_coordinates", interface)
+          .add("refine_interface_factorizations", interface_factorizations);
     }
     if (fstar) j.add("f_star", *fstar);
     if (robust.kind != RobustKind::kNone) {

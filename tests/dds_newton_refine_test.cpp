@@ -71,6 +71,9 @@ TEST(DdsNewtonRefine, AgentsOverDdsTakeTheInProcessIterates) {
   const DistributedResult ref = solve_distributed(g, assignment, opt, g.initial);
   ASSERT_EQ(ref.refines.size(), 1u);
   ASSERT_GE(ref.refines[0].accepted_steps, 1);
+  // The refinement's default preconditioner on this chain: exact solves through the interface
+  // (every agent factors the same interface matrix from the shares it receives over DDS).
+  EXPECT_GE(ref.refines[0].interface_factorizations, 1);
   EXPECT_EQ(json_number(summary, "rounds"), ref.rounds) << summary;
   // The refined point (its gradient norm, summed in agent-id order as in process) and its
   // rounding (the DDS agents' distributed rounding: equal up to summation order).

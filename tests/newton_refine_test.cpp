@@ -61,7 +61,8 @@ TEST(NewtonRefine, ReachesTheCentralizedOptimumWhereTheRoundsStopShortOfIt) {
   EXPECT_GE(n.translation_iterations, n.steps);
   EXPECT_GE(n.exchanges, iterations + 2 * n.steps);
   EXPECT_LE(n.exchanges, iterations + 3 * n.steps);
-  EXPECT_EQ(n.reductions, n.exchanges - n.steps + 1 + n.coarse_assemblies);
+  EXPECT_EQ(n.reductions, n.exchanges - n.steps + 1 + n.coarse_assemblies +
+                              n.interface_factorizations + n.interface_fallbacks);
   EXPECT_LE(n.coarse_assemblies, n.accepted_steps + 1);
   // The rounds stop measurably above f*; the refined estimate is at f*.
   const double gap_plain = (plain.cost - fstar) / fstar;
@@ -124,6 +125,8 @@ ThreeSolves rounds_then_refine_twice(bool refactor_every_step) {
       o.refine.grad_norm_tol = tol;
       o.refine.relative_decrease_tol = 0.0;
       o.refine.refactor_every_step = refactor_every_step;
+      // Block Jacobi's factors are the subject (the interface solves factor their own).
+      o.refine.interface_max_coordinates = 0;
     }
     const DistributedResult r =
         solve_distributed_with_states(live.graph(), live.layout(), live.all_states(), o);
@@ -233,6 +236,62 @@ TEST(NewtonRefine, TrialTranslationsReSolvedLowerTheTrialCostAndReachTheOptimum)
   }
 }
 
+// Interface solves (NewtonRefineOptions::interface_max_coordinates): with each block's
+// Hessian factored exactly and the interface's Schur complement solved by every agent, the
+// preconditioner is the Hessian's inverse (up to the gauge shift), so a Newton step's CG ends
+// in a few iterations where block Jacobi needs dozens; the same optimum either way.
+TEST(NewtonRefine, InterfaceSolvesReachTheBlockJacobiOptimumInFewerCgIterations) {
+  const PoseGraph g = corridor(500, 3, 0.1, 7);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 5);
+  const double fstar = test::tight_optimum(g);
+  DistributedOptions exact = refined(true);
+  exact.grad_norm_tol = 1.0;
+  DistributedOptions jacobi = exact;
+  jacobi.refine.interface_max_coordinates = 0;
+  const DistributedResult a = solve_distributed(g, parts, exact);
+  const DistributedResult b = solve_distributed(g, parts, jacobi);
+  ASSERT_EQ(a.refines.size(), 1u);
+  ASSERT_EQ(b.refines.size(), 1u);
+  const NewtonRefineResult& ra = a.refines[0];
+  const NewtonRefineResult& rb = b.refines[0];
+  EXPECT_EQ(rb.interface_coordinates, 0);
+  EXPECT_EQ(rb.interface_factorizations, 0);
+  // 4 cut edges in a chain of 5 blocks plus the closures' cuts: a few poses a block.
+  EXPECT_GT(ra.interface_coordinates, 0);
+  EXPECT_LE(ra.interface_coordinates, 3 * 20);
+  EXPECT_GE(ra.interface_factorizations, 1);
+  EXPECT_LE(ra.interface_factorizations, ra.accepted_steps + 1);
+  EXPECT_EQ(ra.interface_fallbacks, 0);
+  // Exact solves: each Newton step's CG stops on its residual within a few iterations.
+  for (const NewtonRefineStep& t : ra.trace)
+    if (t.cg_stop == "residual") {
+      EXPECT_LE(t.cg_iterations, 3);
+    }
+  EXPECT_LT(3 * ra.cg_iterations, rb.cg_iterations);
+  EXPECT_LT(std::abs(a.cost - fstar) / fstar, 1e-8);
+  EXPECT_LT(std::abs(b.cost - fstar) / fstar, 1e-8);
+  // A cap below the team's interface leaves block Jacobi (the same run as without).
+  DistributedOptions capped = exact;
+  capped.refine.interface_max_coordinates = ra.interface_coordinates - 1;
+  const DistributedResult c = solve_distributed(g, parts, capped);
+  ASSERT_EQ(c.refines.size(), 1u);
+  EXPECT_EQ(c.refines[0].interface_coordinates, 0);
+  EXPECT_EQ(c.refines[0].cg_iterations, rb.cg_iterations);
+  EXPECT_EQ(c.cost, b.cost);
+}
+
+// The interface solves' decisions (Sigma's factorization, its shift, the fallback) are taken
+// from the same shares in agent-id order by every agent: the same steps in any delivery order.
+TEST(NewtonRefine, InterfaceSolvesTakeTheSameStepsInAnyDeliveryOrder) {
+  const PoseGraph g = corridor(300, 2, 0.1, 3);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  DistributedOptions o = refined(true);
+  o.grad_norm_tol = 1.0;
+  const DistributedResult r = test::expect_same_refinement_in_any_delivery_order(g, parts, o, 5);
+  ASSERT_EQ(r.refines.size(), 1u);
+  EXPECT_GE(r.refines[0].interface_factorizations, 1);
+}
+
 // A geometric tail c_k = f + a q^k: the estimate from two windows is the exact cost still to
 // come; a flat one 0.
 TEST(RoundsTail, AGeometricTailIsEstimatedExactly) {
@@ -324,6 +383,12 @@ TEST(NewtonRefineOptions, ValidateNamesTheBadField) {
   o = {};
   o.relative_decrease_tol = -1;
   EXPECT_NE(message(o).find("relative_decrease_tol"), std::string::npos);
+  o = {};
+  o.interface_max_coordinates = -1;
+  EXPECT_NE(message(o).find("interface_max_coordinates"), std::string::npos);
+  o = {};
+  o.interface_shift = 0;
+  EXPECT_NE(message(o).find("interface_shift"), std::string::npos);
   o = {};
   o.accept_ratio = 0.5;
   EXPECT_NE(message(o).find("accept_ratio"), std::string::npos);

@@ -116,6 +116,9 @@ DistributedOptions refined(NewtonRefineOptions::Coarse coarse) {
   o.certify = true;
   set_refine_mode(o.refine, "newton");
   o.refine.coarse = coarse;
+  // Block Jacobi against its coarse corrections (the interface solves, the default where the
+  // interface fits, are exact: newton_refine_test).
+  o.refine.interface_max_coordinates = 0;
   return o;
 }
 

@@ -7,6 +7,7 @@
 #include <tessera/problem/pose_kernels.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "distributed/interface_solve.hpp"
 #include "distributed/nonzero_rows.hpp"
 #include "distributed/rigid_retraction.hpp"
 #include "distributed/tangent_coarse_space.hpp"
@@ -33,6 +34,9 @@ void NewtonRefineOptions::validate() const {
   if (auto_window < 1) fail("auto_window", "must be >= 1");
   if (translation_iterations < 0) fail("translation_iterations", "must be >= 0");
   if (!(translation_tol > 0 && translation_tol < 1)) fail("translation_tol", "must be in (0, 1)");
+  if (interface_max_coordinates < 0) fail("interface_max_coordinates", "must be >= 0");
+  if (!(interface_shift > 0 && interface_shift <= 1e-3))
+    fail("interface_shift", "must be in (0, 1e-3]");
 }
 
 void set_refine_mode(NewtonRefineOptions& options, const std::string& mode) {
@@ -213,6 +217,9 @@ void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
       case kTranslationSums:
         after_translation_sums(*ready, out);
         break;
+      case kInterface:
+        after_interface(*ready, out);
+        break;
       default:
         after_trial_sums(*ready, out);
         break;
@@ -248,7 +255,20 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
                                              problem_.dim(), static_cast<int>(rows_.size()));
     result_.coarse_unknowns = coarse_->size();
   }
-  prepare_preconditioner();
+  // Interface solves: at rank d (tangent coordinates) without a coarse correction, where the
+  // team's interface fits. The layout is the same on every agent, so is the decision.
+  if (options_.interface_max_coordinates > 0 && !coarse_ &&
+      static_cast<int>(rows_.size()) == problem_.dim() && layout_.num_blocks > 1) {
+    auto solve = std::make_unique<InterfaceSolve>(problem_, layout_, state_.id());
+    if (solve->team_size() > 0 && solve->team_size() <= options_.interface_max_coordinates) {
+      result_.interface_coordinates = static_cast<int>(solve->team_size());
+      interface_ = std::move(solve);
+    }
+  }
+  if (interface_)
+    refactor_due_ = true;  // block Jacobi's factor only where a point falls back to it
+  else
+    prepare_preconditioner();
   if (options_.translation_iterations > 0) factor_translations();
   begin_cg(out);
 }
@@ -266,8 +286,64 @@ void NewtonRefineProtocol::prepare_preconditioner() {
 void NewtonRefineProtocol::begin_cg(std::vector<OutgoingMessage>& out) {
   // Only before a CG that will run: the factor at the point where the refinement stops would
   // not be used.
-  if (refactor_due_) prepare_preconditioner();
+  if (interface_ && interface_due_) return send_interface(out);
+  if (refactor_due_ && !use_interface_) prepare_preconditioner();
   if (coarse_ && coarse_due_) return send_coarse(out);
+  start_cg(out);
+}
+
+void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
+  // This block's share of Sigma at the current point, then its interface residual of -g (the
+  // first CG residual), so that the first direction needs no further message step.
+  std::vector<double> values = interface_->factor(X_, Xn_, egrad_);
+  if (values.front() != 0.0) {
+    interface_->forward(X_, -g_, iy_g_);
+    std::vector<double> rhat(static_cast<std::size_t>(interface_->team_size()), 0.0);
+    interface_->add_interface(iy_g_, rhat.data());
+    values.insert(values.end(), rhat.begin() + interface_->offset(),
+                  rhat.begin() + interface_->offset() + interface_->size());
+  }
+  broadcast(kInterface, values, out);
+}
+
+void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
+                                           std::vector<OutgoingMessage>& out) {
+  // Every agent assembles the same Sigma from the same shares in id order.
+  std::vector<std::vector<double>> shares;
+  ir_g_ = Eigen::VectorXd::Zero(interface_->team_size());
+  bool ok = true;
+  int b = 0;
+  for (const auto& [sender, m] : inbox) {
+    const std::vector<double>& v = std::get<PoseBlockMessage>(m).data;
+    if (v.empty()) throw std::runtime_error("newton refine: empty interface share");
+    if (v.front() == 0.0) {
+      ok = false;
+      shares.push_back({0.0});
+    } else {
+      const auto n = static_cast<std::size_t>(interface_->block_size(b));
+      if (v.size() < n + 1)
+        throw std::runtime_error("newton refine: malformed interface share from agent " +
+                                 std::to_string(sender));
+      shares.emplace_back(v.begin(), v.end() - static_cast<std::ptrdiff_t>(n));
+      ir_g_.segment(interface_->block_offset(b), static_cast<Eigen::Index>(n)) =
+          Eigen::Map<const Eigen::VectorXd>(v.data() + v.size() - n, static_cast<Eigen::Index>(n));
+    }
+    ++b;
+  }
+  if (ok) {
+    std::vector<const std::vector<double>*> ptrs;
+    for (const auto& v : shares) ptrs.push_back(&v);
+    const double eta = options_.interface_shift;
+    ok = interface_->assemble(ptrs, {eta, 1e3 * eta, 1e6 * eta});
+  }
+  interface_due_ = false;
+  use_interface_ = ok;
+  if (ok) {
+    ++result_.interface_factorizations;
+  } else {
+    ++result_.interface_fallbacks;
+    if (refactor_due_) prepare_preconditioner();
+  }
   start_cg(out);
 }
 
@@ -368,6 +444,10 @@ void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
   s_ = Eigen::MatrixXd::Zero(X_.rows(), X_.cols());
   r_ = -g_;
   if (coarse_) coarse_r_ = -coarse_g_;
+  if (use_interface_) {
+    iy_r_ = iy_g_;
+    ir_ = ir_g_;
+  }
   e_Pe_ = e_Pd_ = d_Pd_ = model_ = gs_ = sHs_ = 0.0;
   cg_target_ =
       std::max(0.5 * options_.grad_norm_tol,
@@ -376,7 +456,9 @@ void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
 }
 
 void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
-  if (!coarse_) {
+  if (use_interface_) {
+    z_ = interface_->back(X_, iy_r_, ir_);
+  } else if (!coarse_) {
     z_ = state_.precondition(X_, r_);
   } else if (!options_.coarse_balancing) {
     // Additive: z = B r + Phi A^+ Phi^T r (Phi^T r identical everywhere).
@@ -402,6 +484,24 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
   neighbours_into(inbox, zn_);
   w_ = hessian(z_, zn_);
   std::vector<double> values{dot(r_, z_), dot(z_, w_), r_.squaredNorm()};
+  if (use_interface_) {  // the interface residual of w, for the ones of q and r
+    interface_->forward(X_, w_, iy_w_);
+    values.resize(3 + static_cast<std::size_t>(interface_->team_size()), 0.0);
+    interface_->add_interface(iy_w_, values.data() + 3);
+  }
+  if (use_interface_) {
+    // ||r - alpha q||^2 of this iteration's update from <r, w>, ||w||^2 and the previous q's
+    // products (q = w + beta q_old), so CG stops on its residual right after the update that
+    // reached it instead of one exchange and one sum later: with exact interface solves a
+    // Newton step's CG is one or two iterations. Not with block Jacobi, whose hundreds of
+    // iterations a step would each carry 5 more numbers for one message step saved.
+    const bool first = cg_it_ == 0;
+    values.push_back(dot(r_, w_));
+    values.push_back(w_.squaredNorm());
+    values.push_back(first ? 0.0 : dot(r_, q_));
+    values.push_back(first ? 0.0 : dot(w_, q_));
+    values.push_back(first ? 0.0 : q_.squaredNorm());
+  }
   if (coarse_) {  // Phi^T w, for Phi^T q and so Phi^T r by their recurrences
     const std::size_t n = static_cast<std::size_t>(coarse_->size());
     values.resize(3 + (options_.coarse_balancing ? 2 : 1) * n, 0.0);
@@ -419,8 +519,11 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
 void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
                                       std::vector<OutgoingMessage>& out) {
   const std::size_t n = static_cast<std::size_t>(coarse_ ? coarse_->size() : 0);
+  const std::size_t team =
+      use_interface_ ? static_cast<std::size_t>(interface_->team_size()) : std::size_t{0};
+  const std::size_t extra = use_interface_ ? 5 : 0;  // the products for ||r_next||
   const std::vector<double> t =
-      reduce_in_id_order(inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n);
+      reduce_in_id_order(inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n + team + extra);
   double gamma = t[0], delta = t[1];
   const double rnorm = std::sqrt(std::max(0.0, t[2]));
   Eigen::VectorXd coarse_w;  // Phi^T w
@@ -453,6 +556,16 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
       coarse_q_ = coarse_w;
     else
       coarse_q_ = coarse_w + beta * coarse_q_;
+  }
+  if (use_interface_) {
+    const Eigen::Map<const Eigen::VectorXd> iw(t.data() + 3, static_cast<Eigen::Index>(team));
+    if (cg_it_ == 0) {
+      iq_ = iw;
+      iy_q_ = iy_w_;
+    } else {
+      iq_ = iw + beta * iq_;
+      iy_q_ = iy_w_ + beta * iy_q_;
+    }
   }
   if (cg_it_ == 0) {
     p_ = z_;
@@ -491,6 +604,10 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   s_ += alpha * p_;
   r_ -= alpha * q_;
   if (coarse_) coarse_r_ -= alpha * coarse_q_;
+  if (use_interface_) {
+    ir_ -= alpha * iq_;
+    iy_r_ -= alpha * iy_q_;
+  }
   model_ += -alpha * gamma + 0.5 * alpha * alpha * pHp;
   gs_ += -alpha * gamma;
   sHs_ += alpha * alpha * pHp;
@@ -498,6 +615,13 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   gamma_old_ = gamma;
   alpha_old_ = alpha;
   pHp_old_ = pHp;
+  if (extra > 0) {
+    const double* e = t.data() + 3 + team;
+    const double rq = e[0] + beta * e[2];
+    const double qq = e[1] + 2.0 * beta * e[3] + beta * beta * e[4];
+    const double next = t[2] - 2.0 * alpha * rq + alpha * alpha * qq;
+    if (next <= cg_target_ * cg_target_) return try_step("residual", out);
+  }
   send_direction(out);
 }
 
@@ -550,6 +674,7 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
     gnorm_ = gt;
     ++result_.accepted_steps;
     coarse_due_ = true;
+    interface_due_ = true;
     refactor_due_ = true;  // each CG solve preconditioned at its own point (when asked)
   }
   step_.cost = f_;

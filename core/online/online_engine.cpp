@@ -201,6 +201,9 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     solver.refine.coarse = options.newton_coarse;
     // Nor the trial translations' re-solve (measured on long chains from a cold start).
     solver.refine.translation_iterations = 0;
+    // Nor the interface solves (they factor every block at every point; these steps keep
+    // their factors across steps).
+    solver.refine.interface_max_coordinates = 0;
     solver.grad_norm_tol = std::max(options.newton_after_grad_tol, solver.grad_norm_tol);
   }
   return solver;

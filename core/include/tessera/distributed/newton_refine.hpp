@@ -10,10 +10,14 @@
 //   * Hessian-vector product: each agent forms its own block's rows of Hess f(X)[v] from its own
 //     entries of v and its neighbours' public entries (one neighbour exchange per product);
 //   * CG's inner products are all-agent sums in agent-id order (bit-identical on every agent);
-//   * the preconditioner is block Jacobi (AgentState::precondition: the tangent factor of its
-//     block, else its Q_BB factor) with a coarse correction over rigid motions of smoothed
-//     pieces of the blocks (options.coarse, distributed/tangent_coarse_space.hpp): block Jacobi
-//     alone moves information one block boundary per CG iteration.
+//   * the preconditioner, where the team's interface is small (options.interface_max_coordinates),
+//     is the Hessian's inverse by substructuring (distributed/interface_solve.hpp: each block's
+//     factor and the interface's Schur complement, which every agent factors once per point), so
+//     a Newton step's CG takes 1-3 iterations; elsewhere block Jacobi (AgentState::precondition:
+//     the tangent factor of its block, else its Q_BB factor), optionally with a coarse correction
+//     over rigid motions of smoothed pieces of the blocks (options.coarse,
+//     distributed/tangent_coarse_space.hpp): block Jacobi alone moves information one block
+//     boundary per CG iteration.
 // CG is in the Chronopoulos-Gear form (the two inner products of an iteration from one
 // reduction, <p, Hp> by recurrence), so an iteration is one exchange then one reduction.
 // The trust region (Steihaug-Toint truncated CG in the preconditioner's norm, ratio test on the
@@ -45,6 +49,7 @@
 namespace tessera {
 
 class TangentCoarseSpace;
+class InterfaceSolve;
 
 struct NewtonRefineOptions {
   /// Run the refinement after the block-coordinate solve reached its own tolerance (a solve
@@ -152,6 +157,26 @@ struct NewtonRefineOptions {
   /// Newton step's predicted decrease (the rest it could remove is then small against what the
   /// ratio test weighs). (0, 1).
   double translation_tol = 1e-3;
+  /// Preconditioner: exact solves with the Hessian through the team's interface
+  /// (distributed/interface_solve.hpp) where that interface has at most this many tangent
+  /// coordinates (d(d+1)/2 a pose: ais2klinik at N = 5 102, city10000 909); 0 = off. Each
+  /// block factors its diagonal block of the Riemannian Hessian (interface last) and broadcasts
+  /// its Schur complement and cut couplings once per point (one all-agent message step); every
+  /// agent factors the interface matrix Sigma (as large as this cap) and applies H^-1 exactly
+  /// (up to the shift below) in each CG iteration, whose message steps stay one exchange and
+  /// one sum (the interface residual rides in the sum). Used at rank d with `coarse` kNone. A
+  /// block whose Hessian block is not positive definite (far from a minimiser) factors it
+  /// without the multiplier term (then M is the inverse of that modified H); where no block
+  /// factor or no Sigma is positive definite, that point's CG runs block Jacobi. Why 1000:
+  /// every agent factors Sigma at every point (cost ~ size^3 / 3, dense within each block's
+  /// interface); cubicle's 1,572 coordinates at N = 5 cut its CG iterations 116 -> 3 but
+  /// doubled the CPU of the whole solve (2.5 -> 4.8 s) and the bytes (4.9 -> 40.6 MB), while
+  /// city10000's 909 cost +0.25 s for 84 -> 2 CG iterations (docs/newton-refine.md). >= 0.
+  int interface_max_coordinates = 1000;
+  /// Relative shift eta of Sigma (times its largest diagonal entry; Sigma is singular along the
+  /// gauge); on a failed factorization it is raised 1,000-fold twice before the fallback.
+  /// (0, 1e-3].
+  double interface_shift = 1e-10;
   /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
   CoarseOptions coarse_space_options() const;
   /// Throws InputError naming the bad field.
@@ -193,6 +218,10 @@ struct NewtonRefineResult {
   /// Iterations of the trial points' translation solves (each one exchange and one sum,
   /// counted in `exchanges` and `reductions`).
   int translation_iterations = 0;
+  /// Interface solves (interface_max_coordinates): the team's interface in tangent coordinates
+  /// (0: not used), the points where Sigma was factored (one all-agent message step each,
+  /// counted in `reductions`) and where it could not be (that step's CG ran block Jacobi).
+  int interface_coordinates = 0, interface_factorizations = 0, interface_fallbacks = 0;
   std::vector<NewtonRefineStep> trace;
 };
 
@@ -208,10 +237,11 @@ class NewtonRefineProtocol : public AgentProcess {
     kTrialSums = 64,             ///< Cost share and ||g||^2 at the trial point.
     kCoarse = 65,                ///< The coarse matrix's share and Phi^T g at the current point.
     kTranslationDirection = 66,  ///< Trial translations: public entries of the CG's z.
-    kTranslationSums = 67        ///< Trial translations: <r, z>, <z, H z>.
+    kTranslationSums = 67,       ///< Trial translations: <r, z>, <z, H z>.
+    kInterface = 68              ///< Interface solves: each block's Schur complement and couplings.
   };
   /// The last of the steps: [kStatus, kLastStep] are the refinement's.
-  static constexpr std::uint32_t kLastStep = kTranslationSums;
+  static constexpr std::uint32_t kLastStep = kInterface;
   static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kLastStep; }
 
   /// `state`: the agent at the point to refine (Y, and Yn = the neighbours' public poses of the
@@ -257,6 +287,10 @@ class NewtonRefineProtocol : public AgentProcess {
   // The coarse matrix's share at the current point, summed by every agent (kCoarse).
   void send_coarse(std::vector<OutgoingMessage>& out);
   void after_coarse(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // Interface solves: this block's factor and share of Sigma at the current point (kInterface),
+  // then every agent's Sigma.
+  void send_interface(std::vector<OutgoingMessage>& out);
+  void after_interface(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   // CG from s = 0 at the current point (the coarse matrix, if any, is current).
   void start_cg(std::vector<OutgoingMessage>& out);
   // x's entries at the coarse unknowns this agent touches (coarse_hphi_'s columns).
@@ -322,6 +356,13 @@ class NewtonRefineProtocol : public AgentProcess {
   Eigen::VectorXd coarse_hy_;  // balancing: this agent's share of (H Phi)^T y
   Eigen::VectorXd coarse_g_, coarse_r_, coarse_q_;
   bool coarse_due_ = true;  // the point changed since the coarse matrix was summed
+  // Interface solves (options_.interface_max_coordinates): the solver, whether Sigma is due
+  // (the point changed) and whether this point's CG uses it; y = L^-1 J^T of r, q, w and of -g
+  // (the block's forward solves) and the team's interface residuals of r, q and -g, carried by
+  // CG's recurrences (the one of H z rides in the iteration's sum).
+  std::unique_ptr<InterfaceSolve> interface_;
+  bool interface_due_ = true, use_interface_ = false;
+  Eigen::VectorXd iy_r_, iy_q_, iy_w_, iy_g_, ir_, iq_, ir_g_;
   // Translation solve at the trial point: the own block's translation Laplacian factor, CG
   // state (x the translation change, in the pose layout with zero rotation columns).
   struct TranslationFactor;

@@ -1,0 +1,377 @@
+#include "distributed/interface_solve.hpp"
+
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "solvers/tangent_coordinates.hpp"
+
+namespace tessera {
+
+namespace {
+
+// Block b's interface: its poses some neighbour block needs (a cut measurement touches them),
+// ascending ids (the certificate's interface test uses the same set).
+std::vector<std::size_t> interface_poses(const BlockLayout& layout, int b) {
+  std::vector<std::size_t> poses;
+  for (const auto& to : layout.public_to[static_cast<std::size_t>(b)])
+    poses.insert(poses.end(), to.begin(), to.end());
+  std::sort(poses.begin(), poses.end());
+  poses.erase(std::unique(poses.begin(), poses.end()), poses.end());
+  return poses;
+}
+
+// One pose pair's (d+1) x (d+1) block of Q, column-major (rows: pose i's coordinates).
+struct PosePair {
+  Eigen::Index i = 0, j = 0;
+  std::vector<double> q;
+};
+
+}  // namespace
+
+struct InterfaceSolve::Impl {
+  int d = 0, w = 0, p = 0;
+  Eigen::Index m = 0, mI = 0, mG = 0;  // poses: all, interior, interface
+  std::vector<Eigen::Index> slot;      // local pose -> position in the factor's order
+  std::vector<PosePair> pairs;         // Q_BB's pose blocks with slot[i] >= slot[j]
+  std::vector<PosePair> cut;           // Q's cut blocks (i own, j neighbour), own id < other id
+  std::vector<std::size_t> owned, neighbors;
+  // The team's interface: first coordinate of each interface pose in Sigma.
+  std::unordered_map<std::size_t, Eigen::Index> team_index;
+  std::vector<Eigen::Index> block_offset, block_size;  // per block, in coordinates
+  Eigen::Index team = 0, own_offset = 0;
+  int id = 0;
+  // The block's factor A_bb = L D L^T in the order above, and L's trailing interface block.
+  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt;
+  Eigen::MatrixXd Lgg;
+  Eigen::VectorXd Dinv_interior;
+  // Sigma + eta I.
+  Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower> sigma;
+  bool sigma_ok = false;
+  double shift = 0.0;
+  mutable Eigen::VectorXd b;  // scratch: J^T v in the block's own order
+};
+
+InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& layout, int id)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.d = problem.dim();
+  s.w = s.d + 1;
+  s.p = s.d * (s.d + 1) / 2;
+  s.id = id;
+  s.owned = problem.owned();
+  s.neighbors = problem.neighbors();
+  s.m = static_cast<Eigen::Index>(s.owned.size());
+  const Eigen::Index w = s.w;
+
+  // The team's interface, blocks in id order, each one's poses ascending.
+  for (int b = 0; b < layout.num_blocks; ++b) {
+    const std::vector<std::size_t> poses = interface_poses(layout, b);
+    s.block_offset.push_back(s.team);
+    s.block_size.push_back(s.p * static_cast<Eigen::Index>(poses.size()));
+    for (std::size_t pose : poses) {
+      s.team_index.emplace(pose, s.team);
+      s.team += s.p;
+    }
+  }
+  s.own_offset = s.block_offset[static_cast<std::size_t>(id)];
+
+  std::unordered_map<std::size_t, Eigen::Index> local;
+  for (Eigen::Index i = 0; i < s.m; ++i) local.emplace(s.owned[static_cast<std::size_t>(i)], i);
+  const std::vector<std::size_t> own_interface = interface_poses(layout, id);
+  s.mG = static_cast<Eigen::Index>(own_interface.size());
+  s.mI = s.m - s.mG;
+  s.slot.assign(static_cast<std::size_t>(s.m), -1);
+  for (std::size_t k = 0; k < own_interface.size(); ++k) {
+    auto it = local.find(own_interface[k]);
+    if (it == local.end()) throw std::logic_error("InterfaceSolve: interface pose not owned");
+    s.slot[static_cast<std::size_t>(it->second)] = s.mI + static_cast<Eigen::Index>(k);
+  }
+
+  // Q_BB's pose blocks.
+  const SparseMatrix& Q = problem.data_matrix();
+  std::vector<std::vector<std::size_t>> column(static_cast<std::size_t>(s.m));  // into all
+  std::vector<PosePair> all;
+  for (Eigen::Index c = 0; c < Q.outerSize(); ++c) {
+    const Eigen::Index j = c / w, u = c % w;
+    for (SparseMatrix::InnerIterator it(Q, c); it; ++it) {
+      const Eigen::Index i = it.row() / w, t = it.row() % w;
+      auto& col = column[static_cast<std::size_t>(j)];
+      std::size_t k = 0;
+      while (k < col.size() && all[col[k]].i != i) ++k;
+      if (k == col.size()) {
+        col.push_back(all.size());
+        all.push_back(PosePair{i, j, std::vector<double>(static_cast<std::size_t>(w * w), 0.0)});
+      }
+      all[col[k]].q[static_cast<std::size_t>(u * w + t)] = it.value();
+    }
+  }
+  // Interior order: AMD on the interior poses' pattern.
+  if (s.mI > 0) {
+    std::vector<Eigen::Index> interior_index(static_cast<std::size_t>(s.m), -1), interior;
+    for (Eigen::Index i = 0; i < s.m; ++i)
+      if (s.slot[static_cast<std::size_t>(i)] < 0) {
+        interior_index[static_cast<std::size_t>(i)] = static_cast<Eigen::Index>(interior.size());
+        interior.push_back(i);
+      }
+    std::vector<Eigen::Triplet<double>> t;
+    for (const PosePair& pp : all) {
+      const Eigen::Index a = interior_index[static_cast<std::size_t>(pp.i)];
+      const Eigen::Index c = interior_index[static_cast<std::size_t>(pp.j)];
+      if (a >= 0 && c >= 0) t.emplace_back(a, c, 1.0);
+    }
+    SparseMatrix pattern(s.mI, s.mI);
+    pattern.setFromTriplets(t.begin(), t.end());
+    Eigen::AMDOrdering<int> amd;
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
+    amd(pattern, perm);
+    // perm.indices()(k): the interior index eliminated k-th.
+    for (Eigen::Index k = 0; k < s.mI; ++k)
+      s.slot[static_cast<std::size_t>(interior[static_cast<std::size_t>(perm.indices()(k))])] = k;
+  }
+  for (PosePair& pp : all)
+    if (s.slot[static_cast<std::size_t>(pp.i)] >= s.slot[static_cast<std::size_t>(pp.j)])
+      s.pairs.push_back(std::move(pp));
+
+  // The cut's blocks: Q(i, j) for own i and neighbour j is Q_NB's (j, i) block transposed.
+  const SparseMatrix& Qnb = problem.neighbor_matrix();
+  std::vector<std::vector<std::size_t>> cut_of(static_cast<std::size_t>(s.m));
+  for (Eigen::Index c = 0; c < Qnb.outerSize(); ++c) {
+    const Eigen::Index i = c / w, t = c % w;
+    for (SparseMatrix::InnerIterator it(Qnb, c); it; ++it) {
+      const Eigen::Index j = it.row() / w, u = it.row() % w;
+      if (s.owned[static_cast<std::size_t>(i)] > s.neighbors[static_cast<std::size_t>(j)]) continue;
+      auto& col = cut_of[static_cast<std::size_t>(i)];
+      std::size_t k = 0;
+      while (k < col.size() && s.cut[col[k]].j != j) ++k;
+      if (k == col.size()) {
+        col.push_back(s.cut.size());
+        s.cut.push_back(PosePair{i, j, std::vector<double>(static_cast<std::size_t>(w * w), 0.0)});
+      }
+      s.cut[col[k]].q[static_cast<std::size_t>(u * w + t)] = it.value();
+    }
+  }
+}
+
+InterfaceSolve::~InterfaceSolve() = default;
+
+Eigen::Index InterfaceSolve::team_size() const {
+  return impl_->team;
+}
+Eigen::Index InterfaceSolve::offset() const {
+  return impl_->own_offset;
+}
+Eigen::Index InterfaceSolve::size() const {
+  return impl_->p * impl_->mG;
+}
+Eigen::Index InterfaceSolve::block_offset(int b) const {
+  return impl_->block_offset.at(static_cast<std::size_t>(b));
+}
+Eigen::Index InterfaceSolve::block_size(int b) const {
+  return impl_->block_size.at(static_cast<std::size_t>(b));
+}
+double InterfaceSolve::shift() const {
+  return impl_->shift;
+}
+
+namespace {
+
+template <int D>
+void block_into(const double* q, const Eigen::MatrixXd& Gi, const Eigen::MatrixXd& Gj, double* out,
+                bool diagonal) {
+  constexpr int P = D * (D + 1) / 2;
+  double top = 0.0;
+  tangent_block_fixed<D>(q, Gi, Gj, out, P, diagonal ? &top : nullptr);
+}
+
+}  // namespace
+
+std::vector<double> InterfaceSolve::factor(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
+                                           const Eigen::MatrixXd& egrad) {
+  return factor_impl(X, Xn, egrad, true);
+}
+
+std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
+                                                const Eigen::MatrixXd& egrad, bool multipliers) {
+  Impl& s = *impl_;
+  const int d = s.d, w = s.w, p = s.p;
+  if (X.rows() != d || X.cols() != w * s.m || egrad.rows() != d || egrad.cols() != X.cols() ||
+      Xn.rows() != d)
+    throw std::invalid_argument("InterfaceSolve::factor: not a rank-d point of the block");
+  s.sigma_ok = false;
+  const auto skew = skew_pairs(d);
+  std::vector<Eigen::MatrixXd> G(static_cast<std::size_t>(s.m));
+  for (Eigen::Index i = 0; i < s.m; ++i)
+    G[static_cast<std::size_t>(i)] = pose_basis(X.block(0, i * w, d, d), skew);
+  const Eigen::Index n = s.m * p;
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(s.pairs.size() * static_cast<std::size_t>(p * p));
+  Eigen::MatrixXd B(p, p), Qm(w, w);
+  for (const PosePair& pp : s.pairs) {
+    const bool diag = pp.i == pp.j;
+    const double* q = pp.q.data();
+    if (diag && multipliers) {
+      // H's multiplier term on the rotation part of the diagonal blocks (Q - Lambda, as
+      // TangentPreconditioner::factorize(X, egrad)).
+      Qm = Eigen::Map<const Eigen::MatrixXd>(q, w, w);
+      const Eigen::MatrixXd YG =
+          X.block(0, pp.j * w, d, d).transpose() * egrad.block(0, pp.j * w, d, d);
+      Qm.topLeftCorner(d, d) -= 0.25 * (YG + YG.transpose());
+      q = Qm.data();
+    }
+    if (d == 2)
+      block_into<2>(q, G[static_cast<std::size_t>(pp.i)], G[static_cast<std::size_t>(pp.j)],
+                    B.data(), diag);
+    else
+      block_into<3>(q, G[static_cast<std::size_t>(pp.i)], G[static_cast<std::size_t>(pp.j)],
+                    B.data(), diag);
+    const Eigen::Index ri = s.slot[static_cast<std::size_t>(pp.i)] * p;
+    const Eigen::Index cj = s.slot[static_cast<std::size_t>(pp.j)] * p;
+    for (int c = 0; c < p; ++c)
+      for (int a = diag ? c : 0; a < p; ++a) t.emplace_back(ri + a, cj + c, B(a, c));
+  }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  s.ldlt.compute(A);
+  const bool ok = s.ldlt.info() == Eigen::Success && (s.ldlt.vectorD().array() > 0).all();
+  // Far from a minimiser the block's Hessian may be indefinite: then its block without the
+  // multiplier term (positive definite, as block Jacobi's), and Sigma is the Schur complement
+  // of that modified H, still a symmetric positive definite preconditioner.
+  if (!ok && multipliers) return factor_impl(X, Xn, egrad, false);
+  if (!ok) return {0.0};
+  const Eigen::Index nI = s.mI * p, nG = s.mG * p;
+  s.Dinv_interior = s.ldlt.vectorD().head(nI).cwiseInverse();
+  // L's interface block (unit diagonal; the strictly lower entries are stored).
+  s.Lgg = Eigen::MatrixXd::Identity(nG, nG);
+  const auto& L = s.ldlt.matrixL().nestedExpression();
+  for (Eigen::Index c = nI; c < n; ++c)
+    for (std::remove_reference_t<decltype(L)>::InnerIterator it(L, c); it; ++it)
+      if (it.row() > c) s.Lgg(it.row() - nI, c - nI) = it.value();
+  const Eigen::MatrixXd schur = s.Lgg * s.ldlt.vectorD().tail(nG).asDiagonal() * s.Lgg.transpose();
+
+  std::vector<double> out;
+  out.reserve(static_cast<std::size_t>(2 + nG * (nG + 1) / 2) +
+              s.cut.size() * static_cast<std::size_t>(2 + p * p));
+  out.push_back(multipliers ? 1.0 : 2.0);
+  for (Eigen::Index j = 0; j < nG; ++j)
+    for (Eigen::Index i = j; i < nG; ++i) out.push_back(0.5 * (schur(i, j) + schur(j, i)));
+  out.push_back(static_cast<double>(s.cut.size()));
+  for (const PosePair& pp : s.cut) {
+    const Eigen::MatrixXd Gj = pose_basis(Xn.block(0, pp.j * w, d, d), skew);
+    if (d == 2)
+      block_into<2>(pp.q.data(), G[static_cast<std::size_t>(pp.i)], Gj, B.data(), false);
+    else
+      block_into<3>(pp.q.data(), G[static_cast<std::size_t>(pp.i)], Gj, B.data(), false);
+    out.push_back(static_cast<double>(s.owned[static_cast<std::size_t>(pp.i)]));
+    out.push_back(static_cast<double>(s.neighbors[static_cast<std::size_t>(pp.j)]));
+    out.insert(out.end(), B.data(), B.data() + p * p);
+  }
+  return out;
+}
+
+bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blocks,
+                              const std::vector<double>& relative_shifts) {
+  Impl& s = *impl_;
+  const int p = s.p;
+  s.sigma_ok = false;
+  s.shift = 0.0;
+  if (blocks.size() != s.block_offset.size())
+    throw std::runtime_error("newton refine: interface shares from the wrong number of agents");
+  std::vector<Eigen::Triplet<double>> t;
+  double top = 0.0;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const std::vector<double>& v = *blocks[b];
+    auto fail = [b] {
+      throw std::runtime_error("newton refine: malformed interface share from agent " +
+                               std::to_string(b));
+    };
+    if (v.empty()) fail();
+    if (v[0] == 0.0) return false;  // a block's Hessian is not positive definite
+    const Eigen::Index at = s.block_offset[b], nG = s.block_size[b];
+    std::size_t k = 1;
+    const std::size_t tri = static_cast<std::size_t>(nG * (nG + 1) / 2);
+    if (v.size() < k + tri + 1) fail();
+    for (Eigen::Index j = 0; j < nG; ++j)
+      for (Eigen::Index i = j; i < nG; ++i) {
+        if (i == j) top = std::max(top, v[k]);
+        t.emplace_back(at + i, at + j, v[k++]);
+      }
+    const double count = v[k++];
+    const std::size_t per = static_cast<std::size_t>(2 + p * p);
+    if (!(count >= 0) || v.size() != k + static_cast<std::size_t>(count) * per) fail();
+    for (std::size_t e = 0; e < static_cast<std::size_t>(count); ++e, k += per) {
+      auto ri = s.team_index.find(static_cast<std::size_t>(v[k]));
+      auto ci = s.team_index.find(static_cast<std::size_t>(v[k + 1]));
+      if (ri == s.team_index.end() || ci == s.team_index.end()) fail();
+      for (int c = 0; c < p; ++c)
+        for (int a = 0; a < p; ++a) {
+          const double x = v[k + 2 + static_cast<std::size_t>(c * p + a)];
+          if (x == 0.0) continue;
+          const Eigen::Index r = ri->second + a, cc = ci->second + c;
+          t.emplace_back(std::max(r, cc), std::min(r, cc), x);
+        }
+    }
+  }
+  if (s.team == 0) return false;
+  SparseMatrix sigma(s.team, s.team);
+  sigma.setFromTriplets(t.begin(), t.end());
+  SparseMatrix I(s.team, s.team);
+  I.setIdentity();
+  for (double rel : relative_shifts) {
+    const double eta = rel * std::max(top, 1e-300);
+    s.sigma.compute(sigma + eta * I);
+    if (s.sigma.info() == Eigen::Success) {
+      s.sigma_ok = true;
+      s.shift = rel;
+      return true;
+    }
+  }
+  return false;
+}
+
+void InterfaceSolve::forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
+                             Eigen::VectorXd& y) const {
+  const Impl& s = *impl_;
+  const int p = s.p;
+  s.b.resize(s.m * p);
+  if (s.d == 2)
+    tangent_coordinates<2>(X.data(), v.data(), s.m, s.b.data());
+  else
+    tangent_coordinates<3>(X.data(), v.data(), s.m, s.b.data());
+  y.resize(s.m * p);
+  for (Eigen::Index i = 0; i < s.m; ++i)
+    y.segment(s.slot[static_cast<std::size_t>(i)] * p, p) = s.b.segment(i * p, p);
+  s.ldlt.matrixL().solveInPlace(y);
+}
+
+void InterfaceSolve::add_interface(const Eigen::VectorXd& y, double* team) const {
+  const Impl& s = *impl_;
+  const Eigen::Index nG = s.mG * s.p;
+  if (nG == 0) return;
+  Eigen::Map<Eigen::VectorXd>(team + s.own_offset, nG) += s.Lgg * y.tail(nG);
+}
+
+Eigen::MatrixXd InterfaceSolve::back(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                                     const Eigen::VectorXd& rhat) const {
+  const Impl& s = *impl_;
+  if (!s.sigma_ok) throw std::logic_error("InterfaceSolve::back: no factor of Sigma");
+  const int p = s.p;
+  const Eigen::Index nI = s.mI * p, nG = s.mG * p;
+  const Eigen::VectorXd u = s.sigma.solve(rhat);
+  Eigen::VectorXd v(y.size());
+  v.head(nI) = s.Dinv_interior.cwiseProduct(y.head(nI));
+  if (nG > 0) v.tail(nG) = s.Lgg.transpose() * u.segment(s.own_offset, nG);
+  s.ldlt.matrixU().solveInPlace(v);
+  for (Eigen::Index i = 0; i < s.m; ++i)
+    s.b.segment(i * p, p) = v.segment(s.slot[static_cast<std::size_t>(i)] * p, p);
+  Eigen::MatrixXd Z(s.d, X.cols());
+  if (s.d == 2)
+    tangent_vector<2>(X.data(), s.b.data(), s.m, Z.data());
+  else
+    tangent_vector<3>(X.data(), s.b.data(), s.m, Z.data());
+  return Z;
+}
+
+}  // namespace tessera

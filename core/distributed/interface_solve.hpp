@@ -1,0 +1,84 @@
+#pragma once
+// Exact solves with the Newton refinement's Riemannian Hessian by substructuring
+// (non-overlapping domain decomposition), for its conjugate gradient's preconditioner.
+//
+// In tangent coordinates (tangent_preconditioner.hpp: p = d(d+1)/2 a pose, rank d) the Hessian
+// H = J^T 2 (Q - Lambda) J has the graph's pattern; Lambda (the first-order multipliers) is pose
+// diagonal, so H couples two blocks only through the cut measurements, which join interface
+// poses (poses with a cut measurement). Each block orders its interior first (pose-level AMD)
+// and its interface last and factors its diagonal block, A_bb = L D L^T; with y = L^-1 J^T r:
+//   Sigma u = rhat,  Sigma = blockdiag_b(L_GG D_G L_GG^T) + (the cut's coupling blocks),
+//   rhat_b = L_GG y_G (the interface's Schur-reduced residual),
+//   x_b = L^-T [D_I^-1 y_I ; L_GG^T u_b],  z = J x   (= H^-1 r).
+// Sigma is as large as the team's interface (ais2klinik at N = 5: 102 coordinates, city10000
+// 909), so every agent holds it: the agents broadcast their Schur complements and coupling
+// blocks once per point and every agent factors the same Sigma from the same bits in id order.
+// Applying the preconditioner then needs the team's rhat, which is linear in r: CG carries it
+// by its recurrences (rhat of H z rides in the iteration's all-agent sum), so a CG iteration is
+// still one exchange and one sum (newton_refine.cpp).
+//
+// Sigma is singular along the problem's gauge (a global rigid motion leaves f unchanged) and
+// may be slightly indefinite there away from a critical point: it is factored with a shift
+// eta I, eta relative to its largest diagonal entry, raised on failure (shifts()). The
+// preconditioner is then the inverse of H + eta P_Gamma: symmetric positive definite, exact
+// up to eta.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <memory>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <vector>
+
+namespace tessera {
+
+class InterfaceSolve {
+ public:
+  /// `problem`: agent `id`'s block; `layout`: the team's. Builds the ordering (no values).
+  InterfaceSolve(const BlockProblem& problem, const BlockLayout& layout, int id);
+  ~InterfaceSolve();
+  InterfaceSolve(const InterfaceSolve&) = delete;
+  InterfaceSolve& operator=(const InterfaceSolve&) = delete;
+
+  /// Tangent coordinates of the team's interface (the size of Sigma and of rhat).
+  Eigen::Index team_size() const;
+  /// This block's first coordinate in the team's interface vector, and its count.
+  Eigen::Index offset() const;
+  Eigen::Index size() const;
+  /// Block b's first coordinate in the team's interface vector, and its count.
+  Eigen::Index block_offset(int b) const;
+  Eigen::Index block_size(int b) const;
+
+  /// Factors the block's Hessian block at X (rank d: d rows, the block's poses), Xn (the
+  /// neighbours' poses, rank d) and egrad (the full Euclidean gradient at X, neighbour terms
+  /// included). Returns this block's share of Sigma as message values (flag, Schur complement,
+  /// couplings). Where A_bb is not positive definite, A_bb without the multiplier term
+  /// (flag 2; 1 with it); the flag is 0 when neither is.
+  std::vector<double> factor(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
+                             const Eigen::MatrixXd& egrad);
+  /// Every block's factor() values in id order: assembles Sigma and factors Sigma + eta I with
+  /// eta = each of `relative_shifts` in turn times its largest diagonal entry. False (and the
+  /// solve unusable) when a block's flag is 0 or no shift gives a positive definite factor.
+  bool assemble(const std::vector<const std::vector<double>*>& blocks,
+                const std::vector<double>& relative_shifts);
+  /// The shift the last assemble() factored with (relative), 0 before.
+  double shift() const;
+
+  /// y = L^-1 P J^T v (v: a tangent vector at X, d rows), the block's forward solve.
+  void forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, Eigen::VectorXd& y) const;
+  /// The block's rhat from y: L_GG y_G, added into team (team_size() entries) at offset().
+  void add_interface(const Eigen::VectorXd& y, double* team) const;
+  /// z = J P^T L^-T [D_I^-1 y_I ; L_GG^T u_b], u = (Sigma + eta I)^-1 rhat (rhat: the team's,
+  /// team_size() entries): the preconditioned vector, a tangent vector at X.
+  Eigen::MatrixXd back(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                       const Eigen::VectorXd& rhat) const;
+
+ private:
+  std::vector<double> factor_impl(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
+                                  const Eigen::MatrixXd& egrad, bool multipliers);
+
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tessera
