@@ -72,8 +72,10 @@ options:
   --coarse-aggregates K  smoothed: pieces per block (default 4)
   --coarse-smoothing S   smoothed: smoothing steps of the blend, 0..8 (default 1)
   --refine newton|auto|none after the rounds, trust-region Newton steps on the whole
-                       problem (docs/newton-refine.md); auto: only where the rounds stopped
-                       short of their limit (default auto)
+                       problem (docs/newton-refine.md); auto: where the team's interface
+                       fits the exact interface solves, rounds to gradient 1 then always
+                       the refinement, elsewhere only where the rounds stopped short of
+                       their limit (default auto)
   --refine-grad-tol T, --refine-rel-tol F
                        its stops: ||grad f|| <= T, or a step lowered f by < F f (0 = the
                        defaults, 1e-6 and 1e-7)

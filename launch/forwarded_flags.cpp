@@ -259,9 +259,11 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
       {"refine", "refine", true, ForwardTo::kCoordinator, "--refine newton|auto|none",
        "after the rounds reach --grad-tol, trust-region Newton\n"
        "steps on the whole problem: CG over neighbour exchanges\n"
-       "and all-agent sums (docs/newton-refine.md); auto: only\n"
-       "where the rounds' last cost decreases say they stopped\n"
-       "more than 1e-7 of f above their limit               [auto]",
+       "and all-agent sums (docs/newton-refine.md); auto: where\n"
+       "the team's interface fits the exact interface solves,\n"
+       "rounds to gradient 1, then always the refinement;\n"
+       "elsewhere only where the rounds' last cost decreases say\n"
+       "they stopped more than 1e-7 of f above their limit  [auto]",
        check_refine},
       {"refine-grad-tol", "refine-grad-tol", true, ForwardTo::kCoordinator, "--refine-grad-tol T",
        "the refinement stops at ||grad f|| <= T       [1e-6]", check_refine_grad_tol},

@@ -5,6 +5,7 @@
 #include <tessera/distributed/stage_tag.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "distributed/interface_solve.hpp"
 #include "distributed/rounds_tail.hpp"
 
 namespace tessera {
@@ -18,14 +19,33 @@ void StaircaseOptions::validate() const {
 
 CertifiedAgent::CertifiedAgent(AgentState& state, const BlockLayout& layout,
                                const DistributedOptions& options)
-    : state_(state), layout_(layout), options_(options) {}
+    : state_(state), layout_(layout), options_(options) {
+  const NewtonRefineOptions& r = options_.refine;
+  // The layout is the same on every agent, so is this decision (as the refinement's own).
+  if (r.enabled && r.when == NewtonRefineOptions::When::kIfRoundsSlow &&
+      r.auto_interface_grad_tol > 0 && r.interface_max_coordinates > 0 &&
+      r.coarse == NewtonRefineOptions::Coarse::kNone && layout_.num_blocks > 1) {
+    const Eigen::Index size = interface_tangent_coordinates(layout_, state_.problem().dim());
+    interface_fits_ = size > 0 && size <= r.interface_max_coordinates;
+  }
+}
+
+bool CertifiedAgent::hands_over_early() const {
+  // Not conditioned on the rank: the refinement works on the iterate's active rows, d of them
+  // where the relaxation is tight, whatever the lifted rank.
+  return interface_fits_;
+}
 
 double CertifiedAgent::solve_tolerance() const {
-  return refining_ ? refine_tolerance() : options_.grad_norm_tol;
+  if (refining_) return refine_tolerance();
+  if (hands_over_early())
+    return std::max(options_.grad_norm_tol, options_.refine.auto_interface_grad_tol);
+  return options_.grad_norm_tol;
 }
 
 bool CertifiedAgent::refine_wanted(const std::vector<RoundRecord>& trace) const {
   if (options_.refine.when == NewtonRefineOptions::When::kAlways) return true;
+  if (hands_over_early()) return true;
   return rounds_tail_gap(trace, options_.refine.auto_window, 0.9) > options_.refine.auto_gap_tol;
 }
 

@@ -31,6 +31,13 @@ struct PosePair {
 
 }  // namespace
 
+Eigen::Index interface_tangent_coordinates(const BlockLayout& layout, int dim) {
+  Eigen::Index poses = 0;
+  for (int b = 0; b < layout.num_blocks; ++b)
+    poses += static_cast<Eigen::Index>(interface_poses(layout, b).size());
+  return poses * dim * (dim + 1) / 2;
+}
+
 struct InterfaceSolve::Impl {
   int d = 0, w = 0, p = 0;
   Eigen::Index m = 0, mI = 0, mG = 0;  // poses: all, interior, interface

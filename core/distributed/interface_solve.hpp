@@ -32,6 +32,10 @@
 
 namespace tessera {
 
+/// Tangent coordinates of the team's interface at rank `dim` (d(d+1)/2 a pose with a cut
+/// measurement): the size of Sigma, known from the layout alone, so every agent computes the same.
+Eigen::Index interface_tangent_coordinates(const BlockLayout& layout, int dim);
+
 class InterfaceSolve {
  public:
   /// `problem`: agent `id`'s block; `layout`: the team's. Builds the ordering (no values).

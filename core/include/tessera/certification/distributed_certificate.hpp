@@ -57,8 +57,12 @@ struct DistributedCertificateOptions {
   std::uint64_t seed = 1;  ///< Start vector (hash of the global pose ids and this seed).
   /// The exact interface test runs when the team's interface (poses with a cut measurement)
   /// has at most this many coordinates ((d+1) a pose): agent 0 factors a matrix that large,
-  /// dense within each block's interface. 0 = LOBPCG only. >= 0.
-  int interface_max_coordinates = 1200;
+  /// dense within each block's interface. 0 = LOBPCG only. >= 0. Why 800: the Schur complements
+  /// travel to agent 0 in one message step, 4 bytes a coordinate squared per block; at torus3D's
+  /// 1,004 (N = 5) that is 4 MB and the certificate phase over DDS took 0.37-0.75 s against
+  /// LOBPCG's 0.19-0.34 s, while sphere2500 (704) and city10000 (459 at N = 5, 768 at N = 10)
+  /// decide in one certificate round (docs/distributed-certification.md).
+  int interface_max_coordinates = 800;
   /// The interface test keeps one endpoint of each cut measurement (the one in the lower-
   /// numbered block) and eliminates the other inside its block: Sigma has about half the
   /// coordinates (torus3D, N = 5: 1,004 instead of 1,944), interface_max_coordinates counts

@@ -106,6 +106,9 @@ class CertifiedAgent : public AgentProcess {
   double refine_tolerance() const;
   /// Whether a converged solve with this trace is refined (NewtonRefineOptions::when).
   bool refine_wanted(const std::vector<RoundRecord>& trace) const;
+  /// `--refine auto` where the team's interface fits the refinement's interface solves: the
+  /// rounds hand over to it at NewtonRefineOptions::auto_interface_grad_tol.
+  bool hands_over_early() const;
 
   AgentState& state_;
   const BlockLayout& layout_;
@@ -125,7 +128,8 @@ class CertifiedAgent : public AgentProcess {
   std::vector<CertifyStageRecord> certificates_;
   std::vector<EscapeStageRecord> escapes_;
   std::function<void(const ProtocolSnapshot&)> observer_;
-  bool refining_ = false;  // the current rank's solve continues at refine_tolerance()
+  bool refining_ = false;        // the current rank's solve continues at refine_tolerance()
+  bool interface_fits_ = false;  // the team's interface within the refinement's interface cap
   bool done_ = false;
 };
 

@@ -167,12 +167,22 @@ struct NewtonRefineOptions {
   /// one sum (the interface residual rides in the sum). Used at rank d with `coarse` kNone. A
   /// block whose Hessian block is not positive definite (far from a minimiser) factors it
   /// without the multiplier term (then M is the inverse of that modified H); where no block
-  /// factor or no Sigma is positive definite, that point's CG runs block Jacobi. Why 1000:
+  /// factor or no Sigma is positive definite, that point's CG runs block Jacobi. Why 500:
   /// every agent factors Sigma at every point (cost ~ size^3 / 3, dense within each block's
   /// interface); cubicle's 1,572 coordinates at N = 5 cut its CG iterations 116 -> 3 but
-  /// doubled the CPU of the whole solve (2.5 -> 4.8 s) and the bytes (4.9 -> 40.6 MB), while
-  /// city10000's 909 cost +0.25 s for 84 -> 2 CG iterations (docs/newton-refine.md). >= 0.
-  int interface_max_coordinates = 1000;
+  /// doubled the CPU of the whole solve (2.5 -> 4.8 s) and the bytes (4.9 -> 40.6 MB), and
+  /// city10000's 909 cut 84 -> 2 CG iterations but made launch slower on 2 cores (five agents
+  /// factoring the same Sigma), while parking-garage (348) and ais2klinik (102) gain 4-9x
+  /// (docs/newton-refine.md). >= 0.
+  int interface_max_coordinates = 500;
+  /// kIfRoundsSlow: where the interface solves apply (the team's interface within
+  /// interface_max_coordinates), the rounds stop at max(the solver's grad_norm_tol,
+  /// this) and the refinement always runs. Why: with exact interface solves a Newton step costs
+  /// a few message steps, where the rounds' last decades cost hundreds (ais2klinik at N = 5:
+  /// 488 rounds to 0.01 and 3,141 message steps with the refinement, against 405 message steps
+  /// from gradient 1; docs/newton-refine.md, "Interface solves"). 0 = off (the rounds' tail
+  /// alone decides). >= 0.
+  double auto_interface_grad_tol = 1.0;
   /// Relative shift eta of Sigma (times its largest diagonal entry; Sigma is singular along the
   /// gauge); on a failed factorization it is raised 1,000-fold twice before the fallback.
   /// (0, 1e-3].
