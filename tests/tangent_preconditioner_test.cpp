@@ -21,6 +21,7 @@
 
 #include "lifted_blocks.hpp"
 #include "random_graph.hpp"
+#include "util/frobenius_inner.hpp"
 
 namespace tessera {
 namespace {
@@ -52,10 +53,6 @@ Eigen::MatrixXd euclidean_hessian(const SparseMatrix& Q, int d) {
     for (Eigen::Index b = 0; b < Qd.cols(); ++b)
       H.block(a * d, b * d, d, d) = 2.0 * Qd(a, b) * Eigen::MatrixXd::Identity(d, d);
   return H;
-}
-
-double inner(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
-  return A.cwiseProduct(B).sum();
 }
 
 // At the point where A was factored (no shift), P V solves Proj_X(2 Z Q_BB) = V on the tangent
@@ -150,9 +147,9 @@ TEST(TangentPreconditioner, StaleFactorIsSymmetricPositiveDefiniteOnTheCurrentTa
       const Eigen::MatrixXd Pu = precon.apply(M, X, u), Pv = precon.apply(M, X, v);
       EXPECT_LT((M.tangent_project(X, Pu) - Pu).cwiseAbs().maxCoeff(),
                 1e-12 * Pu.cwiseAbs().maxCoeff());
-      const double uPv = inner(u, Pv), vPu = inner(v, Pu);
+      const double uPv = frobenius_inner(u, Pv), vPu = frobenius_inner(v, Pu);
       EXPECT_NEAR(uPv, vPu, 1e-10 * (std::abs(uPv) + std::abs(vPu)));
-      EXPECT_GT(inner(u, Pu), 0.0);
+      EXPECT_GT(frobenius_inner(u, Pu), 0.0);
     }
   }
 }

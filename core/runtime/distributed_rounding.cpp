@@ -13,6 +13,7 @@
 #include <variant>
 
 #include "runtime/rounding_coarse.hpp"
+#include "util/frobenius_inner.hpp"
 
 namespace tessera::agent {
 
@@ -427,8 +428,7 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
     send_publics(kDirection, step, 2, rows_of(&mw, &x));
     double gamma = 0.0, delta = 0.0, rr = 0.0;
     if (coarse) {
-      const double sc[3] = {(r.array() * u.array()).sum(), (w.array() * u.array()).sum(),
-                            r.squaredNorm()};
+      const double sc[3] = {frobenius_inner(r, u), frobenius_inner(w, u), r.squaredNorm()};
       const CoarseSums cs =
           coarse_reduce(step, sc, coupling_Bw, coarse->block_sum(w), coarse->touched());
       gamma = cs.a;
@@ -437,8 +437,8 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
       zn = cs.V + coarse->times(y);  // Z^T L M w = Z^T L B w + E y
       cw_now = cs.S;
     } else {
-      gamma = reduce(kResidual, step, (r.array() * u.array()).sum(), (w.array() * u.array()).sum(),
-                     &delta, r.squaredNorm(), &rr);
+      gamma = reduce(kResidual, step, frobenius_inner(r, u), frobenius_inner(w, u), &delta,
+                     r.squaredNorm(), &rr);
     }
     mx = gather_publics(kDirection, step, 2);
     ++step;
