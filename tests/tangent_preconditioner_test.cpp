@@ -21,6 +21,7 @@
 
 #include "lifted_blocks.hpp"
 #include "random_graph.hpp"
+#include "test_support.hpp"
 #include "util/frobenius_inner.hpp"
 
 namespace tessera {
@@ -284,31 +285,16 @@ TEST(TangentPreconditioner, APoseLevelEstimateRulesOutOnlyFactorsFarOverTheCap) 
 TEST(TangentPreconditioner, OptionsAreValidated) {
   BlockUpdateOptions o;
   o.tangent_refresh_interval = -1;
-  try {
-    o.validate();
-    FAIL() << "no InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("tangent_refresh_interval"), std::string::npos);
-  }
+  EXPECT_NE(test::validation_message(o).find("tangent_refresh_interval"), std::string::npos);
   o = BlockUpdateOptions{};
   o.tangent_relative_shift = -1e-9;
   EXPECT_THROW(o.validate(), InputError);
   o.tangent_relative_shift = 1e-9;
   o.tangent_radius_scale = 0.0;
-  try {
-    o.validate();
-    FAIL() << "no InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("tangent_radius_scale"), std::string::npos);
-  }
+  EXPECT_NE(test::validation_message(o).find("tangent_radius_scale"), std::string::npos);
   o = BlockUpdateOptions{};
   o.tangent_relative_shift = std::nan("");
-  try {
-    o.validate();
-    FAIL() << "no InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("tangent_relative_shift"), std::string::npos);
-  }
+  EXPECT_NE(test::validation_message(o).find("tangent_relative_shift"), std::string::npos);
 }
 
 }  // namespace
