@@ -306,12 +306,7 @@ TEST(Irbcd, BadOptionsNameTheField) {
   EXPECT_THROW(o.validate(), InputError);
   o = {};
   o.sigma = 100;  // >= n^2 for n = 5
-  try {
-    IrbcdScheme s(o, 5);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("sigma"), std::string::npos);
-  }
+  EXPECT_NE(test::input_error_of([&] { IrbcdScheme s(o, 5); }).find("sigma"), std::string::npos);
   const auto names = [](const IrbcdOptions& bad, const char* field) {
     EXPECT_NE(test::validation_message(bad).find(field), std::string::npos) << field;
   };
