@@ -20,6 +20,7 @@
 
 #include "lifted_blocks.hpp"
 #include "random_graph.hpp"
+#include "test_support.hpp"
 
 namespace tessera {
 namespace {
@@ -96,12 +97,7 @@ Eigen::MatrixXd drift_blocks(const Eigen::MatrixXd& X, int d, const std::vector<
 TEST(CoarseCorrection, OptionsNameTheBadField) {
   CoarseOptions o;
   o.every = 0;
-  try {
-    o.validate();
-    FAIL() << "every = 0 accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("every"), std::string::npos);
-  }
+  EXPECT_NE(test::validation_message(o).find("every"), std::string::npos);
   o = CoarseOptions();
   o.max_iterations = 0;
   EXPECT_THROW(o.validate(), InputError);

@@ -92,21 +92,11 @@ TEST(DdsPublicApi, OptionsNameTheBadField) {
   agent.graph = "g.g2o";
   agent.robots = 2;
   agent.id = 2;  // 0..1
-  try {
-    agent.validate();
-    ADD_FAILURE() << "id 2 of 2 accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("--id"), std::string::npos) << e.what();
-  }
+  EXPECT_NE(test::validation_message(agent).find("--id"), std::string::npos);
   tessera::dds::CoordinatorOptions coordinator;
   coordinator.agents = 2;
   coordinator.session.lease_s = 0.01;  // 0.2..60
-  try {
-    coordinator.validate();
-    ADD_FAILURE() << "lease 0.01 s accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("lease"), std::string::npos) << e.what();
-  }
+  EXPECT_NE(test::validation_message(coordinator).find("lease"), std::string::npos);
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
+#include "test_support.hpp"
+
 namespace tessera {
 namespace {
 
@@ -24,15 +26,6 @@ GeneratorOptions small_grid(double outliers, OutlierKind kind, std::size_t robot
 bool same_measurement(const Measurement& a, const Measurement& b) {
   return a.i == b.i && a.j == b.j && a.R == b.R && a.t == b.t && a.kappa == b.kappa &&
          a.tau == b.tau;
-}
-
-std::string message_of(const GeneratorOptions& o) {
-  try {
-    o.validate();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 TEST(GenerateOutliers, AppendsTheFractionOfLoopClosuresAfterTheUnchangedCleanGraph) {
@@ -93,11 +86,12 @@ TEST(GenerateOutliers, GroupOutliersAgreeWithEachOther) {
 }
 
 TEST(GenerateOutliers, BadOutlierOptionsNameTheField) {
-  EXPECT_NE(message_of(small_grid(0.95, OutlierKind::kRandom)).find("outlier_fraction"),
+  using test::validation_message;
+  EXPECT_NE(validation_message(small_grid(0.95, OutlierKind::kRandom)).find("outlier_fraction"),
             std::string::npos);
-  EXPECT_NE(message_of(small_grid(-0.1, OutlierKind::kRandom)).find("outlier_fraction"),
+  EXPECT_NE(validation_message(small_grid(-0.1, OutlierKind::kRandom)).find("outlier_fraction"),
             std::string::npos);
-  EXPECT_NE(message_of(small_grid(0.1, OutlierKind::kInterRobot, 1)).find("outlier_kind"),
+  EXPECT_NE(validation_message(small_grid(0.1, OutlierKind::kInterRobot, 1)).find("outlier_kind"),
             std::string::npos);
   EXPECT_THROW(parse_outlier_kind("groups"), InputError);
   EXPECT_EQ(parse_outlier_kind("inter-robot"), OutlierKind::kInterRobot);

@@ -16,6 +16,7 @@
 
 #include "launch/forwarded_flags.hpp"
 #include "launch/launch_argv.hpp"
+#include "test_support.hpp"
 
 namespace tessera::launch {
 namespace {
@@ -197,12 +198,7 @@ TEST(LaunchOptions, PublicOptionsParseToTheSameRun) {
   EXPECT_TRUE(has_pair(coordinator, "--output", "x.g2o"));
   EXPECT_TRUE(has_pair(coordinator, "--progress-interval", "0"));
   pub.agents = 65;
-  try {
-    pub.validate();
-    ADD_FAILURE() << "65 agents accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("--agents"), std::string::npos) << e.what();
-  }
+  EXPECT_NE(test::validation_message(pub).find("--agents"), std::string::npos);
 }
 
 }  // namespace

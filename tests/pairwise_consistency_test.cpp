@@ -9,6 +9,9 @@
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "gnc_fixtures.hpp"
+#include "test_support.hpp"
+
 namespace tessera {
 namespace {
 
@@ -23,13 +26,6 @@ GeneratorResult city_with_groups(double fraction) {
   return generate_pose_graph(o);
 }
 
-std::vector<bool> odometry_flags(const PoseGraph& g) {
-  std::vector<bool> known(g.num_measurements());
-  for (std::size_t e = 0; e < known.size(); ++e)
-    known[e] = is_known_inlier(g.measurements[e], KnownInliers::kOdometry);
-  return known;
-}
-
 std::vector<Pose> odometry_chain(const PoseGraph& g, const std::vector<bool>& known) {
   PoseGraph chain;
   chain.d = g.d;
@@ -42,7 +38,7 @@ std::vector<Pose> odometry_chain(const PoseGraph& g, const std::vector<bool>& kn
 TEST(PairwiseConsistency, KeepsEveryTrueClosureAndFlagsEveryMemberOfAWrongGroup) {
   const GeneratorResult r = city_with_groups(0.25);
   ASSERT_FALSE(r.outliers.empty());
-  const std::vector<bool> known = odometry_flags(r.graph);
+  const std::vector<bool> known = test::odometry_flags(r.graph);
   const double c2 = tls_threshold_squared(RobustOptions{}, r.graph.d, r.graph.num_measurements());
   const PairwiseConsistencyResult p =
       pairwise_consistency(r.graph, known, odometry_chain(r.graph, known), c2);
@@ -53,7 +49,7 @@ TEST(PairwiseConsistency, KeepsEveryTrueClosureAndFlagsEveryMemberOfAWrongGroup)
 
 TEST(PairwiseConsistency, CleanClosuresAreAllConsistent) {
   const GeneratorResult r = city_with_groups(0.0);
-  const std::vector<bool> known = odometry_flags(r.graph);
+  const std::vector<bool> known = test::odometry_flags(r.graph);
   const double c2 = tls_threshold_squared(RobustOptions{}, r.graph.d, r.graph.num_measurements());
   const PairwiseConsistencyResult p =
       pairwise_consistency(r.graph, known, odometry_chain(r.graph, known), c2);
@@ -78,25 +74,17 @@ TEST(PairwiseConsistency, PcmGncWithoutConnectedKnownInliersSaysWhy) {
   GncCentralizedOptions o;
   o.robust.kind = RobustKind::kPcmGnc;
   o.robust.known_inliers = KnownInliers::kNone;
-  try {
-    solve_gnc_centralized(dirty.graph, o);
-    FAIL() << "expected an InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("pcm-gnc: the known inliers do not connect"),
-              std::string::npos)
-        << e.what();
-  }
+  EXPECT_NE(test::input_error_of([&] {
+              solve_gnc_centralized(dirty.graph, o);
+            }).find("pcm-gnc: the known inliers do not connect"),
+            std::string::npos);
 }
 
 TEST(PairwiseConsistency, ANegativeReadmissionCountNamesTheField) {
   RobustOptions o;
   o.readmission_passes = -1;
-  try {
-    o.validate();
-    FAIL() << "expected an InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("RobustOptions.readmission_passes"), std::string::npos);
-  }
+  EXPECT_NE(test::validation_message(o).find("RobustOptions.readmission_passes"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "partition/evolutionary.hpp"
 #include "partition/spectral_layouts.hpp"
 #include "structure_graphs.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -204,18 +205,12 @@ TEST(SpectralLayouts, DegenerateInputsGiveNoLayouts) {
 }
 
 TEST(SpectralLayouts, BadOptionsNameTheField) {
-  auto message = [](SpectralLayoutOptions o) {
-    try {
-      o.validate();
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
-  EXPECT_EQ(message({}), "");
+  using tessera::test::validation_message;
+  EXPECT_EQ(validation_message(SpectralLayoutOptions{}), "");
   SpectralLayoutOptions o;
   o.eigenvectors = 0;
-  EXPECT_NE(message(o).find("SpectralLayoutOptions.eigenvectors = 0"), std::string::npos);
+  EXPECT_NE(validation_message(o).find("SpectralLayoutOptions.eigenvectors = 0"),
+            std::string::npos);
   // Each out-of-range field is named in the error.
   const std::vector<std::pair<std::string, std::function<void(SpectralLayoutOptions&)>>> bad = {
       {"max_layouts", [](SpectralLayoutOptions& x) { x.max_layouts = 0; }},
@@ -229,7 +224,7 @@ TEST(SpectralLayouts, BadOptionsNameTheField) {
   for (const auto& [field, spoil] : bad) {
     o = {};
     spoil(o);
-    EXPECT_NE(message(o).find(field), std::string::npos) << field;
+    EXPECT_NE(validation_message(o).find(field), std::string::npos) << field;
   }
   const GraphStructure grid = grid_graph(10, 10);
   o = {};

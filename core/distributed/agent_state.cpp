@@ -8,6 +8,7 @@
 
 #include "distributed/nonzero_rows.hpp"
 #include "distributed/pose_block_codec.hpp"
+#include "util/frobenius_inner.hpp"
 
 namespace tessera {
 
@@ -188,7 +189,7 @@ LocalStatus AgentState::status(bool newton_score) {
     s.grad_norm_sq = g.squaredNorm();
     const Eigen::MatrixXd z =
         euclidean().apply(problem_.manifold(static_cast<int>(Ya.rows())), Ya, g);
-    s.block_grad_norm = std::sqrt(std::max(0.0, (z.array() * g.array()).sum()));
+    s.block_grad_norm = std::sqrt(std::max(0.0, frobenius_inner(z, g)));
     return s;
   }
   if (updated_grad_norm_sq_ >= 0 && updated_version_ == neighbours_version_ && Y == updated_X_) {

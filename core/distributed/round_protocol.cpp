@@ -425,20 +425,30 @@ double RoundProtocol::coarse_correct(const Inbox& inbox, double last_decrease) {
   std::vector<const std::vector<double>*> terms;
   terms.reserve(inbox.size());
   for (const auto& [sender, m] : inbox) terms.push_back(&std::get<RoundStatusMessage>(m).coarse);
-  const CoarseSpace* space = state_.coarse_space();
-  const CoarseResult c = space ? solve_smoothed_coarse(*space, state_.rank(), terms, config_.coarse)
-                               : solve_coarse(layout_, state_.rank(), terms, config_.coarse);
+  const CoarseResult c = solve_coarse_terms(terms);
   if (!c.moved || c.cost_before - c.cost_after < config_.coarse.min_gain * last_decrease)
     return 0.0;
+  apply_coarse_motions(c.motions, c.cost_before - c.cost_after);
+  return c.cost_after - c.cost_before;
+}
+
+CoarseResult RoundProtocol::solve_coarse_terms(
+    const std::vector<const std::vector<double>*>& terms) const {
+  const CoarseSpace* space = state_.coarse_space();
+  return space ? solve_smoothed_coarse(*space, state_.rank(), terms, config_.coarse)
+               : solve_coarse(layout_, state_.rank(), terms, config_.coarse);
+}
+
+void RoundProtocol::apply_coarse_motions(const std::vector<Eigen::MatrixXd>& motions,
+                                         double decrease) {
   // The smoothed space's blend is put back on the manifold afterwards, so its f moves by the
   // coarse decrease to second order in the step (coarse_space.hpp).
-  if (space)
-    state_.apply_smoothed_coarse(c.motions);
+  if (state_.coarse_space())
+    state_.apply_smoothed_coarse(motions);
   else
-    state_.apply_coarse(c.motions);
+    state_.apply_coarse(motions);
   ++coarse_corrections_;
-  coarse_decrease_ += c.cost_before - c.cost_after;
-  return c.cost_after - c.cost_before;
+  coarse_decrease_ += decrease;
 }
 
 const std::vector<int>& RoundProtocol::coarse_unknowns(int agent) {
@@ -453,10 +463,8 @@ void RoundProtocol::solve_gathered_coarse(const Inbox& inbox, std::vector<Outgoi
   std::vector<const std::vector<double>*> terms;
   terms.reserve(inbox.size());
   for (const auto& [sender, m] : inbox) terms.push_back(&coarse_terms_of(m));
-  const CoarseSpace* space = state_.coarse_space();
   const double last_decrease = round_ > 0 ? f_prev_ - held_.f : 0.0;
-  const CoarseResult c = space ? solve_smoothed_coarse(*space, state_.rank(), terms, config_.coarse)
-                               : solve_coarse(layout_, state_.rank(), terms, config_.coarse);
+  const CoarseResult c = solve_coarse_terms(terms);
   const bool applied =
       c.moved && c.cost_before - c.cost_after >= config_.coarse.min_gain * last_decrease;
   const double decrease = c.cost_before - c.cost_after;
@@ -472,12 +480,7 @@ void RoundProtocol::solve_gathered_coarse(const Inbox& inbox, std::vector<Outgoi
   }
   double f = held_.f;
   if (applied) {
-    if (space)
-      state_.apply_smoothed_coarse(c.motions);
-    else
-      state_.apply_coarse(c.motions);
-    ++coarse_corrections_;
-    coarse_decrease_ += decrease;
+    apply_coarse_motions(c.motions, decrease);
     f -= decrease;
   }
   continue_round(held_.rec, f, held_.gsq, held_.norms, out);
@@ -490,12 +493,7 @@ void RoundProtocol::take_coarse_motions(const Inbox& inbox, std::vector<Outgoing
                                                       coarse_unknowns(state_.id()));
   double f = held_.f;
   if (c.applied) {
-    if (space)
-      state_.apply_smoothed_coarse(c.motions);
-    else
-      state_.apply_coarse(c.motions);
-    ++coarse_corrections_;
-    coarse_decrease_ += c.decrease;
+    apply_coarse_motions(c.motions, c.decrease);
     f -= c.decrease;
   }
   continue_round(held_.rec, f, held_.gsq, held_.norms, out);

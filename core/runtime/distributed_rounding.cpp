@@ -13,6 +13,7 @@
 #include <variant>
 
 #include "runtime/rounding_coarse.hpp"
+#include "util/frobenius_inner.hpp"
 
 namespace tessera::agent {
 
@@ -64,6 +65,37 @@ std::vector<std::uint32_t> DistributedRounding::others() const {
   return o;
 }
 
+PoseBlockMessage DistributedRounding::block_message(std::uint32_t phase, std::uint32_t round,
+                                                    std::uint32_t rank) const {
+  PoseBlockMessage m;
+  m.round = round;
+  m.sender = self_;
+  m.phase = phase;
+  m.rank = rank;
+  m.dim = static_cast<std::uint32_t>(d_);
+  return m;
+}
+
+double* DistributedRounding::add_entry(PoseBlockMessage& m, std::uint32_t id) const {
+  m.pose_ids.push_back(id);
+  m.data.resize(m.data.size() + width_of(m.rank), 0.0);
+  return m.data.data() + m.data.size() - width_of(m.rank);
+}
+
+template <class F>
+void DistributedRounding::for_each_entry(const PoseBlockMessage& mine, const char* what, F f) {
+  const std::size_t width = width_of(mine.rank);
+  auto got = mail_.gather(mine.phase, mine.round, others());
+  for (std::uint32_t a : everyone_) {  // agent-id order: bit-identical sums everywhere
+    const PoseBlockMessage& m = a == self_ ? mine : std::get<PoseBlockMessage>(got.at(a));
+    if (m.data.size() != m.pose_ids.size() * width)
+      throw std::runtime_error(std::string("rounding: ") + what + " of the wrong size from agent " +
+                               std::to_string(a));
+    for (std::size_t e = 0; e < m.pose_ids.size(); ++e)
+      f(a, m.pose_ids[e], m.data.data() + e * width);
+  }
+}
+
 DistributedRounding::CoarseSums DistributedRounding::coarse_reduce(
     std::uint32_t round, const double (&scalars)[3], const Eigen::MatrixXd& coupling,
     const Eigen::RowVectorXd& own, const std::vector<std::uint32_t>& touched) {
@@ -71,54 +103,34 @@ DistributedRounding::CoarseSums DistributedRounding::coarse_reduce(
   // entry N: the scalars.
   const auto N = static_cast<std::uint32_t>(everyone_.size());
   const Eigen::Index d = d_;
-  PoseBlockMessage msg;
-  msg.round = round;
-  msg.sender = self_;
-  msg.phase = kCoarseSums;
-  msg.rank = 2;
-  msg.dim = static_cast<std::uint32_t>(d);
-  const std::size_t width = width_of(2);
+  PoseBlockMessage msg = block_message(kCoarseSums, round, 2);
   for (std::uint32_t k : touched) {
-    msg.pose_ids.push_back(k);
-    std::vector<double> v(width, 0.0);
+    double* v = add_entry(msg, k);
     for (Eigen::Index j = 0; j < d; ++j) {
-      v[static_cast<std::size_t>(j)] = coupling(static_cast<Eigen::Index>(k), j);
-      if (k == self_) v[static_cast<std::size_t>(d + j)] = own(j);
+      v[j] = coupling(static_cast<Eigen::Index>(k), j);
+      if (k == self_) v[d + j] = own(j);
     }
-    msg.data.insert(msg.data.end(), v.begin(), v.end());
   }
-  msg.pose_ids.push_back(N);
-  std::vector<double> sc(width, 0.0);
-  std::copy(scalars, scalars + 3, sc.begin());
-  msg.data.insert(msg.data.end(), sc.begin(), sc.end());
+  std::copy(scalars, scalars + 3, add_entry(msg, N));
   mail_.send_all({OutgoingMessage{msg, true, {}}});
-  auto got = mail_.gather(kCoarseSums, round, others());
   CoarseSums out;
   out.V = Eigen::MatrixXd::Zero(N, d);
   out.S = Eigen::MatrixXd::Zero(N, d);
-  for (std::uint32_t a : everyone_) {  // agent-id order: bit-identical sums everywhere
-    const PoseBlockMessage& m = a == self_ ? msg : std::get<PoseBlockMessage>(got.at(a));
-    if (m.data.size() != m.pose_ids.size() * width)
-      throw std::runtime_error("rounding: coarse sums of the wrong size from agent " +
-                               std::to_string(a));
-    for (std::size_t e = 0; e < m.pose_ids.size(); ++e) {
-      const double* v = m.data.data() + e * width;
-      const std::uint32_t k = m.pose_ids[e];
-      if (k > N)
-        throw std::runtime_error("rounding: coarse sums for block " + std::to_string(k) +
-                                 " from agent " + std::to_string(a));
-      if (k == N) {
-        out.a += v[0];
-        out.b += v[1];
-        out.c += v[2];
-        continue;
-      }
-      for (Eigen::Index j = 0; j < d; ++j) {
-        out.V(static_cast<Eigen::Index>(k), j) += v[j];
-        if (k == a) out.S(static_cast<Eigen::Index>(k), j) = v[d + j];
-      }
+  for_each_entry(msg, "coarse sums", [&](std::uint32_t a, std::uint32_t k, const double* v) {
+    if (k > N)
+      throw std::runtime_error("rounding: coarse sums for block " + std::to_string(k) +
+                               " from agent " + std::to_string(a));
+    if (k == N) {
+      out.a += v[0];
+      out.b += v[1];
+      out.c += v[2];
+      return;
     }
-  }
+    for (Eigen::Index j = 0; j < d; ++j) {
+      out.V(static_cast<Eigen::Index>(k), j) += v[j];
+      if (k == a) out.S(static_cast<Eigen::Index>(k), j) = v[d + j];
+    }
+  });
   return out;
 }
 
@@ -137,17 +149,11 @@ void DistributedRounding::send_publics(std::uint32_t phase, std::uint32_t round,
   const std::size_t width = width_of(rank);
   const auto& adj = layout_.adjacent[self_];
   for (std::size_t k = 0; k < adj.size(); ++k) {
-    PoseBlockMessage m;
-    m.round = round;
-    m.sender = self_;
-    m.phase = phase;
-    m.rank = rank;
-    m.dim = static_cast<std::uint32_t>(d_);
+    PoseBlockMessage m = block_message(phase, round, rank);
     for (std::size_t id : layout_.public_to[self_][k]) {
-      m.pose_ids.push_back(static_cast<std::uint32_t>(id));
-      std::vector<double> v = values(id);
-      v.resize(width, 0.0);
-      m.data.insert(m.data.end(), v.begin(), v.end());
+      const std::vector<double> v = values(id);
+      std::copy_n(v.begin(), std::min(v.size(), width),
+                  add_entry(m, static_cast<std::uint32_t>(id)));
     }
     mail_.send_all({OutgoingMessage{m, false, {static_cast<std::uint32_t>(adj[k])}}});
   }
@@ -178,15 +184,9 @@ void DistributedRounding::rotations() {
     G.noalias() += B * B.transpose();
   }
   // The Gram matrix travels as r "poses" of rank r whose first r entries are its columns.
-  PoseBlockMessage gm;
-  gm.sender = self_;
-  gm.phase = kGram;
-  gm.rank = static_cast<std::uint32_t>(r);
-  gm.dim = static_cast<std::uint32_t>(d);
-  for (Eigen::Index c = 0; c < r; ++c) {
-    gm.pose_ids.push_back(static_cast<std::uint32_t>(c));
-    for (Eigen::Index k = 0; k < r * (d + 1); ++k) gm.data.push_back(k < r ? G(k, c) : 0.0);
-  }
+  PoseBlockMessage gm = block_message(kGram, 0, static_cast<std::uint32_t>(r));
+  for (Eigen::Index c = 0; c < r; ++c)
+    std::copy_n(G.col(c).data(), r, add_entry(gm, static_cast<std::uint32_t>(c)));
   mail_.send_all({OutgoingMessage{gm, true, {}}});
   auto got = mail_.gather(kGram, 0, others());
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(r, r);
@@ -338,7 +338,7 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
   // The coarse level's rows of E travel in the same message step (sent before, gathered after).
   const auto N = static_cast<std::uint32_t>(everyone_.size());
   std::optional<RoundingCoarse> coarse;
-  PoseBlockMessage erow;
+  PoseBlockMessage erow = block_message(kCoarseMatrix, 0, 1);
   if (options_.coarse_correction && N > 1) {
     std::vector<std::uint32_t> nb_block;
     for (std::size_t id : nb_ids) nb_block.push_back(local_.owner[id]);
@@ -347,35 +347,20 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
       free_row[static_cast<std::size_t>(k)] = free(own_[static_cast<std::size_t>(k)]);
     coarse.emplace(L_own, L_nb, nb_block, free_row, self_, N);
     const Eigen::VectorXd row = coarse->own_row();
-    erow.sender = self_;
-    erow.phase = kCoarseMatrix;
-    erow.rank = 1;
-    erow.dim = static_cast<std::uint32_t>(d);
-    for (std::uint32_t k : coarse->touched()) {
-      erow.pose_ids.push_back(k);
-      std::vector<double> v(width_of(1), 0.0);
-      v[0] = row(static_cast<Eigen::Index>(k));
-      erow.data.insert(erow.data.end(), v.begin(), v.end());
-    }
+    for (std::uint32_t k : coarse->touched())
+      *add_entry(erow, k) = row(static_cast<Eigen::Index>(k));
     mail_.send_all({OutgoingMessage{erow, true, {}}});
   }
   send_publics(kWarmStartValues, 0, 1, rows_of(&x, nullptr));
   double bb = reduce(kWarmStartNorm, 0, b.squaredNorm(), 0.0, nullptr);
   if (coarse) {
-    auto got = mail_.gather(kCoarseMatrix, 0, others());
     Eigen::MatrixXd E = Eigen::MatrixXd::Zero(N, N);
-    for (std::uint32_t a : everyone_) {
-      const PoseBlockMessage& em = a == self_ ? erow : std::get<PoseBlockMessage>(got.at(a));
-      if (em.data.size() != em.pose_ids.size() * width_of(1))
-        throw std::runtime_error("rounding: coarse row of the wrong size from agent " +
-                                 std::to_string(a));
-      for (std::size_t e = 0; e < em.pose_ids.size(); ++e) {
-        if (em.pose_ids[e] >= N)
-          throw std::runtime_error("rounding: coarse row entry " + std::to_string(em.pose_ids[e]) +
-                                   " from agent " + std::to_string(a));
-        E(a, em.pose_ids[e]) = em.data[e * width_of(1)];
-      }
-    }
+    for_each_entry(erow, "coarse row", [&](std::uint32_t a, std::uint32_t k, const double* v) {
+      if (k >= N)
+        throw std::runtime_error("rounding: coarse row entry " + std::to_string(k) +
+                                 " from agent " + std::to_string(a));
+      E(a, k) = v[0];
+    });
     if (!coarse->factorise(E)) coarse.reset();  // the same E everywhere: all agents agree
   }
   Eigen::MatrixXd r = b - apply(x, gather_publics(kWarmStartValues, 0, 1));
@@ -443,8 +428,7 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
     send_publics(kDirection, step, 2, rows_of(&mw, &x));
     double gamma = 0.0, delta = 0.0, rr = 0.0;
     if (coarse) {
-      const double sc[3] = {(r.array() * u.array()).sum(), (w.array() * u.array()).sum(),
-                            r.squaredNorm()};
+      const double sc[3] = {frobenius_inner(r, u), frobenius_inner(w, u), r.squaredNorm()};
       const CoarseSums cs =
           coarse_reduce(step, sc, coupling_Bw, coarse->block_sum(w), coarse->touched());
       gamma = cs.a;
@@ -453,8 +437,8 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
       zn = cs.V + coarse->times(y);  // Z^T L M w = Z^T L B w + E y
       cw_now = cs.S;
     } else {
-      gamma = reduce(kResidual, step, (r.array() * u.array()).sum(), (w.array() * u.array()).sum(),
-                     &delta, r.squaredNorm(), &rr);
+      gamma = reduce(kResidual, step, frobenius_inner(r, u), frobenius_inner(w, u), &delta,
+                     r.squaredNorm(), &rr);
     }
     mx = gather_publics(kDirection, step, 2);
     ++step;

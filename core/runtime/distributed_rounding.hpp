@@ -135,6 +135,20 @@ class DistributedRounding {
     return static_cast<std::size_t>(rank) * static_cast<std::size_t>(d_ + 1);
   }
 
+  // A pose-block message of this agent's (phase, round, rank) with no entries yet.
+  PoseBlockMessage block_message(std::uint32_t phase, std::uint32_t round,
+                                 std::uint32_t rank) const;
+
+  // Appends entry `id` to `m`: width_of(m.rank) zeros, whose first is returned.
+  double* add_entry(PoseBlockMessage& m, std::uint32_t id) const;
+
+  // Gathers the others' broadcasts of `mine`'s phase and round and calls f(agent, entry id,
+  // the entry's width_of(rank) values) for every entry of every agent's (this agent's own:
+  // `mine`), in agent-id order, so that sums come out bit-identical everywhere. Throws naming
+  // `what` when a message's data does not fit its entries.
+  template <class F>
+  void for_each_entry(const PoseBlockMessage& mine, const char* what, F f);
+
   void rotations();
 
   // The sums of a CG step with the coarse level, in agent-id order: the three scalars of

@@ -5,6 +5,22 @@
 #include "runtime/distributed_rounding.hpp"
 
 namespace tessera::agent {
+namespace {
+
+// Agent 0's report of `phase` to the coordinator, its three values in the status's fields.
+RoundStatusMessage agent0_report(std::uint32_t round, std::uint32_t phase, double cost,
+                                 double grad_norm_sq, double block_grad_norm) {
+  RoundStatusMessage m;
+  m.round = round;
+  m.phase = phase;
+  m.sender = 0;
+  m.cost = cost;
+  m.grad_norm_sq = grad_norm_sq;
+  m.block_grad_norm = block_grad_norm;
+  return m;
+}
+
+}  // namespace
 
 RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout& layout,
                                  const AgentState& state, Mailbox& mail, ProtocolChannel& channel,
@@ -28,59 +44,35 @@ RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout&
   res.send_s = mail.send_s;
   res.rounding_steps = mail.gathers;
 
+  auto send = [&channel](const RoundStatusMessage& m) {
+    channel.send(OutgoingMessage{m, true, {}});
+  };
   if (local.agent_id == 0 && res.certified) {  // before the final report, which ends the wait
-    RoundStatusMessage c;
-    c.round = res.rounds;
-    c.phase = kCertificateReportPhase;
-    c.sender = 0;
-    c.cost = res.min_eigenvalue;
-    c.grad_norm_sq = res.certificate_rounds;
-    c.block_grad_norm = res.final_rank;
+    RoundStatusMessage c = agent0_report(res.rounds, kCertificateReportPhase, res.min_eigenvalue,
+                                         res.certificate_rounds, res.final_rank);
     c.restart_vote = *res.certified;
     c.done_vote = true;
-    channel.send(OutgoingMessage{c, true, {}});
-    RoundStatusMessage b;
-    b.round = res.rounds;
-    b.phase = kCertificateBytesPhase;
-    b.sender = 0;
-    b.cost = static_cast<double>(res.certificate_bytes);
-    b.grad_norm_sq = static_cast<double>(res.escape_bytes);
-    b.block_grad_norm = res.escape_rounds;
-    channel.send(OutgoingMessage{b, true, {}});
+    send(c);
+    send(agent0_report(res.rounds, kCertificateBytesPhase,
+                       static_cast<double>(res.certificate_bytes),
+                       static_cast<double>(res.escape_bytes), res.escape_rounds));
   }
   if (local.agent_id == 0 && res.robust) {
-    RoundStatusMessage r;
-    r.round = res.rounds;
-    r.phase = kRobustReportPhase;
-    r.sender = 0;
-    r.cost = res.robust->outer_iterations;
-    r.grad_norm_sq = static_cast<double>(res.robust->readmitted);
-    r.block_grad_norm = res.robust->threshold_squared;
+    RoundStatusMessage r =
+        agent0_report(res.rounds, kRobustReportPhase, res.robust->outer_iterations,
+                      static_cast<double>(res.robust->readmitted), res.robust->threshold_squared);
     r.done_vote = res.robust->weights_converged;
     r.measurement_ids = res.robust->rejected;
     r.coarse = {static_cast<double>(res.robust->probes),
                 static_cast<double>(res.robust->probes_kept)};
-    channel.send(OutgoingMessage{r, true, {}});
+    send(r);
   }
-  if (local.agent_id == 0) {  // agent 0's times, for the coordinator's phase split
-    RoundStatusMessage t;
-    t.round = res.rounds;
-    t.phase = kPhaseTimesPhase;
-    t.sender = 0;
-    t.cost = res.solve_s;
-    t.grad_norm_sq = res.rounding_s;
-    t.block_grad_norm = res.translation_iterations;
-    channel.send(OutgoingMessage{t, true, {}});
-  }
-  if (local.agent_id == 0) {  // one report for the coordinator's summary
-    RoundStatusMessage st;
-    st.round = res.rounds;
-    st.phase = kFinalReportPhase;
-    st.sender = 0;
-    st.cost = res.cost;
-    st.grad_norm_sq = res.grad_norm * res.grad_norm;
-    st.block_grad_norm = static_cast<double>(res.restarts);
-    channel.send(OutgoingMessage{st, true, {}});
+  if (local.agent_id == 0) {
+    // Agent 0's times, for the coordinator's phase split, then one report for its summary.
+    send(agent0_report(res.rounds, kPhaseTimesPhase, res.solve_s, res.rounding_s,
+                       res.translation_iterations));
+    send(agent0_report(res.rounds, kFinalReportPhase, res.cost, res.grad_norm * res.grad_norm,
+                       static_cast<double>(res.restarts)));
   }
   return res;
 }

@@ -5,6 +5,8 @@
 #include <tessera/solvers/trust_region.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "util/frobenius_inner.hpp"
+
 namespace tessera {
 
 void TrustRegionOptions::validate() const {
@@ -40,10 +42,6 @@ void TrustRegionOptions::validate() const {
 
 namespace {
 
-double inner(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
-  return A.cwiseProduct(B).sum();
-}
-
 // Frobenius norm of the Stiefel columns of a tangent vector (pose i: columns (d+1)i .. (d+1)i+d-1).
 double rotation_norm(const Eigen::MatrixXd& V, int d) {
   double sq = 0.0;
@@ -72,17 +70,17 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
   out.eta = Eigen::MatrixXd::Zero(X.rows(), X.cols());
   out.Heta = out.eta;
   Eigen::MatrixXd r = grad;
-  double r0_norm = std::sqrt(inner(r, r));
+  double r0_norm = std::sqrt(frobenius_inner(r, r));
   // The caller may already hold the preconditioned gradient (it sets the initial radius).
   Eigen::MatrixXd z = precon_grad ? *precon_grad : precondition(r);
-  double z_r = inner(z, r);
+  double z_r = frobenius_inner(z, r);
   double d_Pd = z_r, e_Pd = 0.0, e_Pe = 0.0;
   Eigen::MatrixXd delta = -z;
   const double radius_sq = radius * radius;
   for (int j = 0; j < opt.max_inner_iterations; ++j) {
     out.iterations = j + 1;
     Eigen::MatrixXd Hdelta = problem.hessian_vector(X, egrad, delta);
-    const double d_Hd = inner(delta, Hdelta);
+    const double d_Hd = frobenius_inner(delta, Hdelta);
     const double alpha = z_r / d_Hd;
     const double e_Pe_new = e_Pe + 2.0 * alpha * e_Pd + alpha * alpha * d_Pd;
     if (d_Hd <= 0 || e_Pe_new >= radius_sq) {
@@ -99,7 +97,7 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
     out.Heta += alpha * Hdelta;
     r += alpha * Hdelta;
     r = M.tangent_project(X, r);  // keep rounding errors from leaving the tangent space
-    const double r_norm = std::sqrt(inner(r, r));
+    const double r_norm = std::sqrt(frobenius_inner(r, r));
     if (r_norm <= r0_norm * std::min(std::pow(r0_norm, opt.tcg_theta), kappa)) return out;
     // CG needs one fixed preconditioner: the caller computes the step again with the new one.
     if (precon && precon->changes_at_next_apply()) {
@@ -108,7 +106,7 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
     }
     z = precondition(r);
     const double z_r_old = z_r;
-    z_r = inner(z, r);
+    z_r = frobenius_inner(z, r);
     const double beta = z_r / z_r_old;
     delta = -z + beta * delta;
     e_Pd = beta * (e_Pd + alpha * d_Pd);
@@ -136,7 +134,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   double f = problem.cost(res.X, &f_share);
   Eigen::MatrixXd egrad = problem.euclidean_gradient(res.X);
   Eigen::MatrixXd grad = M.tangent_project(res.X, egrad);
-  double grad_norm = std::sqrt(inner(grad, grad));
+  double grad_norm = std::sqrt(frobenius_inner(grad, grad));
   const double grad_norm0 = grad_norm;
   const double grad_tol = std::max(options.grad_norm_tol, options.relative_grad_tol * grad_norm);
   int accepted_steps = 0;
@@ -148,8 +146,8 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   if (radius <= 0) {
     precon_grad = preconditioner ? preconditioner->apply(M, res.X, grad) : grad;
     have_precon_grad = true;
-    radius = std::max(
-        1e-10, options.initial_radius_scale * std::sqrt(std::max(0.0, inner(precon_grad, grad))));
+    radius = std::max(1e-10, options.initial_radius_scale *
+                                 std::sqrt(std::max(0.0, frobenius_inner(precon_grad, grad))));
   }
   bool reset_radius = false;
   bool recomputed_here = false;  // a step at the current point was computed again
@@ -165,13 +163,14 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
   auto paired_met = [&] {
     if (!paired_stop || grad_norm > options.paired_grad_norm_tol) return false;
     ensure_precon_grad();
-    return std::sqrt(inner(precon_grad, precon_grad)) <= options.preconditioned_grad_norm_tol;
+    return std::sqrt(frobenius_inner(precon_grad, precon_grad)) <=
+           options.preconditioned_grad_norm_tol;
   };
   // 1/2 <P g, g> is the decrease of the model's Newton step when P is the inverse Hessian: what
   // the next step can still gain.
   auto predicted_decrease = [&] {
     ensure_precon_grad();
-    return 0.5 * std::max(0.0, inner(precon_grad, grad));
+    return 0.5 * std::max(0.0, frobenius_inner(precon_grad, grad));
   };
   res.stop_reason = "max_iterations";
   for (int it = 0; it < options.max_iterations; ++it) {
@@ -207,8 +206,8 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       // it is set again as at the start.
       reset_radius = false;
       ensure_precon_grad();
-      radius = std::max(
-          1e-10, options.initial_radius_scale * std::sqrt(std::max(0.0, inner(precon_grad, grad))));
+      radius = std::max(1e-10, options.initial_radius_scale *
+                                   std::sqrt(std::max(0.0, frobenius_inner(precon_grad, grad))));
     }
     TcgOutcome step = truncated_cg(problem, M, res.X, egrad, grad, radius, options, preconditioner,
                                    have_precon_grad ? &precon_grad : nullptr, kappa);
@@ -231,7 +230,8 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
     if (refine) (*refine)(X_new);
     double f_new_share = 0.0;
     const double f_new = problem.cost(X_new, &f_new_share);
-    const double model_decrease = -(inner(grad, step.eta) + 0.5 * inner(step.Heta, step.eta));
+    const double model_decrease =
+        -(frobenius_inner(grad, step.eta) + 0.5 * frobenius_inner(step.Heta, step.eta));
     double rho = (f - f_new) / std::max(model_decrease, std::numeric_limits<double>::min());
     // When both decreases sit at round-off level, the ratio is noise: trust the model.
     const bool round_off =
@@ -260,7 +260,7 @@ TrustRegionResult solve_trust_region(const BlockProblem& problem, const Eigen::M
       f_share = f_new_share;
       egrad = problem.euclidean_gradient(res.X);
       grad = M.tangent_project(res.X, egrad);
-      grad_norm = std::sqrt(inner(grad, grad));
+      grad_norm = std::sqrt(frobenius_inner(grad, grad));
       ++accepted_steps;
     }
     res.iterations = it + 1;

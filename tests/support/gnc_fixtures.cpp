@@ -1,5 +1,7 @@
 #include "gnc_fixtures.hpp"
 
+#include <tessera/robust/tls_weights.hpp>
+
 namespace tessera::test {
 
 GeneratorResult grid_with_outliers(double fraction, std::uint64_t seed) {
@@ -38,6 +40,13 @@ GncDistributedOptions irbcd_gnc() {
   o.solver.algorithm = DistributedAlgorithm::kIrbcd;
   o.solver.grad_norm_tol = 1e-3;
   return o;
+}
+
+std::vector<bool> odometry_flags(const PoseGraph& g) {
+  std::vector<bool> known(g.num_measurements());
+  for (std::size_t e = 0; e < known.size(); ++e)
+    known[e] = is_known_inlier(g.measurements[e], KnownInliers::kOdometry);
+  return known;
 }
 
 }  // namespace tessera::test

@@ -1,6 +1,6 @@
 #pragma once
-// Shared fixtures of the distributed GNC-TLS tests: a small generated grid with outliers, its
-// robots as the blocks, and IRBCD inside GNC-TLS.
+// Shared fixtures of the GNC-TLS tests: small generated graphs with outliers, their robots as
+// the blocks, IRBCD inside GNC-TLS, and the odometry as the known inliers.
 #include <cstdint>
 #include <tessera/generate/generator.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
@@ -20,5 +20,8 @@ GeneratorResult flexible_city(double fraction, OutlierKind kind, std::uint64_t s
 std::vector<int> robots_as_blocks(const GeneratorResult& r);
 /// GNC-TLS around IRBCD, solved to a gradient norm of 1e-3.
 GncDistributedOptions irbcd_gnc();
+/// Per measurement: whether it is odometry (KnownInliers::kOdometry), the known inliers GNC's
+/// `known_inlier_flags` take.
+std::vector<bool> odometry_flags(const PoseGraph& g);
 
 }  // namespace tessera::test

@@ -30,16 +30,23 @@ int run_command(const std::string& command, std::string* output);
 /// Path of a built executable (build/bin/NAME).
 std::string bin(const std::string& name);
 
-/// What `options.validate()` throws as InputError, or "" when the options are valid: for the
-/// "bad options name the field" tests.
-template <class Options>
-std::string validation_message(const Options& options) {
+/// What `f()` throws as InputError, or "" when it throws nothing: for the "bad input says what
+/// is wrong" tests.
+template <class F>
+std::string input_error_of(F&& f) {
   try {
-    options.validate();
+    f();
   } catch (const InputError& e) {
     return e.what();
   }
   return "";
+}
+
+/// What `options.validate()` throws as InputError, or "" when the options are valid: for the
+/// "bad options name the field" tests.
+template <class Options>
+std::string validation_message(const Options& options) {
+  return input_error_of([&options] { options.validate(); });
 }
 
 }  // namespace tessera::test

@@ -164,6 +164,12 @@ class RoundProtocol : public AgentProcess {
   // of f (<= 0).
   // `last_decrease`: f's decrease over the last round (gates the correction, min_gain).
   double coarse_correct(const Inbox& inbox, double last_decrease);
+  // The coarse problem solved from every agent's terms: over the smoothed coarse space's
+  // aggregates when the state has one, else over the blocks.
+  CoarseResult solve_coarse_terms(const std::vector<const std::vector<double>*>& terms) const;
+  // Moves this agent's blocks by the coarse motions (as the space above defines them) and
+  // counts the correction and its decrease of f.
+  void apply_coarse_motions(const std::vector<Eigen::MatrixXd>& motions, double decrease);
   // Gathered exchange: the solver's step (all terms in) and the others' (the motions in).
   void solve_gathered_coarse(const Inbox& inbox, std::vector<OutgoingMessage>& out);
   void take_coarse_motions(const Inbox& inbox, std::vector<OutgoingMessage>& out);
