@@ -145,10 +145,13 @@ WaitStatus Readiness::wait_finished(Seconds timeout) {
 
 std::string Readiness::describe_not_ready_locked(const PeerIdentity& who,
                                                  const std::string& ready_reader) const {
-  bool live = false;
+  bool seen = false, live = false;
   for (const auto& [p, id] : peers_.all_locked())
-    if (id.describe() == who.describe() && !peers_.lost_locked(p)) live = true;
-  if (!live) return who.describe() + " (not discovered)";
+    if (id.describe() == who.describe()) {
+      seen = true;
+      live = live || !peers_.lost_locked(p);
+    }
+  if (!live) return who.describe() + (seen ? " (lost)" : " (not discovered)");
   if (!has_matched_locked(ready_reader, who))
     return who.describe() + " (discovered, its writer not matched by " + ready_reader + ")";
   return who.describe() + " (its writer matched, nothing received)";

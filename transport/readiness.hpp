@@ -93,8 +93,9 @@ class Readiness {
   bool has_matched_locked(const std::string& endpoint, const PeerIdentity& who) const;
   /// " <peer> <peer> ..." the listeners report as matched on `endpoint` (for traces).
   std::string describe_matched_locked(const std::string& endpoint) const;
-  /// `who` followed by why its READY may be missing: "(not discovered)", "(discovered, its
-  /// writer not matched by <ready_reader>)" or "(its writer matched, nothing received)".
+  /// `who` followed by why its READY may be missing: "(not discovered)", "(lost)",
+  /// "(discovered, its writer not matched by <ready_reader>)" or "(its writer matched, nothing
+  /// received)".
   std::string describe_not_ready_locked(const PeerIdentity& who,
                                         const std::string& ready_reader) const;
 
