@@ -154,10 +154,13 @@ void restarted_after_repartition_is_refused(int domain, bool checkpoint) {
   // Up to 600 rounds of 8000 poses: at load 22-28 the survivors were at round ~390 when a 50 s
   // --run-timeout ended the run (4 of 17 runs failed so, test walls 57-80 s; passes 36-58 s).
   r.run_timeout = "150";
-  Process coord = r.coordinator(1, {"--max-rounds", "600"});
+  // Lease 3 s, not 1 s: at load 32-34 a live coordinator or survivor was dropped by the 1 s
+  // lease in 2 of 6 runs ("lost the coordinator ... lease of 1.0 s expired", "lost agent 1
+  // after a re-partition"); the kill of agent 2 is still noticed within ~3 s.
+  Process coord = r.coordinator(1, {"--max-rounds", "600", "--lease", "3"});
   auto agent_argv = [&](int k) {
     std::vector<std::string> a =
-        agent_args(r.graph, r.agents, k, r.run, r.domain, {"--timeout", "20"});
+        agent_args(r.graph, r.agents, k, r.run, r.domain, {"--timeout", "20", "--lease", "3"});
     if (checkpoint) a.insert(a.end(), {"--checkpoint-dir", r.dir + "/ckpt" + std::to_string(k)});
     return a;
   };
