@@ -12,12 +12,14 @@ namespace tessera::agent {
 
 using namespace tessera::transport;
 
-void pass_agent_gate(AgentSession& s, const AgentOptions& o, const std::function<void()>& on_poll) {
+void pass_agent_gate(AgentSession& s, const AgentOptions& o, const std::function<void()>& on_poll,
+                     bool joining) {
   PeerGateOptions gate;
   gate.timeout_s = o.net.timeout_s;
   gate.stall_after_s = o.handshake_stall_s;
   gate.max_reopens = o.handshake_retries;
   gate.force_one_reopen = o.handshake_force_once;
+  gate.joining = joining;
   const PeerGateResult gated = pass_peer_gate(s, gate, on_poll);
   for (const std::string& event : gated.events)
     std::cerr << agent_tag(o.id) << ": " << event << "\n";

@@ -15,7 +15,8 @@ namespace tessera::agent {
 
 /// Returns once the gate passed. `on_poll` runs on every look at the peers (it may throw to
 /// end the wait, e.g. refuse_if_lost). Throws RunFailure on a stop or a timeout.
+/// `joining`: a restarted agent before its rejoin request (PeerGateOptions::joining).
 void pass_agent_gate(transport::AgentSession& session, const AgentOptions& options,
-                     const std::function<void()>& on_poll = {});
+                     const std::function<void()>& on_poll = {}, bool joining = false);
 
 }  // namespace tessera::agent

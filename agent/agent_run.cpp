@@ -65,7 +65,8 @@ void solve(AgentSession& s, const AgentOptions& o, const AgentLog& log, const Ag
     // re-creates its participant if so (nothing was sent yet, so peers just forget the old
     // one), and meanwhile looks for the assignment that says the run went on without it.
     if (!s.options().security_dir.empty()) {
-      pass_agent_gate(s, o, [&] { refuse_if_lost(s, o.id); });
+      pass_agent_gate(
+          s, o, [&] { refuse_if_lost(s, o.id); }, /*joining=*/true);
       log(std::string("peers known") + s.options().transports_note());
     }
     const RollbackRequested order = request_rejoin(s, o.id, restart->snapshots, o.net.timeout_s);

@@ -145,6 +145,26 @@ TEST(PeerGate, SecuredRunsWaitForEveryHandshakeAndOneSideOfAStalledPairReopens) 
       GateStep::kWait);
 }
 
+// A restarted agent asking to rejoin cures every stalled handshake itself: its peers passed
+// their gates and never re-create, so a stall with a running agent of larger id (agent 1 with
+// agent 2 here) stayed until the coordinator gave up on the rejoin.
+TEST(PeerGate, AJoiningAgentReopensForAStalledHandshakeWithAnyPeer) {
+  using transport::judge_peers;
+  const std::vector<PeerView> peers = {view(true, 0, 9, true), view(false, 0, 9, true),
+                                       view(false, 2, 5, false)};
+  EXPECT_EQ(judge_peers(agent_options(1), true, peers, 4).kind, GateStep::kWait);
+  const GateStep s = judge_peers(agent_options(1), true, peers, 4, /*joining=*/true);
+  EXPECT_EQ(s.kind, GateStep::kReopenStalled);
+  EXPECT_EQ(s.why, "agent 2");
+  // Still only once the handshake is older than the stall bound.
+  EXPECT_EQ(
+      judge_peers(agent_options(1), true,
+                  {view(true, 0, 9, true), view(false, 0, 9, true), view(false, 2, 3.9, false)}, 4,
+                  /*joining=*/true)
+          .kind,
+      GateStep::kWait);
+}
+
 // Impostors (unauthenticated participants advertising a member's name, as anyone can in
 // plaintext SPDP data) next to the real, authenticated members: they neither hold the gate
 // nor move the agent to UDP only.

@@ -5,7 +5,7 @@
 // A damaged checkpoint is refused with an error naming the file. In a secured run the
 // restarted agent passes the peer gate before it asks to rejoin (a stalled handshake makes it
 // re-create its participant, forced here) and the run still ends at the undisturbed result.
-// Domains used here: 181-183 and 43 (each test its own, so ctest -j is safe).
+// Domains used here: 181-183 and 138 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -144,7 +144,7 @@ TEST(DdsRejoin, KilledAgentRestartedWithSameIdFinishesAtTheUndisturbedCost) {
 TEST(DdsRejoin, SecuredRestartedAgentPassesThePeerGateThenRejoins) {
   if (run_command("command -v openssl", nullptr) != 0)
     GTEST_SKIP() << "openssl is not installed, skipping";
-  Fixture f = make_fixture(3, 43, "secrejoin");
+  Fixture f = make_fixture(3, 138, "secrejoin");
   ASSERT_FALSE(::testing::Test::HasFailure());
   const std::string sec = f.dir + "/sec";
   ASSERT_EQ(run_command(std::string(TESSERA_SOURCE_DIR) + "/scripts/security/make_identities.sh " +

@@ -1,7 +1,7 @@
 // `tessera replay` over DDS: a reader of the online input topic absorbs the batches into the
 // stream model and ends with the batch graph (same poses, same measurements), whether it
 // subscribed before the replay started or after it finished playing.
-// Domains used here: 42-43 (each test its own).
+// Domains used here: 139-140 (each test its own).
 
 #include <gtest/gtest.h>
 
@@ -58,10 +58,10 @@ void expect_same_graph(const GraphStream& stream, const PoseGraph& whole, std::s
 TEST(DdsReplay, AReaderStartedFirstReceivesTheBatchGraph) {
   const std::string dir = temp_dir();
   generate_graph(dir + "/city.g2o", "--kind city --poses 150 --robots 3");
-  transport::GraphStreamReader reader(42, "replay-first");
+  transport::GraphStreamReader reader(139, "replay-first");
   Process replay = start(
       {bin("tessera"), "replay", dir + "/city.g2o", "--robots", "3", "--run-id", "replay-first",
-       "--domain", "42", "--rate", "400", "--wait-readers", "1", "--linger", "1"},
+       "--domain", "139", "--rate", "400", "--wait-readers", "1", "--linger", "1"},
       dir + "/replay.log");
   const GraphStream stream = read_stream(reader, 2, 3, 60);
   ASSERT_TRUE(wait_all({&replay}, 60));
@@ -78,11 +78,11 @@ TEST(DdsReplay, AReaderStartedAfterThePlayStillReceivesEverything) {
             0)
       << out;
   Process replay =
-      start({bin("tessera"), "replay", dir + "/robots", "--run-id", "replay-late", "--domain", "43",
-             "--rate", "1000", "--linger", "20", "--json", dir + "/replay.json"},
+      start({bin("tessera"), "replay", dir + "/robots", "--run-id", "replay-late", "--domain",
+             "140", "--rate", "1000", "--linger", "20", "--json", dir + "/replay.json"},
             dir + "/replay.log");
   ASSERT_TRUE(wait_for_output(replay, "replayed", 60)) << replay.output();
-  transport::GraphStreamReader reader(43, "replay-late");
+  transport::GraphStreamReader reader(140, "replay-late");
   const GraphStream stream = read_stream(reader, 3, 2, 30);
   kill(replay.pid, SIGTERM);
   wait_all({&replay}, 20);

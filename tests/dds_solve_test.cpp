@@ -1,6 +1,6 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-170, 55-56, 75 and 112-113 (each test its own, so ctest -j is safe).
+// Domains used here: 161-170, 129, 56, 131 and 112-113 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -130,14 +130,14 @@ TEST(DdsSolve, StatusesAllToAllGiveTheInProcessIterates) {
 // Two-level rounds: the coarse terms go to agent 0 (riding in the status to the relay, or on
 // their own), which solves and sends each agent its motions: the same iterates as in process.
 TEST(DdsSolve, CoarseCorrectionOverDdsGivesTheInProcessIterates) {
-  expect_same_as_in_process("irbcd", 55, true, true);
+  expect_same_as_in_process("irbcd", 129, true, true);
   expect_same_as_in_process("irbcd", 56, false, true);
 }
 
 // The smoothed coarse space: every agent builds it from the structure it holds (solver and
 // agents agree on who needs which motions), so the DDS agents give the in-process iterates.
 TEST(DdsSolve, SmoothedCoarseCorrectionOverDdsGivesTheInProcessIterates) {
-  expect_same_as_in_process("irbcd", 75, true, true, true);
+  expect_same_as_in_process("irbcd", 131, true, true, true);
 }
 
 // The gathered coarse exchange with more agents: the terms go to agent 0 (riding in the status

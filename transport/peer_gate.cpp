@@ -18,7 +18,7 @@ void PeerGateOptions::validate() const {
 }
 
 GateStep judge_peers(const SessionOptions& self, bool secured, const std::vector<PeerView>& peers,
-                     double stall_after_s) {
+                     double stall_after_s, bool joining) {
   // Several participants may carry one role's name (in a secured run anyone can advertise
   // it): an authenticated one stands for the role; else the most recently discovered one, so
   // a handshake counts as stalled only when no claimant of the role can still finish it.
@@ -50,7 +50,7 @@ GateStep judge_peers(const SessionOptions& self, bool secured, const std::vector
     if (!v) {
       what = want.describe() + " (not discovered yet)";
     } else if (!v->authenticated) {
-      if (cures_stalled_handshake(self.agent_id, want, v->known_for_s, stall_after_s))
+      if (cures_stalled_handshake(self.agent_id, want, v->known_for_s, stall_after_s, joining))
         return {GateStep::kReopenStalled, want.describe()};
       what = want.describe() + " (not authenticated yet)";
     }
@@ -74,7 +74,8 @@ PeerGateResult pass_peer_gate(Session& s, const PeerGateOptions& o,
     // wait below at once (only a stall, which is a duration, needs the poll).
     const std::uint64_t seen = s.mailroom().state_changes();
     const double stall_after_s = force_pending ? 0.0 : o.stall_after_s;
-    const GateStep step = judge_peers(s.options(), secured, s.peer_views(), stall_after_s);
+    const GateStep step =
+        judge_peers(s.options(), secured, s.peer_views(), stall_after_s, o.joining);
     if (step.kind == GateStep::kPass) {
       r.status = WaitStatus::kReady;
       return r;

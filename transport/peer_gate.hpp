@@ -36,6 +36,10 @@ struct PeerGateOptions {
   bool force_one_reopen = false;
   double retire_notice_s = 0.5;  ///< How long a participant announces that it retires before
                                  ///< it is deleted (Session::replace_participant), >= 0.
+  /// The agent joins a run in progress (a restarted agent before its rejoin request): its
+  /// peers never re-create, so it cures every stalled handshake itself
+  /// (transport/fastdds/handshake_stall.hpp). Default false: a fresh set-up.
+  bool joining = false;
   /// Throws InputError naming the bad field.
   void validate() const;
 };
@@ -52,9 +56,9 @@ struct GateStep {
 };
 
 /// Pure decision for agent `self` (SessionOptions of its current participant) given its live
-/// peers. `secured`: the session uses DDS Security.
+/// peers. `secured`: the session uses DDS Security; `joining`: PeerGateOptions::joining.
 GateStep judge_peers(const SessionOptions& self, bool secured, const std::vector<PeerView>& peers,
-                     double stall_after_s);
+                     double stall_after_s, bool joining = false);
 
 struct PeerGateResult {
   WaitStatus status = WaitStatus::kTimeout;  ///< kReady: passed; kStopped: the run stops.

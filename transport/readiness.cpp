@@ -143,9 +143,24 @@ WaitStatus Readiness::wait_finished(Seconds timeout) {
   return room_.wait_for([&] { return finished_.load(); }, timeout);
 }
 
+std::string Readiness::describe_not_ready_locked(const PeerIdentity& who,
+                                                 const std::string& ready_reader) const {
+  bool seen = false, live = false;
+  for (const auto& [p, id] : peers_.all_locked())
+    if (id.describe() == who.describe()) {
+      seen = true;
+      live = live || !peers_.lost_locked(p);
+    }
+  if (!live) return who.describe() + (seen ? " (lost)" : " (not discovered)");
+  if (!has_matched_locked(ready_reader, who))
+    return who.describe() + " (discovered, its writer not matched by " + ready_reader + ")";
+  return who.describe() + " (its writer matched, nothing received)";
+}
+
 WaitStatus Readiness::barrier(Seconds timeout, std::string* missing,
                               const std::function<void()>& send_ready,
-                              const std::function<void()>& dump_match_state) {
+                              const std::function<void()>& dump_match_state,
+                              const std::string& ready_reader) {
   const auto start = std::chrono::steady_clock::now();
   std::string absent;
   trace_("barrier: waiting for endpoints to match");
@@ -169,8 +184,17 @@ WaitStatus Readiness::barrier(Seconds timeout, std::string* missing,
         return absent.empty();
       },
       left);
-  if (st == WaitStatus::kTimeout && missing) *missing = "no READY from " + absent;
   if (st == WaitStatus::kTimeout) {
+    // Who, and what this process knows of them: undiscovered, READY's endpoints unmatched, or
+    // matched with nothing received (the peer never sent READY or its samples were lost).
+    absent = room_.with_lock([&] {
+      std::string why;
+      for (const auto& p : others)
+        if (!ready_from_.count(p.describe()))
+          why += (why.empty() ? "" : ", ") + describe_not_ready_locked(p, ready_reader);
+      return why;
+    });
+    if (missing) *missing = "no READY from " + absent;
     trace_("barrier: no READY from %s", absent.c_str());
     dump_match_state();
   } else if (st == WaitStatus::kReady) {

@@ -69,9 +69,12 @@ class Readiness {
   /// The readiness barrier: waits until endpoints_matched(), calls `send_ready`, then waits
   /// for READY from every other agent (and the coordinator, for agents), all within
   /// `timeout`. On kTimeout `missing` names who is not ready and `dump_match_state` is
-  /// called (trace of what each endpoint matched).
+  /// called (trace of what each endpoint matched). `ready_reader` ("<topic>/r"): the endpoint
+  /// READY arrives on; a peer whose READY did not come is named with what this process knows
+  /// of it (describe_not_ready_locked).
   WaitStatus barrier(Seconds timeout, std::string* missing, const std::function<void()>& send_ready,
-                     const std::function<void()>& dump_match_state);
+                     const std::function<void()>& dump_match_state,
+                     const std::string& ready_reader);
   /// Waits (not interrupted by a stop, bounded by `timeout`) until `endpoint` has matched
   /// every other process of the run or that process is gone; processes never discovered are
   /// waited for only `unseen_patience`. Returns when done, whatever the outcome.
@@ -90,6 +93,11 @@ class Readiness {
   bool has_matched_locked(const std::string& endpoint, const PeerIdentity& who) const;
   /// " <peer> <peer> ..." the listeners report as matched on `endpoint` (for traces).
   std::string describe_matched_locked(const std::string& endpoint) const;
+  /// `who` followed by why its READY may be missing: "(not discovered)", "(lost)",
+  /// "(discovered, its writer not matched by <ready_reader>)" or "(its writer matched, nothing
+  /// received)".
+  std::string describe_not_ready_locked(const PeerIdentity& who,
+                                        const std::string& ready_reader) const;
 
  private:
   /// The other agents, and the coordinator for an agent of a run that has one.

@@ -107,7 +107,8 @@ bool Session::endpoints_matched(std::string* missing) const {
 WaitStatus Session::ready_barrier(Seconds timeout, std::string* missing) {
   return impl_->readiness.barrier(
       timeout, missing, [this] { send_control(wire::CONTROL_READY); },
-      [this] { impl_->entities.trace_match_state("barrier timeout"); });
+      [this] { impl_->entities.trace_match_state("barrier timeout"); },
+      std::string(kControlTopic) + "/r");
 }
 
 std::vector<PeerIdentity> Session::live_peers() const {
