@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "certification/interface_schur.hpp"
+#include "util/frobenius_inner.hpp"
 
 namespace tessera {
 
@@ -138,9 +139,6 @@ std::vector<std::size_t> lower_side_of(const BlockLayout& layout, int b) {
   return poses;
 }
 
-double dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a.array() * b.array()).sum();
-}
 }  // namespace
 
 std::vector<OutgoingMessage> CertificateProtocol::start() {
@@ -406,7 +404,8 @@ void CertificateProtocol::after_vector(const MessageGate::Inbox& inbox,
   for (const auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), vn);
   if (iteration_ == 0) {
     Sx_ = apply(x_, vn);
-    broadcast(0, kReduce, {dot(x_, x_), dot(x_, Sx_), local_max_diag_}, out);
+    broadcast(0, kReduce, {frobenius_inner(x_, x_), frobenius_inner(x_, Sx_), local_max_diag_},
+              out);
     return;
   }
   Sw_ = apply(w_, vn);
@@ -415,9 +414,9 @@ void CertificateProtocol::after_vector(const MessageGate::Inbox& inbox,
   const int k = has_p_ ? 3 : 2;
   std::vector<double> values{rr_local_};
   for (int i = 0; i < k; ++i)
-    for (int j = i; j < k; ++j) values.push_back(dot(*V[i], *V[j]));
+    for (int j = i; j < k; ++j) values.push_back(frobenius_inner(*V[i], *V[j]));
   for (int i = 0; i < k; ++i)
-    for (int j = i; j < k; ++j) values.push_back(dot(*V[i], *SV[j]));
+    for (int j = i; j < k; ++j) values.push_back(frobenius_inner(*V[i], *SV[j]));
   broadcast(iteration_, kReduce, values, out);
 }
 

@@ -11,6 +11,7 @@
 #include "distributed/nonzero_rows.hpp"
 #include "distributed/rigid_retraction.hpp"
 #include "distributed/tangent_coarse_space.hpp"
+#include "util/frobenius_inner.hpp"
 
 namespace tessera {
 
@@ -57,10 +58,6 @@ CoarseOptions NewtonRefineOptions::coarse_space_options() const {
 }
 
 namespace {
-
-double dot(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a.array() * b.array()).sum();
-}
 
 // 1 for each row of X or Y that is non-zero somewhere, 0 for the others: summed over the agents,
 // the rows in use anywhere.
@@ -484,7 +481,7 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
   neighbours_into(inbox, zn_);
   w_ = hessian(z_, zn_);
-  std::vector<double> values{dot(r_, z_), dot(z_, w_), r_.squaredNorm()};
+  std::vector<double> values{frobenius_inner(r_, z_), frobenius_inner(z_, w_), r_.squaredNorm()};
   if (use_interface_) {  // the interface residual of w, for the ones of q and r
     interface_->forward(X_, w_, iy_w_);
     values.resize(3 + static_cast<std::size_t>(interface_->team_size()), 0.0);
@@ -497,10 +494,10 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
     // Newton step's CG is one or two iterations. Not with block Jacobi, whose hundreds of
     // iterations a step would each carry 5 more numbers for one message step saved.
     const bool first = cg_it_ == 0;
-    values.push_back(dot(r_, w_));
+    values.push_back(frobenius_inner(r_, w_));
     values.push_back(w_.squaredNorm());
-    values.push_back(first ? 0.0 : dot(r_, q_));
-    values.push_back(first ? 0.0 : dot(w_, q_));
+    values.push_back(first ? 0.0 : frobenius_inner(r_, q_));
+    values.push_back(first ? 0.0 : frobenius_inner(w_, q_));
     values.push_back(first ? 0.0 : q_.squaredNorm());
   }
   if (coarse_) {  // Phi^T w, for Phi^T q and so Phi^T r by their recurrences
@@ -776,7 +773,7 @@ void NewtonRefineProtocol::after_translation_direction(const MessageGate::Inbox&
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(tzn_);
   tw_ = problem_.euclidean_gradient(tz_);
   keep_translations(tw_);
-  broadcast(kTranslationSums, {dot(tr_, tz_), dot(tz_, tw_)}, out);
+  broadcast(kTranslationSums, {frobenius_inner(tr_, tz_), frobenius_inner(tz_, tw_)}, out);
 }
 
 void NewtonRefineProtocol::after_translation_sums(const MessageGate::Inbox& inbox,
