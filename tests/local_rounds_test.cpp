@@ -162,6 +162,7 @@ DistributedOptions options(bool local, double tol) {
   o.grad_norm_tol = tol;
   o.round_result = false;
   o.local_rounds.enabled = local;
+  o.refine.auto_interface_grad_tol = 0;  // the rounds to `tol` (no hand-over to the refinement)
   return o;
 }
 

@@ -223,7 +223,12 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
           if (options_.refine.enabled && !solves_.back().trace.empty() &&
               (stop == "grad_norm" || stop == "relative_decrease" || stop == "stalled") &&
               refine_wanted(solves_.back().trace)) {
-            refine_ = std::make_unique<NewtonRefineProtocol>(state_, layout_, options_.refine);
+            NewtonRefineOptions refine = options_.refine;
+            // Handed over early, the refinement also owes the rounds' own tolerance where
+            // that is the tighter one.
+            if (hands_over_early() && options_.grad_norm_tol > 0)
+              refine.grad_norm_tol = std::min(refine.grad_norm_tol, options_.grad_norm_tol);
+            refine_ = std::make_unique<NewtonRefineProtocol>(state_, layout_, refine);
             current_ = refine_.get();
             emit(refine_->start(), out);
             for (const ProtocolMessage& m :
