@@ -193,7 +193,8 @@ const char* kDistributedHelp =
     "  --refine-interface C      its CG's preconditioner solves with the Hessian exactly\n"
     "                            through the blocks' interfaces where the team's interface has\n"
     "                            at most C tangent coordinates; 0 = block Jacobi always\n"
-    "                            (default 1000)\n";
+    "                            (default 500; with --refine auto it also sets where the\n"
+    "                            rounds hand over at gradient 1)\n";
 
 namespace {
 
