@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "certification/interface_schur.hpp"
+#include "distributed/interface_poses.hpp"
 #include "util/frobenius_inner.hpp"
 
 namespace tessera {
@@ -112,17 +113,6 @@ Eigen::MatrixXd CertificateProtocol::apply(const Eigen::MatrixXd& v, const Eigen
 }
 
 namespace {
-// Block b's interface: its poses that some neighbour block needs (a cut measurement touches
-// them), ascending ids.
-std::vector<std::size_t> interface_of(const BlockLayout& layout, int b) {
-  std::vector<std::size_t> poses;
-  for (const auto& to : layout.public_to[static_cast<std::size_t>(b)])
-    poses.insert(poses.end(), to.begin(), to.end());
-  std::sort(poses.begin(), poses.end());
-  poses.erase(std::unique(poses.begin(), poses.end()), poses.end());
-  return poses;
-}
-
 // Block b's poses in the separator that one_side keeps: those some higher-numbered block needs,
 // i.e. the lower block's endpoint of every cut measurement (a vertex cover of the cut that every
 // agent derives from the layout alone).
@@ -165,7 +155,7 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
   std::size_t interface = 0;
   for (int b = 0; b < layout_.num_blocks; ++b)
     interface += options_.interface_one_side ? lower_side_of(layout_, b).size()
-                                             : interface_of(layout_, b).size();
+                                             : interface_poses(layout_, b).size();
   if (options_.interface_max_coordinates > 0 &&
       static_cast<double>(interface) * static_cast<double>(w) <=
           static_cast<double>(options_.interface_max_coordinates)) {
@@ -286,7 +276,7 @@ void CertificateProtocol::after_setup(const MessageGate::Inbox& inbox,
     block = local_separator_schur(problem_, lambda_, shift, lower_side_of(layout_, state_.id()),
                                   [&kept](std::size_t p) { return kept.at(p) != 0; });
   } else {
-    block = local_interface_schur(problem_, lambda_, shift, interface_of(layout_, state_.id()));
+    block = local_interface_schur(problem_, lambda_, shift, interface_poses(layout_, state_.id()));
   }
   PoseBlockMessage m =
       make_reduction_message(state_.id(), 0, kSchur, encode_interface_schur(block));

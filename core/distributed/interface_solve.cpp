@@ -6,22 +6,12 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "distributed/interface_poses.hpp"
 #include "solvers/tangent_coordinates.hpp"
 
 namespace tessera {
 
 namespace {
-
-// Block b's interface: its poses some neighbour block needs (a cut measurement touches them),
-// ascending ids (the certificate's interface test uses the same set).
-std::vector<std::size_t> interface_poses(const BlockLayout& layout, int b) {
-  std::vector<std::size_t> poses;
-  for (const auto& to : layout.public_to[static_cast<std::size_t>(b)])
-    poses.insert(poses.end(), to.begin(), to.end());
-  std::sort(poses.begin(), poses.end());
-  poses.erase(std::unique(poses.begin(), poses.end()), poses.end());
-  return poses;
-}
 
 // One pose pair's (d+1) x (d+1) block of Q, column-major (rows: pose i's coordinates).
 struct PosePair {
