@@ -80,7 +80,9 @@ struct RobustOptions {
   /// nothing. 20: sphere2500 with 25 % random outliers, 5 agents: 255 rounds in all against 530
   /// with every pass to the tolerance (the clean run: 67), the same rejected set.
   int recheck_max_rounds = 20;
-  /// Distributed solvers only: most probes after the re-check passes, >= 0 (0 = none). When a
+  /// Most probes after the re-check passes, >= 0 (0 = none); the centralized solve's tail
+  /// probes take the same budget, probe_ratio and probe_tail_ratio (docs/robust.md, "Tail
+  /// probes, centralized"). Distributed, when a
   /// pass solved to the tolerance changes nothing, each agent proposes the kept measurements it
   /// weighs whose residual is within the bound but above probe_ratio times the median residual
   /// of those measurements; all of them leave, the passes run again (putting back what fits),
