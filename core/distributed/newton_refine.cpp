@@ -1,4 +1,3 @@
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,8 +8,10 @@
 
 #include "distributed/interface_solve.hpp"
 #include "distributed/nonzero_rows.hpp"
+#include "distributed/pipelined_cg.hpp"
 #include "distributed/rigid_retraction.hpp"
 #include "distributed/tangent_coarse_space.hpp"
+#include "distributed/translation_preconditioner.hpp"
 #include "util/frobenius_inner.hpp"
 
 namespace tessera {
@@ -27,15 +28,14 @@ std::vector<double> row_indicators(const Eigen::MatrixXd& X, const Eigen::Matrix
 
 }  // namespace
 
-// The block's translation Laplacian L_BB (its measurements' tau, cut ones on the diagonal),
-// factored: the translation Hessian's own block is 2 L_BB.
-struct NewtonRefineProtocol::TranslationFactor {
-  Eigen::SimplicialLDLT<SparseMatrix> ldlt;
-};
-
 NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout& layout,
                                            const NewtonRefineOptions& options)
-    : state_(state), layout_(layout), options_(options), problem_(state.problem()) {
+    : state_(state),
+      layout_(layout),
+      options_(options),
+      problem_(state.problem()),
+      cg_(std::make_unique<PipelinedCg>()),
+      tcg_(std::make_unique<PipelinedCg>()) {
   options_.validate();
   everyone_.resize(static_cast<std::size_t>(layout_.num_blocks));
   for (int b = 0; b < layout_.num_blocks; ++b) everyone_[static_cast<std::size_t>(b)] = b;
@@ -225,7 +225,8 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
     refactor_due_ = true;  // block Jacobi's factor only where a point falls back to it
   else
     prepare_preconditioner();
-  if (options_.translation_iterations > 0) factor_translations();
+  if (options_.translation_iterations > 0)
+    translation_preconditioner_ = std::make_unique<TranslationPreconditioner>(problem_);
   begin_cg(out);
 }
 
@@ -396,7 +397,7 @@ Eigen::VectorXd NewtonRefineProtocol::touched_of(const Eigen::VectorXd& x) const
 void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
   step_ = NewtonRefineStep{};
   step_.radius = radius_;
-  cg_it_ = 0;
+  cg_->restart();
   s_ = Eigen::MatrixXd::Zero(X_.rows(), X_.cols());
   r_ = -g_;
   if (coarse_) coarse_r_ = -coarse_g_;
@@ -404,7 +405,7 @@ void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
     iy_r_ = iy_g_;
     ir_ = ir_g_;
   }
-  e_Pe_ = e_Pd_ = d_Pd_ = model_ = gs_ = sHs_ = 0.0;
+  model_ = gs_ = sHs_ = 0.0;
   cg_target_ =
       std::max(0.5 * options_.grad_norm_tol,
                gnorm_ * std::min(options_.forcing, std::pow(gnorm_, options_.forcing_power)));
@@ -451,7 +452,7 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
     // reached it instead of one exchange and one sum later: with exact interface solves a
     // Newton step's CG is one or two iterations. Not with block Jacobi, whose hundreds of
     // iterations a step would each carry 5 more numbers for one message step saved.
-    const bool first = cg_it_ == 0;
+    const bool first = cg_->iterations() == 0;
     values.push_back(frobenius_inner(r_, w_));
     values.push_back(w_.squaredNorm());
     values.push_back(first ? 0.0 : frobenius_inner(r_, q_));
@@ -495,66 +496,45 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     subtract_hphi(touched_of(eta), w_);
     coarse_w -= coarse_matrix_ * eta;
   }
-  if (cg_it_ > 0 && rnorm <= cg_target_) return try_step("residual", out);
+  const bool started = cg_->iterations() > 0;
+  if (started && rnorm <= cg_target_) return try_step("residual", out);
   if (result_.cg_iterations >= options_.max_cg_iterations) {
-    if (cg_it_ > 0) return try_step("cap", out);
+    if (started) return try_step("cap", out);
     return finish("max_cg_iterations");
   }
   if (!(gamma > 0)) {  // P r = 0 on a non-zero residual: nothing left to gain
-    if (cg_it_ > 0) return try_step("residual", out);
+    if (started) return try_step("residual", out);
     return finish("stalled");
   }
-  // Chronopoulos-Gear: beta from <r, z>; <p, H p> from <z, H z> and the recurrences.
-  const double beta = cg_it_ == 0 ? 0.0 : gamma / gamma_old_;
-  const double pHp = cg_it_ == 0 ? delta : delta - beta * gamma / alpha_old_;
-  if (coarse_) {
-    if (cg_it_ == 0)
-      coarse_q_ = coarse_w;
-    else
-      coarse_q_ = coarse_w + beta * coarse_q_;
-  }
+  const PipelinedCgIteration it = cg_->begin(gamma, delta);
+  if (coarse_) it.update_direction(coarse_w, coarse_q_);
   if (use_interface_) {
     const Eigen::Map<const Eigen::VectorXd> iw(t.data() + 3, static_cast<Eigen::Index>(team));
-    if (cg_it_ == 0) {
-      iq_ = iw;
-      iy_q_ = iy_w_;
-    } else {
-      iq_ = iw + beta * iq_;
-      iy_q_ = iy_w_ + beta * iy_q_;
-    }
+    it.update_direction(iw, iq_);
+    it.update_direction(iy_w_, iy_q_);
   }
-  if (cg_it_ == 0) {
-    p_ = z_;
-    q_ = w_;
-    d_Pd_ = gamma;
-    e_Pd_ = 0.0;
-  } else {
-    p_ = z_ + beta * p_;
-    q_ = w_ + beta * q_;
-    e_Pd_ = beta * (e_Pd_ + alpha_old_ * d_Pd_);
-    d_Pd_ = gamma + beta * beta * d_Pd_;
-  }
-  ++cg_it_;
+  it.update_direction(z_, p_);
+  it.update_direction(w_, q_);
+  cg_->update_norms(it);
   ++result_.cg_iterations;
   ++step_.cg_iterations;
-  const double alpha = gamma / pHp;
-  const double e_Pe_new = e_Pe_ + 2 * alpha * e_Pd_ + alpha * alpha * d_Pd_;
+  const double alpha = it.alpha, pHp = it.pHp;
+  const double e_Pe_new = cg_->step_norm2_after(it);
   const bool bounded = radius_ > 0;
   if (!(pHp > 0) || (bounded && e_Pe_new >= radius_ * radius_)) {
     if (!bounded) {
       // Unbounded and not positive curvature: take the Cauchy-like step along p scaled to the
       // current step's size (or p itself on the first iteration) inside a radius from now on.
-      radius_ = std::sqrt(std::max(e_Pe_, d_Pd_));
+      radius_ = std::sqrt(std::max(cg_->step_norm2(), cg_->direction_norm2()));
       step_.radius = radius_;
     }
     const double R2 = radius_ * radius_;
-    const double tau =
-        (-e_Pd_ + std::sqrt(std::max(0.0, e_Pd_ * e_Pd_ + d_Pd_ * (R2 - e_Pe_)))) / d_Pd_;
+    const double tau = cg_->boundary_step(R2);
     s_ += tau * p_;
     model_ += -tau * gamma + 0.5 * tau * tau * pHp;
     gs_ += -tau * gamma;      // <g, p> = -<r_0, p> = -<r, p> = -gamma (CG)
     sHs_ += tau * tau * pHp;  // p is H-conjugate to s
-    e_Pe_ = R2;
+    cg_->set_step_norm2(R2);
     return try_step(pHp > 0 ? "boundary" : "negative_curvature", out);
   }
   s_ += alpha * p_;
@@ -567,15 +547,11 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   model_ += -alpha * gamma + 0.5 * alpha * alpha * pHp;
   gs_ += -alpha * gamma;
   sHs_ += alpha * alpha * pHp;
-  e_Pe_ = e_Pe_new;
-  gamma_old_ = gamma;
-  alpha_old_ = alpha;
-  pHp_old_ = pHp;
+  cg_->set_step_norm2(e_Pe_new);
+  cg_->end(it);
   if (extra > 0) {
     const double* e = t.data() + 3 + team;
-    const double rq = e[0] + beta * e[2];
-    const double qq = e[1] + 2.0 * beta * e[3] + beta * beta * e[4];
-    const double next = t[2] - 2.0 * alpha * rq + alpha * alpha * qq;
+    const double next = PipelinedCg::next_residual_norm2(it, t[2], e[0], e[1], e[2], e[3], e[4]);
     if (next <= cg_target_ * cg_target_) return try_step("residual", out);
   }
   send_direction(out);
@@ -615,7 +591,7 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
   const double rho = (actual + reg) / (step_.predicted + reg);
   step_.actual = actual;
   step_.accepted = rho > options_.accept_ratio && std::isfinite(ft);
-  const double step_norm = scale_ * std::sqrt(std::max(0.0, e_Pe_));
+  const double step_norm = scale_ * std::sqrt(std::max(0.0, cg_->step_norm2()));
   if (rho < 0.25 || !std::isfinite(ft)) {
     radius_ = 0.25 * step_norm;
   } else if (rho > 0.75 && radius_ > 0 && step_.cg_stop == "boundary") {
@@ -666,57 +642,18 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
   begin_cg(out);
 }
 
-void NewtonRefineProtocol::keep_translations(Eigen::MatrixXd& v) const {
-  const Eigen::Index w = problem_.dim() + 1;
-  for (Eigen::Index c = 0; c < v.cols(); ++c)
-    if (c % w != w - 1) v.col(c).setZero();
-}
-
-void NewtonRefineProtocol::factor_translations() {
-  // L_BB is Q_BB's translation-translation part (each pose's last column).
-  const SparseMatrix& Q = problem_.data_matrix();
-  const int w = problem_.dim() + 1;
-  const Eigen::Index m = static_cast<Eigen::Index>(problem_.num_owned());
-  std::vector<Eigen::Triplet<double>> trip;
-  for (int k = 0; k < Q.outerSize(); ++k) {
-    if (k % w != w - 1) continue;
-    for (SparseMatrix::InnerIterator it(Q, k); it; ++it)
-      if (it.row() % w == w - 1) trip.emplace_back(it.row() / w, k / w, it.value());
-  }
-  SparseMatrix L(m, m);
-  L.setFromTriplets(trip.begin(), trip.end());
-  translation_factor_ = std::make_unique<TranslationFactor>();
-  translation_factor_->ldlt.compute(L);
-  if (translation_factor_->ldlt.info() != Eigen::Success) {
-    // A block with no cut measurement (one agent): L_BB is singular on the constants. Any
-    // positive definite preconditioner serves CG; a shift of 1e-9 of the largest weight does.
-    double top = 0.0;
-    for (Eigen::Index i = 0; i < m; ++i) top = std::max(top, L.coeff(i, i));
-    SparseMatrix I(m, m);
-    I.setIdentity();
-    translation_factor_->ldlt.compute(L + 1e-9 * std::max(top, 1.0) * I);
-  }
-}
-
 void NewtonRefineProtocol::start_translations(std::vector<OutgoingMessage>& out) {
   // f at fixed rotations is quadratic in the translations: the CG's residual is minus the
   // translation columns of the Euclidean gradient at the trial point.
   tr_ = -problem_.euclidean_gradient(Xt_);
-  keep_translations(tr_);
+  TranslationPreconditioner::keep_translations(problem_.dim(), tr_);
   tx_.setZero(Xt_.rows(), Xt_.cols());
-  tcg_it_ = 0;
+  tcg_->restart();
   send_translation_direction(out);
 }
 
 void NewtonRefineProtocol::send_translation_direction(std::vector<OutgoingMessage>& out) {
-  // z = (2 L_BB)^-1 r on the translation columns, zero elsewhere.
-  const int w = problem_.dim() + 1;
-  const Eigen::Index m = static_cast<Eigen::Index>(problem_.num_owned());
-  Eigen::MatrixXd rt(m, tr_.rows());
-  for (Eigen::Index i = 0; i < m; ++i) rt.row(i) = tr_.col(i * w + w - 1).transpose();
-  const Eigen::MatrixXd zt = translation_factor_->ldlt.solve(rt);
-  tz_.setZero(tr_.rows(), tr_.cols());
-  for (Eigen::Index i = 0; i < m; ++i) tz_.col(i * w + w - 1) = 0.5 * zt.row(i).transpose();
+  translation_preconditioner_->apply(tr_, tz_);
   // An iteration = this exchange and its sum.
   ++result_.translation_iterations;
   ++step_.translation_iterations;
@@ -730,7 +667,7 @@ void NewtonRefineProtocol::after_translation_direction(const MessageGate::Inbox&
   // to theirs), translation columns only; no projection (the translations are Euclidean).
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(tzn_);
   tw_ = problem_.euclidean_gradient(tz_);
-  keep_translations(tw_);
+  TranslationPreconditioner::keep_translations(problem_.dim(), tw_);
   broadcast(kTranslationSums, {frobenius_inner(tr_, tz_), frobenius_inner(tz_, tw_)}, out);
 }
 
@@ -740,28 +677,19 @@ void NewtonRefineProtocol::after_translation_sums(const MessageGate::Inbox& inbo
   const double gamma = t[0], delta = t[1];
   bool stop = !(gamma > 0);
   if (!stop) {
-    const double beta = tcg_it_ == 0 ? 0.0 : gamma / tgamma_old_;
-    const double pHp = tcg_it_ == 0 ? delta : delta - beta * gamma / talpha_old_;
-    if (tcg_it_ == 0) {
-      tp_ = tz_;
-      tq_ = tw_;
-    } else {
-      tp_ = tz_ + beta * tp_;
-      tq_ = tw_ + beta * tq_;
-    }
-    if (!(pHp > 0)) {
+    const PipelinedCgIteration it = tcg_->begin(gamma, delta);
+    it.update_direction(tz_, tp_);
+    it.update_direction(tw_, tq_);
+    if (!(it.pHp > 0)) {
       stop = true;
     } else {
-      const double alpha = gamma / pHp;
-      tx_ += alpha * tp_;
-      tr_ -= alpha * tq_;
-      tgamma_old_ = gamma;
-      talpha_old_ = alpha;
-      ++tcg_it_;
+      tx_ += it.alpha * tp_;
+      tr_ -= it.alpha * tq_;
+      tcg_->end(it);
       // This iteration lowered f by alpha gamma / 2 (exact for the quadratic).
       const double reg = std::max(1.0, std::abs(f_)) * std::numeric_limits<double>::epsilon();
-      stop = 0.5 * alpha * gamma <= options_.translation_tol * std::max(step_.predicted, reg) ||
-             tcg_it_ >= options_.translation_iterations;
+      stop = 0.5 * it.alpha * gamma <= options_.translation_tol * std::max(step_.predicted, reg) ||
+             tcg_->iterations() >= options_.translation_iterations;
     }
   }
   if (!stop) return send_translation_direction(out);

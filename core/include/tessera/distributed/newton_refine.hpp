@@ -50,6 +50,8 @@ namespace tessera {
 
 class TangentCoarseSpace;
 class InterfaceSolve;
+class PipelinedCg;
+class TranslationPreconditioner;
 
 struct NewtonRefineOptions {
   /// Run the refinement after the block-coordinate solve reached its own tolerance (a solve
@@ -318,14 +320,11 @@ class NewtonRefineProtocol : public AgentProcess {
   void after_trial_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void finish(const std::string& why);
   // The trial point's translations re-solved for its rotations (translation_iterations).
-  void factor_translations();
   void start_translations(std::vector<OutgoingMessage>& out);
   void send_translation_direction(std::vector<OutgoingMessage>& out);
   void after_translation_direction(const MessageGate::Inbox& inbox,
                                    std::vector<OutgoingMessage>& out);
   void after_translation_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
-  // Zero in every column but the poses' translations.
-  void keep_translations(Eigen::MatrixXd& v) const;
 
   AgentState& state_;
   const BlockLayout& layout_;
@@ -341,12 +340,11 @@ class NewtonRefineProtocol : public AgentProcess {
   // CG on H s = -g: s, r, z = P r, w = H z, p, q = H p.
   Eigen::MatrixXd s_, r_, z_, w_, p_, q_;
   Eigen::MatrixXd zn_;  // the neighbours' z, kept between CG steps for its storage
-  int cg_it_ = 0;
-  double gamma_old_ = 0.0, alpha_old_ = 0.0, pHp_old_ = 0.0;
-  double e_Pe_ = 0.0, e_Pd_ = 0.0, d_Pd_ = 0.0;  // <s,P^-1 s>, <s,P^-1 p>, <p,P^-1 p>
-  double model_ = 0.0;                           // m(s) = <g, s> + <s, H s> / 2
-  double gs_ = 0.0, sHs_ = 0.0;                  // <g, s>, <s, H s> of the CG step
-  Eigen::MatrixXd s_full_;                       // the CG step; a backtrack tries scale_ of it
+  // Its scalars (iterations, the previous gamma and alpha, the preconditioned norms of s, p).
+  std::unique_ptr<PipelinedCg> cg_;
+  double model_ = 0.0;           // m(s) = <g, s> + <s, H s> / 2
+  double gs_ = 0.0, sHs_ = 0.0;  // <g, s>, <s, H s> of the CG step
+  Eigen::MatrixXd s_full_;       // the CG step; a backtrack tries scale_ of it
   double scale_ = 1.0;
   int backtracks_ = 0;
   double cg_target_ = 0.0;     // residual norm that ends the CG
@@ -375,12 +373,10 @@ class NewtonRefineProtocol : public AgentProcess {
   Eigen::VectorXd iy_r_, iy_q_, iy_w_, iy_g_, ir_, iq_, ir_g_;
   // Translation solve at the trial point: the own block's translation Laplacian factor, CG
   // state (x the translation change, in the pose layout with zero rotation columns).
-  struct TranslationFactor;
-  std::unique_ptr<TranslationFactor> translation_factor_;
+  std::unique_ptr<TranslationPreconditioner> translation_preconditioner_;
   bool translations_solved_ = false;  // the current trial's translations are re-solved
   Eigen::MatrixXd tx_, tr_, tz_, tzn_, tw_, tp_, tq_;
-  int tcg_it_ = 0;
-  double tgamma_old_ = 0.0, talpha_old_ = 0.0;
+  std::unique_ptr<PipelinedCg> tcg_;
   NewtonRefineStep step_;
   bool done_ = false;
   NewtonRefineResult result_;
