@@ -63,6 +63,32 @@ TEST(GncSchedule, CappedReCheckPassesEndWithTheSameSetInFewerRounds) {
   EXPECT_LT(capped.total_rounds, full.total_rounds);
 }
 
+TEST(GncSchedule, APassFromASolvedPassThatChangesNothingEndsThePassesWithTheSameSet) {
+  // A pass solved to the tolerance whose verdict still flips some measurements: the capped
+  // pass after it settles them, and when it changes nothing its verdict stands
+  // (RobustOptions::recheck_confirm_solved) instead of one more pass to the tolerance; the final
+  // solve reaches the tolerance either way.
+  // A steep mu schedule leaves true closures to take back after the first pass to the tolerance.
+  const GeneratorResult r = grid_with_outliers(0.5);
+  GncDistributedOptions o = irbcd_gnc();
+  o.solver.certify = true;
+  o.robust.inner_max_rounds = 5;
+  o.robust.mu_step = 4.0;
+  o.robust.recheck_max_rounds = 1;
+  o.robust.recheck_confirm_solved = false;
+  const GncDistributedResult confirmed_by_full =
+      solve_gnc_distributed(r.graph, robots_as_blocks(r), o);
+  o.robust.recheck_confirm_solved = true;
+  const GncDistributedResult confirmed = solve_gnc_distributed(r.graph, robots_as_blocks(r), o);
+  EXPECT_EQ(confirmed_by_full.rejected, r.outliers);
+  EXPECT_EQ(confirmed.rejected, r.outliers);
+  EXPECT_GT(confirmed.readmitted, 0u);
+  EXPECT_TRUE(confirmed.final_solve.certified);
+  EXPECT_NEAR(confirmed.final_solve.cost, confirmed_by_full.final_solve.cost,
+              1e-8 * confirmed_by_full.final_solve.cost);
+  EXPECT_LT(confirmed.total_rounds, confirmed_by_full.total_rounds);
+}
+
 TEST(GncSchedule, ACleanGraphStartsWhereThePlainSolveStarts) {
   // On clean data the solver's own (chordal) start has the lower TLS cost: nothing to
   // reject, no outer step, and the rounds of the plain solve plus the capped first solve.

@@ -315,6 +315,8 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
   solve_kind_ = GncSolveKind::kInlierPass;
   pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;
   full_pass_next_ = false;
+  pass_from_solved_ = last_pass_full_;
+  last_pass_full_ = false;
   ++g_;
   begin_solve(out);
 }
@@ -413,6 +415,7 @@ void GncAgent::begin_probe(double tls, std::vector<OutgoingMessage>& out) {
   cut.cut_now = std::move(recheck_->probe);
   apply_recheck(cut, in_.measurement_index, rejected_, weights_);
   pass_ = 0;
+  last_pass_full_ = false;
   // The iterate was bent around what the probe cut, and a local solve keeps such a fold; the
   // kept set's fresh start (voted on its cost, as after GNC) does not have it.
   if (fresh_start_) {
@@ -447,6 +450,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
   }
   gnc_rounds_ += solve_->total_rounds();
   if (solve_kind_ == GncSolveKind::kInlierPass) {
+    last_pass_full_ = !pass_capped_;
     if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
@@ -554,6 +558,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       if (fresh) state_->Y = exchange_->candidate();
       exchange_->candidate().resize(0, 0);
       exchange_->forget_candidate_neighbours();
+      last_pass_full_ = false;
       if (final_start_vote_) {
         final_start_vote_ = false;
         if (!fresh) {
@@ -568,8 +573,12 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     case Step::kReadmitted: {
       ++pass_;
       if (recheck_->empty()) {
-        if (pass_capped_) {
-          // No change at a rough solution: the same set once more, solved to the tolerance.
+        // No change at a rough solution: the same set once more, solved to the tolerance; but a
+        // pass that started from a solved pass only settled that pass's flips, and its verdict
+        // stands (RobustOptions::recheck_confirm_solved) when a solve to the tolerance follows.
+        const bool confirmed =
+            options_.robust.recheck_confirm_solved && pass_from_solved_ && final_solve_runs();
+        if (pass_capped_ && !confirmed) {
           full_pass_next_ = true;
           begin_inlier_pass(out);
           return;
@@ -590,6 +599,12 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
           apply_recheck(*recheck_, in_.measurement_index, rejected_, weights_);
       readmitted_ += counts.readmitted;
       late_rejected_ += counts.late_rejected;
+      if (probes_->running() && rejected_ == probes_->base_rejected()) {
+        // The passes took back exactly what the probe changed: it ends here, not kept (its
+        // TLS cost could differ from the base's only by the solves' accuracy).
+        restore_before_probe(out);
+        return;
+      }
       begin_inlier_pass(out);
       return;
     }

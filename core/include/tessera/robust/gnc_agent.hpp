@@ -253,10 +253,12 @@ class GncAgent : public AgentProcess {
   std::vector<bool> dropped_;        // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
   GncSolveKind solve_kind_ = GncSolveKind::kGnc;
-  bool voted_ = false;           // the votes of mu's start are in
-  int pass_ = 0;                 // inlier passes done
-  bool pass_capped_ = false;     // the current pass stops at RobustOptions::recheck_max_rounds
-  bool full_pass_next_ = false;  // the next pass is solved to the tolerance
+  bool voted_ = false;             // the votes of mu's start are in
+  int pass_ = 0;                   // inlier passes done
+  bool pass_capped_ = false;       // the current pass stops at RobustOptions::recheck_max_rounds
+  bool full_pass_next_ = false;    // the next pass is solved to the tolerance
+  bool last_pass_full_ = false;    // the last pass that ended was solved to the tolerance
+  bool pass_from_solved_ = false;  // the current pass starts from a pass solved to the tolerance
   std::size_t readmitted_ = 0;
   std::unique_ptr<RecheckVerdict> recheck_;  // the current re-check exchange's, every agent's
   std::size_t late_rejected_ = 0;
