@@ -94,6 +94,7 @@ void OnlineBaseline::resolve(const PoseGraph& g, const std::vector<int>& assignm
   // the guesses.
   const bool chordal = init_ == "chordal" && count_components(g) == 1;
   chordal_ += chordal ? 1 : 0;
+  if (before_resolve) before_resolve(g.num_poses, g.measurements.size());
   const double c0 = cpu_now();
   const DistributedResult r = resolve_from_scratch(g, assignment, options_, solver_ == "newton",
                                                    chordal ? std::vector<Pose>{} : guesses);

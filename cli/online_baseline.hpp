@@ -14,6 +14,7 @@
 // certificate, with the online steps' Newton steps or the batch solver's rounds.
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/online/graph_stream.hpp>
@@ -51,8 +52,12 @@ class OnlineBaseline {
   /// For progress lines: re-solves done, the number the run will do (about), and their
   /// process CPU so far (0 without --baseline).
   int resolved() const { return sampled_; }
-  long expected() const { return enabled_ ? (counted_ + every_ - 1) / every_ : 0; }
+  long expected() const {  // the middle of every stride of every_ (consider)
+    return enabled_ && counted_ > every_ / 2 ? (counted_ - every_ / 2 - 1) / every_ + 1 : 0;
+  }
   double measured_cpu_s() const { return cpu_s_; }
+  /// Called before each re-solve with its graph's poses and measurements (progress lines).
+  std::function<void(std::size_t, std::size_t)> before_resolve;
 
  private:
   void resolve(const PoseGraph& g, const std::vector<int>& assignment,

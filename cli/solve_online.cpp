@@ -325,6 +325,21 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   };
 
   auto last_line = std::chrono::steady_clock::now();
+  // A re-solve of a large graph can take minutes: announced when the last line is old or the
+  // last re-solve was long.
+  double last_resolve_cpu_s = 0.0, resolve_cpu_before = 0.0;
+  baseline.before_resolve = [&](std::size_t poses, std::size_t measurements) {
+    last_resolve_cpu_s = baseline.measured_cpu_s() - resolve_cpu_before;
+    resolve_cpu_before = baseline.measured_cpu_s();
+    const auto now = std::chrono::steady_clock::now();
+    if (!progress || (std::chrono::duration<double>(now - last_line).count() < progress_interval &&
+                      last_resolve_cpu_s < progress_interval))
+      return;
+    last_line = now;
+    say("baseline re-solve " + std::to_string(baseline.resolved()) + " of ~" +
+        std::to_string(baseline.expected()) + " from scratch on " + std::to_string(poses) +
+        " poses, " + std::to_string(measurements) + " measurements");
+  };
   double step_cpu_s = 0.0;
   auto observer = [&](const OnlineEngine& engine, const OnlineUpdate& u) {
     seen_batches += u.batches;
