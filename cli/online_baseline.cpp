@@ -83,9 +83,9 @@ OnlineBaseline::OnlineBaseline(const Arguments& a, const ReplayPlan& plan, int d
     closures += k;
     publications += k > 0 ? 1 : 0;
   }
+  counted_ = static_cast<long>(per_ == "closure" ? closures : publications);
   if (samples > 0)  // per step: at most one per publication, so K may be smaller
-    every_ =
-        std::max<long>(1, static_cast<long>(per_ == "closure" ? closures : publications) / samples);
+    every_ = std::max<long>(1, counted_ / samples);
 }
 
 void OnlineBaseline::resolve(const PoseGraph& g, const std::vector<int>& assignment,
@@ -94,6 +94,7 @@ void OnlineBaseline::resolve(const PoseGraph& g, const std::vector<int>& assignm
   // the guesses.
   const bool chordal = init_ == "chordal" && count_components(g) == 1;
   chordal_ += chordal ? 1 : 0;
+  if (before_resolve) before_resolve(g.num_poses, g.measurements.size());
   const double c0 = cpu_now();
   const DistributedResult r = resolve_from_scratch(g, assignment, options_, solver_ == "newton",
                                                    chordal ? std::vector<Pose>{} : guesses);
@@ -102,20 +103,36 @@ void OnlineBaseline::resolve(const PoseGraph& g, const std::vector<int>& assignm
   for (const NewtonRefineResult& n : r.refines) cg_ += n.cg_iterations;
 }
 
-void OnlineBaseline::consider(const OnlineEngine& engine, std::size_t count) {
+bool OnlineBaseline::every_pose_linked_up_to(std::size_t count) {
   const PoseGraph& lg = lag_.graph();
-  PoseGraph prefix;
-  prefix.d = lg.d;
-  prefix.num_poses = lg.num_poses;
-  prefix.measurements.assign(lg.measurements.begin(),
-                             lg.measurements.begin() + static_cast<std::ptrdiff_t>(count));
-  if (!every_pose_linked(prefix)) {
+  unlinked_ += lg.num_poses - linked_.size();
+  linked_.resize(lg.num_poses, 0);
+  for (; linked_measurements_ < count; ++linked_measurements_) {
+    const Measurement& m = lg.measurements[linked_measurements_];
+    for (const std::size_t p : {m.i, m.j}) {
+      unlinked_ -= linked_[p] ? 0 : 1;
+      linked_[p] = 1;
+    }
+  }
+  return unlinked_ == 0;
+}
+
+void OnlineBaseline::consider(const OnlineEngine& engine, std::size_t count) {
+  // Called once per publication (or closure) of the replay: the graph is copied only for the
+  // sampled ones (a copy per publication made the 50,000-pose grid's baseline quadratic).
+  if (!every_pose_linked_up_to(count)) {
     ++skipped_;
     return;
   }
   // Sampled in the middle of every stride of every_.
   if (solves_++ % every_ != every_ / 2) return;
   ++sampled_;
+  const PoseGraph& lg = lag_.graph();
+  PoseGraph prefix;
+  prefix.d = lg.d;
+  prefix.num_poses = lg.num_poses;
+  prefix.measurements.assign(lg.measurements.begin(),
+                             lg.measurements.begin() + static_cast<std::ptrdiff_t>(count));
   std::vector<int> assignment(
       engine.assignment().begin(),
       engine.assignment().begin() + static_cast<std::ptrdiff_t>(prefix.num_poses));

@@ -14,6 +14,7 @@
 // certificate, with the online steps' Newton steps or the batch solver's rounds.
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/online/graph_stream.hpp>
@@ -48,12 +49,24 @@ class OnlineBaseline {
   void observe(const OnlineEngine& engine, const OnlineUpdate& update);
   /// The `baseline_*` fields of the JSON summary (nothing without --baseline).
   void add_to(JsonObject& json) const;
+  /// For progress lines: re-solves done, the number the run will do (about), and their
+  /// process CPU so far (0 without --baseline).
+  int resolved() const { return sampled_; }
+  long expected() const {  // the middle of every stride of every_ (consider)
+    return enabled_ && counted_ > every_ / 2 ? (counted_ - every_ / 2 - 1) / every_ + 1 : 0;
+  }
+  double measured_cpu_s() const { return cpu_s_; }
+  /// Called before each re-solve with its graph's poses and measurements (progress lines).
+  std::function<void(std::size_t, std::size_t)> before_resolve;
 
  private:
   void resolve(const PoseGraph& g, const std::vector<int>& assignment,
                const std::vector<Pose>& guesses);
   // Re-solves (sampled) the lagging stream's poses with its first `count` measurements.
   void consider(const OnlineEngine& engine, std::size_t count);
+  // Marks the poses of the lagging stream's measurements up to `count` as linked; true when
+  // every pose of the lagging stream is (incremental: O(new measurements and poses) a call).
+  bool every_pose_linked_up_to(std::size_t count);
 
   const ReplayPlan& plan_;
   OnlineOptions options_;
@@ -63,8 +76,11 @@ class OnlineBaseline {
   double cpu_s_ = 0.0;
   int solves_ = 0, sampled_ = 0, rounds_ = 0, cg_ = 0, chordal_ = 0;
   std::size_t closures_ = 0, publications_ = 0, closure_steps_ = 0, skipped_ = 0;
+  long counted_ = 0;  // publications or closures in the replay (what --baseline-samples splits)
   GraphStream lag_;
   std::size_t lag_next_ = 0;
+  std::vector<char> linked_;  // per pose of the lagging stream: some measurement touches it
+  std::size_t unlinked_ = 0, linked_measurements_ = 0;
 };
 
 }  // namespace tessera::cli

@@ -1,7 +1,12 @@
 #include "solve_online.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <optional>
+#include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/online/replay_schedule.hpp>
@@ -17,17 +22,14 @@
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {"rate",           "speedup",
-                                     "start",          "checkpoints",
-                                     "certify-every",  "refactor-growth",
-                                     "baseline-every", "local-threshold",
-                                     "step-every",     "step-solver",
-                                     "newton-after",   "threads",
-                                     "baseline-per",   "baseline-samples",
-                                     "baseline-init",  "baseline-solver",
-                                     "step-coarse",    nullptr};
-const char* const kOnlineSwitches[] = {"online", "real-time", "baseline", "no-local-rounds",
-                                       nullptr};
+const char* const kOnlineValued[] = {
+    "rate",          "speedup",           "start",          "checkpoints",
+    "certify-every", "refactor-growth",   "baseline-every", "local-threshold",
+    "step-every",    "step-solver",       "newton-after",   "threads",
+    "baseline-per",  "baseline-samples",  "baseline-init",  "baseline-solver",
+    "step-coarse",   "progress-interval", nullptr};
+const char* const kOnlineSwitches[] = {"online",          "real-time",   "baseline",
+                                       "no-local-rounds", "no-progress", nullptr};
 
 const char* kOnlineHelp =
     "\n"
@@ -84,7 +86,13 @@ const char* kOnlineHelp =
     "  --step-coarse none|blocks newton: the CG's coarse correction (default none: block\n"
     "                            Jacobi; blocks: plus one rigid motion per block)\n"
     "  --no-certify              skip the final certificate\n"
-    "  --json FILE               summary with the `updates` array (one object per step)\n";
+    "  --json FILE               summary with the `updates` array (one object per step); a\n"
+    "                            long run rewrites it at every progress line with the steps\n"
+    "                            so far and \"complete\": false\n"
+    "  --progress-interval S     a progress line on stderr (step, stream time, poses, CPU,\n"
+    "                            re-solves) at most every S seconds of wall time, and one per\n"
+    "                            phase after the steps (default 10; 0: after every step)\n"
+    "  --no-progress             no progress lines\n";
 
 namespace {
 
@@ -95,6 +103,46 @@ double percentile(std::vector<double> v, double q) {
   const std::size_t lo = static_cast<std::size_t>(pos);
   const std::size_t hi = std::min(lo + 1, v.size() - 1);
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+JsonObject update_json(const OnlineUpdate& u) {
+  JsonObject j;
+  j.add("time_s", u.time_s)
+      .add("batches", u.batches)
+      .add("poses", u.poses)
+      .add("measurements", u.measurements)
+      .add("total_poses", u.total_poses)
+      .add("total_measurements", u.total_measurements)
+      .add("agents", u.agents)
+      .add("moved", u.moved)
+      .add("largest_block", u.largest_block)
+      .add("rounds", u.rounds)
+      .add("ms", u.ms)
+      .add("cpu_s", u.cpu_s)
+      .add("setup_s", u.setup_s)
+      .add("rounds_cpu_s", u.rounds_cpu_s)
+      .add("critical_path_cpu_s", u.critical_path_cpu_s)
+      .add("latency_s", u.latency_s)
+      .add("bytes", static_cast<std::size_t>(u.bytes))
+      .add("grad_norm", u.grad_norm)
+      .add("stop_reason", u.stop_reason)
+      .add("newton_steps", u.newton_steps)
+      .add("newton_cg_iterations", u.newton_cg_iterations)
+      .add("newton_message_steps", u.newton_message_steps)
+      .add("relaxation_cost", u.relaxation_cost)
+      .add("merges", u.merges)
+      .add("merge_poses_moved", u.merge_poses_moved);
+  return j;
+}
+
+// Writes through a temporary file and a rename: a reader of a summary rewritten while the run
+// goes on never sees half of one.
+void write_replacing(const std::string& path, const std::string& text) {
+  if (path == "-") return write_output(path, text);
+  const std::string tmp = path + ".partial";
+  write_output(tmp, text);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw InputError("cannot write " + path + " (rename from " + tmp + " failed)");
 }
 
 struct Checkpoint {
@@ -170,8 +218,133 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   std::vector<Checkpoint> marks;
   std::size_t seen_batches = 0, next_mark = every;
   OnlineBaseline baseline(a, plan, input.graph.d, options);
+
+  const bool progress = !a.has("no-progress");
+  const double progress_interval = a.get_double("progress-interval", 10.0);
+  if (!(progress_interval >= 0) || !std::isfinite(progress_interval))
+    throw InputError("option --progress-interval: must be a finite number of seconds >= 0");
+  const std::optional<std::string> json_path = a.get("json");
+  const double stream_end_s = plan.batches.empty() ? 0.0 : plan.batches.back().stamp;
+  auto elapsed_s = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  // Phases after the steps are announced only in runs long enough to have printed a line.
+  bool printed = false;
+  auto say = [&](const std::string& line) {
+    if (!progress) return;
+    std::fprintf(stderr, "tessera solve --online: %s; %.1f s wall\n", line.c_str(), elapsed_s());
+    std::fflush(stderr);
+    printed = true;
+  };
+
+  // The summary's fields known while the steps run; `res` (the finished run) adds the rest.
+  std::vector<OnlineUpdate> steps;
+  double wall_s = 0.0;
+  auto summary = [&](const OnlineResult* res) {
+    std::vector<JsonObject> updates, cps, certs;
+    int rounds = 0;
+    std::uint64_t bytes = 0;
+    double cpu_s = 0.0, setup_s = 0.0, rounds_cpu_s = 0.0;
+    std::vector<double> gaps;
+    const std::vector<OnlineUpdate>& done = res ? res->updates : steps;
+    for (const auto& u : done) {
+      updates.push_back(update_json(u));
+      rounds += u.rounds;
+      bytes += u.bytes;
+      cpu_s += u.cpu_s;
+      setup_s += u.setup_s;
+      rounds_cpu_s += u.rounds_cpu_s;
+    }
+    for (const auto& c : marks) {
+      JsonObject j;
+      j.add("time_s", c.time_s)
+          .add("poses", c.graph.num_poses)
+          .add("measurements", c.graph.measurements.size())
+          .add("cost", c.cost);
+      if (res) {
+        j.add("optimum", c.optimum).add("rel_gap", (c.cost - c.optimum) / c.optimum);
+        gaps.push_back((c.cost - c.optimum) / c.optimum);
+      }
+      cps.push_back(std::move(j));
+    }
+    const std::vector<OnlineCertificate> no_certificates;
+    for (const auto& c : res ? res->certificates : no_certificates) {
+      JsonObject o;
+      o.add("time_s", c.time_s)
+          .add("poses", c.poses)
+          .add("certified", c.certified)
+          .add("min_eigenvalue", c.min_eigenvalue)
+          .add("cpu_s", c.cpu_s)
+          .add("escaped", c.escaped)
+          .add("cost_before", c.cost_before)
+          .add("cost_after", c.cost_after);
+      certs.push_back(std::move(o));
+    }
+    const std::vector<double> no_latency;
+    const std::vector<double>& latency = res ? res->batch_latency_s : no_latency;
+    JsonObject j;
+    j.add("graph", graph_path)
+        .add("mode", "online")
+        .add("complete", res != nullptr)
+        .add("algorithm", algorithm_name(options.solver.algorithm))
+        .add("d", input.graph.d)
+        .add("robots", input.robots)
+        .add("poses", res ? res->graph.num_poses : (done.empty() ? 0 : done.back().total_poses))
+        .add("measurements", res ? res->graph.measurements.size()
+                                 : (done.empty() ? 0 : done.back().total_measurements))
+        .add("batches", plan.batches.size())
+        .add("rate", replay.rate)
+        .add("speedup", replay.speedup)
+        .add("real_time", options.real_time)
+        .add("step_every_s", options.step_every_s)
+        .add("step_solver", options.newton_steps ? "newton" : "rounds")
+        .add("grad_tol", options.solver.grad_norm_tol)
+        .add("steps", done.size())
+        .add("rounds", res ? res->rounds : rounds)
+        .add("bytes", static_cast<std::size_t>(res ? res->bytes : bytes))
+        .add("cpu_s", res ? res->cpu_s : cpu_s)
+        .add("setup_s", setup_s)
+        .add("rounds_cpu_s", rounds_cpu_s);
+    if (res) {
+      j.add("latency_median_s", percentile(latency, 0.5))
+          .add("latency_p95_s", percentile(latency, 0.95))
+          .add("max_checkpoint_rel_gap",
+               gaps.empty() ? 0.0 : *std::max_element(gaps.begin(), gaps.end()))
+          .add("repartitions", res->repartitions)
+          .add("poses_moved", res->poses_moved)
+          .add("final_rounds", res->final_rounds)
+          .add("cost", res->cost)
+          .add("grad_norm", res->grad_norm)
+          .add("certified", res->certified)
+          .add("min_eigenvalue", res->min_eigenvalue);
+    }
+    j.add("wall_s", res ? wall_s : elapsed_s());
+    baseline.add_to(j);
+    j.add("certificates", certs).add("checkpoints", cps).add("updates", updates);
+    return j.str();
+  };
+
+  auto last_line = std::chrono::steady_clock::now();
+  // A re-solve of a large graph can take minutes: announced when the last line is old or the
+  // last re-solve was long.
+  double last_resolve_cpu_s = 0.0, resolve_cpu_before = 0.0;
+  baseline.before_resolve = [&](std::size_t poses, std::size_t measurements) {
+    last_resolve_cpu_s = baseline.measured_cpu_s() - resolve_cpu_before;
+    resolve_cpu_before = baseline.measured_cpu_s();
+    const auto now = std::chrono::steady_clock::now();
+    if (!progress || (std::chrono::duration<double>(now - last_line).count() < progress_interval &&
+                      last_resolve_cpu_s < progress_interval))
+      return;
+    last_line = now;
+    say("baseline re-solve " + std::to_string(baseline.resolved()) + " of ~" +
+        std::to_string(baseline.expected()) + " from scratch on " + std::to_string(poses) +
+        " poses, " + std::to_string(measurements) + " measurements");
+  };
+  double step_cpu_s = 0.0;
   auto observer = [&](const OnlineEngine& engine, const OnlineUpdate& u) {
     seen_batches += u.batches;
+    steps.push_back(u);
+    step_cpu_s += u.cpu_s;
     const PoseGraph& g = engine.stream().graph();
     if (every > 0 && seen_batches >= next_mark) {
       const std::vector<Pose> estimate = engine.estimate();
@@ -185,22 +358,41 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       }
     }
     baseline.observe(engine, u);
+    const auto now = std::chrono::steady_clock::now();
+    if (progress && std::chrono::duration<double>(now - last_line).count() >= progress_interval) {
+      last_line = now;
+      char line[320];
+      std::snprintf(line, sizeof line,
+                    "step %zu, stream %.2f of %.2f s, %zu poses, %zu measurements, steps' CPU "
+                    "%.1f s (this step %.2f s, %d Newton CG)",
+                    steps.size(), u.time_s, stream_end_s, u.total_poses, u.total_measurements,
+                    step_cpu_s, u.cpu_s, u.newton_cg_iterations);
+      std::string text = line;
+      if (baseline.expected() > 0) {
+        std::snprintf(line, sizeof line, "; baseline %d of ~%ld re-solves, %.1f CPU-s",
+                      baseline.resolved(), baseline.expected(), baseline.measured_cpu_s());
+        text += line;
+      }
+      say(text);
+      if (json_path && *json_path != "-") write_replacing(*json_path, summary(nullptr));
+    }
+    if (printed && seen_batches == plan.batches.size())
+      say("all " + std::to_string(plan.batches.size()) + " batches absorbed in " +
+          std::to_string(steps.size()) + " steps; final solve" +
+          (options.certify_at_end ? " and certificate" : "") + " on " +
+          std::to_string(g.num_poses) + " poses");
   };
   const OnlineResult res = run_online(input.graph.d, plan.batches, options, observer);
-  const double wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  wall_s = elapsed_s();
 
-  std::vector<double> latency, gaps;
-  double setup_s = 0.0, rounds_cpu_s = 0.0;
-  latency = res.batch_latency_s;
-  for (const auto& u : res.updates) {
-    setup_s += u.setup_s;
-    rounds_cpu_s += u.rounds_cpu_s;
+  for (std::size_t k = 0; k < marks.size(); ++k) {
+    if (printed)
+      say("checkpoint " + std::to_string(k + 1) + " of " + std::to_string(marks.size()) +
+          ": the optimum of the graph of " + std::to_string(marks[k].graph.num_poses) +
+          " poses (centralized solver, offline)");
+    marks[k].optimum = solve_centralized(marks[k].graph).cost;
   }
-  for (auto& c : marks) {
-    c.optimum = solve_centralized(c.graph).cost;
-    gaps.push_back((c.cost - c.optimum) / c.optimum);
-  }
+  const std::vector<double>& latency = res.batch_latency_s;
   std::printf(
       "%s online: %zu poses, %zu measurements, %zu robots, %zu steps, %d rounds; "
       "latency median %.4f s, p95 %.4f s; final cost %.10g, %s, %.3f s\n",
@@ -209,97 +401,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       res.certified ? (*res.certified ? "certified optimal" : "NOT certified")
                     : "not certified (skipped)",
       wall_s);
-  if (auto p = a.get("json")) {
-    std::vector<JsonObject> updates, cps;
-    for (const auto& u : res.updates) {
-      JsonObject j;
-      j.add("time_s", u.time_s)
-          .add("batches", u.batches)
-          .add("poses", u.poses)
-          .add("measurements", u.measurements)
-          .add("total_poses", u.total_poses)
-          .add("total_measurements", u.total_measurements)
-          .add("agents", u.agents)
-          .add("moved", u.moved)
-          .add("largest_block", u.largest_block)
-          .add("rounds", u.rounds)
-          .add("ms", u.ms)
-          .add("cpu_s", u.cpu_s)
-          .add("setup_s", u.setup_s)
-          .add("rounds_cpu_s", u.rounds_cpu_s)
-          .add("critical_path_cpu_s", u.critical_path_cpu_s)
-          .add("latency_s", u.latency_s)
-          .add("bytes", static_cast<std::size_t>(u.bytes))
-          .add("grad_norm", u.grad_norm)
-          .add("stop_reason", u.stop_reason)
-          .add("newton_steps", u.newton_steps)
-          .add("newton_cg_iterations", u.newton_cg_iterations)
-          .add("newton_message_steps", u.newton_message_steps)
-          .add("relaxation_cost", u.relaxation_cost)
-          .add("merges", u.merges)
-          .add("merge_poses_moved", u.merge_poses_moved);
-      updates.push_back(std::move(j));
-    }
-    for (const auto& c : marks) {
-      JsonObject j;
-      j.add("time_s", c.time_s)
-          .add("poses", c.graph.num_poses)
-          .add("measurements", c.graph.measurements.size())
-          .add("cost", c.cost)
-          .add("optimum", c.optimum)
-          .add("rel_gap", (c.cost - c.optimum) / c.optimum);
-      cps.push_back(std::move(j));
-    }
-    std::vector<JsonObject> certs;
-    for (const auto& c : res.certificates) {
-      JsonObject o;
-      o.add("time_s", c.time_s)
-          .add("poses", c.poses)
-          .add("certified", c.certified)
-          .add("min_eigenvalue", c.min_eigenvalue)
-          .add("cpu_s", c.cpu_s)
-          .add("escaped", c.escaped)
-          .add("cost_before", c.cost_before)
-          .add("cost_after", c.cost_after);
-      certs.push_back(std::move(o));
-    }
-    JsonObject j;
-    j.add("graph", graph_path)
-        .add("mode", "online")
-        .add("algorithm", algorithm_name(options.solver.algorithm))
-        .add("d", input.graph.d)
-        .add("robots", input.robots)
-        .add("poses", res.graph.num_poses)
-        .add("measurements", res.graph.measurements.size())
-        .add("batches", plan.batches.size())
-        .add("rate", replay.rate)
-        .add("speedup", replay.speedup)
-        .add("real_time", options.real_time)
-        .add("step_every_s", options.step_every_s)
-        .add("step_solver", options.newton_steps ? "newton" : "rounds")
-        .add("grad_tol", options.solver.grad_norm_tol)
-        .add("steps", res.updates.size())
-        .add("rounds", res.rounds)
-        .add("bytes", static_cast<std::size_t>(res.bytes))
-        .add("cpu_s", res.cpu_s)
-        .add("setup_s", setup_s)
-        .add("rounds_cpu_s", rounds_cpu_s)
-        .add("latency_median_s", percentile(latency, 0.5))
-        .add("latency_p95_s", percentile(latency, 0.95))
-        .add("max_checkpoint_rel_gap",
-             gaps.empty() ? 0.0 : *std::max_element(gaps.begin(), gaps.end()))
-        .add("repartitions", res.repartitions)
-        .add("poses_moved", res.poses_moved)
-        .add("final_rounds", res.final_rounds)
-        .add("cost", res.cost)
-        .add("grad_norm", res.grad_norm)
-        .add("certified", res.certified)
-        .add("min_eigenvalue", res.min_eigenvalue)
-        .add("wall_s", wall_s);
-    baseline.add_to(j);
-    j.add("certificates", certs).add("checkpoints", cps).add("updates", updates);
-    write_output(*p, j.str());
-  }
+  if (json_path) write_replacing(*json_path, summary(&res));
   return 0;
 }
 

@@ -1,6 +1,6 @@
 // `tessera solve GRAPH --online --baseline`: the re-solving baseline of issue 24 counts one
 // re-solve from scratch per publication that brought loop closures (or per closure, or per
-// step), and a sample of them stands for all.
+// step), and a sample of them stands for all. A run says where it is on stderr while it goes.
 
 #include <gtest/gtest.h>
 
@@ -145,6 +145,28 @@ TEST(OnlineCli, TheStepsCoarseCorrectionReachesTheSameCertifiedOptimum) {
                               &out),
             2);
   EXPECT_TRUE(test::contains(out, "--step-coarse")) << out;
+}
+
+TEST(OnlineCli, ARunSaysWhereItIsOnStderrUnlessToldNotTo) {
+  const Replay r = generated();
+  const std::string json = r.dir + "/p.json";
+  const std::string cmd = test::bin("tessera") + " solve " + r.graph +
+                          " --online --robots 2 --rate 10 --speedup 10 --step-every 0.1 "
+                          "--grad-tol 1e-2 --no-certify --baseline --baseline-samples 2 "
+                          "--checkpoints 2 --json " +
+                          json;
+  std::string out;
+  ASSERT_EQ(test::run_command(cmd + " --progress-interval 0", &out), 0) << out;
+  // A line after every step (interval 0), with the re-solves so far, then one per phase.
+  EXPECT_TRUE(test::contains(out, "tessera solve --online: step 1, stream ")) << out;
+  EXPECT_TRUE(test::contains(out, "re-solves")) << out;
+  EXPECT_TRUE(test::contains(out, "batches absorbed in")) << out;
+  EXPECT_TRUE(test::contains(out, "checkpoint 2 of 2")) << out;
+  EXPECT_TRUE(test::contains(test::read_text_file(json), "\"complete\": true"));
+  ASSERT_EQ(test::run_command(cmd + " --no-progress", &out), 0) << out;
+  EXPECT_FALSE(test::contains(out, "tessera solve --online:")) << out;
+  EXPECT_EQ(test::run_command(cmd + " --progress-interval -1", &out), 2);
+  EXPECT_TRUE(test::contains(out, "--progress-interval")) << out;
 }
 
 TEST(OnlineCli, AnUnknownBaselineModeIsRefusedWithExitCode2) {

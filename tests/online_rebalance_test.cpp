@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <random>
 #include <tessera/generate/generator.hpp>
 #include <tessera/online/block_rebalance.hpp>
 #include <tessera/online/online_engine.hpp>
@@ -55,6 +57,89 @@ TEST(BlockRebalance, LeavesBlocksWithinSlackAlone) {
   owner.assign(42, 0);
   owner[41] = 1;
   EXPECT_EQ(rebalance_blocks(g, owner, 2, o).moved, 0u);
+}
+
+// The definition of the moves, one scan of the graph per move: the lowest-id unmoved pose of
+// the largest over-full block (that has one) with a measurement into the lightest block at
+// least two poses lighter, to the first such block among its measurements.
+std::size_t rebalance_by_definition(const PoseGraph& g, std::vector<int>& owner, int blocks,
+                                    double bound) {
+  std::vector<std::size_t> size(static_cast<std::size_t>(blocks), 0);
+  for (int b : owner) ++size[static_cast<std::size_t>(b)];
+  std::vector<std::vector<std::size_t>> adjacent(g.num_poses);
+  for (const Measurement& m : g.measurements) {
+    adjacent[m.i].push_back(m.j);
+    adjacent[m.j].push_back(m.i);
+  }
+  std::vector<char> moved(g.num_poses, 0);
+  std::size_t moves = 0;
+  for (bool any = true; any;) {
+    any = false;
+    std::vector<int> order(static_cast<std::size_t>(blocks));
+    for (int b = 0; b < blocks; ++b) order[static_cast<std::size_t>(b)] = b;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return size[std::size_t(a)] > size[std::size_t(b)]; });
+    for (int big : order) {
+      const std::size_t big_size = size[static_cast<std::size_t>(big)];
+      if (static_cast<double>(big_size) <= bound || big_size <= 1) break;
+      std::size_t pose = g.num_poses;
+      int to = -1;
+      for (std::size_t k = 0; k < g.num_poses; ++k) {
+        if (owner[k] != big || moved[k]) continue;
+        for (std::size_t q : adjacent[k]) {
+          const int c = owner[q];
+          if (c == big || size[std::size_t(c)] + 2 > big_size) continue;
+          if (to < 0 || size[std::size_t(c)] < size[std::size_t(to)]) {
+            to = c;
+            pose = k;
+          }
+        }
+      }
+      if (to < 0) continue;
+      owner[pose] = to;
+      moved[pose] = 1;
+      --size[static_cast<std::size_t>(big)];
+      ++size[static_cast<std::size_t>(to)];
+      ++moves;
+      any = true;
+      break;
+    }
+  }
+  return moves;
+}
+
+TEST(BlockRebalance, MakesTheMovesOfItsDefinitionOnRandomGraphs) {
+  std::mt19937 rng(7);
+  std::size_t total_moves = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::size_t n = 20 + rng() % 200;
+    const int blocks = 2 + static_cast<int>(rng() % 6);
+    PoseGraph g = chain(n);  // odometry, and closures between random poses
+    for (std::size_t k = 0, extra = rng() % (2 * n); k < extra; ++k) {
+      Measurement m;
+      m.i = rng() % n;
+      m.j = (m.i + 1 + rng() % (n - 1)) % n;
+      g.measurements.push_back(m);
+    }
+    // Uneven contiguous blocks (robots), some poses handed to random blocks (earlier moves).
+    std::vector<int> owner(n);
+    for (std::size_t k = 0; k < n; ++k)
+      owner[k] = std::min(blocks - 1, static_cast<int>(blocks * (k * k) / (n * n)));
+    for (std::size_t k = 0; k < n / 10; ++k) owner[rng() % n] = static_cast<int>(rng() % blocks);
+    for (int b = 0; b < blocks; ++b) owner[static_cast<std::size_t>(b)] = b;  // none empty
+    RebalanceOptions o;
+    o.slack = 0.1 * static_cast<double>(rng() % 3);
+    o.min_excess = rng() % 3;
+    std::vector<int> expected = owner;
+    const double bound = (1.0 + o.slack) * std::ceil(static_cast<double>(n) / blocks) +
+                         static_cast<double>(o.min_excess);
+    const std::size_t moves = rebalance_by_definition(g, expected, blocks, bound);
+    const RebalanceResult r = rebalance_blocks(g, owner, blocks, o);
+    EXPECT_EQ(r.moved, moves) << "trial " << trial;
+    EXPECT_EQ(owner, expected) << "trial " << trial;
+    total_moves += moves;
+  }
+  EXPECT_GT(total_moves, 2000u) << "the trials move poses";
 }
 
 TEST(BlockRebalance, RejectsANegativeSlackNamingTheField) {

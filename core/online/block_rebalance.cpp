@@ -1,7 +1,9 @@
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <tessera/online/block_rebalance.hpp>
 #include <tessera/util/input_error.hpp>
+#include <utility>
 
 namespace tessera {
 
@@ -33,10 +35,31 @@ RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner
     adjacent[m.i].push_back(m.j);
     adjacent[m.j].push_back(m.i);
   }
-  // Each pass moves one pose out of the largest over-full block that has a lighter neighbour
-  // block; a pose moves at most once per call, so the loop ends.
+  const std::size_t blocks = static_cast<std::size_t>(num_blocks);
+  // Per pose, its measurements into each block (few blocks a pose: a short list); per pair of
+  // blocks (b, c), the poses of b that may move and have a measurement into c, in id order.
+  // Kept up to date move by move, so a move costs the moved pose's degree, not a scan of the
+  // graph (which made a call that moves M poses O(M n)).
+  std::vector<std::vector<std::pair<int, std::size_t>>> into(n);
+  std::vector<std::set<std::size_t>> border(blocks * blocks);
+  auto count = [&](std::size_t q, int c) -> std::size_t& {
+    for (auto& e : into[q])
+      if (e.first == c) return e.second;
+    into[q].emplace_back(c, 0);
+    return into[q].back().second;
+  };
   std::vector<char> moved(n, 0);
-  std::vector<int> order(static_cast<std::size_t>(num_blocks));
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t q : adjacent[k]) ++count(k, owner[q]);
+  for (std::size_t k = 0; k < n; ++k)
+    for (const auto& [c, links] : into[k])
+      if (c != owner[k] && links > 0)
+        border[static_cast<std::size_t>(owner[k]) * blocks + static_cast<std::size_t>(c)].insert(k);
+  // Each pass moves one pose out of the largest over-full block that has a lighter neighbour
+  // block: the lowest-id pose among those with a measurement into the lightest block at least
+  // two poses lighter, to the first such block among its measurements. A pose moves at most
+  // once per call, so the loop ends.
+  std::vector<int> order(blocks);
   for (;;) {
     for (int b = 0; b < num_blocks; ++b) order[static_cast<std::size_t>(b)] = b;
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
@@ -44,27 +67,42 @@ RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner
     });
     bool any = false;
     for (int big : order) {
-      const std::size_t big_size = size[static_cast<std::size_t>(big)];
+      const std::size_t bg = static_cast<std::size_t>(big);
+      const std::size_t big_size = size[bg];
       if (!over(big_size) || big_size <= 1) break;  // the rest are smaller
-      // The border pose whose lightest neighbouring block is lightest (lowest ids on ties).
-      std::size_t best_pose = n;
-      int best_block = -1;
-      for (std::size_t k = 0; k < n; ++k) {
-        if (owner[k] != big || moved[k]) continue;
-        for (std::size_t q : adjacent[k]) {
-          const int c = owner[q];
-          if (c == big || size[static_cast<std::size_t>(c)] + 2 > big_size) continue;
-          if (best_block < 0 ||
-              size[static_cast<std::size_t>(c)] < size[static_cast<std::size_t>(best_block)]) {
-            best_block = c;
-            best_pose = k;
-          }
+      std::size_t lightest = 0, best_pose = n;
+      for (std::size_t c = 0; c < blocks; ++c) {
+        const std::set<std::size_t>& cand = border[bg * blocks + c];
+        if (c == bg || cand.empty() || size[c] + 2 > big_size) continue;
+        if (best_pose == n || size[c] < lightest) {
+          lightest = size[c];
+          best_pose = *cand.begin();
+        } else if (size[c] == lightest) {
+          best_pose = std::min(best_pose, *cand.begin());
         }
       }
-      if (best_block < 0) continue;  // no lighter neighbour: try the next block
+      if (best_pose == n) continue;  // no lighter neighbour: try the next block
+      int best_block = -1;
+      for (std::size_t q : adjacent[best_pose]) {
+        const int c = owner[q];
+        if (c != big && size[static_cast<std::size_t>(c)] == lightest) {
+          best_block = c;
+          break;
+        }
+      }
+      // The moved pose leaves every candidate list; its neighbours' links follow it.
+      for (const auto& [c, links] : into[best_pose])
+        if (c != big && links > 0)
+          border[bg * blocks + static_cast<std::size_t>(c)].erase(best_pose);
       owner[best_pose] = best_block;
       moved[best_pose] = 1;
-      --size[static_cast<std::size_t>(big)];
+      for (std::size_t q : adjacent[best_pose]) {
+        const std::size_t b = static_cast<std::size_t>(owner[q]);
+        if (--count(q, big) == 0 && b != bg) border[b * blocks + bg].erase(q);
+        if (++count(q, best_block) == 1 && b != static_cast<std::size_t>(best_block) && !moved[q])
+          border[b * blocks + static_cast<std::size_t>(best_block)].insert(q);
+      }
+      --size[bg];
       ++size[static_cast<std::size_t>(best_block)];
       ++res.moved;
       any = true;

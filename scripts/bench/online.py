@@ -39,15 +39,18 @@ def cases(args, work, tessera):
         # With steps shorter than a real-time step's (tick, or a fixed period) there are many more
         # closure steps: sample more sparsely.
         every = (1, 10, 40) if args.steps == "real-time" else (5, 40, 200)
-        out = [("sphere2500", sphere, 5, "sphere2500", every[0]),
-               ("city10000", city, 5, "city10000", every[1]), ("grid3d-50000", grid, 10, grid, every[2])]
+        # The grid's re-solves are of graphs up to 50,000 poses: at most --grid-baseline-samples.
+        grid_samples = min(args.baseline_samples, args.grid_baseline_samples)
+        out = [("sphere2500", sphere, 5, "sphere2500", every[0], args.baseline_samples),
+               ("city10000", city, 5, "city10000", every[1], args.baseline_samples),
+               ("grid3d-50000", grid, 10, grid, every[2], grid_samples)]
         return [c for c in out if not args.cases or c[0] in args.cases.split(",")]
     out = []
     for kind, poses, robots in (("city", args.poses, 5), ("grid3d", args.poses, 5), ("sphere", args.poses, 5)):
         path = os.path.join(work, f"{kind}{poses}.g2o")
         subprocess.run([tessera, "generate", "--kind", kind, "--poses", str(poses), "--robots", str(robots),
                         "--seed", "1", "--out", path], check=True, stdout=subprocess.DEVNULL)
-        out.append((f"{kind}-{poses} (generated)", path, robots, path, 1))
+        out.append((f"{kind}-{poses} (generated)", path, robots, path, 1, args.baseline_samples))
     return out
 
 
@@ -72,6 +75,8 @@ def main():
     ap.add_argument("--baseline-samples", type=int, default=40,
                     help="re-solve about this many of them, spread evenly, and scale the CPU time by "
                          "(counted / re-solved); 0 = all (or --full's fixed strides) (default 40)")
+    ap.add_argument("--grid-baseline-samples", type=int, default=6,
+                    help="with --full: at most this many re-solves of the 50,000-pose grid (default 6)")
     ap.add_argument("--baseline-solver", default="newton", choices=("newton", "rounds"),
                     help="the re-solves' solver: the online steps' Newton steps from scratch (default: "
                          "cheaper than the rounds on the generated graphs) or the batch solver's rounds")
@@ -93,7 +98,7 @@ def main():
     args = ap.parse_args()
     ctx = bc.Ctx(args)
     rows, runs, dds_rows = [], [], []
-    for name, path, robots, fkey, every in cases(args, ctx.work, ctx.bin):
+    for name, path, robots, fkey, every, samples in cases(args, ctx.work, ctx.bin):
         load = os.getloadavg()[0]
         js = os.path.join(ctx.work, os.path.basename(path) + ".online.json")
         cmd = [ctx.bin, "solve", path, "--online", "--robots", str(robots), "--rate", str(args.rate),
@@ -103,8 +108,8 @@ def main():
             cmd += ["--baseline"]
         if not args.no_baseline:
             cmd += ["--baseline-per", args.baseline_per]
-            if args.baseline_samples > 0:
-                cmd += ["--baseline-samples", str(args.baseline_samples)]
+            if samples > 0:
+                cmd += ["--baseline-samples", str(samples)]
             elif every > 1:
                 cmd += ["--baseline-every", str(every)]
             if args.baseline_init != "chordal":
