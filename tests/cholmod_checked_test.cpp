@@ -8,9 +8,13 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCore>
+#include <numeric>
 #include <stdexcept>
 #include <string>
+#include <tessera/problem/block_problem.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
+#include <tessera/solvers/tangent_preconditioner.hpp>
+#include <vector>
 
 #include "random_graph.hpp"
 
@@ -79,6 +83,20 @@ TEST(CholmodChecked, ChordalInitializationReportsAFailedAnalysis) {
   }
   EXPECT_NE(message.find("chordal initialization: CHOLMOD's analysis failed"), std::string::npos)
       << message;
+}
+
+// The tangent preconditioner whose analysis fails is not usable (the caller keeps its Euclidean
+// one), where it would have factored the missing factor later.
+TEST(CholmodChecked, TangentPreconditionerWithAFailedAnalysisIsNotUsable) {
+  test::RandomGraphSpec spec;
+  spec.poses = 40;
+  const PoseGraph g = test::random_pose_graph(spec);
+  std::vector<std::size_t> owned(g.num_poses);
+  std::iota(owned.begin(), owned.end(), std::size_t{0});
+  const BlockProblem problem(3, owned, g.measurements);
+  RefusedAllocations refused;
+  TangentPreconditioner precon(problem, 1e-9, 0, /*supernodal_min_flops=*/1.0);
+  EXPECT_FALSE(precon.usable());
 }
 
 }  // namespace

@@ -27,6 +27,13 @@ inline std::string cholmod_status_text(int status) {
   }
 }
 
+/// Whether the last analysis of `decomposition` failed (CHOLMOD left no factor). Eigen's
+/// analyzePattern() reports Success either way, so its info() cannot tell.
+template <class Decomposition>
+bool cholmod_analysis_failed(Decomposition& decomposition) {
+  return decomposition.cholmod().status < CHOLMOD_OK;
+}
+
 /// `decomposition.compute(A)` (analysis, then numeric factorization), except that a failed
 /// analysis throws std::runtime_error "WHAT: CHOLMOD's analysis failed (REASON)". The numeric
 /// factorization's outcome is left to `decomposition.info()`, as compute() leaves it.
@@ -35,7 +42,7 @@ void cholmod_compute_checked(Decomposition& decomposition, const Matrix& A,
                              const std::string& what) {
   decomposition.analyzePattern(A);
   const int status = decomposition.cholmod().status;
-  if (status < CHOLMOD_OK)
+  if (cholmod_analysis_failed(decomposition))
     throw std::runtime_error(what + ": CHOLMOD's analysis failed (" + cholmod_status_text(status) +
                              ", " + std::to_string(A.rows()) + " x " + std::to_string(A.cols()) +
                              " matrix)");
