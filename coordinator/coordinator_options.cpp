@@ -1,5 +1,6 @@
 #include "coordinator/coordinator_options.hpp"
 
+#include <cmath>
 #include <set>
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
@@ -93,6 +94,10 @@ options:
   --rejected FILE      write the rejected measurement indices (from 0 over the EDGE lines)
   --gnc-solver-start   GNC starts from --init's poses, not from the known inliers'
                        distributed initialization (tessera launch passes it with --init)
+  --reference-cost F   the graph's optimal cost f*, known from elsewhere (tessera solve
+                       --algorithm centralized): the summary reports the final cost's
+                       relative gap to it, rel_gap_to_reference = (cost - F) / F; F > 0
+                       (default: none)
   --status-interval S  print a status line (agents alive, their rounds, lagging or lost
                        agents) every S seconds and on changes; 0 = off (default 5)
   --verbose            print each phase
@@ -133,7 +138,8 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "refine",
                                                             "refine-grad-tol",
                                                             "refine-rel-tol",
-                                                            "setup-at-once"},
+                                                            "setup-at-once",
+                                                            "reference-cost"},
                                                            cli::SessionArgsFor::kProcess);
   valued.insert("graph");
   for (const char* const* r = cli::kRobustValued; *r; ++r) valued.insert(*r);
@@ -224,6 +230,9 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   a.robust = cli::parse_robust_options(args);
   a.gnc_known_start = !args.has("gnc-solver-start");
   a.rejected = args.get_or("rejected", "");
+  a.reference_cost = args.get_double("reference-cost", 0);
+  if (args.has("reference-cost") && !(a.reference_cost > 0 && std::isfinite(a.reference_cost)))
+    throw InputError("option --reference-cost: must be a finite number > 0 (the optimal cost f*)");
   if (a.robust.kind != RobustKind::kNone && (a.rejoin_timeout_s > 0 || a.replicas > 0))
     throw InputError(
         "option --robust: a robust run cannot roll back or re-partition; drop --rejoin-timeout "

@@ -63,6 +63,10 @@ struct CoordinatorOptions {
   /// GNC starts from the known inliers (off when --init is given, like `tessera solve`).
   bool gnc_known_start = true;
   std::string rejected;  ///< --rejected FILE: the rejected measurements, one index a line.
+  /// --reference-cost F: the optimal cost f* of the graph, known from elsewhere (e.g. `tessera
+  /// solve --algorithm centralized`); the summary then reports the final cost's relative gap to it,
+  /// (cost - F) / F. Finite and > 0; 0 = not given (the gap is null).
+  double reference_cost = 0;
 };
 
 /// The --help text; its "%s" stands for the shared session options (cli::process_help).

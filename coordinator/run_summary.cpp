@@ -32,6 +32,13 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("iterations", static_cast<long long>(in.merged.rounds))
       .add("grad_norm", final_value(r.final_grad_norm))
       .add("cost", final_value(r.final_cost))
+      // The final cost's relative gap to the optimum given by --reference-cost.
+      .add("reference_cost",
+           o.reference_cost > 0 ? std::optional<double>(o.reference_cost) : std::nullopt)
+      .add("rel_gap_to_reference",
+           o.reference_cost > 0 && r.have_final_report
+               ? std::optional<double>((r.final_cost - o.reference_cost) / o.reference_cost)
+               : std::nullopt)
       .add("certified",
            r.certificate ? std::optional<bool>(r.certificate->certified) : std::nullopt)
       .add("wall_s", in.total_ms / 1000.0)

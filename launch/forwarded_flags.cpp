@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <climits>
+#include <cmath>
 #include <cstdlib>
 #include <string>
 #include <tessera/distributed/coarse_correction.hpp>
@@ -77,6 +78,12 @@ void whole_number_in(const std::string& v, const char* flag, long lo, long hi) {
   if (x < lo || x > hi)
     throw InputError(std::string("option --") + flag + ": '" + v + "' is not a whole number in " +
                      std::to_string(lo) + ".." + std::to_string(hi));
+}
+void check_reference_cost(const std::string& v) {
+  const double f = number(v, "reference-cost");
+  if (!(f > 0 && std::isfinite(f)))
+    throw InputError("option --reference-cost: '" + v +
+                     "' is not a finite number > 0 (the optimal cost f*)");
 }
 void check_setup_at_once(const std::string& v) {
   whole_number_in(v, "setup-at-once", 0, 1000);
@@ -274,6 +281,11 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "local chordal solve at once (the set-up's memory peak);\n"
        "0 = all at once                                      [8]",
        check_setup_at_once},
+      {"reference-cost", "reference-cost", true, ForwardTo::kCoordinator, "--reference-cost F",
+       "the graph's optimal cost f*, known from elsewhere\n"
+       "(tessera solve --algorithm centralized): the summary\n"
+       "reports rel_gap_to_reference = (cost - F) / F, F > 0",
+       check_reference_cost},
       {"rejected", "rejected", true, ForwardTo::kCoordinator, "--rejected FILE",
        "write the rejected edge indices (from 0 over the EDGE\n"
        "lines), one a line",

@@ -1,6 +1,7 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-170, 129, 56, 131 and 112-113 (each test its own, so ctest -j is safe).
+// Domains used here: 161-170, 176, 129, 56, 131 and 112-113 (each test its own, so ctest -j is
+// safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -14,6 +15,7 @@
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/io/g2o_reader.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
 #include <vector>
 
 #include "dds_process_support.hpp"
@@ -172,12 +174,40 @@ TEST(DdsLaunch, EndToEndOnAGeneratedGraphPrintsTheSummary) {
         "partition_ms", "bytes_sent", "discovery_ms"})
     EXPECT_NE(json.find("\"" + std::string(field) + "\":"), std::string::npos) << field << json;
   EXPECT_EQ(json_field(json, "poses"), 150);
+  EXPECT_EQ(json_text(json, "rel_gap_to_reference"), "null") << json;  // no --reference-cost
   EXPECT_LE(json_field(json, "grad_norm"), 0.01);
   EXPECT_GT(json_field(json, "cost"), 0);
   std::ifstream merged(dir + "/merged.g2o");
   int vertices = 0;
   for (std::string line; std::getline(merged, line);) vertices += line.rfind("VERTEX", 0) == 0;
   EXPECT_EQ(vertices, 150);
+}
+
+// Given the optimal cost (--reference-cost), the summary reports the final cost's relative gap to
+// it; a certified run of a small graph ends at that optimum.
+TEST(DdsLaunch, ReportsTheRelativeGapToAGivenOptimalCost) {
+  const std::string dir = temp_dir();
+  const std::string graph = generate(dir, 120, 2, 1);
+  const double fstar = solve_centralized(read_g2o(graph)).cost;
+  std::ostringstream f;
+  f.precision(17);
+  f << fstar;
+  std::string out;
+  const int rc = run_command(bin("tessera") + " launch " + graph + " --agents 2 --domain 176 " +
+                                 "--partition fast --certify --timeout 60 --reference-cost " +
+                                 f.str() + " --json " + dir + "/s.json 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  const std::string json = slurp(dir + "/s.json");
+  const double cost = json_field(json, "cost"), gap = json_field(json, "rel_gap_to_reference");
+  EXPECT_EQ(json_field(json, "reference_cost"), fstar) << json;
+  EXPECT_NEAR(gap, (cost - fstar) / fstar, 1e-15) << json;
+  EXPECT_LT(std::abs(gap), 1e-6) << json;
+  std::string bad;
+  EXPECT_EQ(run_command(
+                bin("tessera") + " launch " + graph + " --agents 2 --reference-cost -1 2>&1", &bad),
+            2);
+  EXPECT_NE(bad.find("--reference-cost"), std::string::npos) << bad;
 }
 
 // The summary reports each agent's peak resident set, the coordinator's and their sum, and the

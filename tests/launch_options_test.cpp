@@ -128,6 +128,16 @@ TEST(LaunchOptions, CoarseSpaceFlagsReachTheCoordinatorOnly) {
   EXPECT_NE(error_of({"--coarse-every", "x"}).find("--coarse-every"), std::string::npos);
 }
 
+TEST(LaunchOptions, ReferenceCostReachesTheCoordinatorOnlyAndMustBePositive) {
+  LaunchOptions o = parse_launch_options({"--reference-cost", "6055513.25"});
+  o.graph = "/data/graph.g2o";
+  EXPECT_TRUE(has_pair(coordinator_argv(o, paths()), "--reference-cost", "6055513.25"));
+  EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--reference-cost"));
+  for (const char* bad : {"0", "-3", "x", "inf"})
+    EXPECT_NE(error_of({"--reference-cost", bad}).find("--reference-cost"), std::string::npos)
+        << bad;
+}
+
 TEST(LaunchOptions, ProbeAndFinalRefineFlagsReachTheCoordinatorAndNameBadValues) {
   LaunchOptions o = parse_launch_options({"--robust", "gnc-tls", "--gnc-probes", "3",
                                           "--gnc-probe-ratio", "8", "--gnc-final-refine", "none"});

@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <tessera/problem/translation_solve.hpp>
 
+#include "solvers/cholmod_checked.hpp"
+
 namespace tessera {
 
 Eigen::MatrixXd solve_translations(const PoseGraph& graph, const Eigen::MatrixXd& rotations,
@@ -39,7 +41,7 @@ Eigen::MatrixXd solve_translations(const PoseGraph& graph, const Eigen::MatrixXd
   if (n == 1) return t;
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> chol;
   chol.setMode(Eigen::CholmodAuto);  // CHOLMOD chooses simplicial or supernodal
-  chol.compute(L);
+  cholmod_compute_checked(chol, L, "solve_translations");
   if (chol.info() != Eigen::Success)
     throw std::runtime_error(
         "solve_translations: Laplacian factorization failed (disconnected graph?)");

@@ -5,6 +5,8 @@
 #include <tessera/solvers/block_preconditioner.hpp>
 #include <vector>
 
+#include "solvers/cholmod_checked.hpp"
+
 namespace tessera {
 
 struct BlockPreconditioner::Factor {
@@ -85,8 +87,9 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
         c.zrelax[k] = 0.0;
       }
     factor_->llt->analyzePattern(A);
-    if (factor_->llt->info() != Eigen::Success)
-      throw std::runtime_error("BlockPreconditioner: symbolic analysis failed");
+    if (factor_->llt->info() != Eigen::Success || cholmod_analysis_failed(*factor_->llt))
+      throw std::runtime_error("BlockPreconditioner: symbolic analysis failed (" +
+                               cholmod_status_text(factor_->llt->cholmod().status) + ")");
     return static_cast<double>(factor_->llt->cholmod().lnz);
   };
   if (!fallback) {

@@ -6,6 +6,8 @@
 #include <tessera/problem/translation_solve.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
 
+#include "solvers/cholmod_checked.hpp"
+
 namespace tessera {
 
 Eigen::MatrixXd chordal_rotations(const PoseGraph& graph, bool simplicial) {
@@ -46,7 +48,7 @@ Eigen::MatrixXd chordal_rotations(const PoseGraph& graph, bool simplicial) {
   Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> chol;
   // CHOLMOD chooses simplicial or supernodal unless the caller needs it BLAS-free.
   chol.setMode(simplicial ? Eigen::CholmodLDLt : Eigen::CholmodAuto);
-  chol.compute(Hrr);
+  cholmod_compute_checked(chol, Hrr, "chordal initialization");
   if (chol.info() != Eigen::Success)
     throw std::runtime_error("chordal initialization: factorization failed (disconnected graph?)");
   Eigen::MatrixXd Z = chol.solve(rhs);  // rows: d(n-1) coordinates, cols: row index a

@@ -23,7 +23,8 @@ PoseLevelAnalysis analyse_pose_level_pattern(const SparseMatrix& lower, bool wan
   c.method[0].ordering = CHOLMOD_AMD;
   c.postorder = 1;
   symbolic.analyzePattern(lower);
-  if (symbolic.info() != Eigen::Success) return out;
+  // Eigen reports Success even where CHOLMOD left no factor (out of memory, too large).
+  if (symbolic.info() != Eigen::Success || symbolic.factor() == nullptr) return out;
   out.ok = true;
   out.factor_entries = static_cast<double>(c.lnz);
   out.flops = static_cast<double>(c.fl);

@@ -6,6 +6,7 @@
 #include <tessera/solvers/tangent_preconditioner.hpp>
 #include <vector>
 
+#include "solvers/cholmod_checked.hpp"
 #include "solvers/pose_level_analysis.hpp"
 #include "solvers/tangent_coordinates.hpp"
 #include "solvers/tangent_factor.hpp"
@@ -135,7 +136,7 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   } else {
     f.llt.analyzePattern(f.A);
   }
-  if (f.llt.info() != Eigen::Success) return;  // not usable
+  if (f.llt.info() != Eigen::Success || cholmod_analysis_failed(f.llt)) return;  // not usable
   f.entries = static_cast<std::size_t>(f.llt.cholmod().lnz);
   f.flops = f.llt.cholmod().fl;
   // A dense factorization (3D graphs: p = 6 coordinates a pose, (6/4)^3 the flops of the
@@ -148,7 +149,8 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
     cs.method[0].ordering = CHOLMOD_AMD;
     cs.postorder = 1;
     f.llt.analyzePattern(f.A);
-    if (f.llt.info() != Eigen::Success) return;  // not usable
+    // Not usable where the supernodal analysis fails (a factor above CHOLMOD's 2^31 entries).
+    if (cholmod_analysis_failed(f.llt)) return;
     f.entries = static_cast<std::size_t>(f.llt.cholmod().lnz);
     f.supernodal = true;
   }

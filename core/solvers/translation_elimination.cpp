@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <tessera/solvers/translation_elimination.hpp>
 
+#include "solvers/cholmod_checked.hpp"
+
 namespace tessera {
 
 struct TranslationElimination::Factor {
@@ -30,7 +32,7 @@ TranslationElimination::TranslationElimination(int d, std::size_t num_poses,
   Eigen::SparseMatrix<double> L(m, m);
   L.setFromTriplets(trip.begin(), trip.end());
   factor_->llt.setMode(simplicial ? Eigen::CholmodLDLt : Eigen::CholmodAuto);
-  factor_->llt.compute(L);
+  cholmod_compute_checked(factor_->llt, L, "TranslationElimination");
   if (factor_->llt.info() != Eigen::Success)
     throw std::runtime_error(
         "TranslationElimination: Laplacian factorization failed (disconnected graph?)");

@@ -18,7 +18,9 @@ this run's rows; --label names what was measured):
     rounding, final report) and merge (to the summary);
   - the summary's peak memory fields (`peak_rss_mb_per_agent`, `peak_rss_mb_agent_max`,
     `peak_rss_mb_coordinator`, `peak_rss_mb_run`), the sampled peak PSS of the largest agent and the
-    sampled peak of the run's PSS sum (the host's real cost), and the load average.
+    sampled peak of the run's PSS sum (the host's real cost), and the load average;
+  - with --reference-cost F (the graph's f*, from `tessera solve --algorithm centralized`): the
+    summary's `rel_gap_to_reference`, (cost - F) / F.
 Timings taken on a shared machine move with its load (printed beside them); the memory figures
 do not.
 
@@ -30,7 +32,7 @@ their own data would run (the fork server's preloaded whole graph is in every ag
 
 usage: dds_scale.py [--bin build/bin/tessera] [--sizes 20000:2,100000:10] [--domain 65]
                     [--work DIR] [--timeout 3600] [--period 0.5] [--csv FILE] [--robot-files]
-                    [--launch-args="..."] [--min-available-mb MB]
+                    [--launch-args="..."] [--min-available-mb MB] [--reference-cost F]
 
 The set-up's peaks (setup_pss_mb_*) are sampled until the coordinator's first round line;
 --min-available-mb stops a run (SIGTERM to launch) when the host's MemAvailable falls below it.
@@ -179,6 +181,8 @@ def run_one(args, poses, agents, domain):
     cmd = [args.bin, "launch", graph, "--agents", str(agents), "--partition", "fast", "--init",
            "distributed", "--domain", str(domain), "--json", summary, "--timeout",
            str(args.timeout), "--status-interval", "30"] + args.launch_args.split()
+    if args.reference_cost:
+        cmd += ["--reference-cost", repr(args.reference_cost)]
     bc.progress(" ".join(cmd))
     load0 = load()
     t0 = time.monotonic()
@@ -225,6 +229,7 @@ def run_one(args, poses, agents, domain):
         "edges": s.get("edges"), "rounds": s.get("rounds"), "certified": s.get("certified"),
         "min_eigenvalue": s.get("min_eigenvalue"), "cut_edges": s.get("cut_edges"),
         "cost": s.get("cost"), "grad_norm": s.get("grad_norm"),
+        "reference_cost": s.get("reference_cost"), "rel_gap_to_reference": s.get("rel_gap_to_reference"),
         "rounding_s": round(s["rounding_ms"] / 1000.0, 1) if s.get("rounding_ms") else None,
         "rounding_cg_iterations": s.get("rounding_cg_iterations"),
         "peak_rss_mb_agent_max": round(s.get("peak_rss_mb_agent_max", 0), 1),
@@ -252,15 +257,20 @@ def main():
                     help="write only this run's rows; by default they are appended to the CSV's rows")
     ap.add_argument("--min-available-mb", type=int, default=0,
                     help="watchdog: stop a run when the host's MemAvailable falls below this (0 = off)")
+    ap.add_argument("--reference-cost", type=float, default=0,
+                    help="the graph's optimal cost f* (one size only): launch reports the final cost's "
+                         "relative gap to it (rel_gap_to_reference)")
     args = ap.parse_args()
     args.bin = os.path.abspath(args.bin)
+    if args.reference_cost and "," in args.sizes:
+        sys.exit("dds_scale.py: --reference-cost is one graph's f*: give one size")
     os.makedirs(args.work, exist_ok=True)
     rows = []
     for k, spec in enumerate(args.sizes.split(",")):
         poses, agents = (int(x) for x in spec.split(":"))
         rows.append(run_one(args, poses, agents, args.domain + k))
     cols = ["poses", "agents", "input", "rc", "wall_s"] + [p[0] + "_s" for p in PHASES] + [
-        "rounds", "grad_norm", "certified", "min_eigenvalue", "peak_rss_mb_agent_max", "peak_pss_mb_agent_max", "peak_rss_mb_coordinator",
+        "rounds", "grad_norm", "rel_gap_to_reference", "certified", "min_eigenvalue", "peak_rss_mb_agent_max", "peak_pss_mb_agent_max", "peak_rss_mb_coordinator",
         "peak_pss_mb_fork_server", "peak_rss_mb_run", "peak_pss_mb_run_sum", "setup_pss_mb_agent_max",
         "setup_pss_mb_run_sum", "load_start", "load_end"]
     bc.print_table("tessera launch on generated 3D grids (fast partition, distributed init, certified)",
