@@ -175,7 +175,7 @@ const char* kDistributedHelp =
     "                            steps on the whole problem, CG over neighbour exchanges and\n"
     "                            all-agent sums (docs/newton-refine.md) (default auto); auto:\n"
     "                            where the team's interface fits the refinement's exact\n"
-    "                            interface solves (<= 500 tangent coordinates) the rounds\n"
+    "                            interface solves (<= 1000 tangent coordinates) the rounds\n"
     "                            stop at gradient 1 and the refinement always runs; elsewhere\n"
     "                            only where the rounds' last cost decreases say they stopped\n"
     "                            more than 1e-7 of f above their limit\n"
@@ -193,7 +193,7 @@ const char* kDistributedHelp =
     "  --refine-interface C      its CG's preconditioner solves with the Hessian exactly\n"
     "                            through the blocks' interfaces where the team's interface has\n"
     "                            at most C tangent coordinates; 0 = block Jacobi always\n"
-    "                            (default 500; with --refine auto it also sets where the\n"
+    "                            (default 1000; with --refine auto it also sets where the\n"
     "                            rounds hand over at gradient 1)\n";
 
 namespace {

@@ -1,12 +1,14 @@
 #include "launch/process_tuning.hpp"
 
 #include "launch/heap_retention.hpp"
+#include "launch/serial_openmp.hpp"
 #include "launch/startup_batch.hpp"
 
 namespace tessera::launch {
 
 void begin_agent_process() {
   retain_freed_heap();
+  serial_openmp();
 }
 
 std::string end_agent_startup() {

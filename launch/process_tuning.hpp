@@ -8,7 +8,8 @@
 namespace tessera::launch {
 
 /// First thing in an agent process: keeps freed heap memory for the next round
-/// (heap_retention.hpp). Process-wide.
+/// (heap_retention.hpp) and runs OpenMP parallel regions (CHOLMOD's) on one thread
+/// (serial_openmp.hpp). Process-wide.
 void begin_agent_process();
 
 /// When the agent has its assignment (the coordinator's partition is done): its threads leave the

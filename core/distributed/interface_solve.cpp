@@ -1,12 +1,12 @@
 #include "distributed/interface_solve.hpp"
 
 #include <Eigen/OrderingMethods>
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <stdexcept>
 #include <unordered_map>
 
 #include "distributed/interface_poses.hpp"
+#include "solvers/supernodal_factor.hpp"
 #include "solvers/tangent_coordinates.hpp"
 
 namespace tessera {
@@ -40,12 +40,12 @@ struct InterfaceSolve::Impl {
   std::vector<Eigen::Index> block_offset, block_size;  // per block, in coordinates
   Eigen::Index team = 0, own_offset = 0;
   int id = 0;
-  // The block's factor A_bb = L D L^T in the order above, and L's trailing interface block.
-  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt;
+  // The block's factor A_bb = L L^T in the order above, and L's trailing interface block (both
+  // patterns are the same at every point: one analysis each).
+  SupernodalFactor block{SupernodalFactor::Ordering::kGiven};
   Eigen::MatrixXd Lgg;
-  Eigen::VectorXd Dinv_interior;
   // Sigma + eta I.
-  Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower> sigma;
+  SupernodalFactor sigma;
   bool sigma_ok = false;
   double shift = 0.0;
   mutable Eigen::VectorXd b;  // scratch: J^T v in the block's own order
@@ -231,22 +231,16 @@ std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const 
   }
   SparseMatrix A(n, n);
   A.setFromTriplets(t.begin(), t.end());
-  s.ldlt.compute(A);
-  const bool ok = s.ldlt.info() == Eigen::Success && (s.ldlt.vectorD().array() > 0).all();
+  const bool ok = n > 0 && s.block.factor(A);
   // Far from a minimiser the block's Hessian may be indefinite: then its block without the
   // multiplier term (positive definite, as block Jacobi's), and Sigma is the Schur complement
   // of that modified H, still a symmetric positive definite preconditioner.
   if (!ok && multipliers) return factor_impl(X, Xn, egrad, false);
   if (!ok) return {0.0};
   const Eigen::Index nI = s.mI * p, nG = s.mG * p;
-  s.Dinv_interior = s.ldlt.vectorD().head(nI).cwiseInverse();
-  // L's interface block (unit diagonal; the strictly lower entries are stored).
-  s.Lgg = Eigen::MatrixXd::Identity(nG, nG);
-  const auto& L = s.ldlt.matrixL().nestedExpression();
-  for (Eigen::Index c = nI; c < n; ++c)
-    for (std::remove_reference_t<decltype(L)>::InnerIterator it(L, c); it; ++it)
-      if (it.row() > c) s.Lgg(it.row() - nI, c - nI) = it.value();
-  const Eigen::MatrixXd schur = s.Lgg * s.ldlt.vectorD().tail(nG).asDiagonal() * s.Lgg.transpose();
+  // L's interface block; the interface's Schur complement is L_GG L_GG^T.
+  s.Lgg = s.block.trailing_block(nI);
+  const Eigen::MatrixXd schur = s.Lgg.triangularView<Eigen::Lower>() * s.Lgg.transpose();
 
   std::vector<double> out;
   out.reserve(static_cast<std::size_t>(2 + nG * (nG + 1) / 2) +
@@ -304,8 +298,8 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
       if (ri == s.team_index.end() || ci == s.team_index.end()) fail();
       for (int c = 0; c < p; ++c)
         for (int a = 0; a < p; ++a) {
+          // Zeros too: Sigma's pattern, and so its factor's analysis, stays that of the cut.
           const double x = v[k + 2 + static_cast<std::size_t>(c * p + a)];
-          if (x == 0.0) continue;
           const Eigen::Index r = ri->second + a, cc = ci->second + c;
           t.emplace_back(std::max(r, cc), std::min(r, cc), x);
         }
@@ -314,12 +308,9 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
   if (s.team == 0) return false;
   SparseMatrix sigma(s.team, s.team);
   sigma.setFromTriplets(t.begin(), t.end());
-  SparseMatrix I(s.team, s.team);
-  I.setIdentity();
   for (double rel : relative_shifts) {
     const double eta = rel * std::max(top, 1e-300);
-    s.sigma.compute(sigma + eta * I);
-    if (s.sigma.info() == Eigen::Success) {
+    if (s.sigma.factor(sigma, eta)) {
       s.sigma_ok = true;
       s.shift = rel;
       return true;
@@ -340,7 +331,7 @@ void InterfaceSolve::forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
   y.resize(s.m * p);
   for (Eigen::Index i = 0; i < s.m; ++i)
     y.segment(s.slot[static_cast<std::size_t>(i)] * p, p) = s.b.segment(i * p, p);
-  s.ldlt.matrixL().solveInPlace(y);
+  s.block.solve_l(y);
 }
 
 void InterfaceSolve::add_interface(const Eigen::VectorXd& y, double* team) const {
@@ -356,11 +347,12 @@ Eigen::MatrixXd InterfaceSolve::back(const Eigen::MatrixXd& X, const Eigen::Vect
   if (!s.sigma_ok) throw std::logic_error("InterfaceSolve::back: no factor of Sigma");
   const int p = s.p;
   const Eigen::Index nI = s.mI * p, nG = s.mG * p;
-  const Eigen::VectorXd u = s.sigma.solve(rhat);
+  Eigen::VectorXd u;
+  s.sigma.solve(rhat, u);
   Eigen::VectorXd v(y.size());
-  v.head(nI) = s.Dinv_interior.cwiseProduct(y.head(nI));
+  v.head(nI) = y.head(nI);
   if (nG > 0) v.tail(nG) = s.Lgg.transpose() * u.segment(s.own_offset, nG);
-  s.ldlt.matrixU().solveInPlace(v);
+  s.block.solve_lt(v);
   for (Eigen::Index i = 0; i < s.m; ++i)
     s.b.segment(i * p, p) = v.segment(s.slot[static_cast<std::size_t>(i)] * p, p);
   Eigen::MatrixXd Z(s.d, X.cols());

@@ -169,14 +169,16 @@ struct NewtonRefineOptions {
   /// one sum (the interface residual rides in the sum). Used at rank d with `coarse` kNone. A
   /// block whose Hessian block is not positive definite (far from a minimiser) factors it
   /// without the multiplier term (then M is the inverse of that modified H); where no block
-  /// factor or no Sigma is positive definite, that point's CG runs block Jacobi. Why 500:
-  /// every agent factors Sigma at every point (cost ~ size^3 / 3, dense within each block's
-  /// interface); cubicle's 1,572 coordinates at N = 5 cut its CG iterations 116 -> 3 but
-  /// doubled the CPU of the whole solve (2.5 -> 4.8 s) and the bytes (4.9 -> 40.6 MB), and
-  /// city10000's 909 cut 84 -> 2 CG iterations but made launch slower on 2 cores (five agents
-  /// factoring the same Sigma), while parking-garage (348) and ais2klinik (102) gain 4-9x
-  /// (docs/newton-refine.md). >= 0.
-  int interface_max_coordinates = 500;
+  /// factor or no Sigma is positive definite, that point's CG runs block Jacobi. Why 1,000:
+  /// every agent factors Sigma at every point (CHOLMOD supernodal; dense within each block's
+  /// interface, so its cost grows up to size^3 / 3) and receives every Schur complement.
+  /// city10000's 909 coordinates at N = 5 (cap 1,000 against 500, in process): rounds 142 ->
+  /// 48, the refinement's CG 2 iterations, 5.38 against 6.94 billion instructions for the whole
+  /// solve (callgrind), same certified optimum; cubicle's 1,572 cut its CG iterations 116 -> 3
+  /// but doubled the CPU of the whole solve and multiplied the bytes by 8 (4.9 -> 40.6 MB), so
+  /// it stays out, as do torus3D (2,916) and sphere2500 (2,088); parking-garage (348) and
+  /// ais2klinik (102) gain 4-9x (docs/newton-refine.md). >= 0.
+  int interface_max_coordinates = 1000;
   /// kIfRoundsSlow: where the interface solves apply (the team's interface within
   /// interface_max_coordinates), the rounds stop at max(the solver's grad_norm_tol,
   /// this) and the refinement always runs. Why: with exact interface solves a Newton step costs

@@ -1,0 +1,150 @@
+#include "solvers/supernodal_factor.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <algorithm>
+#include <stdexcept>
+#include <vector>
+
+namespace tessera {
+
+struct SupernodalFactor::Impl {
+  explicit Impl(Ordering o) : ordering(o) {
+    cholmod_start(&c);
+    c.print = 0;  // not positive definite is an answer here, not an error to print
+    c.supernodal = CHOLMOD_SUPERNODAL;
+    c.final_ll = 1;
+    c.nmethods = 1;
+    c.method[0].ordering = o == Ordering::kAmd ? CHOLMOD_AMD : CHOLMOD_NATURAL;
+    c.postorder = o == Ordering::kAmd ? 1 : 0;
+  }
+  ~Impl() {
+    for (cholmod_dense** x : {&x_, &y_, &e_})
+      if (*x) cholmod_free_dense(x, &c);
+    if (L) cholmod_free_factor(&L, &c);
+    cholmod_finish(&c);
+  }
+  Ordering ordering;
+  mutable cholmod_common c;  // the solves' workspace and status live here
+  cholmod_factor* L = nullptr;
+  // The analysed pattern.
+  Eigen::Index n = -1;
+  std::vector<int> outer, inner;
+  bool ok = false;
+  int analyses = 0;
+  std::size_t entries = 0;
+  double flops = 0.0;
+  mutable cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;
+};
+
+SupernodalFactor::SupernodalFactor(Ordering ordering) : impl_(std::make_unique<Impl>(ordering)) {}
+SupernodalFactor::~SupernodalFactor() = default;
+
+bool SupernodalFactor::factor(const SparseMatrix& lower, double shift) {
+  Impl& s = *impl_;
+  s.ok = false;
+  if (lower.rows() != lower.cols() || !lower.isCompressed())
+    throw std::invalid_argument("SupernodalFactor: not a square compressed matrix");
+  const Eigen::Index n = lower.rows();
+  const int* outer = lower.outerIndexPtr();
+  const int* inner = lower.innerIndexPtr();
+  const auto nnz = static_cast<std::size_t>(lower.nonZeros());
+  cholmod_sparse a = Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
+  const bool same = s.L && n == s.n && std::equal(outer, outer + n + 1, s.outer.begin()) &&
+                    s.inner.size() == nnz && std::equal(inner, inner + nnz, s.inner.begin());
+  if (!same) {
+    if (s.L) cholmod_free_factor(&s.L, &s.c);
+    s.L = cholmod_analyze(&a, &s.c);
+    if (!s.L) throw std::runtime_error("SupernodalFactor: CHOLMOD analysis failed");
+    ++s.analyses;
+    s.n = n;
+    s.outer.assign(outer, outer + n + 1);
+    s.inner.assign(inner, inner + nnz);
+    s.entries = static_cast<std::size_t>(s.c.lnz);
+    s.flops = s.c.fl;
+  }
+  double beta[2] = {shift, 0.0};
+  cholmod_factorize_p(&a, beta, nullptr, 0, s.L, &s.c);
+  if (s.c.status < CHOLMOD_OK)
+    throw std::runtime_error("SupernodalFactor: CHOLMOD factorization failed");
+  s.ok = s.c.status == CHOLMOD_OK && s.L->minor == s.L->n;
+  return s.ok;
+}
+
+bool SupernodalFactor::ok() const {
+  return impl_->ok;
+}
+
+void SupernodalFactor::solve_system(int system, Eigen::VectorXd& v) const {
+  const Impl& s = *impl_;
+  if (!s.ok) throw std::logic_error("SupernodalFactor: no positive definite factor");
+  if (v.size() != s.n) throw std::invalid_argument("SupernodalFactor: wrong vector size");
+  if (system != CHOLMOD_A && s.ordering != Ordering::kGiven)
+    throw std::logic_error("SupernodalFactor: L solves need the given ordering");
+  cholmod_dense rhs;
+  rhs.nrow = static_cast<std::size_t>(v.size());
+  rhs.ncol = 1;
+  rhs.nzmax = rhs.nrow;
+  rhs.d = rhs.nrow;
+  rhs.x = v.data();
+  rhs.z = nullptr;
+  rhs.xtype = CHOLMOD_REAL;
+  rhs.dtype = CHOLMOD_DOUBLE;
+  if (!cholmod_solve2(system, s.L, &rhs, nullptr, &s.x_, nullptr, &s.y_, &s.e_, &s.c))
+    throw std::runtime_error("SupernodalFactor: CHOLMOD solve failed");
+  v = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(s.x_->x), v.size());
+}
+
+void SupernodalFactor::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+  x = b;
+  solve_system(CHOLMOD_A, x);
+}
+
+void SupernodalFactor::solve_l(Eigen::VectorXd& v) const {
+  solve_system(CHOLMOD_L, v);
+}
+
+void SupernodalFactor::solve_lt(Eigen::VectorXd& v) const {
+  solve_system(CHOLMOD_Lt, v);
+}
+
+Eigen::MatrixXd SupernodalFactor::trailing_block(Eigen::Index first) const {
+  const Impl& s = *impl_;
+  if (!s.ok) throw std::logic_error("SupernodalFactor: no positive definite factor");
+  if (s.ordering != Ordering::kGiven)
+    throw std::logic_error("SupernodalFactor: the trailing block needs the given ordering");
+  const cholmod_factor* L = s.L;
+  const auto n = static_cast<Eigen::Index>(L->n);
+  if (first < 0 || first > n) throw std::invalid_argument("SupernodalFactor: bad first column");
+  const int* perm = static_cast<const int*>(L->Perm);
+  for (Eigen::Index k = first; k < n; ++k)
+    if (perm && perm[k] != k) throw std::logic_error("SupernodalFactor: the factor was reordered");
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n - first, n - first);
+  if (!L->is_super) throw std::logic_error("SupernodalFactor: not a supernodal factor");
+  const int* super = static_cast<const int*>(L->super);
+  const int* pi = static_cast<const int*>(L->pi);
+  const int* px = static_cast<const int*>(L->px);
+  const int* rows = static_cast<const int*>(L->s);
+  const double* x = static_cast<const double*>(L->x);
+  for (std::size_t k = 0; k < L->nsuper; ++k) {
+    const int c0 = super[k], c1 = super[k + 1], nr = pi[k + 1] - pi[k];
+    if (c1 <= first) continue;
+    for (int j = std::max<int>(c0, static_cast<int>(first)); j < c1; ++j)
+      for (int r = j - c0; r < nr; ++r) {
+        const int i = rows[pi[k] + r];
+        out(i - first, j - first) = x[px[k] + static_cast<std::ptrdiff_t>(j - c0) * nr + r];
+      }
+  }
+  return out;
+}
+
+int SupernodalFactor::analyses() const {
+  return impl_->analyses;
+}
+std::size_t SupernodalFactor::factor_entries() const {
+  return impl_->entries;
+}
+double SupernodalFactor::factor_flops() const {
+  return impl_->flops;
+}
+
+}  // namespace tessera
