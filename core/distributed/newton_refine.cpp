@@ -10,6 +10,7 @@
 #include "distributed/interface_solve.hpp"
 #include "distributed/nonzero_rows.hpp"
 #include "distributed/pipelined_cg.hpp"
+#include "distributed/public_pose_messages.hpp"
 #include "distributed/rigid_retraction.hpp"
 #include "distributed/tangent_coarse_space.hpp"
 #include "distributed/translation_preconditioner.hpp"
@@ -47,13 +48,7 @@ NewtonRefineProtocol::~NewtonRefineProtocol() = default;
 void NewtonRefineProtocol::send_public(const Eigen::MatrixXd& v, std::uint32_t step,
                                        std::vector<OutgoingMessage>& out) {
   const auto& adj = layout_.adjacent[static_cast<std::size_t>(state_.id())];
-  for (int a : adj) {
-    OutgoingMessage o;
-    o.message = state_.publish(v, BlockKind::kY, a, message_round_, step);
-    o.broadcast = false;
-    o.recipients = {static_cast<std::uint32_t>(a)};
-    out.push_back(std::move(o));
-  }
+  send_public_poses(state_, v, BlockKind::kY, adj, message_round_, step, out);
   gate_.expect(message_round_, step, adj);
   ++result_.exchanges;
 }
