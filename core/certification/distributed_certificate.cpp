@@ -10,6 +10,7 @@
 
 #include "certification/interface_schur.hpp"
 #include "distributed/interface_poses.hpp"
+#include "distributed/public_pose_messages.hpp"
 #include "util/frobenius_inner.hpp"
 
 namespace tessera {
@@ -366,13 +367,8 @@ void CertificateProtocol::pump(std::vector<OutgoingMessage>& out) {
 
 void CertificateProtocol::send_boundary(const Eigen::MatrixXd& v, std::uint32_t round,
                                         std::vector<OutgoingMessage>& out) {
-  for (int a : layout_.adjacent[static_cast<std::size_t>(state_.id())]) {
-    OutgoingMessage o;
-    o.message = state_.publish(v, BlockKind::kY, a, round, kVector);
-    o.broadcast = false;
-    o.recipients = {static_cast<std::uint32_t>(a)};
-    out.push_back(std::move(o));
-  }
+  send_public_poses(state_, v, BlockKind::kY,
+                    layout_.adjacent[static_cast<std::size_t>(state_.id())], round, kVector, out);
 }
 
 void CertificateProtocol::broadcast(std::uint32_t round, std::uint32_t step,

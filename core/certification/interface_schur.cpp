@@ -1,12 +1,13 @@
 #include "certification/interface_schur.hpp"
 
 #include <Eigen/CholmodSupport>
-#include <Eigen/OrderingMethods>
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
 #include <unordered_map>
+
+#include "solvers/elimination_order.hpp"
 
 // BLAS (the one CHOLMOD's supernodal factorization runs on): C = A A^T, lower triangle.
 extern "C" void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k,
@@ -181,14 +182,10 @@ InterfaceSchurBlock local_separator_schur(const BlockProblem& problem, const Spa
         if (ic >= 0) t.emplace_back(ic, jc, 1.0);
       }
     }
-    SparseMatrix pattern(nI, nI);
-    pattern.setFromTriplets(t.begin(), t.end());
-    Eigen::AMDOrdering<int> amd;
-    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
-    amd(pattern, perm);
-    // perm.indices()(k): the interior index eliminated k-th.
+    const std::vector<Eigen::Index> order = amd_elimination_order(nI, t);  // interior indices
     for (Eigen::Index k = 0; k < nI; ++k)
-      pos[static_cast<std::size_t>(interior[static_cast<std::size_t>(perm.indices()(k))])] = k;
+      pos[static_cast<std::size_t>(
+          interior[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])])] = k;
   }
 
   // The foreign poses' diagonal is a placeholder kappa I (their own block holds their entries):

@@ -6,9 +6,11 @@
 #include <tessera/problem/pose_kernels.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "distributed/coarse_hessian_columns.hpp"
 #include "distributed/interface_solve.hpp"
 #include "distributed/nonzero_rows.hpp"
 #include "distributed/pipelined_cg.hpp"
+#include "distributed/public_pose_messages.hpp"
 #include "distributed/rigid_retraction.hpp"
 #include "distributed/tangent_coarse_space.hpp"
 #include "distributed/translation_preconditioner.hpp"
@@ -46,13 +48,7 @@ NewtonRefineProtocol::~NewtonRefineProtocol() = default;
 void NewtonRefineProtocol::send_public(const Eigen::MatrixXd& v, std::uint32_t step,
                                        std::vector<OutgoingMessage>& out) {
   const auto& adj = layout_.adjacent[static_cast<std::size_t>(state_.id())];
-  for (int a : adj) {
-    OutgoingMessage o;
-    o.message = state_.publish(v, BlockKind::kY, a, message_round_, step);
-    o.broadcast = false;
-    o.recipients = {static_cast<std::uint32_t>(a)};
-    out.push_back(std::move(o));
-  }
+  send_public_poses(state_, v, BlockKind::kY, adj, message_round_, step, out);
   gate_.expect(message_round_, step, adj);
   ++result_.exchanges;
 }
@@ -313,24 +309,16 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   Eigen::MatrixXd v, vn;
   const std::vector<int>& touched = coarse_->touched();
   // Balancing also keeps the own rows of H Phi (one column per touched unknown).
-  if (options_.coarse_balancing) coarse_hphi_.assign(touched.size(), {});
+  if (options_.coarse_balancing) {
+    if (!coarse_hphi_) coarse_hphi_ = std::make_unique<CoarseHessianColumns>(problem_.dim());
+    coarse_hphi_->reset(touched.size());
+  }
   for (std::size_t c = 0; c < touched.size(); ++c) {
     const int u = touched[c];
     coarse_->unit(X_, Xn_, u, v, vn);
     const Eigen::MatrixXd hv = hessian(v, vn);
     coarse_->project(X_, hv, L.col(u).data());
-    if (options_.coarse_balancing) {
-      // Only the poses it is non-zero on (its piece's support and one hop around it): the
-      // products with H Phi cost about one Hessian product an iteration, not one per column.
-      HphiColumn& col = coarse_hphi_[c];
-      const Eigen::Index w = hv.rows() * (problem_.dim() + 1);
-      for (Eigen::Index s = 0; s * w < hv.size(); ++s) {
-        const Eigen::Map<const Eigen::VectorXd> b(hv.data() + s * w, w);
-        if (b.squaredNorm() == 0.0) continue;
-        col.slots.push_back(s);
-        col.values.insert(col.values.end(), b.data(), b.data() + w);
-      }
-    }
+    if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
   }
   std::vector<double> values;
   values.reserve(static_cast<std::size_t>(n * (n + 1) / 2 + n));
@@ -357,33 +345,6 @@ void NewtonRefineProtocol::after_coarse(const MessageGate::Inbox& inbox,
   coarse_due_ = false;
   ++result_.coarse_assemblies;
   start_cg(out);
-}
-
-Eigen::VectorXd NewtonRefineProtocol::hphi_dot(const Eigen::MatrixXd& y) const {
-  Eigen::VectorXd out(static_cast<Eigen::Index>(coarse_hphi_.size()));
-  const Eigen::Index w = y.rows() * (problem_.dim() + 1);
-  for (std::size_t c = 0; c < coarse_hphi_.size(); ++c) {
-    const HphiColumn& col = coarse_hphi_[c];
-    double acc = 0.0;
-    for (std::size_t q = 0; q < col.slots.size(); ++q)
-      acc +=
-          Eigen::Map<const Eigen::VectorXd>(col.values.data() + static_cast<Eigen::Index>(q) * w, w)
-              .dot(Eigen::Map<const Eigen::VectorXd>(y.data() + col.slots[q] * w, w));
-    out(static_cast<Eigen::Index>(c)) = acc;
-  }
-  return out;
-}
-
-void NewtonRefineProtocol::subtract_hphi(const Eigen::VectorXd& x, Eigen::MatrixXd& v) const {
-  const Eigen::Index w = v.rows() * (problem_.dim() + 1);
-  for (std::size_t c = 0; c < coarse_hphi_.size(); ++c) {
-    const HphiColumn& col = coarse_hphi_[c];
-    const double a = x(static_cast<Eigen::Index>(c));
-    for (std::size_t q = 0; q < col.slots.size(); ++q)
-      Eigen::Map<Eigen::VectorXd>(v.data() + col.slots[q] * w, w) -=
-          a * Eigen::Map<const Eigen::VectorXd>(
-                  col.values.data() + static_cast<Eigen::Index>(q) * w, w);
-  }
 }
 
 Eigen::VectorXd NewtonRefineProtocol::touched_of(const Eigen::VectorXd& x) const {
@@ -428,9 +389,9 @@ void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
     // (after_sums: in the coarse space, H of it is the kept H Phi columns: no exchange).
     const Eigen::VectorXd xi = coarse_inverse_ * coarse_r_;
     Eigen::MatrixXd t = r_;
-    subtract_hphi(touched_of(xi), t);
+    coarse_hphi_->subtract(touched_of(xi), t);
     z_ = state_.precondition(X_, t);
-    coarse_hy_ = hphi_dot(z_);
+    coarse_hy_ = coarse_hphi_->dot(z_);
     coarse_->expand(X_, xi, z_);
   }
   send_public(z_, kDirection, out);
@@ -493,7 +454,7 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     gamma -= coarse_r_.dot(eta);
     delta += -2.0 * eta.dot(coarse_w) + eta.dot(coarse_matrix_ * eta);
     coarse_->expand(X_, -eta, z_);
-    subtract_hphi(touched_of(eta), w_);
+    coarse_hphi_->subtract(touched_of(eta), w_);
     coarse_w -= coarse_matrix_ * eta;
   }
   const bool started = cg_->iterations() > 0;

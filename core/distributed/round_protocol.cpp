@@ -5,6 +5,8 @@
 #include <tessera/distributed/protocol_snapshot.hpp>
 #include <tessera/distributed/round_protocol.hpp>
 
+#include "distributed/public_pose_messages.hpp"
+
 namespace tessera {
 namespace {
 
@@ -185,13 +187,8 @@ void RoundProtocol::pump(std::vector<OutgoingMessage>& out) {
 void RoundProtocol::send_poses(const Eigen::MatrixXd& X, BlockKind kind, ProtocolPhase phase,
                                const std::vector<int>& recipients,
                                std::vector<OutgoingMessage>& out) {
-  for (int a : recipients) {
-    OutgoingMessage m;
-    m.message = state_.publish(X, kind, a, u32(round_), static_cast<std::uint32_t>(phase));
-    m.broadcast = false;
-    m.recipients = {u32(a)};
-    out.push_back(std::move(m));
-  }
+  send_public_poses(state_, X, kind, recipients, u32(round_), static_cast<std::uint32_t>(phase),
+                    out);
 }
 
 void RoundProtocol::complete(Inbox& inbox, std::vector<OutgoingMessage>& out) {

@@ -4,6 +4,8 @@
 #include <tessera/problem/lifting.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "distributed/public_pose_messages.hpp"
+
 namespace tessera {
 
 void SaddleEscapeOptions::validate() const {
@@ -39,13 +41,7 @@ std::vector<OutgoingMessage> SaddleEscapeProtocol::start() {
 void SaddleEscapeProtocol::trial(std::vector<OutgoingMessage>& out) {
   Xp_ = problem_.manifold(static_cast<int>(Ya_.rows())).retract(Ya_, alpha_ * dir_);
   const auto& adj = layout_.adjacent[static_cast<std::size_t>(state_.id())];
-  for (int a : adj) {
-    OutgoingMessage o;
-    o.message = state_.publish(Xp_, BlockKind::kY, a, trial_, kPoses);
-    o.broadcast = false;
-    o.recipients = {static_cast<std::uint32_t>(a)};
-    out.push_back(std::move(o));
-  }
+  send_public_poses(state_, Xp_, BlockKind::kY, adj, trial_, kPoses, out);
   gate_.expect(trial_, kPoses, adj);
 }
 

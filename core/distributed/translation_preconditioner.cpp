@@ -31,14 +31,16 @@ TranslationPreconditioner::TranslationPreconditioner(const BlockProblem& problem
   }
 }
 
-void TranslationPreconditioner::apply(const Eigen::MatrixXd& r, Eigen::MatrixXd& z) const {
+void TranslationPreconditioner::apply(const Eigen::MatrixXd& r, Eigen::MatrixXd& z) {
   const int w = dim_ + 1;
   const Eigen::Index m = poses_;
-  Eigen::MatrixXd rt(m, r.rows());
-  for (Eigen::Index i = 0; i < m; ++i) rt.row(i) = r.col(i * w + w - 1).transpose();
-  const Eigen::MatrixXd zt = ldlt_.solve(rt);
+  // resize and the solve's assignment keep the storage of a buffer that has the size already
+  // (every iteration of a trial's solve).
+  rt_.resize(m, r.rows());
+  for (Eigen::Index i = 0; i < m; ++i) rt_.row(i) = r.col(i * w + w - 1).transpose();
+  zt_ = ldlt_.solve(rt_);
   z.setZero(r.rows(), r.cols());
-  for (Eigen::Index i = 0; i < m; ++i) z.col(i * w + w - 1) = 0.5 * zt.row(i).transpose();
+  for (Eigen::Index i = 0; i < m; ++i) z.col(i * w + w - 1) = 0.5 * zt_.row(i).transpose();
 }
 
 void TranslationPreconditioner::keep_translations(int dim, Eigen::MatrixXd& v) {

@@ -19,7 +19,7 @@ class TranslationPreconditioner {
   explicit TranslationPreconditioner(const BlockProblem& problem);
 
   /// z = (2 L_BB)^-1 r on the translation columns, zero elsewhere (z takes r's shape).
-  void apply(const Eigen::MatrixXd& r, Eigen::MatrixXd& z) const;
+  void apply(const Eigen::MatrixXd& r, Eigen::MatrixXd& z);
 
   /// Zero in every column of v but the poses' translations (the last of each d+1).
   static void keep_translations(int dim, Eigen::MatrixXd& v);
@@ -28,6 +28,7 @@ class TranslationPreconditioner {
   int dim_ = 0;
   Eigen::Index poses_ = 0;  // the block's own poses
   Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
+  Eigen::MatrixXd rt_, zt_;  // apply's translation columns of r and z, kept for their storage
 };
 
 }  // namespace tessera

@@ -51,6 +51,7 @@ namespace tessera {
 class TangentCoarseSpace;
 class InterfaceSolve;
 class PipelinedCg;
+class CoarseHessianColumns;
 class TranslationPreconditioner;
 
 struct NewtonRefineOptions {
@@ -309,9 +310,6 @@ class NewtonRefineProtocol : public AgentProcess {
   void start_cg(std::vector<OutgoingMessage>& out);
   // x's entries at the coarse unknowns this agent touches (coarse_hphi_'s columns).
   Eigen::VectorXd touched_of(const Eigen::VectorXd& x) const;
-  // (H Phi)^T y over the own rows, one entry per touched unknown; v -= (H Phi) x.
-  Eigen::VectorXd hphi_dot(const Eigen::MatrixXd& y) const;
-  void subtract_hphi(const Eigen::VectorXd& x, Eigen::MatrixXd& v) const;
   // The block preconditioner for the next CG solve (options_.refactor_every_step).
   void prepare_preconditioner();
   void send_direction(std::vector<OutgoingMessage>& out);
@@ -358,11 +356,7 @@ class NewtonRefineProtocol : public AgentProcess {
   std::unique_ptr<TangentCoarseSpace> coarse_;
   Eigen::MatrixXd coarse_inverse_, coarse_matrix_;
   // Balancing: the own rows of H Phi, one column per touched unknown, on its non-zero poses.
-  struct HphiColumn {
-    std::vector<Eigen::Index> slots;  // pose slots
-    std::vector<double> values;       // r x (d+1) per slot, column-major
-  };
-  std::vector<HphiColumn> coarse_hphi_;
+  std::unique_ptr<CoarseHessianColumns> coarse_hphi_;
   Eigen::VectorXd coarse_hy_;  // balancing: this agent's share of (H Phi)^T y
   Eigen::VectorXd coarse_g_, coarse_r_, coarse_q_;
   bool coarse_due_ = true;  // the point changed since the coarse matrix was summed
