@@ -430,13 +430,13 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   for (const NewtonRefineResult& n : r.refines)
     std::printf(
         "  newton refine: %d steps (%d accepted), %d CG iterations, %d translation CG "
-        "iterations, %d exchanges, %d all-agent sums, %d coarse unknowns, interface %d "
-        "coordinates (%d factorizations, %d fallbacks), |grad f| %.3g -> %.3g, f %.10g -> %.10g, "
-        "stop: %s\n",
-        n.steps, n.accepted_steps, n.cg_iterations, n.translation_iterations, n.exchanges,
-        n.reductions, n.coarse_unknowns, n.interface_coordinates, n.interface_factorizations,
-        n.interface_fallbacks, n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost,
-        n.stop_reason.c_str());
+        "iterations, %d exact translation solves (%d interface poses), %d exchanges, %d "
+        "all-agent sums, %d coarse unknowns, interface %d coordinates (%d factorizations, %d "
+        "fallbacks), |grad f| %.3g -> %.3g, f %.10g -> %.10g, stop: %s\n",
+        n.steps, n.accepted_steps, n.cg_iterations, n.translation_iterations, n.translation_solves,
+        n.translation_interface_poses, n.exchanges, n.reductions, n.coarse_unknowns,
+        n.interface_coordinates, n.interface_factorizations, n.interface_fallbacks,
+        n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost, n.stop_reason.c_str());
   for (const NewtonRefineResult& n : r.refines)
     for (std::size_t k = 0; k < n.trace.size(); ++k) {
       const NewtonRefineStep& t = n.trace[k];
@@ -515,10 +515,13 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     // --refine newton, or the robust final solve's refinement (--gnc-final-refine).
     if (opt.refine.enabled || !r.refines.empty()) {
       int steps = 0, cg = 0, translation_cg = 0, exchanges = 0, reductions = 0;
-      int interface = 0, interface_factorizations = 0;
+      int interface = 0, interface_factorizations = 0, translation_solves = 0;
+      int translation_interface = 0;
       for (const NewtonRefineResult& n : r.refines) {
         interface = std::max(interface, n.interface_coordinates);
         interface_factorizations += n.interface_factorizations;
+        translation_solves += n.translation_solves;
+        translation_interface = std::max(translation_interface, n.translation_interface_poses);
         steps += n.steps;
         cg += n.cg_iterations;
         translation_cg += n.translation_iterations;
@@ -528,6 +531,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       j.add("refine_steps", steps)
           .add("refine_cg_iterations", cg)
           .add("refine_translation_iterations", translation_cg)
+          .add("refine_translation_solves", translation_solves)
+          .add("refine_translation_interface_poses", translation_interface)
           .add("refine_exchanges", exchanges)
           .add("refine_reductions", reductions)
           .add("refine_interface_coordinates", interface)
