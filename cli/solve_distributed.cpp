@@ -73,6 +73,7 @@ const char* const kDistributedValued[] = {"agents",
                                           "refine-coarse-form",
                                           "refine-coarse-aggregates",
                                           "refine-interface",
+                                          "refine-translation-interface",
                                           nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
@@ -194,7 +195,11 @@ const char* kDistributedHelp =
     "                            through the blocks' interfaces where the team's interface has\n"
     "                            at most C tangent coordinates; 0 = block Jacobi always\n"
     "                            (default 500; with --refine auto it also sets where the\n"
-    "                            rounds hand over at gradient 1)\n";
+    "                            rounds hand over at gradient 1)\n"
+    "  --refine-translation-interface P   a trial point's translations are solved exactly\n"
+    "                            through the blocks' interfaces (one all-agent sum) where the\n"
+    "                            team's interface has at most P poses; 0 = block-Jacobi CG\n"
+    "                            always (default 2000)\n";
 
 namespace {
 
@@ -341,6 +346,11 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     if (interface < 0 || interface > 1000000)
       throw InputError("option --refine-interface: must be in 0..1000000");
     opt.refine.interface_max_coordinates = static_cast<int>(interface);
+    const long translation =
+        a.get_long("refine-translation-interface", opt.refine.translation_interface_max_poses);
+    if (translation < 0 || translation > 1000000)
+      throw InputError("option --refine-translation-interface: must be in 0..1000000");
+    opt.refine.translation_interface_max_poses = static_cast<int>(translation);
     opt.refine.coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
                         : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
                                                : NewtonRefineOptions::Coarse::kNone;
