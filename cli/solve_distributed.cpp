@@ -73,6 +73,7 @@ const char* const kDistributedValued[] = {"agents",
                                           "refine-coarse-form",
                                           "refine-coarse-aggregates",
                                           "refine-interface",
+                                          "refine-translation-interface",
                                           nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
@@ -194,7 +195,11 @@ const char* kDistributedHelp =
     "                            through the blocks' interfaces where the team's interface has\n"
     "                            at most C tangent coordinates; 0 = block Jacobi always\n"
     "                            (default 1000; with --refine auto it also sets where the\n"
-    "                            rounds hand over at gradient 1)\n";
+    "                            rounds hand over at gradient 1)\n"
+    "  --refine-translation-interface P   a trial point's translations are solved exactly\n"
+    "                            through the blocks' interfaces (one all-agent sum) where the\n"
+    "                            team's interface has at most P poses; 0 = block-Jacobi CG\n"
+    "                            always (default 2000)\n";
 
 namespace {
 
@@ -341,6 +346,11 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     if (interface < 0 || interface > 1000000)
       throw InputError("option --refine-interface: must be in 0..1000000");
     opt.refine.interface_max_coordinates = static_cast<int>(interface);
+    const long translation =
+        a.get_long("refine-translation-interface", opt.refine.translation_interface_max_poses);
+    if (translation < 0 || translation > 1000000)
+      throw InputError("option --refine-translation-interface: must be in 0..1000000");
+    opt.refine.translation_interface_max_poses = static_cast<int>(translation);
     opt.refine.coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
                         : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
                                                : NewtonRefineOptions::Coarse::kNone;
@@ -430,13 +440,13 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   for (const NewtonRefineResult& n : r.refines)
     std::printf(
         "  newton refine: %d steps (%d accepted), %d CG iterations, %d translation CG "
-        "iterations, %d exchanges, %d all-agent sums, %d coarse unknowns, interface %d "
-        "coordinates (%d factorizations, %d fallbacks), |grad f| %.3g -> %.3g, f %.10g -> %.10g, "
-        "stop: %s\n",
-        n.steps, n.accepted_steps, n.cg_iterations, n.translation_iterations, n.exchanges,
-        n.reductions, n.coarse_unknowns, n.interface_coordinates, n.interface_factorizations,
-        n.interface_fallbacks, n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost,
-        n.stop_reason.c_str());
+        "iterations, %d exact translation solves (%d interface poses), %d exchanges, %d "
+        "all-agent sums, %d coarse unknowns, interface %d coordinates (%d factorizations, %d "
+        "fallbacks), |grad f| %.3g -> %.3g, f %.10g -> %.10g, stop: %s\n",
+        n.steps, n.accepted_steps, n.cg_iterations, n.translation_iterations, n.translation_solves,
+        n.translation_interface_poses, n.exchanges, n.reductions, n.coarse_unknowns,
+        n.interface_coordinates, n.interface_factorizations, n.interface_fallbacks,
+        n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost, n.stop_reason.c_str());
   for (const NewtonRefineResult& n : r.refines)
     for (std::size_t k = 0; k < n.trace.size(); ++k) {
       const NewtonRefineStep& t = n.trace[k];
@@ -515,10 +525,13 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     // --refine newton, or the robust final solve's refinement (--gnc-final-refine).
     if (opt.refine.enabled || !r.refines.empty()) {
       int steps = 0, cg = 0, translation_cg = 0, exchanges = 0, reductions = 0;
-      int interface = 0, interface_factorizations = 0;
+      int interface = 0, interface_factorizations = 0, translation_solves = 0;
+      int translation_interface = 0;
       for (const NewtonRefineResult& n : r.refines) {
         interface = std::max(interface, n.interface_coordinates);
         interface_factorizations += n.interface_factorizations;
+        translation_solves += n.translation_solves;
+        translation_interface = std::max(translation_interface, n.translation_interface_poses);
         steps += n.steps;
         cg += n.cg_iterations;
         translation_cg += n.translation_iterations;
@@ -528,6 +541,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       j.add("refine_steps", steps)
           .add("refine_cg_iterations", cg)
           .add("refine_translation_iterations", translation_cg)
+          .add("refine_translation_solves", translation_solves)
+          .add("refine_translation_interface_poses", translation_interface)
           .add("refine_exchanges", exchanges)
           .add("refine_reductions", reductions)
           .add("refine_interface_coordinates", interface)

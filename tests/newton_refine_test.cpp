@@ -53,15 +53,16 @@ TEST(NewtonRefine, ReachesTheCentralizedOptimumWhereTheRoundsStopShortOfIt) {
   EXPECT_EQ(n.initial_cost, plain.relaxation_cost);
   EXPECT_GE(n.accepted_steps, 1);
   EXPECT_LE(n.steps, 6);
-  // Each CG iteration (Newton or trial translations) is one neighbour exchange and one
-  // all-agent sum; each step adds one of each for its trial point and one more exchange of its
-  // re-solved translations, plus the start's sum, a step's last CG exchange and the coarse
-  // matrix's sum at each new point.
-  const int iterations = n.cg_iterations + n.translation_iterations;
-  EXPECT_GE(n.translation_iterations, n.steps);
-  EXPECT_GE(n.exchanges, iterations + 2 * n.steps);
-  EXPECT_LE(n.exchanges, iterations + 3 * n.steps);
-  EXPECT_EQ(n.reductions, n.exchanges - n.steps + 1 + n.coarse_assemblies +
+  // Each CG iteration is one neighbour exchange and one all-agent sum; each step adds the
+  // exchange of its trial point, the exact solve of its translations (one sum) and its cost's
+  // sum, plus the start's sum, a step's last CG exchange and the interface matrix's sum at
+  // each new point.
+  EXPECT_GT(n.translation_interface_poses, 0);
+  EXPECT_EQ(n.translation_iterations, 0);
+  EXPECT_EQ(n.translation_solves, n.steps);
+  EXPECT_GE(n.exchanges, n.cg_iterations + n.steps);
+  EXPECT_LE(n.exchanges, n.cg_iterations + 2 * n.steps);
+  EXPECT_EQ(n.reductions, n.exchanges + n.translation_solves + 1 + n.coarse_assemblies +
                               n.interface_factorizations + n.interface_fallbacks);
   EXPECT_LE(n.coarse_assemblies, n.accepted_steps + 1);
   // The rounds stop measurably above f*; the refined estimate is at f*.
@@ -201,16 +202,17 @@ PoseGraph corridor(int leg, int closures, double rotation_noise, unsigned seed) 
   return g;
 }
 
-// The trial point's translations re-solved for its rotations: from the same point the same CG
-// step is tried, and its trial lowers f at least as much as the retraction alone (CG on the
-// convex quadratic in the translations lowers f at every iteration), so the trust region is
-// cut less; both reach the optimum.
+// The trial point's translations re-solved for its rotations by the block-Jacobi CG: from the
+// same point the same CG step is tried, and its trial lowers f at least as much as the
+// retraction alone (CG on the convex quadratic in the translations lowers f at every
+// iteration), so the trust region is cut less; both reach the optimum.
 TEST(NewtonRefine, TrialTranslationsReSolvedLowerTheTrialCostAndReachTheOptimum) {
   const PoseGraph g = corridor(500, 3, 0.1, 7);
   const std::vector<int> parts = sequential_partition(g.num_poses, 5);
   const double fstar = test::tight_optimum(g);
   DistributedOptions with = refined(true);
   with.grad_norm_tol = 10.0;
+  with.refine.translation_interface_max_poses = 0;  // the CG
   DistributedOptions without = with;
   without.refine.translation_iterations = 0;
   const DistributedResult a = solve_distributed(g, parts, with);
@@ -234,6 +236,52 @@ TEST(NewtonRefine, TrialTranslationsReSolvedLowerTheTrialCostAndReachTheOptimum)
       EXPECT_GT(t.actual, 0.0);
     }
   }
+}
+
+// Exact trial translations (NewtonRefineOptions::translation_interface_max_poses): the trial's
+// translations are the exact minimiser for its rotations, so its cost is at most the CG's
+// (which stops short of it) from the same CG step; the same optimum in fewer message steps,
+// with no translation CG at all. A cap below the team's interface is the CG run exactly.
+TEST(NewtonRefine, ExactTrialTranslationsReachTheCgOptimumInFewerMessageSteps) {
+  const PoseGraph g = corridor(500, 3, 0.1, 7);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 5);
+  const double fstar = test::tight_optimum(g);
+  DistributedOptions exact = refined(true);
+  exact.grad_norm_tol = 10.0;
+  DistributedOptions cg = exact;
+  cg.refine.translation_interface_max_poses = 0;
+  const DistributedResult a = solve_distributed(g, parts, exact);
+  const DistributedResult b = solve_distributed(g, parts, cg);
+  ASSERT_EQ(a.refines.size(), 1u);
+  ASSERT_EQ(b.refines.size(), 1u);
+  const NewtonRefineResult& ra = a.refines[0];
+  const NewtonRefineResult& rb = b.refines[0];
+  // A U of 1,000 poses in 5 pieces with 3 closures: a few interface poses a block.
+  EXPECT_GT(ra.translation_interface_poses, 0);
+  EXPECT_LE(ra.translation_interface_poses, 20);
+  EXPECT_EQ(ra.translation_iterations, 0);
+  EXPECT_EQ(ra.translation_solves, ra.steps);
+  EXPECT_EQ(rb.translation_interface_poses, 0);
+  EXPECT_EQ(rb.translation_solves, 0);
+  EXPECT_GE(rb.translation_iterations, rb.steps);
+  ASSERT_FALSE(ra.trace.empty());
+  ASSERT_FALSE(rb.trace.empty());
+  EXPECT_EQ(ra.trace[0].cg_iterations, rb.trace[0].cg_iterations);
+  EXPECT_EQ(ra.trace[0].predicted, rb.trace[0].predicted);
+  EXPECT_GE(ra.trace[0].actual, rb.trace[0].actual - 1e-12 * std::abs(ra.initial_cost));
+  // Here the same steps (5) and CG iterations: one sum a trial point in place of the CG's
+  // 21 iterations (two message steps each) and the re-solved translations' exchange.
+  EXPECT_LT(ra.exchanges + ra.reductions, rb.exchanges + rb.reductions);
+  EXPECT_LT(std::abs(a.cost - fstar) / fstar, 1e-8);
+  EXPECT_LT(std::abs(b.cost - fstar) / fstar, 1e-8);
+  DistributedOptions capped = exact;
+  capped.refine.translation_interface_max_poses = ra.translation_interface_poses - 1;
+  const DistributedResult c = solve_distributed(g, parts, capped);
+  ASSERT_EQ(c.refines.size(), 1u);
+  EXPECT_EQ(c.refines[0].translation_interface_poses, 0);
+  EXPECT_EQ(c.refines[0].translation_iterations, rb.translation_iterations);
+  EXPECT_EQ(c.refines[0].exchanges, rb.exchanges);
+  EXPECT_EQ(c.cost, b.cost);
 }
 
 // Interface solves (NewtonRefineOptions::interface_max_coordinates): with each block's
@@ -378,6 +426,9 @@ TEST(NewtonRefineOptions, ValidateNamesTheBadField) {
   o = {};
   o.translation_iterations = -1;
   EXPECT_NE(message(o).find("translation_iterations"), std::string::npos);
+  o = {};
+  o.translation_interface_max_poses = -1;
+  EXPECT_NE(message(o).find("translation_interface_max_poses"), std::string::npos);
   o = {};
   o.translation_tol = 0;
   EXPECT_NE(message(o).find("translation_tol"), std::string::npos);

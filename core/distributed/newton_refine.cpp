@@ -13,6 +13,7 @@
 #include "distributed/public_pose_messages.hpp"
 #include "distributed/rigid_retraction.hpp"
 #include "distributed/tangent_coarse_space.hpp"
+#include "distributed/translation_interface_solve.hpp"
 #include "distributed/translation_preconditioner.hpp"
 #include "util/frobenius_inner.hpp"
 
@@ -106,6 +107,18 @@ std::vector<OutgoingMessage> NewtonRefineProtocol::start() {
   std::vector<double> values{share, g_.squaredNorm()};
   const std::vector<double> used = row_indicators(state_.Y, state_.Yn);
   values.insert(values.end(), used.begin(), used.end());
+  // Exact trial translations: L_BB's factor and Schur complement do not depend on the point, so
+  // they ride in this first sum.
+  if (options_.translation_iterations > 0 && options_.translation_interface_max_poses > 0 &&
+      layout_.num_blocks > 1) {
+    const Eigen::Index team = interface_pose_count(layout_);
+    if (team > 0 && team <= options_.translation_interface_max_poses) {
+      translation_solve_ =
+          std::make_unique<TranslationInterfaceSolve>(problem_, layout_, state_.id());
+      const std::vector<double> share = translation_solve_->share();
+      values.insert(values.end(), share.begin(), share.end());
+    }
+  }
   broadcast(kStatus, values, out);
   pump(out);
   return out;
@@ -172,6 +185,9 @@ void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
       case kInterface:
         after_interface(*ready, out);
         break;
+      case kTranslationSolve:
+        after_translation_solve(*ready, out);
+        break;
       default:
         after_trial_sums(*ready, out);
         break;
@@ -182,7 +198,26 @@ void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
 void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
                                         std::vector<OutgoingMessage>& out) {
   const std::size_t r = static_cast<std::size_t>(state_.Y.rows());
-  const std::vector<double> t = reduce_in_id_order(inbox, 2 + r);
+  // The sums (in id order, as reduce_in_id_order), then each block's translation share.
+  std::vector<double> t(2 + r, 0.0);
+  std::vector<std::vector<double>> shares;
+  for (const auto& [sender, m] : inbox) {
+    const auto* p = std::get_if<PoseBlockMessage>(&m);
+    if (!p || p->data.size() < 2 + r || (p->data.size() > 2 + r) != (translation_solve_ != nullptr))
+      throw std::runtime_error("newton refine: malformed status from agent " +
+                               std::to_string(sender));
+    for (std::size_t k = 0; k < 2 + r; ++k) t[k] += p->data[k];
+    if (translation_solve_)
+      shares.emplace_back(p->data.begin() + static_cast<std::ptrdiff_t>(2 + r), p->data.end());
+  }
+  if (translation_solve_) {
+    std::vector<const std::vector<double>*> ptrs;
+    for (const auto& v : shares) ptrs.push_back(&v);
+    if (translation_solve_->assemble(ptrs))
+      result_.translation_interface_poses = static_cast<int>(translation_solve_->team_size());
+    else
+      translation_solve_.reset();  // a block's L_BB is singular: the CG below
+  }
   std::vector<Eigen::Index> active;
   for (std::size_t k = 0; k < r; ++k)
     if (t[2 + k] > 0) active.push_back(static_cast<Eigen::Index>(k));
@@ -221,7 +256,7 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
     refactor_due_ = true;  // block Jacobi's factor only where a point falls back to it
   else
     prepare_preconditioner();
-  if (options_.translation_iterations > 0)
+  if (options_.translation_iterations > 0 && !translation_solve_)
     translation_preconditioner_ = std::make_unique<TranslationPreconditioner>(problem_);
   begin_cg(out);
 }
@@ -534,6 +569,11 @@ void NewtonRefineProtocol::after_trial(const MessageGate::Inbox& inbox,
   neighbours_into(inbox, Xtn_);
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(Xtn_);
   if (options_.translation_iterations > 0 && !translations_solved_) return start_translations(out);
+  send_trial_sums(out);
+}
+
+void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
+  if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(Xtn_);
   double share = 0.0;
   problem_.cost(Xt_, &share);
   egrad_t_ = problem_.euclidean_gradient(Xt_);
@@ -607,6 +647,18 @@ void NewtonRefineProtocol::start_translations(std::vector<OutgoingMessage>& out)
   // f at fixed rotations is quadratic in the translations: the CG's residual is minus the
   // translation columns of the Euclidean gradient at the trial point.
   tr_ = -problem_.euclidean_gradient(Xt_);
+  if (translation_solve_) {
+    // Exact: x = (2 L)^-1 r, the own block's forward solve now, its interface residual summed.
+    const int w = problem_.dim() + 1;
+    const Eigen::Index m = static_cast<Eigen::Index>(problem_.num_owned());
+    Eigen::MatrixXd b(m, tr_.rows());
+    for (Eigen::Index i = 0; i < m; ++i) b.row(i) = 0.5 * tr_.col(i * w + w - 1).transpose();
+    translation_solve_->forward(b, ty_);
+    const Eigen::MatrixXd rhat = translation_solve_->interface_residual(ty_);
+    ++result_.translation_solves;
+    broadcast(kTranslationSolve, std::vector<double>(rhat.data(), rhat.data() + rhat.size()), out);
+    return;
+  }
   TranslationPreconditioner::keep_translations(problem_.dim(), tr_);
   tx_.setZero(Xt_.rows(), Xt_.cols());
   tcg_->restart();
@@ -657,6 +709,36 @@ void NewtonRefineProtocol::after_translation_sums(const MessageGate::Inbox& inbo
   Xt_ += tx_;
   translations_solved_ = true;
   send_public(Xt_, kTrial, out);
+}
+
+void NewtonRefineProtocol::after_translation_solve(const MessageGate::Inbox& inbox,
+                                                   std::vector<OutgoingMessage>& out) {
+  // The team's interface residual, blocks in id order; every agent solves the same Sigma.
+  const Eigen::Index k = Xt_.rows();
+  Eigen::MatrixXd rhat(translation_solve_->team_size(), k);
+  for (const auto& [sender, m] : inbox) {
+    const auto* p = std::get_if<PoseBlockMessage>(&m);
+    const Eigen::Index n = translation_solve_->block_size(sender);
+    if (!p || static_cast<Eigen::Index>(p->data.size()) != n * k)
+      throw std::runtime_error("newton refine: malformed translation residual from agent " +
+                               std::to_string(sender));
+    rhat.middleRows(translation_solve_->block_offset(sender), n) =
+        Eigen::Map<const Eigen::MatrixXd>(p->data.data(), n, k);
+  }
+  const Eigen::MatrixXd u = translation_solve_->solve_interface(rhat);
+  const Eigen::MatrixXd x = translation_solve_->back(ty_, u);
+  // The own translations, and the neighbours' public ones from u (their own back() writes the
+  // same u into them, so both copies agree to the bit).
+  const int w = problem_.dim() + 1;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) Xt_.col(i * w + w - 1) += x.row(i).transpose();
+  const std::vector<std::size_t>& nb = problem_.neighbors();
+  for (std::size_t j = 0; j < nb.size(); ++j) {
+    const Eigen::Index row = translation_solve_->team_row(nb[j]);
+    if (row < 0) throw std::logic_error("newton refine: a neighbour pose off the interface");
+    Xtn_.col(static_cast<Eigen::Index>(j) * w + w - 1) += u.row(row).transpose();
+  }
+  translations_solved_ = true;
+  send_trial_sums(out);
 }
 
 void NewtonRefineProtocol::finish(const std::string& why) {

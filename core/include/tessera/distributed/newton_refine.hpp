@@ -53,6 +53,7 @@ class InterfaceSolve;
 class PipelinedCg;
 class CoarseHessianColumns;
 class TranslationPreconditioner;
+class TranslationInterfaceSolve;
 
 struct NewtonRefineOptions {
   /// Run the refinement after the block-coordinate solve reached its own tolerance (a solve
@@ -154,12 +155,26 @@ struct NewtonRefineOptions {
   /// places their translations right (lever arms of hundreds of metres on ais2klinik), so the
   /// trust region stayed small and each step ended on its boundary after 150-300 CG iterations.
   /// Each iteration lowers f (CG on a convex quadratic from the retracted point), so any count
-  /// is sound. Costs per iteration one exchange and one all-agent sum (2 numbers). >= 0; 0 = off.
+  /// is sound. Costs per iteration one exchange and one all-agent sum (2 numbers). >= 0; 0 = off
+  /// (no re-solve at all, exact or not).
   int translation_iterations = 50;
   /// The translation CG stops once an iteration lowers f by at most this fraction of the
   /// Newton step's predicted decrease (the rest it could remove is then small against what the
   /// ratio test weighs). (0, 1).
   double translation_tol = 1e-3;
+  /// Exact trial translations: where the team's interface has at most this many poses (poses
+  /// with a cut measurement: ais2klinik at N = 5 34, city10000 303), the re-solve above is one
+  /// exact solve with 2 L by substructuring (distributed/translation_interface_solve.hpp)
+  /// instead of the block-Jacobi CG: each block factors its L_BB (interface last) and sends its
+  /// Schur complement once per refinement, riding in the start's sum (L does not depend on the
+  /// point); every agent factors the interface matrix (this many rows at most, once); a trial
+  /// point then costs one all-agent sum (each block's interface residual, its interface poses x
+  /// the iterate's rows) and no exchange: the solve's interface values are the neighbours' new
+  /// public translations. A block whose L_BB is singular (a pose without measurements) sends
+  /// a flag and the team keeps the CG. Why: the CG took 123 iterations (two message steps
+  /// each) over ais2klinik's 10 trial points, 80 % of the refinement's 305 message steps
+  /// (docs/newton-refine.md, "Exact trial translations"). >= 0; 0 = off (the CG above).
+  int translation_interface_max_poses = 2000;
   /// Preconditioner: exact solves with the Hessian through the team's interface
   /// (distributed/interface_solve.hpp) where that interface has at most this many tangent
   /// coordinates (d(d+1)/2 a pose: ais2klinik at N = 5 102, city10000 909); 0 = off. Each
@@ -206,7 +221,7 @@ void set_refine_mode(NewtonRefineOptions& options, const std::string& mode);
 /// One trust-region step, identical on every agent.
 struct NewtonRefineStep {
   int cg_iterations = 0;
-  int translation_iterations = 0;        ///< Of the trial point's translation solve.
+  int translation_iterations = 0;        ///< Of the trial point's translation CG.
   double radius = 0.0;                   ///< Trust radius the step was computed in (0 = unbounded).
   double predicted = 0.0, actual = 0.0;  ///< Decreases of the model and of f.
   bool accepted = false;
@@ -233,6 +248,10 @@ struct NewtonRefineResult {
   /// Iterations of the trial points' translation solves (each one exchange and one sum,
   /// counted in `exchanges` and `reductions`).
   int translation_iterations = 0;
+  /// Exact trial translations (translation_interface_max_poses): the team's interface poses
+  /// (0: not used, the CG above ran) and the exact solves (one all-agent sum each, counted in
+  /// `reductions`; none of them in translation_iterations).
+  int translation_interface_poses = 0, translation_solves = 0;
   /// Interface solves (interface_max_coordinates): the team's interface in tangent coordinates
   /// (0: not used), the points where Sigma was factored (one all-agent message step each,
   /// counted in `reductions`) and where it could not be (that step's CG ran block Jacobi).
@@ -245,18 +264,20 @@ class NewtonRefineProtocol : public AgentProcess {
   /// Protocol steps (on the wire: the solve stage's phase base + these; RoundProtocol uses
   /// 0..5 in the same stage).
   enum Step : std::uint32_t {
-    kStatus = 60,                ///< Cost share, ||g||^2 and active rows at the start point.
-    kDirection = 61,             ///< Public entries of the preconditioned residual z.
-    kSums = 62,                  ///< CG's <r, z>, <z, H z>, <r, r>.
-    kTrial = 63,                 ///< Public poses of the trial point.
-    kTrialSums = 64,             ///< Cost share and ||g||^2 at the trial point.
-    kCoarse = 65,                ///< The coarse matrix's share and Phi^T g at the current point.
+    kStatus = 60,     ///< Cost share, ||g||^2 and active rows at the start point; the translation
+                      ///< Schur complement (exact trial translations).
+    kDirection = 61,  ///< Public entries of the preconditioned residual z.
+    kSums = 62,       ///< CG's <r, z>, <z, H z>, <r, r>.
+    kTrial = 63,      ///< Public poses of the trial point.
+    kTrialSums = 64,  ///< Cost share and ||g||^2 at the trial point.
+    kCoarse = 65,     ///< The coarse matrix's share and Phi^T g at the current point.
     kTranslationDirection = 66,  ///< Trial translations: public entries of the CG's z.
     kTranslationSums = 67,       ///< Trial translations: <r, z>, <z, H z>.
-    kInterface = 68              ///< Interface solves: each block's Schur complement and couplings.
+    kInterface = 68,             ///< Interface solves: each block's Schur complement and couplings.
+    kTranslationSolve = 69       ///< Exact trial translations: each block's interface residual.
   };
   /// The last of the steps: [kStatus, kLastStep] are the refinement's.
-  static constexpr std::uint32_t kLastStep = kInterface;
+  static constexpr std::uint32_t kLastStep = kTranslationSolve;
   static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kLastStep; }
 
   /// `state`: the agent at the point to refine (Y, and Yn = the neighbours' public poses of the
@@ -325,6 +346,10 @@ class NewtonRefineProtocol : public AgentProcess {
   void after_translation_direction(const MessageGate::Inbox& inbox,
                                    std::vector<OutgoingMessage>& out);
   void after_translation_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // Exact trial translations: the team's interface solve, then the trial's sums.
+  void after_translation_solve(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // The trial point's cost share and ||g||^2 (kTrialSums), its neighbours' poses set.
+  void send_trial_sums(std::vector<OutgoingMessage>& out);
 
   AgentState& state_;
   const BlockLayout& layout_;
@@ -373,6 +398,10 @@ class NewtonRefineProtocol : public AgentProcess {
   bool translations_solved_ = false;  // the current trial's translations are re-solved
   Eigen::MatrixXd tx_, tr_, tz_, tzn_, tw_, tp_, tq_;
   std::unique_ptr<PipelinedCg> tcg_;
+  // Exact trial translations (options_.translation_interface_max_poses): the solve (in use once
+  // ready()) and the forward solve of the current trial's right-hand side.
+  std::unique_ptr<TranslationInterfaceSolve> translation_solve_;
+  Eigen::MatrixXd ty_;
   NewtonRefineStep step_;
   bool done_ = false;
   NewtonRefineResult result_;
