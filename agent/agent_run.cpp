@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <thread>
 
@@ -88,7 +89,7 @@ void solve(AgentSession& s, const AgentOptions& o, const AgentLog& log, const Ag
   // The block set-up's temporaries (the factors' analyses, the matrices they were built from)
   // would otherwise stay under the rounds as free heap: 70 MB on a 16,000-pose 3D block.
   hooks.after_set_up = [] { launch::release_freed_heap(); };
-  if (o.verbose) hooks.on_phase = [&](const std::string& phase) { log(phase_memory_line(phase)); };
+  if (log.verbose) hooks.on_phase = [&](const std::string& phase) { log(phase_memory_line(phase)); };
   log(std::string("round snapshots: ") +
       (hooks.on_round ? "kept (rejoin, checkpoints or replicas)" : "none (nothing reads them)"));
   for (;;) {
@@ -141,7 +142,10 @@ std::optional<AgentCheckpoint> find_restart_checkpoint(const AgentOptions& o) {
 }
 
 void run_agent(const AgentOptions& o, AgentSession& s, std::optional<AgentCheckpoint> restart) {
-  const AgentLog log{agent_tag(o.id), o.verbose};
+  // TESSERA_DDS_TRACE=1 (transport/dds_trace.hpp) also stamps and prints the phase lines.
+  const char* trace = std::getenv("TESSERA_DDS_TRACE");
+  const bool traced = trace && *trace && *trace != '0';
+  const AgentLog log{agent_tag(o.id), o.verbose || traced, traced};
   const auto t0 = std::chrono::steady_clock::now();
   try {
     if (restart) {

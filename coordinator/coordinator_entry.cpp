@@ -4,6 +4,8 @@
 
 #include "coordinator/coordinator_entry.hpp"
 
+#include <atomic>
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,6 +15,7 @@
 #include "coordinator/file_partition.hpp"
 #include "coordinator/run_timeline.hpp"
 #include "session_process.hpp"
+#include "transport/fastdds/teardown_guard.hpp"
 #include "transport/signal_watcher.hpp"
 
 namespace tessera::coordinator {
@@ -35,9 +38,19 @@ int coordinator_main(int argc, char** argv) {
     file_job = std::make_unique<FilePartitionJob>(options.graph, options.agents, options.partition,
                                                   options.partition_seed, options.partition_time_s);
   const cli::ProcessRole role{"tessera-coordinator", options.net.timeout_s};
+  // From the run's successful end (summary written, FINISHED sent) to the participant's
+  // deletion, a Fast DDS 2.9 abort ends the process with exit code 0 and a note
+  // (transport/fastdds/teardown_guard.hpp). run_coordinator's own guard covers its last step and
+  // Session::close the deletion; this one also covers the step between them, where the lease
+  // check's abort struck while the agents' participants left (city10000, load 16). Before the
+  // flag is set an abort stays an abort.
+  std::atomic<bool> delivered{false};
+  const transport::TeardownGuard after_result(transport::kExitOk, "tessera-coordinator",
+                                              std::chrono::seconds(0), &delivered);
   return cli::run_session_process(coordinator_session_options(options), role, signals,
                                   [&](transport::CoordinatorSession& session) {
                                     run_coordinator(options, session, timeline, file_job.get());
+                                    delivered = true;
                                   });
 }
 

@@ -85,7 +85,7 @@ LaunchResult launch(LaunchOptions o) {
   const std::string fork_server = bin + "/tessera-fork-server";
   const bool forked = use_fork_server(o, fork_server);
 
-  const WorkDir work;
+  const WorkDir work(o.keep_logs);
   // A dpgo CSV: the robots' g2o files, one agent each.
   if (const std::string dir = dpgo_csv_as_robot_files(o.graph, o.agents, work.path()); !dir.empty())
     o.graph = dir;
@@ -121,9 +121,10 @@ LaunchResult launch(LaunchOptions o) {
     children = forked ? spawn_forked(fork_server, plan.spec, plan.names, plan.agent_ids,
                                      work.path() + "/fork-server.log", std::min(o.timeout_s, 60.0))
                       : spawn_exec(plan.spec, plan.names, plan.agent_ids);
-    std::printf("launched run %s: coordinator + %ld agents, %s (logs in %s until the end)\n",
+    std::printf("launched run %s: coordinator + %ld agents, %s (logs in %s%s)\n",
                 result.run_id.c_str(), o.agents,
-                forked ? "forked by tessera-fork-server" : "each exec'ed", work.path().c_str());
+                forked ? "forked by tessera-fork-server" : "each exec'ed", work.path().c_str(),
+                o.keep_logs.empty() ? " until the end" : "");
     std::fflush(stdout);
 
     SupervisionOptions watch;

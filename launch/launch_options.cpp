@@ -47,6 +47,9 @@ options:
                        and escape saddles up the staircase (default: on)
   --no-certify         skip the certificate
   --json FILE          also write the summary to FILE
+  --keep-logs DIR      keep the processes' logs in DIR (created when missing; default: a
+                       temporary folder removed at the end); with TESSERA_DDS_TRACE=1 they
+                       hold each process's discovery and set-up steps
   --timeout S          time limit of the whole run, seconds                 [600]
   --poses P            poses of the generated graph (without GRAPH)         [1000]
 %s%s  --quiet              no progress lines
@@ -110,7 +113,7 @@ void LaunchOptions::validate() const {
 LaunchOptions parse_launch_options(const std::vector<std::string>& argv) {
   std::set<std::string> valued = {"agents",   "algorithm",  "partition", "init",
                                   "grad-tol", "max-rounds", "rank",      "seed",
-                                  "json",     "timeout",    "poses"};
+                                  "json",     "timeout",    "poses",     "keep-logs"};
   std::set<std::string> switches = {"quiet",          "certify",         "no-certify",
                                     "no-fork-server", "no-agents-batch", "status-relay",
                                     "no-status-relay"};
@@ -134,6 +137,7 @@ LaunchOptions parse_launch_options(const std::vector<std::string>& argv) {
   o.rank = args.get_long("rank", o.rank);
   o.seed = args.get_long("seed", o.seed);
   o.json = args.get_or("json", "");
+  o.keep_logs = args.get_or("keep-logs", "");
   o.timeout_s = args.get_double("timeout", o.timeout_s);
   o.poses = args.get_long("poses", o.poses);
   o.quiet = args.has("quiet");

@@ -38,6 +38,9 @@ struct LaunchOptions {
   bool certify = true;
   /// Also write the coordinator's JSON summary here ("" = only into the temporary folder).
   std::string json;
+  /// Keep the processes' logs (and the summary, a generated graph) in this folder, created when
+  /// missing ("" = a temporary folder removed at the end).
+  std::string keep_logs;
   /// Time limit of the whole run, seconds, > 0.
   double timeout_s = 600;
   /// Poses of the generated graph (graph == ""), >= agents.

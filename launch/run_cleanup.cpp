@@ -10,7 +10,15 @@
 
 namespace tessera::launch {
 
-WorkDir::WorkDir() {
+WorkDir::WorkDir(const std::string& keep) {
+  if (!keep.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(keep, ec);
+    if (ec) throw std::runtime_error("launch: cannot create " + keep + ": " + ec.message());
+    path_ = keep;
+    keep_ = true;
+    return;
+  }
   char tmpl[] = "/tmp/tessera-launch-XXXXXX";
   if (!mkdtemp(tmpl)) throw std::runtime_error("launch: cannot create a temporary folder");
   path_ = tmpl;
@@ -18,6 +26,7 @@ WorkDir::WorkDir() {
 
 // In process (no `sh -c rm -rf`: two more process starts at the end of every run).
 WorkDir::~WorkDir() {
+  if (keep_) return;
   std::error_code ec;
   std::filesystem::remove_all(path_, ec);
   if (ec)

@@ -7,11 +7,13 @@
 
 namespace tessera::launch {
 
-/// The run's temporary folder (/tmp/tessera-launch-XXXXXX): created by the constructor
-/// (std::runtime_error when it cannot be), removed with everything in it by the destructor.
+/// The run's folder of logs, summaries and generated files: by default a temporary one
+/// (/tmp/tessera-launch-XXXXXX) created by the constructor (std::runtime_error when it cannot be)
+/// and removed with everything in it by the destructor; with `keep` non-empty that folder,
+/// created when missing and left in place (`tessera launch --keep-logs DIR`).
 class WorkDir {
  public:
-  WorkDir();
+  explicit WorkDir(const std::string& keep = "");
   ~WorkDir();
   WorkDir(const WorkDir&) = delete;
   WorkDir& operator=(const WorkDir&) = delete;
@@ -19,6 +21,7 @@ class WorkDir {
 
  private:
   std::string path_;
+  bool keep_ = false;
 };
 
 /// Removes the shared-memory files of dead processes of `domain` (and the listed dead segments)

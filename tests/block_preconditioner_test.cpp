@@ -132,6 +132,27 @@ TEST(BlockPreconditioner, FallsBackToTheBlockDiagonalWhenTheFactorWouldBeTooLarg
   EXPECT_LT((precon.apply(M, X, V) - expected).norm(), 1e-8 * expected.norm());
 }
 
+// falls_back() decides as the constructor does, from the symbolic analysis alone: for caps
+// around the factor's predicted entries (below the lower triangle, between it and the fill, at
+// and above the fill, none), the same answer as block_diagonal() of the constructed one.
+TEST(BlockPreconditioner, FallsBackPredictsTheConstructorsChoiceWithoutFactoring) {
+  const Block b = half_block(5);
+  const BlockProblem problem(b.graph.d, b.owned, b.measurements);
+  const double shift = 1e-6;
+  const std::size_t entries = BlockPreconditioner(problem, shift, 0).factor_entries();
+  ASSERT_GT(entries, 0u);
+  const std::size_t n = static_cast<std::size_t>(problem.data_matrix().rows());
+  bool saw_both[2] = {false, false};
+  for (std::size_t cap :
+       {std::size_t{10}, n, entries - 1, entries, entries + 1, 10 * entries, std::size_t{0}}) {
+    const bool predicted = BlockPreconditioner::falls_back(problem, shift, cap);
+    EXPECT_EQ(predicted, BlockPreconditioner(problem, shift, cap).block_diagonal()) << cap;
+    saw_both[predicted] = true;
+  }
+  EXPECT_TRUE(saw_both[0] && saw_both[1]);                           // the caps cover both answers
+  EXPECT_FALSE(BlockPreconditioner::falls_back(problem, shift, 0));  // 0 = no cap
+}
+
 TEST(BlockPreconditioner, BlockUpdateWithTheFallbackStillDecreasesTheLocalCost) {
   const Block b = half_block(7);
   BlockProblem problem(b.graph.d, b.owned, b.measurements);

@@ -1,6 +1,6 @@
 // Real distributed solves over DDS: the agents run core's round protocol as processes and must
 // give the same iterates as the in-process engine; `tessera launch` end to end.
-// Domains used here: 161-170, 176, 129, 56, 131 and 112-113 (each test its own, so ctest -j is
+// Domains used here: 161-170, 175, 176, 129, 56, 131 and 112-113 (each test its own, so ctest -j is
 // safe).
 
 #include <gtest/gtest.h>
@@ -244,6 +244,28 @@ TEST(DdsLaunch, ReportsPeakMemoryPerAgentAndTheSetUpSteps) {
   EXPECT_NEAR(json_field(json, "peak_rss_mb_run"), per_agent[0] + per_agent[1] + coordinator,
               1e-6 * json_field(json, "peak_rss_mb_run"))
       << json;
+}
+
+// --keep-logs keeps every process's log in the folder it names; with TESSERA_DDS_TRACE=1 each trace
+// line carries the host's monotonic clock and the process's CPU time, so the processes' logs
+// merge into one timeline of the start-up.
+TEST(DdsLaunch, KeepLogsLeavesEveryProcesssTracedLogInTheFolder) {
+  const std::string dir = temp_dir() + "/kept";  // created by launch
+  std::string out;
+  const int rc = run_command("TESSERA_DDS_TRACE=1 " + bin("tessera") +
+                                 " launch --agents 2 --poses 60 --domain 175 --partition fast "
+                                 "--timeout 60 --quiet --keep-logs " +
+                                 dir + " 2>&1",
+                             &out);
+  ASSERT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find("logs in " + dir + ")"), std::string::npos) << out;
+  const std::regex stamp(
+      R"(\[dds +[0-9.]+ @[0-9.]+ cpu [0-9.]+ tessera:[^ ]+:(coordinator|agent:[01])\] )");
+  for (const char* name : {"coordinator.log", "agent0.log", "agent1.log"}) {
+    const std::string log = slurp(dir + "/" + name);
+    EXPECT_TRUE(std::regex_search(log, stamp)) << name << "\n" << log.substr(0, 2000);
+    EXPECT_NE(log.find("barrier: passed"), std::string::npos) << name;
+  }
 }
 
 // The status relay is the default; --no-status-relay turns it off, and both at once are an

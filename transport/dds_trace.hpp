@@ -11,7 +11,9 @@ namespace tessera::transport {
 class DdsTrace {
  public:
   /// On when TESSERA_DDS_TRACE is set and not "0". `who` (the participant name) starts every
-  /// line; times are seconds since this object was made.
+  /// line; times are seconds since this object was made, then "@" and the monotonic clock's
+  /// seconds (CLOCK_MONOTONIC, one clock for every process of the host), then "cpu" and the
+  /// process's CPU seconds so far (all threads).
   explicit DdsTrace(std::string who);
 
   bool on() const { return on_; }

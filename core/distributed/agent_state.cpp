@@ -39,18 +39,22 @@ AgentState::AgentState(int id, int d, const BlockLayout& layout,
   // 3D blocks), the tangent one (p x p pose blocks instead of (d+1) x (d+1): 2.25x the entries
   // in 3D, as many in 2D) is too large as well, and its analysis is skipped (a 100k-pose grid
   // with N = 5 spent 2 s more CPU in set-up analysing tangent factors it could not use).
-  const BlockPreconditioner& q = euclidean();
-  if (options.precondition && options.tangent_preconditioner && !q.block_diagonal()) {
+  // Whether the Q_BB factor would be too large is known from its symbolic analysis alone.
+  block_factor_too_large_ = BlockPreconditioner::falls_back(
+      problem_, BlockPreconditioner::kDefaultRelativeShift, max_factor_entries_);
+  if (options.precondition && options.tangent_preconditioner && !block_factor_too_large_) {
     const std::vector<Eigen::Index> rows = nonzero_rows(Y0, Eigen::MatrixXd());
     if (static_cast<int>(rows.size()) == d) build_tangent(Y0(rows, Eigen::all), options);
   }
-  if (q.block_diagonal()) tangent_tried_ = true;  // never build it later either
-  // With the tangent factor the rank-d updates do not read the Q_BB factor; held beside it, it
-  // was a third to a half of an agent's memory in the rounds (a 16,000-pose 3D block: ~70 of
-  // ~200 MB of heap). Whatever needs it later (an update above rank d, the greedy_newton score,
-  // a failed tangent factorization) factors it again: the same factor, so the same iterates.
-  else if (tangent_ && tangent_->factored())
-    precon_.reset();
+  if (block_factor_too_large_) tangent_tried_ = true;  // never build it later either
+  // With the tangent factor the rank-d updates do not read the Q_BB factor, so it is not
+  // computed here: held beside the tangent one it was a third to a half of an agent's memory
+  // in the rounds (a 16,000-pose 3D block: ~70 of ~200 MB of heap), and factoring it only to
+  // drop it was 787 M of the 3.58 G instructions of the 5 agents' set-up on cubicle. Whatever
+  // needs it later (an update above rank d, the greedy_newton score, a failed tangent
+  // factorization) factors it then: the same factor, so the same iterates. Without a tangent
+  // factor it is the updates' preconditioner, computed with the rest of the set-up as before.
+  if (!(tangent_ && tangent_->factored())) euclidean();
 }
 
 const CoarseTerms& AgentState::coarse() const {

@@ -52,49 +52,80 @@ std::vector<double> diagonal_block_inverses(const SparseMatrix& A, int w) {
 
 }  // namespace
 
+namespace {
+
+// Q_BB + lambda I, lambda = relative_shift * max diagonal entry of Q_BB: the matrix factored.
+SparseMatrix shifted_data_matrix(const BlockProblem& problem, double relative_shift) {
+  const SparseMatrix& Q = problem.data_matrix();
+  const double lambda = relative_shift * std::max(1e-12, Q.diagonal().maxCoeff());
+  SparseMatrix A = Q;
+  for (Eigen::Index k = 0; k < A.rows(); ++k) A.coeffRef(k, k) += lambda;
+  return A;
+}
+
+// The factor holds at least the lower triangle of A; beyond that, CHOLMOD's symbolic analysis
+// predicts its entries (lnz) before any numeric work.
+bool too_large(double entries, std::size_t max_factor_entries) {
+  return max_factor_entries > 0 && entries > static_cast<double>(max_factor_entries);
+}
+
+bool lower_triangle_too_large(const SparseMatrix& A, std::size_t max_factor_entries) {
+  return too_large(0.5 * static_cast<double>(A.nonZeros() + A.rows()), max_factor_entries);
+}
+
+// The symbolic analysis of A in `mode`; returns the factor's predicted entries.
+template <class Cholmod>
+double analyze(Cholmod& llt, const SparseMatrix& A, Eigen::CholmodMode mode,
+               bool simplicial_solves) {
+  llt.setMode(mode);
+  // AMD only. CHOLMOD's default also tries METIS when AMD's fill looks high (it does on 3D
+  // grids) and keeps the better one: METIS never won on any block measured (more fill than
+  // AMD everywhere, docs/irbcd.md section 8), but its trial was ~2/3 of the set-up time of
+  // a 100k-pose grid. The chosen ordering, hence the factor and the iterates, are unchanged.
+  cholmod_common& c = llt.cholmod();
+  c.nmethods = 1;
+  c.method[0].ordering = CHOLMOD_AMD;
+  c.postorder = 1;
+  // A factor to be converted for simplicial solves keeps only fundamental supernodes: the
+  // default relaxed amalgamation stores explicit zeros (cubicle: 1.72 M entries instead of
+  // 1.45 M) that every simplicial solve would then traverse.
+  if (simplicial_solves && mode == Eigen::CholmodSupernodalLLt)
+    for (int k = 0; k < 3; ++k) {
+      c.nrelax[k] = 0;
+      c.zrelax[k] = 0.0;
+    }
+  llt.analyzePattern(A);
+  if (llt.info() != Eigen::Success || cholmod_analysis_failed(llt))
+    throw std::runtime_error("BlockPreconditioner: symbolic analysis failed (" +
+                             cholmod_status_text(llt.cholmod().status) + ")");
+  return static_cast<double>(llt.cholmod().lnz);
+}
+
+}  // namespace
+
+bool BlockPreconditioner::falls_back(const BlockProblem& problem, double relative_shift,
+                                     std::size_t max_factor_entries) {
+  if (max_factor_entries == 0) return false;
+  const SparseMatrix A = shifted_data_matrix(problem, relative_shift);
+  if (lower_triangle_too_large(A, max_factor_entries)) return true;
+  Factor::Cholmod llt;
+  return too_large(analyze(llt, A, Eigen::CholmodLDLt, false), max_factor_entries);
+}
+
 BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double relative_shift,
                                          std::size_t max_factor_entries,
                                          std::size_t supernodal_min_entries,
                                          double supernodal_min_flops, bool simplicial_solves)
     : factor_(std::make_unique<Factor>()) {
-  const SparseMatrix& Q = problem.data_matrix();
-  const double lambda = relative_shift * std::max(1e-12, Q.diagonal().maxCoeff());
-  SparseMatrix A = Q;
-  for (Eigen::Index k = 0; k < A.rows(); ++k) A.coeffRef(k, k) += lambda;
-  // The factor holds at least the lower triangle of A; beyond that, CHOLMOD's symbolic
-  // analysis predicts its entries (lnz) before any numeric work.
-  const auto too_large = [&](double entries) {
-    return max_factor_entries > 0 && entries > static_cast<double>(max_factor_entries);
-  };
-  bool fallback = too_large(0.5 * static_cast<double>(A.nonZeros() + A.rows()));
-  const auto analyze = [&](Eigen::CholmodMode mode) {
+  const SparseMatrix A = shifted_data_matrix(problem, relative_shift);
+  bool fallback = lower_triangle_too_large(A, max_factor_entries);
+  const auto analyze_as = [&](Eigen::CholmodMode mode) {
     factor_->llt = std::make_unique<Factor::Cholmod>();
-    factor_->llt->setMode(mode);
-    // AMD only. CHOLMOD's default also tries METIS when AMD's fill looks high (it does on 3D
-    // grids) and keeps the better one: METIS never won on any block measured (more fill than
-    // AMD everywhere, docs/irbcd.md section 8), but its trial was ~2/3 of the set-up time of
-    // a 100k-pose grid. The chosen ordering, hence the factor and the iterates, are unchanged.
-    cholmod_common& c = factor_->llt->cholmod();
-    c.nmethods = 1;
-    c.method[0].ordering = CHOLMOD_AMD;
-    c.postorder = 1;
-    // A factor to be converted for simplicial solves keeps only fundamental supernodes: the
-    // default relaxed amalgamation stores explicit zeros (cubicle: 1.72 M entries instead of
-    // 1.45 M) that every simplicial solve would then traverse.
-    if (simplicial_solves && mode == Eigen::CholmodSupernodalLLt)
-      for (int k = 0; k < 3; ++k) {
-        c.nrelax[k] = 0;
-        c.zrelax[k] = 0.0;
-      }
-    factor_->llt->analyzePattern(A);
-    if (factor_->llt->info() != Eigen::Success || cholmod_analysis_failed(*factor_->llt))
-      throw std::runtime_error("BlockPreconditioner: symbolic analysis failed (" +
-                               cholmod_status_text(factor_->llt->cholmod().status) + ")");
-    return static_cast<double>(factor_->llt->cholmod().lnz);
+    return analyze(*factor_->llt, A, mode, simplicial_solves);
   };
   if (!fallback) {
-    const double entries = analyze(Eigen::CholmodLDLt);
-    fallback = too_large(entries);
+    const double entries = analyze_as(Eigen::CholmodLDLt);
+    fallback = too_large(entries, max_factor_entries);
     // A large factor is computed supernodally (dense BLAS-3 kernels on its supernodes): on the
     // 4,000-pose blocks of a 100k-pose 3D grid (1.2-2.0 M entries) set-up CPU drops ~7x and
     // the solves are no slower; at ~0.6 M entries both are equal. The re-analysis repeats the
@@ -109,7 +140,7 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
     if (!fallback &&
         ((supernodal_min_entries > 0 && entries > static_cast<double>(supernodal_min_entries)) ||
          (supernodal_min_flops > 0 && flops > supernodal_min_flops)))
-      analyze(Eigen::CholmodSupernodalLLt);
+      analyze_as(Eigen::CholmodSupernodalLLt);
   }
   if (fallback) {
     factor_->entries = 0;
