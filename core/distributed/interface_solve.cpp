@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "distributed/interface_poses.hpp"
+#include "solvers/elimination_order.hpp"
 #include "solvers/supernodal_factor.hpp"
 #include "solvers/tangent_coordinates.hpp"
 
@@ -119,14 +120,10 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
       const Eigen::Index c = interior_index[static_cast<std::size_t>(pp.j)];
       if (a >= 0 && c >= 0) t.emplace_back(a, c, 1.0);
     }
-    SparseMatrix pattern(s.mI, s.mI);
-    pattern.setFromTriplets(t.begin(), t.end());
-    Eigen::AMDOrdering<int> amd;
-    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
-    amd(pattern, perm);
-    // perm.indices()(k): the interior index eliminated k-th.
+    const std::vector<Eigen::Index> order = amd_elimination_order(s.mI, t);  // interior indices
     for (Eigen::Index k = 0; k < s.mI; ++k)
-      s.slot[static_cast<std::size_t>(interior[static_cast<std::size_t>(perm.indices()(k))])] = k;
+      s.slot[static_cast<std::size_t>(
+          interior[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])])] = k;
   }
   for (PosePair& pp : all)
     if (s.slot[static_cast<std::size_t>(pp.i)] >= s.slot[static_cast<std::size_t>(pp.j)])
