@@ -28,6 +28,10 @@ DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSo
       if (options.robust.final_refine) {
         o.refine.enabled = true;
         o.refine.when = NewtonRefineOptions::When::kAlways;
+      } else if (auto_refine) {
+        // Switched off means the rounds' answer: `auto` would otherwise refine wherever the
+        // team's interface fits the interface solves.
+        o.refine.enabled = false;
       }
       break;
   }
