@@ -74,7 +74,7 @@ options:
   --coarse-smoothing S   smoothed: smoothing steps of the blend, 0..8 (default 1)
   --refine newton|auto|none after the rounds, trust-region Newton steps on the whole
                        problem (docs/newton-refine.md); auto: where the team's interface
-                       fits the exact interface solves, rounds to gradient 1 then always
+                       fits the exact interface solves, rounds to gradient 30 then always
                        the refinement, elsewhere only where the rounds stopped short of
                        their limit (default auto)
   --refine-grad-tol T, --refine-rel-tol F

@@ -268,7 +268,7 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "steps on the whole problem: CG over neighbour exchanges\n"
        "and all-agent sums (docs/newton-refine.md); auto: where\n"
        "the team's interface fits the exact interface solves,\n"
-       "rounds to gradient 1, then always the refinement;\n"
+       "rounds to gradient 30, then always the refinement;\n"
        "elsewhere only where the rounds' last cost decreases say\n"
        "they stopped more than 1e-7 of f above their limit  [auto]",
        check_refine},

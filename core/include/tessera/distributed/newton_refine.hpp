@@ -197,12 +197,13 @@ struct NewtonRefineOptions {
   int interface_max_coordinates = 1000;
   /// kIfRoundsSlow: where the interface solves apply (the team's interface within
   /// interface_max_coordinates), the rounds stop at max(the solver's grad_norm_tol,
-  /// this) and the refinement always runs. Why: with exact interface solves a Newton step costs
-  /// a few message steps, where the rounds' last decades cost hundreds (ais2klinik at N = 5:
-  /// 488 rounds to 0.01 and 3,141 message steps with the refinement, against 405 message steps
-  /// from gradient 1; docs/newton-refine.md, "Interface solves"). 0 = off (the rounds' tail
+  /// this) and the refinement always runs. Why: with exact interface solves (and exact trial
+  /// translations) a Newton step costs a few message steps even from a rough point, where the
+  /// rounds' last decades cost hundreds: in process at N = 5, message steps from gradient 1
+  /// against 30: kitti_02 663 -> 123, ais2klinik 127 -> 31, city10000 109 -> 27, the same
+  /// certified optimum (docs/newton-refine.md, "Handing over"). 0 = off (the rounds' tail
   /// alone decides). >= 0.
-  double auto_interface_grad_tol = 1.0;
+  double auto_interface_grad_tol = 30.0;
   /// Relative shift eta of Sigma (times its largest diagonal entry; Sigma is singular along the
   /// gauge); on a failed factorization it is raised 1,000-fold twice before the fallback.
   /// (0, 1e-3].
