@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "distributed/interface_poses.hpp"
+#include "distributed/schur_share.hpp"
 #include "solvers/elimination_order.hpp"
 #include "solvers/supernodal_factor.hpp"
 #include "solvers/tangent_coordinates.hpp"
@@ -275,17 +276,16 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
       throw std::runtime_error("newton refine: malformed interface share from agent " +
                                std::to_string(b));
     };
-    if (v.empty()) fail();
-    if (v[0] == 0.0) return false;  // a block's Hessian is not positive definite
-    const Eigen::Index at = s.block_offset[b], nG = s.block_size[b];
-    std::size_t k = 1;
-    const std::size_t tri = static_cast<std::size_t>(nG * (nG + 1) / 2);
-    if (v.size() < k + tri + 1) fail();
-    for (Eigen::Index j = 0; j < nG; ++j)
-      for (Eigen::Index i = j; i < nG; ++i) {
-        if (i == j) top = std::max(top, v[k]);
-        t.emplace_back(at + i, at + j, v[k++]);
-      }
+    std::size_t k = 0;
+    switch (read_schur_triangle(v, s.block_offset[b], s.block_size[b], t, top, k)) {
+      case SchurShare::kMalformed:
+        fail();
+        break;
+      case SchurShare::kBlockNotPositiveDefinite:
+        return false;  // that block's Hessian
+      case SchurShare::kRead:
+        break;
+    }
     const double count = v[k++];
     const std::size_t per = static_cast<std::size_t>(2 + p * p);
     if (!(count >= 0) || v.size() != k + static_cast<std::size_t>(count) * per) fail();

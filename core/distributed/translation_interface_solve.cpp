@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "distributed/interface_poses.hpp"
+#include "distributed/schur_share.hpp"
 
 namespace tessera {
 
@@ -191,16 +192,16 @@ bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<dou
       throw std::runtime_error("newton refine: malformed translation share from agent " +
                                std::to_string(b));
     };
-    if (v.empty()) fail();
-    if (v[0] == 0.0) return false;  // that block's L_BB is not positive definite
-    const Eigen::Index at = s.block_offset[b], nG = s.block_size[b];
-    std::size_t k = 1;
-    if (v.size() < k + static_cast<std::size_t>(nG * (nG + 1) / 2) + 1) fail();
-    for (Eigen::Index j = 0; j < nG; ++j)
-      for (Eigen::Index i = j; i < nG; ++i) {
-        if (i == j) top = std::max(top, v[k]);
-        t.emplace_back(at + i, at + j, v[k++]);
-      }
+    std::size_t k = 0;
+    switch (read_schur_triangle(v, s.block_offset[b], s.block_size[b], t, top, k)) {
+      case SchurShare::kMalformed:
+        fail();
+        break;
+      case SchurShare::kBlockNotPositiveDefinite:
+        return false;  // that block's L_BB
+      case SchurShare::kRead:
+        break;
+    }
     const double count = v[k++];
     if (!(count >= 0) || v.size() != k + 3 * static_cast<std::size_t>(count)) fail();
     for (; k < v.size(); k += 3) {
