@@ -277,15 +277,8 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
                                std::to_string(b));
     };
     std::size_t k = 0;
-    switch (read_schur_triangle(v, s.block_offset[b], s.block_size[b], t, top, k)) {
-      case SchurShare::kMalformed:
-        fail();
-        break;
-      case SchurShare::kBlockNotPositiveDefinite:
-        return false;  // that block's Hessian
-      case SchurShare::kRead:
-        break;
-    }
+    if (!read_schur_triangle(v, s.block_offset[b], s.block_size[b], t, top, k, fail))
+      return false;  // that block's Hessian is not positive definite
     const double count = v[k++];
     const std::size_t per = static_cast<std::size_t>(2 + p * p);
     if (!(count >= 0) || v.size() != k + static_cast<std::size_t>(count) * per) fail();

@@ -12,26 +12,26 @@
 
 namespace tessera {
 
-enum class SchurShare { kRead, kBlockNotPositiveDefinite, kMalformed };
-
 /// Appends the share's triangle to `t` at rows and columns `at`.. `at + nG - 1` (lower
 /// triangle), raises `top` to its largest diagonal entry and sets `next` to the count's index.
-/// kMalformed when `v` is too short to hold the flag, the triangle and the count.
-inline SchurShare read_schur_triangle(const std::vector<double>& v, Eigen::Index at,
-                                      Eigen::Index nG, std::vector<Eigen::Triplet<double>>& t,
-                                      double& top, std::size_t& next) {
-  if (v.empty()) return SchurShare::kMalformed;
-  if (v[0] == 0.0) return SchurShare::kBlockNotPositiveDefinite;
+/// False when the block's factor failed (its flag is 0); calls `malformed` (which throws) when
+/// `v` is too short to hold the flag, the triangle and the count.
+template <class Malformed>
+bool read_schur_triangle(const std::vector<double>& v, Eigen::Index at, Eigen::Index nG,
+                         std::vector<Eigen::Triplet<double>>& t, double& top, std::size_t& next,
+                         Malformed malformed) {
+  if (v.empty()) malformed();
+  if (v[0] == 0.0) return false;
   std::size_t k = 1;
   const std::size_t tri = static_cast<std::size_t>(nG * (nG + 1) / 2);
-  if (v.size() < k + tri + 1) return SchurShare::kMalformed;
+  if (v.size() < k + tri + 1) malformed();
   for (Eigen::Index j = 0; j < nG; ++j)
     for (Eigen::Index i = j; i < nG; ++i) {
       if (i == j) top = std::max(top, v[k]);
       t.emplace_back(at + i, at + j, v[k++]);
     }
   next = k;
-  return SchurShare::kRead;
+  return true;
 }
 
 }  // namespace tessera

@@ -193,15 +193,8 @@ bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<dou
                                std::to_string(b));
     };
     std::size_t k = 0;
-    switch (read_schur_triangle(v, s.block_offset[b], s.block_size[b], t, top, k)) {
-      case SchurShare::kMalformed:
-        fail();
-        break;
-      case SchurShare::kBlockNotPositiveDefinite:
-        return false;  // that block's L_BB
-      case SchurShare::kRead:
-        break;
-    }
+    if (!read_schur_triangle(v, s.block_offset[b], s.block_size[b], t, top, k, fail))
+      return false;  // that block's L_BB is not positive definite
     const double count = v[k++];
     if (!(count >= 0) || v.size() != k + 3 * static_cast<std::size_t>(count)) fail();
     for (; k < v.size(); k += 3) {
