@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "solvers/cholmod_dense_view.hpp"
+
 namespace tessera {
 
 struct SupernodalFactor::Impl {
@@ -80,15 +82,7 @@ void SupernodalFactor::solve_system(int system, Eigen::VectorXd& v) const {
   if (v.size() != s.n) throw std::invalid_argument("SupernodalFactor: wrong vector size");
   if (system != CHOLMOD_A && s.ordering != Ordering::kGiven)
     throw std::logic_error("SupernodalFactor: L solves need the given ordering");
-  cholmod_dense rhs;
-  rhs.nrow = static_cast<std::size_t>(v.size());
-  rhs.ncol = 1;
-  rhs.nzmax = rhs.nrow;
-  rhs.d = rhs.nrow;
-  rhs.x = v.data();
-  rhs.z = nullptr;
-  rhs.xtype = CHOLMOD_REAL;
-  rhs.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense rhs = cholmod_dense_view(v);
   if (!cholmod_solve2(system, s.L, &rhs, nullptr, &s.x_, nullptr, &s.y_, &s.e_, &s.c))
     throw std::runtime_error("SupernodalFactor: CHOLMOD solve failed");
   v = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(s.x_->x), v.size());

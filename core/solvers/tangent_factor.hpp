@@ -11,6 +11,8 @@
 #include <tessera/solvers/tangent_preconditioner.hpp>
 #include <vector>
 
+#include "solvers/cholmod_dense_view.hpp"
+
 namespace tessera {
 
 // Eigen's CHOLMOD wrapper with access to the factor, so that solves can go through
@@ -44,15 +46,7 @@ struct TangentPreconditioner::Factor {
   // call). The same numeric solve as CholmodDecomposition::solve (cholmod_solve calls
   // cholmod_solve2 with fresh workspace), hence the same result.
   const double* solve() {
-    cholmod_dense rhs;
-    rhs.nrow = static_cast<std::size_t>(b.size());
-    rhs.ncol = 1;
-    rhs.nzmax = rhs.nrow;
-    rhs.d = rhs.nrow;
-    rhs.x = b.data();
-    rhs.z = nullptr;
-    rhs.xtype = CHOLMOD_REAL;
-    rhs.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense rhs = cholmod_dense_view(b);
     cholmod_common& c = llt.cholmod();
     if (!cholmod_solve2(CHOLMOD_A, llt.factor(), &rhs, nullptr, &solve_x, nullptr, &solve_y,
                         &solve_e, &c))
