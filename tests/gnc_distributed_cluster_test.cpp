@@ -126,5 +126,25 @@ TEST(GncDistributed, ClusterProbesRejectExactlyTheGroupsTheAgentsProbesKeep) {
         << e;
 }
 
+// Every agent picks the same probe from the same data whatever order its messages arrive in (as
+// over DDS): a shuffled delivery runs the same probes to the same end.
+TEST(GncDistributed, ClusterProbesDoNotDependOnTheDeliveryOrder) {
+  const GeneratorResult g = flexible_city(0.1, OutlierKind::kGroup, 3);
+  const std::vector<int> blocks = robots_as_blocks(g);
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.cluster_probes = 20;
+  const GncDistributedResult fifo = solve_gnc_distributed(g.graph, blocks, o);
+  o.solver.delivery = DeliveryOrder::kShuffled;
+  o.solver.delivery_seed = 5;
+  const GncDistributedResult shuffled = solve_gnc_distributed(g.graph, blocks, o);
+  EXPECT_GT(fifo.probes, RobustOptions{}.recheck_probes) << "the cluster search ran";
+  EXPECT_EQ(shuffled.probes, fifo.probes);
+  EXPECT_EQ(shuffled.probes_kept, fifo.probes_kept);
+  EXPECT_EQ(shuffled.rejected, fifo.rejected);
+  EXPECT_EQ(shuffled.total_rounds, fifo.total_rounds);
+  EXPECT_EQ(shuffled.final_solve.cost, fifo.final_solve.cost);
+}
+
 }  // namespace
 }  // namespace tessera
