@@ -378,9 +378,11 @@ TEST(DdsRobust, ClusterProbesOverDdsEqualTheInProcessEngine) {
   EXPECT_GE(ref.probes_kept, 1);
   EXPECT_EQ(json_field(summary, "probes"), ref.probes) << summary;
   EXPECT_EQ(json_field(summary, "probes_kept"), ref.probes_kept) << summary;
+  EXPECT_EQ(json_field(summary, "outer_iterations"), ref.outer_iterations) << summary;
   EXPECT_EQ(json_field(summary, "rounds"), ref.total_rounds) << summary;
   EXPECT_EQ(json_array(summary, "rejected"), ref.rejected) << summary;
   EXPECT_NEAR(json_field(summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  EXPECT_EQ(json_field(summary, "min_eigenvalue"), ref.final_solve.min_eigenvalue);
   EXPECT_NE(summary.find("\"certified\": true"), std::string::npos) << summary;
 }
 
