@@ -59,6 +59,8 @@ struct RunOptions {
   /// GNC starts from the known inliers' distributed initialization when they connect the poses
   /// (GncDistributedOptions::known_inlier_start; off when --init is given).
   bool gnc_known_start = true;
+  /// GncDistributedOptions::cluster_probes (0 = none; `--gnc-cluster-probes`).
+  int gnc_cluster_probes = 0;
 };
 
 /// Everything one agent knows after the hand-off.
