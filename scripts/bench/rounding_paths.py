@@ -5,7 +5,7 @@ direct solve (round_solution), on each graph given (default: ais2klinik, city100
 
 The rounding runs in process (one thread per agent over an in-memory channel, the code the DDS
 agents run) on the in-process solver's iterate after launch's solve (`eco` partition, IRBCD,
-gradient 0.01, certificate, `--refine auto` unless --refine says otherwise):
+gradient 0.01, certificate, `--refine auto` and `none` unless --refine says otherwise):
 build/bin/rounding_paths_bench (tests/rounding_paths_bench.cpp). Counts and costs do not depend
 on the load (the CPU milliseconds, all agents' threads, do a little). With --callgrind, each path
 also runs alone under callgrind from the saved solve with only the rounding instrumented, and its
@@ -14,7 +14,7 @@ instruction count (every agent's thread, the in-memory channel's included) is ad
 Prints a table and writes docs/benchmarks/rounding_paths.csv.
 
 usage: rounding_paths.py [--bench build/bin/rounding_paths_bench] [--graphs a,b,c]
-                         [--refine auto|newton|none] [--agents N] [--callgrind] [--csv FILE]
+                         [--refine auto,none] [--agents N] [--callgrind] [--csv FILE]
 """
 import argparse
 import csv
@@ -66,21 +66,21 @@ def main():
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bench", default=os.path.join(ROOT, "build", "bin", "rounding_paths_bench"))
     ap.add_argument("--graphs", default="ais2klinik,city10000,kitti_02")
-    ap.add_argument("--refine", default="auto")
+    ap.add_argument("--refine", default="auto,none", help="launch's --refine values, in turn")
     ap.add_argument("--agents", type=int, default=5)
     ap.add_argument("--callgrind", action="store_true")
     ap.add_argument("--csv", default=os.path.join(bc.OUT_DIR, "rounding_paths.csv"))
     args = ap.parse_args()
     rows = []
-    for g in args.graphs.split(","):
+    for refine, g in [(f, g) for f in args.refine.split(",") for g in args.graphs.split(",")]:
         path = os.path.join(DATA, g + ".g2o")
         with tempfile.TemporaryDirectory() as solved:
-            out = subprocess.run([args.bench, "--agents", str(args.agents), "--refine",
-                                  args.refine, "--save", solved, path], stdout=subprocess.PIPE,
+            out = subprocess.run([args.bench, "--agents", str(args.agents), "--refine", refine,
+                                  "--save", solved, path], stdout=subprocess.PIPE,
                                  stderr=subprocess.STDOUT, text=True, check=True).stdout
             got = parse(out)
             for r in got:
-                r["refine"] = args.refine
+                r["refine"] = refine
                 if args.callgrind:
                     r["instructions"] = instructions(args.bench, path, r["path"], args.agents,
                                                      solved)
