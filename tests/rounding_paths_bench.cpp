@@ -10,9 +10,10 @@
 // --save DIR keeps each graph's solve (assignment, rounds, f(X), X) in DIR/NAME.solved, --load DIR
 // reads it back instead of solving (so a callgrind run of one path spends no time solving).
 // The solve is launch's: `eco` partition (launch's `auto` from 2,000 poses), IRBCD, gradient
-// 0.01, certificate on, `--refine auto`. Under callgrind with --instr-atstart=no only the
-// roundings are instrumented (CALLGRIND_START/STOP_INSTRUMENTATION around them): the
-// instruction count is the path's, every agent's thread. Exit 2 on bad arguments.
+// 0.01, certificate on, `--refine auto` unless --refine says otherwise. Under callgrind with
+// --instr-atstart=no only the roundings are instrumented (CALLGRIND_START/STOP_INSTRUMENTATION
+// around them; scripts/bench/rounding_paths.py also counts only inside
+// DistributedRounding::run, not the harness's set-up of the agents). Exit 2 on bad arguments.
 
 #include <valgrind/callgrind.h>
 

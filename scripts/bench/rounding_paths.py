@@ -8,13 +8,15 @@ agents run) on the in-process solver's iterate after launch's solve (`eco` parti
 gradient 0.01, certificate, `--refine auto` and `none` unless --refine says otherwise):
 build/bin/rounding_paths_bench (tests/rounding_paths_bench.cpp). Counts and costs do not depend
 on the load (the CPU milliseconds, all agents' threads, do a little). With --callgrind, each path
-also runs alone under callgrind from the saved solve with only the rounding instrumented, and its
-instruction count (every agent's thread, the in-memory channel's included) is added.
+also runs alone under callgrind from the saved solve, counting only inside
+DistributedRounding::run (every agent's thread; not the harness's set-up of the agents), and
+its instruction count is added.
 
 Prints a table and writes docs/benchmarks/rounding_paths.csv.
 
 usage: rounding_paths.py [--bench build/bin/rounding_paths_bench] [--graphs a,b,c]
-                         [--refine auto,none] [--agents N] [--callgrind] [--csv FILE]
+                         [--refine auto,none] [--agents N] [--callgrind] [--solved DIR]
+                         [--csv FILE]
 """
 import argparse
 import csv
@@ -46,19 +48,35 @@ def parse(out):
     return rows
 
 
+def inclusive(callgrind_out, function):
+    """Inclusive instructions of `function` (a name's start) in a callgrind output, 0 if absent."""
+    text = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100",
+                           callgrind_out], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                          text=True).stdout
+    for line in text.splitlines():
+        if ":" + function in line:
+            return int(line.split()[0].replace(",", ""))
+    return 0
+
+
 def instructions(bench, graph, path, agents, solved_dir):
-    """Instructions of one path's rounding (every agent's thread), from the saved solve."""
+    """Instructions of one path's rounding (every agent's thread), from the saved solve: the
+    whole DistributedRounding::run and its translation solve alone (run minus the rotations and
+    the cost's share, plus the interface share, which is sent from within the rotations' step)."""
     out = os.path.join(solved_dir, path + ".callgrind")
-    subprocess.run(["valgrind", "--tool=callgrind", "--instr-atstart=no",
+    subprocess.run(["valgrind", "--tool=callgrind", "--instr-atstart=no", "--collect-atstart=no",
+                    "--toggle-collect=tessera::agent::DistributedRounding::run(*",
                     "--callgrind-out-file=" + out, bench, "--agents", str(agents), "--path", path,
                     "--load", solved_dir, graph],
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
     with open(out) as f:
-        for line in f:
-            m = re.match(r"summary:\s+(\d+)", line) or re.match(r"totals:\s+(\d+)", line)
-            if m:
-                return int(m.group(1))
-    return None
+        counts = [int(m.group(1)) for m in
+                  (re.match(r"(?:summary|totals):\s+(\d+)", line) for line in f) if m]
+    total = max(counts) if counts else 0
+    ns = "tessera::agent::DistributedRounding::"
+    solve = (total - inclusive(out, ns + "rotations()") - inclusive(out, ns + "cost_share()") +
+             inclusive(out, ns + "send_interface_share()"))
+    return total, solve
 
 
 def main():
@@ -69,32 +87,39 @@ def main():
     ap.add_argument("--refine", default="auto,none", help="launch's --refine values, in turn")
     ap.add_argument("--agents", type=int, default=5)
     ap.add_argument("--callgrind", action="store_true")
+    ap.add_argument("--solved", default="",
+                    help="keep the solves in DIR/REFINE/NAME.solved and reuse them when there")
     ap.add_argument("--csv", default=os.path.join(bc.OUT_DIR, "rounding_paths.csv"))
     args = ap.parse_args()
     rows = []
     for refine, g in [(f, g) for f in args.refine.split(",") for g in args.graphs.split(",")]:
         path = os.path.join(DATA, g + ".g2o")
-        with tempfile.TemporaryDirectory() as solved:
-            out = subprocess.run([args.bench, "--agents", str(args.agents), "--refine", refine,
-                                  "--save", solved, path], stdout=subprocess.PIPE,
+        with tempfile.TemporaryDirectory() as tmp:
+            solved = os.path.join(args.solved, refine) if args.solved else tmp
+            os.makedirs(solved, exist_ok=True)
+            keep = ["--load" if os.path.exists(os.path.join(solved, g + ".solved")) else "--save",
+                    solved]
+            out = subprocess.run([args.bench, "--agents", str(args.agents), "--refine", refine] +
+                                 keep + [path], stdout=subprocess.PIPE,
                                  stderr=subprocess.STDOUT, text=True, check=True).stdout
             got = parse(out)
             for r in got:
                 r["refine"] = refine
                 if args.callgrind:
-                    r["instructions"] = instructions(args.bench, path, r["path"], args.agents,
-                                                     solved)
+                    r["instructions"], r["solve_instructions"] = instructions(
+                        args.bench, path, r["path"], args.agents, solved)
+                print("ROW", r, flush=True)  # as it comes: a long run keeps what it measured
         rows += got
     print("| graph | poses | cut | refine | path | interface poses | CG iterations | message steps "
           "| rounded cost above the direct solve's (relative) | CPU ms |" +
-          (" instructions |" if args.callgrind else ""))
+          (" instructions: rounding / translation solve |" if args.callgrind else ""))
     print("|---|---|---|---|---|---|---|---|---|---|" + ("---|" if args.callgrind else ""))
     for r in rows:
         print(f"| {r['graph']} | {r['poses']} | {r['cut']} | {r['refine']} | {r['path']} | "
               f"{r['interface_poses']} | {r['cg_iterations']} | {r['message_steps']} | "
               f"{r['relative']:.1e} | {r['cpu_ms']:.0f} |" +
-              (f" {r['instructions'] / 1e6:.1f} M |" if args.callgrind and r['instructions']
-               else ""))
+              (f" {r['instructions'] / 1e6:.1f} M / {r['solve_instructions'] / 1e6:.1f} M |"
+               if args.callgrind else ""))
     with open(args.csv, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()) if rows else ["graph"])
         w.writeheader()
