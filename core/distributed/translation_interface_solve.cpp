@@ -199,13 +199,13 @@ bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<dou
   Impl& s = *impl_;
   s.sigma_ok = false;
   if (blocks.size() != s.block_offset.size())
-    throw std::runtime_error("newton refine: translation shares from the wrong number of agents");
+    throw std::runtime_error("translation interface solve: shares from the wrong number of agents");
   std::vector<Eigen::Triplet<double>> t;
   double top = 0.0;
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     const std::vector<double>& v = *blocks[b];
     auto fail = [b] {
-      throw std::runtime_error("newton refine: malformed translation share from agent " +
+      throw std::runtime_error("translation interface solve: malformed share from agent " +
                                std::to_string(b));
     };
     std::size_t k = 0;

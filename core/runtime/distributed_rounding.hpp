@@ -226,6 +226,7 @@ class DistributedRounding {
   Eigen::MatrixXd frame_;              // r x d: the Gram matrix's top-d eigenvectors
   bool reflected_ = false;             // last row flipped so most blocks are rotations
   std::unique_ptr<TranslationInterfaceSolve> interface_;  // the exact solve, when it runs
+  std::vector<double> interface_share_;                   // this block's share, as sent
 };
 
 }  // namespace tessera::agent

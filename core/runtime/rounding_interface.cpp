@@ -50,8 +50,9 @@ void DistributedRounding::send_interface_share() {
   }
   interface_ = std::make_unique<TranslationInterfaceSolve>(own_, entries, cut, layout_,
                                                            static_cast<int>(self_));
+  interface_share_ = interface_->share();
   mail_.send_all({OutgoingMessage{
-      make_reduction_message(static_cast<int>(self_), 0, kInterfaceShare, interface_->share()),
+      make_reduction_message(static_cast<int>(self_), 0, kInterfaceShare, interface_share_),
       true,
       {}}});
 }
@@ -59,11 +60,10 @@ void DistributedRounding::send_interface_share() {
 bool DistributedRounding::take_interface_shares() {
   if (!interface_) return false;
   auto got = mail_.gather(kInterfaceShare, 0, others());
-  const std::vector<double> mine = interface_->share();
   std::vector<const std::vector<double>*> blocks;
   for (std::uint32_t a : everyone_) {
     if (a == self_) {
-      blocks.push_back(&mine);
+      blocks.push_back(&interface_share_);
       continue;
     }
     const auto* m = std::get_if<PoseBlockMessage>(&got.at(a));
