@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <new>
+#include <tessera/util/resource_error.hpp>
 #include <type_traits>
 
 #include "session_args.hpp"
@@ -96,6 +98,11 @@ int run_role_process(const SessionOptions& options, const ProcessRole& role, Sig
     code = leave(s, role, f.exit_code(), f.what(), f.tell_others());
   } catch (const InputError& e) {
     code = leave(s, role, kExitBadInput, e.what(), true);
+  } catch (const ResourceError& e) {
+    code = leave(s, role, kExitRunFailed, std::string("out of resources: ") + e.what(), true);
+  } catch (const std::bad_alloc&) {
+    code = leave(s, role, kExitRunFailed, "out of resources: out of memory (an allocation failed)",
+                 true);
   } catch (const std::exception& e) {
     // A stop may hide behind another error raised while stopping: prefer the cause.
     if (auto stop = s.mailroom().stop_info())
