@@ -7,10 +7,13 @@
 // The kill is the test-only TESSERA_TEST_AGENT_KILL=STAGE@K:ID (agent/test_abort_hook.hpp),
 // given through /usr/bin/env: the agent SIGKILLs itself at the K-th progress point of STAGE, so
 // the loss lands in that stage on every run, however loaded the host.
-// Domains used here: 214, 219, 220, 227 (each test its own, so ctest -j is safe).
+// A process restarted from its checkpoint after such a kill rejoins: every agent rolls back to
+// a round of the first solve stage and the run repeats the undisturbed one exactly.
+// Domains used here: 214, 219, 220, 227, 229 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <string>
@@ -138,6 +141,67 @@ TEST(DdsStageLoss, AgentKilledInTheRefinementWithoutReplicasStopsTheRunNamingIt)
   for (int k : {0, 1, 3, 4})
     EXPECT_EQ(agents[static_cast<std::size_t>(k)].exit_code, 1)
         << agents[static_cast<std::size_t>(k)].output();
+}
+
+// Killed in the refinement and started again from its checkpoint (a supervisor's restart): the
+// coordinator orders a rollback to the newest checkpoint round every agent has reached (the
+// refinement keeps no snapshots, so a round of the first solve stage), and the run ends with the
+// undisturbed run's cost to the last digit, certified.
+TEST(DdsStageLoss, AgentKilledInTheRefinementRejoinsFromItsCheckpointWithTheUndisturbedResult) {
+  const StageLossRun r = make_run(229, "refinerejoin", "refinement@5");
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const auto coordinator = [&](const std::string& tag) {
+    return start(
+        coordinator_args(r.agents, r.run + tag, r.domain,
+                         {"--timeout", "20", "--run-timeout", "60", "--summary",
+                          r.dir + "/summary" + tag + ".json", "--partition", "eco", "--grad-tol",
+                          "0.0005", "--certify", "--refine", "auto", "--rejoin-timeout", "20"}),
+        r.dir + "/coordinator" + tag + ".log");
+  };
+  const auto agent_argv = [&](const std::string& tag, int k) {
+    const std::string ckpt = r.dir + "/ckpt" + tag + std::to_string(k);
+    mkdir(ckpt.c_str(), 0755);
+    return agent_args(r.graph, r.agents, k, r.run + tag, r.domain,
+                      {"--timeout", "20", "--udp-only", "--checkpoint-dir", ckpt});
+  };
+  const auto run = [&](const std::string& tag, bool kill) {
+    Process coord = coordinator(tag);
+    std::vector<Process> agents;
+    agents.reserve(static_cast<std::size_t>(r.agents) + 1);
+    for (int k = 0; k < r.agents; ++k) {
+      std::vector<std::string> a = agent_argv(tag, k);
+      if (kill && k == r.victim)
+        a.insert(a.begin(), {"/usr/bin/env", "TESSERA_TEST_AGENT_KILL=" + r.kill});
+      agents.push_back(start(a, r.dir + "/agent" + tag + std::to_string(k) + ".log"));
+    }
+    if (kill) {
+      Process& victim = agents[static_cast<std::size_t>(r.victim)];
+      EXPECT_TRUE(wait_all({&victim}, 30)) << victim.output();
+      EXPECT_EQ(victim.exit_code, 128 + SIGKILL) << victim.output();
+      EXPECT_NE(victim.output().find("killed in the refinement"), std::string::npos)
+          << victim.output();
+      agents.push_back(start(agent_argv(tag, r.victim),
+                             r.dir + "/agent" + tag + std::to_string(r.victim) + "-again.log"));
+    }
+    EXPECT_TRUE(wait_all(all_of(coord, agents), 60)) << "a process hung\n"
+                                                     << outputs_of(coord, agents);
+    EXPECT_EQ(coord.exit_code, 0) << outputs_of(coord, agents);
+    for (std::size_t k = 0; k < agents.size(); ++k) {
+      if (kill && k == static_cast<std::size_t>(r.victim)) continue;  // SIGKILLed
+      EXPECT_EQ(agents[k].exit_code, 0) << agents[k].output();
+    }
+    return std::make_pair(coord.output(), slurp(r.dir + "/summary" + tag + ".json"));
+  };
+  const auto [co, disturbed] = run("-killed", true);
+  EXPECT_NE(co.find("rejoined: every agent rolls back to round"), std::string::npos) << co;
+  const auto [co0, undisturbed] = run("-undisturbed", false);
+  EXPECT_NE(disturbed.find("\"certified\": true"), std::string::npos) << disturbed;
+  const auto cost_of = [](const std::string& summary) {
+    const std::size_t at = summary.find("\"cost\": ");
+    return at == std::string::npos ? std::string() : summary.substr(at, summary.find(',', at) - at);
+  };
+  ASSERT_FALSE(cost_of(undisturbed).empty()) << undisturbed;
+  EXPECT_EQ(cost_of(disturbed), cost_of(undisturbed)) << disturbed << "\n" << undisturbed;
 }
 
 }  // namespace
