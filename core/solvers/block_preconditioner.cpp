@@ -168,7 +168,8 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
   if (factor_->supernodal && simplicial_solves &&
       !cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/0, /*to_super=*/0, /*to_packed=*/1,
                              /*to_monotonic=*/1, factor_->llt->raw(), &factor_->llt->cholmod()))
-    throw std::runtime_error("BlockPreconditioner: converting the factor failed");
+    throw_cholmod_failure("BlockPreconditioner", "factor conversion",
+                          factor_->llt->cholmod().status, A.rows(), A.cols());
 }
 
 bool BlockPreconditioner::block_diagonal() const {

@@ -85,7 +85,7 @@ void SupernodalFactor::solve_system(int system, Eigen::VectorXd& v) const {
     throw std::logic_error("SupernodalFactor: L solves need the given ordering");
   cholmod_dense rhs = cholmod_dense_view(v);
   if (!cholmod_solve2(system, s.L, &rhs, nullptr, &s.x_, nullptr, &s.y_, &s.e_, &s.c))
-    throw std::runtime_error("SupernodalFactor: CHOLMOD solve failed");
+    throw_cholmod_failure("SupernodalFactor", "solve", s.c.status, s.n, s.n);
   v = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(s.x_->x), v.size());
 }
 
