@@ -9,7 +9,7 @@
 // the loss lands in that stage on every run, however loaded the host.
 // A process restarted from its checkpoint after such a kill rejoins: every agent rolls back to
 // a round of the first solve stage and the run repeats the undisturbed one exactly.
-// Domains used here: 214, 219, 220, 227, 229 (each test its own, so ctest -j is safe).
+// Domains used here: 86, 214, 219, 220, 227 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -148,7 +148,7 @@ TEST(DdsStageLoss, AgentKilledInTheRefinementWithoutReplicasStopsTheRunNamingIt)
 // refinement keeps no snapshots, so a round of the first solve stage), and the run ends with the
 // undisturbed run's cost to the last digit, certified.
 TEST(DdsStageLoss, AgentKilledInTheRefinementRejoinsFromItsCheckpointWithTheUndisturbedResult) {
-  const StageLossRun r = make_run(229, "refinerejoin", "refinement@5");
+  const StageLossRun r = make_run(86, "refinerejoin", "refinement@5");
   ASSERT_FALSE(::testing::Test::HasFailure());
   const auto coordinator = [&](const std::string& tag) {
     return start(
