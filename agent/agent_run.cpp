@@ -15,6 +15,7 @@
 #include "agent/lost_for_good.hpp"
 #include "agent/rejoin.hpp"
 #include "agent/run_setup.hpp"
+#include "agent/test_abort_hook.hpp"
 #include "launch/heap_retention.hpp"
 #include "runtime/agent_log.hpp"
 #include "runtime/checkpoint_keeper.hpp"
@@ -89,7 +90,10 @@ void solve(AgentSession& s, const AgentOptions& o, const AgentLog& log, const Ag
   // The block set-up's temporaries (the factors' analyses, the matrices they were built from)
   // would otherwise stay under the rounds as free heap: 70 MB on a 16,000-pose 3D block.
   hooks.after_set_up = [] { launch::release_freed_heap(); };
-  if (log.verbose) hooks.on_phase = [&](const std::string& phase) { log(phase_memory_line(phase)); };
+  if (test_kill_armed())  // test builds only (agent/test_abort_hook.hpp)
+    hooks.on_progress_point = [&](ProgressStage stage) { test_kill_point(stage, o.id); };
+  if (log.verbose)
+    hooks.on_phase = [&](const std::string& phase) { log(phase_memory_line(phase)); };
   log(std::string("round snapshots: ") +
       (hooks.on_round ? "kept (rejoin, checkpoints or replicas)" : "none (nothing reads them)"));
   for (;;) {

@@ -10,8 +10,17 @@
 //                   is not complete and must fail (exit 134, launch exit 1);
 //   after-finished  after the coordinator's FINISHED (the merged result is written): the
 //                   cover of cli/session_process.cpp ends the agent with exit 0 and a note.
+//
+// And TESSERA_TEST_AGENT_KILL=STAGE[@K][:ID] SIGKILLs the agent (a process lost for good, as a
+// crash or an OOM kill leaves it) at the K-th (default 1) progress point of a stage after the
+// rounds (tests/dds_stage_loss_test.cpp), STAGE one of
+//   refinement   a protocol message handled in the Newton refinement;
+//   certificate  a protocol message handled in the distributed certificate;
+//   rounding     an iteration of the distributed rounding's translation CG.
 
 #include <cstdint>
+
+#include "runtime/stage_progress.hpp"
 
 namespace tessera::agent {
 
@@ -20,8 +29,17 @@ enum class TestAbortPoint { kBeforeResult, kAfterFinished };
 #ifdef TESSERA_TEST_HOOKS
 /// Aborts the process if TESSERA_TEST_AGENT_ABORT names `at` for agent `id`; else nothing.
 void test_abort_point(TestAbortPoint at, std::uint32_t id);
+/// Whether TESSERA_TEST_AGENT_KILL is set (the round loop then reports every progress point).
+bool test_kill_armed();
+/// Called at each progress point of `stage` on agent `id`: SIGKILLs the process at the one
+/// TESSERA_TEST_AGENT_KILL names; else nothing.
+void test_kill_point(ProgressStage stage, std::uint32_t id);
 #else
 inline void test_abort_point(TestAbortPoint, std::uint32_t) {}
+inline bool test_kill_armed() {
+  return false;
+}
+inline void test_kill_point(ProgressStage, std::uint32_t) {}
 #endif
 
 }  // namespace tessera::agent

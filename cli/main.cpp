@@ -3,8 +3,10 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <string>
 #include <tessera/util/input_error.hpp>
+#include <tessera/util/resource_error.hpp>
 
 #include "commands.hpp"
 
@@ -48,6 +50,14 @@ int main(int argc, char** argv) {
     } catch (const tessera::InputError& e) {
       std::fprintf(stderr, "tessera %s: error: %s\n", c.name, e.what());
       return 2;
+    } catch (const tessera::ResourceError& e) {  // not a bug: a limit of this machine
+      std::fprintf(stderr, "tessera %s: error: out of resources: %s\n", c.name, e.what());
+      return 1;
+    } catch (const std::bad_alloc&) {
+      std::fprintf(stderr,
+                   "tessera %s: error: out of resources: out of memory (an allocation failed)\n",
+                   c.name);
+      return 1;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "tessera %s: internal error: %s\n", c.name, e.what());
       return 3;

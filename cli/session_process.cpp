@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <new>
+#include <tessera/util/resource_error.hpp>
 #include <type_traits>
 
 #include "session_args.hpp"
@@ -58,6 +60,15 @@ int leave(Session& session, const ProcessRole& role, int code, const std::string
   return code;
 }
 
+// What a process's own failure says: a resource limit (util/resource_error.hpp, or an allocation
+// refused) as "out of resources", not as the bare "std::bad_alloc".
+std::string failure_text(const std::exception& e) {
+  if (dynamic_cast<const ResourceError*>(&e)) return std::string("out of resources: ") + e.what();
+  if (dynamic_cast<const std::bad_alloc*>(&e))
+    return "out of resources: out of memory (an allocation failed)";
+  return e.what();
+}
+
 // run_session_process for the session of either role: only agents read FINISHED.
 template <class RoleSession>
 int run_role_process(const SessionOptions& options, const ProcessRole& role, SignalWatcher& signals,
@@ -101,7 +112,7 @@ int run_role_process(const SessionOptions& options, const ProcessRole& role, Sig
     if (auto stop = s.mailroom().stop_info())
       code = leave(s, role, stop->exit_code, stop->reason, !stop->remote);
     else
-      code = leave(s, role, kExitRunFailed, e.what(), true);
+      code = leave(s, role, kExitRunFailed, failure_text(e), true);
   }
   signals.stop();  // the callback refers to the session
   s.close(code);   // a Fast DDS abort or hang while deleting still exits with `code`

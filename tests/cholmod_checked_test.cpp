@@ -8,15 +8,23 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCore>
+#include <cstdlib>
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <tessera/certification/certificate.hpp>
 #include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
 #include <tessera/solvers/tangent_preconditioner.hpp>
+#include <tessera/util/resource_error.hpp>
 #include <vector>
 
+#include "partition/spectral_layouts.hpp"
+#include "partition/work_graph.hpp"
 #include "random_graph.hpp"
+#include "solvers/supernodal_factor.hpp"
+#include "structure_graphs.hpp"
 
 namespace tessera {
 namespace {
@@ -97,6 +105,116 @@ TEST(CholmodChecked, TangentPreconditionerWithAFailedAnalysisIsNotUsable) {
   RefusedAllocations refused;
   TangentPreconditioner precon(problem, 1e-9, 0, /*supernodal_min_flops=*/1.0);
   EXPECT_FALSE(precon.usable());
+}
+
+// The first `allowed` CHOLMOD allocations (malloc and calloc) succeed, every later one fails:
+// a factorization that runs out of memory after its analysis succeeded.
+long g_allowed = 0;
+void* limited_malloc(std::size_t n) {
+  return --g_allowed >= 0 ? std::malloc(n) : nullptr;
+}
+void* limited_calloc(std::size_t n, std::size_t size) {
+  return --g_allowed >= 0 ? std::calloc(n, size) : nullptr;
+}
+struct LimitedAllocations {
+  void* (*saved_malloc)(std::size_t) = SuiteSparse_config.malloc_func;
+  void* (*saved_calloc)(std::size_t, std::size_t) = SuiteSparse_config.calloc_func;
+  explicit LimitedAllocations(long allowed) {
+    g_allowed = allowed;
+    SuiteSparse_config.malloc_func = limited_malloc;
+    SuiteSparse_config.calloc_func = limited_calloc;
+  }
+  ~LimitedAllocations() {
+    SuiteSparse_config.malloc_func = saved_malloc;
+    SuiteSparse_config.calloc_func = saved_calloc;
+  }
+};
+
+TEST(CholmodChecked, FailedAnalysisOutOfMemoryIsAResourceError) {
+  const Eigen::SparseMatrix<double> L = path_laplacian(50);
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> chol;
+  RefusedAllocations refused;
+  EXPECT_THROW(cholmod_compute_checked(chol, L, "test factor"), ResourceError);
+}
+
+// Eigen's info() after a numeric factorization that ran out of memory says NumericalIssue, which
+// the certificate's shift search read as "not positive definite" and shifted on: an error now.
+TEST(CholmodChecked, FactorizationOutOfMemoryThrowsInsteadOfLookingIndefinite) {
+  Eigen::SparseMatrix<double> L = path_laplacian(300);
+  L.coeffRef(0, 0) += 1.0;
+  long analysis_allocations = 0;
+  {
+    Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> probe;
+    LimitedAllocations counting(1L << 40);
+    probe.analyzePattern(L);
+    analysis_allocations = (1L << 40) - g_allowed;
+  }
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>> chol;
+  std::string message;
+  {
+    LimitedAllocations limited(analysis_allocations);
+    try {
+      cholmod_compute_checked(chol, L, "test factor");
+    } catch (const ResourceError& e) {
+      message = e.what();
+    }
+  }
+  EXPECT_NE(message.find("test factor: CHOLMOD's factorization failed (out of memory, 300 x 300"),
+            std::string::npos)
+      << message << " (after " << analysis_allocations << " allocations of the analysis)";
+}
+
+// The centralized certificate's factorizations went through Eigen's compute(): a failed
+// analysis (a factor above 2^31 entries, out of memory) crashed the process in it.
+TEST(CholmodChecked, CentralizedCertificateReportsAFailedAnalysis) {
+  test::RandomGraphSpec spec;
+  spec.poses = 40;
+  const PoseGraph g = test::random_pose_graph(spec);
+  const BlockProblem P = BlockProblem::whole_graph(g.d, g.num_poses, g.measurements);
+  const Eigen::MatrixXd X = lift_poses(g.initial, g.d + 1);
+  std::string message;
+  {
+    RefusedAllocations refused;
+    try {
+      verify_certificate(P, X);
+    } catch (const ResourceError& e) {
+      message = e.what();
+    }
+  }
+  EXPECT_NE(message.find("certificate: CHOLMOD's analysis failed (out of memory"),
+            std::string::npos)
+      << message;
+}
+
+TEST(CholmodChecked, SupernodalFactorOutOfMemoryIsAResourceErrorNamingTheFactor) {
+  Eigen::SparseMatrix<double> L = path_laplacian(50);
+  L.coeffRef(0, 0) += 1.0;
+  const Eigen::SparseMatrix<double> lower = L.triangularView<Eigen::Lower>();
+  SupernodalFactor f;
+  std::string message;
+  {
+    RefusedAllocations refused;
+    try {
+      f.factor(lower);
+    } catch (const ResourceError& e) {
+      message = e.what();
+    }
+  }
+  EXPECT_NE(message.find("SupernodalFactor: CHOLMOD's analysis failed (out of memory, 50 x 50"),
+            std::string::npos)
+      << message;
+  EXPECT_FALSE(f.ok());
+}
+
+// The spectral layouts' shift-invert factor is optional: without it (a failed analysis) the
+// partitioner has no spectral layouts, as when Lanczos does not converge. It crashed in Eigen.
+TEST(CholmodChecked, SpectralLayoutsWithoutAFactorAreNoneInsteadOfACrash) {
+  const GraphStructure s = test::grid_structure(60, 8);
+  const partition_detail::WorkGraph g = partition_detail::to_work_graph(s);
+  const long long lmax = test::uniform_bounds(s, 4, 0.03)[0];
+  ASSERT_FALSE(partition_detail::spectral_layouts(g, 4, lmax, {}).empty());
+  RefusedAllocations refused;
+  EXPECT_TRUE(partition_detail::spectral_layouts(g, 4, lmax, {}).empty());
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <tessera/distributed/loss_recovery.hpp>
 #include <tessera/partition/graph_structure.hpp>
@@ -114,6 +115,35 @@ TEST(LossRecovery, ShapeMismatchIsAnInputError) {
   EXPECT_THROW(solve_distributed_from_lifted(f.graph, f.owner, converge_options(),
                                              Eigen::MatrixXd::Zero(4, 4 * 60)),
                InputError);
+}
+
+// A loss during the Newton refinement or the certificate: the survivors hold no snapshot of those
+// stages, so they start again from their last round's iterate and the replica (as over DDS,
+// tests/dds_stage_loss_test.cpp) and run the certified sequence again: certified at f*.
+TEST(LossRecovery, SurvivorsOfALossAfterTheRoundsRunTheCertifiedSequenceAgainToTheOptimum) {
+  const Fixture f = make_fixture();
+  DistributedOptions certified = converge_options();
+  certified.certify = true;
+  set_refine_mode(certified.refine, "newton");
+  const DistributedResult undisturbed =
+      solve_distributed(f.graph, f.owner, certified, odometry_start(f.graph));
+  ASSERT_TRUE(undisturbed.certified.value_or(false));
+  ASSERT_FALSE(undisturbed.refines.empty()) << "the undisturbed run refines";
+  // The last round before the refinement, and a replica 6 rounds older.
+  DistributedOptions before = converge_options();
+  before.max_rounds = undisturbed.rounds;
+  const DistributedResult last_round =
+      solve_distributed(f.graph, f.owner, before, odometry_start(f.graph));
+  before.max_rounds = std::max(1, undisturbed.rounds - 6);
+  const DistributedResult replica =
+      solve_distributed(f.graph, f.owner, before, odometry_start(f.graph));
+  const LossRecoveryResult r =
+      continue_after_loss(f.graph, f.owner, 5, {2}, last_round.X, replica.X, certified);
+  EXPECT_EQ(r.run.agents, 4);
+  EXPECT_TRUE(r.run.certified.value_or(false));
+  ASSERT_EQ(r.run.poses.size(), f.graph.num_poses);
+  EXPECT_LE(std::abs(r.run.cost - f.fstar), 1e-6 * f.fstar) << r.run.cost << " vs f* " << f.fstar;
+  EXPECT_LE(std::abs(r.run.cost - undisturbed.cost), 1e-6 * f.fstar);
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 #include <tessera/certification/certificate.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "solvers/cholmod_checked.hpp"
+
 namespace tessera {
 
 void CertificateOptions::validate() const {
@@ -125,7 +127,7 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
   double shift = std::max(res.tolerance, 1e-12 * scale);
   Factor factor;
   quiet(factor);
-  factor.compute(shifted(S, shift));
+  cholmod_compute_checked(factor, shifted(S, shift), "certificate");
   ++res.factorizations;
   res.certified = factor.info() == Eigen::Success;
   // Not PSD within eta: push the shift down (S + shift I is PD for shift > -lambda_min,
@@ -133,7 +135,7 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
   while (factor.info() != Eigen::Success) {
     shift *= 10.0;
     if (shift > 1e3 * scale * 4) throw std::runtime_error("certificate: no PD shift found");
-    factor.compute(shifted(S, shift));
+    cholmod_compute_checked(factor, shifted(S, shift), "certificate");
     ++res.factorizations;
   }
   Eigen::VectorXd v;
@@ -163,7 +165,7 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
     if (std::isfinite(tight) && tight < shift) {
       Factor refined;
       quiet(refined);
-      refined.compute(shifted(S, tight));
+      cholmod_compute_checked(refined, shifted(S, tight), "certificate");
       ++res.factorizations;
       if (refined.info() == Eigen::Success)
         res.min_eigenvalue = min_eigen_by_shift_invert(refined, n, tight, options,

@@ -187,6 +187,11 @@ void CertificateProtocol::build_preconditioner() {
   precon_ = std::make_unique<BlockJacobi>();
   double shift = std::max(options_.relative_tolerance, 1e-12) * local_scale;
   const bool pose_wise = state_.block_factor_too_large();
+  // A NaN passes the factorizations below (NaN <= 0 is false): it would spread through every
+  // LOBPCG step of every agent. A non-finite iterate stops here, naming the agent.
+  if (!lambda_.coeffs().allFinite())
+    throw std::runtime_error("certificate: agent " + std::to_string(state_.id()) +
+                             ": its multipliers Lambda are not finite (a non-finite iterate)");
   // The exact factor's matrix S_BB = Q_BB - Lambda_B; the pose-wise fallback (large blocks)
   // reads S_BB's diagonal blocks straight from Q_BB and Lambda_B instead: two matrices the
   // size of Q_BB less at the agent's memory peak.

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "solvers/cholmod_checked.hpp"
 #include "solvers/elimination_order.hpp"
 
 // BLAS (the one CHOLMOD's supernodal factorization runs on): C = A A^T, lower triangle.
@@ -59,10 +60,13 @@ class SupernodalCholesky {
   Eigen::Index factor(const SparseMatrix& lower) {
     cholmod_sparse a = Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
     L_ = cholmod_analyze(&a, &c_);
-    if (!L_) throw std::runtime_error("certificate: CHOLMOD analysis failed");
+    if (!L_)
+      throw_cholmod_failure("certificate (interface Schur complement)", "analysis", c_.status,
+                            lower.rows(), lower.cols());
     cholmod_factorize(&a, L_, &c_);
     if (c_.status < CHOLMOD_OK)
-      throw std::runtime_error("certificate: CHOLMOD factorization failed");
+      throw_cholmod_failure("certificate (interface Schur complement)", "factorization", c_.status,
+                            lower.rows(), lower.cols());
     return static_cast<Eigen::Index>(L_->minor);
   }
 

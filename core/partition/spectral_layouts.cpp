@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "partition/kway_refinement.hpp"
+#include "solvers/cholmod_checked.hpp"
 
 namespace tessera::partition_detail {
 
@@ -88,8 +89,12 @@ Eigen::MatrixXd embedding(const WorkGraph& g, int m, const SpectralLayoutOptions
   L.setFromTriplets(t.begin(), t.end());
   Factor factor;
   factor.cholmod().print = 0;
-  factor.compute(L);
-  if (factor.info() != Eigen::Success) return {};
+  // No factor (a resource limit: out of memory, above CHOLMOD's 2^31 entries): no spectral
+  // layout, as when the factorization or Lanczos fails; the partitioner's other starts remain.
+  factor.analyzePattern(L);
+  if (cholmod_analysis_failed(factor)) return {};
+  factor.factorize(L);
+  if (factor.cholmod().status < CHOLMOD_OK || factor.info() != Eigen::Success) return {};
   ProjectedInverse op(factor, n);
   const Eigen::Index ncv = std::min<Eigen::Index>(n - 1, std::max(2 * m + 1, 20));
   Spectra::SymEigsSolver<ProjectedInverse> eigs(op, m, ncv);

@@ -138,6 +138,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   const RoundConfig config = make_round_config(options, scheme.get());
   Mailbox mail(channel, receive_timeout_s, local.agent_id);
   mail.set_num_agents(local.num_agents);
+  mail.on_progress_point = hooks.on_progress_point;
   RoundLoopResult res;
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<CertifiedAgent> sequence;
@@ -166,6 +167,8 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
       const auto p = sequence->certificate_progress();
       if (p && p->first > 0)  // from its first iteration on: a lambda_min estimate to show
         mail.report_progress(ProgressStage::kCertificate, p->first, p->second);
+      else if (p && mail.on_progress_point)  // nothing to show yet, but a point all the same
+        mail.on_progress_point(ProgressStage::kCertificate);
       else if (const auto r = sequence->refine_progress())
         mail.report_progress(ProgressStage::kRefinement,
                              refinement_iteration(r->step, r->cg_iteration), r->grad_norm);

@@ -33,6 +33,8 @@ struct ProtocolSnapshot;  // distributed/protocol_snapshot.hpp
 
 namespace tessera::agent {
 
+enum class ProgressStage : std::uint32_t;  // runtime/stage_progress.hpp
+
 /// Algorithm options of the run as published by the coordinator (simple fields).
 struct RunOptions {
   std::string algorithm;           ///< Solver name ("" = core's default).
@@ -229,6 +231,10 @@ struct RoundLoopHooks {
   /// Called once the block's problem and preconditioners are built, before the first round:
   /// the set-up's temporaries are freed then (the agent hands that heap back to the kernel).
   std::function<void()> after_set_up;
+  /// Called on every agent at each progress point of a stage after the rounds: a message
+  /// handled in the Newton refinement or the certificate, an iteration of the rounding's
+  /// translation CG (where agent 0 reports progress). Empty: not called.
+  std::function<void(ProgressStage)> on_progress_point;
 };
 
 /// Core's solver options for `options` (core's defaults where a field is 0 or empty).

@@ -71,9 +71,14 @@ class Mailbox {
   /// reports during the certificate and the Newton refinement); may be empty.
   std::function<void()> after_handled;
 
+  /// Called on every agent at each progress point of a stage after the rounds (before the
+  /// report below); may be empty (RoundLoopHooks::on_progress_point).
+  std::function<void(ProgressStage)> on_progress_point;
+
   /// Agent 0's progress report of a stage after the rounds (runtime/stage_progress.hpp); on
   /// the other agents it does nothing.
   void report_progress(ProgressStage stage, std::uint64_t iteration, double value) {
+    if (on_progress_point) on_progress_point(stage);
     if (!progress_) progress_.emplace(self_ == 0, channel_);
     progress_->report(stage, iteration, value);
   }

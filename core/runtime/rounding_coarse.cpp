@@ -40,6 +40,9 @@ bool RoundingCoarse::factorise(Eigen::MatrixXd E) {
   for (Eigen::Index k = 0; k < E.rows(); ++k)
     if (E.row(k).cwiseAbs().maxCoeff() == 0.0) E(k, k) = 1.0;
   E_ = E;
+  // A non-finite sum (a NaN from a peer) passes Eigen's LLT (NaN <= 0 is false): refused
+  // here, so the rounding goes on without the coarse correction rather than with NaNs.
+  if (!E_.allFinite()) return false;
   llt_.compute(E_);
   return llt_.info() == Eigen::Success;
 }

@@ -96,8 +96,8 @@ double analyze(Cholmod& llt, const SparseMatrix& A, Eigen::CholmodMode mode,
     }
   llt.analyzePattern(A);
   if (llt.info() != Eigen::Success || cholmod_analysis_failed(llt))
-    throw std::runtime_error("BlockPreconditioner: symbolic analysis failed (" +
-                             cholmod_status_text(llt.cholmod().status) + ")");
+    throw_cholmod_failure("BlockPreconditioner", "analysis", llt.cholmod().status, A.rows(),
+                          A.cols());
   return static_cast<double>(llt.cholmod().lnz);
 }
 
@@ -152,8 +152,14 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
     return;
   }
   factor_->llt->factorize(A);
+  if (factor_->llt->cholmod().status < CHOLMOD_OK)
+    throw_cholmod_failure("BlockPreconditioner", "factorization", factor_->llt->cholmod().status,
+                          A.rows(), A.cols());
   if (factor_->llt->info() != Eigen::Success)
-    throw std::runtime_error("BlockPreconditioner: Cholesky factorization failed");
+    throw std::runtime_error(
+        "BlockPreconditioner: the block's data matrix is not positive definite (its Cholesky "
+        "factorization stopped at column " +
+        std::to_string(factor_->llt->raw()->minor) + " of " + std::to_string(A.rows()) + ")");
   factor_->supernodal = factor_->llt->cholmod().supernodal == CHOLMOD_SUPERNODAL;
   // The supernodal solve's BLAS calls on small supernodes cost more than they save with a few
   // right-hand sides: the factor is converted to the simplicial LDL^T form, whose solves cost
@@ -162,7 +168,8 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
   if (factor_->supernodal && simplicial_solves &&
       !cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/0, /*to_super=*/0, /*to_packed=*/1,
                              /*to_monotonic=*/1, factor_->llt->raw(), &factor_->llt->cholmod()))
-    throw std::runtime_error("BlockPreconditioner: converting the factor failed");
+    throw_cholmod_failure("BlockPreconditioner", "factor conversion",
+                          factor_->llt->cholmod().status, A.rows(), A.cols());
 }
 
 bool BlockPreconditioner::block_diagonal() const {

@@ -1,13 +1,17 @@
 #pragma once
-// A CHOLMOD factorization through Eigen's wrapper that fails with a message instead of a crash
-// where CHOLMOD's symbolic analysis fails. Eigen's CholmodDecomposition::compute() does not
-// check the analysis: when it returns no factor (a factor above CHOLMOD's size limit of 2^31
-// entries, as the chordal system of the generated 1,000,000-pose 3D grid needs, or out of
-// memory), factorize() dereferences the null factor and the process dies of SIGSEGV.
+// CHOLMOD factorizations that fail with a message instead of a crash or NaNs. Eigen's
+// CholmodDecomposition::compute() does not check the analysis: when it returns no factor (a
+// factor above CHOLMOD's size limit of 2^31 entries, as the chordal system of the generated
+// 1,000,000-pose 3D grid needs, or out of memory), factorize() dereferences the null factor and
+// the process dies of SIGSEGV. A numeric factorization that runs out of memory leaves info()
+// at NumericalIssue, which callers would read as "not positive definite".
+// A resource limit (out of memory, too large) is a ResourceError (util/resource_error.hpp),
+// any other CHOLMOD error a std::runtime_error; both say what was factored and why it failed.
 
 #include <Eigen/CholmodSupport>
 #include <stdexcept>
 #include <string>
+#include <tessera/util/resource_error.hpp>
 
 namespace tessera {
 
@@ -34,19 +38,31 @@ bool cholmod_analysis_failed(Decomposition& decomposition) {
   return decomposition.cholmod().status < CHOLMOD_OK;
 }
 
+/// Throws the error of a failed CHOLMOD step: "WHAT: CHOLMOD's STEP failed (REASON, R x C
+/// matrix)", a ResourceError when `status` is a resource limit (out of memory, too large).
+[[noreturn]] inline void throw_cholmod_failure(const std::string& what, const std::string& step,
+                                               int status, long rows, long cols) {
+  const std::string message = what + ": CHOLMOD's " + step + " failed (" +
+                              cholmod_status_text(status) + ", " + std::to_string(rows) + " x " +
+                              std::to_string(cols) + " matrix)";
+  if (status == CHOLMOD_OUT_OF_MEMORY || status == CHOLMOD_TOO_LARGE) throw ResourceError(message);
+  throw std::runtime_error(message);
+}
+
 /// `decomposition.compute(A)` (analysis, then numeric factorization), except that a failed
-/// analysis throws std::runtime_error "WHAT: CHOLMOD's analysis failed (REASON)". The numeric
-/// factorization's outcome is left to `decomposition.info()`, as compute() leaves it.
+/// analysis or a numeric factorization that ends in a CHOLMOD error (out of memory, not "not
+/// positive definite", which is a warning) throws (throw_cholmod_failure). A matrix that is
+/// not positive definite is left to `decomposition.info()`, as compute() leaves it.
 template <class Decomposition, class Matrix>
 void cholmod_compute_checked(Decomposition& decomposition, const Matrix& A,
                              const std::string& what) {
   decomposition.analyzePattern(A);
-  const int status = decomposition.cholmod().status;
   if (cholmod_analysis_failed(decomposition))
-    throw std::runtime_error(what + ": CHOLMOD's analysis failed (" + cholmod_status_text(status) +
-                             ", " + std::to_string(A.rows()) + " x " + std::to_string(A.cols()) +
-                             " matrix)");
+    throw_cholmod_failure(what, "analysis", decomposition.cholmod().status, A.rows(), A.cols());
   decomposition.factorize(A);
+  if (decomposition.cholmod().status < CHOLMOD_OK)
+    throw_cholmod_failure(what, "factorization", decomposition.cholmod().status, A.rows(),
+                          A.cols());
 }
 
 }  // namespace tessera

@@ -6,6 +6,8 @@
 #include <tessera/solvers/preconditioner_edges.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "solvers/cholmod_checked.hpp"
+
 namespace tessera {
 
 void PreconditionerEdgeOptions::validate() const {
@@ -41,8 +43,9 @@ double prefix_flops(int d, std::size_t num_poses, const std::vector<Measurement>
   c.method[0].ordering = CHOLMOD_AMD;
   c.postorder = 1;
   llt.analyzePattern(A);
-  if (llt.info() != Eigen::Success)
-    throw std::runtime_error("select_preconditioner_edges: symbolic analysis failed");
+  if (llt.info() != Eigen::Success || cholmod_analysis_failed(llt))
+    throw_cholmod_failure("select_preconditioner_edges", "analysis", llt.cholmod().status, A.rows(),
+                          A.cols());
   const double block = d + 1.0;
   return block * block * block * llt.cholmod().fl;
 }

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "solvers/cholmod_checked.hpp"
 #include "solvers/cholmod_dense_view.hpp"
 
 namespace tessera {
@@ -56,7 +57,7 @@ bool SupernodalFactor::factor(const SparseMatrix& lower, double shift) {
   if (!same) {
     if (s.L) cholmod_free_factor(&s.L, &s.c);
     s.L = cholmod_analyze(&a, &s.c);
-    if (!s.L) throw std::runtime_error("SupernodalFactor: CHOLMOD analysis failed");
+    if (!s.L) throw_cholmod_failure("SupernodalFactor", "analysis", s.c.status, n, n);
     ++s.analyses;
     s.n = n;
     s.outer.assign(outer, outer + n + 1);
@@ -67,7 +68,7 @@ bool SupernodalFactor::factor(const SparseMatrix& lower, double shift) {
   double beta[2] = {shift, 0.0};
   cholmod_factorize_p(&a, beta, nullptr, 0, s.L, &s.c);
   if (s.c.status < CHOLMOD_OK)
-    throw std::runtime_error("SupernodalFactor: CHOLMOD factorization failed");
+    throw_cholmod_failure("SupernodalFactor", "factorization", s.c.status, n, n);
   s.ok = s.c.status == CHOLMOD_OK && s.L->minor == s.L->n;
   return s.ok;
 }
@@ -84,7 +85,7 @@ void SupernodalFactor::solve_system(int system, Eigen::VectorXd& v) const {
     throw std::logic_error("SupernodalFactor: L solves need the given ordering");
   cholmod_dense rhs = cholmod_dense_view(v);
   if (!cholmod_solve2(system, s.L, &rhs, nullptr, &s.x_, nullptr, &s.y_, &s.e_, &s.c))
-    throw std::runtime_error("SupernodalFactor: CHOLMOD solve failed");
+    throw_cholmod_failure("SupernodalFactor", "solve", s.c.status, s.n, s.n);
   v = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(s.x_->x), v.size());
 }
 

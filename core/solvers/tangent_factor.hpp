@@ -11,6 +11,7 @@
 #include <tessera/solvers/tangent_preconditioner.hpp>
 #include <vector>
 
+#include "solvers/cholmod_checked.hpp"
 #include "solvers/cholmod_dense_view.hpp"
 
 namespace tessera {
@@ -50,7 +51,8 @@ struct TangentPreconditioner::Factor {
     cholmod_common& c = llt.cholmod();
     if (!cholmod_solve2(CHOLMOD_A, llt.factor(), &rhs, nullptr, &solve_x, nullptr, &solve_y,
                         &solve_e, &c))
-      throw std::runtime_error("TangentPreconditioner: CHOLMOD solve failed");
+      throw_cholmod_failure("TangentPreconditioner", "solve", c.status, static_cast<long>(b.size()),
+                            static_cast<long>(b.size()));
     return static_cast<const double*>(solve_x->x);
   }
 
