@@ -189,10 +189,10 @@ TEST(OnlineCli, UntilPlaysOnlyWhatWasPublishedByThenAndRefusesANegativeTime) {
   EXPECT_GT(json_number(j, "latency_cpu_median_s"), 0.0);
   EXPECT_LE(json_number(j, "latency_cpu_median_s"), json_number(j, "latency_cpu_p95_s"));
   std::string out;
-  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + r.graph +
-                                  " --online --robots 2 --until -1",
-                              &out),
-            2);
+  EXPECT_EQ(
+      test::run_command(
+          test::bin("tessera") + " solve " + r.graph + " --online --robots 2 --until -1", &out),
+      2);
   EXPECT_TRUE(test::contains(out, "--until")) << out;
 }
 
