@@ -27,7 +27,7 @@ const char* const kOnlineValued[] = {
     "certify-every", "refactor-growth",   "baseline-every", "local-threshold",
     "step-every",    "step-solver",       "newton-after",   "threads",
     "baseline-per",  "baseline-samples",  "baseline-init",  "baseline-solver",
-    "step-coarse",   "progress-interval", nullptr};
+    "step-coarse",   "progress-interval", "until",          nullptr};
 const char* const kOnlineSwitches[] = {"online",          "real-time",   "baseline",
                                        "no-local-rounds", "no-progress", nullptr};
 
@@ -85,6 +85,9 @@ const char* kOnlineHelp =
     "  --newton-after T          newton: rounds first, down to ||grad f|| <= T (default: none)\n"
     "  --step-coarse none|blocks newton: the CG's coarse correction (default none: block\n"
     "                            Jacobi; blocks: plus one rigid motion per block)\n"
+    "  --until S                 play only what is published up to S seconds of stream time\n"
+    "                            (a prefix of the mission, e.g. to profile its steps; the\n"
+    "                            final cost needs the graph received by then connected)\n"
     "  --no-certify              skip the final certificate\n"
     "  --json FILE               summary with the `updates` array (one object per step); a\n"
     "                            long run rewrites it at every progress line with the steps\n"
@@ -123,6 +126,8 @@ JsonObject update_json(const OnlineUpdate& u) {
       .add("rounds_cpu_s", u.rounds_cpu_s)
       .add("critical_path_cpu_s", u.critical_path_cpu_s)
       .add("latency_s", u.latency_s)
+      .add("latency_cpu_s", u.latency_cpu_s)
+      .add("message_steps", u.rounds + u.newton_message_steps)
       .add("bytes", static_cast<std::size_t>(u.bytes))
       .add("grad_norm", u.grad_norm)
       .add("stop_reason", u.stop_reason)
@@ -207,7 +212,15 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       files.empty() ? runtime::replay_input_from_file(
                           graph_path, robots > 0 ? static_cast<std::size_t>(robots) : 0)
                     : runtime::replay_input_from_robot_files(files);
-  const ReplayPlan plan = plan_replay(input.graph, input.robot_of_pose, replay);
+  ReplayPlan plan = plan_replay(input.graph, input.robot_of_pose, replay);
+  if (a.has("until")) {
+    const double until = a.get_double("until", 0.0);
+    if (!(until >= 0) || !std::isfinite(until))
+      throw InputError("option --until: must be a finite number of seconds >= 0");
+    plan.batches.erase(std::find_if(plan.batches.begin(), plan.batches.end(),
+                                    [&](const StreamBatch& b) { return b.stamp > until; }),
+                       plan.batches.end());
+  }
 
   // Steps sampled for checkpoints: every `every`-th step that did work (the count is known
   // only afterwards, so sample on the number of batches instead: one per tick).
@@ -308,6 +321,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
     if (res) {
       j.add("latency_median_s", percentile(latency, 0.5))
           .add("latency_p95_s", percentile(latency, 0.95))
+          .add("latency_cpu_median_s", percentile(res->batch_latency_cpu_s, 0.5))
+          .add("latency_cpu_p95_s", percentile(res->batch_latency_cpu_s, 0.95))
           .add("max_checkpoint_rel_gap",
                gaps.empty() ? 0.0 : *std::max_element(gaps.begin(), gaps.end()))
           .add("repartitions", res->repartitions)

@@ -179,5 +179,22 @@ TEST(OnlineCli, AnUnknownBaselineModeIsRefusedWithExitCode2) {
   EXPECT_TRUE(test::contains(out, "--baseline-per")) << out;
 }
 
+TEST(OnlineCli, UntilPlaysOnlyWhatWasPublishedByThenAndRefusesANegativeTime) {
+  const Replay r = generated();
+  // 60 poses a robot at 100 per second of stream: by 0.3 s each robot has published about 31.
+  const std::string j = solve(r, "--until 0.3");
+  EXPECT_GT(json_number(j, "poses"), 40.0);
+  EXPECT_LT(json_number(j, "poses"), 80.0);
+  // The load-free companion of the latency: the steps' CPU time in place of their wall time.
+  EXPECT_GT(json_number(j, "latency_cpu_median_s"), 0.0);
+  EXPECT_LE(json_number(j, "latency_cpu_median_s"), json_number(j, "latency_cpu_p95_s"));
+  std::string out;
+  EXPECT_EQ(
+      test::run_command(
+          test::bin("tessera") + " solve " + r.graph + " --online --robots 2 --until -1", &out),
+      2);
+  EXPECT_TRUE(test::contains(out, "--until")) << out;
+}
+
 }  // namespace
 }  // namespace tessera

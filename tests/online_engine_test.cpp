@@ -412,5 +412,19 @@ TEST(OnlineEngine, AFixedStepPeriodAbsorbsEachPeriodsBatchesAndEndsAtTheBatchOpt
   EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
 }
 
+TEST(OnlineEngine, EachStepsCpuLatencyIsItsLatencyWithItsCpuTimeInPlaceOfItsWallTime) {
+  const auto gen = small_graph(TrajectoryKind::kCity, 90, 3);
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ReplayOptions{});
+  OnlineOptions o = online_options();
+  o.step_every_s = 0.5;
+  const OnlineResult res = run_online(gen.graph.d, plan.batches, o);
+  ASSERT_FALSE(res.updates.empty());
+  for (const OnlineUpdate& u : res.updates) {
+    EXPECT_GE(u.latency_cpu_s, 0.0);
+    EXPECT_NEAR(u.latency_cpu_s, u.latency_s - u.ms / 1000.0 + u.cpu_s, 1e-9);
+  }
+  EXPECT_EQ(res.batch_latency_cpu_s.size(), res.batch_latency_s.size());
+}
+
 }  // namespace
 }  // namespace tessera

@@ -170,7 +170,11 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;
   u.latency_s = now_s - oldest + u.ms / 1000.0;
-  for (double stamp : stamps) totals_.batch_latency_s.push_back(now_s - stamp + u.ms / 1000.0);
+  u.latency_cpu_s = now_s - oldest + u.cpu_s;
+  for (double stamp : stamps) {
+    totals_.batch_latency_s.push_back(now_s - stamp + u.ms / 1000.0);
+    totals_.batch_latency_cpu_s.push_back(now_s - stamp + u.cpu_s);
+  }
   totals_.rounds += u.rounds;
   totals_.repartitions += u.moved > 0 ? 1 : 0;
   totals_.poses_moved += u.moved;

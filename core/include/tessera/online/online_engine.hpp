@@ -140,6 +140,11 @@ struct OnlineUpdate {
   /// Publication of the oldest absorbed batch to the end of the step (stream clock; with
   /// real_time the step's wall time counts as stream time).
   double latency_s = 0.0;
+  /// latency_s with the step's process CPU time (cpu_s) in place of its wall time: what the
+  /// latency would be with this process alone on one core, so it does not grow with the
+  /// machine's load as latency_s does. Its load-free companions are the step's message steps
+  /// (rounds + newton_message_steps) and CG iterations.
+  double latency_cpu_s = 0.0;
   std::uint64_t bytes = 0;  ///< Protocol bytes of the step's rounds.
   double grad_norm = 0.0;   ///< ||grad f|| at the end of the step.
   /// Why the rounds stopped: grad_norm, or stalled (the iterate stopped moving just above the
@@ -178,6 +183,9 @@ struct OnlineResult {
   /// (stream clock), in absorption order. Steps that take long absorb many batches, so this,
   /// not the per-step latency_s, is what a robot waiting for its estimate sees.
   std::vector<double> batch_latency_s;
+  /// The same with the step's process CPU time in place of its wall time
+  /// (OnlineUpdate::latency_cpu_s).
+  std::vector<double> batch_latency_cpu_s;
   std::vector<OnlineCertificate> certificates;  ///< Taken during the run (certify_every_s).
   int rounds = 0;               ///< All steps' rounds (the final certificate's excluded).
   int repartitions = 0;         ///< Steps that moved poses between blocks.
