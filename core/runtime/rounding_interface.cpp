@@ -77,6 +77,9 @@ bool DistributedRounding::take_interface_shares() {
 }
 
 double DistributedRounding::interface_translations() {
+  // The exact solve is one step of the stage: it is a progress point like a CG iteration (the
+  // coordinator sees the rounding begin; test builds can stop an agent here).
+  mail_.report_progress(ProgressStage::kRounding, 0, 0.0);
   const Eigen::Index d = d_, m = static_cast<Eigen::Index>(own_.size());
   std::unordered_map<std::size_t, Eigen::Index> slot;
   for (Eigen::Index s = 0; s < m; ++s) slot.emplace(own_[static_cast<std::size_t>(s)], s);
