@@ -1,3 +1,4 @@
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,6 +8,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "distributed/coarse_hessian_columns.hpp"
+#include "distributed/gauge_space.hpp"
 #include "distributed/interface_solve.hpp"
 #include "distributed/nonzero_rows.hpp"
 #include "distributed/pipelined_cg.hpp"
@@ -291,7 +293,25 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
     values.insert(values.end(), rhat.begin() + interface_->offset(),
                   rhat.begin() + interface_->offset() + interface_->size());
   }
+  // The gauge's sums at this point (H V: local products, V known on the neighbours' poses).
+  gauge_ = std::make_unique<GaugeSpace>(problem_.dim(), X_, Xn_);
+  const int k = gauge_->size();
+  gauge_hv_.clear();
+  for (int c = 0; c < k; ++c) gauge_hv_.push_back(hessian(gauge_->own(c), gauge_->neighbours(c)));
+  const std::size_t at = values.size();
+  values.resize(at + gauge_share_size(), 0.0);
+  double* v = values.data() + at;
+  for (int c = 0; c < k; ++c) {
+    gauge_->dot(gauge_->own(c), v + c * k);
+    gauge_->dot(gauge_hv_[static_cast<std::size_t>(c)], v + k * k + c * k);
+  }
+  gauge_->dot(g_, v + 2 * k * k);
   broadcast(kInterface, values, out);
+}
+
+std::size_t NewtonRefineProtocol::gauge_share_size() const {
+  const auto k = static_cast<std::size_t>(problem_.dim() * (problem_.dim() + 1) / 2);
+  return 2 * k * k + k;
 }
 
 void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
@@ -301,9 +321,13 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
   ir_g_ = Eigen::VectorXd::Zero(interface_->team_size());
   bool ok = true;
   int b = 0;
+  const std::size_t gn = gauge_share_size();
+  std::vector<double> gsum(gn, 0.0);
   for (const auto& [sender, m] : inbox) {
-    const std::vector<double>& v = std::get<PoseBlockMessage>(m).data;
-    if (v.empty()) throw std::runtime_error("newton refine: empty interface share");
+    const std::vector<double>& full = std::get<PoseBlockMessage>(m).data;
+    if (full.size() <= gn) throw std::runtime_error("newton refine: empty interface share");
+    for (std::size_t i = 0; i < gn; ++i) gsum[i] += full[full.size() - gn + i];
+    const std::vector<double> v(full.begin(), full.end() - static_cast<std::ptrdiff_t>(gn));
     if (v.front() == 0.0) {
       ok = false;
       shares.push_back({0.0});
@@ -326,6 +350,12 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
   }
   interface_due_ = false;
   use_interface_ = ok;
+  const int k = gauge_->size();
+  const Eigen::Map<const Eigen::MatrixXd> vv(gsum.data(), k, k), vhv(gsum.data() + k * k, k, k);
+  gauge_vv_ = 0.5 * (vv + vv.transpose());
+  gauge_vhv_ = 0.5 * (vhv + vhv.transpose());
+  gauge_vg_ = Eigen::Map<const Eigen::VectorXd>(gsum.data() + 2 * k * k, k);
+  use_gauge_ = ok && gauge_vv_.llt().info() == Eigen::Success;
   if (ok) {
     ++result_.interface_factorizations;
   } else {
@@ -333,6 +363,13 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
     if (refactor_due_) prepare_preconditioner();
   }
   start_cg(out);
+}
+
+void NewtonRefineProtocol::ground_pose(Eigen::MatrixXd& v) const {
+  // With the interface solves the CG solves the Newton equation of f with the grounded pose
+  // held (interface_solve.hpp): its residual and H's products are zero there, as z is.
+  const Eigen::Index k = interface_->grounded_pose();
+  if (k >= 0) v.middleCols(k * (problem_.dim() + 1), problem_.dim() + 1).setZero();
 }
 
 void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
@@ -400,6 +437,8 @@ void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
   if (use_interface_) {
     iy_r_ = iy_g_;
     ir_ = ir_g_;
+    ground_pose(r_);
+    gauge_vs_ = gauge_vhs_ = Eigen::VectorXd::Zero(gauge_->size());
   }
   model_ = gs_ = sHs_ = 0.0;
   cg_target_ =
@@ -436,6 +475,14 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
   neighbours_into(inbox, zn_);
   w_ = hessian(z_, zn_);
+  Eigen::VectorXd vz, vhz;  // V^T z, V^T H z (H z before the grounded pose's rows are zeroed)
+  if (use_interface_) {
+    vz.resize(gauge_->size());
+    vhz.resize(gauge_->size());
+    gauge_->dot(z_, vz.data());
+    gauge_->dot(w_, vhz.data());
+    ground_pose(w_);
+  }
   std::vector<double> values{frobenius_inner(r_, z_), frobenius_inner(z_, w_), r_.squaredNorm()};
   if (use_interface_) {  // the interface residual of w, for the ones of q and r
     interface_->forward(X_, w_, iy_w_);
@@ -454,6 +501,8 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
     values.push_back(first ? 0.0 : frobenius_inner(r_, q_));
     values.push_back(first ? 0.0 : frobenius_inner(w_, q_));
     values.push_back(first ? 0.0 : q_.squaredNorm());
+    values.insert(values.end(), vz.data(), vz.data() + vz.size());
+    values.insert(values.end(), vhz.data(), vhz.data() + vhz.size());
   }
   if (coarse_) {  // Phi^T w, for Phi^T q and so Phi^T r by their recurrences
     const std::size_t n = static_cast<std::size_t>(coarse_->size());
@@ -475,8 +524,9 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   const std::size_t team =
       use_interface_ ? static_cast<std::size_t>(interface_->team_size()) : std::size_t{0};
   const std::size_t extra = use_interface_ ? 5 : 0;  // the products for ||r_next||
-  const std::vector<double> t =
-      reduce_in_id_order(inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n + team + extra);
+  const std::size_t gk = use_interface_ ? static_cast<std::size_t>(gauge_->size()) : 0;
+  const std::vector<double> t = reduce_in_id_order(
+      inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n + team + extra + 2 * gk);
   double gamma = t[0], delta = t[1];
   const double rnorm = std::sqrt(std::max(0.0, t[2]));
   Eigen::VectorXd coarse_w;  // Phi^T w
@@ -508,6 +558,11 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     const Eigen::Map<const Eigen::VectorXd> iw(t.data() + 3, static_cast<Eigen::Index>(team));
     it.update_direction(iw, iq_);
     it.update_direction(iy_w_, iy_q_);
+    const auto k = static_cast<Eigen::Index>(gk);
+    it.update_direction(Eigen::Map<const Eigen::VectorXd>(t.data() + 3 + team + extra, k),
+                        gauge_vp_);
+    it.update_direction(Eigen::Map<const Eigen::VectorXd>(t.data() + 3 + team + extra + gk, k),
+                        gauge_vhp_);
   }
   it.update_direction(z_, p_);
   it.update_direction(w_, q_);
@@ -527,6 +582,10 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     const double R2 = radius_ * radius_;
     const double tau = cg_->boundary_step(R2);
     s_ += tau * p_;
+    if (use_interface_) {
+      gauge_vs_ += tau * gauge_vp_;
+      gauge_vhs_ += tau * gauge_vhp_;
+    }
     model_ += -tau * gamma + 0.5 * tau * tau * pHp;
     gs_ += -tau * gamma;      // <g, p> = -<r_0, p> = -<r, p> = -gamma (CG)
     sHs_ += tau * tau * pHp;  // p is H-conjugate to s
@@ -539,6 +598,8 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   if (use_interface_) {
     ir_ -= alpha * iq_;
     iy_r_ -= alpha * iy_q_;
+    gauge_vs_ += alpha * gauge_vp_;
+    gauge_vhs_ += alpha * gauge_vhp_;
   }
   model_ += -alpha * gamma + 0.5 * alpha * alpha * pHp;
   gs_ += -alpha * gamma;
@@ -551,6 +612,17 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     if (next <= cg_target_ * cg_target_) return try_step("residual", out);
   }
   send_direction(out);
+}
+
+void NewtonRefineProtocol::project_step_off_gauge() {
+  // s - V c with c = (V^T V)^-1 V^T s: <g, s - V c> = <g, s> - c^T V^T g and
+  // <s - V c, H (s - V c)> = <s, H s> - 2 c^T V^T H s + c^T V^T H V c, every term a sum all
+  // agents hold, so every agent takes the same model.
+  const Eigen::VectorXd c = gauge_vv_.llt().solve(gauge_vs_);
+  gauge_->subtract(c, s_);
+  gs_ -= c.dot(gauge_vg_);
+  sHs_ += -2.0 * c.dot(gauge_vhs_) + c.dot(gauge_vhv_ * c);
+  model_ = gs_ + 0.5 * sHs_;
 }
 
 void NewtonRefineProtocol::finish(const std::string& why) {
