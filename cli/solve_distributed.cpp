@@ -529,7 +529,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     }
     // --refine newton, or the robust final solve's refinement (--gnc-final-refine).
     if (opt.refine.enabled || !r.refines.empty()) {
-      int steps = 0, cg = 0, translation_cg = 0, exchanges = 0, reductions = 0;
+      int steps = 0, accepted = 0, cg = 0, translation_cg = 0, exchanges = 0, reductions = 0;
       int interface = 0, interface_factorizations = 0, translation_solves = 0;
       int translation_interface = 0;
       for (const NewtonRefineResult& n : r.refines) {
@@ -538,12 +538,14 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         translation_solves += n.translation_solves;
         translation_interface = std::max(translation_interface, n.translation_interface_poses);
         steps += n.steps;
+        accepted += n.accepted_steps;
         cg += n.cg_iterations;
         translation_cg += n.translation_iterations;
         exchanges += n.exchanges;
         reductions += n.reductions;
       }
       j.add("refine_steps", steps)
+          .add("refine_accepted_steps", accepted)
           .add("refine_cg_iterations", cg)
           .add("refine_translation_iterations", translation_cg)
           .add("refine_translation_solves", translation_solves)

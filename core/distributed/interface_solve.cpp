@@ -49,6 +49,7 @@ struct InterfaceSolve::Impl {
   // Sigma + eta I.
   SupernodalFactor sigma;
   bool sigma_ok = false;
+  bool grounded = false;  // the team's first interface pose held fixed (its p coordinates)
   double shift = 0.0;
   mutable Eigen::VectorXd b;  // scratch: J^T v in the block's own order
 };
@@ -296,17 +297,47 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
     }
   }
   if (s.team == 0) return false;
-  SparseMatrix sigma(s.team, s.team);
-  sigma.setFromTriplets(t.begin(), t.end());
-  for (double rel : relative_shifts) {
-    const double eta = rel * std::max(top, 1e-300);
-    if (s.sigma.factor(sigma, eta)) {
-      s.sigma_ok = true;
-      s.shift = rel;
-      return true;
+  // Grounded: the team's first interface pose is held fixed, its rows and columns replaced by
+  // top I (u there is then 0 to the bit from a zero rhat there). The gauge is Sigma's kernel on
+  // a connected graph; shifted instead, H + eta P_Gamma left it at eigenvalues of eta times the
+  // interface's share of a rigid motion, and the preconditioner multiplied the round-off
+  // component of the residual along it by up to 1 / eta: ais2klinik's fourth Newton step was
+  // a global rotation of 3.4 rad (99.99 % of the step), whose round-off inner product with the
+  // gradient the model counted as a decrease of 4.8e-6 that f (exactly invariant) could not
+  // give (2.7e-8). The shifts remain for a Sigma that is indefinite away from a minimiser.
+  for (bool ground : {true, false}) {
+    if (ground && (s.team <= p)) continue;
+    std::vector<Eigen::Triplet<double>> g;
+    if (ground) {
+      g.reserve(t.size() + static_cast<std::size_t>(p));
+      for (const auto& e : t)
+        if (e.row() >= p && e.col() >= p) g.push_back(e);
+      for (Eigen::Index k = 0; k < p; ++k) g.emplace_back(k, k, std::max(top, 1e-300));
+    }
+    SparseMatrix sigma(s.team, s.team);
+    if (ground)
+      sigma.setFromTriplets(g.begin(), g.end());
+    else
+      sigma.setFromTriplets(t.begin(), t.end());
+    for (double rel : relative_shifts) {
+      const double eta = rel * std::max(top, 1e-300);
+      if (s.sigma.factor(sigma, eta)) {
+        s.sigma_ok = true;
+        s.grounded = ground;
+        s.shift = rel;
+        return true;
+      }
     }
   }
   return false;
+}
+
+Eigen::Index InterfaceSolve::grounded_pose() const {
+  const Impl& s = *impl_;
+  if (!s.sigma_ok || !s.grounded || s.own_offset != 0 || s.mG == 0) return -1;
+  for (Eigen::Index i = 0; i < s.m; ++i)
+    if (s.slot[static_cast<std::size_t>(i)] == s.mI) return i;
+  return -1;
 }
 
 void InterfaceSolve::forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
@@ -338,13 +369,21 @@ Eigen::MatrixXd InterfaceSolve::back(const Eigen::MatrixXd& X, const Eigen::Vect
   const int p = s.p;
   const Eigen::Index nI = s.mI * p, nG = s.mG * p;
   Eigen::VectorXd u;
-  s.sigma.solve(rhat, u);
+  if (s.grounded) {
+    Eigen::VectorXd r = rhat;
+    r.head(p).setZero();
+    s.sigma.solve(r, u);
+  } else {
+    s.sigma.solve(rhat, u);
+  }
   Eigen::VectorXd v(y.size());
   v.head(nI) = y.head(nI);
   if (nG > 0) v.tail(nG) = s.Lgg.transpose() * u.segment(s.own_offset, nG);
   s.block.solve_lt(v);
   for (Eigen::Index i = 0; i < s.m; ++i)
     s.b.segment(i * p, p) = v.segment(s.slot[static_cast<std::size_t>(i)] * p, p);
+  const Eigen::Index ground = grounded_pose();
+  if (ground >= 0) s.b.segment(ground * p, p).setZero();  // x_G = u = 0 there, to the bit
   Eigen::MatrixXd Z(s.d, X.cols());
   if (s.d == 2)
     tangent_vector<2>(X.data(), s.b.data(), s.m, Z.data());

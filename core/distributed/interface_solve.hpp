@@ -23,11 +23,16 @@
 // by its recurrences (rhat of H z rides in the iteration's all-agent sum), so a CG iteration is
 // still one exchange and one sum (newton_refine.cpp).
 //
-// Sigma is singular along the problem's gauge (a global rigid motion leaves f unchanged) and
-// may be slightly indefinite there away from a critical point: it is factored with a shift
-// eta I, eta relative to its largest diagonal entry, raised on failure (shifts()). The
-// preconditioner is then the inverse of H + eta P_Gamma: symmetric positive definite, exact
-// up to eta.
+// Sigma is singular along the problem's gauge (a global rigid motion leaves f unchanged): the
+// team's first interface pose is held fixed (grounded, as the translation Sigma of
+// translation_interface_solve.hpp), so the preconditioner is the inverse of H restricted to
+// the tangent vectors that leave that pose in place (zero there): symmetric positive
+// semidefinite, exact on that subspace, where H is positive definite near a nondegenerate
+// minimiser. The refinement's CG then solves the Newton equation of the cost with that pose
+// fixed (it zeroes the pose's residual, grounded_pose()). Away from a minimiser the grounded
+// Sigma may still be slightly indefinite: it is factored with a shift eta I, eta relative to
+// its largest diagonal entry, raised on failure; where grounding fails (a disconnected
+// interface), Sigma + eta I, the inverse of H + eta P_Gamma.
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -73,13 +78,18 @@ class InterfaceSolve {
                 const std::vector<double>& relative_shifts);
   /// The shift the last assemble() factored with (relative), 0 before.
   double shift() const;
+  /// The held pose, where the last assemble() grounded Sigma and this block owns the team's
+  /// first interface pose: its local index (back() is zero there, whatever the residual);
+  /// -1 on the other blocks and without grounding.
+  Eigen::Index grounded_pose() const;
 
   /// y = L^-1 P J^T v (v: a tangent vector at X, d rows), the block's forward solve.
   void forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, Eigen::VectorXd& y) const;
   /// The block's rhat from y: L_GG y_G, added into team (team_size() entries) at offset().
   void add_interface(const Eigen::VectorXd& y, double* team) const;
   /// z = J P^T L^-T [y_I ; L_GG^T u_b], u = (Sigma + eta I)^-1 rhat (rhat: the team's,
-  /// team_size() entries): the preconditioned vector, a tangent vector at X.
+  /// team_size() entries; grounded: u and z are 0 at the held pose and rhat there is not
+  /// read): the preconditioned vector, a tangent vector at X.
   Eigen::MatrixXd back(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
                        const Eigen::VectorXd& rhat) const;
 

@@ -7,6 +7,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "distributed/coarse_hessian_columns.hpp"
+#include "distributed/gauge_space.hpp"
 #include "distributed/interface_solve.hpp"
 #include "distributed/nonzero_rows.hpp"
 #include "distributed/pipelined_cg.hpp"
@@ -280,108 +281,6 @@ void NewtonRefineProtocol::begin_cg(std::vector<OutgoingMessage>& out) {
   start_cg(out);
 }
 
-void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
-  // This block's share of Sigma at the current point, then its interface residual of -g (the
-  // first CG residual), so that the first direction needs no further message step.
-  std::vector<double> values = interface_->factor(X_, Xn_, egrad_);
-  if (values.front() != 0.0) {
-    interface_->forward(X_, -g_, iy_g_);
-    std::vector<double> rhat(static_cast<std::size_t>(interface_->team_size()), 0.0);
-    interface_->add_interface(iy_g_, rhat.data());
-    values.insert(values.end(), rhat.begin() + interface_->offset(),
-                  rhat.begin() + interface_->offset() + interface_->size());
-  }
-  broadcast(kInterface, values, out);
-}
-
-void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
-                                           std::vector<OutgoingMessage>& out) {
-  // Every agent assembles the same Sigma from the same shares in id order.
-  std::vector<std::vector<double>> shares;
-  ir_g_ = Eigen::VectorXd::Zero(interface_->team_size());
-  bool ok = true;
-  int b = 0;
-  for (const auto& [sender, m] : inbox) {
-    const std::vector<double>& v = std::get<PoseBlockMessage>(m).data;
-    if (v.empty()) throw std::runtime_error("newton refine: empty interface share");
-    if (v.front() == 0.0) {
-      ok = false;
-      shares.push_back({0.0});
-    } else {
-      const auto n = static_cast<std::size_t>(interface_->block_size(b));
-      if (v.size() < n + 1)
-        throw std::runtime_error("newton refine: malformed interface share from agent " +
-                                 std::to_string(sender));
-      shares.emplace_back(v.begin(), v.end() - static_cast<std::ptrdiff_t>(n));
-      ir_g_.segment(interface_->block_offset(b), static_cast<Eigen::Index>(n)) =
-          Eigen::Map<const Eigen::VectorXd>(v.data() + v.size() - n, static_cast<Eigen::Index>(n));
-    }
-    ++b;
-  }
-  if (ok) {
-    std::vector<const std::vector<double>*> ptrs;
-    for (const auto& v : shares) ptrs.push_back(&v);
-    const double eta = options_.interface_shift;
-    ok = interface_->assemble(ptrs, {eta, 1e3 * eta, 1e6 * eta});
-  }
-  interface_due_ = false;
-  use_interface_ = ok;
-  if (ok) {
-    ++result_.interface_factorizations;
-  } else {
-    ++result_.interface_fallbacks;
-    if (refactor_due_) prepare_preconditioner();
-  }
-  start_cg(out);
-}
-
-void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
-  // This agent's rows of A = Phi^T H Phi: column u is Phi^T (H Phi e_u) over the own poses,
-  // with Phi e_u on the own poses and the neighbour copies (the agent knows both). The share
-  // is symmetrized (only the sum over the agents is symmetric); upper triangle, then Phi^T g.
-  const int n = coarse_->size();
-  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
-  Eigen::MatrixXd v, vn;
-  const std::vector<int>& touched = coarse_->touched();
-  // Balancing also keeps the own rows of H Phi (one column per touched unknown).
-  if (options_.coarse_balancing) {
-    if (!coarse_hphi_) coarse_hphi_ = std::make_unique<CoarseHessianColumns>(problem_.dim());
-    coarse_hphi_->reset(touched.size());
-  }
-  for (std::size_t c = 0; c < touched.size(); ++c) {
-    const int u = touched[c];
-    coarse_->unit(X_, Xn_, u, v, vn);
-    const Eigen::MatrixXd hv = hessian(v, vn);
-    coarse_->project(X_, hv, L.col(u).data());
-    if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
-  }
-  std::vector<double> values;
-  values.reserve(static_cast<std::size_t>(n * (n + 1) / 2 + n));
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i <= j; ++i) values.push_back(0.5 * (L(i, j) + L(j, i)));
-  const std::size_t at = values.size();
-  values.resize(at + static_cast<std::size_t>(n), 0.0);
-  coarse_->project(X_, g_, values.data() + at);
-  broadcast(kCoarse, values, out);
-}
-
-void NewtonRefineProtocol::after_coarse(const MessageGate::Inbox& inbox,
-                                        std::vector<OutgoingMessage>& out) {
-  const int n = coarse_->size();
-  const std::vector<double> t =
-      reduce_in_id_order(inbox, static_cast<std::size_t>(n * (n + 1) / 2 + n));
-  Eigen::MatrixXd A(n, n);
-  std::size_t at = 0;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i <= j; ++i) A(i, j) = A(j, i) = t[at++];
-  coarse_inverse_ = coarse_->pseudo_inverse(A);
-  coarse_matrix_ = A;
-  coarse_g_ = Eigen::Map<const Eigen::VectorXd>(t.data() + at, n);
-  coarse_due_ = false;
-  ++result_.coarse_assemblies;
-  start_cg(out);
-}
-
 Eigen::VectorXd NewtonRefineProtocol::touched_of(const Eigen::VectorXd& x) const {
   const std::vector<int>& touched = coarse_->touched();
   Eigen::VectorXd out(static_cast<Eigen::Index>(touched.size()));
@@ -400,6 +299,8 @@ void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
   if (use_interface_) {
     iy_r_ = iy_g_;
     ir_ = ir_g_;
+    ground_pose(r_);
+    gauge_vs_ = gauge_vhs_ = Eigen::VectorXd::Zero(gauge_->size());
   }
   model_ = gs_ = sHs_ = 0.0;
   cg_target_ =
@@ -436,6 +337,14 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
   neighbours_into(inbox, zn_);
   w_ = hessian(z_, zn_);
+  Eigen::VectorXd vz, vhz;  // V^T z, V^T H z (H z before the grounded pose's rows are zeroed)
+  if (use_interface_) {
+    vz.resize(gauge_->size());
+    vhz.resize(gauge_->size());
+    gauge_->dot(z_, vz.data());
+    gauge_->dot(w_, vhz.data());
+    ground_pose(w_);
+  }
   std::vector<double> values{frobenius_inner(r_, z_), frobenius_inner(z_, w_), r_.squaredNorm()};
   if (use_interface_) {  // the interface residual of w, for the ones of q and r
     interface_->forward(X_, w_, iy_w_);
@@ -454,6 +363,8 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
     values.push_back(first ? 0.0 : frobenius_inner(r_, q_));
     values.push_back(first ? 0.0 : frobenius_inner(w_, q_));
     values.push_back(first ? 0.0 : q_.squaredNorm());
+    values.insert(values.end(), vz.data(), vz.data() + vz.size());
+    values.insert(values.end(), vhz.data(), vhz.data() + vhz.size());
   }
   if (coarse_) {  // Phi^T w, for Phi^T q and so Phi^T r by their recurrences
     const std::size_t n = static_cast<std::size_t>(coarse_->size());
@@ -475,8 +386,9 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   const std::size_t team =
       use_interface_ ? static_cast<std::size_t>(interface_->team_size()) : std::size_t{0};
   const std::size_t extra = use_interface_ ? 5 : 0;  // the products for ||r_next||
-  const std::vector<double> t =
-      reduce_in_id_order(inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n + team + extra);
+  const std::size_t gk = use_interface_ ? static_cast<std::size_t>(gauge_->size()) : 0;
+  const std::vector<double> t = reduce_in_id_order(
+      inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n + team + extra + 2 * gk);
   double gamma = t[0], delta = t[1];
   const double rnorm = std::sqrt(std::max(0.0, t[2]));
   Eigen::VectorXd coarse_w;  // Phi^T w
@@ -508,6 +420,11 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     const Eigen::Map<const Eigen::VectorXd> iw(t.data() + 3, static_cast<Eigen::Index>(team));
     it.update_direction(iw, iq_);
     it.update_direction(iy_w_, iy_q_);
+    const auto k = static_cast<Eigen::Index>(gk);
+    it.update_direction(Eigen::Map<const Eigen::VectorXd>(t.data() + 3 + team + extra, k),
+                        gauge_vp_);
+    it.update_direction(Eigen::Map<const Eigen::VectorXd>(t.data() + 3 + team + extra + gk, k),
+                        gauge_vhp_);
   }
   it.update_direction(z_, p_);
   it.update_direction(w_, q_);
@@ -527,6 +444,10 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     const double R2 = radius_ * radius_;
     const double tau = cg_->boundary_step(R2);
     s_ += tau * p_;
+    if (use_interface_) {
+      gauge_vs_ += tau * gauge_vp_;
+      gauge_vhs_ += tau * gauge_vhp_;
+    }
     model_ += -tau * gamma + 0.5 * tau * tau * pHp;
     gs_ += -tau * gamma;      // <g, p> = -<r_0, p> = -<r, p> = -gamma (CG)
     sHs_ += tau * tau * pHp;  // p is H-conjugate to s
@@ -539,6 +460,8 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   if (use_interface_) {
     ir_ -= alpha * iq_;
     iy_r_ -= alpha * iy_q_;
+    gauge_vs_ += alpha * gauge_vp_;
+    gauge_vhs_ += alpha * gauge_vhp_;
   }
   model_ += -alpha * gamma + 0.5 * alpha * alpha * pHp;
   gs_ += -alpha * gamma;

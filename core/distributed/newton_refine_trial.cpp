@@ -19,6 +19,7 @@ namespace tessera {
 
 void NewtonRefineProtocol::try_step(const std::string& cg_stop, std::vector<OutgoingMessage>& out) {
   step_.cg_stop = cg_stop;
+  if (use_interface_ && use_gauge_) project_step_off_gauge();
   step_.predicted = -model_;
   s_full_ = s_;
   scale_ = 1.0;

@@ -54,6 +54,7 @@ class PipelinedCg;
 class CoarseHessianColumns;
 class TranslationPreconditioner;
 class TranslationInterfaceSolve;
+class GaugeSpace;
 
 struct NewtonRefineOptions {
   /// Run the refinement after the block-coordinate solve reached its own tolerance (a solve
@@ -204,9 +205,10 @@ struct NewtonRefineOptions {
   /// certified optimum (docs/newton-refine.md, "Handing over"). 0 = off (the rounds' tail
   /// alone decides). >= 0.
   double auto_interface_grad_tol = 30.0;
-  /// Relative shift eta of Sigma (times its largest diagonal entry; Sigma is singular along the
-  /// gauge); on a failed factorization it is raised 1,000-fold twice before the fallback.
-  /// (0, 1e-3].
+  /// Relative shift eta of Sigma (times its largest diagonal entry). Sigma is grounded at one
+  /// pose (the gauge, interface_solve.hpp); the shift covers its slight indefiniteness away
+  /// from a minimiser. On a failed factorization it is raised 1,000-fold twice, then the same
+  /// without grounding, before the fallback. (0, 1e-3].
   double interface_shift = 1e-10;
   /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
   CoarseOptions coarse_space_options() const;
@@ -328,6 +330,12 @@ class NewtonRefineProtocol : public AgentProcess {
   // then every agent's Sigma.
   void send_interface(std::vector<OutgoingMessage>& out);
   void after_interface(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // v's columns of the interface solve's grounded pose set to zero (where this block has it).
+  void ground_pose(Eigen::MatrixXd& v) const;
+  // The gauge's numbers in each interface share: V^T V, V^T H V (k x k each) and V^T g.
+  std::size_t gauge_share_size() const;
+  // The CG step's part orthogonal to the gauge, with its model's <g, s> and <s, H s>.
+  void project_step_off_gauge();
   // CG from s = 0 at the current point (the coarse matrix, if any, is current).
   void start_cg(std::vector<OutgoingMessage>& out);
   // x's entries at the coarse unknowns this agent touches (coarse_hphi_'s columns).
@@ -393,6 +401,14 @@ class NewtonRefineProtocol : public AgentProcess {
   std::unique_ptr<InterfaceSolve> interface_;
   bool interface_due_ = true, use_interface_ = false;
   Eigen::VectorXd iy_r_, iy_q_, iy_w_, iy_g_, ir_, iq_, ir_g_;
+  // The gauge with the interface solves (distributed/gauge_space.hpp): its basis V and H V at
+  // the point, the sums V^T V, V^T H V and V^T g (in the interface matrix's sum), and the
+  // CG's V^T p, V^T H p, V^T s, V^T H s by recurrence (V^T z, V^T H z ride in its sums).
+  std::unique_ptr<GaugeSpace> gauge_;
+  std::vector<Eigen::MatrixXd> gauge_hv_;
+  Eigen::MatrixXd gauge_vv_, gauge_vhv_;
+  Eigen::VectorXd gauge_vg_, gauge_vp_, gauge_vhp_, gauge_vs_, gauge_vhs_;
+  bool use_gauge_ = false;
   // Translation solve at the trial point: the own block's translation Laplacian factor, CG
   // state (x the translation change, in the pose layout with zero rotation columns).
   std::unique_ptr<TranslationPreconditioner> translation_preconditioner_;
