@@ -584,7 +584,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
           return;
         }
         const double tls = exchange_->summed_votes().first;
-        if (probes_->running() && !probes_->keeps(tls)) {
+        if (probes_->running() && !probes_->keeps(rejected_, tls)) {
           restore_before_probe(out);
           return;
         }
@@ -599,7 +599,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
           apply_recheck(*recheck_, in_.measurement_index, rejected_, weights_);
       readmitted_ += counts.readmitted;
       late_rejected_ += counts.late_rejected;
-      if (probes_->running() && rejected_ == probes_->base_rejected()) {
+      if (probes_->back_at_base(rejected_)) {
         // The passes took back exactly what the probe changed: it ends here, not kept (its
         // TLS cost could differ from the base's only by the solves' accuracy).
         restore_before_probe(out);

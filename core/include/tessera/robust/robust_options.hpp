@@ -126,6 +126,29 @@ struct RobustOptions {
   /// same band is the return probes' (gnc_centralized.hpp): all of it together, then, with
   /// cluster probes, one closure at a time (tls_recheck.hpp, return_candidates).
   double probe_return_ratio = 4.0;
+  /// Centralized solver only: most swap probes after the other probes, >= 0 (0 = none). A swap
+  /// cuts a kept closure whose r^2 is at least swap_kept_ratio x c^2 and brings back a rejected
+  /// one within swap_return_ratio x c^2 with an end within swap_near pose ids of one of its
+  /// ends (most strained kept closure first), runs the re-check passes from there and stays only
+  /// when the TLS cost over every measurement falls (core/robust/swap_probe.hpp). Why: a wrong
+  /// closure can bend the map around one of its ends until it fits, and the true closure that
+  /// meets it there is cut; each alone is judged right at that bent solution, and a return
+  /// probe cannot undo it while the wrong one holds the bend (sphere2500 with 50 % random
+  /// outliers: wrong closure 5626 (1696-2406) kept at r^2 39.2 against c^2 = 46.2, true closure
+  /// 4195 (1696-1746) cut at 2.9 c^2, cost over the kept set 1,984.7 against f*_clean 1,687.0;
+  /// docs/robust.md, "Swap probes"). 3: there the true closure 4145 at r^2 43.8, which also meets
+  /// pose 1696, comes first and its swap is refused; the second is the fold's.
+  int swap_probes = 3;
+  /// A swap's two closures have an end within this many pose ids, >= 0. 0: the fold's wrong and
+  /// true closure share a pose.
+  int swap_near = 0;
+  /// The kept closure of a swap has r^2 >= this x c^2, in [0, 1]. 0.25: a closure bent to fit
+  /// sits near the bound (39.2 / 46.2 above), the true closures of a file whose noise matches
+  /// its information have a median r^2 near 0.1 c^2 (5.3 in 3D, 2.4 in 2D against c^2 37-48).
+  double swap_kept_ratio = 0.25;
+  /// The rejected closure of a swap has r^2 <= this x c^2, >= 1. 10: the fold's true closure
+  /// lies at 2.9 c^2, the nearest of the 1,225 random wrong closures at 27 c^2.
+  double swap_return_ratio = 10.0;
   /// Distributed solvers only: the final solve of the kept set (weights fixed) ends with the
   /// distributed Newton refinement (distributed/newton_refine.hpp, with the solver's
   /// DistributedOptions::refine settings: ||grad f|| <= 1e-6 by default), whatever
