@@ -4,20 +4,11 @@
 
 namespace tessera::cli {
 
-const char* const kRobustValued[] = {"robust",
-                                     "inlier-threshold",
-                                     "inlier-quantile",
-                                     "gnc-max-outer",
-                                     "gnc-mu-step",
-                                     "gnc-inner-rounds",
-                                     "known-inliers",
-                                     "rejected",
-                                     "gnc-inner-iterations",
-                                     "gnc-probes",
-                                     "gnc-probe-ratio",
-                                     "gnc-final-refine",
-                                     "gnc-swap-probes",
-                                     nullptr};
+const char* const kRobustValued[] = {"robust",          "inlier-threshold", "inlier-quantile",
+                                     "gnc-max-outer",   "gnc-mu-step",      "gnc-inner-rounds",
+                                     "known-inliers",   "rejected",         "gnc-inner-iterations",
+                                     "gnc-probes",      "gnc-probe-ratio",  "gnc-final-refine",
+                                     "gnc-swap-probes", "gnc-pass-refine",  nullptr};
 
 const char* const kRobustHelp =
     "\n"
@@ -60,6 +51,9 @@ const char* const kRobustHelp =
     "  --gnc-final-refine newton|none   distributed: the final solve of the kept set ends with\n"
     "                            Newton refinement to --refine-grad-tol (runs without\n"
     "                            --certify too) [newton]\n"
+    "  --gnc-pass-refine auto|none   distributed, with --refine auto: inlier passes solved to\n"
+    "                            the tolerance hand over to Newton refinement where the\n"
+    "                            team's interface fits the interface solves [none]\n"
     "  --known-inliers odometry|none   never reject edges between consecutive ids [odometry]\n"
     "  --rejected FILE           write the rejected edge indices (from 0 over the EDGE lines)\n";
 
@@ -87,6 +81,10 @@ RobustOptions parse_robust_options(const Arguments& args) {
   o.probe_ratio = args.get_double("gnc-probe-ratio", o.probe_ratio);
   o.swap_probes = static_cast<int>(args.get_long("gnc-swap-probes", o.swap_probes));
   o.final_refine = parse_final_refine(args.get_or("gnc-final-refine", final_refine_name(o)));
+  const std::string pass_refine = args.get_or("gnc-pass-refine", o.refine_passes ? "auto" : "none");
+  if (pass_refine != "auto" && pass_refine != "none")
+    throw InputError("option --gnc-pass-refine: '" + pass_refine + "' is not one of auto, none");
+  o.refine_passes = pass_refine == "auto";
   o.known_inliers =
       parse_known_inliers(args.get_or("known-inliers", known_inliers_name(o.known_inliers)));
   try {

@@ -90,6 +90,16 @@ TEST(SwapProbes, TheCandidatesAreTheStrainedKeptClosuresBesideARejectedOneNearTh
   EXPECT_EQ(swap_candidates(f.graph, f.known, f.bent, f.c2, rules, {f.t}).size(), 1u);
   rules.return_ratio = 2;  // T lies beyond 2 c^2
   EXPECT_TRUE(swap_candidates(f.graph, f.known, f.bent, f.c2, rules, {f.t}).empty());
+
+  // Nothing rejected: no pair, but a kept closure far above the kept median (T: 3 c^2 against
+  // 0.9 c^2) is cut alone when alone_ratio allows it.
+  rules = SwapRules{};
+  EXPECT_TRUE(swap_candidates(f.graph, f.known, f.bent, f.c2, rules, {}).empty());  // 5 x 0.9
+  rules.alone_ratio = 2;
+  const std::vector<ClosureSwap> alone = swap_candidates(f.graph, f.known, f.bent, f.c2, rules, {});
+  ASSERT_EQ(alone.size(), 1u);
+  EXPECT_EQ(alone[0].cut, f.t);
+  EXPECT_FALSE(alone[0].back.has_value());
 }
 
 // The fold: swapping K for T keeps the bend (W holds it), the passes cut T again and take K

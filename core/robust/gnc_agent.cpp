@@ -449,6 +449,8 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     return;
   }
   gnc_rounds_ += solve_->total_rounds();
+  for (const NewtonRefineResult& r : solve_->refines())
+    gnc_refine_steps_ += r.exchanges + r.reductions;
   if (solve_kind_ == GncSolveKind::kInlierPass) {
     last_pass_full_ = !pass_capped_;
     if (probes_->running() && pass_ >= options_.robust.readmission_passes) {

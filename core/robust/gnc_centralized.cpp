@@ -297,6 +297,7 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
   swaps.near = robust.swap_near;
   swaps.kept_ratio = robust.swap_kept_ratio;
   swaps.return_ratio = robust.swap_return_ratio;
+  swaps.alone_ratio = robust.probe_ratio;
   if (swaps.budget > 0 && !out.rejected.empty()) {
     CentralizedOptions trial = final_options;
     trial.certify = false;

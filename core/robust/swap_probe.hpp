@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <tessera/graph/pose_graph.hpp>
 #include <vector>
 
@@ -19,10 +20,10 @@
 
 namespace tessera {
 
-/// A swap: the kept closure it cuts and the rejected closure it brings back.
+/// A swap: the kept closure it cuts and the rejected closure it brings back (none: a cut alone).
 struct ClosureSwap {
   std::size_t cut = 0;
-  std::size_t back = 0;
+  std::optional<std::size_t> back;
 };
 
 /// Which swaps are tried (RobustOptions::swap_*).
@@ -31,12 +32,18 @@ struct SwapRules {
   int near = 0;                ///< An end of each within this many pose ids.
   double kept_ratio = 0.25;    ///< The kept closure's r^2 is at least this times c^2.
   double return_ratio = 50.0;  ///< The rejected closure's r^2 is at most this times c^2.
+  /// A strained kept closure with no rejected one beside it is cut alone when its r^2 is also at
+  /// least this times the median r^2 of the kept closures that may be rejected (<= 0: never).
+  double alone_ratio = 5.0;
 };
 
 /// The swaps worth a try at `poses`: pairs of a kept closure (known[e] false, not in `rejected`,
 /// r^2 >= kept_ratio x c^2) and a rejected one (r^2 <= return_ratio x c^2) with an end of each
 /// within `near` pose ids; most strained kept closure first (largest r^2), and for one kept
-/// closure the rejected ones nearest the bound first. Known measurements never take part.
+/// closure the rejected ones nearest the bound first. Then the strained kept closures with no
+/// such rejected one whose r^2 is at least alone_ratio x the kept median, cut alone (a wrong
+/// closure bent to fit where no true closure was cut), largest r^2 first. Known measurements
+/// never take part.
 std::vector<ClosureSwap> swap_candidates(const PoseGraph& graph, const std::vector<bool>& known,
                                          const std::vector<Pose>& poses, double c2,
                                          const SwapRules& rules,

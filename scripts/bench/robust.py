@@ -311,9 +311,10 @@ def ate(estimate, reference, d):
 # ---- runs
 def message_steps(rounds, summary):
     """Message steps of a distributed run: two a round (docs/irbcd.md) plus the Newton
-    refinement's neighbour exchanges and all-agent sums. Under `--refine auto` a clean run hands
+    refinement's neighbour exchanges and all-agent sums (of the final solve; a robust run's
+    earlier refinements are its JSON's gnc_refine_steps). Under `--refine auto` a clean run hands
     over to the refinement early, so its rounds alone undercount its work (intel: 1 round, 13
-    refinement steps); the robust run refines only its final solve."""
+    refinement steps)."""
     return 2 * rounds + summary.get("refine_exchanges", 0) + summary.get("refine_reductions", 0)
 
 
@@ -788,7 +789,8 @@ def main():
                                    # message steps of the final solve's Newton refinement
                                    d_refine_steps=drob.get("refine_exchanges", 0) +
                                    drob.get("refine_reductions", 0))
-                        row["d_msg_steps"] = message_steps(drob["total_rounds"], drob)
+                        row["d_msg_steps"] = (message_steps(drob["total_rounds"], drob) +
+                                              drob.get("gnc_refine_steps", 0))
                         if dref is not None:
                             clean_steps = message_steps(dref["rounds"], dref)
                             row.update(d_clean_rounds=dref["rounds"],

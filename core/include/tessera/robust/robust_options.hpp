@@ -137,7 +137,10 @@ struct RobustOptions {
   /// outliers: wrong closure 5626 (1696-2406) kept at r^2 39.2 against c^2 = 46.2, true closure
   /// 4195 (1696-1746) cut at 2.9 c^2, cost over the kept set 1,984.7 against f*_clean 1,687.0;
   /// docs/robust.md, "Swap probes"). 3: there the true closure 4145 at r^2 43.8, which also meets
-  /// pose 1696, comes first and its swap is refused; the second is the fold's.
+  /// pose 1696, comes first. A strained kept closure with no such rejected one is cut alone when
+  /// its r^2 is also above probe_ratio x the median r^2 of the kept closures (a wrong closure
+  /// bent to fit where no true closure was cut: sphere2500 75 %, wrong closure 6144 (429-2009) at
+  /// r^2 18.1 against a median of 0.27, c^2 = 46.5); the pairs come first.
   int swap_probes = 3;
   /// A swap's two closures have an end within this many pose ids, >= 0. 0: the fold's wrong and
   /// true closure share a pose.
@@ -159,6 +162,18 @@ struct RobustOptions {
   /// rounding error in fewer rounds than the block updates would need (docs/robust.md, "Final
   /// solve").
   bool final_refine = true;
+  /// Distributed solvers only, with `--refine auto` (the solver's NewtonRefineOptions::when =
+  /// kIfRoundsSlow): an inlier pass solved to the tolerance hands over to the Newton refinement
+  /// where the team's interface fits its interface solves, as a clean solve does; capped passes,
+  /// GNC's own solves and graphs whose interface does not fit are solved by rounds alone. Off
+  /// (default): every solve before the final one is solved by rounds alone. Why: where the
+  /// clean run is mostly refinement (intel, CSAIL at 5 agents: 1 and 0 rounds, 15 and 13 message
+  /// steps) the robust run's passes to the tolerance are what costs (F = 0.25 random: intel
+  /// 1,033 message steps, CSAIL 965); with this on 468 and 295, the same exact sets, certified.
+  /// Where the interface does not fit (manhattan3500) the refinement's block-Jacobi CG would cost
+  /// more message steps than the rounds it saves (16 rounds for 1,958 message steps), hence the
+  /// limit (docs/robust.md, "Final solve").
+  bool refine_passes = false;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
