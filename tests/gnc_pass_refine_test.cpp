@@ -2,19 +2,12 @@
 // hand over to the Newton refinement where the team's interface fits its interface solves.
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <tessera/robust/gnc_distributed.hpp>
 
 #include "gnc_fixtures.hpp"
 
 namespace tessera {
 namespace {
-
-int message_steps(const GncDistributedResult& r) {
-  int steps = 2 * r.total_rounds + r.refine_message_steps;
-  for (const NewtonRefineResult& n : r.final_solve.refines) steps += n.exchanges + n.reductions;
-  return steps;
-}
 
 TEST(GncPassRefine, RefinedPassesEndWithTheSameSetAndCostAndCountTheirMessageSteps) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
@@ -33,8 +26,6 @@ TEST(GncPassRefine, RefinedPassesEndWithTheSameSetAndCostAndCountTheirMessageSte
   EXPECT_NEAR(refined.final_solve.cost, rounds.final_solve.cost, 1e-9 * rounds.final_solve.cost);
   EXPECT_TRUE(refined.final_solve.certified.value_or(false));
   EXPECT_LT(refined.total_rounds, rounds.total_rounds);
-  std::printf("message steps: rounds-only passes %d, refined passes %d\n", message_steps(rounds),
-              message_steps(refined));
 }
 
 }  // namespace
