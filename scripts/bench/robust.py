@@ -7,7 +7,9 @@ then for each outlier kind and fraction F (of the graph's loop closures) wrong c
 appended and the robust and plain solves run. Per cell: precision and recall of the rejected
 set against the labels, relative gap of the robust cost (over the kept measurements) to
 f*_clean, ATE of the estimate against the clean optimum after a rigid alignment, outer steps,
-solver iterations, wall time, certified; beside it the plain solve's cost gap and ATE.
+solver iterations, wall time, certified; beside it the plain solve's cost gap and ATE; for the
+distributed run also its rounds and message steps (two a round plus the Newton refinements'
+exchanges and sums) against the clean distributed run's.
 
 --cluster-probes K gives the centralized robust solve `--gnc-cluster-probes K`; --explain adds,
 for group cells, the TLS cost at the robust estimate and at the clean optimum, the groups that
