@@ -82,6 +82,7 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
     ro.robust.final_refine = asg.gnc_final_refine();
     ro.robust.validate();
     ro.gnc_known_start = asg.gnc_known_start();
+    ro.gnc_cluster_probes = static_cast<int>(asg.gnc_cluster_probes());
   }
   return ro;
 }

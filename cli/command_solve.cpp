@@ -61,10 +61,11 @@ const char* kHelp =
     "                            preconditioner factorization; beyond it the factor keeps the\n"
     "                            known inliers and the highest-weight others that fit; 0 = all\n"
     "                            measurements (docs/robust.md) [1e9]\n"
-    "  --gnc-cluster-probes K    robust centralized: most probes after the re-check passes,\n"
-    "                            each cutting a run of kept closures side by side at once (or\n"
-    "                            taking back one rejected closure near the bound); a probe's\n"
-    "                            result stays only if the TLS cost fell; 0 = none [0]\n"
+    "  --gnc-cluster-probes K    robust: most probes after the re-check passes, each cutting\n"
+    "                            a run of kept closures side by side at once (or taking back\n"
+    "                            one rejected closure near the bound); a probe's result stays\n"
+    "                            only if the TLS cost fell; distributed: every agent runs the\n"
+    "                            same search, no central step; 0 = none [0]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {

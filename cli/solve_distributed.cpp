@@ -398,6 +398,11 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     options.robust = robust;
     options.known_inlier_flags = input.known_inlier;
     options.known_inlier_start = !a.has("init");
+    options.cluster_probes =
+        static_cast<int>(a.get_long("gnc-cluster-probes", options.cluster_probes));
+    if (options.cluster_probes < 0)
+      throw InputError("option --gnc-cluster-probes: GncDistributedOptions.cluster_probes = " +
+                       std::to_string(options.cluster_probes) + ": must be >= 0 (0 = none)");
     gnc = solve_gnc_distributed(graph, part.assignment, options);
   } else {
     gnc.final_solve = solve_distributed(graph, part.assignment, opt);

@@ -53,6 +53,7 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
     asg.gnc_recheck_probes(static_cast<std::uint32_t>(r.recheck_probes));
     asg.gnc_probe_ratio(r.probe_ratio);
     asg.gnc_final_refine(r.final_refine);
+    asg.gnc_cluster_probes(options.gnc_cluster_probes);
     asg.known_inlier(structure.known_inlier);
   }
   return asg;

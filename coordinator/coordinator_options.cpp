@@ -89,7 +89,7 @@ options:
                        lower pose ids (docs/robust.md) (default none)
   --inlier-threshold C, --inlier-quantile P, --gnc-max-outer K, --gnc-mu-step S,
   --gnc-inner-rounds K, --known-inliers odometry|none, --gnc-probes K,
-  --gnc-probe-ratio R, --gnc-final-refine newton|none
+  --gnc-probe-ratio R, --gnc-final-refine newton|none, --gnc-cluster-probes K
                        the GNC options, as for `tessera solve` (docs/robust.md)
   --rejected FILE      write the rejected measurement indices (from 0 over the EDGE lines)
   --gnc-solver-start   GNC starts from --init's poses, not from the known inliers'
@@ -139,7 +139,8 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "refine-grad-tol",
                                                             "refine-rel-tol",
                                                             "setup-at-once",
-                                                            "reference-cost"},
+                                                            "reference-cost",
+                                                            "gnc-cluster-probes"},
                                                            cli::SessionArgsFor::kProcess);
   valued.insert("graph");
   for (const char* const* r = cli::kRobustValued; *r; ++r) valued.insert(*r);
@@ -229,6 +230,7 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   a.status_relay = !args.has("no-status-relay");
   a.robust = cli::parse_robust_options(args);
   a.gnc_known_start = !args.has("gnc-solver-start");
+  a.gnc_cluster_probes = static_cast<std::uint32_t>(nonneg("gnc-cluster-probes", 0));
   a.rejected = args.get_or("rejected", "");
   a.reference_cost = args.get_double("reference-cost", 0);
   if (args.has("reference-cost") && !(a.reference_cost > 0 && std::isfinite(a.reference_cost)))

@@ -62,6 +62,8 @@ struct CoordinatorOptions {
   RobustOptions robust;
   /// GNC starts from the known inliers (off when --init is given, like `tessera solve`).
   bool gnc_known_start = true;
+  /// --gnc-cluster-probes K: GncDistributedOptions::cluster_probes of every agent (0 = none).
+  std::uint32_t gnc_cluster_probes = 0;
   std::string rejected;  ///< --rejected FILE: the rejected measurements, one index a line.
   /// --reference-cost F: the optimal cost f* of the graph, known from elsewhere (e.g. `tessera
   /// solve --algorithm centralized`); the summary then reports the final cost's relative gap to it,

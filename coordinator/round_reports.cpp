@@ -55,6 +55,10 @@ bool RoundReports::on_report(const wire::RoundStatus& m) {
     results_.agent_solve_s = m.cost();
     results_.agent_rounding_s = m.grad_norm_sq();
     results_.rounding_cg_iterations = static_cast<std::uint32_t>(m.block_grad_norm());
+    if (m.coarse().size() == 2) {  // the interface solve's poses, the message steps
+      results_.rounding_interface_poses = static_cast<std::uint32_t>(m.coarse()[0]);
+      results_.rounding_message_steps = static_cast<std::uint32_t>(m.coarse()[1]);
+    }
     return true;
   }
   if (m.phase() == kAgentSetupTimesPhase) {

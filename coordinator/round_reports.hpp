@@ -66,6 +66,9 @@ struct ReportedResults {
   std::optional<double> agent_solve_s, agent_rounding_s;
   // The rounding's translation CG iterations (each one all-agent sum), with those times.
   std::optional<std::uint32_t> rounding_cg_iterations;
+  // The rounding's exact interface solve: the team's interface poses (0 = the CG ran), and
+  // the rounding's message steps (each one a wait for peers).
+  std::optional<std::uint32_t> rounding_interface_poses, rounding_message_steps;
   // Agent 0's set-up (its clock, seconds): the initialisation stage and the hand-off, and
   // whether its chordal start was solved while the run started.
   std::optional<double> agent_init_s, agent_handoff_s;

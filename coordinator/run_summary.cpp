@@ -71,6 +71,14 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("rounding_cg_iterations", r.rounding_cg_iterations
                                          ? std::optional<double>(*r.rounding_cg_iterations)
                                          : std::nullopt)
+      // The rounding's exact interface solve's poses (0: the CG solved the translations;
+      // rounding_translations below says which) and its message steps.
+      .add("rounding_interface_poses", r.rounding_interface_poses
+                                           ? std::optional<double>(*r.rounding_interface_poses)
+                                           : std::nullopt)
+      .add("rounding_message_steps", r.rounding_message_steps
+                                         ? std::optional<double>(*r.rounding_message_steps)
+                                         : std::nullopt)
       // Agent 0's set-up: its initialisation stage and hand-off (runtime/early_chordal.hpp).
       .add("init_ms", r.agent_init_s ? std::optional<double>(1000 * *r.agent_init_s) : std::nullopt)
       .add("handoff_ms",
@@ -90,6 +98,10 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     run_mb += agent_mb.back();
   }
   const double coordinator_mb = static_cast<double>(agent::peak_resident_bytes()) / mb;
+  if (r.rounding_interface_poses)
+    j.add("rounding_translations", *r.rounding_interface_poses > 0 ? "interface" : "cg");
+  else
+    j.add_null("rounding_translations");
   j.add("peak_rss_mb_per_agent", agent_mb)
       .add("peak_rss_mb_agent_max", agent_max)
       .add("peak_rss_mb_coordinator", coordinator_mb)

@@ -178,6 +178,12 @@ void check_gnc_probes(const std::string& v) {
 void check_gnc_probe_ratio(const std::string& v) {
   check_robust_field(v, "gnc-probe-ratio", [](RobustOptions& o, double x) { o.probe_ratio = x; });
 }
+void check_gnc_cluster_probes(const std::string& v) {
+  const double x = number(v, "gnc-cluster-probes");
+  if (!(x >= 0 && x == static_cast<double>(static_cast<long>(x)) && x <= 4294967295.0))
+    throw InputError("option --gnc-cluster-probes: GncDistributedOptions.cluster_probes = " + v +
+                     ": must be an integer >= 0 (0 = none)");
+}
 void check_gnc_final_refine(const std::string& v) {
   if (v != "newton" && v != "none")
     throw InputError("option --gnc-final-refine: '" + v + "' is not one of newton, none");
@@ -240,6 +246,12 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "a probe takes the kept edges with r^2 above R x their\n"
        "agent's median r^2, > 1                              [5]",
        check_gnc_probe_ratio},
+      {"gnc-cluster-probes", "gnc-cluster-probes", true, ForwardTo::kCoordinator,
+       "--gnc-cluster-probes K",
+       "most cluster probes after the re-check passes (runs of\n"
+       "kept closures side by side cut at once; every agent runs\n"
+       "the same search), 0 = none                             [0]",
+       check_gnc_cluster_probes},
       {"gnc-final-refine", "gnc-final-refine", true, ForwardTo::kCoordinator,
        "--gnc-final-refine newton|none",
        "the final solve of the kept set ends with Newton\n"

@@ -354,5 +354,37 @@ TEST(DdsRobust, PcmGncOverDdsEqualsTheInProcessEngine) {
   EXPECT_EQ(ref.rejected, json_array(slurp(dir + "/labels.json"), "outliers"));
 }
 
+// Cluster probes (--gnc-cluster-probes) over DDS: every agent process runs the same search on the
+// same data, so the probes, rounds, rejected set and cost equal the in-process engine's.
+TEST(DdsRobust, ClusterProbesOverDdsEqualTheInProcessEngine) {
+  const std::string dir = temp_dir();
+  const GeneratorResult city = flexible_city(0.1, OutlierKind::kGroup, 3);
+  const std::string graph = dir + "/graph.g2o";
+  write_g2o(city.graph, graph);
+  const std::string run = "robust-cluster-" + std::to_string(getpid());
+  run_to_the_end(dir, graph, 3, run, 229,
+                 {"--timeout", "20", "--run-timeout", "120", "--summary", dir + "/summary.json",
+                  "--partition", "sequential", "--seed", "7", "--certify", "--robust", "gnc-tls",
+                  "--gnc-cluster-probes", "20"},
+                 120);
+  const std::string summary = slurp(dir + "/summary.json");
+  const PoseGraph g = read_g2o(graph);
+  const std::vector<int> assignment = assignment_of(dir, 3);
+  GncDistributedOptions o = in_process_options();
+  o.cluster_probes = 20;
+  const GncDistributedResult ref = solve_gnc_distributed(g, assignment, o);
+  // Beyond the agents' tail probes: the cluster search ran.
+  ASSERT_GT(ref.probes, RobustOptions{}.recheck_probes);
+  EXPECT_GE(ref.probes_kept, 1);
+  EXPECT_EQ(json_field(summary, "probes"), ref.probes) << summary;
+  EXPECT_EQ(json_field(summary, "probes_kept"), ref.probes_kept) << summary;
+  EXPECT_EQ(json_field(summary, "outer_iterations"), ref.outer_iterations) << summary;
+  EXPECT_EQ(json_field(summary, "rounds"), ref.total_rounds) << summary;
+  EXPECT_EQ(json_array(summary, "rejected"), ref.rejected) << summary;
+  EXPECT_NEAR(json_field(summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  EXPECT_EQ(json_field(summary, "min_eigenvalue"), ref.final_solve.min_eigenvalue);
+  EXPECT_NE(summary.find("\"certified\": true"), std::string::npos) << summary;
+}
+
 }  // namespace
 }  // namespace tessera::test::dds

@@ -117,5 +117,25 @@ TEST(RoundReports, AgentZerosSetUpTimesAreKeptForTheSummary) {
   EXPECT_FALSE(*r.results().init_early);
 }
 
+// The phase times also say how the rounding solved its translations (coarse = {interface poses,
+// message steps}); without them (an older agent) the summary leaves both out.
+TEST(RoundReports, AgentZerosPhaseTimesCarryTheRoundingsInterfacePosesAndMessageSteps) {
+  std::ostringstream out;
+  RoundReports r(false, out);
+  wire::RoundStatus m;
+  m.sender(0);
+  m.round(45);
+  m.phase(kAgentPhaseTimesPhase);
+  m.cost(0.25);
+  m.grad_norm_sq(0.125);
+  EXPECT_TRUE(r.on_report(m));
+  EXPECT_FALSE(r.results().rounding_interface_poses.has_value());
+  m.coarse({34.0, 5.0});
+  EXPECT_TRUE(r.on_report(m));
+  ASSERT_TRUE(r.results().rounding_interface_poses.has_value());
+  EXPECT_EQ(*r.results().rounding_interface_poses, 34u);
+  EXPECT_EQ(*r.results().rounding_message_steps, 5u);
+}
+
 }  // namespace
 }  // namespace tessera::coordinator

@@ -69,6 +69,7 @@ TEST(DistributedRounding, FromZeroToTheResidualStopItIsTheDirectSolve) {
   const RoundingCase c = make_case(1000, 4, 20);
   for (bool coarse : {false, true}) {
     DistributedRoundingOptions exact;
+    exact.interface_max_poses = 0;  // the CG
     exact.warm_start = false;
     exact.settle_tolerance = 0;
     exact.coarse_correction = coarse;
@@ -88,12 +89,14 @@ TEST(DistributedRounding, TheCoarseLevelReachesTheDirectSolveInFewerStepsAtManyB
   std::uint32_t exact_steps[2] = {0, 0}, settled_steps[2] = {0, 0};
   for (bool coarse : {false, true}) {
     DistributedRoundingOptions exact;
+    exact.interface_max_poses = 0;  // the CG
     exact.settle_tolerance = 0;
     exact.coarse_correction = coarse;
     const Rounded r = round_in_threads(c, exact);
     ASSERT_TRUE(r.errors.empty()) << r.errors.front();
     EXPECT_LT(worst_position_gap(r.poses, c.solved.poses), 1e-8) << "coarse " << coarse;
     DistributedRoundingOptions settled;
+    settled.interface_max_poses = 0;
     settled.coarse_correction = coarse;
     const Rounded s = round_in_threads(c, settled);
     ASSERT_TRUE(s.errors.empty()) << s.errors.front();
@@ -116,11 +119,13 @@ TEST(DistributedRounding, WarmStartAndCostStopStayWithinTheBoundInFewerIteration
   for (int rounds : {20, 200}) {
     const RoundingCase c = make_case(1000, 4, rounds);
     DistributedRoundingOptions exact;
+    exact.interface_max_poses = 0;  // the CG
     exact.warm_start = false;
     exact.settle_tolerance = 0;
     const Rounded cold = round_in_threads(c, exact);
     ASSERT_TRUE(cold.errors.empty()) << cold.errors.front();
-    const DistributedRoundingOptions defaults;
+    DistributedRoundingOptions defaults;  // the CG's
+    defaults.interface_max_poses = 0;
     const Rounded warm = round_in_threads(c, defaults);
     ASSERT_TRUE(warm.errors.empty()) << warm.errors.front();
     // The direct solve's translations minimise the cost for the rounded rotations: the
@@ -147,6 +152,9 @@ TEST(DistributedRounding, OptionsOutOfRangeNameTheField) {
   o = {};
   o.settle_window = 0;
   EXPECT_THROW(o.validate(), InputError);
+  o = {};
+  o.interface_max_poses = 1000001;
+  EXPECT_NE(test::validation_message(o).find("interface_max_poses"), std::string::npos);
 }
 
 }  // namespace

@@ -211,5 +211,16 @@ TEST(LaunchOptions, PublicOptionsParseToTheSameRun) {
   EXPECT_NE(test::validation_message(pub).find("--agents"), std::string::npos);
 }
 
+TEST(LaunchOptions, ClusterProbesReachTheCoordinatorAndABadCountNamesTheFlag) {
+  LaunchOptions o = parse_launch_options({"--robust", "gnc-tls", "--gnc-cluster-probes", "20"});
+  o.graph = "/data/graph.g2o";
+  EXPECT_TRUE(has_pair(coordinator_argv(o, paths()), "--gnc-cluster-probes", "20"));
+  EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--gnc-cluster-probes"));
+  for (const char* bad : {"-1", "2.5", "x"}) {
+    const std::string e = error_of({"--gnc-cluster-probes", bad});
+    EXPECT_NE(e.find("--gnc-cluster-probes"), std::string::npos) << bad << ": " << e;
+  }
+}
+
 }  // namespace
 }  // namespace tessera::launch

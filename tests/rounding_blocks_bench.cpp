@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
     c.solved = solve_distributed(c.graph, c.assignment, o);
     for (bool coarse : {false, true}) {
       DistributedRoundingOptions settled;
+      settled.interface_max_poses = 0;  // the CG's steps
       settled.coarse_correction = coarse;
       DistributedRoundingOptions exact = settled;
       exact.settle_tolerance = 0;

@@ -23,11 +23,7 @@ struct TranslationInterfaceSolve::Impl {
   Eigen::Index m = 0, mI = 0, mG = 0;         // poses: all, interior, interface
   std::vector<Eigen::Index> slot;             // local pose -> position in the factor's order
   std::vector<Eigen::Index> interface_local;  // the own interface poses' local indices
-  struct Cut {
-    std::size_t own = 0, other = 0;  // global ids, own < other
-    double value = 0.0;
-  };
-  std::vector<Cut> cut;
+  std::vector<Coupling> cut;                  // own < other
   std::unordered_map<std::size_t, Eigen::Index> team_row;
   std::vector<Eigen::Index> block_offset, block_size;
   Eigen::Index team = 0, own_offset = 0;
@@ -44,12 +40,42 @@ struct TranslationInterfaceSolve::Impl {
 TranslationInterfaceSolve::TranslationInterfaceSolve(const BlockProblem& problem,
                                                      const BlockLayout& layout, int id)
     : impl_(std::make_unique<Impl>()) {
-  Impl& s = *impl_;
   const Eigen::Index w = problem.dim() + 1;
   const std::vector<std::size_t>& owned = problem.owned();
   const std::vector<std::size_t>& neighbors = problem.neighbors();
-  s.m = static_cast<Eigen::Index>(owned.size());
 
+  // L_BB: Q_BB's translation-translation entries (each pose's last column).
+  const SparseMatrix& Q = problem.data_matrix();
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index c = w - 1; c < Q.outerSize(); c += w)
+    for (SparseMatrix::InnerIterator it(Q, c); it; ++it)
+      if (it.row() % w == w - 1) entries.emplace_back(it.row() / w, c / w, it.value());
+
+  // The cut's couplings: L(i, j) for own i and neighbour j, from Q_NB's (j, i) entry.
+  const SparseMatrix& Qnb = problem.neighbor_matrix();
+  std::vector<Coupling> cut;
+  for (Eigen::Index c = w - 1; c < Qnb.outerSize(); c += w)
+    for (SparseMatrix::InnerIterator it(Qnb, c); it; ++it) {
+      if (it.row() % w != w - 1 || it.value() == 0.0) continue;
+      cut.push_back({owned[static_cast<std::size_t>(c / w)],
+                     neighbors[static_cast<std::size_t>(it.row() / w)], it.value()});
+    }
+  set_up(owned, entries, cut, layout, id);
+}
+
+TranslationInterfaceSolve::TranslationInterfaceSolve(
+    const std::vector<std::size_t>& owned, const std::vector<Eigen::Triplet<double>>& entries,
+    const std::vector<Coupling>& cut, const BlockLayout& layout, int id)
+    : impl_(std::make_unique<Impl>()) {
+  set_up(owned, entries, cut, layout, id);
+}
+
+void TranslationInterfaceSolve::set_up(const std::vector<std::size_t>& owned,
+                                       const std::vector<Eigen::Triplet<double>>& entries,
+                                       const std::vector<Coupling>& cut, const BlockLayout& layout,
+                                       int id) {
+  Impl& s = *impl_;
+  s.m = static_cast<Eigen::Index>(owned.size());
   // The team's interface, blocks in id order, each one's poses ascending.
   for (int b = 0; b < layout.num_blocks; ++b) {
     const std::vector<std::size_t> poses = interface_poses(layout, b);
@@ -72,13 +98,6 @@ TranslationInterfaceSolve::TranslationInterfaceSolve(const BlockProblem& problem
     s.slot[static_cast<std::size_t>(it->second)] = s.mI + static_cast<Eigen::Index>(k);
     s.interface_local.push_back(it->second);
   }
-
-  // L_BB: Q_BB's translation-translation entries (each pose's last column).
-  const SparseMatrix& Q = problem.data_matrix();
-  std::vector<Eigen::Triplet<double>> entries;
-  for (Eigen::Index c = w - 1; c < Q.outerSize(); c += w)
-    for (SparseMatrix::InnerIterator it(Q, c); it; ++it)
-      if (it.row() % w == w - 1) entries.emplace_back(it.row() / w, c / w, it.value());
 
   // Interior order: AMD on the interior poses' pattern.
   if (s.mI > 0) {
@@ -123,16 +142,13 @@ TranslationInterfaceSolve::TranslationInterfaceSolve(const BlockProblem& problem
         if (it.row() > c) s.Lgg(it.row() - s.mI, c - s.mI) = it.value();
   }
 
-  // The cut's couplings: L(i, j) for own i and neighbour j, from Q_NB's (j, i) entry; the
-  // block with the smaller pose id reports it.
-  const SparseMatrix& Qnb = problem.neighbor_matrix();
-  for (Eigen::Index c = w - 1; c < Qnb.outerSize(); c += w)
-    for (SparseMatrix::InnerIterator it(Qnb, c); it; ++it) {
-      if (it.row() % w != w - 1) continue;
-      const std::size_t own = owned[static_cast<std::size_t>(c / w)];
-      const std::size_t other = neighbors[static_cast<std::size_t>(it.row() / w)];
-      if (own < other && it.value() != 0.0) s.cut.push_back({own, other, it.value()});
-    }
+  // The block with the smaller pose id reports a coupling; one between poses outside the
+  // layout's interface cannot be placed in Sigma: the block says so in its share.
+  for (const Coupling& c : cut) {
+    if (c.own >= c.other) continue;
+    if (s.team_row.count(c.own) == 0 || s.team_row.count(c.other) == 0) s.block_ok = false;
+    s.cut.push_back(c);
+  }
 }
 
 TranslationInterfaceSolve::~TranslationInterfaceSolve() = default;
@@ -171,7 +187,7 @@ std::vector<double> TranslationInterfaceSolve::share() const {
   for (Eigen::Index j = 0; j < s.mG; ++j)
     for (Eigen::Index i = j; i < s.mG; ++i) out.push_back(0.5 * (schur(i, j) + schur(j, i)));
   out.push_back(static_cast<double>(s.cut.size()));
-  for (const Impl::Cut& c : s.cut) {
+  for (const Coupling& c : s.cut) {
     out.push_back(static_cast<double>(c.own));
     out.push_back(static_cast<double>(c.other));
     out.push_back(c.value);
@@ -183,13 +199,13 @@ bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<dou
   Impl& s = *impl_;
   s.sigma_ok = false;
   if (blocks.size() != s.block_offset.size())
-    throw std::runtime_error("newton refine: translation shares from the wrong number of agents");
+    throw std::runtime_error("translation interface solve: shares from the wrong number of agents");
   std::vector<Eigen::Triplet<double>> t;
   double top = 0.0;
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     const std::vector<double>& v = *blocks[b];
     auto fail = [b] {
-      throw std::runtime_error("newton refine: malformed translation share from agent " +
+      throw std::runtime_error("translation interface solve: malformed share from agent " +
                                std::to_string(b));
     };
     std::size_t k = 0;

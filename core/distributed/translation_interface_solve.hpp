@@ -25,6 +25,7 @@
 // definite (a piece of it without a cut measurement) reports so, and the caller falls back.
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <cstddef>
 #include <memory>
 #include <tessera/distributed/block_layout.hpp>
@@ -39,8 +40,23 @@ Eigen::Index interface_pose_count(const BlockLayout& layout);
 
 class TranslationInterfaceSolve {
  public:
+  /// L(own, other) of one cut measurement: `own` a pose of the block, `other` a neighbour's
+  /// (global ids).
+  struct Coupling {
+    std::size_t own = 0, other = 0;
+    double value = 0.0;
+  };
+
   /// `problem`: agent `id`'s block; `layout`: the team's. Orders and factors L_BB.
   TranslationInterfaceSolve(const BlockProblem& problem, const BlockLayout& layout, int id);
+  /// The same from the Laplacian itself (the distributed rounding, which has the measurements
+  /// but no BlockProblem): `owned` the block's poses (global ids, its order), `entries` L_BB's
+  /// (indices into `owned`, both triangles, duplicates add, cut measurements on the diagonal),
+  /// `cut` one coupling per cut measurement (duplicates add). A coupling between poses outside
+  /// the layout's interface makes share() say the block is unusable (flag 0).
+  TranslationInterfaceSolve(const std::vector<std::size_t>& owned,
+                            const std::vector<Eigen::Triplet<double>>& entries,
+                            const std::vector<Coupling>& cut, const BlockLayout& layout, int id);
   ~TranslationInterfaceSolve();
   TranslationInterfaceSolve(const TranslationInterfaceSolve&) = delete;
   TranslationInterfaceSolve& operator=(const TranslationInterfaceSolve&) = delete;
@@ -78,6 +94,12 @@ class TranslationInterfaceSolve {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+
+  // Both constructors: orders and factors L_BB from its entries; keeps the couplings whose own
+  // pose has the smaller id.
+  void set_up(const std::vector<std::size_t>& owned,
+              const std::vector<Eigen::Triplet<double>>& entries, const std::vector<Coupling>& cut,
+              const BlockLayout& layout, int id);
 };
 
 }  // namespace tessera

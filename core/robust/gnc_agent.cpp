@@ -8,6 +8,7 @@
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "robust/gnc_cluster_search.hpp"
 #include "robust/gnc_exchange.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
@@ -55,7 +56,13 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   exchange_ = std::make_unique<GncExchangeBook>(in_, *terms_, *base_);
   mail_ = std::make_unique<GncMailbox>(in_.id);
   recheck_ = std::make_unique<RecheckVerdict>();
-  probes_ = std::make_unique<GncProbes>(options_.robust.recheck_probes);
+  // With cluster probes the search (gnc_cluster_search.hpp) splits the budget: recheck_probes
+  // tail probes, cluster_probes cluster, pair and return probes.
+  probes_ = std::make_unique<GncProbes>(options_.robust.recheck_probes + options_.cluster_probes);
+  if (options_.cluster_probes > 0)
+    search_ = std::make_unique<GncClusterSearch>(in_.structure, terms_->known(),
+                                                 options_.robust.recheck_probes,
+                                                 options_.cluster_probes, options_.clusters);
   weights_.assign(m, 1.0);
 }
 
@@ -408,11 +415,13 @@ bool GncAgent::may_probe() const {
   return probes_->may_start(terms_->known_connected(), options_.robust.readmission_passes);
 }
 
-void GncAgent::begin_probe(double tls, std::vector<OutgoingMessage>& out) {
-  // Every agent holds every agent's probe list (the verdict exchange): the same cut everywhere.
+void GncAgent::begin_probe(double tls, std::vector<std::uint64_t> flip,
+                           std::vector<OutgoingMessage>& out) {
+  // Every agent holds every agent's probe list (the verdict exchange) and runs the same cluster
+  // search: the same flips everywhere.
   probes_->start(GncProbeBase{tls, rejected_, weights_, state_->Y, readmitted_, late_rejected_});
   RecheckVerdict cut;
-  cut.cut_now = std::move(recheck_->probe);
+  cut.cut_now = std::move(flip);
   apply_recheck(cut, in_.measurement_index, rejected_, weights_);
   pass_ = 0;
   last_pass_full_ = false;
@@ -426,7 +435,7 @@ void GncAgent::begin_probe(double tls, std::vector<OutgoingMessage>& out) {
   begin_inlier_pass(out);
 }
 
-void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out) {
+void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out, double rise) {
   GncProbeBase base = probes_->take_base();
   rejected_ = std::move(base.rejected);
   weights_ = std::move(base.weights);
@@ -434,6 +443,15 @@ void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out) {
   late_rejected_ = base.late_rejected;
   // The own block has the same shape whatever the kept set: the next pass starts from it.
   state_->Y = std::move(base.Y);
+  if (search_) {
+    // The next probe starts from the restored set and iterate, which the passes had settled.
+    search_->refused(rise, base.tls);
+    if (may_probe())
+      if (std::optional<std::vector<std::uint64_t>> flip = search_->next(rejected_)) {
+        begin_probe(base.tls, std::move(*flip), out);
+        return;
+      }
+  }
   // One last pass on the restored set (from its converged iterate, so it costs few rounds),
   // then the final solve.
   pass_ = options_.robust.readmission_passes;
@@ -586,12 +604,27 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
           return;
         }
         const double tls = exchange_->summed_votes().first;
-        if (probes_->running() && !probes_->keeps(rejected_, tls)) {
-          restore_before_probe(out);
+        if (probes_->running()) {
+          const double before = probes_->base_tls();
+          if (!probes_->keeps(rejected_, tls)) {
+            restore_before_probe(out, tls - before);
+            return;
+          }
+          if (search_) search_->kept();
+        }
+        if (search_) {
+          // The verdict lists of the set that stays: the tail and the return band of its probes.
+          search_->set_list(recheck_->probe);
+          if (may_probe())
+            if (std::optional<std::vector<std::uint64_t>> flip = search_->next(rejected_)) {
+              begin_probe(tls, std::move(*flip), out);
+              return;
+            }
+          finish(out);
           return;
         }
         if (may_probe() && !recheck_->probe.empty()) {
-          begin_probe(tls, out);
+          begin_probe(tls, std::move(recheck_->probe), out);
           return;
         }
         finish(out);

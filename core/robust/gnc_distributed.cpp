@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/distributed/in_process_driver.hpp>
@@ -31,6 +32,10 @@ double lifted_residual_squared(const Measurement& m, const Eigen::MatrixXd& X, i
 void GncDistributedOptions::validate() const {
   solver.validate();
   robust.validate();
+  if (cluster_probes < 0)
+    throw InputError("GncDistributedOptions.cluster_probes = " + std::to_string(cluster_probes) +
+                     ": must be >= 0 (0 = none)");
+  clusters.validate();
 }
 
 int weight_owner(const Measurement& m, const std::vector<int>& assignment) {

@@ -66,6 +66,8 @@ class GncProbes {
     running_ = false;
     return std::move(base_);
   }
+  /// The summed TLS cost before the running probe.
+  double base_tls() const { return base_.tls; }
   /// The rejected set the running probe started from (ascending).
   const std::vector<std::uint64_t>& base_rejected() const { return base_.rejected; }
   int started() const { return started_; }

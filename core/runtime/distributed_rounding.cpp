@@ -12,6 +12,7 @@
 #include <tessera/util/input_error.hpp>
 #include <variant>
 
+#include "distributed/translation_interface_solve.hpp"
 #include "runtime/rounding_coarse.hpp"
 #include "util/frobenius_inner.hpp"
 
@@ -24,14 +25,27 @@ void DistributedRoundingOptions::validate() const {
   if (settle_window < 1 || settle_window > 1000)
     throw InputError("DistributedRoundingOptions::settle_window must be in [1, 1000], got " +
                      std::to_string(settle_window));
+  if (interface_max_poses > 1000000)
+    throw InputError(
+        "DistributedRoundingOptions::interface_max_poses must be in [0, 1000000], got " +
+        std::to_string(interface_max_poses));
 }
+
+DistributedRounding::~DistributedRounding() = default;
 
 RoundLoopResult DistributedRounding::run(RoundLoopResult res) {
   rotations();
-  res.translation_iterations = translations(res.relaxation_cost);
+  if (take_interface_shares()) {
+    res.translation_iterations = 0;
+    res.rounding_interface_poses = static_cast<std::uint32_t>(interface_->team_size());
+    res.cost = interface_translations();
+  } else {
+    res.translation_iterations = translations(res.relaxation_cost);
+    res.rounding_interface_poses = 0;
+    res.cost = cost();
+  }
   res.poses.clear();
   for (std::size_t s = 0; s < own_.size(); ++s) res.poses.push_back(poses_.at(own_[s]));
-  res.cost = cost();
   return res;
 }
 
@@ -188,6 +202,7 @@ void DistributedRounding::rotations() {
   for (Eigen::Index c = 0; c < r; ++c)
     std::copy_n(G.col(c).data(), r, add_entry(gm, static_cast<std::uint32_t>(c)));
   mail_.send_all({OutgoingMessage{gm, true, {}}});
+  send_interface_share();  // the translation Laplacian does not depend on the rotations
   auto got = mail_.gather(kGram, 0, others());
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(r, r);
   for (std::uint32_t a : everyone_) {
@@ -495,6 +510,10 @@ std::uint32_t DistributedRounding::translations(double relaxation_cost) {
 }
 
 double DistributedRounding::cost() {
+  return reduce(kCost, 0, cost_share(), 0.0, nullptr);
+}
+
+double DistributedRounding::cost_share() const {
   double share = 0.0;
   for (const Measurement& e : local_.measurements) {
     const Pose& a = poses_.at(e.i);
@@ -504,7 +523,7 @@ double DistributedRounding::cost() {
     const bool both = local_.owner[e.i] == self_ && local_.owner[e.j] == self_;
     share += both ? f : 0.5 * f;
   }
-  return reduce(kCost, 0, share, 0.0, nullptr);
+  return share;
 }
 
 }  // namespace tessera::agent

@@ -2,20 +2,28 @@
 // The distributed rounding of the final lifted iterate to SE(d), with no central step: core's
 // round_solution (rank-d truncation via the r x r Gram matrix summed over the agents,
 // reflection by majority, per-block projection to SO(d), translations optimal for those
-// rotations with pose 0 at the origin, by a distributed preconditioned conjugate gradient) up
-// to floating-point summation order and the CG's stop (its cost within
-// DistributedRoundingOptions::cost_bound() of the exact solve's). Runs after core's protocol in
-// run_round_loop, over the same Mailbox.
+// rotations with pose 0 at the origin) up to floating-point summation order. The translations
+// come from one of two solves:
+// - exact, through the team's interface (distributed/translation_interface_solve.hpp) when it
+//   has at most DistributedRoundingOptions::interface_max_poses poses: every agent factors its
+//   translation Laplacian block and sends its Schur complement with the Gram matrix, then one
+//   all-agent sum of the interface residuals (runtime/rounding_interface.cpp);
+// - otherwise (or when a block's Laplacian is singular) a distributed preconditioned conjugate
+//   gradient, one message step per iteration, its cost within
+//   DistributedRoundingOptions::cost_bound() of the exact solve's.
+// Runs after core's protocol in run_round_loop, over the same Mailbox.
 
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/graph/pose.hpp>
 #include <vector>
 
+#include "distributed/translation_interface_solve.hpp"
 #include "runtime/round_loop.hpp"
 #include "runtime/round_mailbox.hpp"
 
@@ -37,7 +45,10 @@ enum RoundingPhase : std::uint32_t {
   kWarmStartValues,            // public entries of the warm start
   kWarmStartNorm,              // |b|^2, with the warm start's step
   kCoarseMatrix,               // a block's row of the coarse matrix E = Z^T L Z
-  kCoarseSums                  // the CG step's sums with the coarse level's terms
+  kCoarseSums,                 // the CG step's sums with the coarse level's terms
+  kInterfaceShare,             // the interface solve: a block's Schur share (with the Gram)
+  kInterfaceResidual,          // the interface solve: a block's interface residual rhat
+  kInterfaceCost               // the interface solve: cost share and pose 0's translation
 };
 
 /// How the rounding solves for the translations (every agent must use the same).
@@ -64,6 +75,14 @@ struct DistributedRoundingOptions {
   /// rounds, 83 / 91 / 109 steps to the default stop at N = 16 / 25 / 64, with it 40 / 40 / 37
   /// (scripts/bench/rounding_blocks.py).
   bool coarse_correction = true;
+  /// Solve the translations exactly through the team's interface (one share with the Gram
+  /// matrix's message, one all-agent sum, instead of the CG's message step per iteration) when
+  /// the team has at most this many interface poses (poses with a cut measurement); 0 = the CG
+  /// always. [0, 1000000]. Every agent holds and factors the interface matrix Sigma (one row per
+  /// interface pose, about as sparse as the cut) and receives every block's dense Schur
+  /// complement (nG (nG + 1) / 2 numbers each): the same cap as the Newton refinement's exact
+  /// trial translations (NewtonRefineOptions::translation_interface_max_poses).
+  std::size_t interface_max_poses = 2000;
 
   /// Throws InputError naming the field when it is out of range.
   void validate() const;
@@ -99,10 +118,15 @@ class DistributedRounding {
     return reduce(phase, 0, a, b, b_sum);
   }
 
+  DistributedRounding(const DistributedRounding&) = delete;
+  DistributedRounding& operator=(const DistributedRounding&) = delete;
+  ~DistributedRounding();
+
   /// Rounds this agent's block of the final lifted iterate (every agent calls it together)
   /// and returns `res` with poses (of `owned`, in order), cost (of the rounded poses, whole
-  /// graph) and translation_iterations set. Throws std::runtime_error when a peer's message
-  /// is missing after the timeout or malformed.
+  /// graph), translation_iterations (0 for the interface solve) and rounding_interface_poses
+  /// (0 for the CG) set. Throws std::runtime_error when a peer's message is missing after the
+  /// timeout or malformed.
   RoundLoopResult run(RoundLoopResult res);
 
  private:
@@ -174,6 +198,20 @@ class DistributedRounding {
 
   // Cost of the rounded poses: internal measurements in full, cut ones half (as core's status).
   double cost();
+  // This agent's share of cost().
+  double cost_share() const;
+
+  // The interface solve (rounding_interface.cpp). send_interface_share(): when the team's
+  // interface is small enough, builds this block's solve and sends its share (before the Gram
+  // matrix's gather, so it costs no wait of its own); every agent decides alike from the
+  // layout. take_interface_shares(): gathers the shares and assembles Sigma; false (the CG
+  // runs) when no share was sent or a block's Laplacian is singular, on every agent alike.
+  void send_interface_share();
+  bool take_interface_shares();
+  // Exact translations: forward solve, one all-agent sum of the interface residuals, back
+  // solve; then pose 0's translation rides on the cost's sum (the solve fixes another pose)
+  // and every translation is shifted by it. Returns the cost.
+  double interface_translations();
 
   DistributedRoundingOptions options_;
   const AgentLocalData& local_;
@@ -187,6 +225,8 @@ class DistributedRounding {
   std::map<std::size_t, Pose> poses_;  // own and neighbours' rounded poses
   Eigen::MatrixXd frame_;              // r x d: the Gram matrix's top-d eigenvectors
   bool reflected_ = false;             // last row flipped so most blocks are rotations
+  std::unique_ptr<TranslationInterfaceSolve> interface_;  // the exact solve, when it runs
+  std::vector<double> interface_share_;                   // this block's share, as sent
 };
 
 }  // namespace tessera::agent

@@ -17,6 +17,7 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   options.solver = distributed_options_of(local.options);
   options.robust = local.options.robust;
   options.known_inlier_start = local.options.gnc_known_start;
+  options.cluster_probes = local.options.gnc_cluster_probes;
   if (options.solver.rank < local.d)
     throw std::runtime_error("rank " + std::to_string(options.solver.rank) +
                              " is below d = " + std::to_string(local.d));

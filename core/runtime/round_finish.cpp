@@ -69,8 +69,11 @@ RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout&
   }
   if (local.agent_id == 0) {
     // Agent 0's times, for the coordinator's phase split, then one report for its summary.
-    send(agent0_report(res.rounds, kPhaseTimesPhase, res.solve_s, res.rounding_s,
-                       res.translation_iterations));
+    RoundStatusMessage times = agent0_report(res.rounds, kPhaseTimesPhase, res.solve_s,
+                                             res.rounding_s, res.translation_iterations);
+    times.coarse = {static_cast<double>(res.rounding_interface_poses),
+                    static_cast<double>(res.rounding_steps)};
+    send(times);
     send(agent0_report(res.rounds, kFinalReportPhase, res.cost, res.grad_norm * res.grad_norm,
                        static_cast<double>(res.restarts)));
   }

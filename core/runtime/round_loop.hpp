@@ -59,6 +59,8 @@ struct RunOptions {
   /// GNC starts from the known inliers' distributed initialization when they connect the poses
   /// (GncDistributedOptions::known_inlier_start; off when --init is given).
   bool gnc_known_start = true;
+  /// GncDistributedOptions::cluster_probes (0 = none; `--gnc-cluster-probes`).
+  int gnc_cluster_probes = 0;
 };
 
 /// Everything one agent knows after the hand-off.
@@ -161,8 +163,10 @@ struct RoundLoopResult {
   double grad_norm = 0.0;        ///< ||grad f|| there.
   double cost = 0.0;             ///< Objective of the rounded poses (whole graph, summed).
   std::uint32_t translation_iterations = 0;  ///< Distributed CG iterations of the rounding.
-  double solve_s = 0.0;                      ///< Time in core's protocol.
-  double rounding_s = 0.0;                   ///< Time in the distributed rounding.
+  /// Team interface poses of the rounding's exact translation solve; 0 = the CG ran.
+  std::uint32_t rounding_interface_poses = 0;
+  double solve_s = 0.0;     ///< Time in core's protocol.
+  double rounding_s = 0.0;  ///< Time in the distributed rounding.
   /// Where the solve and rounding time went (seconds): waiting for messages, handing
   /// messages to the channel (serialising and writing), and the rest (this agent's math).
   double wait_s = 0.0, send_s = 0.0;
@@ -199,7 +203,8 @@ constexpr std::uint32_t kRobustReportPhase = 203;
 /// And, before the final report in every run, its own times: cost = solve_s (core's protocol:
 /// rounds, and certificate and escapes when certified), grad_norm_sq = rounding_s (seconds), so
 /// the coordinator can split the time after the last round into certificate and rounding;
-/// block_grad_norm = the rounding's translation CG iterations.
+/// block_grad_norm = the rounding's translation CG iterations, coarse = {the rounding's interface
+/// poses (0 = the CG solved the translations), its message steps}.
 constexpr std::uint32_t kPhaseTimesPhase = 204;
 /// Agent 0's progress during the certificate and the rounding (runtime/stage_progress.hpp):
 /// round = the stage's iteration, cost = its figure, block_grad_norm = the stage.

@@ -273,7 +273,8 @@ def main():
         "rounds", "grad_norm", "rel_gap_to_reference", "certified", "min_eigenvalue", "peak_rss_mb_agent_max", "peak_pss_mb_agent_max", "peak_rss_mb_coordinator",
         "peak_pss_mb_fork_server", "peak_rss_mb_run", "peak_pss_mb_run_sum", "setup_pss_mb_agent_max",
         "setup_pss_mb_run_sum", "load_start", "load_end"]
-    bc.print_table("tessera launch on generated 3D grids (fast partition, distributed init, certified)",
+    certify = "not certified" if "--no-certify" in args.launch_args.split() else "certified"
+    bc.print_table(f"tessera launch on generated 3D grids (fast partition, distributed init, {certify})",
                    cols, [[bc.fmt(r.get(c, "-")) if not isinstance(r.get(c), str) else r[c] for c in cols]
                           for r in rows])
     # The CSV is the record of every scale run: earlier rows stay unless --replace.

@@ -656,9 +656,10 @@ def main():
     ap.add_argument("--scheme", default="gnc-tls", choices=["gnc-tls", "pcm-gnc"],
                     help="--robust value of the centralized robust solve (the distributed one is gnc-tls)")
     ap.add_argument("--cluster-probes", type=int, default=0,
-                    help="--gnc-cluster-probes K for the centralized robust solve (scheme column: gnc-tls+cluster K)")
+                    help="--gnc-cluster-probes K for the centralized and the distributed robust solve (scheme "
+                         "column: gnc-tls+cluster K)")
     ap.add_argument("--explain", action="store_true",
-                    help="group cells: TLS cost at the centralized robust estimate and at the clean optimum, "
+                    help="group cells: TLS cost at the robust estimates (centralized, distributed: d_ columns) and at the clean optimum, "
                          "groups that kept members (columns tls, tls_clean, groups_kept, true_cut)")
     ap.add_argument("--no-plain", dest="plain", action="store_false",
                     help="skip the plain (non-robust) centralized solve of the contaminated file (slow on "
@@ -702,7 +703,8 @@ def main():
               "d_rejected", "d_precision", "d_recall", "d_gap", "d_ate_m", "d_outer", "d_rounds", "d_clean_rounds",
               "d_round_ratio", "d_bytes", "d_wall_s", "d_certified", "load", "note",
               "d_probes", "d_probes_kept", "d_refine_steps", "probes", "probes_kept", "tls", "tls_clean",
-              "groups_kept", "true_cut", "d_msg_steps", "d_clean_msg_steps", "d_msg_ratio"]
+              "groups_kept", "true_cut", "d_tls", "d_tls_clean", "d_groups_kept", "d_true_cut",
+              "d_msg_steps", "d_clean_msg_steps", "d_msg_ratio"]
     if args.append and os.path.exists(out_csv):
         with open(out_csv) as f:
             fields = next(csv.reader(f))  # an older CSV: its own columns, new ones left out
@@ -772,7 +774,8 @@ def main():
                             ", ".join(f"{k} {v:.1f}" for k, v in why["tls_clean_parts"].items()))
                 if args.distributed:
                     drob, drob_tum, dwall, derr = solve(args.bin, path, work, tag + "_drobust",
-                                                        ["--robust", "gnc-tls"], args.timeout, "irbcd")
+                                                        ["--robust", "gnc-tls"] + cluster_flags, args.timeout,
+                                                        "irbcd")
                     if drob is None:
                         row["note"] = (row.get("note", "") + " distributed: " + derr).strip()
                     else:
@@ -793,6 +796,11 @@ def main():
                                    drob.get("refine_reductions", 0))
                         row["d_msg_steps"] = (message_steps(drob["total_rounds"], drob) +
                                               drob.get("gnc_refine_steps", 0))
+                        if args.explain and kind == "group" and labels:
+                            why = explain(path, read_tum(drob_tum, d), optimum, labels, drob["rejected"],
+                                          drob["inlier_threshold_squared"])
+                            row.update(d_tls=round(why["tls"], 1), d_tls_clean=round(why["tls_clean"], 1),
+                                       d_groups_kept=why["groups_kept"], d_true_cut=why["true_cut"])
                         if dref is not None:
                             clean_steps = message_steps(dref["rounds"], dref)
                             row.update(d_clean_rounds=dref["rounds"],

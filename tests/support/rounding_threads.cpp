@@ -51,6 +51,7 @@ Rounded round_in_threads(const RoundingCase& c, const DistributedRoundingOptions
         RoundLoopResult res;
         res.relaxation_cost = c.solved.relaxation_cost;
         out[k] = DistributedRounding(local, layout, state, mail, options).run(res);
+        out[k].rounding_steps = mail.gathers;
       } catch (const std::exception& e) {
         errors[k] = e.what();
       }
@@ -66,13 +67,16 @@ Rounded round_in_threads(const RoundingCase& c, const DistributedRoundingOptions
     for (std::size_t s = 0; s < layout.poses[k].size(); ++s)
       r.poses[layout.poses[k][s]] = out[k].poses[s];
     if (out[k].cost != out[0].cost ||
-        out[k].translation_iterations != out[0].translation_iterations)
+        out[k].translation_iterations != out[0].translation_iterations ||
+        out[k].rounding_interface_poses != out[0].rounding_interface_poses)
       r.errors.push_back("agent " + std::to_string(k) +
                          " ended with another cost or iteration count");
   }
   if (!r.errors.empty()) return r;
   r.cost = out[0].cost;
   r.iterations = out[0].translation_iterations;
+  r.interface_poses = out[0].rounding_interface_poses;
+  r.steps = out[0].rounding_steps;
   return r;
 }
 

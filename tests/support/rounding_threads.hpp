@@ -25,6 +25,8 @@ struct Rounded {
   std::vector<Pose> poses;  ///< Global order.
   double cost = 0;          ///< As the agents summed it.
   std::uint32_t iterations = 0;
+  /// The interface solve's team interface poses (0: the CG ran) and agent 0's message steps.
+  std::uint32_t interface_poses = 0, steps = 0;
   /// Empty when every agent finished with the same cost and iteration count; else what failed.
   std::vector<std::string> errors;
 };

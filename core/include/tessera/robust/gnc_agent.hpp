@@ -131,11 +131,12 @@ struct GncAgentInput {
 /// passes over the kept set, and the final solve of the kept set.
 enum class GncSolveKind { kGnc, kInlierPass, kFinal };
 
-class GncLocalTerms;    // internal: the TLS math over one agent's view
-struct RecheckVerdict;  // internal: an inlier pass's re-check
-class GncProbes;        // internal: probes after the re-check passes
-class GncMailbox;       // internal: where incoming messages go
-class GncExchangeBook;  // internal: the exchanges' messages and what they carry
+class GncLocalTerms;     // internal: the TLS math over one agent's view
+struct RecheckVerdict;   // internal: an inlier pass's re-check
+class GncProbes;         // internal: probes after the re-check passes
+class GncClusterSearch;  // internal: which probe next, with cluster probes
+class GncMailbox;        // internal: where incoming messages go
+class GncExchangeBook;   // internal: the exchanges' messages and what they carry
 
 class GncAgent : public AgentProcess {
  public:
@@ -238,8 +239,11 @@ class GncAgent : public AgentProcess {
   void after_step_zero(std::vector<OutgoingMessage>& out);
   void drop_inconsistent(const std::vector<std::uint64_t>& ids);
   bool may_probe() const;  // RobustOptions::recheck_probes
-  void begin_probe(double tls, std::vector<OutgoingMessage>& out);
-  void restore_before_probe(std::vector<OutgoingMessage>& out);
+  // A probe from the current set (summed TLS cost `tls`): the measurements of `flip` change side.
+  void begin_probe(double tls, std::vector<std::uint64_t> flip, std::vector<OutgoingMessage>& out);
+  // Undoes the running probe (its TLS cost `rise` above the set before it; 0 when no verdict
+  // judged it); the next probe of the cluster search, or one last pass.
+  void restore_before_probe(std::vector<OutgoingMessage>& out, double rise = 0);
 
   GncAgentInput in_;
   const GncDistributedOptions& options_;
@@ -265,10 +269,11 @@ class GncAgent : public AgentProcess {
   std::size_t readmitted_ = 0;
   std::unique_ptr<RecheckVerdict> recheck_;  // the current re-check exchange's, every agent's
   std::size_t late_rejected_ = 0;
-  std::unique_ptr<GncProbes> probes_;     // RobustOptions::recheck_probes
-  std::vector<std::uint64_t> zero_cut_;   // cut measurements of weight 0 (others' too)
-  std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where
-  std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view
+  std::unique_ptr<GncProbes> probes_;         // RobustOptions::recheck_probes
+  std::unique_ptr<GncClusterSearch> search_;  // GncDistributedOptions::cluster_probes (> 0)
+  std::vector<std::uint64_t> zero_cut_;       // cut measurements of weight 0 (others' too)
+  std::unique_ptr<BlockLayout> base_;         // of every measurement: whose poses go where
+  std::unique_ptr<GncLocalTerms> terms_;      // the TLS math over this agent's view
   Eigen::MatrixXd last_pass_start_;
   std::vector<double> weights_;                // per in_.measurements
   std::unique_ptr<GncMailbox> mail_;           // where incoming messages go

@@ -13,6 +13,7 @@
 #include <optional>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/graph/pose_graph.hpp>
+#include <tessera/robust/closure_clusters.hpp>
 #include <tessera/robust/robust_options.hpp>
 #include <vector>
 
@@ -45,6 +46,21 @@ struct GncDistributedOptions {
   /// set whose optimum is 597). When the iterate is a converged solution of the kept set the
   /// vote keeps it: one gather and one vote, no rounds.
   bool final_kept_set_start = true;
+  /// Most cluster probes after the re-check passes, >= 0 (0 = none, default: the probes of
+  /// RobustOptions::recheck_probes alone). The distributed counterpart of
+  /// GncCentralizedOptions::cluster_probes, in the same order and on the same rule: up to
+  /// recheck_probes tail probes (the agents' own lists) first, then one cluster of kept closures
+  /// side by side at a time (closure_clusters.hpp), then two clusters that share a stretch
+  /// (each raised the TLS cost alone), last the return band together, then one closure of it at
+  /// a time; each one kept only when the summed TLS cost falls, and after a kept one every
+  /// candidate may be tried again. Every agent runs the same search on the same data (the
+  /// endpoints of every measurement, the rejected set, the gathered verdict lists, the summed
+  /// TLS costs), so all pick the same probe without a message (core/robust/gnc_cluster_search.hpp).
+  /// Why: a run of wrong closures between two look-alike stretches bends the map until each of
+  /// them fits, the true closures of the stretch are cut instead, and the agents' tail probes
+  /// cut true and wrong closures alike (intel with group outliers; docs/robust.md).
+  int cluster_probes = 0;
+  ClosureClusterOptions clusters;  ///< Which kept closures form a cluster.
   /// Optional: called after every weight exchange with (agent, outer step, that agent's
   /// measurements by file position, the weights it uses for them); tests compare the two ends
   /// of every cut measurement with it.
