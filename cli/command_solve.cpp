@@ -167,6 +167,10 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
   robust_summary.readmitted = gnc.readmitted;
   robust_summary.probes = gnc.probes;
   robust_summary.probes_kept = gnc.probes_kept;
+  if (robust.kind != RobustKind::kNone) {
+    robust_summary.swap_probes = gnc.swap_probes;
+    robust_summary.swap_probes_kept = gnc.swap_probes_kept;
+  }
   if (robust.kind != RobustKind::kNone)
     std::printf(
         "robust %s: %d outer steps, %zu of %zu measurements rejected, cost over the "

@@ -4,11 +4,11 @@
 
 namespace tessera::cli {
 
-const char* const kRobustValued[] = {"robust",        "inlier-threshold", "inlier-quantile",
-                                     "gnc-max-outer", "gnc-mu-step",      "gnc-inner-rounds",
-                                     "known-inliers", "rejected",         "gnc-inner-iterations",
-                                     "gnc-probes",    "gnc-probe-ratio",  "gnc-final-refine",
-                                     nullptr};
+const char* const kRobustValued[] = {"robust",          "inlier-threshold", "inlier-quantile",
+                                     "gnc-max-outer",   "gnc-mu-step",      "gnc-inner-rounds",
+                                     "known-inliers",   "rejected",         "gnc-inner-iterations",
+                                     "gnc-probes",      "gnc-probe-ratio",  "gnc-final-refine",
+                                     "gnc-swap-probes", "gnc-pass-refine",  nullptr};
 
 const char* const kRobustHelp =
     "\n"
@@ -44,9 +44,17 @@ const char* const kRobustHelp =
     "  --gnc-probe-ratio R       a probe takes the kept edges with r^2 above R x the median r^2\n"
     "                            of the kept edges (distributed: those their agent weighs), > 1 "
     "[5]\n"
+    "  --gnc-swap-probes K       centralized: most swap probes after the other probes (a kept\n"
+    "                            edge with r^2 >= c^2/4 leaves, a rejected one within 10 c^2\n"
+    "                            sharing a pose with it comes back, or none when there is none\n"
+    "                            and its r^2 is above --gnc-probe-ratio x the kept median; kept\n"
+    "                            only if the TLS cost fell), 0 = none [3]\n"
     "  --gnc-final-refine newton|none   distributed: the final solve of the kept set ends with\n"
     "                            Newton refinement to --refine-grad-tol (runs without\n"
     "                            --certify too) [newton]\n"
+    "  --gnc-pass-refine auto|none   distributed, with --refine auto: inlier passes solved to\n"
+    "                            the tolerance hand over to Newton refinement where the\n"
+    "                            team's interface fits the interface solves [none]\n"
     "  --known-inliers odometry|none   never reject edges between consecutive ids [odometry]\n"
     "  --rejected FILE           write the rejected edge indices (from 0 over the EDGE lines)\n";
 
@@ -72,7 +80,12 @@ RobustOptions parse_robust_options(const Arguments& args) {
       static_cast<int>(args.get_long("gnc-inner-iterations", o.inner_max_iterations));
   o.recheck_probes = static_cast<int>(args.get_long("gnc-probes", o.recheck_probes));
   o.probe_ratio = args.get_double("gnc-probe-ratio", o.probe_ratio);
+  o.swap_probes = static_cast<int>(args.get_long("gnc-swap-probes", o.swap_probes));
   o.final_refine = parse_final_refine(args.get_or("gnc-final-refine", final_refine_name(o)));
+  const std::string pass_refine = args.get_or("gnc-pass-refine", o.refine_passes ? "auto" : "none");
+  if (pass_refine != "auto" && pass_refine != "none")
+    throw InputError("option --gnc-pass-refine: '" + pass_refine + "' is not one of auto, none");
+  o.refine_passes = pass_refine == "auto";
   o.known_inliers =
       parse_known_inliers(args.get_or("known-inliers", known_inliers_name(o.known_inliers)));
   try {
@@ -88,6 +101,7 @@ RobustOptions parse_robust_options(const Arguments& args) {
                        : what.find("inner_max_iterations") != std::string::npos
                            ? "--gnc-inner-iterations"
                        : what.find("recheck_probes") != std::string::npos ? "--gnc-probes"
+                       : what.find("swap_probes") != std::string::npos    ? "--gnc-swap-probes"
                        : what.find("probe_ratio") != std::string::npos    ? "--gnc-probe-ratio"
                                                                           : "--robust";
     throw InputError("option " + std::string(flag) + ": " + what);
@@ -113,6 +127,8 @@ void add_robust_fields(JsonObject& json, const RobustSummary& s) {
       .add("probes_kept", s.probes_kept)
       .add("gnc_final_refine", final_refine_name(s.options));
   if (s.total_cg_iterations >= 0) json.add("total_cg_iterations", s.total_cg_iterations);
+  if (s.swap_probes >= 0)
+    json.add("swap_probes", s.swap_probes).add("swap_probes_kept", s.swap_probes_kept);
 }
 
 void write_rejected(const std::string& path, const std::vector<std::size_t>& rejected) {

@@ -42,11 +42,16 @@ struct RobustSummary {
   /// that lowered the TLS cost and stayed.
   int probes = 0;
   int probes_kept = 0;
+  /// Centralized: swap probes (RobustOptions::swap_probes) and those that stayed (-1: distributed,
+  /// not written).
+  int swap_probes = -1;
+  int swap_probes_kept = 0;
 };
 
 /// Appends robust, outer_iterations, total_iterations, inliers, outliers, rejected,
 /// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged, readmitted,
-/// probes, probes_kept, gnc_final_refine (and total_cg_iterations when set).
+/// probes, probes_kept, gnc_final_refine (and total_cg_iterations, swap_probes and
+/// swap_probes_kept when set).
 void add_robust_fields(JsonObject& json, const RobustSummary& summary);
 
 /// Writes one rejected index per line to `path` (InputError when it cannot).

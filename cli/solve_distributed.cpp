@@ -570,6 +570,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       rs.probes_kept = gnc.probes_kept;
       add_robust_fields(j, rs);
       j.add("total_rounds", gnc.total_rounds)
+          .add("gnc_refine_steps", gnc.refine_message_steps)
           .add("total_bytes", static_cast<long long>(gnc.total_bytes));
     }
     write_output(*p, j.str());

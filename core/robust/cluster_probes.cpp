@@ -6,6 +6,8 @@
 #include <tessera/robust/tls_weights.hpp>
 #include <utility>
 
+#include "robust/probe_outcome.hpp"
+
 namespace tessera {
 namespace {
 
@@ -46,12 +48,14 @@ ClusterProbeCounts search_cluster_probes(
   ClosureClusterOptions every = clusters;
   every.min_rejected_near = 0;
   // Runs `next` (the rejected set to try); adopts it when the TLS cost fell by more than the
-  // solves' accuracy (the same set solved again ends within it).
+  // solves' accuracy (the same set solved again ends within it) and the passes did not end at
+  // the set it started from (probe_outcome.hpp).
   auto attempt = [&](std::vector<std::size_t> next) {
     ++out.probes;
     ClusterProbeTrial t = solve(std::move(next));
     const double cost = tls_cost(graph, known, t.poses, c2);
-    if (!(cost < best * (1 - 1e-6))) return cost - best;
+    if (probe_outcome(rejected, best, t.rejected, cost, 1e-6) != ProbeOutcome::kKept)
+      return cost - best;
     best = cost;
     ++out.kept;
     rejected = std::move(t.rejected);

@@ -467,6 +467,8 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     return;
   }
   gnc_rounds_ += solve_->total_rounds();
+  for (const NewtonRefineResult& r : solve_->refines())
+    gnc_refine_steps_ += r.exchanges + r.reductions;
   if (solve_kind_ == GncSolveKind::kInlierPass) {
     last_pass_full_ = !pass_capped_;
     if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
@@ -604,7 +606,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
         const double tls = exchange_->summed_votes().first;
         if (probes_->running()) {
           const double before = probes_->base_tls();
-          if (!probes_->keeps(tls)) {
+          if (!probes_->keeps(rejected_, tls)) {
             restore_before_probe(out, tls - before);
             return;
           }
@@ -632,7 +634,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
           apply_recheck(*recheck_, in_.measurement_index, rejected_, weights_);
       readmitted_ += counts.readmitted;
       late_rejected_ += counts.late_rejected;
-      if (probes_->running() && rejected_ == probes_->base_rejected()) {
+      if (probes_->back_at_base(rejected_)) {
         // The passes took back exactly what the probe changed: it ends here, not kept (its
         // TLS cost could differ from the base's only by the solves' accuracy).
         restore_before_probe(out);

@@ -15,6 +15,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "robust/cluster_probes.hpp"
+#include "robust/swap_probe.hpp"
 
 namespace tessera {
 namespace {
@@ -288,10 +289,33 @@ GncCentralizedResult solve_gnc_centralized(const PoseGraph& graph,
     out.probes = counts.probes;
     out.probes_kept = counts.kept;
     out.readmitted += counts.returned;
-    // The certificate (and the staircase) for the set that stayed.
-    if (counts.kept > 0) adopt(solve_kept_set(out.rejected, out.final_solve.poses, final_options));
   }
-  if (out.readmitted + out.late_rejected > 0 || out.probes_kept > 0)
+  // Swap probes (RobustOptions::swap_probes): a kept closure and a rejected one beside it trade
+  // places, kept only when the TLS cost falls (swap_probe.hpp).
+  SwapRules swaps;
+  swaps.budget = robust.readmission_passes > 0 && known_connected ? robust.swap_probes : 0;
+  swaps.near = robust.swap_near;
+  swaps.kept_ratio = robust.swap_kept_ratio;
+  swaps.return_ratio = robust.swap_return_ratio;
+  swaps.alone_ratio = robust.probe_ratio;
+  if (swaps.budget > 0 && !out.rejected.empty()) {
+    CentralizedOptions trial = final_options;
+    trial.certify = false;
+    KeptSet last;
+    const SwapProbeCounts counts = search_swap_probes(
+        graph, known, c2, swaps, out.rejected, out.final_solve.poses,
+        [&](std::vector<std::size_t> rejected) {
+          last = solve_kept_set(std::move(rejected), out.final_solve.poses, trial);
+          return ClusterProbeTrial{last.rejected, last.solve.poses};
+        },
+        [&] { adopt(std::move(last)); });
+    out.swap_probes = counts.probes;
+    out.swap_probes_kept = counts.kept;
+  }
+  // The certificate (and the staircase) for the set that stayed.
+  if (out.probes_kept + out.swap_probes_kept > 0)
+    adopt(solve_kept_set(out.rejected, out.final_solve.poses, final_options));
+  if (out.readmitted + out.late_rejected > 0 || out.probes_kept + out.swap_probes_kept > 0)
     for (std::size_t e = 0; e < m; ++e)
       if (!known[e])
         out.weights[e] =

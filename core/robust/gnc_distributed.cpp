@@ -157,6 +157,7 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
         out.weights[index[k]] = a.weights()[k];
   }
   out.total_rounds = lead.gnc_rounds();
+  out.refine_message_steps = lead.gnc_refine_steps();
   out.total_bytes = stats.bytes;
 
   // The last solve of the kept set with its full record (trace, certificate, refinement): when

@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "robust/probe_outcome.hpp"
+
 namespace tessera {
 
 /// What a probe goes back to when it does not lower the TLS cost.
@@ -43,13 +45,21 @@ class GncProbes {
     base_ = std::move(base);
   }
   bool running() const { return running_; }
-  /// Ends the running probe's judgement: it stays (and counts as kept) only if the summed TLS
-  /// cost fell below the base's beyond the solves' own accuracy.
-  bool keeps(double tls) {
+  /// Ends the running probe's judgement at the passes' end, with the set `rejected` (ascending)
+  /// and the summed TLS cost `tls`: it stays (and counts as kept) only if the set is not the
+  /// base's and the cost fell below the base's beyond the solves' own accuracy
+  /// (probe_outcome.hpp).
+  bool keeps(const std::vector<std::uint64_t>& rejected, double tls) {
     running_ = false;
-    const bool kept = tls < base_.tls - 1e-9 * std::abs(base_.tls);
+    const bool kept =
+        probe_outcome(base_.rejected, base_.tls, rejected, tls, 1e-9) == ProbeOutcome::kKept;
     if (kept) ++kept_;
     return kept;
+  }
+  /// A pass's verdict put the set back to the running probe's base (what it cut came back): the
+  /// probe ends there, not kept (probe_outcome.hpp), without solving that set again.
+  bool back_at_base(const std::vector<std::uint64_t>& rejected) const {
+    return running_ && rejected == base_.rejected;
   }
   /// Ends the running probe without keeping it; the state to restore.
   GncProbeBase take_base() {

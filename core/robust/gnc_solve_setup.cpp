@@ -1,6 +1,7 @@
 #include "robust/gnc_solve_setup.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <tessera/robust/weighted_graph.hpp>
 
 namespace tessera {
@@ -10,7 +11,9 @@ DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSo
   DistributedOptions o = options.solver;
   // `--refine auto` (the default) is about the accuracy of the answer: GNC's own solves and the
   // inlier passes are intermediate iterates whose accuracy the schedule sets, so only an
-  // explicit `--refine newton` refines them.
+  // explicit `--refine newton` refines them, or RobustOptions::refine_passes the passes solved to
+  // the tolerance, and then only where the interface fits: the rounds' own gap estimate never
+  // asks for the refinement there.
   const bool auto_refine = o.refine.when == NewtonRefineOptions::When::kIfRoundsSlow;
   switch (kind) {
     case GncSolveKind::kGnc:
@@ -22,7 +25,8 @@ DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSo
     case GncSolveKind::kInlierPass:
       o.certify = false;
       if (pass_capped) o.max_rounds = std::min(o.max_rounds, options.robust.recheck_max_rounds);
-      if (auto_refine) o.refine.enabled = false;
+      if (auto_refine && (pass_capped || !options.robust.refine_passes)) o.refine.enabled = false;
+      if (auto_refine) o.refine.auto_gap_tol = std::numeric_limits<double>::infinity();
       break;
     case GncSolveKind::kFinal:
       if (options.robust.final_refine) {

@@ -69,6 +69,13 @@ void RobustOptions::validate() const {
     bad_field("probe_tail_ratio", number_text(probe_tail_ratio), "must be >= 0 (0 = always)");
   if (!(std::isfinite(probe_return_ratio) && probe_return_ratio >= 1))
     bad_field("probe_return_ratio", number_text(probe_return_ratio), "must be >= 1 (1 = none)");
+  if (swap_probes < 0)
+    bad_field("swap_probes", std::to_string(swap_probes), "must be >= 0 (0 = none)");
+  if (swap_near < 0) bad_field("swap_near", std::to_string(swap_near), "must be >= 0");
+  if (!(std::isfinite(swap_kept_ratio) && swap_kept_ratio >= 0 && swap_kept_ratio <= 1))
+    bad_field("swap_kept_ratio", number_text(swap_kept_ratio), "must be in [0, 1]");
+  if (!(std::isfinite(swap_return_ratio) && swap_return_ratio >= 1))
+    bad_field("swap_return_ratio", number_text(swap_return_ratio), "must be >= 1");
   if (!(std::isfinite(weight_tolerance) && weight_tolerance >= 0))
     bad_field("weight_tolerance", number_text(weight_tolerance), "must be >= 0");
 }

@@ -7,7 +7,9 @@ then for each outlier kind and fraction F (of the graph's loop closures) wrong c
 appended and the robust and plain solves run. Per cell: precision and recall of the rejected
 set against the labels, relative gap of the robust cost (over the kept measurements) to
 f*_clean, ATE of the estimate against the clean optimum after a rigid alignment, outer steps,
-solver iterations, wall time, certified; beside it the plain solve's cost gap and ATE.
+solver iterations, wall time, certified; beside it the plain solve's cost gap and ATE; for the
+distributed run also its rounds and message steps (two a round plus the Newton refinements'
+exchanges and sums) against the clean distributed run's.
 
 --cluster-probes K gives the centralized robust solve `--gnc-cluster-probes K`; --explain adds,
 for group cells, the TLS cost at the robust estimate and at the clean optimum, the groups that
@@ -309,6 +311,15 @@ def ate(estimate, reference, d):
 
 
 # ---- runs
+def message_steps(rounds, summary):
+    """Message steps of a distributed run: two a round (docs/irbcd.md) plus the Newton
+    refinement's neighbour exchanges and all-agent sums (of the final solve; a robust run's
+    earlier refinements are its JSON's gnc_refine_steps). Under `--refine auto` a clean run hands
+    over to the refinement early, so its rounds alone undercount its work (intel: 1 round, 13
+    refinement steps)."""
+    return 2 * rounds + summary.get("refine_exchanges", 0) + summary.get("refine_reductions", 0)
+
+
 def solve(tessera, graph, work, tag, extra, timeout, algorithm="centralized"):
     js = os.path.join(work, tag + ".json")
     tum = os.path.join(work, tag + ".tum")
@@ -393,12 +404,15 @@ def plot(csv_path, png_path):
             pts = series(g, kind, "d_round_ratio")
             if pts:
                 ax[3].plot(*zip(*pts), style, color=c, marker="o", label=label)
+            pts = series(g, kind, "d_msg_ratio")
+            if pts:
+                ax[3].plot(*zip(*pts), style, color=c, marker="x", alpha=0.5)
     ax[0].set(xlabel="outlier fraction F", ylabel="recall (o) / precision (x)", title="rejected set vs labels")
     ax[1].set(xlabel="outlier fraction F", ylabel="|cost - f*_clean| / f*_clean", title="cost over the kept edges")
     ax[2].set(xlabel="outlier fraction F", ylabel="ATE to the clean optimum [m]",
               title="ATE: robust (o) vs plain (faint squares)")
     ax[3].axhline(5, color="grey", linestyle=":")
-    ax[3].set(xlabel="outlier fraction F", ylabel="rounds / clean run's rounds",
+    ax[3].set(xlabel="outlier fraction F", ylabel="rounds (o), message steps (x) / clean run's",
               title="distributed (irbcd, 5 agents): all rounds")
     ax[0].set_ylim(-0.02, 1.05)
     ax[1].set_ylim(1e-16, 1e4)
@@ -422,7 +436,8 @@ def table(csv_path):
 
     head = ("| graph | kind | F | outliers | rejected | precision | recall | gap to f*_clean | ATE m | outer | "
             "certified | wall s | plain gap | plain ATE m | dist. rejected | dist. precision | dist. recall | "
-            "dist. gap | dist. ATE m | dist. rounds (clean) | dist. probes (kept) | dist. refine steps | dist. MB | "
+            "dist. gap | dist. ATE m | dist. rounds (clean) | dist. message steps (clean) | dist. probes (kept) | "
+            "dist. refine steps | dist. MB | "
             "dist. wall s | dist. certified | load |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
@@ -435,6 +450,8 @@ def table(csv_path):
             num(r.get("d_recall", ""), "{:.3f}"), num(r.get("d_gap", ""), "{:.1e}"),
             num(r.get("d_ate_m", ""), "{:.2g}"),
             (f"{r['d_rounds']} ({r['d_clean_rounds']})" if r.get("d_rounds") else "-"),
+            (f"{r['d_msg_steps']} ({r['d_clean_msg_steps']}) = {float(r['d_msg_ratio']):.1f}x"
+             if r.get("d_msg_steps") and r.get("d_msg_ratio") else r.get("d_msg_steps") or "-"),
             (f"{r['d_probes']} ({r['d_probes_kept']})" if r.get("d_probes") else "-"),
             r.get("d_refine_steps", "") or "-",
             num(str(float(r["d_bytes"]) / 1e6) if r.get("d_bytes") else "", "{:.1f}"),
@@ -457,7 +474,9 @@ def merge(into_csv, from_csv):
         fields = reader.fieldnames
         rows = list(reader)
     with open(from_csv) as f:
-        incoming = list(csv.DictReader(f))
+        reader = csv.DictReader(f)
+        fields += [c for c in reader.fieldnames if c not in fields]  # columns added since
+        incoming = list(reader)
 
     def key(r):
         return (r["graph"], r["kind"], float(r["F"]), r.get("scheme", ""))
@@ -684,7 +703,8 @@ def main():
               "d_rejected", "d_precision", "d_recall", "d_gap", "d_ate_m", "d_outer", "d_rounds", "d_clean_rounds",
               "d_round_ratio", "d_bytes", "d_wall_s", "d_certified", "load", "note",
               "d_probes", "d_probes_kept", "d_refine_steps", "probes", "probes_kept", "tls", "tls_clean",
-              "groups_kept", "true_cut", "d_tls", "d_tls_clean", "d_groups_kept", "d_true_cut"]
+              "groups_kept", "true_cut", "d_tls", "d_tls_clean", "d_groups_kept", "d_true_cut",
+              "d_msg_steps", "d_clean_msg_steps", "d_msg_ratio"]
     if args.append and os.path.exists(out_csv):
         with open(out_csv) as f:
             fields = next(csv.reader(f))  # an older CSV: its own columns, new ones left out
@@ -774,14 +794,19 @@ def main():
                                    # message steps of the final solve's Newton refinement
                                    d_refine_steps=drob.get("refine_exchanges", 0) +
                                    drob.get("refine_reductions", 0))
+                        row["d_msg_steps"] = (message_steps(drob["total_rounds"], drob) +
+                                              drob.get("gnc_refine_steps", 0))
                         if args.explain and kind == "group" and labels:
                             why = explain(path, read_tum(drob_tum, d), optimum, labels, drob["rejected"],
                                           drob["inlier_threshold_squared"])
                             row.update(d_tls=round(why["tls"], 1), d_tls_clean=round(why["tls_clean"], 1),
                                        d_groups_kept=why["groups_kept"], d_true_cut=why["true_cut"])
                         if dref is not None:
+                            clean_steps = message_steps(dref["rounds"], dref)
                             row.update(d_clean_rounds=dref["rounds"],
-                                       d_round_ratio=drob["total_rounds"] / max(1, dref["rounds"]))
+                                       d_round_ratio=drob["total_rounds"] / max(1, dref["rounds"]),
+                                       d_clean_msg_steps=clean_steps,
+                                       d_msg_ratio=row["d_msg_steps"] / max(1, clean_steps))
                 progress("  " + ", ".join(f"{k}={row.get(k, '')}" for k in fields[3:]))
                 with open(out_csv, "a", newline="") as f:
                     csv.writer(f).writerow([row.get(k, "") for k in fields])

@@ -175,6 +175,9 @@ class GncAgent : public AgentProcess {
   double threshold_squared() const;
   /// Rounds of the solves before the final certified one (first, weighted, inlier passes).
   int gnc_rounds() const { return gnc_rounds_; }
+  /// Message steps (neighbour exchanges and all-agent sums) of the Newton refinements of those
+  /// solves: the inlier passes solved to the tolerance under `--refine auto` (gnc_solve_setup).
+  int gnc_refine_steps() const { return gnc_refine_steps_; }
   /// The own block at the start of the last inlier pass (what the caller of an agent without
   /// the final solve starts that pass from to get its full record).
   const Eigen::MatrixXd& last_pass_start() const { return last_pass_start_; }
@@ -281,7 +284,7 @@ class GncAgent : public AgentProcess {
   std::vector<std::uint64_t> rejected_;
   std::vector<Measurement> kept_;
   std::vector<std::uint64_t> kept_index_;
-  int gnc_rounds_ = 0, final_rounds_ = 0;
+  int gnc_rounds_ = 0, final_rounds_ = 0, gnc_refine_steps_ = 0;
   bool done_ = false;
   std::function<void(int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
       weight_observer_;

@@ -92,6 +92,9 @@ struct GncCentralizedResult {
   /// (RobustOptions::probe_return_ratio), within the budget (at most one without cluster probes).
   int probes = 0;
   int probes_kept = 0;  ///< Of those, the ones that lowered the TLS cost and stayed.
+  /// Swap probes run after those (RobustOptions::swap_probes) and the ones that stayed.
+  int swap_probes = 0;
+  int swap_probes_kept = 0;
   /// The start vote (GncCentralizedOptions::known_inlier_start) chose the known inliers' start.
   bool started_from_known_inliers = false;
   /// Every solve in order: the first (plain) one, the weighted ones, the kept set's.

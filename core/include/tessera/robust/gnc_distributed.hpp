@@ -94,7 +94,11 @@ struct GncDistributedResult {
   std::vector<double> weights;        ///< Last weight of every measurement.
   std::vector<std::size_t> rejected;  ///< Measurements with weight < 0.5 (0 when binary).
   int outer_iterations = 0;
-  int total_rounds = 0;           ///< Rounds of every solve, final included.
+  int total_rounds = 0;  ///< Rounds of every solve, final included.
+  /// Message steps of the Newton refinements of the solves before the final one (the final
+  /// solve's are in final_solve.refines): a round is two message steps, so the run's message
+  /// steps are 2 x total_rounds + this + the final refinement's.
+  int refine_message_steps = 0;
   std::uint64_t total_bytes = 0;  ///< Bytes of every solve plus the outer steps' votes.
   /// Measurements GNC had rejected whose residual at the inlier set's solution was within the
   /// bound (r^2 <= c^2), taken back before the final solve.

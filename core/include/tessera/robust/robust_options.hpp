@@ -126,6 +126,32 @@ struct RobustOptions {
   /// same band is the return probes' (gnc_centralized.hpp): all of it together, then, with
   /// cluster probes, one closure at a time (tls_recheck.hpp, return_candidates).
   double probe_return_ratio = 4.0;
+  /// Centralized solver only: most swap probes after the other probes, >= 0 (0 = none). A swap
+  /// cuts a kept closure whose r^2 is at least swap_kept_ratio x c^2 and brings back a rejected
+  /// one within swap_return_ratio x c^2 with an end within swap_near pose ids of one of its
+  /// ends (most strained kept closure first), runs the re-check passes from there and stays only
+  /// when the TLS cost over every measurement falls (core/robust/swap_probe.hpp). Why: a wrong
+  /// closure can bend the map around one of its ends until it fits, and the true closure that
+  /// meets it there is cut; each alone is judged right at that bent solution, and a return
+  /// probe cannot undo it while the wrong one holds the bend (sphere2500 with 50 % random
+  /// outliers: wrong closure 5626 (1696-2406) kept at r^2 39.2 against c^2 = 46.2, true closure
+  /// 4195 (1696-1746) cut at 2.9 c^2, cost over the kept set 1,984.7 against f*_clean 1,687.0;
+  /// docs/robust.md, "Swap probes"). 3: there the true closure 4145 at r^2 43.8, which also meets
+  /// pose 1696, comes first. A strained kept closure with no such rejected one is cut alone when
+  /// its r^2 is also above probe_ratio x the median r^2 of the kept closures (a wrong closure
+  /// bent to fit where no true closure was cut: sphere2500 75 %, wrong closure 6144 (429-2009) at
+  /// r^2 18.1 against a median of 0.27, c^2 = 46.5); the pairs come first.
+  int swap_probes = 3;
+  /// A swap's two closures have an end within this many pose ids, >= 0. 0: the fold's wrong and
+  /// true closure share a pose.
+  int swap_near = 0;
+  /// The kept closure of a swap has r^2 >= this x c^2, in [0, 1]. 0.25: a closure bent to fit
+  /// sits near the bound (39.2 / 46.2 above), the true closures of a file whose noise matches
+  /// its information have a median r^2 near 0.1 c^2 (5.3 in 3D, 2.4 in 2D against c^2 37-48).
+  double swap_kept_ratio = 0.25;
+  /// The rejected closure of a swap has r^2 <= this x c^2, >= 1. 10: the fold's true closure
+  /// lies at 2.9 c^2, the nearest of the 1,225 random wrong closures at 27 c^2.
+  double swap_return_ratio = 10.0;
   /// Distributed solvers only: the final solve of the kept set (weights fixed) ends with the
   /// distributed Newton refinement (distributed/newton_refine.hpp, with the solver's
   /// DistributedOptions::refine settings: ||grad f|| <= 1e-6 by default), whatever
@@ -136,6 +162,18 @@ struct RobustOptions {
   /// rounding error in fewer rounds than the block updates would need (docs/robust.md, "Final
   /// solve").
   bool final_refine = true;
+  /// Distributed solvers only, with `--refine auto` (the solver's NewtonRefineOptions::when =
+  /// kIfRoundsSlow): an inlier pass solved to the tolerance hands over to the Newton refinement
+  /// where the team's interface fits its interface solves, as a clean solve does; capped passes,
+  /// GNC's own solves and graphs whose interface does not fit are solved by rounds alone. Off
+  /// (default): every solve before the final one is solved by rounds alone. Why: where the
+  /// clean run is mostly refinement (intel, CSAIL at 5 agents: 1 and 0 rounds, 15 and 13 message
+  /// steps) the robust run's passes to the tolerance are what costs (F = 0.25 random: intel
+  /// 1,033 message steps, CSAIL 965); with this on 468 and 295, the same exact sets, certified.
+  /// Where the interface does not fit (manhattan3500) the refinement's block-Jacobi CG would cost
+  /// more message steps than the rounds it saves (16 rounds for 1,958 message steps), hence the
+  /// limit (docs/robust.md, "Final solve").
+  bool refine_passes = false;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
