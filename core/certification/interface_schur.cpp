@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "solvers/elimination_order.hpp"
+#include "util/serial_blas.hpp"
 
 // BLAS (the one CHOLMOD's supernodal factorization runs on): C = A A^T, lower triangle.
 extern "C" void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k,
@@ -25,6 +26,7 @@ Eigen::MatrixXd lower_times_transpose(const Eigen::MatrixXd& L) {
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, n);
   if (n == 0) return out;
   const double one = 1.0, zero = 0.0;
+  const SerialBlasLock lock(serial_blas_mutex());
   dsyrk_("L", "N", &n, &n, &one, L.data(), &n, &zero, out.data(), &n);
   out.triangularView<Eigen::StrictlyUpper>() = out.transpose();
   return out;
@@ -60,7 +62,10 @@ class SupernodalCholesky {
     cholmod_sparse a = Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
     L_ = cholmod_analyze(&a, &c_);
     if (!L_) throw std::runtime_error("certificate: CHOLMOD analysis failed");
-    cholmod_factorize(&a, L_, &c_);
+    {
+      const SerialBlasLock lock(serial_blas_mutex());
+      cholmod_factorize(&a, L_, &c_);
+    }
     if (c_.status < CHOLMOD_OK)
       throw std::runtime_error("certificate: CHOLMOD factorization failed");
     return static_cast<Eigen::Index>(L_->minor);
