@@ -9,6 +9,7 @@
 
 #include "solvers/cholmod_checked.hpp"
 #include "solvers/elimination_order.hpp"
+#include "util/serial_blas.hpp"
 
 // BLAS (the one CHOLMOD's supernodal factorization runs on): C = A A^T, lower triangle.
 extern "C" void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k,
@@ -26,6 +27,7 @@ Eigen::MatrixXd lower_times_transpose(const Eigen::MatrixXd& L) {
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, n);
   if (n == 0) return out;
   const double one = 1.0, zero = 0.0;
+  const SerialBlasLock lock(serial_blas_mutex());
   dsyrk_("L", "N", &n, &n, &one, L.data(), &n, &zero, out.data(), &n);
   out.triangularView<Eigen::StrictlyUpper>() = out.transpose();
   return out;
@@ -63,7 +65,10 @@ class SupernodalCholesky {
     if (!L_)
       throw_cholmod_failure("certificate (interface Schur complement)", "analysis", c_.status,
                             lower.rows(), lower.cols());
-    cholmod_factorize(&a, L_, &c_);
+    {
+      const SerialBlasLock lock(serial_blas_mutex());
+      cholmod_factorize(&a, L_, &c_);
+    }
     if (c_.status < CHOLMOD_OK)
       throw_cholmod_failure("certificate (interface Schur complement)", "factorization", c_.status,
                             lower.rows(), lower.cols());

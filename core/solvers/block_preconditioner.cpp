@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "solvers/cholmod_checked.hpp"
+#include "util/serial_blas.hpp"
 
 namespace tessera {
 
@@ -151,7 +152,12 @@ BlockPreconditioner::BlockPreconditioner(const BlockProblem& problem, double rel
     factor_->block_inverses = diagonal_block_inverses(A, factor_->w);
     return;
   }
-  factor_->llt->factorize(A);
+  if (factor_->llt->raw()->is_super) {  // BLAS on the supernodes
+    const SerialBlasLock lock(serial_blas_mutex());
+    factor_->llt->factorize(A);
+  } else {
+    factor_->llt->factorize(A);
+  }
   if (factor_->llt->cholmod().status < CHOLMOD_OK)
     throw_cholmod_failure("BlockPreconditioner", "factorization", factor_->llt->cholmod().status,
                           A.rows(), A.cols());
@@ -203,7 +209,13 @@ Eigen::MatrixXd BlockPreconditioner::apply(const LiftedManifold& manifold, const
     return manifold.tangent_project(X, 0.5 * Z);
   }
   Eigen::MatrixXd Vt = V.transpose();
-  Eigen::MatrixXd Z = factor_->llt->solve(Vt).transpose();
+  Eigen::MatrixXd Z;
+  if (factor_->llt->raw()->is_super) {  // not converted: BLAS on the supernodes
+    const SerialBlasLock lock(serial_blas_mutex());
+    Z = factor_->llt->solve(Vt).transpose();
+  } else {
+    Z = factor_->llt->solve(Vt).transpose();
+  }
   return manifold.tangent_project(X, 0.5 * Z);
 }
 

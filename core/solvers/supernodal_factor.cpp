@@ -7,6 +7,7 @@
 
 #include "solvers/cholmod_checked.hpp"
 #include "solvers/cholmod_dense_view.hpp"
+#include "util/serial_blas.hpp"
 
 namespace tessera {
 
@@ -66,7 +67,10 @@ bool SupernodalFactor::factor(const SparseMatrix& lower, double shift) {
     s.flops = s.c.fl;
   }
   double beta[2] = {shift, 0.0};
-  cholmod_factorize_p(&a, beta, nullptr, 0, s.L, &s.c);
+  {
+    const SerialBlasLock lock(serial_blas_mutex());
+    cholmod_factorize_p(&a, beta, nullptr, 0, s.L, &s.c);
+  }
   if (s.c.status < CHOLMOD_OK)
     throw_cholmod_failure("SupernodalFactor", "factorization", s.c.status, n, n);
   s.ok = s.c.status == CHOLMOD_OK && s.L->minor == s.L->n;
@@ -84,6 +88,7 @@ void SupernodalFactor::solve_system(int system, Eigen::VectorXd& v) const {
   if (system != CHOLMOD_A && s.ordering != Ordering::kGiven)
     throw std::logic_error("SupernodalFactor: L solves need the given ordering");
   cholmod_dense rhs = cholmod_dense_view(v);
+  const SerialBlasLock lock(serial_blas_mutex());
   if (!cholmod_solve2(system, s.L, &rhs, nullptr, &s.x_, nullptr, &s.y_, &s.e_, &s.c))
     throw_cholmod_failure("SupernodalFactor", "solve", s.c.status, s.n, s.n);
   v = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(s.x_->x), v.size());
