@@ -11,9 +11,6 @@
 #include <algorithm>
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
-#include <tessera/generate/generator.hpp>
-#include <tessera/partition/graph_structure.hpp>
-#include <tessera/partition/partitioner.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/util/input_error.hpp>
 #include <vector>
@@ -24,33 +21,9 @@
 namespace tessera::agent {
 namespace {
 
-// A generated 3D grid, its poses split into N contiguous blocks, and the in-process solver's
-// lifted iterate after `max_rounds` rounds (a point near, not at, a critical point, as the
-// runs the rounding follows usually stop).
-// With `partitioned`, the blocks are the `fast` partition's (compact pieces of the grid, as
-// launch splits large graphs) instead.
+// This file's grids (generator seed 3): grid_rounding_case (support/rounding_threads.hpp).
 RoundingCase make_case(std::size_t poses, int agents, int max_rounds, bool partitioned = false) {
-  GeneratorOptions g;
-  g.kind = TrajectoryKind::kGrid3d;
-  g.num_poses = poses;
-  g.num_robots = static_cast<std::size_t>(agents);
-  g.seed = 3;
-  RoundingCase c;
-  c.graph = generate_pose_graph(g).graph;
-  if (partitioned) {
-    PartitionOptions po;
-    po.parts = agents;
-    po.preset = PartitionPreset::kFast;
-    c.assignment = partition_graph(graph_structure_from_pose_graph(c.graph), po).assignment;
-  } else {
-    for (std::size_t i = 0; i < c.graph.num_poses; ++i)
-      c.assignment.push_back(
-          static_cast<int>(i * static_cast<std::size_t>(agents) / c.graph.num_poses));
-  }
-  DistributedOptions o;
-  o.max_rounds = max_rounds;
-  c.solved = solve_distributed(c.graph, c.assignment, o, c.graph.initial);
-  return c;
+  return grid_rounding_case(poses, agents, max_rounds, partitioned, 3);
 }
 
 // Pose k's position in pose 0's frame: free of the rotation frame a rounding picks.

@@ -11,9 +11,6 @@
 #include <cstddef>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
-#include <tessera/generate/generator.hpp>
-#include <tessera/partition/graph_structure.hpp>
-#include <tessera/partition/partitioner.hpp>
 #include <tessera/problem/objective.hpp>
 #include <vector>
 
@@ -24,30 +21,9 @@
 namespace tessera::agent {
 namespace {
 
-// A generated 3D grid of `poses` in `agents` blocks (contiguous, or the `fast` partition's) and
-// the in-process solver's iterate after `max_rounds` rounds.
+// This file's grids (generator seed 5): grid_rounding_case (support/rounding_threads.hpp).
 RoundingCase grid_case(std::size_t poses, int agents, int max_rounds, bool partitioned) {
-  GeneratorOptions g;
-  g.kind = TrajectoryKind::kGrid3d;
-  g.num_poses = poses;
-  g.num_robots = static_cast<std::size_t>(agents);
-  g.seed = 5;
-  RoundingCase c;
-  c.graph = generate_pose_graph(g).graph;
-  if (partitioned) {
-    PartitionOptions po;
-    po.parts = agents;
-    po.preset = PartitionPreset::kFast;
-    c.assignment = partition_graph(graph_structure_from_pose_graph(c.graph), po).assignment;
-  } else {
-    for (std::size_t i = 0; i < c.graph.num_poses; ++i)
-      c.assignment.push_back(
-          static_cast<int>(i * static_cast<std::size_t>(agents) / c.graph.num_poses));
-  }
-  DistributedOptions o;
-  o.max_rounds = max_rounds;
-  c.solved = solve_distributed(c.graph, c.assignment, o, c.graph.initial);
-  return c;
+  return grid_rounding_case(poses, agents, max_rounds, partitioned, 5);
 }
 
 Eigen::Index team_interface(const RoundingCase& c) {

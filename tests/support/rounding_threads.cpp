@@ -4,12 +4,40 @@
 #include <exception>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
+#include <tessera/generate/generator.hpp>
+#include <tessera/partition/graph_structure.hpp>
+#include <tessera/partition/partitioner.hpp>
 #include <thread>
 
 #include "runtime/round_mailbox.hpp"
 #include "thread_exchange.hpp"
 
 namespace tessera::agent {
+
+RoundingCase grid_rounding_case(std::size_t poses, int agents, int max_rounds, bool partitioned,
+                                std::uint64_t seed) {
+  GeneratorOptions g;
+  g.kind = TrajectoryKind::kGrid3d;
+  g.num_poses = poses;
+  g.num_robots = static_cast<std::size_t>(agents);
+  g.seed = seed;
+  RoundingCase c;
+  c.graph = generate_pose_graph(g).graph;
+  if (partitioned) {
+    PartitionOptions po;
+    po.parts = agents;
+    po.preset = PartitionPreset::kFast;
+    c.assignment = partition_graph(graph_structure_from_pose_graph(c.graph), po).assignment;
+  } else {
+    for (std::size_t i = 0; i < c.graph.num_poses; ++i)
+      c.assignment.push_back(
+          static_cast<int>(i * static_cast<std::size_t>(agents) / c.graph.num_poses));
+  }
+  DistributedOptions o;
+  o.max_rounds = max_rounds;
+  c.solved = solve_distributed(c.graph, c.assignment, o, c.graph.initial);
+  return c;
+}
 
 Rounded round_in_threads(const RoundingCase& c, const DistributedRoundingOptions& options,
                          double timeout_s) {

@@ -3,6 +3,7 @@
 // thread per agent over an in-memory channel, no DDS. Used by distributed_rounding_test and by
 // rounding_iterations_bench (scripts/bench/rounding_iterations.py).
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
@@ -30,6 +31,13 @@ struct Rounded {
   /// Empty when every agent finished with the same cost and iteration count; else what failed.
   std::vector<std::string> errors;
 };
+
+/// A generated 3D grid of `poses` (generator seed `seed`) in `agents` blocks: contiguous runs of
+/// pose ids, or with `partitioned` the `fast` partition's (compact pieces of the grid, as launch
+/// splits large graphs); and the in-process solver's iterate after `max_rounds` rounds (a point
+/// near, not at, a critical point, as the runs the rounding follows usually stop).
+RoundingCase grid_rounding_case(std::size_t poses, int agents, int max_rounds, bool partitioned,
+                                std::uint64_t seed);
 
 /// Runs DistributedRounding with `options` on every block of `c` in its own thread; an agent
 /// that waits longer than `timeout_s` for a message fails (Rounded::errors).
