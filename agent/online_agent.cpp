@@ -82,7 +82,7 @@ class OnlineAgent {
   /// Whether `robot`'s batches may enter: its agent is a member, or it was lost and its
   /// block's adopter absorbs them.
   bool absorbs(std::uint32_t robot) const;
-  void wait_to_hold(const Watermarks& decision);
+  void wait_to_hold(const Watermarks& decision, bool read_channel);
   void publish_estimate();
   void send(const std::vector<OutgoingMessage>& out, std::uint32_t epoch);
   void write_json(bool lead_result);
@@ -377,7 +377,7 @@ bool OnlineAgent::epoch_step() {
   for (auto& [robot, count] : decision)
     if (!absorbs(robot)) count = 0;
   // The members hold what they decided; a joiner following missed epochs may not yet.
-  wait_to_hold(decision);
+  wait_to_hold(decision, true);
   const double step_start = since(start_);
   const double cpu_start = cpu_now();
   const runtime::EnteredData in = view_.enter(decision);
@@ -494,16 +494,34 @@ bool OnlineAgent::absorbs(std::uint32_t robot) const {
   return members().count(robot) > 0 || dead_.count(robot) > 0;
 }
 
-void OnlineAgent::wait_to_hold(const Watermarks& decision) {
+void OnlineAgent::wait_to_hold(const Watermarks& decision, bool read_channel) {
+  // With `read_channel` (an epoch's step) the channel is read here too: a process started again
+  // with a lost agent's id follows the epochs it missed and may wait here for stream data
+  // first, and only the kept take-over votes tell it that it was counted lost (pump_channel
+  // throws then). Not inside a take-over, whose own vote reads the channel: a vote buffered
+  // here before the lost agents are marked dead would start a second take-over. Either way the
+  // wait ends after --timeout seconds without a new batch rather than never.
+  auto last_progress = Clock::now();
+  std::size_t held_before = 0;
   for (;;) {
     bool have_all = true;
     const Watermarks mine = view_.held();
+    std::size_t held = 0;
+    for (const auto& [robot, count] : mine) held += count;
     for (const auto& [robot, count] : decision) {
       auto it = mine.find(robot);
       if (count > (it == mine.end() ? 0 : it->second)) have_all = false;
     }
     if (have_all) return;
+    if (held != held_before) {
+      held_before = held;
+      last_progress = Clock::now();
+    } else if (since(last_progress) > o_.timeout_s) {
+      silent_peer("no new stream batch while waiting for the data of epoch " +
+                  std::to_string(epoch_));
+    }
     pump_stream();
+    if (read_channel) pump_channel();
     channel_.wait(0.01);
   }
 }
@@ -528,7 +546,7 @@ void OnlineAgent::take_over() {
         v.swap(votes_);
         return v;
       },
-      [&](const Watermarks& target) { wait_to_hold(target); });
+      [&](const Watermarks& target) { wait_to_hold(target, false); });
   fig_.report_bytes += step.vote.bytes_sent;
   const std::set<std::uint32_t>& survivors = step.vote.survivors;
   dead_.insert(step.vote.lost.begin(), step.vote.lost.end());
