@@ -77,7 +77,7 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim,
     Process again =
         start({bin("tessera-agent"), "--online", "--robots", "3", "--id", std::to_string(victim),
                "--run-id", run, "--domain", std::to_string(domain), "--on-agent-loss", "continue",
-               "--timeout", "60", "--lease", "3"},
+               "--timeout", "60", "--lease", "3", "--verbose"},  // a failure shows its epochs
               dir + "/again.log");
     ASSERT_TRUE(wait_all({&again}, 60)) << again.output();
     EXPECT_EQ(again.exit_code, 1) << again.output();
