@@ -76,17 +76,23 @@ TEST(RoundReports, RoundTimingAndTheLastLineComeFromAgentZerosFinalDigest) {
 namespace tessera::coordinator {
 namespace {
 
-// Agent 0's own times ride on a report status (phase 204): solve and rounding seconds.
-TEST(RoundReports, AgentZerosPhaseTimesAreKeptForTheSummary) {
-  std::ostringstream out;
-  RoundReports r(false, out);
-  EXPECT_FALSE(r.results().agent_solve_s.has_value());
+// Agent 0's phase-times report of round 45: solve 0.25 s, rounding 0.125 s.
+wire::RoundStatus agent_zero_phase_times() {
   wire::RoundStatus m;
   m.sender(0);
   m.round(45);
   m.phase(kAgentPhaseTimesPhase);
   m.cost(0.25);
   m.grad_norm_sq(0.125);
+  return m;
+}
+
+// Agent 0's own times ride on a report status (phase 204): solve and rounding seconds.
+TEST(RoundReports, AgentZerosPhaseTimesAreKeptForTheSummary) {
+  std::ostringstream out;
+  RoundReports r(false, out);
+  EXPECT_FALSE(r.results().agent_solve_s.has_value());
+  wire::RoundStatus m = agent_zero_phase_times();
   EXPECT_TRUE(r.on_report(m));
   ASSERT_TRUE(r.results().agent_solve_s.has_value());
   EXPECT_EQ(*r.results().agent_solve_s, 0.25);
@@ -122,12 +128,7 @@ TEST(RoundReports, AgentZerosSetUpTimesAreKeptForTheSummary) {
 TEST(RoundReports, AgentZerosPhaseTimesCarryTheRoundingsInterfacePosesAndMessageSteps) {
   std::ostringstream out;
   RoundReports r(false, out);
-  wire::RoundStatus m;
-  m.sender(0);
-  m.round(45);
-  m.phase(kAgentPhaseTimesPhase);
-  m.cost(0.25);
-  m.grad_norm_sq(0.125);
+  wire::RoundStatus m = agent_zero_phase_times();
   EXPECT_TRUE(r.on_report(m));
   EXPECT_FALSE(r.results().rounding_interface_poses.has_value());
   m.coarse({34.0, 5.0});

@@ -19,7 +19,6 @@ usage: rounding_paths.py [--bench build/bin/rounding_paths_bench] [--graphs a,b,
                          [--csv FILE]
 """
 import argparse
-import csv
 import os
 import re
 import subprocess
@@ -120,11 +119,7 @@ def main():
               f"{r['relative']:.1e} | {r['cpu_ms']:.0f} |" +
               (f" {r['instructions'] / 1e6:.1f} M / {r['solve_instructions'] / 1e6:.1f} M |"
                if args.callgrind else ""))
-    with open(args.csv, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()) if rows else ["graph"])
-        w.writeheader()
-        w.writerows(rows)
-    print(f"wrote {os.path.relpath(args.csv)}")
+    bc.write_csv(args.csv, rows)
 
 
 if __name__ == "__main__":
