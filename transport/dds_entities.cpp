@@ -8,6 +8,7 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
 
+#include "transport/fastdds/discovery_port.hpp"
 #include "transport/fastdds/teardown_guard.hpp"
 
 namespace tessera::transport {
@@ -33,7 +34,6 @@ void DdsEntities::open(int domain, const PeerIdentity& me,
     eprosima::fastdds::dds::Log::SetVerbosity(eprosima::fastdds::dds::Log::Kind::Warning);
   participant_listener_ =
       std::make_unique<ParticipantDiscoveryListener>(peers_, opt_.run_id, room_, trace_, muted_);
-  auto* factory = dds::DomainParticipantFactory::get_instance();
   dds::DomainParticipantQos qos = participant_qos(
       participant_name(me), opt_.lease_s, opt_.initial_peers, domain, opt_.num_agents, net_,
       security, opt_.uses_shared_memory(), user_data, opt_.uses_udp());
@@ -49,12 +49,13 @@ void DdsEntities::open(int domain, const PeerIdentity& me,
   const bool own_id = !prefix && first_in_process.exchange(false);
   if (own_id)
     qos.wire_protocol().participant_id = me.coordinator ? 0 : static_cast<int>(me.agent_id) + 1;
-  participant_ = factory->create_participant(domain, qos, participant_listener_.get(),
-                                             dds::StatusMask::none());
+  const std::uint32_t local = local_discovery_participants(opt_.num_agents);
+  participant_ = create_participant_with_discovery_port(domain, qos, participant_listener_.get(),
+                                                        dds::StatusMask::none(), local);
   if (!participant_ && own_id) {
     qos.wire_protocol().participant_id = -1;
-    participant_ = factory->create_participant(domain, qos, participant_listener_.get(),
-                                               dds::StatusMask::none());
+    participant_ = create_participant_with_discovery_port(domain, qos, participant_listener_.get(),
+                                                          dds::StatusMask::none(), local);
   }
   if (!participant_)
     throw TransportError("cannot create a DDS participant on domain " + std::to_string(domain) +

@@ -17,6 +17,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "tesseraPubSubTypes.h"
+#include "transport/fastdds/discovery_port.hpp"
 #include "transport/qos.hpp"
 #include "transport/run_identity.hpp"
 
@@ -51,7 +52,8 @@ struct StreamParticipant {
     // Not "tessera:<run>:..." (participant_name): a run's processes must not take the stream's
     // participants for peers of their run.
     pq.name("tessera-stream:" + run_id + ":" + role);
-    participant = dds::DomainParticipantFactory::get_instance()->create_participant(domain, pq);
+    participant = create_participant_with_discovery_port(
+        domain, pq, nullptr, dds::StatusMask::all(), local_discovery_participants(0));
     if (!participant)
       throw std::runtime_error("graph stream: cannot create a DDS participant on domain " +
                                std::to_string(domain));

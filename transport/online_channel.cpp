@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "tesseraPubSubTypes.h"
+#include "transport/fastdds/discovery_port.hpp"
 #include "transport/message_mapping.hpp"
 #include "transport/network_profile.hpp"
 #include "transport/qos.hpp"
@@ -103,9 +104,9 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     pq.wire_protocol().builtin.discovery_config.leaseDuration = Duration_t(lease_s);
     pq.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod =
         Duration_t(lease_s / 5.0);
-    auto* factory = dds::DomainParticipantFactory::get_instance();
     discovery.impl = this;
-    participant = factory->create_participant(domain, pq, &discovery, dds::StatusMask::none());
+    participant = create_participant_with_discovery_port(
+        domain, pq, &discovery, dds::StatusMask::none(), local_discovery_participants(agents));
     if (!participant)
       throw std::runtime_error("online channel: cannot create a DDS participant on domain " +
                                std::to_string(domain));

@@ -32,6 +32,7 @@
 
 #include "arguments.hpp"
 #include "tesseraPubSubTypes.h"
+#include "transport/fastdds/discovery_port.hpp"
 #include "transport/run_identity.hpp"
 #include "transport/security.hpp"
 #include "transport/signal_watcher.hpp"
@@ -165,8 +166,9 @@ int main(int argc, char** argv) {
     std::cerr << "tessera-dds-snoop: error: " << e.what() << "\n";
     return 2;
   }
-  s.participant = factory->create_participant(static_cast<int>(domain), pq, &plistener,
-                                              fdds::StatusMask::none());
+  s.participant = create_participant_with_discovery_port(static_cast<int>(domain), pq, &plistener,
+                                                         fdds::StatusMask::none(),
+                                                         local_discovery_participants(0));
   if (!s.participant) {
     std::cerr << "tessera-dds-snoop: error: cannot create a participant on domain " << domain
               << "\n";
