@@ -38,7 +38,7 @@ constexpr std::int32_t kVolatileWriterHistory = 256;
 constexpr double kHandshakeHeartbeatS = 0.005;
 
 /// Participant: named, short lease so a dead peer is noticed within ~lease seconds,
-/// optional unicast initial peers (all participant ids up to num_agents + 2 on `domain`),
+/// optional unicast initial peers (participant ids 0..num_agents + 5 on `domain`),
 /// the UDP datagram size and socket buffers of `net`, extra `properties` (DDS Security's,
 /// security.hpp).
 /// `shared_memory` false: UDPv4 only (also between processes of one host). Used by runs that
