@@ -524,6 +524,14 @@ TEST(NewtonRefine, ProjectedGaugeCgMeetsNoSpuriousNegativeCurvatureFromARoughSta
   }
   EXPECT_LT(projected.steps, ground.steps);
   EXPECT_LT(projected.exchanges + projected.reductions, ground.exchanges + ground.reductions);
+  // Each agent's timers (NewtonRefineTimes): every moment charged to one part, and the interface
+  // solves' factorizations and Sigma among them.
+  const NewtonRefineTimes& t = ground.times;
+  EXPECT_NEAR(t.cpu_s, t.setup_s + t.factor_s + t.sigma_s + t.cg_s + t.trial_s + t.translations_s,
+              1e-9);
+  EXPECT_GT(t.factor_s, 0.0);
+  EXPECT_GT(t.sigma_s, 0.0);
+  EXPECT_GT(t.wall_s, 0.0);  // set where the refinement ends
 }
 
 }  // namespace
