@@ -37,6 +37,24 @@ void deliver_final_estimate(AgentSession& s, const AgentLocalData& local,
                   static_cast<unsigned long long>(s.stats().write_retries));
     log(line);
   }
+  if (result.refine_wall_s > 0 || result.certificate_wall_s > 0) {
+    char line[200];
+    std::snprintf(line, sizeof(line),
+                  "after the rounds: refinement %.3f s (waiting %.3f s), certificate %.3f s "
+                  "(waiting %.3f s)",
+                  result.refine_wall_s, result.refine_wait_s, result.certificate_wall_s,
+                  result.certificate_wait_s);
+    log(line);
+  }
+  for (const NewtonRefineTimes& t : result.refine_times) {
+    char line[320];
+    std::snprintf(line, sizeof(line),
+                  "refinement: %.3f s wall, %.3f CPU-s: set-up %.3f, factors %.3f, Sigma %.3f, "
+                  "CG %.3f, trial points %.3f, translations %.3f",
+                  t.wall_s, t.cpu_s, t.setup_s, t.factor_s, t.sigma_s, t.cg_s, t.trial_s,
+                  t.translations_s);
+    log(line);
+  }
   if (!o.output.empty()) write_vertices_g2o(local.owned, result.poses, local.d, o.output);
 
   test_abort_point(TestAbortPoint::kBeforeResult, o.id);

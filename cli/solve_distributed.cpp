@@ -74,6 +74,7 @@ const char* const kDistributedValued[] = {"agents",
                                           "refine-coarse-aggregates",
                                           "refine-interface",
                                           "refine-translation-interface",
+                                          "refine-gauge",
                                           nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
@@ -199,7 +200,11 @@ const char* kDistributedHelp =
     "  --refine-translation-interface P   a trial point's translations are solved exactly\n"
     "                            through the blocks' interfaces (one all-agent sum) where the\n"
     "                            team's interface has at most P poses; 0 = block-Jacobi CG\n"
-    "                            always (default 2000)\n";
+    "                            always (default 2000)\n"
+    "  --refine-gauge project|ground   with the interface solves, its CG works on the\n"
+    "                            tangent vectors orthogonal to the global rigid motions\n"
+    "                            (project) or holds the grounded pose fixed (ground) (default\n"
+    "                            ground)\n";
 
 namespace {
 
@@ -351,6 +356,11 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     if (translation < 0 || translation > 1000000)
       throw InputError("option --refine-translation-interface: must be in 0..1000000");
     opt.refine.translation_interface_max_poses = static_cast<int>(translation);
+    const std::string gauge =
+        a.get_or("refine-gauge", opt.refine.project_gauge ? "project" : "ground");
+    if (gauge != "project" && gauge != "ground")
+      throw InputError("option --refine-gauge: '" + gauge + "' is not one of project, ground");
+    opt.refine.project_gauge = gauge == "project";
     opt.refine.coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
                         : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
                                                : NewtonRefineOptions::Coarse::kNone;
@@ -452,6 +462,12 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         n.translation_interface_poses, n.exchanges, n.reductions, n.coarse_unknowns,
         n.interface_coordinates, n.interface_factorizations, n.interface_fallbacks,
         n.initial_grad_norm, n.grad_norm, n.initial_cost, n.cost, n.stop_reason.c_str());
+  for (const NewtonRefineResult& n : r.refines)
+    std::printf(
+        "  newton refine, agent 0: %.3f s wall, %.3f CPU-s: set-up %.3f, factors %.3f, Sigma "
+        "%.3f, CG %.3f, trial points %.3f, translations %.3f\n",
+        n.times.wall_s, n.times.cpu_s, n.times.setup_s, n.times.factor_s, n.times.sigma_s,
+        n.times.cg_s, n.times.trial_s, n.times.translations_s);
   for (const NewtonRefineResult& n : r.refines)
     for (std::size_t k = 0; k < n.trace.size(); ++k) {
       const NewtonRefineStep& t = n.trace[k];

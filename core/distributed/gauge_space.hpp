@@ -15,6 +15,9 @@
 // (parking-garage at N = 5: 5 Newton steps with the gauge part left in, 4 without, the same f;
 // docs/newton-refine.md, "Gauge").
 //
+// With NewtonRefineOptions::project_gauge the CG instead works on the vectors orthogonal to V
+// (each iteration's z and H z projected off it), so its steps carry no gauge part at all.
+//
 // Each agent holds the columns on its own poses and its neighbours' (from X and Xn), so H V is
 // a local product; the k x k sums V^T V and V^T H V are summed once per point.
 

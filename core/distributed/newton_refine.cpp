@@ -1,4 +1,8 @@
+#include <time.h>
+
+#include <Eigen/Cholesky>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -21,6 +25,16 @@
 namespace tessera {
 
 namespace {
+
+double thread_cpu_s() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+double steady_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 // 1 for each row of X or Y that is non-zero somewhere, 0 for the others: summed over the agents,
 // the rows in use anywhere.
@@ -46,6 +60,16 @@ NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout&
 }
 
 NewtonRefineProtocol::~NewtonRefineProtocol() = default;
+
+void NewtonRefineProtocol::charge_to(double* part) {
+  const double now = thread_cpu_s();
+  if (timed_part_) {
+    *timed_part_ += now - timed_since_;
+    result_.times.cpu_s += now - timed_since_;
+  }
+  timed_part_ = part;
+  timed_since_ = now;
+}
 
 void NewtonRefineProtocol::send_public(const Eigen::MatrixXd& v, std::uint32_t step,
                                        std::vector<OutgoingMessage>& out) {
@@ -99,6 +123,8 @@ Eigen::MatrixXd NewtonRefineProtocol::hessian(const Eigen::MatrixXd& v, const Ei
 
 std::vector<OutgoingMessage> NewtonRefineProtocol::start() {
   std::vector<OutgoingMessage> out;
+  wall_start_ = steady_s();
+  charge_to(&result_.times.setup_s);
   // Local active rows first; the reduction makes them the same everywhere.
   rows_.clear();
   for (Eigen::Index k = 0; k < state_.Y.rows(); ++k) rows_.push_back(k);
@@ -122,6 +148,7 @@ std::vector<OutgoingMessage> NewtonRefineProtocol::start() {
   }
   broadcast(kStatus, values, out);
   pump(out);
+  charge_to(nullptr);
   return out;
 }
 
@@ -136,7 +163,9 @@ std::vector<OutgoingMessage> NewtonRefineProtocol::handle(const ProtocolMessage&
     throw std::runtime_error("newton refine: agent " + std::to_string(state_.id()) +
                              ": duplicate message from agent " + std::to_string(sender));
   std::vector<OutgoingMessage> out;
+  charge_to(&result_.times.cg_s);  // until a step's handler names its part
   pump(out);
+  charge_to(nullptr);
   return out;
 }
 
@@ -198,6 +227,7 @@ void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
 
 void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
                                         std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.setup_s);
   const std::size_t r = static_cast<std::size_t>(state_.Y.rows());
   // The sums (in id order, as reduce_in_id_order), then each block's translation share.
   std::vector<double> t(2 + r, 0.0);
@@ -263,6 +293,7 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
 }
 
 void NewtonRefineProtocol::prepare_preconditioner() {
+  charge_to(&result_.times.factor_s);
   if (options_.refactor_every_step && options_.hessian_multipliers)
     state_.refresh_tangent(X_, egrad_);
   else if (options_.refactor_every_step)
@@ -290,6 +321,7 @@ Eigen::VectorXd NewtonRefineProtocol::touched_of(const Eigen::VectorXd& x) const
 }
 
 void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.cg_s);
   step_ = NewtonRefineStep{};
   step_.radius = radius_;
   cg_->restart();
@@ -299,8 +331,17 @@ void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
   if (use_interface_) {
     iy_r_ = iy_g_;
     ir_ = ir_g_;
-    ground_pose(r_);
     gauge_vs_ = gauge_vhs_ = Eigen::VectorXd::Zero(gauge_->size());
+    if (project_gauge_) {
+      // r = -P g = -g + V c with c = (V^T V)^-1 V^T g (round-off: f is invariant along V), and
+      // its interface residuals from those of V.
+      const Eigen::VectorXd c = gauge_vv_.llt().solve(gauge_vg_);
+      gauge_->subtract(-c, r_);
+      iy_r_ += gauge_fv_ * c;
+      ir_ += gauge_rv_ * c;
+    } else {
+      ground_pose(r_);
+    }
   }
   model_ = gs_ = sHs_ = 0.0;
   cg_target_ =
@@ -335,15 +376,31 @@ void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
 
 void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.cg_s);
   neighbours_into(inbox, zn_);
   w_ = hessian(z_, zn_);
-  Eigen::VectorXd vz, vhz;  // V^T z, V^T H z (H z before the grounded pose's rows are zeroed)
+  Eigen::VectorXd vz, vhz;        // V^T z, V^T H z (H z before the grounded pose's rows are zeroed)
+  Eigen::VectorXd hvr, hvw, hvq;  // projecting: (H V)^T of r, H z and q
   if (use_interface_) {
     vz.resize(gauge_->size());
     vhz.resize(gauge_->size());
     gauge_->dot(z_, vz.data());
     gauge_->dot(w_, vhz.data());
-    ground_pose(w_);
+    if (project_gauge_) {
+      const bool first = cg_->iterations() == 0;
+      const auto k = static_cast<std::size_t>(gauge_->size());
+      hvr.resize(gauge_->size());
+      hvw.resize(gauge_->size());
+      hvq = Eigen::VectorXd::Zero(gauge_->size());
+      for (std::size_t c = 0; c < k; ++c) {
+        const auto i = static_cast<Eigen::Index>(c);
+        hvr(i) = frobenius_inner(gauge_hv_[c], r_);
+        hvw(i) = frobenius_inner(gauge_hv_[c], w_);
+        if (!first) hvq(i) = frobenius_inner(gauge_hv_[c], q_);
+      }
+    } else {
+      ground_pose(w_);
+    }
   }
   std::vector<double> values{frobenius_inner(r_, z_), frobenius_inner(z_, w_), r_.squaredNorm()};
   if (use_interface_) {  // the interface residual of w, for the ones of q and r
@@ -365,6 +422,9 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
     values.push_back(first ? 0.0 : q_.squaredNorm());
     values.insert(values.end(), vz.data(), vz.data() + vz.size());
     values.insert(values.end(), vhz.data(), vhz.data() + vhz.size());
+    values.insert(values.end(), hvr.data(), hvr.data() + hvr.size());
+    values.insert(values.end(), hvw.data(), hvw.data() + hvw.size());
+    values.insert(values.end(), hvq.data(), hvq.data() + hvq.size());
   }
   if (coarse_) {  // Phi^T w, for Phi^T q and so Phi^T r by their recurrences
     const std::size_t n = static_cast<std::size_t>(coarse_->size());
@@ -382,13 +442,16 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
 
 void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
                                       std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.cg_s);
   const std::size_t n = static_cast<std::size_t>(coarse_ ? coarse_->size() : 0);
   const std::size_t team =
       use_interface_ ? static_cast<std::size_t>(interface_->team_size()) : std::size_t{0};
   const std::size_t extra = use_interface_ ? 5 : 0;  // the products for ||r_next||
   const std::size_t gk = use_interface_ ? static_cast<std::size_t>(gauge_->size()) : 0;
-  const std::vector<double> t = reduce_in_id_order(
-      inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n + team + extra + 2 * gk);
+  const std::size_t gsums = (project_gauge_ ? 5 : 2) * gk;
+  std::vector<double> t =
+      reduce_in_id_order(inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n + team + extra + gsums);
+  if (project_gauge_) project_iteration_off_gauge(t);
   double gamma = t[0], delta = t[1];
   const double rnorm = std::sqrt(std::max(0.0, t[2]));
   Eigen::VectorXd coarse_w;  // Phi^T w
@@ -420,6 +483,8 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     const Eigen::Map<const Eigen::VectorXd> iw(t.data() + 3, static_cast<Eigen::Index>(team));
     it.update_direction(iw, iq_);
     it.update_direction(iy_w_, iy_q_);
+  }
+  if (use_interface_ && !project_gauge_) {
     const auto k = static_cast<Eigen::Index>(gk);
     it.update_direction(Eigen::Map<const Eigen::VectorXd>(t.data() + 3 + team + extra, k),
                         gauge_vp_);
@@ -444,7 +509,7 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     const double R2 = radius_ * radius_;
     const double tau = cg_->boundary_step(R2);
     s_ += tau * p_;
-    if (use_interface_) {
+    if (use_interface_ && !project_gauge_) {
       gauge_vs_ += tau * gauge_vp_;
       gauge_vhs_ += tau * gauge_vhp_;
     }
@@ -460,8 +525,10 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   if (use_interface_) {
     ir_ -= alpha * iq_;
     iy_r_ -= alpha * iy_q_;
-    gauge_vs_ += alpha * gauge_vp_;
-    gauge_vhs_ += alpha * gauge_vhp_;
+    if (!project_gauge_) {
+      gauge_vs_ += alpha * gauge_vp_;
+      gauge_vhs_ += alpha * gauge_vhp_;
+    }
   }
   model_ += -alpha * gamma + 0.5 * alpha * alpha * pHp;
   gs_ += -alpha * gamma;
@@ -478,6 +545,7 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
 
 void NewtonRefineProtocol::finish(const std::string& why) {
   result_.stop_reason = why;
+  result_.times.wall_s = steady_s() - wall_start_;
   result_.cost = f_;
   result_.grad_norm = gnorm_;
   if (result_.accepted_steps > 0) {

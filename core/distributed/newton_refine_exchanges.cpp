@@ -11,25 +11,46 @@
 #include "distributed/interface_solve.hpp"
 #include "distributed/public_pose_messages.hpp"
 #include "distributed/tangent_coarse_space.hpp"
+#include "util/frobenius_inner.hpp"
 
 namespace tessera {
 
 void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
   // This block's share of Sigma at the current point, then its interface residual of -g (the
   // first CG residual), so that the first direction needs no further message step.
+  charge_to(&result_.times.factor_s);
   std::vector<double> values = interface_->factor(X_, Xn_, egrad_);
-  if (values.front() != 0.0) {
-    interface_->forward(X_, -g_, iy_g_);
-    std::vector<double> rhat(static_cast<std::size_t>(interface_->team_size()), 0.0);
-    interface_->add_interface(iy_g_, rhat.data());
-    values.insert(values.end(), rhat.begin() + interface_->offset(),
-                  rhat.begin() + interface_->offset() + interface_->size());
-  }
-  // The gauge's sums at this point (H V: local products, V known on the neighbours' poses).
+  // The gauge at this point (H V: local products, V known on the neighbours' poses).
   gauge_ = std::make_unique<GaugeSpace>(problem_.dim(), X_, Xn_);
   const int k = gauge_->size();
   gauge_hv_.clear();
   for (int c = 0; c < k; ++c) gauge_hv_.push_back(hessian(gauge_->own(c), gauge_->neighbours(c)));
+  if (values.front() != 0.0) {
+    // The own segment of the team's interface residual of -g, then (projecting the gauge) of
+    // each column of V and of H V, from the block's forward solves.
+    const auto own = [&](const Eigen::MatrixXd& v, Eigen::VectorXd& y) {
+      interface_->forward(X_, v, y);
+      std::vector<double> rhat(static_cast<std::size_t>(interface_->team_size()), 0.0);
+      interface_->add_interface(y, rhat.data());
+      values.insert(values.end(), rhat.begin() + interface_->offset(),
+                    rhat.begin() + interface_->offset() + interface_->size());
+    };
+    own(-g_, iy_g_);
+    if (options_.project_gauge) {
+      Eigen::VectorXd y;
+      for (int c = 0; c < k; ++c) {
+        own(gauge_->own(c), y);
+        if (c == 0) gauge_fv_.resize(y.size(), k);
+        gauge_fv_.col(c) = y;
+      }
+      for (int c = 0; c < k; ++c) {
+        own(gauge_hv_[static_cast<std::size_t>(c)], y);
+        if (c == 0) gauge_fhv_.resize(y.size(), k);
+        gauge_fhv_.col(c) = y;
+      }
+    }
+  }
+  // The gauge's sums: V^T V, V^T H V, V^T g (and (H V)^T (H V) when projecting).
   const std::size_t at = values.size();
   values.resize(at + gauge_share_size(), 0.0);
   double* v = values.data() + at;
@@ -38,19 +59,31 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
     gauge_->dot(gauge_hv_[static_cast<std::size_t>(c)], v + k * k + c * k);
   }
   gauge_->dot(g_, v + 2 * k * k);
+  if (options_.project_gauge)
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; j < k; ++j)
+        v[2 * k * k + k + i * k + j] = frobenius_inner(gauge_hv_[static_cast<std::size_t>(i)],
+                                                       gauge_hv_[static_cast<std::size_t>(j)]);
   broadcast(kInterface, values, out);
 }
 
 std::size_t NewtonRefineProtocol::gauge_share_size() const {
   const auto k = static_cast<std::size_t>(problem_.dim() * (problem_.dim() + 1) / 2);
-  return 2 * k * k + k;
+  return 2 * k * k + k + (options_.project_gauge ? k * k : 0);
 }
 
 void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
   // Every agent assembles the same Sigma from the same shares in id order.
+  charge_to(&result_.times.sigma_s);
   std::vector<std::vector<double>> shares;
   ir_g_ = Eigen::VectorXd::Zero(interface_->team_size());
+  const int k = gauge_->size();
+  const Eigen::Index per = options_.project_gauge ? 1 + 2 * k : 1;  // rhat vectors a share has
+  if (options_.project_gauge) {
+    gauge_rv_ = Eigen::MatrixXd::Zero(interface_->team_size(), k);
+    gauge_rhv_ = Eigen::MatrixXd::Zero(interface_->team_size(), k);
+  }
   bool ok = true;
   int b = 0;
   const std::size_t gn = gauge_share_size();
@@ -64,13 +97,20 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
       ok = false;
       shares.push_back({0.0});
     } else {
-      const auto n = static_cast<std::size_t>(interface_->block_size(b));
-      if (v.size() < n + 1)
+      const Eigen::Index n = interface_->block_size(b);
+      const auto tail = static_cast<std::size_t>(per * n);
+      if (v.size() < tail + 1)
         throw std::runtime_error("newton refine: malformed interface share from agent " +
                                  std::to_string(sender));
-      shares.emplace_back(v.begin(), v.end() - static_cast<std::ptrdiff_t>(n));
-      ir_g_.segment(interface_->block_offset(b), static_cast<Eigen::Index>(n)) =
-          Eigen::Map<const Eigen::VectorXd>(v.data() + v.size() - n, static_cast<Eigen::Index>(n));
+      shares.emplace_back(v.begin(), v.end() - static_cast<std::ptrdiff_t>(tail));
+      const double* rh = v.data() + v.size() - tail;
+      const Eigen::Index o = interface_->block_offset(b);
+      ir_g_.segment(o, n) = Eigen::Map<const Eigen::VectorXd>(rh, n);
+      for (int c = 0; per > 1 && c < k; ++c) {
+        gauge_rv_.col(c).segment(o, n) = Eigen::Map<const Eigen::VectorXd>(rh + (1 + c) * n, n);
+        gauge_rhv_.col(c).segment(o, n) =
+            Eigen::Map<const Eigen::VectorXd>(rh + (1 + k + c) * n, n);
+      }
     }
     ++b;
   }
@@ -82,12 +122,16 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
   }
   interface_due_ = false;
   use_interface_ = ok;
-  const int k = gauge_->size();
   const Eigen::Map<const Eigen::MatrixXd> vv(gsum.data(), k, k), vhv(gsum.data() + k * k, k, k);
   gauge_vv_ = 0.5 * (vv + vv.transpose());
   gauge_vhv_ = 0.5 * (vhv + vhv.transpose());
   gauge_vg_ = Eigen::Map<const Eigen::VectorXd>(gsum.data() + 2 * k * k, k);
   use_gauge_ = ok && gauge_vv_.llt().info() == Eigen::Success;
+  project_gauge_ = use_gauge_ && options_.project_gauge;
+  if (project_gauge_) {
+    const Eigen::Map<const Eigen::MatrixXd> kk(gsum.data() + 2 * k * k + k, k, k);
+    gauge_hvhv_ = 0.5 * (kk + kk.transpose());
+  }
   if (ok) {
     ++result_.interface_factorizations;
   } else {
@@ -108,6 +152,7 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   // This agent's rows of A = Phi^T H Phi: column u is Phi^T (H Phi e_u) over the own poses,
   // with Phi e_u on the own poses and the neighbour copies (the agent knows both). The share
   // is symmetrized (only the sum over the agents is symmetric); upper triangle, then Phi^T g.
+  charge_to(&result_.times.factor_s);
   const int n = coarse_->size();
   Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
   Eigen::MatrixXd v, vn;
@@ -136,6 +181,7 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
 
 void NewtonRefineProtocol::after_coarse(const MessageGate::Inbox& inbox,
                                         std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.sigma_s);
   const int n = coarse_->size();
   const std::vector<double> t =
       reduce_in_id_order(inbox, static_cast<std::size_t>(n * (n + 1) / 2 + n));
@@ -160,6 +206,34 @@ void NewtonRefineProtocol::project_step_off_gauge() {
   gs_ -= c.dot(gauge_vg_);
   sHs_ += -2.0 * c.dot(gauge_vhs_) + c.dot(gauge_vhv_ * c);
   model_ = gs_ + 0.5 * sHs_;
+}
+
+void NewtonRefineProtocol::project_iteration_off_gauge(std::vector<double>& t) {
+  // The CG on the tangent vectors orthogonal to V with the preconditioner P M P (P the
+  // projection off V, M the grounded Sigma's inverse: positive definite there): z' = z - V a,
+  // a = (V^T V)^-1 V^T z; H z' = H z - (H V) a; its projection w' = H z' - V b with
+  // b = (V^T V)^-1 V^T H z'. The interface residuals of w' follow from those of V and H V. The
+  // sums, from V^T z, V^T H z and (H V)^T of r, H z and the previous q (r and q are
+  // orthogonal to V): <z', H z'> = <z, H z> - 2 a^T V^T H z + a^T V^T H V a; <r, w'> =
+  // <r, H z> - a^T (H V)^T r; ||w'||^2 = ||H z||^2 - 2 a^T (H V)^T H z + a^T (H V)^T H V a
+  // - b^T V^T V b; <w', q> = <H z, q> - a^T (H V)^T q; <r, z'> = <r, z>.
+  const int k = gauge_->size();
+  const Eigen::Index team = interface_->team_size();
+  double* e = t.data() + 3 + team;
+  const Eigen::Map<const Eigen::VectorXd> vz(e + 5, k), vhz(e + 5 + k, k), hvr(e + 5 + 2 * k, k),
+      hvw(e + 5 + 3 * k, k), hvq(e + 5 + 4 * k, k);
+  const Eigen::LLT<Eigen::MatrixXd> G(gauge_vv_);
+  const Eigen::VectorXd a = G.solve(vz);
+  const Eigen::VectorXd b = G.solve(vhz - gauge_vhv_ * a);
+  gauge_->subtract(a, z_);
+  for (int c = 0; c < k; ++c) w_ -= a(c) * gauge_hv_[static_cast<std::size_t>(c)];
+  gauge_->subtract(b, w_);
+  iy_w_ -= gauge_fhv_ * a + gauge_fv_ * b;
+  Eigen::Map<Eigen::VectorXd>(t.data() + 3, team) -= gauge_rhv_ * a + gauge_rv_ * b;
+  t[1] += -2.0 * a.dot(vhz) + a.dot(gauge_vhv_ * a);
+  e[0] -= a.dot(hvr);
+  e[1] += -2.0 * a.dot(hvw) + a.dot(gauge_hvhv_ * a) - b.dot(gauge_vv_ * b);
+  e[3] -= a.dot(hvq);
 }
 
 }  // namespace tessera

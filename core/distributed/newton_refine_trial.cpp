@@ -18,8 +18,10 @@
 namespace tessera {
 
 void NewtonRefineProtocol::try_step(const std::string& cg_stop, std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.trial_s);
   step_.cg_stop = cg_stop;
-  if (use_interface_ && use_gauge_) project_step_off_gauge();
+  // A projected CG's step is orthogonal to the gauge already.
+  if (use_interface_ && use_gauge_ && !project_gauge_) project_step_off_gauge();
   step_.predicted = -model_;
   s_full_ = s_;
   scale_ = 1.0;
@@ -31,6 +33,7 @@ void NewtonRefineProtocol::try_step(const std::string& cg_stop, std::vector<Outg
 
 void NewtonRefineProtocol::after_trial(const MessageGate::Inbox& inbox,
                                        std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.trial_s);
   neighbours_into(inbox, Xtn_);
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(Xtn_);
   if (options_.translation_iterations > 0 && !translations_solved_) return start_translations(out);
@@ -38,6 +41,7 @@ void NewtonRefineProtocol::after_trial(const MessageGate::Inbox& inbox,
 }
 
 void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.trial_s);
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(Xtn_);
   double share = 0.0;
   problem_.cost(Xt_, &share);
@@ -48,6 +52,7 @@ void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
 
 void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
                                             std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.trial_s);
   const std::vector<double> t = reduce_in_id_order(inbox, 2);
   const double ft = t[0], gt = std::sqrt(std::max(0.0, t[1]));
   ++result_.steps;
@@ -106,6 +111,7 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
 void NewtonRefineProtocol::start_translations(std::vector<OutgoingMessage>& out) {
   // f at fixed rotations is quadratic in the translations: the CG's residual is minus the
   // translation columns of the Euclidean gradient at the trial point.
+  charge_to(&result_.times.translations_s);
   tr_ = -problem_.euclidean_gradient(Xt_);
   if (translation_solve_) {
     // Exact: x = (2 L)^-1 r, the own block's forward solve now, its interface residual summed.
@@ -126,6 +132,7 @@ void NewtonRefineProtocol::start_translations(std::vector<OutgoingMessage>& out)
 }
 
 void NewtonRefineProtocol::send_translation_direction(std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.translations_s);
   translation_preconditioner_->apply(tr_, tz_);
   // An iteration = this exchange and its sum.
   ++result_.translation_iterations;
@@ -135,6 +142,7 @@ void NewtonRefineProtocol::send_translation_direction(std::vector<OutgoingMessag
 
 void NewtonRefineProtocol::after_translation_direction(const MessageGate::Inbox& inbox,
                                                        std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.translations_s);
   neighbours_into(inbox, tzn_);
   // The translation Hessian's product: the Euclidean gradient of the direction (neighbours set
   // to theirs), translation columns only; no projection (the translations are Euclidean).
@@ -146,6 +154,7 @@ void NewtonRefineProtocol::after_translation_direction(const MessageGate::Inbox&
 
 void NewtonRefineProtocol::after_translation_sums(const MessageGate::Inbox& inbox,
                                                   std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.translations_s);
   const std::vector<double> t = reduce_in_id_order(inbox, 2);
   const double gamma = t[0], delta = t[1];
   bool stop = !(gamma > 0);
@@ -174,6 +183,7 @@ void NewtonRefineProtocol::after_translation_sums(const MessageGate::Inbox& inbo
 void NewtonRefineProtocol::after_translation_solve(const MessageGate::Inbox& inbox,
                                                    std::vector<OutgoingMessage>& out) {
   // The team's interface residual, blocks in id order; every agent solves the same Sigma.
+  charge_to(&result_.times.translations_s);
   const Eigen::Index k = Xt_.rows();
   Eigen::MatrixXd rhat(translation_solve_->team_size(), k);
   for (const auto& [sender, m] : inbox) {

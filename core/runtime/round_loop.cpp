@@ -162,7 +162,26 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     // The certified sequence. Checkpoints and rollbacks cover its first solve stage.
     sequence = std::make_unique<CertifiedAgent>(state, layout, options);
     if (hooks.on_round) sequence->set_round_observer(hooks.on_round);
+    // The stage kind on the agent now (0 rounds, 1 refinement, 2 certificate) and since when.
+    int timed_stage = 0;
+    double stage_since = 0.0, stage_wait = 0.0;
+    const auto close_stage = [&](int next) {
+      const double now =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (timed_stage == 1) {
+        res.refine_wall_s += now - stage_since;
+        res.refine_wait_s += mail.wait_s - stage_wait;
+      } else if (timed_stage == 2) {
+        res.certificate_wall_s += now - stage_since;
+        res.certificate_wait_s += mail.wait_s - stage_wait;
+      }
+      timed_stage = next;
+      stage_since = now;
+      stage_wait = mail.wait_s;
+    };
     mail.after_handled = [&] {
+      const int now_stage = sequence->refining() ? 1 : sequence->certificate_progress() ? 2 : 0;
+      if (now_stage != timed_stage) close_stage(now_stage);
       round_phase(static_cast<std::size_t>(sequence->total_rounds()));
       const auto p = sequence->certificate_progress();
       if (p && p->first > 0)  // from its first iteration on: a lambda_min estimate to show
@@ -176,6 +195,8 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     mail.run_protocol(
         *sequence, hooks.resume_from ? sequence->resume(*hooks.resume_from) : sequence->start(),
         [&] { return "stage " + std::to_string(sequence->stage()) + " of the certified solve"; });
+    close_stage(0);
+    for (const NewtonRefineResult& r : sequence->refines()) res.refine_times.push_back(r.times);
     const SolveStageRecord& last = sequence->solves().back();
     res.rounds = static_cast<std::uint32_t>(sequence->total_rounds());
     res.restarts = static_cast<std::uint32_t>(sequence->total_restarts());

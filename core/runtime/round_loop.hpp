@@ -174,6 +174,12 @@ struct RoundLoopResult {
   double wait_s = 0.0, send_s = 0.0;
   /// Message steps of the rounding (every one waits for peers: rotations, CG, cost).
   std::uint32_t rounding_steps = 0;
+  /// The stages after the rounds on this agent (seconds, summed over the stages of each kind;
+  /// 0 where none ran): wall from the message whose handling began the stage to the one whose
+  /// handling began the next, and of it waiting for messages; the refinements' own parts.
+  double refine_wall_s = 0.0, refine_wait_s = 0.0;
+  double certificate_wall_s = 0.0, certificate_wait_s = 0.0;
+  std::vector<NewtonRefineTimes> refine_times;
   // Certification (RunOptions::certify), identical on every agent; bytes summed over agents.
   std::optional<bool> certified;
   double min_eigenvalue = 0.0;

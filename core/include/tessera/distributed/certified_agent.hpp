@@ -82,6 +82,8 @@ class CertifiedAgent : public AgentProcess {
   }
   /// While a Newton refinement runs: its progress (NewtonRefineProtocol::progress());
   /// nullopt in the other stages.
+  /// Whether a Newton refinement runs (from its start(), before its first sums are in).
+  bool refining() const { return refine_ && current_ == refine_.get(); }
   std::optional<NewtonRefineProtocol::Progress> refine_progress() const {
     if (!refine_ || current_ != refine_.get()) return std::nullopt;
     return refine_->progress();

@@ -210,6 +210,17 @@ struct NewtonRefineOptions {
   /// from a minimiser. On a failed factorization it is raised 1,000-fold twice, then the same
   /// without grounding, before the fallback. (0, 1e-3].
   double interface_shift = 1e-10;
+  /// With the interface solves: true, the CG works on the tangent vectors orthogonal to the
+  /// gauge (distributed/gauge_space.hpp): each iteration's z and H z are projected off it, the
+  /// projection's sums riding in the iteration's sum, so CG solves the full Newton equation
+  /// (the grounded Sigma's inverse, projected, is its preconditioner); false, CG solves the
+  /// equation with the grounded pose held and the step is projected off the gauge once.
+  /// Why false: on the paper graphs at N = 5 both take the same steps, CG iterations and
+  /// message steps, and projecting costs 4 % more instructions (city10000) and 5-24 % more
+  /// bytes; from a rough start on a 1,000-pose corridor the grounded CG meets negative
+  /// curvature along the gauge (6 steps, one rejected, 36 message steps; projected: 4, 31)
+  /// (docs/newton-refine.md, "Gauge").
+  bool project_gauge = false;
   /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
   CoarseOptions coarse_space_options() const;
   /// Throws InputError naming the bad field.
@@ -235,7 +246,23 @@ struct NewtonRefineStep {
   double grad_norm = 0.0;  ///< ||grad f|| there.
 };
 
-/// Identical on every agent.
+/// Where one agent's refinement went: its own thread's CPU seconds by part (every moment of
+/// start() and handle() is charged to exactly one part), and the wall from start() to the last
+/// step. Per agent (not identical across agents); CPU seconds hold whatever the load.
+struct NewtonRefineTimes {
+  double setup_s = 0.0;  ///< Start point's sums, the solves' orderings, translation factors.
+  /// Each point's factorizations: the interface solves' block factors, Schur complements,
+  /// couplings and the gauge's products (or block Jacobi's factor), and the coarse matrix.
+  double factor_s = 0.0;
+  double sigma_s = 0.0;         ///< Sigma's assembly and factorization (every agent, per point).
+  double cg_s = 0.0;            ///< CG iterations: preconditioner, Hessian products, sums.
+  double trial_s = 0.0;         ///< Trial points: retraction, cost and gradient, verdict.
+  double translations_s = 0.0;  ///< Trial translations: exact solves or the translation CG.
+  double cpu_s = 0.0;           ///< All of the above.
+  double wall_s = 0.0;          ///< start() to the end (waits for the team included).
+};
+
+/// Identical on every agent (but `times`).
 struct NewtonRefineResult {
   /// grad_norm (reached the tolerance), max_steps, max_cg_iterations or stalled (the trust
   /// region shrank below round-off).
@@ -260,6 +287,7 @@ struct NewtonRefineResult {
   /// counted in `reductions`) and where it could not be (that step's CG ran block Jacobi).
   int interface_coordinates = 0, interface_factorizations = 0, interface_fallbacks = 0;
   std::vector<NewtonRefineStep> trace;
+  NewtonRefineTimes times;  ///< This agent's.
 };
 
 class NewtonRefineProtocol : public AgentProcess {
@@ -336,6 +364,9 @@ class NewtonRefineProtocol : public AgentProcess {
   std::size_t gauge_share_size() const;
   // The CG step's part orthogonal to the gauge, with its model's <g, s> and <s, H s>.
   void project_step_off_gauge();
+  // Projecting the gauge: z, H z (and H z's interface residuals) of this iteration projected
+  // off V, and the iteration's sums t (as after_sums reads them) corrected to theirs.
+  void project_iteration_off_gauge(std::vector<double>& t);
   // CG from s = 0 at the current point (the coarse matrix, if any, is current).
   void start_cg(std::vector<OutgoingMessage>& out);
   // x's entries at the coarse unknowns this agent touches (coarse_hphi_'s columns).
@@ -360,11 +391,18 @@ class NewtonRefineProtocol : public AgentProcess {
   // The trial point's cost share and ||g||^2 (kTrialSums), its neighbours' poses set.
   void send_trial_sums(std::vector<OutgoingMessage>& out);
 
+  // Charges this thread's CPU time since the last switch to the current part, then makes
+  // `part` (a field of result_.times, or nullptr between messages) the current one.
+  void charge_to(double* part);
+
   AgentState& state_;
   const BlockLayout& layout_;
   NewtonRefineOptions options_;
   BlockProblem problem_;  // own copy: its neighbour poses are set to directions
   MessageGate gate_;
+  double* timed_part_ = nullptr;  // charge_to()'s current part and its start (thread CPU s)
+  double timed_since_ = 0.0;
+  double wall_start_ = 0.0;          // steady clock at start(), s
   std::uint32_t message_round_ = 0;  // one per message step, the same on every agent
   std::vector<int> everyone_;        // the agents every reduction waits for: 0 .. N-1
   std::vector<Eigen::Index> rows_;   // active rows (non-zero on some agent)
@@ -409,6 +447,11 @@ class NewtonRefineProtocol : public AgentProcess {
   Eigen::MatrixXd gauge_vv_, gauge_vhv_;
   Eigen::VectorXd gauge_vg_, gauge_vp_, gauge_vhp_, gauge_vs_, gauge_vhs_;
   bool use_gauge_ = false;
+  // options_.project_gauge at this point (with use_gauge_): the forward solves F(V), F(H V)
+  // (own, one column each), the team's interface residuals R(V), R(H V) (team_size x k) and
+  // (H V)^T (H V); the projection's coefficients a (of z) and b (of H z) per iteration.
+  bool project_gauge_ = false;
+  Eigen::MatrixXd gauge_fv_, gauge_fhv_, gauge_rv_, gauge_rhv_, gauge_hvhv_;
   // Translation solve at the trial point: the own block's translation Laplacian factor, CG
   // state (x the translation change, in the pose layout with zero rotation columns).
   std::unique_ptr<TranslationPreconditioner> translation_preconditioner_;
