@@ -10,6 +10,7 @@
 #include "solvers/pose_level_analysis.hpp"
 #include "solvers/tangent_coordinates.hpp"
 #include "solvers/tangent_factor.hpp"
+#include "util/serial_blas.hpp"
 
 namespace tessera {
 
@@ -43,7 +44,7 @@ double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& ro
 
 TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double relative_shift,
                                              std::size_t max_factor_entries,
-                                             double supernodal_min_flops)
+                                             double supernodal_min_flops, bool simplicial_solves)
     : factor_(std::make_unique<Factor>()) {
   if (!(relative_shift >= 0))
     throw std::invalid_argument("TangentPreconditioner: relative_shift must be >= 0");
@@ -142,7 +143,16 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   // A dense factorization (3D graphs: p = 6 coordinates a pose, (6/4)^3 the flops of the
   // Euclidean factor of Q) is several times cheaper with BLAS on its supernodes. The re-analysis
   // repeats the AMD ordering, a small part of such a factorization.
-  if (supernodal_min_flops > 0 && f.flops > supernodal_min_flops) {
+  if (supernodal_min_flops > 0 && f.flops > supernodal_min_flops && simplicial_solves) {
+    // Same ordering as the simplicial analysis (no second AMD search); the supernodal factor
+    // holds the relaxed supernodes' explicit zeros too, which its conversion keeps.
+    const cholmod_factor* L = f.llt.factor();
+    const auto* perm = static_cast<const int*>(L->Perm);
+    f.order.assign(perm, perm + L->n);
+    f.convert = true;
+    if (!f.analyze_supernodal()) return;  // not usable
+    f.entries = std::max(f.entries, static_cast<std::size_t>(f.llt.cholmod().lnz));
+  } else if (supernodal_min_flops > 0 && f.flops > supernodal_min_flops) {
     f.llt.setMode(Eigen::CholmodSupernodalLLt);
     cholmod_common& cs = f.llt.cholmod();
     cs.nmethods = 1;
@@ -188,6 +198,10 @@ double TangentPreconditioner::factor_flops() const {
 
 bool TangentPreconditioner::supernodal() const {
   return factor_->supernodal;
+}
+
+bool TangentPreconditioner::supernodal_factorization() const {
+  return factor_->convert;
 }
 
 int TangentPreconditioner::coordinates_per_pose() const {
@@ -253,7 +267,26 @@ bool TangentPreconditioner::factorize_impl(const Eigen::MatrixXd& X, const Eigen
     for (int c = 0; c < p; ++c)
       f.A.valuePtr()[f.value_offset(j, f.diagonal_slot[static_cast<std::size_t>(j)], c) + c] +=
           lambda;
-  f.llt.factorize(f.A);
+  if (f.convert) {
+    // A converted factor is simplicial: the supernodal analysis again (its cost is a small part
+    // of the factorization it enables).
+    if (!f.llt.factor()->is_super && !f.analyze_supernodal()) {
+      f.usable = false;
+      f.factored = false;
+      return false;
+    }
+    {
+      const SerialBlasLock lock(serial_blas_mutex());  // CHOLMOD's supernodal kernels call BLAS
+      f.llt.factorize(f.A);
+    }
+    if (f.llt.info() == Eigen::Success &&
+        !cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/0, /*to_super=*/0, /*to_packed=*/1,
+                               /*to_monotonic=*/1, f.llt.factor(), &f.llt.cholmod()))
+      throw_cholmod_failure("TangentPreconditioner", "factor conversion", f.llt.cholmod().status,
+                            f.A.rows(), f.A.cols());
+  } else {
+    f.llt.factorize(f.A);
+  }
   ++f.factorizations;
   f.calls_since_factor = 0;
   bool positive = f.llt.info() == Eigen::Success;

@@ -38,6 +38,11 @@ struct BlockUpdateOptions {
   int tangent_refresh_interval = 0;
   /// lambda of the tangent factor, relative to the largest diagonal entry of J^T 2Q_BB J (>= 0).
   double tangent_relative_shift = 1e-9;
+  /// Floating-point operations of the tangent factorization (CHOLMOD's symbolic prediction)
+  /// above which it is computed supernodally (BLAS kernels on its supernodes) and converted to
+  /// the simplicial LDL^T form for the solves (>= 0; 0 = always simplicial). Same operator up to
+  /// round-off; see docs/benchmarks/launch_phases.md ("init") for the measured effect.
+  double tangent_supernodal_min_flops = 5e7;
   /// First trust-region radius of an update preconditioned with the tangent factor, in units
   /// of the preconditioned gradient norm sqrt(<P g, g>) (> 0). That norm is the length of P's
   /// Newton step, so with the (nearly exact) tangent factor a radius of 1 stops tCG on the

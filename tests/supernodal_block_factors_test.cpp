@@ -1,0 +1,80 @@
+// The agents' factors computed supernodally and solved in the simplicial form: the tangent
+// preconditioner with simplicial_solves (solvers/tangent_preconditioner.hpp). It is the operator
+// of its simplicial counterpart up to round-off, also after refactorizations.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cstdlib>
+#include <tessera/distributed/rbcd.hpp>
+#include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/lifting.hpp>
+#include <tessera/solvers/tangent_preconditioner.hpp>
+#include <tessera/util/input_error.hpp>
+#include <vector>
+
+#include "lifted_blocks.hpp"
+#include "test_support.hpp"
+
+namespace tessera {
+namespace {
+
+// Supernodal factorization with simplicial solves applies the same J A^-1 J^T as the simplicial
+// factor, with and without the multipliers, and again after a refactorization at another point
+// (the converted factor is re-analysed supernodally): 2D and 3D.
+TEST(SupernodalBlockFactors, TangentFactorWithSimplicialSolvesIsTheSimplicialOperator) {
+  for (int d : {2, 3}) {
+    test::HalfBlock h = test::half_block(d, 5);
+    BlockProblem problem(d, h.owned, h.graph.measurements);
+    const Eigen::MatrixXd all = lift_poses(h.graph.initial, d);
+    problem.set_neighbor_poses(test::pose_columns(all, d, problem.neighbors()));
+    TangentPreconditioner simplicial(problem, 1e-9, 0);
+    TangentPreconditioner converted(problem, 1e-9, 0, /*supernodal_min_flops=*/1.0,
+                                    /*simplicial_solves=*/true);
+    EXPECT_FALSE(simplicial.supernodal_factorization());
+    EXPECT_TRUE(converted.supernodal_factorization());
+    EXPECT_FALSE(converted.supernodal()) << "its solves are simplicial";
+    ASSERT_TRUE(converted.usable());
+    const LiftedManifold M = problem.manifold(d);
+    std::srand(11);
+    Eigen::MatrixXd X = test::pose_columns(all, d, h.owned);
+    for (int point = 0; point < 3; ++point) {
+      X = M.retract(X, 0.01 * M.tangent_project(X, Eigen::MatrixXd::Random(d, X.cols())));
+      const Eigen::MatrixXd egrad = problem.euclidean_gradient(X);
+      if (point == 1) {
+        ASSERT_TRUE(simplicial.factorize(X, egrad));
+        ASSERT_TRUE(converted.factorize(X, egrad));
+        EXPECT_EQ(converted.with_multipliers(), simplicial.with_multipliers());
+      } else {
+        ASSERT_TRUE(simplicial.factorize(X));
+        ASSERT_TRUE(converted.factorize(X));
+      }
+      const Eigen::MatrixXd V = M.tangent_project(X, Eigen::MatrixXd::Random(d, X.cols()));
+      const Eigen::MatrixXd Z = simplicial.apply(M, X, V);
+      const Eigen::MatrixXd Zc = converted.apply(M, X, V);
+      EXPECT_LT((Zc - Z).cwiseAbs().maxCoeff(), 1e-8 * Z.cwiseAbs().maxCoeff())
+          << "d = " << d << ", point " << point;
+    }
+    EXPECT_EQ(converted.factorizations(), 3);
+  }
+}
+
+// Below the flops threshold nothing changes: the factor stays simplicial.
+TEST(SupernodalBlockFactors, TangentFactorBelowTheThresholdStaysSimplicial) {
+  test::HalfBlock h = test::half_block(3, 6);
+  const BlockProblem problem(3, h.owned, h.graph.measurements);
+  const TangentPreconditioner below(problem, 1e-9, 0, 1e300, true);
+  EXPECT_FALSE(below.supernodal_factorization());
+  EXPECT_GT(below.factor_flops(), 0.0);
+}
+
+TEST(SupernodalBlockFactors, TangentThresholdOptionIsValidated) {
+  BlockUpdateOptions o;
+  o.tangent_supernodal_min_flops = -1.0;
+  EXPECT_NE(test::validation_message(o).find("tangent_supernodal_min_flops"), std::string::npos);
+  o.tangent_supernodal_min_flops = std::nan("");
+  EXPECT_THROW(o.validate(), InputError);
+}
+
+}  // namespace
+}  // namespace tessera
