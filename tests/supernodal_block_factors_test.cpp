@@ -1,6 +1,7 @@
 // The agents' factors computed supernodally and solved in the simplicial form: the tangent
-// preconditioner with simplicial_solves (solvers/tangent_preconditioner.hpp). It is the operator
-// of its simplicial counterpart up to round-off, also after refactorizations.
+// preconditioner with simplicial_solves (solvers/tangent_preconditioner.hpp) and the distributed
+// certificate's block factor (certification/shifted_block_factor.hpp). Both are the operators of
+// their simplicial counterparts up to round-off, refactor, and report "not positive definite".
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,7 @@
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
+#include "certification/shifted_block_factor.hpp"
 #include "lifted_blocks.hpp"
 #include "test_support.hpp"
 
@@ -74,6 +76,29 @@ TEST(SupernodalBlockFactors, TangentThresholdOptionIsValidated) {
   EXPECT_NE(test::validation_message(o).find("tangent_supernodal_min_flops"), std::string::npos);
   o.tangent_supernodal_min_flops = std::nan("");
   EXPECT_THROW(o.validate(), InputError);
+}
+
+// The certificate's block factor solves (S + shift I) z = r like a dense Cholesky solve, says
+// "not positive definite" for a shift below -lambda_min(S), and factors after a larger shift.
+TEST(SupernodalBlockFactors, ShiftedBlockFactorSolvesAndRejectsIndefiniteShifts) {
+  for (int d : {2, 3}) {
+    test::HalfBlock h = test::half_block(d, 7);
+    const BlockProblem problem(d, h.owned, h.graph.measurements);
+    const SparseMatrix& S = problem.data_matrix();  // positive semidefinite, with a gauge
+    const int w = d + 1;
+    const Eigen::MatrixXd Sd(S);
+    const double top = Sd.diagonal().maxCoeff();
+    ShiftedBlockFactor factor(S, w);
+    EXPECT_FALSE(factor.factor(S, -0.5 * top)) << "d = " << d;
+    ASSERT_TRUE(factor.factor(S, 1e-6 * top)) << "d = " << d;
+    std::srand(13);
+    const Eigen::MatrixXd r = Eigen::MatrixXd::Random(1, S.cols());
+    const Eigen::MatrixXd z = factor.solve(r);
+    const Eigen::MatrixXd shifted = Sd + 1e-6 * top * Eigen::MatrixXd::Identity(S.rows(), S.cols());
+    const Eigen::VectorXd expect = shifted.llt().solve(r.transpose());
+    EXPECT_LT((z.transpose() - expect).cwiseAbs().maxCoeff(), 1e-8 * expect.cwiseAbs().maxCoeff())
+        << "d = " << d;
+  }
 }
 
 }  // namespace
