@@ -70,6 +70,35 @@ TEST(SupernodalBlockFactors, TangentFactorBelowTheThresholdStaysSimplicial) {
   EXPECT_GT(below.factor_flops(), 0.0);
 }
 
+// Near the threshold (within the pose-level estimate's margin) the exact analysis decides, and
+// a factor just above it is converted too: the same operator at its point.
+TEST(SupernodalBlockFactors, NearTheThresholdTheExactAnalysisDecides) {
+  for (int d : {2, 3}) {
+    test::HalfBlock h = test::half_block(d, 8);
+    BlockProblem problem(d, h.owned, h.graph.measurements);
+    const Eigen::MatrixXd all = lift_poses(h.graph.initial, d);
+    problem.set_neighbor_poses(test::pose_columns(all, d, problem.neighbors()));
+    TangentPreconditioner simplicial(problem, 1e-9, 0);
+    const double flops = simplicial.factor_flops();
+    ASSERT_GT(flops, 0.0);
+    EXPECT_FALSE(
+        TangentPreconditioner(problem, 1e-9, 0, 1.1 * flops, true).supernodal_factorization())
+        << "d = " << d;
+    TangentPreconditioner converted(problem, 1e-9, 0, 0.9 * flops, true);
+    EXPECT_TRUE(converted.supernodal_factorization()) << "d = " << d;
+    const LiftedManifold M = problem.manifold(d);
+    std::srand(17);
+    Eigen::MatrixXd X = test::pose_columns(all, d, h.owned);
+    X = M.retract(X, 0.01 * M.tangent_project(X, Eigen::MatrixXd::Random(d, X.cols())));
+    ASSERT_TRUE(simplicial.factorize(X));
+    ASSERT_TRUE(converted.factorize(X));
+    const Eigen::MatrixXd V = M.tangent_project(X, Eigen::MatrixXd::Random(d, X.cols()));
+    const Eigen::MatrixXd Z = simplicial.apply(M, X, V);
+    EXPECT_LT((converted.apply(M, X, V) - Z).cwiseAbs().maxCoeff(), 1e-8 * Z.cwiseAbs().maxCoeff())
+        << "d = " << d;
+  }
+}
+
 TEST(SupernodalBlockFactors, TangentThresholdOptionIsValidated) {
   BlockUpdateOptions o;
   o.tangent_supernodal_min_flops = -1.0;

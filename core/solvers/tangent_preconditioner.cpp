@@ -23,9 +23,11 @@ constexpr double kSkipFactor = 2.0;
 // Entries of A's LDL^T factor estimated from the pose-level pattern (`rows`: the row blocks of
 // each block column, diagonal included): the pose-level factor's entries (same AMD ordering,
 // symbolic only), each off-diagonal block p x p dense and each diagonal block triangular.
-// `order` (when not null) receives the pose-level analysis' ordering (CHOLMOD's Perm, postordered).
+// `order` (when not null) receives the pose-level analysis' ordering (CHOLMOD's Perm, postordered),
+// `flops` (when not null) p^3 times the pose-level factorization's flops: an estimate of A's,
+// which counts each column's entries squared (0 without an estimate).
 double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& rows, int p,
-                                std::vector<int>* order = nullptr) {
+                                std::vector<int>* order = nullptr, double* flops = nullptr) {
   const Eigen::Index m = static_cast<Eigen::Index>(rows.size());
   std::vector<Eigen::Triplet<double>> t;
   for (Eigen::Index j = 0; j < m; ++j)
@@ -36,6 +38,7 @@ double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& ro
   const PoseLevelAnalysis a = analyse_pose_level_pattern(B, order != nullptr);
   if (!a.ok) return 0.0;  // no estimate: the exact analysis decides
   if (order) *order = a.order;
+  if (flops) *flops = a.flops * p * p * p;
   const double md = static_cast<double>(m), block_entries = a.factor_entries;
   return (block_entries - md) * p * p + md * p * (p + 1) / 2.0;
 }
@@ -54,6 +57,14 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   f.m = static_cast<Eigen::Index>(problem.num_owned());
   f.relative_shift = relative_shift;
   const int w = f.d + 1;
+  // What only the factor needs goes when it is not usable, not with the preconditioner.
+  const auto release_factor_inputs = [&f] {
+    f.A = SparseMatrix();
+    std::vector<double>().swap(f.q_blocks);
+    std::vector<Eigen::Index>().swap(f.block_row);
+    std::vector<Eigen::Index>().swap(f.block_start);
+    std::vector<Eigen::Index>().swap(f.diagonal_slot);
+  };
   SparseMatrix Q = problem.data_matrix();
   Q.makeCompressed();
 
@@ -73,8 +84,9 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   // Its ordering, each pose's p coordinates kept together, is A's: AMD on A itself found the
   // same blocks (p coordinates per pose) at p^2 times the work.
   std::vector<int> pose_order;
+  double flops_estimate = 0.0;
   {
-    const double estimate = pose_level_fill_estimate(rows, f.p, &pose_order);
+    const double estimate = pose_level_fill_estimate(rows, f.p, &pose_order, &flops_estimate);
     if (max_factor_entries > 0 &&
         estimate > kSkipFactor * static_cast<double>(max_factor_entries)) {
       f.entries = static_cast<std::size_t>(estimate);
@@ -120,6 +132,28 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
     }
   f.A.outerIndexPtr()[n] = static_cast<int>(pos);
 
+  // A factorization far above supernodal_min_flops by the pose-level estimate goes to the
+  // supernodal analysis at once (no simplicial analysis only to learn its size); near the
+  // threshold the simplicial analysis decides.
+  std::vector<int> order;
+  if (f.m > 0 && pose_order.size() == static_cast<std::size_t>(f.m)) {
+    order.resize(static_cast<std::size_t>(n));
+    for (Eigen::Index k = 0; k < f.m; ++k)
+      for (int q = 0; q < f.p; ++q)
+        order[static_cast<std::size_t>(k * f.p + q)] =
+            pose_order[static_cast<std::size_t>(k)] * f.p + q;
+  }
+  if (simplicial_solves && supernodal_min_flops > 0 && !order.empty() &&
+      flops_estimate > kSkipFactor * supernodal_min_flops) {
+    f.order = std::move(order);
+    f.convert = true;
+    if (!f.analyze_supernodal()) return;  // not usable
+    f.entries = static_cast<std::size_t>(f.llt.cholmod().lnz);
+    f.flops = f.llt.cholmod().fl;
+    f.usable = max_factor_entries == 0 || f.entries <= max_factor_entries;
+    if (!f.usable) release_factor_inputs();
+    return;
+  }
   // Symbolic analysis once (the pose-level AMD ordering above, else AMD; simplicial LDL^T:
   // supernodal LL^T took 6 % more instructions on the online steps of a 1,000-pose grid).
   f.llt.setMode(Eigen::CholmodLDLt);
@@ -127,12 +161,7 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   c.nmethods = 1;
   c.method[0].ordering = CHOLMOD_AMD;
   c.postorder = 1;
-  if (f.m > 0 && pose_order.size() == static_cast<std::size_t>(f.m)) {
-    std::vector<int> order(static_cast<std::size_t>(n));
-    for (Eigen::Index k = 0; k < f.m; ++k)
-      for (int q = 0; q < f.p; ++q)
-        order[static_cast<std::size_t>(k * f.p + q)] =
-            pose_order[static_cast<std::size_t>(k)] * f.p + q;
+  if (!order.empty()) {
     f.llt.analyze_with_ordering(f.A, order);
   } else {
     f.llt.analyzePattern(f.A);
@@ -165,13 +194,7 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
     f.supernodal = true;
   }
   f.usable = max_factor_entries == 0 || f.entries <= max_factor_entries;
-  if (!f.usable) {  // what only the factor needs goes now, not with the preconditioner
-    f.A = SparseMatrix();
-    std::vector<double>().swap(f.q_blocks);
-    std::vector<Eigen::Index>().swap(f.block_row);
-    std::vector<Eigen::Index>().swap(f.block_start);
-    std::vector<Eigen::Index>().swap(f.diagonal_slot);
-  }
+  if (!f.usable) release_factor_inputs();
 }
 
 TangentPreconditioner::~TangentPreconditioner() = default;
