@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "certification/interface_schur.hpp"
+#include "certification/shifted_block_factor.hpp"
 #include "distributed/interface_poses.hpp"
 #include "distributed/public_pose_messages.hpp"
 #include "util/frobenius_inner.hpp"
@@ -43,7 +44,7 @@ double certificate_start_entry(std::uint64_t seed, std::size_t pose, int coordin
 // m^(4/3)), only the (d+1) x (d+1) diagonal blocks of the shifted S_BB are inverted, one per pose:
 // memory linear in the block, more iterations.
 struct BlockJacobi {
-  Eigen::SimplicialLLT<SparseMatrix> factor;
+  std::unique_ptr<ShiftedBlockFactor> factor;
   int w = 0;                           // > 0: the pose-wise fallback, blocks of w x w
   std::vector<double> block_inverses;  // w x w inverses one after the other (column-major)
   double shift = 0.0;
@@ -75,7 +76,7 @@ struct BlockJacobi {
 
   // r (one row) times the preconditioner.
   Eigen::MatrixXd apply(const Eigen::MatrixXd& r) const {
-    if (w == 0) return factor.solve(r.transpose()).transpose();
+    if (w == 0) return factor->solve(r);
     Eigen::MatrixXd z(r.rows(), r.cols());
     for (Eigen::Index b = 0; b < r.cols() / w; ++b)
       z.middleCols(b * w, w).noalias() =
@@ -195,18 +196,16 @@ void CertificateProtocol::build_preconditioner() {
   // The exact factor's matrix S_BB = Q_BB - Lambda_B; the pose-wise fallback (large blocks)
   // reads S_BB's diagonal blocks straight from Q_BB and Lambda_B instead: two matrices the
   // size of Q_BB less at the agent's memory peak.
-  SparseMatrix S, I;
+  SparseMatrix S;
   if (!pose_wise) {
     S = Q - lambda_;
-    I.resize(S.rows(), S.cols());
-    I.setIdentity();
+    precon_->factor = std::make_unique<ShiftedBlockFactor>(S, static_cast<int>(w));
   }
   for (;;) {
     if (pose_wise) {
       if (precon_->invert_diagonal_blocks(Q, lambda_, shift, static_cast<int>(w))) break;
     } else {
-      precon_->factor.compute(S + shift * I);
-      if (precon_->factor.info() == Eigen::Success) break;
+      if (precon_->factor->factor(S, shift)) break;
     }
     shift *= 10.0;
     if (shift > 1e4 * local_scale)

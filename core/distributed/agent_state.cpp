@@ -146,8 +146,10 @@ bool AgentState::build_tangent(const Eigen::MatrixXd& X, const BlockUpdateOption
   tangent_tried_ = true;
   // The Q_BB factor's cap bounds this one too (it may be set lower for a large team on one host,
   // runtime/team_memory.hpp); 0 there means no cap here either.
+  // Supernodal factorization above options.tangent_supernodal_min_flops, solves simplicial.
   tangent_ = std::make_unique<TangentPreconditioner>(problem_, options.tangent_relative_shift,
-                                                     max_factor_entries_);
+                                                     max_factor_entries_,
+                                                     options.tangent_supernodal_min_flops, true);
   if (!tangent_->usable() || !tangent_->factorize(X)) tangent_.reset();
   return tangent_ != nullptr;
 }

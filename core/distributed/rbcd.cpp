@@ -18,6 +18,8 @@ void BlockUpdateOptions::validate() const {
   if (!(tangent_relative_shift >= 0 && std::isfinite(tangent_relative_shift)))
     fail("tangent_relative_shift", "must be finite and >= 0");
   if (!(grad_reduction >= 0 && grad_reduction < 1)) fail("grad_reduction", "must be in [0, 1)");
+  if (!(tangent_supernodal_min_flops >= 0 && std::isfinite(tangent_supernodal_min_flops)))
+    fail("tangent_supernodal_min_flops", "must be finite and >= 0");
   if (!(tangent_radius_scale > 0 && std::isfinite(tangent_radius_scale)))
     fail("tangent_radius_scale", "must be finite and > 0");
 }

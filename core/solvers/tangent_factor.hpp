@@ -74,6 +74,19 @@ struct TangentPreconditioner::Factor {
   std::size_t entries = 0;
   double flops = 0.0;
   bool supernodal = false;
+  // Supernodal factorizations converted to simplicial LDL^T for the solves (`simplicial_solves`):
+  // `order` is the simplicial analysis' permutation, which each supernodal analysis is given.
+  bool convert = false;
+  std::vector<int> order;
+
+  // The supernodal symbolic analysis of A with `order` (a converted factor is simplicial, and
+  // CHOLMOD factors supernodally only with a supernodal symbolic factor). False when it fails.
+  bool analyze_supernodal() {
+    llt.setMode(Eigen::CholmodSupernodalLLt);
+    llt.cholmod().postorder = 1;
+    llt.analyze_with_ordering(A, order);
+    return llt.info() == Eigen::Success && !cholmod_analysis_failed(llt);
+  }
   bool with_multipliers = false;
   bool usable = false;
   bool factored = false;

@@ -10,6 +10,7 @@
 #include "solvers/pose_level_analysis.hpp"
 #include "solvers/tangent_coordinates.hpp"
 #include "solvers/tangent_factor.hpp"
+#include "util/serial_blas.hpp"
 
 namespace tessera {
 
@@ -22,9 +23,11 @@ constexpr double kSkipFactor = 2.0;
 // Entries of A's LDL^T factor estimated from the pose-level pattern (`rows`: the row blocks of
 // each block column, diagonal included): the pose-level factor's entries (same AMD ordering,
 // symbolic only), each off-diagonal block p x p dense and each diagonal block triangular.
-// `order` (when not null) receives the pose-level analysis' ordering (CHOLMOD's Perm, postordered).
+// `order` (when not null) receives the pose-level analysis' ordering (CHOLMOD's Perm, postordered),
+// `flops` (when not null) p^3 times the pose-level factorization's flops: an estimate of A's,
+// which counts each column's entries squared (0 without an estimate).
 double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& rows, int p,
-                                std::vector<int>* order = nullptr) {
+                                std::vector<int>* order = nullptr, double* flops = nullptr) {
   const Eigen::Index m = static_cast<Eigen::Index>(rows.size());
   std::vector<Eigen::Triplet<double>> t;
   for (Eigen::Index j = 0; j < m; ++j)
@@ -35,6 +38,7 @@ double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& ro
   const PoseLevelAnalysis a = analyse_pose_level_pattern(B, order != nullptr);
   if (!a.ok) return 0.0;  // no estimate: the exact analysis decides
   if (order) *order = a.order;
+  if (flops) *flops = a.flops * p * p * p;
   const double md = static_cast<double>(m), block_entries = a.factor_entries;
   return (block_entries - md) * p * p + md * p * (p + 1) / 2.0;
 }
@@ -43,7 +47,7 @@ double pose_level_fill_estimate(const std::vector<std::vector<Eigen::Index>>& ro
 
 TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double relative_shift,
                                              std::size_t max_factor_entries,
-                                             double supernodal_min_flops)
+                                             double supernodal_min_flops, bool simplicial_solves)
     : factor_(std::make_unique<Factor>()) {
   if (!(relative_shift >= 0))
     throw std::invalid_argument("TangentPreconditioner: relative_shift must be >= 0");
@@ -53,6 +57,14 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   f.m = static_cast<Eigen::Index>(problem.num_owned());
   f.relative_shift = relative_shift;
   const int w = f.d + 1;
+  // What only the factor needs goes when it is not usable, not with the preconditioner.
+  const auto release_factor_inputs = [&f] {
+    f.A = SparseMatrix();
+    std::vector<double>().swap(f.q_blocks);
+    std::vector<Eigen::Index>().swap(f.block_row);
+    std::vector<Eigen::Index>().swap(f.block_start);
+    std::vector<Eigen::Index>().swap(f.diagonal_slot);
+  };
   SparseMatrix Q = problem.data_matrix();
   Q.makeCompressed();
 
@@ -72,8 +84,9 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   // Its ordering, each pose's p coordinates kept together, is A's: AMD on A itself found the
   // same blocks (p coordinates per pose) at p^2 times the work.
   std::vector<int> pose_order;
+  double flops_estimate = 0.0;
   {
-    const double estimate = pose_level_fill_estimate(rows, f.p, &pose_order);
+    const double estimate = pose_level_fill_estimate(rows, f.p, &pose_order, &flops_estimate);
     if (max_factor_entries > 0 &&
         estimate > kSkipFactor * static_cast<double>(max_factor_entries)) {
       f.entries = static_cast<std::size_t>(estimate);
@@ -119,6 +132,28 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
     }
   f.A.outerIndexPtr()[n] = static_cast<int>(pos);
 
+  // A factorization far above supernodal_min_flops by the pose-level estimate goes to the
+  // supernodal analysis at once (no simplicial analysis only to learn its size); near the
+  // threshold the simplicial analysis decides.
+  std::vector<int> order;
+  if (f.m > 0 && pose_order.size() == static_cast<std::size_t>(f.m)) {
+    order.resize(static_cast<std::size_t>(n));
+    for (Eigen::Index k = 0; k < f.m; ++k)
+      for (int q = 0; q < f.p; ++q)
+        order[static_cast<std::size_t>(k * f.p + q)] =
+            pose_order[static_cast<std::size_t>(k)] * f.p + q;
+  }
+  if (simplicial_solves && supernodal_min_flops > 0 && !order.empty() &&
+      flops_estimate > kSkipFactor * supernodal_min_flops) {
+    f.order = std::move(order);
+    f.convert = true;
+    if (!f.analyze_supernodal()) return;  // not usable
+    f.entries = static_cast<std::size_t>(f.llt.cholmod().lnz);
+    f.flops = f.llt.cholmod().fl;
+    f.usable = max_factor_entries == 0 || f.entries <= max_factor_entries;
+    if (!f.usable) release_factor_inputs();
+    return;
+  }
   // Symbolic analysis once (the pose-level AMD ordering above, else AMD; simplicial LDL^T:
   // supernodal LL^T took 6 % more instructions on the online steps of a 1,000-pose grid).
   f.llt.setMode(Eigen::CholmodLDLt);
@@ -126,12 +161,7 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   c.nmethods = 1;
   c.method[0].ordering = CHOLMOD_AMD;
   c.postorder = 1;
-  if (f.m > 0 && pose_order.size() == static_cast<std::size_t>(f.m)) {
-    std::vector<int> order(static_cast<std::size_t>(n));
-    for (Eigen::Index k = 0; k < f.m; ++k)
-      for (int q = 0; q < f.p; ++q)
-        order[static_cast<std::size_t>(k * f.p + q)] =
-            pose_order[static_cast<std::size_t>(k)] * f.p + q;
+  if (!order.empty()) {
     f.llt.analyze_with_ordering(f.A, order);
   } else {
     f.llt.analyzePattern(f.A);
@@ -142,7 +172,16 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   // A dense factorization (3D graphs: p = 6 coordinates a pose, (6/4)^3 the flops of the
   // Euclidean factor of Q) is several times cheaper with BLAS on its supernodes. The re-analysis
   // repeats the AMD ordering, a small part of such a factorization.
-  if (supernodal_min_flops > 0 && f.flops > supernodal_min_flops) {
+  if (supernodal_min_flops > 0 && f.flops > supernodal_min_flops && simplicial_solves) {
+    // Same ordering as the simplicial analysis (no second AMD search); the supernodal factor
+    // holds the relaxed supernodes' explicit zeros too, which its conversion keeps.
+    const cholmod_factor* L = f.llt.factor();
+    const auto* perm = static_cast<const int*>(L->Perm);
+    f.order.assign(perm, perm + L->n);
+    f.convert = true;
+    if (!f.analyze_supernodal()) return;  // not usable
+    f.entries = std::max(f.entries, static_cast<std::size_t>(f.llt.cholmod().lnz));
+  } else if (supernodal_min_flops > 0 && f.flops > supernodal_min_flops) {
     f.llt.setMode(Eigen::CholmodSupernodalLLt);
     cholmod_common& cs = f.llt.cholmod();
     cs.nmethods = 1;
@@ -155,13 +194,7 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
     f.supernodal = true;
   }
   f.usable = max_factor_entries == 0 || f.entries <= max_factor_entries;
-  if (!f.usable) {  // what only the factor needs goes now, not with the preconditioner
-    f.A = SparseMatrix();
-    std::vector<double>().swap(f.q_blocks);
-    std::vector<Eigen::Index>().swap(f.block_row);
-    std::vector<Eigen::Index>().swap(f.block_start);
-    std::vector<Eigen::Index>().swap(f.diagonal_slot);
-  }
+  if (!f.usable) release_factor_inputs();
 }
 
 TangentPreconditioner::~TangentPreconditioner() = default;
@@ -188,6 +221,10 @@ double TangentPreconditioner::factor_flops() const {
 
 bool TangentPreconditioner::supernodal() const {
   return factor_->supernodal;
+}
+
+bool TangentPreconditioner::supernodal_factorization() const {
+  return factor_->convert;
 }
 
 int TangentPreconditioner::coordinates_per_pose() const {
@@ -253,7 +290,26 @@ bool TangentPreconditioner::factorize_impl(const Eigen::MatrixXd& X, const Eigen
     for (int c = 0; c < p; ++c)
       f.A.valuePtr()[f.value_offset(j, f.diagonal_slot[static_cast<std::size_t>(j)], c) + c] +=
           lambda;
-  f.llt.factorize(f.A);
+  if (f.convert) {
+    // A converted factor is simplicial: the supernodal analysis again (its cost is a small part
+    // of the factorization it enables).
+    if (!f.llt.factor()->is_super && !f.analyze_supernodal()) {
+      f.usable = false;
+      f.factored = false;
+      return false;
+    }
+    {
+      const SerialBlasLock lock(serial_blas_mutex());  // CHOLMOD's supernodal kernels call BLAS
+      f.llt.factorize(f.A);
+    }
+    if (f.llt.info() == Eigen::Success &&
+        !cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/0, /*to_super=*/0, /*to_packed=*/1,
+                               /*to_monotonic=*/1, f.llt.factor(), &f.llt.cholmod()))
+      throw_cholmod_failure("TangentPreconditioner", "factor conversion", f.llt.cholmod().status,
+                            f.A.rows(), f.A.cols());
+  } else {
+    f.llt.factorize(f.A);
+  }
   ++f.factorizations;
   f.calls_since_factor = 0;
   bool positive = f.llt.info() == Eigen::Success;

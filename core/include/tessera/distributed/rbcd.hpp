@@ -38,6 +38,13 @@ struct BlockUpdateOptions {
   int tangent_refresh_interval = 0;
   /// lambda of the tangent factor, relative to the largest diagonal entry of J^T 2Q_BB J (>= 0).
   double tangent_relative_shift = 1e-9;
+  /// Floating-point operations of the tangent factorization (CHOLMOD's symbolic prediction)
+  /// above which it is computed supernodally (BLAS kernels on its supernodes) and converted to
+  /// the simplicial LDL^T form for the solves (>= 0; 0 = always simplicial). Same operator up to
+  /// round-off. 1e7: the tangent set-up (analyses and factorization) of torus3D's, sphere2500's
+  /// and cubicle's blocks at N = 5 (1.2e7-1.5e8 flops) takes 41-65 % fewer instructions, while
+  /// city10000's 2D blocks (4e6-8e6 flops) would take 4 % more (docs/benchmarks/launch_phases.md).
+  double tangent_supernodal_min_flops = 1e7;
   /// First trust-region radius of an update preconditioned with the tangent factor, in units
   /// of the preconditioned gradient norm sqrt(<P g, g>) (> 0). That norm is the length of P's
   /// Newton step, so with the (nearly exact) tangent factor a radius of 1 stops tCG on the

@@ -40,10 +40,14 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   /// `supernodal_min_flops`: when CHOLMOD's analysis predicts a factorization of more
   /// floating-point operations, the factor is supernodal LL^T (dense BLAS kernels on its
   /// supernodes) instead of simplicial LDL^T; 0 = always simplicial (same operator up to
-  /// round-off).
+  /// round-off). `simplicial_solves`: such a factor is converted to the simplicial LDL^T form
+  /// after each factorization, so that its solves (a few right-hand sides each) avoid the
+  /// supernodal solve's BLAS calls on small supernodes, and grow() still applies; the factor
+  /// keeps the simplicial factor's fill-reducing ordering. Only the factorization's kernels
+  /// change (same operator up to round-off).
   explicit TangentPreconditioner(const BlockProblem& problem, double relative_shift = 1e-9,
                                  std::size_t max_factor_entries = 16'000'000,
-                                 double supernodal_min_flops = 0);
+                                 double supernodal_min_flops = 0, bool simplicial_solves = false);
   ~TangentPreconditioner() override;
   TangentPreconditioner(const TangentPreconditioner&) = delete;
   TangentPreconditioner& operator=(const TangentPreconditioner&) = delete;
@@ -95,6 +99,9 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   double factor_flops() const;
   /// True when the factor is supernodal (see supernodal_min_flops).
   bool supernodal() const;
+  /// True when the factorizations are supernodal and the factor is converted to the simplicial
+  /// form for the solves (supernodal_min_flops with simplicial_solves).
+  bool supernodal_factorization() const;
   /// Coordinates per pose, d(d+1)/2.
   int coordinates_per_pose() const;
 

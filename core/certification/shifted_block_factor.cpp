@@ -1,0 +1,96 @@
+#include "certification/shifted_block_factor.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <algorithm>
+#include <stdexcept>
+
+#include "solvers/cholmod_checked.hpp"
+#include "solvers/pose_level_analysis.hpp"
+#include "util/serial_blas.hpp"
+
+namespace tessera {
+
+ShiftedBlockFactor::ShiftedBlockFactor(const SparseMatrix& S, int width) {
+  cholmod_start(&c_);
+  c_.print = 0;  // a matrix that is not positive definite is an expected answer (a larger shift)
+  c_.supernodal = CHOLMOD_SUPERNODAL;
+  c_.final_ll = 1;
+  c_.nmethods = 1;
+  c_.method[0].ordering = CHOLMOD_GIVEN;
+  c_.postorder = 1;
+  const Eigen::Index n = S.rows();
+  const Eigen::Index m = width > 0 ? n / width : 0;
+  // Pose-level pattern (lower triangle with the diagonal) and its AMD ordering.
+  std::vector<Eigen::Triplet<double>> t;
+  for (Eigen::Index j = 0; j < m; ++j) t.emplace_back(j, j, 1.0);
+  for (Eigen::Index col = 0; col < S.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(S, col); it; ++it)
+      if (it.row() / width > col / width) t.emplace_back(it.row() / width, col / width, 1.0);
+  SparseMatrix B(m, m);
+  B.setFromTriplets(t.begin(), t.end());
+  const PoseLevelAnalysis a = analyse_pose_level_pattern(B, true);
+  std::vector<int> perm;
+  if (a.ok && a.order.size() == static_cast<std::size_t>(m)) {
+    perm.resize(static_cast<std::size_t>(n));
+    for (Eigen::Index k = 0; k < m; ++k)
+      for (int q = 0; q < width; ++q)
+        perm[static_cast<std::size_t>(k * width + q)] =
+            a.order[static_cast<std::size_t>(k)] * width + q;
+  } else {
+    c_.method[0].ordering = CHOLMOD_AMD;
+  }
+  cholmod_sparse view = Eigen::viewAsCholmod(S.selfadjointView<Eigen::Lower>());
+  L_ = cholmod_analyze_p(&view, perm.empty() ? nullptr : perm.data(), nullptr, 0, &c_);
+  if (!L_) {
+    const int status = c_.status;
+    cholmod_finish(&c_);
+    throw_cholmod_failure("certificate (block preconditioner)", "analysis", status,
+                          static_cast<long>(n), static_cast<long>(n));
+  }
+}
+
+ShiftedBlockFactor::~ShiftedBlockFactor() {
+  for (cholmod_dense** x : {&x_, &y_, &e_})
+    if (*x) cholmod_free_dense(x, &c_);
+  if (L_) cholmod_free_factor(&L_, &c_);
+  cholmod_finish(&c_);
+}
+
+bool ShiftedBlockFactor::factor(const SparseMatrix& S, double shift) {
+  if (!L_->is_super)
+    throw std::logic_error("ShiftedBlockFactor::factor: the matrix was factored already");
+  cholmod_sparse view = Eigen::viewAsCholmod(S.selfadjointView<Eigen::Lower>());
+  double beta[2] = {shift, 0.0};  // factors S + beta[0] I
+  {
+    const SerialBlasLock lock(serial_blas_mutex());  // CHOLMOD's supernodal kernels call BLAS
+    cholmod_factorize_p(&view, beta, nullptr, 0, L_, &c_);
+  }
+  if (c_.status < CHOLMOD_OK)
+    throw_cholmod_failure("certificate (block preconditioner)", "factorization", c_.status,
+                          static_cast<long>(S.rows()), static_cast<long>(S.cols()));
+  if (L_->minor < L_->n) return false;  // not positive definite: the caller shifts further
+  if (!cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/0, /*to_packed=*/1,
+                             /*to_monotonic=*/1, L_, &c_))
+    throw_cholmod_failure("certificate (block preconditioner)", "factor conversion", c_.status,
+                          static_cast<long>(S.rows()), static_cast<long>(S.cols()));
+  return true;
+}
+
+Eigen::MatrixXd ShiftedBlockFactor::solve(const Eigen::MatrixXd& r) {
+  Eigen::MatrixXd out(r.rows(), r.cols());
+  cholmod_dense b;
+  b.nrow = static_cast<std::size_t>(r.cols());
+  b.ncol = 1;
+  b.nzmax = b.nrow;
+  b.d = b.nrow;
+  b.x = const_cast<double*>(r.data());  // one row: its entries are contiguous
+  b.z = nullptr;
+  b.xtype = CHOLMOD_REAL;
+  b.dtype = CHOLMOD_DOUBLE;
+  if (r.rows() != 1 || !cholmod_solve2(CHOLMOD_A, L_, &b, nullptr, &x_, nullptr, &y_, &e_, &c_))
+    throw std::runtime_error("certificate (block preconditioner): solve failed");
+  std::copy_n(static_cast<const double*>(x_->x), r.cols(), out.data());
+  return out;
+}
+
+}  // namespace tessera
