@@ -1,0 +1,35 @@
+#pragma once
+// Names a Fast DDS 2.9 shared-memory defect when a wait of this process times out.
+//
+// Why: a shared-memory listener of Fast DDS 2.9.1 reads a message's buffer from the sender's data
+// segment (/dev/shm/fastrtps_<hex>), opened by name on the first message from that sender. If the
+// sender deleted its participant (which removes the segment) before the listener read that first
+// message, opening fails ("No such file or directory"), the message stays at the head of the
+// port's queue, and the listener retries it forever: the participant never receives anything on
+// that port again (and the listener thread spins). Fixed upstream after 2.9 (eProsima/Fast-DDS
+// pull 3992, "ignore non-existing segment on pop"). It takes a participant that is just starting
+// while another participant of the domain that has just discovered it is deleted: two runs on
+// one domain, one ending while the other starts (seen as `DdsRuntime.TwoConcurrentRunsOnOne
+// DomainDoNotMix` failing with "missing agent 0 (have agent 1)": that agent had discovered its
+// coordinator and announced, and 200,889 such receive errors filled its Fast DDS log in 20 s).
+//
+// What: from the first participant of the process on, Fast DDS's warnings go to a consumer
+// that counts these receive errors (and prints every warning and error as Fast DDS does when
+// TESSERA_DDS_LOG=1, errors only otherwise, as by default). A timed-out wait
+// (transport/run_failure.hpp) appends shm_receive_note() to its message.
+
+#include <cstdint>
+#include <string>
+
+namespace tessera::transport {
+
+/// Installs the counting consumer once per process (idempotent, thread safe).
+void watch_fastdds_log();
+
+/// Receive errors "No such file or directory" counted so far (0 before watch_fastdds_log()).
+std::uint64_t shm_receive_failures();
+
+/// "" when shm_receive_failures() is 0, else a sentence naming the defect and the count.
+std::string shm_receive_note();
+
+}  // namespace tessera::transport
