@@ -13,6 +13,11 @@
 // DomainDoNotMix` failing with "missing agent 0 (have agent 1)": that agent had discovered its
 // coordinator and announced, and 200,889 such receive errors filled its Fast DDS log in 20 s).
 //
+// Avoided where UDP is on: discovery goes over UDP (discover_over_udp, transport/qos.hpp), so a
+// deleted participant's last messages (discovery, to every participant of the domain) no longer
+// reach shared-memory ports; a run's own data reaches its peers long before anyone leaves.
+// Still possible with shared memory only (--transport shm, tessera launch's default).
+//
 // What: from the first participant of the process on, Fast DDS's warnings go to a consumer
 // that counts these receive errors (and prints every warning and error as Fast DDS does when
 // TESSERA_DDS_LOG=1, errors only otherwise, as by default). A timed-out wait
