@@ -9,9 +9,13 @@
 // that port again (and the listener thread spins). Fixed upstream after 2.9 (eProsima/Fast-DDS
 // pull 3992, "ignore non-existing segment on pop"). It takes a participant that is just starting
 // while another participant of the domain that has just discovered it is deleted: two runs on
-// one domain, one ending while the other starts (seen as `DdsRuntime.TwoConcurrentRunsOnOne
-// DomainDoNotMix` failing with "missing agent 0 (have agent 1)": that agent had discovered its
-// coordinator and announced, and 200,889 such receive errors filled its Fast DDS log in 20 s).
+// one domain, one ending while the other starts: `DdsRuntime.TwoConcurrentRunsOnOneDomainDoNot
+// Mix` failed with "missing agent 0 (have agent 1)", that agent having discovered its coordinator
+// and announced; the same two runs started by hand with TESSERA_DDS_LOG=1 failed the same way,
+// and the deaf agent's log held 200,889 such receive errors in 20 s.
+// `scripts/dds_staggered_runs.sh 118 30 0.2` (30 runs 0.2 s apart on one domain) reproduces it
+// on demand: with `EXTRA="--transport shm"` 16 of 30 runs failed (load 10-14), and each of the
+// 16 names the stuck listener.
 //
 // Avoided where UDP is on: discovery goes over UDP (discover_over_udp, transport/qos.hpp), so a
 // deleted participant's last messages (discovery, to every participant of the domain) no longer
