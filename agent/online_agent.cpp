@@ -27,6 +27,7 @@
 #include "agent/takeover_vote.hpp"
 #include "json_writer.hpp"
 #include "runtime/online_agent_view.hpp"
+#include "transport/fastdds/shm_receive_watch.hpp"
 #include "transport/fastdds/teardown_guard.hpp"
 #include "transport/graph_stream_topic.hpp"
 #include "transport/online_channel.hpp"
@@ -115,8 +116,10 @@ class OnlineAgent {
 };
 
 [[noreturn]] void OnlineAgent::silent_peer(const std::string& what) const {
+  const std::string stuck = transport::shm_receive_note();
   throw transport::TransportError("online agent " + std::to_string(o_.id) + ": " + what + " for " +
-                                  std::to_string(o_.timeout_s) + " s (--timeout)");
+                                  std::to_string(o_.timeout_s) + " s (--timeout)" +
+                                  (stuck.empty() ? std::string() : " (" + stuck + ")"));
 }
 
 void OnlineAgent::pump_stream() {

@@ -79,7 +79,9 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim,
                "--run-id", run, "--domain", std::to_string(domain), "--on-agent-loss", "continue",
                "--timeout", "60", "--lease", "3", "--verbose"},  // a failure shows its epochs
               dir + "/again.log");
-    ASSERT_TRUE(wait_all({&again}, 60)) << again.output();
+    // Longer than its --timeout: a restarted agent that hears nothing ends with its own error,
+    // which names a stuck shared-memory listener (transport/fastdds/shm_receive_watch.hpp).
+    ASSERT_TRUE(wait_all({&again}, 90)) << again.output();
     EXPECT_EQ(again.exit_code, 1) << again.output();
     EXPECT_TRUE(contains(again.output(), "counted as lost")) << again.output();
   }

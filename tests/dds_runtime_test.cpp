@@ -219,7 +219,15 @@ void two_concurrent_runs_on_one_domain(int domain, const std::vector<std::string
   std::vector<Process*> all;
   for (auto& p : procs) all.push_back(&p);
   ASSERT_TRUE(wait_all(all, 30));
-  for (Process* p : all) ASSERT_EQ(p->exit_code, 0) << p->output();
+  // Every process's log on failure: the failing coordinator names only whom it missed, the
+  // missed agent says what it waited for (and names a stuck shared-memory listener,
+  // transport/fastdds/shm_receive_watch.hpp).
+  bool all_ok = true;
+  for (Process* p : all) {
+    EXPECT_EQ(p->exit_code, 0) << p->log << ":\n" << p->output();
+    all_ok = all_ok && p->exit_code == 0;
+  }
+  ASSERT_TRUE(all_ok);
   EXPECT_EQ(vertices_of(dir + "/" + unique_run("runA") + ".g2o").size(), 25u);
   EXPECT_EQ(vertices_of(dir + "/" + unique_run("runB") + ".g2o").size(), 36u);
 }

@@ -9,6 +9,7 @@
 #include <fastdds/dds/log/Log.hpp>
 
 #include "transport/fastdds/discovery_port.hpp"
+#include "transport/fastdds/shm_receive_watch.hpp"
 #include "transport/fastdds/teardown_guard.hpp"
 
 namespace tessera::transport {
@@ -29,9 +30,9 @@ DdsEntities::DdsEntities(const SessionOptions& options, const NetworkProfile& ne
 void DdsEntities::open(int domain, const PeerIdentity& me,
                        const std::vector<std::pair<std::string, std::string>>& security,
                        const std::vector<std::uint8_t>& user_data, const GuidPrefix* prefix) {
-  // TESSERA_DDS_LOG=1 shows Fast DDS's own warnings and errors (for diagnosing QoS trouble).
-  if (const char* env = std::getenv("TESSERA_DDS_LOG"); env && *env && *env != '0')
-    eprosima::fastdds::dds::Log::SetVerbosity(eprosima::fastdds::dds::Log::Kind::Warning);
+  // TESSERA_DDS_LOG=1 shows Fast DDS's own warnings and errors (for diagnosing QoS trouble);
+  // the stuck shared-memory listener is counted either way (fastdds/shm_receive_watch.hpp).
+  watch_fastdds_log();
   participant_listener_ =
       std::make_unique<ParticipantDiscoveryListener>(peers_, opt_.run_id, room_, trace_, muted_);
   dds::DomainParticipantQos qos = participant_qos(

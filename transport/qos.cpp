@@ -42,6 +42,20 @@ std::uint32_t socket_buffer_bytes(const NetworkProfile& net, std::uint32_t num_a
 
 }  // namespace
 
+void discover_over_udp(dds::DomainParticipantQos& q) {
+  namespace rtps = eprosima::fastrtps::rtps;
+  rtps::Locator_t unicast;
+  unicast.kind = LOCATOR_KIND_UDPv4;
+  rtps::IPLocator::setIPv4(unicast, 0, 0, 0, 0);
+  unicast.port = 0;
+  q.wire_protocol().builtin.metatrafficUnicastLocatorList.push_back(unicast);
+  rtps::Locator_t multicast;
+  multicast.kind = LOCATOR_KIND_UDPv4;
+  rtps::IPLocator::setIPv4(multicast, "239.255.0.1");
+  multicast.port = 0;
+  q.wire_protocol().builtin.metatrafficMulticastLocatorList.push_back(multicast);
+}
+
 dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
     int domain, std::uint32_t num_agents, const NetworkProfile& net,
@@ -83,6 +97,7 @@ dds::DomainParticipantQos participant_qos(
     q.transport().send_socket_buffer_size = buffer;
     q.transport().listen_socket_buffer_size = buffer;
   }
+  if (shared_memory && udp) discover_over_udp(q);
   for (const auto& [key, value] : properties) q.properties().properties().emplace_back(key, value);
   for (const std::string& ip : initial_peers) {
     // Metatraffic unicast port of participant id p: 7400 + 250 * domain + 10 + 2 * p.

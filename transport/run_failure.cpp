@@ -3,6 +3,8 @@
 #include <csignal>
 #include <cstdio>
 
+#include "transport/fastdds/shm_receive_watch.hpp"
+
 namespace tessera::transport {
 
 void expect_ready(WaitStatus status, const Mailroom& room, double timeout_s,
@@ -15,7 +17,9 @@ void expect_ready(WaitStatus status, const Mailroom& room, double timeout_s,
   }
   char buf[64];
   std::snprintf(buf, sizeof(buf), "timed out after %g s waiting for ", timeout_s);
-  throw RunFailure(kExitRunFailed, buf + what + (detail.empty() ? std::string() : ": " + detail));
+  const std::string stuck = shm_receive_note();
+  throw RunFailure(kExitRunFailed, buf + what + (detail.empty() ? std::string() : ": " + detail) +
+                                       (stuck.empty() ? std::string() : " (" + stuck + ")"));
 }
 
 std::string signal_name(int signo) {

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Starts RUNS short DDS runs (tessera-coordinator + 2 agents on a 36-pose 2D city graph) on one domain,
+# each STEP seconds after the previous one, so that runs end while others start, and counts the
+# runs that failed and the processes whose error names a stuck Fast DDS shared-memory listener
+# (transport/fastdds/shm_receive_watch.hpp). Not a test: a stress for that Fast DDS 2.9 defect.
+# Usage: scripts/dds_staggered_runs.sh [DOMAIN=118] [RUNS=40] [STEP=0.15] [BIN=build/bin]
+# Extra session flags in EXTRA (e.g. EXTRA="--transport udp"). Logs stay in the printed dir.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+DOMAIN="${1:-118}"
+RUNS="${2:-40}"
+STEP="${3:-0.15}"
+BIN="$(cd "${4:-build/bin}" && pwd)"
+EXTRA="${EXTRA:-}"
+DIR="$(mktemp -d /tmp/tessera_staggered_XXXXXX)"
+"$BIN/tessera" generate --kind city --poses 36 --robots 2 --out "$DIR/g.g2o" >/dev/null
+# --lease 5: a loaded host must not turn a slow process into a lost one (another failure).
+SESSION="--domain $DOMAIN --timeout 15 --lease 5 $EXTRA"
+for i in $(seq 1 "$RUNS"); do
+  (
+    run="staggered$i-$$"
+    # shellcheck disable=SC2086
+    "$BIN/tessera-coordinator" --agents 2 --run-id "$run" $SESSION --output "$DIR/$i.g2o" \
+      >"$DIR/$i-coordinator.log" 2>&1 &
+    pids=($!)
+    for k in 0 1; do
+      # shellcheck disable=SC2086
+      "$BIN/tessera-agent" --graph "$DIR/g.g2o" --robots 2 --id "$k" --run-id "$run" $SESSION \
+        >"$DIR/$i-agent$k.log" 2>&1 &
+      pids+=($!)
+    done
+    rc=0
+    for p in "${pids[@]}"; do wait "$p" || rc=1; done
+    echo "$i $rc" >>"$DIR/rc.txt"
+  ) &
+  sleep "$STEP"
+done
+wait
+failed=$(awk '$2 != 0' "$DIR/rc.txt" | wc -l)
+stuck=$(grep -l "Fast DDS shared memory: a listener" "$DIR"/*.log 2>/dev/null | wc -l)
+echo "runs $RUNS, step $STEP s, domain $DOMAIN: $failed failed; $stuck processes name a stuck" \
+  "shared-memory listener; logs in $DIR"
