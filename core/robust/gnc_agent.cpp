@@ -325,7 +325,10 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
   gnc_kept_measurements(in_.measurements, in_.measurement_index, rejected_, kept_, kept_index_);
   solve_without(rejected_);
   solve_kind_ = GncSolveKind::kInlierPass;
-  pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;
+  // A pass that hands over to the refinement is solved to the tolerance even while its set may
+  // still change: from the last iterate that costs fewer message steps than the capped rounds.
+  pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_ &&
+                 !pass_refines(options_, *layout_, in_.d);
   full_pass_next_ = false;
   pass_from_solved_ = last_pass_full_;
   last_pass_full_ = false;
