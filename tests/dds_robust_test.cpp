@@ -399,6 +399,10 @@ TEST(DdsRobust, PassRefineOverDdsEqualsTheInProcessEngine) {
   o.robust.mu_step_max = 4;
   const GncDistributedResult ref = solve_gnc_distributed(g, dds.assignment, o);
   ASSERT_GT(ref.refine_message_steps, 0) << "the passes should hand over to the refinement";
+  GncDistributedOptions fixed = o;
+  fixed.robust.mu_step_max = 0;
+  ASSERT_LT(ref.outer_iterations, solve_gnc_distributed(g, dds.assignment, fixed).outer_iterations)
+      << "the adaptive steps should shorten the schedule (15 against 24 outer steps)";
   EXPECT_EQ(json_field(dds.summary, "gnc_refine_steps"), ref.refine_message_steps) << dds.summary;
   EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
   EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
