@@ -80,6 +80,8 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
     ro.robust.recheck_probes = static_cast<int>(asg.gnc_recheck_probes());
     ro.robust.probe_ratio = asg.gnc_probe_ratio();
     ro.robust.final_refine = asg.gnc_final_refine();
+    ro.robust.refine_passes = asg.gnc_pass_refine();
+    ro.robust.mu_step_max = asg.gnc_mu_step_max();
     ro.robust.validate();
     ro.gnc_known_start = asg.gnc_known_start();
     ro.gnc_cluster_probes = static_cast<int>(asg.gnc_cluster_probes());

@@ -4,11 +4,22 @@
 
 namespace tessera::cli {
 
-const char* const kRobustValued[] = {"robust",          "inlier-threshold", "inlier-quantile",
-                                     "gnc-max-outer",   "gnc-mu-step",      "gnc-inner-rounds",
-                                     "known-inliers",   "rejected",         "gnc-inner-iterations",
-                                     "gnc-probes",      "gnc-probe-ratio",  "gnc-final-refine",
-                                     "gnc-swap-probes", "gnc-pass-refine",  nullptr};
+const char* const kRobustValued[] = {"robust",
+                                     "inlier-threshold",
+                                     "inlier-quantile",
+                                     "gnc-max-outer",
+                                     "gnc-mu-step",
+                                     "gnc-inner-rounds",
+                                     "known-inliers",
+                                     "rejected",
+                                     "gnc-inner-iterations",
+                                     "gnc-probes",
+                                     "gnc-probe-ratio",
+                                     "gnc-final-refine",
+                                     "gnc-swap-probes",
+                                     "gnc-pass-refine",
+                                     "gnc-mu-step-max",
+                                     nullptr};
 
 const char* const kRobustHelp =
     "\n"
@@ -30,6 +41,9 @@ const char* const kRobustHelp =
     "                            1 - 1e-4/m for m rejectable edges (union bound) [0]\n"
     "  --gnc-max-outer K         most outer steps, >= 1 [100]\n"
     "  --gnc-mu-step S           mu grows by S per outer step, > 1 [1.4]\n"
+    "  --gnc-mu-step-max S       distributed: after an outer step that moved no weight across\n"
+    "                            1/2, the next step is the last one squared, up to S; 0 = off,\n"
+    "                            else >= --gnc-mu-step [0]\n"
     "  --gnc-inner-rounds K      distributed: most rounds of each solve before the final\n"
     "                            one (first and weighted), 0 = no cap [5]\n"
     "  --gnc-inner-iterations K  centralized: most trust-region iterations of each solve\n"
@@ -75,6 +89,7 @@ RobustOptions parse_robust_options(const Arguments& args) {
   o.inlier_quantile = args.get_double("inlier-quantile", o.inlier_quantile);
   o.max_outer_iterations = static_cast<int>(args.get_long("gnc-max-outer", o.max_outer_iterations));
   o.mu_step = args.get_double("gnc-mu-step", o.mu_step);
+  o.mu_step_max = args.get_double("gnc-mu-step-max", o.mu_step_max);
   o.inner_max_rounds = static_cast<int>(args.get_long("gnc-inner-rounds", o.inner_max_rounds));
   o.inner_max_iterations =
       static_cast<int>(args.get_long("gnc-inner-iterations", o.inner_max_iterations));
@@ -96,6 +111,7 @@ RobustOptions parse_robust_options(const Arguments& args) {
     const char* flag = what.find("inlier_threshold") != std::string::npos   ? "--inlier-threshold"
                        : what.find("inlier_quantile") != std::string::npos  ? "--inlier-quantile"
                        : what.find("max_outer") != std::string::npos        ? "--gnc-max-outer"
+                       : what.find("mu_step_max") != std::string::npos      ? "--gnc-mu-step-max"
                        : what.find("mu_step") != std::string::npos          ? "--gnc-mu-step"
                        : what.find("inner_max_rounds") != std::string::npos ? "--gnc-inner-rounds"
                        : what.find("inner_max_iterations") != std::string::npos
@@ -121,6 +137,7 @@ void add_robust_fields(JsonObject& json, const RobustSummary& s) {
       .add("inlier_threshold_squared", s.threshold_squared)
       .add("known_inliers", known_inliers_name(s.options.known_inliers))
       .add("gnc_mu_step", s.options.mu_step)
+      .add("gnc_mu_step_max", s.options.mu_step_max)
       .add("weights_converged", s.weights_converged)
       .add("readmitted", s.readmitted)
       .add("probes", s.probes)

@@ -54,6 +54,8 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
     asg.gnc_probe_ratio(r.probe_ratio);
     asg.gnc_final_refine(r.final_refine);
     asg.gnc_cluster_probes(options.gnc_cluster_probes);
+    asg.gnc_pass_refine(r.refine_passes);
+    asg.gnc_mu_step_max(r.mu_step_max);
     asg.known_inlier(structure.known_inlier);
   }
   return asg;

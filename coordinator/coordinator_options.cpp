@@ -89,7 +89,8 @@ options:
                        lower pose ids (docs/robust.md) (default none)
   --inlier-threshold C, --inlier-quantile P, --gnc-max-outer K, --gnc-mu-step S,
   --gnc-inner-rounds K, --known-inliers odometry|none, --gnc-probes K,
-  --gnc-probe-ratio R, --gnc-final-refine newton|none, --gnc-cluster-probes K
+  --gnc-probe-ratio R, --gnc-final-refine newton|none, --gnc-cluster-probes K,
+  --gnc-pass-refine auto|none, --gnc-mu-step-max S
                        the GNC options, as for `tessera solve` (docs/robust.md)
   --rejected FILE      write the rejected measurement indices (from 0 over the EDGE lines)
   --gnc-solver-start   GNC starts from --init's poses, not from the known inliers'

@@ -79,10 +79,11 @@ bool RoundReports::on_report(const wire::RoundStatus& m) {
     r.threshold_squared = m.block_grad_norm();
     r.weights_converged = m.done_vote();
     r.rejected.assign(m.measurement_ids().begin(), m.measurement_ids().end());
-    if (m.coarse().size() == 2) {  // the probes: run, kept
+    if (m.coarse().size() >= 2) {  // the probes: run, kept
       r.probes = static_cast<int>(m.coarse()[0]);
       r.probes_kept = static_cast<int>(m.coarse()[1]);
     }
+    if (m.coarse().size() >= 3) r.refine_steps = static_cast<int>(m.coarse()[2]);
     results_.robust = std::move(r);
     return true;
   }

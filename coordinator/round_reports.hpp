@@ -49,6 +49,7 @@ struct RobustReport {
   double threshold_squared = 0;
   bool weights_converged = false;
   int probes = 0, probes_kept = 0;    ///< RobustOptions::recheck_probes: run, and kept.
+  int refine_steps = 0;               ///< Message steps of the refinements before the final solve.
   std::vector<std::size_t> rejected;  ///< Measurement indices in file order, ascending.
 };
 

@@ -150,7 +150,8 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     rs.probes = r.robust->probes;
     rs.probes_kept = r.robust->probes_kept;
     cli::add_robust_fields(j, rs);
-    j.add("total_rounds", static_cast<long long>(in.merged.rounds));
+    j.add("total_rounds", static_cast<long long>(in.merged.rounds))
+        .add("gnc_refine_steps", static_cast<long long>(r.robust->refine_steps));
   } else {
     j.add("robust", robust_kind_name(o.robust.kind));
   }

@@ -165,6 +165,9 @@ void check_gnc_max_outer(const std::string& v) {
 void check_gnc_mu_step(const std::string& v) {
   check_robust_field(v, "gnc-mu-step", [](RobustOptions& o, double x) { o.mu_step = x; });
 }
+void check_gnc_mu_step_max(const std::string& v) {
+  check_robust_field(v, "gnc-mu-step-max", [](RobustOptions& o, double x) { o.mu_step_max = x; });
+}
 void check_gnc_inner_rounds(const std::string& v) {
   check_robust_field(v, "gnc-inner-rounds", [](RobustOptions& o, double x) {
     o.inner_max_rounds = x == static_cast<int>(x) ? static_cast<int>(x) : -1;
@@ -183,6 +186,10 @@ void check_gnc_cluster_probes(const std::string& v) {
   if (!(x >= 0 && x == static_cast<double>(static_cast<long>(x)) && x <= 4294967295.0))
     throw InputError("option --gnc-cluster-probes: GncDistributedOptions.cluster_probes = " + v +
                      ": must be an integer >= 0 (0 = none)");
+}
+void check_gnc_pass_refine(const std::string& v) {
+  if (v != "auto" && v != "none")
+    throw InputError("option --gnc-pass-refine: '" + v + "' is not one of auto, none");
 }
 void check_gnc_final_refine(const std::string& v) {
   if (v != "newton" && v != "none")
@@ -235,6 +242,11 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "most GNC outer steps, >= 1                           [100]", check_gnc_max_outer},
       {"gnc-mu-step", "gnc-mu-step", true, ForwardTo::kCoordinator, "--gnc-mu-step S",
        "mu grows by S per outer step, > 1                    [1.4]", check_gnc_mu_step},
+      {"gnc-mu-step-max", "gnc-mu-step-max", true, ForwardTo::kCoordinator, "--gnc-mu-step-max S",
+       "after an outer step that moved no weight across 1/2\n"
+       "the next step is the last one squared, up to S; 0 =\n"
+       "off, else >= --gnc-mu-step                          [0]",
+       check_gnc_mu_step_max},
       {"gnc-inner-rounds", "gnc-inner-rounds", true, ForwardTo::kCoordinator,
        "--gnc-inner-rounds K",
        "most rounds of each solve before the final one, 0 = no\n"
@@ -257,6 +269,12 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "the final solve of the kept set ends with Newton\n"
        "refinement to --refine-grad-tol                 [newton]",
        check_gnc_final_refine},
+      {"gnc-pass-refine", "gnc-pass-refine", true, ForwardTo::kCoordinator,
+       "--gnc-pass-refine auto|none",
+       "with --refine auto: the inlier passes solved to the\n"
+       "tolerance hand over to Newton refinement where the\n"
+       "team's interface fits the interface solves        [none]",
+       check_gnc_pass_refine},
       {"known-inliers", "known-inliers", true, ForwardTo::kCoordinator,
        "--known-inliers odometry|none", "never reject edges between consecutive ids [odometry]",
        check_known_inliers},

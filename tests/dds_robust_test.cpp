@@ -386,5 +386,32 @@ TEST(DdsRobust, ClusterProbesOverDdsEqualTheInProcessEngine) {
   EXPECT_NE(summary.find("\"certified\": true"), std::string::npos) << summary;
 }
 
+// --gnc-pass-refine auto and --gnc-mu-step-max reach the agent processes through the
+// assignment: the inlier passes end with the Newton refinement and mu takes the adaptive steps
+// over DDS as in process, with the same outer steps, rounds, refinement message steps, rejected
+// set and cost.
+TEST(DdsRobust, PassRefineOverDdsEqualsTheInProcessEngine) {
+  const RobustRun dds =
+      robust_dds_run(188, {"--gnc-pass-refine", "auto", "--gnc-mu-step-max", "4"});
+  const PoseGraph g = read_g2o(dds.graph);
+  GncDistributedOptions o = in_process_options();
+  o.robust.refine_passes = true;
+  o.robust.mu_step_max = 4;
+  const GncDistributedResult ref = solve_gnc_distributed(g, dds.assignment, o);
+  ASSERT_GT(ref.refine_message_steps, 0) << "the passes should hand over to the refinement";
+  GncDistributedOptions fixed = o;
+  fixed.robust.mu_step_max = 0;
+  ASSERT_LT(ref.outer_iterations, solve_gnc_distributed(g, dds.assignment, fixed).outer_iterations)
+      << "the adaptive steps should shorten the schedule (15 against 24 outer steps)";
+  EXPECT_EQ(json_field(dds.summary, "gnc_refine_steps"), ref.refine_message_steps) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
+  EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
+  EXPECT_EQ(ref.rejected, dds.labels);
+  EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost)
+      << dds.summary;
+  EXPECT_NE(dds.summary.find("\"certified\": true"), std::string::npos) << dds.summary;
+}
+
 }  // namespace
 }  // namespace tessera::test::dds

@@ -93,7 +93,8 @@ TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
   const std::map<std::string, std::string> value = {
       {"robust", "gnc-tls"},      {"known-inliers", "odometry"}, {"gnc-mu-step", "1.4"},
       {"inlier-quantile", "0.5"}, {"refine", "newton"},          {"coarse-space", "smoothed"},
-      {"gnc-probe-ratio", "5"},   {"gnc-final-refine", "none"}};
+      {"gnc-probe-ratio", "5"},   {"gnc-final-refine", "none"},  {"gnc-pass-refine", "auto"},
+      {"gnc-mu-step-max", "2"}};
   for (const ForwardedFlag& f : forwarded_flags()) {
     EXPECT_NE(help.find(std::string("--") + f.name), std::string::npos) << f.name;
     Argv argv = {std::string("--") + f.name};
@@ -220,6 +221,15 @@ TEST(LaunchOptions, ClusterProbesReachTheCoordinatorAndABadCountNamesTheFlag) {
     const std::string e = error_of({"--gnc-cluster-probes", bad});
     EXPECT_NE(e.find("--gnc-cluster-probes"), std::string::npos) << bad << ": " << e;
   }
+}
+
+TEST(LaunchOptions, PassRefineReachesTheCoordinatorAndABadValueNamesTheFlag) {
+  LaunchOptions o = parse_launch_options({"--robust", "gnc-tls", "--gnc-pass-refine", "auto"});
+  o.graph = "/data/graph.g2o";
+  EXPECT_TRUE(has_pair(coordinator_argv(o, paths()), "--gnc-pass-refine", "auto"));
+  EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--gnc-pass-refine"));
+  const std::string e = error_of({"--gnc-pass-refine", "newton"});
+  EXPECT_NE(e.find("--gnc-pass-refine"), std::string::npos) << e;
 }
 
 }  // namespace

@@ -76,11 +76,16 @@ int GncAgent::total_rounds() const {
   return gnc_rounds_ + final_rounds_;
 }
 
-void GncAgent::weights_at_mu(double mu) {
+int GncAgent::weights_at_mu(double mu) {
+  int crossed = 0;
   for (std::size_t k : terms_->owned())
-    if (terms_->may_reject(k) && !dropped_[k])
-      weights_[k] = tls_weight(terms_->residual_squared(k, state_->Y, exchange_->neighbours()),
-                               terms_->c2(), mu);
+    if (terms_->may_reject(k) && !dropped_[k]) {
+      const double w = tls_weight(terms_->residual_squared(k, state_->Y, exchange_->neighbours()),
+                                  terms_->c2(), mu);
+      if ((w >= 0.5) != (weights_[k] >= 0.5)) ++crossed;
+      weights_[k] = w;
+    }
+  return crossed;
 }
 
 std::vector<OutgoingMessage> GncAgent::start() {
@@ -249,15 +254,15 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       to_others(vote_message(exchange_->own_vote()));
       break;
     case Step::kWeights: {
-      weights_at_mu(mu_);
+      const int crossed = weights_at_mu(mu_);
       const double spread = weight_spread(*terms_, weights_);
-      exchange_->own_vote() = {spread, 0};
+      exchange_->own_vote() = {spread, crossed};
       zero_cut_ =
           zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
       const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
       from = as_ints(others);
       for (std::uint32_t a : others) {
-        RoundStatusMessage st = weights_message(a, spread, in_, *terms_, weights_);
+        RoundStatusMessage st = weights_message(a, spread, crossed, in_, *terms_, weights_);
         st.phase = phase;
         st.sender = me;
         out.push_back(OutgoingMessage{std::move(st), false, {a}});
@@ -320,7 +325,10 @@ void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
   gnc_kept_measurements(in_.measurements, in_.measurement_index, rejected_, kept_, kept_index_);
   solve_without(rejected_);
   solve_kind_ = GncSolveKind::kInlierPass;
-  pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_;
+  // A pass that hands over to the refinement is solved to the tolerance even while its set may
+  // still change: from the last iterate that costs fewer message steps than the capped rounds.
+  pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_ &&
+                 !pass_refines(options_, *layout_, in_.d);
   full_pass_next_ = false;
   pass_from_solved_ = last_pass_full_;
   last_pass_full_ = false;
@@ -507,16 +515,21 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     case Step::kVotes: {
       voted_ = true;
       mu_ = gnc_initial_mu(exchange_->largest_vote(), terms_->c2());
+      mu_factor_ = options_.robust.mu_step;
       converged_ = mu_ == 0;
       begin_exchange(converged_ ? Step::kRejected : Step::kWeights, out);
       return;
     }
     case Step::kWeights: {
-      const double spread = exchange_->summed_votes().first;
+      const auto [spread, crossed] = exchange_->summed_votes();
       ++outer_;
       if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
       converged_ = spread <= options_.robust.weight_tolerance;
-      mu_ *= options_.robust.mu_step;
+      // RobustOptions::mu_step_max: a bigger step while the inlier set stays as it was.
+      const double step_max = options_.robust.mu_step_max;
+      mu_factor_ = step_max > 0 && crossed == 0 ? std::min(mu_factor_ * mu_factor_, step_max)
+                                                : options_.robust.mu_step;
+      mu_ *= mu_factor_;
       if (terms_->known_connected()) {
         // This step's block layout: without the cut measurements of weight 0 (every agent's).
         std::sort(zero_cut_.begin(), zero_cut_.end());

@@ -104,7 +104,7 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
       break;
     case GncExchange::kWeights: {
       const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
-      votes_[sender] = {st.grad_norm_sq, 0};
+      votes_[sender] = {st.grad_norm_sq, st.cost};
       read_weights_message(st, sender, in_, to.weights, to.zero_cut);
       break;
     }

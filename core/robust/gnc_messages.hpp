@@ -41,9 +41,12 @@ inline std::pair<double, double> read_vote(const RoundStatusMessage& st) {
 
 /// The weights message for agent `to`: the weights of the cut measurements this agent weighs
 /// whose other end `to` holds, then (with weight 0) its other cut measurements that leave the
-/// solve (for `to`'s block layout), and the weight spread (grad_norm_sq, the stop vote).
-RoundStatusMessage weights_message(std::uint32_t to, double spread, const GncAgentInput& in,
-                                   const GncLocalTerms& terms, const std::vector<double>& weights);
+/// solve (for `to`'s block layout), the weight spread (grad_norm_sq, the stop vote) and the
+/// count of this agent's measurements whose weight crossed 1/2 in this update (cost, the
+/// adaptive mu schedule's vote, RobustOptions::mu_step_max).
+RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed,
+                                   const GncAgentInput& in, const GncLocalTerms& terms,
+                                   const std::vector<double>& weights);
 
 /// Checks `st` from `sender` (ids and weights match; every id is the sender's to weigh) and
 /// applies it: the weights of this agent's measurements, every id of weight 0 to `zero_cut`.

@@ -4,6 +4,8 @@
 #include <limits>
 #include <tessera/robust/weighted_graph.hpp>
 
+#include "distributed/interface_solve.hpp"
+
 namespace tessera {
 
 DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSolveKind kind,
@@ -40,6 +42,18 @@ DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSo
       break;
   }
   return o;
+}
+
+bool pass_refines(const GncDistributedOptions& options, const BlockLayout& layout, int d) {
+  if (!options.robust.refine_passes) return false;
+  const NewtonRefineOptions& r =
+      gnc_solve_options(options, GncSolveKind::kInlierPass, false).refine;
+  if (!r.enabled || r.when != NewtonRefineOptions::When::kIfRoundsSlow ||
+      !(r.auto_interface_grad_tol > 0) || r.interface_max_coordinates <= 0 ||
+      r.coarse != NewtonRefineOptions::Coarse::kNone || layout.num_blocks <= 1)
+    return false;
+  const Eigen::Index size = interface_tangent_coordinates(layout, d);
+  return size > 0 && size <= r.interface_max_coordinates;
 }
 
 std::vector<Measurement> gnc_solve_measurements(const std::vector<Measurement>& measurements,

@@ -56,6 +56,8 @@ void RobustOptions::validate() const {
               "must be >= 0 (0 = no cap)");
   if (!(std::isfinite(mu_step) && mu_step > 1))
     bad_field("mu_step", number_text(mu_step), "must be > 1");
+  if (!(std::isfinite(mu_step_max) && (mu_step_max == 0 || mu_step_max >= mu_step)))
+    bad_field("mu_step_max", number_text(mu_step_max), "must be 0 (off) or >= mu_step");
   if (recheck_max_rounds < 0)
     bad_field("recheck_max_rounds", std::to_string(recheck_max_rounds),
               "must be >= 0 (0 = no cap)");

@@ -82,6 +82,7 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   report.weights_converged = agent.weights_converged();
   report.probes = agent.probes();
   report.probes_kept = agent.probes_kept();
+  report.refine_steps = agent.gnc_refine_steps();
   res.robust = std::move(report);
 
   // The rounding sees the kept measurements (the cost is over them).

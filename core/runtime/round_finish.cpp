@@ -64,7 +64,8 @@ RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout&
     r.done_vote = res.robust->weights_converged;
     r.measurement_ids = res.robust->rejected;
     r.coarse = {static_cast<double>(res.robust->probes),
-                static_cast<double>(res.robust->probes_kept)};
+                static_cast<double>(res.robust->probes_kept),
+                static_cast<double>(res.robust->refine_steps)};
     send(r);
   }
   if (local.agent_id == 0) {

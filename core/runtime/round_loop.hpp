@@ -154,6 +154,9 @@ struct RobustRunReport {
   double threshold_squared = 0;
   bool weights_converged = false;
   int probes = 0, probes_kept = 0;  ///< RobustOptions::recheck_probes: run, and kept.
+  /// Message steps of the Newton refinements before the final solve
+  /// (GncDistributedResult::refine_message_steps).
+  int refine_steps = 0;
 };
 
 struct RoundLoopResult {
@@ -206,7 +209,7 @@ constexpr std::uint32_t kCertificateBytesPhase = 202;
 /// Agent 0's robust report (RunOptions::robust), before the final report: cost = outer
 /// iterations, grad_norm_sq = re-admitted measurements, block_grad_norm = c^2, done_vote =
 /// weights converged, measurement_ids = the rejected measurements, coarse = {probes run,
-/// probes kept}.
+/// probes kept, message steps of the refinements before the final solve}.
 constexpr std::uint32_t kRobustReportPhase = 203;
 /// And, before the final report in every run, its own times: cost = solve_s (core's protocol:
 /// rounds, and certificate and escapes when certified), grad_norm_sq = rounding_s (seconds), so

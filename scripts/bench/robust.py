@@ -681,6 +681,9 @@ def main():
     ap.add_argument("--dds", action="store_true", help="--clean-all: also `tessera launch` (over DDS)")
     ap.add_argument("--dds-only", action="store_true", help="--clean-all: only `tessera launch`")
     ap.add_argument("--domain", type=int, default=70, help="--clean-all --dds: DDS domain id")
+    ap.add_argument("--dist-extra", default="",
+                    help="more options for the distributed robust solve (e.g. --gnc-pass-refine auto); "
+                         "the clean distributed run keeps its own")
     ap.add_argument("--clean-extra", default="", help="--clean-all: more options for every run (e.g. --grad-tol 1e-4)")
     args = ap.parse_args()
     os.makedirs(args.out_dir, exist_ok=True)
@@ -774,7 +777,8 @@ def main():
                             ", ".join(f"{k} {v:.1f}" for k, v in why["tls_clean_parts"].items()))
                 if args.distributed:
                     drob, drob_tum, dwall, derr = solve(args.bin, path, work, tag + "_drobust",
-                                                        ["--robust", "gnc-tls"] + cluster_flags, args.timeout,
+                                                        ["--robust", "gnc-tls"] + cluster_flags +
+                                                        args.dist_extra.split(), args.timeout,
                                                         "irbcd")
                     if drob is None:
                         row["note"] = (row.get("note", "") + " distributed: " + derr).strip()

@@ -230,7 +230,7 @@ class GncAgent : public AgentProcess {
   void pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) const;
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
-  void weights_at_mu(double mu);
+  int weights_at_mu(double mu);         // the count of owned weights that crossed 1/2
   void require_kept_connected() const;  // throws InputError naming the parts left
   std::vector<std::pair<std::uint32_t, std::uint32_t>> solve_structure() const;
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
@@ -279,6 +279,7 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<GncMailbox> mail_;           // where incoming messages go
   std::unique_ptr<GncExchangeBook> exchange_;  // the exchanges' messages and state
   double mu_ = 0;
+  double mu_factor_ = 1;  // the last step of mu (RobustOptions::mu_step_max)
   int outer_ = 0;
   bool converged_ = false;
   std::vector<std::uint64_t> rejected_;

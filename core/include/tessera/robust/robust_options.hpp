@@ -50,6 +50,11 @@ struct RobustOptions {
   int max_outer_iterations = 100;
   /// mu grows by this factor each outer step, > 1. 1.4 is the paper's value.
   double mu_step = 1.4;
+  /// Adaptive mu schedule, distributed solvers only: after a weight update that moved no
+  /// measurement across weight 1/2 (summed over the agents: the inlier set is unchanged) the
+  /// next step is the last one squared, up to this factor; any change returns it to mu_step.
+  /// 0 (default) = off, every step mu_step; otherwise >= mu_step.
+  double mu_step_max = 0.0;
   /// Distributed solvers only: most rounds of every solve before the final one (the first,
   /// unweighted solve and each weighted solve between two weight updates), >= 0, 0 = no cap.
   /// GNC needs only a rough minimiser between weight updates (dpgo's robust mode also updates
