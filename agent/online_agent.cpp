@@ -468,10 +468,12 @@ bool OnlineAgent::epoch_step() {
     ++fig_.solves;
   }
   const double step_end = since(start_);
-  fig_.cpu_s += cpu_now() - cpu_start;
+  const double step_cpu = cpu_now() - cpu_start;
+  fig_.cpu_s += step_cpu;
   fig_.rounds += s.rounds;
   const GraphStream& g = *view_.stream();
-  const double oldest = arrivals_.absorbed(g, step_end, step_start, fig_.batch_latency_s);
+  const double oldest = arrivals_.absorbed(g, step_end, step_start, fig_.batch_latency_s, step_cpu,
+                                           &fig_.batch_latency_cpu_s);
   cli::JsonObject u;
   u.add("epoch", static_cast<long long>(epoch_))
       .add("time_s", step_start)
@@ -486,6 +488,8 @@ bool OnlineAgent::epoch_step() {
       .add("rounds", s.rounds)
       .add("ms", 1000.0 * (step_end - step_start))
       .add("latency_s", step_end - oldest)
+      .add("cpu_s", step_cpu)
+      .add("latency_cpu_s", step_start - oldest + step_cpu)
       .add("grad_norm", s.grad_norm)
       .add("stop_reason", s.stop_reason);
   fig_.updates.push_back(std::move(u));

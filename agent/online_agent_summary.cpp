@@ -35,6 +35,8 @@ std::string online_summary_json(const OnlineAgentOptions& o, const OnlineSummary
       .add("wall_s", state.wall_s)
       .add("latency_median_s", percentile(f.batch_latency_s, 0.5))
       .add("latency_p95_s", percentile(f.batch_latency_s, 0.95))
+      .add("latency_cpu_median_s", percentile(f.batch_latency_cpu_s, 0.5))
+      .add("latency_cpu_p95_s", percentile(f.batch_latency_cpu_s, 0.95))
       .add("certified", final_solve.certified)
       .add("min_eigenvalue", final_solve.min_eigenvalue)
       .add("grad_norm", final_solve.grad_norm);

@@ -21,6 +21,8 @@ struct OnlineFigures {
   std::vector<cli::JsonObject> certificates;  ///< One per certificate of the growing graph.
   std::vector<cli::JsonObject> faults;        ///< One per take-over of lost agents.
   std::vector<double> batch_latency_s;        ///< Arrival to solved, per batch.
+  /// The same with the solve's CPU time in place of its wall time (BatchArrivals::absorbed).
+  std::vector<double> batch_latency_cpu_s;
   std::uint64_t bytes_sent = 0, messages_sent = 0, report_bytes = 0;
   std::uint64_t idle_waits = 0;
   int rounds = 0, solves = 0;

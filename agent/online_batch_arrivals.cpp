@@ -10,11 +10,13 @@ void BatchArrivals::arrived(std::uint32_t robot, std::uint64_t sequence, double 
 }
 
 double BatchArrivals::absorbed(const GraphStream& graph, double solved_at_s, double step_start_s,
-                               std::vector<double>& latencies) {
+                               std::vector<double>& latencies, double step_cpu_s,
+                               std::vector<double>* cpu_latencies) {
   double oldest = step_start_s;
   for (const auto& [key, t] : arrived_at_)
     if (key.second < graph.absorbed_batches(key.first)) {
       latencies.push_back(solved_at_s - t);
+      if (cpu_latencies) cpu_latencies->push_back(std::max(0.0, step_start_s - t) + step_cpu_s);
       oldest = std::min(oldest, t);
     }
   for (auto it = arrived_at_.begin(); it != arrived_at_.end();)

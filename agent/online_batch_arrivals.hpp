@@ -20,8 +20,12 @@ class BatchArrivals {
   /// Appends to `latencies` the latency of every batch `graph` absorbed, for a solve that ended
   /// at `solved_at_s`, and forgets those batches. Returns the arrival of the oldest of them, or
   /// `step_start_s` when that is earlier.
+  /// With `cpu_latencies`, also appends each batch's latency with the solve's CPU time
+  /// `step_cpu_s` in place of its wall time (its wait until `step_start_s` plus `step_cpu_s`:
+  /// what the latency would be with this agent alone on its core).
   double absorbed(const GraphStream& graph, double solved_at_s, double step_start_s,
-                  std::vector<double>& latencies);
+                  std::vector<double>& latencies, double step_cpu_s = 0.0,
+                  std::vector<double>* cpu_latencies = nullptr);
 
  private:
   std::map<std::pair<std::uint32_t, std::uint64_t>, double> arrived_at_;

@@ -135,6 +135,8 @@ JsonObject update_json(const OnlineUpdate& u) {
       .add("newton_cg_iterations", u.newton_cg_iterations)
       .add("newton_message_steps", u.newton_message_steps)
       .add("relaxation_cost", u.relaxation_cost)
+      .add("factorizations", u.factorizations)
+      .add("factor_flops", u.factor_flops)
       .add("merges", u.merges)
       .add("merge_poses_moved", u.merge_poses_moved);
   return j;

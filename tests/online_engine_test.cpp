@@ -15,6 +15,7 @@
 #include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/util/input_error.hpp>
 #include <tuple>
+#include <utility>
 
 #include "test_support.hpp"
 
@@ -424,6 +425,42 @@ TEST(OnlineEngine, EachStepsCpuLatencyIsItsLatencyWithItsCpuTimeInPlaceOfItsWall
     EXPECT_NEAR(u.latency_cpu_s, u.latency_s - u.ms / 1000.0 + u.cpu_s, 1e-9);
   }
   EXPECT_EQ(res.batch_latency_cpu_s.size(), res.batch_latency_s.size());
+}
+
+// Each step reports the tangent factorizations it did and their predicted flops; a block that
+// keeps its factor while it grows (refactor_growth) does fewer of them and the run still ends at
+// the batch optimum.
+TEST(OnlineEngine, StepsCountTheirFactorizationsAndAKeptFactorStillReachesTheBatchOptimum) {
+  const auto gen = small_graph(TrajectoryKind::kGrid3d, 300, 3);
+  ReplayOptions ro;
+  ro.rate = 10;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  OnlineOptions o = online_options();
+  o.step_every_s = 0.5;
+  o.certify_at_end = false;
+  auto totals = [](const OnlineResult& r) {
+    long long factorizations = 0;
+    double flops = 0.0;
+    for (const OnlineUpdate& u : r.updates) {
+      EXPECT_GE(u.factorizations, 0);
+      EXPECT_EQ(u.factorizations > 0, u.factor_flops > 0.0);
+      factorizations += u.factorizations;
+      flops += u.factor_flops;
+    }
+    return std::make_pair(factorizations, flops);
+  };
+  const OnlineResult every = run_online(gen.graph.d, plan.batches, o);
+  o.refactor_growth = 1.0;
+  const OnlineResult kept = run_online(gen.graph.d, plan.batches, o);
+  const auto [every_n, every_flops] = totals(every);
+  const auto [kept_n, kept_flops] = totals(kept);
+  // Without a kept factor every block that got new poses factors again at every step.
+  EXPECT_GE(every_n, static_cast<long long>(every.updates.size()));
+  EXPECT_LT(kept_n, every_n);
+  EXPECT_LT(kept_flops, every_flops);
+  const double f_star = batch_optimum(gen.graph);
+  EXPECT_NEAR(every.cost, f_star, 1e-6 * f_star);
+  EXPECT_NEAR(kept.cost, f_star, 1e-6 * f_star);
 }
 
 }  // namespace

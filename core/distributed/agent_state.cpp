@@ -150,8 +150,17 @@ bool AgentState::build_tangent(const Eigen::MatrixXd& X, const BlockUpdateOption
   tangent_ = std::make_unique<TangentPreconditioner>(problem_, options.tangent_relative_shift,
                                                      max_factor_entries_,
                                                      options.tangent_supernodal_min_flops, true);
-  if (!tangent_->usable() || !tangent_->factorize(X)) tangent_.reset();
+  const bool factored = tangent_->usable() && tangent_->factorize(X);
+  count_tangent_factorizations(0);
+  if (!factored) tangent_.reset();
   return tangent_ != nullptr;
+}
+
+void AgentState::count_tangent_factorizations(int before) {
+  if (!tangent_) return;
+  const int done = tangent_->factorizations() - before;
+  tangent_factorizations_total_ += done;
+  tangent_factor_flops_total_ += done * tangent_->factor_flops();
 }
 
 PoseBlockMessage AgentState::publish(const Eigen::MatrixXd& X, BlockKind kind, int recipient,
@@ -226,8 +235,13 @@ Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::Matri
   BlockPreconditioner* euclid = nullptr;
   const TangentPreconditioner* tangent = nullptr;
   if (options.precondition) {
-    if (options.tangent_preconditioner && Xa.rows() == d_ && build_tangent(Xa, options) &&
-        tangent_->prepare(Xa, options.tangent_refresh_interval))
+    bool prepared = false;
+    if (options.tangent_preconditioner && Xa.rows() == d_ && build_tangent(Xa, options)) {
+      const int before = tangent_->factorizations();
+      prepared = tangent_->prepare(Xa, options.tangent_refresh_interval);
+      count_tangent_factorizations(before);
+    }
+    if (prepared)
       tangent = tangent_.get();
     else
       euclid = &euclidean();
@@ -273,7 +287,11 @@ bool AgentState::refactor_tangent(const Eigen::MatrixXd& X, const Eigen::MatrixX
     if (!build_tangent(X, BlockUpdateOptions{})) return false;
     if (!egrad) return true;  // factored at X when built
   }
-  return tangent_->usable() && (egrad ? tangent_->factorize(X, *egrad) : tangent_->factorize(X));
+  if (!tangent_->usable()) return false;
+  const int before = tangent_->factorizations();
+  const bool factored = egrad ? tangent_->factorize(X, *egrad) : tangent_->factorize(X);
+  count_tangent_factorizations(before);
+  return factored;
 }
 
 bool AgentState::ensure_tangent(const Eigen::MatrixXd& X) {

@@ -39,6 +39,26 @@ std::vector<AgentState*> LiveBlocks::all_states() const {
   return out;
 }
 
+void LiveBlocks::retire(const std::unique_ptr<AgentState>& state) {
+  if (!state) return;
+  retired_factorizations_ += state->tangent_factorizations_total();
+  retired_factor_flops_ += state->tangent_factor_flops_total();
+}
+
+long long LiveBlocks::tangent_factorizations() const {
+  long long n = retired_factorizations_;
+  for (const auto& s : states_)
+    if (s) n += s->tangent_factorizations_total();
+  return n;
+}
+
+double LiveBlocks::tangent_factor_flops() const {
+  double n = retired_factor_flops_;
+  for (const auto& s : states_)
+    if (s) n += s->tangent_factor_flops_total();
+  return n;
+}
+
 Eigen::MatrixXd LiveBlocks::columns(const Eigen::MatrixXd& X,
                                     const std::vector<std::size_t>& compact) const {
   const Eigen::Index w = d_ + 1;
@@ -115,7 +135,10 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
     if (present[b]) order.push_back(static_cast<int>(b));
   const bool renumber = moved || order.size() < block_of_.size() ||
                         !std::equal(block_of_.begin(), block_of_.end(), order.begin());
-  if (renumber) states_.clear();
+  if (renumber) {
+    for (const auto& s : states_) retire(s);
+    states_.clear();
+  }
   block_of_ = std::move(order);
   compact_block_of_.assign(present.size(), -1);
   for (std::size_t c = 0; c < block_of_.size(); ++c)
@@ -133,10 +156,12 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
     touched[static_cast<std::size_t>(blocks_[graph_.measurements[k].i])] = 1;
     touched[static_cast<std::size_t>(blocks_[graph_.measurements[k].j])] = 1;
   }
+  for (std::size_t c = num_blocks; c < states_.size(); ++c) retire(states_[c]);
   states_.resize(num_blocks);
   for (std::size_t c = 0; c < num_blocks; ++c) {
     auto& state = states_[c];
     if (only_block_ >= 0 && block_of_[c] != only_block_) {
+      retire(state);
       state.reset();
       continue;
     }
@@ -153,6 +178,7 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
       ++out.kept;
     }
     if (build) {
+      retire(state);
       state = std::make_unique<AgentState>(static_cast<int>(c), d_, *layout_, graph_.measurements,
                                            Y0, update_);
       ++out.built;

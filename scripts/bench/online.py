@@ -151,6 +151,9 @@ def main():
             "critical_path_cpu_s": sum(u.get("critical_path_cpu_s", 0.0) for u in s["updates"]),
             "step_solver": s.get("step_solver", "rounds"),
             "newton_cg_iterations": sum(u.get("newton_cg_iterations", 0) for u in s["updates"]),
+            # The blocks' tangent factorizations over the steps and their predicted flops (load-free).
+            "factorizations": sum(u.get("factorizations", 0) for u in s["updates"]),
+            "factor_gflops": sum(u.get("factor_flops", 0.0) for u in s["updates"]) / 1e9,
             "message_steps": s["rounds"] + sum(u.get("newton_message_steps", 0) for u in s["updates"]),
             "repartitions": 0, "poses_moved": 0,
             "final_cost": s["cost"], "fstar": fstar,

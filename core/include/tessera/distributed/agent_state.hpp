@@ -103,6 +103,11 @@ class AgentState {
   long long tcg_iterations() const { return tcg_iterations_; }
   long long tangent_updates() const { return tangent_updates_; }
   int tangent_factorizations() const { return tangent_ ? tangent_->factorizations() : 0; }
+  /// Numeric tangent factorizations over this state's life (every factor it held, not only the
+  /// current one) and their floating-point operations as CHOLMOD's analysis predicts them: a
+  /// load-free measure of the preconditioner's cost (the online engine reports it per step).
+  long long tangent_factorizations_total() const { return tangent_factorizations_total_; }
+  double tangent_factor_flops_total() const { return tangent_factor_flops_total_; }
   /// True when this block's Q_BB factor was predicted too large and the block diagonal is used
   /// instead (BlockPreconditioner::block_diagonal): any factor of a matrix with Q_BB's pattern
   /// (the certificate's S_BB) would be as large.
@@ -167,6 +172,10 @@ class AgentState {
   bool block_factor_too_large_ = false;
   std::size_t max_factor_entries_;  // BlockUpdateOptions::max_factor_entries of the constructor
   long long block_updates_ = 0, tcg_iterations_ = 0, tangent_updates_ = 0;
+  long long tangent_factorizations_total_ = 0;
+  double tangent_factor_flops_total_ = 0.0;
+  /// Adds the factorizations tangent_ did since it had done `before` to the totals.
+  void count_tangent_factorizations(int before);
   Eigen::MatrixXd neighbours_set_;  // what problem_ holds, so X_N Q_NB is rebuilt only on change
   // Rows of the current point that are not identically zero, in increasing order. A lifted
   // point [I_d; 0] R (chordal or distributed initialisation) has r - d zero rows, and every

@@ -60,13 +60,23 @@ class LiveBlocks {
   const std::vector<int>& block_of() const { return block_of_; }
   /// Compact block of original block `b`, or -1 when it has no linked pose yet.
   int compact_block(int b) const;
+  /// Tangent factorizations done by every state this object has held (AgentState's
+  /// tangent_factorizations_total, states built again or dropped included) and their predicted
+  /// floating-point operations.
+  long long tangent_factorizations() const;
+  double tangent_factor_flops() const;
   /// Writes the compact iterate `Xc` (rank = X's rows) into the stream-id iterate `X`.
   void write_back(const Eigen::MatrixXd& Xc, Eigen::MatrixXd& X) const;
 
  private:
   Eigen::MatrixXd columns(const Eigen::MatrixXd& X, const std::vector<std::size_t>& compact) const;
 
+  /// Adds a state's factorization totals to the retired ones before it is dropped.
+  void retire(const std::unique_ptr<AgentState>& state);
+
   int d_;
+  long long retired_factorizations_ = 0;
+  double retired_factor_flops_ = 0.0;
   BlockUpdateOptions update_;
   double refactor_growth_;
   int only_block_;

@@ -158,6 +158,11 @@ struct OnlineUpdate {
   int newton_steps = 0;
   int newton_cg_iterations = 0;
   int newton_message_steps = 0;
+  /// The blocks' tangent preconditioner factorizations in this step (set-up and Newton steps)
+  /// and their floating-point operations as CHOLMOD's symbolic analysis predicts them: the
+  /// preconditioner's cost, free of the machine's load.
+  long long factorizations = 0;
+  double factor_flops = 0.0;
   /// OnlineOptions::align_merged_pieces: measurements that linked two pieces of the graph at
   /// this step, and the poses moved to align them.
   std::size_t merges = 0;
