@@ -14,8 +14,7 @@ using tessera::InputError;
 using tessera::read_metis;
 
 std::string metis_file(const std::string& name, const std::string& text) {
-  static const std::string dir = tessera::test::temp_dir();
-  return tessera::test::write_file(dir, name, text);
+  return tessera::test::write_file(tessera::test::temp_dir(), name, text);
 }
 
 // Reads the file and returns the error message ("" if it was accepted).

@@ -7,8 +7,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <random>
 #include <sstream>
+#include <vector>
 
 namespace tessera::test {
 
@@ -20,6 +22,48 @@ std::string shared_dir() {
   return "";
 }
 
+namespace {
+
+// The directories temp_dir() made during the running test. A passed test's are removed when it
+// ends (a suite run makes ~800 of them, some with whole runs' logs); a failed test's stay for
+// the post-mortem, and TESSERA_KEEP_TEST_DIRS=1 keeps every one.
+class TempDirCleanup : public ::testing::EmptyTestEventListener {
+ public:
+  void add(const std::string& dir) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dirs_.push_back(dir);
+  }
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    std::vector<std::string> dirs;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      dirs.swap(dirs_);
+    }
+    const char* keep = std::getenv("TESSERA_KEEP_TEST_DIRS");
+    if (!info.result()->Passed() || (keep && std::string(keep) == "1")) return;
+    for (const std::string& dir : dirs) {
+      std::error_code ignored;
+      std::filesystem::remove_all(dir, ignored);
+    }
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> dirs_;
+};
+
+// Registered on first use; the listener list owns it.
+TempDirCleanup& temp_dir_cleanup() {
+  static TempDirCleanup* cleanup = [] {
+    auto* listener = new TempDirCleanup;
+    ::testing::UnitTest::GetInstance()->listeners().Append(listener);
+    return listener;
+  }();
+  return *cleanup;
+}
+
+}  // namespace
+
 std::string temp_dir() {
   namespace fs = std::filesystem;
   std::random_device rd;
@@ -27,6 +71,8 @@ std::string temp_dir() {
   std::string stem = info ? std::string(info->test_suite_name()) + "_" + info->name() : "tessera";
   fs::path p = fs::temp_directory_path() / ("tessera_test_" + stem + "_" + std::to_string(rd()));
   fs::create_directories(p);
+  // Only a running test's directory: one made outside a test may be shared by several.
+  if (info) temp_dir_cleanup().add(p.string());
   return p.string();
 }
 

@@ -12,7 +12,9 @@ namespace tessera::test {
 /// does not exist on this machine.
 std::string shared_dir();
 
-/// A fresh temporary directory for this test, removed by the OS eventually.
+/// A fresh temporary directory for this test (/tmp/tessera_test_<Suite>_<Test>_<random>),
+/// removed when the test passes, kept when it fails (TESSERA_KEEP_TEST_DIRS=1 keeps them all).
+/// Made inside a test, it lives only as long as that test: never cache it across tests.
 std::string temp_dir();
 
 /// Writes `text` into `dir/name` and returns the path.
