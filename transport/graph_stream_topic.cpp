@@ -53,8 +53,8 @@ struct StreamParticipant {
     // Not "tessera:<run>:..." (participant_name): a run's processes must not take the stream's
     // participants for peers of their run.
     pq.name("tessera-stream:" + run_id + ":" + role);
-    discover_over_udp(pq);  // Fast DDS's built-in UDPv4 + shared memory (qos.hpp)
-    watch_fastdds_log();    // names a stuck shared-memory listener (fastdds/shm_receive_watch.hpp)
+    udp_transport_only(pq);  // processes come and go: no shared memory (qos.hpp)
+    watch_fastdds_log();     // names a stuck shared-memory listener (fastdds/shm_receive_watch.hpp)
     participant = create_participant_with_discovery_port(
         domain, pq, nullptr, dds::StatusMask::all(), local_discovery_participants(0));
     if (!participant)

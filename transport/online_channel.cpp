@@ -106,8 +106,8 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
     pq.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod =
         Duration_t(lease_s / 5.0);
     discovery.impl = this;
-    discover_over_udp(pq);  // Fast DDS's built-in UDPv4 + shared memory (qos.hpp)
-    watch_fastdds_log();    // names a stuck shared-memory listener (fastdds/shm_receive_watch.hpp)
+    udp_transport_only(pq);  // processes come and go: no shared memory (qos.hpp)
+    watch_fastdds_log();     // names a stuck shared-memory listener (fastdds/shm_receive_watch.hpp)
     participant = create_participant_with_discovery_port(
         domain, pq, &discovery, dds::StatusMask::none(), local_discovery_participants(agents));
     if (!participant)

@@ -56,6 +56,12 @@ void discover_over_udp(dds::DomainParticipantQos& q) {
   q.wire_protocol().builtin.metatrafficMulticastLocatorList.push_back(multicast);
 }
 
+void udp_transport_only(dds::DomainParticipantQos& q) {
+  q.transport().use_builtin_transports = false;
+  q.transport().user_transports.push_back(
+      std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+}
+
 dds::DomainParticipantQos participant_qos(
     const std::string& name, double lease_s, const std::vector<std::string>& initial_peers,
     int domain, std::uint32_t num_agents, const NetworkProfile& net,

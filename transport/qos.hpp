@@ -47,6 +47,16 @@ constexpr double kHandshakeHeartbeatS = 0.005;
 /// of 30 failed with discovery over shared memory, 0, 0 and 0 of 30 with this.
 void discover_over_udp(eprosima::fastdds::dds::DomainParticipantQos& qos);
 
+/// UDPv4 only, discovery and data (no shared memory), for the participants of the online runs
+/// (the online channel, the graph stream), whose processes come and go while others run: a
+/// killed agent, one started again with its id, a late joiner, a replay that ends. Both
+/// shared-memory defects above hit exactly those: a port left locked by a process killed while
+/// writing into it, and a listener stalled for good by a peer that deleted its participant
+/// before the listener read its first message. Seen once in a full `ctest -j2`: an agent
+/// started again after a take-over heard nothing for 90 s, and the survivors' reliable writes
+/// to it waited until they failed, ending the run.
+void udp_transport_only(eprosima::fastdds::dds::DomainParticipantQos& qos);
+
 /// Participant: named, short lease so a dead peer is noticed within ~lease seconds,
 /// optional unicast initial peers (participant ids 0..num_agents + 5 on `domain`),
 /// the UDP datagram size and socket buffers of `net`, extra `properties` (DDS Security's,
