@@ -20,25 +20,13 @@ ShiftedBlockFactor::ShiftedBlockFactor(const SparseMatrix& S, int width) {
   c_.postorder = 1;
   const Eigen::Index n = S.rows();
   const Eigen::Index m = width > 0 ? n / width : 0;
-  // Pose-level pattern (lower triangle with the diagonal) and its AMD ordering.
-  std::vector<Eigen::Triplet<double>> t;
-  for (Eigen::Index j = 0; j < m; ++j) t.emplace_back(j, j, 1.0);
-  for (Eigen::Index col = 0; col < S.outerSize(); ++col)
-    for (SparseMatrix::InnerIterator it(S, col); it; ++it)
-      if (it.row() / width > col / width) t.emplace_back(it.row() / width, col / width, 1.0);
-  SparseMatrix B(m, m);
-  B.setFromTriplets(t.begin(), t.end());
-  const PoseLevelAnalysis a = analyse_pose_level_pattern(B, true);
+  // Pose-level pattern and its AMD ordering, expanded to the coordinates.
+  const PoseLevelAnalysis a = analyse_pose_level_pattern(pose_level_pattern(S, width), true);
   std::vector<int> perm;
-  if (a.ok && a.order.size() == static_cast<std::size_t>(m)) {
-    perm.resize(static_cast<std::size_t>(n));
-    for (Eigen::Index k = 0; k < m; ++k)
-      for (int q = 0; q < width; ++q)
-        perm[static_cast<std::size_t>(k * width + q)] =
-            a.order[static_cast<std::size_t>(k)] * width + q;
-  } else {
+  if (a.ok && a.order.size() == static_cast<std::size_t>(m))
+    perm = coordinate_order(a.order, width);
+  else
     c_.method[0].ordering = CHOLMOD_AMD;
-  }
   cholmod_sparse view = Eigen::viewAsCholmod(S.selfadjointView<Eigen::Lower>());
   L_ = cholmod_analyze_p(&view, perm.empty() ? nullptr : perm.data(), nullptr, 0, &c_);
   if (!L_) {

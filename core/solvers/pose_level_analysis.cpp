@@ -35,4 +35,26 @@ PoseLevelAnalysis analyse_pose_level_pattern(const SparseMatrix& lower, bool wan
   return out;
 }
 
+SparseMatrix pose_level_pattern(const SparseMatrix& M, int width) {
+  if (width <= 0) return SparseMatrix();
+  const Eigen::Index m = M.rows() / width;
+  std::vector<Eigen::Triplet<double>> t;
+  for (Eigen::Index j = 0; j < m; ++j) t.emplace_back(j, j, 1.0);
+  for (Eigen::Index col = 0; col < M.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(M, col); it; ++it)
+      if (it.row() / width > col / width) t.emplace_back(it.row() / width, col / width, 1.0);
+  SparseMatrix B(m, m);
+  B.setFromTriplets(t.begin(), t.end());
+  return B;
+}
+
+std::vector<int> coordinate_order(const std::vector<int>& pose_order, int width) {
+  std::vector<int> order(pose_order.size() * static_cast<std::size_t>(width));
+  for (std::size_t k = 0; k < pose_order.size(); ++k)
+    for (int q = 0; q < width; ++q)
+      order[k * static_cast<std::size_t>(width) + static_cast<std::size_t>(q)] =
+          pose_order[k] * width + q;
+  return order;
+}
+
 }  // namespace tessera

@@ -20,4 +20,13 @@ struct PoseLevelAnalysis {
 /// analysis, which reads the pattern only). With `want_order` the result holds the ordering.
 PoseLevelAnalysis analyse_pose_level_pattern(const SparseMatrix& lower, bool want_order);
 
+/// The pose-level pattern of `M` (square, `width` consecutive coordinates a pose): the lower
+/// triangle with the diagonal, one entry where any coordinate of pose i meets one of pose j.
+/// Values carry no meaning (the analysis reads the pattern only).
+SparseMatrix pose_level_pattern(const SparseMatrix& M, int width);
+
+/// A pose ordering (`pose_order[k]`: the pose placed k-th) expanded to the coordinates, each
+/// pose's `width` coordinates kept together and in order.
+std::vector<int> coordinate_order(const std::vector<int>& pose_order, int width);
+
 }  // namespace tessera

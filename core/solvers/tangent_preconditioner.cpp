@@ -136,13 +136,8 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
   // supernodal analysis at once (no simplicial analysis only to learn its size); near the
   // threshold the simplicial analysis decides.
   std::vector<int> order;
-  if (f.m > 0 && pose_order.size() == static_cast<std::size_t>(f.m)) {
-    order.resize(static_cast<std::size_t>(n));
-    for (Eigen::Index k = 0; k < f.m; ++k)
-      for (int q = 0; q < f.p; ++q)
-        order[static_cast<std::size_t>(k * f.p + q)] =
-            pose_order[static_cast<std::size_t>(k)] * f.p + q;
-  }
+  if (f.m > 0 && pose_order.size() == static_cast<std::size_t>(f.m))
+    order = coordinate_order(pose_order, f.p);
   if (simplicial_solves && supernodal_min_flops > 0 && !order.empty() &&
       flops_estimate > kSkipFactor * supernodal_min_flops) {
     f.order = std::move(order);
