@@ -10,6 +10,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <memory>
 
+#include "transport/fastdds/discovery_port.hpp"
 #include "transport/topic_names.hpp"
 
 namespace tessera::transport {
@@ -106,14 +107,14 @@ dds::DomainParticipantQos participant_qos(
   if (shared_memory && udp) discover_over_udp(q);
   for (const auto& [key, value] : properties) q.properties().properties().emplace_back(key, value);
   for (const std::string& ip : initial_peers) {
-    // Metatraffic unicast port of participant id p: 7400 + 250 * domain + 10 + 2 * p.
+    // Metatraffic unicast port of participant id p (fastdds/discovery_port.hpp).
     // + 3: the coordinator and tools; + 3 more: participants re-created by
     // Session::replace_participant, which briefly overlap the ones they replace.
     const std::uint32_t participants = num_agents + 6;
     for (std::uint32_t p = 0; p < participants; ++p) {
       eprosima::fastrtps::rtps::Locator_t loc;
       eprosima::fastrtps::rtps::IPLocator::setIPv4(loc, ip);
-      loc.port = 7400 + 250 * static_cast<std::uint32_t>(domain) + 10 + 2 * p;
+      loc.port = discovery_unicast_port(domain, p);
       q.wire_protocol().builtin.initialPeersList.push_back(loc);
     }
   }
