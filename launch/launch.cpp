@@ -19,6 +19,7 @@
 #include "launch/launch_transport.hpp"
 #include "launch/run_cleanup.hpp"
 #include "launch/supervision.hpp"
+#include "transport/fastdds/shm_segment_keeper.hpp"
 #include "transport/run_identity.hpp"
 
 namespace tessera::launch {
@@ -142,6 +143,12 @@ LaunchResult launch(LaunchOptions o) {
   for (const auto& c : children) any_failed = any_failed || c.code != 0;
   if (any_failed)
     remove_dead_files_of(run_domain, std::move(outcome.run_segments), "after the run");
+  // The shared-memory segments this run's processes kept readable for late readers after
+  // deleting their participants (transport/fastdds/shm_segment_keeper.hpp): nobody of the run
+  // is left to read them.
+  std::vector<int> pids;
+  for (const auto& c : children) pids.push_back(static_cast<int>(c.pid));
+  transport::sweep_kept_segments("/dev/shm", transport::kKeptSegmentLifeS, pids);
   result.exit_code = outcome.exit_code;
   result.failure = outcome.failure;
   result.summary_json = outcome.summary;

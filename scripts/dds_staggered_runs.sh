@@ -14,6 +14,9 @@ BIN="$(cd "${4:-build/bin}" && pwd)"
 EXTRA="${EXTRA:-}"
 DIR="$(mktemp -d /tmp/tessera_staggered_XXXXXX)"
 "$BIN/tessera" generate --kind city --poses 36 --robots 2 --out "$DIR/g.g2o" >/dev/null
+# A launch on the domain first: it removes the shared-memory ports that dead processes of an
+# earlier batch left there (launch/run_cleanup.hpp), which would fail every run of this one.
+"$BIN/tessera" launch "$DIR/g.g2o" --agents 2 --domain "$DOMAIN" --quiet >"$DIR/cleanup.log" 2>&1
 # --lease 5: a loaded host must not turn a slow process into a lost one (another failure).
 SESSION="--domain $DOMAIN --timeout 15 --lease 5 $EXTRA"
 for i in $(seq 1 "$RUNS"); do
