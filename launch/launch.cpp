@@ -13,6 +13,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "launch/dpgo_csv_input.hpp"
+#include "launch/free_domain.hpp"
 #include "launch/huge_page_heaps.hpp"
 #include "launch/launch_argv.hpp"
 #include "launch/launch_children.hpp"
@@ -106,8 +107,16 @@ LaunchResult launch(LaunchOptions o) {
   // hand, an abort inside Fast DDS) can keep this run's participants from discovering each other
   // (every later launch on that domain failed until they were removed). Only files no live
   // process holds or maps go (transport/fastdds/shm_leftovers.hpp).
-  const int run_domain =
-      o.net.session.domain >= 0 ? o.net.session.domain : transport::domain_for_run(result.run_id);
+  // Without --domain: the run id's domain, or the next one no live participant is on
+  // (free_domain.hpp); every process is then told it.
+  if (o.net.session.domain < 0) {
+    const int derived = transport::domain_for_run(result.run_id);
+    o.net.session.domain = free_domain_from(derived);
+    if (o.net.session.domain != derived && !o.quiet)
+      std::printf("domain %d is in use by another run: this run uses domain %d\n", derived,
+                  o.net.session.domain);
+  }
+  const int run_domain = o.net.session.domain;
   {
     const StopSignals signals;
     int pipefd[2];
