@@ -149,6 +149,7 @@ int sweep_kept_segments(const std::string& dir, double life_s, const std::vector
     struct stat st {};
     if (stat((dir + "/" + marker).c_str(), &st) != 0) continue;
     if (static_cast<double>(now - st.st_mtime) < life_s) {
+      if (owners.empty()) continue;
       int owner = 0;
       std::ifstream(dir + "/" + marker) >> owner;
       if (std::find(owners.begin(), owners.end(), owner) == owners.end()) continue;
