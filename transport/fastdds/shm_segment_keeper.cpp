@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdlib>
 #include <ctime>
@@ -56,9 +57,14 @@ std::set<unsigned long> inodes_locked_by(pid_t pid) {
   return out;
 }
 
-std::string link_name(const std::string& segment) {
-  return kLinkHead + hex_of(segment) + "_" + std::to_string(getpid());
+// tessera_link_<pid>_<keeper>_<hex>: one per keeper, so keepers of one process that delete
+// participants at the same time never share a link.
+std::string link_name(const std::string& segment, unsigned long keeper) {
+  return kLinkHead + std::to_string(getpid()) + "_" + std::to_string(keeper) + "_" +
+         hex_of(segment);
 }
+
+std::atomic<unsigned long> next_keeper{0};
 
 // Whether some process holds `lock`'s flock (false when the file is gone).
 bool lock_held(const std::string& path) {
@@ -91,9 +97,12 @@ std::vector<std::string> own_shm_segments(const std::string& dir) {
   return out;
 }
 
+ShmSegmentKeeper::ShmSegmentKeeper(std::string dir)
+    : dir_(std::move(dir)), id_(next_keeper.fetch_add(1)) {}
+
 void ShmSegmentKeeper::keep() {
   for (const std::string& name : own_shm_segments(dir_)) {
-    const std::string target = dir_ + "/" + link_name(name);
+    const std::string target = dir_ + "/" + link_name(name, id_);
     unlink(target.c_str());
     if (link((dir_ + "/" + name).c_str(), target.c_str()) == 0) kept_.push_back(name);
   }
@@ -102,7 +111,7 @@ void ShmSegmentKeeper::keep() {
 std::vector<std::string> ShmSegmentKeeper::restore() {
   std::vector<std::string> restored;
   for (const std::string& name : kept_) {
-    const std::string held = dir_ + "/" + link_name(name);
+    const std::string held = dir_ + "/" + link_name(name, id_);
     // The marker first, so a sweep never sees a restored name without one.
     const std::string marker = dir_ + "/" + kMarkerHead + hex_of(name);
     const int fd = open(marker.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -112,10 +121,12 @@ std::vector<std::string> ShmSegmentKeeper::restore() {
       (void)written;
       close(fd);
     }
-    if (link(held.c_str(), (dir_ + "/" + name).c_str()) == 0)
+    const std::string path = dir_ + "/" + name;
+    if (link(held.c_str(), path.c_str()) == 0)
       restored.push_back(name);
-    else
-      unlink(marker.c_str());  // still there: a live participant's (another in this process)
+    else if (lock_held(path + "_el"))
+      unlink(marker.c_str());  // a live participant's (another one of this process)
+    // else: another keeper of this process restored it meanwhile, marker included
     unlink(held.c_str());
   }
   kept_.clear();
@@ -123,7 +134,7 @@ std::vector<std::string> ShmSegmentKeeper::restore() {
 }
 
 ShmSegmentKeeper::~ShmSegmentKeeper() {
-  for (const std::string& name : kept_) unlink((dir_ + "/" + link_name(name)).c_str());
+  for (const std::string& name : kept_) unlink((dir_ + "/" + link_name(name, id_)).c_str());
 }
 
 int sweep_kept_segments(const std::string& dir, double life_s, const std::vector<int>& owners) {
@@ -138,8 +149,7 @@ int sweep_kept_segments(const std::string& dir, double life_s, const std::vector
   }
   // Links of a process that ended between keep() and restore() (the teardown guard ended it).
   for (const std::string& l : links) {
-    const auto under = l.rfind('_');
-    const long pid = std::strtol(l.c_str() + under + 1, nullptr, 10);
+    const long pid = std::strtol(l.c_str() + kLinkHead.size(), nullptr, 10);
     if (pid > 0 && kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH)
       unlink((dir + "/" + l).c_str());
   }

@@ -36,7 +36,7 @@ inline constexpr double kKeptSegmentLifeS = 10.0;
 
 class ShmSegmentKeeper {
  public:
-  explicit ShmSegmentKeeper(std::string dir = "/dev/shm") : dir_(std::move(dir)) {}
+  explicit ShmSegmentKeeper(std::string dir = "/dev/shm");
   /// Before deleting a participant: hard links to this process's own data segments.
   void keep();
   /// After deleting it: the names Fast DDS removed come back (returned); the links go.
@@ -45,6 +45,7 @@ class ShmSegmentKeeper {
 
  private:
   std::string dir_;
+  unsigned long id_;               // this keeper's number in the process (its links' names)
   std::vector<std::string> kept_;  // segment names (fastrtps_<hex>) linked by keep()
 };
 
