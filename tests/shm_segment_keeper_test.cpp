@@ -98,5 +98,22 @@ TEST(ShmSegmentKeeper, ALiveParticipantsSegmentIsLeftAsItIs) {
   own.delete_participant(dir);
 }
 
+// Two participants of one process deleted at once: each keeper links the process's segments;
+// the deleted one gets its name back once, with its marker, and no link is left.
+TEST(ShmSegmentKeeper, TwoKeepersOfOneProcessRestoreADeletedSegmentOnce) {
+  const std::string dir = test::temp_dir();
+  OwnSegment own(dir);
+  ShmSegmentKeeper first(dir), second(dir);
+  first.keep();
+  second.keep();
+  own.delete_participant(dir);
+  EXPECT_EQ(first.restore(), std::vector<std::string>{kName});
+  EXPECT_TRUE(second.restore().empty());
+  EXPECT_EQ(contents(dir + "/" + kName), "message of the deleted participant");
+  EXPECT_TRUE(exists(dir + "/tessera_kept_0123456789abcdef"));
+  EXPECT_EQ(sweep_kept_segments(dir, 0.0), 1);
+  EXPECT_FALSE(exists(dir + "/" + kName));
+}
+
 }  // namespace
 }  // namespace tessera::transport
