@@ -13,12 +13,14 @@
 #include <tessera/util/input_error.hpp>
 
 #include "launch/dpgo_csv_input.hpp"
+#include "launch/free_domain.hpp"
 #include "launch/huge_page_heaps.hpp"
 #include "launch/launch_argv.hpp"
 #include "launch/launch_children.hpp"
 #include "launch/launch_transport.hpp"
 #include "launch/run_cleanup.hpp"
 #include "launch/supervision.hpp"
+#include "transport/fastdds/shm_segment_keeper.hpp"
 #include "transport/run_identity.hpp"
 
 namespace tessera::launch {
@@ -105,8 +107,16 @@ LaunchResult launch(LaunchOptions o) {
   // hand, an abort inside Fast DDS) can keep this run's participants from discovering each other
   // (every later launch on that domain failed until they were removed). Only files no live
   // process holds or maps go (transport/fastdds/shm_leftovers.hpp).
-  const int run_domain =
-      o.net.session.domain >= 0 ? o.net.session.domain : transport::domain_for_run(result.run_id);
+  // Without --domain: the run id's domain, or the next one no live participant is on
+  // (free_domain.hpp); every process is then told it.
+  if (o.net.session.domain < 0) {
+    const int derived = transport::domain_for_run(result.run_id);
+    o.net.session.domain = free_domain_from(derived);
+    if (o.net.session.domain != derived && !o.quiet)
+      std::printf("domain %d is in use by another run: this run uses domain %d\n", derived,
+                  o.net.session.domain);
+  }
+  const int run_domain = o.net.session.domain;
   {
     const StopSignals signals;
     int pipefd[2];
@@ -142,6 +152,12 @@ LaunchResult launch(LaunchOptions o) {
   for (const auto& c : children) any_failed = any_failed || c.code != 0;
   if (any_failed)
     remove_dead_files_of(run_domain, std::move(outcome.run_segments), "after the run");
+  // The shared-memory segments this run's processes kept readable for late readers after
+  // deleting their participants (transport/fastdds/shm_segment_keeper.hpp): nobody of the run
+  // is left to read them.
+  std::vector<int> pids;
+  for (const auto& c : children) pids.push_back(static_cast<int>(c.pid));
+  transport::sweep_kept_segments("/dev/shm", transport::kKeptSegmentLifeS, pids);
   result.exit_code = outcome.exit_code;
   result.failure = outcome.failure;
   result.summary_json = outcome.summary;

@@ -10,6 +10,7 @@
 
 #include "transport/fastdds/discovery_port.hpp"
 #include "transport/fastdds/shm_receive_watch.hpp"
+#include "transport/fastdds/shm_segment_keeper.hpp"
 #include "transport/fastdds/teardown_guard.hpp"
 
 namespace tessera::transport {
@@ -113,11 +114,29 @@ GuidPrefix DdsEntities::retire() {
 void DdsEntities::close_retired(int exit_code, const std::string& who) {
   for (Retired& r : retired_) {
     trace_("deleting a replaced participant");
-    TeardownGuard guard(exit_code, who, Seconds(kTeardownTimeoutS));
-    r.participant->delete_contained_entities();
-    dds::DomainParticipantFactory::get_instance()->delete_participant(r.participant);
+    delete_participant(r.participant, exit_code, who);
   }
   retired_.clear();
+}
+
+void DdsEntities::delete_participant(dds::DomainParticipant* participant, int exit_code,
+                                     const std::string& who) {
+  // Peers that read our last messages late still find our shared-memory segment
+  // (fastdds/shm_segment_keeper.hpp).
+  ShmSegmentKeeper keeper;
+  if (opt_.uses_shared_memory()) keeper.keep();
+  {
+    // Fast DDS 2.9 may abort or deadlock in here (transport/fastdds/teardown_guard.hpp).
+    TeardownGuard guard(exit_code, who, Seconds(kTeardownTimeoutS));
+    participant->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant);
+  }
+  const std::vector<std::string> restored = keeper.restore();
+  const int swept = opt_.uses_shared_memory() ? sweep_kept_segments() : 0;
+  trace_(
+      "participant deleted: %zu shared-memory segment names kept for late readers, %d old "
+      "ones removed",
+      restored.size(), swept);
 }
 
 dds::DataWriter* DdsEntities::writer(const std::string& name) const {
@@ -156,12 +175,7 @@ void DdsEntities::close(int exit_code, const std::string& who) {
   close_retired(exit_code, who);
   if (!participant_) return;
   trace_("closing: deleting the DDS entities and the participant");
-  {
-    // Fast DDS 2.9 may abort or deadlock in here (transport/fastdds/teardown_guard.hpp).
-    TeardownGuard guard(exit_code, who, Seconds(kTeardownTimeoutS));
-    participant_->delete_contained_entities();
-    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
-  }
+  delete_participant(participant_, exit_code, who);
   participant_ = nullptr;
   writers_.clear();
   readers_.clear();

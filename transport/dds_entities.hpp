@@ -104,6 +104,10 @@ class DdsEntities {
  private:
   template <class PubSubType>
   eprosima::fastdds::dds::Topic* topic(const std::string& name);
+  /// Deletes `participant` and what it contains, bounded by the teardown guard; its
+  /// shared-memory segment stays readable for late readers (fastdds/shm_segment_keeper.hpp).
+  void delete_participant(eprosima::fastdds::dds::DomainParticipant* participant, int exit_code,
+                          const std::string& who);
 
   const SessionOptions& opt_;
   const NetworkProfile& net_;

@@ -14,13 +14,16 @@
 // and announced; the same two runs started by hand with TESSERA_DDS_LOG=1 failed the same way,
 // and the deaf agent's log held 200,889 such receive errors in 20 s.
 // `scripts/dds_staggered_runs.sh 118 30 0.2` (30 runs 0.2 s apart on one domain) reproduces it
-// on demand: with `EXTRA="--transport shm"` 16 of 30 runs failed (load 10-14), and each of the
-// 16 names the stuck listener.
+// on demand without shm_segment_keeper.hpp: with `EXTRA="--transport shm"` 16 of 30 runs failed
+// (load 10-14), and each of the 16 names the stuck listener; with it, 3 of 210 (7 batches, load
+// 14-24) against 64 of 210 without.
 //
-// Avoided where UDP is on: discovery goes over UDP (discover_over_udp, transport/qos.hpp), so a
-// deleted participant's last messages (discovery, to every participant of the domain) no longer
-// reach shared-memory ports; a run's own data reaches its peers long before anyone leaves.
-// Still possible with shared memory only (--transport shm, tessera launch's default).
+// Avoided at its cause: a deleted participant's segment stays readable (shm_segment_keeper.hpp),
+// so the retried message is read as soon as the name is back. Also, where UDP is on, discovery
+// goes over UDP (discover_over_udp, transport/qos.hpp), so a deleted participant's last messages
+// (discovery, to every participant of the domain) do not reach shared-memory ports at all.
+// Still possible: a reader that reads a dead sender's message after a peer's Fast DDS watchdog
+// removed the restored name (it does so >= 5 s after it last saw the sender alive).
 //
 // What: from the first participant of the process on, Fast DDS's warnings go to a consumer
 // that counts these receive errors (and prints every warning and error as Fast DDS does when
