@@ -25,10 +25,9 @@ SessionOptions options_for(bool coordinator, std::uint32_t agent) {
   o.agent_id = agent;
   o.num_agents = 1;
   o.lease_s = 3.0;  // no false peer loss on a loaded machine
-  // UDP only: the agent sends no data before it is deleted, so over shared memory the
-  // coordinator's first message from it can arrive after its segment is gone, and Fast DDS
-  // 2.9.1's listener then stalls and the coordinator's deletion hangs
-  // (transport/fastdds/shm_receive_watch.hpp): 2 of 3 full suites at ctest -j2.
+  // UDP only: the subject is the barrier's message, not the transport. (This test's teardown
+  // was seen to overrun its 5 s guard in full suites at ctest -j2 over shared memory and once
+  // over UDP; the suite sets TESSERA_TEARDOWN_STACKS, so a next overrun prints its stacks.)
   o.transport = "udp";
   return o;
 }

@@ -13,8 +13,12 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
+#include <sstream>
+#include <string>
 #include <thread>
 
 namespace {
@@ -50,6 +54,7 @@ TEST(TeardownGuard, AnAbortDuringTeardownExitsWithTheIntendedCode) {
 TEST(TeardownGuard, ATeardownThatHangsEndsAfterTheBound) {
   const auto start = std::chrono::steady_clock::now();
   EXPECT_EQ(in_child([] {
+              unsetenv("TESSERA_TEARDOWN_STACKS");  // the suite sets it; no stacks here
               TeardownGuard guard(4, "test", std::chrono::milliseconds(200));
               std::this_thread::sleep_for(std::chrono::seconds(30));  // a deadlocked teardown
             }),
@@ -134,3 +139,23 @@ TEST(TeardownGuard, GuardsNestAndTheOuterOneHoldsAgainAfterTheInner) {
 }
 
 }  // namespace
+
+// With TESSERA_TEARDOWN_STACKS set, the overrun's note is followed by every thread's stack, so
+// a teardown hang inside Fast DDS seen once in a test suite shows which lock it waited on.
+TEST(TeardownGuard, AnOverrunPrintsEveryThreadsStackWhenAsked) {
+  if (access("/usr/bin/gdb", X_OK) != 0) GTEST_SKIP() << "gdb is not installed";
+  const std::string log = testing::TempDir() + "teardown_guard_stacks.log";
+  EXPECT_EQ(in_child([&log] {
+              setenv("TESSERA_TEARDOWN_STACKS", "1", 1);
+              if (!std::freopen(log.c_str(), "w", stderr)) _exit(99);
+              TeardownGuard guard(4, "test", std::chrono::milliseconds(200));
+              std::this_thread::sleep_for(std::chrono::seconds(60));  // a deadlocked teardown
+            }),
+            4);
+  std::ifstream in(log);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("teardown did not finish"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("nanosleep"), std::string::npos) << text.str();
+  std::remove(log.c_str());
+}

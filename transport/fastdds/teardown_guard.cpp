@@ -1,11 +1,15 @@
 #include "transport/fastdds/teardown_guard.hpp"
 
+#include <sys/prctl.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <string>
 
 namespace tessera::transport {
 
@@ -33,6 +37,25 @@ extern "C" void on_teardown_abort(int) {
   ssize_t ignored = write(STDERR_FILENO, g_abort_note, g_abort_note_length);
   (void)ignored;
   _exit(g_exit_code);
+}
+
+// With TESSERA_TEARDOWN_STACKS set, a teardown that overran its time prints every thread's
+// stack (gdb, where installed) before the process ends: the hang is inside Fast DDS, and only
+// its threads' stacks say which of its locks is held. The watchdog is an ordinary thread, so
+// forking and waiting here is safe.
+void print_thread_stacks() {
+  const char* wanted = std::getenv("TESSERA_TEARDOWN_STACKS");
+  if (!wanted || !*wanted || access("/usr/bin/gdb", X_OK) != 0) return;
+  prctl(PR_SET_PTRACER, PR_SET_PTRACER_ANY, 0, 0, 0);  // Yama: let the child attach to us
+  const std::string pid = std::to_string(getpid());
+  const pid_t child = fork();
+  if (child == 0) {
+    dup2(STDERR_FILENO, STDOUT_FILENO);
+    execl("/usr/bin/gdb", "gdb", "-nx", "-batch", "-p", pid.c_str(), "-ex", "thread apply all bt",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  if (child > 0) waitpid(child, nullptr, 0);
 }
 
 void set_note(const std::string& note) {
@@ -79,6 +102,7 @@ TeardownGuard::TeardownGuard(int exit_code, const std::string& who,
                  "known Fast DDS 2.9 teardown deadlock); exiting with code %d as intended\n",
                  who.c_str(), timeout.count(), exit_code);
     std::fflush(stderr);
+    print_thread_stacks();
     _exit(exit_code);
   });
 }
