@@ -229,8 +229,8 @@ struct NewtonRefineOptions {
   /// it as it is: the same bits as their own factorization). false: every agent assembles and
   /// factors Sigma at every point. Both take the same steps, CG iterations and message steps
   /// to the same bits; the start point and a step predicted to be the last take the
-  /// every-agent path. Why false: on city10000 at N = 5 shipping saves 7.7 % of the
-  /// refinement's instructions in process (1.95 -> 1.80 G) but sends Sigma's factor (1.9 MB) to
+  /// every-agent path. Why false: on city10000 at N = 5 shipping saves 9.3 % of the
+  /// refinement's instructions in process (1.95 -> 1.77 G) but sends Sigma's factor (1.9 MB) to
   /// every agent at each shipped point (DDS bytes 9.1 -> 13.0 MB), and over DDS on one 2-core
   /// machine the agents' CPU after the rounds did not fall (medians of 6 launches 0.85 vs
   /// 1.08 CPU-s, load 12-17): what the agents' threads save in factorizations their transport
