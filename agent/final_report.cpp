@@ -46,13 +46,16 @@ void deliver_final_estimate(AgentSession& s, const AgentLocalData& local,
                   result.certificate_wait_s);
     log(line);
   }
-  for (const NewtonRefineTimes& t : result.refine_times) {
-    char line[320];
+  for (const NewtonRefineResult& r : result.refines) {
+    const NewtonRefineTimes& t = r.times;
+    char line[400];
     std::snprintf(line, sizeof(line),
                   "refinement: %.3f s wall, %.3f CPU-s: set-up %.3f, factors %.3f, Sigma %.3f, "
-                  "CG %.3f, trial points %.3f, translations %.3f",
+                  "CG %.3f, trial points %.3f, translations %.3f; Sigma factored %d, taken from "
+                  "agent 0 %d; trial block factors unused %d",
                   t.wall_s, t.cpu_s, t.setup_s, t.factor_s, t.sigma_s, t.cg_s, t.trial_s,
-                  t.translations_s);
+                  t.translations_s, r.sigma_factorizations, r.sigma_imports,
+                  r.pending_factors_unused);
     log(line);
   }
   if (!o.output.empty()) write_vertices_g2o(local.owned, result.poses, local.d, o.output);

@@ -75,6 +75,7 @@ const char* const kDistributedValued[] = {"agents",
                                           "refine-interface",
                                           "refine-translation-interface",
                                           "refine-gauge",
+                                          "refine-sigma",
                                           nullptr};
 const char* const kDistributedSwitches[] = {"parallel",      "sequential",  "reference",
                                             "certify",       "sigma-adapt", "sigma-fixed",
@@ -204,7 +205,12 @@ const char* kDistributedHelp =
     "  --refine-gauge project|ground   with the interface solves, its CG works on the\n"
     "                            tangent vectors orthogonal to the global rigid motions\n"
     "                            (project) or holds the grounded pose fixed (ground) (default\n"
-    "                            ground)\n";
+    "                            ground)\n"
+    "  --refine-sigma one|every  with the interface solves, agent 0 factors the interface\n"
+    "                            matrix from shares sent with an accepted trial's sums and\n"
+    "                            sends its factor (one), or every agent factors it at every\n"
+    "                            point (every); the same steps and message steps (default\n"
+    "                            every)\n";
 
 namespace {
 
@@ -361,6 +367,10 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     if (gauge != "project" && gauge != "ground")
       throw InputError("option --refine-gauge: '" + gauge + "' is not one of project, ground");
     opt.refine.project_gauge = gauge == "project";
+    const std::string sigma = a.get_or("refine-sigma", opt.refine.ship_sigma ? "one" : "every");
+    if (sigma != "one" && sigma != "every")
+      throw InputError("option --refine-sigma: '" + sigma + "' is not one of one, every");
+    opt.refine.ship_sigma = sigma == "one";
     opt.refine.coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
                         : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
                                                : NewtonRefineOptions::Coarse::kNone;
@@ -465,9 +475,11 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   for (const NewtonRefineResult& n : r.refines)
     std::printf(
         "  newton refine, agent 0: %.3f s wall, %.3f CPU-s: set-up %.3f, factors %.3f, Sigma "
-        "%.3f, CG %.3f, trial points %.3f, translations %.3f\n",
+        "%.3f, CG %.3f, trial points %.3f, translations %.3f; Sigma factored %d, taken from "
+        "agent 0 %d; trial block factors unused %d\n",
         n.times.wall_s, n.times.cpu_s, n.times.setup_s, n.times.factor_s, n.times.sigma_s,
-        n.times.cg_s, n.times.trial_s, n.times.translations_s);
+        n.times.cg_s, n.times.trial_s, n.times.translations_s, n.sigma_factorizations,
+        n.sigma_imports, n.pending_factors_unused);
   for (const NewtonRefineResult& n : r.refines)
     for (std::size_t k = 0; k < n.trace.size(); ++k) {
       const NewtonRefineStep& t = n.trace[k];

@@ -128,5 +128,51 @@ TEST(SupernodalFactor, GivenOrderKeepsTheInterfaceLastForItsSchurComplement) {
   EXPECT_THROW(amd.trailing_block(nI), std::logic_error);
 }
 
+TEST(SupernodalFactor, ImportedValuesSolveToTheBitLikeTheFactorTheyCameFrom) {
+  // Agent 0 factors the refinement's interface matrix and sends values(); an agent whose own
+  // factor was analysed on the same pattern (an earlier point's matrix) takes them and solves
+  // with exactly the bits agent 0's factor gives.
+  const Eigen::MatrixXd A = blocky(5, 12, 0.5, 1), B = blocky(5, 12, 0.5, 2);
+  SupernodalFactor sender, receiver, fresh;
+  ASSERT_TRUE(sender.factor(lower_of(A, {}), 1e-3));
+  ASSERT_TRUE(receiver.factor(lower_of(B, {}), 1e-3));
+  const std::vector<double> v = sender.values();
+  ASSERT_FALSE(v.empty());
+  EXPECT_FALSE(fresh.import_values(v.data(), v.size())) << "nothing analysed to take them into";
+  EXPECT_FALSE(receiver.import_values(v.data(), v.size() - 1)) << "a different layout";
+  ASSERT_TRUE(receiver.import_values(v.data(), v.size()));
+  EXPECT_TRUE(receiver.ok());
+  EXPECT_EQ(receiver.analyses(), 1);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 2.0);
+  Eigen::VectorXd want, got;
+  sender.solve(b, want);
+  receiver.solve(b, got);
+  for (Eigen::Index i = 0; i < b.size(); ++i) ASSERT_EQ(got(i), want(i)) << "entry " << i;
+  // Only L's entries travel: fewer values than the supernodes hold with their upper triangles.
+  EXPECT_LE(v.size(), sender.factor_entries() + static_cast<std::size_t>(A.rows()) * 12);
+}
+
+TEST(SupernodalFactor, AfterAFailedFactorizationImportEitherSolvesLikeTheSenderOrRefuses) {
+  // The receiver's own last factorization stopped at a pivot: the sender's values make its
+  // factor complete (the same bits as the sender's), or import refuses and the receiver keeps
+  // no usable factor; never a half-old factor.
+  const Eigen::MatrixXd A = blocky(4, 10, 0.5, 3);
+  Eigen::MatrixXd indefinite = A;
+  indefinite(7, 7) = -50.0;
+  SupernodalFactor sender, receiver;
+  ASSERT_TRUE(sender.factor(lower_of(A, {}), 0.0));
+  ASSERT_FALSE(receiver.factor(lower_of(indefinite, {}), 0.0));
+  const std::vector<double> v = sender.values();
+  if (!receiver.import_values(v.data(), v.size())) {
+    EXPECT_FALSE(receiver.ok());
+    return;
+  }
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(A.rows());
+  Eigen::VectorXd want, got;
+  sender.solve(b, want);
+  receiver.solve(b, got);
+  EXPECT_EQ((got - want).norm(), 0.0);
+}
+
 }  // namespace
 }  // namespace tessera

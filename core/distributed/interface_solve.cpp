@@ -43,14 +43,18 @@ struct InterfaceSolve::Impl {
   Eigen::Index team = 0, own_offset = 0;
   int id = 0;
   // The block's factor A_bb = L L^T in the order above, and L's trailing interface block (both
-  // patterns are the same at every point: one analysis each).
-  SupernodalFactor block{SupernodalFactor::Ordering::kGiven};
-  Eigen::MatrixXd Lgg;
+  // patterns are the same at every point: one analysis each); and the same at a trial point
+  // (factor_pending), the current one's until commit_pending().
+  std::unique_ptr<SupernodalFactor> block =
+      std::make_unique<SupernodalFactor>(SupernodalFactor::Ordering::kGiven);
+  std::unique_ptr<SupernodalFactor> pending;
+  Eigen::MatrixXd Lgg, pending_Lgg;
   // Sigma + eta I.
   SupernodalFactor sigma;
   bool sigma_ok = false;
   bool grounded = false;  // the team's first interface pose held fixed (its p coordinates)
   double shift = 0.0;
+  int pattern = -1;           // the pattern sigma was last factored on: 1 grounded, 0 not, -1 none
   mutable Eigen::VectorXd b;  // scratch: J^T v in the block's own order
 };
 
@@ -186,17 +190,41 @@ void block_into(const double* q, const Eigen::MatrixXd& Gi, const Eigen::MatrixX
 
 std::vector<double> InterfaceSolve::factor(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
                                            const Eigen::MatrixXd& egrad) {
-  return factor_impl(X, Xn, egrad, true);
+  impl_->sigma_ok = false;
+  return factor_impl(X, Xn, egrad, true, false);
+}
+
+std::vector<double> InterfaceSolve::factor_pending(const Eigen::MatrixXd& X,
+                                                   const Eigen::MatrixXd& Xn,
+                                                   const Eigen::MatrixXd& egrad) {
+  Impl& s = *impl_;
+  if (!s.pending) {
+    // The current factor's analysis (the pattern is the same at every point): a numeric
+    // factorization only, as at the current point.
+    s.pending = std::make_unique<SupernodalFactor>(SupernodalFactor::Ordering::kGiven);
+    s.pending->adopt_analysis(*s.block);
+  }
+  return factor_impl(X, Xn, egrad, true, true);
+}
+
+void InterfaceSolve::commit_pending() {
+  Impl& s = *impl_;
+  if (!s.pending) throw std::logic_error("InterfaceSolve::commit_pending: no pending factor");
+  std::swap(s.block, s.pending);
+  std::swap(s.Lgg, s.pending_Lgg);
+  s.sigma_ok = false;
 }
 
 std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
-                                                const Eigen::MatrixXd& egrad, bool multipliers) {
+                                                const Eigen::MatrixXd& egrad, bool multipliers,
+                                                bool pending) {
   Impl& s = *impl_;
   const int d = s.d, w = s.w, p = s.p;
   if (X.rows() != d || X.cols() != w * s.m || egrad.rows() != d || egrad.cols() != X.cols() ||
       Xn.rows() != d)
     throw std::invalid_argument("InterfaceSolve::factor: not a rank-d point of the block");
-  s.sigma_ok = false;
+  SupernodalFactor& block = pending ? *s.pending : *s.block;
+  Eigen::MatrixXd& Lgg = pending ? s.pending_Lgg : s.Lgg;
   const auto skew = skew_pairs(d);
   std::vector<Eigen::MatrixXd> G(static_cast<std::size_t>(s.m));
   for (Eigen::Index i = 0; i < s.m; ++i)
@@ -230,16 +258,16 @@ std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const 
   }
   SparseMatrix A(n, n);
   A.setFromTriplets(t.begin(), t.end());
-  const bool ok = n > 0 && s.block.factor(A);
+  const bool ok = n > 0 && block.factor(A);
   // Far from a minimiser the block's Hessian may be indefinite: then its block without the
   // multiplier term (positive definite, as block Jacobi's), and Sigma is the Schur complement
   // of that modified H, still a symmetric positive definite preconditioner.
-  if (!ok && multipliers) return factor_impl(X, Xn, egrad, false);
+  if (!ok && multipliers) return factor_impl(X, Xn, egrad, false, pending);
   if (!ok) return {0.0};
   const Eigen::Index nI = s.mI * p, nG = s.mG * p;
   // L's interface block; the interface's Schur complement is L_GG L_GG^T.
-  s.Lgg = s.block.trailing_block(nI);
-  const Eigen::MatrixXd schur = s.Lgg.triangularView<Eigen::Lower>() * s.Lgg.transpose();
+  Lgg = block.trailing_block(nI);
+  const Eigen::MatrixXd schur = Lgg.triangularView<Eigen::Lower>() * Lgg.transpose();
 
   std::vector<double> out;
   out.reserve(static_cast<std::size_t>(2 + nG * (nG + 1) / 2) +
@@ -321,6 +349,7 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
       sigma.setFromTriplets(t.begin(), t.end());
     for (double rel : relative_shifts) {
       const double eta = rel * std::max(top, 1e-300);
+      s.pattern = ground ? 1 : 0;
       if (s.sigma.factor(sigma, eta)) {
         s.sigma_ok = true;
         s.grounded = ground;
@@ -330,6 +359,26 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
     }
   }
   return false;
+}
+
+std::vector<double> InterfaceSolve::sigma_values() const {
+  const Impl& s = *impl_;
+  if (!s.sigma_ok) return {0.0};
+  std::vector<double> v{1.0, s.grounded ? 1.0 : 0.0, s.shift};
+  const std::vector<double> x = s.sigma.values();
+  v.insert(v.end(), x.begin(), x.end());
+  return v;
+}
+
+bool InterfaceSolve::import_sigma(const double* v, std::size_t count) {
+  Impl& s = *impl_;
+  if (count < 3 || v[0] != 1.0) return false;
+  const bool ground = v[1] != 0.0;
+  if (s.pattern != (ground ? 1 : 0) || !s.sigma.import_values(v + 3, count - 3)) return false;
+  s.sigma_ok = true;
+  s.grounded = ground;
+  s.shift = v[2];
+  return true;
 }
 
 Eigen::Index InterfaceSolve::grounded_pose() const {
@@ -352,7 +401,7 @@ void InterfaceSolve::forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
   y.resize(s.m * p);
   for (Eigen::Index i = 0; i < s.m; ++i)
     y.segment(s.slot[static_cast<std::size_t>(i)] * p, p) = s.b.segment(i * p, p);
-  s.block.solve_l(y);
+  s.block->solve_l(y);
 }
 
 void InterfaceSolve::add_interface(const Eigen::VectorXd& y, double* team) const {
@@ -379,7 +428,7 @@ Eigen::MatrixXd InterfaceSolve::back(const Eigen::MatrixXd& X, const Eigen::Vect
   Eigen::VectorXd v(y.size());
   v.head(nI) = y.head(nI);
   if (nG > 0) v.tail(nG) = s.Lgg.transpose() * u.segment(s.own_offset, nG);
-  s.block.solve_lt(v);
+  s.block->solve_lt(v);
   for (Eigen::Index i = 0; i < s.m; ++i)
     s.b.segment(i * p, p) = v.segment(s.slot[static_cast<std::size_t>(i)] * p, p);
   const Eigen::Index ground = grounded_pose();

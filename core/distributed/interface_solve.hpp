@@ -18,7 +18,9 @@
 // entries in L), the blocks' factors and Schur complements 1.38 -> 0.59.
 // Sigma is as large as the team's interface (ais2klinik at N = 5: 102 coordinates, city10000
 // 909), so every agent holds it: the agents broadcast their Schur complements and coupling
-// blocks once per point and every agent factors the same Sigma from the same bits in id order.
+// blocks once per point and every agent factors the same Sigma from the same bits in id order
+// (or one agent does and the others take its factor's values: sigma_values(), import_sigma();
+// NewtonRefineOptions::ship_sigma).
 // Applying the preconditioner then needs the team's rhat, which is linear in r: CG carries it
 // by its recurrences (rhat of H z rides in the iteration's all-agent sum), so a CG iteration is
 // still one exchange and one sum (newton_refine.cpp).
@@ -71,11 +73,25 @@ class InterfaceSolve {
   /// (flag 2; 1 with it); the flag is 0 when neither is.
   std::vector<double> factor(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
                              const Eigen::MatrixXd& egrad);
+  /// factor() at another point (a trial point) into a second factor, leaving the current one
+  /// and Sigma's in use; commit_pending() makes it the current one (Sigma then due again).
+  std::vector<double> factor_pending(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
+                                     const Eigen::MatrixXd& egrad);
+  void commit_pending();
   /// Every block's factor() values in id order: assembles Sigma and factors Sigma + eta I with
   /// eta = each of `relative_shifts` in turn times its largest diagonal entry. False (and the
   /// solve unusable) when a block's flag is 0 or no shift gives a positive definite factor.
   bool assemble(const std::vector<const std::vector<double>*>& blocks,
                 const std::vector<double>& relative_shifts);
+  /// Sigma's factor after an assemble(), as message values for import_sigma() on the other
+  /// agents: 1, grounded, the relative shift, then the factor's values (SupernodalFactor::
+  /// values()); {0} where the last assemble() failed.
+  std::vector<double> sigma_values() const;
+  /// Takes another agent's sigma_values() from the same shares as this agent's own assemble()
+  /// would factor them, to the bit, without assembling or factoring: true where this agent's
+  /// Sigma factor was last analysed on the same pattern (grounded or not); false otherwise (and
+  /// where that factor failed), leaving assemble() to be called.
+  bool import_sigma(const double* values, std::size_t count);
   /// The shift the last assemble() factored with (relative), 0 before.
   double shift() const;
   /// The held pose, where the last assemble() grounded Sigma and this block owns the team's
@@ -95,7 +111,7 @@ class InterfaceSolve {
 
  private:
   std::vector<double> factor_impl(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
-                                  const Eigen::MatrixXd& egrad, bool multipliers);
+                                  const Eigen::MatrixXd& egrad, bool multipliers, bool pending);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

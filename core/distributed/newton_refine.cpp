@@ -545,6 +545,8 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
 
 void NewtonRefineProtocol::finish(const std::string& why) {
   result_.stop_reason = why;
+  if (shares_ready_) ++result_.pending_factors_unused;  // the accepted trial's, not needed
+  shares_ready_ = false;
   result_.times.wall_s = steady_s() - wall_start_;
   result_.cost = f_;
   result_.grad_norm = gnorm_;

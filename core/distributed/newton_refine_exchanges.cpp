@@ -19,7 +19,17 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
   // This block's share of Sigma at the current point, then its interface residual of -g (the
   // first CG residual), so that the first direction needs no further message step.
   charge_to(&result_.times.factor_s);
-  std::vector<double> values = interface_->factor(X_, Xn_, egrad_);
+  // With the shares in hand (the accepted trial's sum carried them, ship_sigma) the block is
+  // factored at this point already: only its flag goes out, and agent 0's Sigma factor.
+  std::vector<double> values =
+      shares_ready_
+          ? std::vector<double>{next_shares_.at(static_cast<std::size_t>(state_.id())).front()}
+          : interface_->factor(X_, Xn_, egrad_);
+  if (shares_ready_ && state_.id() == 0) {
+    const std::vector<double> sigma = factor_shipped_sigma();
+    values.insert(values.end(), sigma.begin(), sigma.end());
+    charge_to(&result_.times.factor_s);
+  }
   // The gauge at this point (H V: local products, V known on the neighbours' poses).
   gauge_ = std::make_unique<GaugeSpace>(problem_.dim(), X_, Xn_);
   const int k = gauge_->size();
@@ -67,6 +77,21 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
   broadcast(kInterface, values, out);
 }
 
+std::vector<double> NewtonRefineProtocol::factor_shipped_sigma() {
+  charge_to(&result_.times.sigma_s);
+  bool ok = true;
+  for (const auto& v : next_shares_) ok = ok && !v.empty() && v.front() != 0.0;
+  if (ok) {
+    std::vector<const std::vector<double>*> ptrs;
+    for (const auto& v : next_shares_) ptrs.push_back(&v);
+    const double eta = options_.interface_shift;
+    ok = interface_->assemble(ptrs, {eta, 1e3 * eta, 1e6 * eta});
+    ++result_.sigma_factorizations;
+  }
+  if (!ok) return {0.0};
+  return interface_->sigma_values();
+}
+
 std::size_t NewtonRefineProtocol::gauge_share_size() const {
   const auto k = static_cast<std::size_t>(problem_.dim() * (problem_.dim() + 1) / 2);
   return 2 * k * k + k + (options_.project_gauge ? k * k : 0);
@@ -97,6 +122,7 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
       ok = false;
       shares.push_back({0.0});
     } else {
+      // shares_ready_: v is the flag (agent 0: then its Sigma factor) and the residuals.
       const Eigen::Index n = interface_->block_size(b);
       const auto tail = static_cast<std::size_t>(per * n);
       if (v.size() < tail + 1)
@@ -114,12 +140,33 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
     }
     ++b;
   }
-  if (ok) {
+  if (ok && shares_ready_) {
+    // Agent 0's factor of Sigma from the accepted trial's shares (factored there already on
+    // agent 0): taken as it is where this agent's Sigma has the same analysis, else assembled
+    // and factored here from the same shares (the same bits either way).
+    const std::vector<double>& zero = shares.front();
+    if (zero.size() < 2 || zero[1] == 0.0) {
+      ok = false;  // agent 0 found no positive definite shift: neither would this agent
+    } else if (state_.id() != 0) {
+      if (interface_->import_sigma(zero.data() + 1, zero.size() - 1)) {
+        ++result_.sigma_imports;
+      } else {
+        std::vector<const std::vector<double>*> ptrs;
+        for (const auto& v : next_shares_) ptrs.push_back(&v);
+        const double eta = options_.interface_shift;
+        ok = interface_->assemble(ptrs, {eta, 1e3 * eta, 1e6 * eta});
+        ++result_.sigma_factorizations;
+      }
+    }
+  } else if (ok) {
     std::vector<const std::vector<double>*> ptrs;
     for (const auto& v : shares) ptrs.push_back(&v);
     const double eta = options_.interface_shift;
     ok = interface_->assemble(ptrs, {eta, 1e3 * eta, 1e6 * eta});
+    ++result_.sigma_factorizations;
   }
+  shares_ready_ = false;
+  next_shares_.clear();
   interface_due_ = false;
   use_interface_ = ok;
   const Eigen::Map<const Eigen::MatrixXd> vv(gsum.data(), k, k), vhv(gsum.data() + k * k, k, k);

@@ -5,8 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <tessera/distributed/newton_refine.hpp>
 
+#include "distributed/interface_solve.hpp"
 #include "distributed/pipelined_cg.hpp"
 #include "distributed/public_pose_messages.hpp"
 #include "distributed/rigid_retraction.hpp"
@@ -47,13 +50,41 @@ void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
   problem_.cost(Xt_, &share);
   egrad_t_ = problem_.euclidean_gradient(Xt_);
   g_t_ = problem_.riemannian_gradient(Xt_, egrad_t_);
-  broadcast(kTrialSums, {share, g_t_.squaredNorm()}, out);
+  std::vector<double> values{share, g_t_.squaredNorm()};
+  trial_shares_ = ship_trial_shares();
+  if (trial_shares_) {
+    // The block's share of Sigma at the trial point, before the verdict: accepted, agent 0
+    // factors Sigma from these and its factor rides in the next interface step.
+    charge_to(&result_.times.factor_s);
+    const std::vector<double> mine = interface_->factor_pending(Xt_, Xtn_, egrad_t_);
+    values.insert(values.end(), mine.begin(), mine.end());
+  }
+  broadcast(kTrialSums, values, out);
+}
+
+bool NewtonRefineProtocol::ship_trial_shares() const {
+  // Not where the step is predicted to end the refinement (its decrease below the stop's) or
+  // it is the last step allowed: there the block factor would not be used.
+  return options_.ship_sigma && interface_ && use_interface_ &&
+         step_.predicted > options_.relative_decrease_tol * std::abs(f_) &&
+         result_.steps + 1 < options_.max_steps;
 }
 
 void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
                                             std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.trial_s);
-  const std::vector<double> t = reduce_in_id_order(inbox, 2);
+  // The sums (in id order, as reduce_in_id_order), then each block's share of Sigma.
+  double t[2] = {0.0, 0.0};
+  std::vector<std::vector<double>> shares;
+  for (const auto& [sender, m] : inbox) {
+    const auto* p = std::get_if<PoseBlockMessage>(&m);
+    if (!p || p->data.size() < 2 || (p->data.size() > 2) != trial_shares_)
+      throw std::runtime_error("newton refine: malformed trial sums from agent " +
+                               std::to_string(sender));
+    t[0] += p->data[0];
+    t[1] += p->data[1];
+    if (trial_shares_) shares.emplace_back(p->data.begin() + 2, p->data.end());
+  }
   const double ft = t[0], gt = std::sqrt(std::max(0.0, t[1]));
   ++result_.steps;
   const double actual = f_ - ft;
@@ -74,7 +105,15 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
     coarse_due_ = true;
     interface_due_ = true;
     refactor_due_ = true;  // each CG solve preconditioned at its own point (when asked)
+    if (trial_shares_) {
+      interface_->commit_pending();
+      next_shares_ = std::move(shares);
+      shares_ready_ = true;
+    }
+  } else if (trial_shares_) {
+    ++result_.pending_factors_unused;
   }
+  trial_shares_ = false;
   step_.cost = f_;
   step_.grad_norm = gnorm_;
   result_.trace.push_back(step_);

@@ -196,7 +196,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
         *sequence, hooks.resume_from ? sequence->resume(*hooks.resume_from) : sequence->start(),
         [&] { return "stage " + std::to_string(sequence->stage()) + " of the certified solve"; });
     close_stage(0);
-    for (const NewtonRefineResult& r : sequence->refines()) res.refine_times.push_back(r.times);
+    res.refines = sequence->refines();
     const SolveStageRecord& last = sequence->solves().back();
     res.rounds = static_cast<std::uint32_t>(sequence->total_rounds());
     res.restarts = static_cast<std::uint32_t>(sequence->total_restarts());

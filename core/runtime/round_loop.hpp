@@ -179,10 +179,11 @@ struct RoundLoopResult {
   std::uint32_t rounding_steps = 0;
   /// The stages after the rounds on this agent (seconds, summed over the stages of each kind;
   /// 0 where none ran): wall from the message whose handling began the stage to the one whose
-  /// handling began the next, and of it waiting for messages; the refinements' own parts.
+  /// handling began the next, and of it waiting for messages; the refinements' own results
+  /// (their parts' times and this agent's counts).
   double refine_wall_s = 0.0, refine_wait_s = 0.0;
   double certificate_wall_s = 0.0, certificate_wait_s = 0.0;
-  std::vector<NewtonRefineTimes> refine_times;
+  std::vector<NewtonRefineResult> refines;
   // Certification (RunOptions::certify), identical on every agent; bytes summed over agents.
   std::optional<bool> certified;
   double min_eigenvalue = 0.0;

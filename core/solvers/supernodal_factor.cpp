@@ -137,6 +137,71 @@ Eigen::MatrixXd SupernodalFactor::trailing_block(Eigen::Index first) const {
   return out;
 }
 
+namespace {
+
+// Each supernode's columns from its diagonal down (its values are column-major, nr rows per
+// column; the diagonal block's upper triangle is not part of L and is never read by the solves).
+template <class Visit>
+void for_each_factor_column(const cholmod_factor& L, Visit visit) {
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* px = static_cast<const int*>(L.px);
+  for (std::size_t k = 0; k < L.nsuper; ++k) {
+    const int nc = super[k + 1] - super[k], nr = pi[k + 1] - pi[k];
+    for (int j = 0; j < nc; ++j)
+      visit(static_cast<std::size_t>(px[k]) + static_cast<std::size_t>(j) * nr + j,
+            static_cast<std::size_t>(nr - j));
+  }
+}
+
+}  // namespace
+
+std::vector<double> SupernodalFactor::values() const {
+  const Impl& s = *impl_;
+  if (!s.ok || !s.L->is_super || !s.L->x) return {};
+  const double* x = static_cast<const double*>(s.L->x);
+  std::vector<double> out;
+  for_each_factor_column(*s.L, [&](std::size_t at, std::size_t count) {
+    out.insert(out.end(), x + at, x + at + count);
+  });
+  return out;
+}
+
+bool SupernodalFactor::import_values(const double* x, std::size_t count) {
+  Impl& s = *impl_;
+  if (!s.L || !s.L->is_super || s.L->xtype != CHOLMOD_REAL || !s.L->x) return false;
+  std::size_t total = 0;
+  for_each_factor_column(*s.L, [&](std::size_t, std::size_t n) { total += n; });
+  if (total != count) return false;
+  double* to = static_cast<double*>(s.L->x);
+  std::size_t from = 0;
+  for_each_factor_column(*s.L, [&](std::size_t at, std::size_t n) {
+    std::copy_n(x + from, n, to + at);
+    from += n;
+  });
+  s.L->minor = s.L->n;  // a factor that stopped at a pivot holds a complete one now
+  s.ok = true;
+  return true;
+}
+
+void SupernodalFactor::adopt_analysis(const SupernodalFactor& other) {
+  Impl& s = *impl_;
+  const Impl& o = *other.impl_;
+  if (o.ordering != s.ordering)
+    throw std::invalid_argument("SupernodalFactor::adopt_analysis: another ordering");
+  if (s.L) cholmod_free_factor(&s.L, &s.c);
+  s.ok = false;
+  s.n = -1;
+  if (!o.L) return;
+  s.L = cholmod_copy_factor(o.L, &s.c);
+  if (!s.L) throw_cholmod_failure("SupernodalFactor", "copy", s.c.status, o.n, o.n);
+  s.n = o.n;
+  s.outer = o.outer;
+  s.inner = o.inner;
+  s.entries = o.entries;
+  s.flops = o.flops;
+}
+
 int SupernodalFactor::analyses() const {
   return impl_->analyses;
 }

@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <memory>
 #include <tessera/problem/data_matrix.hpp>
+#include <vector>
 
 namespace tessera {
 
@@ -47,6 +48,20 @@ class SupernodalFactor {
   void solve_lt(Eigen::VectorXd& v) const;
   /// kGiven only: L's rows and columns >= first, dense (lower triangular).
   Eigen::MatrixXd trailing_block(Eigen::Index first) const;
+
+  /// The numeric factor's values (CHOLMOD's supernodal L->x, each supernode's columns from the
+  /// diagonal down), for import_values() on another SupernodalFactor; empty without a positive
+  /// definite factor.
+  std::vector<double> values() const;
+  /// Installs values() of a positive definite factor of a matrix with the pattern this one was
+  /// last factored on (the same analysis gives the same supernodes): the solves then give that
+  /// factor's results to the bit. False (nothing changed) where this one holds no numeric
+  /// factor of that layout (no factor() yet, or another size).
+  bool import_values(const double* x, std::size_t count);
+
+  /// Takes `other`'s analysis (ordering, supernodes, pattern; a copy of its factor), so that the
+  /// next factor() of a matrix with that pattern is numeric only. No factor until then.
+  void adopt_analysis(const SupernodalFactor& other);
 
   /// Pattern analyses so far: one per distinct pattern in a row of factor() calls.
   int analyses() const;

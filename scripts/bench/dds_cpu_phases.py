@@ -43,6 +43,9 @@ sys.path.insert(0, HERE)
 import bench_common as bc  # noqa: E402
 
 MARKS = ["partitioned", "first_status", "finals"]
+# --end-to-end: every mark of the coordinator's timeline, in time order.
+MARKS_END_TO_END = ["session", "partitioned", "announced", "ready", "first_status", "last_status",
+                    "finals", "merged"]
 ROLES = ["launch", "fork_server", "coordinator", "agents"]
 
 
@@ -127,13 +130,14 @@ def descendants(root, known):
     return {p for p in out if p == root or os.path.exists("/proc/%d" % p)}
 
 
-def run_launch(tessera, graph, agents, domain, extra, period_s, tmp, env=None):
+def run_launch(tessera, graph, agents, domain, extra, period_s, tmp, env=None, end_to_end=False):
     js = os.path.join(tmp, "dds.json")
     if os.path.exists(js):
         os.unlink(js)
-    p = subprocess.Popen([tessera, "launch", graph, "--agents", str(agents), "--partition",
-                          "highest", "--domain", str(domain), "--json", js, "--init", "file",
-                          "--no-certify", "--quiet"] + extra,
+    fixed = [] if end_to_end else ["--partition", "highest", "--init", "file", "--no-certify"]
+    p = subprocess.Popen([tessera, "launch", graph, "--agents", str(agents), "--domain",
+                          str(domain), "--json", js] + fixed +
+                         ["--quiet"] + extra,
                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
     samples = []  # (monotonic ms, snapshot)
     pids, roles = {p.pid}, {}
@@ -148,9 +152,13 @@ def run_launch(tessera, graph, agents, domain, extra, period_s, tmp, env=None):
     with open(js) as f:
         s = json.load(f)
     base = s["started_monotonic_ms"]
-    marks = {m: base + s["timeline_ms"][m] for m in MARKS if m in s["timeline_ms"]}
+    names = MARKS_END_TO_END if end_to_end else MARKS
+    marks = {m: base + s["timeline_ms"][m] for m in names if m in s["timeline_ms"]}
     row = {"rounds": s["rounds"], "cost": s["cost"], "partition_ms": s["partition_ms"],
            "total_ms": s["total_ms"]}
+    for m in names:
+        if m in s["timeline_ms"]:
+            row["t@%s" % m] = float(s["timeline_ms"][m])
     last = {}
     cut = sorted(marks.items(), key=lambda kv: kv[1])
     at = 0
@@ -174,13 +182,15 @@ def add_cpu(row, mark, threads):
         row["%s@%s:slices" % (role, mark)] = float(sum(v[2] for v in mine))
 
 
-def run_inprocess(tessera, graph, agents, tmp, period_s):
+def run_inprocess(tessera, graph, agents, tmp, period_s, end_to_end=False):
     """(CPU s user + system, run-queue wait s, time slices) of `tessera solve` (the partition
-    is nearly all of it), the latter two from its threads' last schedstat samples."""
+    is nearly all of it), the latter two from its threads' last schedstat samples. With
+    end_to_end, the centralized solver's (`tessera solve G --algorithm centralized`)."""
     u0 = bc.children_usage()
-    p = subprocess.Popen([tessera, "solve", graph, "--algorithm", "irbcd", "--agents",
-                          str(agents), "--partition", "highest", "--init", "file", "--json",
-                          os.path.join(tmp, "ip.json")],
+    args = ([tessera, "solve", graph, "--algorithm", "centralized"] if end_to_end else
+            [tessera, "solve", graph, "--algorithm", "irbcd", "--agents", str(agents),
+             "--partition", "highest", "--init", "file"])
+    p = subprocess.Popen(args + ["--json", os.path.join(tmp, "ip.json")],
                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     last = {}
     while p.poll() is None:
@@ -195,6 +205,30 @@ def run_inprocess(tessera, graph, agents, tmp, period_s):
         sys.exit("tessera solve failed")
     return (bc.cpu_since(u0), sum(v[1] for v in last.values()) / 1e9,
             float(sum(v[2] for v in last.values())))
+
+
+def print_phases(title, row):
+    """CPU seconds of each role between consecutive timeline marks (--end-to-end)."""
+    marks = [m for m in MARKS_END_TO_END if "t@%s" % m in row]
+    marks.sort(key=lambda m: row["t@%s" % m])
+    print("%s: CPU s by phase (from launch's start to each mark of the coordinator's timeline, "
+          "ms)" % title)
+    print("| phase | until ms | " + " | ".join(ROLES) + " | all |")
+    print("|---|---|" + "---|" * (len(ROLES) + 1))
+    prev = "start"
+    for m in marks + ["end"]:
+        cells, total = [], 0.0
+        for role in ROLES:
+            now = row.get("%s@%s" % (role, m), 0.0)
+            before = row.get("%s@%s" % (role, prev), 0.0) if prev != "start" else 0.0
+            cells.append("%.3f" % (now - before))
+            total += now - before
+        until = "%.0f" % row["t@%s" % m] if m != "end" else "%.0f" % row["total_ms"]
+        print("| %s..%s | %s | %s | %.3f |" % (prev, m, until, " | ".join(cells), total))
+        prev = m
+    print("| all | | %s | %.3f |" % (" | ".join("%.3f" % row.get("%s@end" % r, 0.0) for r in ROLES),
+                                    sum(row.get("%s@end" % r, 0.0) for r in ROLES)))
+    print("centralized solver (tessera solve G): %.3f CPU s" % row["cpu_inprocess_s"])
 
 
 def main():
@@ -213,6 +247,10 @@ def main():
     ap.add_argument("--domain", type=int, default=0)
     ap.add_argument("--period-ms", type=float, default=3.0)
     ap.add_argument("--csv", default="")
+    ap.add_argument("--end-to-end", action="store_true",
+                    help="launch with its defaults (partition, certified, initialisation) "
+                    "instead of --partition highest --init file --no-certify; CPU cut at every timeline mark, printed per "
+                    "phase; compared with the centralized solver (tessera solve G)")
     a = ap.parse_args()
     ab = bool(a.ab) or a.ab_launch_args is not None or bool(a.ab_env)
     variants = [("A", a.bin, a.launch_args.split(), None)]
@@ -228,15 +266,19 @@ def main():
             for name, bindir, extra, env in variants:
                 tessera = os.path.join(bindir, "tessera")
                 row = run_launch(tessera, graph, a.agents, a.domain, extra, a.period_ms / 1000,
-                                 tmp, env)
+                                 tmp, env, a.end_to_end)
                 if row is None:
                     sys.exit("run %d (%s) failed" % (k + 1, name))
                 row["variant"], row["run"] = name, k + 1
                 (row["cpu_inprocess_s"], row["wait_inprocess_s"],
                  row["slices_inprocess"]) = run_inprocess(tessera, graph, a.agents, tmp,
-                                                          a.period_ms / 1000)
+                                                          a.period_ms / 1000, a.end_to_end)
                 row["load"] = os.getloadavg()[0]
                 rows.append(row)
+                if a.end_to_end:
+                    print_phases("%s run %d (load %.1f, %d rounds, total %.0f ms)" % (
+                        name, k + 1, row["load"], row["rounds"], row["total_ms"]), row)
+                    continue
                 print("%s run %d: %d rounds, cost %.15g, load %.1f, partition %.0f ms, total %.0f "
                       "ms; CPU s to partitioned / first_status / finals / end: %s; in-process %.3f"
                       % (name, k + 1, row["rounds"], row["cost"], row["load"],
@@ -254,6 +296,10 @@ def main():
         mine = [r for r in rows if r["variant"] == name]
         med = {key: statistics.median(r[key] for r in mine)
                for key in mine[0] if isinstance(mine[0][key], float)}
+        if a.end_to_end:
+            print_phases("%s median over %d runs (loads %s)" % (
+                name, len(mine), ", ".join("%.1f" % r["load"] for r in mine)), med)
+            continue
         print("%s median over %d runs: partition %.0f ms, total %.0f ms; CPU s %s; in-process %.3f" % (
             name, len(mine), med["partition_ms"], med["total_ms"], "; ".join("%s %s" % (role, " / ".join(
                 "%.3f" % med.get("%s@%s" % (role, m), 0) for m in MARKS + ["end"]))

@@ -221,6 +221,21 @@ struct NewtonRefineOptions {
   /// curvature along the gauge (6 steps, one rejected, 36 message steps; projected: 4, 31)
   /// (docs/newton-refine.md, "Gauge").
   bool project_gauge = false;
+  /// With the interface solves: true, where the model says a trial step will not end the
+  /// refinement (its predicted decrease above relative_decrease_tol |f|, steps left), each
+  /// agent factors its block at the trial point before the verdict and its share of Sigma rides
+  /// in the trial's sum; at an accepted trial agent 0 alone assembles and factors Sigma and
+  /// sends the factor in the interface step that every point has anyway (the other agents take
+  /// it as it is: the same bits as their own factorization). false: every agent assembles and
+  /// factors Sigma at every point. Both take the same steps, CG iterations and message steps
+  /// to the same bits; the start point and a step predicted to be the last take the
+  /// every-agent path. Why false: on city10000 at N = 5 shipping saves 9.3 % of the
+  /// refinement's instructions in process (1.95 -> 1.77 G) but sends Sigma's factor (1.9 MB) to
+  /// every agent at each shipped point (DDS bytes 9.1 -> 13.0 MB), and over DDS on one 2-core
+  /// machine the agents' CPU after the rounds did not fall (medians of 6 launches 0.85 vs
+  /// 1.08 CPU-s, load 12-17): what the agents' threads save in factorizations their transport
+  /// spends moving the factor (docs/newton-refine.md, "Who factors Sigma").
+  bool ship_sigma = false;
   /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
   CoarseOptions coarse_space_options() const;
   /// Throws InputError naming the bad field.
@@ -254,9 +269,9 @@ struct NewtonRefineTimes {
   /// Each point's factorizations: the interface solves' block factors, Schur complements,
   /// couplings and the gauge's products (or block Jacobi's factor), and the coarse matrix.
   double factor_s = 0.0;
-  double sigma_s = 0.0;         ///< Sigma's assembly and factorization (every agent, per point).
-  double cg_s = 0.0;            ///< CG iterations: preconditioner, Hessian products, sums.
-  double trial_s = 0.0;         ///< Trial points: retraction, cost and gradient, verdict.
+  double sigma_s = 0.0;  ///< Sigma's assembly and factorization (or taking agent 0's), per point.
+  double cg_s = 0.0;     ///< CG iterations: preconditioner, Hessian products, sums.
+  double trial_s = 0.0;  ///< Trial points: retraction, cost and gradient, verdict.
   double translations_s = 0.0;  ///< Trial translations: exact solves or the translation CG.
   double cpu_s = 0.0;           ///< All of the above.
   double wall_s = 0.0;          ///< start() to the end (waits for the team included).
@@ -286,6 +301,10 @@ struct NewtonRefineResult {
   /// (0: not used), the points where Sigma was factored (one all-agent message step each,
   /// counted in `reductions`) and where it could not be (that step's CG ran block Jacobi).
   int interface_coordinates = 0, interface_factorizations = 0, interface_fallbacks = 0;
+  /// This agent's own assemblies and factorizations of Sigma (points), the points whose Sigma it
+  /// took from agent 0's factor (ship_sigma), and the block factorizations at trial points that
+  /// were not used (a rejected trial, or the refinement stopped there).
+  int sigma_factorizations = 0, sigma_imports = 0, pending_factors_unused = 0;
   std::vector<NewtonRefineStep> trace;
   NewtonRefineTimes times;  ///< This agent's.
 };
@@ -388,8 +407,14 @@ class NewtonRefineProtocol : public AgentProcess {
   void after_translation_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   // Exact trial translations: the team's interface solve, then the trial's sums.
   void after_translation_solve(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
-  // The trial point's cost share and ||g||^2 (kTrialSums), its neighbours' poses set.
+  // The trial point's cost share and ||g||^2 (kTrialSums), its neighbours' poses set; with
+  // ship_trial_shares(), the block's share of Sigma at the trial point after them.
   void send_trial_sums(std::vector<OutgoingMessage>& out);
+  // Whether this trial's sum carries the Sigma shares (options_.ship_sigma): the same inputs,
+  // so the same answer, on every agent.
+  bool ship_trial_shares() const;
+  // Agent 0 with the shares in hand: Sigma assembled and factored, its factor's message values.
+  std::vector<double> factor_shipped_sigma();
 
   // Charges this thread's CPU time since the last switch to the current part, then makes
   // `part` (a field of result_.times, or nullptr between messages) the current one.
@@ -438,6 +463,10 @@ class NewtonRefineProtocol : public AgentProcess {
   // CG's recurrences (the one of H z rides in the iteration's sum).
   std::unique_ptr<InterfaceSolve> interface_;
   bool interface_due_ = true, use_interface_ = false;
+  // ship_sigma: whether the current trial's sum carries the shares; the team's shares at the
+  // accepted trial (id order), in hand for the next interface step (shares_ready_).
+  bool trial_shares_ = false, shares_ready_ = false;
+  std::vector<std::vector<double>> next_shares_;
   Eigen::VectorXd iy_r_, iy_q_, iy_w_, iy_g_, ir_, iq_, ir_g_;
   // The gauge with the interface solves (distributed/gauge_space.hpp): its basis V and H V at
   // the point, the sums V^T V, V^T H V and V^T g (in the interface matrix's sum), and the

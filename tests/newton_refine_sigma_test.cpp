@@ -1,0 +1,67 @@
+// Who factors the refinement's interface matrix Sigma (NewtonRefineOptions::ship_sigma): agent 0
+// alone, from the shares that rode in an accepted trial's sums, sending its factor to the
+// others, or every agent at every point. Both take the same steps, CG iterations and message
+// steps to the same bits.
+
+#include <gtest/gtest.h>
+
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/newton_refine.hpp>
+#include <tessera/partition/sequential_partition.hpp>
+#include <vector>
+
+#include "refine_harness.hpp"
+
+namespace tessera {
+namespace {
+
+DistributedOptions refined(bool ship) {
+  DistributedOptions o;
+  o.grad_norm_tol = 0.01;
+  set_refine_mode(o.refine, "newton");
+  o.refine.ship_sigma = ship;
+  return o;
+}
+
+TEST(NewtonRefineSigma, AgentZeroFactoringSigmaTakesTheSameStepsAsEveryAgentFactoringIt) {
+  const PoseGraph g = test::refine_chain(600, 3);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  const DistributedResult every = solve_distributed(g, parts, refined(false));
+  const DistributedResult one = solve_distributed(g, parts, refined(true));
+  ASSERT_EQ(every.refines.size(), 1u);
+  ASSERT_EQ(one.refines.size(), 1u);
+  const NewtonRefineResult &a = every.refines[0], &b = one.refines[0];
+  ASSERT_GT(a.interface_coordinates, 0) << "the chain's refinement should use interface solves";
+  EXPECT_EQ(b.steps, a.steps);
+  EXPECT_EQ(b.accepted_steps, a.accepted_steps);
+  EXPECT_EQ(b.cg_iterations, a.cg_iterations);
+  EXPECT_EQ(b.exchanges, a.exchanges);
+  EXPECT_EQ(b.reductions, a.reductions);
+  EXPECT_EQ(b.interface_factorizations, a.interface_factorizations);
+  EXPECT_EQ(b.cost, a.cost);
+  EXPECT_EQ(one.relaxation_cost, every.relaxation_cost);
+  EXPECT_EQ(one.cost, every.cost);
+  ASSERT_EQ(one.poses.size(), every.poses.size());
+  for (std::size_t i = 0; i < one.poses.size(); ++i) {
+    ASSERT_EQ(one.poses[i].R, every.poses[i].R) << "pose " << i;
+    ASSERT_EQ(one.poses[i].t, every.poses[i].t) << "pose " << i;
+  }
+  // Every agent factors at every point without shipping; with it, agent 0 (the one reported)
+  // factors at every point too, and a point after the start takes the shipped path unless
+  // its step was predicted to be the last.
+  EXPECT_EQ(a.sigma_factorizations, a.interface_factorizations);
+  EXPECT_EQ(a.sigma_imports, 0);
+  EXPECT_EQ(a.pending_factors_unused, 0);
+  EXPECT_EQ(b.sigma_factorizations, b.interface_factorizations);
+  EXPECT_EQ(b.sigma_imports, 0) << "agent 0 factors; the others take its factor";
+  EXPECT_LE(b.pending_factors_unused, b.steps - b.accepted_steps + 1);
+}
+
+TEST(NewtonRefineSigma, EveryAgentTakesTheSameStepsInAnyDeliveryOrderWithSigmaShipped) {
+  const PoseGraph g = test::refine_chain(600, 3);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 3);
+  test::expect_same_refinement_in_any_delivery_order(g, parts, refined(true), 7);
+}
+
+}  // namespace
+}  // namespace tessera
