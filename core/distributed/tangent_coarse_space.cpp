@@ -35,6 +35,29 @@ TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayo
   if (k < 1) throw std::invalid_argument("TangentCoarseSpace: no active rows");
   for (int a = 0; a < k; ++a)
     for (int b = a + 1; b < k; ++b) rotation_pairs_.emplace_back(a, b);
+  // Groups of linked pieces: the components of the block graph (every agent has the layout, so
+  // every agent finds the same numbering).
+  std::vector<int> root(static_cast<std::size_t>(layout.num_blocks));
+  for (int b = 0; b < layout.num_blocks; ++b) root[static_cast<std::size_t>(b)] = b;
+  auto find = [&](int b) {
+    while (root[static_cast<std::size_t>(b)] != b)
+      b = root[static_cast<std::size_t>(b)] =
+          root[static_cast<std::size_t>(root[static_cast<std::size_t>(b)])];
+    return b;
+  };
+  for (int b = 0; b < layout.num_blocks; ++b)
+    for (int a : layout.adjacent[static_cast<std::size_t>(b)]) {
+      const int ra = find(a), rb = find(b);
+      if (ra != rb) root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+    }
+  std::vector<int> group_of_root(static_cast<std::size_t>(layout.num_blocks), -1);
+  group_of_piece_.resize(static_cast<std::size_t>(pieces_));
+  for (int alpha = 0; alpha < pieces_; ++alpha) {
+    const int block = space ? space->aggregate_block[static_cast<std::size_t>(alpha)] : alpha;
+    int& g = group_of_root[static_cast<std::size_t>(find(block))];
+    if (g < 0) g = groups_++;
+    group_of_piece_[static_cast<std::size_t>(alpha)] = g;
+  }
   own_poses_ = weights_of(space, layout, owned);
   neighbour_poses_ = weights_of(space, layout, neighbours);
   std::vector<char> own(static_cast<std::size_t>(pieces_), 0), any = own;
@@ -136,11 +159,16 @@ Eigen::MatrixXd TangentCoarseSpace::pseudo_inverse(const Eigen::MatrixXd& A, dou
   const Eigen::Index n = size();
   if (A.rows() != n || A.cols() != n)
     throw std::invalid_argument("TangentCoarseSpace: coarse matrix of the wrong size");
-  // P = I - U U^T, U's columns the global motions (generator j on every piece) normalized.
-  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, g_);
-  const double s = 1.0 / std::sqrt(static_cast<double>(pieces_));
-  for (int alpha = 0; alpha < pieces_; ++alpha)
-    for (int j = 0; j < g_; ++j) U(alpha * g_ + j, j) = s;
+  // P = I - U U^T, U's columns the rigid motions of each group (generator j on every piece of
+  // the group) normalized; the groups' supports are disjoint, so the columns are orthonormal.
+  std::vector<int> members(static_cast<std::size_t>(groups_), 0);
+  for (int g : group_of_piece_) ++members[static_cast<std::size_t>(g)];
+  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(groups_) * g_);
+  for (int alpha = 0; alpha < pieces_; ++alpha) {
+    const int g = group_of_piece_[static_cast<std::size_t>(alpha)];
+    const double s = 1.0 / std::sqrt(static_cast<double>(members[static_cast<std::size_t>(g)]));
+    for (int j = 0; j < g_; ++j) U(alpha * g_ + j, g * g_ + j) = s;
+  }
   const Eigen::MatrixXd PA = A - U * (U.transpose() * A);
   Eigen::MatrixXd B = PA - (PA * U) * U.transpose();
   B = (0.5 * (B + B.transpose())).eval();

@@ -54,11 +54,22 @@ class TangentCoarseSpace {
   void unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown, Eigen::MatrixXd& v,
             Eigen::MatrixXd& vn) const;
 
+  /// Pieces whose poses are linked by measurements, directly or through other pieces (the
+  /// connected components of the layout's block graph; a piece of the smoothed space goes with
+  /// its block): group_of(alpha) numbers them densely in order of their first piece.
+  int groups() const { return groups_; }
+  int group_of(int piece) const { return group_of_piece_[static_cast<std::size_t>(piece)]; }
+
   /// A positive semi-definite inverse of the Galerkin matrix A (size() x size(), symmetric):
-  /// the global rigid motions (every piece the same generator: f does not change along them)
-  /// are projected out, then eigenvalues at or below `tol` times the largest (the gauge,
-  /// generators that move no pose, and any negative curvature, which a preconditioner must
-  /// not invert) are dropped. Deterministic: the same A gives the same bits on every agent.
+  /// the rigid motions of each group of linked pieces (every piece of the group the same
+  /// generator: f does not change along them) are projected out, then eigenvalues at or below
+  /// `tol` times the largest (generators that move no pose, and any negative curvature, which a
+  /// preconditioner must not invert) are dropped. Per group, not only the whole team's motion:
+  /// an online graph whose robots have not all met has one gauge per piece of the map, where
+  /// A's entries are round-off or of the gradient's order (f is invariant only at a critical
+  /// point to second order), which a tolerance relative to the largest eigenvalue does not
+  /// catch; their inverses sent CG along directions the retraction does not keep f on.
+  /// Deterministic: the same A gives the same bits on every agent.
   Eigen::MatrixXd pseudo_inverse(const Eigen::MatrixXd& A, double tol = 1e-10) const;
 
  private:
@@ -80,6 +91,8 @@ class TangentCoarseSpace {
             Eigen::MatrixXd& v) const;
 
   int d_, k_, g_, pieces_;
+  int groups_ = 0;
+  std::vector<int> group_of_piece_;
   Poses own_poses_, neighbour_poses_;
   std::vector<int> touched_, own_;
   std::vector<std::pair<int, int>> rotation_pairs_;  // (a, b), a < b, for generators 0..
