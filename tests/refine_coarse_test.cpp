@@ -207,6 +207,9 @@ TEST(TangentCoarseSpace, APieceLinkedToNoOtherHasItsRigidMotionsLeftOutOfTheInve
   EXPECT_EQ(c.groups(), 2);
   EXPECT_EQ(c.group_of(0), c.group_of(1));
   EXPECT_NE(c.group_of(0), c.group_of(2));
+  // Block 2's agent assembles nothing: its piece's motions are all gauge.
+  EXPECT_TRUE(TangentCoarseSpace(nullptr, layout, layout.poses[2], {}, 3, 3).touched().empty());
+  EXPECT_EQ(c.touched().size(), 2u * static_cast<std::size_t>(c.generators()));
   const int g = c.generators();
   std::mt19937 rng(3);
   std::normal_distribution<double> normal;

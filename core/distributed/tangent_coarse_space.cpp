@@ -64,11 +64,18 @@ TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayo
   for (const Weight& w : own_poses_.weights)
     own[static_cast<std::size_t>(w.piece)] = any[static_cast<std::size_t>(w.piece)] = 1;
   for (const Weight& w : neighbour_poses_.weights) any[static_cast<std::size_t>(w.piece)] = 1;
-  for (int a = 0; a < pieces_; ++a)
+  // A piece alone in its group moves only by its gauge: A^+ is zero on its unknowns, so they are
+  // left out of touched() and own() (no Hessian product assembles their columns of A).
+  std::vector<int> members(static_cast<std::size_t>(groups_), 0);
+  for (int g : group_of_piece_) ++members[static_cast<std::size_t>(g)];
+  for (int a = 0; a < pieces_; ++a) {
+    if (members[static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(a)])] < 2)
+      continue;
     for (int j = 0; j < g_; ++j) {
       if (own[static_cast<std::size_t>(a)]) own_.push_back(a * g_ + j);
       if (any[static_cast<std::size_t>(a)]) touched_.push_back(a * g_ + j);
     }
+  }
 }
 
 void TangentCoarseSpace::add_generator(int j, double x, Eigen::MatrixXd& E) const {
@@ -132,7 +139,8 @@ void TangentCoarseSpace::expand(const Eigen::MatrixXd& X, const Eigen::VectorXd&
     Ei.setZero();
     for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
       const Weight& w = own_poses_.weights[q];
-      Ei += w.w * E[static_cast<std::size_t>(w.piece)];
+      const Eigen::MatrixXd& e = E[static_cast<std::size_t>(w.piece)];
+      if (e.size() > 0) Ei += w.w * e;  // empty: a piece alone in its group
     }
     move(Ei, X, static_cast<Eigen::Index>(s), v);
   }

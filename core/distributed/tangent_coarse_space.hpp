@@ -39,9 +39,10 @@ class TangentCoarseSpace {
   /// Coarse unknowns: pieces() x generators(), unknown alpha * generators() + j.
   int size() const { return pieces_ * g_; }
   /// The unknowns whose vectors are non-zero on an own pose or a neighbour copy, ascending:
-  /// the columns of A this agent's rows contribute to.
+  /// the columns of A this agent's rows contribute to. Only pieces linked to another piece
+  /// (groups()): a piece alone in its group moves only by its gauge, where A^+ is zero.
   const std::vector<int>& touched() const { return touched_; }
-  /// The unknowns non-zero on an own pose, ascending.
+  /// The unknowns non-zero on an own pose, ascending (of linked pieces, as touched()).
   const std::vector<int>& own() const { return own_; }
 
   /// out += Phi^T v over the own poses (X: the own point, v: a vector of its shape; out has
