@@ -68,14 +68,24 @@ TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayo
   // left out of touched() and own() (no Hessian product assembles their columns of A).
   std::vector<int> members(static_cast<std::size_t>(groups_), 0);
   for (int g : group_of_piece_) ++members[static_cast<std::size_t>(g)];
+  linked_.assign(static_cast<std::size_t>(pieces_), 0);
   for (int a = 0; a < pieces_; ++a) {
     if (members[static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(a)])] < 2)
       continue;
+    linked_[static_cast<std::size_t>(a)] = 1;
     for (int j = 0; j < g_; ++j) {
       if (own[static_cast<std::size_t>(a)]) own_.push_back(a * g_ + j);
       if (any[static_cast<std::size_t>(a)]) touched_.push_back(a * g_ + j);
     }
   }
+  // project() and expand() visit only the own poses some linked piece weighs (none before the
+  // robots meet): a lone piece's entries of Phi^T v meet only zeros of A^+.
+  for (std::size_t slot = 0; slot + 1 < own_poses_.start.size(); ++slot)
+    for (std::size_t q = own_poses_.start[slot]; q < own_poses_.start[slot + 1]; ++q)
+      if (linked_[static_cast<std::size_t>(own_poses_.weights[q].piece)]) {
+        linked_slots_.push_back(slot);
+        break;
+      }
 }
 
 void TangentCoarseSpace::add_generator(int j, double x, Eigen::MatrixXd& E) const {
@@ -103,14 +113,14 @@ void TangentCoarseSpace::project(const Eigen::MatrixXd& X, const Eigen::MatrixXd
   const Eigen::Index kk = k_ * (k_ + 1);
   std::vector<double> acc(static_cast<std::size_t>(pieces_ * kk), 0.0);
   Eigen::MatrixXd N(k_, k_ + 1);
-  const std::size_t n = own_poses_.start.size() - 1;
-  for (std::size_t s = 0; s < n; ++s) {
+  for (std::size_t s : linked_slots_) {
     const Eigen::Index c = static_cast<Eigen::Index>(s) * (d_ + 1);
     N.leftCols(k_).noalias() = v.middleCols(c, d_ + 1) * X.middleCols(c, d_ + 1).transpose();
     N.col(k_) = v.col(c + d_);
     for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
       const Weight& w = own_poses_.weights[q];
-      Eigen::Map<Eigen::MatrixXd>(acc.data() + w.piece * kk, k_, k_ + 1) += w.w * N;
+      if (linked_[static_cast<std::size_t>(w.piece)])
+        Eigen::Map<Eigen::MatrixXd>(acc.data() + w.piece * kk, k_, k_ + 1) += w.w * N;
     }
   }
   const int rotations = static_cast<int>(rotation_pairs_.size());
@@ -134,8 +144,7 @@ void TangentCoarseSpace::expand(const Eigen::MatrixXd& X, const Eigen::VectorXd&
     add_generator(u % g_, xi(u), e);
   }
   Eigen::MatrixXd Ei(k_, k_ + 1);
-  const std::size_t n = own_poses_.start.size() - 1;
-  for (std::size_t s = 0; s < n; ++s) {
+  for (std::size_t s : linked_slots_) {
     Ei.setZero();
     for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
       const Weight& w = own_poses_.weights[q];

@@ -46,9 +46,9 @@ class TangentCoarseSpace {
   const std::vector<int>& own() const { return own_; }
 
   /// out += Phi^T v over the own poses (X: the own point, v: a vector of its shape; out has
-  /// size() entries).
+  /// size() entries), at the linked pieces' unknowns (the others are left as they are).
   void project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, double* out) const;
-  /// v += Phi xi on the own poses (X's shape).
+  /// v += Phi xi on the own poses (X's shape), xi's entries at own() only.
   void expand(const Eigen::MatrixXd& X, const Eigen::VectorXd& xi, Eigen::MatrixXd& v) const;
   /// The vector of one unknown on the own poses (v) and the neighbour copies (vn), set to the
   /// shapes of X and Xn.
@@ -94,6 +94,8 @@ class TangentCoarseSpace {
   int d_, k_, g_, pieces_;
   int groups_ = 0;
   std::vector<int> group_of_piece_;
+  std::vector<char> linked_;               // by piece: in a group with another piece
+  std::vector<std::size_t> linked_slots_;  // own slots some linked piece weighs
   Poses own_poses_, neighbour_poses_;
   std::vector<int> touched_, own_;
   std::vector<std::pair<int, int>> rotation_pairs_;  // (a, b), a < b, for generators 0..
