@@ -207,8 +207,13 @@ TEST(TangentCoarseSpace, APieceLinkedToNoOtherHasItsRigidMotionsLeftOutOfTheInve
   EXPECT_EQ(c.groups(), 2);
   EXPECT_EQ(c.group_of(0), c.group_of(1));
   EXPECT_NE(c.group_of(0), c.group_of(2));
+  EXPECT_TRUE(c.linked());
   // Block 2's agent assembles nothing: its piece's motions are all gauge.
   EXPECT_TRUE(TangentCoarseSpace(nullptr, layout, layout.poses[2], {}, 3, 3).touched().empty());
+  // Three chains that never meet: no correction at all.
+  const BlockLayout apart = make_block_layout(
+      45, std::vector<std::pair<std::uint32_t, std::uint32_t>>{{0, 1}, {15, 16}, {30, 31}}, parts);
+  EXPECT_FALSE(TangentCoarseSpace(nullptr, apart, apart.poses[0], {}, 3, 3).linked());
   EXPECT_EQ(c.touched().size(), 2u * static_cast<std::size_t>(c.generators()));
   const int g = c.generators();
   std::mt19937 rng(3);

@@ -176,27 +176,40 @@ Eigen::MatrixXd TangentCoarseSpace::pseudo_inverse(const Eigen::MatrixXd& A, dou
   const Eigen::Index n = size();
   if (A.rows() != n || A.cols() != n)
     throw std::invalid_argument("TangentCoarseSpace: coarse matrix of the wrong size");
-  // P = I - U U^T, U's columns the rigid motions of each group (generator j on every piece of
-  // the group) normalized; the groups' supports are disjoint, so the columns are orthonormal.
+  // Pieces of different groups share no measurement, so A is block diagonal over the groups and
+  // so is its pseudo-inverse: one small eigendecomposition per group of two pieces or more (a
+  // lone piece's block is all gauge, zero), not one of all the pieces' unknowns at every point.
+  std::vector<std::vector<Eigen::Index>> unknowns(static_cast<std::size_t>(groups_));
   std::vector<int> members(static_cast<std::size_t>(groups_), 0);
-  for (int g : group_of_piece_) ++members[static_cast<std::size_t>(g)];
-  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(groups_) * g_);
   for (int alpha = 0; alpha < pieces_; ++alpha) {
-    const int g = group_of_piece_[static_cast<std::size_t>(alpha)];
-    const double s = 1.0 / std::sqrt(static_cast<double>(members[static_cast<std::size_t>(g)]));
-    for (int j = 0; j < g_; ++j) U(alpha * g_ + j, g * g_ + j) = s;
+    const auto g = static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(alpha)]);
+    ++members[g];
+    for (int j = 0; j < g_; ++j) unknowns[g].push_back(alpha * g_ + j);
   }
-  const Eigen::MatrixXd PA = A - U * (U.transpose() * A);
-  Eigen::MatrixXd B = PA - (PA * U) * U.transpose();
-  B = (0.5 * (B + B.transpose())).eval();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(B);
-  const Eigen::VectorXd& l = eig.eigenvalues();
-  const double top = l.size() > 0 ? l(l.size() - 1) : 0.0;
-  Eigen::VectorXd inv = Eigen::VectorXd::Zero(l.size());
-  for (Eigen::Index i = 0; i < l.size(); ++i)
-    if (top > 0 && l(i) > tol * top) inv(i) = 1.0 / l(i);
-  const Eigen::MatrixXd& V = eig.eigenvectors();
-  return V * inv.asDiagonal() * V.transpose();
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, n);
+  for (std::size_t group = 0; group < unknowns.size(); ++group) {
+    if (members[group] < 2) continue;
+    const std::vector<Eigen::Index>& idx = unknowns[group];
+    const auto m = static_cast<Eigen::Index>(idx.size());
+    // P = I - U U^T, U's columns the group's rigid motions (generator j on every piece of the
+    // group) normalized.
+    Eigen::MatrixXd U = Eigen::MatrixXd::Zero(m, g_);
+    const double s = 1.0 / std::sqrt(static_cast<double>(members[group]));
+    for (Eigen::Index q = 0; q < m; ++q) U(q, q % g_) = s;
+    const Eigen::MatrixXd Ag = A(idx, idx);
+    const Eigen::MatrixXd PA = Ag - U * (U.transpose() * Ag);
+    Eigen::MatrixXd B = PA - (PA * U) * U.transpose();
+    B = (0.5 * (B + B.transpose())).eval();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(B);
+    const Eigen::VectorXd& l = eig.eigenvalues();
+    const double top = l.size() > 0 ? l(l.size() - 1) : 0.0;
+    Eigen::VectorXd inv = Eigen::VectorXd::Zero(l.size());
+    for (Eigen::Index i = 0; i < l.size(); ++i)
+      if (top > 0 && l(i) > tol * top) inv(i) = 1.0 / l(i);
+    const Eigen::MatrixXd& V = eig.eigenvectors();
+    out(idx, idx) = V * inv.asDiagonal() * V.transpose();
+  }
+  return out;
 }
 
 }  // namespace tessera

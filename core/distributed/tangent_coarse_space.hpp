@@ -60,6 +60,8 @@ class TangentCoarseSpace {
   /// its block): group_of(alpha) numbers them densely in order of their first piece.
   int groups() const { return groups_; }
   int group_of(int piece) const { return group_of_piece_[static_cast<std::size_t>(piece)]; }
+  /// Some group holds two pieces or more (else the correction is zero: every motion is gauge).
+  bool linked() const { return groups_ < pieces_; }
 
   /// A positive semi-definite inverse of the Galerkin matrix A (size() x size(), symmetric):
   /// the rigid motions of each group of linked pieces (every piece of the group the same
@@ -70,7 +72,8 @@ class TangentCoarseSpace {
   /// A's entries are round-off or of the gradient's order (f is invariant only at a critical
   /// point to second order), which a tolerance relative to the largest eigenvalue does not
   /// catch; their inverses sent CG along directions the retraction does not keep f on.
-  /// Deterministic: the same A gives the same bits on every agent.
+  /// Computed per group (A is block diagonal over them; the tolerance is relative to each
+  /// group's largest eigenvalue). Deterministic: the same A gives the same bits on every agent.
   Eigen::MatrixXd pseudo_inverse(const Eigen::MatrixXd& A, double tol = 1e-10) const;
 
  private:
