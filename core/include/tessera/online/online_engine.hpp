@@ -97,7 +97,7 @@ struct OnlineOptions {
   /// and 105.5 against 499.5 at 10,200-12,000 (CPU 1.84 / 3.43 s a step against 2.13 / 6.97,
   /// load 13-15). Off by default because while few robots have met it costs more than it
   /// saves: the coarse matrix is summed at every accepted Newton step (a generated 1,000-pose
-  /// grid3d over 5 robots: 512 CG iterations against 601, 6.41 G instructions against 3.40 G,
+  /// grid3d over 5 robots: 512 CG iterations against 601, 6.30 G instructions against 3.40 G,
   /// callgrind; docs/online.md, "The coarse correction").
   NewtonRefineOptions::Coarse newton_coarse = NewtonRefineOptions::Coarse::kNone;
   /// New poses that new loop closures tie to the estimate are placed by least squares against
