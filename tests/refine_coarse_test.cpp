@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <string>
 #include <tessera/distributed/block_layout.hpp>
@@ -15,6 +16,7 @@
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
+#include <utility>
 #include <vector>
 
 #include "distributed/tangent_coarse_space.hpp"
@@ -186,6 +188,51 @@ TEST(NewtonRefineOptions, TheCoarseSpaceOptionsAreCheckedByName) {
   o = {};
   o.coarse_smoothing_steps = -1;
   EXPECT_NE(message(o).find("coarse_smoothing_steps"), std::string::npos);
+}
+
+TEST(TangentCoarseSpace, APieceLinkedToNoOtherHasItsRigidMotionsLeftOutOfTheInverse) {
+  // Two chains that share no measurement (robots that have not met): blocks 0 and 1 split the
+  // first, block 2 holds the second. Each chain's rigid motion leaves f unchanged, so A's
+  // entries there are round-off (or of the gradient's order away from a critical point); the
+  // pseudo-inverse must not invert them whatever they are. Here A is any symmetric positive
+  // definite matrix: block 2's rows and columns of A^+ and the common motion of blocks 0 and 1
+  // must come out zero, the relative motion of blocks 0 and 1 inverted.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::uint32_t i = 0; i + 1 < 30; ++i) edges.emplace_back(i, i + 1);
+  for (std::uint32_t i = 30; i + 1 < 45; ++i) edges.emplace_back(i, i + 1);
+  std::vector<int> parts(45, 0);
+  for (std::size_t i = 15; i < 45; ++i) parts[i] = i < 30 ? 1 : 2;
+  const BlockLayout layout = make_block_layout(45, edges, parts);
+  const TangentCoarseSpace c(nullptr, layout, layout.poses[0], {15}, 3, 3);
+  EXPECT_EQ(c.groups(), 2);
+  EXPECT_EQ(c.group_of(0), c.group_of(1));
+  EXPECT_NE(c.group_of(0), c.group_of(2));
+  EXPECT_TRUE(c.linked());
+  // Block 2's agent assembles nothing: its piece's motions are all gauge.
+  EXPECT_TRUE(TangentCoarseSpace(nullptr, layout, layout.poses[2], {}, 3, 3).touched().empty());
+  // Three chains that never meet: no correction at all.
+  const BlockLayout apart = make_block_layout(
+      45, std::vector<std::pair<std::uint32_t, std::uint32_t>>{{0, 1}, {15, 16}, {30, 31}}, parts);
+  EXPECT_FALSE(TangentCoarseSpace(nullptr, apart, apart.poses[0], {}, 3, 3).linked());
+  EXPECT_EQ(c.touched().size(), 2u * static_cast<std::size_t>(c.generators()));
+  const int g = c.generators();
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd M(c.size(), c.size());
+  for (Eigen::Index i = 0; i < M.size(); ++i) M.data()[i] = normal(rng);
+  const Eigen::MatrixXd A = M * M.transpose() + Eigen::MatrixXd::Identity(c.size(), c.size());
+  const Eigen::MatrixXd inv = c.pseudo_inverse(A);
+  const double scale = inv.norm();
+  EXPECT_LT(inv.middleRows(2 * g, g).norm(), 1e-12 * scale);
+  EXPECT_LT(inv.middleCols(2 * g, g).norm(), 1e-12 * scale);
+  for (int j = 0; j < g; ++j) {
+    Eigen::VectorXd common = Eigen::VectorXd::Zero(c.size()), relative = common;
+    common(j) = common(g + j) = 1.0;
+    relative(j) = 1.0;
+    relative(g + j) = -1.0;
+    EXPECT_LT((inv * common).norm(), 1e-12 * scale) << "generator " << j;
+    EXPECT_GT((inv * relative).norm(), 1e-6 * scale) << "generator " << j;
+  }
 }
 
 }  // namespace

@@ -271,7 +271,10 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
     coarse_ =
         std::make_unique<TangentCoarseSpace>(space, layout_, problem_.owned(), problem_.neighbors(),
                                              problem_.dim(), static_cast<int>(rows_.size()));
-    result_.coarse_unknowns = coarse_->size();
+    // Every piece alone in its group (robots that have not met): the correction is zero, so no
+    // coarse matrix is summed (the layout is the same on every agent, so is the decision).
+    if (!coarse_->linked()) coarse_.reset();
+    result_.coarse_unknowns = coarse_ ? coarse_->size() : 0;
   }
   // Interface solves: at rank d (tangent coordinates) without a coarse correction, where the
   // team's interface fits. The layout is the same on every agent, so is the decision.

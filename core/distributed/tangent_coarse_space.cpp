@@ -35,17 +35,57 @@ TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayo
   if (k < 1) throw std::invalid_argument("TangentCoarseSpace: no active rows");
   for (int a = 0; a < k; ++a)
     for (int b = a + 1; b < k; ++b) rotation_pairs_.emplace_back(a, b);
+  // Groups of linked pieces: the components of the block graph (every agent has the layout, so
+  // every agent finds the same numbering).
+  std::vector<int> root(static_cast<std::size_t>(layout.num_blocks));
+  for (int b = 0; b < layout.num_blocks; ++b) root[static_cast<std::size_t>(b)] = b;
+  auto find = [&](int b) {
+    while (root[static_cast<std::size_t>(b)] != b)
+      b = root[static_cast<std::size_t>(b)] =
+          root[static_cast<std::size_t>(root[static_cast<std::size_t>(b)])];
+    return b;
+  };
+  for (int b = 0; b < layout.num_blocks; ++b)
+    for (int a : layout.adjacent[static_cast<std::size_t>(b)]) {
+      const int ra = find(a), rb = find(b);
+      if (ra != rb) root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+    }
+  std::vector<int> group_of_root(static_cast<std::size_t>(layout.num_blocks), -1);
+  group_of_piece_.resize(static_cast<std::size_t>(pieces_));
+  for (int alpha = 0; alpha < pieces_; ++alpha) {
+    const int block = space ? space->aggregate_block[static_cast<std::size_t>(alpha)] : alpha;
+    int& g = group_of_root[static_cast<std::size_t>(find(block))];
+    if (g < 0) g = groups_++;
+    group_of_piece_[static_cast<std::size_t>(alpha)] = g;
+  }
   own_poses_ = weights_of(space, layout, owned);
   neighbour_poses_ = weights_of(space, layout, neighbours);
   std::vector<char> own(static_cast<std::size_t>(pieces_), 0), any = own;
   for (const Weight& w : own_poses_.weights)
     own[static_cast<std::size_t>(w.piece)] = any[static_cast<std::size_t>(w.piece)] = 1;
   for (const Weight& w : neighbour_poses_.weights) any[static_cast<std::size_t>(w.piece)] = 1;
-  for (int a = 0; a < pieces_; ++a)
+  // A piece alone in its group moves only by its gauge: A^+ is zero on its unknowns, so they are
+  // left out of touched() and own() (no Hessian product assembles their columns of A).
+  std::vector<int> members(static_cast<std::size_t>(groups_), 0);
+  for (int g : group_of_piece_) ++members[static_cast<std::size_t>(g)];
+  linked_.assign(static_cast<std::size_t>(pieces_), 0);
+  for (int a = 0; a < pieces_; ++a) {
+    if (members[static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(a)])] < 2)
+      continue;
+    linked_[static_cast<std::size_t>(a)] = 1;
     for (int j = 0; j < g_; ++j) {
       if (own[static_cast<std::size_t>(a)]) own_.push_back(a * g_ + j);
       if (any[static_cast<std::size_t>(a)]) touched_.push_back(a * g_ + j);
     }
+  }
+  // project() and expand() visit only the own poses some linked piece weighs (none before the
+  // robots meet): a lone piece's entries of Phi^T v meet only zeros of A^+.
+  for (std::size_t slot = 0; slot + 1 < own_poses_.start.size(); ++slot)
+    for (std::size_t q = own_poses_.start[slot]; q < own_poses_.start[slot + 1]; ++q)
+      if (linked_[static_cast<std::size_t>(own_poses_.weights[q].piece)]) {
+        linked_slots_.push_back(slot);
+        break;
+      }
 }
 
 void TangentCoarseSpace::add_generator(int j, double x, Eigen::MatrixXd& E) const {
@@ -73,14 +113,14 @@ void TangentCoarseSpace::project(const Eigen::MatrixXd& X, const Eigen::MatrixXd
   const Eigen::Index kk = k_ * (k_ + 1);
   std::vector<double> acc(static_cast<std::size_t>(pieces_ * kk), 0.0);
   Eigen::MatrixXd N(k_, k_ + 1);
-  const std::size_t n = own_poses_.start.size() - 1;
-  for (std::size_t s = 0; s < n; ++s) {
+  for (std::size_t s : linked_slots_) {
     const Eigen::Index c = static_cast<Eigen::Index>(s) * (d_ + 1);
     N.leftCols(k_).noalias() = v.middleCols(c, d_ + 1) * X.middleCols(c, d_ + 1).transpose();
     N.col(k_) = v.col(c + d_);
     for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
       const Weight& w = own_poses_.weights[q];
-      Eigen::Map<Eigen::MatrixXd>(acc.data() + w.piece * kk, k_, k_ + 1) += w.w * N;
+      if (linked_[static_cast<std::size_t>(w.piece)])
+        Eigen::Map<Eigen::MatrixXd>(acc.data() + w.piece * kk, k_, k_ + 1) += w.w * N;
     }
   }
   const int rotations = static_cast<int>(rotation_pairs_.size());
@@ -104,12 +144,12 @@ void TangentCoarseSpace::expand(const Eigen::MatrixXd& X, const Eigen::VectorXd&
     add_generator(u % g_, xi(u), e);
   }
   Eigen::MatrixXd Ei(k_, k_ + 1);
-  const std::size_t n = own_poses_.start.size() - 1;
-  for (std::size_t s = 0; s < n; ++s) {
+  for (std::size_t s : linked_slots_) {
     Ei.setZero();
     for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
       const Weight& w = own_poses_.weights[q];
-      Ei += w.w * E[static_cast<std::size_t>(w.piece)];
+      const Eigen::MatrixXd& e = E[static_cast<std::size_t>(w.piece)];
+      if (e.size() > 0) Ei += w.w * e;  // empty: a piece alone in its group
     }
     move(Ei, X, static_cast<Eigen::Index>(s), v);
   }
@@ -136,22 +176,40 @@ Eigen::MatrixXd TangentCoarseSpace::pseudo_inverse(const Eigen::MatrixXd& A, dou
   const Eigen::Index n = size();
   if (A.rows() != n || A.cols() != n)
     throw std::invalid_argument("TangentCoarseSpace: coarse matrix of the wrong size");
-  // P = I - U U^T, U's columns the global motions (generator j on every piece) normalized.
-  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, g_);
-  const double s = 1.0 / std::sqrt(static_cast<double>(pieces_));
-  for (int alpha = 0; alpha < pieces_; ++alpha)
-    for (int j = 0; j < g_; ++j) U(alpha * g_ + j, j) = s;
-  const Eigen::MatrixXd PA = A - U * (U.transpose() * A);
-  Eigen::MatrixXd B = PA - (PA * U) * U.transpose();
-  B = (0.5 * (B + B.transpose())).eval();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(B);
-  const Eigen::VectorXd& l = eig.eigenvalues();
-  const double top = l.size() > 0 ? l(l.size() - 1) : 0.0;
-  Eigen::VectorXd inv = Eigen::VectorXd::Zero(l.size());
-  for (Eigen::Index i = 0; i < l.size(); ++i)
-    if (top > 0 && l(i) > tol * top) inv(i) = 1.0 / l(i);
-  const Eigen::MatrixXd& V = eig.eigenvectors();
-  return V * inv.asDiagonal() * V.transpose();
+  // Pieces of different groups share no measurement, so A is block diagonal over the groups and
+  // so is its pseudo-inverse: one small eigendecomposition per group of two pieces or more (a
+  // lone piece's block is all gauge, zero), not one of all the pieces' unknowns at every point.
+  std::vector<std::vector<Eigen::Index>> unknowns(static_cast<std::size_t>(groups_));
+  std::vector<int> members(static_cast<std::size_t>(groups_), 0);
+  for (int alpha = 0; alpha < pieces_; ++alpha) {
+    const auto g = static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(alpha)]);
+    ++members[g];
+    for (int j = 0; j < g_; ++j) unknowns[g].push_back(alpha * g_ + j);
+  }
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, n);
+  for (std::size_t group = 0; group < unknowns.size(); ++group) {
+    if (members[group] < 2) continue;
+    const std::vector<Eigen::Index>& idx = unknowns[group];
+    const auto m = static_cast<Eigen::Index>(idx.size());
+    // P = I - U U^T, U's columns the group's rigid motions (generator j on every piece of the
+    // group) normalized.
+    Eigen::MatrixXd U = Eigen::MatrixXd::Zero(m, g_);
+    const double s = 1.0 / std::sqrt(static_cast<double>(members[group]));
+    for (Eigen::Index q = 0; q < m; ++q) U(q, q % g_) = s;
+    const Eigen::MatrixXd Ag = A(idx, idx);
+    const Eigen::MatrixXd PA = Ag - U * (U.transpose() * Ag);
+    Eigen::MatrixXd B = PA - (PA * U) * U.transpose();
+    B = (0.5 * (B + B.transpose())).eval();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(B);
+    const Eigen::VectorXd& l = eig.eigenvalues();
+    const double top = l.size() > 0 ? l(l.size() - 1) : 0.0;
+    Eigen::VectorXd inv = Eigen::VectorXd::Zero(l.size());
+    for (Eigen::Index i = 0; i < l.size(); ++i)
+      if (top > 0 && l(i) > tol * top) inv(i) = 1.0 / l(i);
+    const Eigen::MatrixXd& V = eig.eigenvectors();
+    out(idx, idx) = V * inv.asDiagonal() * V.transpose();
+  }
+  return out;
 }
 
 }  // namespace tessera

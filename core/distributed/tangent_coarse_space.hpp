@@ -39,26 +39,41 @@ class TangentCoarseSpace {
   /// Coarse unknowns: pieces() x generators(), unknown alpha * generators() + j.
   int size() const { return pieces_ * g_; }
   /// The unknowns whose vectors are non-zero on an own pose or a neighbour copy, ascending:
-  /// the columns of A this agent's rows contribute to.
+  /// the columns of A this agent's rows contribute to. Only pieces linked to another piece
+  /// (groups()): a piece alone in its group moves only by its gauge, where A^+ is zero.
   const std::vector<int>& touched() const { return touched_; }
-  /// The unknowns non-zero on an own pose, ascending.
+  /// The unknowns non-zero on an own pose, ascending (of linked pieces, as touched()).
   const std::vector<int>& own() const { return own_; }
 
   /// out += Phi^T v over the own poses (X: the own point, v: a vector of its shape; out has
-  /// size() entries).
+  /// size() entries), at the linked pieces' unknowns (the others are left as they are).
   void project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, double* out) const;
-  /// v += Phi xi on the own poses (X's shape).
+  /// v += Phi xi on the own poses (X's shape), xi's entries at own() only.
   void expand(const Eigen::MatrixXd& X, const Eigen::VectorXd& xi, Eigen::MatrixXd& v) const;
   /// The vector of one unknown on the own poses (v) and the neighbour copies (vn), set to the
   /// shapes of X and Xn.
   void unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown, Eigen::MatrixXd& v,
             Eigen::MatrixXd& vn) const;
 
+  /// Pieces whose poses are linked by measurements, directly or through other pieces (the
+  /// connected components of the layout's block graph; a piece of the smoothed space goes with
+  /// its block): group_of(alpha) numbers them densely in order of their first piece.
+  int groups() const { return groups_; }
+  int group_of(int piece) const { return group_of_piece_[static_cast<std::size_t>(piece)]; }
+  /// Some group holds two pieces or more (else the correction is zero: every motion is gauge).
+  bool linked() const { return groups_ < pieces_; }
+
   /// A positive semi-definite inverse of the Galerkin matrix A (size() x size(), symmetric):
-  /// the global rigid motions (every piece the same generator: f does not change along them)
-  /// are projected out, then eigenvalues at or below `tol` times the largest (the gauge,
-  /// generators that move no pose, and any negative curvature, which a preconditioner must
-  /// not invert) are dropped. Deterministic: the same A gives the same bits on every agent.
+  /// the rigid motions of each group of linked pieces (every piece of the group the same
+  /// generator: f does not change along them) are projected out, then eigenvalues at or below
+  /// `tol` times the largest (generators that move no pose, and any negative curvature, which a
+  /// preconditioner must not invert) are dropped. Per group, not only the whole team's motion:
+  /// an online graph whose robots have not all met has one gauge per piece of the map, where
+  /// A's entries are round-off or of the gradient's order (f is invariant only at a critical
+  /// point to second order), which a tolerance relative to the largest eigenvalue does not
+  /// catch; their inverses sent CG along directions the retraction does not keep f on.
+  /// Computed per group (A is block diagonal over them; the tolerance is relative to each
+  /// group's largest eigenvalue). Deterministic: the same A gives the same bits on every agent.
   Eigen::MatrixXd pseudo_inverse(const Eigen::MatrixXd& A, double tol = 1e-10) const;
 
  private:
@@ -80,6 +95,10 @@ class TangentCoarseSpace {
             Eigen::MatrixXd& v) const;
 
   int d_, k_, g_, pieces_;
+  int groups_ = 0;
+  std::vector<int> group_of_piece_;
+  std::vector<char> linked_;               // by piece: in a group with another piece
+  std::vector<std::size_t> linked_slots_;  // own slots some linked piece weighs
   Poses own_poses_, neighbour_poses_;
   std::vector<int> touched_, own_;
   std::vector<std::pair<int, int>> rotation_pairs_;  // (a, b), a < b, for generators 0..

@@ -40,23 +40,15 @@ std::vector<AgentState*> LiveBlocks::all_states() const {
 }
 
 void LiveBlocks::retire(const std::unique_ptr<AgentState>& state) {
-  if (!state) return;
-  retired_factorizations_ += state->tangent_factorizations_total();
-  retired_factor_flops_ += state->tangent_factor_flops_total();
+  if (state)
+    retired_ += {state->tangent_factorizations_total(), state->tangent_factor_flops_total()};
 }
 
-long long LiveBlocks::tangent_factorizations() const {
-  long long n = retired_factorizations_;
+TangentFactorTotals LiveBlocks::tangent_factor_totals() const {
+  TangentFactorTotals t = retired_;
   for (const auto& s : states_)
-    if (s) n += s->tangent_factorizations_total();
-  return n;
-}
-
-double LiveBlocks::tangent_factor_flops() const {
-  double n = retired_factor_flops_;
-  for (const auto& s : states_)
-    if (s) n += s->tangent_factor_flops_total();
-  return n;
+    if (s) t += {s->tangent_factorizations_total(), s->tangent_factor_flops_total()};
+  return t;
 }
 
 Eigen::MatrixXd LiveBlocks::columns(const Eigen::MatrixXd& X,

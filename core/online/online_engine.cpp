@@ -98,8 +98,8 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.agents = static_cast<int>(stream_.robots().size());
   // Idle: nothing new and already converged, so no round and no message.
   if ((u.poses == 0 && u.measurements == 0 && converged_) || graph.num_poses == 0) return u;
-  const long long factorizations_before = blocks_ ? blocks_->tangent_factorizations() : 0;
-  const double flops_before = blocks_ ? blocks_->tangent_factor_flops() : 0.0;
+  const TangentFactorTotals factors_before =
+      blocks_ ? blocks_->tangent_factor_totals() : TangentFactorTotals{};
 
   // New poses join their robot's block; then the blocks follow the graph's growth.
   const auto& robots = stream_.robots();
@@ -170,8 +170,9 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     if (!refines.empty() && !newton_short) u.stop_reason = refines.back().stop_reason;
   }
   if (blocks_) {
-    u.factorizations = blocks_->tangent_factorizations() - factorizations_before;
-    u.factor_flops = blocks_->tangent_factor_flops() - flops_before;
+    const TangentFactorTotals step = blocks_->tangent_factor_totals().since(factors_before);
+    u.factorizations = step.factorizations;
+    u.factor_flops = step.flops;
   }
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;

@@ -26,6 +26,23 @@
 
 namespace tessera {
 
+/// Tangent preconditioner factorizations and their floating-point operations as CHOLMOD's
+/// symbolic analysis predicts them (load-free).
+struct TangentFactorTotals {
+  long long factorizations = 0;
+  double flops = 0.0;
+
+  TangentFactorTotals& operator+=(const TangentFactorTotals& o) {
+    factorizations += o.factorizations;
+    flops += o.flops;
+    return *this;
+  }
+  /// The factorizations done since `before` (a total taken earlier).
+  TangentFactorTotals since(const TangentFactorTotals& before) const {
+    return {factorizations - before.factorizations, flops - before.flops};
+  }
+};
+
 /// What one LiveBlocks::sync did.
 struct LiveSync {
   std::size_t new_poses = 0, new_measurements = 0;  ///< Linked poses / measurements added.
@@ -61,10 +78,9 @@ class LiveBlocks {
   /// Compact block of original block `b`, or -1 when it has no linked pose yet.
   int compact_block(int b) const;
   /// Tangent factorizations done by every state this object has held (AgentState's
-  /// tangent_factorizations_total, states built again or dropped included) and their predicted
-  /// floating-point operations.
-  long long tangent_factorizations() const;
-  double tangent_factor_flops() const;
+  /// tangent_factorizations_total and tangent_factor_flops_total, states built again or dropped
+  /// included).
+  TangentFactorTotals tangent_factor_totals() const;
   /// Writes the compact iterate `Xc` (rank = X's rows) into the stream-id iterate `X`.
   void write_back(const Eigen::MatrixXd& Xc, Eigen::MatrixXd& X) const;
 
@@ -75,8 +91,7 @@ class LiveBlocks {
   void retire(const std::unique_ptr<AgentState>& state);
 
   int d_;
-  long long retired_factorizations_ = 0;
-  double retired_factor_flops_ = 0.0;
+  TangentFactorTotals retired_;  // of the states dropped or built again
   BlockUpdateOptions update_;
   double refactor_growth_;
   int only_block_;
