@@ -43,8 +43,9 @@ inline std::pair<double, double> read_vote(const RoundStatusMessage& st) {
 /// whose other end `to` holds, then (with weight 0) its other cut measurements that leave the
 /// solve (for `to`'s block layout), the weight spread (grad_norm_sq, the stop vote) and the
 /// count of this agent's measurements whose weight crossed 1/2 in this update (cost, the
-/// adaptive mu schedule's vote, RobustOptions::mu_step_max).
-RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed,
+/// adaptive mu schedule's vote, RobustOptions::mu_step_max) and of its measurements with r^2
+/// near the bound (block_grad_norm, the early end's vote, RobustOptions::jump_band).
+RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed, int near_bound,
                                    const GncAgentInput& in, const GncLocalTerms& terms,
                                    const std::vector<double>& weights);
 
