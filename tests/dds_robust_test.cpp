@@ -413,5 +413,26 @@ TEST(DdsRobust, PassRefineOverDdsEqualsTheInProcessEngine) {
   EXPECT_NE(dds.summary.find("\"certified\": true"), std::string::npos) << dds.summary;
 }
 
+// RobustOptions::jump_band (on by default, no flag: every agent runs with the default): the
+// count of residuals near the bound rides in the weights exchange, and over DDS the early end
+// comes at the same outer step with the same set, rounds and cost as in process.
+TEST(DdsRobust, TheEarlyEndOverDdsEqualsTheInProcessEngine) {
+  const RobustRun dds = robust_dds_run(119);
+  const PoseGraph g = read_g2o(dds.graph);
+  const GncDistributedOptions o = in_process_options();
+  const GncDistributedResult ref = solve_gnc_distributed(g, dds.assignment, o);
+  GncDistributedOptions full = o;
+  full.robust.jump_band = 0;
+  ASSERT_LT(ref.outer_iterations, solve_gnc_distributed(g, dds.assignment, full).outer_iterations)
+      << "the residuals should leave the bound's band before the weights are binary";
+  EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
+  EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
+  EXPECT_EQ(ref.rejected, dds.labels);
+  EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost)
+      << dds.summary;
+  EXPECT_NE(dds.summary.find("\"certified\": true"), std::string::npos) << dds.summary;
+}
+
 }  // namespace
 }  // namespace tessera::test::dds

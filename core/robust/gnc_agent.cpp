@@ -256,13 +256,18 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     case Step::kWeights: {
       const int crossed = weights_at_mu(mu_);
       const double spread = weight_spread(*terms_, weights_);
+      const int near = options_.robust.jump_band > 0
+                           ? near_bound_count(*terms_, dropped_, state_->Y, exchange_->neighbours(),
+                                              options_.robust.jump_band)
+                           : 1;
       exchange_->own_vote() = {spread, crossed};
+      exchange_->own_near_bound() = near;
       zero_cut_ =
           zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
       const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
       from = as_ints(others);
       for (std::uint32_t a : others) {
-        RoundStatusMessage st = weights_message(a, spread, crossed, in_, *terms_, weights_);
+        RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_);
         st.phase = phase;
         st.sender = me;
         out.push_back(OutgoingMessage{std::move(st), false, {a}});
@@ -523,8 +528,22 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     case Step::kWeights: {
       const auto [spread, crossed] = exchange_->summed_votes();
       ++outer_;
-      if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
       converged_ = spread <= options_.robust.weight_tolerance;
+      // RobustOptions::jump_band: every residual clear of the bound, so GNC ends at TLS's verdict
+      // at this iterate (the same on both ends of every cut measurement) and the passes follow.
+      const bool jump =
+          !converged_ && options_.robust.jump_band > 0 && exchange_->summed_near_bound() == 0;
+      if (jump) {
+        for (std::size_t k = 0; k < weights_.size(); ++k)
+          if (terms_->may_reject(k) && !dropped_[k])
+            weights_[k] = tls_verdict_weight(weights_[k], mu_);
+        converged_ = true;
+      }
+      if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
+      if (jump) {
+        begin_exchange(Step::kRejected, out);
+        return;
+      }
       // RobustOptions::mu_step_max: a bigger step while the inlier set stays as it was.
       const double step_max = options_.robust.mu_step_max;
       mu_factor_ = step_max > 0 && crossed == 0 ? std::min(mu_factor_ * mu_factor_, step_max)

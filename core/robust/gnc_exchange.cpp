@@ -27,6 +27,12 @@ std::pair<double, double> GncExchangeBook::summed_votes() const {
   return sum;
 }
 
+double GncExchangeBook::summed_near_bound() const {
+  double sum = 0;
+  for (const auto& [sender, v] : near_bound_) sum += v;  // agent-id order
+  return sum;
+}
+
 double GncExchangeBook::largest_vote() const {
   double max_r2 = 0;
   for (const auto& [sender, v] : votes_) max_r2 = std::max(max_r2, v.first);
@@ -105,6 +111,7 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
     case GncExchange::kWeights: {
       const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
       votes_[sender] = {st.grad_norm_sq, st.cost};
+      near_bound_[sender] = unpack_near_bound(st);
       read_weights_message(st, sender, in_, to.weights, to.zero_cut);
       break;
     }

@@ -36,7 +36,14 @@ class GncExchangeBook {
       : in_(in), terms_(terms), base_(base) {}
 
   /// A new exchange: no votes yet.
-  void begin() { votes_.clear(); }
+  void begin() {
+    votes_.clear();
+    near_bound_.clear();
+  }
+  /// The weight exchange's count of residuals near the bound (RobustOptions::jump_band): this
+  /// agent's, and the sum over every agent.
+  double& own_near_bound() { return near_bound_[static_cast<std::uint32_t>(in_.id)]; }
+  double summed_near_bound() const;
   /// This agent's vote of the current exchange (summed with the others' in agent-id order).
   std::pair<double, double>& own_vote() { return votes_[static_cast<std::uint32_t>(in_.id)]; }
   std::pair<double, double> summed_votes() const;  // every agent's, agent-id order
@@ -73,6 +80,7 @@ class GncExchangeBook {
   const BlockLayout& base_;  // of every measurement: whose poses go where
   // Sums of the current exchange (in agent-id order: own and received values kept by sender).
   std::map<std::uint32_t, std::pair<double, double>> votes_;
+  std::map<std::uint32_t, double> near_bound_;
   Eigen::MatrixXd neighbours_;  // neighbours' public poses of the current iterate
   Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
   GatheredValues kept_values_;                        // agent 0's gathers

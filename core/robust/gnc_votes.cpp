@@ -1,6 +1,7 @@
 #include "robust/gnc_votes.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 
 namespace tessera {
@@ -76,6 +77,23 @@ double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weig
   double spread = 0;
   for (std::size_t k : terms.owned()) spread += weights[k] * (1 - weights[k]);
   return spread;
+}
+
+int near_bound_count(const GncLocalTerms& terms, const std::vector<bool>& dropped,
+                     const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours, double band) {
+  int near = 0;
+  const double lo = terms.c2() / band, hi = terms.c2() * band;
+  for (std::size_t k : terms.owned())
+    if (terms.may_reject(k) && !dropped[k]) {
+      const double r2 = terms.residual_squared(k, Y, neighbours);
+      if (r2 > lo && r2 < hi) ++near;
+    }
+  return near;
+}
+
+double tls_verdict_weight(double w, double mu) {
+  // tls_weight(c^2, c^2, mu) = sqrt(mu (mu + 1)) - mu, whatever c.
+  return w >= std::sqrt(mu * (mu + 1)) - mu ? 1.0 : 0.0;
 }
 
 RecheckVerdict recheck_verdict(const GncLocalTerms& terms, const std::vector<std::uint64_t>& index,

@@ -53,6 +53,16 @@ std::vector<std::uint64_t> zero_weight_cut(const GncLocalTerms& terms,
 /// sum w (1 - w) over the measurements this agent weighs: the stop vote.
 double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weights);
 
+/// RobustOptions::jump_band: how many of the measurements this agent weighs (that may be
+/// rejected and were not set aside) have r^2 in (c^2 / band, band c^2) at the iterate Y.
+int near_bound_count(const GncLocalTerms& terms, const std::vector<bool>& dropped,
+                     const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours, double band);
+
+/// TLS's verdict as a weight, from a GNC weight w at mu: 1 when w >= tls_weight(c^2, c^2, mu)
+/// (r^2 <= c^2: w falls as r grows), else 0. A function of the weight alone, so the owner and
+/// the other end of a cut measurement, which holds only the weight it was sent, agree.
+double tls_verdict_weight(double w, double mu);
+
 /// TLS's own verdict at the kept set's solution over the measurements this agent weighs.
 struct RecheckVerdict {
   std::vector<std::uint64_t> taken_back;  ///< Rejected, within the bound: back in (weight 1).

@@ -1,0 +1,86 @@
+// RobustOptions::jump_band (the early end of the distributed GNC): once no residual lies near the
+// bound, GNC ends at TLS's verdict at that iterate and the passes follow; the same answer in
+// fewer outer steps, both ends of every cut measurement with the same weight, the option's
+// range, and the verdict weight as a function of the transmitted weight alone.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <string>
+#include <tessera/robust/gnc_distributed.hpp>
+#include <tessera/robust/tls_weights.hpp>
+#include <tessera/util/input_error.hpp>
+#include <utility>
+#include <vector>
+
+#include "gnc_fixtures.hpp"
+#include "robust/gnc_votes.hpp"
+
+namespace tessera {
+namespace {
+
+TEST(GncJump, ABadBandNamesTheField) {
+  RobustOptions o;
+  o.jump_band = 1.0;  // a band of width 0 around c^2
+  try {
+    o.validate();
+    FAIL() << "jump_band 1 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("RobustOptions.jump_band"), std::string::npos) << e.what();
+  }
+  o.jump_band = 0;  // off
+  EXPECT_NO_THROW(o.validate());
+  o.jump_band = 1.5;
+  EXPECT_NO_THROW(o.validate());
+}
+
+TEST(GncJump, TheVerdictWeightIsOneExactlyWithinTheBound) {
+  // The other end of a cut measurement holds only the weight at mu it was sent: the verdict
+  // taken from that weight must be the verdict of the residual itself.
+  const double c2 = 33.0;
+  for (double mu : {1e-4, 0.01, 0.3, 0.9}) {
+    for (double ratio : {0.05, 0.4, 0.9, 0.999, 1.001, 1.5, 3.0, 1e3}) {
+      const double w = tls_weight(ratio * c2, c2, mu);
+      EXPECT_EQ(tls_verdict_weight(w, mu), ratio <= 1 ? 1.0 : 0.0)
+          << "mu " << mu << ", r^2 = " << ratio << " c^2, w " << w;
+    }
+  }
+}
+
+// The 300-pose soft city with 25 % random outliers, 5 agents: 4 outer steps and 146 rounds in all
+// against 10 and 181 with the weights left to become binary, the same rejected set and cost.
+TEST(GncJump, GncEndsWhenTheResidualsLeaveTheBoundWithTheSameSetInFewerOuterSteps) {
+  const GeneratorResult dirty = test::flexible_city(0.25, OutlierKind::kRandom, 1);
+  const std::vector<int> blocks = test::robots_as_blocks(dirty);
+  GncDistributedOptions o = test::irbcd_gnc();
+  o.solver.certify = true;
+  o.robust.jump_band = 0;
+  const GncDistributedResult full = solve_gnc_distributed(dirty.graph, blocks, o);
+  o.robust.jump_band = 2;
+  // (outer step, measurement) -> weight at each agent that holds it.
+  std::map<std::pair<int, std::uint64_t>, std::map<int, double>> seen;
+  o.weight_observer = [&](int agent, int outer, const std::vector<std::uint64_t>& index,
+                          const std::vector<double>& weights) {
+    for (std::size_t k = 0; k < index.size(); ++k) seen[{outer, index[k]}][agent] = weights[k];
+  };
+  const GncDistributedResult jumped = solve_gnc_distributed(dirty.graph, blocks, o);
+  EXPECT_EQ(full.rejected, dirty.outliers);
+  EXPECT_EQ(jumped.rejected, dirty.outliers);
+  EXPECT_LT(jumped.outer_iterations, full.outer_iterations);
+  EXPECT_LT(jumped.total_rounds, full.total_rounds);
+  EXPECT_NEAR(jumped.final_solve.cost, full.final_solve.cost, 1e-8 * full.final_solve.cost);
+  EXPECT_TRUE(jumped.final_solve.certified.value_or(false));
+  // The last weights, after the jump, are binary and the same on both ends of every cut one.
+  std::size_t last_cut = 0;
+  for (const auto& [key, at] : seen) {
+    if (key.first != jumped.outer_iterations) continue;
+    for (const auto& [agent, w] : at) EXPECT_TRUE(w == 0 || w == 1) << "measurement " << key.second;
+    if (at.size() < 2) continue;
+    ++last_cut;
+    EXPECT_EQ(at.begin()->second, at.rbegin()->second) << "measurement " << key.second;
+  }
+  EXPECT_GT(last_cut, 0u);
+}
+
+}  // namespace
+}  // namespace tessera
