@@ -55,7 +55,7 @@ const char* kHelp =
     "                            only --grad-tol (f* to round-off)\n"
     "  --no-certify              skip the certificate (and the staircase). certified = a\n"
     "                            factorization proved a lower bound f_lb on the optimum (weak\n"
-    "                            duality, at any point) with f(X) - f_lb <= 1e-5 max(1, |f(X)|);\n"
+    "                            duality, at any point) with f(X) - f_lb <= 1e-4 max(1, |f(X)|);\n"
     "                            JSON: dual_lower_bound, suboptimality_bound (cost - f_lb),\n"
     "                            relative_suboptimality_bound, certificate_grad_norm\n"
     "  --preconditioner auto|tangent|euclidean   centralized: the trust region's\n"

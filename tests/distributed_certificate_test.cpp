@@ -430,17 +430,18 @@ TEST(DistributedCertificate, AboveTheInterfaceCapOnlyLobpcgRuns) {
   opt.staircase.certificate.interface_max_coordinates = 3;  // less than one pose
   const DistributedResult without = solve_distributed(g, parts, opt);
   ASSERT_EQ(with.certificates.size(), 1u);
-  ASSERT_GE(without.certificates.size(), 1u);
+  ASSERT_EQ(without.certificates.size(), 1u);
   EXPECT_TRUE(with.certificates[0].result.interface_test);
   EXPECT_FALSE(without.certificates[0].result.interface_test);
   EXPECT_TRUE(*with.certified);
-  // LOBPCG alone estimates lambda_min but proves no bound (dual_bound.hpp): never certified.
-  EXPECT_TRUE(without.certificates[0].result.psd_within_tolerance);
-  EXPECT_FALSE(without.certificates[0].result.bound.proved());
-  EXPECT_FALSE(*without.certified);
+  EXPECT_TRUE(*without.certified);
+  EXPECT_EQ(with.certificate_bound.method, CertificateMethod::kExact);
+  // LOBPCG alone estimates lambda_min at a critical point and proves no bound.
+  EXPECT_EQ(without.certificate_bound.method, CertificateMethod::kLobpcg);
+  EXPECT_FALSE(without.certificate_bound.proved());
   EXPECT_LT(with.certificate_rounds, without.certificate_rounds);
-  EXPECT_NEAR(with.min_eigenvalue, without.certificates[0].result.min_eigenvalue,
-              with.certificates[0].result.tolerance);
+  EXPECT_NEAR(with.min_eigenvalue, without.min_eigenvalue, with.certificates[0].result.tolerance);
+  EXPECT_EQ(with.cost, without.cost);  // the certificate does not move the point
 }
 
 namespace {
@@ -551,15 +552,20 @@ TEST(CertificateBound, DistributedBoundIsTheCentralizedOne) {
   if (near.bound.proved()) {
     EXPECT_LE(near.bound.lower_bound, o.optimum.relaxation_cost);
   }
-  // Without the interface test nothing proves a bound: never certified.
+  // Without the interface test nothing proves a bound: LOBPCG's estimate certifies the
+  // optimum (a critical point), not the point near it, whose lambda_min(S) >= -eta too.
   options.interface_max_coordinates = 0;
   const DistributedCertificateResult lobpcg =
       certify_in_process(g, o.optimum.X, parts, DeliveryOrder::kFifo, {}, nullptr, options);
   EXPECT_FALSE(lobpcg.interface_test);
-  EXPECT_TRUE(lobpcg.psd_within_tolerance);
+  EXPECT_EQ(lobpcg.bound.method, CertificateMethod::kLobpcg);
   EXPECT_FALSE(lobpcg.bound.proved());
-  EXPECT_FALSE(lobpcg.certified);
+  EXPECT_TRUE(lobpcg.certified);
   EXPECT_NEAR(lobpcg.bound.relaxation_cost, f, 1e-10 * f);
+  const DistributedCertificateResult lobpcg_near =
+      certify_in_process(g, o.nearby, parts, DeliveryOrder::kFifo, {}, nullptr, options);
+  EXPECT_TRUE(lobpcg_near.psd_within_tolerance);
+  EXPECT_FALSE(lobpcg_near.certified);
 }
 
 }  // namespace tessera

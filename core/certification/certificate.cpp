@@ -188,8 +188,8 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
   res.psd_within_tolerance = res.certified;
 
   // The weak-duality bound (dual_bound.hpp), proved by factoring S + D from the smallest floor
-  // that would certify up by factors of 10. lambda_min(S) >= the rotation Schur complement's
-  // lambda_min, so -lambda_min(S) is where a saddle's proof can start.
+  // that would certify up by factors of kProofShiftGrowth. lambda_min(S) >= the rotation Schur
+  // complement's lambda_min, so -lambda_min(S) is where a saddle's proof can start.
   const int d = problem.dim();
   const std::size_t poses = problem.num_owned();
   const SparseMatrix& Q = problem.data_matrix();
@@ -203,7 +203,7 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
   double weight_sum = 0.0;
   for (double v : w) weight_sum += v;
   double proved = std::numeric_limits<double>::quiet_NaN();
-  for (double alpha = 1.0; s <= 4e3 * scale; s *= 10.0, alpha *= 10.0) {
+  for (double alpha = 1.0; s <= 4e3 * scale; s *= kProofShiftGrowth, alpha *= kProofShiftGrowth) {
     Factor proof;
     quiet(proof);
     cholmod_compute_checked(proof,

@@ -4,6 +4,17 @@
 
 namespace tessera {
 
+const char* certificate_method_name(CertificateMethod m) {
+  switch (m) {
+    case CertificateMethod::kExact:
+      return "exact";
+    case CertificateMethod::kLobpcg:
+      return "lobpcg";
+    default:
+      return "none";
+  }
+}
+
 double DualBound::relative_suboptimality(double cost) const {
   return suboptimality(cost) / std::max(1.0, std::abs(relaxation_cost));
 }
@@ -14,6 +25,7 @@ DualBound make_dual_bound(double relaxation_cost, double trace_lambda, double gr
   b.relaxation_cost = relaxation_cost;
   b.trace_lambda = trace_lambda;
   b.gradient_norm = gradient_norm;
+  b.method = CertificateMethod::kExact;
   if (std::isfinite(shift_sum) && poses > 0) {
     b.shift = shift_sum / static_cast<double>(poses);
     b.lower_bound = trace_lambda - shift_sum * d;

@@ -58,15 +58,16 @@ struct CertificateResult {
   /// Unit eigenvector of lambda_min, length (d+1)n, set when not certified.
   Eigen::VectorXd min_eigenvector;
   int factorizations = 0;        ///< Every one, proof_factorizations included.
-  int proof_factorizations = 0;  ///< Of S + s P for the bound.
+  int proof_factorizations = 0;  ///< Of S + D for the bound.
   int lanczos_iterations = 0;    ///< Lanczos restarts over every run.
   int lanczos_solves = 0;        ///< Solves with a factor (shift-inverted operator applications).
   double elapsed_s = 0.0;
 };
 
 /// `problem` must own every pose (no neighbours): the centralized problem. At any X, critical or
-/// not, `bound` is proved by factorizations of S + s P (dual_bound.hpp), s from
-/// first_proof_shift up by factors of 10; `certified` needs it within suboptimality_tolerance.
+/// not, `bound` is proved by factorizations of S + D (dual_bound.hpp), its floor from
+/// first_proof_shift up by factors of kProofShiftGrowth; `certified` needs it within
+/// suboptimality_tolerance.
 CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::MatrixXd& X,
                                      const CertificateOptions& options = {});
 

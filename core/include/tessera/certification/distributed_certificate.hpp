@@ -58,11 +58,12 @@ struct DistributedCertificateOptions {
   std::uint64_t seed = 1;  ///< Start vector (hash of the global pose ids and this seed).
   /// The exact interface test runs when the team's interface (poses with a cut measurement)
   /// has at most this many coordinates ((d+1) a pose): agent 0 factors a matrix that large,
-  /// dense within each block's interface. 0 = LOBPCG only. >= 0. Why 800: the Schur complements
-  /// travel to agent 0 in one message step, 4 bytes a coordinate squared per block; at torus3D's
-  /// 1,004 (N = 5) that is 4 MB and the certificate phase over DDS took 0.37-0.75 s against
-  /// LOBPCG's 0.19-0.34 s, while sphere2500 (704) and city10000 (459 at N = 5, 768 at N = 10)
-  /// decide in one certificate round (docs/distributed-certification.md).
+  /// dense within each block's interface. 0 = LOBPCG only (an estimate, no proved bound). >= 0.
+  /// Why 800: the Schur complements travel to agent 0 in one message step, 4 bytes a
+  /// coordinate squared per block; at torus3D's 1,004 (N = 5) that is 4 MB and the certificate
+  /// phase over DDS took 0.37-0.75 s against LOBPCG's 0.19-0.34 s, while sphere2500 (704) and
+  /// city10000 (459 at N = 5, 768 at N = 10) decide in one certificate round
+  /// (docs/distributed-certification.md).
   int interface_max_coordinates = 800;
   /// The interface test keeps one endpoint of each cut measurement (the one in the lower-
   /// numbered block) and eliminates the other inside its block: Sigma has about half the
@@ -78,17 +79,19 @@ struct DistributedCertificateOptions {
 
 /// Identical on every agent except `eigenvector`.
 struct DistributedCertificateResult {
-  /// The bound (below) proved and within suboptimality_tolerance: X is then within that
-  /// relative distance of the optimum (dual_bound.hpp).
+  /// With the interface test: the bound (below) proved and within suboptimality_tolerance (X
+  /// is then within that relative distance of the optimum, dual_bound.hpp). Without it:
+  /// LOBPCG converged to theta >= -eta and |grad f| <= suboptimality_tolerance max(1, |f|)
+  /// (CertificateMethod::kLobpcg, an estimate).
   bool certified = false;
   /// The final Ritz value theta >= -eta (converged, or after an interface test that passed):
   /// an estimate, and alone it says nothing about optimality short of a critical point.
   bool psd_within_tolerance = false;
   /// The weak-duality bound at Y (dual_bound.hpp). Proved only by the interface test (its
-  /// floor s0 from first_proof_shift and alpha from 1, both up by factors of 10 while the
+  /// floor s0 from first_proof_shift and alpha from 1, both up by kProofShiftGrowth while the
   /// test fails, s0 to eta at most); without the test (interface above
   /// interface_max_coordinates, or a block too large to factor) nothing proves it:
-  /// lower_bound is NaN and the point is not certified.
+  /// lower_bound is NaN and `certified` is LOBPCG's estimate at a critical point.
   DualBound bound;
   int proof_tests = 0;          ///< Interface tests run (each: a Schur step and a verdict step).
   bool converged = false;       ///< Ritz residual reached the tolerance.
