@@ -14,6 +14,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "arguments.hpp"
+#include "certificate_output.hpp"
 #include "commands.hpp"
 #include "graph_input.hpp"
 #include "json_writer.hpp"
@@ -52,7 +53,11 @@ const char* kHelp =
     "                            gain < 1e-10 f) holds, or before a step predicted to decrease f\n"
     "                            by < 1e-10 f (ends within ~1e-8 of f*); gradient:\n"
     "                            only --grad-tol (f* to round-off)\n"
-    "  --no-certify              skip the certificate (and the staircase)\n"
+    "  --no-certify              skip the certificate (and the staircase). certified = a\n"
+    "                            factorization proved a lower bound f_lb on the optimum (weak\n"
+    "                            duality, at any point) with f(X) - f_lb <= 1e-4 max(1, |f(X)|);\n"
+    "                            JSON: dual_lower_bound, suboptimality_bound (cost - f_lb),\n"
+    "                            relative_suboptimality_bound, certificate_grad_norm\n"
     "  --preconditioner auto|tangent|euclidean   centralized: the trust region's\n"
     "                            preconditioner at rank d: tangent = the tangent-coordinate\n"
     "                            factor, euclidean = the factor of Q; auto (default) chooses\n"
@@ -155,6 +160,7 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
               r.certified ? (*r.certified ? "certified optimal" : "NOT certified")
                           : "not certified (skipped)",
               wall_s);
+  if (r.certified) std::printf("%s", certificate_bound_line(r.certificate_bound, r.cost).c_str());
   RobustSummary robust_summary;
   robust_summary.options = robust;
   robust_summary.outer_iterations = gnc.outer_iterations;
@@ -205,8 +211,9 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
       add_robust_fields(j, robust_summary);
       j.add("precond_flops", precond_flops).add("precond_full_flops", full_flops);
     }
-    j.add("min_eigenvalue", r.min_eigenvalue)
-        .add("final_rank", r.final_rank)
+    j.add("min_eigenvalue", r.min_eigenvalue);
+    if (r.certified) add_certificate_bound(j, r.certificate_bound, r.cost);
+    j.add("final_rank", r.final_rank)
         .add("stop_reason", r.levels.empty() ? std::string() : r.levels.back().stop_reason)
         .add("preconditioner", r.preconditioner)
         .add("inner_iterations", r.inner_iterations)

@@ -15,6 +15,7 @@
 #include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "certificate_output.hpp"
 #include "graph_input.hpp"
 #include "json_writer.hpp"
 #include "robust_args.hpp"
@@ -158,7 +159,13 @@ const char* kDistributedHelp =
     "  --certify                 after the solve, certify global optimality distributedly\n"
     "                            (lambda_min of S by LOBPCG over neighbour exchanges) and climb\n"
     "                            the staircase on a saddle (off by default; see\n"
-    "                            docs/distributed-certification.md)\n"
+    "                            docs/distributed-certification.md). certified = the interface\n"
+    "                            test proved a lower bound f_lb on the optimum (weak duality)\n"
+    "                            with f(X) - f_lb <= 1e-4 max(1, |f(X)|) (JSON\n"
+    "                            certificate_method exact, dual_lower_bound,\n"
+    "                            suboptimality_bound = cost - f_lb), or, without that test,\n"
+    "                            LOBPCG's lambda_min >= -eta at |grad f| <= 1e-4 max(1, |f|)\n"
+    "                            (certificate_method lobpcg, no bound)\n"
     "  --max-rank R              staircase ceiling with --certify (default 10)\n"
     "  --certify-grad-tol T      with --certify, each rank is solved to --grad-tol and\n"
     "                            certified; if that certificate does not hold, the rank is\n"
@@ -168,9 +175,11 @@ const char* kDistributedHelp =
     "  --certify-residual T      certificate stops at Ritz residual <= T max(1, max diag Q)\n"
     "                            (default 1e-6)\n"
     "  --certify-precon block-jacobi|none   certificate preconditioner (default block-jacobi)\n"
-    "  --certify-interface C     exact test of S + eta I > 0 on the blocks' interfaces before\n"
+    "  --certify-interface C     exact test of S + D > 0 on the blocks' interfaces before\n"
     "                            LOBPCG when they have at most C coordinates (default 800;\n"
-    "                            0 = LOBPCG only; docs/distributed-certification.md)\n"
+    "                            0 = LOBPCG only: an estimate, certified only where\n"
+    "                            |grad f| <= 1e-4 max(1, |f|), no bound proved;\n"
+    "                            docs/distributed-certification.md)\n"
     "  --certify-interface-sides one|both   the interface test keeps one endpoint of each cut\n"
     "                            measurement and eliminates the other in its block, or both\n"
     "                            (default one: about half the coordinates)\n"
@@ -461,6 +470,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         *r.certified ? "certified optimal" : "NOT certified", r.min_eigenvalue,
         r.certificate_tolerance, r.certificate_residual, r.certificate_rounds,
         r.certificate_bytes / 1e6, r.escape_rounds, r.escape_bytes / 1e6, r.final_rank);
+    std::printf("%s", certificate_bound_line(r.certificate_bound, r.cost).c_str());
   }
   for (const NewtonRefineResult& n : r.refines)
     std::printf(
@@ -552,6 +562,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
           .add("escape_rounds", r.escape_rounds)
           .add("escape_bytes", static_cast<long long>(r.escape_bytes))
           .add("staircase_levels", static_cast<int>(r.certificates.size()));
+      add_certificate_bound(j, r.certificate_bound, r.cost);
     } else {
       j.add_null("min_eigenvalue").add_null("certificate_rounds");
     }

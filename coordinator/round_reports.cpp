@@ -43,7 +43,17 @@ bool RoundReports::on_report(const wire::RoundStatus& m) {
   // The report fields ride on the status's numeric fields (core/runtime/round_loop.hpp says which).
   if (m.phase() == kAgentCertificateReportPhase) {
     results_.certificate =
-        CertificateReport{m.restart_vote(), m.cost(), m.grad_norm_sq(), m.block_grad_norm()};
+        CertificateReport{m.restart_vote(), m.cost(), m.grad_norm_sq(), m.block_grad_norm(), {}};
+    // The bound's parts ride in `coarse` (core/runtime/round_finish.cpp).
+    if (m.coarse().size() == 6) {
+      DualBound& b = results_.certificate->bound;
+      b.relaxation_cost = m.coarse()[0];
+      b.trace_lambda = m.coarse()[1];
+      b.gradient_norm = m.coarse()[2];
+      b.shift = m.coarse()[3];
+      b.lower_bound = m.coarse()[4];
+      b.method = static_cast<CertificateMethod>(static_cast<int>(m.coarse()[5]));
+    }
     return true;
   }
   if (m.phase() == kAgentCertificateBytesPhase) {

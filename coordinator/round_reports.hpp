@@ -10,6 +10,7 @@
 #include <map>
 #include <optional>
 #include <ostream>
+#include <tessera/certification/dual_bound.hpp>
 #include <utility>
 #include <vector>
 
@@ -37,6 +38,7 @@ inline bool is_round_status(const wire::RoundStatus& m) {
 struct CertificateReport {
   bool certified;
   double min_eigenvalue, rounds, final_rank;
+  DualBound bound;  ///< NaN fields when the report did not carry it.
 };
 struct CertificateTraffic {
   double certificate, escape, escape_rounds;  ///< Bytes, bytes, rounds.

@@ -4,6 +4,7 @@
 #include <optional>
 #include <vector>
 
+#include "certificate_output.hpp"
 #include "json_writer.hpp"
 #include "robust_args.hpp"
 #include "runtime/peak_memory.hpp"
@@ -129,6 +130,7 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     j.add("min_eigenvalue", r.certificate->min_eigenvalue)
         .add("certificate_rounds", static_cast<long long>(r.certificate->rounds))
         .add("final_rank", static_cast<long long>(r.certificate->final_rank));
+    add_certificate_bound(j, r.certificate->bound, r.final_cost);
     if (r.certificate_bytes)
       j.add("certificate_bytes", static_cast<long long>(r.certificate_bytes->certificate))
           .add("escape_bytes", static_cast<long long>(r.certificate_bytes->escape))

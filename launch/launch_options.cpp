@@ -44,7 +44,12 @@ options:
   --rank R             relaxation rank (0 = the solver's default, 5)        [0]
   --seed S             solver seed                                           [1]
   --certify            after the solve, the agents certify global optimality distributedly
-                       and escape saddles up the staircase (default: on)
+                       and escape saddles up the staircase (default: on). certified = the
+                       exact interface test proved a lower bound f_lb on the optimum (weak
+                       duality) with f(X) - f_lb <= 1e-4 max(1, |f(X)|), or without that test
+                       LOBPCG's estimate at |grad f| <= 1e-4 max(1, |f|); the JSON has
+                       certificate_method, dual_lower_bound, suboptimality_bound (cost - f_lb)
+                       and certificate_grad_norm (docs/distributed-certification.md)
   --no-certify         skip the certificate
   --json FILE          also write the summary to FILE
   --keep-logs DIR      keep the processes' logs in DIR (created when missing; default: a

@@ -1,17 +1,19 @@
 // Distributed certification over DDS: the agents' certified sequence (solve -> certify ->
 // escape -> solve ...) gives the in-process engine's results, and `tessera launch` certifies by
 // default and reports the certificate in its JSON summary.
-// Domains used here: 171-173 (each test its own, so ctest -j is safe).
+// Domains used here: 171-173, 125 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <regex>
 #include <sstream>
 #include <string>
+#include <tessera/certification/dual_bound.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/io/g2o_reader.hpp>
 #include <vector>
@@ -84,6 +86,44 @@ TEST(DdsCertificate, LaunchCertifiesByDefaultAndReportsIt) {
   ASSERT_EQ(rc2, 0) << out;
   const std::string plain = slurp(dir + "/n.json");
   EXPECT_EQ(json_text(plain, "certified"), "null") << plain;
+}
+
+// The certificate's weak-duality bound (dual_bound.hpp) over DDS: the coordinator's summary
+// reports the lower bound the agents proved, the same as in process.
+TEST(DdsCertificate, TheProvedLowerBoundIsTheInProcessOne) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/grid.g2o";
+  generate_graph(graph, "--kind grid3d --poses 125 --robots 3 --seed 3");
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const int agents = 3, domain = 125;
+  const std::string run = "bound-" + std::to_string(getpid());
+  run_to_the_end(dir, graph, agents, run, domain,
+                 {"--timeout", "20", "--run-timeout", "90", "--summary", dir + "/summary.json",
+                  "--partition", "eco", "--certify", "--init", "file"},
+                 90);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  const std::string summary = slurp(dir + "/summary.json");
+
+  const std::vector<int> assignment = assignment_of(dir, agents);
+  const PoseGraph g = read_g2o(graph);
+  DistributedOptions opt;
+  opt.certify = true;
+  const DistributedResult ref = solve_distributed(g, assignment, opt, g.initial);
+  ASSERT_TRUE(ref.certified.value_or(false));
+  ASSERT_TRUE(ref.certificates.back().result.interface_test);
+  const DualBound& b = ref.certificate_bound;
+  ASSERT_TRUE(b.proved());
+  EXPECT_EQ(json_text(summary, "certified"), "true") << summary;
+  const double f = std::abs(b.relaxation_cost);
+  EXPECT_NEAR(json_number(summary, "dual_lower_bound"), b.lower_bound, 1e-9 * f) << summary;
+  EXPECT_NEAR(json_number(summary, "certificate_shift"), b.shift, 1e-12 * b.shift) << summary;
+  EXPECT_NEAR(json_number(summary, "certificate_grad_norm"), b.gradient_norm,
+              1e-6 * b.gradient_norm + 1e-12)
+      << summary;
+  EXPECT_NEAR(json_number(summary, "suboptimality_bound"), ref.cost - b.lower_bound, 1e-9 * f);
+  EXPECT_LE(json_number(summary, "relaxation_suboptimality_bound"),
+            kDefaultSuboptimalityTolerance * std::max(1.0, f))
+      << summary;
 }
 
 }  // namespace

@@ -317,17 +317,21 @@ TEST(DistributedCertificate, HoldsAtALoosePointOnlyWhereTheCentralizedCertificat
       ASSERT_TRUE(r.certified.has_value());
       const CertificateResult central = verify_certificate(whole, r.X);
       SCOPED_TRACE("d " + std::to_string(g.d) + " tol " + std::to_string(tol));
-      if (*r.certified) {
+      // The bound is proved by the same test (S + D > 0) at the same shifts: the same f_lb.
+      const DistributedCertificateResult& last = r.certificates.back().result;
+      if (last.bound.proved()) {
         ++certified;
-        EXPECT_TRUE(central.certified);
-        EXPECT_NEAR(r.min_eigenvalue, central.min_eigenvalue, central.tolerance);
+        ASSERT_TRUE(central.bound.proved());
+        EXPECT_NEAR(last.bound.lower_bound, central.bound.lower_bound,
+                    1e-9 * std::abs(central.bound.relaxation_cost));
+        EXPECT_EQ(last.certified, central.certified);
       } else {
         ++rejected;
       }
     }
   }
   EXPECT_GT(certified, 0);  // the checks above did run
-  std::printf("loose-point verdicts: %d certified, %d not\n", certified, rejected);
+  std::printf("loose-point bounds: %d proved, %d not\n", certified, rejected);
 }
 
 TEST(DistributedStaircase, DeliveryOrderDoesNotChangeTheResult) {
@@ -431,9 +435,137 @@ TEST(DistributedCertificate, AboveTheInterfaceCapOnlyLobpcgRuns) {
   EXPECT_FALSE(without.certificates[0].result.interface_test);
   EXPECT_TRUE(*with.certified);
   EXPECT_TRUE(*without.certified);
+  EXPECT_EQ(with.certificate_bound.method, CertificateMethod::kExact);
+  // LOBPCG alone estimates lambda_min at a critical point and proves no bound.
+  EXPECT_EQ(without.certificate_bound.method, CertificateMethod::kLobpcg);
+  EXPECT_FALSE(without.certificate_bound.proved());
   EXPECT_LT(with.certificate_rounds, without.certificate_rounds);
   EXPECT_NEAR(with.min_eigenvalue, without.min_eigenvalue, with.certificates[0].result.tolerance);
   EXPECT_EQ(with.cost, without.cost);  // the certificate does not move the point
+}
+
+namespace {
+
+// The lifted optimum of a generated graph (certified, f* = its relaxation cost, to round-off)
+// and a point near it that is not first-order critical: the optimum's rotations turned by a
+// small random step. There lambda_min(S) is only slightly negative (S + eta I still factors),
+// but f(Y) is well above f*: only the bound can tell.
+struct OptimumAndNearby {
+  PoseGraph graph;
+  CentralizedResult optimum;
+  Eigen::MatrixXd nearby;
+};
+
+OptimumAndNearby optimum_and_nearby(int d, std::uint64_t seed) {
+  test::RandomGraphSpec spec;
+  spec.d = d;
+  spec.poses = 60;
+  spec.loop_closures = 30;
+  spec.seed = seed;
+  spec.rotation_noise = 0.1;
+  OptimumAndNearby o;
+  o.graph = test::random_pose_graph(spec);
+  CentralizedOptions tight;
+  tight.stop = CentralizedStop::kGradient;
+  o.optimum = solve_centralized(o.graph, tight);
+  const BlockProblem whole = BlockProblem::whole_graph(d, o.graph.num_poses, o.graph.measurements);
+  Eigen::MatrixXd X = o.optimum.X;
+  std::uint64_t z = seed;
+  for (Eigen::Index c = 0; c < X.cols(); ++c)
+    for (Eigen::Index r = 0; r < X.rows(); ++r) {
+      z = z * 6364136223846793005ull + 1442695040888963407ull;
+      X(r, c) += 2e-4 * (static_cast<double>(z >> 11) * 0x1.0p-53 - 0.5);
+    }
+  o.nearby = whole.manifold(static_cast<int>(X.rows())).project(X);
+  return o;
+}
+
+double relaxation_cost(const BlockProblem& whole, const Eigen::MatrixXd& X) {
+  return (X * whole.data_matrix()).cwiseProduct(X).sum();
+}
+
+}  // namespace
+
+// Weak duality at any point: the bound is proved below the optimum, and a point that is not
+// critical is not certified even where lambda_min(S) >= -eta (the old rule's "optimal").
+TEST(CertificateBound, ANonCriticalPointIsNotCertifiedAndItsLowerBoundIsBelowTheOptimum) {
+  for (int d : {2, 3}) {
+    SCOPED_TRACE("d " + std::to_string(d));
+    const OptimumAndNearby o = optimum_and_nearby(d, 21 + static_cast<std::uint64_t>(d));
+    ASSERT_TRUE(o.optimum.certified.value_or(false));
+    const double f_star = o.optimum.relaxation_cost;  // >= the SDP's optimum
+    const BlockProblem whole =
+        BlockProblem::whole_graph(d, o.graph.num_poses, o.graph.measurements);
+    const double f = relaxation_cost(whole, o.nearby);
+    ASSERT_GT(f - f_star, 1e-5 * f_star) << "the point should be clearly suboptimal";
+    const CertificateResult c = verify_certificate(whole, o.nearby);
+    EXPECT_FALSE(c.certified);
+    EXPECT_TRUE(c.psd_within_tolerance);  // what alone used to certify
+    ASSERT_TRUE(c.bound.proved());
+    EXPECT_LE(c.bound.lower_bound, f_star);
+    EXPECT_NEAR(c.bound.relaxation_cost, f, 1e-12 * f);
+    EXPECT_GT(c.bound.gradient_norm, 0.0);
+    std::printf("d %d: f - f* = %.3g, f - f_lb = %.3g, lambda_min(S) = %.3g (eta %.3g)\n", d,
+                f - f_star, f - c.bound.lower_bound, c.min_eigenvalue, c.tolerance);
+  }
+}
+
+TEST(CertificateBound, AtTheOptimumTheBoundIsTight) {
+  for (int d : {2, 3}) {
+    SCOPED_TRACE("d " + std::to_string(d));
+    const OptimumAndNearby o = optimum_and_nearby(d, 31 + static_cast<std::uint64_t>(d));
+    const BlockProblem whole =
+        BlockProblem::whole_graph(d, o.graph.num_poses, o.graph.measurements);
+    const CertificateResult c = verify_certificate(whole, o.optimum.X);
+    EXPECT_TRUE(c.certified);
+    ASSERT_TRUE(c.bound.proved());
+    const double f_star = o.optimum.relaxation_cost;
+    EXPECT_LE(c.bound.lower_bound, f_star);
+    EXPECT_LE(c.bound.relative_suboptimality(f_star), CertificateOptions{}.suboptimality_tolerance);
+    EXPECT_LE(c.bound.gradient_norm, 1e-4 * std::max(1.0, f_star));
+  }
+}
+
+// The agents prove the same bound as the centralized factorization, at the optimum and near it.
+TEST(CertificateBound, DistributedBoundIsTheCentralizedOne) {
+  const OptimumAndNearby o = optimum_and_nearby(3, 41);
+  const PoseGraph& g = o.graph;
+  const BlockProblem whole = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  DistributedCertificateOptions options;
+  options.interface_max_coordinates = 100000;
+  const auto parts = sequential_partition(g.num_poses, 3);
+  const CertificateResult central = verify_certificate(whole, o.optimum.X);
+  const DistributedCertificateResult dist =
+      certify_in_process(g, o.optimum.X, parts, DeliveryOrder::kFifo, {}, nullptr, options);
+  EXPECT_TRUE(central.certified);
+  EXPECT_TRUE(dist.certified);
+  ASSERT_TRUE(dist.bound.proved());
+  EXPECT_NEAR(dist.bound.shift, central.bound.shift, 1e-9 * central.bound.shift);
+  const double f = central.bound.relaxation_cost;
+  EXPECT_NEAR(dist.bound.lower_bound, central.bound.lower_bound, 1e-10 * f);
+  EXPECT_NEAR(dist.bound.relaxation_cost, f, 1e-10 * f);
+  EXPECT_NEAR(dist.bound.gradient_norm, central.bound.gradient_norm, 1e-6 * f);
+
+  const DistributedCertificateResult near =
+      certify_in_process(g, o.nearby, parts, DeliveryOrder::kFifo, {}, nullptr, options);
+  EXPECT_FALSE(near.certified);
+  if (near.bound.proved()) {
+    EXPECT_LE(near.bound.lower_bound, o.optimum.relaxation_cost);
+  }
+  // Without the interface test nothing proves a bound: LOBPCG's estimate certifies the
+  // optimum (a critical point), not the point near it, whose lambda_min(S) >= -eta too.
+  options.interface_max_coordinates = 0;
+  const DistributedCertificateResult lobpcg =
+      certify_in_process(g, o.optimum.X, parts, DeliveryOrder::kFifo, {}, nullptr, options);
+  EXPECT_FALSE(lobpcg.interface_test);
+  EXPECT_EQ(lobpcg.bound.method, CertificateMethod::kLobpcg);
+  EXPECT_FALSE(lobpcg.bound.proved());
+  EXPECT_TRUE(lobpcg.certified);
+  EXPECT_NEAR(lobpcg.bound.relaxation_cost, f, 1e-10 * f);
+  const DistributedCertificateResult lobpcg_near =
+      certify_in_process(g, o.nearby, parts, DeliveryOrder::kFifo, {}, nullptr, options);
+  EXPECT_TRUE(lobpcg_near.psd_within_tolerance);
+  EXPECT_FALSE(lobpcg_near.certified);
 }
 
 }  // namespace tessera

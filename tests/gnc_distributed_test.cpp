@@ -222,7 +222,10 @@ TEST(GncDistributed, TheFinalSolveIsRefinedToTheOptimumOfTheKeptSet) {
   const GncDistributedResult rounds_only = solve_gnc_distributed(dirty.graph, blocks, o);
   EXPECT_EQ(rounds_only.rejected, refined.rejected);
   EXPECT_TRUE(rounds_only.final_solve.refines.empty());
-  EXPECT_GT(rounds_only.final_solve.cost - fstar, 1e-8 * fstar);  // the gradient stop's gap
+  // The gradient stop's point is not certified (its weak-duality bound is above 1e-4,
+  // dual_bound.hpp): the staircase refines the same rank before the certificate holds.
+  EXPECT_GT(rounds_only.final_solve.refine_rounds, 0);
+  EXPECT_TRUE(rounds_only.final_solve.certified.value_or(false));
 
   o.robust.final_refine = true;
   o.solver.certify = false;

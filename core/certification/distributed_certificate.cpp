@@ -24,6 +24,7 @@ void DistributedCertificateOptions::validate() const {
   if (!(residual_tolerance > 0)) fail("residual_tolerance", "must be > 0");
   if (max_iterations <= 0) fail("max_iterations", "must be > 0");
   if (interface_max_coordinates < 0) fail("interface_max_coordinates", "must be >= 0");
+  if (!(suboptimality_tolerance >= 0)) fail("suboptimality_tolerance", "must be >= 0");
 }
 
 double certificate_start_entry(std::uint64_t seed, std::size_t pose, int coordinate, int d) {
@@ -150,6 +151,9 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
   }
   lambda_.resize(w * m, w * m);
   lambda_.setFromTriplets(trip.begin(), trip.end());
+  // The agent's shares of f(Y) = tr(Y Q Y^T) = sum_B <Y_B, (Y Q)_B> and of tr(Lambda).
+  f_local_ = frobenius_inner(Y, G);
+  trace_lambda_local_ = lambda_.diagonal().sum();
   const SparseMatrix& Q = problem_.data_matrix();
   local_max_diag_ = Q.rows() > 0 ? Q.diagonal().maxCoeff() : 0.0;
 
@@ -162,14 +166,20 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
       static_cast<double>(interface) * static_cast<double>(w) <=
           static_cast<double>(options_.interface_max_coordinates)) {
     // The reduction before the interface test: the global eta, whether an agent's block is too
-    // large to factor (then nobody tests), and the Gram matrices of Y's rows (Y Y^T, Y S Y^T,
-    // (Y S)(Y S)^T) for the Ritz pair on the row space.
+    // large to factor (then nobody tests), the Gram matrices of Y's rows (Y Y^T, Y S Y^T,
+    // (Y S)(Y S)^T) for the Ritz pair on the row space, and the bound's sums: f(Y), tr(Lambda),
+    // the number of poses and the proof's weights (dual_bound.hpp).
     const Eigen::MatrixXd YS = apply(Y, state_.Yn);
     const Eigen::MatrixXd grams[3] = {Y * Y.transpose(), Y * YS.transpose(), YS * YS.transpose()};
+    weights_ = proof_shift_weights(YS, Q, d);
+    weight_sum_local_ = 0.0;
+    for (double v : weights_) weight_sum_local_ += v;
     std::vector<double> values{local_max_diag_, state_.block_factor_too_large() ? 1.0 : 0.0};
     for (const auto& g : grams)
       for (Eigen::Index i = 0; i < g.rows(); ++i)
         for (Eigen::Index j = i; j < g.cols(); ++j) values.push_back(0.5 * (g(i, j) + g(j, i)));
+    values.insert(values.end(),
+                  {f_local_, trace_lambda_local_, static_cast<double>(m), weight_sum_local_});
     broadcast(0, kSetup, values, out);
   } else {
     build_preconditioner();
@@ -239,7 +249,7 @@ void CertificateProtocol::after_setup(const MessageGate::Inbox& inbox,
                                       std::vector<OutgoingMessage>& out) {
   const Eigen::Index r = state_.Y.rows();
   const std::size_t tri = static_cast<std::size_t>(r * (r + 1) / 2);
-  const std::vector<double> t = reduce_in_id_order(inbox, 2 + 3 * tri, {0, 1});
+  const std::vector<double> t = reduce_in_id_order(inbox, 2 + 3 * tri + 4, {0, 1});
   result_.scale = std::max(1.0, t[0]);
   result_.tolerance = options_.relative_tolerance * result_.scale;
   Eigen::MatrixXd grams[3];
@@ -249,6 +259,11 @@ void CertificateProtocol::after_setup(const MessageGate::Inbox& inbox,
     for (Eigen::Index i = 0; i < r; ++i)
       for (Eigen::Index j = i; j < r; ++j) g(i, j) = g(j, i) = t[at++];
   }
+  f_ = t[at];
+  trace_lambda_ = t[at + 1];
+  poses_ = t[at + 2];
+  weight_sum_ = t[at + 3];
+  gradient_norm_ = 2.0 * std::sqrt(std::max(0.0, grams[2].trace()));  // 2 ||Y S||_F
   // Rayleigh-Ritz on the row space (the same r x r problem on every agent): the smallest Ritz
   // value and its residual ||x S - theta x||^2 = c^T (Y S)(Y S)^T c - theta^2 for c^T Y Y^T c = 1.
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eb(grams[0]);
@@ -272,7 +287,21 @@ void CertificateProtocol::after_setup(const MessageGate::Inbox& inbox,
     start_lobpcg(out);
     return;
   }
-  const double shift = std::max(result_.tolerance, 1e-12 * result_.scale);
+  // The first test's floor: the smallest that can certify (dual_bound.hpp); it and alpha go
+  // up by factors of kProofShiftGrowth while the test fails, the floor to eta at most.
+  proof_shift_cap_ = std::max(result_.tolerance, 1e-12 * result_.scale);
+  proof_shift_ = std::min(proof_shift_cap_,
+                          first_proof_shift(f_, static_cast<std::size_t>(poses_), problem_.dim(),
+                                            options_.suboptimality_tolerance, result_.scale));
+  proof_alpha_ = 1.0;
+  proof_round_ = 0;
+  send_schur(out);
+}
+
+void CertificateProtocol::send_schur(std::vector<OutgoingMessage>& out) {
+  const Eigen::VectorXd shift =
+      proof_shift_diagonal(problem_.owned(), problem_.dim(), weights_, proof_shift_, proof_alpha_);
+  ++result_.proof_tests;
   InterfaceSchurBlock block;
   if (options_.interface_one_side) {
     std::vector<char> kept(layout_.owner.size(), 0);
@@ -283,18 +312,19 @@ void CertificateProtocol::after_setup(const MessageGate::Inbox& inbox,
   } else {
     block = local_interface_schur(problem_, lambda_, shift, interface_poses(layout_, state_.id()));
   }
+  const std::uint32_t round = proof_round_;
   PoseBlockMessage m =
-      make_reduction_message(state_.id(), 0, kSchur, encode_interface_schur(block));
+      make_reduction_message(state_.id(), round, kSchur, encode_interface_schur(block));
   if (state_.id() == 0) {
-    gate_.add(0, 0, kSchur, std::move(m));
-    gate_.expect(0, kSchur, everyone());
+    gate_.add(0, round, kSchur, std::move(m));
+    gate_.expect(round, kSchur, everyone());
   } else {
     OutgoingMessage o;
     o.message = std::move(m);
     o.broadcast = false;
     o.recipients = {0};
     out.push_back(std::move(o));
-    gate_.expect(0, kVerdict, {0});
+    gate_.expect(round, kVerdict, {0});
   }
 }
 
@@ -306,19 +336,28 @@ void CertificateProtocol::after_schur(const MessageGate::Inbox& inbox,
     blocks.push_back(decode_interface_schur(values));
   }
   const bool pd = interface_positive_definite(blocks, problem_.dim());
-  PoseBlockMessage v = make_reduction_message(0, 0, kVerdict, {pd ? 1.0 : 0.0});
-  gate_.add(0, 0, kVerdict, v);
+  const std::uint32_t round = proof_round_;
+  PoseBlockMessage v = make_reduction_message(0, round, kVerdict, {pd ? 1.0 : 0.0});
+  gate_.add(0, round, kVerdict, v);
   OutgoingMessage o;
   o.message = std::move(v);
   o.broadcast = true;
   out.push_back(std::move(o));
-  gate_.expect(0, kVerdict, {0});
+  gate_.expect(round, kVerdict, {0});
 }
 
 void CertificateProtocol::after_verdict(const MessageGate::Inbox& inbox,
                                         std::vector<OutgoingMessage>& out) {
   interface_certified_ = reduction_values(inbox.at(0), 1)[0] != 0.0;
   result_.interface_test = true;
+  if (!interface_certified_ && proof_shift_ < proof_shift_cap_) {
+    // Not proved at this shift, perhaps at a larger one (a point short of critical).
+    proof_shift_ = std::min(proof_shift_cap_, kProofShiftGrowth * proof_shift_);
+    proof_alpha_ *= kProofShiftGrowth;
+    ++proof_round_;
+    send_schur(out);
+    return;
+  }
   if (interface_certified_ && row_space_residual_ <= options_.residual_tolerance * result_.scale) {
     theta_ = row_space_theta_;
     x_ = row_space_ritz_.transpose() * state_.Y;
@@ -394,8 +433,13 @@ void CertificateProtocol::after_vector(const MessageGate::Inbox& inbox,
   for (const auto& [sender, m] : inbox) state_.absorb(std::get<PoseBlockMessage>(m), vn);
   if (iteration_ == 0) {
     Sx_ = apply(x_, vn);
-    broadcast(0, kReduce, {frobenius_inner(x_, x_), frobenius_inner(x_, Sx_), local_max_diag_},
-              out);
+    std::vector<double> values{frobenius_inner(x_, x_), frobenius_inner(x_, Sx_), local_max_diag_};
+    if (!result_.interface_test) {  // the bound's parts, when no setup reduction carried them
+      const Eigen::MatrixXd YS = apply(state_.Y, state_.Yn);
+      values.insert(values.end(), {f_local_, trace_lambda_local_,
+                                   static_cast<double>(problem_.num_owned()), YS.squaredNorm()});
+    }
+    broadcast(0, kReduce, values, out);
     return;
   }
   Sw_ = apply(w_, vn);
@@ -424,11 +468,29 @@ void CertificateProtocol::begin_iteration(std::vector<OutgoingMessage>& out) {
 void CertificateProtocol::finish(bool converged) {
   result_.converged = converged;
   result_.min_eigenvalue = theta_;
-  // The interface test's verdict is a proof; LOBPCG after it only measured lambda_min (a
-  // Rayleigh quotient below -eta would contradict it: round-off, so not certified).
-  result_.certified = result_.interface_test ? interface_certified_ && theta_ >= -result_.tolerance
-                                             : converged && theta_ >= -result_.tolerance;
-  if (result_.interface_test) ++result_.iterations;
+  result_.psd_within_tolerance = result_.interface_test
+                                     ? interface_certified_ && theta_ >= -result_.tolerance
+                                     : converged && theta_ >= -result_.tolerance;
+  // The interface test's pass is the proof of the bound (dual_bound.hpp); a Ritz value >= -eta
+  // holds short of a critical point too, so it does not certify.
+  const bool proved = result_.interface_test && interface_certified_;
+  result_.bound =
+      make_dual_bound(f_, trace_lambda_, gradient_norm_,
+                      proved ? proof_shift_ * poses_ + proof_alpha_ * weight_sum_ : DualBound::kNaN,
+                      static_cast<std::size_t>(poses_), problem_.dim());
+  if (proved) {
+    result_.certified = bound_certifies(result_.bound, options_.suboptimality_tolerance);
+  } else {
+    // No interface test: LOBPCG's converged estimate, at a point that is first-order critical
+    // to the tolerance (the estimate alone passes short of a critical point: parking-garage's
+    // iterate at |grad f| = 0.0097 did, 7e-4 relative above f*). An interface test that
+    // failed at every shift certifies nothing.
+    result_.bound.method = CertificateMethod::kLobpcg;
+    result_.certified =
+        !result_.interface_test && result_.psd_within_tolerance &&
+        gradient_norm_ <= options_.suboptimality_tolerance * std::max(1.0, std::abs(f_));
+  }
+  if (result_.interface_test) result_.iterations += result_.proof_tests;
   result_.eigenvector = x_;
   done_ = true;
 }
@@ -436,7 +498,13 @@ void CertificateProtocol::finish(bool converged) {
 void CertificateProtocol::after_reduce(const MessageGate::Inbox& inbox,
                                        std::vector<OutgoingMessage>& out) {
   if (iteration_ == 0) {
-    const std::vector<double> t = reduce_in_id_order(inbox, 3, {2});
+    const std::vector<double> t = reduce_in_id_order(inbox, result_.interface_test ? 3 : 7, {2});
+    if (!result_.interface_test) {
+      f_ = t[3];
+      trace_lambda_ = t[4];
+      poses_ = t[5];
+      gradient_norm_ = 2.0 * std::sqrt(std::max(0.0, t[6]));
+    }
     result_.scale = std::max(1.0, t[2]);
     result_.tolerance = options_.relative_tolerance * result_.scale;
     if (!(t[0] > 0)) throw std::runtime_error("certificate: zero start vector");

@@ -106,7 +106,7 @@ class SupernodalCholesky {
 }  // namespace
 
 InterfaceSchurBlock local_interface_schur(const BlockProblem& problem, const SparseMatrix& lambda,
-                                          double shift,
+                                          const Eigen::VectorXd& shift,
                                           const std::vector<std::size_t>& interface_poses) {
   // Every pose with a cut measurement is kept: no pose of another block couples to an
   // eliminated one, so the predicate on the neighbours' poses is never asked about that.
@@ -115,7 +115,8 @@ InterfaceSchurBlock local_interface_schur(const BlockProblem& problem, const Spa
 }
 
 InterfaceSchurBlock local_separator_schur(const BlockProblem& problem, const SparseMatrix& lambda,
-                                          double shift, const std::vector<std::size_t>& kept,
+                                          const Eigen::VectorXd& shift,
+                                          const std::vector<std::size_t>& kept,
                                           const std::function<bool(std::size_t)>& in_separator) {
   InterfaceSchurBlock out;
   const int d = problem.dim();
@@ -199,7 +200,8 @@ InterfaceSchurBlock local_separator_schur(const BlockProblem& problem, const Spa
 
   // The foreign poses' diagonal is a placeholder kappa I (their own block holds their entries):
   // large enough that the trailing block factors, then subtracted from the Schur complement.
-  // The rounding error of that subtraction is ~1e-16 kappa, far below eta.
+  // The rounding error of that subtraction is ~1e-16 kappa, far below the smallest shift the
+  // proof tries (1e-13 max diag Q, dual_bound.hpp).
   double kappa = 1.0;
   for (Eigen::Index k = 0; k < A.outerSize(); ++k)
     for (SparseMatrix::InnerIterator it(A, k); it; ++it)
@@ -212,7 +214,7 @@ InterfaceSchurBlock local_separator_schur(const BlockProblem& problem, const Spa
       const Eigen::Index pr = pos[static_cast<std::size_t>(it.row())];
       if (pr >= pc) t.emplace_back(pr, pc, it.value());
     }
-    t.emplace_back(pc, pc, shift);
+    t.emplace_back(pc, pc, shift(col));
     if (nF > 0 && !is_kept[static_cast<std::size_t>(col / w)])
       for (SparseMatrix::InnerIterator it(Qnb, col); it; ++it)
         if (it.value() != 0.0)
@@ -230,7 +232,7 @@ InterfaceSchurBlock local_separator_schur(const BlockProblem& problem, const Spa
     B.setFromTriplets(t.begin(), t.end());
     SupernodalCholesky llt(CHOLMOD_NATURAL);
     const Eigen::Index failed = llt.factor(B);
-    if (failed < n) return out;  // a principal submatrix of S + eta I is not PD
+    if (failed < n) return out;  // a principal submatrix of S + D is not PD
     if (failed == total) {
       out.positive_definite = true;
       const Eigen::MatrixXd Lgg = llt.trailing_block(nI);

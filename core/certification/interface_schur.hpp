@@ -1,9 +1,11 @@
 #pragma once
-// The exact distributed test of S + eta I > 0 by substructuring (non-overlapping domain
+// The exact distributed test of S + D > 0 by substructuring (non-overlapping domain
 // decomposition). A separator C covers the cut (every cut measurement has an endpoint in C);
 // block b's other poses I_b are coupled to nothing outside the block but separator poses. Then
-//   S + eta I > 0  <=>  every block's (S + eta I)_{I_b I_b} > 0  and  Sigma > 0,
-//   Sigma = (S + eta I)_CC - sum_b S_{C I_b} (S + eta I)_{I_b I_b}^-1 S_{I_b C}
+//   S + D > 0  <=>  every block's (S + D)_{I_b I_b} > 0  and  Sigma > 0,
+//   Sigma = (S + D)_CC - sum_b S_{C I_b} (S + D)_{I_b I_b}^-1 S_{I_b C}
+// (D: the proof's diagonal shift, positive on the rotation coordinates and on global pose 0's
+// translation, zero on the other translations; dual_bound.hpp: what S + D > 0 proves)
 // (the Schur complement lemma). Block b's term lives on its own separator poses and the foreign
 // ones next to its eliminated poses (Gamma_b); each agent computes it from one supernodal
 // factorization (CHOLMOD) of its block and those foreign poses, ordered last, as Schur_b =
@@ -23,12 +25,12 @@ namespace tessera {
 
 /// One block's share of Sigma.
 struct InterfaceSchurBlock {
-  bool positive_definite = false;  ///< S_BB + eta I factored (else S + eta I is not PD).
+  bool positive_definite = false;  ///< S_BB + D factored (else S + D is not PD).
   /// Gamma_b, global ids: the kept own poses (in the caller's order), then the foreign
   /// separator poses coupled to an eliminated own pose (ascending).
   std::vector<std::size_t> poses;
-  /// Schur_b on poses' coordinates (pose-major): Gamma_b's own entries of S + eta I minus
-  /// S_{Gamma I} (S + eta I)_{II}^-1 S_{I Gamma}; a foreign pose's own entries are its owner's.
+  /// Schur_b on poses' coordinates (pose-major): Gamma_b's own entries of S + D minus
+  /// S_{Gamma I} (S + D)_{II}^-1 S_{I Gamma}; a foreign pose's own entries are its owner's.
   Eigen::MatrixXd schur;
   /// Coupling entries to other blocks' interface poses, global coordinates (pose (d+1) + c),
   /// each cut pose pair sent once: by the block owning the smaller pose id.
@@ -36,10 +38,11 @@ struct InterfaceSchurBlock {
   std::vector<double> values;
 };
 
-/// Block b's share. `lambda` is Lambda_B on the block's coordinates (owned order), `shift` is
-/// eta (> 0), `interface_poses` the block's interface (global ids, ascending, all owned).
+/// Block b's share. `lambda` is Lambda_B on the block's coordinates (owned order), `shift` the
+/// diagonal D added to S there (dual_bound.hpp: proof_shift_diagonal), `interface_poses` the
+/// block's interface (global ids, ascending, all owned).
 InterfaceSchurBlock local_interface_schur(const BlockProblem& problem, const SparseMatrix& lambda,
-                                          double shift,
+                                          const Eigen::VectorXd& shift,
                                           const std::vector<std::size_t>& interface_poses);
 
 /// The same share when only a separator C is kept: `kept` are the block's poses in C (owned,
@@ -50,7 +53,8 @@ InterfaceSchurBlock local_interface_schur(const BlockProblem& problem, const Spa
 /// one endpoint of each cut measurement, Sigma has about half the coordinates of the
 /// interface's. local_interface_schur is the case C = every interface pose.
 InterfaceSchurBlock local_separator_schur(const BlockProblem& problem, const SparseMatrix& lambda,
-                                          double shift, const std::vector<std::size_t>& kept,
+                                          const Eigen::VectorXd& shift,
+                                          const std::vector<std::size_t>& kept,
                                           const std::function<bool(std::size_t)>& in_separator);
 
 /// As a message's values and back (the layout of the values is private to these two).
@@ -58,7 +62,7 @@ std::vector<double> encode_interface_schur(const InterfaceSchurBlock& block);
 /// Throws std::runtime_error when `values` are not an encoded block.
 InterfaceSchurBlock decode_interface_schur(const std::vector<double>& values);
 
-/// Every block's share (in block order) gives the verdict S + eta I > 0 (Sigma: the shares'
+/// Every block's share (in block order) gives the verdict S + D > 0 (Sigma: the shares'
 /// Schur complements summed where their poses meet, plus the coupling entries). d: the graph's
 /// dimension (a pose has d + 1 coordinates).
 bool interface_positive_definite(const std::vector<InterfaceSchurBlock>& blocks, int d);

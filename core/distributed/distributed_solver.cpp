@@ -221,6 +221,7 @@ DistributedResult solve_distributed_with_states(const PoseGraph& graph, const Bl
     res.min_eigenvalue = c.min_eigenvalue;
     res.certificate_tolerance = c.tolerance;
     res.certificate_residual = c.residual;
+    res.certificate_bound = c.bound;
   }
   res.certificate_rounds = lead.certificate_iterations();
   res.escape_rounds = lead.escape_trials();

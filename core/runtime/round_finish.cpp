@@ -52,6 +52,9 @@ RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout&
                                          res.certificate_rounds, res.final_rank);
     c.restart_vote = *res.certified;
     c.done_vote = true;
+    const DualBound& b = res.certificate_bound;
+    c.coarse = {b.relaxation_cost, b.trace_lambda, b.gradient_norm,
+                b.shift,           b.lower_bound,  static_cast<double>(b.method)};
     send(c);
     send(agent0_report(res.rounds, kCertificateBytesPhase,
                        static_cast<double>(res.certificate_bytes),

@@ -206,8 +206,10 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
       res.grad_norm = last.trace.back().grad_norm;
     }
     if (options.certify) res.certified = sequence->certified();
-    if (!sequence->certificates().empty())
+    if (!sequence->certificates().empty()) {
       res.min_eigenvalue = sequence->certificates().back().result.min_eigenvalue;
+      res.certificate_bound = sequence->certificates().back().result.bound;
+    }
     res.certificate_rounds = static_cast<std::uint32_t>(sequence->certificate_iterations());
     res.escape_rounds = static_cast<std::uint32_t>(sequence->escape_trials());
     mail.after_handled = nullptr;

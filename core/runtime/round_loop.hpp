@@ -187,6 +187,7 @@ struct RoundLoopResult {
   // Certification (RunOptions::certify), identical on every agent; bytes summed over agents.
   std::optional<bool> certified;
   double min_eigenvalue = 0.0;
+  DualBound certificate_bound;  ///< The last certificate's (dual_bound.hpp).
   std::uint32_t certificate_rounds = 0, escape_rounds = 0;
   std::uint64_t certificate_bytes = 0, escape_bytes = 0;
   std::uint32_t final_rank = 0;

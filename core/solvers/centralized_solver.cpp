@@ -341,7 +341,8 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     quick.lanczos_tolerance =
         std::max(options.certificate.lanczos_tolerance, options.certified_lanczos_tolerance);
     CertificateResult cert = verify_certificate(problem, X, quick);
-    if (!cert.certified && quick.lanczos_tolerance > options.certificate.lanczos_tolerance)
+    if (!cert.psd_within_tolerance &&
+        quick.lanczos_tolerance > options.certificate.lanczos_tolerance)
       cert = verify_certificate(problem, X, options.certificate);
     res.certify_s += seconds_since(cert_start);
     info.min_eigenvalue = cert.min_eigenvalue;
@@ -357,6 +358,7 @@ CentralizedResult solve_centralized(const PoseGraph& graph, const CentralizedOpt
     res.levels.push_back(info);
     res.certified = info.certified;
     res.min_eigenvalue = cert.min_eigenvalue;
+    res.certificate_bound = cert.bound;
     // No eigenvector (Lanczos did not converge): nothing to escape along.
     if (cert.certified || active >= options.max_rank || cert.min_eigenvector.size() == 0) break;
     X = escape_saddle(problem, X, cert.min_eigenvector, tr, precon);

@@ -33,6 +33,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <tessera/certification/dual_bound.hpp>
 #include <tessera/distributed/agent_process.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
@@ -57,24 +58,42 @@ struct DistributedCertificateOptions {
   std::uint64_t seed = 1;  ///< Start vector (hash of the global pose ids and this seed).
   /// The exact interface test runs when the team's interface (poses with a cut measurement)
   /// has at most this many coordinates ((d+1) a pose): agent 0 factors a matrix that large,
-  /// dense within each block's interface. 0 = LOBPCG only. >= 0. Why 800: the Schur complements
-  /// travel to agent 0 in one message step, 4 bytes a coordinate squared per block; at torus3D's
-  /// 1,004 (N = 5) that is 4 MB and the certificate phase over DDS took 0.37-0.75 s against
-  /// LOBPCG's 0.19-0.34 s, while sphere2500 (704) and city10000 (459 at N = 5, 768 at N = 10)
-  /// decide in one certificate round (docs/distributed-certification.md).
+  /// dense within each block's interface. 0 = LOBPCG only (an estimate, no proved bound). >= 0.
+  /// Why 800: the Schur complements travel to agent 0 in one message step, 4 bytes a
+  /// coordinate squared per block; at torus3D's 1,004 (N = 5) that is 4 MB and the certificate
+  /// phase over DDS took 0.37-0.75 s against LOBPCG's 0.19-0.34 s, while sphere2500 (704) and
+  /// city10000 (459 at N = 5, 768 at N = 10) decide in one certificate round
+  /// (docs/distributed-certification.md).
   int interface_max_coordinates = 800;
   /// The interface test keeps one endpoint of each cut measurement (the one in the lower-
   /// numbered block) and eliminates the other inside its block: Sigma has about half the
   /// coordinates (torus3D, N = 5: 1,004 instead of 1,944), interface_max_coordinates counts
   /// those. false: every pose with a cut measurement is kept (both endpoints).
   bool interface_one_side = true;
+  /// `certified` also needs the weak-duality bound (dual_bound.hpp) proved and within this
+  /// relative tolerance: (f(Y) - f_lb) <= suboptimality_tolerance * max(1, |f(Y)|). >= 0.
+  double suboptimality_tolerance = kDefaultSuboptimalityTolerance;
   /// Throws InputError naming the bad field.
   void validate() const;
 };
 
 /// Identical on every agent except `eigenvector`.
 struct DistributedCertificateResult {
+  /// With the interface test: the bound (below) proved and within suboptimality_tolerance (X
+  /// is then within that relative distance of the optimum, dual_bound.hpp). Without it:
+  /// LOBPCG converged to theta >= -eta and |grad f| <= suboptimality_tolerance max(1, |f|)
+  /// (CertificateMethod::kLobpcg, an estimate).
   bool certified = false;
+  /// The final Ritz value theta >= -eta (converged, or after an interface test that passed):
+  /// an estimate, and alone it says nothing about optimality short of a critical point.
+  bool psd_within_tolerance = false;
+  /// The weak-duality bound at Y (dual_bound.hpp). Proved only by the interface test (its
+  /// floor s0 from first_proof_shift and alpha from 1, both up by kProofShiftGrowth while the
+  /// test fails, s0 to eta at most); without the test (interface above
+  /// interface_max_coordinates, or a block too large to factor) nothing proves it:
+  /// lower_bound is NaN and `certified` is LOBPCG's estimate at a critical point.
+  DualBound bound;
+  int proof_tests = 0;          ///< Interface tests run (each: a Schur step and a verdict step).
   bool converged = false;       ///< Ritz residual reached the tolerance.
   double min_eigenvalue = 0.0;  ///< Smallest Ritz value theta (>= lambda_min(S)).
   double residual = 0.0;        ///< ||S x - theta x|| at the end.
@@ -144,6 +163,14 @@ class CertificateProtocol : public AgentProcess {
   bool done_ = false;
   // The interface test: its verdict, and the Ritz pair on the iterate's row space.
   bool interface_certified_ = false;
+  // The bound's parts (summed over the agents) and the interface test's current shift.
+  double f_local_ = 0.0, trace_lambda_local_ = 0.0;
+  double f_ = 0.0, trace_lambda_ = 0.0, gradient_norm_ = 0.0, poses_ = 0.0;
+  double proof_shift_ = 0.0, proof_alpha_ = 1.0, proof_shift_cap_ = 0.0;
+  double weight_sum_local_ = 0.0, weight_sum_ = 0.0;
+  std::vector<double> weights_;  // proof_shift_weights of the agent's poses
+  std::uint32_t proof_round_ = 0;
+  void send_schur(std::vector<OutgoingMessage>& out);
   Eigen::VectorXd row_space_ritz_;  // coefficients over Y's rows
   double row_space_theta_ = 0.0, row_space_residual_ = 0.0;
   DistributedCertificateResult result_;

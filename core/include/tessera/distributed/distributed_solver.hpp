@@ -117,7 +117,9 @@ struct DistributedResult {
   double min_eigenvalue = 0.0;         ///< Last certificate's smallest Ritz value of S.
   double certificate_tolerance = 0.0;  ///< Its eta.
   double certificate_residual = 0.0;   ///< Its Ritz residual.
-  int certificate_rounds = 0;          ///< LOBPCG iterations, all certificates.
+  /// Its weak-duality bound (dual_bound.hpp): NaN lower bound when not proved.
+  DualBound certificate_bound;
+  int certificate_rounds = 0;  ///< LOBPCG iterations, all certificates.
   std::uint64_t certificate_bytes = 0;
   /// Solver rounds (included in `rounds`) spent refining ranks whose certificate at the
   /// solver's tolerance was inconclusive (StaircaseOptions::grad_norm_tol).

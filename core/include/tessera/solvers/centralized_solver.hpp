@@ -142,6 +142,8 @@ struct CentralizedResult {
   int iterations = 0;             ///< Trust-region iterations over all levels.
   std::optional<bool> certified;  ///< Empty when certification was off.
   std::optional<double> min_eigenvalue;
+  /// The last certificate's weak-duality bound (dual_bound.hpp); NaN fields when none ran.
+  DualBound certificate_bound;
   std::vector<StaircaseLevel> levels;
   std::vector<CentralizedIteration> trace;
   /// The preconditioner(s) the trust region used at rank d: "tangent", "euclidean", or
