@@ -14,19 +14,12 @@
 #include "robust/gnc_local_terms.hpp"
 #include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
+#include "robust/gnc_outer_loop.hpp"
 #include "robust/gnc_probes.hpp"
 #include "robust/gnc_solve_setup.hpp"
 #include "robust/gnc_votes.hpp"
 
 namespace tessera {
-
-namespace {
-
-std::vector<int> as_ints(const std::vector<std::uint32_t>& ids) {
-  return {ids.begin(), ids.end()};
-}
-
-}  // namespace
 
 GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bool final_solve)
     : in_(std::move(input)), options_(options), final_solve_wanted_(final_solve) {
@@ -55,6 +48,7 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
   exchange_ = std::make_unique<GncExchangeBook>(in_, *terms_, *base_);
   mail_ = std::make_unique<GncMailbox>(in_.id);
+  outer_ = std::make_unique<GncOuterLoop>();
   recheck_ = std::make_unique<RecheckVerdict>();
   // With cluster probes the search (gnc_cluster_search.hpp) splits the budget: recheck_probes
   // tail probes, cluster_probes cluster, pair and return probes.
@@ -70,6 +64,14 @@ GncAgent::~GncAgent() = default;
 
 double GncAgent::threshold_squared() const {
   return terms_->c2();
+}
+
+int GncAgent::outer_iterations() const {
+  return outer_->outer();
+}
+
+bool GncAgent::weights_converged() const {
+  return outer_->converged();
 }
 
 int GncAgent::total_rounds() const {
@@ -191,114 +193,6 @@ GncExchange GncAgent::exchange() const {
     default:  // not an exchange: begin_exchange() is never called with it
       throw std::logic_error("GncAgent: no exchange at this step");
   }
-}
-
-void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
-  step_ = step;
-  const std::uint32_t phase = gnc_phase(g_, exchange());
-  const auto me = static_cast<std::uint32_t>(in_.id);
-  exchange_->begin();
-  // Whom this agent hears from: a pose exchange from its block neighbours (each sends what it
-  // was sent), a status exchange from every other agent.
-  std::vector<int> from = base_->adjacent[static_cast<std::size_t>(in_.id)];
-  // A status to every other agent, each of which answers with its own.
-  auto to_others = [&](RoundStatusMessage st) {
-    from = as_ints(other_agents(me, in_.num_agents));
-    broadcast_status(std::move(st), me, phase, in_.num_agents, out);
-  };
-  switch (step) {
-    case Step::kPoses:
-      // Weights are computed at the iterate itself: the owners' public poses of every
-      // measurement (the base layout: a measurement out of the current solve still needs
-      // its residual).
-      exchange_->expect_poses(state_->Y.rows(), false);
-      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
-      break;
-    case Step::kStartPoses:
-      // Both starts' public poses: the solver's initialization (kind Y) and the known
-      // inliers' (kind P).
-      exchange_->expect_poses(in_.Y0.rows(), true);
-      exchange_->publish(in_.Y0, BlockKind::kY, phase, out);
-      exchange_->publish(in_.Y0_known, BlockKind::kP, phase, out);
-      break;
-    case Step::kStartVotes:
-      // The TLS cost of each measurement at both starts, summed by its weight owner.
-      exchange_->own_vote() = start_vote_costs(*terms_, in_.Y0, exchange_->neighbours(),
-                                               in_.Y0_known, exchange_->candidate_neighbours());
-      to_others(vote_message(exchange_->own_vote()));
-      break;
-    case Step::kPcm:
-      from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kPcmValues), nullptr, out);
-      break;
-    case Step::kKeptStart:
-      from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kKeptValues), &rejected_,
-                                              out);
-      break;
-    case Step::kCandidatePoses:
-      // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
-      exchange_->expect_poses(state_->Y.rows(), true);
-      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
-      exchange_->publish(exchange_->candidate(), BlockKind::kP, phase, out);
-      break;
-    case Step::kCandidateVotes:
-      // Each kept measurement's cost at both starts, summed by its weight owner.
-      exchange_->own_vote() = kept_set_costs(*terms_, in_.measurement_index, rejected_, state_->Y,
-                                             exchange_->neighbours(), exchange_->candidate(),
-                                             exchange_->candidate_neighbours());
-      to_others(vote_message(exchange_->own_vote()));
-      break;
-    case Step::kVotes:
-      // mu's start needs the largest residual over every measurement that may be rejected.
-      exchange_->own_vote() = {
-          largest_rejectable_residual(*terms_, dropped_, state_->Y, exchange_->neighbours()), 0};
-      to_others(vote_message(exchange_->own_vote()));
-      break;
-    case Step::kWeights: {
-      const int crossed = weights_at_mu(mu_);
-      const double spread = weight_spread(*terms_, weights_);
-      const int near = options_.robust.jump_band > 0
-                           ? near_bound_count(*terms_, dropped_, state_->Y, exchange_->neighbours(),
-                                              options_.robust.jump_band)
-                           : 1;
-      exchange_->own_vote() = {spread, crossed};
-      exchange_->own_near_bound() = near;
-      zero_cut_ =
-          zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
-      const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
-      from = as_ints(others);
-      for (std::uint32_t a : others) {
-        RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_);
-        st.phase = phase;
-        st.sender = me;
-        out.push_back(OutgoingMessage{std::move(st), false, {a}});
-      }
-      break;
-    }
-    case Step::kRejected: {
-      rejected_ = rejected_by_weight(*terms_, in_.measurement_index, weights_);
-      RoundStatusMessage st;
-      st.measurement_ids = rejected_;
-      to_others(std::move(st));
-      break;
-    }
-    case Step::kReadmitted:
-      // TLS's own verdict at the kept set's solution (gnc_votes.hpp); every agent gathers all.
-      // With it the probe's list (only used when nothing else changes) and the TLS cost a probe
-      // is judged by.
-      *recheck_ = recheck_verdict(
-          *terms_, in_.measurement_index, rejected_, state_->Y, exchange_->neighbours(),
-          probes_->may_follow(terms_->known_connected(), options_.robust.readmission_passes)
-              ? options_.robust.probe_ratio
-              : 0.0,
-          options_.robust.probe_tail_ratio);
-      exchange_->own_vote() = {tls_cost(*terms_, state_->Y, exchange_->neighbours()), 0};
-      to_others(readmitted_message(*recheck_, exchange_->own_vote().first));
-      break;
-    default:
-      break;
-  }
-  mail_->begin_exchange(phase, std::move(from));
-  take_exchange(out);
 }
 
 void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
@@ -502,7 +396,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     begin_exchange(Step::kPoses, out);
     return;
   }
-  if (g_ > first_solve_g_ && (converged_ || outer_ >= options_.robust.max_outer_iterations)) {
+  if (g_ > first_solve_g_ && outer_->over(options_.robust)) {
     begin_exchange(Step::kRejected, out);
     return;
   }
@@ -515,40 +409,25 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       if (solve_kind_ == GncSolveKind::kInlierPass)
         begin_exchange(Step::kReadmitted, out);
       else
-        begin_exchange(voted_ ? Step::kWeights : Step::kVotes, out);
+        begin_exchange(outer_->started() ? Step::kWeights : Step::kVotes, out);
       return;
-    case Step::kVotes: {
-      voted_ = true;
-      mu_ = gnc_initial_mu(exchange_->largest_vote(), terms_->c2());
-      mu_factor_ = options_.robust.mu_step;
-      converged_ = mu_ == 0;
-      begin_exchange(converged_ ? Step::kRejected : Step::kWeights, out);
+    case Step::kVotes:
+      outer_->start(exchange_->largest_vote(), terms_->c2(), options_.robust);
+      begin_exchange(outer_->converged() ? Step::kRejected : Step::kWeights, out);
       return;
-    }
     case Step::kWeights: {
       const auto [spread, crossed] = exchange_->summed_votes();
-      ++outer_;
-      converged_ = spread <= options_.robust.weight_tolerance;
-      // RobustOptions::jump_band: every residual clear of the bound, so GNC ends at TLS's verdict
-      // at this iterate (the same on both ends of every cut measurement) and the passes follow.
-      const bool jump =
-          !converged_ && options_.robust.jump_band > 0 && exchange_->summed_near_bound() == 0;
-      if (jump) {
+      const bool jump = outer_->after_update(spread, static_cast<int>(crossed),
+                                             exchange_->summed_near_bound(), options_.robust);
+      if (jump)
         for (std::size_t k = 0; k < weights_.size(); ++k)
           if (terms_->may_reject(k) && !dropped_[k])
-            weights_[k] = tls_verdict_weight(weights_[k], mu_);
-        converged_ = true;
-      }
-      if (weight_observer_) weight_observer_(outer_, in_.measurement_index, weights_);
+            weights_[k] = tls_verdict_weight(weights_[k], outer_->mu());
+      if (weight_observer_) weight_observer_(outer_->outer(), in_.measurement_index, weights_);
       if (jump) {
         begin_exchange(Step::kRejected, out);
         return;
       }
-      // RobustOptions::mu_step_max: a bigger step while the inlier set stays as it was.
-      const double step_max = options_.robust.mu_step_max;
-      mu_factor_ = step_max > 0 && crossed == 0 ? std::min(mu_factor_ * mu_factor_, step_max)
-                                                : options_.robust.mu_step;
-      mu_ *= mu_factor_;
       if (terms_->known_connected()) {
         // This step's block layout: without the cut measurements of weight 0 (every agent's).
         std::sort(zero_cut_.begin(), zero_cut_.end());

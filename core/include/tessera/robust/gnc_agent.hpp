@@ -137,6 +137,7 @@ class GncProbes;         // internal: probes after the re-check passes
 class GncClusterSearch;  // internal: which probe next, with cluster probes
 class GncMailbox;        // internal: where incoming messages go
 class GncExchangeBook;   // internal: the exchanges' messages and what they carry
+class GncOuterLoop;      // internal: mu, its steps and the stop decision
 
 class GncAgent : public AgentProcess {
  public:
@@ -164,11 +165,11 @@ class GncAgent : public AgentProcess {
 
   // Results, identical on every agent once done() (rejected, counts, threshold).
   const std::vector<std::uint64_t>& rejected() const { return rejected_; }  ///< Ascending.
-  int outer_iterations() const { return outer_; }
+  int outer_iterations() const;
   std::size_t readmitted() const { return readmitted_; }  ///< Taken back by the passes.
   /// Kept by GNC, rejected by a pass (beyond the bound at the kept set's solution).
   std::size_t late_rejected() const { return late_rejected_; }
-  bool weights_converged() const { return converged_; }
+  bool weights_converged() const;
   /// Probes run after the re-check passes, and those that lowered the TLS cost and stayed.
   int probes() const;
   int probes_kept() const;
@@ -260,7 +261,6 @@ class GncAgent : public AgentProcess {
   std::vector<bool> dropped_;        // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
   GncSolveKind solve_kind_ = GncSolveKind::kGnc;
-  bool voted_ = false;             // the votes of mu's start are in
   int pass_ = 0;                   // inlier passes done
   bool pass_capped_ = false;       // the current pass stops at RobustOptions::recheck_max_rounds
   bool full_pass_next_ = false;    // the next pass is solved to the tolerance
@@ -278,10 +278,7 @@ class GncAgent : public AgentProcess {
   std::vector<double> weights_;                // per in_.measurements
   std::unique_ptr<GncMailbox> mail_;           // where incoming messages go
   std::unique_ptr<GncExchangeBook> exchange_;  // the exchanges' messages and state
-  double mu_ = 0;
-  double mu_factor_ = 1;  // the last step of mu (RobustOptions::mu_step_max)
-  int outer_ = 0;
-  bool converged_ = false;
+  std::unique_ptr<GncOuterLoop> outer_;        // mu, its steps, the outer-step count, the stop
   std::vector<std::uint64_t> rejected_;
   std::vector<Measurement> kept_;
   std::vector<std::uint64_t> kept_index_;

@@ -1,0 +1,136 @@
+// GncAgent's exchange steps, the sending side: what each step of GNC's own exchanges computes
+// from this agent's view and sends to whom (GncAgent::Step). The state machine that decides which
+// step comes next is gnc_agent.cpp; the messages' layout is gnc_messages.hpp.
+
+#include <tessera/robust/gnc_agent.hpp>
+#include <utility>
+#include <vector>
+
+#include "robust/gnc_exchange.hpp"
+#include "robust/gnc_lead_steps.hpp"
+#include "robust/gnc_local_terms.hpp"
+#include "robust/gnc_mailbox.hpp"
+#include "robust/gnc_messages.hpp"
+#include "robust/gnc_outer_loop.hpp"
+#include "robust/gnc_probes.hpp"
+#include "robust/gnc_votes.hpp"
+
+namespace tessera {
+
+namespace {
+
+std::vector<int> as_ints(const std::vector<std::uint32_t>& ids) {
+  return {ids.begin(), ids.end()};
+}
+
+}  // namespace
+
+void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
+  step_ = step;
+  const std::uint32_t phase = gnc_phase(g_, exchange());
+  const auto me = static_cast<std::uint32_t>(in_.id);
+  exchange_->begin();
+  // Whom this agent hears from: a pose exchange from its block neighbours (each sends what it
+  // was sent), a status exchange from every other agent.
+  std::vector<int> from = base_->adjacent[static_cast<std::size_t>(in_.id)];
+  // A status to every other agent, each of which answers with its own.
+  auto to_others = [&](RoundStatusMessage st) {
+    from = as_ints(other_agents(me, in_.num_agents));
+    broadcast_status(std::move(st), me, phase, in_.num_agents, out);
+  };
+  switch (step) {
+    case Step::kPoses:
+      // Weights are computed at the iterate itself: the owners' public poses of every
+      // measurement (the base layout: a measurement out of the current solve still needs
+      // its residual).
+      exchange_->expect_poses(state_->Y.rows(), false);
+      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
+      break;
+    case Step::kStartPoses:
+      // Both starts' public poses: the solver's initialization (kind Y) and the known
+      // inliers' (kind P).
+      exchange_->expect_poses(in_.Y0.rows(), true);
+      exchange_->publish(in_.Y0, BlockKind::kY, phase, out);
+      exchange_->publish(in_.Y0_known, BlockKind::kP, phase, out);
+      break;
+    case Step::kStartVotes:
+      // The TLS cost of each measurement at both starts, summed by its weight owner.
+      exchange_->own_vote() = start_vote_costs(*terms_, in_.Y0, exchange_->neighbours(),
+                                               in_.Y0_known, exchange_->candidate_neighbours());
+      to_others(vote_message(exchange_->own_vote()));
+      break;
+    case Step::kPcm:
+      from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kPcmValues), nullptr, out);
+      break;
+    case Step::kKeptStart:
+      from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kKeptValues), &rejected_,
+                                              out);
+      break;
+    case Step::kCandidatePoses:
+      // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
+      exchange_->expect_poses(state_->Y.rows(), true);
+      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
+      exchange_->publish(exchange_->candidate(), BlockKind::kP, phase, out);
+      break;
+    case Step::kCandidateVotes:
+      // Each kept measurement's cost at both starts, summed by its weight owner.
+      exchange_->own_vote() = kept_set_costs(*terms_, in_.measurement_index, rejected_, state_->Y,
+                                             exchange_->neighbours(), exchange_->candidate(),
+                                             exchange_->candidate_neighbours());
+      to_others(vote_message(exchange_->own_vote()));
+      break;
+    case Step::kVotes:
+      // mu's start needs the largest residual over every measurement that may be rejected.
+      exchange_->own_vote() = {
+          largest_rejectable_residual(*terms_, dropped_, state_->Y, exchange_->neighbours()), 0};
+      to_others(vote_message(exchange_->own_vote()));
+      break;
+    case Step::kWeights: {
+      const int crossed = weights_at_mu(outer_->mu());
+      const double spread = weight_spread(*terms_, weights_);
+      const int near = options_.robust.jump_band > 0
+                           ? near_bound_count(*terms_, dropped_, state_->Y, exchange_->neighbours(),
+                                              options_.robust.jump_band)
+                           : 1;
+      exchange_->own_vote() = {spread, crossed};
+      exchange_->own_near_bound() = near;
+      zero_cut_ =
+          zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
+      const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
+      from = as_ints(others);
+      for (std::uint32_t a : others) {
+        RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_);
+        st.phase = phase;
+        st.sender = me;
+        out.push_back(OutgoingMessage{std::move(st), false, {a}});
+      }
+      break;
+    }
+    case Step::kRejected: {
+      rejected_ = rejected_by_weight(*terms_, in_.measurement_index, weights_);
+      RoundStatusMessage st;
+      st.measurement_ids = rejected_;
+      to_others(std::move(st));
+      break;
+    }
+    case Step::kReadmitted:
+      // TLS's own verdict at the kept set's solution (gnc_votes.hpp); every agent gathers all.
+      // With it the probe's list (only used when nothing else changes) and the TLS cost a probe
+      // is judged by.
+      *recheck_ = recheck_verdict(
+          *terms_, in_.measurement_index, rejected_, state_->Y, exchange_->neighbours(),
+          probes_->may_follow(terms_->known_connected(), options_.robust.readmission_passes)
+              ? options_.robust.probe_ratio
+              : 0.0,
+          options_.robust.probe_tail_ratio);
+      exchange_->own_vote() = {tls_cost(*terms_, state_->Y, exchange_->neighbours()), 0};
+      to_others(readmitted_message(*recheck_, exchange_->own_vote().first));
+      break;
+    default:
+      break;
+  }
+  mail_->begin_exchange(phase, std::move(from));
+  take_exchange(out);
+}
+
+}  // namespace tessera
