@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <tessera/certification/certificate.hpp>
 #include <tessera/util/input_error.hpp>
@@ -84,18 +85,16 @@ void quiet(Factor& f) {
   f.cholmod().final_ll = 1;
 }
 
-SparseMatrix shifted(const SparseMatrix& S, double shift) {
-  SparseMatrix A = S;
-  for (Eigen::Index k = 0; k < A.rows(); ++k) A.coeffRef(k, k) += shift;
-  return A;
-}
-
-// S + D (dual_bound.hpp).
+// S + diag(D): the proof's per-coordinate shift (dual_bound.hpp), or a uniform one.
 SparseMatrix proof_shifted(const SparseMatrix& S, const Eigen::VectorXd& D) {
   SparseMatrix A = S;
   for (Eigen::Index k = 0; k < A.rows(); ++k)
     if (D(k) != 0.0) A.coeffRef(k, k) += D(k);
   return A;
+}
+
+SparseMatrix shifted(const SparseMatrix& S, double shift) {
+  return proof_shifted(S, Eigen::VectorXd::Constant(S.rows(), shift));
 }
 
 // Largest eigenvalue of (S + shift I)^{-1}: 1/(lambda_min + shift). Returns lambda_min.
@@ -200,8 +199,7 @@ CertificateResult verify_certificate(const BlockProblem& problem, const Eigen::M
   if (!res.psd_within_tolerance && std::isfinite(res.min_eigenvalue))
     s = std::max(s, -1.01 * res.min_eigenvalue);
   const std::vector<double> w = proof_shift_weights(XS, Q, d);
-  double weight_sum = 0.0;
-  for (double v : w) weight_sum += v;
+  const double weight_sum = std::accumulate(w.begin(), w.end(), 0.0);
   double proved = std::numeric_limits<double>::quiet_NaN();
   for (double alpha = 1.0; s <= 4e3 * scale; s *= kProofShiftGrowth, alpha *= kProofShiftGrowth) {
     Factor proof;

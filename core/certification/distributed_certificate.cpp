@@ -3,6 +3,7 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 #include <tessera/certification/distributed_certificate.hpp>
 #include <tessera/util/input_error.hpp>
@@ -172,8 +173,7 @@ std::vector<OutgoingMessage> CertificateProtocol::start() {
     const Eigen::MatrixXd YS = apply(Y, state_.Yn);
     const Eigen::MatrixXd grams[3] = {Y * Y.transpose(), Y * YS.transpose(), YS * YS.transpose()};
     weights_ = proof_shift_weights(YS, Q, d);
-    weight_sum_local_ = 0.0;
-    for (double v : weights_) weight_sum_local_ += v;
+    weight_sum_local_ = std::accumulate(weights_.begin(), weights_.end(), 0.0);
     std::vector<double> values{local_max_diag_, state_.block_factor_too_large() ? 1.0 : 0.0};
     for (const auto& g : grams)
       for (Eigen::Index i = 0; i < g.rows(); ++i)
