@@ -15,6 +15,20 @@
 
 namespace tessera {
 
+namespace {
+
+// Sigma assembled from the agents' shares in id order and factored with the refinement's
+// shifts eta, 1e3 eta, 1e6 eta (the first positive definite one); false where none was.
+bool assemble_sigma(InterfaceSolve& interface, const std::vector<std::vector<double>>& shares,
+                    double eta) {
+  std::vector<const std::vector<double>*> ptrs;
+  ptrs.reserve(shares.size());
+  for (const auto& v : shares) ptrs.push_back(&v);
+  return interface.assemble(ptrs, {eta, 1e3 * eta, 1e6 * eta});
+}
+
+}  // namespace
+
 void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
   // This block's share of Sigma at the current point, then its interface residual of -g (the
   // first CG residual), so that the first direction needs no further message step.
@@ -82,10 +96,7 @@ std::vector<double> NewtonRefineProtocol::factor_shipped_sigma() {
   bool ok = true;
   for (const auto& v : next_shares_) ok = ok && !v.empty() && v.front() != 0.0;
   if (ok) {
-    std::vector<const std::vector<double>*> ptrs;
-    for (const auto& v : next_shares_) ptrs.push_back(&v);
-    const double eta = options_.interface_shift;
-    ok = interface_->assemble(ptrs, {eta, 1e3 * eta, 1e6 * eta});
+    ok = assemble_sigma(*interface_, next_shares_, options_.interface_shift);
     ++result_.sigma_factorizations;
   }
   if (!ok) return {0.0};
@@ -151,18 +162,12 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
       if (interface_->import_sigma(zero.data() + 1, zero.size() - 1)) {
         ++result_.sigma_imports;
       } else {
-        std::vector<const std::vector<double>*> ptrs;
-        for (const auto& v : next_shares_) ptrs.push_back(&v);
-        const double eta = options_.interface_shift;
-        ok = interface_->assemble(ptrs, {eta, 1e3 * eta, 1e6 * eta});
+        ok = assemble_sigma(*interface_, next_shares_, options_.interface_shift);
         ++result_.sigma_factorizations;
       }
     }
   } else if (ok) {
-    std::vector<const std::vector<double>*> ptrs;
-    for (const auto& v : shares) ptrs.push_back(&v);
-    const double eta = options_.interface_shift;
-    ok = interface_->assemble(ptrs, {eta, 1e3 * eta, 1e6 * eta});
+    ok = assemble_sigma(*interface_, shares, options_.interface_shift);
     ++result_.sigma_factorizations;
   }
   shares_ready_ = false;
