@@ -68,6 +68,13 @@ TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayo
   // left out of touched() and own() (no Hessian product assembles their columns of A).
   std::vector<int> members(static_cast<std::size_t>(groups_), 0);
   for (int g : group_of_piece_) ++members[static_cast<std::size_t>(g)];
+  std::vector<std::vector<Eigen::Index>> unknowns(static_cast<std::size_t>(groups_));
+  for (int alpha = 0; alpha < pieces_; ++alpha)
+    for (int j = 0; j < g_; ++j)
+      unknowns[static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(alpha)])]
+          .push_back(alpha * g_ + j);
+  for (std::size_t g = 0; g < unknowns.size(); ++g)
+    if (members[g] >= 2) linked_group_unknowns_.push_back(std::move(unknowns[g]));
   linked_.assign(static_cast<std::size_t>(pieces_), 0);
   for (int a = 0; a < pieces_; ++a) {
     if (members[static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(a)])] < 2)
@@ -179,22 +186,13 @@ Eigen::MatrixXd TangentCoarseSpace::pseudo_inverse(const Eigen::MatrixXd& A, dou
   // Pieces of different groups share no measurement, so A is block diagonal over the groups and
   // so is its pseudo-inverse: one small eigendecomposition per group of two pieces or more (a
   // lone piece's block is all gauge, zero), not one of all the pieces' unknowns at every point.
-  std::vector<std::vector<Eigen::Index>> unknowns(static_cast<std::size_t>(groups_));
-  std::vector<int> members(static_cast<std::size_t>(groups_), 0);
-  for (int alpha = 0; alpha < pieces_; ++alpha) {
-    const auto g = static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(alpha)]);
-    ++members[g];
-    for (int j = 0; j < g_; ++j) unknowns[g].push_back(alpha * g_ + j);
-  }
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, n);
-  for (std::size_t group = 0; group < unknowns.size(); ++group) {
-    if (members[group] < 2) continue;
-    const std::vector<Eigen::Index>& idx = unknowns[group];
+  for (const std::vector<Eigen::Index>& idx : linked_group_unknowns_) {
     const auto m = static_cast<Eigen::Index>(idx.size());
     // P = I - U U^T, U's columns the group's rigid motions (generator j on every piece of the
     // group) normalized.
     Eigen::MatrixXd U = Eigen::MatrixXd::Zero(m, g_);
-    const double s = 1.0 / std::sqrt(static_cast<double>(members[group]));
+    const double s = 1.0 / std::sqrt(static_cast<double>(m / g_));
     for (Eigen::Index q = 0; q < m; ++q) U(q, q % g_) = s;
     const Eigen::MatrixXd Ag = A(idx, idx);
     const Eigen::MatrixXd PA = Ag - U * (U.transpose() * Ag);

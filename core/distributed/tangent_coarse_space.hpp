@@ -99,6 +99,8 @@ class TangentCoarseSpace {
   std::vector<int> group_of_piece_;
   std::vector<char> linked_;               // by piece: in a group with another piece
   std::vector<std::size_t> linked_slots_;  // own slots some linked piece weighs
+  // Unknowns (piece * g + generator) of each group of two pieces or more: A's diagonal blocks.
+  std::vector<std::vector<Eigen::Index>> linked_group_unknowns_;
   Poses own_poses_, neighbour_poses_;
   std::vector<int> touched_, own_;
   std::vector<std::pair<int, int>> rotation_pairs_;  // (a, b), a < b, for generators 0..
