@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <tessera/graph/connectivity.hpp>
 
 namespace tessera {
 
@@ -37,24 +38,12 @@ TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayo
     for (int b = a + 1; b < k; ++b) rotation_pairs_.emplace_back(a, b);
   // Groups of linked pieces: the components of the block graph (every agent has the layout, so
   // every agent finds the same numbering).
-  std::vector<int> root(static_cast<std::size_t>(layout.num_blocks));
-  for (int b = 0; b < layout.num_blocks; ++b) root[static_cast<std::size_t>(b)] = b;
-  auto find = [&](int b) {
-    while (root[static_cast<std::size_t>(b)] != b)
-      b = root[static_cast<std::size_t>(b)] =
-          root[static_cast<std::size_t>(root[static_cast<std::size_t>(b)])];
-    return b;
-  };
-  for (int b = 0; b < layout.num_blocks; ++b)
-    for (int a : layout.adjacent[static_cast<std::size_t>(b)]) {
-      const int ra = find(a), rb = find(b);
-      if (ra != rb) root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-    }
-  std::vector<int> group_of_root(static_cast<std::size_t>(layout.num_blocks), -1);
+  const std::vector<std::size_t> component = connected_components(layout.adjacent);
+  std::vector<int> group_of_component(component.size(), -1);
   group_of_piece_.resize(static_cast<std::size_t>(pieces_));
   for (int alpha = 0; alpha < pieces_; ++alpha) {
     const int block = space ? space->aggregate_block[static_cast<std::size_t>(alpha)] : alpha;
-    int& g = group_of_root[static_cast<std::size_t>(find(block))];
+    int& g = group_of_component[component[static_cast<std::size_t>(block)]];
     if (g < 0) g = groups_++;
     group_of_piece_[static_cast<std::size_t>(alpha)] = g;
   }

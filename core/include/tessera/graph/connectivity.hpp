@@ -10,6 +10,10 @@ namespace tessera {
 /// Component label (0..k-1, in order of the smallest pose id) for each of the graph's poses.
 std::vector<std::size_t> connected_components(const PoseGraph& graph);
 
+/// The same labels for a graph given by adjacency lists (vertex v's neighbours in
+/// adjacency[v]; neighbours out of range are ignored), e.g. a partition's block graph.
+std::vector<std::size_t> connected_components(const std::vector<std::vector<int>>& adjacency);
+
 /// Number of connected components (1 for a connected graph; n for a graph with no edges).
 std::size_t count_components(const PoseGraph& graph);
 
