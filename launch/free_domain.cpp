@@ -8,28 +8,18 @@
 #include <set>
 #include <sstream>
 
+#include "transport/fastdds/proc_locks.hpp"
+#include "transport/fastdds/rtps_ports.hpp"
 #include "transport/run_identity.hpp"
 
 namespace tessera::launch {
 
 namespace {
 
-constexpr long kPortBase = 7400, kDomainGain = 250;  // RTPS's default port mapping
-
-// Inodes of every file some process holds a lock on ("N: FLOCK ADVISORY WRITE PID MAJ:MIN:INODE
-// START END"; a waiter's line has "->" after the number).
+// Inodes of every file some process holds a lock on.
 std::set<unsigned long> locked_inodes(const std::string& locks) {
   std::set<unsigned long> out;
-  std::ifstream in(locks);
-  for (std::string line; std::getline(in, line);) {
-    std::istringstream fields(line);
-    std::string n, kind, mode, access, pid, dev;
-    if (!(fields >> n >> kind)) continue;
-    if (kind == "->" && !(fields >> kind)) continue;
-    if (!(fields >> mode >> access >> pid >> dev)) continue;
-    const auto colon = dev.rfind(':');
-    if (colon != std::string::npos) out.insert(std::strtoul(dev.c_str() + colon + 1, nullptr, 10));
-  }
+  for (const transport::ProcLock& lock : transport::read_proc_locks(locks)) out.insert(lock.inode);
   return out;
 }
 
@@ -76,8 +66,9 @@ bool udp_port_bound(long port, const DomainProbe& probe) {
 }  // namespace
 
 bool domain_in_use(int domain, const DomainProbe& probe) {
-  const long lo = kPortBase + kDomainGain * domain;
-  return udp_port_bound(lo, probe) || shm_port_locked(lo, lo + kDomainGain, probe);
+  const auto lo = static_cast<long>(transport::rtps_domain_port_base(domain));
+  return udp_port_bound(lo, probe) ||
+         shm_port_locked(lo, lo + static_cast<long>(transport::kRtpsDomainGain), probe);
 }
 
 int free_domain_from(int first, const DomainProbe& probe) {

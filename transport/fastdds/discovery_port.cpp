@@ -13,6 +13,8 @@
 #include <iostream>
 #include <string>
 
+#include "transport/fastdds/rtps_ports.hpp"
+
 namespace tessera::transport {
 
 namespace dds = eprosima::fastdds::dds;
@@ -20,12 +22,6 @@ namespace rtps = eprosima::fastrtps::rtps;
 
 namespace {
 
-// The RTPS well-known ports (RTPS 2.x, 9.6.1.1): port base, domain gain, participant gain and
-// the unicast discovery offset. Fast DDS 2.9 uses these defaults (PortParameters).
-constexpr std::uint32_t kPortBase = 7400;
-constexpr std::uint32_t kDomainGain = 250;
-constexpr std::uint32_t kParticipantGain = 2;
-constexpr std::uint32_t kUnicastDiscoveryOffset = 10;
 // Fast DDS's default discovery multicast group.
 constexpr const char* kDiscoveryGroup = "239.255.0.1";
 
@@ -87,12 +83,11 @@ void add_local_discovery_peers(dds::DomainParticipantQos& qos, int domain, std::
 }  // namespace
 
 std::uint16_t discovery_multicast_port(int domain) {
-  return static_cast<std::uint16_t>(kPortBase + kDomainGain * static_cast<std::uint32_t>(domain));
+  return static_cast<std::uint16_t>(rtps_domain_port_base(domain));
 }
 
 std::uint32_t discovery_unicast_port(int domain, std::uint32_t id) {
-  return kPortBase + kDomainGain * static_cast<std::uint32_t>(domain) + kUnicastDiscoveryOffset +
-         kParticipantGain * id;
+  return rtps_domain_port_base(domain) + kRtpsUnicastDiscoveryOffset + kRtpsParticipantGain * id;
 }
 
 std::uint32_t local_discovery_participants(std::uint32_t num_agents) {

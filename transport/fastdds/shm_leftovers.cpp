@@ -11,11 +11,11 @@
 #include <fstream>
 #include <map>
 
+#include "transport/fastdds/rtps_ports.hpp"
+
 namespace tessera::transport {
 
 namespace {
-
-constexpr long kPortBase = 7400, kDomainGain = 250;  // RTPS's default port mapping
 
 bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
@@ -112,7 +112,8 @@ std::set<std::string> mapped_segments(const std::vector<pid_t>& pids) {
 
 ShmCleanupResult remove_dead_shm_files(const ShmCleanupOptions& options) {
   ShmCleanupResult result;
-  const long lo = kPortBase + kDomainGain * options.domain, hi = lo + kDomainGain;
+  const auto lo = static_cast<long>(rtps_domain_port_base(options.domain));
+  const long hi = lo + static_cast<long>(kRtpsDomainGain);
   std::set<std::string> names;
   if (DIR* d = opendir(options.dir.c_str())) {
     while (dirent* e = readdir(d)) names.insert(e->d_name);

@@ -16,6 +16,8 @@
 #include <set>
 #include <sstream>
 
+#include "transport/fastdds/proc_locks.hpp"
+
 namespace tessera::transport {
 
 namespace {
@@ -36,24 +38,11 @@ std::string hex_of(const std::string& segment) {
   return segment.substr(kSegmentHead.size());
 }
 
-// Inodes of the files this process holds an flock on (/proc/locks: "N: FLOCK ADVISORY WRITE
-// PID MAJ:MIN:INODE START END").
+// Inodes of the files process `pid` holds an flock on.
 std::set<unsigned long> inodes_locked_by(pid_t pid) {
   std::set<unsigned long> out;
-  std::ifstream locks("/proc/locks");
-  for (std::string line; std::getline(locks, line);) {
-    std::istringstream in(line);
-    std::string n, kind, mode, access, owner, dev;
-    if (!(in >> n >> kind)) continue;
-    if (kind == "->") {  // a waiter: "N: -> FLOCK ..."
-      if (!(in >> kind)) continue;
-    }
-    if (!(in >> mode >> access >> owner >> dev) || kind != "FLOCK") continue;
-    if (owner != std::to_string(pid)) continue;
-    const auto colon = dev.rfind(':');
-    if (colon == std::string::npos) continue;
-    out.insert(std::strtoul(dev.c_str() + colon + 1, nullptr, 10));
-  }
+  for (const ProcLock& lock : read_proc_locks())
+    if (lock.kind == "FLOCK" && lock.pid == pid) out.insert(lock.inode);
   return out;
 }
 
