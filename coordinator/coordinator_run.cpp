@@ -53,12 +53,20 @@ void run_coordinator(const CoordinatorOptions& o, CoordinatorSession& s, RunTime
   };
   const std::uint32_t N = o.agents;
 
-  // 0. With the whole file on this host (--graph, as tessera launch runs): its partition has
-  // been computed on a thread since before the session, while the participant was created and
-  // the agents started and discovered us (coordinator/file_partition.hpp). Their announcements
-  // queue in the session's inbox meanwhile; the wait for them below keeps its own timeout.
+  // 1. Every agent's announcement.
+  std::vector<wire::AgentAnnouncement> announcements =
+      await_announcements(s, N, o.net.session.run_id, o.net.timeout_s);
+  const double discovery_ms = ms_since(t0);
+  timeline.mark("announced");
+
+  // With the whole file on this host (--graph, as tessera launch runs): its partition has been
+  // computed on a thread since before the session, while the participant was created and the
+  // agents started and discovered us (coordinator/file_partition.hpp); what the run waits for
+  // it from here on is the partition's share of the critical path.
   std::optional<FilePartition> early;
+  double early_wait_ms = 0;
   if (file_job) {
+    const auto wait_start = std::chrono::steady_clock::now();
     std::string why;
     std::chrono::steady_clock::time_point started, ended;
     // A stop meanwhile (signal, an agent's ABORT) ends the run now, not after the partition.
@@ -67,6 +75,8 @@ void run_coordinator(const CoordinatorOptions& o, CoordinatorSession& s, RunTime
         expect_ready(WaitStatus::kStopped, s.mailroom(), o.net.timeout_s,
                      "the partition of " + o.graph);
     early = file_job->take(&why, &started, &ended);
+    early_wait_ms =
+        std::max(0.0, std::chrono::duration<double, std::milli>(ended - wait_start).count());
     timeline.mark_at("partition_start", started);
     if (early) {
       timeline.mark_at("partitioned", ended);
@@ -78,12 +88,6 @@ void run_coordinator(const CoordinatorOptions& o, CoordinatorSession& s, RunTime
           "): partitioning the announced structure");
     }
   }
-
-  // 1. Every agent's announcement.
-  std::vector<wire::AgentAnnouncement> announcements =
-      await_announcements(s, N, o.net.session.run_id, o.net.timeout_s);
-  const double discovery_ms = ms_since(t0);
-  timeline.mark("announced");
   const RunStructure rs = merge_announcements(announcements, N, o.net.session.run_id);
   announcements.clear();
   log("all " + std::to_string(N) + " agents announced (" +
@@ -97,11 +101,11 @@ void run_coordinator(const CoordinatorOptions& o, CoordinatorSession& s, RunTime
   const bool use_early = early && early->fits(rs);
   if (early && !use_early)
     log("the announced structure is not " + o.graph + "'s: partitioning the announced one");
-  const PartitionStepResult part =
-      use_early
-          ? std::move(early->part)
-          : partition_for_agents(rs.graph, N, o.partition, o.partition_seed, o.partition_time_s);
+  PartitionStepResult part = use_early ? std::move(early->part)
+                                       : partition_for_agents(rs.graph, N, o.partition,
+                                                              o.partition_seed, o.partition_time_s);
   early.reset();
+  part.wait_ms = use_early ? early_wait_ms : early_wait_ms + part.ms;
   if (!use_early) {
     timeline.mark("partitioned");
     log("partition (" + o.partition + "): cut " + std::to_string(part.cut_edges) +

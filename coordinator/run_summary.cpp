@@ -58,6 +58,8 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("discovery_ms", in.discovery_ms)
       .add("partition_ms", in.partition.ms)
       .add("partition_early", in.partition.early)
+      .add("partition_cpu_ms", in.partition.cpu_ms)
+      .add("partition_wait_ms", in.partition.wait_ms)
       .add("solve_ms", in.solve_ms)
       .add("rounds_ms", rounds_ms)
       .add("ms_per_round", r.completed_statuses > 1

@@ -108,6 +108,18 @@ void expect_partition_of_the_agents_graph(const std::string& coordinator_file, i
   EXPECT_NE(summary.find(std::string("\"partition_early\": ") + (expect_early ? "true" : "false")),
             std::string::npos)
       << summary;
+  // The partition's CPU is its thread's (at most its wall, here measured around the same call);
+  // the run waits for it after the announcements at most its whole wall when it partitions
+  // the announced structure, and that wait is part of the critical path either way.
+  const double part_ms = json_number(summary, "partition_ms");
+  const double cpu_ms = json_number(summary, "partition_cpu_ms");
+  const double wait_ms = json_number(summary, "partition_wait_ms");
+  EXPECT_GT(cpu_ms, 0.0) << summary;
+  EXPECT_LE(cpu_ms, part_ms + 5.0) << summary;
+  EXPECT_GE(wait_ms, 0.0) << summary;
+  if (!expect_early) {
+    EXPECT_GE(wait_ms, part_ms) << summary;
+  }
   const std::string log = slurp(dir + "/coordinator.log");
   EXPECT_EQ(log.find("partitioning the announced") != std::string::npos, !expect_early) << log;
 }

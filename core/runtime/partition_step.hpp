@@ -12,8 +12,15 @@ namespace tessera::coordinator {
 struct PartitionStepResult {
   std::vector<std::uint32_t> owner;  ///< Agent of every pose.
   double ms = 0;                     ///< Wall time of the partitioning.
-  std::size_t cut_edges = 0;         ///< Measurements between different agents.
-  bool early = false;  ///< Of the graph file, while the agents started (file_partition.hpp).
+  /// CPU time of the thread that partitioned: the partitioner's own cost, which `ms` exceeds
+  /// when the thread shares the cores with the agents starting up (file_partition.hpp).
+  double cpu_ms = 0;
+  /// How long the run waited for the partition once every agent had announced itself: its
+  /// share of the run's critical path (0 when the file's partition ended first; = ms when
+  /// the announced structure is partitioned).
+  double wait_ms = 0;
+  std::size_t cut_edges = 0;  ///< Measurements between different agents.
+  bool early = false;         ///< Of the graph file, while the agents started (file_partition.hpp).
 };
 
 /// Splits the structure among `num_agents` agents with core's partitioner (`preset` as
