@@ -4,7 +4,7 @@
 // liveliness assertions coincided both event threads deadlocked, and deleting a participant
 // then waited for its event thread until the teardown guard ended the process after 5 s
 // (transport/fastdds/intraprocess_builtin.hpp). A coordinator and three agents in one process,
-// with a 0.2 s lease (an assertion every 50 ms each), deadlocked in 6 of 6 runs before the fix.
+// with a 0.2 s lease (an assertion every 50 ms each), deadlocked in 10 of 10 runs before the fix.
 // Run in a child process, so a deadlock ends in the guard's exit code 1, not a hung test.
 // DDS domain 157 (its own, so ctest -j is safe).
 
