@@ -14,8 +14,10 @@
 # failed runs in 56 such batches with EXTRA="--transport shm" (load 9-30, some with two `yes`
 # loops beside), 7 had a reset in one of their own processes and then missed a peer ("missing
 # agent 0", "waiting for the partition assignment"), 2 of those with a stuck listener too; the
-# other 5 (one batch, load 19-25) lost peers whose 5 s lease expired. Choosing participant ids
-# whose port files are absent did not avoid the resets (7 processes against 6 in 12 batches each).
+# other 5 (one batch, load 19-25) had stuck listeners only (3,500-131,000 receive errors in 1-3
+# of their processes), which then took live peers for lost (lease expired). Choosing
+# participant ids whose port files are absent did not avoid the resets (7 processes against 6 in
+# 12 batches each).
 # Usage: scripts/dds_staggered_runs.sh [DOMAIN=118] [RUNS=40] [STEP=0.15] [BIN=build/bin]
 # Extra session flags in EXTRA (e.g. EXTRA="--transport udp"). Logs stay in the printed dir.
 set -uo pipefail
