@@ -4,6 +4,8 @@
 #include <optional>
 #include <sstream>
 
+#include "transport/fastdds/shm_receive_watch.hpp"
+
 namespace tessera::transport {
 
 PeerTracker::PeerTracker(Mailroom& room, const SessionOptions& options, PeerIdentity me)
@@ -160,6 +162,15 @@ void PeerTracker::restart_handshakes() {
   });
 }
 
+namespace {
+// A peer that "stopped responding" may be alive while this process's own shared-memory listener
+// is stuck (transport/fastdds/shm_receive_watch.hpp): the loss then names that too.
+std::string with_stuck_listener_note() {
+  const std::string stuck = shm_receive_note();
+  return stuck.empty() ? std::string() : " (" + stuck + ")";
+}
+}  // namespace
+
 std::string PeerTracker::left_reason(const PeerIdentity& who) const {
   return "lost " + who.describe() + " of run '" + opt_.run_id + "': it left the run";
 }
@@ -195,7 +206,8 @@ void PeerTracker::liveliness_lost(const GuidPrefix& prefix) {
                  buf);
   if (fatal)
     room_.request_stop_after(1,
-                             "lost " + who->describe() + " of run '" + opt_.run_id + "': it " + buf,
+                             "lost " + who->describe() + " of run '" + opt_.run_id + "': it " +
+                                 buf + with_stuck_listener_note(),
                              Seconds(kLivelinessStopDelayS));
 }
 
@@ -219,9 +231,9 @@ void PeerTracker::gone(const GuidPrefix& prefix, const std::string& how, bool gr
                  who->describe().c_str(), how.c_str());
   room_.notify_state_changed();
   if (!fatal) return;
-  const std::string why =
-      graceful ? left_reason(*who)
-               : "lost " + who->describe() + " of run '" + opt_.run_id + "': it " + how;
+  const std::string why = graceful ? left_reason(*who)
+                                   : "lost " + who->describe() + " of run '" + opt_.run_id +
+                                         "': it " + how + with_stuck_listener_note();
   // A peer that left cleanly has (almost always) sent or seen an ABORT that says why;
   // give it a moment to arrive so the message names the cause, not the symptom.
   if (graceful)

@@ -13,6 +13,7 @@
 #include <iostream>
 #include <string>
 
+#include "transport/fastdds/intraprocess_builtin.hpp"
 #include "transport/fastdds/rtps_ports.hpp"
 
 namespace tessera::transport {
@@ -101,6 +102,7 @@ bool discovery_port_bindable(std::uint16_t port) {
 dds::DomainParticipant* create_participant_with_discovery_port(
     int domain, dds::DomainParticipantQos qos, dds::DomainParticipantListener* listener,
     const dds::StatusMask& mask, std::uint32_t local_participants) {
+  keep_builtin_traffic_off_intraprocess();  // before any participant (intraprocess_builtin.hpp)
   auto* factory = dds::DomainParticipantFactory::get_instance();
   if (!opens_udpv4(qos)) return factory->create_participant(domain, qos, listener, mask);
   const std::uint16_t port = discovery_multicast_port(domain);

@@ -28,7 +28,8 @@
 // What: from the first participant of the process on, Fast DDS's warnings go to a consumer
 // that counts these receive errors (and prints every warning and error as Fast DDS does when
 // TESSERA_DDS_LOG=1, errors only otherwise, as by default). A timed-out wait
-// (transport/run_failure.hpp) appends shm_receive_note() to its message.
+// (transport/run_failure.hpp) and a peer declared lost for silence (transport/peer_tracking.cpp:
+// the silence may be this process's own stuck port) append shm_receive_note() to their message.
 
 #include <cstdint>
 #include <string>
