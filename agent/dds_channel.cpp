@@ -19,6 +19,11 @@ void DdsProtocolChannel::send_all(const std::vector<OutgoingMessage>& messages) 
   for (const auto& m : messages) note_status(m.message, true);
 }
 
+void DdsProtocolChannel::report(const AgentReport& report) {
+  if (auto stop = session_.mailroom().stop_info()) throw RunStopped(stop->reason);
+  session_.report(report);
+}
+
 void DdsProtocolChannel::report_progress(std::uint32_t agent, std::uint32_t num_agents,
                                          ProgressDigestOptions options) {
   progress_.emplace(agent, num_agents, agent == 0, options, std::chrono::steady_clock::now());

@@ -19,6 +19,8 @@ class DdsProtocolChannel : public ProtocolChannel {
   void send(const OutgoingMessage& message) override;
   /// AgentSession::send_all: blocks to the status relay ride in the step's status sample.
   void send_all(const std::vector<OutgoingMessage>& messages) override;
+  /// On the coordinator's report topic (AgentSession::report).
+  void report(const AgentReport& report) override;
   std::optional<ProtocolMessage> receive(double timeout_s) override;
   /// The listener wakes this thread only once `wake_after` protocol messages are queued
   /// (AgentSession::set_protocol_wake_threshold); rollbacks, re-partitions and stops as receive().

@@ -240,16 +240,11 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   out.local.known_inlier = std::move(known_flags);
   log("hand-off complete: " + std::to_string(out.local.owned.size()) + " poses, " +
       std::to_string(out.local.measurements.size()) + " measurements");
-  if (o.id == 0) {  // the coordinator's summary splits the time to the first round with these
-    RoundStatusMessage t;
-    t.phase = kSetupTimesPhase;
-    t.sender = 0;
-    t.cost = init_s;
-    t.grad_norm_sq =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - handoff_start).count();
-    t.block_grad_norm = init_early ? 1.0 : 0.0;
-    channel.send(OutgoingMessage{t, false, {}});
-  }
+  if (o.id == 0)  // the coordinator's summary splits the time to the first round with these
+    channel.report(SetupTimesReport{
+        init_s,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - handoff_start).count(),
+        init_early});
   if (!o.dump_local.empty()) write_local_dump(out.local, o.dump_local);
   launch::release_freed_heap();  // the hand-off's messages
   log(phase_memory_line("the hand-off"));

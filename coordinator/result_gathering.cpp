@@ -6,6 +6,7 @@
 #include <string>
 
 #include "runtime/elapsed.hpp"
+#include "transport/report_mapping.hpp"
 #include "transport/run_failure.hpp"
 
 namespace tessera::coordinator {
@@ -41,7 +42,8 @@ void await_final_estimates(CoordinatorSession& s, const CoordinatorOptions& opti
           return (absent.empty() && reports.results().have_final_report &&
                   (!digests || reports.results().have_final_digest)) ||
                  !s.status_watch().queued_locked().empty() ||
-                 !s.progress().queued_locked().empty() || !s.rejoins().queued_locked().empty();
+                 !s.reports().queued_locked().empty() || !s.progress().queued_locked().empty() ||
+                 !s.rejoins().queued_locked().empty();
         },
         Seconds(nap));
     if (absent.empty() && digests && !reports.results().have_final_digest)
@@ -60,14 +62,13 @@ void await_final_estimates(CoordinatorSession& s, const CoordinatorOptions& opti
     }
     for (const auto& m : s.status_watch().take_all()) {
       if (m.epoch() < losses.status_epoch()) continue;  // from before a rollback
-      if (is_round_status(m)) {
-        losses.on_round_status(m.sender(), m.round(), now);
-        reports.on_round_status(m, static_cast<std::uint32_t>(losses.record().expected.size()),
-                                ms_since(t_run));
-      } else {
-        reports.on_report(m);  // other phases: agents' internal statuses, not for us
-      }
+      if (!is_round_status(m)) continue;
+      losses.on_round_status(m.sender(), m.round(), now);
+      reports.on_round_status(m, static_cast<std::uint32_t>(losses.record().expected.size()),
+                              ms_since(t_run));
     }
+    for (const auto& m : s.reports().take_all())
+      if (m.epoch() >= losses.status_epoch()) reports.on_report(from_wire(m));
     if (watch) {
       switch (losses.watch(now)) {
         case LossHandling::Outcome::kRolledBack:

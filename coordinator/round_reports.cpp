@@ -1,6 +1,7 @@
 #include "coordinator/round_reports.hpp"
 
-#include <cmath>
+#include <type_traits>
+#include <variant>
 
 namespace tessera::coordinator {
 
@@ -39,72 +40,37 @@ void RoundReports::on_completed(const CompletedStep& step, double ms) {
   if (step.phase == 1) ++results_.completed_statuses;
 }
 
-bool RoundReports::on_report(const wire::RoundStatus& m) {
-  // The report fields ride on the status's numeric fields (core/runtime/round_loop.hpp says which).
-  if (m.phase() == kAgentCertificateReportPhase) {
-    results_.certificate =
-        CertificateReport{m.restart_vote(), m.cost(), m.grad_norm_sq(), m.block_grad_norm(), {}};
-    // The bound's parts ride in `coarse` (core/runtime/round_finish.cpp).
-    if (m.coarse().size() == 6) {
-      DualBound& b = results_.certificate->bound;
-      b.relaxation_cost = m.coarse()[0];
-      b.trace_lambda = m.coarse()[1];
-      b.gradient_norm = m.coarse()[2];
-      b.shift = m.coarse()[3];
-      b.lower_bound = m.coarse()[4];
-      b.method = static_cast<CertificateMethod>(static_cast<int>(m.coarse()[5]));
-    }
-    return true;
-  }
-  if (m.phase() == kAgentCertificateBytesPhase) {
-    results_.certificate_bytes =
-        CertificateTraffic{m.cost(), m.grad_norm_sq(), m.block_grad_norm()};
-    return true;
-  }
-  if (m.phase() == kAgentPhaseTimesPhase) {
-    results_.agent_solve_s = m.cost();
-    results_.agent_rounding_s = m.grad_norm_sq();
-    results_.rounding_cg_iterations = static_cast<std::uint32_t>(m.block_grad_norm());
-    if (m.coarse().size() == 2) {  // the interface solve's poses, the message steps
-      results_.rounding_interface_poses = static_cast<std::uint32_t>(m.coarse()[0]);
-      results_.rounding_message_steps = static_cast<std::uint32_t>(m.coarse()[1]);
-    }
-    return true;
-  }
-  if (m.phase() == kAgentSetupTimesPhase) {
-    results_.agent_init_s = m.cost();
-    results_.agent_handoff_s = m.grad_norm_sq();
-    results_.init_early = m.block_grad_norm() != 0.0;
-    return true;
-  }
-  if (m.phase() == kAgentStageProgressPhase) {
-    lines_.on_stage(static_cast<std::uint32_t>(m.block_grad_norm()),
-                    static_cast<std::uint64_t>(m.grad_norm_sq()), m.cost());
-    return true;
-  }
-  if (m.phase() == kAgentRobustReportPhase) {
-    RobustReport r;
-    r.outer_iterations = static_cast<int>(m.cost());
-    r.readmitted = static_cast<std::size_t>(m.grad_norm_sq());
-    r.threshold_squared = m.block_grad_norm();
-    r.weights_converged = m.done_vote();
-    r.rejected.assign(m.measurement_ids().begin(), m.measurement_ids().end());
-    if (m.coarse().size() >= 2) {  // the probes: run, kept
-      r.probes = static_cast<int>(m.coarse()[0]);
-      r.probes_kept = static_cast<int>(m.coarse()[1]);
-    }
-    if (m.coarse().size() >= 3) r.refine_steps = static_cast<int>(m.coarse()[2]);
-    results_.robust = std::move(r);
-    return true;
-  }
-  if (m.phase() == kAgentFinalReportPhase) {
-    results_.final_cost = m.cost();
-    results_.final_grad_norm = std::sqrt(m.grad_norm_sq());
-    results_.final_restarts = static_cast<std::uint32_t>(m.block_grad_norm());
-    results_.have_final_report = true;
-    return true;
-  }
-  return false;
+void RoundReports::on_report(const agent::AgentReport& report) {
+  std::visit(
+      [this](const auto& r) {
+        using R = std::decay_t<decltype(r)>;
+        if constexpr (std::is_same_v<R, agent::SetupTimesReport>) {
+          results_.agent_init_s = r.initialization_s;
+          results_.agent_handoff_s = r.handoff_s;
+          results_.init_early = r.initialization_early;
+        } else if constexpr (std::is_same_v<R, agent::StageProgressReport>) {
+          lines_.on_stage(static_cast<std::uint32_t>(r.stage), r.iteration, r.value);
+        } else if constexpr (std::is_same_v<R, agent::CertificateReport>) {
+          results_.certificate = r;
+        } else if constexpr (std::is_same_v<R, agent::CertificateTrafficReport>) {
+          results_.certificate_bytes = r;
+        } else if constexpr (std::is_same_v<R, agent::RobustRunReport>) {
+          results_.robust = r;
+        } else if constexpr (std::is_same_v<R, agent::PhaseTimesReport>) {
+          results_.agent_solve_s = r.solve_s;
+          results_.agent_rounding_s = r.rounding_s;
+          results_.rounding_cg_iterations = r.rounding_cg_iterations;
+          results_.rounding_interface_poses = r.rounding_interface_poses;
+          results_.rounding_message_steps = r.rounding_message_steps;
+        } else {
+          static_assert(std::is_same_v<R, agent::FinalReport>);
+          results_.final_cost = r.cost;
+          results_.final_grad_norm = r.grad_norm;
+          results_.final_restarts = r.restarts;
+          results_.have_final_report = true;
+        }
+      },
+      report);
 }
 
 }  // namespace tessera::coordinator

@@ -1,8 +1,9 @@
 #pragma once
 // What the coordinator reads about the rounds: their progress (the sums of the agents' cost
 // and squared gradient norm of each completed status step, and when steps completed) and
-// agent 0's reports after the solve (final cost and gradient, certificate, certificate
-// traffic). The progress comes from agent 0's progress digests (agent/progress_digest.hpp: a
+// agent 0's reports (runtime/agent_report.hpp: set-up times, stage progress, and after the
+// solve the certificate and its traffic, the robust decisions, phase times, final cost and
+// gradient). The progress comes from agent 0's progress digests (agent/progress_digest.hpp: a
 // few a second, and its last one with the exact round timing), or, while the coordinator
 // arbitrates lost agents, from every agent's round statuses themselves. No traffic of its own.
 
@@ -10,50 +11,20 @@
 #include <map>
 #include <optional>
 #include <ostream>
-#include <tessera/certification/dual_bound.hpp>
 #include <utility>
 #include <vector>
 
+#include "runtime/agent_report.hpp"
 #include "runtime/progress_printer.hpp"
 #include "tessera.h"
 #include "transport/topic_names.hpp"
 
 namespace tessera::coordinator {
 
-// Status phases of agent 0's reports (core/runtime/round_loop.hpp: kFinalReportPhase,
-// kCertificateReportPhase, kCertificateBytesPhase; the coordinator does not link the agent).
-constexpr std::uint32_t kAgentFinalReportPhase = 200;
-constexpr std::uint32_t kAgentCertificateReportPhase = 201;
-constexpr std::uint32_t kAgentCertificateBytesPhase = 202;
-constexpr std::uint32_t kAgentRobustReportPhase = 203;
-constexpr std::uint32_t kAgentPhaseTimesPhase = 204;
-constexpr std::uint32_t kAgentStageProgressPhase = 205;  // runtime/stage_progress.hpp
-constexpr std::uint32_t kAgentSetupTimesPhase = 206;
-
 /// Core's round statuses (phase 1: a round; phase 5: a restart of the momentum).
 inline bool is_round_status(const wire::RoundStatus& m) {
   return transport::is_solve_status_phase(m.phase());
 }
-
-struct CertificateReport {
-  bool certified;
-  double min_eigenvalue, rounds, final_rank;
-  DualBound bound;  ///< NaN fields when the report did not carry it.
-};
-struct CertificateTraffic {
-  double certificate, escape, escape_rounds;  ///< Bytes, bytes, rounds.
-};
-
-/// A robust run's decisions (runtime/round_loop.hpp, kRobustReportPhase).
-struct RobustReport {
-  int outer_iterations = 0;
-  std::size_t readmitted = 0;
-  double threshold_squared = 0;
-  bool weights_converged = false;
-  int probes = 0, probes_kept = 0;    ///< RobustOptions::recheck_probes: run, and kept.
-  int refine_steps = 0;               ///< Message steps of the refinements before the final solve.
-  std::vector<std::size_t> rejected;  ///< Measurement indices in file order, ascending.
-};
 
 /// Everything reported so far (for the summary).
 struct ReportedResults {
@@ -61,9 +32,9 @@ struct ReportedResults {
   double final_cost = 0, final_grad_norm = 0;
   std::uint32_t final_restarts = 0;
   bool have_final_report = false;
-  std::optional<CertificateReport> certificate;
-  std::optional<CertificateTraffic> certificate_bytes;
-  std::optional<RobustReport> robust;
+  std::optional<agent::CertificateReport> certificate;
+  std::optional<agent::CertificateTrafficReport> certificate_bytes;
+  std::optional<agent::RobustRunReport> robust;
   // Agent 0's own clock: its time in core's protocol (rounds, certificate, escapes) and in the
   // distributed rounding, seconds.
   std::optional<double> agent_solve_s, agent_rounding_s;
@@ -100,8 +71,8 @@ class RoundReports {
   void on_digest(const wire::AgentProgress& m, double ms);
   /// The rounds are over: prints the last completed round if its line was held back.
   void finish() { lines_.finish(); }
-  /// One of agent 0's reports (phases kAgent*Phase); false for any other phase.
-  bool on_report(const wire::RoundStatus& m);
+  /// One of agent 0's reports (runtime/agent_report.hpp).
+  void on_report(const agent::AgentReport& report);
 
   /// Forgets the partial sums of rounds not completed (abandoned by a rollback).
   void drop_partial_rounds() { partial_.clear(); }

@@ -134,8 +134,8 @@ std::string run_summary_json(const RunSummaryInputs& in) {
         .add("final_rank", static_cast<long long>(r.certificate->final_rank));
     add_certificate_bound(j, r.certificate->bound, r.final_cost);
     if (r.certificate_bytes)
-      j.add("certificate_bytes", static_cast<long long>(r.certificate_bytes->certificate))
-          .add("escape_bytes", static_cast<long long>(r.certificate_bytes->escape))
+      j.add("certificate_bytes", static_cast<long long>(r.certificate_bytes->certificate_bytes))
+          .add("escape_bytes", static_cast<long long>(r.certificate_bytes->escape_bytes))
           .add("escape_rounds", static_cast<long long>(r.certificate_bytes->escape_rounds));
   } else {
     j.add_null("min_eigenvalue").add_null("certificate_rounds");

@@ -86,8 +86,8 @@ TEST(DdsDelivery, ASessionRefusesTheOptionsOfTheOtherRole) {
 
 TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyItsStatuses) {
   ASSERT_TRUE(coordinator_reads_status(1, true));
-  ASSERT_FALSE(coordinator_reads_status(1, false));  // the digests tell the coordinator
-  ASSERT_TRUE(coordinator_reads_status(200, false));
+  ASSERT_FALSE(coordinator_reads_status(1, false));   // the digests tell the coordinator
+  ASSERT_FALSE(coordinator_reads_status(200, true));  // agent 0's reports: kReportTopic
   ASSERT_FALSE(coordinator_reads_status(101, true));  // a rounding reduction
   ASSERT_FALSE(coordinator_reads_status(300, true));  // the initialisation stage
 
@@ -174,12 +174,11 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   digest.phase(1);
   digest.cost(4.5);
   a1.publish(digest);
-  a0.send(status(200, 0, 8));  // agent 0's final report
+  a0.report(agent::FinalReport{2.5, 1e-3, 1});  // agent 0's final report: its own topic
   for (AgentSession* a : {&a0, &a1, &a2}) a->flush(Seconds(10));
   for (AgentSession* a : {&a1, &a2}) {
-    const std::vector<std::uint32_t> at = received_phases(*a, 3);
+    const std::vector<std::uint32_t> at = received_phases(*a, 2);
     EXPECT_EQ(std::count(at.begin(), at.end(), 1u), 2);
-    EXPECT_EQ(std::count(at.begin(), at.end(), 200u), 1);
   }
   std::vector<wire::AgentProgress> digests;
   const auto digest_until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
@@ -194,9 +193,15 @@ TEST(DdsDelivery, AddressedBlocksReachOnlyTheirRecipientAndTheCoordinatorOnlyIts
   EXPECT_EQ(digests[0].round(), 8u);
   EXPECT_EQ(digests[0].cost(), 4.5);
   EXPECT_EQ(digests[0].run_id(), "delivery-test");
-  const std::vector<wire::RoundStatus> reports = coordinator.status_watch().take_all();
+  EXPECT_TRUE(coordinator.status_watch().take_all().empty());
+  const std::vector<wire::AgentReport> reports = coordinator.reports().take_all();
   ASSERT_EQ(reports.size(), 1u);
-  EXPECT_EQ(reports[0].phase(), 200u);
+  EXPECT_EQ(reports[0].sender(), 0u);
+  ASSERT_EQ(reports[0].body()._d(), wire::REPORT_FINAL);
+  EXPECT_EQ(reports[0].body().final_report().cost(), 2.5);
+  // And no agent received it, not even to drop it.
+  EXPECT_EQ(a1.protocol().size(), 0u);
+  EXPECT_EQ(a2.protocol().size(), 0u);
 
   for (auto it = sessions.rbegin(); it != sessions.rend(); ++it) (*it)->close();
 }

@@ -4,13 +4,16 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <tessera/util/input_error.hpp>
 #include <thread>
+#include <variant>
 
 #include "runtime/local_share.hpp"
 #include "transport/epoch_routing.hpp"
 #include "transport/inbox.hpp"
 #include "transport/message_mapping.hpp"
+#include "transport/report_mapping.hpp"
 #include "transport/riding_blocks.hpp"
 #include "transport/run_identity.hpp"
 #include "transport/status_relay.hpp"
@@ -73,8 +76,10 @@ TEST(DdsMapping, RoundStatusRoundTrips) {
   m.block_grad_norm = 0.25;
   m.restart_vote = true;
   m.done_vote = false;
+  m.near_bound = 17;
   m.coarse = {0.5, -1e-300, 3.0};
   RoundStatusMessage back = from_wire(to_wire_status(m, "r", true, {}));
+  EXPECT_EQ(back.near_bound, 17u);
   EXPECT_EQ(back.coarse, m.coarse);
   EXPECT_EQ(back.round, 2u);
   EXPECT_EQ(back.phase, 3u);
@@ -423,6 +428,118 @@ TEST(DdsEpochRouting, AwaitedSendersWakeTheWaiterOnlyWhenTheStepIsComplete) {
   router.set_awaited(std::nullopt);
   EXPECT_TRUE(ready());
   EXPECT_TRUE(router.deliver(0, 3, false, {0}, status(4, 3)));
+}
+
+}  // namespace
+
+namespace {
+
+using namespace tessera;
+using namespace tessera::transport;
+
+// Agent 0's report through its wire form and back (report_mapping.hpp), with the envelope.
+agent::AgentReport report_round_trip(const agent::AgentReport& r) {
+  const wire::AgentReport w = to_wire_report(r, "run", 4, 2);
+  EXPECT_EQ(w.run_id(), "run");
+  EXPECT_EQ(w.sender(), 4u);
+  EXPECT_EQ(w.epoch(), 2u);
+  agent::AgentReport back = from_wire(w);
+  EXPECT_EQ(back.index(), r.index());
+  return back;
+}
+
+TEST(DdsReportMapping, EveryReportComesBackFieldForField) {
+  const auto setup = std::get<agent::SetupTimesReport>(
+      report_round_trip(agent::SetupTimesReport{0.0625, 1.0 / 3.0, true}));
+  EXPECT_EQ(setup.initialization_s, 0.0625);
+  EXPECT_EQ(setup.handoff_s, 1.0 / 3.0);
+  EXPECT_TRUE(setup.initialization_early);
+
+  const auto stage = std::get<agent::StageProgressReport>(report_round_trip(
+      agent::StageProgressReport{agent::ProgressStage::kRefinement, (3ull << 32) | 412, 1.2e-3}));
+  EXPECT_EQ(stage.stage, agent::ProgressStage::kRefinement);
+  EXPECT_EQ(stage.iteration, (3ull << 32) | 412);
+  EXPECT_EQ(stage.value, 1.2e-3);
+
+  agent::CertificateReport c;
+  c.certified = true;
+  c.min_eigenvalue = -1.0625e-7;
+  c.rounds = 3;
+  c.final_rank = 7;
+  c.bound.method = CertificateMethod::kLobpcg;
+  c.bound.relaxation_cost = 1025.25;
+  c.bound.trace_lambda = 1025.125;
+  c.bound.gradient_norm = 3e-9;
+  c.bound.shift = 2.5e-5;
+  c.bound.lower_bound = 1024.5;
+  const auto cert = std::get<agent::CertificateReport>(report_round_trip(c));
+  EXPECT_TRUE(cert.certified);
+  EXPECT_EQ(cert.min_eigenvalue, c.min_eigenvalue);
+  EXPECT_EQ(cert.rounds, 3u);
+  EXPECT_EQ(cert.final_rank, 7u);
+  EXPECT_EQ(cert.bound.method, CertificateMethod::kLobpcg);
+  EXPECT_EQ(cert.bound.relaxation_cost, 1025.25);
+  EXPECT_EQ(cert.bound.trace_lambda, 1025.125);
+  EXPECT_EQ(cert.bound.gradient_norm, 3e-9);
+  EXPECT_EQ(cert.bound.shift, 2.5e-5);
+  EXPECT_EQ(cert.bound.lower_bound, 1024.5);
+  // An unproved bound stays unproved (NaN parts), and its method with it.
+  agent::CertificateReport unproved;
+  const auto none = std::get<agent::CertificateReport>(report_round_trip(unproved));
+  EXPECT_FALSE(none.certified);
+  EXPECT_EQ(none.bound.method, CertificateMethod::kNone);
+  EXPECT_FALSE(none.bound.proved());
+  EXPECT_TRUE(std::isnan(none.bound.shift));
+
+  const auto traffic = std::get<agent::CertificateTrafficReport>(
+      report_round_trip(agent::CertificateTrafficReport{(1ull << 40) + 3, 142578, 2}));
+  EXPECT_EQ(traffic.certificate_bytes, (1ull << 40) + 3);
+  EXPECT_EQ(traffic.escape_bytes, 142578u);
+  EXPECT_EQ(traffic.escape_rounds, 2u);
+
+  agent::RobustRunReport r;
+  r.outer_iterations = 29;
+  r.rejected = {1099, 1100, 1224};
+  r.readmitted = 44;
+  r.threshold_squared = 42.309352037278586;
+  r.weights_converged = true;
+  r.probes = 2;
+  r.probes_kept = 1;
+  r.refine_steps = 37;
+  const auto robust = std::get<agent::RobustRunReport>(report_round_trip(r));
+  EXPECT_EQ(robust.outer_iterations, 29);
+  EXPECT_EQ(robust.rejected, r.rejected);
+  EXPECT_EQ(robust.readmitted, 44u);
+  EXPECT_EQ(robust.threshold_squared, r.threshold_squared);
+  EXPECT_TRUE(robust.weights_converged);
+  EXPECT_EQ(robust.probes, 2);
+  EXPECT_EQ(robust.probes_kept, 1);
+  EXPECT_EQ(robust.refine_steps, 37);
+
+  const auto times = std::get<agent::PhaseTimesReport>(
+      report_round_trip(agent::PhaseTimesReport{0.25, 0.125, 12, 348, 6}));
+  EXPECT_EQ(times.solve_s, 0.25);
+  EXPECT_EQ(times.rounding_s, 0.125);
+  EXPECT_EQ(times.rounding_cg_iterations, 12u);
+  EXPECT_EQ(times.rounding_interface_poses, 348u);
+  EXPECT_EQ(times.rounding_message_steps, 6u);
+
+  const auto fin = std::get<agent::FinalReport>(
+      report_round_trip(agent::FinalReport{1025.3980556262577, 3.0791907055258897e-09, 5}));
+  EXPECT_EQ(fin.cost, 1025.3980556262577);
+  EXPECT_EQ(fin.grad_norm, 3.0791907055258897e-09);
+  EXPECT_EQ(fin.restarts, 5u);
+}
+
+// A report the decoder cannot read (a stage or certificate method it does not know) is refused,
+// named, instead of being read as some other value.
+TEST(DdsReportMapping, UnknownStagesAndCertificateMethodsAreRefused) {
+  wire::AgentReport w = to_wire_report(agent::StageProgressReport{}, "run", 0, 0);
+  w.body().stage_progress().stage(9);
+  EXPECT_THROW(from_wire(w), TransportError);
+  wire::AgentReport c = to_wire_report(agent::CertificateReport{}, "run", 0, 0);
+  c.body().certificate().method(3);
+  EXPECT_THROW(from_wire(c), TransportError);
 }
 
 }  // namespace

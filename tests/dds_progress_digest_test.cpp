@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "agent/progress_digest.hpp"
+#include "coordinator/round_reports.hpp"
 #include "runtime/progress_printer.hpp"
 #include "runtime/stage_progress.hpp"
 
@@ -124,23 +125,23 @@ TEST(ProgressPrinter, PrintsTheFirstRestartsAndTheLastAndAtMostOneLinePerInterva
   EXPECT_TRUE(quiet.str().empty());
 }
 
-// The stages after the rounds: each report status agent 0 sends (runtime/stage_progress.hpp)
-// becomes one line, read from the status fields as the coordinator reads them.
+// The stages after the rounds: each stage progress report agent 0 sends
+// (runtime/stage_progress.hpp) becomes one line, as the coordinator reads it.
 TEST(ProgressPrinter, PrintsTheCertificateTheRefinementAndTheRoundingFromTheirReports) {
   std::ostringstream out;
-  coordinator::ProgressPrinter lines(true, out, 100.0);
-  auto print = [&](const RoundStatusMessage& m) {
-    EXPECT_EQ(m.phase, agent::kStageProgressPhase);
-    lines.on_stage(static_cast<std::uint32_t>(m.block_grad_norm),
-                   static_cast<std::uint64_t>(m.grad_norm_sq), m.cost);
-  };
-  lines.on_step({50, 1, 3.0, 1e-4}, 0.0);
-  print(agent::stage_progress_status(0, agent::ProgressStage::kRefinement,
-                                     agent::refinement_iteration(1, 0), 1.0e-2));
-  print(agent::stage_progress_status(1, agent::ProgressStage::kRefinement,
-                                     agent::refinement_iteration(3, 412), 1.2e-3));
-  print(agent::stage_progress_status(2, agent::ProgressStage::kCertificate, 65, 0.8137));
-  print(agent::stage_progress_status(3, agent::ProgressStage::kRounding, 7, 2.5e-9));
+  coordinator::RoundReports reports(true, out, 100.0);
+  wire::AgentProgress round50;  // agent 0 saw round 50 complete
+  round50.round(50);
+  round50.phase(1);
+  round50.cost(3.0);
+  round50.grad_norm_sq(1e-4);
+  reports.on_digest(round50, 0.0);
+  reports.on_report(agent::StageProgressReport{agent::ProgressStage::kRefinement,
+                                               agent::refinement_iteration(1, 0), 1.0e-2});
+  reports.on_report(agent::StageProgressReport{agent::ProgressStage::kRefinement,
+                                               agent::refinement_iteration(3, 412), 1.2e-3});
+  reports.on_report(agent::StageProgressReport{agent::ProgressStage::kCertificate, 65, 0.8137});
+  reports.on_report(agent::StageProgressReport{agent::ProgressStage::kRounding, 7, 2.5e-9});
   EXPECT_EQ(out.str(),
             "round 50: cost 3, grad norm 1.000e-02\n"
             "refinement: Newton step 1, CG iteration 0, gradient 1.000e-02\n"

@@ -76,66 +76,71 @@ TEST(RoundReports, RoundTimingAndTheLastLineComeFromAgentZerosFinalDigest) {
 namespace tessera::coordinator {
 namespace {
 
-// Agent 0's phase-times report of round 45: solve 0.25 s, rounding 0.125 s.
-wire::RoundStatus agent_zero_phase_times() {
-  wire::RoundStatus m;
-  m.sender(0);
-  m.round(45);
-  m.phase(kAgentPhaseTimesPhase);
-  m.cost(0.25);
-  m.grad_norm_sq(0.125);
-  return m;
-}
-
-// Agent 0's own times ride on a report status (phase 204): solve and rounding seconds.
+// Agent 0's own times (runtime/agent_report.hpp): solve and rounding seconds, and how the
+// rounding solved its translations; none before the report came.
 TEST(RoundReports, AgentZerosPhaseTimesAreKeptForTheSummary) {
   std::ostringstream out;
   RoundReports r(false, out);
   EXPECT_FALSE(r.results().agent_solve_s.has_value());
-  wire::RoundStatus m = agent_zero_phase_times();
-  EXPECT_TRUE(r.on_report(m));
+  EXPECT_FALSE(r.results().rounding_interface_poses.has_value());
+  r.on_report(agent::PhaseTimesReport{0.25, 0.125, 12, 34, 5});
   ASSERT_TRUE(r.results().agent_solve_s.has_value());
   EXPECT_EQ(*r.results().agent_solve_s, 0.25);
   EXPECT_EQ(*r.results().agent_rounding_s, 0.125);
-  m.phase(1);  // a round status is not a report
-  EXPECT_FALSE(r.on_report(m));
+  EXPECT_EQ(*r.results().rounding_cg_iterations, 12u);
+  EXPECT_EQ(*r.results().rounding_interface_poses, 34u);
+  EXPECT_EQ(*r.results().rounding_message_steps, 5u);
+  EXPECT_FALSE(r.results().have_final_report);
 }
 
-// And its set-up (phase 206, before the first round): initialisation and hand-off seconds, and
-// whether the chordal start had been solved while the run started (runtime/early_chordal.hpp).
+// And its set-up (before the first round): initialisation and hand-off seconds, and whether
+// the chordal start had been solved while the run started (runtime/early_chordal.hpp).
 TEST(RoundReports, AgentZerosSetUpTimesAreKeptForTheSummary) {
   std::ostringstream out;
   RoundReports r(false, out);
   EXPECT_FALSE(r.results().init_early.has_value());
-  wire::RoundStatus m;
-  m.sender(0);
-  m.phase(kAgentSetupTimesPhase);
-  m.cost(0.0625);
-  m.grad_norm_sq(0.03125);
-  m.block_grad_norm(1.0);
-  EXPECT_TRUE(r.on_report(m));
+  r.on_report(agent::SetupTimesReport{0.0625, 0.03125, true});
   ASSERT_TRUE(r.results().agent_init_s.has_value());
   EXPECT_EQ(*r.results().agent_init_s, 0.0625);
   EXPECT_EQ(*r.results().agent_handoff_s, 0.03125);
   EXPECT_TRUE(*r.results().init_early);
-  m.block_grad_norm(0.0);
-  EXPECT_TRUE(r.on_report(m));
+  r.on_report(agent::SetupTimesReport{0.0625, 0.03125, false});
   EXPECT_FALSE(*r.results().init_early);
 }
 
-// The phase times also say how the rounding solved its translations (coarse = {interface poses,
-// message steps}); without them (an older agent) the summary leaves both out.
-TEST(RoundReports, AgentZerosPhaseTimesCarryTheRoundingsInterfacePosesAndMessageSteps) {
+// The final report ends the wait for reports; the certificate, its traffic and a robust run's
+// decisions are kept as they came.
+TEST(RoundReports, TheFinalReportAndTheCertificateAreKeptAsTheyCame) {
   std::ostringstream out;
   RoundReports r(false, out);
-  wire::RoundStatus m = agent_zero_phase_times();
-  EXPECT_TRUE(r.on_report(m));
-  EXPECT_FALSE(r.results().rounding_interface_poses.has_value());
-  m.coarse({34.0, 5.0});
-  EXPECT_TRUE(r.on_report(m));
-  ASSERT_TRUE(r.results().rounding_interface_poses.has_value());
-  EXPECT_EQ(*r.results().rounding_interface_poses, 34u);
-  EXPECT_EQ(*r.results().rounding_message_steps, 5u);
+  agent::CertificateReport c;
+  c.certified = true;
+  c.min_eigenvalue = -1.5e-14;
+  c.rounds = 1;
+  c.final_rank = 5;
+  c.bound.method = CertificateMethod::kExact;
+  c.bound.lower_bound = 1025.25;
+  r.on_report(c);
+  r.on_report(agent::CertificateTrafficReport{142578, 0, 0});
+  agent::RobustRunReport robust;
+  robust.rejected = {3, 9};
+  robust.outer_iterations = 29;
+  r.on_report(robust);
+  EXPECT_FALSE(r.results().have_final_report);
+  r.on_report(agent::FinalReport{1025.5, 3e-9, 2});
+  const ReportedResults& res = r.results();
+  EXPECT_TRUE(res.have_final_report);
+  EXPECT_EQ(res.final_cost, 1025.5);
+  EXPECT_EQ(res.final_grad_norm, 3e-9);
+  EXPECT_EQ(res.final_restarts, 2u);
+  ASSERT_TRUE(res.certificate.has_value());
+  EXPECT_TRUE(res.certificate->certified);
+  EXPECT_EQ(res.certificate->bound.method, CertificateMethod::kExact);
+  EXPECT_EQ(res.certificate->bound.lower_bound, 1025.25);
+  EXPECT_EQ(res.certificate_bytes->certificate_bytes, 142578u);
+  ASSERT_TRUE(res.robust.has_value());
+  EXPECT_EQ(res.robust->rejected, (std::vector<std::uint64_t>{3, 9}));
+  EXPECT_EQ(res.robust->outer_iterations, 29);
 }
 
 }  // namespace

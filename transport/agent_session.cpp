@@ -11,6 +11,7 @@
 
 #include "transport/addressed_filter.hpp"
 #include "transport/message_mapping.hpp"
+#include "transport/report_mapping.hpp"
 #include "transport/riding_blocks.hpp"
 #include "transport/session_parts.hpp"
 #include "transport/topic_names.hpp"
@@ -97,6 +98,11 @@ void AgentSession::publish(const wire::FinalEstimate& m) {
 void AgentSession::publish(wire::AgentProgress m) {
   m.run_id(parts().opt.run_id);
   parts().writer.write(kProgressTopic, m);
+}
+
+void AgentSession::report(const agent::AgentReport& r) {
+  parts().writer.write(kReportTopic,
+                       to_wire_report(r, parts().opt.run_id, parts().me.agent_id, epoch()));
 }
 
 void AgentSession::send(const OutgoingMessage& m) {

@@ -12,6 +12,7 @@
 #include <tessera/protocol/messages.hpp>
 #include <vector>
 
+#include "runtime/agent_report.hpp"
 #include "tessera.h"
 #include "transport/inbox.hpp"
 #include "transport/round_traffic.hpp"
@@ -74,6 +75,9 @@ class AgentSession final : public Session {
   void publish(const wire::FinalEstimate& m);
   /// A progress digest for the coordinator (run id filled in here).
   void publish(wire::AgentProgress m);
+  /// One of agent 0's reports, to the coordinator alone (kReportTopic; run id, this agent's id
+  /// and the current epoch filled in here).
+  void report(const agent::AgentReport& r);
   /// How round statuses travel (round_traffic.hpp). Every agent of a run must choose the same
   /// before its first round status; until then the defaults hold.
   void set_round_traffic(const RoundTraffic& traffic);

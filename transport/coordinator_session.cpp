@@ -22,6 +22,10 @@ Inbox<wire::AgentProgress>& CoordinatorSession::progress() {
   return parts().progress_in;
 }
 
+Inbox<wire::AgentReport>& CoordinatorSession::reports() {
+  return parts().report_in;
+}
+
 Inbox<wire::FinalEstimate>& CoordinatorSession::finals() {
   return parts().final_in;
 }

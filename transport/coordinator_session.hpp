@@ -1,7 +1,7 @@
 #pragma once
 // The coordinator's DDS session: the shared part (transport/session.hpp) plus what only the
 // coordinator reads and sends: the agents' announcements, round statuses, progress digests,
-// final estimates and rejoin requests in, partition assignments out.
+// reports, final estimates and rejoin requests in, partition assignments out.
 
 #include "tessera.h"
 #include "transport/inbox.hpp"
@@ -22,6 +22,8 @@ class CoordinatorSession final : public Session {
   Inbox<wire::RoundStatus>& status_watch();
   /// The agents' progress digests (agent/progress_digest.hpp).
   Inbox<wire::AgentProgress>& progress();
+  /// Agent 0's reports (core/runtime/agent_report.hpp; transport/report_mapping.hpp decodes them).
+  Inbox<wire::AgentReport>& reports();
   Inbox<wire::FinalEstimate>& finals();
   Inbox<wire::Control>& rejoins();  ///< REJOIN requests of restarted agents.
 

@@ -51,6 +51,7 @@ wire::RoundStatus to_wire_status(const RoundStatusMessage& m, const std::string&
   w.block_grad_norm(m.block_grad_norm);
   w.restart_vote(m.restart_vote);
   w.done_vote(m.done_vote);
+  w.near_bound(m.near_bound);
   w.coarse(m.coarse);
   w.measurement_ids(m.measurement_ids);
   w.weights(m.weights);
@@ -87,6 +88,7 @@ RoundStatusMessage from_wire(const wire::RoundStatus& w) {
   m.block_grad_norm = w.block_grad_norm();
   m.restart_vote = w.restart_vote();
   m.done_vote = w.done_vote();
+  m.near_bound = w.near_bound();
   m.coarse = w.coarse();
   require(w.weights().size() == w.measurement_ids().size() || w.weights().empty(),
           "status from agent " + std::to_string(w.sender()) + " has " +

@@ -65,6 +65,9 @@ void create_coordinator_endpoints(SessionParts& s) {
   e.make_reader<wire::AgentProgressPubSubType, wire::AgentProgress>(
       kProgressTopic, false, Expect::kAllAgents,
       [&s](wire::AgentProgress&& m) { s.progress_in.push(std::move(m)); });
+  e.make_reader<wire::AgentReportPubSubType, wire::AgentReport>(
+      kReportTopic, false, Expect::kAllAgents,
+      [&s](wire::AgentReport&& m) { s.report_in.push(std::move(m)); });
 }
 
 void create_agent_endpoints(SessionParts& s) {
@@ -87,11 +90,13 @@ void create_agent_endpoints(SessionParts& s) {
     e.make_writer<wire::PoseBlockPubSubType>(kAddressedBlockTopic, false, Expect::kOtherAgents);
   }
   // Statuses the coordinator reads (coordinator_reads_status) on kStatusTopic, the others on
-  // kAgentStatusTopic; its progress digests on kProgressTopic.
+  // kAgentStatusTopic; its progress digests on kProgressTopic, agent 0's reports on
+  // kReportTopic (every agent writes it: after a re-partition another agent may be agent 0).
   e.make_writer<wire::RoundStatusPubSubType>(kStatusTopic, false,
                                              Expect::kOtherAgentsAndCoordinator);
   e.make_writer<wire::RoundStatusPubSubType>(kAgentStatusTopic, false, Expect::kOtherAgents);
   e.make_writer<wire::AgentProgressPubSubType>(kProgressTopic, false, Expect::kCoordinator);
+  e.make_writer<wire::AgentReportPubSubType>(kReportTopic, false, Expect::kCoordinator);
   // Round statuses through the relay (status_relay.hpp): the others write to it, it reads.
   const bool relayed = s.opt.num_agents >= kMinAgentsForRelay;
   if (relayed && me != kRelayAgent)

@@ -44,6 +44,7 @@ struct SessionParts {
   Inbox<ProtocolMessage> protocol_in{room};
   Inbox<wire::RoundStatus> status_in{room};
   Inbox<wire::AgentProgress> progress_in{room};
+  Inbox<wire::AgentReport> report_in{room};
   Inbox<wire::FinalEstimate> final_in{room};
   Inbox<wire::Control> rejoin_in{room};
   Inbox<wire::Control> rollback_in{room};

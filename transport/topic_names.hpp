@@ -34,6 +34,9 @@ inline constexpr const char* kRelayStatusTopic = "tessera_status_relay";
 /// The agents' progress digests (wire::AgentProgress), read by the coordinator only: a few
 /// samples a second per agent instead of every round status (agent/progress_digest.hpp).
 inline constexpr const char* kProgressTopic = "tessera_agent_progress";
+/// Agent 0's reports (wire::AgentReport: set-up times, stage progress, certificate, robust
+/// decisions, phase times, the final report), read by the coordinator only.
+inline constexpr const char* kReportTopic = "tessera_agent_report";
 
 /// Whether a round status of this phase is one of core's round statuses of the solve
 /// (ProtocolPhase::kStatus = 1, and kRedoStatus = 5 after a momentum restart;
@@ -44,14 +47,14 @@ inline bool is_solve_status_phase(std::uint32_t phase) {
 }
 
 /// Whether the coordinator reads round statuses of this phase (they go on kStatusTopic, the
-/// others on kAgentStatusTopic): agent 0's reports (200..299: final report, certificate;
-/// core/runtime/round_loop.hpp) always, and core's round statuses of the solve (phase 1, and 5
-/// after a restart; coordinator/round_reports.hpp's is_round_status) only when `rounds_followed`:
-/// while the coordinator arbitrates lost agents (rejoin, replicas), whose rollback round and
-/// lag checks need each agent's own latest round. Otherwise it follows the agents' progress
-/// digests (kProgressTopic) and is not woken by the N statuses of every round.
+/// others on kAgentStatusTopic): core's round statuses of the solve (phase 1, and 5 after a
+/// restart; coordinator/round_reports.hpp's is_round_status) only when `rounds_followed`: while
+/// the coordinator arbitrates lost agents (rejoin, replicas), whose rollback round and lag
+/// checks need each agent's own latest round. Otherwise it follows the agents' progress digests
+/// (kProgressTopic) and is not woken by the N statuses of every round. Agent 0's reports have
+/// their own topic (kReportTopic).
 inline bool coordinator_reads_status(std::uint32_t phase, bool rounds_followed) {
-  return (rounds_followed && is_solve_status_phase(phase)) || (phase >= 200 && phase < 300);
+  return rounds_followed && is_solve_status_phase(phase);
 }
 
 /// Runs of at most this many agents use block_topic_for(k); larger ones send addressed blocks on
@@ -67,12 +70,13 @@ inline std::string block_topic_for(std::uint32_t k) {
   return std::string(kBlockTopic) + "_to_" + std::to_string(k);
 }
 
-/// The topics of the per-round traffic (pose blocks and round statuses, every kind) and the
-/// progress digests: many small samples a second, so their endpoints carry no liveliness lease
-/// (qos.hpp; every process's control writer has one).
+/// The topics of the per-round traffic (pose blocks and round statuses, every kind), the
+/// progress digests and agent 0's reports: many small samples a second (the reports: a few a
+/// run, on a status topic before they had their own), so their endpoints carry no liveliness
+/// lease (qos.hpp; every process's control writer has one).
 inline bool is_round_topic(const std::string& name) {
   return name.rfind(kBlockTopic, 0) == 0 || name == kStatusTopic || name == kAgentStatusTopic ||
-         name == kRelayStatusTopic || name == kProgressTopic;
+         name == kRelayStatusTopic || name == kProgressTopic || name == kReportTopic;
 }
 
 }  // namespace tessera::transport

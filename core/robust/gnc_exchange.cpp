@@ -111,7 +111,7 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
     case GncExchange::kWeights: {
       const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
       votes_[sender] = {st.grad_norm_sq, st.cost};
-      near_bound_[sender] = unpack_near_bound(st);
+      near_bound_[sender] = st.near_bound;
       read_weights_message(st, sender, in_, to.weights, to.zero_cut);
       break;
     }

@@ -61,7 +61,7 @@ RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed,
   RoundStatusMessage st;
   st.grad_norm_sq = spread;
   st.cost = crossed;
-  pack_near_bound(st, near_bound);
+  st.near_bound = static_cast<std::uint32_t>(near_bound);
   for (std::size_t k : terms.owned()) {
     const Measurement& m = in.measurements[k];
     const auto other = static_cast<std::uint32_t>(in.owner[std::max(m.i, m.j)]);
@@ -72,14 +72,6 @@ RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed,
     }
   }
   return st;
-}
-
-void pack_near_bound(RoundStatusMessage& st, int near_bound) {
-  st.block_grad_norm = near_bound;
-}
-
-double unpack_near_bound(const RoundStatusMessage& st) {
-  return st.block_grad_norm;
 }
 
 void read_weights_message(const RoundStatusMessage& st, std::uint32_t sender,

@@ -44,17 +44,10 @@ inline std::pair<double, double> read_vote(const RoundStatusMessage& st) {
 /// solve (for `to`'s block layout), the weight spread (grad_norm_sq, the stop vote) and the
 /// count of this agent's measurements whose weight crossed 1/2 in this update (cost, the
 /// adaptive mu schedule's vote, RobustOptions::mu_step_max) and of its measurements with r^2
-/// near the bound (pack_near_bound: the early end's vote, RobustOptions::jump_band).
+/// near the bound (near_bound: the early end's vote, RobustOptions::jump_band).
 RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed, int near_bound,
                                    const GncAgentInput& in, const GncLocalTerms& terms,
                                    const std::vector<double>& weights);
-
-/// The weights message's count of measurements near the bound (RobustOptions::jump_band): the
-/// one place that packs it into a status field and reads it back. It rides in
-/// RoundStatusMessage::block_grad_norm, which the robust exchanges do not use otherwise, until
-/// the IDL gets a field of its own.
-void pack_near_bound(RoundStatusMessage& st, int near_bound);
-double unpack_near_bound(const RoundStatusMessage& st);
 
 /// Checks `st` from `sender` (ids and weights match; every id is the sender's to weigh) and
 /// applies it: the weights of this agent's measurements, every id of weight 0 to `zero_cut`.

@@ -18,8 +18,8 @@
 //                poses when the agents' shares are the generator's robot ranges. The local
 //                solves take turns, a bounded number at once (runtime/setup_turns.hpp).
 //
-// Messages use phases kInitPhaseBase.. (>= 300), which the round protocol (0..5), the rounding
-// (100..) and the final report (200) never use. Every message of the stage is consumed by
+// Messages use phases kInitPhaseBase.. (>= 300), which the round protocol (0..5) and the
+// rounding (100..) never use. Every message of the stage is consumed by
 // its recipient before that recipient leaves the stage (nothing leaks into the round loop),
 // and every agent sends its hand-off only after the stage, so no round message reaches an
 // agent still in it.

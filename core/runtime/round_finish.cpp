@@ -5,22 +5,6 @@
 #include "runtime/distributed_rounding.hpp"
 
 namespace tessera::agent {
-namespace {
-
-// Agent 0's report of `phase` to the coordinator, its three values in the status's fields.
-RoundStatusMessage agent0_report(std::uint32_t round, std::uint32_t phase, double cost,
-                                 double grad_norm_sq, double block_grad_norm) {
-  RoundStatusMessage m;
-  m.round = round;
-  m.phase = phase;
-  m.sender = 0;
-  m.cost = cost;
-  m.grad_norm_sq = grad_norm_sq;
-  m.block_grad_norm = block_grad_norm;
-  return m;
-}
-
-}  // namespace
 
 RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout& layout,
                                  const AgentState& state, Mailbox& mail, ProtocolChannel& channel,
@@ -44,42 +28,18 @@ RoundLoopResult round_and_report(const AgentLocalData& local, const BlockLayout&
   res.send_s = mail.send_s;
   res.rounding_steps = mail.gathers;
 
-  auto send = [&channel](const RoundStatusMessage& m) {
-    channel.send(OutgoingMessage{m, true, {}});
-  };
   if (local.agent_id == 0 && res.certified) {  // before the final report, which ends the wait
-    RoundStatusMessage c = agent0_report(res.rounds, kCertificateReportPhase, res.min_eigenvalue,
-                                         res.certificate_rounds, res.final_rank);
-    c.restart_vote = *res.certified;
-    c.done_vote = true;
-    const DualBound& b = res.certificate_bound;
-    c.coarse = {b.relaxation_cost, b.trace_lambda, b.gradient_norm,
-                b.shift,           b.lower_bound,  static_cast<double>(b.method)};
-    send(c);
-    send(agent0_report(res.rounds, kCertificateBytesPhase,
-                       static_cast<double>(res.certificate_bytes),
-                       static_cast<double>(res.escape_bytes), res.escape_rounds));
+    channel.report(CertificateReport{*res.certified, res.min_eigenvalue, res.certificate_rounds,
+                                     res.final_rank, res.certificate_bound});
+    channel.report(
+        CertificateTrafficReport{res.certificate_bytes, res.escape_bytes, res.escape_rounds});
   }
-  if (local.agent_id == 0 && res.robust) {
-    RoundStatusMessage r =
-        agent0_report(res.rounds, kRobustReportPhase, res.robust->outer_iterations,
-                      static_cast<double>(res.robust->readmitted), res.robust->threshold_squared);
-    r.done_vote = res.robust->weights_converged;
-    r.measurement_ids = res.robust->rejected;
-    r.coarse = {static_cast<double>(res.robust->probes),
-                static_cast<double>(res.robust->probes_kept),
-                static_cast<double>(res.robust->refine_steps)};
-    send(r);
-  }
+  if (local.agent_id == 0 && res.robust) channel.report(*res.robust);
   if (local.agent_id == 0) {
     // Agent 0's times, for the coordinator's phase split, then one report for its summary.
-    RoundStatusMessage times = agent0_report(res.rounds, kPhaseTimesPhase, res.solve_s,
-                                             res.rounding_s, res.translation_iterations);
-    times.coarse = {static_cast<double>(res.rounding_interface_poses),
-                    static_cast<double>(res.rounding_steps)};
-    send(times);
-    send(agent0_report(res.rounds, kFinalReportPhase, res.cost, res.grad_norm * res.grad_norm,
-                       static_cast<double>(res.restarts)));
+    channel.report(PhaseTimesReport{res.solve_s, res.rounding_s, res.translation_iterations,
+                                    res.rounding_interface_poses, res.rounding_steps});
+    channel.report(FinalReport{res.cost, res.grad_norm, res.restarts});
   }
   return res;
 }

@@ -1,7 +1,7 @@
 #pragma once
 // What every agent does after its protocol, plain or robust: round the final lifted iterate to
 // SE(d) with no central step (DistributedRounding), sum the certificate traffic, and, on agent
-// 0, send the reports the coordinator's summary reads (round_loop.hpp's report phases).
+// 0, send the reports the coordinator's summary reads (agent_report.hpp).
 
 #include <chrono>
 #include <tessera/distributed/agent_state.hpp>

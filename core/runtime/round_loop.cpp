@@ -59,6 +59,8 @@ void ProtocolChannel::send_all(const std::vector<OutgoingMessage>& messages) {
   for (const auto& m : messages) send(m);
 }
 
+void ProtocolChannel::report(const AgentReport& /*report*/) {}
+
 std::optional<ProtocolMessage> ProtocolChannel::receive_after(double timeout_s,
                                                               std::size_t /*wake_after*/) {
   return receive(timeout_s);

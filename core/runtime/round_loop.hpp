@@ -27,13 +27,13 @@
 #include <utility>
 #include <vector>
 
+#include "runtime/agent_report.hpp"
+
 namespace tessera {
 struct ProtocolSnapshot;  // distributed/protocol_snapshot.hpp
 }
 
 namespace tessera::agent {
-
-enum class ProgressStage : std::uint32_t;  // runtime/stage_progress.hpp
 
 /// Algorithm options of the run as published by the coordinator (simple fields).
 struct RunOptions {
@@ -144,19 +144,10 @@ class ProtocolChannel {
   /// The default is receive_after(timeout_s, awaited.senders.size()).
   virtual std::optional<ProtocolMessage> receive_awaiting(double timeout_s,
                                                           const AwaitedMessages& awaited);
-};
-
-/// What a robust run decided (robust/gnc_agent.hpp), the same on every agent.
-struct RobustRunReport {
-  int outer_iterations = 0;
-  std::vector<std::uint64_t> rejected;  ///< File positions, ascending.
-  std::size_t readmitted = 0;
-  double threshold_squared = 0;
-  bool weights_converged = false;
-  int probes = 0, probes_kept = 0;  ///< RobustOptions::recheck_probes: run, and kept.
-  /// Message steps of the Newton refinements before the final solve
-  /// (GncDistributedResult::refine_message_steps).
-  int refine_steps = 0;
+  /// Sends one of agent 0's reports to the coordinator (agent_report.hpp); no agent receives
+  /// it. Throws as send(). The default drops it: a run without a coordinator (in-process
+  /// channels) has no one to read it.
+  virtual void report(const AgentReport& report);
 };
 
 struct RoundLoopResult {
@@ -196,37 +187,10 @@ struct RoundLoopResult {
   std::optional<RobustRunReport> robust;
 };
 
-/// Status phases of the messages the round loop adds after core's protocol (distributed
-/// rounding), and the one agent 0 sends for the coordinator's summary: round = rounds,
-/// cost = rounded cost, grad_norm_sq = ||grad f||^2, block_grad_norm = restarts.
+/// Status phases of the messages the round loop adds after core's protocol (the distributed
+/// rounding's reductions); agent 0's reports to the coordinator are AgentReports instead
+/// (agent_report.hpp, ProtocolChannel::report).
 constexpr std::uint32_t kRoundingPhaseBase = 100;
-constexpr std::uint32_t kFinalReportPhase = 200;
-/// Agent 0's certificate report, sent just before the final report when certification ran:
-/// cost = lambda_min estimate, grad_norm_sq = certificate rounds, block_grad_norm = final rank,
-/// restart_vote = certified.
-constexpr std::uint32_t kCertificateReportPhase = 201;
-/// And its traffic: cost = certificate bytes, grad_norm_sq = escape bytes (all agents),
-/// block_grad_norm = escape rounds.
-constexpr std::uint32_t kCertificateBytesPhase = 202;
-/// Agent 0's robust report (RunOptions::robust), before the final report: cost = outer
-/// iterations, grad_norm_sq = re-admitted measurements, block_grad_norm = c^2, done_vote =
-/// weights converged, measurement_ids = the rejected measurements, coarse = {probes run,
-/// probes kept, message steps of the refinements before the final solve}.
-constexpr std::uint32_t kRobustReportPhase = 203;
-/// And, before the final report in every run, its own times: cost = solve_s (core's protocol:
-/// rounds, and certificate and escapes when certified), grad_norm_sq = rounding_s (seconds), so
-/// the coordinator can split the time after the last round into certificate and rounding;
-/// block_grad_norm = the rounding's translation CG iterations, coarse = {the rounding's interface
-/// poses (0 = the CG solved the translations), its message steps}.
-constexpr std::uint32_t kPhaseTimesPhase = 204;
-/// Agent 0's progress during the certificate and the rounding (runtime/stage_progress.hpp):
-/// round = the stage's iteration, cost = its figure, block_grad_norm = the stage.
-constexpr std::uint32_t kStageProgressPhase = 205;
-/// Agent 0's set-up times, to the coordinator only, after its hand-off (before the first round):
-/// cost = the initialisation stage's seconds, grad_norm_sq = the hand-off's seconds (exchange
-/// and assembly of the local problem), block_grad_norm = 1 when the chordal start had been
-/// solved while the run started (runtime/early_chordal.hpp), else 0.
-constexpr std::uint32_t kSetupTimesPhase = 206;
 
 /// Optional recovery hooks of the round loop.
 struct RoundLoopHooks {

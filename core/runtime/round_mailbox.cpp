@@ -4,6 +4,8 @@
 #include <chrono>
 #include <tessera/distributed/in_process_driver.hpp>
 
+#include "runtime/initialization_stage.hpp"
+
 namespace tessera::agent {
 
 namespace {
@@ -81,7 +83,7 @@ std::map<std::uint32_t, ProtocolMessage> Mailbox::gather(
 }
 
 void Mailbox::keep(ProtocolMessage m) {
-  if (phase_of(m) >= kFinalReportPhase) return;  // for the coordinator
+  if (phase_of(m) >= kInitPhaseBase) return;  // a late copy of the initialisation stage's
   stash_[{phase_of(m), round_of(m)}][sender_of(m)] = std::move(m);
 }
 

@@ -11,18 +11,6 @@ void StageProgressOptions::validate() const {
                      std::to_string(period_s));
 }
 
-RoundStatusMessage stage_progress_status(std::uint32_t sequence, ProgressStage stage,
-                                         std::uint64_t iteration, double value) {
-  RoundStatusMessage m;
-  m.round = sequence;
-  m.grad_norm_sq = static_cast<double>(iteration);
-  m.phase = kStageProgressPhase;
-  m.sender = 0;
-  m.cost = value;
-  m.block_grad_norm = static_cast<double>(stage);
-  return m;
-}
-
 StageProgress::StageProgress(bool reporter, ProtocolChannel& channel, StageProgressOptions options)
     : reporter_(reporter),
       channel_(channel),
@@ -35,9 +23,8 @@ void StageProgress::report(ProgressStage stage, std::uint64_t iteration, double 
   if (stage_ == stage && now - last_ < period_) return;
   stage_ = stage;
   last_ = now;
-  // To the coordinator (its reports' topic) only: no agent waits for it.
-  channel_.send(
-      OutgoingMessage{stage_progress_status(sent_++, stage, iteration, value), false, {}});
+  ++sent_;
+  channel_.report(StageProgressReport{stage, iteration, value});  // no agent waits for it
 }
 
 }  // namespace tessera::agent

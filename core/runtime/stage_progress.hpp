@@ -3,9 +3,9 @@
 // iterations, the Newton refinement's CG iterations and the rounding's translation CG iterations.
 // Each is one all-agent step, and at a million poses there are hundreds of them taking many
 // minutes; without these reports the coordinator's output showed only that the agents were alive. A
-// report is a round status of phase kStageProgressPhase (read by the coordinator, as agent 0's
-// other reports), sent when the stage begins and then at most once per period, so its traffic does
-// not depend on how fast the iterations go.
+// report is a StageProgressReport (agent_report.hpp, read by the coordinator as agent 0's other
+// reports), sent when the stage begins and then at most once per period, so its traffic does not
+// depend on how fast the iterations go.
 
 #include <chrono>
 #include <cstdint>
@@ -15,12 +15,9 @@
 
 namespace tessera::agent {
 
-/// Which stage a report is about (the status's block_grad_norm).
-enum class ProgressStage : std::uint32_t { kCertificate = 1, kRounding = 2, kRefinement = 3 };
-
 /// The refinement's iteration field: its trust-region step (1-based) in the high 32 bits and the
 /// CG iteration within that step in the low ones. Both fit in the report's one iteration field
-/// (a double, exact to 2^53), so the refinement's reports are the same size as the others'.
+/// (StageProgressReport::iteration), so the refinement's reports are the same size as the others'.
 constexpr std::uint64_t refinement_iteration(std::uint32_t newton_step,
                                              std::uint32_t cg_iteration) {
   return (static_cast<std::uint64_t>(newton_step) << 32) | cg_iteration;
@@ -35,16 +32,7 @@ struct StageProgressOptions {
   void validate() const;
 };
 
-/// The report status: round = `sequence` (the reports of one agent run count up: the transport
-/// keeps one status per sender, phase and round, so two stages' iteration 0 must not share a
-/// round), grad_norm_sq = the stage's iteration (refinement: refinement_iteration()), cost =
-/// `value` (certificate: the current estimate of lambda_min; rounding: the cost its last steps
-/// removed, which its stop compares; refinement: ||grad f|| at its current point),
-/// block_grad_norm = the stage.
-RoundStatusMessage stage_progress_status(std::uint32_t sequence, ProgressStage stage,
-                                         std::uint64_t iteration, double value);
-
-/// One per agent run (the Mailbox holds it), so that its reports' sequence numbers are unique.
+/// One per agent run (the Mailbox holds it).
 class StageProgress {
  public:
   using Clock = std::chrono::steady_clock;

@@ -183,6 +183,7 @@ int main(int argc, char** argv) {
     s.watch<wire::MeasurementHandoffPubSubType, wire::MeasurementHandoff>(kHandoffTopic);
     s.watch<wire::PoseBlockPubSubType, wire::PoseBlock>(kBlockTopic);
     s.watch<wire::RoundStatusPubSubType, wire::RoundStatus>(kStatusTopic);
+    s.watch<wire::AgentReportPubSubType, wire::AgentReport>(kReportTopic);
     s.watch<wire::FinalEstimatePubSubType, wire::FinalEstimate>(kFinalTopic);
     s.watch<wire::ControlPubSubType, wire::Control>(kControlTopic);
   }

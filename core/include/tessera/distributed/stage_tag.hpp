@@ -6,7 +6,7 @@
 // ones finish the current stage; the stage tells the receiver to keep them for later.
 //
 // Steps >= kAuxiliaryStepBase are reserved for the transport's own exchanges after the sequence
-// (the DDS round loop's distributed rounding and final report).
+// (the DDS round loop's distributed rounding).
 
 #include <cstdint>
 

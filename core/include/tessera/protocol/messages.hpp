@@ -38,6 +38,10 @@ struct RoundStatusMessage {
   double block_grad_norm = 0.0;  ///< This block's own gradient norm (greedy selection).
   bool restart_vote = false;
   bool done_vote = false;
+  /// Robust (GNC) weights messages only (robust/gnc_messages.hpp): the sender's measurements
+  /// whose squared residual is near the bound (RobustOptions::jump_band, the early end's vote);
+  /// 0 otherwise.
+  std::uint32_t near_bound = 0;
   /// Coarse-correction rounds exchanged all to all (CoarseOptions::gather off) only: this
   /// agent's coarse terms (distributed/coarse_correction.hpp); empty otherwise.
   std::vector<double> coarse;
