@@ -194,6 +194,23 @@ struct RobustOptions {
   /// more message steps than the rounds it saves (16 rounds for 1,958 message steps), hence the
   /// limit (docs/robust.md, "Final solve").
   bool refine_passes = false;
+  /// Distributed solvers only, with refine_passes: where the team's interface fits the
+  /// refinement's interface solves (the test of refine_passes, on each weighted solve's layout),
+  /// each weighted solve of GNC (every one after the first, plain solve) is this many Newton
+  /// steps of the refinement (distributed/newton_refine.hpp) from the previous iterate instead of
+  /// inner_max_rounds rounds; and an inlier pass that hands over to the refinement does so at
+  /// once, without block-coordinate rounds first. >= 0; 0 = GNC's weighted solves by rounds (and
+  /// the passes' rounds run down to the hand-over gradient first, as a clean solve's do). The first
+  /// solve stays rounds: from the start, a Newton step goes to the plain problem's nearest
+  /// minimiser, which the wrong closures have bent (intel with 50 % random outliers: 88 true
+  /// closures cut, not certified). Why: one Newton step of a weighted problem costs 7 message
+  /// steps (one CG iteration of the interface solve: 2 neighbour exchanges, 5 all-agent sums)
+  /// and takes its gradient from ~170 to ~0.05, while 5 rounds (10 message steps) leave it rough;
+  /// GNC on near-minimisers misjudges fewer closures, so the passes after it change less
+  /// (F = 0.25 random, 5 agents, with mu_step_max 4: intel 283 -> 188 message steps, CSAIL 138 ->
+  /// 66; docs/robust.md, "Newton steps in GNC"). 1: two steps cost 13 message steps a solve and
+  /// shorten nothing (intel 0.25: 17 outer steps either way, 284 message steps; CSAIL 87).
+  int gnc_refine_steps = 1;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
