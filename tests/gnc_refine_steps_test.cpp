@@ -60,6 +60,7 @@ TEST(GncRefineSteps, WithoutRefinedPassesTheWeightedSolvesStayRounds) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
   GncDistributedOptions o;
   o.robust.kind = RobustKind::kGncTls;
+  o.robust.refine_passes = false;
   o.solver.certify = true;
   o.robust.gnc_refine_steps = 0;
   const GncDistributedResult zero =

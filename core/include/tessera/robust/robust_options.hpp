@@ -184,16 +184,18 @@ struct RobustOptions {
   bool final_refine = true;
   /// Distributed solvers only, with `--refine auto` (the solver's NewtonRefineOptions::when =
   /// kIfRoundsSlow): an inlier pass solved to the tolerance hands over to the Newton refinement
-  /// where the team's interface fits its interface solves, as a clean solve does; capped passes,
-  /// GNC's own solves and graphs whose interface does not fit are solved by rounds alone. Off
-  /// (default): every solve before the final one is solved by rounds alone. Why: where the
-  /// clean run is mostly refinement (intel, CSAIL at 5 agents: 1 and 0 rounds, 15 and 13 message
-  /// steps) the robust run's passes to the tolerance are what costs (F = 0.25 random: intel
-  /// 1,033 message steps, CSAIL 965); with this on 468 and 295, the same exact sets, certified.
-  /// Where the interface does not fit (manhattan3500) the refinement's block-Jacobi CG would cost
-  /// more message steps than the rounds it saves (16 rounds for 1,958 message steps), hence the
-  /// limit (docs/robust.md, "Final solve").
-  bool refine_passes = false;
+  /// where the team's interface fits its interface solves, as a clean solve does, and GNC's
+  /// weighted solves there are Newton steps too (gnc_refine_steps); capped passes, the first
+  /// solve and graphs whose interface does not fit are solved by rounds alone. On (default,
+  /// `--gnc-pass-refine auto`); off: every solve before the final one by rounds alone. Why: where
+  /// the clean run is mostly refinement (intel, CSAIL at 5 agents: 1 and 0 rounds, 15 and 13
+  /// message steps) the robust run's rounds are what costs (F = 0.25 random: intel 1,033 message
+  /// steps off, 195 on; CSAIL 965 and 66; the same exact sets, certified). Where the interface
+  /// does not fit (manhattan3500, sphere2500, city10000, the 1000-pose grid at 5 agents) nothing
+  /// changes: there the refinement's block-Jacobi CG would cost more message steps than the
+  /// rounds it saves (16 rounds for 1,958 message steps), hence the limit (docs/robust.md,
+  /// "Final solve").
+  bool refine_passes = true;
   /// Distributed solvers only, with refine_passes: where the team's interface fits the
   /// refinement's interface solves (the test of refine_passes, on each weighted solve's layout),
   /// each weighted solve of GNC (every one after the first, plain solve) is this many Newton
