@@ -67,8 +67,9 @@ const char* const kRobustHelp =
     "                            Newton refinement to --refine-grad-tol (runs without\n"
     "                            --certify too) [newton]\n"
     "  --gnc-pass-refine auto|none   distributed, with --refine auto: inlier passes solved to\n"
-    "                            the tolerance hand over to Newton refinement where the\n"
-    "                            team's interface fits the interface solves [none]\n"
+    "                            the tolerance and GNC's weighted solves hand over to Newton\n"
+    "                            refinement where the team's interface fits the interface\n"
+    "                            solves [auto]\n"
     "  --known-inliers odometry|none   never reject edges between consecutive ids [odometry]\n"
     "  --rejected FILE           write the rejected edge indices (from 0 over the EDGE lines)\n";
 

@@ -272,8 +272,9 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
       {"gnc-pass-refine", "gnc-pass-refine", true, ForwardTo::kCoordinator,
        "--gnc-pass-refine auto|none",
        "with --refine auto: the inlier passes solved to the\n"
-       "tolerance hand over to Newton refinement where the\n"
-       "team's interface fits the interface solves        [none]",
+       "tolerance and GNC's weighted solves hand over to\n"
+       "Newton refinement where the team's interface fits\n"
+       "the interface solves                              [auto]",
        check_gnc_pass_refine},
       {"known-inliers", "known-inliers", true, ForwardTo::kCoordinator,
        "--known-inliers odometry|none", "never reject edges between consecutive ids [odometry]",

@@ -14,6 +14,7 @@ TEST(GncPassRefine, RefinedPassesEndWithTheSameSetAndCostAndCountTheirMessageSte
   GncDistributedOptions o;  // the solver's defaults: --refine auto, gradient 0.01
   o.robust.kind = RobustKind::kGncTls;
   o.solver.certify = true;
+  o.robust.refine_passes = false;
   const GncDistributedResult rounds =
       solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
   o.robust.refine_passes = true;

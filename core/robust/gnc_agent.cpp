@@ -112,7 +112,10 @@ std::vector<OutgoingMessage> GncAgent::start() {
 void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
   solve_.reset();
-  solve_options_ = gnc_solve_options(options_, solve_kind_, pass_capped_);
+  // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
+  const bool newton_steps = solve_kind_ == GncSolveKind::kGnc && g_ > first_solve_g_ &&
+                            gnc_refines(options_, *layout_, in_.d);
+  solve_options_ = gnc_solve_options(options_, solve_kind_, pass_capped_, newton_steps);
   std::vector<Measurement> measurements;
   if (solve_kind_ == GncSolveKind::kGnc)
     measurements = gnc_solve_measurements(in_.measurements, weights_, g_ > first_solve_g_,

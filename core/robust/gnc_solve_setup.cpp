@@ -9,7 +9,7 @@
 namespace tessera {
 
 DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSolveKind kind,
-                                     bool pass_capped) {
+                                     bool pass_capped, bool newton_steps) {
   DistributedOptions o = options.solver;
   // `--refine auto` (the default) is about the accuracy of the answer: GNC's own solves and the
   // inlier passes are intermediate iterates whose accuracy the schedule sets, so only an
@@ -23,12 +23,23 @@ DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSo
       if (options.robust.inner_max_rounds > 0)
         o.max_rounds = std::min(o.max_rounds, options.robust.inner_max_rounds);
       if (auto_refine) o.refine.enabled = false;
+      if (auto_refine && newton_steps) {
+        // RobustOptions::gnc_refine_steps: the rounds hand over at once (their tolerance is the
+        // hand-over gradient), and the refinement stops after that many steps.
+        o.refine.enabled = true;
+        o.refine.auto_interface_grad_tol = std::numeric_limits<double>::infinity();
+        o.refine.max_steps = options.robust.gnc_refine_steps;
+      }
       break;
     case GncSolveKind::kInlierPass:
       o.certify = false;
       if (pass_capped) o.max_rounds = std::min(o.max_rounds, options.robust.recheck_max_rounds);
       if (auto_refine && (pass_capped || !options.robust.refine_passes)) o.refine.enabled = false;
       if (auto_refine) o.refine.auto_gap_tol = std::numeric_limits<double>::infinity();
+      // A refined pass starts near the previous solution: Newton steps from there at once (no
+      // rounds down to the hand-over gradient first; intel 25 % random: 236 -> 188 message steps).
+      if (auto_refine && o.refine.enabled && options.robust.gnc_refine_steps > 0)
+        o.refine.auto_interface_grad_tol = std::numeric_limits<double>::infinity();
       break;
     case GncSolveKind::kFinal:
       if (options.robust.final_refine) {
@@ -48,6 +59,16 @@ bool pass_refines(const GncDistributedOptions& options, const BlockLayout& layou
   if (!options.robust.refine_passes) return false;
   const NewtonRefineOptions& r =
       gnc_solve_options(options, GncSolveKind::kInlierPass, false).refine;
+  return interface_fits(r, layout, d);
+}
+
+bool gnc_refines(const GncDistributedOptions& options, const BlockLayout& layout, int d) {
+  return options.robust.gnc_refine_steps > 0 && options.robust.refine_passes &&
+         interface_fits(gnc_solve_options(options, GncSolveKind::kGnc, false, true).refine, layout,
+                        d);
+}
+
+bool interface_fits(const NewtonRefineOptions& r, const BlockLayout& layout, int d) {
   if (!r.enabled || r.when != NewtonRefineOptions::When::kIfRoundsSlow ||
       !(r.auto_interface_grad_tol > 0) || r.interface_max_coordinates <= 0 ||
       r.coarse != NewtonRefineOptions::Coarse::kNone || layout.num_blocks <= 1)

@@ -19,8 +19,10 @@ namespace tessera {
 ///   ends the passes is taken at a converged one);
 /// - the final solve certifies as the run asks, and with RobustOptions::final_refine ends with
 ///   the Newton refinement (the answer to the refinement's tolerance).
+/// `newton_steps` (GNC's weighted solves, where gnc_refines()): the solve is
+/// RobustOptions::gnc_refine_steps Newton steps of the refinement, handed over at once.
 DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSolveKind kind,
-                                     bool pass_capped);
+                                     bool pass_capped, bool newton_steps = false);
 
 /// Whether an inlier pass on `layout` (the kept set's) hands over to the Newton refinement
 /// (RobustOptions::refine_passes under `--refine auto`, where the team's interface fits the
@@ -30,6 +32,17 @@ DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSo
 /// steps than RobustOptions::recheck_max_rounds rounds (intel with 25 % random outliers, 5
 /// agents: 7-13 against 40 a pass).
 bool pass_refines(const GncDistributedOptions& options, const BlockLayout& layout, int d);
+
+/// Whether GNC's weighted solve on `layout` (that step's: without the cut measurements of weight
+/// 0) is RobustOptions::gnc_refine_steps Newton steps instead of rounds: with refine_passes, where
+/// the interface fits as for pass_refines(). From the layout alone, so every agent decides the
+/// same.
+bool gnc_refines(const GncDistributedOptions& options, const BlockLayout& layout, int d);
+
+/// Whether `r` (enabled, `--refine auto`, interface solves on, no coarse space) hands over early
+/// on `layout`: the team's interface in tangent coordinates fits r.interface_max_coordinates (the
+/// rule of CertifiedAgent's early hand-over).
+bool interface_fits(const NewtonRefineOptions& r, const BlockLayout& layout, int d);
 
 /// The measurements of GNC's solve: each at its weight (`weighted`; the first solve is plain).
 /// A weight of exactly 0 adds nothing: with `drop_zero` (the known inliers keep the poses

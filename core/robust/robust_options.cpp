@@ -80,6 +80,9 @@ void RobustOptions::validate() const {
     bad_field("swap_kept_ratio", number_text(swap_kept_ratio), "must be in [0, 1]");
   if (!(std::isfinite(swap_return_ratio) && swap_return_ratio >= 1))
     bad_field("swap_return_ratio", number_text(swap_return_ratio), "must be >= 1");
+  if (gnc_refine_steps < 0)
+    bad_field("gnc_refine_steps", std::to_string(gnc_refine_steps),
+              "must be >= 0 (0 = weighted solves by rounds)");
   if (!(std::isfinite(weight_tolerance) && weight_tolerance >= 0))
     bad_field("weight_tolerance", number_text(weight_tolerance), "must be >= 0");
 }

@@ -39,6 +39,9 @@ GncDistributedOptions irbcd_gnc() {
   o.robust.kind = RobustKind::kGncTls;
   o.solver.algorithm = DistributedAlgorithm::kIrbcd;
   o.solver.grad_norm_tol = 1e-3;
+  // The rounds schedule these tests state: GNC's solves and the passes by rounds, also where the
+  // interface fits (RobustOptions::refine_passes; tests/gnc_refine_steps_test.cpp has it on).
+  o.robust.refine_passes = false;
   return o;
 }
 

@@ -18,7 +18,8 @@ GeneratorResult grid_with_outliers(double fraction, std::uint64_t seed = 3);
 GeneratorResult flexible_city(double fraction, OutlierKind kind, std::uint64_t seed);
 /// The generator's robots as the blocks: robot r owns a contiguous id range.
 std::vector<int> robots_as_blocks(const GeneratorResult& r);
-/// GNC-TLS around IRBCD, solved to a gradient norm of 1e-3.
+/// GNC-TLS around IRBCD, solved to a gradient norm of 1e-3, every solve before the final one by
+/// rounds (RobustOptions::refine_passes off).
 GncDistributedOptions irbcd_gnc();
 /// Per measurement: whether it is odometry (KnownInliers::kOdometry), the known inliers GNC's
 /// `known_inlier_flags` take.

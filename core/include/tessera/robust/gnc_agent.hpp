@@ -177,7 +177,8 @@ class GncAgent : public AgentProcess {
   /// Rounds of the solves before the final certified one (first, weighted, inlier passes).
   int gnc_rounds() const { return gnc_rounds_; }
   /// Message steps (neighbour exchanges and all-agent sums) of the Newton refinements of those
-  /// solves: the inlier passes solved to the tolerance under `--refine auto` (gnc_solve_setup).
+  /// solves: GNC's weighted solves and the inlier passes solved to the tolerance where they hand
+  /// over under `--refine auto` (gnc_solve_setup).
   int gnc_refine_steps() const { return gnc_refine_steps_; }
   /// The own block at the start of the last inlier pass (what the caller of an agent without
   /// the final solve starts that pass from to get its full record).

@@ -184,16 +184,35 @@ struct RobustOptions {
   bool final_refine = true;
   /// Distributed solvers only, with `--refine auto` (the solver's NewtonRefineOptions::when =
   /// kIfRoundsSlow): an inlier pass solved to the tolerance hands over to the Newton refinement
-  /// where the team's interface fits its interface solves, as a clean solve does; capped passes,
-  /// GNC's own solves and graphs whose interface does not fit are solved by rounds alone. Off
-  /// (default): every solve before the final one is solved by rounds alone. Why: where the
-  /// clean run is mostly refinement (intel, CSAIL at 5 agents: 1 and 0 rounds, 15 and 13 message
-  /// steps) the robust run's passes to the tolerance are what costs (F = 0.25 random: intel
-  /// 1,033 message steps, CSAIL 965); with this on 468 and 295, the same exact sets, certified.
-  /// Where the interface does not fit (manhattan3500) the refinement's block-Jacobi CG would cost
-  /// more message steps than the rounds it saves (16 rounds for 1,958 message steps), hence the
-  /// limit (docs/robust.md, "Final solve").
-  bool refine_passes = false;
+  /// where the team's interface fits its interface solves, as a clean solve does, and GNC's
+  /// weighted solves there are Newton steps too (gnc_refine_steps); capped passes, the first
+  /// solve and graphs whose interface does not fit are solved by rounds alone. On (default,
+  /// `--gnc-pass-refine auto`); off: every solve before the final one by rounds alone. Why: where
+  /// the clean run is mostly refinement (intel, CSAIL at 5 agents: 1 and 0 rounds, 15 and 13
+  /// message steps) the robust run's rounds are what costs (F = 0.25 random: intel 1,033 message
+  /// steps off, 195 on; CSAIL 965 and 66; the same exact sets, certified). Where the interface
+  /// does not fit (manhattan3500, sphere2500, city10000, the 1000-pose grid at 5 agents) nothing
+  /// changes: there the refinement's block-Jacobi CG would cost more message steps than the
+  /// rounds it saves (16 rounds for 1,958 message steps), hence the limit (docs/robust.md,
+  /// "Final solve").
+  bool refine_passes = true;
+  /// Distributed solvers only, with refine_passes: where the team's interface fits the
+  /// refinement's interface solves (the test of refine_passes, on each weighted solve's layout),
+  /// each weighted solve of GNC (every one after the first, plain solve) is this many Newton
+  /// steps of the refinement (distributed/newton_refine.hpp) from the previous iterate instead of
+  /// inner_max_rounds rounds; and an inlier pass that hands over to the refinement does so at
+  /// once, without block-coordinate rounds first. >= 0; 0 = GNC's weighted solves by rounds (and
+  /// the passes' rounds run down to the hand-over gradient first, as a clean solve's do). The first
+  /// solve stays rounds: from the start, a Newton step goes to the plain problem's nearest
+  /// minimiser, which the wrong closures have bent (intel with 50 % random outliers: 88 true
+  /// closures cut, not certified). Why: one Newton step of a weighted problem costs 7 message
+  /// steps (one CG iteration of the interface solve: 2 neighbour exchanges, 5 all-agent sums)
+  /// and takes its gradient from ~170 to ~0.05, while 5 rounds (10 message steps) leave it rough;
+  /// GNC on near-minimisers misjudges fewer closures, so the passes after it change less
+  /// (F = 0.25 random, 5 agents, with mu_step_max 4: intel 283 -> 188 message steps, CSAIL 138 ->
+  /// 66; docs/robust.md, "Newton steps in GNC"). 1: two steps cost 13 message steps a solve and
+  /// shorten nothing (intel 0.25: 17 outer steps either way, 284 message steps; CSAIL 87).
+  int gnc_refine_steps = 1;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 

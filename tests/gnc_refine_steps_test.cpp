@@ -1,0 +1,79 @@
+// RobustOptions::gnc_refine_steps: with RobustOptions::refine_passes, where the team's interface
+// fits the refinement's interface solves, GNC's weighted solves are Newton steps of the
+// refinement instead of capped rounds, and the refined inlier passes hand over at once.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <tessera/robust/gnc_distributed.hpp>
+#include <tessera/util/input_error.hpp>
+
+#include "gnc_fixtures.hpp"
+
+namespace tessera {
+namespace {
+
+// Message steps of a distributed robust run: two a round plus every refinement's exchanges and
+// all-agent sums (docs/robust.md, "JSON and files").
+int message_steps(const GncDistributedResult& r) {
+  int steps = 2 * r.total_rounds + r.refine_message_steps;
+  for (const NewtonRefineResult& f : r.final_solve.refines) steps += f.exchanges + f.reductions;
+  return steps;
+}
+
+TEST(GncRefineSteps, ANegativeStepCountNamesTheField) {
+  RobustOptions o;
+  o.gnc_refine_steps = -1;
+  try {
+    o.validate();
+    FAIL() << "gnc_refine_steps -1 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("RobustOptions.gnc_refine_steps"), std::string::npos)
+        << e.what();
+  }
+  o.gnc_refine_steps = 0;  // the weighted solves by rounds
+  EXPECT_NO_THROW(o.validate());
+}
+
+TEST(GncRefineSteps, NewtonStepsInGncFindTheSameSetAtTheSameCertifiedCostInFewerMessageSteps) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  GncDistributedOptions o;  // the solver's defaults: --refine auto
+  o.robust.kind = RobustKind::kGncTls;
+  o.robust.refine_passes = true;
+  o.solver.certify = true;
+  o.robust.gnc_refine_steps = 0;
+  const GncDistributedResult rounds =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  o.robust.gnc_refine_steps = 1;
+  const GncDistributedResult newton =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  ASSERT_GT(rounds.refine_message_steps, 0) << "the interface should fit (the passes refine)";
+  EXPECT_EQ(rounds.rejected, dirty.outliers);
+  EXPECT_EQ(newton.rejected, dirty.outliers);
+  EXPECT_NEAR(newton.final_solve.cost, rounds.final_solve.cost, 1e-9 * rounds.final_solve.cost);
+  EXPECT_TRUE(newton.final_solve.certified.value_or(false));
+  // The weighted solves and the passes take no rounds: only the first solve's are left.
+  EXPECT_LE(newton.total_rounds, o.robust.inner_max_rounds + newton.final_solve.rounds);
+  EXPECT_LT(message_steps(newton), message_steps(rounds));
+}
+
+TEST(GncRefineSteps, WithoutRefinedPassesTheWeightedSolvesStayRounds) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.robust.refine_passes = false;
+  o.solver.certify = true;
+  o.robust.gnc_refine_steps = 0;
+  const GncDistributedResult zero =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  o.robust.gnc_refine_steps = 1;  // refine_passes is off: no effect
+  const GncDistributedResult one =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  EXPECT_EQ(one.refine_message_steps, 0);
+  EXPECT_EQ(one.total_rounds, zero.total_rounds);
+  EXPECT_EQ(one.outer_iterations, zero.outer_iterations);
+  EXPECT_EQ(one.rejected, zero.rejected);
+  EXPECT_EQ(one.final_solve.cost, zero.final_solve.cost);
+}
+
+}  // namespace
+}  // namespace tessera
