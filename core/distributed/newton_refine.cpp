@@ -190,7 +190,7 @@ std::optional<AwaitedMessages> NewtonRefineProtocol::awaited() const {
 void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
   while (!done_) {
     std::optional<MessageGate::Inbox> ready = gate_.take_ready();
-    if (!ready) return;  // a message that completes no step is stored, not timed
+    if (!ready) return;              // a message that completes no step is stored, not timed
     charge_to(&result_.times.cg_s);  // until the step's handler names its part
     const std::uint32_t step = gate_.step();
     ++message_round_;
