@@ -66,6 +66,7 @@ RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   ro.refine = asg.refine();
   ro.refine_grad_tol = asg.refine_grad_tol();
   ro.refine_rel_tol = asg.refine_rel_tol();
+  ro.refine_sigma = asg.refine_sigma();
   // One host's factors share one budget (runtime/team_memory.hpp).
   ro.max_factor_entries = team_factor_cap(asg.num_agents());
   if (!asg.robust().empty()) {

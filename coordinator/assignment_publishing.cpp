@@ -38,6 +38,7 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   asg.refine(options.refine);
   asg.refine_grad_tol(options.refine_grad_tol);
   asg.refine_rel_tol(options.refine_rel_tol);
+  asg.refine_sigma(options.refine_sigma);
   asg.setup_at_once(options.setup_at_once);
   if (options.robust.kind != RobustKind::kNone) {
     const RobustOptions& r = options.robust;

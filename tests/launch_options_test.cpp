@@ -94,7 +94,7 @@ TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
       {"robust", "gnc-tls"},      {"known-inliers", "odometry"}, {"gnc-mu-step", "1.4"},
       {"inlier-quantile", "0.5"}, {"refine", "newton"},          {"coarse-space", "smoothed"},
       {"gnc-probe-ratio", "5"},   {"gnc-final-refine", "none"},  {"gnc-pass-refine", "auto"},
-      {"gnc-mu-step-max", "2"}};
+      {"gnc-mu-step-max", "2"},   {"refine-sigma", "one"}};
   for (const ForwardedFlag& f : forwarded_flags()) {
     EXPECT_NE(help.find(std::string("--") + f.name), std::string::npos) << f.name;
     Argv argv = {std::string("--") + f.name};
@@ -230,6 +230,21 @@ TEST(LaunchOptions, PassRefineReachesTheCoordinatorAndABadValueNamesTheFlag) {
   EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--gnc-pass-refine"));
   const std::string e = error_of({"--gnc-pass-refine", "newton"});
   EXPECT_NE(e.find("--gnc-pass-refine"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace tessera::launch
+
+namespace tessera::launch {
+namespace {
+
+TEST(LaunchOptions, RefineSigmaReachesTheCoordinatorAndABadValueNamesTheFlag) {
+  LaunchOptions o = parse_launch_options({"--refine-sigma", "one"});
+  o.graph = "/data/graph.g2o";
+  EXPECT_TRUE(has_pair(coordinator_argv(o, paths()), "--refine-sigma", "one"));
+  EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--refine-sigma"));  // the assignment carries it
+  const std::string e = error_of({"--refine-sigma", "all"});
+  EXPECT_NE(e.find("--refine-sigma"), std::string::npos) << e;
 }
 
 }  // namespace

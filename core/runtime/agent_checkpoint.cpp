@@ -71,6 +71,7 @@ std::string encode_checkpoint(const std::string& run_id, const AgentLocalData& l
   w.string(o.refine);  // a restarted agent must refine as the others do
   w.f64(o.refine_grad_tol);
   w.f64(o.refine_rel_tol);
+  w.string(o.refine_sigma);
   w.u64(snapshots.size());
   for (const auto& s : snapshots) encode(w, s);
   return w.bytes();
@@ -130,6 +131,7 @@ AgentCheckpoint decode_checkpoint(const std::string& payload, const std::string&
     o.refine = r.string("refine");
     o.refine_grad_tol = r.f64("refine grad tolerance");
     o.refine_rel_tol = r.f64("refine relative tolerance");
+    o.refine_sigma = r.string("refine sigma");
     const std::uint64_t n = r.u64("number of snapshots");
     for (std::uint64_t k = 0; k < n; ++k) c.snapshots.push_back(decode_snapshot(r));
     r.expect_end();

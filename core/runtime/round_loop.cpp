@@ -12,6 +12,7 @@
 #include <tessera/distributed/protocol_snapshot.hpp>
 #include <tessera/distributed/round_protocol.hpp>
 #include <tessera/problem/lifting.hpp>
+#include <tessera/util/input_error.hpp>
 
 #include "runtime/gnc_round_loop.hpp"
 #include "runtime/round_finish.hpp"
@@ -49,6 +50,12 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
   set_refine_mode(opt.refine, o.refine);
   if (o.refine_grad_tol > 0) opt.refine.grad_norm_tol = o.refine_grad_tol;
   if (o.refine_rel_tol > 0) opt.refine.relative_decrease_tol = o.refine_rel_tol;
+  if (!o.refine_sigma.empty()) {
+    if (o.refine_sigma != "one" && o.refine_sigma != "every")
+      throw InputError("RunOptions::refine_sigma: '" + o.refine_sigma +
+                       "' is not one of one, every");
+    opt.refine.ship_sigma = o.refine_sigma == "one";
+  }
   if (o.max_factor_entries > 0)
     opt.block_update.max_factor_entries = static_cast<std::size_t>(o.max_factor_entries);
   opt.validate();
