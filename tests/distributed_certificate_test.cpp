@@ -215,10 +215,12 @@ TEST(DistributedStaircase, RankDSaddleEscapesToTheCertifiedOptimum) {
   EXPECT_NEAR(r.cost, ref.cost, 3e-5 * ref.cost);
 }
 
+// The refinement of an inconclusive certificate is by rounds to StaircaseOptions::grad_norm_tol
+// when the Newton refinement is off (below: by the Newton refinement when it is on).
 TEST(DistributedStaircase, InconclusiveCertificateRefinesTheSameRankBeforeEscaping) {
   const PoseGraph g = saddle_graph();
   DistributedOptions o = saddle_options(DeliveryOrder::kFifo);
-  o.refine.auto_interface_grad_tol = 0;  // the rounds to the solver's tolerance, as tested here
+  o.refine.enabled = false;  // the rounds to the refinement tolerance, as tested here
   const DistributedResult r =
       solve_distributed(g, sequential_partition(g.num_poses, 4), o, g.initial);
   // Rank 2 at the solver's tolerance: not certified, so rank 2 is refined (more solver rounds
@@ -635,6 +637,27 @@ TEST(CertificateBound, AnIterateShortOfCriticalIsCertifiedOnlyWithinTheTolerance
   EXPECT_GT(certified, 0);
   EXPECT_GT(by_the_second_test, 0);
   EXPECT_GT(not_certified, 0);
+}
+
+// With the Newton refinement on (the default), an inconclusive certificate's refinement is
+// the Newton refinement's: the refining stage's rounds stop at once (the point is at the
+// solver's tolerance already), a Newton refinement runs there, and only a failure at the
+// refined point leads to the escape.
+TEST(DistributedStaircase, InconclusiveCertificateIsRefinedByNewtonWithoutMoreRounds) {
+  const PoseGraph g = saddle_graph();
+  DistributedOptions o = saddle_options(DeliveryOrder::kFifo);
+  o.refine.auto_interface_grad_tol = 0;  // the rounds to the solver's tolerance first
+  const DistributedResult r =
+      solve_distributed(g, sequential_partition(g.num_poses, 4), o, g.initial);
+  ASSERT_GE(r.certificates.size(), 3u);
+  EXPECT_EQ(r.certificates[0].rank, 2);
+  EXPECT_FALSE(r.certificates[0].result.certified);
+  EXPECT_EQ(r.certificates[1].rank, 2);
+  EXPECT_EQ(r.certificates[1].stage, r.certificates[0].stage + 3);  // solve, no escape between
+  EXPECT_EQ(r.refine_rounds, 0);
+  EXPECT_FALSE(r.refines.empty());
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_TRUE(r.certificates.back().result.certified);
 }
 
 }  // namespace tessera
