@@ -215,10 +215,12 @@ TEST(DistributedStaircase, RankDSaddleEscapesToTheCertifiedOptimum) {
   EXPECT_NEAR(r.cost, ref.cost, 3e-5 * ref.cost);
 }
 
+// The refinement of an inconclusive certificate is by rounds to StaircaseOptions::grad_norm_tol
+// when the Newton refinement is off (below: by the Newton refinement when it is on).
 TEST(DistributedStaircase, InconclusiveCertificateRefinesTheSameRankBeforeEscaping) {
   const PoseGraph g = saddle_graph();
   DistributedOptions o = saddle_options(DeliveryOrder::kFifo);
-  o.refine.auto_interface_grad_tol = 0;  // the rounds to the solver's tolerance, as tested here
+  o.refine.enabled = false;  // the rounds to the refinement tolerance, as tested here
   const DistributedResult r =
       solve_distributed(g, sequential_partition(g.num_poses, 4), o, g.initial);
   // Rank 2 at the solver's tolerance: not certified, so rank 2 is refined (more solver rounds
@@ -566,6 +568,96 @@ TEST(CertificateBound, DistributedBoundIsTheCentralizedOne) {
       certify_in_process(g, o.nearby, parts, DeliveryOrder::kFifo, {}, nullptr, options);
   EXPECT_TRUE(lobpcg_near.psd_within_tolerance);
   EXPECT_FALSE(lobpcg_near.certified);
+}
+
+// The proof's ladder jumps from t = 1 to the largest t whose bound still certifies: there the
+// bound spends 0.99 of the tolerance, and any larger t is over it.
+TEST(CertificateBound, TheLargestCertifyingMultiplierSpendsTheToleranceAndNoMore) {
+  const double f = 717.126, trace_lambda = 717.104, s0 = 4.157e-7, weight_sum = 3.95e-7;
+  const std::size_t n = 5750;
+  const int d = 3;
+  const double tol = kDefaultSuboptimalityTolerance;
+  const double t = largest_certifying_multiplier(f, trace_lambda, s0, weight_sum, n, d, tol);
+  ASSERT_GT(t, 1.0);
+  const auto bound_at = [&](double m) {
+    return make_dual_bound(f, trace_lambda, 0.0, m * (s0 * static_cast<double>(n) + weight_sum), n,
+                           d);
+  };
+  EXPECT_NEAR(bound_at(t).relative_suboptimality(f), kCertifyingMargin * tol, 1e-12);
+  EXPECT_TRUE(bound_certifies(bound_at(t), tol));
+  EXPECT_FALSE(bound_certifies(bound_at(1.02 * t), tol));
+  // f(Y) - tr(Lambda) (the translations' share of the gradient) over the tolerance: no t.
+  EXPECT_LE(largest_certifying_multiplier(f, f - 2 * tol * f, s0, weight_sum, n, d, tol), 0.0);
+}
+
+// Solver iterates ever closer to the optimum (IRBCD stopped at gradient norms 0.3 down to
+// 1e-3): one that is certified is within the tolerance of the optimum (weak duality), the
+// agents' interface test gives the centralized verdict, and some are certified only by the
+// ladder's second test (the largest certifying t), which a ladder of factors of 3 can step over.
+TEST(CertificateBound, AnIterateShortOfCriticalIsCertifiedOnlyWithinTheTolerance) {
+  GeneratorOptions gen;
+  gen.kind = TrajectoryKind::kGrid3d;
+  gen.num_poses = 343;
+  gen.seed = 2;
+  const PoseGraph g = generate_pose_graph(gen).graph;
+  const BlockProblem whole = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  CentralizedOptions tight;
+  tight.stop = CentralizedStop::kGradient;
+  const double f_star = solve_centralized(g, tight).relaxation_cost;
+  const double tol = kDefaultSuboptimalityTolerance;
+  const auto parts = sequential_partition(g.num_poses, 3);
+  DistributedCertificateOptions options;
+  options.interface_max_coordinates = 100000;
+  int certified = 0, by_the_second_test = 0, not_certified = 0;
+  for (double grad_tol : {0.3, 0.1, 0.03, 0.01, 0.003, 0.001}) {
+    SCOPED_TRACE("grad_tol " + std::to_string(grad_tol));
+    DistributedOptions o;
+    o.grad_norm_tol = grad_tol;
+    o.certify = false;
+    o.refine.enabled = false;
+    const DistributedResult r = solve_distributed(g, parts, o, g.initial);
+    const Eigen::MatrixXd& Y = r.X;
+    const double f = relaxation_cost(whole, Y);
+    const CertificateResult c = verify_certificate(whole, Y);
+    const DistributedCertificateResult dist =
+        certify_in_process(g, Y, parts, DeliveryOrder::kFifo, {}, nullptr, options);
+    std::printf("|grad f| %.2g: f - f* = %.3g (%.2g relative), certified %d after %d proof tests\n",
+                r.trace.empty() ? -1.0 : r.trace.back().grad_norm, f - f_star,
+                (f - f_star) / std::max(1.0, f), int(c.certified), c.proof_factorizations);
+    EXPECT_EQ(dist.certified, c.certified);
+    if (c.certified) {
+      ++certified;
+      EXPECT_LE(f - f_star, tol * std::max(1.0, std::abs(f)));
+      EXPECT_LE(c.bound.lower_bound, f_star);
+      if (c.proof_factorizations == 2) ++by_the_second_test;
+    } else {
+      ++not_certified;
+    }
+  }
+  EXPECT_GT(certified, 0);
+  EXPECT_GT(by_the_second_test, 0);
+  EXPECT_GT(not_certified, 0);
+}
+
+// With the Newton refinement on (the default), an inconclusive certificate's refinement is
+// the Newton refinement's: the refining stage's rounds stop at once (the point is at the
+// solver's tolerance already), a Newton refinement runs there, and only a failure at the
+// refined point leads to the escape.
+TEST(DistributedStaircase, InconclusiveCertificateIsRefinedByNewtonWithoutMoreRounds) {
+  const PoseGraph g = saddle_graph();
+  DistributedOptions o = saddle_options(DeliveryOrder::kFifo);
+  o.refine.auto_interface_grad_tol = 0;  // the rounds to the solver's tolerance first
+  const DistributedResult r =
+      solve_distributed(g, sequential_partition(g.num_poses, 4), o, g.initial);
+  ASSERT_GE(r.certificates.size(), 3u);
+  EXPECT_EQ(r.certificates[0].rank, 2);
+  EXPECT_FALSE(r.certificates[0].result.certified);
+  EXPECT_EQ(r.certificates[1].rank, 2);
+  EXPECT_EQ(r.certificates[1].stage, r.certificates[0].stage + 3);  // solve, no escape between
+  EXPECT_EQ(r.refine_rounds, 0);
+  EXPECT_FALSE(r.refines.empty());
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_TRUE(r.certificates.back().result.certified);
 }
 
 }  // namespace tessera

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "certification/interface_schur.hpp"
+#include "certification/row_space_ritz.hpp"
 #include "certification/shifted_block_factor.hpp"
 #include "distributed/interface_poses.hpp"
 #include "distributed/public_pose_messages.hpp"
@@ -264,35 +265,27 @@ void CertificateProtocol::after_setup(const MessageGate::Inbox& inbox,
   poses_ = t[at + 2];
   weight_sum_ = t[at + 3];
   gradient_norm_ = 2.0 * std::sqrt(std::max(0.0, grams[2].trace()));  // 2 ||Y S||_F
-  // Rayleigh-Ritz on the row space (the same r x r problem on every agent): the smallest Ritz
-  // value and its residual ||x S - theta x||^2 = c^T (Y S)(Y S)^T c - theta^2 for c^T Y Y^T c = 1.
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eb(grams[0]);
-  const double top = eb.eigenvalues().maxCoeff();
-  std::vector<Eigen::Index> keep;
-  for (Eigen::Index i = 0; i < r; ++i)
-    if (eb.eigenvalues()(i) > 1e-10 * top) keep.push_back(i);
-  Eigen::MatrixXd Z(r, static_cast<Eigen::Index>(keep.size()));
-  for (std::size_t c = 0; c < keep.size(); ++c)
-    Z.col(static_cast<Eigen::Index>(c)) =
-        eb.eigenvectors().col(keep[c]) / std::sqrt(eb.eigenvalues()(keep[c]));
-  Eigen::MatrixXd C = Z.transpose() * grams[1] * Z;
-  C = (0.5 * (C + C.transpose())).eval();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ec(C);
-  row_space_ritz_ = Z * ec.eigenvectors().col(0);
-  row_space_theta_ = ec.eigenvalues()(0);
-  row_space_residual_ = std::sqrt(std::max(
-      0.0, row_space_ritz_.dot(grams[2] * row_space_ritz_) - row_space_theta_ * row_space_theta_));
+  // Rayleigh-Ritz on the row space (the same r x r problem on every agent).
+  const RowSpaceRitz ritz = row_space_ritz(grams[0], grams[1], grams[2]);
+  row_space_ritz_ = ritz.coefficients;
+  row_space_theta_ = ritz.theta;
+  row_space_residual_ = ritz.residual;
   if (t[1] > 0) {  // an agent's block is too large to factor: LOBPCG only
     build_preconditioner();
     start_lobpcg(out);
     return;
   }
-  // The first test's floor: the smallest that can certify (dual_bound.hpp); it and alpha go
-  // up by factors of kProofShiftGrowth while the test fails, the floor to eta at most.
+  // The proof's ladder D(t) (dual_bound.hpp): t = 1, the floor a tenth of the tolerance; if
+  // that fails, the largest t that certifies; if that fails too, on up by kProofShiftGrowth
+  // (a proved bound that does not certify), the floor to eta at most.
   proof_shift_cap_ = std::max(result_.tolerance, 1e-12 * result_.scale);
-  proof_shift_ = std::min(proof_shift_cap_,
+  proof_floor_ = std::min(proof_shift_cap_,
                           first_proof_shift(f_, static_cast<std::size_t>(poses_), problem_.dim(),
                                             options_.suboptimality_tolerance, result_.scale));
+  proof_largest_ = largest_certifying_multiplier(f_, trace_lambda_, proof_floor_, weight_sum_,
+                                                 static_cast<std::size_t>(poses_), problem_.dim(),
+                                                 options_.suboptimality_tolerance);
+  proof_shift_ = proof_floor_;
   proof_alpha_ = 1.0;
   proof_round_ = 0;
   send_schur(out);
@@ -351,9 +344,16 @@ void CertificateProtocol::after_verdict(const MessageGate::Inbox& inbox,
   interface_certified_ = reduction_values(inbox.at(0), 1)[0] != 0.0;
   result_.interface_test = true;
   if (!interface_certified_ && proof_shift_ < proof_shift_cap_) {
-    // Not proved at this shift, perhaps at a larger one (a point short of critical).
-    proof_shift_ = std::min(proof_shift_cap_, kProofShiftGrowth * proof_shift_);
-    proof_alpha_ *= kProofShiftGrowth;
+    // Not proved at this shift, perhaps at a larger one (a point short of critical): the
+    // largest that certifies after the first, then the rungs above it.
+    if (proof_alpha_ == 1.0 && proof_largest_ > 1.0) {
+      proof_alpha_ = proof_largest_;
+    } else {
+      double t = 1.0;
+      while (t <= proof_alpha_) t *= kProofShiftGrowth;
+      proof_alpha_ = t;
+    }
+    proof_shift_ = std::min(proof_shift_cap_, proof_alpha_ * proof_floor_);
     ++proof_round_;
     send_schur(out);
     return;

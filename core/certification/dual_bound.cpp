@@ -40,6 +40,16 @@ double first_proof_shift(double relaxation_cost, std::size_t poses, int d, doubl
                   1e-13 * std::max(1.0, scale));
 }
 
+double largest_certifying_multiplier(double relaxation_cost, double trace_lambda, double s0,
+                                     double weight_sum, std::size_t poses, int d,
+                                     double tolerance) {
+  const double budget = kCertifyingMargin * tolerance * std::max(1.0, std::abs(relaxation_cost)) -
+                        (relaxation_cost - trace_lambda);
+  const double per_unit = d * (s0 * static_cast<double>(poses) + weight_sum);
+  if (!(budget > 0) || !(per_unit > 0) || !std::isfinite(budget / per_unit)) return 0.0;
+  return budget / per_unit;
+}
+
 bool bound_certifies(const DualBound& bound, double tolerance) {
   return bound.proved() && bound.relative_suboptimality(bound.relaxation_cost) <= tolerance;
 }

@@ -37,7 +37,9 @@ bool CertifiedAgent::hands_over_early() const {
 }
 
 double CertifiedAgent::solve_tolerance() const {
-  if (refining_) return refine_tolerance();
+  // An inconclusive certificate's refinement is the Newton refinement's where it is on: the
+  // rounds stop at once (the point is at the solver's tolerance already) and hand over.
+  if (refining_ && !options_.refine.enabled) return refine_tolerance();
   if (hands_over_early())
     return std::max(options_.grad_norm_tol, options_.refine.auto_interface_grad_tol);
   return options_.grad_norm_tol;
@@ -45,6 +47,7 @@ double CertifiedAgent::solve_tolerance() const {
 
 bool CertifiedAgent::refine_wanted(const std::vector<RoundRecord>& trace) const {
   if (options_.refine.when == NewtonRefineOptions::When::kAlways) return true;
+  if (refining_) return true;  // after an inconclusive certificate (solve_tolerance)
   if (hands_over_early()) return true;
   return rounds_tail_gap(trace, options_.refine.auto_window, 0.9) > options_.refine.auto_gap_tol;
 }

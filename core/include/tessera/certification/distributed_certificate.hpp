@@ -167,6 +167,8 @@ class CertificateProtocol : public AgentProcess {
   double f_local_ = 0.0, trace_lambda_local_ = 0.0;
   double f_ = 0.0, trace_lambda_ = 0.0, gradient_norm_ = 0.0, poses_ = 0.0;
   double proof_shift_ = 0.0, proof_alpha_ = 1.0, proof_shift_cap_ = 0.0;
+  // The ladder's floor (t = 1) and its largest certifying t (largest_certifying_multiplier).
+  double proof_floor_ = 0.0, proof_largest_ = 0.0;
   double weight_sum_local_ = 0.0, weight_sum_ = 0.0;
   std::vector<double> weights_;  // proof_shift_weights of the agent's poses
   std::uint32_t proof_round_ = 0;

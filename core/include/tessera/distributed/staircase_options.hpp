@@ -17,7 +17,9 @@ struct StaircaseOptions {
   /// rank is solved to the solver's tolerance first; measured on the 17 benchmark graphs the
   /// certificate holds there (docs/distributed-certification.md). Only a certificate that
   /// also fails at this tolerance leads to the saddle escape. 0 = never refine (escape at
-  /// once). >= 0.
+  /// once). >= 0. Where the Newton refinement is on (NewtonRefineOptions::enabled) it refines
+  /// instead, to its own grad_norm_tol (certified_agent.hpp); this tolerance then only says
+  /// that a refinement is wanted (> 0).
   double grad_norm_tol = 1e-4;
   DistributedCertificateOptions certificate;
   SaddleEscapeOptions escape;
