@@ -96,8 +96,8 @@ struct GncDistributedResult {
   int outer_iterations = 0;
   int total_rounds = 0;  ///< Rounds of every solve, final included.
   /// Message steps of the Newton refinements of the solves before the final one (the final
-  /// solve's are in final_solve.refines): a round is two message steps, so the run's message
-  /// steps are 2 x total_rounds + this + the final refinement's.
+  /// solve's are in final_refine_message_steps); a round is two message steps (the run's total:
+  /// exchange_steps).
   int refine_message_steps = 0;
   /// Message steps of GNC's own exchanges (GncAgent::exchange_steps()): poses, votes, weights,
   /// rejected sets, verdicts, gathers. The run's message steps in all are
