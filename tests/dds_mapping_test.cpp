@@ -506,6 +506,8 @@ TEST(DdsReportMapping, EveryReportComesBackFieldForField) {
   r.probes = 2;
   r.probes_kept = 1;
   r.refine_steps = 37;
+  r.exchange_steps = 61;
+  r.final_refine_steps = 3;
   const auto robust = std::get<agent::RobustRunReport>(report_round_trip(r));
   EXPECT_EQ(robust.outer_iterations, 29);
   EXPECT_EQ(robust.rejected, r.rejected);
@@ -515,6 +517,8 @@ TEST(DdsReportMapping, EveryReportComesBackFieldForField) {
   EXPECT_EQ(robust.probes, 2);
   EXPECT_EQ(robust.probes_kept, 1);
   EXPECT_EQ(robust.refine_steps, 37);
+  EXPECT_EQ(robust.exchange_steps, 61);
+  EXPECT_EQ(robust.final_refine_steps, 3);
 
   const auto times = std::get<agent::PhaseTimesReport>(
       report_round_trip(agent::PhaseTimesReport{0.25, 0.125, 12, 348, 6}));

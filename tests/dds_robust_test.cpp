@@ -118,6 +118,13 @@ TEST(DdsRobust, IteratesAndRejectedSetEqualTheInProcessEngine) {
   // same ones over DDS.
   EXPECT_GT(ref.refine_message_steps, 0);
   EXPECT_EQ(json_field(dds.summary, "gnc_refine_steps"), ref.refine_message_steps) << dds.summary;
+  // GNC's own exchanges and every wait for peers in all: the same count over DDS.
+  EXPECT_GE(ref.exchange_steps, 2 * ref.outer_iterations + 2);
+  EXPECT_EQ(json_field(dds.summary, "gnc_exchange_steps"), ref.exchange_steps) << dds.summary;
+  EXPECT_EQ(json_field(dds.summary, "message_steps_total"),
+            2 * ref.total_rounds + ref.refine_message_steps + ref.final_refine_message_steps +
+                ref.exchange_steps)
+      << dds.summary;
   EXPECT_EQ(json_field(dds.summary, "readmitted"), static_cast<double>(ref.readmitted));
   EXPECT_EQ(json_field(dds.summary, "outliers"), static_cast<double>(ref.rejected.size()));
   EXPECT_EQ(json_field(dds.summary, "inliers"),

@@ -30,6 +30,9 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   const std::uint32_t phase = gnc_phase(g_, exchange());
   const auto me = static_cast<std::uint32_t>(in_.id);
   exchange_->begin();
+  // A gather at agent 0 (the consistency check's values, the kept set's start) waits twice: for
+  // the values, then for agent 0's answer.
+  exchange_steps_ += step == Step::kPcm || step == Step::kKeptStart ? 2 : 1;
   // Whom this agent hears from: a pose exchange from its block neighbours (each sends what it
   // was sent), a status exchange from every other agent.
   std::vector<int> from = base_->adjacent[static_cast<std::size_t>(in_.id)];

@@ -158,6 +158,7 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   }
   out.total_rounds = lead.gnc_rounds();
   out.refine_message_steps = lead.gnc_refine_steps();
+  out.exchange_steps = lead.exchange_steps();
   out.total_bytes = stats.bytes;
 
   // The last solve of the kept set with its full record (trace, certificate, refinement): when
@@ -183,6 +184,8 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   out.final_solve = solve_distributed_from_lifted(inliers, assignment, last, X);
   if (final_runs) {
     out.total_rounds += out.final_solve.rounds;
+    for (const NewtonRefineResult& n : out.final_solve.refines)
+      out.final_refine_message_steps += n.exchanges + n.reductions;
     out.total_bytes += out.final_solve.bytes_exchanged;
   }
   return out;

@@ -62,6 +62,10 @@ struct RobustRunReport {
   /// Message steps of the Newton refinements before the final solve
   /// (GncDistributedResult::refine_message_steps).
   int refine_steps = 0;
+  /// Message steps of GNC's own exchanges (GncDistributedResult::exchange_steps).
+  int exchange_steps = 0;
+  /// Message steps of the final solve's Newton refinement (0 without a final solve).
+  int final_refine_steps = 0;
 };
 
 /// Agent 0's time after the rounds began, its clock (seconds), and how the rounding went: the

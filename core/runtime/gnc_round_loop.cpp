@@ -83,6 +83,10 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   report.probes = agent.probes();
   report.probes_kept = agent.probes_kept();
   report.refine_steps = agent.gnc_refine_steps();
+  report.exchange_steps = agent.exchange_steps();
+  if (const CertifiedAgent* final_solve = agent.final_sequence())
+    for (const NewtonRefineResult& n : final_solve->refines())
+      report.final_refine_steps += n.exchanges + n.reductions;
   res.robust = std::move(report);
 
   // The rounding sees the kept measurements (the cost is over them).

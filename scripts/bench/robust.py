@@ -312,12 +312,17 @@ def ate(estimate, reference, d):
 
 # ---- runs
 def message_steps(rounds, summary):
-    """Message steps of a distributed run: two a round (docs/irbcd.md) plus the Newton
-    refinement's neighbour exchanges and all-agent sums (of the final solve; a robust run's
-    earlier refinements are its JSON's gnc_refine_steps). Under `--refine auto` a clean run hands
-    over to the refinement early, so its rounds alone undercount its work (intel: 1 round, 13
-    refinement steps)."""
-    return 2 * rounds + summary.get("refine_exchanges", 0) + summary.get("refine_reductions", 0)
+    """Message steps of a distributed run, each a wait for peers: the JSON's message_steps_total
+    (two a round, docs/irbcd.md, plus every Newton refinement's neighbour exchanges and all-agent
+    sums, plus a robust run's own exchanges: poses, votes, weights, rejected sets, verdicts,
+    gathers, its gnc_exchange_steps). Under `--refine auto` a clean run hands over to the
+    refinement early, so its rounds alone undercount its work (intel: 1 round, 13 refinement
+    steps). A binary without message_steps_total: two a round plus the refinements' steps
+    (GNC's own exchanges left out)."""
+    if "message_steps_total" in summary:
+        return summary["message_steps_total"]
+    return (2 * rounds + summary.get("refine_exchanges", 0) + summary.get("refine_reductions", 0) +
+            summary.get("gnc_refine_steps", 0))
 
 
 def solve(tessera, graph, work, tag, extra, timeout, algorithm="centralized"):
@@ -437,7 +442,7 @@ def table(csv_path):
     head = ("| graph | kind | F | outliers | rejected | precision | recall | gap to f*_clean | ATE m | outer | "
             "certified | wall s | plain gap | plain ATE m | dist. rejected | dist. precision | dist. recall | "
             "dist. gap | dist. ATE m | dist. rounds (clean) | dist. message steps (clean) | dist. probes (kept) | "
-            "dist. refine steps | dist. MB | "
+            "dist. GNC exchange steps | dist. refine steps | dist. MB | "
             "dist. wall s | dist. certified | load |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
@@ -453,7 +458,7 @@ def table(csv_path):
             (f"{r['d_msg_steps']} ({r['d_clean_msg_steps']}) = {float(r['d_msg_ratio']):.1f}x"
              if r.get("d_msg_steps") and r.get("d_msg_ratio") else r.get("d_msg_steps") or "-"),
             (f"{r['d_probes']} ({r['d_probes_kept']})" if r.get("d_probes") else "-"),
-            r.get("d_refine_steps", "") or "-",
+            r.get("d_gnc_exchange_steps", "") or "-", r.get("d_refine_steps", "") or "-",
             num(str(float(r["d_bytes"]) / 1e6) if r.get("d_bytes") else "", "{:.1f}"),
             num(r.get("d_wall_s", ""), "{:.3g}"), r.get("d_certified", "") or "-", r["load"]]) + " |")
     return "\n".join(lines)
@@ -707,7 +712,7 @@ def main():
               "d_round_ratio", "d_bytes", "d_wall_s", "d_certified", "load", "note",
               "d_probes", "d_probes_kept", "d_refine_steps", "probes", "probes_kept", "tls", "tls_clean",
               "groups_kept", "true_cut", "d_tls", "d_tls_clean", "d_groups_kept", "d_true_cut",
-              "d_msg_steps", "d_clean_msg_steps", "d_msg_ratio"]
+              "d_msg_steps", "d_clean_msg_steps", "d_msg_ratio", "d_gnc_exchange_steps"]
     if args.append and os.path.exists(out_csv):
         with open(out_csv) as f:
             fields = next(csv.reader(f))  # an older CSV: its own columns, new ones left out
@@ -798,8 +803,8 @@ def main():
                                    # message steps of the final solve's Newton refinement
                                    d_refine_steps=drob.get("refine_exchanges", 0) +
                                    drob.get("refine_reductions", 0))
-                        row["d_msg_steps"] = (message_steps(drob["total_rounds"], drob) +
-                                              drob.get("gnc_refine_steps", 0))
+                        row["d_msg_steps"] = message_steps(drob["total_rounds"], drob)
+                        row["d_gnc_exchange_steps"] = drob.get("gnc_exchange_steps", "")
                         if args.explain and kind == "group" and labels:
                             why = explain(path, read_tum(drob_tum, d), optimum, labels, drob["rejected"],
                                           drob["inlier_threshold_squared"])

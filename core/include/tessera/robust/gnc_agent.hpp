@@ -180,6 +180,11 @@ class GncAgent : public AgentProcess {
   /// solves: GNC's weighted solves and the inlier passes solved to the tolerance where they hand
   /// over under `--refine auto` (gnc_solve_setup).
   int gnc_refine_steps() const { return gnc_refine_steps_; }
+  /// Message steps of GNC's own exchanges (the Step values other than kSolve: poses, votes,
+  /// weights, rejected sets, re-check verdicts, start votes, gathers), each a wait for peers like
+  /// a round: one per exchange, two per gather at agent 0 (the values in, agent 0's answer
+  /// out). The same on every agent (all run the same exchanges).
+  int exchange_steps() const { return exchange_steps_; }
   /// The own block at the start of the last inlier pass (what the caller of an agent without
   /// the final solve starts that pass from to get its full record).
   const Eigen::MatrixXd& last_pass_start() const { return last_pass_start_; }
@@ -283,7 +288,7 @@ class GncAgent : public AgentProcess {
   std::vector<std::uint64_t> rejected_;
   std::vector<Measurement> kept_;
   std::vector<std::uint64_t> kept_index_;
-  int gnc_rounds_ = 0, final_rounds_ = 0, gnc_refine_steps_ = 0;
+  int gnc_rounds_ = 0, final_rounds_ = 0, gnc_refine_steps_ = 0, exchange_steps_ = 0;
   bool done_ = false;
   std::function<void(int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
       weight_observer_;

@@ -96,9 +96,16 @@ struct GncDistributedResult {
   int outer_iterations = 0;
   int total_rounds = 0;  ///< Rounds of every solve, final included.
   /// Message steps of the Newton refinements of the solves before the final one (the final
-  /// solve's are in final_solve.refines): a round is two message steps, so the run's message
-  /// steps are 2 x total_rounds + this + the final refinement's.
+  /// solve's are in final_refine_message_steps); a round is two message steps (the run's total:
+  /// exchange_steps).
   int refine_message_steps = 0;
+  /// Message steps of GNC's own exchanges (GncAgent::exchange_steps()): poses, votes, weights,
+  /// rejected sets, verdicts, gathers. The run's message steps in all are
+  /// 2 x total_rounds + refine_message_steps + final_refine_message_steps + this.
+  int exchange_steps = 0;
+  /// Message steps of the final solve's Newton refinement (0 when no final solve runs: the
+  /// last inlier pass is then the answer and its refinement is in refine_message_steps).
+  int final_refine_message_steps = 0;
   std::uint64_t total_bytes = 0;  ///< Bytes of every solve plus the outer steps' votes.
   /// Measurements GNC had rejected whose residual at the inlier set's solution was within the
   /// bound (r^2 <= c^2), taken back before the final solve.
