@@ -28,11 +28,13 @@ closures (a+k, b+k) all measuring one wrong rigid motion of the clean optimum), 
 generator only makes synthetic graphs.
 """
 import argparse
+import atexit
 import csv
 import json
 import math
 import os
 import random
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -42,6 +44,17 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
 sys.path.insert(0, HERE)
 import bench_common  # noqa: E402
+
+
+def work_dir(args, prefix):
+    """A temporary folder for the generated files and summaries, removed when the script ends
+    unless --keep-work (then its path is printed, to read the runs' files)."""
+    path = tempfile.mkdtemp(prefix=prefix)
+    if args.keep_work:
+        progress(f"work files kept in {path}")
+    else:
+        atexit.register(shutil.rmtree, path, ignore_errors=True)
+    return path
 
 GROUP = 10
 ALL_GRAPHS = ["grid3d", "intel", "CSAIL", "manhattan3500", "sphere2500", "torus3D", "city10000"]
@@ -586,7 +599,7 @@ def clean_all(args, out_csv):
     if not (args.append and os.path.exists(out_csv)):
         with open(out_csv, "w", newline="") as f:
             csv.writer(f).writerow(fields)
-    work = tempfile.mkdtemp(prefix="tessera-robust-clean-")
+    work = work_dir(args, "tessera-robust-clean-")
     engines = (["in process"] if not args.dds_only else []) + (["dds"] if args.dds or args.dds_only else [])
     for name in names:
         graph = os.path.join(args.shared, "datasets", name + ".g2o")
@@ -655,6 +668,8 @@ def main():
     ap.add_argument("--grid-poses", type=int, default=1000)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--timeout", type=float, default=1800, help="seconds per solve")
+    ap.add_argument("--keep-work", action="store_true",
+                    help="keep the temporary folder of generated graphs and summaries (removed by default)")
     ap.add_argument("--no-distributed", dest="distributed", action="store_false",
                     help="skip the distributed (irbcd, 5 agents) column")
     ap.add_argument("--csv", default="robust.csv", help="file name in --out-dir (rows are appended per cell)")
@@ -721,7 +736,7 @@ def main():
             csv.writer(f).writerow(fields)
     scheme = args.scheme + (f"+cluster{args.cluster_probes}" if args.cluster_probes else "")
     cluster_flags = ["--gnc-cluster-probes", str(args.cluster_probes)] if args.cluster_probes else []
-    work = tempfile.mkdtemp(prefix="tessera-robust-")
+    work = work_dir(args, "tessera-robust-")
     for name in args.graphs.split(","):
         clean = clean_graph(args, work, name)
         progress(f"{name}: clean solve")
