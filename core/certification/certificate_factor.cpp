@@ -3,9 +3,9 @@
 #include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <stdexcept>
-#include <vector>
 
 #include "solvers/cholmod_checked.hpp"
+#include "solvers/cholmod_dense_view.hpp"
 #include "solvers/pose_level_analysis.hpp"
 
 namespace tessera {
@@ -26,19 +26,8 @@ CertificateFactor::CertificateFactor(const SparseMatrix& S, int width) : n_(S.ro
   cholmod_start(&c_);
   c_.print = 0;     // a matrix that is not positive definite is an expected answer
   c_.final_ll = 1;  // LL^T: LDL^T exists for indefinite matrices and would pass every test
-  c_.nmethods = 1;
-  c_.method[0].ordering = CHOLMOD_GIVEN;
-  c_.postorder = 1;
-  const Eigen::Index m = width > 0 ? n_ / width : 0;
-  const PoseLevelAnalysis a = analyse_pose_level_pattern(pose_level_pattern(S, width), true);
-  std::vector<int> perm;
-  if (a.ok && a.order.size() == static_cast<std::size_t>(m) && m * width == n_)
-    perm = coordinate_order(a.order, width);
-  else
-    c_.method[0].ordering = CHOLMOD_AMD;
   const SparseMatrix A = with_diagonal(S, Eigen::VectorXd::Ones(n_));
-  cholmod_sparse view = Eigen::viewAsCholmod(A.selfadjointView<Eigen::Lower>());
-  L_ = cholmod_analyze_p(&view, perm.empty() ? nullptr : perm.data(), nullptr, 0, &c_);
+  L_ = analyse_pose_ordered(A, width, c_);
   if (!L_) {
     const int status = c_.status;
     cholmod_finish(&c_);
@@ -65,15 +54,7 @@ bool CertificateFactor::factor(const SparseMatrix& S, const Eigen::VectorXd& D) 
 }
 
 void CertificateFactor::solve(const double* x, double* y) const {
-  cholmod_dense b;
-  b.nrow = static_cast<std::size_t>(n_);
-  b.ncol = 1;
-  b.nzmax = b.nrow;
-  b.d = b.nrow;
-  b.x = const_cast<double*>(x);
-  b.z = nullptr;
-  b.xtype = CHOLMOD_REAL;
-  b.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense b = cholmod_dense_view(x, n_);
   if (!cholmod_solve2(CHOLMOD_A, L_, &b, nullptr, &x_, nullptr, &y_, &e_, &c_))
     throw std::runtime_error("certificate: CHOLMOD's solve failed");
   std::copy_n(static_cast<const double*>(x_->x), n_, y);

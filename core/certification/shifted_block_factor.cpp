@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "solvers/cholmod_checked.hpp"
+#include "solvers/cholmod_dense_view.hpp"
 #include "solvers/pose_level_analysis.hpp"
 #include "util/serial_blas.hpp"
 
@@ -15,20 +16,8 @@ ShiftedBlockFactor::ShiftedBlockFactor(const SparseMatrix& S, int width) {
   c_.print = 0;  // a matrix that is not positive definite is an expected answer (a larger shift)
   c_.supernodal = CHOLMOD_SUPERNODAL;
   c_.final_ll = 1;
-  c_.nmethods = 1;
-  c_.method[0].ordering = CHOLMOD_GIVEN;
-  c_.postorder = 1;
   const Eigen::Index n = S.rows();
-  const Eigen::Index m = width > 0 ? n / width : 0;
-  // Pose-level pattern and its AMD ordering, expanded to the coordinates.
-  const PoseLevelAnalysis a = analyse_pose_level_pattern(pose_level_pattern(S, width), true);
-  std::vector<int> perm;
-  if (a.ok && a.order.size() == static_cast<std::size_t>(m))
-    perm = coordinate_order(a.order, width);
-  else
-    c_.method[0].ordering = CHOLMOD_AMD;
-  cholmod_sparse view = Eigen::viewAsCholmod(S.selfadjointView<Eigen::Lower>());
-  L_ = cholmod_analyze_p(&view, perm.empty() ? nullptr : perm.data(), nullptr, 0, &c_);
+  L_ = analyse_pose_ordered(S, width, c_);
   if (!L_) {
     const int status = c_.status;
     cholmod_finish(&c_);
@@ -66,15 +55,8 @@ bool ShiftedBlockFactor::factor(const SparseMatrix& S, double shift) {
 
 Eigen::MatrixXd ShiftedBlockFactor::solve(const Eigen::MatrixXd& r) {
   Eigen::MatrixXd out(r.rows(), r.cols());
-  cholmod_dense b;
-  b.nrow = static_cast<std::size_t>(r.cols());
-  b.ncol = 1;
-  b.nzmax = b.nrow;
-  b.d = b.nrow;
-  b.x = const_cast<double*>(r.data());  // one row: its entries are contiguous
-  b.z = nullptr;
-  b.xtype = CHOLMOD_REAL;
-  b.dtype = CHOLMOD_DOUBLE;
+  // One row: its entries are contiguous.
+  cholmod_dense b = cholmod_dense_view(r.data(), r.cols());
   if (r.rows() != 1 || !cholmod_solve2(CHOLMOD_A, L_, &b, nullptr, &x_, nullptr, &y_, &e_, &c_))
     throw std::runtime_error("certificate (block preconditioner): solve failed");
   std::copy_n(static_cast<const double*>(x_->x), r.cols(), out.data());

@@ -57,4 +57,20 @@ std::vector<int> coordinate_order(const std::vector<int>& pose_order, int width)
   return order;
 }
 
+cholmod_factor* analyse_pose_ordered(const SparseMatrix& A, int width, cholmod_common& c) {
+  c.nmethods = 1;
+  c.method[0].ordering = CHOLMOD_GIVEN;
+  c.postorder = 1;
+  const Eigen::Index n = A.rows();
+  const Eigen::Index m = width > 0 ? n / width : 0;
+  const PoseLevelAnalysis a = analyse_pose_level_pattern(pose_level_pattern(A, width), true);
+  std::vector<int> perm;
+  if (a.ok && a.order.size() == static_cast<std::size_t>(m) && m * width == n)
+    perm = coordinate_order(a.order, width);
+  else
+    c.method[0].ordering = CHOLMOD_AMD;
+  cholmod_sparse view = Eigen::viewAsCholmod(A.selfadjointView<Eigen::Lower>());
+  return cholmod_analyze_p(&view, perm.empty() ? nullptr : perm.data(), nullptr, 0, &c);
+}
+
 }  // namespace tessera

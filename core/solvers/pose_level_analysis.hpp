@@ -4,6 +4,8 @@
 // tangent preconditioner and the centralized solver's choice of preconditioner estimate a
 // tangent factor's size (each pose's block dense) without assembling it.
 
+#include <cholmod.h>
+
 #include <tessera/problem/data_matrix.hpp>
 #include <vector>
 
@@ -28,5 +30,13 @@ SparseMatrix pose_level_pattern(const SparseMatrix& M, int width);
 /// A pose ordering (`pose_order[k]`: the pose placed k-th) expanded to the coordinates, each
 /// pose's `width` coordinates kept together and in order.
 std::vector<int> coordinate_order(const std::vector<int>& pose_order, int width);
+
+/// CHOLMOD's symbolic analysis of `A` (square, `width` consecutive coordinates a pose; its
+/// lower triangle is read, the diagonal must be in the pattern) ordered at the pose level:
+/// AMD on pose_level_pattern(A), each pose's coordinates kept together, which costs (width)^2
+/// times less than AMD on the coordinates; CHOLMOD's own AMD where that analysis fails or the
+/// size is not a multiple of `width`. Sets `c`'s ordering fields. Null when CHOLMOD's analysis
+/// fails (c.status says why): the caller names the failure.
+cholmod_factor* analyse_pose_ordered(const SparseMatrix& A, int width, cholmod_common& c);
 
 }  // namespace tessera
