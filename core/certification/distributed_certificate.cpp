@@ -1,5 +1,4 @@
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
@@ -537,19 +536,8 @@ void CertificateProtocol::after_reduce(const MessageGate::Inbox& inbox,
     if (B(i, i) > 1e-300) D(i) = 1.0 / std::sqrt(B(i, i));
   const Eigen::MatrixXd Bs = D.asDiagonal() * B * D.asDiagonal();
   const Eigen::MatrixXd As = D.asDiagonal() * A * D.asDiagonal();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eb(Bs);
-  const double top = eb.eigenvalues().maxCoeff();
-  std::vector<int> keep;
-  for (int i = 0; i < k; ++i)
-    if (eb.eigenvalues()(i) > 1e-10 * top) keep.push_back(i);
-  Eigen::MatrixXd Z(k, static_cast<Eigen::Index>(keep.size()));
-  for (std::size_t c = 0; c < keep.size(); ++c)
-    Z.col(static_cast<Eigen::Index>(c)) =
-        eb.eigenvectors().col(keep[c]) / std::sqrt(eb.eigenvalues()(keep[c]));
-  Eigen::MatrixXd C = Z.transpose() * As * Z;
-  C = (0.5 * (C + C.transpose())).eval();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ec(C);
-  const Eigen::VectorXd c = D.asDiagonal() * (Z * ec.eigenvectors().col(0));
+  const PencilPair ritz = smallest_pencil_pair(As, Bs);
+  const Eigen::VectorXd c = D.asDiagonal() * ritz.vector;
   const double cp = has_p_ ? c(2) : 0.0;
   Eigen::MatrixXd p_new = c(1) * w_, Sp_new = c(1) * Sw_;
   if (has_p_) {
@@ -561,7 +549,7 @@ void CertificateProtocol::after_reduce(const MessageGate::Inbox& inbox,
   p_ = std::move(p_new);
   Sp_ = std::move(Sp_new);
   has_p_ = true;
-  theta_ = ec.eigenvalues()(0);
+  theta_ = ritz.value;
   ++iteration_;
   begin_iteration(out);
 }

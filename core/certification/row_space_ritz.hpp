@@ -14,6 +14,15 @@ struct RowSpaceRitz {
   double residual = 0.0;         ///< ||c^T Y S - theta c^T Y||.
 };
 
+/// The smallest eigenpair of the pencil (a, b), b symmetric positive semidefinite: a x = theta b x
+/// on the span of b's eigenvectors whose eigenvalue is above 1e-10 of its largest, x with
+/// x^T b x = 1. The Rayleigh-Ritz step of row_space_ritz and of the distributed LOBPCG.
+struct PencilPair {
+  Eigen::VectorXd vector;
+  double value = 0.0;
+};
+PencilPair smallest_pencil_pair(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
+
 /// Rayleigh-Ritz on the rows of Y (directions with Y Y^T eigenvalue below 1e-10 of its largest
 /// dropped). `yy` = Y Y^T, `ysy` = Y S Y^T, `ss` = (Y S)(Y S)^T.
 RowSpaceRitz row_space_ritz(const Eigen::MatrixXd& yy, const Eigen::MatrixXd& ysy,
