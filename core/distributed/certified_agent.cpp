@@ -20,14 +20,8 @@ void StaircaseOptions::validate() const {
 CertifiedAgent::CertifiedAgent(AgentState& state, const BlockLayout& layout,
                                const DistributedOptions& options)
     : state_(state), layout_(layout), options_(options) {
-  const NewtonRefineOptions& r = options_.refine;
   // The layout is the same on every agent, so is this decision (as the refinement's own).
-  if (r.enabled && r.when == NewtonRefineOptions::When::kIfRoundsSlow &&
-      r.auto_interface_grad_tol > 0 && r.interface_max_coordinates > 0 &&
-      r.coarse == NewtonRefineOptions::Coarse::kNone && layout_.num_blocks > 1) {
-    const Eigen::Index size = interface_tangent_coordinates(layout_, state_.problem().dim());
-    interface_fits_ = size > 0 && size <= r.interface_max_coordinates;
-  }
+  interface_fits_ = interface_fits(options_.refine, layout_, state_.problem().dim());
 }
 
 bool CertifiedAgent::hands_over_early() const {

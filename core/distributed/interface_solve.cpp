@@ -30,6 +30,15 @@ Eigen::Index interface_tangent_coordinates(const BlockLayout& layout, int dim) {
   return poses * dim * (dim + 1) / 2;
 }
 
+bool interface_fits(const NewtonRefineOptions& r, const BlockLayout& layout, int dim) {
+  if (!r.enabled || r.when != NewtonRefineOptions::When::kIfRoundsSlow ||
+      !(r.auto_interface_grad_tol > 0) || r.interface_max_coordinates <= 0 ||
+      r.coarse != NewtonRefineOptions::Coarse::kNone || layout.num_blocks <= 1)
+    return false;
+  const Eigen::Index size = interface_tangent_coordinates(layout, dim);
+  return size > 0 && size <= r.interface_max_coordinates;
+}
+
 struct InterfaceSolve::Impl {
   int d = 0, w = 0, p = 0;
   Eigen::Index m = 0, mI = 0, mG = 0;  // poses: all, interior, interface

@@ -40,6 +40,7 @@
 #include <cstddef>
 #include <memory>
 #include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/newton_refine.hpp>
 #include <tessera/problem/block_problem.hpp>
 #include <vector>
 
@@ -48,6 +49,12 @@ namespace tessera {
 /// Tangent coordinates of the team's interface at rank `dim` (d(d+1)/2 a pose with a cut
 /// measurement): the size of Sigma, known from the layout alone, so every agent computes the same.
 Eigen::Index interface_tangent_coordinates(const BlockLayout& layout, int dim);
+
+/// Whether `r` (enabled, `--refine auto`, interface solves on, no coarse space) hands the rounds
+/// over to the refinement early on `layout`: the team's interface in tangent coordinates fits
+/// r.interface_max_coordinates. From the layout alone, so every agent decides the same
+/// (CertifiedAgent's early hand-over, GNC's Newton steps).
+bool interface_fits(const NewtonRefineOptions& r, const BlockLayout& layout, int dim);
 
 class InterfaceSolve {
  public:

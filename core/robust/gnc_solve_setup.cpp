@@ -68,15 +68,6 @@ bool gnc_refines(const GncDistributedOptions& options, const BlockLayout& layout
                         d);
 }
 
-bool interface_fits(const NewtonRefineOptions& r, const BlockLayout& layout, int d) {
-  if (!r.enabled || r.when != NewtonRefineOptions::When::kIfRoundsSlow ||
-      !(r.auto_interface_grad_tol > 0) || r.interface_max_coordinates <= 0 ||
-      r.coarse != NewtonRefineOptions::Coarse::kNone || layout.num_blocks <= 1)
-    return false;
-  const Eigen::Index size = interface_tangent_coordinates(layout, d);
-  return size > 0 && size <= r.interface_max_coordinates;
-}
-
 std::vector<Measurement> gnc_solve_measurements(const std::vector<Measurement>& measurements,
                                                 const std::vector<double>& weights, bool weighted,
                                                 bool drop_zero) {

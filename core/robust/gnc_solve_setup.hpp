@@ -39,11 +39,6 @@ bool pass_refines(const GncDistributedOptions& options, const BlockLayout& layou
 /// same.
 bool gnc_refines(const GncDistributedOptions& options, const BlockLayout& layout, int d);
 
-/// Whether `r` (enabled, `--refine auto`, interface solves on, no coarse space) hands over early
-/// on `layout`: the team's interface in tangent coordinates fits r.interface_max_coordinates (the
-/// rule of CertifiedAgent's early hand-over).
-bool interface_fits(const NewtonRefineOptions& r, const BlockLayout& layout, int d);
-
 /// The measurements of GNC's solve: each at its weight (`weighted`; the first solve is plain).
 /// A weight of exactly 0 adds nothing: with `drop_zero` (the known inliers keep the poses
 /// connected) such a measurement leaves the solve (fewer block neighbours, fewer colours);
