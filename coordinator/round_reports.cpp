@@ -45,9 +45,7 @@ void RoundReports::on_report(const agent::AgentReport& report) {
       [this](const auto& r) {
         using R = std::decay_t<decltype(r)>;
         if constexpr (std::is_same_v<R, agent::SetupTimesReport>) {
-          results_.agent_init_s = r.initialization_s;
-          results_.agent_handoff_s = r.handoff_s;
-          results_.init_early = r.initialization_early;
+          results_.setup = r;
         } else if constexpr (std::is_same_v<R, agent::StageProgressReport>) {
           lines_.on_stage(static_cast<std::uint32_t>(r.stage), r.iteration, r.value);
         } else if constexpr (std::is_same_v<R, agent::CertificateReport>) {
@@ -57,16 +55,10 @@ void RoundReports::on_report(const agent::AgentReport& report) {
         } else if constexpr (std::is_same_v<R, agent::RobustRunReport>) {
           results_.robust = r;
         } else if constexpr (std::is_same_v<R, agent::PhaseTimesReport>) {
-          results_.agent_solve_s = r.solve_s;
-          results_.agent_rounding_s = r.rounding_s;
-          results_.rounding_cg_iterations = r.rounding_cg_iterations;
-          results_.rounding_interface_poses = r.rounding_interface_poses;
-          results_.rounding_message_steps = r.rounding_message_steps;
+          results_.phase_times = r;
         } else {
           static_assert(std::is_same_v<R, agent::FinalReport>);
-          results_.final_cost = r.cost;
-          results_.final_grad_norm = r.grad_norm;
-          results_.final_restarts = r.restarts;
+          results_.final_report = r;
           results_.have_final_report = true;
         }
       },

@@ -28,25 +28,16 @@ inline bool is_round_status(const wire::RoundStatus& m) {
 
 /// Everything reported so far (for the summary).
 struct ReportedResults {
-  // From agent 0's final report.
-  double final_cost = 0, final_grad_norm = 0;
-  std::uint32_t final_restarts = 0;
-  bool have_final_report = false;
+  // Agent 0's reports as they came (runtime/agent_report.hpp); none before its report came.
+  std::optional<agent::SetupTimesReport> setup;
   std::optional<agent::CertificateReport> certificate;
   std::optional<agent::CertificateTrafficReport> certificate_bytes;
   std::optional<agent::RobustRunReport> robust;
-  // Agent 0's own clock: its time in core's protocol (rounds, certificate, escapes) and in the
-  // distributed rounding, seconds.
-  std::optional<double> agent_solve_s, agent_rounding_s;
-  // The rounding's translation CG iterations (each one all-agent sum), with those times.
-  std::optional<std::uint32_t> rounding_cg_iterations;
-  // The rounding's exact interface solve: the team's interface poses (0 = the CG ran), and
-  // the rounding's message steps (each one a wait for peers).
-  std::optional<std::uint32_t> rounding_interface_poses, rounding_message_steps;
-  // Agent 0's set-up (its clock, seconds): the initialisation stage and the hand-off, and
-  // whether its chordal start was solved while the run started.
-  std::optional<double> agent_init_s, agent_handoff_s;
-  std::optional<bool> init_early;
+  std::optional<agent::PhaseTimesReport> phase_times;
+  /// The last final report; `have_final_report` says whether it is the current run's (false
+  /// before it came and again after a re-partition, until the survivors' run sends its own).
+  agent::FinalReport final_report;
+  bool have_final_report = false;
   // Round timing from the status completions: excludes the fixed costs (hand-off,
   // initialisation, rounding, shutdown) that the solve time holds. From digests: the first is
   // when agent 0's first completion reached the coordinator, the last that plus agent 0's own

@@ -10,6 +10,20 @@
 #include "runtime/peak_memory.hpp"
 
 namespace tessera::coordinator {
+namespace {
+
+// A field of one of agent 0's reports, or null when the report did not come.
+template <class Report, class T>
+std::optional<double> field(const std::optional<Report>& report, T Report::*member) {
+  return report ? std::optional<double>((*report).*member) : std::nullopt;
+}
+
+// Seconds as milliseconds; null stays null.
+std::optional<double> ms(std::optional<double> s) {
+  return s ? std::optional<double>(1000 * *s) : std::nullopt;
+}
+
+}  // namespace
 
 std::string run_summary_json(const RunSummaryInputs& in) {
   const CoordinatorOptions& o = in.options;
@@ -31,19 +45,19 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("d", in.structure.d)
       .add("rank", static_cast<long long>(o.rank ? o.rank : 5))
       .add("iterations", static_cast<long long>(in.merged.rounds))
-      .add("grad_norm", final_value(r.final_grad_norm))
-      .add("cost", final_value(r.final_cost))
+      .add("grad_norm", final_value(r.final_report.grad_norm))
+      .add("cost", final_value(r.final_report.cost))
       // The final cost's relative gap to the optimum given by --reference-cost.
       .add("reference_cost",
            o.reference_cost > 0 ? std::optional<double>(o.reference_cost) : std::nullopt)
       .add("rel_gap_to_reference",
            o.reference_cost > 0 && r.have_final_report
-               ? std::optional<double>((r.final_cost - o.reference_cost) / o.reference_cost)
+               ? std::optional<double>((r.final_report.cost - o.reference_cost) / o.reference_cost)
                : std::nullopt)
       .add("certified",
            r.certificate ? std::optional<bool>(r.certificate->certified) : std::nullopt)
       .add("wall_s", in.total_ms / 1000.0)
-      .add("restarts", static_cast<long long>(r.final_restarts))
+      .add("restarts", static_cast<long long>(r.final_report.restarts))
       .add("bytes_exchanged", static_cast<long long>(total_bytes))
       .add("rollbacks", static_cast<long long>(L.rollbacks))
       .add("run_id", o.net.session.run_id)
@@ -67,26 +81,21 @@ std::string run_summary_json(const RunSummaryInputs& in) {
                                : std::nullopt)
       .add("total_ms", in.total_ms)
       // Agent 0's clock: core's protocol (rounds + certificate + escapes) and the rounding.
-      .add("agent_solve_ms",
-           r.agent_solve_s ? std::optional<double>(1000 * *r.agent_solve_s) : std::nullopt)
-      .add("rounding_ms",
-           r.agent_rounding_s ? std::optional<double>(1000 * *r.agent_rounding_s) : std::nullopt)
-      .add("rounding_cg_iterations", r.rounding_cg_iterations
-                                         ? std::optional<double>(*r.rounding_cg_iterations)
-                                         : std::nullopt)
+      .add("agent_solve_ms", ms(field(r.phase_times, &agent::PhaseTimesReport::solve_s)))
+      .add("rounding_ms", ms(field(r.phase_times, &agent::PhaseTimesReport::rounding_s)))
+      .add("rounding_cg_iterations",
+           field(r.phase_times, &agent::PhaseTimesReport::rounding_cg_iterations))
       // The rounding's exact interface solve's poses (0: the CG solved the translations;
       // rounding_translations below says which) and its message steps.
-      .add("rounding_interface_poses", r.rounding_interface_poses
-                                           ? std::optional<double>(*r.rounding_interface_poses)
-                                           : std::nullopt)
-      .add("rounding_message_steps", r.rounding_message_steps
-                                         ? std::optional<double>(*r.rounding_message_steps)
-                                         : std::nullopt)
+      .add("rounding_interface_poses",
+           field(r.phase_times, &agent::PhaseTimesReport::rounding_interface_poses))
+      .add("rounding_message_steps",
+           field(r.phase_times, &agent::PhaseTimesReport::rounding_message_steps))
       // Agent 0's set-up: its initialisation stage and hand-off (runtime/early_chordal.hpp).
-      .add("init_ms", r.agent_init_s ? std::optional<double>(1000 * *r.agent_init_s) : std::nullopt)
-      .add("handoff_ms",
-           r.agent_handoff_s ? std::optional<double>(1000 * *r.agent_handoff_s) : std::nullopt)
-      .add("init_early", r.init_early)
+      .add("init_ms", ms(field(r.setup, &agent::SetupTimesReport::initialization_s)))
+      .add("handoff_ms", ms(field(r.setup, &agent::SetupTimesReport::handoff_s)))
+      .add("init_early",
+           r.setup ? std::optional<bool>(r.setup->initialization_early) : std::nullopt)
       .add("bytes_sent", std::vector<std::size_t>(in.merged.bytes.begin(), in.merged.bytes.end()))
       .add("hosts", in.structure.hosts);
   // Peak resident sets (MB): each agent's as it sent its final estimate, the coordinator's now,
@@ -101,8 +110,9 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     run_mb += agent_mb.back();
   }
   const double coordinator_mb = static_cast<double>(agent::peak_resident_bytes()) / mb;
-  if (r.rounding_interface_poses)
-    j.add("rounding_translations", *r.rounding_interface_poses > 0 ? "interface" : "cg");
+  if (r.phase_times)
+    j.add("rounding_translations",
+          r.phase_times->rounding_interface_poses > 0 ? "interface" : "cg");
   else
     j.add_null("rounding_translations");
   j.add("peak_rss_mb_per_agent", agent_mb)
@@ -132,7 +142,7 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     j.add("min_eigenvalue", r.certificate->min_eigenvalue)
         .add("certificate_rounds", static_cast<long long>(r.certificate->rounds))
         .add("final_rank", static_cast<long long>(r.certificate->final_rank));
-    add_certificate_bound(j, r.certificate->bound, r.final_cost);
+    add_certificate_bound(j, r.certificate->bound, r.final_report.cost);
     if (r.certificate_bytes)
       j.add("certificate_bytes", static_cast<long long>(r.certificate_bytes->certificate_bytes))
           .add("escape_bytes", static_cast<long long>(r.certificate_bytes->escape_bytes))

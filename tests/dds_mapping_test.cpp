@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tessera/distributed/in_process_driver.hpp>
 #include <tessera/util/input_error.hpp>
 #include <thread>
 #include <variant>
@@ -544,6 +545,28 @@ TEST(DdsReportMapping, UnknownStagesAndCertificateMethodsAreRefused) {
   wire::AgentReport c = to_wire_report(agent::CertificateReport{}, "run", 0, 0);
   c.body().certificate().method(3);
   EXPECT_THROW(from_wire(c), TransportError);
+}
+
+// The in-process estimate (message_bytes) counts a status's content; the DDS sample adds a
+// fixed share of its own (run id, routing, epoch, relay fields, sequence lengths, padding), so
+// more content grows both by the same bytes. Arrays start non-empty: CDR aligns a non-empty
+// sequence of doubles, so the first element can bring padding.
+TEST(DdsMapping, AStatusSampleGrowsByTheInProcessEstimatesGrowth) {
+  RoundStatusMessage small;
+  small.near_bound = 3;
+  small.coarse = {1.0};
+  small.measurement_ids = {4};
+  small.weights = {0.5};
+  RoundStatusMessage large = small;
+  large.coarse.push_back(2.0);
+  large.measurement_ids.insert(large.measurement_ids.end(), {8, 9});
+  large.weights.insert(large.weights.end(), {1.0, 0.0});
+  const auto sample_bytes = [](const RoundStatusMessage& m) {
+    return serialized_size(to_wire_status(m, "run", true, {}));
+  };
+  EXPECT_EQ(message_bytes(large) - message_bytes(small), 5u * 8);
+  EXPECT_EQ(sample_bytes(large) - sample_bytes(small), message_bytes(large) - message_bytes(small));
+  EXPECT_GT(sample_bytes(small), message_bytes(small));
 }
 
 }  // namespace

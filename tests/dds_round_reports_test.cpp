@@ -81,15 +81,14 @@ namespace {
 TEST(RoundReports, AgentZerosPhaseTimesAreKeptForTheSummary) {
   std::ostringstream out;
   RoundReports r(false, out);
-  EXPECT_FALSE(r.results().agent_solve_s.has_value());
-  EXPECT_FALSE(r.results().rounding_interface_poses.has_value());
+  EXPECT_FALSE(r.results().phase_times.has_value());
   r.on_report(agent::PhaseTimesReport{0.25, 0.125, 12, 34, 5});
-  ASSERT_TRUE(r.results().agent_solve_s.has_value());
-  EXPECT_EQ(*r.results().agent_solve_s, 0.25);
-  EXPECT_EQ(*r.results().agent_rounding_s, 0.125);
-  EXPECT_EQ(*r.results().rounding_cg_iterations, 12u);
-  EXPECT_EQ(*r.results().rounding_interface_poses, 34u);
-  EXPECT_EQ(*r.results().rounding_message_steps, 5u);
+  ASSERT_TRUE(r.results().phase_times.has_value());
+  EXPECT_EQ(r.results().phase_times->solve_s, 0.25);
+  EXPECT_EQ(r.results().phase_times->rounding_s, 0.125);
+  EXPECT_EQ(r.results().phase_times->rounding_cg_iterations, 12u);
+  EXPECT_EQ(r.results().phase_times->rounding_interface_poses, 34u);
+  EXPECT_EQ(r.results().phase_times->rounding_message_steps, 5u);
   EXPECT_FALSE(r.results().have_final_report);
 }
 
@@ -98,14 +97,14 @@ TEST(RoundReports, AgentZerosPhaseTimesAreKeptForTheSummary) {
 TEST(RoundReports, AgentZerosSetUpTimesAreKeptForTheSummary) {
   std::ostringstream out;
   RoundReports r(false, out);
-  EXPECT_FALSE(r.results().init_early.has_value());
+  EXPECT_FALSE(r.results().setup.has_value());
   r.on_report(agent::SetupTimesReport{0.0625, 0.03125, true});
-  ASSERT_TRUE(r.results().agent_init_s.has_value());
-  EXPECT_EQ(*r.results().agent_init_s, 0.0625);
-  EXPECT_EQ(*r.results().agent_handoff_s, 0.03125);
-  EXPECT_TRUE(*r.results().init_early);
+  ASSERT_TRUE(r.results().setup.has_value());
+  EXPECT_EQ(r.results().setup->initialization_s, 0.0625);
+  EXPECT_EQ(r.results().setup->handoff_s, 0.03125);
+  EXPECT_TRUE(r.results().setup->initialization_early);
   r.on_report(agent::SetupTimesReport{0.0625, 0.03125, false});
-  EXPECT_FALSE(*r.results().init_early);
+  EXPECT_FALSE(r.results().setup->initialization_early);
 }
 
 // The final report ends the wait for reports; the certificate, its traffic and a robust run's
@@ -130,9 +129,9 @@ TEST(RoundReports, TheFinalReportAndTheCertificateAreKeptAsTheyCame) {
   r.on_report(agent::FinalReport{1025.5, 3e-9, 2});
   const ReportedResults& res = r.results();
   EXPECT_TRUE(res.have_final_report);
-  EXPECT_EQ(res.final_cost, 1025.5);
-  EXPECT_EQ(res.final_grad_norm, 3e-9);
-  EXPECT_EQ(res.final_restarts, 2u);
+  EXPECT_EQ(res.final_report.cost, 1025.5);
+  EXPECT_EQ(res.final_report.grad_norm, 3e-9);
+  EXPECT_EQ(res.final_report.restarts, 2u);
   ASSERT_TRUE(res.certificate.has_value());
   EXPECT_TRUE(res.certificate->certified);
   EXPECT_EQ(res.certificate->bound.method, CertificateMethod::kExact);

@@ -1,5 +1,6 @@
 #include <deque>
 #include <tessera/distributed/distributed_initialization.hpp>
+#include <tessera/graph/connectivity.hpp>
 #include <tessera/solvers/chordal_initialization.hpp>
 #include <tessera/util/input_error.hpp>
 
@@ -28,12 +29,6 @@ Pose inverse(const Pose& a) {
   return {a.R.transpose(), -(a.R.transpose() * a.t)};
 }
 
-// Union-find over a robot's poses, joining only measurements inside the robot.
-std::size_t find(std::vector<std::size_t>& parent, std::size_t x) {
-  while (parent[x] != x) x = parent[x] = parent[parent[x]];
-  return x;
-}
-
 }  // namespace
 
 Pose place_in_frame(const Pose& frame, const Pose& local) {
@@ -46,20 +41,15 @@ RobotUnits robot_units(int d, std::size_t begin, std::size_t end,
   auto inside = [&](const Measurement& m) {
     return m.i >= begin && m.i < end && m.j >= begin && m.j < end;
   };
-  std::vector<std::size_t> parent(n);
-  for (std::size_t i = 0; i < n; ++i) parent[i] = i;
+  std::vector<std::pair<std::size_t, std::size_t>> joined;  // the robot's own, as local ids
   for (const auto& m : measurements)
-    if (inside(m)) parent[find(parent, m.i - begin)] = find(parent, m.j - begin);
-  // Units numbered by their smallest pose; members ascending.
-  std::vector<std::size_t> unit(n), root_unit(n, n), local(n);
+    if (inside(m)) joined.emplace_back(m.i - begin, m.j - begin);
+  // Units numbered by their smallest pose (connected_components' labels); members ascending.
+  const std::vector<std::size_t> unit = connected_components(n, joined);
+  std::vector<std::size_t> local(n);
   RobotUnits out;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t r = find(parent, i);
-    if (root_unit[r] == n) {
-      root_unit[r] = out.members.size();
-      out.members.emplace_back();
-    }
-    unit[i] = root_unit[r];
+    if (unit[i] == out.members.size()) out.members.emplace_back();
     local[i] = out.members[unit[i]].size();
     out.members[unit[i]].push_back(begin + i);
   }

@@ -11,13 +11,29 @@
 
 namespace tessera {
 
+namespace {
+
+template <class T>
+std::size_t array_bytes(const std::vector<T>& values) {
+  return values.size() * sizeof(T);
+}
+
+}  // namespace
+
+// Every field by name: the bindings compile only while they name all of the message's fields,
+// so a field added to a message must be counted here too.
 std::size_t message_bytes(const ProtocolMessage& message) {
-  if (const auto* p = std::get_if<PoseBlockMessage>(&message))
-    return 5 * sizeof(std::uint32_t) + 1 + p->pose_ids.size() * sizeof(std::uint32_t) +
-           p->data.size() * sizeof(double);
-  const auto& s = std::get<RoundStatusMessage>(message);
-  return 3 * sizeof(std::uint32_t) + 3 * sizeof(double) + 2 + s.coarse.size() * sizeof(double) +
-         s.measurement_ids.size() * sizeof(std::uint64_t) + s.weights.size() * sizeof(double);
+  if (const auto* p = std::get_if<PoseBlockMessage>(&message)) {
+    const auto& [round, sender, phase, kind, rank, dim, pose_ids, data] = *p;
+    return sizeof(round) + sizeof(sender) + sizeof(phase) + sizeof(kind) + sizeof(rank) +
+           sizeof(dim) + array_bytes(pose_ids) + array_bytes(data);
+  }
+  const auto& [round, sender, phase, cost, grad_norm_sq, block_grad_norm, restart_vote, done_vote,
+               near_bound, coarse, measurement_ids, weights] =
+      std::get<RoundStatusMessage>(message);
+  return sizeof(round) + sizeof(sender) + sizeof(phase) + sizeof(cost) + sizeof(grad_norm_sq) +
+         sizeof(block_grad_norm) + sizeof(restart_vote) + sizeof(done_vote) + sizeof(near_bound) +
+         array_bytes(coarse) + array_bytes(measurement_ids) + array_bytes(weights);
 }
 
 namespace {

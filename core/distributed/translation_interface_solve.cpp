@@ -1,6 +1,5 @@
 #include "distributed/translation_interface_solve.hpp"
 
-#include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <stdexcept>
@@ -9,6 +8,7 @@
 
 #include "distributed/interface_poses.hpp"
 #include "distributed/schur_share.hpp"
+#include "solvers/elimination_order.hpp"
 
 namespace tessera {
 
@@ -113,13 +113,10 @@ void TranslationInterfaceSolve::set_up(const std::vector<std::size_t>& owned,
       const Eigen::Index c = interior_index[static_cast<std::size_t>(e.col())];
       if (a >= 0 && c >= 0) t.emplace_back(a, c, 1.0);
     }
-    SparseMatrix pattern(s.mI, s.mI);
-    pattern.setFromTriplets(t.begin(), t.end());
-    Eigen::AMDOrdering<int> amd;
-    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm;
-    amd(pattern, perm);
+    const std::vector<Eigen::Index> order = amd_elimination_order(s.mI, t);  // interior indices
     for (Eigen::Index k = 0; k < s.mI; ++k)
-      s.slot[static_cast<std::size_t>(interior[static_cast<std::size_t>(perm.indices()(k))])] = k;
+      s.slot[static_cast<std::size_t>(
+          interior[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])])] = k;
   }
 
   std::vector<Eigen::Triplet<double>> lower;

@@ -52,6 +52,15 @@ std::vector<std::size_t> connected_components(const std::vector<std::vector<int>
   return labels_of(parent);
 }
 
+std::vector<std::size_t> connected_components(
+    std::size_t num_vertices, const std::vector<std::pair<std::size_t, std::size_t>>& edges) {
+  std::vector<std::size_t> parent(num_vertices);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& [u, v] : edges)
+    if (u < num_vertices && v < num_vertices) join(parent, u, v);
+  return labels_of(parent);
+}
+
 std::size_t count_components(const PoseGraph& graph) {
   auto labels = connected_components(graph);
   std::size_t k = 0;

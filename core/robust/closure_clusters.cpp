@@ -1,7 +1,7 @@
 #include <algorithm>
 #include <cstdint>
-#include <numeric>
 #include <string>
+#include <tessera/graph/connectivity.hpp>
 #include <tessera/robust/closure_clusters.hpp>
 #include <tessera/util/input_error.hpp>
 
@@ -14,11 +14,6 @@ struct Span {
 
 Span span_of(const Measurement& m) {
   return {std::min<std::size_t>(m.i, m.j), std::max<std::size_t>(m.i, m.j)};
-}
-
-std::size_t root(std::vector<std::size_t>& parent, std::size_t x) {
-  while (parent[x] != x) x = parent[x] = parent[parent[x]];
-  return x;
 }
 
 std::size_t distance(std::size_t a, std::size_t b) {
@@ -68,20 +63,20 @@ std::vector<ClosureCluster> closure_clusters(const PoseGraph& graph, const std::
   std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) {
     return span_of(graph.measurements[a]).lo < span_of(graph.measurements[b]).lo;
   });
-  // Union of the pairs within the window: a sweep over the lower ends, so only closures whose
-  // lower ends are within the window are compared.
-  std::vector<std::size_t> parent(kept.size());
-  std::iota(parent.begin(), parent.end(), 0);
+  // The pairs within the window (positions in `kept`): a sweep over the lower ends, so only
+  // closures whose lower ends are within the window are compared. Clusters: their components.
+  std::vector<std::pair<std::size_t, std::size_t>> within;
   for (std::size_t a = 0; a < kept.size(); ++a) {
     const Span sa = span_of(graph.measurements[kept[a]]);
     for (std::size_t b = a + 1; b < kept.size(); ++b) {
       const Span sb = span_of(graph.measurements[kept[b]]);
       if (sb.lo > sa.lo + w) break;
-      if (distance(sa.hi, sb.hi) <= w) parent[root(parent, a)] = root(parent, b);
+      if (distance(sa.hi, sb.hi) <= w) within.emplace_back(a, b);
     }
   }
+  const std::vector<std::size_t> component = connected_components(kept.size(), within);
   std::vector<std::vector<std::size_t>> groups(kept.size());
-  for (std::size_t a = 0; a < kept.size(); ++a) groups[root(parent, a)].push_back(kept[a]);
+  for (std::size_t a = 0; a < kept.size(); ++a) groups[component[a]].push_back(kept[a]);
 
   std::vector<ClosureCluster> out;
   const std::size_t near = static_cast<std::size_t>(options.near);

@@ -39,7 +39,13 @@ struct DeliveryStats {
   double critical_path_cpu_s = 0.0;
 };
 
-/// Payload size of a message as it would travel (fixed fields + arrays), in bytes.
+/// Bytes of a message's content as it would travel: every field of the core message at its
+/// own width (a status: 4 x 4-byte ids and counts, 3 doubles, 2 one-byte votes = 42 bytes)
+/// plus its arrays' elements. Transport-independent, so an in-process run and a DDS run count
+/// the same traffic (the DDS agents' certificate_bytes / escape_bytes use it too). A DDS
+/// sample is larger: it adds the run id, routing (broadcast, recipients), the rollback epoch,
+/// its own fields (a status's bundle and riding blocks), sequence lengths and CDR padding,
+/// which the DDS runtime counts in bytes_sent (transport/message_mapping.hpp serialized_size).
 std::size_t message_bytes(const ProtocolMessage& message);
 
 /// Delivers messages until every agent is done (or no message is left, which would be a
