@@ -132,9 +132,12 @@ struct OnlineUpdate {
   int agents = 0;                 ///< Blocks (robots) during the step.
   std::size_t moved = 0;          ///< Poses that changed block (rebalance) before the rounds.
   std::size_t largest_block = 0;  ///< Largest block's poses during the rounds.
-  int rounds = 0;                 ///< Rounds until the gradient was back under tolerance.
-  double ms = 0.0;                ///< Wall time of the step (absorb, extend, rounds).
-  double cpu_s = 0.0;             ///< Process CPU time of the step.
+  /// Measurements between two blocks during the rounds (0 when the cut refinement is off,
+  /// RebalanceOptions::cut_fraction = 1).
+  std::size_t cut = 0;
+  int rounds = 0;      ///< Rounds until the gradient was back under tolerance.
+  double ms = 0.0;     ///< Wall time of the step (absorb, extend, rounds).
+  double cpu_s = 0.0;  ///< Process CPU time of the step.
   /// Of the step's wall time: the agents' set-up (block problems, preconditioner factors),
   /// and the process CPU of the rounds alone.
   double setup_s = 0.0;
