@@ -336,5 +336,14 @@ TEST(CutRefinement, RejectsAnOutOfRangeCutFractionNamingTheField) {
   EXPECT_NE(test::validation_message(o).find("RebalanceOptions.max_passes"), std::string::npos);
 }
 
+TEST(CutRefinement, ARobotThatJoinsOpensItsOwnBlockWhateverItsFirstPoseLinksTo) {
+  // Robot 1's first pose (2) has odometry from robot 0's last (1): it still opens block 1,
+  // and its next pose (3), linked to it alone, follows it there.
+  const PoseGraph g = chain(4);
+  std::vector<int> owner = {0, 0};
+  assign_new_poses(g, owner, {1, 1}, RebalanceOptions{});
+  EXPECT_EQ(owner, (std::vector<int>{0, 0, 1, 1}));
+}
+
 }  // namespace
 }  // namespace tessera

@@ -314,9 +314,23 @@ void assign_new_poses(const PoseGraph& graph, std::vector<int>& owner,
     const std::size_t hi = std::max(m.i, m.j), lo = std::min(m.i, m.j);
     if (hi >= first) earlier[hi - first].push_back(lo);
   }
+  // A block with no pose yet (a robot that just joined) takes its robot's first pose whatever
+  // its links: otherwise a robot whose first pose links to another's (odometry across robots)
+  // would leave its agent an empty block for good.
+  std::vector<std::size_t> size;
+  auto grow = [&](int b) {
+    if (static_cast<std::size_t>(b) >= size.size()) size.resize(static_cast<std::size_t>(b) + 1, 0);
+    ++size[static_cast<std::size_t>(b)];
+  };
+  for (int b : owner) grow(b);
   std::vector<std::pair<int, std::size_t>> count;
   for (std::size_t k = first; k < graph.num_poses; ++k) {
     const int own = robot_block[k - first];
+    if (static_cast<std::size_t>(own) >= size.size() || size[static_cast<std::size_t>(own)] == 0) {
+      owner.push_back(own);
+      grow(own);
+      continue;
+    }
     count.clear();
     for (std::size_t q : earlier[k - first]) {
       const int c = owner[q];
@@ -336,6 +350,7 @@ void assign_new_poses(const PoseGraph& graph, std::vector<int>& owner,
         block = c;
       }
     owner.push_back(block);
+    grow(block);
   }
 }
 

@@ -26,7 +26,11 @@ struct RebalanceOptions {
   /// beyond (1 + slack) ceil(n / N) + min_excess either.
   std::size_t min_excess = 10;
   /// Cut refinement (needs `enabled`): runs when more than `cut_fraction` of the measurements
-  /// join poses of two blocks. In [0, 1]; 1 = never.
+  /// join poses of two blocks. In [0, 1]; 1 = never. city10000 replayed by 5 robots, a step
+  /// every 0.1 s of stream: the cut ends at 395 of 20,687 measurements (110 re-partitions,
+  /// 3,661 poses moved) against 8,369 for the robots' blocks, and the steps take 32,155 CG
+  /// iterations against 103,615 (docs/online.md, "The partition follows the graph"). The cut
+  /// then hovers near the threshold; 0.03 / 0.05 end at 555 / 655 (structure-only replays).
   double cut_fraction = 0.02;
   /// Refinement passes at most (each pass moves a pose at most once and keeps its best
   /// prefix; the next pass starts from there). >= 1.
@@ -81,7 +85,8 @@ std::size_t cut_measurements(const PoseGraph& graph, const std::vector<int>& own
 /// `robot_block[k - owner.size()]` (their robot's block) unless options.place_by_links and the
 /// cut refinement are on, in which case a new pose joins the block holding most of its
 /// measurements to poses that already have one (its robot's block if that is among the most,
-/// else the lowest such block; its robot's block when it has none).
+/// else the lowest such block; its robot's block when it has none, or when that block has no
+/// pose yet: a robot that joins gets a block of its own).
 void assign_new_poses(const PoseGraph& graph, std::vector<int>& owner,
                       const std::vector<int>& robot_block, const RebalanceOptions& options);
 

@@ -41,8 +41,10 @@ struct OnlineOptions {
   /// Run the distributed certificate (with the staircase of solver.staircase) after the
   /// last batch.
   bool certify_at_end = true;
-  /// The partition follows the graph: blocks start as the robots and border poses move out of
-  /// over-full blocks (block_rebalance.hpp) after each absorbed step.
+  /// The partition follows the graph: blocks start as the robots, new poses join the block of
+  /// most of their measurements, and border poses move out of over-full blocks and, when the
+  /// cut passes rebalance.cut_fraction, to cut fewer measurements (block_rebalance.hpp) after
+  /// each absorbed step.
   RebalanceOptions rebalance;
   /// run_online only. false: one step per distinct batch stamp (deterministic). true: the
   /// stamps are a real-time clock; a step absorbs every batch published by the time the
