@@ -228,7 +228,7 @@ TEST(CutRefinement, ReducesTheCutOfBlocksThatCrossEachOther) {
       << before << " -> " << after;
 }
 
-TEST(CutRefinement, NeverPutsABlockOverTheBalanceBoundNorEmptiesOne) {
+TEST(CutRefinement, KeepsEveryBlockWithinTheBalanceBounds) {
   std::mt19937 rng(12);
   for (int trial = 0; trial < 200; ++trial) {
     CrossedBlocks c = crossed_blocks(rng);
@@ -238,11 +238,18 @@ TEST(CutRefinement, NeverPutsABlockOverTheBalanceBoundNorEmptiesOne) {
     const double full = (1.0 + o.slack) * std::ceil(static_cast<double>(c.owner.size()) /
                                                     static_cast<double>(c.blocks)) +
                         static_cast<double>(o.min_excess);
+    const double low = (1.0 - o.slack) * std::floor(static_cast<double>(c.owner.size()) /
+                                                    static_cast<double>(c.blocks));
     const std::vector<std::size_t> start = block_sizes(c.owner, c.blocks);
     rebalance_blocks(c.graph, c.owner, c.blocks, o);
     const std::vector<std::size_t> end = block_sizes(c.owner, c.blocks);
     for (std::size_t b = 0; b < end.size(); ++b) {
       EXPECT_GE(end[b], 1u) << "trial " << trial << " block " << b;
+      // Nor does one above the lower bound fall below it (the cut alone would be smallest with
+      // blocks nearly empty).
+      EXPECT_GE(static_cast<double>(end[b]),
+                std::min(std::floor(low), static_cast<double>(start[b])))
+          << "trial " << trial << " block " << b;
       // A block within the bound stays within it; one above it (the balance moves had no
       // lighter neighbour) does not grow.
       EXPECT_LE(static_cast<double>(end[b]),
@@ -266,7 +273,7 @@ TEST(CutRefinement, EachPassMovesOnlyBorderPoses) {
     o.max_passes = 1;
     for (int pass = 0; pass < 8; ++pass) {
       const std::vector<int> start = passes;
-      moved += refine_cut(c.graph, passes, c.blocks, bound, o);
+      moved += refine_cut(c.graph, passes, c.blocks, bound, 1, o);
       std::vector<char> border_or_next(c.owner.size(), 0);
       for (const Measurement& m : c.graph.measurements) {
         if (start[m.i] != start[m.j]) border_or_next[m.i] = border_or_next[m.j] = 1;
@@ -281,7 +288,7 @@ TEST(CutRefinement, EachPassMovesOnlyBorderPoses) {
     }
     std::vector<int> at_once = c.owner;
     o.max_passes = 8;
-    refine_cut(c.graph, at_once, c.blocks, bound, o);
+    refine_cut(c.graph, at_once, c.blocks, bound, 1, o);
     EXPECT_EQ(at_once, passes) << "trial " << trial;
   }
   EXPECT_GT(moved, 1000u) << "the trials move poses";

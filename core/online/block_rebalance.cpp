@@ -140,7 +140,8 @@ std::size_t balance_moves(const std::vector<std::vector<std::size_t>>& adjacent,
 
 std::size_t refine_with(const std::vector<std::vector<std::size_t>>& adjacent,
                         std::vector<int>& owner, int num_blocks, std::size_t bound,
-                        const RebalanceOptions& options) {
+                        std::size_t lower, const RebalanceOptions& options) {
+  lower = std::max<std::size_t>(lower, 1);
   const std::size_t n = owner.size();
   const std::vector<int> start = owner;
   std::vector<std::size_t> size(static_cast<std::size_t>(num_blocks), 0);
@@ -151,7 +152,7 @@ std::size_t refine_with(const std::vector<std::vector<std::size_t>>& adjacent,
   // its own block), then the lighter block, then the lower one. {gain, block}; block -1: none.
   auto best_move = [&](std::size_t v) -> std::pair<long, int> {
     const int own = owner[v];
-    if (size[static_cast<std::size_t>(own)] <= 1) return {0, -1};
+    if (size[static_cast<std::size_t>(own)] <= lower) return {0, -1};
     const long inside = static_cast<long>(into.links(v, own));
     long best_gain = 0;
     int best = -1;
@@ -241,10 +242,10 @@ std::size_t cut_measurements(const PoseGraph& graph, const std::vector<int>& own
 }
 
 std::size_t refine_cut(const PoseGraph& graph, std::vector<int>& owner, int num_blocks,
-                       std::size_t bound, const RebalanceOptions& options) {
+                       std::size_t bound, std::size_t lower, const RebalanceOptions& options) {
   options.validate();
   if (owner.size() != graph.num_poses || num_blocks <= 1) return 0;
-  return refine_with(adjacency(graph), owner, num_blocks, bound, options);
+  return refine_with(adjacency(graph), owner, num_blocks, bound, lower, options);
 }
 
 RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner, int num_blocks,
@@ -282,8 +283,13 @@ RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner
     if (static_cast<double>(cut) >
         options.cut_fraction * static_cast<double>(graph.measurements.size())) {
       res.refined = true;
-      res.cut_moved = refine_with(adjacent, owner, num_blocks,
-                                  static_cast<std::size_t>(std::floor(full)), options);
+      // Nor below (1 - slack) floor(n / N): a cut without a lower bound is smallest with one
+      // block nearly empty, its agent idle (a robot that stopped publishing lost its block).
+      const double low = (1.0 - options.slack) *
+                         std::floor(static_cast<double>(n) / static_cast<double>(num_blocks));
+      res.cut_moved =
+          refine_with(adjacent, owner, num_blocks, static_cast<std::size_t>(std::floor(full)),
+                      low > 1.0 ? static_cast<std::size_t>(std::floor(low)) : 1, options);
       if (res.cut_moved > 0) {
         cut = cut_measurements(graph, owner);
         // Poses that changed block in the call (a pose the balance moved and the refinement

@@ -6,7 +6,7 @@
 //  - cut: when the measurements between blocks pass a fraction of all measurements (robots
 //    whose trajectories cross the same places: city10000's five robot blocks cut 8,369 of its
 //    20,687 measurements), a k-way Fiduccia-Mattheyses refinement moves border poses to the
-//    block that holds more of their measurements, within the balance bound, and keeps the
+//    block that holds more of their measurements, within the balance bounds, and keeps the
 //    prefix of its moves that cut the fewest measurements (the shortest such prefix).
 // Moving only border poses refines the current partition from where it is: few poses move,
 // and a moved pose joins a block it already had a measurement into.
@@ -68,15 +68,17 @@ struct RebalanceResult {
 RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner, int num_blocks,
                                  const RebalanceOptions& options);
 
-/// The cut refinement alone (rebalance_blocks calls it): passes of single-pose moves, each the
-/// border pose whose move to a block it has a measurement into removes the most cut
-/// measurements (lowest id on ties; the target on ties: the lighter, then the lower block),
-/// into blocks below `bound` poses, never emptying a block; a pass moves a pose at most once,
+/// The cut refinement alone (rebalance_blocks calls it with `bound` = floor((1 + slack)
+/// ceil(n / N) + min_excess) and `lower` = floor((1 - slack) floor(n / N))): passes of
+/// single-pose moves, each the border pose whose move to a block it has a measurement into
+/// removes the most cut measurements (lowest id on ties; the target on ties: the lighter, then
+/// the lower block), into blocks below `bound` poses, out of blocks above `lower` poses (and
+/// never emptying a block); a pass moves a pose at most once,
 /// stops after options.pass_patience moves without a new best and is rolled back to its best
 /// prefix (the shortest on ties). Passes repeat while they cut fewer measurements, up to
 /// options.max_passes. Returns the poses whose block changed; deterministic.
 std::size_t refine_cut(const PoseGraph& graph, std::vector<int>& owner, int num_blocks,
-                       std::size_t bound, const RebalanceOptions& options);
+                       std::size_t bound, std::size_t lower, const RebalanceOptions& options);
 
 /// Measurements whose poses lie in two different blocks.
 std::size_t cut_measurements(const PoseGraph& graph, const std::vector<int>& owner);
