@@ -27,10 +27,11 @@ struct RebalanceOptions {
   std::size_t min_excess = 10;
   /// Cut refinement (needs `enabled`): runs when more than `cut_fraction` of the measurements
   /// join poses of two blocks. In [0, 1]; 1 = never. city10000 replayed by 5 robots, a step
-  /// every 0.1 s of stream: the cut ends at 395 of 20,687 measurements (110 re-partitions,
-  /// 3,661 poses moved) against 8,369 for the robots' blocks, and the steps take 32,155 CG
+  /// every 0.1 s of stream: the cut ends at 509 of 20,687 measurements (146 re-partitions,
+  /// 4,455 poses moved) against 8,369 for the robots' blocks, and the steps take 33,016 CG
   /// iterations against 103,615 (docs/online.md, "The partition follows the graph"). The cut
-  /// then hovers near the threshold; 0.03 / 0.05 end at 555 / 655 (structure-only replays).
+  /// then hovers near the threshold; 0.03 / 0.05 end at 568 / 758 with 2,893 / 1,904 poses
+  /// moved (replays of the structure alone).
   double cut_fraction = 0.02;
   /// Refinement passes at most (each pass moves a pose at most once and keeps its best
   /// prefix; the next pass starts from there). >= 1.
