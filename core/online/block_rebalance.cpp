@@ -147,8 +147,8 @@ std::size_t refine_with(const std::vector<std::vector<std::size_t>>& adjacent,
   std::vector<std::size_t> size(static_cast<std::size_t>(num_blocks), 0);
   for (int b : owner) ++size[static_cast<std::size_t>(b)];
   BlockLinks into(adjacent, owner);
-  // The best move of a pose: to a block it has a measurement into, below the bound, from a
-  // block it does not empty; the most cut measurements removed (links there minus links in
+  // The best move of a pose: to a block it has a measurement into, below `bound`, from a
+  // block above `lower`; the most cut measurements removed (links there minus links in
   // its own block), then the lighter block, then the lower one. {gain, block}; block -1: none.
   auto best_move = [&](std::size_t v) -> std::pair<long, int> {
     const int own = owner[v];
