@@ -485,6 +485,7 @@ bool OnlineAgent::epoch_step() {
       .add("agents", static_cast<long long>(members().size()))
       .add("moved", in.moved)
       .add("largest_block", in.largest_block)
+      .add("cut", in.cut)
       .add("rounds", s.rounds)
       .add("ms", 1000.0 * (step_end - step_start))
       .add("latency_s", step_end - oldest)

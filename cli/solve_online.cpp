@@ -27,7 +27,8 @@ const char* const kOnlineValued[] = {
     "certify-every", "refactor-growth",   "baseline-every", "local-threshold",
     "step-every",    "step-solver",       "newton-after",   "threads",
     "baseline-per",  "baseline-samples",  "baseline-init",  "baseline-solver",
-    "step-coarse",   "progress-interval", "until",          nullptr};
+    "step-coarse",   "progress-interval", "until",          "cut-fraction",
+    nullptr};
 const char* const kOnlineSwitches[] = {"online",          "real-time",   "baseline",
                                        "no-local-rounds", "no-progress", nullptr};
 
@@ -86,6 +87,9 @@ const char* kOnlineHelp =
     "  --step-coarse none|blocks newton: the CG's coarse correction (default none: block\n"
     "                            Jacobi; blocks: plus one rigid motion per block of the\n"
     "                            robots that have met: pays once many robots have met)\n"
+    "  --cut-fraction F          re-partition: refine the blocks' border when more than F of\n"
+    "                            the measurements join two blocks (default 0.02; 1: blocks\n"
+    "                            stay the robots', moved only for balance)\n"
     "  --until S                 play only what is published up to S seconds of stream time\n"
     "                            (a prefix of the mission, e.g. to profile its steps; the\n"
     "                            final cost needs the graph received by then connected)\n"
@@ -120,6 +124,7 @@ JsonObject update_json(const OnlineUpdate& u) {
       .add("agents", u.agents)
       .add("moved", u.moved)
       .add("largest_block", u.largest_block)
+      .add("cut", u.cut)
       .add("rounds", u.rounds)
       .add("ms", u.ms)
       .add("cpu_s", u.cpu_s)
@@ -176,6 +181,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.certify_every_s = a.get_double("certify-every", 0.0);
   options.step_every_s = a.get_double("step-every", 0.0);
   options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
+  options.rebalance.cut_fraction = a.get_double("cut-fraction", options.rebalance.cut_fraction);
   options.solver.threads = static_cast<int>(a.get_long("threads", options.solver.threads));
   options.solver.local_rounds.enabled = !a.has("no-local-rounds");
   options.solver.local_rounds.threshold =

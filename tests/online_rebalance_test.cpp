@@ -130,6 +130,7 @@ TEST(BlockRebalance, MakesTheMovesOfItsDefinitionOnRandomGraphs) {
     RebalanceOptions o;
     o.slack = 0.1 * static_cast<double>(rng() % 3);
     o.min_excess = rng() % 3;
+    o.cut_fraction = 1.0;  // the balance moves alone
     std::vector<int> expected = owner;
     const double bound = (1.0 + o.slack) * std::ceil(static_cast<double>(n) / blocks) +
                          static_cast<double>(o.min_excess);
@@ -171,6 +172,184 @@ TEST(OnlineRebalance, ALateRobotGetsPosesAndTheFinalAnswerEqualsTheBatchOptimum)
   EXPECT_NEAR(res.cost, f_star, 1e-6 * f_star);
   ASSERT_TRUE(res.certified.has_value());
   EXPECT_TRUE(*res.certified);
+}
+
+// The cut refinement: random graphs (a chain and closures, mostly between nearby ids, as a
+// trajectory revisiting places) with blocks that cross each other (interleaved id ranges).
+struct CrossedBlocks {
+  PoseGraph graph;
+  std::vector<int> owner;
+  int blocks = 0;
+};
+
+CrossedBlocks crossed_blocks(std::mt19937& rng) {
+  CrossedBlocks c;
+  const std::size_t n = 30 + rng() % 300;
+  c.blocks = 2 + static_cast<int>(rng() % 5);
+  c.graph = chain(n);
+  for (std::size_t k = 0, extra = rng() % (2 * n); k < extra; ++k) {
+    Measurement m;
+    m.i = rng() % n;
+    m.j = std::min(n - 1, m.i + 1 + rng() % 8);
+    if (m.j != m.i) c.graph.measurements.push_back(m);
+  }
+  // Runs of 1-12 poses handed to the blocks in turn: every block crosses every other.
+  c.owner.resize(n);
+  for (std::size_t k = 0, b = 0; k < n; b = (b + 1) % static_cast<std::size_t>(c.blocks)) {
+    const std::size_t run = 1 + rng() % 12;
+    for (std::size_t r = 0; r < run && k < n; ++r) c.owner[k++] = static_cast<int>(b);
+  }
+  for (int b = 0; b < c.blocks; ++b) c.owner[static_cast<std::size_t>(b)] = b;  // none empty
+  return c;
+}
+
+std::vector<std::size_t> block_sizes(const std::vector<int>& owner, int blocks) {
+  std::vector<std::size_t> size(static_cast<std::size_t>(blocks), 0);
+  for (int b : owner) ++size[static_cast<std::size_t>(b)];
+  return size;
+}
+
+TEST(CutRefinement, ReducesTheCutOfBlocksThatCrossEachOther) {
+  std::mt19937 rng(11);
+  std::size_t before = 0, after = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    CrossedBlocks c = crossed_blocks(rng);
+    RebalanceOptions o;
+    o.min_excess = 0;
+    const RebalanceResult r = rebalance_blocks(c.graph, c.owner, c.blocks, o);
+    EXPECT_TRUE(r.refined) << "trial " << trial;
+    EXPECT_LE(r.cut_after, r.cut_before) << "trial " << trial;
+    EXPECT_EQ(r.cut_after, cut_measurements(c.graph, c.owner)) << "trial " << trial;
+    before += r.cut_before;
+    after += r.cut_after;
+  }
+  // Crossed blocks cut most of the chain; the refinement gathers the runs.
+  EXPECT_LT(static_cast<double>(after), 0.4 * static_cast<double>(before))
+      << before << " -> " << after;
+}
+
+TEST(CutRefinement, KeepsEveryBlockWithinTheBalanceBounds) {
+  std::mt19937 rng(12);
+  for (int trial = 0; trial < 200; ++trial) {
+    CrossedBlocks c = crossed_blocks(rng);
+    RebalanceOptions o;
+    o.slack = 0.1 * static_cast<double>(rng() % 4);
+    o.min_excess = rng() % 4;
+    const double full = (1.0 + o.slack) * std::ceil(static_cast<double>(c.owner.size()) /
+                                                    static_cast<double>(c.blocks)) +
+                        static_cast<double>(o.min_excess);
+    const double low = (1.0 - o.slack) * std::floor(static_cast<double>(c.owner.size()) /
+                                                    static_cast<double>(c.blocks));
+    const std::vector<std::size_t> start = block_sizes(c.owner, c.blocks);
+    rebalance_blocks(c.graph, c.owner, c.blocks, o);
+    const std::vector<std::size_t> end = block_sizes(c.owner, c.blocks);
+    for (std::size_t b = 0; b < end.size(); ++b) {
+      EXPECT_GE(end[b], 1u) << "trial " << trial << " block " << b;
+      // Nor does one above the lower bound fall below it (the cut alone would be smallest with
+      // blocks nearly empty).
+      EXPECT_GE(static_cast<double>(end[b]),
+                std::min(std::floor(low), static_cast<double>(start[b])))
+          << "trial " << trial << " block " << b;
+      // A block within the bound stays within it; one above it (the balance moves had no
+      // lighter neighbour) does not grow.
+      EXPECT_LE(static_cast<double>(end[b]),
+                std::max(std::floor(full), static_cast<double>(start[b])))
+          << "trial " << trial << " block " << b;
+    }
+  }
+}
+
+TEST(CutRefinement, EachPassMovesOnlyBorderPoses) {
+  // One pass: a pose that moves was a border pose when the pass began (a measurement into
+  // another block) or a neighbour of a pose that moved in the same pass (the border moving
+  // pose by pose from where it is). k passes are k one-pass calls.
+  std::mt19937 rng(13);
+  std::size_t moved = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    CrossedBlocks c = crossed_blocks(rng);
+    RebalanceOptions o;
+    const std::size_t bound = c.owner.size() / static_cast<std::size_t>(c.blocks) + 5;
+    std::vector<int> passes = c.owner;
+    o.max_passes = 1;
+    for (int pass = 0; pass < 8; ++pass) {
+      const std::vector<int> start = passes;
+      moved += refine_cut(c.graph, passes, c.blocks, bound, 1, o);
+      std::vector<char> border_or_next(c.owner.size(), 0);
+      for (const Measurement& m : c.graph.measurements) {
+        if (start[m.i] != start[m.j]) border_or_next[m.i] = border_or_next[m.j] = 1;
+        if (passes[m.i] != start[m.i]) border_or_next[m.j] = 1;  // next to a moved pose
+        if (passes[m.j] != start[m.j]) border_or_next[m.i] = 1;
+      }
+      for (std::size_t k = 0; k < c.owner.size(); ++k) {
+        if (passes[k] != start[k]) {
+          EXPECT_TRUE(border_or_next[k]) << "trial " << trial << " pass " << pass << " pose " << k;
+        }
+      }
+    }
+    std::vector<int> at_once = c.owner;
+    o.max_passes = 8;
+    refine_cut(c.graph, at_once, c.blocks, bound, 1, o);
+    EXPECT_EQ(at_once, passes) << "trial " << trial;
+  }
+  EXPECT_GT(moved, 1000u) << "the trials move poses";
+}
+
+TEST(CutRefinement, IsDeterministicAndLeavesALowCutAlone) {
+  std::mt19937 rng(14);
+  CrossedBlocks c = crossed_blocks(rng);
+  RebalanceOptions o;
+  std::vector<int> a = c.owner, b = c.owner;
+  const RebalanceResult ra = rebalance_blocks(c.graph, a, c.blocks, o);
+  const RebalanceResult rb = rebalance_blocks(c.graph, b, c.blocks, o);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(ra.moved, rb.moved);
+  EXPECT_GT(ra.moved, 0u);
+  // At or under cut_fraction nothing moves: the refinement is not even run.
+  std::vector<int> low = c.owner;
+  o.cut_fraction =
+      static_cast<double>(ra.cut_before) / static_cast<double>(c.graph.measurements.size());
+  const RebalanceResult r = rebalance_blocks(c.graph, low, c.blocks, o);
+  EXPECT_FALSE(r.refined);
+  EXPECT_EQ(r.moved, 0u);
+  EXPECT_EQ(low, c.owner);
+}
+
+TEST(CutRefinement, NewPosesJoinTheBlockHoldingMostOfTheirMeasurements) {
+  PoseGraph g = chain(6);  // 0-1-2-3-4-5, and 5-2, 5-3: pose 5 has 1 link to 4, 2 to {2, 3}
+  for (std::size_t k : {2, 3}) {
+    Measurement m;
+    m.i = k;
+    m.j = 5;
+    g.measurements.push_back(m);
+  }
+  std::vector<int> owner = {0, 0, 1, 1};  // poses 4 and 5 are new, robot 0's
+  RebalanceOptions o;
+  assign_new_poses(g, owner, {0, 0}, o);
+  // 4's one measurement to an older pose is into block 1 (pose 3); 5's three are all into
+  // block 1 (4, 2, 3) once 4 joined it.
+  EXPECT_EQ(owner, (std::vector<int>{0, 0, 1, 1, 1, 1}));
+  o.cut_fraction = 1.0;  // refinement off: the robot's block
+  owner = {0, 0, 1, 1};
+  assign_new_poses(g, owner, {0, 0}, o);
+  EXPECT_EQ(owner, (std::vector<int>{0, 0, 1, 1, 0, 0}));
+}
+
+TEST(CutRefinement, RejectsAnOutOfRangeCutFractionNamingTheField) {
+  RebalanceOptions o;
+  o.cut_fraction = 1.5;
+  EXPECT_NE(test::validation_message(o).find("RebalanceOptions.cut_fraction"), std::string::npos);
+  o.cut_fraction = 0.02;
+  o.max_passes = 0;
+  EXPECT_NE(test::validation_message(o).find("RebalanceOptions.max_passes"), std::string::npos);
+}
+
+TEST(CutRefinement, ARobotThatJoinsOpensItsOwnBlockWhateverItsFirstPoseLinksTo) {
+  // Robot 1's first pose (2) has odometry from robot 0's last (1): it still opens block 1,
+  // and its next pose (3), linked to it alone, follows it there.
+  const PoseGraph g = chain(4);
+  std::vector<int> owner = {0, 0};
+  assign_new_poses(g, owner, {1, 1}, RebalanceOptions{});
+  EXPECT_EQ(owner, (std::vector<int>{0, 0, 1, 1}));
 }
 
 }  // namespace

@@ -132,7 +132,10 @@ TEST(OnlineAgentView, SurvivorsAnEpochApartReachTheSameGraphAndMoveTheLostBlockA
   ReplayOptions ro;
   ro.rate = 10;
   const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
-  runtime::OnlineAgentView ahead(0, 3, online_options()), behind(1, 3, online_options());
+  // The take-over's own moves: blocks refined for the cut would also move survivors' poses.
+  OnlineOptions o = online_options();
+  o.rebalance.cut_fraction = 1.0;
+  runtime::OnlineAgentView ahead(0, 3, o), behind(1, 3, o);
   // Both hold the first half; `ahead` passed one more boundary than `behind`.
   const std::size_t half = plan.batches.size() / 2, third = plan.batches.size() / 3;
   for (std::size_t k = 0; k < half; ++k) {

@@ -101,15 +101,19 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   const TangentFactorTotals factors_before =
       blocks_ ? blocks_->tangent_factor_totals() : TangentFactorTotals{};
 
-  // New poses join their robot's block; then the blocks follow the graph's growth.
+  // New poses join a block (their robot's, or the one holding most of their measurements);
+  // then the blocks follow the graph's growth and cut.
   const auto& robots = stream_.robots();
+  std::vector<int> robot_block;
   for (std::size_t k = owner_.size(); k < graph.num_poses; ++k)
-    owner_.push_back(static_cast<int>(
+    robot_block.push_back(static_cast<int>(
         std::find(robots.begin(), robots.end(), stream_.robot_of_pose()[k]) - robots.begin()));
+  assign_new_poses(graph, owner_, robot_block, options_.rebalance);
   const RebalanceResult moves =
       rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
   u.moved = moves.moved;
   u.largest_block = moves.largest_after;
+  u.cut = moves.cut_after;
   // Only the measurements since the last extension can touch a new pose.
   std::size_t composed = 0;
   if (u.poses > 0) {

@@ -86,9 +86,11 @@ EnteredData OnlineAgentView::enter(const Watermarks& decision) {
   e.measurements = graph.measurements.size() - measurements_before;
   const auto& robots = stream_->robots();
   const std::size_t first_new = owner_.size();
+  std::vector<int> robot_block;
   for (std::size_t k = first_new; k < graph.num_poses; ++k)
-    owner_.push_back(static_cast<int>(
+    robot_block.push_back(static_cast<int>(
         std::find(robots.begin(), robots.end(), stream_->robot_of_pose()[k]) - robots.begin()));
+  assign_new_poses(graph, owner_, robot_block, options_.rebalance);
   RebalanceResult moves;
   if (lost_.empty()) {
     moves = rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
@@ -98,6 +100,7 @@ EnteredData OnlineAgentView::enter(const Watermarks& decision) {
   }
   e.moved = moves.moved;
   e.largest_block = moves.largest_after;
+  e.cut = moves.cut_after;
   const std::size_t estimated = static_cast<std::size_t>(X_.cols()) / (graph.d + 1);
   EstimateExtension x = extend_estimate(graph, X_, stream_->guesses());
   X_ = std::move(x.X);

@@ -155,7 +155,11 @@ def main():
             "factorizations": sum(u.get("factorizations", 0) for u in s["updates"]),
             "factor_gflops": sum(u.get("factor_flops", 0.0) for u in s["updates"]) / 1e9,
             "message_steps": s["rounds"] + sum(u.get("newton_message_steps", 0) for u in s["updates"]),
-            "repartitions": 0, "poses_moved": 0,
+            "newton_steps": sum(u.get("newton_steps", 0) for u in s["updates"]),
+            "repartitions": s.get("repartitions", 0), "poses_moved": s.get("poses_moved", 0),
+            # Measurements between two blocks after the last step (0 when the cut refinement is off).
+            "final_cut": s["updates"][-1].get("cut", 0) if s["updates"] else 0,
+            "largest_block": max((u["largest_block"] for u in s["updates"]), default=0),
             "final_cost": s["cost"], "fstar": fstar,
             "final_rel_gap": (s["cost"] - fstar) / fstar if s.get("cost") else None,
             "certified": s["certified"], "load_1min": round(load, 2),
@@ -208,7 +212,8 @@ def step_args(args):
 
 
 def write_outputs(args, ctx, rows, runs, dds_rows):
-    headers = ["graph", "poses", "steps", "step solver", "message steps", "Newton CG", "lat med s", "lat p95 s", "lat CPU med s", "lat CPU p95 s", "max gap", "online CPU s", "set-up s",
+    headers = ["graph", "poses", "steps", "step solver", "message steps", "Newton steps", "Newton CG",
+               "repartitions", "poses moved", "final cut", "largest block", "lat med s", "lat p95 s", "lat CPU med s", "lat CPU p95 s", "max gap", "online CPU s", "set-up s",
                "rounds CPU s", "max step CPU s", "critical path s", "closures", "closure publications", "closure steps", "re-solves", "re-solve rounds", "re-solve CG", "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
     if args.instructions:
         headers += ["online G instr", "re-solve G instr", "instr ratio"]
@@ -216,7 +221,8 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
         f"online runs (rate {args.rate}/s per robot, speedup {args.speedup}, steps {args.steps}, "
         f"grad tol {args.grad_tol})",
         headers,
-        [[r["graph"], r["poses"], r["steps"], r["step_solver"], r["message_steps"], r["newton_cg_iterations"],
+        [[r["graph"], r["poses"], r["steps"], r["step_solver"], r["message_steps"], r["newton_steps"],
+          r["newton_cg_iterations"], r["repartitions"], r["poses_moved"], r["final_cut"], r["largest_block"],
           bc.fmt(r["latency_median_s"], "{:.4f}"),
           bc.fmt(r["latency_p95_s"], "{:.4f}"), bc.fmt(r["latency_cpu_median_s"], "{:.4f}"),
           bc.fmt(r["latency_cpu_p95_s"], "{:.4f}"), bc.fmt(r["max_checkpoint_rel_gap"], "{:.2e}"),
@@ -299,8 +305,9 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
                 "online / re-solve G instr = instructions (valgrind --tool=callgrind, load-free) of the online run "
                 "(tessera::run_online: the steps and the final certified solve) and of its re-solves from scratch "
                 "(tessera::cli::resolve_from_scratch), each in its own run of the same command, and instr ratio = their "
-                "ratio. The "
-                "in-process engine keeps one block per robot: re-partitions and poses moved are 0.\n\n"
+                "ratio; repartitions = steps that moved poses between blocks, poses moved = their sum, final cut = "
+                "measurements between two blocks after the last step (0: cut refinement off, --cut-fraction 1), "
+                "largest block = the largest block's poses over the steps (block_rebalance.hpp).\n\n"
                 f"![online]({args.name}.png)\n")
     print(f"wrote {os.path.relpath(md, bc.ROOT)}")
 

@@ -41,8 +41,10 @@ struct OnlineOptions {
   /// Run the distributed certificate (with the staircase of solver.staircase) after the
   /// last batch.
   bool certify_at_end = true;
-  /// The partition follows the graph: blocks start as the robots and border poses move out of
-  /// over-full blocks (block_rebalance.hpp) after each absorbed step.
+  /// The partition follows the graph: blocks start as the robots, new poses join the block of
+  /// most of their measurements, and border poses move out of over-full blocks and, when the
+  /// cut passes rebalance.cut_fraction, to cut fewer measurements (block_rebalance.hpp) after
+  /// each absorbed step.
   RebalanceOptions rebalance;
   /// run_online only. false: one step per distinct batch stamp (deterministic). true: the
   /// stamps are a real-time clock; a step absorbs every batch published by the time the
@@ -132,9 +134,12 @@ struct OnlineUpdate {
   int agents = 0;                 ///< Blocks (robots) during the step.
   std::size_t moved = 0;          ///< Poses that changed block (rebalance) before the rounds.
   std::size_t largest_block = 0;  ///< Largest block's poses during the rounds.
-  int rounds = 0;                 ///< Rounds until the gradient was back under tolerance.
-  double ms = 0.0;                ///< Wall time of the step (absorb, extend, rounds).
-  double cpu_s = 0.0;             ///< Process CPU time of the step.
+  /// Measurements between two blocks during the rounds (0 when the cut refinement is off,
+  /// RebalanceOptions::cut_fraction = 1).
+  std::size_t cut = 0;
+  int rounds = 0;      ///< Rounds until the gradient was back under tolerance.
+  double ms = 0.0;     ///< Wall time of the step (absorb, extend, rounds).
+  double cpu_s = 0.0;  ///< Process CPU time of the step.
   /// Of the step's wall time: the agents' set-up (block problems, preconditioner factors),
   /// and the process CPU of the rounds alone.
   double setup_s = 0.0;
