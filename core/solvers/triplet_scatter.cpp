@@ -1,5 +1,7 @@
 #include "solvers/triplet_scatter.hpp"
 
+#include <algorithm>
+#include <limits>
 #include <stdexcept>
 
 namespace tessera {
@@ -11,25 +13,43 @@ bool TripletScatter::build(Eigen::Index n, const std::vector<int>& rows,
   rows_.clear();
   cols_.clear();
   matrix_ = SparseMatrix();
-  if (rows.size() != cols.size() || n < 0) return false;
-  // Each entry's value is its own index (exact in a double below 2^53): after setFromTriplets
-  // the value at each place says which entry went there.
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(rows.size());
-  for (std::size_t k = 0; k < rows.size(); ++k) {
+  if (rows.size() != cols.size() || n < 0 || n > std::numeric_limits<int>::max() ||
+      rows.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    return false;
+  const auto nn = static_cast<std::size_t>(n);
+  const std::size_t nnz = rows.size();
+  // Two stable counting sorts (by row, then by column): compressed columns with their rows
+  // ascending, setFromTriplets' layout, in O(entries + n).
+  std::vector<int> row_start(nn + 1, 0), col_start(nn + 1, 0);
+  for (std::size_t k = 0; k < nnz; ++k) {
     if (rows[k] < 0 || rows[k] >= n || cols[k] < 0 || cols[k] >= n) return false;
-    t.emplace_back(rows[k], cols[k], static_cast<double>(k));
+    ++row_start[static_cast<std::size_t>(rows[k]) + 1];
+    ++col_start[static_cast<std::size_t>(cols[k]) + 1];
   }
+  for (std::size_t i = 0; i < nn; ++i) {
+    row_start[i + 1] += row_start[i];
+    col_start[i + 1] += col_start[i];
+  }
+  std::vector<int> by_row(nnz);
+  for (std::size_t k = 0; k < nnz; ++k)
+    by_row[static_cast<std::size_t>(row_start[static_cast<std::size_t>(rows[k])]++)] =
+        static_cast<int>(k);
   SparseMatrix m(n, n);
-  m.setFromTriplets(t.begin(), t.end());
-  if (static_cast<std::size_t>(m.nonZeros()) != rows.size()) return false;  // a repeat
-  std::vector<Eigen::Index> where(rows.size(), -1);
-  const double* v = m.valuePtr();
-  for (Eigen::Index i = 0; i < m.nonZeros(); ++i) {
-    const auto k = static_cast<std::size_t>(v[i]);
-    if (k >= where.size() || where[k] >= 0) return false;
-    where[k] = i;
+  m.resizeNonZeros(static_cast<Eigen::Index>(nnz));
+  std::copy(col_start.begin(), col_start.end(), m.outerIndexPtr());
+  std::vector<Eigen::Index> where(nnz);
+  int* inner = m.innerIndexPtr();
+  for (int k : by_row) {
+    const auto c = static_cast<std::size_t>(cols[static_cast<std::size_t>(k)]);
+    const int at = col_start[c]++;
+    inner[at] = rows[static_cast<std::size_t>(k)];
+    where[static_cast<std::size_t>(k)] = at;
   }
+  // A position twice: the same row next to itself in its column.
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (int a = m.outerIndexPtr()[j] + 1; a < m.outerIndexPtr()[j + 1]; ++a)
+      if (inner[a] == inner[a - 1]) return false;
+  std::fill(m.valuePtr(), m.valuePtr() + nnz, 0.0);
   n_ = n;
   rows_ = rows;
   cols_ = cols;

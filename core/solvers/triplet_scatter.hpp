@@ -2,11 +2,12 @@
 // A sparse matrix assembled again and again from entries at the same positions, listed in the
 // same order (a factorization whose pattern does not change from point to point: the Newton
 // refinement's block Hessians and its interface matrix Sigma). The positions are sorted into
-// compressed columns once (Eigen's setFromTriplets); each later assembly writes every value
-// straight to its place. No position may repeat (no entries are summed), so the matrix is the
-// one setFromTriplets would build from the same entries, to the bit, explicit zeros included.
-// On city10000 at N = 5 (in process, callgrind) setFromTriplets was 112 M of the refinement's
-// 1.95 G instructions, sorting the same ~100k positions at each of the three points.
+// compressed columns once (two counting sorts: the layout of Eigen's setFromTriplets); each
+// later assembly writes every value straight to its place. No position may repeat (no entries are
+// summed), so the matrix is the one setFromTriplets would build from the same entries, to the bit,
+// explicit zeros included. On city10000 at N = 5 (in process, callgrind) setFromTriplets was 112 M
+// of the refinement's 1.95 G instructions, sorting the same ~100k positions at each of the three
+// points.
 
 #include <Eigen/SparseCore>
 #include <cstddef>
