@@ -12,7 +12,6 @@ bool TripletScatter::build(Eigen::Index n, const std::vector<int>& rows,
   where_.clear();
   rows_.clear();
   cols_.clear();
-  matrix_ = SparseMatrix();
   if (rows.size() != cols.size() || n < 0 || n > std::numeric_limits<int>::max() ||
       rows.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     return false;
@@ -34,10 +33,11 @@ bool TripletScatter::build(Eigen::Index n, const std::vector<int>& rows,
   for (std::size_t k = 0; k < nnz; ++k)
     by_row[static_cast<std::size_t>(row_start[static_cast<std::size_t>(rows[k])]++)] =
         static_cast<int>(k);
-  SparseMatrix m(n, n);
+  SparseMatrix& m = matrix_;  // written in place (SparseMatrix assignment copies)
+  m.resize(n, n);
   m.resizeNonZeros(static_cast<Eigen::Index>(nnz));
   std::copy(col_start.begin(), col_start.end(), m.outerIndexPtr());
-  std::vector<Eigen::Index> where(nnz);
+  std::vector<int> where(nnz);
   int* inner = m.innerIndexPtr();
   for (int k : by_row) {
     const auto c = static_cast<std::size_t>(cols[static_cast<std::size_t>(k)]);
@@ -48,13 +48,15 @@ bool TripletScatter::build(Eigen::Index n, const std::vector<int>& rows,
   // A position twice: the same row next to itself in its column.
   for (Eigen::Index j = 0; j < n; ++j)
     for (int a = m.outerIndexPtr()[j] + 1; a < m.outerIndexPtr()[j + 1]; ++a)
-      if (inner[a] == inner[a - 1]) return false;
+      if (inner[a] == inner[a - 1]) {
+        m = SparseMatrix();
+        return false;
+      }
   std::fill(m.valuePtr(), m.valuePtr() + nnz, 0.0);
   n_ = n;
   rows_ = rows;
   cols_ = cols;
   where_ = std::move(where);
-  matrix_ = std::move(m);
   return true;
 }
 

@@ -32,8 +32,8 @@ class TripletScatter {
 
  private:
   Eigen::Index n_ = -1;
-  std::vector<int> rows_, cols_;     // the positions, in the callers' order
-  std::vector<Eigen::Index> where_;  // k-th position -> its index in matrix_'s values
+  std::vector<int> rows_, cols_;  // the positions, in the callers' order
+  std::vector<int> where_;        // k-th position -> its index in matrix_'s values
   SparseMatrix matrix_;
 };
 
