@@ -2,6 +2,7 @@
 
 #include <Eigen/OrderingMethods>
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -16,10 +17,11 @@ namespace tessera {
 
 namespace {
 
-// One pose pair's (d+1) x (d+1) block of Q, column-major (rows: pose i's coordinates).
+// One pose pair's (d+1) x (d+1) block of Q, column-major (rows: pose i's coordinates), in a
+// fixed array (d <= 3): no heap block per pair (a city10000 block has ~10,000 pairs).
 struct PosePair {
   Eigen::Index i = 0, j = 0;
-  std::vector<double> q;
+  std::array<double, 16> q{};
 };
 
 }  // namespace
@@ -78,6 +80,7 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
   Impl& s = *impl_;
   s.d = problem.dim();
   s.w = s.d + 1;
+  if (s.d != 2 && s.d != 3) throw std::invalid_argument("InterfaceSolve: d must be 2 or 3");
   s.p = s.d * (s.d + 1) / 2;
   s.id = id;
   s.owned = problem.owned();
@@ -122,7 +125,7 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
       while (k < col.size() && all[col[k]].i != i) ++k;
       if (k == col.size()) {
         col.push_back(all.size());
-        all.push_back(PosePair{i, j, std::vector<double>(static_cast<std::size_t>(w * w), 0.0)});
+        all.push_back(PosePair{i, j, {}});
       }
       all[col[k]].q[static_cast<std::size_t>(u * w + t)] = it.value();
     }
@@ -163,7 +166,7 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
       while (k < col.size() && s.cut[col[k]].j != j) ++k;
       if (k == col.size()) {
         col.push_back(s.cut.size());
-        s.cut.push_back(PosePair{i, j, std::vector<double>(static_cast<std::size_t>(w * w), 0.0)});
+        s.cut.push_back(PosePair{i, j, {}});
       }
       s.cut[col[k]].q[static_cast<std::size_t>(u * w + t)] = it.value();
     }
