@@ -16,6 +16,11 @@ namespace tessera::launch {
 /// max-active-levels to 0 through the OpenMP runtime loaded with CHOLMOD, found at run time (no
 /// link dependency). Process-wide; call once, early. False when no OpenMP runtime is loaded
 /// (then there are no parallel regions to restrict).
+/// Also makes CHOLMOD's regions run inline on the calling thread (GOMP_parallel, defined in
+/// serial_openmp.cpp), without libgomp's per-region team of one.
 bool serial_openmp();
+
+/// Whether serial_openmp() was called in this process (regions then run inline).
+bool openmp_regions_run_inline();
 
 }  // namespace tessera::launch

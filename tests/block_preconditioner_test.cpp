@@ -172,5 +172,19 @@ TEST(BlockPreconditioner, BlockUpdateWithTheFallbackStillDecreasesTheLocalCost) 
   EXPECT_LT(problem.cost(X1), 0.9 * problem.cost(X0));
 }
 
+// A cap at or above the dense lower triangle, n (n + 1) / 2 entries, is never exceeded whatever
+// the ordering: falls_back() answers without an analysis, and as the constructor does.
+TEST(BlockPreconditioner, FallsBackAgreesWithTheConstructorAroundTheDenseTriangleCap) {
+  const Block b = half_block(5);
+  const BlockProblem problem(b.graph.d, b.owned, b.measurements);
+  const double shift = 1e-6;
+  const std::size_t n = static_cast<std::size_t>(problem.data_matrix().rows());
+  const std::size_t dense = n * (n + 1) / 2;
+  for (std::size_t cap : {dense - 1, dense, dense + 1}) {
+    EXPECT_FALSE(BlockPreconditioner::falls_back(problem, shift, cap)) << cap;
+    EXPECT_FALSE(BlockPreconditioner(problem, shift, cap).block_diagonal()) << cap;
+  }
+}
+
 }  // namespace
 }  // namespace tessera

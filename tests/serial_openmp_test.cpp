@@ -8,6 +8,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <vector>
+
 #include "solvers/supernodal_factor.hpp"
 
 namespace {
@@ -37,6 +39,38 @@ TEST(SerialOpenmp, TheAgentsThreadRunsParallelRegionsAlone) {
   if (pid == 0) {
     if (!tessera::launch::serial_openmp()) _exit(3);
     _exit(max_active_levels() == 0 ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+}
+
+// After serial_openmp() CHOLMOD's parallel regions run inline on the calling thread (this
+// executable's GOMP_parallel, launch/serial_openmp.cpp), and a supernodal factor large enough
+// for CHOLMOD to open its regions holds the same bits as with libgomp's teams before.
+TEST(SerialOpenmp, InlineRegionsGiveTheFactorOfLibgompsTeams) {
+  const int n = 600;
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < n; ++j) {
+    t.emplace_back(j, j, 8.0 + (j % 7));
+    for (int d : {1, 2, 5, 40, 150})
+      if (j + d < n) t.emplace_back(j + d, j, -0.5 + 0.01 * ((j * d) % 13));
+  }
+  SparseMatrix lower(n, n);
+  lower.setFromTriplets(t.begin(), t.end());
+  tessera::SupernodalFactor before;
+  ASSERT_TRUE(before.factor(lower));
+  const std::vector<double> want = before.values();
+  ASSERT_FALSE(want.empty());
+  EXPECT_FALSE(tessera::launch::openmp_regions_run_inline());
+  const pid_t pid = fork();
+  if (pid == 0) {
+    tessera::launch::serial_openmp();
+    if (!tessera::launch::openmp_regions_run_inline()) _exit(2);
+    tessera::SupernodalFactor after;
+    if (!after.factor(lower)) _exit(3);
+    _exit(after.values() == want ? 0 : 1);
   }
   int status = 0;
   ASSERT_EQ(waitpid(pid, &status, 0), pid);

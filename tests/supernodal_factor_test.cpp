@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/CholmodSupport>
 #include <Eigen/Dense>
 #include <random>
 #include <vector>
@@ -172,6 +173,64 @@ TEST(SupernodalFactor, AfterAFailedFactorizationImportEitherSolvesLikeTheSenderO
   sender.solve(b, want);
   receiver.solve(b, got);
   EXPECT_EQ((got - want).norm(), 0.0);
+}
+
+// The AMD-ordered factor, whose input this class permutes itself (solvers/supernodal_factor.cpp),
+// holds the bits of CHOLMOD's own factor of the same matrix (two transposes per factorization),
+// and its solve gives CHOLMOD's solve's bits: at the analysis and at a later point's values.
+TEST(SupernodalFactor, AmdFactorAndSolveEqualCholmodsOwnPermutedFactorToTheBit) {
+  for (std::uint64_t seed : {11u, 12u}) {
+    const SparseMatrix first = lower_of(blocky(6, 10, 0.5, seed), {{25, 3}, {41, 12}});
+    const SparseMatrix later = lower_of(blocky(6, 10, 0.5, seed + 100), {{25, 3}, {41, 12}});
+    ASSERT_TRUE(first.isCompressed());
+    SupernodalFactor ours;
+    cholmod_common c;
+    cholmod_start(&c);
+    c.print = 0;
+    c.supernodal = CHOLMOD_SUPERNODAL;
+    c.final_ll = 1;
+    c.nmethods = 1;
+    c.method[0].ordering = CHOLMOD_AMD;
+    c.postorder = 1;
+    cholmod_sparse a0 = Eigen::viewAsCholmod(first.selfadjointView<Eigen::Lower>());
+    cholmod_factor* L = cholmod_analyze(&a0, &c);
+    ASSERT_NE(L, nullptr);
+    ASSERT_NE(L->ordering, CHOLMOD_NATURAL);
+    for (const SparseMatrix* m : {&first, &later}) {
+      ASSERT_TRUE(ours.factor(*m, 1e-3));
+      cholmod_sparse a = Eigen::viewAsCholmod(m->selfadjointView<Eigen::Lower>());
+      double beta[2] = {1e-3, 0.0};
+      ASSERT_TRUE(cholmod_factorize_p(&a, beta, nullptr, 0, L, &c));
+      ASSERT_EQ(L->minor, L->n);
+      // values(): each supernode's columns from the diagonal down, as CHOLMOD stores them.
+      std::vector<double> want;
+      const int* super = static_cast<const int*>(L->super);
+      const int* pi = static_cast<const int*>(L->pi);
+      const int* px = static_cast<const int*>(L->px);
+      const double* x = static_cast<const double*>(L->x);
+      for (std::size_t k = 0; k < L->nsuper; ++k) {
+        const int nc = super[k + 1] - super[k], nr = pi[k + 1] - pi[k];
+        for (int j = 0; j < nc; ++j)
+          want.insert(want.end(), x + px[k] + j * nr + j, x + px[k] + (j + 1) * nr);
+      }
+      const std::vector<double> got = ours.values();
+      ASSERT_EQ(got.size(), want.size());
+      for (std::size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], want[i]) << "entry " << i;
+      Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(m->rows(), -1.0, 2.0), mine;
+      ours.solve(b, mine);
+      cholmod_dense* B = cholmod_allocate_dense(b.size(), 1, b.size(), CHOLMOD_REAL, &c);
+      std::copy(b.data(), b.data() + b.size(), static_cast<double*>(B->x));
+      cholmod_dense* X = cholmod_solve(CHOLMOD_A, L, B, &c);
+      ASSERT_NE(X, nullptr);
+      const double* xs = static_cast<const double*>(X->x);
+      for (Eigen::Index i = 0; i < b.size(); ++i) ASSERT_EQ(mine(i), xs[i]) << "entry " << i;
+      cholmod_free_dense(&X, &c);
+      cholmod_free_dense(&B, &c);
+    }
+    EXPECT_EQ(ours.analyses(), 1);
+    cholmod_free_factor(&L, &c);
+    cholmod_finish(&c);
+  }
 }
 
 }  // namespace

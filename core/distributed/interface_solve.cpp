@@ -2,6 +2,7 @@
 
 #include <Eigen/OrderingMethods>
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -10,15 +11,17 @@
 #include "solvers/elimination_order.hpp"
 #include "solvers/supernodal_factor.hpp"
 #include "solvers/tangent_coordinates.hpp"
+#include "solvers/triplet_scatter.hpp"
 
 namespace tessera {
 
 namespace {
 
-// One pose pair's (d+1) x (d+1) block of Q, column-major (rows: pose i's coordinates).
+// One pose pair's (d+1) x (d+1) block of Q, column-major (rows: pose i's coordinates), in a
+// fixed array (d <= 3): no heap block per pair (a city10000 block has ~10,000 pairs).
 struct PosePair {
   Eigen::Index i = 0, j = 0;
-  std::vector<double> q;
+  std::array<double, 16> q{};
 };
 
 }  // namespace
@@ -63,7 +66,12 @@ struct InterfaceSolve::Impl {
   bool sigma_ok = false;
   bool grounded = false;  // the team's first interface pose held fixed (its p coordinates)
   double shift = 0.0;
-  int pattern = -1;           // the pattern sigma was last factored on: 1 grounded, 0 not, -1 none
+  int pattern = -1;  // the pattern sigma was last factored on: 1 grounded, 0 not, -1 none
+  // The block's Hessian A_bb (lower triangle, the order above) and Sigma (grounded or not), as
+  // positions laid out once and values written at each point (solvers/triplet_scatter.hpp).
+  TripletScatter block_pattern, sigma_pattern[2];
+  bool block_pattern_ready = false;
+  std::vector<double> block_values;
   mutable Eigen::VectorXd b;  // scratch: J^T v in the block's own order
 };
 
@@ -72,6 +80,7 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
   Impl& s = *impl_;
   s.d = problem.dim();
   s.w = s.d + 1;
+  if (s.d != 2 && s.d != 3) throw std::invalid_argument("InterfaceSolve: d must be 2 or 3");
   s.p = s.d * (s.d + 1) / 2;
   s.id = id;
   s.owned = problem.owned();
@@ -116,7 +125,7 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
       while (k < col.size() && all[col[k]].i != i) ++k;
       if (k == col.size()) {
         col.push_back(all.size());
-        all.push_back(PosePair{i, j, std::vector<double>(static_cast<std::size_t>(w * w), 0.0)});
+        all.push_back(PosePair{i, j, {}});
       }
       all[col[k]].q[static_cast<std::size_t>(u * w + t)] = it.value();
     }
@@ -157,7 +166,7 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
       while (k < col.size() && s.cut[col[k]].j != j) ++k;
       if (k == col.size()) {
         col.push_back(s.cut.size());
-        s.cut.push_back(PosePair{i, j, std::vector<double>(static_cast<std::size_t>(w * w), 0.0)});
+        s.cut.push_back(PosePair{i, j, {}});
       }
       s.cut[col[k]].q[static_cast<std::size_t>(u * w + t)] = it.value();
     }
@@ -239,8 +248,12 @@ std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const 
   for (Eigen::Index i = 0; i < s.m; ++i)
     G[static_cast<std::size_t>(i)] = pose_basis(X.block(0, i * w, d, d), skew);
   const Eigen::Index n = s.m * p;
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(s.pairs.size() * static_cast<std::size_t>(p * p));
+  // A's positions are the same at every point: laid out once, then only the values are written.
+  const bool layout = !s.block_pattern_ready;
+  std::vector<int> rows, cols;
+  std::vector<double>& vals = s.block_values;
+  vals.clear();
+  vals.reserve(s.pairs.size() * static_cast<std::size_t>(p * p));
   Eigen::MatrixXd B(p, p), Qm(w, w);
   for (const PosePair& pp : s.pairs) {
     const bool diag = pp.i == pp.j;
@@ -263,11 +276,22 @@ std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const 
     const Eigen::Index ri = s.slot[static_cast<std::size_t>(pp.i)] * p;
     const Eigen::Index cj = s.slot[static_cast<std::size_t>(pp.j)] * p;
     for (int c = 0; c < p; ++c)
-      for (int a = diag ? c : 0; a < p; ++a) t.emplace_back(ri + a, cj + c, B(a, c));
+      for (int a = diag ? c : 0; a < p; ++a) {
+        vals.push_back(B(a, c));
+        if (layout) {
+          rows.push_back(static_cast<int>(ri + a));
+          cols.push_back(static_cast<int>(cj + c));
+        }
+      }
   }
-  SparseMatrix A(n, n);
-  A.setFromTriplets(t.begin(), t.end());
-  const bool ok = n > 0 && block.factor(A);
+  if (layout) {
+    // The pose pairs are distinct, so no position repeats.
+    if (!s.block_pattern.build(n, rows, cols))
+      throw std::logic_error("InterfaceSolve: a repeated entry in the block's Hessian");
+    s.block_pattern_ready = true;
+  }
+  s.block_pattern.fill(vals);
+  const bool ok = n > 0 && block.factor(s.block_pattern.matrix());
   // Far from a minimiser the block's Hessian may be indefinite: then its block without the
   // multiplier term (positive definite, as block Jacobi's), and Sigma is the Schur complement
   // of that modified H, still a symmetric positive definite preconditioner.
@@ -351,11 +375,27 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
         if (e.row() >= p && e.col() >= p) g.push_back(e);
       for (Eigen::Index k = 0; k < p; ++k) g.emplace_back(k, k, std::max(top, 1e-300));
     }
-    SparseMatrix sigma(s.team, s.team);
-    if (ground)
-      sigma.setFromTriplets(g.begin(), g.end());
-    else
-      sigma.setFromTriplets(t.begin(), t.end());
+    // Sigma's positions are those of the last point's unless the shares' layout changed.
+    const std::vector<Eigen::Triplet<double>>& e = ground ? g : t;
+    std::vector<int> rows, cols;
+    std::vector<double> vals;
+    rows.reserve(e.size());
+    cols.reserve(e.size());
+    vals.reserve(e.size());
+    for (const auto& x : e) {
+      rows.push_back(static_cast<int>(x.row()));
+      cols.push_back(static_cast<int>(x.col()));
+      vals.push_back(x.value());
+    }
+    TripletScatter& scatter = s.sigma_pattern[ground ? 1 : 0];
+    SparseMatrix summed;  // where a position repeats (not from well-formed shares): summed
+    if (scatter.matches(s.team, rows, cols) || scatter.build(s.team, rows, cols)) {
+      scatter.fill(vals);
+    } else {
+      summed.resize(s.team, s.team);
+      summed.setFromTriplets(e.begin(), e.end());
+    }
+    const SparseMatrix& sigma = summed.rows() > 0 ? summed : scatter.matrix();
     for (double rel : relative_shifts) {
       const double eta = rel * std::max(top, 1e-300);
       s.pattern = ground ? 1 : 0;
