@@ -71,6 +71,10 @@ const char* kHelp =
     "                            one rejected closure near the bound); a probe's result stays\n"
     "                            only if the TLS cost fell; distributed: every agent runs the\n"
     "                            same search, no central step; 0 = none [0]\n"
+    "  --gnc-jump-side both|beyond   robust distributed: which residuals near the bound hold\n"
+    "                            GNC's early end back: within a factor 2 of c^2 on both sides,\n"
+    "                            or only those beyond it (the passes judge the ones within it on\n"
+    "                            the kept set) [both]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {
@@ -244,6 +248,7 @@ int run_solve(const Args& args) {
   for (const char* const* o = kRobustValued; *o; ++o) valued.insert(*o);
   valued.insert("precond-max-flops");
   valued.insert("gnc-cluster-probes");
+  valued.insert("gnc-jump-side");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
@@ -254,7 +259,13 @@ int run_solve(const Args& args) {
     throw InputError("expected exactly one GRAPH argument (see tessera solve --help)");
   if (a.has("online")) return solve_online_command(a, a.positional()[0], start);
   const std::string algorithm = a.get_or("algorithm", "centralized");
-  const RobustOptions robust = parse_robust_options(a);
+  RobustOptions robust = parse_robust_options(a);
+  // RobustOptions::jump_band_inside; `tessera solve` only (launch's agents take the default).
+  const std::string jump_side =
+      a.get_or("gnc-jump-side", robust.jump_band_inside ? "both" : "beyond");
+  if (jump_side != "both" && jump_side != "beyond")
+    throw InputError("option --gnc-jump-side: '" + jump_side + "' is not one of both, beyond");
+  robust.jump_band_inside = jump_side == "both";
   if (algorithm == "centralized")
     return solve_centralized_command(a, a.positional()[0], robust, start);
   if (algorithm == "rbcd" || algorithm == "rbcd++" || algorithm == "irbcd")

@@ -1,4 +1,6 @@
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/coarse_space.hpp>
@@ -252,12 +254,23 @@ bool GncAgent::final_solve_runs() const {
   return options_.solver.certify || options_.robust.final_refine;
 }
 
+bool GncAgent::final_vote_settled() const {
+  // The fresh start of a set voted on before costs what that vote summed; an iterate solved to
+  // the tolerance on the same set that ends clearly below it wins the vote (the margin covers
+  // the two sums' different order of terms).
+  if (!std::isfinite(last_pass_cost_)) return false;
+  for (const auto& [set, cost] : fresh_start_costs_)
+    if (set == rejected_ && last_pass_cost_ < cost - 1e-9 * std::abs(cost)) return true;
+  return false;
+}
+
 void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   // Before the final solve (here or the caller's): is the passes' iterate worse over the kept
   // set than the kept set's own fresh start (GncDistributedOptions::final_kept_set_start)? Then
   // it is a fold, and the passes judged their set on it: they run again from the fresh start.
+  // Not when the outcome is already known (final_vote_settled): the iterate stays.
   if (final_solve_runs() && fresh_start_ && options_.final_kept_set_start && !final_start_voted_ &&
-      !rejected_.empty()) {
+      !rejected_.empty() && !final_vote_settled()) {
     final_start_voted_ = true;
     final_start_vote_ = true;
     require_kept_connected();
@@ -381,6 +394,9 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     gnc_refine_steps_ += r.exchanges + r.reductions;
   if (solve_kind_ == GncSolveKind::kInlierPass) {
     last_pass_full_ = !pass_capped_;
+    last_pass_cost_ = std::numeric_limits<double>::quiet_NaN();
+    if (!pass_capped_ && !solve_->solves().empty() && !solve_->solves().back().trace.empty())
+      last_pass_cost_ = solve_->solves().back().trace.back().cost;
     if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
@@ -488,6 +504,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kCandidateVotes: {
       const auto [at_iterate, at_candidate] = exchange_->summed_votes();
+      fresh_start_costs_.emplace_back(rejected_, at_candidate);
       const bool fresh = at_candidate < at_iterate;
       if (fresh) state_->Y = exchange_->candidate();
       exchange_->candidate().resize(0, 0);

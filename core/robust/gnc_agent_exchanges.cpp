@@ -91,10 +91,11 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     case Step::kWeights: {
       const int crossed = weights_at_mu(outer_->mu());
       const double spread = weight_spread(*terms_, weights_);
-      const int near = options_.robust.jump_band > 0
-                           ? near_bound_count(*terms_, dropped_, state_->Y, exchange_->neighbours(),
-                                              options_.robust.jump_band)
-                           : 1;
+      const int near =
+          options_.robust.jump_band > 0
+              ? near_bound_count(*terms_, dropped_, state_->Y, exchange_->neighbours(),
+                                 options_.robust.jump_band, options_.robust.jump_band_inside)
+              : 1;
       exchange_->own_vote() = {spread, crossed};
       exchange_->own_near_bound() = near;
       zero_cut_ =

@@ -80,9 +80,10 @@ double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weig
 }
 
 int near_bound_count(const GncLocalTerms& terms, const std::vector<bool>& dropped,
-                     const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours, double band) {
+                     const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours, double band,
+                     bool inside) {
   int near = 0;
-  const double lo = terms.c2() / band, hi = terms.c2() * band;
+  const double lo = inside ? terms.c2() / band : terms.c2(), hi = terms.c2() * band;
   for (std::size_t k : terms.owned())
     if (terms.may_reject(k) && !dropped[k]) {
       const double r2 = terms.residual_squared(k, Y, neighbours);

@@ -54,9 +54,11 @@ std::vector<std::uint64_t> zero_weight_cut(const GncLocalTerms& terms,
 double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weights);
 
 /// RobustOptions::jump_band: how many of the measurements this agent weighs (that may be
-/// rejected and were not set aside) have r^2 in (c^2 / band, band c^2) at the iterate Y.
+/// rejected and were not set aside) have r^2 in (c^2 / band, band c^2) at the iterate Y, or with
+/// `inside` false in (c^2, band c^2) (RobustOptions::jump_band_inside).
 int near_bound_count(const GncLocalTerms& terms, const std::vector<bool>& dropped,
-                     const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours, double band);
+                     const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours, double band,
+                     bool inside);
 
 /// TLS's verdict as a weight, from a GNC weight w at mu: 1 when w >= tls_weight(c^2, c^2, mu)
 /// (r^2 <= c^2: w falls as r grows), else 0. A function of the weight alone, so the owner and

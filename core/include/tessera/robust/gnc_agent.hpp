@@ -42,6 +42,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -264,7 +265,15 @@ class GncAgent : public AgentProcess {
   bool fresh_start_ = false;         // the kept set's fresh start (kept_set_start, chordal)
   bool final_start_voted_ = false;   // the vote before the final solve ran (once)
   bool final_start_vote_ = false;    // the running candidate vote is that one
-  std::vector<bool> dropped_;        // per in_.measurements: outside the consistent set (pcm)
+  // Every kept-set vote so far: the rejected set it was taken on and its fresh start's summed
+  // cost over the kept set (a function of the set). With last_pass_cost_ they tell when the vote
+  // before the final solve would keep the iterate (final_vote_settled()).
+  std::vector<std::pair<std::vector<std::uint64_t>, double>> fresh_start_costs_;
+  // The kept set's summed cost at the end of the last inlier pass when that pass was solved to
+  // the tolerance (the solve's last trace record, the same on every agent); NaN otherwise.
+  double last_pass_cost_ = std::numeric_limits<double>::quiet_NaN();
+  bool final_vote_settled() const;
+  std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
   GncSolveKind solve_kind_ = GncSolveKind::kGnc;
   int pass_ = 0;                   // inlier passes done
