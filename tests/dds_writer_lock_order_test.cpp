@@ -8,10 +8,11 @@
 // after cycle, creates 4 readers that never take (a one-sample history rejects the rest, so
 // they NACK them and the writer keeps repairing) and deletes them 150 ms later. After each
 // cycle the writer must go on publishing; a writer that stopped is replaced (and counted).
-// Measured (load 11-15): with VOLATILE writers (Fast DDS's removal on acknowledgement) the
-// writer hung 2, 1, 3 and 1 times in four runs of 100 cycles (the gdb stacks of a run's first
-// hang: the inversion above); with writer_qos's writers, 0 times in four runs of 100 cycles.
-// The environment variables below only serve such measurements. Domain 135.
+// Measured (seven runs of 100 cycles each way, load 11-20): with Fast DDS's VOLATILE writer
+// (TESSERA_LOCK_ORDER_VOLATILE=1) the writer hung 2, 1, 3, 1, 3, 3 and 8 times, 21 in 700
+// cycles (the gdb stacks of a run's first hang, TESSERA_TEARDOWN_STACKS=1: the inversion
+// above); with writer_qos's writers 0 in 700. The environment variables below only serve such
+// measurements. Domain 135.
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -91,8 +92,11 @@ const char* const kWriterRunEnv = "TESSERA_LOCK_ORDER_WRITER_RUN";
   fdds::TypeSupport type(new tessera::wire::PoseBlockPubSubType());
   type.register_type(p);
   fdds::Topic* t = p->create_topic(kTopic, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
-  fdds::DataWriter* w = p->create_publisher(publisher_qos(run))
-                            ->create_datawriter(t, writer_qos(false, 1.0, 2, net, false));
+  fdds::DataWriterQos q = writer_qos(false, 1.0, 2, net, false);
+  // TESSERA_LOCK_ORDER_VOLATILE=1: Fast DDS's VOLATILE writer instead (shows the hang).
+  if (const char* v = std::getenv("TESSERA_LOCK_ORDER_VOLATILE"); v && std::string(v) == "1")
+    q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+  fdds::DataWriter* w = p->create_publisher(publisher_qos(run))->create_datawriter(t, q);
   if (!w) _exit(4);
   tessera::wire::PoseBlock s;
   s.run_id(run);
