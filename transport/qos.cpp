@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "transport/fastdds/discovery_port.hpp"
+#include "transport/fastdds/reader_removal_lock_order.hpp"
 #include "transport/topic_names.hpp"
 
 namespace tessera::transport {
@@ -143,8 +144,11 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
   // write() never blocks long: when the bounded history is full it returns and we retry
   // after waiting for acknowledgements (Session::Impl::write).
   q.reliability().max_blocking_time = Duration_t(0, 10000000);
-  q.durability().kind =
-      transient_local ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
+  // TRANSIENT_LOCAL for every topic: on the hand-shake topics so late joiners get what was
+  // written; on the others (whose readers are VOLATILE, so they get only what is written after
+  // they matched) so that Fast DDS 2.9.1 never removes acknowledged samples while a reader
+  // leaves, which could hang the process (fastdds/reader_removal_lock_order.hpp).
+  keep_acknowledged_samples(q);
   // Bounded KEEP_ALL: unbounded limits let acknowledged samples pile up (hundreds of MB).
   q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
   const std::int32_t history = transient_local ? kWriterHistory : kVolatileWriterHistory;
