@@ -89,13 +89,13 @@ struct RobustOptions {
   /// Distributed solvers only, with recheck_probes: whether a probe may cut kept measurements
   /// (its tail side) while the rejected set is still GNC's own, untouched by the re-check passes
   /// (true), or only brings back the return band then (false, default; once the passes or a kept
-  /// probe changed the set, the cut side runs as before). Why: a set the passes left alone is one
-  /// GNC's graduated weights settled on the whole graph, and cutting its tail has been refused
-  /// every time (intel random 0.1/0.25/0.5 and group 0.1/0.5, every CSAIL cell), at 45
-  /// refinement steps, ~10 exchanges and a 7-step restore each on intel; every kept tail cut
-  /// started from a set the passes had changed (manhattan3500 random 0.1-0.5, intel group 0.25).
-  /// The return side stays: torus3D's kept probe brings a true closure back from just beyond the
-  /// bound (docs/robust.md, "Probes"). `tessera solve --gnc-probe-cut always|after-passes`.
+  /// probe changed the set, the cut side runs as before). Why: every tail cut from GNC's own set
+  /// was refused (intel random 0.1/0.25/0.5, group 0.1/0.5, every CSAIL cell; ~62 message steps
+  /// each on intel), every kept one started from a set the passes had changed (manhattan3500
+  /// random, intel group 0.25); the return side stays (torus3D's kept probe brings a true closure
+  /// back from just beyond the bound). F = 0.25 random, 5 agents: intel 224 -> 168 message
+  /// steps, CSAIL 92 -> 72, the others the same; same answers in 34 of 35 cells (docs/robust.md,
+  /// "Cut only after the passes changed GNC's set"). `tessera solve --gnc-probe-cut always|...`.
   bool probe_cut_untouched = false;
   /// Distributed solvers only: most rounds of every solve before the final one (the first,
   /// unweighted solve and each weighted solve between two weight updates), >= 0, 0 = no cap.
