@@ -78,7 +78,7 @@ const char* kHelp =
     "  --gnc-probe-cut always|after-passes   robust distributed: whether a re-check probe may\n"
     "                            cut kept measurements while the rejected set is still GNC's\n"
     "                            own (always), or only once the re-check passes changed it;\n"
-    "                            before that it only brings back the return band [after-passes]\n"
+    "                            before that it only brings back the return band [always]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {

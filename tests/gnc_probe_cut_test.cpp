@@ -16,9 +16,10 @@ using test::robots_as_blocks;
 
 // The 125-pose grid with 25 % random outliers: GNC rejects exactly the wrong closures and the
 // passes change nothing. With probe_ratio 1.5 and no tail rule the agents name half the true
-// closures for a probe. Run from GNC's own set (probe_cut_untouched) the probe cuts them, the
-// passes take them back and the TLS cost refuses it; by default a probe cuts only after the
-// passes changed the set, so no probe runs: the same set and cost in fewer rounds.
+// closures for a probe. Run from GNC's own set (probe_cut_untouched, the default) the probe cuts
+// them, the passes take them back and the TLS cost refuses it; with probe_cut_untouched false a
+// probe cuts only after the passes changed the set, so no probe runs: the same set and cost in
+// fewer rounds.
 TEST(GncProbeCut, NoProbeCutsKeptMeasurementsWhileTheSetIsStillGncsOwn) {
   const GeneratorResult dirty = grid_with_outliers(0.25);
   const std::vector<int> blocks = robots_as_blocks(dirty);
@@ -26,7 +27,7 @@ TEST(GncProbeCut, NoProbeCutsKeptMeasurementsWhileTheSetIsStillGncsOwn) {
   o.solver.certify = true;
   o.robust.probe_ratio = 1.5;
   o.robust.probe_tail_ratio = 0;
-  ASSERT_FALSE(o.robust.probe_cut_untouched);  // the default
+  o.robust.probe_cut_untouched = false;
   const GncDistributedResult after_passes = solve_gnc_distributed(dirty.graph, blocks, o);
   o.robust.probe_cut_untouched = true;
   const GncDistributedResult always = solve_gnc_distributed(dirty.graph, blocks, o);
