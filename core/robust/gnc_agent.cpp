@@ -338,6 +338,17 @@ bool GncAgent::may_probe() const {
   return probes_->may_start(terms_->known_connected(), options_.robust.readmission_passes);
 }
 
+std::vector<std::uint64_t> GncAgent::probe_flips(std::vector<std::uint64_t> listed) const {
+  if (options_.robust.probe_cut_untouched || rejected_ != gnc_rejected_) return listed;
+  // Every agent holds the same list and set (the verdict exchange): the same flips everywhere.
+  listed.erase(std::remove_if(listed.begin(), listed.end(),
+                              [&](std::uint64_t id) {
+                                return !std::binary_search(rejected_.begin(), rejected_.end(), id);
+                              }),
+               listed.end());
+  return listed;
+}
+
 void GncAgent::begin_probe(double tls, std::vector<std::uint64_t> flip,
                            std::vector<OutgoingMessage>& out) {
   // Every agent holds every agent's probe list (the verdict exchange) and runs the same cluster
@@ -458,6 +469,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     }
     case Step::kRejected:
       std::sort(rejected_.begin(), rejected_.end());
+      gnc_rejected_ = rejected_;
       // Nothing rejected: the GNC iterate is already the plain solve's.
       if (fresh_start_ && !rejected_.empty()) {
         require_kept_connected();  // before initializing the kept set
@@ -554,9 +566,12 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
           finish(out);
           return;
         }
-        if (may_probe() && !recheck_->probe.empty()) {
-          begin_probe(tls, std::move(recheck_->probe), out);
-          return;
+        if (may_probe()) {
+          std::vector<std::uint64_t> flip = probe_flips(std::move(recheck_->probe));
+          if (!flip.empty()) {
+            begin_probe(tls, std::move(flip), out);
+            return;
+          }
         }
         finish(out);
         return;

@@ -71,8 +71,8 @@ struct RobustOptions {
   /// sphere2500, the 1000-pose grid: the same outer steps and answers).
   double jump_band = 2.0;
   /// Distributed solvers only, with jump_band: whether residuals within the bound also hold the
-  /// early end back (true, default: the band (c^2 / B, B c^2), both sides) or only those beyond
-  /// it, (c^2, B c^2) (false; `tessera solve --gnc-jump-side beyond`). Why one side can do: at the
+  /// early end back (true: the band (c^2 / B, B c^2), both sides; `tessera solve --gnc-jump-side
+  /// both`) or only those beyond it, (c^2, B c^2) (false, default). Why one side can do: at the
   /// end each weight takes TLS's own verdict, and the passes then solve the kept set with every
   /// kept measurement at weight 1 and cut the kept ones beyond the bound at that solution, so a
   /// residual just within the bound is judged there on the kept set itself; a rejected one is
@@ -80,11 +80,23 @@ struct RobustOptions {
   /// (a true closure whose cut lets the map relax), which is what GNC's graduated weights are
   /// for. intel with 25 % random outliers, 5 agents: from outer step 14 of 18 every wrong closure
   /// lies beyond 43 c^2 and no residual in (c^2, 2 c^2), while a true closure's r^2 falls from
-  /// 0.95 c^2 to 0.41 c^2 over steps 14-17. F = 0.25 random, one side: intel 251 -> 224 message
-  /// steps, the 1000-pose grid 384 -> 304, sphere2500 728 -> 706, CSAIL and manhattan3500 the
-  /// same, every set and cost the same; not the default because manhattan3500 at F = 0.5 takes
-  /// 10,469 message steps against 10,399 (docs/robust.md, "Early end").
-  bool jump_band_inside = true;
+  /// 0.95 c^2 to 0.41 c^2 over steps 14-17. F = 0.25 random, one side against both: intel 251 ->
+  /// 224 message steps, the 1000-pose grid 384 -> 304, sphere2500 728 -> 706, CSAIL and
+  /// manhattan3500 the same, every set and cost the same; the cells that lose are manhattan3500
+  /// random 0.5, 10,399 -> 10,469 message steps (+0.7 %, the same set) and group 0.5, 91,347 ->
+  /// 93,115 (+1.9 %, the same set, not certified either way) (docs/robust.md, "Early end").
+  bool jump_band_inside = false;
+  /// Distributed solvers only, with recheck_probes: whether a probe may cut kept measurements
+  /// (its tail side) while the rejected set is still GNC's own, untouched by the re-check passes
+  /// (true, default), or only brings back the return band then (false; once the passes or a kept
+  /// probe changed the set, the cut side runs as before). Most tail cuts from GNC's own set are
+  /// refused (intel random 0.1/0.25/0.5, group 0.1/0.5, every CSAIL cell; ~62 message steps each
+  /// on intel): false saves them, F = 0.25 random, 5 agents: intel 224 -> 168 message steps,
+  /// CSAIL 92 -> 72. Not the default: manhattan3500 group 0.25 needs that cut (with it 12,265
+  /// message steps, precision 0.974, recall 0.980, certified; without, 76,603, 0.899, 0.949,
+  /// not certified; docs/robust.md, "Cut only after the passes changed GNC's set").
+  /// `tessera solve --gnc-probe-cut always|after-passes`.
+  bool probe_cut_untouched = true;
   /// Distributed solvers only: most rounds of every solve before the final one (the first,
   /// unweighted solve and each weighted solve between two weight updates), >= 0, 0 = no cap.
   /// GNC needs only a rough minimiser between weight updates (dpgo's robust mode also updates
