@@ -54,6 +54,19 @@ class BlockLinks {
   std::vector<std::vector<std::pair<int, std::size_t>>> into_;
 };
 
+std::vector<std::size_t> block_sizes(const std::vector<int>& owner, int num_blocks) {
+  std::vector<std::size_t> size(static_cast<std::size_t>(num_blocks), 0);
+  for (int b : owner) ++size[static_cast<std::size_t>(b)];
+  return size;
+}
+
+// Poses whose block differs between `before` and `after` (a pose moved and moved back has not).
+std::size_t poses_changed(const std::vector<int>& before, const std::vector<int>& after) {
+  std::size_t changed = 0;
+  for (std::size_t k = 0; k < after.size(); ++k) changed += after[k] != before[k] ? 1 : 0;
+  return changed;
+}
+
 double balance_bound(std::size_t n, int num_blocks, const RebalanceOptions& options) {
   return (1.0 + options.slack) *
          std::ceil(static_cast<double>(n) / static_cast<double>(num_blocks));
@@ -144,8 +157,7 @@ std::size_t refine_with(const std::vector<std::vector<std::size_t>>& adjacent,
   lower = std::max<std::size_t>(lower, 1);
   const std::size_t n = owner.size();
   const std::vector<int> start = owner;
-  std::vector<std::size_t> size(static_cast<std::size_t>(num_blocks), 0);
-  for (int b : owner) ++size[static_cast<std::size_t>(b)];
+  std::vector<std::size_t> size = block_sizes(owner, num_blocks);
   BlockLinks into(adjacent, owner);
   // The best move of a pose: to a block it has a measurement into, below `bound`, from a
   // block above `lower`; the most cut measurements removed (links there minus links in
@@ -228,9 +240,7 @@ std::size_t refine_with(const std::vector<std::vector<std::size_t>>& adjacent,
     }
     if (best_total <= 0) break;
   }
-  std::size_t changed = 0;
-  for (std::size_t k = 0; k < n; ++k) changed += owner[k] != start[k] ? 1 : 0;
-  return changed;
+  return poses_changed(start, owner);
 }
 
 }  // namespace
@@ -254,8 +264,7 @@ RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner
   RebalanceResult res;
   const std::size_t n = graph.num_poses;
   if (owner.size() != n || num_blocks <= 0) return res;
-  std::vector<std::size_t> size(static_cast<std::size_t>(num_blocks), 0);
-  for (int b : owner) ++size[static_cast<std::size_t>(b)];
+  std::vector<std::size_t> size = block_sizes(owner, num_blocks);
   res.largest_before = *std::max_element(size.begin(), size.end());
   res.largest_after = res.largest_before;
   if (!options.enabled || num_blocks == 1) return res;
@@ -264,24 +273,24 @@ RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner
   const bool refine = options.cut_fraction < 1.0;
   const bool over = std::any_of(size.begin(), size.end(),
                                 [&](std::size_t s) { return static_cast<double>(s) > full; });
+  auto cut_high = [&](std::size_t cut) {
+    return refine && static_cast<double>(cut) >
+                         options.cut_fraction * static_cast<double>(graph.measurements.size());
+  };
   std::size_t cut = 0;
   if (refine) {
     cut = cut_measurements(graph, owner);
     res.cut_before = res.cut_after = cut;
   }
-  const bool cut_high =
-      refine && static_cast<double>(cut) >
-                    options.cut_fraction * static_cast<double>(graph.measurements.size());
   // Nothing over the bound and the cut low (most steps): done before the graph's adjacency is
   // built.
-  if (!over && !cut_high) return res;
+  if (!over && !cut_high(cut)) return res;
   const std::vector<std::vector<std::size_t>> adjacent = adjacency(graph);
   const std::vector<int> start = refine ? owner : std::vector<int>{};
   if (over) res.moved = balance_moves(adjacent, owner, size, num_blocks, bound, options);
   if (refine) {
     if (res.moved > 0) cut = cut_measurements(graph, owner);
-    if (static_cast<double>(cut) >
-        options.cut_fraction * static_cast<double>(graph.measurements.size())) {
+    if (cut_high(cut)) {
       res.refined = true;
       // Nor below (1 - slack) floor(n / N): a cut without a lower bound is smallest with one
       // block nearly empty, its agent idle (a robot that stopped publishing lost its block).
@@ -294,14 +303,12 @@ RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner
         cut = cut_measurements(graph, owner);
         // Poses that changed block in the call (a pose the balance moved and the refinement
         // moved back has not).
-        res.moved = 0;
-        for (std::size_t k = 0; k < n; ++k) res.moved += owner[k] != start[k] ? 1 : 0;
+        res.moved = poses_changed(start, owner);
       }
     }
     res.cut_after = cut;
   }
-  size.assign(static_cast<std::size_t>(num_blocks), 0);
-  for (int b : owner) ++size[static_cast<std::size_t>(b)];
+  size = block_sizes(owner, num_blocks);
   res.largest_after = *std::max_element(size.begin(), size.end());
   return res;
 }
