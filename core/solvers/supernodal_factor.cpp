@@ -48,17 +48,18 @@ struct SupernodalFactor::Impl {
   std::vector<int> perm;
   TripletScatter permuted;
   mutable Eigen::VectorXd scratch;
-  bool take_permutation(const SparseMatrix& lower);
+  void take_permutation(const SparseMatrix& lower);
 };
 
 // After a kAmd analysis: moves the factor's permutation P into s.perm, lays out the lower
 // triangle of lower(P, P) (s.permuted) and marks the factor as taking its input in that order
-// (natural ordering, identity Perm). False (factor untouched) where the layout fails.
-bool SupernodalFactor::Impl::take_permutation(const SparseMatrix& lower) {
+// (natural ordering, identity Perm). Where the layout fails, s.perm stays empty and the factor
+// untouched.
+void SupernodalFactor::Impl::take_permutation(const SparseMatrix& lower) {
   Impl& s = *this;
   cholmod_factor* L = s.L;
   const auto n = static_cast<Eigen::Index>(L->n);
-  if (!L->Perm || L->ordering == CHOLMOD_NATURAL) return false;
+  if (!L->Perm || L->ordering == CHOLMOD_NATURAL) return;
   const int* P = static_cast<const int*>(L->Perm);
   std::vector<int> inverse(static_cast<std::size_t>(n));
   for (Eigen::Index k = 0; k < n; ++k)
@@ -68,13 +69,13 @@ bool SupernodalFactor::Impl::take_permutation(const SparseMatrix& lower) {
   cols.reserve(static_cast<std::size_t>(lower.nonZeros()));
   for (Eigen::Index j = 0; j < n; ++j)
     for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
-      if (it.row() < j) return false;  // CHOLMOD reads the lower triangle only
+      if (it.row() < j) return;  // CHOLMOD reads the lower triangle only
       const int a = inverse[static_cast<std::size_t>(it.row())];
       const int b = inverse[static_cast<std::size_t>(j)];
       rows.push_back(std::max(a, b));
       cols.push_back(std::min(a, b));
     }
-  if (!s.permuted.build(n, rows, cols)) return false;
+  if (!s.permuted.build(n, rows, cols)) return;
   s.perm.assign(P, P + n);
   int* perm = static_cast<int*>(L->Perm);
   for (Eigen::Index k = 0; k < n; ++k) perm[k] = static_cast<int>(k);
@@ -83,7 +84,6 @@ bool SupernodalFactor::Impl::take_permutation(const SparseMatrix& lower) {
     for (Eigen::Index k = 0; k < n; ++k) iperm[k] = static_cast<int>(k);
   }
   L->ordering = CHOLMOD_NATURAL;
-  return true;
 }
 
 SupernodalFactor::SupernodalFactor(Ordering ordering) : impl_(std::make_unique<Impl>(ordering)) {}
@@ -112,10 +112,8 @@ bool SupernodalFactor::factor(const SparseMatrix& lower, double shift) {
     s.entries = static_cast<std::size_t>(s.c.lnz);
     s.flops = s.c.fl;
     s.perm.clear();
-    if (s.ordering == Ordering::kAmd && !s.take_permutation(lower)) {
-      // Keeps CHOLMOD's own permuted path (the same factor).
-      s.perm.clear();
-    }
+    // Where the layout fails (perm stays empty), CHOLMOD's own permuted path: the same factor.
+    if (s.ordering == Ordering::kAmd) s.take_permutation(lower);
   }
   double beta[2] = {shift, 0.0};
   if (!s.perm.empty()) {
