@@ -60,4 +60,31 @@ TEST(TripletScatter, RepeatedOrOutOfRangePositionsAreRefused) {
 }
 
 }  // namespace
+// assign() takes the entries as triplets: the same matrix as setFromTriplets at every point,
+// laid out again only when the positions change, and refused (nothing held) on a repeat.
+TEST(TripletScatter, AssignedTripletsGiveSetFromTripletsMatrixAndRelayoutOnNewPositions) {
+  auto same = [](const SparseMatrix& got, const std::vector<Eigen::Triplet<double>>& t) {
+    SparseMatrix want(4, 4);
+    want.setFromTriplets(t.begin(), t.end());
+    if (got.nonZeros() != want.nonZeros()) return false;
+    for (Eigen::Index i = 0; i < want.nonZeros(); ++i)
+      if (got.innerIndexPtr()[i] != want.innerIndexPtr()[i] ||
+          got.valuePtr()[i] != want.valuePtr()[i])
+        return false;
+    return true;
+  };
+  TripletScatter scatter;
+  std::vector<Eigen::Triplet<double>> t{{3, 0, 1.5}, {0, 0, 2.0}, {2, 1, 0.0}};
+  ASSERT_TRUE(scatter.assign(4, t));
+  EXPECT_TRUE(same(scatter.matrix(), t));
+  t = {{3, 0, -4.0}, {0, 0, 7.0}, {2, 1, 0.25}};  // same positions, new values
+  ASSERT_TRUE(scatter.assign(4, t));
+  EXPECT_TRUE(same(scatter.matrix(), t));
+  t = {{1, 1, 3.0}, {3, 0, 1.0}};  // new positions: laid out again
+  ASSERT_TRUE(scatter.assign(4, t));
+  EXPECT_TRUE(same(scatter.matrix(), t));
+  EXPECT_FALSE(scatter.assign(4, {{1, 1, 1.0}, {1, 1, 2.0}}));
+  EXPECT_THROW(scatter.fill(std::vector<double>{1.0, 2.0}), std::logic_error);
+}
+
 }  // namespace tessera

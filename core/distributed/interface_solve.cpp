@@ -377,21 +377,9 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
     }
     // Sigma's positions are those of the last point's unless the shares' layout changed.
     const std::vector<Eigen::Triplet<double>>& e = ground ? g : t;
-    std::vector<int> rows, cols;
-    std::vector<double> vals;
-    rows.reserve(e.size());
-    cols.reserve(e.size());
-    vals.reserve(e.size());
-    for (const auto& x : e) {
-      rows.push_back(static_cast<int>(x.row()));
-      cols.push_back(static_cast<int>(x.col()));
-      vals.push_back(x.value());
-    }
     TripletScatter& scatter = s.sigma_pattern[ground ? 1 : 0];
     SparseMatrix summed;  // where a position repeats (not from well-formed shares): summed
-    if (scatter.matches(s.team, rows, cols) || scatter.build(s.team, rows, cols)) {
-      scatter.fill(vals);
-    } else {
+    if (!scatter.assign(s.team, e)) {
       summed.resize(s.team, s.team);
       summed.setFromTriplets(e.begin(), e.end());
     }

@@ -65,6 +65,23 @@ bool TripletScatter::matches(Eigen::Index n, const std::vector<int>& rows,
   return n_ >= 0 && n == n_ && rows == rows_ && cols == cols_;
 }
 
+bool TripletScatter::assign(Eigen::Index n, const std::vector<Eigen::Triplet<double>>& entries) {
+  bool same = n_ >= 0 && n == n_ && entries.size() == rows_.size();
+  for (std::size_t k = 0; same && k < entries.size(); ++k)
+    same = entries[k].row() == rows_[k] && entries[k].col() == cols_[k];
+  if (!same) {
+    std::vector<int> rows(entries.size()), cols(entries.size());
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      rows[k] = static_cast<int>(entries[k].row());
+      cols[k] = static_cast<int>(entries[k].col());
+    }
+    if (!build(n, rows, cols)) return false;
+  }
+  double* v = matrix_.valuePtr();
+  for (std::size_t k = 0; k < entries.size(); ++k) v[where_[k]] = entries[k].value();
+  return true;
+}
+
 void TripletScatter::fill(const std::vector<double>& values) {
   fill(values.data(), values.size());
 }

@@ -27,6 +27,11 @@ class TripletScatter {
   /// The matrix keeps its pattern: the previous values are all overwritten.
   void fill(const std::vector<double>& values);
   void fill(const double* values, std::size_t count);
+  /// build() from the entries' positions unless the pattern already holds exactly those (same
+  /// n, same positions in the same order), then fill() with their values: the values of a
+  /// pattern seen before are written without copying the positions out. False (nothing held)
+  /// where build() fails.
+  bool assign(Eigen::Index n, const std::vector<Eigen::Triplet<double>>& entries);
   /// The assembled matrix (compressed columns, rows sorted within each column).
   const SparseMatrix& matrix() const { return matrix_; }
 
