@@ -134,7 +134,7 @@ dds::SubscriberQos subscriber_qos(const std::string& run_id) {
   return q;
 }
 
-dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_t num_agents,
+dds::DataWriterQos writer_qos(bool handshake, double lease_s, std::uint32_t num_agents,
                               const NetworkProfile& net, bool liveliness) {
   dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
   // Room to filter for every agent's reader on the writer's side (addressed_filter.hpp):
@@ -151,20 +151,19 @@ dds::DataWriterQos writer_qos(bool transient_local, double lease_s, std::uint32_
   keep_acknowledged_samples(q);
   // Bounded KEEP_ALL: unbounded limits let acknowledged samples pile up (hundreds of MB).
   q.history().kind = dds::KEEP_ALL_HISTORY_QOS;
-  const std::int32_t history = transient_local ? kWriterHistory : kVolatileWriterHistory;
+  const std::int32_t history = handshake ? kWriterHistory : kVolatileWriterHistory;
   q.resource_limits().max_samples = history;
   q.resource_limits().max_instances = 1;
   q.resource_limits().max_samples_per_instance = history;
   q.resource_limits().allocated_samples = 4;
   // The default 3 s heartbeat stalls request/reply exchanges for seconds after a loss.
-  q.reliable_writer_qos().times.heartbeatPeriod =
-      Duration_t(transient_local ? std::min(net.heartbeat_period_s, kHandshakeHeartbeatS)
-                                 : net.heartbeat_period_s);
+  q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(
+      handshake ? std::min(net.heartbeat_period_s, kHandshakeHeartbeatS) : net.heartbeat_period_s);
   q.reliable_writer_qos().times.nackResponseDelay = Duration_t(net.nack_response_delay_s);
   // Not Fast DDS's 0 on the volatile (per-round) topics: NetworkProfile::nack_suppression_s.
   // The hand-shake topics are written a few times a run and keep answering at once.
   q.reliable_writer_qos().times.nackSupressionDuration =
-      Duration_t(transient_local ? 0.0 : net.nack_suppression_s);
+      Duration_t(handshake ? 0.0 : net.nack_suppression_s);
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
   q.liveliness().lease_duration =
       liveliness ? Duration_t(lease_s) : eprosima::fastrtps::c_TimeInfinite;

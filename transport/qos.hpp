@@ -81,9 +81,11 @@ eprosima::fastdds::dds::PublisherQos publisher_qos(const std::string& run_id);
 eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);
 /// Reliable, bounded KEEP_ALL, heartbeat and repair delays of `net`, AUTOMATIC liveliness
 /// with `lease_s` (`liveliness` false: no liveliness lease at all).
-/// Writers are TRANSIENT_LOCAL on every topic (fastdds/reader_removal_lock_order.hpp);
-/// readers are TRANSIENT_LOCAL on the hand-shake topics (`transient_local`: late joiners
-/// still get them), VOLATILE otherwise (they get only what is written after they matched).
+/// `handshake` / `transient_local`: a hand-shake topic (written a few times a run: a short
+/// history, a short heartbeat, no NACK suppression). Writers are TRANSIENT_LOCAL on every topic
+/// (fastdds/reader_removal_lock_order.hpp); readers are TRANSIENT_LOCAL on the hand-shake topics
+/// (late joiners still get them), VOLATILE otherwise (they get only what is written after they
+/// matched).
 ///
 /// The per-round topics (pose blocks, round statuses) use `liveliness` false: with a lease,
 /// Fast DDS 2.9 asserts the writer's liveliness on every write and the reader's on every
@@ -92,7 +94,7 @@ eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);
 /// round over 6 processes). A dead peer is still noticed by the participant lease and by the
 /// liveliness of its set-up topics' writers (control, announcement, ...), which stay AUTOMATIC
 /// and are asserted by the participant's periodic liveliness messages.
-eprosima::fastdds::dds::DataWriterQos writer_qos(bool transient_local, double lease_s,
+eprosima::fastdds::dds::DataWriterQos writer_qos(bool handshake, double lease_s,
                                                  std::uint32_t num_agents,
                                                  const NetworkProfile& net, bool liveliness = true);
 eprosima::fastdds::dds::DataReaderQos reader_qos(bool transient_local, double lease_s,
