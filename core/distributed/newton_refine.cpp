@@ -61,6 +61,12 @@ NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout&
 
 NewtonRefineProtocol::~NewtonRefineProtocol() = default;
 
+int message_steps(const std::vector<NewtonRefineResult>& refines) {
+  int steps = 0;
+  for (const NewtonRefineResult& r : refines) steps += r.message_steps();
+  return steps;
+}
+
 void NewtonRefineProtocol::charge_to(double* part) {
   // The same part goes on: its time is charged at the next switch. Each reading of the thread's
   // CPU clock is a system call (no vDSO path for it), and a CG iteration of block Jacobi delivers

@@ -167,7 +167,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     for (const NewtonRefineResult& n : refines) {
       u.newton_steps += n.steps;
       u.newton_cg_iterations += n.cg_iterations;
-      u.newton_message_steps += n.exchanges + n.reductions;
+      u.newton_message_steps += n.message_steps();
     }
     // The step ended where the Newton steps stopped (grad_norm), or where the rounds after them
     // did.

@@ -401,8 +401,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     return;
   }
   gnc_rounds_ += solve_->total_rounds();
-  for (const NewtonRefineResult& r : solve_->refines())
-    gnc_refine_steps_ += r.exchanges + r.reductions;
+  gnc_refine_steps_ += message_steps(solve_->refines());
   if (solve_kind_ == GncSolveKind::kInlierPass) {
     last_pass_full_ = !pass_capped_;
     last_pass_cost_ = std::numeric_limits<double>::quiet_NaN();

@@ -184,8 +184,7 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   out.final_solve = solve_distributed_from_lifted(inliers, assignment, last, X);
   if (final_runs) {
     out.total_rounds += out.final_solve.rounds;
-    for (const NewtonRefineResult& n : out.final_solve.refines)
-      out.final_refine_message_steps += n.exchanges + n.reductions;
+    out.final_refine_message_steps = message_steps(out.final_solve.refines);
     out.total_bytes += out.final_solve.bytes_exchanged;
   }
   return out;

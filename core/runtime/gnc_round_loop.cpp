@@ -85,8 +85,7 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   report.refine_steps = agent.gnc_refine_steps();
   report.exchange_steps = agent.exchange_steps();
   if (const CertifiedAgent* final_solve = agent.final_sequence())
-    for (const NewtonRefineResult& n : final_solve->refines())
-      report.final_refine_steps += n.exchanges + n.reductions;
+    report.final_refine_steps += message_steps(final_solve->refines());
   res.robust = std::move(report);
 
   // The rounding sees the kept measurements (the cost is over them).

@@ -261,9 +261,11 @@ struct NewtonRefineStep {
   double grad_norm = 0.0;  ///< ||grad f|| there.
 };
 
-/// Where one agent's refinement went: its own thread's CPU seconds by part (every moment of
-/// start() and handle() is charged to exactly one part), and the wall from start() to the last
-/// step. Per agent (not identical across agents); CPU seconds hold whatever the load.
+/// Where one agent's refinement went: its own thread's CPU seconds by part (start() and the
+/// handling of every message that completes a step are charged to exactly one part; storing a
+/// message that completes no step is not timed: each reading of the thread's CPU clock is a
+/// system call), and the wall from start() to the last step. Per agent (not identical across
+/// agents); CPU seconds hold whatever the load.
 struct NewtonRefineTimes {
   double setup_s = 0.0;  ///< Start point's sums, the solves' orderings, translation factors.
   /// Each point's factorizations: the interface solves' block factors, Schur complements,
@@ -287,6 +289,8 @@ struct NewtonRefineResult {
   int steps = 0, accepted_steps = 0, cg_iterations = 0;
   /// Message steps: neighbour exchanges (CG directions and trial poses) and all-agent sums.
   int exchanges = 0, reductions = 0;
+  /// Both together: the refinement's waits for peers (a round of IRBCD is two).
+  int message_steps() const { return exchanges + reductions; }
   /// Coarse correction: its unknowns (pieces x generators; 0 without), and how many times its
   /// matrix was summed (one all-agent sum each, counted in `reductions`).
   int coarse_unknowns = 0, coarse_assemblies = 0;
@@ -308,6 +312,9 @@ struct NewtonRefineResult {
   std::vector<NewtonRefineStep> trace;
   NewtonRefineTimes times;  ///< This agent's.
 };
+
+/// Message steps of several refinements (the sum of their message_steps()).
+int message_steps(const std::vector<NewtonRefineResult>& refines);
 
 class NewtonRefineProtocol : public AgentProcess {
  public:
