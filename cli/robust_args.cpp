@@ -128,6 +128,14 @@ RobustOptions parse_robust_options(const Arguments& args) {
   return o;
 }
 
+void add_message_step_fields(JsonObject& json, const RobustMessageSteps& steps) {
+  json.add("total_rounds", steps.rounds)
+      .add("gnc_refine_steps", steps.gnc_refine_steps)
+      .add("gnc_exchange_steps", steps.exchange_steps)
+      .add("final_refine_steps", steps.final_refine_steps)
+      .add("message_steps_total", steps.total());
+}
+
 void add_robust_fields(JsonObject& json, const RobustSummary& s) {
   json.add("robust", robust_kind_name(s.options.kind))
       .add("outer_iterations", s.outer_iterations)

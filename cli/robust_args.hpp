@@ -54,6 +54,22 @@ struct RobustSummary {
 /// swap_probes_kept when set).
 void add_robust_fields(JsonObject& json, const RobustSummary& summary);
 
+/// A distributed robust run's message steps, each a wait for peers (docs/robust.md).
+struct RobustMessageSteps {
+  long long rounds = 0;              ///< Rounds of every solve, final included (two steps each).
+  long long gnc_refine_steps = 0;    ///< The Newton refinements' before the final solve.
+  long long final_refine_steps = 0;  ///< The final solve's Newton refinement's.
+  long long exchange_steps = 0;      ///< GNC's own exchanges (poses, votes, weights, gathers).
+  /// Every wait for peers of the run: 2 x rounds + the other three.
+  long long total() const {
+    return 2 * rounds + gnc_refine_steps + final_refine_steps + exchange_steps;
+  }
+};
+
+/// Appends total_rounds, gnc_refine_steps, gnc_exchange_steps, final_refine_steps and
+/// message_steps_total (`tessera solve` and the coordinator's summary alike).
+void add_message_step_fields(JsonObject& json, const RobustMessageSteps& steps);
+
 /// Writes one rejected index per line to `path` (InputError when it cannot).
 void write_rejected(const std::string& path, const std::vector<std::size_t>& rejected);
 

@@ -610,24 +610,14 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       rs.probes = gnc.probes;
       rs.probes_kept = gnc.probes_kept;
       add_robust_fields(j, rs);
-      j.add("total_rounds", gnc.total_rounds)
-          .add("gnc_refine_steps", gnc.refine_message_steps)
-          .add("gnc_exchange_steps", gnc.exchange_steps)
-          .add("final_refine_steps", gnc.final_refine_message_steps)
-          .add("total_bytes", static_cast<long long>(gnc.total_bytes));
-    }
-    // Every wait for peers of the run (docs/robust.md): two a round (docs/irbcd.md), the
-    // Newton refinements' neighbour exchanges and all-agent sums, and a robust run's own
-    // exchanges (poses, votes, weights, rejected sets, verdicts, gathers).
-    long long message_steps = 0;
-    if (robust.kind != RobustKind::kNone) {
-      message_steps = 2LL * gnc.total_rounds + gnc.refine_message_steps +
-                      gnc.final_refine_message_steps + gnc.exchange_steps;
+      add_message_step_fields(j, {gnc.total_rounds, gnc.refine_message_steps,
+                                  gnc.final_refine_message_steps, gnc.exchange_steps});
+      j.add("total_bytes", static_cast<long long>(gnc.total_bytes));
     } else {
-      message_steps = 2LL * r.rounds;
-      for (const NewtonRefineResult& n : r.refines) message_steps += n.exchanges + n.reductions;
+      // Every wait for peers of the run (docs/robust.md): two a round (docs/irbcd.md) and the
+      // Newton refinements' neighbour exchanges and all-agent sums.
+      j.add("message_steps_total", 2LL * r.rounds + message_steps(r.refines));
     }
-    j.add("message_steps_total", message_steps);
     write_output(*p, j.str());
   }
   return 0;

@@ -164,15 +164,9 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     rs.probes = r.robust->probes;
     rs.probes_kept = r.robust->probes_kept;
     cli::add_robust_fields(j, rs);
-    // Every wait for peers of the run: two a round (docs/irbcd.md), the refinements' neighbour
-    // exchanges and all-agent sums, and GNC's own exchanges (docs/robust.md).
-    const long long total = 2 * static_cast<long long>(in.merged.rounds) + r.robust->refine_steps +
-                            r.robust->final_refine_steps + r.robust->exchange_steps;
-    j.add("total_rounds", static_cast<long long>(in.merged.rounds))
-        .add("gnc_refine_steps", static_cast<long long>(r.robust->refine_steps))
-        .add("gnc_exchange_steps", static_cast<long long>(r.robust->exchange_steps))
-        .add("final_refine_steps", static_cast<long long>(r.robust->final_refine_steps))
-        .add("message_steps_total", total);
+    cli::add_message_step_fields(j,
+                                 {static_cast<long long>(in.merged.rounds), r.robust->refine_steps,
+                                  r.robust->final_refine_steps, r.robust->exchange_steps});
   } else {
     j.add("robust", robust_kind_name(o.robust.kind));
   }
