@@ -51,6 +51,14 @@ std::optional<std::size_t> GraphStream::id_of(const PoseKey& key) const {
   return it->second;
 }
 
+std::vector<int> GraphStream::robot_blocks_from(std::size_t first) const {
+  std::vector<int> block;
+  for (std::size_t k = first; k < robot_of_pose_.size(); ++k)
+    block.push_back(static_cast<int>(std::find(robots_.begin(), robots_.end(), robot_of_pose_[k]) -
+                                     robots_.begin()));
+  return block;
+}
+
 std::uint64_t GraphStream::absorbed_batches(std::uint32_t robot) const {
   auto it = next_sequence_.find(robot);
   return it == next_sequence_.end() ? 0 : it->second;

@@ -104,11 +104,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   // New poses join a block (their robot's, or the one holding most of their measurements);
   // then the blocks follow the graph's growth and cut.
   const auto& robots = stream_.robots();
-  std::vector<int> robot_block;
-  for (std::size_t k = owner_.size(); k < graph.num_poses; ++k)
-    robot_block.push_back(static_cast<int>(
-        std::find(robots.begin(), robots.end(), stream_.robot_of_pose()[k]) - robots.begin()));
-  assign_new_poses(graph, owner_, robot_block, options_.rebalance);
+  assign_new_poses(graph, owner_, stream_.robot_blocks_from(owner_.size()), options_.rebalance);
   const RebalanceResult moves =
       rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
   u.moved = moves.moved;

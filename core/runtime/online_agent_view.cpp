@@ -86,11 +86,7 @@ EnteredData OnlineAgentView::enter(const Watermarks& decision) {
   e.measurements = graph.measurements.size() - measurements_before;
   const auto& robots = stream_->robots();
   const std::size_t first_new = owner_.size();
-  std::vector<int> robot_block;
-  for (std::size_t k = first_new; k < graph.num_poses; ++k)
-    robot_block.push_back(static_cast<int>(
-        std::find(robots.begin(), robots.end(), stream_->robot_of_pose()[k]) - robots.begin()));
-  assign_new_poses(graph, owner_, robot_block, options_.rebalance);
+  assign_new_poses(graph, owner_, stream_->robot_blocks_from(first_new), options_.rebalance);
   RebalanceResult moves;
   if (lost_.empty()) {
     moves = rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);

@@ -53,6 +53,9 @@ class GraphStream {
   std::optional<std::size_t> id_of(const PoseKey& key) const;
   /// Robots seen so far, in order of their first absorbed pose.
   const std::vector<std::uint32_t>& robots() const { return robots_; }
+  /// For the poses from id `first` on: their robot's position in robots() (the block each
+  /// robot's agent starts with).
+  std::vector<int> robot_blocks_from(std::size_t first) const;
   /// Batches of `robot` absorbed so far (the next expected sequence number). Agents report it
   /// so they can agree on when a batch enters (absorb_gate.hpp).
   std::uint64_t absorbed_batches(std::uint32_t robot) const;
