@@ -8,7 +8,7 @@
 
 #include "distributed/interface_poses.hpp"
 #include "distributed/schur_share.hpp"
-#include "solvers/elimination_order.hpp"
+#include "solvers/interface_last_order.hpp"
 #include "solvers/supernodal_factor.hpp"
 #include "solvers/tangent_coordinates.hpp"
 #include "solvers/triplet_scatter.hpp"
@@ -130,25 +130,10 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
       all[col[k]].q[static_cast<std::size_t>(u * w + t)] = it.value();
     }
   }
-  // Interior order: AMD on the interior poses' pattern.
-  if (s.mI > 0) {
-    std::vector<Eigen::Index> interior_index(static_cast<std::size_t>(s.m), -1), interior;
-    for (Eigen::Index i = 0; i < s.m; ++i)
-      if (s.slot[static_cast<std::size_t>(i)] < 0) {
-        interior_index[static_cast<std::size_t>(i)] = static_cast<Eigen::Index>(interior.size());
-        interior.push_back(i);
-      }
-    std::vector<Eigen::Triplet<double>> t;
-    for (const PosePair& pp : all) {
-      const Eigen::Index a = interior_index[static_cast<std::size_t>(pp.i)];
-      const Eigen::Index c = interior_index[static_cast<std::size_t>(pp.j)];
-      if (a >= 0 && c >= 0) t.emplace_back(a, c, 1.0);
-    }
-    const std::vector<Eigen::Index> order = amd_elimination_order(s.mI, t);  // interior indices
-    for (Eigen::Index k = 0; k < s.mI; ++k)
-      s.slot[static_cast<std::size_t>(
-          interior[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])])] = k;
-  }
+  // Interior poses first (fill-reducing order), the interface's last.
+  place_interior_first(s.slot, [&](const auto& add) {
+    for (const PosePair& pp : all) add(pp.i, pp.j);
+  });
   for (PosePair& pp : all)
     if (s.slot[static_cast<std::size_t>(pp.i)] >= s.slot[static_cast<std::size_t>(pp.j)])
       s.pairs.push_back(std::move(pp));

@@ -8,7 +8,7 @@
 
 #include "distributed/interface_poses.hpp"
 #include "distributed/schur_share.hpp"
-#include "solvers/elimination_order.hpp"
+#include "solvers/interface_last_order.hpp"
 
 namespace tessera {
 
@@ -99,25 +99,10 @@ void TranslationInterfaceSolve::set_up(const std::vector<std::size_t>& owned,
     s.interface_local.push_back(it->second);
   }
 
-  // Interior order: AMD on the interior poses' pattern.
-  if (s.mI > 0) {
-    std::vector<Eigen::Index> interior_index(static_cast<std::size_t>(s.m), -1), interior;
-    for (Eigen::Index i = 0; i < s.m; ++i)
-      if (s.slot[static_cast<std::size_t>(i)] < 0) {
-        interior_index[static_cast<std::size_t>(i)] = static_cast<Eigen::Index>(interior.size());
-        interior.push_back(i);
-      }
-    std::vector<Eigen::Triplet<double>> t;
-    for (const auto& e : entries) {
-      const Eigen::Index a = interior_index[static_cast<std::size_t>(e.row())];
-      const Eigen::Index c = interior_index[static_cast<std::size_t>(e.col())];
-      if (a >= 0 && c >= 0) t.emplace_back(a, c, 1.0);
-    }
-    const std::vector<Eigen::Index> order = amd_elimination_order(s.mI, t);  // interior indices
-    for (Eigen::Index k = 0; k < s.mI; ++k)
-      s.slot[static_cast<std::size_t>(
-          interior[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])])] = k;
-  }
+  // Interior poses first (fill-reducing order), the interface's last.
+  place_interior_first(s.slot, [&](const auto& add) {
+    for (const auto& e : entries) add(e.row(), e.col());
+  });
 
   std::vector<Eigen::Triplet<double>> lower;
   for (const auto& e : entries) {
