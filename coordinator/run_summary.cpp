@@ -164,9 +164,9 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     rs.probes = r.robust->probes;
     rs.probes_kept = r.robust->probes_kept;
     cli::add_robust_fields(j, rs);
-    cli::add_message_step_fields(j,
-                                 {static_cast<long long>(in.merged.rounds), r.robust->refine_steps,
-                                  r.robust->final_refine_steps, r.robust->exchange_steps});
+    cli::add_message_step_fields(
+        j, {static_cast<long long>(in.merged.rounds), r.robust->refine_message_steps,
+            r.robust->final_refine_steps, r.robust->exchange_steps});
   } else {
     j.add("robust", robust_kind_name(o.robust.kind));
   }
