@@ -136,6 +136,22 @@ void add_message_step_fields(JsonObject& json, const RobustMessageSteps& steps) 
       .add("message_steps_total", steps.total());
 }
 
+RobustSummary distributed_robust_summary(const RobustOptions& options, const GncAgentResult& gnc,
+                                         int total_iterations, std::size_t measurements) {
+  RobustSummary rs;
+  rs.options = options;
+  rs.outer_iterations = gnc.outer_iterations;
+  rs.total_iterations = total_iterations;
+  rs.measurements = measurements;
+  rs.rejected = gnc.rejected;
+  rs.threshold_squared = gnc.threshold_squared;
+  rs.weights_converged = gnc.weights_converged;
+  rs.readmitted = gnc.readmitted;
+  rs.probes = gnc.probes;
+  rs.probes_kept = gnc.probes_kept;
+  return rs;
+}
+
 void add_robust_fields(JsonObject& json, const RobustSummary& s) {
   json.add("robust", robust_kind_name(s.options.kind))
       .add("outer_iterations", s.outer_iterations)

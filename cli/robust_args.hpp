@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <tessera/robust/gnc_agent_result.hpp>
 #include <tessera/robust/robust_options.hpp>
 #include <vector>
 
@@ -47,6 +48,12 @@ struct RobustSummary {
   int swap_probes = -1;
   int swap_probes_kept = 0;
 };
+
+/// A distributed robust run's summary: `options`, the agents' result (GncAgentResult: the
+/// in-process driver's GncDistributedResult or agent 0's report over DDS), the rounds of every
+/// solve (total_iterations) and the graph's measurement count.
+RobustSummary distributed_robust_summary(const RobustOptions& options, const GncAgentResult& gnc,
+                                         int total_iterations, std::size_t measurements);
 
 /// Appends robust, outer_iterations, total_iterations, inliers, outliers, rejected,
 /// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged, readmitted,

@@ -598,18 +598,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     }
     if (fstar) j.add("f_star", *fstar);
     if (robust.kind != RobustKind::kNone) {
-      RobustSummary rs;
-      rs.options = robust;
-      rs.outer_iterations = gnc.outer_iterations;
-      rs.total_iterations = gnc.total_rounds;
-      rs.measurements = graph.num_measurements();
-      rs.rejected = gnc.rejected;
-      rs.threshold_squared = gnc.threshold_squared;
-      rs.weights_converged = gnc.weights_converged;
-      rs.readmitted = gnc.readmitted;
-      rs.probes = gnc.probes;
-      rs.probes_kept = gnc.probes_kept;
-      add_robust_fields(j, rs);
+      add_robust_fields(
+          j, distributed_robust_summary(robust, gnc, gnc.total_rounds, graph.num_measurements()));
       add_message_step_fields(j, {gnc.total_rounds, gnc.refine_message_steps,
                                   gnc.final_refine_message_steps, gnc.exchange_steps});
       j.add("total_bytes", static_cast<long long>(gnc.total_bytes));

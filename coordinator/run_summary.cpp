@@ -152,21 +152,12 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     j.add("final_rank", static_cast<long long>(o.rank ? o.rank : 5));
   }
   if (r.robust) {
-    cli::RobustSummary rs;
-    rs.options = o.robust;
-    rs.outer_iterations = r.robust->outer_iterations;
-    rs.total_iterations = static_cast<int>(in.merged.rounds);
-    rs.measurements = in.structure.num_measurements;
-    rs.rejected = r.robust->rejected;
-    rs.threshold_squared = r.robust->threshold_squared;
-    rs.weights_converged = r.robust->weights_converged;
-    rs.readmitted = r.robust->readmitted;
-    rs.probes = r.robust->probes;
-    rs.probes_kept = r.robust->probes_kept;
-    cli::add_robust_fields(j, rs);
-    cli::add_message_step_fields(j,
-                                 {static_cast<long long>(in.merged.rounds), r.robust->refine_steps,
-                                  r.robust->final_refine_steps, r.robust->exchange_steps});
+    cli::add_robust_fields(
+        j, cli::distributed_robust_summary(o.robust, *r.robust, static_cast<int>(in.merged.rounds),
+                                           in.structure.num_measurements));
+    cli::add_message_step_fields(
+        j, {static_cast<long long>(in.merged.rounds), r.robust->refine_message_steps,
+            r.robust->final_refine_steps, r.robust->exchange_steps});
   } else {
     j.add("robust", robust_kind_name(o.robust.kind));
   }

@@ -80,6 +80,10 @@ TEST(DdsFilePartition, AnotherStructureDoesNotFitAndAnUnreadableFileIsNoPartitio
 
 // Coordinator `--graph coordinator_file` + 3 agents on `graph` (coordinator first, so the
 // agents start while it partitions); the agents' owners must be `partition_graph` of `graph`.
+// Preset `eco` (7 ms of CPU for this graph), not `highest` (2.1 CPU-s): with another file the
+// coordinator partitions twice while the agents wait for their assignment under their 20 s
+// --timeout, and at load 12-21 on a 2-core host the two `highest` partitions took 25-34 s of
+// wall. Which partition the run uses does not depend on the preset.
 void expect_partition_of_the_agents_graph(const std::string& coordinator_file, int domain,
                                           bool expect_early) {
   const std::string dir = temp_dir();
@@ -91,14 +95,14 @@ void expect_partition_of_the_agents_graph(const std::string& coordinator_file, i
                                           "--run-timeout",    "60",
                                           "--summary",        dir + "/summary.json",
                                           "--init",           "file",
-                                          "--partition",      "highest",
+                                          "--partition",      "eco",
                                           "--partition-seed", "2",
                                           "--graph",          dir + "/" + coordinator_file,
                                           "--verbose"};
   run_to_the_end(dir, graph, 3, run, domain, cargs, 90);
   PartitionOptions popt;
   popt.parts = 3;
-  popt.preset = parse_preset("highest");
+  popt.preset = parse_preset("eco");
   popt.seed = 2;
   popt.objective = PartitionObjective::kRounds;  // the coordinator's (partition_step.hpp)
   const std::vector<int> part =

@@ -506,7 +506,7 @@ TEST(DdsReportMapping, EveryReportComesBackFieldForField) {
   r.weights_converged = true;
   r.probes = 2;
   r.probes_kept = 1;
-  r.refine_steps = 37;
+  r.refine_message_steps = 37;
   r.exchange_steps = 61;
   r.final_refine_steps = 3;
   const auto robust = std::get<agent::RobustRunReport>(report_round_trip(r));
@@ -517,7 +517,7 @@ TEST(DdsReportMapping, EveryReportComesBackFieldForField) {
   EXPECT_TRUE(robust.weights_converged);
   EXPECT_EQ(robust.probes, 2);
   EXPECT_EQ(robust.probes_kept, 1);
-  EXPECT_EQ(robust.refine_steps, 37);
+  EXPECT_EQ(robust.refine_message_steps, 37);
   EXPECT_EQ(robust.exchange_steps, 61);
   EXPECT_EQ(robust.final_refine_steps, 3);
 

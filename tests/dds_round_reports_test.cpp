@@ -138,7 +138,7 @@ TEST(RoundReports, TheFinalReportAndTheCertificateAreKeptAsTheyCame) {
   EXPECT_EQ(res.certificate->bound.lower_bound, 1025.25);
   EXPECT_EQ(res.certificate_bytes->certificate_bytes, 142578u);
   ASSERT_TRUE(res.robust.has_value());
-  EXPECT_EQ(res.robust->rejected, (std::vector<std::uint64_t>{3, 9}));
+  EXPECT_EQ(res.robust->rejected, (std::vector<std::size_t>{3, 9}));
   EXPECT_EQ(res.robust->outer_iterations, 29);
 }
 

@@ -63,7 +63,7 @@ wire::AgentReportBody body_of(const agent::RobustRunReport& r) {
   w.weights_converged(r.weights_converged);
   w.probes(static_cast<std::uint32_t>(r.probes));
   w.probes_kept(static_cast<std::uint32_t>(r.probes_kept));
-  w.refine_steps(static_cast<std::uint32_t>(r.refine_steps));
+  w.refine_steps(static_cast<std::uint32_t>(r.refine_message_steps));
   w.exchange_steps(static_cast<std::uint32_t>(r.exchange_steps));
   w.final_refine_steps(static_cast<std::uint32_t>(r.final_refine_steps));
   wire::AgentReportBody b;
@@ -168,7 +168,7 @@ agent::AgentReport from_wire(const wire::AgentReport& w) {
       r.weights_converged = x.weights_converged();
       r.probes = static_cast<int>(x.probes());
       r.probes_kept = static_cast<int>(x.probes_kept());
-      r.refine_steps = static_cast<int>(x.refine_steps());
+      r.refine_message_steps = static_cast<int>(x.refine_steps());
       r.exchange_steps = static_cast<int>(x.exchange_steps());
       r.final_refine_steps = static_cast<int>(x.final_refine_steps());
       return r;

@@ -8,7 +8,7 @@
 #include <unordered_map>
 
 #include "solvers/cholmod_checked.hpp"
-#include "solvers/elimination_order.hpp"
+#include "solvers/interface_last_order.hpp"
 #include "util/serial_blas.hpp"
 
 // BLAS (the one CHOLMOD's supernodal factorization runs on): C = A A^T, lower triangle.
@@ -173,30 +173,12 @@ InterfaceSchurBlock local_separator_schur(const BlockProblem& problem, const Spa
   out.poses = kept;
   for (std::size_t k : foreign) out.poses.push_back(neighbors[k]);
 
-  std::vector<Eigen::Index> interior;  // old coordinate of interior index i
-  interior.reserve(static_cast<std::size_t>(nI));
-  for (Eigen::Index c = 0; c < n; ++c)
-    if (pos[static_cast<std::size_t>(c)] < 0) interior.push_back(c);
-  std::vector<Eigen::Index> interior_index(static_cast<std::size_t>(n), -1);
-  for (std::size_t i = 0; i < interior.size(); ++i)
-    interior_index[static_cast<std::size_t>(interior[i])] = static_cast<Eigen::Index>(i);
-
   const SparseMatrix A = problem.data_matrix() - lambda;
-  if (nI > 0) {
-    std::vector<Eigen::Triplet<double>> t;
-    for (Eigen::Index col = 0; col < n; ++col) {
-      const Eigen::Index jc = interior_index[static_cast<std::size_t>(col)];
-      if (jc < 0) continue;
-      for (SparseMatrix::InnerIterator it(A, col); it; ++it) {
-        const Eigen::Index ic = interior_index[static_cast<std::size_t>(it.row())];
-        if (ic >= 0) t.emplace_back(ic, jc, 1.0);
-      }
-    }
-    const std::vector<Eigen::Index> order = amd_elimination_order(nI, t);  // interior indices
-    for (Eigen::Index k = 0; k < nI; ++k)
-      pos[static_cast<std::size_t>(
-          interior[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])])] = k;
-  }
+  place_interior_first(pos, [&](const auto& add) {
+    for (Eigen::Index col = 0; col < n; ++col)
+      if (pos[static_cast<std::size_t>(col)] < 0)  // an interior column
+        for (SparseMatrix::InnerIterator it(A, col); it; ++it) add(it.row(), col);
+  });
 
   // The foreign poses' diagonal is a placeholder kappa I (their own block holds their entries):
   // large enough that the trailing block factors, then subtracted from the Schur complement.

@@ -8,7 +8,8 @@
 
 #include "distributed/interface_poses.hpp"
 #include "distributed/schur_share.hpp"
-#include "solvers/elimination_order.hpp"
+#include "distributed/team_interface.hpp"
+#include "solvers/interface_last_order.hpp"
 #include "solvers/supernodal_factor.hpp"
 #include "solvers/tangent_coordinates.hpp"
 #include "solvers/triplet_scatter.hpp"
@@ -49,10 +50,8 @@ struct InterfaceSolve::Impl {
   std::vector<PosePair> pairs;         // Q_BB's pose blocks with slot[i] >= slot[j]
   std::vector<PosePair> cut;           // Q's cut blocks (i own, j neighbour), own id < other id
   std::vector<std::size_t> owned, neighbors;
-  // The team's interface: first coordinate of each interface pose in Sigma.
-  std::unordered_map<std::size_t, Eigen::Index> team_index;
-  std::vector<Eigen::Index> block_offset, block_size;  // per block, in coordinates
-  Eigen::Index team = 0, own_offset = 0;
+  TeamInterface team;  // the team's interface in Sigma, in tangent coordinates
+  Eigen::Index own_offset = 0;
   int id = 0;
   // The block's factor A_bb = L L^T in the order above, and L's trailing interface block (both
   // patterns are the same at every point: one analysis each); and the same at a trial point
@@ -88,29 +87,12 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
   s.m = static_cast<Eigen::Index>(s.owned.size());
   const Eigen::Index w = s.w;
 
-  // The team's interface, blocks in id order, each one's poses ascending.
-  for (int b = 0; b < layout.num_blocks; ++b) {
-    const std::vector<std::size_t> poses = interface_poses(layout, b);
-    s.block_offset.push_back(s.team);
-    s.block_size.push_back(s.p * static_cast<Eigen::Index>(poses.size()));
-    for (std::size_t pose : poses) {
-      s.team_index.emplace(pose, s.team);
-      s.team += s.p;
-    }
-  }
-  s.own_offset = s.block_offset[static_cast<std::size_t>(id)];
-
-  std::unordered_map<std::size_t, Eigen::Index> local;
-  for (Eigen::Index i = 0; i < s.m; ++i) local.emplace(s.owned[static_cast<std::size_t>(i)], i);
-  const std::vector<std::size_t> own_interface = interface_poses(layout, id);
-  s.mG = static_cast<Eigen::Index>(own_interface.size());
-  s.mI = s.m - s.mG;
-  s.slot.assign(static_cast<std::size_t>(s.m), -1);
-  for (std::size_t k = 0; k < own_interface.size(); ++k) {
-    auto it = local.find(own_interface[k]);
-    if (it == local.end()) throw std::logic_error("InterfaceSolve: interface pose not owned");
-    s.slot[static_cast<std::size_t>(it->second)] = s.mI + static_cast<Eigen::Index>(k);
-  }
+  s.team = team_interface(layout, s.p);
+  s.own_offset = s.team.block_offset[static_cast<std::size_t>(id)];
+  OwnInterfaceLast own = own_interface_last(s.owned, layout, id, "InterfaceSolve");
+  s.slot = std::move(own.slot);
+  s.mI = own.interior;
+  s.mG = s.m - s.mI;
 
   // Q_BB's pose blocks.
   const SparseMatrix& Q = problem.data_matrix();
@@ -130,25 +112,10 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
       all[col[k]].q[static_cast<std::size_t>(u * w + t)] = it.value();
     }
   }
-  // Interior order: AMD on the interior poses' pattern.
-  if (s.mI > 0) {
-    std::vector<Eigen::Index> interior_index(static_cast<std::size_t>(s.m), -1), interior;
-    for (Eigen::Index i = 0; i < s.m; ++i)
-      if (s.slot[static_cast<std::size_t>(i)] < 0) {
-        interior_index[static_cast<std::size_t>(i)] = static_cast<Eigen::Index>(interior.size());
-        interior.push_back(i);
-      }
-    std::vector<Eigen::Triplet<double>> t;
-    for (const PosePair& pp : all) {
-      const Eigen::Index a = interior_index[static_cast<std::size_t>(pp.i)];
-      const Eigen::Index c = interior_index[static_cast<std::size_t>(pp.j)];
-      if (a >= 0 && c >= 0) t.emplace_back(a, c, 1.0);
-    }
-    const std::vector<Eigen::Index> order = amd_elimination_order(s.mI, t);  // interior indices
-    for (Eigen::Index k = 0; k < s.mI; ++k)
-      s.slot[static_cast<std::size_t>(
-          interior[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])])] = k;
-  }
+  // Interior poses first (fill-reducing order), the interface's last.
+  place_interior_first(s.slot, [&](const auto& add) {
+    for (const PosePair& pp : all) add(pp.i, pp.j);
+  });
   for (PosePair& pp : all)
     if (s.slot[static_cast<std::size_t>(pp.i)] >= s.slot[static_cast<std::size_t>(pp.j)])
       s.pairs.push_back(std::move(pp));
@@ -176,7 +143,7 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
 InterfaceSolve::~InterfaceSolve() = default;
 
 Eigen::Index InterfaceSolve::team_size() const {
-  return impl_->team;
+  return impl_->team.size;
 }
 Eigen::Index InterfaceSolve::offset() const {
   return impl_->own_offset;
@@ -185,10 +152,10 @@ Eigen::Index InterfaceSolve::size() const {
   return impl_->p * impl_->mG;
 }
 Eigen::Index InterfaceSolve::block_offset(int b) const {
-  return impl_->block_offset.at(static_cast<std::size_t>(b));
+  return impl_->team.block_offset.at(static_cast<std::size_t>(b));
 }
 Eigen::Index InterfaceSolve::block_size(int b) const {
-  return impl_->block_size.at(static_cast<std::size_t>(b));
+  return impl_->team.block_size.at(static_cast<std::size_t>(b));
 }
 double InterfaceSolve::shift() const {
   return impl_->shift;
@@ -328,7 +295,7 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
   const int p = s.p;
   s.sigma_ok = false;
   s.shift = 0.0;
-  if (blocks.size() != s.block_offset.size())
+  if (blocks.size() != s.team.block_offset.size())
     throw std::runtime_error("newton refine: interface shares from the wrong number of agents");
   std::vector<Eigen::Triplet<double>> t;
   double top = 0.0;
@@ -339,15 +306,15 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
                                std::to_string(b));
     };
     std::size_t k = 0;
-    if (!read_schur_triangle(v, s.block_offset[b], s.block_size[b], t, top, k, fail))
+    if (!read_schur_triangle(v, s.team.block_offset[b], s.team.block_size[b], t, top, k, fail))
       return false;  // that block's Hessian is not positive definite
     const double count = v[k++];
     const std::size_t per = static_cast<std::size_t>(2 + p * p);
     if (!(count >= 0) || v.size() != k + static_cast<std::size_t>(count) * per) fail();
     for (std::size_t e = 0; e < static_cast<std::size_t>(count); ++e, k += per) {
-      auto ri = s.team_index.find(static_cast<std::size_t>(v[k]));
-      auto ci = s.team_index.find(static_cast<std::size_t>(v[k + 1]));
-      if (ri == s.team_index.end() || ci == s.team_index.end()) fail();
+      auto ri = s.team.first.find(static_cast<std::size_t>(v[k]));
+      auto ci = s.team.first.find(static_cast<std::size_t>(v[k + 1]));
+      if (ri == s.team.first.end() || ci == s.team.first.end()) fail();
       for (int c = 0; c < p; ++c)
         for (int a = 0; a < p; ++a) {
           // Zeros too: Sigma's pattern, and so its factor's analysis, stays that of the cut.
@@ -357,7 +324,7 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
         }
     }
   }
-  if (s.team == 0) return false;
+  if (s.team.size == 0) return false;
   // Grounded: the team's first interface pose is held fixed, its rows and columns replaced by
   // top I (u there is then 0 to the bit from a zero rhat there). The gauge is Sigma's kernel on
   // a connected graph; shifted instead, H + eta P_Gamma left it at eigenvalues of eta times the
@@ -367,7 +334,7 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
   // gradient the model counted as a decrease of 4.8e-6 that f (exactly invariant) could not
   // give (2.7e-8). The shifts remain for a Sigma that is indefinite away from a minimiser.
   for (bool ground : {true, false}) {
-    if (ground && (s.team <= p)) continue;
+    if (ground && (s.team.size <= p)) continue;
     std::vector<Eigen::Triplet<double>> g;
     if (ground) {
       g.reserve(t.size() + static_cast<std::size_t>(p));
@@ -379,8 +346,8 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
     const std::vector<Eigen::Triplet<double>>& e = ground ? g : t;
     TripletScatter& scatter = s.sigma_pattern[ground ? 1 : 0];
     SparseMatrix summed;  // where a position repeats (not from well-formed shares): summed
-    if (!scatter.assign(s.team, e)) {
-      summed.resize(s.team, s.team);
+    if (!scatter.assign(s.team.size, e)) {
+      summed.resize(s.team.size, s.team.size);
       summed.setFromTriplets(e.begin(), e.end());
     }
     const SparseMatrix& sigma = summed.rows() > 0 ? summed : scatter.matrix();

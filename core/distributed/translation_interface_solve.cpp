@@ -8,7 +8,8 @@
 
 #include "distributed/interface_poses.hpp"
 #include "distributed/schur_share.hpp"
-#include "solvers/elimination_order.hpp"
+#include "distributed/team_interface.hpp"
+#include "solvers/interface_last_order.hpp"
 
 namespace tessera {
 
@@ -24,9 +25,8 @@ struct TranslationInterfaceSolve::Impl {
   std::vector<Eigen::Index> slot;             // local pose -> position in the factor's order
   std::vector<Eigen::Index> interface_local;  // the own interface poses' local indices
   std::vector<Coupling> cut;                  // own < other
-  std::unordered_map<std::size_t, Eigen::Index> team_row;
-  std::vector<Eigen::Index> block_offset, block_size;
-  Eigen::Index team = 0, own_offset = 0;
+  TeamInterface team;                         // the team's interface in Sigma, one row a pose
+  Eigen::Index own_offset = 0;
   // L_BB = L D L^T in the order above; L's trailing interface block; D's interior inverse.
   Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt;
   bool block_ok = false;
@@ -76,48 +76,18 @@ void TranslationInterfaceSolve::set_up(const std::vector<std::size_t>& owned,
                                        int id) {
   Impl& s = *impl_;
   s.m = static_cast<Eigen::Index>(owned.size());
-  // The team's interface, blocks in id order, each one's poses ascending.
-  for (int b = 0; b < layout.num_blocks; ++b) {
-    const std::vector<std::size_t> poses = interface_poses(layout, b);
-    s.block_offset.push_back(s.team);
-    s.block_size.push_back(static_cast<Eigen::Index>(poses.size()));
-    for (std::size_t pose : poses) s.team_row.emplace(pose, s.team++);
-  }
-  s.own_offset = s.block_offset.at(static_cast<std::size_t>(id));
+  s.team = team_interface(layout, 1);
+  s.own_offset = s.team.block_offset.at(static_cast<std::size_t>(id));
+  OwnInterfaceLast own = own_interface_last(owned, layout, id, "TranslationInterfaceSolve");
+  s.slot = std::move(own.slot);
+  s.interface_local = std::move(own.local);
+  s.mI = own.interior;
+  s.mG = s.m - s.mI;
 
-  std::unordered_map<std::size_t, Eigen::Index> local;
-  for (Eigen::Index i = 0; i < s.m; ++i) local.emplace(owned[static_cast<std::size_t>(i)], i);
-  const std::vector<std::size_t> own_interface = interface_poses(layout, id);
-  s.mG = static_cast<Eigen::Index>(own_interface.size());
-  s.mI = s.m - s.mG;
-  s.slot.assign(static_cast<std::size_t>(s.m), -1);
-  for (std::size_t k = 0; k < own_interface.size(); ++k) {
-    auto it = local.find(own_interface[k]);
-    if (it == local.end())
-      throw std::logic_error("TranslationInterfaceSolve: interface pose not owned");
-    s.slot[static_cast<std::size_t>(it->second)] = s.mI + static_cast<Eigen::Index>(k);
-    s.interface_local.push_back(it->second);
-  }
-
-  // Interior order: AMD on the interior poses' pattern.
-  if (s.mI > 0) {
-    std::vector<Eigen::Index> interior_index(static_cast<std::size_t>(s.m), -1), interior;
-    for (Eigen::Index i = 0; i < s.m; ++i)
-      if (s.slot[static_cast<std::size_t>(i)] < 0) {
-        interior_index[static_cast<std::size_t>(i)] = static_cast<Eigen::Index>(interior.size());
-        interior.push_back(i);
-      }
-    std::vector<Eigen::Triplet<double>> t;
-    for (const auto& e : entries) {
-      const Eigen::Index a = interior_index[static_cast<std::size_t>(e.row())];
-      const Eigen::Index c = interior_index[static_cast<std::size_t>(e.col())];
-      if (a >= 0 && c >= 0) t.emplace_back(a, c, 1.0);
-    }
-    const std::vector<Eigen::Index> order = amd_elimination_order(s.mI, t);  // interior indices
-    for (Eigen::Index k = 0; k < s.mI; ++k)
-      s.slot[static_cast<std::size_t>(
-          interior[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])])] = k;
-  }
+  // Interior poses first (fill-reducing order), the interface's last.
+  place_interior_first(s.slot, [&](const auto& add) {
+    for (const auto& e : entries) add(e.row(), e.col());
+  });
 
   std::vector<Eigen::Triplet<double>> lower;
   for (const auto& e : entries) {
@@ -143,7 +113,7 @@ void TranslationInterfaceSolve::set_up(const std::vector<std::size_t>& owned,
   // layout's interface cannot be placed in Sigma: the block says so in its share.
   for (const Coupling& c : cut) {
     if (c.own >= c.other) continue;
-    if (s.team_row.count(c.own) == 0 || s.team_row.count(c.other) == 0) s.block_ok = false;
+    if (s.team.first.count(c.own) == 0 || s.team.first.count(c.other) == 0) s.block_ok = false;
     s.cut.push_back(c);
   }
 }
@@ -151,7 +121,7 @@ void TranslationInterfaceSolve::set_up(const std::vector<std::size_t>& owned,
 TranslationInterfaceSolve::~TranslationInterfaceSolve() = default;
 
 Eigen::Index TranslationInterfaceSolve::team_size() const {
-  return impl_->team;
+  return impl_->team.size;
 }
 Eigen::Index TranslationInterfaceSolve::offset() const {
   return impl_->own_offset;
@@ -160,14 +130,14 @@ Eigen::Index TranslationInterfaceSolve::size() const {
   return impl_->mG;
 }
 Eigen::Index TranslationInterfaceSolve::block_offset(int b) const {
-  return impl_->block_offset.at(static_cast<std::size_t>(b));
+  return impl_->team.block_offset.at(static_cast<std::size_t>(b));
 }
 Eigen::Index TranslationInterfaceSolve::block_size(int b) const {
-  return impl_->block_size.at(static_cast<std::size_t>(b));
+  return impl_->team.block_size.at(static_cast<std::size_t>(b));
 }
 Eigen::Index TranslationInterfaceSolve::team_row(std::size_t pose) const {
-  auto it = impl_->team_row.find(pose);
-  return it == impl_->team_row.end() ? -1 : it->second;
+  auto it = impl_->team.first.find(pose);
+  return it == impl_->team.first.end() ? -1 : it->second;
 }
 bool TranslationInterfaceSolve::ready() const {
   return impl_->sigma_ok;
@@ -195,7 +165,7 @@ std::vector<double> TranslationInterfaceSolve::share() const {
 bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blocks) {
   Impl& s = *impl_;
   s.sigma_ok = false;
-  if (blocks.size() != s.block_offset.size())
+  if (blocks.size() != s.team.block_offset.size())
     throw std::runtime_error("translation interface solve: shares from the wrong number of agents");
   std::vector<Eigen::Triplet<double>> t;
   double top = 0.0;
@@ -206,7 +176,7 @@ bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<dou
                                std::to_string(b));
     };
     std::size_t k = 0;
-    if (!read_schur_triangle(v, s.block_offset[b], s.block_size[b], t, top, k, fail))
+    if (!read_schur_triangle(v, s.team.block_offset[b], s.team.block_size[b], t, top, k, fail))
       return false;  // that block's L_BB is not positive definite
     const double count = v[k++];
     if (!(count >= 0) || v.size() != k + 3 * static_cast<std::size_t>(count)) fail();
@@ -217,15 +187,15 @@ bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<dou
       t.emplace_back(std::max(r, c), std::min(r, c), v[k + 2]);
     }
   }
-  if (s.team == 0) return false;
+  if (s.team.size == 0) return false;
   // Grounded: the first interface pose's row and column dropped (the constants are Sigma's
   // kernel on a connected graph, so the rest is positive definite and solved exactly).
-  if (s.team > 1) {
+  if (s.team.size > 1) {
     std::vector<Eigen::Triplet<double>> g;
     g.reserve(t.size());
     for (const auto& e : t)
       if (e.row() > 0 && e.col() > 0) g.emplace_back(e.row() - 1, e.col() - 1, e.value());
-    SparseMatrix reduced(s.team - 1, s.team - 1);
+    SparseMatrix reduced(s.team.size - 1, s.team.size - 1);
     reduced.setFromTriplets(g.begin(), g.end());
     s.sigma.compute(reduced);
     if (s.sigma.info() == Eigen::Success) {
@@ -233,9 +203,9 @@ bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<dou
       return true;
     }
   }
-  SparseMatrix sigma(s.team, s.team);
+  SparseMatrix sigma(s.team.size, s.team.size);
   sigma.setFromTriplets(t.begin(), t.end());
-  SparseMatrix I(s.team, s.team);
+  SparseMatrix I(s.team.size, s.team.size);
   I.setIdentity();
   s.sigma.compute(sigma + 1e-10 * std::max(top, 1e-300) * I);
   s.grounded = false;
@@ -261,9 +231,9 @@ Eigen::MatrixXd TranslationInterfaceSolve::solve_interface(const Eigen::MatrixXd
   const Impl& s = *impl_;
   if (!s.sigma_ok) throw std::logic_error("TranslationInterfaceSolve: no factor of Sigma");
   if (!s.grounded) return s.sigma.solve(rhat);
-  Eigen::MatrixXd u(s.team, rhat.cols());
+  Eigen::MatrixXd u(s.team.size, rhat.cols());
   u.row(0).setZero();
-  u.bottomRows(s.team - 1) = s.sigma.solve(rhat.bottomRows(s.team - 1));
+  u.bottomRows(s.team.size - 1) = s.sigma.solve(rhat.bottomRows(s.team.size - 1));
   return u;
 }
 

@@ -80,6 +80,20 @@ int GncAgent::total_rounds() const {
   return gnc_rounds_ + final_rounds_;
 }
 
+GncAgentResult GncAgent::result() const {
+  GncAgentResult r;
+  r.outer_iterations = outer_iterations();
+  r.rejected.assign(rejected_.begin(), rejected_.end());
+  r.readmitted = readmitted_;
+  r.threshold_squared = threshold_squared();
+  r.weights_converged = weights_converged();
+  r.probes = probes();
+  r.probes_kept = probes_kept();
+  r.refine_message_steps = gnc_refine_steps_;
+  r.exchange_steps = exchange_steps_;
+  return r;
+}
+
 int GncAgent::weights_at_mu(double mu) {
   int crossed = 0;
   for (std::size_t k : terms_->owned())

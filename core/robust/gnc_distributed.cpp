@@ -139,14 +139,8 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
 
   GncDistributedResult out;
   const GncAgent& lead = *gnc.front();
-  out.outer_iterations = lead.outer_iterations();
-  out.weights_converged = lead.weights_converged();
-  out.threshold_squared = lead.threshold_squared();
-  out.readmitted = lead.readmitted();
+  static_cast<GncAgentResult&>(out) = lead.result();
   out.late_rejected = lead.late_rejected();
-  out.probes = lead.probes();
-  out.probes_kept = lead.probes_kept();
-  out.rejected.assign(lead.rejected().begin(), lead.rejected().end());
   out.weights.assign(graph.num_measurements(), 1.0);
   // Each measurement's weight as its owner computed it.
   for (int b = 0; b < agents; ++b) {
@@ -157,8 +151,6 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
         out.weights[index[k]] = a.weights()[k];
   }
   out.total_rounds = lead.gnc_rounds();
-  out.refine_message_steps = lead.gnc_refine_steps();
-  out.exchange_steps = lead.exchange_steps();
   out.total_bytes = stats.bytes;
 
   // The last solve of the kept set with its full record (trace, certificate, refinement): when

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <tessera/certification/dual_bound.hpp>
+#include <tessera/robust/gnc_agent_result.hpp>
 #include <variant>
 #include <vector>
 
@@ -51,19 +52,9 @@ struct CertificateTrafficReport {
   std::uint32_t escape_rounds = 0;
 };
 
-/// What a robust run decided (robust/gnc_agent.hpp), the same on every agent.
-struct RobustRunReport {
-  int outer_iterations = 0;
-  std::vector<std::uint64_t> rejected;  ///< Measurements by file position, ascending.
-  std::size_t readmitted = 0;           ///< Measurements the re-check passes let back in.
-  double threshold_squared = 0;         ///< c^2.
-  bool weights_converged = false;
-  int probes = 0, probes_kept = 0;  ///< RobustOptions::recheck_probes: run, and kept.
-  /// Message steps of the Newton refinements before the final solve
-  /// (GncDistributedResult::refine_message_steps).
-  int refine_steps = 0;
-  /// Message steps of GNC's own exchanges (GncDistributedResult::exchange_steps).
-  int exchange_steps = 0;
+/// What a robust run decided (GncAgentResult, robust/gnc_agent_result.hpp: the same on every
+/// agent) and agent 0's final solve's refinement.
+struct RobustRunReport : GncAgentResult {
   /// Message steps of the final solve's Newton refinement (0 without a final solve).
   int final_refine_steps = 0;
 };

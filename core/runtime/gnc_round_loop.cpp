@@ -75,17 +75,9 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   }
   res.final_rank = static_cast<std::uint32_t>(agent.state().rank());
   RobustRunReport report;
-  report.outer_iterations = agent.outer_iterations();
-  report.rejected = agent.rejected();
-  report.readmitted = agent.readmitted();
-  report.threshold_squared = agent.threshold_squared();
-  report.weights_converged = agent.weights_converged();
-  report.probes = agent.probes();
-  report.probes_kept = agent.probes_kept();
-  report.refine_steps = agent.gnc_refine_steps();
-  report.exchange_steps = agent.exchange_steps();
+  static_cast<GncAgentResult&>(report) = agent.result();
   if (const CertifiedAgent* final_solve = agent.final_sequence())
-    report.final_refine_steps += message_steps(final_solve->refines());
+    report.final_refine_steps = message_steps(final_solve->refines());
   res.robust = std::move(report);
 
   // The rounding sees the kept measurements (the cost is over them).

@@ -1,7 +1,8 @@
 #pragma once
 // A fill-reducing elimination order (approximate minimum degree, Eigen::AMDOrdering) of a
 // symmetric sparsity pattern. The substructuring factorizations (the refinement's interface
-// solves and the certificate's interface test) order their blocks' interior poses by it.
+// solves and the certificate's interface test) order their blocks' interior unknowns by it
+// (interface_last_order.hpp).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>

@@ -52,6 +52,7 @@
 #include <tessera/distributed/certified_agent.hpp>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/graph/measurement.hpp>
+#include <tessera/robust/gnc_agent_result.hpp>
 #include <tessera/robust/gnc_distributed.hpp>
 #include <utility>
 #include <vector>
@@ -165,6 +166,8 @@ class GncAgent : public AgentProcess {
   }
 
   // Results, identical on every agent once done() (rejected, counts, threshold).
+  /// Every figure of GncAgentResult, read off this agent (once done()).
+  GncAgentResult result() const;
   const std::vector<std::uint64_t>& rejected() const { return rejected_; }  ///< Ascending.
   int outer_iterations() const;
   std::size_t readmitted() const { return readmitted_; }  ///< Taken back by the passes.

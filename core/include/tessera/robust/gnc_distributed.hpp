@@ -14,6 +14,7 @@
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/graph/pose_graph.hpp>
 #include <tessera/robust/closure_clusters.hpp>
+#include <tessera/robust/gnc_agent_result.hpp>
 #include <tessera/robust/robust_options.hpp>
 #include <vector>
 
@@ -95,36 +96,21 @@ AgentWeights agent_weights(int agent, const PoseGraph& graph, const std::vector<
                            const Eigen::MatrixXd& X, const RobustOptions& robust, double c2,
                            double mu, const std::vector<bool>& flags = {});
 
-struct GncDistributedResult {
-  DistributedResult final_solve;      ///< The inlier-set solve (cost over kept measurements).
-  std::vector<double> weights;        ///< Last weight of every measurement.
-  std::vector<std::size_t> rejected;  ///< Measurements with weight < 0.5 (0 when binary).
-  int outer_iterations = 0;
-  int total_rounds = 0;  ///< Rounds of every solve, final included.
-  /// Message steps of the Newton refinements of the solves before the final one (the final
-  /// solve's are in final_refine_message_steps); a round is two message steps (the run's total:
-  /// exchange_steps).
-  int refine_message_steps = 0;
-  /// Message steps of GNC's own exchanges (GncAgent::exchange_steps()): poses, votes, weights,
-  /// rejected sets, verdicts, gathers. The run's message steps in all are
-  /// 2 x total_rounds + refine_message_steps + final_refine_message_steps + this.
-  int exchange_steps = 0;
+/// The run's decisions (rejected set, counts, threshold, the solves' message steps before the
+/// final one) are GncAgentResult's, agent 0's (every agent holds the same).
+struct GncDistributedResult : GncAgentResult {
+  DistributedResult final_solve;  ///< The inlier-set solve (cost over kept measurements).
+  std::vector<double> weights;    ///< Last weight of every measurement.
+  int total_rounds = 0;           ///< Rounds of every solve, final included.
   /// Message steps of the final solve's Newton refinement (0 when no final solve runs: the
-  /// last inlier pass is then the answer and its refinement is in refine_message_steps).
+  /// last inlier pass is then the answer and its refinement is in refine_message_steps). The
+  /// run's message steps in all are
+  /// 2 x total_rounds + refine_message_steps + final_refine_message_steps + exchange_steps.
   int final_refine_message_steps = 0;
   std::uint64_t total_bytes = 0;  ///< Bytes of every solve plus the outer steps' votes.
-  /// Measurements GNC had rejected whose residual at the inlier set's solution was within the
-  /// bound (r^2 <= c^2), taken back before the final solve.
-  std::size_t readmitted = 0;
   /// Measurements GNC had kept whose residual at an inlier set's solution was beyond the bound,
-  /// rejected by the same passes.
+  /// rejected by the re-check passes (GncAgent::late_rejected()).
   std::size_t late_rejected = 0;
-  /// Probes after the passes (RobustOptions::recheck_probes) and those that lowered the TLS
-  /// cost and stayed.
-  int probes = 0;
-  int probes_kept = 0;
-  double threshold_squared = 0;
-  bool weights_converged = false;
 };
 
 /// The known inliers' start of distributed GNC (GncDistributedOptions::known_inlier_start): the

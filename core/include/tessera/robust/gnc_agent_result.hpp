@@ -1,0 +1,37 @@
+#pragma once
+// What a distributed GNC run decided, as every agent holds it once its GncAgent is done
+// (robust/gnc_agent.hpp): filled by GncAgent::result() alone, and the common part of what both
+// drivers hand on: the in-process driver's GncDistributedResult (robust/gnc_distributed.hpp)
+// and agent 0's report over DDS (RobustRunReport, core/runtime/agent_report.hpp). The run's
+// rounds and the final solve's figures are not here: each driver counts those its own way.
+
+#include <cstddef>
+#include <vector>
+
+namespace tessera {
+
+struct GncAgentResult {
+  int outer_iterations = 0;
+  /// Measurements by file position, ascending: those of weight < 0.5 (0 when binary) after
+  /// the re-check passes and probes.
+  std::vector<std::size_t> rejected;
+  /// Measurements GNC had rejected whose residual at the inlier set's solution was within the
+  /// bound (r^2 <= c^2), taken back by the re-check passes.
+  std::size_t readmitted = 0;
+  double threshold_squared = 0;  ///< c^2.
+  bool weights_converged = false;
+  /// Probes after the passes (RobustOptions::recheck_probes) and those that lowered the TLS
+  /// cost and stayed.
+  int probes = 0;
+  int probes_kept = 0;
+  /// Message steps (neighbour exchanges and all-agent sums) of the Newton refinements of the
+  /// solves before the final one: GNC's weighted solves and the inlier passes. The final
+  /// solve's are counted by the driver.
+  int refine_message_steps = 0;
+  /// Message steps of GNC's own exchanges: poses, votes, weights, rejected sets, verdicts,
+  /// start votes, gathers (one per exchange, two per gather at agent 0). A run's message steps
+  /// in all are 2 x its rounds + refine_message_steps + the final solve's refinement's + this.
+  int exchange_steps = 0;
+};
+
+}  // namespace tessera
