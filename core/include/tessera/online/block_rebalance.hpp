@@ -52,6 +52,10 @@ struct RebalanceOptions {
 struct RebalanceResult {
   std::size_t moved = 0;                              ///< Poses that changed block.
   std::size_t largest_before = 0, largest_after = 0;  ///< Largest block's pose count.
+  std::size_t smallest_after = 0;                     ///< Smallest block's pose count.
+  /// Single-pose moves along chains of blocks that brought blocks within the bounds (a pose
+  /// passed along a chain counts once per hop); 0 without the cut refinement.
+  std::size_t chain_moves = 0;
   /// Of `moved`: poses the cut refinement moved (the rest are balance moves).
   std::size_t cut_moved = 0;
   /// Measurements between two blocks before and after the call (computed only when the
@@ -64,8 +68,17 @@ struct RebalanceResult {
 /// block that has one), to the lightest neighbouring block that is at least two poses
 /// lighter, until every block is within the bound or no such move is left. Poses do not pass
 /// through a block in one call (no cascade): a full block between an over-full one and a light
-/// one stops the move. Then, when the cut is above options.cut_fraction, refine_cut.
-/// `owner[k]` in 0..num_blocks-1; no block becomes empty.
+/// one stops the move. With the cut refinement on (cut_fraction < 1), then the bounds by
+/// chains: every block still above the upper bound `floor((1 + slack) ceil(n / N) +
+/// min_excess)` gives poses to the nearest block below it, and every block under the floor
+/// `floor((1 - slack) floor(n / N))` (at least 1) takes poses from the nearest block above it,
+/// each pose passing along the shortest chain of blocks linked by measurements, one border
+/// pose a hop, so the blocks in between keep their size. Then, when the cut is above
+/// options.cut_fraction, refine_cut, which keeps both bounds. So after a call with the
+/// refinement on, a block is out of the bounds only when no chain of measurements links it to a
+/// block that could take (give) a pose: a piece of the graph whose blocks are all at or past
+/// the bound (a robot that has met no other). `owner[k]` in 0..num_blocks-1; no block becomes
+/// empty.
 RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner, int num_blocks,
                                  const RebalanceOptions& options);
 
