@@ -19,7 +19,9 @@ namespace tessera {
 
 struct RebalanceOptions {
   bool enabled = true;
-  /// A block may hold up to (1 + slack) ceil(n / N) poses before poses move out of it. >= 0.
+  /// A block may hold up to (1 + slack) ceil(n / N) poses before poses move out of it and,
+  /// with the cut refinement on, no fewer than (1 - slack) floor(n / N) (rebalance_blocks).
+  /// >= 0.
   double slack = 0.2;
   /// ... and only when it is at least this many poses over that bound (small graphs at the
   /// start of a mission are not worth moving poses for). The cut refinement never fills a block
@@ -27,8 +29,8 @@ struct RebalanceOptions {
   std::size_t min_excess = 10;
   /// Cut refinement (needs `enabled`): runs when more than `cut_fraction` of the measurements
   /// join poses of two blocks. In [0, 1]; 1 = never. city10000 replayed by 5 robots, a step
-  /// every 0.1 s of stream: the cut ends at 509 of 20,687 measurements (146 re-partitions,
-  /// 4,455 poses moved) against 8,369 for the robots' blocks, and the steps take 33,016 CG
+  /// every 0.1 s of stream: the cut ends at 478 of 20,687 measurements (156 re-partitions,
+  /// 3,961 poses moved) against 8,369 for the robots' blocks, and the steps take 34,354 CG
   /// iterations against 103,615 (docs/online.md, "The partition follows the graph"). The cut
   /// then hovers near the threshold; 0.03 / 0.05 end at 568 / 758 with 2,893 / 1,904 poses
   /// moved (replays of the structure alone).
