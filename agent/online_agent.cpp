@@ -12,6 +12,7 @@
 #include <tessera/certification/rounding_gap.hpp>
 #include <tessera/distributed/certified_agent.hpp>
 #include <tessera/graph/connectivity.hpp>
+#include <tessera/online/block_rebalance.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
 #include <tessera/util/input_error.hpp>
@@ -26,6 +27,7 @@
 #include "agent/online_takeover_step.hpp"
 #include "agent/takeover_vote.hpp"
 #include "json_writer.hpp"
+#include "rebalance_args.hpp"
 #include "runtime/online_agent_view.hpp"
 #include "transport/fastdds/shm_receive_watch.hpp"
 #include "transport/fastdds/teardown_guard.hpp"
@@ -85,6 +87,8 @@ class OnlineAgent {
   bool absorbs(std::uint32_t robot) const;
   void wait_to_hold(const Watermarks& decision, bool read_channel);
   void publish_estimate();
+  /// Batches entered per robot 0..robots-1 (the epoch's absorption watermarks).
+  std::vector<std::size_t> entered_per_robot() const;
   void send(const std::vector<OutgoingMessage>& out, std::uint32_t epoch);
   void write_json(bool lead_result);
   [[noreturn]] void silent_peer(const std::string& what) const;
@@ -99,9 +103,10 @@ class OnlineAgent {
   OnlineBlockSolver block_;  // this agent's block, grown from solve to solve
   std::map<std::uint32_t, std::map<std::uint32_t, transport::OnlineReportSample>> reports_;
   std::map<std::uint32_t, std::set<std::uint32_t>> members_{{0, {0}}};
-  std::set<std::uint32_t> seen_;  // agents heard from (hello or report)
-  std::set<std::uint32_t> dead_;  // members lost and taken over
-  std::uint32_t floor_ = 0;       // reports of epochs below it belong to an abandoned epoch
+  std::set<std::uint32_t> seen_;     // agents heard from (hello or report)
+  std::set<std::uint32_t> dead_;     // members lost and taken over
+  std::set<std::uint32_t> refused_;  // hellos with other re-partition options (not admitted)
+  std::uint32_t floor_ = 0;          // reports of epochs below it belong to an abandoned epoch
   std::vector<transport::OnlineReportSample> votes_;  // take-over votes not yet read
   bool finishing_ = false;
   double next_certificate_ = 0.0, last_publish_ = -1e300;
@@ -131,6 +136,18 @@ void OnlineAgent::pump_stream() {
 
 void OnlineAgent::pump_channel() {
   for (auto& r : channel_.take_reports()) {
+    // Every agent moves the blocks itself, so all use the lead's re-partition options: an
+    // agent whose options differ is not admitted (its hello is not counted), and an agent
+    // that reads the lead's report with other options than its own stops, naming the option.
+    const std::string differs =
+        cli::rebalance_disagreement(o_.online.rebalance, r.rebalance, r.sender);
+    if (r.epoch == transport::kHelloEpoch && !differs.empty()) {
+      if (refused_.insert(r.sender).second)
+        std::fprintf(stderr,
+                     "agent %d: agent %u not admitted: its re-partition options differ (%s)\n",
+                     o_.id, r.sender, differs.c_str());
+      continue;
+    }
     if (r.sender < static_cast<std::uint32_t>(o_.robots) && dead_.count(r.sender) == 0)
       seen_.insert(r.sender);
     if (r.epoch == transport::kHelloEpoch) continue;
@@ -147,8 +164,10 @@ void OnlineAgent::pump_channel() {
       continue;
     }
     if (r.epoch < floor_) continue;  // an epoch abandoned at a take-over
-    if (r.sender == lead_of(r.epoch))
+    if (r.sender == lead_of(r.epoch)) {
+      if (!differs.empty()) throw InputError(differs);
       members_[r.epoch + 1] = std::set<std::uint32_t>(r.next_members.begin(), r.next_members.end());
+    }
     if (r.epoch >= epoch_) reports_[r.epoch][r.sender] = std::move(r);
   }
   for (auto& m : channel_.take_messages())
@@ -292,6 +311,7 @@ int OnlineAgent::run() {
     transport::OnlineReportSample hello;
     hello.epoch = transport::kHelloEpoch;
     hello.sender = me;
+    hello.rebalance = o_.online.rebalance;
     fig_.report_bytes += channel_.send_report(hello);
   }
   for (;;) {
@@ -334,6 +354,7 @@ bool OnlineAgent::epoch_step() {
     mine.dim = view_.dim();
     mine.pose_ids = block_.own_ids();
     mine.data = block_.own_data();
+    mine.rebalance = o_.online.rebalance;
     if (me == lead_of(epoch_)) {
       if (o_.certify_every_s > 0 && changed_since_certificate_ &&
           since(start_) >= next_certificate_) {
@@ -485,7 +506,9 @@ bool OnlineAgent::epoch_step() {
       .add("agents", static_cast<long long>(members().size()))
       .add("moved", in.moved)
       .add("largest_block", in.largest_block)
+      .add("smallest_block", in.smallest_block)
       .add("cut", in.cut)
+      .add("entered", entered_per_robot())
       .add("rounds", s.rounds)
       .add("ms", 1000.0 * (step_end - step_start))
       .add("latency_s", step_end - oldest)
@@ -496,6 +519,13 @@ bool OnlineAgent::epoch_step() {
   fig_.updates.push_back(std::move(u));
   ++epoch_;
   return true;
+}
+
+std::vector<std::size_t> OnlineAgent::entered_per_robot() const {
+  std::vector<std::size_t> out(static_cast<std::size_t>(o_.robots), 0);
+  for (const auto& [robot, count] : view_.entered())
+    if (robot < out.size()) out[robot] = static_cast<std::size_t>(count);
+  return out;
 }
 
 bool OnlineAgent::absorbs(std::uint32_t robot) const {
@@ -545,6 +575,7 @@ void OnlineAgent::take_over() {
   mine.dim = view_.dim();
   mine.pose_ids = block_.own_ids();
   mine.data = block_.own_data();
+  mine.rebalance = o_.online.rebalance;
   const TakeoverStepResult step = takeover_step(
       channel_, view_, members(), mine, o_.timeout_s,
       [&] {
@@ -588,6 +619,14 @@ void OnlineAgent::write_json(bool lead_result) {
   state.final_solve = final_;
   state.wall_s = since(start_);
   if (lead_result && have_cost_) state.cost = cost_;
+  if (const GraphStream* g = view_.stream()) {
+    state.final_blocks.assign(static_cast<std::size_t>(o_.robots), 0);
+    for (int b : view_.owner()) {
+      const std::uint32_t robot = g->robots()[static_cast<std::size_t>(b)];
+      if (robot < state.final_blocks.size()) ++state.final_blocks[robot];
+    }
+    state.final_cut = cut_measurements(g->graph(), view_.owner());
+  }
   cli::write_output(o_.json, online_summary_json(o_, state, fig_));
 }
 

@@ -1,9 +1,12 @@
 #include "agent/online_agent_options.hpp"
 
+#include <set>
+#include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/util/input_error.hpp>
 
 #include "arguments.hpp"
+#include "rebalance_args.hpp"
 #include "transport/run_identity.hpp"
 
 namespace tessera::agent {
@@ -52,6 +55,10 @@ options:
   --verbose           print each epoch (members, what entered, solve or idle)
   --help              this text
 
+re-partition (the same on every agent of the run: each moves the blocks itself; an agent
+whose options differ from the lead's stops with exit code 2 naming the option):
+%REBALANCE%
+
 exit codes: 0 done, 1 the run failed (a peer went silent, or this agent was counted lost and
 its block taken over), 2 bad options or input.
 )";
@@ -59,16 +66,25 @@ its block taken over), 2 bad options or input.
 }  // namespace
 
 const char* online_agent_usage() {
-  return kOnlineUsage;
+  static const std::string text = [] {
+    std::string t = kOnlineUsage;
+    const std::string mark = "%REBALANCE%\n";
+    t.replace(t.find(mark), mark.size(), cli::kRebalanceHelp);
+    return t;
+  }();
+  return text.c_str();
 }
 
 OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& argv) {
-  const cli::Arguments args(
-      argv,
-      {"robots", "id", "run-id", "domain", "algorithm", "rank", "grad-tol", "max-rounds", "timeout",
-       "json", "certify-every", "certify-iters", "publish-every", "tum-dir", "on-agent-loss",
-       "step-solver", "newton-after", "lease"},
-      {"online", "no-certify", "verbose", "help"});
+  std::set<std::string> valued = {"robots",        "id",      "run-id",        "domain",
+                                  "algorithm",     "rank",    "grad-tol",      "max-rounds",
+                                  "timeout",       "json",    "certify-every", "certify-iters",
+                                  "publish-every", "tum-dir", "on-agent-loss", "step-solver",
+                                  "newton-after",  "lease"};
+  std::set<std::string> switches = {"online", "no-certify", "verbose", "help"};
+  for (const char* const* f = cli::kRebalanceValued; *f; ++f) valued.insert(*f);
+  for (const char* const* f = cli::kRebalanceSwitches; *f; ++f) switches.insert(*f);
+  const cli::Arguments args(argv, valued, switches);
   OnlineAgentOptions o;
   const auto run_id = args.get("run-id");
   if (!run_id) throw InputError("option --run-id ID is required (see --help)");
@@ -112,6 +128,7 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
     throw InputError("option --step-solver: '" + step_solver + "' is not one of newton, rounds");
   o.online.newton_steps = step_solver == "newton";
   o.online.newton_after_grad_tol = args.get_double("newton-after", o.online.newton_after_grad_tol);
+  o.online.rebalance = cli::parse_rebalance_options(args);
   o.online.validate();
   return o;
 }

@@ -41,6 +41,18 @@ std::string online_summary_json(const OnlineAgentOptions& o, const OnlineSummary
       .add("min_eigenvalue", final_solve.min_eigenvalue)
       .add("grad_norm", final_solve.grad_norm);
   if (state.cost) j.add("cost", *state.cost);
+  const RebalanceOptions& b = o.online.rebalance;
+  cli::JsonObject rebalance;
+  rebalance.add("enabled", b.enabled)
+      .add("cut_fraction", b.cut_fraction)
+      .add("slack", b.slack)
+      .add("min_excess", b.min_excess)
+      .add("max_passes", b.max_passes)
+      .add("pass_patience", b.pass_patience)
+      .add("place_by_links", b.place_by_links);
+  j.add("rebalance", rebalance)
+      .add("final_blocks", state.final_blocks)
+      .add("final_cut", state.final_cut);
   j.add("publications", f.publications);
   j.add("updates", f.updates);
   if (!f.certificates.empty()) j.add("certificates", f.certificates);

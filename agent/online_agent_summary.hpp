@@ -40,6 +40,10 @@ struct OnlineSummaryState {
   SolveOutcome final_solve;
   double wall_s = 0.0;
   std::optional<double> cost;  ///< f of the rounded estimate: only the lead's answer has it.
+  /// At the end: the poses of robot r's block (r = 0..robots-1; 0 for a robot with no block)
+  /// and the measurements between two blocks.
+  std::vector<std::size_t> final_blocks;
+  std::size_t final_cut = 0;
 };
 
 /// The agent's summary as JSON text (fields as documented in docs/online.md).

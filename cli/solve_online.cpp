@@ -17,6 +17,7 @@
 
 #include "json_writer.hpp"
 #include "online_baseline.hpp"
+#include "rebalance_args.hpp"
 #include "robot_files.hpp"
 #include "runtime/replay_input.hpp"
 
@@ -28,9 +29,11 @@ const char* const kOnlineValued[] = {
     "step-every",    "step-solver",       "newton-after",   "threads",
     "baseline-per",  "baseline-samples",  "baseline-init",  "baseline-solver",
     "step-coarse",   "progress-interval", "until",          "cut-fraction",
+    "block-slack",   "block-min-excess",  "cut-passes",     "cut-patience",
     nullptr};
 const char* const kOnlineSwitches[] = {"online",          "real-time",   "baseline",
-                                       "no-local-rounds", "no-progress", nullptr};
+                                       "no-local-rounds", "no-progress", "no-place-by-links",
+                                       "no-rebalance",    nullptr};
 
 const char* kOnlineHelp =
     "\n"
@@ -90,6 +93,14 @@ const char* kOnlineHelp =
     "  --cut-fraction F          re-partition: refine the blocks' border when more than F of\n"
     "                            the measurements join two blocks (default 0.02; 1: blocks\n"
     "                            stay the robots', moved only for balance)\n"
+    "  --block-slack S           blocks stay within (1 + S) ceil(n/N) + K poses and, with the\n"
+    "                            refinement on, above (1 - S) floor(n/N) (default 0.2)\n"
+    "  --block-min-excess K      K of that bound (default 10)\n"
+    "  --cut-passes P            refinement passes at most (default 8)\n"
+    "  --cut-patience K          a pass stops after K moves without a better cut (default 64)\n"
+    "  --no-place-by-links       new poses join their robot's block, not the block holding\n"
+    "                            most of their measurements\n"
+    "  --no-rebalance            blocks stay the robots' (no move at all)\n"
     "  --until S                 play only what is published up to S seconds of stream time\n"
     "                            (a prefix of the mission, e.g. to profile its steps; the\n"
     "                            final cost needs the graph received by then connected)\n"
@@ -124,6 +135,7 @@ JsonObject update_json(const OnlineUpdate& u) {
       .add("agents", u.agents)
       .add("moved", u.moved)
       .add("largest_block", u.largest_block)
+      .add("smallest_block", u.smallest_block)
       .add("cut", u.cut)
       .add("rounds", u.rounds)
       .add("ms", u.ms)
@@ -181,7 +193,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.certify_every_s = a.get_double("certify-every", 0.0);
   options.step_every_s = a.get_double("step-every", 0.0);
   options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
-  options.rebalance.cut_fraction = a.get_double("cut-fraction", options.rebalance.cut_fraction);
+  options.rebalance = parse_rebalance_options(a);
   options.solver.threads = static_cast<int>(a.get_long("threads", options.solver.threads));
   options.solver.local_rounds.enabled = !a.has("no-local-rounds");
   options.solver.local_rounds.threshold =

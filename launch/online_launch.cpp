@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -20,6 +21,7 @@
 #include "arguments.hpp"
 #include "launch/launch.hpp"
 #include "launch/launch_loss_policy.hpp"
+#include "rebalance_args.hpp"
 #include "transport/run_identity.hpp"
 
 namespace tessera::launch {
@@ -62,6 +64,8 @@ new, and certify the estimate after every robot's last batch.
   --json FILE         the summary: the lead's (agent 0, or the lowest surviving agent:
                       updates, final answer) and every agent's traffic under "agents"
   --keep-logs DIR     keep the processes' logs and summaries in DIR
+
+re-partition (passed to every agent: each moves the blocks itself, so all use the same):
 )";
 
 std::string read_text(const std::string& path) {
@@ -118,14 +122,18 @@ int run_online_launch(const std::vector<std::string>& argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
       std::fputs(kOnlineHelp, stdout);
+      std::fputs(cli::kRebalanceHelp, stdout);
       return 0;
     }
-  const cli::Arguments args(
-      argv, {"agents",  "rate",          "speedup",       "start",         "run-id",
-             "domain",  "algorithm",     "rank",          "grad-tol",      "timeout",
-             "json",    "keep-logs",     "certify-every", "certify-iters", "publish-every",
-             "tum-dir", "on-agent-loss", "step-solver",   "newton-after",  "lease"},
-      {"online", "no-certify"});
+  std::set<std::string> valued = {"agents",        "rate",          "speedup",       "start",
+                                  "run-id",        "domain",        "algorithm",     "rank",
+                                  "grad-tol",      "timeout",       "json",          "keep-logs",
+                                  "certify-every", "certify-iters", "publish-every", "tum-dir",
+                                  "on-agent-loss", "step-solver",   "newton-after",  "lease"};
+  std::set<std::string> switches = {"online", "no-certify"};
+  for (const char* const* f = cli::kRebalanceValued; *f; ++f) valued.insert(*f);
+  for (const char* const* f = cli::kRebalanceSwitches; *f; ++f) switches.insert(*f);
+  const cli::Arguments args(argv, valued, switches);
   if (args.positional().size() != 1)
     throw InputError("launch --online: expected one GRAPH argument (see --online --help)");
   const std::string graph = args.positional().front();
@@ -151,6 +159,7 @@ int run_online_launch(const std::vector<std::string>& argv) {
   const long domain = args.get_long("domain", transport::domain_for_run(run_id));
   if (domain < 0 || domain > transport::kMaxDomain)
     throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));
+  cli::parse_rebalance_options(args);  // checked here: a bad value is named before any start
 
   if (auto dir = args.get("tum-dir")) {
     std::error_code ec;
@@ -184,6 +193,13 @@ int run_online_launch(const std::vector<std::string>& argv) {
         a.push_back(std::string("--") + flag);
         a.push_back(*v);
       }
+    for (const char* const* flag = cli::kRebalanceValued; *flag; ++flag)
+      if (auto v = args.get(*flag)) {
+        a.push_back(std::string("--") + *flag);
+        a.push_back(*v);
+      }
+    for (const char* const* flag = cli::kRebalanceSwitches; *flag; ++flag)
+      if (args.has(*flag)) a.push_back(std::string("--") + *flag);
     if (args.has("no-certify")) a.push_back("--no-certify");
     a.push_back("--json");
     a.push_back(work + "/agent-" + std::to_string(i) + ".json");

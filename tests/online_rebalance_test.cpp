@@ -352,5 +352,86 @@ TEST(CutRefinement, ARobotThatJoinsOpensItsOwnBlockWhateverItsFirstPoseLinksTo) 
   EXPECT_EQ(owner, (std::vector<int>{0, 0, 1, 1}));
 }
 
+std::size_t floor_of(std::size_t n, int blocks, const RebalanceOptions& o) {
+  const double low = (1.0 - o.slack) * std::floor(static_cast<double>(n) / blocks);
+  return low > 1.0 ? static_cast<std::size_t>(std::floor(low)) : 1;
+}
+
+TEST(BlockBounds, ABlockUnderTheFloorTakesPosesPassedAlongTheChainOfBlocks) {
+  // Chain 0..59: A = 0..33, B = 34..49, C = 50..59. The floor is floor(0.8 * 20) = 16: C (10)
+  // is under it, its only neighbour B is at it, so A gives 6 poses to B and B 6 to C.
+  const PoseGraph g = chain(60);
+  std::vector<int> owner(60, 0);
+  for (std::size_t k = 34; k < 60; ++k) owner[k] = k < 50 ? 1 : 2;
+  RebalanceOptions o;
+  o.cut_fraction = 0.5;  // the refinement is on; the cut (2 of 59) is under its threshold
+  const RebalanceResult r = rebalance_blocks(g, owner, 3, o);
+  EXPECT_FALSE(r.refined);
+  EXPECT_EQ(r.chain_moves, 12u);
+  EXPECT_EQ(r.moved, 12u);
+  EXPECT_EQ(r.smallest_after, 16u);
+  for (std::size_t k = 0; k < 60; ++k) EXPECT_EQ(owner[k], k < 28 ? 0 : k < 44 ? 1 : 2) << k;
+  EXPECT_EQ(r.cut_after, 2u);
+}
+
+TEST(BlockBounds, ABlockThatNoBlockAboveTheFloorReachesStaysUnderIt) {
+  // Two pieces: 0..39 (blocks 0 and 1) and 40..44 (block 2, a robot that has met no other).
+  PoseGraph g = chain(45);
+  g.measurements.erase(g.measurements.begin() + 39);  // no 39 - 40
+  std::vector<int> owner(45, 0);
+  for (std::size_t k = 20; k < 45; ++k) owner[k] = k < 40 ? 1 : 2;
+  const std::vector<int> start = owner;
+  const RebalanceResult r = rebalance_blocks(g, owner, 3, RebalanceOptions{});
+  EXPECT_EQ(r.moved, 0u);
+  EXPECT_EQ(r.smallest_after, 5u);  // under the floor, 12
+  EXPECT_EQ(owner, start);
+}
+
+TEST(BlockBounds, BothBoundsHoldAfterEveryCallOfAGrowingGraphWhoseNewPosesJoinOtherBlocks) {
+  // Robots whose trajectories cross (crossed_blocks' closures between nearby ids): new poses
+  // join the block of their measurements, which leaves robots' blocks light and fills others
+  // past their neighbours; after every call every block holds the floor and at most the upper
+  // bound (the graph is connected).
+  std::mt19937 rng(21);
+  std::size_t chain_moves = 0, checks = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const CrossedBlocks c = crossed_blocks(rng);
+    const std::size_t n = c.owner.size();
+    RebalanceOptions o;
+    o.slack = 0.1 * static_cast<double>(1 + rng() % 3);
+    o.min_excess = rng() % 4;
+    std::vector<int> owner;
+    const std::size_t step = 1 + rng() % 12;
+    for (std::size_t have = std::min<std::size_t>(n, static_cast<std::size_t>(c.blocks));;) {
+      PoseGraph g = c.graph;  // its first `have` poses
+      g.num_poses = have;
+      g.measurements.erase(
+          std::remove_if(g.measurements.begin(), g.measurements.end(),
+                         [&](const Measurement& m) { return std::max(m.i, m.j) >= have; }),
+          g.measurements.end());
+      const std::vector<int> robot(c.owner.begin() + static_cast<long>(owner.size()),
+                                   c.owner.begin() + static_cast<long>(have));
+      assign_new_poses(g, owner, robot, o);
+      const RebalanceResult r = rebalance_blocks(g, owner, c.blocks, o);
+      chain_moves += r.chain_moves;
+      const std::vector<std::size_t> size = block_sizes(owner, c.blocks);
+      const double full = (1.0 + o.slack) * std::ceil(static_cast<double>(have) / c.blocks) +
+                          static_cast<double>(o.min_excess);
+      for (std::size_t b = 0; b < size.size(); ++b) {
+        EXPECT_GE(size[b], floor_of(have, c.blocks, o))
+            << "trial " << trial << " poses " << have << " block " << b;
+        EXPECT_LE(static_cast<double>(size[b]), std::floor(full))
+            << "trial " << trial << " poses " << have << " block " << b;
+      }
+      EXPECT_EQ(r.smallest_after, *std::min_element(size.begin(), size.end()));
+      ++checks;
+      if (have == n) break;
+      have = std::min(n, have + step);
+    }
+  }
+  EXPECT_GT(chain_moves, 100u) << "the placements leave blocks out of the bounds";
+  EXPECT_GT(checks, 500u);
+}
+
 }  // namespace
 }  // namespace tessera

@@ -228,6 +228,14 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       r.certify = w.certify();
       r.lost = w.lost();
       r.at_epoch = w.at_epoch();
+      const wire::OnlineRebalance& b = w.rebalance();
+      r.rebalance.enabled = b.enabled();
+      r.rebalance.slack = b.slack();
+      r.rebalance.min_excess = static_cast<std::size_t>(b.min_excess());
+      r.rebalance.cut_fraction = b.cut_fraction();
+      r.rebalance.max_passes = static_cast<int>(b.max_passes());
+      r.rebalance.pass_patience = static_cast<std::size_t>(b.pass_patience());
+      r.rebalance.place_by_links = b.place_by_links();
       reports.push_back(std::move(r));
     }
   }
@@ -276,6 +284,14 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   w.certify(r.certify);
   w.lost(r.lost);
   w.at_epoch(r.at_epoch);
+  wire::OnlineRebalance& b = w.rebalance();
+  b.enabled(r.rebalance.enabled);
+  b.slack(r.rebalance.slack);
+  b.min_excess(r.rebalance.min_excess);
+  b.cut_fraction(r.rebalance.cut_fraction);
+  b.max_passes(static_cast<std::uint32_t>(r.rebalance.max_passes));
+  b.pass_patience(r.rebalance.pass_patience);
+  b.place_by_links(r.rebalance.place_by_links);
   if (!write_patiently(impl_->report_writer, w))
     throw std::runtime_error("online channel: a report write failed");
   return serialized_size(w);

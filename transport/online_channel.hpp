@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 #include <tessera/online/absorb_gate.hpp>
+#include <tessera/online/block_rebalance.hpp>
 #include <tessera/protocol/messages.hpp>
 #include <vector>
 
@@ -35,6 +36,9 @@ struct OnlineReportSample {
   /// epoch it was in; `held` is then what entered its graph.
   std::vector<std::uint32_t> lost;
   std::uint32_t at_epoch = 0;
+  /// The sender's re-partition options: every agent moves the blocks itself, so all must use
+  /// the lead's (agent/online_agent.cpp checks).
+  RebalanceOptions rebalance;
 };
 
 /// The epoch of a hello: an agent that is not a member yet asks to join.

@@ -151,6 +151,120 @@ std::size_t balance_moves(const std::vector<std::vector<std::size_t>>& adjacent,
   return count;
 }
 
+// The bounds by chains of blocks (rebalance_blocks' second part, with the cut refinement on):
+// every block above `upper` poses gives border poses away until it holds `upper`, and every
+// block under `lower` takes border poses until it holds `lower`. A pose moves only to a block
+// it has a measurement into; when the neighbouring block cannot take it (at `upper` itself) or
+// cannot spare one (at `lower`), poses pass along the shortest chain of blocks to the nearest
+// block below `upper` (above `lower`), one hop each, so only the two blocks at the ends of the
+// chain change size. Per hop the pose moved is the border pose whose move cuts the fewest
+// measurements (links into the receiving block minus links in its own; lowest id on ties). A
+// block whose chains of measurements reach no such block stays out of the bound (a piece of
+// the graph, e.g. a robot that has met no other, whose blocks are all at or past it). Each
+// chain brings one block one pose closer to the bound and none further, so the loop ends.
+// Returns the single-pose moves made.
+std::size_t chain_moves(const std::vector<std::vector<std::size_t>>& adjacent,
+                        std::vector<int>& owner, std::vector<std::size_t>& size, int num_blocks,
+                        std::size_t lower, std::size_t upper) {
+  const std::size_t n = owner.size();
+  const std::size_t blocks = static_cast<std::size_t>(num_blocks);
+  BlockLinks into(adjacent, owner);
+  // (b, c): the poses of b with a measurement into c. Not empty exactly when (c, b) is not.
+  std::vector<std::set<std::size_t>> border(blocks * blocks);
+  for (std::size_t k = 0; k < n; ++k)
+    for (const auto& [c, links] : into.of(k))
+      if (c != owner[k] && links > 0)
+        border[static_cast<std::size_t>(owner[k]) * blocks + static_cast<std::size_t>(c)].insert(k);
+  auto move = [&](std::size_t v, std::size_t to) {
+    const std::size_t from = static_cast<std::size_t>(owner[v]);
+    for (const auto& [c, links] : into.of(v))
+      if (static_cast<std::size_t>(c) != from && links > 0)
+        border[from * blocks + static_cast<std::size_t>(c)].erase(v);
+    owner[v] = static_cast<int>(to);
+    for (const auto& [c, links] : into.of(v))
+      if (static_cast<std::size_t>(c) != to && links > 0)
+        border[to * blocks + static_cast<std::size_t>(c)].insert(v);
+    for (std::size_t q : adjacent[v]) {
+      const std::size_t b = static_cast<std::size_t>(owner[q]);
+      if (--into.count(q, static_cast<int>(from)) == 0 && b != from)
+        border[b * blocks + from].erase(q);
+      if (++into.count(q, static_cast<int>(to)) == 1 && b != to) border[b * blocks + to].insert(q);
+    }
+    --size[from];
+    ++size[to];
+  };
+  // One pose from block c to block `to` (c has a border pose into it).
+  auto hop = [&](std::size_t c, std::size_t to) {
+    std::size_t pose = n;
+    long best = 0;
+    for (std::size_t v : border[c * blocks + to]) {
+      const long gain = static_cast<long>(into.links(v, static_cast<int>(to))) -
+                        static_cast<long>(into.links(v, static_cast<int>(c)));
+      if (pose == n || gain > best) {
+        pose = v;
+        best = gain;
+      }
+    }
+    if (pose < n) move(pose, to);  // (a block on the chain keeps its border poses to the next)
+  };
+  // Breadth first from `from` over the blocks linked by border poses, in id order: the first
+  // block for which `found` holds, or `blocks`; prev[] leads back to `from`.
+  std::vector<std::size_t> prev(blocks), queue;
+  std::vector<char> seen(blocks);
+  auto nearest = [&](std::size_t from, auto found) {
+    std::fill(seen.begin(), seen.end(), 0);
+    seen[from] = 1;
+    queue.assign(1, from);
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const std::size_t b = queue[head];
+      for (std::size_t c = 0; c < blocks; ++c) {
+        if (seen[c] || border[b * blocks + c].empty()) continue;
+        seen[c] = 1;
+        prev[c] = b;
+        if (found(c)) return c;
+        queue.push_back(c);
+      }
+    }
+    return blocks;
+  };
+  std::size_t count = 0;
+  // A block that no chain links to a block that can take (give) a pose: moves elsewhere never
+  // change that (a block that could pass a pose towards it would have been found).
+  std::vector<char> stuck_over(blocks, 0), stuck_under(blocks, 0);
+  for (;;) {
+    // The largest block above `upper`, else the smallest under `lower` (lowest id on ties).
+    std::size_t heavy = blocks, light = blocks;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      if (!stuck_over[b] && size[b] > upper && (heavy == blocks || size[b] > size[heavy]))
+        heavy = b;
+      if (!stuck_under[b] && size[b] < lower && (light == blocks || size[b] < size[light]))
+        light = b;
+    }
+    if (heavy != blocks) {
+      const std::size_t to = nearest(heavy, [&](std::size_t c) { return size[c] < upper; });
+      if (to == blocks) {
+        stuck_over[heavy] = 1;
+        continue;
+      }
+      // The chain heavy -> ... -> to, moved from its far end so each hop's giver has a pose.
+      std::vector<std::size_t> chain{to};
+      while (chain.back() != heavy) chain.push_back(prev[chain.back()]);
+      for (std::size_t k = 0; k + 1 < chain.size(); ++k) hop(chain[k + 1], chain[k]);
+      count += chain.size() - 1;
+    } else if (light != blocks) {
+      const std::size_t from = nearest(light, [&](std::size_t c) { return size[c] > lower; });
+      if (from == blocks) {
+        stuck_under[light] = 1;
+        continue;
+      }
+      for (std::size_t c = from; c != light; c = prev[c], ++count) hop(c, prev[c]);
+    } else {
+      break;
+    }
+  }
+  return count;
+}
+
 std::size_t refine_with(const std::vector<std::vector<std::size_t>>& adjacent,
                         std::vector<int>& owner, int num_blocks, std::size_t bound,
                         std::size_t lower, const RebalanceOptions& options) {
@@ -267,12 +381,22 @@ RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner
   std::vector<std::size_t> size = block_sizes(owner, num_blocks);
   res.largest_before = *std::max_element(size.begin(), size.end());
   res.largest_after = res.largest_before;
+  res.smallest_after = *std::min_element(size.begin(), size.end());
   if (!options.enabled || num_blocks == 1) return res;
   const double bound = balance_bound(n, num_blocks, options);
   const double full = bound + static_cast<double>(options.min_excess);
   const bool refine = options.cut_fraction < 1.0;
   const bool over = std::any_of(size.begin(), size.end(),
                                 [&](std::size_t s) { return static_cast<double>(s) > full; });
+  // The floor, (1 - slack) floor(n / N) poses: with the cut refinement on, no block stays
+  // under it (chain_moves), and the refinement takes none below it (a cut with no lower bound
+  // is smallest with a block nearly empty, its agent idle: a robot that stopped publishing
+  // lost all but 3 of its block's poses to the others).
+  const double low_bound =
+      (1.0 - options.slack) * std::floor(static_cast<double>(n) / static_cast<double>(num_blocks));
+  const std::size_t lower = low_bound > 1.0 ? static_cast<std::size_t>(std::floor(low_bound)) : 1;
+  const bool under =
+      refine && std::any_of(size.begin(), size.end(), [&](std::size_t s) { return s < lower; });
   auto cut_high = [&](std::size_t cut) {
     return refine && static_cast<double>(cut) >
                          options.cut_fraction * static_cast<double>(graph.measurements.size());
@@ -282,34 +406,32 @@ RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner
     cut = cut_measurements(graph, owner);
     res.cut_before = res.cut_after = cut;
   }
-  // Nothing over the bound and the cut low (most steps): done before the graph's adjacency is
-  // built.
-  if (!over && !cut_high(cut)) return res;
+  // Nothing over the bound, nothing under the floor and the cut low (most steps): done before
+  // the graph's adjacency is built.
+  if (!over && !under && !cut_high(cut)) return res;
   const std::vector<std::vector<std::size_t>> adjacent = adjacency(graph);
   const std::vector<int> start = refine ? owner : std::vector<int>{};
   if (over) res.moved = balance_moves(adjacent, owner, size, num_blocks, bound, options);
   if (refine) {
-    if (res.moved > 0) cut = cut_measurements(graph, owner);
+    // What the balance moves left over the bound (no lighter neighbour) or under the floor
+    // goes by chains of blocks.
+    const std::size_t upper = static_cast<std::size_t>(std::floor(full));
+    if (std::any_of(size.begin(), size.end(),
+                    [&](std::size_t s) { return s < lower || s > upper; }))
+      res.chain_moves = chain_moves(adjacent, owner, size, num_blocks, lower, upper);
+    if (res.moved > 0 || res.chain_moves > 0) cut = cut_measurements(graph, owner);
     if (cut_high(cut)) {
       res.refined = true;
-      // Nor below (1 - slack) floor(n / N): a cut without a lower bound is smallest with one
-      // block nearly empty, its agent idle (a robot that stopped publishing lost its block).
-      const double low = (1.0 - options.slack) *
-                         std::floor(static_cast<double>(n) / static_cast<double>(num_blocks));
-      res.cut_moved =
-          refine_with(adjacent, owner, num_blocks, static_cast<std::size_t>(std::floor(full)),
-                      low > 1.0 ? static_cast<std::size_t>(std::floor(low)) : 1, options);
-      if (res.cut_moved > 0) {
-        cut = cut_measurements(graph, owner);
-        // Poses that changed block in the call (a pose the balance moved and the refinement
-        // moved back has not).
-        res.moved = poses_changed(start, owner);
-      }
+      res.cut_moved = refine_with(adjacent, owner, num_blocks, upper, lower, options);
+      if (res.cut_moved > 0) cut = cut_measurements(graph, owner);
     }
+    // Poses that changed block in the call (a pose moved and moved back has not).
+    res.moved = poses_changed(start, owner);
     res.cut_after = cut;
   }
   size = block_sizes(owner, num_blocks);
   res.largest_after = *std::max_element(size.begin(), size.end());
+  res.smallest_after = *std::min_element(size.begin(), size.end());
   return res;
 }
 

@@ -109,6 +109,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
       rebalance_blocks(graph, owner_, static_cast<int>(robots.size()), options_.rebalance);
   u.moved = moves.moved;
   u.largest_block = moves.largest_after;
+  u.smallest_block = moves.smallest_after;
   u.cut = moves.cut_after;
   // Only the measurements since the last extension can touch a new pose.
   std::size_t composed = 0;

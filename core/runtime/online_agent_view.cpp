@@ -96,6 +96,7 @@ EnteredData OnlineAgentView::enter(const Watermarks& decision) {
   }
   e.moved = moves.moved;
   e.largest_block = moves.largest_after;
+  e.smallest_block = moves.smallest_after;
   e.cut = moves.cut_after;
   const std::size_t estimated = static_cast<std::size_t>(X_.cols()) / (graph.d + 1);
   EstimateExtension x = extend_estimate(graph, X_, stream_->guesses());

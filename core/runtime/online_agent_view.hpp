@@ -31,6 +31,7 @@ struct EnteredData {
   std::vector<double> stamps;  ///< Publication stamp of each absorbed batch.
   std::size_t moved = 0;       ///< Poses the rebalance moved to another block.
   std::size_t largest_block = 0;
+  std::size_t smallest_block = 0;
   std::size_t cut = 0;  ///< Measurements between two blocks (0: cut refinement off).
   /// New poses placed by composing a new measurement from an estimated pose: when this equals
   /// `measurements`, every new measurement has zero residual at the extended estimate.

@@ -19,7 +19,9 @@ namespace tessera {
 
 struct RebalanceOptions {
   bool enabled = true;
-  /// A block may hold up to (1 + slack) ceil(n / N) poses before poses move out of it. >= 0.
+  /// A block may hold up to (1 + slack) ceil(n / N) poses before poses move out of it and,
+  /// with the cut refinement on, no fewer than (1 - slack) floor(n / N) (rebalance_blocks).
+  /// >= 0.
   double slack = 0.2;
   /// ... and only when it is at least this many poses over that bound (small graphs at the
   /// start of a mission are not worth moving poses for). The cut refinement never fills a block
@@ -27,8 +29,8 @@ struct RebalanceOptions {
   std::size_t min_excess = 10;
   /// Cut refinement (needs `enabled`): runs when more than `cut_fraction` of the measurements
   /// join poses of two blocks. In [0, 1]; 1 = never. city10000 replayed by 5 robots, a step
-  /// every 0.1 s of stream: the cut ends at 509 of 20,687 measurements (146 re-partitions,
-  /// 4,455 poses moved) against 8,369 for the robots' blocks, and the steps take 33,016 CG
+  /// every 0.1 s of stream: the cut ends at 478 of 20,687 measurements (156 re-partitions,
+  /// 3,961 poses moved) against 8,369 for the robots' blocks, and the steps take 34,354 CG
   /// iterations against 103,615 (docs/online.md, "The partition follows the graph"). The cut
   /// then hovers near the threshold; 0.03 / 0.05 end at 568 / 758 with 2,893 / 1,904 poses
   /// moved (replays of the structure alone).
@@ -52,6 +54,10 @@ struct RebalanceOptions {
 struct RebalanceResult {
   std::size_t moved = 0;                              ///< Poses that changed block.
   std::size_t largest_before = 0, largest_after = 0;  ///< Largest block's pose count.
+  std::size_t smallest_after = 0;                     ///< Smallest block's pose count.
+  /// Single-pose moves along chains of blocks that brought blocks within the bounds (a pose
+  /// passed along a chain counts once per hop); 0 without the cut refinement.
+  std::size_t chain_moves = 0;
   /// Of `moved`: poses the cut refinement moved (the rest are balance moves).
   std::size_t cut_moved = 0;
   /// Measurements between two blocks before and after the call (computed only when the
@@ -64,8 +70,17 @@ struct RebalanceResult {
 /// block that has one), to the lightest neighbouring block that is at least two poses
 /// lighter, until every block is within the bound or no such move is left. Poses do not pass
 /// through a block in one call (no cascade): a full block between an over-full one and a light
-/// one stops the move. Then, when the cut is above options.cut_fraction, refine_cut.
-/// `owner[k]` in 0..num_blocks-1; no block becomes empty.
+/// one stops the move. With the cut refinement on (cut_fraction < 1), then the bounds by
+/// chains: every block still above the upper bound `floor((1 + slack) ceil(n / N) +
+/// min_excess)` gives poses to the nearest block below it, and every block under the floor
+/// `floor((1 - slack) floor(n / N))` (at least 1) takes poses from the nearest block above it,
+/// each pose passing along the shortest chain of blocks linked by measurements, one border
+/// pose a hop, so the blocks in between keep their size. Then, when the cut is above
+/// options.cut_fraction, refine_cut, which keeps both bounds. So after a call with the
+/// refinement on, a block is out of the bounds only when no chain of measurements links it to a
+/// block that could take (give) a pose: a piece of the graph whose blocks are all at or past
+/// the bound (a robot that has met no other). `owner[k]` in 0..num_blocks-1; no block becomes
+/// empty.
 RebalanceResult rebalance_blocks(const PoseGraph& graph, std::vector<int>& owner, int num_blocks,
                                  const RebalanceOptions& options);
 

@@ -134,6 +134,7 @@ struct OnlineUpdate {
   int agents = 0;                 ///< Blocks (robots) during the step.
   std::size_t moved = 0;          ///< Poses that changed block (rebalance) before the rounds.
   std::size_t largest_block = 0;  ///< Largest block's poses during the rounds.
+  std::size_t smallest_block = 0;  ///< Smallest block's poses during the rounds.
   /// Measurements between two blocks during the rounds (0 when the cut refinement is off,
   /// RebalanceOptions::cut_fraction = 1).
   std::size_t cut = 0;
