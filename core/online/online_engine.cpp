@@ -230,6 +230,8 @@ DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
   if (blocks_->graph().num_poses == 0) return res;
   DistributedOptions run = solver;
   if (run.refine.enabled && run.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed) {
+    // The smoothed pieces follow the linked graph and its blocks, which change at every step:
+    // built again here (a pass over the measurements), one space shared by every agent.
     const PoseGraph& g = blocks_->graph();
     const auto space = std::make_shared<const CoarseSpace>(make_coarse_space(
         g.num_poses, g.measurements, blocks_->layout().owner, run.refine.coarse_space_options()));
