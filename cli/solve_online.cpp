@@ -87,9 +87,11 @@ const char* kOnlineHelp =
     "                            distributed Newton steps from the warm start (default) or\n"
     "                            block-coordinate rounds only\n"
     "  --newton-after T          newton: rounds first, down to ||grad f|| <= T (default: none)\n"
-    "  --step-coarse none|blocks newton: the CG's coarse correction (default none: block\n"
-    "                            Jacobi; blocks: plus one rigid motion per block of the\n"
-    "                            robots that have met: pays once many robots have met)\n"
+    "  --step-coarse none|blocks|smoothed   newton: the CG's coarse correction (default\n"
+    "                            none: block Jacobi; blocks: plus one rigid motion per block\n"
+    "                            of the robots that have met; smoothed: plus the rigid\n"
+    "                            motions of 8 smoothed pieces of each such block: the fewest\n"
+    "                            CG iterations once robots have met)\n"
     "  --cut-fraction F          re-partition: refine the blocks' border when more than F of\n"
     "                            the measurements join two blocks (default 0.02; 1: blocks\n"
     "                            stay the robots', moved only for balance)\n"
@@ -205,10 +207,12 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
     options.newton_steps = step_solver == "newton";
     options.newton_after_grad_tol = a.get_double("newton-after", options.newton_after_grad_tol);
     const std::string coarse = a.get_or("step-coarse", "none");
-    if (coarse != "none" && coarse != "blocks")
-      throw InputError("option --step-coarse: '" + coarse + "' is not one of none, blocks");
-    options.newton_coarse = coarse == "blocks" ? NewtonRefineOptions::Coarse::kBlocks
-                                               : NewtonRefineOptions::Coarse::kNone;
+    if (coarse != "none" && coarse != "blocks" && coarse != "smoothed")
+      throw InputError("option --step-coarse: '" + coarse +
+                       "' is not one of none, blocks, smoothed");
+    options.newton_coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
+                            : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
+                                                   : NewtonRefineOptions::Coarse::kNone;
   }
   options.validate();
   ReplayOptions replay;

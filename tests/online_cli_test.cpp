@@ -140,8 +140,12 @@ TEST(OnlineCli, TheStepsCoarseCorrectionReachesTheSameCertifiedOptimum) {
   EXPECT_NEAR(json_number(coarse, "cost"), json_number(plain, "cost"),
               1e-8 * json_number(plain, "cost"));
   EXPECT_TRUE(test::contains(coarse, "\"certified\": true")) << coarse;
+  const std::string smoothed = run("--step-coarse smoothed");
+  EXPECT_NEAR(json_number(smoothed, "cost"), json_number(plain, "cost"),
+              1e-8 * json_number(plain, "cost"));
+  EXPECT_TRUE(test::contains(smoothed, "\"certified\": true")) << smoothed;
   EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + r.graph +
-                                  " --online --robots 2 --step-coarse smoothed",
+                                  " --online --robots 2 --step-coarse pieces",
                               &out),
             2);
   EXPECT_TRUE(test::contains(out, "--step-coarse")) << out;

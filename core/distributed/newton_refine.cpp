@@ -371,13 +371,13 @@ void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
   } else if (!options_.coarse_balancing) {
     // Additive: z = B r + Phi A^+ Phi^T r (Phi^T r identical everywhere).
     z_ = state_.precondition(X_, r_);
-    coarse_->expand(X_, coarse_inverse_ * coarse_r_, z_);
+    coarse_->expand(X_, coarse_->times_inverse(coarse_r_), z_);
   } else {
     // Balancing, z = C r + (I - C H) B (I - H C) r with C = Phi A^+ Phi^T: here y = B (r - H Phi
     // xi), xi = A^+ Phi^T r, and z' = y + Phi xi is sent; the last term -C H y needs the sum
     // (H Phi)^T y, which rides in this iteration's sum, and is taken off z' and H z' then
     // (after_sums: in the coarse space, H of it is the kept H Phi columns: no exchange).
-    const Eigen::VectorXd xi = coarse_inverse_ * coarse_r_;
+    const Eigen::VectorXd xi = coarse_->times_inverse(coarse_r_);
     Eigen::MatrixXd t = r_;
     coarse_hphi_->subtract(touched_of(xi), t);
     z_ = state_.precondition(X_, t);
@@ -472,13 +472,13 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   if (coarse_ && options_.coarse_balancing) {
     // z = z' - Phi eta, H z = w' - H Phi eta with eta = A^+ (H Phi)^T y; the sums follow from
     // the ones of z' and Phi^T w' = (H Phi)^T z'.
-    const Eigen::VectorXd eta =
-        coarse_inverse_ * Eigen::Map<const Eigen::VectorXd>(t.data() + 3 + n, coarse_->size());
+    const Eigen::VectorXd eta = coarse_->times_inverse(
+        Eigen::Map<const Eigen::VectorXd>(t.data() + 3 + n, coarse_->size()));
     gamma -= coarse_r_.dot(eta);
-    delta += -2.0 * eta.dot(coarse_w) + eta.dot(coarse_matrix_ * eta);
+    delta += -2.0 * eta.dot(coarse_w) + eta.dot(coarse_->times_matrix(eta));
     coarse_->expand(X_, -eta, z_);
     coarse_hphi_->subtract(touched_of(eta), w_);
-    coarse_w -= coarse_matrix_ * eta;
+    coarse_w -= coarse_->times_matrix(eta);
   }
   const bool started = cg_->iterations() > 0;
   if (started && rnorm <= cg_target_) return try_step("residual", out);

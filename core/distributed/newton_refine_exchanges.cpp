@@ -3,8 +3,11 @@
 // The state machine is newton_refine.cpp, the trial point newton_refine_trial.cpp.
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <stdexcept>
 #include <tessera/distributed/newton_refine.hpp>
+#include <tessera/manifold/lifted_manifold.hpp>
+#include <tessera/problem/pose_kernels.hpp>
 
 #include "distributed/coarse_hessian_columns.hpp"
 #include "distributed/gauge_space.hpp"
@@ -214,17 +217,76 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
     if (!coarse_hphi_) coarse_hphi_ = std::make_unique<CoarseHessianColumns>(problem_.dim());
     coarse_hphi_->reset(touched.size());
   }
+  // Each column's Hessian product on the poses it reaches only: Phi e_u lives on its piece's
+  // poses S (own) and Sn (neighbour copies), so H Phi e_u = Proj(2 v Q_BB + 2 vn Q_NB) - W is
+  // non-zero only on the own poses J that share a measurement with S or Sn (Q_BB's and Q_NB's
+  // pattern), and Phi^T of it is a sum over J. The products per pose are the full product's,
+  // so the column is the same; its cost is |J| poses, not the block.
+  const SparseMatrix& qbb = problem_.data_matrix();
+  const SparseMatrix& qnb = problem_.neighbor_matrix();
+  const Eigen::Index w = problem_.dim() + 1;
+  const auto rows = static_cast<Eigen::Index>(X_.rows());
+  const auto own_poses = static_cast<Eigen::Index>(problem_.owned().size());
+  // Own poses that share a measurement with each neighbour copy (Q_NB's pattern, by row).
+  std::vector<std::vector<Eigen::Index>> own_of_neighbour(problem_.neighbors().size());
+  for (Eigen::Index col = 0; col < qnb.outerSize(); col += w)
+    for (SparseMatrix::InnerIterator it(qnb, col); it; ++it)
+      if (it.row() % w == 0)
+        own_of_neighbour[static_cast<std::size_t>(it.row() / w)].push_back(col / w);
+  std::vector<char> in_j(static_cast<std::size_t>(own_poses), 0);
+  Eigen::MatrixXd hv = Eigen::MatrixXd::Zero(rows, X_.cols());
+  std::vector<Eigen::Index> J;
+  int piece = -1;
   for (std::size_t c = 0; c < touched.size(); ++c) {
     const int u = touched[c];
+    if (u / coarse_->generators() != piece) {  // a new piece: its poses J
+      piece = u / coarse_->generators();
+      for (Eigen::Index j : J) in_j[static_cast<std::size_t>(j)] = 0;
+      J.clear();
+      for (Eigen::Index i : coarse_->own_slots(piece))
+        for (Eigen::Index q = 0; q < w; ++q)
+          for (SparseMatrix::InnerIterator it(qbb, i * w + q); it; ++it)
+            if (!in_j[static_cast<std::size_t>(it.row() / w)]) {
+              in_j[static_cast<std::size_t>(it.row() / w)] = 1;
+              J.push_back(it.row() / w);
+            }
+      for (Eigen::Index i : coarse_->neighbour_slots(piece))
+        for (Eigen::Index j : own_of_neighbour[static_cast<std::size_t>(i)])
+          if (!in_j[static_cast<std::size_t>(j)]) {
+            in_j[static_cast<std::size_t>(j)] = 1;
+            J.push_back(j);
+          }
+      std::sort(J.begin(), J.end());
+    }
     coarse_->unit(X_, Xn_, u, v, vn);
-    const Eigen::MatrixXd hv = hessian(v, vn);
-    coarse_->project(X_, hv, L.col(u).data());
+    const auto nj = static_cast<Eigen::Index>(J.size());
+    Eigen::MatrixXd HJ = Eigen::MatrixXd::Zero(rows, w * nj), XJ(rows, w * nj), GJ(rows, w * nj),
+                    VJ(rows, w * nj);
+    for (Eigen::Index a = 0; a < nj; ++a) {
+      const Eigen::Index from = J[static_cast<std::size_t>(a)] * w;
+      XJ.middleCols(a * w, w) = X_.middleCols(from, w);
+      GJ.middleCols(a * w, w) = egrad_.middleCols(from, w);
+      VJ.middleCols(a * w, w) = v.middleCols(from, w);
+      for (Eigen::Index q = 0; q < w; ++q) {
+        for (SparseMatrix::InnerIterator it(qbb, from + q); it; ++it)
+          HJ.col(a * w + q) += (2.0 * it.value()) * v.col(it.row());
+        if (vn.cols() > 0)
+          for (SparseMatrix::InnerIterator it(qnb, from + q); it; ++it)
+            HJ.col(a * w + q) += (2.0 * it.value()) * vn.col(it.row());
+      }
+    }
+    apply_hessian_projection(XJ, GJ, VJ, problem_.dim(), HJ);
+    HJ = LiftedManifold(static_cast<int>(rows), problem_.dim(), static_cast<std::size_t>(nj))
+             .tangent_project(XJ, HJ);
+    for (Eigen::Index a = 0; a < nj; ++a)
+      hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = HJ.middleCols(a * w, w);
+    coarse_->project(X_, hv, J, L.col(u).data());
     if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
+    for (Eigen::Index j : J) hv.middleCols(j * w, w).setZero();  // zero again, off J too
   }
   std::vector<double> values;
-  values.reserve(static_cast<std::size_t>(n * (n + 1) / 2 + n));
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i <= j; ++i) values.push_back(0.5 * (L(i, j) + L(j, i)));
+  values.reserve(coarse_->packed_size() + static_cast<std::size_t>(n));
+  coarse_->pack(L, values);
   const std::size_t at = values.size();
   values.resize(at + static_cast<std::size_t>(n), 0.0);
   coarse_->project(X_, g_, values.data() + at);
@@ -235,14 +297,9 @@ void NewtonRefineProtocol::after_coarse(const MessageGate::Inbox& inbox,
                                         std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.sigma_s);
   const int n = coarse_->size();
-  const std::vector<double> t =
-      reduce_in_id_order(inbox, static_cast<std::size_t>(n * (n + 1) / 2 + n));
-  Eigen::MatrixXd A(n, n);
-  std::size_t at = 0;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i <= j; ++i) A(i, j) = A(j, i) = t[at++];
-  coarse_inverse_ = coarse_->pseudo_inverse(A);
-  coarse_matrix_ = A;
+  const std::size_t at = coarse_->packed_size();
+  const std::vector<double> t = reduce_in_id_order(inbox, at + static_cast<std::size_t>(n));
+  coarse_->set_matrix(t.data());
   coarse_g_ = Eigen::Map<const Eigen::VectorXd>(t.data() + at, n);
   coarse_due_ = false;
   ++result_.coarse_assemblies;

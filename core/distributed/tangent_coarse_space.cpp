@@ -53,10 +53,20 @@ TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayo
   for (const Weight& w : own_poses_.weights)
     own[static_cast<std::size_t>(w.piece)] = any[static_cast<std::size_t>(w.piece)] = 1;
   for (const Weight& w : neighbour_poses_.weights) any[static_cast<std::size_t>(w.piece)] = 1;
-  // A piece alone in its group moves only by its gauge: A^+ is zero on its unknowns, so they are
-  // left out of touched() and own() (no Hessian product assembles their columns of A).
+  // A group of one block (a robot that has met no other) is left out of touched() and own(): no
+  // Hessian product assembles its columns of A. A piece alone in its group moves only by its
+  // gauge (A^+ is zero on its unknowns); the pieces of the smoothed space inside one lone block
+  // bend it, which block Jacobi's solve with the block's own factor already does.
   std::vector<int> members(static_cast<std::size_t>(groups_), 0);
-  for (int g : group_of_piece_) ++members[static_cast<std::size_t>(g)];
+  {
+    std::vector<int> last_block(static_cast<std::size_t>(groups_), -1);
+    for (int alpha = 0; alpha < pieces_; ++alpha) {
+      const int block = space ? space->aggregate_block[static_cast<std::size_t>(alpha)] : alpha;
+      const auto g = static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(alpha)]);
+      if (last_block[g] != block) ++members[g];  // aggregates are numbered by block
+      last_block[g] = block;
+    }
+  }
   std::vector<std::vector<Eigen::Index>> unknowns(static_cast<std::size_t>(groups_));
   for (int alpha = 0; alpha < pieces_; ++alpha)
     for (int j = 0; j < g_; ++j)
@@ -98,20 +108,24 @@ void TangentCoarseSpace::add_generator(int j, double x, Eigen::MatrixXd& E) cons
 void TangentCoarseSpace::move(const Eigen::MatrixXd& E, const Eigen::MatrixXd& X, Eigen::Index s,
                               Eigen::MatrixXd& v) const {
   const Eigen::Index c = s * (d_ + 1);
-  v.middleCols(c, d_ + 1).noalias() += E.leftCols(k_) * X.middleCols(c, d_ + 1);
+  // lazyProduct: a k x k times k x (d+1) product, where the GEMM path costs more than the flops.
+  v.middleCols(c, d_ + 1).noalias() += E.leftCols(k_).lazyProduct(X.middleCols(c, d_ + 1));
   v.col(c + d_) += E.col(k_);
 }
 
-void TangentCoarseSpace::project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
-                                 double* out) const {
+template <class Slots>
+void TangentCoarseSpace::project_over(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
+                                      const Slots& slots, double* out) const {
   // Per piece, sum_i w_i [v_i X_i^T, v_i's translation] (k x (k+1)); <E, that> for each
   // generator E is its coordinate.
   const Eigen::Index kk = k_ * (k_ + 1);
   std::vector<double> acc(static_cast<std::size_t>(pieces_ * kk), 0.0);
   Eigen::MatrixXd N(k_, k_ + 1);
-  for (std::size_t s : linked_slots_) {
+  for (const auto slot : slots) {
+    const auto s = static_cast<std::size_t>(slot);
     const Eigen::Index c = static_cast<Eigen::Index>(s) * (d_ + 1);
-    N.leftCols(k_).noalias() = v.middleCols(c, d_ + 1) * X.middleCols(c, d_ + 1).transpose();
+    N.leftCols(k_).noalias() =
+        v.middleCols(c, d_ + 1).lazyProduct(X.middleCols(c, d_ + 1).transpose());
     N.col(k_) = v.col(c + d_);
     for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
       const Weight& w = own_poses_.weights[q];
@@ -129,6 +143,27 @@ void TangentCoarseSpace::project(const Eigen::MatrixXd& X, const Eigen::MatrixXd
     }
     for (int a = 0; a < k_; ++a) o[rotations + a] += A(a, k_);
   }
+}
+
+void TangentCoarseSpace::project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
+                                 double* out) const {
+  project_over(X, v, linked_slots_, out);
+}
+
+void TangentCoarseSpace::project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
+                                 const std::vector<Eigen::Index>& slots, double* out) const {
+  project_over(X, v, slots, out);
+}
+
+std::vector<Eigen::Index> TangentCoarseSpace::slots_of(const Poses& p, int piece) {
+  std::vector<Eigen::Index> out;
+  for (std::size_t s = 0; s + 1 < p.start.size(); ++s)
+    for (std::size_t q = p.start[s]; q < p.start[s + 1]; ++q)
+      if (p.weights[q].piece == piece) {
+        out.push_back(static_cast<Eigen::Index>(s));
+        break;
+      }
+  return out;
 }
 
 void TangentCoarseSpace::expand(const Eigen::MatrixXd& X, const Eigen::VectorXd& xi,
@@ -168,35 +203,127 @@ void TangentCoarseSpace::unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& X
   fill(neighbour_poses_, Xn, vn);
 }
 
+Eigen::MatrixXd TangentCoarseSpace::group_inverse(const Eigen::MatrixXd& Ag, double tol) const {
+  const Eigen::Index m = Ag.rows();
+  // P = I - U U^T, U's columns the group's rigid motions (generator j on every piece of the
+  // group) normalized.
+  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(m, g_);
+  const double s = 1.0 / std::sqrt(static_cast<double>(m / g_));
+  for (Eigen::Index q = 0; q < m; ++q) U(q, q % g_) = s;
+  const Eigen::MatrixXd PA = Ag - U * (U.transpose() * Ag);
+  Eigen::MatrixXd B = PA - (PA * U) * U.transpose();
+  B = (0.5 * (B + B.transpose())).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(B);
+  const Eigen::VectorXd& l = eig.eigenvalues();
+  const double top = l.size() > 0 ? l(l.size() - 1) : 0.0;
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(l.size());
+  for (Eigen::Index i = 0; i < l.size(); ++i)
+    if (top > 0 && l(i) > tol * top) inv(i) = 1.0 / l(i);
+  const Eigen::MatrixXd& V = eig.eigenvectors();
+  return V * inv.asDiagonal() * V.transpose();
+}
+
 Eigen::MatrixXd TangentCoarseSpace::pseudo_inverse(const Eigen::MatrixXd& A, double tol) const {
   const Eigen::Index n = size();
   if (A.rows() != n || A.cols() != n)
     throw std::invalid_argument("TangentCoarseSpace: coarse matrix of the wrong size");
   // Pieces of different groups share no measurement, so A is block diagonal over the groups and
-  // so is its pseudo-inverse: one small eigendecomposition per group of two pieces or more (a
+  // so is its pseudo-inverse: one small eigendecomposition per group of two blocks or more (a
   // lone piece's block is all gauge, zero), not one of all the pieces' unknowns at every point.
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, n);
+  for (const std::vector<Eigen::Index>& idx : linked_group_unknowns_)
+    out(idx, idx) = group_inverse(A(idx, idx), tol);
+  return out;
+}
+
+std::size_t TangentCoarseSpace::packed_size() const {
+  std::size_t n = 0;
+  for (const std::vector<Eigen::Index>& idx : linked_group_unknowns_)
+    n += idx.size() * (idx.size() + 1) / 2;
+  return n;
+}
+
+void TangentCoarseSpace::pack(const Eigen::MatrixXd& L, std::vector<double>& out) const {
+  for (const std::vector<Eigen::Index>& idx : linked_group_unknowns_)
+    for (std::size_t j = 0; j < idx.size(); ++j)
+      for (std::size_t i = 0; i <= j; ++i)
+        out.push_back(0.5 * (L(idx[i], idx[j]) + L(idx[j], idx[i])));
+}
+
+void TangentCoarseSpace::set_matrix(const double* packed, double tol) {
+  matrices_.clear();
   for (const std::vector<Eigen::Index>& idx : linked_group_unknowns_) {
     const auto m = static_cast<Eigen::Index>(idx.size());
-    // P = I - U U^T, U's columns the group's rigid motions (generator j on every piece of the
-    // group) normalized.
-    Eigen::MatrixXd U = Eigen::MatrixXd::Zero(m, g_);
-    const double s = 1.0 / std::sqrt(static_cast<double>(m / g_));
-    for (Eigen::Index q = 0; q < m; ++q) U(q, q % g_) = s;
-    const Eigen::MatrixXd Ag = A(idx, idx);
-    const Eigen::MatrixXd PA = Ag - U * (U.transpose() * Ag);
-    Eigen::MatrixXd B = PA - (PA * U) * U.transpose();
+    GroupMatrix gm;
+    gm.A.resize(m, m);
+    for (Eigen::Index j = 0; j < m; ++j)
+      for (Eigen::Index i = 0; i <= j; ++i) gm.A(i, j) = gm.A(j, i) = *packed++;
+    // B = P A P with P = I - U U^T (U: the group's rigid motions, generator j on every piece,
+    // normalized); U U^T's entries are 1/pieces where the generators agree.
+    const double s = 1.0 / static_cast<double>(m / g_);
+    const auto project = [&](const Eigen::MatrixXd& M) {  // P M
+      Eigen::MatrixXd out = M;
+      for (int j = 0; j < g_; ++j) {
+        Eigen::RowVectorXd mean = Eigen::RowVectorXd::Zero(M.cols());
+        for (Eigen::Index q = j; q < m; q += g_) mean += M.row(q);
+        mean *= s;
+        for (Eigen::Index q = j; q < m; q += g_) out.row(q) -= mean;
+      }
+      return out;
+    };
+    Eigen::MatrixXd B = project(project(gm.A).transpose());
     B = (0.5 * (B + B.transpose())).eval();
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(B);
-    const Eigen::VectorXd& l = eig.eigenvalues();
-    const double top = l.size() > 0 ? l(l.size() - 1) : 0.0;
-    Eigen::VectorXd inv = Eigen::VectorXd::Zero(l.size());
-    for (Eigen::Index i = 0; i < l.size(); ++i)
-      if (top > 0 && l(i) > tol * top) inv(i) = 1.0 / l(i);
-    const Eigen::MatrixXd& V = eig.eigenvectors();
-    out(idx, idx) = V * inv.asDiagonal() * V.transpose();
+    const double c = B.diagonal().maxCoeff();
+    Eigen::MatrixXd shifted = B;
+    for (Eigen::Index p = 0; p < m; ++p)
+      for (Eigen::Index q = p % g_; q < m; q += g_) shifted(p, q) += c * s;
+    gm.llt.compute(shifted);
+    bool ok = c > 0 && gm.llt.info() == Eigen::Success;
+    if (ok) {
+      const Eigen::VectorXd pivots = gm.llt.matrixLLT().diagonal().cwiseAbs2();
+      ok = pivots.minCoeff() > tol * pivots.maxCoeff();
+    }
+    if (!ok) {
+      gm.dense = true;
+      gm.inverse = group_inverse(gm.A, tol);
+    }
+    matrices_.push_back(std::move(gm));
   }
-  return out;
+}
+
+Eigen::VectorXd TangentCoarseSpace::times_matrix(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(x.size());
+  for (std::size_t g = 0; g < matrices_.size(); ++g)
+    y(linked_group_unknowns_[g]) = matrices_[g].A * x(linked_group_unknowns_[g]);
+  return y;
+}
+
+Eigen::VectorXd TangentCoarseSpace::times_inverse(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(x.size());
+  for (std::size_t g = 0; g < matrices_.size(); ++g) {
+    const std::vector<Eigen::Index>& idx = linked_group_unknowns_[g];
+    const GroupMatrix& gm = matrices_[g];
+    if (gm.dense) {
+      y(idx) = gm.inverse * x(idx);
+      continue;
+    }
+    const auto m = static_cast<Eigen::Index>(idx.size());
+    const double s = 1.0 / static_cast<double>(m / g_);
+    const auto project = [&](Eigen::VectorXd& v) {  // v -= U U^T v
+      for (int j = 0; j < g_; ++j) {
+        double mean = 0.0;
+        for (Eigen::Index q = j; q < m; q += g_) mean += v(q);
+        mean *= s;
+        for (Eigen::Index q = j; q < m; q += g_) v(q) -= mean;
+      }
+    };
+    Eigen::VectorXd v = x(idx);
+    project(v);
+    v = gm.llt.solve(v);
+    project(v);
+    y(idx) = v;
+  }
+  return y;
 }
 
 }  // namespace tessera

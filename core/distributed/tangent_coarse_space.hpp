@@ -15,6 +15,7 @@
 // Each agent knows the weights of its own poses and of its copies of its neighbours' poses from
 // the space (identical on every agent), so Phi and Phi^T of its rows need no message.
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <cstddef>
 #include <tessera/distributed/block_layout.hpp>
@@ -39,8 +40,8 @@ class TangentCoarseSpace {
   /// Coarse unknowns: pieces() x generators(), unknown alpha * generators() + j.
   int size() const { return pieces_ * g_; }
   /// The unknowns whose vectors are non-zero on an own pose or a neighbour copy, ascending:
-  /// the columns of A this agent's rows contribute to. Only pieces linked to another piece
-  /// (groups()): a piece alone in its group moves only by its gauge, where A^+ is zero.
+  /// the columns of A this agent's rows contribute to. Only pieces in a group of two blocks or
+  /// more (groups()).
   const std::vector<int>& touched() const { return touched_; }
   /// The unknowns non-zero on an own pose, ascending (of linked pieces, as touched()).
   const std::vector<int>& own() const { return own_; }
@@ -48,6 +49,14 @@ class TangentCoarseSpace {
   /// out += Phi^T v over the own poses (X: the own point, v: a vector of its shape; out has
   /// size() entries), at the linked pieces' unknowns (the others are left as they are).
   void project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, double* out) const;
+  /// The same over the own pose slots `slots` only (ascending; v zero on the others).
+  void project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
+               const std::vector<Eigen::Index>& slots, double* out) const;
+  /// The own and neighbour slots where `piece` has a weight, ascending.
+  std::vector<Eigen::Index> own_slots(int piece) const { return slots_of(own_poses_, piece); }
+  std::vector<Eigen::Index> neighbour_slots(int piece) const {
+    return slots_of(neighbour_poses_, piece);
+  }
   /// v += Phi xi on the own poses (X's shape), xi's entries at own() only.
   void expand(const Eigen::MatrixXd& X, const Eigen::VectorXd& xi, Eigen::MatrixXd& v) const;
   /// The vector of one unknown on the own poses (v) and the neighbour copies (vn), set to the
@@ -60,8 +69,9 @@ class TangentCoarseSpace {
   /// its block): group_of(alpha) numbers them densely in order of their first piece.
   int groups() const { return groups_; }
   int group_of(int piece) const { return group_of_piece_[static_cast<std::size_t>(piece)]; }
-  /// Some group holds two pieces or more (else the correction is zero: every motion is gauge).
-  bool linked() const { return groups_ < pieces_; }
+  /// Some group holds pieces of two blocks or more (else the correction is left out: every
+  /// motion of a lone piece is gauge, and a lone block's inner pieces are block Jacobi's work).
+  bool linked() const { return !linked_group_unknowns_.empty(); }
 
   /// A positive semi-definite inverse of the Galerkin matrix A (size() x size(), symmetric):
   /// the rigid motions of each group of linked pieces (every piece of the group the same
@@ -76,6 +86,22 @@ class TangentCoarseSpace {
   /// group's largest eigenvalue). Deterministic: the same A gives the same bits on every agent.
   Eigen::MatrixXd pseudo_inverse(const Eigen::MatrixXd& A, double tol = 1e-10) const;
 
+  /// What an agent's share of A needs to carry: per group of two blocks or more, the upper
+  /// triangle of its diagonal block (A is zero between groups and on lone pieces), so a sum
+  /// costs sum_g m_g (m_g + 1) / 2 numbers rather than size() (size() + 1) / 2.
+  std::size_t packed_size() const;
+  /// Appends to `out` the packed_size() numbers of L (size() x size()), symmetrized.
+  void pack(const Eigen::MatrixXd& L, std::vector<double>& out) const;
+  /// Keeps the summed packed numbers as A, block by block, and A^+ (as pseudo_inverse(), but
+  /// from a Cholesky factor of each group's projected block plus its rigid motions, P (B + c U
+  /// U^T)^-1 P: n^3 / 3 flops against the eigendecomposition's ~10 n^3, which it falls back to
+  /// where that factor fails or has a pivot at or below `tol` times the largest: negative
+  /// curvature, or a generator that moves no pose).
+  void set_matrix(const double* packed, double tol = 1e-10);
+  /// A x and A^+ x with the kept A (x and the result: size() entries; zero outside the groups).
+  Eigen::VectorXd times_matrix(const Eigen::VectorXd& x) const;
+  Eigen::VectorXd times_inverse(const Eigen::VectorXd& x) const;
+
  private:
   struct Weight {
     int piece;
@@ -86,6 +112,13 @@ class TangentCoarseSpace {
     std::vector<std::size_t> start;
     std::vector<Weight> weights;
   };
+  // The pseudo-inverse of one group's block of A (the group's rigid motions projected out).
+  Eigen::MatrixXd group_inverse(const Eigen::MatrixXd& Ag, double tol) const;
+  static std::vector<Eigen::Index> slots_of(const Poses& p, int piece);
+  // project()'s sums over the given own slots.
+  template <class Slots>
+  void project_over(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, const Slots& slots,
+                    double* out) const;
   static Poses weights_of(const CoarseSpace* space, const BlockLayout& layout,
                           const std::vector<std::size_t>& ids);
   // [Omega c] of generator j scaled by x, added to E (k x (k+1)).
@@ -104,6 +137,15 @@ class TangentCoarseSpace {
   Poses own_poses_, neighbour_poses_;
   std::vector<int> touched_, own_;
   std::vector<std::pair<int, int>> rotation_pairs_;  // (a, b), a < b, for generators 0..
+  // set_matrix: per linked group, A's block, and A^+ as a Cholesky factor of B + c U U^T (then
+  // projected) or, where that failed, as a dense matrix.
+  struct GroupMatrix {
+    Eigen::MatrixXd A;
+    Eigen::LLT<Eigen::MatrixXd> llt;
+    bool dense = false;
+    Eigen::MatrixXd inverse;
+  };
+  std::vector<GroupMatrix> matrices_;
 };
 
 }  // namespace tessera

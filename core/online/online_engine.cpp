@@ -3,6 +3,7 @@
 #include <cmath>
 #include <ctime>
 #include <tessera/certification/rounding_gap.hpp>
+#include <tessera/distributed/coarse_space.hpp>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
 #include <tessera/online/lifted_rank.hpp>
@@ -35,8 +36,6 @@ void OnlineOptions::validate() const {
     throw InputError("OnlineOptions.step_every_s: a fixed step period excludes real_time");
   if (!(newton_forcing > 0 && newton_forcing < 1))
     throw InputError("OnlineOptions.newton_forcing must be in (0, 1)");
-  if (newton_coarse == NewtonRefineOptions::Coarse::kSmoothed)
-    throw InputError("OnlineOptions.newton_coarse: kSmoothed is not available (kNone or kBlocks)");
   if (!(newton_after_grad_tol > 0))
     throw InputError("OnlineOptions.newton_after_grad_tol must be > 0 (+infinity: no round)");
   DistributedOptions s = solver;
@@ -231,6 +230,14 @@ DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
   if (blocks_->graph().num_poses == 0) return res;
   DistributedOptions run = solver;
+  if (run.refine.enabled && run.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed) {
+    // The smoothed pieces follow the linked graph and its blocks, which change at every step:
+    // built again here (a pass over the measurements), one space shared by every agent.
+    const PoseGraph& g = blocks_->graph();
+    const auto space = std::make_shared<const CoarseSpace>(make_coarse_space(
+        g.num_poses, g.measurements, blocks_->layout().owner, run.refine.coarse_space_options()));
+    for (AgentState* s : blocks_->all_states()) s->use_refine_space(space);
+  }
   run.round_result = false;  // in the linked graph's ids: the caller rounds X_
   res = solve_distributed_with_states(blocks_->graph(), blocks_->layout(), blocks_->all_states(),
                                       run);

@@ -91,16 +91,20 @@ struct OnlineOptions {
   /// 75 / 76 / 64 at 0.03; CG iterations 1,747 / 632 / 575 against 1,646 / 601 / 529. In (0, 1).
   double newton_forcing = 0.03;
   /// The Newton steps' coarse correction (NewtonRefineOptions::coarse): kNone (block Jacobi,
-  /// the default) or kBlocks (plus one rigid motion per block; the blocks of a robot that has
-  /// met no other are left out, their motions being a gauge: tangent_coarse_space.hpp).
-  /// kSmoothed is not available here (its space is built where batch agents are set up).
-  /// kBlocks pays once the robots form a chain of blocks: a generated 20,000-pose grid over 10
-  /// robots, a step every 0.1 s, 65.5 CG iterations a step against 167.6 at 8,000-10,100 poses
-  /// and 105.5 against 499.5 at 10,200-12,000 (CPU 1.84 / 3.43 s a step against 2.13 / 6.97,
-  /// load 13-15). Off by default because while few robots have met it costs more than it
-  /// saves: the coarse matrix is summed at every accepted Newton step (a generated 1,000-pose
-  /// grid3d over 5 robots: 512 CG iterations against 601, 6.30 G instructions against 3.40 G,
-  /// callgrind; docs/online.md, "The coarse correction").
+  /// the default), kBlocks (plus one rigid motion per block) or kSmoothed (plus the rigid
+  /// motions of solver.refine.coarse_aggregates smoothed pieces of each block, the space built
+  /// from the linked graph at every solve). Only blocks in a group of two or more linked blocks
+  /// take part: a robot that has met no other is left out (its motions are a gauge, its inner
+  /// bending block Jacobi's work), so before the robots meet the steps are block Jacobi's
+  /// (tangent_coarse_space.hpp). Once they meet, the error a closure leaves is bending across
+  /// blocks, which block Jacobi moves one block boundary per CG iteration: a generated
+  /// 20,000-pose grid over 10 robots, a step every 0.1 s, first 11,010 poses: 12,442 CG
+  /// iterations without, 6,161 with kBlocks, 4,071 with kSmoothed (at 10,000-11,000 poses 527 /
+  /// 103 / 36 a step; CPU 140 / 105 / 100 s, load 6-19). Off by default: while robots have
+  /// only met in pairs kSmoothed cuts fewer iterations than it costs (the same grid at
+  /// 4,600-8,000 poses: 48 against 67 CG iterations a step, 0.96 against 0.55 CPU-s); and the
+  /// coarse matrix is summed at every accepted Newton step (docs/online.md, "The coarse
+  /// correction").
   NewtonRefineOptions::Coarse newton_coarse = NewtonRefineOptions::Coarse::kNone;
   /// New poses that new loop closures tie to the estimate are placed by least squares against
   /// every new measurement after composition (new_pose_placement.hpp), not only along their

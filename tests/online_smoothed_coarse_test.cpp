@@ -1,0 +1,150 @@
+// The online Newton steps' smoothed coarse correction (OnlineOptions::newton_coarse = kSmoothed:
+// rigid motions of smoothed pieces inside the blocks, built from the linked graph at every
+// solve): its coarse inverse from a Cholesky factor is the pseudo-inverse of the Galerkin matrix
+// (so the preconditioner is the same symmetric positive definite one), robots that have not met
+// take block Jacobi's steps, and once they meet it takes fewer CG iterations than block Jacobi
+// and than one rigid motion per block to the batch optimum.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <random>
+#include <tessera/distributed/block_layout.hpp>
+#include <tessera/generate/generator.hpp>
+#include <tessera/online/online_engine.hpp>
+#include <tessera/online/replay_schedule.hpp>
+#include <tessera/online/stream_batch.hpp>
+#include <tessera/solvers/centralized_solver.hpp>
+#include <utility>
+#include <vector>
+
+#include "distributed/tangent_coarse_space.hpp"
+
+namespace tessera {
+namespace {
+
+// Blocks 0 and 1 hold one chain, block 2 a chain of its own (a robot that has met no other).
+BlockLayout two_groups() {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::uint32_t i = 0; i + 1 < 30; ++i) edges.emplace_back(i, i + 1);
+  for (std::uint32_t i = 30; i + 1 < 45; ++i) edges.emplace_back(i, i + 1);
+  std::vector<int> parts(45, 0);
+  for (std::size_t i = 15; i < 45; ++i) parts[i] = i < 30 ? 1 : 2;
+  return make_block_layout(45, edges, parts);
+}
+
+// set_matrix's A x and A^+ x against A and pseudo_inverse(A) for a symmetric A.
+void expect_kept_matrix_is_the_pseudo_inverse(const Eigen::MatrixXd& A) {
+  const BlockLayout layout = two_groups();
+  TangentCoarseSpace c(nullptr, layout, layout.poses[0], {15}, 3, 3);
+  std::vector<double> packed;
+  c.pack(A, packed);
+  ASSERT_EQ(packed.size(), c.packed_size());
+  // Only blocks 0 and 1 (one group, 2 x 6 unknowns) are carried.
+  EXPECT_EQ(c.packed_size(), 12u * 13u / 2u);
+  c.set_matrix(packed.data());
+  const Eigen::MatrixXd inv = c.pseudo_inverse(A);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  const int g = c.generators();
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::VectorXd x(c.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i) x(i) = normal(rng);
+    const Eigen::VectorXd y = c.times_inverse(x);
+    EXPECT_LT((y - inv * x).norm(), 1e-10 * (inv * x).norm()) << "trial " << trial;
+    // Block 2's unknowns: nothing (all gauge).
+    EXPECT_EQ(y.segment(2 * g, g).norm(), 0.0);
+    // A x over the group only (A is zero between groups and on a lone piece).
+    Eigen::VectorXd ax = Eigen::VectorXd::Zero(c.size());
+    ax.head(2 * g) = A.topLeftCorner(2 * g, 2 * g) * x.head(2 * g);
+    EXPECT_LT((c.times_matrix(x) - ax).norm(), 1e-12 * ax.norm());
+  }
+}
+
+TEST(OnlineSmoothedCoarse, TheCholeskyInverseIsThePseudoInverseOfTheGalerkinMatrix) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd M(18, 18);
+  for (Eigen::Index i = 0; i < M.size(); ++i) M.data()[i] = normal(rng);
+  // Positive definite: the Cholesky path.
+  expect_kept_matrix_is_the_pseudo_inverse(M * M.transpose() + Eigen::MatrixXd::Identity(18, 18));
+  // Indefinite (negative curvature along some combination): the eigendecomposition's fallback,
+  // which drops the negative eigenvalues as pseudo_inverse does.
+  expect_kept_matrix_is_the_pseudo_inverse(M + M.transpose());
+}
+
+GeneratorResult grid(std::size_t n, std::size_t robots) {
+  GeneratorOptions o;
+  o.kind = TrajectoryKind::kGrid3d;
+  o.num_poses = n;
+  o.num_robots = robots;
+  o.seed = 3;
+  return generate_pose_graph(o);
+}
+
+OnlineOptions options(NewtonRefineOptions::Coarse coarse) {
+  OnlineOptions o;
+  o.solver.grad_norm_tol = 1e-5;
+  o.step_every_s = 0.5;
+  o.certify_at_end = false;
+  o.newton_coarse = coarse;
+  return o;
+}
+
+int cg_iterations(const OnlineResult& r) {
+  int cg = 0;
+  for (const OnlineUpdate& u : r.updates) cg += u.newton_cg_iterations;
+  return cg;
+}
+
+TEST(OnlineSmoothedCoarse, RobotsThatHaveNotMetTakeBlockJacobisNewtonSteps) {
+  // Three robots that never meet: each block's pieces bend only their own block, which block
+  // Jacobi's own factor does, so no coarse space is built at all.
+  const auto gen = grid(240, 3);
+  ReplayOptions ro;
+  ro.rate = 10;
+  ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  for (StreamBatch& b : plan.batches)
+    b.measurements.erase(
+        std::remove_if(b.measurements.begin(), b.measurements.end(),
+                       [](const StreamMeasurement& m) { return m.from.robot != m.to.robot; }),
+        b.measurements.end());
+  const OnlineResult none =
+      run_online(gen.graph.d, plan.batches, options(NewtonRefineOptions::Coarse::kNone));
+  const OnlineResult smoothed =
+      run_online(gen.graph.d, plan.batches, options(NewtonRefineOptions::Coarse::kSmoothed));
+  ASSERT_EQ(smoothed.updates.size(), none.updates.size());
+  int steps = 0;
+  for (std::size_t k = 0; k < none.updates.size(); ++k) {
+    EXPECT_EQ(smoothed.updates[k].newton_steps, none.updates[k].newton_steps) << "step " << k;
+    EXPECT_EQ(smoothed.updates[k].newton_cg_iterations, none.updates[k].newton_cg_iterations)
+        << "step " << k;
+    steps += none.updates[k].newton_steps;
+  }
+  EXPECT_GT(steps, 0);
+  EXPECT_EQ(smoothed.grad_norm, none.grad_norm);
+}
+
+TEST(OnlineSmoothedCoarse, OnceTheRobotsMeetItTakesFewerCgIterationsToTheBatchOptimum) {
+  const auto gen = grid(600, 4);
+  ReplayOptions ro;
+  ro.rate = 10;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  const OnlineResult none =
+      run_online(gen.graph.d, plan.batches, options(NewtonRefineOptions::Coarse::kNone));
+  const OnlineResult blocks =
+      run_online(gen.graph.d, plan.batches, options(NewtonRefineOptions::Coarse::kBlocks));
+  const OnlineResult smoothed =
+      run_online(gen.graph.d, plan.batches, options(NewtonRefineOptions::Coarse::kSmoothed));
+  EXPECT_LT(cg_iterations(smoothed), cg_iterations(none));
+  EXPECT_LT(cg_iterations(smoothed), cg_iterations(blocks));
+  const double f_star = solve_centralized(gen.graph).cost;
+  EXPECT_NEAR(smoothed.cost, f_star, 1e-6 * f_star);
+  std::printf("CG iterations: block Jacobi %d, blocks' rigid motions %d, smoothed pieces %d\n",
+              cg_iterations(none), cg_iterations(blocks), cg_iterations(smoothed));
+}
+
+}  // namespace
+}  // namespace tessera
