@@ -75,10 +75,12 @@ const char* kHelp =
     "                            GNC's early end back: within a factor 2 of c^2 on both sides,\n"
     "                            or only those beyond it (the passes judge the ones within it on\n"
     "                            the kept set) [beyond]\n"
-    "  --gnc-probe-cut always|after-passes   robust distributed: whether a re-check probe may\n"
-    "                            cut kept measurements while the rejected set is still GNC's\n"
-    "                            own (always), or only once the re-check passes changed it;\n"
-    "                            before that it only brings back the return band [always]\n"
+    "  --gnc-probe-cut always|after-passes|auto   robust distributed: whether a re-check\n"
+    "                            probe may cut kept measurements while the rejected set is\n"
+    "                            still GNC's own (always), or only once the re-check passes\n"
+    "                            changed it (before that it only brings back the return band);\n"
+    "                            auto: after the passes where GNC's weighted solves were\n"
+    "                            Newton steps, always where they were rounds [auto]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {
@@ -271,13 +273,12 @@ int run_solve(const Args& args) {
   if (jump_side != "both" && jump_side != "beyond")
     throw InputError("option --gnc-jump-side: '" + jump_side + "' is not one of both, beyond");
   robust.jump_band_inside = jump_side == "both";
-  // RobustOptions::probe_cut_untouched; `tessera solve` only, like --gnc-jump-side.
-  const std::string probe_cut =
-      a.get_or("gnc-probe-cut", robust.probe_cut_untouched ? "always" : "after-passes");
-  if (probe_cut != "always" && probe_cut != "after-passes")
-    throw InputError("option --gnc-probe-cut: '" + probe_cut +
-                     "' is not one of always, after-passes");
-  robust.probe_cut_untouched = probe_cut == "always";
+  // RobustOptions::probe_cut; `tessera solve` only, like --gnc-jump-side.
+  try {
+    robust.probe_cut = parse_probe_cut(a.get_or("gnc-probe-cut", probe_cut_name(robust.probe_cut)));
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-probe-cut: ") + e.what());
+  }
   if (algorithm == "centralized")
     return solve_centralized_command(a, a.positional()[0], robust, start);
   if (algorithm == "rbcd" || algorithm == "rbcd++" || algorithm == "irbcd")
