@@ -81,6 +81,10 @@ const char* kHelp =
     "                            changed it (before that it only brings back the return band);\n"
     "                            auto: after the passes where GNC's weighted solves were\n"
     "                            Newton steps, always where they were rounds [auto]\n"
+    "  --gnc-newton-mu-step-max S   robust distributed: while --gnc-mu-step-max is 0, where\n"
+    "                            GNC's weighted solves are Newton steps, mu's step after an\n"
+    "                            outer step that moved no weight across 1/2 is the last one\n"
+    "                            squared, up to S; 0 = none, else > 1 [4]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {
@@ -256,6 +260,7 @@ int run_solve(const Args& args) {
   valued.insert("gnc-cluster-probes");
   valued.insert("gnc-jump-side");
   valued.insert("gnc-probe-cut");
+  valued.insert("gnc-newton-mu-step-max");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
@@ -278,6 +283,13 @@ int run_solve(const Args& args) {
     robust.probe_cut = parse_probe_cut(a.get_or("gnc-probe-cut", probe_cut_name(robust.probe_cut)));
   } catch (const InputError& e) {
     throw InputError(std::string("option --gnc-probe-cut: ") + e.what());
+  }
+  // RobustOptions::newton_mu_step_max; `tessera solve` only, like --gnc-probe-cut.
+  robust.newton_mu_step_max = a.get_double("gnc-newton-mu-step-max", robust.newton_mu_step_max);
+  try {
+    robust.validate();
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-newton-mu-step-max: ") + e.what());
   }
   if (algorithm == "centralized")
     return solve_centralized_command(a, a.positional()[0], robust, start);

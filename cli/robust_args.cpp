@@ -147,6 +147,7 @@ void add_robust_fields(JsonObject& json, const RobustSummary& s) {
       .add("known_inliers", known_inliers_name(s.options.known_inliers))
       .add("gnc_mu_step", s.options.mu_step)
       .add("gnc_mu_step_max", s.options.mu_step_max)
+      .add("gnc_newton_mu_step_max", s.options.newton_mu_step_max)
       .add("gnc_jump_side", s.options.jump_band_inside ? "both" : "beyond")
       .add("gnc_probe_cut", probe_cut_name(s.options.probe_cut))
       .add("weights_converged", s.weights_converged)

@@ -455,8 +455,9 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kWeights: {
       const auto [spread, crossed] = exchange_->summed_votes();
-      const bool jump = outer_->after_update(spread, static_cast<int>(crossed),
-                                             exchange_->summed_near_bound(), options_.robust);
+      const bool jump =
+          outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
+                               options_.robust, gnc_newton_steps_);
       if (jump)
         for (std::size_t k = 0; k < weights_.size(); ++k)
           if (terms_->may_reject(k) && !dropped_[k])

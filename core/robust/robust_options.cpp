@@ -70,6 +70,8 @@ void RobustOptions::validate() const {
     bad_field("mu_step", number_text(mu_step), "must be > 1");
   if (!(std::isfinite(mu_step_max) && (mu_step_max == 0 || mu_step_max >= mu_step)))
     bad_field("mu_step_max", number_text(mu_step_max), "must be 0 (off) or >= mu_step");
+  if (!(std::isfinite(newton_mu_step_max) && (newton_mu_step_max == 0 || newton_mu_step_max > 1)))
+    bad_field("newton_mu_step_max", number_text(newton_mu_step_max), "must be 0 (none) or > 1");
   if (!(std::isfinite(jump_band) && (jump_band == 0 || jump_band > 1)))
     bad_field("jump_band", number_text(jump_band), "must be 0 (off) or > 1");
   if (recheck_max_rounds < 0)

@@ -67,6 +67,19 @@ struct RobustOptions {
   /// next step is the last one squared, up to this factor; any change returns it to mu_step.
   /// 0 (default) = off, every step mu_step; otherwise >= mu_step.
   double mu_step_max = 0.0;
+  /// Distributed solvers only: the mu_step_max that applies, while mu_step_max is 0, where every
+  /// weighted solve of GNC so far was a Newton step (gnc_refine_steps, where the team's interface
+  /// fits; decided from each solve's layout, the same on every agent); 0 = none (mu_step there
+  /// too), else > 1 (a value below mu_step caps nothing). `tessera solve
+  /// --gnc-newton-mu-step-max`. Why: a Newton step ends each weighted solve near its minimiser,
+  /// as the centralized GNC's full solves do, so a bigger step of mu while no weight crosses 1/2
+  /// moves only weights that stay on their side. 4: F = 0.25 random, 5 agents, message steps
+  /// 168 -> 159 on intel (15 -> 14 outer steps), 0.5 159 -> 109 (14 -> 8), intel group 0.25 466 ->
+  /// 412, CSAIL 0.5 72 -> 63, group 0.5 213 -> 204; every intel and CSAIL cell of the benchmark
+  /// (random and group 0.1 / 0.25 / 0.5) the same answer; 2 and 9 give the same answers (9 the
+  /// same counts, 2 intel 0.5 127). Where GNC's solves are rounds nothing changes (there adaptive
+  /// mu cost manhattan3500 a probe: docs/robust.md, "Fewer outer steps").
+  double newton_mu_step_max = 4.0;
   /// Distributed solvers only: GNC ends early when, at a weight update, no measurement that may
   /// be rejected has its r^2 within a factor of this of the bound (c^2 / B < r^2 < B c^2, summed
   /// over the agents with the weight votes): each weight then jumps to TLS's own verdict at that
@@ -111,7 +124,7 @@ struct RobustOptions {
   /// fold: manhattan3500 with 25 % group outliers needs it (with it 12,265 message steps,
   /// precision 0.974, recall 0.980, certified; without, 76,603, 0.899, 0.949, not certified).
   /// F = 0.25 random, 5 agents, always -> auto: intel 224 -> 168 message steps, CSAIL 92 -> 72,
-  /// every other graph the same run; every answer of the benchmark's grid the same
+  /// every other graph the same run; every answer the same on the benchmark's cells run
   /// (docs/robust.md, "Cut only after the passes changed GNC's set").
   /// `tessera solve --gnc-probe-cut always|after-passes|auto`.
   ProbeCut probe_cut = ProbeCut::kAuto;
