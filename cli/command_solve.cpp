@@ -75,10 +75,16 @@ const char* kHelp =
     "                            GNC's early end back: within a factor 2 of c^2 on both sides,\n"
     "                            or only those beyond it (the passes judge the ones within it on\n"
     "                            the kept set) [beyond]\n"
-    "  --gnc-probe-cut always|after-passes   robust distributed: whether a re-check probe may\n"
-    "                            cut kept measurements while the rejected set is still GNC's\n"
-    "                            own (always), or only once the re-check passes changed it;\n"
-    "                            before that it only brings back the return band [always]\n"
+    "  --gnc-probe-cut always|after-passes|auto   robust distributed: whether a re-check\n"
+    "                            probe may cut kept measurements while the rejected set is\n"
+    "                            still GNC's own (always), or only once the re-check passes\n"
+    "                            changed it (before that it only brings back the return band);\n"
+    "                            auto: after the passes where GNC's weighted solves were\n"
+    "                            Newton steps, always where they were rounds [auto]\n"
+    "  --gnc-newton-mu-step-max S   robust distributed: while --gnc-mu-step-max is 0, where\n"
+    "                            GNC's weighted solves are Newton steps, mu's step after an\n"
+    "                            outer step that moved no weight across 1/2 is the last one\n"
+    "                            squared, up to S; 0 = none, else > 1 [4]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {
@@ -254,6 +260,7 @@ int run_solve(const Args& args) {
   valued.insert("gnc-cluster-probes");
   valued.insert("gnc-jump-side");
   valued.insert("gnc-probe-cut");
+  valued.insert("gnc-newton-mu-step-max");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
@@ -271,13 +278,19 @@ int run_solve(const Args& args) {
   if (jump_side != "both" && jump_side != "beyond")
     throw InputError("option --gnc-jump-side: '" + jump_side + "' is not one of both, beyond");
   robust.jump_band_inside = jump_side == "both";
-  // RobustOptions::probe_cut_untouched; `tessera solve` only, like --gnc-jump-side.
-  const std::string probe_cut =
-      a.get_or("gnc-probe-cut", robust.probe_cut_untouched ? "always" : "after-passes");
-  if (probe_cut != "always" && probe_cut != "after-passes")
-    throw InputError("option --gnc-probe-cut: '" + probe_cut +
-                     "' is not one of always, after-passes");
-  robust.probe_cut_untouched = probe_cut == "always";
+  // RobustOptions::probe_cut; `tessera solve` only, like --gnc-jump-side.
+  try {
+    robust.probe_cut = parse_probe_cut(a.get_or("gnc-probe-cut", probe_cut_name(robust.probe_cut)));
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-probe-cut: ") + e.what());
+  }
+  // RobustOptions::newton_mu_step_max; `tessera solve` only, like --gnc-probe-cut.
+  robust.newton_mu_step_max = a.get_double("gnc-newton-mu-step-max", robust.newton_mu_step_max);
+  try {
+    robust.validate();
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-newton-mu-step-max: ") + e.what());
+  }
   if (algorithm == "centralized")
     return solve_centralized_command(a, a.positional()[0], robust, start);
   if (algorithm == "rbcd" || algorithm == "rbcd++" || algorithm == "irbcd")

@@ -416,6 +416,7 @@ TEST(DdsRobust, PassRefineOverDdsEqualsTheInProcessEngine) {
   ASSERT_GT(ref.refine_message_steps, 0) << "the passes should hand over to the refinement";
   GncDistributedOptions fixed = o;
   fixed.robust.mu_step_max = 0;
+  fixed.robust.newton_mu_step_max = 0;
   ASSERT_LT(ref.outer_iterations, solve_gnc_distributed(g, dds.assignment, fixed).outer_iterations)
       << "the adaptive steps should shorten the schedule (15 against 24 outer steps)";
   EXPECT_EQ(json_field(dds.summary, "gnc_refine_steps"), ref.refine_message_steps) << dds.summary;

@@ -32,6 +32,7 @@ TEST(GncAdaptiveMu, BiggerStepsWhileTheSetStaysEndWithTheSameSetInFewerOuterStep
   GncDistributedOptions o;
   o.robust.kind = RobustKind::kGncTls;
   o.solver.certify = true;
+  o.robust.newton_mu_step_max = 0;  // the fixed step on Newton steps too
   const GncDistributedResult fixed =
       solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
   o.robust.mu_step_max = 4;

@@ -143,7 +143,7 @@ TEST(GncDistributed, AProbeThatDoesNotLowerTheTlsCostIsUndone) {
   o.robust.probe_tail_ratio = 1.5;  // the default: these residuals have no heavy tail
   EXPECT_EQ(solve_gnc_distributed(dirty.graph, robots_as_blocks(dirty), o).probes, 0);
   o.robust.probe_tail_ratio = 0;
-  o.robust.probe_cut_untouched = true;  // the passes leave GNC's set alone here
+  o.robust.probe_cut = ProbeCut::kAlways;  // the passes leave GNC's set alone here
   const GncDistributedResult probed =
       solve_gnc_distributed(dirty.graph, robots_as_blocks(dirty), o);
   EXPECT_EQ(probed.probes, 1);

@@ -14,6 +14,7 @@ GncDistributedOptions capped(int outer) {
   o.robust.kind = RobustKind::kGncTls;
   o.solver.certify = true;
   o.robust.max_outer_iterations = outer;
+  o.robust.newton_mu_step_max = 0;  // mu's fixed step: the cap, not the schedule, ends GNC
   return o;
 }
 

@@ -75,5 +75,53 @@ TEST(GncRefineSteps, WithoutRefinedPassesTheWeightedSolvesStayRounds) {
   EXPECT_EQ(one.final_solve.cost, zero.final_solve.cost);
 }
 
+// RobustOptions::newton_mu_step_max: where GNC's weighted solves are Newton steps (refine_passes,
+// gnc_refine_steps 1: the interface fits on the 125-pose grid), mu's step grows while no weight
+// crosses 1/2: fewer outer steps, the same set and certified cost; where they are rounds the
+// option changes nothing.
+TEST(GncRefineSteps, BiggerMuStepsOnNewtonStepsKeepTheSetAndCostAndChangeNothingOnRounds) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  GncDistributedOptions o;  // the solver's defaults: --refine auto
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.certify = true;
+  ASSERT_EQ(o.robust.newton_mu_step_max, 4.0);
+  const GncDistributedResult bigger =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  o.robust.newton_mu_step_max = 0;
+  const GncDistributedResult fixed =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  ASSERT_GT(fixed.refine_message_steps, 0) << "GNC's solves should be Newton steps here";
+  EXPECT_EQ(bigger.rejected, dirty.outliers);
+  EXPECT_EQ(fixed.rejected, dirty.outliers);
+  EXPECT_LT(bigger.outer_iterations, fixed.outer_iterations);
+  EXPECT_NEAR(bigger.final_solve.cost, fixed.final_solve.cost, 1e-9 * fixed.final_solve.cost);
+  EXPECT_TRUE(bigger.final_solve.certified.value_or(false));
+
+  o.robust.gnc_refine_steps = 0;  // GNC's weighted solves by rounds
+  const GncDistributedResult rounds_off =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  o.robust.newton_mu_step_max = 4;
+  const GncDistributedResult rounds_on =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  EXPECT_EQ(rounds_on.outer_iterations, rounds_off.outer_iterations);
+  EXPECT_EQ(rounds_on.total_rounds, rounds_off.total_rounds);
+  EXPECT_EQ(rounds_on.rejected, rounds_off.rejected);
+  EXPECT_EQ(rounds_on.final_solve.cost, rounds_off.final_solve.cost);
+}
+
+TEST(GncRefineSteps, ANewtonMuStepMaxOfOneNamesTheField) {
+  RobustOptions o;
+  o.newton_mu_step_max = 1;
+  try {
+    o.validate();
+    FAIL() << "newton_mu_step_max 1 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("RobustOptions.newton_mu_step_max"), std::string::npos)
+        << e.what();
+  }
+  o.newton_mu_step_max = 0;  // none
+  EXPECT_NO_THROW(o.validate());
+}
+
 }  // namespace
 }  // namespace tessera

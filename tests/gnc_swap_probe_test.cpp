@@ -201,7 +201,7 @@ TEST(GncDistributed, AProbeWhosePassesTakeBackExactlyWhatItCutEndsNotKept) {
   o.robust.probe_ratio = 1.5;
   o.robust.probe_tail_ratio = 0;
   o.robust.recheck_probes = 1;
-  o.robust.probe_cut_untouched = true;  // the passes leave GNC's set alone here
+  o.robust.probe_cut = ProbeCut::kAlways;  // the passes leave GNC's set alone here
   const GncDistributedResult r =
       solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
   EXPECT_EQ(r.probes, 1);

@@ -132,6 +132,10 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   const bool newton_steps = solve_kind_ == GncSolveKind::kGnc && g_ > first_solve_g_ &&
                             gnc_refines(options_, *layout_, in_.d);
   solve_options_ = gnc_solve_options(options_, solve_kind_, pass_capped_, newton_steps);
+  if (solve_kind_ == GncSolveKind::kGnc && g_ > first_solve_g_) {
+    gnc_newton_steps_ = (weighted_solves_ == 0 || gnc_newton_steps_) && newton_steps;
+    ++weighted_solves_;
+  }
   std::vector<Measurement> measurements;
   if (solve_kind_ == GncSolveKind::kGnc)
     measurements = gnc_solve_measurements(in_.measurements, weights_, g_ > first_solve_g_,
@@ -353,7 +357,12 @@ bool GncAgent::may_probe() const {
 }
 
 std::vector<std::uint64_t> GncAgent::probe_flips(std::vector<std::uint64_t> listed) const {
-  if (options_.robust.probe_cut_untouched || rejected_ != gnc_rejected_) return listed;
+  // RobustOptions::probe_cut: from GNC's own set the tail side is cut always, never, or where
+  // GNC's weighted solves were rounds.
+  const ProbeCut rule = options_.robust.probe_cut;
+  const bool cut_untouched =
+      rule == ProbeCut::kAlways || (rule == ProbeCut::kAuto && !gnc_newton_steps_);
+  if (cut_untouched || rejected_ != gnc_rejected_) return listed;
   // Every agent holds the same list and set (the verdict exchange): the same flips everywhere.
   listed.erase(std::remove_if(listed.begin(), listed.end(),
                               [&](std::uint64_t id) {
@@ -460,8 +469,9 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kWeights: {
       const auto [spread, crossed] = exchange_->summed_votes();
-      const bool jump = outer_->after_update(spread, static_cast<int>(crossed),
-                                             exchange_->summed_near_bound(), options_.robust);
+      const bool jump =
+          outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
+                               options_.robust, gnc_newton_steps_);
       if (jump)
         for (std::size_t k = 0; k < weights_.size(); ++k)
           if (terms_->may_reject(k) && !dropped_[k])

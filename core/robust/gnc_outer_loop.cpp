@@ -13,7 +13,7 @@ void GncOuterLoop::start(double largest_residual_squared, double c2, const Robus
 }
 
 bool GncOuterLoop::after_update(double spread, int crossed, int near_bound,
-                                const RobustOptions& options) {
+                                const RobustOptions& options, bool newton) {
   ++outer_;
   converged_ = spread <= options.weight_tolerance;
   // RobustOptions::jump_band: every residual clear of the bound, so GNC ends at TLS's verdict at
@@ -22,9 +22,14 @@ bool GncOuterLoop::after_update(double spread, int crossed, int near_bound,
     converged_ = true;
     return true;
   }
-  // RobustOptions::mu_step_max: a bigger step while the inlier set stays as it was.
-  const double step_max = options.mu_step_max;
-  factor_ = step_max > 0 && crossed == 0 ? std::min(factor_ * factor_, step_max) : options.mu_step;
+  // RobustOptions::mu_step_max (newton_mu_step_max on Newton steps): a bigger step while the
+  // inlier set stays as it was, never below mu_step.
+  const double step_max = options.mu_step_max > 0 ? options.mu_step_max
+                          : newton                ? options.newton_mu_step_max
+                                                  : 0.0;
+  factor_ = step_max > 0 && crossed == 0
+                ? std::max(options.mu_step, std::min(factor_ * factor_, step_max))
+                : options.mu_step;
   mu_ *= factor_;
   return false;
 }

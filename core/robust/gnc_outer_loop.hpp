@@ -19,7 +19,10 @@ class GncOuterLoop {
   /// for that verdict. Otherwise mu takes its next step (RobustOptions::mu_step, squared up to
   /// mu_step_max while no weight crossed 1/2) and converged() says whether the next solve is
   /// the last weighted one.
-  bool after_update(double spread, int crossed, int near_bound, const RobustOptions& options);
+  /// `newton`: every weighted solve so far was a Newton step (RobustOptions::newton_mu_step_max
+  /// then caps the step while mu_step_max is 0).
+  bool after_update(double spread, int crossed, int near_bound, const RobustOptions& options,
+                    bool newton = false);
 
   /// The weighted solves are over: converged, or RobustOptions::max_outer_iterations reached.
   bool over(const RobustOptions& options) const {

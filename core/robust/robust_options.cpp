@@ -40,6 +40,18 @@ KnownInliers parse_known_inliers(const std::string& name) {
   throw InputError("unknown known-inlier set '" + name + "' (valid: odometry, none)");
 }
 
+const char* probe_cut_name(ProbeCut cut) {
+  if (cut == ProbeCut::kAlways) return "always";
+  return cut == ProbeCut::kAfterPasses ? "after-passes" : "auto";
+}
+
+ProbeCut parse_probe_cut(const std::string& name) {
+  if (name == "always") return ProbeCut::kAlways;
+  if (name == "after-passes") return ProbeCut::kAfterPasses;
+  if (name == "auto") return ProbeCut::kAuto;
+  throw InputError("'" + name + "' is not one of always, after-passes, auto");
+}
+
 void RobustOptions::validate() const {
   if (!(std::isfinite(inlier_threshold) && inlier_threshold >= 0))
     bad_field("inlier_threshold", number_text(inlier_threshold),
@@ -58,6 +70,8 @@ void RobustOptions::validate() const {
     bad_field("mu_step", number_text(mu_step), "must be > 1");
   if (!(std::isfinite(mu_step_max) && (mu_step_max == 0 || mu_step_max >= mu_step)))
     bad_field("mu_step_max", number_text(mu_step_max), "must be 0 (off) or >= mu_step");
+  if (!(std::isfinite(newton_mu_step_max) && (newton_mu_step_max == 0 || newton_mu_step_max > 1)))
+    bad_field("newton_mu_step_max", number_text(newton_mu_step_max), "must be 0 (none) or > 1");
   if (!(std::isfinite(jump_band) && (jump_band == 0 || jump_band > 1)))
     bad_field("jump_band", number_text(jump_band), "must be 0 (off) or > 1");
   if (recheck_max_rounds < 0)
@@ -73,6 +87,10 @@ void RobustOptions::validate() const {
     bad_field("probe_tail_ratio", number_text(probe_tail_ratio), "must be >= 0 (0 = always)");
   if (!(std::isfinite(probe_return_ratio) && probe_return_ratio >= 1))
     bad_field("probe_return_ratio", number_text(probe_return_ratio), "must be >= 1 (1 = none)");
+  if (probe_cut != ProbeCut::kAlways && probe_cut != ProbeCut::kAfterPasses &&
+      probe_cut != ProbeCut::kAuto)
+    bad_field("probe_cut", std::to_string(static_cast<int>(probe_cut)),
+              "must be always, after-passes or auto");
   if (swap_probes < 0)
     bad_field("swap_probes", std::to_string(swap_probes), "must be >= 0 (0 = none)");
   if (swap_near < 0) bad_field("swap_near", std::to_string(swap_near), "must be >= 0");

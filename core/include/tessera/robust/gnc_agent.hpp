@@ -251,7 +251,7 @@ class GncAgent : public AgentProcess {
   void drop_inconsistent(const std::vector<std::uint64_t>& ids);
   bool may_probe() const;  // RobustOptions::recheck_probes
   // The part of a probe list the probe flips: all of it, or, while the set is still GNC's own
-  // and RobustOptions::probe_cut_untouched is false, only the rejected ones (the return side).
+  // and RobustOptions::probe_cut says so, only the rejected ones (the return side).
   std::vector<std::uint64_t> probe_flips(std::vector<std::uint64_t> listed) const;
   // A probe from the current set (summed TLS cost `tls`): the measurements of `flip` change side.
   void begin_probe(double tls, std::vector<std::uint64_t> flip, std::vector<OutgoingMessage>& out);
@@ -302,6 +302,9 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<GncOuterLoop> outer_;        // mu, its steps, the outer-step count, the stop
   std::vector<std::uint64_t> rejected_;
   std::vector<std::uint64_t> gnc_rejected_;  // GNC's own set, before the passes (ascending)
+  // Every weighted solve of GNC so far was a Newton step (gnc_refines), and there was one.
+  bool gnc_newton_steps_ = false;
+  int weighted_solves_ = 0;
   std::vector<Measurement> kept_;
   std::vector<std::uint64_t> kept_index_;
   int gnc_rounds_ = 0, final_rounds_ = 0, gnc_refine_steps_ = 0, exchange_steps_ = 0;

@@ -24,10 +24,22 @@ enum class KnownInliers {
   kNone,      ///< Every measurement may be rejected.
 };
 
+/// When a distributed re-check probe may cut kept measurements (its tail side) while the
+/// rejected set is still GNC's own, untouched by the re-check passes (RobustOptions::probe_cut).
+enum class ProbeCut {
+  kAlways,       ///< Whatever the set.
+  kAfterPasses,  ///< Only once the passes (or a kept probe) changed GNC's set.
+  /// After the passes where every weighted solve of GNC was a Newton step
+  /// (RobustOptions::gnc_refine_steps), always where GNC's solves were rounds.
+  kAuto,
+};
+
 const char* robust_kind_name(RobustKind kind);              ///< "none", "gnc-tls" or "pcm-gnc".
 RobustKind parse_robust_kind(const std::string& name);      ///< InputError lists valid names.
 const char* known_inliers_name(KnownInliers known);         ///< "odometry" or "none".
 KnownInliers parse_known_inliers(const std::string& name);  ///< InputError lists valid names.
+const char* probe_cut_name(ProbeCut cut);                   ///< "always", "after-passes" or "auto".
+ProbeCut parse_probe_cut(const std::string& name);          ///< InputError lists valid names.
 
 struct RobustOptions {
   RobustKind kind = RobustKind::kNone;
@@ -55,6 +67,19 @@ struct RobustOptions {
   /// next step is the last one squared, up to this factor; any change returns it to mu_step.
   /// 0 (default) = off, every step mu_step; otherwise >= mu_step.
   double mu_step_max = 0.0;
+  /// Distributed solvers only: the mu_step_max that applies, while mu_step_max is 0, where every
+  /// weighted solve of GNC so far was a Newton step (gnc_refine_steps, where the team's interface
+  /// fits; decided from each solve's layout, the same on every agent); 0 = none (mu_step there
+  /// too), else > 1 (a value below mu_step caps nothing). `tessera solve
+  /// --gnc-newton-mu-step-max`. Why: a Newton step ends each weighted solve near its minimiser,
+  /// as the centralized GNC's full solves do, so a bigger step of mu while no weight crosses 1/2
+  /// moves only weights that stay on their side. 4: F = 0.25 random, 5 agents, message steps
+  /// 168 -> 159 on intel (15 -> 14 outer steps), 0.5 159 -> 109 (14 -> 8), intel group 0.25 466 ->
+  /// 412, CSAIL 0.5 72 -> 63, group 0.5 213 -> 204; every intel and CSAIL cell of the benchmark
+  /// (random and group 0.1 / 0.25 / 0.5) the same answer; 2 and 9 give the same answers (9 the
+  /// same counts, 2 intel 0.5 127). Where GNC's solves are rounds nothing changes (there adaptive
+  /// mu cost manhattan3500 a probe: docs/robust.md, "Fewer outer steps").
+  double newton_mu_step_max = 4.0;
   /// Distributed solvers only: GNC ends early when, at a weight update, no measurement that may
   /// be rejected has its r^2 within a factor of this of the bound (c^2 / B < r^2 < B c^2, summed
   /// over the agents with the weight votes): each weight then jumps to TLS's own verdict at that
@@ -88,15 +113,21 @@ struct RobustOptions {
   bool jump_band_inside = false;
   /// Distributed solvers only, with recheck_probes: whether a probe may cut kept measurements
   /// (its tail side) while the rejected set is still GNC's own, untouched by the re-check passes
-  /// (true, default), or only brings back the return band then (false; once the passes or a kept
-  /// probe changed the set, the cut side runs as before). Most tail cuts from GNC's own set are
-  /// refused (intel random 0.1/0.25/0.5, group 0.1/0.5, every CSAIL cell; ~62 message steps each
-  /// on intel): false saves them, F = 0.25 random, 5 agents: intel 224 -> 168 message steps,
-  /// CSAIL 92 -> 72. Not the default: manhattan3500 group 0.25 needs that cut (with it 12,265
-  /// message steps, precision 0.974, recall 0.980, certified; without, 76,603, 0.899, 0.949,
-  /// not certified; docs/robust.md, "Cut only after the passes changed GNC's set").
-  /// `tessera solve --gnc-probe-cut always|after-passes`.
-  bool probe_cut_untouched = true;
+  /// (kAlways), only once the passes or a kept probe changed it (kAfterPasses: before that it
+  /// only brings back the return band), or (kAuto, default) after the passes where every
+  /// weighted solve of GNC was a Newton step and always where GNC's solves were rounds (decided
+  /// from each solve's layout, gnc_solve_setup.hpp: the same on every agent). Why: where GNC
+  /// runs on Newton steps (intel and CSAIL at 5 agents) it ends on near-minimisers of each
+  /// weighted problem, and every tail cut from its own set on the benchmark's cells was refused
+  /// (intel random 0.1/0.25/0.5, every CSAIL cell: the cut true closures come back; ~56 message
+  /// steps each on intel, 20 on CSAIL), while where GNC's solves are 5 rounds the cut undoes a
+  /// fold: manhattan3500 with 25 % group outliers needs it (with it 12,265 message steps,
+  /// precision 0.974, recall 0.980, certified; without, 76,603, 0.899, 0.949, not certified).
+  /// F = 0.25 random, 5 agents, always -> auto: intel 224 -> 168 message steps, CSAIL 92 -> 72,
+  /// every other graph the same run; every answer the same on the benchmark's cells run
+  /// (docs/robust.md, "Cut only after the passes changed GNC's set").
+  /// `tessera solve --gnc-probe-cut always|after-passes|auto`.
+  ProbeCut probe_cut = ProbeCut::kAuto;
   /// Distributed solvers only: most rounds of every solve before the final one (the first,
   /// unweighted solve and each weighted solve between two weight updates), >= 0, 0 = no cap.
   /// GNC needs only a rough minimiser between weight updates (dpgo's robust mode also updates
