@@ -99,6 +99,15 @@ class InterfaceSolve {
   /// Sigma factor was last analysed on the same pattern (grounded or not); false otherwise (and
   /// where that factor failed), leaving assemble() to be called.
   bool import_sigma(const double* values, std::size_t count);
+  /// Sigma factored on another agent (NewtonRefineOptions::ship_solves): this agent takes
+  /// solves with it as that agent's solve() segments, so it records only how it was factored
+  /// (grounded or not) for grounded_pose() and back_own(). Cleared by the next factor().
+  void adopt_remote_sigma(bool grounded);
+  /// Whether the last assemble() (or adopt_remote_sigma()) grounded Sigma.
+  bool grounded() const;
+  /// u = (Sigma + eta I)^-1 rhat, the team's (team_size() entries; grounded: 0 at the held
+  /// pose, rhat there not read), from this agent's own factor (after a successful assemble()).
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhat) const;
   /// The shift the last assemble() factored with (relative), 0 before.
   double shift() const;
   /// The held pose, where the last assemble() grounded Sigma and this block owns the team's
@@ -115,6 +124,10 @@ class InterfaceSolve {
   /// read): the preconditioned vector, a tangent vector at X.
   Eigen::MatrixXd back(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
                        const Eigen::VectorXd& rhat) const;
+  /// back() from this block's own segment of u (size() entries from u_own: solve()'s
+  /// entries [offset(), offset() + size())), wherever Sigma was factored.
+  Eigen::MatrixXd back_own(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                           const double* u_own) const;
 
  private:
   std::vector<double> factor_impl(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,

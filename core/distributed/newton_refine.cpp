@@ -228,6 +228,9 @@ void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
       case kTranslationSolve:
         after_translation_solve(*ready, out);
         break;
+      case kSolution:
+        after_solution(*ready, out);
+        break;
       default:
         after_trial_sums(*ready, out);
         break;
@@ -334,6 +337,11 @@ Eigen::VectorXd NewtonRefineProtocol::touched_of(const Eigen::VectorXd& x) const
 }
 
 void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
+  reset_cg();
+  send_direction(out);
+}
+
+void NewtonRefineProtocol::reset_cg() {
   charge_to(&result_.times.cg_s);
   step_ = NewtonRefineStep{};
   step_.radius = radius_;
@@ -360,11 +368,12 @@ void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
   cg_target_ =
       std::max(0.5 * options_.grad_norm_tol,
                gnorm_ * std::min(options_.forcing, std::pow(gnorm_, options_.forcing_power)));
-  send_direction(out);
 }
 
 void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
-  if (use_interface_) {
+  if (use_interface_ && options_.ship_solves) {
+    return send_solution(true, out);  // z from the holder's solve (after_solution)
+  } else if (use_interface_) {
     z_ = interface_->back(X_, iy_r_, ir_);
   } else if (!coarse_) {
     z_ = state_.precondition(X_, r_);

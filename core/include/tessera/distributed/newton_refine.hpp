@@ -236,6 +236,18 @@ struct NewtonRefineOptions {
   /// 1.08 CPU-s, load 12-17): what the agents' threads save in factorizations their transport
   /// spends moving the factor (docs/newton-refine.md, "Who factors Sigma").
   bool ship_sigma = false;
+  /// With the interface solves: true, at each point ONE agent (agent k at the k-th point, mod
+  /// N: in turn) receives the blocks' Schur complements and couplings (the other agents only
+  /// the flags and interface residuals), assembles and factors Sigma, and for each CG
+  /// direction solves with it and sends each agent its own segment of the solution (a short
+  /// vector: the agent's interface coordinates), one more message step a direction, on which
+  /// every agent waits for that one agent. false: every agent factors Sigma (ship_sigma: or
+  /// takes agent 0's factor) and solves with it itself. The same bits either way (the same
+  /// shares in id order, the same factorization and solves), so the same steps, CG iterations
+  /// and iterates. Why: the agents' identical Sigma factorizations were redundant CPU, which is
+  /// wall on a machine with fewer cores than agents (docs/newton-refine.md, "Who factors
+  /// Sigma"). Not with ship_sigma.
+  bool ship_solves = false;
   /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
   CoarseOptions coarse_space_options() const;
   /// Throws InputError naming the bad field.
@@ -246,6 +258,15 @@ struct NewtonRefineOptions {
 /// (kIfRoundsSlow). One parser for the command line, the coordinator, launch and the agents'
 /// assignment. Throws InputError "option --refine: 'v' is not one of newton, auto, none".
 void set_refine_mode(NewtonRefineOptions& options, const std::string& mode);
+
+/// The `--refine-sigma` values as options: who factors the interface solves' Sigma. "every"
+/// (each agent, ship_sigma and ship_solves off), "one" (ship_sigma) or "solve" (ship_solves).
+/// One parser for the command line, the coordinator and the agents' assignment. Throws
+/// InputError "<what>: 'v' is not one of every, one, solve".
+void set_sigma_mode(NewtonRefineOptions& options, const std::string& mode,
+                    const std::string& what = "option --refine-sigma");
+/// The `--refine-sigma` value of `options` (set_sigma_mode's inverse).
+std::string sigma_mode(const NewtonRefineOptions& options);
 
 /// One trust-region step, identical on every agent.
 struct NewtonRefineStep {
@@ -289,8 +310,10 @@ struct NewtonRefineResult {
   int steps = 0, accepted_steps = 0, cg_iterations = 0;
   /// Message steps: neighbour exchanges (CG directions and trial poses) and all-agent sums.
   int exchanges = 0, reductions = 0;
-  /// Both together: the refinement's waits for peers (a round of IRBCD is two).
-  int message_steps() const { return exchanges + reductions; }
+  /// ship_solves: the CG directions' steps that wait for the agent solving with Sigma.
+  int solution_steps = 0;
+  /// All together: the refinement's waits for peers (a round of IRBCD is two).
+  int message_steps() const { return exchanges + reductions + solution_steps; }
   /// Coarse correction: its unknowns (pieces x generators; 0 without), and how many times its
   /// matrix was summed (one all-agent sum each, counted in `reductions`).
   int coarse_unknowns = 0, coarse_assemblies = 0;
@@ -331,10 +354,12 @@ class NewtonRefineProtocol : public AgentProcess {
     kTranslationDirection = 66,  ///< Trial translations: public entries of the CG's z.
     kTranslationSums = 67,       ///< Trial translations: <r, z>, <z, H z>.
     kInterface = 68,             ///< Interface solves: each block's Schur complement and couplings.
-    kTranslationSolve = 69       ///< Exact trial translations: each block's interface residual.
+    kTranslationSolve = 69,      ///< Exact trial translations: each block's interface residual.
+    kSolution =
+        70  ///< ship_solves: Sigma's solve, each agent's segment, from the agent holding it.
   };
   /// The last of the steps: [kStatus, kLastStep] are the refinement's.
-  static constexpr std::uint32_t kLastStep = kTranslationSolve;
+  static constexpr std::uint32_t kLastStep = kSolution;
   static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kLastStep; }
 
   /// `state`: the agent at the point to refine (Y, and Yn = the neighbours' public poses of the
@@ -400,6 +425,17 @@ class NewtonRefineProtocol : public AgentProcess {
   // The block preconditioner for the next CG solve (options_.refactor_every_step).
   void prepare_preconditioner();
   void send_direction(std::vector<OutgoingMessage>& out);
+  // ship_solves: a share's trailing interface residuals (this block's), in values.
+  std::size_t share_tail() const;
+  // ship_solves, on the holder: u = Sigma^-1 rhat of the current residual, each agent's segment
+  // sent to it (kSolution, after the flag and grounding); everyone waits for it. With ok false
+  // (no positive definite Sigma at this point), the flag 0 alone.
+  void send_solution(bool ok, std::vector<OutgoingMessage>& out);
+  void after_solution(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // After a point's Sigma: whether the CG uses it (ok), the gauge's sums, fallback otherwise.
+  void take_interface_verdict(bool ok);
+  // start_cg()'s state (s = 0, r = -g, the interface residuals) without the first direction.
+  void reset_cg();
   void after_direction(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void after_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void try_step(const std::string& cg_stop, std::vector<OutgoingMessage>& out);
@@ -474,6 +510,11 @@ class NewtonRefineProtocol : public AgentProcess {
   // accepted trial (id order), in hand for the next interface step (shares_ready_).
   bool trial_shares_ = false, shares_ready_ = false;
   std::vector<std::vector<double>> next_shares_;
+  // ship_solves: the point's Sigma verdict is the holder's, not yet known here (it comes with
+  // the point's first solution).
+  bool verdict_due_ = false;
+  int interface_points_ = 0;  // points whose shares were sent (the holder's turn)
+  int sigma_holder_ = 0;      // the current point's holder
   Eigen::VectorXd iy_r_, iy_q_, iy_w_, iy_g_, ir_, iq_, ir_g_;
   // The gauge with the interface solves (distributed/gauge_space.hpp): its basis V and H V at
   // the point, the sums V^T V, V^T H V and V^T g (in the interface matrix's sum), and the
