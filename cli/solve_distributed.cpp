@@ -220,10 +220,9 @@ const char* kDistributedHelp =
     "  --refine-sigma one|every|solve  with the interface solves, agent 0 factors the\n"
     "                            interface matrix from shares sent with an accepted trial's\n"
     "                            sums and sends its factor (one), every agent factors it at\n"
-    "                            every point (every), or one agent a point (in turn) factors\n"
-    "                            it and sends each agent its part of every solve (solve: one\n"
-    "                            more message step a CG iteration); the same iterates\n"
-    "                            (default every)\n";
+    "                            every point (every), or agent 0 alone factors it and sends\n"
+    "                            each agent its part of every solve (solve: one more message\n"
+    "                            step a CG iteration); the same iterates (default solve)\n";
 
 namespace {
 

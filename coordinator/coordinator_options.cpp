@@ -81,9 +81,9 @@ options:
                        its stops: ||grad f|| <= T, or a step lowered f by < F f (0 = the
                        defaults, 1e-6 and 1e-7)
   --refine-sigma one|every|solve  with its interface solves, agent 0 factors the interface
-                       matrix and sends its factor (one), every agent factors it (every;
-                       default), or one agent a point factors it and sends each agent its
-                       part of every solve (solve)
+                       matrix and sends its factor (one), every agent factors it (every),
+                       or agent 0 alone factors it and sends each agent its part of every
+                       solve (solve; default)
   --setup-at-once K    at most K agents run the distributed initialisation's local chordal
                        solve at once (agent a after agent a - K): those factorizations are
                        the set-up's memory peak; 0 = all at once (default 8)

@@ -315,9 +315,9 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "--refine-sigma one|every|solve",
        "with the interface solves, agent 0 factors the\n"
        "interface matrix and sends its factor (one), every\n"
-       "agent factors it at every point (every), or one agent\n"
-       "a point factors it and sends each agent its part of\n"
-       "every solve (solve); the same iterates         [every]",
+       "agent factors it at every point (every), or agent 0\n"
+       "alone factors it and sends each agent its part of\n"
+       "every solve (solve); the same iterates         [solve]",
        check_refine_sigma},
       {"setup-at-once", "setup-at-once", true, ForwardTo::kCoordinator, "--setup-at-once K",
        "at most K agents in the distributed initialisation's\n"

@@ -55,6 +55,7 @@ NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout&
       cg_(std::make_unique<PipelinedCg>()),
       tcg_(std::make_unique<PipelinedCg>()) {
   options_.validate();
+  if (options_.ship_sigma) options_.ship_solves = false;  // agent 0 sends its factor instead
   everyone_.resize(static_cast<std::size_t>(layout_.num_blocks));
   for (int b = 0; b < layout_.num_blocks; ++b) everyone_[static_cast<std::size_t>(b)] = b;
 }
@@ -296,6 +297,7 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
     auto solve = std::make_unique<InterfaceSolve>(problem_, layout_, state_.id());
     if (solve->team_size() > 0 && solve->team_size() <= options_.interface_max_coordinates) {
       result_.interface_coordinates = static_cast<int>(solve->team_size());
+      if (solve->team_size() < options_.ship_solves_min_coordinates) options_.ship_solves = false;
       interface_ = std::move(solve);
     }
   }

@@ -31,7 +31,7 @@ void NewtonRefineOptions::validate() const {
   if (!(auto_interface_grad_tol >= 0)) fail("auto_interface_grad_tol", "must be >= 0");
   if (!(interface_shift > 0 && interface_shift <= 1e-3))
     fail("interface_shift", "must be in (0, 1e-3]");
-  if (ship_solves && ship_sigma) fail("ship_solves", "and ship_sigma exclude each other");
+  if (ship_solves_min_coordinates < 0) fail("ship_solves_min_coordinates", "must be >= 0");
 }
 
 void set_refine_mode(NewtonRefineOptions& options, const std::string& mode) {

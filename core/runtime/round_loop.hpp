@@ -55,7 +55,7 @@ struct RunOptions {
   double refine_grad_tol = 0;
   double refine_rel_tol = 0;
   /// Who factors the refinement's interface matrix (set_sigma_mode): "one" (agent 0, which
-  /// sends its factor), "solve" (one agent a point, which sends its solves), "every", or ""
+  /// sends its factor), "solve" (agent 0, which sends its solves), "every", or ""
   /// (core's default).
   std::string refine_sigma;
   /// BlockUpdateOptions::max_factor_entries (0 = core's default; runtime/team_memory.hpp).

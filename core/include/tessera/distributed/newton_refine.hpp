@@ -12,8 +12,9 @@
 //   * CG's inner products are all-agent sums in agent-id order (bit-identical on every agent);
 //   * the preconditioner, where the team's interface is small (options.interface_max_coordinates),
 //     is the Hessian's inverse by substructuring (distributed/interface_solve.hpp: each block's
-//     factor and the interface's Schur complement, which every agent factors once per point), so
-//     a Newton step's CG takes 1-3 iterations; elsewhere block Jacobi (AgentState::precondition:
+//     factor and the interface's Schur complement, which agent 0 factors once per point and solves
+//     with for every agent, NewtonRefineOptions::ship_solves), so a Newton step's CG takes 1-3
+//     iterations; elsewhere block Jacobi (AgentState::precondition:
 //     the tangent factor of its block, else its Q_BB factor), optionally with a coarse correction
 //     over rigid motions of smoothed pieces of the blocks (options.coarse,
 //     distributed/tangent_coarse_space.hpp): block Jacobi alone moves information one block
@@ -180,10 +181,11 @@ struct NewtonRefineOptions {
   /// (distributed/interface_solve.hpp) where that interface has at most this many tangent
   /// coordinates (d(d+1)/2 a pose: ais2klinik at N = 5 102, city10000 909); 0 = off. Each
   /// block factors its diagonal block of the Riemannian Hessian (interface last) and broadcasts
-  /// its Schur complement and cut couplings once per point (one all-agent message step); every
-  /// agent factors the interface matrix Sigma (as large as this cap) and applies H^-1 exactly
-  /// (up to the shift below) in each CG iteration, whose message steps stay one exchange and
-  /// one sum (the interface residual rides in the sum). Used at rank d with `coarse` kNone. A
+  /// its Schur complement and cut couplings once per point (one all-agent message step); the
+  /// interface matrix Sigma (as large as this cap) is factored (by agent 0, ship_solves, or by
+  /// every agent) and H^-1 applied exactly (up to the shift below) in each CG iteration, whose
+  /// message steps are one exchange and one sum (the interface residual rides in the sum), and
+  /// with ship_solves agent 0's solution. Used at rank d with `coarse` kNone. A
   /// block whose Hessian block is not positive definite (far from a minimiser) factors it
   /// without the multiplier term (then M is the inverse of that modified H); where no block
   /// factor or no Sigma is positive definite, that point's CG runs block Jacobi. Why 1,000:
@@ -236,18 +238,27 @@ struct NewtonRefineOptions {
   /// 1.08 CPU-s, load 12-17): what the agents' threads save in factorizations their transport
   /// spends moving the factor (docs/newton-refine.md, "Who factors Sigma").
   bool ship_sigma = false;
-  /// With the interface solves: true, at each point ONE agent (agent k at the k-th point, mod
-  /// N: in turn) receives the blocks' Schur complements and couplings (the other agents only
-  /// the flags and interface residuals), assembles and factors Sigma, and for each CG
-  /// direction solves with it and sends each agent its own segment of the solution (a short
-  /// vector: the agent's interface coordinates), one more message step a direction, on which
-  /// every agent waits for that one agent. false: every agent factors Sigma (ship_sigma: or
-  /// takes agent 0's factor) and solves with it itself. The same bits either way (the same
-  /// shares in id order, the same factorization and solves), so the same steps, CG iterations
-  /// and iterates. Why: the agents' identical Sigma factorizations were redundant CPU, which is
-  /// wall on a machine with fewer cores than agents (docs/newton-refine.md, "Who factors
-  /// Sigma"). Not with ship_sigma.
-  bool ship_solves = false;
+  /// With the interface solves: true, at each point ONE agent (agent 0) receives the blocks'
+  /// Schur complements and couplings (the other agents only the flags, interface residuals and
+  /// gauge sums), assembles and factors Sigma, and for each CG direction solves with it and
+  /// sends each agent its own segment of the solution (a short vector: the agent's interface
+  /// coordinates), one more message step a direction, on which every agent waits for agent 0.
+  /// false: every agent factors Sigma and solves with it itself. The same bits either way (the
+  /// same shares in id order, the same factorization and solves), so the same steps, CG
+  /// iterations and iterates. ship_sigma, where set, takes precedence (agent 0 sends its factor
+  /// instead). Why true: the agents' identical Sigma factorizations are redundant CPU, which is
+  /// wall where agents share processors. city10000 at N = 5 in process (callgrind): the whole
+  /// solve 4.335 -> 3.842 G instructions, the refinement 1.948 -> 1.487 G, bytes 14.7 -> 4.8 MB,
+  /// message steps 27 -> 30; over DDS on a 2-core machine the agents' CPU after the rounds
+  /// 0.865 -> 0.730 CPU-s (medians, load 16-19) (docs/newton-refine.md, "Who factors Sigma").
+  bool ship_solves = true;
+  /// ship_solves applies where the team's interface has at least this many tangent
+  /// coordinates (Sigma's size; the same on every agent); below it every agent factors Sigma.
+  /// Why: Sigma's factorization grows about as its size cubed, the extra message step a CG
+  /// direction does not: at city10000's 909 coordinates one factorization is ~37 M
+  /// instructions (every agent doing it 553 M over 3 points), at ais2klinik's 102 about
+  /// (102 / 909)^3 of that, less than the wait for one more message. >= 0.
+  int ship_solves_min_coordinates = 500;
   /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
   CoarseOptions coarse_space_options() const;
   /// Throws InputError naming the bad field.
@@ -513,8 +524,7 @@ class NewtonRefineProtocol : public AgentProcess {
   // ship_solves: the point's Sigma verdict is the holder's, not yet known here (it comes with
   // the point's first solution).
   bool verdict_due_ = false;
-  int interface_points_ = 0;  // points whose shares were sent (the holder's turn)
-  int sigma_holder_ = 0;      // the current point's holder
+  int sigma_holder_ = 0;  // the agent holding Sigma's factor (agent 0)
   Eigen::VectorXd iy_r_, iy_q_, iy_w_, iy_g_, ir_, iq_, ir_g_;
   // The gauge with the interface solves (distributed/gauge_space.hpp): its basis V and H V at
   // the point, the sums V^T V, V^T H V and V^T g (in the interface matrix's sum), and the
