@@ -217,11 +217,12 @@ const char* kDistributedHelp =
     "                            tangent vectors orthogonal to the global rigid motions\n"
     "                            (project) or holds the grounded pose fixed (ground) (default\n"
     "                            ground)\n"
-    "  --refine-sigma one|every  with the interface solves, agent 0 factors the interface\n"
-    "                            matrix from shares sent with an accepted trial's sums and\n"
-    "                            sends its factor (one), or every agent factors it at every\n"
-    "                            point (every); the same steps and message steps (default\n"
-    "                            every)\n";
+    "  --refine-sigma one|every|solve  with the interface solves, agent 0 factors the\n"
+    "                            interface matrix from shares sent with an accepted trial's\n"
+    "                            sums and sends its factor (one), every agent factors it at\n"
+    "                            every point (every), or agent 0 alone factors it and sends\n"
+    "                            each agent its part of every solve (solve: one more message\n"
+    "                            step a CG iteration); the same iterates (default solve)\n";
 
 namespace {
 
@@ -378,10 +379,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     if (gauge != "project" && gauge != "ground")
       throw InputError("option --refine-gauge: '" + gauge + "' is not one of project, ground");
     opt.refine.project_gauge = gauge == "project";
-    const std::string sigma = a.get_or("refine-sigma", opt.refine.ship_sigma ? "one" : "every");
-    if (sigma != "one" && sigma != "every")
-      throw InputError("option --refine-sigma: '" + sigma + "' is not one of one, every");
-    opt.refine.ship_sigma = sigma == "one";
+    set_sigma_mode(opt.refine, a.get_or("refine-sigma", sigma_mode(opt.refine)));
     opt.refine.coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
                         : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
                                                : NewtonRefineOptions::Coarse::kNone;

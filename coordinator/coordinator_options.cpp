@@ -80,8 +80,10 @@ options:
   --refine-grad-tol T, --refine-rel-tol F
                        its stops: ||grad f|| <= T, or a step lowered f by < F f (0 = the
                        defaults, 1e-6 and 1e-7)
-  --refine-sigma one|every  with its interface solves, agent 0 factors the interface matrix
-                       and sends its factor (one), or every agent factors it (every; default)
+  --refine-sigma one|every|solve  with its interface solves, agent 0 factors the interface
+                       matrix and sends its factor (one), every agent factors it (every),
+                       or agent 0 alone factors it and sends each agent its part of every
+                       solve (solve; default)
   --setup-at-once K    at most K agents run the distributed initialisation's local chordal
                        solve at once (agent a after agent a - K): those factorizations are
                        the set-up's memory peak; 0 = all at once (default 8)
@@ -224,8 +226,10 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   if (!(a.refine_grad_tol >= 0)) throw InputError("option --refine-grad-tol: must be >= 0");
   if (!(a.refine_rel_tol >= 0)) throw InputError("option --refine-rel-tol: must be >= 0");
   a.refine_sigma = args.get_or("refine-sigma", a.refine_sigma);
-  if (!a.refine_sigma.empty() && a.refine_sigma != "one" && a.refine_sigma != "every")
-    throw InputError("option --refine-sigma: '" + a.refine_sigma + "' is not one of one, every");
+  if (!a.refine_sigma.empty()) {
+    NewtonRefineOptions check;
+    set_sigma_mode(check, a.refine_sigma);
+  }
   a.setup_at_once = static_cast<std::uint32_t>(nonneg("setup-at-once", a.setup_at_once));
   if (a.setup_at_once > agent::SetupTurnOptions::kMaxSetupAtOnce)
     throw InputError("option --setup-at-once: must be 0.." +

@@ -54,8 +54,8 @@ struct CoordinatorOptions {
   double refine_grad_tol = 0;
   double refine_rel_tol = 0;
   /// Who factors the interface matrix of its interface solves (--refine-sigma,
-  /// NewtonRefineOptions::ship_sigma): "one" (agent 0, which sends its factor), "every", or ""
-  /// (core's default: every).
+  /// set_sigma_mode): "one" (agent 0, which sends its factor), "solve" (agent 0, which sends
+  /// its solves), "every", or "" (core's default: solve).
   std::string refine_sigma;
   /// At most this many agents in the distributed initialisation's local solve at once
   /// (--setup-at-once; core/runtime/setup_turns.hpp): their factorizations are the set-up's

@@ -62,8 +62,8 @@ void check_refine_rel_tol(const std::string& v) {
   check_tolerance(v, "refine-rel-tol");
 }
 void check_refine_sigma(const std::string& v) {
-  if (v != "one" && v != "every")
-    throw InputError("option --refine-sigma: '" + v + "' is not one of one, every");
+  NewtonRefineOptions check;
+  set_sigma_mode(check, v);
 }
 
 // `v` as a whole number, else an InputError naming the flag.
@@ -311,11 +311,13 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "the refinement stops at ||grad f|| <= T       [1e-6]", check_refine_grad_tol},
       {"refine-rel-tol", "refine-rel-tol", true, ForwardTo::kCoordinator, "--refine-rel-tol F",
        "or after a step that lowered f by < F f           [1e-7]", check_refine_rel_tol},
-      {"refine-sigma", "refine-sigma", true, ForwardTo::kCoordinator, "--refine-sigma one|every",
+      {"refine-sigma", "refine-sigma", true, ForwardTo::kCoordinator,
+       "--refine-sigma one|every|solve",
        "with the interface solves, agent 0 factors the\n"
-       "interface matrix and sends its factor (one), or every\n"
-       "agent factors it at every point (every); the same\n"
-       "steps and message steps                         [every]",
+       "interface matrix and sends its factor (one), every\n"
+       "agent factors it at every point (every), or agent 0\n"
+       "alone factors it and sends each agent its part of\n"
+       "every solve (solve); the same iterates         [solve]",
        check_refine_sigma},
       {"setup-at-once", "setup-at-once", true, ForwardTo::kCoordinator, "--setup-at-once K",
        "at most K agents in the distributed initialisation's\n"

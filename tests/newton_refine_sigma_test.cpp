@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/distributed/newton_refine.hpp>
 #include <tessera/partition/sequential_partition.hpp>
@@ -20,6 +21,7 @@ DistributedOptions refined(bool ship) {
   o.grad_norm_tol = 0.01;
   set_refine_mode(o.refine, "newton");
   o.refine.ship_sigma = ship;
+  o.refine.ship_solves = false;
   return o;
 }
 
@@ -61,6 +63,69 @@ TEST(NewtonRefineSigma, EveryAgentTakesTheSameStepsInAnyDeliveryOrderWithSigmaSh
   const PoseGraph g = test::refine_chain(600, 3);
   const std::vector<int> parts = sequential_partition(g.num_poses, 3);
   test::expect_same_refinement_in_any_delivery_order(g, parts, refined(true), 7);
+}
+
+// NewtonRefineOptions::ship_solves (`--refine-sigma solve`): agent 0 alone assembles and
+// factors Sigma and sends each agent its segment of every solve.
+DistributedOptions refined_solves() {
+  DistributedOptions o = refined(false);
+  o.refine.ship_solves = true;
+  o.refine.ship_solves_min_coordinates = 0;  // the chain's interface is small
+  return o;
+}
+
+TEST(NewtonRefineSigma, OneAgentSolvingWithSigmaTakesTheSameStepsAsEveryAgentFactoringIt) {
+  const PoseGraph g = test::refine_chain(600, 3);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  const DistributedResult every = solve_distributed(g, parts, refined(false));
+  const DistributedResult solves = solve_distributed(g, parts, refined_solves());
+  ASSERT_EQ(every.refines.size(), 1u);
+  ASSERT_EQ(solves.refines.size(), 1u);
+  const NewtonRefineResult &a = every.refines[0], &b = solves.refines[0];
+  ASSERT_GT(a.interface_coordinates, 0) << "the chain's refinement should use interface solves";
+  EXPECT_EQ(b.steps, a.steps);
+  EXPECT_EQ(b.accepted_steps, a.accepted_steps);
+  EXPECT_EQ(b.cg_iterations, a.cg_iterations);
+  EXPECT_EQ(b.exchanges, a.exchanges);
+  EXPECT_EQ(b.reductions, a.reductions);
+  EXPECT_EQ(b.interface_factorizations, a.interface_factorizations);
+  EXPECT_EQ(b.cost, a.cost);
+  EXPECT_EQ(solves.cost, every.cost);
+  ASSERT_EQ(solves.poses.size(), every.poses.size());
+  for (std::size_t i = 0; i < solves.poses.size(); ++i) {
+    ASSERT_EQ(solves.poses[i].R, every.poses[i].R) << "pose " << i;
+    ASSERT_EQ(solves.poses[i].t, every.poses[i].t) << "pose " << i;
+  }
+  // One message step more for each CG direction (each iteration's and each step's first);
+  // agent 0 (the one reported) holds Sigma at every point.
+  EXPECT_EQ(a.solution_steps, 0);
+  EXPECT_GE(b.solution_steps, b.cg_iterations);
+  EXPECT_EQ(b.message_steps(), a.message_steps() + b.solution_steps);
+  EXPECT_EQ(a.sigma_factorizations, a.interface_factorizations);
+  EXPECT_EQ(b.sigma_factorizations, b.interface_factorizations);
+  // The other agents receive only each share's flag and residuals, not its Schur complement.
+  EXPECT_LT(solves.bytes_exchanged, every.bytes_exchanged);
+}
+
+TEST(NewtonRefineSigma, EveryAgentTakesTheSameStepsInAnyDeliveryOrderWithSigmaSolvesShipped) {
+  const PoseGraph g = test::refine_chain(600, 3);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 3);
+  test::expect_same_refinement_in_any_delivery_order(g, parts, refined_solves(), 7);
+}
+
+TEST(NewtonRefineSigma, RefineSigmaNamesTheThreeWaysAndSolveIsTheDefault) {
+  EXPECT_EQ(sigma_mode(NewtonRefineOptions{}), "solve");
+  NewtonRefineOptions m;
+  for (const std::string mode : {"every", "one", "solve"}) {
+    set_sigma_mode(m, mode);
+    EXPECT_EQ(sigma_mode(m), mode);
+  }
+  try {
+    set_sigma_mode(m, "two");
+    FAIL() << "expected an InputError";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("--refine-sigma"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -63,7 +63,8 @@ struct InterfaceSolve::Impl {
   // Sigma + eta I.
   SupernodalFactor sigma;
   bool sigma_ok = false;
-  bool grounded = false;  // the team's first interface pose held fixed (its p coordinates)
+  bool sigma_here = false;  // sigma_ok from this agent's own factor (not adopt_remote_sigma())
+  bool grounded = false;    // the team's first interface pose held fixed (its p coordinates)
   double shift = 0.0;
   int pattern = -1;  // the pattern sigma was last factored on: 1 grounded, 0 not, -1 none
   // The block's Hessian A_bb (lower triangle, the order above) and Sigma (grounded or not), as
@@ -356,6 +357,7 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
       s.pattern = ground ? 1 : 0;
       if (s.sigma.factor(sigma, eta)) {
         s.sigma_ok = true;
+        s.sigma_here = true;
         s.grounded = ground;
         s.shift = rel;
         return true;
@@ -380,6 +382,7 @@ bool InterfaceSolve::import_sigma(const double* v, std::size_t count) {
   const bool ground = v[1] != 0.0;
   if (s.pattern != (ground ? 1 : 0) || !s.sigma.import_values(v + 3, count - 3)) return false;
   s.sigma_ok = true;
+  s.sigma_here = true;
   s.grounded = ground;
   s.shift = v[2];
   return true;
@@ -415,23 +418,48 @@ void InterfaceSolve::add_interface(const Eigen::VectorXd& y, double* team) const
   Eigen::Map<Eigen::VectorXd>(team + s.own_offset, nG) += s.Lgg * y.tail(nG);
 }
 
-Eigen::MatrixXd InterfaceSolve::back(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
-                                     const Eigen::VectorXd& rhat) const {
+void InterfaceSolve::adopt_remote_sigma(bool grounded) {
+  Impl& s = *impl_;
+  s.sigma_ok = true;
+  s.sigma_here = false;
+  s.grounded = grounded;
+}
+
+bool InterfaceSolve::grounded() const {
+  return impl_->grounded;
+}
+
+Eigen::VectorXd InterfaceSolve::solve(const Eigen::VectorXd& rhat) const {
   const Impl& s = *impl_;
-  if (!s.sigma_ok) throw std::logic_error("InterfaceSolve::back: no factor of Sigma");
-  const int p = s.p;
-  const Eigen::Index nI = s.mI * p, nG = s.mG * p;
+  if (!s.sigma_ok || !s.sigma_here)
+    throw std::logic_error("InterfaceSolve::solve: no factor of Sigma");
   Eigen::VectorXd u;
   if (s.grounded) {
     Eigen::VectorXd r = rhat;
-    r.head(p).setZero();
+    r.head(s.p).setZero();
     s.sigma.solve(r, u);
   } else {
     s.sigma.solve(rhat, u);
   }
+  return u;
+}
+
+Eigen::MatrixXd InterfaceSolve::back(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                                     const Eigen::VectorXd& rhat) const {
+  if (!impl_->sigma_ok) throw std::logic_error("InterfaceSolve::back: no factor of Sigma");
+  const Eigen::VectorXd u = solve(rhat);
+  return back_own(X, y, u.data() + impl_->own_offset);
+}
+
+Eigen::MatrixXd InterfaceSolve::back_own(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                                         const double* u_own) const {
+  const Impl& s = *impl_;
+  if (!s.sigma_ok) throw std::logic_error("InterfaceSolve::back_own: no factor of Sigma");
+  const int p = s.p;
+  const Eigen::Index nI = s.mI * p, nG = s.mG * p;
   Eigen::VectorXd v(y.size());
   v.head(nI) = y.head(nI);
-  if (nG > 0) v.tail(nG) = s.Lgg.transpose() * u.segment(s.own_offset, nG);
+  if (nG > 0) v.tail(nG) = s.Lgg.transpose() * Eigen::Map<const Eigen::VectorXd>(u_own, nG);
   s.block->solve_lt(v);
   for (Eigen::Index i = 0; i < s.m; ++i)
     s.b.segment(i * p, p) = v.segment(s.slot[static_cast<std::size_t>(i)] * p, p);

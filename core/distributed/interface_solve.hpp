@@ -17,10 +17,11 @@
 // instructions, Sigma's assembly and factorizations 2.81 -> 0.52 (27.9 Mflop each, 151,785
 // entries in L), the blocks' factors and Schur complements 1.38 -> 0.59.
 // Sigma is as large as the team's interface (ais2klinik at N = 5: 102 coordinates, city10000
-// 909), so every agent holds it: the agents broadcast their Schur complements and coupling
-// blocks once per point and every agent factors the same Sigma from the same bits in id order
-// (or one agent does and the others take its factor's values: sigma_values(), import_sigma();
-// NewtonRefineOptions::ship_sigma).
+// 909). By default (NewtonRefineOptions::ship_solves) agent 0 alone receives the Schur
+// complements and coupling blocks, factors Sigma and solves with it: the others take their
+// segment of each solve (back_own(), adopt_remote_sigma()). Otherwise every agent factors the
+// same Sigma from the same bits in id order (or one agent does and the others take its
+// factor's values: sigma_values(), import_sigma(); NewtonRefineOptions::ship_sigma).
 // Applying the preconditioner then needs the team's rhat, which is linear in r: CG carries it
 // by its recurrences (rhat of H z rides in the iteration's all-agent sum), so a CG iteration is
 // still one exchange and one sum (newton_refine.cpp).
@@ -99,6 +100,15 @@ class InterfaceSolve {
   /// Sigma factor was last analysed on the same pattern (grounded or not); false otherwise (and
   /// where that factor failed), leaving assemble() to be called.
   bool import_sigma(const double* values, std::size_t count);
+  /// Sigma factored on another agent (NewtonRefineOptions::ship_solves): this agent takes
+  /// solves with it as that agent's solve() segments, so it records only how it was factored
+  /// (grounded or not) for grounded_pose() and back_own(). Cleared by the next factor().
+  void adopt_remote_sigma(bool grounded);
+  /// Whether the last assemble() (or adopt_remote_sigma()) grounded Sigma.
+  bool grounded() const;
+  /// u = (Sigma + eta I)^-1 rhat, the team's (team_size() entries; grounded: 0 at the held
+  /// pose, rhat there not read), from this agent's own factor (after a successful assemble()).
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhat) const;
   /// The shift the last assemble() factored with (relative), 0 before.
   double shift() const;
   /// The held pose, where the last assemble() grounded Sigma and this block owns the team's
@@ -115,6 +125,10 @@ class InterfaceSolve {
   /// read): the preconditioned vector, a tangent vector at X.
   Eigen::MatrixXd back(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
                        const Eigen::VectorXd& rhat) const;
+  /// back() from this block's own segment of u (size() entries from u_own: solve()'s
+  /// entries [offset(), offset() + size())), wherever Sigma was factored.
+  Eigen::MatrixXd back_own(const Eigen::MatrixXd& X, const Eigen::VectorXd& y,
+                           const double* u_own) const;
 
  private:
   std::vector<double> factor_impl(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,

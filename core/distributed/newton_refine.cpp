@@ -55,6 +55,7 @@ NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout&
       cg_(std::make_unique<PipelinedCg>()),
       tcg_(std::make_unique<PipelinedCg>()) {
   options_.validate();
+  if (options_.ship_sigma) options_.ship_solves = false;  // agent 0 sends its factor instead
   everyone_.resize(static_cast<std::size_t>(layout_.num_blocks));
   for (int b = 0; b < layout_.num_blocks; ++b) everyone_[static_cast<std::size_t>(b)] = b;
 }
@@ -228,6 +229,9 @@ void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
       case kTranslationSolve:
         after_translation_solve(*ready, out);
         break;
+      case kSolution:
+        after_solution(*ready, out);
+        break;
       default:
         after_trial_sums(*ready, out);
         break;
@@ -293,6 +297,7 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
     auto solve = std::make_unique<InterfaceSolve>(problem_, layout_, state_.id());
     if (solve->team_size() > 0 && solve->team_size() <= options_.interface_max_coordinates) {
       result_.interface_coordinates = static_cast<int>(solve->team_size());
+      if (solve->team_size() < options_.ship_solves_min_coordinates) options_.ship_solves = false;
       interface_ = std::move(solve);
     }
   }
@@ -334,6 +339,11 @@ Eigen::VectorXd NewtonRefineProtocol::touched_of(const Eigen::VectorXd& x) const
 }
 
 void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
+  reset_cg();
+  send_direction(out);
+}
+
+void NewtonRefineProtocol::reset_cg() {
   charge_to(&result_.times.cg_s);
   step_ = NewtonRefineStep{};
   step_.radius = radius_;
@@ -360,11 +370,12 @@ void NewtonRefineProtocol::start_cg(std::vector<OutgoingMessage>& out) {
   cg_target_ =
       std::max(0.5 * options_.grad_norm_tol,
                gnorm_ * std::min(options_.forcing, std::pow(gnorm_, options_.forcing_power)));
-  send_direction(out);
 }
 
 void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
-  if (use_interface_) {
+  if (use_interface_ && options_.ship_solves) {
+    return send_solution(true, out);  // z from the holder's solve (after_solution)
+  } else if (use_interface_) {
     z_ = interface_->back(X_, iy_r_, ir_);
   } else if (!coarse_) {
     z_ = state_.precondition(X_, r_);

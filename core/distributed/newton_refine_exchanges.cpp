@@ -91,7 +91,89 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
       for (int j = 0; j < k; ++j)
         v[2 * k * k + k + i * k + j] = frobenius_inner(gauge_hv_[static_cast<std::size_t>(i)],
                                                        gauge_hv_[static_cast<std::size_t>(j)]);
-  broadcast(kInterface, values, out);
+  if (!options_.ship_solves) return broadcast(kInterface, values, out);
+  // Agent 0 alone assembles Sigma: it receives the whole shares, the others each share's flag,
+  // interface residuals and gauge sums only. Always the same agent: its Sigma pattern and
+  // symbolic analysis are laid out once (each first assemble() on an agent does both; taking
+  // turns on city10000's 3 points cost 183 M instructions in assemble() against 111 M).
+  const int n = layout_.num_blocks;
+  sigma_holder_ = 0;
+  const std::size_t tail = values.size() - at + (values.front() != 0.0 ? share_tail() : 0);
+  std::vector<double> brief{values.front()};
+  brief.insert(brief.end(), values.end() - static_cast<std::ptrdiff_t>(tail), values.end());
+  const int id = state_.id();
+  gate_.add(id, message_round_, kInterface,
+            make_reduction_message(id, message_round_, kInterface, values));
+  for (int b = 0; b < n; ++b) {
+    if (b == id) continue;
+    OutgoingMessage o;
+    o.message =
+        make_reduction_message(id, message_round_, kInterface, b == sigma_holder_ ? values : brief);
+    o.broadcast = false;
+    o.recipients = {static_cast<std::uint32_t>(b)};
+    out.push_back(std::move(o));
+  }
+  gate_.expect(message_round_, kInterface, everyone_);
+  ++result_.reductions;
+}
+
+std::size_t NewtonRefineProtocol::share_tail() const {
+  // A share's interface residuals (of -g, and projecting the gauge of V and H V): per block.
+  const auto per = static_cast<std::size_t>(options_.project_gauge ? 1 + 2 * gauge_->size() : 1);
+  return per * static_cast<std::size_t>(interface_->size());
+}
+
+void NewtonRefineProtocol::send_solution(bool ok, std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.sigma_s);
+  const int holder = sigma_holder_;
+  if (state_.id() == holder) {
+    Eigen::VectorXd u;
+    if (ok) u = interface_->solve(ir_);
+    for (int b = 0; b < layout_.num_blocks; ++b) {
+      std::vector<double> values{ok ? 1.0 : 0.0, ok && interface_->grounded() ? 1.0 : 0.0};
+      if (ok)
+        values.insert(values.end(), u.data() + interface_->block_offset(b),
+                      u.data() + interface_->block_offset(b) + interface_->block_size(b));
+      PoseBlockMessage m = make_reduction_message(holder, message_round_, kSolution, values);
+      if (b == holder) {
+        gate_.add(holder, message_round_, kSolution, m);
+        continue;
+      }
+      OutgoingMessage o;
+      o.message = std::move(m);
+      o.broadcast = false;
+      o.recipients = {static_cast<std::uint32_t>(b)};
+      out.push_back(std::move(o));
+    }
+  }
+  gate_.expect(message_round_, kSolution, {holder});
+  ++result_.solution_steps;
+}
+
+void NewtonRefineProtocol::after_solution(const MessageGate::Inbox& inbox,
+                                          std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.cg_s);
+  const auto found = inbox.find(sigma_holder_);
+  const auto* m = found == inbox.end() ? nullptr : std::get_if<PoseBlockMessage>(&found->second);
+  const std::size_t own = static_cast<std::size_t>(interface_->size());
+  if (!m || m->data.size() < 2 || m->data.size() != (m->data[0] != 0.0 ? 2 + own : 2))
+    throw std::runtime_error("newton refine: malformed interface solution from agent " +
+                             std::to_string(sigma_holder_));
+  const std::vector<double>& v = m->data;
+  if (v[0] == 0.0) {  // no positive definite Sigma at this point: block Jacobi, on every agent
+    verdict_due_ = false;
+    take_interface_verdict(false);
+    return start_cg(out);
+  }
+  if (verdict_due_) {  // the point's first solution: Sigma factored on the holder
+    verdict_due_ = false;
+    interface_->adopt_remote_sigma(v[1] != 0.0);
+    take_interface_verdict(true);
+    reset_cg();
+  }
+  charge_to(&result_.times.cg_s);
+  z_ = interface_->back_own(X_, iy_r_, v.data() + 2);
+  send_public(z_, kDirection, out);
 }
 
 std::vector<double> NewtonRefineProtocol::factor_shipped_sigma() {
@@ -154,6 +236,7 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
     }
     ++b;
   }
+  const bool all_flags = ok;  // every block factored (each share's flag, known to all)
   if (ok && shares_ready_) {
     // Agent 0's factor of Sigma from the accepted trial's shares (factored there already on
     // agent 0): taken as it is where this agent's Sigma has the same analysis, else assembled
@@ -169,31 +252,47 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
         ++result_.sigma_factorizations;
       }
     }
-  } else if (ok) {
+  } else if (ok && (!options_.ship_solves || state_.id() == sigma_holder_)) {
     ok = assemble_sigma(*interface_, shares, options_.interface_shift);
     ++result_.sigma_factorizations;
   }
   shares_ready_ = false;
   next_shares_.clear();
   interface_due_ = false;
-  use_interface_ = ok;
   const Eigen::Map<const Eigen::MatrixXd> vv(gsum.data(), k, k), vhv(gsum.data() + k * k, k, k);
   gauge_vv_ = 0.5 * (vv + vv.transpose());
   gauge_vhv_ = 0.5 * (vhv + vhv.transpose());
   gauge_vg_ = Eigen::Map<const Eigen::VectorXd>(gsum.data() + 2 * k * k, k);
-  use_gauge_ = ok && gauge_vv_.llt().info() == Eigen::Success;
-  project_gauge_ = use_gauge_ && options_.project_gauge;
-  if (project_gauge_) {
+  if (options_.project_gauge) {
     const Eigen::Map<const Eigen::MatrixXd> kk(gsum.data() + 2 * k * k + k, k, k);
     gauge_hvhv_ = 0.5 * (kk + kk.transpose());
   }
+  if (options_.ship_solves && all_flags) {
+    // Only the holder knows whether Sigma factored: its first solution says so.
+    if (state_.id() == sigma_holder_) {
+      if (ok) {
+        take_interface_verdict(true);
+        reset_cg();
+      }
+      return send_solution(ok, out);
+    }
+    verdict_due_ = true;
+    return send_solution(true, out);  // waits for the holder's
+  }
+  take_interface_verdict(ok);
+  start_cg(out);
+}
+
+void NewtonRefineProtocol::take_interface_verdict(bool ok) {
+  use_interface_ = ok;
+  use_gauge_ = ok && gauge_vv_.llt().info() == Eigen::Success;
+  project_gauge_ = use_gauge_ && options_.project_gauge;
   if (ok) {
     ++result_.interface_factorizations;
   } else {
     ++result_.interface_fallbacks;
     if (refactor_due_) prepare_preconditioner();
   }
-  start_cg(out);
 }
 
 void NewtonRefineProtocol::ground_pose(Eigen::MatrixXd& v) const {

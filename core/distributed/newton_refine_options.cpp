@@ -31,6 +31,7 @@ void NewtonRefineOptions::validate() const {
   if (!(auto_interface_grad_tol >= 0)) fail("auto_interface_grad_tol", "must be >= 0");
   if (!(interface_shift > 0 && interface_shift <= 1e-3))
     fail("interface_shift", "must be in (0, 1e-3]");
+  if (ship_solves_min_coordinates < 0) fail("ship_solves_min_coordinates", "must be >= 0");
 }
 
 void set_refine_mode(NewtonRefineOptions& options, const std::string& mode) {
@@ -39,6 +40,18 @@ void set_refine_mode(NewtonRefineOptions& options, const std::string& mode) {
   options.enabled = mode != "none";
   options.when = mode == "auto" ? NewtonRefineOptions::When::kIfRoundsSlow
                                 : NewtonRefineOptions::When::kAlways;
+}
+
+void set_sigma_mode(NewtonRefineOptions& options, const std::string& mode,
+                    const std::string& what) {
+  if (mode != "every" && mode != "one" && mode != "solve")
+    throw InputError(what + ": '" + mode + "' is not one of every, one, solve");
+  options.ship_sigma = mode == "one";
+  options.ship_solves = mode == "solve";
+}
+
+std::string sigma_mode(const NewtonRefineOptions& options) {
+  return options.ship_solves ? "solve" : options.ship_sigma ? "one" : "every";
 }
 
 CoarseOptions NewtonRefineOptions::coarse_space_options() const {

@@ -50,12 +50,8 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
   set_refine_mode(opt.refine, o.refine);
   if (o.refine_grad_tol > 0) opt.refine.grad_norm_tol = o.refine_grad_tol;
   if (o.refine_rel_tol > 0) opt.refine.relative_decrease_tol = o.refine_rel_tol;
-  if (!o.refine_sigma.empty()) {
-    if (o.refine_sigma != "one" && o.refine_sigma != "every")
-      throw InputError("RunOptions::refine_sigma: '" + o.refine_sigma +
-                       "' is not one of one, every");
-    opt.refine.ship_sigma = o.refine_sigma == "one";
-  }
+  if (!o.refine_sigma.empty())
+    set_sigma_mode(opt.refine, o.refine_sigma, "RunOptions::refine_sigma");
   if (o.max_factor_entries > 0)
     opt.block_update.max_factor_entries = static_cast<std::size_t>(o.max_factor_entries);
   opt.validate();

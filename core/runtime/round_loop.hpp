@@ -54,8 +54,9 @@ struct RunOptions {
   std::string refine = "auto";  ///< "none", "newton" or "auto" (set_refine_mode).
   double refine_grad_tol = 0;
   double refine_rel_tol = 0;
-  /// Who factors the refinement's interface matrix (NewtonRefineOptions::ship_sigma): "one"
-  /// (agent 0, which sends its factor), "every", or "" (core's default).
+  /// Who factors the refinement's interface matrix (set_sigma_mode): "one" (agent 0, which
+  /// sends its factor), "solve" (agent 0, which sends its solves), "every", or ""
+  /// (core's default).
   std::string refine_sigma;
   /// BlockUpdateOptions::max_factor_entries (0 = core's default; runtime/team_memory.hpp).
   std::uint64_t max_factor_entries = 0;

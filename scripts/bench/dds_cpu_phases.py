@@ -259,7 +259,7 @@ def main():
         env.update(kv.split("=", 1) for kv in a.ab_env)
         variants.append(("B", a.ab or a.bin, (a.ab_launch_args if a.ab_launch_args is not None
                                               else a.launch_args).split(), env))
-    rows = []
+    rows, failed = [], []
     with tempfile.TemporaryDirectory(prefix="dds-cpu-") as tmp:
         graph = prepared_graph(os.path.join(a.bin, "tessera"), a.graph, tmp)
         for k in range(a.runs):
@@ -267,8 +267,12 @@ def main():
                 tessera = os.path.join(bindir, "tessera")
                 row = run_launch(tessera, graph, a.agents, a.domain, extra, a.period_ms / 1000,
                                  tmp, env, a.end_to_end)
-                if row is None:
-                    sys.exit("run %d (%s) failed" % (k + 1, name))
+                if row is None:  # counted and skipped: one failed launch must not lose the rest
+                    print("run %d (%s) failed (load %.1f): skipped" % (k + 1, name,
+                                                                      os.getloadavg()[0]),
+                          flush=True)
+                    failed.append("%s%d" % (name, k + 1))
+                    continue
                 row["variant"], row["run"] = name, k + 1
                 (row["cpu_inprocess_s"], row["wait_inprocess_s"],
                  row["slices_inprocess"]) = run_inprocess(tessera, graph, a.agents, tmp,
@@ -292,8 +296,12 @@ def main():
                                               row["%s@partitioned:slices" % role])
                           for role in ROLES), row["wait_inprocess_s"], row["slices_inprocess"]),
                       flush=True)
+    if failed:
+        print("failed runs (skipped): %s" % ", ".join(failed))
     for name, _, _, _ in variants:
         mine = [r for r in rows if r["variant"] == name]
+        if not mine:
+            sys.exit("every run of %s failed" % name)
         med = {key: statistics.median(r[key] for r in mine)
                for key in mine[0] if isinstance(mine[0][key], float)}
         if a.end_to_end:

@@ -12,8 +12,9 @@
 //   * CG's inner products are all-agent sums in agent-id order (bit-identical on every agent);
 //   * the preconditioner, where the team's interface is small (options.interface_max_coordinates),
 //     is the Hessian's inverse by substructuring (distributed/interface_solve.hpp: each block's
-//     factor and the interface's Schur complement, which every agent factors once per point), so
-//     a Newton step's CG takes 1-3 iterations; elsewhere block Jacobi (AgentState::precondition:
+//     factor and the interface's Schur complement, which agent 0 factors once per point and solves
+//     with for every agent, NewtonRefineOptions::ship_solves), so a Newton step's CG takes 1-3
+//     iterations; elsewhere block Jacobi (AgentState::precondition:
 //     the tangent factor of its block, else its Q_BB factor), optionally with a coarse correction
 //     over rigid motions of smoothed pieces of the blocks (options.coarse,
 //     distributed/tangent_coarse_space.hpp): block Jacobi alone moves information one block
@@ -180,10 +181,11 @@ struct NewtonRefineOptions {
   /// (distributed/interface_solve.hpp) where that interface has at most this many tangent
   /// coordinates (d(d+1)/2 a pose: ais2klinik at N = 5 102, city10000 909); 0 = off. Each
   /// block factors its diagonal block of the Riemannian Hessian (interface last) and broadcasts
-  /// its Schur complement and cut couplings once per point (one all-agent message step); every
-  /// agent factors the interface matrix Sigma (as large as this cap) and applies H^-1 exactly
-  /// (up to the shift below) in each CG iteration, whose message steps stay one exchange and
-  /// one sum (the interface residual rides in the sum). Used at rank d with `coarse` kNone. A
+  /// its Schur complement and cut couplings once per point (one all-agent message step); the
+  /// interface matrix Sigma (as large as this cap) is factored (by agent 0, ship_solves, or by
+  /// every agent) and H^-1 applied exactly (up to the shift below) in each CG iteration, whose
+  /// message steps are one exchange and one sum (the interface residual rides in the sum), and
+  /// with ship_solves agent 0's solution. Used at rank d with `coarse` kNone. A
   /// block whose Hessian block is not positive definite (far from a minimiser) factors it
   /// without the multiplier term (then M is the inverse of that modified H); where no block
   /// factor or no Sigma is positive definite, that point's CG runs block Jacobi. Why 1,000:
@@ -236,6 +238,27 @@ struct NewtonRefineOptions {
   /// 1.08 CPU-s, load 12-17): what the agents' threads save in factorizations their transport
   /// spends moving the factor (docs/newton-refine.md, "Who factors Sigma").
   bool ship_sigma = false;
+  /// With the interface solves: true, at each point ONE agent (agent 0) receives the blocks'
+  /// Schur complements and couplings (the other agents only the flags, interface residuals and
+  /// gauge sums), assembles and factors Sigma, and for each CG direction solves with it and
+  /// sends each agent its own segment of the solution (a short vector: the agent's interface
+  /// coordinates), one more message step a direction, on which every agent waits for agent 0.
+  /// false: every agent factors Sigma and solves with it itself. The same bits either way (the
+  /// same shares in id order, the same factorization and solves), so the same steps, CG
+  /// iterations and iterates. ship_sigma, where set, takes precedence (agent 0 sends its factor
+  /// instead). Why true: the agents' identical Sigma factorizations are redundant CPU, which is
+  /// wall where agents share processors. city10000 at N = 5 in process (callgrind): the whole
+  /// solve 4.335 -> 3.842 G instructions, the refinement 1.948 -> 1.487 G, bytes 14.7 -> 4.8 MB,
+  /// message steps 27 -> 30; over DDS on a 2-core machine the agents' CPU after the rounds
+  /// 0.865 -> 0.730 CPU-s (medians, load 16-19) (docs/newton-refine.md, "Who factors Sigma").
+  bool ship_solves = true;
+  /// ship_solves applies where the team's interface has at least this many tangent
+  /// coordinates (Sigma's size; the same on every agent); below it every agent factors Sigma.
+  /// Why: Sigma's factorization grows about as its size cubed, the extra message step a CG
+  /// direction does not: at city10000's 909 coordinates one factorization is ~37 M
+  /// instructions (every agent doing it 553 M over 3 points), at ais2klinik's 102 about
+  /// (102 / 909)^3 of that, less than the wait for one more message. >= 0.
+  int ship_solves_min_coordinates = 500;
   /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
   CoarseOptions coarse_space_options() const;
   /// Throws InputError naming the bad field.
@@ -246,6 +269,15 @@ struct NewtonRefineOptions {
 /// (kIfRoundsSlow). One parser for the command line, the coordinator, launch and the agents'
 /// assignment. Throws InputError "option --refine: 'v' is not one of newton, auto, none".
 void set_refine_mode(NewtonRefineOptions& options, const std::string& mode);
+
+/// The `--refine-sigma` values as options: who factors the interface solves' Sigma. "every"
+/// (each agent, ship_sigma and ship_solves off), "one" (ship_sigma) or "solve" (ship_solves).
+/// One parser for the command line, the coordinator and the agents' assignment. Throws
+/// InputError "<what>: 'v' is not one of every, one, solve".
+void set_sigma_mode(NewtonRefineOptions& options, const std::string& mode,
+                    const std::string& what = "option --refine-sigma");
+/// The `--refine-sigma` value of `options` (set_sigma_mode's inverse).
+std::string sigma_mode(const NewtonRefineOptions& options);
 
 /// One trust-region step, identical on every agent.
 struct NewtonRefineStep {
@@ -289,8 +321,10 @@ struct NewtonRefineResult {
   int steps = 0, accepted_steps = 0, cg_iterations = 0;
   /// Message steps: neighbour exchanges (CG directions and trial poses) and all-agent sums.
   int exchanges = 0, reductions = 0;
-  /// Both together: the refinement's waits for peers (a round of IRBCD is two).
-  int message_steps() const { return exchanges + reductions; }
+  /// ship_solves: the CG directions' steps that wait for the agent solving with Sigma.
+  int solution_steps = 0;
+  /// All together: the refinement's waits for peers (a round of IRBCD is two).
+  int message_steps() const { return exchanges + reductions + solution_steps; }
   /// Coarse correction: its unknowns (pieces x generators; 0 without), and how many times its
   /// matrix was summed (one all-agent sum each, counted in `reductions`).
   int coarse_unknowns = 0, coarse_assemblies = 0;
@@ -331,10 +365,12 @@ class NewtonRefineProtocol : public AgentProcess {
     kTranslationDirection = 66,  ///< Trial translations: public entries of the CG's z.
     kTranslationSums = 67,       ///< Trial translations: <r, z>, <z, H z>.
     kInterface = 68,             ///< Interface solves: each block's Schur complement and couplings.
-    kTranslationSolve = 69       ///< Exact trial translations: each block's interface residual.
+    kTranslationSolve = 69,      ///< Exact trial translations: each block's interface residual.
+    kSolution =
+        70  ///< ship_solves: Sigma's solve, each agent's segment, from the agent holding it.
   };
   /// The last of the steps: [kStatus, kLastStep] are the refinement's.
-  static constexpr std::uint32_t kLastStep = kTranslationSolve;
+  static constexpr std::uint32_t kLastStep = kSolution;
   static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kLastStep; }
 
   /// `state`: the agent at the point to refine (Y, and Yn = the neighbours' public poses of the
@@ -400,6 +436,17 @@ class NewtonRefineProtocol : public AgentProcess {
   // The block preconditioner for the next CG solve (options_.refactor_every_step).
   void prepare_preconditioner();
   void send_direction(std::vector<OutgoingMessage>& out);
+  // ship_solves: a share's trailing interface residuals (this block's), in values.
+  std::size_t share_tail() const;
+  // ship_solves, on the holder: u = Sigma^-1 rhat of the current residual, each agent's segment
+  // sent to it (kSolution, after the flag and grounding); everyone waits for it. With ok false
+  // (no positive definite Sigma at this point), the flag 0 alone.
+  void send_solution(bool ok, std::vector<OutgoingMessage>& out);
+  void after_solution(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // After a point's Sigma: whether the CG uses it (ok), the gauge's sums, fallback otherwise.
+  void take_interface_verdict(bool ok);
+  // start_cg()'s state (s = 0, r = -g, the interface residuals) without the first direction.
+  void reset_cg();
   void after_direction(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void after_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   void try_step(const std::string& cg_stop, std::vector<OutgoingMessage>& out);
@@ -474,6 +521,10 @@ class NewtonRefineProtocol : public AgentProcess {
   // accepted trial (id order), in hand for the next interface step (shares_ready_).
   bool trial_shares_ = false, shares_ready_ = false;
   std::vector<std::vector<double>> next_shares_;
+  // ship_solves: the point's Sigma verdict is the holder's, not yet known here (it comes with
+  // the point's first solution).
+  bool verdict_due_ = false;
+  int sigma_holder_ = 0;  // the agent holding Sigma's factor (agent 0)
   Eigen::VectorXd iy_r_, iy_q_, iy_w_, iy_g_, ir_, iq_, ir_g_;
   // The gauge with the interface solves (distributed/gauge_space.hpp): its basis V and H V at
   // the point, the sums V^T V, V^T H V and V^T g (in the interface matrix's sum), and the
