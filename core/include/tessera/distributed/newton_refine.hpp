@@ -248,7 +248,7 @@ struct NewtonRefineOptions {
   /// iterations and iterates. ship_sigma, where set, takes precedence (agent 0 sends its factor
   /// instead). Why true: the agents' identical Sigma factorizations are redundant CPU, which is
   /// wall where agents share processors. city10000 at N = 5 in process (callgrind): the whole
-  /// solve 4.335 -> 3.842 G instructions, the refinement 1.948 -> 1.487 G, bytes 14.7 -> 4.8 MB,
+  /// solve 4.335 -> 3.842 G instructions, the refinement 1.948 -> 1.487 G, bytes 14.67 -> 4.72 MB,
   /// message steps 27 -> 30; over DDS on a 2-core machine the agents' CPU after the rounds
   /// 0.865 -> 0.730 CPU-s (medians, load 16-19) (docs/newton-refine.md, "Who factors Sigma").
   bool ship_solves = true;
