@@ -73,7 +73,7 @@ std::string session_options_help(SessionArgsFor who) {
   if (who == SessionArgsFor::kProcess)
     h += "  --timeout S        bound on each wait for peers during set-up, in seconds (default 30)\n";
   h += "  --lease S          participant/liveliness lease in seconds: a dead peer is noticed after\n"
-       "                     about this long (default 1, range 0.2..60)\n";
+       "                     about this long (default 2, range 0.2..60)\n";
   if (who == SessionArgsFor::kLaunch)
     h += "                     (launch, more than 32 agents: default 30; a loaded host may not\n"
          "                     schedule a process for seconds)\n";

@@ -55,8 +55,8 @@ struct OnlineProtocolSample {
   ProtocolMessage message;
 };
 
-/// Participant lease of an online agent, seconds (Session's default is 1 s; 2 s leaves room for
-/// a loaded host, where 1 s once declared a live peer lost).
+/// Participant lease of an online agent, seconds (as a batch Session's default: 2 s leaves room
+/// for a loaded host, where 1 s declared live peers lost).
 constexpr double kDefaultOnlineLeaseS = 2.0;
 
 class OnlineChannel {

@@ -16,8 +16,10 @@ struct SessionOptions {
   std::uint32_t agent_id = 0;      ///< 0..num_agents-1 (agents only).
   std::uint32_t num_agents = 1;    ///< N >= 1.
   /// Participant lease and writer liveliness lease in seconds (0.2..60). A SIGKILLed peer is
-  /// noticed after about this long (participant announcements go out every lease/5).
-  double lease_s = 1.0;
+  /// noticed after about this long (participant announcements go out every lease/5). 2 s: on a
+  /// loaded host a live process can go unscheduled for over a second, and 1 s then counted it
+  /// lost (docs/dds-runtime.md, "QoS").
+  double lease_s = 2.0;
   /// IPv4 addresses of hosts to contact by unicast for discovery (when multicast is blocked).
   std::vector<std::string> initial_peers;
   /// Transport profile (network_profile.hpp): "default", or "lossy" for links that drop

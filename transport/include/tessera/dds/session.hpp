@@ -13,7 +13,7 @@ struct SessionOptions {
   /// DDS domain 0..232; < 0: derived from the run id.
   int domain = -1;
   /// Participant lease, seconds (0.2..60): a dead peer is noticed after about this long.
-  double lease_s = 1.0;
+  double lease_s = 2.0;
   /// IPv4 addresses of other hosts to contact by unicast (when multicast is not available).
   std::vector<std::string> peers;
   /// "default", or "lossy" for links that drop packets.
