@@ -106,6 +106,10 @@ struct OnlineOptions {
   /// coarse matrix is summed at every accepted Newton step (docs/online.md, "The coarse
   /// correction").
   NewtonRefineOptions::Coarse newton_coarse = NewtonRefineOptions::Coarse::kNone;
+  /// With newton_coarse: the linked blocks a group needs for the correction to apply to it
+  /// (NewtonRefineOptions::coarse_min_blocks); smaller groups, robots met in pairs for
+  /// instance, take block Jacobi's steps. >= 2.
+  int newton_coarse_min_blocks = 2;
   /// New poses that new loop closures tie to the estimate are placed by least squares against
   /// every new measurement after composition (new_pose_placement.hpp), not only along their
   /// odometry. false: composition only.
@@ -135,9 +139,9 @@ struct OnlineUpdate {
   std::size_t measurements = 0;  ///< New measurements.
   std::size_t total_poses = 0;   ///< Graph size after the step.
   std::size_t total_measurements = 0;
-  int agents = 0;                 ///< Blocks (robots) during the step.
-  std::size_t moved = 0;          ///< Poses that changed block (rebalance) before the rounds.
-  std::size_t largest_block = 0;  ///< Largest block's poses during the rounds.
+  int agents = 0;                  ///< Blocks (robots) during the step.
+  std::size_t moved = 0;           ///< Poses that changed block (rebalance) before the rounds.
+  std::size_t largest_block = 0;   ///< Largest block's poses during the rounds.
   std::size_t smallest_block = 0;  ///< Smallest block's poses during the rounds.
   /// Measurements between two blocks during the rounds (0 when the cut refinement is off,
   /// RebalanceOptions::cut_fraction = 1).
