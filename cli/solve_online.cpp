@@ -111,7 +111,7 @@ const char* kOnlineHelp =
     "                            motions of 8 smoothed pieces of each such block: the fewest\n"
     "                            CG iterations once robots have met)\n"
     "  --step-coarse-min-blocks M   the correction only for groups of at least M linked\n"
-    "                            blocks, smaller ones take block Jacobi's steps (default 2)\n"
+    "                            blocks, smaller ones take block Jacobi's steps (default 3)\n"
     "  --cut-fraction F          re-partition: refine the blocks' border when more than F of\n"
     "                            the measurements join two blocks (default 0.02; 1: blocks\n"
     "                            stay the robots', moved only for balance)\n"

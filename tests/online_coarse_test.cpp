@@ -95,6 +95,7 @@ OnlineOptions options(NewtonRefineOptions::Coarse coarse) {
   o.step_every_s = 0.5;
   o.certify_at_end = false;
   o.newton_coarse = coarse;
+  o.newton_coarse_min_blocks = 2;
   return o;
 }
 

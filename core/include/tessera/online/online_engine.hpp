@@ -108,8 +108,13 @@ struct OnlineOptions {
   NewtonRefineOptions::Coarse newton_coarse = NewtonRefineOptions::Coarse::kNone;
   /// With newton_coarse: the linked blocks a group needs for the correction to apply to it
   /// (NewtonRefineOptions::coarse_min_blocks); smaller groups, robots met in pairs for
-  /// instance, take block Jacobi's steps. >= 2.
-  int newton_coarse_min_blocks = 2;
+  /// instance, take block Jacobi's steps. Default 3: a pair's relative motion saves few CG
+  /// iterations for the coarse sums and products it costs. The 20,000-pose grid above with
+  /// kSmoothed, first 11,010 poses: at 4,600-8,000 poses (pairs only) 67.2 CG iterations and
+  /// 0.54 CPU-s a step with 3 (block Jacobi's counts exactly) against 48.4 and 0.91 with 2; in
+  /// all 5,249 against 4,071 CG iterations, 481 against 494 Newton steps, 67 against 93 CPU-s
+  /// (load 6-16; docs/online.md, "The coarse correction"). >= 2.
+  int newton_coarse_min_blocks = 3;
   /// New poses that new loop closures tie to the estimate are placed by least squares against
   /// every new measurement after composition (new_pose_placement.hpp), not only along their
   /// odometry. false: composition only.
