@@ -93,18 +93,18 @@ struct OnlineOptions {
   /// The Newton steps' coarse correction (NewtonRefineOptions::coarse): kNone (block Jacobi,
   /// the default), kBlocks (plus one rigid motion per block) or kSmoothed (plus the rigid
   /// motions of solver.refine.coarse_aggregates smoothed pieces of each block, the space built
-  /// from the linked graph at every solve). Only blocks in a group of two or more linked blocks
-  /// take part: a robot that has met no other is left out (its motions are a gauge, its inner
-  /// bending block Jacobi's work), so before the robots meet the steps are block Jacobi's
-  /// (tangent_coarse_space.hpp). Once they meet, the error a closure leaves is bending across
-  /// blocks, which block Jacobi moves one block boundary per CG iteration: a generated
+  /// from the linked graph at every solve). Only blocks in a group of newton_coarse_min_blocks
+  /// linked blocks or more take part: a robot that has met no other is left out (its motions are a
+  /// gauge, its inner bending block Jacobi's work), so before the robots meet the steps are block
+  /// Jacobi's (tangent_coarse_space.hpp). Once they meet, the error a closure leaves is bending
+  /// across blocks, which block Jacobi moves one block boundary per CG iteration: a generated
   /// 20,000-pose grid over 10 robots, a step every 0.1 s, first 11,010 poses: 12,442 CG
-  /// iterations without, 6,161 with kBlocks, 4,071 with kSmoothed (at 10,000-11,000 poses 527 /
-  /// 103 / 36 a step; CPU 140 / 105 / 100 s, load 6-19). Off by default: while robots have
-  /// only met in pairs kSmoothed cuts fewer iterations than it costs (the same grid at
-  /// 4,600-8,000 poses: 48 against 67 CG iterations a step, 0.96 against 0.55 CPU-s); and the
-  /// coarse matrix is summed at every accepted Newton step (docs/online.md, "The coarse
-  /// correction").
+  /// iterations without, 6,161 with kBlocks, 4,071 with kSmoothed and newton_coarse_min_blocks = 2
+  /// (at 10,000-11,000 poses 527 / 103 / 36 a step; CPU 140 / 105 / 100 s, load 6-19). Off by
+  /// default: while robots have only met in pairs kSmoothed cuts fewer iterations than it costs
+  /// (the same grid at 4,600-8,000 poses: 48 against 67 CG iterations a step, 0.96 against 0.55
+  /// CPU-s); and the coarse matrix is summed at every accepted Newton step (docs/online.md, "The
+  /// coarse correction").
   NewtonRefineOptions::Coarse newton_coarse = NewtonRefineOptions::Coarse::kNone;
   /// With newton_coarse: the linked blocks a group needs for the correction to apply to it
   /// (NewtonRefineOptions::coarse_min_blocks); smaller groups, robots met in pairs for
