@@ -23,14 +23,32 @@
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {
-    "rate",          "speedup",           "start",          "checkpoints",
-    "certify-every", "refactor-growth",   "baseline-every", "local-threshold",
-    "step-every",    "step-solver",       "newton-after",   "threads",
-    "baseline-per",  "baseline-samples",  "baseline-init",  "baseline-solver",
-    "step-coarse",   "progress-interval", "until",          "cut-fraction",
-    "block-slack",   "block-min-excess",  "cut-passes",     "cut-patience",
-    nullptr};
+const char* const kOnlineValued[] = {"rate",
+                                     "speedup",
+                                     "start",
+                                     "checkpoints",
+                                     "certify-every",
+                                     "refactor-growth",
+                                     "baseline-every",
+                                     "local-threshold",
+                                     "step-every",
+                                     "step-solver",
+                                     "newton-after",
+                                     "threads",
+                                     "baseline-per",
+                                     "baseline-samples",
+                                     "baseline-init",
+                                     "baseline-solver",
+                                     "step-coarse",
+                                     "progress-interval",
+                                     "until",
+                                     "cut-fraction",
+                                     "block-slack",
+                                     "block-min-excess",
+                                     "cut-passes",
+                                     "cut-patience",
+                                     "step-coarse-min-blocks",
+                                     nullptr};
 const char* const kOnlineSwitches[] = {"online",          "real-time",   "baseline",
                                        "no-local-rounds", "no-progress", "no-place-by-links",
                                        "no-rebalance",    nullptr};
@@ -92,6 +110,8 @@ const char* kOnlineHelp =
     "                            of the robots that have met; smoothed: plus the rigid\n"
     "                            motions of 8 smoothed pieces of each such block: the fewest\n"
     "                            CG iterations once robots have met)\n"
+    "  --step-coarse-min-blocks M   the correction only for groups of at least M linked\n"
+    "                            blocks, smaller ones take block Jacobi's steps (default 3)\n"
     "  --cut-fraction F          re-partition: refine the blocks' border when more than F of\n"
     "                            the measurements join two blocks (default 0.02; 1: blocks\n"
     "                            stay the robots', moved only for balance)\n"
@@ -213,6 +233,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
     options.newton_coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
                             : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
                                                    : NewtonRefineOptions::Coarse::kNone;
+    options.newton_coarse_min_blocks =
+        static_cast<int>(a.get_long("step-coarse-min-blocks", options.newton_coarse_min_blocks));
   }
   options.validate();
   ReplayOptions replay;

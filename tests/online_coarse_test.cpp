@@ -14,6 +14,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/generate/generator.hpp>
 #include <tessera/online/online_engine.hpp>
@@ -93,6 +95,7 @@ OnlineOptions options(NewtonRefineOptions::Coarse coarse) {
   o.step_every_s = 0.5;
   o.certify_at_end = false;
   o.newton_coarse = coarse;
+  o.newton_coarse_min_blocks = 2;
   return o;
 }
 
@@ -164,6 +167,77 @@ TEST(OnlineCoarse, OnceTheRobotsMeetItTakesFewerCgIterationsToTheBatchOptimum) {
   EXPECT_NEAR(smoothed.cost, f_star, 1e-6 * f_star);
   std::printf("CG iterations: block Jacobi %d, blocks' rigid motions %d, smoothed pieces %d\n",
               cg_iterations(none), cg_iterations(blocks), cg_iterations(smoothed));
+}
+
+// Blocks 0, 1 and 2 hold one chain, block 3 a chain of its own.
+BlockLayout three_linked_blocks_and_a_lone_one() {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::uint32_t i = 0; i + 1 < 45; ++i) edges.emplace_back(i, i + 1);
+  for (std::uint32_t i = 45; i + 1 < 60; ++i) edges.emplace_back(i, i + 1);
+  std::vector<int> parts(60, 0);
+  for (std::size_t i = 0; i < 60; ++i) parts[i] = static_cast<int>(i / 15);
+  return make_block_layout(60, edges, parts);
+}
+
+TEST(OnlineCoarse, GroupsOfFewerLinkedBlocksThanTheMinimumAreLeftOut) {
+  // Two linked blocks: in with the default minimum, out (as a lone block) with 3.
+  const BlockLayout pair = two_groups();
+  EXPECT_TRUE(TangentCoarseSpace(nullptr, pair, pair.poses[0], {15}, 3, 3).linked());
+  const TangentCoarseSpace pair_min3(nullptr, pair, pair.poses[0], {15}, 3, 3, 3);
+  EXPECT_FALSE(pair_min3.linked());
+  EXPECT_EQ(pair_min3.packed_size(), 0u);
+  EXPECT_TRUE(pair_min3.own().empty());
+  // Three linked blocks: in with 3 (3 x 6 unknowns carried), out with 4; the lone block never.
+  const BlockLayout three = three_linked_blocks_and_a_lone_one();
+  const TangentCoarseSpace min3(nullptr, three, three.poses[1], {14, 30}, 3, 3, 3);
+  EXPECT_TRUE(min3.linked());
+  EXPECT_EQ(min3.packed_size(), 18u * 19u / 2u);
+  EXPECT_FALSE(TangentCoarseSpace(nullptr, three, three.poses[1], {14, 30}, 3, 3, 4).linked());
+}
+
+TEST(OnlineCoarse, AMinimumGroupBelowTwoBlocksIsRejectedNamingTheField) {
+  NewtonRefineOptions refine;
+  refine.coarse_min_blocks = 1;
+  try {
+    refine.validate();
+    ADD_FAILURE() << "coarse_min_blocks = 1 accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("coarse_min_blocks"), std::string::npos) << e.what();
+  }
+  OnlineOptions online;
+  online.newton_coarse_min_blocks = 1;
+  try {
+    online.validate();
+    ADD_FAILURE() << "newton_coarse_min_blocks = 1 accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("newton_coarse_min_blocks"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(OnlineSmoothedCoarse, RobotsMetOnlyInPairsTakeBlockJacobisStepsWithAMinimumOfThree) {
+  // Two robots: one group of two blocks at most, so with newton_coarse_min_blocks = 3 no
+  // coarse space is built and every step is block Jacobi's, bit for bit.
+  const auto gen = grid(240, 2);
+  ReplayOptions ro;
+  ro.rate = 10;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  const OnlineResult none =
+      run_online(gen.graph.d, plan.batches, options(NewtonRefineOptions::Coarse::kNone));
+  OnlineOptions o = options(NewtonRefineOptions::Coarse::kSmoothed);
+  o.newton_coarse_min_blocks = 3;
+  const OnlineResult min3 = run_online(gen.graph.d, plan.batches, o);
+  const OnlineResult min2 =
+      run_online(gen.graph.d, plan.batches, options(NewtonRefineOptions::Coarse::kSmoothed));
+  ASSERT_EQ(min3.updates.size(), none.updates.size());
+  for (std::size_t k = 0; k < none.updates.size(); ++k) {
+    EXPECT_EQ(min3.updates[k].newton_steps, none.updates[k].newton_steps) << "step " << k;
+    EXPECT_EQ(min3.updates[k].newton_cg_iterations, none.updates[k].newton_cg_iterations)
+        << "step " << k;
+  }
+  EXPECT_EQ(min3.cost, none.cost);
+  // The pair does take the correction with the default minimum (the test is not vacuous).
+  EXPECT_NE(cg_iterations(min2), cg_iterations(none));
 }
 
 }  // namespace

@@ -282,9 +282,9 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
   if (options_.coarse != NewtonRefineOptions::Coarse::kNone) {
     const CoarseSpace* space =
         options_.coarse == NewtonRefineOptions::Coarse::kSmoothed ? state_.refine_space() : nullptr;
-    coarse_ =
-        std::make_unique<TangentCoarseSpace>(space, layout_, problem_.owned(), problem_.neighbors(),
-                                             problem_.dim(), static_cast<int>(rows_.size()));
+    coarse_ = std::make_unique<TangentCoarseSpace>(
+        space, layout_, problem_.owned(), problem_.neighbors(), problem_.dim(),
+        static_cast<int>(rows_.size()), options_.coarse_min_blocks);
     // Every piece alone in its group (robots that have not met): the correction is zero, so no
     // coarse matrix is summed (the layout is the same on every agent, so is the decision).
     if (!coarse_->linked()) coarse_.reset();

@@ -28,12 +28,15 @@ TangentCoarseSpace::Poses TangentCoarseSpace::weights_of(const CoarseSpace* spac
 
 TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayout& layout,
                                        const std::vector<std::size_t>& owned,
-                                       const std::vector<std::size_t>& neighbours, int d, int k)
+                                       const std::vector<std::size_t>& neighbours, int d, int k,
+                                       int min_group_blocks)
     : d_(d),
       k_(k),
       g_(k * (k - 1) / 2 + k),
       pieces_(space ? space->num_aggregates : layout.num_blocks) {
   if (k < 1) throw std::invalid_argument("TangentCoarseSpace: no active rows");
+  if (min_group_blocks < 2)
+    throw std::invalid_argument("TangentCoarseSpace: min_group_blocks must be >= 2");
   for (int a = 0; a < k; ++a)
     for (int b = a + 1; b < k; ++b) rotation_pairs_.emplace_back(a, b);
   // Groups of linked pieces: the components of the block graph (every agent has the layout, so
@@ -73,10 +76,11 @@ TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayo
       unknowns[static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(alpha)])]
           .push_back(alpha * g_ + j);
   for (std::size_t g = 0; g < unknowns.size(); ++g)
-    if (members[g] >= 2) linked_group_unknowns_.push_back(std::move(unknowns[g]));
+    if (members[g] >= min_group_blocks) linked_group_unknowns_.push_back(std::move(unknowns[g]));
   linked_.assign(static_cast<std::size_t>(pieces_), 0);
   for (int a = 0; a < pieces_; ++a) {
-    if (members[static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(a)])] < 2)
+    if (members[static_cast<std::size_t>(group_of_piece_[static_cast<std::size_t>(a)])] <
+        min_group_blocks)
       continue;
     linked_[static_cast<std::size_t>(a)] = 1;
     for (int j = 0; j < g_; ++j) {

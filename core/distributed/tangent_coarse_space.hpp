@@ -29,10 +29,11 @@ class TangentCoarseSpace {
   /// `space`: the pieces and weights (null: one piece per block, weight 1, from the layout).
   /// `owned`, `neighbours`: global ids of the block's poses and neighbour copies (BlockProblem
   /// order); `d`: the poses' dimension; `k`: the rows of the vectors it maps (the refinement's
-  /// active rows).
+  /// active rows); `min_group_blocks`: the blocks a group needs to take part (>= 2; groups()).
   TangentCoarseSpace(const CoarseSpace* space, const BlockLayout& layout,
                      const std::vector<std::size_t>& owned,
-                     const std::vector<std::size_t>& neighbours, int d, int k);
+                     const std::vector<std::size_t>& neighbours, int d, int k,
+                     int min_group_blocks = 2);
 
   /// Generators per piece: k(k-1)/2 rotations then k translations.
   int generators() const { return g_; }
@@ -41,7 +42,7 @@ class TangentCoarseSpace {
   int size() const { return pieces_ * g_; }
   /// The unknowns whose vectors are non-zero on an own pose or a neighbour copy, ascending:
   /// the columns of A this agent's rows contribute to. Only pieces in a group of two blocks or
-  /// more (groups()).
+  /// more (groups(); `min_group_blocks` or more where the constructor was given that).
   const std::vector<int>& touched() const { return touched_; }
   /// The unknowns non-zero on an own pose, ascending (of linked pieces, as touched()).
   const std::vector<int>& own() const { return own_; }
@@ -69,8 +70,9 @@ class TangentCoarseSpace {
   /// its block): group_of(alpha) numbers them densely in order of their first piece.
   int groups() const { return groups_; }
   int group_of(int piece) const { return group_of_piece_[static_cast<std::size_t>(piece)]; }
-  /// Some group holds pieces of two blocks or more (else the correction is left out: every
-  /// motion of a lone piece is gauge, and a lone block's inner pieces are block Jacobi's work).
+  /// Some group holds pieces of `min_group_blocks` blocks or more (else the correction is left
+  /// out: every motion of a lone piece is gauge, and a lone block's inner pieces are block
+  /// Jacobi's work; a group of fewer blocks is left out as a lone block is).
   bool linked() const { return !linked_group_unknowns_.empty(); }
 
   /// A positive semi-definite inverse of the Galerkin matrix A (size() x size(), symmetric):

@@ -36,6 +36,8 @@ void OnlineOptions::validate() const {
     throw InputError("OnlineOptions.step_every_s: a fixed step period excludes real_time");
   if (!(newton_forcing > 0 && newton_forcing < 1))
     throw InputError("OnlineOptions.newton_forcing must be in (0, 1)");
+  if (newton_coarse_min_blocks < 2)
+    throw InputError("OnlineOptions.newton_coarse_min_blocks must be >= 2");
   if (!(newton_after_grad_tol > 0))
     throw InputError("OnlineOptions.newton_after_grad_tol must be > 0 (+infinity: no round)");
   DistributedOptions s = solver;
@@ -210,6 +212,7 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     solver.refine.refactor_every_step = false;
     solver.refine.forcing = options.newton_forcing;
     solver.refine.coarse = options.newton_coarse;
+    solver.refine.coarse_min_blocks = options.newton_coarse_min_blocks;
     // Nor the trial translations' re-solve (measured on long chains from a cold start).
     solver.refine.translation_iterations = 0;
     // Nor the interface solves (they factor every block at every point; these steps keep

@@ -148,6 +148,12 @@ struct NewtonRefineOptions {
   /// kSmoothed: pieces per block (>= 1) and smoothing steps of their weights (0..8).
   int coarse_aggregates = 8;
   int coarse_smoothing_steps = 1;
+  /// The blocks a group of linked blocks needs for its pieces to take part in the coarse
+  /// correction (TangentCoarseSpace::groups()); a smaller group takes block Jacobi's steps, as
+  /// a robot that has met no other does. A connected graph of N blocks is one group, so batch
+  /// solves with N >= this are unchanged. Default 2 (every linked group); the online steps set
+  /// their own (OnlineOptions::newton_coarse_min_blocks). >= 2.
+  int coarse_min_blocks = 2;
   /// Translations re-solved at every trial point: after the retraction moves the poses, the
   /// agents run up to this many iterations of a distributed conjugate gradient on the
   /// translations alone (the rotations fixed, f is quadratic in them: Hessian 2 L, L the

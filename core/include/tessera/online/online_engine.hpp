@@ -93,19 +93,28 @@ struct OnlineOptions {
   /// The Newton steps' coarse correction (NewtonRefineOptions::coarse): kNone (block Jacobi,
   /// the default), kBlocks (plus one rigid motion per block) or kSmoothed (plus the rigid
   /// motions of solver.refine.coarse_aggregates smoothed pieces of each block, the space built
-  /// from the linked graph at every solve). Only blocks in a group of two or more linked blocks
-  /// take part: a robot that has met no other is left out (its motions are a gauge, its inner
-  /// bending block Jacobi's work), so before the robots meet the steps are block Jacobi's
-  /// (tangent_coarse_space.hpp). Once they meet, the error a closure leaves is bending across
-  /// blocks, which block Jacobi moves one block boundary per CG iteration: a generated
+  /// from the linked graph at every solve). Only blocks in a group of newton_coarse_min_blocks
+  /// linked blocks or more take part: a robot that has met no other is left out (its motions are a
+  /// gauge, its inner bending block Jacobi's work), so before the robots meet the steps are block
+  /// Jacobi's (tangent_coarse_space.hpp). Once they meet, the error a closure leaves is bending
+  /// across blocks, which block Jacobi moves one block boundary per CG iteration: a generated
   /// 20,000-pose grid over 10 robots, a step every 0.1 s, first 11,010 poses: 12,442 CG
-  /// iterations without, 6,161 with kBlocks, 4,071 with kSmoothed (at 10,000-11,000 poses 527 /
-  /// 103 / 36 a step; CPU 140 / 105 / 100 s, load 6-19). Off by default: while robots have
-  /// only met in pairs kSmoothed cuts fewer iterations than it costs (the same grid at
-  /// 4,600-8,000 poses: 48 against 67 CG iterations a step, 0.96 against 0.55 CPU-s); and the
-  /// coarse matrix is summed at every accepted Newton step (docs/online.md, "The coarse
-  /// correction").
+  /// iterations without, 6,161 with kBlocks, 4,071 with kSmoothed and newton_coarse_min_blocks = 2
+  /// (at 10,000-11,000 poses 527 / 103 / 36 a step; CPU 140 / 105 / 100 s, load 6-19). Off by
+  /// default: while robots have only met in pairs kSmoothed cuts fewer iterations than it costs
+  /// (the same grid at 4,600-8,000 poses: 48 against 67 CG iterations a step, 0.96 against 0.55
+  /// CPU-s); and the coarse matrix is summed at every accepted Newton step (docs/online.md, "The
+  /// coarse correction").
   NewtonRefineOptions::Coarse newton_coarse = NewtonRefineOptions::Coarse::kNone;
+  /// With newton_coarse: the linked blocks a group needs for the correction to apply to it
+  /// (NewtonRefineOptions::coarse_min_blocks); smaller groups, robots met in pairs for
+  /// instance, take block Jacobi's steps. Default 3: a pair's relative motion saves few CG
+  /// iterations for the coarse sums and products it costs. The 20,000-pose grid above with
+  /// kSmoothed, first 11,010 poses: at 4,600-8,000 poses (pairs only) 67.2 CG iterations and
+  /// 0.54 CPU-s a step with 3 (block Jacobi's counts exactly) against 48.4 and 0.91 with 2; in
+  /// all 5,249 against 4,071 CG iterations, 481 against 494 Newton steps, 67 against 93 CPU-s
+  /// (load 6-16; docs/online.md, "The coarse correction"). >= 2.
+  int newton_coarse_min_blocks = 3;
   /// New poses that new loop closures tie to the estimate are placed by least squares against
   /// every new measurement after composition (new_pose_placement.hpp), not only along their
   /// odometry. false: composition only.
@@ -135,9 +144,9 @@ struct OnlineUpdate {
   std::size_t measurements = 0;  ///< New measurements.
   std::size_t total_poses = 0;   ///< Graph size after the step.
   std::size_t total_measurements = 0;
-  int agents = 0;                 ///< Blocks (robots) during the step.
-  std::size_t moved = 0;          ///< Poses that changed block (rebalance) before the rounds.
-  std::size_t largest_block = 0;  ///< Largest block's poses during the rounds.
+  int agents = 0;                  ///< Blocks (robots) during the step.
+  std::size_t moved = 0;           ///< Poses that changed block (rebalance) before the rounds.
+  std::size_t largest_block = 0;   ///< Largest block's poses during the rounds.
   std::size_t smallest_block = 0;  ///< Smallest block's poses during the rounds.
   /// Measurements between two blocks during the rounds (0 when the cut refinement is off,
   /// RebalanceOptions::cut_fraction = 1).
