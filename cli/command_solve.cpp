@@ -18,6 +18,7 @@
 #include "commands.hpp"
 #include "graph_input.hpp"
 #include "json_writer.hpp"
+#include "rebalance_args.hpp"
 #include "robust_args.hpp"
 #include "solve_distributed.hpp"
 #include "solve_online.hpp"
@@ -255,6 +256,8 @@ int run_solve(const Args& args) {
   for (const char* const* o = kDistributedSwitches; *o; ++o) switches.insert(*o);
   for (const char* const* o = kOnlineValued; *o; ++o) valued.insert(*o);
   for (const char* const* o = kOnlineSwitches; *o; ++o) switches.insert(*o);
+  for (const char* const* o = kRebalanceValued; *o; ++o) valued.insert(*o);
+  for (const char* const* o = kRebalanceSwitches; *o; ++o) switches.insert(*o);
   for (const char* const* o = kRobustValued; *o; ++o) valued.insert(*o);
   valued.insert("precond-max-flops");
   valued.insert("gnc-cluster-probes");
@@ -263,8 +266,8 @@ int run_solve(const Args& args) {
   valued.insert("gnc-newton-mu-step-max");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
-    std::printf("%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
-                kOnlineHelp, kRobustHelp);
+    std::printf("%s%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
+                kOnlineHelp, kRebalanceHelp, kRobustHelp);
     return 0;
   }
   if (a.positional().size() != 1)

@@ -1,9 +1,9 @@
 #include "rebalance_args.hpp"
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <tessera/util/input_error.hpp>
+
+#include "io/number_text.hpp"
 
 namespace tessera::cli {
 
@@ -46,20 +46,6 @@ RebalanceOptions parse_rebalance_options(const Arguments& args) {
   return o;
 }
 
-namespace {
-
-std::string number(double v) {
-  // The shortest of %g's precisions that reads back the same value.
-  char text[32];
-  for (int p = 1; p <= 17; ++p) {
-    std::snprintf(text, sizeof text, "%.*g", p, v);
-    if (std::strtod(text, nullptr) == v) break;
-  }
-  return text;
-}
-
-}  // namespace
-
 std::string rebalance_disagreement(const RebalanceOptions& mine, const RebalanceOptions& lead,
                                    unsigned lead_agent) {
   std::string flag, here, there;
@@ -69,12 +55,12 @@ std::string rebalance_disagreement(const RebalanceOptions& mine, const Rebalance
     there = lead.enabled ? "absent" : "given";
   } else if (mine.cut_fraction != lead.cut_fraction) {
     flag = "--cut-fraction";
-    here = number(mine.cut_fraction);
-    there = number(lead.cut_fraction);
+    here = exact_text(mine.cut_fraction);
+    there = exact_text(lead.cut_fraction);
   } else if (mine.slack != lead.slack) {
     flag = "--block-slack";
-    here = number(mine.slack);
-    there = number(lead.slack);
+    here = exact_text(mine.slack);
+    there = exact_text(lead.slack);
   } else if (mine.min_excess != lead.min_excess) {
     flag = "--block-min-excess";
     here = std::to_string(mine.min_excess);

@@ -23,35 +23,15 @@
 
 namespace tessera::cli {
 
-const char* const kOnlineValued[] = {"rate",
-                                     "speedup",
-                                     "start",
-                                     "checkpoints",
-                                     "certify-every",
-                                     "refactor-growth",
-                                     "baseline-every",
-                                     "local-threshold",
-                                     "step-every",
-                                     "step-solver",
-                                     "newton-after",
-                                     "threads",
-                                     "baseline-per",
-                                     "baseline-samples",
-                                     "baseline-init",
-                                     "baseline-solver",
-                                     "step-coarse",
-                                     "progress-interval",
-                                     "until",
-                                     "cut-fraction",
-                                     "block-slack",
-                                     "block-min-excess",
-                                     "cut-passes",
-                                     "cut-patience",
-                                     "step-coarse-min-blocks",
-                                     nullptr};
+const char* const kOnlineValued[] = {
+    "rate",          "speedup",           "start",          "checkpoints",
+    "certify-every", "refactor-growth",   "baseline-every", "local-threshold",
+    "step-every",    "step-solver",       "newton-after",   "threads",
+    "baseline-per",  "baseline-samples",  "baseline-init",  "baseline-solver",
+    "step-coarse",   "progress-interval", "until",          "step-coarse-min-blocks",
+    nullptr};
 const char* const kOnlineSwitches[] = {"online",          "real-time",   "baseline",
-                                       "no-local-rounds", "no-progress", "no-place-by-links",
-                                       "no-rebalance",    nullptr};
+                                       "no-local-rounds", "no-progress", nullptr};
 
 const char* kOnlineHelp =
     "\n"
@@ -112,17 +92,6 @@ const char* kOnlineHelp =
     "                            CG iterations once robots have met)\n"
     "  --step-coarse-min-blocks M   the correction only for groups of at least M linked\n"
     "                            blocks, smaller ones take block Jacobi's steps (default 3)\n"
-    "  --cut-fraction F          re-partition: refine the blocks' border when more than F of\n"
-    "                            the measurements join two blocks (default 0.02; 1: blocks\n"
-    "                            stay the robots', moved only for balance)\n"
-    "  --block-slack S           blocks stay within (1 + S) ceil(n/N) + K poses and, with the\n"
-    "                            refinement on, above (1 - S) floor(n/N) (default 0.2)\n"
-    "  --block-min-excess K      K of that bound (default 10)\n"
-    "  --cut-passes P            refinement passes at most (default 8)\n"
-    "  --cut-patience K          a pass stops after K moves without a better cut (default 64)\n"
-    "  --no-place-by-links       new poses join their robot's block, not the block holding\n"
-    "                            most of their measurements\n"
-    "  --no-rebalance            blocks stay the robots' (no move at all)\n"
     "  --until S                 play only what is published up to S seconds of stream time\n"
     "                            (a prefix of the mission, e.g. to profile its steps; the\n"
     "                            final cost needs the graph received by then connected)\n"
