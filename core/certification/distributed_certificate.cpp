@@ -311,11 +311,7 @@ void CertificateProtocol::send_schur(std::vector<OutgoingMessage>& out) {
     gate_.add(0, round, kSchur, std::move(m));
     gate_.expect(round, kSchur, everyone());
   } else {
-    OutgoingMessage o;
-    o.message = std::move(m);
-    o.broadcast = false;
-    o.recipients = {0};
-    out.push_back(std::move(o));
+    out.push_back(addressed_to(0, std::move(m)));
     gate_.expect(round, kVerdict, {0});
   }
 }

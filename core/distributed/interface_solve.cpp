@@ -70,7 +70,6 @@ struct InterfaceSolve::Impl {
   // The block's Hessian A_bb (lower triangle, the order above) and Sigma (grounded or not), as
   // positions laid out once and values written at each point (solvers/triplet_scatter.hpp).
   TripletScatter block_pattern, sigma_pattern[2];
-  bool block_pattern_ready = false;
   std::vector<double> block_values;
   mutable Eigen::VectorXd b;  // scratch: J^T v in the block's own order
 };
@@ -217,7 +216,7 @@ std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const 
     G[static_cast<std::size_t>(i)] = pose_basis(X.block(0, i * w, d, d), skew);
   const Eigen::Index n = s.m * p;
   // A's positions are the same at every point: laid out once, then only the values are written.
-  const bool layout = !s.block_pattern_ready;
+  const bool layout = !s.block_pattern.built();
   std::vector<int> rows, cols;
   std::vector<double>& vals = s.block_values;
   vals.clear();
@@ -256,7 +255,6 @@ std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const 
     // The pose pairs are distinct, so no position repeats.
     if (!s.block_pattern.build(n, rows, cols))
       throw std::logic_error("InterfaceSolve: a repeated entry in the block's Hessian");
-    s.block_pattern_ready = true;
   }
   s.block_pattern.fill(vals);
   const bool ok = n > 0 && block.factor(s.block_pattern.matrix());

@@ -485,11 +485,12 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
     // the ones of z' and Phi^T w' = (H Phi)^T z'.
     const Eigen::VectorXd eta = coarse_->times_inverse(
         Eigen::Map<const Eigen::VectorXd>(t.data() + 3 + n, coarse_->size()));
+    const Eigen::VectorXd a_eta = coarse_->times_matrix(eta);
     gamma -= coarse_r_.dot(eta);
-    delta += -2.0 * eta.dot(coarse_w) + eta.dot(coarse_->times_matrix(eta));
+    delta += -2.0 * eta.dot(coarse_w) + eta.dot(a_eta);
     coarse_->expand(X_, -eta, z_);
     coarse_hphi_->subtract(touched_of(eta), w_);
-    coarse_w -= coarse_->times_matrix(eta);
+    coarse_w -= a_eta;
   }
   const bool started = cg_->iterations() > 0;
   if (started && rnorm <= cg_target_) return try_step("residual", out);

@@ -42,7 +42,7 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
       shares_ready_
           ? std::vector<double>{next_shares_.at(static_cast<std::size_t>(state_.id())).front()}
           : interface_->factor(X_, Xn_, egrad_);
-  if (shares_ready_ && state_.id() == 0) {
+  if (shares_ready_ && state_.id() == kSigmaHolder) {
     const std::vector<double> sigma = factor_shipped_sigma();
     values.insert(values.end(), sigma.begin(), sigma.end());
     charge_to(&result_.times.factor_s);
@@ -97,7 +97,6 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
   // symbolic analysis are laid out once (each first assemble() on an agent does both; taking
   // turns on city10000's 3 points cost 183 M instructions in assemble() against 111 M).
   const int n = layout_.num_blocks;
-  sigma_holder_ = 0;
   const std::size_t tail = values.size() - at + (values.front() != 0.0 ? share_tail() : 0);
   std::vector<double> brief{values.front()};
   brief.insert(brief.end(), values.end() - static_cast<std::ptrdiff_t>(tail), values.end());
@@ -106,12 +105,9 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
             make_reduction_message(id, message_round_, kInterface, values));
   for (int b = 0; b < n; ++b) {
     if (b == id) continue;
-    OutgoingMessage o;
-    o.message =
-        make_reduction_message(id, message_round_, kInterface, b == sigma_holder_ ? values : brief);
-    o.broadcast = false;
-    o.recipients = {static_cast<std::uint32_t>(b)};
-    out.push_back(std::move(o));
+    out.push_back(addressed_to(static_cast<std::uint32_t>(b),
+                               make_reduction_message(id, message_round_, kInterface,
+                                                      b == kSigmaHolder ? values : brief)));
   }
   gate_.expect(message_round_, kInterface, everyone_);
   ++result_.reductions;
@@ -125,8 +121,7 @@ std::size_t NewtonRefineProtocol::share_tail() const {
 
 void NewtonRefineProtocol::send_solution(bool ok, std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.sigma_s);
-  const int holder = sigma_holder_;
-  if (state_.id() == holder) {
+  if (state_.id() == kSigmaHolder) {
     Eigen::VectorXd u;
     if (ok) u = interface_->solve(ir_);
     for (int b = 0; b < layout_.num_blocks; ++b) {
@@ -134,31 +129,27 @@ void NewtonRefineProtocol::send_solution(bool ok, std::vector<OutgoingMessage>& 
       if (ok)
         values.insert(values.end(), u.data() + interface_->block_offset(b),
                       u.data() + interface_->block_offset(b) + interface_->block_size(b));
-      PoseBlockMessage m = make_reduction_message(holder, message_round_, kSolution, values);
-      if (b == holder) {
-        gate_.add(holder, message_round_, kSolution, m);
+      PoseBlockMessage m = make_reduction_message(kSigmaHolder, message_round_, kSolution, values);
+      if (b == kSigmaHolder) {
+        gate_.add(kSigmaHolder, message_round_, kSolution, m);
         continue;
       }
-      OutgoingMessage o;
-      o.message = std::move(m);
-      o.broadcast = false;
-      o.recipients = {static_cast<std::uint32_t>(b)};
-      out.push_back(std::move(o));
+      out.push_back(addressed_to(static_cast<std::uint32_t>(b), std::move(m)));
     }
   }
-  gate_.expect(message_round_, kSolution, {holder});
+  gate_.expect(message_round_, kSolution, {kSigmaHolder});
   ++result_.solution_steps;
 }
 
 void NewtonRefineProtocol::after_solution(const MessageGate::Inbox& inbox,
                                           std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.cg_s);
-  const auto found = inbox.find(sigma_holder_);
+  const auto found = inbox.find(kSigmaHolder);
   const auto* m = found == inbox.end() ? nullptr : std::get_if<PoseBlockMessage>(&found->second);
   const std::size_t own = static_cast<std::size_t>(interface_->size());
   if (!m || m->data.size() < 2 || m->data.size() != (m->data[0] != 0.0 ? 2 + own : 2))
     throw std::runtime_error("newton refine: malformed interface solution from agent " +
-                             std::to_string(sigma_holder_));
+                             std::to_string(kSigmaHolder));
   const std::vector<double>& v = m->data;
   if (v[0] == 0.0) {  // no positive definite Sigma at this point: block Jacobi, on every agent
     verdict_due_ = false;
@@ -171,7 +162,6 @@ void NewtonRefineProtocol::after_solution(const MessageGate::Inbox& inbox,
     take_interface_verdict(true);
     reset_cg();
   }
-  charge_to(&result_.times.cg_s);
   z_ = interface_->back_own(X_, iy_r_, v.data() + 2);
   send_public(z_, kDirection, out);
 }
@@ -252,7 +242,7 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
         ++result_.sigma_factorizations;
       }
     }
-  } else if (ok && (!options_.ship_solves || state_.id() == sigma_holder_)) {
+  } else if (ok && (!options_.ship_solves || state_.id() == kSigmaHolder)) {
     ok = assemble_sigma(*interface_, shares, options_.interface_shift);
     ++result_.sigma_factorizations;
   }
@@ -269,7 +259,7 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
   }
   if (options_.ship_solves && all_flags) {
     // Only the holder knows whether Sigma factored: its first solution says so.
-    if (state_.id() == sigma_holder_) {
+    if (state_.id() == kSigmaHolder) {
       if (ok) {
         take_interface_verdict(true);
         reset_cg();
@@ -335,6 +325,8 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   std::vector<char> in_j(static_cast<std::size_t>(own_poses), 0);
   Eigen::MatrixXd hv = Eigen::MatrixXd::Zero(rows, X_.cols());
   std::vector<Eigen::Index> J;
+  // On J's poses: the point and Euclidean gradient (a piece's), a column's v and H v.
+  Eigen::MatrixXd XJ, GJ, VJ, HJ;
   int piece = -1;
   for (std::size_t c = 0; c < touched.size(); ++c) {
     const int u = touched[c];
@@ -356,15 +348,21 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
             J.push_back(j);
           }
       std::sort(J.begin(), J.end());
+      const auto nj = static_cast<Eigen::Index>(J.size());
+      XJ.resize(rows, w * nj);
+      GJ.resize(rows, w * nj);
+      VJ.resize(rows, w * nj);
+      for (Eigen::Index a = 0; a < nj; ++a) {
+        const Eigen::Index from = J[static_cast<std::size_t>(a)] * w;
+        XJ.middleCols(a * w, w) = X_.middleCols(from, w);
+        GJ.middleCols(a * w, w) = egrad_.middleCols(from, w);
+      }
     }
     coarse_->unit(X_, Xn_, u, v, vn);
     const auto nj = static_cast<Eigen::Index>(J.size());
-    Eigen::MatrixXd HJ = Eigen::MatrixXd::Zero(rows, w * nj), XJ(rows, w * nj), GJ(rows, w * nj),
-                    VJ(rows, w * nj);
+    HJ.setZero(rows, w * nj);
     for (Eigen::Index a = 0; a < nj; ++a) {
       const Eigen::Index from = J[static_cast<std::size_t>(a)] * w;
-      XJ.middleCols(a * w, w) = X_.middleCols(from, w);
-      GJ.middleCols(a * w, w) = egrad_.middleCols(from, w);
       VJ.middleCols(a * w, w) = v.middleCols(from, w);
       for (Eigen::Index q = 0; q < w; ++q) {
         for (SparseMatrix::InnerIterator it(qbb, from + q); it; ++it)

@@ -16,13 +16,9 @@ namespace tessera {
 inline void send_public_poses(const AgentState& state, const Eigen::MatrixXd& X, BlockKind kind,
                               const std::vector<int>& recipients, std::uint32_t round,
                               std::uint32_t phase, std::vector<OutgoingMessage>& out) {
-  for (int a : recipients) {
-    OutgoingMessage o;
-    o.message = state.publish(X, kind, a, round, phase);
-    o.broadcast = false;
-    o.recipients = {static_cast<std::uint32_t>(a)};
-    out.push_back(std::move(o));
-  }
+  for (int a : recipients)
+    out.push_back(
+        addressed_to(static_cast<std::uint32_t>(a), state.publish(X, kind, a, round, phase)));
 }
 
 }  // namespace tessera

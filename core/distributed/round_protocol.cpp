@@ -267,11 +267,7 @@ void RoundProtocol::begin_status(ProtocolPhase phase, std::vector<OutgoingMessag
         if (state_.id() == kCoarseSolver) {
           gate_.add(state_.id(), u32(round_), step_of(step), std::move(t));
         } else {
-          OutgoingMessage o;
-          o.message = std::move(t);
-          o.broadcast = false;
-          o.recipients = {u32(kCoarseSolver)};
-          out.push_back(std::move(o));
+          out.push_back(addressed_to(u32(kCoarseSolver), std::move(t)));
         }
       }
     }
@@ -467,13 +463,10 @@ void RoundProtocol::solve_gathered_coarse(const Inbox& inbox, std::vector<Outgoi
   const double decrease = c.cost_before - c.cost_after;
   for (int a = 0; a < layout_.num_blocks; ++a) {
     if (a == state_.id()) continue;
-    OutgoingMessage o;
-    o.message = coarse_motions_message(state_.id(), u32(round_),
+    out.push_back(addressed_to(
+        u32(a), coarse_motions_message(state_.id(), u32(round_),
                                        static_cast<std::uint32_t>(ProtocolPhase::kCoarseMotions),
-                                       coarse_unknowns(a), c.motions, decrease, applied);
-    o.broadcast = false;
-    o.recipients = {u32(a)};
-    out.push_back(std::move(o));
+                                       coarse_unknowns(a), c.motions, decrease, applied)));
   }
   double f = held_.f;
   if (applied) {

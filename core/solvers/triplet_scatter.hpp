@@ -21,6 +21,8 @@ class TripletScatter {
   /// Sets the pattern: an n x n matrix with an entry at each (rows[k], cols[k]), k-th value
   /// in fill()'s order. False (nothing held) where a position repeats or is out of range.
   bool build(Eigen::Index n, const std::vector<int>& rows, const std::vector<int>& cols);
+  /// Whether a pattern is held (the last build() returned true).
+  bool built() const { return n_ >= 0; }
   /// Whether the pattern was built (build() returned true) from exactly these positions.
   bool matches(Eigen::Index n, const std::vector<int>& rows, const std::vector<int>& cols) const;
   /// Writes values[k] to the place of the k-th position (values.size() == the positions').

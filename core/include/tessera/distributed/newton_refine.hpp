@@ -511,7 +511,6 @@ class NewtonRefineProtocol : public AgentProcess {
   // its Galerkin matrix, Phi^T g at the current point, Phi^T r and Phi^T q of the CG
   // (recurrences, as r and q: Phi^T w rides in each iteration's sum).
   std::unique_ptr<TangentCoarseSpace> coarse_;
-  Eigen::MatrixXd coarse_inverse_, coarse_matrix_;
   // Balancing: the own rows of H Phi, one column per touched unknown, on its non-zero poses.
   std::unique_ptr<CoarseHessianColumns> coarse_hphi_;
   Eigen::VectorXd coarse_hy_;  // balancing: this agent's share of (H Phi)^T y
@@ -530,7 +529,9 @@ class NewtonRefineProtocol : public AgentProcess {
   // ship_solves: the point's Sigma verdict is the holder's, not yet known here (it comes with
   // the point's first solution).
   bool verdict_due_ = false;
-  int sigma_holder_ = 0;  // the agent holding Sigma's factor (agent 0)
+  // The agent that assembles and factors Sigma for the team (ship_sigma, ship_solves): always
+  // the same one, so its pattern and symbolic analysis are laid out once.
+  static constexpr int kSigmaHolder = 0;
   Eigen::VectorXd iy_r_, iy_q_, iy_w_, iy_g_, ir_, iq_, ir_g_;
   // The gauge with the interface solves (distributed/gauge_space.hpp): its basis V and H V at
   // the point, the sums V^T V, V^T H V and V^T g (in the interface matrix's sum), and the

@@ -7,6 +7,7 @@
 // the r x (d+1) block [Y_i | p_i] stored column-major.
 
 #include <cstdint>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -59,5 +60,14 @@ struct OutgoingMessage {
   bool broadcast = true;
   std::vector<std::uint32_t> recipients;  ///< Used when broadcast is false.
 };
+
+/// `message` addressed to one agent only.
+inline OutgoingMessage addressed_to(std::uint32_t agent, ProtocolMessage message) {
+  OutgoingMessage o;
+  o.message = std::move(message);
+  o.broadcast = false;
+  o.recipients = {agent};
+  return o;
+}
 
 }  // namespace tessera
