@@ -8,6 +8,24 @@
 
 namespace tessera {
 
+namespace {
+
+// M -= U U^T M in place, U's columns a group's rigid motions (generator j on every piece,
+// normalized; `s` = 1 / pieces): the mean over the pieces of each generator's rows q = j mod g
+// taken out of those rows (each mean is taken before its own rows change and no other rows).
+template <typename Derived>
+void remove_rigid_means(Eigen::MatrixBase<Derived>& M, int g, double s) {
+  const Eigen::Index m = M.rows();
+  for (int j = 0; j < g; ++j) {
+    Eigen::RowVectorXd mean = Eigen::RowVectorXd::Zero(M.cols());
+    for (Eigen::Index q = j; q < m; q += g) mean += M.row(q);
+    mean *= s;
+    for (Eigen::Index q = j; q < m; q += g) M.row(q) -= mean;
+  }
+}
+
+}  // namespace
+
 TangentCoarseSpace::Poses TangentCoarseSpace::weights_of(const CoarseSpace* space,
                                                          const BlockLayout& layout,
                                                          const std::vector<std::size_t>& ids) {
@@ -265,23 +283,15 @@ void TangentCoarseSpace::set_matrix(const double* packed, double tol) {
     // B = P A P with P = I - U U^T (U: the group's rigid motions, generator j on every piece,
     // normalized); U U^T's entries are 1/pieces where the generators agree.
     const double s = 1.0 / static_cast<double>(m / g_);
-    const auto project = [&](const Eigen::MatrixXd& M) {  // P M
-      Eigen::MatrixXd out = M;
-      for (int j = 0; j < g_; ++j) {
-        Eigen::RowVectorXd mean = Eigen::RowVectorXd::Zero(M.cols());
-        for (Eigen::Index q = j; q < m; q += g_) mean += M.row(q);
-        mean *= s;
-        for (Eigen::Index q = j; q < m; q += g_) out.row(q) -= mean;
-      }
-      return out;
-    };
-    Eigen::MatrixXd B = project(project(gm.A).transpose());
+    Eigen::MatrixXd B = gm.A;
+    remove_rigid_means(B, g_, s);
+    B.transposeInPlace();
+    remove_rigid_means(B, g_, s);
     B = (0.5 * (B + B.transpose())).eval();
     const double c = B.diagonal().maxCoeff();
-    Eigen::MatrixXd shifted = B;
     for (Eigen::Index p = 0; p < m; ++p)
-      for (Eigen::Index q = p % g_; q < m; q += g_) shifted(p, q) += c * s;
-    gm.llt.compute(shifted);
+      for (Eigen::Index q = p % g_; q < m; q += g_) B(p, q) += c * s;
+    gm.llt.compute(B);
     bool ok = c > 0 && gm.llt.info() == Eigen::Success;
     if (ok) {
       const Eigen::VectorXd pivots = gm.llt.matrixLLT().diagonal().cwiseAbs2();
@@ -311,20 +321,11 @@ Eigen::VectorXd TangentCoarseSpace::times_inverse(const Eigen::VectorXd& x) cons
       y(idx) = gm.inverse * x(idx);
       continue;
     }
-    const auto m = static_cast<Eigen::Index>(idx.size());
-    const double s = 1.0 / static_cast<double>(m / g_);
-    const auto project = [&](Eigen::VectorXd& v) {  // v -= U U^T v
-      for (int j = 0; j < g_; ++j) {
-        double mean = 0.0;
-        for (Eigen::Index q = j; q < m; q += g_) mean += v(q);
-        mean *= s;
-        for (Eigen::Index q = j; q < m; q += g_) v(q) -= mean;
-      }
-    };
+    const double s = 1.0 / static_cast<double>(static_cast<Eigen::Index>(idx.size()) / g_);
     Eigen::VectorXd v = x(idx);
-    project(v);
+    remove_rigid_means(v, g_, s);
     v = gm.llt.solve(v);
-    project(v);
+    remove_rigid_means(v, g_, s);
     y(idx) = v;
   }
   return y;
