@@ -247,10 +247,7 @@ std::size_t chain_moves(const std::vector<std::vector<std::size_t>>& adjacent,
         continue;
       }
       // The chain heavy -> ... -> to, moved from its far end so each hop's giver has a pose.
-      std::vector<std::size_t> chain{to};
-      while (chain.back() != heavy) chain.push_back(prev[chain.back()]);
-      for (std::size_t k = 0; k + 1 < chain.size(); ++k) hop(chain[k + 1], chain[k]);
-      count += chain.size() - 1;
+      for (std::size_t c = to; c != heavy; c = prev[c], ++count) hop(prev[c], c);
     } else if (light != blocks) {
       const std::size_t from = nearest(light, [&](std::size_t c) { return size[c] > lower; });
       if (from == blocks) {
