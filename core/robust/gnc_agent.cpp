@@ -129,17 +129,17 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
   solve_.reset();
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
-  const bool newton_steps = solve_kind_ == GncSolveKind::kGnc && g_ > first_solve_g_ &&
-                            gnc_refines(options_, *layout_, in_.d);
+  const bool weighted = solve_kind_ == GncSolveKind::kGnc && g_ > first_solve_g_;
+  const bool newton_steps = weighted && gnc_refines(options_, *layout_, in_.d);
   solve_options_ = gnc_solve_options(options_, solve_kind_, pass_capped_, newton_steps);
-  if (solve_kind_ == GncSolveKind::kGnc && g_ > first_solve_g_) {
+  if (weighted) {
     gnc_newton_steps_ = (weighted_solves_ == 0 || gnc_newton_steps_) && newton_steps;
     ++weighted_solves_;
   }
   std::vector<Measurement> measurements;
   if (solve_kind_ == GncSolveKind::kGnc)
-    measurements = gnc_solve_measurements(in_.measurements, weights_, g_ > first_solve_g_,
-                                          terms_->known_connected());
+    measurements =
+        gnc_solve_measurements(in_.measurements, weights_, weighted, terms_->known_connected());
   else
     measurements = kept_;
   const Eigen::MatrixXd Y = state_ ? state_->Y : in_.Y0;
