@@ -128,30 +128,6 @@ RobustOptions parse_robust_options(const Arguments& args) {
   return o;
 }
 
-void add_message_step_fields(JsonObject& json, const RobustMessageSteps& steps) {
-  json.add("total_rounds", steps.rounds)
-      .add("gnc_refine_steps", steps.gnc_refine_steps)
-      .add("gnc_exchange_steps", steps.exchange_steps)
-      .add("final_refine_steps", steps.final_refine_steps)
-      .add("message_steps_total", steps.total());
-}
-
-RobustSummary distributed_robust_summary(const RobustOptions& options, const GncAgentResult& gnc,
-                                         int total_iterations, std::size_t measurements) {
-  RobustSummary rs;
-  rs.options = options;
-  rs.outer_iterations = gnc.outer_iterations;
-  rs.total_iterations = total_iterations;
-  rs.measurements = measurements;
-  rs.rejected = gnc.rejected;
-  rs.threshold_squared = gnc.threshold_squared;
-  rs.weights_converged = gnc.weights_converged;
-  rs.readmitted = gnc.readmitted;
-  rs.probes = gnc.probes;
-  rs.probes_kept = gnc.probes_kept;
-  return rs;
-}
-
 void add_robust_fields(JsonObject& json, const RobustSummary& s) {
   json.add("robust", robust_kind_name(s.options.kind))
       .add("outer_iterations", s.outer_iterations)
@@ -180,6 +156,31 @@ void write_rejected(const std::string& path, const std::vector<std::size_t>& rej
   std::string text;
   for (std::size_t e : rejected) text += std::to_string(e) + "\n";
   write_output(path, text);
+}
+
+void add_distributed_robust_fields(JsonObject& json, const RobustOptions& options,
+                                   const GncAgentResult& gnc, long long rounds,
+                                   std::size_t measurements, long long final_refine_steps) {
+  RobustSummary rs;
+  rs.options = options;
+  rs.outer_iterations = gnc.outer_iterations;
+  rs.total_iterations = static_cast<int>(rounds);
+  rs.measurements = measurements;
+  rs.rejected = gnc.rejected;
+  rs.threshold_squared = gnc.threshold_squared;
+  rs.weights_converged = gnc.weights_converged;
+  rs.readmitted = gnc.readmitted;
+  rs.probes = gnc.probes;
+  rs.probes_kept = gnc.probes_kept;
+  add_robust_fields(json, rs);
+  const long long gnc_refine_steps = gnc.refine_message_steps;
+  const long long exchange_steps = gnc.exchange_steps;
+  json.add("total_rounds", rounds)
+      .add("gnc_refine_steps", gnc_refine_steps)
+      .add("gnc_exchange_steps", exchange_steps)
+      .add("final_refine_steps", final_refine_steps)
+      .add("message_steps_total",
+           2 * rounds + gnc_refine_steps + final_refine_steps + exchange_steps);
 }
 
 }  // namespace tessera::cli

@@ -49,33 +49,22 @@ struct RobustSummary {
   int swap_probes_kept = 0;
 };
 
-/// A distributed robust run's summary: `options`, the agents' result (GncAgentResult: the
-/// in-process driver's GncDistributedResult or agent 0's report over DDS), the rounds of every
-/// solve (total_iterations) and the graph's measurement count.
-RobustSummary distributed_robust_summary(const RobustOptions& options, const GncAgentResult& gnc,
-                                         int total_iterations, std::size_t measurements);
-
 /// Appends robust, outer_iterations, total_iterations, inliers, outliers, rejected,
 /// inlier_threshold_squared, known_inliers, gnc_mu_step, weights_converged, readmitted,
 /// probes, probes_kept, gnc_final_refine (and total_cg_iterations, swap_probes and
 /// swap_probes_kept when set).
 void add_robust_fields(JsonObject& json, const RobustSummary& summary);
 
-/// A distributed robust run's message steps, each a wait for peers (docs/robust.md).
-struct RobustMessageSteps {
-  long long rounds = 0;              ///< Rounds of every solve, final included (two steps each).
-  long long gnc_refine_steps = 0;    ///< The Newton refinements' before the final solve.
-  long long final_refine_steps = 0;  ///< The final solve's Newton refinement's.
-  long long exchange_steps = 0;      ///< GNC's own exchanges (poses, votes, weights, gathers).
-  /// Every wait for peers of the run: 2 x rounds + the other three.
-  long long total() const {
-    return 2 * rounds + gnc_refine_steps + final_refine_steps + exchange_steps;
-  }
-};
-
-/// Appends total_rounds, gnc_refine_steps, gnc_exchange_steps, final_refine_steps and
-/// message_steps_total (`tessera solve` and the coordinator's summary alike).
-void add_message_step_fields(JsonObject& json, const RobustMessageSteps& steps);
+/// A distributed robust run's fields: add_robust_fields of `options` and the agents' result
+/// (GncAgentResult: the in-process driver's GncDistributedResult or agent 0's report over DDS),
+/// with `rounds` (the rounds of every solve, final included) and the graph's `measurements`;
+/// then its message steps, each a wait for peers (docs/robust.md): total_rounds,
+/// gnc_refine_steps, gnc_exchange_steps, final_refine_steps (the final solve's Newton
+/// refinement's, `final_refine_steps`) and message_steps_total = 2 x rounds + the other three
+/// (`tessera solve` and the coordinator's summary alike).
+void add_distributed_robust_fields(JsonObject& json, const RobustOptions& options,
+                                   const GncAgentResult& gnc, long long rounds,
+                                   std::size_t measurements, long long final_refine_steps);
 
 /// Writes one rejected index per line to `path` (InputError when it cannot).
 void write_rejected(const std::string& path, const std::vector<std::size_t>& rejected);

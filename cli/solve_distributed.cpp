@@ -596,10 +596,8 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     }
     if (fstar) j.add("f_star", *fstar);
     if (robust.kind != RobustKind::kNone) {
-      add_robust_fields(
-          j, distributed_robust_summary(robust, gnc, gnc.total_rounds, graph.num_measurements()));
-      add_message_step_fields(j, {gnc.total_rounds, gnc.refine_message_steps,
-                                  gnc.final_refine_message_steps, gnc.exchange_steps});
+      add_distributed_robust_fields(j, robust, gnc, gnc.total_rounds, graph.num_measurements(),
+                                    gnc.final_refine_message_steps);
       j.add("total_bytes", static_cast<long long>(gnc.total_bytes));
     } else {
       // Every wait for peers of the run (docs/robust.md): two a round (docs/irbcd.md) and the

@@ -152,12 +152,9 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     j.add("final_rank", static_cast<long long>(o.rank ? o.rank : 5));
   }
   if (r.robust) {
-    cli::add_robust_fields(
-        j, cli::distributed_robust_summary(o.robust, *r.robust, static_cast<int>(in.merged.rounds),
-                                           in.structure.num_measurements));
-    cli::add_message_step_fields(
-        j, {static_cast<long long>(in.merged.rounds), r.robust->refine_message_steps,
-            r.robust->final_refine_steps, r.robust->exchange_steps});
+    cli::add_distributed_robust_fields(j, o.robust, *r.robust,
+                                       static_cast<long long>(in.merged.rounds),
+                                       in.structure.num_measurements, r.robust->final_refine_steps);
   } else {
     j.add("robust", robust_kind_name(o.robust.kind));
   }
