@@ -56,7 +56,7 @@ class OnlineAgent {
         view_(o.id, o.robots, o.online),
         stream_(o.domain, o.run_id),
         channel_(o.domain, o.run_id, static_cast<std::uint32_t>(o.id),
-                 static_cast<std::uint32_t>(o.robots), o.lease_s),
+                 static_cast<std::uint32_t>(o.robots), o.lease_s, o.online.rebalance),
         start_(Clock::now()),
         block_(o.online) {}
 
@@ -311,7 +311,6 @@ int OnlineAgent::run() {
     transport::OnlineReportSample hello;
     hello.epoch = transport::kHelloEpoch;
     hello.sender = me;
-    hello.rebalance = o_.online.rebalance;
     fig_.report_bytes += channel_.send_report(hello);
   }
   for (;;) {
@@ -354,7 +353,6 @@ bool OnlineAgent::epoch_step() {
     mine.dim = view_.dim();
     mine.pose_ids = block_.own_ids();
     mine.data = block_.own_data();
-    mine.rebalance = o_.online.rebalance;
     if (me == lead_of(epoch_)) {
       if (o_.certify_every_s > 0 && changed_since_certificate_ &&
           since(start_) >= next_certificate_) {
@@ -575,7 +573,6 @@ void OnlineAgent::take_over() {
   mine.dim = view_.dim();
   mine.pose_ids = block_.own_ids();
   mine.data = block_.own_data();
-  mine.rebalance = o_.online.rebalance;
   const TakeoverStepResult step = takeover_step(
       channel_, view_, members(), mine, o_.timeout_s,
       [&] {

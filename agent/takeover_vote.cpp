@@ -55,7 +55,6 @@ TakeoverVoteOutcome hold_takeover_vote(
       v.data = mine.data;
       v.lost.assign(agreement.lost().begin(), agreement.lost().end());
       v.at_epoch = mine.epoch;
-      v.rebalance = mine.rebalance;
       out.bytes_sent += channel.send_report(v);
       count(std::move(v));
       last_progress = Clock::now();

@@ -10,7 +10,6 @@
 #include <map>
 #include <set>
 #include <tessera/online/absorb_gate.hpp>
-#include <tessera/online/block_rebalance.hpp>
 #include <vector>
 
 #include "transport/online_channel.hpp"
@@ -26,7 +25,6 @@ struct OwnVote {
   int rank = 0, dim = 0;    ///< Of its block's poses (dim 0: none yet).
   std::vector<std::uint32_t> pose_ids;
   std::vector<double> data;
-  RebalanceOptions rebalance;  ///< Its re-partition options (every report carries them).
 };
 
 struct TakeoverVoteOutcome {

@@ -125,12 +125,15 @@ int run_online_launch(const std::vector<std::string>& argv) {
       std::fputs(cli::kRebalanceHelp, stdout);
       return 0;
     }
-  std::set<std::string> valued = {"agents",        "rate",          "speedup",       "start",
-                                  "run-id",        "domain",        "algorithm",     "rank",
-                                  "grad-tol",      "timeout",       "json",          "keep-logs",
-                                  "certify-every", "certify-iters", "publish-every", "tum-dir",
-                                  "on-agent-loss", "step-solver",   "newton-after",  "lease"};
+  // Launch's options that every agent gets as they are.
+  static const char* const kForwarded[] = {
+      "algorithm",     "rank",          "grad-tol", "timeout",       "certify-every",
+      "certify-iters", "publish-every", "tum-dir",  "on-agent-loss", "step-solver",
+      "newton-after",  "lease",         nullptr};
+  std::set<std::string> valued = {"agents", "rate",   "speedup", "start",
+                                  "run-id", "domain", "json",    "keep-logs"};
   std::set<std::string> switches = {"online", "no-certify"};
+  for (const char* const* f = kForwarded; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceValued; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceSwitches; *f; ++f) switches.insert(*f);
   const cli::Arguments args(argv, valued, switches);
@@ -182,25 +185,21 @@ int run_online_launch(const std::vector<std::string>& argv) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<Process> procs;
   const std::vector<std::string> common = {"--run-id", run_id, "--domain", std::to_string(domain)};
+  // What every agent gets of launch's own options, in this order.
+  std::vector<std::string> forwarded;
+  auto forward_valued = [&](const char* flag) {
+    if (auto v = args.get(flag)) forwarded.insert(forwarded.end(), {std::string("--") + flag, *v});
+  };
+  for (const char* const* flag = kForwarded; *flag; ++flag) forward_valued(*flag);
+  for (const char* const* flag = cli::kRebalanceValued; *flag; ++flag) forward_valued(*flag);
+  for (const char* const* flag = cli::kRebalanceSwitches; *flag; ++flag)
+    if (args.has(*flag)) forwarded.push_back(std::string("--") + *flag);
+  if (args.has("no-certify")) forwarded.push_back("--no-certify");
   for (long i = 0; i < agents; ++i) {
     std::vector<std::string> a = {bin + "/tessera-agent", "--online", "--robots",
                                   std::to_string(agents), "--id",     std::to_string(i)};
     a.insert(a.end(), common.begin(), common.end());
-    for (const char* flag :
-         {"algorithm", "rank", "grad-tol", "timeout", "certify-every", "certify-iters",
-          "publish-every", "tum-dir", "on-agent-loss", "step-solver", "newton-after", "lease"})
-      if (auto v = args.get(flag)) {
-        a.push_back(std::string("--") + flag);
-        a.push_back(*v);
-      }
-    for (const char* const* flag = cli::kRebalanceValued; *flag; ++flag)
-      if (auto v = args.get(*flag)) {
-        a.push_back(std::string("--") + *flag);
-        a.push_back(*v);
-      }
-    for (const char* const* flag = cli::kRebalanceSwitches; *flag; ++flag)
-      if (args.has(*flag)) a.push_back(std::string("--") + *flag);
-    if (args.has("no-certify")) a.push_back("--no-certify");
+    a.insert(a.end(), forwarded.begin(), forwarded.end());
     a.push_back("--json");
     a.push_back(work + "/agent-" + std::to_string(i) + ".json");
     procs.push_back(

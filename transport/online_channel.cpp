@@ -53,6 +53,7 @@ bool write_patiently(dds::DataWriter* writer, Sample& sample) {
 struct OnlineChannel::Impl : public dds::DataReaderListener {
   std::string run_id;
   std::uint32_t agent;
+  RebalanceOptions rebalance;  // this agent's, written into every report it sends
   dds::DomainParticipant* participant = nullptr;
   dds::Publisher* publisher = nullptr;
   dds::Subscriber* subscriber = nullptr;
@@ -246,8 +247,11 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
 };
 
 OnlineChannel::OnlineChannel(int domain, const std::string& run_id, std::uint32_t agent,
-                             std::uint32_t agents, double lease_s)
-    : impl_(std::make_unique<Impl>(domain, run_id, agent, agents, lease_s)) {}
+                             std::uint32_t agents, double lease_s,
+                             const RebalanceOptions& rebalance)
+    : impl_(std::make_unique<Impl>(domain, run_id, agent, agents, lease_s)) {
+  impl_->rebalance = rebalance;
+}
 OnlineChannel::~OnlineChannel() = default;
 
 std::size_t OnlineChannel::send(const OutgoingMessage& m, std::uint32_t epoch) {
@@ -284,14 +288,15 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   w.certify(r.certify);
   w.lost(r.lost);
   w.at_epoch(r.at_epoch);
+  const RebalanceOptions& own = impl_->rebalance;
   wire::OnlineRebalance& b = w.rebalance();
-  b.enabled(r.rebalance.enabled);
-  b.slack(r.rebalance.slack);
-  b.min_excess(r.rebalance.min_excess);
-  b.cut_fraction(r.rebalance.cut_fraction);
-  b.max_passes(static_cast<std::uint32_t>(r.rebalance.max_passes));
-  b.pass_patience(r.rebalance.pass_patience);
-  b.place_by_links(r.rebalance.place_by_links);
+  b.enabled(own.enabled);
+  b.slack(own.slack);
+  b.min_excess(own.min_excess);
+  b.cut_fraction(own.cut_fraction);
+  b.max_passes(static_cast<std::uint32_t>(own.max_passes));
+  b.pass_patience(own.pass_patience);
+  b.place_by_links(own.place_by_links);
   if (!write_patiently(impl_->report_writer, w))
     throw std::runtime_error("online channel: a report write failed");
   return serialized_size(w);

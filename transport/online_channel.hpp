@@ -36,8 +36,9 @@ struct OnlineReportSample {
   /// epoch it was in; `held` is then what entered its graph.
   std::vector<std::uint32_t> lost;
   std::uint32_t at_epoch = 0;
-  /// The sender's re-partition options: every agent moves the blocks itself, so all must use
-  /// the lead's (agent/online_agent.cpp checks).
+  /// The sender's re-partition options, on received reports (a channel writes its own agent's,
+  /// OnlineChannel's `rebalance`, into every report it sends): every agent moves the blocks
+  /// itself, so all must use the lead's (agent/online_agent.cpp checks).
   RebalanceOptions rebalance;
 };
 
@@ -63,9 +64,10 @@ class OnlineChannel {
  public:
   /// Joins `domain` with partition `run_id` (validated: InputError). `agents` sizes the
   /// history limits. `lease_s`: the participant lease, seconds (a member silent that long is
-  /// lost). Throws std::runtime_error when DDS refuses.
+  /// lost). `rebalance`: this agent's re-partition options, carried by every report it sends.
+  /// Throws std::runtime_error when DDS refuses.
   OnlineChannel(int domain, const std::string& run_id, std::uint32_t agent, std::uint32_t agents,
-                double lease_s = kDefaultOnlineLeaseS);
+                double lease_s = kDefaultOnlineLeaseS, const RebalanceOptions& rebalance = {});
   ~OnlineChannel();
   OnlineChannel(const OnlineChannel&) = delete;
   OnlineChannel& operator=(const OnlineChannel&) = delete;
