@@ -494,10 +494,11 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     for (std::size_t k = 0; k < n.trace.size(); ++k) {
       const NewtonRefineStep& t = n.trace[k];
       std::printf(
-          "    step %zu: %d CG (%s), %d translation CG, predicted %.3g, actual %.3g, %s, f %.12g, "
-          "|grad f| %.3g\n",
-          k + 1, t.cg_iterations, t.cg_stop.c_str(), t.translation_iterations, t.predicted,
-          t.actual, t.accepted ? "accepted" : "rejected", t.cost, t.grad_norm);
+          "    step %zu: %d CG (%s), %d translation CG, radius %.3g, step %.3g, predicted %.3g, "
+          "actual %.3g, %s, f %.12g, |grad f| %.3g\n",
+          k + 1, t.cg_iterations, t.cg_stop.c_str(), t.translation_iterations, t.radius,
+          t.step_norm, t.predicted, t.actual, t.accepted ? "accepted" : "rejected", t.cost,
+          t.grad_norm);
     }
   if (robust.kind != RobustKind::kNone)
     std::printf(

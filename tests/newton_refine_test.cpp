@@ -536,3 +536,51 @@ TEST(NewtonRefine, ProjectedGaugeCgMeetsNoSpuriousNegativeCurvatureFromARoughSta
 
 }  // namespace
 }  // namespace tessera
+
+namespace tessera {
+namespace {
+
+// The corridor's poses composed along its odometry: every step's rotation noise adds up, so
+// the legs start bent far from the optimum, where Hess f is indefinite.
+std::vector<Pose> composed_odometry(const PoseGraph& g) {
+  std::vector<Pose> poses(g.num_poses);
+  poses[0].R = Eigen::Matrix2d::Identity();
+  poses[0].t = Eigen::Vector2d::Zero();
+  for (const Measurement& m : g.measurements) {
+    if (m.j != m.i + 1) continue;
+    poses[m.j].R = poses[m.i].R * m.R;
+    poses[m.j].t = poses[m.i].t + poses[m.i].R * m.t;
+  }
+  return poses;
+}
+
+// Truncated CG that meets negative curvature follows the direction to the trust region's
+// boundary, as one stopped by the boundary does: the step is as long as the radius, and where f
+// falls as the model predicts (ratio above 3/4) the next step's radius is twice as large. From
+// the composed odometry the first CG meets negative curvature at its second iteration and f
+// falls by 1.04e6 where the model predicted 1.01e6. Were only the "boundary" stop counted as
+// cut by the region, the radius would stay where such a step left it.
+TEST(NewtonRefine, ANegativeCurvatureStepOnTheBoundaryThatLowersFAsPredictedDoublesTheRadius) {
+  const PoseGraph g = corridor(500, 3, 0.05, 7);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 5);
+  DistributedOptions o = refined(true);
+  o.grad_norm_tol = 1e300;  // no round: the Newton steps from the composed odometry
+  o.refine.grad_norm_tol = 1e-6;
+  const DistributedResult r = solve_distributed(g, parts, o, composed_odometry(g));
+  ASSERT_EQ(r.refines.size(), 1u);
+  const std::vector<NewtonRefineStep>& trace = r.refines[0].trace;
+  int doubled = 0;
+  for (std::size_t k = 0; k < trace.size(); ++k) {
+    const NewtonRefineStep& t = trace[k];
+    if (t.cg_stop != "negative_curvature") continue;
+    EXPECT_NEAR(t.step_norm, t.radius, 1e-9 * t.radius) << "step " << k;
+    if (t.accepted && t.actual > 0.8 * t.predicted && k + 1 < trace.size()) {
+      EXPECT_EQ(trace[k + 1].radius, 2.0 * t.radius) << "step " << k;
+      ++doubled;
+    }
+  }
+  EXPECT_GE(doubled, 1);
+}
+
+}  // namespace
+}  // namespace tessera

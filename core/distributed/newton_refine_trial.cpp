@@ -88,9 +88,13 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
   const double ft = t[0], gt = std::sqrt(std::max(0.0, t[1]));
   ++result_.steps;
   const double actual = f_ - ft;
+  step_.step_norm = scale_ * std::sqrt(std::max(0.0, cg_->step_norm2()));
+  // Cut by the trust region (Manopt's limitedbyTR): CG stopped at its boundary or followed
+  // negative curvature to it (after_sums takes both to the radius). Were only the first
+  // counted, steps that meet negative curvature every time would never grow the region.
+  const bool on_boundary = step_.cg_stop == "boundary" || step_.cg_stop == "negative_curvature";
   const TrustRegionVerdict verdict = judge_trust_region_step(
-      f_, ft, step_.predicted, scale_ * std::sqrt(std::max(0.0, cg_->step_norm2())), radius_,
-      step_.cg_stop == "boundary", options_.accept_ratio);
+      f_, ft, step_.predicted, step_.step_norm, radius_, on_boundary, options_.accept_ratio);
   step_.actual = actual;
   step_.accepted = verdict.accepted;
   radius_ = verdict.radius;

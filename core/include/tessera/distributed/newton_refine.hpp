@@ -288,8 +288,11 @@ std::string sigma_mode(const NewtonRefineOptions& options);
 /// One trust-region step, identical on every agent.
 struct NewtonRefineStep {
   int cg_iterations = 0;
-  int translation_iterations = 0;        ///< Of the trial point's translation CG.
-  double radius = 0.0;                   ///< Trust radius the step was computed in (0 = unbounded).
+  int translation_iterations = 0;  ///< Of the trial point's translation CG.
+  double radius = 0.0;             ///< Trust radius the step was computed in (0 = unbounded).
+  /// Length of the step taken, in the radius's (the preconditioner's) norm: the radius itself
+  /// where CG stopped on the boundary or at negative curvature.
+  double step_norm = 0.0;
   double predicted = 0.0, actual = 0.0;  ///< Decreases of the model and of f.
   bool accepted = false;
   /// residual, boundary, negative_curvature or cap; backtrack: the last CG step scaled down
