@@ -10,7 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <random>
@@ -78,6 +80,42 @@ TEST(OnlineSmoothedCoarse, TheCholeskyInverseIsThePseudoInverseOfTheGalerkinMatr
   // Indefinite (negative curvature along some combination): the eigendecomposition's fallback,
   // which drops the negative eigenvalues as pseudo_inverse does.
   expect_kept_matrix_is_the_pseudo_inverse(M + M.transpose());
+}
+
+// A positive definite group block with one direction (not a rigid motion of the group) of
+// curvature 2e-11 of the largest: its Cholesky pivots stay above 1e-10 of the largest, but the
+// direction is left out of the inverse as pseudo_inverse leaves it out, not multiplied by 5e10.
+TEST(OnlineSmoothedCoarse, ADirectionOfNearlyNoCurvatureIsLeftOutOfTheCoarseInverse) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  const Eigen::Index m = 12, g = 6;  // the group: blocks 0 and 1, 6 generators each
+  Eigen::MatrixXd M(m, m);
+  for (Eigen::Index i = 0; i < M.size(); ++i) M.data()[i] = normal(rng);
+  // P S P, P = I - U U^T with U the group's rigid motions (generator j on both pieces).
+  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(m, g);
+  for (Eigen::Index q = 0; q < m; ++q) U(q, q % g) = 1.0 / std::sqrt(2.0);
+  const Eigen::MatrixXd P = Eigen::MatrixXd::Identity(m, m) - U * U.transpose();
+  const Eigen::MatrixXd S = P * (M * M.transpose() + Eigen::MatrixXd::Identity(m, m)) * P;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
+  // Eigenvalues 0 (x6, the rigid motions) then the six others: the smallest of those set to
+  // 2e-11 of the largest.
+  Eigen::VectorXd l = eig.eigenvalues();
+  const double top = l(m - 1);
+  l(g) = 2e-11 * top;
+  const Eigen::MatrixXd& V = eig.eigenvectors();
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(18, 18);
+  A.topLeftCorner(m, m) = V * l.asDiagonal() * V.transpose();
+  expect_kept_matrix_is_the_pseudo_inverse(A);
+
+  const BlockLayout layout = two_groups();
+  TangentCoarseSpace c(nullptr, layout, layout.poses[0], {15}, 3, 3);
+  std::vector<double> packed;
+  c.pack(A, packed);
+  c.set_matrix(packed.data());
+  Eigen::VectorXd flat = Eigen::VectorXd::Zero(c.size());
+  flat.head(m) = V.col(g);
+  // Kept, the inverse would be 5e10 / top along it; left out, round-off of the other inverses.
+  EXPECT_LT(c.times_inverse(flat).norm(), 1e-3 / l(g + 1));
 }
 
 GeneratorResult grid(std::size_t n, std::size_t robots) {

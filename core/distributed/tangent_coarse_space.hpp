@@ -97,8 +97,10 @@ class TangentCoarseSpace {
   /// Keeps the summed packed numbers as A, block by block, and A^+ (as pseudo_inverse(), but
   /// from a Cholesky factor of each group's projected block plus its rigid motions, P (B + c U
   /// U^T)^-1 P: n^3 / 3 flops against the eigendecomposition's ~10 n^3, which it falls back to
-  /// where that factor fails or has a pivot at or below `tol` times the largest: negative
-  /// curvature, or a generator that moves no pose).
+  /// where that factor fails, has a pivot at or below `tol` times the largest, or its smallest
+  /// eigenvalue, estimated by inverse iteration with the factor, is at or below `tol` times the
+  /// largest diagonal entry: negative curvature, a generator that moves no pose, or a direction
+  /// of nearly no curvature, which pseudo_inverse() drops too).
   void set_matrix(const double* packed, double tol = 1e-10);
   /// A x and A^+ x with the kept A (x and the result: size() entries; zero outside the groups).
   Eigen::VectorXd times_matrix(const Eigen::VectorXd& x) const;
