@@ -208,7 +208,7 @@ struct NewtonRefineOptions {
   /// this) and the refinement always runs. Why: with exact interface solves (and exact trial
   /// translations) a Newton step costs a few message steps even from a rough point, where the
   /// rounds' last decades cost hundreds: in process at N = 5, message steps from gradient 1
-  /// against 30: kitti_02 663 -> 123, ais2klinik 127 -> 31, city10000 109 -> 27, the same
+  /// against 30: kitti_02 661 -> 125, ais2klinik 121 -> 33, city10000 111 -> 30, the same
   /// certified optimum (docs/newton-refine.md, "Handing over"). 0 = off (the rounds' tail
   /// alone decides). >= 0.
   double auto_interface_grad_tol = 30.0;
