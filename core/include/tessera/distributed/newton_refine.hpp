@@ -178,8 +178,8 @@ struct NewtonRefineOptions {
   /// point then costs one all-agent sum (each block's interface residual, its interface poses x
   /// the iterate's rows) and no exchange: the solve's interface values are the neighbours' new
   /// public translations. A block whose L_BB is singular (a pose without measurements) sends
-  /// a flag and the team keeps the CG. Why: the CG took 123 iterations (two message steps
-  /// each) over ais2klinik's 10 trial points, 80 % of the refinement's 305 message steps
+  /// a flag and the team keeps the CG. Why: the CG took 120 iterations (two message steps
+  /// each) over ais2klinik's 9 trial points, 80 % of the refinement's 299 message steps
   /// (docs/newton-refine.md, "Exact trial translations"). >= 0; 0 = off (the CG above).
   int translation_interface_max_poses = 2000;
   /// Preconditioner: exact solves with the Hessian through the team's interface
