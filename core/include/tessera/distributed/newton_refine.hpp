@@ -193,15 +193,17 @@ struct NewtonRefineOptions {
   /// and with kShipSolves agent 0's solution. Used at rank d with `coarse` kNone. A block whose
   /// Hessian block is not positive definite (far from a minimiser) factors it without the
   /// multiplier term (then M is the inverse of that modified H); where no block factor or no Sigma
-  /// is positive definite, that point's CG runs block Jacobi. Why 1,000: every agent factors Sigma
-  /// at every point (CHOLMOD supernodal; dense within each block's interface, so its cost grows up
-  /// to size^3 / 3) and receives every Schur complement. city10000's 909 coordinates at N = 5 (cap
-  /// 1,000 against 500, in process): rounds 142 -> 48, the refinement's CG 2 iterations, 5.38
-  /// against 6.94 billion instructions for the whole solve (callgrind), same certified optimum;
-  /// cubicle's 1,572 cut its CG iterations 116 -> 3 but doubled the CPU of the whole solve and
-  /// multiplied the bytes by 8 (4.9 -> 40.6 MB), so it stays out, as do torus3D (2,916) and
-  /// sphere2500 (2,088); parking-garage (348) and ais2klinik (102) gain 4-9x
-  /// (docs/newton-refine.md). >= 0.
+  /// is positive definite, that point's CG runs block Jacobi. Why 1,000: Sigma's factorization
+  /// (CHOLMOD supernodal; dense within each block's interface) grows up to size^3 / 3. Chosen
+  /// when every agent factored Sigma at every point and received every Schur complement:
+  /// city10000's 909 coordinates at N = 5 (cap 1,000 against 500, in process): rounds 142 -> 48,
+  /// the refinement's CG 2 iterations, 5.38 against 6.94 billion instructions for the whole solve
+  /// (callgrind), same certified optimum; cubicle's 1,572 cut its CG iterations 116 -> 3 but then
+  /// doubled the CPU of the whole solve and multiplied the bytes by 8 (4.9 -> 40.6 MB), so it
+  /// stayed out, as did torus3D (2,916) and sphere2500 (2,088). With kShipSolves, the default
+  /// from ship_solves_min_coordinates, that cost is agent 0's alone (cubicle 4.9 -> 4.8 MB, user
+  /// CPU 0.6x, loaded); the cap has not been re-chosen since (docs/newton-refine.md, "Cap").
+  /// parking-garage (348) and ais2klinik (102) gain 4-9x. >= 0.
   int interface_max_coordinates = 1000;
   /// kIfRoundsSlow: where the interface solves apply (the team's interface within
   /// interface_max_coordinates), the rounds stop at max(the solver's grad_norm_tol,
