@@ -225,7 +225,7 @@ struct NewtonRefineOptions {
   /// (the grounded Sigma's inverse, projected, is its preconditioner); false, CG solves the
   /// equation with the grounded pose held and the step is projected off the gauge once.
   /// Why false: on the paper graphs at N = 5 both take the same steps, CG iterations and
-  /// message steps, and projecting costs 4 % more instructions (city10000) and 5-24 % more
+  /// message steps, and projecting costs 5 % more instructions (city10000) and 10-27 % more
   /// bytes; from a rough start on a 1,000-pose corridor the grounded CG meets negative
   /// curvature along the gauge (6 steps, one rejected, 36 message steps; projected: 4, 31)
   /// (docs/newton-refine.md, "Gauge").
