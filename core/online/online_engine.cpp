@@ -223,6 +223,17 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
   return solver;
 }
 
+void use_online_refine_space(const LiveBlocks& blocks, const DistributedOptions& solver) {
+  if (!solver.refine.enabled || solver.refine.coarse != NewtonRefineOptions::Coarse::kSmoothed)
+    return;
+  const PoseGraph& g = blocks.graph();
+  // One space shared by every held state.
+  const auto space = std::make_shared<const CoarseSpace>(make_coarse_space(
+      g.num_poses, g.measurements, blocks.layout().owner, solver.refine.coarse_space_options()));
+  for (const auto& s : blocks.states())
+    if (s) s->use_refine_space(space);
+}
+
 DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
   DistributedResult res;
   if (!blocks_)
@@ -233,14 +244,7 @@ DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
   if (blocks_->graph().num_poses == 0) return res;
   DistributedOptions run = solver;
-  if (run.refine.enabled && run.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed) {
-    // The smoothed pieces follow the linked graph and its blocks, which change at every step:
-    // built again here (a pass over the measurements), one space shared by every agent.
-    const PoseGraph& g = blocks_->graph();
-    const auto space = std::make_shared<const CoarseSpace>(make_coarse_space(
-        g.num_poses, g.measurements, blocks_->layout().owner, run.refine.coarse_space_options()));
-    for (AgentState* s : blocks_->all_states()) s->use_refine_space(space);
-  }
+  use_online_refine_space(*blocks_, run);
   run.round_result = false;  // in the linked graph's ids: the caller rounds X_
   res = solve_distributed_with_states(blocks_->graph(), blocks_->layout(), blocks_->all_states(),
                                       run);
