@@ -81,6 +81,8 @@ class LiveBlocks {
   /// tangent_factorizations_total and tangent_factor_flops_total, states built again or dropped
   /// included).
   TangentFactorTotals tangent_factor_totals() const;
+  /// Block states built from scratch by every sync so far (LiveSync::built summed).
+  long long built_total() const { return built_total_; }
   /// Writes the compact iterate `Xc` (rank = X's rows) into the stream-id iterate `X`.
   void write_back(const Eigen::MatrixXd& Xc, Eigen::MatrixXd& X) const;
 
@@ -92,6 +94,7 @@ class LiveBlocks {
 
   int d_;
   TangentFactorTotals retired_;  // of the states dropped or built again
+  long long built_total_ = 0;
   BlockUpdateOptions update_;
   double refactor_growth_;
   int only_block_;
