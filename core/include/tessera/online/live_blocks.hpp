@@ -46,7 +46,7 @@ struct TangentFactorTotals {
 /// What one LiveBlocks::sync did.
 struct LiveSync {
   std::size_t new_poses = 0, new_measurements = 0;  ///< Linked poses / measurements added.
-  int built = 0;     ///< Block states built from scratch (new blocks, re-partitioned blocks).
+  int built = 0;     ///< Block states built from scratch (new blocks, blocks a move changed).
   int extended = 0;  ///< Block states grown in place.
   int kept = 0;      ///< Block states with nothing new.
 };
