@@ -139,6 +139,7 @@ JsonObject update_json(const OnlineUpdate& u) {
       .add("relaxation_cost", u.relaxation_cost)
       .add("factorizations", u.factorizations)
       .add("factor_flops", u.factor_flops)
+      .add("blocks_built", u.blocks_built)
       .add("merges", u.merges)
       .add("merge_poses_moved", u.merge_poses_moved);
   return j;

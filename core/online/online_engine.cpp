@@ -101,6 +101,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   if ((u.poses == 0 && u.measurements == 0 && converged_) || graph.num_poses == 0) return u;
   const TangentFactorTotals factors_before =
       blocks_ ? blocks_->tangent_factor_totals() : TangentFactorTotals{};
+  const long long built_before = blocks_ ? blocks_->built_total() : 0;
 
   // New poses join a block (their robot's, or the one holding most of their measurements);
   // then the blocks follow the graph's growth and cut.
@@ -175,6 +176,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     const TangentFactorTotals step = blocks_->tangent_factor_totals().since(factors_before);
     u.factorizations = step.factorizations;
     u.factor_flops = step.flops;
+    u.blocks_built = blocks_->built_total() - built_before;
   }
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;

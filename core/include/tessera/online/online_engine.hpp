@@ -194,6 +194,9 @@ struct OnlineUpdate {
   /// preconditioner's cost, free of the machine's load.
   long long factorizations = 0;
   double factor_flops = 0.0;
+  /// Block states built from scratch in this step's set-up (LiveBlocks::sync: new blocks, and
+  /// the blocks a re-partition gave or took poses); the others grew in place or were kept.
+  long long blocks_built = 0;
   /// OnlineOptions::align_merged_pieces: measurements that linked two pieces of the graph at
   /// this step, and the poses moved to align them.
   std::size_t merges = 0;
