@@ -154,6 +154,15 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
         make_coarse_space(in_.num_poses, solve_structure(), in_.owner,
                           solve_options_.refine.coarse_space_options())));
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
+  trial_pending_ = poses_sent_early_ = poses_early_stale_ = false;
+  if (newton_steps && send_poses_with_trial())
+    solve_->set_trial_observer([this](const Eigen::MatrixXd& Y) {
+      // One trial per solve (a single Newton step); after rounds the iterate the last pose
+      // exchange holds is not the solve's start, so those take the exchange of their own.
+      if (poses_sent_early_ || trial_pending_ || solve_->total_rounds() > 0) return;
+      trial_Y_ = Y;
+      trial_pending_ = true;
+    });
   pass_on(solve_->start(), out);
   const std::uint32_t g = g_;
   // Messages of this solve that came while this agent was behind; once the solve has ended,
@@ -180,12 +189,23 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> GncAgent::solve_structure()
 }
 
 // The inner solve's messages, tagged with this GNC step.
-void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out,
-                       std::vector<OutgoingMessage>& out) const {
+void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) {
   for (auto& o : solve_out) {
     std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
     out.push_back(std::move(o));
   }
+  if (trial_pending_) {
+    // Beside the trial's sums, which every agent waits for anyway: this step's pose exchange.
+    exchange_->publish(trial_Y_, BlockKind::kY, gnc_phase(g_, GncExchange::kPoses), out);
+    trial_pending_ = false;
+    poses_sent_early_ = true;
+  }
+}
+
+bool GncAgent::send_poses_with_trial() const {
+  // Every agent decides the same: the options, and the outer loop's state (the summed votes).
+  return options_.robust.exchanges_ride_along && options_.robust.gnc_refine_steps == 1 &&
+         !outer_->over(options_.robust);
 }
 
 GncExchange GncAgent::exchange() const {
@@ -223,9 +243,10 @@ void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
   if (!ready) return;
   // Read into the book, or the agent's own data the exchange changes.
   for (const ProtocolMessage& m : *ready)
-    exchange_->read(exchange(), m,
-                    GncExchangeTargets{weights_, zero_cut_, rejected_, *recheck_,
-                                       state_ ? state_->Y.rows() : in_.Y0.rows()});
+    if (!(step_ == Step::kPoses && poses_early_stale_))
+      exchange_->read(exchange(), m,
+                      GncExchangeTargets{weights_, zero_cut_, low_weights_, rejected_, *recheck_,
+                                         state_ ? state_->Y.rows() : in_.Y0.rows()});
   after_exchange(out);
 }
 
@@ -240,6 +261,22 @@ void GncAgent::require_kept_connected() const {
                      std::to_string(parts) +
                      " unconnected parts, so no estimate is defined (too few consistent "
                      "measurements; try --known-inliers odometry or a larger --inlier-threshold)");
+}
+
+void GncAgent::begin_rejected(std::vector<OutgoingMessage>& out) {
+  // No weight exchange yet (nothing could be an outlier), or the rejected set's own exchange.
+  if (outer_->outer() == 0 || !options_.robust.exchanges_ride_along) {
+    begin_exchange(Step::kRejected, out);
+    return;
+  }
+  // The weights have not changed since the last weight exchange (a last weighted solve moves
+  // only the iterate), which brought every other agent's weights below 1/2: the rejected set is
+  // known here as the exchange would have brought it, with TLS's verdict after an early end.
+  rejected_ = rejected_by_weight(*terms_, in_.measurement_index, weights_);
+  for (const auto& [id, w] : low_weights_)
+    if ((jumped_ ? tls_verdict_weight(w, outer_->mu()) : w) < 0.5) rejected_.push_back(id);
+  step_ = Step::kRejected;
+  after_exchange(out);
 }
 
 void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
@@ -449,8 +486,14 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     return;
   }
   if (g_ > first_solve_g_ && outer_->over(options_.robust)) {
-    begin_exchange(Step::kRejected, out);
+    begin_rejected(out);
     return;
+  }
+  if (poses_sent_early_) {
+    // The trial's poses are the iterate's when the step was accepted (the same on every agent:
+    // the verdict is on summed values); otherwise the iterate is the solve's start.
+    const std::vector<NewtonRefineResult>& r = solve_->refines();
+    poses_early_stale_ = !(r.size() == 1 && r.front().accepted_steps == 1);
   }
   begin_exchange(Step::kPoses, out);
 }
@@ -465,20 +508,24 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kVotes:
       outer_->start(exchange_->largest_vote(), terms_->c2(), options_.robust);
-      begin_exchange(outer_->converged() ? Step::kRejected : Step::kWeights, out);
+      if (outer_->converged())
+        begin_rejected(out);
+      else
+        begin_exchange(Step::kWeights, out);
       return;
     case Step::kWeights: {
       const auto [spread, crossed] = exchange_->summed_votes();
       const bool jump =
           outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
                                options_.robust, gnc_newton_steps_);
+      jumped_ = jump;
       if (jump)
         for (std::size_t k = 0; k < weights_.size(); ++k)
           if (terms_->may_reject(k) && !dropped_[k])
             weights_[k] = tls_verdict_weight(weights_[k], outer_->mu());
       if (weight_observer_) weight_observer_(outer_->outer(), in_.measurement_index, weights_);
       if (jump) {
-        begin_exchange(Step::kRejected, out);
+        begin_rejected(out);
         return;
       }
       if (terms_->known_connected()) {

@@ -32,7 +32,9 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   exchange_->begin();
   // A gather at agent 0 (the consistency check's values, the kept set's start) waits twice: for
   // the values, then for agent 0's answer.
-  exchange_steps_ += step == Step::kPcm || step == Step::kKeptStart ? 2 : 1;
+  // The poses sent beside a weighted solve's trial sums are no step of their own.
+  const bool early = step == Step::kPoses && poses_sent_early_;
+  exchange_steps_ += step == Step::kPcm || step == Step::kKeptStart ? 2 : early ? 0 : 1;
   // Whom this agent hears from: a pose exchange from its block neighbours (each sends what it
   // was sent), a status exchange from every other agent.
   std::vector<int> from = base_->adjacent[static_cast<std::size_t>(in_.id)];
@@ -46,6 +48,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // Weights are computed at the iterate itself: the owners' public poses of every
       // measurement (the base layout: a measurement out of the current solve still needs
       // its residual).
+      if (early) {
+        if (!poses_early_stale_) exchange_->expect_poses(state_->Y.rows(), false);
+        break;
+      }
       exchange_->expect_poses(state_->Y.rows(), false);
       exchange_->publish(state_->Y, BlockKind::kY, phase, out);
       break;
@@ -89,6 +95,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       to_others(vote_message(exchange_->own_vote()));
       break;
     case Step::kWeights: {
+      low_weights_.clear();
       const int crossed = weights_at_mu(outer_->mu());
       const double spread = weight_spread(*terms_, weights_);
       const int near =
@@ -103,7 +110,8 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
       from = as_ints(others);
       for (std::uint32_t a : others) {
-        RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_);
+        RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_,
+                                                options_.robust.exchanges_ride_along);
         st.phase = phase;
         st.sender = me;
         out.push_back(OutgoingMessage{std::move(st), false, {a}});

@@ -112,7 +112,7 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
       const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
       votes_[sender] = {st.grad_norm_sq, st.cost};
       near_bound_[sender] = st.near_bound;
-      read_weights_message(st, sender, in_, to.weights, to.zero_cut);
+      read_weights_message(st, sender, in_, to.weights, to.zero_cut, to.low_weights);
       break;
     }
     case GncExchange::kRejected: {

@@ -24,6 +24,7 @@ namespace tessera {
 struct GncExchangeTargets {
   std::vector<double>& weights;
   std::vector<std::uint64_t>& zero_cut;
+  std::vector<std::pair<std::uint64_t, double>>& low_weights;
   std::vector<std::uint64_t>& rejected;
   RecheckVerdict& recheck;
   Eigen::Index rank;  // rows of the own block (the kept set's start is read at it)

@@ -57,7 +57,7 @@ RoundStatusMessage vote_message(const std::pair<double, double>& sums) {
 
 RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed, int near_bound,
                                    const GncAgentInput& in, const GncLocalTerms& terms,
-                                   const std::vector<double>& weights) {
+                                   const std::vector<double>& weights, bool low_too) {
   RoundStatusMessage st;
   st.grad_norm_sq = spread;
   st.cost = crossed;
@@ -66,7 +66,8 @@ RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed,
     const Measurement& m = in.measurements[k];
     const auto other = static_cast<std::uint32_t>(in.owner[std::max(m.i, m.j)]);
     const bool cut = in.owner[m.i] != in.owner[m.j];
-    if (other == to || (terms.known_connected() && cut && weights[k] == 0)) {
+    if (other == to || (terms.known_connected() && cut && weights[k] == 0) ||
+        (low_too && terms.may_reject(k) && weights[k] < 0.5)) {
       st.measurement_ids.push_back(in.measurement_index[k]);
       st.weights.push_back(weights[k]);
     }
@@ -76,7 +77,8 @@ RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed,
 
 void read_weights_message(const RoundStatusMessage& st, std::uint32_t sender,
                           const GncAgentInput& in, std::vector<double>& weights,
-                          std::vector<std::uint64_t>& zero_cut) {
+                          std::vector<std::uint64_t>& zero_cut,
+                          std::vector<std::pair<std::uint64_t, double>>& low) {
   const std::string me = agent_prefix(in.id);
   if (st.weights.size() != st.measurement_ids.size())
     throw std::runtime_error(me + "weights from agent " + std::to_string(sender) +
@@ -90,7 +92,9 @@ void read_weights_message(const RoundStatusMessage& st, std::uint32_t sender,
                                " sent the weight of measurement " + std::to_string(id) +
                                ", not its own");
     if (const auto k = position_of(in.measurement_index, id)) weights[*k] = st.weights[q];
-    if (st.weights[q] == 0) zero_cut.push_back(id);
+    const auto [i, j] = in.structure[id];
+    if (st.weights[q] == 0 && in.owner[i] != in.owner[j]) zero_cut.push_back(id);
+    if (st.weights[q] < 0.5) low.emplace_back(id, st.weights[q]);
   }
 }
 
