@@ -35,8 +35,10 @@ TEST(GncExchangeSteps, EachOuterStepTakesAPoseAndAWeightExchange) {
 
 // RobustOptions::exchanges_ride_along: where GNC's weighted solves are single Newton steps (the
 // interface fits on the 125-pose grid), the poses of each weight update travel beside the
-// trial's sums and the rejected set with the last weights; the run is otherwise the same.
-TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasWithOneStepFewerAnOuterStep) {
+// trial's sums, the rejected set with the last weights, the values agent 0 needs for the kept
+// set's fresh start with mu's start votes and the start's neighbour poses with agent 0's
+// answer; the run is otherwise the same.
+TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
   using Weights = std::tuple<int, int, std::vector<std::uint64_t>, std::vector<double>>;
   auto run = [&](bool ride_along, std::vector<Weights>& seen) {
@@ -68,8 +70,10 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasWithOneStepFewerA
   EXPECT_EQ(along.final_solve.cost, apart.final_solve.cost);
   EXPECT_TRUE(along.final_solve.certified.value_or(false));
   // The pose exchange before each weight update but the first (which follows the plain solve's
-  // rounds), and the rejected set's exchange.
-  EXPECT_EQ(apart.exchange_steps - along.exchange_steps, apart.outer_iterations);
+  // rounds) and the rejected set's exchange; at the kept set's fresh start (one, after GNC's
+  // early end: the iterate's poses are the last weight update's) the values' way to agent 0 and
+  // the pose exchange of both starts.
+  EXPECT_EQ(apart.exchange_steps - along.exchange_steps, apart.outer_iterations + 2);
 }
 
 }  // namespace

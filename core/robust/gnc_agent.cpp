@@ -127,6 +127,7 @@ std::vector<OutgoingMessage> GncAgent::start() {
 
 void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
+  neighbours_current_ = false;
   solve_.reset();
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
   const bool weighted = solve_kind_ == GncSolveKind::kGnc && g_ > first_solve_g_;
@@ -200,6 +201,12 @@ void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out, std::vector<Outgo
     trial_pending_ = false;
     poses_sent_early_ = true;
   }
+}
+
+bool GncAgent::gather_values_early() const {
+  // Not with pcm-gnc (its check gathers at agent 0 already, and consumes them) nor without a
+  // fresh start to use them; the same on every agent.
+  return options_.robust.exchanges_ride_along && fresh_start_ && !in_.pcm && in_.num_agents > 1;
 }
 
 bool GncAgent::send_poses_with_trial() const {
@@ -372,12 +379,28 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   // Agent 0: the kept set's initialization, each agent's block sent, its own kept.
   const Eigen::MatrixXd X = kept_set_start(exchange_->kept_values(), in_, rejected_.size(),
                                            static_cast<int>(state_->Y.rows()));
+  // With values_held_, each agent's neighbours' poses of the start too (the poses of other
+  // agents at the ends of its measurements, as GncLocalTerms::neighbours() lists them): no pose
+  // exchange of the start follows.
+  std::vector<std::vector<std::size_t>> nb(static_cast<std::size_t>(in_.num_agents));
+  if (values_held_) {
+    for (const auto& [i, j] : in_.structure)
+      if (in_.owner[i] != in_.owner[j]) {
+        nb[static_cast<std::size_t>(in_.owner[i])].push_back(j);
+        nb[static_cast<std::size_t>(in_.owner[j])].push_back(i);
+      }
+    for (auto& ids : nb) {
+      std::sort(ids.begin(), ids.end());
+      ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    }
+    exchange_->candidate_neighbours() = block_of(X, terms_->neighbours(), in_.d);
+  }
   for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
-    out.push_back(
-        OutgoingMessage{kept_start_block(block_of(X, base_->poses[a], in_.d), base_->poses[a],
-                                         in_.d, gnc_phase(g_, GncExchange::kKeptStart)),
-                        false,
-                        {a}});
+    out.push_back(OutgoingMessage{
+        kept_start_block(block_of(X, base_->poses[a], in_.d), base_->poses[a], in_.d,
+                         gnc_phase(g_, GncExchange::kKeptStart), block_of(X, nb[a], in_.d), nb[a]),
+        false,
+        {a}});
   exchange_->candidate() = block_of(X, base_->poses[0], in_.d);
 }
 
@@ -437,6 +460,7 @@ void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out, double ri
   late_rejected_ = base.late_rejected;
   // The own block has the same shape whatever the kept set: the next pass starts from it.
   state_->Y = std::move(base.Y);
+  neighbours_current_ = false;
   if (search_) {
     // The next probe starts from the restored set and iterate, which the passes had settled.
     search_->refused(rise, base.tls);
@@ -501,6 +525,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
 void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   switch (step_) {
     case Step::kPoses:
+      neighbours_current_ = true;
       if (solve_kind_ == GncSolveKind::kInlierPass)
         begin_exchange(Step::kReadmitted, out);
       else
@@ -550,6 +575,12 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kKeptStart:
       if (in_.id == 0) start_kept_set(out);
+      // Both starts' neighbour poses are here already: the iterate's from the last pose
+      // exchange, the fresh start's from agent 0.
+      if (values_held_ && neighbours_current_) {
+        begin_exchange(Step::kCandidateVotes, out);
+        return;
+      }
       begin_exchange(Step::kCandidatePoses, out);
       return;
     case Step::kPcm: {
@@ -582,13 +613,17 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     }
     case Step::kCandidatePoses:
+      neighbours_current_ = true;
       begin_exchange(Step::kCandidateVotes, out);
       return;
     case Step::kCandidateVotes: {
       const auto [at_iterate, at_candidate] = exchange_->summed_votes();
       fresh_start_costs_.emplace_back(rejected_, at_candidate);
       const bool fresh = at_candidate < at_iterate;
-      if (fresh) state_->Y = exchange_->candidate();
+      if (fresh) {
+        state_->Y = exchange_->candidate();
+        neighbours_current_ = false;
+      }
       exchange_->candidate().resize(0, 0);
       exchange_->forget_candidate_neighbours();
       last_pass_full_ = false;

@@ -75,12 +75,17 @@ RoundStatusMessage readmitted_message(const RecheckVerdict& verdict, double tls_
 void read_readmitted_message(const RoundStatusMessage& st, std::uint32_t sender, int receiver,
                              RecheckVerdict& into);
 
-/// Agent 0's message of another agent's block Y of the kept set's start (poses `ids`).
+/// Agent 0's message of another agent's block Y of the kept set's start (poses `ids`), then the
+/// start's poses `nb_ids` of the agent's neighbours (columns of `nb`; none when empty).
 PoseBlockMessage kept_start_block(const Eigen::MatrixXd& Y, const std::vector<std::size_t>& ids,
-                                  int d, std::uint32_t phase);
-/// The own block of the kept set's start (r x (d+1)|own|) from agent 0's `block`. Throws
-/// std::runtime_error naming `receiver` when it is not exactly the poses `own` at rank r.
+                                  int d, std::uint32_t phase, const Eigen::MatrixXd& nb = {},
+                                  const std::vector<std::size_t>& nb_ids = {});
+/// The own block of the kept set's start (r x (d+1)|own|) from agent 0's `block`; the
+/// neighbours' poses that follow it, if any, go to `nb_out` (r x (d+1)|nb|, columns of the
+/// ascending neighbour poses `nb`, zero where none came). Throws std::runtime_error naming
+/// `receiver` when the block does not start with exactly the poses `own` at rank r.
 Eigen::MatrixXd read_kept_start(const PoseBlockMessage& block, const std::vector<std::size_t>& own,
-                                Eigen::Index r, int d, int receiver);
+                                Eigen::Index r, int d, int receiver,
+                                const std::vector<std::size_t>& nb, Eigen::MatrixXd& nb_out);
 
 }  // namespace tessera

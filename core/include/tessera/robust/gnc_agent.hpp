@@ -303,6 +303,15 @@ class GncAgent : public AgentProcess {
   // that exchange ended GNC at TLS's verdict (RobustOptions::jump_band).
   std::vector<std::pair<std::uint64_t, double>> low_weights_;
   bool jumped_ = false;
+  // Agent 0 holds every measurement's value (sent beside the first weights, with
+  // RobustOptions::exchanges_ride_along and the kept set's fresh start): a fresh start then
+  // waits only for agent 0's answer, not for the values first. The same on every agent.
+  bool values_held_ = false;
+  bool gather_values_early() const;
+  // The neighbours' public poses the exchange book holds are the current iterate's (a pose
+  // exchange since the iterate last moved). With values_held_ the kept set's fresh start then
+  // needs no pose exchange: agent 0 sends each agent its neighbours' poses of the start too.
+  bool neighbours_current_ = false;
   std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where
   std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view
   Eigen::MatrixXd last_pass_start_;
