@@ -29,6 +29,7 @@
 #include "json_writer.hpp"
 #include "rebalance_args.hpp"
 #include "runtime/online_agent_view.hpp"
+#include "step_coarse_args.hpp"
 #include "transport/fastdds/shm_receive_watch.hpp"
 #include "transport/fastdds/teardown_guard.hpp"
 #include "transport/graph_stream_topic.hpp"
@@ -49,6 +50,26 @@ double cpu_now() {
   return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
 }
 
+// The options every agent of the run must share, as this agent's reports carry them.
+transport::OnlineTeamOptions team_options(const OnlineOptions& o) {
+  transport::OnlineTeamOptions t;
+  t.rebalance = o.rebalance;
+  t.step_coarse = o.newton_coarse;
+  t.step_coarse_min_blocks = o.newton_coarse_min_blocks;
+  return t;
+}
+
+// "" when `theirs` (agent `sender`'s report) equals `mine`; else the first option that differs.
+std::string team_disagreement(const transport::OnlineTeamOptions& mine,
+                              const transport::OnlineTeamOptions& theirs, unsigned sender) {
+  std::string differs = cli::rebalance_disagreement(mine.rebalance, theirs.rebalance, sender);
+  if (differs.empty())
+    differs =
+        cli::step_coarse_disagreement(mine.step_coarse, mine.step_coarse_min_blocks,
+                                      theirs.step_coarse, theirs.step_coarse_min_blocks, sender);
+  return differs;
+}
+
 class OnlineAgent {
  public:
   explicit OnlineAgent(const OnlineAgentOptions& o)
@@ -56,7 +77,7 @@ class OnlineAgent {
         view_(o.id, o.robots, o.online),
         stream_(o.domain, o.run_id),
         channel_(o.domain, o.run_id, static_cast<std::uint32_t>(o.id),
-                 static_cast<std::uint32_t>(o.robots), o.lease_s, o.online.rebalance),
+                 static_cast<std::uint32_t>(o.robots), o.lease_s, team_options(o.online)),
         start_(Clock::now()),
         block_(o.online) {}
 
@@ -136,16 +157,15 @@ void OnlineAgent::pump_stream() {
 
 void OnlineAgent::pump_channel() {
   for (auto& r : channel_.take_reports()) {
-    // Every agent moves the blocks itself, so all use the lead's re-partition options: an
-    // agent whose options differ is not admitted (its hello is not counted), and an agent
+    // Every agent moves the blocks itself and takes part in every message step of the Newton
+    // steps' coarse correction, so all use the lead's re-partition and --step-coarse options:
+    // an agent whose options differ is not admitted (its hello is not counted), and an agent
     // that reads the lead's report with other options than its own stops, naming the option.
-    const std::string differs =
-        cli::rebalance_disagreement(o_.online.rebalance, r.rebalance, r.sender);
+    const std::string differs = team_disagreement(team_options(o_.online), r.team, r.sender);
     if (r.epoch == transport::kHelloEpoch && !differs.empty()) {
       if (refused_.insert(r.sender).second)
-        std::fprintf(stderr,
-                     "agent %d: agent %u not admitted: its re-partition options differ (%s)\n",
-                     o_.id, r.sender, differs.c_str());
+        std::fprintf(stderr, "agent %d: agent %u not admitted: its options differ (%s)\n", o_.id,
+                     r.sender, differs.c_str());
       continue;
     }
     if (r.sender < static_cast<std::uint32_t>(o_.robots) && dead_.count(r.sender) == 0)
@@ -508,6 +528,10 @@ bool OnlineAgent::epoch_step() {
       .add("cut", in.cut)
       .add("entered", entered_per_robot())
       .add("rounds", s.rounds)
+      .add("newton_steps", s.newton_steps)
+      .add("newton_cg_iterations", s.newton_cg_iterations)
+      .add("newton_message_steps", s.newton_message_steps)
+      .add("coarse_unknowns", s.coarse_unknowns)
       .add("ms", 1000.0 * (step_end - step_start))
       .add("latency_s", step_end - oldest)
       .add("cpu_s", step_cpu)

@@ -7,6 +7,7 @@
 
 #include "arguments.hpp"
 #include "rebalance_args.hpp"
+#include "step_coarse_args.hpp"
 #include "transport/run_identity.hpp"
 
 namespace tessera::agent {
@@ -45,7 +46,7 @@ options:
                       (distributed Newton steps from the warm start) or rounds [newton]
   --newton-after T    newton: block-coordinate rounds first, down to ||grad f|| <= T
                                                                      [none]
-  --certify-every S   also certify the graph received so far every S seconds (the lead's
+%STEPCOARSE%  --certify-every S   also certify the graph received so far every S seconds (the lead's
                       clock; at the next epoch that brought data, once the graph is
                       connected; no staircase climb)                  [0 = off]
   --publish-every S   publish this robot's current estimate (rounded to SE(d)) on topic
@@ -55,8 +56,12 @@ options:
   --verbose           print each epoch (members, what entered, solve or idle)
   --help              this text
 
-re-partition (the same on every agent of the run: each moves the blocks itself; an agent
-whose options differ from the lead's stops with exit code 2 naming the option):
+The --step-coarse options and the re-partition's below are the same on every agent of the
+run (the coarse correction adds message steps to every agent's Newton steps; each agent moves
+the blocks itself): an agent whose options differ from the lead's stops with exit code 2
+naming the option.
+
+re-partition:
 %REBALANCE%
 
 exit codes: 0 done, 1 the run failed (a peer went silent, or this agent was counted lost and
@@ -68,8 +73,11 @@ its block taken over), 2 bad options or input.
 const char* online_agent_usage() {
   static const std::string text = [] {
     std::string t = kOnlineUsage;
-    const std::string mark = "%REBALANCE%\n";
-    t.replace(t.find(mark), mark.size(), cli::kRebalanceHelp);
+    const auto put = [&t](const std::string& mark, const char* text) {
+      t.replace(t.find(mark), mark.size(), text);
+    };
+    put("%STEPCOARSE%", cli::kStepCoarseHelp);
+    put("%REBALANCE%\n", cli::kRebalanceHelp);
     return t;
   }();
   return text.c_str();
@@ -84,6 +92,7 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
   std::set<std::string> switches = {"online", "no-certify", "verbose", "help"};
   for (const char* const* f = cli::kRebalanceValued; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceSwitches; *f; ++f) switches.insert(*f);
+  for (const char* const* f = cli::kStepCoarseValued; *f; ++f) valued.insert(*f);
   const cli::Arguments args(argv, valued, switches);
   OnlineAgentOptions o;
   const auto run_id = args.get("run-id");
@@ -128,6 +137,7 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
     throw InputError("option --step-solver: '" + step_solver + "' is not one of newton, rounds");
   o.online.newton_steps = step_solver == "newton";
   o.online.newton_after_grad_tol = args.get_double("newton-after", o.online.newton_after_grad_tol);
+  cli::parse_step_coarse_options(args, o.online);
   o.online.rebalance = cli::parse_rebalance_options(args);
   o.online.validate();
   return o;

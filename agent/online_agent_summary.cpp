@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "step_coarse_args.hpp"
+
 namespace tessera::agent {
 
 double percentile(std::vector<double> v, double q) {
@@ -21,6 +23,8 @@ std::string online_summary_json(const OnlineAgentOptions& o, const OnlineSummary
       .add("robots", o.robots)
       .add("run_id", o.run_id)
       .add("step_solver", o.online.newton_steps ? "newton" : "rounds")
+      .add("step_coarse", cli::step_coarse_name(o.online.newton_coarse))
+      .add("step_coarse_min_blocks", o.online.newton_coarse_min_blocks)
       .add("epochs", static_cast<long long>(state.epochs))
       .add("solves", f.solves)
       .add("rounds", f.rounds)

@@ -1,5 +1,6 @@
 #include "agent/online_block_solver.hpp"
 
+#include <algorithm>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/online/online_engine.hpp>
@@ -30,6 +31,7 @@ SolveOutcome OnlineBlockSolver::solve(runtime::OnlineAgentView& view, bool certi
   // A certificate while the graph grows does not climb the staircase: the iterate keeps its
   // rank for the next data (a saddle is reported as not certified).
   if (!climb) solver.staircase.max_rank = solver.rank;
+  use_online_refine_space(*live_, solver);
   const BlockLayout& layout = live_->layout();
   const auto& ids = layout.poses[static_cast<std::size_t>(c)];
   AgentState& state = *live_->states()[static_cast<std::size_t>(c)];
@@ -47,6 +49,12 @@ SolveOutcome OnlineBlockSolver::solve(runtime::OnlineAgentView& view, bool certi
   out.stop_reason = last.stop_reason;
   out.grad_norm = last.trace.empty() ? 0.0 : last.trace.back().grad_norm;
   if (!last.trace.empty()) out.relaxation_cost = last.trace.back().cost;
+  for (const NewtonRefineResult& n : agent.refines()) {
+    out.newton_steps += n.steps;
+    out.newton_cg_iterations += n.cg_iterations;
+    out.newton_message_steps += n.message_steps();
+    out.coarse_unknowns = std::max(out.coarse_unknowns, n.coarse_unknowns);
+  }
   out.certified = agent.certified();
   if (!agent.certificates().empty())
     out.min_eigenvalue = agent.certificates().back().result.min_eigenvalue;

@@ -24,6 +24,7 @@
 #include "solve_online.hpp"
 #include "solve_output.hpp"
 #include "solver_graph.hpp"
+#include "step_coarse_args.hpp"
 
 namespace tessera::cli {
 namespace {
@@ -258,6 +259,7 @@ int run_solve(const Args& args) {
   for (const char* const* o = kOnlineSwitches; *o; ++o) switches.insert(*o);
   for (const char* const* o = kRebalanceValued; *o; ++o) valued.insert(*o);
   for (const char* const* o = kRebalanceSwitches; *o; ++o) switches.insert(*o);
+  for (const char* const* o = kStepCoarseValued; *o; ++o) valued.insert(*o);
   for (const char* const* o = kRobustValued; *o; ++o) valued.insert(*o);
   valued.insert("precond-max-flops");
   valued.insert("gnc-cluster-probes");
@@ -266,8 +268,8 @@ int run_solve(const Args& args) {
   valued.insert("gnc-newton-mu-step-max");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
-    std::printf("%s%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
-                kOnlineHelp, kRebalanceHelp, kRobustHelp);
+    std::printf("%s%s%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
+                kOnlineHelp, kStepCoarseHelp, kRebalanceHelp, kRobustHelp);
     return 0;
   }
   if (a.positional().size() != 1)

@@ -20,6 +20,7 @@
 #include "rebalance_args.hpp"
 #include "robot_files.hpp"
 #include "runtime/replay_input.hpp"
+#include "step_coarse_args.hpp"
 
 namespace tessera::cli {
 
@@ -28,8 +29,7 @@ const char* const kOnlineValued[] = {
     "certify-every", "refactor-growth",   "baseline-every", "local-threshold",
     "step-every",    "step-solver",       "newton-after",   "threads",
     "baseline-per",  "baseline-samples",  "baseline-init",  "baseline-solver",
-    "step-coarse",   "progress-interval", "until",          "step-coarse-min-blocks",
-    nullptr};
+    "until",         "progress-interval", nullptr};
 const char* const kOnlineSwitches[] = {"online",          "real-time",   "baseline",
                                        "no-local-rounds", "no-progress", nullptr};
 
@@ -85,13 +85,6 @@ const char* kOnlineHelp =
     "                            distributed Newton steps from the warm start (default) or\n"
     "                            block-coordinate rounds only\n"
     "  --newton-after T          newton: rounds first, down to ||grad f|| <= T (default: none)\n"
-    "  --step-coarse none|blocks|smoothed   newton: the CG's coarse correction (default\n"
-    "                            none: block Jacobi; blocks: plus one rigid motion per block\n"
-    "                            of the robots that have met; smoothed: plus the rigid\n"
-    "                            motions of 8 smoothed pieces of each such block: the fewest\n"
-    "                            CG iterations once robots have met)\n"
-    "  --step-coarse-min-blocks M   the correction only for groups of at least M linked\n"
-    "                            blocks, smaller ones take block Jacobi's steps (default 3)\n"
     "  --until S                 play only what is published up to S seconds of stream time\n"
     "                            (a prefix of the mission, e.g. to profile its steps; the\n"
     "                            final cost needs the graph received by then connected)\n"
@@ -146,6 +139,7 @@ JsonObject update_json(const OnlineUpdate& u) {
       .add("relaxation_cost", u.relaxation_cost)
       .add("factorizations", u.factorizations)
       .add("factor_flops", u.factor_flops)
+      .add("blocks_built", u.blocks_built)
       .add("merges", u.merges)
       .add("merge_poses_moved", u.merge_poses_moved);
   return j;
@@ -195,15 +189,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
       throw InputError("option --step-solver: '" + step_solver + "' is not one of newton, rounds");
     options.newton_steps = step_solver == "newton";
     options.newton_after_grad_tol = a.get_double("newton-after", options.newton_after_grad_tol);
-    const std::string coarse = a.get_or("step-coarse", "none");
-    if (coarse != "none" && coarse != "blocks" && coarse != "smoothed")
-      throw InputError("option --step-coarse: '" + coarse +
-                       "' is not one of none, blocks, smoothed");
-    options.newton_coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
-                            : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
-                                                   : NewtonRefineOptions::Coarse::kNone;
-    options.newton_coarse_min_blocks =
-        static_cast<int>(a.get_long("step-coarse-min-blocks", options.newton_coarse_min_blocks));
+    parse_step_coarse_options(a, options);
   }
   options.validate();
   ReplayOptions replay;

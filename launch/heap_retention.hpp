@@ -6,8 +6,7 @@
 // (trim) and the next round faulted the same pages back in: ~100k minor faults in a kitti_02
 // run of 5 agents against ~6k in the in-process engine, ~10 us of CPU each on the virtual
 // machines measured, i.e. ~1 CPU-s of a 5-6 CPU-s run (docs/dds-runtime.md, "The agents'
-// heap"). Launch's huge-page heaps (launch/huge_page_heaps.hpp) make those
-// faults cheaper; this removes them, for agents started by hand too.
+// heap"). This removes those faults, for agents started by hand too.
 
 #include <cstddef>
 

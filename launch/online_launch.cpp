@@ -22,6 +22,7 @@
 #include "launch/launch.hpp"
 #include "launch/launch_loss_policy.hpp"
 #include "rebalance_args.hpp"
+#include "step_coarse_args.hpp"
 #include "transport/run_identity.hpp"
 
 namespace tessera::launch {
@@ -57,7 +58,7 @@ new, and certify the estimate after every robot's last batch.
   --certify-every S   also certify the graph received so far every S seconds
   --step-solver S     newton or rounds: how the agents solve a grown graph [newton]
   --newton-after T    newton: rounds first, down to ||grad f|| <= T  [none]
-  --publish-every S   each agent publishes its robot's estimate every S seconds
+%STEPCOARSE%  --publish-every S   each agent publishes its robot's estimate every S seconds
                       (topic tessera_online_estimate)
   --tum-dir DIR       per-robot TUM snapshots DIR/robot<r>.tum, rewritten at every
                       publication and at the end
@@ -65,7 +66,11 @@ new, and certify the estimate after every robot's last batch.
                       updates, final answer) and every agent's traffic under "agents"
   --keep-logs DIR     keep the processes' logs and summaries in DIR
 
-re-partition (passed to every agent: each moves the blocks itself, so all use the same):
+The --step-coarse options and the re-partition's below are passed to every agent (the coarse
+correction adds message steps to every agent's Newton steps; each agent moves the blocks
+itself), so all use the same.
+
+re-partition:
 )";
 
 std::string read_text(const std::string& path) {
@@ -121,7 +126,10 @@ bool wants_online_launch(const std::vector<std::string>& argv) {
 int run_online_launch(const std::vector<std::string>& argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
-      std::fputs(kOnlineHelp, stdout);
+      std::string help = kOnlineHelp;
+      const std::string mark = "%STEPCOARSE%";
+      help.replace(help.find(mark), mark.size(), cli::kStepCoarseHelp);
+      std::fputs(help.c_str(), stdout);
       std::fputs(cli::kRebalanceHelp, stdout);
       return 0;
     }
@@ -136,6 +144,7 @@ int run_online_launch(const std::vector<std::string>& argv) {
   for (const char* const* f = kForwarded; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceValued; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceSwitches; *f; ++f) switches.insert(*f);
+  for (const char* const* f = cli::kStepCoarseValued; *f; ++f) valued.insert(*f);
   const cli::Arguments args(argv, valued, switches);
   if (args.positional().size() != 1)
     throw InputError("launch --online: expected one GRAPH argument (see --online --help)");
@@ -162,7 +171,10 @@ int run_online_launch(const std::vector<std::string>& argv) {
   const long domain = args.get_long("domain", transport::domain_for_run(run_id));
   if (domain < 0 || domain > transport::kMaxDomain)
     throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));
-  cli::parse_rebalance_options(args);  // checked here: a bad value is named before any start
+  // Checked here: a bad value is named before any start.
+  cli::parse_rebalance_options(args);
+  OnlineOptions step_coarse;
+  cli::parse_step_coarse_options(args, step_coarse);
 
   if (auto dir = args.get("tum-dir")) {
     std::error_code ec;
@@ -192,6 +204,7 @@ int run_online_launch(const std::vector<std::string>& argv) {
   };
   for (const char* const* flag = kForwarded; *flag; ++flag) forward_valued(*flag);
   for (const char* const* flag = cli::kRebalanceValued; *flag; ++flag) forward_valued(*flag);
+  for (const char* const* flag = cli::kStepCoarseValued; *flag; ++flag) forward_valued(*flag);
   for (const char* const* flag = cli::kRebalanceSwitches; *flag; ++flag)
     if (args.has(*flag)) forwarded.push_back(std::string("--") + *flag);
   if (args.has("no-certify")) forwarded.push_back("--no-certify");

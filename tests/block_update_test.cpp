@@ -122,19 +122,19 @@ TEST(BlockUpdate, IrbcdSettingsApplyToIrbcdOnly) {
 }
 
 TEST(BlockUpdate, OptionsAreValidated) {
-  using test::validation_message;
+  using test::validation_names;
   DistributedOptions o;
   o.block_update.grad_reduction = 1.0;
-  EXPECT_NE(validation_message(o).find("grad_reduction"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "grad_reduction"));
   o = {};
   o.block_update.grad_reduction = -0.5;
-  EXPECT_NE(validation_message(o).find("grad_reduction"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "grad_reduction"));
   o = {};
   o.irbcd_trust_region_steps = -1;
-  EXPECT_NE(validation_message(o).find("irbcd_trust_region_steps"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "irbcd_trust_region_steps"));
   o = {};
   o.irbcd_grad_reduction = 1.0;
-  EXPECT_NE(validation_message(o).find("irbcd_grad_reduction"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "irbcd_grad_reduction"));
 }
 
 }  // namespace

@@ -31,7 +31,6 @@
 
 #include "dds_process_support.hpp"
 #include "launch/fork_spec.hpp"
-#include "launch/huge_page_heaps.hpp"
 #include "launch/launch_children.hpp"
 #include "launch/startup_batch.hpp"
 #include "transport/fastdds/shm_leftovers.hpp"
@@ -236,26 +235,8 @@ TEST(DdsForkServer, ForkedProcessesAreLaunchsChildrenNamedLikeTheExecutablesAndS
     std::string name;
     std::getline(comm, name);
     EXPECT_EQ(name.rfind("tessera-", 0), 0u) << name;
-    // launch asked for huge-page heaps (launch/huge_page_heaps.hpp) before starting the server.
-    std::ifstream env("/proc/" + std::to_string(pid) + "/environ");
-    const std::string environ_text((std::istreambuf_iterator<char>(env)),
-                                   std::istreambuf_iterator<char>());
-    EXPECT_NE(environ_text.find("glibc.malloc.hugetlb="), std::string::npos) << pattern;
   }
   run.end();
-}
-
-TEST(HugePageHeaps, AddsTheTunableAndKeepsTheUsersOwn) {
-  EXPECT_EQ(launch::with_huge_page_heaps(""), "glibc.malloc.hugetlb=1");
-  EXPECT_EQ(launch::with_huge_page_heaps("glibc.malloc.arena_max=2"),
-            "glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1");
-  // The user's own choice (here: off) stays, wherever it stands in the list.
-  EXPECT_EQ(launch::with_huge_page_heaps("glibc.malloc.hugetlb=0"), "glibc.malloc.hugetlb=0");
-  EXPECT_EQ(launch::with_huge_page_heaps("glibc.malloc.arena_max=2:glibc.malloc.hugetlb=2"),
-            "glibc.malloc.arena_max=2:glibc.malloc.hugetlb=2");
-  // A longer name that merely starts like it is another tunable.
-  EXPECT_EQ(launch::with_huge_page_heaps("glibc.malloc.hugetlbx=1"),
-            "glibc.malloc.hugetlbx=1:glibc.malloc.hugetlb=1");
 }
 
 TEST(DdsForkServer, BadFileStopsTheForkedRunWithTheAgentsReason) {

@@ -41,6 +41,26 @@ PoseGraph saddle_graph() {
   return generate_pose_graph(g).graph;
 }
 
+// The random graph most tests here certify on: 60 poses, 30 loop closures, rotation noise as
+// given (0.1-0.3 rad: enough for critical points that are not optima).
+PoseGraph noisy_graph(int d, std::uint64_t seed, double rotation_noise) {
+  test::RandomGraphSpec spec;
+  spec.d = d;
+  spec.poses = 60;
+  spec.loop_closures = 30;
+  spec.seed = seed;
+  spec.rotation_noise = rotation_noise;
+  return test::random_pose_graph(spec);
+}
+
+// A lifted point at rank r that is not critical (its last row bent towards the first): S is well
+// defined and indefinite there.
+Eigen::MatrixXd bent_point(const BlockProblem& whole, const std::vector<Pose>& initial, int r) {
+  Eigen::MatrixXd X = lift_poses(initial, r);
+  X.row(r - 1) = 0.3 * X.row(0);
+  return whole.manifold(r).project(X);
+}
+
 // Runs only the certificate protocol of N agents on an arbitrary lifted point X.
 // `update` configures the agents (their Q_BB factor cap); `too_large`, when given, receives
 // each agent's block_factor_too_large().
@@ -72,18 +92,9 @@ DistributedCertificateResult certify_in_process(const PoseGraph& g, const Eigen:
 }
 
 TEST(DistributedCertificate, MinimumEigenvalueMatchesCentralizedAtAnyPoint) {
-  test::RandomGraphSpec spec;
-  spec.d = 2;
-  spec.poses = 60;
-  spec.loop_closures = 30;
-  spec.seed = 4;
-  spec.rotation_noise = 0.3;
-  const PoseGraph g = test::random_pose_graph(spec);
-  // An arbitrary (non-critical) lifted point: S is well defined and indefinite there.
-  Eigen::MatrixXd X = lift_poses(g.initial, 3);
-  X.row(2) = 0.3 * X.row(0);
-  X = BlockProblem::whole_graph(2, g.num_poses, g.measurements).manifold(3).project(X);
+  const PoseGraph g = noisy_graph(2, 4, 0.3);
   const BlockProblem whole = BlockProblem::whole_graph(2, g.num_poses, g.measurements);
+  const Eigen::MatrixXd X = bent_point(whole, g.initial, 3);
   const CertificateResult central = verify_certificate(whole, X);
   ASSERT_FALSE(central.certified);
   const DistributedCertificateResult dist =
@@ -100,17 +111,9 @@ TEST(DistributedCertificate, MinimumEigenvalueMatchesCentralizedAtAnyPoint) {
 // (d+1) x (d+1) diagonal blocks of its shifted S_BB) instead of factoring its whole block: the
 // same minimum eigenvalue, memory linear in the block.
 TEST(DistributedCertificate, PoseWisePreconditionerAboveTheFactorCapFindsTheSameEigenvalue) {
-  test::RandomGraphSpec spec;
-  spec.d = 3;
-  spec.poses = 60;
-  spec.loop_closures = 30;
-  spec.seed = 5;
-  spec.rotation_noise = 0.3;
-  const PoseGraph g = test::random_pose_graph(spec);
-  Eigen::MatrixXd X = lift_poses(g.initial, 4);
-  X.row(3) = 0.3 * X.row(0);
+  const PoseGraph g = noisy_graph(3, 5, 0.3);
   const BlockProblem whole = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
-  X = whole.manifold(4).project(X);
+  const Eigen::MatrixXd X = bent_point(whole, g.initial, 4);
   const CertificateResult central = verify_certificate(whole, X);
   const std::vector<int> parts = sequential_partition(g.num_poses, 3);
   BlockUpdateOptions capped;
@@ -265,13 +268,7 @@ TEST(DistributedStaircase, ASolveOutOfRoundsIsCertifiedOnceAndNotContinued) {
 // tight cluster at the top of the shift-inverted spectrum; the centralized certificate still
 // reports lambda_min (the narrow Lanczos run from X's rows once missed it there: NaN).
 TEST(DistributedCertificate, TheCentralizedCertificateReportsLambdaMinAtRefinedPoints) {
-  test::RandomGraphSpec spec;
-  spec.d = 3;
-  spec.poses = 60;
-  spec.loop_closures = 30;
-  spec.rotation_noise = 0.2;
-  spec.seed = 5;
-  const PoseGraph g = test::random_pose_graph(spec);
+  const PoseGraph g = noisy_graph(3, 5, 0.2);
   const BlockProblem whole = BlockProblem::whole_graph(g.d, g.num_poses, g.measurements);
   for (double tol : {1.0, 0.1}) {
     DistributedOptions opt;
@@ -293,15 +290,7 @@ TEST(DistributedCertificate, TheCentralizedCertificateReportsLambdaMinAtRefinedP
 
 TEST(DistributedCertificate, HoldsAtALoosePointOnlyWhereTheCentralizedCertificateHolds) {
   std::vector<PoseGraph> graphs;
-  for (std::uint64_t seed : {5u, 6u}) {
-    test::RandomGraphSpec spec;
-    spec.d = seed == 5u ? 3 : 2;
-    spec.poses = 60;
-    spec.loop_closures = 30;
-    spec.rotation_noise = 0.2;
-    spec.seed = seed;
-    graphs.push_back(test::random_pose_graph(spec));
-  }
+  for (std::uint64_t seed : {5u, 6u}) graphs.push_back(noisy_graph(seed == 5u ? 3 : 2, seed, 0.2));
   graphs.push_back(saddle_graph());
   int certified = 0, rejected = 0;
   for (const PoseGraph& g : graphs) {
@@ -367,22 +356,13 @@ TEST(DistributedStaircase, DeliveryOrderDoesNotChangeTheResult) {
 TEST(DistributedCertificate, InterfaceTestGivesTheCentralizedFactorizationsVerdict) {
   int certified = 0, rejected = 0;
   for (int d : {2, 3}) {
-    test::RandomGraphSpec spec;
-    spec.d = d;
-    spec.poses = 60;
-    spec.loop_closures = 30;
-    spec.seed = 7 + static_cast<std::uint64_t>(d);
-    spec.rotation_noise = 0.2;
-    const PoseGraph g = test::random_pose_graph(spec);
+    const PoseGraph g = noisy_graph(d, 7 + static_cast<std::uint64_t>(d), 0.2);
     const BlockProblem whole = BlockProblem::whole_graph(d, g.num_poses, g.measurements);
     CentralizedOptions tight;
     tight.stop = CentralizedStop::kGradient;
     const CentralizedResult opt = solve_centralized(g, tight);
     ASSERT_TRUE(opt.certified.value_or(false));
-    std::vector<Eigen::MatrixXd> points{opt.X};
-    Eigen::MatrixXd bent = lift_poses(g.initial, 3);  // not critical: S is indefinite there
-    bent.row(2) = 0.3 * bent.row(0);
-    points.push_back(whole.manifold(3).project(bent));
+    const std::vector<Eigen::MatrixXd> points{opt.X, bent_point(whole, g.initial, 3)};
     std::vector<std::vector<int>> partitions{sequential_partition(g.num_poses, 1),
                                              sequential_partition(g.num_poses, 3)};
     std::vector<int> scattered(g.num_poses);
@@ -459,14 +439,8 @@ struct OptimumAndNearby {
 };
 
 OptimumAndNearby optimum_and_nearby(int d, std::uint64_t seed) {
-  test::RandomGraphSpec spec;
-  spec.d = d;
-  spec.poses = 60;
-  spec.loop_closures = 30;
-  spec.seed = seed;
-  spec.rotation_noise = 0.1;
   OptimumAndNearby o;
-  o.graph = test::random_pose_graph(spec);
+  o.graph = noisy_graph(d, seed, 0.1);
   CentralizedOptions tight;
   tight.stop = CentralizedStop::kGradient;
   o.optimum = solve_centralized(o.graph, tight);

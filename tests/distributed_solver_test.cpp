@@ -18,6 +18,7 @@
 
 #include "lifted_blocks.hpp"
 #include "random_graph.hpp"
+#include "test_support.hpp"
 
 namespace tessera {
 namespace {
@@ -464,39 +465,34 @@ TEST(DistributedSolver, BlockDiagonalFallbackAboveTheFactorCap) {
 }
 
 TEST(DistributedSolver, BadOptionsNameTheField) {
-  auto message_of = [](auto&& f) {
-    try {
-      f();
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  using test::input_error_of;
+  using test::validation_names;
   DistributedOptions o;
   o.grad_norm_tol = -1;
-  EXPECT_NE(message_of([&] { o.validate(); }).find("grad_norm_tol"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "grad_norm_tol"));
   o = {};
   o.max_rounds = -2;
-  EXPECT_NE(message_of([&] { o.validate(); }).find("max_rounds"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "max_rounds"));
   o = {};
   o.block_update.trust_region_steps = 0;
-  EXPECT_NE(message_of([&] { o.validate(); }).find("trust_region_steps"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "trust_region_steps"));
   o = {};
   o.irbcd.b0 = 0;
-  EXPECT_NE(message_of([&] { o.validate(); }).find("b0"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "b0"));
   o = {};
   o.irbcd.sigma = -1;
-  EXPECT_NE(message_of([&] { o.validate(); }).find("sigma"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "IrbcdOptions.sigma"));
   const PoseGraph g = small_graph(3, 20, 1);
   o = {};
   o.rank = 2;
-  EXPECT_NE(message_of([&] { solve_distributed(g, sequential_partition(20, 2), o); }).find("rank"),
-            std::string::npos);
+  EXPECT_NE(
+      input_error_of([&] { solve_distributed(g, sequential_partition(20, 2), o); }).find("rank"),
+      std::string::npos);
   std::vector<int> bad(20, 0);
   bad[3] = 2;  // block 1 empty
-  EXPECT_NE(message_of([&] { solve_distributed(g, bad, DistributedOptions{}); }).find("empty"),
+  EXPECT_NE(input_error_of([&] { solve_distributed(g, bad, DistributedOptions{}); }).find("empty"),
             std::string::npos);
-  EXPECT_NE(message_of([] { parse_algorithm("sgd"); }).find("rbcd"), std::string::npos);
+  EXPECT_NE(input_error_of([] { parse_algorithm("sgd"); }).find("rbcd"), std::string::npos);
 }
 
 }  // namespace

@@ -6,15 +6,14 @@
 
 #include <cmath>
 #include <map>
-#include <string>
 #include <tessera/robust/gnc_distributed.hpp>
 #include <tessera/robust/tls_weights.hpp>
-#include <tessera/util/input_error.hpp>
 #include <utility>
 #include <vector>
 
 #include "gnc_fixtures.hpp"
 #include "robust/gnc_votes.hpp"
+#include "test_support.hpp"
 
 namespace tessera {
 namespace {
@@ -22,12 +21,7 @@ namespace {
 TEST(GncJump, ABadBandNamesTheField) {
   RobustOptions o;
   o.jump_band = 1.0;  // a band of width 0 around c^2
-  try {
-    o.validate();
-    FAIL() << "jump_band 1 accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("RobustOptions.jump_band"), std::string::npos) << e.what();
-  }
+  EXPECT_TRUE(test::validation_names(o, "RobustOptions.jump_band"));
   o.jump_band = 0;  // off
   EXPECT_NO_THROW(o.validate());
   o.jump_band = 1.5;

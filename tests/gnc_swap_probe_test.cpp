@@ -10,13 +10,13 @@
 #include <tessera/robust/robust_options.hpp>
 #include <tessera/robust/tls_recheck.hpp>
 #include <tessera/robust/tls_weights.hpp>
-#include <tessera/util/input_error.hpp>
 #include <vector>
 
 #include "gnc_fixtures.hpp"
 #include "robust/gnc_probes.hpp"
 #include "robust/probe_outcome.hpp"
 #include "robust/swap_probe.hpp"
+#include "test_support.hpp"
 
 namespace tessera {
 namespace {
@@ -211,26 +211,18 @@ TEST(GncDistributed, AProbeWhosePassesTakeBackExactlyWhatItCutEndsNotKept) {
 }
 
 TEST(SwapProbes, BadSwapOptionsNameTheField) {
-  auto field_of = [](RobustOptions o) {
-    try {
-      o.validate();
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   RobustOptions o;
   o.swap_probes = -1;
-  EXPECT_NE(field_of(o).find("RobustOptions.swap_probes"), std::string::npos);
+  EXPECT_TRUE(test::validation_names(o, "RobustOptions.swap_probes"));
   o = RobustOptions{};
   o.swap_near = -1;
-  EXPECT_NE(field_of(o).find("RobustOptions.swap_near"), std::string::npos);
+  EXPECT_TRUE(test::validation_names(o, "RobustOptions.swap_near"));
   o = RobustOptions{};
   o.swap_kept_ratio = 1.5;
-  EXPECT_NE(field_of(o).find("RobustOptions.swap_kept_ratio"), std::string::npos);
+  EXPECT_TRUE(test::validation_names(o, "RobustOptions.swap_kept_ratio"));
   o = RobustOptions{};
   o.swap_return_ratio = 0.5;
-  EXPECT_NE(field_of(o).find("RobustOptions.swap_return_ratio"), std::string::npos);
+  EXPECT_TRUE(test::validation_names(o, "RobustOptions.swap_return_ratio"));
 }
 
 }  // namespace

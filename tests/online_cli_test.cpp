@@ -149,6 +149,11 @@ TEST(OnlineCli, TheStepsCoarseCorrectionReachesTheSameCertifiedOptimum) {
                               &out),
             2);
   EXPECT_TRUE(test::contains(out, "--step-coarse")) << out;
+  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + r.graph +
+                                  " --online --robots 2 --step-coarse-min-blocks 1",
+                              &out),
+            2);
+  EXPECT_TRUE(test::contains(out, "option --step-coarse-min-blocks")) << out;
 }
 
 TEST(OnlineCli, ARunSaysWhereItIsOnStderrUnlessToldNotTo) {

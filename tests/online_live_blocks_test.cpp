@@ -137,23 +137,56 @@ TEST(LiveBlocks, ABlockWithNoNewDataIsKeptAsItIs) {
   EXPECT_EQ(before->problem().neighbors(), neighbours);
 }
 
-TEST(LiveBlocks, MovedPosesRebuildTheBlocks) {
+TEST(LiveBlocks, AMoveRebuildsOnlyTheBlocksThatGaveOrTookPoses) {
   const auto gen = small_graph(TrajectoryKind::kSphere, 120, 3);
   GrownRun run(gen, 5, 0.25);
   std::vector<int> owner;
   for (std::size_t k = 0; k < run.stream.graph().num_poses; ++k)
     owner.push_back(static_cast<int>(run.stream.robot_of_pose()[k]));
-  // The last pose of robot 0 moves to robot 1's block.
-  std::size_t last0 = 0;
-  for (std::size_t k = 0; k < owner.size(); ++k)
-    if (owner[k] == 0) last0 = k;
-  owner[last0] = 1;
+  // A pose that robot 0's block holds as a neighbour moves between robots 1 and 2: block 0
+  // keeps its own and neighbour poses, but that neighbour's owner (and so the index of its
+  // block among block 0's neighbour blocks, which the coarse terms read) changes.
+  const std::vector<std::size_t>& full = run.live.full_id();
+  const int c0 = run.live.compact_block(0);
+  ASSERT_EQ(c0, 0);
+  const AgentState* kept = run.live.states()[0].get();
+  std::size_t moved = full.size();
+  for (std::size_t nb : kept->problem().neighbors())
+    if (moved == full.size()) moved = full[nb];
+  ASSERT_LT(moved, owner.size());
+  owner[moved] = 3 - owner[moved];
+  const std::vector<double> terms_before = kept->coarse_terms();  // built on the old layout
+  const long long factorizations = kept->tangent_factorizations_total();
+  EXPECT_GT(factorizations, 0);
+  const std::vector<std::size_t> neighbours = kept->problem().neighbors();
   const LiveSync s = run.live.sync(run.stream.graph(), owner, run.X);
-  EXPECT_EQ(s.built, 3);
+  EXPECT_EQ(s.built, 2);
+  EXPECT_EQ(s.kept, 1);
+  EXPECT_EQ(s.extended, 0);
   const std::size_t compact =
-      std::find(run.live.full_id().begin(), run.live.full_id().end(), last0) -
-      run.live.full_id().begin();
-  EXPECT_EQ(run.live.block_of()[static_cast<std::size_t>(run.live.layout().owner[compact])], 1);
+      static_cast<std::size_t>(std::find(full.begin(), full.end(), moved) - full.begin());
+  const BlockLayout& layout = run.live.layout();
+  EXPECT_EQ(run.live.block_of()[static_cast<std::size_t>(layout.owner[compact])], owner[moved]);
+  // The unchanged block kept its state and its factor, and starts from the iterate.
+  const AgentState& state = *run.live.states()[0];
+  EXPECT_EQ(&state, kept);
+  EXPECT_EQ(state.tangent_factorizations_total(), factorizations);
+  EXPECT_EQ(state.problem().neighbors(), neighbours);
+  const PoseGraph& g = run.live.graph();
+  const Eigen::MatrixXd Xc = pose_columns(run.X, g.d, full);
+  EXPECT_EQ(state.Y, pose_columns(Xc, g.d, layout.poses[0]));
+  // Every block, kept or built again, is the one a build on the new layout gives: its coarse
+  // terms (which read the neighbours' owners) included.
+  for (int c = 0; c < layout.num_blocks; ++c) {
+    const AgentState& live = *run.live.states()[static_cast<std::size_t>(c)];
+    const auto& own = layout.poses[static_cast<std::size_t>(c)];
+    AgentState fresh(c, g.d, layout, g.measurements, pose_columns(Xc, g.d, own));
+    EXPECT_EQ(live.problem().owned(), fresh.problem().owned());
+    EXPECT_EQ(live.problem().neighbors(), fresh.problem().neighbors());
+    fresh.reset_iterate(live.Y, live.Yn);
+    EXPECT_EQ(live.coarse_terms(), fresh.coarse_terms());
+  }
+  EXPECT_NE(state.coarse_terms(), terms_before);
 }
 
 TEST(TangentPreconditionerGrow, TheGrownPreconditionerIsSymmetricPositiveDefinite) {

@@ -83,8 +83,7 @@ TEST(PairwiseConsistency, PcmGncWithoutConnectedKnownInliersSaysWhy) {
 TEST(PairwiseConsistency, ANegativeReadmissionCountNamesTheField) {
   RobustOptions o;
   o.readmission_passes = -1;
-  EXPECT_NE(test::validation_message(o).find("RobustOptions.readmission_passes"),
-            std::string::npos);
+  EXPECT_TRUE(test::validation_names(o, "RobustOptions.readmission_passes"));
 }
 
 }  // namespace

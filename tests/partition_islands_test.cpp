@@ -22,6 +22,7 @@ namespace {
 using namespace tessera;
 using namespace tessera::partition_detail;
 using tessera::test::validation_message;
+using tessera::test::validation_names;
 
 using test::grid_with_chords;
 
@@ -213,25 +214,25 @@ TEST(IslandSearch, BadOptionsNameTheField) {
   EvolutionParams p;
   EXPECT_EQ(validation_message(p), "");
   p.islands.islands = 0;
-  EXPECT_NE(validation_message(p).find("IslandOptions.islands"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "IslandOptions.islands"));
   p.islands.islands = 9;
-  EXPECT_NE(validation_message(p).find("IslandOptions.islands"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "IslandOptions.islands"));
   p = {};
   p.islands.exchange_every = -1;
-  EXPECT_NE(validation_message(p).find("IslandOptions.exchange_every"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "IslandOptions.exchange_every"));
   p = {};
   p.islands.second_matching_share = 1.5;
-  EXPECT_NE(validation_message(p).find("IslandOptions.second_matching_share"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "IslandOptions.second_matching_share"));
   p.islands.second_matching_share = -0.5;
-  EXPECT_NE(validation_message(p).find("IslandOptions.second_matching_share"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "IslandOptions.second_matching_share"));
   p = {};
   p.islands.short_islands = 9;
-  EXPECT_NE(validation_message(p).find("IslandOptions.short_islands"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "IslandOptions.short_islands"));
   p = {};
   p.islands.short_budget = 0.0;
-  EXPECT_NE(validation_message(p).find("IslandOptions.short_budget"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "IslandOptions.short_budget"));
   p.islands.short_budget = 1.5;
-  EXPECT_NE(validation_message(p).find("IslandOptions.short_budget"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "IslandOptions.short_budget"));
   p = {};
   p.islands.islands = 8;
   p.islands.exchange_every = 5;

@@ -17,6 +17,7 @@ namespace {
 using namespace tessera;
 using namespace tessera::partition_detail;
 using tessera::test::validation_message;
+using tessera::test::validation_names;
 
 // A 10 x 10 grid in two halves of exactly 50 vertices (bound 50, no slack), except that one
 // vertex of each half sits on the other side: cut 14 instead of the straight 10. Each tooth
@@ -112,13 +113,13 @@ TEST(RelaxedPolish, AfterTheSearchItNeverLosesTheBestCut) {
 TEST(RelaxedPolish, BadOptionsNameTheField) {
   RelaxedPolishOptions o;
   o.rounds = -1;
-  EXPECT_NE(validation_message(o).find("RelaxedPolishOptions.rounds"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "RelaxedPolishOptions.rounds"));
   o = {};
   o.min_relax = 0.0;
-  EXPECT_NE(validation_message(o).find("RelaxedPolishOptions.min_relax"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "RelaxedPolishOptions.min_relax"));
   o = {};
   o.max_relax = 0.001;  // below min_relax
-  EXPECT_NE(validation_message(o).find("RelaxedPolishOptions.max_relax"), std::string::npos);
+  EXPECT_TRUE(validation_names(o, "RelaxedPolishOptions.max_relax"));
   EXPECT_EQ(validation_message(RelaxedPolishOptions{}), "");
 }
 
@@ -126,13 +127,13 @@ TEST(EvolutionParams, BadOptionsNameTheField) {
   EvolutionParams p;
   EXPECT_EQ(validation_message(p), "");
   p.population = 0;
-  EXPECT_NE(validation_message(p).find("EvolutionParams.population"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "EvolutionParams.population"));
   p = {};
   p.mutation_rate = 1.5;
-  EXPECT_NE(validation_message(p).find("EvolutionParams.mutation_rate"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "EvolutionParams.mutation_rate"));
   p = {};
   p.polish.max_relax = 0.9;
-  EXPECT_NE(validation_message(p).find("RelaxedPolishOptions.max_relax"), std::string::npos);
+  EXPECT_TRUE(validation_names(p, "RelaxedPolishOptions.max_relax"));
 }
 
 }  // namespace

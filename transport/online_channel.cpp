@@ -36,6 +36,18 @@ using eprosima::fastrtps::types::ReturnCode_t;
 namespace {
 // Reports kept per agent for joiners: one per epoch boundary.
 constexpr std::int32_t kReportHistory = 100000;
+
+// OnlineStepCoarse's numbers (idl/tessera.idl): 0 none, 1 blocks, 2 smoothed.
+std::uint32_t wire_of_coarse(NewtonRefineOptions::Coarse c) {
+  return c == NewtonRefineOptions::Coarse::kBlocks     ? 1u
+         : c == NewtonRefineOptions::Coarse::kSmoothed ? 2u
+                                                       : 0u;
+}
+NewtonRefineOptions::Coarse coarse_of_wire(std::uint32_t v) {
+  return v == 1u   ? NewtonRefineOptions::Coarse::kBlocks
+         : v == 2u ? NewtonRefineOptions::Coarse::kSmoothed
+                   : NewtonRefineOptions::Coarse::kNone;
+}
 }  // namespace
 
 // A reliable write that finds the bounded history full of samples some reader has not
@@ -53,7 +65,7 @@ bool write_patiently(dds::DataWriter* writer, Sample& sample) {
 struct OnlineChannel::Impl : public dds::DataReaderListener {
   std::string run_id;
   std::uint32_t agent;
-  RebalanceOptions rebalance;  // this agent's, written into every report it sends
+  OnlineTeamOptions team;  // this agent's, written into every report it sends
   dds::DomainParticipant* participant = nullptr;
   dds::Publisher* publisher = nullptr;
   dds::Subscriber* subscriber = nullptr;
@@ -230,13 +242,16 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       r.lost = w.lost();
       r.at_epoch = w.at_epoch();
       const wire::OnlineRebalance& b = w.rebalance();
-      r.rebalance.enabled = b.enabled();
-      r.rebalance.slack = b.slack();
-      r.rebalance.min_excess = static_cast<std::size_t>(b.min_excess());
-      r.rebalance.cut_fraction = b.cut_fraction();
-      r.rebalance.max_passes = static_cast<int>(b.max_passes());
-      r.rebalance.pass_patience = static_cast<std::size_t>(b.pass_patience());
-      r.rebalance.place_by_links = b.place_by_links();
+      RebalanceOptions& rb = r.team.rebalance;
+      rb.enabled = b.enabled();
+      rb.slack = b.slack();
+      rb.min_excess = static_cast<std::size_t>(b.min_excess());
+      rb.cut_fraction = b.cut_fraction();
+      rb.max_passes = static_cast<int>(b.max_passes());
+      rb.pass_patience = static_cast<std::size_t>(b.pass_patience());
+      rb.place_by_links = b.place_by_links();
+      r.team.step_coarse = coarse_of_wire(w.step_coarse().coarse());
+      r.team.step_coarse_min_blocks = static_cast<int>(w.step_coarse().min_blocks());
       reports.push_back(std::move(r));
     }
   }
@@ -247,10 +262,9 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
 };
 
 OnlineChannel::OnlineChannel(int domain, const std::string& run_id, std::uint32_t agent,
-                             std::uint32_t agents, double lease_s,
-                             const RebalanceOptions& rebalance)
+                             std::uint32_t agents, double lease_s, const OnlineTeamOptions& team)
     : impl_(std::make_unique<Impl>(domain, run_id, agent, agents, lease_s)) {
-  impl_->rebalance = rebalance;
+  impl_->team = team;
 }
 OnlineChannel::~OnlineChannel() = default;
 
@@ -288,7 +302,7 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   w.certify(r.certify);
   w.lost(r.lost);
   w.at_epoch(r.at_epoch);
-  const RebalanceOptions& own = impl_->rebalance;
+  const RebalanceOptions& own = impl_->team.rebalance;
   wire::OnlineRebalance& b = w.rebalance();
   b.enabled(own.enabled);
   b.slack(own.slack);
@@ -297,6 +311,8 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   b.max_passes(static_cast<std::uint32_t>(own.max_passes));
   b.pass_patience(own.pass_patience);
   b.place_by_links(own.place_by_links);
+  w.step_coarse().coarse(wire_of_coarse(impl_->team.step_coarse));
+  w.step_coarse().min_blocks(static_cast<std::uint32_t>(impl_->team.step_coarse_min_blocks));
   if (!write_patiently(impl_->report_writer, w))
     throw std::runtime_error("online channel: a report write failed");
   return serialized_size(w);

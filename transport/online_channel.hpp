@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <tessera/distributed/newton_refine.hpp>
 #include <tessera/online/absorb_gate.hpp>
 #include <tessera/online/block_rebalance.hpp>
 #include <tessera/protocol/messages.hpp>
@@ -20,6 +21,17 @@ inline constexpr const char* kOnlineBlockTopic = "tessera_online_block";
 inline constexpr const char* kOnlineStatusTopic = "tessera_online_status";
 inline constexpr const char* kOnlineReportTopic = "tessera_online_report";
 inline constexpr const char* kOnlineEstimateTopic = "tessera_online_estimate";
+
+/// The options every agent of an online run must share: each agent moves the blocks itself
+/// (the re-partition), and the Newton steps' coarse correction adds message steps to every CG
+/// iteration of every agent. (OnlineOptions::place_new_poses and align_merged_pieces shape
+/// every agent's estimate too, but no flag sets them: every agent runs with their defaults.)
+struct OnlineTeamOptions {
+  RebalanceOptions rebalance;
+  /// OnlineOptions::newton_coarse and newton_coarse_min_blocks (their defaults here too).
+  NewtonRefineOptions::Coarse step_coarse = NewtonRefineOptions::Coarse::kNone;
+  int step_coarse_min_blocks = 3;
+};
 
 struct OnlineReportSample {
   std::uint32_t epoch = 0;
@@ -36,10 +48,10 @@ struct OnlineReportSample {
   /// epoch it was in; `held` is then what entered its graph.
   std::vector<std::uint32_t> lost;
   std::uint32_t at_epoch = 0;
-  /// The sender's re-partition options, on received reports (a channel writes its own agent's,
-  /// OnlineChannel's `rebalance`, into every report it sends): every agent moves the blocks
-  /// itself, so all must use the lead's (agent/online_agent.cpp checks).
-  RebalanceOptions rebalance;
+  /// The sender's team options, on received reports (a channel writes its own agent's,
+  /// OnlineChannel's `team`, into every report it sends): all must be the lead's
+  /// (agent/online_agent.cpp checks).
+  OnlineTeamOptions team;
 };
 
 /// The epoch of a hello: an agent that is not a member yet asks to join.
@@ -64,10 +76,10 @@ class OnlineChannel {
  public:
   /// Joins `domain` with partition `run_id` (validated: InputError). `agents` sizes the
   /// history limits. `lease_s`: the participant lease, seconds (a member silent that long is
-  /// lost). `rebalance`: this agent's re-partition options, carried by every report it sends.
+  /// lost). `team`: this agent's team options, carried by every report it sends.
   /// Throws std::runtime_error when DDS refuses.
   OnlineChannel(int domain, const std::string& run_id, std::uint32_t agent, std::uint32_t agents,
-                double lease_s = kDefaultOnlineLeaseS, const RebalanceOptions& rebalance = {});
+                double lease_s = kDefaultOnlineLeaseS, const OnlineTeamOptions& team = {});
   ~OnlineChannel();
   OnlineChannel(const OnlineChannel&) = delete;
   OnlineChannel& operator=(const OnlineChannel&) = delete;

@@ -107,6 +107,13 @@ void AgentState::extend(const std::vector<Measurement>& measurements, std::size_
   }
 }
 
+void AgentState::neighbours_moved(const std::vector<Measurement>& measurements) {
+  coarse_.reset();
+  coarse_source_ = &measurements;
+  smoothed_.reset();
+  space_.reset();
+}
+
 void AgentState::apply_coarse(const std::vector<Eigen::MatrixXd>& motions) {
   const Eigen::MatrixXd& own = motions[static_cast<std::size_t>(id_)];
   apply_motion(own, d_, Y);

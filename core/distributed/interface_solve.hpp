@@ -17,11 +17,11 @@
 // instructions, Sigma's assembly and factorizations 2.81 -> 0.52 (27.9 Mflop each, 151,785
 // entries in L), the blocks' factors and Schur complements 1.38 -> 0.59.
 // Sigma is as large as the team's interface (ais2klinik at N = 5: 102 coordinates, city10000
-// 909). By default (NewtonRefineOptions::ship_solves) agent 0 alone receives the Schur
-// complements and coupling blocks, factors Sigma and solves with it: the others take their
+// 909). By default (NewtonRefineOptions::SigmaFactoring::kShipSolves) agent 0 alone receives the
+// Schur complements and coupling blocks, factors Sigma and solves with it: the others take their
 // segment of each solve (back_own(), adopt_remote_sigma()). Otherwise every agent factors the
 // same Sigma from the same bits in id order (or one agent does and the others take its
-// factor's values: sigma_values(), import_sigma(); NewtonRefineOptions::ship_sigma).
+// factor's values: sigma_values(), import_sigma(); SigmaFactoring::kShipFactor).
 // Applying the preconditioner then needs the team's rhat, which is linear in r: CG carries it
 // by its recurrences (rhat of H z rides in the iteration's all-agent sum), so a CG iteration is
 // still one exchange and one sum (newton_refine.cpp).
@@ -100,8 +100,8 @@ class InterfaceSolve {
   /// Sigma factor was last analysed on the same pattern (grounded or not); false otherwise (and
   /// where that factor failed), leaving assemble() to be called.
   bool import_sigma(const double* values, std::size_t count);
-  /// Sigma factored on another agent (NewtonRefineOptions::ship_solves): this agent takes
-  /// solves with it as that agent's solve() segments, so it records only how it was factored
+  /// Sigma factored on another agent (NewtonRefineOptions::SigmaFactoring::kShipSolves): this agent
+  /// takes solves with it as that agent's solve() segments, so it records only how it was factored
   /// (grounded or not) for grounded_pose() and back_own(). Cleared by the next factor().
   void adopt_remote_sigma(bool grounded);
   /// Whether the last assemble() (or adopt_remote_sigma()) grounded Sigma.

@@ -55,7 +55,6 @@ NewtonRefineProtocol::NewtonRefineProtocol(AgentState& state, const BlockLayout&
       cg_(std::make_unique<PipelinedCg>()),
       tcg_(std::make_unique<PipelinedCg>()) {
   options_.validate();
-  if (options_.ship_sigma) options_.ship_solves = false;  // agent 0 sends its factor instead
   everyone_.resize(static_cast<std::size_t>(layout_.num_blocks));
   for (int b = 0; b < layout_.num_blocks; ++b) everyone_[static_cast<std::size_t>(b)] = b;
 }
@@ -297,7 +296,9 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
     auto solve = std::make_unique<InterfaceSolve>(problem_, layout_, state_.id());
     if (solve->team_size() > 0 && solve->team_size() <= options_.interface_max_coordinates) {
       result_.interface_coordinates = static_cast<int>(solve->team_size());
-      if (solve->team_size() < options_.ship_solves_min_coordinates) options_.ship_solves = false;
+      if (options_.sigma_factoring == SigmaFactoring::kShipSolves &&
+          solve->team_size() < options_.ship_solves_min_coordinates)
+        options_.sigma_factoring = SigmaFactoring::kEveryAgent;
       interface_ = std::move(solve);
     }
   }
@@ -373,7 +374,7 @@ void NewtonRefineProtocol::reset_cg() {
 }
 
 void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
-  if (use_interface_ && options_.ship_solves) {
+  if (use_interface_ && options_.sigma_factoring == SigmaFactoring::kShipSolves) {
     return send_solution(true, out);  // z from the holder's solve (after_solution)
   } else if (use_interface_) {
     z_ = interface_->back(X_, iy_r_, ir_);

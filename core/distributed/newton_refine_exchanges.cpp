@@ -36,7 +36,7 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
   // This block's share of Sigma at the current point, then its interface residual of -g (the
   // first CG residual), so that the first direction needs no further message step.
   charge_to(&result_.times.factor_s);
-  // With the shares in hand (the accepted trial's sum carried them, ship_sigma) the block is
+  // With the shares in hand (the accepted trial's sum carried them, kShipFactor) the block is
   // factored at this point already: only its flag goes out, and agent 0's Sigma factor.
   std::vector<double> values =
       shares_ready_
@@ -91,7 +91,8 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
       for (int j = 0; j < k; ++j)
         v[2 * k * k + k + i * k + j] = frobenius_inner(gauge_hv_[static_cast<std::size_t>(i)],
                                                        gauge_hv_[static_cast<std::size_t>(j)]);
-  if (!options_.ship_solves) return broadcast(kInterface, values, out);
+  if (options_.sigma_factoring != SigmaFactoring::kShipSolves)
+    return broadcast(kInterface, values, out);
   // Agent 0 alone assembles Sigma: it receives the whole shares, the others each share's flag,
   // interface residuals and gauge sums only. Always the same agent: its Sigma pattern and
   // symbolic analysis are laid out once (each first assemble() on an agent does both; taking
@@ -242,7 +243,8 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
         ++result_.sigma_factorizations;
       }
     }
-  } else if (ok && (!options_.ship_solves || state_.id() == kSigmaHolder)) {
+  } else if (ok && (options_.sigma_factoring != SigmaFactoring::kShipSolves ||
+                    state_.id() == kSigmaHolder)) {
     ok = assemble_sigma(*interface_, shares, options_.interface_shift);
     ++result_.sigma_factorizations;
   }
@@ -257,7 +259,7 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
     const Eigen::Map<const Eigen::MatrixXd> kk(gsum.data() + 2 * k * k + k, k, k);
     gauge_hvhv_ = 0.5 * (kk + kk.transpose());
   }
-  if (options_.ship_solves && all_flags) {
+  if (options_.sigma_factoring == SigmaFactoring::kShipSolves && all_flags) {
     // Only the holder knows whether Sigma factored: its first solution says so.
     if (state_.id() == kSigmaHolder) {
       if (ok) {

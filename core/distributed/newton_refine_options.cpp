@@ -32,6 +32,10 @@ void NewtonRefineOptions::validate() const {
   if (!(auto_interface_grad_tol >= 0)) fail("auto_interface_grad_tol", "must be >= 0");
   if (!(interface_shift > 0 && interface_shift <= 1e-3))
     fail("interface_shift", "must be in (0, 1e-3]");
+  if (sigma_factoring != SigmaFactoring::kEveryAgent &&
+      sigma_factoring != SigmaFactoring::kShipFactor &&
+      sigma_factoring != SigmaFactoring::kShipSolves)
+    fail("sigma_factoring", "must be kEveryAgent, kShipFactor or kShipSolves");
   if (ship_solves_min_coordinates < 0) fail("ship_solves_min_coordinates", "must be >= 0");
 }
 
@@ -47,12 +51,22 @@ void set_sigma_mode(NewtonRefineOptions& options, const std::string& mode,
                     const std::string& what) {
   if (mode != "every" && mode != "one" && mode != "solve")
     throw InputError(what + ": '" + mode + "' is not one of every, one, solve");
-  options.ship_sigma = mode == "one";
-  options.ship_solves = mode == "solve";
+  using SigmaFactoring = NewtonRefineOptions::SigmaFactoring;
+  options.sigma_factoring = mode == "every" ? SigmaFactoring::kEveryAgent
+                            : mode == "one" ? SigmaFactoring::kShipFactor
+                                            : SigmaFactoring::kShipSolves;
 }
 
 std::string sigma_mode(const NewtonRefineOptions& options) {
-  return options.ship_solves ? "solve" : options.ship_sigma ? "one" : "every";
+  switch (options.sigma_factoring) {
+    case NewtonRefineOptions::SigmaFactoring::kEveryAgent:
+      return "every";
+    case NewtonRefineOptions::SigmaFactoring::kShipFactor:
+      return "one";
+    case NewtonRefineOptions::SigmaFactoring::kShipSolves:
+      return "solve";
+  }
+  return "solve";  // not reached: validate() rejects other values
 }
 
 CoarseOptions NewtonRefineOptions::coarse_space_options() const {

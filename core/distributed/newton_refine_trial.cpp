@@ -71,7 +71,7 @@ void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
 bool NewtonRefineProtocol::ship_trial_shares() const {
   // Not where the step is predicted to end the refinement (its decrease below the stop's) or
   // it is the last step allowed: there the block factor would not be used.
-  return options_.ship_sigma && interface_ && use_interface_ &&
+  return options_.sigma_factoring == SigmaFactoring::kShipFactor && interface_ && use_interface_ &&
          step_.predicted > options_.relative_decrease_tol * std::abs(f_) &&
          result_.steps + 1 < options_.max_steps;
 }

@@ -81,11 +81,21 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
   compact_of_.resize(graph.num_poses, kNone);
   const std::size_t first_new = graph_.measurements.size();
   const std::size_t n_old = full_id_.size();
-  // Poses a re-partition moved: every state is built again (rare; the cheap path would have to
-  // move rows between factors).
+  // Poses a re-partition moved: the blocks that gave or took one are built again (growing them
+  // in place would have to move rows between factors). The others keep their states: their own
+  // poses and neighbour poses are the same, only the neighbours' owners changed.
   bool moved = false;
+  std::vector<char> reshaped;  // by original block
+  auto reshape = [&](int b) {
+    if (b < 0) throw std::invalid_argument("LiveBlocks::sync: negative block");
+    if (static_cast<std::size_t>(b) >= reshaped.size())
+      reshaped.resize(static_cast<std::size_t>(b) + 1, 0);
+    reshaped[static_cast<std::size_t>(b)] = 1;
+  };
   for (std::size_t s = 0; s < n_old; ++s)
     if (owner[full_id_[s]] != owner_[s]) {
+      reshape(owner_[s]);
+      reshape(owner[full_id_[s]]);
       owner_[s] = owner[full_id_[s]];
       moved = true;
     }
@@ -125,7 +135,7 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
   std::vector<int> order;
   for (std::size_t b = 0; b < present.size(); ++b)
     if (present[b]) order.push_back(static_cast<int>(b));
-  const bool renumber = moved || order.size() < block_of_.size() ||
+  const bool renumber = order.size() < block_of_.size() ||
                         !std::equal(block_of_.begin(), block_of_.end(), order.begin());
   if (renumber) {
     for (const auto& s : states_) retire(s);
@@ -135,7 +145,7 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
   compact_block_of_.assign(present.size(), -1);
   for (std::size_t c = 0; c < block_of_.size(); ++c)
     compact_block_of_[static_cast<std::size_t>(block_of_[c])] = static_cast<int>(c);
-  const std::size_t renumber_from = renumber ? 0 : n_old;
+  const std::size_t renumber_from = renumber || moved ? 0 : n_old;
   blocks_.resize(n);
   for (std::size_t s = renumber_from; s < n; ++s)
     blocks_[s] = compact_block_of_[static_cast<std::size_t>(owner_[s])];
@@ -158,7 +168,8 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
       continue;
     }
     const Eigen::MatrixXd Y0 = columns(X, layout_->poses[c]);
-    bool build = !state;
+    const auto b = static_cast<std::size_t>(block_of_[c]);
+    bool build = !state || (b < reshaped.size() && reshaped[b]);
     if (!build && touched[c]) {
       try {
         state->extend(graph_.measurements, first_new, Y0, refactor_growth_);
@@ -167,6 +178,7 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
         build = true;  // the block lost or reordered poses
       }
     } else if (!build) {
+      if (moved) state->neighbours_moved(graph_.measurements);
       ++out.kept;
     }
     if (build) {
@@ -174,6 +186,7 @@ LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,
       state = std::make_unique<AgentState>(static_cast<int>(c), d_, *layout_, graph_.measurements,
                                            Y0, update_);
       ++out.built;
+      ++built_total_;
     }
     state->reset_iterate(Y0, columns(X, state->problem().neighbors()));
   }

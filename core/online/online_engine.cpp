@@ -101,6 +101,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   if ((u.poses == 0 && u.measurements == 0 && converged_) || graph.num_poses == 0) return u;
   const TangentFactorTotals factors_before =
       blocks_ ? blocks_->tangent_factor_totals() : TangentFactorTotals{};
+  const long long built_before = blocks_ ? blocks_->built_total() : 0;
 
   // New poses join a block (their robot's, or the one holding most of their measurements);
   // then the blocks follow the graph's growth and cut.
@@ -175,6 +176,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     const TangentFactorTotals step = blocks_->tangent_factor_totals().since(factors_before);
     u.factorizations = step.factorizations;
     u.factor_flops = step.flops;
+    u.blocks_built = blocks_->built_total() - built_before;
   }
   u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
   u.cpu_s = cpu_now() - cpu_start;
@@ -223,6 +225,17 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
   return solver;
 }
 
+void use_online_refine_space(const LiveBlocks& blocks, const DistributedOptions& solver) {
+  if (!solver.refine.enabled || solver.refine.coarse != NewtonRefineOptions::Coarse::kSmoothed)
+    return;
+  const PoseGraph& g = blocks.graph();
+  // One space shared by every held state.
+  const auto space = std::make_shared<const CoarseSpace>(make_coarse_space(
+      g.num_poses, g.measurements, blocks.layout().owner, solver.refine.coarse_space_options()));
+  for (const auto& s : blocks.states())
+    if (s) s->use_refine_space(space);
+}
+
 DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
   DistributedResult res;
   if (!blocks_)
@@ -233,14 +246,7 @@ DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
   if (blocks_->graph().num_poses == 0) return res;
   DistributedOptions run = solver;
-  if (run.refine.enabled && run.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed) {
-    // The smoothed pieces follow the linked graph and its blocks, which change at every step:
-    // built again here (a pass over the measurements), one space shared by every agent.
-    const PoseGraph& g = blocks_->graph();
-    const auto space = std::make_shared<const CoarseSpace>(make_coarse_space(
-        g.num_poses, g.measurements, blocks_->layout().owner, run.refine.coarse_space_options()));
-    for (AgentState* s : blocks_->all_states()) s->use_refine_space(space);
-  }
+  use_online_refine_space(*blocks_, run);
   run.round_result = false;  // in the linked graph's ids: the caller rounds X_
   res = solve_distributed_with_states(blocks_->graph(), blocks_->layout(), blocks_->all_states(),
                                       run);

@@ -51,6 +51,20 @@ std::string validation_message(const Options& options) {
   return input_error_of([&options] { options.validate(); });
 }
 
+/// Whether `options.validate()` throws an InputError whose message contains `field` (a field's
+/// name, often qualified: "RobustOptions.mu_step"); a failure shows what it threw instead, or
+/// that it accepted the options. For `EXPECT_TRUE(test::validation_names(o, "..."))`.
+template <class Options>
+::testing::AssertionResult validation_names(const Options& options, const std::string& field) {
+  const std::string message = validation_message(options);
+  if (message.find(field) != std::string::npos) return ::testing::AssertionSuccess();
+  if (message.empty())
+    return ::testing::AssertionFailure()
+           << "validate() accepted the options, expected an error naming '" << field << "'";
+  return ::testing::AssertionFailure()
+         << "validate() threw '" << message << "', which does not name '" << field << "'";
+}
+
 }  // namespace tessera::test
 
 /// Skips the current test with a clear message when ../shared is not there.

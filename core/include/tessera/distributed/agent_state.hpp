@@ -130,6 +130,12 @@ class AgentState {
   /// state then).
   void extend(const std::vector<Measurement>& measurements, std::size_t first_new,
               const Eigen::MatrixXd& Y0, double refactor_growth);
+  /// Poses of other blocks changed block (an online re-partition) while this block's own poses
+  /// and neighbour poses stayed: the layout this state was built with now has other neighbour
+  /// owners and adjacency. Drops what was built from them (the coarse terms, built again on
+  /// first use from `measurements`, the same growing vector, which must outlive this state; the
+  /// smoothed coarse pieces, set again by use_coarse_space). The problem and its factors stay.
+  void neighbours_moved(const std::vector<Measurement>& measurements);
   /// Starts the sequences afresh at Y0 (any rank, e.g. r + 1 after a saddle escape) with
   /// neighbours at Yn0 (same rank, neighbour order).
   void reset_iterate(const Eigen::MatrixXd& Y0, const Eigen::MatrixXd& Yn0);

@@ -13,12 +13,11 @@
 //   * the preconditioner, where the team's interface is small (options.interface_max_coordinates),
 //     is the Hessian's inverse by substructuring (distributed/interface_solve.hpp: each block's
 //     factor and the interface's Schur complement, which agent 0 factors once per point and solves
-//     with for every agent, NewtonRefineOptions::ship_solves), so a Newton step's CG takes 1-3
-//     iterations; elsewhere block Jacobi (AgentState::precondition:
-//     the tangent factor of its block, else its Q_BB factor), optionally with a coarse correction
-//     over rigid motions of smoothed pieces of the blocks (options.coarse,
-//     distributed/tangent_coarse_space.hpp): block Jacobi alone moves information one block
-//     boundary per CG iteration.
+//     with for every agent, NewtonRefineOptions::SigmaFactoring::kShipSolves), so a Newton step's
+//     CG takes 1-3 iterations; elsewhere block Jacobi (AgentState::precondition: the tangent factor
+//     of its block, else its Q_BB factor), optionally with a coarse correction over rigid motions
+//     of smoothed pieces of the blocks (options.coarse, distributed/tangent_coarse_space.hpp):
+//     block Jacobi alone moves information one block boundary per CG iteration.
 // CG is in the Chronopoulos-Gear form (the two inner products of an iteration from one
 // reduction, <p, Hp> by recurrence), so an iteration is one exchange then one reduction.
 // The trust region (Steihaug-Toint truncated CG in the preconditioner's norm, ratio test on the
@@ -180,8 +179,8 @@ struct NewtonRefineOptions {
   /// point then costs one all-agent sum (each block's interface residual, its interface poses x
   /// the iterate's rows) and no exchange: the solve's interface values are the neighbours' new
   /// public translations. A block whose L_BB is singular (a pose without measurements) sends
-  /// a flag and the team keeps the CG. Why: the CG took 123 iterations (two message steps
-  /// each) over ais2klinik's 10 trial points, 80 % of the refinement's 305 message steps
+  /// a flag and the team keeps the CG. Why: the CG took 120 iterations (two message steps
+  /// each) over ais2klinik's 9 trial points, 80 % of the refinement's 299 message steps
   /// (docs/newton-refine.md, "Exact trial translations"). >= 0; 0 = off (the CG above).
   int translation_interface_max_poses = 2000;
   /// Preconditioner: exact solves with the Hessian through the team's interface
@@ -189,28 +188,30 @@ struct NewtonRefineOptions {
   /// coordinates (d(d+1)/2 a pose: ais2klinik at N = 5 102, city10000 909); 0 = off. Each
   /// block factors its diagonal block of the Riemannian Hessian (interface last) and broadcasts
   /// its Schur complement and cut couplings once per point (one all-agent message step); the
-  /// interface matrix Sigma (as large as this cap) is factored (by agent 0, ship_solves, or by
-  /// every agent) and H^-1 applied exactly (up to the shift below) in each CG iteration, whose
-  /// message steps are one exchange and one sum (the interface residual rides in the sum), and
-  /// with ship_solves agent 0's solution. Used at rank d with `coarse` kNone. A
-  /// block whose Hessian block is not positive definite (far from a minimiser) factors it
-  /// without the multiplier term (then M is the inverse of that modified H); where no block
-  /// factor or no Sigma is positive definite, that point's CG runs block Jacobi. Why 1,000:
-  /// every agent factors Sigma at every point (CHOLMOD supernodal; dense within each block's
-  /// interface, so its cost grows up to size^3 / 3) and receives every Schur complement.
-  /// city10000's 909 coordinates at N = 5 (cap 1,000 against 500, in process): rounds 142 ->
-  /// 48, the refinement's CG 2 iterations, 5.38 against 6.94 billion instructions for the whole
-  /// solve (callgrind), same certified optimum; cubicle's 1,572 cut its CG iterations 116 -> 3
-  /// but doubled the CPU of the whole solve and multiplied the bytes by 8 (4.9 -> 40.6 MB), so
-  /// it stays out, as do torus3D (2,916) and sphere2500 (2,088); parking-garage (348) and
-  /// ais2klinik (102) gain 4-9x (docs/newton-refine.md). >= 0.
+  /// interface matrix Sigma (as large as this cap) is factored (by agent 0 or by every agent,
+  /// `sigma_factoring`) and H^-1 applied exactly (up to the shift below) in each CG iteration,
+  /// whose message steps are one exchange and one sum (the interface residual rides in the sum),
+  /// and with kShipSolves agent 0's solution. Used at rank d with `coarse` kNone. A block whose
+  /// Hessian block is not positive definite (far from a minimiser) factors it without the
+  /// multiplier term (then M is the inverse of that modified H); where no block factor or no Sigma
+  /// is positive definite, that point's CG runs block Jacobi. Why 1,000: Sigma's factorization
+  /// (CHOLMOD supernodal; dense within each block's interface) grows up to size^3 / 3. Chosen
+  /// when every agent factored Sigma at every point and received every Schur complement:
+  /// city10000's 909 coordinates at N = 5 (cap 1,000 against 500, in process): rounds 142 -> 48,
+  /// the refinement's CG 2 iterations, 5.38 against 6.94 billion instructions for the whole solve
+  /// (callgrind), same certified optimum; cubicle's 1,572 cut its CG iterations 116 -> 3 but then
+  /// doubled the CPU of the whole solve and multiplied the bytes by 8 (4.9 -> 40.6 MB), so it
+  /// stayed out, as did torus3D (2,916) and sphere2500 (2,088). With kShipSolves, the default
+  /// from ship_solves_min_coordinates, that cost is agent 0's alone (cubicle 4.9 -> 4.8 MB, user
+  /// CPU 0.6x, loaded); the cap has not been re-chosen since (docs/newton-refine.md, "Cap").
+  /// parking-garage (348) and ais2klinik (102) gain 4-9x. >= 0.
   int interface_max_coordinates = 1000;
   /// kIfRoundsSlow: where the interface solves apply (the team's interface within
   /// interface_max_coordinates), the rounds stop at max(the solver's grad_norm_tol,
   /// this) and the refinement always runs. Why: with exact interface solves (and exact trial
   /// translations) a Newton step costs a few message steps even from a rough point, where the
   /// rounds' last decades cost hundreds: in process at N = 5, message steps from gradient 1
-  /// against 30: kitti_02 663 -> 123, ais2klinik 127 -> 31, city10000 109 -> 27, the same
+  /// against 30: kitti_02 661 -> 125, ais2klinik 121 -> 33, city10000 111 -> 30, the same
   /// certified optimum (docs/newton-refine.md, "Handing over"). 0 = off (the rounds' tail
   /// alone decides). >= 0.
   double auto_interface_grad_tol = 30.0;
@@ -225,41 +226,45 @@ struct NewtonRefineOptions {
   /// (the grounded Sigma's inverse, projected, is its preconditioner); false, CG solves the
   /// equation with the grounded pose held and the step is projected off the gauge once.
   /// Why false: on the paper graphs at N = 5 both take the same steps, CG iterations and
-  /// message steps, and projecting costs 4 % more instructions (city10000) and 5-24 % more
+  /// message steps, and projecting costs 5 % more instructions (city10000) and 10-27 % more
   /// bytes; from a rough start on a 1,000-pose corridor the grounded CG meets negative
   /// curvature along the gauge (6 steps, one rejected, 36 message steps; projected: 4, 31)
   /// (docs/newton-refine.md, "Gauge").
   bool project_gauge = false;
-  /// With the interface solves: true, where the model says a trial step will not end the
-  /// refinement (its predicted decrease above relative_decrease_tol |f|, steps left), each
-  /// agent factors its block at the trial point before the verdict and its share of Sigma rides
-  /// in the trial's sum; at an accepted trial agent 0 alone assembles and factors Sigma and
-  /// sends the factor in the interface step that every point has anyway (the other agents take
-  /// it as it is: the same bits as their own factorization). false: every agent assembles and
-  /// factors Sigma at every point. Both take the same steps, CG iterations and message steps
-  /// to the same bits; the start point and a step predicted to be the last take the
-  /// every-agent path. Why false: on city10000 at N = 5 shipping saves 9.3 % of the
-  /// refinement's instructions in process (1.95 -> 1.77 G) but sends Sigma's factor (1.9 MB) to
-  /// every agent at each shipped point (DDS bytes 9.1 -> 13.0 MB), and over DDS on one 2-core
-  /// machine the agents' CPU after the rounds did not fall (medians of 6 launches 0.85 vs
-  /// 1.08 CPU-s, load 12-17): what the agents' threads save in factorizations their transport
-  /// spends moving the factor (docs/newton-refine.md, "Who factors Sigma").
-  bool ship_sigma = false;
-  /// With the interface solves: true, at each point ONE agent (agent 0) receives the blocks'
-  /// Schur complements and couplings (the other agents only the flags, interface residuals and
-  /// gauge sums), assembles and factors Sigma, and for each CG direction solves with it and
-  /// sends each agent its own segment of the solution (a short vector: the agent's interface
-  /// coordinates), one more message step a direction, on which every agent waits for agent 0.
-  /// false: every agent factors Sigma and solves with it itself. The same bits either way (the
-  /// same shares in id order, the same factorization and solves), so the same steps, CG
-  /// iterations and iterates. ship_sigma, where set, takes precedence (agent 0 sends its factor
-  /// instead). Why true: the agents' identical Sigma factorizations are redundant CPU, which is
-  /// wall where agents share processors. city10000 at N = 5 in process (callgrind): the whole
-  /// solve 4.335 -> 3.842 G instructions, the refinement 1.948 -> 1.487 G, bytes 14.67 -> 4.72 MB,
-  /// message steps 27 -> 30; over DDS on a 2-core machine the agents' CPU after the rounds
-  /// 0.865 -> 0.730 CPU-s (medians, load 16-19) (docs/newton-refine.md, "Who factors Sigma").
-  bool ship_solves = true;
-  /// ship_solves applies where the team's interface has at least this many tangent
+  /// Who assembles and factors Sigma, the interface solves' matrix, at each point
+  /// (`--refine-sigma`, set_sigma_mode). All three take the same steps, CG iterations and
+  /// iterates to the same bits (the same shares in id order, the same factorization and
+  /// solves); they differ in CPU, bytes and message steps.
+  ///   kEveryAgent (`every`): every agent assembles and factors Sigma at every point and solves
+  ///   with it itself.
+  ///   kShipFactor (`one`): where the model says a trial step will not end the refinement (its
+  ///   predicted decrease above relative_decrease_tol |f|, steps left), each agent factors its
+  ///   block at the trial point before the verdict and its share of Sigma rides in the trial's
+  ///   sum; at an accepted trial agent 0 alone assembles and factors Sigma and sends the factor
+  ///   in the interface step that every point has anyway (the other agents take it as it is:
+  ///   the same bits as their own factorization). The start point and a step predicted to be
+  ///   the last take the every-agent path. Why not the default: on city10000 at N = 5 it saves
+  ///   9.3 % of the refinement's instructions in process (1.95 -> 1.77 G) but sends Sigma's
+  ///   factor (1.9 MB) to every agent at each shipped point (DDS bytes 9.1 -> 13.0 MB), and
+  ///   over DDS on one 2-core machine the agents' CPU after the rounds did not fall (medians
+  ///   of 6 launches 0.85 vs 1.08 CPU-s, load 12-17): what the agents' threads save in
+  ///   factorizations their transport spends moving the factor.
+  ///   kShipSolves (`solve`, the default): at each point ONE agent (agent 0) receives the
+  ///   blocks' Schur complements and couplings (the other agents only the flags, interface
+  ///   residuals and gauge sums), assembles and factors Sigma, and for each CG direction solves
+  ///   with it and sends each agent its own segment of the solution (a short vector: the
+  ///   agent's interface coordinates), one more message step a direction, on which every agent
+  ///   waits for agent 0. Where Sigma is smaller than ship_solves_min_coordinates the team
+  ///   runs kEveryAgent instead. Why the default: the agents' identical Sigma factorizations
+  ///   are redundant CPU, which is wall where agents share processors. city10000 at N = 5 in
+  ///   process (callgrind), against kEveryAgent: the whole solve 4.335 -> 3.842 G
+  ///   instructions, the refinement 1.948 -> 1.487 G, bytes 14.67 -> 4.72 MB, message steps
+  ///   27 -> 30; over DDS on a 2-core machine the agents' CPU after the rounds 0.865 -> 0.730
+  ///   CPU-s (medians, load 16-19).
+  /// (docs/newton-refine.md, "Who factors Sigma".)
+  enum class SigmaFactoring { kEveryAgent, kShipFactor, kShipSolves };
+  SigmaFactoring sigma_factoring = SigmaFactoring::kShipSolves;
+  /// kShipSolves applies where the team's interface has at least this many tangent
   /// coordinates (Sigma's size; the same on every agent); below it every agent factors Sigma.
   /// Why: Sigma's factorization grows about as its size cubed, the extra message step a CG
   /// direction does not: at city10000's 909 coordinates one factorization is ~37 M
@@ -278,9 +283,9 @@ struct NewtonRefineOptions {
 void set_refine_mode(NewtonRefineOptions& options, const std::string& mode);
 
 /// The `--refine-sigma` values as options: who factors the interface solves' Sigma. "every"
-/// (each agent, ship_sigma and ship_solves off), "one" (ship_sigma) or "solve" (ship_solves).
-/// One parser for the command line, the coordinator and the agents' assignment. Throws
-/// InputError "<what>: 'v' is not one of every, one, solve".
+/// (SigmaFactoring::kEveryAgent), "one" (kShipFactor) or "solve" (kShipSolves). One parser for the
+/// command line, the coordinator and the agents' assignment. Throws InputError "<what>: 'v' is not
+/// one of every, one, solve".
 void set_sigma_mode(NewtonRefineOptions& options, const std::string& mode,
                     const std::string& what = "option --refine-sigma");
 /// The `--refine-sigma` value of `options` (set_sigma_mode's inverse).
@@ -328,7 +333,7 @@ struct NewtonRefineResult {
   int steps = 0, accepted_steps = 0, cg_iterations = 0;
   /// Message steps: neighbour exchanges (CG directions and trial poses) and all-agent sums.
   int exchanges = 0, reductions = 0;
-  /// ship_solves: the CG directions' steps that wait for the agent solving with Sigma.
+  /// kShipSolves: the CG directions' steps that wait for the agent solving with Sigma.
   int solution_steps = 0;
   /// All together: the refinement's waits for peers (a round of IRBCD is two).
   int message_steps() const { return exchanges + reductions + solution_steps; }
@@ -347,7 +352,7 @@ struct NewtonRefineResult {
   /// counted in `reductions`) and where it could not be (that step's CG ran block Jacobi).
   int interface_coordinates = 0, interface_factorizations = 0, interface_fallbacks = 0;
   /// This agent's own assemblies and factorizations of Sigma (points), the points whose Sigma it
-  /// took from agent 0's factor (ship_sigma), and the block factorizations at trial points that
+  /// took from agent 0's factor (kShipFactor), and the block factorizations at trial points that
   /// were not used (a rejected trial, or the refinement stopped there).
   int sigma_factorizations = 0, sigma_imports = 0, pending_factors_unused = 0;
   std::vector<NewtonRefineStep> trace;
@@ -374,7 +379,7 @@ class NewtonRefineProtocol : public AgentProcess {
     kInterface = 68,             ///< Interface solves: each block's Schur complement and couplings.
     kTranslationSolve = 69,      ///< Exact trial translations: each block's interface residual.
     kSolution =
-        70  ///< ship_solves: Sigma's solve, each agent's segment, from the agent holding it.
+        70  ///< kShipSolves: Sigma's solve, each agent's segment, from the agent holding it.
   };
   /// The last of the steps: [kStatus, kLastStep] are the refinement's.
   static constexpr std::uint32_t kLastStep = kSolution;
@@ -417,6 +422,7 @@ class NewtonRefineProtocol : public AgentProcess {
   }
 
  private:
+  using SigmaFactoring = NewtonRefineOptions::SigmaFactoring;
   void pump(std::vector<OutgoingMessage>& out);
   void send_public(const Eigen::MatrixXd& v, std::uint32_t step, std::vector<OutgoingMessage>& out);
   void broadcast(std::uint32_t step, const std::vector<double>& values,
@@ -451,9 +457,9 @@ class NewtonRefineProtocol : public AgentProcess {
   // The block preconditioner for the next CG solve (options_.refactor_every_step).
   void prepare_preconditioner();
   void send_direction(std::vector<OutgoingMessage>& out);
-  // ship_solves: a share's trailing interface residuals (this block's), in values.
+  // kShipSolves: a share's trailing interface residuals (this block's), in values.
   std::size_t share_tail() const;
-  // ship_solves, on the holder: u = Sigma^-1 rhat of the current residual, each agent's segment
+  // kShipSolves, on the holder: u = Sigma^-1 rhat of the current residual, each agent's segment
   // sent to it (kSolution, after the flag and grounding); everyone waits for it. With ok false
   // (no positive definite Sigma at this point), the flag 0 alone.
   void send_solution(bool ok, std::vector<OutgoingMessage>& out);
@@ -479,7 +485,7 @@ class NewtonRefineProtocol : public AgentProcess {
   // The trial point's cost share and ||g||^2 (kTrialSums), its neighbours' poses set; with
   // ship_trial_shares(), the block's share of Sigma at the trial point after them.
   void send_trial_sums(std::vector<OutgoingMessage>& out);
-  // Whether this trial's sum carries the Sigma shares (options_.ship_sigma): the same inputs,
+  // Whether this trial's sum carries the Sigma shares (kShipFactor): the same inputs,
   // so the same answer, on every agent.
   bool ship_trial_shares() const;
   // Agent 0 with the shares in hand: Sigma assembled and factored, its factor's message values.
@@ -531,14 +537,14 @@ class NewtonRefineProtocol : public AgentProcess {
   // CG's recurrences (the one of H z rides in the iteration's sum).
   std::unique_ptr<InterfaceSolve> interface_;
   bool interface_due_ = true, use_interface_ = false;
-  // ship_sigma: whether the current trial's sum carries the shares; the team's shares at the
+  // kShipFactor: whether the current trial's sum carries the shares; the team's shares at the
   // accepted trial (id order), in hand for the next interface step (shares_ready_).
   bool trial_shares_ = false, shares_ready_ = false;
   std::vector<std::vector<double>> next_shares_;
-  // ship_solves: the point's Sigma verdict is the holder's, not yet known here (it comes with
+  // kShipSolves: the point's Sigma verdict is the holder's, not yet known here (it comes with
   // the point's first solution).
   bool verdict_due_ = false;
-  // The agent that assembles and factors Sigma for the team (ship_sigma, ship_solves): always
+  // The agent that assembles and factors Sigma for the team (kShipFactor, kShipSolves): always
   // the same one, so its pattern and symbolic analysis are laid out once.
   static constexpr int kSigmaHolder = 0;
   Eigen::VectorXd iy_r_, iy_q_, iy_w_, iy_g_, ir_, iq_, ir_g_;

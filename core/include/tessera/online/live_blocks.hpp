@@ -46,7 +46,7 @@ struct TangentFactorTotals {
 /// What one LiveBlocks::sync did.
 struct LiveSync {
   std::size_t new_poses = 0, new_measurements = 0;  ///< Linked poses / measurements added.
-  int built = 0;     ///< Block states built from scratch (new blocks, re-partitioned blocks).
+  int built = 0;     ///< Block states built from scratch (new blocks, blocks a move changed).
   int extended = 0;  ///< Block states grown in place.
   int kept = 0;      ///< Block states with nothing new.
 };
@@ -81,6 +81,8 @@ class LiveBlocks {
   /// tangent_factorizations_total and tangent_factor_flops_total, states built again or dropped
   /// included).
   TangentFactorTotals tangent_factor_totals() const;
+  /// Block states built from scratch by every sync so far (LiveSync::built summed).
+  long long built_total() const { return built_total_; }
   /// Writes the compact iterate `Xc` (rank = X's rows) into the stream-id iterate `X`.
   void write_back(const Eigen::MatrixXd& Xc, Eigen::MatrixXd& X) const;
 
@@ -92,6 +94,7 @@ class LiveBlocks {
 
   int d_;
   TangentFactorTotals retired_;  // of the states dropped or built again
+  long long built_total_ = 0;
   BlockUpdateOptions update_;
   double refactor_growth_;
   int only_block_;

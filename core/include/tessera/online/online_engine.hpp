@@ -136,6 +136,13 @@ struct OnlineOptions {
 /// in-process engine's and `tessera-agent --online`'s, so both take the same steps.
 DistributedOptions online_step_solver(const OnlineOptions& options);
 
+/// With `solver`'s Newton steps and their smoothed coarse correction
+/// (NewtonRefineOptions::Coarse::kSmoothed): gives every state `blocks` holds the smoothed
+/// pieces of its linked graph and blocks. Those change at every step, so the pieces are built
+/// again for every solve (a pass over the measurements); every DDS agent builds the same ones
+/// from the same graph. Otherwise does nothing.
+void use_online_refine_space(const LiveBlocks& blocks, const DistributedOptions& solver);
+
 /// One step of the online run (the JSON `updates` array of `tessera launch --online`).
 struct OnlineUpdate {
   double time_s = 0.0;           ///< When the step began (stream clock).
@@ -187,6 +194,9 @@ struct OnlineUpdate {
   /// preconditioner's cost, free of the machine's load.
   long long factorizations = 0;
   double factor_flops = 0.0;
+  /// Block states built from scratch in this step's set-up (LiveBlocks::sync: new blocks, and
+  /// the blocks a re-partition gave or took poses); the others grew in place or were kept.
+  long long blocks_built = 0;
   /// OnlineOptions::align_merged_pieces: measurements that linked two pieces of the graph at
   /// this step, and the poses moved to align them.
   std::size_t merges = 0;

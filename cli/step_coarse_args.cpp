@@ -1,0 +1,65 @@
+#include "step_coarse_args.hpp"
+
+#include <tessera/util/input_error.hpp>
+
+namespace tessera::cli {
+
+const char* const kStepCoarseValued[] = {"step-coarse", "step-coarse-min-blocks", nullptr};
+
+const char* const kStepCoarseHelp =
+    "  --step-coarse C     newton: the CG's coarse correction, none (block Jacobi), blocks\n"
+    "                      (plus one rigid motion per block of the robots that have met) or\n"
+    "                      smoothed (plus the rigid motions of 8 smoothed pieces of each such\n"
+    "                      block: the fewest CG iterations once robots have met)  [none]\n"
+    "  --step-coarse-min-blocks M  the correction only for groups of at least M linked\n"
+    "                      blocks, smaller ones take block Jacobi's steps, >= 2   [3]\n";
+
+const char* step_coarse_name(NewtonRefineOptions::Coarse c) {
+  switch (c) {
+    case NewtonRefineOptions::Coarse::kBlocks:
+      return "blocks";
+    case NewtonRefineOptions::Coarse::kSmoothed:
+      return "smoothed";
+    case NewtonRefineOptions::Coarse::kNone:
+      break;
+  }
+  return "none";
+}
+
+void parse_step_coarse_options(const Arguments& args, OnlineOptions& options) {
+  const std::string coarse = args.get_or("step-coarse", "none");
+  if (coarse != "none" && coarse != "blocks" && coarse != "smoothed")
+    throw InputError("option --step-coarse: '" + coarse + "' is not one of none, blocks, smoothed");
+  options.newton_coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
+                          : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
+                                                 : NewtonRefineOptions::Coarse::kNone;
+  const long min_blocks = args.get_long("step-coarse-min-blocks", options.newton_coarse_min_blocks);
+  if (min_blocks < 2 || min_blocks > 1000000)
+    throw InputError("option --step-coarse-min-blocks: must be 2..1000000");
+  options.newton_coarse_min_blocks = static_cast<int>(min_blocks);
+}
+
+std::string step_coarse_disagreement(NewtonRefineOptions::Coarse mine, int mine_min_blocks,
+                                     NewtonRefineOptions::Coarse lead, int lead_min_blocks,
+                                     unsigned lead_agent) {
+  std::string flag, here, there;
+  if (mine != lead) {
+    flag = "--step-coarse";
+    here = step_coarse_name(mine);
+    there = step_coarse_name(lead);
+  } else if (mine != NewtonRefineOptions::Coarse::kNone && mine_min_blocks != lead_min_blocks) {
+    // Without a correction the minimum group changes nothing.
+    flag = "--step-coarse-min-blocks";
+    here = std::to_string(mine_min_blocks);
+    there = std::to_string(lead_min_blocks);
+  } else {
+    return "";
+  }
+  return "option " + flag + ": this agent's " + here + " differs from the lead's (agent " +
+         std::to_string(lead_agent) + ") " + there +
+         "; the coarse correction adds message steps to every agent's Newton steps, so all must "
+         "be started with the same --step-coarse options (tessera launch --online passes its own "
+         "to every agent)";
+}
+
+}  // namespace tessera::cli

@@ -1,0 +1,34 @@
+#pragma once
+// The coarse correction of an online run's Newton steps (OnlineOptions::newton_coarse and
+// newton_coarse_min_blocks, docs/online.md) as `tessera solve --online`, `tessera launch
+// --online` and `tessera-agent --online` spell it, and the agreement the DDS agents check: the
+// correction adds message steps to every CG iteration of every agent, so all must use the
+// same options (the lead's).
+
+#include <string>
+#include <tessera/online/online_engine.hpp>
+
+#include "arguments.hpp"
+
+namespace tessera::cli {
+
+/// Valued option names (without "--"), null-terminated: step-coarse, step-coarse-min-blocks.
+extern const char* const kStepCoarseValued[];
+/// Help text of those options (aligned as the agent's and launch's usage texts).
+extern const char* const kStepCoarseHelp;
+
+/// "none", "blocks" or "smoothed": the flag's value for `c`.
+const char* step_coarse_name(NewtonRefineOptions::Coarse c);
+
+/// Sets options.newton_coarse and newton_coarse_min_blocks from the flags (their defaults for
+/// absent ones); InputError names the bad option.
+void parse_step_coarse_options(const Arguments& args, OnlineOptions& options);
+
+/// "" when `mine` equals `lead` (coarse correction and, with one, its minimum group);
+/// otherwise a message naming the first option that differs with both values, e.g.
+/// "option --step-coarse: this agent's none differs from the lead's (agent 0) smoothed ...".
+std::string step_coarse_disagreement(NewtonRefineOptions::Coarse mine, int mine_min_blocks,
+                                     NewtonRefineOptions::Coarse lead, int lead_min_blocks,
+                                     unsigned lead_agent);
+
+}  // namespace tessera::cli

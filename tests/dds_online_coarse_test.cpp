@@ -1,0 +1,93 @@
+// The coarse correction of the online Newton steps over DDS (--step-coarse,
+// --step-coarse-min-blocks; docs/online.md): `tessera launch --online` passes the flags to every
+// agent, the agents' steps use the correction and end where the in-process run does, and an
+// agent started by hand with another --step-coarse than the lead's stops with exit code 2
+// naming the option (the correction adds message steps to every agent's Newton steps).
+// Domains 205 and 206.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <csignal>
+#include <string>
+
+#include "dds_process_support.hpp"
+
+namespace tessera::test::dds {
+namespace {
+
+TEST(DdsOnlineCoarse, SmoothedStepsOverDdsEndWhereTheInProcessRunEnds) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/grid.g2o";
+  generate_graph(graph, "--kind grid3d --poses 150 --robots 3");
+  // Groups of two linked blocks get the correction too: it runs as soon as two robots met.
+  const std::string flags =
+      " --rate 20 --speedup 2 --step-coarse smoothed --step-coarse-min-blocks 2";
+  std::string out;
+  ASSERT_EQ(run_command(bin("tessera") + " solve " + graph + " --online --robots 3 --no-progress" +
+                            flags + " --json " + dir + "/in_process.json",
+                        &out),
+            0)
+      << out;
+  const std::string in_process = read_text_file(dir + "/in_process.json");
+  EXPECT_EQ(json_text(in_process, "certified"), "true");
+  const double f_in_process = json_number(in_process, "cost");
+
+  ASSERT_EQ(run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
+                            " --agents 3 --online --domain 205 --timeout 60" + flags + " --json " +
+                            dir + "/online.json --keep-logs " + dir + "/logs",
+                        &out),
+            0)
+      << out;
+  const std::string json = read_text_file(dir + "/online.json");
+  EXPECT_EQ(json_text(json, "certified"), "true");
+  EXPECT_NEAR(json_number(json, "cost"), f_in_process, 1e-6 * f_in_process);
+  for (int a = 0; a < 3; ++a) {
+    const std::string agent = read_text_file(dir + "/logs/agent-" + std::to_string(a) + ".json");
+    EXPECT_EQ(json_text(agent, "step_coarse"), "\"smoothed\"") << "agent " << a;
+    EXPECT_EQ(json_number(agent, "step_coarse_min_blocks"), 2) << "agent " << a;
+    // Some step's Newton steps ran with the smoothed pieces' coarse space: more unknowns than
+    // one rigid motion per block (6 in 3D, 18 for the 3 blocks: --step-coarse blocks' space,
+    // which a smoothed run whose agents lacked the pieces would fall back to).
+    double largest = 0;
+    for (std::size_t at = agent.find("\"coarse_unknowns\": "); at != std::string::npos;
+         at = agent.find("\"coarse_unknowns\": ", at + 1))
+      largest = std::max(largest, json_number(agent, "coarse_unknowns", at));
+    EXPECT_GT(largest, 18) << "agent " << a;
+  }
+
+  // Bad values are launch's own input errors, before any process starts.
+  EXPECT_EQ(run_command(bin("tessera") + " launch " + graph +
+                            " --agents 3 --online --step-coarse pieces 2>&1",
+                        &out),
+            2);
+  EXPECT_TRUE(contains(out, "option --step-coarse: 'pieces'")) << out;
+  EXPECT_EQ(run_command(bin("tessera") + " launch " + graph +
+                            " --agents 3 --online --step-coarse-min-blocks 1 2>&1",
+                        &out),
+            2);
+  EXPECT_TRUE(contains(out, "option --step-coarse-min-blocks")) << out;
+}
+
+TEST(DdsOnlineCoarse, AnAgentWithAnotherStepCoarseThanTheLeadsIsRefused) {
+  const std::string dir = temp_dir();
+  const std::string run = "online-coarse-differs";
+  Process lead = start({bin("tessera-agent"), "--online", "--robots", "2", "--id", "0", "--run-id",
+                        run, "--domain", "206", "--timeout", "60", "--step-coarse", "smoothed"},
+                       dir + "/lead.log");
+  Process other = start({bin("tessera-agent"), "--online", "--robots", "2", "--id", "1", "--run-id",
+                         run, "--domain", "206", "--timeout", "60"},
+                        dir + "/other.log");
+  const bool ended = wait_all({&other}, 60);
+  kill(lead.pid, SIGTERM);
+  wait_all({&lead}, 30);
+  ASSERT_TRUE(ended) << "the agent with another --step-coarse did not stop";
+  EXPECT_EQ(other.exit_code, 2) << other.output();
+  EXPECT_TRUE(contains(other.output(),
+                       "option --step-coarse: this agent's none differs from the "
+                       "lead's (agent 0) smoothed"))
+      << other.output();
+}
+
+}  // namespace
+}  // namespace tessera::test::dds
