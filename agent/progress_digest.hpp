@@ -1,8 +1,8 @@
 #pragma once
 // An agent's progress digest for the coordinator (wire::AgentProgress, docs/dds-runtime.md,
-// "Progress digests"). The coordinator used to read every agent's status of every round
+// "Progress digests"). Why: for the coordinator to read every agent's status of every round
 // (N deliveries and N wake-ups of its receive thread a round, ~1/5 of a cheap round's
-// deliveries) only to print progress, time the rounds and spot lagging agents. Each agent
+// deliveries) only to print progress, time the rounds and spot lagging agents is waste. Each agent
 // already sees every status of a step (it needs them for the step's sums), so it can tell the
 // coordinator the same things a few times a second instead: the newest step it has seen
 // complete with its sums, the step it still waits in and for whom, and the round timing.

@@ -118,8 +118,9 @@ TEST(DdsRobust, IteratesAndRejectedSetEqualTheInProcessEngine) {
   // same ones over DDS.
   EXPECT_GT(ref.refine_message_steps, 0);
   EXPECT_EQ(json_field(dds.summary, "gnc_refine_steps"), ref.refine_message_steps) << dds.summary;
-  // GNC's own exchanges and every wait for peers in all: the same count over DDS.
-  EXPECT_GE(ref.exchange_steps, 2 * ref.outer_iterations + 2);
+  // GNC's own exchanges and every wait for peers in all: the same count over DDS. At least a
+  // weight exchange per outer step (the poses travel with the Newton steps' trial sums).
+  EXPECT_GE(ref.exchange_steps, ref.outer_iterations + 2);
   EXPECT_EQ(json_field(dds.summary, "gnc_exchange_steps"), ref.exchange_steps) << dds.summary;
   EXPECT_EQ(json_field(dds.summary, "message_steps_total"),
             2 * ref.total_rounds + ref.refine_message_steps + ref.final_refine_message_steps +

@@ -2,7 +2,11 @@
 // sets, verdicts, gathers) are waits for peers like rounds, counted beside them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <tessera/robust/gnc_distributed.hpp>
+#include <tuple>
+#include <vector>
 
 #include "gnc_fixtures.hpp"
 
@@ -27,6 +31,49 @@ TEST(GncExchangeSteps, EachOuterStepTakesAPoseAndAWeightExchange) {
     // Before each weight update the iterate's poses; mu's start vote once; the rejected set once.
     EXPECT_GE(r.exchange_steps, 2 * k + 2) << k << " outer steps";
   }
+}
+
+// RobustOptions::exchanges_ride_along: where GNC's weighted solves are single Newton steps (the
+// interface fits on the 125-pose grid), the poses of each weight update travel beside the
+// trial's sums, the rejected set with the last weights, the values agent 0 needs for the kept
+// set's fresh start with mu's start votes and the start's neighbour poses with agent 0's
+// answer; the run is otherwise the same.
+TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  using Weights = std::tuple<int, int, std::vector<std::uint64_t>, std::vector<double>>;
+  auto run = [&](bool ride_along, std::vector<Weights>& seen) {
+    GncDistributedOptions o;  // --refine auto, refined passes: Newton steps in GNC
+    o.robust.kind = RobustKind::kGncTls;
+    o.solver.certify = true;
+    o.robust.exchanges_ride_along = ride_along;
+    o.weight_observer = [&](int agent, int outer, const std::vector<std::uint64_t>& index,
+                            const std::vector<double>& w) {
+      seen.emplace_back(agent, outer, index, w);
+    };
+    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  };
+  std::vector<Weights> seen_apart, seen_along;
+  const GncDistributedResult apart = run(false, seen_apart);
+  const GncDistributedResult along = run(true, seen_along);
+  ASSERT_GT(apart.refine_message_steps, 0) << "GNC's weighted solves should be Newton steps";
+  ASSERT_GT(apart.outer_iterations, 2);
+  EXPECT_EQ(along.rejected, dirty.outliers);
+  EXPECT_EQ(along.rejected, apart.rejected);
+  EXPECT_EQ(along.outer_iterations, apart.outer_iterations);
+  EXPECT_EQ(along.total_rounds, apart.total_rounds);
+  EXPECT_EQ(along.refine_message_steps, apart.refine_message_steps);
+  // Every agent's weights after every outer step, to the bit (the agents report in the order
+  // their messages come in, which the steps change).
+  std::sort(seen_apart.begin(), seen_apart.end());
+  std::sort(seen_along.begin(), seen_along.end());
+  EXPECT_EQ(seen_along, seen_apart);
+  EXPECT_EQ(along.final_solve.cost, apart.final_solve.cost);
+  EXPECT_TRUE(along.final_solve.certified.value_or(false));
+  // The pose exchange before each weight update but the first (which follows the plain solve's
+  // rounds) and the rejected set's exchange; at the kept set's fresh start (one, after GNC's
+  // early end: the iterate's poses are the last weight update's) the values' way to agent 0 and
+  // the pose exchange of both starts.
+  EXPECT_EQ(apart.exchange_steps - along.exchange_steps, apart.outer_iterations + 2);
 }
 
 }  // namespace

@@ -226,6 +226,7 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
             if (hands_over_early() && options_.grad_norm_tol > 0)
               refine.grad_norm_tol = std::min(refine.grad_norm_tol, options_.grad_norm_tol);
             refine_ = std::make_unique<NewtonRefineProtocol>(state_, layout_, refine);
+            if (trial_observer_) refine_->set_trial_observer(trial_observer_);
             current_ = refine_.get();
             emit(refine_->start(), out);
             for (const ProtocolMessage& m :

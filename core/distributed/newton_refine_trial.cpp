@@ -51,6 +51,12 @@ void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
   egrad_t_ = problem_.euclidean_gradient(Xt_);
   g_t_ = problem_.riemannian_gradient(Xt_, egrad_t_);
   std::vector<double> values{share, g_t_.squaredNorm()};
+  if (trial_observer_) {
+    // The block finish() would leave: the trial point on the rows in use, zero elsewhere.
+    Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(state_.Y.rows(), state_.Y.cols());
+    Y(rows_, Eigen::all) = Xt_;
+    trial_observer_(Y);
+  }
   trial_shares_ = ship_trial_shares();
   if (trial_shares_) {
     // The block's share of Sigma at the trial point, before the verdict: accepted, agent 0

@@ -1,11 +1,11 @@
 #pragma once
 // Internal: one population of the memetic search (evolutionary.hpp), advanced in steps.
 //
-// evolve() used to run the whole search in one loop. The island model (island_search.hpp) has
-// to stop every population at fixed step counts, hand individuals between them and resume, so
-// the population and its loop state live here and run() advances them by a given number of
-// steps. Run without interruption (one island) it draws exactly the random numbers the single
-// loop drew, so a seed gives the same partition as before the split.
+// Why in steps: the island model (island_search.hpp) has to stop every population at fixed
+// step counts, hand individuals between them and resume, so the population and its loop state
+// live here and run() advances them by a given number of steps. Run without interruption (one
+// island) it draws exactly the random numbers of one uninterrupted loop, so a seed gives the
+// same partition whether or not the search runs in steps.
 
 #include <vector>
 

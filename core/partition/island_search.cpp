@@ -152,7 +152,7 @@ IslandSearchResult island_search(
       if (s.improved() > 0)
         steps += " (last at step " + std::to_string(s.last_improved_step()) + ")";
       if (count == 1) {
-        detail = steps;  // the single search's trace, as before the islands
+        detail = steps;  // one island: the plain search's trace, no island prefix
         break;
       }
       detail += (i > 0 ? "; " : "") + ("island " + std::to_string(i) + ": ") +

@@ -127,6 +127,7 @@ std::vector<OutgoingMessage> GncAgent::start() {
 
 void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
+  neighbours_current_ = false;
   solve_.reset();
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
   const bool weighted = solve_kind_ == GncSolveKind::kGnc && g_ > first_solve_g_;
@@ -154,6 +155,15 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
         make_coarse_space(in_.num_poses, solve_structure(), in_.owner,
                           solve_options_.refine.coarse_space_options())));
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
+  trial_pending_ = poses_sent_early_ = poses_early_stale_ = false;
+  if (newton_steps && send_poses_with_trial())
+    solve_->set_trial_observer([this](const Eigen::MatrixXd& Y) {
+      // One trial per solve (a single Newton step); after rounds the iterate the last pose
+      // exchange holds is not the solve's start, so those take the exchange of their own.
+      if (poses_sent_early_ || trial_pending_ || solve_->total_rounds() > 0) return;
+      trial_Y_ = Y;
+      trial_pending_ = true;
+    });
   pass_on(solve_->start(), out);
   const std::uint32_t g = g_;
   // Messages of this solve that came while this agent was behind; once the solve has ended,
@@ -180,12 +190,29 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> GncAgent::solve_structure()
 }
 
 // The inner solve's messages, tagged with this GNC step.
-void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out,
-                       std::vector<OutgoingMessage>& out) const {
+void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) {
   for (auto& o : solve_out) {
     std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
     out.push_back(std::move(o));
   }
+  if (trial_pending_) {
+    // Beside the trial's sums, which every agent waits for anyway: this step's pose exchange.
+    exchange_->publish(trial_Y_, BlockKind::kY, gnc_phase(g_, GncExchange::kPoses), out);
+    trial_pending_ = false;
+    poses_sent_early_ = true;
+  }
+}
+
+bool GncAgent::gather_values_early() const {
+  // Not with pcm-gnc (its check gathers at agent 0 already, and consumes them) nor without a
+  // fresh start to use them; the same on every agent.
+  return options_.robust.exchanges_ride_along && fresh_start_ && !in_.pcm && in_.num_agents > 1;
+}
+
+bool GncAgent::send_poses_with_trial() const {
+  // Every agent decides the same: the options, and the outer loop's state (the summed votes).
+  return options_.robust.exchanges_ride_along && options_.robust.gnc_refine_steps == 1 &&
+         !outer_->over(options_.robust);
 }
 
 GncExchange GncAgent::exchange() const {
@@ -223,9 +250,10 @@ void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
   if (!ready) return;
   // Read into the book, or the agent's own data the exchange changes.
   for (const ProtocolMessage& m : *ready)
-    exchange_->read(exchange(), m,
-                    GncExchangeTargets{weights_, zero_cut_, rejected_, *recheck_,
-                                       state_ ? state_->Y.rows() : in_.Y0.rows()});
+    if (!(step_ == Step::kPoses && poses_early_stale_))
+      exchange_->read(exchange(), m,
+                      GncExchangeTargets{weights_, zero_cut_, low_weights_, rejected_, *recheck_,
+                                         state_ ? state_->Y.rows() : in_.Y0.rows()});
   after_exchange(out);
 }
 
@@ -240,6 +268,22 @@ void GncAgent::require_kept_connected() const {
                      std::to_string(parts) +
                      " unconnected parts, so no estimate is defined (too few consistent "
                      "measurements; try --known-inliers odometry or a larger --inlier-threshold)");
+}
+
+void GncAgent::begin_rejected(std::vector<OutgoingMessage>& out) {
+  // No weight exchange yet (nothing could be an outlier), or the rejected set's own exchange.
+  if (outer_->outer() == 0 || !options_.robust.exchanges_ride_along) {
+    begin_exchange(Step::kRejected, out);
+    return;
+  }
+  // The weights have not changed since the last weight exchange (a last weighted solve moves
+  // only the iterate), which brought every other agent's weights below 1/2: the rejected set is
+  // known here as the exchange would have brought it, with TLS's verdict after an early end.
+  rejected_ = rejected_by_weight(*terms_, in_.measurement_index, weights_);
+  for (const auto& [id, w] : low_weights_)
+    if ((jumped_ ? tls_verdict_weight(w, outer_->mu()) : w) < 0.5) rejected_.push_back(id);
+  step_ = Step::kRejected;
+  after_exchange(out);
 }
 
 void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
@@ -335,12 +379,28 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   // Agent 0: the kept set's initialization, each agent's block sent, its own kept.
   const Eigen::MatrixXd X = kept_set_start(exchange_->kept_values(), in_, rejected_.size(),
                                            static_cast<int>(state_->Y.rows()));
+  // With values_held_, each agent's neighbours' poses of the start too (the poses of other
+  // agents at the ends of its measurements, as GncLocalTerms::neighbours() lists them): no pose
+  // exchange of the start follows.
+  std::vector<std::vector<std::size_t>> nb(static_cast<std::size_t>(in_.num_agents));
+  if (values_held_) {
+    for (const auto& [i, j] : in_.structure)
+      if (in_.owner[i] != in_.owner[j]) {
+        nb[static_cast<std::size_t>(in_.owner[i])].push_back(j);
+        nb[static_cast<std::size_t>(in_.owner[j])].push_back(i);
+      }
+    for (auto& ids : nb) {
+      std::sort(ids.begin(), ids.end());
+      ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    }
+    exchange_->candidate_neighbours() = block_of(X, terms_->neighbours(), in_.d);
+  }
   for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
-    out.push_back(
-        OutgoingMessage{kept_start_block(block_of(X, base_->poses[a], in_.d), base_->poses[a],
-                                         in_.d, gnc_phase(g_, GncExchange::kKeptStart)),
-                        false,
-                        {a}});
+    out.push_back(OutgoingMessage{
+        kept_start_block(block_of(X, base_->poses[a], in_.d), base_->poses[a], in_.d,
+                         gnc_phase(g_, GncExchange::kKeptStart), block_of(X, nb[a], in_.d), nb[a]),
+        false,
+        {a}});
   exchange_->candidate() = block_of(X, base_->poses[0], in_.d);
 }
 
@@ -400,6 +460,7 @@ void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out, double ri
   late_rejected_ = base.late_rejected;
   // The own block has the same shape whatever the kept set: the next pass starts from it.
   state_->Y = std::move(base.Y);
+  neighbours_current_ = false;
   if (search_) {
     // The next probe starts from the restored set and iterate, which the passes had settled.
     search_->refused(rise, base.tls);
@@ -449,8 +510,14 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     return;
   }
   if (g_ > first_solve_g_ && outer_->over(options_.robust)) {
-    begin_exchange(Step::kRejected, out);
+    begin_rejected(out);
     return;
+  }
+  if (poses_sent_early_) {
+    // The trial's poses are the iterate's when the step was accepted (the same on every agent:
+    // the verdict is on summed values); otherwise the iterate is the solve's start.
+    const std::vector<NewtonRefineResult>& r = solve_->refines();
+    poses_early_stale_ = !(r.size() == 1 && r.front().accepted_steps == 1);
   }
   begin_exchange(Step::kPoses, out);
 }
@@ -458,6 +525,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
 void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   switch (step_) {
     case Step::kPoses:
+      neighbours_current_ = true;
       if (solve_kind_ == GncSolveKind::kInlierPass)
         begin_exchange(Step::kReadmitted, out);
       else
@@ -465,20 +533,24 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kVotes:
       outer_->start(exchange_->largest_vote(), terms_->c2(), options_.robust);
-      begin_exchange(outer_->converged() ? Step::kRejected : Step::kWeights, out);
+      if (outer_->converged())
+        begin_rejected(out);
+      else
+        begin_exchange(Step::kWeights, out);
       return;
     case Step::kWeights: {
       const auto [spread, crossed] = exchange_->summed_votes();
       const bool jump =
           outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
                                options_.robust, gnc_newton_steps_);
+      jumped_ = jump;
       if (jump)
         for (std::size_t k = 0; k < weights_.size(); ++k)
           if (terms_->may_reject(k) && !dropped_[k])
             weights_[k] = tls_verdict_weight(weights_[k], outer_->mu());
       if (weight_observer_) weight_observer_(outer_->outer(), in_.measurement_index, weights_);
       if (jump) {
-        begin_exchange(Step::kRejected, out);
+        begin_rejected(out);
         return;
       }
       if (terms_->known_connected()) {
@@ -503,6 +575,12 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kKeptStart:
       if (in_.id == 0) start_kept_set(out);
+      // Both starts' neighbour poses are here already: the iterate's from the last pose
+      // exchange, the fresh start's from agent 0.
+      if (values_held_ && neighbours_current_) {
+        begin_exchange(Step::kCandidateVotes, out);
+        return;
+      }
       begin_exchange(Step::kCandidatePoses, out);
       return;
     case Step::kPcm: {
@@ -535,13 +613,17 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     }
     case Step::kCandidatePoses:
+      neighbours_current_ = true;
       begin_exchange(Step::kCandidateVotes, out);
       return;
     case Step::kCandidateVotes: {
       const auto [at_iterate, at_candidate] = exchange_->summed_votes();
       fresh_start_costs_.emplace_back(rejected_, at_candidate);
       const bool fresh = at_candidate < at_iterate;
-      if (fresh) state_->Y = exchange_->candidate();
+      if (fresh) {
+        state_->Y = exchange_->candidate();
+        neighbours_current_ = false;
+      }
       exchange_->candidate().resize(0, 0);
       exchange_->forget_candidate_neighbours();
       last_pass_full_ = false;

@@ -2,6 +2,7 @@
 // from this agent's view and sends to whom (GncAgent::Step). The state machine that decides which
 // step comes next is gnc_agent.cpp; the messages' layout is gnc_messages.hpp.
 
+#include <algorithm>
 #include <tessera/robust/gnc_agent.hpp>
 #include <utility>
 #include <vector>
@@ -32,7 +33,12 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   exchange_->begin();
   // A gather at agent 0 (the consistency check's values, the kept set's start) waits twice: for
   // the values, then for agent 0's answer.
-  exchange_steps_ += step == Step::kPcm || step == Step::kKeptStart ? 2 : 1;
+  // The poses sent beside a weighted solve's trial sums are no step of their own.
+  const bool early = step == Step::kPoses && poses_sent_early_;
+  exchange_steps_ += step == Step::kPcm || (step == Step::kKeptStart && !values_held_) ? 2
+                     : early                                                           ? 0
+                                                                                       : 1;
+  bool values_too = false;  // agent 0's exchange takes the others' values beside their status
   // Whom this agent hears from: a pose exchange from its block neighbours (each sends what it
   // was sent), a status exchange from every other agent.
   std::vector<int> from = base_->adjacent[static_cast<std::size_t>(in_.id)];
@@ -46,6 +52,10 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // Weights are computed at the iterate itself: the owners' public poses of every
       // measurement (the base layout: a measurement out of the current solve still needs
       // its residual).
+      if (early) {
+        if (!poses_early_stale_) exchange_->expect_poses(state_->Y.rows(), false);
+        break;
+      }
       exchange_->expect_poses(state_->Y.rows(), false);
       exchange_->publish(state_->Y, BlockKind::kY, phase, out);
       break;
@@ -66,6 +76,19 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kPcmValues), nullptr, out);
       break;
     case Step::kKeptStart:
+      if (values_held_) {
+        if (in_.id == 0) {
+          // The kept ones of the values held since mu's start: nothing to wait for.
+          GatheredValues& kept = exchange_->kept_values();
+          kept.clear();
+          for (const auto& v : exchange_->held_values())
+            if (!std::binary_search(rejected_.begin(), rejected_.end(), v.first)) kept.push_back(v);
+          after_exchange(out);
+          return;
+        }
+        from = {0};  // agent 0's answer
+        break;
+      }
       from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kKeptValues), &rejected_,
                                               out);
       break;
@@ -89,6 +112,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       to_others(vote_message(exchange_->own_vote()));
       break;
     case Step::kWeights: {
+      low_weights_.clear();
       const int crossed = weights_at_mu(outer_->mu());
       const double spread = weight_spread(*terms_, weights_);
       const int near =
@@ -103,10 +127,24 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
       from = as_ints(others);
       for (std::uint32_t a : others) {
-        RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_);
+        RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_,
+                                                options_.robust.exchanges_ride_along);
         st.phase = phase;
         st.sender = me;
         out.push_back(OutgoingMessage{std::move(st), false, {a}});
+      }
+      if (gather_values_early() && !values_held_) {
+        // Beside the first weights (clean data has none), once: the values of the measurements
+        // this agent weighs, to agent 0.
+        values_held_ = true;
+        if (in_.id == 0) {
+          values_too = true;
+          exchange_->held_values().clear();
+          append_owned_values(in_, *terms_, nullptr, exchange_->held_values());
+        } else {
+          out.push_back(
+              OutgoingMessage{owned_values_block(in_, *terms_, nullptr, phase), false, {0}});
+        }
       }
       break;
     }
@@ -133,7 +171,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
     default:
       break;
   }
-  mail_->begin_exchange(phase, std::move(from));
+  mail_->begin_exchange(phase, std::move(from), values_too);
   take_exchange(out);
 }
 

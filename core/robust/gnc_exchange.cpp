@@ -89,7 +89,8 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
     case GncExchange::kKeptStart:  // agent 0's fresh start of the kept set: this agent's block
       candidate_ = read_kept_start(
           expect_pose_block(message, in_.id, "a status where the kept set's start belongs"),
-          base_.poses[static_cast<std::size_t>(in_.id)], to.rank, in_.d, in_.id);
+          base_.poses[static_cast<std::size_t>(in_.id)], to.rank, in_.d, in_.id,
+          terms_.neighbours(), candidate_neighbours_);
       break;
     case GncExchange::kPoses:
     case GncExchange::kCandidatePoses:
@@ -109,10 +110,14 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
       votes_[sender] = read_vote(expect_status(message, in_.id, kStatusBelongs));
       break;
     case GncExchange::kWeights: {
+      if (const auto* block = std::get_if<PoseBlockMessage>(&message)) {  // agent 0: the values
+        decode_measurement_block(*block, in_.d, in_.num_poses, "robust solve", held_values_);
+        break;
+      }
       const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
       votes_[sender] = {st.grad_norm_sq, st.cost};
       near_bound_[sender] = st.near_bound;
-      read_weights_message(st, sender, in_, to.weights, to.zero_cut);
+      read_weights_message(st, sender, in_, to.weights, to.zero_cut, to.low_weights);
       break;
     }
     case GncExchange::kRejected: {

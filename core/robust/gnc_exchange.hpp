@@ -24,6 +24,7 @@ namespace tessera {
 struct GncExchangeTargets {
   std::vector<double>& weights;
   std::vector<std::uint64_t>& zero_cut;
+  std::vector<std::pair<std::uint64_t, double>>& low_weights;
   std::vector<std::uint64_t>& rejected;
   RecheckVerdict& recheck;
   Eigen::Index rank;  // rows of the own block (the kept set's start is read at it)
@@ -69,8 +70,14 @@ class GncExchangeBook {
   const Eigen::MatrixXd& neighbours() const { return neighbours_; }
   const Eigen::MatrixXd& candidate_neighbours() const { return candidate_neighbours_; }
   void forget_candidate_neighbours() { candidate_neighbours_.resize(0, 0); }
+  /// The candidate start's neighbour poses when agent 0 sent (or, at agent 0, computed) them
+  /// with the start: empty otherwise.
+  Eigen::MatrixXd& candidate_neighbours() { return candidate_neighbours_; }
   Eigen::MatrixXd& candidate() { return candidate_; }
   GatheredValues& kept_values() { return kept_values_; }
+  /// Agent 0: every measurement's value, gathered once beside the first weights (static data),
+  /// from which each fresh start of a kept set takes its own (GncAgent::values_held_).
+  GatheredValues& held_values() { return held_values_; }
   /// Agent 0's consistency check as another agent received it.
   const std::vector<std::uint64_t>& pcm_dropped() const { return pcm_dropped_; }
 
@@ -84,6 +91,7 @@ class GncExchangeBook {
   Eigen::MatrixXd neighbours_;  // neighbours' public poses of the current iterate
   Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
   GatheredValues kept_values_;                        // agent 0's gathers
+  GatheredValues held_values_;                        // agent 0: every measurement's
   std::vector<std::uint64_t> pcm_dropped_;
 };
 

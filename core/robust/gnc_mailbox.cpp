@@ -25,9 +25,10 @@ std::vector<ProtocolMessage> GncMailbox::begin_solve(std::uint32_t g) {
   return gate_.take_steps(g * kGncStepStride, g * kGncStepStride + kGncExchangeBase);
 }
 
-void GncMailbox::begin_exchange(std::uint32_t phase, std::vector<int> senders) {
+void GncMailbox::begin_exchange(std::uint32_t phase, std::vector<int> senders, bool values_too) {
   waiting_ = Waiting::kExchange;
   phase_ = phase;
+  second_part_ = two_starts(phase) || values_too;
   ready_.clear();
   gate_.expect(0, phase, std::move(senders));
 }
@@ -51,7 +52,12 @@ std::uint32_t GncMailbox::gate_round(const ProtocolMessage& m) const {
   const std::uint32_t phase = message_phase(m);
   if (phase % kGncStepStride < kGncExchangeBase) return message_round(m);
   const auto* block = std::get_if<PoseBlockMessage>(&m);
-  return two_starts(phase) && block && block->kind == BlockKind::kP ? 1 : 0;
+  if (two_starts(phase)) return block && block->kind == BlockKind::kP ? 1 : 0;
+  // Measurement values beside the first weights (the wire's round stays 0: a runtime waits by
+  // it).
+  const std::uint32_t weights =
+      kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kWeights);
+  return block && phase % kGncStepStride == weights ? 1 : 0;
 }
 
 std::runtime_error GncMailbox::unexpected(const ProtocolMessage& m) const {
@@ -83,8 +89,8 @@ std::optional<std::vector<ProtocolMessage>> GncMailbox::take_exchange() {
         throw unexpected(m);
       ready_.push_back(std::move(m));
     }
-    if (two_starts(phase_) && gate_.round() == 0) {
-      gate_.expect(1, phase_, expected);  // the kind P blocks from the same neighbours
+    if (second_part_ && gate_.round() == 0) {
+      gate_.expect(1, phase_, expected);  // the kind P blocks (or values) from the same senders
       continue;
     }
     waiting_ = Waiting::kNothing;

@@ -24,8 +24,10 @@ class GncMailbox {
   /// by phase, round, sender; phases as on the wire).
   std::vector<ProtocolMessage> begin_solve(std::uint32_t g);
   /// The exchange of `phase` (gnc_phase()) from now on: one message from each of `senders`;
-  /// both starts' poses (GncExchange::kStartPoses, kCandidatePoses) two, kind Y and kind P.
-  void begin_exchange(std::uint32_t phase, std::vector<int> senders);
+  /// both starts' poses (GncExchange::kStartPoses, kCandidatePoses) two, kind Y and kind P; with
+  /// `values_too` (the first GncExchange::kWeights at agent 0), a status and a block of measurement
+  /// values.
+  void begin_exchange(std::uint32_t phase, std::vector<int> senders, bool values_too = false);
 
   /// True when `m` is the running solve's (the caller hands it over); otherwise it waits for
   /// its step, or is dropped when of a step left. Throws std::runtime_error on a message the
@@ -50,8 +52,9 @@ class GncMailbox {
 
   int id_;
   Waiting waiting_ = Waiting::kNothing;
-  std::uint32_t g_ = 0;      // the running solve's GNC step
-  std::uint32_t phase_ = 0;  // the current exchange's
+  std::uint32_t g_ = 0;       // the running solve's GNC step
+  std::uint32_t phase_ = 0;   // the current exchange's
+  bool second_part_ = false;  // the current exchange has a part 1 (both starts, or values)
   MessageGate gate_;
   std::vector<ProtocolMessage> ready_;  // the exchange's first part, once all are in
 };

@@ -57,7 +57,7 @@ RoundStatusMessage vote_message(const std::pair<double, double>& sums) {
 
 RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed, int near_bound,
                                    const GncAgentInput& in, const GncLocalTerms& terms,
-                                   const std::vector<double>& weights) {
+                                   const std::vector<double>& weights, bool low_too) {
   RoundStatusMessage st;
   st.grad_norm_sq = spread;
   st.cost = crossed;
@@ -66,7 +66,8 @@ RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed,
     const Measurement& m = in.measurements[k];
     const auto other = static_cast<std::uint32_t>(in.owner[std::max(m.i, m.j)]);
     const bool cut = in.owner[m.i] != in.owner[m.j];
-    if (other == to || (terms.known_connected() && cut && weights[k] == 0)) {
+    if (other == to || (terms.known_connected() && cut && weights[k] == 0) ||
+        (low_too && terms.may_reject(k) && weights[k] < 0.5)) {
       st.measurement_ids.push_back(in.measurement_index[k]);
       st.weights.push_back(weights[k]);
     }
@@ -76,7 +77,8 @@ RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed,
 
 void read_weights_message(const RoundStatusMessage& st, std::uint32_t sender,
                           const GncAgentInput& in, std::vector<double>& weights,
-                          std::vector<std::uint64_t>& zero_cut) {
+                          std::vector<std::uint64_t>& zero_cut,
+                          std::vector<std::pair<std::uint64_t, double>>& low) {
   const std::string me = agent_prefix(in.id);
   if (st.weights.size() != st.measurement_ids.size())
     throw std::runtime_error(me + "weights from agent " + std::to_string(sender) +
@@ -90,7 +92,9 @@ void read_weights_message(const RoundStatusMessage& st, std::uint32_t sender,
                                " sent the weight of measurement " + std::to_string(id) +
                                ", not its own");
     if (const auto k = position_of(in.measurement_index, id)) weights[*k] = st.weights[q];
-    if (st.weights[q] == 0) zero_cut.push_back(id);
+    const auto [i, j] = in.structure[id];
+    if (st.weights[q] == 0 && in.owner[i] != in.owner[j]) zero_cut.push_back(id);
+    if (st.weights[q] < 0.5) low.emplace_back(id, st.weights[q]);
   }
 }
 
@@ -143,7 +147,8 @@ void read_readmitted_message(const RoundStatusMessage& st, std::uint32_t sender,
 }
 
 PoseBlockMessage kept_start_block(const Eigen::MatrixXd& Y, const std::vector<std::size_t>& ids,
-                                  int d, std::uint32_t phase) {
+                                  int d, std::uint32_t phase, const Eigen::MatrixXd& nb,
+                                  const std::vector<std::size_t>& nb_ids) {
   PoseBlockMessage b;
   b.sender = 0;
   b.phase = phase;
@@ -151,20 +156,35 @@ PoseBlockMessage kept_start_block(const Eigen::MatrixXd& Y, const std::vector<st
   b.rank = static_cast<std::uint32_t>(Y.rows());
   b.dim = static_cast<std::uint32_t>(d);
   for (std::size_t id : ids) b.pose_ids.push_back(static_cast<std::uint32_t>(id));
+  for (std::size_t id : nb_ids) b.pose_ids.push_back(static_cast<std::uint32_t>(id));
   b.data.assign(Y.data(), Y.data() + Y.size());
+  b.data.insert(b.data.end(), nb.data(), nb.data() + nb.size());
   return b;
 }
 
 Eigen::MatrixXd read_kept_start(const PoseBlockMessage& block, const std::vector<std::size_t>& own,
-                                Eigen::Index r, int d, int receiver) {
+                                Eigen::Index r, int d, int receiver,
+                                const std::vector<std::size_t>& nb, Eigen::MatrixXd& nb_out) {
   const Eigen::Index w = (d + 1) * r;
-  if (block.rank != static_cast<std::uint32_t>(r) || block.pose_ids.size() != own.size() ||
-      block.data.size() != own.size() * static_cast<std::size_t>(w) ||
+  if (block.rank != static_cast<std::uint32_t>(r) || block.pose_ids.size() < own.size() ||
+      block.data.size() != block.pose_ids.size() * static_cast<std::size_t>(w) ||
       !std::equal(own.begin(), own.end(), block.pose_ids.begin()))
     throw std::runtime_error(agent_prefix(receiver) +
                              "malformed start of the kept set from agent 0");
+  // The own poses, then the neighbours' (decoded as two blocks of the same sender).
+  PoseBlockMessage part = block;
+  part.pose_ids.resize(own.size());
+  part.data.resize(own.size() * static_cast<std::size_t>(w));
   Eigen::MatrixXd Y(r, (d + 1) * static_cast<Eigen::Index>(own.size()));
-  decode_neighbour_poses(block, own, d, receiver, Y);
+  decode_neighbour_poses(part, own, d, receiver, Y);
+  if (block.pose_ids.size() > own.size()) {
+    part.pose_ids.assign(block.pose_ids.begin() + static_cast<std::ptrdiff_t>(own.size()),
+                         block.pose_ids.end());
+    part.data.assign(block.data.begin() + static_cast<std::ptrdiff_t>(own.size()) * w,
+                     block.data.end());
+    nb_out = Eigen::MatrixXd::Zero(r, (d + 1) * static_cast<Eigen::Index>(nb.size()));
+    decode_neighbour_poses(part, nb, d, receiver, nb_out);
+  }
   return Y;
 }
 

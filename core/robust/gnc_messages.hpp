@@ -40,21 +40,25 @@ inline std::pair<double, double> read_vote(const RoundStatusMessage& st) {
 }
 
 /// The weights message for agent `to`: the weights of the cut measurements this agent weighs
-/// whose other end `to` holds, then (with weight 0) its other cut measurements that leave the
-/// solve (for `to`'s block layout), the weight spread (grad_norm_sq, the stop vote) and the
-/// count of this agent's measurements whose weight crossed 1/2 in this update (cost, the
+/// whose other end `to` holds, (with weight 0) its other cut measurements that leave the
+/// solve (for `to`'s block layout) and, with `low_too`, its other measurements of weight below
+/// 1/2 (RobustOptions::exchanges_ride_along: with them every agent knows the rejected set GNC
+/// ends with, without an exchange of its own), the weight spread (grad_norm_sq, the stop vote) and
+/// the count of this agent's measurements whose weight crossed 1/2 in this update (cost, the
 /// adaptive mu schedule's vote, RobustOptions::mu_step_max) and of its measurements with r^2
 /// near the bound (near_bound: the early end's vote, RobustOptions::jump_band).
 RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed, int near_bound,
                                    const GncAgentInput& in, const GncLocalTerms& terms,
-                                   const std::vector<double>& weights);
+                                   const std::vector<double>& weights, bool low_too);
 
 /// Checks `st` from `sender` (ids and weights match; every id is the sender's to weigh) and
-/// applies it: the weights of this agent's measurements, every id of weight 0 to `zero_cut`.
+/// applies it: the weights of this agent's measurements, every cut id of weight 0 to
+/// `zero_cut`, every id of weight below 1/2 with its weight to `low`.
 /// Throws std::runtime_error naming this agent and the sender.
 void read_weights_message(const RoundStatusMessage& st, std::uint32_t sender,
                           const GncAgentInput& in, std::vector<double>& weights,
-                          std::vector<std::uint64_t>& zero_cut);
+                          std::vector<std::uint64_t>& zero_cut,
+                          std::vector<std::pair<std::uint64_t, double>>& low);
 
 /// The values of the measurements this agent weighs (all, or with `rejected` non-null those not
 /// in it) as agent 0 gathers them: this agent's block to send, or agent 0's own entries.
@@ -71,12 +75,17 @@ RoundStatusMessage readmitted_message(const RecheckVerdict& verdict, double tls_
 void read_readmitted_message(const RoundStatusMessage& st, std::uint32_t sender, int receiver,
                              RecheckVerdict& into);
 
-/// Agent 0's message of another agent's block Y of the kept set's start (poses `ids`).
+/// Agent 0's message of another agent's block Y of the kept set's start (poses `ids`), then the
+/// start's poses `nb_ids` of the agent's neighbours (columns of `nb`; none when empty).
 PoseBlockMessage kept_start_block(const Eigen::MatrixXd& Y, const std::vector<std::size_t>& ids,
-                                  int d, std::uint32_t phase);
-/// The own block of the kept set's start (r x (d+1)|own|) from agent 0's `block`. Throws
-/// std::runtime_error naming `receiver` when it is not exactly the poses `own` at rank r.
+                                  int d, std::uint32_t phase, const Eigen::MatrixXd& nb = {},
+                                  const std::vector<std::size_t>& nb_ids = {});
+/// The own block of the kept set's start (r x (d+1)|own|) from agent 0's `block`; the
+/// neighbours' poses that follow it, if any, go to `nb_out` (r x (d+1)|nb|, columns of the
+/// ascending neighbour poses `nb`, zero where none came). Throws std::runtime_error naming
+/// `receiver` when the block does not start with exactly the poses `own` at rank r.
 Eigen::MatrixXd read_kept_start(const PoseBlockMessage& block, const std::vector<std::size_t>& own,
-                                Eigen::Index r, int d, int receiver);
+                                Eigen::Index r, int d, int receiver,
+                                const std::vector<std::size_t>& nb, Eigen::MatrixXd& nb_out);
 
 }  // namespace tessera

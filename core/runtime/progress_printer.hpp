@@ -1,8 +1,8 @@
 #pragma once
 // The coordinator's progress lines ("round K: cost C, grad norm G", "round K (restart): ...";
-// public output, which tessera launch passes on), at most one per `min_interval_ms` (launch
-// used to print one a round: 1456 lines for kitti_02, each one a pipe write and ~3 wake-ups
-// on a busy host). Always printed: the first completed step, every restart and, through
+// public output, which tessera launch passes on), at most one per `min_interval_ms` (one a
+// round would be 1456 lines for kitti_02, each one a pipe write and ~3 wake-ups on a busy
+// host). Always printed: the first completed step, every restart and, through
 // finish(), the last step seen; in between, the newest step once the interval has passed.
 
 #include <cstdint>

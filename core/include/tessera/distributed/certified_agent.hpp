@@ -54,6 +54,11 @@ class CertifiedAgent : public AgentProcess {
   void set_round_observer(std::function<void(const ProtocolSnapshot&)> observer) {
     observer_ = std::move(observer);
   }
+  /// Observer of the trial points of the Newton refinements this agent runs
+  /// (NewtonRefineProtocol::set_trial_observer).
+  void set_trial_observer(std::function<void(const Eigen::MatrixXd&)> observer) {
+    trial_observer_ = std::move(observer);
+  }
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
   bool done() const override { return done_; }
   /// The running stage's count (messages of later stages are kept aside, not counted).
@@ -133,6 +138,7 @@ class CertifiedAgent : public AgentProcess {
   std::vector<CertifyStageRecord> certificates_;
   std::vector<EscapeStageRecord> escapes_;
   std::function<void(const ProtocolSnapshot&)> observer_;
+  std::function<void(const Eigen::MatrixXd&)> trial_observer_;
   bool refining_ = false;        // the current rank's solve continues at refine_tolerance()
   bool interface_fits_ = false;  // the team's interface within the refinement's interface cap
   bool done_ = false;

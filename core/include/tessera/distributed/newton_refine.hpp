@@ -35,6 +35,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -401,6 +402,14 @@ class NewtonRefineProtocol : public AgentProcess {
   /// The current message step's missing senders (a stalled run names them).
   std::optional<AwaitedMessages> awaited() const override;
   const NewtonRefineResult& result() const { return result_; }
+  /// Called with each trial point, its translations solved, as the trial's sums go out: the own
+  /// block at the iterate's rank (rows no agent uses are zero), exactly the block the agent
+  /// holds if the trial is accepted. A caller that must exchange the accepted point's poses can
+  /// send them beside the sums instead of in a message step of its own (robust GNC's weighted
+  /// solves).
+  void set_trial_observer(std::function<void(const Eigen::MatrixXd&)> observer) {
+    trial_observer_ = std::move(observer);
+  }
 
   /// Where the refinement is, for progress reports: the trust-region step being computed
   /// (1-based, rejected ones and backtracks counted), the CG iterations of that step so far and
@@ -566,6 +575,7 @@ class NewtonRefineProtocol : public AgentProcess {
   std::unique_ptr<TranslationInterfaceSolve> translation_solve_;
   Eigen::MatrixXd ty_;
   NewtonRefineStep step_;
+  std::function<void(const Eigen::MatrixXd&)> trial_observer_;
   bool done_ = false;
   NewtonRefineResult result_;
 };

@@ -237,13 +237,19 @@ class GncAgent : public AgentProcess {
   // The current exchange's messages once all are in: read, then after_exchange().
   void take_exchange(std::vector<OutgoingMessage>& out);
   GncExchange exchange() const;  // the current step's, as this agent sends or awaits it
-  // The inner solve's messages, tagged with this GNC step.
-  void pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) const;
+  // The inner solve's messages, tagged with this GNC step; with them the trial point's poses
+  // when the solve just sent its trial sums (send_poses_with_trial).
+  void pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out);
+  // Whether this weighted solve's trial point, if accepted, is the iterate whose poses the next
+  // weight update needs: a single Newton step, not the last weighted solve.
+  bool send_poses_with_trial() const;
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
   int weights_at_mu(double mu);         // the count of owned weights that crossed 1/2
   void require_kept_connected() const;  // throws InputError naming the parts left
   std::vector<std::pair<std::uint32_t, std::uint32_t>> solve_structure() const;
+  // GNC's rejected set: from the last weight exchange where there was one, else an exchange.
+  void begin_rejected(std::vector<OutgoingMessage>& out);
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
   void finish(std::vector<OutgoingMessage>& out);
   void start_kept_set(std::vector<OutgoingMessage>& out);
@@ -293,8 +299,21 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<GncProbes> probes_;         // RobustOptions::recheck_probes
   std::unique_ptr<GncClusterSearch> search_;  // GncDistributedOptions::cluster_probes (> 0)
   std::vector<std::uint64_t> zero_cut_;       // cut measurements of weight 0 (others' too)
-  std::unique_ptr<BlockLayout> base_;         // of every measurement: whose poses go where
-  std::unique_ptr<GncLocalTerms> terms_;      // the TLS math over this agent's view
+  // The other agents' measurements of weight below 1/2 at the last weight exchange, and whether
+  // that exchange ended GNC at TLS's verdict (RobustOptions::jump_band).
+  std::vector<std::pair<std::uint64_t, double>> low_weights_;
+  bool jumped_ = false;
+  // Agent 0 holds every measurement's value (sent beside the first weights, with
+  // RobustOptions::exchanges_ride_along and the kept set's fresh start): a fresh start then
+  // waits only for agent 0's answer, not for the values first. The same on every agent.
+  bool values_held_ = false;
+  bool gather_values_early() const;
+  // The neighbours' public poses the exchange book holds are the current iterate's (a pose
+  // exchange since the iterate last moved). With values_held_ the kept set's fresh start then
+  // needs no pose exchange: agent 0 sends each agent its neighbours' poses of the start too.
+  bool neighbours_current_ = false;
+  std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where
+  std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view
   Eigen::MatrixXd last_pass_start_;
   std::vector<double> weights_;                // per in_.measurements
   std::unique_ptr<GncMailbox> mail_;           // where incoming messages go
@@ -304,6 +323,13 @@ class GncAgent : public AgentProcess {
   std::vector<std::uint64_t> gnc_rejected_;  // GNC's own set, before the passes (ascending)
   // Every weighted solve of GNC so far was a Newton step (gnc_refines), and there was one.
   bool gnc_newton_steps_ = false;
+  // The running weighted solve's trial point (own block) and whether its public poses still
+  // have to go out: they travel beside the trial's sums as this step's pose exchange
+  // (poses_sent_early_), so the exchange after the solve waits for nothing. When the trial is
+  // not accepted (poses_early_stale_) the iterate has not moved since the last pose exchange,
+  // whose poses stay; the early ones are read and dropped.
+  Eigen::MatrixXd trial_Y_;
+  bool trial_pending_ = false, poses_sent_early_ = false, poses_early_stale_ = false;
   int weighted_solves_ = 0;
   std::vector<Measurement> kept_;
   std::vector<std::uint64_t> kept_index_;

@@ -271,6 +271,26 @@ struct RobustOptions {
   /// 66; docs/robust.md, "Newton steps in GNC"). 1: two steps cost 13 message steps a solve and
   /// shorten nothing (intel 0.25: 17 outer steps either way, 284 message steps; CSAIL 87).
   int gnc_refine_steps = 1;
+  /// Distributed solvers only: GNC's exchanges ride on messages that are sent anyway, with the
+  /// same values, so the run is the same but for its message steps (and bytes):
+  /// - where a weighted solve is a single Newton step (gnc_refine_steps 1) that another weight
+  ///   update follows, each agent sends its neighbours the trial point's public poses beside the
+  ///   trial's sums; accepted, that point is the iterate whose poses the weight update needs, so
+  ///   the pose exchange after the solve waits for nothing (not accepted, the iterate is the
+  ///   solve's start, whose poses every agent holds from the exchange before);
+  /// - every weights message also carries the sender's other measurements of weight below 1/2,
+  ///   so GNC's rejected set (the weights do not change after the last weight exchange) needs
+  ///   no exchange of its own;
+  /// - with the kept set's fresh start (GncAgentInput::kept_set_start), the agents send agent 0
+  ///   the values of the measurements they weigh once, beside the first weights, so a fresh
+  ///   start waits only for agent 0's answer; that answer also carries each agent's neighbours'
+  ///   poses of the start, so where the iterate has not moved since the last pose exchange
+  ///   (after GNC's early end, or a pass's verdict) the two starts' pose exchange is left out.
+  /// On (default); off: every one of those exchanges. Why: each is a wait for peers like a
+  /// round. F = 0.25 random, 5 agents: intel 166 -> 150 message steps, CSAIL 74 -> 67; every
+  /// intel and CSAIL cell of the benchmark the same `--out` bytes and rejected set
+  /// (docs/robust.md, "Exchanges that ride along").
+  bool exchanges_ride_along = true;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
