@@ -160,7 +160,8 @@ void write_rejected(const std::string& path, const std::vector<std::size_t>& rej
 
 void add_distributed_robust_fields(JsonObject& json, const RobustOptions& options,
                                    const GncAgentResult& gnc, long long rounds,
-                                   std::size_t measurements, long long final_refine_steps) {
+                                   std::size_t measurements, long long final_refine_steps,
+                                   long long final_solve_stages) {
   RobustSummary rs;
   rs.options = options;
   rs.outer_iterations = gnc.outer_iterations;
@@ -175,12 +176,14 @@ void add_distributed_robust_fields(JsonObject& json, const RobustOptions& option
   add_robust_fields(json, rs);
   const long long gnc_refine_steps = gnc.refine_message_steps;
   const long long exchange_steps = gnc.exchange_steps;
+  const long long solve_stages = gnc.solve_stages + final_solve_stages;
   json.add("total_rounds", rounds)
       .add("gnc_refine_steps", gnc_refine_steps)
       .add("gnc_exchange_steps", exchange_steps)
       .add("final_refine_steps", final_refine_steps)
+      .add("solve_stages", solve_stages)
       .add("message_steps_total",
-           2 * rounds + gnc_refine_steps + final_refine_steps + exchange_steps);
+           2 * rounds + 2 * solve_stages + gnc_refine_steps + final_refine_steps + exchange_steps);
 }
 
 }  // namespace tessera::cli

@@ -60,11 +60,14 @@ void add_robust_fields(JsonObject& json, const RobustSummary& summary);
 /// with `rounds` (the rounds of every solve, final included) and the graph's `measurements`;
 /// then its message steps, each a wait for peers (docs/robust.md): total_rounds,
 /// gnc_refine_steps, gnc_exchange_steps, final_refine_steps (the final solve's Newton
-/// refinement's, `final_refine_steps`) and message_steps_total = 2 x rounds + the other three
-/// (`tessera solve` and the coordinator's summary alike).
+/// refinement's, `final_refine_steps`), solve_stages (GncAgentResult::solve_stages +
+/// `final_solve_stages`: each opens with a pose exchange and ends with a status round) and
+/// message_steps_total = 2 x rounds + 2 x solve_stages + the other three (`tessera solve` and
+/// the coordinator's summary alike).
 void add_distributed_robust_fields(JsonObject& json, const RobustOptions& options,
                                    const GncAgentResult& gnc, long long rounds,
-                                   std::size_t measurements, long long final_refine_steps);
+                                   std::size_t measurements, long long final_refine_steps,
+                                   long long final_solve_stages);
 
 /// Writes one rejected index per line to `path` (InputError when it cannot).
 void write_rejected(const std::string& path, const std::vector<std::size_t>& rejected);

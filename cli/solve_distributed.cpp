@@ -598,12 +598,17 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     if (fstar) j.add("f_star", *fstar);
     if (robust.kind != RobustKind::kNone) {
       add_distributed_robust_fields(j, robust, gnc, gnc.total_rounds, graph.num_measurements(),
-                                    gnc.final_refine_message_steps);
-      j.add("total_bytes", static_cast<long long>(gnc.total_bytes));
+                                    gnc.final_refine_message_steps, gnc.final_solve_stages);
+      j.add("total_bytes", static_cast<long long>(gnc.total_bytes))
+          .add("longest_message_chain", static_cast<long long>(gnc.longest_chain));
     } else {
-      // Every wait for peers of the run (docs/robust.md): two a round (docs/irbcd.md) and the
-      // Newton refinements' neighbour exchanges and all-agent sums.
-      j.add("message_steps_total", 2LL * r.rounds + message_steps(r.refines));
+      // Every wait for peers of the run (docs/robust.md): two a round (docs/irbcd.md), two a
+      // solve stage (its opening pose exchange and closing status round) and the Newton
+      // refinements' neighbour exchanges and all-agent sums.
+      j.add("solve_stages", r.solve_stages)
+          .add("message_steps_total",
+               2LL * r.rounds + 2LL * r.solve_stages + message_steps(r.refines))
+          .add("longest_message_chain", static_cast<long long>(r.longest_chain));
     }
     write_output(*p, j.str());
   }

@@ -152,9 +152,9 @@ std::string run_summary_json(const RunSummaryInputs& in) {
     j.add("final_rank", static_cast<long long>(o.rank ? o.rank : 5));
   }
   if (r.robust) {
-    cli::add_distributed_robust_fields(j, o.robust, *r.robust,
-                                       static_cast<long long>(in.merged.rounds),
-                                       in.structure.num_measurements, r.robust->final_refine_steps);
+    cli::add_distributed_robust_fields(
+        j, o.robust, *r.robust, static_cast<long long>(in.merged.rounds),
+        in.structure.num_measurements, r.robust->final_refine_steps, r.robust->final_solve_stages);
   } else {
     j.add("robust", robust_kind_name(o.robust.kind));
   }

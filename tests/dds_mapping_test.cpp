@@ -509,6 +509,8 @@ TEST(DdsReportMapping, EveryReportComesBackFieldForField) {
   r.refine_message_steps = 37;
   r.exchange_steps = 61;
   r.final_refine_steps = 3;
+  r.solve_stages = 40;
+  r.final_solve_stages = 2;
   const auto robust = std::get<agent::RobustRunReport>(report_round_trip(r));
   EXPECT_EQ(robust.outer_iterations, 29);
   EXPECT_EQ(robust.rejected, r.rejected);
@@ -520,6 +522,8 @@ TEST(DdsReportMapping, EveryReportComesBackFieldForField) {
   EXPECT_EQ(robust.refine_message_steps, 37);
   EXPECT_EQ(robust.exchange_steps, 61);
   EXPECT_EQ(robust.final_refine_steps, 3);
+  EXPECT_EQ(robust.solve_stages, 40);
+  EXPECT_EQ(robust.final_solve_stages, 2);
 
   const auto times = std::get<agent::PhaseTimesReport>(
       report_round_trip(agent::PhaseTimesReport{0.25, 0.125, 12, 348, 6}));

@@ -19,8 +19,8 @@ using test::robots_as_blocks;
 
 // Every wait for peers of a run (docs/robust.md, "JSON and files": message_steps_total).
 int message_steps(const GncDistributedResult& r) {
-  return 2 * r.total_rounds + r.refine_message_steps + r.final_refine_message_steps +
-         r.exchange_steps;
+  return 2 * r.total_rounds + 2 * (r.solve_stages + r.final_solve_stages) + r.refine_message_steps +
+         r.final_refine_message_steps + r.exchange_steps;
 }
 
 // The 125-pose grid with 25 % random outliers: GNC rejects exactly the wrong closures and the

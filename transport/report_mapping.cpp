@@ -66,6 +66,8 @@ wire::AgentReportBody body_of(const agent::RobustRunReport& r) {
   w.refine_steps(static_cast<std::uint32_t>(r.refine_message_steps));
   w.exchange_steps(static_cast<std::uint32_t>(r.exchange_steps));
   w.final_refine_steps(static_cast<std::uint32_t>(r.final_refine_steps));
+  w.solve_stages(static_cast<std::uint32_t>(r.solve_stages));
+  w.final_solve_stages(static_cast<std::uint32_t>(r.final_solve_stages));
   wire::AgentReportBody b;
   b.robust(std::move(w));
   return b;
@@ -171,6 +173,8 @@ agent::AgentReport from_wire(const wire::AgentReport& w) {
       r.refine_message_steps = static_cast<int>(x.refine_steps());
       r.exchange_steps = static_cast<int>(x.exchange_steps());
       r.final_refine_steps = static_cast<int>(x.final_refine_steps());
+      r.solve_stages = static_cast<int>(x.solve_stages());
+      r.final_solve_stages = static_cast<int>(x.final_solve_stages());
       return r;
     }
     case wire::REPORT_PHASE_TIMES: {

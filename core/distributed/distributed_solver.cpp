@@ -191,10 +191,12 @@ DistributedResult solve_distributed_with_states(const PoseGraph& graph, const Bl
 
   const CertifiedAgent& lead = *sequences.front();
   res.rounds = lead.total_rounds();
+  res.solve_stages = static_cast<int>(lead.solves().size());
   res.restarts = lead.total_restarts();
   res.stop_reason = lead.solves().back().stop_reason;
   res.bytes_exchanged = stats.bytes;
   res.messages = stats.messages;
+  res.longest_chain = stats.longest_chain;
   int offset = 0;
   for (const auto& stage : lead.solves()) {
     for (const auto& r : stage.trace) {

@@ -41,6 +41,7 @@ namespace {
 struct Delivery {
   std::size_t recipient;
   ProtocolMessage message;
+  std::uint64_t chain = 0;  // its place in the longest chain of messages that led to it
 };
 
 double thread_cpu_s() {
@@ -61,13 +62,16 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
   std::deque<Delivery> queue;
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<double>> cpu;
   const std::size_t n = agents.size();
+  // The longest chain of messages each agent has handled (DeliveryStats::longest_chain).
+  std::vector<std::uint64_t> chain(n, 0);
   // CPU seconds of one handled message, charged to its recipient in the message's (stage, round).
   auto charge = [&](const ProtocolMessage& message, std::size_t recipient, double seconds) {
     auto& per_agent = cpu[{stage_of_phase(message_phase(message)), round_of(message)}];
     if (per_agent.empty()) per_agent.assign(n, 0.0);
     per_agent[recipient] += seconds;
   };
-  auto post = [&](std::size_t sender, std::vector<OutgoingMessage>&& out) {
+  // `after`: the sender's chain when it sent them.
+  auto post = [&](std::size_t sender, std::vector<OutgoingMessage>&& out, std::uint64_t after) {
     for (auto& o : out) {
       const std::size_t bytes = message_bytes(o.message);
       const std::uint32_t round = round_of(o.message);
@@ -80,7 +84,7 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
         if (stats.bytes_per_stage.size() <= stage) stats.bytes_per_stage.resize(stage + 1, 0);
         stats.bytes_per_stage[stage] += bytes;
         stats.bytes_per_stage_round[{stage, round}] += bytes;
-        queue.push_back({recipient, o.message});
+        queue.push_back({recipient, o.message, after + 1});
       };
       if (o.broadcast) {
         for (std::size_t r = 0; r < n; ++r)
@@ -91,9 +95,9 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
     }
   };
   if (order == DeliveryOrder::kReversed) {
-    for (std::size_t i = n; i-- > 0;) post(i, begin(i));
+    for (std::size_t i = n; i-- > 0;) post(i, begin(i), 0);
   } else {
-    for (std::size_t i = 0; i < n; ++i) post(i, begin(i));
+    for (std::size_t i = 0; i < n; ++i) post(i, begin(i), 0);
   }
   std::uint64_t state = delivery_seed * 0x9E3779B97F4A7C15ull + 1;
   auto next_random = [&] {  // xorshift64*: reproducible and cheap
@@ -116,7 +120,8 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
     std::vector<std::vector<std::size_t>> mine(n);
     std::vector<Delivery> wave;
     std::vector<std::vector<OutgoingMessage>> outs;
-    std::vector<double> took;  // < 0: not handled (agent done)
+    std::vector<double> took;          // < 0: not handled (agent done)
+    std::vector<std::uint64_t> after;  // the recipient's chain once it handled the delivery
     while (!queue.empty()) {
       wave.assign(std::make_move_iterator(queue.begin()), std::make_move_iterator(queue.end()));
       queue.clear();
@@ -128,11 +133,14 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
       }
       outs.assign(wave.size(), {});
       took.assign(wave.size(), -1.0);
+      after.assign(wave.size(), 0);
       pool.run(n, [&](std::size_t r) {
         double t0 = thread_cpu_s();
         for (std::size_t k : mine[r]) {
           if (agents[r]->done()) continue;
           outs[k] = agents[r]->handle(wave[k].message);
+          chain[r] = std::max(chain[r], wave[k].chain);  // this thread's agent only
+          after[k] = chain[r];
           const double t1 = thread_cpu_s();
           took[k] = t1 - t0;
           t0 = t1;
@@ -141,7 +149,7 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
       for (std::size_t k = 0; k < wave.size(); ++k) {
         if (took[k] < 0) continue;
         charge(wave[k].message, wave[k].recipient, took[k]);
-        post(wave[k].recipient, std::move(outs[k]));
+        post(wave[k].recipient, std::move(outs[k]), after[k]);
       }
     }
   }
@@ -163,11 +171,13 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
     if (d.recipient >= n) throw std::logic_error("in-process driver: message to unknown agent");
     if (agents[d.recipient]->done()) continue;
     std::vector<OutgoingMessage> out = agents[d.recipient]->handle(d.message);
+    chain[d.recipient] = std::max(chain[d.recipient], d.chain);
     const double t = thread_cpu_s();
     charge(d.message, d.recipient, t - t_prev);
     t_prev = t;
-    post(d.recipient, std::move(out));
+    post(d.recipient, std::move(out), chain[d.recipient]);
   }
+  stats.longest_chain = *std::max_element(chain.begin(), chain.end());
   for (const auto& [slot, per_agent] : cpu)
     stats.critical_path_cpu_s += *std::max_element(per_agent.begin(), per_agent.end());
   for (auto* a : agents)

@@ -91,6 +91,7 @@ GncAgentResult GncAgent::result() const {
   r.probes_kept = probes_kept();
   r.refine_message_steps = gnc_refine_steps_;
   r.exchange_steps = exchange_steps_;
+  r.solve_stages = gnc_solve_stages_;
   return r;
 }
 
@@ -485,6 +486,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     return;
   }
   gnc_rounds_ += solve_->total_rounds();
+  gnc_solve_stages_ += static_cast<int>(solve_->solves().size());
   gnc_refine_steps_ += message_steps(solve_->refines());
   if (solve_kind_ == GncSolveKind::kInlierPass) {
     last_pass_full_ = !pass_capped_;

@@ -152,6 +152,7 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   }
   out.total_rounds = lead.gnc_rounds();
   out.total_bytes = stats.bytes;
+  out.longest_chain = stats.longest_chain;
 
   // The last solve of the kept set with its full record (trace, certificate, refinement): when
   // the agents run a final solve (certification or RobustOptions::final_refine) that one, from
@@ -177,7 +178,9 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   if (final_runs) {
     out.total_rounds += out.final_solve.rounds;
     out.final_refine_message_steps = message_steps(out.final_solve.refines);
+    out.final_solve_stages = out.final_solve.solve_stages;
     out.total_bytes += out.final_solve.bytes_exchanged;
+    out.longest_chain += out.final_solve.longest_chain;
   }
   return out;
 }

@@ -57,6 +57,8 @@ struct CertificateTrafficReport {
 struct RobustRunReport : GncAgentResult {
   /// Message steps of the final solve's Newton refinement (0 without a final solve).
   int final_refine_steps = 0;
+  /// Solve stages of the final solve (0 without one).
+  int final_solve_stages = 0;
 };
 
 /// Agent 0's time after the rounds began, its clock (seconds), and how the rounding went: the

@@ -76,8 +76,10 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   res.final_rank = static_cast<std::uint32_t>(agent.state().rank());
   RobustRunReport report;
   static_cast<GncAgentResult&>(report) = agent.result();
-  if (const CertifiedAgent* final_solve = agent.final_sequence())
+  if (const CertifiedAgent* final_solve = agent.final_sequence()) {
     report.final_refine_steps = message_steps(final_solve->refines());
+    report.final_solve_stages = static_cast<int>(final_solve->solves().size());
+  }
   res.robust = std::move(report);
 
   // The rounding sees the kept measurements (the cost is over them).

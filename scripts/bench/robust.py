@@ -326,9 +326,10 @@ def ate(estimate, reference, d):
 # ---- runs
 def message_steps(rounds, summary):
     """Message steps of a distributed run, each a wait for peers: the JSON's message_steps_total
-    (two a round, docs/irbcd.md, plus every Newton refinement's neighbour exchanges and all-agent
-    sums, plus a robust run's own exchanges: poses, votes, weights, rejected sets, verdicts,
-    gathers, its gnc_exchange_steps). Under `--refine auto` a clean run hands over to the
+    (two a round, docs/irbcd.md, two a solve stage (its opening pose exchange and closing status
+    round), plus every Newton refinement's neighbour exchanges and all-agent sums, plus a robust
+    run's own exchanges: poses, votes, weights, rejected sets, verdicts, gathers, its
+    gnc_exchange_steps). Under `--refine auto` a clean run hands over to the
     refinement early, so its rounds alone undercount its work (intel: 1 round, 13 refinement
     steps). A binary without message_steps_total: two a round plus the refinements' steps
     (GNC's own exchanges left out)."""

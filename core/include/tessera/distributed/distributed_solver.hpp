@@ -105,6 +105,9 @@ struct DistributedRound {
 struct DistributedResult {
   int agents = 0;
   int rounds = 0;  ///< Block-update rounds done, all solve stages (restarts' redos inside).
+  /// Solve stages run (one per rank solved or refined): each opens with a pose exchange and
+  /// ends with a status round, two message steps beyond two a round.
+  int solve_stages = 0;
   int restarts = 0;
   /// grad_norm, max_rounds, relative_decrease or stalled (the iterate stopped moving above
   /// the tolerance: RoundProtocol::stop_reason()).
@@ -112,6 +115,9 @@ struct DistributedResult {
   std::vector<DistributedRound> trace;
   std::uint64_t bytes_exchanged = 0;  ///< Every message (solve, certificate, escape).
   std::uint64_t messages = 0;
+  /// The longest chain of messages (DeliveryStats::longest_chain): the message steps waited
+  /// through one after another, certificates and escapes included.
+  std::uint64_t longest_chain = 0;
   // Certification (options.certify): nullopt / zero when off.
   std::optional<bool> certified;
   double min_eigenvalue = 0.0;         ///< Last certificate's smallest Ritz value of S.

@@ -37,6 +37,10 @@ struct DeliveryStats {
   /// message's time includes the driver's queueing just before it (the receiving side's share
   /// of a transport).
   double critical_path_cpu_s = 0.0;
+  /// The longest chain of messages each sent by the previous one's recipient after it handled
+  /// it: message steps the run waits through one after another whatever the network, a count
+  /// the protocols' own message-step figures (two a round, ...) can be checked against.
+  std::uint64_t longest_chain = 0;
 };
 
 /// Bytes of a message's content as it would travel: every field of the core message at its

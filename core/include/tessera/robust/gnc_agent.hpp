@@ -334,6 +334,7 @@ class GncAgent : public AgentProcess {
   std::vector<Measurement> kept_;
   std::vector<std::uint64_t> kept_index_;
   int gnc_rounds_ = 0, final_rounds_ = 0, gnc_refine_steps_ = 0, exchange_steps_ = 0;
+  int gnc_solve_stages_ = 0;  // before the final solve
   bool done_ = false;
   std::function<void(int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
       weight_observer_;

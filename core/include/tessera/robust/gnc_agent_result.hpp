@@ -30,8 +30,13 @@ struct GncAgentResult {
   int refine_message_steps = 0;
   /// Message steps of GNC's own exchanges: poses, votes, weights, rejected sets, verdicts,
   /// start votes, gathers (one per exchange, two per gather at agent 0). A run's message steps
-  /// in all are 2 x its rounds + refine_message_steps + the final solve's refinement's + this.
+  /// in all are 2 x its rounds + 2 x its solve stages + refine_message_steps + the final
+  /// solve's refinement's + this.
   int exchange_steps = 0;
+  /// Solve stages of the solves before the final one (CertifiedAgent::solves(), summed): each
+  /// opens with a pose exchange and ends with a status round, two message steps beyond two a
+  /// round.
+  int solve_stages = 0;
 };
 
 }  // namespace tessera

@@ -104,10 +104,14 @@ struct GncDistributedResult : GncAgentResult {
   int total_rounds = 0;           ///< Rounds of every solve, final included.
   /// Message steps of the final solve's Newton refinement (0 when no final solve runs: the
   /// last inlier pass is then the answer and its refinement is in refine_message_steps). The
-  /// run's message steps in all are
-  /// 2 x total_rounds + refine_message_steps + final_refine_message_steps + exchange_steps.
+  /// run's message steps in all are 2 x total_rounds + 2 x (solve_stages + final_solve_stages)
+  /// + refine_message_steps + final_refine_message_steps + exchange_steps.
   int final_refine_message_steps = 0;
+  int final_solve_stages = 0;     ///< Solve stages of the final solve (0 when none runs).
   std::uint64_t total_bytes = 0;  ///< Bytes of every solve plus the outer steps' votes.
+  /// The longest chain of messages of the agents' run and then the final solve's
+  /// (DeliveryStats::longest_chain).
+  std::uint64_t longest_chain = 0;
   /// Measurements GNC had kept whose residual at an inlier set's solution was beyond the bound,
   /// rejected by the re-check passes (GncAgent::late_rejected()).
   std::size_t late_rejected = 0;

@@ -1,0 +1,50 @@
+// A run's message steps (docs/robust.md, "JSON and files": message_steps_total) against the
+// longest chain of messages the in-process driver saw (DeliveryStats::longest_chain): every
+// counted wait lies on one chain of messages, each sent after the previous one came in, so
+// the count is what the run waits through one after another. Without certification: the
+// certificate's own message steps are not in the count.
+#include <gtest/gtest.h>
+
+#include <tessera/distributed/distributed_solver.hpp>
+#include <tessera/distributed/newton_refine.hpp>
+#include <tessera/robust/gnc_distributed.hpp>
+
+#include "gnc_fixtures.hpp"
+
+namespace tessera {
+namespace {
+
+// Two a round, two a solve stage (its opening pose exchange and closing status round) and the
+// Newton refinements' neighbour exchanges and all-agent sums.
+long long message_steps(const DistributedResult& r) {
+  return 2LL * r.rounds + 2LL * r.solve_stages + message_steps(r.refines);
+}
+
+long long message_steps(const GncDistributedResult& r) {
+  return 2LL * r.total_rounds + 2LL * (r.solve_stages + r.final_solve_stages) +
+         r.refine_message_steps + r.final_refine_message_steps + r.exchange_steps;
+}
+
+TEST(MessageSteps, ACleanSolveCountsEveryWaitOfItsLongestChain) {
+  const GeneratorResult clean = test::grid_with_outliers(0.0);
+  DistributedOptions o;  // IRBCD, --refine auto: rounds, then the Newton refinement
+  o.certify = false;
+  const DistributedResult r = solve_distributed(clean.graph, test::robots_as_blocks(clean), o);
+  ASSERT_EQ(r.solve_stages, 1);
+  ASSERT_FALSE(r.refines.empty()) << "the rounds should hand over to the refinement";
+  EXPECT_EQ(message_steps(r), static_cast<long long>(r.longest_chain));
+}
+
+TEST(MessageSteps, ARobustRunCountsEveryWaitOfItsLongestChain) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  GncDistributedOptions o;  // Newton steps in GNC, exchanges riding along
+  o.robust.kind = RobustKind::kGncTls;
+  const GncDistributedResult r =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  ASSERT_GT(r.outer_iterations, 2);
+  ASSERT_GT(r.solve_stages, r.outer_iterations) << "a solve stage per solve";
+  EXPECT_EQ(message_steps(r), static_cast<long long>(r.longest_chain));
+}
+
+}  // namespace
+}  // namespace tessera
