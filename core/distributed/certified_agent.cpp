@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <tessera/distributed/agent_factory.hpp>
 #include <tessera/distributed/certified_agent.hpp>
@@ -97,6 +98,42 @@ std::vector<OutgoingMessage> CertifiedAgent::start() {
   begin(0, out);
   advance(out);
   return out;
+}
+
+bool CertifiedAgent::can_start_at_refinement() const {
+  // Such rounds stop at their round-0 status ("grad_norm") and refine_wanted() holds there.
+  return !options_.certify && options_.refine.enabled && hands_over_early() &&
+         std::isinf(solve_tolerance());
+}
+
+std::vector<OutgoingMessage> CertifiedAgent::start_at_refinement() {
+  if (!can_start_at_refinement())
+    throw std::logic_error("CertifiedAgent: this solve does not start at its refinement");
+  std::vector<OutgoingMessage> out;
+  stage_ = 0;
+  solves_.push_back(
+      {stage_, state_.rank(), 0, 0, "grad_norm", {}, solve_tolerance(), refining_, false});
+  begin_refine(out);
+  advance(out);
+  return out;
+}
+
+void CertifiedAgent::begin_refine(std::vector<OutgoingMessage>& out) {
+  NewtonRefineOptions refine = options_.refine;
+  // Handed over early, the refinement also owes the rounds' own tolerance where that is the
+  // tighter one.
+  if (hands_over_early() && options_.grad_norm_tol > 0)
+    refine.grad_norm_tol = std::min(refine.grad_norm_tol, options_.grad_norm_tol);
+  refine_ = std::make_unique<NewtonRefineProtocol>(state_, layout_, refine);
+  if (trial_observer_) refine_->set_trial_observer(trial_observer_);
+  current_ = refine_.get();
+  emit(refine_->start(), out);
+  for (const ProtocolMessage& m :
+       kept_.take_steps(tag_phase(stage_, NewtonRefineProtocol::kStatus),
+                        tag_phase(stage_, NewtonRefineProtocol::kLastStep) + 1)) {
+    if (current_->done()) break;
+    to_current(m, out);
+  }
 }
 
 std::vector<OutgoingMessage> CertifiedAgent::resume(const ProtocolSnapshot& snapshot) {
@@ -220,21 +257,7 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
           if (options_.refine.enabled && !solves_.back().trace.empty() &&
               (stop == "grad_norm" || stop == "relative_decrease" || stop == "stalled") &&
               refine_wanted(solves_.back().trace)) {
-            NewtonRefineOptions refine = options_.refine;
-            // Handed over early, the refinement also owes the rounds' own tolerance where
-            // that is the tighter one.
-            if (hands_over_early() && options_.grad_norm_tol > 0)
-              refine.grad_norm_tol = std::min(refine.grad_norm_tol, options_.grad_norm_tol);
-            refine_ = std::make_unique<NewtonRefineProtocol>(state_, layout_, refine);
-            if (trial_observer_) refine_->set_trial_observer(trial_observer_);
-            current_ = refine_.get();
-            emit(refine_->start(), out);
-            for (const ProtocolMessage& m :
-                 kept_.take_steps(tag_phase(stage_, NewtonRefineProtocol::kStatus),
-                                  tag_phase(stage_, NewtonRefineProtocol::kLastStep) + 1)) {
-              if (current_->done()) break;
-              to_current(m, out);
-            }
+            begin_refine(out);
             continue;
           }
         } else {
@@ -243,7 +266,9 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
           const NewtonRefineResult& r = refine_->result();
           refines_.push_back(r);
           if (r.accepted_steps > 0) {
-            RoundRecord last = solves_.back().trace.back();
+            // Started at the refinement, the stage has no round record to copy.
+            RoundRecord last =
+                solves_.back().trace.empty() ? RoundRecord{} : solves_.back().trace.back();
             last.cost = r.cost;
             last.grad_norm = r.grad_norm;
             last.selected.clear();
@@ -253,7 +278,7 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
           refine_.reset();
           current_ = solve_.get();
         }
-        if (!options_.certify || solve_->trace().empty()) {
+        if (!options_.certify || !solve_ || solve_->trace().empty()) {
           done_ = true;
           break;
         }

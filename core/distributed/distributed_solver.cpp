@@ -191,7 +191,7 @@ DistributedResult solve_distributed_with_states(const PoseGraph& graph, const Bl
 
   const CertifiedAgent& lead = *sequences.front();
   res.rounds = lead.total_rounds();
-  res.solve_stages = static_cast<int>(lead.solves().size());
+  res.solve_stages = opened_solve_stages(lead.solves());
   res.restarts = lead.total_restarts();
   res.stop_reason = lead.solves().back().stop_reason;
   res.bytes_exchanged = stats.bytes;

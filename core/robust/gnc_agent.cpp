@@ -128,6 +128,7 @@ std::vector<OutgoingMessage> GncAgent::start() {
 
 void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
+  const bool neighbours_known = neighbours_current_;
   neighbours_current_ = false;
   solve_.reset();
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
@@ -165,7 +166,16 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
       trial_Y_ = Y;
       trial_pending_ = true;
     });
-  pass_on(solve_->start(), out);
+  // A weighted solve by Newton steps right after a pose exchange of its start (every agent's
+  // steps are the same): its rounds would open with that exchange again and stop at their first
+  // status, so it starts at the refinement with the exchange's poses (the same bits).
+  if (newton_steps && neighbours_known && options_.robust.exchanges_ride_along &&
+      solve_->can_start_at_refinement()) {
+    state_->reset_iterate(state_->Y, exchange_->neighbours_at(state_->problem().neighbors()));
+    pass_on(solve_->start_at_refinement(), out);
+  } else {
+    pass_on(solve_->start(), out);
+  }
   const std::uint32_t g = g_;
   // Messages of this solve that came while this agent was behind; once the solve has ended,
   // the rest are of no use.
@@ -486,7 +496,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     return;
   }
   gnc_rounds_ += solve_->total_rounds();
-  gnc_solve_stages_ += static_cast<int>(solve_->solves().size());
+  gnc_solve_stages_ += opened_solve_stages(solve_->solves());
   gnc_refine_steps_ += message_steps(solve_->refines());
   if (solve_kind_ == GncSolveKind::kInlierPass) {
     last_pass_full_ = !pass_capped_;

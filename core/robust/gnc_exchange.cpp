@@ -1,6 +1,7 @@
 #include "robust/gnc_exchange.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 #include <tessera/distributed/message_gate.hpp>
 
@@ -43,6 +44,21 @@ void GncExchangeBook::expect_poses(Eigen::Index rows, bool both_starts) {
   neighbours_ = Eigen::MatrixXd::Zero(
       rows, (in_.d + 1) * static_cast<Eigen::Index>(terms_.neighbours().size()));
   if (both_starts) candidate_neighbours_ = neighbours_;
+}
+
+Eigen::MatrixXd GncExchangeBook::neighbours_at(const std::vector<std::size_t>& poses) const {
+  const std::vector<std::size_t>& book = terms_.neighbours();  // sorted
+  const Eigen::Index w = in_.d + 1;
+  Eigen::MatrixXd out(neighbours_.rows(), w * static_cast<Eigen::Index>(poses.size()));
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const auto it = std::lower_bound(book.begin(), book.end(), poses[k]);
+    if (it == book.end() || *it != poses[k])
+      throw std::logic_error("GncExchangeBook: pose " + std::to_string(poses[k]) +
+                             " is no neighbour pose of agent " + std::to_string(in_.id));
+    out.middleCols(w * static_cast<Eigen::Index>(k), w) =
+        neighbours_.middleCols(w * static_cast<Eigen::Index>(it - book.begin()), w);
+  }
+  return out;
 }
 
 void GncExchangeBook::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,

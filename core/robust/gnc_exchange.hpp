@@ -68,6 +68,9 @@ class GncExchangeBook {
   void read(GncExchange e, const ProtocolMessage& message, GncExchangeTargets to);
 
   const Eigen::MatrixXd& neighbours() const { return neighbours_; }
+  /// The neighbours' poses of the last pose exchange at `poses` (global ids, each one of this
+  /// agent's neighbour poses; columns in that order), e.g. a solve's AgentState::Yn.
+  Eigen::MatrixXd neighbours_at(const std::vector<std::size_t>& poses) const;
   const Eigen::MatrixXd& candidate_neighbours() const { return candidate_neighbours_; }
   void forget_candidate_neighbours() { candidate_neighbours_.resize(0, 0); }
   /// The candidate start's neighbour poses when agent 0 sent (or, at agent 0, computed) them

@@ -78,7 +78,7 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   static_cast<GncAgentResult&>(report) = agent.result();
   if (const CertifiedAgent* final_solve = agent.final_sequence()) {
     report.final_refine_steps = message_steps(final_solve->refines());
-    report.final_solve_stages = static_cast<int>(final_solve->solves().size());
+    report.final_solve_stages = opened_solve_stages(final_solve->solves());
   }
   res.robust = std::move(report);
 

@@ -49,6 +49,16 @@ class CertifiedAgent : public AgentProcess {
   /// Instead of start(): the first solve stage continues from `snapshot` (a coordinated
   /// rollback, see RoundProtocol::resume); the later stages follow as usual.
   std::vector<OutgoingMessage> resume(const ProtocolSnapshot& snapshot);
+  /// Whether the first solve stage's rounds would stop at their first status and hand over to
+  /// the Newton refinement (an infinite hand-over gradient, no certificate): then
+  /// start_at_refinement() may replace start(). The same on every agent (options and layout).
+  bool can_start_at_refinement() const;
+  /// Instead of start(), where can_start_at_refinement() holds and the state's neighbour copies
+  /// (AgentState::Yn) are the neighbours' current poses, as every agent of the run knows: the
+  /// first solve stage begins at its Newton refinement, without the rounds' opening pose
+  /// exchange and round-0 status (the refinement takes its own). The stage's record has no
+  /// rounds and SolveStageRecord::opened false. Every agent of the run must start so.
+  std::vector<OutgoingMessage> start_at_refinement();
   /// Observer of the FIRST solve stage's consistent points (RoundProtocol::set_round_observer):
   /// snapshots of later stages would not be resumable from stage 0.
   void set_round_observer(std::function<void(const ProtocolSnapshot&)> observer) {
@@ -101,6 +111,8 @@ class CertifiedAgent : public AgentProcess {
   void begin(std::uint32_t stage, std::vector<OutgoingMessage>& out,
              const ProtocolSnapshot* resume_from = nullptr);
   void advance(std::vector<OutgoingMessage>& out);
+  /// The current solve stage's Newton refinement begins (its early messages handed over).
+  void begin_refine(std::vector<OutgoingMessage>& out);
   void emit(std::vector<OutgoingMessage>&& sub, std::vector<OutgoingMessage>& out) const;
   /// Hands a message of the current stage (stage-tagged phase, as on the wire) to the running
   /// protocol; a solve stage's refinement messages wait until its refinement runs.
