@@ -74,6 +74,18 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   // early end: the iterate's poses are the last weight update's) the values' way to agent 0 and
   // the pose exchange of both starts.
   EXPECT_EQ(apart.exchange_steps - along.exchange_steps, apart.outer_iterations + 2);
+  // Each weighted solve (a Newton step, after a pose exchange of its start) starts at its
+  // refinement: no solve stage of its own. Left: the plain solve, the passes, the final solve.
+  // (An outer step ended early by a jump has no weighted solve after its weight update.)
+  EXPECT_GE(apart.solve_stages - along.solve_stages, apart.outer_iterations - 1);
+  EXPECT_EQ(along.final_solve_stages, apart.final_solve_stages);
+  // Every step left out was a real wait: the longest chain of messages is shorter by as many.
+  auto steps = [](const GncDistributedResult& r) {
+    return 2 * r.total_rounds + 2 * (r.solve_stages + r.final_solve_stages) +
+           r.refine_message_steps + r.final_refine_message_steps + r.exchange_steps;
+  };
+  EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - along.longest_chain),
+            steps(apart) - steps(along));
 }
 
 }  // namespace

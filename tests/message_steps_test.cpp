@@ -37,13 +37,20 @@ TEST(MessageSteps, ACleanSolveCountsEveryWaitOfItsLongestChain) {
 
 TEST(MessageSteps, ARobustRunCountsEveryWaitOfItsLongestChain) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
-  GncDistributedOptions o;  // Newton steps in GNC, exchanges riding along
-  o.robust.kind = RobustKind::kGncTls;
-  const GncDistributedResult r =
-      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
-  ASSERT_GT(r.outer_iterations, 2);
-  ASSERT_GT(r.solve_stages, r.outer_iterations) << "a solve stage per solve";
-  EXPECT_EQ(message_steps(r), static_cast<long long>(r.longest_chain));
+  for (bool ride_along : {true, false}) {
+    GncDistributedOptions o;  // Newton steps in GNC
+    o.robust.kind = RobustKind::kGncTls;
+    o.robust.exchanges_ride_along = ride_along;
+    const GncDistributedResult r =
+        solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+    ASSERT_GT(r.outer_iterations, 2);
+    if (ride_along)  // the weighted solves start at their refinement, with no stage steps
+      ASSERT_LT(r.solve_stages, r.outer_iterations) << "a solve stage per weighted solve";
+    else
+      ASSERT_GT(r.solve_stages, r.outer_iterations) << "a solve stage per solve";
+    EXPECT_EQ(message_steps(r), static_cast<long long>(r.longest_chain))
+        << "exchanges_ride_along " << ride_along;
+  }
 }
 
 }  // namespace

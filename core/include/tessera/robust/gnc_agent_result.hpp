@@ -33,9 +33,10 @@ struct GncAgentResult {
   /// in all are 2 x its rounds + 2 x its solve stages + refine_message_steps + the final
   /// solve's refinement's + this.
   int exchange_steps = 0;
-  /// Solve stages of the solves before the final one (CertifiedAgent::solves(), summed): each
-  /// opens with a pose exchange and ends with a status round, two message steps beyond two a
-  /// round.
+  /// Solve stages of the solves before the final one that open with a pose exchange and end
+  /// with a status round, two message steps beyond two a round (opened_solve_stages of
+  /// CertifiedAgent::solves(), summed; a weighted solve that starts at its refinement has
+  /// none).
   int solve_stages = 0;
 };
 
