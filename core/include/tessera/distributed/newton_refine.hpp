@@ -203,7 +203,9 @@ struct NewtonRefineOptions {
   /// doubled the CPU of the whole solve and multiplied the bytes by 8 (4.9 -> 40.6 MB), so it
   /// stayed out, as did torus3D (2,916) and sphere2500 (2,088). With kShipSolves, the default
   /// from ship_solves_min_coordinates, that cost is agent 0's alone (cubicle 4.9 -> 4.8 MB, user
-  /// CPU 0.6x, loaded); the cap has not been re-chosen since (docs/newton-refine.md, "Cap").
+  /// CPU 0.6x, loaded). With kShipSolves, at 3,000 (callgrind, whole solve): cubicle and
+  /// sphere2500 0.74x and 0.76x the instructions, torus3D 1.74x (and 7.5x the bytes), so no cap
+  /// suits all three and it stays at 1,000 (docs/newton-refine.md, "Cap").
   /// parking-garage (348) and ais2klinik (102) gain 4-9x. >= 0.
   int interface_max_coordinates = 1000;
   /// kIfRoundsSlow: where the interface solves apply (the team's interface within
