@@ -1,3 +1,7 @@
+// GncAgent's state machine: its construction, the outer loop's transitions after each solve and
+// each exchange (after_solve, after_exchange), the end of the run and its result. The solves are
+// gnc_agent_solve.cpp, the exchanges gnc_agent_exchanges.cpp, the probes gnc_agent_probes.cpp.
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -126,148 +130,6 @@ std::vector<OutgoingMessage> GncAgent::start() {
   return out;
 }
 
-void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
-  step_ = Step::kSolve;
-  const bool neighbours_known = neighbours_current_;
-  neighbours_current_ = false;
-  solve_.reset();
-  // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
-  const bool weighted = solve_kind_ == GncSolveKind::kGnc && g_ > first_solve_g_;
-  const bool newton_steps = weighted && gnc_refines(options_, *layout_, in_.d);
-  solve_options_ = gnc_solve_options(options_, solve_kind_, pass_capped_, newton_steps);
-  if (weighted) {
-    gnc_newton_steps_ = (weighted_solves_ == 0 || gnc_newton_steps_) && newton_steps;
-    ++weighted_solves_;
-  }
-  std::vector<Measurement> measurements;
-  if (solve_kind_ == GncSolveKind::kGnc)
-    measurements =
-        gnc_solve_measurements(in_.measurements, weights_, weighted, terms_->known_connected());
-  else
-    measurements = kept_;
-  const Eigen::MatrixXd Y = state_ ? state_->Y : in_.Y0;
-  if (solve_kind_ == GncSolveKind::kInlierPass) last_pass_start_ = Y;
-  state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
-                                        solve_options_.block_update);
-  if (solve_options_.refine.enabled &&
-      solve_options_.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed)
-    // The refinement's coarse space over the graph this solve works on, as the in-process
-    // solve of the same graph builds it (every agent the same, no message).
-    state_->use_refine_space(std::make_shared<const CoarseSpace>(
-        make_coarse_space(in_.num_poses, solve_structure(), in_.owner,
-                          solve_options_.refine.coarse_space_options())));
-  solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
-  trial_pending_ = poses_sent_early_ = poses_early_stale_ = false;
-  if (newton_steps && send_poses_with_trial())
-    solve_->set_trial_observer([this](const Eigen::MatrixXd& Y) {
-      // One trial per solve (a single Newton step); after rounds the iterate the last pose
-      // exchange holds is not the solve's start, so those take the exchange of their own.
-      if (poses_sent_early_ || trial_pending_ || solve_->total_rounds() > 0) return;
-      trial_Y_ = Y;
-      trial_pending_ = true;
-    });
-  // A weighted solve by Newton steps right after a pose exchange of its start (every agent's
-  // steps are the same): its rounds would open with that exchange again and stop at their first
-  // status, so it starts at the refinement with the exchange's poses (the same bits).
-  if (newton_steps && neighbours_known && options_.robust.exchanges_ride_along &&
-      solve_->can_start_at_refinement()) {
-    state_->reset_iterate(state_->Y, exchange_->neighbours_at(state_->problem().neighbors()));
-    pass_on(solve_->start_at_refinement(), out);
-  } else {
-    pass_on(solve_->start(), out);
-  }
-  const std::uint32_t g = g_;
-  // Messages of this solve that came while this agent was behind; once the solve has ended,
-  // the rest are of no use.
-  for (const ProtocolMessage& m : mail_->begin_solve(g)) {
-    if (done_ || g_ != g || step_ != Step::kSolve) break;
-    to_solve(m, out);
-  }
-  if (!done_ && g_ == g && step_ == Step::kSolve && solve_->done()) after_solve(out);
-}
-
-void GncAgent::to_solve(const ProtocolMessage& message, std::vector<OutgoingMessage>& out) {
-  ProtocolMessage m = message;
-  std::visit([&](auto& x) { x.phase -= g_ * kGncStepStride; }, m);
-  pass_on(solve_->handle(m), out);
-  if (solve_->done()) after_solve(out);
-}
-
-// Endpoints of the measurements the current solve works on, file order: the kept set for the
-// passes and the final solve, the whole graph for GNC's weighted solves.
-std::vector<std::pair<std::uint32_t, std::uint32_t>> GncAgent::solve_structure() const {
-  return solve_kind_ == GncSolveKind::kGnc ? in_.structure
-                                           : inlier_structure(in_.structure, rejected_);
-}
-
-// The inner solve's messages, tagged with this GNC step.
-void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out) {
-  for (auto& o : solve_out) {
-    std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
-    out.push_back(std::move(o));
-  }
-  if (trial_pending_) {
-    // Beside the trial's sums, which every agent waits for anyway: this step's pose exchange.
-    exchange_->publish(trial_Y_, BlockKind::kY, gnc_phase(g_, GncExchange::kPoses), out);
-    trial_pending_ = false;
-    poses_sent_early_ = true;
-  }
-}
-
-bool GncAgent::gather_values_early() const {
-  // Not with pcm-gnc (its check gathers at agent 0 already, and consumes them) nor without a
-  // fresh start to use them; the same on every agent.
-  return options_.robust.exchanges_ride_along && fresh_start_ && !in_.pcm && in_.num_agents > 1;
-}
-
-bool GncAgent::send_poses_with_trial() const {
-  // Every agent decides the same: the options, and the outer loop's state (the summed votes).
-  return options_.robust.exchanges_ride_along && options_.robust.gnc_refine_steps == 1 &&
-         !outer_->over(options_.robust);
-}
-
-GncExchange GncAgent::exchange() const {
-  switch (step_) {
-    case Step::kPoses:
-      return GncExchange::kPoses;
-    case Step::kVotes:
-      return GncExchange::kVotes;
-    case Step::kWeights:
-      return GncExchange::kWeights;
-    case Step::kRejected:
-      return GncExchange::kRejected;
-    case Step::kReadmitted:
-      return GncExchange::kReadmitted;
-    case Step::kKeptStart:
-      // Agent 0 gathers the kept values; the others wait for its start.
-      return in_.id == 0 ? GncExchange::kKeptValues : GncExchange::kKeptStart;
-    case Step::kCandidatePoses:
-      return GncExchange::kCandidatePoses;
-    case Step::kCandidateVotes:
-      return GncExchange::kCandidateVotes;
-    case Step::kPcm:
-      return in_.id == 0 ? GncExchange::kPcmValues : GncExchange::kPcmDropped;
-    case Step::kStartPoses:
-      return GncExchange::kStartPoses;
-    case Step::kStartVotes:
-      return GncExchange::kStartVotes;
-    default:  // not an exchange: begin_exchange() is never called with it
-      throw std::logic_error("GncAgent: no exchange at this step");
-  }
-}
-
-void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
-  std::optional<std::vector<ProtocolMessage>> ready = mail_->take_exchange();
-  if (!ready) return;
-  // Read into the book, or the agent's own data the exchange changes.
-  for (const ProtocolMessage& m : *ready)
-    if (!(step_ == Step::kPoses && poses_early_stale_))
-      exchange_->read(exchange(), m,
-                      GncExchangeTargets{weights_, zero_cut_, low_weights_, rejected_, *recheck_,
-                                         state_ ? state_->Y.rows() : in_.Y0.rows()});
-  after_exchange(out);
-}
-
 void GncAgent::require_kept_connected() const {
   // The kept set must connect every pose (every agent checks the same set).
   const std::size_t parts =
@@ -295,32 +157,6 @@ void GncAgent::begin_rejected(std::vector<OutgoingMessage>& out) {
     if ((jumped_ ? tls_verdict_weight(w, outer_->mu()) : w) < 0.5) rejected_.push_back(id);
   step_ = Step::kRejected;
   after_exchange(out);
-}
-
-void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
-  require_kept_connected();
-  gnc_kept_measurements(in_.measurements, in_.measurement_index, rejected_, kept_, kept_index_);
-  solve_without(rejected_);
-  solve_kind_ = GncSolveKind::kInlierPass;
-  // A pass that hands over to the refinement is solved to the tolerance even while its set may
-  // still change: from the last iterate that costs fewer message steps than the capped rounds.
-  pass_capped_ = options_.robust.recheck_max_rounds > 0 && !full_pass_next_ &&
-                 !pass_refines(options_, *layout_, in_.d);
-  full_pass_next_ = false;
-  pass_from_solved_ = last_pass_full_;
-  last_pass_full_ = false;
-  ++g_;
-  begin_solve(out);
-}
-
-void GncAgent::solve_without(const std::vector<std::uint64_t>& dropped) {
-  auto layout = std::make_unique<BlockLayout>(
-      make_block_layout(in_.num_poses, structure_without(in_.structure, dropped), in_.owner));
-  // The state refers to the layout: keep the iterate as the next start, then replace both.
-  if (state_) in_.Y0 = state_->Y;
-  solve_.reset();
-  state_.reset();
-  layout_ = std::move(layout);
 }
 
 bool GncAgent::final_solve_runs() const {
@@ -413,79 +249,6 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
         false,
         {a}});
   exchange_->candidate() = block_of(X, base_->poses[0], in_.d);
-}
-
-int GncAgent::probes() const {
-  return probes_->started();
-}
-
-int GncAgent::probes_kept() const {
-  return probes_->kept();
-}
-
-bool GncAgent::may_probe() const {
-  return probes_->may_start(terms_->known_connected(), options_.robust.readmission_passes);
-}
-
-std::vector<std::uint64_t> GncAgent::probe_flips(std::vector<std::uint64_t> listed) const {
-  // RobustOptions::probe_cut: from GNC's own set the tail side is cut always, never, or where
-  // GNC's weighted solves were rounds.
-  const ProbeCut rule = options_.robust.probe_cut;
-  const bool cut_untouched =
-      rule == ProbeCut::kAlways || (rule == ProbeCut::kAuto && !gnc_newton_steps_);
-  if (cut_untouched || rejected_ != gnc_rejected_) return listed;
-  // Every agent holds the same list and set (the verdict exchange): the same flips everywhere.
-  listed.erase(std::remove_if(listed.begin(), listed.end(),
-                              [&](std::uint64_t id) {
-                                return !std::binary_search(rejected_.begin(), rejected_.end(), id);
-                              }),
-               listed.end());
-  return listed;
-}
-
-void GncAgent::begin_probe(double tls, std::vector<std::uint64_t> flip,
-                           std::vector<OutgoingMessage>& out) {
-  // Every agent holds every agent's probe list (the verdict exchange) and runs the same cluster
-  // search: the same flips everywhere.
-  probes_->start(GncProbeBase{tls, rejected_, weights_, state_->Y, readmitted_, late_rejected_});
-  RecheckVerdict cut;
-  cut.cut_now = std::move(flip);
-  apply_recheck(cut, in_.measurement_index, rejected_, weights_);
-  pass_ = 0;
-  last_pass_full_ = false;
-  // The iterate was bent around what the probe cut, and a local solve keeps such a fold; the
-  // kept set's fresh start (voted on its cost, as after GNC) does not have it.
-  if (fresh_start_) {
-    require_kept_connected();
-    begin_exchange(Step::kKeptStart, out);
-    return;
-  }
-  begin_inlier_pass(out);
-}
-
-void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out, double rise) {
-  GncProbeBase base = probes_->take_base();
-  rejected_ = std::move(base.rejected);
-  weights_ = std::move(base.weights);
-  readmitted_ = base.readmitted;
-  late_rejected_ = base.late_rejected;
-  // The own block has the same shape whatever the kept set: the next pass starts from it.
-  state_->Y = std::move(base.Y);
-  neighbours_current_ = false;
-  if (search_) {
-    // The next probe starts from the restored set and iterate, which the passes had settled.
-    search_->refused(rise, base.tls);
-    if (may_probe())
-      if (std::optional<std::vector<std::uint64_t>> flip = search_->next(rejected_)) {
-        begin_probe(base.tls, std::move(*flip), out);
-        return;
-      }
-  }
-  // One last pass on the restored set (from its converged iterate, so it costs few rounds),
-  // then the final solve.
-  pass_ = options_.robust.readmission_passes;
-  full_pass_next_ = true;
-  begin_inlier_pass(out);
 }
 
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {

@@ -1,8 +1,10 @@
-// GncAgent's exchange steps, the sending side: what each step of GNC's own exchanges computes
-// from this agent's view and sends to whom (GncAgent::Step). The state machine that decides which
-// step comes next is gnc_agent.cpp; the messages' layout is gnc_messages.hpp.
+// GncAgent's exchange steps: what each step of GNC's own exchanges computes from this agent's view
+// and sends to whom (GncAgent::Step), which exchange a step is, and reading a completed exchange
+// into the book. The state machine that decides which step comes next is gnc_agent.cpp; the
+// messages' layout is gnc_messages.hpp.
 
 #include <algorithm>
+#include <stdexcept>
 #include <tessera/robust/gnc_agent.hpp>
 #include <utility>
 #include <vector>
@@ -173,6 +175,48 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   }
   mail_->begin_exchange(phase, std::move(from), values_too);
   take_exchange(out);
+}
+
+GncExchange GncAgent::exchange() const {
+  switch (step_) {
+    case Step::kPoses:
+      return GncExchange::kPoses;
+    case Step::kVotes:
+      return GncExchange::kVotes;
+    case Step::kWeights:
+      return GncExchange::kWeights;
+    case Step::kRejected:
+      return GncExchange::kRejected;
+    case Step::kReadmitted:
+      return GncExchange::kReadmitted;
+    case Step::kKeptStart:
+      // Agent 0 gathers the kept values; the others wait for its start.
+      return in_.id == 0 ? GncExchange::kKeptValues : GncExchange::kKeptStart;
+    case Step::kCandidatePoses:
+      return GncExchange::kCandidatePoses;
+    case Step::kCandidateVotes:
+      return GncExchange::kCandidateVotes;
+    case Step::kPcm:
+      return in_.id == 0 ? GncExchange::kPcmValues : GncExchange::kPcmDropped;
+    case Step::kStartPoses:
+      return GncExchange::kStartPoses;
+    case Step::kStartVotes:
+      return GncExchange::kStartVotes;
+    default:  // not an exchange: begin_exchange() is never called with it
+      throw std::logic_error("GncAgent: no exchange at this step");
+  }
+}
+
+void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
+  std::optional<std::vector<ProtocolMessage>> ready = mail_->take_exchange();
+  if (!ready) return;
+  // Read into the book, or the agent's own data the exchange changes.
+  for (const ProtocolMessage& m : *ready)
+    if (!(step_ == Step::kPoses && poses_early_stale_))
+      exchange_->read(exchange(), m,
+                      GncExchangeTargets{weights_, zero_cut_, low_weights_, rejected_, *recheck_,
+                                         state_ ? state_->Y.rows() : in_.Y0.rows()});
+  after_exchange(out);
 }
 
 }  // namespace tessera
