@@ -21,6 +21,7 @@
 #include "robust_args.hpp"
 #include "solve_output.hpp"
 #include "solver_graph.hpp"
+#include "step_coarse_args.hpp"
 
 namespace tessera::cli {
 
@@ -354,10 +355,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
         a.get_double("refine-rel-tol", opt.refine.relative_decrease_tol);
     opt.refine.max_cg_iterations =
         static_cast<int>(a.get_long("refine-cg-iters", opt.refine.max_cg_iterations));
-    const std::string coarse = a.get_or("refine-coarse", "none");
-    if (coarse != "blocks" && coarse != "smoothed" && coarse != "none")
-      throw InputError("option --refine-coarse: '" + coarse +
-                       "' is not one of blocks, smoothed, none");
+    opt.refine.coarse = coarse_from_flag("--refine-coarse", a.get_or("refine-coarse", "none"));
     const std::string form = a.get_or("refine-coarse-form", "balancing");
     if (form != "balancing" && form != "additive")
       throw InputError("option --refine-coarse-form: '" + form +
@@ -380,9 +378,6 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       throw InputError("option --refine-gauge: '" + gauge + "' is not one of project, ground");
     opt.refine.project_gauge = gauge == "project";
     set_sigma_mode(opt.refine, a.get_or("refine-sigma", sigma_mode(opt.refine)));
-    opt.refine.coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
-                        : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
-                                               : NewtonRefineOptions::Coarse::kNone;
   }
   const long agents = a.get_long("agents", 5);
   if (agents < 1 || agents > 64) throw InputError("option --agents: must be in 1..64");

@@ -26,13 +26,15 @@ const char* step_coarse_name(NewtonRefineOptions::Coarse c) {
   return "none";
 }
 
+NewtonRefineOptions::Coarse coarse_from_flag(const std::string& flag, const std::string& value) {
+  for (auto c : {NewtonRefineOptions::Coarse::kNone, NewtonRefineOptions::Coarse::kBlocks,
+                 NewtonRefineOptions::Coarse::kSmoothed})
+    if (value == step_coarse_name(c)) return c;
+  throw InputError("option " + flag + ": '" + value + "' is not one of none, blocks, smoothed");
+}
+
 void parse_step_coarse_options(const Arguments& args, OnlineOptions& options) {
-  const std::string coarse = args.get_or("step-coarse", "none");
-  if (coarse != "none" && coarse != "blocks" && coarse != "smoothed")
-    throw InputError("option --step-coarse: '" + coarse + "' is not one of none, blocks, smoothed");
-  options.newton_coarse = coarse == "blocks"     ? NewtonRefineOptions::Coarse::kBlocks
-                          : coarse == "smoothed" ? NewtonRefineOptions::Coarse::kSmoothed
-                                                 : NewtonRefineOptions::Coarse::kNone;
+  options.newton_coarse = coarse_from_flag("--step-coarse", args.get_or("step-coarse", "none"));
   const long min_blocks = args.get_long("step-coarse-min-blocks", options.newton_coarse_min_blocks);
   if (min_blocks < 2 || min_blocks > 1000000)
     throw InputError("option --step-coarse-min-blocks: must be 2..1000000");

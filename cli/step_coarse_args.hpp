@@ -20,6 +20,10 @@ extern const char* const kStepCoarseHelp;
 /// "none", "blocks" or "smoothed": the flag's value for `c`.
 const char* step_coarse_name(NewtonRefineOptions::Coarse c);
 
+/// The coarse correction `value` names ("none", "blocks" or "smoothed"); InputError names
+/// `flag` (e.g. "--refine-coarse") otherwise. Batch and online flags share it.
+NewtonRefineOptions::Coarse coarse_from_flag(const std::string& flag, const std::string& value);
+
 /// Sets options.newton_coarse and newton_coarse_min_blocks from the flags (their defaults for
 /// absent ones); InputError names the bad option.
 void parse_step_coarse_options(const Arguments& args, OnlineOptions& options);
