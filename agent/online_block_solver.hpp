@@ -2,7 +2,7 @@
 // This agent's block of an online run's graph: its problem, kept from solve to solve and grown
 // with the new data (LiveBlocks), one solve of it from the current estimate, and the block's
 // poses that go out with the next report. The messages of the round protocol are the agent's
-// (agent/online_agent.cpp): the solve hands it the CertifiedAgent to drive.
+// (agent/online_link.hpp): the solve hands it the CertifiedAgent to drive.
 
 #include <cstdint>
 #include <functional>

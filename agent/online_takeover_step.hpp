@@ -2,7 +2,8 @@
 // The take-over after a member of an online run was lost (--on-agent-loss continue,
 // docs/online.md "Lost agents"): the survivors vote (agent/takeover_vote.hpp), reach the same
 // graph and estimate, and move the lost blocks to their adopters. The agent's own bookkeeping
-// (epochs, members, queues) is reset by its state machine (agent/online_agent.cpp).
+// (epochs, members, queues) is reset by its state machine (agent/online_agent.cpp,
+// runtime/online_membership.hpp).
 
 #include <cstddef>
 #include <cstdint>

@@ -1,5 +1,6 @@
 #pragma once
-// One DDS agent's view of an online run, without DDS (the loop is agent/online_agent.cpp).
+// One DDS agent's view of an online run, without DDS (the loop is agent/online_agent.cpp,
+// one epoch agent/online_epoch_step.cpp).
 // Every agent reads every robot's stream: the graph's structure and measurements are small
 // next to the iterates, and an inter-robot closure published by one robot must reach the
 // agents of both of its poses. Batches wait in a buffer until all agents hold them: at each
