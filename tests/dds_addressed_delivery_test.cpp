@@ -10,6 +10,7 @@
 #include <chrono>
 #include <future>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,9 @@ namespace {
 using namespace tessera;
 using namespace tessera::transport;
 using tessera::transport::test::pass_readiness_barriers;
+using tessera::transport::test::pose_block_to;
 using tessera::transport::test::received_phases;
+using tessera::transport::test::session_options;
 
 constexpr int kDomain = 95;
 constexpr std::uint32_t kAgents = kMaxAgentsWithRecipientTopics + 2;
@@ -102,31 +105,16 @@ TEST(AddressedFilter, PassesWhatItCannotReadSoThatTheReaderReportsIt) {
 }
 
 SessionOptions options_for(bool coordinator, std::uint32_t agent) {
-  SessionOptions o;
-  o.run_id = "addressed-test";
-  o.domain = kDomain;
-  o.coordinator = coordinator;
-  o.agent_id = agent;
-  o.num_agents = kAgents;
-  o.lease_s = 5.0;  // no false peer loss on a loaded machine
-  return o;
+  return session_options("addressed-test", kDomain, coordinator, agent, kAgents, 5.0);
 }
 
+// A block of `poses` poses to `recipients` (not empty).
 OutgoingMessage block_to(std::vector<std::uint32_t> recipients, std::uint32_t phase,
                          std::size_t poses) {
-  PoseBlockMessage b;
-  b.round = 7;
-  b.sender = 0;
-  b.phase = phase;
-  b.rank = 2;
-  b.dim = 1;
-  for (std::size_t k = 0; k < poses; ++k) b.pose_ids.push_back(static_cast<std::uint32_t>(k));
-  b.data.assign(poses * 4, 1.0);
-  OutgoingMessage m;
-  m.message = b;
-  m.broadcast = false;
-  m.recipients = std::move(recipients);
-  return m;
+  std::vector<std::uint32_t> ids(poses);
+  std::iota(ids.begin(), ids.end(), 0u);
+  return pose_block_to(std::move(recipients), phase, std::move(ids),
+                       std::vector<double>(poses * 4, 1.0));
 }
 
 TEST(DdsAddressedDelivery, BlocksAndHandoffsReachOnlyTheirRecipientInALargeRun) {

@@ -32,15 +32,13 @@ TEST(DdsCertificate, StaircaseOverDdsGivesTheInProcessResult) {
   ASSERT_FALSE(::testing::Test::HasFailure());
   const int agents = 3, domain = 171;
   const std::string run = "cert-" + std::to_string(getpid());
-  run_to_the_end(dir, graph, agents, run, domain,
-                 {"--timeout", "20", "--run-timeout", "90", "--summary", dir + "/summary.json",
-                  "--partition", "eco", "--rank", "2", "--certify", "--init",
-                  "file"},  // the in-process reference starts from the file's poses too
-                 90);
+  const auto [summary, assignment] = run_and_read(
+      dir, graph, agents, run, domain,
+      {"--timeout", "20", "--run-timeout", "90", "--partition", "eco", "--rank", "2", "--certify",
+       "--init", "file"},  // the in-process reference starts from the file's poses too
+      90);
   ASSERT_FALSE(::testing::Test::HasFailure());
-  const std::string summary = slurp(dir + "/summary.json");
 
-  const std::vector<int> assignment = assignment_of(dir, agents);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(assignment.size(), g.num_poses);
   DistributedOptions opt;
@@ -97,14 +95,13 @@ TEST(DdsCertificate, TheProvedLowerBoundIsTheInProcessOne) {
   ASSERT_FALSE(::testing::Test::HasFailure());
   const int agents = 3, domain = 125;
   const std::string run = "bound-" + std::to_string(getpid());
-  run_to_the_end(dir, graph, agents, run, domain,
-                 {"--timeout", "20", "--run-timeout", "90", "--summary", dir + "/summary.json",
-                  "--partition", "eco", "--certify", "--init", "file"},
-                 90);
+  const auto [summary, assignment] =
+      run_and_read(dir, graph, agents, run, domain,
+                   {"--timeout", "20", "--run-timeout", "90", "--partition", "eco", "--certify",
+                    "--init", "file"},
+                   90);
   ASSERT_FALSE(::testing::Test::HasFailure());
-  const std::string summary = slurp(dir + "/summary.json");
 
-  const std::vector<int> assignment = assignment_of(dir, agents);
   const PoseGraph g = read_g2o(graph);
   DistributedOptions opt;
   opt.certify = true;

@@ -36,11 +36,9 @@ TEST(DdsDefaultLease, KilledAgentIsLostThroughTheDefaultLeaseAndNamed) {
        "--max-rounds", "100000",   "--partition", "fast",   "--timeout", "60"},
       dir + "/launch.log");
   ASSERT_TRUE(wait_for_round(launch, 2, 30)) << launch.output();
-  std::string pid;
-  // "[t]" keeps the pattern from matching the shell that runs pgrep.
-  run_command("pgrep -f '[t]essera-agent.*--id 1 --run-id " + run_id + " ' | head -1", &pid);
-  ASSERT_FALSE(pid.empty());
-  kill(std::stoi(pid), SIGKILL);
+  const pid_t pid = agent_pid(run_id, 1);
+  ASSERT_GT(pid, 0);
+  kill(pid, SIGKILL);
   ASSERT_TRUE(wait_all({&launch}, 30)) << launch.output();
   EXPECT_EQ(launch.exit_code, 1) << launch.output();
   const std::string out = launch.output();

@@ -25,36 +25,19 @@ namespace {
 using namespace tessera;
 using namespace tessera::transport;
 using tessera::transport::test::pass_readiness_barriers;
+using tessera::transport::test::pose_block_to;
 using tessera::transport::test::received_phases;
+using tessera::transport::test::session_options;
 
 constexpr int kDomain = 60;
 constexpr std::uint32_t kAgents = 3;
 
 SessionOptions options_for(bool coordinator, std::uint32_t agent) {
-  SessionOptions o;
-  o.run_id = "delivery-test";
-  o.domain = kDomain;
-  o.coordinator = coordinator;
-  o.agent_id = agent;
-  o.num_agents = kAgents;
-  o.lease_s = 3.0;  // no false peer loss on a loaded machine
-  return o;
+  return session_options("delivery-test", kDomain, coordinator, agent, kAgents, 3.0);
 }
 
 OutgoingMessage block_to(std::vector<std::uint32_t> recipients, std::uint32_t phase) {
-  PoseBlockMessage b;
-  b.round = 7;
-  b.sender = 0;
-  b.phase = phase;
-  b.rank = 2;
-  b.dim = 1;
-  b.pose_ids = {3};
-  b.data = {1.0, 2.0, 3.0, 4.0};
-  OutgoingMessage m;
-  m.message = b;
-  m.broadcast = recipients.empty();
-  m.recipients = std::move(recipients);
-  return m;
+  return pose_block_to(std::move(recipients), phase, {3}, {1.0, 2.0, 3.0, 4.0});
 }
 
 OutgoingMessage status(std::uint32_t phase, std::uint32_t sender = 0, std::uint32_t round = 7) {

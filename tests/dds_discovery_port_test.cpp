@@ -69,15 +69,9 @@ TEST(DdsDiscoveryPort, AnOnlineLaunchWhoseDiscoveryPortIsHeldEndsCertified) {
   const std::uint16_t port = transport::discovery_multicast_port(115);
   PlainUdpSocket held(port);
   ASSERT_TRUE(held.bound()) << "port " << port << " is in use";
-  std::string out;
-  ASSERT_EQ(run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
-                            " --agents 3 --online --rate 20 --speedup 2 --domain 115 --timeout 60"
-                            " --json " +
-                            dir + "/online.json --keep-logs " + dir + "/logs",
-                        &out),
-            0)
-      << out;
-  EXPECT_EQ(json_text(read_text_file(dir + "/online.json"), "certified"), "true");
+  const std::string json = online_launch(dir, graph, 115, "--rate 20 --speedup 2");
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  EXPECT_EQ(json_text(json, "certified"), "true");
   // Every process says once which port was taken and what it does instead.
   const std::string agent_log = read_text_file(dir + "/logs/agent-0.log");
   EXPECT_NE(agent_log.find("UDP port " + std::to_string(port) +

@@ -46,14 +46,10 @@ void expect_launch_gives_the_in_process_iterates(const std::string& extra, int d
   const std::string graph =
       generate_graph(dir + "/graph.g2o", "--kind grid3d --poses 240 --robots 3 --seed 5");
   const std::string solver = " --agents 3 --algorithm irbcd --partition eco --seed 7 --init file";
-  std::string out;
-  ASSERT_EQ(
-      run_command(bin("tessera") + " solve " + graph + solver + " --json " + dir + "/ip.json 2>&1",
-                  &out),
-      0)
-      << out;
-  const std::string ip = slurp(dir + "/ip.json");
+  const std::string ip = solve_summary(dir, graph, solver, "ip");
+  ASSERT_FALSE(::testing::Test::HasFailure());
   ASSERT_GT(json_field(ip, "rounds"), 1) << "the graph should need a few rounds";
+  std::string out;
 
   const auto before = shm_files();
   const int rc = run_command(bin("tessera") + " launch " + graph + solver + " --no-certify" +

@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "dds_session_support.hpp"
 #include "transport/agent_session.hpp"
 #include "transport/coordinator_session.hpp"
 
@@ -27,13 +28,9 @@ constexpr int kDomain = 157;
 constexpr std::uint32_t kAgents = 3;
 
 SessionOptions options_for(bool coordinator, std::uint32_t agent) {
-  SessionOptions o;
-  o.run_id = "intraprocess-test";
-  o.domain = kDomain;
-  o.coordinator = coordinator;
-  o.agent_id = agent;
-  o.num_agents = kAgents;
-  o.lease_s = 0.2;  // the shortest allowed: each writer asserts its liveliness every 50 ms
+  // The shortest lease allowed: each writer asserts its liveliness every 50 ms.
+  SessionOptions o =
+      test::session_options("intraprocess-test", kDomain, coordinator, agent, kAgents, 0.2);
   o.transport = "udp";
   return o;
 }

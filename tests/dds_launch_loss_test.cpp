@@ -70,12 +70,7 @@ struct LaunchRun {
   pid_t agent_pid(int k) const {
     const auto until = Clock::now() + std::chrono::seconds(30);
     while (Clock::now() < until) {
-      std::string pid;
-      // "[t]" keeps the pattern from matching the shell that runs pgrep.
-      run_command("pgrep -f '[t]essera-agent.*--id " + std::to_string(k) + " --run-id " + run_id +
-                      " ' | head -1",
-                  &pid);
-      if (!pid.empty()) return static_cast<pid_t>(std::stol(pid));
+      if (const pid_t pid = dds::agent_pid(run_id, k); pid > 0) return pid;
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
     return 0;

@@ -56,14 +56,13 @@ TEST(DdsNewtonRefine, AgentsOverDdsTakeTheInProcessIterates) {
   ASSERT_FALSE(::testing::Test::HasFailure());
   const int agents = 3, domain = 80;
   const std::string run = "refine-" + std::to_string(getpid());
-  run_to_the_end(dir, graph, agents, run, domain,
-                 {"--timeout", "20", "--run-timeout", "90", "--summary", dir + "/summary.json",
-                  "--partition", "eco", "--refine", "newton", "--init", "file"},
-                 90);
+  const auto [summary, assignment] =
+      run_and_read(dir, graph, agents, run, domain,
+                   {"--timeout", "20", "--run-timeout", "90", "--partition", "eco", "--refine",
+                    "newton", "--init", "file"},
+                   90);
   ASSERT_FALSE(::testing::Test::HasFailure());
-  const std::string summary = slurp(dir + "/summary.json");
 
-  const std::vector<int> assignment = assignment_of(dir, agents);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(assignment.size(), g.num_poses);
   DistributedOptions opt;

@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <csignal>
 #include <string>
 
 #include "dds_process_support.hpp"
@@ -23,27 +22,17 @@ TEST(DdsOnlineCoarse, SmoothedStepsOverDdsEndWhereTheInProcessRunEnds) {
   // Groups of two linked blocks get the correction too: it runs as soon as two robots met.
   const std::string flags =
       " --rate 20 --speedup 2 --step-coarse smoothed --step-coarse-min-blocks 2";
-  std::string out;
-  ASSERT_EQ(run_command(bin("tessera") + " solve " + graph + " --online --robots 3 --no-progress" +
-                            flags + " --json " + dir + "/in_process.json",
-                        &out),
-            0)
-      << out;
-  const std::string in_process = read_text_file(dir + "/in_process.json");
+  const std::string in_process =
+      solve_summary(dir, graph, "--online --robots 3 --no-progress" + flags, "in_process");
   EXPECT_EQ(json_text(in_process, "certified"), "true");
   const double f_in_process = json_number(in_process, "cost");
 
-  ASSERT_EQ(run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
-                            " --agents 3 --online --domain 205 --timeout 60" + flags + " --json " +
-                            dir + "/online.json --keep-logs " + dir + "/logs",
-                        &out),
-            0)
-      << out;
-  const std::string json = read_text_file(dir + "/online.json");
+  const std::string json = online_launch(dir, graph, 205, flags);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   EXPECT_EQ(json_text(json, "certified"), "true");
   EXPECT_NEAR(json_number(json, "cost"), f_in_process, 1e-6 * f_in_process);
   for (int a = 0; a < 3; ++a) {
-    const std::string agent = read_text_file(dir + "/logs/agent-" + std::to_string(a) + ".json");
+    const std::string agent = online_agent_summary(dir, a);
     EXPECT_EQ(json_text(agent, "step_coarse"), "\"smoothed\"") << "agent " << a;
     EXPECT_EQ(json_number(agent, "step_coarse_min_blocks"), 2) << "agent " << a;
     // Some step's Newton steps ran with the smoothed pieces' coarse space: more unknowns than
@@ -57,6 +46,7 @@ TEST(DdsOnlineCoarse, SmoothedStepsOverDdsEndWhereTheInProcessRunEnds) {
   }
 
   // Bad values are launch's own input errors, before any process starts.
+  std::string out;
   EXPECT_EQ(run_command(bin("tessera") + " launch " + graph +
                             " --agents 3 --online --step-coarse pieces 2>&1",
                         &out),
@@ -71,18 +61,8 @@ TEST(DdsOnlineCoarse, SmoothedStepsOverDdsEndWhereTheInProcessRunEnds) {
 
 TEST(DdsOnlineCoarse, AnAgentWithAnotherStepCoarseThanTheLeadsIsRefused) {
   const std::string dir = temp_dir();
-  const std::string run = "online-coarse-differs";
-  Process lead = start({bin("tessera-agent"), "--online", "--robots", "2", "--id", "0", "--run-id",
-                        run, "--domain", "206", "--timeout", "60", "--step-coarse", "smoothed"},
-                       dir + "/lead.log");
-  Process other = start({bin("tessera-agent"), "--online", "--robots", "2", "--id", "1", "--run-id",
-                         run, "--domain", "206", "--timeout", "60"},
-                        dir + "/other.log");
-  const bool ended = wait_all({&other}, 60);
-  kill(lead.pid, SIGTERM);
-  wait_all({&lead}, 30);
-  ASSERT_TRUE(ended) << "the agent with another --step-coarse did not stop";
-  EXPECT_EQ(other.exit_code, 2) << other.output();
+  const Process other =
+      refused_beside_lead(dir, "online-coarse-differs", 206, {"--step-coarse", "smoothed"});
   EXPECT_TRUE(contains(other.output(),
                        "option --step-coarse: this agent's none differs from the "
                        "lead's (agent 0) smoothed"))

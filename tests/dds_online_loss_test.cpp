@@ -27,11 +27,7 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim,
   const std::string graph = dir + "/grid.g2o";
   const std::string run = name + "-" + std::to_string(getpid());
   generate_graph(graph, "--kind grid3d --poses 300 --robots 3");
-  std::string out;
-  ASSERT_EQ(
-      run_command(bin("tessera") + " solve " + graph + " --json " + dir + "/batch.json", &out), 0)
-      << out;
-  const std::string batch = read_text_file(dir + "/batch.json");
+  const std::string batch = solve_summary(dir, graph, "", "batch");
   ASSERT_EQ(json_text(batch, "certified"), "true");
   const double f_star = json_number(batch, "cost");
   // Reads the agents' reports (never writes) to see how far the stream has entered.
@@ -57,13 +53,9 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim,
     }
   }
   ASSERT_GE(entered, 60u) << "the stream did not start: " << launch.output();
-  std::string pid;
-  // "[t]" keeps the pattern from matching the shell that runs pgrep.
-  run_command("pgrep -f '[t]essera-agent --online --robots 3 --id " + std::to_string(victim) +
-                  " --run-id " + run + " ' | head -1",
-              &pid);
-  ASSERT_FALSE(pid.empty()) << launch.output();
-  ASSERT_EQ(kill(static_cast<pid_t>(std::stol(pid)), SIGKILL), 0);
+  const pid_t pid = agent_pid(run, victim);
+  ASSERT_GT(pid, 0) << launch.output();
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
   if (restart) {
     // Once the survivors voted, the victim started again with its id is told it was lost
     // for good and leaves (the votes are kept for late readers); the run goes on.
@@ -75,9 +67,9 @@ void kill_mid_replay_and_finish(int domain, const std::string& name, int victim,
     }
     ASSERT_TRUE(voted) << launch.output();
     Process again =
-        start({bin("tessera-agent"), "--online", "--robots", "3", "--id", std::to_string(victim),
-               "--run-id", run, "--domain", std::to_string(domain), "--on-agent-loss", "continue",
-               "--timeout", "60", "--lease", "3", "--verbose"},  // a failure shows its epochs
+        start(online_agent_args(3, victim, run, domain,
+                                {"--on-agent-loss", "continue", "--timeout", "60", "--lease", "3",
+                                 "--verbose"}),  // a failure shows its epochs
               dir + "/again.log");
     // Longer than its --timeout: a restarted agent that hears nothing ends with its own error,
     // which names a stuck shared-memory listener (transport/fastdds/shm_receive_watch.hpp).

@@ -6,7 +6,6 @@
 
 #include <gtest/gtest.h>
 
-#include <csignal>
 #include <string>
 #include <tessera/online/block_rebalance.hpp>
 #include <tessera/online/replay_schedule.hpp>
@@ -76,32 +75,21 @@ TEST(DdsOnlineRebalance, TheLaunchsOptionsReachEveryAgentWhichMovesAsInProcessAn
   EXPECT_NE(out.find("--cut-fraction"), std::string::npos) << out;
 
   // The same graph and flags in one process: the answer the DDS run must reach.
-  ASSERT_EQ(run_command(bin("tessera") + " solve " + graph +
-                            " --online --robots 3 --rate 20 --speedup 2 --no-progress" + flag_text +
-                            " --json " + dir + "/in_process.json",
-                        &out),
-            0)
-      << out;
-  const std::string in_process = read_text_file(dir + "/in_process.json");
+  const std::string in_process = solve_summary(
+      dir, graph, "--online --robots 3 --rate 20 --speedup 2 --no-progress" + flag_text,
+      "in_process");
   EXPECT_EQ(json_text(in_process, "certified"), "true");
   const double f_online = json_number(in_process, "cost");
 
-  ASSERT_EQ(
-      run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
-                      " --agents 3 --online --rate 20 --speedup 2 --domain 178 --timeout 60" +
-                      flag_text + " --json " + dir + "/online.json --keep-logs " + dir + "/logs",
-                  &out),
-      0)
-      << out;
-  const std::string json = read_text_file(dir + "/online.json");
+  const std::string json = online_launch(dir, graph, 178, "--rate 20 --speedup 2" + flag_text);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   EXPECT_EQ(json_text(json, "certified"), "true");
   EXPECT_NEAR(json_number(json, "cost"), f_online, 1e-6 * f_online);
 
   // Every agent used the launch's options.
   std::vector<std::string> agent(3);
   for (int a = 0; a < 3; ++a) {
-    agent[static_cast<std::size_t>(a)] =
-        read_text_file(dir + "/logs/agent-" + std::to_string(a) + ".json");
+    agent[static_cast<std::size_t>(a)] = online_agent_summary(dir, a);
     const std::string& j = agent[static_cast<std::size_t>(a)];
     EXPECT_EQ(json_number(j, "cut_fraction"), 0.05) << "agent " << a;
     EXPECT_EQ(json_number(j, "slack"), 0.3) << "agent " << a;
@@ -150,18 +138,8 @@ TEST(DdsOnlineRebalance, TheLaunchsOptionsReachEveryAgentWhichMovesAsInProcessAn
 
   // An agent started by hand with another cut fraction than the lead's stops, naming it (the
   // lead does not admit it, when its hello arrived before it stopped).
-  const std::string run = "online-rebalance-differs";
-  Process lead = start({bin("tessera-agent"), "--online", "--robots", "2", "--id", "0", "--run-id",
-                        run, "--domain", "178", "--timeout", "60", "--cut-fraction", "0.05"},
-                       dir + "/lead.log");
-  Process other = start({bin("tessera-agent"), "--online", "--robots", "2", "--id", "1", "--run-id",
-                         run, "--domain", "178", "--timeout", "60"},
-                        dir + "/other.log");
-  const bool ended = wait_all({&other}, 60);
-  kill(lead.pid, SIGTERM);
-  wait_all({&lead}, 30);
-  ASSERT_TRUE(ended) << "the agent with other options did not stop";
-  EXPECT_EQ(other.exit_code, 2) << other.output();
+  const Process other =
+      refused_beside_lead(dir, "online-rebalance-differs", 178, {"--cut-fraction", "0.05"});
   EXPECT_TRUE(contains(other.output(), "option --cut-fraction")) << other.output();
   EXPECT_TRUE(contains(other.output(), "0.02")) << other.output();
   EXPECT_TRUE(contains(other.output(), "0.05")) << other.output();

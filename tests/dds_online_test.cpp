@@ -25,11 +25,7 @@ namespace {
 
 // The batch optimum f* of `graph` (centralized solver, certified).
 double batch_optimum(const std::string& dir, const std::string& graph) {
-  std::string out;
-  EXPECT_EQ(
-      run_command(bin("tessera") + " solve " + graph + " --json " + dir + "/batch.json", &out), 0)
-      << out;
-  const std::string json = read_text_file(dir + "/batch.json");
+  const std::string json = solve_summary(dir, graph, "", "batch");
   EXPECT_EQ(json_text(json, "certified"), "true");
   return json_number(json, "cost");
 }
@@ -53,16 +49,10 @@ TEST(DdsOnline, TheOnlineLaunchEndsAtTheBatchOptimumAndEveryAgentSolvesTheSameGr
   const std::string graph = dir + "/grid.g2o";
   generate_graph(graph, "--kind grid3d --poses 150 --robots 3");
   const double f_star = batch_optimum(dir, graph);
-  std::string out;
-  ASSERT_EQ(
-      run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
-                      " --agents 3 --online --rate 20 --speedup 2 --domain 57 --timeout 60"
-                      " --publish-every 0.2 --certify-every 0.5 --tum-dir " +
-                      dir + "/tum --json " + dir + "/online.json --keep-logs " + dir + "/logs",
-                  &out),
-      0)
-      << out;
-  const std::string json = read_text_file(dir + "/online.json");
+  const std::string json = online_launch(
+      dir, graph, 57,
+      "--rate 20 --speedup 2 --publish-every 0.2 --certify-every 0.5 --tum-dir " + dir + "/tum");
+  ASSERT_FALSE(::testing::Test::HasFailure());
   EXPECT_EQ(json_text(json, "certified"), "true");
   EXPECT_NEAR(json_number(json, "cost"), f_star, 1e-6 * f_star);
   const PoseGraph batch = read_g2o(graph);
@@ -78,11 +68,10 @@ TEST(DdsOnline, TheOnlineLaunchEndsAtTheBatchOptimumAndEveryAgentSolvesTheSameGr
   EXPECT_GE(json_number(json, "publications"), 1);
   // A new measurement (inter-robot closures included) enters every agent at the same epoch:
   // whenever two agents solved at an epoch, they solved the same graph.
-  const auto lead = updates_of(read_text_file(dir + "/logs/agent-0.json"));
+  const auto lead = updates_of(online_agent_summary(dir, 0));
   ASSERT_FALSE(lead.empty());
   for (int a = 1; a < 3; ++a) {
-    const auto other =
-        updates_of(read_text_file(dir + "/logs/agent-" + std::to_string(a) + ".json"));
+    const auto other = updates_of(online_agent_summary(dir, a));
     int common = 0;
     for (const auto& [epoch, sizes] : other) {
       auto it = lead.find(epoch);
@@ -99,24 +88,19 @@ TEST(DdsOnline, TheOnlineLaunchForwardsTheStepSolverToEveryAgent) {
   const std::string graph = dir + "/grid.g2o";
   generate_graph(graph, "--kind grid3d --poses 150 --robots 3");
   const double f_star = batch_optimum(dir, graph);
-  std::string out;
-  ASSERT_EQ(run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
-                            " --agents 3 --online --rate 20 --speedup 2 --domain 136 --timeout 60"
-                            " --step-solver rounds --json " +
-                            dir + "/online.json --keep-logs " + dir + "/logs",
-                        &out),
-            0)
-      << out;
-  const std::string json = read_text_file(dir + "/online.json");
+  const std::string json =
+      online_launch(dir, graph, 136, "--rate 20 --speedup 2 --step-solver rounds");
+  ASSERT_FALSE(::testing::Test::HasFailure());
   EXPECT_EQ(json_text(json, "certified"), "true");
   EXPECT_NEAR(json_number(json, "cost"), f_star, 1e-6 * f_star);
   for (int a = 0; a < 3; ++a) {
-    const std::string agent = read_text_file(dir + "/logs/agent-" + std::to_string(a) + ".json");
+    const std::string agent = online_agent_summary(dir, a);
     EXPECT_EQ(json_text(agent, "step_solver"), "\"rounds\"") << "agent " << a;
     // Rounds only: the steps that solved did it by block-coordinate rounds.
     EXPECT_GT(json_number(agent, "rounds"), 0) << "agent " << a;
   }
   // A bad value is an input error of launch itself, before any process starts.
+  std::string out;
   EXPECT_EQ(run_command(bin("tessera") + " launch " + graph +
                             " --agents 3 --online --step-solver gauss 2>&1",
                         &out),
@@ -153,9 +137,9 @@ TEST(DdsOnline, ALateAgentJoinsIdleAgentsSendNothingAndTheAnswerIsTheBatchOptimu
              "--rate", "40", "--speedup", "2", "--start", "0,0,12", "--linger", "1"},
             dir + "/replay.log");
   auto agent = [&](int id) {
-    return start({bin("tessera-agent"), "--online", "--robots", "3", "--id", std::to_string(id),
-                  "--run-id", run, "--domain", "58", "--timeout", "60", "--json",
-                  dir + "/agent" + std::to_string(id) + ".json"},
+    return start(online_agent_args(
+                     3, id, run, 58,
+                     {"--timeout", "60", "--json", dir + "/agent" + std::to_string(id) + ".json"}),
                  dir + "/agent" + std::to_string(id) + ".log");
   };
   Process a0 = agent(0), a1 = agent(1);
@@ -197,10 +181,8 @@ TEST(DdsOnline, WhenAMemberGoesSilentTheOthersStopNamingIt) {
                          dir + "/replay.log");
   std::vector<Process> agents;
   for (int id = 0; id < 3; ++id)
-    agents.push_back(
-        start({bin("tessera-agent"), "--online", "--robots", "3", "--id", std::to_string(id),
-               "--run-id", run, "--domain", "59", "--timeout", "3"},
-              dir + "/agent" + std::to_string(id) + ".log"));
+    agents.push_back(start(online_agent_args(3, id, run, 59, {"--timeout", "3"}),
+                           dir + "/agent" + std::to_string(id) + ".log"));
   std::this_thread::sleep_for(std::chrono::seconds(2));
   kill(agents[2].pid, SIGTERM);
   ASSERT_TRUE(wait_all({&replay, &agents[0], &agents[1], &agents[2]}, 60)) << "a process hung";

@@ -1,9 +1,10 @@
 #pragma once
 // Helpers for the DDS runtime tests (header-only; not a *_test.cpp so it is no test of its
-// own): the command lines of tessera-agent / tessera-coordinator, start them in the
-// background, wait for them or for a line of their output with a deadline (a test never
-// hangs: stragglers are SIGKILLed), write the small graphs the tests use, read what the
-// agents dumped, and find shared-memory files nobody uses any more.
+// own): the command lines of tessera-agent (batch and --online) / tessera-coordinator, start
+// them in the background, wait for them or for a line of their output with a deadline (a test
+// never hangs: stragglers are SIGKILLed), write the small graphs the tests use, run a solve or
+// an online launch and read its summary, read what the agents dumped, and find shared-memory
+// files nobody uses any more.
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -174,6 +175,17 @@ inline void run_to_the_end(const std::string& dir, const std::string& graph, int
   std::vector<Process*> all = all_of(coord, procs);
   EXPECT_TRUE(wait_all(all, wait_s)) << "a process hung";
   for (Process* p : all) EXPECT_EQ(p->exit_code, 0) << p->output();
+}
+
+/// The pid of agent `id` of run `run_id` (a tessera-agent process, started by launch or by
+/// hand), 0 when there is none.
+inline pid_t agent_pid(const std::string& run_id, int id) {
+  std::string pid;
+  // "[t]" keeps the pattern from matching the shell that runs pgrep.
+  run_command("pgrep -f '[t]essera-agent.*--id " + std::to_string(id) + " --run-id " + run_id +
+                  " ' | head -1",
+              &pid);
+  return pid.empty() ? 0 : static_cast<pid_t>(std::stol(pid));
 }
 
 /// Waits until `text` appears in `p`'s output (polling every 20 ms); false after `timeout_s`.
@@ -396,6 +408,77 @@ inline double json_number(const std::string& json, const std::string& key, std::
   return text.empty() || text == "null" ? NAN : std::stod(text);
 }
 
+/// `tessera solve GRAPH ARGS --json DIR/NAME.json` (exit code 0, a test failure otherwise):
+/// the summary's text.
+inline std::string solve_summary(const std::string& dir, const std::string& graph,
+                                 const std::string& args, const std::string& name) {
+  const std::string json = dir + "/" + name + ".json";
+  std::string out;
+  EXPECT_EQ(
+      run_command(bin("tessera") + " solve " + graph + " " + args + " --json " + json + " 2>&1",
+                  &out),
+      0)
+      << out;
+  return read_text_file(json);
+}
+
+/// `tessera launch GRAPH --agents 3 --online --domain D --timeout 60 ARGS --json
+/// DIR/online.json --keep-logs DIR/logs`, killed after 240 s (exit code 0, a test failure
+/// otherwise): the lead's summary. Each agent's is online_agent_summary(dir, a).
+inline std::string online_launch(const std::string& dir, const std::string& graph, int domain,
+                                 const std::string& args) {
+  std::string out;
+  EXPECT_EQ(
+      run_command("timeout -s KILL 240 " + bin("tessera") + " launch " + graph +
+                      " --agents 3 --online --domain " + std::to_string(domain) + " --timeout 60 " +
+                      args + " --json " + dir + "/online.json" + " --keep-logs " + dir + "/logs",
+                  &out),
+      0)
+      << out;
+  return read_text_file(dir + "/online.json");
+}
+
+/// Agent `a`'s summary of an online_launch in `dir`.
+inline std::string online_agent_summary(const std::string& dir, int a) {
+  return read_text_file(dir + "/logs/agent-" + std::to_string(a) + ".json");
+}
+
+/// `tessera-agent --online` as agent `id` of `robots` of run `run` on `domain`, then `extra`.
+inline std::vector<std::string> online_agent_args(int robots, int id, const std::string& run,
+                                                  int domain,
+                                                  const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> a = {bin("tessera-agent"),
+                                "--online",
+                                "--robots",
+                                std::to_string(robots),
+                                "--id",
+                                std::to_string(id),
+                                "--run-id",
+                                run,
+                                "--domain",
+                                std::to_string(domain)};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
+/// Agent 1 of run `run` on `domain`, started beside a lead (agent 0) that has `lead_extra`
+/// on top of the same options, must stop because its team options differ from the lead's:
+/// exit code 2, within 60 s (a test failure otherwise). Its process, for its output.
+inline Process refused_beside_lead(const std::string& dir, const std::string& run, int domain,
+                                   const std::vector<std::string>& lead_extra) {
+  std::vector<std::string> lead_args = {"--timeout", "60"};
+  lead_args.insert(lead_args.end(), lead_extra.begin(), lead_extra.end());
+  Process lead = start(online_agent_args(2, 0, run, domain, lead_args), dir + "/lead.log");
+  Process other =
+      start(online_agent_args(2, 1, run, domain, {"--timeout", "60"}), dir + "/other.log");
+  const bool ended = wait_all({&other}, 60);
+  kill(lead.pid, SIGTERM);
+  wait_all({&lead}, 30);
+  EXPECT_TRUE(ended) << "the agent with other options than the lead's did not stop";
+  EXPECT_EQ(other.exit_code, 2) << other.output();
+  return other;
+}
+
 /// Owned pose ids listed in an agent's --dump-local file.
 inline std::vector<int> owned_of(const std::string& path) {
   std::ifstream f(path);
@@ -424,6 +507,22 @@ inline std::vector<int> assignment_of(const std::string& dir, int agents) {
   std::vector<int> out;
   for (auto& [id, k] : owner) out.push_back(k);
   return out;
+}
+
+/// What a run of run_to_the_end wrote: the coordinator's summary and the partition it chose.
+struct FinishedRun {
+  std::string summary;          ///< DIR/summary.json (the coordinator's --summary).
+  std::vector<int> assignment;  ///< The agent of every pose (assignment_of).
+};
+
+/// run_to_the_end with `--summary DIR/summary.json` after `coordinator_extra`, then what the
+/// run wrote.
+inline FinishedRun run_and_read(const std::string& dir, const std::string& graph, int agents,
+                                const std::string& run, int domain,
+                                std::vector<std::string> coordinator_extra, double wait_s) {
+  coordinator_extra.insert(coordinator_extra.end(), {"--summary", dir + "/summary.json"});
+  run_to_the_end(dir, graph, agents, run, domain, coordinator_extra, wait_s);
+  return {read_text_file(dir + "/summary.json"), assignment_of(dir, agents)};
 }
 
 }  // namespace tessera::test::dds

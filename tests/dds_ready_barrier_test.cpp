@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "dds_session_support.hpp"
 #include "transport/agent_session.hpp"
 #include "transport/coordinator_session.hpp"
 
@@ -18,13 +19,8 @@ namespace {
 constexpr int kDomain = 132;
 
 SessionOptions options_for(bool coordinator, std::uint32_t agent) {
-  SessionOptions o;
-  o.run_id = "ready-barrier-test";
-  o.domain = kDomain;
-  o.coordinator = coordinator;
-  o.agent_id = agent;
-  o.num_agents = 1;
-  o.lease_s = 3.0;  // no false peer loss on a loaded machine
+  SessionOptions o =
+      test::session_options("ready-barrier-test", kDomain, coordinator, agent, 1, 3.0);
   // UDP only: the subject is the barrier's message, not the transport. (This test's teardown
   // overran its 5 s guard in 7 of 126 runs at load 10-16: its two sessions' liveliness
   // assertions deadlocked, transport/fastdds/intraprocess_builtin.hpp.)

@@ -44,6 +44,18 @@ std::vector<std::size_t> lines_of(const std::string& path) {
   return out;
 }
 
+// 3 agent processes on `graph` in `dir` (sequential partition: one robot each, run id
+// `run`) with `--robust kind`, the certificate and `extra`.
+FinishedRun robust_run(const std::string& dir, const std::string& graph, const std::string& run,
+                       int domain, const std::string& kind,
+                       const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args = {
+      "--timeout", "20", "--run-timeout", "120",      "--partition", "sequential",
+      "--seed",    "7",  "--certify",     "--robust", kind};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return run_and_read(dir, graph, 3, run, domain, args, 120);
+}
+
 struct RobustRun {
   std::string dir, graph, summary;
   std::vector<std::size_t> labels;
@@ -61,15 +73,11 @@ RobustRun robust_dds_run(int domain, const std::vector<std::string>& extra = {})
                                r.dir + "/labels.json");
   r.labels = json_array(slurp(r.dir + "/labels.json"), "outliers");
   const std::string run = "robust-" + std::to_string(getpid()) + "-" + std::to_string(domain);
-  std::vector<std::string> args = {"--timeout",   "20",         "--run-timeout",
-                                   "120",         "--summary",  r.dir + "/summary.json",
-                                   "--partition", "sequential", "--seed",
-                                   "7",           "--certify",  "--robust",
-                                   "gnc-tls",     "--rejected", r.dir + "/rejected.txt"};
+  std::vector<std::string> args = {"--rejected", r.dir + "/rejected.txt"};
   args.insert(args.end(), extra.begin(), extra.end());
-  run_to_the_end(r.dir, r.graph, 3, run, domain, args, 120);
-  r.summary = slurp(r.dir + "/summary.json");
-  r.assignment = assignment_of(r.dir, 3);
+  FinishedRun done = robust_run(r.dir, r.graph, run, domain, "gnc-tls", args);
+  r.summary = std::move(done.summary);
+  r.assignment = std::move(done.assignment);
   return r;
 }
 
@@ -92,6 +100,15 @@ std::string dpgo_csv_of(const PoseGraph& g, std::size_t per_robot,
     csv += row;
   }
   return csv;
+}
+
+// The DDS run's summary `json` reports what the in-process engine did (`ref`): the same outer
+// steps, rounds and rejected set, and the same cost to 1e-12 relative.
+void expect_same_run(const std::string& json, const GncDistributedResult& ref) {
+  EXPECT_EQ(json_field(json, "outer_iterations"), ref.outer_iterations) << json;
+  EXPECT_EQ(json_field(json, "rounds"), ref.total_rounds) << json;
+  EXPECT_EQ(json_array(json, "rejected"), ref.rejected) << json;
+  EXPECT_NEAR(json_field(json, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost) << json;
 }
 
 GncDistributedOptions in_process_options() {
@@ -162,13 +179,8 @@ TEST(DdsRobust, OnCleanDataTheVoteTakesTheSolversStartAsInProcess) {
   const std::string graph =
       generate_graph(dir + "/graph.g2o", "--kind grid3d --poses 216 --robots 3 --seed 4");
   const std::string run = "robust-clean-" + std::to_string(getpid());
-  run_to_the_end(dir, graph, 3, run, 70,
-                 {"--timeout", "20", "--run-timeout", "120", "--summary", dir + "/summary.json",
-                  "--partition", "sequential", "--seed", "7", "--certify", "--robust", "gnc-tls"},
-                 120);
-  const std::string summary = slurp(dir + "/summary.json");
+  const auto [summary, assignment] = robust_run(dir, graph, run, 70, "gnc-tls");
   const PoseGraph g = read_g2o(graph);
-  const std::vector<int> assignment = assignment_of(dir, 3);
   const GncDistributedResult ref = solve_gnc_distributed(g, assignment, in_process_options());
   EXPECT_TRUE(ref.rejected.empty());
   EXPECT_EQ(json_field(summary, "rounds"), ref.total_rounds) << summary;
@@ -190,10 +202,7 @@ TEST(DdsRobust, WithoutKnownInliersTheRunStillEqualsTheInProcessEngine) {
   GncDistributedOptions o = in_process_options();
   o.robust.known_inliers = KnownInliers::kNone;
   const GncDistributedResult ref = solve_gnc_distributed(g, dds.assignment, o);
-  EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
-  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
-  EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
-  EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  expect_same_run(dds.summary, ref);
 }
 
 // The probes over DDS: on a soft map with group outliers a probe runs and stays (the in-process
@@ -205,14 +214,9 @@ TEST(DdsRobust, AProbeOverDdsEqualsTheInProcessEngine) {
   const std::string graph = dir + "/graph.g2o";
   write_g2o(city.graph, graph);
   const std::string run = "robust-probe-" + std::to_string(getpid());
-  run_to_the_end(
-      dir, graph, 3, run, 137,
-      {"--timeout", "20", "--run-timeout", "120", "--summary", dir + "/summary.json", "--partition",
-       "sequential", "--seed", "7", "--certify", "--robust", "gnc-tls", "--gnc-probes", "1"},
-      120);
-  const std::string summary = slurp(dir + "/summary.json");
+  const auto [summary, assignment] =
+      robust_run(dir, graph, run, 137, "gnc-tls", {"--gnc-probes", "1"});
   const PoseGraph g = read_g2o(graph);
-  const std::vector<int> assignment = assignment_of(dir, 3);
   GncDistributedOptions o = in_process_options();
   o.robust.recheck_probes = 1;
   const GncDistributedResult ref = solve_gnc_distributed(g, assignment, o);
@@ -284,10 +288,7 @@ TEST(DdsRobust, LaunchOnADpgoCsvFileEqualsTheInProcessEngine) {
       read.graph, std::vector<int>(read.robot_of.begin(), read.robot_of.end()),
       in_process_options());
   EXPECT_EQ(json_field(json, "poses"), 216);
-  EXPECT_EQ(json_field(json, "outer_iterations"), ref.outer_iterations) << json;
-  EXPECT_EQ(json_field(json, "rounds"), ref.total_rounds) << json;
-  EXPECT_EQ(json_array(json, "rejected"), ref.rejected) << json;
-  EXPECT_NEAR(json_field(json, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  expect_same_run(json, ref);
   EXPECT_NE(json.find("\"certified\": true"), std::string::npos) << json;
 
   // One agent per robot of the file.
@@ -351,21 +352,13 @@ TEST(DdsRobust, PcmGncOverDdsEqualsTheInProcessEngine) {
                                            "--outliers 0.1 --outlier-kind group --labels " +
                                                dir + "/labels.json");
   const std::string run = "robust-pcm-" + std::to_string(getpid());
-  run_to_the_end(dir, graph, 3, run, 72,
-                 {"--timeout", "20", "--run-timeout", "120", "--summary", dir + "/summary.json",
-                  "--partition", "sequential", "--seed", "7", "--certify", "--robust", "pcm-gnc"},
-                 120);
-  const std::string summary = slurp(dir + "/summary.json");
+  const auto [summary, assignment] = robust_run(dir, graph, run, 72, "pcm-gnc");
   const PoseGraph g = read_g2o(graph);
-  const std::vector<int> assignment = assignment_of(dir, 3);
   GncDistributedOptions o = in_process_options();
   o.robust.kind = RobustKind::kPcmGnc;
   const GncDistributedResult ref = solve_gnc_distributed(g, assignment, o);
   EXPECT_NE(summary.find("\"robust\": \"pcm-gnc\""), std::string::npos) << summary;
-  EXPECT_EQ(json_field(summary, "outer_iterations"), ref.outer_iterations) << summary;
-  EXPECT_EQ(json_field(summary, "rounds"), ref.total_rounds) << summary;
-  EXPECT_EQ(json_array(summary, "rejected"), ref.rejected) << summary;
-  EXPECT_NEAR(json_field(summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  expect_same_run(summary, ref);
   EXPECT_NE(summary.find("\"certified\": true"), std::string::npos) << summary;
   EXPECT_EQ(ref.rejected, json_array(slurp(dir + "/labels.json"), "outliers"));
 }
@@ -378,14 +371,9 @@ TEST(DdsRobust, ClusterProbesOverDdsEqualTheInProcessEngine) {
   const std::string graph = dir + "/graph.g2o";
   write_g2o(city.graph, graph);
   const std::string run = "robust-cluster-" + std::to_string(getpid());
-  run_to_the_end(dir, graph, 3, run, 229,
-                 {"--timeout", "20", "--run-timeout", "120", "--summary", dir + "/summary.json",
-                  "--partition", "sequential", "--seed", "7", "--certify", "--robust", "gnc-tls",
-                  "--gnc-cluster-probes", "20"},
-                 120);
-  const std::string summary = slurp(dir + "/summary.json");
+  const auto [summary, assignment] =
+      robust_run(dir, graph, run, 229, "gnc-tls", {"--gnc-cluster-probes", "20"});
   const PoseGraph g = read_g2o(graph);
-  const std::vector<int> assignment = assignment_of(dir, 3);
   GncDistributedOptions o = in_process_options();
   o.cluster_probes = 20;
   const GncDistributedResult ref = solve_gnc_distributed(g, assignment, o);
@@ -394,10 +382,7 @@ TEST(DdsRobust, ClusterProbesOverDdsEqualTheInProcessEngine) {
   EXPECT_GE(ref.probes_kept, 1);
   EXPECT_EQ(json_field(summary, "probes"), ref.probes) << summary;
   EXPECT_EQ(json_field(summary, "probes_kept"), ref.probes_kept) << summary;
-  EXPECT_EQ(json_field(summary, "outer_iterations"), ref.outer_iterations) << summary;
-  EXPECT_EQ(json_field(summary, "rounds"), ref.total_rounds) << summary;
-  EXPECT_EQ(json_array(summary, "rejected"), ref.rejected) << summary;
-  EXPECT_NEAR(json_field(summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost);
+  expect_same_run(summary, ref);
   EXPECT_EQ(json_field(summary, "min_eigenvalue"), ref.final_solve.min_eigenvalue);
   EXPECT_NE(summary.find("\"certified\": true"), std::string::npos) << summary;
 }
@@ -421,12 +406,8 @@ TEST(DdsRobust, PassRefineOverDdsEqualsTheInProcessEngine) {
   ASSERT_LT(ref.outer_iterations, solve_gnc_distributed(g, dds.assignment, fixed).outer_iterations)
       << "the adaptive steps should shorten the schedule (15 against 24 outer steps)";
   EXPECT_EQ(json_field(dds.summary, "gnc_refine_steps"), ref.refine_message_steps) << dds.summary;
-  EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
-  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
-  EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
+  expect_same_run(dds.summary, ref);
   EXPECT_EQ(ref.rejected, dds.labels);
-  EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost)
-      << dds.summary;
   EXPECT_NE(dds.summary.find("\"certified\": true"), std::string::npos) << dds.summary;
 }
 
@@ -442,12 +423,8 @@ TEST(DdsRobust, TheEarlyEndOverDdsEqualsTheInProcessEngine) {
   full.robust.jump_band = 0;
   ASSERT_LT(ref.outer_iterations, solve_gnc_distributed(g, dds.assignment, full).outer_iterations)
       << "the residuals should leave the bound's band before the weights are binary";
-  EXPECT_EQ(json_field(dds.summary, "outer_iterations"), ref.outer_iterations) << dds.summary;
-  EXPECT_EQ(json_field(dds.summary, "rounds"), ref.total_rounds) << dds.summary;
-  EXPECT_EQ(json_array(dds.summary, "rejected"), ref.rejected) << dds.summary;
+  expect_same_run(dds.summary, ref);
   EXPECT_EQ(ref.rejected, dds.labels);
-  EXPECT_NEAR(json_field(dds.summary, "cost"), ref.final_solve.cost, 1e-12 * ref.final_solve.cost)
-      << dds.summary;
   EXPECT_NE(dds.summary.find("\"certified\": true"), std::string::npos) << dds.summary;
 }
 

@@ -34,23 +34,13 @@ Eigen::VectorXd in_frame_of_pose_0(const std::vector<Pose>& p, std::size_t k) {
   return p[0].R.transpose() * (p[k].t - p[0].t);
 }
 
-struct DdsRun {
-  std::string summary;
-  std::vector<int> assignment;
-};
-
-DdsRun run_dds(const std::string& dir, const std::string& graph, int agents, int domain,
-               const std::vector<std::string>& solver_args) {
+FinishedRun run_dds(const std::string& dir, const std::string& graph, int agents, int domain,
+                    const std::vector<std::string>& solver_args) {
   const std::string run = "solve-" + std::to_string(getpid()) + "-" + std::to_string(domain);
   std::vector<std::string> cargs = {
-      "--timeout",           "20",       "--run-timeout",     "60",        "--summary",
-      dir + "/summary.json", "--output", dir + "/merged.g2o", "--progress"};
+      "--timeout", "20", "--run-timeout", "60", "--output", dir + "/merged.g2o", "--progress"};
   cargs.insert(cargs.end(), solver_args.begin(), solver_args.end());
-  run_to_the_end(dir, graph, agents, run, domain, cargs, 60);
-  DdsRun r;
-  r.summary = slurp(dir + "/summary.json");
-  r.assignment = assignment_of(dir, agents);
-  return r;
+  return run_and_read(dir, graph, agents, run, domain, cargs, 60);
 }
 
 void expect_same_as_in_process(const std::string& algorithm, int domain, bool status_relay = true,
@@ -64,7 +54,7 @@ void expect_same_as_in_process(const std::string& algorithm, int domain, bool st
   if (smoothed)
     coordinator_args.insert(coordinator_args.end(),
                             {"--coarse-space", "smoothed", "--coarse-aggregates", "2"});
-  const DdsRun dds = run_dds(dir, graph, agents, domain, coordinator_args);
+  const FinishedRun dds = run_dds(dir, graph, agents, domain, coordinator_args);
   const PoseGraph g = read_g2o(graph);
   ASSERT_EQ(dds.assignment.size(), g.num_poses);
 
@@ -368,11 +358,9 @@ TEST(DdsLaunch, AgentKilledDuringTheRoundsIsNamedByEveryone) {
                           "--timeout",    "60",     "--lease",      "3"},
                          dir + "/launch.log");
   ASSERT_TRUE(wait_for_round(launch, 2, 20)) << launch.output();
-  std::string pid;
-  // "[t]" keeps the pattern from matching the shell that runs pgrep.
-  run_command("pgrep -f '[t]essera-agent.*--id 1 --run-id " + run_id + " ' | head -1", &pid);
-  ASSERT_FALSE(pid.empty());
-  kill(std::stoi(pid), SIGKILL);
+  const pid_t pid = agent_pid(run_id, 1);
+  ASSERT_GT(pid, 0);
+  kill(pid, SIGKILL);
   ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
   EXPECT_EQ(launch.exit_code, 1) << launch.output();
   const std::string out = launch.output();
@@ -423,14 +411,13 @@ TEST(DdsLaunch, HungAgentIsNamedAsLaggingAndTheRunGoesOn) {
                           "1"},
                          dir + "/launch.log");
   ASSERT_TRUE(wait_for_round(launch, 2, 30)) << launch.output();
-  std::string pid;
-  run_command("pgrep -f '[t]essera-agent.*--id 1 --run-id " + run_id + " ' | head -1", &pid);
-  ASSERT_FALSE(pid.empty());
-  kill(std::stoi(pid), SIGSTOP);
+  const pid_t pid = agent_pid(run_id, 1);
+  ASSERT_GT(pid, 0);
+  kill(pid, SIGSTOP);
   // Silent for the monitor's lag_s (3 s) while the others report: named within a few seconds.
   const bool named = wait_for_output(launch, "lagging: 1", 20);
   const long stopped_at = last_progress_round(launch.output());
-  kill(std::stoi(pid), SIGCONT);
+  kill(pid, SIGCONT);
   ASSERT_TRUE(named) << launch.output();
   const std::string lag_line = launch.output().substr(launch.output().find("lagging: 1"));
   EXPECT_EQ(lag_line.find("lagging: 1,"), std::string::npos) << lag_line;  // agent 1 only
