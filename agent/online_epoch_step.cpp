@@ -71,16 +71,6 @@ EpochReports read_reports(OnlineAgentState& s, OnlineLink& link) {
   return out;
 }
 
-// What enters now: what every member holds, of the members' robots and those of lost agents
-// (their blocks' adopters absorb them); a robot's data waits for its agent.
-Watermarks entry_decision(const OnlineAgentState& s, const std::vector<Watermarks>& held) {
-  AbsorbGate gate;
-  Watermarks decision = gate.decide(held);
-  for (auto& [robot, count] : decision)
-    if (!s.membership.absorbs(robot, s.epoch)) count = 0;
-  return decision;
-}
-
 void print_entered(const OnlineAgentState& s, const runtime::EnteredData& in, bool member) {
   std::string who;
   for (std::uint32_t m : s.members()) who += " " + std::to_string(m);
@@ -202,7 +192,7 @@ bool enter_and_act(OnlineAgentState& s, OnlineLink& link, const EpochReports& re
   }
   if (s.o.publish_every_s > 0 && s.now_s() - s.last_publish_s >= s.o.publish_every_s)
     link.publish_estimate();
-  const Watermarks decision = entry_decision(s, reports.held);
+  const Watermarks decision = s.membership.entering(reports.held, s.epoch);
   // The members hold what they decided; a joiner following missed epochs may not yet.
   link.wait_to_hold(decision, true);
   const double step_start = s.now_s();

@@ -41,13 +41,6 @@ double since(OnlineClock::time_point t) {
   return std::chrono::duration<double>(OnlineClock::now() - t).count();
 }
 
-// Whether `m` is a protocol message of `epoch` for block `me` from another block.
-bool addressed_to(const transport::OnlineProtocolSample& m, std::uint32_t epoch, std::uint32_t me) {
-  return m.epoch == epoch && m.sender != me &&
-         (m.broadcast ||
-          std::find(m.recipients.begin(), m.recipients.end(), me) != m.recipients.end());
-}
-
 }  // namespace
 
 OnlineLink::OnlineLink(OnlineAgentState& state)
@@ -74,7 +67,7 @@ void OnlineLink::pump_stream() {
 void OnlineLink::pump_channel() {
   for (auto& r : channel_.take_reports()) file_report(std::move(r));
   for (auto& m : channel_.take_messages())
-    if (m.epoch >= s_.epoch) pending_.push_back(std::move(m));
+    if (m.epoch >= s_.epoch) pending_.push(std::move(m));
 }
 
 void OnlineLink::file_report(transport::OnlineReportSample&& r) {
@@ -130,9 +123,7 @@ std::vector<transport::OnlineReportSample> OnlineLink::take_votes() {
 void OnlineLink::drop_before(std::uint32_t epoch) {
   for (auto it = reports_.begin(); it != reports_.end();)
     it = it->first < epoch ? reports_.erase(it) : std::next(it);
-  pending_.erase(std::remove_if(pending_.begin(), pending_.end(),
-                                [&](const auto& m) { return m.epoch < epoch; }),
-                 pending_.end());
+  pending_.drop_before(epoch);
 }
 
 void OnlineLink::wait_matched() {
@@ -239,25 +230,10 @@ void OnlineLink::run_rounds(CertifiedAgent& agent, std::uint32_t me) {
   send(agent.start());
   auto last_message = OnlineClock::now();
   while (!agent.done()) {
-    bool handled = false;
-    // One pass over the queue, compacting it in place (no erase from its middle per message):
-    // this epoch's messages for this agent are handled in arrival order, later epochs' wait for
-    // their solve, older epochs' leftovers and messages for others go. Once the solve is done,
-    // the rest stays queued as it is.
-    std::size_t keep = 0, k = 0;
-    for (; k < pending_.size() && !agent.done(); ++k) {
-      auto& m = pending_[k];
-      if (addressed_to(m, s_.epoch, me)) {
-        send(agent.handle(m.message));
-        handled = true;
-      } else if (m.epoch > s_.epoch) {
-        if (keep != k) pending_[keep] = std::move(m);
-        ++keep;
-      }
-    }
-    for (; k < pending_.size(); ++k, ++keep)
-      if (keep != k) pending_[keep] = std::move(pending_[k]);
-    pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(keep), pending_.end());
+    const bool handled = pending_.take(
+        s_.epoch, me,
+        [&](const transport::OnlineProtocolSample& m) { send(agent.handle(m.message)); },
+        [&] { return agent.done(); });
     if (agent.done()) break;
     if (handled) {
       last_message = OnlineClock::now();

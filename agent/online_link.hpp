@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "agent/online_agent_state.hpp"
+#include "runtime/epoch_message_queue.hpp"
 #include "transport/graph_stream_topic.hpp"
 #include "transport/online_channel.hpp"
 
@@ -81,7 +82,7 @@ class OnlineLink {
   std::map<std::uint32_t, std::map<std::uint32_t, transport::OnlineReportSample>> reports_;
   std::vector<transport::OnlineReportSample> votes_;  // take-over votes not yet read
   std::set<std::uint32_t> refused_;  // hellos with other team options (not admitted)
-  std::vector<transport::OnlineProtocolSample> pending_;
+  runtime::EpochMessageQueue<transport::OnlineProtocolSample> pending_;
 };
 
 }  // namespace tessera::agent

@@ -69,5 +69,16 @@ TEST(OnlineMembership, ATakeOverGoesOnWithTheSurvivorsAtAFreshEpoch) {
   EXPECT_EQ(m.next_members(5, {}), (Agents{1, 2}));
 }
 
+TEST(OnlineMembership, WhatEntersIsWhatEveryMemberHoldsOfTheRobotsAbsorbedAtTheEpoch) {
+  runtime::OnlineMembership m(4);
+  m.admit(0, {0, 1, 2});
+  m.taken_over({2}, {0, 1}, 3);
+  // Epoch 3: members 0 and 1; robot 2's data goes to its block's adopter, robot 3's waits
+  // for its agent.
+  const Watermarks a{{0, 5}, {1, 4}, {2, 7}, {3, 2}};
+  const Watermarks b{{0, 3}, {1, 6}, {2, 9}, {3, 2}};
+  EXPECT_EQ(m.entering({a, b}, 3), (Watermarks{{0, 3}, {1, 4}, {2, 7}, {3, 0}}));
+}
+
 }  // namespace
 }  // namespace tessera

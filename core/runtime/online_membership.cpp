@@ -21,6 +21,15 @@ bool OnlineMembership::absorbs(std::uint32_t robot, std::uint32_t epoch) const {
   return is_member(robot, epoch) || lost(robot);
 }
 
+Watermarks OnlineMembership::entering(const std::vector<Watermarks>& held,
+                                      std::uint32_t epoch) const {
+  AbsorbGate gate;
+  Watermarks decision = gate.decide(held);
+  for (auto& [robot, count] : decision)
+    if (!absorbs(robot, epoch)) count = 0;
+  return decision;
+}
+
 void OnlineMembership::heard_from(std::uint32_t agent) {
   if (agent < robots_ && !lost(agent)) heard_.insert(agent);
 }

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <map>
 #include <set>
+#include <tessera/online/absorb_gate.hpp>
 #include <vector>
 
 namespace tessera::runtime {
@@ -28,6 +29,10 @@ class OnlineMembership {
   /// Whether `robot`'s batches may enter at `epoch`: its agent is a member, or it was lost and
   /// its block's adopter absorbs them. A robot's data otherwise waits for its agent.
   bool absorbs(std::uint32_t robot, std::uint32_t epoch) const;
+
+  /// What enters at `epoch`: what every member holds (`held`, one per member: the element-wise
+  /// minimum), of the robots absorbed at `epoch` only; another robot's data waits for its agent.
+  Watermarks entering(const std::vector<Watermarks>& held, std::uint32_t epoch) const;
 
   /// Agent `agent` said hello or reported. Agents outside 0..robots-1 and lost agents are not
   /// counted.
