@@ -135,7 +135,7 @@ dds::SubscriberQos subscriber_qos(const std::string& run_id) {
 }
 
 dds::DataWriterQos writer_qos(bool handshake, double lease_s, std::uint32_t num_agents,
-                              const NetworkProfile& net, bool liveliness) {
+                              const NetworkProfile& net, bool liveliness, bool waited_for) {
   dds::DataWriterQos q = dds::DATAWRITER_QOS_DEFAULT;
   // Room to filter for every agent's reader on the writer's side (addressed_filter.hpp):
   // Fast DDS's default of 32 would leave the readers past it to filter for themselves.
@@ -157,8 +157,11 @@ dds::DataWriterQos writer_qos(bool handshake, double lease_s, std::uint32_t num_
   q.resource_limits().max_samples_per_instance = history;
   q.resource_limits().allocated_samples = 4;
   // The default 3 s heartbeat stalls request/reply exchanges for seconds after a loss.
-  q.reliable_writer_qos().times.heartbeatPeriod = Duration_t(
-      handshake ? std::min(net.heartbeat_period_s, kHandshakeHeartbeatS) : net.heartbeat_period_s);
+  const bool short_heartbeat =
+      handshake || (waited_for && num_agents <= kMaxAgentsWithRecipientTopics);
+  q.reliable_writer_qos().times.heartbeatPeriod =
+      Duration_t(short_heartbeat ? std::min(net.heartbeat_period_s, kHandshakeHeartbeatS)
+                                 : net.heartbeat_period_s);
   q.reliable_writer_qos().times.nackResponseDelay = Duration_t(net.nack_response_delay_s);
   // Not Fast DDS's 0 on the volatile (per-round) topics: NetworkProfile::nack_suppression_s.
   // The hand-shake topics are written a few times a run and keep answering at once.
