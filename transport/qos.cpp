@@ -194,6 +194,13 @@ dds::DataReaderQos reader_qos(bool transient_local, double lease_s, std::uint32_
   q.resource_limits().max_samples_per_instance = limit;
   q.resource_limits().allocated_samples = 4;
   q.reliable_reader_qos().times.heartbeatResponseDelay = Duration_t(net.heartbeat_response_delay_s);
+  // A hand-shake sample that reaches this process before its writer is matched (endpoint
+  // discovery races the first write of a TRANSIENT_LOCAL writer) is dropped; in launch traces it
+  // came again 70 ms after the match, at the reader's first acknowledgement (Fast DDS's default
+  // delay): an agent's announcement, on the critical path of the launch.
+  if (transient_local)
+    q.reliable_reader_qos().times.initialAcknackDelay =
+        Duration_t(std::min(net.heartbeat_period_s, kHandshakeHeartbeatS));
   q.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
   q.liveliness().lease_duration =
       liveliness ? Duration_t(lease_s) : eprosima::fastrtps::c_TimeInfinite;

@@ -1,7 +1,11 @@
-// The heartbeat of the hand-off writers (transport/qos.cpp, writer_qos's `waited_for`). An agent
-// waits for its hand-off parts to be acknowledged every few parts (agent/handoff_exchange.cpp),
-// and a reader acknowledges only when a heartbeat asks: at the per-round topics' 50 ms each wait
-// lasted until the next heartbeat. No timing is asserted, only the QoS each writer gets.
+// When readers acknowledge, as set by transport/qos.cpp. A reader acknowledges only when a
+// heartbeat asks, or once, a delay after it matched a writer:
+// - the hand-off writers (writer_qos's `waited_for`): an agent waits for its hand-off parts to
+//   be acknowledged every few parts (agent/handoff_exchange.cpp), so each wait lasted until the
+//   writer's next heartbeat, 50 ms at the per-round topics' period;
+// - the hand-shake readers (TRANSIENT_LOCAL): a sample dropped because it arrived before its
+//   writer was matched came again only at the reader's first acknowledgement, 70 ms by default.
+// No timing is asserted, only the QoS each endpoint gets.
 
 #include <gtest/gtest.h>
 
@@ -13,8 +17,14 @@ namespace {
 
 using namespace tessera::transport;
 
+double seconds(const eprosima::fastrtps::Duration_t& d) {
+  return static_cast<double>(d.to_ns()) * 1e-9;
+}
 double heartbeat_s(const eprosima::fastdds::dds::DataWriterQos& q) {
-  return static_cast<double>(q.reliable_writer_qos().times.heartbeatPeriod.to_ns()) * 1e-9;
+  return seconds(q.reliable_writer_qos().times.heartbeatPeriod);
+}
+double first_acknack_s(const eprosima::fastdds::dds::DataReaderQos& q) {
+  return seconds(q.reliable_reader_qos().times.initialAcknackDelay);
 }
 
 TEST(HandoffHeartbeat, HandoffWritersOfSmallRunsAskForAcknowledgementsAtTheHandshakePeriod) {
@@ -44,6 +54,18 @@ TEST(HandoffHeartbeat, LargerRunsKeepTheProfilesPeriodSinceEachHeartbeatAsksEver
   NetworkProfile fast = def;
   fast.heartbeat_period_s = 0.001;
   EXPECT_NEAR(heartbeat_s(writer_qos(false, 2.0, 5, fast, true, true)), 0.001, 1e-9);
+}
+
+TEST(HandshakeReaders, AskForWhatTheyMissedAHandshakeHeartbeatAfterMatchingNot70Ms) {
+  const NetworkProfile def = network_profile("default");
+  const eprosima::fastdds::dds::DataReaderQos fast_dds_default;
+  ASSERT_NEAR(first_acknack_s(fast_dds_default), 0.070, 1e-9);
+  for (std::uint32_t agents : {2u, 5u, 64u})
+    EXPECT_NEAR(first_acknack_s(reader_qos(true, 2.0, agents, def, true)), kHandshakeHeartbeatS,
+                1e-9)
+        << agents << " agents";
+  // The volatile readers get only what is written after they matched: Fast DDS's delay.
+  EXPECT_NEAR(first_acknack_s(reader_qos(false, 2.0, 5, def, false)), 0.070, 1e-9);
 }
 
 }  // namespace
