@@ -19,7 +19,7 @@ namespace tessera::agent {
 /// What sending a hand-off took (for the agent's log).
 struct HandoffSending {
   std::size_t parts = 0;    ///< Parts written, to every peer together.
-  double send_s = 0.0;      ///< From the first part's write to the last one's.
+  double send_s = 0.0;      ///< Planning and writing every part, waits included.
   double ack_wait_s = 0.0;  ///< Of which waiting for parts to be acknowledged.
 };
 
