@@ -2,7 +2,8 @@
 // heartbeat asks, or once, a delay after it matched a writer:
 // - the hand-off writers (writer_qos's `waited_for`): an agent waits for its hand-off parts to
 //   be acknowledged every few parts (agent/handoff_exchange.cpp), so each wait lasted until the
-//   writer's next heartbeat, 50 ms at the per-round topics' period;
+//   writer's next heartbeat, 50 ms at the per-round topics' period, or, for a lost part, until
+//   the end of the writer's 50 ms NACK suppression window;
 // - the hand-shake readers (TRANSIENT_LOCAL): a sample dropped because it arrived before its
 //   writer was matched came again only at the reader's first acknowledgement, 70 ms by default.
 // No timing is asserted, only the QoS each endpoint gets.
@@ -23,11 +24,14 @@ double seconds(const eprosima::fastrtps::Duration_t& d) {
 double heartbeat_s(const eprosima::fastdds::dds::DataWriterQos& q) {
   return seconds(q.reliable_writer_qos().times.heartbeatPeriod);
 }
+double nack_window_s(const eprosima::fastdds::dds::DataWriterQos& q) {
+  return seconds(q.reliable_writer_qos().times.nackSupressionDuration);
+}
 double first_acknack_s(const eprosima::fastdds::dds::DataReaderQos& q) {
   return seconds(q.reliable_reader_qos().times.initialAcknackDelay);
 }
 
-TEST(HandoffHeartbeat, HandoffWritersOfSmallRunsAskForAcknowledgementsAtTheHandshakePeriod) {
+TEST(HandoffHeartbeat, HandoffWritersOfSmallRunsAskForAcknowledgementsAndRepairAtTheHandshakePace) {
   const NetworkProfile def = network_profile("default");
   ASSERT_GT(def.heartbeat_period_s, kHandshakeHeartbeatS);
   EXPECT_TRUE(is_handoff_topic(kHandoffTopic));
@@ -39,7 +43,10 @@ TEST(HandoffHeartbeat, HandoffWritersOfSmallRunsAskForAcknowledgementsAtTheHands
     EXPECT_NEAR(heartbeat_s(writer_qos(false, 2.0, agents, def, true, waited_for)),
                 kHandshakeHeartbeatS, 1e-9)
         << agents << " agents";
-  // Every other volatile writer keeps the profile's period.
+  // A part lost in the burst is repaired at once, not after the NACK suppression window.
+  EXPECT_EQ(nack_window_s(writer_qos(false, 2.0, 5, def, true, waited_for)), 0.0);
+  // Every other volatile writer keeps the profile's period and window.
+  EXPECT_NEAR(nack_window_s(writer_qos(false, 2.0, 5, def, true)), def.nack_suppression_s, 1e-9);
   EXPECT_NEAR(heartbeat_s(writer_qos(false, 2.0, 5, def, false)), def.heartbeat_period_s, 1e-9);
   EXPECT_NEAR(heartbeat_s(writer_qos(false, 2.0, 5, def, true)), def.heartbeat_period_s, 1e-9);
 }
@@ -50,6 +57,8 @@ TEST(HandoffHeartbeat, LargerRunsKeepTheProfilesPeriodSinceEachHeartbeatAsksEver
     EXPECT_NEAR(heartbeat_s(writer_qos(false, 2.0, agents, def, true, true)),
                 def.heartbeat_period_s, 1e-9)
         << agents << " agents";
+  EXPECT_NEAR(nack_window_s(writer_qos(false, 2.0, 25, def, true, true)), def.nack_suppression_s,
+              1e-9);
   // A profile with a shorter period than the hand-shake's keeps its own.
   NetworkProfile fast = def;
   fast.heartbeat_period_s = 0.001;
