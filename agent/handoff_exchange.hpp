@@ -16,14 +16,23 @@
 
 namespace tessera::agent {
 
+/// What sending a hand-off took (for the agent's log).
+struct HandoffSending {
+  std::size_t parts = 0;    ///< Parts written, to every peer together.
+  double send_s = 0.0;      ///< Planning and writing every part, waits included.
+  double ack_wait_s = 0.0;  ///< Of which waiting for parts to be acknowledged.
+};
+
 /// Publishes `share`'s hand-off to every agent but `self` under `owner`, then waits up to
 /// `timeout_s` for every part of a hand-off from each of them. Returns them decoded, one per
 /// sender (its parts joined in order), by sender id.
 /// Throws RunFailure on a stop or the timeout (naming the agents not heard from).
+/// `sending`, when given, receives what sending took.
 std::vector<ReceivedHandoff> exchange_handoffs(transport::AgentSession& session,
                                                const RobotShare& share,
                                                const std::vector<std::uint32_t>& owner,
                                                std::uint32_t self, std::uint32_t robots,
-                                               const std::string& run_id, double timeout_s);
+                                               const std::string& run_id, double timeout_s,
+                                               HandoffSending* sending = nullptr);
 
 }  // namespace tessera::agent

@@ -233,14 +233,19 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   // 1M-pose grid on 2 cores: 30 s timed out), so the wait is bounded like a round's, not like a
   // network step; a dead peer is noticed by its lease meanwhile.
   const auto handoff_start = std::chrono::steady_clock::now();
+  HandoffSending sending;
   std::vector<ReceivedHandoff> received =
       exchange_handoffs(s, share, asg.owner(), o.id, o.robots, o.net.session.run_id,
-                        std::max(o.net.timeout_s, o.round_timeout_s));
+                        std::max(o.net.timeout_s, o.round_timeout_s), &sending);
   out.local = assemble_local(share, asg.owner(), o.id, o.robots, std::move(received), run_options);
   out.local.structure = std::move(structure);
   out.local.known_inlier = std::move(known_flags);
   log("hand-off complete: " + std::to_string(out.local.owned.size()) + " poses, " +
-      std::to_string(out.local.measurements.size()) + " measurements");
+      std::to_string(out.local.measurements.size()) + " measurements; sent " +
+      std::to_string(sending.parts) + " parts in " +
+      std::to_string(static_cast<long>(sending.send_s * 1000)) +
+      " ms (waiting for acknowledgements " +
+      std::to_string(static_cast<long>(sending.ack_wait_s * 1000)) + " ms)");
   if (o.id == 0)  // the coordinator's summary splits the time to the first round with these
     channel.report(SetupTimesReport{
         init_s,

@@ -167,7 +167,9 @@ void DdsEntities::make_writer(const std::string& name, bool transient_local, Exp
   writer_listeners_.push_back(
       std::make_unique<WriterMatchListener>(readiness_, name + "/w", muted_));
   dds::DataWriter* w = publisher_->create_datawriter(
-      t, writer_qos(transient_local, opt_.lease_s, opt_.num_agents, net_, !is_round_topic(name)),
+      t,
+      writer_qos(transient_local, opt_.lease_s, opt_.num_agents, net_, !is_round_topic(name),
+                 is_handoff_topic(name)),
       writer_listeners_.back().get(), dds::StatusMask::publication_matched());
   if (!w) throw TransportError("cannot create DDS writer for " + name);
   writers_[name] = w;

@@ -94,9 +94,20 @@ eprosima::fastdds::dds::SubscriberQos subscriber_qos(const std::string& run_id);
 /// round over 6 processes). A dead peer is still noticed by the participant lease and by the
 /// liveliness of its set-up topics' writers (control, announcement, ...), which stay AUTOMATIC
 /// and are asserted by the participant's periodic liveliness messages.
+///
+/// `waited_for`: a writer whose application waits for its samples to be acknowledged between
+/// bursts (the hand-off's parts): in runs of up to kMaxAgentsWithRecipientTopics agents it gets
+/// the hand-shake heartbeat and no NACK suppression, since a reader acknowledges only when a
+/// heartbeat asks and each wait otherwise lasted until the next 50 ms heartbeat (city10000, 5
+/// agents: agent 0 waited 50-110 ms twice while handing off its 39 parts, on the run's critical
+/// path). Larger runs keep the profile's period: every heartbeat asks every matched reader for an
+/// acknowledgement, so its traffic grows as N^2 while a burst is unacknowledged.
 eprosima::fastdds::dds::DataWriterQos writer_qos(bool handshake, double lease_s,
                                                  std::uint32_t num_agents,
-                                                 const NetworkProfile& net, bool liveliness = true);
+                                                 const NetworkProfile& net, bool liveliness = true,
+                                                 bool waited_for = false);
+/// Readers of the hand-shake topics (`transient_local`) send their first acknowledgement after
+/// kHandshakeHeartbeatS instead of Fast DDS's 70 ms (qos.cpp says why).
 eprosima::fastdds::dds::DataReaderQos reader_qos(bool transient_local, double lease_s,
                                                  std::uint32_t num_agents,
                                                  const NetworkProfile& net, bool liveliness = true);

@@ -79,4 +79,10 @@ inline bool is_round_topic(const std::string& name) {
          name == kRelayStatusTopic || name == kProgressTopic || name == kReportTopic;
 }
 
+/// The hand-off topics: written in one burst at set-up (and for replicas and take-overs), whose
+/// writer waits for its parts to be acknowledged every few parts (agent/handoff_exchange.cpp).
+inline bool is_handoff_topic(const std::string& name) {
+  return name == kHandoffTopic || name == kAddressedHandoffTopic;
+}
+
 }  // namespace tessera::transport

@@ -13,7 +13,9 @@ start-up step:
   init        (agents) the initialisation stage done (chordal start)
   hand-off    (agents) every other agent's hand-off received
   set-up      (agents) the block set-up done (the block updates' factorizations)
-and the coordinator's timeline. Then every ordered pair of processes (X sees Y) whose endpoint
+and the coordinator's timeline; how long after the coordinator's announcement reader matched
+each agent's writer the announcement arrived; what sending agent 0's hand-off took (parts, wall,
+waits for acknowledgements). Then every ordered pair of processes (X sees Y) whose endpoint
 matches completed more than --late ms after X discovered Y's participant: the signature of an
 endpoint-discovery message that arrived before its sender's participant was known, dropped and
 recovered only by the reader's first acknowledgement (Fast DDS 2.9's built-in endpoint-discovery
@@ -134,6 +136,22 @@ def main():
         print("%-4s" % who + " ".join(cells))
     print("coordinator timeline, ms: " +
           ", ".join("%s %.0f" % (k, v) for k, v in (s.get("timeline_ms") or {}).items()))
+    # A TRANSIENT_LOCAL announcement that arrived before the coordinator's reader had matched its
+    # writer comes again only when that reader asks (its first acknowledgement).
+    matched, received = {}, {}
+    for t, _, who, text, _ in events:
+        m = re.match(r"tessera_announce/r matched agent (\d+)", text)
+        if who == "c" and m:
+            matched.setdefault(int(m.group(1)), t)
+        m = re.match(r"received on tessera_announce from agent (\d+)", text)
+        if who == "c" and m:
+            received.setdefault(int(m.group(1)), t)
+    print("announcements, the coordinator's reader matched -> sample received, ms: " +
+          ", ".join("a%d %.0f" % (k, 1000 * (received[k] - matched[k]))
+                    for k in sorted(matched) if k in received))
+    for line in open(os.path.join(folder, "agent0.log"), errors="replace"):
+        if "hand-off complete" in line and "sent" in line:
+            print("agent 0's hand-off: " + line.split("measurements; ", 1)[-1].strip())
     pairs = late_pairs(events, a.late)
     print("endpoint matches later than %.0f ms after the participant's discovery (X sees Y: ms; "
           "Y sees X: ms): %s" % (a.late, ", ".join("%s<-%s %.0f (%.0f)" % (x, y, g, b)
