@@ -33,9 +33,11 @@ their own data would run (the fork server's preloaded whole graph is in every ag
 usage: dds_scale.py [--bin build/bin/tessera] [--sizes 20000:2,100000:10] [--domain 65]
                     [--work DIR] [--timeout 3600] [--period 0.5] [--csv FILE] [--robot-files]
                     [--launch-args="..."] [--min-available-mb MB] [--reference-cost F]
+                    [--samples FILE]
 
 The set-up's peaks (setup_pss_mb_*) are sampled until the coordinator's first round line;
---min-available-mb stops a run (SIGTERM to launch) when the host's MemAvailable falls below it.
+--min-available-mb stops a run (SIGTERM to launch) when the host's MemAvailable falls below it;
+--samples writes every sample (the agents' mean and largest PSS over the run's time).
 """
 import argparse
 import csv
@@ -120,9 +122,10 @@ class Sampler(threading.Thread):
     min_available_mb > 0 a watchdog: when the host's MemAvailable falls below it, launch is sent
     SIGTERM (other jobs share the host; a run must not push it into the OOM killer)."""
 
-    def __init__(self, root, period, min_available_mb=0):
+    def __init__(self, root, period, min_available_mb=0, samples=None):
         super().__init__(daemon=True)
         self.root, self.period, self.min_available_mb = root, period, min_available_mb
+        self.samples, self.t0 = samples, time.monotonic()  # samples: an open CSV file, or None
         self.rss, self.pss, self.pss_sum, self.stop = {}, {}, 0, False
         self.in_rounds, self.setup_pss_sum, self.setup_pss_agent = False, 0, 0
         self.stopped_by_watchdog, self.least_available_mb = False, None
@@ -131,6 +134,7 @@ class Sampler(threading.Thread):
         while not self.stop:
             total = 0
             largest = 0
+            agents = []
             for p in descendants(self.root):
                 role = role_of(p)
                 if role is None:
@@ -143,12 +147,19 @@ class Sampler(threading.Thread):
                 self.pss[role] = max(self.pss.get(role, 0), pss)
                 if role.startswith("agent"):
                     largest = max(largest, pss)
+                    agents.append(pss)
                 total += pss
             self.pss_sum = max(self.pss_sum, total)
             if not self.in_rounds:
                 self.setup_pss_sum = max(self.setup_pss_sum, total)
                 self.setup_pss_agent = max(self.setup_pss_agent, largest)
             avail = mem_available_mb()
+            if self.samples:
+                mean = sum(agents) / len(agents) if agents else 0
+                self.samples.write(f"{time.monotonic() - self.t0:.1f},{int(self.in_rounds)},{len(agents)},"
+                                   f"{mean / 1024:.1f},{largest / 1024:.1f},{total / 1024:.1f},{avail},"
+                                   f"{load():.2f}\n")
+                self.samples.flush()
             if avail is not None:
                 self.least_available_mb = min(avail, self.least_available_mb or avail)
                 if self.min_available_mb and avail < self.min_available_mb and not self.stopped_by_watchdog:
@@ -187,7 +198,12 @@ def run_one(args, poses, agents, domain):
     load0 = load()
     t0 = time.monotonic()
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    sampler = Sampler(proc.pid, args.period, args.min_available_mb)
+    samples = None
+    if args.samples:
+        samples = open(args.samples.replace("{size}", f"{poses}_{agents}"), "w")
+        samples.write("elapsed_s,in_rounds,agents,agent_pss_mb_mean,agent_pss_mb_max,run_pss_mb_sum,"
+                      "mem_available_mb,load\n")
+    sampler = Sampler(proc.pid, args.period, args.min_available_mb, samples)
     sampler.start()
     in_summary = False
     for line in proc.stdout:  # progress and errors stay visible; the summary is read from its file
@@ -202,6 +218,8 @@ def run_one(args, poses, agents, domain):
     wall = time.monotonic() - t0
     sampler.stop = True
     sampler.join()
+    if samples:
+        samples.close()
     agent_pss = {k: v for k, v in sampler.pss.items() if k.startswith("agent")}
     agent_rss = {k: v for k, v in sampler.rss.items() if k.startswith("agent")}
     row = {"poses": poses, "agents": agents, "input": "robot files" if args.robot_files else "one file",
@@ -257,6 +275,10 @@ def main():
                     help="write only this run's rows; by default they are appended to the CSV's rows")
     ap.add_argument("--min-available-mb", type=int, default=0,
                     help="watchdog: stop a run when the host's MemAvailable falls below this (0 = off)")
+    ap.add_argument("--samples", default="",
+                    help="write every memory sample to this CSV ({size} becomes POSES_AGENTS): elapsed "
+                         "s, whether the rounds have begun, the agents' mean and largest PSS, the run's "
+                         "PSS sum, MemAvailable, load")
     ap.add_argument("--reference-cost", type=float, default=0,
                     help="the graph's optimal cost f* (one size only): launch reports the final cost's "
                          "relative gap to it (rel_gap_to_reference)")
