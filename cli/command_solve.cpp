@@ -87,6 +87,10 @@ const char* kHelp =
     "                            GNC's weighted solves are Newton steps, mu's step after an\n"
     "                            outer step that moved no weight across 1/2 is the last one\n"
     "                            squared, up to S; 0 = none, else > 1 [4]\n"
+    "  --gnc-step-sigma every|refine-sigma   robust distributed: who factors the interface\n"
+    "                            solves' matrix in GNC's weighted Newton steps: every agent\n"
+    "                            (no wait for agent 0's solve), or as --refine-sigma says; the\n"
+    "                            same iterates [every]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {
@@ -266,6 +270,7 @@ int run_solve(const Args& args) {
   valued.insert("gnc-jump-side");
   valued.insert("gnc-probe-cut");
   valued.insert("gnc-newton-mu-step-max");
+  valued.insert("gnc-step-sigma");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
@@ -289,6 +294,13 @@ int run_solve(const Args& args) {
   } catch (const InputError& e) {
     throw InputError(std::string("option --gnc-probe-cut: ") + e.what());
   }
+  // RobustOptions::step_sigma_every_agent; `tessera solve` only, like --gnc-probe-cut.
+  const std::string step_sigma =
+      a.get_or("gnc-step-sigma", robust.step_sigma_every_agent ? "every" : "refine-sigma");
+  if (step_sigma != "every" && step_sigma != "refine-sigma")
+    throw InputError("option --gnc-step-sigma: '" + step_sigma +
+                     "' is not one of every, refine-sigma");
+  robust.step_sigma_every_agent = step_sigma == "every";
   // RobustOptions::newton_mu_step_max; `tessera solve` only, like --gnc-probe-cut.
   robust.newton_mu_step_max = a.get_double("gnc-newton-mu-step-max", robust.newton_mu_step_max);
   try {

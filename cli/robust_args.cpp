@@ -177,7 +177,8 @@ void add_distributed_robust_fields(JsonObject& json, const RobustOptions& option
   const long long gnc_refine_steps = gnc.refine_message_steps;
   const long long exchange_steps = gnc.exchange_steps;
   const long long solve_stages = gnc.solve_stages + final_solve_stages;
-  json.add("total_rounds", rounds)
+  json.add("gnc_step_sigma", options.step_sigma_every_agent ? "every" : "refine-sigma")
+      .add("total_rounds", rounds)
       .add("gnc_refine_steps", gnc_refine_steps)
       .add("gnc_exchange_steps", exchange_steps)
       .add("final_refine_steps", final_refine_steps)

@@ -49,6 +49,37 @@ TEST(GncRefineSteps, NewtonStepsInGncFindTheSameSetAtTheSameCertifiedCostInFewer
   EXPECT_LT(message_steps(newton), message_steps(rounds));
 }
 
+// RobustOptions::step_sigma_every_agent: where the solver would have agent 0 alone factor Sigma
+// and ship every solve (kShipSolves: here forced with a threshold of 0, the grid's interface is
+// small), GNC's weighted Newton steps have every agent factor it instead: no wait for agent 0's
+// solve, the same iterates.
+TEST(GncRefineSteps, WeightedStepsThatFactorSigmaOnEveryAgentTakeTheSameIteratesInFewerSteps) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.certify = true;
+  o.solver.refine.sigma_factoring = NewtonRefineOptions::SigmaFactoring::kShipSolves;
+  o.solver.refine.ship_solves_min_coordinates = 0;
+  o.robust.step_sigma_every_agent = false;
+  const GncDistributedResult shipped =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  o.robust.step_sigma_every_agent = true;
+  const GncDistributedResult every =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  ASSERT_GT(shipped.refine_message_steps, 0) << "the weighted solves should be Newton steps";
+  EXPECT_EQ(every.rejected, dirty.outliers);
+  EXPECT_EQ(every.rejected, shipped.rejected);
+  EXPECT_EQ(every.outer_iterations, shipped.outer_iterations);
+  EXPECT_EQ(every.weights, shipped.weights);
+  EXPECT_EQ(every.final_solve.cost, shipped.final_solve.cost);
+  EXPECT_TRUE(every.final_solve.certified.value_or(false));
+  EXPECT_EQ(every.exchange_steps, shipped.exchange_steps);
+  EXPECT_EQ(every.total_rounds, shipped.total_rounds);
+  // At least one message step less per weighted solve (one CG direction each).
+  EXPECT_LE(every.refine_message_steps,
+            shipped.refine_message_steps - (shipped.outer_iterations - 1));
+}
+
 TEST(GncRefineSteps, WithoutRefinedPassesTheWeightedSolvesStayRounds) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
   GncDistributedOptions o;

@@ -29,6 +29,11 @@ DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSo
         o.refine.enabled = true;
         o.refine.auto_interface_grad_tol = std::numeric_limits<double>::infinity();
         o.refine.max_steps = options.robust.gnc_refine_steps;
+        // RobustOptions::step_sigma_every_agent: one direction per point does not pay for
+        // agent 0's solves' message step.
+        if (options.robust.step_sigma_every_agent &&
+            o.refine.sigma_factoring == NewtonRefineOptions::SigmaFactoring::kShipSolves)
+          o.refine.sigma_factoring = NewtonRefineOptions::SigmaFactoring::kEveryAgent;
       }
       break;
     case GncSolveKind::kInlierPass:

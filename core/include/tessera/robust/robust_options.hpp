@@ -271,6 +271,22 @@ struct RobustOptions {
   /// 66; docs/robust.md, "Newton steps in GNC"). 1: two steps cost 13 message steps a solve and
   /// shorten nothing (intel 0.25: 17 outer steps either way, 284 message steps; CSAIL 87).
   int gnc_refine_steps = 1;
+  /// Distributed solvers only, where GNC's weighted solves are Newton steps (gnc_refine_steps):
+  /// in those steps every agent factors the interface solves' Sigma itself
+  /// (NewtonRefineOptions::SigmaFactoring::kEveryAgent) where the solver's refinement would have
+  /// agent 0 alone factor it and send each agent its part of every solve (kShipSolves, the
+  /// default where Sigma has at least ship_solves_min_coordinates coordinates); other
+  /// factorings, the passes and the final solve keep the solver's. The same iterates either way.
+  /// Why: kShipSolves saves the agents' redundant factorizations at the price of one message
+  /// step per CG direction, which pays where a point has many directions; a weighted solve has
+  /// one point and, with exact interface solves, one direction, so it buys nothing there and
+  /// every agent waits for agent 0's solve instead. F = 0.25 random, 5 agents: intel 156 -> 149
+  /// message steps, CSAIL 73 -> 71, every intel and CSAIL cell of the benchmark (random and
+  /// group, 0.1 / 0.25 / 0.5) the same `--out` bytes and rejected set; the price, every agent
+  /// receiving and factoring every share: intel 18.8 -> 29.8 MB, 2.77 -> 3.76 G instructions
+  /// over all agents (docs/robust.md, "Who factors Sigma in GNC's Newton steps").
+  /// `tessera solve --gnc-step-sigma every|refine-sigma`.
+  bool step_sigma_every_agent = true;
   /// Distributed solvers only: GNC's exchanges ride on messages that are sent anyway, with the
   /// same values, so the run is the same but for its message steps (and bytes):
   /// - where a weighted solve is a single Newton step (gnc_refine_steps 1) that another weight
