@@ -301,6 +301,11 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.factor_s);
   const int n = coarse_->size();
   Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
+  // Without the multipliers: LD, the share of Phi^T Proj(2 V Q) Phi, is the matrix inverted;
+  // L (Hess f's) is still needed by balancing (its H Phi columns and A's products).
+  const bool data_part = !options_.coarse_multipliers;
+  const bool galerkin = !data_part || options_.coarse_balancing;
+  Eigen::MatrixXd LD = data_part ? Eigen::MatrixXd::Zero(n, n) : Eigen::MatrixXd();
   Eigen::MatrixXd v, vn;
   const std::vector<int>& touched = coarse_->touched();
   // Balancing also keeps the own rows of H Phi (one column per touched unknown).
@@ -374,18 +379,28 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
             HJ.col(a * w + q) += (2.0 * it.value()) * vn.col(it.row());
       }
     }
-    apply_hessian_projection(XJ, GJ, VJ, problem_.dim(), HJ);
-    HJ = LiftedManifold(static_cast<int>(rows), problem_.dim(), static_cast<std::size_t>(nj))
-             .tangent_project(XJ, HJ);
-    for (Eigen::Index a = 0; a < nj; ++a)
-      hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = HJ.middleCols(a * w, w);
-    coarse_->project(X_, hv, J, L.col(u).data());
-    if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
+    const LiftedManifold manifold(static_cast<int>(rows), problem_.dim(),
+                                  static_cast<std::size_t>(nj));
+    if (data_part) {
+      const Eigen::MatrixXd DJ = manifold.tangent_project(XJ, HJ);
+      for (Eigen::Index a = 0; a < nj; ++a)
+        hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = DJ.middleCols(a * w, w);
+      coarse_->project(X_, hv, J, LD.col(u).data());
+    }
+    if (galerkin) {
+      apply_hessian_projection(XJ, GJ, VJ, problem_.dim(), HJ);
+      HJ = manifold.tangent_project(XJ, HJ);
+      for (Eigen::Index a = 0; a < nj; ++a)
+        hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = HJ.middleCols(a * w, w);
+      coarse_->project(X_, hv, J, L.col(u).data());
+      if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
+    }
     for (Eigen::Index j : J) hv.middleCols(j * w, w).setZero();  // zero again, off J too
   }
   std::vector<double> values;
-  values.reserve(coarse_->packed_size() + static_cast<std::size_t>(n));
-  coarse_->pack(L, values);
+  values.reserve(2 * coarse_->packed_size() + static_cast<std::size_t>(n));
+  if (data_part) coarse_->pack(LD, values);
+  if (galerkin) coarse_->pack(L, values);
   const std::size_t at = values.size();
   values.resize(at + static_cast<std::size_t>(n), 0.0);
   coarse_->project(X_, g_, values.data() + at);
@@ -396,9 +411,15 @@ void NewtonRefineProtocol::after_coarse(const MessageGate::Inbox& inbox,
                                         std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.sigma_s);
   const int n = coarse_->size();
-  const std::size_t at = coarse_->packed_size();
+  const std::size_t packed = coarse_->packed_size();
+  const bool data_part = !options_.coarse_multipliers;
+  const bool both = data_part && options_.coarse_balancing;  // send_coarse's order
+  const std::size_t at = both ? 2 * packed : packed;
   const std::vector<double> t = reduce_in_id_order(inbox, at + static_cast<std::size_t>(n));
-  coarse_->set_matrix(t.data());
+  if (both)
+    coarse_->set_matrices(t.data(), t.data() + packed);
+  else
+    coarse_->set_matrix(t.data());
   coarse_g_ = Eigen::Map<const Eigen::VectorXd>(t.data() + at, n);
   coarse_due_ = false;
   ++result_.coarse_assemblies;

@@ -102,7 +102,13 @@ class TangentCoarseSpace {
   /// largest diagonal entry: negative curvature, a generator that moves no pose, or a direction
   /// of nearly no curvature, which pseudo_inverse() drops too).
   void set_matrix(const double* packed, double tol = 1e-10);
-  /// A x and A^+ x with the kept A (x and the result: size() entries; zero outside the groups).
+  /// The same, but inverting `inverted` (packed as `galerkin`) while times_matrix() keeps
+  /// multiplying by `galerkin`: a preconditioner built from another matrix than the Hessian's
+  /// Galerkin matrix (NewtonRefineOptions::coarse_multipliers false) whose balancing still
+  /// needs Phi^T H Phi.
+  void set_matrices(const double* inverted, const double* galerkin, double tol = 1e-10);
+  /// A x and A^+ x with the kept A (x and the result: size() entries; zero outside the groups;
+  /// with set_matrices(), A x is the Galerkin matrix's and A^+ x the inverted one's).
   Eigen::VectorXd times_matrix(const Eigen::VectorXd& x) const;
   Eigen::VectorXd times_inverse(const Eigen::VectorXd& x) const;
 
