@@ -334,21 +334,27 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   std::vector<Eigen::Index> J;
   // On J's poses: the point and Euclidean gradient (a piece's), a column's v and H v.
   Eigen::MatrixXd XJ, GJ, VJ, HJ;
+  // A column's vector, zero but on its piece's slots (set and cleared per column).
+  v.setZero(rows, X_.cols());
+  vn.setZero(rows, Xn_.cols());
+  std::vector<Eigen::Index> own_slots, neighbour_slots;
   int piece = -1;
   for (std::size_t c = 0; c < touched.size(); ++c) {
     const int u = touched[c];
     if (u / coarse_->generators() != piece) {  // a new piece: its poses J
       piece = u / coarse_->generators();
+      own_slots = coarse_->own_slots(piece);
+      neighbour_slots = coarse_->neighbour_slots(piece);
       for (Eigen::Index j : J) in_j[static_cast<std::size_t>(j)] = 0;
       J.clear();
-      for (Eigen::Index i : coarse_->own_slots(piece))
+      for (Eigen::Index i : own_slots)
         for (Eigen::Index q = 0; q < w; ++q)
           for (SparseMatrix::InnerIterator it(qbb, i * w + q); it; ++it)
             if (!in_j[static_cast<std::size_t>(it.row() / w)]) {
               in_j[static_cast<std::size_t>(it.row() / w)] = 1;
               J.push_back(it.row() / w);
             }
-      for (Eigen::Index i : coarse_->neighbour_slots(piece))
+      for (Eigen::Index i : neighbour_slots)
         for (Eigen::Index j : own_of_neighbour[static_cast<std::size_t>(i)])
           if (!in_j[static_cast<std::size_t>(j)]) {
             in_j[static_cast<std::size_t>(j)] = 1;
@@ -365,7 +371,7 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
         GJ.middleCols(a * w, w) = egrad_.middleCols(from, w);
       }
     }
-    coarse_->unit(X_, Xn_, u, v, vn);
+    coarse_->unit_on(X_, Xn_, u, own_slots, neighbour_slots, v, vn);
     const auto nj = static_cast<Eigen::Index>(J.size());
     HJ.setZero(rows, w * nj);
     for (Eigen::Index a = 0; a < nj; ++a) {
@@ -396,6 +402,8 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
       if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
     }
     for (Eigen::Index j : J) hv.middleCols(j * w, w).setZero();  // zero again, off J too
+    for (Eigen::Index i : own_slots) v.middleCols(i * w, w).setZero();
+    for (Eigen::Index i : neighbour_slots) vn.middleCols(i * w, w).setZero();
   }
   std::vector<double> values;
   values.reserve(2 * coarse_->packed_size() + static_cast<std::size_t>(n));

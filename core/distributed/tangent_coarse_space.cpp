@@ -226,6 +226,24 @@ void TangentCoarseSpace::unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& X
   fill(neighbour_poses_, Xn, vn);
 }
 
+void TangentCoarseSpace::unit_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
+                                 const std::vector<Eigen::Index>& own,
+                                 const std::vector<Eigen::Index>& neighbour, Eigen::MatrixXd& v,
+                                 Eigen::MatrixXd& vn) const {
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(k_, k_ + 1);
+  add_generator(unknown % g_, 1.0, E);
+  const int piece = unknown / g_;
+  auto fill = [&](const Poses& p, const std::vector<Eigen::Index>& slots, const Eigen::MatrixXd& P,
+                  Eigen::MatrixXd& out) {
+    for (Eigen::Index s : slots)
+      for (std::size_t q = p.start[static_cast<std::size_t>(s)];
+           q < p.start[static_cast<std::size_t>(s) + 1]; ++q)
+        if (p.weights[q].piece == piece) move(p.weights[q].w * E, P, s, out);
+  };
+  fill(own_poses_, own, X, v);
+  fill(neighbour_poses_, neighbour, Xn, vn);
+}
+
 Eigen::MatrixXd TangentCoarseSpace::group_inverse(const Eigen::MatrixXd& Ag, double tol) const {
   const Eigen::Index m = Ag.rows();
   // P = I - U U^T, U's columns the group's rigid motions (generator j on every piece of the

@@ -64,6 +64,12 @@ class TangentCoarseSpace {
   /// shapes of X and Xn.
   void unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown, Eigen::MatrixXd& v,
             Eigen::MatrixXd& vn) const;
+  /// The same on the unknown's piece's slots only (`own`, `neighbour`: own_slots() and
+  /// neighbour_slots() of its piece), adding to v and vn of X's and Xn's shapes, which the caller
+  /// keeps zero elsewhere: a column then costs its piece's poses, not the whole block.
+  void unit_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
+               const std::vector<Eigen::Index>& own, const std::vector<Eigen::Index>& neighbour,
+               Eigen::MatrixXd& v, Eigen::MatrixXd& vn) const;
 
   /// Pieces whose poses are linked by measurements, directly or through other pieces (the
   /// connected components of the layout's block graph; a piece of the smoothed space goes with
