@@ -301,6 +301,11 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.factor_s);
   const int n = coarse_->size();
   Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
+  // Without the multipliers: LD, the share of Phi^T Proj(2 V Q) Phi, is the matrix inverted;
+  // L (Hess f's) is still needed by balancing (its H Phi columns and A's products).
+  const bool data_part = !options_.coarse_multipliers;
+  const bool galerkin = !data_part || options_.coarse_balancing;
+  Eigen::MatrixXd LD = data_part ? Eigen::MatrixXd::Zero(n, n) : Eigen::MatrixXd();
   Eigen::MatrixXd v, vn;
   const std::vector<int>& touched = coarse_->touched();
   // Balancing also keeps the own rows of H Phi (one column per touched unknown).
@@ -329,21 +334,27 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   std::vector<Eigen::Index> J;
   // On J's poses: the point and Euclidean gradient (a piece's), a column's v and H v.
   Eigen::MatrixXd XJ, GJ, VJ, HJ;
+  // A column's vector, zero but on its piece's slots (set and cleared per column).
+  v.setZero(rows, X_.cols());
+  vn.setZero(rows, Xn_.cols());
+  std::vector<Eigen::Index> own_slots, neighbour_slots;
   int piece = -1;
   for (std::size_t c = 0; c < touched.size(); ++c) {
     const int u = touched[c];
     if (u / coarse_->generators() != piece) {  // a new piece: its poses J
       piece = u / coarse_->generators();
+      own_slots = coarse_->own_slots(piece);
+      neighbour_slots = coarse_->neighbour_slots(piece);
       for (Eigen::Index j : J) in_j[static_cast<std::size_t>(j)] = 0;
       J.clear();
-      for (Eigen::Index i : coarse_->own_slots(piece))
+      for (Eigen::Index i : own_slots)
         for (Eigen::Index q = 0; q < w; ++q)
           for (SparseMatrix::InnerIterator it(qbb, i * w + q); it; ++it)
             if (!in_j[static_cast<std::size_t>(it.row() / w)]) {
               in_j[static_cast<std::size_t>(it.row() / w)] = 1;
               J.push_back(it.row() / w);
             }
-      for (Eigen::Index i : coarse_->neighbour_slots(piece))
+      for (Eigen::Index i : neighbour_slots)
         for (Eigen::Index j : own_of_neighbour[static_cast<std::size_t>(i)])
           if (!in_j[static_cast<std::size_t>(j)]) {
             in_j[static_cast<std::size_t>(j)] = 1;
@@ -360,7 +371,7 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
         GJ.middleCols(a * w, w) = egrad_.middleCols(from, w);
       }
     }
-    coarse_->unit(X_, Xn_, u, v, vn);
+    coarse_->unit_on(X_, Xn_, u, own_slots, neighbour_slots, v, vn);
     const auto nj = static_cast<Eigen::Index>(J.size());
     HJ.setZero(rows, w * nj);
     for (Eigen::Index a = 0; a < nj; ++a) {
@@ -374,18 +385,30 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
             HJ.col(a * w + q) += (2.0 * it.value()) * vn.col(it.row());
       }
     }
-    apply_hessian_projection(XJ, GJ, VJ, problem_.dim(), HJ);
-    HJ = LiftedManifold(static_cast<int>(rows), problem_.dim(), static_cast<std::size_t>(nj))
-             .tangent_project(XJ, HJ);
-    for (Eigen::Index a = 0; a < nj; ++a)
-      hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = HJ.middleCols(a * w, w);
-    coarse_->project(X_, hv, J, L.col(u).data());
-    if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
+    const LiftedManifold manifold(static_cast<int>(rows), problem_.dim(),
+                                  static_cast<std::size_t>(nj));
+    if (data_part) {
+      const Eigen::MatrixXd DJ = manifold.tangent_project(XJ, HJ);
+      for (Eigen::Index a = 0; a < nj; ++a)
+        hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = DJ.middleCols(a * w, w);
+      coarse_->project(X_, hv, J, LD.col(u).data());
+    }
+    if (galerkin) {
+      apply_hessian_projection(XJ, GJ, VJ, problem_.dim(), HJ);
+      HJ = manifold.tangent_project(XJ, HJ);
+      for (Eigen::Index a = 0; a < nj; ++a)
+        hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = HJ.middleCols(a * w, w);
+      coarse_->project(X_, hv, J, L.col(u).data());
+      if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
+    }
     for (Eigen::Index j : J) hv.middleCols(j * w, w).setZero();  // zero again, off J too
+    for (Eigen::Index i : own_slots) v.middleCols(i * w, w).setZero();
+    for (Eigen::Index i : neighbour_slots) vn.middleCols(i * w, w).setZero();
   }
   std::vector<double> values;
-  values.reserve(coarse_->packed_size() + static_cast<std::size_t>(n));
-  coarse_->pack(L, values);
+  values.reserve(2 * coarse_->packed_size() + static_cast<std::size_t>(n));
+  if (data_part) coarse_->pack(LD, values);
+  if (galerkin) coarse_->pack(L, values);
   const std::size_t at = values.size();
   values.resize(at + static_cast<std::size_t>(n), 0.0);
   coarse_->project(X_, g_, values.data() + at);
@@ -396,9 +419,15 @@ void NewtonRefineProtocol::after_coarse(const MessageGate::Inbox& inbox,
                                         std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.sigma_s);
   const int n = coarse_->size();
-  const std::size_t at = coarse_->packed_size();
+  const std::size_t packed = coarse_->packed_size();
+  const bool data_part = !options_.coarse_multipliers;
+  const bool both = data_part && options_.coarse_balancing;  // send_coarse's order
+  const std::size_t at = both ? 2 * packed : packed;
   const std::vector<double> t = reduce_in_id_order(inbox, at + static_cast<std::size_t>(n));
-  coarse_->set_matrix(t.data());
+  if (both)
+    coarse_->set_matrices(t.data(), t.data() + packed);
+  else
+    coarse_->set_matrix(t.data());
   coarse_g_ = Eigen::Map<const Eigen::VectorXd>(t.data() + at, n);
   coarse_due_ = false;
   ++result_.coarse_assemblies;

@@ -226,6 +226,24 @@ void TangentCoarseSpace::unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& X
   fill(neighbour_poses_, Xn, vn);
 }
 
+void TangentCoarseSpace::unit_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
+                                 const std::vector<Eigen::Index>& own,
+                                 const std::vector<Eigen::Index>& neighbour, Eigen::MatrixXd& v,
+                                 Eigen::MatrixXd& vn) const {
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(k_, k_ + 1);
+  add_generator(unknown % g_, 1.0, E);
+  const int piece = unknown / g_;
+  auto fill = [&](const Poses& p, const std::vector<Eigen::Index>& slots, const Eigen::MatrixXd& P,
+                  Eigen::MatrixXd& out) {
+    for (Eigen::Index s : slots)
+      for (std::size_t q = p.start[static_cast<std::size_t>(s)];
+           q < p.start[static_cast<std::size_t>(s) + 1]; ++q)
+        if (p.weights[q].piece == piece) move(p.weights[q].w * E, P, s, out);
+  };
+  fill(own_poses_, own, X, v);
+  fill(neighbour_poses_, neighbour, Xn, vn);
+}
+
 Eigen::MatrixXd TangentCoarseSpace::group_inverse(const Eigen::MatrixXd& Ag, double tol) const {
   const Eigen::Index m = Ag.rows();
   // P = I - U U^T, U's columns the group's rigid motions (generator j on every piece of the
@@ -274,17 +292,26 @@ void TangentCoarseSpace::pack(const Eigen::MatrixXd& L, std::vector<double>& out
 }
 
 void TangentCoarseSpace::set_matrix(const double* packed, double tol) {
+  set_matrices(packed, nullptr, tol);
+}
+
+void TangentCoarseSpace::set_matrices(const double* inverted, const double* galerkin, double tol) {
   matrices_.clear();
+  auto unpack = [](const double*& packed, Eigen::Index m) {
+    Eigen::MatrixXd M(m, m);
+    for (Eigen::Index j = 0; j < m; ++j)
+      for (Eigen::Index i = 0; i <= j; ++i) M(i, j) = M(j, i) = *packed++;
+    return M;
+  };
   for (const std::vector<Eigen::Index>& idx : linked_group_unknowns_) {
     const auto m = static_cast<Eigen::Index>(idx.size());
     GroupMatrix gm;
-    gm.A.resize(m, m);
-    for (Eigen::Index j = 0; j < m; ++j)
-      for (Eigen::Index i = 0; i <= j; ++i) gm.A(i, j) = gm.A(j, i) = *packed++;
-    // B = P A P with P = I - U U^T (U: the group's rigid motions, generator j on every piece,
+    const Eigen::MatrixXd M = unpack(inverted, m);  // the matrix whose pseudo-inverse is kept
+    gm.A = galerkin ? unpack(galerkin, m) : M;
+    // B = P M P with P = I - U U^T (U: the group's rigid motions, generator j on every piece,
     // normalized); U U^T's entries are 1/pieces where the generators agree.
     const double s = 1.0 / static_cast<double>(m / g_);
-    Eigen::MatrixXd B = gm.A;
+    Eigen::MatrixXd B = M;
     remove_rigid_means(B, g_, s);
     B.transposeInPlace();
     remove_rigid_means(B, g_, s);
@@ -320,7 +347,7 @@ void TangentCoarseSpace::set_matrix(const double* packed, double tol) {
     }
     if (!ok) {
       gm.dense = true;
-      gm.inverse = group_inverse(gm.A, tol);
+      gm.inverse = group_inverse(M, tol);
     }
     matrices_.push_back(std::move(gm));
   }

@@ -64,6 +64,12 @@ class TangentCoarseSpace {
   /// shapes of X and Xn.
   void unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown, Eigen::MatrixXd& v,
             Eigen::MatrixXd& vn) const;
+  /// The same on the unknown's piece's slots only (`own`, `neighbour`: own_slots() and
+  /// neighbour_slots() of its piece), adding to v and vn of X's and Xn's shapes, which the caller
+  /// keeps zero elsewhere: a column then costs its piece's poses, not the whole block.
+  void unit_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
+               const std::vector<Eigen::Index>& own, const std::vector<Eigen::Index>& neighbour,
+               Eigen::MatrixXd& v, Eigen::MatrixXd& vn) const;
 
   /// Pieces whose poses are linked by measurements, directly or through other pieces (the
   /// connected components of the layout's block graph; a piece of the smoothed space goes with
@@ -102,7 +108,13 @@ class TangentCoarseSpace {
   /// largest diagonal entry: negative curvature, a generator that moves no pose, or a direction
   /// of nearly no curvature, which pseudo_inverse() drops too).
   void set_matrix(const double* packed, double tol = 1e-10);
-  /// A x and A^+ x with the kept A (x and the result: size() entries; zero outside the groups).
+  /// The same, but inverting `inverted` (packed as `galerkin`) while times_matrix() keeps
+  /// multiplying by `galerkin`: a preconditioner built from another matrix than the Hessian's
+  /// Galerkin matrix (NewtonRefineOptions::coarse_multipliers false) whose balancing still
+  /// needs Phi^T H Phi.
+  void set_matrices(const double* inverted, const double* galerkin, double tol = 1e-10);
+  /// A x and A^+ x with the kept A (x and the result: size() entries; zero outside the groups;
+  /// with set_matrices(), A x is the Galerkin matrix's and A^+ x the inverted one's).
   Eigen::VectorXd times_matrix(const Eigen::VectorXd& x) const;
   Eigen::VectorXd times_inverse(const Eigen::VectorXd& x) const;
 

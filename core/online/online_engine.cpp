@@ -215,6 +215,11 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     solver.refine.forcing = options.newton_forcing;
     solver.refine.coarse = options.newton_coarse;
     solver.refine.coarse_min_blocks = options.newton_coarse_min_blocks;
+    // The coarse matrix from the Hessian's data part, as the kept block factors above are:
+    // positive semi-definite at any point. A step that starts far from the optimum (a batch of
+    // loop closures) made the Galerkin matrix indefinite or nearly singular, and its inverse
+    // sent the trust region's steps where the model did not hold (docs/online.md).
+    solver.refine.coarse_multipliers = false;
     // Nor the trial translations' re-solve (measured on long chains from a cold start).
     solver.refine.translation_iterations = 0;
     // Nor the interface solves (they factor every block at every point; these steps keep

@@ -145,6 +145,17 @@ struct NewtonRefineOptions {
   /// (H Phi)^T y rides in the same sum, so still one exchange and one sum an iteration, each
   /// agent keeping its rows of H Phi). false: additive, B + C.
   bool coarse_balancing = true;
+  /// Which Hessian the coarse matrix A inverts. true: the Riemannian Hessian, multiplier term
+  /// included (A = Phi^T Hess f Phi, the Galerkin matrix). false: its data part only,
+  /// Phi^T Proj(2 V Q) Phi, positive semi-definite at every point, as the block factors are
+  /// without `hessian_multipliers` (balancing still uses Hess f for its H Phi and A's
+  /// products). Why: away from a minimum the multiplier term can make A indefinite or nearly
+  /// singular in the pieces' relative motions; its pseudo-inverse then drops the negative
+  /// directions and blows up the nearly flat ones, so those motions are short in the
+  /// preconditioner's norm the trust region bounds, and the steps were long in f's
+  /// (docs/online.md, "Smoothed pieces"). The online steps keep their block factors without
+  /// the multipliers and set false; batch refinements keep true.
+  bool coarse_multipliers = true;
   /// kSmoothed: pieces per block (>= 1) and smoothing steps of their weights (0..8).
   int coarse_aggregates = 8;
   int coarse_smoothing_steps = 1;
