@@ -19,6 +19,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -91,6 +92,10 @@ class DdsEntities {
   const std::map<std::string, eprosima::fastdds::dds::DataWriter*>& writers() const {
     return writers_;
   }
+  /// Whether the readers of topic `name` are VOLATILE (made with `transient_local` false):
+  /// they never receive what its writer wrote before they matched, so the writer's
+  /// acknowledged samples serve nobody (SampleWriter drops them).
+  bool readers_volatile(const std::string& name) const { return volatile_topics_.count(name) > 0; }
 
   /// Traces what Fast DDS itself reports as matched on each endpoint next to what the
   /// listeners reported (when a barrier times out). Nothing when tracing is off.
@@ -133,6 +138,7 @@ class DdsEntities {
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::map<std::string, eprosima::fastdds::dds::DataWriter*> writers_;
+  std::set<std::string> volatile_topics_;
   std::vector<eprosima::fastdds::dds::DataReader*> readers_;
   std::map<std::string, eprosima::fastdds::dds::DataReader*> reader_by_name_;
 
@@ -173,6 +179,7 @@ void DdsEntities::make_writer(const std::string& name, bool transient_local, Exp
       writer_listeners_.back().get(), dds::StatusMask::publication_matched());
   if (!w) throw TransportError("cannot create DDS writer for " + name);
   writers_[name] = w;
+  if (!transient_local) volatile_topics_.insert(name);
   readiness_.expect(name + "/w", e, agent);
 }
 

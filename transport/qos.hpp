@@ -24,10 +24,10 @@ constexpr std::int32_t kWriterHistory = 16;
 /// acknowledge only when a heartbeat asks (every heartbeat period, 50 ms by default), so
 /// a writer sending faster than kWriterHistory samples per heartbeat period stalled in
 /// write() until the next acknowledgement (measured: 5 agents broadcasting one status per
-/// step, 3-4% of the writes waited > 10 ms; mean step 2.4-3.0 ms -> 1.3-1.5 ms with 64). A
-/// writer keeps its last 256 samples (it drops the oldest acknowledged one when a write needs
-/// room): torus3D, 5 agents, 400 rounds, peak RSS per agent 61-64 MB -> 66-67 MB compared with
-/// dropping each sample once acknowledged (load 18-19). 256 because the distributed
+/// step, 3-4% of the writes waited > 10 ms; mean step 2.4-3.0 ms -> 1.3-1.5 ms with 64). Such
+/// a writer drops the oldest acknowledged sample when a write needs room, and SampleWriter
+/// drops all of them once acknowledged, every kDropAcknowledgedEvery writes
+/// (sample_writing.hpp): the bound is for samples in flight, not kept. 256 because the distributed
 /// rounding writes one status per message step (~0.85 ms on 2 cores), ~59 per heartbeat
 /// period, and 64 filled at times (every agent's status writer at once, each write() then
 /// blocked for its 10 ms max_blocking_time and retried); 256 holds 50 ms of messages at 0.2 ms.

@@ -24,9 +24,10 @@
 // acknowledged one when its (bounded KEEP_ALL) history is full and a new sample is written,
 // in the writing thread, which holds no locator-selector lock. The readers of the per-round
 // topics stay VOLATILE, and a VOLATILE reader gets nothing a writer wrote before it matched
-// (the writer sends it a GAP for its history), so what any reader receives is unchanged. The
-// cost: a writer keeps its last history-bound samples (transport/qos.hpp,
-// kVolatileWriterHistory) instead of only those not yet acknowledged.
+// (the writer sends it a GAP for its history), so what any reader receives is unchanged. Such
+// a writer would keep its last history-bound samples (transport/qos.hpp,
+// kVolatileWriterHistory); the writing thread drops the acknowledged ones instead
+// (transport/sample_writing.hpp, kDropAcknowledgedEvery).
 
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
