@@ -21,8 +21,8 @@
 #include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
 #include "robust/gnc_outer_loop.hpp"
-#include "robust/gnc_probes.hpp"
-#include "robust/gnc_solve_setup.hpp"
+#include "robust/gnc_probe_stage.hpp"
+#include "robust/gnc_solve_stage.hpp"
 #include "robust/gnc_votes.hpp"
 
 namespace tessera {
@@ -50,19 +50,15 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
   fresh_start_ = in_.kept_set_start && in_.initialization == DistributedInit::kChordal;
   dropped_.assign(in_.measurements.size(), false);
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
-  layout_ = std::make_unique<BlockLayout>(*base_);
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
+  stage_ =
+      std::make_unique<GncSolveStage>(in_, options_, terms_->known_connected(), std::move(in_.Y0));
   exchange_ = std::make_unique<GncExchangeBook>(in_, *terms_, *base_);
   mail_ = std::make_unique<GncMailbox>(in_.id);
   outer_ = std::make_unique<GncOuterLoop>();
   recheck_ = std::make_unique<RecheckVerdict>();
-  // With cluster probes the search (gnc_cluster_search.hpp) splits the budget: recheck_probes
-  // tail probes, cluster_probes cluster, pair and return probes.
-  probes_ = std::make_unique<GncProbes>(options_.robust.recheck_probes + options_.cluster_probes);
-  if (options_.cluster_probes > 0)
-    search_ = std::make_unique<GncClusterSearch>(in_.structure, terms_->known(),
-                                                 options_.robust.recheck_probes,
-                                                 options_.cluster_probes, options_.clusters);
+  probes_ =
+      std::make_unique<GncProbeStage>(in_, options_, terms_->known(), terms_->known_connected());
   weights_.assign(m, 1.0);
 }
 
@@ -81,7 +77,43 @@ bool GncAgent::weights_converged() const {
 }
 
 int GncAgent::total_rounds() const {
-  return gnc_rounds_ + final_rounds_;
+  return stage_->gnc_rounds() + stage_->final_rounds();
+}
+
+int GncAgent::gnc_rounds() const {
+  return stage_->gnc_rounds();
+}
+
+int GncAgent::gnc_refine_steps() const {
+  return stage_->gnc_refine_steps();
+}
+
+const Eigen::MatrixXd& GncAgent::last_pass_start() const {
+  return stage_->last_pass_start();
+}
+
+const AgentState& GncAgent::state() const {
+  return stage_->state();
+}
+
+const CertifiedAgent& GncAgent::last_solve() const {
+  return stage_->solve();
+}
+
+const CertifiedAgent* GncAgent::final_sequence() const {
+  return stage_->kind() == GncSolveKind::kFinal ? &stage_->solve() : nullptr;
+}
+
+const BlockLayout& GncAgent::layout() const {
+  return stage_->layout();
+}
+
+const std::vector<Measurement>& GncAgent::kept_measurements() const {
+  return stage_->kept();
+}
+
+const std::vector<std::uint64_t>& GncAgent::kept_index() const {
+  return stage_->kept_index();
 }
 
 GncAgentResult GncAgent::result() const {
@@ -93,9 +125,9 @@ GncAgentResult GncAgent::result() const {
   r.weights_converged = weights_converged();
   r.probes = probes();
   r.probes_kept = probes_kept();
-  r.refine_message_steps = gnc_refine_steps_;
+  r.refine_message_steps = stage_->gnc_refine_steps();
   r.exchange_steps = exchange_steps_;
-  r.solve_stages = gnc_solve_stages_;
+  r.solve_stages = stage_->gnc_solve_stages();
   return r;
 }
 
@@ -103,8 +135,9 @@ int GncAgent::weights_at_mu(double mu) {
   int crossed = 0;
   for (std::size_t k : terms_->owned())
     if (terms_->may_reject(k) && !dropped_[k]) {
-      const double w = tls_weight(terms_->residual_squared(k, state_->Y, exchange_->neighbours()),
-                                  terms_->c2(), mu);
+      const double w =
+          tls_weight(terms_->residual_squared(k, stage_->iterate(), exchange_->neighbours()),
+                     terms_->c2(), mu);
       if ((w >= 0.5) != (weights_[k] >= 0.5)) ++crossed;
       weights_[k] = w;
     }
@@ -193,7 +226,7 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   }
   // The certificate once, on the set that stays (re-admission ran on uncertified solves: the
   // staircase may raise the rank, which a further pass could not start from).
-  solve_kind_ = GncSolveKind::kFinal;
+  stage_->to_final();
   ++g_;
   begin_solve(out);
 }
@@ -225,7 +258,7 @@ void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   // Agent 0: the kept set's initialization, each agent's block sent, its own kept.
   const Eigen::MatrixXd X = kept_set_start(exchange_->kept_values(), in_, rejected_.size(),
-                                           static_cast<int>(state_->Y.rows()));
+                                           static_cast<int>(stage_->iterate().rows()));
   // With values_held_, each agent's neighbours' poses of the start too (the poses of other
   // agents at the ends of its measurements, as GncLocalTerms::neighbours() lists them): no pose
   // exchange of the start follows.
@@ -252,20 +285,15 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
 }
 
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
-  if (solve_kind_ == GncSolveKind::kFinal) {
-    final_rounds_ += solve_->total_rounds();
+  stage_->tally();
+  if (stage_->kind() == GncSolveKind::kFinal) {
     done_ = true;
     step_ = Step::kDone;
     return;
   }
-  gnc_rounds_ += solve_->total_rounds();
-  gnc_solve_stages_ += opened_solve_stages(solve_->solves());
-  gnc_refine_steps_ += message_steps(solve_->refines());
-  if (solve_kind_ == GncSolveKind::kInlierPass) {
+  if (stage_->kind() == GncSolveKind::kInlierPass) {
     last_pass_full_ = !pass_capped_;
-    last_pass_cost_ = std::numeric_limits<double>::quiet_NaN();
-    if (!pass_capped_ && !solve_->solves().empty() && !solve_->solves().back().trace.empty())
-      last_pass_cost_ = solve_->solves().back().trace.back().cost;
+    last_pass_cost_ = pass_capped_ ? std::numeric_limits<double>::quiet_NaN() : stage_->last_cost();
     if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
@@ -288,12 +316,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     begin_rejected(out);
     return;
   }
-  if (poses_sent_early_) {
-    // The trial's poses are the iterate's when the step was accepted (the same on every agent:
-    // the verdict is on summed values); otherwise the iterate is the solve's start.
-    const std::vector<NewtonRefineResult>& r = solve_->refines();
-    poses_early_stale_ = !(r.size() == 1 && r.front().accepted_steps == 1);
-  }
+  if (stage_->poses_sent_early()) stage_->judge_early_poses();
   begin_exchange(Step::kPoses, out);
 }
 
@@ -301,7 +324,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   switch (step_) {
     case Step::kPoses:
       neighbours_current_ = true;
-      if (solve_kind_ == GncSolveKind::kInlierPass)
+      if (stage_->kind() == GncSolveKind::kInlierPass)
         begin_exchange(Step::kReadmitted, out);
       else
         begin_exchange(outer_->started() ? Step::kWeights : Step::kVotes, out);
@@ -317,7 +340,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       const auto [spread, crossed] = exchange_->summed_votes();
       const bool jump =
           outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
-                               options_.robust, gnc_newton_steps_);
+                               options_.robust, stage_->newton_steps_only());
       jumped_ = jump;
       if (jump)
         for (std::size_t k = 0; k < weights_.size(); ++k)
@@ -381,7 +404,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       return;
     case Step::kStartVotes: {
       const auto [at_start, at_known] = exchange_->summed_votes();
-      if (at_known < at_start) in_.Y0 = std::move(in_.Y0_known);
+      if (at_known < at_start) stage_->set_start(std::move(in_.Y0_known));
       in_.Y0_known.resize(0, 0);
       exchange_->forget_candidate_neighbours();
       after_step_zero(out);
@@ -396,7 +419,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       fresh_start_costs_.emplace_back(rejected_, at_candidate);
       const bool fresh = at_candidate < at_iterate;
       if (fresh) {
-        state_->Y = exchange_->candidate();
+        stage_->set_iterate(exchange_->candidate());
         neighbours_current_ = false;
       }
       exchange_->candidate().resize(0, 0);
@@ -433,25 +456,12 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
             restore_before_probe(out, tls - before);
             return;
           }
-          if (search_) search_->kept();
         }
-        if (search_) {
-          // The verdict lists of the set that stays: the tail and the return band of its probes.
-          search_->set_list(recheck_->probe);
-          if (may_probe())
-            if (std::optional<std::vector<std::uint64_t>> flip = search_->next(rejected_)) {
-              begin_probe(tls, std::move(*flip), out);
-              return;
-            }
-          finish(out);
+        if (std::optional<std::vector<std::uint64_t>> flip =
+                probes_->next(std::move(recheck_->probe), rejected_, gnc_rejected_,
+                              stage_->newton_steps_only())) {
+          begin_probe(tls, std::move(*flip), out);
           return;
-        }
-        if (may_probe()) {
-          std::vector<std::uint64_t> flip = probe_flips(std::move(recheck_->probe));
-          if (!flip.empty()) {
-            begin_probe(tls, std::move(flip), out);
-            return;
-          }
         }
         finish(out);
         return;
@@ -486,14 +496,14 @@ std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {
 
 std::size_t GncAgent::messages_needed() const {
   if (done_) return 0;
-  if (step_ == Step::kSolve) return std::max<std::size_t>(solve_->messages_needed(), 1);
+  if (step_ == Step::kSolve) return std::max<std::size_t>(stage_->solve().messages_needed(), 1);
   return mail_->messages_needed();
 }
 
 std::optional<AwaitedMessages> GncAgent::awaited() const {
   if (done_) return std::nullopt;
   if (step_ == Step::kSolve) {
-    std::optional<AwaitedMessages> a = solve_->awaited();
+    std::optional<AwaitedMessages> a = stage_->solve().awaited();
     if (a) a->phase += g_ * kGncStepStride;
     return a;
   }

@@ -15,7 +15,8 @@
 #include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
 #include "robust/gnc_outer_loop.hpp"
-#include "robust/gnc_probes.hpp"
+#include "robust/gnc_probe_stage.hpp"
+#include "robust/gnc_solve_stage.hpp"
 #include "robust/gnc_votes.hpp"
 
 namespace tessera {
@@ -32,11 +33,12 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   step_ = step;
   const std::uint32_t phase = gnc_phase(g_, exchange());
   const auto me = static_cast<std::uint32_t>(in_.id);
+  const Eigen::MatrixXd& Y = stage_->iterate();  // the iterate, or the start before a solve
   exchange_->begin();
   // A gather at agent 0 (the consistency check's values, the kept set's start) waits twice: for
   // the values, then for agent 0's answer.
   // The poses sent beside a weighted solve's trial sums are no step of their own.
-  const bool early = step == Step::kPoses && poses_sent_early_;
+  const bool early = step == Step::kPoses && stage_->poses_sent_early();
   exchange_steps_ += step == Step::kPcm || (step == Step::kKeptStart && !values_held_) ? 2
                      : early                                                           ? 0
                                                                                        : 1;
@@ -55,23 +57,23 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // measurement (the base layout: a measurement out of the current solve still needs
       // its residual).
       if (early) {
-        if (!poses_early_stale_) exchange_->expect_poses(state_->Y.rows(), false);
+        if (!stage_->poses_early_stale()) exchange_->expect_poses(Y.rows(), false);
         break;
       }
-      exchange_->expect_poses(state_->Y.rows(), false);
-      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
+      exchange_->expect_poses(Y.rows(), false);
+      exchange_->publish(Y, BlockKind::kY, phase, out);
       break;
     case Step::kStartPoses:
       // Both starts' public poses: the solver's initialization (kind Y) and the known
       // inliers' (kind P).
-      exchange_->expect_poses(in_.Y0.rows(), true);
-      exchange_->publish(in_.Y0, BlockKind::kY, phase, out);
+      exchange_->expect_poses(Y.rows(), true);
+      exchange_->publish(Y, BlockKind::kY, phase, out);
       exchange_->publish(in_.Y0_known, BlockKind::kP, phase, out);
       break;
     case Step::kStartVotes:
       // The TLS cost of each measurement at both starts, summed by its weight owner.
-      exchange_->own_vote() = start_vote_costs(*terms_, in_.Y0, exchange_->neighbours(),
-                                               in_.Y0_known, exchange_->candidate_neighbours());
+      exchange_->own_vote() = start_vote_costs(*terms_, Y, exchange_->neighbours(), in_.Y0_known,
+                                               exchange_->candidate_neighbours());
       to_others(vote_message(exchange_->own_vote()));
       break;
     case Step::kPcm:
@@ -96,21 +98,21 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       break;
     case Step::kCandidatePoses:
       // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
-      exchange_->expect_poses(state_->Y.rows(), true);
-      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
+      exchange_->expect_poses(Y.rows(), true);
+      exchange_->publish(Y, BlockKind::kY, phase, out);
       exchange_->publish(exchange_->candidate(), BlockKind::kP, phase, out);
       break;
     case Step::kCandidateVotes:
       // Each kept measurement's cost at both starts, summed by its weight owner.
-      exchange_->own_vote() = kept_set_costs(*terms_, in_.measurement_index, rejected_, state_->Y,
-                                             exchange_->neighbours(), exchange_->candidate(),
-                                             exchange_->candidate_neighbours());
+      exchange_->own_vote() =
+          kept_set_costs(*terms_, in_.measurement_index, rejected_, Y, exchange_->neighbours(),
+                         exchange_->candidate(), exchange_->candidate_neighbours());
       to_others(vote_message(exchange_->own_vote()));
       break;
     case Step::kVotes:
       // mu's start needs the largest residual over every measurement that may be rejected.
       exchange_->own_vote() = {
-          largest_rejectable_residual(*terms_, dropped_, state_->Y, exchange_->neighbours()), 0};
+          largest_rejectable_residual(*terms_, dropped_, Y, exchange_->neighbours()), 0};
       to_others(vote_message(exchange_->own_vote()));
       break;
     case Step::kWeights: {
@@ -119,7 +121,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       const double spread = weight_spread(*terms_, weights_);
       const int near =
           options_.robust.jump_band > 0
-              ? near_bound_count(*terms_, dropped_, state_->Y, exchange_->neighbours(),
+              ? near_bound_count(*terms_, dropped_, Y, exchange_->neighbours(),
                                  options_.robust.jump_band, options_.robust.jump_band_inside)
               : 1;
       exchange_->own_vote() = {spread, crossed};
@@ -161,13 +163,11 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       // TLS's own verdict at the kept set's solution (gnc_votes.hpp); every agent gathers all.
       // With it the probe's list (only used when nothing else changes) and the TLS cost a probe
       // is judged by.
-      *recheck_ = recheck_verdict(
-          *terms_, in_.measurement_index, rejected_, state_->Y, exchange_->neighbours(),
-          probes_->may_follow(terms_->known_connected(), options_.robust.readmission_passes)
-              ? options_.robust.probe_ratio
-              : 0.0,
-          options_.robust.probe_tail_ratio);
-      exchange_->own_vote() = {tls_cost(*terms_, state_->Y, exchange_->neighbours()), 0};
+      *recheck_ =
+          recheck_verdict(*terms_, in_.measurement_index, rejected_, Y, exchange_->neighbours(),
+                          probes_->may_follow() ? options_.robust.probe_ratio : 0.0,
+                          options_.robust.probe_tail_ratio);
+      exchange_->own_vote() = {tls_cost(*terms_, Y, exchange_->neighbours()), 0};
       to_others(readmitted_message(*recheck_, exchange_->own_vote().first));
       break;
     default:
@@ -212,10 +212,10 @@ void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
   if (!ready) return;
   // Read into the book, or the agent's own data the exchange changes.
   for (const ProtocolMessage& m : *ready)
-    if (!(step_ == Step::kPoses && poses_early_stale_))
+    if (!(step_ == Step::kPoses && stage_->poses_early_stale()))
       exchange_->read(exchange(), m,
                       GncExchangeTargets{weights_, zero_cut_, low_weights_, rejected_, *recheck_,
-                                         state_ ? state_->Y.rows() : in_.Y0.rows()});
+                                         stage_->iterate().rows()});
   after_exchange(out);
 }
 
