@@ -336,40 +336,11 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       else
         begin_exchange(Step::kWeights, out);
       return;
-    case Step::kWeights: {
-      const auto [spread, crossed] = exchange_->summed_votes();
-      const bool jump =
-          outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
-                               options_.robust, stage_->newton_steps_only());
-      jumped_ = jump;
-      if (jump)
-        for (std::size_t k = 0; k < weights_.size(); ++k)
-          if (terms_->may_reject(k) && !dropped_[k])
-            weights_[k] = tls_verdict_weight(weights_[k], outer_->mu());
-      if (weight_observer_) weight_observer_(outer_->outer(), in_.measurement_index, weights_);
-      if (jump) {
-        begin_rejected(out);
-        return;
-      }
-      if (terms_->known_connected()) {
-        // This step's block layout: without the cut measurements of weight 0 (every agent's).
-        std::sort(zero_cut_.begin(), zero_cut_.end());
-        solve_without(zero_cut_);
-      }
-      ++g_;
-      begin_solve(out);
+    case Step::kWeights:
+      after_weights(out);
       return;
-    }
     case Step::kRejected:
-      std::sort(rejected_.begin(), rejected_.end());
-      gnc_rejected_ = rejected_;
-      // Nothing rejected: the GNC iterate is already the plain solve's.
-      if (fresh_start_ && !rejected_.empty()) {
-        require_kept_connected();  // before initializing the kept set
-        begin_exchange(Step::kKeptStart, out);
-        return;
-      }
-      begin_inlier_pass(out);
+      after_rejected(out);
       return;
     case Step::kKeptStart:
       if (in_.id == 0) start_kept_set(out);
@@ -381,24 +352,9 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       }
       begin_exchange(Step::kCandidatePoses, out);
       return;
-    case Step::kPcm: {
-      if (in_.id == 0) {
-        const std::vector<std::uint64_t> ids =
-            inconsistent_closures(exchange_->kept_values(), in_, *terms_);
-        RoundStatusMessage st;
-        st.measurement_ids = ids;
-        broadcast_status(std::move(st), 0, gnc_phase(g_, GncExchange::kPcmDropped), in_.num_agents,
-                         out);
-        drop_inconsistent(ids);
-      } else {
-        drop_inconsistent(exchange_->pcm_dropped());
-      }
-      if (in_.Y0_known.size() > 0)
-        begin_exchange(Step::kStartPoses, out);
-      else
-        after_step_zero(out);
+    case Step::kPcm:
+      after_pcm(out);
       return;
-    }
     case Step::kStartPoses:
       begin_exchange(Step::kStartVotes, out);
       return;
@@ -414,74 +370,136 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       neighbours_current_ = true;
       begin_exchange(Step::kCandidateVotes, out);
       return;
-    case Step::kCandidateVotes: {
-      const auto [at_iterate, at_candidate] = exchange_->summed_votes();
-      fresh_start_costs_.emplace_back(rejected_, at_candidate);
-      const bool fresh = at_candidate < at_iterate;
-      if (fresh) {
-        stage_->set_iterate(exchange_->candidate());
-        neighbours_current_ = false;
-      }
-      exchange_->candidate().resize(0, 0);
-      exchange_->forget_candidate_neighbours();
-      last_pass_full_ = false;
-      if (final_start_vote_) {
-        final_start_vote_ = false;
-        if (!fresh) {
-          finish(out);  // the iterate stays: on to the final solve
-          return;
-        }
-        pass_ = 0;  // the passes again, with their own budget
-      }
-      begin_inlier_pass(out);
+    case Step::kCandidateVotes:
+      after_candidate_votes(out);
       return;
-    }
-    case Step::kReadmitted: {
-      ++pass_;
-      if (recheck_->empty()) {
-        // No change at a rough solution: the same set once more, solved to the tolerance; but a
-        // pass that started from a solved pass only settled that pass's flips, and its verdict
-        // stands (RobustOptions::recheck_confirm_solved) when a solve to the tolerance follows.
-        const bool confirmed =
-            options_.robust.recheck_confirm_solved && pass_from_solved_ && final_solve_runs();
-        if (pass_capped_ && !confirmed) {
-          full_pass_next_ = true;
-          begin_inlier_pass(out);
-          return;
-        }
-        const double tls = exchange_->summed_votes().first;
-        if (probes_->running()) {
-          const double before = probes_->base_tls();
-          if (!probes_->keeps(rejected_, tls)) {
-            restore_before_probe(out, tls - before);
-            return;
-          }
-        }
-        if (std::optional<std::vector<std::uint64_t>> flip =
-                probes_->next(std::move(recheck_->probe), rejected_, gnc_rejected_,
-                              stage_->newton_steps_only())) {
-          begin_probe(tls, std::move(*flip), out);
-          return;
-        }
-        finish(out);
-        return;
-      }
-      const RecheckCounts counts =
-          apply_recheck(*recheck_, in_.measurement_index, rejected_, weights_);
-      readmitted_ += counts.readmitted;
-      late_rejected_ += counts.late_rejected;
-      if (probes_->back_at_base(rejected_)) {
-        // The passes took back exactly what the probe changed: it ends here, not kept (its
-        // TLS cost could differ from the base's only by the solves' accuracy).
-        restore_before_probe(out);
-        return;
-      }
-      begin_inlier_pass(out);
+    case Step::kReadmitted:
+      after_verdict(out);
       return;
-    }
     default:
       return;
   }
+}
+
+void GncAgent::after_rejected(std::vector<OutgoingMessage>& out) {
+  std::sort(rejected_.begin(), rejected_.end());
+  gnc_rejected_ = rejected_;
+  // Nothing rejected: the GNC iterate is already the plain solve's.
+  if (fresh_start_ && !rejected_.empty()) {
+    require_kept_connected();  // before initializing the kept set
+    begin_exchange(Step::kKeptStart, out);
+    return;
+  }
+  begin_inlier_pass(out);
+}
+
+void GncAgent::after_weights(std::vector<OutgoingMessage>& out) {
+  const auto [spread, crossed] = exchange_->summed_votes();
+  const bool jump =
+      outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
+                           options_.robust, stage_->newton_steps_only());
+  jumped_ = jump;
+  if (jump)
+    for (std::size_t k = 0; k < weights_.size(); ++k)
+      if (terms_->may_reject(k) && !dropped_[k])
+        weights_[k] = tls_verdict_weight(weights_[k], outer_->mu());
+  if (weight_observer_) weight_observer_(outer_->outer(), in_.measurement_index, weights_);
+  if (jump) {
+    begin_rejected(out);
+    return;
+  }
+  if (terms_->known_connected()) {
+    // This step's block layout: without the cut measurements of weight 0 (every agent's).
+    std::sort(zero_cut_.begin(), zero_cut_.end());
+    solve_without(zero_cut_);
+  }
+  ++g_;
+  begin_solve(out);
+}
+
+void GncAgent::after_pcm(std::vector<OutgoingMessage>& out) {
+  if (in_.id == 0) {
+    const std::vector<std::uint64_t> ids =
+        inconsistent_closures(exchange_->kept_values(), in_, *terms_);
+    RoundStatusMessage st;
+    st.measurement_ids = ids;
+    broadcast_status(std::move(st), 0, gnc_phase(g_, GncExchange::kPcmDropped), in_.num_agents,
+                     out);
+    drop_inconsistent(ids);
+  } else {
+    drop_inconsistent(exchange_->pcm_dropped());
+  }
+  if (in_.Y0_known.size() > 0)
+    begin_exchange(Step::kStartPoses, out);
+  else
+    after_step_zero(out);
+}
+
+void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {
+  const auto [at_iterate, at_candidate] = exchange_->summed_votes();
+  fresh_start_costs_.emplace_back(rejected_, at_candidate);
+  const bool fresh = at_candidate < at_iterate;
+  if (fresh) {
+    stage_->set_iterate(exchange_->candidate());
+    neighbours_current_ = false;
+  }
+  exchange_->candidate().resize(0, 0);
+  exchange_->forget_candidate_neighbours();
+  last_pass_full_ = false;
+  if (final_start_vote_) {
+    final_start_vote_ = false;
+    if (!fresh) {
+      finish(out);  // the iterate stays: on to the final solve
+      return;
+    }
+    pass_ = 0;  // the passes again, with their own budget
+  }
+  begin_inlier_pass(out);
+}
+
+void GncAgent::after_verdict(std::vector<OutgoingMessage>& out) {
+  ++pass_;
+  if (recheck_->empty()) {
+    after_unchanged_verdict(out);
+    return;
+  }
+  const RecheckCounts counts = apply_recheck(*recheck_, in_.measurement_index, rejected_, weights_);
+  readmitted_ += counts.readmitted;
+  late_rejected_ += counts.late_rejected;
+  if (probes_->back_at_base(rejected_)) {
+    // The passes took back exactly what the probe changed: it ends here, not kept (its
+    // TLS cost could differ from the base's only by the solves' accuracy).
+    restore_before_probe(out);
+    return;
+  }
+  begin_inlier_pass(out);
+}
+
+void GncAgent::after_unchanged_verdict(std::vector<OutgoingMessage>& out) {
+  // No change at a rough solution: the same set once more, solved to the tolerance; but a pass
+  // that started from a solved pass only settled that pass's flips, and its verdict stands
+  // (RobustOptions::recheck_confirm_solved) when a solve to the tolerance follows.
+  const bool confirmed =
+      options_.robust.recheck_confirm_solved && pass_from_solved_ && final_solve_runs();
+  if (pass_capped_ && !confirmed) {
+    full_pass_next_ = true;
+    begin_inlier_pass(out);
+    return;
+  }
+  const double tls = exchange_->summed_votes().first;
+  if (probes_->running()) {
+    const double before = probes_->base_tls();
+    if (!probes_->keeps(rejected_, tls)) {
+      restore_before_probe(out, tls - before);
+      return;
+    }
+  }
+  if (std::optional<std::vector<std::uint64_t>> flip = probes_->next(
+          std::move(recheck_->probe), rejected_, gnc_rejected_, stage_->newton_steps_only())) {
+    begin_probe(tls, std::move(*flip), out);
+    return;
+  }
+  finish(out);
 }
 
 std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {

@@ -230,6 +230,20 @@ class GncAgent : public AgentProcess {
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
   void after_solve(std::vector<OutgoingMessage>& out);
   void after_exchange(std::vector<OutgoingMessage>& out);
+  // What the exchange of each kind sends (the current step's): the poses of the iterate and
+  // of a second start; a status to every other agent; the weights (true when agent 0 takes the
+  // others' values beside them).
+  void send_poses(std::uint32_t phase, std::vector<OutgoingMessage>& out);
+  void send_status(std::uint32_t phase, std::vector<OutgoingMessage>& out);
+  bool send_weights(std::uint32_t phase, std::vector<OutgoingMessage>& out);
+  // after_exchange() of the steps with more to decide.
+  void after_weights(std::vector<OutgoingMessage>& out);
+  void after_rejected(std::vector<OutgoingMessage>& out);
+  void after_pcm(std::vector<OutgoingMessage>& out);
+  void after_candidate_votes(std::vector<OutgoingMessage>& out);
+  void after_verdict(std::vector<OutgoingMessage>& out);
+  // A re-check verdict that changes nothing: a pass to the tolerance, a probe, or the end.
+  void after_unchanged_verdict(std::vector<OutgoingMessage>& out);
   // One message of the running solve, handed to it; after_solve() when that ends the solve.
   void to_solve(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
   // The current exchange's messages once all are in: read, then after_exchange().
