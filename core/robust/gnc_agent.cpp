@@ -1,20 +1,18 @@
 // GncAgent's state machine: its construction, the outer loop's transitions after each solve and
-// each exchange (after_solve, after_exchange), the end of the run and its result. The solves are
-// gnc_agent_solve.cpp, the exchanges gnc_agent_exchanges.cpp, the probes gnc_agent_probes.cpp.
+// each exchange (after_solve, after_exchange) and the end of the run. The solves are
+// gnc_agent_solve.cpp, the exchanges gnc_agent_exchanges.cpp, the probes gnc_agent_probes.cpp,
+// the results gnc_agent_results.cpp.
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <tessera/distributed/coarse_space.hpp>
-#include <tessera/distributed/stage_tag.hpp>
 #include <tessera/robust/gnc_agent.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
 
-#include "robust/gnc_cluster_search.hpp"
 #include "robust/gnc_exchange.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
@@ -63,73 +61,6 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
 }
 
 GncAgent::~GncAgent() = default;
-
-double GncAgent::threshold_squared() const {
-  return terms_->c2();
-}
-
-int GncAgent::outer_iterations() const {
-  return outer_->outer();
-}
-
-bool GncAgent::weights_converged() const {
-  return outer_->converged();
-}
-
-int GncAgent::total_rounds() const {
-  return stage_->gnc_rounds() + stage_->final_rounds();
-}
-
-int GncAgent::gnc_rounds() const {
-  return stage_->gnc_rounds();
-}
-
-int GncAgent::gnc_refine_steps() const {
-  return stage_->gnc_refine_steps();
-}
-
-const Eigen::MatrixXd& GncAgent::last_pass_start() const {
-  return stage_->last_pass_start();
-}
-
-const AgentState& GncAgent::state() const {
-  return stage_->state();
-}
-
-const CertifiedAgent& GncAgent::last_solve() const {
-  return stage_->solve();
-}
-
-const CertifiedAgent* GncAgent::final_sequence() const {
-  return stage_->kind() == GncSolveKind::kFinal ? &stage_->solve() : nullptr;
-}
-
-const BlockLayout& GncAgent::layout() const {
-  return stage_->layout();
-}
-
-const std::vector<Measurement>& GncAgent::kept_measurements() const {
-  return stage_->kept();
-}
-
-const std::vector<std::uint64_t>& GncAgent::kept_index() const {
-  return stage_->kept_index();
-}
-
-GncAgentResult GncAgent::result() const {
-  GncAgentResult r;
-  r.outer_iterations = outer_iterations();
-  r.rejected.assign(rejected_.begin(), rejected_.end());
-  r.readmitted = readmitted_;
-  r.threshold_squared = threshold_squared();
-  r.weights_converged = weights_converged();
-  r.probes = probes();
-  r.probes_kept = probes_kept();
-  r.refine_message_steps = stage_->gnc_refine_steps();
-  r.exchange_steps = exchange_steps_;
-  r.solve_stages = stage_->gnc_solve_stages();
-  return r;
-}
 
 int GncAgent::weights_at_mu(double mu) {
   int crossed = 0;
@@ -259,20 +190,11 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   // Agent 0: the kept set's initialization, each agent's block sent, its own kept.
   const Eigen::MatrixXd X = kept_set_start(exchange_->kept_values(), in_, rejected_.size(),
                                            static_cast<int>(stage_->iterate().rows()));
-  // With values_held_, each agent's neighbours' poses of the start too (the poses of other
-  // agents at the ends of its measurements, as GncLocalTerms::neighbours() lists them): no pose
-  // exchange of the start follows.
+  // With values_held_, each agent's neighbours' poses of the start too: no pose exchange of the
+  // start follows.
   std::vector<std::vector<std::size_t>> nb(static_cast<std::size_t>(in_.num_agents));
   if (values_held_) {
-    for (const auto& [i, j] : in_.structure)
-      if (in_.owner[i] != in_.owner[j]) {
-        nb[static_cast<std::size_t>(in_.owner[i])].push_back(j);
-        nb[static_cast<std::size_t>(in_.owner[j])].push_back(i);
-      }
-    for (auto& ids : nb) {
-      std::sort(ids.begin(), ids.end());
-      ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    }
+    nb = cut_neighbours(in_);
     exchange_->candidate_neighbours() = block_of(X, terms_->neighbours(), in_.d);
   }
   for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)

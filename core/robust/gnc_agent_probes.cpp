@@ -13,14 +13,6 @@
 
 namespace tessera {
 
-int GncAgent::probes() const {
-  return probes_->started();
-}
-
-int GncAgent::probes_kept() const {
-  return probes_->kept();
-}
-
 void GncAgent::begin_probe(double tls, std::vector<std::uint64_t> flip,
                            std::vector<OutgoingMessage>& out) {
   // Every agent holds every agent's probe list (the verdict exchange) and runs the same cluster
