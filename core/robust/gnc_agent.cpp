@@ -14,6 +14,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "robust/gnc_exchange.hpp"
+#include "robust/gnc_kept_start_votes.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
 #include "robust/gnc_mailbox.hpp"
@@ -45,7 +46,8 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
       static_cast<long long>(kMaxGncSteps))
     throw InputError("RobustOptions.max_outer_iterations + readmission_passes must be <= " +
                      std::to_string(kMaxGncSteps - 4) + " for the distributed solve");
-  fresh_start_ = in_.kept_set_start && in_.initialization == DistributedInit::kChordal;
+  kept_votes_ = std::make_unique<GncKeptStartVotes>(
+      in_.kept_set_start && in_.initialization == DistributedInit::kChordal);
   dropped_.assign(in_.measurements.size(), false);
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
@@ -127,25 +129,13 @@ bool GncAgent::final_solve_runs() const {
   return options_.solver.certify || options_.robust.final_refine;
 }
 
-bool GncAgent::final_vote_settled() const {
-  // The fresh start of a set voted on before costs what that vote summed; an iterate solved to
-  // the tolerance on the same set that ends clearly below it wins the vote (the margin covers
-  // the two sums' different order of terms).
-  if (!std::isfinite(last_pass_cost_)) return false;
-  for (const auto& [set, cost] : fresh_start_costs_)
-    if (set == rejected_ && last_pass_cost_ < cost - 1e-9 * std::abs(cost)) return true;
-  return false;
-}
-
 void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   // Before the final solve (here or the caller's): is the passes' iterate worse over the kept
   // set than the kept set's own fresh start (GncDistributedOptions::final_kept_set_start)? Then
   // it is a fold, and the passes judged their set on it: they run again from the fresh start.
-  // Not when the outcome is already known (final_vote_settled): the iterate stays.
-  if (final_solve_runs() && fresh_start_ && options_.final_kept_set_start && !final_start_voted_ &&
-      !rejected_.empty() && !final_vote_settled()) {
-    final_start_voted_ = true;
-    final_start_vote_ = true;
+  // Not when the outcome is already known (GncKeptStartVotes): the iterate stays.
+  if (kept_votes_->final_vote_due(final_solve_runs() && options_.final_kept_set_start, rejected_)) {
+    kept_votes_->begin_final_vote();
     require_kept_connected();
     begin_exchange(Step::kKeptStart, out);
     return;
@@ -215,7 +205,8 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
   }
   if (stage_->kind() == GncSolveKind::kInlierPass) {
     last_pass_full_ = !pass_capped_;
-    last_pass_cost_ = pass_capped_ ? std::numeric_limits<double>::quiet_NaN() : stage_->last_cost();
+    kept_votes_->set_last_pass_cost(pass_capped_ ? std::numeric_limits<double>::quiet_NaN()
+                                                 : stage_->last_cost());
     if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
@@ -307,7 +298,7 @@ void GncAgent::after_rejected(std::vector<OutgoingMessage>& out) {
   std::sort(rejected_.begin(), rejected_.end());
   gnc_rejected_ = rejected_;
   // Nothing rejected: the GNC iterate is already the plain solve's.
-  if (fresh_start_ && !rejected_.empty()) {
+  if (kept_votes_->enabled() && !rejected_.empty()) {
     require_kept_connected();  // before initializing the kept set
     begin_exchange(Step::kKeptStart, out);
     return;
@@ -359,7 +350,7 @@ void GncAgent::after_pcm(std::vector<OutgoingMessage>& out) {
 
 void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {
   const auto [at_iterate, at_candidate] = exchange_->summed_votes();
-  fresh_start_costs_.emplace_back(rejected_, at_candidate);
+  const bool final_vote = kept_votes_->ended(rejected_, at_candidate);
   const bool fresh = at_candidate < at_iterate;
   if (fresh) {
     stage_->set_iterate(exchange_->candidate());
@@ -368,8 +359,7 @@ void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {
   exchange_->candidate().resize(0, 0);
   exchange_->forget_candidate_neighbours();
   last_pass_full_ = false;
-  if (final_start_vote_) {
-    final_start_vote_ = false;
+  if (final_vote) {
     if (!fresh) {
       finish(out);  // the iterate stays: on to the final solve
       return;

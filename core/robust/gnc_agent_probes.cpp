@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "robust/gnc_kept_start_votes.hpp"
 #include "robust/gnc_probe_stage.hpp"
 #include "robust/gnc_solve_stage.hpp"
 #include "robust/gnc_votes.hpp"
@@ -26,7 +27,7 @@ void GncAgent::begin_probe(double tls, std::vector<std::uint64_t> flip,
   last_pass_full_ = false;
   // The iterate was bent around what the probe cut, and a local solve keeps such a fold; the
   // kept set's fresh start (voted on its cost, as after GNC) does not have it.
-  if (fresh_start_) {
+  if (kept_votes_->enabled()) {
     require_kept_connected();
     begin_exchange(Step::kKeptStart, out);
     return;

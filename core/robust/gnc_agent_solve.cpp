@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "robust/gnc_exchange.hpp"
+#include "robust/gnc_kept_start_votes.hpp"
 #include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
 #include "robust/gnc_outer_loop.hpp"
@@ -63,7 +64,8 @@ void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out, std::vector<Outgo
 bool GncAgent::gather_values_early() const {
   // Not with pcm-gnc (its check gathers at agent 0 already, and consumes them) nor without a
   // fresh start to use them; the same on every agent.
-  return options_.robust.exchanges_ride_along && fresh_start_ && !in_.pcm && in_.num_agents > 1;
+  return options_.robust.exchanges_ride_along && kept_votes_->enabled() && !in_.pcm &&
+         in_.num_agents > 1;
 }
 
 bool GncAgent::send_poses_with_trial() const {

@@ -133,13 +133,14 @@ struct GncAgentInput {
 /// passes over the kept set, and the final solve of the kept set.
 enum class GncSolveKind { kGnc, kInlierPass, kFinal };
 
-class GncLocalTerms;    // internal: the TLS math over one agent's view
-struct RecheckVerdict;  // internal: an inlier pass's re-check
-class GncSolveStage;    // internal: each step's solve, its layout and iterate
-class GncProbeStage;    // internal: probes after the re-check passes
-class GncMailbox;       // internal: where incoming messages go
-class GncExchangeBook;  // internal: the exchanges' messages and what they carry
-class GncOuterLoop;     // internal: mu, its steps and the stop decision
+class GncLocalTerms;      // internal: the TLS math over one agent's view
+struct RecheckVerdict;    // internal: an inlier pass's re-check
+class GncSolveStage;      // internal: each step's solve, its layout and iterate
+class GncProbeStage;      // internal: probes after the re-check passes
+class GncKeptStartVotes;  // internal: the kept set's fresh start against the iterate
+class GncMailbox;         // internal: where incoming messages go
+class GncExchangeBook;    // internal: the exchanges' messages and what they carry
+class GncOuterLoop;       // internal: mu, its steps and the stop decision
 
 class GncAgent : public AgentProcess {
  public:
@@ -278,17 +279,8 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<GncSolveStage> stage_;  // the running solve, its layout and the iterate
   std::uint32_t g_ = 0;                   // GNC step
   std::uint32_t first_solve_g_ = 0;       // 1 after a start vote (step 0 is the vote's)
-  bool fresh_start_ = false;              // the kept set's fresh start (kept_set_start, chordal)
-  bool final_start_voted_ = false;        // the vote before the final solve ran (once)
-  bool final_start_vote_ = false;         // the running candidate vote is that one
-  // Every kept-set vote so far: the rejected set it was taken on and its fresh start's summed
-  // cost over the kept set (a function of the set). With last_pass_cost_ they tell when the vote
-  // before the final solve would keep the iterate (final_vote_settled()).
-  std::vector<std::pair<std::vector<std::uint64_t>, double>> fresh_start_costs_;
-  // The kept set's summed cost at the end of the last inlier pass when that pass was solved to
-  // the tolerance (the solve's last trace record, the same on every agent); NaN otherwise.
-  double last_pass_cost_ = std::numeric_limits<double>::quiet_NaN();
-  bool final_vote_settled() const;
+  // The kept set's fresh start (kept_set_start, chordal): its votes against the iterate.
+  std::unique_ptr<GncKeptStartVotes> kept_votes_;
   std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
   int pass_ = 0;                   // inlier passes done
