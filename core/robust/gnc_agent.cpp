@@ -1,28 +1,27 @@
 // GncAgent's state machine: its construction, the outer loop's transitions after each solve and
-// each exchange (after_solve, after_exchange), the end of the run and its result. The solves are
-// gnc_agent_solve.cpp, the exchanges gnc_agent_exchanges.cpp, the probes gnc_agent_probes.cpp.
+// each exchange (after_solve, after_exchange) and the end of the run. The solves are
+// gnc_agent_solve.cpp, the exchanges gnc_agent_exchanges.cpp, the probes gnc_agent_probes.cpp,
+// the results gnc_agent_results.cpp.
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <tessera/distributed/coarse_space.hpp>
-#include <tessera/distributed/stage_tag.hpp>
 #include <tessera/robust/gnc_agent.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
 #include <tessera/util/input_error.hpp>
 
-#include "robust/gnc_cluster_search.hpp"
 #include "robust/gnc_exchange.hpp"
+#include "robust/gnc_kept_start_votes.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
 #include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
 #include "robust/gnc_outer_loop.hpp"
-#include "robust/gnc_probes.hpp"
-#include "robust/gnc_solve_setup.hpp"
+#include "robust/gnc_probe_stage.hpp"
+#include "robust/gnc_solve_stage.hpp"
 #include "robust/gnc_votes.hpp"
 
 namespace tessera {
@@ -47,64 +46,31 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
       static_cast<long long>(kMaxGncSteps))
     throw InputError("RobustOptions.max_outer_iterations + readmission_passes must be <= " +
                      std::to_string(kMaxGncSteps - 4) + " for the distributed solve");
-  fresh_start_ = in_.kept_set_start && in_.initialization == DistributedInit::kChordal;
+  kept_votes_ = std::make_unique<GncKeptStartVotes>(
+      in_.kept_set_start && in_.initialization == DistributedInit::kChordal);
   dropped_.assign(in_.measurements.size(), false);
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
-  layout_ = std::make_unique<BlockLayout>(*base_);
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
+  stage_ =
+      std::make_unique<GncSolveStage>(in_, options_, terms_->known_connected(), std::move(in_.Y0));
   exchange_ = std::make_unique<GncExchangeBook>(in_, *terms_, *base_);
   mail_ = std::make_unique<GncMailbox>(in_.id);
   outer_ = std::make_unique<GncOuterLoop>();
   recheck_ = std::make_unique<RecheckVerdict>();
-  // With cluster probes the search (gnc_cluster_search.hpp) splits the budget: recheck_probes
-  // tail probes, cluster_probes cluster, pair and return probes.
-  probes_ = std::make_unique<GncProbes>(options_.robust.recheck_probes + options_.cluster_probes);
-  if (options_.cluster_probes > 0)
-    search_ = std::make_unique<GncClusterSearch>(in_.structure, terms_->known(),
-                                                 options_.robust.recheck_probes,
-                                                 options_.cluster_probes, options_.clusters);
+  probes_ =
+      std::make_unique<GncProbeStage>(in_, options_, terms_->known(), terms_->known_connected());
   weights_.assign(m, 1.0);
 }
 
 GncAgent::~GncAgent() = default;
 
-double GncAgent::threshold_squared() const {
-  return terms_->c2();
-}
-
-int GncAgent::outer_iterations() const {
-  return outer_->outer();
-}
-
-bool GncAgent::weights_converged() const {
-  return outer_->converged();
-}
-
-int GncAgent::total_rounds() const {
-  return gnc_rounds_ + final_rounds_;
-}
-
-GncAgentResult GncAgent::result() const {
-  GncAgentResult r;
-  r.outer_iterations = outer_iterations();
-  r.rejected.assign(rejected_.begin(), rejected_.end());
-  r.readmitted = readmitted_;
-  r.threshold_squared = threshold_squared();
-  r.weights_converged = weights_converged();
-  r.probes = probes();
-  r.probes_kept = probes_kept();
-  r.refine_message_steps = gnc_refine_steps_;
-  r.exchange_steps = exchange_steps_;
-  r.solve_stages = gnc_solve_stages_;
-  return r;
-}
-
 int GncAgent::weights_at_mu(double mu) {
   int crossed = 0;
   for (std::size_t k : terms_->owned())
     if (terms_->may_reject(k) && !dropped_[k]) {
-      const double w = tls_weight(terms_->residual_squared(k, state_->Y, exchange_->neighbours()),
-                                  terms_->c2(), mu);
+      const double w =
+          tls_weight(terms_->residual_squared(k, stage_->iterate(), exchange_->neighbours()),
+                     terms_->c2(), mu);
       if ((w >= 0.5) != (weights_[k] >= 0.5)) ++crossed;
       weights_[k] = w;
     }
@@ -163,25 +129,13 @@ bool GncAgent::final_solve_runs() const {
   return options_.solver.certify || options_.robust.final_refine;
 }
 
-bool GncAgent::final_vote_settled() const {
-  // The fresh start of a set voted on before costs what that vote summed; an iterate solved to
-  // the tolerance on the same set that ends clearly below it wins the vote (the margin covers
-  // the two sums' different order of terms).
-  if (!std::isfinite(last_pass_cost_)) return false;
-  for (const auto& [set, cost] : fresh_start_costs_)
-    if (set == rejected_ && last_pass_cost_ < cost - 1e-9 * std::abs(cost)) return true;
-  return false;
-}
-
 void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   // Before the final solve (here or the caller's): is the passes' iterate worse over the kept
   // set than the kept set's own fresh start (GncDistributedOptions::final_kept_set_start)? Then
   // it is a fold, and the passes judged their set on it: they run again from the fresh start.
-  // Not when the outcome is already known (final_vote_settled): the iterate stays.
-  if (final_solve_runs() && fresh_start_ && options_.final_kept_set_start && !final_start_voted_ &&
-      !rejected_.empty() && !final_vote_settled()) {
-    final_start_voted_ = true;
-    final_start_vote_ = true;
+  // Not when the outcome is already known (GncKeptStartVotes): the iterate stays.
+  if (kept_votes_->final_vote_due(final_solve_runs() && options_.final_kept_set_start, rejected_)) {
+    kept_votes_->begin_final_vote();
     require_kept_connected();
     begin_exchange(Step::kKeptStart, out);
     return;
@@ -193,7 +147,7 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   }
   // The certificate once, on the set that stays (re-admission ran on uncertified solves: the
   // staircase may raise the rank, which a further pass could not start from).
-  solve_kind_ = GncSolveKind::kFinal;
+  stage_->to_final();
   ++g_;
   begin_solve(out);
 }
@@ -225,21 +179,12 @@ void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   // Agent 0: the kept set's initialization, each agent's block sent, its own kept.
   const Eigen::MatrixXd X = kept_set_start(exchange_->kept_values(), in_, rejected_.size(),
-                                           static_cast<int>(state_->Y.rows()));
-  // With values_held_, each agent's neighbours' poses of the start too (the poses of other
-  // agents at the ends of its measurements, as GncLocalTerms::neighbours() lists them): no pose
-  // exchange of the start follows.
+                                           static_cast<int>(stage_->iterate().rows()));
+  // With values_held_, each agent's neighbours' poses of the start too: no pose exchange of the
+  // start follows.
   std::vector<std::vector<std::size_t>> nb(static_cast<std::size_t>(in_.num_agents));
   if (values_held_) {
-    for (const auto& [i, j] : in_.structure)
-      if (in_.owner[i] != in_.owner[j]) {
-        nb[static_cast<std::size_t>(in_.owner[i])].push_back(j);
-        nb[static_cast<std::size_t>(in_.owner[j])].push_back(i);
-      }
-    for (auto& ids : nb) {
-      std::sort(ids.begin(), ids.end());
-      ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    }
+    nb = cut_neighbours(in_);
     exchange_->candidate_neighbours() = block_of(X, terms_->neighbours(), in_.d);
   }
   for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
@@ -252,20 +197,16 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
 }
 
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
-  if (solve_kind_ == GncSolveKind::kFinal) {
-    final_rounds_ += solve_->total_rounds();
+  stage_->tally();
+  if (stage_->kind() == GncSolveKind::kFinal) {
     done_ = true;
     step_ = Step::kDone;
     return;
   }
-  gnc_rounds_ += solve_->total_rounds();
-  gnc_solve_stages_ += opened_solve_stages(solve_->solves());
-  gnc_refine_steps_ += message_steps(solve_->refines());
-  if (solve_kind_ == GncSolveKind::kInlierPass) {
+  if (stage_->kind() == GncSolveKind::kInlierPass) {
     last_pass_full_ = !pass_capped_;
-    last_pass_cost_ = std::numeric_limits<double>::quiet_NaN();
-    if (!pass_capped_ && !solve_->solves().empty() && !solve_->solves().back().trace.empty())
-      last_pass_cost_ = solve_->solves().back().trace.back().cost;
+    kept_votes_->set_last_pass_cost(pass_capped_ ? std::numeric_limits<double>::quiet_NaN()
+                                                 : stage_->last_cost());
     if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
@@ -288,12 +229,7 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     begin_rejected(out);
     return;
   }
-  if (poses_sent_early_) {
-    // The trial's poses are the iterate's when the step was accepted (the same on every agent:
-    // the verdict is on summed values); otherwise the iterate is the solve's start.
-    const std::vector<NewtonRefineResult>& r = solve_->refines();
-    poses_early_stale_ = !(r.size() == 1 && r.front().accepted_steps == 1);
-  }
+  if (stage_->poses_sent_early()) stage_->judge_early_poses();
   begin_exchange(Step::kPoses, out);
 }
 
@@ -301,7 +237,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
   switch (step_) {
     case Step::kPoses:
       neighbours_current_ = true;
-      if (solve_kind_ == GncSolveKind::kInlierPass)
+      if (stage_->kind() == GncSolveKind::kInlierPass)
         begin_exchange(Step::kReadmitted, out);
       else
         begin_exchange(outer_->started() ? Step::kWeights : Step::kVotes, out);
@@ -313,40 +249,11 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       else
         begin_exchange(Step::kWeights, out);
       return;
-    case Step::kWeights: {
-      const auto [spread, crossed] = exchange_->summed_votes();
-      const bool jump =
-          outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
-                               options_.robust, gnc_newton_steps_);
-      jumped_ = jump;
-      if (jump)
-        for (std::size_t k = 0; k < weights_.size(); ++k)
-          if (terms_->may_reject(k) && !dropped_[k])
-            weights_[k] = tls_verdict_weight(weights_[k], outer_->mu());
-      if (weight_observer_) weight_observer_(outer_->outer(), in_.measurement_index, weights_);
-      if (jump) {
-        begin_rejected(out);
-        return;
-      }
-      if (terms_->known_connected()) {
-        // This step's block layout: without the cut measurements of weight 0 (every agent's).
-        std::sort(zero_cut_.begin(), zero_cut_.end());
-        solve_without(zero_cut_);
-      }
-      ++g_;
-      begin_solve(out);
+    case Step::kWeights:
+      after_weights(out);
       return;
-    }
     case Step::kRejected:
-      std::sort(rejected_.begin(), rejected_.end());
-      gnc_rejected_ = rejected_;
-      // Nothing rejected: the GNC iterate is already the plain solve's.
-      if (fresh_start_ && !rejected_.empty()) {
-        require_kept_connected();  // before initializing the kept set
-        begin_exchange(Step::kKeptStart, out);
-        return;
-      }
-      begin_inlier_pass(out);
+      after_rejected(out);
       return;
     case Step::kKeptStart:
       if (in_.id == 0) start_kept_set(out);
@@ -358,30 +265,15 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       }
       begin_exchange(Step::kCandidatePoses, out);
       return;
-    case Step::kPcm: {
-      if (in_.id == 0) {
-        const std::vector<std::uint64_t> ids =
-            inconsistent_closures(exchange_->kept_values(), in_, *terms_);
-        RoundStatusMessage st;
-        st.measurement_ids = ids;
-        broadcast_status(std::move(st), 0, gnc_phase(g_, GncExchange::kPcmDropped), in_.num_agents,
-                         out);
-        drop_inconsistent(ids);
-      } else {
-        drop_inconsistent(exchange_->pcm_dropped());
-      }
-      if (in_.Y0_known.size() > 0)
-        begin_exchange(Step::kStartPoses, out);
-      else
-        after_step_zero(out);
+    case Step::kPcm:
+      after_pcm(out);
       return;
-    }
     case Step::kStartPoses:
       begin_exchange(Step::kStartVotes, out);
       return;
     case Step::kStartVotes: {
       const auto [at_start, at_known] = exchange_->summed_votes();
-      if (at_known < at_start) in_.Y0 = std::move(in_.Y0_known);
+      if (at_known < at_start) stage_->set_start(std::move(in_.Y0_known));
       in_.Y0_known.resize(0, 0);
       exchange_->forget_candidate_neighbours();
       after_step_zero(out);
@@ -391,87 +283,135 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       neighbours_current_ = true;
       begin_exchange(Step::kCandidateVotes, out);
       return;
-    case Step::kCandidateVotes: {
-      const auto [at_iterate, at_candidate] = exchange_->summed_votes();
-      fresh_start_costs_.emplace_back(rejected_, at_candidate);
-      const bool fresh = at_candidate < at_iterate;
-      if (fresh) {
-        state_->Y = exchange_->candidate();
-        neighbours_current_ = false;
-      }
-      exchange_->candidate().resize(0, 0);
-      exchange_->forget_candidate_neighbours();
-      last_pass_full_ = false;
-      if (final_start_vote_) {
-        final_start_vote_ = false;
-        if (!fresh) {
-          finish(out);  // the iterate stays: on to the final solve
-          return;
-        }
-        pass_ = 0;  // the passes again, with their own budget
-      }
-      begin_inlier_pass(out);
+    case Step::kCandidateVotes:
+      after_candidate_votes(out);
       return;
-    }
-    case Step::kReadmitted: {
-      ++pass_;
-      if (recheck_->empty()) {
-        // No change at a rough solution: the same set once more, solved to the tolerance; but a
-        // pass that started from a solved pass only settled that pass's flips, and its verdict
-        // stands (RobustOptions::recheck_confirm_solved) when a solve to the tolerance follows.
-        const bool confirmed =
-            options_.robust.recheck_confirm_solved && pass_from_solved_ && final_solve_runs();
-        if (pass_capped_ && !confirmed) {
-          full_pass_next_ = true;
-          begin_inlier_pass(out);
-          return;
-        }
-        const double tls = exchange_->summed_votes().first;
-        if (probes_->running()) {
-          const double before = probes_->base_tls();
-          if (!probes_->keeps(rejected_, tls)) {
-            restore_before_probe(out, tls - before);
-            return;
-          }
-          if (search_) search_->kept();
-        }
-        if (search_) {
-          // The verdict lists of the set that stays: the tail and the return band of its probes.
-          search_->set_list(recheck_->probe);
-          if (may_probe())
-            if (std::optional<std::vector<std::uint64_t>> flip = search_->next(rejected_)) {
-              begin_probe(tls, std::move(*flip), out);
-              return;
-            }
-          finish(out);
-          return;
-        }
-        if (may_probe()) {
-          std::vector<std::uint64_t> flip = probe_flips(std::move(recheck_->probe));
-          if (!flip.empty()) {
-            begin_probe(tls, std::move(flip), out);
-            return;
-          }
-        }
-        finish(out);
-        return;
-      }
-      const RecheckCounts counts =
-          apply_recheck(*recheck_, in_.measurement_index, rejected_, weights_);
-      readmitted_ += counts.readmitted;
-      late_rejected_ += counts.late_rejected;
-      if (probes_->back_at_base(rejected_)) {
-        // The passes took back exactly what the probe changed: it ends here, not kept (its
-        // TLS cost could differ from the base's only by the solves' accuracy).
-        restore_before_probe(out);
-        return;
-      }
-      begin_inlier_pass(out);
+    case Step::kReadmitted:
+      after_verdict(out);
       return;
-    }
     default:
       return;
   }
+}
+
+void GncAgent::after_rejected(std::vector<OutgoingMessage>& out) {
+  std::sort(rejected_.begin(), rejected_.end());
+  gnc_rejected_ = rejected_;
+  // Nothing rejected: the GNC iterate is already the plain solve's.
+  if (kept_votes_->enabled() && !rejected_.empty()) {
+    require_kept_connected();  // before initializing the kept set
+    begin_exchange(Step::kKeptStart, out);
+    return;
+  }
+  begin_inlier_pass(out);
+}
+
+void GncAgent::after_weights(std::vector<OutgoingMessage>& out) {
+  const auto [spread, crossed] = exchange_->summed_votes();
+  const bool jump =
+      outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
+                           options_.robust, stage_->newton_steps_only());
+  jumped_ = jump;
+  if (jump)
+    for (std::size_t k = 0; k < weights_.size(); ++k)
+      if (terms_->may_reject(k) && !dropped_[k])
+        weights_[k] = tls_verdict_weight(weights_[k], outer_->mu());
+  if (weight_observer_) weight_observer_(outer_->outer(), in_.measurement_index, weights_);
+  if (jump) {
+    begin_rejected(out);
+    return;
+  }
+  if (terms_->known_connected()) {
+    // This step's block layout: without the cut measurements of weight 0 (every agent's).
+    std::sort(zero_cut_.begin(), zero_cut_.end());
+    solve_without(zero_cut_);
+  }
+  ++g_;
+  begin_solve(out);
+}
+
+void GncAgent::after_pcm(std::vector<OutgoingMessage>& out) {
+  if (in_.id == 0) {
+    const std::vector<std::uint64_t> ids =
+        inconsistent_closures(exchange_->kept_values(), in_, *terms_);
+    RoundStatusMessage st;
+    st.measurement_ids = ids;
+    broadcast_status(std::move(st), 0, gnc_phase(g_, GncExchange::kPcmDropped), in_.num_agents,
+                     out);
+    drop_inconsistent(ids);
+  } else {
+    drop_inconsistent(exchange_->pcm_dropped());
+  }
+  if (in_.Y0_known.size() > 0)
+    begin_exchange(Step::kStartPoses, out);
+  else
+    after_step_zero(out);
+}
+
+void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {
+  const auto [at_iterate, at_candidate] = exchange_->summed_votes();
+  const bool final_vote = kept_votes_->ended(rejected_, at_candidate);
+  const bool fresh = at_candidate < at_iterate;
+  if (fresh) {
+    stage_->set_iterate(exchange_->candidate());
+    neighbours_current_ = false;
+  }
+  exchange_->candidate().resize(0, 0);
+  exchange_->forget_candidate_neighbours();
+  last_pass_full_ = false;
+  if (final_vote) {
+    if (!fresh) {
+      finish(out);  // the iterate stays: on to the final solve
+      return;
+    }
+    pass_ = 0;  // the passes again, with their own budget
+  }
+  begin_inlier_pass(out);
+}
+
+void GncAgent::after_verdict(std::vector<OutgoingMessage>& out) {
+  ++pass_;
+  if (recheck_->empty()) {
+    after_unchanged_verdict(out);
+    return;
+  }
+  const RecheckCounts counts = apply_recheck(*recheck_, in_.measurement_index, rejected_, weights_);
+  readmitted_ += counts.readmitted;
+  late_rejected_ += counts.late_rejected;
+  if (probes_->back_at_base(rejected_)) {
+    // The passes took back exactly what the probe changed: it ends here, not kept (its
+    // TLS cost could differ from the base's only by the solves' accuracy).
+    restore_before_probe(out);
+    return;
+  }
+  begin_inlier_pass(out);
+}
+
+void GncAgent::after_unchanged_verdict(std::vector<OutgoingMessage>& out) {
+  // No change at a rough solution: the same set once more, solved to the tolerance; but a pass
+  // that started from a solved pass only settled that pass's flips, and its verdict stands
+  // (RobustOptions::recheck_confirm_solved) when a solve to the tolerance follows.
+  const bool confirmed =
+      options_.robust.recheck_confirm_solved && pass_from_solved_ && final_solve_runs();
+  if (pass_capped_ && !confirmed) {
+    full_pass_next_ = true;
+    begin_inlier_pass(out);
+    return;
+  }
+  const double tls = exchange_->summed_votes().first;
+  if (probes_->running()) {
+    const double before = probes_->base_tls();
+    if (!probes_->keeps(rejected_, tls)) {
+      restore_before_probe(out, tls - before);
+      return;
+    }
+  }
+  if (std::optional<std::vector<std::uint64_t>> flip = probes_->next(
+          std::move(recheck_->probe), rejected_, gnc_rejected_, stage_->newton_steps_only())) {
+    begin_probe(tls, std::move(*flip), out);
+    return;
+  }
+  finish(out);
 }
 
 std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {
@@ -486,14 +426,14 @@ std::vector<OutgoingMessage> GncAgent::handle(const ProtocolMessage& message) {
 
 std::size_t GncAgent::messages_needed() const {
   if (done_) return 0;
-  if (step_ == Step::kSolve) return std::max<std::size_t>(solve_->messages_needed(), 1);
+  if (step_ == Step::kSolve) return std::max<std::size_t>(stage_->solve().messages_needed(), 1);
   return mail_->messages_needed();
 }
 
 std::optional<AwaitedMessages> GncAgent::awaited() const {
   if (done_) return std::nullopt;
   if (step_ == Step::kSolve) {
-    std::optional<AwaitedMessages> a = solve_->awaited();
+    std::optional<AwaitedMessages> a = stage_->solve().awaited();
     if (a) a->phase += g_ * kGncStepStride;
     return a;
   }

@@ -15,7 +15,8 @@
 #include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
 #include "robust/gnc_outer_loop.hpp"
-#include "robust/gnc_probes.hpp"
+#include "robust/gnc_probe_stage.hpp"
+#include "robust/gnc_solve_stage.hpp"
 #include "robust/gnc_votes.hpp"
 
 namespace tessera {
@@ -36,145 +37,155 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   // A gather at agent 0 (the consistency check's values, the kept set's start) waits twice: for
   // the values, then for agent 0's answer.
   // The poses sent beside a weighted solve's trial sums are no step of their own.
-  const bool early = step == Step::kPoses && poses_sent_early_;
+  const bool early = step == Step::kPoses && stage_->poses_sent_early();
   exchange_steps_ += step == Step::kPcm || (step == Step::kKeptStart && !values_held_) ? 2
                      : early                                                           ? 0
                                                                                        : 1;
+  if (step == Step::kKeptStart && values_held_ && in_.id == 0) {
+    // The kept ones of the values held since mu's start: nothing to wait for.
+    GatheredValues& kept = exchange_->kept_values();
+    kept.clear();
+    for (const auto& v : exchange_->held_values())
+      if (!std::binary_search(rejected_.begin(), rejected_.end(), v.first)) kept.push_back(v);
+    after_exchange(out);
+    return;
+  }
   bool values_too = false;  // agent 0's exchange takes the others' values beside their status
   // Whom this agent hears from: a pose exchange from its block neighbours (each sends what it
-  // was sent), a status exchange from every other agent.
-  std::vector<int> from = base_->adjacent[static_cast<std::size_t>(in_.id)];
-  // A status to every other agent, each of which answers with its own.
-  auto to_others = [&](RoundStatusMessage st) {
-    from = as_ints(other_agents(me, in_.num_agents));
-    broadcast_status(std::move(st), me, phase, in_.num_agents, out);
-  };
+  // was sent), a status exchange from every other agent, each of which answers with its own.
+  std::vector<int> from = as_ints(other_agents(me, in_.num_agents));
   switch (step) {
     case Step::kPoses:
-      // Weights are computed at the iterate itself: the owners' public poses of every
-      // measurement (the base layout: a measurement out of the current solve still needs
-      // its residual).
-      if (early) {
-        if (!poses_early_stale_) exchange_->expect_poses(state_->Y.rows(), false);
-        break;
-      }
-      exchange_->expect_poses(state_->Y.rows(), false);
-      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
-      break;
     case Step::kStartPoses:
-      // Both starts' public poses: the solver's initialization (kind Y) and the known
-      // inliers' (kind P).
-      exchange_->expect_poses(in_.Y0.rows(), true);
-      exchange_->publish(in_.Y0, BlockKind::kY, phase, out);
-      exchange_->publish(in_.Y0_known, BlockKind::kP, phase, out);
-      break;
-    case Step::kStartVotes:
-      // The TLS cost of each measurement at both starts, summed by its weight owner.
-      exchange_->own_vote() = start_vote_costs(*terms_, in_.Y0, exchange_->neighbours(),
-                                               in_.Y0_known, exchange_->candidate_neighbours());
-      to_others(vote_message(exchange_->own_vote()));
+    case Step::kCandidatePoses:
+      send_poses(phase, out);
+      from = base_->adjacent[static_cast<std::size_t>(in_.id)];
       break;
     case Step::kPcm:
       from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kPcmValues), nullptr, out);
       break;
     case Step::kKeptStart:
-      if (values_held_) {
-        if (in_.id == 0) {
-          // The kept ones of the values held since mu's start: nothing to wait for.
-          GatheredValues& kept = exchange_->kept_values();
-          kept.clear();
-          for (const auto& v : exchange_->held_values())
-            if (!std::binary_search(rejected_.begin(), rejected_.end(), v.first)) kept.push_back(v);
-          after_exchange(out);
-          return;
-        }
-        from = {0};  // agent 0's answer
-        break;
-      }
-      from = exchange_->gather_values_at_lead(gnc_phase(g_, GncExchange::kKeptValues), &rejected_,
-                                              out);
+      from = values_held_ ? std::vector<int>{0}  // agent 0's answer
+                          : exchange_->gather_values_at_lead(
+                                gnc_phase(g_, GncExchange::kKeptValues), &rejected_, out);
       break;
-    case Step::kCandidatePoses:
-      // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
-      exchange_->expect_poses(state_->Y.rows(), true);
-      exchange_->publish(state_->Y, BlockKind::kY, phase, out);
-      exchange_->publish(exchange_->candidate(), BlockKind::kP, phase, out);
-      break;
-    case Step::kCandidateVotes:
-      // Each kept measurement's cost at both starts, summed by its weight owner.
-      exchange_->own_vote() = kept_set_costs(*terms_, in_.measurement_index, rejected_, state_->Y,
-                                             exchange_->neighbours(), exchange_->candidate(),
-                                             exchange_->candidate_neighbours());
-      to_others(vote_message(exchange_->own_vote()));
-      break;
-    case Step::kVotes:
-      // mu's start needs the largest residual over every measurement that may be rejected.
-      exchange_->own_vote() = {
-          largest_rejectable_residual(*terms_, dropped_, state_->Y, exchange_->neighbours()), 0};
-      to_others(vote_message(exchange_->own_vote()));
-      break;
-    case Step::kWeights: {
-      low_weights_.clear();
-      const int crossed = weights_at_mu(outer_->mu());
-      const double spread = weight_spread(*terms_, weights_);
-      const int near =
-          options_.robust.jump_band > 0
-              ? near_bound_count(*terms_, dropped_, state_->Y, exchange_->neighbours(),
-                                 options_.robust.jump_band, options_.robust.jump_band_inside)
-              : 1;
-      exchange_->own_vote() = {spread, crossed};
-      exchange_->own_near_bound() = near;
-      zero_cut_ =
-          zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
-      const std::vector<std::uint32_t> others = other_agents(me, in_.num_agents);
-      from = as_ints(others);
-      for (std::uint32_t a : others) {
-        RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_,
-                                                options_.robust.exchanges_ride_along);
-        st.phase = phase;
-        st.sender = me;
-        out.push_back(OutgoingMessage{std::move(st), false, {a}});
-      }
-      if (gather_values_early() && !values_held_) {
-        // Beside the first weights (clean data has none), once: the values of the measurements
-        // this agent weighs, to agent 0.
-        values_held_ = true;
-        if (in_.id == 0) {
-          values_too = true;
-          exchange_->held_values().clear();
-          append_owned_values(in_, *terms_, nullptr, exchange_->held_values());
-        } else {
-          out.push_back(
-              OutgoingMessage{owned_values_block(in_, *terms_, nullptr, phase), false, {0}});
-        }
-      }
-      break;
-    }
-    case Step::kRejected: {
-      rejected_ = rejected_by_weight(*terms_, in_.measurement_index, weights_);
-      RoundStatusMessage st;
-      st.measurement_ids = rejected_;
-      to_others(std::move(st));
-      break;
-    }
-    case Step::kReadmitted:
-      // TLS's own verdict at the kept set's solution (gnc_votes.hpp); every agent gathers all.
-      // With it the probe's list (only used when nothing else changes) and the TLS cost a probe
-      // is judged by.
-      *recheck_ = recheck_verdict(
-          *terms_, in_.measurement_index, rejected_, state_->Y, exchange_->neighbours(),
-          probes_->may_follow(terms_->known_connected(), options_.robust.readmission_passes)
-              ? options_.robust.probe_ratio
-              : 0.0,
-          options_.robust.probe_tail_ratio);
-      exchange_->own_vote() = {tls_cost(*terms_, state_->Y, exchange_->neighbours()), 0};
-      to_others(readmitted_message(*recheck_, exchange_->own_vote().first));
+    case Step::kWeights:
+      values_too = send_weights(phase, out);
       break;
     default:
+      send_status(phase, out);
       break;
   }
   mail_->begin_exchange(phase, std::move(from), values_too);
   take_exchange(out);
+}
+
+void GncAgent::send_poses(std::uint32_t phase, std::vector<OutgoingMessage>& out) {
+  const Eigen::MatrixXd& Y = stage_->iterate();  // the iterate, or the start before a solve
+  switch (step_) {
+    case Step::kPoses:
+      // Weights are computed at the iterate itself: the owners' public poses of every
+      // measurement (the base layout: a measurement out of the current solve still needs
+      // its residual).
+      if (stage_->poses_sent_early()) {
+        if (!stage_->poses_early_stale()) exchange_->expect_poses(Y.rows(), false);
+        return;
+      }
+      exchange_->expect_poses(Y.rows(), false);
+      exchange_->publish(Y, BlockKind::kY, phase, out);
+      return;
+    case Step::kStartPoses:
+      // Both starts' public poses: the solver's initialization (kind Y) and the known
+      // inliers' (kind P).
+      exchange_->expect_poses(Y.rows(), true);
+      exchange_->publish(Y, BlockKind::kY, phase, out);
+      exchange_->publish(in_.Y0_known, BlockKind::kP, phase, out);
+      return;
+    default:  // Step::kCandidatePoses
+      // Both starts' public poses: the iterate's (kind Y) and the other one's (kind P).
+      exchange_->expect_poses(Y.rows(), true);
+      exchange_->publish(Y, BlockKind::kY, phase, out);
+      exchange_->publish(exchange_->candidate(), BlockKind::kP, phase, out);
+      return;
+  }
+}
+
+void GncAgent::send_status(std::uint32_t phase, std::vector<OutgoingMessage>& out) {
+  const Eigen::MatrixXd& Y = stage_->iterate();  // the iterate, or the start before a solve
+  RoundStatusMessage st;
+  switch (step_) {
+    case Step::kStartVotes:
+      // The TLS cost of each measurement at both starts, summed by its weight owner.
+      exchange_->own_vote() = start_vote_costs(*terms_, Y, exchange_->neighbours(), in_.Y0_known,
+                                               exchange_->candidate_neighbours());
+      st = vote_message(exchange_->own_vote());
+      break;
+    case Step::kCandidateVotes:
+      // Each kept measurement's cost at both starts, summed by its weight owner.
+      exchange_->own_vote() =
+          kept_set_costs(*terms_, in_.measurement_index, rejected_, Y, exchange_->neighbours(),
+                         exchange_->candidate(), exchange_->candidate_neighbours());
+      st = vote_message(exchange_->own_vote());
+      break;
+    case Step::kVotes:
+      // mu's start needs the largest residual over every measurement that may be rejected.
+      exchange_->own_vote() = {
+          largest_rejectable_residual(*terms_, dropped_, Y, exchange_->neighbours()), 0};
+      st = vote_message(exchange_->own_vote());
+      break;
+    case Step::kRejected:
+      rejected_ = rejected_by_weight(*terms_, in_.measurement_index, weights_);
+      st.measurement_ids = rejected_;
+      break;
+    case Step::kReadmitted:
+      // TLS's own verdict at the kept set's solution (gnc_votes.hpp); every agent gathers all.
+      // With it the probe's list (only used when nothing else changes) and the TLS cost a probe
+      // is judged by.
+      *recheck_ =
+          recheck_verdict(*terms_, in_.measurement_index, rejected_, Y, exchange_->neighbours(),
+                          probes_->may_follow() ? options_.robust.probe_ratio : 0.0,
+                          options_.robust.probe_tail_ratio);
+      exchange_->own_vote() = {tls_cost(*terms_, Y, exchange_->neighbours()), 0};
+      st = readmitted_message(*recheck_, exchange_->own_vote().first);
+      break;
+    default:  // not a status exchange: begin_exchange() sends it otherwise
+      throw std::logic_error("GncAgent: no status exchange at this step");
+  }
+  broadcast_status(std::move(st), static_cast<std::uint32_t>(in_.id), phase, in_.num_agents, out);
+}
+
+bool GncAgent::send_weights(std::uint32_t phase, std::vector<OutgoingMessage>& out) {
+  const auto me = static_cast<std::uint32_t>(in_.id);
+  low_weights_.clear();
+  const int crossed = weights_at_mu(outer_->mu());
+  const double spread = weight_spread(*terms_, weights_);
+  const int near =
+      options_.robust.jump_band > 0
+          ? near_bound_count(*terms_, dropped_, stage_->iterate(), exchange_->neighbours(),
+                             options_.robust.jump_band, options_.robust.jump_band_inside)
+          : 1;
+  exchange_->own_vote() = {spread, crossed};
+  exchange_->own_near_bound() = near;
+  zero_cut_ =
+      zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
+  for (std::uint32_t a : other_agents(me, in_.num_agents)) {
+    RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_,
+                                            options_.robust.exchanges_ride_along);
+    st.phase = phase;
+    st.sender = me;
+    out.push_back(OutgoingMessage{std::move(st), false, {a}});
+  }
+  if (!gather_values_early() || values_held_) return false;
+  // Beside the first weights (clean data has none), once: the values of the measurements this
+  // agent weighs, to agent 0.
+  values_held_ = true;
+  if (in_.id != 0) {
+    out.push_back(OutgoingMessage{owned_values_block(in_, *terms_, nullptr, phase), false, {0}});
+    return false;
+  }
+  exchange_->held_values().clear();
+  append_owned_values(in_, *terms_, nullptr, exchange_->held_values());
+  return true;  // agent 0 takes the others' values beside their weights
 }
 
 GncExchange GncAgent::exchange() const {
@@ -212,10 +223,10 @@ void GncAgent::take_exchange(std::vector<OutgoingMessage>& out) {
   if (!ready) return;
   // Read into the book, or the agent's own data the exchange changes.
   for (const ProtocolMessage& m : *ready)
-    if (!(step_ == Step::kPoses && poses_early_stale_))
+    if (!(step_ == Step::kPoses && stage_->poses_early_stale()))
       exchange_->read(exchange(), m,
                       GncExchangeTargets{weights_, zero_cut_, low_weights_, rejected_, *recheck_,
-                                         state_ ? state_->Y.rows() : in_.Y0.rows()});
+                                         stage_->iterate().rows()});
   after_exchange(out);
 }
 

@@ -58,4 +58,18 @@ Eigen::MatrixXd kept_set_start(GatheredValues& values, const GncAgentInput& in,
   return lift_poses(initial_poses(kept, in.initialization, in.num_agents), r);
 }
 
+std::vector<std::vector<std::size_t>> cut_neighbours(const GncAgentInput& in) {
+  std::vector<std::vector<std::size_t>> nb(static_cast<std::size_t>(in.num_agents));
+  for (const auto& [i, j] : in.structure)
+    if (in.owner[i] != in.owner[j]) {
+      nb[static_cast<std::size_t>(in.owner[i])].push_back(j);
+      nb[static_cast<std::size_t>(in.owner[j])].push_back(i);
+    }
+  for (auto& ids : nb) {
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  }
+  return nb;
+}
+
 }  // namespace tessera

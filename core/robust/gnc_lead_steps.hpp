@@ -29,4 +29,9 @@ std::vector<std::uint64_t> inconsistent_closures(GatheredValues& values, const G
 Eigen::MatrixXd kept_set_start(GatheredValues& values, const GncAgentInput& in,
                                std::size_t rejected, int r);
 
+/// For every agent, the poses of other agents at the ends of its measurements (ascending), as
+/// GncLocalTerms::neighbours() lists them on that agent: what agent 0 sends each agent beside
+/// its block of the kept set's start.
+std::vector<std::vector<std::size_t>> cut_neighbours(const GncAgentInput& in);
+
 }  // namespace tessera

@@ -133,13 +133,14 @@ struct GncAgentInput {
 /// passes over the kept set, and the final solve of the kept set.
 enum class GncSolveKind { kGnc, kInlierPass, kFinal };
 
-class GncLocalTerms;     // internal: the TLS math over one agent's view
-struct RecheckVerdict;   // internal: an inlier pass's re-check
-class GncProbes;         // internal: probes after the re-check passes
-class GncClusterSearch;  // internal: which probe next, with cluster probes
-class GncMailbox;        // internal: where incoming messages go
-class GncExchangeBook;   // internal: the exchanges' messages and what they carry
-class GncOuterLoop;      // internal: mu, its steps and the stop decision
+class GncLocalTerms;      // internal: the TLS math over one agent's view
+struct RecheckVerdict;    // internal: an inlier pass's re-check
+class GncSolveStage;      // internal: each step's solve, its layout and iterate
+class GncProbeStage;      // internal: probes after the re-check passes
+class GncKeptStartVotes;  // internal: the kept set's fresh start against the iterate
+class GncMailbox;         // internal: where incoming messages go
+class GncExchangeBook;    // internal: the exchanges' messages and what they carry
+class GncOuterLoop;       // internal: mu, its steps and the stop decision
 
 class GncAgent : public AgentProcess {
  public:
@@ -179,11 +180,11 @@ class GncAgent : public AgentProcess {
   int probes_kept() const;
   double threshold_squared() const;
   /// Rounds of the solves before the final certified one (first, weighted, inlier passes).
-  int gnc_rounds() const { return gnc_rounds_; }
+  int gnc_rounds() const;
   /// Message steps (neighbour exchanges and all-agent sums) of the Newton refinements of those
   /// solves: GNC's weighted solves and the inlier passes solved to the tolerance where they hand
   /// over under `--refine auto` (gnc_solve_setup).
-  int gnc_refine_steps() const { return gnc_refine_steps_; }
+  int gnc_refine_steps() const;
   /// Message steps of GNC's own exchanges (the Step values other than kSolve: poses, votes,
   /// weights, rejected sets, re-check verdicts, start votes, gathers), each a wait for peers like
   /// a round: one per exchange, two per gather at agent 0 (the values in, agent 0's answer
@@ -191,26 +192,24 @@ class GncAgent : public AgentProcess {
   int exchange_steps() const { return exchange_steps_; }
   /// The own block at the start of the last inlier pass (what the caller of an agent without
   /// the final solve starts that pass from to get its full record).
-  const Eigen::MatrixXd& last_pass_start() const { return last_pass_start_; }
+  const Eigen::MatrixXd& last_pass_start() const;
   int total_rounds() const;
   /// The current weight of each of this agent's measurements (same order as the input's).
   const std::vector<double>& weights() const { return weights_; }
   const std::vector<std::uint64_t>& measurement_index() const { return in_.measurement_index; }
   /// The iterate: own block, lifted (after the final solve: of the kept set).
-  const AgentState& state() const { return *state_; }
+  const AgentState& state() const;
   /// The final solve (nullptr before it or without it), its layout and kept measurements.
   /// The last solve (the certified one, or the last inlier pass); valid once done().
-  const CertifiedAgent& last_solve() const { return *solve_; }
-  const CertifiedAgent* final_sequence() const {
-    return solve_kind_ == GncSolveKind::kFinal ? solve_.get() : nullptr;
-  }
+  const CertifiedAgent& last_solve() const;
+  const CertifiedAgent* final_sequence() const;
   /// Whether a final solve of the kept set follows the inlier passes (with certification or
   /// RobustOptions::final_refine); otherwise the last pass, solved to the tolerance, is the
   /// answer.
   bool final_solve_runs() const;
-  const BlockLayout& layout() const { return *layout_; }
-  const std::vector<Measurement>& kept_measurements() const { return kept_; }
-  const std::vector<std::uint64_t>& kept_index() const { return kept_index_; }
+  const BlockLayout& layout() const;
+  const std::vector<Measurement>& kept_measurements() const;
+  const std::vector<std::uint64_t>& kept_index() const;
 
  private:
   enum class Step {
@@ -232,13 +231,27 @@ class GncAgent : public AgentProcess {
   void begin_exchange(Step step, std::vector<OutgoingMessage>& out);
   void after_solve(std::vector<OutgoingMessage>& out);
   void after_exchange(std::vector<OutgoingMessage>& out);
+  // What the exchange of each kind sends (the current step's): the poses of the iterate and
+  // of a second start; a status to every other agent; the weights (true when agent 0 takes the
+  // others' values beside them).
+  void send_poses(std::uint32_t phase, std::vector<OutgoingMessage>& out);
+  void send_status(std::uint32_t phase, std::vector<OutgoingMessage>& out);
+  bool send_weights(std::uint32_t phase, std::vector<OutgoingMessage>& out);
+  // after_exchange() of the steps with more to decide.
+  void after_weights(std::vector<OutgoingMessage>& out);
+  void after_rejected(std::vector<OutgoingMessage>& out);
+  void after_pcm(std::vector<OutgoingMessage>& out);
+  void after_candidate_votes(std::vector<OutgoingMessage>& out);
+  void after_verdict(std::vector<OutgoingMessage>& out);
+  // A re-check verdict that changes nothing: a pass to the tolerance, a probe, or the end.
+  void after_unchanged_verdict(std::vector<OutgoingMessage>& out);
   // One message of the running solve, handed to it; after_solve() when that ends the solve.
   void to_solve(const ProtocolMessage& m, std::vector<OutgoingMessage>& out);
   // The current exchange's messages once all are in: read, then after_exchange().
   void take_exchange(std::vector<OutgoingMessage>& out);
   GncExchange exchange() const;  // the current step's, as this agent sends or awaits it
   // The inner solve's messages, tagged with this GNC step; with them the trial point's poses
-  // when the solve just sent its trial sums (send_poses_with_trial).
+  // when the solve just handed one out (send_poses_with_trial).
   void pass_on(std::vector<OutgoingMessage> solve_out, std::vector<OutgoingMessage>& out);
   // Whether this weighted solve's trial point, if accepted, is the iterate whose poses the next
   // weight update needs: a single Newton step, not the last weighted solve.
@@ -247,7 +260,6 @@ class GncAgent : public AgentProcess {
   void solve_without(const std::vector<std::uint64_t>& dropped);
   int weights_at_mu(double mu);         // the count of owned weights that crossed 1/2
   void require_kept_connected() const;  // throws InputError naming the parts left
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> solve_structure() const;
   // GNC's rejected set: from the last weight exchange where there was one, else an exchange.
   void begin_rejected(std::vector<OutgoingMessage>& out);
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
@@ -255,10 +267,6 @@ class GncAgent : public AgentProcess {
   void start_kept_set(std::vector<OutgoingMessage>& out);
   void after_step_zero(std::vector<OutgoingMessage>& out);
   void drop_inconsistent(const std::vector<std::uint64_t>& ids);
-  bool may_probe() const;  // RobustOptions::recheck_probes
-  // The part of a probe list the probe flips: all of it, or, while the set is still GNC's own
-  // and RobustOptions::probe_cut says so, only the rejected ones (the return side).
-  std::vector<std::uint64_t> probe_flips(std::vector<std::uint64_t> listed) const;
   // A probe from the current set (summed TLS cost `tls`): the measurements of `flip` change side.
   void begin_probe(double tls, std::vector<std::uint64_t> flip, std::vector<OutgoingMessage>& out);
   // Undoes the running probe (its TLS cost `rise` above the set before it; 0 when no verdict
@@ -268,26 +276,13 @@ class GncAgent : public AgentProcess {
   GncAgentInput in_;
   const GncDistributedOptions& options_;
   bool final_solve_wanted_;
-  DistributedOptions solve_options_;  // the running solve's options
-  std::unique_ptr<BlockLayout> layout_;
-  std::unique_ptr<AgentState> state_;
-  std::unique_ptr<CertifiedAgent> solve_;
-  std::uint32_t g_ = 0;              // GNC step
-  std::uint32_t first_solve_g_ = 0;  // 1 after a start vote (step 0 is the vote's)
-  bool fresh_start_ = false;         // the kept set's fresh start (kept_set_start, chordal)
-  bool final_start_voted_ = false;   // the vote before the final solve ran (once)
-  bool final_start_vote_ = false;    // the running candidate vote is that one
-  // Every kept-set vote so far: the rejected set it was taken on and its fresh start's summed
-  // cost over the kept set (a function of the set). With last_pass_cost_ they tell when the vote
-  // before the final solve would keep the iterate (final_vote_settled()).
-  std::vector<std::pair<std::vector<std::uint64_t>, double>> fresh_start_costs_;
-  // The kept set's summed cost at the end of the last inlier pass when that pass was solved to
-  // the tolerance (the solve's last trace record, the same on every agent); NaN otherwise.
-  double last_pass_cost_ = std::numeric_limits<double>::quiet_NaN();
-  bool final_vote_settled() const;
+  std::unique_ptr<GncSolveStage> stage_;  // the running solve, its layout and the iterate
+  std::uint32_t g_ = 0;                   // GNC step
+  std::uint32_t first_solve_g_ = 0;       // 1 after a start vote (step 0 is the vote's)
+  // The kept set's fresh start (kept_set_start, chordal): its votes against the iterate.
+  std::unique_ptr<GncKeptStartVotes> kept_votes_;
   std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
-  GncSolveKind solve_kind_ = GncSolveKind::kGnc;
   int pass_ = 0;                   // inlier passes done
   bool pass_capped_ = false;       // the current pass stops at RobustOptions::recheck_max_rounds
   bool full_pass_next_ = false;    // the next pass is solved to the tolerance
@@ -296,9 +291,8 @@ class GncAgent : public AgentProcess {
   std::size_t readmitted_ = 0;
   std::unique_ptr<RecheckVerdict> recheck_;  // the current re-check exchange's, every agent's
   std::size_t late_rejected_ = 0;
-  std::unique_ptr<GncProbes> probes_;         // RobustOptions::recheck_probes
-  std::unique_ptr<GncClusterSearch> search_;  // GncDistributedOptions::cluster_probes (> 0)
-  std::vector<std::uint64_t> zero_cut_;       // cut measurements of weight 0 (others' too)
+  std::unique_ptr<GncProbeStage> probes_;  // RobustOptions::recheck_probes, cluster_probes
+  std::vector<std::uint64_t> zero_cut_;    // cut measurements of weight 0 (others' too)
   // The other agents' measurements of weight below 1/2 at the last weight exchange, and whether
   // that exchange ended GNC at TLS's verdict (RobustOptions::jump_band).
   std::vector<std::pair<std::uint64_t, double>> low_weights_;
@@ -312,29 +306,15 @@ class GncAgent : public AgentProcess {
   // exchange since the iterate last moved). With values_held_ the kept set's fresh start then
   // needs no pose exchange: agent 0 sends each agent its neighbours' poses of the start too.
   bool neighbours_current_ = false;
-  std::unique_ptr<BlockLayout> base_;     // of every measurement: whose poses go where
-  std::unique_ptr<GncLocalTerms> terms_;  // the TLS math over this agent's view
-  Eigen::MatrixXd last_pass_start_;
+  std::unique_ptr<BlockLayout> base_;          // of every measurement: whose poses go where
+  std::unique_ptr<GncLocalTerms> terms_;       // the TLS math over this agent's view
   std::vector<double> weights_;                // per in_.measurements
   std::unique_ptr<GncMailbox> mail_;           // where incoming messages go
   std::unique_ptr<GncExchangeBook> exchange_;  // the exchanges' messages and state
   std::unique_ptr<GncOuterLoop> outer_;        // mu, its steps, the outer-step count, the stop
   std::vector<std::uint64_t> rejected_;
   std::vector<std::uint64_t> gnc_rejected_;  // GNC's own set, before the passes (ascending)
-  // Every weighted solve of GNC so far was a Newton step (gnc_refines), and there was one.
-  bool gnc_newton_steps_ = false;
-  // The running weighted solve's trial point (own block) and whether its public poses still
-  // have to go out: they travel beside the trial's sums as this step's pose exchange
-  // (poses_sent_early_), so the exchange after the solve waits for nothing. When the trial is
-  // not accepted (poses_early_stale_) the iterate has not moved since the last pose exchange,
-  // whose poses stay; the early ones are read and dropped.
-  Eigen::MatrixXd trial_Y_;
-  bool trial_pending_ = false, poses_sent_early_ = false, poses_early_stale_ = false;
-  int weighted_solves_ = 0;
-  std::vector<Measurement> kept_;
-  std::vector<std::uint64_t> kept_index_;
-  int gnc_rounds_ = 0, final_rounds_ = 0, gnc_refine_steps_ = 0, exchange_steps_ = 0;
-  int gnc_solve_stages_ = 0;  // before the final solve
+  int exchange_steps_ = 0;
   bool done_ = false;
   std::function<void(int, const std::vector<std::uint64_t>&, const std::vector<double>&)>
       weight_observer_;
