@@ -90,7 +90,7 @@ const char* kHelp =
     "  --gnc-step-sigma every|refine-sigma   robust distributed: who factors the interface\n"
     "                            solves' matrix in GNC's weighted Newton steps: every agent\n"
     "                            (no wait for agent 0's solve), or as --refine-sigma says; the\n"
-    "                            same iterates [every]\n"
+    "                            same iterates [refine-sigma]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {

@@ -106,6 +106,34 @@ TEST(NewtonRefineSigma, EveryAgentTakesTheSameStepsInAnyDeliveryOrderWithSigmaSo
                                                      7);
 }
 
+// NewtonRefineOptions::analyses: a run that keeps its agents' interface factors between
+// refinements analyses a pattern once; a refinement on a pattern its factors hold factors
+// numerically only and takes the same steps to the same bits, one on another pattern analyses.
+TEST(NewtonRefineSigma, ARefinementOnThePatternOfTheStoredFactorsSkipsTheirAnalysesToTheSameBits) {
+  const PoseGraph g = test::refine_chain(600, 3), h = test::refine_chain(480, 3);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  const std::vector<int> h_parts = sequential_partition(h.num_poses, 4);
+  DistributedOptions o = refined(SigmaFactoring::kEveryAgent);
+  const DistributedResult fresh = solve_distributed(g, parts, o);
+  const DistributedResult h_fresh = solve_distributed(h, h_parts, o);
+  ASSERT_EQ(fresh.refines.size(), 1u);
+  ASSERT_EQ(h_fresh.refines.size(), 1u);
+  // The block's factor and Sigma's, each analysed once in the refinement.
+  EXPECT_GE(fresh.refines[0].interface_analyses, 2);
+  o.refine.analyses = make_interface_analysis_store();
+  const DistributedResult first = solve_distributed(g, parts, o);
+  const DistributedResult again = solve_distributed(g, parts, o);
+  const DistributedResult other = solve_distributed(h, h_parts, o);
+  ASSERT_EQ(first.refines.size(), 1u);
+  ASSERT_EQ(again.refines.size(), 1u);
+  ASSERT_EQ(other.refines.size(), 1u);
+  EXPECT_EQ(first.refines[0].interface_analyses, fresh.refines[0].interface_analyses);
+  EXPECT_EQ(again.refines[0].interface_analyses, 0);
+  EXPECT_EQ(other.refines[0].interface_analyses, h_fresh.refines[0].interface_analyses);
+  expect_same_refinement(fresh, again);
+  expect_same_refinement(h_fresh, other);
+}
+
 TEST(NewtonRefineSigma, RefineSigmaNamesTheThreeWaysAndSolveIsTheDefault) {
   EXPECT_EQ(sigma_mode(NewtonRefineOptions{}), "solve");
   NewtonRefineOptions m;

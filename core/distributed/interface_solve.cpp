@@ -43,6 +43,48 @@ bool interface_fits(const NewtonRefineOptions& r, const BlockLayout& layout, int
   return size > 0 && size <= r.interface_max_coordinates;
 }
 
+struct InterfaceFactors {
+  // The block's factor A_bb = L L^T in the order below, and the same at a trial point
+  // (factor_pending), the current one's until commit_pending() (both patterns are the same at
+  // every point: one analysis each).
+  std::unique_ptr<SupernodalFactor> block =
+      std::make_unique<SupernodalFactor>(SupernodalFactor::Ordering::kGiven);
+  std::unique_ptr<SupernodalFactor> pending;
+  // Sigma + eta I, not grounded and grounded: two patterns, so two analyses that a point which
+  // falls back from one to the other keeps.
+  SupernodalFactor sigma[2];
+  // The block's Hessian A_bb (lower triangle, the order below) and Sigma (not grounded,
+  // grounded), as positions laid out once and values written at each point
+  // (solvers/triplet_scatter.hpp).
+  TripletScatter block_pattern, sigma_pattern[2];
+  // Analyses run by the factors above so far.
+  int analyses() const {
+    return block->analyses() + (pending ? pending->analyses() : 0) + sigma[0].analyses() +
+           sigma[1].analyses();
+  }
+};
+
+InterfaceAnalysisStore::InterfaceAnalysisStore() = default;
+InterfaceAnalysisStore::~InterfaceAnalysisStore() = default;
+
+std::unique_ptr<InterfaceFactors> InterfaceAnalysisStore::take(int id) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  auto it = held_.find(id);
+  if (it == held_.end() || !it->second) return std::make_unique<InterfaceFactors>();
+  std::unique_ptr<InterfaceFactors> out = std::move(it->second);
+  held_.erase(it);
+  return out;
+}
+
+void InterfaceAnalysisStore::give(int id, std::unique_ptr<InterfaceFactors> factors) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  held_[id] = std::move(factors);
+}
+
+std::shared_ptr<InterfaceAnalysisStore> make_interface_analysis_store() {
+  return std::make_shared<InterfaceAnalysisStore>();
+}
+
 struct InterfaceSolve::Impl {
   int d = 0, w = 0, p = 0;
   Eigen::Index m = 0, mI = 0, mG = 0;  // poses: all, interior, interface
@@ -53,30 +95,32 @@ struct InterfaceSolve::Impl {
   TeamInterface team;  // the team's interface in Sigma, in tangent coordinates
   Eigen::Index own_offset = 0;
   int id = 0;
-  // The block's factor A_bb = L L^T in the order above, and L's trailing interface block (both
-  // patterns are the same at every point: one analysis each); and the same at a trial point
-  // (factor_pending), the current one's until commit_pending().
-  std::unique_ptr<SupernodalFactor> block =
-      std::make_unique<SupernodalFactor>(SupernodalFactor::Ordering::kGiven);
-  std::unique_ptr<SupernodalFactor> pending;
+  // The factors (InterfaceFactors), from the store where there is one, and the analyses they had
+  // run before; L's trailing interface block at the current point and at a trial point.
+  std::shared_ptr<InterfaceAnalysisStore> store;
+  std::unique_ptr<InterfaceFactors> f;
+  int analyses_before = 0;
+  bool block_checked = false;  // A_bb's positions compared with f->block_pattern's
   Eigen::MatrixXd Lgg, pending_Lgg;
-  // Sigma + eta I.
-  SupernodalFactor sigma;
   bool sigma_ok = false;
   bool sigma_here = false;  // sigma_ok from this agent's own factor (not adopt_remote_sigma())
   bool grounded = false;    // the team's first interface pose held fixed (its p coordinates)
   double shift = 0.0;
-  int pattern = -1;  // the pattern sigma was last factored on: 1 grounded, 0 not, -1 none
-  // The block's Hessian A_bb (lower triangle, the order above) and Sigma (grounded or not), as
-  // positions laid out once and values written at each point (solvers/triplet_scatter.hpp).
-  TripletScatter block_pattern, sigma_pattern[2];
+  int pattern = -1;  // the Sigma factor last factored: 1 grounded, 0 not, -1 none
   std::vector<double> block_values;
   mutable Eigen::VectorXd b;  // scratch: J^T v in the block's own order
 };
 
-InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& layout, int id)
+InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& layout, int id,
+                               std::shared_ptr<InterfaceAnalysisStore> store)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
+  s.store = std::move(store);
+  s.f = s.store ? s.store->take(id) : std::make_unique<InterfaceFactors>();
+  // The trial points' factor takes the block factor's analysis when first needed (a copy, where
+  // one held from another refinement may be of another pattern).
+  s.f->pending.reset();
+  s.analyses_before = s.f->analyses();
   s.d = problem.dim();
   s.w = s.d + 1;
   if (s.d != 2 && s.d != 3) throw std::invalid_argument("InterfaceSolve: d must be 2 or 3");
@@ -140,7 +184,14 @@ InterfaceSolve::InterfaceSolve(const BlockProblem& problem, const BlockLayout& l
   }
 }
 
-InterfaceSolve::~InterfaceSolve() = default;
+InterfaceSolve::~InterfaceSolve() {
+  Impl& s = *impl_;
+  if (s.store && s.f) s.store->give(s.id, std::move(s.f));
+}
+
+int InterfaceSolve::analyses() const {
+  return impl_->f->analyses() - impl_->analyses_before;
+}
 
 Eigen::Index InterfaceSolve::team_size() const {
   return impl_->team.size;
@@ -182,20 +233,20 @@ std::vector<double> InterfaceSolve::factor(const Eigen::MatrixXd& X, const Eigen
 std::vector<double> InterfaceSolve::factor_pending(const Eigen::MatrixXd& X,
                                                    const Eigen::MatrixXd& Xn,
                                                    const Eigen::MatrixXd& egrad) {
-  Impl& s = *impl_;
-  if (!s.pending) {
+  InterfaceFactors& f = *impl_->f;
+  if (!f.pending) {
     // The current factor's analysis (the pattern is the same at every point): a numeric
     // factorization only, as at the current point.
-    s.pending = std::make_unique<SupernodalFactor>(SupernodalFactor::Ordering::kGiven);
-    s.pending->adopt_analysis(*s.block);
+    f.pending = std::make_unique<SupernodalFactor>(SupernodalFactor::Ordering::kGiven);
+    f.pending->adopt_analysis(*f.block);
   }
   return factor_impl(X, Xn, egrad, true, true);
 }
 
 void InterfaceSolve::commit_pending() {
   Impl& s = *impl_;
-  if (!s.pending) throw std::logic_error("InterfaceSolve::commit_pending: no pending factor");
-  std::swap(s.block, s.pending);
+  if (!s.f->pending) throw std::logic_error("InterfaceSolve::commit_pending: no pending factor");
+  std::swap(s.f->block, s.f->pending);
   std::swap(s.Lgg, s.pending_Lgg);
   s.sigma_ok = false;
 }
@@ -208,15 +259,17 @@ std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const 
   if (X.rows() != d || X.cols() != w * s.m || egrad.rows() != d || egrad.cols() != X.cols() ||
       Xn.rows() != d)
     throw std::invalid_argument("InterfaceSolve::factor: not a rank-d point of the block");
-  SupernodalFactor& block = pending ? *s.pending : *s.block;
+  SupernodalFactor& block = pending ? *s.f->pending : *s.f->block;
   Eigen::MatrixXd& Lgg = pending ? s.pending_Lgg : s.Lgg;
   const auto skew = skew_pairs(d);
   std::vector<Eigen::MatrixXd> G(static_cast<std::size_t>(s.m));
   for (Eigen::Index i = 0; i < s.m; ++i)
     G[static_cast<std::size_t>(i)] = pose_basis(X.block(0, i * w, d, d), skew);
   const Eigen::Index n = s.m * p;
-  // A's positions are the same at every point: laid out once, then only the values are written.
-  const bool layout = !s.block_pattern.built();
+  // A's positions are the same at every point: compared with the held layout at the first one
+  // (a store's factors may hold another block's), then only the values are written.
+  const bool layout = !s.block_checked;
+  TripletScatter& block_pattern = s.f->block_pattern;
   std::vector<int> rows, cols;
   std::vector<double>& vals = s.block_values;
   vals.clear();
@@ -251,13 +304,14 @@ std::vector<double> InterfaceSolve::factor_impl(const Eigen::MatrixXd& X, const 
         }
       }
   }
-  if (layout) {
+  if (layout && !block_pattern.matches(n, rows, cols)) {
     // The pose pairs are distinct, so no position repeats.
-    if (!s.block_pattern.build(n, rows, cols))
+    if (!block_pattern.build(n, rows, cols))
       throw std::logic_error("InterfaceSolve: a repeated entry in the block's Hessian");
   }
-  s.block_pattern.fill(vals);
-  const bool ok = n > 0 && block.factor(s.block_pattern.matrix());
+  s.block_checked = true;
+  block_pattern.fill(vals);
+  const bool ok = n > 0 && block.factor(block_pattern.matrix());
   // Far from a minimiser the block's Hessian may be indefinite: then its block without the
   // multiplier term (positive definite, as block Jacobi's), and Sigma is the Schur complement
   // of that modified H, still a symmetric positive definite preconditioner.
@@ -343,7 +397,7 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
     }
     // Sigma's positions are those of the last point's unless the shares' layout changed.
     const std::vector<Eigen::Triplet<double>>& e = ground ? g : t;
-    TripletScatter& scatter = s.sigma_pattern[ground ? 1 : 0];
+    TripletScatter& scatter = s.f->sigma_pattern[ground ? 1 : 0];
     SparseMatrix summed;  // where a position repeats (not from well-formed shares): summed
     if (!scatter.assign(s.team.size, e)) {
       summed.resize(s.team.size, s.team.size);
@@ -353,7 +407,7 @@ bool InterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blo
     for (double rel : relative_shifts) {
       const double eta = rel * std::max(top, 1e-300);
       s.pattern = ground ? 1 : 0;
-      if (s.sigma.factor(sigma, eta)) {
+      if (s.f->sigma[s.pattern].factor(sigma, eta)) {
         s.sigma_ok = true;
         s.sigma_here = true;
         s.grounded = ground;
@@ -369,7 +423,7 @@ std::vector<double> InterfaceSolve::sigma_values() const {
   const Impl& s = *impl_;
   if (!s.sigma_ok) return {0.0};
   std::vector<double> v{1.0, s.grounded ? 1.0 : 0.0, s.shift};
-  const std::vector<double> x = s.sigma.values();
+  const std::vector<double> x = s.f->sigma[s.grounded ? 1 : 0].values();
   v.insert(v.end(), x.begin(), x.end());
   return v;
 }
@@ -378,7 +432,8 @@ bool InterfaceSolve::import_sigma(const double* v, std::size_t count) {
   Impl& s = *impl_;
   if (count < 3 || v[0] != 1.0) return false;
   const bool ground = v[1] != 0.0;
-  if (s.pattern != (ground ? 1 : 0) || !s.sigma.import_values(v + 3, count - 3)) return false;
+  if (s.pattern != (ground ? 1 : 0) || !s.f->sigma[s.pattern].import_values(v + 3, count - 3))
+    return false;
   s.sigma_ok = true;
   s.sigma_here = true;
   s.grounded = ground;
@@ -406,7 +461,7 @@ void InterfaceSolve::forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
   y.resize(s.m * p);
   for (Eigen::Index i = 0; i < s.m; ++i)
     y.segment(s.slot[static_cast<std::size_t>(i)] * p, p) = s.b.segment(i * p, p);
-  s.block->solve_l(y);
+  s.f->block->solve_l(y);
 }
 
 void InterfaceSolve::add_interface(const Eigen::VectorXd& y, double* team) const {
@@ -435,9 +490,9 @@ Eigen::VectorXd InterfaceSolve::solve(const Eigen::VectorXd& rhat) const {
   if (s.grounded) {
     Eigen::VectorXd r = rhat;
     r.head(s.p).setZero();
-    s.sigma.solve(r, u);
+    s.f->sigma[1].solve(r, u);
   } else {
-    s.sigma.solve(rhat, u);
+    s.f->sigma[0].solve(rhat, u);
   }
   return u;
 }
@@ -458,7 +513,7 @@ Eigen::MatrixXd InterfaceSolve::back_own(const Eigen::MatrixXd& X, const Eigen::
   Eigen::VectorXd v(y.size());
   v.head(nI) = y.head(nI);
   if (nG > 0) v.tail(nG) = s.Lgg.transpose() * Eigen::Map<const Eigen::VectorXd>(u_own, nG);
-  s.block->solve_lt(v);
+  s.f->block->solve_lt(v);
   for (Eigen::Index i = 0; i < s.m; ++i)
     s.b.segment(i * p, p) = v.segment(s.slot[static_cast<std::size_t>(i)] * p, p);
   const Eigen::Index ground = grounded_pose();

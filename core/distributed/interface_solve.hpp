@@ -11,7 +11,8 @@
 //   rhat_b = L_GG y_G (the interface's Schur-reduced residual),
 //   x_b = L^-T [y_I ; L_GG^T u_b],  z = J x   (= H^-1 r).
 // Both factors are CHOLMOD's supernodal LL^T (solvers/supernodal_factor.hpp), each analysed
-// once (their patterns do not change from point to point). Against Eigen's simplicial LDL^T
+// once (their patterns do not change from point to point), and with an InterfaceAnalysisStore
+// once per pattern across the refinements of a run (below). Against Eigen's simplicial LDL^T
 // (blocks) and LL^T (Sigma, AMD at every factorization), on city10000 at N = 5 (909 interface
 // coordinates, two points, in process; callgrind): the refinement 4.57 -> 1.46 billion
 // instructions, Sigma's assembly and factorizations 2.81 -> 0.52 (27.9 Mflop each, 151,785
@@ -39,7 +40,9 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/newton_refine.hpp>
 #include <tessera/problem/block_problem.hpp>
@@ -57,10 +60,39 @@ Eigen::Index interface_tangent_coordinates(const BlockLayout& layout, int dim);
 /// (CertifiedAgent's early hand-over, GNC's Newton steps).
 bool interface_fits(const NewtonRefineOptions& r, const BlockLayout& layout, int dim);
 
+/// An agent's interface-solve factors with their symbolic analyses (orderings, supernodes) and
+/// their matrices' layouts, as one InterfaceSolve leaves them (interface_solve.cpp).
+struct InterfaceFactors;
+
+/// Where the refinements of a run keep each agent's InterfaceFactors from one InterfaceSolve to
+/// the next (NewtonRefineOptions::analyses). Why: GNC's weighted solves are one refinement each,
+/// and each built its block's factor and Sigma's analysis afresh on patterns that mostly repeat
+/// (intel, 25 % random outliers: Sigma's analyses were half of its 1.65 G instructions). An
+/// InterfaceSolve takes its agent's factors and gives them back when it ends; a factor whose
+/// matrix has the pattern it was analysed on factors numerically only, the same factor to the
+/// bit, and one with another pattern is analysed again. Agents are keyed by id (in process
+/// every agent's refinements share one store); take and give are locked.
+class InterfaceAnalysisStore {
+ public:
+  InterfaceAnalysisStore();
+  ~InterfaceAnalysisStore();
+  InterfaceAnalysisStore(const InterfaceAnalysisStore&) = delete;
+  InterfaceAnalysisStore& operator=(const InterfaceAnalysisStore&) = delete;
+  /// Agent `id`'s factors, removed from the store (fresh ones where it holds none).
+  std::unique_ptr<InterfaceFactors> take(int id);
+  void give(int id, std::unique_ptr<InterfaceFactors> factors);
+
+ private:
+  std::mutex mutex_;
+  std::map<int, std::unique_ptr<InterfaceFactors>> held_;
+};
+
 class InterfaceSolve {
  public:
   /// `problem`: agent `id`'s block; `layout`: the team's. Builds the ordering (no values).
-  InterfaceSolve(const BlockProblem& problem, const BlockLayout& layout, int id);
+  /// `store` (may be null): where the factors come from and go back to (InterfaceAnalysisStore).
+  InterfaceSolve(const BlockProblem& problem, const BlockLayout& layout, int id,
+                 std::shared_ptr<InterfaceAnalysisStore> store = nullptr);
   ~InterfaceSolve();
   InterfaceSolve(const InterfaceSolve&) = delete;
   InterfaceSolve& operator=(const InterfaceSolve&) = delete;
@@ -111,6 +143,9 @@ class InterfaceSolve {
   Eigen::VectorXd solve(const Eigen::VectorXd& rhat) const;
   /// The shift the last assemble() factored with (relative), 0 before.
   double shift() const;
+  /// Symbolic analyses this solve ran (its block's factors and Sigma's, grounded or not): one
+  /// per pattern its factors did not hold already.
+  int analyses() const;
   /// The held pose, where the last assemble() grounded Sigma and this block owns the team's
   /// first interface pose: its local index (back() is zero there, whatever the residual);
   /// -1 on the other blocks and without grounding.

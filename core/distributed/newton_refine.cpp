@@ -293,7 +293,8 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
   // team's interface fits. The layout is the same on every agent, so is the decision.
   if (options_.interface_max_coordinates > 0 && !coarse_ &&
       static_cast<int>(rows_.size()) == problem_.dim() && layout_.num_blocks > 1) {
-    auto solve = std::make_unique<InterfaceSolve>(problem_, layout_, state_.id());
+    auto solve =
+        std::make_unique<InterfaceSolve>(problem_, layout_, state_.id(), options_.analyses);
     if (solve->team_size() > 0 && solve->team_size() <= options_.interface_max_coordinates) {
       result_.interface_coordinates = static_cast<int>(solve->team_size());
       if (options_.sigma_factoring == SigmaFactoring::kShipSolves &&
@@ -571,6 +572,7 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
 
 void NewtonRefineProtocol::finish(const std::string& why) {
   result_.stop_reason = why;
+  if (interface_) result_.interface_analyses = interface_->analyses();
   if (shares_ready_) ++result_.pending_factors_unused;  // the accepted trial's, not needed
   shares_ready_ = false;
   result_.times.wall_s = steady_s() - wall_start_;

@@ -78,8 +78,13 @@ std::optional<std::vector<Pose>> known_inlier_poses(const PoseGraph& graph,
 
 GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
                                            const std::vector<int>& assignment,
-                                           const GncDistributedOptions& options) {
-  options.validate();
+                                           const GncDistributedOptions& run_options) {
+  run_options.validate();
+  // The agents' refinements keep their factors' analyses from one solve to the next
+  // (NewtonRefineOptions::analyses; the agents hold these options by reference).
+  GncDistributedOptions options = run_options;
+  if (!options.solver.refine.analyses)
+    options.solver.refine.analyses = make_interface_analysis_store();
   if (!options.known_inlier_flags.empty() &&
       options.known_inlier_flags.size() != graph.num_measurements())
     throw std::invalid_argument("solve_gnc_distributed: one known-inlier flag per measurement");

@@ -18,6 +18,8 @@ RoundLoopResult run_gnc_round_loop(const AgentLocalData& local, ProtocolChannel&
   options.robust = local.options.robust;
   options.known_inlier_start = local.options.gnc_known_start;
   options.cluster_probes = local.options.gnc_cluster_probes;
+  // The refinements keep their factors' analyses from one solve to the next.
+  options.solver.refine.analyses = make_interface_analysis_store();
   if (options.solver.rank < local.d)
     throw std::runtime_error("rank " + std::to_string(options.solver.rank) +
                              " is below d = " + std::to_string(local.d));

@@ -51,6 +51,7 @@ namespace tessera {
 
 class TangentCoarseSpace;
 class InterfaceSolve;
+class InterfaceAnalysisStore;
 class PipelinedCg;
 class CoarseHessianColumns;
 class TranslationPreconditioner;
@@ -284,11 +285,21 @@ struct NewtonRefineOptions {
   /// instructions (every agent doing it 553 M over 3 points), at ais2klinik's 102 about
   /// (102 / 909)^3 of that, less than the wait for one more message. >= 0.
   int ship_solves_min_coordinates = 500;
+  /// Not a setting but where a run keeps its agents' interface-solve factors from one
+  /// refinement to the next (make_interface_analysis_store()); null (the default): each
+  /// refinement analyses its factors' patterns afresh. With a store, a refinement whose block
+  /// Hessian or Sigma has the pattern of the agent's previous refinement factors it numerically
+  /// only: the same factors to the bit, the same iterates. The distributed GNC sets one (its
+  /// weighted solves are one refinement each, on layouts that mostly repeat).
+  std::shared_ptr<InterfaceAnalysisStore> analyses;
   /// The CoarseOptions that build the kSmoothed space (make_coarse_space).
   CoarseOptions coarse_space_options() const;
   /// Throws InputError naming the bad field.
   void validate() const;
 };
+
+/// A store for NewtonRefineOptions::analyses (one per run, shared by its agents).
+std::shared_ptr<InterfaceAnalysisStore> make_interface_analysis_store();
 
 /// The `--refine` values as options: "none" (enabled off), "newton" (kAlways) or "auto"
 /// (kIfRoundsSlow). One parser for the command line, the coordinator, launch and the agents'
@@ -371,6 +382,9 @@ struct NewtonRefineResult {
   /// took from agent 0's factor (kShipFactor), and the block factorizations at trial points that
   /// were not used (a rejected trial, or the refinement stopped there).
   int sigma_factorizations = 0, sigma_imports = 0, pending_factors_unused = 0;
+  /// This agent's symbolic analyses of its interface solves' factors (its block's, Sigma's):
+  /// one per pattern its factors did not hold (NewtonRefineOptions::analyses).
+  int interface_analyses = 0;
   std::vector<NewtonRefineStep> trace;
   NewtonRefineTimes times;  ///< This agent's.
 };

@@ -277,16 +277,16 @@ struct RobustOptions {
   /// agent 0 alone factor it and send each agent its part of every solve (kShipSolves, the
   /// default where Sigma has at least ship_solves_min_coordinates coordinates); other
   /// factorings, the passes and the final solve keep the solver's. The same iterates either way.
-  /// Why: kShipSolves saves the agents' redundant factorizations at the price of one message
-  /// step per CG direction, which pays where a point has many directions; a weighted solve has
-  /// one point and, with exact interface solves, one direction, so it buys nothing there and
-  /// every agent waits for agent 0's solve instead. F = 0.25 random, 5 agents: intel 156 -> 149
-  /// message steps, CSAIL 73 -> 71, every intel and CSAIL cell of the benchmark (random and
-  /// group, 0.1 / 0.25 / 0.5) the same `--out` bytes and rejected set; the price, every agent
-  /// receiving and factoring every share: intel 18.8 -> 29.8 MB, 2.77 -> 3.76 G instructions
-  /// over all agents (docs/robust.md, "Who factors Sigma in GNC's Newton steps").
+  /// On, a weighted solve (one point, one CG direction) saves the message step of waiting for
+  /// agent 0's solve; the price is every agent receiving every share and factoring Sigma.
+  /// Off by default because that price is larger than the step it saves: F = 0.25 random, 5
+  /// agents, on against off: intel 149 against 156 message steps, 29.8 against 18.8 MB, 3.53
+  /// against 2.55 G instructions over all agents (+38 %; in process, callgrind, with the factors'
+  /// analyses kept across the weighted solves, NewtonRefineOptions::analyses); CSAIL 71 against
+  /// 73; every intel and CSAIL cell of the benchmark the same `--out` bytes and rejected set
+  /// (docs/robust.md, "Who factors Sigma in GNC's Newton steps").
   /// `tessera solve --gnc-step-sigma every|refine-sigma`.
-  bool step_sigma_every_agent = true;
+  bool step_sigma_every_agent = false;
   /// Distributed solvers only: GNC's exchanges ride on messages that are sent anyway, with the
   /// same values, so the run is the same but for its message steps (and bytes):
   /// - where a weighted solve is a single Newton step (gnc_refine_steps 1) that another weight
