@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "tesseraPubSubTypes.h"
+#include "transport/acknowledged_drop.hpp"
 #include "transport/fastdds/discovery_port.hpp"
 #include "transport/fastdds/shm_receive_watch.hpp"
 #include "transport/message_mapping.hpp"
@@ -62,6 +63,25 @@ bool write_patiently(dds::DataWriter* writer, Sample& sample) {
   return false;
 }
 
+// A writer whose readers are VOLATILE (pose blocks, statuses): it drops its acknowledged
+// samples (acknowledged_drop.hpp) instead of keeping its last kVolatileWriterHistory for the
+// whole mission. The lock makes the drop and the write one step.
+namespace {
+struct DroppingWriter {
+  dds::DataWriter* writer = nullptr;
+  std::mutex mutex;
+  AcknowledgedDrop drop;
+};
+}  // namespace
+template <class Sample>
+bool write_patiently(DroppingWriter& w, Sample& sample) {
+  std::lock_guard<std::mutex> lock(w.mutex);
+  w.drop.before_write(*w.writer);
+  if (!write_patiently(w.writer, sample)) return false;
+  w.drop.written();
+  return true;
+}
+
 struct OnlineChannel::Impl : public dds::DataReaderListener {
   std::string run_id;
   std::uint32_t agent;
@@ -74,7 +94,8 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
   dds::TypeSupport report_type{new wire::OnlineReportPubSubType()};
   dds::TypeSupport estimate_type{new wire::FinalEstimatePubSubType()};
   dds::DataWriter* estimate_writer = nullptr;
-  dds::DataWriter *block_writer = nullptr, *status_writer = nullptr, *report_writer = nullptr;
+  DroppingWriter block_writer, status_writer;
+  dds::DataWriter* report_writer = nullptr;
   dds::DataReader *block_reader = nullptr, *status_reader = nullptr, *report_reader = nullptr;
   std::mutex mutex;
   std::condition_variable cv;
@@ -160,8 +181,8 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       if (!writer || !reader)
         throw std::runtime_error(std::string("online channel: cannot create endpoints of ") + name);
     };
-    endpoints(kOnlineBlockTopic, block_type, false, block_writer, block_reader);
-    endpoints(kOnlineStatusTopic, status_type, false, status_writer, status_reader);
+    endpoints(kOnlineBlockTopic, block_type, false, block_writer.writer, block_reader);
+    endpoints(kOnlineStatusTopic, status_type, false, status_writer.writer, status_reader);
     // Reports are kept for readers that match later: the first epoch's reports may be sent
     // before every agent's reader is discovered.
     endpoints(kOnlineReportTopic, report_type, true, report_writer, report_reader);
@@ -358,7 +379,7 @@ std::vector<OnlineProtocolSample> OnlineChannel::take_messages() {
 
 int OnlineChannel::matched_peers() const {
   int fewest = 1 << 30;
-  for (auto* w : {impl_->block_writer, impl_->status_writer}) {
+  for (auto* w : {impl_->block_writer.writer, impl_->status_writer.writer}) {
     dds::PublicationMatchedStatus s;
     w->get_publication_matched_status(s);
     fewest = std::min(fewest, s.current_count);
@@ -372,7 +393,7 @@ int OnlineChannel::matched_peers() const {
 }
 
 void OnlineChannel::flush(double timeout_s) {
-  for (auto* w : {impl_->block_writer, impl_->status_writer, impl_->report_writer})
+  for (auto* w : {impl_->block_writer.writer, impl_->status_writer.writer, impl_->report_writer})
     w->wait_for_acknowledgments(Duration_t(timeout_s));
 }
 

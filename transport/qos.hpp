@@ -25,12 +25,13 @@ constexpr std::int32_t kWriterHistory = 16;
 /// a writer sending faster than kWriterHistory samples per heartbeat period stalled in
 /// write() until the next acknowledgement (measured: 5 agents broadcasting one status per
 /// step, 3-4% of the writes waited > 10 ms; mean step 2.4-3.0 ms -> 1.3-1.5 ms with 64). Such
-/// a writer drops the oldest acknowledged sample when a write needs room, and SampleWriter
-/// drops all of them once acknowledged, every kDropAcknowledgedEvery writes
-/// (sample_writing.hpp): the bound is for samples in flight, not kept. 256 because the distributed
-/// rounding writes one status per message step (~0.85 ms on 2 cores), ~59 per heartbeat
-/// period, and 64 filled at times (every agent's status writer at once, each write() then
-/// blocked for its 10 ms max_blocking_time and retried); 256 holds 50 ms of messages at 0.2 ms.
+/// a writer drops the oldest acknowledged sample when a write needs room, and its writing
+/// thread drops all of them once acknowledged, every kDropAcknowledgedEvery writes
+/// (acknowledged_drop.hpp): the bound is for samples in flight, not kept. 256 because the
+/// distributed rounding writes one status per message step (~0.85 ms on 2 cores), ~59 per
+/// heartbeat period, and 64 filled at times (every agent's status writer at once, each write()
+/// then blocked for its 10 ms max_blocking_time and retried); 256 holds 50 ms of messages at
+/// 0.2 ms.
 constexpr std::int32_t kVolatileWriterHistory = 256;
 /// Heartbeat period of the TRANSIENT_LOCAL writers (seconds, at most; the profile's period
 /// when shorter): they write a handful of samples per run (READY, ABORT, FINISHED, the

@@ -27,15 +27,16 @@ void SampleWriter::write_raw(const std::string& name, void* sample, std::size_t 
                         std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(bound_s));
   Topic& state = topic_state(name);
   std::lock_guard<std::mutex> lock(state.mutex);
-  // Before the write: the sample just written is never acknowledged yet.
-  drop_acknowledged(name, w, state.writes_since_drop);
+  // Only writers whose readers are VOLATILE: the others keep their samples for late joiners.
+  const bool drops = entities_.readers_volatile(name);
+  if (drops) state.drop.before_write(*w);
   for (;;) {
     // The handle overload reports why a write failed (the plain one only returns a bool).
     ReturnCode_t rc = w->write(sample, rtps::c_InstanceHandle_Unknown);
     if (rc == ReturnCode_t::RETCODE_OK) {
       bytes_ += size;
       ++messages_;
-      ++state.writes_since_drop;
+      if (drops) state.drop.written();
       return;
     }
     if (rc == ReturnCode_t::RETCODE_BAD_PARAMETER || rc == ReturnCode_t::RETCODE_NOT_ENABLED ||
@@ -64,17 +65,6 @@ SampleWriter::Topic& SampleWriter::topic_state(const std::string& name) {
   std::unique_ptr<Topic>& t = topics_[name];
   if (!t) t = std::make_unique<Topic>();
   return *t;
-}
-
-void SampleWriter::drop_acknowledged(const std::string& name, eprosima::fastdds::dds::DataWriter* w,
-                                     std::uint32_t& writes_since_drop) {
-  if (writes_since_drop < kDropAcknowledgedEvery || !entities_.readers_volatile(name)) return;
-  // Not all acknowledged yet: try again after the next write (readers acknowledge when a
-  // heartbeat asks, every heartbeat period).
-  if (w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 0)) != ReturnCode_t::RETCODE_OK)
-    return;
-  std::size_t removed = 0;
-  if (w->clear_history(&removed) == ReturnCode_t::RETCODE_OK) writes_since_drop = 0;
 }
 
 void SampleWriter::flush(Seconds timeout) {

@@ -3,7 +3,7 @@
 // samples) waits for acknowledgements and retries until SessionOptions::write_timeout_s,
 // then throws TransportError; the session's counters (SessionStats). Also the bounded waits
 // for acknowledgements, and dropping the acknowledged samples a writer with VOLATILE readers
-// would otherwise keep (kDropAcknowledgedEvery). Internal to transport/.
+// would otherwise keep (acknowledged_drop.hpp). Internal to transport/.
 
 #include <atomic>
 #include <cstddef>
@@ -13,6 +13,7 @@
 #include <mutex>
 #include <string>
 
+#include "transport/acknowledged_drop.hpp"
 #include "transport/dds_entities.hpp"
 #include "transport/dds_trace.hpp"
 #include "transport/inbox.hpp"
@@ -20,18 +21,6 @@
 #include "transport/session_options.hpp"
 
 namespace tessera::transport {
-
-/// A writer whose readers are all VOLATILE drops its acknowledged samples (DataWriter::
-/// clear_history, once every sample it holds is acknowledged) after every this many writes.
-/// Why: such a writer is TRANSIENT_LOCAL (fastdds/reader_removal_lock_order.hpp), so Fast DDS
-/// removes an acknowledged sample only when a write needs room, and every writer kept its last
-/// kVolatileWriterHistory samples for the rest of the run, sized in its topic's payload pool:
-/// an agent's heap grew round after round until its pose-block and status writers held 256
-/// samples each (docs/scale.md). Its readers received nothing of them: a VOLATILE reader gets
-/// only what is written after it matched, and an acknowledged sample is never sent again. The
-/// drop happens in the writing thread, like Fast DDS's own removal when the history is full,
-/// never while a reader is being removed.
-constexpr std::uint32_t kDropAcknowledgedEvery = 16;
 
 class SampleWriter {
  public:
@@ -61,18 +50,10 @@ class SampleWriter {
 
  private:
   void write_raw(const std::string& topic, void* sample, std::size_t bytes, double timeout_s);
-  /// Before a write on `w` (topic `name`, its Topic state locked): once kDropAcknowledgedEvery
-  /// writes went out since the last drop, drops the writer's samples if its readers are VOLATILE
-  /// and every sample is acknowledged (else tries again at the next write).
-  void drop_acknowledged(const std::string& name, eprosima::fastdds::dds::DataWriter* w,
-                         std::uint32_t& writes_since_drop);
-
-  // Per topic: a write and the drop that may follow it are one step (no other thread's write
-  // comes between the acknowledgement check and the drop, which would remove an
-  // unacknowledged sample).
+  // Per topic: a write and the drop before it are one step (AcknowledgedDrop).
   struct Topic {
     std::mutex mutex;
-    std::uint32_t writes_since_drop = 0;
+    AcknowledgedDrop drop;
   };
   Topic& topic_state(const std::string& name);
 

@@ -27,7 +27,7 @@
 // (the writer sends it a GAP for its history), so what any reader receives is unchanged. Such
 // a writer would keep its last history-bound samples (transport/qos.hpp,
 // kVolatileWriterHistory); the writing thread drops the acknowledged ones instead
-// (transport/sample_writing.hpp, kDropAcknowledgedEvery).
+// (transport/acknowledged_drop.hpp, kDropAcknowledgedEvery).
 
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
