@@ -14,6 +14,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "robust/gnc_exchange.hpp"
+#include "robust/gnc_inlier_passes.hpp"
 #include "robust/gnc_kept_start_votes.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
@@ -48,6 +49,7 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
                      std::to_string(kMaxGncSteps - 4) + " for the distributed solve");
   kept_votes_ = std::make_unique<GncKeptStartVotes>(
       in_.kept_set_start && in_.initialization == DistributedInit::kChordal);
+  passes_ = std::make_unique<GncInlierPasses>(options_.robust);
   dropped_.assign(in_.measurements.size(), false);
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
@@ -204,18 +206,18 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     return;
   }
   if (stage_->kind() == GncSolveKind::kInlierPass) {
-    last_pass_full_ = !pass_capped_;
-    kept_votes_->set_last_pass_cost(pass_capped_ ? std::numeric_limits<double>::quiet_NaN()
-                                                 : stage_->last_cost());
-    if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
+    passes_->solved();
+    kept_votes_->set_last_pass_cost(passes_->capped() ? std::numeric_limits<double>::quiet_NaN()
+                                                      : stage_->last_cost());
+    if (probes_->running() && passes_->budget_spent()) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
       return;
     }
-    if (pass_ >= options_.robust.readmission_passes || rejected_.empty()) {
+    if (passes_->budget_spent() || rejected_.empty()) {
       // Without a final solve to follow, the last pass must reach the tolerance itself.
-      if (pass_capped_ && !final_solve_runs()) {
-        full_pass_next_ = true;
+      if (passes_->capped() && !final_solve_runs()) {
+        passes_->solve_next_fully();
         begin_inlier_pass(out);
         return;
       }
@@ -358,19 +360,19 @@ void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {
   }
   exchange_->candidate().resize(0, 0);
   exchange_->forget_candidate_neighbours();
-  last_pass_full_ = false;
+  passes_->forget_solved_start();
   if (final_vote) {
     if (!fresh) {
       finish(out);  // the iterate stays: on to the final solve
       return;
     }
-    pass_ = 0;  // the passes again, with their own budget
+    passes_->restart_budget();  // the passes again, with their own budget
   }
   begin_inlier_pass(out);
 }
 
 void GncAgent::after_verdict(std::vector<OutgoingMessage>& out) {
-  ++pass_;
+  passes_->judged();
   if (recheck_->empty()) {
     after_unchanged_verdict(out);
     return;
@@ -391,10 +393,8 @@ void GncAgent::after_unchanged_verdict(std::vector<OutgoingMessage>& out) {
   // No change at a rough solution: the same set once more, solved to the tolerance; but a pass
   // that started from a solved pass only settled that pass's flips, and its verdict stands
   // (RobustOptions::recheck_confirm_solved) when a solve to the tolerance follows.
-  const bool confirmed =
-      options_.robust.recheck_confirm_solved && pass_from_solved_ && final_solve_runs();
-  if (pass_capped_ && !confirmed) {
-    full_pass_next_ = true;
+  if (passes_->unchanged_needs_full_pass(final_solve_runs())) {
+    passes_->solve_next_fully();
     begin_inlier_pass(out);
     return;
   }
