@@ -1,7 +1,7 @@
 // GncAgent's state machine: its construction, the outer loop's transitions after each solve and
-// each exchange (after_solve, after_exchange) and the end of the run. The solves are
-// gnc_agent_solve.cpp, the exchanges gnc_agent_exchanges.cpp, the probes gnc_agent_probes.cpp,
-// the results gnc_agent_results.cpp.
+// each exchange (after_solve, after_exchange) and the end of the run. The opening steps (pcm-gnc's
+// check, the start vote) are gnc_agent_opening.cpp, the solves gnc_agent_solve.cpp, the exchanges
+// gnc_agent_exchanges.cpp, the probes gnc_agent_probes.cpp, the results gnc_agent_results.cpp.
 
 #include <algorithm>
 #include <cmath>
@@ -79,25 +79,6 @@ int GncAgent::weights_at_mu(double mu) {
   return crossed;
 }
 
-std::vector<OutgoingMessage> GncAgent::start() {
-  std::vector<OutgoingMessage> out;
-  if (in_.pcm) {
-    if (!terms_->known_connected()) {
-      const std::string why =
-          "robust pcm-gnc: the known inliers do not connect the poses, so there is no odometry "
-          "to test closures against (use --robust gnc-tls)";
-      if (in_.source.empty()) throw InputError(why);
-      throw InputError(in_.source, 0, why);
-    }
-    begin_exchange(Step::kPcm, out);
-  } else if (in_.Y0_known.size() > 0) {
-    begin_exchange(Step::kStartPoses, out);
-  } else {
-    begin_solve(out);
-  }
-  return out;
-}
-
 void GncAgent::require_kept_connected() const {
   // The kept set must connect every pose (every agent checks the same set).
   const std::size_t parts =
@@ -152,30 +133,6 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   stage_->to_final();
   ++g_;
   begin_solve(out);
-}
-
-void GncAgent::after_step_zero(std::vector<OutgoingMessage>& out) {
-  first_solve_g_ = ++g_;
-  begin_solve(out);
-}
-
-void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
-  // Weight 0 from the start, never re-weighted (the inlier passes may take them back).
-  zero_cut_.clear();
-  for (std::uint64_t id : ids) {
-    if (id >= in_.structure.size())
-      throw std::runtime_error("robust pcm-gnc: measurement " + std::to_string(id) +
-                               " out of range");
-    if (const auto k = position_of(in_.measurement_index, id)) {
-      dropped_[*k] = true;
-      weights_[*k] = 0.0;
-    }
-    const auto& [i, j] = in_.structure[id];
-    if (in_.owner[i] != in_.owner[j]) zero_cut_.push_back(id);
-  }
-  // They leave the solves (the known inliers connect the poses): the layout without them.
-  std::sort(zero_cut_.begin(), zero_cut_.end());
-  solve_without(zero_cut_);
 }
 
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
@@ -273,14 +230,9 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     case Step::kStartPoses:
       begin_exchange(Step::kStartVotes, out);
       return;
-    case Step::kStartVotes: {
-      const auto [at_start, at_known] = exchange_->summed_votes();
-      if (at_known < at_start) stage_->set_start(std::move(in_.Y0_known));
-      in_.Y0_known.resize(0, 0);
-      exchange_->forget_candidate_neighbours();
-      after_step_zero(out);
+    case Step::kStartVotes:
+      after_start_votes(out);
       return;
-    }
     case Step::kCandidatePoses:
       neighbours_current_ = true;
       begin_exchange(Step::kCandidateVotes, out);
@@ -330,24 +282,6 @@ void GncAgent::after_weights(std::vector<OutgoingMessage>& out) {
   }
   ++g_;
   begin_solve(out);
-}
-
-void GncAgent::after_pcm(std::vector<OutgoingMessage>& out) {
-  if (in_.id == 0) {
-    const std::vector<std::uint64_t> ids =
-        inconsistent_closures(exchange_->kept_values(), in_, *terms_);
-    RoundStatusMessage st;
-    st.measurement_ids = ids;
-    broadcast_status(std::move(st), 0, gnc_phase(g_, GncExchange::kPcmDropped), in_.num_agents,
-                     out);
-    drop_inconsistent(ids);
-  } else {
-    drop_inconsistent(exchange_->pcm_dropped());
-  }
-  if (in_.Y0_known.size() > 0)
-    begin_exchange(Step::kStartPoses, out);
-  else
-    after_step_zero(out);
 }
 
 void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {

@@ -243,6 +243,7 @@ class GncAgent : public AgentProcess {
   void after_rejected(std::vector<OutgoingMessage>& out);
   void after_pcm(std::vector<OutgoingMessage>& out);
   void after_candidate_votes(std::vector<OutgoingMessage>& out);
+  void after_start_votes(std::vector<OutgoingMessage>& out);
   void after_verdict(std::vector<OutgoingMessage>& out);
   // A re-check verdict that changes nothing: a pass to the tolerance, a probe, or the end.
   void after_unchanged_verdict(std::vector<OutgoingMessage>& out);
