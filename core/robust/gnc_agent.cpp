@@ -1,7 +1,7 @@
 // GncAgent's state machine: its construction, the outer loop's transitions after each solve and
-// each exchange (after_solve, after_exchange) and the end of the run. The solves are
-// gnc_agent_solve.cpp, the exchanges gnc_agent_exchanges.cpp, the probes gnc_agent_probes.cpp,
-// the results gnc_agent_results.cpp.
+// each exchange (after_solve, after_exchange) and the end of the run. The opening steps (pcm-gnc's
+// check, the start vote) are gnc_agent_opening.cpp, the solves gnc_agent_solve.cpp, the exchanges
+// gnc_agent_exchanges.cpp, the probes gnc_agent_probes.cpp, the results gnc_agent_results.cpp.
 
 #include <algorithm>
 #include <cmath>
@@ -14,6 +14,7 @@
 #include <tessera/util/input_error.hpp>
 
 #include "robust/gnc_exchange.hpp"
+#include "robust/gnc_inlier_passes.hpp"
 #include "robust/gnc_kept_start_votes.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
@@ -48,6 +49,7 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
                      std::to_string(kMaxGncSteps - 4) + " for the distributed solve");
   kept_votes_ = std::make_unique<GncKeptStartVotes>(
       in_.kept_set_start && in_.initialization == DistributedInit::kChordal);
+  passes_ = std::make_unique<GncInlierPasses>(options_.robust);
   dropped_.assign(in_.measurements.size(), false);
   base_ = std::make_unique<BlockLayout>(make_block_layout(in_.num_poses, in_.structure, in_.owner));
   terms_ = std::make_unique<GncLocalTerms>(in_, options_.robust, *base_);
@@ -75,25 +77,6 @@ int GncAgent::weights_at_mu(double mu) {
       weights_[k] = w;
     }
   return crossed;
-}
-
-std::vector<OutgoingMessage> GncAgent::start() {
-  std::vector<OutgoingMessage> out;
-  if (in_.pcm) {
-    if (!terms_->known_connected()) {
-      const std::string why =
-          "robust pcm-gnc: the known inliers do not connect the poses, so there is no odometry "
-          "to test closures against (use --robust gnc-tls)";
-      if (in_.source.empty()) throw InputError(why);
-      throw InputError(in_.source, 0, why);
-    }
-    begin_exchange(Step::kPcm, out);
-  } else if (in_.Y0_known.size() > 0) {
-    begin_exchange(Step::kStartPoses, out);
-  } else {
-    begin_solve(out);
-  }
-  return out;
 }
 
 void GncAgent::require_kept_connected() const {
@@ -152,30 +135,6 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   begin_solve(out);
 }
 
-void GncAgent::after_step_zero(std::vector<OutgoingMessage>& out) {
-  first_solve_g_ = ++g_;
-  begin_solve(out);
-}
-
-void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
-  // Weight 0 from the start, never re-weighted (the inlier passes may take them back).
-  zero_cut_.clear();
-  for (std::uint64_t id : ids) {
-    if (id >= in_.structure.size())
-      throw std::runtime_error("robust pcm-gnc: measurement " + std::to_string(id) +
-                               " out of range");
-    if (const auto k = position_of(in_.measurement_index, id)) {
-      dropped_[*k] = true;
-      weights_[*k] = 0.0;
-    }
-    const auto& [i, j] = in_.structure[id];
-    if (in_.owner[i] != in_.owner[j]) zero_cut_.push_back(id);
-  }
-  // They leave the solves (the known inliers connect the poses): the layout without them.
-  std::sort(zero_cut_.begin(), zero_cut_.end());
-  solve_without(zero_cut_);
-}
-
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   // Agent 0: the kept set's initialization, each agent's block sent, its own kept.
   const Eigen::MatrixXd X = kept_set_start(exchange_->kept_values(), in_, rejected_.size(),
@@ -204,18 +163,18 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     return;
   }
   if (stage_->kind() == GncSolveKind::kInlierPass) {
-    last_pass_full_ = !pass_capped_;
-    kept_votes_->set_last_pass_cost(pass_capped_ ? std::numeric_limits<double>::quiet_NaN()
-                                                 : stage_->last_cost());
-    if (probes_->running() && pass_ >= options_.robust.readmission_passes) {
+    passes_->solved();
+    kept_votes_->set_last_pass_cost(passes_->capped() ? std::numeric_limits<double>::quiet_NaN()
+                                                      : stage_->last_cost());
+    if (probes_->running() && passes_->budget_spent()) {
       // The probe's passes ran out before a verdict could judge it: it does not stay.
       restore_before_probe(out);
       return;
     }
-    if (pass_ >= options_.robust.readmission_passes || rejected_.empty()) {
+    if (passes_->budget_spent() || rejected_.empty()) {
       // Without a final solve to follow, the last pass must reach the tolerance itself.
-      if (pass_capped_ && !final_solve_runs()) {
-        full_pass_next_ = true;
+      if (passes_->capped() && !final_solve_runs()) {
+        passes_->solve_next_fully();
         begin_inlier_pass(out);
         return;
       }
@@ -271,14 +230,9 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
     case Step::kStartPoses:
       begin_exchange(Step::kStartVotes, out);
       return;
-    case Step::kStartVotes: {
-      const auto [at_start, at_known] = exchange_->summed_votes();
-      if (at_known < at_start) stage_->set_start(std::move(in_.Y0_known));
-      in_.Y0_known.resize(0, 0);
-      exchange_->forget_candidate_neighbours();
-      after_step_zero(out);
+    case Step::kStartVotes:
+      after_start_votes(out);
       return;
-    }
     case Step::kCandidatePoses:
       neighbours_current_ = true;
       begin_exchange(Step::kCandidateVotes, out);
@@ -330,24 +284,6 @@ void GncAgent::after_weights(std::vector<OutgoingMessage>& out) {
   begin_solve(out);
 }
 
-void GncAgent::after_pcm(std::vector<OutgoingMessage>& out) {
-  if (in_.id == 0) {
-    const std::vector<std::uint64_t> ids =
-        inconsistent_closures(exchange_->kept_values(), in_, *terms_);
-    RoundStatusMessage st;
-    st.measurement_ids = ids;
-    broadcast_status(std::move(st), 0, gnc_phase(g_, GncExchange::kPcmDropped), in_.num_agents,
-                     out);
-    drop_inconsistent(ids);
-  } else {
-    drop_inconsistent(exchange_->pcm_dropped());
-  }
-  if (in_.Y0_known.size() > 0)
-    begin_exchange(Step::kStartPoses, out);
-  else
-    after_step_zero(out);
-}
-
 void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {
   const auto [at_iterate, at_candidate] = exchange_->summed_votes();
   const bool final_vote = kept_votes_->ended(rejected_, at_candidate);
@@ -358,19 +294,19 @@ void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {
   }
   exchange_->candidate().resize(0, 0);
   exchange_->forget_candidate_neighbours();
-  last_pass_full_ = false;
+  passes_->forget_solved_start();
   if (final_vote) {
     if (!fresh) {
       finish(out);  // the iterate stays: on to the final solve
       return;
     }
-    pass_ = 0;  // the passes again, with their own budget
+    passes_->restart_budget();  // the passes again, with their own budget
   }
   begin_inlier_pass(out);
 }
 
 void GncAgent::after_verdict(std::vector<OutgoingMessage>& out) {
-  ++pass_;
+  passes_->judged();
   if (recheck_->empty()) {
     after_unchanged_verdict(out);
     return;
@@ -391,10 +327,8 @@ void GncAgent::after_unchanged_verdict(std::vector<OutgoingMessage>& out) {
   // No change at a rough solution: the same set once more, solved to the tolerance; but a pass
   // that started from a solved pass only settled that pass's flips, and its verdict stands
   // (RobustOptions::recheck_confirm_solved) when a solve to the tolerance follows.
-  const bool confirmed =
-      options_.robust.recheck_confirm_solved && pass_from_solved_ && final_solve_runs();
-  if (pass_capped_ && !confirmed) {
-    full_pass_next_ = true;
+  if (passes_->unchanged_needs_full_pass(final_solve_runs())) {
+    passes_->solve_next_fully();
     begin_inlier_pass(out);
     return;
   }

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "robust/gnc_inlier_passes.hpp"
 #include "robust/gnc_kept_start_votes.hpp"
 #include "robust/gnc_probe_stage.hpp"
 #include "robust/gnc_solve_stage.hpp"
@@ -23,8 +24,8 @@ void GncAgent::begin_probe(double tls, std::vector<std::uint64_t> flip,
   RecheckVerdict cut;
   cut.cut_now = std::move(flip);
   apply_recheck(cut, in_.measurement_index, rejected_, weights_);
-  pass_ = 0;
-  last_pass_full_ = false;
+  passes_->restart_budget();
+  passes_->forget_solved_start();
   // The iterate was bent around what the probe cut, and a local solve keeps such a fold; the
   // kept set's fresh start (voted on its cost, as after GNC) does not have it.
   if (kept_votes_->enabled()) {
@@ -51,8 +52,7 @@ void GncAgent::restore_before_probe(std::vector<OutgoingMessage>& out, double ri
   }
   // One last pass on the restored set (from its converged iterate, so it costs few rounds),
   // then the final solve.
-  pass_ = options_.robust.readmission_passes;
-  full_pass_next_ = true;
+  passes_->last_full_pass();
   begin_inlier_pass(out);
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "robust/gnc_exchange.hpp"
+#include "robust/gnc_inlier_passes.hpp"
 #include "robust/gnc_kept_start_votes.hpp"
 #include "robust/gnc_mailbox.hpp"
 #include "robust/gnc_messages.hpp"
@@ -23,7 +24,7 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   neighbours_current_ = false;
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
   const bool weighted = stage_->kind() == GncSolveKind::kGnc && g_ > first_solve_g_;
-  stage_->open(weighted, pass_capped_, send_poses_with_trial(), weights_, rejected_);
+  stage_->open(weighted, passes_->capped(), send_poses_with_trial(), weights_, rejected_);
   // A weighted solve by Newton steps right after a pose exchange of its start (every agent's
   // steps are the same): its rounds would open with that exchange again and stop at their first
   // status, so it starts at the refinement with the exchange's poses (the same bits).
@@ -77,13 +78,7 @@ bool GncAgent::send_poses_with_trial() const {
 void GncAgent::begin_inlier_pass(std::vector<OutgoingMessage>& out) {
   require_kept_connected();
   stage_->to_kept_set(rejected_);
-  // A pass that hands over to the refinement is solved to the tolerance even while its set may
-  // still change: from the last iterate that costs fewer message steps than the capped rounds.
-  pass_capped_ =
-      options_.robust.recheck_max_rounds > 0 && !full_pass_next_ && !stage_->pass_refines();
-  full_pass_next_ = false;
-  pass_from_solved_ = last_pass_full_;
-  last_pass_full_ = false;
+  passes_->open(stage_->pass_refines());
   ++g_;
   begin_solve(out);
 }

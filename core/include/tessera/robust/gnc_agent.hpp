@@ -138,6 +138,7 @@ struct RecheckVerdict;    // internal: an inlier pass's re-check
 class GncSolveStage;      // internal: each step's solve, its layout and iterate
 class GncProbeStage;      // internal: probes after the re-check passes
 class GncKeptStartVotes;  // internal: the kept set's fresh start against the iterate
+class GncInlierPasses;    // internal: the inlier passes' count and which are capped
 class GncMailbox;         // internal: where incoming messages go
 class GncExchangeBook;    // internal: the exchanges' messages and what they carry
 class GncOuterLoop;       // internal: mu, its steps and the stop decision
@@ -242,6 +243,7 @@ class GncAgent : public AgentProcess {
   void after_rejected(std::vector<OutgoingMessage>& out);
   void after_pcm(std::vector<OutgoingMessage>& out);
   void after_candidate_votes(std::vector<OutgoingMessage>& out);
+  void after_start_votes(std::vector<OutgoingMessage>& out);
   void after_verdict(std::vector<OutgoingMessage>& out);
   // A re-check verdict that changes nothing: a pass to the tolerance, a probe, or the end.
   void after_unchanged_verdict(std::vector<OutgoingMessage>& out);
@@ -283,11 +285,7 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<GncKeptStartVotes> kept_votes_;
   std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
   Step step_ = Step::kSolve;
-  int pass_ = 0;                   // inlier passes done
-  bool pass_capped_ = false;       // the current pass stops at RobustOptions::recheck_max_rounds
-  bool full_pass_next_ = false;    // the next pass is solved to the tolerance
-  bool last_pass_full_ = false;    // the last pass that ended was solved to the tolerance
-  bool pass_from_solved_ = false;  // the current pass starts from a pass solved to the tolerance
+  std::unique_ptr<GncInlierPasses> passes_;  // their count, which are capped, which start solved
   std::size_t readmitted_ = 0;
   std::unique_ptr<RecheckVerdict> recheck_;  // the current re-check exchange's, every agent's
   std::size_t late_rejected_ = 0;
