@@ -418,6 +418,9 @@ TEST(NewtonRefineOptions, ValidateNamesTheBadField) {
   o.forcing = 1.0;
   EXPECT_TRUE(test::validation_names(o, "forcing"));
   o = {};
+  o.coarse_keep_steps = 0;
+  EXPECT_TRUE(test::validation_names(o, "coarse_keep_steps"));
+  o = {};
   o.auto_gap_tol = 0;
   EXPECT_TRUE(test::validation_names(o, "auto_gap_tol"));
   o = {};

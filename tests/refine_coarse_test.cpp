@@ -176,6 +176,46 @@ TEST(NewtonRefine, EveryAgentTakesTheSameTwoLevelStepsInAnyDeliveryOrder) {
   EXPECT_GT(a.refines[0].coarse_assemblies, 0);
 }
 
+int coarse_assemblies(const DistributedResult& r) {
+  int n = 0;
+  for (const auto& s : r.refines) n += s.coarse_assemblies;
+  return n;
+}
+
+TEST(NewtonRefine, ACoarseMatrixKeptForAFewStepsIsSummedLessOftenForTheSameCertifiedOptimum) {
+  // The data part's matrix (positive semi-definite at any point) kept for the accepted steps
+  // between sums: the preconditioner stays positive definite, so the steps still reach the
+  // optimum; only Phi^T g is summed at the kept steps' points.
+  const PoseGraph g = test::refine_chain(600, 3);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 5);
+  DistributedOptions every = refined(NewtonRefineOptions::Coarse::kSmoothed);
+  every.refine.coarse_multipliers = false;
+  DistributedOptions kept = every;
+  kept.refine.coarse_keep_steps = 3;
+  const DistributedResult a = solve_distributed(g, parts, every);
+  const DistributedResult b = solve_distributed(g, parts, kept);
+  for (const DistributedResult* r : {&a, &b}) {
+    ASSERT_FALSE(r->refines.empty());
+    ASSERT_TRUE(r->certified.has_value());
+    EXPECT_TRUE(*r->certified);
+  }
+  EXPECT_NEAR(b.relaxation_cost, a.relaxation_cost, 1e-8 * a.relaxation_cost);
+  EXPECT_GT(coarse_assemblies(b), 0);
+  EXPECT_LT(coarse_assemblies(b), coarse_assemblies(a));
+}
+
+TEST(NewtonRefine, EveryAgentTakesTheSameStepsWithAKeptCoarseMatrixInAnyDeliveryOrder) {
+  const PoseGraph g = test::refine_chain(300, 4);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  DistributedOptions fifo = refined(NewtonRefineOptions::Coarse::kSmoothed);
+  fifo.certify = false;
+  fifo.refine.coarse_multipliers = false;
+  fifo.refine.coarse_keep_steps = 2;
+  const DistributedResult a = test::expect_same_refinement_in_any_delivery_order(g, parts, fifo, 5);
+  ASSERT_EQ(a.refines.size(), 1u);
+  EXPECT_GT(a.refines[0].coarse_assemblies, 0);
+}
+
 TEST(NewtonRefineOptions, TheCoarseSpaceOptionsAreCheckedByName) {
   NewtonRefineOptions o;
   EXPECT_EQ(test::validation_message(o), "");

@@ -381,7 +381,7 @@ void NewtonRefineProtocol::send_direction(std::vector<OutgoingMessage>& out) {
     z_ = interface_->back(X_, iy_r_, ir_);
   } else if (!coarse_) {
     z_ = state_.precondition(X_, r_);
-  } else if (!options_.coarse_balancing) {
+  } else if (!balancing()) {
     // Additive: z = B r + Phi A^+ Phi^T r (Phi^T r identical everywhere).
     z_ = state_.precondition(X_, r_);
     coarse_->expand(X_, coarse_->times_inverse(coarse_r_), z_);
@@ -454,9 +454,9 @@ void NewtonRefineProtocol::after_direction(const MessageGate::Inbox& inbox,
   }
   if (coarse_) {  // Phi^T w, for Phi^T q and so Phi^T r by their recurrences
     const std::size_t n = static_cast<std::size_t>(coarse_->size());
-    values.resize(3 + (options_.coarse_balancing ? 2 : 1) * n, 0.0);
+    values.resize(3 + (balancing() ? 2 : 1) * n, 0.0);
     coarse_->project(X_, w_, values.data() + 3);
-    if (options_.coarse_balancing) {  // and (H Phi)^T y
+    if (balancing()) {  // and (H Phi)^T y
       const std::vector<int>& touched = coarse_->touched();
       for (std::size_t c = 0; c < touched.size(); ++c)
         values[3 + n + static_cast<std::size_t>(touched[c])] =
@@ -476,13 +476,13 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
   const std::size_t gk = use_interface_ ? static_cast<std::size_t>(gauge_->size()) : 0;
   const std::size_t gsums = (project_gauge_ ? 5 : 2) * gk;
   std::vector<double> t =
-      reduce_in_id_order(inbox, 3 + (options_.coarse_balancing ? 2 : 1) * n + team + extra + gsums);
+      reduce_in_id_order(inbox, 3 + (balancing() ? 2 : 1) * n + team + extra + gsums);
   if (project_gauge_) project_iteration_off_gauge(t);
   double gamma = t[0], delta = t[1];
   const double rnorm = std::sqrt(std::max(0.0, t[2]));
   Eigen::VectorXd coarse_w;  // Phi^T w
   if (coarse_) coarse_w = Eigen::Map<const Eigen::VectorXd>(t.data() + 3, coarse_->size());
-  if (coarse_ && options_.coarse_balancing) {
+  if (coarse_ && balancing()) {
     // z = z' - Phi eta, H z = w' - H Phi eta with eta = A^+ (H Phi)^T y; the sums follow from
     // the ones of z' and Phi^T w' = (H Phi)^T z'.
     const Eigen::VectorXd eta = coarse_->times_inverse(

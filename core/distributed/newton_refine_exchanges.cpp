@@ -304,6 +304,15 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   // Without the multipliers: LD, the share of Phi^T Proj(2 V Q) Phi, is the matrix inverted;
   // L (Hess f's) is still needed by balancing (its H Phi columns and A's products).
   const bool data_part = !options_.coarse_multipliers;
+  // The data part's matrix from an earlier point: only Phi^T g is summed at this one.
+  coarse_fresh_ = !(data_part && result_.coarse_assemblies > 0 &&
+                    coarse_kept_steps_ < options_.coarse_keep_steps);
+  if (!coarse_fresh_) {
+    std::vector<double> values(static_cast<std::size_t>(n), 0.0);
+    coarse_->project(X_, g_, values.data());
+    return broadcast(kCoarse, values, out);
+  }
+  coarse_kept_steps_ = 0;
   const bool galerkin = !data_part || options_.coarse_balancing;
   Eigen::MatrixXd LD = data_part ? Eigen::MatrixXd::Zero(n, n) : Eigen::MatrixXd();
   Eigen::MatrixXd v, vn;
@@ -420,6 +429,12 @@ void NewtonRefineProtocol::after_coarse(const MessageGate::Inbox& inbox,
   charge_to(&result_.times.sigma_s);
   const int n = coarse_->size();
   const std::size_t packed = coarse_->packed_size();
+  if (!coarse_fresh_) {
+    const std::vector<double> t = reduce_in_id_order(inbox, static_cast<std::size_t>(n));
+    coarse_g_ = Eigen::Map<const Eigen::VectorXd>(t.data(), n);
+    coarse_due_ = false;
+    return start_cg(out);
+  }
   const bool data_part = !options_.coarse_multipliers;
   const bool both = data_part && options_.coarse_balancing;  // send_coarse's order
   const std::size_t at = both ? 2 * packed : packed;

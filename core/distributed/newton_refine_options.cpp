@@ -23,6 +23,7 @@ void NewtonRefineOptions::validate() const {
   if (coarse_smoothing_steps < 0 || coarse_smoothing_steps > 8)
     fail("coarse_smoothing_steps", "must be in 0..8");
   if (coarse_min_blocks < 2) fail("coarse_min_blocks", "must be >= 2");
+  if (coarse_keep_steps < 1) fail("coarse_keep_steps", "must be >= 1");
   if (!(auto_gap_tol > 0)) fail("auto_gap_tol", "must be > 0");
   if (auto_window < 1) fail("auto_window", "must be >= 1");
   if (translation_iterations < 0) fail("translation_iterations", "must be >= 0");

@@ -113,6 +113,7 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
     gnorm_ = gt;
     ++result_.accepted_steps;
     coarse_due_ = true;
+    ++coarse_kept_steps_;
     interface_due_ = true;
     refactor_due_ = true;  // each CG solve preconditioned at its own point (when asked)
     if (trial_shares_) {

@@ -157,6 +157,14 @@ struct NewtonRefineOptions {
   /// (docs/online.md, "Smoothed pieces"). The online steps keep their block factors without
   /// the multipliers and set false; batch refinements keep true.
   bool coarse_multipliers = true;
+  /// With coarse_multipliers false: the inverted data-part matrix is summed at every this many
+  /// accepted Newton steps and kept for the ones between (only Phi^T g is summed at their
+  /// points; the kept matrix is positive semi-definite, so the preconditioner stays positive
+  /// definite). Those steps' CGs take the additive form: balancing needs the H Phi columns and
+  /// Galerkin matrix of their own point. Why: summing the matrix and the H Phi columns was about
+  /// a third of the online steps' CPU on the 5,000-pose grid (docs/online.md). Default 1 (every
+  /// accepted step; batch refinements); the online steps set 3. >= 1.
+  int coarse_keep_steps = 1;
   /// kSmoothed: pieces per block (>= 1) and smoothing steps of their weights (0..8).
   int coarse_aggregates = 8;
   int coarse_smoothing_steps = 1;
@@ -561,6 +569,11 @@ class NewtonRefineProtocol : public AgentProcess {
   Eigen::VectorXd coarse_hy_;  // balancing: this agent's share of (H Phi)^T y
   Eigen::VectorXd coarse_g_, coarse_r_, coarse_q_;
   bool coarse_due_ = true;  // the point changed since the coarse matrix was summed
+  // Kept coarse matrix: accepted steps since it was summed, and whether this CG balances
+  // (only with the matrix summed at its own point: balancing needs that point's H Phi).
+  int coarse_kept_steps_ = 0;
+  bool coarse_fresh_ = true;
+  bool balancing() const { return options_.coarse_balancing && coarse_fresh_; }
   // Interface solves (options_.interface_max_coordinates): the solver, whether Sigma is due
   // (the point changed) and whether this point's CG uses it; y = L^-1 J^T of r, q, w and of -g
   // (the block's forward solves) and the team's interface residuals of r, q and -g, carried by
