@@ -61,6 +61,16 @@ void send_one_at_a_time(AgentSession& from, AgentSession& to, int count) {
   }
 }
 
+constexpr int kMoreBlocks = 100;
+
+// The heap in use after `send_more` less before it, in MB.
+template <class SendMore>
+double heap_growth_mb(SendMore send_more) {
+  const std::size_t before = heap_in_use();
+  send_more();
+  return (static_cast<double>(heap_in_use()) - static_cast<double>(before)) / kMB;
+}
+
 TEST(DdsWriterHistory, AWriterWithVolatileReadersDropsItsAcknowledgedSamples) {
   static_assert(kDropAcknowledgedEvery < kVolatileWriterHistory);
   std::vector<std::unique_ptr<Session>> sessions;
@@ -73,12 +83,9 @@ TEST(DdsWriterHistory, AWriterWithVolatileReadersDropsItsAcknowledgedSamples) {
 
   // Past the first drop: the payload pools of both ends hold what one cycle needs.
   ASSERT_NO_FATAL_FAILURE(send_one_at_a_time(a0, a1, 2 * kDropAcknowledgedEvery));
-  const std::size_t before = heap_in_use();
   // 100 more blocks: kept, they would be 100 x 128 KB = 12.5 MB more.
-  constexpr int kMore = 100;
-  ASSERT_NO_FATAL_FAILURE(send_one_at_a_time(a0, a1, kMore));
-  const std::size_t after = heap_in_use();
-  const double grown_mb = (static_cast<double>(after) - static_cast<double>(before)) / kMB;
+  const double grown_mb = heap_growth_mb([&] { send_one_at_a_time(a0, a1, kMoreBlocks); });
+  ASSERT_FALSE(HasFatalFailure());
   EXPECT_LT(grown_mb, 3.0) << "the writer kept its acknowledged samples";
 }
 
@@ -115,12 +122,9 @@ TEST(DdsWriterHistory, AnOnlineAgentsBlockWriterDropsItsAcknowledgedSamples) {
   ASSERT_GE(a1.matched_peers(), 2);
 
   ASSERT_NO_FATAL_FAILURE(send_one_at_a_time(a0, a1, 2 * kDropAcknowledgedEvery));
-  const std::size_t before = heap_in_use();
   // 100 more blocks: kept, they would be 100 x 128 KB = 12.5 MB more.
-  constexpr int kMore = 100;
-  ASSERT_NO_FATAL_FAILURE(send_one_at_a_time(a0, a1, kMore));
-  const std::size_t after = heap_in_use();
-  const double grown_mb = (static_cast<double>(after) - static_cast<double>(before)) / kMB;
+  const double grown_mb = heap_growth_mb([&] { send_one_at_a_time(a0, a1, kMoreBlocks); });
+  ASSERT_FALSE(HasFatalFailure());
   EXPECT_LT(grown_mb, 3.0) << "the writer kept its acknowledged samples";
 }
 
