@@ -216,6 +216,29 @@ TEST(NewtonRefine, EveryAgentTakesTheSameStepsWithAKeptCoarseMatrixInAnyDelivery
   EXPECT_GT(a.refines[0].coarse_assemblies, 0);
 }
 
+TEST(NewtonRefine, AKeptCoarseMatrixsStepTakesPhiTgFromTheAcceptedTrialsSum) {
+  // The step after an accepted trial keeps the matrix: Phi^T g at its point rode in the trial's
+  // sum (the trial point is the new point), so it sends no coarse sum of its own. Each point
+  // gets Phi^T g once, by a coarse sum or by the trial's, and a summed matrix serves at most
+  // coarse_keep_steps - 1 carried steps.
+  const PoseGraph g = test::refine_chain(600, 3);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 5);
+  DistributedOptions kept = refined(NewtonRefineOptions::Coarse::kSmoothed);
+  kept.refine.coarse_multipliers = false;
+  kept.refine.coarse_keep_steps = 3;
+  const DistributedResult r = solve_distributed(g, parts, kept);
+  ASSERT_FALSE(r.refines.empty());
+  ASSERT_TRUE(r.certified.has_value());
+  EXPECT_TRUE(*r.certified);
+  int carried = 0;
+  for (const NewtonRefineResult& s : r.refines) {
+    carried += s.coarse_gradients_carried;
+    EXPECT_LE(s.coarse_assemblies + s.coarse_gradients_carried, s.accepted_steps + 1);
+    EXPECT_LE(s.coarse_gradients_carried, 2 * s.coarse_assemblies);
+  }
+  EXPECT_GT(carried, 0);
+}
+
 TEST(NewtonRefineOptions, TheCoarseSpaceOptionsAreCheckedByName) {
   NewtonRefineOptions o;
   EXPECT_EQ(test::validation_message(o), "");

@@ -13,6 +13,7 @@
 #include "distributed/pipelined_cg.hpp"
 #include "distributed/public_pose_messages.hpp"
 #include "distributed/rigid_retraction.hpp"
+#include "distributed/tangent_coarse_space.hpp"
 #include "distributed/translation_interface_solve.hpp"
 #include "distributed/translation_preconditioner.hpp"
 #include "distributed/trust_region_rule.hpp"
@@ -57,6 +58,14 @@ void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
     Y(rows_, Eigen::all) = Xt_;
     trial_observer_(Y);
   }
+  trial_coarse_g_ = ship_trial_coarse_gradient();
+  if (trial_coarse_g_) {
+    // Phi^T g at the trial point: accepted, it is the next step's (whose matrix is the kept
+    // one), so that step needs no coarse sum of its own.
+    const std::size_t at = values.size();
+    values.resize(at + static_cast<std::size_t>(coarse_->size()), 0.0);
+    coarse_->project(Xt_, g_t_, values.data() + at);
+  }
   trial_shares_ = ship_trial_shares();
   if (trial_shares_) {
     // The block's share of Sigma at the trial point, before the verdict: accepted, agent 0
@@ -66,6 +75,13 @@ void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
     values.insert(values.end(), mine.begin(), mine.end());
   }
   broadcast(kTrialSums, values, out);
+}
+
+bool NewtonRefineProtocol::ship_trial_coarse_gradient() const {
+  // Where an accepted trial's step would keep the coarse matrix (send_coarse's test, one
+  // accepted step on): the same on every agent.
+  return coarse_ && !options_.coarse_multipliers && result_.coarse_assemblies > 0 &&
+         coarse_kept_steps_ + 1 < options_.coarse_keep_steps;
 }
 
 bool NewtonRefineProtocol::ship_trial_shares() const {
@@ -79,17 +95,20 @@ bool NewtonRefineProtocol::ship_trial_shares() const {
 void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
                                             std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.trial_s);
-  // The sums (in id order, as reduce_in_id_order), then each block's share of Sigma.
-  double t[2] = {0.0, 0.0};
+  // The sums (in id order, as reduce_in_id_order), Phi^T g's (trial_coarse_g_), then each
+  // block's share of Sigma.
+  const std::size_t sums =
+      2 + (trial_coarse_g_ ? static_cast<std::size_t>(coarse_->size()) : std::size_t{0});
+  std::vector<double> t(sums, 0.0);
   std::vector<std::vector<double>> shares;
   for (const auto& [sender, m] : inbox) {
     const auto* p = std::get_if<PoseBlockMessage>(&m);
-    if (!p || p->data.size() < 2 || (p->data.size() > 2) != trial_shares_)
+    if (!p || p->data.size() < sums || (p->data.size() > sums) != trial_shares_)
       throw std::runtime_error("newton refine: malformed trial sums from agent " +
                                std::to_string(sender));
-    t[0] += p->data[0];
-    t[1] += p->data[1];
-    if (trial_shares_) shares.emplace_back(p->data.begin() + 2, p->data.end());
+    for (std::size_t k = 0; k < sums; ++k) t[k] += p->data[k];
+    if (trial_shares_)
+      shares.emplace_back(p->data.begin() + static_cast<std::ptrdiff_t>(sums), p->data.end());
   }
   const double ft = t[0], gt = std::sqrt(std::max(0.0, t[1]));
   ++result_.steps;
@@ -114,6 +133,12 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
     ++result_.accepted_steps;
     coarse_due_ = true;
     ++coarse_kept_steps_;
+    if (trial_coarse_g_) {  // the kept matrix's step: its Phi^T g came with these sums
+      coarse_g_ = Eigen::Map<const Eigen::VectorXd>(t.data() + 2, coarse_->size());
+      coarse_fresh_ = false;
+      coarse_due_ = false;
+      ++result_.coarse_gradients_carried;
+    }
     interface_due_ = true;
     refactor_due_ = true;  // each CG solve preconditioned at its own point (when asked)
     if (trial_shares_) {
@@ -124,7 +149,7 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
   } else if (trial_shares_) {
     ++result_.pending_factors_unused;
   }
-  trial_shares_ = false;
+  trial_shares_ = trial_coarse_g_ = false;
   step_.cost = f_;
   step_.grad_norm = gnorm_;
   result_.trace.push_back(step_);

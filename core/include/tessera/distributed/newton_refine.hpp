@@ -375,6 +375,9 @@ struct NewtonRefineResult {
   /// Coarse correction: its unknowns (pieces x generators; 0 without), and how many times its
   /// matrix was summed (one all-agent sum each, counted in `reductions`).
   int coarse_unknowns = 0, coarse_assemblies = 0;
+  /// Accepted steps that kept the coarse matrix and took Phi^T g at their point from the
+  /// trial's sum (no coarse message step of their own).
+  int coarse_gradients_carried = 0;
   /// Iterations of the trial points' translation solves (each one exchange and one sum,
   /// counted in `exchanges` and `reductions`).
   int translation_iterations = 0;
@@ -573,6 +576,10 @@ class NewtonRefineProtocol : public AgentProcess {
   // (only with the matrix summed at its own point: balancing needs that point's H Phi).
   int coarse_kept_steps_ = 0;
   bool coarse_fresh_ = true;
+  // Whether the current trial's sum carries Phi^T g at the trial point (an accepted one keeps
+  // the matrix): that step then sends no coarse sum.
+  bool trial_coarse_g_ = false;
+  bool ship_trial_coarse_gradient() const;
   bool balancing() const { return options_.coarse_balancing && coarse_fresh_; }
   // Interface solves (options_.interface_max_coordinates): the solver, whether Sigma is due
   // (the point changed) and whether this point's CG uses it; y = L^-1 J^T of r, q, w and of -g
