@@ -7,7 +7,7 @@ namespace tessera::transport {
 
 using eprosima::fastrtps::types::ReturnCode_t;
 
-void AcknowledgedDrop::before_write(eprosima::fastdds::dds::DataWriter& w) {
+void AcknowledgedDrop::drop_if_due(eprosima::fastdds::dds::DataWriter& w) {
   if (writes_since_drop_ < kDropAcknowledgedEvery) return;
   if (w.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 0)) != ReturnCode_t::RETCODE_OK)
     return;

@@ -4,6 +4,7 @@
 // blocks and statuses. Internal to transport/.
 
 #include <cstdint>
+#include <mutex>
 
 namespace eprosima::fastdds::dds {
 class DataWriter;
@@ -23,20 +24,29 @@ namespace tessera::transport {
 /// never while a reader is being removed.
 constexpr std::uint32_t kDropAcknowledgedEvery = 16;
 
-/// The drop schedule of one writer. The caller holds one lock over before_write(), the write
-/// and written(), so that no other thread's write falls between the acknowledgement check and
-/// the drop (which would remove an unacknowledged sample).
+/// The drop schedule of one writer, and the lock that makes the acknowledgement check, the drop
+/// and the write one step (another thread's write between the check and the drop would remove
+/// an unacknowledged sample).
 class AcknowledgedDrop {
  public:
-  /// Before a write on `w`: once kDropAcknowledgedEvery writes went out since the last drop,
-  /// drops its samples if every one is acknowledged (else tries again at the next write;
-  /// readers acknowledge when a heartbeat asks, every heartbeat period). Before, not after:
-  /// the sample just written is never acknowledged yet.
-  void before_write(eprosima::fastdds::dds::DataWriter& w);
-  /// After a successful write.
-  void written() { ++writes_since_drop_; }
+  /// Runs `write` (returns true when the sample went out) on `w` under the lock; before it,
+  /// once kDropAcknowledgedEvery writes went out since the last drop, drops the writer's samples
+  /// if every one is acknowledged (else tries again at the next write; readers acknowledge when
+  /// a heartbeat asks, every heartbeat period). Before, not after: the sample just written is
+  /// never acknowledged yet.
+  template <class Write>
+  bool write(eprosima::fastdds::dds::DataWriter& w, Write&& write) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    drop_if_due(w);
+    if (!write()) return false;
+    ++writes_since_drop_;
+    return true;
+  }
 
  private:
+  void drop_if_due(eprosima::fastdds::dds::DataWriter& w);
+
+  std::mutex mutex_;
   std::uint32_t writes_since_drop_ = 0;
 };
 

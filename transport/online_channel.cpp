@@ -63,25 +63,6 @@ bool write_patiently(dds::DataWriter* writer, Sample& sample) {
   return false;
 }
 
-// A writer whose readers are VOLATILE (pose blocks, statuses): it drops its acknowledged
-// samples (acknowledged_drop.hpp) instead of keeping its last kVolatileWriterHistory for the
-// whole mission. The lock makes the drop and the write one step.
-namespace {
-struct DroppingWriter {
-  dds::DataWriter* writer = nullptr;
-  std::mutex mutex;
-  AcknowledgedDrop drop;
-};
-}  // namespace
-template <class Sample>
-bool write_patiently(DroppingWriter& w, Sample& sample) {
-  std::lock_guard<std::mutex> lock(w.mutex);
-  w.drop.before_write(*w.writer);
-  if (!write_patiently(w.writer, sample)) return false;
-  w.drop.written();
-  return true;
-}
-
 struct OnlineChannel::Impl : public dds::DataReaderListener {
   std::string run_id;
   std::uint32_t agent;
@@ -94,7 +75,10 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
   dds::TypeSupport report_type{new wire::OnlineReportPubSubType()};
   dds::TypeSupport estimate_type{new wire::FinalEstimatePubSubType()};
   dds::DataWriter* estimate_writer = nullptr;
-  DroppingWriter block_writer, status_writer;
+  // Their readers are VOLATILE: they drop their acknowledged samples (acknowledged_drop.hpp)
+  // instead of keeping their last kVolatileWriterHistory for the whole mission.
+  dds::DataWriter *block_writer = nullptr, *status_writer = nullptr;
+  AcknowledgedDrop block_drop, status_drop;
   dds::DataWriter* report_writer = nullptr;
   dds::DataReader *block_reader = nullptr, *status_reader = nullptr, *report_reader = nullptr;
   std::mutex mutex;
@@ -181,8 +165,8 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       if (!writer || !reader)
         throw std::runtime_error(std::string("online channel: cannot create endpoints of ") + name);
     };
-    endpoints(kOnlineBlockTopic, block_type, false, block_writer.writer, block_reader);
-    endpoints(kOnlineStatusTopic, status_type, false, status_writer.writer, status_reader);
+    endpoints(kOnlineBlockTopic, block_type, false, block_writer, block_reader);
+    endpoints(kOnlineStatusTopic, status_type, false, status_writer, status_reader);
     // Reports are kept for readers that match later: the first epoch's reports may be sent
     // before every agent's reader is discovered.
     endpoints(kOnlineReportTopic, report_type, true, report_writer, report_reader);
@@ -293,14 +277,16 @@ std::size_t OnlineChannel::send(const OutgoingMessage& m, std::uint32_t epoch) {
   if (const auto* block = std::get_if<PoseBlockMessage>(&m.message)) {
     wire::PoseBlock w = to_wire_block(*block, impl_->run_id, m.broadcast, m.recipients);
     w.epoch(epoch);
-    if (!write_patiently(impl_->block_writer, w))
+    if (!impl_->block_drop.write(*impl_->block_writer,
+                                 [&] { return write_patiently(impl_->block_writer, w); }))
       throw std::runtime_error("online channel: a pose block write failed");
     return serialized_size(w);
   }
   wire::RoundStatus w = to_wire_status(std::get<RoundStatusMessage>(m.message), impl_->run_id,
                                        m.broadcast, m.recipients);
   w.epoch(epoch);
-  if (!write_patiently(impl_->status_writer, w))
+  if (!impl_->status_drop.write(*impl_->status_writer,
+                                [&] { return write_patiently(impl_->status_writer, w); }))
     throw std::runtime_error("online channel: a round status write failed");
   return serialized_size(w);
 }
@@ -379,7 +365,7 @@ std::vector<OnlineProtocolSample> OnlineChannel::take_messages() {
 
 int OnlineChannel::matched_peers() const {
   int fewest = 1 << 30;
-  for (auto* w : {impl_->block_writer.writer, impl_->status_writer.writer}) {
+  for (auto* w : {impl_->block_writer, impl_->status_writer}) {
     dds::PublicationMatchedStatus s;
     w->get_publication_matched_status(s);
     fewest = std::min(fewest, s.current_count);
@@ -393,7 +379,7 @@ int OnlineChannel::matched_peers() const {
 }
 
 void OnlineChannel::flush(double timeout_s) {
-  for (auto* w : {impl_->block_writer.writer, impl_->status_writer.writer, impl_->report_writer})
+  for (auto* w : {impl_->block_writer, impl_->status_writer, impl_->report_writer})
     w->wait_for_acknowledgments(Duration_t(timeout_s));
 }
 

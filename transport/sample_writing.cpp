@@ -18,25 +18,32 @@ SampleWriter::SampleWriter(const DdsEntities& entities, const SessionOptions& op
 
 void SampleWriter::write_raw(const std::string& name, void* sample, std::size_t size,
                              double timeout_s) {
-  const double bound_s = timeout_s > 0 ? timeout_s : opt_.write_timeout_s;
   eprosima::fastdds::dds::DataWriter* w = entities_.writer(name);
   if (!w)
     throw TransportError("this " + std::string(coordinator_ ? "coordinator" : "agent") +
                          " does not write " + name);
+  // Only writers whose readers are VOLATILE drop: the others keep their samples for late joiners.
+  if (!entities_.readers_volatile(name)) {
+    write_retrying(*w, name, sample, size, timeout_s);
+    return;
+  }
+  drop_of(name).write(*w, [&] {
+    write_retrying(*w, name, sample, size, timeout_s);
+    return true;  // write_retrying throws when the sample does not go out
+  });
+}
+
+void SampleWriter::write_retrying(eprosima::fastdds::dds::DataWriter& w, const std::string& name,
+                                  void* sample, std::size_t size, double timeout_s) {
+  const double bound_s = timeout_s > 0 ? timeout_s : opt_.write_timeout_s;
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(bound_s));
-  Topic& state = topic_state(name);
-  std::lock_guard<std::mutex> lock(state.mutex);
-  // Only writers whose readers are VOLATILE: the others keep their samples for late joiners.
-  const bool drops = entities_.readers_volatile(name);
-  if (drops) state.drop.before_write(*w);
   for (;;) {
     // The handle overload reports why a write failed (the plain one only returns a bool).
-    ReturnCode_t rc = w->write(sample, rtps::c_InstanceHandle_Unknown);
+    ReturnCode_t rc = w.write(sample, rtps::c_InstanceHandle_Unknown);
     if (rc == ReturnCode_t::RETCODE_OK) {
       bytes_ += size;
       ++messages_;
-      if (drops) state.drop.written();
       return;
     }
     if (rc == ReturnCode_t::RETCODE_BAD_PARAMETER || rc == ReturnCode_t::RETCODE_NOT_ENABLED ||
@@ -56,15 +63,15 @@ void SampleWriter::write_raw(const std::string& name, void* sample, std::size_t 
       throw TransportError("could not send on " + name + " within " + buf +
                            ": the receivers do not acknowledge (history full)");
     }
-    w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 20000000));
+    w.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 20000000));
   }
 }
 
-SampleWriter::Topic& SampleWriter::topic_state(const std::string& name) {
-  std::lock_guard<std::mutex> lock(topics_mutex_);
-  std::unique_ptr<Topic>& t = topics_[name];
-  if (!t) t = std::make_unique<Topic>();
-  return *t;
+AcknowledgedDrop& SampleWriter::drop_of(const std::string& name) {
+  std::lock_guard<std::mutex> lock(drops_mutex_);
+  std::unique_ptr<AcknowledgedDrop>& d = drops_[name];
+  if (!d) d = std::make_unique<AcknowledgedDrop>();
+  return *d;
 }
 
 void SampleWriter::flush(Seconds timeout) {

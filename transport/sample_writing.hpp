@@ -50,20 +50,19 @@ class SampleWriter {
 
  private:
   void write_raw(const std::string& topic, void* sample, std::size_t bytes, double timeout_s);
-  // Per topic: a write and the drop before it are one step (AcknowledgedDrop).
-  struct Topic {
-    std::mutex mutex;
-    AcknowledgedDrop drop;
-  };
-  Topic& topic_state(const std::string& name);
+  // The write with its retries while the history is full; throws TransportError at the bound.
+  void write_retrying(eprosima::fastdds::dds::DataWriter& w, const std::string& topic, void* sample,
+                      std::size_t bytes, double timeout_s);
+  // The drop schedule of a topic whose readers are VOLATILE (made at its first write).
+  AcknowledgedDrop& drop_of(const std::string& topic);
 
   const DdsEntities& entities_;
   const SessionOptions& opt_;
   bool coordinator_;
   const DdsTrace& trace_;
   std::atomic<std::uint64_t> bytes_{0}, messages_{0}, retries_{0};
-  std::mutex topics_mutex_;
-  std::map<std::string, std::unique_ptr<Topic>> topics_;
+  std::mutex drops_mutex_;
+  std::map<std::string, std::unique_ptr<AcknowledgedDrop>> drops_;
 };
 
 }  // namespace tessera::transport
