@@ -305,8 +305,8 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   // L (Hess f's) is still needed by balancing (its H Phi columns and A's products).
   const bool data_part = !options_.coarse_multipliers;
   // The data part's matrix from an earlier point: only Phi^T g is summed at this one.
-  coarse_fresh_ = !(data_part && result_.coarse_assemblies > 0 &&
-                    coarse_kept_steps_ < options_.coarse_keep_steps);
+  coarse_fresh_ = !keeps_coarse_matrix(data_part, result_.coarse_assemblies, coarse_kept_steps_,
+                                       options_.coarse_keep_steps);
   if (!coarse_fresh_) {
     std::vector<double> values(static_cast<std::size_t>(n), 0.0);
     coarse_->project(X_, g_, values.data());

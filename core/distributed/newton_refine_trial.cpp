@@ -80,8 +80,8 @@ void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
 bool NewtonRefineProtocol::ship_trial_coarse_gradient() const {
   // Where an accepted trial's step would keep the coarse matrix (send_coarse's test, one
   // accepted step on): the same on every agent.
-  return coarse_ && !options_.coarse_multipliers && result_.coarse_assemblies > 0 &&
-         coarse_kept_steps_ + 1 < options_.coarse_keep_steps;
+  return coarse_ && keeps_coarse_matrix(!options_.coarse_multipliers, result_.coarse_assemblies,
+                                        coarse_kept_steps_ + 1, options_.coarse_keep_steps);
 }
 
 bool NewtonRefineProtocol::ship_trial_shares() const {

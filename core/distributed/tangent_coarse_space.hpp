@@ -164,4 +164,12 @@ class TangentCoarseSpace {
   std::vector<GroupMatrix> matrices_;
 };
 
+/// Whether a Newton step whose coarse matrix was summed `kept_steps` accepted steps ago keeps it
+/// (sums only Phi^T g): only the data part's matrix is kept (`data_part`, no multipliers), once
+/// one was assembled, for fewer than `keep_steps` steps (NewtonRefineOptions::coarse_keep_steps).
+/// The one rule behind the step's coarse sum and the trial sums that carry its Phi^T g ahead.
+inline bool keeps_coarse_matrix(bool data_part, int assemblies, int kept_steps, int keep_steps) {
+  return data_part && assemblies > 0 && kept_steps < keep_steps;
+}
+
 }  // namespace tessera
