@@ -9,12 +9,14 @@
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/certified_agent.hpp>
+#include <tessera/distributed/coarse_exchange.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/distributed/protocol_snapshot.hpp>
 #include <tessera/distributed/round_protocol.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "runtime/coarse_space_share.hpp"
 #include "runtime/gnc_round_loop.hpp"
 #include "runtime/round_finish.hpp"
 #include "runtime/round_mailbox.hpp"
@@ -120,10 +122,14 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
                    options.block_update);
   phase("block state");
   if (options.coarse.enabled && options.coarse.space == CoarseSpaceKind::kSmoothed) {
-    // Every agent builds the same space from the structure: no message needed.
-    auto space = std::make_shared<const CoarseSpace>(make_coarse_space(
-        local.num_poses, local.structure, std::vector<int>(local.owner.begin(), local.owner.end()),
-        options.coarse));
+    // Every agent builds the same space from the structure (no message needed) and keeps the
+    // part it reads.
+    CoarseSpace built =
+        make_coarse_space(local.num_poses, local.structure,
+                          std::vector<int>(local.owner.begin(), local.owner.end()), options.coarse);
+    if (static_cast<int>(local.agent_id) != kCoarseSolver)
+      keep_agent_share(built, layout, static_cast<int>(local.agent_id), local.measurements);
+    auto space = std::make_shared<const CoarseSpace>(std::move(built));
     const std::size_t space_bytes = space->bytes();
     state.use_coarse_space(std::move(space), local.measurements);
     // Its two parts by what they grow with (docs/scale.md, "The memory model").
