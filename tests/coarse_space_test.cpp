@@ -148,6 +148,27 @@ TEST(SmoothedCoarseSpace, PiecesStayInTheirBlockAndWeightsArePartitionsOfUnity) 
   EXPECT_GT(across_blocks, 0u);  // the blend crosses block borders
 }
 
+// Every agent keeps the whole graph's weight lists through the run: they are sized once, not
+// left with a doubling's spare capacity, and bytes() counts what the lists hold.
+TEST(SmoothedCoarseSpace, WeightListsHoldNoSpareCapacityAndBytesCountThem) {
+  const Grid G = grid(400, 0.01);
+  const PoseGraph& g = G.graph;
+  const std::vector<int> part = sequential_partition(g.num_poses, 5);
+  CoarseOptions o;
+  o.aggregates = 3;
+  o.smoothing_steps = 2;
+  const CoarseSpace s = make_coarse_space(g.num_poses, g.measurements, part, o);
+  const std::size_t entries = s.weight_start.back();
+  ASSERT_GT(entries, g.num_poses);  // some poses are blended
+  EXPECT_EQ(s.weight.size(), entries);
+  EXPECT_EQ(s.weight.capacity(), entries);
+  EXPECT_EQ(s.weight_aggregate.capacity(), entries);
+  // At least the per-pose lists (owner, aggregate, weight_start) and the weights themselves.
+  EXPECT_GE(s.bytes(), g.num_poses * (2 * sizeof(int) + sizeof(std::size_t)) +
+                           entries * (sizeof(int) + sizeof(double)));
+  EXPECT_LT(s.bytes(), g.num_poses * 64 + entries * 16);
+}
+
 TEST(SmoothedCoarseSpace, CostIsTheModelOfFAndTheBlendStaysOnTheManifold) {
   const Grid G = grid(300, 0.01);
   const PoseGraph& g = G.graph;

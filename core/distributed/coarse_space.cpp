@@ -158,6 +158,14 @@ bool CoarseSpace::rigid_invariant(std::size_t i, std::size_t j) const {
          weight_aggregate[weight_start[i]] == weight_aggregate[weight_start[j]];
 }
 
+std::size_t CoarseSpace::bytes() const {
+  return aggregate_block.capacity() * sizeof(int) + owner.capacity() * sizeof(int) +
+         aggregate.capacity() * sizeof(int) + weight_start.capacity() * sizeof(std::size_t) +
+         weight_aggregate.capacity() * sizeof(int) + weight.capacity() * sizeof(double) +
+         pair_start.capacity() * sizeof(std::size_t) +
+         pairs.capacity() * sizeof(std::pair<int, int>);
+}
+
 CoarseSpace make_coarse_space(std::size_t num_poses, const Edges& edges,
                               const std::vector<int>& assignment, const CoarseOptions& options) {
   options.validate();
@@ -185,8 +193,13 @@ CoarseSpace make_coarse_space(std::size_t num_poses, const Edges& edges,
     const std::vector<Weights> w =
         smooth_weights(s, all, options.smoothing_steps, options.smoothing_weight);
     s.weight_start.assign(num_poses + 1, 0);
-    for (std::size_t i = 0; i < num_poses; ++i) {
+    for (std::size_t i = 0; i < num_poses; ++i)
       s.weight_start[i + 1] = s.weight_start[i] + w[i].size();
+    // Every agent keeps these whole-graph lists through the run: sized once, not grown by
+    // doubling (which left up to half their capacity unused).
+    s.weight_aggregate.reserve(s.weight_start[num_poses]);
+    s.weight.reserve(s.weight_start[num_poses]);
+    for (std::size_t i = 0; i < num_poses; ++i) {
       for (const auto& [a, v] : w[i]) {
         s.weight_aggregate.push_back(a);
         s.weight.push_back(v);
@@ -297,6 +310,14 @@ SmoothedCoarseTerms::SmoothedCoarseTerms(const CoarseSpace& space, int id, int d
       }
     edges_.push_back(std::move(e));
   }
+}
+
+std::size_t SmoothedCoarseTerms::bytes() const {
+  std::size_t b = edges_.capacity() * sizeof(Edge) + pieces_.capacity() * sizeof(Piece) +
+                  pair_index_.capacity() * sizeof(std::size_t);
+  for (const Edge& e : edges_)
+    b += static_cast<std::size_t>(e.R.size() + e.t.size()) * sizeof(double);
+  return b;
 }
 
 std::vector<double> SmoothedCoarseTerms::compute(const Eigen::MatrixXd& X,

@@ -2,18 +2,21 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <memory>
 #include <tessera/certification/certificate_cap.hpp>
 #include <tessera/distributed/agent_factory.hpp>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/certified_agent.hpp>
+#include <tessera/distributed/coarse_exchange.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/distributed/protocol_snapshot.hpp>
 #include <tessera/distributed/round_protocol.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "runtime/coarse_space_share.hpp"
 #include "runtime/gnc_round_loop.hpp"
 #include "runtime/round_finish.hpp"
 #include "runtime/round_mailbox.hpp"
@@ -117,13 +120,25 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   AgentState state(static_cast<int>(local.agent_id), local.d, layout, local.measurements,
                    lifted ? local.lifted_start : lift_poses(local.initial, options.rank),
                    options.block_update);
-  if (options.coarse.enabled && options.coarse.space == CoarseSpaceKind::kSmoothed)
-    // Every agent builds the same space from the structure: no message needed.
-    state.use_coarse_space(
-        std::make_shared<const CoarseSpace>(make_coarse_space(
-            local.num_poses, local.structure,
-            std::vector<int>(local.owner.begin(), local.owner.end()), options.coarse)),
-        local.measurements);
+  phase("block state");
+  if (options.coarse.enabled && options.coarse.space == CoarseSpaceKind::kSmoothed) {
+    // Every agent builds the same space from the structure (no message needed) and keeps the
+    // part it reads.
+    CoarseSpace built =
+        make_coarse_space(local.num_poses, local.structure,
+                          std::vector<int>(local.owner.begin(), local.owner.end()), options.coarse);
+    if (static_cast<int>(local.agent_id) != kCoarseSolver)
+      keep_agent_share(built, layout, static_cast<int>(local.agent_id), local.measurements);
+    auto space = std::make_shared<const CoarseSpace>(std::move(built));
+    const std::size_t space_bytes = space->bytes();
+    state.use_coarse_space(std::move(space), local.measurements);
+    // Its two parts by what they grow with (docs/scale.md, "The memory model").
+    char sizes[96];
+    std::snprintf(sizes, sizeof(sizes), " (the space %.1f MB, the block's terms %.1f MB)",
+                  static_cast<double>(space_bytes) / 1048576.0,
+                  static_cast<double>(state.smoothed_coarse_bytes()) / 1048576.0);
+    phase(std::string("smoothed coarse space") + sizes);
+  }
   if (options.refine.enabled && options.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed)
     state.use_refine_space(std::make_shared<const CoarseSpace>(make_coarse_space(
         local.num_poses, local.structure, std::vector<int>(local.owner.begin(), local.owner.end()),
@@ -131,11 +146,16 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   if (hooks.after_set_up) hooks.after_set_up();
   phase("block set-up");
   // The rounds' memory lines, from whichever protocol runs below.
-  std::size_t last_round_logged = 0;
+  // The count can move by more than one round between two handled messages, so a line is due
+  // when a round worth one was passed.
+  std::size_t last_round_seen = 0;
   const auto round_phase = [&](std::size_t rounds) {
-    if (!hooks.on_phase || rounds == last_round_logged || !worth_a_memory_line(rounds)) return;
-    last_round_logged = rounds;
-    phase("round " + std::to_string(rounds));
+    if (!hooks.on_phase || rounds <= last_round_seen) return;
+    bool due = false;
+    for (std::size_t r = last_round_seen + 1; r <= rounds && !due; ++r)
+      due = worth_a_memory_line(r);
+    last_round_seen = rounds;
+    if (due) phase("round " + std::to_string(rounds));
   };
   const double variables =
       static_cast<double>(options.rank) * (local.d + 1) * static_cast<double>(local.num_poses);
@@ -187,7 +207,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
     mail.after_handled = [&] {
       const int now_stage = sequence->refining() ? 1 : sequence->certificate_progress() ? 2 : 0;
       if (now_stage != timed_stage) close_stage(now_stage);
-      round_phase(static_cast<std::size_t>(sequence->total_rounds()));
+      round_phase(static_cast<std::size_t>(sequence->rounds_so_far()));
       const auto p = sequence->certificate_progress();
       if (p && p->first > 0)  // from its first iteration on: a lambda_min estimate to show
         mail.report_progress(ProgressStage::kCertificate, p->first, p->second);

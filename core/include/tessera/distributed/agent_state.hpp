@@ -76,6 +76,8 @@ class AgentState {
   const CoarseSpace* refine_space() const { return refine_space_.get(); }
   /// This agent's smoothed coarse terms at (Y, Yn); needs use_coarse_space.
   std::vector<double> smoothed_coarse_terms() const { return smoothed_->compute(Y, Yn); }
+  /// Bytes of this agent's smoothed coarse terms (0 without use_coarse_space).
+  std::size_t smoothed_coarse_bytes() const { return smoothed_ ? smoothed_->bytes() : 0; }
   /// Moves Y, V and the neighbour copies Yn, Vn by their blended motions (one per aggregate).
   void apply_smoothed_coarse(const std::vector<Eigen::MatrixXd>& motions);
   /// This block's preconditioner applied to a tangent vector G at X (X: the block's point on

@@ -87,6 +87,12 @@ class CertifiedAgent : public AgentProcess {
   int final_rank() const { return state_.rank(); }
   /// Sums over the solve stages.
   int total_rounds() const;
+  /// total_rounds() and the rounds of the solve stage running now (total_rounds() counts a
+  /// stage once it has ended).
+  int rounds_so_far() const {
+    const bool solving = !done_ && solve_ && current_ == solve_.get();
+    return total_rounds() + (solving ? solve_->rounds() : 0);
+  }
   int total_restarts() const;
   /// Sums of the certificate's LOBPCG iterations and of the escapes' line-search trials.
   int certificate_iterations() const;

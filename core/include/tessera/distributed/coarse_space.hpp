@@ -53,6 +53,9 @@ struct CoarseSpace {
   /// An edge whose both ends move by the same single rigid motion: its residual's norm never
   /// changes, so it is left out of Q_c.
   bool rigid_invariant(std::size_t i, std::size_t j) const;
+  /// Bytes its lists hold (their capacities): every agent keeps the whole graph's
+  /// (docs/scale.md, "The memory model").
+  std::size_t bytes() const;
 };
 
 /// Builds the space of `options` (aggregates, smoothing_steps, smoothing_weight) from the
@@ -77,6 +80,9 @@ class SmoothedCoarseTerms {
   /// for each of the agent's pairs (CoarseSpace::pairs order) Q_alpha,beta on I x I: the upper
   /// triangle column by column when alpha = beta, else the whole block column-major.
   std::vector<double> compute(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn) const;
+
+  /// Bytes held (lists' capacities and each edge's R and t): grows with the agent's edges.
+  std::size_t bytes() const;
 
  private:
   // One piece in the blend of an edge's ends: its weight at the target j and at the source i
