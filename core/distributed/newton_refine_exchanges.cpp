@@ -33,6 +33,13 @@ bool assemble_sigma(InterfaceSolve& interface, const std::vector<std::vector<dou
 }  // namespace
 
 void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
+  const std::vector<double> values = interface_share();
+  if (options_.sigma_factoring != SigmaFactoring::kShipSolves)
+    return broadcast(kInterface, values, out);
+  send_to_holder(kInterface, values, brief_share(values), out);
+}
+
+std::vector<double> NewtonRefineProtocol::interface_share() {
   // This block's share of Sigma at the current point, then its interface residual of -g (the
   // first CG residual), so that the first direction needs no further message step.
   charge_to(&result_.times.factor_s);
@@ -91,26 +98,34 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
       for (int j = 0; j < k; ++j)
         v[2 * k * k + k + i * k + j] = frobenius_inner(gauge_hv_[static_cast<std::size_t>(i)],
                                                        gauge_hv_[static_cast<std::size_t>(j)]);
-  if (options_.sigma_factoring != SigmaFactoring::kShipSolves)
-    return broadcast(kInterface, values, out);
+  return values;
+}
+
+std::vector<double> NewtonRefineProtocol::brief_share(const std::vector<double>& values) const {
+  // The flag, the interface residuals (where the block factored) and the gauge's sums.
+  const std::size_t tail =
+      gauge_share_size() + (values.front() != 0.0 ? share_tail() : std::size_t{0});
+  std::vector<double> brief{values.front()};
+  brief.insert(brief.end(), values.end() - static_cast<std::ptrdiff_t>(tail), values.end());
+  return brief;
+}
+
+void NewtonRefineProtocol::send_to_holder(std::uint32_t step, const std::vector<double>& full,
+                                          const std::vector<double>& brief,
+                                          std::vector<OutgoingMessage>& out) {
   // Agent 0 alone assembles Sigma: it receives the whole shares, the others each share's flag,
   // interface residuals and gauge sums only. Always the same agent: its Sigma pattern and
   // symbolic analysis are laid out once (each first assemble() on an agent does both; taking
   // turns on city10000's 3 points cost 183 M instructions in assemble() against 111 M).
-  const int n = layout_.num_blocks;
-  const std::size_t tail = values.size() - at + (values.front() != 0.0 ? share_tail() : 0);
-  std::vector<double> brief{values.front()};
-  brief.insert(brief.end(), values.end() - static_cast<std::ptrdiff_t>(tail), values.end());
   const int id = state_.id();
-  gate_.add(id, message_round_, kInterface,
-            make_reduction_message(id, message_round_, kInterface, values));
-  for (int b = 0; b < n; ++b) {
+  gate_.add(id, message_round_, step, make_reduction_message(id, message_round_, step, full));
+  for (int b = 0; b < layout_.num_blocks; ++b) {
     if (b == id) continue;
-    out.push_back(addressed_to(static_cast<std::uint32_t>(b),
-                               make_reduction_message(id, message_round_, kInterface,
-                                                      b == kSigmaHolder ? values : brief)));
+    out.push_back(addressed_to(
+        static_cast<std::uint32_t>(b),
+        make_reduction_message(id, message_round_, step, b == kSigmaHolder ? full : brief)));
   }
-  gate_.expect(message_round_, kInterface, everyone_);
+  gate_.expect(message_round_, step, everyone_);
   ++result_.reductions;
 }
 
@@ -186,6 +201,15 @@ std::size_t NewtonRefineProtocol::gauge_share_size() const {
 
 void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
+  std::vector<std::pair<int, const std::vector<double>*>> shares;
+  for (const auto& [sender, m] : inbox)
+    shares.emplace_back(sender, &std::get<PoseBlockMessage>(m).data);
+  use_interface_shares(shares, out);
+}
+
+void NewtonRefineProtocol::use_interface_shares(
+    const std::vector<std::pair<int, const std::vector<double>*>>& inbox,
+    std::vector<OutgoingMessage>& out) {
   // Every agent assembles the same Sigma from the same shares in id order.
   charge_to(&result_.times.sigma_s);
   std::vector<std::vector<double>> shares;
@@ -200,8 +224,8 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
   int b = 0;
   const std::size_t gn = gauge_share_size();
   std::vector<double> gsum(gn, 0.0);
-  for (const auto& [sender, m] : inbox) {
-    const std::vector<double>& full = std::get<PoseBlockMessage>(m).data;
+  for (const auto& [sender, data] : inbox) {
+    const std::vector<double>& full = *data;
     if (full.size() <= gn) throw std::runtime_error("newton refine: empty interface share");
     for (std::size_t i = 0; i < gn; ++i) gsum[i] += full[full.size() - gn + i];
     const std::vector<double> v(full.begin(), full.end() - static_cast<std::ptrdiff_t>(gn));

@@ -36,6 +36,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,6 +46,7 @@
 #include <tessera/distributed/coarse_correction.hpp>
 #include <tessera/distributed/message_gate.hpp>
 #include <tessera/problem/block_problem.hpp>
+#include <utility>
 #include <vector>
 
 namespace tessera {
@@ -253,6 +255,17 @@ struct NewtonRefineOptions {
   /// curvature along the gauge (6 steps, one rejected, 36 message steps; projected: 4, 31)
   /// (docs/newton-refine.md, "Gauge").
   bool project_gauge = false;
+  /// With the interface solves: the start point's interface shares (each block's Schur
+  /// complement and couplings, interface residual of -g and gauge sums; kShipSolves: the
+  /// brief ones to the agents other than agent 0) ride in the start's sum (kStatus) instead of
+  /// a message step of their own right after it. Each agent factors its block at the start
+  /// point before the sum says whether a refinement runs at all: where the start's gradient is
+  /// already below grad_norm_tol, or the rows in use on some agent are not the first d (then
+  /// the interface step runs as before), that factorization is not used. The same iterates
+  /// either way; one message step fewer per refinement (GNC's weighted solves are one
+  /// refinement of one Newton step each; docs/newton-refine.md). A core option without a flag:
+  /// every agent of a run uses the same value.
+  bool interface_in_status = true;
   /// Who assembles and factors Sigma, the interface solves' matrix, at each point
   /// (`--refine-sigma`, set_sigma_mode). All three take the same steps, CG iterations and
   /// iterates to the same bits (the same shares in id order, the same factorization and
@@ -448,6 +461,12 @@ class NewtonRefineProtocol : public AgentProcess {
   void set_trial_observer(std::function<void(const Eigen::MatrixXd&)> observer) {
     trial_observer_ = std::move(observer);
   }
+  /// Before start(): ||grad f|| at the start point as the team last summed it (the rounds' last
+  /// status; the same on every agent). At or below grad_norm_tol the refinement will stop at
+  /// its start's sum, so the interface shares (interface_in_status) stay out of that sum: a
+  /// robust run's final solve that only checks its gradient sent them for nothing (CSAIL, 25 %
+  /// random outliers: 1.4 MB). Only bytes and work depend on it, never the iterates.
+  void set_start_grad_norm(double grad_norm) { start_grad_norm_ = grad_norm; }
 
   /// Where the refinement is, for progress reports: the trust-region step being computed
   /// (1-based, rejected ones and backtracks counted), the CG iterations of that step so far and
@@ -474,6 +493,10 @@ class NewtonRefineProtocol : public AgentProcess {
   double evaluate_point();
   Eigen::MatrixXd hessian(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
   void after_status(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // Whether this agent's rows in use (own and neighbour poses) are all below d.
+  bool nonzero_rows_within(Eigen::Index d) const;
+  // The point and its gradients on rows_ only (rows_taken_).
+  void take_rows();
   void begin_cg(std::vector<OutgoingMessage>& out);
   // The coarse matrix's share at the current point, summed by every agent (kCoarse).
   void send_coarse(std::vector<OutgoingMessage>& out);
@@ -482,6 +505,21 @@ class NewtonRefineProtocol : public AgentProcess {
   // then every agent's Sigma.
   void send_interface(std::vector<OutgoingMessage>& out);
   void after_interface(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // send_interface()'s message values: this block's factor and share of Sigma at the current
+  // point, its interface residuals and the gauge's sums (sets the point's gauge and forward
+  // solves of -g).
+  std::vector<double> interface_share();
+  // kShipSolves: what of a share the agents other than the holder receive.
+  std::vector<double> brief_share(const std::vector<double>& values) const;
+  // kShipSolves: `full` to the holder (and this agent's own gate), `brief` to the others.
+  void send_to_holder(std::uint32_t step, const std::vector<double>& full,
+                      const std::vector<double>& brief, std::vector<OutgoingMessage>& out);
+  // after_interface() on the team's shares (every agent's, in id order), wherever they came in.
+  void use_interface_shares(const std::vector<std::pair<int, const std::vector<double>*>>& shares,
+                            std::vector<OutgoingMessage>& out);
+  // The interface solves where they apply to the team's interface (its size within the cap),
+  // null elsewhere; the layout is the same on every agent, so is the answer.
+  std::unique_ptr<InterfaceSolve> make_interface();
   // v's columns of the interface solve's grounded pose set to zero (where this block has it).
   void ground_pose(Eigen::MatrixXd& v) const;
   // The gauge's numbers in each interface share: V^T V, V^T H V (k x k each) and V^T g.
@@ -587,6 +625,10 @@ class NewtonRefineProtocol : public AgentProcess {
   // CG's recurrences (the one of H z rides in the iteration's sum).
   std::unique_ptr<InterfaceSolve> interface_;
   bool interface_due_ = true, use_interface_ = false;
+  // options_.interface_in_status: the start's sum has the interface shares' field (the same on
+  // every agent); this agent's point is on the first d rows already (its share computed there).
+  bool status_shares_ = false, rows_taken_ = false;
+  double start_grad_norm_ = std::numeric_limits<double>::quiet_NaN();  // NaN: not known
   // kShipFactor: whether the current trial's sum carries the shares; the team's shares at the
   // accepted trial (id order), in hand for the next interface step (shares_ready_).
   bool trial_shares_ = false, shares_ready_ = false;
