@@ -119,16 +119,23 @@ double NewtonRefineProtocol::evaluate_point() {
 }
 
 Eigen::MatrixXd NewtonRefineProtocol::hessian(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn) {
+  return hessian_at(X_, egrad_, v, vn);
+}
+
+Eigen::MatrixXd NewtonRefineProtocol::hessian_at(const Eigen::MatrixXd& X,
+                                                 const Eigen::MatrixXd& egrad,
+                                                 const Eigen::MatrixXd& v,
+                                                 const Eigen::MatrixXd& vn) {
   // The block's rows of Hess f(X)[v]: 2 (v_B Q_BB + v_N Q_NB) (euclidean_gradient with the
   // neighbours set to v_N), projected with the Weingarten term of the block's own poses.
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(vn);
   Eigen::MatrixXd H = problem_.euclidean_gradient(v);
-  apply_hessian_projection(X_, egrad_, v, problem_.dim(), H);
+  apply_hessian_projection(X, egrad, v, problem_.dim(), H);
   // The kernel leaves the Weingarten term V sym(X^T egrad) unprojected (its normal part does
   // not change an inner product with a tangent vector). CG's residual must be tangent: the
   // tangent preconditioner maps a normal component to zero, so <r, P r> fell to 1e-34 while
   // ||r|| stayed at half its start (sphere2500) and the residual test never held.
-  return problem_.manifold(static_cast<int>(X_.rows())).tangent_project(X_, H);
+  return problem_.manifold(static_cast<int>(X.rows())).tangent_project(X, H);
 }
 
 std::vector<OutgoingMessage> NewtonRefineProtocol::start() {
@@ -170,7 +177,7 @@ std::vector<OutgoingMessage> NewtonRefineProtocol::start() {
     // use on every agent unless some agent says otherwise (after_status()).
     rows_.resize(static_cast<std::size_t>(problem_.dim()));
     take_rows();
-    full = interface_share();
+    full = interface_share(X_, Xn_, egrad_, g_, false);
     if (options_.sigma_factoring == SigmaFactoring::kShipSolves) brief = brief_share(full);
     charge_to(&result_.times.setup_s);
   }
@@ -407,7 +414,8 @@ void NewtonRefineProtocol::prepare_preconditioner() {
 void NewtonRefineProtocol::begin_cg(std::vector<OutgoingMessage>& out) {
   // Only before a CG that will run: the factor at the point where the refinement stops would
   // not be used.
-  if (interface_ && interface_due_) return send_interface(out);
+  if (interface_ && interface_due_)
+    return interface_carried_ ? use_carried_shares(out) : send_interface(out);
   if (refactor_due_ && !use_interface_) prepare_preconditioner();
   if (coarse_ && coarse_due_) return send_coarse(out);
   start_cg(out);
@@ -654,8 +662,9 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
 void NewtonRefineProtocol::finish(const std::string& why) {
   result_.stop_reason = why;
   if (interface_) result_.interface_analyses = interface_->analyses();
-  if (shares_ready_) ++result_.pending_factors_unused;  // the accepted trial's, not needed
-  shares_ready_ = false;
+  // The accepted trial's, not needed.
+  if (shares_ready_ || interface_carried_) ++result_.pending_factors_unused;
+  shares_ready_ = interface_carried_ = false;
   result_.times.wall_s = steady_s() - wall_start_;
   result_.cost = f_;
   result_.grad_norm = gnorm_;

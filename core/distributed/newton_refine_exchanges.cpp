@@ -33,43 +33,48 @@ bool assemble_sigma(InterfaceSolve& interface, const std::vector<std::vector<dou
 }  // namespace
 
 void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
-  const std::vector<double> values = interface_share();
+  const std::vector<double> values = interface_share(X_, Xn_, egrad_, g_, false);
   if (options_.sigma_factoring != SigmaFactoring::kShipSolves)
     return broadcast(kInterface, values, out);
   send_to_holder(kInterface, values, brief_share(values), out);
 }
 
-std::vector<double> NewtonRefineProtocol::interface_share() {
-  // This block's share of Sigma at the current point, then its interface residual of -g (the
-  // first CG residual), so that the first direction needs no further message step.
+std::vector<double> NewtonRefineProtocol::interface_share(const Eigen::MatrixXd& X,
+                                                          const Eigen::MatrixXd& Xn,
+                                                          const Eigen::MatrixXd& egrad,
+                                                          const Eigen::MatrixXd& g, bool pending) {
+  // This block's share of Sigma at the point, then its interface residual of -g (the first CG
+  // residual), so that the first direction needs no further message step.
   charge_to(&result_.times.factor_s);
   // With the shares in hand (the accepted trial's sum carried them, kShipFactor) the block is
   // factored at this point already: only its flag goes out, and agent 0's Sigma factor.
   std::vector<double> values =
       shares_ready_
           ? std::vector<double>{next_shares_.at(static_cast<std::size_t>(state_.id())).front()}
-          : interface_->factor(X_, Xn_, egrad_);
+      : pending ? interface_->factor_pending(X, Xn, egrad)
+                : interface_->factor(X, Xn, egrad);
   if (shares_ready_ && state_.id() == kSigmaHolder) {
     const std::vector<double> sigma = factor_shipped_sigma();
     values.insert(values.end(), sigma.begin(), sigma.end());
     charge_to(&result_.times.factor_s);
   }
   // The gauge at this point (H V: local products, V known on the neighbours' poses).
-  gauge_ = std::make_unique<GaugeSpace>(problem_.dim(), X_, Xn_);
+  gauge_ = std::make_unique<GaugeSpace>(problem_.dim(), X, Xn);
   const int k = gauge_->size();
   gauge_hv_.clear();
-  for (int c = 0; c < k; ++c) gauge_hv_.push_back(hessian(gauge_->own(c), gauge_->neighbours(c)));
+  for (int c = 0; c < k; ++c)
+    gauge_hv_.push_back(hessian_at(X, egrad, gauge_->own(c), gauge_->neighbours(c)));
   if (values.front() != 0.0) {
     // The own segment of the team's interface residual of -g, then (projecting the gauge) of
     // each column of V and of H V, from the block's forward solves.
     const auto own = [&](const Eigen::MatrixXd& v, Eigen::VectorXd& y) {
-      interface_->forward(X_, v, y);
+      interface_->forward(X, v, y, pending);
       std::vector<double> rhat(static_cast<std::size_t>(interface_->team_size()), 0.0);
-      interface_->add_interface(y, rhat.data());
+      interface_->add_interface(y, rhat.data(), pending);
       values.insert(values.end(), rhat.begin() + interface_->offset(),
                     rhat.begin() + interface_->offset() + interface_->size());
     };
-    own(-g_, iy_g_);
+    own(-g, iy_g_);
     if (options_.project_gauge) {
       Eigen::VectorXd y;
       for (int c = 0; c < k; ++c) {
@@ -92,7 +97,7 @@ std::vector<double> NewtonRefineProtocol::interface_share() {
     gauge_->dot(gauge_->own(c), v + c * k);
     gauge_->dot(gauge_hv_[static_cast<std::size_t>(c)], v + k * k + c * k);
   }
-  gauge_->dot(g_, v + 2 * k * k);
+  gauge_->dot(g, v + 2 * k * k);
   if (options_.project_gauge)
     for (int i = 0; i < k; ++i)
       for (int j = 0; j < k; ++j)
@@ -127,6 +132,25 @@ void NewtonRefineProtocol::send_to_holder(std::uint32_t step, const std::vector<
   }
   gate_.expect(message_round_, step, everyone_);
   ++result_.reductions;
+}
+
+void NewtonRefineProtocol::swap_point_parts() {
+  std::swap(gauge_, trial_gauge_);
+  std::swap(gauge_hv_, trial_gauge_hv_);
+  std::swap(iy_g_, trial_iy_g_);
+  std::swap(gauge_fv_, trial_gauge_fv_);
+  std::swap(gauge_fhv_, trial_gauge_fhv_);
+}
+
+void NewtonRefineProtocol::use_carried_shares(std::vector<OutgoingMessage>& out) {
+  const std::vector<std::vector<double>> carried = std::move(next_shares_);
+  next_shares_.clear();
+  interface_carried_ = false;
+  ++result_.interface_shares_carried;
+  std::vector<std::pair<int, const std::vector<double>*>> in;
+  for (std::size_t b = 0; b < carried.size(); ++b)
+    in.emplace_back(static_cast<int>(b), &carried[b]);
+  use_interface_shares(in, out);
 }
 
 std::size_t NewtonRefineProtocol::share_tail() const {
