@@ -56,14 +56,18 @@ TEST(NewtonRefine, ReachesTheCentralizedOptimumWhereTheRoundsStopShortOfIt) {
   // Each CG iteration is one neighbour exchange and one all-agent sum; each step adds the
   // exchange of its trial point, the exact solve of its translations (one sum) and its cost's
   // sum, plus the start's sum, a step's last CG exchange and the interface matrix's sum at
-  // each new point.
+  // each new point but the start, whose shares ride in the start's sum, and those whose shares
+  // rode in the accepted trial's sum.
   EXPECT_GT(n.translation_interface_poses, 0);
   EXPECT_EQ(n.translation_iterations, 0);
   EXPECT_EQ(n.translation_solves, n.steps);
   EXPECT_GE(n.exchanges, n.cg_iterations + n.steps);
   EXPECT_LE(n.exchanges, n.cg_iterations + 2 * n.steps);
-  EXPECT_EQ(n.reductions, n.exchanges + n.translation_solves + 1 + n.coarse_assemblies +
-                              n.interface_factorizations + n.interface_fallbacks);
+  ASSERT_GT(n.interface_coordinates, 0);
+  EXPECT_GE(n.interface_shares_carried, 1);
+  EXPECT_EQ(n.reductions, n.exchanges + n.translation_solves + n.coarse_assemblies +
+                              n.interface_factorizations + n.interface_fallbacks -
+                              n.interface_shares_carried);
   EXPECT_LE(n.coarse_assemblies, n.accepted_steps + 1);
   // The rounds stop measurably above f*; the refined estimate is at f*.
   const double gap_plain = (plain.cost - fstar) / fstar;
@@ -72,6 +76,75 @@ TEST(NewtonRefine, ReachesTheCentralizedOptimumWhereTheRoundsStopShortOfIt) {
   EXPECT_LT(std::abs(gap_newton), 1e-8) << "plain " << gap_plain;
   EXPECT_LT(newton.grad_norm, plain.grad_norm);
   EXPECT_EQ(newton.relaxation_cost, n.cost);
+}
+
+// NewtonRefineOptions::interface_in_status: the start point's interface shares ride in its
+// status sum, so the refinement takes the same steps to the same bits in one message step
+// fewer, whether every agent factors Sigma or agent 0 alone solves with it (its brief shares to
+// the others).
+TEST(NewtonRefine, TheStartPointsInterfaceSharesInItsStatusSumSaveAMessageStepForTheSameSteps) {
+  const PoseGraph g = long_chain();
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  using SigmaFactoring = NewtonRefineOptions::SigmaFactoring;
+  for (const SigmaFactoring sigma : {SigmaFactoring::kEveryAgent, SigmaFactoring::kShipSolves}) {
+    DistributedOptions on = refined(true);
+    on.refine.sigma_factoring = sigma;
+    on.refine.ship_solves_min_coordinates = 0;  // the chain's interface is small
+    DistributedOptions off = on;
+    off.refine.interface_in_status = false;
+    const DistributedResult a = solve_distributed(g, parts, off);
+    const DistributedResult b = solve_distributed(g, parts, on);
+    ASSERT_EQ(a.refines.size(), 1u);
+    ASSERT_EQ(b.refines.size(), 1u);
+    const NewtonRefineResult &x = a.refines[0], &y = b.refines[0];
+    ASSERT_GT(x.interface_coordinates, 0) << "the chain's refinement should use interface solves";
+    EXPECT_EQ(y.interface_coordinates, x.interface_coordinates);
+    EXPECT_EQ(y.steps, x.steps);
+    EXPECT_EQ(y.accepted_steps, x.accepted_steps);
+    EXPECT_EQ(y.cg_iterations, x.cg_iterations);
+    EXPECT_EQ(y.interface_factorizations, x.interface_factorizations);
+    EXPECT_EQ(y.exchanges, x.exchanges);
+    EXPECT_EQ(y.solution_steps, x.solution_steps);
+    EXPECT_EQ(y.reductions, x.reductions - 1);
+    EXPECT_EQ(y.message_steps(), x.message_steps() - 1);
+    EXPECT_EQ(y.cost, x.cost);
+    EXPECT_EQ(b.X, a.X);
+  }
+}
+
+// NewtonRefineOptions::interface_in_trial_sums: a trial predicted not to end the refinement
+// carries each block's interface share at the trial point in its sum, so an accepted one's CG
+// starts without an interface step: the same steps to the same bits, one message step fewer
+// per such step, whether every agent factors Sigma or agent 0 alone solves with it.
+TEST(NewtonRefine, AnAcceptedTrialsInterfaceSharesInItsSumSaveAMessageStepForTheSameSteps) {
+  const PoseGraph g = long_chain();
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  using SigmaFactoring = NewtonRefineOptions::SigmaFactoring;
+  for (const SigmaFactoring sigma : {SigmaFactoring::kEveryAgent, SigmaFactoring::kShipSolves}) {
+    DistributedOptions on = refined(true);
+    on.refine.sigma_factoring = sigma;
+    on.refine.ship_solves_min_coordinates = 0;  // the chain's interface is small
+    DistributedOptions off = on;
+    off.refine.interface_in_trial_sums = false;
+    const DistributedResult a = solve_distributed(g, parts, off);
+    const DistributedResult b = solve_distributed(g, parts, on);
+    ASSERT_EQ(a.refines.size(), 1u);
+    ASSERT_EQ(b.refines.size(), 1u);
+    const NewtonRefineResult &x = a.refines[0], &y = b.refines[0];
+    ASSERT_GT(x.interface_coordinates, 0) << "the chain's refinement should use interface solves";
+    ASSERT_GE(x.accepted_steps, 2) << "a step after an accepted one should run";
+    EXPECT_EQ(x.interface_shares_carried, 0);
+    EXPECT_GE(y.interface_shares_carried, 1);
+    EXPECT_EQ(y.steps, x.steps);
+    EXPECT_EQ(y.accepted_steps, x.accepted_steps);
+    EXPECT_EQ(y.cg_iterations, x.cg_iterations);
+    EXPECT_EQ(y.interface_factorizations, x.interface_factorizations);
+    EXPECT_EQ(y.exchanges, x.exchanges);
+    EXPECT_EQ(y.solution_steps, x.solution_steps);
+    EXPECT_EQ(y.reductions, x.reductions - y.interface_shares_carried);
+    EXPECT_EQ(y.cost, x.cost);
+    EXPECT_EQ(b.X, a.X);
+  }
 }
 
 TEST(NewtonRefine, EveryAgentTakesTheSameStepsInAnyDeliveryOrder) {

@@ -126,6 +126,8 @@ void CertifiedAgent::begin_refine(std::vector<OutgoingMessage>& out) {
     refine.grad_norm_tol = std::min(refine.grad_norm_tol, options_.grad_norm_tol);
   refine_ = std::make_unique<NewtonRefineProtocol>(state_, layout_, refine);
   if (trial_observer_) refine_->set_trial_observer(trial_observer_);
+  if (!solves_.empty() && !solves_.back().trace.empty())
+    refine_->set_start_grad_norm(solves_.back().trace.back().grad_norm);
   current_ = refine_.get();
   emit(refine_->start(), out);
   for (const ProtocolMessage& m :

@@ -449,8 +449,8 @@ Eigen::Index InterfaceSolve::grounded_pose() const {
   return -1;
 }
 
-void InterfaceSolve::forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
-                             Eigen::VectorXd& y) const {
+void InterfaceSolve::forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, Eigen::VectorXd& y,
+                             bool pending) const {
   const Impl& s = *impl_;
   const int p = s.p;
   s.b.resize(s.m * p);
@@ -461,14 +461,17 @@ void InterfaceSolve::forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v,
   y.resize(s.m * p);
   for (Eigen::Index i = 0; i < s.m; ++i)
     y.segment(s.slot[static_cast<std::size_t>(i)] * p, p) = s.b.segment(i * p, p);
-  s.f->block->solve_l(y);
+  if (pending && !s.f->pending)
+    throw std::logic_error("InterfaceSolve::forward: no pending factor");
+  (pending ? s.f->pending : s.f->block)->solve_l(y);
 }
 
-void InterfaceSolve::add_interface(const Eigen::VectorXd& y, double* team) const {
+void InterfaceSolve::add_interface(const Eigen::VectorXd& y, double* team, bool pending) const {
   const Impl& s = *impl_;
   const Eigen::Index nG = s.mG * s.p;
   if (nG == 0) return;
-  Eigen::Map<Eigen::VectorXd>(team + s.own_offset, nG) += s.Lgg * y.tail(nG);
+  Eigen::Map<Eigen::VectorXd>(team + s.own_offset, nG) +=
+      (pending ? s.pending_Lgg : s.Lgg) * y.tail(nG);
 }
 
 void InterfaceSolve::adopt_remote_sigma(bool grounded) {

@@ -151,10 +151,13 @@ class InterfaceSolve {
   /// -1 on the other blocks and without grounding.
   Eigen::Index grounded_pose() const;
 
-  /// y = L^-1 P J^T v (v: a tangent vector at X, d rows), the block's forward solve.
-  void forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, Eigen::VectorXd& y) const;
-  /// The block's rhat from y: L_GG y_G, added into team (team_size() entries) at offset().
-  void add_interface(const Eigen::VectorXd& y, double* team) const;
+  /// y = L^-1 P J^T v (v: a tangent vector at X, d rows), the block's forward solve (`pending`:
+  /// with the factor_pending() one, X its point).
+  void forward(const Eigen::MatrixXd& X, const Eigen::MatrixXd& v, Eigen::VectorXd& y,
+               bool pending = false) const;
+  /// The block's rhat from y: L_GG y_G, added into team (team_size() entries) at offset()
+  /// (`pending`: the factor_pending() one's L_GG).
+  void add_interface(const Eigen::VectorXd& y, double* team, bool pending = false) const;
   /// z = J P^T L^-T [y_I ; L_GG^T u_b], u = (Sigma + eta I)^-1 rhat (rhat: the team's,
   /// team_size() entries; grounded: u and z are 0 at the held pose and rhat there is not
   /// read): the preconditioned vector, a tangent vector at X.

@@ -119,16 +119,23 @@ double NewtonRefineProtocol::evaluate_point() {
 }
 
 Eigen::MatrixXd NewtonRefineProtocol::hessian(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn) {
+  return hessian_at(X_, egrad_, v, vn);
+}
+
+Eigen::MatrixXd NewtonRefineProtocol::hessian_at(const Eigen::MatrixXd& X,
+                                                 const Eigen::MatrixXd& egrad,
+                                                 const Eigen::MatrixXd& v,
+                                                 const Eigen::MatrixXd& vn) {
   // The block's rows of Hess f(X)[v]: 2 (v_B Q_BB + v_N Q_NB) (euclidean_gradient with the
   // neighbours set to v_N), projected with the Weingarten term of the block's own poses.
   if (problem_.num_neighbors() > 0) problem_.set_neighbor_poses(vn);
   Eigen::MatrixXd H = problem_.euclidean_gradient(v);
-  apply_hessian_projection(X_, egrad_, v, problem_.dim(), H);
+  apply_hessian_projection(X, egrad, v, problem_.dim(), H);
   // The kernel leaves the Weingarten term V sym(X^T egrad) unprojected (its normal part does
   // not change an inner product with a tangent vector). CG's residual must be tangent: the
   // tangent preconditioner maps a normal component to zero, so <r, P r> fell to 1e-34 while
   // ||r|| stayed at half its start (sphere2500) and the residual test never held.
-  return problem_.manifold(static_cast<int>(X_.rows())).tangent_project(X_, H);
+  return problem_.manifold(static_cast<int>(X.rows())).tangent_project(X, H);
 }
 
 std::vector<OutgoingMessage> NewtonRefineProtocol::start() {
@@ -146,20 +153,76 @@ std::vector<OutgoingMessage> NewtonRefineProtocol::start() {
   values.insert(values.end(), used.begin(), used.end());
   // Exact trial translations: L_BB's factor and Schur complement do not depend on the point, so
   // they ride in this first sum.
+  std::vector<double> translation_share;
   if (options_.translation_iterations > 0 && options_.translation_interface_max_poses > 0 &&
       layout_.num_blocks > 1) {
     const Eigen::Index team = interface_pose_count(layout_);
     if (team > 0 && team <= options_.translation_interface_max_poses) {
       translation_solve_ =
           std::make_unique<TranslationInterfaceSolve>(problem_, layout_, state_.id());
-      const std::vector<double> share = translation_solve_->share();
-      values.insert(values.end(), share.begin(), share.end());
+      translation_share = translation_solve_->share();
     }
   }
-  broadcast(kStatus, values, out);
+  // The interface shares at the start point, in this sum too: the count of this block's, then
+  // its values (0: none; after_status() then sends them in a step of their own).
+  // Not where the team's last sum at this point says the refinement stops at this one.
+  status_shares_ =
+      options_.interface_in_status && options_.coarse == NewtonRefineOptions::Coarse::kNone &&
+      state_.Y.rows() >= problem_.dim() && !(start_grad_norm_ <= options_.grad_norm_tol);
+  if (status_shares_) interface_ = make_interface();
+  status_shares_ = status_shares_ && interface_;
+  std::vector<double> full, brief;
+  if (status_shares_ && nonzero_rows_within(problem_.dim())) {
+    // Each share is at the point on the first d rows, the interface solves' rank: the ones in
+    // use on every agent unless some agent says otherwise (after_status()).
+    rows_.resize(static_cast<std::size_t>(problem_.dim()));
+    take_rows();
+    full = interface_share(X_, Xn_, egrad_, g_, false);
+    if (options_.sigma_factoring == SigmaFactoring::kShipSolves) brief = brief_share(full);
+    charge_to(&result_.times.setup_s);
+  }
+  const auto with_shares = [&](const std::vector<double>& shares) {
+    std::vector<double> v = values;
+    if (status_shares_) {
+      v.push_back(static_cast<double>(shares.size()));
+      v.insert(v.end(), shares.begin(), shares.end());
+    }
+    v.insert(v.end(), translation_share.begin(), translation_share.end());
+    return v;
+  };
+  if (status_shares_ && options_.sigma_factoring == SigmaFactoring::kShipSolves)
+    send_to_holder(kStatus, with_shares(full), with_shares(full.empty() ? full : brief), out);
+  else
+    broadcast(kStatus, with_shares(full), out);
   pump(out);
   charge_to(nullptr);
   return out;
+}
+
+bool NewtonRefineProtocol::nonzero_rows_within(Eigen::Index d) const {
+  for (Eigen::Index k : nonzero_rows(state_.Y, state_.Yn))
+    if (k >= d) return false;
+  return true;
+}
+
+void NewtonRefineProtocol::take_rows() {
+  // Every step maps rows that are zero on every agent to zero: work on the others only.
+  X_ = state_.Y(rows_, Eigen::all);
+  Xn_ = state_.Yn(rows_, Eigen::all);
+  egrad_ = egrad_(rows_, Eigen::all).eval();
+  g_ = g_(rows_, Eigen::all).eval();
+  rows_taken_ = true;
+}
+
+std::unique_ptr<InterfaceSolve> NewtonRefineProtocol::make_interface() {
+  if (options_.interface_max_coordinates <= 0 || layout_.num_blocks <= 1) return nullptr;
+  auto solve = std::make_unique<InterfaceSolve>(problem_, layout_, state_.id(), options_.analyses);
+  if (solve->team_size() <= 0 || solve->team_size() > options_.interface_max_coordinates)
+    return nullptr;
+  if (options_.sigma_factoring == SigmaFactoring::kShipSolves &&
+      solve->team_size() < options_.ship_solves_min_coordinates)
+    options_.sigma_factoring = SigmaFactoring::kEveryAgent;
+  return solve;
 }
 
 std::vector<OutgoingMessage> NewtonRefineProtocol::handle(const ProtocolMessage& message) {
@@ -242,17 +305,30 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
                                         std::vector<OutgoingMessage>& out) {
   charge_to(&result_.times.setup_s);
   const std::size_t r = static_cast<std::size_t>(state_.Y.rows());
-  // The sums (in id order, as reduce_in_id_order), then each block's translation share.
+  // The sums (in id order, as reduce_in_id_order), then (status_shares_) each block's
+  // interface share after its count, then each block's translation share.
   std::vector<double> t(2 + r, 0.0);
   std::vector<std::vector<double>> shares;
+  std::vector<std::vector<double>> interface_shares;  // every block's, or none
   for (const auto& [sender, m] : inbox) {
     const auto* p = std::get_if<PoseBlockMessage>(&m);
-    if (!p || p->data.size() < 2 + r || (p->data.size() > 2 + r) != (translation_solve_ != nullptr))
+    std::size_t at = 2 + r;
+    std::size_t count = 0;
+    if (p && status_shares_ && p->data.size() > at) {
+      count = static_cast<std::size_t>(p->data[at]);
+      ++at;
+    }
+    if (!p || p->data.size() < at + count ||
+        (p->data.size() > at + count) != (translation_solve_ != nullptr) ||
+        (status_shares_ && at == 2 + r))
       throw std::runtime_error("newton refine: malformed status from agent " +
                                std::to_string(sender));
     for (std::size_t k = 0; k < 2 + r; ++k) t[k] += p->data[k];
+    const auto from = p->data.begin() + static_cast<std::ptrdiff_t>(at);
+    if (count > 0 && interface_shares.size() == static_cast<std::size_t>(sender))
+      interface_shares.emplace_back(from, from + static_cast<std::ptrdiff_t>(count));
     if (translation_solve_)
-      shares.emplace_back(p->data.begin() + static_cast<std::ptrdiff_t>(2 + r), p->data.end());
+      shares.emplace_back(from + static_cast<std::ptrdiff_t>(count), p->data.end());
   }
   if (translation_solve_) {
     std::vector<const std::vector<double>*> ptrs;
@@ -266,18 +342,29 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
   for (std::size_t k = 0; k < r; ++k)
     if (t[2 + k] > 0) active.push_back(static_cast<Eigen::Index>(k));
   if (active.empty()) active.push_back(0);
+  // The shares are at the first d rows: usable where those are the team's rows in use and
+  // every block sent its share.
+  bool shares_usable = interface_shares.size() == static_cast<std::size_t>(layout_.num_blocks) &&
+                       active.size() == static_cast<std::size_t>(problem_.dim());
+  for (std::size_t k = 0; shares_usable && k < active.size(); ++k)
+    shares_usable = active[k] == static_cast<Eigen::Index>(k);
+  if (rows_taken_ && !shares_usable) {
+    X_ = state_.Y;  // back to the whole start point
+    Xn_ = state_.Yn;
+    evaluate_point();
+    rows_taken_ = false;
+  }
   rows_ = active;
-  // Every step maps rows that are zero on every agent to zero: work on the others only.
-  X_ = state_.Y(rows_, Eigen::all);
-  Xn_ = state_.Yn(rows_, Eigen::all);
-  egrad_ = egrad_(rows_, Eigen::all).eval();
-  g_ = g_(rows_, Eigen::all).eval();
+  if (!rows_taken_) take_rows();
   f_ = t[0];
   gnorm_ = std::sqrt(std::max(0.0, t[1]));
   result_.initial_cost = result_.cost = f_;
   result_.initial_grad_norm = result_.grad_norm = gnorm_;
   radius_ = options_.initial_radius;
-  if (gnorm_ <= options_.grad_norm_tol) return finish("grad_norm");
+  if (gnorm_ <= options_.grad_norm_tol) {
+    interface_.reset();  // a share sent in the start's sum is not used
+    return finish("grad_norm");
+  }
   if (options_.coarse != NewtonRefineOptions::Coarse::kNone) {
     const CoarseSpace* space =
         options_.coarse == NewtonRefineOptions::Coarse::kSmoothed ? state_.refine_space() : nullptr;
@@ -291,24 +378,25 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
   }
   // Interface solves: at rank d (tangent coordinates) without a coarse correction, where the
   // team's interface fits. The layout is the same on every agent, so is the decision.
-  if (options_.interface_max_coordinates > 0 && !coarse_ &&
-      static_cast<int>(rows_.size()) == problem_.dim() && layout_.num_blocks > 1) {
-    auto solve =
-        std::make_unique<InterfaceSolve>(problem_, layout_, state_.id(), options_.analyses);
-    if (solve->team_size() > 0 && solve->team_size() <= options_.interface_max_coordinates) {
-      result_.interface_coordinates = static_cast<int>(solve->team_size());
-      if (options_.sigma_factoring == SigmaFactoring::kShipSolves &&
-          solve->team_size() < options_.ship_solves_min_coordinates)
-        options_.sigma_factoring = SigmaFactoring::kEveryAgent;
-      interface_ = std::move(solve);
-    }
+  if (!coarse_ && static_cast<int>(rows_.size()) == problem_.dim()) {
+    if (!interface_) interface_ = make_interface();
+  } else {
+    interface_.reset();
   }
-  if (interface_)
+  if (interface_) {
+    result_.interface_coordinates = static_cast<int>(interface_->team_size());
     refactor_due_ = true;  // block Jacobi's factor only where a point falls back to it
-  else
+  } else {
     prepare_preconditioner();
+  }
   if (options_.translation_iterations > 0 && !translation_solve_)
     translation_preconditioner_ = std::make_unique<TranslationPreconditioner>(problem_);
+  if (interface_ && shares_usable) {
+    std::vector<std::pair<int, const std::vector<double>*>> in;
+    for (std::size_t b = 0; b < interface_shares.size(); ++b)
+      in.emplace_back(static_cast<int>(b), &interface_shares[b]);
+    return use_interface_shares(in, out);
+  }
   begin_cg(out);
 }
 
@@ -326,7 +414,8 @@ void NewtonRefineProtocol::prepare_preconditioner() {
 void NewtonRefineProtocol::begin_cg(std::vector<OutgoingMessage>& out) {
   // Only before a CG that will run: the factor at the point where the refinement stops would
   // not be used.
-  if (interface_ && interface_due_) return send_interface(out);
+  if (interface_ && interface_due_)
+    return interface_carried_ ? use_carried_shares(out) : send_interface(out);
   if (refactor_due_ && !use_interface_) prepare_preconditioner();
   if (coarse_ && coarse_due_) return send_coarse(out);
   start_cg(out);
@@ -573,8 +662,9 @@ void NewtonRefineProtocol::after_sums(const MessageGate::Inbox& inbox,
 void NewtonRefineProtocol::finish(const std::string& why) {
   result_.stop_reason = why;
   if (interface_) result_.interface_analyses = interface_->analyses();
-  if (shares_ready_) ++result_.pending_factors_unused;  // the accepted trial's, not needed
-  shares_ready_ = false;
+  // The accepted trial's, not needed.
+  if (shares_ready_ || interface_carried_) ++result_.pending_factors_unused;
+  shares_ready_ = interface_carried_ = false;
   result_.times.wall_s = steady_s() - wall_start_;
   result_.cost = f_;
   result_.grad_norm = gnorm_;

@@ -33,36 +33,48 @@ bool assemble_sigma(InterfaceSolve& interface, const std::vector<std::vector<dou
 }  // namespace
 
 void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
-  // This block's share of Sigma at the current point, then its interface residual of -g (the
-  // first CG residual), so that the first direction needs no further message step.
+  const std::vector<double> values = interface_share(X_, Xn_, egrad_, g_, false);
+  if (options_.sigma_factoring != SigmaFactoring::kShipSolves)
+    return broadcast(kInterface, values, out);
+  send_to_holder(kInterface, values, brief_share(values), out);
+}
+
+std::vector<double> NewtonRefineProtocol::interface_share(const Eigen::MatrixXd& X,
+                                                          const Eigen::MatrixXd& Xn,
+                                                          const Eigen::MatrixXd& egrad,
+                                                          const Eigen::MatrixXd& g, bool pending) {
+  // This block's share of Sigma at the point, then its interface residual of -g (the first CG
+  // residual), so that the first direction needs no further message step.
   charge_to(&result_.times.factor_s);
   // With the shares in hand (the accepted trial's sum carried them, kShipFactor) the block is
   // factored at this point already: only its flag goes out, and agent 0's Sigma factor.
   std::vector<double> values =
       shares_ready_
           ? std::vector<double>{next_shares_.at(static_cast<std::size_t>(state_.id())).front()}
-          : interface_->factor(X_, Xn_, egrad_);
+      : pending ? interface_->factor_pending(X, Xn, egrad)
+                : interface_->factor(X, Xn, egrad);
   if (shares_ready_ && state_.id() == kSigmaHolder) {
     const std::vector<double> sigma = factor_shipped_sigma();
     values.insert(values.end(), sigma.begin(), sigma.end());
     charge_to(&result_.times.factor_s);
   }
   // The gauge at this point (H V: local products, V known on the neighbours' poses).
-  gauge_ = std::make_unique<GaugeSpace>(problem_.dim(), X_, Xn_);
+  gauge_ = std::make_unique<GaugeSpace>(problem_.dim(), X, Xn);
   const int k = gauge_->size();
   gauge_hv_.clear();
-  for (int c = 0; c < k; ++c) gauge_hv_.push_back(hessian(gauge_->own(c), gauge_->neighbours(c)));
+  for (int c = 0; c < k; ++c)
+    gauge_hv_.push_back(hessian_at(X, egrad, gauge_->own(c), gauge_->neighbours(c)));
   if (values.front() != 0.0) {
     // The own segment of the team's interface residual of -g, then (projecting the gauge) of
     // each column of V and of H V, from the block's forward solves.
     const auto own = [&](const Eigen::MatrixXd& v, Eigen::VectorXd& y) {
-      interface_->forward(X_, v, y);
+      interface_->forward(X, v, y, pending);
       std::vector<double> rhat(static_cast<std::size_t>(interface_->team_size()), 0.0);
-      interface_->add_interface(y, rhat.data());
+      interface_->add_interface(y, rhat.data(), pending);
       values.insert(values.end(), rhat.begin() + interface_->offset(),
                     rhat.begin() + interface_->offset() + interface_->size());
     };
-    own(-g_, iy_g_);
+    own(-g, iy_g_);
     if (options_.project_gauge) {
       Eigen::VectorXd y;
       for (int c = 0; c < k; ++c) {
@@ -85,33 +97,60 @@ void NewtonRefineProtocol::send_interface(std::vector<OutgoingMessage>& out) {
     gauge_->dot(gauge_->own(c), v + c * k);
     gauge_->dot(gauge_hv_[static_cast<std::size_t>(c)], v + k * k + c * k);
   }
-  gauge_->dot(g_, v + 2 * k * k);
+  gauge_->dot(g, v + 2 * k * k);
   if (options_.project_gauge)
     for (int i = 0; i < k; ++i)
       for (int j = 0; j < k; ++j)
         v[2 * k * k + k + i * k + j] = frobenius_inner(gauge_hv_[static_cast<std::size_t>(i)],
                                                        gauge_hv_[static_cast<std::size_t>(j)]);
-  if (options_.sigma_factoring != SigmaFactoring::kShipSolves)
-    return broadcast(kInterface, values, out);
+  return values;
+}
+
+std::vector<double> NewtonRefineProtocol::brief_share(const std::vector<double>& values) const {
+  // The flag, the interface residuals (where the block factored) and the gauge's sums.
+  const std::size_t tail =
+      gauge_share_size() + (values.front() != 0.0 ? share_tail() : std::size_t{0});
+  std::vector<double> brief{values.front()};
+  brief.insert(brief.end(), values.end() - static_cast<std::ptrdiff_t>(tail), values.end());
+  return brief;
+}
+
+void NewtonRefineProtocol::send_to_holder(std::uint32_t step, const std::vector<double>& full,
+                                          const std::vector<double>& brief,
+                                          std::vector<OutgoingMessage>& out) {
   // Agent 0 alone assembles Sigma: it receives the whole shares, the others each share's flag,
   // interface residuals and gauge sums only. Always the same agent: its Sigma pattern and
   // symbolic analysis are laid out once (each first assemble() on an agent does both; taking
   // turns on city10000's 3 points cost 183 M instructions in assemble() against 111 M).
-  const int n = layout_.num_blocks;
-  const std::size_t tail = values.size() - at + (values.front() != 0.0 ? share_tail() : 0);
-  std::vector<double> brief{values.front()};
-  brief.insert(brief.end(), values.end() - static_cast<std::ptrdiff_t>(tail), values.end());
   const int id = state_.id();
-  gate_.add(id, message_round_, kInterface,
-            make_reduction_message(id, message_round_, kInterface, values));
-  for (int b = 0; b < n; ++b) {
+  gate_.add(id, message_round_, step, make_reduction_message(id, message_round_, step, full));
+  for (int b = 0; b < layout_.num_blocks; ++b) {
     if (b == id) continue;
-    out.push_back(addressed_to(static_cast<std::uint32_t>(b),
-                               make_reduction_message(id, message_round_, kInterface,
-                                                      b == kSigmaHolder ? values : brief)));
+    out.push_back(addressed_to(
+        static_cast<std::uint32_t>(b),
+        make_reduction_message(id, message_round_, step, b == kSigmaHolder ? full : brief)));
   }
-  gate_.expect(message_round_, kInterface, everyone_);
+  gate_.expect(message_round_, step, everyone_);
   ++result_.reductions;
+}
+
+void NewtonRefineProtocol::swap_point_parts() {
+  std::swap(gauge_, trial_gauge_);
+  std::swap(gauge_hv_, trial_gauge_hv_);
+  std::swap(iy_g_, trial_iy_g_);
+  std::swap(gauge_fv_, trial_gauge_fv_);
+  std::swap(gauge_fhv_, trial_gauge_fhv_);
+}
+
+void NewtonRefineProtocol::use_carried_shares(std::vector<OutgoingMessage>& out) {
+  const std::vector<std::vector<double>> carried = std::move(next_shares_);
+  next_shares_.clear();
+  interface_carried_ = false;
+  ++result_.interface_shares_carried;
+  std::vector<std::pair<int, const std::vector<double>*>> in;
+  for (std::size_t b = 0; b < carried.size(); ++b)
+    in.emplace_back(static_cast<int>(b), &carried[b]);
+  use_interface_shares(in, out);
 }
 
 std::size_t NewtonRefineProtocol::share_tail() const {
@@ -186,6 +225,15 @@ std::size_t NewtonRefineProtocol::gauge_share_size() const {
 
 void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
                                            std::vector<OutgoingMessage>& out) {
+  std::vector<std::pair<int, const std::vector<double>*>> shares;
+  for (const auto& [sender, m] : inbox)
+    shares.emplace_back(sender, &std::get<PoseBlockMessage>(m).data);
+  use_interface_shares(shares, out);
+}
+
+void NewtonRefineProtocol::use_interface_shares(
+    const std::vector<std::pair<int, const std::vector<double>*>>& inbox,
+    std::vector<OutgoingMessage>& out) {
   // Every agent assembles the same Sigma from the same shares in id order.
   charge_to(&result_.times.sigma_s);
   std::vector<std::vector<double>> shares;
@@ -200,8 +248,8 @@ void NewtonRefineProtocol::after_interface(const MessageGate::Inbox& inbox,
   int b = 0;
   const std::size_t gn = gauge_share_size();
   std::vector<double> gsum(gn, 0.0);
-  for (const auto& [sender, m] : inbox) {
-    const std::vector<double>& full = std::get<PoseBlockMessage>(m).data;
+  for (const auto& [sender, data] : inbox) {
+    const std::vector<double>& full = *data;
     if (full.size() <= gn) throw std::runtime_error("newton refine: empty interface share");
     for (std::size_t i = 0; i < gn; ++i) gsum[i] += full[full.size() - gn + i];
     const std::vector<double> v(full.begin(), full.end() - static_cast<std::ptrdiff_t>(gn));

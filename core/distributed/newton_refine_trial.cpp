@@ -74,7 +74,34 @@ void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
     const std::vector<double> mine = interface_->factor_pending(Xt_, Xtn_, egrad_t_);
     values.insert(values.end(), mine.begin(), mine.end());
   }
-  broadcast(kTrialSums, values, out);
+  trial_interface_ = ship_trial_interface();
+  if (!trial_interface_) return broadcast(kTrialSums, values, out);
+  // The whole interface share at the trial point, before the verdict (its gauge and forward
+  // solves kept aside): accepted, the next CG starts from these with no interface step.
+  swap_point_parts();
+  const std::vector<double> full = interface_share(Xt_, Xtn_, egrad_t_, g_t_, true);
+  std::vector<double> brief;
+  if (options_.sigma_factoring == SigmaFactoring::kShipSolves) brief = brief_share(full);
+  swap_point_parts();
+  charge_to(&result_.times.trial_s);
+  const auto with = [&](const std::vector<double>& share) {
+    std::vector<double> v = values;
+    v.insert(v.end(), share.begin(), share.end());
+    return v;
+  };
+  if (options_.sigma_factoring == SigmaFactoring::kShipSolves)
+    send_to_holder(kTrialSums, with(full), with(brief), out);
+  else
+    broadcast(kTrialSums, with(full), out);
+}
+
+bool NewtonRefineProtocol::ship_trial_interface() const {
+  // As ship_trial_shares(), where Sigma's shares at each point are the interface step's whole
+  // message (every agent factoring Sigma, or agent 0 solving with it).
+  return options_.interface_in_trial_sums &&
+         options_.sigma_factoring != SigmaFactoring::kShipFactor && interface_ && use_interface_ &&
+         step_.predicted > options_.relative_decrease_tol * std::abs(f_) &&
+         result_.steps + 1 < options_.max_steps;
 }
 
 bool NewtonRefineProtocol::ship_trial_coarse_gradient() const {
@@ -103,11 +130,12 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
   std::vector<std::vector<double>> shares;
   for (const auto& [sender, m] : inbox) {
     const auto* p = std::get_if<PoseBlockMessage>(&m);
-    if (!p || p->data.size() < sums || (p->data.size() > sums) != trial_shares_)
+    const bool carried = trial_shares_ || trial_interface_;
+    if (!p || p->data.size() < sums || (p->data.size() > sums) != carried)
       throw std::runtime_error("newton refine: malformed trial sums from agent " +
                                std::to_string(sender));
     for (std::size_t k = 0; k < sums; ++k) t[k] += p->data[k];
-    if (trial_shares_)
+    if (carried)
       shares.emplace_back(p->data.begin() + static_cast<std::ptrdiff_t>(sums), p->data.end());
   }
   const double ft = t[0], gt = std::sqrt(std::max(0.0, t[1]));
@@ -141,15 +169,19 @@ void NewtonRefineProtocol::after_trial_sums(const MessageGate::Inbox& inbox,
     }
     interface_due_ = true;
     refactor_due_ = true;  // each CG solve preconditioned at its own point (when asked)
-    if (trial_shares_) {
+    if (trial_shares_ || trial_interface_) {
       interface_->commit_pending();
       next_shares_ = std::move(shares);
-      shares_ready_ = true;
+      shares_ready_ = trial_shares_;
     }
-  } else if (trial_shares_) {
+    if (trial_interface_) {  // the next CG's interface step is in hand
+      swap_point_parts();
+      interface_carried_ = true;
+    }
+  } else if (trial_shares_ || trial_interface_) {
     ++result_.pending_factors_unused;
   }
-  trial_shares_ = trial_coarse_g_ = false;
+  trial_shares_ = trial_interface_ = trial_coarse_g_ = false;
   step_.cost = f_;
   step_.grad_norm = gnorm_;
   result_.trace.push_back(step_);

@@ -36,6 +36,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,6 +46,7 @@
 #include <tessera/distributed/coarse_correction.hpp>
 #include <tessera/distributed/message_gate.hpp>
 #include <tessera/problem/block_problem.hpp>
+#include <utility>
 #include <vector>
 
 namespace tessera {
@@ -253,6 +255,25 @@ struct NewtonRefineOptions {
   /// curvature along the gauge (6 steps, one rejected, 36 message steps; projected: 4, 31)
   /// (docs/newton-refine.md, "Gauge").
   bool project_gauge = false;
+  /// With the interface solves: the start point's interface shares (each block's Schur
+  /// complement and couplings, interface residual of -g and gauge sums; kShipSolves: the
+  /// brief ones to the agents other than agent 0) ride in the start's sum (kStatus) instead of
+  /// a message step of their own right after it. Each agent factors its block at the start
+  /// point before the sum says whether a refinement runs at all: where the start's gradient is
+  /// already below grad_norm_tol, or the rows in use on some agent are not the first d (then
+  /// the interface step runs as before), that factorization is not used. The same iterates
+  /// either way; one message step fewer per refinement (GNC's weighted solves are one
+  /// refinement of one Newton step each; docs/newton-refine.md). A core option without a flag:
+  /// every agent of a run uses the same value.
+  bool interface_in_status = true;
+  /// With the interface solves (every agent factoring Sigma, or agent 0 solving with it): where
+  /// the model predicts that a trial step will not end the refinement (as kShipFactor's test
+  /// below), each agent factors its block at the trial point before the verdict and its whole
+  /// interface share there rides in the trial's sum; an accepted trial's CG then starts with no
+  /// interface step of its own. A rejected trial's or a last step's factorization is not used
+  /// (pending_factors_unused). The same iterates either way; one message step fewer per
+  /// accepted step but the last. A core option without a flag, as interface_in_status.
+  bool interface_in_trial_sums = true;
   /// Who assembles and factors Sigma, the interface solves' matrix, at each point
   /// (`--refine-sigma`, set_sigma_mode). All three take the same steps, CG iterations and
   /// iterates to the same bits (the same shares in id order, the same factorization and
@@ -378,6 +399,9 @@ struct NewtonRefineResult {
   /// Accepted steps that kept the coarse matrix and took Phi^T g at their point from the
   /// trial's sum (no coarse message step of their own).
   int coarse_gradients_carried = 0;
+  /// Accepted steps whose interface shares at their point came with the trial's sum
+  /// (interface_in_trial_sums: no interface message step of their own).
+  int interface_shares_carried = 0;
   /// Iterations of the trial points' translation solves (each one exchange and one sum,
   /// counted in `exchanges` and `reductions`).
   int translation_iterations = 0;
@@ -387,7 +411,9 @@ struct NewtonRefineResult {
   int translation_interface_poses = 0, translation_solves = 0;
   /// Interface solves (interface_max_coordinates): the team's interface in tangent coordinates
   /// (0: not used), the points where Sigma was factored (one all-agent message step each,
-  /// counted in `reductions`) and where it could not be (that step's CG ran block Jacobi).
+  /// counted in `reductions`, but where the shares rode in the sum before: the start's with
+  /// interface_in_status, interface_shares_carried) and where it could not be (that step's CG
+  /// ran block Jacobi).
   int interface_coordinates = 0, interface_factorizations = 0, interface_fallbacks = 0;
   /// This agent's own assemblies and factorizations of Sigma (points), the points whose Sigma it
   /// took from agent 0's factor (kShipFactor), and the block factorizations at trial points that
@@ -448,6 +474,12 @@ class NewtonRefineProtocol : public AgentProcess {
   void set_trial_observer(std::function<void(const Eigen::MatrixXd&)> observer) {
     trial_observer_ = std::move(observer);
   }
+  /// Before start(): ||grad f|| at the start point as the team last summed it (the rounds' last
+  /// status; the same on every agent). At or below grad_norm_tol the refinement will stop at
+  /// its start's sum, so the interface shares (interface_in_status) stay out of that sum: a
+  /// robust run's final solve that only checks its gradient sent them for nothing (CSAIL, 25 %
+  /// random outliers: 1.4 MB). Only bytes and work depend on it, never the iterates.
+  void set_start_grad_norm(double grad_norm) { start_grad_norm_ = grad_norm; }
 
   /// Where the refinement is, for progress reports: the trust-region step being computed
   /// (1-based, rejected ones and backtracks counted), the CG iterations of that step so far and
@@ -473,7 +505,14 @@ class NewtonRefineProtocol : public AgentProcess {
   // Local pieces at (X_, Xn_): egrad_, g_ and the cost share.
   double evaluate_point();
   Eigen::MatrixXd hessian(const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
+  // The same at another point X (egrad its Euclidean gradient).
+  Eigen::MatrixXd hessian_at(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
+                             const Eigen::MatrixXd& v, const Eigen::MatrixXd& vn);
   void after_status(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // Whether this agent's rows in use (own and neighbour poses) are all below d.
+  bool nonzero_rows_within(Eigen::Index d) const;
+  // The point and its gradients on rows_ only (rows_taken_).
+  void take_rows();
   void begin_cg(std::vector<OutgoingMessage>& out);
   // The coarse matrix's share at the current point, summed by every agent (kCoarse).
   void send_coarse(std::vector<OutgoingMessage>& out);
@@ -482,6 +521,31 @@ class NewtonRefineProtocol : public AgentProcess {
   // then every agent's Sigma.
   void send_interface(std::vector<OutgoingMessage>& out);
   void after_interface(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // send_interface()'s message values: this block's factor and share of Sigma at the current
+  // point, its interface residuals and the gauge's sums (sets the point's gauge and forward
+  // solves of -g).
+  std::vector<double> interface_share(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn,
+                                      const Eigen::MatrixXd& egrad, const Eigen::MatrixXd& g,
+                                      bool pending);
+  // The point's gauge and forward solves (gauge_, gauge_hv_, iy_g_, gauge_fv_, gauge_fhv_)
+  // swapped with the trial point's (interface_in_trial_sums).
+  void swap_point_parts();
+  // The accepted trial's interface shares, carried by its sum: the step kInterface would be.
+  void use_carried_shares(std::vector<OutgoingMessage>& out);
+  // Whether this trial's sum carries the whole interface share at the trial point
+  // (interface_in_trial_sums): the same inputs, so the same answer, on every agent.
+  bool ship_trial_interface() const;
+  // kShipSolves: what of a share the agents other than the holder receive.
+  std::vector<double> brief_share(const std::vector<double>& values) const;
+  // kShipSolves: `full` to the holder (and this agent's own gate), `brief` to the others.
+  void send_to_holder(std::uint32_t step, const std::vector<double>& full,
+                      const std::vector<double>& brief, std::vector<OutgoingMessage>& out);
+  // after_interface() on the team's shares (every agent's, in id order), wherever they came in.
+  void use_interface_shares(const std::vector<std::pair<int, const std::vector<double>*>>& shares,
+                            std::vector<OutgoingMessage>& out);
+  // The interface solves where they apply to the team's interface (its size within the cap),
+  // null elsewhere; the layout is the same on every agent, so is the answer.
+  std::unique_ptr<InterfaceSolve> make_interface();
   // v's columns of the interface solve's grounded pose set to zero (where this block has it).
   void ground_pose(Eigen::MatrixXd& v) const;
   // The gauge's numbers in each interface share: V^T V, V^T H V (k x k each) and V^T g.
@@ -587,6 +651,18 @@ class NewtonRefineProtocol : public AgentProcess {
   // CG's recurrences (the one of H z rides in the iteration's sum).
   std::unique_ptr<InterfaceSolve> interface_;
   bool interface_due_ = true, use_interface_ = false;
+  // options_.interface_in_status: the start's sum has the interface shares' field (the same on
+  // every agent); this agent's point is on the first d rows already (its share computed there).
+  bool status_shares_ = false, rows_taken_ = false;
+  // interface_in_trial_sums: whether the current trial's sum carries its interface shares, and
+  // whether the accepted trial's (next_shares_) are in hand for the next CG; the trial point's
+  // gauge and forward solves meanwhile (swap_point_parts()).
+  bool trial_interface_ = false, interface_carried_ = false;
+  std::unique_ptr<GaugeSpace> trial_gauge_;
+  std::vector<Eigen::MatrixXd> trial_gauge_hv_;
+  Eigen::VectorXd trial_iy_g_;
+  Eigen::MatrixXd trial_gauge_fv_, trial_gauge_fhv_;
+  double start_grad_norm_ = std::numeric_limits<double>::quiet_NaN();  // NaN: not known
   // kShipFactor: whether the current trial's sum carries the shares; the team's shares at the
   // accepted trial (id order), in hand for the next interface step (shares_ready_).
   bool trial_shares_ = false, shares_ready_ = false;
