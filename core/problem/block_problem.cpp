@@ -3,6 +3,7 @@
 #include <string>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/pose_kernels.hpp>
+#include <utility>
 
 namespace tessera {
 namespace {
@@ -220,6 +221,11 @@ Eigen::MatrixXd BlockProblem::euclidean_gradient(const Eigen::MatrixXd& X,
 Eigen::MatrixXd BlockProblem::riemannian_gradient(const Eigen::MatrixXd& X,
                                                   const Eigen::MatrixXd& egrad) const {
   return manifold(static_cast<int>(X.rows())).tangent_project(X, egrad);
+}
+
+Eigen::MatrixXd BlockProblem::riemannian_gradient(const Eigen::MatrixXd& X,
+                                                  Eigen::MatrixXd&& egrad) const {
+  return manifold(static_cast<int>(X.rows())).tangent_project(X, std::move(egrad));
 }
 
 Eigen::MatrixXd BlockProblem::hessian_vector(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,

@@ -78,6 +78,8 @@ class BlockProblem {
                                      const Eigen::MatrixXd& X_neighbors) const;
   /// Riemannian gradient on the block's manifold.
   Eigen::MatrixXd riemannian_gradient(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad) const;
+  /// The same, projecting egrad in its own storage (no copy; the same values).
+  Eigen::MatrixXd riemannian_gradient(const Eigen::MatrixXd& X, Eigen::MatrixXd&& egrad) const;
   /// Riemannian Hessian applied to tangent V at X (egrad = Euclidean gradient at X).
   Eigen::MatrixXd hessian_vector(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
                                  const Eigen::MatrixXd& V) const;
