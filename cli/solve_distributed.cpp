@@ -18,6 +18,7 @@
 #include "certificate_output.hpp"
 #include "graph_input.hpp"
 #include "json_writer.hpp"
+#include "partition_file.hpp"
 #include "robust_args.hpp"
 #include "solve_output.hpp"
 #include "solver_graph.hpp"
@@ -61,6 +62,7 @@ const char* const kDistributedValued[] = {"agents",
                                           "irbcd-class-score",
                                           "partition-objective",
                                           "partition-time",
+                                          "partition-file",
                                           "coarse",
                                           "coarse-every",
                                           "coarse-min-gain",
@@ -101,6 +103,9 @@ const char* kDistributedHelp =
     "  --partition-time S        cap the partitioner's search at S seconds of wall time\n"
     "                            (default 0: no cap, the preset's own effort; with a cap the\n"
     "                            partition depends on the machine's speed)\n"
+    "  --partition-file FILE     the block of every pose from FILE instead of a search (one\n"
+    "                            block id per line, as tessera partition --out writes, or a\n"
+    "                            JSON object with an \"assignment\" array); ids 0..agents-1\n"
     "  --init chordal|distributed|file   initial guess (default chordal; file = VERTEX poses)\n"
     "  --robots R                robots of --init distributed: R contiguous id ranges (default N)\n"
     "  --grad-tol T              stop at ||grad f|| <= T, full cost (default 0.01)\n"
@@ -242,6 +247,29 @@ void write_trace(const std::string& path, const DistributedResult& r) {
     out << buf;
   }
   if (!out) throw InputError(path, 0, "write failed");
+}
+
+// --partition-file: the given blocks with the figures a search reports (no search time).
+PartitionResult given_partition(const PoseGraph& graph, const std::string& path, int parts) {
+  PartitionResult part;
+  part.assignment = read_partition(path, graph.num_poses);
+  std::vector<bool> used(static_cast<std::size_t>(parts), false);
+  for (int b : part.assignment) {
+    if (b >= parts)
+      throw InputError(
+          path, 0,
+          "block " + std::to_string(b) + " is not below --agents " + std::to_string(parts));
+    used[static_cast<std::size_t>(b)] = true;
+  }
+  for (int b = 0; b < parts; ++b)
+    if (!used[static_cast<std::size_t>(b)])
+      throw InputError(path, 0, "block " + std::to_string(b) + " holds no pose");
+  const GraphStructure structure = graph_structure_from_pose_graph(graph);
+  part.metrics = compute_partition_metrics(structure, part.assignment, parts);
+  const BlockAdjacency adjacency = block_adjacency(structure, part.assignment, parts);
+  part.adjacent_block_pairs = adjacency.adjacent_block_pairs;
+  part.colours = adjacency.colours;
+  return part;
 }
 
 }  // namespace
@@ -403,7 +431,12 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   if (!(popt.time_limit_s >= 0.0))
     throw InputError("option --partition-time: must be >= 0 seconds (0 = no cap)");
   popt.validate();
-  PartitionResult part = partition_graph(graph_structure_from_pose_graph(graph), popt);
+  const std::optional<std::string> partition_file = a.get("partition-file");
+  if (partition_file && a.has("partition"))
+    throw InputError("options --partition and --partition-file exclude each other");
+  PartitionResult part = partition_file
+                             ? given_partition(graph, *partition_file, popt.parts)
+                             : partition_graph(graph_structure_from_pose_graph(graph), popt);
   if (popt.preset == PartitionPreset::kSequential)  // a multi-robot file: each robot its poses
     if (auto by_robot = robot_partition(input.keys, graph.num_poses, popt.parts)) {
       part.assignment = std::move(*by_robot);
@@ -444,7 +477,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
   std::printf(
       "%s: %zu poses, %zu edges, d = %d; %s, %ld agents, %s partition (cut %lld, %d colours)\n",
       graph_path.c_str(), graph.num_poses, graph.num_measurements(), graph.d,
-      algorithm_name(opt.algorithm), agents, preset_name(popt.preset),
+      algorithm_name(opt.algorithm), agents, partition_file ? "file" : preset_name(popt.preset),
       static_cast<long long>(part.metrics.cut_edges), part.colours);
   std::printf("  %d rounds (%d restarts), stop: %s, |grad f| = %.4g, relaxation f = %.10g\n",
               r.rounds, r.restarts, r.stop_reason.c_str(), r.grad_norm, r.relaxation_cost);
@@ -516,7 +549,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
     JsonObject j = solve_json(graph_path, graph, summary);
     j.add("wall_s", wall_s)
         .add("agents", static_cast<int>(agents))
-        .add("partition", preset_name(popt.preset))
+        .add("partition", partition_file ? "file" : preset_name(popt.preset))
         .add("cut_edges", static_cast<long long>(part.metrics.cut_edges))
         .add("partition_objective", objective_name(popt.objective))
         .add("colours", part.colours)

@@ -138,6 +138,59 @@ TEST(DistributedCli, ParallelByDefaultSequentialOnRequest) {
   EXPECT_NE(out.find("--sequential"), std::string::npos) << out;
 }
 
+// A partition written by `tessera partition --out` and given back with --partition-file solves
+// exactly as the same search run inside `solve` (same blocks, same iterates); a file that does
+// not fit the run is refused, naming the file.
+TEST(DistributedCli, APartitionFileSolvesLikeTheSameSearchInsideSolve) {
+  const std::string dir = test::temp_dir();
+  const std::string g = graph_file(dir);
+  const std::string tessera = test::bin("tessera");
+  std::string out;
+  ASSERT_EQ(test::run_command(tessera + " partition " + g +
+                                  " --parts 3 --preset eco --objective rounds --seed 1 --out " +
+                                  dir + "/p.txt",
+                              &out),
+            0)
+      << out;
+  const std::string solve = tessera + " solve " + g + " --algorithm irbcd --trace ";
+  ASSERT_EQ(test::run_command(
+                solve + dir + "/a.csv --agents 3 --partition eco --json " + dir + "/a.json", &out),
+            0)
+      << out;
+  ASSERT_EQ(test::run_command(solve + dir + "/b.csv --agents 3 --partition-file " + dir +
+                                  "/p.txt --json " + dir + "/b.json",
+                              &out),
+            0)
+      << out;
+  // The trace's last column is wall time: compare round, cost, gradient, selection, restart.
+  auto without_times = [](const std::string& csv) {
+    std::istringstream in(csv);
+    std::string line, kept;
+    while (std::getline(in, line)) kept += line.substr(0, line.rfind(',')) + "\n";
+    return kept;
+  };
+  EXPECT_EQ(without_times(test::read_text_file(dir + "/a.csv")),
+            without_times(test::read_text_file(dir + "/b.csv")));
+  const std::string a = test::read_text_file(dir + "/a.json");
+  const std::string b = test::read_text_file(dir + "/b.json");
+  EXPECT_NE(b.find("\"partition\": \"file\""), std::string::npos) << b;
+  for (const char* key : {"\"cut_edges\"", "\"colours\"", "\"adjacent_block_pairs\""}) {
+    const std::size_t at = a.find(key), bt = b.find(key);
+    ASSERT_NE(at, std::string::npos) << key;
+    ASSERT_NE(bt, std::string::npos) << key;
+    EXPECT_EQ(a.substr(at, a.find(',', at) - at), b.substr(bt, b.find(',', bt) - bt)) << key;
+  }
+  EXPECT_EQ(
+      test::run_command(solve + dir + "/c.csv --agents 2 --partition-file " + dir + "/p.txt", &out),
+      2);
+  EXPECT_NE(out.find("p.txt"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(solve + dir + "/c.csv --agents 3 --partition eco --partition-file " +
+                                  dir + "/p.txt",
+                              &out),
+            2);
+  EXPECT_NE(out.find("exclude"), std::string::npos) << out;
+}
+
 TEST(DistributedCli, RejectsBadOptions) {
   const std::string dir = test::temp_dir();
   const std::string g = graph_file(dir);

@@ -300,6 +300,32 @@ TEST(Momentum, InPlaceFormsAreBitIdenticalToTheReturningForms) {
     }
 }
 
+// A lifted start keeps r - d zero rows in P and V, and Proj_M then skips them. A pose whose zero
+// rows hold a negligible 1e-300 instead takes the full path; every Gram entry and so every
+// active row come out the same to the last bit, and the zero rows stay exactly zero.
+TEST(Momentum, ProjectionSkippingZeroRowsMatchesTheFullOneBitForBit) {
+  for (int d : {2, 3}) {
+    const int n = 8, w = d + 1;
+    const LiftedManifold Md(d, d, n), M(5, d, n);
+    Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(5, n * w), V = Y;
+    Y.topRows(d) = Md.project(Eigen::MatrixXd::Random(d, n * w));
+    V.topRows(d) = Md.project(Y.topRows(d) + 0.05 * Eigen::MatrixXd::Random(d, n * w));
+    const MomentumCoefficients c{0.4, 0.93, 1.7};
+    const Eigen::MatrixXd P = extrapolate(M, c, Y, V);
+    EXPECT_TRUE(P.bottomRows(5 - d).isZero(0.0)) << d;
+    Eigen::MatrixXd Y_full = Y;
+    for (int i = 0; i < n; ++i) Y_full(4, i * w) = 1e-300;  // every pose on the full path
+    const Eigen::MatrixXd P_full = extrapolate(M, c, Y_full, V);
+    EXPECT_FALSE(P_full.bottomRows(1).isZero(0.0)) << d;
+    EXPECT_TRUE(P.topRows(d) == P_full.topRows(d)) << d;
+    const Eigen::MatrixXd V1 = momentum_update(M, c, V, P, Y);
+    const Eigen::MatrixXd V1_full = momentum_update(M, c, V, P, Y_full);
+    EXPECT_TRUE(V1.bottomRows(5 - d).isZero(0.0)) << d;
+    EXPECT_TRUE(V1.topRows(d) == V1_full.topRows(d)) << d;
+    EXPECT_LT(M.distance_from_manifold(V1), 1e-12) << d;
+  }
+}
+
 TEST(Irbcd, BadOptionsNameTheField) {
   IrbcdOptions o;
   o.b0 = -1;

@@ -6,6 +6,7 @@
 #include <random>
 #include <tessera/manifold/lifted_manifold.hpp>
 #include <tessera/problem/block_problem.hpp>
+#include <tessera/problem/pose_block_matrix.hpp>
 #include <tessera/problem/pose_kernels.hpp>
 #include <vector>
 
@@ -48,6 +49,40 @@ TEST_P(PoseKernels, DenseTimesSparseMatchesEigen) {
   EXPECT_LE(max_abs(out - ref2), 1e-12 * max_abs(ref2));
 }
 
+// The agents' products read Q_BB by dense pose blocks (entries the sparse form lacks are explicit
+// zeros there): the same values as the sparse kernel to the last bit, for every row count.
+TEST_P(PoseKernels, PoseBlockProductIsBitIdenticalToTheSparseOne) {
+  const auto [d, r] = GetParam();
+  auto g = test::random_pose_graph({d, 30, 20, 0.05, 0.1, 9});
+  const BlockProblem whole = BlockProblem::whole_graph(d, g.num_poses, g.measurements);
+  const SparseMatrix& Q = whole.data_matrix();
+  const PoseBlockMatrix B(Q, d + 1);
+  EXPECT_LT(B.num_blocks(), static_cast<std::size_t>(Q.nonZeros()));  // one index a block
+  std::srand(4);
+  for (int rows : {r, d}) {
+    const Eigen::MatrixXd X = Eigen::MatrixXd::Random(rows, Q.rows());
+    Eigen::MatrixXd sparse, blocks;
+    scaled_dense_times_sparse(X, Q, 2.0, sparse);
+    B.times(X, 2.0, blocks);
+    EXPECT_TRUE(blocks == sparse) << d << " " << rows;
+  }
+  // A block problem's gradient and Hessian products, with and without the pose blocks.
+  std::vector<std::size_t> own;
+  for (std::size_t i = 0; i < g.num_poses; i += 2) own.push_back(i);
+  BlockProblem plain(d, own, g.measurements), by_blocks(d, own, g.measurements);
+  by_blocks.use_pose_blocks();
+  EXPECT_GT(by_blocks.pose_blocks_bytes(), 0u);
+  const LiftedManifold M(r, d, own.size());
+  const Eigen::MatrixXd X = random_point(M, 7);
+  const Eigen::MatrixXd Xn = Eigen::MatrixXd::Random(r, (d + 1) * plain.num_neighbors());
+  plain.set_neighbor_poses(Xn);
+  by_blocks.set_neighbor_poses(Xn);
+  const Eigen::MatrixXd G = plain.euclidean_gradient(X);
+  EXPECT_TRUE(by_blocks.euclidean_gradient(X) == G);
+  const Eigen::MatrixXd V = M.tangent_project(X, Eigen::MatrixXd::Random(r, M.cols()));
+  EXPECT_TRUE(by_blocks.hessian_vector(X, G, V) == plain.hessian_vector(X, G, V));
+}
+
 TEST_P(PoseKernels, HessianProjectionMatchesManifoldOperations) {
   const auto [d, r] = GetParam();
   const LiftedManifold M(r, d, 17);
@@ -69,6 +104,9 @@ TEST(PoseKernelsShapes, RejectMismatchedOperands) {
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3, 6);
   EXPECT_THROW(apply_hessian_projection(X, X, X, 2, H), std::invalid_argument);
   EXPECT_THROW(apply_hessian_projection(X, X, X, 4, X), std::invalid_argument);
+  EXPECT_THROW(PoseBlockMatrix(Q, 4), std::invalid_argument);  // 9 is not a multiple of 4
+  Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(3, 6);
+  EXPECT_THROW(PoseBlockMatrix(Q, 3).times(Y, 1.0, out), std::invalid_argument);
 }
 
 INSTANTIATE_TEST_SUITE_P(RanksAndDimensions, PoseKernels,

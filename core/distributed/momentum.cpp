@@ -71,14 +71,41 @@ inline double gram_entry(const double* x, const double* y, Eigen::Index n_runtim
   return s;
 }
 
+// gram_entry<5> of two columns whose rows D..4 are zero, without those rows: the terms it
+// drops are exact zeros, and the ones it keeps are added in gram_entry<5>'s order (lanes of even
+// and odd k), so the sum has the same value.
+template <int D>
+inline double gram_entry_zero_tail(const double* x, const double* y) {
+  if constexpr (D == 3) return (x[0] * y[0] + x[2] * y[2]) + x[1] * y[1];
+  return x[0] * y[0] + x[1] * y[1];
+}
+
+// True when rows D..R-1 of the r x D Stiefel block at A are zero: a pose of the lifted start
+// ([I_d; 0] R, chordal or distributed) keeps r - d zero rows through every blend and projection
+// until a saddle escape fills them.
+template <int D, int R>
+inline bool zero_tail(const double* A) {
+  bool zero = true;
+  for (int a = 0; a < D; ++a)
+    for (int k = D; k < R; ++k) zero = zero && A[a * R + k] == 0.0;
+  return zero;
+}
+
 // Replaces the r x D column-major Stiefel block at A by its polar factor (R > 0: r is R).
 template <int D, int R>
 void project_pose(double* A, Eigen::Index r_runtime) {
   const Eigen::Index r = R > 0 ? R : r_runtime;
   using Small = Eigen::Matrix<double, D, D>;
+  // P and V are kept at the relaxation rank (5) but only their first d rows are non-zero while
+  // the run stays at its lifted start's rows: the Gram matrix and the product then skip the zero
+  // rows (a third to a half of a projection's arithmetic), with the same values.
+  constexpr bool kCanSkip = R == 5 && D < R;
+  const bool skip = kCanSkip && zero_tail<D, (R > 0 ? R : 1)>(A);
   Small B;
   for (int a = 0; a < D; ++a)
-    for (int b = a; b < D; ++b) B(a, b) = B(b, a) = gram_entry<R>(A + a * r, A + b * r, r);
+    for (int b = a; b < D; ++b)
+      B(a, b) = B(b, a) = skip ? gram_entry_zero_tail<D>(A + a * r, A + b * r)
+                               : gram_entry<R>(A + a * r, A + b * r, r);
   Small inv_sqrt;
   if (!newton_schulz_inv_sqrt<D>(B, inv_sqrt)) {
     Eigen::SelfAdjointEigenSolver<Small> es(B);
@@ -91,8 +118,10 @@ void project_pose(double* A, Eigen::Index r_runtime) {
     inv_sqrt = es.eigenvectors() * l.cwiseSqrt().cwiseInverse().asDiagonal() *
                es.eigenvectors().transpose();
   }
-  // Row by row, each entry summed over k in order (as the lazy product A * inv_sqrt did).
-  for (Eigen::Index i = 0; i < r; ++i) {
+  // Row by row, each entry summed over k in order (as the lazy product A * inv_sqrt did). Zero
+  // rows stay zero.
+  const Eigen::Index rows = skip ? D : r;
+  for (Eigen::Index i = 0; i < rows; ++i) {
     double row[D];
     for (int j = 0; j < D; ++j) {
       double s = A[i] * inv_sqrt(0, j);

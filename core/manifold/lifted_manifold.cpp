@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <string>
 #include <tessera/manifold/lifted_manifold.hpp>
+#include <utility>
 
 #include "manifold/sym_product.hpp"
 
@@ -100,18 +101,24 @@ void tangent_project_poses(const double* X, const double* V, Eigen::Index r_runt
 
 Eigen::MatrixXd LiftedManifold::tangent_project(const Eigen::MatrixXd& X,
                                                 const Eigen::MatrixXd& V) const {
-  Eigen::MatrixXd out = V;
+  return tangent_project(X, Eigen::MatrixXd(V));
+}
+
+Eigen::MatrixXd LiftedManifold::tangent_project(const Eigen::MatrixXd& X,
+                                                Eigen::MatrixXd&& V) const {
+  // Pose by pose, sym(Y_i^T V_i) is read before V_i is updated, so V may be the output.
+  Eigen::MatrixXd out = std::move(V);
   const Eigen::Index r = X.rows();
   if (d_ == 2) {
     if (r == 2)
-      tangent_project_poses<2, 2>(X.data(), V.data(), r, n_, out.data());
+      tangent_project_poses<2, 2>(X.data(), out.data(), r, n_, out.data());
     else
-      tangent_project_poses<2, 0>(X.data(), V.data(), r, n_, out.data());
+      tangent_project_poses<2, 0>(X.data(), out.data(), r, n_, out.data());
   } else {
     if (r == 3)
-      tangent_project_poses<3, 3>(X.data(), V.data(), r, n_, out.data());
+      tangent_project_poses<3, 3>(X.data(), out.data(), r, n_, out.data());
     else
-      tangent_project_poses<3, 0>(X.data(), V.data(), r, n_, out.data());
+      tangent_project_poses<3, 0>(X.data(), out.data(), r, n_, out.data());
   }
   return out;
 }

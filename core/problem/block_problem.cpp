@@ -3,6 +3,7 @@
 #include <string>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/pose_kernels.hpp>
+#include <utility>
 
 namespace tessera {
 namespace {
@@ -167,8 +168,20 @@ void BlockProblem::extend(const std::vector<std::size_t>& new_owned,
   if (delta.neighbour.nonZeros() > 0) Q_nb_ = SparseMatrix(Q_nb_ + delta.neighbour);
   Q_bb_.makeCompressed();
   Q_nb_.makeCompressed();
+  if (Q_bb_blocks_) use_pose_blocks();
   X_n_.resize(0, 0);  // the neighbours' poses are stale: set_neighbor_poses again
   linear_.resize(0, 0);
+}
+
+void BlockProblem::use_pose_blocks() {
+  Q_bb_blocks_.emplace(Q_bb_, d_ + 1);
+}
+
+void BlockProblem::times_own(const Eigen::MatrixXd& X, double scale, Eigen::MatrixXd& out) const {
+  if (Q_bb_blocks_)
+    Q_bb_blocks_->times(X, scale, out);
+  else
+    scaled_dense_times_sparse(X, Q_bb_, scale, out);
 }
 
 void BlockProblem::set_neighbor_poses(const Eigen::MatrixXd& X_neighbors) {
@@ -186,7 +199,7 @@ double BlockProblem::cost(const Eigen::MatrixXd& X, double* share) const {
 
 Eigen::MatrixXd BlockProblem::euclidean_gradient(const Eigen::MatrixXd& X) const {
   Eigen::MatrixXd G;
-  scaled_dense_times_sparse(X, Q_bb_, 2.0, G);
+  times_own(X, 2.0, G);
   if (!neighbors_.empty()) G += 2.0 * linear_;
   return G;
 }
@@ -196,7 +209,7 @@ Eigen::MatrixXd BlockProblem::euclidean_gradient(const Eigen::MatrixXd& X,
   if (X_neighbors.cols() != (d_ + 1) * static_cast<Eigen::Index>(neighbors_.size()))
     throw std::invalid_argument("BlockProblem: neighbour poses have the wrong size");
   Eigen::MatrixXd G;
-  scaled_dense_times_sparse(X, Q_bb_, 2.0, G);
+  times_own(X, 2.0, G);
   if (!neighbors_.empty()) {
     Eigen::MatrixXd linear;
     scaled_dense_times_sparse(X_neighbors, Q_nb_, 1.0, linear);
@@ -210,11 +223,16 @@ Eigen::MatrixXd BlockProblem::riemannian_gradient(const Eigen::MatrixXd& X,
   return manifold(static_cast<int>(X.rows())).tangent_project(X, egrad);
 }
 
+Eigen::MatrixXd BlockProblem::riemannian_gradient(const Eigen::MatrixXd& X,
+                                                  Eigen::MatrixXd&& egrad) const {
+  return manifold(static_cast<int>(X.rows())).tangent_project(X, std::move(egrad));
+}
+
 Eigen::MatrixXd BlockProblem::hessian_vector(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
                                              const Eigen::MatrixXd& V) const {
   // Proj_X(2 V Q_BB) - Weingarten(X, egrad, V), fused (problem/pose_kernels.hpp).
   Eigen::MatrixXd H;
-  scaled_dense_times_sparse(V, Q_bb_, 2.0, H);
+  times_own(V, 2.0, H);
   apply_hessian_projection(X, egrad, V, d_, H);
   return H;
 }

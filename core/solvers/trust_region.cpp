@@ -4,6 +4,7 @@
 #include <limits>
 #include <tessera/solvers/trust_region.hpp>
 #include <tessera/util/input_error.hpp>
+#include <utility>
 
 #include "util/frobenius_inner.hpp"
 
@@ -96,7 +97,7 @@ TcgOutcome truncated_cg(const BlockProblem& problem, const LiftedManifold& M,
     out.eta += alpha * delta;
     out.Heta += alpha * Hdelta;
     r += alpha * Hdelta;
-    r = M.tangent_project(X, r);  // keep rounding errors from leaving the tangent space
+    r = M.tangent_project(X, std::move(r));  // keep rounding errors from leaving the tangent space
     const double r_norm = std::sqrt(frobenius_inner(r, r));
     if (r_norm <= r0_norm * std::min(std::pow(r0_norm, opt.tcg_theta), kappa)) return out;
     // CG needs one fixed preconditioner: the caller computes the step again with the new one.

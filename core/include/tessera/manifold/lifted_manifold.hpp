@@ -26,6 +26,8 @@ class LiftedManifold {
   /// Orthogonal projection of an ambient V onto the tangent space at X:
   /// V_i - Y_i sym(Y_i^T V_i) on Stiefel blocks, translations unchanged.
   Eigen::MatrixXd tangent_project(const Eigen::MatrixXd& X, const Eigen::MatrixXd& V) const;
+  /// The same, projecting V in its own storage (no copy of V; the same values).
+  Eigen::MatrixXd tangent_project(const Eigen::MatrixXd& X, Eigen::MatrixXd&& V) const;
 
   /// Retraction R_X(V) = project(X + V) (the polar retraction).
   Eigen::MatrixXd retract(const Eigen::MatrixXd& X, const Eigen::MatrixXd& V) const;

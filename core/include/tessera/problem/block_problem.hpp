@@ -9,9 +9,11 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <optional>
 #include <tessera/graph/measurement.hpp>
 #include <tessera/manifold/lifted_manifold.hpp>
 #include <tessera/problem/data_matrix.hpp>
+#include <tessera/problem/pose_block_matrix.hpp>
 #include <unordered_map>
 #include <vector>
 
@@ -52,6 +54,12 @@ class BlockProblem {
   /// Q_NB: the cut measurements' coupling, (d+1)k neighbour rows x (d+1)m owned columns.
   const SparseMatrix& neighbor_matrix() const { return Q_nb_; }
   LiftedManifold manifold(int r) const { return LiftedManifold(r, d_, owned_.size()); }
+  /// Keeps Q_BB also as dense pose blocks (PoseBlockMatrix), which the products of the
+  /// gradient and the Hessian then read: the same values, about a third fewer instructions
+  /// for those products, and ~1 KB more memory per pose in 3D (0.9 KB in 2D). The agents'
+  /// rounds use it; extend() keeps it. Bytes held: pose_blocks_bytes().
+  void use_pose_blocks();
+  std::size_t pose_blocks_bytes() const { return Q_bb_blocks_ ? Q_bb_blocks_->bytes() : 0; }
 
   /// Fixes the neighbours' lifted poses (r x (d+1)k, neighbors() order). Must be called
   /// before evaluating a block with neighbours, and again whenever they change.
@@ -70,6 +78,8 @@ class BlockProblem {
                                      const Eigen::MatrixXd& X_neighbors) const;
   /// Riemannian gradient on the block's manifold.
   Eigen::MatrixXd riemannian_gradient(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad) const;
+  /// The same, projecting egrad in its own storage (no copy; the same values).
+  Eigen::MatrixXd riemannian_gradient(const Eigen::MatrixXd& X, Eigen::MatrixXd&& egrad) const;
   /// Riemannian Hessian applied to tangent V at X (egrad = Euclidean gradient at X).
   Eigen::MatrixXd hessian_vector(const Eigen::MatrixXd& X, const Eigen::MatrixXd& egrad,
                                  const Eigen::MatrixXd& V) const;
@@ -98,7 +108,10 @@ class BlockProblem {
   // its measurements (so it outlives its input): the cost loops read them contiguously.
   std::vector<double> packed_;
   SparseMatrix Q_bb_;
-  SparseMatrix Q_nb_;  // (d+1)k x (d+1)m
+  SparseMatrix Q_nb_;                           // (d+1)k x (d+1)m
+  std::optional<PoseBlockMatrix> Q_bb_blocks_;  // Q_bb_ by pose blocks (use_pose_blocks)
+  // out = scale X Q_BB, by pose blocks when held.
+  void times_own(const Eigen::MatrixXd& X, double scale, Eigen::MatrixXd& out) const;
   Eigen::MatrixXd X_n_;
   Eigen::MatrixXd linear_;  // X_N Q_NB, r x (d+1)m
 };
