@@ -244,6 +244,39 @@ void TangentCoarseSpace::unit_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd
   fill(neighbour_poses_, neighbour, Xn, vn);
 }
 
+void TangentCoarseSpace::lift_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int piece,
+                                 const std::vector<Eigen::Index>& own,
+                                 const std::vector<Eigen::Index>& neighbour, Eigen::MatrixXd& W,
+                                 Eigen::MatrixXd& Wn) const {
+  auto fill = [&](const Poses& p, const std::vector<Eigen::Index>& slots, const Eigen::MatrixXd& P,
+                  Eigen::MatrixXd& out) {
+    for (Eigen::Index s : slots)
+      for (std::size_t q = p.start[static_cast<std::size_t>(s)];
+           q < p.start[static_cast<std::size_t>(s) + 1]; ++q)
+        if (p.weights[q].piece == piece) {
+          const double w = p.weights[q].w;
+          const Eigen::Index c = s * (d_ + 1);
+          out.block(0, c, k_, d_ + 1) += w * P.middleCols(c, d_ + 1);
+          out(k_, c + d_) += w;
+        }
+  };
+  fill(own_poses_, own, X, W);
+  fill(neighbour_poses_, neighbour, Xn, Wn);
+}
+
+void TangentCoarseSpace::apply_generator(int j, const Eigen::MatrixXd& M,
+                                         Eigen::MatrixXd& out) const {
+  out.setZero(k_, M.cols());
+  const int rotations = static_cast<int>(rotation_pairs_.size());
+  if (j < rotations) {  // Omega = e_a e_b^T - e_b e_a^T
+    const auto [a, b] = rotation_pairs_[static_cast<std::size_t>(j)];
+    out.row(a) = M.row(b);
+    out.row(b) = -M.row(a);
+  } else {  // c = e_a
+    out.row(j - rotations) = M.row(k_);
+  }
+}
+
 Eigen::MatrixXd TangentCoarseSpace::group_inverse(const Eigen::MatrixXd& Ag, double tol) const {
   const Eigen::Index m = Ag.rows();
   // P = I - U U^T, U's columns the group's rigid motions (generator j on every piece of the

@@ -71,6 +71,19 @@ class TangentCoarseSpace {
                const std::vector<Eigen::Index>& own, const std::vector<Eigen::Index>& neighbour,
                Eigen::MatrixXd& v, Eigen::MatrixXd& vn) const;
 
+  /// The lift of one piece: on its slots (`own`, `neighbour`: own_slots() and neighbour_slots()),
+  /// slot s of W (Wn) += w_s [X_s; 0 1], k + 1 rows, w_s the slot's weight of the piece; the
+  /// caller keeps W and Wn zero elsewhere. Each of the piece's unknowns' vectors is E W with E =
+  /// [Omega c] its generator (k x (k+1)), so a linear map M of them all is E (W M): one product
+  /// per piece, not one per generator (apply_generator() reads each off it).
+  void lift_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int piece,
+               const std::vector<Eigen::Index>& own, const std::vector<Eigen::Index>& neighbour,
+               Eigen::MatrixXd& W, Eigen::MatrixXd& Wn) const;
+  /// out = E M for generator j (M: k + 1 rows; out: k rows, M's columns): E's one or two
+  /// non-zero entries are +-1, so out's rows are copies of M's rows (with the vectors lift_on()
+  /// gives, the same numbers as unit_on()'s, whose products with E's zeros add only zeros).
+  void apply_generator(int j, const Eigen::MatrixXd& M, Eigen::MatrixXd& out) const;
+
   /// Pieces whose poses are linked by measurements, directly or through other pieces (the
   /// connected components of the layout's block graph; a piece of the smoothed space goes with
   /// its block): group_of(alpha) numbers them densely in order of their first piece.
