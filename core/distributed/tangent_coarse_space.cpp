@@ -130,10 +130,21 @@ void TangentCoarseSpace::add_generator(int j, double x, Eigen::MatrixXd& E) cons
 
 void TangentCoarseSpace::move(const Eigen::MatrixXd& E, const Eigen::MatrixXd& X, Eigen::Index s,
                               Eigen::MatrixXd& v) const {
-  const Eigen::Index c = s * (d_ + 1);
-  // lazyProduct: a k x k times k x (d+1) product, where the GEMM path costs more than the flops.
-  v.middleCols(c, d_ + 1).noalias() += E.leftCols(k_).lazyProduct(X.middleCols(c, d_ + 1));
-  v.col(c + d_) += E.col(k_);
+  // A k x k times k x (d+1) product written out: Eigen's GEMM path costs more than the flops and
+  // its coefficient-wise lazy product is a call per entry (both ran in every CG iteration). The
+  // sums run in the same order as the lazy product's.
+  const Eigen::Index k = k_, c = s * (d_ + 1);
+  const double* e = E.data();
+  const double* x = X.data() + c * k;
+  double* o = v.data() + c * k;
+  for (Eigen::Index col = 0; col <= d_; ++col, x += k, o += k)
+    for (Eigen::Index i = 0; i < k; ++i) {
+      double acc = e[i] * x[0];
+      for (Eigen::Index m = 1; m < k; ++m) acc += e[i + m * k] * x[m];
+      o[i] += acc;
+    }
+  o -= k;  // the translation column
+  for (Eigen::Index i = 0; i < k; ++i) o[i] += e[i + k * k];
 }
 
 template <class Slots>
@@ -144,11 +155,19 @@ void TangentCoarseSpace::project_over(const Eigen::MatrixXd& X, const Eigen::Mat
   const Eigen::Index kk = k_ * (k_ + 1);
   std::vector<double> acc(static_cast<std::size_t>(pieces_ * kk), 0.0);
   Eigen::MatrixXd N(k_, k_ + 1);
+  const Eigen::Index k = k_;
   for (const auto slot : slots) {
     const auto s = static_cast<std::size_t>(slot);
     const Eigen::Index c = static_cast<Eigen::Index>(s) * (d_ + 1);
-    N.leftCols(k_).noalias() =
-        v.middleCols(c, d_ + 1).lazyProduct(X.middleCols(c, d_ + 1).transpose());
+    // N = [v_s X_s^T, v_s's translation], the product written out as in move().
+    const double* vs = v.data() + c * k;
+    const double* xs = X.data() + c * k;
+    for (Eigen::Index j = 0; j < k; ++j)
+      for (Eigen::Index i = 0; i < k; ++i) {
+        double acc = vs[i] * xs[j];
+        for (Eigen::Index col = 1; col <= d_; ++col) acc += vs[i + col * k] * xs[j + col * k];
+        N(i, j) = acc;
+      }
     N.col(k_) = v.col(c + d_);
     for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
       const Weight& w = own_poses_.weights[q];
