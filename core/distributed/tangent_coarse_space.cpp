@@ -245,24 +245,6 @@ void TangentCoarseSpace::unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& X
   fill(neighbour_poses_, Xn, vn);
 }
 
-void TangentCoarseSpace::unit_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
-                                 const std::vector<Eigen::Index>& own,
-                                 const std::vector<Eigen::Index>& neighbour, Eigen::MatrixXd& v,
-                                 Eigen::MatrixXd& vn) const {
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(k_, k_ + 1);
-  add_generator(unknown % g_, 1.0, E);
-  const int piece = unknown / g_;
-  auto fill = [&](const Poses& p, const std::vector<Eigen::Index>& slots, const Eigen::MatrixXd& P,
-                  Eigen::MatrixXd& out) {
-    for (Eigen::Index s : slots)
-      for (std::size_t q = p.start[static_cast<std::size_t>(s)];
-           q < p.start[static_cast<std::size_t>(s) + 1]; ++q)
-        if (p.weights[q].piece == piece) move(p.weights[q].w * E, P, s, out);
-  };
-  fill(own_poses_, own, X, v);
-  fill(neighbour_poses_, neighbour, Xn, vn);
-}
-
 void TangentCoarseSpace::lift_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int piece,
                                  const std::vector<Eigen::Index>& own,
                                  const std::vector<Eigen::Index>& neighbour, Eigen::MatrixXd& W,

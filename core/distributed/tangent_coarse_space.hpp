@@ -64,13 +64,6 @@ class TangentCoarseSpace {
   /// shapes of X and Xn.
   void unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown, Eigen::MatrixXd& v,
             Eigen::MatrixXd& vn) const;
-  /// The same on the unknown's piece's slots only (`own`, `neighbour`: own_slots() and
-  /// neighbour_slots() of its piece), adding to v and vn of X's and Xn's shapes, which the caller
-  /// keeps zero elsewhere: a column then costs its piece's poses, not the whole block.
-  void unit_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
-               const std::vector<Eigen::Index>& own, const std::vector<Eigen::Index>& neighbour,
-               Eigen::MatrixXd& v, Eigen::MatrixXd& vn) const;
-
   /// The lift of one piece: on its slots (`own`, `neighbour`: own_slots() and neighbour_slots()),
   /// slot s of W (Wn) += w_s [X_s; 0 1], k + 1 rows, w_s the slot's weight of the piece; the
   /// caller keeps W and Wn zero elsewhere. Each of the piece's unknowns' vectors is E W with E =
@@ -81,7 +74,7 @@ class TangentCoarseSpace {
                Eigen::MatrixXd& W, Eigen::MatrixXd& Wn) const;
   /// out = E M for generator j (M: k + 1 rows; out: k rows, M's columns): E's one or two
   /// non-zero entries are +-1, so out's rows are copies of M's rows (with the vectors lift_on()
-  /// gives, the same numbers as unit_on()'s, whose products with E's zeros add only zeros).
+  /// gives, the same numbers as unit()'s, whose products with E's zeros add only zeros).
   void apply_generator(int j, const Eigen::MatrixXd& M, Eigen::MatrixXd& out) const;
 
   /// Pieces whose poses are linked by measurements, directly or through other pieces (the
