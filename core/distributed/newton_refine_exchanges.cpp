@@ -412,7 +412,7 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
       for (Eigen::Index a = 0; a < nj; ++a)
         hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = HJ.middleCols(a * w, w);
       coarse_->project(X_, hv, J, L.col(u).data());
-      if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
+      if (options_.coarse_balancing) coarse_hphi_->keep(c, hv, J);
     }
     for (Eigen::Index j : J) hv.middleCols(j * w, w).setZero();  // zero again, off J too
   }
