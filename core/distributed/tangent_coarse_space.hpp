@@ -145,9 +145,8 @@ class TangentCoarseSpace {
                           const std::vector<std::size_t>& ids);
   // [Omega c] of generator j scaled by x, added to E (k x (k+1)).
   void add_generator(int j, double x, Eigen::MatrixXd& E) const;
-  // v's slot s += E [X_s; 0 1].
-  void move(const Eigen::MatrixXd& E, const Eigen::MatrixXd& X, Eigen::Index s,
-            Eigen::MatrixXd& v) const;
+  // v's slot s += E [X_s; 0 1], E = e[0 .. k(k+1)) column-major k x (k+1).
+  void move(const double* e, const Eigen::MatrixXd& X, Eigen::Index s, Eigen::MatrixXd& v) const;
 
   int d_, k_, g_, pieces_;
   int groups_ = 0;
