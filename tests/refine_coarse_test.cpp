@@ -10,6 +10,7 @@
 #include <random>
 #include <string>
 #include <tessera/distributed/block_layout.hpp>
+#include <tessera/distributed/coarse_space.hpp>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/distributed/newton_refine.hpp>
 #include <tessera/partition/sequential_partition.hpp>
@@ -78,6 +79,42 @@ TEST(TangentCoarseSpace, ItsProjectionIsTheAdjointOfItsMapAndItsVectorsAreTangen
       const int piece = u / c.generators();
       EXPECT_TRUE(piece == b || layout.adjacency_index(b, piece) >= 0) << u;
     }
+  }
+}
+
+TEST(TangentCoarseSpace, EachGeneratorOfAPiecesLiftIsThatUnknownsVector) {
+  // The coarse matrix's columns read every generator of a piece off one lift (lift_on, then
+  // apply_generator): each must be the unknown's own vector, number for number, on the own
+  // poses and the neighbour copies, with the smoothed space's blended weights.
+  const PoseGraph g = test::refine_chain(120, 5);
+  const std::vector<int> parts = sequential_partition(g.num_poses, 3);
+  const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, parts);
+  NewtonRefineOptions options;
+  options.coarse_aggregates = 4;
+  const CoarseSpace space =
+      make_coarse_space(g.num_poses, g.measurements, parts, options.coarse_space_options());
+  const Eigen::MatrixXd Y = lift_poses(chordal_initialization(g), g.d);
+  for (int b = 0; b < 3; ++b) {
+    const BlockPoint p = block_point(g, layout, b, Y);
+    const TangentCoarseSpace c(&space, layout, p.problem.owned(), p.problem.neighbors(), g.d, g.d);
+    ASSERT_FALSE(c.touched().empty());
+    int pieces_seen = 0, last = -1;
+    for (int u : c.touched()) {
+      const int piece = u / c.generators();
+      if (piece != last) ++pieces_seen;
+      last = piece;
+      Eigen::MatrixXd lift = Eigen::MatrixXd::Zero(p.X.rows() + 1, p.X.cols());
+      Eigen::MatrixXd liftn = Eigen::MatrixXd::Zero(p.X.rows() + 1, p.Xn.cols());
+      c.lift_on(p.X, p.Xn, piece, c.own_slots(piece), c.neighbour_slots(piece), lift, liftn);
+      Eigen::MatrixXd v, vn, ev, evn;
+      c.unit(p.X, p.Xn, u, v, vn);
+      c.apply_generator(u % c.generators(), lift, ev);
+      c.apply_generator(u % c.generators(), liftn, evn);
+      EXPECT_TRUE(ev == v) << "block " << b << " unknown " << u;
+      EXPECT_TRUE(evn == vn) << "block " << b << " unknown " << u;
+      EXPECT_GT(v.norm() + vn.norm(), 0.0) << "block " << b << " unknown " << u;
+    }
+    EXPECT_GT(pieces_seen, 4) << "block " << b;  // its own pieces and some of a neighbour's
   }
 }
 

@@ -6,10 +6,11 @@ void CoarseHessianColumns::reset(std::size_t columns) {
   columns_.assign(columns, {});
 }
 
-void CoarseHessianColumns::keep(std::size_t c, const Eigen::MatrixXd& hv) {
+void CoarseHessianColumns::keep(std::size_t c, const Eigen::MatrixXd& hv,
+                                const std::vector<Eigen::Index>& slots) {
   Column& col = columns_[c];
   const Eigen::Index w = hv.rows() * (dim_ + 1);
-  for (Eigen::Index s = 0; s * w < hv.size(); ++s) {
+  for (const Eigen::Index s : slots) {
     const Eigen::Map<const Eigen::VectorXd> b(hv.data() + s * w, w);
     if (b.squaredNorm() == 0.0) continue;
     col.slots.push_back(s);

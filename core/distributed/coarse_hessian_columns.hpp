@@ -18,8 +18,9 @@ class CoarseHessianColumns {
 
   /// Drops what is kept and makes room for `columns` columns, all zero.
   void reset(std::size_t columns);
-  /// Keeps hv = the own rows of H Phi e_u as column c (its non-zero poses only).
-  void keep(std::size_t c, const Eigen::MatrixXd& hv);
+  /// Keeps hv = the own rows of H Phi e_u as column c (its non-zero poses only). `slots`
+  /// (ascending): the pose slots where hv may be non-zero, the only ones looked at.
+  void keep(std::size_t c, const Eigen::MatrixXd& hv, const std::vector<Eigen::Index>& slots);
   std::size_t size() const { return columns_.size(); }
 
   /// (H Phi)^T y over the own rows, one entry per column.

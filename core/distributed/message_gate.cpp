@@ -93,6 +93,10 @@ std::vector<double> reduce_in_id_order(const MessageGate::Inbox& inbox, std::siz
   bool first = true;
   for (const auto& [sender, m] : inbox) {
     const auto& v = reduction_values(m, count);
+    if (max_entries.empty()) {  // plain sums (a coarse matrix sum carries tens of thousands)
+      for (std::size_t k = 0; k < count; ++k) total[k] += v[k];
+      continue;
+    }
     for (std::size_t k = 0; k < count; ++k) {
       const bool is_max = std::find(max_entries.begin(), max_entries.end(), k) != max_entries.end();
       if (is_max)

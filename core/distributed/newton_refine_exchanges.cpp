@@ -363,7 +363,6 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   coarse_kept_steps_ = 0;
   const bool galerkin = !data_part || options_.coarse_balancing;
   Eigen::MatrixXd LD = data_part ? Eigen::MatrixXd::Zero(n, n) : Eigen::MatrixXd();
-  Eigen::MatrixXd v, vn;
   const std::vector<int>& touched = coarse_->touched();
   // Balancing also keeps the own rows of H Phi (one column per touched unknown).
   if (options_.coarse_balancing) {
@@ -374,7 +373,9 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   // poses S (own) and Sn (neighbour copies), so H Phi e_u = Proj(2 v Q_BB + 2 vn Q_NB) - W is
   // non-zero only on the own poses J that share a measurement with S or Sn (Q_BB's and Q_NB's
   // pattern), and Phi^T of it is a sum over J. The products per pose are the full product's,
-  // so the column is the same; its cost is |J| poses, not the block.
+  // so the column is the same; its cost is |J| poses, not the block. And a piece's generators
+  // share one product: v = E L with L the piece's lift (lift_on), so 2 v Q = E (2 L Q), whose
+  // rows each generator's E copies (apply_generator): the same sums, once per piece.
   const SparseMatrix& qbb = problem_.data_matrix();
   const SparseMatrix& qnb = problem_.neighbor_matrix();
   const Eigen::Index w = problem_.dim() + 1;
@@ -389,19 +390,23 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
   std::vector<char> in_j(static_cast<std::size_t>(own_poses), 0);
   Eigen::MatrixXd hv = Eigen::MatrixXd::Zero(rows, X_.cols());
   std::vector<Eigen::Index> J;
-  // On J's poses: the point and Euclidean gradient (a piece's), a column's v and H v.
-  Eigen::MatrixXd XJ, GJ, VJ, HJ;
-  // A column's vector, zero but on its piece's slots (set and cleared per column).
-  v.setZero(rows, X_.cols());
-  vn.setZero(rows, Xn_.cols());
+  // On J's poses: the point and Euclidean gradient, the piece's lift and 2 lift Q, a column's
+  // v and H v.
+  Eigen::MatrixXd XJ, GJ, LJ, MJ, VJ, HJ;
+  // The piece's lift, zero but on its slots (set and cleared per piece).
+  Eigen::MatrixXd lift = Eigen::MatrixXd::Zero(rows + 1, X_.cols());
+  Eigen::MatrixXd liftn = Eigen::MatrixXd::Zero(rows + 1, Xn_.cols());
   std::vector<Eigen::Index> own_slots, neighbour_slots;
   int piece = -1;
   for (std::size_t c = 0; c < touched.size(); ++c) {
     const int u = touched[c];
-    if (u / coarse_->generators() != piece) {  // a new piece: its poses J
+    if (u / coarse_->generators() != piece) {  // a new piece: its poses J and its product
+      for (Eigen::Index i : own_slots) lift.middleCols(i * w, w).setZero();
+      for (Eigen::Index i : neighbour_slots) liftn.middleCols(i * w, w).setZero();
       piece = u / coarse_->generators();
       own_slots = coarse_->own_slots(piece);
       neighbour_slots = coarse_->neighbour_slots(piece);
+      coarse_->lift_on(X_, Xn_, piece, own_slots, neighbour_slots, lift, liftn);
       for (Eigen::Index j : J) in_j[static_cast<std::size_t>(j)] = 0;
       J.clear();
       for (Eigen::Index i : own_slots)
@@ -421,27 +426,25 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
       const auto nj = static_cast<Eigen::Index>(J.size());
       XJ.resize(rows, w * nj);
       GJ.resize(rows, w * nj);
-      VJ.resize(rows, w * nj);
+      LJ.resize(rows + 1, w * nj);
+      MJ.setZero(rows + 1, w * nj);
       for (Eigen::Index a = 0; a < nj; ++a) {
         const Eigen::Index from = J[static_cast<std::size_t>(a)] * w;
         XJ.middleCols(a * w, w) = X_.middleCols(from, w);
         GJ.middleCols(a * w, w) = egrad_.middleCols(from, w);
+        LJ.middleCols(a * w, w) = lift.middleCols(from, w);
+        for (Eigen::Index q = 0; q < w; ++q) {
+          for (SparseMatrix::InnerIterator it(qbb, from + q); it; ++it)
+            MJ.col(a * w + q) += (2.0 * it.value()) * lift.col(it.row());
+          if (liftn.cols() > 0)
+            for (SparseMatrix::InnerIterator it(qnb, from + q); it; ++it)
+              MJ.col(a * w + q) += (2.0 * it.value()) * liftn.col(it.row());
+        }
       }
     }
-    coarse_->unit_on(X_, Xn_, u, own_slots, neighbour_slots, v, vn);
+    const int generator = u % coarse_->generators();
+    coarse_->apply_generator(generator, MJ, HJ);
     const auto nj = static_cast<Eigen::Index>(J.size());
-    HJ.setZero(rows, w * nj);
-    for (Eigen::Index a = 0; a < nj; ++a) {
-      const Eigen::Index from = J[static_cast<std::size_t>(a)] * w;
-      VJ.middleCols(a * w, w) = v.middleCols(from, w);
-      for (Eigen::Index q = 0; q < w; ++q) {
-        for (SparseMatrix::InnerIterator it(qbb, from + q); it; ++it)
-          HJ.col(a * w + q) += (2.0 * it.value()) * v.col(it.row());
-        if (vn.cols() > 0)
-          for (SparseMatrix::InnerIterator it(qnb, from + q); it; ++it)
-            HJ.col(a * w + q) += (2.0 * it.value()) * vn.col(it.row());
-      }
-    }
     const LiftedManifold manifold(static_cast<int>(rows), problem_.dim(),
                                   static_cast<std::size_t>(nj));
     if (data_part) {
@@ -451,16 +454,15 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
       coarse_->project(X_, hv, J, LD.col(u).data());
     }
     if (galerkin) {
+      coarse_->apply_generator(generator, LJ, VJ);
       apply_hessian_projection(XJ, GJ, VJ, problem_.dim(), HJ);
       HJ = manifold.tangent_project(XJ, HJ);
       for (Eigen::Index a = 0; a < nj; ++a)
         hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = HJ.middleCols(a * w, w);
       coarse_->project(X_, hv, J, L.col(u).data());
-      if (options_.coarse_balancing) coarse_hphi_->keep(c, hv);
+      if (options_.coarse_balancing) coarse_hphi_->keep(c, hv, J);
     }
     for (Eigen::Index j : J) hv.middleCols(j * w, w).setZero();  // zero again, off J too
-    for (Eigen::Index i : own_slots) v.middleCols(i * w, w).setZero();
-    for (Eigen::Index i : neighbour_slots) vn.middleCols(i * w, w).setZero();
   }
   std::vector<double> values;
   values.reserve(2 * coarse_->packed_size() + static_cast<std::size_t>(n));

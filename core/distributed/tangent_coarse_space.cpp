@@ -128,12 +128,22 @@ void TangentCoarseSpace::add_generator(int j, double x, Eigen::MatrixXd& E) cons
   }
 }
 
-void TangentCoarseSpace::move(const Eigen::MatrixXd& E, const Eigen::MatrixXd& X, Eigen::Index s,
+void TangentCoarseSpace::move(const double* e, const Eigen::MatrixXd& X, Eigen::Index s,
                               Eigen::MatrixXd& v) const {
-  const Eigen::Index c = s * (d_ + 1);
-  // lazyProduct: a k x k times k x (d+1) product, where the GEMM path costs more than the flops.
-  v.middleCols(c, d_ + 1).noalias() += E.leftCols(k_).lazyProduct(X.middleCols(c, d_ + 1));
-  v.col(c + d_) += E.col(k_);
+  // A k x k times k x (d+1) product written out: Eigen's GEMM path costs more than the flops and
+  // its coefficient-wise lazy product is a call per entry (both ran in every CG iteration). The
+  // sums run in the same order as the lazy product's.
+  const Eigen::Index k = k_, c = s * (d_ + 1);
+  const double* x = X.data() + c * k;
+  double* o = v.data() + c * k;
+  for (Eigen::Index col = 0; col <= d_; ++col, x += k, o += k)
+    for (Eigen::Index i = 0; i < k; ++i) {
+      double acc = e[i] * x[0];
+      for (Eigen::Index m = 1; m < k; ++m) acc += e[i + m * k] * x[m];
+      o[i] += acc;
+    }
+  o -= k;  // the translation column
+  for (Eigen::Index i = 0; i < k; ++i) o[i] += e[i + k * k];
 }
 
 template <class Slots>
@@ -144,11 +154,19 @@ void TangentCoarseSpace::project_over(const Eigen::MatrixXd& X, const Eigen::Mat
   const Eigen::Index kk = k_ * (k_ + 1);
   std::vector<double> acc(static_cast<std::size_t>(pieces_ * kk), 0.0);
   Eigen::MatrixXd N(k_, k_ + 1);
+  const Eigen::Index k = k_;
   for (const auto slot : slots) {
     const auto s = static_cast<std::size_t>(slot);
     const Eigen::Index c = static_cast<Eigen::Index>(s) * (d_ + 1);
-    N.leftCols(k_).noalias() =
-        v.middleCols(c, d_ + 1).lazyProduct(X.middleCols(c, d_ + 1).transpose());
+    // N = [v_s X_s^T, v_s's translation], the product written out as in move().
+    const double* vs = v.data() + c * k;
+    const double* xs = X.data() + c * k;
+    for (Eigen::Index j = 0; j < k; ++j)
+      for (Eigen::Index i = 0; i < k; ++i) {
+        double acc = vs[i] * xs[j];
+        for (Eigen::Index col = 1; col <= d_; ++col) acc += vs[i + col * k] * xs[j + col * k];
+        N(i, j) = acc;
+      }
     N.col(k_) = v.col(c + d_);
     for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
       const Weight& w = own_poses_.weights[q];
@@ -191,21 +209,38 @@ std::vector<Eigen::Index> TangentCoarseSpace::slots_of(const Poses& p, int piece
 
 void TangentCoarseSpace::expand(const Eigen::MatrixXd& X, const Eigen::VectorXd& xi,
                                 Eigen::MatrixXd& v) const {
-  std::vector<Eigen::MatrixXd> E(static_cast<std::size_t>(pieces_));
+  // Each own piece's [Omega c] (k x (k+1), column-major, one buffer: this runs twice in every CG
+  // iteration), then each slot's blend of them; the sums in the order of add_generator() and of
+  // Eigen's E_i += w E_alpha.
+  const int k = k_;
+  const std::size_t kk = static_cast<std::size_t>(k * (k + 1));
+  const int rotations = static_cast<int>(rotation_pairs_.size());
+  std::vector<double> E(static_cast<std::size_t>(pieces_) * kk, 0.0);
+  std::vector<char> has(static_cast<std::size_t>(pieces_), 0);  // empty: alone in its group
   for (int u : own_) {
-    Eigen::MatrixXd& e = E[static_cast<std::size_t>(u / g_)];
-    if (e.size() == 0) e = Eigen::MatrixXd::Zero(k_, k_ + 1);
-    add_generator(u % g_, xi(u), e);
+    const auto piece = static_cast<std::size_t>(u / g_);
+    has[piece] = 1;
+    double* e = E.data() + piece * kk;
+    const int j = u % g_;
+    if (j < rotations) {
+      const auto [a, b] = rotation_pairs_[static_cast<std::size_t>(j)];
+      e[a + b * k] += xi(u);
+      e[b + a * k] -= xi(u);
+    } else {
+      e[(j - rotations) + k * k] += xi(u);
+    }
   }
-  Eigen::MatrixXd Ei(k_, k_ + 1);
+  std::vector<double> Ei(kk);
   for (std::size_t s : linked_slots_) {
-    Ei.setZero();
+    std::fill(Ei.begin(), Ei.end(), 0.0);
     for (std::size_t q = own_poses_.start[s]; q < own_poses_.start[s + 1]; ++q) {
       const Weight& w = own_poses_.weights[q];
-      const Eigen::MatrixXd& e = E[static_cast<std::size_t>(w.piece)];
-      if (e.size() > 0) Ei += w.w * e;  // empty: a piece alone in its group
+      const auto piece = static_cast<std::size_t>(w.piece);
+      if (!has[piece]) continue;
+      const double* e = E.data() + piece * kk;
+      for (std::size_t t = 0; t < kk; ++t) Ei[t] += w.w * e[t];
     }
-    move(Ei, X, static_cast<Eigen::Index>(s), v);
+    move(Ei.data(), X, static_cast<Eigen::Index>(s), v);
   }
 }
 
@@ -219,29 +254,46 @@ void TangentCoarseSpace::unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& X
     const std::size_t n = p.start.size() - 1;
     for (std::size_t s = 0; s < n; ++s)
       for (std::size_t q = p.start[s]; q < p.start[s + 1]; ++q)
-        if (p.weights[q].piece == piece)
-          move(p.weights[q].w * E, P, static_cast<Eigen::Index>(s), out);
+        if (p.weights[q].piece == piece) {
+          const Eigen::MatrixXd wE = p.weights[q].w * E;
+          move(wE.data(), P, static_cast<Eigen::Index>(s), out);
+        }
   };
   fill(own_poses_, X, v);
   fill(neighbour_poses_, Xn, vn);
 }
 
-void TangentCoarseSpace::unit_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
+void TangentCoarseSpace::lift_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int piece,
                                  const std::vector<Eigen::Index>& own,
-                                 const std::vector<Eigen::Index>& neighbour, Eigen::MatrixXd& v,
-                                 Eigen::MatrixXd& vn) const {
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(k_, k_ + 1);
-  add_generator(unknown % g_, 1.0, E);
-  const int piece = unknown / g_;
+                                 const std::vector<Eigen::Index>& neighbour, Eigen::MatrixXd& W,
+                                 Eigen::MatrixXd& Wn) const {
   auto fill = [&](const Poses& p, const std::vector<Eigen::Index>& slots, const Eigen::MatrixXd& P,
                   Eigen::MatrixXd& out) {
     for (Eigen::Index s : slots)
       for (std::size_t q = p.start[static_cast<std::size_t>(s)];
            q < p.start[static_cast<std::size_t>(s) + 1]; ++q)
-        if (p.weights[q].piece == piece) move(p.weights[q].w * E, P, s, out);
+        if (p.weights[q].piece == piece) {
+          const double w = p.weights[q].w;
+          const Eigen::Index c = s * (d_ + 1);
+          out.block(0, c, k_, d_ + 1) += w * P.middleCols(c, d_ + 1);
+          out(k_, c + d_) += w;
+        }
   };
-  fill(own_poses_, own, X, v);
-  fill(neighbour_poses_, neighbour, Xn, vn);
+  fill(own_poses_, own, X, W);
+  fill(neighbour_poses_, neighbour, Xn, Wn);
+}
+
+void TangentCoarseSpace::apply_generator(int j, const Eigen::MatrixXd& M,
+                                         Eigen::MatrixXd& out) const {
+  out.setZero(k_, M.cols());
+  const int rotations = static_cast<int>(rotation_pairs_.size());
+  if (j < rotations) {  // Omega = e_a e_b^T - e_b e_a^T
+    const auto [a, b] = rotation_pairs_[static_cast<std::size_t>(j)];
+    out.row(a) = M.row(b);
+    out.row(b) = -M.row(a);
+  } else {  // c = e_a
+    out.row(j - rotations) = M.row(k_);
+  }
 }
 
 Eigen::MatrixXd TangentCoarseSpace::group_inverse(const Eigen::MatrixXd& Ag, double tol) const {

@@ -64,12 +64,18 @@ class TangentCoarseSpace {
   /// shapes of X and Xn.
   void unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown, Eigen::MatrixXd& v,
             Eigen::MatrixXd& vn) const;
-  /// The same on the unknown's piece's slots only (`own`, `neighbour`: own_slots() and
-  /// neighbour_slots() of its piece), adding to v and vn of X's and Xn's shapes, which the caller
-  /// keeps zero elsewhere: a column then costs its piece's poses, not the whole block.
-  void unit_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
+  /// The lift of one piece: on its slots (`own`, `neighbour`: own_slots() and neighbour_slots()),
+  /// slot s of W (Wn) += w_s [X_s; 0 1], k + 1 rows, w_s the slot's weight of the piece; the
+  /// caller keeps W and Wn zero elsewhere. Each of the piece's unknowns' vectors is E W with E =
+  /// [Omega c] its generator (k x (k+1)), so a linear map M of them all is E (W M): one product
+  /// per piece, not one per generator (apply_generator() reads each off it).
+  void lift_on(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int piece,
                const std::vector<Eigen::Index>& own, const std::vector<Eigen::Index>& neighbour,
-               Eigen::MatrixXd& v, Eigen::MatrixXd& vn) const;
+               Eigen::MatrixXd& W, Eigen::MatrixXd& Wn) const;
+  /// out = E M for generator j (M: k + 1 rows; out: k rows, M's columns): E's one or two
+  /// non-zero entries are +-1, so out's rows are copies of M's rows (with the vectors lift_on()
+  /// gives, the same numbers as unit()'s, whose products with E's zeros add only zeros).
+  void apply_generator(int j, const Eigen::MatrixXd& M, Eigen::MatrixXd& out) const;
 
   /// Pieces whose poses are linked by measurements, directly or through other pieces (the
   /// connected components of the layout's block graph; a piece of the smoothed space goes with
@@ -139,9 +145,8 @@ class TangentCoarseSpace {
                           const std::vector<std::size_t>& ids);
   // [Omega c] of generator j scaled by x, added to E (k x (k+1)).
   void add_generator(int j, double x, Eigen::MatrixXd& E) const;
-  // v's slot s += E [X_s; 0 1].
-  void move(const Eigen::MatrixXd& E, const Eigen::MatrixXd& X, Eigen::Index s,
-            Eigen::MatrixXd& v) const;
+  // v's slot s += E [X_s; 0 1], E = e[0 .. k(k+1)) column-major k x (k+1).
+  void move(const double* e, const Eigen::MatrixXd& X, Eigen::Index s, Eigen::MatrixXd& v) const;
 
   int d_, k_, g_, pieces_;
   int groups_ = 0;

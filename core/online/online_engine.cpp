@@ -237,6 +237,19 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
 void use_online_refine_space(const LiveBlocks& blocks, const DistributedOptions& solver) {
   if (!solver.refine.enabled || solver.refine.coarse != NewtonRefineOptions::Coarse::kSmoothed)
     return;
+  // Until some group of linked blocks is as large as the correction's minimum, the steps are
+  // block Jacobi's whatever the space (TangentCoarseSpace::linked(): a piece goes with its
+  // block), so the space is not built: it costs a pass over the whole graph at every solve.
+  const BlockLayout& layout = blocks.layout();
+  std::vector<int> group_blocks(static_cast<std::size_t>(layout.num_blocks), 0);
+  int largest = 0;
+  for (const std::size_t c : connected_components(layout.adjacent))
+    largest = std::max(largest, ++group_blocks[c]);
+  if (largest < solver.refine.coarse_min_blocks) {
+    for (const auto& s : blocks.states())
+      if (s) s->use_refine_space(nullptr);
+    return;
+  }
   const PoseGraph& g = blocks.graph();
   // One space shared by every held state.
   const auto space = std::make_shared<const CoarseSpace>(make_coarse_space(
