@@ -133,6 +133,45 @@ TEST(GncRefineSteps, BiggerMuStepsOnNewtonStepsKeepTheSetAndCostAndChangeNothing
   EXPECT_EQ(rounds_on.final_solve.cost, rounds_off.final_solve.cost);
 }
 
+// RobustOptions::kept_solves_start_at_refinement: a refined inlier pass starts at the kept set's
+// fresh start (whose neighbour poses came with it) or after the previous pass's pose exchange,
+// and the final solve where the last pass ended, after that pass's pose exchange, at a gradient
+// far below the rounds' tolerance. Their rounds would only repeat a pose exchange and stop at
+// their first status, so they start at the Newton refinement: two message steps fewer each,
+// the same points, set, cost and certificate.
+TEST(GncRefineSteps, TheKeptSetsSolvesStartAtTheirRefinementWithTheSameAnswerAndCertificate) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.certify = true;
+  o.robust.kept_solves_start_at_refinement = false;
+  const GncDistributedResult opened =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  o.robust.kept_solves_start_at_refinement = true;
+  const GncDistributedResult started =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  ASSERT_EQ(opened.final_solve_stages, 1);
+  ASSERT_EQ(opened.final_solve.rounds, 0) << "the last pass should leave the rounds nothing";
+  EXPECT_EQ(started.final_solve_stages, 0);
+  EXPECT_EQ(started.final_solve.rounds, 0);
+  EXPECT_LT(started.solve_stages, opened.solve_stages) << "a pass should start at its refinement";
+  EXPECT_EQ(started.total_rounds, opened.total_rounds);
+  EXPECT_EQ(started.refine_message_steps, opened.refine_message_steps);
+  EXPECT_EQ(started.exchange_steps, opened.exchange_steps);
+  EXPECT_EQ(started.outer_iterations, opened.outer_iterations);
+  EXPECT_EQ(started.readmitted, opened.readmitted);
+  EXPECT_EQ(started.rejected, dirty.outliers);
+  EXPECT_EQ(started.rejected, opened.rejected);
+  EXPECT_EQ(started.final_refine_message_steps, opened.final_refine_message_steps);
+  EXPECT_EQ(started.final_solve.X, opened.final_solve.X);
+  EXPECT_EQ(started.final_solve.cost, opened.final_solve.cost);
+  EXPECT_EQ(started.final_solve.relaxation_cost, opened.final_solve.relaxation_cost);
+  ASSERT_TRUE(opened.final_solve.certified.value_or(false));
+  EXPECT_TRUE(started.final_solve.certified.value_or(false));
+  EXPECT_EQ(started.final_solve.min_eigenvalue, opened.final_solve.min_eigenvalue);
+  EXPECT_EQ(started.final_solve.longest_chain + 2, opened.final_solve.longest_chain);
+}
+
 TEST(GncRefineSteps, ANewtonMuStepMaxOfOneNamesTheField) {
   RobustOptions o;
   o.newton_mu_step_max = 1;

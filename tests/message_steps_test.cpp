@@ -41,10 +41,11 @@ TEST(MessageSteps, ARobustRunCountsEveryWaitOfItsLongestChain) {
     GncDistributedOptions o;  // Newton steps in GNC
     o.robust.kind = RobustKind::kGncTls;
     o.robust.exchanges_ride_along = ride_along;
+    o.robust.kept_solves_start_at_refinement = ride_along;
     const GncDistributedResult r =
         solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
     ASSERT_GT(r.outer_iterations, 2);
-    if (ride_along)  // the weighted solves start at their refinement, with no stage steps
+    if (ride_along)  // the weighted and kept set's solves start at their refinement
       ASSERT_LT(r.solve_stages, r.outer_iterations) << "a solve stage per weighted solve";
     else
       ASSERT_GT(r.solve_stages, r.outer_iterations) << "a solve stage per solve";

@@ -94,6 +94,7 @@ void CertifiedAgent::emit(std::vector<OutgoingMessage>&& sub,
 }
 
 std::vector<OutgoingMessage> CertifiedAgent::start() {
+  if (known_start_ && can_start_at_refinement()) return start_at_refinement();
   std::vector<OutgoingMessage> out;
   begin(0, out);
   advance(out);
@@ -101,9 +102,14 @@ std::vector<OutgoingMessage> CertifiedAgent::start() {
 }
 
 bool CertifiedAgent::can_start_at_refinement() const {
-  // Such rounds stop at their round-0 status ("grad_norm") and refine_wanted() holds there.
-  return !options_.certify && options_.refine.enabled && hands_over_early() &&
-         std::isinf(solve_tolerance());
+  // Such rounds stop at their round-0 status ("grad_norm") and refine_wanted() holds there. A
+  // certificate follows the refinement as it follows the rounds.
+  if (!options_.refine.enabled) return false;
+  const bool refined =
+      hands_over_early() || options_.refine.when == NewtonRefineOptions::When::kAlways;
+  const double tol = solve_tolerance();
+  const bool stops_at_start = std::isinf(tol) || (known_start_ && known_grad_norm_ <= 0.5 * tol);
+  return refined && stops_at_start;
 }
 
 std::vector<OutgoingMessage> CertifiedAgent::start_at_refinement() {
@@ -128,6 +134,8 @@ void CertifiedAgent::begin_refine(std::vector<OutgoingMessage>& out) {
   if (trial_observer_) refine_->set_trial_observer(trial_observer_);
   if (!solves_.empty() && !solves_.back().trace.empty())
     refine_->set_start_grad_norm(solves_.back().trace.back().grad_norm);
+  else if (known_start_ && stage_ == 0)
+    refine_->set_start_grad_norm(known_grad_norm_);
   current_ = refine_.get();
   emit(refine_->start(), out);
   for (const ProtocolMessage& m :
@@ -267,8 +275,10 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
           // (and the escape's reference cost) are the refined ones.
           const NewtonRefineResult& r = refine_->result();
           refines_.push_back(r);
-          if (r.accepted_steps > 0) {
-            // Started at the refinement, the stage has no round record to copy.
+          // Started at the refinement, the stage has no round record to copy: its point is the
+          // refinement's (moved or not), which the certificate and the escape start from.
+          const bool started_here = !solve_;
+          if (r.accepted_steps > 0 || (started_here && solves_.back().trace.empty())) {
             RoundRecord last =
                 solves_.back().trace.empty() ? RoundRecord{} : solves_.back().trace.back();
             last.cost = r.cost;
@@ -280,7 +290,8 @@ void CertifiedAgent::advance(std::vector<OutgoingMessage>& out) {
           refine_.reset();
           current_ = solve_.get();
         }
-        if (!options_.certify || !solve_ || solve_->trace().empty()) {
+        const bool no_point = solve_ ? solve_->trace().empty() : solves_.back().trace.empty();
+        if (!options_.certify || no_point) {
           done_ = true;
           break;
         }

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <memory>
 #include <stdexcept>
@@ -116,7 +117,7 @@ DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<in
 DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
                                                 const std::vector<int>& assignment,
                                                 const DistributedOptions& options,
-                                                const Eigen::MatrixXd& X0) {
+                                                const Eigen::MatrixXd& X0, double known_grad_norm) {
   const auto start = Clock::now();
   check_options(graph, options);
   const Eigen::Index w = graph.d + 1;
@@ -138,6 +139,15 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
           X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
     states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb,
                                                   options.block_update));
+    if (!std::isnan(known_grad_norm)) {
+      // The neighbours' poses of X0, as the rounds' opening exchange would bring them.
+      const auto& nb = states.back()->problem().neighbors();
+      Eigen::MatrixXd Yn(options.rank, w * static_cast<Eigen::Index>(nb.size()));
+      for (std::size_t s = 0; s < nb.size(); ++s)
+        Yn.middleCols(w * static_cast<Eigen::Index>(s), w) =
+            X0.middleCols(w * static_cast<Eigen::Index>(nb[s]), w);
+      states.back()->reset_iterate(Yb, Yn);
+    }
     pointers.push_back(states.back().get());
   }
   if (options.coarse.enabled && options.coarse.space == CoarseSpaceKind::kSmoothed) {
@@ -152,7 +162,8 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
     for (AgentState* s : pointers) s->use_refine_space(space);
   }
   const double setup_s = since(start);
-  DistributedResult res = solve_distributed_with_states(graph, layout, pointers, options);
+  DistributedResult res =
+      solve_distributed_with_states(graph, layout, pointers, options, known_grad_norm);
   res.init_s += setup_s;
   res.wall_s = since(start);
   return res;
@@ -160,7 +171,8 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
 
 DistributedResult solve_distributed_with_states(const PoseGraph& graph, const BlockLayout& layout,
                                                 const std::vector<AgentState*>& states,
-                                                const DistributedOptions& options) {
+                                                const DistributedOptions& options,
+                                                double known_grad_norm) {
   const auto start = Clock::now();
   check_options(graph, options);
   const Eigen::Index w = graph.d + 1;
@@ -177,6 +189,7 @@ DistributedResult solve_distributed_with_states(const PoseGraph& graph, const Bl
   for (int b = 0; b < N; ++b) {
     sequences.push_back(
         std::make_unique<CertifiedAgent>(*states[static_cast<std::size_t>(b)], layout, options));
+    if (!std::isnan(known_grad_norm)) sequences.back()->set_known_start(known_grad_norm);
     agents.push_back(sequences.back().get());
   }
   res.init_s = since(start);

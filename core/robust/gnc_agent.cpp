@@ -123,6 +123,11 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
     begin_exchange(Step::kKeptStart, out);
     return;
   }
+  // The final solve starts where the last pass ended, whose pose exchange every agent holds
+  // (RobustOptions::kept_solves_start_at_refinement).
+  final_start_grad_norm_ = options_.robust.kept_solves_start_at_refinement && neighbours_current_
+                               ? stage_->pass_grad_norm()
+                               : std::numeric_limits<double>::quiet_NaN();
   if (!final_solve_runs() || !final_solve_wanted_) {
     done_ = true;
     step_ = Step::kDone;
@@ -290,7 +295,11 @@ void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {
   const bool fresh = at_candidate < at_iterate;
   if (fresh) {
     stage_->set_iterate(exchange_->candidate());
-    neighbours_current_ = false;
+    // The fresh start's neighbour poses came with it (agent 0's answer, or the two starts' pose
+    // exchange): a pass may start at its refinement from there.
+    // (Every agent decides the same: the option alone.)
+    neighbours_current_ = options_.robust.kept_solves_start_at_refinement;
+    if (neighbours_current_) exchange_->adopt_candidate_neighbours();
   }
   exchange_->candidate().resize(0, 0);
   exchange_->forget_candidate_neighbours();

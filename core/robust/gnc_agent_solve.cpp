@@ -4,6 +4,7 @@
 // gnc_agent.cpp.
 
 #include <algorithm>
+#include <cmath>
 #include <tessera/robust/gnc_agent.hpp>
 #include <utility>
 #include <vector>
@@ -25,9 +26,13 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
   const bool weighted = stage_->kind() == GncSolveKind::kGnc && g_ > first_solve_g_;
   stage_->open(weighted, passes_->capped(), send_poses_with_trial(), weights_, rejected_);
-  // A weighted solve by Newton steps right after a pose exchange of its start (every agent's
-  // steps are the same): its rounds would open with that exchange again and stop at their first
-  // status, so it starts at the refinement with the exchange's poses (the same bits).
+  if (neighbours_known && stage_->kind() == GncSolveKind::kFinal &&
+      !std::isnan(final_start_grad_norm_))
+    stage_->know_start(final_start_grad_norm_);
+  // A weighted solve by Newton steps, or the final solve from the last pass's point, right
+  // after a pose exchange of its start (every agent's steps are the same): its rounds would
+  // open with that exchange again and stop at their first status, so it starts at the
+  // refinement with the exchange's poses (the same bits).
   if (neighbours_known && stage_->may_start_at_refinement())
     pass_on(stage_->start_at_refinement(
                 exchange_->neighbours_at(stage_->state().problem().neighbors())),

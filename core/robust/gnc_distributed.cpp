@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -179,7 +180,10 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   last.refine = gnc_solve_options(
                     options, final_runs ? GncSolveKind::kFinal : GncSolveKind::kInlierPass, false)
                     .refine;
-  out.final_solve = solve_distributed_from_lifted(inliers, assignment, last, X);
+  // Where the agents' final solve would start at its refinement, so does this one.
+  out.final_solve = solve_distributed_from_lifted(
+      inliers, assignment, last, X,
+      final_runs ? lead.final_start_grad_norm() : std::numeric_limits<double>::quiet_NaN());
   if (final_runs) {
     out.total_rounds += out.final_solve.rounds;
     out.final_refine_message_steps = message_steps(out.final_solve.refines);

@@ -73,6 +73,8 @@ class GncExchangeBook {
   Eigen::MatrixXd neighbours_at(const std::vector<std::size_t>& poses) const;
   const Eigen::MatrixXd& candidate_neighbours() const { return candidate_neighbours_; }
   void forget_candidate_neighbours() { candidate_neighbours_.resize(0, 0); }
+  /// The second start became the iterate: its neighbours' poses are the iterate's now.
+  void adopt_candidate_neighbours() { neighbours_ = candidate_neighbours_; }
   /// The candidate start's neighbour poses when agent 0 sent (or, at agent 0, computed) them
   /// with the start: empty otherwise.
   Eigen::MatrixXd& candidate_neighbours() { return candidate_neighbours_; }

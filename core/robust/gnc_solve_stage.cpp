@@ -27,6 +27,7 @@ void GncSolveStage::drop(const std::vector<std::uint64_t>& dropped) {
       make_block_layout(in_.num_poses, structure_without(in_.structure, dropped), in_.owner));
   // The state refers to the layout: keep the iterate as the next start, then replace both.
   if (state_) start_ = state_->Y;
+  pass_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
   solve_.reset();
   state_.reset();
   layout_ = std::move(layout);
@@ -70,6 +71,7 @@ void GncSolveStage::open(bool weighted, bool capped, bool trial_poses,
         make_coarse_space(in_.num_poses, structure(rejected), in_.owner,
                           solve_options_.refine.coarse_space_options())));
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
+  start_known_ = false;
   trial_pending_ = poses_sent_early_ = poses_early_stale_ = false;
   if (newton_steps_ && trial_poses)
     solve_->set_trial_observer([this](const Eigen::MatrixXd& Y) {
@@ -81,8 +83,16 @@ void GncSolveStage::open(bool weighted, bool capped, bool trial_poses,
     });
 }
 
+void GncSolveStage::know_start(double grad_norm) {
+  solve_->set_known_start(grad_norm);
+  start_known_ = true;
+}
+
 bool GncSolveStage::may_start_at_refinement() const {
-  return newton_steps_ && options_.robust.exchanges_ride_along && solve_->can_start_at_refinement();
+  const bool weighted = newton_steps_ && options_.robust.exchanges_ride_along;
+  const bool pass =
+      kind_ == GncSolveKind::kInlierPass && options_.robust.kept_solves_start_at_refinement;
+  return (weighted || pass || start_known_) && solve_->can_start_at_refinement();
 }
 
 std::vector<OutgoingMessage> GncSolveStage::start_at_refinement(const Eigen::MatrixXd& neighbours) {
@@ -109,6 +119,7 @@ void GncSolveStage::tally() {
     final_rounds_ += solve_->total_rounds();
     return;
   }
+  if (kind_ == GncSolveKind::kInlierPass) pass_grad_norm_ = last_grad_norm();
   gnc_rounds_ += solve_->total_rounds();
   gnc_solve_stages_ += opened_solve_stages(solve_->solves());
   gnc_refine_steps_ += message_steps(solve_->refines());
@@ -118,6 +129,12 @@ double GncSolveStage::last_cost() const {
   if (solve_->solves().empty() || solve_->solves().back().trace.empty())
     return std::numeric_limits<double>::quiet_NaN();
   return solve_->solves().back().trace.back().cost;
+}
+
+double GncSolveStage::last_grad_norm() const {
+  if (solve_->solves().empty() || solve_->solves().back().trace.empty())
+    return std::numeric_limits<double>::quiet_NaN();
+  return solve_->solves().back().trace.back().grad_norm;
 }
 
 std::vector<std::pair<std::uint32_t, std::uint32_t>> GncSolveStage::structure(

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
@@ -47,8 +48,12 @@ class GncSolveStage {
   /// out its trial point), `rejected` (the current rejected set: the passes' coarse space).
   void open(bool weighted, bool capped, bool trial_poses, const std::vector<double>& weights,
             const std::vector<std::uint64_t>& rejected);
-  /// The opened solve by Newton steps may start at its refinement (its rounds would open with a
-  /// pose exchange just held and stop at their first status).
+  /// Before the opened solve starts: its start is the iterate, where the team's last solve of
+  /// the same problem ended with summed gradient `grad_norm` (CertifiedAgent::set_known_start).
+  void know_start(double grad_norm);
+  /// The opened solve may start at its refinement (its rounds would open with a pose exchange
+  /// just held and stop at their first status): a weighted solve by Newton steps, or a solve
+  /// whose start is known (know_start) within its rounds' tolerance.
   bool may_start_at_refinement() const;
   /// The opened solve's first messages: from its rounds, or (may_start_at_refinement) from its
   /// refinement with the neighbours' poses `neighbours` of the iterate (state().problem()'s
@@ -61,8 +66,9 @@ class GncSolveStage {
   void judge_early_poses();
   /// Adds the ended solve's rounds, stages and refinement message steps to the totals.
   void tally();
-  /// The ended solve's summed cost (its last trace record), NaN without one.
+  /// The ended solve's summed cost and gradient (its last trace record), NaN without one.
   double last_cost() const;
+  double last_grad_norm() const;
 
   GncSolveKind kind() const { return kind_; }
   CertifiedAgent& solve() { return *solve_; }
@@ -71,7 +77,10 @@ class GncSolveStage {
   const AgentState& state() const { return *state_; }
   /// The iterate (own block, lifted), or the next start before the first solve.
   const Eigen::MatrixXd& iterate() const { return state_ ? state_->Y : start_; }
-  void set_iterate(Eigen::MatrixXd Y) { state_->Y = std::move(Y); }
+  void set_iterate(Eigen::MatrixXd Y) {
+    state_->Y = std::move(Y);
+    pass_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
+  }
   const BlockLayout& layout() const { return *layout_; }
   bool pass_refines() const;  // the passes hand over to the Newton refinement (gnc_solve_setup)
 
@@ -83,6 +92,9 @@ class GncSolveStage {
   const std::vector<Measurement>& kept() const { return kept_; }
   const std::vector<std::uint64_t>& kept_index() const { return kept_index_; }
   const Eigen::MatrixXd& last_pass_start() const { return last_pass_start_; }
+  /// The summed gradient at the iterate where the last inlier pass ended there (its last
+  /// record); NaN once the iterate or the layout changed since, or without a record.
+  double pass_grad_norm() const { return pass_grad_norm_; }
   int gnc_rounds() const { return gnc_rounds_; }
   int final_rounds() const { return final_rounds_; }
   int gnc_refine_steps() const { return gnc_refine_steps_; }
@@ -104,6 +116,8 @@ class GncSolveStage {
   std::unique_ptr<AgentState> state_;
   std::unique_ptr<CertifiedAgent> solve_;
   bool newton_steps_ = false;  // the opened solve is a weighted one by Newton steps
+  bool start_known_ = false;   // know_start() for the opened solve
+  double pass_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
   bool gnc_newton_steps_ = false;
   int weighted_solves_ = 0;
   Eigen::MatrixXd trial_Y_;

@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,15 +50,27 @@ class CertifiedAgent : public AgentProcess {
   /// Instead of start(): the first solve stage continues from `snapshot` (a coordinated
   /// rollback, see RoundProtocol::resume); the later stages follow as usual.
   std::vector<OutgoingMessage> resume(const ProtocolSnapshot& snapshot);
+  /// Before start(): the state's neighbour copies (AgentState::Yn) are the neighbours' current
+  /// poses and `grad_norm` is ||grad f|| at the start point as the team last summed it, in a
+  /// solve of the same problem that ended there (the same on every agent). Where that settles
+  /// the first solve stage's rounds at their round-0 status (can_start_at_refinement()), start()
+  /// begins at the refinement (start_at_refinement()).
+  void set_known_start(double grad_norm) {
+    known_start_ = true;
+    known_grad_norm_ = grad_norm;
+  }
   /// Whether the first solve stage's rounds would stop at their first status and hand over to
-  /// the Newton refinement (an infinite hand-over gradient, no certificate): then
-  /// start_at_refinement() may replace start(). The same on every agent (options and layout).
+  /// the Newton refinement: their hand-over gradient is infinite, or the known start's gradient
+  /// (set_known_start) is within half their tolerance (the rounds' own sum of it differs only
+  /// by rounding); and the refinement follows such a stop. Then start_at_refinement() may
+  /// replace start(). The same on every agent (options, layout and the known sum).
   bool can_start_at_refinement() const;
   /// Instead of start(), where can_start_at_refinement() holds and the state's neighbour copies
   /// (AgentState::Yn) are the neighbours' current poses, as every agent of the run knows: the
   /// first solve stage begins at its Newton refinement, without the rounds' opening pose
   /// exchange and round-0 status (the refinement takes its own). The stage's record has no
-  /// rounds and SolveStageRecord::opened false. Every agent of the run must start so.
+  /// rounds and SolveStageRecord::opened false; its trace is the refinement's point. The
+  /// certificate, where on, follows as after the rounds. Every agent of the run must start so.
   std::vector<OutgoingMessage> start_at_refinement();
   /// Observer of the FIRST solve stage's consistent points (RoundProtocol::set_round_observer):
   /// snapshots of later stages would not be resumable from stage 0.
@@ -157,6 +170,8 @@ class CertifiedAgent : public AgentProcess {
   std::vector<EscapeStageRecord> escapes_;
   std::function<void(const ProtocolSnapshot&)> observer_;
   std::function<void(const Eigen::MatrixXd&)> trial_observer_;
+  bool known_start_ = false;  // set_known_start()
+  double known_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
   bool refining_ = false;        // the current rank's solve continues at refine_tolerance()
   bool interface_fits_ = false;  // the team's interface within the refinement's interface cap
   bool done_ = false;

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <tessera/distributed/block_selection.hpp>
@@ -173,19 +174,23 @@ DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<in
 /// The same from a lifted starting point X0 (r x (d+1)n, global pose order, each block [Y_i |
 /// p_i] with Y_i in St(d, r)): e.g. the iterate of an earlier run whose agents changed, so a run
 /// continues where it was instead of starting over. Throws InputError when X0 has the wrong
-/// shape.
-DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
-                                                const std::vector<int>& assignment,
-                                                const DistributedOptions& options,
-                                                const Eigen::MatrixXd& X0);
+/// shape. `known_grad_norm`: ||grad f(X0)|| as a finished solve of the same problem summed
+/// it (NaN: not known); where it settles the rounds at their first status, the agents start at
+/// their Newton refinement with X0's neighbour poses (CertifiedAgent::set_known_start), without
+/// the rounds' opening pose exchange and round-0 status.
+DistributedResult solve_distributed_from_lifted(
+    const PoseGraph& graph, const std::vector<int>& assignment, const DistributedOptions& options,
+    const Eigen::MatrixXd& X0, double known_grad_norm = std::numeric_limits<double>::quiet_NaN());
 
 class AgentState;
 /// The same with agents whose states already exist (states[b] = block b of `layout`, built
 /// over `graph`'s measurements, each at its starting point): an online run keeps them from
 /// step to step and grows them in place (live_blocks.hpp) instead of building every block
 /// problem and preconditioner again. The states hold the final iterate afterwards.
-DistributedResult solve_distributed_with_states(const PoseGraph& graph, const BlockLayout& layout,
-                                                const std::vector<AgentState*>& states,
-                                                const DistributedOptions& options);
+/// `known_grad_norm` as above (the states' neighbour copies must then be current).
+DistributedResult solve_distributed_with_states(
+    const PoseGraph& graph, const BlockLayout& layout, const std::vector<AgentState*>& states,
+    const DistributedOptions& options,
+    double known_grad_norm = std::numeric_limits<double>::quiet_NaN());
 
 }  // namespace tessera

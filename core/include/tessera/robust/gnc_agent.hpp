@@ -208,6 +208,11 @@ class GncAgent : public AgentProcess {
   /// RobustOptions::final_refine); otherwise the last pass, solved to the tolerance, is the
   /// answer.
   bool final_solve_runs() const;
+  /// Once done() without the final solve run here: the summed gradient at the iterate where
+  /// the final solve may start at its Newton refinement (RobustOptions::
+  /// kept_solves_start_at_refinement; the iterate is the last pass's end and every agent holds its
+  /// neighbours' poses there), NaN where it opens with its rounds.
+  double final_start_grad_norm() const { return final_start_grad_norm_; }
   const BlockLayout& layout() const;
   const std::vector<Measurement>& kept_measurements() const;
   const std::vector<std::uint64_t>& kept_index() const;
@@ -304,6 +309,7 @@ class GncAgent : public AgentProcess {
   // exchange since the iterate last moved). With values_held_ the kept set's fresh start then
   // needs no pose exchange: agent 0 sends each agent its neighbours' poses of the start too.
   bool neighbours_current_ = false;
+  double final_start_grad_norm_ = std::numeric_limits<double>::quiet_NaN();  // finish()
   std::unique_ptr<BlockLayout> base_;          // of every measurement: whose poses go where
   std::unique_ptr<GncLocalTerms> terms_;       // the TLS math over this agent's view
   std::vector<double> weights_;                // per in_.measurements
