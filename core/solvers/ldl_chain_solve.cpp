@@ -1,20 +1,95 @@
 #include "solvers/ldl_chain_solve.hpp"
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 namespace tessera {
 namespace {
 
 // The row updates of a forward chain over one run: x[k] -= a[k] y0 (+ b[k] y1 (+ c[k] y2)),
-// the sum formed left to right as CHOLMOD forms it. Element-wise, so vectorising keeps the bits.
-void forward_run(double* __restrict x, const double* __restrict a, double y0, int length) {
-  for (int k = 0; k < length; ++k) x[k] -= a[k] * y0;
+// the sum formed left to right as CHOLMOD forms it. Element-wise, so two rows to an SSE2
+// register keep the bits.
+void forward_run(double* x, const double* a, double y0, int length) {
+  int k = 0;
+#ifdef __SSE2__
+  const __m128d v0 = _mm_set1_pd(y0);
+  for (; k + 2 <= length; k += 2)
+    _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), _mm_mul_pd(_mm_loadu_pd(a + k), v0)));
+#endif
+  for (; k < length; ++k) x[k] -= a[k] * y0;
 }
-void forward_run(double* __restrict x, const double* __restrict a, const double* __restrict b,
-                 double y0, double y1, int length) {
-  for (int k = 0; k < length; ++k) x[k] -= a[k] * y0 + b[k] * y1;
+void forward_run(double* x, const double* a, const double* b, double y0, double y1, int length) {
+  int k = 0;
+#ifdef __SSE2__
+  const __m128d v0 = _mm_set1_pd(y0), v1 = _mm_set1_pd(y1);
+  for (; k + 2 <= length; k += 2) {
+    const __m128d s =
+        _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(a + k), v0), _mm_mul_pd(_mm_loadu_pd(b + k), v1));
+    _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), s));
+  }
+#endif
+  for (; k < length; ++k) x[k] -= a[k] * y0 + b[k] * y1;
 }
-void forward_run(double* __restrict x, const double* __restrict a, const double* __restrict b,
-                 const double* __restrict c, double y0, double y1, double y2, int length) {
-  for (int k = 0; k < length; ++k) x[k] -= a[k] * y0 + b[k] * y1 + c[k] * y2;
+void forward_run(double* x, const double* a, const double* b, const double* c, double y0, double y1,
+                 double y2, int length) {
+  int k = 0;
+#ifdef __SSE2__
+  const __m128d v0 = _mm_set1_pd(y0), v1 = _mm_set1_pd(y1), v2 = _mm_set1_pd(y2);
+  for (; k + 2 <= length; k += 2) {
+    __m128d s =
+        _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(a + k), v0), _mm_mul_pd(_mm_loadu_pd(b + k), v1));
+    s = _mm_add_pd(s, _mm_mul_pd(_mm_loadu_pd(c + k), v2));
+    _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), s));
+  }
+#endif
+  for (; k < length; ++k) x[k] -= a[k] * y0 + b[k] * y1 + c[k] * y2;
+}
+
+// A backward chain's dots over its runs: y_c -= a_c[k] x[k] for k in order, each y_c its own
+// sequential sum. Two rows' products are formed in one SSE2 register and subtracted low lane
+// first: the same operations in the same order.
+#ifdef __SSE2__
+inline void subtract_pair(__m128d& y, __m128d product) {
+  y = _mm_sub_sd(_mm_sub_sd(y, product), _mm_unpackhi_pd(product, product));
+}
+#endif
+
+template <int W>
+void backward_runs(double (&y)[3], const double* (&a)[3], const double* X,
+                   const LdlChainSolve::Run* run, const LdlChainSolve::Run* end) {
+  const double* a0 = a[0];
+  const double* a1 = a[1];
+  const double* a2 = a[2];
+  double y0 = y[0], y1 = y[1], y2 = y[2];
+  for (; run != end; ++run) {
+    const double* x = X + run->row;
+    const int length = run->length;
+    int k = 0;
+#ifdef __SSE2__
+    __m128d s0 = _mm_set_sd(y0), s1 = _mm_set_sd(y1), s2 = _mm_set_sd(y2);
+    for (; k + 2 <= length; k += 2) {
+      const __m128d xv = _mm_loadu_pd(x + k);
+      subtract_pair(s0, _mm_mul_pd(_mm_loadu_pd(a0 + k), xv));
+      if constexpr (W > 1) subtract_pair(s1, _mm_mul_pd(_mm_loadu_pd(a1 + k), xv));
+      if constexpr (W > 2) subtract_pair(s2, _mm_mul_pd(_mm_loadu_pd(a2 + k), xv));
+    }
+    y0 = _mm_cvtsd_f64(s0);
+    if constexpr (W > 1) y1 = _mm_cvtsd_f64(s1);
+    if constexpr (W > 2) y2 = _mm_cvtsd_f64(s2);
+#endif
+    for (; k < length; ++k) {
+      y0 -= a0[k] * x[k];
+      if constexpr (W > 1) y1 -= a1[k] * x[k];
+      if constexpr (W > 2) y2 -= a2[k] * x[k];
+    }
+    a0 += length;
+    a1 += length;
+    a2 += length;
+  }
+  y[0] = y0;
+  y[1] = y1;
+  y[2] = y2;
 }
 
 }  // namespace
@@ -120,61 +195,30 @@ void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* ou
   // D L^T x = y: each column divided by its D entry first, then its dot with the rows below
   // subtracted in the factor's row order.
   for (const Chain& ch : backward_) {
-    const int j = ch.column, p = Lp[j];
+    const int j = ch.column, w = ch.width;
     const Run* run = backward_runs_.data() + ch.run_begin;
     const Run* end = backward_runs_.data() + ch.run_end;
-    const double* a = Lx + p + 1;
-    if (ch.width == 1) {
-      double y0 = X[j] / Lx[p];
-      for (; run != end; ++run) {
-        const double* x = X + run->row;
-        for (int k = 0; k < run->length; ++k) y0 -= a[k] * x[k];
-        a += run->length;
-      }
-      X[j] = y0;
-    } else if (ch.width == 2) {
-      const int q = Lp[j - 1];
-      const double t = Lx[q + 1];
-      double y0 = X[j] / Lx[p];
-      double y1 = X[j - 1] / Lx[q];
-      const double* b = Lx + q + 2;
-      for (; run != end; ++run) {
-        const double* x = X + run->row;
-        for (int k = 0; k < run->length; ++k) {
-          y0 -= a[k] * x[k];
-          y1 -= b[k] * x[k];
-        }
-        a += run->length;
-        b += run->length;
-      }
-      y1 -= t * y0;
-      X[j] = y0;
-      X[j - 1] = y1;
-    } else {
-      const int q = Lp[j - 1], r = Lp[j - 2];
-      const double t0 = Lx[q + 1], t1 = Lx[r + 1], t2 = Lx[r + 2];
-      double y0 = X[j] / Lx[p];
-      double y1 = X[j - 1] / Lx[q];
-      double y2 = X[j - 2] / Lx[r];
-      const double* b = Lx + q + 2;
-      const double* c = Lx + r + 3;
-      for (; run != end; ++run) {
-        const double* x = X + run->row;
-        for (int k = 0; k < run->length; ++k) {
-          y0 -= a[k] * x[k];
-          y1 -= b[k] * x[k];
-          y2 -= c[k] * x[k];
-        }
-        a += run->length;
-        b += run->length;
-        c += run->length;
-      }
-      y1 -= t0 * y0;
-      y2 -= t2 * y0 + t1 * y1;
-      X[j - 2] = y2;
-      X[j - 1] = y1;
-      X[j] = y0;
+    // Column j - c: its diagonal at Lp[j - c], then c entries inside the chain, then the rows.
+    int col[3] = {Lp[j], 0, 0};
+    double y[3] = {X[j] / Lx[col[0]], 0.0, 0.0};
+    for (int c = 1; c < w; ++c) {
+      col[c] = Lp[j - c];
+      y[c] = X[j - c] / Lx[col[c]];
     }
+    const double* a[3] = {Lx + col[0] + 1, Lx + col[1] + 2, Lx + col[2] + 3};
+    if (w == 3)
+      backward_runs<3>(y, a, X, run, end);
+    else if (w == 2)
+      backward_runs<2>(y, a, X, run, end);
+    else
+      backward_runs<1>(y, a, X, run, end);
+    if (w == 2) {
+      y[1] -= Lx[col[1] + 1] * y[0];
+    } else if (w == 3) {
+      y[1] -= Lx[col[1] + 1] * y[0];
+      y[2] -= Lx[col[2] + 2] * y[0] + Lx[col[2] + 1] * y[1];
+    }
+    for (int c = w - 1; c >= 0; --c) X[j - c] = y[c];
   }
   for (int k = 0; k < n; ++k) out[perm ? perm[k] : k] = X[k];
 }

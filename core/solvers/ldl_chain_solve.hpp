@@ -33,17 +33,18 @@ class LdlChainSolve {
   /// factor build() indexed.
   void solve(const cholmod_factor* L, const double* rhs, double* out) const;
 
+  /// Rows row .. row + length - 1 of a chain's pattern.
+  struct Run {
+    int row;
+    int length;
+  };
+
  private:
   struct Chain {
     int column;  // forward: the chain's first column; backward: its last
     int width;   // 1, 2 or 3
     int run_begin, run_end;
   };
-  struct Run {
-    int row;     // first row of the run
-    int length;  // consecutive rows
-  };
-
   static void add_runs(const int* rows, int count, std::vector<Run>& runs);
 
   std::vector<Chain> forward_, backward_;
