@@ -14,6 +14,7 @@ void forward_run(double* x, const double* a, double y0, int length) {
   int k = 0;
 #ifdef __SSE2__
   const __m128d v0 = _mm_set1_pd(y0);
+#pragma GCC unroll 2
   for (; k + 2 <= length; k += 2)
     _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), _mm_mul_pd(_mm_loadu_pd(a + k), v0)));
 #endif
@@ -23,6 +24,7 @@ void forward_run(double* x, const double* a, const double* b, double y0, double 
   int k = 0;
 #ifdef __SSE2__
   const __m128d v0 = _mm_set1_pd(y0), v1 = _mm_set1_pd(y1);
+#pragma GCC unroll 2
   for (; k + 2 <= length; k += 2) {
     const __m128d s =
         _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(a + k), v0), _mm_mul_pd(_mm_loadu_pd(b + k), v1));
@@ -36,6 +38,7 @@ void forward_run(double* x, const double* a, const double* b, const double* c, d
   int k = 0;
 #ifdef __SSE2__
   const __m128d v0 = _mm_set1_pd(y0), v1 = _mm_set1_pd(y1), v2 = _mm_set1_pd(y2);
+#pragma GCC unroll 2
   for (; k + 2 <= length; k += 2) {
     __m128d s =
         _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(a + k), v0), _mm_mul_pd(_mm_loadu_pd(b + k), v1));
@@ -68,6 +71,7 @@ void backward_runs(double (&y)[3], const double* (&a)[3], const double* X,
     int k = 0;
 #ifdef __SSE2__
     __m128d s0 = _mm_set_sd(y0), s1 = _mm_set_sd(y1), s2 = _mm_set_sd(y2);
+#pragma GCC unroll 2
     for (; k + 2 <= length; k += 2) {
       const __m128d xv = _mm_loadu_pd(x + k);
       subtract_pair(s0, _mm_mul_pd(_mm_loadu_pd(a0 + k), xv));
