@@ -1,4 +1,7 @@
 #include <Eigen/Eigenvalues>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/momentum.hpp>
@@ -121,7 +124,33 @@ void project_pose(double* A, Eigen::Index r_runtime) {
   // Row by row, each entry summed over k in order (as the lazy product A * inv_sqrt did). Zero
   // rows stay zero.
   const Eigen::Index rows = skip ? D : r;
-  for (Eigen::Index i = 0; i < rows; ++i) {
+  Eigen::Index i = 0;
+#ifdef __SSE2__
+  // Two rows to a register: the rows of a column are adjacent in A, and each entry's sum is
+  // formed as below (element-wise, so the same values).
+  if (rows >= 2) {
+    __m128d m[D][D];
+#pragma GCC unroll 4
+    for (int k = 0; k < D; ++k)
+#pragma GCC unroll 4
+      for (int j = 0; j < D; ++j) m[k][j] = _mm_set1_pd(inv_sqrt(k, j));
+    for (; i + 2 <= rows; i += 2) {
+      __m128d column[D], out[D];
+#pragma GCC unroll 4
+      for (int k = 0; k < D; ++k) column[k] = _mm_loadu_pd(A + k * r + i);
+#pragma GCC unroll 4
+      for (int j = 0; j < D; ++j) {
+        __m128d s = _mm_mul_pd(column[0], m[0][j]);
+#pragma GCC unroll 4
+        for (int k = 1; k < D; ++k) s = _mm_add_pd(s, _mm_mul_pd(column[k], m[k][j]));
+        out[j] = s;
+      }
+#pragma GCC unroll 4
+      for (int j = 0; j < D; ++j) _mm_storeu_pd(A + j * r + i, out[j]);
+    }
+  }
+#endif
+  for (; i < rows; ++i) {
     double row[D];
     for (int j = 0; j < D; ++j) {
       double s = A[i] * inv_sqrt(0, j);

@@ -13,6 +13,7 @@
 
 #include "solvers/cholmod_checked.hpp"
 #include "solvers/cholmod_dense_view.hpp"
+#include "solvers/ldl_chain_solve.hpp"
 
 namespace tessera {
 
@@ -43,10 +44,15 @@ struct TangentPreconditioner::Factor {
     for (cholmod_dense** x : {&solve_x, &solve_y, &solve_e})
       if (*x) cholmod_free_dense(x, &c);
   }
-  // A^{-1} b for the right-hand side in `b`; the result lives in solve_x (valid until the next
-  // call). The same numeric solve as CholmodDecomposition::solve (cholmod_solve calls
+  // A^{-1} b for the right-hand side in `b`; the result is valid until the next call. The same
+  // numeric solve as CholmodDecomposition::solve (cholmod_solve calls
   // cholmod_solve2 with fresh workspace), hence the same result.
   const double* solve() {
+    if (chain.ready()) {
+      solution.resize(b.size());
+      chain.solve(llt.factor(), b.data(), solution.data());
+      return solution.data();
+    }
     cholmod_dense rhs = cholmod_dense_view(b);
     cholmod_common& c = llt.cholmod();
     if (!cholmod_solve2(CHOLMOD_A, llt.factor(), &rhs, nullptr, &solve_x, nullptr, &solve_y,
@@ -71,6 +77,10 @@ struct TangentPreconditioner::Factor {
   // Solve workspace, reused by every apply (agents apply their own preconditioner only).
   Eigen::VectorXd b;
   cholmod_dense *solve_x = nullptr, *solve_y = nullptr, *solve_e = nullptr;
+  // The same solve with a simplicial factor, fewer instructions (ldl_chain_solve.hpp); indexed
+  // after every factorization.
+  LdlChainSolve chain;
+  Eigen::VectorXd solution;
   std::size_t entries = 0;
   double flops = 0.0;
   bool supernodal = false;

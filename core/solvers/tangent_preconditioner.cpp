@@ -317,12 +317,14 @@ bool TangentPreconditioner::factorize_impl(const Eigen::MatrixXd& X, const Eigen
   }
   f.with_multipliers = egrad != nullptr && positive;
   if (egrad && !positive) return factorize_impl(X, nullptr);
+  f.chain.clear();
   if (f.llt.info() != Eigen::Success) {
     f.usable = false;  // keep the caller on its Euclidean preconditioner from now on
     f.factored = false;
     return false;
   }
   f.factored = true;
+  f.chain.build(f.llt.factor());  // not built (CHOLMOD solves) for a supernodal factor
   return true;
 }
 

@@ -1,0 +1,230 @@
+#include "solvers/ldl_chain_solve.hpp"
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
+namespace tessera {
+namespace {
+
+// The row updates of a forward chain over one run: x[k] -= a[k] y0 (+ b[k] y1 (+ c[k] y2)),
+// the sum formed left to right as CHOLMOD forms it. Element-wise, so two rows to an SSE2
+// register keep the bits.
+void forward_run(double* x, const double* a, double y0, int length) {
+  int k = 0;
+#ifdef __SSE2__
+  const __m128d v0 = _mm_set1_pd(y0);
+#pragma GCC unroll 2
+  for (; k + 2 <= length; k += 2)
+    _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), _mm_mul_pd(_mm_loadu_pd(a + k), v0)));
+#endif
+  for (; k < length; ++k) x[k] -= a[k] * y0;
+}
+void forward_run(double* x, const double* a, const double* b, double y0, double y1, int length) {
+  int k = 0;
+#ifdef __SSE2__
+  const __m128d v0 = _mm_set1_pd(y0), v1 = _mm_set1_pd(y1);
+#pragma GCC unroll 2
+  for (; k + 2 <= length; k += 2) {
+    const __m128d s =
+        _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(a + k), v0), _mm_mul_pd(_mm_loadu_pd(b + k), v1));
+    _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), s));
+  }
+#endif
+  for (; k < length; ++k) x[k] -= a[k] * y0 + b[k] * y1;
+}
+void forward_run(double* x, const double* a, const double* b, const double* c, double y0, double y1,
+                 double y2, int length) {
+  int k = 0;
+#ifdef __SSE2__
+  const __m128d v0 = _mm_set1_pd(y0), v1 = _mm_set1_pd(y1), v2 = _mm_set1_pd(y2);
+#pragma GCC unroll 2
+  for (; k + 2 <= length; k += 2) {
+    __m128d s =
+        _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(a + k), v0), _mm_mul_pd(_mm_loadu_pd(b + k), v1));
+    s = _mm_add_pd(s, _mm_mul_pd(_mm_loadu_pd(c + k), v2));
+    _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), s));
+  }
+#endif
+  for (; k < length; ++k) x[k] -= a[k] * y0 + b[k] * y1 + c[k] * y2;
+}
+
+// A backward chain's dots over its runs: y_c -= a_c[k] x[k] for k in order, each y_c its own
+// sequential sum. Two rows' products are formed in one SSE2 register and subtracted low lane
+// first: the same operations in the same order.
+#ifdef __SSE2__
+inline void subtract_pair(__m128d& y, __m128d product) {
+  y = _mm_sub_sd(_mm_sub_sd(y, product), _mm_unpackhi_pd(product, product));
+}
+#endif
+
+template <int W>
+void backward_runs(double (&y)[3], const double* (&a)[3], const double* X,
+                   const LdlChainSolve::Run* run, const LdlChainSolve::Run* end) {
+  const double* a0 = a[0];
+  const double* a1 = a[1];
+  const double* a2 = a[2];
+  double y0 = y[0], y1 = y[1], y2 = y[2];
+  for (; run != end; ++run) {
+    const double* x = X + run->row;
+    const int length = run->length;
+    int k = 0;
+#ifdef __SSE2__
+    __m128d s0 = _mm_set_sd(y0), s1 = _mm_set_sd(y1), s2 = _mm_set_sd(y2);
+#pragma GCC unroll 2
+    for (; k + 2 <= length; k += 2) {
+      const __m128d xv = _mm_loadu_pd(x + k);
+      subtract_pair(s0, _mm_mul_pd(_mm_loadu_pd(a0 + k), xv));
+      if constexpr (W > 1) subtract_pair(s1, _mm_mul_pd(_mm_loadu_pd(a1 + k), xv));
+      if constexpr (W > 2) subtract_pair(s2, _mm_mul_pd(_mm_loadu_pd(a2 + k), xv));
+    }
+    y0 = _mm_cvtsd_f64(s0);
+    if constexpr (W > 1) y1 = _mm_cvtsd_f64(s1);
+    if constexpr (W > 2) y2 = _mm_cvtsd_f64(s2);
+#endif
+    for (; k < length; ++k) {
+      y0 -= a0[k] * x[k];
+      if constexpr (W > 1) y1 -= a1[k] * x[k];
+      if constexpr (W > 2) y2 -= a2[k] * x[k];
+    }
+    a0 += length;
+    a1 += length;
+    a2 += length;
+  }
+  y[0] = y0;
+  y[1] = y1;
+  y[2] = y2;
+}
+
+}  // namespace
+
+void LdlChainSolve::clear() {
+  forward_.clear();
+  backward_.clear();
+  forward_runs_.clear();
+  backward_runs_.clear();
+  ready_ = false;
+}
+
+void LdlChainSolve::add_runs(const int* rows, int count, std::vector<Run>& runs) {
+  for (int t = 0; t < count;) {
+    int length = 1;
+    while (t + length < count && rows[t + length] == rows[t] + length) ++length;
+    runs.push_back({rows[t], length});
+    t += length;
+  }
+}
+
+bool LdlChainSolve::build(const cholmod_factor* L) {
+  clear();
+  if (L == nullptr || L->is_super || L->is_ll || L->xtype != CHOLMOD_REAL ||
+      L->itype != CHOLMOD_INT || L->dtype != CHOLMOD_DOUBLE || L->x == nullptr)
+    return false;
+  const int n = static_cast<int>(L->n);
+  const auto* Lp = static_cast<const int*>(L->p);
+  const auto* Li = static_cast<const int*>(L->i);
+  const auto* Lnz = static_cast<const int*>(L->nz);
+  // CHOLMOD's forward chain test (j, j+1, j+2 share their rows below the chain).
+  for (int j = 0; j < n;) {
+    const int p = Lp[j], lnz = Lnz[j];
+    int width = 3;
+    if (lnz < 4 || lnz != Lnz[j + 1] + 1 || Li[p + 1] != j + 1)
+      width = 1;
+    else if (lnz != Lnz[j + 2] + 2 || Li[p + 2] != j + 2)
+      width = 2;
+    const int begin = static_cast<int>(forward_runs_.size());
+    add_runs(Li + p + width, lnz - width, forward_runs_);
+    forward_.push_back({j, width, begin, static_cast<int>(forward_runs_.size())});
+    j += width;
+  }
+  // Its backward chain test (j, j-1, j-2), from the last column.
+  for (int j = n - 1; j >= 0;) {
+    const int p = Lp[j], lnz = Lnz[j];
+    int width = 3;
+    if (j < 4 || lnz != Lnz[j - 1] - 1 || Li[Lp[j - 1] + 1] != j)
+      width = 1;
+    else if (lnz != Lnz[j - 2] - 2 || Li[Lp[j - 2] + 2] != j)
+      width = 2;
+    const int begin = static_cast<int>(backward_runs_.size());
+    add_runs(Li + p + 1, lnz - 1, backward_runs_);
+    backward_.push_back({j, width, begin, static_cast<int>(backward_runs_.size())});
+    j -= width;
+  }
+  y_.assign(static_cast<std::size_t>(n), 0.0);
+  ready_ = true;
+  return true;
+}
+
+void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* out) const {
+  const int n = static_cast<int>(L->n);
+  const auto* Lp = static_cast<const int*>(L->p);
+  const auto* Lx = static_cast<const double*>(L->x);
+  const auto* perm = static_cast<const int*>(L->Perm);
+  double* X = y_.data();
+  for (int k = 0; k < n; ++k) X[k] = rhs[perm ? perm[k] : k];
+
+  // L y = P b (unit diagonal).
+  for (const Chain& ch : forward_) {
+    const int j = ch.column, p = Lp[j];
+    const Run* run = forward_runs_.data() + ch.run_begin;
+    const Run* end = forward_runs_.data() + ch.run_end;
+    if (ch.width == 1) {
+      const double y0 = X[j];
+      const double* a = Lx + p + 1;
+      for (; run != end; a += run->length, ++run) forward_run(X + run->row, a, y0, run->length);
+    } else if (ch.width == 2) {
+      const int q = Lp[j + 1];
+      const double y0 = X[j];
+      const double y1 = X[j + 1] - Lx[p + 1] * y0;
+      X[j + 1] = y1;
+      const double* a = Lx + p + 2;
+      const double* b = Lx + q + 1;
+      for (; run != end; a += run->length, b += run->length, ++run)
+        forward_run(X + run->row, a, b, y0, y1, run->length);
+    } else {
+      const int q = Lp[j + 1], r = Lp[j + 2];
+      const double y0 = X[j];
+      const double y1 = X[j + 1] - Lx[p + 1] * y0;
+      const double y2 = X[j + 2] - Lx[p + 2] * y0 - Lx[q + 1] * y1;
+      X[j + 1] = y1;
+      X[j + 2] = y2;
+      const double* a = Lx + p + 3;
+      const double* b = Lx + q + 2;
+      const double* c = Lx + r + 1;
+      for (; run != end; a += run->length, b += run->length, c += run->length, ++run)
+        forward_run(X + run->row, a, b, c, y0, y1, y2, run->length);
+    }
+  }
+
+  // D L^T x = y: each column divided by its D entry first, then its dot with the rows below
+  // subtracted in the factor's row order.
+  for (const Chain& ch : backward_) {
+    const int j = ch.column, w = ch.width;
+    const Run* run = backward_runs_.data() + ch.run_begin;
+    const Run* end = backward_runs_.data() + ch.run_end;
+    // Column j - c: its diagonal at Lp[j - c], then c entries inside the chain, then the rows.
+    int col[3] = {Lp[j], 0, 0};
+    double y[3] = {X[j] / Lx[col[0]], 0.0, 0.0};
+    for (int c = 1; c < w; ++c) {
+      col[c] = Lp[j - c];
+      y[c] = X[j - c] / Lx[col[c]];
+    }
+    const double* a[3] = {Lx + col[0] + 1, Lx + col[1] + 2, Lx + col[2] + 3};
+    if (w == 3)
+      backward_runs<3>(y, a, X, run, end);
+    else if (w == 2)
+      backward_runs<2>(y, a, X, run, end);
+    else
+      backward_runs<1>(y, a, X, run, end);
+    if (w == 2) {
+      y[1] -= Lx[col[1] + 1] * y[0];
+    } else if (w == 3) {
+      y[1] -= Lx[col[1] + 1] * y[0];
+      y[2] -= Lx[col[2] + 2] * y[0] + Lx[col[2] + 1] * y[1];
+    }
+    for (int c = w - 1; c >= 0; --c) X[j - c] = y[c];
+  }
+  for (int k = 0; k < n; ++k) out[perm ? perm[k] : k] = X[k];
+}
+
+}  // namespace tessera
