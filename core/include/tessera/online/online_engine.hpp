@@ -117,10 +117,11 @@ struct OnlineOptions {
   int newton_coarse_min_blocks = 3;
   /// With kSmoothed: the pieces of each block (NewtonRefineOptions::coarse_aggregates), or
   /// kCoarseAggregatesAuto: one piece per kCoarseAutoPosesPerPiece poses of the block, rounded,
-  /// 1..kCoarseAutoMaxPieces, chosen again at every solve as the blocks grow. Why auto: a
-  /// group's coarse matrix has a rigid motion per piece, and its dense products in every CG
-  /// iteration cost more than a small block's own Hessian product (docs/online.md, "Pieces per
-  /// block"). Default 8. >= 0 (0 = auto).
+  /// 1..kCoarseAutoMaxPieces, chosen again at every solve as the blocks grow. Default 8: auto
+  /// saves a tenth of the instructions on sphere2500 (500-pose blocks, whose 8 pieces make the
+  /// coarse matrix's dense products cost more than the blocks' own) but costs more than 8 on
+  /// the grid and city10000 while their blocks are small (city10000's 2D chains want many
+  /// pieces at any block size; docs/online.md, "Pieces per block"). >= 0 (0 = auto).
   int newton_coarse_aggregates = 8;
   static constexpr int kCoarseAggregatesAuto = 0;
   static constexpr int kCoarseAutoPosesPerPiece = 250;
