@@ -25,6 +25,8 @@ std::string online_summary_json(const OnlineAgentOptions& o, const OnlineSummary
       .add("step_solver", o.online.newton_steps ? "newton" : "rounds")
       .add("step_coarse", cli::step_coarse_name(o.online.newton_coarse))
       .add("step_coarse_min_blocks", o.online.newton_coarse_min_blocks)
+      .add("step_coarse_aggregates",
+           cli::step_coarse_aggregates_name(o.online.newton_coarse_aggregates))
       .add("epochs", static_cast<long long>(state.epochs))
       .add("solves", f.solves)
       .add("rounds", f.rounds)

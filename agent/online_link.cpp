@@ -23,6 +23,7 @@ transport::OnlineTeamOptions team_options(const OnlineOptions& o) {
   t.rebalance = o.rebalance;
   t.step_coarse = o.newton_coarse;
   t.step_coarse_min_blocks = o.newton_coarse_min_blocks;
+  t.step_coarse_aggregates = o.newton_coarse_aggregates;
   return t;
 }
 
@@ -31,9 +32,9 @@ std::string team_disagreement(const transport::OnlineTeamOptions& mine,
                               const transport::OnlineTeamOptions& theirs, unsigned sender) {
   std::string differs = cli::rebalance_disagreement(mine.rebalance, theirs.rebalance, sender);
   if (differs.empty())
-    differs =
-        cli::step_coarse_disagreement(mine.step_coarse, mine.step_coarse_min_blocks,
-                                      theirs.step_coarse, theirs.step_coarse_min_blocks, sender);
+    differs = cli::step_coarse_disagreement(
+        mine.step_coarse, mine.step_coarse_min_blocks, mine.step_coarse_aggregates,
+        theirs.step_coarse, theirs.step_coarse_min_blocks, theirs.step_coarse_aggregates, sender);
   return differs;
 }
 

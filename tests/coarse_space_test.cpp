@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/distributed/coarse_correction.hpp>
@@ -18,6 +20,7 @@
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/util/input_error.hpp>
+#include <utility>
 #include <vector>
 
 #include "lifted_blocks.hpp"
@@ -114,6 +117,36 @@ TEST(SmoothedCoarseSpace, OptionsNameTheBadField) {
   EXPECT_THROW(o.validate(), InputError);
   EXPECT_EQ(parse_coarse_space("smoothed"), CoarseSpaceKind::kSmoothed);
   EXPECT_THROW(parse_coarse_space("rigid"), InputError);
+}
+
+TEST(SmoothedCoarseSpace, PosesPerAggregateGivesEachBlockPiecesByItsSizeUpToAggregates) {
+  CoarseOptions o;
+  o.aggregates = 8;
+  for (std::size_t n : {1u, 100u, 500u, 5000u}) EXPECT_EQ(block_aggregates(o, n), 8) << n;
+  o.poses_per_aggregate = 250;
+  // One piece per 250 poses, rounded, at least one and at most `aggregates`.
+  const std::pair<std::size_t, int> expected[] = {
+      {1, 1}, {124, 1}, {374, 1}, {375, 2}, {500, 2}, {1000, 4}, {1800, 7}, {2000, 8}, {40000, 8}};
+  for (const auto& [n, pieces] : expected) EXPECT_EQ(block_aggregates(o, n), pieces) << n;
+  o.poses_per_aggregate = -1;
+  EXPECT_TRUE(test::validation_names(o, "poses_per_aggregate"));
+}
+
+TEST(SmoothedCoarseSpace, ABlockTwiceAsLargeGetsTwiceThePiecesUnderPosesPerAggregate) {
+  // One chain of 180 poses: block 0 the first 60, block 1 the other 120.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::uint32_t i = 0; i + 1 < 180; ++i) edges.emplace_back(i, i + 1);
+  std::vector<int> part(180, 0);
+  for (std::size_t i = 60; i < 180; ++i) part[i] = 1;
+  CoarseOptions o;
+  o.space = CoarseSpaceKind::kSmoothed;
+  o.aggregates = 8;
+  o.poses_per_aggregate = 20;
+  const CoarseSpace s = make_coarse_space(180, edges, part, o);
+  EXPECT_EQ(std::count(s.aggregate_block.begin(), s.aggregate_block.end(), 0), 3);
+  EXPECT_EQ(std::count(s.aggregate_block.begin(), s.aggregate_block.end(), 1), 6);
+  o.poses_per_aggregate = 0;
+  EXPECT_EQ(make_coarse_space(180, edges, part, o).num_aggregates, 16);
 }
 
 TEST(SmoothedCoarseSpace, PiecesStayInTheirBlockAndWeightsArePartitionsOfUnity) {

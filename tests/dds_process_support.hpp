@@ -462,15 +462,18 @@ inline std::vector<std::string> online_agent_args(int robots, int id, const std:
 }
 
 /// Agent 1 of run `run` on `domain`, started beside a lead (agent 0) that has `lead_extra`
-/// on top of the same options, must stop because its team options differ from the lead's:
-/// exit code 2, within 60 s (a test failure otherwise). Its process, for its output.
+/// on top of the same options (and agent 1 `other_extra`), must stop because its team options
+/// differ from the lead's: exit code 2, within 60 s (a test failure otherwise). Its process,
+/// for its output.
 inline Process refused_beside_lead(const std::string& dir, const std::string& run, int domain,
-                                   const std::vector<std::string>& lead_extra) {
+                                   const std::vector<std::string>& lead_extra,
+                                   const std::vector<std::string>& other_extra = {}) {
   std::vector<std::string> lead_args = {"--timeout", "60"};
   lead_args.insert(lead_args.end(), lead_extra.begin(), lead_extra.end());
+  std::vector<std::string> other_args = {"--timeout", "60"};
+  other_args.insert(other_args.end(), other_extra.begin(), other_extra.end());
   Process lead = start(online_agent_args(2, 0, run, domain, lead_args), dir + "/lead.log");
-  Process other =
-      start(online_agent_args(2, 1, run, domain, {"--timeout", "60"}), dir + "/other.log");
+  Process other = start(online_agent_args(2, 1, run, domain, other_args), dir + "/other.log");
   const bool ended = wait_all({&other}, 60);
   kill(lead.pid, SIGTERM);
   wait_all({&lead}, 30);

@@ -154,6 +154,11 @@ TEST(OnlineCli, TheStepsCoarseCorrectionReachesTheSameCertifiedOptimum) {
                               &out),
             2);
   EXPECT_TRUE(test::contains(out, "option --step-coarse-min-blocks")) << out;
+  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + r.graph +
+                                  " --online --robots 2 --step-coarse-aggregates many",
+                              &out),
+            2);
+  EXPECT_TRUE(test::contains(out, "option --step-coarse-aggregates")) << out;
 }
 
 TEST(OnlineCli, ARunSaysWhereItIsOnStderrUnlessToldNotTo) {

@@ -269,6 +269,46 @@ TEST(OnlineCoarse, AMinimumGroupBelowTwoBlocksIsRejectedNamingTheField) {
   EXPECT_TRUE(test::validation_names(online, "newton_coarse_min_blocks"));
 }
 
+TEST(OnlineSmoothedCoarse, NegativePiecesPerBlockAreRejectedNamingTheField) {
+  OnlineOptions online;
+  online.newton_coarse_aggregates = -1;
+  EXPECT_TRUE(test::validation_names(online, "newton_coarse_aggregates"));
+  NewtonRefineOptions refine;
+  refine.coarse_poses_per_aggregate = -1;
+  EXPECT_TRUE(test::validation_names(refine, "coarse_poses_per_aggregate"));
+}
+
+TEST(OnlineSmoothedCoarse, AutoPiecesPerBlockFollowTheBlockSizeAndReachTheBatchOptimum) {
+  OnlineOptions o = options(NewtonRefineOptions::Coarse::kSmoothed);
+  o.newton_coarse_aggregates = OnlineOptions::kCoarseAggregatesAuto;
+  const NewtonRefineOptions refine = online_step_solver(o).refine;
+  const CoarseOptions space = refine.coarse_space_options();
+  EXPECT_EQ(block_aggregates(space, 500), 2);
+  EXPECT_EQ(block_aggregates(space, 1000), 4);
+  EXPECT_EQ(block_aggregates(space, 2000), 8);
+  // A fixed count is every block's.
+  o.newton_coarse_aggregates = 3;
+  EXPECT_EQ(block_aggregates(online_step_solver(o).refine.coarse_space_options(), 2000), 3);
+
+  // 150-pose blocks: one piece each with auto, eight by default; both end at the optimum, auto's
+  // certified.
+  const auto gen = grid(600, 4);
+  ReplayOptions ro;
+  ro.rate = 10;
+  const ReplayPlan plan = plan_replay(gen.graph, gen.robot_of, ro);
+  o.newton_coarse_aggregates = OnlineOptions::kCoarseAggregatesAuto;
+  o.certify_at_end = true;
+  const OnlineResult automatic = run_online(gen.graph.d, plan.batches, o);
+  ASSERT_TRUE(automatic.certified.has_value());
+  EXPECT_TRUE(*automatic.certified);
+  const OnlineResult eight =
+      run_online(gen.graph.d, plan.batches, options(NewtonRefineOptions::Coarse::kSmoothed));
+  const double f_star = solve_centralized(gen.graph).cost;
+  EXPECT_NEAR(automatic.cost, f_star, 1e-6 * f_star);
+  EXPECT_NEAR(eight.cost, f_star, 1e-6 * f_star);
+  EXPECT_NE(cg_iterations(automatic), cg_iterations(eight));  // the pieces did change
+}
+
 TEST(OnlineSmoothedCoarse, RobotsMetOnlyInPairsTakeBlockJacobisStepsWithAMinimumOfThree) {
   // Two robots: one group of two blocks at most, so with newton_coarse_min_blocks = 3 no
   // coarse space is built and every step is block Jacobi's, bit for bit.

@@ -257,6 +257,7 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       rb.place_by_links = b.place_by_links();
       r.team.step_coarse = coarse_of_wire(w.step_coarse().coarse());
       r.team.step_coarse_min_blocks = static_cast<int>(w.step_coarse().min_blocks());
+      r.team.step_coarse_aggregates = static_cast<int>(w.step_coarse().aggregates());
       reports.push_back(std::move(r));
     }
   }
@@ -320,6 +321,7 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   b.place_by_links(own.place_by_links);
   w.step_coarse().coarse(wire_of_coarse(impl_->team.step_coarse));
   w.step_coarse().min_blocks(static_cast<std::uint32_t>(impl_->team.step_coarse_min_blocks));
+  w.step_coarse().aggregates(static_cast<std::uint32_t>(impl_->team.step_coarse_aggregates));
   if (!write_patiently(impl_->report_writer, w))
     throw std::runtime_error("online channel: a report write failed");
   return serialized_size(w);

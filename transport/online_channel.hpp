@@ -28,9 +28,11 @@ inline constexpr const char* kOnlineEstimateTopic = "tessera_online_estimate";
 /// every agent's estimate too, but no flag sets them: every agent runs with their defaults.)
 struct OnlineTeamOptions {
   RebalanceOptions rebalance;
-  /// OnlineOptions::newton_coarse and newton_coarse_min_blocks (their defaults here too).
+  /// OnlineOptions::newton_coarse, newton_coarse_min_blocks and newton_coarse_aggregates
+  /// (their defaults here too; 0 = auto).
   NewtonRefineOptions::Coarse step_coarse = NewtonRefineOptions::Coarse::kNone;
   int step_coarse_min_blocks = 3;
+  int step_coarse_aggregates = 8;
 };
 
 struct OnlineReportSample {

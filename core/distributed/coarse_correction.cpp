@@ -22,10 +22,19 @@ void CoarseOptions::validate() const {
   if (!(min_gain >= 0 && std::isfinite(min_gain)))
     throw InputError("CoarseOptions.min_gain must be finite and >= 0");
   if (aggregates < 1) throw InputError("CoarseOptions.aggregates must be >= 1");
+  if (poses_per_aggregate < 0) throw InputError("CoarseOptions.poses_per_aggregate must be >= 0");
   if (smoothing_steps < 0 || smoothing_steps > 8)
     throw InputError("CoarseOptions.smoothing_steps must be in 0..8");
   if (!(smoothing_weight > 0 && smoothing_weight <= 1))
     throw InputError("CoarseOptions.smoothing_weight must be in (0, 1]");
+}
+
+int block_aggregates(const CoarseOptions& options, std::size_t block_poses) {
+  if (options.poses_per_aggregate <= 0) return options.aggregates;
+  const std::size_t per = static_cast<std::size_t>(options.poses_per_aggregate);
+  const std::size_t pieces = (block_poses + per / 2) / per;
+  return static_cast<int>(
+      std::clamp<std::size_t>(pieces, 1, static_cast<std::size_t>(options.aggregates)));
 }
 
 const char* coarse_space_name(CoarseSpaceKind kind) {

@@ -39,11 +39,13 @@ struct Adjacency {
   }
 };
 
-// Splits each block's own graph into about k pieces: seeds by farthest-point BFS (the first
-// seed the pose farthest from the block's first pose), every pose to its nearest seed in hops
-// (ties to the earlier seed); a part of the block that no seed reaches gets a piece of its own.
+// Splits each block's own graph into about block_aggregates() pieces: seeds by farthest-point BFS
+// (the first seed the pose farthest from the block's first pose), every pose to its nearest seed in
+// hops (ties to the earlier seed); a part of the block that no seed reaches gets a piece of its
+// own.
 void grow_aggregates(CoarseSpace& s, const Adjacency& inside,
-                     const std::vector<std::vector<std::size_t>>& block_poses, int k) {
+                     const std::vector<std::vector<std::size_t>>& block_poses,
+                     const CoarseOptions& options) {
   const std::size_t n = s.owner.size();
   s.aggregate.assign(n, -1);
   std::vector<int> dist(n, -1);
@@ -80,6 +82,7 @@ void grow_aggregates(CoarseSpace& s, const Adjacency& inside,
   };
   for (int b = 0; b < s.num_blocks; ++b) {
     const auto& mine = block_poses[static_cast<std::size_t>(b)];
+    const int k = block_aggregates(options, mine.size());
     std::vector<std::size_t> seeds;
     int far = 0;
     bfs(mine, {mine.front()});
@@ -186,7 +189,7 @@ CoarseSpace make_coarse_space(std::size_t num_poses, const Edges& edges,
     const Adjacency inside(num_poses, edges, [&](std::uint32_t i, std::uint32_t j) {
       return assignment[i] == assignment[j];
     });
-    grow_aggregates(s, inside, block_poses, options.aggregates);
+    grow_aggregates(s, inside, block_poses, options);
   }
   {
     const Adjacency all(num_poses, edges, [](std::uint32_t, std::uint32_t) { return true; });

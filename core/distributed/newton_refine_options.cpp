@@ -20,6 +20,7 @@ void NewtonRefineOptions::validate() const {
   if (!(accept_ratio >= 0 && accept_ratio < 0.25)) fail("accept_ratio", "must be in [0, 0.25)");
   if (max_backtracks < 0) fail("max_backtracks", "must be >= 0");
   if (coarse_aggregates < 1) fail("coarse_aggregates", "must be >= 1");
+  if (coarse_poses_per_aggregate < 0) fail("coarse_poses_per_aggregate", "must be >= 0");
   if (coarse_smoothing_steps < 0 || coarse_smoothing_steps > 8)
     fail("coarse_smoothing_steps", "must be in 0..8");
   if (coarse_min_blocks < 2) fail("coarse_min_blocks", "must be >= 2");
@@ -74,6 +75,7 @@ CoarseOptions NewtonRefineOptions::coarse_space_options() const {
   CoarseOptions c;
   c.space = CoarseSpaceKind::kSmoothed;
   c.aggregates = coarse_aggregates;
+  c.poses_per_aggregate = coarse_poses_per_aggregate;
   c.smoothing_steps = coarse_smoothing_steps;
   return c;
 }

@@ -38,6 +38,8 @@ void OnlineOptions::validate() const {
     throw InputError("OnlineOptions.newton_forcing must be in (0, 1)");
   if (newton_coarse_min_blocks < 2)
     throw InputError("OnlineOptions.newton_coarse_min_blocks must be >= 2");
+  if (newton_coarse_aggregates < 0)
+    throw InputError("OnlineOptions.newton_coarse_aggregates must be >= 0 (0 = auto)");
   if (!(newton_after_grad_tol > 0))
     throw InputError("OnlineOptions.newton_after_grad_tol must be > 0 (+infinity: no round)");
   DistributedOptions s = solver;
@@ -215,6 +217,13 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     solver.refine.forcing = options.newton_forcing;
     solver.refine.coarse = options.newton_coarse;
     solver.refine.coarse_min_blocks = options.newton_coarse_min_blocks;
+    if (options.newton_coarse_aggregates == OnlineOptions::kCoarseAggregatesAuto) {
+      solver.refine.coarse_aggregates = OnlineOptions::kCoarseAutoMaxPieces;
+      solver.refine.coarse_poses_per_aggregate = OnlineOptions::kCoarseAutoPosesPerPiece;
+    } else {
+      solver.refine.coarse_aggregates = options.newton_coarse_aggregates;
+      solver.refine.coarse_poses_per_aggregate = 0;
+    }
     // The coarse matrix from the Hessian's data part, as the kept block factors above are:
     // positive semi-definite at any point. A step that starts far from the optimum (a batch of
     // loop closures) made the Galerkin matrix indefinite or nearly singular, and its inverse

@@ -48,6 +48,12 @@ struct CoarseOptions {
   /// kSmoothed: aggregates grown per block (>= 1; a block whose own graph falls apart gets
   /// one more per extra piece).
   int aggregates = 4;
+  /// kSmoothed: > 0 scales each block's pieces with its size, one piece per this many of its
+  /// poses (rounded), at least 1 and at most `aggregates` (block_aggregates()); 0: `aggregates`
+  /// pieces in every block. Why: a group's coarse matrix has a rigid motion per piece, and its
+  /// dense products in every CG iteration of the Newton steps cost more than small blocks' own
+  /// Hessian products (docs/online.md, "Pieces per block"). >= 0.
+  int poses_per_aggregate = 0;
   /// kSmoothed: Jacobi smoothing steps of the aggregates' indicator functions over the whole
   /// graph (0..8; 0 = piecewise rigid). Each step widens every blend by one measurement hop.
   int smoothing_steps = 1;
@@ -78,6 +84,12 @@ struct CoarseOptions {
   /// Whether round `round` is a correction round.
   bool scheduled(int round) const { return enabled && round % every == 0; }
 };
+
+/// The pieces the smoothed space grows in a block of `block_poses` poses (before a part of the
+/// block that falls apart adds its own): `options.aggregates`, or with
+/// `options.poses_per_aggregate` > 0 one piece per that many poses, rounded, in
+/// [1, options.aggregates].
+int block_aggregates(const CoarseOptions& options, std::size_t block_poses);
 
 /// One agent's cut edges, and the coarse terms they give at a point: its own diagonal block of
 /// Q_c and the off-diagonal blocks to its higher-numbered neighbours (each block of Q_c is

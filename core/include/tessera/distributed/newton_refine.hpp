@@ -169,6 +169,10 @@ struct NewtonRefineOptions {
   int coarse_keep_steps = 1;
   /// kSmoothed: pieces per block (>= 1) and smoothing steps of their weights (0..8).
   int coarse_aggregates = 8;
+  /// kSmoothed: > 0 gives a block one piece per this many of its poses, 1..coarse_aggregates
+  /// (CoarseOptions::poses_per_aggregate; the online steps' `--step-coarse-aggregates auto`);
+  /// 0 (the default): coarse_aggregates in every block. >= 0.
+  int coarse_poses_per_aggregate = 0;
   int coarse_smoothing_steps = 1;
   /// The blocks a group of linked blocks needs for its pieces to take part in the coarse
   /// correction (TangentCoarseSpace::groups()); a smaller group takes block Jacobi's steps, as

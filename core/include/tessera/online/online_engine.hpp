@@ -92,7 +92,7 @@ struct OnlineOptions {
   double newton_forcing = 0.03;
   /// The Newton steps' coarse correction (NewtonRefineOptions::coarse): kNone (block Jacobi,
   /// the default), kBlocks (plus one rigid motion per block) or kSmoothed (plus the rigid
-  /// motions of solver.refine.coarse_aggregates smoothed pieces of each block, the space built
+  /// motions of newton_coarse_aggregates smoothed pieces of each block, the space built
   /// from the linked graph at every solve). Only blocks in a group of newton_coarse_min_blocks
   /// linked blocks or more take part: a robot that has met no other is left out (its motions are a
   /// gauge, its inner bending block Jacobi's work), so before the robots meet the steps are block
@@ -115,6 +115,17 @@ struct OnlineOptions {
   /// all 5,249 against 4,071 CG iterations, 481 against 494 Newton steps, 67 against 93 CPU-s
   /// (load 6-16; docs/online.md, "The coarse correction"). >= 2.
   int newton_coarse_min_blocks = 3;
+  /// With kSmoothed: the pieces of each block (NewtonRefineOptions::coarse_aggregates), or
+  /// kCoarseAggregatesAuto: one piece per kCoarseAutoPosesPerPiece poses of the block, rounded,
+  /// 1..kCoarseAutoMaxPieces, chosen again at every solve as the blocks grow. Default 8: auto
+  /// saves a tenth of the instructions on sphere2500 (500-pose blocks, whose 8 pieces make the
+  /// coarse matrix's dense products cost more than the blocks' own) but costs more than 8 on
+  /// the grid and city10000 while their blocks are small (city10000's 2D chains want many
+  /// pieces at any block size; docs/online.md, "Pieces per block"). >= 0 (0 = auto).
+  int newton_coarse_aggregates = 8;
+  static constexpr int kCoarseAggregatesAuto = 0;
+  static constexpr int kCoarseAutoPosesPerPiece = 250;
+  static constexpr int kCoarseAutoMaxPieces = 8;
   /// New poses that new loop closures tie to the estimate are placed by least squares against
   /// every new measurement after composition (new_pose_placement.hpp), not only along their
   /// odometry. false: composition only.
