@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <tessera/distributed/newton_refine.hpp>
+#include <tessera/distributed/newton_refine_options.hpp>
 #include <tessera/online/absorb_gate.hpp>
 #include <tessera/online/block_rebalance.hpp>
 #include <tessera/protocol/messages.hpp>

@@ -44,7 +44,7 @@
 #include <memory>
 #include <mutex>
 #include <tessera/distributed/block_layout.hpp>
-#include <tessera/distributed/newton_refine.hpp>
+#include <tessera/distributed/newton_refine_options.hpp>
 #include <tessera/problem/block_problem.hpp>
 #include <vector>
 

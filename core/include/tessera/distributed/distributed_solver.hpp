@@ -12,7 +12,8 @@
 #include <tessera/distributed/in_process_driver.hpp>
 #include <tessera/distributed/irbcd.hpp>
 #include <tessera/distributed/local_rounds.hpp>
-#include <tessera/distributed/newton_refine.hpp>
+#include <tessera/distributed/newton_refine_options.hpp>
+#include <tessera/distributed/newton_refine_result.hpp>
 #include <tessera/distributed/rbcd.hpp>
 #include <tessera/distributed/rbcd_plus_plus.hpp>
 #include <tessera/distributed/stage_records.hpp>
