@@ -117,14 +117,14 @@ TangentCoarseSpace::TangentCoarseSpace(const CoarseSpace* space, const BlockLayo
       }
 }
 
-void TangentCoarseSpace::add_generator(int j, double x, Eigen::MatrixXd& E) const {
+void TangentCoarseSpace::add_generator(int j, double x, double* e) const {
   const int rotations = static_cast<int>(rotation_pairs_.size());
   if (j < rotations) {
     const auto [a, b] = rotation_pairs_[static_cast<std::size_t>(j)];
-    E(a, b) += x;
-    E(b, a) -= x;
+    e[a + b * k_] += x;
+    e[b + a * k_] -= x;
   } else {
-    E(j - rotations, k_) += x;
+    e[(j - rotations) + k_ * k_] += x;
   }
 }
 
@@ -214,21 +214,12 @@ void TangentCoarseSpace::expand(const Eigen::MatrixXd& X, const Eigen::VectorXd&
   // Eigen's E_i += w E_alpha.
   const int k = k_;
   const std::size_t kk = static_cast<std::size_t>(k * (k + 1));
-  const int rotations = static_cast<int>(rotation_pairs_.size());
   std::vector<double> E(static_cast<std::size_t>(pieces_) * kk, 0.0);
   std::vector<char> has(static_cast<std::size_t>(pieces_), 0);  // empty: alone in its group
   for (int u : own_) {
     const auto piece = static_cast<std::size_t>(u / g_);
     has[piece] = 1;
-    double* e = E.data() + piece * kk;
-    const int j = u % g_;
-    if (j < rotations) {
-      const auto [a, b] = rotation_pairs_[static_cast<std::size_t>(j)];
-      e[a + b * k] += xi(u);
-      e[b + a * k] -= xi(u);
-    } else {
-      e[(j - rotations) + k * k] += xi(u);
-    }
+    add_generator(u % g_, xi(u), E.data() + piece * kk);
   }
   std::vector<double> Ei(kk);
   for (std::size_t s : linked_slots_) {
@@ -247,7 +238,7 @@ void TangentCoarseSpace::expand(const Eigen::MatrixXd& X, const Eigen::VectorXd&
 void TangentCoarseSpace::unit(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Xn, int unknown,
                               Eigen::MatrixXd& v, Eigen::MatrixXd& vn) const {
   Eigen::MatrixXd E = Eigen::MatrixXd::Zero(k_, k_ + 1);
-  add_generator(unknown % g_, 1.0, E);
+  add_generator(unknown % g_, 1.0, E.data());
   const int piece = unknown / g_;
   auto fill = [&](const Poses& p, const Eigen::MatrixXd& P, Eigen::MatrixXd& out) {
     out.setZero(P.rows(), P.cols());

@@ -143,8 +143,8 @@ class TangentCoarseSpace {
                     double* out) const;
   static Poses weights_of(const CoarseSpace* space, const BlockLayout& layout,
                           const std::vector<std::size_t>& ids);
-  // [Omega c] of generator j scaled by x, added to E (k x (k+1)).
-  void add_generator(int j, double x, Eigen::MatrixXd& E) const;
+  // [Omega c] of generator j scaled by x, added to E = e[0 .. k(k+1)) column-major k x (k+1).
+  void add_generator(int j, double x, double* e) const;
   // v's slot s += E [X_s; 0 1], E = e[0 .. k(k+1)) column-major k x (k+1).
   void move(const double* e, const Eigen::MatrixXd& X, Eigen::Index s, Eigen::MatrixXd& v) const;
 
