@@ -73,8 +73,8 @@ struct DistributedOptions {
   bool certify = false;
   StaircaseOptions staircase;
   /// After each solve stage that converged, Newton steps on the whole problem to
-  /// refine.grad_norm_tol (newton_refine.hpp; by default only where the rounds' trace says they
-  /// stopped short of their limit, `--refine auto`).
+  /// refine.grad_norm_tol (newton_refine_options.hpp; by default only where the rounds' trace says
+  /// they stopped short of their limit, `--refine auto`).
   NewtonRefineOptions refine;
   /// Round the final iterate to SE(d) (`poses`, `cost`). Off for callers that keep the lifted
   /// iterate and whose graph may not be connected yet (the online engine's steps), where the
