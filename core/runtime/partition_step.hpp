@@ -21,6 +21,9 @@ struct PartitionStepResult {
   double wait_ms = 0;
   std::size_t cut_edges = 0;  ///< Measurements between different agents.
   bool early = false;         ///< Of the graph file, while the agents started (file_partition.hpp).
+  /// How far the partitioning thread's nice was below the process's (0: not; the
+  /// coordinator's early partition with --partition-nice, coordinator/partition_priority.hpp).
+  int thread_nice = 0;
 };
 
 /// Splits the structure among `num_agents` agents with core's partitioner (`preset` as
