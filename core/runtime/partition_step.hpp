@@ -21,7 +21,7 @@ struct PartitionStepResult {
   double wait_ms = 0;
   std::size_t cut_edges = 0;  ///< Measurements between different agents.
   bool early = false;         ///< Of the graph file, while the agents started (file_partition.hpp).
-  /// How far the partitioning thread's nice was below the process's (0: not; the
+  /// The partitioning thread's nice minus the process's (0: the same; < 0 for the
   /// coordinator's early partition with --partition-nice, coordinator/partition_priority.hpp).
   int thread_nice = 0;
 };
