@@ -36,7 +36,8 @@ int coordinator_main(int argc, char** argv) {
   std::unique_ptr<FilePartitionJob> file_job;
   if (!options.graph.empty())
     file_job = std::make_unique<FilePartitionJob>(options.graph, options.agents, options.partition,
-                                                  options.partition_seed, options.partition_time_s);
+                                                  options.partition_seed, options.partition_time_s,
+                                                  options.partition_nice);
   const cli::ProcessRole role{"tessera-coordinator", options.net.timeout_s};
   // From the run's successful end (summary written, FINISHED sent) to the participant's
   // deletion, a Fast DDS 2.9 abort ends the process with exit code 0 and a note

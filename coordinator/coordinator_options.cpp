@@ -52,6 +52,12 @@ options:
                        that partition is used if their announced structure is exactly the
                        file's (otherwise, or if FILE cannot be read, the announced structure is
                        partitioned as without it). Only endpoints are kept (default: none)
+  --partition-nice N   the nice of the thread that partitions --graph's file while the
+                       agents start, relative to this process's, -20..0: at a lower nice it
+                       takes most of a core instead of a fair share beside the agents'
+                       start-up, which it then delays (needs root or a matching RLIMIT_NICE,
+                       else it stays; the summary's partition_nice says what it got)
+                       (default 0: the same)
   --progress           print round progress (sum of the agents' cost and gradient norm)
   --progress-interval S  at most one progress line per S seconds besides the first, the
                        restarts and the last; 0 = every round the coordinator sees (every
@@ -120,6 +126,7 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "partition",
                                                             "partition-seed",
                                                             "partition-time",
+                                                            "partition-nice",
                                                             "rank",
                                                             "algorithm",
                                                             "init",
@@ -173,6 +180,9 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   a.partition_time_s = args.get_double("partition-time", 0);
   if (!(a.partition_time_s >= 0))
     throw InputError("option --partition-time: must be >= 0 seconds (0 = no cap)");
+  const long nice = args.get_long("partition-nice", a.partition_nice);
+  if (nice < -20 || nice > 0) throw InputError("option --partition-nice: must be -20..0");
+  a.partition_nice = static_cast<int>(nice);
   a.rank = static_cast<std::uint32_t>(nonneg("rank", 0));
   a.algorithm = args.get_or("algorithm", "");
   a.init = args.get_or("init", init_name(DistributedOptions{}.initialization));

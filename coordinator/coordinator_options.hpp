@@ -20,8 +20,11 @@ struct CoordinatorOptions {
   std::string partition = "auto";
   std::uint64_t partition_seed = 1;
   double partition_time_s = 0;  ///< --partition-time: cap of the partitioner's search, s; 0 = none.
-  std::uint32_t rank = 0;       ///< 0 = core's default (5).
-  std::string algorithm, init;  ///< Empty algorithm = core's default (irbcd).
+  /// --partition-nice: the nice of the thread partitioning --graph while the agents start,
+  /// relative to the process's, -20..0 (coordinator/partition_priority.hpp); 0 = the same.
+  int partition_nice = 0;
+  std::uint32_t rank = 0;                 ///< 0 = core's default (5).
+  std::string algorithm, init;            ///< Empty algorithm = core's default (irbcd).
   std::uint32_t max_rounds = 0;           ///< 0 = core's default.
   double grad_tol = 0, rel_cost_tol = 0;  ///< 0 = core's defaults.
   std::uint64_t seed = 1;

@@ -82,7 +82,8 @@ void run_coordinator(const CoordinatorOptions& o, CoordinatorSession& s, RunTime
       timeline.mark_at("partitioned", ended);
       log("partition of " + o.graph + " (" + o.partition + ") while the agents start: cut " +
           std::to_string(early->part.cut_edges) + " measurements in " +
-          std::to_string(early->part.ms) + " ms");
+          std::to_string(early->part.ms) + " ms, thread nice " +
+          std::to_string(early->part.thread_nice) + " from the process's");
     } else {
       log("cannot partition " + o.graph + " early (" + why +
           "): partitioning the announced structure");

@@ -8,6 +8,8 @@
 #include <thread>
 #include <utility>
 
+#include "coordinator/partition_priority.hpp"
+
 namespace tessera::coordinator {
 
 bool FilePartition::fits(const RunStructure& rs) const {
@@ -63,14 +65,17 @@ struct FilePartitionJob::State {
 };
 
 FilePartitionJob::FilePartitionJob(std::string path, std::uint32_t num_agents, std::string preset,
-                                   std::uint64_t seed, double time_limit_s)
+                                   std::uint64_t seed, double time_limit_s, int nice)
     : state_(std::make_shared<State>()) {
   std::thread([st = state_, path = std::move(path), num_agents, preset = std::move(preset), seed,
-               time_limit_s] {
+               time_limit_s, nice] {
+    // Before the file's read too: it is the partition's input, in the same start-up.
+    const int got_nice = lower_partition_thread_nice(nice);
     const auto started = std::chrono::steady_clock::now();
     std::string why;
     std::optional<FilePartition> r =
         partition_graph_file(path, num_agents, preset, seed, &why, time_limit_s);
+    if (r) r->part.thread_nice = got_nice;
     const auto ended = std::chrono::steady_clock::now();
     std::lock_guard<std::mutex> lock(st->mutex);
     st->result = std::move(r);

@@ -74,6 +74,7 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("partition_early", in.partition.early)
       .add("partition_cpu_ms", in.partition.cpu_ms)
       .add("partition_wait_ms", in.partition.wait_ms)
+      .add("partition_nice", in.partition.thread_nice)
       .add("solve_ms", in.solve_ms)
       .add("rounds_ms", rounds_ms)
       .add("ms_per_round", r.completed_statuses > 1

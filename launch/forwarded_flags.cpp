@@ -45,6 +45,12 @@ void check_partition_time(const std::string& v) {
   number_in(v, "partition-time", 0, 86400, "0..86400");
 }
 
+void check_partition_nice(const std::string& v) {
+  const double x = number(v, "partition-nice");
+  if (!(x >= -20 && x <= 0) || x != static_cast<double>(static_cast<int>(x)))
+    throw InputError("launch: --partition-nice must be a whole number in -20..0");
+}
+
 void check_refine(const std::string& v) {
   NewtonRefineOptions checked;
   set_refine_mode(checked, v);
@@ -223,6 +229,12 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "none, the preset's own effort (with a cap the partition\n"
        "depends on the machine's speed)                           [0]",
        check_partition_time},
+      {"partition-nice", "partition-nice", true, ForwardTo::kCoordinator, "--partition-nice N",
+       "the nice of the coordinator's thread that partitions GRAPH\n"
+       "while the agents start, relative to the run's, -20..0; it\n"
+       "then delays their start-up (needs root or a matching\n"
+       "RLIMIT_NICE; JSON partition_nice: what it got)            [0]",
+       check_partition_nice},
       {"setup-timeout", "timeout", true, ForwardTo::kBoth, "--setup-timeout S",
        "bound on each set-up wait of a process (the agents'\n"
        "announcements, the assignment, the readiness barrier);\n"

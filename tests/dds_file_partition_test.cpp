@@ -5,16 +5,20 @@
 // Domains used here: 54, 55 (each test its own, so ctest -j is safe).
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <string>
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/partition/graph_structure.hpp>
 #include <tessera/partition/partitioner.hpp>
+#include <thread>
 #include <vector>
 
 #include "announcement_support.hpp"
 #include "coordinator/file_partition.hpp"
+#include "coordinator/partition_priority.hpp"
 #include "coordinator/run_structure.hpp"
 #include "dds_process_support.hpp"
 #include "runtime/local_share.hpp"
@@ -50,6 +54,36 @@ TEST(DdsFilePartition, IsThePartitionOfTheAnnouncedStructure) {
   ASSERT_TRUE(threaded) << why;
   EXPECT_EQ(threaded->part.owner, announced.owner);
   EXPECT_LE(started, ended);
+}
+
+// The partition thread's priority (coordinator/partition_priority.hpp) is asked for, not
+// assumed: the thread reports how far its nice went down (as asked where the process may lower
+// it, e.g. as root; 0 otherwise), and the partition does not depend on it. No DDS.
+TEST(DdsFilePartition, ItsThreadReportsTheNiceItGotAndPartitionsTheSame) {
+  int before = 0, got = 0, after = 0;
+  std::thread([&] {
+    const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+    before = getpriority(PRIO_PROCESS, tid);
+    got = coordinator::lower_partition_thread_nice(-3);
+    after = getpriority(PRIO_PROCESS, tid);
+  }).join();
+  EXPECT_EQ(after - before, got);
+  EXPECT_TRUE(got == -3 || got == 0 || after == -20) << got;
+  // This thread's nice is its own.
+  EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid))), before);
+
+  const std::string dir = temp_dir();
+  const std::string path =
+      generate_graph(dir + "/g.g2o", "--kind grid3d --poses 200 --robots 4 --seed 6");
+  std::string why;
+  coordinator::FilePartitionJob plain(path, 4, "fast", 2);
+  coordinator::FilePartitionJob raised(path, 4, "fast", 2, 0.0, -3);
+  const auto a = plain.take(&why, nullptr, nullptr);
+  const auto b = raised.take(&why, nullptr, nullptr);
+  ASSERT_TRUE(a && b) << why;
+  EXPECT_EQ(a->part.thread_nice, 0);
+  EXPECT_EQ(b->part.thread_nice, got);
+  EXPECT_EQ(a->part.owner, b->part.owner);
 }
 
 TEST(DdsFilePartition, AnotherStructureDoesNotFitAndAnUnreadableFileIsNoPartition) {

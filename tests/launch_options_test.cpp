@@ -94,7 +94,7 @@ TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
       {"robust", "gnc-tls"},      {"known-inliers", "odometry"}, {"gnc-mu-step", "1.4"},
       {"inlier-quantile", "0.5"}, {"refine", "newton"},          {"coarse-space", "smoothed"},
       {"gnc-probe-ratio", "5"},   {"gnc-final-refine", "none"},  {"gnc-pass-refine", "auto"},
-      {"gnc-mu-step-max", "2"},   {"refine-sigma", "one"}};
+      {"gnc-mu-step-max", "2"},   {"refine-sigma", "one"},       {"partition-nice", "-5"}};
   for (const ForwardedFlag& f : forwarded_flags()) {
     EXPECT_NE(help.find(std::string("--") + f.name), std::string::npos) << f.name;
     Argv argv = {std::string("--") + f.name};
@@ -174,6 +174,18 @@ TEST(LaunchOptions, DefaultPresetIsAutoAndThePartitionTimeReachesTheCoordinator)
   EXPECT_TRUE(has_pair(coordinator, "--partition", "auto"));
   EXPECT_TRUE(has_pair(coordinator, "--partition-time", "2.5"));
   EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--partition-time"));
+}
+
+// The early partition thread's nice (coordinator/partition_priority.hpp) is the coordinator's
+// business alone; a raise above the run's priority is the only thing it may ask for.
+TEST(LaunchOptions, PartitionNiceReachesTheCoordinatorOnlyAndStaysInMinus20To0) {
+  LaunchOptions o = parse_launch_options({"--partition-nice", "-20"});
+  o.graph = "/data/graph.g2o";
+  EXPECT_TRUE(has_pair(coordinator_argv(o, paths()), "--partition-nice", "-20"));
+  EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--partition-nice"));
+  for (const char* bad : {"1", "-21", "-2.5", "x"})
+    EXPECT_NE(error_of({"--partition-nice", bad}).find("--partition-nice"), std::string::npos)
+        << bad;
 }
 
 TEST(LaunchOptions, GradientToleranceReachesTheCoordinatorAsTheSameNumber) {

@@ -21,6 +21,9 @@ struct PartitionStepResult {
   double wait_ms = 0;
   std::size_t cut_edges = 0;  ///< Measurements between different agents.
   bool early = false;         ///< Of the graph file, while the agents started (file_partition.hpp).
+  /// The partitioning thread's nice minus the process's (0: the same; < 0 for the
+  /// coordinator's early partition with --partition-nice, coordinator/partition_priority.hpp).
+  int thread_nice = 0;
 };
 
 /// Splits the structure among `num_agents` agents with core's partitioner (`preset` as
