@@ -286,7 +286,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
     int rounds = 0;
     std::uint64_t bytes = 0;
     double cpu_s = 0.0, setup_s = 0.0, rounds_cpu_s = 0.0;
-    std::vector<double> gaps, gap_latency_s, gap_latency_cpu_s;
+    std::vector<double> gaps, gap_latency_s, gap_latency_cpu_s, gap_cg;
     const std::vector<OnlineUpdate>& done = res ? res->updates : steps;
     for (const auto& u : done) {
       updates.push_back(update_json(u));
@@ -312,8 +312,13 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         j.add("time_to_gap_s", c.gap.wall_s).add("time_to_gap_cpu_s", c.gap.cpu_s);
         j.add("time_to_stay_s", c.gap.stays ? c.wait_s + c.points[*c.gap.stays].wall_s
                                             : std::numeric_limits<double>::infinity());
+        // The load-free companion: the step's CG iterations up to that point.
+        const double cg = c.gap.first ? c.points[*c.gap.first].cg_iterations
+                                      : std::numeric_limits<double>::infinity();
+        j.add("cg_to_gap", cg);
         gap_latency_s.push_back(c.gap.wall_s);
         gap_latency_cpu_s.push_back(c.gap.cpu_s);
+        gap_cg.push_back(cg);
       }
       std::vector<JsonObject> points;
       for (std::size_t k = 0; k < c.points.size(); ++k) {
@@ -321,6 +326,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         p.add("at", c.points[k].at)
             .add("wall_s", c.points[k].wall_s)
             .add("cpu_s", c.points[k].cpu_s)
+            .add("newton_steps", c.points[k].newton_steps)
+            .add("cg_iterations", c.points[k].cg_iterations)
             .add("cost", c.points[k].cost);
         if (res) p.add("rel_gap", c.gap.rel_gaps[k]);
         points.push_back(std::move(p));
@@ -378,6 +385,8 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("gap_latency_p95_s", percentile_or_inf(gap_latency_s, 0.95))
           .add("gap_latency_cpu_median_s", percentile_or_inf(gap_latency_cpu_s, 0.5))
           .add("gap_latency_cpu_p95_s", percentile_or_inf(gap_latency_cpu_s, 0.95))
+          .add("gap_cg_median", percentile_or_inf(gap_cg, 0.5))
+          .add("gap_cg_p95", percentile_or_inf(gap_cg, 0.95))
           .add("gap_latency_missed",
                static_cast<std::size_t>(std::count_if(gap_latency_s.begin(), gap_latency_s.end(),
                                                       [](double t) { return !std::isfinite(t); })))

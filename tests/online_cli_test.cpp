@@ -219,6 +219,7 @@ TEST(OnlineCli, CheckpointsSayHowSoonTheEstimateCameWithinTheGapBound) {
   EXPECT_GE(json_number(j, "gap_latency_median_s"), 0.0);
   EXPECT_LE(json_number(j, "gap_latency_median_s"), json_number(j, "gap_latency_p95_s"));
   EXPECT_LE(json_number(j, "gap_latency_cpu_median_s"), json_number(j, "gap_latency_cpu_p95_s"));
+  EXPECT_LE(json_number(j, "gap_cg_median"), json_number(j, "gap_cg_p95"));
   // The first checkpoint's: within the bound no later than its step's end.
   EXPECT_LE(json_number(j, "time_to_gap_s"), json_number(j, "step_latency_s"));
   EXPECT_TRUE(test::contains(j, "\"at\": \"absorbed\"")) << j;

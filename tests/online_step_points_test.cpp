@@ -100,15 +100,24 @@ TEST(OnlineStepPoints,
     EXPECT_EQ(s.points.front().at, "absorbed");
     EXPECT_EQ(s.points.front().X.leftCols(s.before.cols()), s.before);
     EXPECT_EQ(s.points.front().X.cols(), s.after.cols());
+    EXPECT_EQ(s.points.front().newton_steps, 0);
+    EXPECT_EQ(s.points.front().cg_iterations, 0);
     // Last the step's own iterate, at the step's own times.
     EXPECT_EQ(s.points.back().at, "end");
     EXPECT_EQ(s.points.back().X, s.after);
     EXPECT_EQ(s.points.back().wall_s, u.ms / 1000.0);
     EXPECT_EQ(s.points.back().cpu_s, u.cpu_s);
+    EXPECT_EQ(s.points.back().newton_steps, u.newton_steps);
+    EXPECT_EQ(s.points.back().cg_iterations, u.newton_cg_iterations);
     for (std::size_t k = 1; k + 1 < s.points.size(); ++k) {
       EXPECT_EQ(s.points[k].at, "newton");
       EXPECT_LE(s.points[k - 1].wall_s, s.points[k].wall_s);
       EXPECT_LE(s.points[k - 1].cpu_s, s.points[k].cpu_s);
+      // Counted up to the point, rejected Newton steps included.
+      EXPECT_LT(s.points[k - 1].newton_steps, s.points[k].newton_steps);
+      EXPECT_LE(s.points[k - 1].cg_iterations, s.points[k].cg_iterations);
+      EXPECT_LE(s.points[k].newton_steps, u.newton_steps);
+      EXPECT_LE(s.points[k].cg_iterations, u.newton_cg_iterations);
       ++newton_points;
     }
     EXPECT_LE(static_cast<int>(s.points.size()) - 2, u.newton_steps) << "accepted steps only";
@@ -172,7 +181,12 @@ TEST(OnlineStepPoints, TwoThreadsKeepTheSamePointsAsOne) {
 }
 
 StepPointCost point(double wall_s, double cost) {
-  return {"newton", wall_s, wall_s / 2, cost};
+  StepPointCost p;
+  p.at = "newton";
+  p.wall_s = wall_s;
+  p.cpu_s = wall_s / 2;
+  p.cost = cost;
+  return p;
 }
 
 TEST(GapLatency, IsTheFirstPointWithinTheBoundPlusTheWaitAndInfiniteWithoutOne) {

@@ -157,6 +157,7 @@ def main():
             "gap_latency_cpu_median_s": s.get("gap_latency_cpu_median_s"),
             "gap_latency_cpu_p95_s": s.get("gap_latency_cpu_p95_s"),
             "gap_latency_missed": s.get("gap_latency_missed"),
+            "gap_cg_median": s.get("gap_cg_median"),
             "absorbed_gap_median": median([c["points"][0]["rel_gap"] for c in s.get("checkpoints", [])
                                            if c.get("points")]),
             "rounds_per_s": s["rounds"] / stream_s, "bytes_per_s_per_agent": s["bytes"] / stream_s / robots,
@@ -241,17 +242,17 @@ def step_args(args):
     return ["--step-every", str(float(args.steps))]
 
 
-def gap_fmt(r, key):
+def gap_fmt(r, key, spec="{:.4f}"):
     """A gap latency; "never" where the JSON has null (a checkpoint whose step ended above the bound)."""
     if r[key] is None and r["checkpoints"]:
         return "never"
-    return bc.fmt(r[key], "{:.4f}")
+    return bc.fmt(r[key], spec)
 
 
 def write_outputs(args, ctx, rows, runs, dds_rows):
     headers = ["graph", "poses", "steps", "step solver", "message steps", "Newton steps", "Newton CG",
                "repartitions", "poses moved", "final cut", "largest block", "lat med s", "lat p95 s", "lat CPU med s", "lat CPU p95 s", "checkpoints", "gap lat med s",
-               "gap lat p95 s", "gap lat CPU med s", "gap lat CPU p95 s", "gap missed", "absorbed gap med", "max gap", "online CPU s", "set-up s",
+               "gap lat p95 s", "gap lat CPU med s", "gap lat CPU p95 s", "gap CG med", "gap missed", "absorbed gap med", "max gap", "online CPU s", "set-up s",
                "rounds CPU s", "max step CPU s", "critical path s", "closures", "closure publications", "closure steps", "re-solves", "re-solve rounds", "re-solve CG", "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
     if args.instructions:
         headers += ["online G instr", "re-solve G instr", "instr ratio"]
@@ -265,7 +266,7 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
           bc.fmt(r["latency_p95_s"], "{:.4f}"), bc.fmt(r["latency_cpu_median_s"], "{:.4f}"),
           bc.fmt(r["latency_cpu_p95_s"], "{:.4f}"), r["checkpoints"], gap_fmt(r, "gap_latency_median_s"),
           gap_fmt(r, "gap_latency_p95_s"), gap_fmt(r, "gap_latency_cpu_median_s"),
-          gap_fmt(r, "gap_latency_cpu_p95_s"), r["gap_latency_missed"], bc.fmt(r["absorbed_gap_median"], "{:.1e}"),
+          gap_fmt(r, "gap_latency_cpu_p95_s"), gap_fmt(r, "gap_cg_median", "{:.0f}"), r["gap_latency_missed"], bc.fmt(r["absorbed_gap_median"], "{:.1e}"),
           bc.fmt(r["max_checkpoint_rel_gap"], "{:.2e}"),
           bc.fmt(r["online_cpu_s"], "{:.2f}"), bc.fmt(r["online_setup_s"], "{:.2f}"),
           bc.fmt(r["online_rounds_cpu_s"], "{:.2f}"), bc.fmt(r["max_step_cpu_s"], "{:.2f}"),
@@ -340,7 +341,8 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
                 "(--gap-bound): the estimates are the absorbed one (new poses composed and placed, before any "
                 "solve), each accepted Newton step's and the step's end, each rounded and costed on graph k after "
                 "the step; median and 95th percentile over the checkpoints, with wall time (gap lat) or the step's "
-                "process CPU (gap lat CPU) since the step began, as the latency's; gap missed = checkpoints whose "
+                "process CPU (gap lat CPU) since the step began, as the latency's; gap CG med = median over the "
+                "checkpoints of the step's Newton CG iterations up to that estimate (load-free); gap missed = checkpoints whose "
                 "step ended above the bound (their gap latency counts as infinite; never = a median or 95th "
                 "percentile among them); absorbed gap med = median relative gap of the absorbed estimate (before any "
                 "solve); with --speedup S the replay's clock runs S times faster than the robots', so the wait "

@@ -29,6 +29,10 @@ struct StepPoint {
   /// sums on the way out: the verdict that accepts it comes one all-agent sum later. The
   /// "end" point has the step's own times, so no point is later than the step.
   double wall_s = 0.0, cpu_s = 0.0;
+  /// The step's Newton steps (accepted or not) and their CG iterations up to this point: its
+  /// load-free cost (0 at "absorbed"; OnlineUpdate's newton_steps and newton_cg_iterations at
+  /// "end").
+  int newton_steps = 0, cg_iterations = 0;
   Eigen::MatrixXd X;  ///< The lifted iterate (r x (d+1)n, stream ids).
 };
 
@@ -36,6 +40,7 @@ struct StepPoint {
 struct StepPointCost {
   std::string at;
   double wall_s = 0.0, cpu_s = 0.0;
+  int newton_steps = 0, cg_iterations = 0;
   double cost = 0.0;  ///< Objective of the rounded estimate (reference convention).
 };
 
