@@ -5,11 +5,13 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/online/replay_schedule.hpp>
+#include <tessera/online/step_points.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/util/input_error.hpp>
@@ -29,7 +31,7 @@ const char* const kOnlineValued[] = {
     "certify-every", "refactor-growth",   "baseline-every", "local-threshold",
     "step-every",    "step-solver",       "newton-after",   "threads",
     "baseline-per",  "baseline-samples",  "baseline-init",  "baseline-solver",
-    "until",         "progress-interval", nullptr};
+    "until",         "progress-interval", "gap-bound",      nullptr};
 const char* const kOnlineSwitches[] = {"online",          "real-time",   "baseline",
                                        "no-local-rounds", "no-progress", nullptr};
 
@@ -51,7 +53,9 @@ const char* kOnlineHelp =
     "                            was published by then), whatever the machine's load\n"
     "  --checkpoints K           at K evenly spaced steps, the estimate's relative gap to the\n"
     "                            optimum of the graph received so far (centralized solver,\n"
-    "                            computed after the run, not timed)\n"
+    "                            computed after the run, not timed), and how soon after\n"
+    "                            its last data the estimate came within --gap-bound of it\n"
+    "  --gap-bound B             the checkpoints' relative gap bound (default 1e-3, > 0)\n"
     "  --baseline                also re-solve from scratch (no warm start) after every loop\n"
     "                            closure, to the same tolerance, and report its CPU time\n"
     "  --baseline-per publication|closure|step   publication (default): once per batch a\n"
@@ -129,6 +133,7 @@ JsonObject update_json(const OnlineUpdate& u) {
       .add("critical_path_cpu_s", u.critical_path_cpu_s)
       .add("latency_s", u.latency_s)
       .add("latency_cpu_s", u.latency_cpu_s)
+      .add("newest_publication_s", u.newest_publication_s)
       .add("message_steps", u.rounds + u.newton_message_steps)
       .add("bytes", static_cast<std::size_t>(u.bytes))
       .add("grad_norm", u.grad_norm)
@@ -160,7 +165,25 @@ struct Checkpoint {
   PoseGraph graph;
   double cost = 0.0;
   double optimum = 0.0;
+  // The step's estimates (StepPoint) with their costs on `graph`, its newest data's wait for
+  // the step, and the step's own latencies (from its oldest data, to its end).
+  std::vector<StepPointCost> points;
+  double wait_s = 0.0;
+  double step_latency_s = 0.0, step_latency_cpu_s = 0.0;
+  GapLatency gap;  // against `optimum`, after the run
 };
+
+// percentile() where some values may be +infinity (checkpoints never within the bound).
+double percentile_or_inf(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(pos);
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  const double frac = pos - static_cast<double>(lo);
+  if (frac == 0.0 || v[lo] == v[hi]) return v[lo];
+  return v[lo] + frac * (v[hi] - v[lo]);
+}
 
 }  // namespace
 
@@ -205,6 +228,9 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   replay.validate();
   const long checkpoints = a.get_long("checkpoints", 0);
   if (checkpoints < 0) throw InputError("option --checkpoints: must be >= 0");
+  const double gap_bound = a.get_double("gap-bound", 1e-3);
+  if (!(gap_bound > 0) || !std::isfinite(gap_bound))
+    throw InputError("option --gap-bound: must be a finite number > 0");
 
   const auto files = robot_files_of(graph_path);
   const long robots = a.get_long("robots", 1);
@@ -260,7 +286,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
     int rounds = 0;
     std::uint64_t bytes = 0;
     double cpu_s = 0.0, setup_s = 0.0, rounds_cpu_s = 0.0;
-    std::vector<double> gaps;
+    std::vector<double> gaps, gap_latency_s, gap_latency_cpu_s, gap_cg;
     const std::vector<OnlineUpdate>& done = res ? res->updates : steps;
     for (const auto& u : done) {
       updates.push_back(update_json(u));
@@ -276,10 +302,37 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("poses", c.graph.num_poses)
           .add("measurements", c.graph.measurements.size())
           .add("cost", c.cost);
+      j.add("wait_s", c.wait_s)
+          .add("step_latency_s", c.step_latency_s)
+          .add("step_latency_cpu_s", c.step_latency_cpu_s);
       if (res) {
         j.add("optimum", c.optimum).add("rel_gap", (c.cost - c.optimum) / c.optimum);
         gaps.push_back((c.cost - c.optimum) / c.optimum);
+        // null where no estimate of the step was within the bound
+        j.add("time_to_gap_s", c.gap.wall_s).add("time_to_gap_cpu_s", c.gap.cpu_s);
+        j.add("time_to_stay_s", c.gap.stays ? c.wait_s + c.points[*c.gap.stays].wall_s
+                                            : std::numeric_limits<double>::infinity());
+        // The load-free companion: the step's CG iterations up to that point.
+        const double cg = c.gap.first ? c.points[*c.gap.first].cg_iterations
+                                      : std::numeric_limits<double>::infinity();
+        j.add("cg_to_gap", cg);
+        gap_latency_s.push_back(c.gap.wall_s);
+        gap_latency_cpu_s.push_back(c.gap.cpu_s);
+        gap_cg.push_back(cg);
       }
+      std::vector<JsonObject> points;
+      for (std::size_t k = 0; k < c.points.size(); ++k) {
+        JsonObject p;
+        p.add("at", c.points[k].at)
+            .add("wall_s", c.points[k].wall_s)
+            .add("cpu_s", c.points[k].cpu_s)
+            .add("newton_steps", c.points[k].newton_steps)
+            .add("cg_iterations", c.points[k].cg_iterations)
+            .add("cost", c.points[k].cost);
+        if (res) p.add("rel_gap", c.gap.rel_gaps[k]);
+        points.push_back(std::move(p));
+      }
+      j.add("points", points);
       cps.push_back(std::move(j));
     }
     const std::vector<OnlineCertificate> no_certificates;
@@ -327,6 +380,16 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("latency_cpu_p95_s", percentile(res->batch_latency_cpu_s, 0.95))
           .add("max_checkpoint_rel_gap",
                gaps.empty() ? 0.0 : *std::max_element(gaps.begin(), gaps.end()))
+          .add("gap_bound", gap_bound)
+          .add("gap_latency_median_s", percentile_or_inf(gap_latency_s, 0.5))
+          .add("gap_latency_p95_s", percentile_or_inf(gap_latency_s, 0.95))
+          .add("gap_latency_cpu_median_s", percentile_or_inf(gap_latency_cpu_s, 0.5))
+          .add("gap_latency_cpu_p95_s", percentile_or_inf(gap_latency_cpu_s, 0.95))
+          .add("gap_cg_median", percentile_or_inf(gap_cg, 0.5))
+          .add("gap_cg_p95", percentile_or_inf(gap_cg, 0.95))
+          .add("gap_latency_missed",
+               static_cast<std::size_t>(std::count_if(gap_latency_s.begin(), gap_latency_s.end(),
+                                                      [](double t) { return !std::isfinite(t); })))
           .add("repartitions", res->repartitions)
           .add("poses_moved", res->poses_moved)
           .add("final_rounds", res->final_rounds)
@@ -358,6 +421,11 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         " poses, " + std::to_string(measurements) + " measurements");
   };
   double step_cpu_s = 0.0;
+  // The steps that may be checkpoints keep their estimates (a copy of the iterate per point):
+  // a step that turns out not to be one (the robots have not met) drops them at the next.
+  auto before_step = [&](OnlineEngine& engine, std::size_t batches) {
+    engine.keep_step_points(every > 0 && seen_batches + batches >= next_mark);
+  };
   auto observer = [&](const OnlineEngine& engine, const OnlineUpdate& u) {
     seen_batches += u.batches;
     steps.push_back(u);
@@ -371,6 +439,10 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         c.time_s = u.time_s;
         c.graph = g;
         c.cost = evaluate_objective(g, estimate);
+        c.points = cost_step_points(g, engine.step_points());
+        c.wait_s = u.time_s - u.newest_publication_s;
+        c.step_latency_s = u.latency_s;
+        c.step_latency_cpu_s = u.latency_cpu_s;
         marks.push_back(std::move(c));
       }
     }
@@ -399,7 +471,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           (options.certify_at_end ? " and certificate" : "") + " on " +
           std::to_string(g.num_poses) + " poses");
   };
-  const OnlineResult res = run_online(input.graph.d, plan.batches, options, observer);
+  const OnlineResult res = run_online(input.graph.d, plan.batches, options, observer, before_step);
   wall_s = elapsed_s();
 
   for (std::size_t k = 0; k < marks.size(); ++k) {
@@ -408,6 +480,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           ": the optimum of the graph of " + std::to_string(marks[k].graph.num_poses) +
           " poses (centralized solver, offline)");
     marks[k].optimum = solve_centralized(marks[k].graph).cost;
+    marks[k].gap = gap_latency(marks[k].points, marks[k].optimum, gap_bound, marks[k].wait_s);
   }
   const std::vector<double>& latency = res.batch_latency_s;
   std::printf(

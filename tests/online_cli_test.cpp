@@ -1,6 +1,7 @@
 // `tessera solve GRAPH --online --baseline`: the re-solving baseline of issue 24 counts one
 // re-solve from scratch per publication that brought loop closures (or per closure, or per
 // step), and a sample of them stands for all. A run says where it is on stderr while it goes.
+// Its checkpoints say how soon the estimate came within a gap bound of their optimum.
 
 #include <gtest/gtest.h>
 
@@ -208,6 +209,26 @@ TEST(OnlineCli, UntilPlaysOnlyWhatWasPublishedByThenAndRefusesANegativeTime) {
           test::bin("tessera") + " solve " + r.graph + " --online --robots 2 --until -1", &out),
       2);
   EXPECT_TRUE(test::contains(out, "--until")) << out;
+}
+
+TEST(OnlineCli, CheckpointsSayHowSoonTheEstimateCameWithinTheGapBound) {
+  const Replay r = generated();
+  const std::string j = solve(r, "--checkpoints 3 --gap-bound 1e-3");
+  EXPECT_EQ(json_number(j, "gap_bound"), 1e-3);
+  EXPECT_EQ(json_number(j, "gap_latency_missed"), 0.0);
+  EXPECT_GE(json_number(j, "gap_latency_median_s"), 0.0);
+  EXPECT_LE(json_number(j, "gap_latency_median_s"), json_number(j, "gap_latency_p95_s"));
+  EXPECT_LE(json_number(j, "gap_latency_cpu_median_s"), json_number(j, "gap_latency_cpu_p95_s"));
+  EXPECT_LE(json_number(j, "gap_cg_median"), json_number(j, "gap_cg_p95"));
+  // The first checkpoint's: within the bound no later than its step's end.
+  EXPECT_LE(json_number(j, "time_to_gap_s"), json_number(j, "step_latency_s"));
+  EXPECT_TRUE(test::contains(j, "\"at\": \"absorbed\"")) << j;
+  std::string out;
+  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + r.graph +
+                                  " --online --robots 2 --checkpoints 2 --gap-bound 0",
+                              &out),
+            2);
+  EXPECT_TRUE(test::contains(out, "--gap-bound")) << out;
 }
 
 }  // namespace

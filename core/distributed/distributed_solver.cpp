@@ -12,6 +12,7 @@
 #include <tessera/distributed/distributed_solver.hpp>
 #include <tessera/distributed/round_protocol.hpp>
 #include <tessera/distributed/stage_tag.hpp>
+#include <tessera/distributed/trial_point_watch.hpp>
 #include <tessera/problem/lifting.hpp>
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
@@ -173,6 +174,12 @@ DistributedResult solve_distributed_with_states(const PoseGraph& graph, const Bl
                                                 const std::vector<AgentState*>& states,
                                                 const DistributedOptions& options,
                                                 double known_grad_norm) {
+  return solve_distributed_watching_trials(graph, layout, states, options, {}, known_grad_norm);
+}
+
+DistributedResult solve_distributed_watching_trials(
+    const PoseGraph& graph, const BlockLayout& layout, const std::vector<AgentState*>& states,
+    const DistributedOptions& options, const TrialPointWatch& watch, double known_grad_norm) {
   const auto start = Clock::now();
   check_options(graph, options);
   const Eigen::Index w = graph.d + 1;
@@ -190,6 +197,8 @@ DistributedResult solve_distributed_with_states(const PoseGraph& graph, const Bl
     sequences.push_back(
         std::make_unique<CertifiedAgent>(*states[static_cast<std::size_t>(b)], layout, options));
     if (!std::isnan(known_grad_norm)) sequences.back()->set_known_start(known_grad_norm);
+    if (watch)
+      sequences.back()->set_trial_observer([&watch, b](const Eigen::MatrixXd& Y) { watch(b, Y); });
     agents.push_back(sequences.back().get());
   }
   res.init_s = since(start);

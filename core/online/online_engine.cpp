@@ -2,8 +2,11 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <mutex>
+#include <stdexcept>
 #include <tessera/certification/rounding_gap.hpp>
 #include <tessera/distributed/coarse_space.hpp>
+#include <tessera/distributed/trial_point_watch.hpp>
 #include <tessera/graph/connectivity.hpp>
 #include <tessera/online/estimate_extension.hpp>
 #include <tessera/online/lifted_rank.hpp>
@@ -78,18 +81,31 @@ std::vector<Pose> OnlineEngine::estimate() const {
   return round_solution(stream_.graph(), X_);
 }
 
+double OnlineEngine::step_wall_s() const {
+  return std::chrono::duration<double>(Clock::now() - step_wall_start_).count();
+}
+
+double OnlineEngine::step_cpu_s() const {
+  return cpu_now() - step_cpu_start_;
+}
+
 OnlineUpdate OnlineEngine::step(double now_s) {
-  const auto wall_start = Clock::now();
-  const double cpu_start = cpu_now();
+  step_wall_start_ = Clock::now();
+  step_cpu_start_ = cpu_now();
+  const auto wall_start = step_wall_start_;
+  const double cpu_start = step_cpu_start_;
+  points_.clear();
+  const bool keep = keep_points_;
   OnlineUpdate u;
   u.time_s = now_s;
-  double oldest = now_s;
+  double oldest = now_s, newest = 0.0;
   const std::size_t poses_before = stream_.graph().num_poses;
   const std::size_t measurements_before = stream_.graph().measurements.size();
   std::vector<double> stamps;
   for (const StreamBatch& b : received_) {
     u.batches += stream_.absorb(b).batches;
     oldest = std::min(oldest, b.stamp);
+    newest = std::max(newest, b.stamp);
     stamps.push_back(b.stamp);
   }
   received_.clear();
@@ -99,6 +115,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.total_poses = graph.num_poses;
   u.total_measurements = graph.measurements.size();
   u.agents = static_cast<int>(stream_.robots().size());
+  u.newest_publication_s = stamps.empty() ? now_s : newest;
   // Idle: nothing new and already converged, so no round and no message.
   if ((u.poses == 0 && u.measurements == 0 && converged_) || graph.num_poses == 0) return u;
   const TangentFactorTotals factors_before =
@@ -130,6 +147,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     u.merges = merges.merges;
     u.merge_poses_moved = merges.poses_moved;
   }
+  if (keep) points_.push_back({"absorbed", step_wall_s(), step_cpu_s(), 0, 0, X_});
   if (converged_ && composed == u.measurements) {
     // Every new measurement placed a new pose (odometry, mostly): each has zero residual at
     // the composed poses, so f and its gradient are what they were and the agents, which were
@@ -138,7 +156,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     u.relaxation_cost = last_relaxation_cost_;
     u.stop_reason = "unchanged";
   } else {
-    DistributedResult res = solve_linked(online_step_solver(options_));
+    DistributedResult res = solve_linked(online_step_solver(options_), keep);
     // Newton steps that stopped above the tolerance (a step far from the model's region, e.g.
     // the closures of sphere2500's last rings: 20 trust-region steps left |grad f| at 9) hand
     // over to the rounds from where they stopped: the step ends under the tolerance either way.
@@ -184,6 +202,9 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.cpu_s = cpu_now() - cpu_start;
   u.latency_s = now_s - oldest + u.ms / 1000.0;
   u.latency_cpu_s = now_s - oldest + u.cpu_s;
+  // Out of the step's times: the step ended here.
+  if (keep)
+    points_.push_back({"end", u.ms / 1000.0, u.cpu_s, u.newton_steps, u.newton_cg_iterations, X_});
   for (double stamp : stamps) {
     totals_.batch_latency_s.push_back(now_s - stamp + u.ms / 1000.0);
     totals_.batch_latency_cpu_s.push_back(now_s - stamp + u.cpu_s);
@@ -267,7 +288,84 @@ void use_online_refine_space(const LiveBlocks& blocks, const DistributedOptions&
     if (s) s->use_refine_space(space);
 }
 
-DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
+namespace {
+
+// The agents' trial points of one solve (TrialPointWatch), gathered per trial: agent b's k-th
+// call is the k-th step of its refinements' traces, the same steps on every agent.
+class TrialPoints {
+ public:
+  TrialPoints(int blocks, std::function<double()> wall_s, std::function<double()> cpu_s)
+      : blocks_(blocks),
+        wall_s_(std::move(wall_s)),
+        cpu_s_(std::move(cpu_s)),
+        calls_(static_cast<std::size_t>(blocks), 0) {}
+
+  TrialPointWatch watch() {
+    return [this](int b, const Eigen::MatrixXd& Y) {
+      const double wall = wall_s_(), cpu = cpu_s_();
+      const std::lock_guard<std::mutex> lock(mutex_);
+      const std::size_t k = calls_[static_cast<std::size_t>(b)]++;
+      if (trials_.size() <= k) trials_.resize(k + 1);
+      Trial& t = trials_[k];
+      if (t.blocks.empty()) t.blocks.resize(static_cast<std::size_t>(blocks_));
+      t.blocks[static_cast<std::size_t>(b)] = Y;
+      // The point exists once its last block does.
+      t.wall_s = std::max(t.wall_s, wall);
+      t.cpu_s = std::max(t.cpu_s, cpu);
+      ++t.received;
+    };
+  }
+
+  /// The accepted trials of `refines` as points over `X` (stream ids; the linked poses'
+  /// columns replaced through `blocks`).
+  void accepted(const std::vector<NewtonRefineResult>& refines, const LiveBlocks& blocks,
+                const Eigen::MatrixXd& X, std::vector<StepPoint>& out) const {
+    std::vector<const NewtonRefineStep*> steps;
+    for (const NewtonRefineResult& r : refines)
+      for (const NewtonRefineStep& s : r.trace) steps.push_back(&s);
+    if (steps.size() != trials_.size())
+      throw std::logic_error("online step points: " + std::to_string(trials_.size()) +
+                             " trial points for " + std::to_string(steps.size()) + " Newton steps");
+    const BlockLayout& layout = blocks.layout();
+    const Eigen::Index w = blocks.graph().d + 1;
+    int cg = 0;
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      cg += steps[k]->cg_iterations;
+      if (!steps[k]->accepted) continue;
+      const Trial& t = trials_[k];
+      if (t.received != blocks_)
+        throw std::logic_error("online step points: a trial point lacks a block");
+      Eigen::MatrixXd linked(X.rows(), w * static_cast<Eigen::Index>(layout.owner.size()));
+      for (int b = 0; b < blocks_; ++b) {
+        const auto& ids = layout.poses[static_cast<std::size_t>(b)];
+        const Eigen::MatrixXd& Y = t.blocks[static_cast<std::size_t>(b)];
+        for (std::size_t s = 0; s < ids.size(); ++s)
+          linked.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
+              Y.middleCols(w * static_cast<Eigen::Index>(s), w);
+      }
+      StepPoint p{"newton", t.wall_s, t.cpu_s, static_cast<int>(k) + 1, cg, X};
+      blocks.write_back(linked, p.X);
+      out.push_back(std::move(p));
+    }
+  }
+
+ private:
+  struct Trial {
+    std::vector<Eigen::MatrixXd> blocks;
+    int received = 0;
+    double wall_s = 0.0, cpu_s = 0.0;
+  };
+  int blocks_;
+  std::function<double()> wall_s_, cpu_s_;
+  std::mutex mutex_;
+  std::vector<std::size_t> calls_;
+  std::vector<Trial> trials_;
+};
+
+}  // namespace
+
+DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver,
+                                             bool keep_newton_points) {
   DistributedResult res;
   if (!blocks_)
     blocks_ = std::make_unique<LiveBlocks>(stream_.graph().d, solver.block_update,
@@ -279,10 +377,20 @@ DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver) {
   DistributedOptions run = solver;
   use_online_refine_space(*blocks_, run);
   run.round_result = false;  // in the linked graph's ids: the caller rounds X_
-  res = solve_distributed_with_states(blocks_->graph(), blocks_->layout(), blocks_->all_states(),
-                                      run);
+  std::optional<TrialPoints> trials;
+  if (keep_newton_points && run.refine.enabled)
+    trials.emplace(
+        blocks_->layout().num_blocks, [this] { return step_wall_s(); },
+        [this] { return step_cpu_s(); });
+  res =
+      solve_distributed_watching_trials(blocks_->graph(), blocks_->layout(), blocks_->all_states(),
+                                        run, trials ? trials->watch() : TrialPointWatch{});
   res.init_s += setup_s;
-  if (res.X.rows() == X_.rows()) blocks_->write_back(res.X, X_);
+  if (res.X.rows() == X_.rows()) {
+    blocks_->write_back(res.X, X_);
+    // The poses outside the linked graph are the same at every trial point.
+    if (trials) trials->accepted(res.refines, *blocks_, X_, points_);
+  }
   return res;
 }
 
@@ -354,7 +462,8 @@ std::optional<OnlineCertificate> OnlineEngine::certify(double now_s) {
 }
 
 OnlineResult run_online(int d, const std::vector<StreamBatch>& batches,
-                        const OnlineOptions& options, const OnlineObserver& observer) {
+                        const OnlineOptions& options, const OnlineObserver& observer,
+                        const OnlineStepStart& before_step) {
   OnlineEngine engine(d, options);
   double clock = 0.0, next_certificate = options.certify_every_s;
   std::size_t next = 0;
@@ -367,7 +476,9 @@ OnlineResult run_online(int d, const std::vector<StreamBatch>& batches,
                    std::ceil(batches[next].stamp / options.step_every_s) * options.step_every_s);
     else
       clock = std::max(clock, batches[next].stamp);
+    const std::size_t first = next;
     while (next < batches.size() && batches[next].stamp <= clock) engine.receive(batches[next++]);
+    if (before_step) before_step(engine, next - first);
     const OnlineUpdate u = engine.step(clock);
     if (observer && (u.poses > 0 || u.measurements > 0 || u.rounds > 0)) observer(engine, u);
     if (options.real_time) clock += u.ms / 1000.0;

@@ -5,7 +5,9 @@ publish it while one agent per robot solves in one process (`tessera solve GRAPH
 Per run: median and 95th percentile latency over the batches (publication of a batch to the
 end of the step that absorbed it, when the gradient is back under the tolerance; with
 --real-time the steps' wall time is stream time), the relative gap to the optimum of the graph received so far at
-sampled checkpoints (centralized solver, offline), rounds and bytes per second of stream,
+sampled checkpoints (centralized solver, offline) and how soon after a checkpoint's data the
+estimate came within --gap-bound of that optimum (the issue's latency target; median and 95th
+percentile over the checkpoints), rounds and bytes per second of stream,
 the CPU time of the online run against re-solving from scratch after every loop closure (the
 issue's baseline: same agents and blocks, on the graph published up to and with each closure, a
 sample of them re-solved and scaled), and the final cost against the batch optimum f*
@@ -70,6 +72,8 @@ def main():
     ap.add_argument("--speedup", type=float, default=10.0, help="replay speedup (default 10)")
     ap.add_argument("--grad-tol", type=float, default=1e-3, help="agents' gradient tolerance (default 1e-3)")
     ap.add_argument("--checkpoints", type=int, default=5, help="checkpoints per run (default 5)")
+    ap.add_argument("--gap-bound", type=float, default=1e-3,
+                    help="the checkpoints' relative gap bound for the gap latency (default 1e-3)")
     ap.add_argument("--full", action="store_true", help="the issue's sizes (long on a shared machine)")
     ap.add_argument("--steps", default="real-time",
                     help="real-time (a step absorbs what was published while the last one ran: depends on the "
@@ -112,7 +116,8 @@ def main():
         js = os.path.join(ctx.work, os.path.basename(path) + ".online.json")
         cmd = [ctx.bin, "solve", path, "--online", "--robots", str(robots), "--rate", str(args.rate),
                "--speedup", str(args.speedup)] + step_args(args) + [
-               "--grad-tol", str(args.grad_tol), "--checkpoints", str(args.checkpoints), "--json", js]
+               "--grad-tol", str(args.grad_tol), "--checkpoints", str(args.checkpoints),
+               "--gap-bound", str(args.gap_bound), "--json", js]
         if not args.no_baseline:
             cmd += ["--baseline"]
         if not args.no_baseline:
@@ -145,6 +150,16 @@ def main():
             "latency_median_s": s["latency_median_s"], "latency_p95_s": s["latency_p95_s"],
             "latency_cpu_median_s": s.get("latency_cpu_median_s"), "latency_cpu_p95_s": s.get("latency_cpu_p95_s"),
             "max_checkpoint_rel_gap": s["max_checkpoint_rel_gap"],
+            # The issue's latency: a checkpoint's newest data to an estimate within the gap bound
+            # (null in the JSON: some checkpoint's step ended above it).
+            "gap_bound": s.get("gap_bound"), "checkpoints": len(s.get("checkpoints", [])),
+            "gap_latency_median_s": s.get("gap_latency_median_s"), "gap_latency_p95_s": s.get("gap_latency_p95_s"),
+            "gap_latency_cpu_median_s": s.get("gap_latency_cpu_median_s"),
+            "gap_latency_cpu_p95_s": s.get("gap_latency_cpu_p95_s"),
+            "gap_latency_missed": s.get("gap_latency_missed"),
+            "gap_cg_median": s.get("gap_cg_median"),
+            "absorbed_gap_median": median([c["points"][0]["rel_gap"] for c in s.get("checkpoints", [])
+                                           if c.get("points")]),
             "rounds_per_s": s["rounds"] / stream_s, "bytes_per_s_per_agent": s["bytes"] / stream_s / robots,
             "online_cpu_s": s["cpu_s"], "online_setup_s": s["setup_s"], "online_rounds_cpu_s": s["rounds_cpu_s"], "baseline_cpu_s": s.get("baseline_cpu_s"),
             "baseline_solves": s.get("baseline_solves"), "baseline_resolved": s.get("baseline_resolved"),
@@ -180,6 +195,13 @@ def main():
         if args.dds:
             dds_rows.append(run_dds(args, ctx, name, path, robots, fstar))
         write_outputs(args, ctx, rows, runs, dds_rows)  # after each case: a long run keeps what it did
+
+
+def median(values):
+    v = sorted(values)
+    if not v:
+        return None
+    return v[len(v) // 2] if len(v) % 2 else 0.5 * (v[len(v) // 2 - 1] + v[len(v) // 2])
 
 
 def callgrind(ctx, cmd, function):
@@ -220,9 +242,17 @@ def step_args(args):
     return ["--step-every", str(float(args.steps))]
 
 
+def gap_fmt(r, key, spec="{:.4f}"):
+    """A gap latency; "never" where the JSON has null (a checkpoint whose step ended above the bound)."""
+    if r[key] is None and r["checkpoints"]:
+        return "never"
+    return bc.fmt(r[key], spec)
+
+
 def write_outputs(args, ctx, rows, runs, dds_rows):
     headers = ["graph", "poses", "steps", "step solver", "message steps", "Newton steps", "Newton CG",
-               "repartitions", "poses moved", "final cut", "largest block", "lat med s", "lat p95 s", "lat CPU med s", "lat CPU p95 s", "max gap", "online CPU s", "set-up s",
+               "repartitions", "poses moved", "final cut", "largest block", "lat med s", "lat p95 s", "lat CPU med s", "lat CPU p95 s", "checkpoints", "gap lat med s",
+               "gap lat p95 s", "gap lat CPU med s", "gap lat CPU p95 s", "gap CG med", "gap missed", "absorbed gap med", "max gap", "online CPU s", "set-up s",
                "rounds CPU s", "max step CPU s", "critical path s", "closures", "closure publications", "closure steps", "re-solves", "re-solve rounds", "re-solve CG", "re-solve CPU s", "ratio", "final rel gap", "certified", "load"]
     if args.instructions:
         headers += ["online G instr", "re-solve G instr", "instr ratio"]
@@ -234,7 +264,10 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
           r["newton_cg_iterations"], r["repartitions"], r["poses_moved"], r["final_cut"], r["largest_block"],
           bc.fmt(r["latency_median_s"], "{:.4f}"),
           bc.fmt(r["latency_p95_s"], "{:.4f}"), bc.fmt(r["latency_cpu_median_s"], "{:.4f}"),
-          bc.fmt(r["latency_cpu_p95_s"], "{:.4f}"), bc.fmt(r["max_checkpoint_rel_gap"], "{:.2e}"),
+          bc.fmt(r["latency_cpu_p95_s"], "{:.4f}"), r["checkpoints"], gap_fmt(r, "gap_latency_median_s"),
+          gap_fmt(r, "gap_latency_p95_s"), gap_fmt(r, "gap_latency_cpu_median_s"),
+          gap_fmt(r, "gap_latency_cpu_p95_s"), gap_fmt(r, "gap_cg_median", "{:.0f}"), r["gap_latency_missed"], bc.fmt(r["absorbed_gap_median"], "{:.1e}"),
+          bc.fmt(r["max_checkpoint_rel_gap"], "{:.2e}"),
           bc.fmt(r["online_cpu_s"], "{:.2f}"), bc.fmt(r["online_setup_s"], "{:.2f}"),
           bc.fmt(r["online_rounds_cpu_s"], "{:.2f}"), bc.fmt(r["max_step_cpu_s"], "{:.2f}"),
           bc.fmt(r["critical_path_cpu_s"], "{:.2f}"),
@@ -264,7 +297,11 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
     for name, s in runs:
         t = [u["time_s"] for u in s["updates"]]
-        axes[0].plot(t, [max(u["latency_s"], 1e-4) for u in s["updates"]], ".", ms=3, label=name)
+        line, = axes[0].plot(t, [max(u["latency_s"], 1e-4) for u in s["updates"]], ".", ms=3, label=name)
+        cps = [c for c in s.get("checkpoints", []) if c.get("time_to_gap_s") is not None]
+        if cps:
+            axes[0].plot([c["time_s"] for c in cps], [max(c["time_to_gap_s"], 1e-4) for c in cps], "x", ms=7,
+                         color=line.get_color(), label=f"{name}: checkpoint within the gap bound")
         axes[1].plot(t, [u["rounds"] for u in s["updates"]], ".", ms=3, label=name)
     bc.style_log_axes(axes[0], "stream time (s)", "latency per step", "seconds")
     axes[1].set_xlabel("stream time (s)")
@@ -297,7 +334,19 @@ def write_outputs(args, ctx, rows, runs, dds_rows):
                 "message steps = rounds plus the Newton steps' neighbour exchanges and all-agent sums over all "
                 "steps (load-free); Newton CG = their CG iterations; "
                 "latency = publication of a batch to the end of the step that absorbed it "
-                "(gradient back under the tolerance or stalled), median and 95th percentile over all batches; max "
+                "(gradient back under the tolerance or stalled), median and 95th percentile over all batches; "
+                "gap lat = the issue's latency target, per checkpoint k the time from the publication of the "
+                "newest batch of the graph received by k (stream clock) to the first estimate of the step that "
+                "absorbed it whose relative gap (f(estimate) - f*_k) / f*_k is at most " + f"{args.gap_bound:g}" + " "
+                "(--gap-bound): the estimates are the absorbed one (new poses composed and placed, before any "
+                "solve), each accepted Newton step's and the step's end, each rounded and costed on graph k after "
+                "the step; median and 95th percentile over the checkpoints, with wall time (gap lat) or the step's "
+                "process CPU (gap lat CPU) since the step began, as the latency's; gap CG med = median over the "
+                "checkpoints of the step's Newton CG iterations up to that estimate (load-free); gap missed = checkpoints whose "
+                "step ended above the bound (their gap latency counts as infinite; never = a median or 95th "
+                "percentile among them); absorbed gap med = median relative gap of the absorbed estimate (before any "
+                "solve); with --speedup S the replay's clock runs S times faster than the robots', so the wait "
+                "for a step is S times shorter than at real time while the step's compute time is not; max "
                 "gap = largest relative gap (f(estimate) - f*_k) / f*_k over the checkpoints, f*_k the centralized "
                 "optimum of the graph received by checkpoint k; online CPU = process CPU of all steps and the final "
                 "certificate; max step CPU s = the longest step's process CPU (all agents); critical path s = the rounds' compute time summed over the steps with every agent on its own machine (per message step the slowest agent); set-up s = wall time of the agents' set-up (block problems, preconditioner factors) over the steps; rounds CPU s = process CPU of the rounds alone; closures = loop closure measurements in the replay; closure publications = batches (one robot, one "

@@ -12,6 +12,7 @@
 // (DistributedOptions::certify's staircase) from the last iterate.
 
 #include <Eigen/Core>
+#include <chrono>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -23,6 +24,7 @@
 #include <tessera/online/component_alignment.hpp>
 #include <tessera/online/graph_stream.hpp>
 #include <tessera/online/live_blocks.hpp>
+#include <tessera/online/step_points.hpp>
 #include <tessera/online/stream_batch.hpp>
 #include <vector>
 
@@ -187,6 +189,9 @@ struct OnlineUpdate {
   /// machine's load as latency_s does. Its load-free companions are the step's message steps
   /// (rounds + newton_message_steps) and CG iterations.
   double latency_cpu_s = 0.0;
+  /// Publication of the newest absorbed batch (stream clock): the graph of this step is
+  /// complete from then on, so time_s minus it is how long its last data waited for the step.
+  double newest_publication_s = 0.0;
   std::uint64_t bytes = 0;  ///< Protocol bytes of the step's rounds.
   double grad_norm = 0.0;   ///< ||grad f|| at the end of the step.
   /// Why the rounds stopped: grad_norm, or stalled (the iterate stopped moving just above the
@@ -284,11 +289,21 @@ class OnlineEngine {
   /// Block (agent) of each stream id: its robot's position in stream().robots() unless the
   /// rebalance moved it.
   const std::vector<int>& assignment() const { return owner_; }
+  /// Whether the next steps record the estimates they pass through (step_points()): off by
+  /// default, and meant for a few steps only (each point is a copy of the lifted iterate).
+  void keep_step_points(bool keep) { keep_points_ = keep; }
+  /// The last step's points (step_points.hpp) when it kept them, in time order: absorbed, each
+  /// accepted Newton step's, end; empty otherwise. Cleared when the next step begins.
+  const std::vector<StepPoint>& step_points() const { return points_; }
 
  private:
   /// Runs the agents from X_ on the poses some measurement touches and writes their result
   /// back into X_ (when the rank did not change: a staircase climb leaves X_ as it was).
-  DistributedResult solve_linked(const DistributedOptions& solver);
+  /// `keep_newton_points`: appends each accepted Newton step's point to points_.
+  DistributedResult solve_linked(const DistributedOptions& solver, bool keep_newton_points = false);
+  /// The step's clocks since it began (wall, process CPU).
+  double step_wall_s() const;
+  double step_cpu_s() const;
   /// A step's solver with rounds only (after Newton steps that stopped above the tolerance).
   DistributedOptions plain_step_solver() const;
 
@@ -303,14 +318,22 @@ class OnlineEngine {
   bool converged_ = true;                                     // gradient under tolerance at X_
   double last_grad_norm_ = 0.0, last_relaxation_cost_ = 0.0;  // at the end of the last solve
   OnlineResult totals_;
+  bool keep_points_ = false;
+  std::vector<StepPoint> points_;                          // the last step's, when kept
+  std::chrono::steady_clock::time_point step_wall_start_;  // the running step's start
+  double step_cpu_start_ = 0.0;
 };
 
 /// Called after every step of run_online that did work (not for idle steps).
 using OnlineObserver = std::function<void(const OnlineEngine&, const OnlineUpdate&)>;
+/// Called before every step of run_online with the batches it is about to absorb (received,
+/// not yet in the graph): e.g. to have the engine keep that step's points (keep_step_points).
+using OnlineStepStart = std::function<void(OnlineEngine&, std::size_t batches)>;
 
 /// Plays `batches` (ordered by stamp) into an engine (see OnlineOptions::real_time) and
 /// finishes it.
 OnlineResult run_online(int d, const std::vector<StreamBatch>& batches,
-                        const OnlineOptions& options, const OnlineObserver& observer = {});
+                        const OnlineOptions& options, const OnlineObserver& observer = {},
+                        const OnlineStepStart& before_step = {});
 
 }  // namespace tessera
