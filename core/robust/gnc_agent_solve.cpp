@@ -21,6 +21,7 @@ namespace tessera {
 
 void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
+  trial_weights_sent_ = false;
   const bool neighbours_known = neighbours_current_;
   neighbours_current_ = false;
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
@@ -62,9 +63,13 @@ void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out, std::vector<Outgo
     std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
     out.push_back(std::move(o));
   }
-  // Beside the trial's sums, which every agent waits for anyway: this step's pose exchange.
-  if (const Eigen::MatrixXd* trial = stage_->take_trial())
+  // Beside the trial's sums, which every agent waits for anyway: this step's pose exchange, and
+  // the weight update at the trial point.
+  if (const Eigen::MatrixXd* trial = stage_->take_trial()) {
     exchange_->publish(*trial, BlockKind::kY, gnc_phase(g_, GncExchange::kPoses), out);
+    if (options_.robust.weights_ride_trial_sums && (!gather_values_early() || values_held_))
+      send_trial_weights(*trial, out);
+  }
 }
 
 bool GncAgent::gather_values_early() const {

@@ -125,6 +125,7 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
     case GncExchange::kStartVotes:
       votes_[sender] = read_vote(expect_status(message, in_.id, kStatusBelongs));
       break;
+    case GncExchange::kTrialWeights:  // the same message, sent beside a trial's sums
     case GncExchange::kWeights: {
       if (const auto* block = std::get_if<PoseBlockMessage>(&message)) {  // agent 0: the values
         decode_measurement_block(*block, in_.d, in_.num_poses, "robust solve", held_values_);

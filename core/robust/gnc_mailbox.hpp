@@ -37,6 +37,10 @@ class GncMailbox {
   /// part in agent-id order), removed; nothing more until the next begin_*. Else nullopt.
   std::optional<std::vector<ProtocolMessage>> take_exchange();
 
+  /// Drops the messages of the exchange of `phase` that came already: one that will not be
+  /// waited for (one that comes later waits in the gate unread, and is dropped on arrival once
+  /// this agent has left its step).
+  void discard(std::uint32_t phase) { gate_.discard(0, phase); }
   /// The current exchange's missing messages (not during a solve: the solve names its own).
   std::size_t messages_needed() const;
   AwaitedMessages awaited() const;

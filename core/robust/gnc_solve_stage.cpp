@@ -74,11 +74,12 @@ void GncSolveStage::open(bool weighted, bool capped, bool trial_poses,
   start_known_ = false;
   trial_pending_ = poses_sent_early_ = poses_early_stale_ = false;
   if (newton_steps_ && trial_poses)
-    solve_->set_trial_observer([this](const Eigen::MatrixXd& Y) {
+    solve_->set_trial_observer([this](const Eigen::MatrixXd& Y, const Eigen::MatrixXd& Yn) {
       // One trial per solve (a single Newton step); after rounds the iterate the last pose
       // exchange holds is not the solve's start, so those take the exchange of their own.
       if (poses_sent_early_ || trial_pending_ || solve_->total_rounds() > 0) return;
       trial_Y_ = Y;
+      trial_Yn_ = Yn;
       trial_pending_ = true;
     });
 }

@@ -62,6 +62,9 @@ class GncSolveStage {
   std::vector<OutgoingMessage> start_at_refinement(const Eigen::MatrixXd& neighbours);
   /// The trial point to publish beside its sums, once (nullptr when none is pending).
   const Eigen::MatrixXd* take_trial();
+  /// The last trial point's neighbour poses (state().problem().neighbors() order, the trial's
+  /// rows): what a weight update at that point reads beside the own block.
+  const Eigen::MatrixXd& trial_neighbours() const { return trial_Yn_; }
   /// After the solve: whether the early poses are the iterate's (the step was accepted).
   void judge_early_poses();
   /// Adds the ended solve's rounds, stages and refinement message steps to the totals.
@@ -120,7 +123,7 @@ class GncSolveStage {
   double pass_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
   bool gnc_newton_steps_ = false;
   int weighted_solves_ = 0;
-  Eigen::MatrixXd trial_Y_;
+  Eigen::MatrixXd trial_Y_, trial_Yn_;
   bool trial_pending_ = false, poses_sent_early_ = false, poses_early_stale_ = false;
   std::vector<Measurement> kept_;
   std::vector<std::uint64_t> kept_index_;

@@ -79,7 +79,8 @@ class CertifiedAgent : public AgentProcess {
   }
   /// Observer of the trial points of the Newton refinements this agent runs
   /// (NewtonRefineProtocol::set_trial_observer).
-  void set_trial_observer(std::function<void(const Eigen::MatrixXd&)> observer) {
+  void set_trial_observer(
+      std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> observer) {
     trial_observer_ = std::move(observer);
   }
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
@@ -169,7 +170,7 @@ class CertifiedAgent : public AgentProcess {
   std::vector<CertifyStageRecord> certificates_;
   std::vector<EscapeStageRecord> escapes_;
   std::function<void(const ProtocolSnapshot&)> observer_;
-  std::function<void(const Eigen::MatrixXd&)> trial_observer_;
+  std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> trial_observer_;
   bool known_start_ = false;  // set_known_start()
   double known_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
   bool refining_ = false;        // the current rank's solve continues at refine_tolerance()

@@ -82,7 +82,11 @@ enum class GncExchange : std::uint32_t {
   kPcmValues = 10,
   kPcmDropped = 11,
   kStartPoses = 12,
-  kStartVotes = 13
+  kStartVotes = 13,
+  /// The weights at a weighted solve's trial point, sent beside its sums
+  /// (RobustOptions::weights_ride_trial_sums); read as the step's weight exchange when the
+  /// trial is accepted.
+  kTrialWeights = 14
 };
 inline std::uint32_t gnc_phase(std::uint32_t step, GncExchange e) {
   return step * kGncStepStride + kGncExchangeBase + static_cast<std::uint32_t>(e);
@@ -265,7 +269,14 @@ class GncAgent : public AgentProcess {
   bool send_poses_with_trial() const;
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
-  int weights_at_mu(double mu);         // the count of owned weights that crossed 1/2
+  int weights_at_mu(double mu);  // the count of owned weights that crossed 1/2
+  // The weight update at the trial point `Y` the solve just handed out, sent beside its sums
+  // (RobustOptions::weights_ride_trial_sums); kept aside until the solve's verdict.
+  void send_trial_weights(const Eigen::MatrixXd& Y, std::vector<OutgoingMessage>& out);
+  // The weight exchange after the solve reads the trial's weights (sent, and the trial accepted).
+  bool trial_weights_stand() const;
+  // The weight exchange from the trial's weights: this agent's kept aside, the others' in.
+  void begin_trial_weights(std::vector<OutgoingMessage>& out);
   void require_kept_connected() const;  // throws InputError naming the parts left
   // GNC's rejected set: from the last weight exchange where there was one, else an exchange.
   void begin_rejected(std::vector<OutgoingMessage>& out);
@@ -300,6 +311,13 @@ class GncAgent : public AgentProcess {
   // that exchange ended GNC at TLS's verdict (RobustOptions::jump_band).
   std::vector<std::pair<std::uint64_t, double>> low_weights_;
   bool jumped_ = false;
+  // The weight update at the running weighted solve's trial point (send_trial_weights): the
+  // weights, the cut ones of weight 0, the spread and crossing votes, the near-bound count.
+  bool trial_weights_sent_ = false;
+  std::vector<double> trial_weights_;
+  std::vector<std::uint64_t> trial_zero_cut_;
+  std::pair<double, double> trial_vote_{0.0, 0.0};
+  double trial_near_ = 0.0;
   // Agent 0 holds every measurement's value (sent beside the first weights, with
   // RobustOptions::exchanges_ride_along and the kept set's fresh start): a fresh start then
   // waits only for agent 0's answer, not for the values first. The same on every agent.

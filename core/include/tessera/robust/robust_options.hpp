@@ -319,6 +319,19 @@ struct RobustOptions {
   /// 140 -> 136, CSAIL 67 -> 63), the same `--out` bytes, rejected set and certificate
   /// (docs/robust.md, "Where the steps go now").
   bool kept_solves_start_at_refinement = true;
+  /// Distributed solvers only, with exchanges_ride_along: where a weighted solve is a single
+  /// Newton step that another weight update follows, each agent computes that update at the
+  /// trial point (its neighbours' poses there are known once the trial's translations are
+  /// solved) and sends its weights message beside the trial's sums; accepted, the trial point is
+  /// the iterate, so the weight exchange after the solve waits for nothing (not accepted, the
+  /// exchange runs as before). A cut measurement of weight 0 whose other end the weighted solve
+  /// does not hold (it left the solve's layout) has no known pose at the trial point: it stays
+  /// at weight 0 and out of the early end's count until the inlier passes judge it at the kept
+  /// set's solution. On (default); off: the weight exchange of its own. Why: one message step
+  /// an outer step (F = 0.25 random, 5 agents: intel 136 -> 123, CSAIL 63 -> 59), every intel
+  /// and CSAIL cell of the benchmark the same `--out` bytes and rejected set (docs/robust.md,
+  /// "Weights beside the trial's sums").
+  bool weights_ride_trial_sums = true;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
