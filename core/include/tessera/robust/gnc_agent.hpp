@@ -73,20 +73,21 @@ enum class GncExchange : std::uint32_t {
   kPoses = 1,
   kVotes = 2,
   kWeights = 3,
-  kRejected = 4,
-  kReadmitted = 5,
-  kKeptValues = 6,
-  kKeptStart = 7,
-  kCandidatePoses = 8,
-  kCandidateVotes = 9,
-  kPcmValues = 10,
-  kPcmDropped = 11,
-  kStartPoses = 12,
-  kStartVotes = 13,
   /// The weights at a weighted solve's trial point, sent beside its sums
   /// (RobustOptions::weights_ride_trial_sums); read as the step's weight exchange when the
-  /// trial is accepted.
-  kTrialWeights = 14
+  /// trial is accepted. Below the exchanges that may follow it in the same step (the rejected
+  /// set's, the kept set's start after an early end), whose messages must wait, not be dropped.
+  kTrialWeights = 4,
+  kRejected = 5,
+  kReadmitted = 6,
+  kKeptValues = 7,
+  kKeptStart = 8,
+  kCandidatePoses = 9,
+  kCandidateVotes = 10,
+  kPcmValues = 11,
+  kPcmDropped = 12,
+  kStartPoses = 13,
+  kStartVotes = 14
 };
 inline std::uint32_t gnc_phase(std::uint32_t step, GncExchange e) {
   return step * kGncStepStride + kGncExchangeBase + static_cast<std::uint32_t>(e);
