@@ -136,5 +136,29 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
 }
 
+// RobustOptions::first_solve_takes_start_poses: the start vote's exchange of both starts' poses
+// is also the first solve's opening exchange; the run is the same, one message step shorter.
+TEST(GncExchangeSteps, TheFirstSolveTakesTheStartVotesPosesAndTheRunIsOneStepShorter) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  auto run = [&](bool take) {
+    GncDistributedOptions o;
+    o.robust.kind = RobustKind::kGncTls;
+    o.solver.certify = true;
+    o.robust.first_solve_takes_start_poses = take;
+    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  };
+  const GncDistributedResult apart = run(false);
+  const GncDistributedResult taken = run(true);
+  ASSERT_TRUE(apart.final_solve.certified.value_or(false));
+  EXPECT_EQ(taken.rejected, apart.rejected);
+  EXPECT_EQ(taken.outer_iterations, apart.outer_iterations);
+  EXPECT_EQ(taken.total_rounds, apart.total_rounds);
+  EXPECT_EQ(taken.refine_message_steps, apart.refine_message_steps);
+  EXPECT_EQ(taken.final_solve.cost, apart.final_solve.cost);
+  EXPECT_EQ(taken.final_solve.X, apart.final_solve.X);  // the same iterate, to the bit
+  EXPECT_EQ(apart.exchange_steps - taken.exchange_steps, 1);
+  EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - taken.longest_chain), 1);
+}
+
 }  // namespace
 }  // namespace tessera

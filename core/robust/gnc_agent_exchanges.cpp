@@ -46,8 +46,11 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   exchange_->begin();
   // A gather at agent 0 (the consistency check's values, the kept set's start) waits twice: for
   // the values, then for agent 0's answer.
-  // The poses sent beside a weighted solve's trial sums are no step of their own.
-  const bool early = step == Step::kPoses && stage_->poses_sent_early();
+  // The poses sent beside a weighted solve's trial sums are no step of their own; the start
+  // vote's is the first solve's opening exchange, counted with its solve stage
+  // (RobustOptions::first_solve_takes_start_poses).
+  const bool early = (step == Step::kPoses && stage_->poses_sent_early()) ||
+                     (step == Step::kStartPoses && options_.robust.first_solve_takes_start_poses);
   exchange_steps_ += step == Step::kPcm || (step == Step::kKeptStart && !values_held_) ? 2
                      : early                                                           ? 0
                                                                                        : 1;

@@ -34,8 +34,16 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   // after a pose exchange of its start (every agent's steps are the same): its rounds would
   // open with that exchange again and stop at their first status, so it starts at the
   // refinement with the exchange's poses (the same bits).
+  // The first solve right after the start vote's pose exchange
+  // (RobustOptions::first_solve_takes_start_poses): its rounds take those poses instead of an
+  // opening exchange of the same.
+  const bool first = stage_->kind() == GncSolveKind::kGnc && g_ == first_solve_g_;
   if (neighbours_known && stage_->may_start_at_refinement())
     pass_on(stage_->start_at_refinement(
+                exchange_->neighbours_at(stage_->state().problem().neighbors())),
+            out);
+  else if (neighbours_known && first)
+    pass_on(stage_->solve().start_with_neighbours(
                 exchange_->neighbours_at(stage_->state().problem().neighbors())),
             out);
   else

@@ -332,6 +332,14 @@ struct RobustOptions {
   /// and CSAIL cell of the benchmark the same `--out` bytes and rejected set (docs/robust.md,
   /// "Weights beside the trial's sums").
   bool weights_ride_trial_sums = true;
+  /// Distributed solvers only, with the start vote (GncAgentInput::Y0_known): its exchange of
+  /// both starts' public poses is also the first solve's opening pose exchange. Every agent
+  /// holds its neighbours' poses of the start the vote takes, so the first solve's rounds begin
+  /// at their round-0 status with them (CertifiedAgent::start_with_neighbours), the same
+  /// iterates. On (default); off: the first solve opens with its own pose exchange. Why: one
+  /// message step a run (F = 0.25 random, 5 agents: intel 123 -> 122, CSAIL 59 -> 58); every
+  /// intel and CSAIL cell of the benchmark the same `--out` bytes and rejected set.
+  bool first_solve_takes_start_poses = true;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
