@@ -19,7 +19,9 @@
 //               leave the weighted solve, so every agent must know the block adjacency), and
 //               its weight spread sum w (1 - w) (the stop vote)
 //     solve k (weighted, warm-started)
-//     poses  -> neighbours (when another step follows)
+//     poses  -> neighbours (when another step follows; where solve k is a single Newton step
+//               they, and the next weights computed at its trial point, travel beside the
+//               trial's sums: RobustOptions::exchanges_ride_along, weights_ride_trial_sums)
 //   rejected -> every agent: the measurements it owns with weight < 0.5
 //   [with GncAgentInput::kept_set_start: kept values -> agent 0, which initializes the kept
 //    set and sends each agent its block; poses of the iterate and of that start, then a vote

@@ -328,9 +328,9 @@ struct RobustOptions {
   /// does not hold (it left the solve's layout) has no known pose at the trial point: it stays
   /// at weight 0 and out of the early end's count until the inlier passes judge it at the kept
   /// set's solution. On (default); off: the weight exchange of its own. Why: one message step
-  /// an outer step (F = 0.25 random, 5 agents: intel 136 -> 123, CSAIL 63 -> 59), every intel
-  /// and CSAIL cell of the benchmark the same `--out` bytes and rejected set (docs/robust.md,
-  /// "Weights beside the trial's sums").
+  /// an outer step (F = 0.25 random, 5 agents: 13 fewer on intel, 4 on CSAIL; 122 and 58 at the
+  /// defaults), every intel and CSAIL cell of the benchmark the same `--out` bytes and rejected
+  /// set (docs/robust.md, "Weights beside the trial's sums").
   bool weights_ride_trial_sums = true;
   /// Distributed solvers only, with the start vote (GncAgentInput::Y0_known): its exchange of
   /// both starts' public poses is also the first solve's opening pose exchange. Every agent
