@@ -160,5 +160,31 @@ TEST(GncExchangeSteps, TheFirstSolveTakesTheStartVotesPosesAndTheRunIsOneStepSho
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - taken.longest_chain), 1);
 }
 
+// RobustOptions::pass_poses_ride_trial_sums: a refined inlier pass's trial poses go out beside
+// each trial's sums; the pose exchange after the pass reads the last accepted trial's. The run is
+// the same, one message step shorter per such pass.
+TEST(GncExchangeSteps, APassReadsItsLastAcceptedTrialsPosesAndTheRunIsShorter) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  auto run = [&](bool beside) {
+    GncDistributedOptions o;  // refined passes: Newton steps
+    o.robust.kind = RobustKind::kGncTls;
+    o.solver.certify = true;
+    o.robust.pass_poses_ride_trial_sums = beside;
+    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  };
+  const GncDistributedResult apart = run(false);
+  const GncDistributedResult beside = run(true);
+  ASSERT_TRUE(apart.final_solve.certified.value_or(false));
+  EXPECT_EQ(beside.rejected, apart.rejected);
+  EXPECT_EQ(beside.readmitted, apart.readmitted);
+  EXPECT_EQ(beside.total_rounds, apart.total_rounds);
+  EXPECT_EQ(beside.refine_message_steps, apart.refine_message_steps);
+  EXPECT_EQ(beside.final_solve.cost, apart.final_solve.cost);
+  EXPECT_EQ(beside.final_solve.X, apart.final_solve.X);  // the same iterate, to the bit
+  const int saved = apart.exchange_steps - beside.exchange_steps;
+  EXPECT_GE(saved, 1);  // at least the pass after GNC
+  EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
+}
+
 }  // namespace
 }  // namespace tessera

@@ -31,6 +31,23 @@ std::vector<int> as_ints(const std::vector<std::uint32_t>& ids) {
 }  // namespace
 
 void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
+  if (step == Step::kPoses && pass_trials_sent_ > 0) {
+    // An inlier pass's trial poses came beside their sums: the last accepted one's are the
+    // pass's point (RobustOptions::pass_poses_ride_trial_sums); the others are of no use.
+    const std::uint32_t phase = gnc_phase(g_, GncExchange::kPassTrialPoses);
+    const std::uint32_t take = stage_->last_accepted_trial();
+    for (std::uint32_t t = 1; t <= pass_trials_sent_; ++t)
+      if (t != take) mail_->discard(phase, t);
+    pass_trials_sent_ = 0;
+    if (take > 0) {
+      step_ = step;
+      exchange_->begin();
+      exchange_->expect_poses(stage_->iterate().rows(), false);
+      mail_->begin_trial_exchange(phase, take, base_->adjacent[static_cast<std::size_t>(in_.id)]);
+      take_exchange(out);
+      return;
+    }
+  }
   if (step == Step::kWeights && trial_weights_sent_) {
     trial_weights_sent_ = false;
     if (stage_->poses_sent_early() && !stage_->poses_early_stale()) {

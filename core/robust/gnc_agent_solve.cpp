@@ -26,7 +26,13 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   neighbours_current_ = false;
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
   const bool weighted = stage_->kind() == GncSolveKind::kGnc && g_ > first_solve_g_;
-  stage_->open(weighted, passes_->capped(), send_poses_with_trial(), weights_, rejected_);
+  // Trial poses beside the sums: a weighted solve's one (the next weight update's), or every
+  // trial of an inlier pass (RobustOptions::pass_poses_ride_trial_sums).
+  const bool trial_poses = stage_->kind() == GncSolveKind::kInlierPass
+                               ? options_.robust.pass_poses_ride_trial_sums
+                               : weighted && send_poses_with_trial();
+  pass_trials_sent_ = 0;
+  stage_->open(weighted, passes_->capped(), trial_poses, weights_, rejected_);
   if (neighbours_known && stage_->kind() == GncSolveKind::kFinal &&
       !std::isnan(final_start_grad_norm_))
     stage_->know_start(final_start_grad_norm_);
@@ -74,6 +80,12 @@ void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out, std::vector<Outgo
   // Beside the trial's sums, which every agent waits for anyway: this step's pose exchange, and
   // the weight update at the trial point.
   if (const Eigen::MatrixXd* trial = stage_->take_trial()) {
+    if (stage_->kind() == GncSolveKind::kInlierPass) {  // every trial, numbered
+      pass_trials_sent_ = stage_->trials_taken();
+      exchange_->publish(*trial, BlockKind::kY, gnc_phase(g_, GncExchange::kPassTrialPoses), out,
+                         pass_trials_sent_);
+      return;
+    }
     exchange_->publish(*trial, BlockKind::kY, gnc_phase(g_, GncExchange::kPoses), out);
     if (options_.robust.weights_ride_trial_sums && (!gather_values_early() || values_held_))
       send_trial_weights(*trial, out);

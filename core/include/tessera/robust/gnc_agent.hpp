@@ -81,15 +81,19 @@ enum class GncExchange : std::uint32_t {
   /// set's, the kept set's start after an early end), whose messages must wait, not be dropped.
   kTrialWeights = 4,
   kRejected = 5,
-  kReadmitted = 6,
-  kKeptValues = 7,
-  kKeptStart = 8,
-  kCandidatePoses = 9,
-  kCandidateVotes = 10,
-  kPcmValues = 11,
-  kPcmDropped = 12,
-  kStartPoses = 13,
-  kStartVotes = 14
+  /// An inlier pass's trial points' poses, sent beside each trial's sums (the wire's round is
+  /// the trial's number, from 1; RobustOptions::pass_poses_ride_trial_sums): the pass's pose
+  /// exchange reads the last accepted one's. Below the verdict that follows it.
+  kPassTrialPoses = 6,
+  kReadmitted = 7,
+  kKeptValues = 8,
+  kKeptStart = 9,
+  kCandidatePoses = 10,
+  kCandidateVotes = 11,
+  kPcmValues = 12,
+  kPcmDropped = 13,
+  kStartPoses = 14,
+  kStartVotes = 15
 };
 inline std::uint32_t gnc_phase(std::uint32_t step, GncExchange e) {
   return step * kGncStepStride + kGncExchangeBase + static_cast<std::uint32_t>(e);
@@ -321,6 +325,8 @@ class GncAgent : public AgentProcess {
   std::vector<std::uint64_t> trial_zero_cut_;
   std::pair<double, double> trial_vote_{0.0, 0.0};
   double trial_near_ = 0.0;
+  // The running inlier pass's trial points whose poses went out (pass_poses_ride_trial_sums).
+  std::uint32_t pass_trials_sent_ = 0;
   // Agent 0 holds every measurement's value (sent beside the first weights, with
   // RobustOptions::exchanges_ride_along and the kept set's fresh start): a fresh start then
   // waits only for agent 0's answer, not for the values first. The same on every agent.

@@ -340,6 +340,14 @@ struct RobustOptions {
   /// message step a run (F = 0.25 random, 5 agents: intel 123 -> 122, CSAIL 59 -> 58); every
   /// intel and CSAIL cell of the benchmark the same `--out` bytes and rejected set.
   bool first_solve_takes_start_poses = true;
+  /// Distributed solvers only: an inlier pass that runs Newton steps sends each trial point's
+  /// public poses to the neighbours beside the trial's sums (tagged with the trial's number);
+  /// the pose exchange after the pass then reads those of the last accepted trial, which is the
+  /// pass's point to the bit, instead of waiting for an exchange of its own. Without an accepted
+  /// trial the exchange runs as before. On (default); off: the exchange of its own. Why: one
+  /// message step per refined pass (F = 0.25 random, 5 agents: intel 122 -> 121, CSAIL
+  /// 58 -> 57), the same `--out` bytes and rejected sets.
+  bool pass_poses_ride_trial_sums = true;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
