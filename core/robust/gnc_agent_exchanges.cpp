@@ -213,13 +213,7 @@ void GncAgent::send_trial_weights(const Eigen::MatrixXd& Y, std::vector<Outgoing
     out_of_reach[k] = true;
   }
   trial_weights_ = weights_;
-  int crossed = 0;
-  for (std::size_t k : terms_->owned())
-    if (terms_->may_reject(k) && !out_of_reach[k]) {
-      const double wk = tls_weight(terms_->residual_squared(k, Y, N), terms_->c2(), outer_->mu());
-      if ((wk >= 0.5) != (weights_[k] >= 0.5)) ++crossed;
-      trial_weights_[k] = wk;
-    }
+  const int crossed = weights_at(outer_->mu(), Y, N, out_of_reach, trial_weights_);
   const double spread = weight_spread(*terms_, trial_weights_);
   const int near = options_.robust.jump_band > 0
                        ? near_bound_count(*terms_, out_of_reach, Y, N, options_.robust.jump_band,

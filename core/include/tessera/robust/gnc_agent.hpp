@@ -277,6 +277,10 @@ class GncAgent : public AgentProcess {
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
   int weights_at_mu(double mu);  // the count of owned weights that crossed 1/2
+  // The same at the iterate `Y` with its neighbours' poses (the exchange book's columns) into `w`,
+  // leaving the measurements flagged in `skip` as they are.
+  int weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours,
+                 const std::vector<bool>& skip, std::vector<double>& w) const;
   // The weight update at the trial point `Y` the solve just handed out, sent beside its sums
   // (RobustOptions::weights_ride_trial_sums); kept aside until the solve's verdict.
   void send_trial_weights(const Eigen::MatrixXd& Y, std::vector<OutgoingMessage>& out);
