@@ -46,6 +46,7 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
     o.robust.kind = RobustKind::kGncTls;
     o.solver.certify = true;
     o.robust.exchanges_ride_along = ride_along;
+    o.robust.weights_ride_trial_sums = false;  // its own test below
     o.weight_observer = [&](int agent, int outer, const std::vector<std::uint64_t>& index,
                             const std::vector<double>& w) {
       seen.emplace_back(agent, outer, index, w);
@@ -86,6 +87,103 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   };
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - along.longest_chain),
             steps(apart) - steps(along));
+}
+
+// RobustOptions::weights_ride_trial_sums: each weight update after a weighted solve by a single
+// Newton step is computed at the trial point and travels beside the trial's sums; the trial
+// accepted, the weight exchange after the solve waits for nothing. The same weights, set and
+// cost; one message step fewer per such update, each a real wait (the longest chain).
+TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  using Weights = std::tuple<int, int, std::vector<std::uint64_t>, std::vector<double>>;
+  auto run = [&](bool beside, std::vector<Weights>& seen) {
+    GncDistributedOptions o;  // --refine auto, refined passes: Newton steps in GNC
+    o.robust.kind = RobustKind::kGncTls;
+    o.solver.certify = true;
+    o.robust.weights_ride_trial_sums = beside;
+    o.weight_observer = [&](int agent, int outer, const std::vector<std::uint64_t>& index,
+                            const std::vector<double>& w) {
+      seen.emplace_back(agent, outer, index, w);
+    };
+    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  };
+  std::vector<Weights> seen_apart, seen_beside;
+  const GncDistributedResult apart = run(false, seen_apart);
+  const GncDistributedResult beside = run(true, seen_beside);
+  ASSERT_GT(apart.refine_message_steps, 0) << "GNC's weighted solves should be Newton steps";
+  ASSERT_GT(apart.outer_iterations, 3);
+  EXPECT_EQ(beside.rejected, dirty.outliers);
+  EXPECT_EQ(beside.rejected, apart.rejected);
+  EXPECT_EQ(beside.outer_iterations, apart.outer_iterations);
+  EXPECT_EQ(beside.total_rounds, apart.total_rounds);
+  EXPECT_EQ(beside.refine_message_steps, apart.refine_message_steps);
+  std::sort(seen_apart.begin(), seen_apart.end());
+  std::sort(seen_beside.begin(), seen_beside.end());
+  EXPECT_EQ(seen_beside, seen_apart);  // every agent's weights after every outer step, to the bit
+  EXPECT_EQ(beside.final_solve.cost, apart.final_solve.cost);
+  EXPECT_TRUE(beside.final_solve.certified.value_or(false));
+  // Every update after a weighted solve (all but the first, after the plain solve's rounds)
+  // whose trial was accepted: at least one, at most one per such update.
+  const int saved = apart.exchange_steps - beside.exchange_steps;
+  EXPECT_GE(saved, 1);
+  EXPECT_LE(saved, apart.outer_iterations - 1);
+  EXPECT_EQ(beside.solve_stages, apart.solve_stages);
+  auto steps = [](const GncDistributedResult& r) {
+    return 2 * r.total_rounds + 2 * (r.solve_stages + r.final_solve_stages) +
+           r.refine_message_steps + r.final_refine_message_steps + r.exchange_steps;
+  };
+  EXPECT_EQ(steps(apart) - steps(beside), saved);
+  EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
+}
+
+// RobustOptions::first_solve_takes_start_poses: the start vote's exchange of both starts' poses
+// is also the first solve's opening exchange; the run is the same, one message step shorter.
+TEST(GncExchangeSteps, TheFirstSolveTakesTheStartVotesPosesAndTheRunIsOneStepShorter) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  auto run = [&](bool take) {
+    GncDistributedOptions o;
+    o.robust.kind = RobustKind::kGncTls;
+    o.solver.certify = true;
+    o.robust.first_solve_takes_start_poses = take;
+    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  };
+  const GncDistributedResult apart = run(false);
+  const GncDistributedResult taken = run(true);
+  ASSERT_TRUE(apart.final_solve.certified.value_or(false));
+  EXPECT_EQ(taken.rejected, apart.rejected);
+  EXPECT_EQ(taken.outer_iterations, apart.outer_iterations);
+  EXPECT_EQ(taken.total_rounds, apart.total_rounds);
+  EXPECT_EQ(taken.refine_message_steps, apart.refine_message_steps);
+  EXPECT_EQ(taken.final_solve.cost, apart.final_solve.cost);
+  EXPECT_EQ(taken.final_solve.X, apart.final_solve.X);  // the same iterate, to the bit
+  EXPECT_EQ(apart.exchange_steps - taken.exchange_steps, 1);
+  EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - taken.longest_chain), 1);
+}
+
+// RobustOptions::pass_poses_ride_trial_sums: a refined inlier pass's trial poses go out beside
+// each trial's sums; the pose exchange after the pass reads the last accepted trial's. The run is
+// the same, one message step shorter per such pass.
+TEST(GncExchangeSteps, APassReadsItsLastAcceptedTrialsPosesAndTheRunIsShorter) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  auto run = [&](bool beside) {
+    GncDistributedOptions o;  // refined passes: Newton steps
+    o.robust.kind = RobustKind::kGncTls;
+    o.solver.certify = true;
+    o.robust.pass_poses_ride_trial_sums = beside;
+    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  };
+  const GncDistributedResult apart = run(false);
+  const GncDistributedResult beside = run(true);
+  ASSERT_TRUE(apart.final_solve.certified.value_or(false));
+  EXPECT_EQ(beside.rejected, apart.rejected);
+  EXPECT_EQ(beside.readmitted, apart.readmitted);
+  EXPECT_EQ(beside.total_rounds, apart.total_rounds);
+  EXPECT_EQ(beside.refine_message_steps, apart.refine_message_steps);
+  EXPECT_EQ(beside.final_solve.cost, apart.final_solve.cost);
+  EXPECT_EQ(beside.final_solve.X, apart.final_solve.X);  // the same iterate, to the bit
+  const int saved = apart.exchange_steps - beside.exchange_steps;
+  EXPECT_GE(saved, 1);  // at least the pass after GNC
+  EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
 }
 
 }  // namespace

@@ -49,6 +49,50 @@ TEST(GncMailbox, AnExchangeIsReadInAgentIdOrderOnceEverySendersMessageIsIn) {
   EXPECT_FALSE(mail.take_exchange().has_value());  // read once
 }
 
+// RobustOptions::weights_ride_trial_sums: the trial's weights are read as the step's weight
+// exchange after the solve. Agent 0, done with it first, may end GNC early and send the kept
+// set's fresh start in the same step: that message waits for this agent, it is not dropped as
+// one of a step left behind.
+TEST(GncMailbox, TheKeptStartAfterTheTrialsWeightsWaitsForThisAgent) {
+  GncMailbox mail(1);
+  const std::uint32_t weights = gnc_phase(4, GncExchange::kTrialWeights);
+  const std::uint32_t kept = gnc_phase(4, GncExchange::kKeptStart);
+  const std::uint32_t rejected = gnc_phase(4, GncExchange::kRejected);
+  EXPECT_LT(weights, rejected);
+  mail.begin_exchange(weights, {0, 2});
+  EXPECT_FALSE(mail.add(block(0, 0, weights)));
+  EXPECT_FALSE(mail.add(block(0, 0, kept)));  // agent 0 is a step ahead
+  EXPECT_FALSE(mail.take_exchange().has_value());
+  EXPECT_FALSE(mail.add(block(2, 0, weights)));
+  ASSERT_TRUE(mail.take_exchange().has_value());
+  mail.begin_exchange(kept, {0});
+  const std::optional<std::vector<ProtocolMessage>> ready = mail.take_exchange();
+  ASSERT_TRUE(ready.has_value());  // it was kept
+  EXPECT_EQ(message_phase(ready->front()), kept);
+}
+
+// RobustOptions::pass_poses_ride_trial_sums: an inlier pass's trial poses carry their trial's
+// number in the wire's round; the pass's pose exchange takes the one trial it names, and a
+// runtime waiting by (round, phase) is told that round.
+TEST(GncMailbox, APassesPoseExchangeTakesTheTrialItNames) {
+  GncMailbox mail(1);
+  const std::uint32_t trials = gnc_phase(6, GncExchange::kPassTrialPoses);
+  EXPECT_LT(trials, gnc_phase(6, GncExchange::kReadmitted));
+  EXPECT_FALSE(mail.add(block(0, 1, trials)));  // trial 1 and 2 from agent 0, before the exchange
+  EXPECT_FALSE(mail.add(block(0, 2, trials)));
+  mail.discard(trials, 1);
+  mail.begin_trial_exchange(trials, 2, {0, 2});
+  EXPECT_FALSE(mail.take_exchange().has_value());
+  EXPECT_EQ(mail.awaited().round, 2u);
+  EXPECT_EQ(mail.awaited().senders, (std::vector<std::uint32_t>{2}));
+  EXPECT_FALSE(mail.add(block(2, 2, trials)));
+  const std::optional<std::vector<ProtocolMessage>> ready = mail.take_exchange();
+  ASSERT_TRUE(ready.has_value());
+  ASSERT_EQ(ready->size(), 2u);
+  EXPECT_EQ(message_round(ready->front()), 2u);
+  EXPECT_EQ(message_round(ready->back()), 2u);
+}
+
 TEST(GncMailbox, AFasterAgentsLaterStepsWaitAndAStepLeftBehindIsDropped) {
   GncMailbox mail(0);
   const std::uint32_t poses = gnc_phase(1, GncExchange::kPoses);

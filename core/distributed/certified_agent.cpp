@@ -101,6 +101,15 @@ std::vector<OutgoingMessage> CertifiedAgent::start() {
   return out;
 }
 
+std::vector<OutgoingMessage> CertifiedAgent::start_with_neighbours(
+    const Eigen::MatrixXd& neighbours) {
+  start_neighbours_ = neighbours;
+  std::vector<OutgoingMessage> out;
+  begin(0, out);
+  advance(out);
+  return out;
+}
+
 bool CertifiedAgent::can_start_at_refinement() const {
   // Such rounds stop at their round-0 status ("grad_norm") and refine_wanted() holds there. A
   // certificate follows the refinement as it follows the rounds.
@@ -189,7 +198,12 @@ void CertifiedAgent::begin(std::uint32_t stage, std::vector<OutgoingMessage>& ou
       current_ = escape_.get();
       break;
   }
-  emit(current_->start(), out);
+  if (solve_ && current_ == solve_.get() && start_neighbours_.size() > 0) {
+    emit(solve_->start_with_neighbours(start_neighbours_), out);
+    start_neighbours_.resize(0, 0);
+  } else {
+    emit(current_->start(), out);
+  }
   // Messages of this stage that arrived while we were still in an earlier one.
   for (const ProtocolMessage& m : kept_.take_steps(tag_phase(stage, 0), tag_phase(stage + 1, 0))) {
     if (current_->done()) break;

@@ -56,7 +56,9 @@ void NewtonRefineProtocol::send_trial_sums(std::vector<OutgoingMessage>& out) {
     // The block finish() would leave: the trial point on the rows in use, zero elsewhere.
     Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(state_.Y.rows(), state_.Y.cols());
     Y(rows_, Eigen::all) = Xt_;
-    trial_observer_(Y);
+    Eigen::MatrixXd Yn = Eigen::MatrixXd::Zero(state_.Y.rows(), Xtn_.cols());
+    if (Xtn_.cols() > 0) Yn(rows_, Eigen::all) = Xtn_;
+    trial_observer_(Y, Yn);
   }
   trial_coarse_g_ = ship_trial_coarse_gradient();
   if (trial_coarse_g_) {

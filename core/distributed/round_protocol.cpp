@@ -67,6 +67,20 @@ std::vector<OutgoingMessage> RoundProtocol::start() {
   return out;
 }
 
+std::vector<OutgoingMessage> RoundProtocol::start_with_neighbours(
+    const Eigen::MatrixXd& neighbours) {
+  if (neighbours.rows() != state_.Yn.rows() || neighbours.cols() != state_.Yn.cols())
+    throw std::invalid_argument("RoundProtocol: the start's neighbour poses have the wrong size");
+  start_time_ = std::chrono::steady_clock::now();
+  std::vector<OutgoingMessage> out;
+  // What the opening exchange's messages would have written (ProtocolPhase::kInit).
+  state_.Yn = neighbours;
+  state_.Vn = state_.Yn;
+  begin_status(ProtocolPhase::kStatus, out);
+  pump(out);
+  return out;
+}
+
 ProtocolSnapshot RoundProtocol::snapshot() const {
   ProtocolSnapshot s;
   s.agent = state_.id();

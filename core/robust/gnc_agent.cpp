@@ -67,14 +67,17 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
 GncAgent::~GncAgent() = default;
 
 int GncAgent::weights_at_mu(double mu) {
+  return weights_at(mu, stage_->iterate(), exchange_->neighbours(), dropped_, weights_);
+}
+
+int GncAgent::weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours,
+                         const std::vector<bool>& skip, std::vector<double>& w) const {
   int crossed = 0;
   for (std::size_t k : terms_->owned())
-    if (terms_->may_reject(k) && !dropped_[k]) {
-      const double w =
-          tls_weight(terms_->residual_squared(k, stage_->iterate(), exchange_->neighbours()),
-                     terms_->c2(), mu);
-      if ((w >= 0.5) != (weights_[k] >= 0.5)) ++crossed;
-      weights_[k] = w;
+    if (terms_->may_reject(k) && !skip[k]) {
+      const double wk = tls_weight(terms_->residual_squared(k, Y, neighbours), terms_->c2(), mu);
+      if ((wk >= 0.5) != (w[k] >= 0.5)) ++crossed;
+      w[k] = wk;
     }
   return crossed;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <tessera/robust/gnc_agent.hpp>
+#include <tessera/robust/tls_weights.hpp>
 #include <utility>
 #include <vector>
 
@@ -30,14 +31,43 @@ std::vector<int> as_ints(const std::vector<std::uint32_t>& ids) {
 }  // namespace
 
 void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
+  if (step == Step::kPoses && pass_trials_sent_ > 0) {
+    // An inlier pass's trial poses came beside their sums: the last accepted one's are the
+    // pass's point (RobustOptions::pass_poses_ride_trial_sums); the others are of no use.
+    const std::uint32_t phase = gnc_phase(g_, GncExchange::kPassTrialPoses);
+    const std::uint32_t take = stage_->last_accepted_trial();
+    for (std::uint32_t t = 1; t <= pass_trials_sent_; ++t)
+      if (t != take) mail_->discard(phase, t);
+    pass_trials_sent_ = 0;
+    if (take > 0) {
+      step_ = step;
+      exchange_->begin();
+      exchange_->expect_poses(stage_->iterate().rows(), false);
+      mail_->begin_trial_exchange(phase, take, base_->adjacent[static_cast<std::size_t>(in_.id)]);
+      take_exchange(out);
+      return;
+    }
+  }
+  if (step == Step::kWeights && trial_weights_sent_) {
+    trial_weights_sent_ = false;
+    if (stage_->poses_sent_early() && !stage_->poses_early_stale()) {
+      begin_trial_weights(out);
+      return;
+    }
+    // The trial was not accepted: the weights go out at the iterate as ever.
+    mail_->discard(gnc_phase(g_, GncExchange::kTrialWeights));
+  }
   step_ = step;
   const std::uint32_t phase = gnc_phase(g_, exchange());
   const auto me = static_cast<std::uint32_t>(in_.id);
   exchange_->begin();
   // A gather at agent 0 (the consistency check's values, the kept set's start) waits twice: for
   // the values, then for agent 0's answer.
-  // The poses sent beside a weighted solve's trial sums are no step of their own.
-  const bool early = step == Step::kPoses && stage_->poses_sent_early();
+  // The poses sent beside a weighted solve's trial sums are no step of their own; the start
+  // vote's is the first solve's opening exchange, counted with its solve stage
+  // (RobustOptions::first_solve_takes_start_poses).
+  const bool early = (step == Step::kPoses && stage_->poses_sent_early()) ||
+                     (step == Step::kStartPoses && options_.robust.first_solve_takes_start_poses);
   exchange_steps_ += step == Step::kPcm || (step == Step::kKeptStart && !values_held_) ? 2
                      : early                                                           ? 0
                                                                                        : 1;
@@ -152,6 +182,71 @@ void GncAgent::send_status(std::uint32_t phase, std::vector<OutgoingMessage>& ou
       throw std::logic_error("GncAgent: no status exchange at this step");
   }
   broadcast_status(std::move(st), static_cast<std::uint32_t>(in_.id), phase, in_.num_agents, out);
+}
+
+void GncAgent::send_trial_weights(const Eigen::MatrixXd& Y, std::vector<OutgoingMessage>& out) {
+  // The neighbours' poses at the trial point, in the exchange book's columns (the base layout's):
+  // the solve's neighbours are known there (their translations solved as this agent's). The
+  // other end of a cut measurement of weight 0 may be no neighbour of the solve's layout: its
+  // weight stays 0 and it is not near the bound (RobustOptions::weights_ride_trial_sums).
+  const std::vector<std::size_t>& nb = terms_->neighbours();
+  const std::vector<std::size_t>& solve_nb = stage_->state().problem().neighbors();
+  const Eigen::MatrixXd& Yn = stage_->trial_neighbours();
+  const Eigen::Index w = in_.d + 1;
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(Y.rows(), w * static_cast<Eigen::Index>(nb.size()));
+  std::vector<bool> held(in_.num_poses, false);
+  for (std::size_t j = 0; j < solve_nb.size(); ++j) {
+    const auto c = std::lower_bound(nb.begin(), nb.end(), solve_nb[j]) - nb.begin();
+    if (c == static_cast<std::ptrdiff_t>(nb.size()) ||
+        nb[static_cast<std::size_t>(c)] != solve_nb[j])
+      continue;
+    N.middleCols(w * c, w) = Yn.middleCols(w * static_cast<Eigen::Index>(j), w);
+    held[solve_nb[j]] = true;
+  }
+  std::vector<bool> out_of_reach = dropped_;
+  for (std::size_t k : terms_->owned()) {
+    const Measurement& m = in_.measurements[k];
+    const std::size_t other = in_.owner[m.i] == in_.id ? m.j : m.i;
+    if (in_.owner[other] == in_.id || held[other]) continue;
+    if (terms_->may_reject(k) && weights_[k] != 0)
+      throw std::logic_error("GncAgent: a weighted measurement's other end is off the solve");
+    out_of_reach[k] = true;
+  }
+  trial_weights_ = weights_;
+  const int crossed = weights_at(outer_->mu(), Y, N, out_of_reach, trial_weights_);
+  const double spread = weight_spread(*terms_, trial_weights_);
+  const int near = options_.robust.jump_band > 0
+                       ? near_bound_count(*terms_, out_of_reach, Y, N, options_.robust.jump_band,
+                                          options_.robust.jump_band_inside)
+                       : 1;
+  trial_vote_ = {spread, crossed};
+  trial_near_ = near;
+  trial_zero_cut_ =
+      zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, trial_weights_);
+  const auto me = static_cast<std::uint32_t>(in_.id);
+  for (std::uint32_t a : other_agents(me, in_.num_agents)) {
+    RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, trial_weights_,
+                                            options_.robust.exchanges_ride_along);
+    st.phase = gnc_phase(g_, GncExchange::kTrialWeights);
+    st.sender = me;
+    out.push_back(OutgoingMessage{std::move(st), false, {a}});
+  }
+  trial_weights_sent_ = true;
+}
+
+void GncAgent::begin_trial_weights(std::vector<OutgoingMessage>& out) {
+  // The accepted trial point is the iterate, to the bit: its weight update is this step's, sent
+  // already; the others' came beside the trial's sums (no step of its own).
+  step_ = Step::kWeights;
+  exchange_->begin();
+  low_weights_.clear();
+  weights_ = std::move(trial_weights_);
+  zero_cut_ = std::move(trial_zero_cut_);
+  exchange_->own_vote() = trial_vote_;
+  exchange_->own_near_bound() = trial_near_;
+  mail_->begin_exchange(gnc_phase(g_, GncExchange::kTrialWeights),
+                        as_ints(other_agents(static_cast<std::uint32_t>(in_.id), in_.num_agents)));
+  take_exchange(out);
 }
 
 bool GncAgent::send_weights(std::uint32_t phase, std::vector<OutgoingMessage>& out) {

@@ -76,8 +76,15 @@ void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
 
 void GncAgent::after_start_votes(std::vector<OutgoingMessage>& out) {
   const auto [at_start, at_known] = exchange_->summed_votes();
-  if (at_known < at_start) stage_->set_start(std::move(in_.Y0_known));
+  const bool known = at_known < at_start;
+  if (known) stage_->set_start(std::move(in_.Y0_known));
   in_.Y0_known.resize(0, 0);
+  // RobustOptions::first_solve_takes_start_poses: the winner's neighbour poses came with the
+  // vote's pose exchange (the same on every agent: the option and the summed votes).
+  if (options_.robust.first_solve_takes_start_poses) {
+    if (known) exchange_->adopt_candidate_neighbours();
+    neighbours_current_ = true;
+  }
   exchange_->forget_candidate_neighbours();
   after_step_zero(out);
 }

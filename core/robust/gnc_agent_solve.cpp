@@ -21,11 +21,18 @@ namespace tessera {
 
 void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   step_ = Step::kSolve;
+  trial_weights_sent_ = false;
   const bool neighbours_known = neighbours_current_;
   neighbours_current_ = false;
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
   const bool weighted = stage_->kind() == GncSolveKind::kGnc && g_ > first_solve_g_;
-  stage_->open(weighted, passes_->capped(), send_poses_with_trial(), weights_, rejected_);
+  // Trial poses beside the sums: a weighted solve's one (the next weight update's), or every
+  // trial of an inlier pass (RobustOptions::pass_poses_ride_trial_sums).
+  const bool trial_poses = stage_->kind() == GncSolveKind::kInlierPass
+                               ? options_.robust.pass_poses_ride_trial_sums
+                               : weighted && send_poses_with_trial();
+  pass_trials_sent_ = 0;
+  stage_->open(weighted, passes_->capped(), trial_poses, weights_, rejected_);
   if (neighbours_known && stage_->kind() == GncSolveKind::kFinal &&
       !std::isnan(final_start_grad_norm_))
     stage_->know_start(final_start_grad_norm_);
@@ -33,8 +40,16 @@ void GncAgent::begin_solve(std::vector<OutgoingMessage>& out) {
   // after a pose exchange of its start (every agent's steps are the same): its rounds would
   // open with that exchange again and stop at their first status, so it starts at the
   // refinement with the exchange's poses (the same bits).
+  // The first solve right after the start vote's pose exchange
+  // (RobustOptions::first_solve_takes_start_poses): its rounds take those poses instead of an
+  // opening exchange of the same.
+  const bool first = stage_->kind() == GncSolveKind::kGnc && g_ == first_solve_g_;
   if (neighbours_known && stage_->may_start_at_refinement())
     pass_on(stage_->start_at_refinement(
+                exchange_->neighbours_at(stage_->state().problem().neighbors())),
+            out);
+  else if (neighbours_known && first)
+    pass_on(stage_->solve().start_with_neighbours(
                 exchange_->neighbours_at(stage_->state().problem().neighbors())),
             out);
   else
@@ -62,9 +77,19 @@ void GncAgent::pass_on(std::vector<OutgoingMessage> solve_out, std::vector<Outgo
     std::visit([&](auto& x) { x.phase += g_ * kGncStepStride; }, o.message);
     out.push_back(std::move(o));
   }
-  // Beside the trial's sums, which every agent waits for anyway: this step's pose exchange.
-  if (const Eigen::MatrixXd* trial = stage_->take_trial())
+  // Beside the trial's sums, which every agent waits for anyway: this step's pose exchange, and
+  // the weight update at the trial point.
+  if (const Eigen::MatrixXd* trial = stage_->take_trial()) {
+    if (stage_->kind() == GncSolveKind::kInlierPass) {  // every trial, numbered
+      pass_trials_sent_ = stage_->trials_taken();
+      exchange_->publish(*trial, BlockKind::kY, gnc_phase(g_, GncExchange::kPassTrialPoses), out,
+                         pass_trials_sent_);
+      return;
+    }
     exchange_->publish(*trial, BlockKind::kY, gnc_phase(g_, GncExchange::kPoses), out);
+    if (options_.robust.weights_ride_trial_sums && (!gather_values_early() || values_held_))
+      send_trial_weights(*trial, out);
+  }
 }
 
 bool GncAgent::gather_values_early() const {

@@ -62,12 +62,12 @@ Eigen::MatrixXd GncExchangeBook::neighbours_at(const std::vector<std::size_t>& p
 }
 
 void GncExchangeBook::publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
-                              std::vector<OutgoingMessage>& out) const {
+                              std::vector<OutgoingMessage>& out, std::uint32_t round) const {
   const auto& adjacent = base_.adjacent[static_cast<std::size_t>(in_.id)];
   for (std::size_t q = 0; q < adjacent.size(); ++q) {
     const auto to_agent = static_cast<std::uint32_t>(adjacent[q]);
     out.push_back(OutgoingMessage{
-        encode_public_poses(base_, in_.id, q, in_.d, Y, kind, 0, phase), false, {to_agent}});
+        encode_public_poses(base_, in_.id, q, in_.d, Y, kind, round, phase), false, {to_agent}});
   }
 }
 
@@ -109,6 +109,7 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
           terms_.neighbours(), candidate_neighbours_);
       break;
     case GncExchange::kPoses:
+    case GncExchange::kPassTrialPoses:
     case GncExchange::kCandidatePoses:
     case GncExchange::kStartPoses: {
       const PoseBlockMessage& block = expect_pose_block(
@@ -125,6 +126,7 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
     case GncExchange::kStartVotes:
       votes_[sender] = read_vote(expect_status(message, in_.id, kStatusBelongs));
       break;
+    case GncExchange::kTrialWeights:  // the same message, sent beside a trial's sums
     case GncExchange::kWeights: {
       if (const auto* block = std::get_if<PoseBlockMessage>(&message)) {  // agent 0: the values
         decode_measurement_block(*block, in_.d, in_.num_poses, "robust solve", held_values_);

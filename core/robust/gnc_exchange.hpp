@@ -55,7 +55,7 @@ class GncExchangeBook {
   void expect_poses(Eigen::Index rows, bool both_starts);
   /// `Y`'s public poses to every block neighbour.
   void publish(const Eigen::MatrixXd& Y, BlockKind kind, std::uint32_t phase,
-               std::vector<OutgoingMessage>& out) const;
+               std::vector<OutgoingMessage>& out, std::uint32_t round = 0) const;
   /// Agent 0 gathers the values of the measurements the agents weigh (each measurement once;
   /// with `rejected` non-null those not in it): the others send theirs, agent 0 keeps its own
   /// and waits. Returns whom this agent waits for (the others wait for agent 0's answer).

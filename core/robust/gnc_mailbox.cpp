@@ -10,6 +10,11 @@ namespace tessera {
 namespace {
 
 // The exchanges that carry two blocks per neighbour: both starts' poses (kind Y, kind P).
+bool pass_trial(std::uint32_t phase) {
+  return phase % kGncStepStride ==
+         kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kPassTrialPoses);
+}
+
 bool two_starts(std::uint32_t phase) {
   const std::uint32_t e = phase % kGncStepStride;
   return e == kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kStartPoses) ||
@@ -23,6 +28,15 @@ std::vector<ProtocolMessage> GncMailbox::begin_solve(std::uint32_t g) {
   g_ = g;
   ready_.clear();
   return gate_.take_steps(g * kGncStepStride, g * kGncStepStride + kGncExchangeBase);
+}
+
+void GncMailbox::begin_trial_exchange(std::uint32_t phase, std::uint32_t trial,
+                                      std::vector<int> senders) {
+  waiting_ = Waiting::kExchange;
+  phase_ = phase;
+  second_part_ = false;
+  ready_.clear();
+  gate_.expect(trial, phase, std::move(senders));
 }
 
 void GncMailbox::begin_exchange(std::uint32_t phase, std::vector<int> senders, bool values_too) {
@@ -51,6 +65,7 @@ std::uint32_t GncMailbox::lowest_current_phase() const {
 std::uint32_t GncMailbox::gate_round(const ProtocolMessage& m) const {
   const std::uint32_t phase = message_phase(m);
   if (phase % kGncStepStride < kGncExchangeBase) return message_round(m);
+  if (pass_trial(phase)) return message_round(m);  // the trial's number
   const auto* block = std::get_if<PoseBlockMessage>(&m);
   if (two_starts(phase)) return block && block->kind == BlockKind::kP ? 1 : 0;
   // Measurement values beside the first weights (the wire's round stays 0: a runtime waits by
@@ -105,7 +120,9 @@ std::size_t GncMailbox::messages_needed() const {
 
 AwaitedMessages GncMailbox::awaited() const {
   const std::vector<int> missing = gate_.missing();
-  return AwaitedMessages{0, phase_, {missing.begin(), missing.end()}};
+  // The wire's round is 0 but for a pass's trial poses (their trial's number).
+  return AwaitedMessages{
+      pass_trial(phase_) ? gate_.round() : 0, phase_, {missing.begin(), missing.end()}};
 }
 
 }  // namespace tessera

@@ -28,6 +28,9 @@ class GncMailbox {
   /// `values_too` (the first GncExchange::kWeights at agent 0), a status and a block of measurement
   /// values.
   void begin_exchange(std::uint32_t phase, std::vector<int> senders, bool values_too = false);
+  /// The exchange of an inlier pass's trial poses (GncExchange::kPassTrialPoses) of trial
+  /// `trial` (the wire's round): one message from each of `senders`.
+  void begin_trial_exchange(std::uint32_t phase, std::uint32_t trial, std::vector<int> senders);
 
   /// True when `m` is the running solve's (the caller hands it over); otherwise it waits for
   /// its step, or is dropped when of a step left. Throws std::runtime_error on a message the
@@ -37,6 +40,10 @@ class GncMailbox {
   /// part in agent-id order), removed; nothing more until the next begin_*. Else nullopt.
   std::optional<std::vector<ProtocolMessage>> take_exchange();
 
+  /// Drops the messages of the exchange of `phase` that came already: one that will not be
+  /// waited for (one that comes later waits in the gate unread, and is dropped on arrival once
+  /// this agent has left its step).
+  void discard(std::uint32_t phase, std::uint32_t round = 0) { gate_.discard(round, phase); }
   /// The current exchange's missing messages (not during a solve: the solve names its own).
   std::size_t messages_needed() const;
   AwaitedMessages awaited() const;

@@ -73,12 +73,20 @@ void GncSolveStage::open(bool weighted, bool capped, bool trial_poses,
   solve_ = std::make_unique<CertifiedAgent>(*state_, *layout_, solve_options_);
   start_known_ = false;
   trial_pending_ = poses_sent_early_ = poses_early_stale_ = false;
-  if (newton_steps_ && trial_poses)
-    solve_->set_trial_observer([this](const Eigen::MatrixXd& Y) {
+  trials_taken_ = 0;
+  if (kind_ == GncSolveKind::kInlierPass && trial_poses)
+    solve_->set_trial_observer([this](const Eigen::MatrixXd& Y, const Eigen::MatrixXd&) {
+      // Every trial of the pass: which one ends it is known only after its sums.
+      trial_Y_ = Y;
+      trial_pending_ = true;
+    });
+  else if (newton_steps_ && trial_poses)
+    solve_->set_trial_observer([this](const Eigen::MatrixXd& Y, const Eigen::MatrixXd& Yn) {
       // One trial per solve (a single Newton step); after rounds the iterate the last pose
       // exchange holds is not the solve's start, so those take the exchange of their own.
       if (poses_sent_early_ || trial_pending_ || solve_->total_rounds() > 0) return;
       trial_Y_ = Y;
+      trial_Yn_ = Yn;
       trial_pending_ = true;
     });
 }
@@ -103,8 +111,21 @@ std::vector<OutgoingMessage> GncSolveStage::start_at_refinement(const Eigen::Mat
 const Eigen::MatrixXd* GncSolveStage::take_trial() {
   if (!trial_pending_) return nullptr;
   trial_pending_ = false;
-  poses_sent_early_ = true;
+  ++trials_taken_;
+  if (kind_ != GncSolveKind::kInlierPass) poses_sent_early_ = true;
   return &trial_Y_;
+}
+
+std::uint32_t GncSolveStage::last_accepted_trial() const {
+  // The refinements' trials in order, one trace record each (the same on every agent: the
+  // verdicts are on summed values); 0 when none was accepted or not every trial was handed out.
+  std::uint32_t t = 0, last = 0;
+  for (const NewtonRefineResult& r : solve_->refines())
+    for (const NewtonRefineStep& step : r.trace) {
+      ++t;
+      if (step.accepted) last = t;
+    }
+  return t == trials_taken_ ? last : 0;
 }
 
 void GncSolveStage::judge_early_poses() {

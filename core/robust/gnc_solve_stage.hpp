@@ -45,7 +45,8 @@ class GncSolveStage {
   /// Sets up the next solve of the current kind from the iterate: `weighted` (GNC's weighted
   /// solve, with the current `weights` per GncAgentInput::measurements), `capped` (an inlier pass
   /// stopped at RobustOptions::recheck_max_rounds), `trial_poses` (a single Newton step hands
-  /// out its trial point), `rejected` (the current rejected set: the passes' coarse space).
+  /// out its trial point; an inlier pass every trial point), `rejected` (the current rejected set:
+  /// the passes' coarse space).
   void open(bool weighted, bool capped, bool trial_poses, const std::vector<double>& weights,
             const std::vector<std::uint64_t>& rejected);
   /// Before the opened solve starts: its start is the iterate, where the team's last solve of
@@ -60,8 +61,17 @@ class GncSolveStage {
   /// neighbours, in that order).
   std::vector<OutgoingMessage> start() { return solve_->start(); }
   std::vector<OutgoingMessage> start_at_refinement(const Eigen::MatrixXd& neighbours);
-  /// The trial point to publish beside its sums, once (nullptr when none is pending).
+  /// The trial point to publish beside its sums, once (nullptr when none is pending). A weighted
+  /// solve hands out its one trial; an inlier pass opened with `trial_poses` every trial.
   const Eigen::MatrixXd* take_trial();
+  /// Trials handed out since the solve opened (the last one's number, from 1).
+  std::uint32_t trials_taken() const { return trials_taken_; }
+  /// After an inlier pass: the number of its last accepted trial, whose point the iterate is,
+  /// or 0 (none accepted, or not every trial handed out).
+  std::uint32_t last_accepted_trial() const;
+  /// The last trial point's neighbour poses (state().problem().neighbors() order, the trial's
+  /// rows): what a weight update at that point reads beside the own block.
+  const Eigen::MatrixXd& trial_neighbours() const { return trial_Yn_; }
   /// After the solve: whether the early poses are the iterate's (the step was accepted).
   void judge_early_poses();
   /// Adds the ended solve's rounds, stages and refinement message steps to the totals.
@@ -120,8 +130,9 @@ class GncSolveStage {
   double pass_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
   bool gnc_newton_steps_ = false;
   int weighted_solves_ = 0;
-  Eigen::MatrixXd trial_Y_;
+  Eigen::MatrixXd trial_Y_, trial_Yn_;
   bool trial_pending_ = false, poses_sent_early_ = false, poses_early_stale_ = false;
+  std::uint32_t trials_taken_ = 0;
   std::vector<Measurement> kept_;
   std::vector<std::uint64_t> kept_index_;
   Eigen::MatrixXd last_pass_start_;

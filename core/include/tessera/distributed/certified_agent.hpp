@@ -72,6 +72,11 @@ class CertifiedAgent : public AgentProcess {
   /// rounds and SolveStageRecord::opened false; its trace is the refinement's point. The
   /// certificate, where on, follows as after the rounds. Every agent of the run must start so.
   std::vector<OutgoingMessage> start_at_refinement();
+  /// Instead of start(), where every agent of the run already holds its neighbours' public
+  /// poses of the start, `neighbours` (problem().neighbors() order): the first solve stage's
+  /// rounds begin without their opening pose exchange (RoundProtocol::start_with_neighbours),
+  /// the same iterates. Every agent of the run must start so.
+  std::vector<OutgoingMessage> start_with_neighbours(const Eigen::MatrixXd& neighbours);
   /// Observer of the FIRST solve stage's consistent points (RoundProtocol::set_round_observer):
   /// snapshots of later stages would not be resumable from stage 0.
   void set_round_observer(std::function<void(const ProtocolSnapshot&)> observer) {
@@ -79,7 +84,8 @@ class CertifiedAgent : public AgentProcess {
   }
   /// Observer of the trial points of the Newton refinements this agent runs
   /// (NewtonRefineProtocol::set_trial_observer).
-  void set_trial_observer(std::function<void(const Eigen::MatrixXd&)> observer) {
+  void set_trial_observer(
+      std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> observer) {
     trial_observer_ = std::move(observer);
   }
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
@@ -169,8 +175,9 @@ class CertifiedAgent : public AgentProcess {
   std::vector<CertifyStageRecord> certificates_;
   std::vector<EscapeStageRecord> escapes_;
   std::function<void(const ProtocolSnapshot&)> observer_;
-  std::function<void(const Eigen::MatrixXd&)> trial_observer_;
-  bool known_start_ = false;  // set_known_start()
+  std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> trial_observer_;
+  bool known_start_ = false;          // set_known_start()
+  Eigen::MatrixXd start_neighbours_;  // start_with_neighbours(), until the first stage opens
   double known_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
   bool refining_ = false;        // the current rank's solve continues at refine_tolerance()
   bool interface_fits_ = false;  // the team's interface within the refinement's interface cap

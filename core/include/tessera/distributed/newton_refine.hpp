@@ -100,10 +100,12 @@ class NewtonRefineProtocol : public AgentProcess {
   const NewtonRefineResult& result() const { return result_; }
   /// Called with each trial point, its translations solved, as the trial's sums go out: the own
   /// block at the iterate's rank (rows no agent uses are zero), exactly the block the agent
-  /// holds if the trial is accepted. A caller that must exchange the accepted point's poses can
-  /// send them beside the sums instead of in a message step of its own (robust GNC's weighted
-  /// solves).
-  void set_trial_observer(std::function<void(const Eigen::MatrixXd&)> observer) {
+  /// holds if the trial is accepted, and its neighbours' public poses there (problem().neighbors()
+  /// order, the same rows), the bits each neighbour holds of its own. A caller that must exchange
+  /// the accepted point's poses, or values computed from them, can send them beside the sums
+  /// instead of in a message step of its own (robust GNC's weighted solves).
+  void set_trial_observer(
+      std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> observer) {
     trial_observer_ = std::move(observer);
   }
   /// Before start(): ||grad f|| at the start point as the team last summed it (the rounds' last
@@ -330,7 +332,7 @@ class NewtonRefineProtocol : public AgentProcess {
   std::unique_ptr<TranslationInterfaceSolve> translation_solve_;
   Eigen::MatrixXd ty_;
   NewtonRefineStep step_;
-  std::function<void(const Eigen::MatrixXd&)> trial_observer_;
+  std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> trial_observer_;
   bool done_ = false;
   NewtonRefineResult result_;
 };

@@ -86,6 +86,11 @@ class RoundProtocol : public AgentProcess {
   RoundProtocol(AgentState& state, const BlockLayout& layout, const RoundConfig& config);
 
   std::vector<OutgoingMessage> start() override;
+  /// Instead of start(), where every agent of the run already holds its neighbours' public
+  /// poses of the start (a caller's exchange of the same poses just before): `neighbours` are
+  /// they (problem().neighbors() order, the start's rows), taken as the opening exchange would
+  /// take them, and round 0's status goes out at once. Every agent of the run must start so.
+  std::vector<OutgoingMessage> start_with_neighbours(const Eigen::MatrixXd& neighbours);
   /// Consumes one message addressed to this agent. Throws std::runtime_error on a message
   /// that cannot belong to this run (bad sender, wrong shape, unexpected pose).
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;

@@ -19,7 +19,9 @@
 //               leave the weighted solve, so every agent must know the block adjacency), and
 //               its weight spread sum w (1 - w) (the stop vote)
 //     solve k (weighted, warm-started)
-//     poses  -> neighbours (when another step follows)
+//     poses  -> neighbours (when another step follows; where solve k is a single Newton step
+//               they, and the next weights computed at its trial point, travel beside the
+//               trial's sums: RobustOptions::exchanges_ride_along, weights_ride_trial_sums)
 //   rejected -> every agent: the measurements it owns with weight < 0.5
 //   [with GncAgentInput::kept_set_start: kept values -> agent 0, which initializes the kept
 //    set and sends each agent its block; poses of the iterate and of that start, then a vote
@@ -73,16 +75,25 @@ enum class GncExchange : std::uint32_t {
   kPoses = 1,
   kVotes = 2,
   kWeights = 3,
-  kRejected = 4,
-  kReadmitted = 5,
-  kKeptValues = 6,
-  kKeptStart = 7,
-  kCandidatePoses = 8,
-  kCandidateVotes = 9,
-  kPcmValues = 10,
-  kPcmDropped = 11,
-  kStartPoses = 12,
-  kStartVotes = 13
+  /// The weights at a weighted solve's trial point, sent beside its sums
+  /// (RobustOptions::weights_ride_trial_sums); read as the step's weight exchange when the
+  /// trial is accepted. Below the exchanges that may follow it in the same step (the rejected
+  /// set's, the kept set's start after an early end), whose messages must wait, not be dropped.
+  kTrialWeights = 4,
+  kRejected = 5,
+  /// An inlier pass's trial points' poses, sent beside each trial's sums (the wire's round is
+  /// the trial's number, from 1; RobustOptions::pass_poses_ride_trial_sums): the pass's pose
+  /// exchange reads the last accepted one's. Below the verdict that follows it.
+  kPassTrialPoses = 6,
+  kReadmitted = 7,
+  kKeptValues = 8,
+  kKeptStart = 9,
+  kCandidatePoses = 10,
+  kCandidateVotes = 11,
+  kPcmValues = 12,
+  kPcmDropped = 13,
+  kStartPoses = 14,
+  kStartVotes = 15
 };
 inline std::uint32_t gnc_phase(std::uint32_t step, GncExchange e) {
   return step * kGncStepStride + kGncExchangeBase + static_cast<std::uint32_t>(e);
@@ -265,7 +276,18 @@ class GncAgent : public AgentProcess {
   bool send_poses_with_trial() const;
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
-  int weights_at_mu(double mu);         // the count of owned weights that crossed 1/2
+  int weights_at_mu(double mu);  // the count of owned weights that crossed 1/2
+  // The same at the iterate `Y` with its neighbours' poses (the exchange book's columns) into `w`,
+  // leaving the measurements flagged in `skip` as they are.
+  int weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours,
+                 const std::vector<bool>& skip, std::vector<double>& w) const;
+  // The weight update at the trial point `Y` the solve just handed out, sent beside its sums
+  // (RobustOptions::weights_ride_trial_sums); kept aside until the solve's verdict.
+  void send_trial_weights(const Eigen::MatrixXd& Y, std::vector<OutgoingMessage>& out);
+  // The weight exchange after the solve reads the trial's weights (sent, and the trial accepted).
+  bool trial_weights_stand() const;
+  // The weight exchange from the trial's weights: this agent's kept aside, the others' in.
+  void begin_trial_weights(std::vector<OutgoingMessage>& out);
   void require_kept_connected() const;  // throws InputError naming the parts left
   // GNC's rejected set: from the last weight exchange where there was one, else an exchange.
   void begin_rejected(std::vector<OutgoingMessage>& out);
@@ -300,6 +322,15 @@ class GncAgent : public AgentProcess {
   // that exchange ended GNC at TLS's verdict (RobustOptions::jump_band).
   std::vector<std::pair<std::uint64_t, double>> low_weights_;
   bool jumped_ = false;
+  // The weight update at the running weighted solve's trial point (send_trial_weights): the
+  // weights, the cut ones of weight 0, the spread and crossing votes, the near-bound count.
+  bool trial_weights_sent_ = false;
+  std::vector<double> trial_weights_;
+  std::vector<std::uint64_t> trial_zero_cut_;
+  std::pair<double, double> trial_vote_{0.0, 0.0};
+  double trial_near_ = 0.0;
+  // The running inlier pass's trial points whose poses went out (pass_poses_ride_trial_sums).
+  std::uint32_t pass_trials_sent_ = 0;
   // Agent 0 holds every measurement's value (sent beside the first weights, with
   // RobustOptions::exchanges_ride_along and the kept set's fresh start): a fresh start then
   // waits only for agent 0's answer, not for the values first. The same on every agent.

@@ -319,6 +319,35 @@ struct RobustOptions {
   /// 140 -> 136, CSAIL 67 -> 63), the same `--out` bytes, rejected set and certificate
   /// (docs/robust.md, "Where the steps go now").
   bool kept_solves_start_at_refinement = true;
+  /// Distributed solvers only, with exchanges_ride_along: where a weighted solve is a single
+  /// Newton step that another weight update follows, each agent computes that update at the
+  /// trial point (its neighbours' poses there are known once the trial's translations are
+  /// solved) and sends its weights message beside the trial's sums; accepted, the trial point is
+  /// the iterate, so the weight exchange after the solve waits for nothing (not accepted, the
+  /// exchange runs as before). A cut measurement of weight 0 whose other end the weighted solve
+  /// does not hold (it left the solve's layout) has no known pose at the trial point: it stays
+  /// at weight 0 and out of the early end's count until the inlier passes judge it at the kept
+  /// set's solution. On (default); off: the weight exchange of its own. Why: one message step
+  /// an outer step (F = 0.25 random, 5 agents: 13 fewer on intel, 4 on CSAIL; 122 and 58 at the
+  /// defaults), every intel and CSAIL cell of the benchmark the same `--out` bytes and rejected
+  /// set (docs/robust.md, "Weights beside the trial's sums").
+  bool weights_ride_trial_sums = true;
+  /// Distributed solvers only, with the start vote (GncAgentInput::Y0_known): its exchange of
+  /// both starts' public poses is also the first solve's opening pose exchange. Every agent
+  /// holds its neighbours' poses of the start the vote takes, so the first solve's rounds begin
+  /// at their round-0 status with them (CertifiedAgent::start_with_neighbours), the same
+  /// iterates. On (default); off: the first solve opens with its own pose exchange. Why: one
+  /// message step a run (F = 0.25 random, 5 agents: intel 123 -> 122, CSAIL 59 -> 58); every
+  /// intel and CSAIL cell of the benchmark the same `--out` bytes and rejected set.
+  bool first_solve_takes_start_poses = true;
+  /// Distributed solvers only: an inlier pass that runs Newton steps sends each trial point's
+  /// public poses to the neighbours beside the trial's sums (tagged with the trial's number);
+  /// the pose exchange after the pass then reads those of the last accepted trial, which is the
+  /// pass's point to the bit, instead of waiting for an exchange of its own. Without an accepted
+  /// trial the exchange runs as before. On (default); off: the exchange of its own. Why: one
+  /// message step per refined pass (F = 0.25 random, 5 agents: intel 122 -> 121, CSAIL
+  /// 58 -> 57), the same `--out` bytes and rejected sets.
+  bool pass_poses_ride_trial_sums = true;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
