@@ -2,6 +2,7 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -22,24 +23,45 @@ namespace {
 // products; points far from the manifold the d x d eigen-decomposition, (nearly) rank-deficient
 // ones the SVD. Everything lives on the stack: these projections run on every pose of every
 // agent each round.
+// ||E||_F of a 3 x 3 E in the order of Eigen 3.4's vectorised E.norm() (two-lane packets of the
+// column-major entries 0-7 summed pairwise, the lanes added, then entry 8): the same value, so
+// the same branches below as with E.norm().
+inline double frobenius_norm_3(const double (&E)[3][3]) {
+  auto sq = [](double x) { return x * x; };
+  const double lane0 = (sq(E[0][0]) + sq(E[2][0])) + (sq(E[1][1]) + sq(E[0][2]));
+  const double lane1 = (sq(E[1][0]) + sq(E[0][1])) + (sq(E[2][1]) + sq(E[1][2]));
+  return std::sqrt((lane0 + lane1) + sq(E[2][2]));
+}
+
 template <int D>
 bool inv_sqrt_near_identity(const Eigen::Matrix<double, D, D>& B, Eigen::Matrix<double, D, D>& Z) {
   using Small = Eigen::Matrix<double, D, D>;
-  const Small I = Small::Identity();
-  Small E = I - B;
-  double e = E.norm();
+  // E = I - B and T = I + E/2 entry by entry, as the Eigen expressions of the Newton-Schulz
+  // start computed them (no temporaries: this runs twice per pose and round).
+  double e1[D][D];
+#pragma GCC unroll 3
+  for (int j = 0; j < D; ++j)
+#pragma GCC unroll 3
+    for (int i = 0; i < D; ++i) e1[i][j] = (i == j ? 1.0 : 0.0) - B(i, j);
+  double e = 0.0;
+  if constexpr (D == 3) {
+    e = frobenius_norm_3(e1);
+  } else {
+    Small E;
+    for (int j = 0; j < D; ++j)
+      for (int i = 0; i < D; ++i) E(i, j) = e1[i][j];
+    e = E.norm();
+  }
   if (!(e < 0.5)) return false;
-  Small T = I + 0.5 * E;
-  Z = T;
+#pragma GCC unroll 3
+  for (int j = 0; j < D; ++j)
+#pragma GCC unroll 3
+    for (int i = 0; i < D; ++i) Z(i, j) = (i == j ? 1.0 : 0.0) + 0.5 * e1[i][j];
   if (e < 1e-9) return true;
   if (e < 1e-4) {
     // E is symmetric (B is), so are its powers: their upper triangles, mirrored. Entries (i, j)
     // and (j, i) of E^2 are the same products in the same order: E^2 is symmetric to the bit.
-    double e1[D][D], e2[D][D], e3[D][D];
-#pragma GCC unroll 3
-    for (int j = 0; j < D; ++j)
-#pragma GCC unroll 3
-      for (int i = 0; i < D; ++i) e1[i][j] = E(i, j);
+    double e2[D][D], e3[D][D];
 #pragma GCC unroll 3
     for (int i = 0; i < D; ++i)
 #pragma GCC unroll 3
@@ -66,8 +88,11 @@ bool inv_sqrt_near_identity(const Eigen::Matrix<double, D, D>& B, Eigen::Matrix<
         Z(i, j) = (i == j ? 1.0 : 0.0) + (0.5 * e1[i][j] + (0.375 * e2[i][j] + 0.3125 * e3[i][j]));
     return true;
   }
-  // Newton-Schulz. The first step has Z = I: E = I - B and Z = T without the two products by I
-  // (equal to them up to the sign of exact zeros). The last step's Y update is not used: skipped.
+  // Newton-Schulz from Z = T. The first step has Z = I: E = I - B and Z = T without the two
+  // products by I (equal to them up to the sign of exact zeros). The last step's Y update is not
+  // used: skipped.
+  const Small I = Small::Identity();
+  Small T = Z, E;
   Small Y = B * T;
   for (int it = 1; it < 12; ++it) {
     E = I - Z * Y;
