@@ -197,7 +197,22 @@ void AgentState::set_point(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neig
 }
 
 Eigen::MatrixXd AgentState::active_part(const Eigen::MatrixXd& X) const {
-  if (static_cast<Eigen::Index>(rows_.size()) == X.rows()) return X;
+  const auto k = static_cast<Eigen::Index>(rows_.size());
+  if (k == X.rows()) return X;
+  if (k == 3 && rows_.back() == 2) {
+    // A 3D lifted point's active rows are its first 3 (rows_ is increasing): copied column by
+    // column, without an index per entry.
+    Eigen::MatrixXd out(3, X.cols());
+    const Eigen::Index r = X.rows();
+    const double* x = X.data();
+    double* o = out.data();
+    for (Eigen::Index j = 0; j < X.cols(); ++j, x += r, o += 3) {
+      o[0] = x[0];
+      o[1] = x[1];
+      o[2] = x[2];
+    }
+    return out;
+  }
   return X(rows_, Eigen::all);
 }
 
