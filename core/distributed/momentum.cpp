@@ -168,10 +168,16 @@ void project_pose(double* A, Eigen::Index r_runtime) {
   constexpr bool kCanSkip = R == 5 && D < R;
   const bool skip = kCanSkip && zero_tail<D, (R > 0 ? R : 1)>(A);
   Small B;
-  for (int a = 0; a < D; ++a)
-    for (int b = a; b < D; ++b)
-      B(a, b) = B(b, a) = skip ? gram_entry_zero_tail<D>(A + a * r, A + b * r)
-                               : gram_entry<R>(A + a * r, A + b * r, r);
+  // Two loops rather than one with the choice inside, so that each unrolls.
+  if (skip) {
+#pragma GCC unroll 3
+    for (int a = 0; a < D; ++a)
+#pragma GCC unroll 3
+      for (int b = a; b < D; ++b) B(a, b) = B(b, a) = gram_entry_zero_tail<D>(A + a * r, A + b * r);
+  } else {
+    for (int a = 0; a < D; ++a)
+      for (int b = a; b < D; ++b) B(a, b) = B(b, a) = gram_entry<R>(A + a * r, A + b * r, r);
+  }
   Small inv_sqrt;
   if (!inv_sqrt_near_identity<D>(B, inv_sqrt)) {
     Eigen::SelfAdjointEigenSolver<Small> es(B);
@@ -215,11 +221,14 @@ void project_pose(double* A, Eigen::Index r_runtime) {
 #endif
   for (; i < rows; ++i) {
     double row[D];
+#pragma GCC unroll 4
     for (int j = 0; j < D; ++j) {
       double s = A[i] * inv_sqrt(0, j);
+#pragma GCC unroll 4
       for (int k = 1; k < D; ++k) s += A[k * r + i] * inv_sqrt(k, j);
       row[j] = s;
     }
+#pragma GCC unroll 4
     for (int j = 0; j < D; ++j) A[j * r + i] = row[j];
   }
 }
