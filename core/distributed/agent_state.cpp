@@ -274,6 +274,17 @@ Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::Matri
       block_update(problem_, Xa, options, euclid, &updated_grad_norm_sq_, tangent, &stats);
   if (all_rows) {
     updated_X_ = std::move(Xn);
+  } else if (rows_.back() == static_cast<Eigen::Index>(rows_.size()) - 1) {
+    // The first k rows (a lifted point's): column by column, the rest +0 as Zero() gives, in
+    // one pass instead of zeroing everything and scattering through a row index.
+    const Eigen::Index k = Xn.rows(), r = X0.rows();
+    updated_X_.resize(r, X0.cols());
+    const double* x = Xn.data();
+    double* o = updated_X_.data();
+    for (Eigen::Index j = 0; j < X0.cols(); ++j, x += k, o += r) {
+      for (Eigen::Index i = 0; i < k; ++i) o[i] = x[i];
+      for (Eigen::Index i = k; i < r; ++i) o[i] = 0.0;
+    }
   } else {
     updated_X_ = Eigen::MatrixXd::Zero(X0.rows(), X0.cols());
     updated_X_(rows_, Eigen::all) = Xn;
