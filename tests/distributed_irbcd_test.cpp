@@ -274,6 +274,31 @@ TEST(Momentum, ProjectionMatchesThePolarFactorNearAndFar) {
   }
 }
 
+// Points within ~1e-4 of the manifold (||A^T A - I||; almost every pose of a round) take the
+// binomial series for (A^T A)^{-1/2}, nearer ones (below 1e-9) its first term, the others
+// Newton-Schulz: each must give the SVD's polar factor to round-off, for both dimensions and for
+// the lifted rank as well as r = d (the SVD itself is exact to ~1e-15 here).
+TEST(Momentum, ProjectionNearTheManifoldMatchesThePolarFactorToRoundOff) {
+  for (int d : {2, 3})
+    for (int r : {d, 5}) {
+      const int n = 12, w = d + 1;
+      const LiftedManifold M(r, d, n);
+      std::srand(11);
+      const Eigen::MatrixXd Y = M.project(Eigen::MatrixXd::Random(r, n * w));
+      for (double t : {1e-10, 3e-9, 1e-7, 1e-6, 1e-5, 3e-5, 1e-4, 1e-3}) {
+        const Eigen::MatrixXd A = Y + t * Eigen::MatrixXd::Random(r, n * w);
+        const Eigen::MatrixXd P = project_to_manifold(M, A);
+        double worst = 0.0;
+        for (int i = 0; i < n; ++i) {
+          const Eigen::MatrixXd polar = polar_factor(A.middleCols(i * w, d));
+          worst = std::max(worst, (P.middleCols(i * w, d) - polar).cwiseAbs().maxCoeff());
+          EXPECT_TRUE(P.col(i * w + d) == A.col(i * w + d));  // translations untouched
+        }
+        EXPECT_LT(worst, 2e-15) << d << " " << r << " " << t;
+      }
+    }
+}
+
 // The round protocol forms P, V (and the neighbours' copies) in place in the agent's buffers:
 // writing into an existing matrix, or into one of the inputs, must give exactly what the
 // returning forms give, for every rank (the Gram entries of Proj_M are summed in an order that

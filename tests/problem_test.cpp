@@ -257,6 +257,28 @@ TEST_P(ProblemTest, DataMatrixEqualsTheTripletAssemblyExactly) {
   expect_identical(BlockProblem(d, owned, ms).data_matrix(), Qbb);
 }
 
+// The cost at d rows (the agents' active rows: an unrolled, for d = 3 paired, edge kernel) is
+// the general-rank loop's to the bit: the same point with two zero rows appended adds only exact
+// zeros to an edge's sums, in the same order. One measurement a problem, so that each edge's
+// term is compared alone (in a sum over many, a last-bit difference is rounded away).
+TEST_P(ProblemTest, CostAtTheActiveRowsEqualsTheGeneralRankLoopBitForBit) {
+  const int d = GetParam();
+  auto g = test::random_pose_graph({d, 40, 30, 0.05, 0.1, 8});
+  const LiftedManifold M(d, d, g.num_poses);
+  std::srand(21);
+  for (std::size_t e = 0; e < 200; ++e) {
+    const BlockProblem P =
+        BlockProblem::whole_graph(d, g.num_poses, {g.measurements[e % g.measurements.size()]});
+    // Points off the manifold too: larger residuals, more rounding to tell orders apart.
+    const Eigen::MatrixXd X = random_point(M, 100 + e) + 0.3 * Eigen::MatrixXd::Random(d, M.cols());
+    Eigen::MatrixXd Xp = Eigen::MatrixXd::Zero(d + 2, X.cols());
+    Xp.topRows(d) = X;
+    const double f = P.cost(X), f_padded = P.cost(Xp);
+    EXPECT_GT(f, 0.0);
+    EXPECT_EQ(f, f_padded) << e;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Dimensions, ProblemTest, ::testing::Values(2, 3));
 
 }  // namespace

@@ -197,7 +197,22 @@ void AgentState::set_point(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neig
 }
 
 Eigen::MatrixXd AgentState::active_part(const Eigen::MatrixXd& X) const {
-  if (static_cast<Eigen::Index>(rows_.size()) == X.rows()) return X;
+  const auto k = static_cast<Eigen::Index>(rows_.size());
+  if (k == X.rows()) return X;
+  if (k == 3 && rows_.back() == 2) {
+    // A 3D lifted point's active rows are its first 3 (rows_ is increasing): copied column by
+    // column, without an index per entry.
+    Eigen::MatrixXd out(3, X.cols());
+    const Eigen::Index r = X.rows();
+    const double* x = X.data();
+    double* o = out.data();
+    for (Eigen::Index j = 0; j < X.cols(); ++j, x += r, o += 3) {
+      o[0] = x[0];
+      o[1] = x[1];
+      o[2] = x[2];
+    }
+    return out;
+  }
   return X(rows_, Eigen::all);
 }
 
@@ -259,6 +274,17 @@ Eigen::MatrixXd AgentState::update(const Eigen::MatrixXd& X0, const Eigen::Matri
       block_update(problem_, Xa, options, euclid, &updated_grad_norm_sq_, tangent, &stats);
   if (all_rows) {
     updated_X_ = std::move(Xn);
+  } else if (rows_.back() == static_cast<Eigen::Index>(rows_.size()) - 1) {
+    // The first k rows (a lifted point's): column by column, the rest +0 as Zero() gives, in
+    // one pass instead of zeroing everything and scattering through a row index.
+    const Eigen::Index k = Xn.rows(), r = X0.rows();
+    updated_X_.resize(r, X0.cols());
+    const double* x = Xn.data();
+    double* o = updated_X_.data();
+    for (Eigen::Index j = 0; j < X0.cols(); ++j, x += k, o += r) {
+      for (Eigen::Index i = 0; i < k; ++i) o[i] = x[i];
+      for (Eigen::Index i = k; i < r; ++i) o[i] = 0.0;
+    }
   } else {
     updated_X_ = Eigen::MatrixXd::Zero(X0.rows(), X0.cols());
     updated_X_(rows_, Eigen::all) = Xn;

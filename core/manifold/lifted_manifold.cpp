@@ -86,14 +86,17 @@ void tangent_project_poses(const double* X, const double* V, Eigen::Index r_runt
 #pragma GCC unroll 16
     for (int b = 0; b < D; ++b) {
       double* o = o0 + b * r;
+      const double* v = B + b * r;  // o itself when out is V
 #pragma GCC unroll 16
       for (int a = 0; a < D; ++a) {
         const double w = -1.0 * sym[a][b];
         const double* Ca = A + a * r;
 #pragma GCC unroll 16
-        for (Eigen::Index k = 0; k < r; ++k) o[k] += w * Ca[k];
+        for (Eigen::Index k = 0; k < r; ++k) o[k] = (a == 0 ? v[k] : o[k]) + w * Ca[k];
       }
     }
+    if (out != V)  // the translation column is V's
+      for (Eigen::Index k = 0; k < r; ++k) o0[D * r + k] = B[D * r + k];
   }
 }
 
@@ -101,7 +104,23 @@ void tangent_project_poses(const double* X, const double* V, Eigen::Index r_runt
 
 Eigen::MatrixXd LiftedManifold::tangent_project(const Eigen::MatrixXd& X,
                                                 const Eigen::MatrixXd& V) const {
-  return tangent_project(X, Eigen::MatrixXd(V));
+  if (V.cols() != (d_ + 1) * static_cast<Eigen::Index>(n_) || V.rows() != X.rows())
+    return tangent_project(X, Eigen::MatrixXd(V));
+  // Written from V straight into a new matrix (no copy of V first): the same sums.
+  Eigen::MatrixXd out(V.rows(), V.cols());
+  const Eigen::Index r = X.rows();
+  if (d_ == 2) {
+    if (r == 2)
+      tangent_project_poses<2, 2>(X.data(), V.data(), r, n_, out.data());
+    else
+      tangent_project_poses<2, 0>(X.data(), V.data(), r, n_, out.data());
+  } else {
+    if (r == 3)
+      tangent_project_poses<3, 3>(X.data(), V.data(), r, n_, out.data());
+    else
+      tangent_project_poses<3, 0>(X.data(), V.data(), r, n_, out.data());
+  }
+  return out;
 }
 
 Eigen::MatrixXd LiftedManifold::tangent_project(const Eigen::MatrixXd& X,

@@ -28,8 +28,9 @@ PoseBlockMatrix::PoseBlockMatrix(const SparseMatrix& Q, int w) : w_(w), rows_(Q.
         const int I = static_cast<int>(it.row() / w);
         const auto b = first + static_cast<std::size_t>(
                                    std::lower_bound(rows.begin(), rows.end(), I) - rows.begin());
-        values_[b * static_cast<std::size_t>(w * w) + q * static_cast<std::size_t>(w) +
-                static_cast<std::size_t>(it.row() % w)] = it.value();
+        values_[b * static_cast<std::size_t>(w * w) +
+                static_cast<std::size_t>(it.row() % w) * static_cast<std::size_t>(w) + q] =
+            it.value();
       }
     }
     start_[static_cast<std::size_t>(J) + 1] = row_block_.size();
@@ -62,7 +63,7 @@ void block_times(const double* X, Eigen::Index r, const std::vector<std::size_t>
 #pragma GCC unroll 4
       for (int q = 0; q < W; ++q)
 #pragma GCC unroll 4
-        for (int p = 0; p < W; ++p) acc[q] += v[q * W + p] * ConstMap(x + r * p, r);
+        for (int p = 0; p < W; ++p) acc[q] += v[p * W + q] * ConstMap(x + r * p, r);
     }
     double* o = out + pose * static_cast<Eigen::Index>(J);
     for (int q = 0; q < W; ++q) Eigen::Map<Vec>(o + r * q, r) = scale * acc[q];
@@ -94,7 +95,7 @@ void block_times_3(const double* X, const std::vector<std::size_t>& start,
       for (int q = 0; q < W; ++q)
 #pragma GCC unroll 4
         for (int p = 0; p < W; ++p) {
-          const double c = v[q * W + p];
+          const double c = v[p * W + q];
           a01[q] += c * x01[p];
           a2[q] += c * x[3 * p + 2];
         }
@@ -109,6 +110,48 @@ void block_times_3(const double* X, const std::vector<std::size_t>& start,
   }
 }
 
+// block_times<4, 3> for the 3D agents' rank-3 products (most of them): the 3 x 4 accumulators
+// of a block column are six registers of two output columns each. A block's row p (its entries
+// (p, 0..3), adjacent in the row-major block) is two registers, each multiplied by X's entry
+// (a, p) in both lanes: only full-width operations, against block_times_3's half-empty row 2
+// and one broadcast per entry. Each accumulator still takes its terms in increasing block row,
+// then in increasing p, so the values are the same.
+inline void block_times_3_by_4(const double* X, const std::vector<std::size_t>& start,
+                               const std::vector<int>& row_block, const std::vector<double>& values,
+                               double scale, double* out) {
+  typedef double Pair __attribute__((vector_size(16)));
+  constexpr Eigen::Index pose = 12;
+  for (std::size_t J = 0; J + 1 < start.size(); ++J) {
+    Pair acc[3][2];
+    for (int a = 0; a < 3; ++a) acc[a][0] = acc[a][1] = Pair{0.0, 0.0};
+    for (std::size_t b = start[J]; b < start[J + 1]; ++b) {
+      const double* x = X + pose * row_block[b];
+      const double* v = values.data() + b * 16;
+#pragma GCC unroll 4
+      for (int p = 0; p < 4; ++p) {
+        Pair v01, v23;
+        std::memcpy(&v01, v + 4 * p, sizeof(Pair));
+        std::memcpy(&v23, v + 4 * p + 2, sizeof(Pair));
+#pragma GCC unroll 3
+        for (int a = 0; a < 3; ++a) {
+          const Pair xa = {x[3 * p + a], x[3 * p + a]};
+          acc[a][0] += xa * v01;
+          acc[a][1] += xa * v23;
+        }
+      }
+    }
+    double* o = out + pose * static_cast<Eigen::Index>(J);
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; ++a) {
+      const Pair s01 = scale * acc[a][0], s23 = scale * acc[a][1];
+      o[a] = s01[0];
+      o[3 + a] = s01[1];
+      o[6 + a] = s23[0];
+      o[9 + a] = s23[1];
+    }
+  }
+}
+
 template <int W>
 void block_times_rows(const double* X, Eigen::Index r, const std::vector<std::size_t>& start,
                       const std::vector<int>& row_block, const std::vector<double>& values,
@@ -117,7 +160,10 @@ void block_times_rows(const double* X, Eigen::Index r, const std::vector<std::si
     case 2:
       return block_times<W, 2>(X, r, start, row_block, values, scale, out);
     case 3:
-      return block_times_3<W>(X, start, row_block, values, scale, out);
+      if constexpr (W == 4)
+        return block_times_3_by_4(X, start, row_block, values, scale, out);
+      else
+        return block_times_3<W>(X, start, row_block, values, scale, out);
     case 4:
       return block_times<W, 4>(X, r, start, row_block, values, scale, out);
     case 5:

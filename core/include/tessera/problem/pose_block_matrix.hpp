@@ -37,7 +37,7 @@ class PoseBlockMatrix {
   Eigen::Index rows_ = 0;
   std::vector<std::size_t> start_{0};  // blocks of block column J: start_[J] .. start_[J+1]-1
   std::vector<int> row_block_;         // block row of each block, increasing within a column
-  std::vector<double> values_;         // w^2 per block, column-major (entry (p, q) at q w + p)
+  std::vector<double> values_;         // w^2 per block, row-major (entry (p, q) at p w + q)
 };
 
 }  // namespace tessera
