@@ -172,6 +172,26 @@ TEST(FieldCli, PlotWritesAPng) {
   EXPECT_TRUE(contains(out, g.dir + "/rej2.txt:2: measurement 99999 does not exist")) << out;
 }
 
+TEST(FieldCli, PlotReadsTheStampsFileItIsGiven) {
+  const Generated g = generate("grid3d", 90);
+  const std::string png = g.dir + "/fig.png";
+  std::string out;
+  // Accepted and used (as tessera eval uses it), not parsed and ignored: a missing file is named.
+  EXPECT_EQ(run_command(bin("tessera") + " plot " + g.graph + " --truth " + g.truth + " --stamps " +
+                            g.dir + "/missing.txt --out " + png,
+                        &out),
+            2)
+      << out;
+  EXPECT_TRUE(contains(out, g.dir + "/missing.txt")) << out;
+  ASSERT_EQ(run_command(bin("tessera") + " plot " + g.graph + " --truth " + g.truth + " --stamps " +
+                            g.stamps + " --out " + png,
+                        &out),
+            0)
+      << out;
+  EXPECT_FALSE(contains(out, "drawn unaligned")) << out;
+  EXPECT_TRUE(std::filesystem::exists(png));
+}
+
 TEST(FieldCli, BadInputsExitTwoNamingFileAndLine) {
   const Generated g = generate();
   std::string out;
