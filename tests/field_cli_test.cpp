@@ -192,6 +192,19 @@ TEST(FieldCli, PlotReadsTheStampsFileItIsGiven) {
   EXPECT_TRUE(std::filesystem::exists(png));
 }
 
+TEST(FieldCli, LaunchTakesItsOutputOptionsAlsoAsNameEqualsValue) {
+  // A missing graph ends launch before any process starts, after its options are parsed.
+  const std::string dir = tessera::test::temp_dir();
+  for (const std::string flag : {"--out", "--tum", "--tum-dir", "--plot", "--keys", "--stamps"}) {
+    std::string out;
+    EXPECT_EQ(run_command(bin("tessera") + " launch " + dir + "/missing.g2o " + flag + "=x", &out),
+              2)
+        << flag << ": " << out;
+    EXPECT_FALSE(contains(out, "unknown option")) << flag << ": " << out;
+    EXPECT_TRUE(contains(out, dir + "/missing.g2o")) << flag << ": " << out;
+  }
+}
+
 TEST(FieldCli, BadInputsExitTwoNamingFileAndLine) {
   const Generated g = generate();
   std::string out;
