@@ -57,7 +57,8 @@ const char* const kHelp =
     "                 better cut (default 0: the preset's window, max(40, a third of its steps))\n"
     "  --out FILE     write the block id of pose i on line i (0-based, one per line)\n"
     "  --json FILE    write the figures as one JSON object to FILE ('-' for stdout)\n"
-    "  --format F     g2o | metis: override the format detection\n"
+    "  --format F     g2o | metis: override the format detection (default: detected from\n"
+    "                 the file)\n"
     "  --help         show this text\n"
     "\n"
     "exit status: 0 on success, 2 on bad input (the message says what is wrong).\n";

@@ -47,6 +47,8 @@ const char* const kHelp =
     "                          (input ids)\n"
     "  --title TEXT            figure title (default: the file name)\n"
     "  --keys auto|plain|gtsam how ids name robots                                [auto]\n"
+    "  --stamps FILE           timestamps for the poses of graph inputs ('id stamp'), so\n"
+    "                          --truth's alignment matches poses by time, as tessera eval\n"
     "  --help                  this text\n";
 
 // Which measurements were rejected: a line "e" names measurement e (0-based over the EDGE
@@ -113,6 +115,7 @@ int run_plot(const Args& args) {
   fig.title = a.get_or("title", std::filesystem::path(input).filename().string());
   TrajectoryReadOptions read;
   read.keys = parse_keys_option(a.get_or("keys", "auto"));
+  read.stamps = a.get_or("stamps", "");                   // the same matching as tessera eval's
   const Trajectory probe = read_trajectory(input, read);  // any of the accepted inputs
   std::optional<G2oReadResult> graph;
   if (!std::filesystem::is_directory(input)) {

@@ -27,19 +27,26 @@ LaunchOutputs take_launch_outputs(std::vector<std::string>& argv) {
   LaunchOutputs o;
   std::vector<std::string> rest;
   for (std::size_t k = 0; k < argv.size(); ++k) {
+    // `--name value` or `--name=value`, as every other option (cli/arguments.hpp).
+    const std::size_t eq = argv[k].find('=');
+    const std::string name = argv[k].substr(0, eq);
     std::optional<std::string>* slot = nullptr;
-    if (argv[k] == "--out") slot = &o.out;
-    if (argv[k] == "--tum") slot = &o.tum;
-    if (argv[k] == "--tum-dir") slot = &o.tum_dir;
-    if (argv[k] == "--plot") slot = &o.plot;
-    if (argv[k] == "--keys") slot = &o.keys;
-    if (argv[k] == "--stamps") slot = &o.stamps;
+    if (name == "--out") slot = &o.out;
+    if (name == "--tum") slot = &o.tum;
+    if (name == "--tum-dir") slot = &o.tum_dir;
+    if (name == "--plot") slot = &o.plot;
+    if (name == "--keys") slot = &o.keys;
+    if (name == "--stamps") slot = &o.stamps;
     if (!slot) {
       rest.push_back(argv[k]);
       continue;
     }
-    if (k + 1 >= argv.size()) throw InputError("launch: option " + argv[k] + " needs a value");
-    if (*slot) throw InputError("launch: option " + argv[k] + " given twice");
+    if (*slot) throw InputError("launch: option " + name + " given twice");
+    if (eq != std::string::npos) {
+      *slot = argv[k].substr(eq + 1);
+      continue;
+    }
+    if (k + 1 >= argv.size()) throw InputError("launch: option " + name + " needs a value");
     *slot = argv[++k];
   }
   argv = std::move(rest);

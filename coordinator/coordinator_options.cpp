@@ -93,15 +93,20 @@ options:
   --setup-at-once K    at most K agents run the distributed initialisation's local chordal
                        solve at once (agent a after agent a - K): those factorizations are
                        the set-up's memory peak; 0 = all at once (default 8)
-  --robust none|gnc-tls  gnc-tls: reject outlier measurements by graduated non-convexity
-                       with a truncated least-squares cost, then solve (and with --certify
-                       certify) the kept ones; every agent weighs the measurements of its
-                       lower pose ids (docs/robust.md) (default none)
+  --robust none|gnc-tls|pcm-gnc  gnc-tls: reject outlier measurements by graduated
+                       non-convexity with a truncated least-squares cost, then solve (and
+                       with --certify certify) the kept ones; every agent weighs the
+                       measurements of its lower pose ids; pcm-gnc: agent 0 first drops
+                       closures outside the largest pairwise-consistent set
+                       (docs/robust.md) (default none)
   --inlier-threshold C, --inlier-quantile P, --gnc-max-outer K, --gnc-mu-step S,
   --gnc-inner-rounds K, --known-inliers odometry|none, --gnc-probes K,
   --gnc-probe-ratio R, --gnc-final-refine newton|none, --gnc-cluster-probes K,
   --gnc-pass-refine auto|none, --gnc-mu-step-max S
                        the GNC options, as for `tessera solve` (docs/robust.md)
+  --gnc-inner-iterations K, --gnc-swap-probes K
+                       accepted for `tessera solve`'s option set; they are the centralized
+                       GNC's and change nothing in a distributed run
   --rejected FILE      write the rejected measurement indices (from 0 over the EDGE lines)
   --gnc-solver-start   GNC starts from --init's poses, not from the known inliers'
                        distributed initialization (tessera launch passes it with --init)

@@ -172,6 +172,39 @@ TEST(FieldCli, PlotWritesAPng) {
   EXPECT_TRUE(contains(out, g.dir + "/rej2.txt:2: measurement 99999 does not exist")) << out;
 }
 
+TEST(FieldCli, PlotReadsTheStampsFileItIsGiven) {
+  const Generated g = generate("grid3d", 90);
+  const std::string png = g.dir + "/fig.png";
+  std::string out;
+  // Accepted and used (as tessera eval uses it), not parsed and ignored: a missing file is named.
+  EXPECT_EQ(run_command(bin("tessera") + " plot " + g.graph + " --truth " + g.truth + " --stamps " +
+                            g.dir + "/missing.txt --out " + png,
+                        &out),
+            2)
+      << out;
+  EXPECT_TRUE(contains(out, g.dir + "/missing.txt")) << out;
+  ASSERT_EQ(run_command(bin("tessera") + " plot " + g.graph + " --truth " + g.truth + " --stamps " +
+                            g.stamps + " --out " + png,
+                        &out),
+            0)
+      << out;
+  EXPECT_FALSE(contains(out, "drawn unaligned")) << out;
+  EXPECT_TRUE(std::filesystem::exists(png));
+}
+
+TEST(FieldCli, LaunchTakesItsOutputOptionsAlsoAsNameEqualsValue) {
+  // A missing graph ends launch before any process starts, after its options are parsed.
+  const std::string dir = tessera::test::temp_dir();
+  for (const std::string flag : {"--out", "--tum", "--tum-dir", "--plot", "--keys", "--stamps"}) {
+    std::string out;
+    EXPECT_EQ(run_command(bin("tessera") + " launch " + dir + "/missing.g2o " + flag + "=x", &out),
+              2)
+        << flag << ": " << out;
+    EXPECT_FALSE(contains(out, "unknown option")) << flag << ": " << out;
+    EXPECT_TRUE(contains(out, dir + "/missing.g2o")) << flag << ": " << out;
+  }
+}
+
 TEST(FieldCli, BadInputsExitTwoNamingFileAndLine) {
   const Generated g = generate();
   std::string out;

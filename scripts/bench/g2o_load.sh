@@ -21,8 +21,9 @@ for f in $(ls -S "$DATA"/*.g2o); do
     { time "$TESSERA" info "$f" --json "$TMP/info.json" >/dev/null; } 2>>"$TMP/procs"
     sed -n 's/.*"load_s": \([0-9.e+-]*\).*/\1/p' "$TMP/info.json" >>"$TMP/loads"
   done
-  poses=$(sed -n 's/.*"poses": \([0-9]*\).*/\1/p' "$TMP/info.json")
-  edges=$(sed -n 's/.*"edges": \([0-9]*\).*/\1/p' "$TMP/info.json")
+  # The first match: the per-robot list further down has "poses" too.
+  poses=$(sed -n 's/^  "poses": \([0-9]*\).*/\1/p' "$TMP/info.json" | head -1)
+  edges=$(sed -n 's/^  "edges": \([0-9]*\).*/\1/p' "$TMP/info.json" | head -1)
   read_ms=$(sort -g "$TMP/loads" | head -1 | awk '{printf "%.1f", $1 * 1000}')
   proc_ms=$(sort -g "$TMP/procs" | head -1 | awk '{printf "%.0f", $1 * 1000}')
   printf "%-30s %9d %7d %7d %9s %11s\n" "$(basename "$f")" "$(stat -c %s "$f")" "$poses" "$edges" \
