@@ -198,7 +198,8 @@ DistributedResult solve_distributed_watching_trials(
         std::make_unique<CertifiedAgent>(*states[static_cast<std::size_t>(b)], layout, options));
     if (!std::isnan(known_grad_norm)) sequences.back()->set_known_start(known_grad_norm);
     if (watch)
-      sequences.back()->set_trial_observer([&watch, b](const Eigen::MatrixXd& Y) { watch(b, Y); });
+      sequences.back()->set_trial_observer(
+          [&watch, b](const Eigen::MatrixXd& Y, const Eigen::MatrixXd&) { watch(b, Y); });
     agents.push_back(sequences.back().get());
   }
   res.init_s = since(start);
