@@ -81,12 +81,8 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   EXPECT_GE(apart.solve_stages - along.solve_stages, apart.outer_iterations - 1);
   EXPECT_EQ(along.final_solve_stages, apart.final_solve_stages);
   // Every step left out was a real wait: the longest chain of messages is shorter by as many.
-  auto steps = [](const GncDistributedResult& r) {
-    return 2 * r.total_rounds + 2 * (r.solve_stages + r.final_solve_stages) +
-           r.refine_message_steps + r.final_refine_message_steps + r.exchange_steps;
-  };
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - along.longest_chain),
-            steps(apart) - steps(along));
+            test::message_steps(apart) - test::message_steps(along));
 }
 
 // RobustOptions::weights_ride_trial_sums: each weight update after a weighted solve by a single
@@ -128,11 +124,7 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
   EXPECT_GE(saved, 1);
   EXPECT_LE(saved, apart.outer_iterations - 1);
   EXPECT_EQ(beside.solve_stages, apart.solve_stages);
-  auto steps = [](const GncDistributedResult& r) {
-    return 2 * r.total_rounds + 2 * (r.solve_stages + r.final_solve_stages) +
-           r.refine_message_steps + r.final_refine_message_steps + r.exchange_steps;
-  };
-  EXPECT_EQ(steps(apart) - steps(beside), saved);
+  EXPECT_EQ(test::message_steps(apart) - test::message_steps(beside), saved);
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
 }
 
