@@ -107,13 +107,17 @@ const char* kOnlineHelp =
 
 namespace {
 
+// Linear interpolation between the nearest ranks. Some values may be +infinity (checkpoints
+// never within the gap bound): where no interpolation is needed, the value itself, not inf - inf.
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
   const double pos = q * static_cast<double>(v.size() - 1);
   const std::size_t lo = static_cast<std::size_t>(pos);
   const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+  const double frac = pos - static_cast<double>(lo);
+  if (frac == 0.0 || v[lo] == v[hi]) return v[lo];
+  return v[lo] + frac * (v[hi] - v[lo]);
 }
 
 JsonObject update_json(const OnlineUpdate& u) {
@@ -176,18 +180,6 @@ struct Checkpoint {
   double step_latency_s = 0.0, step_latency_cpu_s = 0.0;
   GapLatency gap;  // against `optimum`, after the run
 };
-
-// percentile() where some values may be +infinity (checkpoints never within the bound).
-double percentile_or_inf(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(pos);
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  const double frac = pos - static_cast<double>(lo);
-  if (frac == 0.0 || v[lo] == v[hi]) return v[lo];
-  return v[lo] + frac * (v[hi] - v[lo]);
-}
 
 }  // namespace
 
@@ -385,12 +377,12 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
           .add("max_checkpoint_rel_gap",
                gaps.empty() ? 0.0 : *std::max_element(gaps.begin(), gaps.end()))
           .add("gap_bound", gap_bound)
-          .add("gap_latency_median_s", percentile_or_inf(gap_latency_s, 0.5))
-          .add("gap_latency_p95_s", percentile_or_inf(gap_latency_s, 0.95))
-          .add("gap_latency_cpu_median_s", percentile_or_inf(gap_latency_cpu_s, 0.5))
-          .add("gap_latency_cpu_p95_s", percentile_or_inf(gap_latency_cpu_s, 0.95))
-          .add("gap_cg_median", percentile_or_inf(gap_cg, 0.5))
-          .add("gap_cg_p95", percentile_or_inf(gap_cg, 0.95))
+          .add("gap_latency_median_s", percentile(gap_latency_s, 0.5))
+          .add("gap_latency_p95_s", percentile(gap_latency_s, 0.95))
+          .add("gap_latency_cpu_median_s", percentile(gap_latency_cpu_s, 0.5))
+          .add("gap_latency_cpu_p95_s", percentile(gap_latency_cpu_s, 0.95))
+          .add("gap_cg_median", percentile(gap_cg, 0.5))
+          .add("gap_cg_p95", percentile(gap_cg, 0.95))
           .add("gap_latency_missed",
                static_cast<std::size_t>(std::count_if(gap_latency_s.begin(), gap_latency_s.end(),
                                                       [](double t) { return !std::isfinite(t); })))

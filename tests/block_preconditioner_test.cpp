@@ -160,7 +160,7 @@ TEST(BlockPreconditioner, BlockUpdateWithTheFallbackStillDecreasesTheLocalCost) 
   // Perturbed start: lifted ground truth moved away along a random tangent direction.
   const Eigen::MatrixXd all = lift_poses(b.graph.initial, r);
   const Eigen::Index cols = problem.data_matrix().rows();
-  problem.set_neighbor_poses(test::pose_columns(all, b.graph.d, problem.neighbors()));
+  problem.set_neighbor_poses(gather_pose_columns(all, problem.neighbors(), b.graph.d));
   const LiftedManifold M = problem.manifold(r);
   Eigen::MatrixXd X0 = all.leftCols(cols);
   X0 = M.retract(X0, 0.3 * M.tangent_project(X0, Eigen::MatrixXd::Random(r, cols)));

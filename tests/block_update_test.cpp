@@ -33,9 +33,9 @@ PerturbedBlock perturbed_block(int d, std::uint64_t seed) {
   BlockProblem problem(d, hb.owned, hb.graph.measurements);
   const int r = 5;
   const Eigen::MatrixXd X = lift_poses(hb.graph.initial, r);
-  problem.set_neighbor_poses(test::pose_columns(X, d, problem.neighbors()));
+  problem.set_neighbor_poses(gather_pose_columns(X, problem.neighbors(), d));
   const LiftedManifold M = problem.manifold(r);
-  const Eigen::MatrixXd Y0 = test::pose_columns(X, d, hb.owned);
+  const Eigen::MatrixXd Y0 = gather_pose_columns(X, hb.owned, d);
   std::srand(static_cast<unsigned>(seed));
   const Eigen::MatrixXd v = M.tangent_project(Y0, Eigen::MatrixXd::Random(r, Y0.cols()));
   Eigen::MatrixXd start = M.retract(Y0, 0.5 * v);

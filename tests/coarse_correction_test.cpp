@@ -18,14 +18,11 @@
 #include <unsupported/Eigen/MatrixFunctions>
 #include <vector>
 
-#include "lifted_blocks.hpp"
 #include "random_graph.hpp"
 #include "test_support.hpp"
 
 namespace tessera {
 namespace {
-
-using test::pose_columns;
 
 // Edge terms of f at the lifted X, split into the cut's part and the blocks' inside part.
 void split_cost(const PoseGraph& g, const std::vector<int>& part, const Eigen::MatrixXd& X,
@@ -49,8 +46,8 @@ std::vector<std::vector<double>> all_terms(const PoseGraph& g, const BlockLayout
     const auto& owned = layout.poses[static_cast<std::size_t>(a)];
     const BlockProblem problem(g.d, owned, g.measurements);
     const CoarseTerms terms(a, g.d, layout, problem.owned(), problem.neighbors(), g.measurements);
-    out.push_back(
-        terms.compute(pose_columns(X, g.d, owned), pose_columns(X, g.d, problem.neighbors())));
+    out.push_back(terms.compute(gather_pose_columns(X, owned, g.d),
+                                gather_pose_columns(X, problem.neighbors(), g.d)));
   }
   return out;
 }

@@ -22,13 +22,10 @@
 #include <tessera/problem/lifting.hpp>
 #include <vector>
 
-#include "lifted_blocks.hpp"
 #include "round_agents.hpp"
 
 namespace tessera {
 namespace {
-
-using test::pose_columns;
 
 struct Grid {
   PoseGraph graph;
@@ -68,8 +65,8 @@ std::vector<std::unique_ptr<AgentState>> agents(const PoseGraph& g, const BlockL
   for (int a = 0; a < layout.num_blocks; ++a) {
     auto s = std::make_unique<AgentState>(
         a, g.d, layout, g.measurements,
-        pose_columns(X, g.d, layout.poses[static_cast<std::size_t>(a)]));
-    s->Yn = pose_columns(X, g.d, s->problem().neighbors());
+        gather_pose_columns(X, layout.poses[static_cast<std::size_t>(a)], g.d));
+    s->Yn = gather_pose_columns(X, s->problem().neighbors(), g.d);
     s->Vn = s->Yn;
     if (space) s->use_coarse_space(space, g.measurements);
     out.push_back(std::move(s));
@@ -124,7 +121,7 @@ void expect_received_motions_are_the_all_to_all_ones(bool smoothed) {
     EXPECT_TRUE(f.Y == s.Y) << "agent " << a;
     EXPECT_TRUE(f.Yn == s.Yn) << "agent " << a;
     EXPECT_TRUE(f.Vn == s.Vn) << "agent " << a;
-    EXPECT_FALSE(f.Y == pose_columns(X, g.d, layout.poses[static_cast<std::size_t>(a)]));
+    EXPECT_FALSE(f.Y == gather_pose_columns(X, layout.poses[static_cast<std::size_t>(a)], g.d));
   }
 }
 

@@ -16,12 +16,8 @@
 #include <tessera/problem/lifting.hpp>
 #include <vector>
 
-#include "lifted_blocks.hpp"
-
 namespace tessera {
 namespace {
-
-using test::pose_columns;
 
 TEST(CoarseSpaceShare, AnAgentReadsTheSameTermsPiecesAndBlendFromItsShare) {
   GeneratorOptions go;
@@ -60,8 +56,8 @@ TEST(CoarseSpaceShare, AnAgentReadsTheSameTermsPiecesAndBlendFromItsShare) {
     EXPECT_LT(share.bytes(), full.bytes() * 3 / 4) << "agent " << a;
 
     const BlockProblem p(g.d, layout.poses[static_cast<std::size_t>(a)], g.measurements);
-    const Eigen::MatrixXd Xo = pose_columns(X, g.d, p.owned());
-    const Eigen::MatrixXd Xn = pose_columns(X, g.d, p.neighbors());
+    const Eigen::MatrixXd Xo = gather_pose_columns(X, p.owned(), g.d);
+    const Eigen::MatrixXd Xn = gather_pose_columns(X, p.neighbors(), g.d);
     const SmoothedCoarseTerms from_full(full, a, g.d, p.owned(), p.neighbors(), touching);
     const SmoothedCoarseTerms from_share(share, a, g.d, p.owned(), p.neighbors(), touching);
     EXPECT_EQ(from_share.compute(Xo, Xn), from_full.compute(Xo, Xn)) << "agent " << a;

@@ -23,13 +23,10 @@
 #include <utility>
 #include <vector>
 
-#include "lifted_blocks.hpp"
 #include "test_support.hpp"
 
 namespace tessera {
 namespace {
-
-using test::pose_columns;
 
 // f at a lifted iterate of the whole graph.
 double f_of(const PoseGraph& g, const Eigen::MatrixXd& X) {
@@ -60,7 +57,8 @@ std::vector<std::vector<double>> smoothed_terms(const PoseGraph& g, const Coarse
   for (int a = 0; a < layout.num_blocks; ++a) {
     const BlockProblem p(g.d, layout.poses[static_cast<std::size_t>(a)], g.measurements);
     const SmoothedCoarseTerms t(space, a, g.d, p.owned(), p.neighbors(), g.measurements);
-    out.push_back(t.compute(pose_columns(X, g.d, p.owned()), pose_columns(X, g.d, p.neighbors())));
+    out.push_back(t.compute(gather_pose_columns(X, p.owned(), g.d),
+                            gather_pose_columns(X, p.neighbors(), g.d)));
   }
   return out;
 }
@@ -79,8 +77,8 @@ double block_space_decrease(const PoseGraph& g, const std::vector<int>& part,
   for (int a = 0; a < layout.num_blocks; ++a) {
     const BlockProblem p(g.d, layout.poses[static_cast<std::size_t>(a)], g.measurements);
     const CoarseTerms t(a, g.d, layout, p.owned(), p.neighbors(), g.measurements);
-    terms.push_back(
-        t.compute(pose_columns(X, g.d, p.owned()), pose_columns(X, g.d, p.neighbors())));
+    terms.push_back(t.compute(gather_pose_columns(X, p.owned(), g.d),
+                              gather_pose_columns(X, p.neighbors(), g.d)));
   }
   const CoarseResult c = solve_coarse(layout, static_cast<int>(X.rows()), pointers(terms), o);
   return c.cost_before - c.cost_after;

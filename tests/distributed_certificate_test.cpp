@@ -23,7 +23,6 @@
 #include <tessera/solvers/centralized_solver.hpp>
 #include <vector>
 
-#include "lifted_blocks.hpp"
 #include "random_graph.hpp"
 
 namespace tessera {
@@ -77,9 +76,9 @@ DistributedCertificateResult certify_in_process(const PoseGraph& g, const Eigen:
   for (int b = 0; b < layout.num_blocks; ++b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
     states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
-                                                  test::pose_columns(X, g.d, ids), update));
+                                                  gather_pose_columns(X, ids, g.d), update));
     if (too_large) too_large->push_back(states.back()->block_factor_too_large());
-    states.back()->Yn = test::pose_columns(X, g.d, states.back()->problem().neighbors());
+    states.back()->Yn = gather_pose_columns(X, states.back()->problem().neighbors(), g.d);
     protocols.push_back(std::make_unique<CertificateProtocol>(*states.back(), layout, options));
     agents.push_back(protocols.back().get());
   }

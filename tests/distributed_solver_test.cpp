@@ -16,7 +16,6 @@
 #include <tessera/solvers/centralized_solver.hpp>
 #include <tessera/util/input_error.hpp>
 
-#include "lifted_blocks.hpp"
 #include "random_graph.hpp"
 #include "test_support.hpp"
 
@@ -38,8 +37,6 @@ double optimum(const PoseGraph& g) {
   o.stop = CentralizedStop::kGradient;
   return solve_centralized(g, o).cost;
 }
-
-using test::pose_columns;
 
 TEST(DistributedSolver, TwoBlocksConvergeToCentralizedOptimum) {
   const PoseGraph g = small_graph(2, 40, 3);
@@ -94,8 +91,8 @@ TEST(DistributedSolver, AgentCostSharesSumToGlobalCost) {
   for (int b = 0; b < 3; ++b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
     BlockProblem p(3, ids, g.measurements);
-    p.set_neighbor_poses(pose_columns(X, 3, p.neighbors()));
-    const Eigen::MatrixXd Xb = pose_columns(X, 3, ids);
+    p.set_neighbor_poses(gather_pose_columns(X, p.neighbors(), 3));
+    const Eigen::MatrixXd Xb = gather_pose_columns(X, ids, 3);
     sum += p.cost_share(Xb);
     gsq += p.riemannian_gradient(Xb, p.euclidean_gradient(Xb)).squaredNorm();
   }
@@ -116,9 +113,9 @@ TEST(DistributedSolver, StatusAfterUpdateMatchesFreshGradient) {
   const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
   const Eigen::MatrixXd X = lift_poses(g.initial, 5);
   const auto& ids = layout.poses[0];
-  AgentState agent(0, 3, layout, g.measurements, pose_columns(X, 3, ids));
+  AgentState agent(0, 3, layout, g.measurements, gather_pose_columns(X, ids, 3));
   BlockProblem fresh(3, ids, g.measurements);
-  agent.Yn = pose_columns(X, 3, fresh.neighbors());
+  agent.Yn = gather_pose_columns(X, fresh.neighbors(), 3);
   auto fresh_gsq = [&] {
     fresh.set_neighbor_poses(agent.Yn);
     return fresh.riemannian_gradient(agent.Y, fresh.euclidean_gradient(agent.Y)).squaredNorm();
@@ -152,12 +149,12 @@ TEST(DistributedSolver, ActiveRowUpdateEqualsTheFullRankUpdate) {
   const LiftedManifold M = full.manifold(r);
   // Start away from the optimum of the block so that the update moves.
   std::srand(4);
-  const Eigen::MatrixXd Y0 = pose_columns(X, 3, ids);
+  const Eigen::MatrixXd Y0 = gather_pose_columns(X, ids, 3);
   const Eigen::MatrixXd tangent = M.tangent_project(Y0, Eigen::MatrixXd::Random(r, Y0.cols()));
   Eigen::MatrixXd start = M.retract(Y0, 0.2 * tangent);
   start.bottomRows(r - 3).setZero();  // keep the zero rows of the lifting
   start = M.project(start);
-  const Eigen::MatrixXd Yn = pose_columns(X, 3, full.neighbors());
+  const Eigen::MatrixXd Yn = gather_pose_columns(X, full.neighbors(), 3);
 
   // The Q_BB preconditioner on both sides (the tangent one exists at rank d only).
   BlockUpdateOptions euclidean;
@@ -189,9 +186,9 @@ TEST(DistributedSolver, GreedyNewtonScoreIsThePreconditionedGradientNorm) {
   for (std::size_t i = 0; i < g.num_poses; ++i) a[i] = i < 15 ? 0 : 1;
   const BlockLayout layout = make_block_layout(g.num_poses, g.measurements, a);
   const Eigen::MatrixXd X = lift_poses(g.initial, 5);
-  AgentState agent(0, 2, layout, g.measurements, pose_columns(X, 2, layout.poses[0]));
+  AgentState agent(0, 2, layout, g.measurements, gather_pose_columns(X, layout.poses[0], 2));
   BlockProblem fresh(2, layout.poses[0], g.measurements);
-  agent.Yn = pose_columns(X, 2, fresh.neighbors());
+  agent.Yn = gather_pose_columns(X, fresh.neighbors(), 2);
   fresh.set_neighbor_poses(agent.Yn);
   const Eigen::MatrixXd grad =
       fresh.riemannian_gradient(agent.Y, fresh.euclidean_gradient(agent.Y));
@@ -432,9 +429,9 @@ TEST(DistributedSolver, ReleasedBlockFactorGivesTheSameUpdate) {
   const Eigen::MatrixXd X = lift_poses(g.initial, 5);
   BlockUpdateOptions o;
   o.tangent_preconditioner = false;  // the Q_BB factor preconditions every update
-  AgentState kept(0, 3, layout, g.measurements, pose_columns(X, 3, layout.poses[0]), o);
-  AgentState released(0, 3, layout, g.measurements, pose_columns(X, 3, layout.poses[0]), o);
-  kept.Yn = released.Yn = pose_columns(X, 3, kept.problem().neighbors());
+  AgentState kept(0, 3, layout, g.measurements, gather_pose_columns(X, layout.poses[0], 3), o);
+  AgentState released(0, 3, layout, g.measurements, gather_pose_columns(X, layout.poses[0], 3), o);
+  kept.Yn = released.Yn = gather_pose_columns(X, kept.problem().neighbors(), 3);
   released.release_block_factor();
   const Eigen::MatrixXd a_step = kept.update(kept.Y, kept.Yn, o);
   const Eigen::MatrixXd b_step = released.update(released.Y, released.Yn, o);
@@ -452,9 +449,10 @@ TEST(DistributedSolver, BlockDiagonalFallbackAboveTheFactorCap) {
   const Eigen::MatrixXd X = lift_poses(g.initial, 5);
   BlockUpdateOptions capped;
   capped.max_factor_entries = 1;
-  AgentState small(0, 3, layout, g.measurements, pose_columns(X, 3, layout.poses[0]), capped);
+  AgentState small(0, 3, layout, g.measurements, gather_pose_columns(X, layout.poses[0], 3),
+                   capped);
   EXPECT_TRUE(small.block_factor_too_large());
-  AgentState exact(0, 3, layout, g.measurements, pose_columns(X, 3, layout.poses[0]));
+  AgentState exact(0, 3, layout, g.measurements, gather_pose_columns(X, layout.poses[0], 3));
   EXPECT_FALSE(exact.block_factor_too_large());
   DistributedOptions opt;
   opt.block_update.max_factor_entries = 1;

@@ -13,10 +13,32 @@
 namespace tessera {
 namespace {
 
-GncDistributedOptions capped(int outer) {
-  GncDistributedOptions o;
+// GNC-TLS, certified; the runs compared below differ in one RobustOptions switch.
+GncDistributedOptions certified_tls() {
+  GncDistributedOptions o;  // --refine auto, refined passes: Newton steps in GNC
   o.robust.kind = RobustKind::kGncTls;
   o.solver.certify = true;
+  return o;
+}
+
+using Weights = std::tuple<int, int, std::vector<std::uint64_t>, std::vector<double>>;
+
+// Solves `dirty` with its robots as the blocks, with every agent's weights after every outer
+// step in `seen`, sorted (the agents report in the order their messages come in, which the
+// steps change).
+GncDistributedResult solve_recording_weights(const GeneratorResult& dirty, GncDistributedOptions o,
+                                             std::vector<Weights>& seen) {
+  o.weight_observer = [&](int agent, int outer, const std::vector<std::uint64_t>& index,
+                          const std::vector<double>& w) {
+    seen.emplace_back(agent, outer, index, w);
+  };
+  GncDistributedResult r = solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  std::sort(seen.begin(), seen.end());
+  return r;
+}
+
+GncDistributedOptions capped(int outer) {
+  GncDistributedOptions o = certified_tls();
   o.robust.max_outer_iterations = outer;
   o.robust.newton_mu_step_max = 0;  // mu's fixed step: the cap, not the schedule, ends GNC
   return o;
@@ -40,18 +62,11 @@ TEST(GncExchangeSteps, EachOuterStepTakesAPoseAndAWeightExchange) {
 // answer; the run is otherwise the same.
 TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
-  using Weights = std::tuple<int, int, std::vector<std::uint64_t>, std::vector<double>>;
   auto run = [&](bool ride_along, std::vector<Weights>& seen) {
-    GncDistributedOptions o;  // --refine auto, refined passes: Newton steps in GNC
-    o.robust.kind = RobustKind::kGncTls;
-    o.solver.certify = true;
+    GncDistributedOptions o = certified_tls();
     o.robust.exchanges_ride_along = ride_along;
     o.robust.weights_ride_trial_sums = false;  // its own test below
-    o.weight_observer = [&](int agent, int outer, const std::vector<std::uint64_t>& index,
-                            const std::vector<double>& w) {
-      seen.emplace_back(agent, outer, index, w);
-    };
-    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+    return solve_recording_weights(dirty, o, seen);
   };
   std::vector<Weights> seen_apart, seen_along;
   const GncDistributedResult apart = run(false, seen_apart);
@@ -63,11 +78,7 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   EXPECT_EQ(along.outer_iterations, apart.outer_iterations);
   EXPECT_EQ(along.total_rounds, apart.total_rounds);
   EXPECT_EQ(along.refine_message_steps, apart.refine_message_steps);
-  // Every agent's weights after every outer step, to the bit (the agents report in the order
-  // their messages come in, which the steps change).
-  std::sort(seen_apart.begin(), seen_apart.end());
-  std::sort(seen_along.begin(), seen_along.end());
-  EXPECT_EQ(seen_along, seen_apart);
+  EXPECT_EQ(seen_along, seen_apart);  // every agent's weights after every outer step, to the bit
   EXPECT_EQ(along.final_solve.cost, apart.final_solve.cost);
   EXPECT_TRUE(along.final_solve.certified.value_or(false));
   // The pose exchange before each weight update but the first (which follows the plain solve's
@@ -81,12 +92,8 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   EXPECT_GE(apart.solve_stages - along.solve_stages, apart.outer_iterations - 1);
   EXPECT_EQ(along.final_solve_stages, apart.final_solve_stages);
   // Every step left out was a real wait: the longest chain of messages is shorter by as many.
-  auto steps = [](const GncDistributedResult& r) {
-    return 2 * r.total_rounds + 2 * (r.solve_stages + r.final_solve_stages) +
-           r.refine_message_steps + r.final_refine_message_steps + r.exchange_steps;
-  };
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - along.longest_chain),
-            steps(apart) - steps(along));
+            test::message_steps(apart) - test::message_steps(along));
 }
 
 // RobustOptions::weights_ride_trial_sums: each weight update after a weighted solve by a single
@@ -95,17 +102,10 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
 // cost; one message step fewer per such update, each a real wait (the longest chain).
 TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
-  using Weights = std::tuple<int, int, std::vector<std::uint64_t>, std::vector<double>>;
   auto run = [&](bool beside, std::vector<Weights>& seen) {
-    GncDistributedOptions o;  // --refine auto, refined passes: Newton steps in GNC
-    o.robust.kind = RobustKind::kGncTls;
-    o.solver.certify = true;
+    GncDistributedOptions o = certified_tls();
     o.robust.weights_ride_trial_sums = beside;
-    o.weight_observer = [&](int agent, int outer, const std::vector<std::uint64_t>& index,
-                            const std::vector<double>& w) {
-      seen.emplace_back(agent, outer, index, w);
-    };
-    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+    return solve_recording_weights(dirty, o, seen);
   };
   std::vector<Weights> seen_apart, seen_beside;
   const GncDistributedResult apart = run(false, seen_apart);
@@ -117,8 +117,6 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
   EXPECT_EQ(beside.outer_iterations, apart.outer_iterations);
   EXPECT_EQ(beside.total_rounds, apart.total_rounds);
   EXPECT_EQ(beside.refine_message_steps, apart.refine_message_steps);
-  std::sort(seen_apart.begin(), seen_apart.end());
-  std::sort(seen_beside.begin(), seen_beside.end());
   EXPECT_EQ(seen_beside, seen_apart);  // every agent's weights after every outer step, to the bit
   EXPECT_EQ(beside.final_solve.cost, apart.final_solve.cost);
   EXPECT_TRUE(beside.final_solve.certified.value_or(false));
@@ -128,11 +126,7 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
   EXPECT_GE(saved, 1);
   EXPECT_LE(saved, apart.outer_iterations - 1);
   EXPECT_EQ(beside.solve_stages, apart.solve_stages);
-  auto steps = [](const GncDistributedResult& r) {
-    return 2 * r.total_rounds + 2 * (r.solve_stages + r.final_solve_stages) +
-           r.refine_message_steps + r.final_refine_message_steps + r.exchange_steps;
-  };
-  EXPECT_EQ(steps(apart) - steps(beside), saved);
+  EXPECT_EQ(test::message_steps(apart) - test::message_steps(beside), saved);
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
 }
 
@@ -141,9 +135,7 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
 TEST(GncExchangeSteps, TheFirstSolveTakesTheStartVotesPosesAndTheRunIsOneStepShorter) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
   auto run = [&](bool take) {
-    GncDistributedOptions o;
-    o.robust.kind = RobustKind::kGncTls;
-    o.solver.certify = true;
+    GncDistributedOptions o = certified_tls();
     o.robust.first_solve_takes_start_poses = take;
     return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
   };
@@ -166,9 +158,7 @@ TEST(GncExchangeSteps, TheFirstSolveTakesTheStartVotesPosesAndTheRunIsOneStepSho
 TEST(GncExchangeSteps, APassReadsItsLastAcceptedTrialsPosesAndTheRunIsShorter) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
   auto run = [&](bool beside) {
-    GncDistributedOptions o;  // refined passes: Newton steps
-    o.robust.kind = RobustKind::kGncTls;
-    o.solver.certify = true;
+    GncDistributedOptions o = certified_tls();
     o.robust.pass_poses_ride_trial_sums = beside;
     return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
   };

@@ -17,11 +17,7 @@ using test::grid_with_outliers;
 using test::irbcd_gnc;
 using test::robots_as_blocks;
 
-// Every wait for peers of a run (docs/robust.md, "JSON and files": message_steps_total).
-int message_steps(const GncDistributedResult& r) {
-  return 2 * r.total_rounds + 2 * (r.solve_stages + r.final_solve_stages) + r.refine_message_steps +
-         r.final_refine_message_steps + r.exchange_steps;
-}
+using test::message_steps;
 
 // The 125-pose grid with 25 % random outliers: GNC rejects exactly the wrong closures and the
 // passes change nothing. With probe_ratio 1.5 and no tail rule the agents name half the true

@@ -15,6 +15,7 @@
 #include <tessera/distributed/in_process_driver.hpp>
 #include <tessera/distributed/local_rounds.hpp>
 #include <tessera/distributed/stage_tag.hpp>
+#include <tessera/problem/lifting.hpp>
 #include <tessera/util/input_error.hpp>
 #include <vector>
 
@@ -119,19 +120,15 @@ struct Outcome {
 Outcome run(const PoseGraph& graph, const Eigen::MatrixXd& X0, const DistributedOptions& options,
             DeliveryOrder order = DeliveryOrder::kFifo) {
   const BlockLayout layout = make_block_layout(graph.num_poses, graph.measurements, robot_blocks());
-  const Eigen::Index w = graph.d + 1;
   std::vector<std::unique_ptr<AgentState>> states;
   std::vector<std::unique_ptr<CertifiedAgent>> agents;
   std::vector<std::unique_ptr<Counting>> counters;
   std::vector<AgentProcess*> processes;
   for (int b = 0; b < layout.num_blocks; ++b) {
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    Eigen::MatrixXd Yb(X0.rows(), w * static_cast<Eigen::Index>(ids.size()));
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
-          X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-    states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb,
-                                                  options.algorithm_block_update()));
+    states.push_back(std::make_unique<AgentState>(
+        b, graph.d, layout, graph.measurements,
+        gather_pose_columns(X0, layout.poses[static_cast<std::size_t>(b)], graph.d),
+        options.algorithm_block_update()));
     agents.push_back(std::make_unique<CertifiedAgent>(*states.back(), layout, options));
     counters.push_back(std::make_unique<Counting>(*agents.back()));
     processes.push_back(counters.back().get());
@@ -140,10 +137,8 @@ Outcome run(const PoseGraph& graph, const Eigen::MatrixXd& X0, const Distributed
   Outcome out;
   out.X = Eigen::MatrixXd::Zero(X0.rows(), X0.cols());
   for (int b = 0; b < layout.num_blocks; ++b) {
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      out.X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
-          states[static_cast<std::size_t>(b)]->Y.middleCols(w * static_cast<Eigen::Index>(s), w);
+    scatter_pose_columns(states[static_cast<std::size_t>(b)]->Y,
+                         layout.poses[static_cast<std::size_t>(b)], graph.d, out.X);
     out.statuses.push_back(counters[static_cast<std::size_t>(b)]->statuses);
     out.later_statuses.push_back(counters[static_cast<std::size_t>(b)]->later_statuses);
     out.pose_blocks.push_back(counters[static_cast<std::size_t>(b)]->pose_blocks);

@@ -20,10 +20,7 @@ long long message_steps(const DistributedResult& r) {
   return 2LL * r.rounds + 2LL * r.solve_stages + message_steps(r.refines);
 }
 
-long long message_steps(const GncDistributedResult& r) {
-  return 2LL * r.total_rounds + 2LL * (r.solve_stages + r.final_solve_stages) +
-         r.refine_message_steps + r.final_refine_message_steps + r.exchange_steps;
-}
+using test::message_steps;
 
 TEST(MessageSteps, ACleanSolveCountsEveryWaitOfItsLongestChain) {
   const GeneratorResult clean = test::grid_with_outliers(0.0);

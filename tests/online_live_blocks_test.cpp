@@ -31,16 +31,6 @@ double relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).norm() / std::max(1.0, b.norm());
 }
 
-// Columns of the poses `ids` of X (r x (d+1)n).
-Eigen::MatrixXd pose_columns(const Eigen::MatrixXd& X, int d, const std::vector<std::size_t>& ids) {
-  const Eigen::Index w = d + 1;
-  Eigen::MatrixXd out(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
-  for (std::size_t s = 0; s < ids.size(); ++s)
-    out.middleCols(w * static_cast<Eigen::Index>(s), w) =
-        X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-  return out;
-}
-
 // Plays `gen` as its robots' front ends would and syncs a LiveBlocks (blocks = robots) every
 // `every` batches, as the online engine does at its steps.
 struct GrownRun {
@@ -88,7 +78,7 @@ TEST(LiveBlocks, BlocksGrownInPlaceEqualBlocksBuiltOnTheFinalGraph) {
     EXPECT_EQ(run.built, 4);
     EXPECT_GT(run.extended, every == 7 ? 40 : 4);
     // The compact iterate of the linked graph, and a second point to evaluate at.
-    Eigen::MatrixXd Xc = pose_columns(run.X, d, run.live.full_id());
+    Eigen::MatrixXd Xc = gather_pose_columns(run.X, run.live.full_id(), d);
     std::mt19937 rng(7);
     std::normal_distribution<double> noise(0.0, 0.1);
     Eigen::MatrixXd Xr = Xc.unaryExpr([&](double v) { return v + noise(rng); });
@@ -105,10 +95,10 @@ TEST(LiveBlocks, BlocksGrownInPlaceEqualBlocksBuiltOnTheFinalGraph) {
                                     Eigen::MatrixXd(fresh.data_matrix())),
                 1e-14);
       // The state starts from the iterate.
-      EXPECT_EQ(state.Y, pose_columns(Xc, d, layout.poses[static_cast<std::size_t>(c)]));
+      EXPECT_EQ(state.Y, gather_pose_columns(Xc, layout.poses[static_cast<std::size_t>(c)], d));
       for (const Eigen::MatrixXd* P : {&Xc, &Xr}) {
-        const Eigen::MatrixXd Xb = pose_columns(*P, d, grown.owned());
-        const Eigen::MatrixXd Xn = pose_columns(*P, d, grown.neighbors());
+        const Eigen::MatrixXd Xb = gather_pose_columns(*P, grown.owned(), d);
+        const Eigen::MatrixXd Xn = gather_pose_columns(*P, grown.neighbors(), d);
         grown.set_neighbor_poses(Xn);
         fresh.set_neighbor_poses(Xn);
         const double f = fresh.cost(Xb);
@@ -173,14 +163,14 @@ TEST(LiveBlocks, AMoveRebuildsOnlyTheBlocksThatGaveOrTookPoses) {
   EXPECT_EQ(state.tangent_factorizations_total(), factorizations);
   EXPECT_EQ(state.problem().neighbors(), neighbours);
   const PoseGraph& g = run.live.graph();
-  const Eigen::MatrixXd Xc = pose_columns(run.X, g.d, full);
-  EXPECT_EQ(state.Y, pose_columns(Xc, g.d, layout.poses[0]));
+  const Eigen::MatrixXd Xc = gather_pose_columns(run.X, full, g.d);
+  EXPECT_EQ(state.Y, gather_pose_columns(Xc, layout.poses[0], g.d));
   // Every block, kept or built again, is the one a build on the new layout gives: its coarse
   // terms (which read the neighbours' owners) included.
   for (int c = 0; c < layout.num_blocks; ++c) {
     const AgentState& live = *run.live.states()[static_cast<std::size_t>(c)];
     const auto& own = layout.poses[static_cast<std::size_t>(c)];
-    AgentState fresh(c, g.d, layout, g.measurements, pose_columns(Xc, g.d, own));
+    AgentState fresh(c, g.d, layout, g.measurements, gather_pose_columns(Xc, own, g.d));
     EXPECT_EQ(live.problem().owned(), fresh.problem().owned());
     EXPECT_EQ(live.problem().neighbors(), fresh.problem().neighbors());
     fresh.reset_iterate(live.Y, live.Yn);

@@ -12,6 +12,7 @@
 #include <tessera/online/absorb_gate.hpp>
 #include <tessera/online/online_engine.hpp>
 #include <tessera/online/replay_schedule.hpp>
+#include <tessera/problem/lifting.hpp>
 #include <tessera/solvers/centralized_solver.hpp>
 
 #include "runtime/online_agent_view.hpp"
@@ -60,11 +61,8 @@ TEST(RobotLeaves, ARobotThatStopsPublishingKeepsItsBlockAndItsPosesAreStillOptim
       gen.graph.d, plan.batches, online_options(),
       [&](const OnlineEngine& engine, const OnlineUpdate& u) {
         const auto ids = poses_of(engine.stream(), 0);
-        const Eigen::Index w = engine.stream().graph().d + 1;
-        Eigen::MatrixXd now(engine.iterate().rows(), w * static_cast<Eigen::Index>(ids.size()));
-        for (std::size_t s = 0; s < ids.size(); ++s)
-          now.middleCols(w * static_cast<Eigen::Index>(s), w) =
-              engine.iterate().middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
+        const Eigen::MatrixXd now =
+            gather_pose_columns(engine.iterate(), ids, engine.stream().graph().d);
         if (u.time_s > robot0_end) {
           ++steps_after;
           // Its agent is still one of the run's, and its block still holds its poses.

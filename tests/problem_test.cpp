@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <random>
+#include <stdexcept>
 #include <tessera/manifold/lifted_manifold.hpp>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/data_matrix.hpp>
@@ -108,14 +109,8 @@ TEST_P(ProblemTest, BlockCostSharesSumToGlobalCost) {
     std::vector<std::size_t> owned;
     for (std::size_t i = b; i < g.num_poses; i += 3) owned.push_back(i);
     BlockProblem P(d, owned, g.measurements);
-    auto gather = [&](const std::vector<std::size_t>& ids) {
-      Eigen::MatrixXd Xb(r, (d + 1) * static_cast<Eigen::Index>(ids.size()));
-      for (std::size_t k = 0; k < ids.size(); ++k)
-        Xb.middleCols((d + 1) * k, d + 1) = X.middleCols((d + 1) * ids[k], d + 1);
-      return Xb;
-    };
-    P.set_neighbor_poses(gather(P.neighbors()));
-    Eigen::MatrixXd Xb = gather(owned);
+    P.set_neighbor_poses(gather_pose_columns(X, P.neighbors(), d));
+    Eigen::MatrixXd Xb = gather_pose_columns(X, owned, d);
     sum += P.cost_share(Xb);
     // The block gradient equals the global gradient restricted to the block.
     Eigen::MatrixXd G = whole.euclidean_gradient(X);
@@ -280,6 +275,37 @@ TEST_P(ProblemTest, CostAtTheActiveRowsEqualsTheGeneralRankLoopBitForBit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Dimensions, ProblemTest, ::testing::Values(2, 3));
+
+TEST(PoseColumns, AGatheredBlockHoldsItsPosesInIdOrderAndScattersBackIntoThemOnly) {
+  const int d = 2;
+  const Eigen::MatrixXd X = Eigen::MatrixXd::Random(4, 3 * 5);  // rank 4, 5 poses
+  const std::vector<std::size_t> ids{3, 0};
+  const Eigen::MatrixXd Y = gather_pose_columns(X, ids, d);
+  ASSERT_EQ(Y.rows(), 4);
+  ASSERT_EQ(Y.cols(), 6);
+  EXPECT_EQ(Y.leftCols(3), X.middleCols(9, 3));
+  EXPECT_EQ(Y.rightCols(3), X.leftCols(3));
+
+  Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(4, 15);
+  scatter_pose_columns(Y, ids, d, Z);
+  EXPECT_EQ(Z.middleCols(9, 3), X.middleCols(9, 3));
+  EXPECT_EQ(Z.leftCols(3), X.leftCols(3));
+  EXPECT_TRUE(Z.middleCols(3, 6).isZero(0.0));  // poses 1 and 2: not in `ids`
+  EXPECT_TRUE(Z.rightCols(3).isZero(0.0));      // pose 4
+}
+
+TEST(PoseColumns, AnIdPastTheLastPoseOrABlockOfAnotherSizeThrows) {
+  const int d = 3;
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(5, 4 * 3);
+  EXPECT_THROW(gather_pose_columns(X, {1, 3}, d), std::out_of_range);
+  EXPECT_THROW(scatter_pose_columns(Eigen::MatrixXd::Zero(5, 8), {0, 3}, d, X), std::out_of_range);
+  // One pose short, or another rank than X's.
+  EXPECT_THROW(scatter_pose_columns(Eigen::MatrixXd::Zero(5, 4), {0, 1}, d, X),
+               std::invalid_argument);
+  EXPECT_THROW(scatter_pose_columns(Eigen::MatrixXd::Zero(4, 8), {0, 1}, d, X),
+               std::invalid_argument);
+  EXPECT_TRUE(X.isZero(0.0));  // nothing written by a call that throws on its sizes
+}
 
 }  // namespace
 }  // namespace tessera

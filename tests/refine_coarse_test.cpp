@@ -37,16 +37,8 @@ BlockPoint block_point(const PoseGraph& g, const BlockLayout& layout, int b,
                        const Eigen::MatrixXd& Y) {
   BlockPoint p{
       BlockProblem(g.d, layout.poses[static_cast<std::size_t>(b)], g.measurements), {}, {}};
-  const Eigen::Index w = g.d + 1;
-  auto gather = [&](const std::vector<std::size_t>& ids) {
-    Eigen::MatrixXd M(Y.rows(), w * static_cast<Eigen::Index>(ids.size()));
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      M.middleCols(w * static_cast<Eigen::Index>(s), w) =
-          Y.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-    return M;
-  };
-  p.X = gather(p.problem.owned());
-  p.Xn = gather(p.problem.neighbors());
+  p.X = gather_pose_columns(Y, p.problem.owned(), g.d);
+  p.Xn = gather_pose_columns(Y, p.problem.neighbors(), g.d);
   return p;
 }
 

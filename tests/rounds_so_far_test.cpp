@@ -59,19 +59,15 @@ TEST(RoundsSoFar, CountTheRunningSolveStageAndEndAtTheTotal) {
   o.certify = false;
   o.refine.enabled = false;
   const Eigen::MatrixXd X0 = lift_poses(gen.ground_truth, o.rank);
-  const Eigen::Index w = graph.d + 1;
   std::vector<std::unique_ptr<AgentState>> states;
   std::vector<std::unique_ptr<CertifiedAgent>> agents;
   std::vector<std::unique_ptr<Recording>> recorders;
   std::vector<AgentProcess*> processes;
   for (int b = 0; b < layout.num_blocks; ++b) {
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    Eigen::MatrixXd Yb(X0.rows(), w * static_cast<Eigen::Index>(ids.size()));
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
-          X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-    states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb,
-                                                  o.algorithm_block_update()));
+    states.push_back(std::make_unique<AgentState>(
+        b, graph.d, layout, graph.measurements,
+        gather_pose_columns(X0, layout.poses[static_cast<std::size_t>(b)], graph.d),
+        o.algorithm_block_update()));
     agents.push_back(std::make_unique<CertifiedAgent>(*states.back(), layout, o));
     recorders.push_back(std::make_unique<Recording>(*agents.back()));
     processes.push_back(recorders.back().get());

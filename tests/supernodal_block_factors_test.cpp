@@ -29,7 +29,7 @@ TEST(SupernodalBlockFactors, TangentFactorWithSimplicialSolvesIsTheSimplicialOpe
     test::HalfBlock h = test::half_block(d, 5);
     BlockProblem problem(d, h.owned, h.graph.measurements);
     const Eigen::MatrixXd all = lift_poses(h.graph.initial, d);
-    problem.set_neighbor_poses(test::pose_columns(all, d, problem.neighbors()));
+    problem.set_neighbor_poses(gather_pose_columns(all, problem.neighbors(), d));
     TangentPreconditioner simplicial(problem, 1e-9, 0);
     TangentPreconditioner converted(problem, 1e-9, 0, /*supernodal_min_flops=*/1.0,
                                     /*simplicial_solves=*/true);
@@ -39,7 +39,7 @@ TEST(SupernodalBlockFactors, TangentFactorWithSimplicialSolvesIsTheSimplicialOpe
     ASSERT_TRUE(converted.usable());
     const LiftedManifold M = problem.manifold(d);
     std::srand(11);
-    Eigen::MatrixXd X = test::pose_columns(all, d, h.owned);
+    Eigen::MatrixXd X = gather_pose_columns(all, h.owned, d);
     for (int point = 0; point < 3; ++point) {
       X = M.retract(X, 0.01 * M.tangent_project(X, Eigen::MatrixXd::Random(d, X.cols())));
       const Eigen::MatrixXd egrad = problem.euclidean_gradient(X);
@@ -77,7 +77,7 @@ TEST(SupernodalBlockFactors, NearTheThresholdTheExactAnalysisDecides) {
     test::HalfBlock h = test::half_block(d, 8);
     BlockProblem problem(d, h.owned, h.graph.measurements);
     const Eigen::MatrixXd all = lift_poses(h.graph.initial, d);
-    problem.set_neighbor_poses(test::pose_columns(all, d, problem.neighbors()));
+    problem.set_neighbor_poses(gather_pose_columns(all, problem.neighbors(), d));
     TangentPreconditioner simplicial(problem, 1e-9, 0);
     const double flops = simplicial.factor_flops();
     ASSERT_GT(flops, 0.0);
@@ -88,7 +88,7 @@ TEST(SupernodalBlockFactors, NearTheThresholdTheExactAnalysisDecides) {
     EXPECT_TRUE(converted.supernodal_factorization()) << "d = " << d;
     const LiftedManifold M = problem.manifold(d);
     std::srand(17);
-    Eigen::MatrixXd X = test::pose_columns(all, d, h.owned);
+    Eigen::MatrixXd X = gather_pose_columns(all, h.owned, d);
     X = M.retract(X, 0.01 * M.tangent_project(X, Eigen::MatrixXd::Random(d, X.cols())));
     ASSERT_TRUE(simplicial.factorize(X));
     ASSERT_TRUE(converted.factorize(X));

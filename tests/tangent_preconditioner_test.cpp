@@ -43,7 +43,7 @@ Block half_block(int d, std::uint64_t seed, int r) {
 }
 
 Eigen::MatrixXd gather(const Eigen::MatrixXd& from, const std::vector<std::size_t>& which, int d) {
-  return test::pose_columns(from, d, which);
+  return gather_pose_columns(from, which, d);
 }
 
 // 2 V Q as a matrix acting on the column-major vec of a d-row V: 2 (Q kron I_d).

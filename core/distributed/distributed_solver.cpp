@@ -134,20 +134,13 @@ DistributedResult solve_distributed_from_lifted(const PoseGraph& graph,
   std::vector<AgentState*> pointers;
   for (int b = 0; b < N; ++b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    Eigen::MatrixXd Yb(options.rank, w * static_cast<Eigen::Index>(ids.size()));
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      Yb.middleCols(w * static_cast<Eigen::Index>(s), w) =
-          X0.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
+    const Eigen::MatrixXd Yb = gather_pose_columns(X0, ids, graph.d);
     states.push_back(std::make_unique<AgentState>(b, graph.d, layout, graph.measurements, Yb,
                                                   options.block_update));
     if (!std::isnan(known_grad_norm)) {
       // The neighbours' poses of X0, as the rounds' opening exchange would bring them.
-      const auto& nb = states.back()->problem().neighbors();
-      Eigen::MatrixXd Yn(options.rank, w * static_cast<Eigen::Index>(nb.size()));
-      for (std::size_t s = 0; s < nb.size(); ++s)
-        Yn.middleCols(w * static_cast<Eigen::Index>(s), w) =
-            X0.middleCols(w * static_cast<Eigen::Index>(nb[s]), w);
-      states.back()->reset_iterate(Yb, Yn);
+      states.back()->reset_iterate(
+          Yb, gather_pose_columns(X0, states.back()->problem().neighbors(), graph.d));
     }
     pointers.push_back(states.back().get());
   }
@@ -252,13 +245,9 @@ DistributedResult solve_distributed_watching_trials(
   res.escape_rounds = lead.escape_trials();
   res.final_rank = lead.final_rank();
   res.X.resize(res.final_rank, w * static_cast<Eigen::Index>(graph.num_poses));
-  for (int b = 0; b < N; ++b) {
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    const Eigen::MatrixXd& Yb = states[static_cast<std::size_t>(b)]->Y;
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      res.X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
-          Yb.middleCols(w * static_cast<Eigen::Index>(s), w);
-  }
+  for (int b = 0; b < N; ++b)
+    scatter_pose_columns(states[static_cast<std::size_t>(b)]->Y,
+                         layout.poses[static_cast<std::size_t>(b)], graph.d, res.X);
   for (const auto& s : states) {
     res.block_updates += s->block_updates();
     res.tcg_iterations += s->tcg_iterations();

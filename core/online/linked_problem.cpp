@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <tessera/online/linked_problem.hpp>
+#include <tessera/problem/lifting.hpp>
 
 namespace tessera {
 
@@ -9,10 +10,7 @@ int LinkedProblem::compact_block(int b) const {
 }
 
 void LinkedProblem::write_back(const Eigen::MatrixXd& X, Eigen::MatrixXd& full) const {
-  const Eigen::Index w = graph.d + 1;
-  for (std::size_t s = 0; s < full_id.size(); ++s)
-    full.middleCols(w * static_cast<Eigen::Index>(full_id[s]), w) =
-        X.middleCols(w * static_cast<Eigen::Index>(s), w);
+  scatter_pose_columns(X, full_id, graph.d, full);
 }
 
 LinkedProblem make_linked_problem(const PoseGraph& graph, const std::vector<int>& owner,

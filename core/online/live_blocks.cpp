@@ -2,6 +2,7 @@
 #include <stdexcept>
 #include <string>
 #include <tessera/online/live_blocks.hpp>
+#include <tessera/problem/lifting.hpp>
 
 namespace tessera {
 
@@ -65,9 +66,7 @@ void LiveBlocks::write_back(const Eigen::MatrixXd& Xc, Eigen::MatrixXd& X) const
   const Eigen::Index w = d_ + 1;
   if (Xc.rows() != X.rows() || Xc.cols() != w * static_cast<Eigen::Index>(full_id_.size()))
     throw std::invalid_argument("LiveBlocks::write_back: iterate of the wrong size");
-  for (std::size_t s = 0; s < full_id_.size(); ++s)
-    X.middleCols(w * static_cast<Eigen::Index>(full_id_[s]), w) =
-        Xc.middleCols(w * static_cast<Eigen::Index>(s), w);
+  scatter_pose_columns(Xc, full_id_, d_, X);
 }
 
 LiveSync LiveBlocks::sync(const PoseGraph& graph, const std::vector<int>& owner,

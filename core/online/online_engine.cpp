@@ -2,7 +2,6 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
-#include <mutex>
 #include <stdexcept>
 #include <tessera/certification/rounding_gap.hpp>
 #include <tessera/distributed/coarse_space.hpp>
@@ -15,6 +14,8 @@
 #include <tessera/problem/objective.hpp>
 #include <tessera/problem/rounding.hpp>
 #include <tessera/util/input_error.hpp>
+
+#include "online/trial_points.hpp"
 
 namespace tessera {
 
@@ -287,82 +288,6 @@ void use_online_refine_space(const LiveBlocks& blocks, const DistributedOptions&
   for (const auto& s : blocks.states())
     if (s) s->use_refine_space(space);
 }
-
-namespace {
-
-// The agents' trial points of one solve (TrialPointWatch), gathered per trial: agent b's k-th
-// call is the k-th step of its refinements' traces, the same steps on every agent.
-class TrialPoints {
- public:
-  TrialPoints(int blocks, std::function<double()> wall_s, std::function<double()> cpu_s)
-      : blocks_(blocks),
-        wall_s_(std::move(wall_s)),
-        cpu_s_(std::move(cpu_s)),
-        calls_(static_cast<std::size_t>(blocks), 0) {}
-
-  TrialPointWatch watch() {
-    return [this](int b, const Eigen::MatrixXd& Y) {
-      const double wall = wall_s_(), cpu = cpu_s_();
-      const std::lock_guard<std::mutex> lock(mutex_);
-      const std::size_t k = calls_[static_cast<std::size_t>(b)]++;
-      if (trials_.size() <= k) trials_.resize(k + 1);
-      Trial& t = trials_[k];
-      if (t.blocks.empty()) t.blocks.resize(static_cast<std::size_t>(blocks_));
-      t.blocks[static_cast<std::size_t>(b)] = Y;
-      // The point exists once its last block does.
-      t.wall_s = std::max(t.wall_s, wall);
-      t.cpu_s = std::max(t.cpu_s, cpu);
-      ++t.received;
-    };
-  }
-
-  /// The accepted trials of `refines` as points over `X` (stream ids; the linked poses'
-  /// columns replaced through `blocks`).
-  void accepted(const std::vector<NewtonRefineResult>& refines, const LiveBlocks& blocks,
-                const Eigen::MatrixXd& X, std::vector<StepPoint>& out) const {
-    std::vector<const NewtonRefineStep*> steps;
-    for (const NewtonRefineResult& r : refines)
-      for (const NewtonRefineStep& s : r.trace) steps.push_back(&s);
-    if (steps.size() != trials_.size())
-      throw std::logic_error("online step points: " + std::to_string(trials_.size()) +
-                             " trial points for " + std::to_string(steps.size()) + " Newton steps");
-    const BlockLayout& layout = blocks.layout();
-    const Eigen::Index w = blocks.graph().d + 1;
-    int cg = 0;
-    for (std::size_t k = 0; k < steps.size(); ++k) {
-      cg += steps[k]->cg_iterations;
-      if (!steps[k]->accepted) continue;
-      const Trial& t = trials_[k];
-      if (t.received != blocks_)
-        throw std::logic_error("online step points: a trial point lacks a block");
-      Eigen::MatrixXd linked(X.rows(), w * static_cast<Eigen::Index>(layout.owner.size()));
-      for (int b = 0; b < blocks_; ++b) {
-        const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-        const Eigen::MatrixXd& Y = t.blocks[static_cast<std::size_t>(b)];
-        for (std::size_t s = 0; s < ids.size(); ++s)
-          linked.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
-              Y.middleCols(w * static_cast<Eigen::Index>(s), w);
-      }
-      StepPoint p{"newton", t.wall_s, t.cpu_s, static_cast<int>(k) + 1, cg, X};
-      blocks.write_back(linked, p.X);
-      out.push_back(std::move(p));
-    }
-  }
-
- private:
-  struct Trial {
-    std::vector<Eigen::MatrixXd> blocks;
-    int received = 0;
-    double wall_s = 0.0, cpu_s = 0.0;
-  };
-  int blocks_;
-  std::function<double()> wall_s_, cpu_s_;
-  std::mutex mutex_;
-  std::vector<std::size_t> calls_;
-  std::vector<Trial> trials_;
-};
-
-}  // namespace
 
 DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver,
                                              bool keep_newton_points) {

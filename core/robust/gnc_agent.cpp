@@ -8,6 +8,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tessera/problem/lifting.hpp>
 #include <tessera/robust/gnc_agent.hpp>
 #include <tessera/robust/tls_weights.hpp>
 #include <tessera/robust/weighted_graph.hpp>
@@ -152,15 +153,16 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   std::vector<std::vector<std::size_t>> nb(static_cast<std::size_t>(in_.num_agents));
   if (values_held_) {
     nb = cut_neighbours(in_);
-    exchange_->candidate_neighbours() = block_of(X, terms_->neighbours(), in_.d);
+    exchange_->candidate_neighbours() = gather_pose_columns(X, terms_->neighbours(), in_.d);
   }
   for (std::uint32_t a = 1; a < static_cast<std::uint32_t>(in_.num_agents); ++a)
     out.push_back(OutgoingMessage{
-        kept_start_block(block_of(X, base_->poses[a], in_.d), base_->poses[a], in_.d,
-                         gnc_phase(g_, GncExchange::kKeptStart), block_of(X, nb[a], in_.d), nb[a]),
+        kept_start_block(gather_pose_columns(X, base_->poses[a], in_.d), base_->poses[a], in_.d,
+                         gnc_phase(g_, GncExchange::kKeptStart),
+                         gather_pose_columns(X, nb[a], in_.d), nb[a]),
         false,
         {a}});
-  exchange_->candidate() = block_of(X, base_->poses[0], in_.d);
+  exchange_->candidate() = gather_pose_columns(X, base_->poses[0], in_.d);
 }
 
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {

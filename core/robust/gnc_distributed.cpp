@@ -125,8 +125,8 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
       in.measurement_index.push_back(e);
     }
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    in.Y0 = block_of(X0, ids, graph.d);
-    if (known) in.Y0_known = block_of(X0_known, ids, graph.d);
+    in.Y0 = gather_pose_columns(X0, ids, graph.d);
+    if (known) in.Y0_known = gather_pose_columns(X0_known, ids, graph.d);
     in.kept_set_start = options.kept_set_start;
     in.initialization = solver.initialization;
     in.source = graph.source;
@@ -169,11 +169,8 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   Eigen::MatrixXd X(solver.rank, w * static_cast<Eigen::Index>(graph.num_poses));
   for (int b = 0; b < agents; ++b) {
     const GncAgent& a = *gnc[static_cast<std::size_t>(b)];
-    const Eigen::MatrixXd& Y = final_runs ? a.state().Y : a.last_pass_start();
-    const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    for (std::size_t s = 0; s < ids.size(); ++s)
-      X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w) =
-          Y.middleCols(w * static_cast<Eigen::Index>(s), w);
+    scatter_pose_columns(final_runs ? a.state().Y : a.last_pass_start(),
+                         layout.poses[static_cast<std::size_t>(b)], graph.d, X);
   }
   DistributedOptions last = solver;
   // The refinement as the agents' own solve of that kind had it.

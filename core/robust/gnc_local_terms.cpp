@@ -51,15 +51,6 @@ std::optional<std::size_t> position_of(const std::vector<std::uint64_t>& index, 
   return static_cast<std::size_t>(pos - index.begin());
 }
 
-Eigen::MatrixXd block_of(const Eigen::MatrixXd& X, const std::vector<std::size_t>& ids, int d) {
-  const Eigen::Index w = d + 1;
-  Eigen::MatrixXd Y(X.rows(), w * static_cast<Eigen::Index>(ids.size()));
-  for (std::size_t s = 0; s < ids.size(); ++s)
-    Y.middleCols(w * static_cast<Eigen::Index>(s), w) =
-        X.middleCols(w * static_cast<Eigen::Index>(ids[s]), w);
-  return Y;
-}
-
 GncLocalTerms::GncLocalTerms(const GncAgentInput& in, const RobustOptions& robust,
                              const BlockLayout& base)
     : in_(in), base_(base) {

@@ -65,7 +65,4 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_without(
 /// Where the measurement of file position `id` is in `index` (ascending), if it is there.
 std::optional<std::size_t> position_of(const std::vector<std::uint64_t>& index, std::uint64_t id);
 
-/// The columns of the poses `ids` (ascending) of X (r x (d+1)n, every pose): one agent's block.
-Eigen::MatrixXd block_of(const Eigen::MatrixXd& X, const std::vector<std::size_t>& ids, int d);
-
 }  // namespace tessera

@@ -4,16 +4,6 @@
 
 namespace tessera::test {
 
-Eigen::MatrixXd pose_columns(const Eigen::MatrixXd& X, int d,
-                             const std::vector<std::size_t>& which) {
-  const Eigen::Index w = d + 1;
-  Eigen::MatrixXd out(X.rows(), w * static_cast<Eigen::Index>(which.size()));
-  for (std::size_t s = 0; s < which.size(); ++s)
-    out.middleCols(w * static_cast<Eigen::Index>(s), w) =
-        X.middleCols(w * static_cast<Eigen::Index>(which[s]), w);
-  return out;
-}
-
 HalfBlock half_block(int d, std::uint64_t seed) {
   RandomGraphSpec spec;
   spec.d = d;

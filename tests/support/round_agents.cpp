@@ -3,8 +3,6 @@
 #include <Eigen/Core>
 #include <tessera/problem/lifting.hpp>
 
-#include "lifted_blocks.hpp"
-
 namespace tessera::test {
 
 AgentsOfRun::AgentsOfRun(const PoseGraph& g, int N, const DistributedOptions& opt) : graph(g) {
@@ -17,8 +15,8 @@ AgentsOfRun::AgentsOfRun(const PoseGraph& g, int N, const DistributedOptions& op
   const RoundConfig config = make_round_config(opt, scheme.get());
   for (int b = 0; b < N; ++b) {
     const auto& ids = layout.poses[static_cast<std::size_t>(b)];
-    states.push_back(
-        std::make_unique<AgentState>(b, g.d, layout, g.measurements, pose_columns(X0, g.d, ids)));
+    states.push_back(std::make_unique<AgentState>(b, g.d, layout, g.measurements,
+                                                  gather_pose_columns(X0, ids, g.d)));
     protocols.push_back(std::make_unique<RoundProtocol>(*states.back(), layout, config));
     agents.push_back(protocols.back().get());
   }
