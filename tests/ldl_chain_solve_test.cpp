@@ -2,7 +2,7 @@
 // cholmod_solve2's result, bit for bit, on simplicial LDL^T factors of pose-block matrices:
 // with a pose-contiguous ordering (the preconditioner's), with CHOLMOD's scalar AMD ordering,
 // and after a supernodal factor's conversion (explicit zeros in the pattern); supernodal
-// factors are refused.
+// factors are refused. Both kernel sets (AVX where the CPU has it, and SSE2) are checked.
 
 #include "solvers/ldl_chain_solve.hpp"
 
@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "solvers/tangent_factor.hpp"
+#include "util/avx_kernels.hpp"
 
 namespace tessera {
 namespace {
@@ -80,12 +81,19 @@ void expect_same_bits(CholmodLdlt& llt, Eigen::Index n) {
     Eigen::VectorXd mine(n);
     chain.solve(llt.factor(), b.data(), mine.data());
     EXPECT_EQ(std::memcmp(mine.data(), x->x, static_cast<std::size_t>(n) * sizeof(double)), 0);
+    // The baseline (SSE2) kernels as well where the AVX ones ran.
+    const bool avx = set_avx_kernels(false);
+    chain.solve(llt.factor(), b.data(), mine.data());
+    set_avx_kernels(avx);
+    EXPECT_EQ(std::memcmp(mine.data(), x->x, static_cast<std::size_t>(n) * sizeof(double)), 0)
+        << "without AVX";
     cholmod_free_dense(&x, &llt.cholmod());
   }
 }
 
 TEST(LdlChainSolve, MatchesCholmodBitForBitWithPoseContiguousOrdering) {
-  for (int p : {3, 6}) {
+  // Runs of 3, 6 and 7 rows: every remainder after the four-row registers.
+  for (int p : {3, 6, 7}) {
     SparseMatrix A = pose_block_matrix(60, p, 50, 11u + static_cast<unsigned>(p));
     std::vector<int> order = pose_contiguous_order(60, p, 5);
     CholmodLdlt llt;

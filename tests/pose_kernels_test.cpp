@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "random_graph.hpp"
+#include "util/avx_kernels.hpp"
 
 namespace tessera {
 namespace {
@@ -65,6 +66,11 @@ TEST_P(PoseKernels, PoseBlockProductIsBitIdenticalToTheSparseOne) {
     scaled_dense_times_sparse(X, Q, 2.0, sparse);
     B.times(X, 2.0, blocks);
     EXPECT_TRUE(blocks == sparse) << d << " " << rows;
+    // The baseline (SSE2) kernels as well where the AVX ones ran.
+    const bool avx = set_avx_kernels(false);
+    B.times(X, 2.0, blocks);
+    set_avx_kernels(avx);
+    EXPECT_TRUE(blocks == sparse) << d << " " << rows << " without AVX";
   }
   // A block problem's gradient and Hessian products, with and without the pose blocks.
   std::vector<std::size_t> own;

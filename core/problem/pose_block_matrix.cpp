@@ -3,6 +3,13 @@
 #include <stdexcept>
 #include <tessera/problem/pose_block_matrix.hpp>
 
+#include "util/avx_kernels.hpp"
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define TESSERA_AVX_KERNELS 1
+#endif
+
 namespace tessera {
 
 PoseBlockMatrix::PoseBlockMatrix(const SparseMatrix& Q, int w) : w_(w), rows_(Q.rows()) {
@@ -152,6 +159,46 @@ inline void block_times_3_by_4(const double* X, const std::vector<std::size_t>& 
   }
 }
 
+#ifdef TESSERA_AVX_KERNELS
+// block_times_3_by_4 with a block row's four entries in one AVX register: the accumulator of
+// output row a holds its four columns, and each term is X's entry (a, p) broadcast times the
+// block's row p. The same multiplications and additions per entry in the same order (no FMA),
+// so the same values, for half the vector instructions.
+__attribute__((target("avx"))) void block_times_3_by_4_avx(const double* X,
+                                                           const std::vector<std::size_t>& start,
+                                                           const std::vector<int>& row_block,
+                                                           const std::vector<double>& values,
+                                                           double scale, double* out) {
+  constexpr Eigen::Index pose = 12;
+  const __m256d s = _mm256_set1_pd(scale);
+  for (std::size_t J = 0; J + 1 < start.size(); ++J) {
+    __m256d acc0 = _mm256_setzero_pd(), acc1 = acc0, acc2 = acc0;
+    for (std::size_t b = start[J]; b < start[J + 1]; ++b) {
+      const double* x = X + pose * row_block[b];
+      const double* v = values.data() + b * 16;
+#pragma GCC unroll 4
+      for (int p = 0; p < 4; ++p) {
+        const __m256d row = _mm256_loadu_pd(v + 4 * p);
+        acc0 = _mm256_add_pd(acc0, _mm256_mul_pd(_mm256_broadcast_sd(x + 3 * p), row));
+        acc1 = _mm256_add_pd(acc1, _mm256_mul_pd(_mm256_broadcast_sd(x + 3 * p + 1), row));
+        acc2 = _mm256_add_pd(acc2, _mm256_mul_pd(_mm256_broadcast_sd(x + 3 * p + 2), row));
+      }
+    }
+    alignas(32) double r[3][4];
+    _mm256_store_pd(r[0], _mm256_mul_pd(s, acc0));
+    _mm256_store_pd(r[1], _mm256_mul_pd(s, acc1));
+    _mm256_store_pd(r[2], _mm256_mul_pd(s, acc2));
+    double* o = out + pose * static_cast<Eigen::Index>(J);
+#pragma GCC unroll 4
+    for (int q = 0; q < 4; ++q) {
+      o[3 * q] = r[0][q];
+      o[3 * q + 1] = r[1][q];
+      o[3 * q + 2] = r[2][q];
+    }
+  }
+}
+#endif
+
 template <int W>
 void block_times_rows(const double* X, Eigen::Index r, const std::vector<std::size_t>& start,
                       const std::vector<int>& row_block, const std::vector<double>& values,
@@ -160,9 +207,13 @@ void block_times_rows(const double* X, Eigen::Index r, const std::vector<std::si
     case 2:
       return block_times<W, 2>(X, r, start, row_block, values, scale, out);
     case 3:
-      if constexpr (W == 4)
+      if constexpr (W == 4) {
+#ifdef TESSERA_AVX_KERNELS
+        if (avx_kernels_enabled())
+          return block_times_3_by_4_avx(X, start, row_block, values, scale, out);
+#endif
         return block_times_3_by_4(X, start, row_block, values, scale, out);
-      else
+      } else
         return block_times_3<W>(X, start, row_block, values, scale, out);
     case 4:
       return block_times<W, 4>(X, r, start, row_block, values, scale, out);

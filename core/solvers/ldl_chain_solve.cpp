@@ -1,7 +1,13 @@
 #include "solvers/ldl_chain_solve.hpp"
 
+#include "util/avx_kernels.hpp"
+
 #ifdef __SSE2__
 #include <emmintrin.h>
+#endif
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define TESSERA_AVX_KERNELS 1
 #endif
 
 namespace tessera {
@@ -96,6 +102,131 @@ void backward_runs(double (&y)[3], const double* (&a)[3], const double* X,
   y[2] = y2;
 }
 
+// The baseline kernels, as the solve's chain loop calls them.
+struct Sse2Kernels {
+  template <class... Args>
+  static void forward_run(Args... args) {
+    ::tessera::forward_run(args...);
+  }
+  template <int W>
+  static void backward_runs(double (&y)[3], const double* (&a)[3], const double* X,
+                            const LdlChainSolve::Run* run, const LdlChainSolve::Run* end) {
+    ::tessera::backward_runs<W>(y, a, X, run, end);
+  }
+};
+
+#ifdef TESSERA_AVX_KERNELS
+// The same row updates and dots with four rows to an AVX register (no FMA: each product is
+// rounded before it is added, as above), so the same values.
+struct AvxKernels {
+  __attribute__((target("avx"))) static void forward_run(double* x, const double* a, double y0,
+                                                         int length) {
+    int k = 0;
+    const __m256d v0 = _mm256_set1_pd(y0);
+    for (; k + 4 <= length; k += 4)
+      _mm256_storeu_pd(
+          x + k, _mm256_sub_pd(_mm256_loadu_pd(x + k), _mm256_mul_pd(_mm256_loadu_pd(a + k), v0)));
+    if (k + 2 <= length) {
+      const __m128d w0 = _mm256_castpd256_pd128(v0);
+      _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), _mm_mul_pd(_mm_loadu_pd(a + k), w0)));
+      k += 2;
+    }
+    for (; k < length; ++k) x[k] -= a[k] * y0;
+  }
+  __attribute__((target("avx"))) static void forward_run(double* x, const double* a,
+                                                         const double* b, double y0, double y1,
+                                                         int length) {
+    int k = 0;
+    const __m256d v0 = _mm256_set1_pd(y0), v1 = _mm256_set1_pd(y1);
+    for (; k + 4 <= length; k += 4) {
+      const __m256d s = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(a + k), v0),
+                                      _mm256_mul_pd(_mm256_loadu_pd(b + k), v1));
+      _mm256_storeu_pd(x + k, _mm256_sub_pd(_mm256_loadu_pd(x + k), s));
+    }
+    if (k + 2 <= length) {
+      const __m128d s = _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(a + k), _mm256_castpd256_pd128(v0)),
+                                   _mm_mul_pd(_mm_loadu_pd(b + k), _mm256_castpd256_pd128(v1)));
+      _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), s));
+      k += 2;
+    }
+    for (; k < length; ++k) x[k] -= a[k] * y0 + b[k] * y1;
+  }
+  __attribute__((target("avx"))) static void forward_run(double* x, const double* a,
+                                                         const double* b, const double* c,
+                                                         double y0, double y1, double y2,
+                                                         int length) {
+    int k = 0;
+    const __m256d v0 = _mm256_set1_pd(y0), v1 = _mm256_set1_pd(y1), v2 = _mm256_set1_pd(y2);
+    for (; k + 4 <= length; k += 4) {
+      __m256d s = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(a + k), v0),
+                                _mm256_mul_pd(_mm256_loadu_pd(b + k), v1));
+      s = _mm256_add_pd(s, _mm256_mul_pd(_mm256_loadu_pd(c + k), v2));
+      _mm256_storeu_pd(x + k, _mm256_sub_pd(_mm256_loadu_pd(x + k), s));
+    }
+    if (k + 2 <= length) {
+      __m128d s = _mm_add_pd(_mm_mul_pd(_mm_loadu_pd(a + k), _mm256_castpd256_pd128(v0)),
+                             _mm_mul_pd(_mm_loadu_pd(b + k), _mm256_castpd256_pd128(v1)));
+      s = _mm_add_pd(s, _mm_mul_pd(_mm_loadu_pd(c + k), _mm256_castpd256_pd128(v2)));
+      _mm_storeu_pd(x + k, _mm_sub_pd(_mm_loadu_pd(x + k), s));
+      k += 2;
+    }
+    for (; k < length; ++k) x[k] -= a[k] * y0 + b[k] * y1 + c[k] * y2;
+  }
+
+  // backward_runs<W> with four rows' products in one register, subtracted lane by lane in row
+  // order (two SSE2 pairs, low lane first).
+  template <int W>
+  __attribute__((target("avx"))) static void backward_runs(double (&y)[3], const double* (&a)[3],
+                                                           const double* X,
+                                                           const LdlChainSolve::Run* run,
+                                                           const LdlChainSolve::Run* end) {
+    const double* a0 = a[0];
+    const double* a1 = a[1];
+    const double* a2 = a[2];
+    __m128d s0 = _mm_set_sd(y[0]), s1 = _mm_set_sd(y[1]), s2 = _mm_set_sd(y[2]);
+    for (; run != end; ++run) {
+      const double* x = X + run->row;
+      const int length = run->length;
+      int k = 0;
+      for (; k + 4 <= length; k += 4) {
+        const __m256d xv = _mm256_loadu_pd(x + k);
+        subtract_quad(s0, _mm256_mul_pd(_mm256_loadu_pd(a0 + k), xv));
+        if constexpr (W > 1) subtract_quad(s1, _mm256_mul_pd(_mm256_loadu_pd(a1 + k), xv));
+        if constexpr (W > 2) subtract_quad(s2, _mm256_mul_pd(_mm256_loadu_pd(a2 + k), xv));
+      }
+      if (k + 2 <= length) {
+        const __m128d xv = _mm_loadu_pd(x + k);
+        subtract_pair(s0, _mm_mul_pd(_mm_loadu_pd(a0 + k), xv));
+        if constexpr (W > 1) subtract_pair(s1, _mm_mul_pd(_mm_loadu_pd(a1 + k), xv));
+        if constexpr (W > 2) subtract_pair(s2, _mm_mul_pd(_mm_loadu_pd(a2 + k), xv));
+        k += 2;
+      }
+      if (k < length) {
+        const __m128d xv = _mm_load_sd(x + k);
+        s0 = _mm_sub_sd(s0, _mm_mul_sd(_mm_load_sd(a0 + k), xv));
+        if constexpr (W > 1) s1 = _mm_sub_sd(s1, _mm_mul_sd(_mm_load_sd(a1 + k), xv));
+        if constexpr (W > 2) s2 = _mm_sub_sd(s2, _mm_mul_sd(_mm_load_sd(a2 + k), xv));
+      }
+      a0 += length;
+      a1 += length;
+      a2 += length;
+    }
+    y[0] = _mm_cvtsd_f64(s0);
+    y[1] = _mm_cvtsd_f64(s1);
+    y[2] = _mm_cvtsd_f64(s2);
+  }
+
+ private:
+  __attribute__((target("avx"))) static void subtract_pair(__m128d& y, __m128d product) {
+    y = _mm_sub_sd(_mm_sub_sd(y, product), _mm_unpackhi_pd(product, product));
+  }
+  __attribute__((target("avx"))) static void subtract_quad(__m128d& y, __m256d product) {
+    subtract_pair(y, _mm256_castpd256_pd128(product));
+    subtract_pair(y, _mm256_extractf128_pd(product, 1));
+  }
+};
+#endif
+
 }  // namespace
 
 void LdlChainSolve::clear() {
@@ -157,12 +288,31 @@ bool LdlChainSolve::build(const cholmod_factor* L) {
 
 void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* out) const {
   const int n = static_cast<int>(L->n);
-  const auto* Lp = static_cast<const int*>(L->p);
-  const auto* Lx = static_cast<const double*>(L->x);
   const auto* perm = static_cast<const int*>(L->Perm);
   double* X = y_.data();
   for (int k = 0; k < n; ++k) X[k] = rhs[perm ? perm[k] : k];
+#ifdef TESSERA_AVX_KERNELS
+  if (avx_kernels_enabled())
+    solve_chains_avx(L, X);
+  else
+#endif
+    solve_chains<Sse2Kernels>(L, X);
+  for (int k = 0; k < n; ++k) out[perm ? perm[k] : k] = X[k];
+}
 
+#ifdef TESSERA_AVX_KERNELS
+// The chain loop compiled for AVX, so that the AVX kernels inline into it.
+__attribute__((target("avx"), flatten)) void LdlChainSolve::solve_chains_avx(
+    const cholmod_factor* L, double* X) const {
+  solve_chains<AvxKernels>(L, X);
+}
+#endif
+
+template <class Kernels>
+inline __attribute__((always_inline)) void LdlChainSolve::solve_chains(const cholmod_factor* L,
+                                                                       double* X) const {
+  const auto* Lp = static_cast<const int*>(L->p);
+  const auto* Lx = static_cast<const double*>(L->x);
   // L y = P b (unit diagonal).
   for (const Chain& ch : forward_) {
     const int j = ch.column, p = Lp[j];
@@ -171,7 +321,8 @@ void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* ou
     if (ch.width == 1) {
       const double y0 = X[j];
       const double* a = Lx + p + 1;
-      for (; run != end; a += run->length, ++run) forward_run(X + run->row, a, y0, run->length);
+      for (; run != end; a += run->length, ++run)
+        Kernels::forward_run(X + run->row, a, y0, run->length);
     } else if (ch.width == 2) {
       const int q = Lp[j + 1];
       const double y0 = X[j];
@@ -180,7 +331,7 @@ void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* ou
       const double* a = Lx + p + 2;
       const double* b = Lx + q + 1;
       for (; run != end; a += run->length, b += run->length, ++run)
-        forward_run(X + run->row, a, b, y0, y1, run->length);
+        Kernels::forward_run(X + run->row, a, b, y0, y1, run->length);
     } else {
       const int q = Lp[j + 1], r = Lp[j + 2];
       const double y0 = X[j];
@@ -192,7 +343,7 @@ void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* ou
       const double* b = Lx + q + 2;
       const double* c = Lx + r + 1;
       for (; run != end; a += run->length, b += run->length, c += run->length, ++run)
-        forward_run(X + run->row, a, b, c, y0, y1, y2, run->length);
+        Kernels::forward_run(X + run->row, a, b, c, y0, y1, y2, run->length);
     }
   }
 
@@ -211,11 +362,11 @@ void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* ou
     }
     const double* a[3] = {Lx + col[0] + 1, Lx + col[1] + 2, Lx + col[2] + 3};
     if (w == 3)
-      backward_runs<3>(y, a, X, run, end);
+      Kernels::template backward_runs<3>(y, a, X, run, end);
     else if (w == 2)
-      backward_runs<2>(y, a, X, run, end);
+      Kernels::template backward_runs<2>(y, a, X, run, end);
     else
-      backward_runs<1>(y, a, X, run, end);
+      Kernels::template backward_runs<1>(y, a, X, run, end);
     if (w == 2) {
       y[1] -= Lx[col[1] + 1] * y[0];
     } else if (w == 3) {
@@ -224,7 +375,6 @@ void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* ou
     }
     for (int c = w - 1; c >= 0; --c) X[j - c] = y[c];
   }
-  for (int k = 0; k < n; ++k) out[perm ? perm[k] : k] = X[k];
 }
 
 }  // namespace tessera

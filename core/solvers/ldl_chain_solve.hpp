@@ -46,6 +46,10 @@ class LdlChainSolve {
     int run_begin, run_end;
   };
   static void add_runs(const int* rows, int count, std::vector<Run>& runs);
+  // The forward and backward substitutions on X (permuted order), with one kernel set.
+  template <class Kernels>
+  void solve_chains(const cholmod_factor* L, double* X) const;
+  void solve_chains_avx(const cholmod_factor* L, double* X) const;
 
   std::vector<Chain> forward_, backward_;
   std::vector<Run> forward_runs_, backward_runs_;
