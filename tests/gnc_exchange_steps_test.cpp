@@ -93,7 +93,7 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   EXPECT_EQ(along.final_solve_stages, apart.final_solve_stages);
   // Every step left out was a real wait: the longest chain of messages is shorter by as many.
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - along.longest_chain),
-            test::message_steps(apart) - test::message_steps(along));
+            message_steps(apart) - message_steps(along));
 }
 
 // RobustOptions::weights_ride_trial_sums: each weight update after a weighted solve by a single
@@ -126,7 +126,7 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
   EXPECT_GE(saved, 1);
   EXPECT_LE(saved, apart.outer_iterations - 1);
   EXPECT_EQ(beside.solve_stages, apart.solve_stages);
-  EXPECT_EQ(test::message_steps(apart) - test::message_steps(beside), saved);
+  EXPECT_EQ(message_steps(apart) - message_steps(beside), saved);
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
 }
 
