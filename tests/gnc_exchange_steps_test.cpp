@@ -37,6 +37,25 @@ GncDistributedResult solve_recording_weights(const GeneratorResult& dirty, GncDi
   return r;
 }
 
+// `dirty` solved with certified_tls() and the RobustOptions switch `flag` set to `on`.
+GncDistributedResult solve_with(const GeneratorResult& dirty, bool RobustOptions::*flag, bool on) {
+  GncDistributedOptions o = certified_tls();
+  o.robust.*flag = on;
+  return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+}
+
+// The same run but for its message steps: the same set, outer steps, rounds, refinements' steps
+// and final iterate, to the bit.
+void expect_same_run(const GncDistributedResult& a, const GncDistributedResult& b) {
+  EXPECT_EQ(a.rejected, b.rejected);
+  EXPECT_EQ(a.readmitted, b.readmitted);
+  EXPECT_EQ(a.outer_iterations, b.outer_iterations);
+  EXPECT_EQ(a.total_rounds, b.total_rounds);
+  EXPECT_EQ(a.refine_message_steps, b.refine_message_steps);
+  EXPECT_EQ(a.final_solve.cost, b.final_solve.cost);
+  EXPECT_EQ(a.final_solve.X, b.final_solve.X);
+}
+
 GncDistributedOptions capped(int outer) {
   GncDistributedOptions o = certified_tls();
   o.robust.max_outer_iterations = outer;
@@ -134,20 +153,11 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
 // is also the first solve's opening exchange; the run is the same, one message step shorter.
 TEST(GncExchangeSteps, TheFirstSolveTakesTheStartVotesPosesAndTheRunIsOneStepShorter) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
-  auto run = [&](bool take) {
-    GncDistributedOptions o = certified_tls();
-    o.robust.first_solve_takes_start_poses = take;
-    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
-  };
-  const GncDistributedResult apart = run(false);
-  const GncDistributedResult taken = run(true);
+  const auto flag = &RobustOptions::first_solve_takes_start_poses;
+  const GncDistributedResult apart = solve_with(dirty, flag, false);
+  const GncDistributedResult taken = solve_with(dirty, flag, true);
   ASSERT_TRUE(apart.final_solve.certified.value_or(false));
-  EXPECT_EQ(taken.rejected, apart.rejected);
-  EXPECT_EQ(taken.outer_iterations, apart.outer_iterations);
-  EXPECT_EQ(taken.total_rounds, apart.total_rounds);
-  EXPECT_EQ(taken.refine_message_steps, apart.refine_message_steps);
-  EXPECT_EQ(taken.final_solve.cost, apart.final_solve.cost);
-  EXPECT_EQ(taken.final_solve.X, apart.final_solve.X);  // the same iterate, to the bit
+  expect_same_run(taken, apart);
   EXPECT_EQ(apart.exchange_steps - taken.exchange_steps, 1);
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - taken.longest_chain), 1);
 }
@@ -157,20 +167,11 @@ TEST(GncExchangeSteps, TheFirstSolveTakesTheStartVotesPosesAndTheRunIsOneStepSho
 // the same, one message step shorter per such pass.
 TEST(GncExchangeSteps, APassReadsItsLastAcceptedTrialsPosesAndTheRunIsShorter) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
-  auto run = [&](bool beside) {
-    GncDistributedOptions o = certified_tls();
-    o.robust.pass_poses_ride_trial_sums = beside;
-    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
-  };
-  const GncDistributedResult apart = run(false);
-  const GncDistributedResult beside = run(true);
+  const auto flag = &RobustOptions::pass_poses_ride_trial_sums;
+  const GncDistributedResult apart = solve_with(dirty, flag, false);
+  const GncDistributedResult beside = solve_with(dirty, flag, true);
   ASSERT_TRUE(apart.final_solve.certified.value_or(false));
-  EXPECT_EQ(beside.rejected, apart.rejected);
-  EXPECT_EQ(beside.readmitted, apart.readmitted);
-  EXPECT_EQ(beside.total_rounds, apart.total_rounds);
-  EXPECT_EQ(beside.refine_message_steps, apart.refine_message_steps);
-  EXPECT_EQ(beside.final_solve.cost, apart.final_solve.cost);
-  EXPECT_EQ(beside.final_solve.X, apart.final_solve.X);  // the same iterate, to the bit
+  expect_same_run(beside, apart);
   const int saved = apart.exchange_steps - beside.exchange_steps;
   EXPECT_GE(saved, 1);  // at least the pass after GNC
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
