@@ -174,17 +174,14 @@ void add_distributed_robust_fields(JsonObject& json, const RobustOptions& option
   rs.probes = gnc.probes;
   rs.probes_kept = gnc.probes_kept;
   add_robust_fields(json, rs);
-  const long long gnc_refine_steps = gnc.refine_message_steps;
-  const long long exchange_steps = gnc.exchange_steps;
-  const long long solve_stages = gnc.solve_stages + final_solve_stages;
   json.add("gnc_step_sigma", options.step_sigma_every_agent ? "every" : "refine-sigma")
       .add("total_rounds", rounds)
-      .add("gnc_refine_steps", gnc_refine_steps)
-      .add("gnc_exchange_steps", exchange_steps)
+      .add("gnc_refine_steps", gnc.refine_message_steps)
+      .add("gnc_exchange_steps", gnc.exchange_steps)
       .add("final_refine_steps", final_refine_steps)
-      .add("solve_stages", solve_stages)
+      .add("solve_stages", gnc.solve_stages + final_solve_stages)
       .add("message_steps_total",
-           2 * rounds + 2 * solve_stages + gnc_refine_steps + final_refine_steps + exchange_steps);
+           message_steps(gnc, rounds, final_solve_stages, final_refine_steps));
 }
 
 }  // namespace tessera::cli

@@ -62,8 +62,8 @@ void add_robust_fields(JsonObject& json, const RobustSummary& summary);
 /// gnc_refine_steps, gnc_exchange_steps, final_refine_steps (the final solve's Newton
 /// refinement's, `final_refine_steps`), solve_stages (GncAgentResult::solve_stages +
 /// `final_solve_stages`: each opens with a pose exchange and ends with a status round) and
-/// message_steps_total = 2 x rounds + 2 x solve_stages + the other three (`tessera solve` and
-/// the coordinator's summary alike).
+/// message_steps_total (core's message_steps of GncAgentResult: 2 x rounds + 2 x solve_stages +
+/// the other three; `tessera solve` and the coordinator's summary alike).
 void add_distributed_robust_fields(JsonObject& json, const RobustOptions& options,
                                    const GncAgentResult& gnc, long long rounds,
                                    std::size_t measurements, long long final_refine_steps,

@@ -633,12 +633,9 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       j.add("total_bytes", static_cast<long long>(gnc.total_bytes))
           .add("longest_message_chain", static_cast<long long>(gnc.longest_chain));
     } else {
-      // Every wait for peers of the run (docs/robust.md): two a round (docs/irbcd.md), two a
-      // solve stage (its opening pose exchange and closing status round) and the Newton
-      // refinements' neighbour exchanges and all-agent sums.
+      // Without GNC's exchanges: the plain run's count (DistributedResult's message_steps).
       j.add("solve_stages", r.solve_stages)
-          .add("message_steps_total",
-               2LL * r.rounds + 2LL * r.solve_stages + message_steps(r.refines))
+          .add("message_steps_total", message_steps(r))
           .add("longest_message_chain", static_cast<long long>(r.longest_chain));
     }
     write_output(*p, j.str());

@@ -65,12 +65,12 @@ struct FilePartitionJob::State {
 };
 
 FilePartitionJob::FilePartitionJob(std::string path, std::uint32_t num_agents, std::string preset,
-                                   std::uint64_t seed, double time_limit_s, int nice)
+                                   std::uint64_t seed, double time_limit_s, int nice_offset)
     : state_(std::make_shared<State>()) {
   std::thread([st = state_, path = std::move(path), num_agents, preset = std::move(preset), seed,
-               time_limit_s, nice] {
+               time_limit_s, nice_offset] {
     // Before the file's read too: it is the partition's input, in the same start-up.
-    const int got_nice = lower_partition_thread_nice(nice);
+    const int got_nice = lower_partition_thread_nice(nice_offset);
     const auto started = std::chrono::steady_clock::now();
     std::string why;
     std::optional<FilePartition> r =

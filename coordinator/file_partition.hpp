@@ -43,14 +43,14 @@ std::optional<FilePartition> partition_graph_file(const std::string& path, std::
                                                   const std::string& preset, std::uint64_t seed,
                                                   std::string* why, double time_limit_s = 0.0);
 
-/// partition_graph_file on a thread of its own, started at once, its nice lowered by -`nice`
-/// where the process may (partition_priority.hpp; the result's `part.thread_nice` says by how
-/// much it was). The thread is detached: a process that fails before taking the result exits
-/// (transport::exit_process) without waiting for it.
+/// partition_graph_file on a thread of its own, started at once, its nice moved by
+/// `nice_offset` (-20..0) from the process's where the kernel allows it (partition_priority.hpp;
+/// the result's `part.thread_nice` says by how much it was). The thread is detached: a process that
+/// fails before taking the result exits (transport::exit_process) without waiting for it.
 class FilePartitionJob {
  public:
   FilePartitionJob(std::string path, std::uint32_t num_agents, std::string preset,
-                   std::uint64_t seed, double time_limit_s = 0.0, int nice = 0);
+                   std::uint64_t seed, double time_limit_s = 0.0, int nice_offset = 0);
   /// True once the result is there; waits at most `wait` for it.
   bool ready(std::chrono::milliseconds wait) const;
   /// Waits for the result (local work with no timeout, like the partition of the

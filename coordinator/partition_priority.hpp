@@ -18,10 +18,9 @@
 
 namespace tessera::coordinator {
 
-/// Lowers the calling thread's nice by -`offset` (offset -20..0; 0 = leave it), relative to its
-/// own, so that a run started under `nice -n K` keeps its place among the user's processes (a
-/// nice below -20 is -20). Returns the change it got: `offset` (less when clamped), 0 when the
-/// kernel refused.
+/// Moves the calling thread's nice by `offset` (-20..0; 0 = leave it) from its own, so that a run
+/// started under `nice -n K` keeps its place among the user's processes (a nice below -20 is -20).
+/// Returns the change it got: `offset` (less when clamped), 0 when the kernel refused.
 int lower_partition_thread_nice(int offset);
 
 }  // namespace tessera::coordinator

@@ -37,6 +37,25 @@ GncDistributedResult solve_recording_weights(const GeneratorResult& dirty, GncDi
   return r;
 }
 
+// `dirty` solved with certified_tls() and the RobustOptions switch `flag` set to `on`.
+GncDistributedResult solve_with(const GeneratorResult& dirty, bool RobustOptions::*flag, bool on) {
+  GncDistributedOptions o = certified_tls();
+  o.robust.*flag = on;
+  return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+}
+
+// The same run but for its message steps: the same set, outer steps, rounds, refinements' steps
+// and final iterate, to the bit.
+void expect_same_run(const GncDistributedResult& a, const GncDistributedResult& b) {
+  EXPECT_EQ(a.rejected, b.rejected);
+  EXPECT_EQ(a.readmitted, b.readmitted);
+  EXPECT_EQ(a.outer_iterations, b.outer_iterations);
+  EXPECT_EQ(a.total_rounds, b.total_rounds);
+  EXPECT_EQ(a.refine_message_steps, b.refine_message_steps);
+  EXPECT_EQ(a.final_solve.cost, b.final_solve.cost);
+  EXPECT_EQ(a.final_solve.X, b.final_solve.X);
+}
+
 GncDistributedOptions capped(int outer) {
   GncDistributedOptions o = certified_tls();
   o.robust.max_outer_iterations = outer;
@@ -74,12 +93,8 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   ASSERT_GT(apart.refine_message_steps, 0) << "GNC's weighted solves should be Newton steps";
   ASSERT_GT(apart.outer_iterations, 2);
   EXPECT_EQ(along.rejected, dirty.outliers);
-  EXPECT_EQ(along.rejected, apart.rejected);
-  EXPECT_EQ(along.outer_iterations, apart.outer_iterations);
-  EXPECT_EQ(along.total_rounds, apart.total_rounds);
-  EXPECT_EQ(along.refine_message_steps, apart.refine_message_steps);
+  expect_same_run(along, apart);
   EXPECT_EQ(seen_along, seen_apart);  // every agent's weights after every outer step, to the bit
-  EXPECT_EQ(along.final_solve.cost, apart.final_solve.cost);
   EXPECT_TRUE(along.final_solve.certified.value_or(false));
   // The pose exchange before each weight update but the first (which follows the plain solve's
   // rounds) and the rejected set's exchange; at the kept set's fresh start (one, after GNC's
@@ -93,7 +108,7 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
   EXPECT_EQ(along.final_solve_stages, apart.final_solve_stages);
   // Every step left out was a real wait: the longest chain of messages is shorter by as many.
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - along.longest_chain),
-            test::message_steps(apart) - test::message_steps(along));
+            message_steps(apart) - message_steps(along));
 }
 
 // RobustOptions::weights_ride_trial_sums: each weight update after a weighted solve by a single
@@ -113,12 +128,8 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
   ASSERT_GT(apart.refine_message_steps, 0) << "GNC's weighted solves should be Newton steps";
   ASSERT_GT(apart.outer_iterations, 3);
   EXPECT_EQ(beside.rejected, dirty.outliers);
-  EXPECT_EQ(beside.rejected, apart.rejected);
-  EXPECT_EQ(beside.outer_iterations, apart.outer_iterations);
-  EXPECT_EQ(beside.total_rounds, apart.total_rounds);
-  EXPECT_EQ(beside.refine_message_steps, apart.refine_message_steps);
+  expect_same_run(beside, apart);
   EXPECT_EQ(seen_beside, seen_apart);  // every agent's weights after every outer step, to the bit
-  EXPECT_EQ(beside.final_solve.cost, apart.final_solve.cost);
   EXPECT_TRUE(beside.final_solve.certified.value_or(false));
   // Every update after a weighted solve (all but the first, after the plain solve's rounds)
   // whose trial was accepted: at least one, at most one per such update.
@@ -126,7 +137,7 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
   EXPECT_GE(saved, 1);
   EXPECT_LE(saved, apart.outer_iterations - 1);
   EXPECT_EQ(beside.solve_stages, apart.solve_stages);
-  EXPECT_EQ(test::message_steps(apart) - test::message_steps(beside), saved);
+  EXPECT_EQ(message_steps(apart) - message_steps(beside), saved);
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
 }
 
@@ -134,20 +145,11 @@ TEST(GncExchangeSteps, WeightsBesideTheTrialSumsLeaveTheRunAsItWasInFewerSteps) 
 // is also the first solve's opening exchange; the run is the same, one message step shorter.
 TEST(GncExchangeSteps, TheFirstSolveTakesTheStartVotesPosesAndTheRunIsOneStepShorter) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
-  auto run = [&](bool take) {
-    GncDistributedOptions o = certified_tls();
-    o.robust.first_solve_takes_start_poses = take;
-    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
-  };
-  const GncDistributedResult apart = run(false);
-  const GncDistributedResult taken = run(true);
+  const auto flag = &RobustOptions::first_solve_takes_start_poses;
+  const GncDistributedResult apart = solve_with(dirty, flag, false);
+  const GncDistributedResult taken = solve_with(dirty, flag, true);
   ASSERT_TRUE(apart.final_solve.certified.value_or(false));
-  EXPECT_EQ(taken.rejected, apart.rejected);
-  EXPECT_EQ(taken.outer_iterations, apart.outer_iterations);
-  EXPECT_EQ(taken.total_rounds, apart.total_rounds);
-  EXPECT_EQ(taken.refine_message_steps, apart.refine_message_steps);
-  EXPECT_EQ(taken.final_solve.cost, apart.final_solve.cost);
-  EXPECT_EQ(taken.final_solve.X, apart.final_solve.X);  // the same iterate, to the bit
+  expect_same_run(taken, apart);
   EXPECT_EQ(apart.exchange_steps - taken.exchange_steps, 1);
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - taken.longest_chain), 1);
 }
@@ -157,20 +159,11 @@ TEST(GncExchangeSteps, TheFirstSolveTakesTheStartVotesPosesAndTheRunIsOneStepSho
 // the same, one message step shorter per such pass.
 TEST(GncExchangeSteps, APassReadsItsLastAcceptedTrialsPosesAndTheRunIsShorter) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25);
-  auto run = [&](bool beside) {
-    GncDistributedOptions o = certified_tls();
-    o.robust.pass_poses_ride_trial_sums = beside;
-    return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
-  };
-  const GncDistributedResult apart = run(false);
-  const GncDistributedResult beside = run(true);
+  const auto flag = &RobustOptions::pass_poses_ride_trial_sums;
+  const GncDistributedResult apart = solve_with(dirty, flag, false);
+  const GncDistributedResult beside = solve_with(dirty, flag, true);
   ASSERT_TRUE(apart.final_solve.certified.value_or(false));
-  EXPECT_EQ(beside.rejected, apart.rejected);
-  EXPECT_EQ(beside.readmitted, apart.readmitted);
-  EXPECT_EQ(beside.total_rounds, apart.total_rounds);
-  EXPECT_EQ(beside.refine_message_steps, apart.refine_message_steps);
-  EXPECT_EQ(beside.final_solve.cost, apart.final_solve.cost);
-  EXPECT_EQ(beside.final_solve.X, apart.final_solve.X);  // the same iterate, to the bit
+  expect_same_run(beside, apart);
   const int saved = apart.exchange_steps - beside.exchange_steps;
   EXPECT_GE(saved, 1);  // at least the pass after GNC
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);

@@ -17,8 +17,6 @@ using test::grid_with_outliers;
 using test::irbcd_gnc;
 using test::robots_as_blocks;
 
-using test::message_steps;
-
 // The 125-pose grid with 25 % random outliers: GNC rejects exactly the wrong closures and the
 // passes change nothing. With probe_ratio 1.5 and no tail rule the agents name half the true
 // closures for a probe. Run from GNC's own set (ProbeCut::kAlways) the probe cuts them, the

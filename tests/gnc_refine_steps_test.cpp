@@ -11,14 +11,6 @@
 namespace tessera {
 namespace {
 
-// Message steps of a distributed robust run: two a round plus every refinement's exchanges and
-// all-agent sums (docs/robust.md, "JSON and files").
-int message_steps(const GncDistributedResult& r) {
-  int steps = 2 * r.total_rounds + r.refine_message_steps;
-  for (const NewtonRefineResult& f : r.final_solve.refines) steps += f.exchanges + f.reductions;
-  return steps;
-}
-
 TEST(GncRefineSteps, ANegativeStepCountNamesTheField) {
   RobustOptions o;
   o.gnc_refine_steps = -1;

@@ -14,14 +14,6 @@
 namespace tessera {
 namespace {
 
-// Two a round, two a solve stage (its opening pose exchange and closing status round) and the
-// Newton refinements' neighbour exchanges and all-agent sums.
-long long message_steps(const DistributedResult& r) {
-  return 2LL * r.rounds + 2LL * r.solve_stages + message_steps(r.refines);
-}
-
-using test::message_steps;
-
 TEST(MessageSteps, ACleanSolveCountsEveryWaitOfItsLongestChain) {
   const GeneratorResult clean = test::grid_with_outliers(0.0);
   DistributedOptions o;  // IRBCD, --refine auto: rounds, then the Newton refinement

@@ -267,4 +267,8 @@ DistributedResult solve_distributed_watching_trials(
   return res;
 }
 
+long long message_steps(const DistributedResult& r) {
+  return 2LL * r.rounds + 2LL * r.solve_stages + message_steps(r.refines);
+}
+
 }  // namespace tessera

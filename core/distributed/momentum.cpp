@@ -12,6 +12,16 @@
 namespace tessera {
 namespace {
 
+// ||E||_F of a 3 x 3 E in the order of Eigen 3.4's vectorised E.norm() (two-lane packets of the
+// column-major entries 0-7 summed pairwise, the lanes added, then entry 8): the same value, so
+// the same branches below as with E.norm().
+inline double frobenius_norm_3(const double (&E)[3][3]) {
+  auto sq = [](double x) { return x * x; };
+  const double lane0 = (sq(E[0][0]) + sq(E[2][0])) + (sq(E[1][1]) + sq(E[0][2]));
+  const double lane1 = (sq(E[1][0]) + sq(E[0][1])) + (sq(E[2][1]) + sq(E[1][2]));
+  return std::sqrt((lane0 + lane1) + sq(E[2][2]));
+}
+
 // Proj_M pose by pose. The polar factor of an r x d block A is A (A^T A)^{-1/2}. The points
 // projected here (convex combinations of nearby manifold points) are close to the manifold:
 // with B = A^T A = I - E, ||E|| is below 1e-4 for all but ~0.3 % of the poses of a round
@@ -23,16 +33,6 @@ namespace {
 // products; points far from the manifold the d x d eigen-decomposition, (nearly) rank-deficient
 // ones the SVD. Everything lives on the stack: these projections run on every pose of every
 // agent each round.
-// ||E||_F of a 3 x 3 E in the order of Eigen 3.4's vectorised E.norm() (two-lane packets of the
-// column-major entries 0-7 summed pairwise, the lanes added, then entry 8): the same value, so
-// the same branches below as with E.norm().
-inline double frobenius_norm_3(const double (&E)[3][3]) {
-  auto sq = [](double x) { return x * x; };
-  const double lane0 = (sq(E[0][0]) + sq(E[2][0])) + (sq(E[1][1]) + sq(E[0][2]));
-  const double lane1 = (sq(E[1][0]) + sq(E[0][1])) + (sq(E[2][1]) + sq(E[1][2]));
-  return std::sqrt((lane0 + lane1) + sq(E[2][2]));
-}
-
 template <int D>
 bool inv_sqrt_near_identity(const Eigen::Matrix<double, D, D>& B, Eigen::Matrix<double, D, D>& Z) {
   using Small = Eigen::Matrix<double, D, D>;

@@ -6,9 +6,7 @@
 
 namespace tessera {
 
-/// The rows of X (and of `also`, when it has entries) that are non-zero somewhere: the rows a
-/// lifted point actually uses. An iterate lifted from dimension d keeps the others at exact
-/// zero and every step maps them to zero, so protocols send and work on these rows only.
+/// Whether row k of M has a non-zero entry.
 inline bool row_has_nonzero(const Eigen::MatrixXd& M, Eigen::Index k) {
   // Strided down row k, four columns a test: a used row stops at its first column, an unused
   // one (the common case) is read to the end.
@@ -22,6 +20,9 @@ inline bool row_has_nonzero(const Eigen::MatrixXd& M, Eigen::Index k) {
   return false;
 }
 
+/// The rows of X (and of `also`, when it has entries) that are non-zero somewhere: the rows a
+/// lifted point actually uses. An iterate lifted from dimension d keeps the others at exact
+/// zero and every step maps them to zero, so protocols send and work on these rows only.
 inline std::vector<Eigen::Index> nonzero_rows(const Eigen::MatrixXd& X,
                                               const Eigen::MatrixXd& also) {
   std::vector<Eigen::Index> rows;

@@ -100,6 +100,23 @@ void tangent_project_poses(const double* X, const double* V, Eigen::Index r_runt
   }
 }
 
+// tangent_project_poses for dimension d and X's rows: V's n poses into out (out may be V).
+void tangent_project_all(int d, const Eigen::MatrixXd& X, const double* V, std::size_t n,
+                         double* out) {
+  const Eigen::Index r = X.rows();
+  if (d == 2) {
+    if (r == 2)
+      tangent_project_poses<2, 2>(X.data(), V, r, n, out);
+    else
+      tangent_project_poses<2, 0>(X.data(), V, r, n, out);
+  } else {
+    if (r == 3)
+      tangent_project_poses<3, 3>(X.data(), V, r, n, out);
+    else
+      tangent_project_poses<3, 0>(X.data(), V, r, n, out);
+  }
+}
+
 }  // namespace
 
 Eigen::MatrixXd LiftedManifold::tangent_project(const Eigen::MatrixXd& X,
@@ -108,18 +125,7 @@ Eigen::MatrixXd LiftedManifold::tangent_project(const Eigen::MatrixXd& X,
     return tangent_project(X, Eigen::MatrixXd(V));
   // Written from V straight into a new matrix (no copy of V first): the same sums.
   Eigen::MatrixXd out(V.rows(), V.cols());
-  const Eigen::Index r = X.rows();
-  if (d_ == 2) {
-    if (r == 2)
-      tangent_project_poses<2, 2>(X.data(), V.data(), r, n_, out.data());
-    else
-      tangent_project_poses<2, 0>(X.data(), V.data(), r, n_, out.data());
-  } else {
-    if (r == 3)
-      tangent_project_poses<3, 3>(X.data(), V.data(), r, n_, out.data());
-    else
-      tangent_project_poses<3, 0>(X.data(), V.data(), r, n_, out.data());
-  }
+  tangent_project_all(d_, X, V.data(), n_, out.data());
   return out;
 }
 
@@ -127,18 +133,7 @@ Eigen::MatrixXd LiftedManifold::tangent_project(const Eigen::MatrixXd& X,
                                                 Eigen::MatrixXd&& V) const {
   // Pose by pose, sym(Y_i^T V_i) is read before V_i is updated, so V may be the output.
   Eigen::MatrixXd out = std::move(V);
-  const Eigen::Index r = X.rows();
-  if (d_ == 2) {
-    if (r == 2)
-      tangent_project_poses<2, 2>(X.data(), out.data(), r, n_, out.data());
-    else
-      tangent_project_poses<2, 0>(X.data(), out.data(), r, n_, out.data());
-  } else {
-    if (r == 3)
-      tangent_project_poses<3, 3>(X.data(), out.data(), r, n_, out.data());
-    else
-      tangent_project_poses<3, 0>(X.data(), out.data(), r, n_, out.data());
-  }
+  tangent_project_all(d_, X, out.data(), n_, out.data());
   return out;
 }
 

@@ -240,13 +240,9 @@ Eigen::MatrixXd BlockProblem::hessian_vector(const Eigen::MatrixXd& X, const Eig
 
 namespace {
 
-// One measurement's term, kappa ||X_j^R - X_i^R R||^2 + tau ||t_j - t_i - X_i^R t||^2, for a fixed
-// d (and, when R > 0, a fixed number of rows): the same operations in the same order as the
-// runtime-d loops it replaces (bit-identical), unrolled by the compiler. `m` is the edge's
-// packed measurement: R (d x d, column-major), t (d), kappa, tau.
 // edge_term<3, 3> (the 3D agents' active rows, most of their cost evaluations) with rows 0 and
 // 1 of every difference in one register (GCC's vector extension: SSE2 on x86-64) and row 2
-// apart. Each difference is formed element-wise as in the loop below; the squares are then added
+// apart. Each difference is formed element-wise as in edge_term's loop; the squares are then added
 // to rot and tr one by one in the loop's order (row 0's, row 1's, row 2's), so the same value.
 inline double edge_term_3x3(const double* Xi, const double* Xj, const double* m) {
   typedef double Pair __attribute__((vector_size(16)));
@@ -294,6 +290,10 @@ inline double edge_term_3x3(const double* Xi, const double* Xj, const double* m)
   return m[12] * rot + m[13] * tr;
 }
 
+// One measurement's term, kappa ||X_j^R - X_i^R R||^2 + tau ||t_j - t_i - X_i^R t||^2, for a fixed
+// d (and, when R > 0, a fixed number of rows): the same operations in the same order as the
+// runtime-d loops it replaces (bit-identical), unrolled by the compiler. `m` is the edge's
+// packed measurement: R (d x d, column-major), t (d), kappa, tau.
 template <int D, int R>
 double edge_term(const double* Xi, const double* Xj, const double* m, Eigen::Index r_runtime) {
   if constexpr (D == 3 && R == 3) return edge_term_3x3(Xi, Xj, m);

@@ -31,32 +31,9 @@ std::vector<int> as_ints(const std::vector<std::uint32_t>& ids) {
 }  // namespace
 
 void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
-  if (step == Step::kPoses && pass_trials_sent_ > 0) {
-    // An inlier pass's trial poses came beside their sums: the last accepted one's are the
-    // pass's point (RobustOptions::pass_poses_ride_trial_sums); the others are of no use.
-    const std::uint32_t phase = gnc_phase(g_, GncExchange::kPassTrialPoses);
-    const std::uint32_t take = stage_->last_accepted_trial();
-    for (std::uint32_t t = 1; t <= pass_trials_sent_; ++t)
-      if (t != take) mail_->discard(phase, t);
-    pass_trials_sent_ = 0;
-    if (take > 0) {
-      step_ = step;
-      exchange_->begin();
-      exchange_->expect_poses(stage_->iterate().rows(), false);
-      mail_->begin_trial_exchange(phase, take, base_->adjacent[static_cast<std::size_t>(in_.id)]);
-      take_exchange(out);
-      return;
-    }
-  }
-  if (step == Step::kWeights && trial_weights_sent_) {
-    trial_weights_sent_ = false;
-    if (stage_->poses_sent_early() && !stage_->poses_early_stale()) {
-      begin_trial_weights(out);
-      return;
-    }
-    // The trial was not accepted: the weights go out at the iterate as ever.
-    mail_->discard(gnc_phase(g_, GncExchange::kTrialWeights));
-  }
+  // Exchanges whose messages went out beside a solve's trial sums, where that trial stands.
+  if (step == Step::kPoses && pass_trials_sent_ > 0 && begin_pass_trial_poses(out)) return;
+  if (step == Step::kWeights && trial_weights_sent_ && begin_trial_weights(out)) return;
   step_ = step;
   const std::uint32_t phase = gnc_phase(g_, exchange());
   const auto me = static_cast<std::uint32_t>(in_.id);
@@ -234,7 +211,30 @@ void GncAgent::send_trial_weights(const Eigen::MatrixXd& Y, std::vector<Outgoing
   trial_weights_sent_ = true;
 }
 
-void GncAgent::begin_trial_weights(std::vector<OutgoingMessage>& out) {
+bool GncAgent::begin_pass_trial_poses(std::vector<OutgoingMessage>& out) {
+  // An inlier pass's trial poses came beside their sums: the last accepted one's are the
+  // pass's point (RobustOptions::pass_poses_ride_trial_sums); the others are of no use.
+  const std::uint32_t phase = gnc_phase(g_, GncExchange::kPassTrialPoses);
+  const std::uint32_t take = stage_->last_accepted_trial();
+  for (std::uint32_t t = 1; t <= pass_trials_sent_; ++t)
+    if (t != take) mail_->discard(phase, t);
+  pass_trials_sent_ = 0;
+  if (take == 0) return false;
+  step_ = Step::kPoses;
+  exchange_->begin();
+  exchange_->expect_poses(stage_->iterate().rows(), false);
+  mail_->begin_trial_exchange(phase, take, base_->adjacent[static_cast<std::size_t>(in_.id)]);
+  take_exchange(out);
+  return true;
+}
+
+bool GncAgent::begin_trial_weights(std::vector<OutgoingMessage>& out) {
+  trial_weights_sent_ = false;
+  if (!stage_->poses_sent_early() || stage_->poses_early_stale()) {
+    // The trial was not accepted: the weights go out at the iterate as ever.
+    mail_->discard(gnc_phase(g_, GncExchange::kTrialWeights));
+    return false;
+  }
   // The accepted trial point is the iterate, to the bit: its weight update is this step's, sent
   // already; the others' came beside the trial's sums (no step of its own).
   step_ = Step::kWeights;
@@ -247,6 +247,7 @@ void GncAgent::begin_trial_weights(std::vector<OutgoingMessage>& out) {
   mail_->begin_exchange(gnc_phase(g_, GncExchange::kTrialWeights),
                         as_ints(other_agents(static_cast<std::uint32_t>(in_.id), in_.num_agents)));
   take_exchange(out);
+  return true;
 }
 
 bool GncAgent::send_weights(std::uint32_t phase, std::vector<OutgoingMessage>& out) {

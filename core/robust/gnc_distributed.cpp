@@ -191,4 +191,8 @@ GncDistributedResult solve_gnc_distributed(const PoseGraph& graph,
   return out;
 }
 
+long long message_steps(const GncDistributedResult& r) {
+  return message_steps(r, r.total_rounds, r.final_solve_stages, r.final_refine_message_steps);
+}
+
 }  // namespace tessera

@@ -9,12 +9,13 @@ namespace tessera {
 
 namespace {
 
-// The exchanges that carry two blocks per neighbour: both starts' poses (kind Y, kind P).
+// An inlier pass's trial poses: the one exchange whose wire round is not 0 (the trial's number).
 bool pass_trial(std::uint32_t phase) {
   return phase % kGncStepStride ==
          kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kPassTrialPoses);
 }
 
+// The exchanges that carry two blocks per neighbour: both starts' poses (kind Y, kind P).
 bool two_starts(std::uint32_t phase) {
   const std::uint32_t e = phase % kGncStepStride;
   return e == kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kStartPoses) ||

@@ -14,11 +14,6 @@ GeneratorResult grid_with_outliers(double fraction, std::uint64_t seed) {
   return generate_pose_graph(o);
 }
 
-long long message_steps(const GncDistributedResult& r) {
-  return 2LL * r.total_rounds + 2LL * (r.solve_stages + r.final_solve_stages) +
-         r.refine_message_steps + r.final_refine_message_steps + r.exchange_steps;
-}
-
 GeneratorResult flexible_city(double fraction, OutlierKind kind, std::uint64_t seed) {
   GeneratorOptions o;
   o.kind = TrajectoryKind::kCity;

@@ -21,10 +21,6 @@ std::vector<int> robots_as_blocks(const GeneratorResult& r);
 /// GNC-TLS around IRBCD, solved to a gradient norm of 1e-3, every solve before the final one by
 /// rounds (RobustOptions::refine_passes off).
 GncDistributedOptions irbcd_gnc();
-/// Every wait for peers of a GNC run (docs/robust.md, "JSON and files": message_steps_total):
-/// two a round, two a solve stage (its opening pose exchange and closing status round), the
-/// Newton refinements' steps and GNC's own exchanges.
-long long message_steps(const GncDistributedResult& r);
 /// Per measurement: whether it is odometry (KnownInliers::kOdometry), the known inliers GNC's
 /// `known_inlier_flags` take.
 std::vector<bool> odometry_flags(const PoseGraph& g);

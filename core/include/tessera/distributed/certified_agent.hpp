@@ -84,10 +84,7 @@ class CertifiedAgent : public AgentProcess {
   }
   /// Observer of the trial points of the Newton refinements this agent runs
   /// (NewtonRefineProtocol::set_trial_observer).
-  void set_trial_observer(
-      std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> observer) {
-    trial_observer_ = std::move(observer);
-  }
+  void set_trial_observer(TrialObserver observer) { trial_observer_ = std::move(observer); }
   std::vector<OutgoingMessage> handle(const ProtocolMessage& message) override;
   bool done() const override { return done_; }
   /// The running stage's count (messages of later stages are kept aside, not counted).
@@ -175,7 +172,7 @@ class CertifiedAgent : public AgentProcess {
   std::vector<CertifyStageRecord> certificates_;
   std::vector<EscapeStageRecord> escapes_;
   std::function<void(const ProtocolSnapshot&)> observer_;
-  std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> trial_observer_;
+  TrialObserver trial_observer_;
   bool known_start_ = false;          // set_known_start()
   Eigen::MatrixXd start_neighbours_;  // start_with_neighbours(), until the first stage opens
   double known_grad_norm_ = std::numeric_limits<double>::quiet_NaN();

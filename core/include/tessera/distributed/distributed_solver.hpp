@@ -166,6 +166,13 @@ struct DistributedResult {
   std::string full_report() const;
 };
 
+/// Every wait for peers of a run but its certification's (certificates, escapes; docs/robust.md,
+/// "JSON and files": message_steps_total): two a round (docs/irbcd.md), two a solve stage (its
+/// opening pose exchange and closing status round) and the Newton refinements' message steps. Equal
+/// to longest_chain without certification. A robust run counts more: message_steps of its
+/// GncDistributedResult (robust/gnc_distributed.hpp).
+long long message_steps(const DistributedResult& r);
+
 /// Solves `graph` with the blocks of `assignment` (block id per pose, 0..N-1, none empty).
 /// `initial`: initial poses; empty = options.initialization.
 DistributedResult solve_distributed(const PoseGraph& graph, const std::vector<int>& assignment,

@@ -61,6 +61,10 @@ class TranslationPreconditioner;
 class TranslationInterfaceSolve;
 class GaugeSpace;
 
+/// Observer of a refinement's trial points (NewtonRefineProtocol::set_trial_observer): the own
+/// block `Y` and the neighbours' public poses `Yn` there.
+using TrialObserver = std::function<void(const Eigen::MatrixXd& Y, const Eigen::MatrixXd& Yn)>;
+
 class NewtonRefineProtocol : public AgentProcess {
  public:
   /// Protocol steps (on the wire: the solve stage's phase base + these; RoundProtocol uses
@@ -104,10 +108,7 @@ class NewtonRefineProtocol : public AgentProcess {
   /// order, the same rows), the bits each neighbour holds of its own. A caller that must exchange
   /// the accepted point's poses, or values computed from them, can send them beside the sums
   /// instead of in a message step of its own (robust GNC's weighted solves).
-  void set_trial_observer(
-      std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> observer) {
-    trial_observer_ = std::move(observer);
-  }
+  void set_trial_observer(TrialObserver observer) { trial_observer_ = std::move(observer); }
   /// Before start(): ||grad f|| at the start point as the team last summed it (the rounds' last
   /// status; the same on every agent). At or below grad_norm_tol the refinement will stop at
   /// its start's sum, so the interface shares (interface_in_status) stay out of that sum: a
@@ -332,7 +333,7 @@ class NewtonRefineProtocol : public AgentProcess {
   std::unique_ptr<TranslationInterfaceSolve> translation_solve_;
   Eigen::MatrixXd ty_;
   NewtonRefineStep step_;
-  std::function<void(const Eigen::MatrixXd&, const Eigen::MatrixXd&)> trial_observer_;
+  TrialObserver trial_observer_;
   bool done_ = false;
   NewtonRefineResult result_;
 };

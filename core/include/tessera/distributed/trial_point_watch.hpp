@@ -1,7 +1,7 @@
 #pragma once
 // A solve whose agents' Newton trial points are watched from outside the agents: the online
-// engine keeps the estimates a step passes through (online/step_points.hpp) with the agents and
-// driver solve_distributed_with_states runs, not a copy of them.
+// engine records the estimates a step passes through (online/step_points.hpp) from the same
+// agents and driver as solve_distributed_with_states, not from a copy of that driver.
 
 #include <Eigen/Core>
 #include <functional>

@@ -24,7 +24,7 @@ struct StepPoint {
   /// point; "end": where the step ended (after the rounds that follow Newton steps that stopped
   /// above the tolerance, or the rounds of a rounds-only step).
   std::string at;
-  /// Since the step began, on OnlineUpdate's clocks: wall seconds (ms) and process CPU seconds
+  /// Since the step began, on OnlineUpdate's clocks: wall seconds (wall_s) and process CPU seconds
   /// (cpu_s). A Newton step's point is timed when the last agent formed its trial point, its
   /// sums on the way out: the verdict that accepts it comes one all-agent sum later. The
   /// "end" point has the step's own times, so no point is later than the step.

@@ -284,10 +284,12 @@ class GncAgent : public AgentProcess {
   // The weight update at the trial point `Y` the solve just handed out, sent beside its sums
   // (RobustOptions::weights_ride_trial_sums); kept aside until the solve's verdict.
   void send_trial_weights(const Eigen::MatrixXd& Y, std::vector<OutgoingMessage>& out);
-  // The weight exchange after the solve reads the trial's weights (sent, and the trial accepted).
-  bool trial_weights_stand() const;
-  // The weight exchange from the trial's weights: this agent's kept aside, the others' in.
-  void begin_trial_weights(std::vector<OutgoingMessage>& out);
+  // After a solve that sent them: the weight exchange from the trial's weights (this agent's kept
+  // aside, the others' in) when the trial was accepted; false (the messages dropped) otherwise.
+  bool begin_trial_weights(std::vector<OutgoingMessage>& out);
+  // After an inlier pass that sent its trials' poses: the pose exchange from the last accepted
+  // trial's; false (every trial's messages dropped) when none was.
+  bool begin_pass_trial_poses(std::vector<OutgoingMessage>& out);
   void require_kept_connected() const;  // throws InputError naming the parts left
   // GNC's rejected set: from the last weight exchange where there was one, else an exchange.
   void begin_rejected(std::vector<OutgoingMessage>& out);

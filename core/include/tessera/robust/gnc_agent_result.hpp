@@ -30,8 +30,7 @@ struct GncAgentResult {
   int refine_message_steps = 0;
   /// Message steps of GNC's own exchanges: poses, votes, weights, rejected sets, verdicts,
   /// start votes, gathers (one per exchange, two per gather at agent 0). A run's message steps
-  /// in all are 2 x its rounds + 2 x its solve stages + refine_message_steps + the final
-  /// solve's refinement's + this.
+  /// in all: message_steps() below.
   int exchange_steps = 0;
   /// Solve stages of the solves before the final one that open with a pose exchange and end
   /// with a status round, two message steps beyond two a round (opened_solve_stages of
@@ -39,5 +38,15 @@ struct GncAgentResult {
   /// none).
   int solve_stages = 0;
 };
+
+/// Every wait for peers of a distributed GNC run but its certificates' (docs/robust.md, "JSON
+/// and files": message_steps_total): two a round (`rounds`: of every solve, final included),
+/// two a solve stage (its opening pose exchange and closing status round: the result's
+/// solve_stages + `final_solve_stages`), the Newton refinements' message steps
+/// (refine_message_steps + the final solve's `final_refine_steps`) and GNC's own exchanges
+/// (exchange_steps). The rounds and the final solve are not in the result (each driver counts
+/// them its own way), so they come in beside it; without a final solve its two counts are 0.
+long long message_steps(const GncAgentResult& gnc, long long rounds, long long final_solve_stages,
+                        long long final_refine_steps);
 
 }  // namespace tessera

@@ -104,8 +104,7 @@ struct GncDistributedResult : GncAgentResult {
   int total_rounds = 0;           ///< Rounds of every solve, final included.
   /// Message steps of the final solve's Newton refinement (0 when no final solve runs: the
   /// last inlier pass is then the answer and its refinement is in refine_message_steps). The
-  /// run's message steps in all are 2 x total_rounds + 2 x (solve_stages + final_solve_stages)
-  /// + refine_message_steps + final_refine_message_steps + exchange_steps.
+  /// run's message steps in all: message_steps() below.
   int final_refine_message_steps = 0;
   int final_solve_stages = 0;     ///< Solve stages of the final solve (0 when none runs).
   std::uint64_t total_bytes = 0;  ///< Bytes of every solve plus the outer steps' votes.
@@ -116,6 +115,11 @@ struct GncDistributedResult : GncAgentResult {
   /// rejected by the re-check passes (GncAgent::late_rejected()).
   std::size_t late_rejected = 0;
 };
+
+/// Every wait for peers of the run but its certificates' (GncAgentResult's message_steps()
+/// with total_rounds, final_solve_stages and final_refine_message_steps): equal to
+/// longest_chain without certification (every counted wait lies on one chain of messages).
+long long message_steps(const GncDistributedResult& r);
 
 /// The known inliers' start of distributed GNC (GncDistributedOptions::known_inlier_start): the
 /// distributed initialization (with solver.robots, or `agents`, robots) of the measurements that

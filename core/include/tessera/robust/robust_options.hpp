@@ -317,7 +317,7 @@ struct RobustOptions {
   /// tolerance. The refinement and the certificate run as before. On (default); off: those solves
   /// open with their rounds. Why: two message steps a solve (F = 0.25 random, 5 agents: intel
   /// 140 -> 136, CSAIL 67 -> 63), the same `--out` bytes, rejected set and certificate
-  /// (docs/robust.md, "Where the steps go now").
+  /// (docs/robust.md, "The kept set's solves start at their refinement").
   bool kept_solves_start_at_refinement = true;
   /// Distributed solvers only, with exchanges_ride_along: where a weighted solve is a single
   /// Newton step that another weight update follows, each agent computes that update at the
@@ -338,7 +338,8 @@ struct RobustOptions {
   /// at their round-0 status with them (CertifiedAgent::start_with_neighbours), the same
   /// iterates. On (default); off: the first solve opens with its own pose exchange. Why: one
   /// message step a run (F = 0.25 random, 5 agents: intel 123 -> 122, CSAIL 59 -> 58); every
-  /// intel and CSAIL cell of the benchmark the same `--out` bytes and rejected set.
+  /// intel and CSAIL cell of the benchmark the same `--out` bytes and rejected set
+  /// (docs/robust.md, "The first solve takes the start vote's poses").
   bool first_solve_takes_start_poses = true;
   /// Distributed solvers only: an inlier pass that runs Newton steps sends each trial point's
   /// public poses to the neighbours beside the trial's sums (tagged with the trial's number);
@@ -346,7 +347,8 @@ struct RobustOptions {
   /// pass's point to the bit, instead of waiting for an exchange of its own. Without an accepted
   /// trial the exchange runs as before. On (default); off: the exchange of its own. Why: one
   /// message step per refined pass (F = 0.25 random, 5 agents: intel 122 -> 121, CSAIL
-  /// 58 -> 57), the same `--out` bytes and rejected sets.
+  /// 58 -> 57), the same `--out` bytes and rejected sets (docs/robust.md, "A pass's poses beside
+  /// its trials' sums").
   bool pass_poses_ride_trial_sums = true;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
