@@ -18,6 +18,7 @@
 #include "commands.hpp"
 #include "graph_input.hpp"
 #include "json_writer.hpp"
+#include "launch/serial_openmp.hpp"
 #include "rebalance_args.hpp"
 #include "robust_args.hpp"
 #include "solve_distributed.hpp"
@@ -279,6 +280,11 @@ int run_solve(const Args& args) {
   }
   if (a.positional().size() != 1)
     throw InputError("expected exactly one GRAPH argument (see tessera solve --help)");
+  // Every algorithm's CHOLMOD factorizations run on the solver's own threads, as in the agent
+  // processes: CHOLMOD's OpenMP teams of 4 parallelise only its supernodal factorization's
+  // zeroing and scattering loops (the BLAS is serial), so on these problems they added
+  // fork/join and spin-waiting, not speed (launch/serial_openmp.hpp, docs/decisions.md). Same bits.
+  launch::serial_openmp();
   if (a.has("online")) return solve_online_command(a, a.positional()[0], start);
   const std::string algorithm = a.get_or("algorithm", "centralized");
   RobustOptions robust = parse_robust_options(a);

@@ -18,7 +18,6 @@
 #include <vector>
 
 #include "json_writer.hpp"
-#include "launch/serial_openmp.hpp"
 #include "online_baseline.hpp"
 #include "rebalance_args.hpp"
 #include "robot_files.hpp"
@@ -186,10 +185,6 @@ struct Checkpoint {
 
 int solve_online_command(const Arguments& a, const std::string& graph_path,
                          std::chrono::steady_clock::time_point start) {
-  // The agents' CHOLMOD factorizations run on the driver's threads (--threads), which fill the
-  // cores already: CHOLMOD's own OpenMP teams of 4 in each supernodal factorization only added
-  // fork/join and spin-waiting to the steps' CPU (launch/serial_openmp.hpp). Same bits.
-  launch::serial_openmp();
   OnlineOptions options;
   options.solver.algorithm = parse_algorithm(a.get_or("algorithm", "irbcd"));
   options.solver.grad_norm_tol = a.get_double("grad-tol", options.solver.grad_norm_tol);
