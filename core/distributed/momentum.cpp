@@ -3,11 +3,12 @@
 #include <emmintrin.h>
 #endif
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/momentum.hpp>
 #include <utility>
+
+#include "util/double_pair.hpp"
 
 namespace tessera {
 namespace {
@@ -267,20 +268,6 @@ void blend_and_project(const LiftedManifold& M, Eigen::MatrixXd& out, const Blen
     blend_and_project<3>(out, poses, blend);
 }
 
-// The blends below work on two doubles at a time (GCC's vector extension: SSE2 on x86-64, plain
-// code elsewhere). Element-wise, the same operations in the same order, so the same values.
-typedef double Pair __attribute__((vector_size(16)));
-
-inline Pair load_pair(const double* p) {
-  Pair v;
-  std::memcpy(&v, p, sizeof(Pair));
-  return v;
-}
-
-inline void store_pair(double* p, Pair v) {
-  std::memcpy(p, &v, sizeof(Pair));
-}
-
 void check_same_shape(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const char* what) {
   if (a.rows() != b.rows() || a.cols() != b.cols())
     throw std::invalid_argument(std::string(what) + ": operands of different shapes");
@@ -302,7 +289,8 @@ void extrapolate_into(const LiftedManifold& M, const MomentumCoefficients& c,
   const double* v = V.data();
   blend_and_project(M, out, [&](Eigen::Index at, Eigen::Index n, double* dst) {
     // Element by element the expression alpha V + (1 - alpha) Y of the previous version.
-    const Pair a2 = {a, a}, one_minus_a2 = {one_minus_a, one_minus_a};
+    // Two doubles at a time (util/double_pair.hpp): element-wise, the same values.
+    const DoublePair a2 = {a, a}, one_minus_a2 = {one_minus_a, one_minus_a};
     Eigen::Index k = 0;
     for (; k + 2 <= n; k += 2)
       store_pair(dst + k, a2 * load_pair(v + at + k) + one_minus_a2 * load_pair(y + at + k));
@@ -323,10 +311,10 @@ void momentum_update_into(const LiftedManifold& M, const MomentumCoefficients& c
   blend_and_project(M, out, [&](Eigen::Index at, Eigen::Index n, double* dst) {
     // (beta V + (1 - beta) P) + gamma (Y_new - P), element by element, as before. dst may be
     // v's pose: each pair is read before it is written.
-    const Pair b2 = {b, b}, one_minus_b2 = {one_minus_b, one_minus_b}, g2 = {g, g};
+    const DoublePair b2 = {b, b}, one_minus_b2 = {one_minus_b, one_minus_b}, g2 = {g, g};
     Eigen::Index k = 0;
     for (; k + 2 <= n; k += 2) {
-      const Pair pk = load_pair(p + at + k);
+      const DoublePair pk = load_pair(p + at + k);
       store_pair(dst + k, (b2 * load_pair(v + at + k) + one_minus_b2 * pk) +
                               g2 * (load_pair(y + at + k) - pk));
     }

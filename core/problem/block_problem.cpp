@@ -1,10 +1,11 @@
 #include <algorithm>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/pose_kernels.hpp>
 #include <utility>
+
+#include "util/double_pair.hpp"
 
 namespace tessera {
 namespace {
@@ -245,24 +246,18 @@ namespace {
 // apart. Each difference is formed element-wise as in edge_term's loop; the squares are then added
 // to rot and tr one by one in the loop's order (row 0's, row 1's, row 2's), so the same value.
 inline double edge_term_3x3(const double* Xi, const double* Xj, const double* m) {
-  typedef double Pair __attribute__((vector_size(16)));
-  auto load = [](const double* p) {
-    Pair v;
-    std::memcpy(&v, p, sizeof(Pair));
-    return v;
-  };
   const double* Rm = m;
   const double* t = m + 9;
-  const Pair xi0 = load(Xi), xi1 = load(Xi + 3), xi2 = load(Xi + 6);
-  Pair ta = load(Xj + 9) - load(Xi + 9);
+  const DoublePair xi0 = load_pair(Xi), xi1 = load_pair(Xi + 3), xi2 = load_pair(Xi + 6);
+  DoublePair ta = load_pair(Xj + 9) - load_pair(Xi + 9);
   ta -= xi0 * t[0];
   ta -= xi1 * t[1];
   ta -= xi2 * t[2];
-  const Pair ta2 = ta * ta;
-  Pair v2[3];
+  const DoublePair ta2 = ta * ta;
+  DoublePair v2[3];
 #pragma GCC unroll 3
   for (int b = 0; b < 3; ++b) {
-    Pair v = load(Xj + 3 * b);
+    DoublePair v = load_pair(Xj + 3 * b);
     v -= xi0 * Rm[3 * b];
     v -= xi1 * Rm[3 * b + 1];
     v -= xi2 * Rm[3 * b + 2];

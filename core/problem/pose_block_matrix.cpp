@@ -1,14 +1,9 @@
 #include <algorithm>
-#include <cstring>
 #include <stdexcept>
 #include <tessera/problem/pose_block_matrix.hpp>
 
 #include "util/avx_kernels.hpp"
-
-#if defined(__GNUC__) && defined(__x86_64__)
-#include <immintrin.h>
-#define TESSERA_AVX_KERNELS 1
-#endif
+#include "util/double_pair.hpp"
 
 namespace tessera {
 
@@ -84,20 +79,19 @@ template <int W>
 void block_times_3(const double* X, const std::vector<std::size_t>& start,
                    const std::vector<int>& row_block, const std::vector<double>& values,
                    double scale, double* out) {
-  typedef double Pair __attribute__((vector_size(16)));
   constexpr Eigen::Index pose = 3 * W;
   for (std::size_t J = 0; J + 1 < start.size(); ++J) {
-    Pair a01[W];
+    DoublePair a01[W];
     double a2[W];
     for (int q = 0; q < W; ++q) {
-      a01[q] = Pair{0.0, 0.0};
+      a01[q] = DoublePair{0.0, 0.0};
       a2[q] = 0.0;
     }
     for (std::size_t b = start[J]; b < start[J + 1]; ++b) {
       const double* x = X + pose * row_block[b];
       const double* v = values.data() + b * W * W;
-      Pair x01[W];
-      for (int p = 0; p < W; ++p) std::memcpy(&x01[p], x + 3 * p, sizeof(Pair));
+      DoublePair x01[W];
+      for (int p = 0; p < W; ++p) x01[p] = load_pair(x + 3 * p);
 #pragma GCC unroll 4
       for (int q = 0; q < W; ++q)
 #pragma GCC unroll 4
@@ -109,7 +103,7 @@ void block_times_3(const double* X, const std::vector<std::size_t>& start,
     }
     double* o = out + pose * static_cast<Eigen::Index>(J);
     for (int q = 0; q < W; ++q) {
-      const Pair s = scale * a01[q];
+      const DoublePair s = scale * a01[q];
       o[3 * q] = s[0];
       o[3 * q + 1] = s[1];
       o[3 * q + 2] = scale * a2[q];
@@ -126,22 +120,19 @@ void block_times_3(const double* X, const std::vector<std::size_t>& start,
 inline void block_times_3_by_4(const double* X, const std::vector<std::size_t>& start,
                                const std::vector<int>& row_block, const std::vector<double>& values,
                                double scale, double* out) {
-  typedef double Pair __attribute__((vector_size(16)));
   constexpr Eigen::Index pose = 12;
   for (std::size_t J = 0; J + 1 < start.size(); ++J) {
-    Pair acc[3][2];
-    for (int a = 0; a < 3; ++a) acc[a][0] = acc[a][1] = Pair{0.0, 0.0};
+    DoublePair acc[3][2];
+    for (int a = 0; a < 3; ++a) acc[a][0] = acc[a][1] = DoublePair{0.0, 0.0};
     for (std::size_t b = start[J]; b < start[J + 1]; ++b) {
       const double* x = X + pose * row_block[b];
       const double* v = values.data() + b * 16;
 #pragma GCC unroll 4
       for (int p = 0; p < 4; ++p) {
-        Pair v01, v23;
-        std::memcpy(&v01, v + 4 * p, sizeof(Pair));
-        std::memcpy(&v23, v + 4 * p + 2, sizeof(Pair));
+        const DoublePair v01 = load_pair(v + 4 * p), v23 = load_pair(v + 4 * p + 2);
 #pragma GCC unroll 3
         for (int a = 0; a < 3; ++a) {
-          const Pair xa = {x[3 * p + a], x[3 * p + a]};
+          const DoublePair xa = {x[3 * p + a], x[3 * p + a]};
           acc[a][0] += xa * v01;
           acc[a][1] += xa * v23;
         }
@@ -150,7 +141,7 @@ inline void block_times_3_by_4(const double* X, const std::vector<std::size_t>& 
     double* o = out + pose * static_cast<Eigen::Index>(J);
 #pragma GCC unroll 3
     for (int a = 0; a < 3; ++a) {
-      const Pair s01 = scale * acc[a][0], s23 = scale * acc[a][1];
+      const DoublePair s01 = scale * acc[a][0], s23 = scale * acc[a][1];
       o[a] = s01[0];
       o[3 + a] = s01[1];
       o[6 + a] = s23[0];

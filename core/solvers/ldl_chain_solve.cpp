@@ -5,10 +5,6 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
-#if defined(__GNUC__) && defined(__x86_64__)
-#include <immintrin.h>
-#define TESSERA_AVX_KERNELS 1
-#endif
 
 namespace tessera {
 namespace {

@@ -4,6 +4,14 @@
 // target attribute, never FMA: a fused multiply-add rounds once and would change the bits)
 // and pick it at run time here. Both copies compute the same operations in the same order, so
 // the results are the same bits either way.
+//
+// TESSERA_AVX_KERNELS is defined where the AVX copies can be compiled at all (GCC-compatible
+// compilers on x86-64); the kernels' files build those copies only under it.
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define TESSERA_AVX_KERNELS 1
+#endif
 
 namespace tessera {
 
