@@ -161,6 +161,27 @@ void GncAgent::send_status(std::uint32_t phase, std::vector<OutgoingMessage>& ou
   broadcast_status(std::move(st), static_cast<std::uint32_t>(in_.id), phase, in_.num_agents, out);
 }
 
+int GncAgent::near_bound_at(const std::vector<bool>& skip, const Eigen::MatrixXd& Y,
+                            const Eigen::MatrixXd& neighbours) const {
+  // Without the early end every update counts as "near", so GNC never ends early.
+  if (options_.robust.jump_band <= 0) return 1;
+  return near_bound_count(*terms_, skip, Y, neighbours, options_.robust.jump_band,
+                          options_.robust.jump_band_inside);
+}
+
+void GncAgent::broadcast_weights(std::uint32_t phase, double spread, int crossed, int near,
+                                 const std::vector<double>& w,
+                                 std::vector<OutgoingMessage>& out) const {
+  const auto me = static_cast<std::uint32_t>(in_.id);
+  for (std::uint32_t a : other_agents(me, in_.num_agents)) {
+    RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, w,
+                                            options_.robust.exchanges_ride_along);
+    st.phase = phase;
+    st.sender = me;
+    out.push_back(OutgoingMessage{std::move(st), false, {a}});
+  }
+}
+
 void GncAgent::send_trial_weights(const Eigen::MatrixXd& Y, std::vector<OutgoingMessage>& out) {
   // The neighbours' poses at the trial point, in the exchange book's columns (the base layout's):
   // the solve's neighbours are known there (their translations solved as this agent's). The
@@ -192,22 +213,13 @@ void GncAgent::send_trial_weights(const Eigen::MatrixXd& Y, std::vector<Outgoing
   trial_weights_ = weights_;
   const int crossed = weights_at(outer_->mu(), Y, N, out_of_reach, trial_weights_);
   const double spread = weight_spread(*terms_, trial_weights_);
-  const int near = options_.robust.jump_band > 0
-                       ? near_bound_count(*terms_, out_of_reach, Y, N, options_.robust.jump_band,
-                                          options_.robust.jump_band_inside)
-                       : 1;
+  const int near = near_bound_at(out_of_reach, Y, N);
   trial_vote_ = {spread, crossed};
   trial_near_ = near;
   trial_zero_cut_ =
       zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, trial_weights_);
-  const auto me = static_cast<std::uint32_t>(in_.id);
-  for (std::uint32_t a : other_agents(me, in_.num_agents)) {
-    RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, trial_weights_,
-                                            options_.robust.exchanges_ride_along);
-    st.phase = gnc_phase(g_, GncExchange::kTrialWeights);
-    st.sender = me;
-    out.push_back(OutgoingMessage{std::move(st), false, {a}});
-  }
+  broadcast_weights(gnc_phase(g_, GncExchange::kTrialWeights), spread, crossed, near,
+                    trial_weights_, out);
   trial_weights_sent_ = true;
 }
 
@@ -251,26 +263,15 @@ bool GncAgent::begin_trial_weights(std::vector<OutgoingMessage>& out) {
 }
 
 bool GncAgent::send_weights(std::uint32_t phase, std::vector<OutgoingMessage>& out) {
-  const auto me = static_cast<std::uint32_t>(in_.id);
   low_weights_.clear();
   const int crossed = weights_at_mu(outer_->mu());
   const double spread = weight_spread(*terms_, weights_);
-  const int near =
-      options_.robust.jump_band > 0
-          ? near_bound_count(*terms_, dropped_, stage_->iterate(), exchange_->neighbours(),
-                             options_.robust.jump_band, options_.robust.jump_band_inside)
-          : 1;
+  const int near = near_bound_at(dropped_, stage_->iterate(), exchange_->neighbours());
   exchange_->own_vote() = {spread, crossed};
   exchange_->own_near_bound() = near;
   zero_cut_ =
       zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
-  for (std::uint32_t a : other_agents(me, in_.num_agents)) {
-    RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, weights_,
-                                            options_.robust.exchanges_ride_along);
-    st.phase = phase;
-    st.sender = me;
-    out.push_back(OutgoingMessage{std::move(st), false, {a}});
-  }
+  broadcast_weights(phase, spread, crossed, near, weights_, out);
   if (!gather_values_early() || values_held_) return false;
   // Beside the first weights (clean data has none), once: the values of the measurements this
   // agent weighs, to agent 0.

@@ -284,6 +284,13 @@ class GncAgent : public AgentProcess {
   // The weight update at the trial point `Y` the solve just handed out, sent beside its sums
   // (RobustOptions::weights_ride_trial_sums); kept aside until the solve's verdict.
   void send_trial_weights(const Eigen::MatrixXd& Y, std::vector<OutgoingMessage>& out);
+  // A weight update's near-bound count at `Y` (RobustOptions::jump_band; 1 when off) and its
+  // weights `w` with the vote, to every other agent: the same for the update at the iterate
+  // and at a trial point.
+  int near_bound_at(const std::vector<bool>& skip, const Eigen::MatrixXd& Y,
+                    const Eigen::MatrixXd& neighbours) const;
+  void broadcast_weights(std::uint32_t phase, double spread, int crossed, int near,
+                         const std::vector<double>& w, std::vector<OutgoingMessage>& out) const;
   // After a solve that sent them: the weight exchange from the trial's weights (this agent's kept
   // aside, the others' in) when the trial was accepted; false (the messages dropped) otherwise.
   bool begin_trial_weights(std::vector<OutgoingMessage>& out);
