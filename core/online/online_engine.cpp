@@ -93,8 +93,6 @@ double OnlineEngine::step_cpu_s() const {
 OnlineUpdate OnlineEngine::step(double now_s) {
   step_wall_start_ = Clock::now();
   step_cpu_start_ = cpu_now();
-  const auto wall_start = step_wall_start_;
-  const double cpu_start = step_cpu_start_;
   points_.clear();
   const bool keep = keep_points_;
   OnlineUpdate u;
@@ -199,8 +197,8 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     u.factor_flops = step.flops;
     u.blocks_built = blocks_->built_total() - built_before;
   }
-  u.ms = std::chrono::duration<double, std::milli>(Clock::now() - wall_start).count();
-  u.cpu_s = cpu_now() - cpu_start;
+  u.ms = 1000.0 * step_wall_s();
+  u.cpu_s = step_cpu_s();
   u.latency_s = now_s - oldest + u.ms / 1000.0;
   u.latency_cpu_s = now_s - oldest + u.cpu_s;
   // Out of the step's times: the step ended here.
