@@ -94,7 +94,7 @@ void CertifiedAgent::emit(std::vector<OutgoingMessage>&& sub,
 }
 
 std::vector<OutgoingMessage> CertifiedAgent::start() {
-  if (known_start_ && can_start_at_refinement()) return start_at_refinement();
+  if (known_grad_norm_ && can_start_at_refinement()) return start_at_refinement();
   std::vector<OutgoingMessage> out;
   begin(0, out);
   advance(out);
@@ -117,7 +117,8 @@ bool CertifiedAgent::can_start_at_refinement() const {
   const bool refined =
       hands_over_early() || options_.refine.when == NewtonRefineOptions::When::kAlways;
   const double tol = solve_tolerance();
-  const bool stops_at_start = std::isinf(tol) || (known_start_ && known_grad_norm_ <= 0.5 * tol);
+  const bool stops_at_start =
+      std::isinf(tol) || (known_grad_norm_ && *known_grad_norm_ <= 0.5 * tol);
   return refined && stops_at_start;
 }
 
@@ -143,8 +144,8 @@ void CertifiedAgent::begin_refine(std::vector<OutgoingMessage>& out) {
   if (trial_observer_) refine_->set_trial_observer(trial_observer_);
   if (!solves_.empty() && !solves_.back().trace.empty())
     refine_->set_start_grad_norm(solves_.back().trace.back().grad_norm);
-  else if (known_start_ && stage_ == 0)
-    refine_->set_start_grad_norm(known_grad_norm_);
+  else if (known_grad_norm_ && stage_ == 0)
+    refine_->set_start_grad_norm(*known_grad_norm_);
   current_ = refine_.get();
   emit(refine_->start(), out);
   for (const ProtocolMessage& m :

@@ -20,7 +20,6 @@
 
 #include <cstdint>
 #include <functional>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -55,10 +54,7 @@ class CertifiedAgent : public AgentProcess {
   /// solve of the same problem that ended there (the same on every agent). Where that settles
   /// the first solve stage's rounds at their round-0 status (can_start_at_refinement()), start()
   /// begins at the refinement (start_at_refinement()).
-  void set_known_start(double grad_norm) {
-    known_start_ = true;
-    known_grad_norm_ = grad_norm;
-  }
+  void set_known_start(double grad_norm) { known_grad_norm_ = grad_norm; }
   /// Whether the first solve stage's rounds would stop at their first status and hand over to
   /// the Newton refinement: their hand-over gradient is infinite, or the known start's gradient
   /// (set_known_start) is within half their tolerance (the rounds' own sum of it differs only
@@ -173,9 +169,8 @@ class CertifiedAgent : public AgentProcess {
   std::vector<EscapeStageRecord> escapes_;
   std::function<void(const ProtocolSnapshot&)> observer_;
   TrialObserver trial_observer_;
-  bool known_start_ = false;          // set_known_start()
-  Eigen::MatrixXd start_neighbours_;  // start_with_neighbours(), until the first stage opens
-  double known_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
+  std::optional<double> known_grad_norm_;  // set_known_start()
+  Eigen::MatrixXd start_neighbours_;       // start_with_neighbours(), until the first stage opens
   bool refining_ = false;        // the current rank's solve continues at refine_tolerance()
   bool interface_fits_ = false;  // the team's interface within the refinement's interface cap
   bool done_ = false;
