@@ -8,6 +8,7 @@
 #include <tessera/distributed/newton_refine.hpp>
 #include <tessera/manifold/lifted_manifold.hpp>
 #include <tessera/problem/pose_kernels.hpp>
+#include <utility>
 
 #include "distributed/coarse_hessian_columns.hpp"
 #include "distributed/gauge_space.hpp"
@@ -456,7 +457,7 @@ void NewtonRefineProtocol::send_coarse(std::vector<OutgoingMessage>& out) {
     if (galerkin) {
       coarse_->apply_generator(generator, LJ, VJ);
       apply_hessian_projection(XJ, GJ, VJ, problem_.dim(), HJ);
-      HJ = manifold.tangent_project(XJ, HJ);
+      HJ = manifold.tangent_project(XJ, std::move(HJ));  // in place: the same sums
       for (Eigen::Index a = 0; a < nj; ++a)
         hv.middleCols(J[static_cast<std::size_t>(a)] * w, w) = HJ.middleCols(a * w, w);
       coarse_->project(X_, hv, J, L.col(u).data());
