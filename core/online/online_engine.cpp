@@ -146,7 +146,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     u.merges = merges.merges;
     u.merge_poses_moved = merges.poses_moved;
   }
-  if (keep) points_.push_back({"absorbed", step_wall_s(), step_cpu_s(), 0, 0, X_});
+  if (keep) points_.push_back({{"absorbed", step_wall_s(), step_cpu_s(), 0, 0}, X_});
   if (converged_ && composed == u.measurements) {
     // Every new measurement placed a new pose (odometry, mostly): each has zero residual at
     // the composed poses, so f and its gradient are what they were and the agents, which were
@@ -203,7 +203,8 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.latency_cpu_s = now_s - oldest + u.cpu_s;
   // Out of the step's times: the step ended here.
   if (keep)
-    points_.push_back({"end", u.ms / 1000.0, u.cpu_s, u.newton_steps, u.newton_cg_iterations, X_});
+    points_.push_back(
+        {{"end", u.ms / 1000.0, u.cpu_s, u.newton_steps, u.newton_cg_iterations}, X_});
   for (double stamp : stamps) {
     totals_.batch_latency_s.push_back(now_s - stamp + u.ms / 1000.0);
     totals_.batch_latency_cpu_s.push_back(now_s - stamp + u.cpu_s);

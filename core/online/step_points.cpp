@@ -10,8 +10,7 @@ std::vector<StepPointCost> cost_step_points(const PoseGraph& graph,
   std::vector<StepPointCost> out;
   out.reserve(points.size());
   for (const StepPoint& p : points)
-    out.push_back({p.at, p.wall_s, p.cpu_s, p.newton_steps, p.cg_iterations,
-                   evaluate_objective(graph, round_solution(graph, p.X))});
+    out.push_back({p, evaluate_objective(graph, round_solution(graph, p.X))});
   return out;
 }
 

@@ -51,7 +51,7 @@ void TrialPoints::accepted(const std::vector<NewtonRefineResult>& refines, const
     for (int b = 0; b < blocks_; ++b)
       scatter_pose_columns(t.blocks[static_cast<std::size_t>(b)],
                            layout.poses[static_cast<std::size_t>(b)], d, linked);
-    StepPoint p{"newton", t.wall_s, t.cpu_s, static_cast<int>(k) + 1, cg, X};
+    StepPoint p{{"newton", t.wall_s, t.cpu_s, static_cast<int>(k) + 1, cg}, X};
     blocks.write_back(linked, p.X);
     out.push_back(std::move(p));
   }

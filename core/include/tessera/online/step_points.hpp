@@ -18,29 +18,31 @@
 
 namespace tessera {
 
-/// One estimate of a step (OnlineEngine::keep_step_points).
-struct StepPoint {
+/// Where in its step an estimate was, and when: what a kept point (StepPoint) and its costed
+/// form (StepPointCost) share.
+struct StepMark {
   /// "absorbed": the new data taken in, before any solve; "newton": an accepted Newton step's
   /// point; "end": where the step ended (after the rounds that follow Newton steps that stopped
   /// above the tolerance, or the rounds of a rounds-only step).
   std::string at;
-  /// Since the step began, on OnlineUpdate's clocks: wall seconds (wall_s) and process CPU seconds
-  /// (cpu_s). A Newton step's point is timed when the last agent formed its trial point, its
-  /// sums on the way out: the verdict that accepts it comes one all-agent sum later. The
+  /// Since the step began, on OnlineUpdate's clocks: wall seconds (wall_s) and process CPU
+  /// seconds (cpu_s). A Newton step's point is timed when the last agent formed its trial point,
+  /// its sums on the way out: the verdict that accepts it comes one all-agent sum later. The
   /// "end" point has the step's own times, so no point is later than the step.
   double wall_s = 0.0, cpu_s = 0.0;
   /// The step's Newton steps (accepted or not) and their CG iterations up to this point: its
   /// load-free cost (0 at "absorbed"; OnlineUpdate's newton_steps and newton_cg_iterations at
   /// "end").
   int newton_steps = 0, cg_iterations = 0;
+};
+
+/// One estimate of a step (OnlineEngine::keep_step_points).
+struct StepPoint : StepMark {
   Eigen::MatrixXd X;  ///< The lifted iterate (r x (d+1)n, stream ids).
 };
 
 /// A point's estimate and its cost (cost_step_points).
-struct StepPointCost {
-  std::string at;
-  double wall_s = 0.0, cpu_s = 0.0;
-  int newton_steps = 0, cg_iterations = 0;
+struct StepPointCost : StepMark {
   double cost = 0.0;  ///< Objective of the rounded estimate (reference convention).
 };
 
