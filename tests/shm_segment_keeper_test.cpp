@@ -10,6 +10,7 @@
 #include <sys/file.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -64,6 +65,38 @@ TEST(ShmSegmentKeeper, FindsTheSegmentsThisProcessMapsAndHoldsTheLockOf) {
   EXPECT_EQ(own_shm_segments(dir), std::vector<std::string>{kName});
   own.delete_participant(dir);
   EXPECT_TRUE(own_shm_segments(dir).empty());
+}
+
+TEST(ShmSegmentKeeper, APeersSegmentThisProcessMapsIsNotItsOwn) {
+  // A live peer's segment: mapped here (to write to the peer) and its lock file open here, but
+  // the lock held by the peer's process.
+  const std::string dir = test::temp_dir();
+  const std::string path = dir + "/" + kName;
+  std::ofstream(path) << "a live peer's segment\n";
+  const int data_fd = open(path.c_str(), O_RDONLY);
+  void* map = mmap(nullptr, 4096, PROT_READ, MAP_SHARED, data_fd, 0);
+  const int lock_fd = open((path + "_el").c_str(), O_RDWR | O_CREAT, 0644);
+  int locked[2], release[2];
+  ASSERT_EQ(pipe(locked), 0);
+  ASSERT_EQ(pipe(release), 0);
+  const pid_t peer = fork();
+  ASSERT_GE(peer, 0);
+  if (peer == 0) {
+    const int fd = open((path + "_el").c_str(), O_RDWR);
+    char c = flock(fd, LOCK_EX) == 0 ? 'y' : 'n';
+    if (write(locked[1], &c, 1) != 1 || read(release[0], &c, 1) != 1) _exit(1);
+    _exit(0);
+  }
+  char c = 0;
+  ASSERT_EQ(read(locked[0], &c, 1), 1);
+  ASSERT_EQ(c, 'y');
+  EXPECT_TRUE(own_shm_segments(dir).empty());
+  ASSERT_EQ(write(release[1], &c, 1), 1);
+  int status = 0;
+  waitpid(peer, &status, 0);
+  EXPECT_EQ(status, 0);
+  munmap(map, 4096);
+  for (int fd : {data_fd, lock_fd, locked[0], locked[1], release[0], release[1]}) close(fd);
 }
 
 TEST(ShmSegmentKeeper, ADeletedParticipantsSegmentGetsItsNameAndContentsBack) {

@@ -1,7 +1,7 @@
 #pragma once
 // The file locks the kernel lists in /proc/locks. Fast DDS 2.9 marks a live shared-memory
 // segment or port by holding a lock on its "_el"/"_sl" file, so a lock tells a live owner from
-// a dead one (shm_segment_keeper.hpp, launch/free_domain.hpp). No Fast DDS types.
+// a dead one (launch/free_domain.hpp). No Fast DDS types.
 
 #include <string>
 #include <vector>
