@@ -51,7 +51,8 @@ TEST_P(PoseKernels, DenseTimesSparseMatchesEigen) {
 }
 
 // The agents' products read Q_BB by dense pose blocks (entries the sparse form lacks are explicit
-// zeros there): the same values as the sparse kernel to the last bit, for every row count.
+// zeros there): the same values as the sparse kernel to the last bit, for every row count
+// (one row: the certificate's LOBPCG vectors).
 TEST_P(PoseKernels, PoseBlockProductIsBitIdenticalToTheSparseOne) {
   const auto [d, r] = GetParam();
   auto g = test::random_pose_graph({d, 30, 20, 0.05, 0.1, 9});
@@ -60,7 +61,7 @@ TEST_P(PoseKernels, PoseBlockProductIsBitIdenticalToTheSparseOne) {
   const PoseBlockMatrix B(Q, d + 1);
   EXPECT_LT(B.num_blocks(), static_cast<std::size_t>(Q.nonZeros()));  // one index a block
   std::srand(4);
-  for (int rows : {r, d}) {
+  for (int rows : {1, r, d}) {
     const Eigen::MatrixXd X = Eigen::MatrixXd::Random(rows, Q.rows());
     Eigen::MatrixXd sparse, blocks;
     scaled_dense_times_sparse(X, Q, 2.0, sparse);
