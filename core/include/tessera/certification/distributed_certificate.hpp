@@ -153,6 +153,9 @@ class CertificateProtocol : public AgentProcess {
   // product): a copy would be the block's largest transient (its Q_BB and edge data).
   const BlockProblem& problem_;
   SparseMatrix lambda_;  // Lambda_B on the block's coordinates
+  // The same Lambda_B as d x d blocks (column-major), pose after pose: the LOBPCG products.
+  std::vector<double> lambda_blocks_;
+  void subtract_times_lambda(const Eigen::MatrixXd& v, Eigen::MatrixXd& out) const;
   std::unique_ptr<BlockJacobi> precon_;
   double local_max_diag_ = 0.0;
   MessageGate gate_;
