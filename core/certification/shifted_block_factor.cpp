@@ -46,15 +46,20 @@ bool ShiftedBlockFactor::factor(const SparseMatrix& S, double shift) {
     throw_cholmod_failure("certificate (block preconditioner)", "factorization", c_.status,
                           static_cast<long>(S.rows()), static_cast<long>(S.cols()));
   if (L_->minor < L_->n) return false;  // not positive definite: the caller shifts further
-  if (!cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/0, /*to_packed=*/1,
+  if (!cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/0, /*to_super=*/0, /*to_packed=*/1,
                              /*to_monotonic=*/1, L_, &c_))
     throw_cholmod_failure("certificate (block preconditioner)", "factor conversion", c_.status,
                           static_cast<long>(S.rows()), static_cast<long>(S.cols()));
+  chain_.build(L_);
   return true;
 }
 
 Eigen::MatrixXd ShiftedBlockFactor::solve(const Eigen::MatrixXd& r) {
   Eigen::MatrixXd out(r.rows(), r.cols());
+  if (chain_.ready() && r.rows() == 1) {
+    chain_.solve(L_, r.data(), out.data());
+    return out;
+  }
   // One row: its entries are contiguous.
   cholmod_dense b = cholmod_dense_view(r.data(), r.cols());
   if (r.rows() != 1 || !cholmod_solve2(CHOLMOD_A, L_, &b, nullptr, &x_, nullptr, &y_, &e_, &c_))

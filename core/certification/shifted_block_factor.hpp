@@ -5,14 +5,18 @@
 //
 // How: ordered at the pose level (CHOLMOD's AMD on the m x m pattern of Q_BB's pose blocks, each
 // pose's d + 1 coordinates kept together: (d+1)^2 times less work than AMD on the matrix itself),
-// factored supernodally (BLAS kernels on the supernodes) and converted to the simplicial form,
-// whose solve with one right-hand side avoids the supernodal solve's BLAS calls on small
-// supernodes. Same operator as any Cholesky factor of the matrix, up to round-off.
+// factored supernodally (BLAS kernels on the supernodes) and converted to simplicial LDL^T, whose
+// solve with one right-hand side avoids the supernodal solve's BLAS calls on small supernodes and
+// goes through LdlChainSolve (solvers/ldl_chain_solve.hpp: CHOLMOD's LDL^T solve, ~0.6x its
+// instructions; CHOLMOD's LL^T solve has no such copy). Same operator as any Cholesky factor of
+// the matrix, up to round-off.
 
 #include <cholmod.h>
 
 #include <tessera/problem/data_matrix.hpp>
 #include <vector>
+
+#include "solvers/ldl_chain_solve.hpp"
 
 namespace tessera {
 
@@ -34,6 +38,7 @@ class ShiftedBlockFactor {
   cholmod_common c_;
   cholmod_factor* L_ = nullptr;
   cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;  // solve workspace, reused
+  LdlChainSolve chain_;                                       // indexed after every factorization
 };
 
 }  // namespace tessera
