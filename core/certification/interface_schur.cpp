@@ -174,11 +174,23 @@ InterfaceSchurBlock local_separator_schur(const BlockProblem& problem, const Spa
   for (std::size_t k : foreign) out.poses.push_back(neighbors[k]);
 
   const SparseMatrix A = problem.data_matrix() - lambda;
-  place_interior_first(pos, [&](const auto& add) {
-    for (Eigen::Index col = 0; col < n; ++col)
-      if (pos[static_cast<std::size_t>(col)] < 0)  // an interior column
-        for (SparseMatrix::InnerIterator it(A, col); it; ++it) add(it.row(), col);
+  // The eliminated poses' order is found at the pose level (a pose's w coordinates stay
+  // together, in order): the pattern's pose blocks are dense, so AMD on the poses orders what AMD
+  // on the coordinates would, on w^2 times fewer entries (it was a quarter of the agents' test).
+  std::vector<Eigen::Index> pose_pos(owned.size(), -1);
+  for (std::size_t k = 0; k < kept.size(); ++k)
+    pose_pos[static_cast<std::size_t>(slot.at(kept[k]))] =
+        (n - nK) / w + static_cast<Eigen::Index>(k);
+  place_interior_first(pose_pos, [&](const auto& add) {
+    for (Eigen::Index col = 0; col < n; col += w)
+      if (pose_pos[static_cast<std::size_t>(col / w)] < 0)  // an interior pose
+        for (Eigen::Index c = col; c < col + w; ++c)
+          for (SparseMatrix::InnerIterator it(A, c); it; ++it) add(it.row() / w, col / w);
   });
+  for (std::size_t p = 0; p < owned.size(); ++p)
+    if (!is_kept[p])
+      for (Eigen::Index c = 0; c < w; ++c)
+        pos[static_cast<std::size_t>(w * static_cast<Eigen::Index>(p) + c)] = w * pose_pos[p] + c;
 
   // The foreign poses' diagonal is a placeholder kappa I (their own block holds their entries):
   // large enough that the trailing block factors, then subtracted from the Schur complement.
