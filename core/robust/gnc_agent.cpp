@@ -74,10 +74,12 @@ int GncAgent::weights_at_mu(double mu) {
 int GncAgent::weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours,
                          const std::vector<bool>& skip, std::vector<double>& w) const {
   int crossed = 0;
+  const bool falls_only = options_.robust.mu_step_hold == MuStepHold::kFalls;
   for (std::size_t k : terms_->owned())
     if (terms_->may_reject(k) && !skip[k]) {
       const double wk = tls_weight(terms_->residual_squared(k, Y, neighbours), terms_->c2(), mu);
-      if ((wk >= 0.5) != (w[k] >= 0.5)) ++crossed;
+      // RobustOptions::mu_step_hold: what holds the adaptive step of mu back.
+      if (falls_only ? wk < 0.5 && w[k] >= 0.5 : (wk >= 0.5) != (w[k] >= 0.5)) ++crossed;
       w[k] = wk;
     }
   return crossed;

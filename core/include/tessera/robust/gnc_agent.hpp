@@ -276,7 +276,9 @@ class GncAgent : public AgentProcess {
   bool send_poses_with_trial() const;
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
-  int weights_at_mu(double mu);  // the count of owned weights that crossed 1/2
+  // The count of owned weights that crossed 1/2 (only those that fell below it with
+  // RobustOptions::mu_step_hold kFalls).
+  int weights_at_mu(double mu);
   // The same at the iterate `Y` with its neighbours' poses (the exchange book's columns) into `w`,
   // leaving the measurements flagged in `skip` as they are.
   int weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours,
