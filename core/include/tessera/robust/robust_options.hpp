@@ -102,7 +102,7 @@ struct RobustOptions {
   /// 0.1 / 0.5 119 -> 70 / 90 -> 82, group 0.1 / 0.25 the same sets (66 -> 68, 346 -> 242), group
   /// 0.5 precision 0.885 -> 0.879, recall 0.781 -> 0.797, cost gap 1.97 -> 1.73; CSAIL every
   /// cell the same set, random 0.1 81 -> 106 (one true closure misjudged, taken back by a pass)
-  /// (docs/robust.md, "Bigger mu steps on Newton steps").
+  /// (docs/robust.md, "Only falling weights hold the bigger step back").
   MuStepHold mu_step_hold = MuStepHold::kFalls;
   /// Distributed solvers only: GNC ends early when, at a weight update, no measurement that may
   /// be rejected has its r^2 within a factor of this of the bound (c^2 / B < r^2 < B c^2, summed
@@ -374,6 +374,19 @@ struct RobustOptions {
   /// 58 -> 57), the same `--out` bytes and rejected sets (docs/robust.md, "A pass's poses beside
   /// its trials' sums").
   bool pass_poses_ride_trial_sums = true;
+  /// Distributed solvers only, with exchanges_ride_along and the kept set's fresh start: when GNC
+  /// ends early (jump_band) at a weight update, the vote between the iterate and the kept set's
+  /// fresh start that follows needs no exchange of its own. Each agent's weights message carries
+  /// its cost over the measurements it weighs that TLS's verdict at that update keeps (the cost
+  /// the vote would sum at the iterate), and agent 0, which computes the fresh start from every
+  /// measurement's value, sends the start's cost over the kept set beside each agent's block
+  /// (summed per weight owner in file order, then in agent-id order: the vote's own sums, to the
+  /// bit). Every agent then compares the same two sums. Other votes (after a probe, before the
+  /// final solve, after GNC ended without the early end) run their exchange as before. On
+  /// (default); off: the vote's exchange. Why: one message step a run with outliers, the same
+  /// iterates (intel random 0.25, 5 agents: 76 -> 75; docs/robust.md, "The fresh start's vote
+  /// beside the weights").
+  bool kept_vote_rides_weights = true;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
