@@ -96,8 +96,8 @@ struct RobustOptions {
   /// (the weight 1/2 lies at r^2 = c^2 mu (mu + 1) / (mu + 1/2)^2, which grows with mu), so
   /// rises are the schedule's own doing and say nothing about whether the inlier set is
   /// settling; a fall comes from the iterate moving a residual out. On intel with 25 % random
-  /// outliers 4-63 weights cross 1/2 at every update and none falls, so with kCrossings the
-  /// bigger step ran once. `tessera solve --gnc-mu-hold falls|crossings`. F = 0.25 random, 5
+  /// outliers 4-63 weights crossed 1/2 at 12 of the 13 updates after the first and none fell,
+  /// so with kCrossings the bigger step ran once. `tessera solve --gnc-mu-hold falls|crossings`. F = 0.25 random, 5
   /// agents, crossings -> falls: intel 14 -> 7 outer steps, 121 -> 76 message steps; intel random
   /// 0.1 / 0.5 119 -> 70 / 90 -> 82, group 0.1 / 0.25 the same sets (66 -> 68, 346 -> 242), group
   /// 0.5 precision 0.885 -> 0.879, recall 0.781 -> 0.797, cost gap 1.97 -> 1.73; CSAIL every
