@@ -97,12 +97,11 @@ struct RobustOptions {
   /// rises are the schedule's own doing and say nothing about whether the inlier set is
   /// settling; a fall comes from the iterate moving a residual out. On intel with 25 % random
   /// outliers 4-63 weights crossed 1/2 at 12 of the 13 updates after the first and none fell,
-  /// so with kCrossings the bigger step ran once. `tessera solve --gnc-mu-hold falls|crossings`. F = 0.25 random, 5
-  /// agents, crossings -> falls: intel 14 -> 7 outer steps, 121 -> 76 message steps; intel random
-  /// 0.1 / 0.5 119 -> 70 / 90 -> 82, group 0.1 / 0.25 the same sets (66 -> 68, 346 -> 242), group
-  /// 0.5 precision 0.885 -> 0.879, recall 0.781 -> 0.797, cost gap 1.97 -> 1.73; CSAIL every
-  /// cell the same set, random 0.1 81 -> 106 (one true closure misjudged, taken back by a pass)
-  /// (docs/robust.md, "Only falling weights hold the bigger step back").
+  /// so with kCrossings the bigger step ran once. `tessera solve --gnc-mu-hold falls|crossings`.
+  /// F = 0.25 random, 5 agents, crossings -> falls: intel 14 -> 7 outer steps, 121 -> 76 message
+  /// steps; intel random 0.1 / 0.5 119 -> 70 / 90 -> 82, group 0.1 / 0.25 the same sets, group 0.5
+  /// precision 0.885 -> 0.879, recall 0.781 -> 0.797; CSAIL every cell the same set, random 0.1
+  /// 81 -> 106 (docs/robust.md, "Only falling weights hold the bigger step back").
   MuStepHold mu_step_hold = MuStepHold::kFalls;
   /// Distributed solvers only: GNC ends early when, at a weight update, no measurement that may
   /// be rejected has its r^2 within a factor of this of the bound (c^2 / B < r^2 < B c^2, summed
