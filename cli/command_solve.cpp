@@ -88,6 +88,9 @@ const char* kHelp =
     "                            GNC's weighted solves are Newton steps, mu's step after an\n"
     "                            outer step that moved no weight across 1/2 is the last one\n"
     "                            squared, up to S; 0 = none, else > 1 [4]\n"
+    "  --gnc-mu-hold falls|crossings   robust distributed: which weights, at an update, return\n"
+    "                            the bigger step of mu to --gnc-mu-step: those that fell below\n"
+    "                            1/2 (left the inlier set), or any that crossed 1/2 [falls]\n"
     "  --gnc-step-sigma every|refine-sigma   robust distributed: who factors the interface\n"
     "                            solves' matrix in GNC's weighted Newton steps: every agent\n"
     "                            (no wait for agent 0's solve), or as --refine-sigma says; the\n"
@@ -272,6 +275,7 @@ int run_solve(const Args& args) {
   valued.insert("gnc-probe-cut");
   valued.insert("gnc-newton-mu-step-max");
   valued.insert("gnc-step-sigma");
+  valued.insert("gnc-mu-hold");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
@@ -307,6 +311,13 @@ int run_solve(const Args& args) {
     throw InputError("option --gnc-step-sigma: '" + step_sigma +
                      "' is not one of every, refine-sigma");
   robust.step_sigma_every_agent = step_sigma == "every";
+  // RobustOptions::mu_step_hold; `tessera solve` only, like --gnc-probe-cut.
+  try {
+    robust.mu_step_hold =
+        parse_mu_step_hold(a.get_or("gnc-mu-hold", mu_step_hold_name(robust.mu_step_hold)));
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-mu-hold: ") + e.what());
+  }
   // RobustOptions::newton_mu_step_max; `tessera solve` only, like --gnc-probe-cut.
   robust.newton_mu_step_max = a.get_double("gnc-newton-mu-step-max", robust.newton_mu_step_max);
   try {

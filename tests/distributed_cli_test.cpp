@@ -224,6 +224,11 @@ TEST(DistributedCli, RejectsBadOptions) {
   EXPECT_NE(out.find("grad_reduction"), std::string::npos) << out;
   EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + g + " --algorithm sgd", &out), 2);
   EXPECT_NE(out.find("irbcd"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + g +
+                                  " --algorithm irbcd --robust gnc-tls --gnc-mu-hold rises",
+                              &out),
+            2);
+  EXPECT_NE(out.find("--gnc-mu-hold"), std::string::npos) << out;
 }
 
 }  // namespace

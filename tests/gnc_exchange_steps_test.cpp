@@ -85,6 +85,7 @@ TEST(GncExchangeSteps, ExchangesThatRideAlongLeaveTheRunAsItWasInFewerSteps) {
     GncDistributedOptions o = certified_tls();
     o.robust.exchanges_ride_along = ride_along;
     o.robust.weights_ride_trial_sums = false;  // its own test below
+    o.robust.kept_vote_rides_weights = false;  // likewise
     return solve_recording_weights(dirty, o, seen);
   };
   std::vector<Weights> seen_apart, seen_along;
@@ -167,6 +168,22 @@ TEST(GncExchangeSteps, APassReadsItsLastAcceptedTrialsPosesAndTheRunIsShorter) {
   const int saved = apart.exchange_steps - beside.exchange_steps;
   EXPECT_GE(saved, 1);  // at least the pass after GNC
   EXPECT_EQ(static_cast<std::int64_t>(apart.longest_chain - beside.longest_chain), saved);
+}
+
+// RobustOptions::kept_vote_rides_weights: after GNC's early end the vote between the iterate and
+// the kept set's fresh start takes the iterate's cost from the last weights messages and the
+// start's from agent 0's answer, summed as the vote sums them; the run is the same (the same
+// vote outcome, every later step alike), one message step shorter.
+TEST(GncExchangeSteps, TheFreshStartsVoteRidesTheWeightsAndTheRunIsOneStepShorter) {
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  const auto flag = &RobustOptions::kept_vote_rides_weights;
+  const GncDistributedResult voted = solve_with(dirty, flag, false);
+  const GncDistributedResult ridden = solve_with(dirty, flag, true);
+  ASSERT_TRUE(voted.final_solve.certified.value_or(false));
+  ASSERT_FALSE(voted.rejected.empty());
+  expect_same_run(ridden, voted);
+  EXPECT_EQ(voted.exchange_steps - ridden.exchange_steps, 1);
+  EXPECT_EQ(static_cast<std::int64_t>(voted.longest_chain - ridden.longest_chain), 1);
 }
 
 }  // namespace

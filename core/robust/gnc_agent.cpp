@@ -74,10 +74,12 @@ int GncAgent::weights_at_mu(double mu) {
 int GncAgent::weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours,
                          const std::vector<bool>& skip, std::vector<double>& w) const {
   int crossed = 0;
+  const bool falls_only = options_.robust.mu_step_hold == MuStepHold::kFalls;
   for (std::size_t k : terms_->owned())
     if (terms_->may_reject(k) && !skip[k]) {
       const double wk = tls_weight(terms_->residual_squared(k, Y, neighbours), terms_->c2(), mu);
-      if ((wk >= 0.5) != (w[k] >= 0.5)) ++crossed;
+      // RobustOptions::mu_step_hold: what holds the adaptive step of mu back.
+      if (falls_only ? wk < 0.5 && w[k] >= 0.5 : (wk >= 0.5) != (w[k] >= 0.5)) ++crossed;
       w[k] = wk;
     }
   return crossed;
@@ -146,8 +148,14 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
 
 void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
   // Agent 0: the kept set's initialization, each agent's block sent, its own kept.
+  // With the iterate's cost known from the weights, the start's own cost goes with it: the vote
+  // needs no exchange (RobustOptions::kept_vote_rides_weights).
+  double cost = 0;
   const Eigen::MatrixXd X = kept_set_start(exchange_->kept_values(), in_, rejected_.size(),
-                                           static_cast<int>(stage_->iterate().rows()));
+                                           static_cast<int>(stage_->iterate().rows()),
+                                           iterate_kept_cost_ ? &cost : nullptr);
+  exchange_->candidate_cost().reset();
+  if (iterate_kept_cost_) exchange_->candidate_cost() = cost;
   // With values_held_, each agent's neighbours' poses of the start too: no pose exchange of the
   // start follows.
   std::vector<std::vector<std::size_t>> nb(static_cast<std::size_t>(in_.num_agents));
@@ -163,6 +171,11 @@ void GncAgent::start_kept_set(std::vector<OutgoingMessage>& out) {
         false,
         {a}});
   exchange_->candidate() = gather_pose_columns(X, base_->poses[0], in_.d);
+  if (exchange_->candidate_cost()) {
+    RoundStatusMessage st;
+    st.cost = *exchange_->candidate_cost();
+    broadcast_status(std::move(st), 0, gnc_phase(g_, GncExchange::kKeptStart), in_.num_agents, out);
+  }
 }
 
 void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
@@ -229,6 +242,13 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       // Both starts' neighbour poses are here already: the iterate's from the last pose
       // exchange, the fresh start's from agent 0.
       if (values_held_ && neighbours_current_) {
+        // Both costs are here too: the iterate's from the last weights, the start's from agent 0.
+        if (iterate_kept_cost_ && exchange_->candidate_cost()) {
+          const std::pair<double, double> sums{*iterate_kept_cost_, *exchange_->candidate_cost()};
+          iterate_kept_cost_.reset();
+          after_candidate_votes(sums, out);
+          return;
+        }
         begin_exchange(Step::kCandidateVotes, out);
         return;
       }
@@ -248,7 +268,7 @@ void GncAgent::after_exchange(std::vector<OutgoingMessage>& out) {
       begin_exchange(Step::kCandidateVotes, out);
       return;
     case Step::kCandidateVotes:
-      after_candidate_votes(out);
+      after_candidate_votes(exchange_->summed_votes(), out);
       return;
     case Step::kReadmitted:
       after_verdict(out);
@@ -262,6 +282,7 @@ void GncAgent::after_rejected(std::vector<OutgoingMessage>& out) {
   std::sort(rejected_.begin(), rejected_.end());
   gnc_rejected_ = rejected_;
   // Nothing rejected: the GNC iterate is already the plain solve's.
+  if (rejected_.empty()) iterate_kept_cost_.reset();
   if (kept_votes_->enabled() && !rejected_.empty()) {
     require_kept_connected();  // before initializing the kept set
     begin_exchange(Step::kKeptStart, out);
@@ -276,6 +297,10 @@ void GncAgent::after_weights(std::vector<OutgoingMessage>& out) {
       outer_->after_update(spread, static_cast<int>(crossed), exchange_->summed_near_bound(),
                            options_.robust, stage_->newton_steps_only());
   jumped_ = jump;
+  // The early end's rejected set follows from these weights with no exchange: its cost at the
+  // iterate is the one the weights messages carried.
+  iterate_kept_cost_.reset();
+  if (jump && kept_vote_rides_weights()) iterate_kept_cost_ = exchange_->summed_kept_cost();
   if (jump)
     for (std::size_t k = 0; k < weights_.size(); ++k)
       if (terms_->may_reject(k) && !dropped_[k])
@@ -294,8 +319,10 @@ void GncAgent::after_weights(std::vector<OutgoingMessage>& out) {
   begin_solve(out);
 }
 
-void GncAgent::after_candidate_votes(std::vector<OutgoingMessage>& out) {
-  const auto [at_iterate, at_candidate] = exchange_->summed_votes();
+void GncAgent::after_candidate_votes(std::pair<double, double> sums,
+                                     std::vector<OutgoingMessage>& out) {
+  iterate_kept_cost_.reset();
+  const auto [at_iterate, at_candidate] = sums;
   const bool final_vote = kept_votes_->ended(rejected_, at_candidate);
   const bool fresh = at_candidate < at_iterate;
   if (fresh) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "robust/gnc_exchange.hpp"
+#include "robust/gnc_kept_start_votes.hpp"
 #include "robust/gnc_lead_steps.hpp"
 #include "robust/gnc_local_terms.hpp"
 #include "robust/gnc_mailbox.hpp"
@@ -75,6 +76,8 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
       from = values_held_ ? std::vector<int>{0}  // agent 0's answer
                           : exchange_->gather_values_at_lead(
                                 gnc_phase(g_, GncExchange::kKeptValues), &rejected_, out);
+      // Beside agent 0's start, its cost over the kept set (the vote's second sum).
+      values_too = in_.id != 0 && iterate_kept_cost_.has_value();
       break;
     case Step::kWeights:
       values_too = send_weights(phase, out);
@@ -169,13 +172,32 @@ int GncAgent::near_bound_at(const std::vector<bool>& skip, const Eigen::MatrixXd
                           options_.robust.jump_band_inside);
 }
 
+bool GncAgent::kept_vote_rides_weights() const {
+  return options_.robust.kept_vote_rides_weights && options_.robust.exchanges_ride_along &&
+         kept_votes_->enabled();
+}
+
+double GncAgent::kept_cost_at(const std::vector<double>& w, const Eigen::MatrixXd& Y,
+                              const Eigen::MatrixXd& neighbours) const {
+  if (!kept_vote_rides_weights()) return 0;
+  // As the vote sums it (kept_set_costs): the kept measurements this agent weighs, in order;
+  // kept is what the rejected set after an early end keeps (GncAgent::after_weights).
+  double cost = 0;
+  for (std::size_t k : terms_->owned()) {
+    const double verdict =
+        terms_->may_reject(k) && !dropped_[k] ? tls_verdict_weight(w[k], outer_->mu()) : w[k];
+    if (verdict >= 0.5) cost += terms_->residual_squared(k, Y, neighbours);
+  }
+  return cost;
+}
+
 void GncAgent::broadcast_weights(std::uint32_t phase, double spread, int crossed, int near,
-                                 const std::vector<double>& w,
+                                 const std::vector<double>& w, double kept_cost,
                                  std::vector<OutgoingMessage>& out) const {
   const auto me = static_cast<std::uint32_t>(in_.id);
   for (std::uint32_t a : other_agents(me, in_.num_agents)) {
     RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, w,
-                                            options_.robust.exchanges_ride_along);
+                                            options_.robust.exchanges_ride_along, kept_cost);
     st.phase = phase;
     st.sender = me;
     out.push_back(OutgoingMessage{std::move(st), false, {a}});
@@ -218,8 +240,9 @@ void GncAgent::send_trial_weights(const Eigen::MatrixXd& Y, std::vector<Outgoing
   trial_near_ = near;
   trial_zero_cut_ =
       zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, trial_weights_);
+  trial_kept_cost_ = kept_cost_at(trial_weights_, Y, N);
   broadcast_weights(gnc_phase(g_, GncExchange::kTrialWeights), spread, crossed, near,
-                    trial_weights_, out);
+                    trial_weights_, trial_kept_cost_, out);
   trial_weights_sent_ = true;
 }
 
@@ -256,6 +279,7 @@ bool GncAgent::begin_trial_weights(std::vector<OutgoingMessage>& out) {
   zero_cut_ = std::move(trial_zero_cut_);
   exchange_->own_vote() = trial_vote_;
   exchange_->own_near_bound() = trial_near_;
+  exchange_->own_kept_cost() = trial_kept_cost_;
   mail_->begin_exchange(gnc_phase(g_, GncExchange::kTrialWeights),
                         as_ints(other_agents(static_cast<std::uint32_t>(in_.id), in_.num_agents)));
   take_exchange(out);
@@ -271,7 +295,8 @@ bool GncAgent::send_weights(std::uint32_t phase, std::vector<OutgoingMessage>& o
   exchange_->own_near_bound() = near;
   zero_cut_ =
       zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
-  broadcast_weights(phase, spread, crossed, near, weights_, out);
+  exchange_->own_kept_cost() = kept_cost_at(weights_, stage_->iterate(), exchange_->neighbours());
+  broadcast_weights(phase, spread, crossed, near, weights_, exchange_->own_kept_cost(), out);
   if (!gather_values_early() || values_held_) return false;
   // Beside the first weights (clean data has none), once: the values of the measurements this
   // agent weighs, to agent 0.

@@ -34,6 +34,12 @@ double GncExchangeBook::summed_near_bound() const {
   return sum;
 }
 
+double GncExchangeBook::summed_kept_cost() const {
+  double sum = 0;
+  for (const auto& [sender, v] : kept_costs_) sum += v;  // agent-id order
+  return sum;
+}
+
 double GncExchangeBook::largest_vote() const {
   double max_r2 = 0;
   for (const auto& [sender, v] : votes_) max_r2 = std::max(max_r2, v.first);
@@ -103,6 +109,11 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
           in_.num_poses, "robust solve", kept_values_);
       break;
     case GncExchange::kKeptStart:  // agent 0's fresh start of the kept set: this agent's block
+      // With it, its cost over the kept set (RobustOptions::kept_vote_rides_weights).
+      if (const auto* st = std::get_if<RoundStatusMessage>(&message)) {
+        candidate_cost_ = st->cost;
+        break;
+      }
       candidate_ = read_kept_start(
           expect_pose_block(message, in_.id, "a status where the kept set's start belongs"),
           base_.poses[static_cast<std::size_t>(in_.id)], to.rank, in_.d, in_.id,
@@ -135,6 +146,7 @@ void GncExchangeBook::read(GncExchange e, const ProtocolMessage& message, GncExc
       const RoundStatusMessage& st = expect_status(message, in_.id, kStatusBelongs);
       votes_[sender] = {st.grad_norm_sq, st.cost};
       near_bound_[sender] = st.near_bound;
+      kept_costs_[sender] = st.block_grad_norm;
       read_weights_message(st, sender, in_, to.weights, to.zero_cut, to.low_weights);
       break;
     }

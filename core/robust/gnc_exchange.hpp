@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <tessera/distributed/agent_process.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/protocol/messages.hpp>
@@ -40,11 +41,20 @@ class GncExchangeBook {
   void begin() {
     votes_.clear();
     near_bound_.clear();
+    kept_costs_.clear();
+    candidate_cost_.reset();
   }
   /// The weight exchange's count of residuals near the bound (RobustOptions::jump_band): this
   /// agent's, and the sum over every agent.
   double& own_near_bound() { return near_bound_[static_cast<std::uint32_t>(in_.id)]; }
   double summed_near_bound() const;
+  /// The weight exchange's cost over the kept set at TLS's verdict
+  /// (RobustOptions::kept_vote_rides_weights): this agent's, and the sum over every agent.
+  double& own_kept_cost() { return kept_costs_[static_cast<std::uint32_t>(in_.id)]; }
+  double summed_kept_cost() const;
+  /// The kept set's fresh start's cost over the kept set, when agent 0 sent it beside the start
+  /// (or, at agent 0, computed it) in the running exchange; empty otherwise.
+  std::optional<double>& candidate_cost() { return candidate_cost_; }
   /// This agent's vote of the current exchange (summed with the others' in agent-id order).
   std::pair<double, double>& own_vote() { return votes_[static_cast<std::uint32_t>(in_.id)]; }
   std::pair<double, double> summed_votes() const;  // every agent's, agent-id order
@@ -93,6 +103,8 @@ class GncExchangeBook {
   // Sums of the current exchange (in agent-id order: own and received values kept by sender).
   std::map<std::uint32_t, std::pair<double, double>> votes_;
   std::map<std::uint32_t, double> near_bound_;
+  std::map<std::uint32_t, double> kept_costs_;
+  std::optional<double> candidate_cost_;
   Eigen::MatrixXd neighbours_;  // neighbours' public poses of the current iterate
   Eigen::MatrixXd candidate_, candidate_neighbours_;  // the first inlier pass's other start
   GatheredValues kept_values_;                        // agent 0's gathers

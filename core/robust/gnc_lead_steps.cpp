@@ -5,7 +5,9 @@
 #include <string>
 #include <tessera/distributed/distributed_initialization.hpp>
 #include <tessera/problem/lifting.hpp>
+#include <tessera/robust/gnc_distributed.hpp>
 #include <tessera/robust/pairwise_consistency.hpp>
+#include <tessera/robust/tls_weights.hpp>
 
 namespace tessera {
 
@@ -49,13 +51,26 @@ std::vector<std::uint64_t> inconsistent_closures(GatheredValues& values, const G
 }
 
 Eigen::MatrixXd kept_set_start(GatheredValues& values, const GncAgentInput& in,
-                               std::size_t rejected, int r) {
+                               std::size_t rejected, int r, double* cost) {
   const PoseGraph kept = in_file_order(values, in, true);
   if (kept.measurements.size() + rejected != in.structure.size())
     throw std::runtime_error("robust solve: agent 0 has " +
                              std::to_string(kept.measurements.size()) + " kept measurements, not " +
                              std::to_string(in.structure.size() - rejected));
-  return lift_poses(initial_poses(kept, in.initialization, in.num_agents), r);
+  Eigen::MatrixXd X = lift_poses(initial_poses(kept, in.initialization, in.num_agents), r);
+  if (cost) {
+    // Each agent's vote sums its own measurements in file order (kept_set_costs); the votes are
+    // added in agent-id order.
+    const Eigen::Index w = in.d + 1;
+    std::vector<double> by_owner(static_cast<std::size_t>(in.num_agents), 0.0);
+    for (const Measurement& m : kept.measurements)
+      by_owner[static_cast<std::size_t>(weight_owner(m, in.owner))] +=
+          lifted_residual_squared(m, X.middleCols(w * static_cast<Eigen::Index>(m.i), w),
+                                  X.middleCols(w * static_cast<Eigen::Index>(m.j), w));
+    *cost = 0;
+    for (double c : by_owner) *cost += c;
+  }
+  return X;
 }
 
 std::vector<std::vector<std::size_t>> cut_neighbours(const GncAgentInput& in) {

@@ -24,10 +24,13 @@ std::vector<std::uint64_t> inconsistent_closures(GatheredValues& values, const G
                                                  const GncLocalTerms& terms);
 
 /// The initialization of the kept set (every measurement but the `rejected` ones, in `values`,
-/// consumed), lifted to rank `r`: r x (d+1)n, every pose. Throws std::runtime_error on a
-/// measurement sent twice or a count that does not match.
+/// consumed), lifted to rank `r`: r x (d+1)n, every pose. With `cost` non-null, also its cost
+/// over those measurements, summed as the agents' vote sums it (each weight owner's in file
+/// order, then the owners' sums in agent-id order: the same bits;
+/// RobustOptions::kept_vote_rides_weights). Throws std::runtime_error on a measurement sent twice
+/// or a count that does not match.
 Eigen::MatrixXd kept_set_start(GatheredValues& values, const GncAgentInput& in,
-                               std::size_t rejected, int r);
+                               std::size_t rejected, int r, double* cost = nullptr);
 
 /// For every agent, the poses of other agents at the ends of its measurements (ascending), as
 /// GncLocalTerms::neighbours() lists them on that agent: what agent 0 sends each agent beside

@@ -69,10 +69,13 @@ std::uint32_t GncMailbox::gate_round(const ProtocolMessage& m) const {
   if (pass_trial(phase)) return message_round(m);  // the trial's number
   const auto* block = std::get_if<PoseBlockMessage>(&m);
   if (two_starts(phase)) return block && block->kind == BlockKind::kP ? 1 : 0;
-  // Measurement values beside the first weights (the wire's round stays 0: a runtime waits by
-  // it).
+  // Measurement values beside the first weights, and the start's cost beside agent 0's start of
+  // the kept set (the wire's round stays 0: a runtime waits by it).
   const std::uint32_t weights =
       kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kWeights);
+  const std::uint32_t kept_start =
+      kGncExchangeBase + static_cast<std::uint32_t>(GncExchange::kKeptStart);
+  if (phase % kGncStepStride == kept_start) return block ? 0 : 1;
   return block && phase % kGncStepStride == weights ? 1 : 0;
 }
 

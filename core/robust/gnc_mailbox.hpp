@@ -26,7 +26,7 @@ class GncMailbox {
   /// The exchange of `phase` (gnc_phase()) from now on: one message from each of `senders`;
   /// both starts' poses (GncExchange::kStartPoses, kCandidatePoses) two, kind Y and kind P; with
   /// `values_too` (the first GncExchange::kWeights at agent 0), a status and a block of measurement
-  /// values.
+  /// values, or (GncExchange::kKeptStart) agent 0's start and a status with its cost.
   void begin_exchange(std::uint32_t phase, std::vector<int> senders, bool values_too = false);
   /// The exchange of an inlier pass's trial poses (GncExchange::kPassTrialPoses) of trial
   /// `trial` (the wire's round): one message from each of `senders`.

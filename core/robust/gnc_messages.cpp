@@ -57,10 +57,12 @@ RoundStatusMessage vote_message(const std::pair<double, double>& sums) {
 
 RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed, int near_bound,
                                    const GncAgentInput& in, const GncLocalTerms& terms,
-                                   const std::vector<double>& weights, bool low_too) {
+                                   const std::vector<double>& weights, bool low_too,
+                                   double kept_cost) {
   RoundStatusMessage st;
   st.grad_norm_sq = spread;
   st.cost = crossed;
+  st.block_grad_norm = kept_cost;
   st.near_bound = static_cast<std::uint32_t>(near_bound);
   for (std::size_t k : terms.owned()) {
     const Measurement& m = in.measurements[k];

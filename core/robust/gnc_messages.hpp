@@ -47,9 +47,12 @@ inline std::pair<double, double> read_vote(const RoundStatusMessage& st) {
 /// the count of this agent's measurements whose weight crossed 1/2 in this update (cost, the
 /// adaptive mu schedule's vote, RobustOptions::mu_step_max) and of its measurements with r^2
 /// near the bound (near_bound: the early end's vote, RobustOptions::jump_band).
+/// `kept_cost` (block_grad_norm) is the sender's cost over the measurements it weighs that an
+/// early end at this update keeps (RobustOptions::kept_vote_rides_weights; 0 when unused).
 RoundStatusMessage weights_message(std::uint32_t to, double spread, int crossed, int near_bound,
                                    const GncAgentInput& in, const GncLocalTerms& terms,
-                                   const std::vector<double>& weights, bool low_too);
+                                   const std::vector<double>& weights, bool low_too,
+                                   double kept_cost = 0);
 
 /// Checks `st` from `sender` (ids and weights match; every id is the sender's to weigh) and
 /// applies it: the weights of this agent's measurements, every cut id of weight 0 to

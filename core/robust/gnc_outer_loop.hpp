@@ -14,6 +14,7 @@ class GncOuterLoop {
   void start(double largest_residual_squared, double c2, const RobustOptions& options);
 
   /// After a weight update with the team's weight spread, count of weights that crossed 1/2
+  /// (that fell below it, with RobustOptions::mu_step_hold kFalls)
   /// and count of residuals within RobustOptions::jump_band of the bound. Returns true when
   /// GNC ends at TLS's verdict now (the jump: nothing is near the bound); mu stays where it was
   /// for that verdict. Otherwise mu takes its next step (RobustOptions::mu_step, squared up to

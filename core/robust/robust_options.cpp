@@ -52,6 +52,16 @@ ProbeCut parse_probe_cut(const std::string& name) {
   throw InputError("'" + name + "' is not one of always, after-passes, auto");
 }
 
+const char* mu_step_hold_name(MuStepHold hold) {
+  return hold == MuStepHold::kFalls ? "falls" : "crossings";
+}
+
+MuStepHold parse_mu_step_hold(const std::string& name) {
+  if (name == "falls") return MuStepHold::kFalls;
+  if (name == "crossings") return MuStepHold::kCrossings;
+  throw InputError("'" + name + "' is not one of falls, crossings");
+}
+
 void RobustOptions::validate() const {
   if (!(std::isfinite(inlier_threshold) && inlier_threshold >= 0))
     bad_field("inlier_threshold", number_text(inlier_threshold),
@@ -72,6 +82,9 @@ void RobustOptions::validate() const {
     bad_field("mu_step_max", number_text(mu_step_max), "must be 0 (off) or >= mu_step");
   if (!(std::isfinite(newton_mu_step_max) && (newton_mu_step_max == 0 || newton_mu_step_max > 1)))
     bad_field("newton_mu_step_max", number_text(newton_mu_step_max), "must be 0 (none) or > 1");
+  if (mu_step_hold != MuStepHold::kCrossings && mu_step_hold != MuStepHold::kFalls)
+    bad_field("mu_step_hold", std::to_string(static_cast<int>(mu_step_hold)),
+              "must be crossings or falls");
   if (!(std::isfinite(jump_band) && (jump_band == 0 || jump_band > 1)))
     bad_field("jump_band", number_text(jump_band), "must be 0 (off) or > 1");
   if (recheck_max_rounds < 0)

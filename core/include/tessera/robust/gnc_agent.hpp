@@ -258,7 +258,16 @@ class GncAgent : public AgentProcess {
   void after_weights(std::vector<OutgoingMessage>& out);
   void after_rejected(std::vector<OutgoingMessage>& out);
   void after_pcm(std::vector<OutgoingMessage>& out);
-  void after_candidate_votes(std::vector<OutgoingMessage>& out);
+  // The vote's sums: the kept set's cost at the iterate and at the fresh start.
+  void after_candidate_votes(std::pair<double, double> sums, std::vector<OutgoingMessage>& out);
+  // RobustOptions::kept_vote_rides_weights: the weights messages carry each agent's cost over
+  // the kept set at TLS's verdict (the same on every agent: options and data only).
+  bool kept_vote_rides_weights() const;
+  // This agent's cost over the measurements it weighs that an early end at this update keeps
+  // (weights `w` at TLS's verdict, as after_weights maps them), at `Y` and its neighbours; 0
+  // without kept_vote_rides_weights().
+  double kept_cost_at(const std::vector<double>& w, const Eigen::MatrixXd& Y,
+                      const Eigen::MatrixXd& neighbours) const;
   void after_start_votes(std::vector<OutgoingMessage>& out);
   void after_verdict(std::vector<OutgoingMessage>& out);
   // A re-check verdict that changes nothing: a pass to the tolerance, a probe, or the end.
@@ -276,7 +285,9 @@ class GncAgent : public AgentProcess {
   bool send_poses_with_trial() const;
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
-  int weights_at_mu(double mu);  // the count of owned weights that crossed 1/2
+  // The count of owned weights that crossed 1/2 (only those that fell below it with
+  // RobustOptions::mu_step_hold kFalls).
+  int weights_at_mu(double mu);
   // The same at the iterate `Y` with its neighbours' poses (the exchange book's columns) into `w`,
   // leaving the measurements flagged in `skip` as they are.
   int weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours,
@@ -290,7 +301,8 @@ class GncAgent : public AgentProcess {
   int near_bound_at(const std::vector<bool>& skip, const Eigen::MatrixXd& Y,
                     const Eigen::MatrixXd& neighbours) const;
   void broadcast_weights(std::uint32_t phase, double spread, int crossed, int near,
-                         const std::vector<double>& w, std::vector<OutgoingMessage>& out) const;
+                         const std::vector<double>& w, double kept_cost,
+                         std::vector<OutgoingMessage>& out) const;
   // After a solve that sent them: the weight exchange from the trial's weights (this agent's kept
   // aside, the others' in) when the trial was accepted; false (the messages dropped) otherwise.
   bool begin_trial_weights(std::vector<OutgoingMessage>& out);
@@ -338,6 +350,11 @@ class GncAgent : public AgentProcess {
   std::vector<std::uint64_t> trial_zero_cut_;
   std::pair<double, double> trial_vote_{0.0, 0.0};
   double trial_near_ = 0.0;
+  double trial_kept_cost_ = 0.0;
+  // The kept set's summed cost at the iterate after GNC's early end, from the last weights
+  // exchange (RobustOptions::kept_vote_rides_weights): the fresh start's vote then needs no
+  // exchange. Empty otherwise, and once that vote is taken.
+  std::optional<double> iterate_kept_cost_;
   // The running inlier pass's trial points whose poses went out (pass_poses_ride_trial_sums).
   std::uint32_t pass_trials_sent_ = 0;
   // Agent 0 holds every measurement's value (sent beside the first weights, with

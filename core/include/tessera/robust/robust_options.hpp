@@ -34,12 +34,21 @@ enum class ProbeCut {
   kAuto,
 };
 
+/// Which weight changes at an update hold the adaptive mu step back to RobustOptions::mu_step
+/// (RobustOptions::mu_step_hold).
+enum class MuStepHold {
+  kCrossings,  ///< Any weight that crossed 1/2, either way.
+  kFalls,      ///< Only a weight that fell below 1/2: a measurement left the inlier set.
+};
+
 const char* robust_kind_name(RobustKind kind);              ///< "none", "gnc-tls" or "pcm-gnc".
 RobustKind parse_robust_kind(const std::string& name);      ///< InputError lists valid names.
 const char* known_inliers_name(KnownInliers known);         ///< "odometry" or "none".
 KnownInliers parse_known_inliers(const std::string& name);  ///< InputError lists valid names.
 const char* probe_cut_name(ProbeCut cut);                   ///< "always", "after-passes" or "auto".
 ProbeCut parse_probe_cut(const std::string& name);          ///< InputError lists valid names.
+const char* mu_step_hold_name(MuStepHold hold);             ///< "crossings" or "falls".
+MuStepHold parse_mu_step_hold(const std::string& name);     ///< InputError lists valid names.
 
 struct RobustOptions {
   RobustKind kind = RobustKind::kNone;
@@ -80,6 +89,20 @@ struct RobustOptions {
   /// same counts, 2 intel 0.5 127). Where GNC's solves are rounds nothing changes (there adaptive
   /// mu cost manhattan3500 a probe: docs/robust.md, "Fewer outer steps").
   double newton_mu_step_max = 4.0;
+  /// Distributed solvers only, with the adaptive step (mu_step_max, newton_mu_step_max): which
+  /// weight changes at an update return the next step to mu_step. kFalls (default): only
+  /// weights that fell below 1/2 (a measurement left the inlier set); kCrossings: a weight that
+  /// crossed 1/2 either way. Why: at a fixed iterate a larger mu only raises weights across 1/2
+  /// (the weight 1/2 lies at r^2 = c^2 mu (mu + 1) / (mu + 1/2)^2, which grows with mu), so
+  /// rises are the schedule's own doing and say nothing about whether the inlier set is
+  /// settling; a fall comes from the iterate moving a residual out. On intel with 25 % random
+  /// outliers 4-63 weights crossed 1/2 at 12 of the 13 updates after the first and none fell,
+  /// so with kCrossings the bigger step ran once. `tessera solve --gnc-mu-hold falls|crossings`.
+  /// F = 0.25 random, 5 agents, crossings -> falls: intel 14 -> 7 outer steps, 121 -> 76 message
+  /// steps; intel random 0.1 / 0.5 119 -> 70 / 90 -> 82, group 0.1 / 0.25 the same sets, group 0.5
+  /// precision 0.885 -> 0.879, recall 0.781 -> 0.797; CSAIL every cell the same set, random 0.1
+  /// 81 -> 106 (docs/robust.md, "Only falling weights hold the bigger step back").
+  MuStepHold mu_step_hold = MuStepHold::kFalls;
   /// Distributed solvers only: GNC ends early when, at a weight update, no measurement that may
   /// be rejected has its r^2 within a factor of this of the bound (c^2 / B < r^2 < B c^2, summed
   /// over the agents with the weight votes): each weight then jumps to TLS's own verdict at that
@@ -350,6 +373,19 @@ struct RobustOptions {
   /// 58 -> 57), the same `--out` bytes and rejected sets (docs/robust.md, "A pass's poses beside
   /// its trials' sums").
   bool pass_poses_ride_trial_sums = true;
+  /// Distributed solvers only, with exchanges_ride_along and the kept set's fresh start: when GNC
+  /// ends early (jump_band) at a weight update, the vote between the iterate and the kept set's
+  /// fresh start that follows needs no exchange of its own. Each agent's weights message carries
+  /// its cost over the measurements it weighs that TLS's verdict at that update keeps (the cost
+  /// the vote would sum at the iterate), and agent 0, which computes the fresh start from every
+  /// measurement's value, sends the start's cost over the kept set beside each agent's block
+  /// (summed per weight owner in file order, then in agent-id order: the vote's own sums, to the
+  /// bit). Every agent then compares the same two sums. Other votes (after a probe, before the
+  /// final solve, after GNC ended without the early end) run their exchange as before. On
+  /// (default); off: the vote's exchange. Why: one message step a run with outliers, the same
+  /// iterates (intel random 0.25, 5 agents: 76 -> 75; docs/robust.md, "The fresh start's vote
+  /// beside the weights").
+  bool kept_vote_rides_weights = true;
   /// Stop when sum_e w_e (1 - w_e) falls below this (weights binary), >= 0.
   double weight_tolerance = 1e-6;
 
