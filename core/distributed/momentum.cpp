@@ -8,6 +8,7 @@
 #include <tessera/distributed/momentum.hpp>
 #include <utility>
 
+#include "manifold/polar_lanes.hpp"
 #include "util/double_pair.hpp"
 
 namespace tessera {
@@ -241,7 +242,24 @@ template <int D, int R, typename Blend>
 void blend_and_project(Eigen::MatrixXd& out, Eigen::Index poses, const Blend& blend) {
   const Eigen::Index r = out.rows(), w = (D + 1) * r;
   double* base = out.data();
-  for (Eigen::Index i = 0; i < poses; ++i) {
+  Eigen::Index i = 0;
+  if constexpr (D == 3 && (R == 3 || R == 5)) {
+    // polar_lanes() poses at a time, one a vector lane (the same bits as pose by pose); a group
+    // with a pose outside the series' reach, or (R = 5) with non-zero rows 3-4, goes pose by pose.
+    const int lanes = polar_lanes();
+    double* group[kMaxPolarLanes];
+    for (; i + lanes <= poses; i += lanes) {
+      bool zero_tails = true;
+      for (int l = 0; l < lanes; ++l) {
+        group[l] = base + (i + l) * w;
+        blend((i + l) * w, w, group[l]);
+        if constexpr (R == 5) zero_tails = zero_tails && zero_tail<3, 5>(group[l]);
+      }
+      if (!zero_tails || !polar_lanes_3d(group, lanes, r, R == 5))
+        for (int l = 0; l < lanes; ++l) project_pose<D, R>(group[l], r);
+    }
+  }
+  for (; i < poses; ++i) {
     blend(i * w, w, base + i * w);
     project_pose<D, R>(base + i * w, r);
   }

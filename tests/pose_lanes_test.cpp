@@ -1,0 +1,93 @@
+// The kernels that take several poses at once, one pose a vector lane (manifold/polar_lanes.hpp),
+// against the pose-by-pose code they stand for: the same bits, with AVX (four lanes) and without
+// (two), for groups the lanes take and groups they hand back.
+
+#include <gtest/gtest.h>
+
+#include <tessera/distributed/momentum.hpp>
+#include <tessera/manifold/lifted_manifold.hpp>
+#include <vector>
+
+#include "manifold/polar_lanes.hpp"
+#include "util/avx_kernels.hpp"
+
+namespace tessera {
+namespace {
+
+// n 3D poses at rank r near the manifold, pose i at distance ~offsets[i % size] from it. With
+// r = 5 the rows 3-4 are zero (a lifted start's) except in the poses listed in `full_rows`.
+Eigen::MatrixXd poses_near_manifold(int r, int n, const std::vector<double>& offsets,
+                                    const std::vector<int>& full_rows, unsigned seed) {
+  std::srand(seed);
+  const LiftedManifold M3(3, 3, n);
+  const Eigen::MatrixXd Y = M3.project(Eigen::MatrixXd::Random(3, 4 * n));
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(r, 4 * n);
+  for (int i = 0; i < n; ++i) {
+    const double t = offsets[static_cast<std::size_t>(i) % offsets.size()];
+    A.block(0, 4 * i, 3, 4) = Y.middleCols(4 * i, 4) + t * Eigen::MatrixXd::Random(3, 4);
+  }
+  for (int i : full_rows) A.block(3, 4 * i, r - 3, 4) = 1e-3 * Eigen::MatrixXd::Random(r - 3, 4);
+  return A;
+}
+
+// Proj_M of every pose on its own: one pose is fewer than any group, so the pose-by-pose code.
+Eigen::MatrixXd project_pose_by_pose(const Eigen::MatrixXd& A) {
+  Eigen::MatrixXd out = A;
+  const LiftedManifold one(static_cast<int>(A.rows()), 3, 1);
+  for (Eigen::Index i = 0; i < A.cols() / 4; ++i)
+    out.middleCols(4 * i, 4) = project_to_manifold(one, A.middleCols(4 * i, 4));
+  return out;
+}
+
+class PoseLanes : public ::testing::TestWithParam<bool> {
+ protected:
+  void SetUp() override { avx_before_ = set_avx_kernels(GetParam()); }
+  void TearDown() override { set_avx_kernels(avx_before_); }
+  bool avx_before_ = false;
+};
+
+TEST_P(PoseLanes, ProjectionInLanesIsBitIdenticalToPoseByPose) {
+  // Offsets below 1e-9 (the series' first term), within the series (1e-7, 1e-5), and beyond it
+  // (Newton-Schulz, the eigen-decomposition): groups of each kind and mixed ones, plus the
+  // leftover poses after the last whole group.
+  const std::vector<std::vector<double>> mixes = {
+      {1e-12, 1e-7, 1e-5, 3e-11}, {1e-7}, {1e-12, 1e-7, 1e-3, 1e-6, 1e-8, 0.7, 1e-6}};
+  for (int r : {3, 5})
+    for (std::size_t m = 0; m < mixes.size(); ++m) {
+      const int n = 23;
+      const std::vector<int> full = r == 5 ? std::vector<int>{5, 14} : std::vector<int>{};
+      const Eigen::MatrixXd A = poses_near_manifold(r, n, mixes[m], full, 17 + m);
+      const LiftedManifold M(r, 3, n);
+      EXPECT_TRUE(project_to_manifold(M, A) == project_pose_by_pose(A)) << r << " " << m;
+      // The momentum blends take the same path.
+      const MomentumCoefficients c{0.25, 1.0, 0.0};
+      const Eigen::MatrixXd Y = poses_near_manifold(r, n, {0.0}, {}, 3);
+      EXPECT_TRUE(extrapolate(M, c, Y, A) == project_pose_by_pose(0.25 * A + 0.75 * Y))
+          << r << " " << m;
+    }
+}
+
+TEST_P(PoseLanes, AGroupWithAPoseOutsideTheSeriesIsHandedBackUntouched) {
+  const int lanes = polar_lanes();
+  EXPECT_EQ(lanes, avx_kernels_enabled() ? 4 : 2);
+  for (int r : {3, 5}) {
+    Eigen::MatrixXd A = poses_near_manifold(r, lanes, {1e-6}, {}, 5);
+    std::vector<double*> group;
+    for (int l = 0; l < lanes; ++l) group.push_back(A.data() + 4 * r * l);
+    const Eigen::MatrixXd expected = project_pose_by_pose(A);
+    Eigen::MatrixXd B = A;
+    B(1, 4 * (lanes - 1)) += 1e-3;  // the last pose: Newton-Schulz's
+    std::vector<double*> far;
+    for (int l = 0; l < lanes; ++l) far.push_back(B.data() + 4 * r * l);
+    const Eigen::MatrixXd B0 = B;
+    EXPECT_FALSE(polar_lanes_3d(far.data(), lanes, r, r == 5));
+    EXPECT_TRUE(B == B0);
+    ASSERT_TRUE(polar_lanes_3d(group.data(), lanes, r, r == 5));
+    EXPECT_TRUE(A == expected) << r;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(WithAndWithoutAvx, PoseLanes, ::testing::Bool());
+
+}  // namespace
+}  // namespace tessera
