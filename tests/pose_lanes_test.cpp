@@ -1,14 +1,16 @@
-// The kernels that take several poses at once, one pose a vector lane (manifold/polar_lanes.hpp),
+// The kernels that take several poses at once, one pose a vector lane (manifold/pose_lanes.hpp),
 // against the pose-by-pose code they stand for: the same bits, with AVX (four lanes) and without
 // (two), for groups the lanes take and groups they hand back.
+
+#include "manifold/pose_lanes.hpp"
 
 #include <gtest/gtest.h>
 
 #include <tessera/distributed/momentum.hpp>
 #include <tessera/manifold/lifted_manifold.hpp>
+#include <tessera/problem/pose_kernels.hpp>
 #include <vector>
 
-#include "manifold/polar_lanes.hpp"
 #include "util/avx_kernels.hpp"
 
 namespace tessera {
@@ -68,23 +70,44 @@ TEST_P(PoseLanes, ProjectionInLanesIsBitIdenticalToPoseByPose) {
 }
 
 TEST_P(PoseLanes, AGroupWithAPoseOutsideTheSeriesIsHandedBackUntouched) {
-  const int lanes = polar_lanes();
+  const int lanes = pose_lanes();
   EXPECT_EQ(lanes, avx_kernels_enabled() ? 4 : 2);
   for (int r : {3, 5}) {
     Eigen::MatrixXd A = poses_near_manifold(r, lanes, {1e-6}, {}, 5);
-    std::vector<double*> group;
-    for (int l = 0; l < lanes; ++l) group.push_back(A.data() + 4 * r * l);
     const Eigen::MatrixXd expected = project_pose_by_pose(A);
     Eigen::MatrixXd B = A;
     B(1, 4 * (lanes - 1)) += 1e-3;  // the last pose: Newton-Schulz's
-    std::vector<double*> far;
-    for (int l = 0; l < lanes; ++l) far.push_back(B.data() + 4 * r * l);
     const Eigen::MatrixXd B0 = B;
-    EXPECT_FALSE(polar_lanes_3d(far.data(), lanes, r, r == 5));
+    EXPECT_FALSE(polar_in_lanes(B.data(), lanes, r));
     EXPECT_TRUE(B == B0);
-    ASSERT_TRUE(polar_lanes_3d(group.data(), lanes, r, r == 5));
+    ASSERT_TRUE(polar_in_lanes(A.data(), lanes, r));
     EXPECT_TRUE(A == expected) << r;
   }
+}
+
+// The agents' tangent projections and Hessian projections at r = 3 (their active rows): in
+// groups, with the leftover poses after the last group pose by pose.
+TEST_P(PoseLanes, TangentAndHessianProjectionsInLanesAreBitIdenticalToPoseByPose) {
+  const int n = 23;
+  const LiftedManifold M(3, 3, n), one(3, 3, 1);
+  const Eigen::MatrixXd X = poses_near_manifold(3, n, {0.0}, {}, 8);
+  std::srand(9);
+  const Eigen::MatrixXd V = Eigen::MatrixXd::Random(3, 4 * n);
+  const Eigen::MatrixXd G = Eigen::MatrixXd::Random(3, 4 * n);
+  const Eigen::MatrixXd H0 = Eigen::MatrixXd::Random(3, 4 * n);
+  Eigen::MatrixXd projected(3, 4 * n), H = H0, H_each = H0;
+  for (int i = 0; i < n; ++i) {
+    projected.middleCols(4 * i, 4) =
+        one.tangent_project(X.middleCols(4 * i, 4), V.middleCols(4 * i, 4));
+    Eigen::MatrixXd h = H0.middleCols(4 * i, 4);
+    apply_hessian_projection(X.middleCols(4 * i, 4), G.middleCols(4 * i, 4), V.middleCols(4 * i, 4),
+                             3, h);
+    H_each.middleCols(4 * i, 4) = h;
+  }
+  EXPECT_TRUE(M.tangent_project(X, V) == projected);
+  EXPECT_TRUE(M.tangent_project(X, Eigen::MatrixXd(V)) == projected);  // in place
+  apply_hessian_projection(X, G, V, 3, H);
+  EXPECT_TRUE(H == H_each);
 }
 
 INSTANTIATE_TEST_SUITE_P(WithAndWithoutAvx, PoseLanes, ::testing::Bool());

@@ -8,7 +8,7 @@
 #include <tessera/distributed/momentum.hpp>
 #include <utility>
 
-#include "manifold/polar_lanes.hpp"
+#include "manifold/pose_lanes.hpp"
 #include "util/double_pair.hpp"
 
 namespace tessera {
@@ -244,19 +244,18 @@ void blend_and_project(Eigen::MatrixXd& out, Eigen::Index poses, const Blend& bl
   double* base = out.data();
   Eigen::Index i = 0;
   if constexpr (D == 3 && (R == 3 || R == 5)) {
-    // polar_lanes() poses at a time, one a vector lane (the same bits as pose by pose); a group
+    // pose_lanes() poses at a time, one a vector lane (the same bits as pose by pose); a group
     // with a pose outside the series' reach, or (R = 5) with non-zero rows 3-4, goes pose by pose.
-    const int lanes = polar_lanes();
-    double* group[kMaxPolarLanes];
+    const int lanes = pose_lanes();
     for (; i + lanes <= poses; i += lanes) {
+      double* group = base + i * w;
       bool zero_tails = true;
       for (int l = 0; l < lanes; ++l) {
-        group[l] = base + (i + l) * w;
-        blend((i + l) * w, w, group[l]);
-        if constexpr (R == 5) zero_tails = zero_tails && zero_tail<3, 5>(group[l]);
+        blend((i + l) * w, w, group + l * w);
+        if constexpr (R == 5) zero_tails = zero_tails && zero_tail<3, 5>(group + l * w);
       }
-      if (!zero_tails || !polar_lanes_3d(group, lanes, r, R == 5))
-        for (int l = 0; l < lanes; ++l) project_pose<D, R>(group[l], r);
+      if (!zero_tails || !polar_in_lanes(group, lanes, r))
+        for (int l = 0; l < lanes; ++l) project_pose<D, R>(group + l * w, r);
     }
   }
   for (; i < poses; ++i) {
