@@ -1,6 +1,7 @@
-// The kernels that take several poses at once, one pose a vector lane (manifold/pose_lanes.hpp),
-// against the pose-by-pose code they stand for: the same bits, with AVX (four lanes) and without
-// (two), for groups the lanes take and groups they hand back.
+// The kernels that take several poses or measurements at once, one a vector lane
+// (manifold/pose_lanes.hpp, problem/edge_lanes.hpp), against the one-by-one code they stand for:
+// the same bits, with AVX (four lanes) and without (two), for groups the lanes take and groups they
+// hand back.
 
 #include "manifold/pose_lanes.hpp"
 
@@ -8,9 +9,11 @@
 
 #include <tessera/distributed/momentum.hpp>
 #include <tessera/manifold/lifted_manifold.hpp>
+#include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/pose_kernels.hpp>
 #include <vector>
 
+#include "random_graph.hpp"
 #include "util/avx_kernels.hpp"
 
 namespace tessera {
@@ -108,6 +111,36 @@ TEST_P(PoseLanes, TangentAndHessianProjectionsInLanesAreBitIdenticalToPoseByPose
   EXPECT_TRUE(M.tangent_project(X, Eigen::MatrixXd(V)) == projected);  // in place
   apply_hessian_projection(X, G, V, 3, H);
   EXPECT_TRUE(H == H_each);
+}
+
+// The cost at a 3D block's 3 active rows adds its measurements' terms computed in groups (the
+// leftover ones one by one); at rank 5 (rows 3-4 zero) every term comes from the general
+// per-measurement loop, which gives each term's bits (ProblemTest): the same sums to the bit.
+TEST_P(PoseLanes, CostInLanesIsBitIdenticalToTheGeneralLoop) {
+  auto g = test::random_pose_graph({3, 40, 31, 0.05, 0.1, 8});
+  std::vector<std::size_t> own;
+  for (std::size_t i = 0; i < g.num_poses; i += 3) own.push_back(i);
+  BlockProblem whole = BlockProblem::whole_graph(3, g.num_poses, g.measurements);
+  BlockProblem block(3, own, g.measurements);
+  std::srand(12);
+  const Eigen::MatrixXd Xn = Eigen::MatrixXd::Random(3, 4 * block.num_neighbors());
+  Eigen::MatrixXd Xn5 = Eigen::MatrixXd::Zero(5, Xn.cols());
+  Xn5.topRows(3) = Xn;
+  for (BlockProblem* P : {&whole, &block}) {
+    const Eigen::Index n = P == &whole ? static_cast<Eigen::Index>(g.num_poses)
+                                       : static_cast<Eigen::Index>(own.size());
+    // Off the manifold too: larger residuals, more rounding to tell orders apart.
+    const Eigen::MatrixXd X = Eigen::MatrixXd::Random(3, 4 * n);
+    Eigen::MatrixXd X5 = Eigen::MatrixXd::Zero(5, X.cols());
+    X5.topRows(3) = X;
+    double share = 0.0, share5 = 0.0;
+    if (P == &block) P->set_neighbor_poses(Xn);
+    const double f = P->cost(X, &share);
+    if (P == &block) P->set_neighbor_poses(Xn5);
+    const double f5 = P->cost(X5, &share5);
+    EXPECT_EQ(f, f5);
+    EXPECT_EQ(share, share5);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(WithAndWithoutAvx, PoseLanes, ::testing::Bool());

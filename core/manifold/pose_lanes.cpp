@@ -3,34 +3,10 @@
 #include <emmintrin.h>
 
 #include "util/avx_kernels.hpp"
+#include "util/lanes.hpp"
 
 namespace tessera {
 namespace {
-
-// GCC's vector extension: element-wise operations, each lane rounded as the scalar operation
-// (no FMA is ever formed: neither copy is compiled with it).
-typedef double Lanes2 __attribute__((vector_size(16)));
-typedef double Lanes4 __attribute__((vector_size(32)));
-
-// Each kernel is written once and inlined into each copy, where it is compiled for that copy's
-// instruction set. Vectors pass by reference only (a 32-byte vector by value would change the
-// calling convention of a non-AVX function).
-#define TESSERA_LANE_INLINE inline __attribute__((always_inline))
-
-// Entry `at` of each of the group's poses (pose l at p + l * stride).
-template <typename V, int L>
-TESSERA_LANE_INLINE void gather(V& v, const double* p, Eigen::Index stride, Eigen::Index at) {
-  if constexpr (L == 4)
-    v = V{p[at], p[stride + at], p[2 * stride + at], p[3 * stride + at]};
-  else
-    v = V{p[at], p[stride + at]};
-}
-
-template <typename V, int L>
-TESSERA_LANE_INLINE void scatter(const V& v, double* p, Eigen::Index stride, Eigen::Index at) {
-#pragma GCC unroll 4
-  for (int l = 0; l < L; ++l) p[l * stride + at] = v[l];
-}
 
 // The group's 3 x 3 rotation blocks at rank R: m[k][i] = entry (i, k).
 template <typename V, int L, int R>
@@ -38,7 +14,7 @@ TESSERA_LANE_INLINE void gather_rotations(V (&m)[3][3], const double* p) {
 #pragma GCC unroll 4
   for (int k = 0; k < 3; ++k)
 #pragma GCC unroll 4
-    for (int i = 0; i < 3; ++i) gather<V, L>(m[k][i], p, 4 * R, k * R + i);
+    for (int i = 0; i < 3; ++i) gather_lanes<V, L>(m[k][i], p, 4 * R, k * R + i);
 }
 
 // sym_product<3, 3>: S = sym(A^T B), each entry of A^T B summed from +0 over k in order.
@@ -136,7 +112,7 @@ TESSERA_LANE_INLINE bool polar(double* A) {
       V s = a[0][i] * z[0][j];
       s += a[1][i] * z[1][j];
       s += a[2][i] * z[2][j];
-      scatter<V, L>(s, A, 4 * R, j * R + i);
+      scatter_lanes<V, L>(s, A, 4 * R, j * R + i);
     }
   return true;
 }
@@ -156,7 +132,7 @@ TESSERA_LANE_INLINE void tangent_project(const double* X, const double* Vp, doub
       V o = v[b][k] + (-1.0 * s[0][b]) * x[0][k];
       o = o + (-1.0 * s[1][b]) * x[1][k];
       o = o + (-1.0 * s[2][b]) * x[2][k];
-      scatter<V, L>(o, out, 12, 3 * b + k);
+      scatter_lanes<V, L>(o, out, 12, 3 * b + k);
     }
 }
 
@@ -183,7 +159,7 @@ TESSERA_LANE_INLINE void hessian_projection(const double* X, const double* G, co
       V o = h[b][k];
 #pragma GCC unroll 4
       for (int a = 0; a < 3; ++a) o -= sh[a][b] * x[a][k] + sg[a][b] * v[a][k];
-      scatter<V, L>(o, H, 12, 3 * b + k);
+      scatter_lanes<V, L>(o, H, 12, 3 * b + k);
     }
 }
 

@@ -5,6 +5,8 @@
 #include <tessera/problem/pose_kernels.hpp>
 #include <utility>
 
+#include "manifold/pose_lanes.hpp"
+#include "problem/edge_lanes.hpp"
 #include "util/double_pair.hpp"
 
 namespace tessera {
@@ -327,7 +329,28 @@ double BlockProblem::sum_edges(const Eigen::MatrixXd& X, double* share) const {
   constexpr std::size_t stride = D * D + D + 2;
   const double* packed = packed_.data();
   double f = 0.0, s = 0.0;
-  for (std::size_t k = 0; k < edges_.size(); ++k) {
+  std::size_t k = 0;
+  if constexpr (D == 3 && R == 3) {
+    // pose_lanes() terms at a time, one a vector lane (the same bits as edge_term<3, 3>), added
+    // up in order as below.
+    const std::size_t lanes = static_cast<std::size_t>(pose_lanes());
+    const double* xi[kMaxPoseLanes];
+    const double* xj[kMaxPoseLanes];
+    double terms[kMaxPoseLanes];
+    for (; k + lanes <= edges_.size(); k += lanes) {
+      for (std::size_t l = 0; l < lanes; ++l) {
+        xi[l] = column(edges_[k + l].slot_i);
+        xj[l] = column(edges_[k + l].slot_j);
+      }
+      edge_terms_in_lanes(xi, xj, packed + k * stride, static_cast<int>(lanes), terms);
+      for (std::size_t l = 0; l < lanes; ++l) {
+        const Edge& e = edges_[k + l];
+        f += terms[l];
+        s += (e.slot_i < m && e.slot_j < m) ? terms[l] : 0.5 * terms[l];
+      }
+    }
+  }
+  for (; k < edges_.size(); ++k) {
     const Edge& e = edges_[k];
     const double c = edge_term<D, R>(column(e.slot_i), column(e.slot_j), packed + k * stride, r);
     f += c;

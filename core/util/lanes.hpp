@@ -1,0 +1,45 @@
+#pragma once
+// Vectors of doubles for the kernels that handle several poses or measurements at once, one a
+// lane: GCC's vector extension, element-wise, each lane rounded as the scalar operation (no FMA
+// is ever formed: no copy is compiled with it). A kernel is a template over the vector type,
+// written once and inlined (TESSERA_LANE_INLINE) into a copy per instruction set, where it is
+// compiled for that set: four lanes in the AVX copy (util/avx_kernels.hpp), two in the SSE2
+// one. Vectors pass by reference only: a 32-byte vector by value would change the calling
+// convention of a non-AVX function.
+
+#include <Eigen/Core>
+
+namespace tessera {
+
+typedef double Lanes2 __attribute__((vector_size(16)));
+typedef double Lanes4 __attribute__((vector_size(32)));
+
+#define TESSERA_LANE_INLINE inline __attribute__((always_inline))
+
+/// Lane l of v = p[l * stride + at].
+template <typename V, int L>
+TESSERA_LANE_INLINE void gather_lanes(V& v, const double* p, Eigen::Index stride, Eigen::Index at) {
+  if constexpr (L == 4)
+    v = V{p[at], p[stride + at], p[2 * stride + at], p[3 * stride + at]};
+  else
+    v = V{p[at], p[stride + at]};
+}
+
+/// Lane l of v = p[l][at].
+template <typename V, int L>
+TESSERA_LANE_INLINE void gather_lanes(V& v, const double* const* p, Eigen::Index at) {
+  if constexpr (L == 4)
+    v = V{p[0][at], p[1][at], p[2][at], p[3][at]};
+  else
+    v = V{p[0][at], p[1][at]};
+}
+
+/// p[l * stride + at] = lane l of v.
+template <typename V, int L>
+TESSERA_LANE_INLINE void scatter_lanes(const V& v, double* p, Eigen::Index stride,
+                                       Eigen::Index at) {
+#pragma GCC unroll 4
+  for (int l = 0; l < L; ++l) p[l * stride + at] = v[l];
+}
+
+}  // namespace tessera
