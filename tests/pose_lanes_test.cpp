@@ -69,6 +69,11 @@ TEST_P(PoseLanes, ProjectionInLanesIsBitIdenticalToPoseByPose) {
       const Eigen::MatrixXd Y = poses_near_manifold(r, n, {0.0}, {}, 3);
       EXPECT_TRUE(extrapolate(M, c, Y, A) == project_pose_by_pose(0.25 * A + 0.75 * Y))
           << r << " " << m;
+      const MomentumCoefficients c2{0.0, 0.875, 0.3};
+      const Eigen::MatrixXd Yn = poses_near_manifold(r, n, {1e-6}, {}, 4);
+      EXPECT_TRUE(momentum_update(M, c2, A, Y, Yn) ==
+                  project_pose_by_pose((0.875 * A + 0.125 * Y) + 0.3 * (Yn - Y)))
+          << r << " " << m;
     }
 }
 

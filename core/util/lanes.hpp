@@ -8,6 +8,7 @@
 // convention of a non-AVX function.
 
 #include <Eigen/Core>
+#include <cstring>
 
 namespace tessera {
 
@@ -15,6 +16,18 @@ typedef double Lanes2 __attribute__((vector_size(16)));
 typedef double Lanes4 __attribute__((vector_size(32)));
 
 #define TESSERA_LANE_INLINE inline __attribute__((always_inline))
+
+/// v = p[0 .. lanes) (no alignment needed).
+template <typename V>
+TESSERA_LANE_INLINE void load_lanes(V& v, const double* p) {
+  std::memcpy(&v, p, sizeof(V));
+}
+
+/// p[0 .. lanes) = v.
+template <typename V>
+TESSERA_LANE_INLINE void store_lanes(double* p, const V& v) {
+  std::memcpy(p, &v, sizeof(V));
+}
 
 /// Lane l of v = p[l * stride + at].
 template <typename V, int L>
