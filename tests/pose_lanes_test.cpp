@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "random_graph.hpp"
+#include "solvers/tangent_coordinates.hpp"
 #include "util/avx_kernels.hpp"
 
 namespace tessera {
@@ -116,6 +117,26 @@ TEST_P(PoseLanes, TangentAndHessianProjectionsInLanesAreBitIdenticalToPoseByPose
   EXPECT_TRUE(M.tangent_project(X, Eigen::MatrixXd(V)) == projected);  // in place
   apply_hessian_projection(X, G, V, 3, H);
   EXPECT_TRUE(H == H_each);
+}
+
+// The tangent preconditioner's coordinate maps J^T V and J c (solvers/tangent_coordinates.hpp):
+// in groups, against one pose a call.
+TEST_P(PoseLanes, TangentCoordinateMapsInLanesAreBitIdenticalToPoseByPose) {
+  const int n = 23;
+  const Eigen::MatrixXd X = poses_near_manifold(3, n, {0.0}, {}, 10);
+  std::srand(11);
+  const Eigen::MatrixXd V = Eigen::MatrixXd::Random(3, 4 * n);
+  const Eigen::VectorXd c = Eigen::VectorXd::Random(6 * n);
+  Eigen::VectorXd b(6 * n), b_each(6 * n);
+  Eigen::MatrixXd Z(3, 4 * n), Z_each(3, 4 * n);
+  tangent_coordinates<3>(X.data(), V.data(), n, b.data());
+  tangent_vector<3>(X.data(), c.data(), n, Z.data());
+  for (int i = 0; i < n; ++i) {
+    tangent_coordinates<3>(X.data() + 12 * i, V.data() + 12 * i, 1, b_each.data() + 6 * i);
+    tangent_vector<3>(X.data() + 12 * i, c.data() + 6 * i, 1, Z_each.data() + 12 * i);
+  }
+  EXPECT_TRUE(b == b_each);
+  EXPECT_TRUE(Z == Z_each);
 }
 
 // The cost at a 3D block's 3 active rows adds its measurements' terms computed in groups (the

@@ -32,10 +32,15 @@ TESSERA_LANE_INLINE void store_lanes(double* p, const V& v) {
 /// Lane l of v = p[l * stride + at].
 template <typename V, int L>
 TESSERA_LANE_INLINE void gather_lanes(V& v, const double* p, Eigen::Index stride, Eigen::Index at) {
-  if constexpr (L == 4)
-    v = V{p[at], p[stride + at], p[2 * stride + at], p[3 * stride + at]};
-  else
-    v = V{p[at], p[stride + at]};
+  // Through a plain array: assigning a braced vector inside a loop made GCC warn that the
+  // target's previous value may be read uninitialised.
+  if constexpr (L == 4) {
+    const double e[4] = {p[at], p[stride + at], p[2 * stride + at], p[3 * stride + at]};
+    std::memcpy(&v, e, sizeof(V));
+  } else {
+    const double e[2] = {p[at], p[stride + at]};
+    std::memcpy(&v, e, sizeof(V));
+  }
 }
 
 /// Lane l of v = p[l][at].
