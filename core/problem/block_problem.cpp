@@ -333,22 +333,9 @@ double BlockProblem::sum_edges(const Eigen::MatrixXd& X, double* share) const {
   if constexpr (D == 3 && R == 3) {
     // pose_lanes() terms at a time, one a vector lane (the same bits as edge_term<3, 3>), added
     // up in order as below.
-    const std::size_t lanes = static_cast<std::size_t>(pose_lanes());
-    const double* xi[kMaxPoseLanes];
-    const double* xj[kMaxPoseLanes];
-    double terms[kMaxPoseLanes];
-    for (; k + lanes <= edges_.size(); k += lanes) {
-      for (std::size_t l = 0; l < lanes; ++l) {
-        xi[l] = column(edges_[k + l].slot_i);
-        xj[l] = column(edges_[k + l].slot_j);
-      }
-      edge_terms_in_lanes(xi, xj, packed + k * stride, static_cast<int>(lanes), terms);
-      for (std::size_t l = 0; l < lanes; ++l) {
-        const Edge& e = edges_[k + l];
-        f += terms[l];
-        s += (e.slot_i < m && e.slot_j < m) ? terms[l] : 0.5 * terms[l];
-      }
-    }
+    static_assert(sizeof(Edge) == 2 * sizeof(std::size_t), "Edge is its two slots");
+    k = sum_edge_terms_in_lanes(reinterpret_cast<const std::size_t*>(edges_.data()), edges_.size(),
+                                X.data(), X_n_.data(), m, packed, f, s);
   }
   for (; k < edges_.size(); ++k) {
     const Edge& e = edges_[k];

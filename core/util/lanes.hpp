@@ -29,11 +29,12 @@ TESSERA_LANE_INLINE void store_lanes(double* p, const V& v) {
   std::memcpy(p, &v, sizeof(V));
 }
 
+// The gathers go through a plain array: a braced vector assigned inside a loop made GCC warn
+// that the target's previous value may be read uninitialised.
+
 /// Lane l of v = p[l * stride + at].
 template <typename V, int L>
 TESSERA_LANE_INLINE void gather_lanes(V& v, const double* p, Eigen::Index stride, Eigen::Index at) {
-  // Through a plain array: assigning a braced vector inside a loop made GCC warn that the
-  // target's previous value may be read uninitialised.
   if constexpr (L == 4) {
     const double e[4] = {p[at], p[stride + at], p[2 * stride + at], p[3 * stride + at]};
     std::memcpy(&v, e, sizeof(V));
@@ -46,10 +47,13 @@ TESSERA_LANE_INLINE void gather_lanes(V& v, const double* p, Eigen::Index stride
 /// Lane l of v = p[l][at].
 template <typename V, int L>
 TESSERA_LANE_INLINE void gather_lanes(V& v, const double* const* p, Eigen::Index at) {
-  if constexpr (L == 4)
-    v = V{p[0][at], p[1][at], p[2][at], p[3][at]};
-  else
-    v = V{p[0][at], p[1][at]};
+  if constexpr (L == 4) {
+    const double e[4] = {p[0][at], p[1][at], p[2][at], p[3][at]};
+    std::memcpy(&v, e, sizeof(V));
+  } else {
+    const double e[2] = {p[0][at], p[1][at]};
+    std::memcpy(&v, e, sizeof(V));
+  }
 }
 
 /// p[l * stride + at] = lane l of v.
