@@ -3,6 +3,7 @@
 #include <string>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/pose_kernels.hpp>
+#include <type_traits>
 #include <utility>
 
 #include "manifold/pose_lanes.hpp"
@@ -333,7 +334,8 @@ double BlockProblem::sum_edges(const Eigen::MatrixXd& X, double* share) const {
   if constexpr (D == 3 && R == 3) {
     // pose_lanes() terms at a time, one a vector lane (the same bits as edge_term<3, 3>), added
     // up in order as below.
-    static_assert(sizeof(Edge) == 2 * sizeof(std::size_t), "Edge is its two slots");
+    static_assert(std::is_standard_layout_v<Edge> && sizeof(Edge) == 2 * sizeof(std::size_t),
+                  "Edge is its two slots");
     k = sum_edge_terms_in_lanes(reinterpret_cast<const std::size_t*>(edges_.data()), edges_.size(),
                                 X.data(), X_n_.data(), m, packed, f, s);
   }
