@@ -8,7 +8,9 @@
 #include <tessera/distributed/momentum.hpp>
 #include <utility>
 
-#include "util/double_pair.hpp"
+#include "manifold/pose_lanes.hpp"
+#include "util/avx_kernels.hpp"
+#include "util/lanes.hpp"
 
 namespace tessera {
 namespace {
@@ -241,7 +243,22 @@ template <int D, int R, typename Blend>
 void blend_and_project(Eigen::MatrixXd& out, Eigen::Index poses, const Blend& blend) {
   const Eigen::Index r = out.rows(), w = (D + 1) * r;
   double* base = out.data();
-  for (Eigen::Index i = 0; i < poses; ++i) {
+  Eigen::Index i = 0;
+  if constexpr (D == 3 && (R == 3 || R == 5)) {
+    // pose_lanes() poses at a time, one a vector lane (the same bits as pose by pose); a group
+    // with a pose outside the series' reach, or (R = 5) with non-zero rows 3-4, goes pose by pose.
+    const int lanes = pose_lanes();
+    for (; i + lanes <= poses; i += lanes) {
+      double* group = base + i * w;
+      bool zero_tails = true;
+      blend(i * w, lanes * w, group);  // the group's poses are consecutive
+      if constexpr (R == 5)
+        for (int l = 0; l < lanes; ++l) zero_tails = zero_tails && zero_tail<3, 5>(group + l * w);
+      if (!zero_tails || !polar_in_lanes(group, lanes, r))
+        for (int l = 0; l < lanes; ++l) project_pose<D, R>(group + l * w, r);
+    }
+  }
+  for (; i < poses; ++i) {
     blend(i * w, w, base + i * w);
     project_pose<D, R>(base + i * w, r);
   }
@@ -268,6 +285,75 @@ void blend_and_project(const LiftedManifold& M, Eigen::MatrixXd& out, const Blen
     blend_and_project<3>(out, poses, blend);
 }
 
+// The momentum blends, element by element over n doubles (dst may be v's): four at a time in
+// the AVX copy, two in the SSE2 one, the rest one by one; element-wise, so the same values.
+template <typename V, int L>
+TESSERA_LANE_INLINE void extrapolate_blend(double a, double one_minus_a, const double* v,
+                                           const double* y, double* dst, Eigen::Index n) {
+  Eigen::Index k = 0;
+  for (; k + L <= n; k += L) {
+    V vk, yk;
+    load_lanes(vk, v + k);
+    load_lanes(yk, y + k);
+    const V out = a * vk + one_minus_a * yk;
+    store_lanes(dst + k, out);
+  }
+  if constexpr (L == 4)
+    if (k + 2 <= n)
+      return extrapolate_blend<Lanes2, 2>(a, one_minus_a, v + k, y + k, dst + k, n - k);
+  for (; k < n; ++k) dst[k] = a * v[k] + one_minus_a * y[k];
+}
+
+template <typename V, int L>
+TESSERA_LANE_INLINE void momentum_blend(double b, double one_minus_b, double g, const double* v,
+                                        const double* p, const double* y, double* dst,
+                                        Eigen::Index n) {
+  Eigen::Index k = 0;
+  for (; k + L <= n; k += L) {
+    V vk, pk, yk;
+    load_lanes(vk, v + k);
+    load_lanes(pk, p + k);
+    load_lanes(yk, y + k);
+    const V out = (b * vk + one_minus_b * pk) + g * (yk - pk);
+    store_lanes(dst + k, out);
+  }
+  if constexpr (L == 4)
+    if (k + 2 <= n)
+      return momentum_blend<Lanes2, 2>(b, one_minus_b, g, v + k, p + k, y + k, dst + k, n - k);
+  for (; k < n; ++k) dst[k] = (b * v[k] + one_minus_b * p[k]) + g * (y[k] - p[k]);
+}
+
+#ifdef TESSERA_AVX_KERNELS
+__attribute__((target("avx"))) void extrapolate_blend_avx(double a, double one_minus_a,
+                                                          const double* v, const double* y,
+                                                          double* dst, Eigen::Index n) {
+  extrapolate_blend<Lanes4, 4>(a, one_minus_a, v, y, dst, n);
+}
+
+__attribute__((target("avx"))) void momentum_blend_avx(double b, double one_minus_b, double g,
+                                                       const double* v, const double* p,
+                                                       const double* y, double* dst,
+                                                       Eigen::Index n) {
+  momentum_blend<Lanes4, 4>(b, one_minus_b, g, v, p, y, dst, n);
+}
+#endif
+
+void extrapolate_blend(double a, double one_minus_a, const double* v, const double* y, double* dst,
+                       Eigen::Index n) {
+#ifdef TESSERA_AVX_KERNELS
+  if (avx_kernels_enabled()) return extrapolate_blend_avx(a, one_minus_a, v, y, dst, n);
+#endif
+  extrapolate_blend<Lanes2, 2>(a, one_minus_a, v, y, dst, n);
+}
+
+void momentum_blend(double b, double one_minus_b, double g, const double* v, const double* p,
+                    const double* y, double* dst, Eigen::Index n) {
+#ifdef TESSERA_AVX_KERNELS
+  if (avx_kernels_enabled()) return momentum_blend_avx(b, one_minus_b, g, v, p, y, dst, n);
+#endif
+  momentum_blend<Lanes2, 2>(b, one_minus_b, g, v, p, y, dst, n);
+}
+
 void check_same_shape(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const char* what) {
   if (a.rows() != b.rows() || a.cols() != b.cols())
     throw std::invalid_argument(std::string(what) + ": operands of different shapes");
@@ -289,12 +375,7 @@ void extrapolate_into(const LiftedManifold& M, const MomentumCoefficients& c,
   const double* v = V.data();
   blend_and_project(M, out, [&](Eigen::Index at, Eigen::Index n, double* dst) {
     // Element by element the expression alpha V + (1 - alpha) Y of the previous version.
-    // Two doubles at a time (util/double_pair.hpp): element-wise, the same values.
-    const DoublePair a2 = {a, a}, one_minus_a2 = {one_minus_a, one_minus_a};
-    Eigen::Index k = 0;
-    for (; k + 2 <= n; k += 2)
-      store_pair(dst + k, a2 * load_pair(v + at + k) + one_minus_a2 * load_pair(y + at + k));
-    for (; k < n; ++k) dst[k] = a * v[at + k] + one_minus_a * y[at + k];
+    extrapolate_blend(a, one_minus_a, v + at, y + at, dst, n);
   });
 }
 
@@ -310,16 +391,8 @@ void momentum_update_into(const LiftedManifold& M, const MomentumCoefficients& c
   const double* y = Y_new.data();
   blend_and_project(M, out, [&](Eigen::Index at, Eigen::Index n, double* dst) {
     // (beta V + (1 - beta) P) + gamma (Y_new - P), element by element, as before. dst may be
-    // v's pose: each pair is read before it is written.
-    const DoublePair b2 = {b, b}, one_minus_b2 = {one_minus_b, one_minus_b}, g2 = {g, g};
-    Eigen::Index k = 0;
-    for (; k + 2 <= n; k += 2) {
-      const DoublePair pk = load_pair(p + at + k);
-      store_pair(dst + k, (b2 * load_pair(v + at + k) + one_minus_b2 * pk) +
-                              g2 * (load_pair(y + at + k) - pk));
-    }
-    for (; k < n; ++k)
-      dst[k] = (b * v[at + k] + one_minus_b * p[at + k]) + g * (y[at + k] - p[at + k]);
+    // v's pose: each element is read before it is written.
+    momentum_blend(b, one_minus_b, g, v + at, p + at, y + at, dst, n);
   });
 }
 

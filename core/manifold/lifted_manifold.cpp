@@ -5,6 +5,7 @@
 #include <tessera/manifold/lifted_manifold.hpp>
 #include <utility>
 
+#include "manifold/pose_lanes.hpp"
 #include "manifold/sym_product.hpp"
 
 namespace tessera {
@@ -76,7 +77,19 @@ template <int D, int R>
 void tangent_project_poses(const double* X, const double* V, Eigen::Index r_runtime, std::size_t n,
                            double* out) {
   const Eigen::Index r = R > 0 ? R : r_runtime;
-  for (std::size_t i = 0; i < n; ++i) {
+  std::size_t i = 0;
+  if constexpr (D == 3 && R == 3) {
+    // pose_lanes() poses at a time, one a vector lane: the same bits as the loop below.
+    const std::size_t lanes = static_cast<std::size_t>(pose_lanes());
+    for (; i + lanes <= n; i += lanes) {
+      const Eigen::Index offset = 12 * static_cast<Eigen::Index>(i);
+      tangent_project_in_lanes(X + offset, V + offset, static_cast<int>(lanes), out + offset);
+      if (out != V)  // the translation columns are V's
+        for (std::size_t l = 0; l < lanes; ++l)
+          for (Eigen::Index k = 9; k < 12; ++k) out[offset + 12 * l + k] = V[offset + 12 * l + k];
+    }
+  }
+  for (; i < n; ++i) {
     const Eigen::Index offset = r * static_cast<Eigen::Index>((D + 1) * i);
     const double* A = X + offset;
     const double* B = V + offset;

@@ -3,8 +3,11 @@
 #include <string>
 #include <tessera/problem/block_problem.hpp>
 #include <tessera/problem/pose_kernels.hpp>
+#include <type_traits>
 #include <utility>
 
+#include "manifold/pose_lanes.hpp"
+#include "problem/edge_lanes.hpp"
 #include "util/double_pair.hpp"
 
 namespace tessera {
@@ -327,7 +330,16 @@ double BlockProblem::sum_edges(const Eigen::MatrixXd& X, double* share) const {
   constexpr std::size_t stride = D * D + D + 2;
   const double* packed = packed_.data();
   double f = 0.0, s = 0.0;
-  for (std::size_t k = 0; k < edges_.size(); ++k) {
+  std::size_t k = 0;
+  if constexpr (D == 3 && R == 3) {
+    // pose_lanes() terms at a time, one a vector lane (the same bits as edge_term<3, 3>), added
+    // up in order as below.
+    static_assert(std::is_standard_layout_v<Edge> && sizeof(Edge) == 2 * sizeof(std::size_t),
+                  "Edge is its two slots");
+    k = sum_edge_terms_in_lanes(reinterpret_cast<const std::size_t*>(edges_.data()), edges_.size(),
+                                X.data(), X_n_.data(), m, packed, f, s);
+  }
+  for (; k < edges_.size(); ++k) {
     const Edge& e = edges_[k];
     const double c = edge_term<D, R>(column(e.slot_i), column(e.slot_j), packed + k * stride, r);
     f += c;

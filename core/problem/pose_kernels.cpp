@@ -1,6 +1,7 @@
 #include <stdexcept>
 #include <tessera/problem/pose_kernels.hpp>
 
+#include "manifold/pose_lanes.hpp"
 #include "manifold/sym_product.hpp"
 
 namespace tessera {
@@ -33,7 +34,15 @@ void hessian_projection(const double* X, const double* G, const double* V, Eigen
                         Eigen::Index n, double* H) {
   const Eigen::Index rr = R > 0 ? R : r;
   const Eigen::Index stride = rr * (D + 1);
-  for (Eigen::Index i = 0; i < n; ++i) {
+  Eigen::Index i = 0;
+  if constexpr (D == 3 && R == 3) {
+    // pose_lanes() poses at a time, one a vector lane: the same bits as the loop below.
+    const int lanes = pose_lanes();
+    for (; i + lanes <= n; i += lanes)
+      hessian_projection_in_lanes(X + stride * i, G + stride * i, V + stride * i, lanes,
+                                  H + stride * i);
+  }
+  for (; i < n; ++i) {
     const double* Xi = X + stride * i;
     const double* Vi = V + stride * i;
     double* Hi = H + stride * i;

@@ -1,5 +1,7 @@
 #include "solvers/ldl_chain_solve.hpp"
 
+#include <algorithm>
+
 #include "util/avx_kernels.hpp"
 
 #ifdef __SSE2__
@@ -286,14 +288,21 @@ void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* ou
   const int n = static_cast<int>(L->n);
   const auto* perm = static_cast<const int*>(L->Perm);
   double* X = y_.data();
-  for (int k = 0; k < n; ++k) X[k] = rhs[perm ? perm[k] : k];
+  // The permutation test outside the loops (-O2 does not unswitch them).
+  if (perm)
+    for (int k = 0; k < n; ++k) X[k] = rhs[perm[k]];
+  else
+    std::copy(rhs, rhs + n, X);
 #ifdef TESSERA_AVX_KERNELS
   if (avx_kernels_enabled())
     solve_chains_avx(L, X);
   else
 #endif
     solve_chains<Sse2Kernels>(L, X);
-  for (int k = 0; k < n; ++k) out[perm ? perm[k] : k] = X[k];
+  if (perm)
+    for (int k = 0; k < n; ++k) out[perm[k]] = X[k];
+  else
+    std::copy(X, X + n, out);
 }
 
 #ifdef TESSERA_AVX_KERNELS

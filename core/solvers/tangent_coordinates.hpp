@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "solvers/tangent_coordinate_lanes.hpp"
+
 namespace tessera {
 
 // The rotation-coordinate index pairs (a < b) of the skew basis E_ab = e_b e_a^T - e_a e_b^T.
@@ -56,7 +58,9 @@ void tangent_block_fixed(const double* Qij, const Eigen::MatrixXd& Gi, const Eig
 template <int D>
 void tangent_coordinates(const double* X, const double* V, Eigen::Index m, double* b) {
   constexpr int W = D + 1, P = D * (D + 1) / 2, NR = P - D;
-  for (Eigen::Index i = 0; i < m; ++i) {
+  Eigen::Index i = 0;
+  if constexpr (D == 3) i = tangent_coordinates_in_lanes(X, V, m, b);  // the same bits
+  for (; i < m; ++i) {
     const double* Y = X + i * W * D;   // d x d rotation block, column-major
     const double* Vi = V + i * W * D;  // d x (d+1) pose block
     double Wm[D][W];                   // Wm[a][c] = (Y^T V_i)(a, c)
@@ -77,7 +81,9 @@ void tangent_coordinates(const double* X, const double* V, Eigen::Index m, doubl
 template <int D>
 void tangent_vector(const double* X, const double* c, Eigen::Index m, double* Z) {
   constexpr int W = D + 1, P = D * (D + 1) / 2, NR = P - D;
-  for (Eigen::Index i = 0; i < m; ++i) {
+  Eigen::Index i = 0;
+  if constexpr (D == 3) i = tangent_vector_in_lanes(X, c, m, Z);  // the same bits
+  for (; i < m; ++i) {
     const double* Y = X + i * W * D;
     const double* ci = c + i * P;
     double S[W][D] = {};  // S[col][row]: Omega(omega) and u
