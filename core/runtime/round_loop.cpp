@@ -102,9 +102,10 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
                              " is below d = " + std::to_string(local.d));
 
   // Every agent builds the same layout from the structure (endpoints only, 8 bytes a
-  // measurement of the whole graph: no Measurement copies, which held 72).
-  const BlockLayout layout = make_block_layout(
-      local.num_poses, local.structure, std::vector<int>(local.owner.begin(), local.owner.end()));
+  // measurement of the whole graph: no Measurement copies, which held 72). The layout and
+  // the coarse spaces take the owners as int; one conversion serves them all.
+  const std::vector<int> owner(local.owner.begin(), local.owner.end());
+  const BlockLayout layout = make_block_layout(local.num_poses, local.structure, owner);
   const auto phase = [&](const std::string& name) {
     if (hooks.on_phase) hooks.on_phase(name);
   };
@@ -124,9 +125,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   if (options.coarse.enabled && options.coarse.space == CoarseSpaceKind::kSmoothed) {
     // Every agent builds the same space from the structure (no message needed) and keeps the
     // part it reads.
-    CoarseSpace built =
-        make_coarse_space(local.num_poses, local.structure,
-                          std::vector<int>(local.owner.begin(), local.owner.end()), options.coarse);
+    CoarseSpace built = make_coarse_space(local.num_poses, local.structure, owner, options.coarse);
     if (static_cast<int>(local.agent_id) != kCoarseSolver)
       keep_agent_share(built, layout, static_cast<int>(local.agent_id), local.measurements);
     auto space = std::make_shared<const CoarseSpace>(std::move(built));
@@ -141,8 +140,7 @@ RoundLoopResult run_round_loop(const AgentLocalData& local, ProtocolChannel& cha
   }
   if (options.refine.enabled && options.refine.coarse == NewtonRefineOptions::Coarse::kSmoothed)
     state.use_refine_space(std::make_shared<const CoarseSpace>(make_coarse_space(
-        local.num_poses, local.structure, std::vector<int>(local.owner.begin(), local.owner.end()),
-        options.refine.coarse_space_options())));
+        local.num_poses, local.structure, owner, options.refine.coarse_space_options())));
   if (hooks.after_set_up) hooks.after_set_up();
   phase("block set-up");
   // The rounds' memory lines, from whichever protocol runs below.
