@@ -38,6 +38,21 @@ TESSERA_LANE_INLINE void sym_product(const V (&a)[3][3], const V (&b)[3][3], V (
     for (int y = x; y < 3; ++y) s[x][y] = s[y][x] = 0.5 * (p[x][y] + p[y][x]);
 }
 
+// P = A E for the symmetric powers of E: the upper triangle, each entry summed over k in
+// order, mirrored (A and E are powers of one symmetric E, so they commute and P is symmetric).
+template <typename V>
+TESSERA_LANE_INLINE void power_step(const V (&a)[3][3], const V (&e)[3][3], V (&p)[3][3]) {
+#pragma GCC unroll 4
+  for (int i = 0; i < 3; ++i)
+#pragma GCC unroll 4
+    for (int j = i; j < 3; ++j) {
+      V s = a[i][0] * e[0][j];
+      s += a[i][1] * e[1][j];
+      s += a[i][2] * e[2][j];
+      p[i][j] = p[j][i] = s;
+    }
+}
+
 // momentum.cpp's project_pose<3, R> for the poses of the series' reach. R = 5: rows 3 and 4
 // zero (gram_entry_zero_tail<3>'s order); R = 3: gram_entry<3>'s order.
 template <typename V, int L, int R>
@@ -77,24 +92,8 @@ TESSERA_LANE_INLINE bool polar(double* A) {
   // powers: upper triangles, mirrored), each entry as inv_sqrt_near_identity<3> forms it.
   const auto tiny = e < 1e-9;
   V e2[3][3], e3[3][3], z[3][3];
-#pragma GCC unroll 4
-  for (int i = 0; i < 3; ++i)
-#pragma GCC unroll 4
-    for (int j = i; j < 3; ++j) {
-      V s = e1[i][0] * e1[0][j];
-      s += e1[i][1] * e1[1][j];
-      s += e1[i][2] * e1[2][j];
-      e2[i][j] = e2[j][i] = s;
-    }
-#pragma GCC unroll 4
-  for (int i = 0; i < 3; ++i)
-#pragma GCC unroll 4
-    for (int j = i; j < 3; ++j) {
-      V s = e2[i][0] * e1[0][j];
-      s += e2[i][1] * e1[1][j];
-      s += e2[i][2] * e1[2][j];
-      e3[i][j] = e3[j][i] = s;
-    }
+  power_step(e1, e1, e2);
+  power_step(e2, e1, e3);
 #pragma GCC unroll 4
   for (int i = 0; i < 3; ++i)
 #pragma GCC unroll 4
