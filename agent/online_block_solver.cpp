@@ -19,7 +19,7 @@ SolveOutcome OnlineBlockSolver::solve(runtime::OnlineAgentView& view, bool certi
   // This agent's block problem is kept from solve to solve and grown with the new data.
   if (!live_)
     live_ = std::make_unique<LiveBlocks>(stream->graph().d, options_.solver.block_update,
-                                         options_.refactor_growth, view.own_block());
+                                         live_refactor_growth(options_), view.own_block());
   live_->sync(stream->graph(), view.owner(), view.iterate());
   const int c = live_->compact_block(view.own_block());
   if (live_->graph().num_poses == 0 || c < 0) return out;

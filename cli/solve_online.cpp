@@ -31,7 +31,8 @@ const char* const kOnlineValued[] = {
     "certify-every", "refactor-growth",   "baseline-every", "local-threshold",
     "step-every",    "step-solver",       "newton-after",   "threads",
     "baseline-per",  "baseline-samples",  "baseline-init",  "baseline-solver",
-    "until",         "progress-interval", "gap-bound",      nullptr};
+    "until",         "progress-interval", "gap-bound",      "first-step-factors",
+    nullptr};
 const char* const kOnlineSwitches[] = {"online",          "real-time",   "baseline",
                                        "no-local-rounds", "no-progress", nullptr};
 
@@ -83,6 +84,12 @@ const char* kOnlineHelp =
     "                            poses appended to it, until it has G times more poses than\n"
     "                            it was computed for (default 0: a new factor whenever the\n"
     "                            block gets new poses)\n"
+    "  --first-step-factors new|grown   newton: the preconditioner of a step's first Newton\n"
+    "                            step, the grown blocks' new factors (default) or their held\n"
+    "                            factors with the new poses appended, new ones built at the\n"
+    "                            first accepted Newton step's point (no factorization\n"
+    "                            before that point, but appending costs more on large\n"
+    "                            3-D blocks; docs/online.md)\n"
     "  --threads T               the agents handle their messages on T threads (1..64,\n"
     "                            default 1); the same iterates as one thread\n"
     "  --local-threshold F       local rounds: a block works only while its gradient norm\n"
@@ -197,6 +204,13 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.certify_every_s = a.get_double("certify-every", 0.0);
   options.step_every_s = a.get_double("step-every", 0.0);
   options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
+  {
+    const std::string first =
+        a.get_or("first-step-factors", options.first_step_on_grown_factors ? "grown" : "new");
+    if (first != "new" && first != "grown")
+      throw InputError("option --first-step-factors: '" + first + "' is not one of new, grown");
+    options.first_step_on_grown_factors = first == "grown";
+  }
   options.rebalance = parse_rebalance_options(a);
   options.solver.threads = static_cast<int>(a.get_long("threads", options.solver.threads));
   options.solver.local_rounds.enabled = !a.has("no-local-rounds");
@@ -312,6 +326,10 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         const double cg = c.gap.first ? c.points[*c.gap.first].cg_iterations
                                       : std::numeric_limits<double>::infinity();
         j.add("cg_to_gap", cg);
+        // And the fixed cost before it: the blocks' factorizations.
+        j.add("factorizations_to_gap",
+              c.gap.first ? static_cast<double>(c.points[*c.gap.first].factorizations)
+                          : std::numeric_limits<double>::infinity());
         gap_latency_s.push_back(c.gap.wall_s);
         gap_latency_cpu_s.push_back(c.gap.cpu_s);
         gap_cg.push_back(cg);
@@ -324,6 +342,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
             .add("cpu_s", c.points[k].cpu_s)
             .add("newton_steps", c.points[k].newton_steps)
             .add("cg_iterations", c.points[k].cg_iterations)
+            .add("factorizations", c.points[k].factorizations)
             .add("cost", c.points[k].cost);
         if (res) p.add("rel_gap", c.gap.rel_gaps[k]);
         points.push_back(std::move(p));

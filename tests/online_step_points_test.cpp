@@ -180,6 +180,54 @@ TEST(OnlineStepPoints, TwoThreadsKeepTheSamePointsAsOne) {
   }
 }
 
+// first_step_on_grown_factors: a step's first Newton step runs on the blocks' held factors
+// with the new poses appended, so its point waits for fewer factorizations (none where every
+// block's could be appended to); the blocks factor after it instead, no more often in the run,
+// and the run ends where the default one does.
+TEST(OnlineStepPoints, OnGrownFactorsTheFirstNewtonPointWaitsForNoFactorizationSameEnd) {
+  const Replay r = replay();
+  const auto all = [](std::size_t) { return true; };
+  OnlineOptions o = options(1);
+  const std::vector<KeptStep> fresh = run_keeping(r, o, all);
+  o.first_step_on_grown_factors = true;
+  const std::vector<KeptStep> grown = run_keeping(r, o, all);
+  ASSERT_EQ(fresh.size(), grown.size());
+  auto first_newton = [](const KeptStep& s) -> const StepPoint* {
+    for (const StepPoint& p : s.points)
+      if (p.at == "newton") return &p;
+    return nullptr;
+  };
+  long long fresh_first = 0, grown_first = 0, fresh_all = 0, grown_all = 0;
+  int compared = 0, without = 0;
+  for (std::size_t k = 0; k < fresh.size(); ++k) {
+    fresh_all += fresh[k].update.factorizations;
+    grown_all += grown[k].update.factorizations;
+    const StepPoint* f = first_newton(fresh[k]);
+    const StepPoint* g = first_newton(grown[k]);
+    if (!f || !g) continue;
+    fresh_first += f->factorizations;
+    grown_first += g->factorizations;
+    // Counted up to the point: no more than the step did.
+    EXPECT_LE(g->factorizations, grown[k].update.factorizations);
+    EXPECT_EQ(grown[k].points.back().factorizations, grown[k].update.factorizations);
+    // A block whose new poses could not be appended (TangentPreconditioner::grow) factors first.
+    if (f->factorizations > 0 && g->factorizations == 0) ++without;
+    ++compared;
+  }
+  EXPECT_GE(compared, 3);
+  EXPECT_GT(without, 0);
+  EXPECT_GT(fresh_first, 0);
+  EXPECT_LT(grown_first, fresh_first);
+  EXPECT_LE(grown_all, fresh_all);
+  // The same optimum at the end (converged to 1e-5 both).
+  const KeptStep& a = fresh.back();
+  const KeptStep& b = grown.back();
+  ASSERT_EQ(count_components(a.graph), 1u);
+  const double optimum = solve_centralized(a.graph).cost;
+  EXPECT_NEAR(evaluate_objective(a.graph, a.estimate), optimum, 1e-6 * optimum);
+  EXPECT_NEAR(evaluate_objective(b.graph, b.estimate), optimum, 1e-6 * optimum);
+}
+
 StepPointCost point(double wall_s, double cost) {
   StepPointCost p;
   p.at = "newton";

@@ -333,6 +333,14 @@ bool AgentState::ensure_tangent(const Eigen::MatrixXd& X) {
   return refresh_tangent(X);
 }
 
+bool AgentState::rebuild_grown_tangent(const Eigen::MatrixXd& X) {
+  if (X.rows() != d_ || !tangent_ || !tangent_->factored() || tangent_->grown_poses() == 0)
+    return false;
+  tangent_.reset();
+  tangent_tried_ = false;
+  return refresh_tangent(X);
+}
+
 double AgentState::local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours) {
   set_point(X, neighbours);
   return problem_.cost(active_part(X));

@@ -406,8 +406,12 @@ void NewtonRefineProtocol::prepare_preconditioner() {
     state_.refresh_tangent(X_, egrad_);
   else if (options_.refactor_every_step)
     state_.refresh_tangent(X_);
-  else
+  else {
+    // The start's CG ran on the grown factor; the first accepted point builds the deferred one.
+    if (options_.refactor_grown_factors && result_.accepted_steps > 0)
+      state_.rebuild_grown_tangent(X_);
     state_.ensure_tangent(X_);
+  }
   refactor_due_ = false;
 }
 

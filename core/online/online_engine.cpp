@@ -117,8 +117,8 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   u.newest_publication_s = stamps.empty() ? now_s : newest;
   // Idle: nothing new and already converged, so no round and no message.
   if ((u.poses == 0 && u.measurements == 0 && converged_) || graph.num_poses == 0) return u;
-  const TangentFactorTotals factors_before =
-      blocks_ ? blocks_->tangent_factor_totals() : TangentFactorTotals{};
+  step_factors_before_ = blocks_ ? blocks_->tangent_factor_totals() : TangentFactorTotals{};
+  const TangentFactorTotals factors_before = step_factors_before_;
   const long long built_before = blocks_ ? blocks_->built_total() : 0;
 
   // New poses join a block (their robot's, or the one holding most of their measurements);
@@ -204,7 +204,8 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   // Out of the step's times: the step ended here.
   if (keep)
     points_.push_back(
-        {{"end", u.ms / 1000.0, u.cpu_s, u.newton_steps, u.newton_cg_iterations}, X_});
+        {{"end", u.ms / 1000.0, u.cpu_s, u.newton_steps, u.newton_cg_iterations, u.factorizations},
+         X_});
   for (double stamp : stamps) {
     totals_.batch_latency_s.push_back(now_s - stamp + u.ms / 1000.0);
     totals_.batch_latency_cpu_s.push_back(now_s - stamp + u.cpu_s);
@@ -235,6 +236,7 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     // The step is done only under the tolerance: a small decrease is no reason to stop.
     solver.refine.relative_decrease_tol = 0.0;
     solver.refine.refactor_every_step = false;
+    solver.refine.refactor_grown_factors = options.first_step_on_grown_factors;
     solver.refine.forcing = options.newton_forcing;
     solver.refine.coarse = options.newton_coarse;
     solver.refine.coarse_min_blocks = options.newton_coarse_min_blocks;
@@ -262,6 +264,12 @@ DistributedOptions online_step_solver(const OnlineOptions& options) {
     solver.grad_norm_tol = std::max(options.newton_after_grad_tol, solver.grad_norm_tol);
   }
   return solver;
+}
+
+double live_refactor_growth(const OnlineOptions& options) {
+  if (options.first_step_on_grown_factors && options.newton_steps)
+    return std::numeric_limits<double>::infinity();
+  return options.refactor_growth;
 }
 
 void use_online_refine_space(const LiveBlocks& blocks, const DistributedOptions& solver) {
@@ -293,7 +301,7 @@ DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver,
   DistributedResult res;
   if (!blocks_)
     blocks_ = std::make_unique<LiveBlocks>(stream_.graph().d, solver.block_update,
-                                           options_.refactor_growth);
+                                           live_refactor_growth(options_));
   const auto setup_start = Clock::now();
   blocks_->sync(stream_.graph(), owner_, X_);
   const double setup_s = std::chrono::duration<double>(Clock::now() - setup_start).count();
@@ -305,7 +313,11 @@ DistributedResult OnlineEngine::solve_linked(const DistributedOptions& solver,
   if (keep_newton_points && run.refine.enabled)
     trials.emplace(
         blocks_->layout().num_blocks, [this] { return step_wall_s(); },
-        [this] { return step_cpu_s(); });
+        [this] { return step_cpu_s(); },
+        [this](int b) {
+          return blocks_->states()[static_cast<std::size_t>(b)]->tangent_factorizations_total();
+        },
+        blocks_->tangent_factor_totals().since(step_factors_before_).factorizations);
   res =
       solve_distributed_watching_trials(blocks_->graph(), blocks_->layout(), blocks_->all_states(),
                                         run, trials ? trials->watch() : TrialPointWatch{});

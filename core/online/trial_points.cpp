@@ -8,15 +8,23 @@
 
 namespace tessera {
 
-TrialPoints::TrialPoints(int blocks, std::function<double()> wall_s, std::function<double()> cpu_s)
+TrialPoints::TrialPoints(int blocks, std::function<double()> wall_s, std::function<double()> cpu_s,
+                         std::function<long long(int)> factorizations, long long earlier)
     : blocks_(blocks),
       wall_s_(std::move(wall_s)),
       cpu_s_(std::move(cpu_s)),
-      calls_(static_cast<std::size_t>(blocks), 0) {}
+      factorizations_(std::move(factorizations)),
+      earlier_(earlier),
+      calls_(static_cast<std::size_t>(blocks), 0) {
+  for (int b = 0; b < blocks_; ++b) factorizations_before_.push_back(factorizations_(b));
+}
 
 TrialPointWatch TrialPoints::watch() {
   return [this](int b, const Eigen::MatrixXd& Y) {
     const double wall = wall_s_(), cpu = cpu_s_();
+    // This block's own count, on its own thread: no other thread changes it meanwhile.
+    const long long factored =
+        factorizations_(b) - factorizations_before_[static_cast<std::size_t>(b)];
     const std::lock_guard<std::mutex> lock(mutex_);
     const std::size_t k = calls_[static_cast<std::size_t>(b)]++;
     if (trials_.size() <= k) trials_.resize(k + 1);
@@ -25,6 +33,7 @@ TrialPointWatch TrialPoints::watch() {
     t.blocks[static_cast<std::size_t>(b)] = Y;
     t.wall_s = std::max(t.wall_s, wall);
     t.cpu_s = std::max(t.cpu_s, cpu);
+    t.factorizations += factored;
     ++t.received;
   };
 }
@@ -51,7 +60,8 @@ void TrialPoints::accepted(const std::vector<NewtonRefineResult>& refines, const
     for (int b = 0; b < blocks_; ++b)
       scatter_pose_columns(t.blocks[static_cast<std::size_t>(b)],
                            layout.poses[static_cast<std::size_t>(b)], d, linked);
-    StepPoint p{{"newton", t.wall_s, t.cpu_s, static_cast<int>(k) + 1, cg}, X};
+    StepPoint p{
+        {"newton", t.wall_s, t.cpu_s, static_cast<int>(k) + 1, cg, earlier_ + t.factorizations}, X};
     blocks.write_back(linked, p.X);
     out.push_back(std::move(p));
   }

@@ -20,8 +20,12 @@ namespace tessera {
 class TrialPoints {
  public:
   /// `blocks` agents; `wall_s` and `cpu_s` time a trial (the step's clocks), read when a block
-  /// arrives: a trial point exists once its last block does.
-  TrialPoints(int blocks, std::function<double()> wall_s, std::function<double()> cpu_s);
+  /// arrives: a trial point exists once its last block does. `factorizations(b)`: block b's
+  /// tangent factorizations so far (AgentState::tangent_factorizations_total), read here and
+  /// on b's own thread when its block arrives; `earlier`: the step's factorizations before
+  /// the solve. A trial's factorizations are `earlier` plus every block's since here.
+  TrialPoints(int blocks, std::function<double()> wall_s, std::function<double()> cpu_s,
+              std::function<long long(int)> factorizations, long long earlier);
 
   /// The watch to give the solve. It refers to this object, which must outlive the solve.
   TrialPointWatch watch();
@@ -37,9 +41,13 @@ class TrialPoints {
     std::vector<Eigen::MatrixXd> blocks;
     int received = 0;
     double wall_s = 0.0, cpu_s = 0.0;
+    long long factorizations = 0;
   };
   int blocks_;
   std::function<double()> wall_s_, cpu_s_;
+  std::function<long long(int)> factorizations_;
+  std::vector<long long> factorizations_before_;  // by block, at construction
+  long long earlier_;
   std::mutex mutex_;  // the watch is called concurrently for different agents
   std::vector<std::size_t> calls_;
   std::vector<Trial> trials_;

@@ -96,6 +96,12 @@ class AgentState {
   /// As refresh_tangent, but a block that holds a factor keeps it (computed at an earlier point
   /// or grown: stale, still positive definite); factors only when it holds none.
   bool ensure_tangent(const Eigen::MatrixXd& X);
+  /// A block whose factor was grown (extend() kept it, its new poses appended) builds a new one
+  /// at X, as a block without a factor would (analysis and factorization of the grown block);
+  /// a block whose factor was not grown keeps it. The Newton steps of an online step run their
+  /// first CG on the grown factor and call this at the first accepted step's point
+  /// (NewtonRefineOptions::refactor_grown_factors). True when a new factor was built.
+  bool rebuild_grown_tangent(const Eigen::MatrixXd& X);
   /// Local objective f_B(X) with neighbours at `neighbours`.
   double local_cost(const Eigen::MatrixXd& X, const Eigen::MatrixXd& neighbours);
   /// Totals over this agent's block updates so far (BlockUpdateStats summed): updates,

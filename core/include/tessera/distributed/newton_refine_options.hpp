@@ -73,6 +73,14 @@ struct NewtonRefineOptions {
   /// were a third of their instructions on a generated 1,000-pose city (docs/online.md,
   /// "Newton steps").
   bool refactor_every_step = true;
+  /// Without refactor_every_step: a block whose held factor was grown (AgentState::extend
+  /// appended new poses to it, TangentPreconditioner::grow) builds a new one at the first
+  /// accepted step's point instead of keeping it, so only the first CG runs on the grown factor.
+  /// Why: an online step's first Newton point is the first estimate near the new optimum, and
+  /// building the grown blocks' factors before its CG was most of the CPU until that point on a
+  /// 50,000-pose grid (OnlineOptions::first_step_on_grown_factors, off by default there for
+  /// the cost of growing; docs/online.md). Default false: blocks keep what they hold.
+  bool refactor_grown_factors = false;
   /// With refactor_every_step: each block's tangent factor includes the Hessian's multiplier
   /// term (TangentPreconditioner::factorize(X, egrad)), so block Jacobi applies the inverse of
   /// the block's diagonal block of the Riemannian Hessian itself (where that is positive

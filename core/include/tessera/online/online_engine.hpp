@@ -69,6 +69,18 @@ struct OnlineOptions {
   /// save (callgrind, a generated 1,000-pose grid, 5 robots, a step every 0.1 s: 3.30 G
   /// instructions at 0, 3.79 G at 0.1, 6.38 G at 0.25; docs/online.md). >= 0.
   double refactor_growth = 0.0;
+  /// With newton_steps: a block that grows keeps its factor, its new poses appended to it
+  /// (TangentPreconditioner::grow), for the step's first Newton step only; each such block
+  /// builds its new factor at the first accepted Newton step's point
+  /// (NewtonRefineOptions::refactor_grown_factors), so the step's later CGs are preconditioned
+  /// as with refactor_growth 0. Why: that first point is the step's first estimate near the new
+  /// optimum (the gap latency, docs/online.md), and the grown blocks' new factors were most of
+  /// the CPU before it. Overrides refactor_growth while on. Default false: on the 50,000-pose
+  /// grid (3,500-pose 3-D blocks) appending the new poses costs more than the factorizations it
+  /// defers (the first point 2.9-3.2 against 1.7-1.8 CPU-s after the same 4 CG iterations),
+  /// though the factors built at the first point cut the run's CG iterations by a fifth
+  /// (docs/online.md, "The first Newton step on grown factors").
+  bool first_step_on_grown_factors = false;
   /// How a step brings ||grad f|| back under solver.grad_norm_tol after new data. true: block-
   /// coordinate rounds down to max(newton_after_grad_tol, the tolerance), then distributed
   /// trust-region Newton steps (newton_refine.hpp, solver.refine's settings with its tolerance
@@ -155,6 +167,12 @@ DistributedOptions online_step_solver(const OnlineOptions& options);
 /// again for every solve (a pass over the measurements); every DDS agent builds the same ones
 /// from the same graph. Otherwise does nothing.
 void use_online_refine_space(const LiveBlocks& blocks, const DistributedOptions& solver);
+
+/// How much a growing block's factor may grow before the block builds a new one
+/// (LiveBlocks' refactor_growth): options.refactor_growth, or unbounded with
+/// first_step_on_grown_factors and newton_steps (the Newton steps build it after their first
+/// step). The in-process engine's and `tessera-agent --online`'s, so both keep the same factors.
+double live_refactor_growth(const OnlineOptions& options);
 
 /// One step of the online run (the JSON `updates` array of `tessera launch --online`).
 struct OnlineUpdate {
@@ -322,6 +340,7 @@ class OnlineEngine {
   std::vector<StepPoint> points_;                          // the last step's, when kept
   std::chrono::steady_clock::time_point step_wall_start_;  // the running step's start
   double step_cpu_start_ = 0.0;
+  TangentFactorTotals step_factors_before_;  // the blocks' at the running step's start
 };
 
 /// Called after every step of run_online that did work (not for idle steps).

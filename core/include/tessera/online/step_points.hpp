@@ -34,6 +34,10 @@ struct StepMark {
   /// load-free cost (0 at "absorbed"; OnlineUpdate's newton_steps and newton_cg_iterations at
   /// "end").
   int newton_steps = 0, cg_iterations = 0;
+  /// The blocks' tangent factorizations in the step up to this point (set-up and Newton
+  /// steps; OnlineUpdate::factorizations at "end"): the fixed cost a point waited for, free
+  /// of the machine's load.
+  long long factorizations = 0;
 };
 
 /// One estimate of a step (OnlineEngine::keep_step_points).
