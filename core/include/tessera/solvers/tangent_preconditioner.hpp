@@ -76,12 +76,14 @@ class TangentPreconditioner : public RiemannianPreconditioner {
 
   /// The block grew (`problem` after BlockProblem::extend, `X` its rank-d point with the new
   /// poses appended): the poses after the factored ones (this growth's and earlier ones') are
-  /// preconditioned with a factor of their own part of A at X (their couplings among themselves
-  /// kept, those to the factored poses left out), the factored poses with the held factor: block
-  /// Jacobi over {factored poses, grown poses}, still symmetric positive definite, merely less
-  /// exact, so a growing block is not refactored for every few poses. Returns false (nothing
-  /// changed) when no factor is held, X does not fit or the grown part is not positive definite.
-  /// factorize() then refuses (the caller builds a new preconditioner for the grown block).
+  /// appended to the held factor with their couplings to the factored poses kept, through the
+  /// grown poses' Schur complement (the new measurements' share of A on the old poses they
+  /// touch enters by a low-rank correction). The old poses' own block stays the held factor's,
+  /// from the point it was factored at: still symmetric positive definite, merely less exact,
+  /// so a growing block is not refactored for every few poses. Returns false
+  /// (nothing changed) when no factor is held, X does not fit or the grown part is not positive
+  /// definite. factorize() then refuses (the caller builds a new preconditioner for the grown
+  /// block).
   bool grow(const BlockProblem& problem, const Eigen::MatrixXd& X);
   /// Poses appended to the factor by grow().
   Eigen::Index grown_poses() const;
