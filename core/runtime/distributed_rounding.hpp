@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/graph/pose.hpp>
@@ -48,7 +49,8 @@ enum RoundingPhase : std::uint32_t {
   kCoarseSums,                 // the CG step's sums with the coarse level's terms
   kInterfaceShare,             // the interface solve: a block's Schur share (with the Gram)
   kInterfaceResidual,          // the interface solve: a block's interface residual rhat
-  kInterfaceCost               // the interface solve: cost share and pose 0's translation
+  kInterfaceCost,              // the interface solve: cost share and pose 0's translation
+  kInterfaceSolution           // the interface solve: u from the agent that factors Sigma
 };
 
 /// How the rounding solves for the translations (every agent must use the same).
@@ -204,14 +206,19 @@ class DistributedRounding {
   // The interface solve (rounding_interface.cpp). send_interface_share(): when the team's
   // interface is small enough, builds this block's solve and sends its share (before the Gram
   // matrix's gather, so it costs no wait of its own); every agent decides alike from the
-  // layout. take_interface_shares(): gathers the shares and assembles Sigma; false (the CG
-  // runs) when no share was sent or a block's Laplacian is singular, on every agent alike.
+  // layout. take_interface_shares(): gathers the shares; the first agent (sigma_agent())
+  // assembles and factors Sigma, the others only check the shares; false (the CG runs) when no
+  // share was sent or a block's Laplacian is singular, on every agent alike.
   void send_interface_share();
   bool take_interface_shares();
-  // Exact translations: forward solve, one all-agent sum of the interface residuals, back
-  // solve; then pose 0's translation rides on the cost's sum (the solve fixes another pose)
-  // and every translation is shifted by it. Returns the cost.
-  double interface_translations();
+  // Exact translations: forward solve, one all-agent sum of the interface residuals; the first
+  // agent solves u = Sigma^-1 rhat and sends it to all (every agent factoring the same Sigma
+  // was most of the rounding's instructions); back solve; then pose 0's translation rides on
+  // the cost's sum (the solve fixes another pose) and every translation is shifted by it.
+  // Returns the cost; nothing (the CG runs, on every agent alike) when Sigma could not be
+  // factored.
+  std::optional<double> interface_translations();
+  std::uint32_t sigma_agent() const { return everyone_.front(); }
 
   DistributedRoundingOptions options_;
   const AgentLocalData& local_;

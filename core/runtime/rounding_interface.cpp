@@ -3,15 +3,17 @@
 // translations minimise t^T L t - 2 b^T t, L the weighted translation Laplacian, which does not
 // depend on the rotations. So each block factors its L_BB (interior first, interface last) and
 // sends its Schur complement on the interface with the Gram matrix, before any rotation is
-// known; after the rotations' exchange one all-agent sum of the blocks' interface residuals
-// gives every agent the interface translations u = Sigma^-1 rhat, and each back-substitutes its
-// interior. The neighbours' public translations are rows of u, bit for bit what their owners
+// known; after the rotations' exchange the first agent gathers the blocks' interface residuals
+// and sends every agent the interface translations u = Sigma^-1 rhat (it alone factors Sigma:
+// five agents factoring the same Sigma were half the rounding's instructions on torus3D), and
+// each back-substitutes its interior. The neighbours' public translations are rows of u, bit for bit what their owners
 // hold. Against the CG (distributed_rounding.cpp, translations()): 3 message steps (share,
 // residual, cost) instead of its warm start's 2, a start step per restart and one per
 // iteration, and the exact solve instead of one within cost_bound().
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/message_gate.hpp>
@@ -72,11 +74,15 @@ bool DistributedRounding::take_interface_shares() {
                                std::to_string(a));
     blocks.push_back(&m->data);
   }
-  if (!interface_->assemble(blocks)) interface_.reset();  // the same shares everywhere
+  // Only sigma_agent() factors Sigma; the shares' check is the same everywhere. A factor that
+  // fails there is announced with u (interface_translations()).
+  const bool factor = self_ == sigma_agent();
+  if (!interface_->assemble(blocks, factor) && (!factor || !interface_->assemble(blocks, false)))
+    interface_.reset();
   return interface_ != nullptr;
 }
 
-double DistributedRounding::interface_translations() {
+std::optional<double> DistributedRounding::interface_translations() {
   // The exact solve is one step of the stage: it is a progress point like a CG iteration (the
   // coordinator sees the rounding begin; test builds can stop an agent here).
   mail_.report_progress(ProgressStage::kRounding, 0, 0.0);
@@ -98,19 +104,42 @@ double DistributedRounding::interface_translations() {
   const std::vector<double> values(rhat.data(), rhat.data() + rhat.size());
   const PoseBlockMessage mine =
       make_reduction_message(static_cast<int>(self_), 0, kInterfaceResidual, values);
-  mail_.send_all({OutgoingMessage{mine, true, {}}});
-  auto got = mail_.gather(kInterfaceResidual, 0, others());
-  Eigen::MatrixXd R(interface_->team_size(), d);
-  for (std::uint32_t a : everyone_) {
-    const auto* msg = a == self_ ? &mine : std::get_if<PoseBlockMessage>(&got.at(a));
-    const Eigen::Index n = interface_->block_size(static_cast<int>(a));
-    if (!msg || msg->data.size() != static_cast<std::size_t>(n * d))
-      throw std::runtime_error("rounding: interface residual of the wrong size from agent " +
-                               std::to_string(a));
-    R.middleRows(interface_->block_offset(static_cast<int>(a)), n) =
-        Eigen::Map<const Eigen::MatrixXd>(msg->data.data(), n, d);
+  // Only sigma_agent() holds Sigma's factor: it gathers the residuals, solves u = Sigma^-1 rhat
+  // and sends u to all, flag first (0: its factor failed, the CG runs everywhere). The same bits
+  // as every agent's own factor of the same Sigma on the same residuals gave.
+  const Eigen::Index team = interface_->team_size();
+  Eigen::MatrixXd u;
+  if (self_ != sigma_agent()) {
+    mail_.send_all({addressed_to(sigma_agent(), mine)});
+    auto sol = mail_.gather(kInterfaceSolution, 0, {sigma_agent()});
+    const auto* msg = std::get_if<PoseBlockMessage>(&sol.at(sigma_agent()));
+    if (!msg || msg->data.empty())
+      throw std::runtime_error("rounding: interface solution of the wrong kind");
+    if (msg->data[0] == 0.0) return std::nullopt;
+    if (msg->data.size() != static_cast<std::size_t>(1 + team * d))
+      throw std::runtime_error("rounding: interface solution of the wrong size");
+    u = Eigen::Map<const Eigen::MatrixXd>(msg->data.data() + 1, team, d);
+  } else {
+    auto got = mail_.gather(kInterfaceResidual, 0, others());
+    Eigen::MatrixXd R(team, d);
+    for (std::uint32_t a : everyone_) {
+      const auto* msg = a == self_ ? &mine : std::get_if<PoseBlockMessage>(&got.at(a));
+      const Eigen::Index n = interface_->block_size(static_cast<int>(a));
+      if (!msg || msg->data.size() != static_cast<std::size_t>(n * d))
+        throw std::runtime_error("rounding: interface residual of the wrong size from agent " +
+                                 std::to_string(a));
+      R.middleRows(interface_->block_offset(static_cast<int>(a)), n) =
+          Eigen::Map<const Eigen::MatrixXd>(msg->data.data(), n, d);
+    }
+    std::vector<double> sent(1, interface_->ready() ? 1.0 : 0.0);
+    if (interface_->ready()) {
+      u = interface_->solve_interface(R);
+      sent.insert(sent.end(), u.data(), u.data() + u.size());
+    }
+    mail_.send_all({OutgoingMessage{
+        make_reduction_message(static_cast<int>(self_), 0, kInterfaceSolution, sent), true, {}}});
+    if (!interface_->ready()) return std::nullopt;
   }
-  const Eigen::MatrixXd u = interface_->solve_interface(R);
   const Eigen::MatrixXd x = interface_->back(y, u);
   for (Eigen::Index k = 0; k < m; ++k)
     poses_[own_[static_cast<std::size_t>(k)]].t = x.row(k).transpose();
