@@ -6,9 +6,9 @@
 // known; after the rotations' exchange the first agent gathers the blocks' interface residuals
 // and sends every agent the interface translations u = Sigma^-1 rhat (it alone factors Sigma:
 // five agents factoring the same Sigma were half the rounding's instructions on torus3D), and
-// each back-substitutes its interior. The neighbours' public translations are rows of u, bit for bit what their owners
-// hold. Against the CG (distributed_rounding.cpp, translations()): 3 message steps (share,
-// residual, cost) instead of its warm start's 2, a start step per restart and one per
+// each back-substitutes its interior. The neighbours' public translations are rows of u, bit for
+// bit what their owners hold. Against the CG (distributed_rounding.cpp, translations()): 3 message
+// steps (share, residual, cost) instead of its warm start's 2, a start step per restart and one per
 // iteration, and the exact solve instead of one within cost_bound().
 
 #include <Eigen/Core>
@@ -121,6 +121,7 @@ std::optional<double> DistributedRounding::interface_translations() {
     u = Eigen::Map<const Eigen::MatrixXd>(msg->data.data() + 1, team, d);
   } else {
     auto got = mail_.gather(kInterfaceResidual, 0, others());
+    ++mail_.gathers;  // a wait for the others, though this agent sent nothing since the last
     Eigen::MatrixXd R(team, d);
     for (std::uint32_t a : everyone_) {
       const auto* msg = a == self_ ? &mine : std::get_if<PoseBlockMessage>(&got.at(a));
