@@ -29,6 +29,10 @@ void DistributedRoundingOptions::validate() const {
     throw InputError(
         "DistributedRoundingOptions::interface_max_poses must be in [0, 1000000], got " +
         std::to_string(interface_max_poses));
+  if (interface_one_factor_min_poses > 1000000)
+    throw InputError(
+        "DistributedRoundingOptions::interface_one_factor_min_poses must be in [0, 1000000], got " +
+        std::to_string(interface_one_factor_min_poses));
 }
 
 DistributedRounding::~DistributedRounding() = default;
