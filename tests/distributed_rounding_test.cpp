@@ -128,6 +128,9 @@ TEST(DistributedRounding, OptionsOutOfRangeNameTheField) {
   o = {};
   o.interface_max_poses = 1000001;
   EXPECT_TRUE(test::validation_names(o, "interface_max_poses"));
+  o = {};
+  o.interface_one_factor_min_poses = 1000001;
+  EXPECT_TRUE(test::validation_names(o, "interface_one_factor_min_poses"));
 }
 
 }  // namespace

@@ -79,6 +79,25 @@ TEST(RoundingInterface, PartitionedBlocksGetTheDirectSolvesPosesAndCost) {
   expect_direct_solve(c);
 }
 
+TEST(RoundingInterface, OneAgentFactoringSigmaGivesThePosesOfEveryAgentFactoringItBitForBit) {
+  const RoundingCase c = grid_case(600, 5, 20, true);
+  DistributedRoundingOptions one, every;
+  one.interface_one_factor_min_poses = 0;
+  every.interface_one_factor_min_poses = 1000000;
+  const Rounded a = round_in_threads(c, one);
+  const Rounded b = round_in_threads(c, every);
+  ASSERT_TRUE(a.errors.empty()) << a.errors.front();
+  ASSERT_TRUE(b.errors.empty()) << b.errors.front();
+  EXPECT_EQ(a.interface_poses, static_cast<std::uint32_t>(team_interface(c)));
+  EXPECT_EQ(b.interface_poses, a.interface_poses);
+  EXPECT_EQ(a.steps, b.steps) << "the first agent's wait for the residuals is a step";
+  EXPECT_EQ(a.cost, b.cost);
+  for (std::size_t k = 0; k < a.poses.size(); ++k) {
+    EXPECT_EQ(a.poses[k].R, b.poses[k].R) << "pose " << k;
+    EXPECT_EQ(a.poses[k].t, b.poses[k].t) << "pose " << k;
+  }
+}
+
 TEST(RoundingInterface, CapBelowTheTeamInterfaceRunsTheCgBitForBit) {
   const RoundingCase c = grid_case(600, 4, 20, false);
   const Eigen::Index team = team_interface(c);

@@ -100,6 +100,36 @@ TEST(TranslationInterfaceSolve, SolvesTheWholeGraphsLaplacianFromTheBlocksAndOne
   EXPECT_LT(residual, 1e-10);
 }
 
+// The distributed rounding lets one agent factor Sigma and send u: the others assemble without
+// a factor, which checks the shares alike (a block whose L_BB is singular makes every agent
+// fall back) and leaves them not ready; their back solves take that agent's u.
+TEST(TranslationInterfaceSolve, AnAssembleWithoutAFactorChecksTheSharesAndIsNotReady) {
+  const PoseGraph g = test::refine_chain(200, 3);
+  const int N = 3;
+  const BlockLayout layout =
+      make_block_layout(g.num_poses, g.measurements, sequential_partition(g.num_poses, N));
+  std::vector<BlockProblem> problems;
+  for (int b = 0; b < N; ++b)
+    problems.emplace_back(g.d, layout.poses[static_cast<std::size_t>(b)], g.measurements);
+  std::vector<std::unique_ptr<TranslationInterfaceSolve>> solves;
+  for (int b = 0; b < N; ++b)
+    solves.push_back(std::make_unique<TranslationInterfaceSolve>(
+        problems[static_cast<std::size_t>(b)], layout, b));
+  std::vector<std::vector<double>> shares;
+  for (const auto& s : solves) shares.push_back(s->share());
+  std::vector<const std::vector<double>*> ptrs;
+  for (const auto& v : shares) ptrs.push_back(&v);
+  EXPECT_TRUE(solves[0]->assemble(ptrs));
+  EXPECT_TRUE(solves[0]->ready());
+  EXPECT_TRUE(solves[1]->assemble(ptrs, false));
+  EXPECT_FALSE(solves[1]->ready());
+  // A block that reports a singular L_BB: no agent goes on, factor or not.
+  const std::vector<double> singular{0.0};
+  ptrs[2] = &singular;
+  EXPECT_FALSE(solves[1]->assemble(ptrs, false));
+  EXPECT_FALSE(solves[0]->assemble(ptrs));
+}
+
 // L_BB holds the block's cut measurements on its diagonal, so a pose whose measurements are all
 // cut ones still makes it positive definite; a pose without any measurement does not, and the
 // block says so (the refinement then falls back to its block-Jacobi translation CG).

@@ -162,7 +162,8 @@ std::vector<double> TranslationInterfaceSolve::share() const {
   return out;
 }
 
-bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blocks) {
+bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<double>*>& blocks,
+                                         bool factor) {
   Impl& s = *impl_;
   s.sigma_ok = false;
   if (blocks.size() != s.team.block_offset.size())
@@ -188,6 +189,7 @@ bool TranslationInterfaceSolve::assemble(const std::vector<const std::vector<dou
     }
   }
   if (s.team.size == 0) return false;
+  if (!factor) return true;
   // Grounded: the first interface pose's row and column dropped (the constants are Sigma's
   // kernel on a connected graph, so the rest is positive definite and solved exactly).
   if (s.team.size > 1) {

@@ -76,8 +76,10 @@ class TranslationInterfaceSolve {
   /// neighbour pose, value) for each.
   std::vector<double> share() const;
   /// Every block's share() in id order: assembles and factors Sigma. False (the solve unusable)
-  /// when a block's flag is 0 or Sigma cannot be factored.
-  bool assemble(const std::vector<const std::vector<double>*>& blocks);
+  /// when a block's flag is 0 or Sigma cannot be factored. With `factor` false only the shares
+  /// are read and checked (false when a block's flag is 0): an agent that receives u from the
+  /// one agent that factors Sigma needs no factor of its own (ready() stays false).
+  bool assemble(const std::vector<const std::vector<double>*>& blocks, bool factor = true);
   /// True after an assemble() that succeeded.
   bool ready() const;
 

@@ -29,17 +29,24 @@ void DistributedRoundingOptions::validate() const {
     throw InputError(
         "DistributedRoundingOptions::interface_max_poses must be in [0, 1000000], got " +
         std::to_string(interface_max_poses));
+  if (interface_one_factor_min_poses > 1000000)
+    throw InputError(
+        "DistributedRoundingOptions::interface_one_factor_min_poses must be in [0, 1000000], got " +
+        std::to_string(interface_one_factor_min_poses));
 }
 
 DistributedRounding::~DistributedRounding() = default;
 
 RoundLoopResult DistributedRounding::run(RoundLoopResult res) {
   rotations();
-  if (take_interface_shares()) {
+  std::optional<double> exact;
+  if (take_interface_shares()) exact = interface_translations();
+  if (exact) {
     res.translation_iterations = 0;
     res.rounding_interface_poses = static_cast<std::uint32_t>(interface_->team_size());
-    res.cost = interface_translations();
+    res.cost = *exact;
   } else {
+    interface_.reset();
     res.translation_iterations = translations(res.relaxation_cost);
     res.rounding_interface_poses = 0;
     res.cost = cost();

@@ -6,8 +6,9 @@
 // come from one of two solves:
 // - exact, through the team's interface (distributed/translation_interface_solve.hpp) when it
 //   has at most DistributedRoundingOptions::interface_max_poses poses: every agent factors its
-//   translation Laplacian block and sends its Schur complement with the Gram matrix, then one
-//   all-agent sum of the interface residuals (runtime/rounding_interface.cpp);
+//   translation Laplacian block and sends its Schur complement with the Gram matrix, then its
+//   interface residuals to the agent that factors Sigma and back the interface translations
+//   (runtime/rounding_interface.cpp);
 // - otherwise (or when a block's Laplacian is singular) a distributed preconditioned conjugate
 //   gradient, one message step per iteration, its cost within
 //   DistributedRoundingOptions::cost_bound() of the exact solve's.
@@ -18,6 +19,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <tessera/distributed/agent_state.hpp>
 #include <tessera/distributed/block_layout.hpp>
 #include <tessera/graph/pose.hpp>
@@ -48,7 +50,8 @@ enum RoundingPhase : std::uint32_t {
   kCoarseSums,                 // the CG step's sums with the coarse level's terms
   kInterfaceShare,             // the interface solve: a block's Schur share (with the Gram)
   kInterfaceResidual,          // the interface solve: a block's interface residual rhat
-  kInterfaceCost               // the interface solve: cost share and pose 0's translation
+  kInterfaceCost,              // the interface solve: cost share and pose 0's translation
+  kInterfaceSolution           // the interface solve: u from the agent that factors Sigma
 };
 
 /// How the rounding solves for the translations (every agent must use the same).
@@ -78,11 +81,18 @@ struct DistributedRoundingOptions {
   /// Solve the translations exactly through the team's interface (one share with the Gram
   /// matrix's message, one all-agent sum, instead of the CG's message step per iteration) when
   /// the team has at most this many interface poses (poses with a cut measurement); 0 = the CG
-  /// always. [0, 1000000]. Every agent holds and factors the interface matrix Sigma (one row per
-  /// interface pose, about as sparse as the cut) and receives every block's dense Schur
+  /// always. [0, 1000000]. Every agent holds the interface matrix Sigma (one row per interface
+  /// pose, about as sparse as the cut; its factor: interface_one_factor_min_poses) and receives
+  /// every block's dense Schur
   /// complement (nG (nG + 1) / 2 numbers each): the same cap as the Newton refinement's exact
   /// trial translations (NewtonRefineOptions::translation_interface_max_poses).
   std::size_t interface_max_poses = 2000;
+  /// From this many interface poses on, only the first agent factors Sigma: the others send it
+  /// their interface residuals and receive u (one more delivery, the same bits); below it every
+  /// agent factors Sigma and the residuals go to all in one message step. Sigma's factorization
+  /// grows about as its size cubed, the extra delivery does not: torus3D's 483-pose Sigma took
+  /// 37 M instructions an agent, ais2klinik's 32-pose one little. [0, 1000000].
+  std::size_t interface_one_factor_min_poses = 200;
 
   /// Throws InputError naming the field when it is out of range.
   void validate() const;
@@ -204,14 +214,21 @@ class DistributedRounding {
   // The interface solve (rounding_interface.cpp). send_interface_share(): when the team's
   // interface is small enough, builds this block's solve and sends its share (before the Gram
   // matrix's gather, so it costs no wait of its own); every agent decides alike from the
-  // layout. take_interface_shares(): gathers the shares and assembles Sigma; false (the CG
-  // runs) when no share was sent or a block's Laplacian is singular, on every agent alike.
+  // layout. take_interface_shares(): gathers the shares; the first agent (sigma_agent())
+  // assembles and factors Sigma, the others only check the shares (every agent factors it below
+  // interface_one_factor_min_poses); false (the CG runs) when no share was sent or a block's
+  // Laplacian is singular, on every agent alike.
   void send_interface_share();
   bool take_interface_shares();
-  // Exact translations: forward solve, one all-agent sum of the interface residuals, back
-  // solve; then pose 0's translation rides on the cost's sum (the solve fixes another pose)
-  // and every translation is shifted by it. Returns the cost.
-  double interface_translations();
+  // Exact translations: forward solve, the interface residuals to the first agent, which solves
+  // u = Sigma^-1 rhat and sends it to all (every agent factoring the same Sigma was most of the
+  // rounding's instructions), or below interface_one_factor_min_poses one all-agent sum of
+  // them and every agent's own solve; back solve; then pose 0's translation rides on
+  // the cost's sum (the solve fixes another pose) and every translation is shifted by it.
+  // Returns the cost; nothing (the CG runs, on every agent alike) when Sigma could not be
+  // factored.
+  std::optional<double> interface_translations();
+  std::uint32_t sigma_agent() const { return everyone_.front(); }
 
   DistributedRoundingOptions options_;
   const AgentLocalData& local_;
@@ -226,7 +243,8 @@ class DistributedRounding {
   Eigen::MatrixXd frame_;              // r x d: the Gram matrix's top-d eigenvectors
   bool reflected_ = false;             // last row flipped so most blocks are rotations
   std::unique_ptr<TranslationInterfaceSolve> interface_;  // the exact solve, when it runs
-  std::vector<double> interface_share_;                   // this block's share, as sent
+  bool one_factor_ = false;  // only sigma_agent() factors Sigma (interface_one_factor_min_poses)
+  std::vector<double> interface_share_;  // this block's share, as sent
 };
 
 }  // namespace tessera::agent

@@ -3,15 +3,19 @@
 // translations minimise t^T L t - 2 b^T t, L the weighted translation Laplacian, which does not
 // depend on the rotations. So each block factors its L_BB (interior first, interface last) and
 // sends its Schur complement on the interface with the Gram matrix, before any rotation is
-// known; after the rotations' exchange one all-agent sum of the blocks' interface residuals
-// gives every agent the interface translations u = Sigma^-1 rhat, and each back-substitutes its
-// interior. The neighbours' public translations are rows of u, bit for bit what their owners
-// hold. Against the CG (distributed_rounding.cpp, translations()): 3 message steps (share,
-// residual, cost) instead of its warm start's 2, a start step per restart and one per
+// known; after the rotations' exchange the first agent gathers the blocks' interface residuals
+// and sends every agent the interface translations u = Sigma^-1 rhat (it alone factors Sigma
+// from DistributedRoundingOptions::interface_one_factor_min_poses interface poses on: five
+// agents factoring the same Sigma were half the rounding's instructions on torus3D; below,
+// every agent factors it and one all-agent sum of the residuals gives each u), and each
+// back-substitutes its interior. The neighbours' public translations are rows of u, bit for
+// bit what their owners hold. Against the CG (distributed_rounding.cpp, translations()): 3 message
+// steps (share, residual, cost) instead of its warm start's 2, a start step per restart and one per
 // iteration, and the exact solve instead of one within cost_bound().
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <tessera/distributed/message_gate.hpp>
@@ -28,6 +32,7 @@ void DistributedRounding::send_interface_share() {
   if (cap == 0 || everyone_.size() < 2) return;
   const auto team = static_cast<std::size_t>(interface_pose_count(layout_));
   if (team == 0 || team > cap) return;
+  one_factor_ = team >= options_.interface_one_factor_min_poses;
   // L's rows of the owned poses, from the measurements as the CG builds them (no pose fixed:
   // the interface solve grounds the team's first interface pose, run() shifts to pose 0).
   std::unordered_map<std::size_t, Eigen::Index> slot;
@@ -72,11 +77,16 @@ bool DistributedRounding::take_interface_shares() {
                                std::to_string(a));
     blocks.push_back(&m->data);
   }
-  if (!interface_->assemble(blocks)) interface_.reset();  // the same shares everywhere
+  // With one factor only sigma_agent() factors Sigma; the shares' check is the same everywhere.
+  // A factor that fails is announced with u, or fails alike on every agent
+  // (interface_translations()).
+  const bool factor = !one_factor_ || self_ == sigma_agent();
+  if (!interface_->assemble(blocks, factor) && (!factor || !interface_->assemble(blocks, false)))
+    interface_.reset();
   return interface_ != nullptr;
 }
 
-double DistributedRounding::interface_translations() {
+std::optional<double> DistributedRounding::interface_translations() {
   // The exact solve is one step of the stage: it is a progress point like a CG iteration (the
   // coordinator sees the rounding begin; test builds can stop an agent here).
   mail_.report_progress(ProgressStage::kRounding, 0, 0.0);
@@ -98,19 +108,45 @@ double DistributedRounding::interface_translations() {
   const std::vector<double> values(rhat.data(), rhat.data() + rhat.size());
   const PoseBlockMessage mine =
       make_reduction_message(static_cast<int>(self_), 0, kInterfaceResidual, values);
-  mail_.send_all({OutgoingMessage{mine, true, {}}});
-  auto got = mail_.gather(kInterfaceResidual, 0, others());
-  Eigen::MatrixXd R(interface_->team_size(), d);
-  for (std::uint32_t a : everyone_) {
-    const auto* msg = a == self_ ? &mine : std::get_if<PoseBlockMessage>(&got.at(a));
-    const Eigen::Index n = interface_->block_size(static_cast<int>(a));
-    if (!msg || msg->data.size() != static_cast<std::size_t>(n * d))
-      throw std::runtime_error("rounding: interface residual of the wrong size from agent " +
-                               std::to_string(a));
-    R.middleRows(interface_->block_offset(static_cast<int>(a)), n) =
-        Eigen::Map<const Eigen::MatrixXd>(msg->data.data(), n, d);
+  // With one factor (one_factor_), only sigma_agent() holds Sigma's factor: it gathers the
+  // residuals, solves u = Sigma^-1 rhat and sends u to all, flag first (0: its factor failed,
+  // the CG runs everywhere). The same bits as every agent's own factor of the same Sigma on the
+  // same residuals gave. Otherwise every agent gathers every residual and solves itself.
+  const Eigen::Index team = interface_->team_size();
+  Eigen::MatrixXd u;
+  if (one_factor_ && self_ != sigma_agent()) {
+    mail_.send_all({addressed_to(sigma_agent(), mine)});
+    auto sol = mail_.gather(kInterfaceSolution, 0, {sigma_agent()});
+    const auto* msg = std::get_if<PoseBlockMessage>(&sol.at(sigma_agent()));
+    if (!msg || msg->data.empty())
+      throw std::runtime_error("rounding: interface solution of the wrong kind");
+    if (msg->data[0] == 0.0) return std::nullopt;
+    if (msg->data.size() != static_cast<std::size_t>(1 + team * d))
+      throw std::runtime_error("rounding: interface solution of the wrong size");
+    u = Eigen::Map<const Eigen::MatrixXd>(msg->data.data() + 1, team, d);
+  } else {
+    if (!one_factor_) mail_.send_all({OutgoingMessage{mine, true, {}}});
+    auto got = mail_.gather(kInterfaceResidual, 0, others());
+    if (one_factor_) ++mail_.gathers;  // a wait for the others, though it sent nothing since
+    Eigen::MatrixXd R(team, d);
+    for (std::uint32_t a : everyone_) {
+      const auto* msg = a == self_ ? &mine : std::get_if<PoseBlockMessage>(&got.at(a));
+      const Eigen::Index n = interface_->block_size(static_cast<int>(a));
+      if (!msg || msg->data.size() != static_cast<std::size_t>(n * d))
+        throw std::runtime_error("rounding: interface residual of the wrong size from agent " +
+                                 std::to_string(a));
+      R.middleRows(interface_->block_offset(static_cast<int>(a)), n) =
+          Eigen::Map<const Eigen::MatrixXd>(msg->data.data(), n, d);
+    }
+    if (interface_->ready()) u = interface_->solve_interface(R);
+    if (one_factor_) {
+      std::vector<double> sent(1, interface_->ready() ? 1.0 : 0.0);
+      sent.insert(sent.end(), u.data(), u.data() + u.size());
+      mail_.send_all({OutgoingMessage{
+          make_reduction_message(static_cast<int>(self_), 0, kInterfaceSolution, sent), true, {}}});
+    }
+    if (!interface_->ready()) return std::nullopt;  // every agent alike: the same Sigma
   }
-  const Eigen::MatrixXd u = interface_->solve_interface(R);
   const Eigen::MatrixXd x = interface_->back(y, u);
   for (Eigen::Index k = 0; k < m; ++k)
     poses_[own_[static_cast<std::size_t>(k)]].t = x.row(k).transpose();
