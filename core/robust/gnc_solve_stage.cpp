@@ -146,7 +146,7 @@ bool GncSolveStage::newton_step_untrusted(double trust) const {
   for (const NewtonRefineResult& r : solve_->refines())
     for (const NewtonRefineStep& step : r.trace)
       if (step.accepted) last = &step;
-  return last == nullptr || last->cg_stop != "residual" || last->actual < trust * last->predicted;
+  return last == nullptr || last->actual < trust * last->predicted;
 }
 
 void GncSolveStage::solve_again_by_rounds() {

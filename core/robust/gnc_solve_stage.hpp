@@ -101,8 +101,8 @@ class GncSolveStage {
   bool newton_steps_only() const { return gnc_newton_steps_; }
   /// The ended solve was a weighted one by Newton steps whose model did not hold at its end
   /// (RobustOptions::newton_step_trust `trust` > 0): no step accepted, or the last accepted one
-  /// ended on the trust region's boundary or at negative curvature, or lowered f by less than
-  /// `trust` times its predicted decrease. The same on every agent (summed values).
+  /// lowered f by less than `trust` times its predicted decrease. The same on every agent
+  /// (summed values).
   bool newton_step_untrusted(double trust) const;
   /// The iterate goes back to the ended Newton step's start, and the next weighted solve (of
   /// the same weights) runs by rounds, once.

@@ -296,10 +296,10 @@ struct RobustOptions {
   int gnc_refine_steps = 1;
   /// Distributed solvers only, where GNC's weighted solves are Newton steps (gnc_refine_steps):
   /// the weights are updated at a Newton step's point only when its quadratic model held there:
-  /// the step was accepted, ended inside the trust region (its CG stopped on the residual, not
-  /// on the boundary or at negative curvature) and lowered f by at least this fraction of the
-  /// model's predicted decrease (the trust region's usual "very successful" test). Otherwise
-  /// the iterate goes back to the step's start and the same weighted problem is solved by
+  /// the step was accepted and lowered f by at least this fraction of the model's predicted
+  /// decrease (the trust region's usual "very successful" test; a step cut short on the trust
+  /// region's boundary or at negative curvature passes it when its model held). Otherwise the
+  /// iterate goes back to the step's start and the same weighted problem is solved by
   /// rounds (inner_max_rounds), and the weights are updated there. Every agent decides the same
   /// (the verdicts are on summed values; no message). [0, 1]; 0 = off (every Newton step's end
   /// is taken as the weighted solve's answer). Why: GNC follows the weighted problem's
