@@ -88,6 +88,11 @@ const char* kHelp =
     "                            GNC's weighted solves are Newton steps, mu's step after an\n"
     "                            outer step that moved no weight across 1/2 is the last one\n"
     "                            squared, up to S; 0 = none, else > 1 [4]\n"
+    "  --gnc-step-trust R   robust distributed: where GNC's weighted solves are Newton steps,\n"
+    "                            the weights are updated at a step's point only when it was\n"
+    "                            accepted with actual/predicted decrease >= R; otherwise\n"
+    "                            the same weights are solved by rounds from the step's\n"
+    "                            start first; [0, 1], 0 = off [0.75]\n"
     "  --gnc-mu-hold falls|crossings   robust distributed: which weights, at an update, return\n"
     "                            the bigger step of mu to --gnc-mu-step: those that fell below\n"
     "                            1/2 (left the inlier set), or any that crossed 1/2 [falls]\n"
@@ -276,6 +281,7 @@ int run_solve(const Args& args) {
   valued.insert("gnc-newton-mu-step-max");
   valued.insert("gnc-step-sigma");
   valued.insert("gnc-mu-hold");
+  valued.insert("gnc-step-trust");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
@@ -324,6 +330,13 @@ int run_solve(const Args& args) {
     robust.validate();
   } catch (const InputError& e) {
     throw InputError(std::string("option --gnc-newton-mu-step-max: ") + e.what());
+  }
+  // RobustOptions::newton_step_trust; `tessera solve` only, like --gnc-probe-cut.
+  robust.newton_step_trust = a.get_double("gnc-step-trust", robust.newton_step_trust);
+  try {
+    robust.validate();
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-step-trust: ") + e.what());
   }
   if (algorithm == "centralized")
     return solve_centralized_command(a, a.positional()[0], robust, start);

@@ -229,6 +229,11 @@ TEST(DistributedCli, RejectsBadOptions) {
                               &out),
             2);
   EXPECT_NE(out.find("--gnc-mu-hold"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + g +
+                                  " --algorithm irbcd --robust gnc-tls --gnc-step-trust 2",
+                              &out),
+            2);
+  EXPECT_NE(out.find("--gnc-step-trust"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -211,6 +211,19 @@ void GncAgent::after_solve(std::vector<OutgoingMessage>& out) {
     begin_rejected(out);
     return;
   }
+  if (g_ > first_solve_g_ && stage_->newton_step_untrusted(options_.robust.newton_step_trust)) {
+    // RobustOptions::newton_step_trust: the Newton model did not hold, so its end is no
+    // minimiser to weigh at; the same weights are solved by rounds from the step's start. The
+    // trial's poses and weights that went out beside its sums are of no use (later copies are
+    // dropped on arrival: their step is left).
+    mail_->discard(gnc_phase(g_, GncExchange::kPoses));
+    mail_->discard(gnc_phase(g_, GncExchange::kTrialWeights));
+    trial_weights_sent_ = false;
+    stage_->solve_again_by_rounds();
+    ++g_;
+    begin_solve(out);
+    return;
+  }
   if (stage_->poses_sent_early()) stage_->judge_early_poses();
   begin_exchange(Step::kPoses, out);
 }

@@ -48,9 +48,12 @@ void GncSolveStage::open(bool weighted, bool capped, bool trial_poses,
                          const std::vector<std::uint64_t>& rejected) {
   solve_.reset();
   // GNC's weighted solves (not the first, plain one) by Newton steps where the interface fits.
-  newton_steps_ = weighted && gnc_refines(options_, *layout_, in_.d);
+  // A solve again by rounds (solve_again_by_rounds()) solves the same weights as the step.
+  const bool again = weighted && rounds_next_;
+  rounds_next_ = false;
+  newton_steps_ = weighted && !again && gnc_refines(options_, *layout_, in_.d);
   solve_options_ = gnc_solve_options(options_, kind_, capped, newton_steps_);
-  if (weighted) {
+  if (weighted && !again) {
     gnc_newton_steps_ = (weighted_solves_ == 0 || gnc_newton_steps_) && newton_steps_;
     ++weighted_solves_;
   }
@@ -60,6 +63,7 @@ void GncSolveStage::open(bool weighted, bool capped, bool trial_poses,
   else
     measurements = kept_;
   const Eigen::MatrixXd Y = state_ ? state_->Y : start_;
+  if (newton_steps_) step_start_ = Y;  // solve_again_by_rounds() may return there
   if (kind_ == GncSolveKind::kInlierPass) last_pass_start_ = Y;
   state_ = std::make_unique<AgentState>(in_.id, in_.d, *layout_, measurements, Y,
                                         solve_options_.block_update);
@@ -133,6 +137,21 @@ void GncSolveStage::judge_early_poses() {
   // the verdict is on summed values); otherwise the iterate is the solve's start.
   const std::vector<NewtonRefineResult>& r = solve_->refines();
   poses_early_stale_ = !(r.size() == 1 && r.front().accepted_steps == 1);
+}
+
+bool GncSolveStage::newton_step_untrusted(double trust) const {
+  if (!newton_steps_ || trust <= 0 || solve_->total_rounds() > 0) return false;
+  // The last accepted step is where the iterate is (its trial point).
+  const NewtonRefineStep* last = nullptr;
+  for (const NewtonRefineResult& r : solve_->refines())
+    for (const NewtonRefineStep& step : r.trace)
+      if (step.accepted) last = &step;
+  return last == nullptr || last->actual < trust * last->predicted;
+}
+
+void GncSolveStage::solve_again_by_rounds() {
+  rounds_next_ = true;
+  state_->Y = step_start_;
 }
 
 void GncSolveStage::tally() {

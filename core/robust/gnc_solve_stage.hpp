@@ -96,8 +96,17 @@ class GncSolveStage {
 
   bool poses_sent_early() const { return poses_sent_early_; }
   bool poses_early_stale() const { return poses_early_stale_; }
-  /// Every weighted solve so far was a Newton step, and there was one.
+  /// Every weighted solve so far was a Newton step, and there was one (a solve again by rounds,
+  /// solve_again_by_rounds(), is not counted: the weights it solves for are a Newton step's).
   bool newton_steps_only() const { return gnc_newton_steps_; }
+  /// The ended solve was a weighted one by Newton steps whose model did not hold at its end
+  /// (RobustOptions::newton_step_trust `trust` > 0): no step accepted, or the last accepted one
+  /// lowered f by less than `trust` times its predicted decrease. The same on every agent
+  /// (summed values).
+  bool newton_step_untrusted(double trust) const;
+  /// The iterate goes back to the ended Newton step's start, and the next weighted solve (of
+  /// the same weights) runs by rounds, once.
+  void solve_again_by_rounds();
 
   const std::vector<Measurement>& kept() const { return kept_; }
   const std::vector<std::uint64_t>& kept_index() const { return kept_index_; }
@@ -125,8 +134,10 @@ class GncSolveStage {
   std::unique_ptr<BlockLayout> layout_;
   std::unique_ptr<AgentState> state_;
   std::unique_ptr<CertifiedAgent> solve_;
-  bool newton_steps_ = false;  // the opened solve is a weighted one by Newton steps
-  bool start_known_ = false;   // know_start() for the opened solve
+  bool newton_steps_ = false;   // the opened solve is a weighted one by Newton steps
+  bool rounds_next_ = false;    // solve_again_by_rounds(): the next weighted solve by rounds
+  Eigen::MatrixXd step_start_;  // the opened Newton step's start
+  bool start_known_ = false;    // know_start() for the opened solve
   double pass_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
   bool gnc_newton_steps_ = false;
   int weighted_solves_ = 0;

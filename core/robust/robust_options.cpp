@@ -114,6 +114,8 @@ void RobustOptions::validate() const {
   if (gnc_refine_steps < 0)
     bad_field("gnc_refine_steps", std::to_string(gnc_refine_steps),
               "must be >= 0 (0 = weighted solves by rounds)");
+  if (!(std::isfinite(newton_step_trust) && newton_step_trust >= 0 && newton_step_trust <= 1))
+    bad_field("newton_step_trust", number_text(newton_step_trust), "must be in [0, 1] (0 = off)");
   if (!(std::isfinite(weight_tolerance) && weight_tolerance >= 0))
     bad_field("weight_tolerance", number_text(weight_tolerance), "must be >= 0");
 }
