@@ -435,27 +435,41 @@ void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* ou
 #ifdef TESSERA_AVX_KERNELS
   if (avx_kernels_enabled()) {
     if (split_dots_)
-      solve_chains_avx<true>(L, X);
+      solve_chains_avx_split(L, X);
     else
-      solve_chains_avx<false>(L, X);
+      solve_chains_avx(L, X);
   } else
 #endif
       if (split_dots_)
-    solve_chains<Sse2Kernels, true>(L, X);
+    solve_chains_sse2_split(L, X);
   else
-    solve_chains<Sse2Kernels, false>(L, X);
+    solve_chains_sse2(L, X);
   if (perm)
     for (int k = 0; k < n; ++k) out[perm[k]] = X[k];
   else
     std::copy(X, X + n, out);
 }
 
+// Each kernel set's chain loop as its own function with its kernels inlined (both inlined
+// into solve(), GCC called the kernels instead).
+__attribute__((flatten)) void LdlChainSolve::solve_chains_sse2(const cholmod_factor* L,
+                                                               double* X) const {
+  solve_chains<Sse2Kernels, false>(L, X);
+}
+__attribute__((flatten)) void LdlChainSolve::solve_chains_sse2_split(const cholmod_factor* L,
+                                                                     double* X) const {
+  solve_chains<Sse2Kernels, true>(L, X);
+}
+
 #ifdef TESSERA_AVX_KERNELS
-// The chain loop compiled for AVX, so that the AVX kernels inline into it.
-template <bool Split>
+// The chain loops compiled for AVX, so that the AVX kernels inline into them.
 __attribute__((target("avx"), flatten)) void LdlChainSolve::solve_chains_avx(
     const cholmod_factor* L, double* X) const {
-  solve_chains<AvxKernels, Split>(L, X);
+  solve_chains<AvxKernels, false>(L, X);
+}
+__attribute__((target("avx"), flatten)) void LdlChainSolve::solve_chains_avx_split(
+    const cholmod_factor* L, double* X) const {
+  solve_chains<AvxKernels, true>(L, X);
 }
 #endif
 

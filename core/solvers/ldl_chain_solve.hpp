@@ -58,8 +58,10 @@ class LdlChainSolve {
   // The forward and backward substitutions on X (permuted order), with one kernel set.
   template <class Kernels, bool Split>
   void solve_chains(const cholmod_factor* L, double* X) const;
-  template <bool Split>
+  void solve_chains_sse2(const cholmod_factor* L, double* X) const;
+  void solve_chains_sse2_split(const cholmod_factor* L, double* X) const;
   void solve_chains_avx(const cholmod_factor* L, double* X) const;
+  void solve_chains_avx_split(const cholmod_factor* L, double* X) const;
 
   std::vector<Chain> forward_, backward_;
   std::vector<Run> forward_runs_, backward_runs_;
