@@ -59,6 +59,7 @@ const char* const kDistributedValued[] = {"agents",
                                           "sigma-max",
                                           "irbcd-a0",
                                           "tangent-radius",
+                                          "tangent-dots",
                                           "irbcd-class-score",
                                           "partition-objective",
                                           "partition-time",
@@ -134,6 +135,8 @@ const char* kDistributedHelp =
     "                            updates of an agent (default 0: once, at its first update)\n"
     "  --tangent-radius S        first trust-region radius of a tangent-preconditioned update,\n"
     "                            in units of its preconditioned gradient norm (default 3)\n"
+    "  --tangent-dots split|sequential   the tangent factor's backward dot products as four\n"
+    "                            partial sums (default) or CHOLMOD's sequential sums (its bits)\n"
     "  --restart-c C             restart constant c1 of RBCD++/IRBCD (< 0: never restart;\n"
     "                            default 0)\n"
     "  --sigma S                 IRBCD sigma (default 1e-4; the paper: 1e-3)\n"
@@ -277,6 +280,13 @@ PartitionResult given_partition(const PoseGraph& graph, const std::string& path,
 
 }  // namespace
 
+bool parse_tangent_split_dots(const Arguments& a) {
+  const std::string dots = a.get_or("tangent-dots", "split");
+  if (dots != "split" && dots != "sequential")
+    throw InputError("option --tangent-dots: '" + dots + "' is not one of split, sequential");
+  return dots == "split";
+}
+
 int solve_distributed_command(const Arguments& a, const std::string& graph_path,
                               const RobustOptions& robust,
                               std::chrono::steady_clock::time_point start) {
@@ -319,6 +329,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       static_cast<int>(a.get_long("tangent-refresh", opt.block_update.tangent_refresh_interval));
   opt.block_update.tangent_radius_scale =
       a.get_double("tangent-radius", opt.block_update.tangent_radius_scale);
+  opt.block_update.tangent_split_dots = parse_tangent_split_dots(a);
   opt.block_update.max_attempts =
       std::max(opt.block_update.max_attempts, opt.block_update.trust_region_steps);
   if (a.has("restart-c")) {

@@ -22,6 +22,7 @@
 #include "rebalance_args.hpp"
 #include "robot_files.hpp"
 #include "runtime/replay_input.hpp"
+#include "solve_distributed.hpp"
 #include "step_coarse_args.hpp"
 
 namespace tessera::cli {
@@ -92,6 +93,8 @@ const char* kOnlineHelp =
     "                            3-D blocks; docs/online.md)\n"
     "  --threads T               the agents handle their messages on T threads (1..64,\n"
     "                            default 1); the same iterates as one thread\n"
+    "  --tangent-dots split|sequential   the block factors' backward dot products as four\n"
+    "                            partial sums (default) or CHOLMOD's sequential sums\n"
     "  --local-threshold F       local rounds: a block works only while its gradient norm\n"
     "                            is above F * grad-tol / sqrt(blocks), in (0, 1] (default 1)\n"
     "  --no-local-rounds         every block works and sends in every round\n"
@@ -213,6 +216,7 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   }
   options.rebalance = parse_rebalance_options(a);
   options.solver.threads = static_cast<int>(a.get_long("threads", options.solver.threads));
+  options.solver.block_update.tangent_split_dots = parse_tangent_split_dots(a);
   options.solver.local_rounds.enabled = !a.has("no-local-rounds");
   options.solver.local_rounds.threshold =
       a.get_double("local-threshold", options.solver.local_rounds.threshold);

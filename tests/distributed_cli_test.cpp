@@ -212,6 +212,11 @@ TEST(DistributedCli, RejectsBadOptions) {
           test::bin("tessera") + " solve " + g + " --algorithm irbcd --tangent-radius 0", &out),
       2);
   EXPECT_NE(out.find("tangent_radius_scale"), std::string::npos) << out;
+  EXPECT_EQ(
+      test::run_command(
+          test::bin("tessera") + " solve " + g + " --algorithm irbcd --tangent-dots fast", &out),
+      2);
+  EXPECT_NE(out.find("--tangent-dots"), std::string::npos) << out;
   EXPECT_EQ(test::run_command(test::bin("tessera") + " solve " + g +
                                   " --algorithm irbcd --irbcd-grad-reduction 1",
                               &out),

@@ -158,6 +158,7 @@ bool AgentState::build_tangent(const Eigen::MatrixXd& X, const BlockUpdateOption
   tangent_ = std::make_unique<TangentPreconditioner>(problem_, options.tangent_relative_shift,
                                                      max_factor_entries_,
                                                      options.tangent_supernodal_min_flops, true);
+  tangent_->set_split_dots(options.tangent_split_dots);
   const bool factored = tangent_->usable() && tangent_->factorize(X);
   count_tangent_factorizations(0);
   if (!factored) tangent_.reset();

@@ -100,16 +100,95 @@ void backward_runs(double (&y)[3], const double* (&a)[3], const double* X,
   y[2] = y2;
 }
 
+// backward_runs<W> with split dots (LdlChainSolve::set_split_dots): four partial sums per
+// column, lane l taking each run's rows k = l mod 4, lane 0 starting from y_c, the others from
+// 0; at the end y_c = (l0 + l2) + (l1 + l3). Lanes 0-1 and 2-3 are two SSE2 registers here and
+// one AVX register below: the same operations on every lane, so the same bits.
+template <int W>
+void backward_runs_split(double (&y)[3], const double* (&a)[3], const double* X,
+                         const LdlChainSolve::Run* run, const LdlChainSolve::Run* end) {
+  const double* a0 = a[0];
+  const double* a1 = a[1];
+  const double* a2 = a[2];
+#ifdef __SSE2__
+  __m128d lo0 = _mm_set_sd(y[0]), lo1 = _mm_set_sd(y[1]), lo2 = _mm_set_sd(y[2]);
+  __m128d hi0 = _mm_setzero_pd(), hi1 = hi0, hi2 = hi0;
+  for (; run != end; ++run) {
+    const double* x = X + run->row;
+    const int length = run->length;
+    int k = 0;
+    for (; k + 4 <= length; k += 4) {
+      const __m128d xl = _mm_loadu_pd(x + k), xh = _mm_loadu_pd(x + k + 2);
+      lo0 = _mm_sub_pd(lo0, _mm_mul_pd(_mm_loadu_pd(a0 + k), xl));
+      hi0 = _mm_sub_pd(hi0, _mm_mul_pd(_mm_loadu_pd(a0 + k + 2), xh));
+      if constexpr (W > 1) {
+        lo1 = _mm_sub_pd(lo1, _mm_mul_pd(_mm_loadu_pd(a1 + k), xl));
+        hi1 = _mm_sub_pd(hi1, _mm_mul_pd(_mm_loadu_pd(a1 + k + 2), xh));
+      }
+      if constexpr (W > 2) {
+        lo2 = _mm_sub_pd(lo2, _mm_mul_pd(_mm_loadu_pd(a2 + k), xl));
+        hi2 = _mm_sub_pd(hi2, _mm_mul_pd(_mm_loadu_pd(a2 + k + 2), xh));
+      }
+    }
+    if (k + 2 <= length) {  // lanes 0-1, then lane 2
+      const __m128d xl = _mm_loadu_pd(x + k);
+      lo0 = _mm_sub_pd(lo0, _mm_mul_pd(_mm_loadu_pd(a0 + k), xl));
+      if constexpr (W > 1) lo1 = _mm_sub_pd(lo1, _mm_mul_pd(_mm_loadu_pd(a1 + k), xl));
+      if constexpr (W > 2) lo2 = _mm_sub_pd(lo2, _mm_mul_pd(_mm_loadu_pd(a2 + k), xl));
+      k += 2;
+      if (k < length) {
+        const __m128d xs = _mm_load_sd(x + k);
+        hi0 = _mm_sub_sd(hi0, _mm_mul_sd(_mm_load_sd(a0 + k), xs));
+        if constexpr (W > 1) hi1 = _mm_sub_sd(hi1, _mm_mul_sd(_mm_load_sd(a1 + k), xs));
+        if constexpr (W > 2) hi2 = _mm_sub_sd(hi2, _mm_mul_sd(_mm_load_sd(a2 + k), xs));
+      }
+    } else if (k < length) {  // lane 0
+      const __m128d xs = _mm_load_sd(x + k);
+      lo0 = _mm_sub_sd(lo0, _mm_mul_sd(_mm_load_sd(a0 + k), xs));
+      if constexpr (W > 1) lo1 = _mm_sub_sd(lo1, _mm_mul_sd(_mm_load_sd(a1 + k), xs));
+      if constexpr (W > 2) lo2 = _mm_sub_sd(lo2, _mm_mul_sd(_mm_load_sd(a2 + k), xs));
+    }
+    a0 += length;
+    a1 += length;
+    a2 += length;
+  }
+  auto reduce = [](__m128d lo, __m128d hi) {
+    const __m128d t = _mm_add_pd(lo, hi);
+    return _mm_cvtsd_f64(_mm_add_sd(t, _mm_unpackhi_pd(t, t)));
+  };
+  y[0] = reduce(lo0, hi0);
+  if constexpr (W > 1) y[1] = reduce(lo1, hi1);
+  if constexpr (W > 2) y[2] = reduce(lo2, hi2);
+#else
+  double s[3][4] = {{y[0], 0, 0, 0}, {y[1], 0, 0, 0}, {y[2], 0, 0, 0}};
+  for (; run != end; ++run) {
+    const double* x = X + run->row;
+    for (int k = 0; k < run->length; ++k) {
+      s[0][k % 4] -= a0[k] * x[k];
+      if constexpr (W > 1) s[1][k % 4] -= a1[k] * x[k];
+      if constexpr (W > 2) s[2][k % 4] -= a2[k] * x[k];
+    }
+    a0 += run->length;
+    a1 += run->length;
+    a2 += run->length;
+  }
+  for (int c = 0; c < W; ++c) y[c] = (s[c][0] + s[c][2]) + (s[c][1] + s[c][3]);
+#endif
+}
+
 // The baseline kernels, as the solve's chain loop calls them.
 struct Sse2Kernels {
   template <class... Args>
   static void forward_run(Args... args) {
     ::tessera::forward_run(args...);
   }
-  template <int W>
+  template <int W, bool Split>
   static void backward_runs(double (&y)[3], const double* (&a)[3], const double* X,
                             const LdlChainSolve::Run* run, const LdlChainSolve::Run* end) {
-    ::tessera::backward_runs<W>(y, a, X, run, end);
+    if constexpr (Split)
+      ::tessera::backward_runs_split<W>(y, a, X, run, end);
+    else
+      ::tessera::backward_runs<W>(y, a, X, run, end);
   }
 };
 
@@ -171,13 +250,69 @@ struct AvxKernels {
     for (; k < length; ++k) x[k] -= a[k] * y0 + b[k] * y1 + c[k] * y2;
   }
 
-  // backward_runs<W> with four rows' products in one register, subtracted lane by lane in row
-  // order (two SSE2 pairs, low lane first).
-  template <int W>
+  template <int W, bool Split>
   __attribute__((target("avx"))) static void backward_runs(double (&y)[3], const double* (&a)[3],
                                                            const double* X,
                                                            const LdlChainSolve::Run* run,
                                                            const LdlChainSolve::Run* end) {
+    if constexpr (Split)
+      backward_runs_split<W>(y, a, X, run, end);
+    else
+      backward_runs_sequential<W>(y, a, X, run, end);
+  }
+
+  // backward_runs_split<W> (above) with the four lanes in one register. A run's last 1-3 rows
+  // are loaded masked: the other lanes subtract 0 * 0 = +0, which leaves any value as it is.
+  template <int W>
+  __attribute__((target("avx"))) static void backward_runs_split(double (&y)[3],
+                                                                 const double* (&a)[3],
+                                                                 const double* X,
+                                                                 const LdlChainSolve::Run* run,
+                                                                 const LdlChainSolve::Run* end) {
+    alignas(32) static const long long kMasks[4][4] = {
+        {0, 0, 0, 0}, {-1, 0, 0, 0}, {-1, -1, 0, 0}, {-1, -1, -1, 0}};
+    const double* a0 = a[0];
+    const double* a1 = a[1];
+    const double* a2 = a[2];
+    __m256d s0 = _mm256_set_pd(0.0, 0.0, 0.0, y[0]);
+    __m256d s1 = _mm256_set_pd(0.0, 0.0, 0.0, y[1]);
+    __m256d s2 = _mm256_set_pd(0.0, 0.0, 0.0, y[2]);
+    for (; run != end; ++run) {
+      const double* x = X + run->row;
+      const int length = run->length;
+      int k = 0;
+      for (; k + 4 <= length; k += 4) {
+        const __m256d xv = _mm256_loadu_pd(x + k);
+        s0 = _mm256_sub_pd(s0, _mm256_mul_pd(_mm256_loadu_pd(a0 + k), xv));
+        if constexpr (W > 1) s1 = _mm256_sub_pd(s1, _mm256_mul_pd(_mm256_loadu_pd(a1 + k), xv));
+        if constexpr (W > 2) s2 = _mm256_sub_pd(s2, _mm256_mul_pd(_mm256_loadu_pd(a2 + k), xv));
+      }
+      if (k < length) {
+        const __m256i mask =
+            _mm256_load_si256(reinterpret_cast<const __m256i*>(kMasks[length - k]));
+        const __m256d xv = _mm256_maskload_pd(x + k, mask);
+        s0 = _mm256_sub_pd(s0, _mm256_mul_pd(_mm256_maskload_pd(a0 + k, mask), xv));
+        if constexpr (W > 1)
+          s1 = _mm256_sub_pd(s1, _mm256_mul_pd(_mm256_maskload_pd(a1 + k, mask), xv));
+        if constexpr (W > 2)
+          s2 = _mm256_sub_pd(s2, _mm256_mul_pd(_mm256_maskload_pd(a2 + k, mask), xv));
+      }
+      a0 += length;
+      a1 += length;
+      a2 += length;
+    }
+    y[0] = reduce(s0);
+    if constexpr (W > 1) y[1] = reduce(s1);
+    if constexpr (W > 2) y[2] = reduce(s2);
+  }
+
+ private:
+  // backward_runs<W> with four rows' products in one register, subtracted lane by lane in row
+  // order (two SSE2 pairs, low lane first).
+  template <int W>
+  __attribute__((target("avx"))) static void backward_runs_sequential(
+      double (&y)[3], const double* (&a)[3], const double* X, const LdlChainSolve::Run* run,
+      const LdlChainSolve::Run* end) {
     const double* a0 = a[0];
     const double* a1 = a[1];
     const double* a2 = a[2];
@@ -214,7 +349,11 @@ struct AvxKernels {
     y[2] = _mm_cvtsd_f64(s2);
   }
 
- private:
+  // (l0 + l2) + (l1 + l3), as the SSE2 copy sums its two registers.
+  __attribute__((target("avx"))) static double reduce(__m256d s) {
+    const __m128d t = _mm_add_pd(_mm256_castpd256_pd128(s), _mm256_extractf128_pd(s, 1));
+    return _mm_cvtsd_f64(_mm_add_sd(t, _mm_unpackhi_pd(t, t)));
+  }
   __attribute__((target("avx"))) static void subtract_pair(__m128d& y, __m128d product) {
     y = _mm_sub_sd(_mm_sub_sd(y, product), _mm_unpackhi_pd(product, product));
   }
@@ -294,26 +433,47 @@ void LdlChainSolve::solve(const cholmod_factor* L, const double* rhs, double* ou
   else
     std::copy(rhs, rhs + n, X);
 #ifdef TESSERA_AVX_KERNELS
-  if (avx_kernels_enabled())
-    solve_chains_avx(L, X);
-  else
+  if (avx_kernels_enabled()) {
+    if (split_dots_)
+      solve_chains_avx_split(L, X);
+    else
+      solve_chains_avx(L, X);
+  } else
 #endif
-    solve_chains<Sse2Kernels>(L, X);
+      if (split_dots_)
+    solve_chains_sse2_split(L, X);
+  else
+    solve_chains_sse2(L, X);
   if (perm)
     for (int k = 0; k < n; ++k) out[perm[k]] = X[k];
   else
     std::copy(X, X + n, out);
 }
 
+// Each kernel set's chain loop as its own function with its kernels inlined (both inlined
+// into solve(), GCC called the kernels instead).
+__attribute__((flatten)) void LdlChainSolve::solve_chains_sse2(const cholmod_factor* L,
+                                                               double* X) const {
+  solve_chains<Sse2Kernels, false>(L, X);
+}
+__attribute__((flatten)) void LdlChainSolve::solve_chains_sse2_split(const cholmod_factor* L,
+                                                                     double* X) const {
+  solve_chains<Sse2Kernels, true>(L, X);
+}
+
 #ifdef TESSERA_AVX_KERNELS
-// The chain loop compiled for AVX, so that the AVX kernels inline into it.
+// The chain loops compiled for AVX, so that the AVX kernels inline into them.
 __attribute__((target("avx"), flatten)) void LdlChainSolve::solve_chains_avx(
     const cholmod_factor* L, double* X) const {
-  solve_chains<AvxKernels>(L, X);
+  solve_chains<AvxKernels, false>(L, X);
+}
+__attribute__((target("avx"), flatten)) void LdlChainSolve::solve_chains_avx_split(
+    const cholmod_factor* L, double* X) const {
+  solve_chains<AvxKernels, true>(L, X);
 }
 #endif
 
-template <class Kernels>
+template <class Kernels, bool Split>
 inline __attribute__((always_inline)) void LdlChainSolve::solve_chains(const cholmod_factor* L,
                                                                        double* X) const {
   const auto* Lp = static_cast<const int*>(L->p);
@@ -353,7 +513,7 @@ inline __attribute__((always_inline)) void LdlChainSolve::solve_chains(const cho
   }
 
   // D L^T x = y: each column divided by its D entry first, then its dot with the rows below
-  // subtracted in the factor's row order.
+  // subtracted in the factor's row order (or, with Split, as four partial sums).
   for (const Chain& ch : backward_) {
     const int j = ch.column, w = ch.width;
     const Run* run = backward_runs_.data() + ch.run_begin;
@@ -367,11 +527,11 @@ inline __attribute__((always_inline)) void LdlChainSolve::solve_chains(const cho
     }
     const double* a[3] = {Lx + col[0] + 1, Lx + col[1] + 2, Lx + col[2] + 3};
     if (w == 3)
-      Kernels::template backward_runs<3>(y, a, X, run, end);
+      Kernels::template backward_runs<3, Split>(y, a, X, run, end);
     else if (w == 2)
-      Kernels::template backward_runs<2>(y, a, X, run, end);
+      Kernels::template backward_runs<2, Split>(y, a, X, run, end);
     else
-      Kernels::template backward_runs<1>(y, a, X, run, end);
+      Kernels::template backward_runs<1, Split>(y, a, X, run, end);
     if (w == 2) {
       y[1] -= Lx[col[1] + 1] * y[0];
     } else if (w == 3) {

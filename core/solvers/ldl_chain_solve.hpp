@@ -13,6 +13,10 @@
 // each chain's row update as one expression. build() finds the same chains (forward and
 // backward differ: their tests differ) and the solve evaluates the same expressions in the same
 // order, reading the values from the factor itself (no copy of L).
+//
+// Optionally (set_split_dots) the backward dots are summed as four partial sums instead: no
+// longer CHOLMOD's bits (the same solve up to round-off), but the sums are no longer one
+// dependency chain of subtractions, which is what limits the backward pass's speed.
 
 #include <Eigen/CholmodSupport>
 #include <vector>
@@ -25,6 +29,11 @@ class LdlChainSolve {
   /// held) for any other factor; the caller then solves with CHOLMOD. Call again after every
   /// numeric factorization (the column layout may change).
   bool build(const cholmod_factor* L);
+  /// Backward dots as four partial sums (lane l takes each run's rows k = l mod 4, summed
+  /// (l0 + l2) + (l1 + l3) at the end) instead of CHOLMOD's sequential sum. Off by default
+  /// (CHOLMOD's bits). Both kernel sets (AVX, SSE2) compute the same lanes, so the same bits.
+  void set_split_dots(bool split) { split_dots_ = split; }
+  bool split_dots() const { return split_dots_; }
   /// True when build() succeeded.
   bool ready() const { return ready_; }
   void clear();
@@ -47,14 +56,18 @@ class LdlChainSolve {
   };
   static void add_runs(const int* rows, int count, std::vector<Run>& runs);
   // The forward and backward substitutions on X (permuted order), with one kernel set.
-  template <class Kernels>
+  template <class Kernels, bool Split>
   void solve_chains(const cholmod_factor* L, double* X) const;
+  void solve_chains_sse2(const cholmod_factor* L, double* X) const;
+  void solve_chains_sse2_split(const cholmod_factor* L, double* X) const;
   void solve_chains_avx(const cholmod_factor* L, double* X) const;
+  void solve_chains_avx_split(const cholmod_factor* L, double* X) const;
 
   std::vector<Chain> forward_, backward_;
   std::vector<Run> forward_runs_, backward_runs_;
   mutable std::vector<double> y_;
   bool ready_ = false;
+  bool split_dots_ = false;
 };
 
 }  // namespace tessera

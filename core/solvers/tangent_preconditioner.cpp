@@ -226,6 +226,10 @@ int TangentPreconditioner::coordinates_per_pose() const {
   return factor_->p;
 }
 
+void TangentPreconditioner::set_split_dots(bool split) {
+  factor_->chain.set_split_dots(split);
+}
+
 bool TangentPreconditioner::factorize(const Eigen::MatrixXd& X) {
   return factorize_impl(X, nullptr);
 }

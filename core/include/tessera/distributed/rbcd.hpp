@@ -52,6 +52,11 @@ struct BlockUpdateOptions {
   /// cubicle 187 -> 166, docs/irbcd.md section 5). Q_BB-preconditioned updates keep 1: their
   /// norm is inflated by the amplified normal components.
   double tangent_radius_scale = 3.0;
+  /// The tangent factor's solves sum their backward dot products as four partial sums instead
+  /// of CHOLMOD's one sequential sum (solvers/ldl_chain_solve.hpp): the same solve up to
+  /// round-off, with shorter dependency chains (docs/irbcd.md section 8). Only the agents'
+  /// block updates use it; the centralized solver's factor keeps CHOLMOD's bits.
+  bool tangent_split_dots = true;
   /// Entries of the block's Q_BB Cholesky factor (CHOLMOD's prediction) above which the block
   /// diagonal is used instead, for the updates and the certificate's preconditioner alike
   /// (solvers/block_preconditioner.hpp; 0 = always the exact factor). The default, 16 M entries

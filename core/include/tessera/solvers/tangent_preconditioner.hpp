@@ -106,6 +106,10 @@ class TangentPreconditioner : public RiemannianPreconditioner {
   bool supernodal_factorization() const;
   /// Coordinates per pose, d(d+1)/2.
   int coordinates_per_pose() const;
+  /// The simplicial solves' backward dots as four partial sums (LdlChainSolve::set_split_dots):
+  /// fewer cycles, but no longer CHOLMOD's bits (the same operator up to round-off). Off by
+  /// default; kept across factorizations.
+  void set_split_dots(bool split);
 
   /// The basis J(X) of the tangent space at X, one column per coordinate (pose after pose,
   /// rotation then translation coordinates): for tests and diagnostics.
