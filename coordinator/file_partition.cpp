@@ -3,14 +3,12 @@
 #include <condition_variable>
 #include <exception>
 #include <mutex>
-#include <optional>
 #include <tessera/io/g2o_reader.hpp>
 #include <tessera/partition/robot_partition.hpp>
 #include <thread>
 #include <utility>
 
 #include "coordinator/partition_priority.hpp"
-#include "runtime/preloaded_graph.hpp"
 
 namespace tessera::coordinator {
 
@@ -26,15 +24,10 @@ std::optional<FilePartition> partition_graph_file(const std::string& path, std::
     std::vector<std::pair<std::size_t, std::size_t>> pairs;
     std::optional<std::vector<int>> by_robot;
     {
-      // Under tessera launch the fork server parsed this file before forking this process
-      // (runtime/preloaded_graph.hpp): the same read, so the same structure, without a second
-      // parse on the cores the agents start on. The sequential preset needs the file's keys.
-      const PoseGraph* preloaded = preset == "sequential" ? nullptr : agent::preloaded_graph(path);
-      std::optional<G2oReadResult> read;  // values dropped at the end of this scope
-      if (!preloaded) read.emplace(read_g2o_file(path));
-      const PoseGraph& graph = preloaded ? *preloaded : read->graph;
+      const G2oReadResult read = read_g2o_file(path);  // values dropped at the end of this scope
+      const PoseGraph& graph = read.graph;
       if (preset == "sequential")
-        by_robot = robot_partition(read->keys, graph.num_poses, static_cast<int>(num_agents));
+        by_robot = robot_partition(read.keys, graph.num_poses, static_cast<int>(num_agents));
       fp.num_poses = graph.num_poses;
       pairs.reserve(graph.measurements.size());
       fp.edge_i.reserve(graph.measurements.size());

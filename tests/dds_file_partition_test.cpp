@@ -22,7 +22,6 @@
 #include "coordinator/run_structure.hpp"
 #include "dds_process_support.hpp"
 #include "runtime/local_share.hpp"
-#include "runtime/preloaded_graph.hpp"
 
 namespace tessera::test::dds {
 namespace {
@@ -111,32 +110,6 @@ TEST(DdsFilePartition, AnotherStructureDoesNotFitAndAnUnreadableFileIsNoPartitio
   EXPECT_NE(why.find("missing.g2o"), std::string::npos) << why;
   coordinator::FilePartitionJob job(dir + "/missing.g2o", 4, "eco", 1);
   EXPECT_FALSE(job.take(nullptr, nullptr, nullptr));
-}
-
-// Under tessera launch the fork server parses the file before it forks the coordinator
-// (runtime/preloaded_graph.hpp): the early partition is that parse's, the file is not read again
-// (here it is replaced on disk after the parse), except by the sequential preset, which needs the
-// file's keys.
-TEST(DdsFilePartition, TheForkServersParseIsPartitionedWithoutReadingTheFileAgain) {
-  const std::string dir = temp_dir();
-  const std::string path =
-      generate_graph(dir + "/g.g2o", "--kind grid3d --poses 300 --robots 4 --seed 6");
-  const coordinator::RunStructure rs =
-      coordinator::merge_announcements(announcements_of(read_g2o(path), 4), 4, "r");
-  std::string why;
-  const auto from_file = coordinator::partition_graph_file(path, 4, "eco", 1, &why);
-  ASSERT_TRUE(from_file) << why;
-  agent::preload_graph(path);
-  generate_graph(path, "--kind grid3d --poses 300 --robots 4 --seed 7");  // other closures
-  const auto preloaded = coordinator::partition_graph_file(path, 4, "eco", 1, &why);
-  ASSERT_TRUE(preloaded) << why;
-  EXPECT_TRUE(preloaded->fits(rs));
-  EXPECT_EQ(preloaded->part.owner, from_file->part.owner);
-  const auto sequential = coordinator::partition_graph_file(path, 4, "sequential", 1, &why);
-  ASSERT_TRUE(sequential) << why;
-  EXPECT_FALSE(sequential->fits(rs));          // read from the replaced file
-  agent::preload_graph(dir + "/missing.g2o");  // keeps nothing: the slot is empty again
-  EXPECT_EQ(agent::preloaded_graph(path), nullptr);
 }
 
 // Coordinator `--graph coordinator_file` + 3 agents on `graph` (coordinator first, so the

@@ -99,27 +99,11 @@ std::string shared_agent_graph(const launch::ForkSpec& spec) {
 //   process otherwise builds when it announces its first endpoint. It is a table of type
 //   descriptions: it starts no thread and opens nothing (checked with strace; the thread
 //   count is checked again before every fork).
-// Called before the coordinator's fork when the coordinator partitions the file the agents share
-// (coordinator_reads_agents_file): it then partitions the parsed graph it inherits instead of
-// parsing the file again on its partition thread, on the cores the agents start on; otherwise
-// after the coordinator's fork, which is then on the run's critical path.
+// Called after the coordinator's fork: that one is on the run's critical path.
 void prepare_agents(const launch::ForkSpec& spec) {
   if (const std::string graph = shared_agent_graph(spec); !graph.empty())
     agent::preload_graph(graph);
   eprosima::fastrtps::types::TypeObjectFactory::get_instance();
-}
-
-// Whether the coordinator's --graph (the file it partitions while the agents start) is the file
-// every agent reads.
-bool coordinator_reads_agents_file(const launch::ForkSpec& spec) {
-  const std::string shared = shared_agent_graph(spec);
-  if (shared.empty()) return false;
-  for (const launch::ForkChild& c : spec.children)
-    if (c.role == launch::ForkRole::kCoordinator) {
-      const auto it = std::find(c.argv.begin(), c.argv.end(), "--graph");
-      return it != c.argv.end() && it + 1 != c.argv.end() && *(it + 1) == shared;
-    }
-  return false;
 }
 
 // The memory holding this process's argv strings (contiguous on Linux): what ps and pgrep -f
@@ -215,10 +199,9 @@ int main(int argc, char** argv) {
   const ArgvArea area{argv[0], static_cast<std::size_t>(argv[argc - 1] +
                                                         std::strlen(argv[argc - 1]) + 1 - argv[0])};
   const bool batch = agents_batch_at_start(spec);
-  const bool prepare_first = coordinator_reads_agents_file(spec);
   bool prepared = false;
   for (std::size_t k = 0; k < spec.children.size(); ++k) {
-    if (!prepared && (prepare_first || spec.children[k].role == launch::ForkRole::kAgent)) {
+    if (!prepared && spec.children[k].role == launch::ForkRole::kAgent) {
       prepare_agents(spec);
       prepared = true;
     }
