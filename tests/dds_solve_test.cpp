@@ -323,11 +323,31 @@ TEST(DdsLaunch, BadGraphFailsWithTheAgentsReason) {
 
 TEST(DdsLaunch, SigintStopsEveryProcess) {
   const std::string dir = temp_dir();
-  Process launch = start(
-      {bin("tessera"), "launch", "--agents", "3", "--poses", "600", "--domain", "165", "--grad-tol",
-       "1e-12", "--max-rounds", "100000", "--partition", "fast", "--timeout", "60"},
-      dir + "/launch.log");
-  // Wait until the rounds run, then interrupt.
+  Process launch = start({bin("tessera"),
+                          "launch",
+                          "--agents",
+                          "3",
+                          "--poses",
+                          "600",
+                          "--domain",
+                          "165",
+                          "--grad-tol",
+                          "1e-12",
+                          "--max-rounds",
+                          "100000",
+                          "--refine",
+                          "none",
+                          "--progress-interval",
+                          "0",
+                          "--partition",
+                          "fast",
+                          "--timeout",
+                          "60"},
+                         dir + "/launch.log");
+  // Wait until the rounds run, then interrupt. The signal must arrive before the run ends: the
+  // Newton refinement would end it a few rounds in (a quarter of a second), and with progress
+  // lines every 0.1 s the first after round 0 could be the last. Rounds alone (about a hundred)
+  // with a line every round leave the interrupt a hundred rounds to spare.
   ASSERT_TRUE(wait_for_round(launch, 2, 20)) << launch.output();
   kill(launch.pid, SIGINT);
   ASSERT_TRUE(wait_all({&launch}, 15)) << launch.output();
