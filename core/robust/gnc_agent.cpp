@@ -67,10 +67,6 @@ GncAgent::GncAgent(GncAgentInput input, const GncDistributedOptions& options, bo
 
 GncAgent::~GncAgent() = default;
 
-int GncAgent::weights_at_mu(double mu) {
-  return weights_at(mu, stage_->iterate(), exchange_->neighbours(), dropped_, weights_);
-}
-
 int GncAgent::weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours,
                          const std::vector<bool>& skip, std::vector<double>& w) const {
   int crossed = 0;

@@ -191,13 +191,34 @@ double GncAgent::kept_cost_at(const std::vector<double>& w, const Eigen::MatrixX
   return cost;
 }
 
-void GncAgent::broadcast_weights(std::uint32_t phase, double spread, int crossed, int near,
-                                 const std::vector<double>& w, double kept_cost,
+GncAgent::WeightUpdate GncAgent::weight_update(std::vector<double> w, const Eigen::MatrixXd& Y,
+                                               const Eigen::MatrixXd& neighbours,
+                                               const std::vector<bool>& skip) const {
+  WeightUpdate u;
+  const int crossed = weights_at(outer_->mu(), Y, neighbours, skip, w);
+  u.vote = {weight_spread(*terms_, w), crossed};
+  u.near = near_bound_at(skip, Y, neighbours);
+  u.zero_cut = zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, w);
+  u.kept_cost = kept_cost_at(w, Y, neighbours);
+  u.weights = std::move(w);
+  return u;
+}
+
+void GncAgent::adopt_weights(WeightUpdate u) {
+  weights_ = std::move(u.weights);
+  zero_cut_ = std::move(u.zero_cut);
+  exchange_->own_vote() = u.vote;
+  exchange_->own_near_bound() = u.near;
+  exchange_->own_kept_cost() = u.kept_cost;
+}
+
+void GncAgent::broadcast_weights(std::uint32_t phase, const WeightUpdate& u,
                                  std::vector<OutgoingMessage>& out) const {
   const auto me = static_cast<std::uint32_t>(in_.id);
   for (std::uint32_t a : other_agents(me, in_.num_agents)) {
-    RoundStatusMessage st = weights_message(a, spread, crossed, near, in_, *terms_, w,
-                                            options_.robust.exchanges_ride_along, kept_cost);
+    RoundStatusMessage st =
+        weights_message(a, u.vote.first, static_cast<int>(u.vote.second), static_cast<int>(u.near),
+                        in_, *terms_, u.weights, options_.robust.exchanges_ride_along, u.kept_cost);
     st.phase = phase;
     st.sender = me;
     out.push_back(OutgoingMessage{std::move(st), false, {a}});
@@ -232,17 +253,8 @@ void GncAgent::send_trial_weights(const Eigen::MatrixXd& Y, std::vector<Outgoing
       throw std::logic_error("GncAgent: a weighted measurement's other end is off the solve");
     out_of_reach[k] = true;
   }
-  trial_weights_ = weights_;
-  const int crossed = weights_at(outer_->mu(), Y, N, out_of_reach, trial_weights_);
-  const double spread = weight_spread(*terms_, trial_weights_);
-  const int near = near_bound_at(out_of_reach, Y, N);
-  trial_vote_ = {spread, crossed};
-  trial_near_ = near;
-  trial_zero_cut_ =
-      zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, trial_weights_);
-  trial_kept_cost_ = kept_cost_at(trial_weights_, Y, N);
-  broadcast_weights(gnc_phase(g_, GncExchange::kTrialWeights), spread, crossed, near,
-                    trial_weights_, trial_kept_cost_, out);
+  trial_update_ = weight_update(weights_, Y, N, out_of_reach);
+  broadcast_weights(gnc_phase(g_, GncExchange::kTrialWeights), trial_update_, out);
   trial_weights_sent_ = true;
 }
 
@@ -275,11 +287,7 @@ bool GncAgent::begin_trial_weights(std::vector<OutgoingMessage>& out) {
   step_ = Step::kWeights;
   exchange_->begin();
   low_weights_.clear();
-  weights_ = std::move(trial_weights_);
-  zero_cut_ = std::move(trial_zero_cut_);
-  exchange_->own_vote() = trial_vote_;
-  exchange_->own_near_bound() = trial_near_;
-  exchange_->own_kept_cost() = trial_kept_cost_;
+  adopt_weights(std::move(trial_update_));
   mail_->begin_exchange(gnc_phase(g_, GncExchange::kTrialWeights),
                         as_ints(other_agents(static_cast<std::uint32_t>(in_.id), in_.num_agents)));
   take_exchange(out);
@@ -288,15 +296,9 @@ bool GncAgent::begin_trial_weights(std::vector<OutgoingMessage>& out) {
 
 bool GncAgent::send_weights(std::uint32_t phase, std::vector<OutgoingMessage>& out) {
   low_weights_.clear();
-  const int crossed = weights_at_mu(outer_->mu());
-  const double spread = weight_spread(*terms_, weights_);
-  const int near = near_bound_at(dropped_, stage_->iterate(), exchange_->neighbours());
-  exchange_->own_vote() = {spread, crossed};
-  exchange_->own_near_bound() = near;
-  zero_cut_ =
-      zero_weight_cut(*terms_, in_.measurements, in_.owner, in_.measurement_index, weights_);
-  exchange_->own_kept_cost() = kept_cost_at(weights_, stage_->iterate(), exchange_->neighbours());
-  broadcast_weights(phase, spread, crossed, near, weights_, exchange_->own_kept_cost(), out);
+  WeightUpdate u = weight_update(weights_, stage_->iterate(), exchange_->neighbours(), dropped_);
+  broadcast_weights(phase, u, out);
+  adopt_weights(std::move(u));
   if (!gather_values_early() || values_held_) return false;
   // Beside the first weights (clean data has none), once: the values of the measurements this
   // agent weighs, to agent 0.

@@ -286,23 +286,33 @@ class GncAgent : public AgentProcess {
   // The solves from here on without the measurements `dropped` (ascending); the iterate is kept.
   void solve_without(const std::vector<std::uint64_t>& dropped);
   // The count of owned weights that crossed 1/2 (only those that fell below it with
-  // RobustOptions::mu_step_hold kFalls).
-  int weights_at_mu(double mu);
-  // The same at the iterate `Y` with its neighbours' poses (the exchange book's columns) into `w`,
-  // leaving the measurements flagged in `skip` as they are.
+  // RobustOptions::mu_step_hold kFalls), at the iterate `Y` with its neighbours' poses (the
+  // exchange book's columns) into `w`, leaving the measurements flagged in `skip` as they are.
   int weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours,
                  const std::vector<bool>& skip, std::vector<double>& w) const;
+  // One weight update at a point, with all that goes out beside it: the same for the update at
+  // the iterate and at a trial point.
+  struct WeightUpdate {
+    std::vector<double> weights;
+    std::vector<std::uint64_t> zero_cut;       // cut measurements of weight 0 (others' too)
+    std::pair<double, double> vote{0.0, 0.0};  // (spread, crossed)
+    double near = 0.0;       // near-bound count (RobustOptions::jump_band; 1 when off)
+    double kept_cost = 0.0;  // kept_cost_at
+  };
+  // The update from weights `w` at `Y` with its neighbours' poses, `skip` left as they are.
+  WeightUpdate weight_update(std::vector<double> w, const Eigen::MatrixXd& Y,
+                             const Eigen::MatrixXd& neighbours,
+                             const std::vector<bool>& skip) const;
+  // Makes `u` this agent's weights and its own entries of the exchange (its vote, near-bound
+  // count and kept cost); broadcast_weights() sends it to every other agent.
+  void adopt_weights(WeightUpdate u);
+  void broadcast_weights(std::uint32_t phase, const WeightUpdate& u,
+                         std::vector<OutgoingMessage>& out) const;
   // The weight update at the trial point `Y` the solve just handed out, sent beside its sums
   // (RobustOptions::weights_ride_trial_sums); kept aside until the solve's verdict.
   void send_trial_weights(const Eigen::MatrixXd& Y, std::vector<OutgoingMessage>& out);
-  // A weight update's near-bound count at `Y` (RobustOptions::jump_band; 1 when off) and its
-  // weights `w` with the vote, to every other agent: the same for the update at the iterate
-  // and at a trial point.
   int near_bound_at(const std::vector<bool>& skip, const Eigen::MatrixXd& Y,
                     const Eigen::MatrixXd& neighbours) const;
-  void broadcast_weights(std::uint32_t phase, double spread, int crossed, int near,
-                         const std::vector<double>& w, double kept_cost,
-                         std::vector<OutgoingMessage>& out) const;
   // After a solve that sent them: the weight exchange from the trial's weights (this agent's kept
   // aside, the others' in) when the trial was accepted; false (the messages dropped) otherwise.
   bool begin_trial_weights(std::vector<OutgoingMessage>& out);
@@ -343,14 +353,9 @@ class GncAgent : public AgentProcess {
   // that exchange ended GNC at TLS's verdict (RobustOptions::jump_band).
   std::vector<std::pair<std::uint64_t, double>> low_weights_;
   bool jumped_ = false;
-  // The weight update at the running weighted solve's trial point (send_trial_weights): the
-  // weights, the cut ones of weight 0, the spread and crossing votes, the near-bound count.
+  // The weight update at the running weighted solve's trial point (send_trial_weights).
   bool trial_weights_sent_ = false;
-  std::vector<double> trial_weights_;
-  std::vector<std::uint64_t> trial_zero_cut_;
-  std::pair<double, double> trial_vote_{0.0, 0.0};
-  double trial_near_ = 0.0;
-  double trial_kept_cost_ = 0.0;
+  WeightUpdate trial_update_;
   // The kept set's summed cost at the iterate after GNC's early end, from the last weights
   // exchange (RobustOptions::kept_vote_rides_weights): the fresh start's vote then needs no
   // exchange. Empty otherwise, and once that vote is taken.
