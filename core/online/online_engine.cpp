@@ -118,7 +118,6 @@ OnlineUpdate OnlineEngine::step(double now_s) {
   // Idle: nothing new and already converged, so no round and no message.
   if ((u.poses == 0 && u.measurements == 0 && converged_) || graph.num_poses == 0) return u;
   step_factors_before_ = blocks_ ? blocks_->tangent_factor_totals() : TangentFactorTotals{};
-  const TangentFactorTotals factors_before = step_factors_before_;
   const long long built_before = blocks_ ? blocks_->built_total() : 0;
 
   // New poses join a block (their robot's, or the one holding most of their measurements);
@@ -192,7 +191,7 @@ OnlineUpdate OnlineEngine::step(double now_s) {
     if (!refines.empty() && !newton_short) u.stop_reason = refines.back().stop_reason;
   }
   if (blocks_) {
-    const TangentFactorTotals step = blocks_->tangent_factor_totals().since(factors_before);
+    const TangentFactorTotals step = blocks_->tangent_factor_totals().since(step_factors_before_);
     u.factorizations = step.factorizations;
     u.factor_flops = step.flops;
     u.blocks_built = blocks_->built_total() - built_before;

@@ -311,6 +311,7 @@ class GncAgent : public AgentProcess {
   // The weight update at the trial point `Y` the solve just handed out, sent beside its sums
   // (RobustOptions::weights_ride_trial_sums); kept aside until the solve's verdict.
   void send_trial_weights(const Eigen::MatrixXd& Y, std::vector<OutgoingMessage>& out);
+  // The near-bound count at `Y` (RobustOptions::jump_band; 1 when off, so GNC never ends early).
   int near_bound_at(const std::vector<bool>& skip, const Eigen::MatrixXd& Y,
                     const Eigen::MatrixXd& neighbours) const;
   // After a solve that sent them: the weight exchange from the trial's weights (this agent's kept
