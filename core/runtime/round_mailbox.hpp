@@ -90,6 +90,10 @@ class Mailbox {
   /// missing senders after the receive timeout.
   std::map<std::uint32_t, ProtocolMessage> gather(std::uint32_t phase, std::uint32_t round,
                                                   const std::vector<std::uint32_t>& senders);
+  /// A gather counts as a message step (`gathers`) when this agent sent since the last one.
+  /// This makes the next gather count though it did not: a gather at one agent, where the
+  /// others' sends are the step.
+  void next_gather_is_a_step() { sent_since_gather_ = true; }
 
  private:
   static std::uint32_t phase_of(const ProtocolMessage& m) {

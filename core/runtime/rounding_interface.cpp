@@ -125,9 +125,11 @@ std::optional<double> DistributedRounding::interface_translations() {
       throw std::runtime_error("rounding: interface solution of the wrong size");
     u = Eigen::Map<const Eigen::MatrixXd>(msg->data.data() + 1, team, d);
   } else {
-    if (!one_factor_) mail_.send_all({OutgoingMessage{mine, true, {}}});
+    if (one_factor_)
+      mail_.next_gather_is_a_step();
+    else
+      mail_.send_all({OutgoingMessage{mine, true, {}}});
     auto got = mail_.gather(kInterfaceResidual, 0, others());
-    if (one_factor_) ++mail_.gathers;  // a wait for the others, though it sent nothing since
     Eigen::MatrixXd R(team, d);
     for (std::uint32_t a : everyone_) {
       const auto* msg = a == self_ ? &mine : std::get_if<PoseBlockMessage>(&got.at(a));
