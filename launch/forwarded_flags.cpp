@@ -335,9 +335,9 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "up to S; 0 = none, else > 1                          [4]",
        check_gnc_newton_mu_step_max},
       {"gnc-mu-hold", "gnc-mu-hold", true, ForwardTo::kCoordinator, "--gnc-mu-hold falls|crossings",
-       "which weights, at an update, return the bigger step\n"
-       "of mu to --gnc-mu-step: those that fell below 1/2, or\n"
-       "any that crossed 1/2                           [falls]",
+       "which weights, at an update,\n"
+       "return the bigger step of mu to --gnc-mu-step: those\n"
+       "that fell below 1/2, or any that crossed 1/2   [falls]",
        check_gnc_mu_hold},
       {"gnc-step-trust", "gnc-step-trust", true, ForwardTo::kCoordinator, "--gnc-step-trust R",
        "where GNC's weighted solves are Newton steps, weights\n"
@@ -353,16 +353,18 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        check_gnc_jump_side},
       {"gnc-probe-cut", "gnc-probe-cut", true, ForwardTo::kCoordinator,
        "--gnc-probe-cut always|after-passes|auto",
-       "whether a re-check probe may cut kept measurements\n"
-       "while the rejected set is still GNC's own (always), or\n"
-       "only once the passes changed it; auto: after the passes\n"
-       "where GNC's solves were Newton steps             [auto]",
+       "a re-check probe may cut kept\n"
+       "measurements while the rejected set is still GNC's own\n"
+       "(always), or only once the passes changed it; auto:\n"
+       "after the passes where GNC's solves were Newton steps,\n"
+       "always where they were rounds                    [auto]",
        check_gnc_probe_cut},
       {"gnc-step-sigma", "gnc-step-sigma", true, ForwardTo::kCoordinator,
        "--gnc-step-sigma every|refine-sigma",
-       "who factors the interface solves' matrix in GNC's\n"
-       "weighted Newton steps: every agent, or as\n"
-       "--refine-sigma says; the same iterates  [refine-sigma]",
+       "who factors the interface\n"
+       "solves' matrix in GNC's weighted Newton steps: every\n"
+       "agent, or as --refine-sigma says; the same iterates\n"
+       "                                          [refine-sigma]",
        check_gnc_step_sigma},
       {"known-inliers", "known-inliers", true, ForwardTo::kCoordinator,
        "--known-inliers odometry|none", "never reject edges between consecutive ids [odometry]",
@@ -405,9 +407,9 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        check_refine_sigma},
       {"tangent-dots", "tangent-dots", true, ForwardTo::kCoordinator,
        "--tangent-dots split|sequential",
-       "the tangent preconditioner's backward dot products as\n"
-       "four partial sums, or CHOLMOD's sequential sums (its\n"
-       "bits); every agent uses the same                 [split]",
+       "the tangent preconditioner's\n"
+       "backward dot products as four partial sums, or CHOLMOD's\n"
+       "sequential sums (its bits)                       [split]",
        check_tangent_dots},
       {"setup-at-once", "setup-at-once", true, ForwardTo::kCoordinator, "--setup-at-once K",
        "at most K agents in the distributed initialisation's\n"
