@@ -7,6 +7,7 @@
 
 #include "arguments.hpp"
 #include "rebalance_args.hpp"
+#include "run_wide_args.hpp"
 #include "step_coarse_args.hpp"
 #include "transport/run_identity.hpp"
 
@@ -46,7 +47,13 @@ options:
                       (distributed Newton steps from the warm start) or rounds [newton]
   --newton-after T    newton: block-coordinate rounds first, down to ||grad f|| <= T
                                                                      [none]
-%STEPCOARSE%  --certify-every S   also certify the graph received so far every S seconds (the lead's
+%STEPCOARSE%  --first-step-factors new|grown  newton: the preconditioner of a step's first Newton
+                      step: the grown blocks' new factors, or their held factors with the
+                      new poses appended, new ones built at the first accepted Newton
+                      step's point (docs/online.md)                  [new]
+  --tangent-dots split|sequential  the tangent preconditioner's backward dot products as
+                      four partial sums, or CHOLMOD's sequential sums (its bits) [split]
+  --certify-every S   also certify the graph received so far every S seconds (the lead's
                       clock; at the next epoch that brought data, once the graph is
                       connected; no staircase climb)                  [0 = off]
   --publish-every S   publish this robot's current estimate (rounded to SE(d)) on topic
@@ -56,10 +63,11 @@ options:
   --verbose           print each epoch (members, what entered, solve or idle)
   --help              this text
 
-The --step-coarse options and the re-partition's below are the same on every agent of the
-run (the coarse correction adds message steps to every agent's Newton steps; each agent moves
-the blocks itself): an agent whose options differ from the lead's stops with exit code 2
-naming the option.
+The --step-coarse options, --first-step-factors, --tangent-dots and the re-partition's below
+are the same on every agent of the run (the coarse correction adds message steps to every
+agent's Newton steps, the other two change every agent's arithmetic; each agent moves the
+blocks itself): an agent whose options differ from the lead's stops with exit code 2 naming
+the option.
 
 re-partition:
 %REBALANCE%
@@ -89,6 +97,7 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
                                   "timeout",       "json",    "certify-every", "certify-iters",
                                   "publish-every", "tum-dir", "on-agent-loss", "step-solver",
                                   "newton-after",  "lease"};
+  valued.insert({"first-step-factors", "tangent-dots"});  // cli/run_wide_args.hpp
   std::set<std::string> switches = {"online", "no-certify", "verbose", "help"};
   for (const char* const* f = cli::kRebalanceValued; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceSwitches; *f; ++f) switches.insert(*f);
@@ -138,6 +147,8 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
   o.online.newton_steps = step_solver == "newton";
   o.online.newton_after_grad_tol = args.get_double("newton-after", o.online.newton_after_grad_tol);
   cli::parse_step_coarse_options(args, o.online);
+  o.online.first_step_on_grown_factors = cli::first_step_on_grown_factors_of(args);
+  s.block_update.tangent_split_dots = cli::tangent_split_dots_of(args);
   o.online.rebalance = cli::parse_rebalance_options(args);
   o.online.validate();
   return o;

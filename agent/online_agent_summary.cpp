@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "run_wide_args.hpp"
 #include "step_coarse_args.hpp"
 
 namespace tessera::agent {
@@ -27,6 +28,8 @@ std::string online_summary_json(const OnlineAgentOptions& o, const OnlineSummary
       .add("step_coarse_min_blocks", o.online.newton_coarse_min_blocks)
       .add("step_coarse_aggregates",
            cli::step_coarse_aggregates_name(o.online.newton_coarse_aggregates))
+      .add("first_step_factors", cli::first_step_factors_name(o.online.first_step_on_grown_factors))
+      .add("tangent_dots", cli::tangent_dots_name(o.online.solver.block_update.tangent_split_dots))
       .add("epochs", static_cast<long long>(state.epochs))
       .add("solves", f.solves)
       .add("rounds", f.rounds)

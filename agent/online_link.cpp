@@ -9,6 +9,7 @@
 #include "agent/online_takeover_step.hpp"
 #include "agent/takeover_vote.hpp"
 #include "rebalance_args.hpp"
+#include "run_wide_args.hpp"
 #include "step_coarse_args.hpp"
 #include "transport/fastdds/shm_receive_watch.hpp"
 #include "transport/transport_error.hpp"
@@ -24,6 +25,8 @@ transport::OnlineTeamOptions team_options(const OnlineOptions& o) {
   t.step_coarse = o.newton_coarse;
   t.step_coarse_min_blocks = o.newton_coarse_min_blocks;
   t.step_coarse_aggregates = o.newton_coarse_aggregates;
+  t.first_step_on_grown_factors = o.first_step_on_grown_factors;
+  t.tangent_split_dots = o.solver.block_update.tangent_split_dots;
   return t;
 }
 
@@ -35,6 +38,10 @@ std::string team_disagreement(const transport::OnlineTeamOptions& mine,
     differs = cli::step_coarse_disagreement(
         mine.step_coarse, mine.step_coarse_min_blocks, mine.step_coarse_aggregates,
         theirs.step_coarse, theirs.step_coarse_min_blocks, theirs.step_coarse_aggregates, sender);
+  if (differs.empty())
+    differs = cli::run_wide_disagreement(mine.first_step_on_grown_factors, mine.tangent_split_dots,
+                                         theirs.first_step_on_grown_factors,
+                                         theirs.tangent_split_dots, sender);
   return differs;
 }
 

@@ -25,6 +25,7 @@
 #include "runtime/phase_memory.hpp"
 #include "runtime/preloaded_graph.hpp"
 #include "runtime/team_memory.hpp"
+#include "transport/assignment_options.hpp"
 #include "transport/run_failure.hpp"
 #include "transport/run_identity.hpp"
 
@@ -50,43 +51,11 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> structure_of(
   return structure;
 }
 
-RunOptions run_options_of(const wire::PartitionAssignment& asg) {
-  RunOptions ro;
-  ro.algorithm = asg.algorithm();
-  ro.initialization = asg.initialization();
-  ro.rank = asg.rank();
-  ro.max_rounds = asg.max_rounds();
-  ro.grad_norm_tolerance = asg.grad_norm_tolerance();
-  ro.relative_cost_tolerance = asg.relative_cost_tolerance();
-  ro.seed = asg.seed();
-  ro.certify = asg.certify();
-  ro.coarse_every = asg.coarse_every();
-  ro.coarse_aggregates = asg.coarse_aggregates();
-  ro.coarse_smoothing = asg.coarse_smoothing();
-  ro.refine = asg.refine();
-  ro.refine_grad_tol = asg.refine_grad_tol();
-  ro.refine_rel_tol = asg.refine_rel_tol();
-  ro.refine_sigma = asg.refine_sigma();
-  // One host's factors share one budget (runtime/team_memory.hpp).
+// The run's options as the assignment carries them (transport/assignment_options.hpp), with
+// this host's factor budget: one host's factors share one budget (runtime/team_memory.hpp).
+RunOptions host_run_options(const wire::PartitionAssignment& asg) {
+  RunOptions ro = transport::run_options_of(asg);
   ro.max_factor_entries = team_factor_cap(asg.num_agents());
-  if (!asg.robust().empty()) {
-    ro.robust.kind = parse_robust_kind(asg.robust());
-    ro.robust.inlier_threshold = asg.inlier_threshold();
-    ro.robust.inlier_quantile = asg.inlier_quantile();
-    ro.robust.max_outer_iterations = static_cast<int>(asg.gnc_max_outer());
-    ro.robust.mu_step = asg.gnc_mu_step();
-    ro.robust.inner_max_rounds = static_cast<int>(asg.gnc_inner_max_rounds());
-    ro.robust.known_inliers = parse_known_inliers(asg.known_inliers());
-    ro.robust.readmission_passes = static_cast<int>(asg.gnc_readmission_passes());
-    ro.robust.recheck_probes = static_cast<int>(asg.gnc_recheck_probes());
-    ro.robust.probe_ratio = asg.gnc_probe_ratio();
-    ro.robust.final_refine = asg.gnc_final_refine();
-    ro.robust.refine_passes = asg.gnc_pass_refine();
-    ro.robust.mu_step_max = asg.gnc_mu_step_max();
-    ro.robust.validate();
-    ro.gnc_known_start = asg.gnc_known_start();
-    ro.gnc_cluster_probes = static_cast<int>(asg.gnc_cluster_probes());
-  }
   return ro;
 }
 
@@ -173,7 +142,7 @@ RunSetup set_up_fresh_run(AgentSession& s, const AgentOptions& o, const AgentLog
   std::vector<std::uint32_t>().swap(asg.edge_i());
   std::vector<std::uint32_t>().swap(asg.edge_j());
   DdsProtocolChannel channel(s);
-  const RunOptions run_options = run_options_of(asg);
+  const RunOptions run_options = host_run_options(asg);
   SetupTurnOptions turns;
   turns.max_at_once = asg.setup_at_once();
   turns.after_local_solve = [] { launch::release_freed_heap(); };

@@ -74,32 +74,6 @@ const char* kHelp =
     "                            one rejected closure near the bound); a probe's result stays\n"
     "                            only if the TLS cost fell; distributed: every agent runs the\n"
     "                            same search, no central step; 0 = none [0]\n"
-    "  --gnc-jump-side both|beyond   robust distributed: which residuals near the bound hold\n"
-    "                            GNC's early end back: within a factor 2 of c^2 on both sides,\n"
-    "                            or only those beyond it (the passes judge the ones within it on\n"
-    "                            the kept set) [beyond]\n"
-    "  --gnc-probe-cut always|after-passes|auto   robust distributed: whether a re-check\n"
-    "                            probe may cut kept measurements while the rejected set is\n"
-    "                            still GNC's own (always), or only once the re-check passes\n"
-    "                            changed it (before that it only brings back the return band);\n"
-    "                            auto: after the passes where GNC's weighted solves were\n"
-    "                            Newton steps, always where they were rounds [auto]\n"
-    "  --gnc-newton-mu-step-max S   robust distributed: while --gnc-mu-step-max is 0, where\n"
-    "                            GNC's weighted solves are Newton steps, mu's step after an\n"
-    "                            outer step that moved no weight across 1/2 is the last one\n"
-    "                            squared, up to S; 0 = none, else > 1 [4]\n"
-    "  --gnc-step-trust R   robust distributed: where GNC's weighted solves are Newton steps,\n"
-    "                            the weights are updated at a step's point only when it was\n"
-    "                            accepted with actual/predicted decrease >= R; otherwise\n"
-    "                            the same weights are solved by rounds from the step's\n"
-    "                            start first; [0, 1], 0 = off [0.75]\n"
-    "  --gnc-mu-hold falls|crossings   robust distributed: which weights, at an update, return\n"
-    "                            the bigger step of mu to --gnc-mu-step: those that fell below\n"
-    "                            1/2 (left the inlier set), or any that crossed 1/2 [falls]\n"
-    "  --gnc-step-sigma every|refine-sigma   robust distributed: who factors the interface\n"
-    "                            solves' matrix in GNC's weighted Newton steps: every agent\n"
-    "                            (no wait for agent 0's solve), or as --refine-sigma says; the\n"
-    "                            same iterates [refine-sigma]\n"
     "  --raw-quaternions         do not normalise edge quaternions when reading\n";
 
 Initialization parse_init(const std::string& s) {
@@ -276,12 +250,6 @@ int run_solve(const Args& args) {
   for (const char* const* o = kRobustValued; *o; ++o) valued.insert(*o);
   valued.insert("precond-max-flops");
   valued.insert("gnc-cluster-probes");
-  valued.insert("gnc-jump-side");
-  valued.insert("gnc-probe-cut");
-  valued.insert("gnc-newton-mu-step-max");
-  valued.insert("gnc-step-sigma");
-  valued.insert("gnc-mu-hold");
-  valued.insert("gnc-step-trust");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
@@ -297,47 +265,7 @@ int run_solve(const Args& args) {
   launch::serial_openmp();
   if (a.has("online")) return solve_online_command(a, a.positional()[0], start);
   const std::string algorithm = a.get_or("algorithm", "centralized");
-  RobustOptions robust = parse_robust_options(a);
-  // RobustOptions::jump_band_inside; `tessera solve` only (launch's agents take the default).
-  const std::string jump_side =
-      a.get_or("gnc-jump-side", robust.jump_band_inside ? "both" : "beyond");
-  if (jump_side != "both" && jump_side != "beyond")
-    throw InputError("option --gnc-jump-side: '" + jump_side + "' is not one of both, beyond");
-  robust.jump_band_inside = jump_side == "both";
-  // RobustOptions::probe_cut; `tessera solve` only, like --gnc-jump-side.
-  try {
-    robust.probe_cut = parse_probe_cut(a.get_or("gnc-probe-cut", probe_cut_name(robust.probe_cut)));
-  } catch (const InputError& e) {
-    throw InputError(std::string("option --gnc-probe-cut: ") + e.what());
-  }
-  // RobustOptions::step_sigma_every_agent; `tessera solve` only, like --gnc-probe-cut.
-  const std::string step_sigma =
-      a.get_or("gnc-step-sigma", robust.step_sigma_every_agent ? "every" : "refine-sigma");
-  if (step_sigma != "every" && step_sigma != "refine-sigma")
-    throw InputError("option --gnc-step-sigma: '" + step_sigma +
-                     "' is not one of every, refine-sigma");
-  robust.step_sigma_every_agent = step_sigma == "every";
-  // RobustOptions::mu_step_hold; `tessera solve` only, like --gnc-probe-cut.
-  try {
-    robust.mu_step_hold =
-        parse_mu_step_hold(a.get_or("gnc-mu-hold", mu_step_hold_name(robust.mu_step_hold)));
-  } catch (const InputError& e) {
-    throw InputError(std::string("option --gnc-mu-hold: ") + e.what());
-  }
-  // RobustOptions::newton_mu_step_max; `tessera solve` only, like --gnc-probe-cut.
-  robust.newton_mu_step_max = a.get_double("gnc-newton-mu-step-max", robust.newton_mu_step_max);
-  try {
-    robust.validate();
-  } catch (const InputError& e) {
-    throw InputError(std::string("option --gnc-newton-mu-step-max: ") + e.what());
-  }
-  // RobustOptions::newton_step_trust; `tessera solve` only, like --gnc-probe-cut.
-  robust.newton_step_trust = a.get_double("gnc-step-trust", robust.newton_step_trust);
-  try {
-    robust.validate();
-  } catch (const InputError& e) {
-    throw InputError(std::string("option --gnc-step-trust: ") + e.what());
-  }
+  const RobustOptions robust = parse_robust_options(a);
   if (algorithm == "centralized")
     return solve_centralized_command(a, a.positional()[0], robust, start);
   if (algorithm == "rbcd" || algorithm == "rbcd++" || algorithm == "irbcd")

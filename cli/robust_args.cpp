@@ -19,6 +19,12 @@ const char* const kRobustValued[] = {"robust",
                                      "gnc-swap-probes",
                                      "gnc-pass-refine",
                                      "gnc-mu-step-max",
+                                     "gnc-jump-side",
+                                     "gnc-probe-cut",
+                                     "gnc-newton-mu-step-max",
+                                     "gnc-step-sigma",
+                                     "gnc-mu-hold",
+                                     "gnc-step-trust",
                                      nullptr};
 
 const char* const kRobustHelp =
@@ -70,6 +76,32 @@ const char* const kRobustHelp =
     "                            the tolerance and GNC's weighted solves hand over to Newton\n"
     "                            refinement where the team's interface fits the interface\n"
     "                            solves [auto]\n"
+    "  --gnc-jump-side both|beyond   distributed: which residuals near the bound hold\n"
+    "                            GNC's early end back: within a factor 2 of c^2 on both sides,\n"
+    "                            or only those beyond it (the passes judge the ones within it on\n"
+    "                            the kept set) [beyond]\n"
+    "  --gnc-probe-cut always|after-passes|auto   distributed: whether a re-check\n"
+    "                            probe may cut kept measurements while the rejected set is\n"
+    "                            still GNC's own (always), or only once the re-check passes\n"
+    "                            changed it (before that it only brings back the return band);\n"
+    "                            auto: after the passes where GNC's weighted solves were\n"
+    "                            Newton steps, always where they were rounds [auto]\n"
+    "  --gnc-newton-mu-step-max S   distributed: while --gnc-mu-step-max is 0, where\n"
+    "                            GNC's weighted solves are Newton steps, mu's step after an\n"
+    "                            outer step that moved no weight across 1/2 is the last one\n"
+    "                            squared, up to S; 0 = none, else > 1 [4]\n"
+    "  --gnc-step-trust R        distributed: where GNC's weighted solves are Newton steps,\n"
+    "                            the weights are updated at a step's point only when it was\n"
+    "                            accepted with actual/predicted decrease >= R; otherwise\n"
+    "                            the same weights are solved by rounds from the step's\n"
+    "                            start first; [0, 1], 0 = off [0.75]\n"
+    "  --gnc-mu-hold falls|crossings   distributed: which weights, at an update, return\n"
+    "                            the bigger step of mu to --gnc-mu-step: those that fell below\n"
+    "                            1/2 (left the inlier set), or any that crossed 1/2 [falls]\n"
+    "  --gnc-step-sigma every|refine-sigma   distributed: who factors the interface\n"
+    "                            solves' matrix in GNC's weighted Newton steps: every agent\n"
+    "                            (no wait for agent 0's solve), or as --refine-sigma says; the\n"
+    "                            same iterates [refine-sigma]\n"
     "  --known-inliers odometry|none   never reject edges between consecutive ids [odometry]\n"
     "  --rejected FILE           write the rejected edge indices (from 0 over the EDGE lines)\n";
 
@@ -104,23 +136,51 @@ RobustOptions parse_robust_options(const Arguments& args) {
   o.refine_passes = pass_refine == "auto";
   o.known_inliers =
       parse_known_inliers(args.get_or("known-inliers", known_inliers_name(o.known_inliers)));
+  // The distributed GNC's own (RobustOptions' fields of the same names); every agent of a DDS
+  // run takes them from the coordinator's assignment (transport/assignment_options.hpp).
+  const std::string jump_side =
+      args.get_or("gnc-jump-side", o.jump_band_inside ? "both" : "beyond");
+  if (jump_side != "both" && jump_side != "beyond")
+    throw InputError("option --gnc-jump-side: '" + jump_side + "' is not one of both, beyond");
+  o.jump_band_inside = jump_side == "both";
+  try {
+    o.probe_cut = parse_probe_cut(args.get_or("gnc-probe-cut", probe_cut_name(o.probe_cut)));
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-probe-cut: ") + e.what());
+  }
+  const std::string step_sigma =
+      args.get_or("gnc-step-sigma", o.step_sigma_every_agent ? "every" : "refine-sigma");
+  if (step_sigma != "every" && step_sigma != "refine-sigma")
+    throw InputError("option --gnc-step-sigma: '" + step_sigma +
+                     "' is not one of every, refine-sigma");
+  o.step_sigma_every_agent = step_sigma == "every";
+  try {
+    o.mu_step_hold =
+        parse_mu_step_hold(args.get_or("gnc-mu-hold", mu_step_hold_name(o.mu_step_hold)));
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-mu-hold: ") + e.what());
+  }
+  o.newton_mu_step_max = args.get_double("gnc-newton-mu-step-max", o.newton_mu_step_max);
+  o.newton_step_trust = args.get_double("gnc-step-trust", o.newton_step_trust);
   try {
     o.validate();
   } catch (const InputError& e) {
     // Name the flag the user typed as well as the field.
     const std::string what = e.what();
-    const char* flag = what.find("inlier_threshold") != std::string::npos   ? "--inlier-threshold"
-                       : what.find("inlier_quantile") != std::string::npos  ? "--inlier-quantile"
-                       : what.find("max_outer") != std::string::npos        ? "--gnc-max-outer"
-                       : what.find("mu_step_max") != std::string::npos      ? "--gnc-mu-step-max"
-                       : what.find("mu_step") != std::string::npos          ? "--gnc-mu-step"
-                       : what.find("inner_max_rounds") != std::string::npos ? "--gnc-inner-rounds"
-                       : what.find("inner_max_iterations") != std::string::npos
-                           ? "--gnc-inner-iterations"
-                       : what.find("recheck_probes") != std::string::npos ? "--gnc-probes"
-                       : what.find("swap_probes") != std::string::npos    ? "--gnc-swap-probes"
-                       : what.find("probe_ratio") != std::string::npos    ? "--gnc-probe-ratio"
-                                                                          : "--robust";
+    const char* flag =
+        what.find("inlier_threshold") != std::string::npos       ? "--inlier-threshold"
+        : what.find("inlier_quantile") != std::string::npos      ? "--inlier-quantile"
+        : what.find("max_outer") != std::string::npos            ? "--gnc-max-outer"
+        : what.find("newton_mu_step_max") != std::string::npos   ? "--gnc-newton-mu-step-max"
+        : what.find("newton_step_trust") != std::string::npos    ? "--gnc-step-trust"
+        : what.find("mu_step_max") != std::string::npos          ? "--gnc-mu-step-max"
+        : what.find("mu_step") != std::string::npos              ? "--gnc-mu-step"
+        : what.find("inner_max_rounds") != std::string::npos     ? "--gnc-inner-rounds"
+        : what.find("inner_max_iterations") != std::string::npos ? "--gnc-inner-iterations"
+        : what.find("recheck_probes") != std::string::npos       ? "--gnc-probes"
+        : what.find("swap_probes") != std::string::npos          ? "--gnc-swap-probes"
+        : what.find("probe_ratio") != std::string::npos          ? "--gnc-probe-ratio"
+                                                                 : "--robust";
     throw InputError("option " + std::string(flag) + ": " + what);
   }
   if (o.kind == RobustKind::kNone && args.has("rejected"))

@@ -20,6 +20,7 @@
 #include "json_writer.hpp"
 #include "partition_file.hpp"
 #include "robust_args.hpp"
+#include "run_wide_args.hpp"
 #include "solve_output.hpp"
 #include "solver_graph.hpp"
 #include "step_coarse_args.hpp"
@@ -280,13 +281,6 @@ PartitionResult given_partition(const PoseGraph& graph, const std::string& path,
 
 }  // namespace
 
-bool parse_tangent_split_dots(const Arguments& a) {
-  const std::string dots = a.get_or("tangent-dots", "split");
-  if (dots != "split" && dots != "sequential")
-    throw InputError("option --tangent-dots: '" + dots + "' is not one of split, sequential");
-  return dots == "split";
-}
-
 int solve_distributed_command(const Arguments& a, const std::string& graph_path,
                               const RobustOptions& robust,
                               std::chrono::steady_clock::time_point start) {
@@ -329,7 +323,7 @@ int solve_distributed_command(const Arguments& a, const std::string& graph_path,
       static_cast<int>(a.get_long("tangent-refresh", opt.block_update.tangent_refresh_interval));
   opt.block_update.tangent_radius_scale =
       a.get_double("tangent-radius", opt.block_update.tangent_radius_scale);
-  opt.block_update.tangent_split_dots = parse_tangent_split_dots(a);
+  opt.block_update.tangent_split_dots = tangent_split_dots_of(a);
   opt.block_update.max_attempts =
       std::max(opt.block_update.max_attempts, opt.block_update.trust_region_steps);
   if (a.has("restart-c")) {

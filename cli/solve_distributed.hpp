@@ -16,9 +16,6 @@ extern const char* const kDistributedSwitches[];
 /// The help text of the distributed algorithms (appended to solve --help).
 extern const char* kDistributedHelp;
 
-/// --tangent-dots split|sequential (BlockUpdateOptions::tangent_split_dots; default split).
-bool parse_tangent_split_dots(const Arguments& args);
-
 /// With robust.kind = kGncTls the solve is GNC-TLS around the distributed solver
 /// (robust/gnc_distributed.hpp) and the summary gets the robust fields.
 int solve_distributed_command(const Arguments& args, const std::string& graph_path,

@@ -21,6 +21,7 @@
 #include "online_baseline.hpp"
 #include "rebalance_args.hpp"
 #include "robot_files.hpp"
+#include "run_wide_args.hpp"
 #include "runtime/replay_input.hpp"
 #include "solve_distributed.hpp"
 #include "step_coarse_args.hpp"
@@ -207,16 +208,10 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.certify_every_s = a.get_double("certify-every", 0.0);
   options.step_every_s = a.get_double("step-every", 0.0);
   options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
-  {
-    const std::string first =
-        a.get_or("first-step-factors", options.first_step_on_grown_factors ? "grown" : "new");
-    if (first != "new" && first != "grown")
-      throw InputError("option --first-step-factors: '" + first + "' is not one of new, grown");
-    options.first_step_on_grown_factors = first == "grown";
-  }
+  options.first_step_on_grown_factors = first_step_on_grown_factors_of(a);
   options.rebalance = parse_rebalance_options(a);
   options.solver.threads = static_cast<int>(a.get_long("threads", options.solver.threads));
-  options.solver.block_update.tangent_split_dots = parse_tangent_split_dots(a);
+  options.solver.block_update.tangent_split_dots = tangent_split_dots_of(a);
   options.solver.local_rounds.enabled = !a.has("no-local-rounds");
   options.solver.local_rounds.threshold =
       a.get_double("local-threshold", options.solver.local_rounds.threshold);

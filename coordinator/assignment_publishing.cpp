@@ -3,11 +3,42 @@
 #include <string>
 #include <tessera/robust/robust_options.hpp>
 
+#include "transport/assignment_options.hpp"
 #include "transport/run_failure.hpp"
 
 namespace tessera::coordinator {
 
 using namespace tessera::transport;
+
+namespace {
+
+// What every agent runs, as the command line says (transport/assignment_options.hpp carries
+// it).
+agent::RunOptions agents_run_options(const CoordinatorOptions& o) {
+  agent::RunOptions ro;
+  ro.algorithm = o.algorithm;
+  ro.initialization = o.init;
+  ro.rank = o.rank;
+  ro.max_rounds = o.max_rounds;
+  ro.grad_norm_tolerance = o.grad_tol;
+  ro.relative_cost_tolerance = o.rel_cost_tol;
+  ro.seed = o.seed;
+  ro.certify = false;  // publish_assignment sets it
+  ro.coarse_every = o.coarse_every;
+  ro.coarse_aggregates = o.coarse_aggregates;
+  ro.coarse_smoothing = o.coarse_smoothing;
+  ro.refine = o.refine;
+  ro.refine_grad_tol = o.refine_grad_tol;
+  ro.refine_rel_tol = o.refine_rel_tol;
+  ro.refine_sigma = o.refine_sigma;
+  ro.tangent_split_dots = o.tangent_split_dots;
+  ro.robust = o.robust;
+  ro.gnc_known_start = o.gnc_known_start;
+  ro.gnc_cluster_probes = static_cast<int>(o.gnc_cluster_probes);
+  return ro;
+}
+
+}  // namespace
 
 wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
                                           const RunStructure& structure,
@@ -17,48 +48,17 @@ wire::PartitionAssignment make_assignment(const CoordinatorOptions& options,
   asg.num_agents(options.agents);
   asg.num_poses(static_cast<std::uint32_t>(structure.num_poses));
   asg.dim(static_cast<std::uint32_t>(structure.d));
-  asg.rank(options.rank);
   asg.owner(part.owner);
   asg.edge_i(structure.edge_i);
   asg.edge_j(structure.edge_j);
-  asg.algorithm(options.algorithm);
-  asg.initialization(options.init);
-  asg.max_rounds(options.max_rounds);
-  asg.grad_norm_tolerance(options.grad_tol);
-  asg.relative_cost_tolerance(options.rel_cost_tol);
-  asg.seed(options.seed);
+  write_run_options(agents_run_options(options), asg);
   asg.partition_ms(part.ms);
   asg.rejoin_timeout_s(options.rejoin_timeout_s);
   asg.replicas(options.replicas);
   asg.status_relay(options.status_relay);
   asg.replica_every(options.replica_every);
-  asg.coarse_every(options.coarse_every);
-  asg.coarse_aggregates(options.coarse_aggregates);
-  asg.coarse_smoothing(options.coarse_smoothing);
-  asg.refine(options.refine);
-  asg.refine_grad_tol(options.refine_grad_tol);
-  asg.refine_rel_tol(options.refine_rel_tol);
-  asg.refine_sigma(options.refine_sigma);
   asg.setup_at_once(options.setup_at_once);
-  if (options.robust.kind != RobustKind::kNone) {
-    const RobustOptions& r = options.robust;
-    asg.robust(robust_kind_name(r.kind));
-    asg.inlier_threshold(r.inlier_threshold);
-    asg.inlier_quantile(r.inlier_quantile);
-    asg.gnc_max_outer(static_cast<std::uint32_t>(r.max_outer_iterations));
-    asg.gnc_mu_step(r.mu_step);
-    asg.gnc_inner_max_rounds(static_cast<std::uint32_t>(r.inner_max_rounds));
-    asg.known_inliers(known_inliers_name(r.known_inliers));
-    asg.gnc_known_start(options.gnc_known_start);
-    asg.gnc_readmission_passes(static_cast<std::uint32_t>(r.readmission_passes));
-    asg.gnc_recheck_probes(static_cast<std::uint32_t>(r.recheck_probes));
-    asg.gnc_probe_ratio(r.probe_ratio);
-    asg.gnc_final_refine(r.final_refine);
-    asg.gnc_cluster_probes(options.gnc_cluster_probes);
-    asg.gnc_pass_refine(r.refine_passes);
-    asg.gnc_mu_step_max(r.mu_step_max);
-    asg.known_inlier(structure.known_inlier);
-  }
+  if (options.robust.kind != RobustKind::kNone) asg.known_inlier(structure.known_inlier);
   return asg;
 }
 

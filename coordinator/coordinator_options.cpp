@@ -8,6 +8,7 @@
 
 #include "arguments.hpp"
 #include "robust_args.hpp"
+#include "run_wide_args.hpp"
 #include "runtime/setup_turns.hpp"
 
 namespace tessera::coordinator {
@@ -90,6 +91,9 @@ options:
                        matrix and sends its factor (one), every agent factors it (every),
                        or agent 0 alone factors it and sends each agent its part of every
                        solve (solve; default)
+  --tangent-dots split|sequential  the tangent preconditioner's backward dot products as
+                       four partial sums, or CHOLMOD's sequential sums (its bits), in every
+                       agent (default split)
   --setup-at-once K    at most K agents run the distributed initialisation's local chordal
                        solve at once (agent a after agent a - K): those factorizations are
                        the set-up's memory peak; 0 = all at once (default 8)
@@ -102,7 +106,9 @@ options:
   --inlier-threshold C, --inlier-quantile P, --gnc-max-outer K, --gnc-mu-step S,
   --gnc-inner-rounds K, --known-inliers odometry|none, --gnc-probes K,
   --gnc-probe-ratio R, --gnc-final-refine newton|none, --gnc-cluster-probes K,
-  --gnc-pass-refine auto|none, --gnc-mu-step-max S
+  --gnc-pass-refine auto|none, --gnc-mu-step-max S, --gnc-newton-mu-step-max S,
+  --gnc-mu-hold falls|crossings, --gnc-step-trust R, --gnc-jump-side both|beyond,
+  --gnc-probe-cut always|after-passes|auto, --gnc-step-sigma every|refine-sigma
                        the GNC options, as for `tessera solve` (docs/robust.md)
   --gnc-inner-iterations K, --gnc-swap-probes K
                        accepted for `tessera solve`'s option set; they are the centralized
@@ -158,7 +164,8 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
                                                             "refine-sigma",
                                                             "setup-at-once",
                                                             "reference-cost",
-                                                            "gnc-cluster-probes"},
+                                                            "gnc-cluster-probes",
+                                                            "tangent-dots"},
                                                            cli::SessionArgsFor::kProcess);
   valued.insert("graph");
   for (const char* const* r = cli::kRobustValued; *r; ++r) valued.insert(*r);
@@ -254,6 +261,7 @@ CoordinatorOptions parse_coordinator_options(const std::vector<std::string>& arg
   if (args.has("status-relay") && args.has("no-status-relay"))
     throw InputError("options --status-relay and --no-status-relay exclude each other");
   a.status_relay = !args.has("no-status-relay");
+  a.tangent_split_dots = cli::tangent_split_dots_of(args);
   a.robust = cli::parse_robust_options(args);
   a.gnc_known_start = !args.has("gnc-solver-start");
   a.gnc_cluster_probes = static_cast<std::uint32_t>(nonneg("gnc-cluster-probes", 0));

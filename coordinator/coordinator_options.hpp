@@ -64,8 +64,10 @@ struct CoordinatorOptions {
   /// (--setup-at-once; core/runtime/setup_turns.hpp): their factorizations are the set-up's
   /// memory peak, and on a few cores they share the CPU anyway. 0 = all at once.
   std::uint32_t setup_at_once = 8;
-  /// Robust solve (--robust, --inlier-threshold, --inlier-quantile, --gnc-max-outer,
-  /// --gnc-mu-step, --gnc-inner-rounds, --known-inliers; docs/robust.md).
+  /// BlockUpdateOptions::tangent_split_dots of every agent (--tangent-dots split|sequential).
+  bool tangent_split_dots = true;
+  /// Robust solve (--robust and the GNC options of cli::kRobustValued, parsed as `tessera
+  /// solve` parses them; docs/robust.md).
   RobustOptions robust;
   /// GNC starts from the known inliers (off when --init is given, like `tessera solve`).
   bool gnc_known_start = true;

@@ -10,6 +10,8 @@
 #include <tessera/robust/robust_options.hpp>
 #include <tessera/util/input_error.hpp>
 
+#include "cli/run_wide_args.hpp"
+
 namespace tessera::launch {
 
 namespace {
@@ -197,6 +199,39 @@ void check_gnc_cluster_probes(const std::string& v) {
     throw InputError("option --gnc-cluster-probes: GncDistributedOptions.cluster_probes = " + v +
                      ": must be an integer >= 0 (0 = none)");
 }
+void check_gnc_newton_mu_step_max(const std::string& v) {
+  check_robust_field(v, "gnc-newton-mu-step-max",
+                     [](RobustOptions& o, double x) { o.newton_mu_step_max = x; });
+}
+void check_gnc_step_trust(const std::string& v) {
+  check_robust_field(v, "gnc-step-trust",
+                     [](RobustOptions& o, double x) { o.newton_step_trust = x; });
+}
+void check_gnc_mu_hold(const std::string& v) {
+  try {
+    parse_mu_step_hold(v);
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-mu-hold: ") + e.what());
+  }
+}
+void check_gnc_probe_cut(const std::string& v) {
+  try {
+    parse_probe_cut(v);
+  } catch (const InputError& e) {
+    throw InputError(std::string("option --gnc-probe-cut: ") + e.what());
+  }
+}
+void check_gnc_jump_side(const std::string& v) {
+  if (v != "both" && v != "beyond")
+    throw InputError("option --gnc-jump-side: '" + v + "' is not one of both, beyond");
+}
+void check_gnc_step_sigma(const std::string& v) {
+  if (v != "every" && v != "refine-sigma")
+    throw InputError("option --gnc-step-sigma: '" + v + "' is not one of every, refine-sigma");
+}
+void check_tangent_dots(const std::string& v) {
+  cli::parse_tangent_dots(v);
+}
 void check_gnc_pass_refine(const std::string& v) {
   if (v != "auto" && v != "none")
     throw InputError("option --gnc-pass-refine: '" + v + "' is not one of auto, none");
@@ -292,6 +327,45 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "Newton refinement where the team's interface fits\n"
        "the interface solves                              [auto]",
        check_gnc_pass_refine},
+      {"gnc-newton-mu-step-max", "gnc-newton-mu-step-max", true, ForwardTo::kCoordinator,
+       "--gnc-newton-mu-step-max S",
+       "while --gnc-mu-step-max is 0, where GNC's weighted\n"
+       "solves are Newton steps, mu's step after an outer step\n"
+       "that moved no weight across 1/2 is the last one squared,\n"
+       "up to S; 0 = none, else > 1                          [4]",
+       check_gnc_newton_mu_step_max},
+      {"gnc-mu-hold", "gnc-mu-hold", true, ForwardTo::kCoordinator, "--gnc-mu-hold falls|crossings",
+       "which weights, at an update,\n"
+       "return the bigger step of mu to --gnc-mu-step: those\n"
+       "that fell below 1/2, or any that crossed 1/2   [falls]",
+       check_gnc_mu_hold},
+      {"gnc-step-trust", "gnc-step-trust", true, ForwardTo::kCoordinator, "--gnc-step-trust R",
+       "where GNC's weighted solves are Newton steps, weights\n"
+       "are updated at a step's point only when it was accepted\n"
+       "with actual/predicted decrease >= R, else the same\n"
+       "weights are solved by rounds first; [0, 1], 0 = off [0.75]",
+       check_gnc_step_trust},
+      {"gnc-jump-side", "gnc-jump-side", true, ForwardTo::kCoordinator,
+       "--gnc-jump-side both|beyond",
+       "which residuals near the bound hold GNC's early end\n"
+       "back: within a factor 2 of c^2 on both sides, or only\n"
+       "those beyond it                               [beyond]",
+       check_gnc_jump_side},
+      {"gnc-probe-cut", "gnc-probe-cut", true, ForwardTo::kCoordinator,
+       "--gnc-probe-cut always|after-passes|auto",
+       "a re-check probe may cut kept\n"
+       "measurements while the rejected set is still GNC's own\n"
+       "(always), or only once the passes changed it; auto:\n"
+       "after the passes where GNC's solves were Newton steps,\n"
+       "always where they were rounds                    [auto]",
+       check_gnc_probe_cut},
+      {"gnc-step-sigma", "gnc-step-sigma", true, ForwardTo::kCoordinator,
+       "--gnc-step-sigma every|refine-sigma",
+       "who factors the interface\n"
+       "solves' matrix in GNC's weighted Newton steps: every\n"
+       "agent, or as --refine-sigma says; the same iterates\n"
+       "                                          [refine-sigma]",
+       check_gnc_step_sigma},
       {"known-inliers", "known-inliers", true, ForwardTo::kCoordinator,
        "--known-inliers odometry|none", "never reject edges between consecutive ids [odometry]",
        check_known_inliers},
@@ -331,6 +405,12 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "alone factors it and sends each agent its part of\n"
        "every solve (solve); the same iterates         [solve]",
        check_refine_sigma},
+      {"tangent-dots", "tangent-dots", true, ForwardTo::kCoordinator,
+       "--tangent-dots split|sequential",
+       "the tangent preconditioner's\n"
+       "backward dot products as four partial sums, or CHOLMOD's\n"
+       "sequential sums (its bits)                       [split]",
+       check_tangent_dots},
       {"setup-at-once", "setup-at-once", true, ForwardTo::kCoordinator, "--setup-at-once K",
        "at most K agents in the distributed initialisation's\n"
        "local chordal solve at once (the set-up's memory peak);\n"

@@ -10,6 +10,7 @@
 #include "cli/arguments.hpp"
 #include "cli/robot_files.hpp"
 #include "launch/forwarded_flags.hpp"
+#include "launch/solve_only_flags.hpp"
 #include "transport/security.hpp"
 
 namespace tessera::launch {
@@ -116,6 +117,7 @@ void LaunchOptions::validate() const {
 }
 
 LaunchOptions parse_launch_options(const std::vector<std::string>& argv) {
+  refuse_solve_only_flags(argv, solve_only_flags());
   std::set<std::string> valued = {"agents",   "algorithm",  "partition", "init",
                                   "grad-tol", "max-rounds", "rank",      "seed",
                                   "json",     "timeout",    "poses",     "keep-logs"};

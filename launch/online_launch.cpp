@@ -21,7 +21,9 @@
 #include "arguments.hpp"
 #include "launch/launch.hpp"
 #include "launch/launch_loss_policy.hpp"
+#include "launch/solve_only_flags.hpp"
 #include "rebalance_args.hpp"
+#include "run_wide_args.hpp"
 #include "step_coarse_args.hpp"
 #include "transport/run_identity.hpp"
 
@@ -48,6 +50,7 @@ new, and certify the estimate after every robot's last batch.
   --algorithm A       rbcd, rbcd++ or irbcd                          [irbcd]
   --rank R            lifted rank                                    [5]
   --grad-tol G        gradient-norm tolerance of every solve         [0.01]
+  --max-rounds K      rounds per solve at most                       [10000]
   --no-certify        no certificate at the end
   --timeout S         an agent gives up when a peer is silent S seconds [120]
   --lease S           the agents' DDS participant lease: a member silent S seconds is lost
@@ -58,7 +61,12 @@ new, and certify the estimate after every robot's last batch.
   --certify-every S   also certify the graph received so far every S seconds
   --step-solver S     newton or rounds: how the agents solve a grown graph [newton]
   --newton-after T    newton: rounds first, down to ||grad f|| <= T  [none]
-%STEPCOARSE%  --publish-every S   each agent publishes its robot's estimate every S seconds
+%STEPCOARSE%  --first-step-factors new|grown  newton: the preconditioner of a step's first Newton
+                      step: the grown blocks' new factors, or their held factors with the
+                      new poses appended (docs/online.md)            [new]
+  --tangent-dots split|sequential  the tangent preconditioner's backward dot products as
+                      four partial sums, or CHOLMOD's sequential sums (its bits) [split]
+  --publish-every S   each agent publishes its robot's estimate every S seconds
                       (topic tessera_online_estimate)
   --tum-dir DIR       per-robot TUM snapshots DIR/robot<r>.tum, rewritten at every
                       publication and at the end
@@ -66,9 +74,11 @@ new, and certify the estimate after every robot's last batch.
                       updates, final answer) and every agent's traffic under "agents"
   --keep-logs DIR     keep the processes' logs and summaries in DIR
 
-The --step-coarse options and the re-partition's below are passed to every agent (the coarse
-correction adds message steps to every agent's Newton steps; each agent moves the blocks
-itself), so all use the same.
+The --step-coarse options, --first-step-factors, --tangent-dots and the re-partition's below
+are passed to every agent (the coarse correction adds message steps to every agent's Newton
+steps, the other two change every agent's arithmetic; each agent moves the blocks itself), so
+all use the same. Options of tessera solve --online that a run over DDS cannot use (its
+in-process evaluation: --checkpoints, --baseline...) are refused, naming the reason.
 
 re-partition:
 )";
@@ -134,10 +144,14 @@ int run_online_launch(const std::vector<std::string>& argv) {
       return 0;
     }
   // Launch's options that every agent gets as they are.
-  static const char* const kForwarded[] = {
-      "algorithm",     "rank",          "grad-tol", "timeout",       "certify-every",
-      "certify-iters", "publish-every", "tum-dir",  "on-agent-loss", "step-solver",
-      "newton-after",  "lease",         nullptr};
+  static const char* const kForwarded[] = {"algorithm",     "rank",
+                                           "grad-tol",      "timeout",
+                                           "certify-every", "certify-iters",
+                                           "publish-every", "tum-dir",
+                                           "on-agent-loss", "step-solver",
+                                           "newton-after",  "lease",
+                                           "max-rounds",    "first-step-factors",
+                                           "tangent-dots",  nullptr};
   std::set<std::string> valued = {"agents", "rate",   "speedup", "start",
                                   "run-id", "domain", "json",    "keep-logs"};
   std::set<std::string> switches = {"online", "no-certify"};
@@ -145,6 +159,7 @@ int run_online_launch(const std::vector<std::string>& argv) {
   for (const char* const* f = cli::kRebalanceValued; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceSwitches; *f; ++f) switches.insert(*f);
   for (const char* const* f = cli::kStepCoarseValued; *f; ++f) valued.insert(*f);
+  refuse_solve_only_flags(argv, online_solve_only_flags());
   const cli::Arguments args(argv, valued, switches);
   if (args.positional().size() != 1)
     throw InputError("launch --online: expected one GRAPH argument (see --online --help)");
@@ -173,6 +188,10 @@ int run_online_launch(const std::vector<std::string>& argv) {
     throw InputError("option --domain: must be 0.." + std::to_string(transport::kMaxDomain));
   // Checked here: a bad value is named before any start.
   cli::parse_rebalance_options(args);
+  cli::first_step_on_grown_factors_of(args);
+  cli::tangent_split_dots_of(args);
+  if (args.has("max-rounds") && args.get_long("max-rounds", 0) < 1)
+    throw InputError("option --max-rounds: must be >= 1");
   OnlineOptions step_coarse;
   cli::parse_step_coarse_options(args, step_coarse);
 

@@ -16,6 +16,7 @@
 
 #include "launch/forwarded_flags.hpp"
 #include "launch/launch_argv.hpp"
+#include "launch/solve_only_flags.hpp"
 #include "test_support.hpp"
 
 namespace tessera::launch {
@@ -90,11 +91,24 @@ TEST(LaunchOptions, AgentZeroSolvesTheChordalStartEarlyOnlyFromTheForkServersWho
 TEST(LaunchOptions, EveryForwardedFlagIsAcceptedAndListedInTheHelp) {
   const std::string help = launch_help();
   // A valid value of each flag: "1" unless that is out of the flag's range.
-  const std::map<std::string, std::string> value = {
-      {"robust", "gnc-tls"},      {"known-inliers", "odometry"}, {"gnc-mu-step", "1.4"},
-      {"inlier-quantile", "0.5"}, {"refine", "newton"},          {"coarse-space", "smoothed"},
-      {"gnc-probe-ratio", "5"},   {"gnc-final-refine", "none"},  {"gnc-pass-refine", "auto"},
-      {"gnc-mu-step-max", "2"},   {"refine-sigma", "one"},       {"partition-nice", "-5"}};
+  const std::map<std::string, std::string> value = {{"robust", "gnc-tls"},
+                                                    {"known-inliers", "odometry"},
+                                                    {"gnc-mu-step", "1.4"},
+                                                    {"inlier-quantile", "0.5"},
+                                                    {"refine", "newton"},
+                                                    {"coarse-space", "smoothed"},
+                                                    {"gnc-probe-ratio", "5"},
+                                                    {"gnc-final-refine", "none"},
+                                                    {"gnc-pass-refine", "auto"},
+                                                    {"gnc-mu-step-max", "2"},
+                                                    {"refine-sigma", "one"},
+                                                    {"partition-nice", "-5"},
+                                                    {"gnc-newton-mu-step-max", "4"},
+                                                    {"gnc-mu-hold", "crossings"},
+                                                    {"gnc-jump-side", "both"},
+                                                    {"gnc-probe-cut", "always"},
+                                                    {"gnc-step-sigma", "every"},
+                                                    {"tangent-dots", "sequential"}};
   for (const ForwardedFlag& f : forwarded_flags()) {
     EXPECT_NE(help.find(std::string("--") + f.name), std::string::npos) << f.name;
     Argv argv = {std::string("--") + f.name};
@@ -257,6 +271,59 @@ TEST(LaunchOptions, RefineSigmaReachesTheCoordinatorAndABadValueNamesTheFlag) {
   EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--refine-sigma"));  // the assignment carries it
   const std::string e = error_of({"--refine-sigma", "all"});
   EXPECT_NE(e.find("--refine-sigma"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace tessera::launch
+
+namespace tessera::launch {
+namespace {
+
+// The options that were `tessera solve`'s only: launch passes them to the coordinator, which
+// puts them in the assignment (transport/assignment_options.hpp), so no agent gets them on its
+// command line; bad values are named before any process starts.
+TEST(LaunchOptions, SolveOnlyGncAndTangentFlagsReachTheCoordinatorAndNameBadValues) {
+  const std::vector<std::pair<std::string, std::string>> flags = {
+      {"gnc-mu-hold", "crossings"},  {"gnc-step-trust", "0.5"},   {"gnc-newton-mu-step-max", "9"},
+      {"gnc-jump-side", "both"},     {"gnc-probe-cut", "always"}, {"gnc-step-sigma", "every"},
+      {"tangent-dots", "sequential"}};
+  Argv argv = {"--robust", "gnc-tls"};
+  for (const auto& [flag, value] : flags) argv.insert(argv.end(), {"--" + flag, value});
+  LaunchOptions o = parse_launch_options(argv);
+  o.graph = "/data/graph.g2o";
+  const Argv coordinator = coordinator_argv(o, paths());
+  for (const auto& [flag, value] : flags) {
+    EXPECT_TRUE(has_pair(coordinator, "--" + flag, value)) << flag;
+    EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--" + flag)) << flag;
+  }
+  const std::map<std::string, std::string> bad = {
+      {"gnc-mu-hold", "rises"},    {"gnc-step-trust", "1.5"},  {"gnc-newton-mu-step-max", "1"},
+      {"gnc-jump-side", "inside"}, {"gnc-probe-cut", "never"}, {"gnc-step-sigma", "one"},
+      {"tangent-dots", "parallel"}};
+  for (const auto& [flag, value] : bad) {
+    const std::string e = error_of({"--" + flag, value});
+    EXPECT_NE(e.find("--" + flag), std::string::npos) << flag << ": " << e;
+  }
+}
+
+// A `tessera solve` option that cannot reach the agent processes is refused by name, with the
+// reason, instead of as an unknown option.
+TEST(LaunchOptions, SolveOnlyFlagsAreRefusedWithTheirReason) {
+  const std::string select = error_of({"--agents", "3", "--select", "uniform"});
+  EXPECT_NE(select.find("--select is an option of `tessera solve` only"), std::string::npos)
+      << select;
+  EXPECT_NE(select.find("assignment does not carry it"), std::string::npos) << select;
+  const std::string reference = error_of({"--reference"});
+  EXPECT_NE(reference.find("--reference-cost"), std::string::npos) << reference;
+  const std::string stop = error_of({"--stop=gradient"});
+  EXPECT_NE(stop.find("centralized"), std::string::npos) << stop;
+  EXPECT_NE(error_of({"--sequential"}).find("--sequential is an option"), std::string::npos);
+  // No row names a flag launch takes.
+  const std::string help = launch_help();
+  for (const SolveOnlyFlag& f : solve_only_flags()) {
+    EXPECT_EQ(find_forwarded_flag(f.name), nullptr) << f.name;
+    EXPECT_EQ(help.find(std::string("  --") + f.name + " "), std::string::npos) << f.name;
+  }
 }
 
 }  // namespace

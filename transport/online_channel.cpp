@@ -258,6 +258,8 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       r.team.step_coarse = coarse_of_wire(w.step_coarse().coarse());
       r.team.step_coarse_min_blocks = static_cast<int>(w.step_coarse().min_blocks());
       r.team.step_coarse_aggregates = static_cast<int>(w.step_coarse().aggregates());
+      r.team.first_step_on_grown_factors = w.first_step_grown_factors();
+      r.team.tangent_split_dots = !w.tangent_sequential_dots();
       reports.push_back(std::move(r));
     }
   }
@@ -322,6 +324,8 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   w.step_coarse().coarse(wire_of_coarse(impl_->team.step_coarse));
   w.step_coarse().min_blocks(static_cast<std::uint32_t>(impl_->team.step_coarse_min_blocks));
   w.step_coarse().aggregates(static_cast<std::uint32_t>(impl_->team.step_coarse_aggregates));
+  w.first_step_grown_factors(impl_->team.first_step_on_grown_factors);
+  w.tangent_sequential_dots(!impl_->team.tangent_split_dots);
   if (!write_patiently(impl_->report_writer, w))
     throw std::runtime_error("online channel: a report write failed");
   return serialized_size(w);

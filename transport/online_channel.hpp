@@ -33,6 +33,10 @@ struct OnlineTeamOptions {
   NewtonRefineOptions::Coarse step_coarse = NewtonRefineOptions::Coarse::kNone;
   int step_coarse_min_blocks = 3;
   int step_coarse_aggregates = 8;
+  /// OnlineOptions::first_step_on_grown_factors and BlockUpdateOptions::tangent_split_dots of
+  /// OnlineOptions::solver (their defaults here too).
+  bool first_step_on_grown_factors = false;
+  bool tangent_split_dots = true;
 };
 
 struct OnlineReportSample {

@@ -72,6 +72,7 @@ std::string encode_checkpoint(const std::string& run_id, const AgentLocalData& l
   w.f64(o.refine_grad_tol);
   w.f64(o.refine_rel_tol);
   w.string(o.refine_sigma);
+  w.u32(o.tangent_split_dots ? 1 : 0);  // the dot products' bits, as the others'
   w.u64(snapshots.size());
   for (const auto& s : snapshots) encode(w, s);
   return w.bytes();
@@ -132,6 +133,7 @@ AgentCheckpoint decode_checkpoint(const std::string& payload, const std::string&
     o.refine_grad_tol = r.f64("refine grad tolerance");
     o.refine_rel_tol = r.f64("refine relative tolerance");
     o.refine_sigma = r.string("refine sigma");
+    o.tangent_split_dots = r.u32("tangent split dots") != 0;
     const std::uint64_t n = r.u64("number of snapshots");
     for (std::uint64_t k = 0; k < n; ++k) c.snapshots.push_back(decode_snapshot(r));
     r.expect_end();

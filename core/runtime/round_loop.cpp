@@ -57,6 +57,7 @@ DistributedOptions distributed_options_of(const RunOptions& o) {
     set_sigma_mode(opt.refine, o.refine_sigma, "RunOptions::refine_sigma");
   if (o.max_factor_entries > 0)
     opt.block_update.max_factor_entries = static_cast<std::size_t>(o.max_factor_entries);
+  opt.block_update.tangent_split_dots = o.tangent_split_dots;
   opt.validate();
   return opt;
 }

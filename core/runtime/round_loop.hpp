@@ -60,6 +60,10 @@ struct RunOptions {
   std::string refine_sigma;
   /// BlockUpdateOptions::max_factor_entries (0 = core's default; runtime/team_memory.hpp).
   std::uint64_t max_factor_entries = 0;
+  /// BlockUpdateOptions::tangent_split_dots (`--tangent-dots split|sequential`): the tangent
+  /// factor's backward dot products as four partial sums (core's default) or CHOLMOD's sequential
+  /// sums. Changes the iterates' last bits, so every agent must use the run's one value.
+  bool tangent_split_dots = true;
   /// Robust solve (`--robust`; robust/gnc_agent.hpp runs it): kind none = plain least squares.
   RobustOptions robust;
   /// GNC starts from the known inliers' distributed initialization when they connect the poses
