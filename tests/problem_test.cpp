@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+#include <Eigen/SVD>
 #include <algorithm>
+#include <cstring>
 #include <random>
 #include <stdexcept>
 #include <tessera/manifold/lifted_manifold.hpp>
@@ -274,7 +277,51 @@ TEST_P(ProblemTest, CostAtTheActiveRowsEqualsTheGeneralRankLoopBitForBit) {
   }
 }
 
+// The general SVD route project_to_rotation took for every size: its 2 x 2 and 3 x 3 blocks
+// now go through fixed-size matrices, and the chordal start and the rounding must not move a bit.
+Eigen::MatrixXd rotation_by_dynamic_svd(const Eigen::MatrixXd& A) {
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::MatrixXd U = svd.matrixU();
+  const Eigen::MatrixXd& V = svd.matrixV();
+  if ((U * V.transpose()).determinant() < 0) U.col(U.cols() - 1) *= -1.0;
+  return U * V.transpose();
+}
+
+TEST_P(ProblemTest, ProjectToRotationIsTheGeneralSvdsResultBitForBit) {
+  const int d = GetParam();
+  std::mt19937 gen(11);
+  std::normal_distribution<double> normal;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3> into(d, d);
+  for (int k = 0; k < 20000; ++k) {
+    Eigen::MatrixXd A(d, d);
+    for (Eigen::Index e = 0; e < A.size(); ++e) A.data()[e] = normal(gen);
+    // Half near a rotation or a reflection, as the chordal start's and the rounding's blocks are.
+    if (k % 2 == 1) A = rotation_by_dynamic_svd(A) + 1e-3 * A;
+    if (k % 4 == 3) A.row(0) *= -1.0;
+    const Eigen::MatrixXd expected = rotation_by_dynamic_svd(A);
+    const Eigen::MatrixXd got = project_to_rotation(A);
+    ASSERT_EQ(got.rows(), d);
+    ASSERT_EQ(got.cols(), d);
+    ASSERT_EQ(0, std::memcmp(got.data(), expected.data(), sizeof(double) * d * d)) << "k = " << k;
+    project_to_rotation(A, into);
+    ASSERT_EQ(0, std::memcmp(into.data(), expected.data(), sizeof(double) * d * d)) << "k = " << k;
+    EXPECT_GT(determinant_of(got), 0.0);
+    EXPECT_EQ(determinant_of(A) < 0, A.determinant() < 0) << "k = " << k;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Dimensions, ProblemTest, ::testing::Values(2, 3));
+
+TEST(ProjectToRotation, AnotherSizeTakesTheGeneralSvdAndAMismatchedOutputThrows) {
+  std::srand(5);
+  const Eigen::MatrixXd A = Eigen::MatrixXd::Random(5, 5);
+  const Eigen::MatrixXd R = project_to_rotation(A);
+  EXPECT_EQ(0, std::memcmp(R.data(), rotation_by_dynamic_svd(A).data(), sizeof(double) * 25));
+  EXPECT_NEAR(determinant_of(R), 1.0, 1e-12);
+  Eigen::MatrixXd wrong(3, 3);
+  EXPECT_THROW(project_to_rotation(Eigen::MatrixXd::Identity(2, 2), wrong), std::invalid_argument);
+  EXPECT_THROW(project_to_rotation(Eigen::MatrixXd::Identity(2, 3), wrong), std::invalid_argument);
+}
 
 TEST(PoseColumns, AGatheredBlockHoldsItsPosesInIdOrderAndScattersBackIntoThemOnly) {
   const int d = 2;

@@ -51,12 +51,70 @@ void scatter_pose_columns(const Eigen::MatrixXd& Y, const std::vector<std::size_
     X.middleCols(pose_column(X, ids[s], w), w) = Y.middleCols(w * static_cast<Eigen::Index>(s), w);
 }
 
-Eigen::MatrixXd project_to_rotation(const Eigen::MatrixXd& A) {
+namespace {
+
+// out = U V^T entry by entry, each sum over c in increasing order: the arithmetic of the
+// dynamic-size product (Eigen's fixed-size product of 2 x 2 and 3 x 3 matrices is vectorized in
+// another order and would move the last bit).
+template <int D>
+void times_transpose(const Eigen::Matrix<double, D, D>& U, const Eigen::Matrix<double, D, D>& V,
+                     Eigen::Matrix<double, D, D>& out) {
+  for (int j = 0; j < D; ++j)
+    for (int i = 0; i < D; ++i) {
+      double acc = U(i, 0) * V(j, 0);
+      for (int c = 1; c < D; ++c) acc += U(i, c) * V(j, c);
+      out(i, j) = acc;
+    }
+}
+
+// project_to_rotation for d = 2, 3 without the heap: a fixed-size JacobiSVD computes the same U
+// and V as the dynamic-size one (the same sweeps; the dynamic one's QR preconditioner is skipped
+// for square matrices), and the products are formed as the dynamic ones are, so the result is the
+// same to the bit, in a quarter to a half of the instructions (the dynamic SVD's allocations were
+// most of its cost on 2 x 2 blocks). The determinant's sign decides alike (it is +-1).
+template <int D>
+void nearest_rotation(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> out) {
+  using Small = Eigen::Matrix<double, D, D>;
+  const Small a = A;
+  Eigen::JacobiSVD<Small> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Small U = svd.matrixU();
+  const Small& V = svd.matrixV();
+  Small R;
+  times_transpose<D>(U, V, R);
+  if (R.determinant() < 0) {
+    U.col(D - 1) *= -1.0;
+    times_transpose<D>(U, V, R);
+  }
+  out = R;
+}
+
+}  // namespace
+
+void project_to_rotation(const Eigen::Ref<const Eigen::MatrixXd>& A,
+                         Eigen::Ref<Eigen::MatrixXd> out) {
+  if (A.rows() != A.cols() || out.rows() != A.rows() || out.cols() != A.cols())
+    throw std::invalid_argument("project_to_rotation: " + std::to_string(A.rows()) + " x " +
+                                std::to_string(A.cols()) + " into " + std::to_string(out.rows()) +
+                                " x " + std::to_string(out.cols()));
+  if (A.rows() == 2) return nearest_rotation<2>(A, out);
+  if (A.rows() == 3) return nearest_rotation<3>(A, out);
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::MatrixXd U = svd.matrixU();
   const Eigen::MatrixXd& V = svd.matrixV();
   if ((U * V.transpose()).determinant() < 0) U.col(U.cols() - 1) *= -1.0;
-  return U * V.transpose();
+  out = U * V.transpose();
+}
+
+Eigen::MatrixXd project_to_rotation(const Eigen::MatrixXd& A) {
+  Eigen::MatrixXd out(A.rows(), A.cols());
+  project_to_rotation(A, out);
+  return out;
+}
+
+double determinant_of(const Eigen::Ref<const Eigen::MatrixXd>& A) {
+  if (A.rows() == 2 && A.cols() == 2) return Eigen::Matrix2d(A).determinant();
+  if (A.rows() == 3 && A.cols() == 3) return Eigen::Matrix3d(A).determinant();
+  return Eigen::MatrixXd(A).determinant();
 }
 
 Eigen::MatrixXd pad_rank(const Eigen::MatrixXd& X, int extra) {

@@ -17,10 +17,10 @@ Eigen::MatrixXd round_rotations(const Eigen::MatrixXd& X, int d) {
   Eigen::MatrixXd R = U.transpose() * Y;                // d x dn
   Eigen::Index negative = 0;
   for (Eigen::Index i = 0; i < n; ++i)
-    if (R.middleCols(d * i, d).determinant() < 0) ++negative;
+    if (determinant_of(R.middleCols(d * i, d)) < 0) ++negative;
   if (2 * negative > n) R.row(d - 1) *= -1.0;  // reflect so most blocks are rotations
   for (Eigen::Index i = 0; i < n; ++i)
-    R.middleCols(d * i, d) = project_to_rotation(R.middleCols(d * i, d));
+    project_to_rotation(R.middleCols(d * i, d), R.middleCols(d * i, d));
   return R;
 }
 

@@ -230,18 +230,22 @@ void DistributedRounding::rotations() {
   const Eigen::MatrixXd& U = frame_;
   Eigen::MatrixXd R(d, d * m);
   double negative = 0;
+  // d x d blocks on the stack (d <= 3): no heap traffic per pose.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3> Ri(d, d);
   for (Eigen::Index i = 0; i < m; ++i) {
     R.middleCols(d * i, d) = U.transpose() * Y_.middleCols((d + 1) * i, d);
-    if (R.middleCols(d * i, d).determinant() < 0) negative += 1;
+    if (determinant_of(R.middleCols(d * i, d)) < 0) negative += 1;
   }
   const double total_negative = reduce(kNegative, 0, negative, 0.0, nullptr);
   const double n = static_cast<double>(local_.num_poses);
   reflected_ = 2 * total_negative > n;
   for (Eigen::Index i = 0; i < m; ++i) {
-    Eigen::MatrixXd Ri = R.middleCols(d * i, d);
+    Ri = R.middleCols(d * i, d);
     if (reflected_) Ri.row(d - 1) *= -1.0;
-    poses_[own_[static_cast<std::size_t>(i)]] =
-        Pose{project_to_rotation(Ri), Eigen::VectorXd::Zero(d)};
+    Pose& p = poses_[own_[static_cast<std::size_t>(i)]];
+    p.R.resize(d, d);
+    project_to_rotation(Ri, p.R);
+    p.t = Eigen::VectorXd::Zero(d);
   }
   auto nb = exchange(kRotations, 0, static_cast<std::uint32_t>(d), [&](std::size_t id) {
     const Pose& p = poses_.at(id);

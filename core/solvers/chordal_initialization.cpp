@@ -52,9 +52,11 @@ Eigen::MatrixXd chordal_rotations(const PoseGraph& graph, bool simplicial) {
   if (chol.info() != Eigen::Success)
     throw std::runtime_error("chordal initialization: factorization failed (disconnected graph?)");
   Eigen::MatrixXd Z = chol.solve(rhs);  // rows: d(n-1) coordinates, cols: row index a
+  // d x d on the stack: no heap traffic per pose.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3> Ri(d, d);
   for (Index i = 1; i < n; ++i) {
-    Eigen::MatrixXd Ri = Z.middleRows(d * (i - 1), d).transpose();  // row a of R_i = column a of Z
-    R.middleCols(d * i, d) = project_to_rotation(Ri);
+    Ri = Z.middleRows(d * (i - 1), d).transpose();  // row a of R_i = column a of Z
+    project_to_rotation(Ri, R.middleCols(d * i, d));
   }
   return R;
 }

@@ -27,6 +27,16 @@ void scatter_pose_columns(const Eigen::MatrixXd& Y, const std::vector<std::size_
 
 /// Nearest rotation (det +1) to a square matrix.
 Eigen::MatrixXd project_to_rotation(const Eigen::MatrixXd& A);
+/// The same written into `out` (A's size; it may be A itself), without heap allocations for
+/// 2 x 2 and 3 x 3 (the same bits as the returning form). Throws std::invalid_argument if A is
+/// not square or `out` is not its size.
+void project_to_rotation(const Eigen::Ref<const Eigen::MatrixXd>& A,
+                         Eigen::Ref<Eigen::MatrixXd> out);
+
+/// Determinant of a square matrix: 2 x 2 and 3 x 3 by their closed forms, without the heap (the
+/// dynamic-size determinant factors an LU copy); the last bits may differ from that one's, so
+/// its sign is what callers compare (the rounding's side of each block: rotation or reflection).
+double determinant_of(const Eigen::Ref<const Eigen::MatrixXd>& A);
 
 /// Adds `extra` zero rows (the staircase's rank increase keeps the cost unchanged).
 Eigen::MatrixXd pad_rank(const Eigen::MatrixXd& X, int extra);
