@@ -18,6 +18,7 @@
 #include "commands.hpp"
 #include "graph_input.hpp"
 #include "json_writer.hpp"
+#include "launch/heap_retention.hpp"
 #include "launch/serial_openmp.hpp"
 #include "rebalance_args.hpp"
 #include "robust_args.hpp"
@@ -263,7 +264,15 @@ int run_solve(const Args& args) {
   // zeroing and scattering loops (the BLAS is serial), so on these problems they added
   // fork/join and spin-waiting, not speed (launch/serial_openmp.hpp, docs/decisions.md). Same bits.
   launch::serial_openmp();
-  if (a.has("online")) return solve_online_command(a, a.positional()[0], start);
+  if (a.has("online")) {
+    // Freed heap kept for the next step, as in the agent processes (launch/heap_retention.hpp):
+    // every step builds the grown blocks' factors again and every CG iteration's messages are
+    // copied, and with glibc's default thresholds those freed blocks went back to the kernel and
+    // were faulted in again (the 5,000-pose grid's online run: 72-84k minor faults and 0.9-1.3
+    // s of system time against 32k and 0.4-0.5 s; docs/online.md). Same bits.
+    launch::retain_freed_heap();
+    return solve_online_command(a, a.positional()[0], start);
+  }
   const std::string algorithm = a.get_or("algorithm", "centralized");
   const RobustOptions robust = parse_robust_options(a);
   if (algorithm == "centralized")

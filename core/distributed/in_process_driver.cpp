@@ -76,7 +76,9 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
       const std::size_t bytes = message_bytes(o.message);
       const std::uint32_t round = round_of(o.message);
       const std::uint32_t stage = stage_of_phase(message_phase(o.message));
-      auto count = [&](std::size_t recipient) {
+      // The last recipient takes the message itself, the others a copy: a CG iteration's pose
+      // blocks and coarse sums were copied once more than delivered.
+      auto count = [&](std::size_t recipient, bool last) {
         ++stats.messages;
         stats.bytes += bytes;
         if (stats.bytes_per_round.size() <= round) stats.bytes_per_round.resize(round + 1, 0);
@@ -84,13 +86,18 @@ DeliveryStats deliver(const std::vector<AgentProcess*>& agents, DeliveryOrder or
         if (stats.bytes_per_stage.size() <= stage) stats.bytes_per_stage.resize(stage + 1, 0);
         stats.bytes_per_stage[stage] += bytes;
         stats.bytes_per_stage_round[{stage, round}] += bytes;
-        queue.push_back({recipient, o.message, after + 1});
+        if (last)
+          queue.push_back({recipient, std::move(o.message), after + 1});
+        else
+          queue.push_back({recipient, o.message, after + 1});
       };
       if (o.broadcast) {
+        const std::size_t final_recipient = sender + 1 < n ? n - 1 : n - 2;
         for (std::size_t r = 0; r < n; ++r)
-          if (r != sender) count(r);
+          if (r != sender) count(r, r == final_recipient);
       } else {
-        for (auto r : o.recipients) count(r);
+        for (std::size_t k = 0; k < o.recipients.size(); ++k)
+          count(o.recipients[k], k + 1 == o.recipients.size());
       }
     }
   };

@@ -71,7 +71,8 @@ struct TangentPreconditioner::Factor {
   std::vector<Eigen::Index> block_start, block_row, diagonal_slot;
   // Q_BB's (d+1) x (d+1) block of each pose-block pair, column-major, in block_row order.
   std::vector<double> q_blocks;
-  // A with its full pattern (every pose-block pair p x p dense; CHOLMOD reads the lower half).
+  // A's lower block triangle (every pose-block pair i >= j p x p dense, the diagonal blocks
+  // whole; CHOLMOD reads the lower half).
   SparseMatrix A;
   CholmodLdlt llt;
   // Solve workspace, reused by every apply (agents apply their own preconditioner only).
@@ -153,9 +154,10 @@ struct TangentPreconditioner::Factor {
   int factorizations = 0;
   int calls_since_factor = 0;
 
-  // Offset in A's value array of entry (0, c) of the block in slot s of block column j.
+  // Offset in A's value array of entry (0, c) of the block in slot s (>= diagonal_slot[j]) of
+  // block column j.
   Eigen::Index value_offset(Eigen::Index j, Eigen::Index s, int c) const {
-    return A.outerIndexPtr()[j * p + c] + (s - block_start[static_cast<std::size_t>(j)]) * p;
+    return A.outerIndexPtr()[j * p + c] + (s - diagonal_slot[static_cast<std::size_t>(j)]) * p;
   }
 };
 

@@ -112,16 +112,23 @@ TangentPreconditioner::TangentPreconditioner(const BlockProblem& problem, double
         f.q_blocks[static_cast<std::size_t>(slot * w * w + s * w + it.row() % w)] = it.value();
       }
   }
-  // A's pattern: block column j's columns each hold p rows per row block.
+  // A's pattern, lower block triangle only: block column j's columns each hold p rows per row
+  // block i >= j. CHOLMOD reads A's lower half only, and every analysis and factorization
+  // transposes the whole stored pattern: the blocks above the diagonal were half of that work
+  // (and of A's memory) for entries never read.
   const Eigen::Index n = f.m * f.p;
-  const Eigen::Index nnz = static_cast<Eigen::Index>(f.block_row.size()) * f.p * f.p;
+  Eigen::Index lower_blocks = 0;
+  for (Eigen::Index j = 0; j < f.m; ++j)
+    lower_blocks += f.block_start[static_cast<std::size_t>(j) + 1] -
+                    f.diagonal_slot[static_cast<std::size_t>(j)];
+  const Eigen::Index nnz = lower_blocks * f.p * f.p;
   f.A.resize(n, n);
   f.A.resizeNonZeros(nnz);
   Eigen::Index pos = 0;
   for (Eigen::Index j = 0; j < f.m; ++j)
     for (int c = 0; c < f.p; ++c) {
       f.A.outerIndexPtr()[j * f.p + c] = static_cast<int>(pos);
-      for (Eigen::Index s = f.block_start[static_cast<std::size_t>(j)];
+      for (Eigen::Index s = f.diagonal_slot[static_cast<std::size_t>(j)];
            s < f.block_start[static_cast<std::size_t>(j) + 1]; ++s)
         for (int r = 0; r < f.p; ++r) {
           f.A.innerIndexPtr()[pos] =
@@ -254,12 +261,13 @@ bool TangentPreconditioner::factorize_impl(const Eigen::MatrixXd& X, const Eigen
   for (Eigen::Index i = 0; i < f.m; ++i)
     G[static_cast<std::size_t>(i)] = pose_basis(X.block(0, i * w, d, d), pairs);
   // Block (i, j) of A = 2 G_i^T (Q_ij kron I_d) G_j, for i >= j only: CHOLMOD reads A's lower
-  // half, so the blocks above the diagonal are never computed (they stay 0).
+  // half, so the blocks above the diagonal are not stored.
   double max_diagonal = 0.0;
   for (Eigen::Index j = 0; j < f.m; ++j) {
     const Eigen::MatrixXd& Gj = G[static_cast<std::size_t>(j)];
-    const Eigen::Index begin = f.block_start[static_cast<std::size_t>(j)];
-    const Eigen::Index column_size = (f.block_start[static_cast<std::size_t>(j) + 1] - begin) * p;
+    const Eigen::Index column_size = (f.block_start[static_cast<std::size_t>(j) + 1] -
+                                      f.diagonal_slot[static_cast<std::size_t>(j)]) *
+                                     p;
     for (Eigen::Index s = f.diagonal_slot[static_cast<std::size_t>(j)];
          s < f.block_start[static_cast<std::size_t>(j) + 1]; ++s) {
       const Eigen::Index i = f.block_row[static_cast<std::size_t>(s)];
