@@ -78,6 +78,9 @@ const char* kHelp =
     "                            GNC's early end back: within a factor 2 of c^2 on both sides,\n"
     "                            or only those beyond it (the passes judge the ones within it on\n"
     "                            the kept set) [beyond]\n"
+    "  --gnc-jump-band-max M     robust distributed: at small mu the band of GNC's early end\n"
+    "                            widens beyond 2 c^2 to where the weights reach 0, up to M c^2;\n"
+    "                            <= 2: 2 c^2 whatever mu [30]\n"
     "  --gnc-probe-cut always|after-passes|auto   robust distributed: whether a re-check\n"
     "                            probe may cut kept measurements while the rejected set is\n"
     "                            still GNC's own (always), or only once the re-check passes\n"
@@ -277,6 +280,7 @@ int run_solve(const Args& args) {
   valued.insert("precond-max-flops");
   valued.insert("gnc-cluster-probes");
   valued.insert("gnc-jump-side");
+  valued.insert("gnc-jump-band-max");
   valued.insert("gnc-probe-cut");
   valued.insert("gnc-newton-mu-step-max");
   valued.insert("gnc-step-sigma");
@@ -304,6 +308,8 @@ int run_solve(const Args& args) {
   if (jump_side != "both" && jump_side != "beyond")
     throw InputError("option --gnc-jump-side: '" + jump_side + "' is not one of both, beyond");
   robust.jump_band_inside = jump_side == "both";
+  // RobustOptions::jump_band_max; `tessera solve` only, like --gnc-jump-side.
+  robust.jump_band_max = a.get_double("gnc-jump-band-max", robust.jump_band_max);
   // RobustOptions::probe_cut; `tessera solve` only, like --gnc-jump-side.
   try {
     robust.probe_cut = parse_probe_cut(a.get_or("gnc-probe-cut", probe_cut_name(robust.probe_cut)));

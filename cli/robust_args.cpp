@@ -143,6 +143,7 @@ void add_robust_fields(JsonObject& json, const RobustSummary& s) {
       .add("gnc_mu_hold", mu_step_hold_name(s.options.mu_step_hold))
       .add("gnc_step_trust", s.options.newton_step_trust)
       .add("gnc_jump_side", s.options.jump_band_inside ? "both" : "beyond")
+      .add("gnc_jump_band_max", s.options.jump_band_max)
       .add("gnc_probe_cut", probe_cut_name(s.options.probe_cut))
       .add("weights_converged", s.weights_converged)
       .add("readmitted", s.readmitted)
