@@ -20,6 +20,7 @@ const char* const kRobustValued[] = {"robust",
                                      "gnc-pass-refine",
                                      "gnc-mu-step-max",
                                      "gnc-jump-side",
+                                     "gnc-jump-band-max",
                                      "gnc-probe-cut",
                                      "gnc-newton-mu-step-max",
                                      "gnc-step-sigma",
@@ -80,6 +81,9 @@ const char* const kRobustHelp =
     "                            GNC's early end back: within a factor 2 of c^2 on both sides,\n"
     "                            or only those beyond it (the passes judge the ones within it on\n"
     "                            the kept set) [beyond]\n"
+    "  --gnc-jump-band-max M     distributed: at small mu the band of GNC's early end\n"
+    "                            widens beyond 2 c^2 to where the weights reach 0, up to M c^2;\n"
+    "                            <= 2: 2 c^2 whatever mu [30]\n"
     "  --gnc-probe-cut always|after-passes|auto   distributed: whether a re-check\n"
     "                            probe may cut kept measurements while the rejected set is\n"
     "                            still GNC's own (always), or only once the re-check passes\n"
@@ -143,6 +147,7 @@ RobustOptions parse_robust_options(const Arguments& args) {
   if (jump_side != "both" && jump_side != "beyond")
     throw InputError("option --gnc-jump-side: '" + jump_side + "' is not one of both, beyond");
   o.jump_band_inside = jump_side == "both";
+  o.jump_band_max = args.get_double("gnc-jump-band-max", o.jump_band_max);
   try {
     o.probe_cut = parse_probe_cut(args.get_or("gnc-probe-cut", probe_cut_name(o.probe_cut)));
   } catch (const InputError& e) {
@@ -203,6 +208,7 @@ void add_robust_fields(JsonObject& json, const RobustSummary& s) {
       .add("gnc_mu_hold", mu_step_hold_name(s.options.mu_step_hold))
       .add("gnc_step_trust", s.options.newton_step_trust)
       .add("gnc_jump_side", s.options.jump_band_inside ? "both" : "beyond")
+      .add("gnc_jump_band_max", s.options.jump_band_max)
       .add("gnc_probe_cut", probe_cut_name(s.options.probe_cut))
       .add("weights_converged", s.weights_converged)
       .add("readmitted", s.readmitted)

@@ -108,7 +108,8 @@ options:
   --gnc-probe-ratio R, --gnc-final-refine newton|none, --gnc-cluster-probes K,
   --gnc-pass-refine auto|none, --gnc-mu-step-max S, --gnc-newton-mu-step-max S,
   --gnc-mu-hold falls|crossings, --gnc-step-trust R, --gnc-jump-side both|beyond,
-  --gnc-probe-cut always|after-passes|auto, --gnc-step-sigma every|refine-sigma
+  --gnc-jump-band-max M, --gnc-probe-cut always|after-passes|auto,
+  --gnc-step-sigma every|refine-sigma
                        the GNC options, as for `tessera solve` (docs/robust.md)
   --gnc-inner-iterations K, --gnc-swap-probes K
                        accepted for `tessera solve`'s option set; they are the centralized

@@ -225,6 +225,10 @@ void check_gnc_jump_side(const std::string& v) {
   if (v != "both" && v != "beyond")
     throw InputError("option --gnc-jump-side: '" + v + "' is not one of both, beyond");
 }
+void check_gnc_jump_band_max(const std::string& v) {
+  check_robust_field(v, "gnc-jump-band-max",
+                     [](RobustOptions& o, double x) { o.jump_band_max = x; });
+}
 void check_gnc_step_sigma(const std::string& v) {
   if (v != "every" && v != "refine-sigma")
     throw InputError("option --gnc-step-sigma: '" + v + "' is not one of every, refine-sigma");
@@ -351,6 +355,12 @@ const std::vector<ForwardedFlag>& forwarded_flags() {
        "back: within a factor 2 of c^2 on both sides, or only\n"
        "those beyond it                               [beyond]",
        check_gnc_jump_side},
+      {"gnc-jump-band-max", "gnc-jump-band-max", true, ForwardTo::kCoordinator,
+       "--gnc-jump-band-max M",
+       "at small mu the band of GNC's early end widens\n"
+       "beyond 2 c^2 to where the weights reach 0, up to\n"
+       "M c^2; <= 2: 2 c^2 whatever mu                    [30]",
+       check_gnc_jump_band_max},
       {"gnc-probe-cut", "gnc-probe-cut", true, ForwardTo::kCoordinator,
        "--gnc-probe-cut always|after-passes|auto",
        "a re-check probe may cut kept\n"

@@ -2,8 +2,8 @@
 // (transport/assignment_options.hpp): what the coordinator writes every agent reads back, field
 // by field, the solve-only options that launch now forwards included (--tangent-dots and the
 // distributed GNC's --gnc-mu-hold, --gnc-step-trust, --gnc-newton-mu-step-max, --gnc-jump-side,
-// --gnc-probe-cut, --gnc-step-sigma); absent flags keep core's defaults; a value the agents do not
-// know is an InputError naming its field. No process is started.
+// --gnc-jump-band-max, --gnc-probe-cut, --gnc-step-sigma); absent flags keep core's defaults; a
+// value the agents do not know is an InputError naming its field. No process is started.
 
 #include <gtest/gtest.h>
 
@@ -56,6 +56,7 @@ agent::RunOptions tuned() {
   r.mu_step_hold = MuStepHold::kCrossings;
   r.newton_step_trust = 0.5;
   r.jump_band_inside = true;
+  r.jump_band_max = 12;
   r.probe_cut = ProbeCut::kAlways;
   r.step_sigma_every_agent = true;
   o.gnc_known_start = false;
@@ -87,6 +88,7 @@ void expect_same_robust(const RobustOptions& a, const RobustOptions& b) {
   EXPECT_EQ(a.mu_step_hold, b.mu_step_hold);
   EXPECT_EQ(a.newton_step_trust, b.newton_step_trust);
   EXPECT_EQ(a.jump_band_inside, b.jump_band_inside);
+  EXPECT_EQ(a.jump_band_max, b.jump_band_max);
   EXPECT_EQ(a.probe_cut, b.probe_cut);
   EXPECT_EQ(a.step_sigma_every_agent, b.step_sigma_every_agent);
 }

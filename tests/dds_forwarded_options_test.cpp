@@ -57,7 +57,7 @@ TEST(DdsForwardedOptions, ALaunchWithTheGncFlagsRunsTheSolvesRun) {
   const std::string common = "--agents 3 --partition sequential --robust gnc-tls";
   const std::string flags =
       " --gnc-mu-hold crossings --gnc-step-trust 0 --gnc-newton-mu-step-max 0"
-      " --gnc-jump-side both --gnc-probe-cut always --gnc-step-sigma every";
+      " --gnc-jump-side both --gnc-jump-band-max 12 --gnc-probe-cut always --gnc-step-sigma every";
   const std::string solve_args = common + " --algorithm irbcd --certify";
   const std::string solve = solve_summary(dir, graph, solve_args + flags, "solve");
   const std::string plain = solve_summary(dir, graph, solve_args, "plain");

@@ -284,9 +284,9 @@ namespace {
 // command line; bad values are named before any process starts.
 TEST(LaunchOptions, SolveOnlyGncAndTangentFlagsReachTheCoordinatorAndNameBadValues) {
   const std::vector<std::pair<std::string, std::string>> flags = {
-      {"gnc-mu-hold", "crossings"},  {"gnc-step-trust", "0.5"},   {"gnc-newton-mu-step-max", "9"},
-      {"gnc-jump-side", "both"},     {"gnc-probe-cut", "always"}, {"gnc-step-sigma", "every"},
-      {"tangent-dots", "sequential"}};
+      {"gnc-mu-hold", "crossings"}, {"gnc-step-trust", "0.5"},     {"gnc-newton-mu-step-max", "9"},
+      {"gnc-jump-side", "both"},    {"gnc-probe-cut", "always"},   {"gnc-step-sigma", "every"},
+      {"gnc-jump-band-max", "12"},  {"tangent-dots", "sequential"}};
   Argv argv = {"--robust", "gnc-tls"};
   for (const auto& [flag, value] : flags) argv.insert(argv.end(), {"--" + flag, value});
   LaunchOptions o = parse_launch_options(argv);
@@ -297,9 +297,9 @@ TEST(LaunchOptions, SolveOnlyGncAndTangentFlagsReachTheCoordinatorAndNameBadValu
     EXPECT_FALSE(has(agent_argv(o, paths(), 0), "--" + flag)) << flag;
   }
   const std::map<std::string, std::string> bad = {
-      {"gnc-mu-hold", "rises"},    {"gnc-step-trust", "1.5"},  {"gnc-newton-mu-step-max", "1"},
-      {"gnc-jump-side", "inside"}, {"gnc-probe-cut", "never"}, {"gnc-step-sigma", "one"},
-      {"tangent-dots", "parallel"}};
+      {"gnc-mu-hold", "rises"},    {"gnc-step-trust", "1.5"},   {"gnc-newton-mu-step-max", "1"},
+      {"gnc-jump-side", "inside"}, {"gnc-probe-cut", "never"},  {"gnc-step-sigma", "one"},
+      {"gnc-jump-band-max", "-1"}, {"tangent-dots", "parallel"}};
   for (const auto& [flag, value] : bad) {
     const std::string e = error_of({"--" + flag, value});
     EXPECT_NE(e.find("--" + flag), std::string::npos) << flag << ": " << e;

@@ -44,6 +44,7 @@ void write_run_options(const agent::RunOptions& o, wire::PartitionAssignment& as
   asg.gnc_mu_hold(mu_step_hold_name(r.mu_step_hold));
   asg.gnc_step_trust(r.newton_step_trust);
   asg.gnc_jump_band_inside(r.jump_band_inside);
+  asg.gnc_jump_band_max(r.jump_band_max);
   asg.gnc_probe_cut(probe_cut_name(r.probe_cut));
   asg.gnc_step_sigma_every(r.step_sigma_every_agent);
 }
@@ -89,6 +90,7 @@ agent::RunOptions run_options_of(const wire::PartitionAssignment& asg) {
   }
   r.newton_step_trust = asg.gnc_step_trust();
   r.jump_band_inside = asg.gnc_jump_band_inside();
+  r.jump_band_max = asg.gnc_jump_band_max();
   try {
     if (!asg.gnc_probe_cut().empty()) r.probe_cut = parse_probe_cut(asg.gnc_probe_cut());
   } catch (const InputError& e) {

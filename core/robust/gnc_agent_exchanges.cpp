@@ -168,8 +168,13 @@ int GncAgent::near_bound_at(const std::vector<bool>& skip, const Eigen::MatrixXd
                             const Eigen::MatrixXd& neighbours) const {
   // Without the early end every update counts as "near", so GNC never ends early.
   if (options_.robust.jump_band <= 0) return 1;
-  return near_bound_count(*terms_, skip, Y, neighbours, options_.robust.jump_band,
-                          options_.robust.jump_band_inside);
+  // RobustOptions::jump_band_max: residuals beyond the bound whose weight at mu is not yet 0
+  // (r^2 < (mu + 1) / mu c^2) hold the end back too, up to the cap.
+  const double mu = outer_->mu();
+  const double band = mu > 0 ? std::max(options_.robust.jump_band,
+                                        std::min((mu + 1) / mu, options_.robust.jump_band_max))
+                             : options_.robust.jump_band;
+  return near_bound_count(*terms_, skip, Y, neighbours, band, options_.robust.jump_band_inside);
 }
 
 bool GncAgent::kept_vote_rides_weights() const {

@@ -55,7 +55,8 @@ double weight_spread(const GncLocalTerms& terms, const std::vector<double>& weig
 
 /// RobustOptions::jump_band: how many of the measurements this agent weighs (that may be
 /// rejected and were not set aside) have r^2 in (c^2 / band, band c^2) at the iterate Y, or with
-/// `inside` false in (c^2, band c^2) (RobustOptions::jump_band_inside).
+/// `inside` false in (c^2, band c^2) (RobustOptions::jump_band_inside). The caller picks the band
+/// (RobustOptions::jump_band, widened at small mu up to jump_band_max).
 int near_bound_count(const GncLocalTerms& terms, const std::vector<bool>& dropped,
                      const Eigen::MatrixXd& Y, const Eigen::MatrixXd& neighbours, double band,
                      bool inside);

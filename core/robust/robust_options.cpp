@@ -87,6 +87,9 @@ void RobustOptions::validate() const {
               "must be crossings or falls");
   if (!(std::isfinite(jump_band) && (jump_band == 0 || jump_band > 1)))
     bad_field("jump_band", number_text(jump_band), "must be 0 (off) or > 1");
+  if (!(std::isfinite(jump_band_max) && jump_band_max >= 0))
+    bad_field("jump_band_max", number_text(jump_band_max),
+              "must be >= 0 (<= jump_band: no widening)");
   if (recheck_max_rounds < 0)
     bad_field("recheck_max_rounds", std::to_string(recheck_max_rounds),
               "must be >= 0 (0 = no cap)");
