@@ -148,6 +148,33 @@ TEST(NewtonRefine, AnAcceptedTrialsInterfaceSharesInItsSumSaveAMessageStepForThe
   }
 }
 
+// Exact trial translations with one factor of their Sigma (translation_one_factor_min_poses):
+// agent 0 alone factors it and sends every agent u, so each trial costs one more message step
+// and the run is the same to the bit as every agent factoring it; in any delivery order too.
+TEST(NewtonRefine, OneTranslationSigmaFactorGivesTheSameRunToTheBitInOneMoreStepATrial) {
+  const PoseGraph g = long_chain();
+  const std::vector<int> parts = sequential_partition(g.num_poses, 4);
+  DistributedOptions every = refined(true);
+  every.refine.translation_one_factor_min_poses = 1000000;
+  DistributedOptions one = every;
+  one.refine.translation_one_factor_min_poses = 0;
+  const DistributedResult a = solve_distributed(g, parts, every);
+  const DistributedResult b = solve_distributed(g, parts, one);
+  ASSERT_EQ(a.refines.size(), 1u);
+  ASSERT_EQ(b.refines.size(), 1u);
+  const NewtonRefineResult &x = a.refines[0], &y = b.refines[0];
+  ASSERT_GT(x.translation_solves, 0) << "the chain's trials should use exact translations";
+  EXPECT_EQ(x.translation_solutions_received, 0);
+  EXPECT_EQ(y.translation_solutions_received, y.translation_solves);
+  expect_same_steps(x, y);
+  EXPECT_EQ(y.translation_solves, x.translation_solves);
+  EXPECT_EQ(y.reductions, x.reductions + y.translation_solves);
+  EXPECT_EQ(b.X, a.X);
+  EXPECT_EQ(b.cost, a.cost);
+  const std::vector<int> three = sequential_partition(g.num_poses, 3);
+  test::expect_same_refinement_in_any_delivery_order(g, three, one, 11);
+}
+
 TEST(NewtonRefine, EveryAgentTakesTheSameStepsInAnyDeliveryOrder) {
   const PoseGraph g = long_chain();
   const std::vector<int> parts = sequential_partition(g.num_poses, 3);
@@ -506,6 +533,9 @@ TEST(NewtonRefineOptions, ValidateNamesTheBadField) {
   o = {};
   o.translation_interface_max_poses = -1;
   EXPECT_TRUE(test::validation_names(o, "translation_interface_max_poses"));
+  o = NewtonRefineOptions{};
+  o.translation_one_factor_min_poses = -1;
+  EXPECT_TRUE(test::validation_names(o, "translation_one_factor_min_poses"));
   o = {};
   o.translation_tol = 0;
   EXPECT_TRUE(test::validation_names(o, "translation_tol"));

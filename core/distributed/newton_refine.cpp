@@ -161,6 +161,7 @@ std::vector<OutgoingMessage> NewtonRefineProtocol::start() {
       translation_solve_ =
           std::make_unique<TranslationInterfaceSolve>(problem_, layout_, state_.id());
       translation_share = translation_solve_->share();
+      translation_one_factor_ = team >= options_.translation_one_factor_min_poses;
     }
   }
   // The interface shares at the start point, in this sum too: the count of this block's, then
@@ -294,6 +295,9 @@ void NewtonRefineProtocol::pump(std::vector<OutgoingMessage>& out) {
       case kSolution:
         after_solution(*ready, out);
         break;
+      case kTranslationSolution:
+        after_translation_solution(*ready, out);
+        break;
       default:
         after_trial_sums(*ready, out);
         break;
@@ -333,7 +337,11 @@ void NewtonRefineProtocol::after_status(const MessageGate::Inbox& inbox,
   if (translation_solve_) {
     std::vector<const std::vector<double>*> ptrs;
     for (const auto& v : shares) ptrs.push_back(&v);
-    if (translation_solve_->assemble(ptrs))
+    // With one factor the others only check the shares; a factor that fails on the holder is
+    // announced with its first u (after_translation_solution()), else it fails on every agent.
+    const bool factor = !translation_one_factor_ || state_.id() == kSigmaHolder;
+    if (translation_solve_->assemble(ptrs, factor) ||
+        (factor && translation_one_factor_ && translation_solve_->assemble(ptrs, false)))
       result_.translation_interface_poses = static_cast<int>(translation_solve_->team_size());
     else
       translation_solve_.reset();  // a block's L_BB is singular: the CG below

@@ -30,6 +30,8 @@ void NewtonRefineOptions::validate() const {
   if (translation_iterations < 0) fail("translation_iterations", "must be >= 0");
   if (!(translation_tol > 0 && translation_tol < 1)) fail("translation_tol", "must be in (0, 1)");
   if (translation_interface_max_poses < 0) fail("translation_interface_max_poses", "must be >= 0");
+  if (translation_one_factor_min_poses < 0)
+    fail("translation_one_factor_min_poses", "must be >= 0");
   if (interface_max_coordinates < 0) fail("interface_max_coordinates", "must be >= 0");
   if (!(auto_interface_grad_tol >= 0)) fail("auto_interface_grad_tol", "must be >= 0");
   if (!(interface_shift > 0 && interface_shift <= 1e-3))

@@ -231,7 +231,22 @@ void NewtonRefineProtocol::start_translations(std::vector<OutgoingMessage>& out)
     translation_solve_->forward(b, ty_);
     const Eigen::MatrixXd rhat = translation_solve_->interface_residual(ty_);
     ++result_.translation_solves;
-    broadcast(kTranslationSolve, std::vector<double>(rhat.data(), rhat.data() + rhat.size()), out);
+    std::vector<double> values(rhat.data(), rhat.data() + rhat.size());
+    if (!translation_one_factor_) return broadcast(kTranslationSolve, values, out);
+    // One factor: the residuals to the holder alone; the others count the step as passed (the
+    // holder's message round moves on when it has them all) and wait for its u.
+    const int id = state_.id();
+    PoseBlockMessage msg = make_reduction_message(id, message_round_, kTranslationSolve, values);
+    ++result_.reductions;
+    if (id == kSigmaHolder) {
+      gate_.add(id, message_round_, kTranslationSolve, msg);
+      gate_.expect(message_round_, kTranslationSolve, everyone_);
+      return;
+    }
+    out.push_back(addressed_to(static_cast<std::uint32_t>(kSigmaHolder), std::move(msg)));
+    ++message_round_;
+    gate_.expect(message_round_, kTranslationSolution, {kSigmaHolder});
+    ++result_.reductions;
     return;
   }
   TranslationPreconditioner::keep_translations(problem_.dim(), tr_);
@@ -304,7 +319,53 @@ void NewtonRefineProtocol::after_translation_solve(const MessageGate::Inbox& inb
     rhat.middleRows(translation_solve_->block_offset(sender), n) =
         Eigen::Map<const Eigen::MatrixXd>(p->data.data(), n, k);
   }
-  const Eigen::MatrixXd u = translation_solve_->solve_interface(rhat);
+  if (!translation_one_factor_)
+    return take_translation_solution(translation_solve_->solve_interface(rhat), out);
+  // The holder: u to every agent, flag first (0: its Sigma could not be factored).
+  const bool ok = translation_solve_->ready();
+  Eigen::MatrixXd u;
+  if (ok) u = translation_solve_->solve_interface(rhat);
+  std::vector<double> values{ok ? 1.0 : 0.0};
+  values.insert(values.end(), u.data(), u.data() + u.size());
+  PoseBlockMessage m =
+      make_reduction_message(kSigmaHolder, message_round_, kTranslationSolution, values);
+  gate_.add(kSigmaHolder, message_round_, kTranslationSolution, m);
+  OutgoingMessage o;
+  o.message = std::move(m);
+  o.broadcast = true;
+  out.push_back(std::move(o));
+  gate_.expect(message_round_, kTranslationSolution, {kSigmaHolder});
+  ++result_.reductions;
+}
+
+void NewtonRefineProtocol::after_translation_solution(const MessageGate::Inbox& inbox,
+                                                      std::vector<OutgoingMessage>& out) {
+  charge_to(&result_.times.translations_s);
+  const Eigen::Index k = Xt_.rows(), team = translation_solve_->team_size();
+  const auto found = inbox.find(kSigmaHolder);
+  const auto* m = found == inbox.end() ? nullptr : std::get_if<PoseBlockMessage>(&found->second);
+  if (!m || m->data.empty() ||
+      m->data.size() != (m->data[0] != 0.0 ? static_cast<std::size_t>(1 + team * k) : 1))
+    throw std::runtime_error("newton refine: malformed translation solution from agent " +
+                             std::to_string(kSigmaHolder));
+  ++result_.translation_solutions_received;
+  if (m->data[0] == 0.0) {
+    // No factor of Sigma on the holder: the block-Jacobi CG from here on, on every agent.
+    translation_solve_.reset();
+    translation_one_factor_ = false;
+    --result_.translation_solves;
+    result_.translation_interface_poses = 0;
+    translation_preconditioner_ = std::make_unique<TranslationPreconditioner>(problem_);
+    TranslationPreconditioner::keep_translations(problem_.dim(), tr_);
+    tx_.setZero(Xt_.rows(), Xt_.cols());
+    tcg_->restart();
+    return send_translation_direction(out);
+  }
+  take_translation_solution(Eigen::Map<const Eigen::MatrixXd>(m->data.data() + 1, team, k), out);
+}
+
+void NewtonRefineProtocol::take_translation_solution(const Eigen::MatrixXd& u,
+                                                     std::vector<OutgoingMessage>& out) {
   const Eigen::MatrixXd x = translation_solve_->back(ty_, u);
   // The own translations, and the neighbours' public ones from u (their own back() writes the
   // same u into them, so both copies agree to the bit).

@@ -82,10 +82,12 @@ class NewtonRefineProtocol : public AgentProcess {
     kInterface = 68,             ///< Interface solves: each block's Schur complement and couplings.
     kTranslationSolve = 69,      ///< Exact trial translations: each block's interface residual.
     kSolution =
-        70  ///< kShipSolves: Sigma's solve, each agent's segment, from the agent holding it.
+        70,  ///< kShipSolves: Sigma's solve, each agent's segment, from the agent holding it.
+    kTranslationSolution = 71  ///< Exact trial translations with one factor of their Sigma
+                               ///< (translation_one_factor_min_poses): the holder's u.
   };
   /// The last of the steps: [kStatus, kLastStep] are the refinement's.
-  static constexpr std::uint32_t kLastStep = kSolution;
+  static constexpr std::uint32_t kLastStep = kTranslationSolution;
   static bool is_refine_step(std::uint32_t step) { return step >= kStatus && step <= kLastStep; }
 
   /// `state`: the agent at the point to refine (Y, and Yn = the neighbours' public poses of the
@@ -222,6 +224,11 @@ class NewtonRefineProtocol : public AgentProcess {
   void after_translation_sums(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
   // Exact trial translations: the team's interface solve, then the trial's sums.
   void after_translation_solve(const MessageGate::Inbox& inbox, std::vector<OutgoingMessage>& out);
+  // One translation Sigma factor: the holder's u (flag first) taken by every agent.
+  void after_translation_solution(const MessageGate::Inbox& inbox,
+                                  std::vector<OutgoingMessage>& out);
+  // The trial's translations from u (the team's interface rows), then the trial's sums.
+  void take_translation_solution(const Eigen::MatrixXd& u, std::vector<OutgoingMessage>& out);
   // The trial point's cost share and ||g||^2 (kTrialSums), its neighbours' poses set; with
   // ship_trial_shares(), the block's share of Sigma at the trial point after them.
   void send_trial_sums(std::vector<OutgoingMessage>& out);
@@ -332,6 +339,10 @@ class NewtonRefineProtocol : public AgentProcess {
   // ready()) and the forward solve of the current trial's right-hand side.
   std::unique_ptr<TranslationInterfaceSolve> translation_solve_;
   Eigen::MatrixXd ty_;
+  // Only kSigmaHolder factors the translation Sigma (options_.translation_one_factor_min_poses;
+  // decided from the layout, the same on every agent): the others send it their residuals and
+  // take its u (kTranslationSolution).
+  bool translation_one_factor_ = false;
   NewtonRefineStep step_;
   TrialObserver trial_observer_;
   bool done_ = false;

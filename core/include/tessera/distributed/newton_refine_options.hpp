@@ -169,6 +169,12 @@ struct NewtonRefineOptions {
   /// each) over ais2klinik's 9 trial points, 80 % of the refinement's 299 message steps
   /// (docs/newton-refine.md, "Exact trial translations"). >= 0; 0 = off (the CG above).
   int translation_interface_max_poses = 2000;
+  /// Exact trial translations from this many interface poses on: only agent 0 factors their
+  /// Sigma; each trial's residuals go to it and it sends every agent u (one more message step a
+  /// trial, the same u to the bit). Below, every agent factors Sigma and one all-agent sum gives
+  /// each u. Why: the factor (city10000 at N = 5: 303 rows, about 11 M instructions) was repeated
+  /// on every agent, 55 M instructions over five. >= 0.
+  int translation_one_factor_min_poses = 200;
   /// Preconditioner: exact solves with the Hessian through the team's interface
   /// (distributed/interface_solve.hpp) where that interface has at most this many tangent
   /// coordinates (d(d+1)/2 a pose: ais2klinik at N = 5 102, city10000 909); 0 = off. Each

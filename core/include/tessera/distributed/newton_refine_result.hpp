@@ -72,6 +72,9 @@ struct NewtonRefineResult {
   /// (0: not used, the CG above ran) and the exact solves (one all-agent sum each, counted in
   /// `reductions`; none of them in translation_iterations).
   int translation_interface_poses = 0, translation_solves = 0;
+  /// Of those, the solves whose u came from agent 0's factor (translation_one_factor_min_poses;
+  /// each one more message step, counted in `reductions`).
+  int translation_solutions_received = 0;
   /// Interface solves (interface_max_coordinates): the team's interface in tangent coordinates
   /// (0: not used), the points where Sigma was factored (one all-agent message step each,
   /// counted in `reductions`, but where the shares rode in the sum before: the start's with
