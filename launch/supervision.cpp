@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "launch/failure_report.hpp"
 #include "runtime/progress_lines.hpp"
 #include "transport/fastdds/shm_leftovers.hpp"
 
@@ -93,10 +94,14 @@ void stop_after_failure(std::vector<Child>& children, SupervisionOutcome& out) {
   }
   note_segments(children, out.run_segments);  // stop_all may have to SIGKILL some of them
   stop_all(children, out.exit_code == 130 ? 5.0 : 3.0);
+  std::vector<FailedProcess> failed;
   for (const auto& c : children)
     if (c.code != 0 && c.code != 130 && c.code != 143)
-      std::fprintf(stderr, "  %s (exit %d):\n%s", c.name.c_str(), c.code,
-                   tail_of(c.log, 6).c_str());
+      failed.push_back({c.name, c.agent, c.code, tail_of(c.log, 6)});
+  for (const FailureGroup& g : group_failures(failed))
+    std::fprintf(stderr, "  %s (exit %d):\n%s", g.label().c_str(), g.members.front()->code,
+                 g.members.front()->tail.c_str());
+  if (out.exit_code == 1) out.exit_code = exit_code_after_failure(failed);
 }
 
 }  // namespace

@@ -43,7 +43,7 @@ struct SupervisionOptions {
 
 struct SupervisionOutcome {
   std::string failure;  ///< why the run failed; "" when it did not
-  int exit_code = 0;    ///< 0, 1 (failed) or 130 (interrupted)
+  int exit_code = 0;    ///< 0, 1 (failed), 2 (bad input: failure_report.hpp) or 130 (interrupted)
   /// The summary was read and printed (once the coordinator said it was written).
   bool summary_printed = false;
   std::string summary;  ///< its text

@@ -241,10 +241,25 @@ TEST(DdsForkServer, BadFileStopsTheForkedRunWithTheAgentsReason) {
   std::string out;
   const int rc = run_command(
       bin("tessera") + " launch " + graph + " --agents 2 --domain 53 --timeout 30 2>&1", &out);
-  EXPECT_NE(rc, 0) << out;
+  EXPECT_EQ(rc, 2) << out;  // bad input: tessera solve's exit code (launch/failure_report.hpp)
   EXPECT_NE(out.find("forked by tessera-fork-server"), std::string::npos) << out;
   EXPECT_NE(out.find("bad.g2o"), std::string::npos) << out;  // the agent's message names the file
   EXPECT_NE(out.find("exit 2"), std::string::npos) << out;   // its exit code, as when exec'ed
+}
+
+// More agents than poses: every agent says so and exits with 2; launch shows the message once,
+// under all their names, and exits with 2 as `tessera solve` does for bad input.
+TEST(DdsForkServer, AGraphTooSmallForTheTeamIsReportedOnceWithTheInputErrorsExitCode) {
+  const std::string dir = temp_dir();
+  const std::string graph = write_file(
+      dir, "two.g2o", "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n");
+  std::string out;
+  const int rc = run_command(
+      bin("tessera") + " launch " + graph + " --agents 3 --domain 53 --timeout 30 2>&1", &out);
+  EXPECT_EQ(rc, 2) << out;
+  EXPECT_NE(out.find("agents 0, 1 and 2 (exit 2):"), std::string::npos) << out;
+  EXPECT_NE(out.find("cannot split 2 poses among 3 robots"), std::string::npos) << out;
+  EXPECT_EQ(out.find("tessera-agent[1]"), std::string::npos) << out;  // shown once, as agent 0's
 }
 
 // A child that ignores SIGINT is SIGKILLed after the grace period, and launch names it (its
