@@ -53,7 +53,7 @@ options:
                       step's point (docs/online.md)                  [new]
   --tangent-dots split|sequential  the tangent preconditioner's backward dot products as
                       four partial sums, or CHOLMOD's sequential sums (its bits) [split]
-  --certify-every S   also certify the graph received so far every S seconds (the lead's
+%GROWTHLOCAL%  --certify-every S   also certify the graph received so far every S seconds (the lead's
                       clock; at the next epoch that brought data, once the graph is
                       connected; no staircase climb)                  [0 = off]
   --publish-every S   publish this robot's current estimate (rounded to SE(d)) on topic
@@ -63,11 +63,12 @@ options:
   --verbose           print each epoch (members, what entered, solve or idle)
   --help              this text
 
-The --step-coarse options, --first-step-factors, --tangent-dots and the re-partition's below
-are the same on every agent of the run (the coarse correction adds message steps to every
-agent's Newton steps, the other two change every agent's arithmetic; each agent moves the
-blocks itself): an agent whose options differ from the lead's stops with exit code 2 naming
-the option.
+The --step-coarse options, --first-step-factors, --tangent-dots, --refactor-growth,
+--local-threshold, --no-local-rounds and the re-partition's below are the same on every
+agent of the run (the coarse correction adds message steps to every agent's Newton steps,
+the local rounds decide which agents send each round, the others change every agent's
+arithmetic; each agent moves the blocks itself): an agent whose options differ from the
+lead's stops with exit code 2 naming the option.
 
 re-partition:
 %REBALANCE%
@@ -85,6 +86,7 @@ const char* online_agent_usage() {
       t.replace(t.find(mark), mark.size(), text);
     };
     put("%STEPCOARSE%", cli::kStepCoarseHelp);
+    put("%GROWTHLOCAL%", cli::kGrowthAndLocalRoundsHelp);
     put("%REBALANCE%\n", cli::kRebalanceHelp);
     return t;
   }();
@@ -97,8 +99,9 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
                                   "timeout",       "json",    "certify-every", "certify-iters",
                                   "publish-every", "tum-dir", "on-agent-loss", "step-solver",
                                   "newton-after",  "lease"};
-  valued.insert({"first-step-factors", "tangent-dots"});  // cli/run_wide_args.hpp
-  std::set<std::string> switches = {"online", "no-certify", "verbose", "help"};
+  valued.insert({"first-step-factors", "tangent-dots", "refactor-growth",
+                 "local-threshold"});  // cli/run_wide_args.hpp
+  std::set<std::string> switches = {"online", "no-certify", "no-local-rounds", "verbose", "help"};
   for (const char* const* f = cli::kRebalanceValued; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceSwitches; *f; ++f) switches.insert(*f);
   for (const char* const* f = cli::kStepCoarseValued; *f; ++f) valued.insert(*f);
@@ -149,6 +152,7 @@ OnlineAgentOptions parse_online_agent_options(const std::vector<std::string>& ar
   cli::parse_step_coarse_options(args, o.online);
   o.online.first_step_on_grown_factors = cli::first_step_on_grown_factors_of(args);
   s.block_update.tangent_split_dots = cli::tangent_split_dots_of(args);
+  cli::parse_growth_and_local_rounds(args, o.online);
   o.online.rebalance = cli::parse_rebalance_options(args);
   o.online.validate();
   return o;

@@ -27,7 +27,20 @@ transport::OnlineTeamOptions team_options(const OnlineOptions& o) {
   t.step_coarse_aggregates = o.newton_coarse_aggregates;
   t.first_step_on_grown_factors = o.first_step_on_grown_factors;
   t.tangent_split_dots = o.solver.block_update.tangent_split_dots;
+  t.local_rounds = o.solver.local_rounds.enabled;
+  t.local_threshold = o.solver.local_rounds.threshold;
+  t.refactor_growth = o.refactor_growth;
   return t;
+}
+
+cli::RunWideOptions run_wide_options(const transport::OnlineTeamOptions& t) {
+  cli::RunWideOptions o;
+  o.first_step_on_grown_factors = t.first_step_on_grown_factors;
+  o.tangent_split_dots = t.tangent_split_dots;
+  o.local_rounds = t.local_rounds;
+  o.local_threshold = t.local_threshold;
+  o.refactor_growth = t.refactor_growth;
+  return o;
 }
 
 // "" when `theirs` (agent `sender`'s report) equals `mine`; else the first option that differs.
@@ -39,9 +52,7 @@ std::string team_disagreement(const transport::OnlineTeamOptions& mine,
         mine.step_coarse, mine.step_coarse_min_blocks, mine.step_coarse_aggregates,
         theirs.step_coarse, theirs.step_coarse_min_blocks, theirs.step_coarse_aggregates, sender);
   if (differs.empty())
-    differs = cli::run_wide_disagreement(mine.first_step_on_grown_factors, mine.tangent_split_dots,
-                                         theirs.first_step_on_grown_factors,
-                                         theirs.tangent_split_dots, sender);
+    differs = cli::run_wide_disagreement(run_wide_options(mine), run_wide_options(theirs), sender);
   return differs;
 }
 
@@ -80,9 +91,10 @@ void OnlineLink::pump_channel() {
 
 void OnlineLink::file_report(transport::OnlineReportSample&& r) {
   // Every agent moves the blocks itself and takes part in every message step of the Newton
-  // steps' coarse correction, so all use the lead's re-partition and --step-coarse options:
-  // an agent whose options differ is not admitted (its hello is not counted), and an agent
-  // that reads the lead's report with other options than its own stops, naming the option.
+  // steps' coarse correction, so all use the lead's re-partition and --step-coarse options
+  // (and its run-wide solver options, cli/run_wide_args.hpp: the local rounds decide who sends
+  // each round): an agent whose options differ is not admitted (its hello is not counted), and an
+  // agent that reads the lead's report with other options than its own stops, naming the option.
   const std::string differs = team_disagreement(team_options(s_.o.online), r.team, r.sender);
   if (r.epoch == transport::kHelloEpoch && !differs.empty()) {
     if (refused_.insert(r.sender).second)

@@ -2,11 +2,13 @@
 // Solver options that change every agent's arithmetic, as `tessera solve`, `tessera launch`,
 // tessera-coordinator and `tessera-agent --online` spell them: the backward dot products of
 // the tangent preconditioner (--tangent-dots) and, online, the factors of a step's first Newton
-// step (--first-step-factors). Over DDS every agent of a run must use the same value: the
-// coordinator's assignment carries --tangent-dots (transport/assignment_options.hpp), and the
-// online agents check --first-step-factors and --tangent-dots against the lead's.
+// step (--first-step-factors), when a growing block's factor is rebuilt (--refactor-growth) and
+// the local rounds (--no-local-rounds, --local-threshold). Over DDS every agent of a run must
+// use the same value: the coordinator's assignment carries --tangent-dots
+// (transport/assignment_options.hpp), and the online agents check all five against the lead's.
 
 #include <string>
+#include <tessera/online/online_engine.hpp>
 
 #include "arguments.hpp"
 
@@ -29,10 +31,28 @@ const char* first_step_factors_name(bool grown);
 /// --first-step-factors of `args` (default new).
 bool first_step_on_grown_factors_of(const Arguments& args);
 
-/// "" when an online agent's --first-step-factors (`mine_grown`) and --tangent-dots
-/// (`mine_split`) equal the lead's (agent `lead_agent`); else a message naming the first flag
-/// that differs, both values, and why all agents must share it.
-std::string run_wide_disagreement(bool mine_grown, bool mine_split, bool lead_grown,
-                                  bool lead_split, unsigned lead_agent);
+/// Help text of --refactor-growth, --local-threshold and --no-local-rounds (aligned as the
+/// agent's and launch's usage texts).
+extern const char* const kGrowthAndLocalRoundsHelp;
+/// Sets options.refactor_growth (--refactor-growth, >= 0) and options.solver.local_rounds
+/// (--no-local-rounds; --local-threshold, in (0, 1]) from `args`, defaults for absent ones;
+/// InputError names the bad option. `tessera solve --online`, `tessera launch --online` and
+/// `tessera-agent --online` share it.
+void parse_growth_and_local_rounds(const Arguments& args, OnlineOptions& options);
+
+/// The options an online agent of a DDS run must share with the lead (OnlineOptions' fields).
+struct RunWideOptions {
+  bool first_step_on_grown_factors = false;  ///< first_step_on_grown_factors
+  bool tangent_split_dots = true;            ///< solver.block_update.tangent_split_dots
+  bool local_rounds = true;                  ///< solver.local_rounds.enabled
+  double local_threshold = 1.0;              ///< solver.local_rounds.threshold
+  double refactor_growth = 0.0;              ///< refactor_growth
+};
+
+/// "" when an online agent's options (`mine`) equal the lead's (agent `lead_agent`; the
+/// threshold only with local rounds on); else a message naming the first flag that differs,
+/// both values, and why all agents must share it.
+std::string run_wide_disagreement(const RunWideOptions& mine, const RunWideOptions& lead,
+                                  unsigned lead_agent);
 
 }  // namespace tessera::cli

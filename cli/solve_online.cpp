@@ -207,14 +207,11 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
   options.real_time = a.has("real-time");
   options.certify_every_s = a.get_double("certify-every", 0.0);
   options.step_every_s = a.get_double("step-every", 0.0);
-  options.refactor_growth = a.get_double("refactor-growth", options.refactor_growth);
   options.first_step_on_grown_factors = first_step_on_grown_factors_of(a);
   options.rebalance = parse_rebalance_options(a);
   options.solver.threads = static_cast<int>(a.get_long("threads", options.solver.threads));
   options.solver.block_update.tangent_split_dots = tangent_split_dots_of(a);
-  options.solver.local_rounds.enabled = !a.has("no-local-rounds");
-  options.solver.local_rounds.threshold =
-      a.get_double("local-threshold", options.solver.local_rounds.threshold);
+  parse_growth_and_local_rounds(a, options);
   {
     const std::string step_solver = a.get_or("step-solver", "newton");
     if (step_solver != "newton" && step_solver != "rounds")

@@ -16,6 +16,7 @@
 #include <string>
 #include <tessera/util/input_error.hpp>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "arguments.hpp"
@@ -66,7 +67,7 @@ new, and certify the estimate after every robot's last batch.
                       new poses appended (docs/online.md)            [new]
   --tangent-dots split|sequential  the tangent preconditioner's backward dot products as
                       four partial sums, or CHOLMOD's sequential sums (its bits) [split]
-  --publish-every S   each agent publishes its robot's estimate every S seconds
+%GROWTHLOCAL%  --publish-every S   each agent publishes its robot's estimate every S seconds
                       (topic tessera_online_estimate)
   --tum-dir DIR       per-robot TUM snapshots DIR/robot<r>.tum, rewritten at every
                       publication and at the end
@@ -74,11 +75,13 @@ new, and certify the estimate after every robot's last batch.
                       updates, final answer) and every agent's traffic under "agents"
   --keep-logs DIR     keep the processes' logs and summaries in DIR
 
-The --step-coarse options, --first-step-factors, --tangent-dots and the re-partition's below
-are passed to every agent (the coarse correction adds message steps to every agent's Newton
-steps, the other two change every agent's arithmetic; each agent moves the blocks itself), so
-all use the same. Options of tessera solve --online that a run over DDS cannot use (its
-in-process evaluation: --checkpoints, --baseline...) are refused, naming the reason.
+The --step-coarse options, --first-step-factors, --tangent-dots, --refactor-growth,
+--local-threshold, --no-local-rounds and the re-partition's below are passed to every agent
+(the coarse correction adds message steps to every agent's Newton steps, the local rounds
+decide which agents send each round, the others change every agent's arithmetic; each agent
+moves the blocks itself), so all use the same. Options of tessera solve --online that a run
+over DDS cannot use (its in-process evaluation: --checkpoints, --baseline...) are refused,
+naming the reason.
 
 re-partition:
 )";
@@ -137,24 +140,27 @@ int run_online_launch(const std::vector<std::string>& argv) {
   for (const auto& a : argv)
     if (a == "--help" || a == "-h") {
       std::string help = kOnlineHelp;
-      const std::string mark = "%STEPCOARSE%";
-      help.replace(help.find(mark), mark.size(), cli::kStepCoarseHelp);
+      for (const auto& [mark, text] :
+           {std::pair<std::string, const char*>{"%STEPCOARSE%", cli::kStepCoarseHelp},
+            {"%GROWTHLOCAL%", cli::kGrowthAndLocalRoundsHelp}})
+        help.replace(help.find(mark), mark.size(), text);
       std::fputs(help.c_str(), stdout);
       std::fputs(cli::kRebalanceHelp, stdout);
       return 0;
     }
   // Launch's options that every agent gets as they are.
-  static const char* const kForwarded[] = {"algorithm",     "rank",
-                                           "grad-tol",      "timeout",
-                                           "certify-every", "certify-iters",
-                                           "publish-every", "tum-dir",
-                                           "on-agent-loss", "step-solver",
-                                           "newton-after",  "lease",
-                                           "max-rounds",    "first-step-factors",
-                                           "tangent-dots",  nullptr};
+  static const char* const kForwarded[] = {"algorithm",       "rank",
+                                           "grad-tol",        "timeout",
+                                           "certify-every",   "certify-iters",
+                                           "publish-every",   "tum-dir",
+                                           "on-agent-loss",   "step-solver",
+                                           "newton-after",    "lease",
+                                           "max-rounds",      "first-step-factors",
+                                           "tangent-dots",    "refactor-growth",
+                                           "local-threshold", nullptr};
   std::set<std::string> valued = {"agents", "rate",   "speedup", "start",
                                   "run-id", "domain", "json",    "keep-logs"};
-  std::set<std::string> switches = {"online", "no-certify"};
+  std::set<std::string> switches = {"online", "no-certify", "no-local-rounds"};
   for (const char* const* f = kForwarded; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceValued; *f; ++f) valued.insert(*f);
   for (const char* const* f = cli::kRebalanceSwitches; *f; ++f) switches.insert(*f);
@@ -192,8 +198,9 @@ int run_online_launch(const std::vector<std::string>& argv) {
   cli::tangent_split_dots_of(args);
   if (args.has("max-rounds") && args.get_long("max-rounds", 0) < 1)
     throw InputError("option --max-rounds: must be >= 1");
-  OnlineOptions step_coarse;
-  cli::parse_step_coarse_options(args, step_coarse);
+  OnlineOptions checked;
+  cli::parse_step_coarse_options(args, checked);
+  cli::parse_growth_and_local_rounds(args, checked);
 
   if (auto dir = args.get("tum-dir")) {
     std::error_code ec;
@@ -226,7 +233,8 @@ int run_online_launch(const std::vector<std::string>& argv) {
   for (const char* const* flag = cli::kStepCoarseValued; *flag; ++flag) forward_valued(*flag);
   for (const char* const* flag = cli::kRebalanceSwitches; *flag; ++flag)
     if (args.has(*flag)) forwarded.push_back(std::string("--") + *flag);
-  if (args.has("no-certify")) forwarded.push_back("--no-certify");
+  for (const char* flag : {"no-certify", "no-local-rounds"})
+    if (args.has(flag)) forwarded.push_back(std::string("--") + flag);
   for (long i = 0; i < agents; ++i) {
     std::vector<std::string> a = {bin + "/tessera-agent", "--online", "--robots",
                                   std::to_string(agents), "--id",     std::to_string(i)};

@@ -15,9 +15,6 @@ constexpr const char* kCentralized =
 constexpr const char* kCentralizedGnc =
     "it sets the centralized GNC, and launch runs the distributed one (tessera-coordinator "
     "accepts it for tessera solve's option set and changes nothing with it)";
-constexpr const char* kNotCarriedOnline =
-    "tessera-agent --online does not take it, so every agent would run core's default; tune it "
-    "with tessera solve --online (in process)";
 constexpr const char* kInProcessOnly =
     "it is part of tessera solve --online's in-process evaluation, which a run over DDS does "
     "not do";
@@ -115,9 +112,6 @@ const std::vector<SolveOnlyFlag>& online_solve_only_flags() {
       {"progress-interval", "launch --online prints no progress lines of its own"},
       {"threads",
        "it runs the in-process agents on that many threads; over DDS each agent is a process"},
-      {"refactor-growth", kNotCarriedOnline},
-      {"local-threshold", kNotCarriedOnline},
-      {"no-local-rounds", kNotCarriedOnline},
   };
   return flags;
 }

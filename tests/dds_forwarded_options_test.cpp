@@ -2,7 +2,7 @@
 // (transport/assignment_options.hpp for a batch run, the online agents' team options for an
 // online one): a launch with a non-default value gives the in-process solve's run with that
 // value, and an online agent with another value than the lead's is refused. Domains 109, 122,
-// 123 and 133.
+// 123, 133 and 212.
 
 #include <gtest/gtest.h>
 
@@ -94,14 +94,15 @@ TEST(DdsForwardedOptions, ALaunchWithSequentialTangentDotsEndsAtTheSolvesIterate
   EXPECT_NE(grad["sequential"], grad["split"]);
 }
 
-// Online: launch passes --first-step-factors and --tangent-dots to every agent, which all use
-// them, and the run ends where the in-process one does.
+// Online: launch passes --first-step-factors, --tangent-dots and --local-threshold to every
+// agent, which all use them, and the run ends where the in-process one does.
 TEST(DdsForwardedOptions, AnOnlineLaunchPassesTheStepFactorsAndDotsToEveryAgent) {
   const std::string dir = temp_dir();
   const std::string graph = dir + "/grid.g2o";
   generate_graph(graph, "--kind grid3d --poses 150 --robots 3");
   const std::string flags =
-      " --rate 20 --speedup 2 --first-step-factors grown --tangent-dots sequential";
+      " --rate 20 --speedup 2 --first-step-factors grown --tangent-dots sequential"
+      " --local-threshold 0.5";
   const std::string in_process =
       solve_summary(dir, graph, "--online --robots 3 --no-progress" + flags, "in_process");
   EXPECT_EQ(json_text(in_process, "certified"), "true");
@@ -114,6 +115,9 @@ TEST(DdsForwardedOptions, AnOnlineLaunchPassesTheStepFactorsAndDotsToEveryAgent)
     const std::string agent = online_agent_summary(dir, a);
     EXPECT_EQ(json_text(agent, "first_step_factors"), "\"grown\"") << "agent " << a;
     EXPECT_EQ(json_text(agent, "tangent_dots"), "\"sequential\"") << "agent " << a;
+    EXPECT_EQ(json_text(agent, "local_rounds"), "true") << "agent " << a;
+    EXPECT_EQ(json_number(agent, "local_threshold"), 0.5) << "agent " << a;
+    EXPECT_EQ(json_number(agent, "refactor_growth"), 0.0) << "agent " << a;
   }
   // Bad values and the in-process evaluation's flags are launch's own input errors.
   std::string out;
@@ -127,9 +131,38 @@ TEST(DdsForwardedOptions, AnOnlineLaunchPassesTheStepFactorsAndDotsToEveryAgent)
                   &out),
       2);
   EXPECT_TRUE(contains(out, "--checkpoints is an option of `tessera solve` only")) << out;
+  EXPECT_EQ(run_command(bin("tessera") + " launch " + graph +
+                            " --agents 3 --online --local-threshold 1.5 2>&1",
+                        &out),
+            2);
+  EXPECT_TRUE(contains(out, "option --local-threshold: must be in (0, 1]")) << out;
 }
 
-TEST(DdsForwardedOptions, AnOnlineAgentWithOtherStepFactorsThanTheLeadsIsRefused) {
+// Online: launch passes --refactor-growth and --no-local-rounds to every agent (with the
+// default first-step factors, so the growth decides when the grown blocks factor again), and
+// the run ends where the in-process one does.
+TEST(DdsForwardedOptions, AnOnlineLaunchPassesTheFactorGrowthAndNoLocalRoundsToEveryAgent) {
+  const std::string dir = temp_dir();
+  const std::string graph = dir + "/grid.g2o";
+  generate_graph(graph, "--kind grid3d --poses 150 --robots 3");
+  const std::string flags = " --rate 20 --speedup 2 --refactor-growth 0.1 --no-local-rounds";
+  const std::string in_process =
+      solve_summary(dir, graph, "--online --robots 3 --no-progress" + flags, "in_process");
+  EXPECT_EQ(json_text(in_process, "certified"), "true");
+  const double f_in_process = json_number(in_process, "cost");
+  const std::string json = online_launch(dir, graph, 212, flags);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  EXPECT_EQ(json_text(json, "certified"), "true");
+  EXPECT_NEAR(json_number(json, "cost"), f_in_process, 1e-6 * f_in_process);
+  for (int a = 0; a < 3; ++a) {
+    const std::string agent = online_agent_summary(dir, a);
+    EXPECT_EQ(json_number(agent, "refactor_growth"), 0.1) << "agent " << a;
+    EXPECT_EQ(json_text(agent, "local_rounds"), "false") << "agent " << a;
+    EXPECT_EQ(json_text(agent, "first_step_factors"), "\"new\"") << "agent " << a;
+  }
+}
+
+TEST(DdsForwardedOptions, AnOnlineAgentWithOtherSolverOptionsThanTheLeadsIsRefused) {
   const std::string dir = temp_dir();
   const Process other =
       refused_beside_lead(dir, "online-factors-differ", 133, {"--first-step-factors", "grown"});
@@ -143,6 +176,19 @@ TEST(DdsForwardedOptions, AnOnlineAgentWithOtherStepFactorsThanTheLeadsIsRefused
                        "option --tangent-dots: this agent's sequential differs from the "
                        "lead's (agent 0) split"))
       << dots.output();
+  // Local rounds decide which agents send their statuses each round.
+  const Process local =
+      refused_beside_lead(dir, "online-local-differs", 133, {"--no-local-rounds"});
+  EXPECT_TRUE(contains(local.output(),
+                       "option --no-local-rounds: this agent's absent differs from the "
+                       "lead's (agent 0) given"))
+      << local.output();
+  const Process growth =
+      refused_beside_lead(dir, "online-growth-differs", 133, {}, {"--refactor-growth", "0.25"});
+  EXPECT_TRUE(contains(growth.output(),
+                       "option --refactor-growth: this agent's 0.25 differs from the "
+                       "lead's (agent 0) 0"))
+      << growth.output();
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 
 #include "launch/forwarded_flags.hpp"
 #include "launch/launch_argv.hpp"
+#include "launch/online_launch.hpp"
 #include "launch/solve_only_flags.hpp"
 #include "test_support.hpp"
 
@@ -324,6 +325,34 @@ TEST(LaunchOptions, SolveOnlyFlagsAreRefusedWithTheirReason) {
     EXPECT_EQ(find_forwarded_flag(f.name), nullptr) << f.name;
     EXPECT_EQ(help.find(std::string("  --") + f.name + " "), std::string::npos) << f.name;
   }
+}
+
+// An online launch takes `tessera solve --online`'s factor growth and local rounds (it passes
+// them to every agent), names a bad value before it starts anything, and lists them in its
+// help; the flags a run over DDS cannot use are still refused.
+TEST(LaunchOptions, AnOnlineLaunchTakesTheFactorGrowthAndLocalRounds) {
+  const std::vector<std::string> flags = {"refactor-growth", "local-threshold", "no-local-rounds"};
+  EXPECT_NO_THROW(refuse_solve_only_flags(
+      {"--refactor-growth", "0.1", "--local-threshold=0.5", "--no-local-rounds"},
+      online_solve_only_flags()));
+  EXPECT_THROW(refuse_solve_only_flags({"--checkpoints", "3"}, online_solve_only_flags()),
+               InputError);
+  const std::string graph = test::write_file(test::temp_dir(), "graph.g2o", "");
+  const auto error = [&graph](const Argv& extra) {
+    Argv argv = {graph, "--agents", "3", "--online"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return test::input_error_of([&argv] { run_online_launch(argv); });
+  };
+  EXPECT_EQ(error({"--local-threshold", "0"}), "option --local-threshold: must be in (0, 1]");
+  EXPECT_EQ(error({"--no-local-rounds", "--refactor-growth", "-1"}),
+            "option --refactor-growth: must be a finite number >= 0");
+  ::testing::internal::CaptureStdout();
+  EXPECT_EQ(run_online_launch({"--online", "--help"}), 0);
+  const std::string help = ::testing::internal::GetCapturedStdout();
+  for (const std::string& f : flags)
+    EXPECT_NE(help.find("  --" + f + " "), std::string::npos) << f << "\n" << help;
+  for (const SolveOnlyFlag& f : online_solve_only_flags())
+    EXPECT_EQ(help.find(std::string("  --") + f.name + " "), std::string::npos) << f.name;
 }
 
 }  // namespace

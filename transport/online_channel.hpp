@@ -37,6 +37,11 @@ struct OnlineTeamOptions {
   /// OnlineOptions::solver (their defaults here too).
   bool first_step_on_grown_factors = false;
   bool tangent_split_dots = true;
+  /// LocalRoundOptions::enabled and threshold of OnlineOptions::solver, and
+  /// OnlineOptions::refactor_growth (their online defaults here too).
+  bool local_rounds = true;
+  double local_threshold = 1.0;
+  double refactor_growth = 0.0;
 };
 
 struct OnlineReportSample {
