@@ -6,6 +6,7 @@
 #include <tessera/robust/gnc_distributed.hpp>
 
 #include "gnc_fixtures.hpp"
+#include "robust/gnc_solve_setup.hpp"
 #include "test_support.hpp"
 
 namespace tessera {
@@ -70,6 +71,37 @@ TEST(GncRefineSteps, WeightedStepsThatFactorSigmaOnEveryAgentTakeTheSameIterates
   // At least one message step less per weighted solve (one CG direction each).
   EXPECT_LE(every.refine_message_steps,
             shipped.refine_message_steps - (shipped.outer_iterations - 1));
+}
+
+// A weighted solve is one Newton step, one trial: its exact trial translations never wait for
+// agent 0's solve. NewtonRefineOptions::translation_one_factor_min_poses applies to the inlier
+// passes and the final solve, whose refinements take several trials, not to GNC's steps; the
+// answer is the same either way.
+TEST(GncRefineSteps, WeightedStepsSolveTheirTrialTranslationsOnEveryAgent) {
+  GncDistributedOptions o;
+  o.robust.kind = RobustKind::kGncTls;
+  o.solver.refine.translation_one_factor_min_poses = 0;  // agent 0's solves wherever allowed
+  EXPECT_GT(
+      gnc_solve_options(o, GncSolveKind::kGnc, false, true).refine.translation_one_factor_min_poses,
+      1000000);
+  EXPECT_EQ(gnc_solve_options(o, GncSolveKind::kInlierPass, false)
+                .refine.translation_one_factor_min_poses,
+            0);
+  EXPECT_EQ(
+      gnc_solve_options(o, GncSolveKind::kFinal, false).refine.translation_one_factor_min_poses, 0);
+
+  const GeneratorResult dirty = test::grid_with_outliers(0.25);
+  o.solver.certify = true;
+  const GncDistributedResult low =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  o.solver.refine.translation_one_factor_min_poses = 1000000;  // every agent factors
+  const GncDistributedResult high =
+      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  ASSERT_GT(high.refine_message_steps, 0) << "the weighted solves should be Newton steps";
+  EXPECT_EQ(low.rejected, dirty.outliers);
+  EXPECT_EQ(low.rejected, high.rejected);
+  EXPECT_EQ(low.weights, high.weights);
+  EXPECT_TRUE(low.final_solve.certified.value_or(false));
 }
 
 TEST(GncRefineSteps, WithoutRefinedPassesTheWeightedSolvesStayRounds) {

@@ -34,6 +34,10 @@ DistributedOptions gnc_solve_options(const GncDistributedOptions& options, GncSo
         if (options.robust.step_sigma_every_agent &&
             o.refine.sigma_factoring == NewtonRefineOptions::SigmaFactoring::kShipSolves)
           o.refine.sigma_factoring = NewtonRefineOptions::SigmaFactoring::kEveryAgent;
+        // A weighted solve is one Newton step, one trial: agent 0's translation solve would
+        // add a message step to each, for a small factor (the trial translations' Sigma, one
+        // row per interface pose) that every agent factors in about the time it waits.
+        o.refine.translation_one_factor_min_poses = std::numeric_limits<int>::max();
       }
       break;
     case GncSolveKind::kInlierPass:
