@@ -33,7 +33,9 @@ fi
 
 JOBS=$(nproc 2>/dev/null || echo 2)
 launcher=()
-command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+# The tests' precompiled header (tests/CMakeLists.txt) is cacheable only with this sloppiness.
+command -v ccache >/dev/null &&
+  launcher=("-DCMAKE_CXX_COMPILER_LAUNCHER=env;CCACHE_SLOPPINESS=pch_defines,time_macros;ccache")
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTESSERA_WERROR="${TESSERA_WERROR:-ON}" \
   "${launcher[@]}" >/dev/null
 cmake --build build -j "$JOBS"
