@@ -97,9 +97,13 @@ void OnlineLink::file_report(transport::OnlineReportSample&& r) {
   // agent that reads the lead's report with other options than its own stops, naming the option.
   const std::string differs = team_disagreement(team_options(s_.o.online), r.team, r.sender);
   if (r.epoch == transport::kHelloEpoch && !differs.empty()) {
+    // Said as the joiner reads it: its values against the team's (the lead's, which every
+    // member shares).
     if (refused_.insert(r.sender).second)
-      std::fprintf(stderr, "agent %d: agent %u not admitted: its options differ (%s)\n", s_.o.id,
-                   r.sender, differs.c_str());
+      std::fprintf(
+          stderr, "agent %d: agent %u not admitted: its options differ (%s)\n", s_.o.id, r.sender,
+          team_disagreement(r.team, team_options(s_.o.online), s_.membership.lead_of(s_.epoch))
+              .c_str());
     return;
   }
   s_.membership.heard_from(r.sender);
