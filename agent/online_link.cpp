@@ -25,22 +25,8 @@ transport::OnlineTeamOptions team_options(const OnlineOptions& o) {
   t.step_coarse = o.newton_coarse;
   t.step_coarse_min_blocks = o.newton_coarse_min_blocks;
   t.step_coarse_aggregates = o.newton_coarse_aggregates;
-  t.first_step_on_grown_factors = o.first_step_on_grown_factors;
-  t.tangent_split_dots = o.solver.block_update.tangent_split_dots;
-  t.local_rounds = o.solver.local_rounds.enabled;
-  t.local_threshold = o.solver.local_rounds.threshold;
-  t.refactor_growth = o.refactor_growth;
+  t.run_wide = cli::run_wide_options_of(o);
   return t;
-}
-
-cli::RunWideOptions run_wide_options(const transport::OnlineTeamOptions& t) {
-  cli::RunWideOptions o;
-  o.first_step_on_grown_factors = t.first_step_on_grown_factors;
-  o.tangent_split_dots = t.tangent_split_dots;
-  o.local_rounds = t.local_rounds;
-  o.local_threshold = t.local_threshold;
-  o.refactor_growth = t.refactor_growth;
-  return o;
 }
 
 // "" when `theirs` (agent `sender`'s report) equals `mine`; else the first option that differs.
@@ -51,8 +37,7 @@ std::string team_disagreement(const transport::OnlineTeamOptions& mine,
     differs = cli::step_coarse_disagreement(
         mine.step_coarse, mine.step_coarse_min_blocks, mine.step_coarse_aggregates,
         theirs.step_coarse, theirs.step_coarse_min_blocks, theirs.step_coarse_aggregates, sender);
-  if (differs.empty())
-    differs = cli::run_wide_disagreement(run_wide_options(mine), run_wide_options(theirs), sender);
+  if (differs.empty()) differs = cli::run_wide_disagreement(mine.run_wide, theirs.run_wide, sender);
   return differs;
 }
 

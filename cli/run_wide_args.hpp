@@ -11,6 +11,7 @@
 #include <tessera/online/online_engine.hpp>
 
 #include "arguments.hpp"
+#include "cli/run_wide_options.hpp"
 
 namespace tessera::cli {
 
@@ -39,15 +40,6 @@ extern const char* const kGrowthAndLocalRoundsHelp;
 /// InputError names the bad option. `tessera solve --online`, `tessera launch --online` and
 /// `tessera-agent --online` share it.
 void parse_growth_and_local_rounds(const Arguments& args, OnlineOptions& options);
-
-/// The options an online agent of a DDS run must share with the lead (OnlineOptions' fields).
-struct RunWideOptions {
-  bool first_step_on_grown_factors = false;  ///< first_step_on_grown_factors
-  bool tangent_split_dots = true;            ///< solver.block_update.tangent_split_dots
-  bool local_rounds = true;                  ///< solver.local_rounds.enabled
-  double local_threshold = 1.0;              ///< solver.local_rounds.threshold
-  double refactor_growth = 0.0;              ///< refactor_growth
-};
 
 /// "" when an online agent's options (`mine`) equal the lead's (agent `lead_agent`; the
 /// threshold only with local rounds on); else a message naming the first flag that differs,

@@ -9,10 +9,11 @@ namespace {
 std::string anonymous_tail(const FailedProcess& p) {
   if (p.agent < 0) return p.tail;
   const std::string own = "tessera-agent[" + std::to_string(p.agent) + "]";
+  const std::string anonymous = "tessera-agent[*]";
   std::string out = p.tail;
   for (std::size_t at = out.find(own); at != std::string::npos;
-       at = out.find(own, at + sizeof("tessera-agent[*]") - 1))
-    out.replace(at, own.size(), "tessera-agent[*]");
+       at = out.find(own, at + anonymous.size()))
+    out.replace(at, own.size(), anonymous);
   return out;
 }
 

@@ -258,11 +258,11 @@ struct OnlineChannel::Impl : public dds::DataReaderListener {
       r.team.step_coarse = coarse_of_wire(w.step_coarse().coarse());
       r.team.step_coarse_min_blocks = static_cast<int>(w.step_coarse().min_blocks());
       r.team.step_coarse_aggregates = static_cast<int>(w.step_coarse().aggregates());
-      r.team.first_step_on_grown_factors = w.first_step_grown_factors();
-      r.team.tangent_split_dots = !w.tangent_sequential_dots();
-      r.team.local_rounds = !w.no_local_rounds();
-      r.team.local_threshold = w.local_threshold();
-      r.team.refactor_growth = w.refactor_growth();
+      r.team.run_wide.first_step_on_grown_factors = w.first_step_grown_factors();
+      r.team.run_wide.tangent_split_dots = !w.tangent_sequential_dots();
+      r.team.run_wide.local_rounds = !w.no_local_rounds();
+      r.team.run_wide.local_threshold = w.local_threshold();
+      r.team.run_wide.refactor_growth = w.refactor_growth();
       reports.push_back(std::move(r));
     }
   }
@@ -327,11 +327,11 @@ std::size_t OnlineChannel::send_report(const OnlineReportSample& r) {
   w.step_coarse().coarse(wire_of_coarse(impl_->team.step_coarse));
   w.step_coarse().min_blocks(static_cast<std::uint32_t>(impl_->team.step_coarse_min_blocks));
   w.step_coarse().aggregates(static_cast<std::uint32_t>(impl_->team.step_coarse_aggregates));
-  w.first_step_grown_factors(impl_->team.first_step_on_grown_factors);
-  w.tangent_sequential_dots(!impl_->team.tangent_split_dots);
-  w.no_local_rounds(!impl_->team.local_rounds);
-  w.local_threshold(impl_->team.local_threshold);
-  w.refactor_growth(impl_->team.refactor_growth);
+  w.first_step_grown_factors(impl_->team.run_wide.first_step_on_grown_factors);
+  w.tangent_sequential_dots(!impl_->team.run_wide.tangent_split_dots);
+  w.no_local_rounds(!impl_->team.run_wide.local_rounds);
+  w.local_threshold(impl_->team.run_wide.local_threshold);
+  w.refactor_growth(impl_->team.run_wide.refactor_growth);
   if (!write_patiently(impl_->report_writer, w))
     throw std::runtime_error("online channel: a report write failed");
   return serialized_size(w);

@@ -15,6 +15,8 @@
 #include <tessera/protocol/messages.hpp>
 #include <vector>
 
+#include "cli/run_wide_options.hpp"
+
 namespace tessera::transport {
 
 inline constexpr const char* kOnlineBlockTopic = "tessera_online_block";
@@ -33,15 +35,8 @@ struct OnlineTeamOptions {
   NewtonRefineOptions::Coarse step_coarse = NewtonRefineOptions::Coarse::kNone;
   int step_coarse_min_blocks = 3;
   int step_coarse_aggregates = 8;
-  /// OnlineOptions::first_step_on_grown_factors and BlockUpdateOptions::tangent_split_dots of
-  /// OnlineOptions::solver (their defaults here too).
-  bool first_step_on_grown_factors = false;
-  bool tangent_split_dots = true;
-  /// LocalRoundOptions::enabled and threshold of OnlineOptions::solver, and
-  /// OnlineOptions::refactor_growth (their online defaults here too).
-  bool local_rounds = true;
-  double local_threshold = 1.0;
-  double refactor_growth = 0.0;
+  /// OnlineOptions' run-wide solver options (their online defaults here too).
+  cli::RunWideOptions run_wide;
 };
 
 struct OnlineReportSample {
