@@ -3,8 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "run_wide_args.hpp"
-#include "step_coarse_args.hpp"
+#include "online_options_json.hpp"
 
 namespace tessera::agent {
 
@@ -20,20 +19,9 @@ std::string online_summary_json(const OnlineAgentOptions& o, const OnlineSummary
   const GraphStream* g = state.graph;
   const SolveOutcome& final_solve = state.final_solve;
   cli::JsonObject j;
-  j.add("agent", o.id)
-      .add("robots", o.robots)
-      .add("run_id", o.run_id)
-      .add("step_solver", o.online.newton_steps ? "newton" : "rounds")
-      .add("step_coarse", cli::step_coarse_name(o.online.newton_coarse))
-      .add("step_coarse_min_blocks", o.online.newton_coarse_min_blocks)
-      .add("step_coarse_aggregates",
-           cli::step_coarse_aggregates_name(o.online.newton_coarse_aggregates))
-      .add("first_step_factors", cli::first_step_factors_name(o.online.first_step_on_grown_factors))
-      .add("tangent_dots", cli::tangent_dots_name(o.online.solver.block_update.tangent_split_dots))
-      .add("refactor_growth", o.online.refactor_growth)
-      .add("local_rounds", o.online.solver.local_rounds.enabled)
-      .add("local_threshold", o.online.solver.local_rounds.threshold)
-      .add("epochs", static_cast<long long>(state.epochs))
+  j.add("agent", o.id).add("robots", o.robots).add("run_id", o.run_id);
+  cli::add_online_solver_options(j, o.online);
+  j.add("epochs", static_cast<long long>(state.epochs))
       .add("solves", f.solves)
       .add("rounds", f.rounds)
       .add("final_rounds", final_solve.rounds)
@@ -53,16 +41,7 @@ std::string online_summary_json(const OnlineAgentOptions& o, const OnlineSummary
       .add("min_eigenvalue", final_solve.min_eigenvalue)
       .add("grad_norm", final_solve.grad_norm);
   if (state.cost) j.add("cost", *state.cost);
-  const RebalanceOptions& b = o.online.rebalance;
-  cli::JsonObject rebalance;
-  rebalance.add("enabled", b.enabled)
-      .add("cut_fraction", b.cut_fraction)
-      .add("slack", b.slack)
-      .add("min_excess", b.min_excess)
-      .add("max_passes", b.max_passes)
-      .add("pass_patience", b.pass_patience)
-      .add("place_by_links", b.place_by_links);
-  j.add("rebalance", rebalance)
+  j.add("rebalance", cli::rebalance_options_json(o.online.rebalance))
       .add("final_blocks", state.final_blocks)
       .add("final_cut", state.final_cut);
   j.add("publications", f.publications);

@@ -19,6 +19,7 @@
 
 #include "json_writer.hpp"
 #include "online_baseline.hpp"
+#include "online_options_json.hpp"
 #include "rebalance_args.hpp"
 #include "robot_files.hpp"
 #include "run_wide_args.hpp"
@@ -375,8 +376,9 @@ int solve_online_command(const Arguments& a, const std::string& graph_path,
         .add("rate", replay.rate)
         .add("speedup", replay.speedup)
         .add("real_time", options.real_time)
-        .add("step_every_s", options.step_every_s)
-        .add("step_solver", options.newton_steps ? "newton" : "rounds")
+        .add("step_every_s", options.step_every_s);
+    add_online_solver_options(j, options);
+    j.add("rebalance", rebalance_options_json(options.rebalance))
         .add("grad_tol", options.solver.grad_norm_tol)
         .add("steps", done.size())
         .add("rounds", res ? res->rounds : rounds)

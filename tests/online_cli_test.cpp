@@ -231,5 +231,29 @@ TEST(OnlineCli, CheckpointsSayHowSoonTheEstimateCameWithinTheGapBound) {
   EXPECT_TRUE(test::contains(out, "--gap-bound")) << out;
 }
 
+TEST(OnlineCli, TheSummaryReportsTheSolverOptionsTheRunUsed) {
+  const Replay r = generated();
+  const std::string defaults = solve(r, "");
+  for (const char* field :
+       {"\"step_solver\": \"newton\"", "\"first_step_factors\": \"new\"",
+        "\"tangent_dots\": \"split\"", "\"local_rounds\": true", "\"step_coarse\": "})
+    EXPECT_TRUE(test::contains(defaults, field)) << field << " missing in\n" << defaults;
+  EXPECT_EQ(json_number(defaults, "refactor_growth"), 0.0);
+  EXPECT_EQ(json_number(defaults, "local_threshold"), 1.0);
+
+  const std::string set = solve(r,
+                                "--refactor-growth 0.25 --local-threshold 0.5 --first-step-factors "
+                                "grown --tangent-dots sequential --step-coarse smoothed "
+                                "--cut-fraction 0.05 --block-slack 0.3");
+  for (const char* field : {"\"first_step_factors\": \"grown\"", "\"tangent_dots\": \"sequential\"",
+                            "\"step_coarse\": \"smoothed\""})
+    EXPECT_TRUE(test::contains(set, field)) << field << " missing in\n" << set;
+  EXPECT_EQ(json_number(set, "refactor_growth"), 0.25);
+  EXPECT_EQ(json_number(set, "local_threshold"), 0.5);
+  EXPECT_EQ(json_number(set, "cut_fraction"), 0.05);
+  EXPECT_EQ(json_number(set, "slack"), 0.3);
+  EXPECT_TRUE(test::contains(solve(r, "--no-local-rounds"), "\"local_rounds\": false"));
+}
+
 }  // namespace
 }  // namespace tessera
