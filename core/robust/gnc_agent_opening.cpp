@@ -86,12 +86,24 @@ void GncAgent::after_start_votes(std::vector<OutgoingMessage>& out) {
     neighbours_current_ = true;
   }
   exchange_->forget_candidate_neighbours();
+  start_voted_ = true;
   after_step_zero(out);
 }
 
 void GncAgent::after_step_zero(std::vector<OutgoingMessage>& out) {
   first_solve_g_ = ++g_;
+  if (weighs_at_start()) {
+    // RobustOptions::weigh_at_start: mu's start and the first weights at the voted start, the
+    // step the first solve would have had (its exchanges' tags are the same).
+    begin_exchange(neighbours_current_ ? Step::kVotes : Step::kPoses, out);
+    return;
+  }
   begin_solve(out);
+}
+
+bool GncAgent::weighs_at_start() const {
+  // Every agent decides the same: the option and whether the run has the start vote.
+  return options_.robust.weigh_at_start && start_voted_;
 }
 
 }  // namespace tessera
