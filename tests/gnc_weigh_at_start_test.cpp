@@ -38,5 +38,16 @@ TEST(GncWeighAtStart, GncWeighsAtTheVotedStartWithNoRoundAndEndsAtTheSameSetInFe
   EXPECT_LT(message_steps(on), message_steps(off));
 }
 
+// The soft 300-pose city with 10 % group outliers, seed 2: nothing lies near the bound at the
+// first weights, so GNC ends there (RobustOptions::jump_band) before any solve has run, and the
+// kept set's fresh start, which wins its vote, becomes the passes' start.
+TEST(GncWeighAtStart, AnEndAtTheFirstWeightsHandsTheKeptSetsStartToThePasses) {
+  const GeneratorResult dirty = test::flexible_city(0.1, OutlierKind::kGroup, 2);
+  const GncDistributedResult r = solve(dirty, true);
+  EXPECT_EQ(r.outer_iterations, 1);
+  EXPECT_EQ(r.rejected, dirty.outliers);
+  EXPECT_TRUE(r.final_solve.certified.value_or(false));
+}
+
 }  // namespace
 }  // namespace tessera
