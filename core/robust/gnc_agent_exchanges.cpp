@@ -47,7 +47,7 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   // (RobustOptions::weigh_at_start: none).
   const bool early = (step == Step::kPoses && stage_->poses_sent_early()) ||
                      (step == Step::kStartPoses && options_.robust.first_solve_takes_start_poses &&
-                      !options_.robust.weigh_at_start);
+                      !weighs_at_start());
   exchange_steps_ += step == Step::kPcm || (step == Step::kKeptStart && !values_held_) ? 2
                      : early                                                           ? 0
                                                                                        : 1;

@@ -95,6 +95,8 @@ class GncSolveStage {
   }
   const BlockLayout& layout() const { return *layout_; }
   bool pass_refines() const;  // the passes hand over to the Newton refinement (gnc_solve_setup)
+  // GNC's weighted solves on the current layout are Newton steps (gnc_solve_setup).
+  bool gnc_refines() const;
 
   bool poses_sent_early() const { return poses_sent_early_; }
   bool poses_early_stale() const { return poses_early_stale_; }

@@ -327,7 +327,8 @@ class GncAgent : public AgentProcess {
   void finish(std::vector<OutgoingMessage>& out);
   void start_kept_set(std::vector<OutgoingMessage>& out);
   void after_step_zero(std::vector<OutgoingMessage>& out);
-  // RobustOptions::weigh_at_start applies: the start vote ran, so no first solve.
+  // RobustOptions::weigh_at_start applies after a start vote: GNC's weighted solves are Newton
+  // steps, so no first solve follows the vote.
   bool weighs_at_start() const;
   void drop_inconsistent(const std::vector<std::uint64_t>& ids);
   // A probe from the current set (summed TLS cost `tls`): the measurements of `flip` change side.
