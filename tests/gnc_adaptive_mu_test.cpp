@@ -61,6 +61,9 @@ TEST(GncAdaptiveMu, OnlyFallingWeightsHoldTheBiggerStepBackAndTheSetStaysInFewer
   // Every weighted solve a Newton step as it ends: with newton_step_trust the rough first steps
   // here are solved by rounds first, and both holds then take 6 outer steps.
   o.robust.newton_step_trust = 0;
+  // From the plain solve's rough point, where the weights fall and rise over several updates
+  // (weighed at the voted start instead, both holds take 6 outer steps here).
+  o.robust.weigh_at_start = false;
   ASSERT_EQ(o.robust.mu_step_hold, MuStepHold::kFalls);
   const GncDistributedResult falls =
       solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);

@@ -95,6 +95,9 @@ TEST(GncDistributed, ClusterProbesRejectExactlyTheGroupsTheAgentsProbesKeep) {
   // GNC's solves by rounds: with Newton steps (RobustOptions::gnc_refine_steps) GNC alone finds
   // exactly these groups here, and there is nothing left for the cluster probes to show.
   o.robust.refine_passes = false;
+  // After the plain solve's rounds: weighed at the voted start (RobustOptions::weigh_at_start)
+  // GNC alone finds exactly these groups here too.
+  o.robust.weigh_at_start = false;
   const GncDistributedResult without = solve_gnc_distributed(g.graph, blocks, o);
   o.cluster_probes = 20;
   const GncDistributedResult with = solve_gnc_distributed(g.graph, blocks, o);

@@ -37,7 +37,9 @@ TEST(MessageSteps, ARobustRunCountsEveryWaitOfItsLongestChain) {
     if (ride_along)  // the weighted and kept set's solves start at their refinement
       ASSERT_LT(r.solve_stages, r.outer_iterations) << "a solve stage per weighted solve";
     else
-      ASSERT_GT(r.solve_stages, r.outer_iterations) << "a solve stage per solve";
+      // (a weighted solve per weight update but the early end's, a pass and the final solve;
+      // no first solve: RobustOptions::weigh_at_start)
+      ASSERT_GE(r.solve_stages, r.outer_iterations) << "a solve stage per solve";
     EXPECT_EQ(message_steps(r), static_cast<long long>(r.longest_chain))
         << "exchanges_ride_along " << ride_along;
   }

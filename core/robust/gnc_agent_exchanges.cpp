@@ -43,9 +43,11 @@ void GncAgent::begin_exchange(Step step, std::vector<OutgoingMessage>& out) {
   // the values, then for agent 0's answer.
   // The poses sent beside a weighted solve's trial sums are no step of their own; the start
   // vote's is the first solve's opening exchange, counted with its solve stage
-  // (RobustOptions::first_solve_takes_start_poses).
+  // (RobustOptions::first_solve_takes_start_poses), where that solve runs
+  // (RobustOptions::weigh_at_start: none).
   const bool early = (step == Step::kPoses && stage_->poses_sent_early()) ||
-                     (step == Step::kStartPoses && options_.robust.first_solve_takes_start_poses);
+                     (step == Step::kStartPoses && options_.robust.first_solve_takes_start_poses &&
+                      !weighs_at_start());
   exchange_steps_ += step == Step::kPcm || (step == Step::kKeptStart && !values_held_) ? 2
                      : early                                                           ? 0
                                                                                        : 1;

@@ -87,12 +87,16 @@ class GncSolveStage {
   const AgentState& state() const { return *state_; }
   /// The iterate (own block, lifted), or the next start before the first solve.
   const Eigen::MatrixXd& iterate() const { return state_ ? state_->Y : start_; }
+  /// The iterate, or the next start while no solve has run (GNC ended at its first weights:
+  /// RobustOptions::weigh_at_start).
   void set_iterate(Eigen::MatrixXd Y) {
-    state_->Y = std::move(Y);
+    (state_ ? state_->Y : start_) = std::move(Y);
     pass_grad_norm_ = std::numeric_limits<double>::quiet_NaN();
   }
   const BlockLayout& layout() const { return *layout_; }
   bool pass_refines() const;  // the passes hand over to the Newton refinement (gnc_solve_setup)
+  // GNC's weighted solves on the current layout are Newton steps (gnc_solve_setup).
+  bool gnc_refines() const;
 
   bool poses_sent_early() const { return poses_sent_early_; }
   bool poses_early_stale() const { return poses_early_stale_; }

@@ -42,6 +42,9 @@ GncDistributedOptions irbcd_gnc() {
   // The rounds schedule these tests state: GNC's solves and the passes by rounds, also where the
   // interface fits (RobustOptions::refine_passes; tests/gnc_refine_steps_test.cpp has it on).
   o.robust.refine_passes = false;
+  // GNC's first weights after the plain solve's rounds, not at the voted start
+  // (RobustOptions::weigh_at_start): the rough GNC these tests' schedules act on.
+  o.robust.weigh_at_start = false;
   return o;
 }
 
