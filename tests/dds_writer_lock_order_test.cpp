@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -39,6 +40,7 @@
 #include <vector>
 
 #include "tesseraPubSubTypes.h"
+#include "transport/fastdds/shm_leftovers.hpp"
 #include "transport/network_profile.hpp"
 #include "transport/qos.hpp"
 
@@ -78,8 +80,13 @@ std::size_t sample_doubles() {
   return env ? static_cast<std::size_t>(std::atol(env)) : 2000;
 }
 
+volatile std::sig_atomic_t writer_stop = 0;
+extern "C" void on_writer_term(int) {
+  writer_stop = 1;
+}
+
 // The writer process (this test binary again, with kWriterRunEnv set to the run id): publishes
-// blocks as fast as write() lets it. Never returns.
+// blocks as fast as write() lets it until SIGTERM, then deletes its participant. Never returns.
 const char* const kWriterRunEnv = "TESSERA_LOCK_ORDER_WRITER_RUN";
 
 [[noreturn]] void writer_process(const std::string& run) {
@@ -101,11 +108,32 @@ const char* const kWriterRunEnv = "TESSERA_LOCK_ORDER_WRITER_RUN";
   tessera::wire::PoseBlock s;
   s.run_id(run);
   s.data(std::vector<double>(sample_doubles(), 1.0));
-  for (std::uint32_t round = 0;; ++round) {
+  std::signal(SIGTERM, on_writer_term);
+  for (std::uint32_t round = 0; !writer_stop; ++round) {
     s.round(round);
     w->write(&s);
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
+  p->delete_contained_entities();
+  factory->delete_participant(p);
+  _exit(0);
+}
+
+// Stops the writer process. Not by SIGKILL while it runs: its Fast DDS threads (the flow
+// controller sending repairs) hold the readers' shared-memory port mutex while they write, and
+// a process killed then leaves it locked; this process's participant then aborted when it was
+// deleted ("Interprocess mutex timeout when locking", seen at the end of a run of 100 cycles).
+// SIGTERM ends the writer between two writes and deletes its participant; SIGKILL only when
+// it does not exit within 10 s (a hung writer).
+void stop_writer(pid_t writer) {
+  kill(writer, SIGTERM);
+  const auto deadline = Clock::now() + std::chrono::seconds(10);
+  while (Clock::now() < deadline) {
+    if (waitpid(writer, nullptr, WNOHANG) == writer) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  kill(writer, SIGKILL);
+  waitpid(writer, nullptr, 0);
 }
 
 // Starts the writer process (a fresh exec: this process already has Fast DDS threads).
@@ -187,6 +215,14 @@ TEST(DdsWriterLockOrder, ReaderLeavingWhileItsRepairsAreQueuedDoesNotHangTheWrit
   if (const char* run = std::getenv(kWriterRunEnv)) writer_process(run);
   const std::string run = "lock-order-" + std::to_string(getpid());
   const NetworkProfile net = network_profile(profile());
+  // A hung writer process is SIGKILLed while it writes, so it can die holding a port's mutex:
+  // an earlier run of this test (or one that crashed) may have left such a port of this domain
+  // in /dev/shm, and a participant that gets the same port number then aborts on "Interprocess
+  // mutex timeout when locking". Dead files go first, as before every `tessera launch`
+  // (transport/fastdds/shm_leftovers.hpp).
+  ShmCleanupOptions dead;
+  dead.domain = kDomain;
+  remove_dead_shm_files(dead);
   pid_t writer = start_writer(run);
   ASSERT_GT(writer, 0);
   int generation = 0;
@@ -238,8 +274,9 @@ TEST(DdsWriterLockOrder, ReaderLeavingWhileItsRepairsAreQueuedDoesNotHangTheWrit
   std::printf("%d cycles of %d leaving readers: the writer process hung in %d\n", n,
               leaving_per_cycle(), hangs);
   EXPECT_EQ(hangs, 0);
-  kill(writer, SIGKILL);
-  waitpid(writer, nullptr, 0);
+  stop_writer(writer);
+  readers.reset();
+  remove_dead_shm_files(dead);  // a hung writer's ports, which it could not remove
 }
 
 }  // namespace
