@@ -10,12 +10,21 @@
 namespace tessera {
 namespace {
 
-GncDistributedResult solve(const GeneratorResult& dirty, bool weigh_at_start) {
-  GncDistributedOptions o;  // the solver's defaults: --refine auto, GNC by Newton steps
+// The solver's defaults (--refine auto: GNC by Newton steps), certified.
+GncDistributedOptions gnc_options(bool weigh_at_start) {
+  GncDistributedOptions o;
   o.robust.kind = RobustKind::kGncTls;
   o.solver.certify = true;
   o.robust.weigh_at_start = weigh_at_start;
+  return o;
+}
+
+GncDistributedResult solve(const GeneratorResult& dirty, const GncDistributedOptions& o) {
   return solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+}
+
+GncDistributedResult solve(const GeneratorResult& dirty, bool weigh_at_start) {
+  return solve(dirty, gnc_options(weigh_at_start));
 }
 
 // The 125-pose grid with 25 % random outliers, seed 1: after the plain solve's 5 rounds the
@@ -43,15 +52,11 @@ TEST(GncWeighAtStart, GncWeighsAtTheVotedStartWithNoRoundAndEndsAtTheSameSetInFe
 // the start, manhattan3500 with 25 % random outliers kept a wrong closure.
 TEST(GncWeighAtStart, WhereGncsSolvesAreRoundsThePlainFirstSolveStays) {
   const GeneratorResult dirty = test::grid_with_outliers(0.25, 1);
-  GncDistributedOptions o;
-  o.robust.kind = RobustKind::kGncTls;
-  o.solver.certify = true;
+  GncDistributedOptions o = gnc_options(true);
   o.robust.refine_passes = false;
-  const GncDistributedResult on =
-      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  const GncDistributedResult on = solve(dirty, o);
   o.robust.weigh_at_start = false;
-  const GncDistributedResult off =
-      solve_gnc_distributed(dirty.graph, test::robots_as_blocks(dirty), o);
+  const GncDistributedResult off = solve(dirty, o);
   EXPECT_EQ(on.refine_message_steps, 0);
   EXPECT_EQ(on.total_rounds, off.total_rounds);
   EXPECT_EQ(on.exchange_steps, off.exchange_steps);

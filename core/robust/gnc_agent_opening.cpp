@@ -52,7 +52,7 @@ void GncAgent::after_pcm(std::vector<OutgoingMessage>& out) {
   if (in_.Y0_known.size() > 0)
     begin_exchange(Step::kStartPoses, out);
   else
-    after_step_zero(out);
+    after_step_zero(false, out);
 }
 
 void GncAgent::drop_inconsistent(const std::vector<std::uint64_t>& ids) {
@@ -86,13 +86,12 @@ void GncAgent::after_start_votes(std::vector<OutgoingMessage>& out) {
     neighbours_current_ = true;
   }
   exchange_->forget_candidate_neighbours();
-  start_voted_ = true;
-  after_step_zero(out);
+  after_step_zero(true, out);
 }
 
-void GncAgent::after_step_zero(std::vector<OutgoingMessage>& out) {
+void GncAgent::after_step_zero(bool start_voted, std::vector<OutgoingMessage>& out) {
   first_solve_g_ = ++g_;
-  if (start_voted_ && weighs_at_start()) {
+  if (start_voted && weighs_at_start()) {
     // RobustOptions::weigh_at_start: mu's start and the first weights at the voted start, the
     // step the first solve would have had (its exchanges' tags are the same).
     begin_exchange(neighbours_current_ ? Step::kVotes : Step::kPoses, out);

@@ -55,7 +55,7 @@ void GncSolveStage::open(bool weighted, bool capped, bool trial_poses,
   // A solve again by rounds (solve_again_by_rounds()) solves the same weights as the step.
   const bool again = weighted && rounds_next_;
   rounds_next_ = false;
-  newton_steps_ = weighted && !again && tessera::gnc_refines(options_, *layout_, in_.d);
+  newton_steps_ = weighted && !again && gnc_refines();
   solve_options_ = gnc_solve_options(options_, kind_, capped, newton_steps_);
   if (weighted && !again) {
     gnc_newton_steps_ = (weighted_solves_ == 0 || gnc_newton_steps_) && newton_steps_;

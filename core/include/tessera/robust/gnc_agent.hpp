@@ -326,7 +326,9 @@ class GncAgent : public AgentProcess {
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
   void finish(std::vector<OutgoingMessage>& out);
   void start_kept_set(std::vector<OutgoingMessage>& out);
-  void after_step_zero(std::vector<OutgoingMessage>& out);
+  // After the pcm drop or the start vote (`start_voted`): the first solve, or with
+  // RobustOptions::weigh_at_start after a vote, the first weight update.
+  void after_step_zero(bool start_voted, std::vector<OutgoingMessage>& out);
   // RobustOptions::weigh_at_start applies after a start vote: GNC's weighted solves are Newton
   // steps, so no first solve follows the vote.
   bool weighs_at_start() const;
@@ -343,7 +345,6 @@ class GncAgent : public AgentProcess {
   std::unique_ptr<GncSolveStage> stage_;  // the running solve, its layout and the iterate
   std::uint32_t g_ = 0;                   // GNC step
   std::uint32_t first_solve_g_ = 0;       // 1 after a start vote (step 0 is the vote's)
-  bool start_voted_ = false;              // the start vote ran (step 0)
   // The kept set's fresh start (kept_set_start, chordal): its votes against the iterate.
   std::unique_ptr<GncKeptStartVotes> kept_votes_;
   std::vector<bool> dropped_;  // per in_.measurements: outside the consistent set (pcm)
