@@ -12,8 +12,12 @@ bool retain_freed_heap() {
   return mapping && trim;
 }
 
-void release_freed_heap() {
+bool release_freed_heap() {
+  // mallinfo2's free bytes also count pages an earlier trim already handed back, so this can
+  // trim when less is resident; it never keeps more than the bound.
+  if (mallinfo2().fordblks < kRetainedHeapBytes) return false;
   malloc_trim(0);
+  return true;
 }
 
 }  // namespace tessera::launch

@@ -24,11 +24,12 @@ inline constexpr std::size_t kOwnMappingBytes = std::size_t{32} << 20;
 /// changes nothing that matters for correctness) when the C library refuses a setting.
 bool retain_freed_heap();
 
-/// Hands every whole free page of the heap back to the kernel now (malloc_trim): called where
-/// a set-up phase's transients (the file's text, the initialisation's factorization) were just
-/// freed, so the rounds do not run on top of them. In a run of many agents on one host those
-/// kept pages add up (up to kRetainedHeapBytes an agent). The rounds' own temporaries are
-/// allocated again in the first round and kept from then on.
-void release_freed_heap();
+/// Hands every whole free page of the heap back to the kernel now (malloc_trim) when malloc
+/// holds at least kRetainedHeapBytes of free heap: called where a set-up phase's transients (the
+/// file's text, the initialisation's factorization) were just freed, so the rounds do not run on
+/// top of them. In a run of many agents on one host those kept pages add up. Below the bound the
+/// pages stay, as they do at the heap's top: trimming them cost each agent a few madvise calls
+/// and the next phase a fault per page it touched again. Returns whether it trimmed.
+bool release_freed_heap();
 
 }  // namespace tessera::launch
