@@ -130,6 +130,9 @@ TEST(GncJump, ClosuresBeyondTheBoundThatStillHaveWeightHoldTheEarlyEndBack) {
   // After the plain solve's rounds: weighed at the voted start (RobustOptions::weigh_at_start)
   // the band of B alone does not end GNC early here.
   o.robust.weigh_at_start = false;
+  // Ten re-check passes (RobustOptions::readmission_passes' former default): twenty take the
+  // cut true closures back after the early end too.
+  o.robust.readmission_passes = 10;
   o.robust.jump_band_max = 0;
   const GncDistributedResult fixed = solve_gnc_distributed(dirty.graph, blocks, o);
   o.robust.jump_band_max = 30;
