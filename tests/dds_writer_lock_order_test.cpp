@@ -39,6 +39,7 @@
 #include <thread>
 #include <vector>
 
+#include "dds_process_support.hpp"
 #include "tesseraPubSubTypes.h"
 #include "transport/fastdds/shm_leftovers.hpp"
 #include "transport/network_profile.hpp"
@@ -126,14 +127,10 @@ const char* const kWriterRunEnv = "TESSERA_LOCK_ORDER_WRITER_RUN";
 // SIGTERM ends the writer between two writes and deletes its participant; SIGKILL only when
 // it does not exit within 10 s (a hung writer).
 void stop_writer(pid_t writer) {
+  tessera::test::dds::Process p;
+  p.pid = writer;
   kill(writer, SIGTERM);
-  const auto deadline = Clock::now() + std::chrono::seconds(10);
-  while (Clock::now() < deadline) {
-    if (waitpid(writer, nullptr, WNOHANG) == writer) return;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  kill(writer, SIGKILL);
-  waitpid(writer, nullptr, 0);
+  tessera::test::dds::wait_all({&p}, 10.0);
 }
 
 // Starts the writer process (a fresh exec: this process already has Fast DDS threads).

@@ -8,46 +8,45 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdio>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
+
+#include "runtime/phase_memory.hpp"
 
 namespace {
 
 constexpr std::size_t kBlock = 96 * 1024;  // below glibc's initial mapping threshold: heap
 constexpr int kBlocks = 40;                // ~3.8 MB, far above the default trim threshold
 
-// In a child: optionally retain, grow the heap by kBlocks blocks, free them from the top down,
-// and report through the exit code whether the freed top (keepcost) is still in the process.
-int freed_top_kept_in_child(bool retain) {
+// Runs `body` in a forked child (the malloc settings are process-wide) and returns its result
+// as the child's exit code, or -1 when the child could not run or did not exit.
+template <class Body>
+int exit_code_in_child(Body body) {
   const pid_t pid = fork();
-  if (pid == 0) {
-    if (retain && !tessera::launch::retain_freed_heap()) _exit(3);
-    std::vector<void*> blocks;
-    blocks.reserve(kBlocks);
-    for (int i = 0; i < kBlocks; ++i) {
-      blocks.push_back(std::malloc(kBlock));
-      if (!blocks.back()) _exit(4);
-      std::memset(blocks.back(), 1, kBlock);  // touched: these pages are really in the process
-    }
-    for (int i = kBlocks - 1; i >= 0; --i) std::free(blocks[static_cast<std::size_t>(i)]);
-    const struct mallinfo2 info = mallinfo2();
-    _exit(info.keepcost >= (kBlocks - 2) * kBlock ? 0 : 1);
-  }
+  if (pid == 0) _exit(body());
   int status = 0;
   if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
   return WEXITSTATUS(status);
 }
 
-// Resident bytes of this process (/proc/self/statm), or 0 when unreadable.
-std::size_t resident_bytes() {
-  std::FILE* f = std::fopen("/proc/self/statm", "r");
-  if (!f) return 0;
-  unsigned long size = 0, resident = 0;
-  const int read = std::fscanf(f, "%lu %lu", &size, &resident);
-  std::fclose(f);
-  return read == 2 ? resident * static_cast<std::size_t>(sysconf(_SC_PAGESIZE)) : 0;
+// In a child: optionally retain, grow the heap by kBlocks blocks, free them from the top down,
+// and report through the exit code whether the freed top (keepcost) is still in the process.
+int freed_top_kept_in_child(bool retain) {
+  return exit_code_in_child([retain] {
+    if (retain && !tessera::launch::retain_freed_heap()) return 3;
+    std::vector<void*> blocks;
+    blocks.reserve(kBlocks);
+    for (int i = 0; i < kBlocks; ++i) {
+      blocks.push_back(std::malloc(kBlock));
+      if (!blocks.back()) return 4;
+      std::memset(blocks.back(), 1, kBlock);  // touched: these pages are really in the process
+    }
+    for (int i = kBlocks - 1; i >= 0; --i) std::free(blocks[static_cast<std::size_t>(i)]);
+    const struct mallinfo2 info = mallinfo2();
+    return info.keepcost >= (kBlocks - 2) * kBlock ? 0 : 1;
+  });
 }
 
 // In a child: retain, fill `blocks` blocks of `block` bytes (touched) below one more that
@@ -55,34 +54,30 @@ std::size_t resident_bytes() {
 // Exit code: 0 released and the resident memory fell by at least half of what was freed, 1
 // kept and resident memory within 1 MB of before, 2 anything else; 3-5 set-up failures.
 int release_in_child(std::size_t block, int blocks) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    if (!tessera::launch::retain_freed_heap()) _exit(3);
+  return exit_code_in_child([block, blocks] {
+    if (!tessera::launch::retain_freed_heap()) return 3;
     std::vector<void*> filled;
     filled.reserve(static_cast<std::size_t>(blocks));
     for (int i = 0; i < blocks; ++i) {
       filled.push_back(std::malloc(block));
-      if (!filled.back()) _exit(4);
+      if (!filled.back()) return 4;
       std::memset(filled.back(), 1, block);
     }
     // The pin: one more block of the same size, taken from the heap's top after the others
     // (a small one could come from a free chunk further down and pin nothing).
     void* pin = std::malloc(block);
-    if (!pin) _exit(4);
+    if (!pin) return 4;
     for (void* b : filled) std::free(b);
-    const std::size_t before = resident_bytes();
-    if (before == 0) _exit(5);
+    const std::uint64_t before = tessera::agent::sample_phase_memory().rss;
+    if (before == 0) return 5;
     const bool released = tessera::launch::release_freed_heap();
-    const std::size_t after = resident_bytes();
-    const std::size_t freed = block * static_cast<std::size_t>(blocks);
-    if (released && before > after && before - after >= freed / 2) _exit(0);
-    if (!released && after + (std::size_t{1} << 20) >= before && after <= before + (1u << 20))
-      _exit(1);
-    _exit(2);
-  }
-  int status = 0;
-  if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
-  return WEXITSTATUS(status);
+    const std::uint64_t after = tessera::agent::sample_phase_memory().rss;
+    const std::uint64_t freed = block * static_cast<std::uint64_t>(blocks);
+    const std::uint64_t slack = std::uint64_t{1} << 20;
+    if (released && before > after && before - after >= freed / 2) return 0;
+    if (!released && after + slack >= before && after <= before + slack) return 1;
+    return 2;
+  });
 }
 
 }  // namespace

@@ -192,9 +192,9 @@ struct RobustOptions {
   /// fitted with the help of a distortion) leaves; the new set is solved again, at most this many
   /// times, >= 0 (0 = never). Each pass lowers the TLS cost or ends the passes. 20: manhattan3500
   /// with 25 % random outliers needs 4 (docs/robust.md, "Re-check"); robust.py's sphere2500 with
-  /// 75 % group outliers, distributed, needs 11-20: at 10 the budget ran out while the passes
-  /// still changed the set, so no probe could follow and 6 wrong closures stayed (precision 0.925,
-  /// not certified, 22,405 message steps); at 20 exact and certified in 3,486.
+  /// 75 % group outliers, distributed, needs more than 10: at 10 the budget ran out while the
+  /// passes still changed the set, so no probe could follow and 6 wrong closures stayed (precision
+  /// 0.925, not certified, 22,405 message steps); at 20 exact and certified in 3,486.
   int readmission_passes = 20;
   /// Distributed solvers only: most rounds of a re-check pass's solve while the set may still
   /// change, >= 0, 0 = no cap. The passes end only after a pass solved to the tolerance changed
