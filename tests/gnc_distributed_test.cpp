@@ -363,6 +363,7 @@ TEST(GncDistributed, TheLastFreshStartVoteReplacesARoughIterateAndThePassesTakeB
   o.robust.recheck_max_rounds = 1;
   o.robust.readmission_passes = 2;
   o.robust.recheck_probes = 0;
+  o.stall_kept_set_start = false;  // this test's vote alone (the stall vote is the next test's)
   o.final_kept_set_start = false;
   const GncDistributedResult without = solve_gnc_distributed(dirty.graph, blocks, o);
   o.final_kept_set_start = true;
@@ -373,6 +374,36 @@ TEST(GncDistributed, TheLastFreshStartVoteReplacesARoughIterateAndThePassesTakeB
                             dirty.outliers.begin(), dirty.outliers.end()));
   EXPECT_EQ(with.rejected, dirty.outliers);
   EXPECT_GT(with.readmitted, without.readmitted);
+  EXPECT_TRUE(with.final_solve.certified.value_or(false));
+  const double fstar = solve_centralized(grid_with_outliers(0.0, 3).graph).cost;
+  EXPECT_NEAR(with.final_solve.cost, fstar, 1e-6 * fstar);
+}
+
+// The fresh-start vote when the passes stall (GncDistributedOptions::stall_kept_set_start). With
+// weak solves (block updates of 4 unpreconditioned tCG iterations, one round per GNC step and
+// per capped pass) a capped pass that changes nothing leaves a rough iterate, from which the
+// same set would next be solved to the tolerance, fold and all. With the vote the kept set's
+// fresh start wins there: the same exact set, certified at the optimum, in fewer rounds (here
+// 104 against 198).
+TEST(GncDistributed, AStalledPassVotesForTheFreshStartAndSavesRounds) {
+  const GeneratorResult dirty = grid_with_outliers(0.5, 3);
+  const std::vector<int> blocks = robots_as_blocks(dirty);
+  GncDistributedOptions o = irbcd_gnc();
+  o.solver.certify = true;
+  o.solver.block_update.max_inner_iterations = 4;
+  o.solver.block_update.precondition = false;
+  o.robust.inner_max_rounds = 1;
+  o.robust.recheck_max_rounds = 1;
+  o.robust.recheck_probes = 0;
+  o.stall_kept_set_start = false;
+  const GncDistributedResult without = solve_gnc_distributed(dirty.graph, blocks, o);
+  o.stall_kept_set_start = true;
+  const GncDistributedResult with = solve_gnc_distributed(dirty.graph, blocks, o);
+
+  EXPECT_EQ(without.rejected, dirty.outliers);
+  EXPECT_EQ(with.rejected, dirty.outliers);
+  EXPECT_LT(with.total_rounds, without.total_rounds);
+  EXPECT_GT(with.exchange_steps, without.exchange_steps);  // the vote's exchanges
   EXPECT_TRUE(with.final_solve.certified.value_or(false));
   const double fstar = solve_centralized(grid_with_outliers(0.0, 3).graph).cost;
   EXPECT_NEAR(with.final_solve.cost, fstar, 1e-6 * fstar);

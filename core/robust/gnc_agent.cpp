@@ -333,6 +333,7 @@ void GncAgent::after_candidate_votes(std::pair<double, double> sums,
   iterate_kept_cost_.reset();
   const auto [at_iterate, at_candidate] = sums;
   const bool final_vote = kept_votes_->ended(rejected_, at_candidate);
+  const bool stall_vote = kept_votes_->take_stall_vote();
   const bool fresh = at_candidate < at_iterate;
   if (fresh) {
     stage_->set_iterate(exchange_->candidate());
@@ -352,6 +353,8 @@ void GncAgent::after_candidate_votes(std::pair<double, double> sums,
     }
     passes_->restart_budget();  // the passes again, with their own budget
   }
+  // A stall vote the iterate won: its set solved to the tolerance, as without the vote.
+  if (stall_vote && !fresh) passes_->solve_next_fully();
   begin_inlier_pass(out);
 }
 
@@ -378,6 +381,12 @@ void GncAgent::after_unchanged_verdict(std::vector<OutgoingMessage>& out) {
   // that started from a solved pass only settled that pass's flips, and its verdict stands
   // (RobustOptions::recheck_confirm_solved) when a solve to the tolerance follows.
   if (passes_->unchanged_needs_full_pass(final_solve_runs())) {
+    if (options_.stall_kept_set_start && kept_votes_->stall_vote_due(rejected_)) {
+      kept_votes_->begin_stall_vote();
+      require_kept_connected();
+      begin_exchange(Step::kKeptStart, out);
+      return;
+    }
     passes_->solve_next_fully();
     begin_inlier_pass(out);
     return;

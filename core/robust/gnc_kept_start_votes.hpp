@@ -1,10 +1,12 @@
 #pragma once
 // The votes between the iterate and a fresh start of the kept set in the distributed GNC
 // (GncAgentInput::kept_set_start with the chordal initialization): after GNC's rejected set,
-// after each probe, and once before the final solve (GncDistributedOptions::
-// final_kept_set_start). GncAgent runs their exchanges; this holds which vote runs and what the
-// earlier ones summed, which tells when the vote before the final solve would keep the iterate
-// (then it does not run). Every agent holds the same: the sums are the summed votes.
+// after each probe, where a capped pass changes nothing on a set not voted on before
+// (GncDistributedOptions::stall_kept_set_start), and once before the final solve
+// (GncDistributedOptions::final_kept_set_start). GncAgent runs their exchanges; this holds which
+// vote runs and what the earlier ones summed, which tells when the vote before the final solve
+// would keep the iterate (then it does not run). Every agent holds the same: the sums are the
+// summed votes.
 
 #include <cmath>
 #include <cstdint>
@@ -27,6 +29,21 @@ class GncKeptStartVotes {
     return wanted && enabled_ && !final_voted_ && !rejected.empty() && !settled(rejected);
   }
   void begin_final_vote() { final_voted_ = final_running_ = true; }
+  /// A vote when the passes stall on the set `rejected` (ascending) is due: something rejected
+  /// and no vote on this set before (its fresh start's cost is a function of the set).
+  bool stall_vote_due(const std::vector<std::uint64_t>& rejected) const {
+    if (!enabled_ || rejected.empty()) return false;
+    for (const auto& entry : costs_)
+      if (entry.first == rejected) return false;
+    return true;
+  }
+  void begin_stall_vote() { stall_running_ = true; }
+  /// Whether the vote that just ended was a stall vote (asked once, after ended()).
+  bool take_stall_vote() {
+    const bool stall = stall_running_;
+    stall_running_ = false;
+    return stall;
+  }
   /// A vote on the set `rejected` ended, the fresh start's summed cost over the kept set
   /// `fresh_cost` (a function of the set): whether it was the vote before the final solve.
   bool ended(const std::vector<std::uint64_t>& rejected, double fresh_cost) {
@@ -53,6 +70,7 @@ class GncKeptStartVotes {
   bool enabled_;
   bool final_voted_ = false;    // the vote before the final solve ran (once)
   bool final_running_ = false;  // the running vote is that one
+  bool stall_running_ = false;  // the running (or just ended) vote is a stall vote
   std::vector<std::pair<std::vector<std::uint64_t>, double>> costs_;  // every vote so far
   double last_pass_cost_ = std::numeric_limits<double>::quiet_NaN();
 };
