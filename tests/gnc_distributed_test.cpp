@@ -347,22 +347,28 @@ TEST(GncDistributed, TheLastFreshStartVoteIsSkippedWhenTheSolvedKeptSetIsKnownTo
   EXPECT_EQ(with.total_bytes, without.total_bytes);
 }
 
-// The same vote where the passes end on a rough iterate: with weak solves (block updates of 4
-// unpreconditioned tCG iterations, one round per GNC step and per pass, two passes) the passes
-// judge the set on an iterate far from the kept set's solution and leave true closures cut.
-// Over the kept set the fresh start then costs less than that iterate, wins the vote, and the
-// passes, run again from it, take those closures back: exactly the wrong closures go.
-TEST(GncDistributed, TheLastFreshStartVoteReplacesARoughIterateAndThePassesTakeBackTrueClosures) {
-  const GeneratorResult dirty = grid_with_outliers(0.5, 3);
-  const std::vector<int> blocks = robots_as_blocks(dirty);
+// Weak solves, certified: block updates of 4 unpreconditioned tCG iterations, one round per GNC
+// step and per capped pass, no probes. The passes then judge their sets on rough iterates.
+GncDistributedOptions weak_solves() {
   GncDistributedOptions o = irbcd_gnc();
   o.solver.certify = true;
   o.solver.block_update.max_inner_iterations = 4;
   o.solver.block_update.precondition = false;
   o.robust.inner_max_rounds = 1;
   o.robust.recheck_max_rounds = 1;
-  o.robust.readmission_passes = 2;
   o.robust.recheck_probes = 0;
+  return o;
+}
+
+// The same vote where the passes end on a rough iterate: with weak solves (two passes) the passes
+// judge the set on an iterate far from the kept set's solution and leave true closures cut.
+// Over the kept set the fresh start then costs less than that iterate, wins the vote, and the
+// passes, run again from it, take those closures back: exactly the wrong closures go.
+TEST(GncDistributed, TheLastFreshStartVoteReplacesARoughIterateAndThePassesTakeBackTrueClosures) {
+  const GeneratorResult dirty = grid_with_outliers(0.5, 3);
+  const std::vector<int> blocks = robots_as_blocks(dirty);
+  GncDistributedOptions o = weak_solves();
+  o.robust.readmission_passes = 2;
   o.stall_kept_set_start = false;  // this test's vote alone (the stall vote is the next test's)
   o.final_kept_set_start = false;
   const GncDistributedResult without = solve_gnc_distributed(dirty.graph, blocks, o);
@@ -380,21 +386,14 @@ TEST(GncDistributed, TheLastFreshStartVoteReplacesARoughIterateAndThePassesTakeB
 }
 
 // The fresh-start vote when the passes stall (GncDistributedOptions::stall_kept_set_start). With
-// weak solves (block updates of 4 unpreconditioned tCG iterations, one round per GNC step and
-// per capped pass) a capped pass that changes nothing leaves a rough iterate, from which the
+// weak solves a capped pass that changes nothing leaves a rough iterate, from which the
 // same set would next be solved to the tolerance, fold and all. With the vote the kept set's
 // fresh start wins there: the same exact set, certified at the optimum, in fewer rounds (here
 // 104 against 198).
 TEST(GncDistributed, AStalledPassVotesForTheFreshStartAndSavesRounds) {
   const GeneratorResult dirty = grid_with_outliers(0.5, 3);
   const std::vector<int> blocks = robots_as_blocks(dirty);
-  GncDistributedOptions o = irbcd_gnc();
-  o.solver.certify = true;
-  o.solver.block_update.max_inner_iterations = 4;
-  o.solver.block_update.precondition = false;
-  o.robust.inner_max_rounds = 1;
-  o.robust.recheck_max_rounds = 1;
-  o.robust.recheck_probes = 0;
+  GncDistributedOptions o = weak_solves();
   o.stall_kept_set_start = false;
   const GncDistributedResult without = solve_gnc_distributed(dirty.graph, blocks, o);
   o.stall_kept_set_start = true;
