@@ -60,6 +60,7 @@ void deliver_final_estimate(AgentSession& s, const AgentLocalData& local,
   }
   if (!o.output.empty()) write_vertices_g2o(local.owned, result.poses, local.d, o.output);
 
+  test_hold_point(o.id);
   test_abort_point(TestAbortPoint::kBeforeResult, o.id);
   wire::FinalEstimate fin;
   fin.run_id(o.net.session.run_id);

@@ -25,22 +25,9 @@ std::optional<std::string> spec_for(const char* env, std::uint32_t id) {
   return spec.substr(0, colon);
 }
 
-void hold_until_released(std::uint32_t id) {
-  const char* env = std::getenv("TESSERA_TEST_AGENT_HOLD");
-  if (!env) return;
-  const std::optional<std::string> path = spec_for(env, id);
-  if (!path) return;
-  std::cerr << "tessera-agent[" << id << "]: TESSERA_TEST_AGENT_HOLD: holding the result until "
-            << *path << " exists" << std::endl;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (access(path->c_str(), F_OK) != 0 && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-}
-
 }  // namespace
 
 void test_abort_point(TestAbortPoint at, std::uint32_t id) {
-  if (at == TestAbortPoint::kBeforeResult) hold_until_released(id);
   const char* env = std::getenv("TESSERA_TEST_AGENT_ABORT");
   if (!env) return;
   const std::optional<std::string> when = spec_for(env, id);
@@ -53,6 +40,18 @@ void test_abort_point(TestAbortPoint at, std::uint32_t id) {
   std::thread([] { std::abort(); }).join();
 }
 
+void test_hold_point(std::uint32_t id) {
+  const char* env = std::getenv("TESSERA_TEST_AGENT_HOLD");
+  if (!env) return;
+  const std::optional<std::string> path = spec_for(env, id);
+  if (!path) return;
+  std::cerr << "tessera-agent[" << id << "]: TESSERA_TEST_AGENT_HOLD: holding the result until "
+            << *path << " exists" << std::endl;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (access(path->c_str(), F_OK) != 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+}
+
 bool test_kill_armed() {
   return std::getenv("TESSERA_TEST_AGENT_KILL") != nullptr;
 }
@@ -60,12 +59,9 @@ bool test_kill_armed() {
 void test_kill_point(ProgressStage stage, std::uint32_t id) {
   const char* env = std::getenv("TESSERA_TEST_AGENT_KILL");
   if (!env) return;
-  std::string spec = env;
-  const std::size_t colon = spec.find(':');
-  if (colon != std::string::npos) {
-    if (spec.substr(colon + 1) != std::to_string(id)) return;
-    spec = spec.substr(0, colon);
-  }
+  const std::optional<std::string> mine = spec_for(env, id);
+  if (!mine) return;
+  std::string spec = *mine;
   unsigned long at = 1;
   const std::size_t sign = spec.find('@');
   if (sign != std::string::npos) {

@@ -18,10 +18,11 @@
 //   certificate  a protocol message handled in the distributed certificate;
 //   rounding     an iteration of the distributed rounding's translation CG.
 //
-// And TESSERA_TEST_AGENT_HOLD=PATH[:ID] holds the agent where `before-result` would abort it
-// until the file PATH exists (at most 120 s), so a test can keep a run alive, its coordinator
-// answering, until something it starts has happened (tests/dds_loss_test.cpp: a restarted
-// process refused while the survivors' run is still on, however fast their rounds are).
+// And TESSERA_TEST_AGENT_HOLD=PATH[:ID] holds the agent just before its result is published
+// (test_hold_point, before the `before-result` abort point) until the file PATH exists (at most 120
+// s), so a test can keep a run alive, its coordinator answering, until something it starts has
+// happened (tests/dds_loss_test.cpp: a restarted process refused while the survivors' run is still
+// on, however fast their rounds are).
 
 #include <cstdint>
 
@@ -32,10 +33,11 @@ namespace tessera::agent {
 enum class TestAbortPoint { kBeforeResult, kAfterFinished };
 
 #ifdef TESSERA_TEST_HOOKS
-/// Aborts the process if TESSERA_TEST_AGENT_ABORT names `at` for agent `id`; at
-/// kBeforeResult, first waits while TESSERA_TEST_AGENT_HOLD names a file that does not exist
-/// yet (at most 120 s); else nothing.
+/// Aborts the process if TESSERA_TEST_AGENT_ABORT names `at` for agent `id`; else nothing.
 void test_abort_point(TestAbortPoint at, std::uint32_t id);
+/// Waits while TESSERA_TEST_AGENT_HOLD names, for agent `id`, a file that does not exist yet
+/// (at most 120 s); else nothing.
+void test_hold_point(std::uint32_t id);
 /// Whether TESSERA_TEST_AGENT_KILL is set (the round loop then reports every progress point).
 bool test_kill_armed();
 /// Called at each progress point of `stage` on agent `id`: SIGKILLs the process at the one
@@ -43,6 +45,7 @@ bool test_kill_armed();
 void test_kill_point(ProgressStage stage, std::uint32_t id);
 #else
 inline void test_abort_point(TestAbortPoint, std::uint32_t) {}
+inline void test_hold_point(std::uint32_t) {}
 inline bool test_kill_armed() {
   return false;
 }

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dds_process_support.hpp"
@@ -22,8 +23,7 @@ const char* const kNote = "note: Fast DDS aborted after the run's work was done"
 
 // argv run with TESSERA_TEST_AGENT_ABORT=spec in its environment.
 std::vector<std::string> with_abort(const std::string& spec, std::vector<std::string> argv) {
-  argv.insert(argv.begin(), {"/usr/bin/env", "TESSERA_TEST_AGENT_ABORT=" + spec});
-  return argv;
+  return with_env("TESSERA_TEST_AGENT_ABORT=" + spec, std::move(argv));
 }
 
 std::vector<std::string> launch_args(const std::string& graph, int domain, const std::string& run) {

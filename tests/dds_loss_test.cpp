@@ -175,9 +175,8 @@ void restarted_after_repartition_is_refused(int domain, bool checkpoint) {
   std::vector<Process> agents;
   for (int k = 0; k < r.agents; ++k) {
     if (checkpoint) mkdir((r.dir + "/ckpt" + std::to_string(k)).c_str(), 0755);
-    std::vector<std::string> argv = agent_argv(k);
-    argv.insert(argv.begin(), {"/usr/bin/env", "TESSERA_TEST_AGENT_HOLD=" + released});
-    agents.push_back(start(argv, r.dir + "/agent" + std::to_string(k) + ".log"));
+    agents.push_back(start(with_env("TESSERA_TEST_AGENT_HOLD=" + released, agent_argv(k)),
+                           r.dir + "/agent" + std::to_string(k) + ".log"));
   }
   const bool started = wait_for_round(coord, 10, 30);
   kill(agents[2].pid, SIGKILL);

@@ -109,6 +109,14 @@ inline bool wait_all(std::vector<Process*> procs, double timeout_s) {
   }
 }
 
+/// `argv` run through /usr/bin/env with `assignment` ("NAME=value") in its environment (the
+/// agents' test-only hooks, agent/test_abort_hook.hpp).
+inline std::vector<std::string> with_env(const std::string& assignment,
+                                         std::vector<std::string> argv) {
+  argv.insert(argv.begin(), {"/usr/bin/env", assignment});
+  return argv;
+}
+
 /// tessera-agent for robot `id` of `robots` on `graph`, run `run` on `domain`, then `extra`.
 inline std::vector<std::string> agent_args(const std::string& graph, int robots, int id,
                                            const std::string& run, int domain,

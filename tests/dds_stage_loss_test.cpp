@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dds_process_support.hpp"
@@ -73,7 +74,7 @@ bool run_with_a_kill(const StageLossRun& r, int replicas, Process& coord,
   for (int k = 0; k < r.agents; ++k) {
     std::vector<std::string> a =
         agent_args(r.graph, r.agents, k, r.run, r.domain, {"--timeout", "20", "--udp-only"});
-    if (k == r.victim) a.insert(a.begin(), {"/usr/bin/env", "TESSERA_TEST_AGENT_KILL=" + r.kill});
+    if (k == r.victim) a = with_env("TESSERA_TEST_AGENT_KILL=" + r.kill, std::move(a));
     agents.push_back(start(a, r.dir + "/agent" + std::to_string(k) + ".log"));
   }
   return wait_all(all_of(coord, agents), 60);
@@ -170,8 +171,7 @@ TEST(DdsStageLoss, AgentKilledInTheRefinementRejoinsFromItsCheckpointWithTheUndi
     agents.reserve(static_cast<std::size_t>(r.agents) + 1);
     for (int k = 0; k < r.agents; ++k) {
       std::vector<std::string> a = agent_argv(tag, k);
-      if (kill && k == r.victim)
-        a.insert(a.begin(), {"/usr/bin/env", "TESSERA_TEST_AGENT_KILL=" + r.kill});
+      if (kill && k == r.victim) a = with_env("TESSERA_TEST_AGENT_KILL=" + r.kill, std::move(a));
       agents.push_back(start(a, r.dir + "/agent" + tag + std::to_string(k) + ".log"));
     }
     if (kill) {

@@ -81,6 +81,11 @@ int GncAgent::weights_at(double mu, const Eigen::MatrixXd& Y, const Eigen::Matri
   return crossed;
 }
 
+void GncAgent::begin_kept_start_vote(std::vector<OutgoingMessage>& out) {
+  require_kept_connected();  // before initializing the kept set
+  begin_exchange(Step::kKeptStart, out);
+}
+
 void GncAgent::require_kept_connected() const {
   // The kept set must connect every pose (every agent checks the same set).
   const std::size_t parts =
@@ -120,9 +125,8 @@ void GncAgent::finish(std::vector<OutgoingMessage>& out) {
   // it is a fold, and the passes judged their set on it: they run again from the fresh start.
   // Not when the outcome is already known (GncKeptStartVotes): the iterate stays.
   if (kept_votes_->final_vote_due(final_solve_runs() && options_.final_kept_set_start, rejected_)) {
-    kept_votes_->begin_final_vote();
-    require_kept_connected();
-    begin_exchange(Step::kKeptStart, out);
+    kept_votes_->begin(GncKeptStartVotes::Kind::kFinal);
+    begin_kept_start_vote(out);
     return;
   }
   // The final solve starts where the last pass ended, whose pose exchange every agent holds
@@ -293,8 +297,7 @@ void GncAgent::after_rejected(std::vector<OutgoingMessage>& out) {
   // Nothing rejected: the GNC iterate is already the plain solve's.
   if (rejected_.empty()) iterate_kept_cost_.reset();
   if (kept_votes_->enabled() && !rejected_.empty()) {
-    require_kept_connected();  // before initializing the kept set
-    begin_exchange(Step::kKeptStart, out);
+    begin_kept_start_vote(out);
     return;
   }
   begin_inlier_pass(out);
@@ -332,8 +335,7 @@ void GncAgent::after_candidate_votes(std::pair<double, double> sums,
                                      std::vector<OutgoingMessage>& out) {
   iterate_kept_cost_.reset();
   const auto [at_iterate, at_candidate] = sums;
-  const bool final_vote = kept_votes_->ended(rejected_, at_candidate);
-  const bool stall_vote = kept_votes_->take_stall_vote();
+  const GncKeptStartVotes::Kind vote = kept_votes_->ended(rejected_, at_candidate);
   const bool fresh = at_candidate < at_iterate;
   if (fresh) {
     stage_->set_iterate(exchange_->candidate());
@@ -346,7 +348,7 @@ void GncAgent::after_candidate_votes(std::pair<double, double> sums,
   exchange_->candidate().resize(0, 0);
   exchange_->forget_candidate_neighbours();
   passes_->forget_solved_start();
-  if (final_vote) {
+  if (vote == GncKeptStartVotes::Kind::kFinal) {
     if (!fresh) {
       finish(out);  // the iterate stays: on to the final solve
       return;
@@ -354,7 +356,7 @@ void GncAgent::after_candidate_votes(std::pair<double, double> sums,
     passes_->restart_budget();  // the passes again, with their own budget
   }
   // A stall vote the iterate won: its set solved to the tolerance, as without the vote.
-  if (stall_vote && !fresh) passes_->solve_next_fully();
+  if (vote == GncKeptStartVotes::Kind::kStall && !fresh) passes_->solve_next_fully();
   begin_inlier_pass(out);
 }
 
@@ -382,9 +384,8 @@ void GncAgent::after_unchanged_verdict(std::vector<OutgoingMessage>& out) {
   // (RobustOptions::recheck_confirm_solved) when a solve to the tolerance follows.
   if (passes_->unchanged_needs_full_pass(final_solve_runs())) {
     if (options_.stall_kept_set_start && kept_votes_->stall_vote_due(rejected_)) {
-      kept_votes_->begin_stall_vote();
-      require_kept_connected();
-      begin_exchange(Step::kKeptStart, out);
+      kept_votes_->begin(GncKeptStartVotes::Kind::kStall);
+      begin_kept_start_vote(out);
       return;
     }
     passes_->solve_next_fully();

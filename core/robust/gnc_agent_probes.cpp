@@ -29,8 +29,7 @@ void GncAgent::begin_probe(double tls, std::vector<std::uint64_t> flip,
   // The iterate was bent around what the probe cut, and a local solve keeps such a fold; the
   // kept set's fresh start (voted on its cost, as after GNC) does not have it.
   if (kept_votes_->enabled()) {
-    require_kept_connected();
-    begin_exchange(Step::kKeptStart, out);
+    begin_kept_start_vote(out);
     return;
   }
   begin_inlier_pass(out);

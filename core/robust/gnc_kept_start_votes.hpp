@@ -8,6 +8,7 @@
 // would keep the iterate (then it does not run). Every agent holds the same: the sums are the
 // summed votes.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -22,41 +23,43 @@ class GncKeptStartVotes {
 
   /// Fresh starts of the kept set are voted on at all.
   bool enabled() const { return enabled_; }
+  /// Which vote runs: after GNC or a probe (kStart), where the passes stall
+  /// (GncDistributedOptions::stall_kept_set_start) or before the final solve.
+  enum class Kind { kStart, kStall, kFinal };
+
   /// The vote before the final solve is due on the set `rejected` (ascending): `wanted` (a final
   /// solve follows and final_kept_set_start), not run yet, something rejected, and its outcome
   /// not known already.
   bool final_vote_due(bool wanted, const std::vector<std::uint64_t>& rejected) const {
     return wanted && enabled_ && !final_voted_ && !rejected.empty() && !settled(rejected);
   }
-  void begin_final_vote() { final_voted_ = final_running_ = true; }
-  /// A vote when the passes stall on the set `rejected` (ascending) is due: something rejected
+  /// A vote where the passes stall on the set `rejected` (ascending) is due: something rejected
   /// and no vote on this set before (its fresh start's cost is a function of the set).
   bool stall_vote_due(const std::vector<std::uint64_t>& rejected) const {
-    if (!enabled_ || rejected.empty()) return false;
-    for (const auto& entry : costs_)
-      if (entry.first == rejected) return false;
-    return true;
+    return enabled_ && !rejected.empty() && !voted_on(rejected);
   }
-  void begin_stall_vote() { stall_running_ = true; }
-  /// Whether the vote that just ended was a stall vote (asked once, after ended()).
-  bool take_stall_vote() {
-    const bool stall = stall_running_;
-    stall_running_ = false;
-    return stall;
+  /// The next vote is of `kind` (kStart unless said otherwise).
+  void begin(Kind kind) {
+    running_ = kind;
+    if (kind == Kind::kFinal) final_voted_ = true;
   }
   /// A vote on the set `rejected` ended, the fresh start's summed cost over the kept set
-  /// `fresh_cost` (a function of the set): whether it was the vote before the final solve.
-  bool ended(const std::vector<std::uint64_t>& rejected, double fresh_cost) {
+  /// `fresh_cost` (a function of the set): which vote it was.
+  Kind ended(const std::vector<std::uint64_t>& rejected, double fresh_cost) {
     costs_.emplace_back(rejected, fresh_cost);
-    const bool final_vote = final_running_;
-    final_running_ = false;
-    return final_vote;
+    const Kind kind = running_;
+    running_ = Kind::kStart;
+    return kind;
   }
   /// The kept set's summed cost at the end of the last inlier pass when that pass was solved to
   /// the tolerance (the solve's last trace record, the same on every agent); NaN otherwise.
   void set_last_pass_cost(double cost) { last_pass_cost_ = cost; }
 
  private:
+  bool voted_on(const std::vector<std::uint64_t>& rejected) const {
+    return std::any_of(costs_.begin(), costs_.end(),
+                       [&](const auto& entry) { return entry.first == rejected; });
+  }
   bool settled(const std::vector<std::uint64_t>& rejected) const {
     // The fresh start of a set voted on before costs what that vote summed; an iterate solved to
     // the tolerance on the same set that ends clearly below it wins the vote (the margin covers
@@ -68,9 +71,8 @@ class GncKeptStartVotes {
   }
 
   bool enabled_;
-  bool final_voted_ = false;    // the vote before the final solve ran (once)
-  bool final_running_ = false;  // the running vote is that one
-  bool stall_running_ = false;  // the running (or just ended) vote is a stall vote
+  bool final_voted_ = false;     // the vote before the final solve ran (once)
+  Kind running_ = Kind::kStart;  // the running vote
   std::vector<std::pair<std::vector<std::uint64_t>, double>> costs_;  // every vote so far
   double last_pass_cost_ = std::numeric_limits<double>::quiet_NaN();
 };

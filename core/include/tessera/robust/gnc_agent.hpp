@@ -321,6 +321,9 @@ class GncAgent : public AgentProcess {
   // trial's; false (every trial's messages dropped) when none was.
   bool begin_pass_trial_poses(std::vector<OutgoingMessage>& out);
   void require_kept_connected() const;  // throws InputError naming the parts left
+  // The vote between the iterate and the kept set's fresh start (its kind told to kept_votes_
+  // before): the kept set must connect the poses, then the gather at agent 0.
+  void begin_kept_start_vote(std::vector<OutgoingMessage>& out);
   // GNC's rejected set: from the last weight exchange where there was one, else an exchange.
   void begin_rejected(std::vector<OutgoingMessage>& out);
   void begin_inlier_pass(std::vector<OutgoingMessage>& out);
