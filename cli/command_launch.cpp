@@ -7,19 +7,30 @@
 #include <tessera/util/input_error.hpp>
 
 #include "commands.hpp"
+#include "launch/heap_pages.hpp"
 #include "launch/launch.hpp"
 #include "launch/online_launch.hpp"
 #include "launch_outputs.hpp"
 
 namespace tessera::cli {
 
-int run_launch(const Args& argv) {
-  if (launch::wants_online_launch(argv)) return launch::run_online_launch(argv);
+int run_launch(const Args& given) {
+  Args argv = given;
+  const std::string heap_pages = take_heap_pages_flag(argv);
+  const launch::HeapPages pages = launch::parse_heap_pages(heap_pages, "option --heap-pages");
+  if (launch::wants_online_launch(argv)) {
+    // First: this may re-run the process on huge-page heaps, which every process of the run
+    // then inherits (launch/heap_pages.hpp).
+    if (!launch::wants_launch_help(argv)) launch::enter_heap_pages(pages, process_argv());
+    return launch::run_online_launch(argv);
+  }
   if (launch::wants_launch_help(argv)) {
     std::fputs(launch::launch_help().c_str(), stdout);
+    std::fputs(kHeapPagesHelp, stdout);
     std::printf("\nOutputs in GRAPH's terms (one whole GRAPH file):\n%s", kLaunchOutputHelp);
     return 0;
   }
+  launch::enter_heap_pages(pages, process_argv());
   std::vector<std::string> rest = argv;
   const LaunchOutputs outputs = take_launch_outputs(rest);
   launch::LaunchOptions options = launch::parse_launch_options(rest);

@@ -18,6 +18,7 @@
 #include "commands.hpp"
 #include "graph_input.hpp"
 #include "json_writer.hpp"
+#include "launch/heap_pages.hpp"
 #include "launch/heap_retention.hpp"
 #include "launch/serial_openmp.hpp"
 #include "rebalance_args.hpp"
@@ -234,8 +235,10 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
 
 }  // namespace
 
-int run_solve(const Args& args) {
+int run_solve(const Args& given) {
   const auto start = std::chrono::steady_clock::now();
+  Args args = given;
+  const std::string heap_pages = take_heap_pages_flag(args);
   std::set<std::string> valued = {"algorithm", "out",      "tum",      "json",    "trace", "init",
                                   "rank",      "max-rank", "grad-tol", "tum-dir", "stop"};
   valued.insert("preconditioner");
@@ -253,12 +256,15 @@ int run_solve(const Args& args) {
   valued.insert("gnc-cluster-probes");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
-    std::printf("%s%s%s%s%s%s%s%s", kHelp, kSolutionOutputHelp, kGraphInputHelp, kDistributedHelp,
-                kOnlineHelp, kStepCoarseHelp, kRebalanceHelp, kRobustHelp);
+    std::printf("%s%s%s%s%s%s%s%s%s", kHelp, kHeapPagesHelp, kSolutionOutputHelp, kGraphInputHelp,
+                kDistributedHelp, kOnlineHelp, kStepCoarseHelp, kRebalanceHelp, kRobustHelp);
     return 0;
   }
   if (a.positional().size() != 1)
     throw InputError("expected exactly one GRAPH argument (see tessera solve --help)");
+  // Before the solve allocates: this may re-run the process on huge-page heaps.
+  launch::enter_heap_pages(launch::parse_heap_pages(heap_pages, "option --heap-pages"),
+                           process_argv());
   // Every algorithm's CHOLMOD factorizations run on the solver's own threads, as in the agent
   // processes: CHOLMOD's OpenMP teams of 4 parallelise only its supernodal factorization's
   // zeroing and scattering loops (the BLAS is serial), so on these problems they added

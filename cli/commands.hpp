@@ -18,4 +18,14 @@ int run_eval(const Args& args);
 int run_plot(const Args& args);
 int run_replay(const Args& args);
 
+/// main()'s argv, whole: what a command re-executes the process with (launch/heap_pages.hpp).
+char** process_argv();
+
+/// Removes --heap-pages VALUE (or --heap-pages=VALUE) from `args` and returns VALUE, "auto"
+/// when absent.
+std::string take_heap_pages_flag(Args& args);
+
+/// The --heap-pages help line shared by solve and launch.
+extern const char* const kHeapPagesHelp;
+
 }  // namespace tessera::cli

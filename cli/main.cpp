@@ -12,6 +12,8 @@
 
 namespace {
 
+char** g_argv = nullptr;
+
 struct Command {
   const char* name;
   int (*run)(const tessera::cli::Args&);
@@ -36,7 +38,12 @@ void print_usage() {
 
 }  // namespace
 
+char** tessera::cli::process_argv() {
+  return g_argv;
+}
+
 int main(int argc, char** argv) {
+  g_argv = argv;
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
     print_usage();
     return argc < 2 ? 2 : 0;

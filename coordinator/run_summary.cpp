@@ -6,6 +6,7 @@
 
 #include "certificate_output.hpp"
 #include "json_writer.hpp"
+#include "launch/heap_pages.hpp"
 #include "robust_args.hpp"
 #include "runtime/peak_memory.hpp"
 
@@ -120,6 +121,13 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("peak_rss_mb_agent_max", agent_max)
       .add("peak_rss_mb_coordinator", coordinator_mb)
       .add("peak_rss_mb_run", run_mb + coordinator_mb);
+  // The heaps' page size and the probe behind it (launch/heap_pages.hpp).
+  const launch::HeapPagesChoice heap = launch::heap_pages_in_effect();
+  j.add("heap_pages", heap.name());
+  if (heap.fresh_page_us >= 0)
+    j.add("fresh_page_us", heap.fresh_page_us);
+  else
+    j.add_null("fresh_page_us");
   if (in.timeline)
     j.add("timeline_ms", in.timeline->json())
         .add("started_monotonic_ms", in.timeline->started_monotonic_ms());

@@ -124,9 +124,8 @@ LaunchResult launch(LaunchOptions o) {
     const ProcessPlan plan = plan_processes(o, paths, pipefd[1]);
     remove_dead_files_of(run_domain, {}, "before the run");
 
-    // The children's heaps stay in 4 KB pages (no glibc.malloc.hugetlb): on a virtual machine
-    // that hands free memory back to its host, a huge page first touched after a pause cost
-    // ~3 ms of CPU per MB against ~0.4 for 4 KB pages (docs/dds-runtime.md, "Start-up").
+    // The children inherit this process's environment, and with it the heaps' page size that
+    // `tessera launch` chose before (launch/heap_pages.hpp).
     t0 = std::chrono::steady_clock::now();
     // Both close our copy of the progress pipe's write end once the coordinator has its own.
     children = forked ? spawn_forked(fork_server, plan.spec, plan.names, plan.agent_ids,
