@@ -13,7 +13,7 @@ Two measurements, each `--repeat` times:
           MADV_HUGEPAGE) and in 4 KB pages: after `--pause` seconds, then again at once; CPU-s of
           this process (user + system)
   launch  per heap mode (`4k`: GLIBC_TUNABLES=glibc.malloc.hugetlb=0; `huge`: ...=1, what
-          launch asks for its processes by default), after `--pause` seconds, `--runs`
+          `--heap-pages auto` gives where a fresh 4 KB page costs 8 us or more), after `--pause` seconds, `--runs`
           launches of G back to back (`tessera launch G --agents N`); per position: CPU-s of all
           the run's processes (user, system), minor faults, huge pages faulted (/proc/vmstat
           thp_fault_alloc, machine-wide) and the wall
