@@ -236,6 +236,28 @@ TEST(DdsLaunch, ReportsPeakMemoryPerAgentAndTheSetUpSteps) {
       << json;
 }
 
+// --heap-pages 2m reaches the run's processes: the coordinator, forked after launch re-ran itself,
+// reports the page size from its own GLIBC_TUNABLES (launch/heap_pages.hpp).
+TEST(DdsLaunch, TheRunsProcessesInheritTheHeapPagesLaunchChose) {
+  std::ifstream thp("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string mode;
+  std::getline(thp, mode);
+  if (mode.empty() || mode.find("[never]") != std::string::npos)
+    GTEST_SKIP() << "transparent huge pages are off on this host";
+  const std::string dir = temp_dir();
+  std::string out;
+  ASSERT_EQ(run_command("env -u GLIBC_TUNABLES " + bin("tessera") +
+                            " launch --agents 2 --poses 120 --domain 62 --partition fast"
+                            " --timeout 60 --heap-pages 2m --json " +
+                            dir + "/s.json 2>&1",
+                        &out),
+            0)
+      << out;
+  const std::string json = slurp(dir + "/s.json");
+  EXPECT_NE(json.find("\"heap_pages\": \"2m\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"fresh_page_us\": null"), std::string::npos) << json;
+}
+
 // --keep-logs keeps every process's log in the folder it names; with TESSERA_DDS_TRACE=1 each trace
 // line carries the host's monotonic clock and the process's CPU time, so the processes' logs
 // merge into one timeline of the start-up.
