@@ -24,7 +24,9 @@ agent 0's own clock for two parts of init, in the CSV: its initialisation stage 
 with the chordal start solved while the run started, `init_early`, little more than the wait for
 the others' values) and its hand-off (`handoff_own_s`); and the total, the centralized wall, their
 ratio (launch to exit / centralized), the relative gap of each to f* (optima.csv), certification,
-rounds and the load. Writes docs/benchmarks/launch_phases.csv.
+rounds and the load; the heaps' page size each side ran on (`heap_pages`, `centralized_heap_pages`,
+and the probe's `fresh_page_us`: `--heap-pages auto` chooses per host, docs/dds-runtime.md).
+Writes docs/benchmarks/launch_phases.csv.
 Wall times depend on the machine's load: it is printed per graph; phases are the coordinator's
 timeline (CLOCK_MONOTONIC, shared by the processes of the host) and agent 0's clock.
 
@@ -185,7 +187,9 @@ def main():
                            centralized_cpu_s=round(c["cpu_s"], 3),
                            ratio=round(s["exit_wall_s"] / c["wall_s_process"], 3),
                            rel_gap=gap, centralized_rel_gap=cgap, centralized_certified=c["certified"],
-                           peak_rss_mb_agent_max=s.get("peak_rss_mb_agent_max"), load_avg_1min=round(load, 2))
+                           peak_rss_mb_agent_max=s.get("peak_rss_mb_agent_max"),
+                           heap_pages=s.get("heap_pages"), centralized_heap_pages=c.get("heap_pages"),
+                           fresh_page_us=s.get("fresh_page_us"), load_avg_1min=round(load, 2))
                 rows.append(row)
             # the median pair by ratio
             med = sorted(rows[-len(runs):], key=lambda r: r["ratio"])[len(runs) // 2]
@@ -196,6 +200,12 @@ def main():
             print(" ".join(f"{c:>9s}" if i else f"{c:15s}" for i, c in enumerate(cells)), flush=True)
     print(f"machine at end: {bc.machine()}")
     if rows:
+        # --heap-pages auto picks the heaps' page size per host (docs/dds-runtime.md): say which ran.
+        probes = [r["fresh_page_us"] for r in rows if r["fresh_page_us"] is not None]
+        print("heap pages: launch %s, centralized %s%s" % (
+            "/".join(sorted({str(r["heap_pages"]) for r in rows})),
+            "/".join(sorted({str(r["centralized_heap_pages"]) for r in rows})),
+            f" (a fresh 4 KB page {min(probes):.1f}-{max(probes):.1f} us)" if probes else ""))
         os.makedirs(os.path.dirname(a.csv), exist_ok=True)
         bc.write_csv(a.csv, rows)
         big = [r for r in rows if r["poses"] >= 5000]
