@@ -6,7 +6,7 @@
 #include <tessera/io/robot_trajectories.hpp>
 #include <tessera/io/tum_writer.hpp>
 
-#include "launch/heap_pages.hpp"
+#include "heap_pages_json.hpp"
 
 namespace tessera::cli {
 
@@ -48,13 +48,7 @@ JsonObject solve_json(const std::string& graph_path, const PoseGraph& graph,
       .add("cost", summary.cost)
       .add("relaxation_cost", summary.relaxation_cost)
       .add("certified", summary.certified);
-  // The heaps' page size and the probe behind it (launch/heap_pages.hpp).
-  const launch::HeapPagesChoice heap = launch::heap_pages_in_effect();
-  j.add("heap_pages", heap.name());
-  if (heap.fresh_page_us >= 0)
-    j.add("fresh_page_us", heap.fresh_page_us);
-  else
-    j.add_null("fresh_page_us");
+  add_heap_pages(j);
   return j;
 }
 

@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "certificate_output.hpp"
+#include "heap_pages_json.hpp"
 #include "json_writer.hpp"
-#include "launch/heap_pages.hpp"
 #include "robust_args.hpp"
 #include "runtime/peak_memory.hpp"
 
@@ -121,13 +121,7 @@ std::string run_summary_json(const RunSummaryInputs& in) {
       .add("peak_rss_mb_agent_max", agent_max)
       .add("peak_rss_mb_coordinator", coordinator_mb)
       .add("peak_rss_mb_run", run_mb + coordinator_mb);
-  // The heaps' page size and the probe behind it (launch/heap_pages.hpp).
-  const launch::HeapPagesChoice heap = launch::heap_pages_in_effect();
-  j.add("heap_pages", heap.name());
-  if (heap.fresh_page_us >= 0)
-    j.add("fresh_page_us", heap.fresh_page_us);
-  else
-    j.add_null("fresh_page_us");
+  cli::add_heap_pages(j);
   if (in.timeline)
     j.add("timeline_ms", in.timeline->json())
         .add("started_monotonic_ms", in.timeline->started_monotonic_ms());
