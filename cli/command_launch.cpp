@@ -21,7 +21,7 @@ int run_launch(const Args& given) {
   if (launch::wants_online_launch(argv)) {
     // First: this may re-run the process on huge-page heaps, which every process of the run
     // then inherits (launch/heap_pages.hpp).
-    if (!launch::wants_launch_help(argv)) launch::enter_heap_pages(pages, process_argv());
+    if (!launch::wants_launch_help(argv)) launch::enter_heap_pages(pages);
     return launch::run_online_launch(argv);
   }
   if (launch::wants_launch_help(argv)) {
@@ -30,7 +30,7 @@ int run_launch(const Args& given) {
     std::printf("\nOutputs in GRAPH's terms (one whole GRAPH file):\n%s", kLaunchOutputHelp);
     return 0;
   }
-  launch::enter_heap_pages(pages, process_argv());
+  launch::enter_heap_pages(pages);
   std::vector<std::string> rest = argv;
   const LaunchOutputs outputs = take_launch_outputs(rest);
   launch::LaunchOptions options = launch::parse_launch_options(rest);

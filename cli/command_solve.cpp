@@ -235,10 +235,8 @@ int solve_centralized_command(const Arguments& a, const std::string& graph_path,
 
 }  // namespace
 
-int run_solve(const Args& given) {
+int run_solve(const Args& args) {
   const auto start = std::chrono::steady_clock::now();
-  Args args = given;
-  const std::string heap_pages = take_heap_pages_flag(args);
   std::set<std::string> valued = {"algorithm", "out",      "tum",      "json",    "trace", "init",
                                   "rank",      "max-rank", "grad-tol", "tum-dir", "stop"};
   valued.insert("preconditioner");
@@ -254,6 +252,7 @@ int run_solve(const Args& given) {
   for (const char* const* o = kRobustValued; *o; ++o) valued.insert(*o);
   valued.insert("precond-max-flops");
   valued.insert("gnc-cluster-probes");
+  valued.insert("heap-pages");
   Arguments a(args, valued, switches);
   if (a.has("help")) {
     std::printf("%s%s%s%s%s%s%s%s%s", kHelp, kHeapPagesHelp, kSolutionOutputHelp, kGraphInputHelp,
@@ -263,8 +262,8 @@ int run_solve(const Args& given) {
   if (a.positional().size() != 1)
     throw InputError("expected exactly one GRAPH argument (see tessera solve --help)");
   // Before the solve allocates: this may re-run the process on huge-page heaps.
-  launch::enter_heap_pages(launch::parse_heap_pages(heap_pages, "option --heap-pages"),
-                           process_argv());
+  launch::enter_heap_pages(
+      launch::parse_heap_pages(a.get_or("heap-pages", "auto"), "option --heap-pages"));
   // Every algorithm's CHOLMOD factorizations run on the solver's own threads, as in the agent
   // processes: CHOLMOD's OpenMP teams of 4 parallelise only its supernodal factorization's
   // zeroing and scattering loops (the BLAS is serial), so on these problems they added

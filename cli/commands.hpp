@@ -18,11 +18,9 @@ int run_eval(const Args& args);
 int run_plot(const Args& args);
 int run_replay(const Args& args);
 
-/// main()'s argv, whole: what a command re-executes the process with (launch/heap_pages.hpp).
-char** process_argv();
-
 /// Removes --heap-pages VALUE (or --heap-pages=VALUE) from `args` and returns VALUE, "auto"
-/// when absent.
+/// when absent. For `tessera launch`, whose flags go on to two parsers (batch and --online),
+/// neither of which knows this process-level flag; `tessera solve` parses it with the rest.
 std::string take_heap_pages_flag(Args& args);
 
 /// The --heap-pages help line shared by solve and launch.

@@ -12,8 +12,6 @@
 
 namespace {
 
-char** g_argv = nullptr;
-
 struct Command {
   const char* name;
   int (*run)(const tessera::cli::Args&);
@@ -38,12 +36,7 @@ void print_usage() {
 
 }  // namespace
 
-char** tessera::cli::process_argv() {
-  return g_argv;
-}
-
 int main(int argc, char** argv) {
-  g_argv = argv;
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
     print_usage();
     return argc < 2 ? 2 : 0;

@@ -10,8 +10,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <string>
 #include <tessera/util/input_error.hpp>
+#include <vector>
 
 namespace tessera::launch {
 
@@ -83,6 +86,23 @@ bool parse_record(const std::string& text, HeapPagesChoice& out) {
   return true;
 }
 
+// The choice recorded in the environment, when it is the one in effect (GLIBC_TUNABLES agrees).
+std::optional<HeapPagesChoice> recorded_choice() {
+  HeapPagesChoice c;
+  if (parse_record(env_or_empty(kRecordVariable), c) &&
+      c.huge == hugetlb_on(env_or_empty("GLIBC_TUNABLES")))
+    return c;
+  return std::nullopt;
+}
+
+// This process's own command line, from /proc (what main() was given), for execv.
+std::vector<std::string> own_command_line() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::vector<std::string> args;
+  for (std::string arg; std::getline(in, arg, '\0');) args.push_back(arg);
+  return args;
+}
+
 }  // namespace
 
 HeapPages parse_heap_pages(const std::string& value, const std::string& flag) {
@@ -142,20 +162,22 @@ double fresh_page_cost_us() {
   return best;
 }
 
-HeapPagesChoice enter_heap_pages(HeapPages mode, char** argv) {
-  HeapPagesChoice c;
+HeapPagesChoice enter_heap_pages(HeapPages mode) {
   // A parent (or this process before it re-executed) has decided already.
-  if (mode == HeapPages::kAuto && parse_record(env_or_empty(kRecordVariable), c) &&
-      c.huge == hugetlb_on(env_or_empty("GLIBC_TUNABLES")))
-    return c;
+  if (mode == HeapPages::kAuto)
+    if (std::optional<HeapPagesChoice> recorded = recorded_choice()) return *recorded;
   const std::string tunables = env_or_empty("GLIBC_TUNABLES");
-  c = decide_heap_pages(mode, tunables, read_thp_setting(), &fresh_page_cost_us);
+  HeapPagesChoice c = decide_heap_pages(mode, tunables, read_thp_setting(), &fresh_page_cost_us);
   if (c.huge != hugetlb_on(tunables)) {
     // glibc reads its tunables once, at start-up: only a new image of this process takes them.
     const std::string next = with_hugetlb(tunables, c.huge ? "1" : "0");
     record(c);
     setenv("GLIBC_TUNABLES", next.c_str(), 1);
-    execv("/proc/self/exe", argv);
+    std::vector<std::string> args = own_command_line();
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv("/proc/self/exe", argv.data());
     const int err = errno;
     if (tunables.empty())
       unsetenv("GLIBC_TUNABLES");
@@ -169,10 +191,9 @@ HeapPagesChoice enter_heap_pages(HeapPages mode, char** argv) {
 }
 
 HeapPagesChoice heap_pages_in_effect() {
-  HeapPagesChoice c;
+  if (std::optional<HeapPagesChoice> recorded = recorded_choice()) return *recorded;
   const std::string tunables = env_or_empty("GLIBC_TUNABLES");
-  if (parse_record(env_or_empty(kRecordVariable), c) && c.huge == hugetlb_on(tunables)) return c;
-  c = HeapPagesChoice{};
+  HeapPagesChoice c;
   c.huge = hugetlb_on(tunables);
   c.reason = hugetlb_value(tunables).empty()
                  ? "glibc's default"

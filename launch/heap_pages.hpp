@@ -47,12 +47,12 @@ HeapPagesChoice decide_heap_pages(HeapPages mode, const std::string& tunables,
 double fresh_page_cost_us();
 
 /// Puts this process's heap on the page size `mode` selects. When that needs huge pages not yet
-/// in effect, it re-executes the process (/proc/self/exe, the same `argv`) with
+/// in effect, it re-executes the process (/proc/self/exe with its own command line) with
 /// glibc.malloc.hugetlb=1 added to GLIBC_TUNABLES and the choice recorded in the environment, so
 /// it returns only in the process that runs on the chosen heap (or when the re-execution
 /// failed: then 4 KB pages, said in the reason). Call it first, before the process allocates
 /// what it will use. Children started later inherit the environment, and so the choice.
-HeapPagesChoice enter_heap_pages(HeapPages mode, char** argv);
+HeapPagesChoice enter_heap_pages(HeapPages mode);
 
 /// The choice in effect in this process, from its environment (what enter_heap_pages() of this
 /// process or of its parent recorded; else what GLIBC_TUNABLES says). For run summaries.
