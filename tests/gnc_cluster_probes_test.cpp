@@ -78,6 +78,45 @@ TEST(ClosureClusters, ARunSideBySideIsOneClusterAndOnlyCutClosuresNearItPointAtI
   EXPECT_EQ(c[0].members.size(), 6u);
 }
 
+TEST(ClosureClusters, ARunGncPartlyCutComesFirstThenTheLongestThenTheOneMoreCutClosuresPointAt) {
+  PoseGraph g = chain(400);
+  const std::size_t pair = g.num_measurements();
+  add_closure(g, 10, 100);  // a pair with three cut closures beside it
+  add_closure(g, 11, 101);
+  const std::size_t run = g.num_measurements();
+  for (std::size_t k = 0; k < 6; ++k) add_closure(g, 200 + k, 300 + k);  // a run of six
+  const std::size_t other_pair = g.num_measurements();
+  add_closure(g, 150, 250);  // a second pair, one cut closure beside it
+  add_closure(g, 151, 251);
+  std::vector<std::size_t> cut;
+  for (std::size_t i : {20u, 22u, 24u}) {
+    add_closure(g, i, 380);
+    cut.push_back(g.num_measurements() - 1);
+  }
+  add_closure(g, 210, 390);  // near the run: one cut closure
+  cut.push_back(g.num_measurements() - 1);
+  add_closure(g, 160, 395);  // near the second pair
+  cut.push_back(g.num_measurements() - 1);
+  const std::size_t partly_cut = g.num_measurements();
+  add_closure(g, 60, 120);  // a pair whose run goes on in a cut closure
+  add_closure(g, 61, 121);
+  add_closure(g, 62, 122);
+  cut.push_back(g.num_measurements() - 1);
+  std::sort(cut.begin(), cut.end());
+
+  const std::vector<ClosureCluster> c =
+      closure_clusters(g, odometry_flags(g), cut, ClosureClusterOptions{});
+  ASSERT_EQ(c.size(), 4u);
+  EXPECT_EQ(c[0].members.front(), partly_cut) << "GNC cut the rest of its run: first";
+  EXPECT_EQ(c[0].rejected_in_run, 1u);
+  EXPECT_EQ(c[1].members.front(), run) << "a longer run holds a bend more firmly: next";
+  EXPECT_EQ(c[1].members.size(), 6u);
+  EXPECT_EQ(c[1].rejected_in_run, 0u);
+  EXPECT_EQ(c[2].members.front(), pair) << "then, among equals, the most cut closures near";
+  EXPECT_EQ(c[2].rejected_near, 3u);
+  EXPECT_EQ(c[3].members.front(), other_pair);
+}
+
 TEST(ClosureClusters, BadOptionsNameTheField) {
   const PoseGraph g = chain(10);
   ClosureClusterOptions o;

@@ -39,7 +39,7 @@ TEST(GncClusterSearch, TriesTheTailThenEachClusterThenTheReturnBandTogetherThenA
   const std::uint64_t near_a = c.add(40, 140), near_b = c.add(45, 180);  // rejected, the band
   const Ids rejected = {cut, near_a, near_b};
   GncClusterSearch search(c.structure, c.known, /*tail_budget=*/1, /*budget=*/10, {});
-  search.set_list({near_b, tail, near_a});
+  search.set_list({near_b, tail, near_a}, {near_b, tail, near_a});
 
   EXPECT_EQ(search.next(rejected), (Ids{tail, near_a, near_b})) << "the agents' tail probe";
   search.refused(5.0, 100.0);
@@ -55,10 +55,27 @@ TEST(GncClusterSearch, TriesTheTailThenEachClusterThenTheReturnBandTogetherThenA
   EXPECT_EQ(search.tail_probes(), 1);
   EXPECT_EQ(search.probes(), 4);
 
-  // A kept probe changes the set: every candidate may be tried again (the tail budget is spent).
+  // A kept probe changes the set: every candidate may be tried again (the tail budget is spent),
+  // and the band together comes first, since a cut fold lets its true closures back in.
   search.kept();
-  search.set_list({near_a});
+  search.set_list({near_a, near_b}, {near_a, near_b});
+  EXPECT_EQ(search.next(rejected), (Ids{near_a, near_b})) << "a probe stayed: the band first";
+  search.refused(1.0, 100.0);
   EXPECT_EQ(search.next(rejected), (Ids{run0, run1, run2}));
+}
+
+TEST(GncClusterSearch, TheTailProbeFlipsWhatTheStageGivesIt) {
+  Chain c(200);
+  c.add(10, 100);
+  c.add(11, 101);
+  const std::uint64_t tail = c.add(60, 160);  // kept, named by an agent's tail
+  const std::uint64_t band = c.add(40, 140);  // rejected, in the return band
+  GncClusterSearch search(c.structure, c.known, /*tail_budget=*/1, /*budget=*/10, {});
+  // Where GNC's own set keeps its tail (GncProbeStage::flips), only the band comes back.
+  search.set_list({tail, band}, {band});
+  EXPECT_EQ(search.next({band}), (Ids{band}));
+  EXPECT_EQ(search.tail_probes(), 1);
+  EXPECT_EQ(search.probes(), 0);
 }
 
 TEST(GncClusterSearch, TheBudgetBoundsTheClusterAndReturnProbes) {
@@ -66,7 +83,7 @@ TEST(GncClusterSearch, TheBudgetBoundsTheClusterAndReturnProbes) {
   const std::uint64_t run0 = c.add(10, 100), run1 = c.add(11, 101);
   const std::uint64_t cut = c.add(20, 110);
   GncClusterSearch search(c.structure, c.known, 0, 1, {});
-  search.set_list({cut});
+  search.set_list({cut}, {});
   EXPECT_EQ(search.next({cut}), (Ids{run0, run1}));
   search.refused(1.0, 10.0);
   EXPECT_EQ(search.next({cut}), std::nullopt) << "budget of one spent";

@@ -78,6 +78,26 @@ std::vector<ClosureCluster> closure_clusters(const PoseGraph& graph, const std::
   std::vector<std::vector<std::size_t>> groups(kept.size());
   for (std::size_t a = 0; a < kept.size(); ++a) groups[component[a]].push_back(kept[a]);
 
+  // The rejected closures by lower end, to find those in a cluster's own run.
+  std::vector<Span> cut_spans;
+  for (std::size_t e : cut) cut_spans.push_back(span_of(graph.measurements[e]));
+  std::sort(cut_spans.begin(), cut_spans.end(), [](const Span& a, const Span& b) {
+    return a.lo < b.lo || (a.lo == b.lo && a.hi < b.hi);
+  });
+  auto in_run = [&](const std::vector<std::size_t>& members) {
+    std::vector<std::size_t> found;  // positions in cut_spans
+    for (std::size_t e : members) {
+      const Span s = span_of(graph.measurements[e]);
+      auto it = std::lower_bound(cut_spans.begin(), cut_spans.end(), s.lo > w ? s.lo - w : 0,
+                                 [](const Span& a, std::size_t lo) { return a.lo < lo; });
+      for (; it != cut_spans.end() && it->lo <= s.lo + w; ++it)
+        if (distance(it->hi, s.hi) <= w)
+          found.push_back(static_cast<std::size_t>(it - cut_spans.begin()));
+    }
+    std::sort(found.begin(), found.end());
+    return static_cast<std::size_t>(std::unique(found.begin(), found.end()) - found.begin());
+  };
+
   std::vector<ClosureCluster> out;
   const std::size_t near = static_cast<std::size_t>(options.near);
   for (std::vector<std::size_t>& g : groups) {
@@ -104,12 +124,15 @@ std::vector<ClosureCluster> closure_clusters(const PoseGraph& graph, const std::
       if (d <= near) ++c.rejected_near;
     }
     if (c.rejected_near < options.min_rejected_near) continue;
+    c.rejected_in_run = in_run(g);
     c.members = std::move(g);
     out.push_back(std::move(c));
   }
   std::sort(out.begin(), out.end(), [](const ClosureCluster& a, const ClosureCluster& b) {
-    if (a.rejected_near != b.rejected_near) return a.rejected_near > b.rejected_near;
+    const bool a_cut = a.rejected_in_run > 0, b_cut = b.rejected_in_run > 0;
+    if (a_cut != b_cut) return a_cut;
     if (a.members.size() != b.members.size()) return a.members.size() > b.members.size();
+    if (a.rejected_near != b.rejected_near) return a.rejected_near > b.rejected_near;
     return a.members.front() < b.members.front();
   });
   return out;

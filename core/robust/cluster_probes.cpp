@@ -42,6 +42,9 @@ ClusterProbeCounts search_cluster_probes(
   // closure), then each closure of the band alone.
   bool returned_together = false;
   std::vector<std::size_t> returned_alone;
+  // Right after a kept probe the band together comes first: the true closures a cut fold had
+  // pushed beyond the bound come back there, before another cluster is cut on their account.
+  bool band_first = false;
   auto untried = [&](const std::vector<std::size_t>& p) {
     return std::find(tried.begin(), tried.end(), p) == tried.end();
   };
@@ -65,8 +68,24 @@ ClusterProbeCounts search_cluster_probes(
     returned_together = false;
     returned_alone.clear();
     tail_tried = false;
+    band_first = true;
     keep();
     return 0.0;
+  };
+  auto band = [&] {
+    return return_ratio > 1 ? return_candidates(graph, poses, c2, return_ratio, rejected)
+                            : std::vector<std::size_t>{};
+  };
+  // Runs the probe that brings `back` (ascending) back.
+  auto attempt_return = [&](const std::vector<std::size_t>& back) {
+    std::vector<std::size_t> next;
+    std::set_difference(rejected.begin(), rejected.end(), back.begin(), back.end(),
+                        std::back_inserter(next));
+    const int kept_before = out.kept;
+    attempt(std::move(next));
+    if (out.kept > kept_before)
+      for (std::size_t e : back)
+        out.returned += std::binary_search(rejected.begin(), rejected.end(), e) ? 0 : 1;
   };
   for (;;) {
     // First, a tail probe (the distributed probe's rule, gnc_votes): when the kept residuals
@@ -79,9 +98,7 @@ ClusterProbeCounts search_cluster_probes(
       const std::vector<std::size_t> cut = tail_candidates(
           graph, known, poses, c2, rules.tail_cut_ratio, rules.tail_ratio, rejected);
       if (!cut.empty()) {
-        std::vector<std::size_t> back =
-            return_ratio > 1 ? return_candidates(graph, poses, c2, return_ratio, rejected)
-                             : std::vector<std::size_t>{};
+        std::vector<std::size_t> back = band();
         std::sort(back.begin(), back.end());
         std::vector<std::size_t> next;
         std::set_difference(rejected.begin(), rejected.end(), back.begin(), back.end(),
@@ -98,6 +115,17 @@ ClusterProbeCounts search_cluster_probes(
       }
     }
     if (out.probes - tail_probes >= rules.budget) break;
+    if (band_first) {
+      band_first = false;
+      std::vector<std::size_t> back = band();
+      if (!back.empty()) {
+        returned_together = true;
+        if (back.size() == 1) returned_alone.push_back(back.front());
+        std::sort(back.begin(), back.end());
+        attempt_return(back);
+        continue;
+      }
+    }
     Probe probe;
     for (const ClosureCluster& c : rules.cut_clusters
                                        ? closure_clusters(graph, known, rejected, clusters)
@@ -150,16 +178,14 @@ ClusterProbeCounts search_cluster_probes(
     // random 0.1: r^2 47.5 against c^2 = 46.6, 8.1 at the clean optimum; intel, group 0.1: 71.9
     // against 32.8, 4.3 there); when one of several returned together is wrong, the passes cut it
     // again or the TLS cost refuses the lot, and the closures alone remain.
-    const std::vector<std::size_t> band =
-        return_ratio > 1 ? return_candidates(graph, poses, c2, return_ratio, rejected)
-                         : std::vector<std::size_t>{};
+    const std::vector<std::size_t> listed = band();
     std::vector<std::size_t> back;
-    if (band.size() > 1 && !returned_together) {
+    if (listed.size() > 1 && !returned_together) {
       returned_together = true;
-      back = band;
+      back = listed;
       std::sort(back.begin(), back.end());
     } else {
-      for (std::size_t e : band)
+      for (std::size_t e : listed)
         if (std::find(returned_alone.begin(), returned_alone.end(), e) == returned_alone.end()) {
           back = {e};
           returned_alone.push_back(e);
@@ -167,14 +193,7 @@ ClusterProbeCounts search_cluster_probes(
         }
     }
     if (back.empty()) break;
-    std::vector<std::size_t> next;
-    std::set_difference(rejected.begin(), rejected.end(), back.begin(), back.end(),
-                        std::back_inserter(next));
-    const int kept_before = out.kept;
-    attempt(std::move(next));
-    if (out.kept > kept_before)
-      for (std::size_t e : back)
-        out.returned += std::binary_search(rejected.begin(), rejected.end(), e) ? 0 : 1;
+    attempt_return(back);
   }
   return out;
 }

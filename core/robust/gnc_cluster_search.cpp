@@ -27,10 +27,18 @@ GncClusterSearch::GncClusterSearch(
   }
 }
 
-void GncClusterSearch::set_list(const std::vector<std::uint64_t>& listed) {
-  listed_ = listed;
-  std::sort(listed_.begin(), listed_.end());
-  listed_.erase(std::unique(listed_.begin(), listed_.end()), listed_.end());
+namespace {
+std::vector<std::uint64_t> sorted_unique(std::vector<std::uint64_t> ids) {
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
+}
+}  // namespace
+
+void GncClusterSearch::set_list(const std::vector<std::uint64_t>& listed,
+                                const std::vector<std::uint64_t>& tail) {
+  listed_ = sorted_unique(listed);
+  tail_ = sorted_unique(tail);
 }
 
 bool GncClusterSearch::untried(const std::vector<std::size_t>& members) const {
@@ -84,15 +92,32 @@ std::optional<std::vector<std::uint64_t>> GncClusterSearch::next(
   auto is_rejected = [&](std::uint64_t id) {
     return std::binary_search(rejected.begin(), rejected.end(), id);
   };
+  std::vector<std::uint64_t> band;
+  std::copy_if(listed_.begin(), listed_.end(), std::back_inserter(band), is_rejected);
   // First, the agents' tail probe: the kept measurements they named leave, the band comes back.
   if (tail_used_ < tail_budget_ && !tail_tried_) {
     tail_tried_ = true;
-    if (!std::all_of(listed_.begin(), listed_.end(), is_rejected)) {
+    if (!tail_.empty()) {
       ++tail_used_;
-      return listed_;
+      // A tail probe that only returns the band is the band-together probe: not tried twice.
+      if (tail_ == band) {
+        returned_together_ = true;
+        if (band.size() == 1) returned_alone_.push_back(band.front());
+      }
+      return tail_;
     }
   }
   if (used_ >= budget_) return std::nullopt;
+  // Right after a kept probe, the band together first: the true closures a cut fold had pushed
+  // beyond the bound come back there, before another cluster is cut on their account.
+  if (band_first_ && !band.empty()) {
+    band_first_ = false;
+    returned_together_ = true;
+    if (band.size() == 1) returned_alone_.push_back(band.front());
+    ++used_;
+    return band;
+  }
+  band_first_ = false;
   if (std::optional<Probe> p = next_cluster(rejected)) {
     ++used_;
     tried_.push_back(p->members);
@@ -101,8 +126,6 @@ std::optional<std::vector<std::uint64_t>> GncClusterSearch::next(
   }
   // Last, the return band (rejected closures within RobustOptions::probe_return_ratio c^2 at the
   // state's solution): all together, then one at a time in file order.
-  std::vector<std::uint64_t> band;
-  std::copy_if(listed_.begin(), listed_.end(), std::back_inserter(band), is_rejected);
   std::vector<std::uint64_t> back;
   if (band.size() > 1 && !returned_together_) {
     returned_together_ = true;
@@ -127,6 +150,7 @@ void GncClusterSearch::kept() {
   returned_together_ = false;
   returned_alone_.clear();
   tail_tried_ = false;
+  band_first_ = true;
 }
 
 void GncClusterSearch::refused(double rise, double base) {

@@ -6,7 +6,7 @@
 // closures side by side at a time (closure_clusters.hpp), then two clusters that share a stretch
 // together (each raised the TLS cost alone), last the return band together, then one closure of
 // it at a time. Each probe is judged by the summed TLS cost (GncProbes::keeps); a kept one makes
-// every kind possible again.
+// every kind possible again, the return band together first.
 //
 // Who decides: every agent runs this search on the same data and so picks the same probe with
 // no message of its own. A cluster is a property of the endpoints of the kept closures (every
@@ -37,9 +37,11 @@ class GncClusterSearch {
                    ClosureClusterOptions clusters);
 
   /// The verdict list at the state the next probes start from (every agent's RecheckVerdict::
-  /// probe, any order): the kept ones name the tail, the rejected ones the return band. Called
-  /// at every state that a probe does not undo (the first one, and after each kept probe).
-  void set_list(const std::vector<std::uint64_t>& listed);
+  /// probe, any order), whose rejected ones are the return band, and the tail probe's flips
+  /// (GncProbeStage::flips: the list, or only its rejected ones where GNC's own set keeps its
+  /// tail). Called at every state that a probe does not undo (the first one, and after each
+  /// kept probe).
+  void set_list(const std::vector<std::uint64_t>& listed, const std::vector<std::uint64_t>& tail);
   /// The measurements the next probe flips (kept ones leave, rejected ones come back;
   /// ascending), from the set `rejected` (ascending), or nullopt when the search is over.
   std::optional<std::vector<std::uint64_t>> next(const std::vector<std::uint64_t>& rejected);
@@ -64,13 +66,14 @@ class GncClusterSearch {
   std::vector<bool> known_;
   int tail_budget_, budget_;
   ClosureClusterOptions clusters_;
-  std::vector<std::uint64_t> listed_;  // ascending
+  std::vector<std::uint64_t> listed_, tail_;  // ascending
   int tail_used_ = 0, used_ = 0;
   bool tail_tried_ = false;
   std::vector<std::vector<std::size_t>> tried_;
   std::vector<std::pair<double, Probe>> raised_;
   std::optional<Probe> running_;  // the running probe when it is a cluster or pair probe
   bool returned_together_ = false;
+  bool band_first_ = false;  // a probe stayed: the return band together comes first
   std::vector<std::uint64_t> returned_alone_;
 };
 

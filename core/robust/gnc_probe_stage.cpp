@@ -49,8 +49,10 @@ std::optional<std::vector<std::uint64_t>> GncProbeStage::next(
     std::vector<std::uint64_t> listed, const std::vector<std::uint64_t>& rejected,
     const std::vector<std::uint64_t>& gnc_rejected, bool newton_steps) {
   if (search_) {
-    // The verdict lists of the set that stays: the tail and the return band of its probes.
-    search_->set_list(listed);
+    // The verdict lists of the set that stays: the return band of its probes, and its tail
+    // probe's flips on the same rule as without cluster probes.
+    std::vector<std::uint64_t> tail = flips(listed, rejected, gnc_rejected, newton_steps);
+    search_->set_list(listed, tail);
     if (!may_start()) return std::nullopt;
     return search_->next(rejected);
   }

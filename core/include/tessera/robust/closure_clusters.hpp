@@ -34,6 +34,9 @@ struct ClosureClusterOptions {
 struct ClosureCluster {
   std::vector<std::size_t> members;  ///< Measurement indices, ascending.
   std::size_t rejected_near = 0;     ///< Rejected closures with an end near its stretches.
+  /// Rejected closures of its own run: within the window of a member at both ends (a run whose
+  /// other members GNC cut, so part of it was already judged wrong).
+  std::size_t rejected_in_run = 0;
   /// Its two stretches: the id ranges of its members' lower and upper ends.
   std::size_t lo_first = 0, lo_last = 0, hi_first = 0, hi_last = 0;
 };
@@ -44,8 +47,9 @@ bool clusters_meet(const ClosureCluster& a, const ClosureCluster& b, int near);
 
 /// The clusters of the kept closures (known[e] false, e not in `rejected`, which is ascending)
 /// with at least options.min_size members and at least options.min_rejected_near rejected
-/// closures near them, most
-/// rejected_near first (then larger first, then lower first member).
+/// closures near them. Order: the runs with a rejected member of their own first (GNC cut the
+/// rest of such a run: the strongest sign of a wrong one), then longer first (a longer run holds
+/// a bend more firmly), then most rejected_near first, then lower first member.
 std::vector<ClosureCluster> closure_clusters(const PoseGraph& graph, const std::vector<bool>& known,
                                              const std::vector<std::size_t>& rejected,
                                              const ClosureClusterOptions& options);
