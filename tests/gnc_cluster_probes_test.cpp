@@ -117,6 +117,20 @@ TEST(ClosureClusters, ARunGncPartlyCutComesFirstThenTheLongestThenTheOneMoreCutC
   EXPECT_EQ(c[3].members.front(), other_pair);
 }
 
+TEST(ClosureClusters, PartlyCutRunsAreOneProbeOnlyWhenThereAreTwoOrMore) {
+  ClosureCluster one, two, whole;
+  one.members = {5, 9};
+  one.rejected_in_run = 1;
+  two.members = {2, 7};
+  two.rejected_in_run = 2;
+  whole.members = {1, 3};
+  EXPECT_TRUE(partly_cut_runs({one, whole}).members.empty()) << "one run is a single probe";
+  const ClusterUnion both = partly_cut_runs({whole, one, two});
+  EXPECT_EQ(both.members, (std::vector<std::size_t>{2, 5, 7, 9}));
+  ASSERT_EQ(both.parts.size(), 2u);
+  EXPECT_EQ(both.parts[0].members, one.members);
+}
+
 TEST(ClosureClusters, BadOptionsNameTheField) {
   const PoseGraph g = chain(10);
   ClosureClusterOptions o;

@@ -64,6 +64,28 @@ TEST(GncClusterSearch, TriesTheTailThenEachClusterThenTheReturnBandTogetherThenA
   EXPECT_EQ(search.next(rejected), (Ids{run0, run1, run2}));
 }
 
+TEST(GncClusterSearch, EveryRunGncPartlyCutIsCutTogetherFirstThenOneRunAtATime) {
+  Chain c(300);
+  const std::uint64_t a0 = c.add(10, 100), a1 = c.add(11, 101), cut_a = c.add(12, 102);
+  const std::uint64_t b0 = c.add(150, 250), b1 = c.add(151, 251), cut_b = c.add(152, 252);
+  Ids longer;  // a longer run, wholly kept, with a cut closure near it
+  for (std::uint32_t k = 0; k < 5; ++k) longer.push_back(c.add(50 + k, 200 + k));
+  const std::uint64_t near_longer = c.add(60, 280);
+  Ids rejected = {cut_a, cut_b, near_longer};
+  std::sort(rejected.begin(), rejected.end());
+  GncClusterSearch search(c.structure, c.known, /*tail_budget=*/0, /*budget=*/10, {});
+  search.set_list({}, {});
+
+  EXPECT_EQ(search.next(rejected), (Ids{a0, a1, b0, b1}))
+      << "runs that share one bend may only leave together";
+  search.refused(1.0, 100.0);
+  EXPECT_EQ(search.next(rejected), (Ids{a0, a1})) << "then each partly cut run";
+  search.refused(1.0, 100.0);
+  EXPECT_EQ(search.next(rejected), (Ids{b0, b1}));
+  search.refused(1.0, 100.0);
+  EXPECT_EQ(search.next(rejected), longer) << "then the longer runs";
+}
+
 TEST(GncClusterSearch, TheTailProbeFlipsWhatTheStageGivesIt) {
   Chain c(200);
   c.add(10, 100);

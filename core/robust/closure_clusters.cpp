@@ -37,6 +37,18 @@ void ClosureClusterOptions::validate() const {
     throw InputError("ClosureClusterOptions.near = " + std::to_string(near) + ": must be >= 0");
 }
 
+ClusterUnion partly_cut_runs(const std::vector<ClosureCluster>& clusters) {
+  ClusterUnion out;
+  for (const ClosureCluster& c : clusters)
+    if (c.rejected_in_run > 0) {
+      out.parts.push_back(c);
+      out.members.insert(out.members.end(), c.members.begin(), c.members.end());
+    }
+  if (out.parts.size() < 2) return {};
+  std::sort(out.members.begin(), out.members.end());
+  return out;
+}
+
 bool clusters_meet(const ClosureCluster& a, const ClosureCluster& b, int near) {
   // Two id ranges meet when the gap between them is at most `near`.
   auto gap = [](std::size_t f1, std::size_t l1, std::size_t f2, std::size_t l2) {

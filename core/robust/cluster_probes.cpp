@@ -12,10 +12,7 @@ namespace tessera {
 namespace {
 
 // A probe: the clusters it cuts together, and their members (ascending).
-struct Probe {
-  std::vector<ClosureCluster> parts;
-  std::vector<std::size_t> members;
-};
+using Probe = ClusterUnion;
 
 }  // namespace
 
@@ -126,14 +123,16 @@ ClusterProbeCounts search_cluster_probes(
         continue;
       }
     }
-    Probe probe;
-    for (const ClosureCluster& c : rules.cut_clusters
-                                       ? closure_clusters(graph, known, rejected, clusters)
-                                       : std::vector<ClosureCluster>{})
-      if (untried(c.members)) {
+    const std::vector<ClosureCluster> listed =
+        rules.cut_clusters ? closure_clusters(graph, known, rejected, clusters)
+                           : std::vector<ClosureCluster>{};
+    // First every run GNC partly cut, together (partly_cut_runs); then one run at a time.
+    Probe probe = partly_cut_runs(listed);
+    if (!untried(probe.members)) probe = {};
+    for (const ClosureCluster& c : listed)
+      if (probe.members.empty() && untried(c.members)) {
         probe.parts = {c};
         probe.members = c.members;
-        break;
       }
     if (probe.members.empty() && !raised.empty()) {
       std::stable_sort(raised.begin(), raised.end(),
@@ -178,14 +177,14 @@ ClusterProbeCounts search_cluster_probes(
     // random 0.1: r^2 47.5 against c^2 = 46.6, 8.1 at the clean optimum; intel, group 0.1: 71.9
     // against 32.8, 4.3 there); when one of several returned together is wrong, the passes cut it
     // again or the TLS cost refuses the lot, and the closures alone remain.
-    const std::vector<std::size_t> listed = band();
+    const std::vector<std::size_t> returnable = band();
     std::vector<std::size_t> back;
-    if (listed.size() > 1 && !returned_together) {
+    if (returnable.size() > 1 && !returned_together) {
       returned_together = true;
-      back = listed;
+      back = returnable;
       std::sort(back.begin(), back.end());
     } else {
-      for (std::size_t e : listed)
+      for (std::size_t e : returnable)
         if (std::find(returned_alone.begin(), returned_alone.end(), e) == returned_alone.end()) {
           back = {e};
           returned_alone.push_back(e);

@@ -3,7 +3,8 @@
 // cluster_probes, RobustOptions::probe_return_ratio): which set to try next, and when to stop.
 // A probe cuts the kept closures far above the median residual while the rejected ones just
 // beyond the bound come back (a tail probe), or cuts a run of kept closures (closure_clusters.hpp),
-// or several runs that share a stretch, or takes back rejected closures just beyond the bound
+// or several runs that share a stretch (first every run GNC partly cut, together), or takes back
+// rejected closures just beyond the bound
 // (all of them together, then one at a time; together first right after a kept probe, whose cut
 // may have let true closures back within reach); the caller solves the kept set from there (with
 // the re-check passes) and the result stays only when the TLS cost over every measurement falls.

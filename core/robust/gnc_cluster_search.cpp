@@ -48,8 +48,12 @@ bool GncClusterSearch::untried(const std::vector<std::size_t>& members) const {
 std::optional<GncClusterSearch::Probe> GncClusterSearch::next_cluster(
     const std::vector<std::uint64_t>& rejected) const {
   const std::vector<std::size_t> cut(rejected.begin(), rejected.end());
-  // One cluster that was not tried since the set last changed, most rejected closures near first.
-  for (const ClosureCluster& c : closure_clusters(skeleton_, known_, cut, clusters_))
+  const std::vector<ClosureCluster> listed = closure_clusters(skeleton_, known_, cut, clusters_);
+  // First every run GNC partly cut, together (partly_cut_runs).
+  Probe partly = partly_cut_runs(listed);
+  if (!partly.members.empty() && untried(partly.members)) return partly;
+  // One cluster that was not tried since the set last changed, in closure_clusters' order.
+  for (const ClosureCluster& c : listed)
     if (untried(c.members)) return Probe{{c}, c.members};
   if (raised_.empty()) return std::nullopt;
   // Two runs that share a stretch can hold one bend together, so that cutting either alone

@@ -2,8 +2,9 @@
 // Which probe the distributed GNC runs next after its re-check passes when cluster probes are on
 // (GncDistributedOptions::cluster_probes): the distributed counterpart of the centralized search
 // (cluster_probes.hpp), in the same order. First a tail probe (the kept measurements the agents
-// name by their own residual tails leave, the return band comes back), then one cluster of kept
-// closures side by side at a time (closure_clusters.hpp), then two clusters that share a stretch
+// name by their own residual tails leave, the return band comes back), then every run GNC
+// partly cut together, then one cluster of kept closures side by side at a time
+// (closure_clusters.hpp), then two clusters that share a stretch
 // together (each raised the TLS cost alone), last the return band together, then one closure of
 // it at a time. Each probe is judged by the summed TLS cost (GncProbes::keeps); a kept one makes
 // every kind possible again, the return band together first.
@@ -55,10 +56,7 @@ class GncClusterSearch {
   int probes() const { return used_; }  ///< Cluster, pair and return probes.
 
  private:
-  struct Probe {
-    std::vector<ClosureCluster> parts;
-    std::vector<std::size_t> members;  // ascending
-  };
+  using Probe = ClusterUnion;  // the runs a probe cuts, and their members (ascending)
   bool untried(const std::vector<std::size_t>& members) const;
   std::optional<Probe> next_cluster(const std::vector<std::uint64_t>& rejected) const;
 

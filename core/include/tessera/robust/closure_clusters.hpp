@@ -41,6 +41,17 @@ struct ClosureCluster {
   std::size_t lo_first = 0, lo_last = 0, hi_first = 0, hi_last = 0;
 };
 
+/// Runs cut together by one probe: the clusters and their members (ascending).
+struct ClusterUnion {
+  std::vector<ClosureCluster> parts;
+  std::vector<std::size_t> members;
+};
+
+/// Every cluster of `clusters` that GNC partly cut (rejected_in_run > 0), as one probe; empty
+/// when there are fewer than two. Wrong runs that share stretches hold one bend together, and
+/// cutting one of them alone leaves the bend to the others (intel, group 0.75).
+ClusterUnion partly_cut_runs(const std::vector<ClosureCluster>& clusters);
+
 /// True when a stretch of `a` and a stretch of `b` lie within `near` pose ids of each other: two
 /// runs that share a stretch can hold one bend of the map together.
 bool clusters_meet(const ClosureCluster& a, const ClosureCluster& b, int near);
